@@ -1,0 +1,21 @@
+# add_module_library(NAME SRCS a.cc b.cc DEPS other libs)
+#   One static library per module folder, headers beside sources, included as "module/foo.h".
+function(add_module_library name)
+  cmake_parse_arguments(ARG "" "" "SRCS;DEPS" ${ARGN})
+  add_library(blurcue_${name} STATIC ${ARG_SRCS})
+  target_include_directories(blurcue_${name} PUBLIC ${PROJECT_SOURCE_DIR}/src)
+  target_link_libraries(blurcue_${name} PUBLIC ${ARG_DEPS})
+  target_compile_options(blurcue_${name} PRIVATE -Wall -Wextra -Wno-array-bounds)  # GCC 12 false positive in nlohmann/json
+endfunction()
+
+# add_module_test(NAME SRCS a_test.cc DEPS libs [LABELS gl slow])
+#   One GoogleTest executable, registered with CTest test by test.
+function(add_module_test name)
+  cmake_parse_arguments(ARG "" "" "SRCS;DEPS;LABELS" ${ARGN})
+  add_executable(${name} ${ARG_SRCS})
+  target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest_main)
+  target_compile_options(${name} PRIVATE -Wall -Wextra -Wno-array-bounds)
+  include(GoogleTest)
+  gtest_discover_tests(${name} WORKING_DIRECTORY ${PROJECT_BINARY_DIR}
+                       PROPERTIES LABELS "${ARG_LABELS}" DISCOVERY_TIMEOUT 60)
+endfunction()

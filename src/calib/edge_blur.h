@@ -1,0 +1,60 @@
+#pragma once
+// Blur measurement on one straight black/white edge section of a photo (thesis section 4.3), two ways:
+//  - the thesis's own method (the anchor every better method is compared against), and
+//  - a robust model fit in linear light.
+// Both return r in the DESIGN.md unit: 2 x the standard deviation of the optical line-spread function.
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace blurcue::calib {
+
+// One edge section in image pixels.
+struct EdgeSegment {
+  cv::Point2d a, b;          // end points (the square corners bounding the section)
+  double half_window_px = 0; // how far across the edge samples may reach on each side
+                             // (about half the image distance to the neighbouring parallel edge)
+};
+
+struct ModelFitOptions {
+  double along_fraction = 0.5;   // use the central part of the section (avoids the X-junctions at its ends)
+  double min_contrast = 0.03;    // |step| in linear light below this: "low_contrast"
+  double max_rms_rel = 0.08;     // fit residual rms / |step| above this: "poor_fit"
+  double saturation_level = 0.99;// linear value at or above which a sample counts as clipped
+  double max_saturated_fraction = 0.05;
+};
+
+struct ModelFit {
+  bool ok = false;                 // usable: none of the disqualifying flags below
+  std::vector<std::string> flags;  // "low_contrast", "saturated", "crowded", "poor_fit", "too_few_pixels"
+                                   // disqualify; "flaw" (robustly rejected outliers) is informational
+  double r_px = 0;                 // optical blur radius, pixel aperture removed
+  std::string psf;                 // "disc" or "gaussian": the family that fit better
+  double offset_px = 0;            // fitted edge position along the normal, relative to the segment line
+  double step = 0;                 // signed step in linear light (dark->bright along the normal is > 0)
+  double rms_rel = 0;              // residual rms / |step|
+  int samples = 0;                 // pixels used
+};
+
+// `linear` is a one-channel CV_32F image in linear light [0, 1].
+ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, const ModelFitOptions& options = {});
+
+struct ThesisOptions {
+  int sma_n = 5;             // simple-moving-average length, eq. 4.1
+  double threshold = 1.0;    // grey levels per pixel
+  int max_profile_px = 200;  // "around 200 pixels" per profile
+};
+
+struct ThesisMeasure {
+  bool ok = false;  // false when no gradient sample exceeds the threshold
+  double r_px = 0;  // half the count of contiguous above-threshold gradient samples around the peak
+  int count = 0;
+};
+
+// The thesis's method on the 8-bit grey image as stored (gamma-encoded, as the thesis did): one profile
+// perpendicular to the edge through the section midpoint, SMA-smoothed, gradient, count of contiguous pixels
+// whose |gradient| exceeds the threshold around the peak, halved.
+ThesisMeasure MeasureEdgeThesis(const cv::Mat& grey8, const EdgeSegment& segment, const ThesisOptions& options = {});
+
+}  // namespace blurcue::calib

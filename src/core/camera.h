@@ -1,0 +1,45 @@
+#pragma once
+// The camera description every module shares: optics (focal length, f-number, sensor) and the image it makes.
+#include <array>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/json_io.h"
+
+namespace blurcue {
+
+struct Camera {
+  double focal_length_mm = 0;
+  double f_number = 0;
+  double sensor_width_mm = 0;
+  double sensor_height_mm = 0;
+  int image_width_px = 0;
+  int image_height_px = 0;
+  // Row-major 3x3 intrinsics in pixels when a lens calibration exists; otherwise derived from the optics.
+  std::optional<std::array<double, 9>> camera_matrix;
+  std::vector<double> dist_coeffs;  // OpenCV order (k1 k2 p1 p2 [k3 ...]); empty = none
+
+  // mm per pixel on the sensor (the thesis's sigma): sensor width / image width.
+  double PixelPitchMm() const { return sensor_width_mm / image_width_px; }
+  // Aperture diameter D = f / N in mm.
+  double ApertureMm() const { return focal_length_mm / f_number; }
+  // camera_matrix if given, else fx = fy = f / pitch and the principal point at the image centre.
+  std::array<double, 9> Intrinsics() const;
+  // The same camera with the image resampled to width x height (intrinsics scaled, optics unchanged).
+  Camera Resized(int width_px, int height_px) const;
+
+  // Throws Error(kInput) "where/field: must be ..., got ..." for the first impossible value.
+  void Validate(const std::string& where) const;
+};
+
+Camera CameraFromJson(const Json& json, const std::string& where);
+Json CameraToJson(const Camera& camera);
+// Reads and validates camera.json; errors name the file and the field.
+Camera LoadCamera(const std::filesystem::path& path);
+
+// The thesis's camera (Table 4.1/4.2): f = 21 mm, f/5.6, 23.4 x 15.6 mm sensor, 4592 x 3056 px.
+Camera ThesisCamera();
+
+}  // namespace blurcue

@@ -1,0 +1,24 @@
+#pragma once
+// Images on disk and linear light. Blur and measurement happen in linear light (DESIGN.md): decode sRGB first.
+#include <filesystem>
+
+#include <opencv2/core.hpp>
+
+namespace blurcue {
+
+// Reads an image as 8-bit BGR or grey as stored; throws Error(kInput) naming the file when unreadable.
+cv::Mat ReadImage(const std::filesystem::path& path, int flags = -1 /* cv::IMREAD_UNCHANGED */);
+// Writes via a temporary file and rename; creates the folder; throws naming the file on failure.
+void WriteImage(const std::filesystem::path& path, const cv::Mat& image);
+
+// sRGB transfer function, one channel value in [0, 1].
+double SrgbToLinear(double v);
+double LinearToSrgb(double v);
+// 8-bit sRGB (any channel count) -> CV_32F linear in [0, 1] with a 256-entry table.
+cv::Mat DecodeSrgb8(const cv::Mat& srgb8);
+// CV_32F linear (clamped to [0, 1]) -> 8-bit sRGB, rounded.
+cv::Mat EncodeSrgb8(const cv::Mat& linear);
+// 8-bit BGR/BGRA/grey -> one-channel 8-bit grey (as stored: gamma-encoded).
+cv::Mat ToGrey8(const cv::Mat& image);
+
+}  // namespace blurcue

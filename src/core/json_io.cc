@@ -1,0 +1,51 @@
+#include "core/json_io.h"
+
+#include <fstream>
+#include <sstream>
+
+#include "core/error.h"
+
+namespace blurcue {
+
+Json ReadJsonFile(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path.string(), "cannot open file");
+  try {
+    return Json::parse(in);
+  } catch (const Json::parse_error& e) {
+    throw InputError(path.string(), std::string("not valid JSON: ") + e.what());
+  }
+}
+
+void WriteJsonFile(const std::filesystem::path& path, const Json& json) {
+  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
+  const std::filesystem::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) throw InputError(path.string(), "cannot write file");
+    out << json.dump(2) << "\n";
+    if (!out) throw InputError(path.string(), "write failed");
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+static const Json& RequireField(const Json& obj, const std::string& key, const std::string& where) {
+  if (!obj.is_object()) throw InputError(where, "must be an object, got " + obj.dump());
+  auto it = obj.find(key);
+  if (it == obj.end()) throw InputError(where + "/" + key, "is required but missing");
+  return *it;
+}
+
+double RequireNumber(const Json& obj, const std::string& key, const std::string& where) {
+  const Json& v = RequireField(obj, key, where);
+  if (!v.is_number()) throw InputError(where + "/" + key, "must be a number, got " + v.dump());
+  return v.get<double>();
+}
+
+int RequireInt(const Json& obj, const std::string& key, const std::string& where) {
+  const Json& v = RequireField(obj, key, where);
+  if (!v.is_number_integer()) throw InputError(where + "/" + key, "must be an integer, got " + v.dump());
+  return v.get<int>();
+}
+
+}  // namespace blurcue

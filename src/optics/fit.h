@@ -1,0 +1,42 @@
+#pragma once
+// A thin-lens model fitted to many measured (u, r) pairs, so an estimate need not hang on one reference edge.
+#include <string>
+#include <vector>
+
+#include "optics/thin_lens.h"
+
+namespace blurcue::optics {
+
+struct BlurSample {
+  double u_mm = 0;
+  double r_px = 0;      // measured blur radius (unsigned)
+  double weight = 1.0;  // e.g. the measurement's confidence; 0 drops the sample
+};
+
+struct FitOptions {
+  // Huber threshold in px for the robust loss (residuals beyond it count linearly, not squared).
+  double huber_px = 0.5;
+  // Also fit a blur floor r0 added in quadrature, r = sqrt(r_thin_lens^2 + r0^2) (residual optics blur that the
+  // thin lens does not explain). Kept only when it lowers the leave-one-out error: model no more than needed.
+  bool allow_floor = true;
+};
+
+struct FittedModel {
+  double focus_mm = 0;     // u0, may be +infinity
+  double aperture_mm = 0;  // effective D (the thin lens's D when the optics are ideal)
+  double floor_px = 0;     // r0, 0 when the simpler model was kept
+  double rms_px = 0;       // robust fit residual
+  double loo_rms_px = 0;   // leave-one-out prediction error of the kept model
+  int samples_used = 0;    // with weight > 0
+  int outliers = 0;        // samples whose residual exceeds 3 huber_px at the optimum
+  std::string kind;        // "thin_lens" or "thin_lens+floor"
+
+  // Predicted unsigned radius at depth u (px), with the lens's f and pitch.
+  double PredictPx(const Lens& lens, double u_mm) const;
+};
+
+// Robust least squares over (focus, aperture[, floor]). Throws Error(kNotFound) with fewer than 3 usable samples
+// or samples all at one depth.
+FittedModel FitThinLens(const Lens& lens, const std::vector<BlurSample>& samples, const FitOptions& options = {});
+
+}  // namespace blurcue::optics

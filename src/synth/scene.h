@@ -1,0 +1,70 @@
+#pragma once
+// Ground-truth scenes: a checkerboard lying on a table, photographed through a thin lens with known blur.
+// Everything is rendered in linear light and encoded to sRGB at the end, like a camera's JPEG/PNG.
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/board.h"
+#include "core/camera.h"
+#include "core/json_io.h"
+
+namespace blurcue::synth {
+
+enum class Psf { kDisc, kGaussian };
+
+struct SceneOptions {
+  // Thesis set-up (Table 4.2) at a quarter of its 4592 x 3056 resolution, so the default renders in seconds.
+  Camera camera = ThesisCamera().Resized(1148, 764);
+  Board board;
+  double tilt_deg = 38;        // camera pitched down from the horizontal (the thesis's "tilting angle")
+  double edge1_u_mm = 342.3;   // depth (camera z) of the midpoint of edge 1
+  double lateral_mm = 0;       // board shifted sideways (board x) from the optical axis
+  double yaw_deg = 0;          // board turned about the table normal (0: edges parallel to the image rows)
+  // Focus distance (camera z, mm); NaN = on edge 1, as in the thesis; +infinity allowed.
+  double focus_mm = std::numeric_limits<double>::quiet_NaN();
+  // When set, every pixel gets this blur radius instead of the thin lens's (for measurement tests).
+  std::optional<double> fixed_r_px;
+  double blur_gain = 1.0;      // multiplies every thin-lens radius (a lens blurrier than ideal)
+  Psf psf = Psf::kDisc;
+  double white = 0.80;         // linear reflectance x exposure of the white squares
+  double black = 0.04;         // ... of the black squares
+  double table = 0.30;         // mean of the (textured) table
+  double noise_std = 0.0;      // Gaussian sensor noise, linear units, plus shot noise of the same scale at white
+  int jpeg_quality = 0;        // 0: none; 1..100: JPEG round trip before writing PNG
+  int flaws = 0;               // dark printing spots on white squares near edges (thesis Fig. 4.15)
+  uint64_t seed = 1;
+  int supersample = 4;         // sub-pixels per pixel side for anti-aliasing and the PSF
+};
+
+struct SectionTruth {
+  int edge = 0;      // 1-based
+  int section = 0;   // 1-based
+  double u_mm = 0;   // camera z of the midpoint
+  double r_px = 0;   // true optical blur radius at the midpoint (DESIGN.md unit; excludes pixel area)
+  bool flawed = false;  // a printing flaw touches this section
+};
+
+struct Scene {
+  cv::Mat image;           // 8-bit BGR sRGB, with board
+  cv::Mat image_no_board;  // the same view with only the table
+  Camera camera;
+  Board board;
+  cv::Vec3d rvec, tvec;    // board frame -> camera (OpenCV convention), mm
+  double focus_mm = 0;
+  std::vector<SectionTruth> sections;  // edge-major: edges 1..E, sections 1..S
+  Json truth;              // everything above plus the options, as written to truth.json
+};
+
+// Throws Error(kInput) for impossible options (board not in view, focus <= f, ...), naming the option.
+Scene RenderScene(const SceneOptions& options);
+
+// Writes DIR/scene.png, DIR/scene-no-board.png, DIR/camera.json, DIR/truth.json.
+void WriteScene(const Scene& scene, const std::filesystem::path& dir);
+
+}  // namespace blurcue::synth
