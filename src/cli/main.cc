@@ -1,1 +1,48 @@
-int main() { return 0; }
+// blurcue: measure the defocus blur of a real scene, predict it anywhere, render and run depth-cue studies.
+#include <iostream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <opencv2/core.hpp>
+
+#include "cli/commands.h"
+#include "core/error.h"
+
+int main(int argc, char** argv) {
+  using namespace blurcue;
+  CLI::App app{"blurcue " BLURCUE_VERSION
+               " - blur as a depth cue: calibrate a scene's defocus blur, predict it anywhere, run studies.\n"
+               "Typical flow: synth-scene (or a photo + camera.json) -> calibrate -> estimate.\n"
+               "Run 'blurcue COMMAND --help' for the options of one command."};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("blurcue ") + BLURCUE_VERSION);
+
+  // The command table: one entry per subcommand, each in its own file under src/cli/.
+  const std::vector<std::pair<const char*, void (*)(CLI::App&)>> commands = {
+      {"synth-scene", &cli::AddSynthSceneCommand},
+      {"calibrate", &cli::AddCalibrateCommand},
+      {"estimate", &cli::AddEstimateCommand},
+      {"bench", &cli::AddBenchCommand},
+  };
+  for (const auto& [name, add] : commands) add(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() != 0) std::cerr << "blurcue: ";
+    const int code = app.exit(e);
+    return code == 0 ? 0 : static_cast<int>(ErrorKind::kUsage);
+  } catch (const Error& e) {
+    std::cerr << "blurcue: " << e.what() << "\n";
+    return e.exit_code();
+  } catch (const cv::Exception& e) {
+    std::cerr << "blurcue: OpenCV: " << e.err << " (" << e.func << ")\n";
+    return static_cast<int>(ErrorKind::kInternal);
+  } catch (const std::exception& e) {
+    std::cerr << "blurcue: " << e.what() << "\n";
+    return static_cast<int>(ErrorKind::kInternal);
+  }
+  return 0;
+}

@@ -1,0 +1,13 @@
+#pragma once
+// The subcommands of `blurcue`. Each Add* registers one CLI11 subcommand whose callback does the work and throws
+// blurcue::Error on failure; main() turns that into one line on stderr and the error's exit code.
+#include <CLI/CLI.hpp>
+
+namespace blurcue::cli {
+
+void AddEstimateCommand(CLI::App& app);     // estimate_command.cc
+void AddSynthSceneCommand(CLI::App& app);   // synth_scene_command.cc
+void AddCalibrateCommand(CLI::App& app);    // calibrate_command.cc
+void AddBenchCommand(CLI::App& app);        // bench_command.cc
+
+}  // namespace blurcue::cli
