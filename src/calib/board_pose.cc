@@ -1,0 +1,113 @@
+#include "calib/board_pose.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/error.h"
+
+namespace blurcue::calib {
+
+cv::Matx33d CameraMatrix(const Camera& camera) {
+  const auto k = camera.Intrinsics();
+  return cv::Matx33d(k.data());
+}
+
+cv::Vec3d ToCamera(const BoardPose& pose, const std::array<double, 3>& p) {
+  cv::Matx33d rot;
+  cv::Rodrigues(pose.rvec, rot);
+  return rot * cv::Vec3d(p[0], p[1], p[2]) + pose.tvec;
+}
+
+std::vector<cv::Point2d> Project(const BoardPose& pose, const Camera& camera,
+                                 const std::vector<std::array<double, 3>>& board_mm) {
+  std::vector<cv::Point3d> object;
+  object.reserve(board_mm.size());
+  for (const auto& p : board_mm) object.emplace_back(p[0], p[1], p[2]);
+  std::vector<cv::Point2d> image;
+  if (object.empty()) return image;
+  cv::projectPoints(object, pose.rvec, pose.tvec, CameraMatrix(camera), camera.dist_coeffs, image);
+  return image;
+}
+
+namespace {
+
+// Solves the pose for inner corners given in board order; returns the RMS reprojection error.
+double SolvePose(const std::vector<cv::Point2f>& corners, const Board& board, const Camera& camera,
+                 cv::Vec3d& rvec, cv::Vec3d& tvec) {
+  std::vector<cv::Point3f> object;
+  for (int iy = 0; iy < board.InnerCornersY(); ++iy)
+    for (int ix = 0; ix < board.InnerCornersX(); ++ix)
+      object.emplace_back(float((ix + 1) * board.square_mm), float((iy + 1) * board.square_mm), 0.f);
+  const cv::Matx33d k = CameraMatrix(camera);
+  // IPPE is the closed-form solver for planar targets; LM then polishes it.
+  cv::solvePnP(object, corners, k, camera.dist_coeffs, rvec, tvec, false, cv::SOLVEPNP_IPPE);
+  cv::solvePnPRefineLM(object, corners, k, camera.dist_coeffs, rvec, tvec);
+  std::vector<cv::Point2f> reprojected;
+  cv::projectPoints(object, rvec, tvec, k, camera.dist_coeffs, reprojected);
+  double sum = 0;
+  for (size_t i = 0; i < corners.size(); ++i) {
+    const cv::Point2f d = corners[i] - reprojected[i];
+    sum += d.dot(d);
+  }
+  return std::sqrt(sum / corners.size());
+}
+
+}  // namespace
+
+BoardPose FindBoardPose(const cv::Mat& grey8, const Camera& camera, const Board& board,
+                        const DetectOptions& options) {
+  CV_Assert(grey8.type() == CV_8UC1);
+  const int nx = board.InnerCornersX(), ny = board.InnerCornersY();
+  const cv::Size pattern(nx, ny);
+
+  // Detection cost grows with pixels; the corners' rough places do not need them all.
+  const double scale = std::min(1.0, double(options.detect_max_side_px) / std::max(grey8.cols, grey8.rows));
+  cv::Mat small = grey8;
+  if (scale < 1.0) cv::resize(grey8, small, cv::Size(), scale, scale, cv::INTER_AREA);
+  std::vector<cv::Point2f> found;
+  bool ok = cv::findChessboardCornersSB(small, pattern, found, cv::CALIB_CB_NORMALIZE_IMAGE);
+  if (!ok)
+    ok = cv::findChessboardCorners(small, pattern, found,
+                                   cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE);
+  if (!ok || int(found.size()) != nx * ny)
+    throw Error(ErrorKind::kNotFound, "no " + board.Name() + " checkerboard found (looked for " +
+                                          std::to_string(nx) + "x" + std::to_string(ny) + " inner corners)");
+  for (auto& p : found) p *= 1.0 / scale;
+
+  // Refine at full resolution with a window a quarter of the corner spacing: wide enough for blurred corners,
+  // narrow enough not to reach the next corner.
+  double spacing = 1e9;
+  for (int iy = 0; iy < ny; ++iy)
+    for (int ix = 0; ix + 1 < nx; ++ix)
+      spacing = std::min(spacing, double(cv::norm(found[iy * nx + ix + 1] - found[iy * nx + ix])));
+  const int half = std::clamp(int(spacing / 4), 2, 40);
+  cv::cornerSubPix(grey8, found, cv::Size(half, half), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 40, 0.01));
+
+  // OpenCV returns ny rows of nx corners in one of four orders; put them in the board frame: y (rows) away from
+  // the camera so edge 1 is the nearest, x left to right in the image.
+  auto at = [&](int ix, int iy, bool flip_x, bool flip_y) {
+    return found[(flip_y ? ny - 1 - iy : iy) * nx + (flip_x ? nx - 1 - ix : ix)];
+  };
+  auto ordered = [&](bool flip_x, bool flip_y) {
+    std::vector<cv::Point2f> c;
+    for (int iy = 0; iy < ny; ++iy)
+      for (int ix = 0; ix < nx; ++ix) c.push_back(at(ix, iy, flip_x, flip_y));
+    return c;
+  };
+  const bool flip_x = at(nx - 1, 0, false, false).x < at(0, 0, false, false).x;
+  BoardPose pose;
+  pose.corners = ordered(flip_x, false);
+  SolvePose(pose.corners, board, camera, pose.rvec, pose.tvec);
+  const double z_first = ToCamera(pose, {0, board.square_mm, 0})[2];
+  const double z_last = ToCamera(pose, {0, ny * board.square_mm, 0})[2];
+  // Flipping the row order alone keeps x left to right; with y away from the camera, z = x cross y points up.
+  if (z_last < z_first) pose.corners = ordered(flip_x, true);
+  pose.reprojection_error_px = SolvePose(pose.corners, board, camera, pose.rvec, pose.tvec);
+  return pose;
+}
+
+}  // namespace blurcue::calib

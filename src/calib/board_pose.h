@@ -1,0 +1,36 @@
+#pragma once
+// Finding the printed checkerboard in a photo and solving the camera pose (thesis section 4.2).
+#include <array>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/board.h"
+#include "core/camera.h"
+
+namespace blurcue::calib {
+
+struct BoardPose {
+  cv::Vec3d rvec, tvec;               // board frame (core/board.h) -> camera, mm
+  double reprojection_error_px = 0;   // RMS over the inner corners
+  // Inner corners in board order: index iy * (cols - 1) + ix is the corner at ((ix + 1) s, (iy + 1) s).
+  std::vector<cv::Point2f> corners;
+};
+
+struct DetectOptions {
+  int detect_max_side_px = 1400;  // detect on a copy no larger than this, then refine at full resolution
+};
+
+// Finds the board in an 8-bit grey photo, orders its corners in the board frame (edge 1 = nearest the camera)
+// and solves the pose with the camera's intrinsics. Throws Error(kNotFound) when no board of this size is seen.
+BoardPose FindBoardPose(const cv::Mat& grey8, const Camera& camera, const Board& board,
+                        const DetectOptions& options = {});
+
+cv::Matx33d CameraMatrix(const Camera& camera);
+// Board-frame point (mm) -> camera frame (mm).
+cv::Vec3d ToCamera(const BoardPose& pose, const std::array<double, 3>& board_mm);
+// Board-frame points (mm) -> image pixels, with the camera's distortion.
+std::vector<cv::Point2d> Project(const BoardPose& pose, const Camera& camera,
+                                 const std::vector<std::array<double, 3>>& board_mm);
+
+}  // namespace blurcue::calib

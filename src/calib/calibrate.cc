@@ -1,0 +1,213 @@
+#include "calib/calibrate.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include <opencv2/imgproc.hpp>
+
+#include "core/error.h"
+#include "core/image.h"
+#include "optics/thin_lens.h"
+
+namespace blurcue::calib {
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// Linear-light grey of an 8-bit sRGB photo: decode each channel first, then mix (mixing encoded values would
+// bend edges).
+cv::Mat LinearGrey(const cv::Mat& photo) {
+  cv::Mat linear = DecodeSrgb8(photo);
+  if (linear.channels() == 1) return linear;
+  cv::Mat grey;
+  cv::cvtColor(linear, grey, linear.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+  return grey;
+}
+
+}  // namespace
+
+CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& board,
+                      const CalibrateOptions& options) {
+  if (photo.cols != camera.image_width_px || photo.rows != camera.image_height_px)
+    throw InputError("camera /image_width_px, /image_height_px",
+                     "say " + std::to_string(camera.image_width_px) + "x" + std::to_string(camera.image_height_px) +
+                         " but the photo is " + std::to_string(photo.cols) + "x" + std::to_string(photo.rows));
+  if (options.reference_edge < 1 || options.reference_edge > board.EdgeCount())
+    throw Error(ErrorKind::kUsage, "--reference-edge must be 1.." + std::to_string(board.EdgeCount()) + ", got " +
+                                       std::to_string(options.reference_edge));
+  CalibResult result;
+  result.camera = camera;
+  result.board = board;
+  result.reference_edge = options.reference_edge;
+
+  auto t0 = std::chrono::steady_clock::now();
+  const cv::Mat grey8 = ToGrey8(photo);
+  result.pose = FindBoardPose(grey8, camera, board, options.detect);
+  result.detect_ms = MsSince(t0);
+
+  // Geometry of every section: end points in the photo and 3-D midpoint.
+  t0 = std::chrono::steady_clock::now();
+  const cv::Mat linear = LinearGrey(photo);
+  const int E = board.EdgeCount(), S = board.SectionCount();
+  std::vector<std::array<double, 3>> points;  // per section: start, end, midpoint
+  for (int e = 1; e <= E; ++e)
+    for (int s = 1; s <= S; ++s) {
+      points.push_back(board.SectionStart(e, s));
+      points.push_back(board.SectionEnd(e, s));
+      points.push_back(board.SectionMidpoint(e, s));
+    }
+  const std::vector<cv::Point2d> px = Project(result.pose, camera, points);
+  auto mid_px = [&](int e, int s) { return px[((e - 1) * S + (s - 1)) * 3 + 2]; };
+
+  for (int e = 1; e <= E; ++e) {
+    EdgeResult edge;
+    edge.index = e;
+    for (int s = 1; s <= S; ++s) {
+      const size_t i = ((e - 1) * S + (s - 1)) * 3;
+      SectionResult sec;
+      sec.edge = e;
+      sec.section = s;
+      sec.a_px = px[i];
+      sec.b_px = px[i + 1];
+      sec.midpoint_camera_mm = ToCamera(result.pose, points[i + 2]);
+      sec.u_mm = sec.midpoint_camera_mm[2];
+      // Half the distance to the nearest parallel edge in the photo bounds how far across the edge we may look.
+      const cv::Point2d m = px[i + 2];
+      double gap = 1e9;
+      if (e > 1) gap = std::min(gap, cv::norm(m - mid_px(e - 1, s)));
+      if (e < E) gap = std::min(gap, cv::norm(m - mid_px(e + 1, s)));
+      EdgeSegment seg{sec.a_px, sec.b_px, 0.5 * gap};
+      sec.fit = MeasureEdgeModel(linear, seg, options.model_fit);
+      sec.thesis = MeasureEdgeThesis(grey8, seg, options.thesis);
+      edge.sections.push_back(sec);
+    }
+    result.edges.push_back(std::move(edge));
+  }
+  result.measure_ms = MsSince(t0);
+
+  // Estimation: eq. 3.7 from the reference edge, and a thin-lens model fitted to every usable section.
+  t0 = std::chrono::steady_clock::now();
+  const optics::Lens lens = optics::Lens::FromCamera(camera);
+  EdgeResult& ref = result.edges[options.reference_edge - 1];
+  std::vector<double> ref_r, ref_u;
+  for (const auto& s : ref.sections)
+    if (s.fit.ok) ref_r.push_back(s.fit.r_px), ref_u.push_back(s.u_mm);
+  if (ref_r.empty())
+    throw Error(ErrorKind::kNotFound, "reference edge " + std::to_string(options.reference_edge) +
+                                          " has no usable section (all flagged); choose another --reference-edge");
+  // The median resists a flawed section; the thesis averaged its 7 sections.
+  result.reference_r_px = Median(ref_r);
+  result.reference_u_mm = Median(ref_u);
+
+  std::vector<optics::BlurSample> samples;
+  for (const auto& edge : result.edges)
+    for (const auto& s : edge.sections)
+      if (s.fit.ok) samples.push_back({s.u_mm, s.fit.r_px, 1.0});
+  result.model = optics::FitThinLens(lens, samples, options.optics_fit);
+
+  for (auto& edge : result.edges) {
+    double su = 0;
+    for (auto& s : edge.sections) {
+      su += s.u_mm;
+      try {
+        s.r_estimated_px = optics::Eq37Px(lens, result.reference_u_mm, result.reference_r_px, s.u_mm);
+      } catch (const Error& e) {
+        if (e.kind() != ErrorKind::kDomain) throw;
+        s.estimated_note = e.what();
+      }
+      s.r_fitted_px = result.model.PredictPx(lens, s.u_mm);
+      if (s.fit.ok) {
+        ++edge.usable;
+        edge.r_px += s.fit.r_px;
+        edge.r_thesis_px += s.thesis.r_px;
+        edge.r_estimated_px += s.r_estimated_px.value_or(0);
+        edge.r_fitted_px += s.r_fitted_px;
+      }
+    }
+    edge.u_mm = su / edge.sections.size();
+    if (edge.usable > 0) {
+      edge.r_px /= edge.usable;
+      edge.r_thesis_px /= edge.usable;
+      edge.r_estimated_px /= edge.usable;
+      edge.r_fitted_px /= edge.usable;
+    }
+  }
+  result.estimate_ms = MsSince(t0);
+  return result;
+}
+
+Json CalibToJson(const CalibResult& r) {
+  auto vec = [](const cv::Vec3d& v) { return Json::array({v[0], v[1], v[2]}); };
+  auto opt = [](const std::optional<double>& v) { return v ? Json(*v) : Json(nullptr); };
+  Json edges = Json::array();
+  for (const auto& e : r.edges) {
+    Json sections = Json::array();
+    for (const auto& s : e.sections) {
+      Json js = {{"index", s.section},
+                 {"u_mm", s.u_mm},
+                 {"midpoint_camera_mm", vec(s.midpoint_camera_mm)},
+                 {"image_px", {{s.a_px.x, s.a_px.y}, {s.b_px.x, s.b_px.y}}},
+                 {"r_px", s.fit.r_px},
+                 {"r_thesis_px", s.thesis.r_px},
+                 {"r_estimated_px", opt(s.r_estimated_px)},
+                 {"r_fitted_px", s.r_fitted_px},
+                 {"ok", s.fit.ok},
+                 {"flags", s.fit.flags},
+                 {"psf", s.fit.psf},
+                 {"fit_rms_rel", s.fit.rms_rel},
+                 {"step_linear", s.fit.step},
+                 {"thesis_ok", s.thesis.ok}};
+      if (!s.estimated_note.empty()) js["r_estimated_note"] = s.estimated_note;
+      sections.push_back(js);
+    }
+    edges.push_back({{"index", e.index}, {"u_mm", e.u_mm}, {"usable_sections", e.usable}, {"sections", sections}});
+  }
+  const auto& m = r.model;
+  return {
+      {"format", "blurcue-calib"},
+      {"version", 1},
+      {"software", std::string("blurcue ") + BLURCUE_VERSION},
+      {"camera", CameraToJson(r.camera)},
+      {"board", {{"cols", r.board.cols}, {"rows", r.board.rows}, {"square_mm", r.board.square_mm}}},
+      {"pose", {{"rvec", vec(r.pose.rvec)}, {"tvec", vec(r.pose.tvec)},
+                {"reprojection_error_px", r.pose.reprojection_error_px}}},
+      {"reference_edge", r.reference_edge},
+      {"reference", {{"u_mm", r.reference_u_mm}, {"r_px", r.reference_r_px}}},
+      {"model", {{"kind", m.kind}, {"focus_mm", std::isinf(m.focus_mm) ? Json("infinity") : Json(m.focus_mm)},
+                 {"aperture_mm", m.aperture_mm}, {"floor_px", m.floor_px}, {"rms_px", m.rms_px},
+                 {"loo_rms_px", m.loo_rms_px}, {"samples_used", m.samples_used}, {"outliers", m.outliers}}},
+      {"timing_ms", {{"detect", r.detect_ms}, {"measure", r.measure_ms}, {"estimate", r.estimate_ms}}},
+      {"edges", edges},
+  };
+}
+
+std::string FormatEdgeTable(const CalibResult& r) {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof line, "%4s %8s %6s %9s %9s %9s %9s\n", "edge", "u/mm", "usable", "measured",
+                "thesis", "eq3.7", "fitted");
+  out += line;
+  for (const auto& e : r.edges) {
+    if (e.usable == 0) {
+      std::snprintf(line, sizeof line, "%4d %8.1f %6s %9s %9s %9s %9s\n", e.index, e.u_mm, "0/7", "-", "-", "-",
+                    "-");
+    } else {
+      std::snprintf(line, sizeof line, "%4d %8.1f %4d/%d %9.2f %9.2f %9.2f %9.2f\n", e.index, e.u_mm, e.usable,
+                    int(e.sections.size()), e.r_px, e.r_thesis_px, e.r_estimated_px, e.r_fitted_px);
+    }
+    out += line;
+  }
+  return out;
+}
+
+}  // namespace blurcue::calib

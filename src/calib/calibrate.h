@@ -1,0 +1,74 @@
+#pragma once
+// The calibration pipeline (thesis Fig. 4.1, steps 1-4): find the board, solve the pose, measure the blur of
+// every edge section two ways, and estimate every section from the reference edge (eq. 3.7) and from a thin-lens
+// model fitted to all usable sections.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "calib/board_pose.h"
+#include "calib/edge_blur.h"
+#include "core/board.h"
+#include "core/camera.h"
+#include "core/json_io.h"
+#include "optics/fit.h"
+
+namespace blurcue::calib {
+
+struct CalibrateOptions {
+  int reference_edge = 1;  // the thesis used the nearest edge, focused on it
+  DetectOptions detect;
+  ModelFitOptions model_fit;
+  ThesisOptions thesis;
+  optics::FitOptions optics_fit;
+};
+
+struct SectionResult {
+  int edge = 0, section = 0;          // 1-based
+  cv::Vec3d midpoint_camera_mm;       // 3-D midpoint in the camera frame
+  double u_mm = 0;                    // its depth (camera z)
+  cv::Point2d a_px, b_px;             // the section's end points in the photo
+  ModelFit fit;                       // r_px = fit.r_px, usable when fit.ok
+  ThesisMeasure thesis;               // r_thesis_px
+  std::optional<double> r_estimated_px;  // eq. 3.7 from the reference edge; empty where it does not hold
+  std::string estimated_note;            // why it is empty
+  double r_fitted_px = 0;                // fitted thin-lens model
+};
+
+struct EdgeResult {
+  int index = 0;
+  double u_mm = 0;  // mean depth of its sections
+  std::vector<SectionResult> sections;
+  // Means over usable sections (NaN-free: count says how many were usable).
+  int usable = 0;
+  double r_px = 0, r_thesis_px = 0, r_estimated_px = 0, r_fitted_px = 0;
+};
+
+struct CalibResult {
+  Camera camera;
+  Board board;
+  BoardPose pose;
+  int reference_edge = 1;
+  double reference_u_mm = 0, reference_r_px = 0;
+  optics::FittedModel model;
+  std::vector<EdgeResult> edges;
+  double detect_ms = 0, measure_ms = 0, estimate_ms = 0;  // where the time went
+};
+
+// `photo` is 8-bit BGR or grey sRGB as read from disk. Throws Error(kInput) when the photo's size differs from
+// the camera's, Error(kNotFound) when no board is found or the reference edge has no usable section.
+CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& board,
+                      const CalibrateOptions& options = {});
+
+// calib.json: camera, board, pose, reference edge, fitted model, and 11 edges x 7 sections with u_mm, r_px,
+// r_thesis_px, r_estimated_px, r_fitted_px, ok (and flags, psf, fit quality).
+Json CalibToJson(const CalibResult& result);
+
+// The thesis's Figure 4.11 as a text table: per edge, depth, measured (model fit and thesis method), estimated by
+// eq. 3.7 and by the fitted model, and how many sections were usable.
+std::string FormatEdgeTable(const CalibResult& result);
+
+}  // namespace blurcue::calib
