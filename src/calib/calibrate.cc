@@ -130,7 +130,7 @@ CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& b
         ++edge.usable;
         edge.r_px += s.fit.r_px;
         edge.r_thesis_px += s.thesis.r_px;
-        edge.r_estimated_px += s.r_estimated_px.value_or(0);
+        if (s.r_estimated_px) ++edge.estimated, edge.r_estimated_px += *s.r_estimated_px;
         edge.r_fitted_px += s.r_fitted_px;
       }
     }
@@ -138,7 +138,7 @@ CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& b
     if (edge.usable > 0) {
       edge.r_px /= edge.usable;
       edge.r_thesis_px /= edge.usable;
-      edge.r_estimated_px /= edge.usable;
+      if (edge.estimated > 0) edge.r_estimated_px /= edge.estimated;
       edge.r_fitted_px /= edge.usable;
     }
   }
@@ -191,21 +191,29 @@ Json CalibToJson(const CalibResult& r) {
   };
 }
 
-std::string FormatEdgeTable(const CalibResult& r) {
+std::string FormatEdgeTable(const CalibResult& r, const std::vector<double>& true_r_per_edge) {
+  const bool truth = true_r_per_edge.size() == r.edges.size();
   std::string out;
   char line[256];
-  std::snprintf(line, sizeof line, "%4s %8s %6s %9s %9s %9s %9s\n", "edge", "u/mm", "usable", "measured",
-                "thesis", "eq3.7", "fitted");
+  std::snprintf(line, sizeof line, "%4s %8s %6s %9s %9s %9s %9s%s\n", "edge", "u/mm", "usable", "measured",
+                "thesis", "eq3.7", "fitted", truth ? "      true" : "");
   out += line;
-  for (const auto& e : r.edges) {
+  for (size_t i = 0; i < r.edges.size(); ++i) {
+    const EdgeResult& e = r.edges[i];
     if (e.usable == 0) {
-      std::snprintf(line, sizeof line, "%4d %8.1f %6s %9s %9s %9s %9s\n", e.index, e.u_mm, "0/7", "-", "-", "-",
-                    "-");
+      std::snprintf(line, sizeof line, "%4d %8.1f %6s %9s %9s %9s %9s", e.index, e.u_mm, "0/7", "-", "-", "-", "-");
     } else {
-      std::snprintf(line, sizeof line, "%4d %8.1f %4d/%d %9.2f %9.2f %9.2f %9.2f\n", e.index, e.u_mm, e.usable,
-                    int(e.sections.size()), e.r_px, e.r_thesis_px, e.r_estimated_px, e.r_fitted_px);
+      char est[32] = "        -";  // eq. 3.7 does not hold nearer than focus
+      if (e.estimated > 0) std::snprintf(est, sizeof est, "%9.2f", e.r_estimated_px);
+      std::snprintf(line, sizeof line, "%4d %8.1f %4d/%d %9.2f %9.2f %s %9.2f", e.index, e.u_mm, e.usable,
+                    int(e.sections.size()), e.r_px, e.r_thesis_px, est, e.r_fitted_px);
     }
     out += line;
+    if (truth) {
+      std::snprintf(line, sizeof line, " %9.2f", true_r_per_edge[i]);
+      out += line;
+    }
+    out += "\n";
   }
   return out;
 }

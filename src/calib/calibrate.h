@@ -44,6 +44,7 @@ struct EdgeResult {
   std::vector<SectionResult> sections;
   // Means over usable sections (NaN-free: count says how many were usable).
   int usable = 0;
+  int estimated = 0;  // usable sections where eq. 3.7 holds (r_estimated_px averages those)
   double r_px = 0, r_thesis_px = 0, r_estimated_px = 0, r_fitted_px = 0;
 };
 
@@ -69,6 +70,7 @@ Json CalibToJson(const CalibResult& result);
 
 // The thesis's Figure 4.11 as a text table: per edge, depth, measured (model fit and thesis method), estimated by
 // eq. 3.7 and by the fitted model, and how many sections were usable.
-std::string FormatEdgeTable(const CalibResult& result);
+// With `true_r_per_edge` (from a ground-truth scene) a column of true radii is added.
+std::string FormatEdgeTable(const CalibResult& result, const std::vector<double>& true_r_per_edge = {});
 
 }  // namespace blurcue::calib

@@ -1,9 +1,13 @@
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <vector>
 #include <cstdio>
 #include <iostream>
 #include <string>
 
 #include "calib/calibrate.h"
+#include "calib/truth.h"
 #include "cli/commands.h"
 #include "core/error.h"
 #include "core/image.h"
@@ -12,7 +16,7 @@ namespace blurcue::cli {
 
 void AddCalibrateCommand(CLI::App& app) {
   struct Args {
-    std::string photo, camera, out = "calib.json", board = "7x10";
+    std::string photo, camera, out = "calib.json", board = "7x10", truth;
     double square_mm = 25;
     int reference_edge = 1;
     bool quiet = false;
@@ -39,6 +43,10 @@ void AddCalibrateCommand(CLI::App& app) {
   cmd->add_option("--reference-edge", args->reference_edge, "edge whose measured blur feeds eq. 3.7")
       ->capture_default_str();
   cmd->add_option("--out", args->out, "where to write calib.json")->capture_default_str();
+  cmd->add_option("--truth", args->truth,
+                  "truth.json of a ground-truth scene (blurcue synth-scene): adds the true radius to the table\n"
+                  "and prints the pose and blur errors of every method")
+      ->check(CLI::ExistingFile);
   cmd->add_flag("--quiet", args->quiet, "print only errors");
   cmd->callback([args] {
     const auto t0 = std::chrono::steady_clock::now();
@@ -68,7 +76,33 @@ void AddCalibrateCommand(CLI::App& app) {
                 " leave-one-out %.3f px, %d outliers of %d\n",
                 m.kind.c_str(), m.focus_mm, m.aperture_mm, camera.ApertureMm(), m.floor_px, m.rms_px, m.loo_rms_px,
                 m.outliers, m.samples_used);
-    std::printf("\n%s\n", calib::FormatEdgeTable(result).c_str());
+    std::vector<double> true_r;
+    if (!args->truth.empty()) {
+      const calib::TruthComparison cmp =
+          calib::CompareToTruth(result, ReadJsonFile(args->truth), args->truth + ": ");
+      true_r = cmp.true_r_per_edge;
+      std::printf("against truth: pose %.3f mm / %.3f deg, section depths within %.3f mm\n",
+                  cmp.translation_error_mm, cmp.rotation_error_deg, cmp.max_depth_error_mm);
+      auto summary = [&](const char* name, calib::MethodError calib::SectionComparison::*m) {
+        int answered = 0, within = 0;
+        double sum_abs = 0, worst = 0;
+        for (const auto& row : cmp.sections) {
+          const calib::MethodError& e = row.*m;
+          if (!e.answered) continue;
+          ++answered;
+          sum_abs += std::abs(e.error_px);
+          worst = std::max(worst, std::abs(e.error_px));
+          within += std::abs(e.error_px) <= calib::MeasureTolerancePx(row.true_r_px);
+        }
+        std::printf("  %-22s answered %2d/%zu, mean |error| %.3f px, worst %.3f px, within max(0.25 px, 5%%): %d\n",
+                    name, answered, cmp.sections.size(), answered ? sum_abs / answered : 0.0, worst, within);
+      };
+      summary("model fit (r_px)", &calib::SectionComparison::model);
+      summary("thesis (r_thesis_px)", &calib::SectionComparison::thesis);
+      summary("eq. 3.7 (r_estimated)", &calib::SectionComparison::estimated);
+      summary("fitted (r_fitted_px)", &calib::SectionComparison::fitted);
+    }
+    std::printf("\n%s\n", calib::FormatEdgeTable(result, true_r).c_str());
     std::printf("time: read %.0f ms, detect+pose %.0f ms, measure %.0f ms, estimate %.1f ms\n", read_ms,
                 result.detect_ms, result.measure_ms, result.estimate_ms);
     std::printf("wrote %s\n", args->out.c_str());

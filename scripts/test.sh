@@ -1,0 +1,7 @@
+#!/usr/bin/env bash
+# Set up, build, and run every test (unit, integration, CLI) and the demo.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/demo.sh
+cd build
+ctest --output-on-failure -j2 --timeout 600
