@@ -24,8 +24,8 @@ double Median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-// Linear-light grey of an 8-bit sRGB photo: decode each channel first, then mix (mixing encoded values would
-// bend edges).
+}  // namespace
+
 cv::Mat LinearGrey(const cv::Mat& photo) {
   cv::Mat linear = DecodeSrgb8(photo);
   if (linear.channels() == 1) return linear;
@@ -33,8 +33,6 @@ cv::Mat LinearGrey(const cv::Mat& photo) {
   cv::cvtColor(linear, grey, linear.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
   return grey;
 }
-
-}  // namespace
 
 CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& board,
                       const CalibrateOptions& options) {
@@ -77,8 +75,6 @@ CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& b
       SectionResult sec;
       sec.edge = e;
       sec.section = s;
-      sec.a_px = px[i];
-      sec.b_px = px[i + 1];
       sec.midpoint_camera_mm = ToCamera(result.pose, points[i + 2]);
       sec.u_mm = sec.midpoint_camera_mm[2];
       // Half the distance to the nearest parallel edge in the photo bounds how far across the edge we may look.
@@ -86,9 +82,9 @@ CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& b
       double gap = 1e9;
       if (e > 1) gap = std::min(gap, cv::norm(m - mid_px(e - 1, s)));
       if (e < E) gap = std::min(gap, cv::norm(m - mid_px(e + 1, s)));
-      EdgeSegment seg{sec.a_px, sec.b_px, 0.5 * gap};
-      sec.fit = MeasureEdgeModel(linear, seg, options.model_fit);
-      sec.thesis = MeasureEdgeThesis(grey8, seg, options.thesis);
+      sec.segment = EdgeSegment{px[i], px[i + 1], 0.5 * gap};
+      sec.fit = MeasureEdgeModel(linear, sec.segment, options.model_fit);
+      sec.thesis = MeasureEdgeThesis(grey8, sec.segment, options.thesis);
       edge.sections.push_back(sec);
     }
     result.edges.push_back(std::move(edge));
@@ -156,7 +152,7 @@ Json CalibToJson(const CalibResult& r) {
       Json js = {{"index", s.section},
                  {"u_mm", s.u_mm},
                  {"midpoint_camera_mm", vec(s.midpoint_camera_mm)},
-                 {"image_px", {{s.a_px.x, s.a_px.y}, {s.b_px.x, s.b_px.y}}},
+                 {"image_px", {{s.segment.a.x, s.segment.a.y}, {s.segment.b.x, s.segment.b.y}}},
                  {"r_px", s.fit.r_px},
                  {"r_thesis_px", s.thesis.r_px},
                  {"r_estimated_px", opt(s.r_estimated_px)},

@@ -30,7 +30,7 @@ struct SectionResult {
   int edge = 0, section = 0;          // 1-based
   cv::Vec3d midpoint_camera_mm;       // 3-D midpoint in the camera frame
   double u_mm = 0;                    // its depth (camera z)
-  cv::Point2d a_px, b_px;             // the section's end points in the photo
+  EdgeSegment segment;                // the section in the photo (end points, window across it)
   ModelFit fit;                       // r_px = fit.r_px, usable when fit.ok
   ThesisMeasure thesis;               // r_thesis_px
   std::optional<double> r_estimated_px;  // eq. 3.7 from the reference edge; empty where it does not hold
@@ -58,6 +58,10 @@ struct CalibResult {
   std::vector<EdgeResult> edges;
   double detect_ms = 0, measure_ms = 0, estimate_ms = 0;  // where the time went
 };
+
+// Linear-light grey of an 8-bit sRGB photo: each channel decoded first, then mixed (mixing encoded values would
+// bend edges). CV_32F, one channel.
+cv::Mat LinearGrey(const cv::Mat& photo);
 
 // `photo` is 8-bit BGR or grey sRGB as read from disk. Throws Error(kInput) when the photo's size differs from
 // the camera's, Error(kNotFound) when no board is found or the reference edge has no usable section.

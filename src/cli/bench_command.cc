@@ -1,8 +1,69 @@
+#include <cstdio>
+#include <iostream>
+#include <string>
+
+#include "bench/measure_bench.h"
 #include "cli/commands.h"
 
 namespace blurcue::cli {
 
-// placeholder: being written
-void AddBenchCommand(CLI::App&) {}
+namespace {
+
+void AddMeasure(CLI::App& bench) {
+  struct Args {
+    std::string out = "results/bench/measure.csv";
+    bool quick = false, no_full_res = false;
+    uint64_t seed = 1;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = bench.add_subcommand(
+      "measure",
+      "Speed against accuracy of the blur measurement and estimation methods.\n"
+      "Renders ground-truth scenes (the thesis set-up), sweeping one factor at a time - sensor noise, contrast,\n"
+      "JPEG quality, printing flaws, blur size, camera tilt - calibrates each, and records for every method\n"
+      "(model_fit = r_px, thesis = r_thesis_px, eq37 = r_estimated_px, fitted_model = r_fitted_px) how many\n"
+      "sections it answered, its error against the true radius and its time per section. A method meets the\n"
+      "target in a condition when it answers >= 50 % of sections and >= 90 % of those are within max(0.25 px, 5 %).\n"
+      "Then times the whole calibration of one full-resolution 4592 x 3056 photo.\n"
+      "Takes a few minutes; --quick runs two levels per factor.");
+  cmd->add_option("--out", args->out, "CSV, one row per (method, condition)")->capture_default_str();
+  cmd->add_option("--seed", args->seed, "seed of the scenes' noise, texture and flaws")->capture_default_str();
+  cmd->add_flag("--quick", args->quick, "two levels per factor (smoke run)");
+  cmd->add_flag("--no-full-res", args->no_full_res, "skip the full-resolution timing");
+  cmd->callback([args] {
+    bench::MeasureBenchOptions options;
+    options.quick = args->quick;
+    options.seed = args->seed;
+    options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+    const auto rows = bench::RunMeasureBench(options);
+    bench::WriteMeasureCsv(rows, args->out);
+    std::printf("wrote %s (%zu rows)\n\nwhere each method breaks (target: max(0.25 px, 5 %%) on >= 90 %% of answered "
+                "sections, >= 50 %% answered):\n%s",
+                args->out.c_str(), rows.size(), bench::DescribeBreakpoints(rows).c_str());
+    for (const auto& r : rows)
+      if (r.factor == "base" && r.method == "model_fit")
+        for (const auto& t : rows)
+          if (t.factor == "base" && t.method == "thesis")
+            std::printf("\nbase scene: model fit %.1f us/section, mean |error| %.3f px; thesis %.1f us/section, "
+                        "mean |error| %.3f px (time ratio model/thesis %.2f)\n",
+                        r.time_us_per_section, r.mean_abs_error_px, t.time_us_per_section, t.mean_abs_error_px,
+                        r.time_us_per_section / t.time_us_per_section);
+    if (args->no_full_res) return;
+    const bench::PipelineTiming t = bench::TimeFullResolution(3, options.progress);
+    std::printf("\nfull resolution %dx%d (best of 3): calibration %.0f ms = detect+pose %.0f + measure %.0f + "
+                "estimate %.1f ms (PNG decode %.0f ms more; target < 1000 ms: %s)\n"
+                "  per section: model fit %.1f us, thesis %.1f us\n",
+                t.width, t.height, t.total_ms, t.detect_ms, t.measure_ms, t.estimate_ms, t.decode_ms,
+                t.total_ms < 1000 ? "met" : "NOT met", t.model_us_per_section, t.thesis_us_per_section);
+  });
+}
+
+}  // namespace
+
+void AddBenchCommand(CLI::App& app) {
+  CLI::App* bench = app.add_subcommand("bench", "Benchmarks that chart speed against accuracy (CSV under results/bench/).");
+  bench->require_subcommand(1);
+  AddMeasure(*bench);
+}
 
 }  // namespace blurcue::cli

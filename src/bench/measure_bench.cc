@@ -1,0 +1,278 @@
+#include "bench/measure_bench.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "calib/calibrate.h"
+#include "calib/truth.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "synth/scene.h"
+
+namespace blurcue::bench {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Ms(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+struct Condition {
+  std::string factor;
+  double level;
+  synth::SceneOptions scene;
+};
+
+synth::SceneOptions Base(uint64_t seed) {
+  synth::SceneOptions o;  // thesis set-up at quarter resolution
+  o.noise_std = 0.004;
+  o.seed = seed;
+  return o;
+}
+
+// One factor at a time from the base scene, in order of increasing difficulty.
+std::vector<Condition> Conditions(bool quick, uint64_t seed) {
+  std::vector<Condition> c;
+  c.push_back({"base", 0, Base(seed)});
+  auto pick = [quick](std::vector<double> levels) {
+    if (quick) levels = {levels.front(), levels.back()};
+    return levels;
+  };
+  for (double n : pick({0.0, 0.002, 0.005, 0.01, 0.02, 0.04})) {
+    auto o = Base(seed);
+    o.noise_std = n;
+    c.push_back({"noise", n, o});
+  }
+  for (double m : pick({0.9, 0.5, 0.2, 0.1, 0.05, 0.02})) {  // Michelson contrast around a mean of 0.42
+    auto o = Base(seed);
+    o.white = 0.42 * (1 + m);
+    o.black = 0.42 * (1 - m);
+    c.push_back({"contrast", m, o});
+  }
+  for (double q : pick({95, 80, 60, 40, 20, 10})) {
+    auto o = Base(seed);
+    o.jpeg_quality = int(q);
+    c.push_back({"jpeg", q, o});
+  }
+  for (double f : pick({3, 10, 25, 50})) {
+    auto o = Base(seed);
+    o.flaws = int(f);
+    c.push_back({"flaws", f, o});
+  }
+  // Blur size: one radius everywhere, a steeper view and half resolution so big radii still fit between edges.
+  for (double r : pick({0.5, 1, 2, 4, 8, 12, 16, 20})) {
+    auto o = Base(seed);
+    o.camera = ThesisCamera().Resized(2296, 1528);
+    o.tilt_deg = 65;
+    o.fixed_r_px = r;
+    o.supersample = r >= 2 ? 2 : 4;
+    c.push_back({"blur", r, o});
+  }
+  for (double t : pick({20, 30, 45, 55, 65, 75})) {
+    auto o = Base(seed);
+    o.tilt_deg = t;
+    c.push_back({"tilt", t, o});
+  }
+  return c;
+}
+
+MeasureRow Summarize(const std::string& method, const Condition& cond, const calib::TruthComparison& cmp,
+                     calib::MethodError calib::SectionComparison::*member, double time_us) {
+  MeasureRow row;
+  row.method = method;
+  row.factor = cond.factor;
+  row.level = cond.level;
+  row.sections = int(cmp.sections.size());
+  row.time_us_per_section = time_us;
+  std::vector<double> abs_err;
+  double sum_signed = 0;
+  int within = 0;
+  for (const auto& s : cmp.sections) {
+    const calib::MethodError& e = s.*member;
+    if (!e.answered) continue;
+    abs_err.push_back(std::abs(e.error_px));
+    sum_signed += e.error_px;
+    within += std::abs(e.error_px) <= calib::MeasureTolerancePx(s.true_r_px);
+  }
+  row.answered = int(abs_err.size());
+  if (!abs_err.empty()) {
+    std::sort(abs_err.begin(), abs_err.end());
+    const size_t n = abs_err.size();
+    double sum = 0;
+    for (double v : abs_err) sum += v;
+    row.mean_abs_error_px = sum / n;
+    row.median_abs_error_px = abs_err[n / 2];
+    row.p90_abs_error_px = abs_err[std::min(n - 1, size_t(0.9 * n))];
+    row.max_abs_error_px = abs_err.back();
+    row.bias_px = sum_signed / n;
+    row.within_target = double(within) / n;
+  }
+  row.meets_target = row.answered * 2 >= row.sections && row.within_target >= 0.9;
+  return row;
+}
+
+// Times both measurement methods over every section of a calibrated photo, best of `repeats` runs.
+void TimeMethods(const cv::Mat& photo, const calib::CalibResult& result, int repeats, double& model_us,
+                 double& thesis_us) {
+  const cv::Mat linear = calib::LinearGrey(photo);
+  const cv::Mat grey8 = ToGrey8(photo);
+  int n = 0;
+  for (const auto& e : result.edges) n += int(e.sections.size());
+  model_us = thesis_us = 1e30;
+  for (int rep = 0; rep < repeats; ++rep) {
+    auto t0 = Clock::now();
+    for (const auto& e : result.edges)
+      for (const auto& s : e.sections) calib::MeasureEdgeModel(linear, s.segment);
+    model_us = std::min(model_us, 1000 * Ms(t0) / n);
+    t0 = Clock::now();
+    for (const auto& e : result.edges)
+      for (const auto& s : e.sections) calib::MeasureEdgeThesis(grey8, s.segment);
+    thesis_us = std::min(thesis_us, 1000 * Ms(t0) / n);
+  }
+}
+
+}  // namespace
+
+std::vector<MeasureRow> RunMeasureBench(const MeasureBenchOptions& options) {
+  std::vector<MeasureRow> rows;
+  const auto conditions = Conditions(options.quick, options.seed);
+  int done = 0;
+  for (const Condition& cond : conditions) {
+    auto t0 = Clock::now();
+    const synth::Scene scene = synth::RenderScene(cond.scene);
+    const double render_ms = Ms(t0);
+    calib::CalibResult result;
+    try {
+      result = calib::Calibrate(scene.image, scene.camera, scene.board);
+    } catch (const Error& e) {
+      // No board or no usable reference: every method of this condition gives no answer.
+      if (options.progress)
+        options.progress("[" + std::to_string(++done) + "/" + std::to_string(conditions.size()) + "] " +
+                         cond.factor + " " + std::to_string(cond.level) + ": calibration failed: " + e.what());
+      for (const char* m : {"model_fit", "thesis", "eq37", "fitted_model"}) {
+        MeasureRow row;
+        row.method = m;
+        row.factor = cond.factor;
+        row.level = cond.level;
+        row.sections = scene.board.EdgeCount() * scene.board.SectionCount();
+        rows.push_back(row);
+      }
+      continue;
+    }
+    const calib::TruthComparison cmp = calib::CompareToTruth(result, scene.truth, "truth");
+    double model_us = 0, thesis_us = 0;
+    TimeMethods(scene.image, result, 3, model_us, thesis_us);
+    const double n = double(cmp.sections.size());
+    rows.push_back(Summarize("model_fit", cond, cmp, &calib::SectionComparison::model, model_us));
+    rows.push_back(Summarize("thesis", cond, cmp, &calib::SectionComparison::thesis, thesis_us));
+    rows.push_back(Summarize("eq37", cond, cmp, &calib::SectionComparison::estimated, 0));
+    rows.push_back(Summarize("fitted_model", cond, cmp, &calib::SectionComparison::fitted,
+                             1000 * result.estimate_ms / n));
+    if (options.progress) {
+      char line[256];
+      std::snprintf(line, sizeof line,
+                    "[%d/%zu] %-8s %-6g render %5.0f ms, calibrate %4.0f ms; |error| model %.3f px, thesis %.3f px",
+                    ++done, conditions.size(), cond.factor.c_str(), cond.level, render_ms,
+                    result.detect_ms + result.measure_ms + result.estimate_ms, rows[rows.size() - 4].mean_abs_error_px,
+                    rows[rows.size() - 3].mean_abs_error_px);
+      options.progress(line);
+    }
+  }
+  return rows;
+}
+
+void WriteMeasureCsv(const std::vector<MeasureRow>& rows, const std::filesystem::path& path) {
+  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
+  const auto tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) throw InputError(path.string(), "cannot write file");
+    out << "method,factor,level,sections,answered,mean_abs_error_px,median_abs_error_px,p90_abs_error_px,"
+           "max_abs_error_px,bias_px,within_target,time_us_per_section,meets_target\n";
+    for (const auto& r : rows) {
+      char line[512];
+      std::snprintf(line, sizeof line, "%s,%s,%g,%d,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.2f,%d\n", r.method.c_str(),
+                    r.factor.c_str(), r.level, r.sections, r.answered, r.mean_abs_error_px, r.median_abs_error_px,
+                    r.p90_abs_error_px, r.max_abs_error_px, r.bias_px, r.within_target, r.time_us_per_section,
+                    int(r.meets_target));
+      out << line;
+    }
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+std::string DescribeBreakpoints(const std::vector<MeasureRow>& rows) {
+  // Rows come in sweep order (increasing difficulty), so the first failing level is where the method breaks.
+  std::map<std::pair<std::string, std::string>, std::vector<const MeasureRow*>> groups;
+  std::vector<std::pair<std::string, std::string>> order;
+  for (const auto& r : rows) {
+    if (r.factor == "base") continue;
+    auto key = std::make_pair(r.method, r.factor);
+    if (!groups.count(key)) order.push_back(key);
+    groups[key].push_back(&r);
+  }
+  std::ostringstream out;
+  for (const auto& key : order) {
+    const auto& g = groups[key];
+    std::ostringstream held;
+    const MeasureRow* broke = nullptr;
+    for (const MeasureRow* r : g) {
+      if (r->meets_target) {
+        held << (held.tellp() > 0 ? ", " : "") << r->level;
+      } else if (!broke) {
+        broke = r;
+      }
+    }
+    char line[512];
+    if (!broke) {
+      std::snprintf(line, sizeof line, "  %-12s %-8s holds at every level (%s)\n", key.first.c_str(),
+                    key.second.c_str(), held.str().c_str());
+    } else {
+      std::snprintf(line, sizeof line,
+                    "  %-12s %-8s breaks at %g: answered %d/%d, %.0f%% within target, mean |error| %.2f px%s%s\n",
+                    key.first.c_str(), key.second.c_str(), broke->level, broke->answered, broke->sections,
+                    100 * broke->within_target, broke->mean_abs_error_px, held.tellp() > 0 ? "; holds at " : "",
+                    held.str().c_str());
+    }
+    out << line;
+  }
+  return out.str();
+}
+
+PipelineTiming TimeFullResolution(int repeats, const std::function<void(const std::string&)>& progress) {
+  PipelineTiming t;
+  synth::SceneOptions o = Base(1);
+  o.camera = ThesisCamera();
+  o.supersample = 2;
+  t.width = o.camera.image_width_px;
+  t.height = o.camera.image_height_px;
+  if (progress) progress("rendering a full-resolution thesis scene (4592 x 3056) ...");
+  auto t0 = Clock::now();
+  const synth::Scene scene = synth::RenderScene(o);
+  t.render_s = Ms(t0) / 1000;
+  std::vector<uint8_t> png;
+  cv::imencode(".png", scene.image, png);
+  t.total_ms = t.decode_ms = t.detect_ms = t.measure_ms = t.estimate_ms = 1e30;
+  calib::CalibResult result;
+  for (int rep = 0; rep < repeats; ++rep) {
+    t0 = Clock::now();
+    const cv::Mat photo = cv::imdecode(png, cv::IMREAD_COLOR);
+    t.decode_ms = std::min(t.decode_ms, Ms(t0));
+    t0 = Clock::now();
+    result = calib::Calibrate(photo, scene.camera, scene.board);
+    t.total_ms = std::min(t.total_ms, Ms(t0));
+    t.detect_ms = std::min(t.detect_ms, result.detect_ms);
+    t.measure_ms = std::min(t.measure_ms, result.measure_ms);
+    t.estimate_ms = std::min(t.estimate_ms, result.estimate_ms);
+    if (progress) progress("  run " + std::to_string(rep + 1) + ": " + std::to_string(int(Ms(t0))) + " ms");
+  }
+  TimeMethods(scene.image, result, 3, t.model_us_per_section, t.thesis_us_per_section);
+  return t;
+}
+
+}  // namespace blurcue::bench

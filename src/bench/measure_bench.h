@@ -1,0 +1,45 @@
+#pragma once
+// Speed against accuracy of the blur measurement methods, on ground-truth scenes swept one factor at a time:
+// sensor noise, contrast, JPEG quality, printing flaws, blur size and camera tilt. One row per (method, condition).
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace blurcue::bench {
+
+struct MeasureRow {
+  std::string method;      // "model_fit", "thesis", "eq37", "fitted_model"
+  std::string factor;      // "base", "noise", "contrast", "jpeg", "flaws", "blur", "tilt"
+  double level = 0;        // the factor's value (noise std, Michelson contrast, JPEG quality, spots, r px, deg)
+  int sections = 0;        // sections in the scene
+  int answered = 0;        // sections the method gave a value for (model fit: flagged ok)
+  double mean_abs_error_px = 0, median_abs_error_px = 0, p90_abs_error_px = 0, max_abs_error_px = 0;
+  double bias_px = 0;          // mean signed error
+  double within_target = 0;    // fraction of answered sections within max(0.25 px, 5 %)
+  double time_us_per_section = 0;  // measurement methods: per section; estimators: per section from measured input
+  bool meets_target = false;   // answered >= 50 % of sections and >= 90 % of them within target
+};
+
+struct MeasureBenchOptions {
+  bool quick = false;     // two conditions per factor (a smoke run for CI)
+  uint64_t seed = 1;
+  std::function<void(const std::string&)> progress;  // one line per condition
+};
+
+std::vector<MeasureRow> RunMeasureBench(const MeasureBenchOptions& options);
+void WriteMeasureCsv(const std::vector<MeasureRow>& rows, const std::filesystem::path& path);
+// For each (method, factor): the levels where the method meets its target and where it first fails.
+std::string DescribeBreakpoints(const std::vector<MeasureRow>& rows);
+
+struct PipelineTiming {
+  int width = 0, height = 0;
+  double render_s = 0;                      // making the scene (not part of calibration)
+  double decode_ms = 0;                     // PNG decode
+  double detect_ms = 0, measure_ms = 0, estimate_ms = 0, total_ms = 0;  // calibration proper
+  double model_us_per_section = 0, thesis_us_per_section = 0;
+};
+// Full-resolution thesis scene (4592 x 3056): time of each calibration stage, best of `repeats`.
+PipelineTiming TimeFullResolution(int repeats, const std::function<void(const std::string&)>& progress);
+
+}  // namespace blurcue::bench
