@@ -1,0 +1,163 @@
+// The calibration pipeline against ground-truth scenes: a board on a table rendered through a thin lens with
+// known pose and known blur (src/synth), calibrated as a photo would be.
+#include "calib/calibrate.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "calib/truth.h"
+#include "core/error.h"
+#include "optics/fit.h"
+#include "synth/scene.h"
+
+namespace blurcue::calib {
+namespace {
+
+synth::SceneOptions Thesis(double noise = 0.004) {
+  synth::SceneOptions o;
+  o.noise_std = noise;
+  o.seed = 11;
+  return o;
+}
+
+// Focused in front of the board so every edge is blurred by 2-4 px at this resolution.
+synth::SceneOptions Blurry() {
+  synth::SceneOptions o = Thesis();
+  o.focus_mm = 260;
+  return o;
+}
+
+struct Run {
+  synth::Scene scene;
+  CalibResult result;
+  TruthComparison cmp;
+};
+
+Run Calibrated(const synth::SceneOptions& o) {
+  Run r;
+  r.scene = synth::RenderScene(o);
+  r.result = Calibrate(r.scene.image, r.scene.camera, r.scene.board);
+  r.cmp = CompareToTruth(r.result, r.scene.truth, "truth");
+  return r;
+}
+
+void PrintSideBySide(const Run& r) {
+  std::printf("edge  true   model  thesis  eq3.7  fitted\n");
+  for (size_t e = 0; e < r.result.edges.size(); ++e) {
+    const EdgeResult& edge = r.result.edges[e];
+    std::printf("%4d %6.2f %6.2f %6.2f %6.2f %6.2f\n", edge.index, r.cmp.true_r_per_edge[e], edge.r_px,
+                edge.r_thesis_px, edge.r_estimated_px, edge.r_fitted_px);
+  }
+}
+
+TEST(Calibrate, PoseWithinOneMillimetreAndHalfDegree) {
+  const Run r = Calibrated(Thesis());
+  EXPECT_LT(r.cmp.translation_error_mm, 1.0);
+  EXPECT_LT(r.cmp.rotation_error_deg, 0.5);
+  EXPECT_LT(r.cmp.max_depth_error_mm, 1.0);
+  EXPECT_LT(r.result.pose.reprojection_error_px, 0.5);
+}
+
+TEST(Calibrate, ElevenEdgesOfSevenSectionsNearestFirst) {
+  const Run r = Calibrated(Thesis());
+  ASSERT_EQ(r.result.edges.size(), 11u);
+  for (size_t e = 0; e < 11; ++e) {
+    EXPECT_EQ(r.result.edges[e].sections.size(), 7u);
+    if (e > 0) EXPECT_GT(r.result.edges[e].u_mm, r.result.edges[e - 1].u_mm);
+  }
+  // Focus is on edge 1 (the thesis set-up), so edge 1 is nearly sharp and blur grows with depth.
+  EXPECT_NEAR(r.result.edges[0].u_mm, 342.3, 1.0);
+  EXPECT_GT(r.result.edges[10].r_px, r.result.edges[5].r_px);
+  EXPECT_GT(r.result.edges[5].r_px, r.result.edges[0].r_px);
+}
+
+TEST(Calibrate, ModelFitWithinToleranceOfTrueBlur) {
+  const Run r = Calibrated(Blurry());
+  PrintSideBySide(r);
+  int ok = 0, within = 0;
+  for (const auto& s : r.cmp.sections) {
+    if (!s.model.answered) continue;
+    ++ok;
+    within += std::abs(s.model.error_px) <= MeasureTolerancePx(s.true_r_px);
+  }
+  EXPECT_GE(ok, 0.8 * r.cmp.sections.size());
+  EXPECT_GE(within, 0.9 * ok) << within << " of " << ok << " usable sections within max(0.25 px, 5 %)";
+}
+
+TEST(Calibrate, FittedModelPredictsHeldOutEdges) {
+  const Run r = Calibrated(Blurry());
+  const optics::Lens lens = optics::Lens::FromCamera(r.scene.camera);
+  std::vector<optics::BlurSample> train;
+  for (const auto& edge : r.result.edges)
+    for (const auto& s : edge.sections)
+      if (edge.index <= 7 && s.fit.ok) train.push_back({s.u_mm, s.fit.r_px, 1.0});
+  const optics::FittedModel model = optics::FitThinLens(lens, train);
+  for (int e = 8; e <= 11; ++e) {
+    const EdgeResult& edge = r.result.edges[e - 1];
+    const double truth = r.cmp.true_r_per_edge[e - 1];
+    EXPECT_NEAR(model.PredictPx(lens, edge.u_mm), truth, 0.05 * truth) << "edge " << e;
+  }
+}
+
+TEST(Calibrate, Eq37FromTheReferenceEdgeFollowsTheThinLens) {
+  // Truth is a thin lens, so eq. 3.7 from a well-measured reference must land near the truth too.
+  const Run r = Calibrated(Blurry());
+  const TruthComparison& c = r.cmp;
+  for (int e = 2; e <= 11; ++e)
+    EXPECT_NEAR(r.result.edges[e - 1].r_estimated_px, c.true_r_per_edge[e - 1], 0.1 * c.true_r_per_edge[e - 1] + 0.1)
+        << "edge " << e;
+}
+
+TEST(Calibrate, JsonHasEveryFieldTheIssueNames) {
+  const Run r = Calibrated(Thesis());
+  const Json j = CalibToJson(r.result);
+  for (const char* key : {"camera", "board", "pose", "reference_edge", "edges"}) EXPECT_TRUE(j.contains(key)) << key;
+  for (const char* key : {"rvec", "tvec", "reprojection_error_px"}) EXPECT_TRUE(j["pose"].contains(key)) << key;
+  ASSERT_EQ(j["edges"].size(), 11u);
+  for (const Json& e : j["edges"]) {
+    EXPECT_TRUE(e.contains("index") && e.contains("u_mm"));
+    ASSERT_EQ(e["sections"].size(), 7u);
+    for (const Json& s : e["sections"])
+      for (const char* key : {"u_mm", "r_px", "r_thesis_px", "r_estimated_px", "r_fitted_px", "ok"})
+        EXPECT_TRUE(s.contains(key)) << key;
+  }
+}
+
+TEST(Calibrate, PhotoWithoutBoardIsNotFound) {
+  const synth::Scene scene = synth::RenderScene(Thesis());
+  try {
+    Calibrate(scene.image_no_board, scene.camera, scene.board);
+    FAIL() << "expected no board";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kNotFound);
+    EXPECT_NE(std::string(e.what()).find("7x10"), std::string::npos);
+  }
+}
+
+TEST(Calibrate, BoardOfAnotherSizeIsNotFound) {
+  const synth::Scene scene = synth::RenderScene(Thesis());
+  Board other = scene.board;
+  other.cols = 8;
+  try {
+    Calibrate(scene.image, scene.camera, other);
+    FAIL() << "expected no 8x10 board";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kNotFound);
+  }
+}
+
+TEST(Calibrate, CameraOfAnotherImageSizeIsAnInputError) {
+  const synth::Scene scene = synth::RenderScene(Thesis());
+  try {
+    Calibrate(scene.image, ThesisCamera(), scene.board);
+    FAIL() << "expected a size mismatch";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    EXPECT_NE(std::string(e.what()).find("1148x764"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace blurcue::calib
