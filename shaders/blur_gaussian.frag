@@ -1,0 +1,25 @@
+#version 330 core
+// One pass of the separable Gaussian (the thesis's appendix A shader, in linear light with premultiplied alpha).
+// Weights exp(-i^2 / (2 s^2)) for |i| <= u_taps, normalised by their sum (eq. 4.6) so brightness is kept.
+// Texels are fetched exactly; outside the image the border texel repeats (clamp to edge).
+uniform sampler2D u_image;     // linear, premultiplied RGBA
+uniform vec2 u_direction;      // (1, 0) horizontal pass, (0, 1) vertical pass
+uniform float u_sigma_px;      // s = r / 2
+uniform int u_taps;            // kernel half-width, ceil(3 s): as wide as s needs and no wider
+out vec4 o_color;
+void main() {
+  ivec2 size = textureSize(u_image, 0);
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  ivec2 step = ivec2(u_direction);
+  vec4 sum = texelFetch(u_image, p, 0);
+  float weight_sum = 1.0;
+  float k = -0.5 / (u_sigma_px * u_sigma_px);
+  for (int i = 1; i <= u_taps; ++i) {
+    float w = exp(k * float(i * i));
+    ivec2 a = clamp(p - i * step, ivec2(0), size - 1);
+    ivec2 b = clamp(p + i * step, ivec2(0), size - 1);
+    sum += w * (texelFetch(u_image, a, 0) + texelFetch(u_image, b, 0));
+    weight_sum += 2.0 * w;
+  }
+  o_color = sum / weight_sum;
+}

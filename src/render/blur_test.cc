@@ -1,0 +1,88 @@
+// GL tests (label "gl"): they run on Mesa's llvmpipe through EGL with no display.
+#include "render/blur.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "core/error.h"
+#include "render/gl_context.h"
+#include "render/gl_objects.h"
+
+namespace blurcue::render {
+namespace {
+
+class GlTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { context_ = GlContext::CreateOffscreen().release(); }
+  static void TearDownTestSuite() { delete context_; }
+  static GlContext* context_;
+};
+GlContext* GlTest::context_ = nullptr;
+
+// Premultiplied linear RGBA: a sharp bright square with an alpha edge on a transparent field.
+cv::Mat Square(int w, int h) {
+  cv::Mat img(h, w, CV_32FC4, cv::Scalar(0, 0, 0, 0));
+  img(cv::Rect(w / 4, h / 4, w / 2, h / 2)).setTo(cv::Scalar(0.8, 0.5, 0.2, 1.0));
+  img(cv::Rect(w / 4, h / 4, w / 8, h / 2)).setTo(cv::Scalar(0.05, 0.05, 0.05, 1.0));
+  return img;
+}
+
+TEST_F(GlTest, ContextIsLlvmpipeCore33OrLater) {
+  const std::string d = context_->Describe();
+  EXPECT_NE(d.find("Core Profile"), std::string::npos) << d;
+}
+
+TEST_F(GlTest, ShaderCompileErrorNamesTheShaderAndCarriesTheLog) {
+  try {
+    Program::FromSource("#version 330 core\nvoid main() { gl_Position = vec4(0); }\n",
+                        "#version 330 core\nout vec4 o; void main() { o = undefined_thing; }\n", "broken.frag");
+    FAIL() << "expected a compile error";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("broken.frag"), std::string::npos) << what;
+    EXPECT_NE(what.find("undefined_thing"), std::string::npos) << what;
+  }
+}
+
+TEST_F(GlTest, GaussianMatchesCpuReference) {
+  GlBlur blur;
+  const cv::Mat img = Square(160, 120);
+  for (double r : {1.0, 4.0, 8.0, 16.0}) {
+    const cv::Mat gl = blur.Gaussian(img, r), cpu = GaussianBlurCpu(img, r);
+    cv::Mat diff;
+    cv::absdiff(gl, cpu, diff);
+    const cv::Scalar mean = cv::mean(diff);
+    double max = 0;
+    cv::minMaxLoc(diff.reshape(1), nullptr, &max);
+    EXPECT_LE((mean[0] + mean[1] + mean[2] + mean[3]) / 4, 0.5 / 255) << "r = " << r;
+    EXPECT_LE(max, 3.0 / 255) << "r = " << r;
+  }
+}
+
+TEST(CpuBlur, GaussianKeepsBrightness) {
+  // Normalised kernel (eq. 4.6): the sum of light is unchanged away from the borders.
+  const cv::Mat img = Square(200, 200);
+  const cv::Mat out = GaussianBlurCpu(img, 8);
+  EXPECT_NEAR(cv::sum(out)[0], cv::sum(img)[0], 1e-3 * cv::sum(img)[0]);
+  EXPECT_NEAR(cv::sum(out)[3], cv::sum(img)[3], 1e-3 * cv::sum(img)[3]);
+}
+
+TEST(CpuBlur, GaussianEdgeHasRequestedRadius) {
+  // r = 2 x std of the LSF: the derivative of a blurred step has std r / 2.
+  cv::Mat img(1, 400, CV_32FC4, cv::Scalar(0, 0, 0, 1));
+  img.colRange(200, 400).setTo(cv::Scalar(1, 1, 1, 1));
+  const double r = 10;
+  const cv::Mat out = GaussianBlurCpu(img, r);
+  double m0 = 0, m1 = 0, m2 = 0;
+  for (int x = 1; x < 400; ++x) {
+    const double d = out.at<cv::Vec4f>(0, x)[0] - out.at<cv::Vec4f>(0, x - 1)[0];
+    const double pos = x - 0.5;
+    m0 += d, m1 += d * pos, m2 += d * pos * pos;
+  }
+  const double var = m2 / m0 - (m1 / m0) * (m1 / m0);
+  EXPECT_NEAR(2 * std::sqrt(var), r, 0.05 * r);
+}
+
+}  // namespace
+}  // namespace blurcue::render

@@ -1,0 +1,125 @@
+#include "render/gl_context.h"
+
+#include <cstdio>
+
+#include <epoxy/egl.h>
+#include <epoxy/gl.h>
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+
+#include "core/error.h"
+
+namespace blurcue::render {
+namespace {
+
+std::string Hex(int v) {
+  char b[16];
+  std::snprintf(b, sizeof b, "0x%04x", v);
+  return b;
+}
+
+class EglContext final : public GlContext {
+ public:
+  EglContext() {
+    // The surfaceless platform needs no X server, no GBM device and no config: exactly what batch jobs want.
+    auto get_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
+    if (!get_display) throw Error(ErrorKind::kInternal, "EGL: eglGetPlatformDisplayEXT is missing");
+    display_ = get_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+    EGLint major = 0, minor = 0;
+    if (display_ == EGL_NO_DISPLAY || !eglInitialize(display_, &major, &minor))
+      throw Error(ErrorKind::kInternal, "EGL: cannot initialise the surfaceless display, error " + Hex(eglGetError()) +
+                                            " (is Mesa's libegl1 installed?)");
+    eglBindAPI(EGL_OPENGL_API);
+    const EGLint attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
+                                 EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+    context_ = eglCreateContext(display_, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attributes);
+    if (context_ == EGL_NO_CONTEXT) {
+      const int err = eglGetError();
+      eglTerminate(display_);
+      throw Error(ErrorKind::kInternal, "EGL: cannot create a GL 3.3 core context, error " + Hex(err));
+    }
+    MakeCurrent();
+  }
+  ~EglContext() override {
+    eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    eglDestroyContext(display_, context_);
+    eglTerminate(display_);
+  }
+  void MakeCurrent() override {
+    if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_))
+      throw Error(ErrorKind::kInternal, "EGL: eglMakeCurrent failed, error " + Hex(eglGetError()));
+  }
+  void SwapBuffers() override { glFinish(); }
+
+ private:
+  EGLDisplay display_ = EGL_NO_DISPLAY;
+  EGLContext context_ = EGL_NO_CONTEXT;
+};
+
+class GlfwContext final : public GlContext {
+ public:
+  explicit GlfwContext(const WindowOptions& o) {
+    glfwSetErrorCallback([](int code, const char* text) { std::fprintf(stderr, "GLFW %d: %s\n", code, text); });
+    if (!glfwInit()) throw Error(ErrorKind::kInternal, "GLFW: cannot initialise (no display? run under Xvfb)");
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+    GLFWmonitor* monitor = nullptr;
+    if (o.fullscreen) {
+      int count = 0;
+      GLFWmonitor** monitors = glfwGetMonitors(&count);
+      if (o.monitor < 0 || o.monitor >= count) {
+        glfwTerminate();
+        throw Error(ErrorKind::kInput, "display monitor " + std::to_string(o.monitor) + " does not exist (" +
+                                           std::to_string(count) + " connected)");
+      }
+      monitor = monitors[o.monitor];
+    }
+    window_ = glfwCreateWindow(o.width_px, o.height_px, o.title.c_str(), monitor, nullptr);
+    if (!window_) {
+      glfwTerminate();
+      throw Error(ErrorKind::kInternal, "GLFW: cannot open a GL 3.3 core window");
+    }
+    MakeCurrent();
+    glfwSwapInterval(o.vsync ? 1 : 0);
+  }
+  ~GlfwContext() override {
+    glfwDestroyWindow(window_);
+    glfwTerminate();
+  }
+  void MakeCurrent() override { glfwMakeContextCurrent(window_); }
+  void SwapBuffers() override {
+    glfwSwapBuffers(window_);
+    glfwPollEvents();
+  }
+  bool ShouldClose() const override { return glfwWindowShouldClose(window_); }
+  int width_px() const override {
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(window_, &w, &h);
+    return w;
+  }
+  int height_px() const override {
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(window_, &w, &h);
+    return h;
+  }
+
+ private:
+  GLFWwindow* window_ = nullptr;
+};
+
+}  // namespace
+
+std::unique_ptr<GlContext> GlContext::CreateOffscreen() { return std::make_unique<EglContext>(); }
+std::unique_ptr<GlContext> GlContext::CreateWindow(const WindowOptions& options) {
+  return std::make_unique<GlfwContext>(options);
+}
+
+std::string GlContext::Describe() const {
+  const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  const auto* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
+  return std::string(renderer ? renderer : "?") + " | " + (version ? version : "?");
+}
+
+}  // namespace blurcue::render

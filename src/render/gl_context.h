@@ -1,0 +1,43 @@
+#pragma once
+// An OpenGL 3.3 core context, offscreen through EGL on Mesa's surfaceless platform (no display: batch rendering
+// and every test) or in a GLFW window for participants. GL calls go through libepoxy.
+#include <memory>
+#include <string>
+
+namespace blurcue::render {
+
+struct WindowOptions {
+  int width_px = 1280, height_px = 720;
+  bool fullscreen = false;
+  int monitor = 0;      // which monitor when fullscreen
+  bool vsync = true;
+  std::string title = "blurcue";
+};
+
+class GlContext {
+ public:
+  // Throws Error(kInternal) with the EGL error code when no surfaceless GL 3.3 core context can be made.
+  static std::unique_ptr<GlContext> CreateOffscreen();
+  // Throws Error(kInternal) when GLFW cannot open a window (no display: run under Xvfb).
+  static std::unique_ptr<GlContext> CreateWindow(const WindowOptions& options);
+
+  virtual ~GlContext() = default;
+  GlContext(const GlContext&) = delete;
+  GlContext& operator=(const GlContext&) = delete;
+
+  virtual void MakeCurrent() = 0;
+  // Window: present the back buffer (blocks to the refresh with vsync). Offscreen: glFinish.
+  virtual void SwapBuffers() = 0;
+  // Window: true once the user asked to close it. Offscreen: false.
+  virtual bool ShouldClose() const { return false; }
+  // Size of the default framebuffer in pixels (0 x 0 offscreen: render to framebuffers).
+  virtual int width_px() const { return 0; }
+  virtual int height_px() const { return 0; }
+  // GL_RENDERER and GL_VERSION, for the session record.
+  std::string Describe() const;
+
+ protected:
+  GlContext() = default;
+};
+
+}  // namespace blurcue::render

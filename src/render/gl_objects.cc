@@ -1,0 +1,142 @@
+#include "render/gl_objects.h"
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include "core/error.h"
+
+namespace blurcue::render {
+namespace {
+
+std::string ReadText(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path.string(), "cannot open shader file");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+GLuint Compile(GLenum type, const std::string& source, const std::string& name) {
+  const GLuint shader = glCreateShader(type);
+  const char* text = source.c_str();
+  glShaderSource(shader, 1, &text, nullptr);
+  glCompileShader(shader);
+  GLint ok = 0;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    GLint length = 0;
+    glGetShaderiv(shader, GL_INFO_LOG_LENGTH, &length);
+    std::vector<char> log(std::max(length, 1));
+    glGetShaderInfoLog(shader, length, nullptr, log.data());
+    glDeleteShader(shader);
+    throw Error(ErrorKind::kInternal, name + ": compile failed: " + std::string(log.data()));
+  }
+  return shader;
+}
+
+}  // namespace
+
+std::filesystem::path ShaderDir() {
+  if (const char* dir = std::getenv("BLURCUE_SHADER_DIR")) return dir;
+  return std::filesystem::path(BLURCUE_SOURCE_DIR) / "shaders";
+}
+
+Program Program::FromFiles(const std::filesystem::path& vertex, const std::filesystem::path& fragment) {
+  return FromSource(ReadText(vertex), ReadText(fragment), vertex.string() + " + " + fragment.string());
+}
+
+Program Program::FromSource(const std::string& vertex, const std::string& fragment, const std::string& name) {
+  const GLuint vs = Compile(GL_VERTEX_SHADER, vertex, name + " (vertex)");
+  GLuint fs = 0;
+  try {
+    fs = Compile(GL_FRAGMENT_SHADER, fragment, name + " (fragment)");
+  } catch (...) {
+    glDeleteShader(vs);
+    throw;
+  }
+  Program p;
+  p.name_ = GlName(glCreateProgram(), [](GLuint id) { glDeleteProgram(id); });
+  glAttachShader(p.id(), vs);
+  glAttachShader(p.id(), fs);
+  glLinkProgram(p.id());
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  GLint ok = 0;
+  glGetProgramiv(p.id(), GL_LINK_STATUS, &ok);
+  if (!ok) {
+    GLint length = 0;
+    glGetProgramiv(p.id(), GL_INFO_LOG_LENGTH, &length);
+    std::vector<char> log(std::max(length, 1));
+    glGetProgramInfoLog(p.id(), length, nullptr, log.data());
+    throw Error(ErrorKind::kInternal, name + ": link failed: " + std::string(log.data()));
+  }
+  return p;
+}
+
+Texture::Texture(int width_px, int height_px, GLenum internal_format)
+    : width_(width_px), height_(height_px), format_(internal_format) {
+  GLuint id = 0;
+  glGenTextures(1, &id);
+  name_ = GlName(id, [](GLuint i) { glDeleteTextures(1, &i); });
+  glBindTexture(GL_TEXTURE_2D, id);
+  glTexImage2D(GL_TEXTURE_2D, 0, internal_format, width_px, height_px, 0, GL_RGBA, GL_FLOAT, nullptr);
+  // Blur passes fetch texels exactly (texelFetch or pixel-centre coordinates): no filtering, clamp at borders.
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+}
+
+void Texture::Upload(const cv::Mat& rgba) {
+  CV_Assert(rgba.cols == width_ && rgba.rows == height_ && rgba.channels() == 4);
+  CV_Assert(rgba.depth() == CV_32F || rgba.depth() == CV_8U);
+  const cv::Mat data = rgba.isContinuous() ? rgba : rgba.clone();
+  glBindTexture(GL_TEXTURE_2D, name_.id());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, GL_RGBA,
+                  rgba.depth() == CV_32F ? GL_FLOAT : GL_UNSIGNED_BYTE, data.data);
+}
+
+cv::Mat Texture::Download() const {
+  cv::Mat out(height_, width_, CV_32FC4);
+  glBindTexture(GL_TEXTURE_2D, name_.id());
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, out.data);
+  return out;
+}
+
+void Texture::Bind(int unit) const {
+  glActiveTexture(GL_TEXTURE0 + unit);
+  glBindTexture(GL_TEXTURE_2D, name_.id());
+}
+
+Framebuffer::Framebuffer(const Texture& color) : width_(color.width_px()), height_(color.height_px()) {
+  GLuint id = 0;
+  glGenFramebuffers(1, &id);
+  name_ = GlName(id, [](GLuint i) { glDeleteFramebuffers(1, &i); });
+  glBindFramebuffer(GL_FRAMEBUFFER, id);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, color.id(), 0);
+  const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE)
+    throw Error(ErrorKind::kInternal, "GL: framebuffer incomplete, status " + std::to_string(status));
+}
+
+void Framebuffer::Bind() const {
+  glBindFramebuffer(GL_FRAMEBUFFER, name_.id());
+  glViewport(0, 0, width_, height_);
+}
+
+FullscreenPass::FullscreenPass() {
+  GLuint id = 0;
+  glGenVertexArrays(1, &id);
+  vao_ = GlName(id, [](GLuint i) { glDeleteVertexArrays(1, &i); });
+}
+
+void FullscreenPass::Draw() const {
+  glBindVertexArray(vao_.id());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+}  // namespace blurcue::render

@@ -1,0 +1,104 @@
+#pragma once
+// Move-only RAII handles for the GL objects blurcue uses (after Magnum's GL layer): no copies, destroyed with the
+// context current, errors that name the shader file and carry the driver's log.
+#include <filesystem>
+#include <string>
+#include <utility>
+
+#include <epoxy/gl.h>
+#include <opencv2/core.hpp>
+
+namespace blurcue::render {
+
+// Where shaders live: $BLURCUE_SHADER_DIR, else the source tree's shaders/.
+std::filesystem::path ShaderDir();
+
+class GlName {
+ public:
+  using Deleter = void (*)(GLuint);
+  GlName() = default;
+  GlName(GLuint id, Deleter deleter) : id_(id), deleter_(deleter) {}
+  GlName(GlName&& o) noexcept : id_(std::exchange(o.id_, 0)), deleter_(o.deleter_) {}
+  GlName& operator=(GlName&& o) noexcept {
+    if (this != &o) {
+      Reset();
+      id_ = std::exchange(o.id_, 0);
+      deleter_ = o.deleter_;
+    }
+    return *this;
+  }
+  GlName(const GlName&) = delete;
+  GlName& operator=(const GlName&) = delete;
+  ~GlName() { Reset(); }
+  GLuint id() const { return id_; }
+
+ private:
+  void Reset() {
+    if (id_ && deleter_) deleter_(id_);
+    id_ = 0;
+  }
+  GLuint id_ = 0;
+  Deleter deleter_ = nullptr;
+};
+
+class Program {
+ public:
+  // Compiles and links; throws Error(kInternal) "FILE: compile failed: <driver log>" on failure.
+  static Program FromFiles(const std::filesystem::path& vertex, const std::filesystem::path& fragment);
+  static Program FromSource(const std::string& vertex, const std::string& fragment, const std::string& name);
+  void Use() const { glUseProgram(name_.id()); }
+  // -1 when the uniform is absent or optimised out (setting it is then a no-op, as in GL).
+  GLint Uniform(const char* name) const { return glGetUniformLocation(name_.id(), name); }
+  GLuint id() const { return name_.id(); }
+
+ private:
+  GlName name_;
+};
+
+class Texture {
+ public:
+  // An empty RGBA texture; internal_format e.g. GL_RGBA32F (linear, premultiplied) or GL_RGBA8.
+  Texture(int width_px, int height_px, GLenum internal_format = GL_RGBA32F);
+  // Uploads CV_32FC4 (or CV_8UC4) rows top-down; row 0 of the Mat is texture row 0.
+  void Upload(const cv::Mat& rgba);
+  // Reads the whole texture back as CV_32FC4.
+  cv::Mat Download() const;
+  void Bind(int unit) const;
+  int width_px() const { return width_; }
+  int height_px() const { return height_; }
+  GLuint id() const { return name_.id(); }
+
+ private:
+  GlName name_;
+  int width_ = 0, height_ = 0;
+  GLenum format_ = GL_RGBA32F;
+};
+
+class Framebuffer {
+ public:
+  // Renders into `color` (which must outlive this framebuffer).
+  explicit Framebuffer(const Texture& color);
+  void Bind() const;
+  GLuint id() const { return name_.id(); }
+
+ private:
+  GlName name_;
+  int width_ = 0, height_ = 0;
+};
+
+// A full-screen triangle for image passes (vertex shader derives positions from gl_VertexID).
+class FullscreenPass {
+ public:
+  FullscreenPass();
+  void Draw() const;
+
+ private:
+  GlName vao_;
+};
+
+static_assert(!std::is_copy_constructible_v<Program>);
+static_assert(!std::is_copy_constructible_v<Texture>);
+static_assert(!std::is_copy_constructible_v<Framebuffer>);
+static_assert(std::is_nothrow_move_constructible_v<Program>);
+
+}  // namespace blurcue::render
