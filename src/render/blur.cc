@@ -1,10 +1,12 @@
 #include "render/blur.h"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/image.h"
 #include "render/gl_objects.h"
 
 namespace blurcue::render {
@@ -25,9 +27,99 @@ cv::Mat GaussianBlurCpu(const cv::Mat& rgba, double r_px) {
   return out;
 }
 
+cv::Mat DiscKernel(double r_px) {
+  const int t = int(std::ceil(r_px + 0.5));
+  cv::Mat k(2 * t + 1, 2 * t + 1, CV_32F);
+  for (int y = -t; y <= t; ++y)
+    for (int x = -t; x <= t; ++x)
+      k.at<float>(y + t, x + t) = float(std::clamp(r_px + 0.5 - std::hypot(x, y), 0.0, 1.0));
+  return k / cv::sum(k)[0];
+}
+
+cv::Mat DiscBlurCpu(const cv::Mat& rgba, double r_px) {
+  CV_Assert(rgba.type() == CV_32FC4);
+  if (r_px <= 0) return rgba.clone();
+  cv::Mat out;
+  cv::filter2D(rgba, out, CV_32F, DiscKernel(r_px), cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
+  return out;
+}
+
+cv::Mat ButterworthBlurCpu(const cv::Mat& rgba, double cutoff, int order) {
+  CV_Assert(rgba.type() == CV_32FC4 && cutoff > 0 && order >= 1);
+  const int w = rgba.cols, h = rgba.rows;
+  // Mirror padding to sizes the DFT likes.
+  const int pw = cv::getOptimalDFTSize(2 * w), ph = cv::getOptimalDFTSize(2 * h);
+  cv::Mat padded;
+  cv::copyMakeBorder(rgba, padded, 0, ph - h, 0, pw - w, cv::BORDER_REFLECT);
+  // Transfer function on the padded grid; frequency in cycles per *original* width.
+  cv::Mat H(ph, pw, CV_32F);
+  for (int v = 0; v < ph; ++v)
+    for (int u = 0; u < pw; ++u) {
+      const double fu = (u <= pw / 2 ? u : u - pw) / double(pw) * w;
+      const double fv = (v <= ph / 2 ? v : v - ph) / double(ph) * w;
+      H.at<float>(v, u) = float(1.0 / (1.0 + std::pow(std::hypot(fu, fv) / cutoff, 2 * order)));
+    }
+  std::vector<cv::Mat> channels;
+  cv::split(padded, channels);
+  for (cv::Mat& c : channels) {
+    cv::Mat spectrum;
+    cv::dft(c, spectrum, cv::DFT_COMPLEX_OUTPUT);
+    cv::Mat planes[2];
+    cv::split(spectrum, planes);
+    planes[0] = planes[0].mul(H);
+    planes[1] = planes[1].mul(H);
+    cv::merge(planes, 2, spectrum);
+    cv::dft(spectrum, c, cv::DFT_INVERSE | cv::DFT_SCALE | cv::DFT_REAL_OUTPUT);
+  }
+  cv::Mat out;
+  cv::merge(channels, out);
+  return out(cv::Rect(0, 0, w, h)).clone();
+}
+
+cv::Mat ToLinearPremultiplied(const cv::Mat& image8) {
+  cv::Mat bgra;
+  if (image8.channels() == 1) cv::cvtColor(image8, bgra, cv::COLOR_GRAY2BGRA);
+  else if (image8.channels() == 3) cv::cvtColor(image8, bgra, cv::COLOR_BGR2BGRA);
+  else bgra = image8;
+  // Colour is sRGB-encoded, alpha is linear coverage: decode only the colour.
+  cv::Mat linear = DecodeSrgb8(bgra);
+  for (int y = 0; y < linear.rows; ++y) {
+    cv::Vec4f* row = linear.ptr<cv::Vec4f>(y);
+    const cv::Vec4b* src = bgra.ptr<cv::Vec4b>(y);
+    for (int x = 0; x < linear.cols; ++x) {
+      const float a = src[x][3] / 255.f;
+      row[x] = cv::Vec4f(row[x][0] * a, row[x][1] * a, row[x][2] * a, a);
+    }
+  }
+  return linear;
+}
+
+cv::Mat FromLinearPremultiplied(const cv::Mat& rgba, bool keep_alpha) {
+  CV_Assert(rgba.type() == CV_32FC4);
+  cv::Mat colour(rgba.size(), CV_32FC3), alpha(rgba.size(), CV_8U);
+  for (int y = 0; y < rgba.rows; ++y) {
+    const cv::Vec4f* src = rgba.ptr<cv::Vec4f>(y);
+    cv::Vec3f* dst = colour.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < rgba.cols; ++x) {
+      const float a = std::clamp(src[x][3], 0.f, 1.f);
+      dst[x] = a > 1e-6f ? cv::Vec3f(src[x][0] / a, src[x][1] / a, src[x][2] / a) : cv::Vec3f(0, 0, 0);
+      alpha.at<uint8_t>(y, x) = uint8_t(std::lround(a * 255));
+    }
+  }
+  cv::Mat out = EncodeSrgb8(colour);
+  if (!keep_alpha) return out;
+  cv::Mat channels[4];
+  cv::split(out, channels);
+  channels[3] = alpha;
+  cv::merge(channels, 4, out);
+  return out;
+}
+
 GlBlur::GlBlur()
     : gaussian_(std::make_unique<Program>(
           Program::FromFiles(ShaderDir() / "fullscreen.vert", ShaderDir() / "blur_gaussian.frag"))),
+      disc_(std::make_unique<Program>(
+          Program::FromFiles(ShaderDir() / "fullscreen.vert", ShaderDir() / "blur_disc.frag"))),
       pass_(std::make_unique<FullscreenPass>()) {}
 
 GlBlur::~GlBlur() = default;
@@ -51,6 +143,23 @@ cv::Mat GlBlur::Gaussian(const cv::Mat& rgba, double r_px) {
   to_target.Bind();
   middle.Bind(0);
   glUniform2f(gaussian_->Uniform("u_direction"), 0, 1);
+  pass_->Draw();
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  return target.Download();
+}
+
+cv::Mat GlBlur::Disc(const cv::Mat& rgba, double r_px) {
+  CV_Assert(rgba.type() == CV_32FC4);
+  if (r_px <= 0) return rgba.clone();
+  Texture source(rgba.cols, rgba.rows), target(rgba.cols, rgba.rows);
+  source.Upload(rgba);
+  Framebuffer to_target(target);
+  disc_->Use();
+  glUniform1i(disc_->Uniform("u_image"), 0);
+  glUniform1f(disc_->Uniform("u_radius_px"), float(r_px));
+  glUniform1i(disc_->Uniform("u_taps"), int(std::ceil(r_px + 0.5)));
+  to_target.Bind();
+  source.Bind(0);
   pass_->Draw();
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   return target.Download();

@@ -13,6 +13,20 @@ int GaussianTaps(double sigma_px);
 // CPU reference: the shader's separable kernel (normalised, clamp-to-edge) on CV_32FC4 premultiplied linear RGBA.
 cv::Mat GaussianBlurCpu(const cv::Mat& rgba, double r_px);
 
+// The pillbox kernel of radius r (px): weight clamp(r + 0.5 - distance, 0, 1), normalised; (2 t + 1)^2 taps with
+// t = ceil(r + 0.5). The same formula as shaders/blur_disc.frag.
+cv::Mat DiscKernel(double r_px);
+cv::Mat DiscBlurCpu(const cv::Mat& rgba, double r_px);
+
+// Second-order Butterworth low-pass (the thesis's pre-research filter), in the frequency domain:
+// H = 1 / (1 + (D / D0)^(2 n)), D the distance from zero frequency in cycles per image width, D0 = cutoff.
+// The image is mirror-padded first so its borders do not wrap around.
+cv::Mat ButterworthBlurCpu(const cv::Mat& rgba, double cutoff_cycles_per_width, int order = 2);
+
+// 8-bit sRGB BGR/BGRA/grey -> CV_32FC4 linear premultiplied BGRA, and back (alpha kept when `keep_alpha`).
+cv::Mat ToLinearPremultiplied(const cv::Mat& image8);
+cv::Mat FromLinearPremultiplied(const cv::Mat& rgba, bool keep_alpha);
+
 class GlContext;
 class Program;
 class FullscreenPass;
@@ -26,9 +40,11 @@ class GlBlur {
   GlBlur& operator=(const GlBlur&) = delete;
   // Two passes (horizontal, vertical) of the Gaussian of r = 2 s; CV_32FC4 in and out.
   cv::Mat Gaussian(const cv::Mat& rgba, double r_px);
+  // One pass of the pillbox of radius r.
+  cv::Mat Disc(const cv::Mat& rgba, double r_px);
 
  private:
-  std::unique_ptr<Program> gaussian_;
+  std::unique_ptr<Program> gaussian_, disc_;
   std::unique_ptr<FullscreenPass> pass_;
 };
 

@@ -86,3 +86,75 @@ TEST(CpuBlur, GaussianEdgeHasRequestedRadius) {
 
 }  // namespace
 }  // namespace blurcue::render
+
+namespace blurcue::render {
+namespace {
+
+TEST_F(GlTest, DiscMatchesCpuReference) {
+  GlBlur blur;
+  const cv::Mat img = Square(120, 100);
+  for (double r : {0.7, 3.0, 8.0}) {
+    cv::Mat diff;
+    cv::absdiff(blur.Disc(img, r), DiscBlurCpu(img, r), diff);
+    const cv::Scalar mean = cv::mean(diff);
+    double max = 0;
+    cv::minMaxLoc(diff.reshape(1), nullptr, &max);
+    EXPECT_LE((mean[0] + mean[1] + mean[2] + mean[3]) / 4, 0.5 / 255) << "r = " << r;
+    EXPECT_LE(max, 3.0 / 255) << "r = " << r;
+  }
+}
+
+// 2 x std of the derivative of a blurred vertical step, first channel.
+double EdgeRadius(const cv::Mat& out) {
+  const int y = out.rows / 2;
+  double m0 = 0, m1 = 0, m2 = 0;
+  for (int x = 1; x < out.cols; ++x) {
+    const double d = out.at<cv::Vec4f>(y, x)[0] - out.at<cv::Vec4f>(y, x - 1)[0];
+    const double pos = x - 0.5;
+    m0 += d, m1 += d * pos, m2 += d * pos * pos;
+  }
+  return 2 * std::sqrt(m2 / m0 - (m1 / m0) * (m1 / m0));
+}
+
+TEST(CpuBlur, DiscEdgeHasRequestedRadius) {
+  // A disc of radius R has an LSF (a semicircle) of std R / 2, so r = R.
+  cv::Mat img(41, 300, CV_32FC4, cv::Scalar(0, 0, 0, 1));
+  img.colRange(150, 300).setTo(cv::Scalar(1, 1, 1, 1));
+  for (double r : {4.0, 10.0, 16.0}) EXPECT_NEAR(EdgeRadius(DiscBlurCpu(img, r)), r, 0.05 * r) << r;
+}
+
+TEST(CpuBlur, ButterworthKeepsMeanAndSoftensMoreAtLowerCutoff) {
+  cv::Mat step(41, 256, CV_32FC4, cv::Scalar(0, 0, 0, 1));
+  step.colRange(128, 256).setTo(cv::Scalar(1, 1, 1, 1));
+  const cv::Mat soft = ButterworthBlurCpu(step, 8), sharp = ButterworthBlurCpu(step, 40);
+  EXPECT_NEAR(cv::mean(soft)[0], cv::mean(step)[0], 0.01);
+  EXPECT_NEAR(cv::mean(soft)[3], 1.0, 0.01);
+  // The second moment of a Butterworth LSF of order >= 2 is zero (H''(0) = 0: the ringing lobes cancel it), so
+  // r = 2 std is no measure of it; the 10-90 % rise distance is.
+  auto rise = [](const cv::Mat& out) {
+    int x10 = -1, x90 = -1;
+    for (int x = 0; x < out.cols; ++x) {
+      const float v = out.at<cv::Vec4f>(out.rows / 2, x)[0];
+      if (x10 < 0 && v >= 0.1f) x10 = x;
+      if (x90 < 0 && v >= 0.9f) x90 = x;
+    }
+    return x90 - x10;
+  };
+  EXPECT_GT(rise(soft), 3 * rise(sharp));
+}
+
+TEST(LinearPremultiplied, RoundTripsEightBitImages) {
+  cv::Mat img(8, 8, CV_8UC4);
+  cv::randu(img, 0, 256);
+  img.col(0).setTo(cv::Scalar(10, 200, 30, 255));
+  const cv::Mat back = FromLinearPremultiplied(ToLinearPremultiplied(img), true);
+  // Colour is exact where alpha is 255; elsewhere un-premultiplying 8-bit alpha loses a level at most.
+  EXPECT_EQ(cv::norm(img.col(0), back.col(0), cv::NORM_INF), 0);
+  cv::Mat a, b;
+  cv::extractChannel(img, a, 3);
+  cv::extractChannel(back, b, 3);
+  EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0);
+}
+
+}  // namespace
+}  // namespace blurcue::render

@@ -1,0 +1,23 @@
+#version 330 core
+// The thin-lens pillbox: every texel within radius R (= r, DESIGN.md) of the pixel, weighted by how much of it the
+// disc covers (1 inside, a linear ramp over the last pixel, 0 outside), normalised. Linear, premultiplied RGBA.
+uniform sampler2D u_image;
+uniform float u_radius_px;
+uniform int u_taps;            // ceil(R + 0.5)
+out vec4 o_color;
+void main() {
+  ivec2 size = textureSize(u_image, 0);
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  vec4 sum = vec4(0.0);
+  float weight_sum = 0.0;
+  for (int dy = -u_taps; dy <= u_taps; ++dy) {
+    for (int dx = -u_taps; dx <= u_taps; ++dx) {
+      float w = clamp(u_radius_px + 0.5 - length(vec2(dx, dy)), 0.0, 1.0);
+      if (w > 0.0) {
+        sum += w * texelFetch(u_image, clamp(p + ivec2(dx, dy), ivec2(0), size - 1), 0);
+        weight_sum += w;
+      }
+    }
+  }
+  o_color = sum / weight_sum;
+}
