@@ -1,0 +1,11 @@
+# Runs CMD with ARGS and checks it fails with exit code EXPECT_CODE and one line on stderr containing EXPECT_TEXT.
+execute_process(COMMAND ${CMD} ${ARGS} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+string(STRIP "${err}" err)
+if(NOT code EQUAL EXPECT_CODE)
+  message(FATAL_ERROR "exit code ${code}, expected ${EXPECT_CODE}\nstdout: ${out}\nstderr: ${err}")
+endif()
+string(FIND "${err}" "${EXPECT_TEXT}" at)
+if(at EQUAL -1)
+  message(FATAL_ERROR "stderr lacks '${EXPECT_TEXT}':\n${err}")
+endif()
+message(STATUS "ok: exit ${code}: ${err}")
