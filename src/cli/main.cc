@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
       {"synth-scene", &cli::AddSynthSceneCommand},
       {"calibrate", &cli::AddCalibrateCommand},
       {"estimate", &cli::AddEstimateCommand},
+      {"blur", &cli::AddBlurCommand},
       {"bench", &cli::AddBenchCommand},
   };
   for (const auto& [name, add] : commands) add(app);
