@@ -1,0 +1,132 @@
+#include "calib/scene_blur.h"
+
+#include <cmath>
+#include <limits>
+
+#include <opencv2/calib3d.hpp>
+
+#include "core/error.h"
+#include "optics/thin_lens.h"
+
+namespace blurcue::calib {
+namespace {
+
+cv::Vec3d Vec3(const Json& obj, const std::string& key, const std::string& where) {
+  const Json& v = obj.contains(key) ? obj[key] : Json();
+  if (!v.is_array() || v.size() != 3 || !v[0].is_number() || !v[1].is_number() || !v[2].is_number())
+    throw InputError(where + "/" + key, "must be an array of 3 numbers, got " + v.dump());
+  return {v[0].get<double>(), v[1].get<double>(), v[2].get<double>()};
+}
+
+const Json& Object(const Json& obj, const std::string& key, const std::string& where) {
+  if (!obj.contains(key) || !obj[key].is_object()) throw InputError(where + "/" + key, "must be an object");
+  return obj[key];
+}
+
+}  // namespace
+
+cv::Vec3d SceneCalib::ToCamera(const cv::Vec3d& board_mm) const {
+  cv::Matx33d rot;
+  cv::Rodrigues(rvec, rot);
+  return rot * board_mm + tvec;
+}
+
+SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
+  if (j.value("format", "") != "blurcue-calib")
+    throw InputError(where + "/format", "must be \"blurcue-calib\" (a file written by blurcue calibrate)");
+  SceneCalib s;
+  s.camera = CameraFromJson(Object(j, "camera", where), where + "/camera");
+  const Json& board = Object(j, "board", where);
+  s.board.cols = RequireInt(board, "cols", where + "/board");
+  s.board.rows = RequireInt(board, "rows", where + "/board");
+  s.board.square_mm = RequireNumber(board, "square_mm", where + "/board");
+  s.board.Validate(where + "/board");
+  const Json& pose = Object(j, "pose", where);
+  s.rvec = Vec3(pose, "rvec", where + "/pose");
+  s.tvec = Vec3(pose, "tvec", where + "/pose");
+  s.reference_edge = RequireInt(j, "reference_edge", where);
+  const Json& ref = Object(j, "reference", where);
+  s.reference_u_mm = RequireNumber(ref, "u_mm", where + "/reference");
+  s.reference_r_px = RequireNumber(ref, "r_px", where + "/reference");
+  const Json& model = Object(j, "model", where);
+  s.model.kind = model.value("kind", "thin_lens");
+  s.model.focus_mm = model.contains("focus_mm") && model["focus_mm"] == "infinity"
+                         ? std::numeric_limits<double>::infinity()
+                         : RequireNumber(model, "focus_mm", where + "/model");
+  s.model.aperture_mm = RequireNumber(model, "aperture_mm", where + "/model");
+  s.model.floor_px = model.value("floor_px", 0.0);
+  if (!j.contains("edges") || !j["edges"].is_array()) throw InputError(where + "/edges", "must be an array");
+  for (size_t e = 0; e < j["edges"].size(); ++e) {
+    const Json& edge = j["edges"][e];
+    const std::string ew = where + "/edges/" + std::to_string(e);
+    const int index = RequireInt(edge, "index", ew);
+    if (!edge.contains("sections") || !edge["sections"].is_array())
+      throw InputError(ew + "/sections", "must be an array");
+    for (size_t k = 0; k < edge["sections"].size(); ++k) {
+      const Json& sec = edge["sections"][k];
+      const std::string sw = ew + "/sections/" + std::to_string(k);
+      SceneCalib::Section out;
+      out.edge = index;
+      out.section = RequireInt(sec, "index", sw);
+      out.midpoint_camera_mm = Vec3(sec, "midpoint_camera_mm", sw);
+      out.r_px = RequireNumber(sec, "r_px", sw);
+      out.ok = sec.value("ok", false);
+      s.sections.push_back(out);
+    }
+  }
+  return s;
+}
+
+SceneCalib LoadSceneCalib(const std::filesystem::path& path) {
+  return SceneCalibFromJson(ReadJsonFile(path), path.string() + ": ");
+}
+
+BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px) {
+  if (text == "none") return BlurSource::kNone;
+  if (text == "measured") return BlurSource::kMeasured;
+  if (text == "estimated") return BlurSource::kEstimated;
+  if (text == "fitted") return BlurSource::kFitted;
+  char* end = nullptr;
+  const double r = std::strtod(text.c_str(), &end);
+  if (end != text.c_str() && *end == '\0' && r >= 0 && std::isfinite(r)) {
+    if (fixed_r_px) *fixed_r_px = r;
+    return BlurSource::kFixed;
+  }
+  throw Error(ErrorKind::kUsage,
+              "blur source must be none, measured, estimated, fitted or a radius in px >= 0, got '" + text + "'");
+}
+
+std::string ToString(BlurSource source) {
+  switch (source) {
+    case BlurSource::kNone: return "none";
+    case BlurSource::kMeasured: return "measured";
+    case BlurSource::kEstimated: return "estimated";
+    case BlurSource::kFitted: return "fitted";
+    case BlurSource::kFixed: return "fixed";
+  }
+  return "?";
+}
+
+double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& p, double fixed_r_px) {
+  const optics::Lens lens = optics::Lens::FromCamera(scene.camera);
+  switch (source) {
+    case BlurSource::kNone: return 0;
+    case BlurSource::kFixed: return fixed_r_px;
+    case BlurSource::kEstimated: return optics::Eq37Px(lens, scene.reference_u_mm, scene.reference_r_px, p[2]);
+    case BlurSource::kFitted: return scene.model.PredictPx(lens, p[2]);
+    case BlurSource::kMeasured: {
+      const SceneCalib::Section* best = nullptr;
+      double best_d = 1e300;
+      for (const auto& s : scene.sections) {
+        if (!s.ok) continue;
+        const double d = cv::norm(s.midpoint_camera_mm - p);
+        if (d < best_d) best_d = d, best = &s;
+      }
+      if (!best) throw Error(ErrorKind::kNotFound, "the calibration has no usable measured section");
+      return best->r_px;
+    }
+  }
+  return 0;
+}
+
+}  // namespace blurcue::calib

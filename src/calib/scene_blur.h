@@ -1,0 +1,53 @@
+#pragma once
+// A calibrated scene read back from calib.json, and the blur it calls for at any 3-D point: what the renderer asks
+// when it places virtual content (thesis section 4.4: "the blur on any point in the camera scene could be
+// calculated now").
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/board.h"
+#include "core/camera.h"
+#include "core/json_io.h"
+#include "optics/fit.h"
+
+namespace blurcue::calib {
+
+struct SceneCalib {
+  Camera camera;
+  Board board;
+  cv::Vec3d rvec, tvec;  // board frame -> camera, mm
+  int reference_edge = 1;
+  double reference_u_mm = 0, reference_r_px = 0;
+  optics::FittedModel model;
+  struct Section {
+    int edge = 0, section = 0;
+    cv::Vec3d midpoint_camera_mm;
+    double r_px = 0;
+    bool ok = false;
+  };
+  std::vector<Section> sections;
+
+  // Board-frame point (mm) -> camera frame (mm).
+  cv::Vec3d ToCamera(const cv::Vec3d& board_mm) const;
+};
+
+// Reads calib.json as written by `blurcue calibrate`; errors name the file and the JSON pointer.
+SceneCalib LoadSceneCalib(const std::filesystem::path& path);
+SceneCalib SceneCalibFromJson(const Json& json, const std::string& where);
+
+enum class BlurSource { kNone, kMeasured, kEstimated, kFitted, kFixed };
+// "none", "measured", "estimated", "fitted", or a number (a fixed radius in px). Throws Error(kUsage) otherwise.
+BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px);
+std::string ToString(BlurSource source);
+
+// Blur radius (px) the scene calls for at a camera-frame point:
+//   measured  - r_px of the nearest usable measured section (3-D distance between midpoints);
+//   estimated - eq. 3.7 from the reference edge at the point's depth (Error(kDomain) nearer than focus);
+//   fitted    - the fitted thin-lens model at the point's depth;
+//   fixed     - fixed_r_px; none - 0.
+double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& point_camera_mm, double fixed_r_px = 0);
+
+}  // namespace blurcue::calib
