@@ -1,1 +1,230 @@
-// placeholder: being written
+#include "optics/fit.h"
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+
+namespace blurcue::optics {
+namespace {
+
+const Lens kThesis{21.0, 21.0 / 5.6, 5.1e-3};
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// Table 4.3's edge depths (given there in cm), edge 1 nearest.
+const double kEdgeMm[] = {342.3, 359.6, 377.0, 394.3, 411.7, 429.0, 446.3, 463.7, 481.0, 498.3, 527.3};
+
+// Textbook blur-circle radius in px, r = D f |u - u0| / (2 u (u0 - f) pitch), independent of the code under test.
+double TruthPx(double u0, double u, double aperture_mm = kThesis.aperture_mm, double floor_px = 0) {
+  const double f = kThesis.focal_length_mm;
+  const double c = std::isinf(u0) ? aperture_mm * f / u : aperture_mm * f * std::abs(u - u0) / (u * (u0 - f));
+  const double r = c / 2 / kThesis.pixel_pitch_mm;
+  return std::sqrt(r * r + floor_px * floor_px);
+}
+
+struct SceneSpec {
+  double focus_mm = 258.18;  // what the thesis's r1 = 8 px at edge 1 implies
+  double floor_px = 0;
+  double noise_px = 0;
+  int first_edge = 1, last_edge = 11;
+  uint64_t seed = 1;
+};
+
+// 7 sections per edge, like the 11 x 7 sections of the thesis's board.
+std::vector<BlurSample> Samples(const SceneSpec& spec) {
+  std::mt19937_64 rng(spec.seed);
+  std::normal_distribution<double> noise(0.0, spec.noise_px);
+  std::vector<BlurSample> out;
+  for (int e = spec.first_edge; e <= spec.last_edge; ++e)
+    for (int s = 0; s < 7; ++s) {
+      const double u = kEdgeMm[e - 1];
+      const double r = TruthPx(spec.focus_mm, u, kThesis.aperture_mm, spec.floor_px);
+      out.push_back({u, std::max(0.0, r + (spec.noise_px > 0 ? noise(rng) : 0.0)), 1.0});
+    }
+  return out;
+}
+
+TEST(FitThinLens, RecoversFocusAndApertureFromExactSamples) {
+  const FittedModel m = FitThinLens(kThesis, Samples({}));
+  EXPECT_NEAR(m.focus_mm, 258.18, 0.01 * 258.18);
+  EXPECT_NEAR(m.aperture_mm, 3.75, 0.01 * 3.75);
+  EXPECT_EQ(m.kind, "thin_lens");
+  EXPECT_EQ(m.floor_px, 0.0);
+  EXPECT_EQ(m.samples_used, 77);
+  EXPECT_EQ(m.outliers, 0);
+  EXPECT_LT(m.rms_px, 1e-3);
+  EXPECT_LT(m.loo_rms_px, 1e-3);
+}
+
+TEST(FitThinLens, RecoversFocusAndApertureFromNoisySamples) {
+  SceneSpec spec;
+  spec.noise_px = 0.2;
+  const FittedModel m = FitThinLens(kThesis, Samples(spec));
+  EXPECT_NEAR(m.focus_mm, 258.18, 0.03 * 258.18);
+  EXPECT_NEAR(m.aperture_mm, 3.75, 0.03 * 3.75);
+  // The residual is the noise, no more and not much less.
+  EXPECT_GT(m.rms_px, 0.1);
+  EXPECT_LT(m.rms_px, 0.3);
+}
+
+TEST(FitThinLens, RobustToGrossOutliers) {
+  SceneSpec spec;
+  spec.noise_px = 0.1;
+  std::vector<BlurSample> samples = Samples(spec);
+  // A printing flaw (dark spots) doubles the measured radius on every tenth section.
+  int flawed = 0;
+  for (size_t i = 3; i < samples.size(); i += 10) samples[i].r_px *= 2, ++flawed;
+  ASSERT_GE(flawed, 7);
+  const FittedModel m = FitThinLens(kThesis, samples);
+  EXPECT_NEAR(m.focus_mm, 258.18, 0.03 * 258.18);
+  EXPECT_NEAR(m.aperture_mm, 3.75, 0.03 * 3.75);
+  EXPECT_EQ(m.outliers, flawed);
+  EXPECT_LT(m.rms_px, 0.3);
+}
+
+TEST(FitThinLens, FocusInsideTheSampleRange) {
+  SceneSpec spec;
+  spec.focus_mm = 430.0;
+  const FittedModel m = FitThinLens(kThesis, Samples(spec));
+  EXPECT_NEAR(m.focus_mm, 430.0, 0.01 * 430.0);
+  EXPECT_NEAR(m.aperture_mm, 3.75, 0.01 * 3.75);
+}
+
+TEST(FitThinLens, FocusBeyondAllSamples) {
+  SceneSpec spec;
+  spec.focus_mm = 800.0;
+  spec.noise_px = 0.1;
+  const FittedModel m = FitThinLens(kThesis, Samples(spec));
+  EXPECT_NEAR(m.focus_mm, 800.0, 0.03 * 800.0);
+  EXPECT_NEAR(m.aperture_mm, 3.75, 0.03 * 3.75);
+}
+
+TEST(FitThinLens, FocusAtInfinity) {
+  SceneSpec spec;
+  spec.focus_mm = kInf;
+  const FittedModel m = FitThinLens(kThesis, Samples(spec));
+  // Beyond 1 km is infinity for a 21 mm lens looking at half a metre.
+  EXPECT_GT(m.focus_mm, 1e6);
+  EXPECT_NEAR(m.aperture_mm, 3.75, 0.01 * 3.75);
+  EXPECT_NEAR(m.PredictPx(kThesis, 1000.0), TruthPx(kInf, 1000.0), 0.01 * TruthPx(kInf, 1000.0));
+}
+
+TEST(FitThinLens, KeepsFloorWhenDataHaveOne) {
+  SceneSpec spec;
+  spec.focus_mm = 430.0;
+  spec.floor_px = 1.5;
+  spec.noise_px = 0.05;
+  const FittedModel m = FitThinLens(kThesis, Samples(spec));
+  EXPECT_EQ(m.kind, "thin_lens+floor");
+  EXPECT_NEAR(m.floor_px, 1.5, 0.1 * 1.5);
+  EXPECT_NEAR(m.focus_mm, 430.0, 0.02 * 430.0);
+  EXPECT_NEAR(m.aperture_mm, 3.75, 0.03 * 3.75);
+  EXPECT_LT(m.loo_rms_px, 0.1);
+}
+
+TEST(FitThinLens, DropsFloorWhenDataHaveNone) {
+  SceneSpec spec;
+  spec.focus_mm = 430.0;
+  spec.noise_px = 0.05;
+  for (uint64_t seed = 1; seed <= 5; ++seed) {
+    spec.seed = seed;
+    const FittedModel m = FitThinLens(kThesis, Samples(spec));
+    EXPECT_EQ(m.kind, "thin_lens") << "seed " << seed;
+    EXPECT_EQ(m.floor_px, 0.0) << "seed " << seed;
+  }
+}
+
+TEST(FitThinLens, NoFloorWhenNotAllowed) {
+  SceneSpec spec;
+  spec.focus_mm = 430.0;
+  spec.floor_px = 1.5;
+  FitOptions options;
+  options.allow_floor = false;
+  const FittedModel m = FitThinLens(kThesis, Samples(spec), options);
+  EXPECT_EQ(m.kind, "thin_lens");
+  EXPECT_EQ(m.floor_px, 0.0);
+  // The floor it may not model shows up in the residual.
+  EXPECT_GT(m.rms_px, 0.1);
+}
+
+TEST(FitThinLens, PredictsHeldOutDepths) {
+  SceneSpec spec;
+  spec.noise_px = 0.1;
+  spec.last_edge = 7;
+  const FittedModel m = FitThinLens(kThesis, Samples(spec));
+  for (int e = 8; e <= 11; ++e) {
+    const double truth = TruthPx(258.18, kEdgeMm[e - 1]);
+    EXPECT_NEAR(m.PredictPx(kThesis, kEdgeMm[e - 1]), truth, 0.05 * truth) << "edge " << e;
+  }
+}
+
+TEST(FitThinLens, ZeroWeightDropsSample) {
+  std::vector<BlurSample> samples = Samples({});
+  samples.push_back({400.0, 1000.0, 0.0});
+  const FittedModel m = FitThinLens(kThesis, samples);
+  EXPECT_EQ(m.samples_used, 77);
+  EXPECT_EQ(m.outliers, 0);
+  EXPECT_NEAR(m.focus_mm, 258.18, 0.01 * 258.18);
+}
+
+TEST(FitThinLens, FewerThanThreeSamplesIsNotFound) {
+  const std::vector<BlurSample> two = {{342.3, 8.0, 1.0}, {527.3, 16.6, 1.0}, {400.0, 12.0, 0.0}};
+  try {
+    FitThinLens(kThesis, two);
+    FAIL() << "expected Error(kNotFound)";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kNotFound);
+    EXPECT_NE(std::string(e.what()).find("got 2"), std::string::npos) << e.what();
+  }
+}
+
+TEST(FitThinLens, SamplesAtOneDepthIsNotFound) {
+  const std::vector<BlurSample> one_depth = {{400.0, 8.0, 1.0}, {400.0, 8.5, 1.0}, {400.0, 7.5, 1.0}};
+  try {
+    FitThinLens(kThesis, one_depth);
+    FAIL() << "expected Error(kNotFound)";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kNotFound);
+    EXPECT_NE(std::string(e.what()).find("one depth"), std::string::npos) << e.what();
+  }
+}
+
+TEST(FitThinLens, SampleInsideFocalLengthIsDomainError) {
+  std::vector<BlurSample> samples = Samples({});
+  samples[5].u_mm = 20.0;
+  try {
+    FitThinLens(kThesis, samples);
+    FAIL() << "expected Error(kDomain)";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kDomain);
+    EXPECT_NE(std::string(e.what()).find("sample 5"), std::string::npos) << e.what();
+  }
+}
+
+TEST(FitThinLens, NegativeRadiusIsInputError) {
+  std::vector<BlurSample> samples = Samples({});
+  samples[2].r_px = -1.0;
+  try {
+    FitThinLens(kThesis, samples);
+    FAIL() << "expected Error(kInput)";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    EXPECT_NE(std::string(e.what()).find("sample 2 r_px: must be a finite number >= 0, got -1"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(FittedModel, PredictPxAddsFloorInQuadrature) {
+  FittedModel m;
+  m.focus_mm = 430.0;
+  m.aperture_mm = 3.75;
+  m.floor_px = 2.0;
+  for (double u : {342.3, 430.0, 527.3})
+    EXPECT_NEAR(m.PredictPx(kThesis, u), TruthPx(430.0, u, 3.75, 2.0), 1e-9) << "u = " << u;
+}
+
+}  // namespace
+}  // namespace blurcue::optics
