@@ -5,6 +5,8 @@
 #include <sstream>
 #include <vector>
 
+#include <opencv2/imgproc.hpp>
+
 #include "core/error.h"
 
 namespace blurcue::render {
@@ -89,6 +91,25 @@ Texture::Texture(int width_px, int height_px, GLenum internal_format)
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
 }
 
+Texture Texture::FromSrgbImage(const cv::Mat& image) {
+  CV_Assert(image.depth() == CV_8U && (image.channels() == 3 || image.channels() == 4 || image.channels() == 1));
+  cv::Mat rgba;
+  const int code = image.channels() == 1 ? cv::COLOR_GRAY2RGBA
+                   : image.channels() == 3 ? cv::COLOR_BGR2RGBA : cv::COLOR_BGRA2RGBA;
+  cv::cvtColor(image, rgba, code);
+  Texture t(rgba.cols, rgba.rows, GL_SRGB8_ALPHA8);
+  glBindTexture(GL_TEXTURE_2D, t.id());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, rgba.cols, rgba.rows, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
+  glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  // Longitude wraps around a sphere; latitude and card edges clamp.
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  return t;
+}
+
 void Texture::Upload(const cv::Mat& rgba) {
   CV_Assert(rgba.cols == width_ && rgba.rows == height_ && rgba.channels() == 4);
   CV_Assert(rgba.depth() == CV_32F || rgba.depth() == CV_8U);
@@ -112,12 +133,21 @@ void Texture::Bind(int unit) const {
   glBindTexture(GL_TEXTURE_2D, name_.id());
 }
 
-Framebuffer::Framebuffer(const Texture& color) : width_(color.width_px()), height_(color.height_px()) {
+Framebuffer::Framebuffer(const Texture& color, bool with_depth)
+    : width_(color.width_px()), height_(color.height_px()) {
   GLuint id = 0;
   glGenFramebuffers(1, &id);
   name_ = GlName(id, [](GLuint i) { glDeleteFramebuffers(1, &i); });
   glBindFramebuffer(GL_FRAMEBUFFER, id);
   glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, color.id(), 0);
+  if (with_depth) {
+    GLuint rb = 0;
+    glGenRenderbuffers(1, &rb);
+    depth_ = GlName(rb, [](GLuint i) { glDeleteRenderbuffers(1, &i); });
+    glBindRenderbuffer(GL_RENDERBUFFER, rb);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width_, height_);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, rb);
+  }
   const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE)
     throw Error(ErrorKind::kInternal, "GL: framebuffer incomplete, status " + std::to_string(status));

@@ -59,7 +59,11 @@ class Texture {
  public:
   // An empty RGBA texture; internal_format e.g. GL_RGBA32F (linear, premultiplied) or GL_RGBA8.
   Texture(int width_px, int height_px, GLenum internal_format = GL_RGBA32F);
-  // Uploads CV_32FC4 (or CV_8UC4) rows top-down; row 0 of the Mat is texture row 0.
+  // An sRGB texture (sampling decodes to linear) from an 8-bit BGR/BGRA image, mipmapped and trilinear, for
+  // object surfaces seen smaller than their texture.
+  static Texture FromSrgbImage(const cv::Mat& bgr_or_bgra);
+  // Uploads CV_32FC4 (or CV_8UC4) rows top-down; row 0 of the Mat is texture row 0. Everything in blurcue keeps
+  // that convention (image row = texture row = gl_FragCoord.y), so nothing is ever flipped.
   void Upload(const cv::Mat& rgba);
   // Reads the whole texture back as CV_32FC4.
   cv::Mat Download() const;
@@ -76,13 +80,13 @@ class Texture {
 
 class Framebuffer {
  public:
-  // Renders into `color` (which must outlive this framebuffer).
-  explicit Framebuffer(const Texture& color);
+  // Renders into `color` (which must outlive this framebuffer), with a depth buffer when `with_depth`.
+  explicit Framebuffer(const Texture& color, bool with_depth = false);
   void Bind() const;
   GLuint id() const { return name_.id(); }
 
  private:
-  GlName name_;
+  GlName name_, depth_;
   int width_ = 0, height_ = 0;
 };
 

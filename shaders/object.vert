@@ -1,0 +1,17 @@
+#version 330 core
+// Virtual content in the board frame (mm), projected with the calibrated pose and intrinsics.
+layout(location = 0) in vec3 a_position;  // board frame, mm
+layout(location = 1) in vec3 a_normal;    // board frame
+layout(location = 2) in vec2 a_uv;
+uniform mat4 u_board_to_camera;           // rigid: the calibrated pose (OpenCV camera frame, mm)
+uniform mat4 u_projection;                // camera frame -> clip, image rows = framebuffer rows
+out vec3 v_normal_camera;
+out vec2 v_uv;
+out float v_depth_mm;
+void main() {
+  vec4 p = u_board_to_camera * vec4(a_position, 1.0);
+  v_normal_camera = mat3(u_board_to_camera) * a_normal;
+  v_uv = a_uv;
+  v_depth_mm = p.z;
+  gl_Position = u_projection * p;
+}

@@ -1,0 +1,230 @@
+#include "render/scene_render.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/error.h"
+#include "render/blur.h"
+#include "render/gl_objects.h"
+
+namespace blurcue::render {
+namespace {
+
+struct Vertex {
+  float position[3];
+  float normal[3];
+  float uv[2];
+};
+
+cv::Matx33d SpinAboutX(double deg) {
+  const double a = deg * M_PI / 180, c = std::cos(a), s = std::sin(a);
+  return {1, 0, 0, 0, c, -s, 0, s, c};
+}
+
+// A UV sphere: longitude along u, latitude along v (v = 0 at the board's +z pole).
+std::vector<Vertex> SphereTriangles(const VirtualObject& o) {
+  const int n_lat = 48, n_lon = 96;
+  const cv::Matx33d spin = SpinAboutX(o.spin_deg);
+  auto vertex = [&](int i, int j) {
+    const double theta = M_PI * i / n_lat, phi = 2 * M_PI * j / n_lon;
+    const cv::Vec3d n = spin * cv::Vec3d(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                                         std::cos(theta));
+    const cv::Vec3d p = o.center_board_mm + o.size_mm * n;
+    return Vertex{{float(p[0]), float(p[1]), float(p[2])},
+                  {float(n[0]), float(n[1]), float(n[2])},
+                  {float(double(j) / n_lon), float(double(i) / n_lat)}};
+  };
+  std::vector<Vertex> tris;
+  for (int i = 0; i < n_lat; ++i)
+    for (int j = 0; j < n_lon; ++j) {
+      const Vertex a = vertex(i, j), b = vertex(i + 1, j), c = vertex(i + 1, j + 1), d = vertex(i, j + 1);
+      tris.insert(tris.end(), {a, b, c, a, c, d});
+    }
+  return tris;
+}
+
+// A flat card on the table; texture row 0 (the image's top) on the far side (+y).
+std::vector<Vertex> CardTriangles(const VirtualObject& o) {
+  const float h = float(o.size_mm / 2), x = float(o.center_board_mm[0]), y = float(o.center_board_mm[1]),
+              z = float(o.center_board_mm[2]);
+  const Vertex a{{x - h, y + h, z}, {0, 0, 1}, {0, 0}}, b{{x + h, y + h, z}, {0, 0, 1}, {1, 0}},
+      c{{x + h, y - h, z}, {0, 0, 1}, {1, 1}}, d{{x - h, y - h, z}, {0, 0, 1}, {0, 1}};
+  return {a, b, c, a, c, d};
+}
+
+// The corners of the object's board-frame bounding box.
+std::vector<cv::Point3d> BoxCorners(const VirtualObject& o) {
+  const double h = o.size_mm, hz = o.kind == VirtualObject::Kind::kCard ? 0 : o.size_mm;
+  const double hx = o.kind == VirtualObject::Kind::kCard ? o.size_mm / 2 : h;
+  std::vector<cv::Point3d> corners;
+  for (int sx : {-1, 1})
+    for (int sy : {-1, 1})
+      for (int sz : {-1, 1})
+        corners.emplace_back(o.center_board_mm[0] + sx * hx, o.center_board_mm[1] + sy * hx,
+                             o.center_board_mm[2] + sz * hz);
+  return corners;
+}
+
+}  // namespace
+
+struct SceneRenderer::Impl {
+  Camera camera;
+  cv::Vec3d rvec, tvec;
+  cv::Matx33d rotation;
+  Program program = Program::FromFiles(ShaderDir() / "object.vert", ShaderDir() / "object.frag");
+  GlName vao, vbo;
+  // Textures by the address of their pixels: a moving ball re-uses its texture every frame.
+  std::map<const uchar*, std::unique_ptr<Texture>> textures;
+
+  const Texture& TextureFor(const cv::Mat& image) {
+    auto& slot = textures[image.data];
+    if (!slot) slot = std::make_unique<Texture>(Texture::FromSrgbImage(image));
+    return *slot;
+  }
+};
+
+SceneRenderer::SceneRenderer(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->camera = camera;
+  impl_->rvec = rvec;
+  impl_->tvec = tvec;
+  cv::Rodrigues(rvec, impl_->rotation);
+  GLuint id = 0;
+  glGenVertexArrays(1, &id);
+  impl_->vao = GlName(id, [](GLuint i) { glDeleteVertexArrays(1, &i); });
+  glGenBuffers(1, &id);
+  impl_->vbo = GlName(id, [](GLuint i) { glDeleteBuffers(1, &i); });
+  glBindVertexArray(impl_->vao.id());
+  glBindBuffer(GL_ARRAY_BUFFER, impl_->vbo.id());
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, position)));
+  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, normal)));
+  glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, uv)));
+  for (int i = 0; i < 3; ++i) glEnableVertexAttribArray(i);
+  glBindVertexArray(0);
+}
+
+SceneRenderer::~SceneRenderer() = default;
+
+Footprint SceneRenderer::Measure(const VirtualObject& o) const {
+  const auto corners = BoxCorners(o);
+  std::vector<cv::Point2d> px;
+  cv::projectPoints(corners, impl_->rvec, impl_->tvec, cv::Matx33d(impl_->camera.Intrinsics().data()),
+                    impl_->camera.dist_coeffs, px);
+  Footprint f;
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+  f.z_min_mm = 1e300, f.z_max_mm = -1e300;
+  for (size_t i = 0; i < corners.size(); ++i) {
+    x0 = std::min(x0, px[i].x), x1 = std::max(x1, px[i].x), y0 = std::min(y0, px[i].y), y1 = std::max(y1, px[i].y);
+    const double z = (impl_->rotation * cv::Vec3d(corners[i]) + impl_->tvec)[2];
+    f.z_min_mm = std::min(f.z_min_mm, z), f.z_max_mm = std::max(f.z_max_mm, z);
+  }
+  f.bounds = cv::Rect(cv::Point(int(std::floor(x0)) - 1, int(std::floor(y0)) - 1),
+                      cv::Point(int(std::ceil(x1)) + 2, int(std::ceil(y1)) + 2));
+  f.z_center_mm = (impl_->rotation * o.center_board_mm + impl_->tvec)[2];
+  if (o.kind == VirtualObject::Kind::kBall) {  // a sphere spans its diameter in depth, not its box's diagonal
+    f.z_min_mm = f.z_center_mm - o.size_mm;
+    f.z_max_mm = f.z_center_mm + o.size_mm;
+  }
+  return f;
+}
+
+Layer SceneRenderer::Draw(const VirtualObject& o, int margin_px) {
+  const Camera& cam = impl_->camera;
+  const Footprint f = Measure(o);
+  Layer layer;
+  layer.roi = cv::Rect(f.bounds.x - margin_px, f.bounds.y - margin_px, f.bounds.width + 2 * margin_px,
+                       f.bounds.height + 2 * margin_px) &
+              cv::Rect(0, 0, cam.image_width_px, cam.image_height_px);
+  if (layer.roi.empty()) {
+    layer.bgra = cv::Mat(0, 0, CV_32FC4);
+    return layer;
+  }
+  const int w = layer.roi.width, h = layer.roi.height;
+  const auto k = cam.Intrinsics();
+  // Camera frame -> clip for this sub-window; framebuffer row r is image row roi.y + r (nothing is flipped).
+  const double n = 1.0, far = 1e5;
+  glm::mat4 projection(0.0f);  // column-major: projection[col][row]
+  projection[0][0] = float(2 * k[0] / w);
+  projection[1][1] = float(2 * k[4] / h);
+  projection[2][0] = float(2 * (k[2] + 0.5 - layer.roi.x) / w - 1);
+  projection[2][1] = float(2 * (k[5] + 0.5 - layer.roi.y) / h - 1);
+  projection[2][2] = float((far + n) / (far - n));
+  projection[3][2] = float(-2 * far * n / (far - n));
+  projection[2][3] = 1.0f;
+  glm::mat4 pose(1.0f);
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) pose[c][r] = float(impl_->rotation(r, c));
+    pose[3][r] = float(impl_->tvec[r]);
+  }
+
+  const std::vector<Vertex> tris = o.kind == VirtualObject::Kind::kBall ? SphereTriangles(o) : CardTriangles(o);
+  Texture target(w, h);
+  Framebuffer fb(target, /*with_depth=*/true);
+  fb.Bind();
+  glClearColor(0, 0, 0, 0);
+  glClearDepth(1.0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_DEPTH_TEST);
+  glDisable(GL_CULL_FACE);  // the unflipped image-row convention mirrors winding
+  Program& p = impl_->program;
+  p.Use();
+  glUniformMatrix4fv(p.Uniform("u_board_to_camera"), 1, GL_FALSE, glm::value_ptr(pose));
+  glUniformMatrix4fv(p.Uniform("u_projection"), 1, GL_FALSE, glm::value_ptr(projection));
+  // Light from above the table and behind the camera: camera frame has y down.
+  const glm::vec3 light = glm::normalize(glm::vec3(-0.3f, -1.0f, -0.6f));
+  glUniform3f(p.Uniform("u_light_dir"), light.x, light.y, light.z);
+  glUniform1f(p.Uniform("u_ambient"), 0.45f);
+  glUniform1f(p.Uniform("u_lit"), o.kind == VirtualObject::Kind::kBall ? 1.0f : 0.0f);
+  glUniform1f(p.Uniform("u_brightness"), float(o.brightness));
+  glUniform1f(p.Uniform("u_contrast"), float(o.contrast));
+  glUniform1i(p.Uniform("u_texture"), 0);
+  impl_->TextureFor(o.texture).Bind(0);
+  glBindVertexArray(impl_->vao.id());
+  glBindBuffer(GL_ARRAY_BUFFER, impl_->vbo.id());
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(tris.size() * sizeof(Vertex)), tris.data(), GL_STREAM_DRAW);
+  glDrawArrays(GL_TRIANGLES, 0, GLsizei(tris.size()));
+  glBindVertexArray(0);
+  glDisable(GL_DEPTH_TEST);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  cv::cvtColor(target.Download(), layer.bgra, cv::COLOR_RGBA2BGRA);
+  return layer;
+}
+
+int KernelMarginPx(const std::string& method, double r_px) {
+  if (r_px <= 0) return 0;
+  return method == "disc" ? int(std::ceil(r_px + 0.5)) : GaussianTaps(r_px / 2);
+}
+
+void BlurLayer(Layer& layer, const std::string& method, double r_px, GlBlur* gl) {
+  if (r_px <= 0 || layer.bgra.empty()) return;
+  if (method != "gaussian" && method != "disc")
+    throw Error(ErrorKind::kUsage, "blur method for objects must be gaussian or disc, got '" + method + "'");
+  const bool disc = method == "disc";
+  if (gl) {
+    layer.bgra = disc ? gl->Disc(layer.bgra, r_px) : gl->Gaussian(layer.bgra, r_px);
+  } else {
+    layer.bgra = disc ? DiscBlurCpu(layer.bgra, r_px) : GaussianBlurCpu(layer.bgra, r_px);
+  }
+}
+
+void CompositeOver(cv::Mat& background, const Layer& layer) {
+  CV_Assert(background.type() == CV_32FC3);
+  if (layer.bgra.empty()) return;
+  for (int y = 0; y < layer.roi.height; ++y) {
+    cv::Vec3f* bg = background.ptr<cv::Vec3f>(layer.roi.y + y) + layer.roi.x;
+    const cv::Vec4f* fg = layer.bgra.ptr<cv::Vec4f>(y);
+    for (int x = 0; x < layer.roi.width; ++x) {
+      const float keep = 1.0f - fg[x][3];
+      bg[x] = cv::Vec3f(fg[x][0] + keep * bg[x][0], fg[x][1] + keep * bg[x][1], fg[x][2] + keep * bg[x][2]);
+    }
+  }
+}
+
+}  // namespace blurcue::render

@@ -1,0 +1,65 @@
+#pragma once
+// Virtual content placed in a calibrated scene's board frame (mm), drawn with GL into a layer that covers only the
+// object's pixels plus the blur kernel's margin (model no more than a scene needs), blurred, and composited over
+// the photo in linear light.
+#include <memory>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "core/camera.h"
+
+namespace blurcue::render {
+
+struct VirtualObject {
+  enum class Kind { kCard, kBall };
+  Kind kind = Kind::kBall;
+  // Card: centre of a flat square card lying on the table (z = 0); ball: centre of the sphere.
+  cv::Vec3d center_board_mm{0, 0, 10};
+  double size_mm = 10;  // card: side; ball: radius
+  cv::Mat texture;      // 8-bit sRGB BGR/BGRA: equirectangular for a ball, the card's face for a card
+  double brightness = 1.0, contrast = 1.0;
+  double spin_deg = 0;  // rotation of a ball about the board's x axis (rolling along y)
+};
+
+// Where the object lands in the photo, and how far it spans in depth.
+struct Footprint {
+  cv::Rect bounds;             // projected bounding box in image pixels (not clipped)
+  double z_min_mm = 0, z_max_mm = 0, z_center_mm = 0;
+};
+
+// An object drawn alone: premultiplied linear RGBA (CV_32FC4, BGRA order like OpenCV) over `roi` of the photo.
+struct Layer {
+  cv::Rect roi;
+  cv::Mat bgra;
+};
+
+class SceneRenderer {
+ public:
+  // Needs a current GL context. rvec/tvec: board frame -> camera (mm).
+  SceneRenderer(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec);
+  ~SceneRenderer();
+  SceneRenderer(const SceneRenderer&) = delete;
+  SceneRenderer& operator=(const SceneRenderer&) = delete;
+
+  Footprint Measure(const VirtualObject& object) const;
+  // Draws the object into a layer covering its bounds grown by margin_px, clipped to the image.
+  Layer Draw(const VirtualObject& object, int margin_px);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Blurs a layer in place with one radius: "gaussian" (s = r/2) or "disc", on the GL path when `gl` is given
+// (CPU reference otherwise). The layer's margin must cover the kernel.
+class GlBlur;
+void BlurLayer(Layer& layer, const std::string& method, double r_px, GlBlur* gl);
+
+// The margin (px) a blur of radius r needs around an object: the kernel's half-width.
+int KernelMarginPx(const std::string& method, double r_px);
+
+// `background` linear BGR (CV_32FC3); the layer composited over it ("over", premultiplied), in place.
+void CompositeOver(cv::Mat& background_linear, const Layer& layer);
+
+}  // namespace blurcue::render
