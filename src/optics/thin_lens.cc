@@ -21,11 +21,12 @@ void RequireBeyondFocalLength(const Lens& lens, double u_mm, const char* name) {
                                         Mm(lens.focal_length_mm) + ": a thin lens forms no real image there");
 }
 
-// v0/v for a point at u: u0 (u - f) / (u (u0 - f)); at u0 = infinity it is (u - f) / u.
+// 1 - f/u = f / v: written this way every formula stays finite for a point or a focus at infinity.
+double InverseMagnification(const Lens& lens, double u_mm) { return 1 - lens.focal_length_mm / u_mm; }
+
+// v0 / v for a point at u with focus at u0: u0 (u - f) / (u (u0 - f)).
 double ImageDistanceRatio(const Lens& lens, double focus_mm, double u_mm) {
-  const double f = lens.focal_length_mm;
-  if (std::isinf(focus_mm)) return (u_mm - f) / u_mm;
-  return focus_mm * (u_mm - f) / (u_mm * (focus_mm - f));
+  return InverseMagnification(lens, u_mm) / InverseMagnification(lens, focus_mm);
 }
 
 }  // namespace
@@ -49,8 +50,9 @@ double BlurRadiusPx(const Lens& lens, double focus_mm, double u_mm) {
 double Eq37SignedPx(const Lens& lens, double u1_mm, double r1_signed_px, double u2_mm) {
   RequireBeyondFocalLength(lens, u1_mm, "u1");
   RequireBeyondFocalLength(lens, u2_mm, "u2");
-  const double f = lens.focal_length_mm, D = lens.aperture_mm, sigma = lens.pixel_pitch_mm;
-  const double ratio = u1_mm * (u2_mm - f) / (u2_mm * (u1_mm - f));
+  const double D = lens.aperture_mm, sigma = lens.pixel_pitch_mm;
+  // u1 (u2 - f) / (u2 (u1 - f)), the published ratio, in a form that holds at infinity too.
+  const double ratio = InverseMagnification(lens, u2_mm) / InverseMagnification(lens, u1_mm);
   return (ratio * (2 * r1_signed_px * sigma + D) - D) / (2 * sigma);
 }
 
@@ -75,7 +77,7 @@ double FocusFromReferenceMm(const Lens& lens, double u1_mm, double r1_signed_px)
   RequireBeyondFocalLength(lens, u1_mm, "u1");
   const double f = lens.focal_length_mm;
   // v0 / v1 = (2 R1 + D) / D  ->  v0, then u0 = f v0 / (v0 - f).
-  const double v1 = f * u1_mm / (u1_mm - f);
+  const double v1 = f / InverseMagnification(lens, u1_mm);
   const double v0 = v1 * (2 * r1_signed_px * lens.pixel_pitch_mm + lens.aperture_mm) / lens.aperture_mm;
   const double eps = 1e-12 * f;
   if (std::abs(v0 - f) <= eps) return std::numeric_limits<double>::infinity();

@@ -176,9 +176,8 @@ TEST(ThinLens, NeverReturnsNaN) {
     }
 }
 
-// Known gap in thin_lens.cc, left to its owner: a point (u, u1 or u2) at +infinity gives inf/inf = NaN, where the
-// thin lens has a finite answer, R = D f / (2 (u0 - f)). Enable once fixed.
-TEST(ThinLens, DISABLED_PointAtInfinityIsFinite) {
+// A point (u, u1 or u2) at +infinity has a finite blur circle, R = D f / (2 (u0 - f)), not inf/inf.
+TEST(ThinLens, PointAtInfinityIsFinite) {
   const double expected = kThesis.aperture_mm * kThesis.focal_length_mm / (2 * (430.0 - 21.0)) /
                           kThesis.pixel_pitch_mm;
   EXPECT_NEAR(SignedBlurRadiusPx(kThesis, 430.0, kInf), expected, 1e-9);
