@@ -10,5 +10,6 @@ void AddSynthSceneCommand(CLI::App& app);   // synth_scene_command.cc
 void AddCalibrateCommand(CLI::App& app);    // calibrate_command.cc
 void AddBenchCommand(CLI::App& app);        // bench_command.cc
 void AddBlurCommand(CLI::App& app);         // blur_command.cc
+void AddRenderCommand(CLI::App& app);       // render_command.cc
 
 }  // namespace blurcue::cli

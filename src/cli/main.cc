@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
       {"calibrate", &cli::AddCalibrateCommand},
       {"estimate", &cli::AddEstimateCommand},
       {"blur", &cli::AddBlurCommand},
+      {"render", &cli::AddRenderCommand},
       {"bench", &cli::AddBenchCommand},
   };
   for (const auto& [name, add] : commands) add(app);
