@@ -1,0 +1,130 @@
+// GL tests (label "gl"): virtual objects in a calibrated scene, on Mesa's llvmpipe through EGL, no display.
+#include "render/scene_render.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "render/blur.h"
+#include "render/gl_context.h"
+
+namespace blurcue::render {
+namespace {
+
+// The thesis's view, built by hand: camera pitched down 38 deg, looking at the board's centre from 440 mm.
+struct View {
+  Camera camera = ThesisCamera().Resized(1148, 764);
+  cv::Vec3d rvec, tvec;
+  View() {
+    const double a = 38 * M_PI / 180, s = std::sin(a), c = std::cos(a);
+    const cv::Matx33d r(1, 0, 0, 0, -s, -c, 0, c, -s);  // rows: camera x, y, z in board coordinates
+    const cv::Vec3d forward(0, c, -s), target(87.5, 125, 0);
+    const cv::Vec3d centre = target - 440.0 * forward;
+    cv::Rodrigues(r, rvec);
+    tvec = -(r * centre);
+  }
+};
+
+class SceneRenderTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { context_ = GlContext::CreateOffscreen().release(); }
+  static void TearDownTestSuite() { delete context_; }
+  static GlContext* context_;
+};
+GlContext* SceneRenderTest::context_ = nullptr;
+
+VirtualObject Ball(double y_mm) {
+  VirtualObject o;
+  o.kind = VirtualObject::Kind::kBall;
+  o.size_mm = 10;
+  o.center_board_mm = {87.5, y_mm, 10};
+  o.texture = cv::Mat(64, 128, CV_8UC3, cv::Scalar(200, 200, 200));
+  o.texture(cv::Rect(0, 0, 64, 32)).setTo(cv::Scalar(30, 30, 30));
+  return o;
+}
+
+cv::Point2d AlphaCentroid(const Layer& layer, double* area) {
+  cv::Mat alpha;
+  cv::extractChannel(layer.bgra, alpha, 3);
+  const cv::Moments m = cv::moments(alpha);
+  *area = m.m00;
+  return {layer.roi.x + m.m10 / m.m00 - 0.5, layer.roi.y + m.m01 / m.m00 - 0.5};
+}
+
+TEST_F(SceneRenderTest, BallLandsWhereThePoseProjectsIt) {
+  const View v;
+  SceneRenderer renderer(v.camera, v.rvec, v.tvec);
+  for (double y : {0.0, 150.0, 250.0}) {
+    const VirtualObject ball = Ball(y);
+    const Layer layer = renderer.Draw(ball, 2);
+    std::vector<cv::Point2d> px;
+    cv::projectPoints(std::vector<cv::Point3d>{cv::Point3d(ball.center_board_mm)}, v.rvec, v.tvec,
+                      cv::Matx33d(v.camera.Intrinsics().data()), cv::noArray(), px);
+    double area = 0;
+    const cv::Point2d c = AlphaCentroid(layer, &area);
+    // The silhouette's centroid sits within a pixel of the projected centre (perspective shifts it slightly).
+    EXPECT_NEAR(c.x, px[0].x, 1.0) << "y = " << y;
+    EXPECT_NEAR(c.y, px[0].y, 1.0) << "y = " << y;
+  }
+}
+
+TEST_F(SceneRenderTest, BallShrinksWithDistance) {
+  const View v;
+  SceneRenderer renderer(v.camera, v.rvec, v.tvec);
+  double near_area = 0, far_area = 0;
+  AlphaCentroid(renderer.Draw(Ball(0), 2), &near_area);
+  AlphaCentroid(renderer.Draw(Ball(250), 2), &far_area);
+  const double z_near = renderer.Measure(Ball(0)).z_center_mm, z_far = renderer.Measure(Ball(250)).z_center_mm;
+  // Apparent area of a sphere goes as 1 / depth^2.
+  EXPECT_NEAR(far_area / near_area, (z_near * z_near) / (z_far * z_far), 0.05);
+}
+
+TEST_F(SceneRenderTest, LayerCoversOnlyTheObjectAndItsMargin) {
+  const View v;
+  SceneRenderer renderer(v.camera, v.rvec, v.tvec);
+  const VirtualObject ball = Ball(150);
+  const Footprint f = renderer.Measure(ball);
+  const Layer layer = renderer.Draw(ball, 7);
+  EXPECT_EQ(layer.roi.width, f.bounds.width + 14);
+  EXPECT_LT(layer.roi.area(), 0.01 * v.camera.image_width_px * v.camera.image_height_px);
+  // Nothing is drawn in the margin.
+  cv::Mat alpha;
+  cv::extractChannel(layer.bgra, alpha, 3);
+  EXPECT_EQ(cv::countNonZero(alpha.rowRange(0, 6)), 0);
+  EXPECT_EQ(cv::countNonZero(alpha.colRange(0, 6)), 0);
+}
+
+TEST_F(SceneRenderTest, BlurringTheLayerKeepsTheObjectsLight) {
+  const View v;
+  SceneRenderer renderer(v.camera, v.rvec, v.tvec);
+  GlBlur gl;
+  const VirtualObject ball = Ball(150);
+  for (const char* method : {"gaussian", "disc"}) {
+    Layer layer = renderer.Draw(ball, KernelMarginPx(method, 6) + 1);
+    const cv::Scalar before = cv::sum(layer.bgra);
+    Layer cpu = layer;
+    BlurLayer(layer, method, 6, &gl);
+    BlurLayer(cpu, method, 6, nullptr);
+    const cv::Scalar after = cv::sum(layer.bgra);
+    for (int c = 0; c < 4; ++c) EXPECT_NEAR(after[c], before[c], 1e-3 * before[c] + 1e-3) << method;
+    cv::Mat diff;
+    cv::absdiff(layer.bgra, cpu.bgra, diff);
+    double max = 0;
+    cv::minMaxLoc(diff.reshape(1), nullptr, &max);
+    EXPECT_LE(max, 3.0 / 255) << method;
+  }
+}
+
+TEST(Composite, OverIsPremultipliedAndLinear) {
+  cv::Mat background(4, 4, CV_32FC3, cv::Scalar(0.5, 0.5, 0.5));
+  Layer layer{cv::Rect(1, 1, 2, 2), cv::Mat(2, 2, CV_32FC4, cv::Scalar(0.2, 0.2, 0.2, 0.25))};
+  CompositeOver(background, layer);
+  EXPECT_FLOAT_EQ(background.at<cv::Vec3f>(1, 1)[0], 0.2f + 0.75f * 0.5f);
+  EXPECT_FLOAT_EQ(background.at<cv::Vec3f>(0, 0)[0], 0.5f);
+}
+
+}  // namespace
+}  // namespace blurcue::render
