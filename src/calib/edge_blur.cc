@@ -1,1 +1,432 @@
-// placeholder: being written
+#include "calib/edge_blur.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "core/image.h"
+
+namespace blurcue::calib {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kMinRadiusPx = 0.02;    // fits never go below this (a Gaussian of s = 0 has no derivative)
+constexpr double kMaxRadiusPx = 200.0;   // ... nor above this
+constexpr double kBlackClip = 1e-4;      // linear value at or below which a sample counts as clipped black
+constexpr double kFineBinPx = 0.25;      // finest bin across the edge (ISO 12233 uses 1/4 pixel)
+constexpr int kMinSamples = 100;
+
+enum class Psf { kDisc, kGaussian };
+
+// Geometry shared by both methods. The normal is the segment direction turned +90 degrees in image
+// coordinates (x right, y down): n = (-t.y, t.x). Pixel centres sit at integer coordinates (OpenCV).
+struct Frame {
+  cv::Point2d a, t, n;
+  double length = 0;
+};
+
+Frame MakeFrame(const EdgeSegment& s) {
+  Frame f;
+  f.a = s.a;
+  const cv::Point2d d = s.b - s.a;
+  f.length = std::hypot(d.x, d.y);
+  if (f.length > 0) f.t = d / f.length;
+  f.n = cv::Point2d(-f.t.y, f.t.x);
+  return f;
+}
+
+// ---- Edge spread functions ---------------------------------------------------------------------------
+// F2 is the second antiderivative of the optical ESF (zero far on the dark side): F2(x) = E[(x - X)_+^2] / 2
+// with X distributed as the LSF. The pixel's own aperture, projected on the normal, is the convolution of two
+// boxes of widths |n.x| and |n.y| (a trapezoid; variance 1/12 at any angle). Averaging the ESF over two boxes
+// is a second divided difference of F2, so the whole model stays in closed form.
+
+double StdNormalPdf(double z) { return 0.3989422804014327 * std::exp(-0.5 * z * z); }
+double StdNormalCdf(double z) { return 0.5 * std::erfc(-z * 0.7071067811865476); }
+
+double F1Gauss(double x, double s) {
+  const double z = x / s;
+  return x * StdNormalCdf(z) + s * StdNormalPdf(z);
+}
+double F2Gauss(double x, double s) {
+  const double z = x / s;
+  return 0.5 * (x * x + s * s) * StdNormalCdf(z) + 0.5 * x * s * StdNormalPdf(z);
+}
+
+// Disc of radius R: the LSF is a semicircle on [-R, R], variance R^2 / 4.
+double F1Disc(double x, double R) {
+  if (x <= -R) return 0;
+  if (x >= R) return x;
+  const double u = x / R, q = std::sqrt(std::max(0.0, 1 - u * u));
+  return R * (0.5 * u + (u * std::asin(u) + q - q * q * q / 3) / kPi);
+}
+double F2Disc(double x, double R) {
+  if (x <= -R) return 0;
+  if (x >= R) return 0.5 * (x * x + 0.25 * R * R);
+  const double u = x / R, q = std::sqrt(std::max(0.0, 1 - u * u)), as = std::asin(u);
+  const double bracket = -(u * q * q * q / 4 + 0.375 * (u * q + as)) / 3 + 0.5 * u * u * as - 0.25 * (as - u * q) +
+                         0.5 * (u * q + as);
+  return R * R * (0.25 * u * u + bracket / kPi + 1.0 / 16);
+}
+
+struct EsfModel {
+  Psf psf = Psf::kDisc;
+  double r = 1;            // DESIGN.md unit
+  double w1 = 1, w2 = 0;   // pixel aperture boxes across the edge, w1 >= w2
+  double reach = 0;        // beyond |x| > reach the model is exactly 0 or 1
+
+  EsfModel(Psf p, double radius, double box1, double box2) : psf(p), r(radius), w1(box1), w2(box2) {
+    const double optical = psf == Psf::kDisc ? r : 4.0 * r;  // Gaussian: 8 s
+    reach = optical + 0.5 * (w1 + w2) + 1e-9;
+  }
+
+  double F1(double x) const { return psf == Psf::kDisc ? F1Disc(x, r) : F1Gauss(x, 0.5 * r); }
+  double F2(double x) const { return psf == Psf::kDisc ? F2Disc(x, r) : F2Gauss(x, 0.5 * r); }
+
+  // ESF in [0, 1] at signed distance x from the edge, pixel aperture included.
+  double operator()(double x) const {
+    if (x <= -reach) return 0;
+    if (x >= reach) return 1;
+    const double h1 = 0.5 * w1, h2 = 0.5 * w2;
+    double v;
+    if (w2 < 1e-3) {
+      v = (F1(x + h1) - F1(x - h1)) / w1;
+    } else {
+      v = (F2(x + h1 + h2) - F2(x + h1 - h2) - F2(x - h1 + h2) + F2(x - h1 - h2)) / (w1 * w2);
+    }
+    return std::clamp(v, 0.0, 1.0);
+  }
+};
+
+// ---- Sampling and binning ----------------------------------------------------------------------------
+
+struct Sample {
+  float d, v;
+};
+
+struct Bin {
+  int index = 0;  // position in the bin grid
+  double x = 0;   // mean signed distance of its samples
+  double v = 0;   // median value
+  double w = 0;   // weight (sample count)
+};
+
+double MedianInPlace(float* first, float* last) {
+  const ptrdiff_t n = last - first;
+  float* mid = first + n / 2;
+  std::nth_element(first, mid, last);
+  if (n % 2) return *mid;
+  const float lo = *std::max_element(first, mid);
+  return 0.5 * (static_cast<double>(lo) + *mid);
+}
+
+// Bins samples of |d| <= half_window at `width`; per bin the median value (rejects printing spots).
+// `order` and `values` are scratch buffers kept between calls.
+std::vector<Bin> MakeBins(const std::vector<Sample>& samples, double half_window, double width,
+                          std::vector<int>& start, std::vector<float>& values) {
+  const int nb = std::max(1, static_cast<int>(std::ceil(2 * half_window / width)));
+  auto index = [&](double d) { return std::clamp(static_cast<int>((d + half_window) / width), 0, nb - 1); };
+  start.assign(nb + 1, 0);
+  std::vector<double> sum_d(nb, 0.0);
+  for (const Sample& s : samples) {
+    const int i = index(s.d);
+    ++start[i + 1];
+    sum_d[i] += s.d;
+  }
+  for (int i = 0; i < nb; ++i) start[i + 1] += start[i];
+  values.resize(samples.size());
+  std::vector<int> fill(start.begin(), start.end() - 1);
+  for (const Sample& s : samples) values[fill[index(s.d)]++] = s.v;
+  std::vector<Bin> bins;
+  bins.reserve(nb);
+  for (int i = 0; i < nb; ++i) {
+    const int n = start[i + 1] - start[i];
+    if (n == 0) continue;
+    bins.push_back({i, sum_d[i] / n, MedianInPlace(values.data() + start[i], values.data() + start[i + 1]),
+                    static_cast<double>(n)});
+  }
+  return bins;
+}
+
+// ---- Fit ---------------------------------------------------------------------------------------------
+
+struct FitState {
+  double d0 = 0, r = 1, a = 0, b = 0, sse = std::numeric_limits<double>::infinity();
+};
+
+// For fixed (d0, r) the levels a, b follow by weighted linear least squares (variable projection).
+FitState Evaluate(const std::vector<Bin>& bins, Psf psf, double d0, double r, double w1, double w2) {
+  FitState st;
+  st.d0 = d0;
+  st.r = r;
+  const EsfModel model(psf, r, w1, w2);
+  double sw = 0, se = 0, see = 0, sv = 0, sev = 0;
+  for (const Bin& bin : bins) {
+    const double e = model(bin.x - d0);
+    sw += bin.w, se += bin.w * e, see += bin.w * e * e, sv += bin.w * bin.v, sev += bin.w * e * bin.v;
+  }
+  const double det = sw * see - se * se;
+  if (!(det > 1e-12 * sw * sw)) {  // the model is flat over the bins: no step to fit
+    st.a = sv / std::max(sw, 1e-12);
+    st.b = 0;
+  } else {
+    st.b = (sw * sev - se * sv) / det;
+    st.a = (sv - st.b * se) / sw;
+  }
+  double sse = 0;
+  for (const Bin& bin : bins) {
+    const double res = bin.v - st.a - st.b * model(bin.x - d0);
+    sse += bin.w * res * res;
+  }
+  st.sse = sse;
+  return st;
+}
+
+// Levenberg-Marquardt on (d0, r) of the reduced (a, b eliminated) problem, numeric Jacobian.
+FitState FitFamily(const std::vector<Bin>& bins, Psf psf, double d0, double r, double w1, double w2,
+                   double d0_limit) {
+  r = std::clamp(r, kMinRadiusPx, kMaxRadiusPx);
+  FitState best = Evaluate(bins, psf, d0, r, w1, w2);
+  double lambda = 1e-3;
+  std::vector<double> res0, jd, jr;
+  auto residuals = [&](const FitState& st, std::vector<double>& out) {
+    const EsfModel model(psf, st.r, w1, w2);
+    out.resize(bins.size());
+    for (size_t i = 0; i < bins.size(); ++i)
+      out[i] = std::sqrt(bins[i].w) * (bins[i].v - st.a - st.b * model(bins[i].x - st.d0));
+  };
+  for (int iter = 0; iter < 40; ++iter) {
+    const double h = 1e-3 * (1 + best.r);
+    residuals(best, res0);
+    FitState pd = Evaluate(bins, psf, best.d0 + h, best.r, w1, w2);
+    residuals(pd, jd);
+    const double rh = best.r + h;
+    FitState pr = Evaluate(bins, psf, best.d0, rh, w1, w2);
+    residuals(pr, jr);
+    // J = d(residual)/d(param); normal equations with Marquardt scaling.
+    double A00 = 0, A01 = 0, A11 = 0, g0 = 0, g1 = 0;
+    for (size_t i = 0; i < bins.size(); ++i) {
+      const double j0 = (jd[i] - res0[i]) / h, j1 = (jr[i] - res0[i]) / h;
+      A00 += j0 * j0, A01 += j0 * j1, A11 += j1 * j1;
+      g0 += j0 * res0[i], g1 += j1 * res0[i];
+    }
+    bool improved = false;
+    for (int tries = 0; tries < 10 && !improved; ++tries) {
+      const double B00 = A00 * (1 + lambda) + 1e-15, B11 = A11 * (1 + lambda) + 1e-15;
+      const double det = B00 * B11 - A01 * A01;
+      if (!(std::abs(det) > 0)) break;
+      const double s0 = -(B11 * g0 - A01 * g1) / det, s1 = -(B00 * g1 - A01 * g0) / det;
+      const double nd0 = std::clamp(best.d0 + s0, -d0_limit, d0_limit);
+      const double nr = std::clamp(best.r + s1, kMinRadiusPx, kMaxRadiusPx);
+      const FitState trial = Evaluate(bins, psf, nd0, nr, w1, w2);
+      if (trial.sse < best.sse) {
+        const double gain = best.sse - trial.sse;
+        const bool tiny_step = std::abs(nd0 - best.d0) < 1e-5 && std::abs(nr - best.r) < 1e-5 * (1 + best.r);
+        best = trial;
+        lambda = std::max(lambda * 0.3, 1e-9);
+        improved = true;
+        if (tiny_step || gain < 1e-12 * (1 + best.sse)) return best;
+      } else {
+        lambda *= 10;
+      }
+    }
+    if (!improved) break;
+  }
+  return best;
+}
+
+// Moment-free start: edge position from the area under the normalised profile, radius from the width of its
+// 10-90 % zone (Gaussian: 1.28 r, disc: about 1.16 r; the pixel box alone gives 0.8 px).
+void StartEstimate(const std::vector<Bin>& bins, double half_window, double* d0, double* r) {
+  std::vector<float> lo, hi;
+  for (const Bin& b : bins) {
+    if (b.x < -0.5 * half_window) lo.push_back(static_cast<float>(b.v));
+    if (b.x > 0.5 * half_window) hi.push_back(static_cast<float>(b.v));
+  }
+  *d0 = 0;
+  *r = 1;
+  if (lo.empty() || hi.empty() || bins.size() < 4) return;
+  const double vlo = MedianInPlace(lo.data(), lo.data() + lo.size());
+  const double vhi = MedianInPlace(hi.data(), hi.data() + hi.size());
+  const double span = vhi - vlo;
+  if (std::abs(span) < 1e-9) return;
+  double area = 0, width = 0;
+  for (size_t i = 0; i + 1 < bins.size(); ++i) {
+    const double dx = bins[i + 1].x - bins[i].x;
+    const double p0 = (bins[i].v - vlo) / span, p1 = (bins[i + 1].v - vlo) / span;
+    area += 0.5 * dx * (p0 + p1);
+    width += 0.5 * dx * ((p0 > 0.1 && p0 < 0.9) + (p1 > 0.1 && p1 < 0.9));
+  }
+  *d0 = std::clamp(bins.back().x - area, -half_window, half_window);
+  *r = std::max(0.3, std::sqrt(std::max(0.0, width * width - 0.64)) / 1.25);
+}
+
+}  // namespace
+
+ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, const ModelFitOptions& options) {
+  ModelFit fit;
+  fit.psf = "disc";
+  CV_Assert(linear.type() == CV_32FC1);
+  const Frame f = MakeFrame(segment);
+  const double hw = segment.half_window_px;
+  if (!(f.length > 1) || !(hw > 1) || linear.empty() || !std::isfinite(hw)) {
+    fit.flags = {"too_few_pixels"};
+    return fit;
+  }
+
+  // Pixels in the oriented rectangle: the central `along_fraction` of the section, +-hw across it.
+  const double frac = std::clamp(options.along_fraction, 0.0, 1.0);
+  const double s_lo = 0.5 * (1 - frac) * f.length, s_hi = 0.5 * (1 + frac) * f.length;
+  double xmin = 1e18, xmax = -1e18, ymin = 1e18, ymax = -1e18;
+  for (double s : {s_lo, s_hi})
+    for (double d : {-hw, hw}) {
+      const cv::Point2d p = f.a + s * f.t + d * f.n;
+      xmin = std::min(xmin, p.x), xmax = std::max(xmax, p.x), ymin = std::min(ymin, p.y), ymax = std::max(ymax, p.y);
+    }
+  const int x0 = std::max(0, static_cast<int>(std::ceil(xmin))), x1 = std::min(linear.cols - 1, int(std::floor(xmax)));
+  const int y0 = std::max(0, static_cast<int>(std::ceil(ymin))), y1 = std::min(linear.rows - 1, int(std::floor(ymax)));
+  std::vector<Sample> samples;
+  if (x0 <= x1 && y0 <= y1) samples.reserve(static_cast<size_t>((x1 - x0 + 1)) * (y1 - y0 + 1) / 2 + 16);
+  int clipped = 0;
+  double s_min = 1e18, s_max = -1e18;
+  for (int y = y0; y <= y1; ++y) {
+    const float* row = linear.ptr<float>(y);
+    const double ry = y - f.a.y;
+    double s = (x0 - f.a.x) * f.t.x + ry * f.t.y;
+    double d = (x0 - f.a.x) * f.n.x + ry * f.n.y;
+    for (int x = x0; x <= x1; ++x, s += f.t.x, d += f.n.x) {
+      if (s < s_lo || s > s_hi || d < -hw || d > hw) continue;
+      const float v = row[x];
+      if (!std::isfinite(v)) continue;
+      samples.push_back({static_cast<float>(d), v});
+      if (v >= options.saturation_level || v <= kBlackClip) ++clipped;
+      s_min = std::min(s_min, s), s_max = std::max(s_max, s);
+    }
+  }
+  fit.samples = static_cast<int>(samples.size());
+  if (fit.samples < kMinSamples || s_max - s_min < 4) {
+    fit.flags = {"too_few_pixels"};
+    return fit;
+  }
+
+  // Super-resolved edge spread function: fine bins first, for a start, then bins of r/8 for the fit.
+  std::vector<int> start;
+  std::vector<float> values;
+  std::vector<Bin> bins = MakeBins(samples, hw, kFineBinPx, start, values);
+  double d0 = 0, r0 = 1;
+  StartEstimate(bins, hw, &d0, &r0);
+  double bin_width = std::max(kFineBinPx, r0 / 8);
+  if (bin_width > kFineBinPx) bins = MakeBins(samples, hw, bin_width, start, values);
+  if (bins.size() < 6) {
+    fit.flags = {"too_few_pixels"};
+    return fit;
+  }
+
+  const double w1 = std::max(std::abs(f.n.x), std::abs(f.n.y)), w2 = std::min(std::abs(f.n.x), std::abs(f.n.y));
+  FitState best;
+  Psf best_psf = Psf::kDisc;
+  for (Psf psf : {Psf::kDisc, Psf::kGaussian}) {
+    // Two starts guard against a start far on the wrong side of the minimum.
+    for (double scale : {1.0, 0.5}) {
+      const FitState st = FitFamily(bins, psf, d0, r0 * scale, w1, w2, hw);
+      if (st.sse < best.sse) best = st, best_psf = psf;
+      if (r0 < 1) break;
+    }
+  }
+
+  double sw = 0;
+  for (const Bin& b : bins) sw += b.w;
+  fit.r_px = std::isfinite(best.r) ? best.r : 0;
+  fit.psf = best_psf == Psf::kDisc ? "disc" : "gaussian";
+  fit.offset_px = std::isfinite(best.d0) ? best.d0 : 0;
+  fit.step = std::isfinite(best.b) ? best.b : 0;
+  const double rms = std::sqrt(std::max(0.0, best.sse) / std::max(sw, 1.0));
+  fit.rms_rel = std::abs(fit.step) > 1e-12 && std::isfinite(rms) ? rms / std::abs(fit.step) : 1e9;
+
+  // Printing flaws: samples far from their bin's median (the median already ignored them).
+  {
+    const int nb = static_cast<int>(start.size()) - 1;
+    std::vector<float> med(nb, 0.f);
+    for (const Bin& b : bins) med[b.index] = static_cast<float>(b.v);
+    std::vector<float> dev(samples.size());
+    for (size_t i = 0; i < samples.size(); ++i) {
+      const int k = std::clamp(static_cast<int>((samples[i].d + hw) / bin_width), 0, nb - 1);
+      dev[i] = std::abs(samples[i].v - med[k]);
+    }
+    std::vector<float> tmp = dev;
+    const double sigma = 1.4826 * MedianInPlace(tmp.data(), tmp.data() + tmp.size());
+    const double limit = std::max(6 * sigma, 0.25 * std::abs(fit.step));
+    const long outliers = std::count_if(dev.begin(), dev.end(), [&](float v) { return v > limit; });
+    if (std::abs(fit.step) > 0 && outliers > std::max<long>(10, samples.size() / 1000)) fit.flags.push_back("flaw");
+  }
+
+  bool bad = false;
+  auto flag = [&](const char* name) { fit.flags.push_back(name), bad = true; };
+  if (std::abs(fit.step) < options.min_contrast) flag("low_contrast");
+  if (clipped > options.max_saturated_fraction * fit.samples) flag("saturated");
+  // The blur must fit in the window on both sides of the edge, the X-junctions at the section ends must not
+  // reach into the central part used (a disc reaches r), and the image border must leave enough of that part.
+  const double reach = 1.5 * fit.r_px + 2;
+  if (reach > hw - std::abs(fit.offset_px) || 0.5 * (1 - frac) * f.length < fit.r_px + 1 ||
+      s_max - s_min < std::min(2 * reach, 0.5 * frac * f.length))
+    flag("crowded");
+  if (fit.rms_rel > options.max_rms_rel) flag("poor_fit");
+  fit.ok = !bad;
+  return fit;
+}
+
+ThesisMeasure MeasureEdgeThesis(const cv::Mat& grey8, const EdgeSegment& segment, const ThesisOptions& options) {
+  ThesisMeasure out;
+  if (grey8.empty()) return out;
+  const cv::Mat grey = grey8.type() == CV_8UC1 ? grey8 : ToGrey8(grey8);
+  const Frame f = MakeFrame(segment);
+  if (!(f.length > 0) || !(segment.half_window_px >= 1)) return out;
+  const cv::Point2d m = 0.5 * (segment.a + segment.b);
+
+  // Profile across the edge through the midpoint, bilinear at 1 px steps; stops at the image border.
+  const int K = static_cast<int>(std::floor(std::min(0.5 * options.max_profile_px, segment.half_window_px)));
+  if (grey.cols < 2 || grey.rows < 2) return out;
+  auto sample = [&](int k, double* v) {
+    const double x = m.x + k * f.n.x, y = m.y + k * f.n.y;
+    if (!(x >= 0 && y >= 0 && x <= grey.cols - 1 && y <= grey.rows - 1)) return false;
+    const int xi = std::min(static_cast<int>(x), grey.cols - 2), yi = std::min(static_cast<int>(y), grey.rows - 2);
+    const double fx = x - xi, fy = y - yi;
+    const uint8_t* r0 = grey.ptr<uint8_t>(yi);
+    const uint8_t* r1 = grey.ptr<uint8_t>(yi + 1);
+    *v = (1 - fy) * ((1 - fx) * r0[xi] + fx * r0[xi + 1]) + fy * ((1 - fx) * r1[xi] + fx * r1[xi + 1]);
+    return true;
+  };
+  std::vector<double> before, after;
+  double v;
+  for (int k = 0; k >= -K && sample(k, &v); --k) before.push_back(v);
+  for (int k = 1; k <= K && sample(k, &v); ++k) after.push_back(v);
+  std::vector<double> profile(before.rbegin(), before.rend());
+  profile.insert(profile.end(), after.begin(), after.end());
+
+  // Eq. 4.1: trailing simple moving average of n samples, then the forward-difference gradient.
+  const int n = std::max(1, options.sma_n);
+  if (static_cast<int>(profile.size()) < n + 1) return out;
+  std::vector<double> sma;
+  double acc = 0;
+  for (size_t i = 0; i < profile.size(); ++i) {
+    acc += profile[i];
+    if (i >= static_cast<size_t>(n)) acc -= profile[i - n];
+    if (i + 1 >= static_cast<size_t>(n)) sma.push_back(acc / n);
+  }
+  std::vector<double> grad(sma.size() - 1);
+  for (size_t i = 0; i + 1 < sma.size(); ++i) grad[i] = std::abs(sma[i + 1] - sma[i]);
+  if (grad.empty()) return out;
+  const size_t peak = std::max_element(grad.begin(), grad.end()) - grad.begin();
+  if (!(grad[peak] > options.threshold)) return out;
+  size_t lo = peak, hi = peak;
+  while (lo > 0 && grad[lo - 1] > options.threshold) --lo;
+  while (hi + 1 < grad.size() && grad[hi + 1] > options.threshold) ++hi;
+  out.count = static_cast<int>(hi - lo + 1);
+  out.r_px = 0.5 * out.count;
+  out.ok = true;
+  return out;
+}
+
+}  // namespace blurcue::calib
