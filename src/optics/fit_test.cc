@@ -217,6 +217,18 @@ TEST(FitThinLens, NegativeRadiusIsInputError) {
   }
 }
 
+TEST(FitThinLens, SampleAtInfinityIsUsable) {
+  // A far background sample (u = infinity) has the finite radius D f / (2 (u0 - f) pitch).
+  std::vector<BlurSample> samples = Samples({});
+  const double at_infinity =
+      kThesis.aperture_mm * kThesis.focal_length_mm / (2 * (258.18 - kThesis.focal_length_mm)) / kThesis.pixel_pitch_mm;
+  samples.push_back({kInf, at_infinity, 1.0});
+  const FittedModel m = FitThinLens(kThesis, samples);
+  EXPECT_EQ(m.samples_used, 78);
+  EXPECT_EQ(m.outliers, 0);
+  EXPECT_NEAR(m.focus_mm, 258.18, 0.01 * 258.18);
+}
+
 TEST(FittedModel, PredictPxAddsFloorInQuadrature) {
   FittedModel m;
   m.focus_mm = 430.0;

@@ -140,8 +140,7 @@ TEST(ThinLens, ImpossibleNearSideReferenceIsDomainError) {
 
 TEST(ThinLens, NeverReturnsNaN) {
   // Every combination either throws Error or gives a finite number (or +infinity for a focus distance).
-  // Depths are finite here; a point at infinity is the disabled test below.
-  const double values[] = {-100, 0, 1e-9, 20.999999, 21, 21.000001, 22, 100, 258, 342.3, 527.3, 1e6, 1e12};
+  const double values[] = {-100, 0, 1e-9, 20.999999, 21, 21.000001, 22, 100, 258, 342.3, 527.3, 1e6, 1e12, kInf};
   const double radii[] = {-100, -22.6, -8, 0, 1e-9, 8, 16.61, 100};
   int finite = 0;
   for (double a : values)
