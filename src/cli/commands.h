@@ -11,5 +11,6 @@ void AddCalibrateCommand(CLI::App& app);    // calibrate_command.cc
 void AddBenchCommand(CLI::App& app);        // bench_command.cc
 void AddBlurCommand(CLI::App& app);         // blur_command.cc
 void AddRenderCommand(CLI::App& app);       // render_command.cc
+void AddMakeStimuliCommand(CLI::App& app);  // make_stimuli_command.cc
 
 }  // namespace blurcue::cli

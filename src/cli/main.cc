@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
       {"blur", &cli::AddBlurCommand},
       {"render", &cli::AddRenderCommand},
       {"bench", &cli::AddBenchCommand},
+      {"make-stimuli", &cli::AddMakeStimuliCommand},
   };
   for (const auto& [name, add] : commands) add(app);
 
