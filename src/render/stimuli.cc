@@ -389,7 +389,13 @@ cv::Mat FacePicture(int width_px) {
 std::vector<std::filesystem::path> WriteStandardStimuli(const std::filesystem::path& dir) {
   std::vector<std::filesystem::path> written;
   auto write = [&](const char* name, const cv::Mat& image) {
-    WriteImage(dir / name, image);
+    // WriteImage reports encoder failures as Error but lets the folder's filesystem_error through; make that an
+    // input error too, so the command's exit code says "bad path" rather than "bug".
+    try {
+      WriteImage(dir / name, image);
+    } catch (const std::filesystem::filesystem_error& e) {
+      throw InputError((dir / name).string(), std::string("cannot write: ") + e.code().message());
+    }
     written.push_back(dir / name);
   };
   write("soccer.png", SoccerTexture(2048));
