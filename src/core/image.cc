@@ -19,7 +19,9 @@ cv::Mat ReadImage(const std::filesystem::path& path, int flags) {
 }
 
 void WriteImage(const std::filesystem::path& path, const cv::Mat& image) {
-  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
+  std::error_code ec;
+  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path(), ec);
+  if (ec) throw InputError(path.string(), "cannot create its folder: " + ec.message());
   // Keep the extension on the temporary name: OpenCV picks the encoder from it.
   const std::filesystem::path tmp = path.parent_path() / (".tmp-" + path.filename().string());
   bool ok = false;

@@ -18,7 +18,9 @@ Json ReadJsonFile(const std::filesystem::path& path) {
 }
 
 void WriteJsonFile(const std::filesystem::path& path, const Json& json) {
-  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
+  std::error_code ec;
+  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path(), ec);
+  if (ec) throw InputError(path.string(), "cannot create its folder: " + ec.message());
   const std::filesystem::path tmp = path.string() + ".tmp";
   {
     std::ofstream out(tmp);
