@@ -30,21 +30,21 @@ synth::SceneOptions Blurry() {
   return o;
 }
 
-struct Run {
+struct Calibration {
   synth::Scene scene;
   CalibResult result;
   TruthComparison cmp;
 };
 
-Run Calibrated(const synth::SceneOptions& o) {
-  Run r;
+Calibration Calibrated(const synth::SceneOptions& o) {
+  Calibration r;
   r.scene = synth::RenderScene(o);
   r.result = Calibrate(r.scene.image, r.scene.camera, r.scene.board);
   r.cmp = CompareToTruth(r.result, r.scene.truth, "truth");
   return r;
 }
 
-void PrintSideBySide(const Run& r) {
+void PrintSideBySide(const Calibration& r) {
   std::printf("edge  true   model  thesis  eq3.7  fitted\n");
   for (size_t e = 0; e < r.result.edges.size(); ++e) {
     const EdgeResult& edge = r.result.edges[e];
@@ -54,7 +54,7 @@ void PrintSideBySide(const Run& r) {
 }
 
 TEST(Calibrate, PoseWithinOneMillimetreAndHalfDegree) {
-  const Run r = Calibrated(Thesis());
+  const Calibration r = Calibrated(Thesis());
   EXPECT_LT(r.cmp.translation_error_mm, 1.0);
   EXPECT_LT(r.cmp.rotation_error_deg, 0.5);
   EXPECT_LT(r.cmp.max_depth_error_mm, 1.0);
@@ -62,7 +62,7 @@ TEST(Calibrate, PoseWithinOneMillimetreAndHalfDegree) {
 }
 
 TEST(Calibrate, ElevenEdgesOfSevenSectionsNearestFirst) {
-  const Run r = Calibrated(Thesis());
+  const Calibration r = Calibrated(Thesis());
   ASSERT_EQ(r.result.edges.size(), 11u);
   for (size_t e = 0; e < 11; ++e) {
     EXPECT_EQ(r.result.edges[e].sections.size(), 7u);
@@ -75,7 +75,7 @@ TEST(Calibrate, ElevenEdgesOfSevenSectionsNearestFirst) {
 }
 
 TEST(Calibrate, ModelFitWithinToleranceOfTrueBlur) {
-  const Run r = Calibrated(Blurry());
+  const Calibration r = Calibrated(Blurry());
   PrintSideBySide(r);
   int ok = 0, within = 0;
   for (const auto& s : r.cmp.sections) {
@@ -88,7 +88,7 @@ TEST(Calibrate, ModelFitWithinToleranceOfTrueBlur) {
 }
 
 TEST(Calibrate, FittedModelPredictsHeldOutEdges) {
-  const Run r = Calibrated(Blurry());
+  const Calibration r = Calibrated(Blurry());
   const optics::Lens lens = optics::Lens::FromCamera(r.scene.camera);
   std::vector<optics::BlurSample> train;
   for (const auto& edge : r.result.edges)
@@ -104,7 +104,7 @@ TEST(Calibrate, FittedModelPredictsHeldOutEdges) {
 
 TEST(Calibrate, Eq37FromTheReferenceEdgeFollowsTheThinLens) {
   // Truth is a thin lens, so eq. 3.7 from a well-measured reference must land near the truth too.
-  const Run r = Calibrated(Blurry());
+  const Calibration r = Calibrated(Blurry());
   const TruthComparison& c = r.cmp;
   for (int e = 2; e <= 11; ++e)
     EXPECT_NEAR(r.result.edges[e - 1].r_estimated_px, c.true_r_per_edge[e - 1], 0.1 * c.true_r_per_edge[e - 1] + 0.1)
@@ -112,7 +112,7 @@ TEST(Calibrate, Eq37FromTheReferenceEdgeFollowsTheThinLens) {
 }
 
 TEST(Calibrate, JsonHasEveryFieldTheIssueNames) {
-  const Run r = Calibrated(Thesis());
+  const Calibration r = Calibrated(Thesis());
   const Json j = CalibToJson(r.result);
   for (const char* key : {"camera", "board", "pose", "reference_edge", "edges"}) EXPECT_TRUE(j.contains(key)) << key;
   for (const char* key : {"rvec", "tvec", "reprojection_error_px"}) EXPECT_TRUE(j["pose"].contains(key)) << key;
@@ -161,7 +161,7 @@ TEST(Calibrate, CameraOfAnotherImageSizeIsAnInputError) {
 }
 
 TEST(SceneCalib, ReadsBackCalibJsonAndAnswersEverySource) {
-  const Run r = Calibrated(Blurry());
+  const Calibration r = Calibrated(Blurry());
   const SceneCalib scene = SceneCalibFromJson(CalibToJson(r.result), "calib.json: ");
   ASSERT_EQ(scene.sections.size(), 77u);
   // At the midpoint of edge 9 section 4 each source answers, and all agree with the truth within 15 %.
@@ -179,7 +179,7 @@ TEST(SceneCalib, ReadsBackCalibJsonAndAnswersEverySource) {
 }
 
 TEST(SceneCalib, BadFieldIsNamed) {
-  const Run r = Calibrated(Thesis());
+  const Calibration r = Calibrated(Thesis());
   Json j = CalibToJson(r.result);
   j["pose"]["tvec"] = {1, 2};
   try {
