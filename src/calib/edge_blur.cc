@@ -78,7 +78,7 @@ struct EsfModel {
   double reach = 0;        // beyond |x| > reach the model is exactly 0 or 1
 
   EsfModel(Psf p, double radius, double box1, double box2) : psf(p), r(radius), w1(box1), w2(box2) {
-    const double optical = psf == Psf::kDisc ? r : 4.0 * r;  // Gaussian: 8 s
+    const double optical = psf == Psf::kDisc ? r : 3.5 * r;  // Gaussian: 7 s (tail 1e-12)
     reach = optical + 0.5 * (w1 + w2) + 1e-9;
   }
 
@@ -109,21 +109,20 @@ struct Sample {
 struct Bin {
   int index = 0;  // position in the bin grid
   double x = 0;   // mean signed distance of its samples
-  double v = 0;   // median value
+  double v = 0;   // robust value: the median, then (RefineBins) the mean of the samples near it
   double w = 0;   // weight (sample count)
+  double median = 0;
 };
 
+// The upper median (for even counts): robust statistics need no averaging of the middle pair.
 double MedianInPlace(float* first, float* last) {
-  const ptrdiff_t n = last - first;
-  float* mid = first + n / 2;
+  float* mid = first + (last - first) / 2;
   std::nth_element(first, mid, last);
-  if (n % 2) return *mid;
-  const float lo = *std::max_element(first, mid);
-  return 0.5 * (static_cast<double>(lo) + *mid);
+  return *mid;
 }
 
 // Bins samples of |d| <= half_window at `width`; per bin the median value (rejects printing spots).
-// `order` and `values` are scratch buffers kept between calls.
+// `start` (per bin, where its values begin) and `values` (grouped by bin) are kept for RefineBins.
 std::vector<Bin> MakeBins(const std::vector<Sample>& samples, double half_window, double width,
                           std::vector<int>& start, std::vector<float>& values) {
   const int nb = std::max(1, static_cast<int>(std::ceil(2 * half_window / width)));
@@ -144,10 +143,49 @@ std::vector<Bin> MakeBins(const std::vector<Sample>& samples, double half_window
   for (int i = 0; i < nb; ++i) {
     const int n = start[i + 1] - start[i];
     if (n == 0) continue;
-    bins.push_back({i, sum_d[i] / n, MedianInPlace(values.data() + start[i], values.data() + start[i + 1]),
-                    static_cast<double>(n)});
+    const double median = MedianInPlace(values.data() + start[i], values.data() + start[i + 1]);
+    bins.push_back({i, sum_d[i] / n, median, static_cast<double>(n), median});
   }
   return bins;
+}
+
+struct BinStats {
+  double sigma = 0;    // noise std, from the median absolute deviation from the bin medians
+  long outliers = 0;   // samples farther than `flaw_limit` from their bin's median
+  long clipped = 0;    // samples in bins whose median is clipped black or white
+};
+
+// The median rejects printing spots but wastes a third of the information in Gaussian noise, and on 8-bit data
+// it snaps to code values; the mean of the samples that are not flaws (within max(6 sigma, flaw_rel x step) of
+// the median) recovers both. A narrower window would cut quantised noise asymmetrically in the transition bins
+// and widen the edge. Near a clip level (black at 0) the median is kept: there clipped noise would bias a mean.
+BinStats RefineBins(std::vector<Bin>& bins, const std::vector<int>& start, std::vector<float>& values,
+                    double flaw_rel, double step, double white_clip, double black_clip) {
+  BinStats st;
+  // A few thousand deviations pin the noise level as well as all of them.
+  const int stride = std::max<int>(1, static_cast<int>(values.size() / 4096));
+  std::vector<float> dev;
+  dev.reserve(values.size() / stride + bins.size());
+  for (const Bin& b : bins)
+    for (int k = start[b.index]; k < start[b.index + 1]; k += stride) dev.push_back(std::abs(values[k] - float(b.median)));
+  if (dev.empty()) return st;
+  st.sigma = 1.4826 * MedianInPlace(dev.data(), dev.data() + dev.size());
+  const double flaw = std::max(6 * st.sigma, flaw_rel * std::abs(step));
+  for (Bin& b : bins) {
+    const float* first = values.data() + start[b.index];
+    const float* last = values.data() + start[b.index + 1];
+    double sum = 0;
+    int n = 0;
+    for (const float* v = first; v != last; ++v) {
+      const double d = std::abs(*v - b.median);
+      if (d <= flaw) sum += *v, ++n;
+      else ++st.outliers;
+    }
+    if (b.median >= white_clip || b.median <= black_clip) st.clipped += last - first;
+    const bool near_clip = b.median <= black_clip + 2 * st.sigma || b.median >= 1 - 2 * st.sigma;
+    if (n > 0 && !near_clip) b.v = sum / n;
+  }
+  return st;
 }
 
 // ---- Fit ---------------------------------------------------------------------------------------------
@@ -157,15 +195,20 @@ struct FitState {
 };
 
 // For fixed (d0, r) the levels a, b follow by weighted linear least squares (variable projection).
-FitState Evaluate(const std::vector<Bin>& bins, Psf psf, double d0, double r, double w1, double w2) {
+// Fills `residuals` (weighted) when given.
+FitState Evaluate(const std::vector<Bin>& bins, Psf psf, double d0, double r, double w1, double w2,
+                  std::vector<double>* residuals = nullptr) {
   FitState st;
   st.d0 = d0;
   st.r = r;
   const EsfModel model(psf, r, w1, w2);
+  thread_local std::vector<double> e;
+  e.resize(bins.size());
   double sw = 0, se = 0, see = 0, sv = 0, sev = 0;
-  for (const Bin& bin : bins) {
-    const double e = model(bin.x - d0);
-    sw += bin.w, se += bin.w * e, see += bin.w * e * e, sv += bin.w * bin.v, sev += bin.w * e * bin.v;
+  for (size_t i = 0; i < bins.size(); ++i) {
+    const Bin& bin = bins[i];
+    e[i] = model(bin.x - d0);
+    sw += bin.w, se += bin.w * e[i], see += bin.w * e[i] * e[i], sv += bin.w * bin.v, sev += bin.w * e[i] * bin.v;
   }
   const double det = sw * see - se * se;
   if (!(det > 1e-12 * sw * sw)) {  // the model is flat over the bins: no step to fit
@@ -176,9 +219,11 @@ FitState Evaluate(const std::vector<Bin>& bins, Psf psf, double d0, double r, do
     st.a = (sv - st.b * se) / sw;
   }
   double sse = 0;
-  for (const Bin& bin : bins) {
-    const double res = bin.v - st.a - st.b * model(bin.x - d0);
-    sse += bin.w * res * res;
+  if (residuals) residuals->resize(bins.size());
+  for (size_t i = 0; i < bins.size(); ++i) {
+    const double res = bins[i].v - st.a - st.b * e[i];
+    sse += bins[i].w * res * res;
+    if (residuals) (*residuals)[i] = std::sqrt(bins[i].w) * res;
   }
   st.sse = sse;
   return st;
@@ -188,23 +233,13 @@ FitState Evaluate(const std::vector<Bin>& bins, Psf psf, double d0, double r, do
 FitState FitFamily(const std::vector<Bin>& bins, Psf psf, double d0, double r, double w1, double w2,
                    double d0_limit) {
   r = std::clamp(r, kMinRadiusPx, kMaxRadiusPx);
-  FitState best = Evaluate(bins, psf, d0, r, w1, w2);
+  std::vector<double> res0, jd, jr, trial_res;
+  FitState best = Evaluate(bins, psf, d0, r, w1, w2, &res0);
   double lambda = 1e-3;
-  std::vector<double> res0, jd, jr;
-  auto residuals = [&](const FitState& st, std::vector<double>& out) {
-    const EsfModel model(psf, st.r, w1, w2);
-    out.resize(bins.size());
-    for (size_t i = 0; i < bins.size(); ++i)
-      out[i] = std::sqrt(bins[i].w) * (bins[i].v - st.a - st.b * model(bins[i].x - st.d0));
-  };
   for (int iter = 0; iter < 40; ++iter) {
     const double h = 1e-3 * (1 + best.r);
-    residuals(best, res0);
-    FitState pd = Evaluate(bins, psf, best.d0 + h, best.r, w1, w2);
-    residuals(pd, jd);
-    const double rh = best.r + h;
-    FitState pr = Evaluate(bins, psf, best.d0, rh, w1, w2);
-    residuals(pr, jr);
+    Evaluate(bins, psf, best.d0 + h, best.r, w1, w2, &jd);
+    Evaluate(bins, psf, best.d0, best.r + h, w1, w2, &jr);
     // J = d(residual)/d(param); normal equations with Marquardt scaling.
     double A00 = 0, A01 = 0, A11 = 0, g0 = 0, g1 = 0;
     for (size_t i = 0; i < bins.size(); ++i) {
@@ -220,8 +255,9 @@ FitState FitFamily(const std::vector<Bin>& bins, Psf psf, double d0, double r, d
       const double s0 = -(B11 * g0 - A01 * g1) / det, s1 = -(B00 * g1 - A01 * g0) / det;
       const double nd0 = std::clamp(best.d0 + s0, -d0_limit, d0_limit);
       const double nr = std::clamp(best.r + s1, kMinRadiusPx, kMaxRadiusPx);
-      const FitState trial = Evaluate(bins, psf, nd0, nr, w1, w2);
+      const FitState trial = Evaluate(bins, psf, nd0, nr, w1, w2, &trial_res);
       if (trial.sse < best.sse) {
+        res0.swap(trial_res);
         const double gain = best.sse - trial.sse;
         const bool tiny_step = std::abs(nd0 - best.d0) < 1e-5 && std::abs(nr - best.r) < 1e-5 * (1 + best.r);
         best = trial;
@@ -237,29 +273,39 @@ FitState FitFamily(const std::vector<Bin>& bins, Psf psf, double d0, double r, d
   return best;
 }
 
-// Moment-free start: edge position from the area under the normalised profile, radius from the width of its
-// 10-90 % zone (Gaussian: 1.28 r, disc: about 1.16 r; the pixel box alone gives 0.8 px).
-void StartEstimate(const std::vector<Bin>& bins, double half_window, double* d0, double* r) {
+// Plateau levels from the outer halves of the window (bin medians): the signed step, for the flaw limit.
+double PlateauStep(const std::vector<Bin>& bins, double half_window, double* low) {
   std::vector<float> lo, hi;
   for (const Bin& b : bins) {
-    if (b.x < -0.5 * half_window) lo.push_back(static_cast<float>(b.v));
-    if (b.x > 0.5 * half_window) hi.push_back(static_cast<float>(b.v));
+    if (b.x < -0.5 * half_window) lo.push_back(static_cast<float>(b.median));
+    if (b.x > 0.5 * half_window) hi.push_back(static_cast<float>(b.median));
   }
+  *low = 0;
+  if (lo.empty() || hi.empty()) return 0;
+  *low = MedianInPlace(lo.data(), lo.data() + lo.size());
+  return MedianInPlace(hi.data(), hi.data() + hi.size()) - *low;
+}
+
+// Start for the fit: edge position from the area under the normalised profile, radius from the width of its
+// 10-90 % zone around that position (Gaussian: 1.28 r, disc: about 1.16 r; the pixel box alone gives 0.8 px).
+void StartEstimate(const std::vector<Bin>& bins, double half_window, double low, double step, double* d0,
+                   double* r) {
   *d0 = 0;
   *r = 1;
-  if (lo.empty() || hi.empty() || bins.size() < 4) return;
-  const double vlo = MedianInPlace(lo.data(), lo.data() + lo.size());
-  const double vhi = MedianInPlace(hi.data(), hi.data() + hi.size());
-  const double span = vhi - vlo;
-  if (std::abs(span) < 1e-9) return;
-  double area = 0, width = 0;
-  for (size_t i = 0; i + 1 < bins.size(); ++i) {
-    const double dx = bins[i + 1].x - bins[i].x;
-    const double p0 = (bins[i].v - vlo) / span, p1 = (bins[i + 1].v - vlo) / span;
-    area += 0.5 * dx * (p0 + p1);
-    width += 0.5 * dx * ((p0 > 0.1 && p0 < 0.9) + (p1 > 0.1 && p1 < 0.9));
-  }
+  if (std::abs(step) < 1e-9 || bins.size() < 4) return;
+  auto p = [&](const Bin& b) { return (b.v - low) / step; };
+  double area = 0;
+  for (size_t i = 0; i + 1 < bins.size(); ++i) area += 0.5 * (bins[i + 1].x - bins[i].x) * (p(bins[i]) + p(bins[i + 1]));
   *d0 = std::clamp(bins.back().x - area, -half_window, half_window);
+  double x10 = bins.front().x, x90 = bins.back().x;
+  for (const Bin& b : bins) {
+    if (b.x < *d0 && p(b) <= 0.1) x10 = b.x;
+    if (b.x > *d0 && p(b) >= 0.9) {
+      x90 = b.x;
+      break;
+    }
+  }
+  const double width = x90 - x10;
   *r = std::max(0.3, std::sqrt(std::max(0.0, width * width - 0.64)) / 1.25);
 }
 
@@ -289,7 +335,6 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
   const int y0 = std::max(0, static_cast<int>(std::ceil(ymin))), y1 = std::min(linear.rows - 1, int(std::floor(ymax)));
   std::vector<Sample> samples;
   if (x0 <= x1 && y0 <= y1) samples.reserve(static_cast<size_t>((x1 - x0 + 1)) * (y1 - y0 + 1) / 2 + 16);
-  int clipped = 0;
   double s_min = 1e18, s_max = -1e18;
   for (int y = y0; y <= y1; ++y) {
     const float* row = linear.ptr<float>(y);
@@ -301,7 +346,6 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
       const float v = row[x];
       if (!std::isfinite(v)) continue;
       samples.push_back({static_cast<float>(d), v});
-      if (v >= options.saturation_level || v <= kBlackClip) ++clipped;
       s_min = std::min(s_min, s), s_max = std::max(s_max, s);
     }
   }
@@ -311,29 +355,54 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
     return fit;
   }
 
-  // Super-resolved edge spread function: fine bins first, for a start, then bins of r/8 for the fit.
+  // Super-resolved edge spread function: fine bins of a subsample first, for a start, then bins of r/8 of all
+  // samples for the fit.
   std::vector<int> start;
   std::vector<float> values;
-  std::vector<Bin> bins = MakeBins(samples, hw, kFineBinPx, start, values);
-  double d0 = 0, r0 = 1;
-  StartEstimate(bins, hw, &d0, &r0);
-  double bin_width = std::max(kFineBinPx, r0 / 8);
-  if (bin_width > kFineBinPx) bins = MakeBins(samples, hw, bin_width, start, values);
-  if (bins.size() < 6) {
-    fit.flags = {"too_few_pixels"};
-    return fit;
+  std::vector<Bin> bins;
+  {
+    const size_t stride = std::max<size_t>(1, samples.size() / 8000);
+    std::vector<Sample> sub;
+    sub.reserve(samples.size() / stride + 1);
+    for (size_t i = 0; i < samples.size(); i += stride) sub.push_back(samples[i]);
+    bins = MakeBins(sub, hw, kFineBinPx, start, values);
   }
+  double low = 0;
+  const double step0 = PlateauStep(bins, hw, &low);
+  // Samples more than a quarter step (and 6 sigma) from their bin's median are printing flaws (or worse); bins
+  // of r/8 hold at most ~1/16 step of slope either side of the median, so the edge itself is never cut.
+  BinStats stats = RefineBins(bins, start, values, 0.25, step0, options.saturation_level, kBlackClip);
+  double d0 = 0, r0 = 1;
+  StartEstimate(bins, hw, low, step0, &d0, &r0);
 
   const double w1 = std::max(std::abs(f.n.x), std::abs(f.n.y)), w2 = std::min(std::abs(f.n.x), std::abs(f.n.y));
   FitState best;
   Psf best_psf = Psf::kDisc;
-  for (Psf psf : {Psf::kDisc, Psf::kGaussian}) {
-    // Two starts guard against a start far on the wrong side of the minimum.
-    for (double scale : {1.0, 0.5}) {
-      const FitState st = FitFamily(bins, psf, d0, r0 * scale, w1, w2, hw);
-      if (st.sse < best.sse) best = st, best_psf = psf;
-      if (r0 < 1) break;
+  double bin_width = 0;  // the start bins hold a subsample: always rebin
+  // Bins wider than r/6 would smear the edge they sample; refit on finer bins when the fit says so.
+  for (int pass = 0; pass < 3; ++pass) {
+    const double want = std::max(kFineBinPx, r0 / 8);
+    if (std::abs(want - bin_width) > 1e-9) {
+      bin_width = want;
+      bins = MakeBins(samples, hw, bin_width, start, values);
+      stats = RefineBins(bins, start, values, 0.25, step0, options.saturation_level, kBlackClip);
     }
+    if (bins.size() < 6) {
+      fit.flags = {"too_few_pixels"};
+      return fit;
+    }
+    best = FitState{};
+    for (Psf psf : {Psf::kDisc, Psf::kGaussian}) {
+      // Two starts guard against a start far on the wrong side of the minimum.
+      for (double scale : {1.0, 0.5}) {
+        const FitState st = FitFamily(bins, psf, d0, r0 * scale, w1, w2, hw);
+        if (st.sse < best.sse) best = st, best_psf = psf;
+        if (r0 < 1) break;
+      }
+    }
+    if (!(bin_width > std::max(kFineBinPx, best.r / 6))) break;
+    d0 = best.d0;
+    r0 = best.r;
   }
 
   double sw = 0;
@@ -345,27 +414,15 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
   const double rms = std::sqrt(std::max(0.0, best.sse) / std::max(sw, 1.0));
   fit.rms_rel = std::abs(fit.step) > 1e-12 && std::isfinite(rms) ? rms / std::abs(fit.step) : 1e9;
 
-  // Printing flaws: samples far from their bin's median (the median already ignored them).
-  {
-    const int nb = static_cast<int>(start.size()) - 1;
-    std::vector<float> med(nb, 0.f);
-    for (const Bin& b : bins) med[b.index] = static_cast<float>(b.v);
-    std::vector<float> dev(samples.size());
-    for (size_t i = 0; i < samples.size(); ++i) {
-      const int k = std::clamp(static_cast<int>((samples[i].d + hw) / bin_width), 0, nb - 1);
-      dev[i] = std::abs(samples[i].v - med[k]);
-    }
-    std::vector<float> tmp = dev;
-    const double sigma = 1.4826 * MedianInPlace(tmp.data(), tmp.data() + tmp.size());
-    const double limit = std::max(6 * sigma, 0.25 * std::abs(fit.step));
-    const long outliers = std::count_if(dev.begin(), dev.end(), [&](float v) { return v > limit; });
-    if (std::abs(fit.step) > 0 && outliers > std::max<long>(10, samples.size() / 1000)) fit.flags.push_back("flaw");
-  }
+  // Printing flaws: samples far from their bin's median (rejected above, reported here).
+  if (std::abs(step0) > 0 && stats.outliers > std::max<long>(10, static_cast<long>(samples.size()) / 1000))
+    fit.flags.push_back("flaw");
 
   bool bad = false;
   auto flag = [&](const char* name) { fit.flags.push_back(name), bad = true; };
   if (std::abs(fit.step) < options.min_contrast) flag("low_contrast");
-  if (clipped > options.max_saturated_fraction * fit.samples) flag("saturated");
+  // Clipped noise tails do not bias the bin medians; clipped signal (a bin whose median is clipped) does.
+  if (stats.clipped > options.max_saturated_fraction * fit.samples) flag("saturated");
   // The blur must fit in the window on both sides of the edge, the X-junctions at the section ends must not
   // reach into the central part used (a disc reaches r), and the image border must leave enough of that part.
   const double reach = 1.5 * fit.r_px + 2;
