@@ -254,6 +254,47 @@ TEST(EdgeModel, BlurWiderThanTheWindowIsCrowded) {
   EXPECT_TRUE(HasFlag(fit, "crowded")) << Describe(fit);
 }
 
+// A 30 px section keeps its central half only 7.5 px from the X-junctions: a 12 px blur reaches into it.
+TEST(EdgeModel, SectionTooShortForItsBlurIsCrowded) {
+  EdgeSpec spec;
+  spec.r_px = 12;
+  spec.length_px = 30;
+  const EdgeImage img = Render(spec);
+  const ModelFit fit = MeasureEdgeModel(img.linear, img.segment);
+  EXPECT_FALSE(fit.ok);
+  EXPECT_TRUE(HasFlag(fit, "crowded")) << Describe(fit);
+}
+
+// Noise clipped at 0 on a near-black square is not clipped signal: the bin medians are unbiased.
+TEST(EdgeModel, ClippedNoiseTailsAreNotSaturation) {
+  EdgeSpec spec;
+  spec.black = 0.01;
+  spec.noise = 0.02;
+  const EdgeImage img = Render(spec);
+  const ModelFit fit = MeasureEdgeModel(img.linear, img.segment);
+  EXPECT_TRUE(fit.ok) << Describe(fit);
+  EXPECT_FALSE(HasFlag(fit, "saturated")) << Describe(fit);
+  EXPECT_NEAR(fit.r_px, spec.r_px, Tolerance(spec.r_px)) << Describe(fit);
+}
+
+// 5 % Michelson contrast in 8-bit sRGB spans ~8 code values: bin medians would snap to codes and widen the edge;
+// the bins' trimmed means do not.
+TEST(EdgeModel, LowContrastEightBitEdgeStillAccurate) {
+  for (double r : {0.5, 1.0, 3.0, 8.0}) {
+    EdgeSpec spec;
+    spec.psf = "gaussian";
+    spec.r_px = r;
+    spec.angle_deg = 43;
+    spec.black = 0.42 * 0.95;
+    spec.white = 0.42 * 1.05;
+    spec.noise = 0.004;
+    const EdgeImage img = Render(spec);
+    const ModelFit fit = MeasureEdgeModel(img.linear, img.segment);
+    EXPECT_TRUE(fit.ok) << Describe(fit);
+    EXPECT_NEAR(fit.r_px, r, Tolerance(r)) << Describe(fit);
+  }
+}
+
 // Two edges in one window (a stripe) are not one step.
 TEST(EdgeModel, StripeIsAPoorFit) {
   EdgeSpec spec;
