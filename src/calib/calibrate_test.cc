@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
+#include <string>
 #include <cstdio>
 
 #include "calib/scene_blur.h"
@@ -36,13 +38,20 @@ struct Calibration {
   TruthComparison cmp;
 };
 
-Calibration Calibrated(const synth::SceneOptions& o) {
+// Rendering a scene takes seconds: each distinct scene is rendered and calibrated once per test binary.
+const Calibration& Calibrated(const synth::SceneOptions& o) {
+  static std::map<std::string, Calibration> cache;
+  const std::string key = std::to_string(o.focus_mm) + "/" + std::to_string(o.noise_std);
+  auto it = cache.find(key);
+  if (it != cache.end()) return it->second;
   Calibration r;
   r.scene = synth::RenderScene(o);
   r.result = Calibrate(r.scene.image, r.scene.camera, r.scene.board);
   r.cmp = CompareToTruth(r.result, r.scene.truth, "truth");
-  return r;
+  return cache.emplace(key, std::move(r)).first->second;
 }
+
+const synth::Scene& Rendered(const synth::SceneOptions& o) { return Calibrated(o).scene; }
 
 void PrintSideBySide(const Calibration& r) {
   std::printf("edge  true   model  thesis  eq3.7  fitted\n");
@@ -54,7 +63,7 @@ void PrintSideBySide(const Calibration& r) {
 }
 
 TEST(Calibrate, PoseWithinOneMillimetreAndHalfDegree) {
-  const Calibration r = Calibrated(Thesis());
+  const Calibration& r = Calibrated(Thesis());
   EXPECT_LT(r.cmp.translation_error_mm, 1.0);
   EXPECT_LT(r.cmp.rotation_error_deg, 0.5);
   EXPECT_LT(r.cmp.max_depth_error_mm, 1.0);
@@ -62,7 +71,7 @@ TEST(Calibrate, PoseWithinOneMillimetreAndHalfDegree) {
 }
 
 TEST(Calibrate, ElevenEdgesOfSevenSectionsNearestFirst) {
-  const Calibration r = Calibrated(Thesis());
+  const Calibration& r = Calibrated(Thesis());
   ASSERT_EQ(r.result.edges.size(), 11u);
   for (size_t e = 0; e < 11; ++e) {
     EXPECT_EQ(r.result.edges[e].sections.size(), 7u);
@@ -75,7 +84,7 @@ TEST(Calibrate, ElevenEdgesOfSevenSectionsNearestFirst) {
 }
 
 TEST(Calibrate, ModelFitWithinToleranceOfTrueBlur) {
-  const Calibration r = Calibrated(Blurry());
+  const Calibration& r = Calibrated(Blurry());
   PrintSideBySide(r);
   int ok = 0, within = 0;
   for (const auto& s : r.cmp.sections) {
@@ -88,7 +97,7 @@ TEST(Calibrate, ModelFitWithinToleranceOfTrueBlur) {
 }
 
 TEST(Calibrate, FittedModelPredictsHeldOutEdges) {
-  const Calibration r = Calibrated(Blurry());
+  const Calibration& r = Calibrated(Blurry());
   const optics::Lens lens = optics::Lens::FromCamera(r.scene.camera);
   std::vector<optics::BlurSample> train;
   for (const auto& edge : r.result.edges)
@@ -104,7 +113,7 @@ TEST(Calibrate, FittedModelPredictsHeldOutEdges) {
 
 TEST(Calibrate, Eq37FromTheReferenceEdgeFollowsTheThinLens) {
   // Truth is a thin lens, so eq. 3.7 from a well-measured reference must land near the truth too.
-  const Calibration r = Calibrated(Blurry());
+  const Calibration& r = Calibrated(Blurry());
   const TruthComparison& c = r.cmp;
   for (int e = 2; e <= 11; ++e)
     EXPECT_NEAR(r.result.edges[e - 1].r_estimated_px, c.true_r_per_edge[e - 1], 0.1 * c.true_r_per_edge[e - 1] + 0.1)
@@ -112,7 +121,7 @@ TEST(Calibrate, Eq37FromTheReferenceEdgeFollowsTheThinLens) {
 }
 
 TEST(Calibrate, JsonHasEveryFieldTheIssueNames) {
-  const Calibration r = Calibrated(Thesis());
+  const Calibration& r = Calibrated(Thesis());
   const Json j = CalibToJson(r.result);
   for (const char* key : {"camera", "board", "pose", "reference_edge", "edges"}) EXPECT_TRUE(j.contains(key)) << key;
   for (const char* key : {"rvec", "tvec", "reprojection_error_px"}) EXPECT_TRUE(j["pose"].contains(key)) << key;
@@ -127,7 +136,7 @@ TEST(Calibrate, JsonHasEveryFieldTheIssueNames) {
 }
 
 TEST(Calibrate, PhotoWithoutBoardIsNotFound) {
-  const synth::Scene scene = synth::RenderScene(Thesis());
+  const synth::Scene& scene = Rendered(Thesis());
   try {
     Calibrate(scene.image_no_board, scene.camera, scene.board);
     FAIL() << "expected no board";
@@ -138,7 +147,7 @@ TEST(Calibrate, PhotoWithoutBoardIsNotFound) {
 }
 
 TEST(Calibrate, BoardOfAnotherSizeIsNotFound) {
-  const synth::Scene scene = synth::RenderScene(Thesis());
+  const synth::Scene& scene = Rendered(Thesis());
   Board other = scene.board;
   other.cols = 8;
   try {
@@ -150,7 +159,7 @@ TEST(Calibrate, BoardOfAnotherSizeIsNotFound) {
 }
 
 TEST(Calibrate, CameraOfAnotherImageSizeIsAnInputError) {
-  const synth::Scene scene = synth::RenderScene(Thesis());
+  const synth::Scene& scene = Rendered(Thesis());
   try {
     Calibrate(scene.image, ThesisCamera(), scene.board);
     FAIL() << "expected a size mismatch";
@@ -161,7 +170,7 @@ TEST(Calibrate, CameraOfAnotherImageSizeIsAnInputError) {
 }
 
 TEST(SceneCalib, ReadsBackCalibJsonAndAnswersEverySource) {
-  const Calibration r = Calibrated(Blurry());
+  const Calibration& r = Calibrated(Blurry());
   const SceneCalib scene = SceneCalibFromJson(CalibToJson(r.result), "calib.json: ");
   ASSERT_EQ(scene.sections.size(), 77u);
   // At the midpoint of edge 9 section 4 each source answers, and all agree with the truth within 15 %.
@@ -169,7 +178,8 @@ TEST(SceneCalib, ReadsBackCalibJsonAndAnswersEverySource) {
   const double truth = r.cmp.sections[8 * 7 + 3].true_r_px;
   double fixed = 0;
   EXPECT_EQ(BlurAtPx(scene, ParseBlurSource("none", nullptr), s.midpoint_camera_mm), 0.0);
-  EXPECT_EQ(BlurAtPx(scene, ParseBlurSource("2.5", &fixed), s.midpoint_camera_mm, fixed), 2.5);
+  const BlurSource fixed_source = ParseBlurSource("2.5", &fixed);
+  EXPECT_EQ(BlurAtPx(scene, fixed_source, s.midpoint_camera_mm, fixed), 2.5);
   EXPECT_NEAR(BlurAtPx(scene, BlurSource::kMeasured, s.midpoint_camera_mm), s.fit.r_px, 1e-9);
   EXPECT_NEAR(BlurAtPx(scene, BlurSource::kEstimated, s.midpoint_camera_mm), truth, 0.15 * truth);
   EXPECT_NEAR(BlurAtPx(scene, BlurSource::kFitted, s.midpoint_camera_mm), truth, 0.15 * truth);
@@ -179,7 +189,7 @@ TEST(SceneCalib, ReadsBackCalibJsonAndAnswersEverySource) {
 }
 
 TEST(SceneCalib, BadFieldIsNamed) {
-  const Calibration r = Calibrated(Thesis());
+  const Calibration& r = Calibrated(Thesis());
   Json j = CalibToJson(r.result);
   j["pose"]["tvec"] = {1, 2};
   try {
