@@ -1,7 +1,6 @@
 #include "calib/edge_blur.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
