@@ -31,6 +31,16 @@ int main(int argc, char** argv) {
   };
   for (const auto& [name, add] : commands) add(app);
 
+  // An unknown command says how to list the known ones (CLI11 alone would say "a subcommand is required").
+  if (argc > 1 && argv[1][0] != '-') {
+    bool known = false;
+    for (const auto& [name, add] : commands) known = known || name == std::string(argv[1]);
+    if (!known) {
+      std::cerr << "blurcue: unknown command '" << argv[1] << "'; 'blurcue --help' lists the commands\n";
+      return static_cast<int>(ErrorKind::kUsage);
+    }
+  }
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
