@@ -1,1 +1,346 @@
-// placeholder: being written
+// Ground-truth scenes checked against truth computed another way: the tilted-plane geometry by hand, the thin
+// lens written out here, OpenCV's own board detector and projection, and edge moments measured in the image.
+#include "synth/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/error.h"
+#include "core/image.h"
+
+namespace blurcue::synth {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// The thesis set-up at an eighth of its resolution: quick to render, big enough for OpenCV to find the board.
+SceneOptions Small() {
+  SceneOptions o;
+  o.camera = ThesisCamera().Resized(574, 382);
+  o.supersample = 2;
+  return o;
+}
+
+// A steep view of a small board with big squares, one blur radius everywhere: room for wide edge profiles.
+SceneOptions FixedBlur(double r, Psf psf) {
+  SceneOptions o;
+  o.camera = ThesisCamera().Resized(800, 532);
+  o.board = Board{5, 4, 25};
+  o.tilt_deg = 75;
+  o.edge1_u_mm = 300;
+  o.fixed_r_px = r;
+  o.psf = psf;
+  o.supersample = r < 2 ? 4 : 2;
+  return o;
+}
+
+cv::Mat Linear(const cv::Mat& bgr8) { return DecodeSrgb8(ToGrey8(bgr8)); }
+
+cv::Point2d Project(const Scene& s, double x, double y) {
+  std::vector<cv::Point3d> p{{x, y, 0}};
+  std::vector<cv::Point2d> q;
+  const auto k = s.camera.Intrinsics();
+  cv::projectPoints(p, s.rvec, s.tvec, cv::Matx33d(k.data()), cv::noArray(), q);
+  return q[0];
+}
+
+// The profile across edge `edge` at the middle of section `section`: linear light, averaged over the middle half
+// of the section's columns, rows within half the distance to the neighbouring edges. At yaw 0 the edges of
+// constant board y are image rows, so every column crosses the edge at the same row.
+struct Profile {
+  double edge_row = 0;       // where the pose puts the edge line (pixel centres at integers)
+  int first_row = 0;         // image row of values[0]
+  std::vector<double> values;
+};
+
+Profile EdgeProfile(const Scene& s, int edge, int section) {
+  const cv::Mat lin = Linear(s.image);
+  const double sq = s.board.square_mm, y = (edge - 1) * sq, xm = (section - 0.5) * sq;
+  const cv::Point2d a = Project(s, (section - 1) * sq, y), c = Project(s, section * sq, y);
+  EXPECT_NEAR(a.y, c.y, 1e-6) << "edges of constant board y must be image rows at yaw 0";
+  const double spacing = std::min(Project(s, xm, y - sq).y - a.y, a.y - Project(s, xm, y + sq).y);
+  const int half = static_cast<int>(spacing / 2) - 1;
+  const int centre = static_cast<int>(std::lround(a.y));
+  const int x0 = static_cast<int>(a.x + (c.x - a.x) / 4), x1 = static_cast<int>(c.x - (c.x - a.x) / 4);
+  Profile p;
+  p.edge_row = a.y;
+  p.first_row = centre - half;
+  for (int row = centre - half; row <= centre + half; ++row) {
+    double sum = 0;
+    for (int x = x0; x <= x1; ++x) sum += lin.at<float>(row, x);
+    p.values.push_back(sum / (x1 - x0 + 1));
+  }
+  return p;
+}
+
+// Fraction of a unit step's light that a PSF of radius r has spread past offset t (the edge spread function).
+double EdgeSpread(double t, double r, Psf psf) {
+  if (r <= 0) return t >= 0 ? 1 : 0;
+  if (psf == Psf::kGaussian) return 0.5 * std::erfc(-t / (r / 2) / std::sqrt(2.0));
+  if (t <= -r) return 0;
+  if (t >= r) return 1;
+  return 0.5 + (t * std::sqrt(r * r - t * t) + r * r * std::asin(t / r)) / (kPi * r * r);
+}
+
+// What a camera pixel sees across an edge from `before` (rows above) to `after`: the edge spread function
+// averaged over the pixel's area, written from scratch (numerical integration), independent of the renderer.
+std::vector<double> ExpectedProfile(const Profile& p, double r, Psf psf, double before, double after) {
+  std::vector<double> out;
+  for (size_t i = 0; i < p.values.size(); ++i) {
+    const double row = p.first_row + static_cast<double>(i);
+    double sum = 0;
+    constexpr int kSteps = 200;
+    for (int k = 0; k < kSteps; ++k) sum += EdgeSpread(row - 0.5 + (k + 0.5) / kSteps - p.edge_row, r, psf);
+    out.push_back(before + (after - before) * sum / kSteps);
+  }
+  return out;
+}
+
+double RmsDifference(const std::vector<double>& a, const std::vector<double>& b) {
+  double sum = 0;
+  for (size_t i = 0; i < a.size(); ++i) sum += (a[i] - b[i]) * (a[i] - b[i]);
+  return std::sqrt(sum / a.size());
+}
+
+// Edge 3, section 3 of the 5x4 board in FixedBlur: black square above (farther), white below.
+constexpr double kBlack = 0.04, kWhite = 0.80;
+
+// The radius whose expected profile fits the rendered one best (golden-section search).
+double FittedRadius(const Profile& p, Psf psf, double r_hi) {
+  auto cost = [&](double r) { return RmsDifference(p.values, ExpectedProfile(p, r, psf, kBlack, kWhite)); };
+  double lo = 0, hi = r_hi;
+  const double g = (std::sqrt(5.0) - 1) / 2;
+  for (int it = 0; it < 40; ++it) {
+    const double a = hi - g * (hi - lo), b = lo + g * (hi - lo);
+    (cost(a) < cost(b) ? hi : lo) = (cost(a) < cost(b) ? b : a);
+  }
+  return 0.5 * (lo + hi);
+}
+
+TEST(SynthScene, SectionDepthsFollowTheTiltedBoard) {
+  const SceneOptions o = Small();
+  const Scene s = RenderScene(o);
+  ASSERT_EQ(s.sections.size(), 77u);
+  const double c = std::cos(38 * kPi / 180);
+  for (const SectionTruth& t : s.sections) {
+    EXPECT_NEAR(t.u_mm, 342.3 + (t.edge - 1) * 25 * c, 1e-9) << "edge " << t.edge << " section " << t.section;
+    // The pose says the same: the section midpoint's camera z.
+    cv::Matx33d R;
+    cv::Rodrigues(s.rvec, R);
+    const cv::Vec3d p = R * cv::Vec3d((t.section - 0.5) * 25, (t.edge - 1) * 25, 0) + s.tvec;
+    EXPECT_NEAR(p[2], t.u_mm, 1e-9);
+  }
+  EXPECT_EQ(s.sections.front().edge, 1);
+  EXPECT_EQ(s.sections[7].edge, 2);  // edge-major
+  EXPECT_EQ(s.sections[7].section, 1);
+  EXPECT_NEAR(s.focus_mm, 342.3, 1e-9);
+}
+
+TEST(SynthScene, RadiusIsTheThinLensWrittenOut) {
+  SceneOptions o = Small();
+  o.focus_mm = 300;
+  o.blur_gain = 1.5;
+  const Scene s = RenderScene(o);
+  const double f = 21, D = 21 / 5.6, pitch = 23.4 / 574;
+  const double v0 = 1 / (1 / f - 1 / 300.0);
+  for (const SectionTruth& t : s.sections) {
+    const double v = 1 / (1 / f - 1 / t.u_mm);
+    const double R = D / 2 * std::abs(v0 - v) / v;  // blur-circle radius on the sensor
+    EXPECT_NEAR(t.r_px, 1.5 * R / pitch, 1e-9);
+  }
+  EXPECT_GT(s.sections.back().r_px, s.sections.front().r_px);
+}
+
+TEST(SynthScene, OpenCvFindsTheBoardWhereThePoseSays) {
+  SceneOptions o = Small();
+  o.noise_std = 0.003;
+  const Scene s = RenderScene(o);
+  std::vector<cv::Point2f> corners;
+  const cv::Size pattern(s.board.InnerCornersX(), s.board.InnerCornersY());
+  ASSERT_TRUE(cv::findChessboardCornersSB(ToGrey8(s.image), pattern, corners));
+  ASSERT_EQ(corners.size(), 54u);
+  for (const cv::Point2f& c : corners) {
+    double best = 1e9;
+    for (int i = 1; i < s.board.cols; ++i)
+      for (int j = 1; j < s.board.rows; ++j)
+        best = std::min(best, cv::norm(Project(s, i * 25.0, j * 25.0) - cv::Point2d(c)));
+    EXPECT_LT(best, 0.5) << c;
+  }
+  EXPECT_FALSE(cv::findChessboardCornersSB(ToGrey8(s.image_no_board), pattern, corners));
+}
+
+struct BlurCase {
+  double r;
+  Psf psf;
+};
+
+class RenderedBlur : public ::testing::TestWithParam<BlurCase> {};
+
+// The rendered edge is the requested PSF's edge spread averaged over the pixel: point by point within 1 % of the
+// step, and the best-fitting radius within 3 % (plus 0.02 px) of the requested one.
+TEST_P(RenderedBlur, EdgeProfileIsTheRequestedPsfOverThePixel) {
+  const BlurCase c = GetParam();
+  const Scene s = RenderScene(FixedBlur(c.r, c.psf));
+  const Profile p = EdgeProfile(s, 3, 3);
+  const std::vector<double> expected = ExpectedProfile(p, c.r, c.psf, kBlack, kWhite);
+  EXPECT_LT(RmsDifference(p.values, expected), 0.01 * (kWhite - kBlack));
+  // Below ~0.3 px the blur hardly leaves the pixel the edge falls in, so no profile can tell the radius.
+  if (c.r >= 0.3) EXPECT_NEAR(FittedRadius(p, c.psf, 2 * c.r + 2), c.r, 0.03 * c.r + 0.02);
+}
+
+// Second moment, the DESIGN.md definition: the differenced profile's variance is r^2/4 plus the pixel's area
+// (1/12 px^2) plus the difference's own unit box (1/12 px^2). Exact for blur of a pixel or more; for smaller
+// blur it depends on where the edge falls within a pixel, which the profile test above covers.
+TEST_P(RenderedBlur, EdgeSecondMomentIsTheRequestedRadius) {
+  const BlurCase c = GetParam();
+  if (c.r < 1) GTEST_SKIP() << "sampling phase dominates below a pixel";
+  const Profile p = EdgeProfile(RenderScene(FixedBlur(c.r, c.psf)), 3, 3);
+  double m0 = 0, m1 = 0, m2 = 0;
+  for (size_t i = 0; i + 1 < p.values.size(); ++i) {
+    const double g = p.values[i + 1] - p.values[i], t = i + 0.5;
+    m0 += g, m1 += g * t, m2 += g * t * t;
+  }
+  const double var = m2 / m0 - (m1 / m0) * (m1 / m0);
+  EXPECT_NEAR(2 * std::sqrt(var - 1.0 / 6), c.r, 0.03 * c.r) << "variance " << var;
+}
+
+INSTANTIATE_TEST_SUITE_P(SynthScene, RenderedBlur,
+                         ::testing::Values(BlurCase{0, Psf::kDisc}, BlurCase{0.3, Psf::kDisc},
+                                           BlurCase{0.6, Psf::kGaussian}, BlurCase{1, Psf::kDisc},
+                                           BlurCase{1, Psf::kGaussian}, BlurCase{3, Psf::kDisc},
+                                           BlurCase{3, Psf::kGaussian}, BlurCase{8, Psf::kDisc},
+                                           BlurCase{8, Psf::kGaussian}));
+
+TEST(SynthScene, BlurKeepsTheLight) {
+  const Scene sharp = RenderScene(FixedBlur(0, Psf::kDisc));
+  const Scene blurred = RenderScene(FixedBlur(6, Psf::kDisc));
+  const cv::Mat a = Linear(sharp.image), b = Linear(blurred.image);
+  // A large area holding whole squares and edges: the mean is unchanged.
+  const cv::Rect area(150, 120, 500, 300);
+  EXPECT_NEAR(cv::mean(b(area))[0], cv::mean(a(area))[0], 0.003);
+  // The middle of a white square (column 1, row 2 of a 5x4 board) is still exactly white.
+  const cv::Point2d centre = Project(blurred, 1.5 * 25, 2.5 * 25);
+  const cv::Rect mid(int(centre.x) - 5, int(centre.y) - 5, 11, 11);
+  EXPECT_NEAR(cv::mean(b(mid))[0], 0.80, 0.005);
+  EXPECT_NEAR(cv::mean(a(mid))[0], 0.80, 0.005);
+}
+
+TEST(SynthScene, BlurGrowsWithDistanceBeyondFocus) {
+  const Scene s = RenderScene(Small());
+  EXPECT_NEAR(s.sections.front().r_px, 0, 1e-9);  // focused on edge 1
+  for (size_t i = 7; i < s.sections.size(); ++i) EXPECT_GT(s.sections[i].r_px, s.sections[i - 7].r_px);
+  // Rendered: each edge's profile fits the thin lens's radius at that depth (black beyond, white nearer).
+  // (Edges nearer than 6 blur by under half a pixel: a blur that stays inside one pixel does not change it.)
+  double previous = 0;
+  for (int edge : {6, 8, 10}) {
+    const double truth = s.sections[(edge - 1) * 7 + 3].r_px;
+    const double fitted = FittedRadius(EdgeProfile(s, edge, 4), Psf::kDisc, 4);
+    EXPECT_NEAR(fitted, truth, 0.05 + 0.03 * truth) << "edge " << edge;
+    EXPECT_GT(fitted, previous);
+    previous = fitted;
+  }
+}
+
+TEST(SynthScene, SameSeedSameBytes) {
+  SceneOptions o = Small();
+  o.noise_std = 0.01;
+  o.flaws = 4;
+  o.jpeg_quality = 80;
+  const Scene a = RenderScene(o), b = RenderScene(o);
+  EXPECT_EQ(cv::norm(a.image, b.image, cv::NORM_INF), 0);
+  EXPECT_EQ(cv::norm(a.image_no_board, b.image_no_board, cv::NORM_INF), 0);
+  EXPECT_EQ(a.truth.dump(), b.truth.dump());
+}
+
+TEST(SynthScene, DifferentSeedWithNoiseDifferentImage) {
+  SceneOptions o = Small();
+  o.noise_std = 0.01;
+  const Scene a = RenderScene(o);
+  o.seed = 2;
+  const Scene b = RenderScene(o);
+  EXPECT_GT(cv::norm(a.image, b.image, cv::NORM_L1) / a.image.total(), 1.0);
+}
+
+TEST(SynthScene, FlawsAreRecordedAndDarkenTheirSections) {
+  SceneOptions o = Small();
+  o.camera = ThesisCamera().Resized(1148, 764);  // spots of ~3 mm need a few pixels
+  const Scene clean = RenderScene(o);
+  o.flaws = 5;
+  const Scene flawed = RenderScene(o);
+  ASSERT_EQ(flawed.truth["flaws"].size(), 5u);
+  int flawed_sections = 0;
+  cv::Mat clean_g = ToGrey8(clean.image), flawed_g = ToGrey8(flawed.image), diff;
+  cv::subtract(clean_g, flawed_g, diff, cv::noArray(), CV_32S);
+  double min_diff;
+  cv::minMaxLoc(diff, &min_diff);
+  EXPECT_GE(min_diff, -1) << "flaws only darken";
+  for (const SectionTruth& t : flawed.sections) {
+    if (!t.flawed) continue;
+    ++flawed_sections;
+    // The band around the section (half-way to the neighbouring edges) holds clearly darker pixels.
+    const cv::Point2d a = Project(flawed, (t.section - 1) * 25.0, (t.edge - 1.5) * 25.0);
+    const cv::Point2d b = Project(flawed, t.section * 25.0, (t.edge - 0.5) * 25.0);
+    cv::Rect band(cv::Point(int(std::min(a.x, b.x)), int(std::min(a.y, b.y))),
+                  cv::Point(int(std::max(a.x, b.x)) + 1, int(std::max(a.y, b.y)) + 1));
+    band &= cv::Rect(0, 0, diff.cols, diff.rows);
+    double max_diff;
+    cv::minMaxLoc(diff(band), nullptr, &max_diff);
+    EXPECT_GT(max_diff, 25) << "edge " << t.edge << " section " << t.section;
+  }
+  EXPECT_GE(flawed_sections, 1);
+  EXPECT_LE(flawed_sections, 10);
+  for (const SectionTruth& t : clean.sections) EXPECT_FALSE(t.flawed);
+}
+
+TEST(SynthScene, TruthJsonHoldsWhatCalibrationReads) {
+  const Scene s = RenderScene(Small());
+  for (const char* key : {"options", "camera", "board", "pose", "focus_mm", "aperture_mm", "pixel_pitch_mm", "sections"})
+    EXPECT_TRUE(s.truth.contains(key)) << key;
+  EXPECT_EQ(s.truth["pose"]["rvec"].size(), 3u);
+  EXPECT_EQ(s.truth["pose"]["rotation"].size(), 3u);
+  EXPECT_EQ(s.truth["sections"].size(), 77u);
+  EXPECT_EQ(s.truth["sections"][8]["edge"], 2);
+  EXPECT_EQ(s.truth["sections"][8]["section"], 2);
+}
+
+TEST(SynthScene, ImpossibleOptionsNameTheOption) {
+  auto expect = [](SceneOptions o, const std::string& name) {
+    try {
+      RenderScene(o);
+      ADD_FAILURE() << "no error for " << name;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::kInput);
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  };
+  SceneOptions o = Small();
+  o.focus_mm = 21;
+  expect(o, "focus_mm");
+  o = Small();
+  o.edge1_u_mm = 120;  // too near: the board overflows the view
+  expect(o, "edge1_u_mm");
+  o = Small();
+  o.tilt_deg = -5;
+  expect(o, "tilt_deg");
+  o = Small();
+  o.fixed_r_px = -1;
+  expect(o, "fixed_r_px");
+}
+
+TEST(SynthScene, LowTiltShowsTheBackWall) {
+  SceneOptions o = Small();
+  o.tilt_deg = 15;  // the view reaches above the horizon
+  o.edge1_u_mm = 600;
+  const Scene s = RenderScene(o);
+  EXPECT_EQ(s.sections.size(), 77u);
+  EXPECT_GT(s.truth["r_range_px"][1].get<double>(), s.sections.back().r_px);
+}
+
+}  // namespace
+}  // namespace blurcue::synth
