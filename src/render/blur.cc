@@ -27,7 +27,14 @@ cv::Mat GaussianBlurCpu(const cv::Mat& rgba, double r_px) {
   return out;
 }
 
-cv::Mat DiscKernel(double r_px) {
+double DiscCoverageRadiusPx(double r_px) {
+  // The one-pixel coverage ramp widens the disc's line-spread function by a pixel's variance (1/12 px^2), which
+  // is r^2 / 4 in the DESIGN.md unit; take it out so the kernel's r is the requested one.
+  return std::sqrt(std::max(r_px * r_px - 1.0 / 3.0, 0.0));
+}
+
+cv::Mat DiscKernel(double requested_r_px) {
+  const double r_px = DiscCoverageRadiusPx(requested_r_px);
   const int t = int(std::ceil(r_px + 0.5));
   cv::Mat k(2 * t + 1, 2 * t + 1, CV_32F);
   for (int y = -t; y <= t; ++y)
@@ -156,8 +163,9 @@ cv::Mat GlBlur::Disc(const cv::Mat& rgba, double r_px) {
   Framebuffer to_target(target);
   disc_->Use();
   glUniform1i(disc_->Uniform("u_image"), 0);
-  glUniform1f(disc_->Uniform("u_radius_px"), float(r_px));
-  glUniform1i(disc_->Uniform("u_taps"), int(std::ceil(r_px + 0.5)));
+  const double coverage_r = DiscCoverageRadiusPx(r_px);
+  glUniform1f(disc_->Uniform("u_radius_px"), float(coverage_r));
+  glUniform1i(disc_->Uniform("u_taps"), int(std::ceil(coverage_r + 0.5)));
   to_target.Bind();
   source.Bind(0);
   pass_->Draw();

@@ -13,8 +13,10 @@ int GaussianTaps(double sigma_px);
 // CPU reference: the shader's separable kernel (normalised, clamp-to-edge) on CV_32FC4 premultiplied linear RGBA.
 cv::Mat GaussianBlurCpu(const cv::Mat& rgba, double r_px);
 
-// The pillbox kernel of radius r (px): weight clamp(r + 0.5 - distance, 0, 1), normalised; (2 t + 1)^2 taps with
-// t = ceil(r + 0.5). The same formula as shaders/blur_disc.frag.
+// The pillbox kernel for radius r (px): weight clamp(R + 0.5 - distance, 0, 1), normalised, (2 t + 1)^2 taps with
+// t = ceil(R + 0.5), where R = DiscCoverageRadiusPx(r) = sqrt(r^2 - 1/3) takes out the variance the coverage ramp
+// adds. The same formula as shaders/blur_disc.frag.
+double DiscCoverageRadiusPx(double r_px);
 cv::Mat DiscKernel(double r_px);
 cv::Mat DiscBlurCpu(const cv::Mat& rgba, double r_px);
 

@@ -158,3 +158,46 @@ TEST(LinearPremultiplied, RoundTripsEightBitImages) {
 
 }  // namespace
 }  // namespace blurcue::render
+
+#include "calib/edge_blur.h"
+#include "core/image.h"
+
+namespace blurcue::render {
+namespace {
+
+// The renderer's blur, measured by the calibration's own measurement: a slanted step in linear light, blurred on
+// the GPU, written as 8-bit sRGB like any stimulus, read back and measured.
+TEST_F(GlTest, RenderedEdgeMeasuresAsTheRequestedRadius) {
+  GlBlur blur;
+  const int w = 240, h = 200;
+  cv::Mat step(h, w, CV_32FC4);
+  const double angle = 6 * M_PI / 180;  // slanted, so the edge is sampled at many sub-pixel phases
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      // Area coverage of the bright side by 4x4 sub-samples: a sharp, anti-aliased step.
+      double cover = 0;
+      for (int sy = 0; sy < 4; ++sy)
+        for (int sx = 0; sx < 4; ++sx) {
+          const double px = x + (sx + 0.5) / 4 - 0.5 - w / 2.0, py = y + (sy + 0.5) / 4 - 0.5 - h / 2.0;
+          cover += (py * std::cos(angle) - px * std::sin(angle) > 0) / 16.0;
+        }
+      const float v = float(0.05 + 0.75 * cover);
+      step.at<cv::Vec4f>(y, x) = cv::Vec4f(v, v, v, 1);
+    }
+  const cv::Point2d centre(w / 2.0 - 0.5, h / 2.0 - 0.5), along(std::cos(angle), std::sin(angle));
+  const calib::EdgeSegment segment{centre - 80.0 * along, centre + 80.0 * along, 90};
+  for (const char* method : {"gaussian", "disc"})
+    for (double r : {2.0, 5.0, 12.0}) {
+      const cv::Mat blurred = std::string(method) == "disc" ? blur.Disc(step, r) : blur.Gaussian(step, r);
+      // Through 8-bit sRGB and back, as a stimulus on disk would be.
+      cv::Mat bgr;
+      cv::cvtColor(FromLinearPremultiplied(blurred, false), bgr, cv::COLOR_BGR2GRAY);
+      const calib::ModelFit fit = calib::MeasureEdgeModel(DecodeSrgb8(bgr), segment);
+      ASSERT_TRUE(fit.ok) << method << " r = " << r << " flags " << (fit.flags.empty() ? "" : fit.flags[0]) << " r_fit " << fit.r_px;
+      std::printf("%s r %.1f measured %.3f\n", method, r, fit.r_px);
+      EXPECT_NEAR(fit.r_px, r, 0.05 * r) << method;
+    }
+}
+
+}  // namespace
+}  // namespace blurcue::render
