@@ -257,6 +257,19 @@ void BuildDisc(double R, Level* l) {
   l->reach = std::max(n, static_cast<int>(std::ceil(l->row_half[n] + 0.5)));
 }
 
+// Variance across columns of a disc level: each row's segment [-h, h] integrated over unit cells.
+double ColumnVariance(const Level& l) {
+  double v = 0;
+  for (size_t k = 0; k < l.row_weight.size(); ++k) {
+    const double h = l.row_half[k];
+    double s = 0;
+    for (int i = -static_cast<int>(h) - 1; i <= static_cast<int>(h) + 1; ++i)
+      s += i * i * std::max(0.0, std::min(i + 0.5, h) - std::max(i - 0.5, -h));
+    v += l.row_weight[k] * s / (2 * h);
+  }
+  return v;
+}
+
 double RowVariance(const std::vector<double>& w) {
   const int n = static_cast<int>(w.size()) / 2;
   double v = 0;
@@ -293,6 +306,18 @@ Level MakeLevel(double r_px, int ss, Psf psf) {
       (RowVariance(t.row_weight) < target ? lo : hi) = mid;
     }
     BuildDisc(0.5 * (lo + hi), &l);
+    // Rows of a small disc cut into cells are not round: widen (or narrow) every row's segment by one factor so
+    // the spread across columns matches the spread across rows, i.e. the kernel is isotropic in second moment.
+    const std::vector<double> halves = l.row_half;
+    double klo = 0.05, khi = 4;
+    for (int it = 0; it < 60; ++it) {
+      const double mid = 0.5 * (klo + khi);
+      for (size_t k = 0; k < halves.size(); ++k) l.row_half[k] = halves[k] * mid;
+      (ColumnVariance(l) < target ? klo : khi) = mid;
+    }
+    for (size_t k = 0; k < halves.size(); ++k) l.row_half[k] = halves[k] * 0.5 * (klo + khi);
+    const int rows = static_cast<int>(l.row_weight.size()) / 2;
+    l.reach = std::max(rows, static_cast<int>(std::ceil(*std::max_element(l.row_half.begin(), l.row_half.end()) + 0.5)));
   } else {
     // Width fixed first (3 sigma, at least one tap) so the variance is continuous in sigma.
     const int n = std::max(1, static_cast<int>(std::ceil(3 * std::sqrt(target))));

@@ -79,6 +79,24 @@ Profile EdgeProfile(const Scene& s, int edge, int section) {
   return p;
 }
 
+// The profile across the board line x = 50 mm between edges 2 and 3 (black left, white right) of FixedBlur's
+// board shifted so that line lies (nearly) on the optical axis, where it is an image column.
+Profile ColumnProfile(const Scene& s) {
+  const cv::Mat lin = Linear(s.image);
+  const cv::Point2d top = Project(s, 50, 50 - 25 / 4.0), bottom = Project(s, 50, 25 + 25 / 4.0);
+  EXPECT_NEAR(top.x, bottom.x, 0.1);
+  const int centre = static_cast<int>(std::lround(top.x)), half = 20;
+  Profile p;
+  p.edge_row = 0.5 * (top.x + bottom.x);
+  p.first_row = centre - half;
+  for (int col = centre - half; col <= centre + half; ++col) {
+    double sum = 0;
+    for (int y = static_cast<int>(top.y) + 1; y < static_cast<int>(bottom.y); ++y) sum += lin.at<float>(y, col);
+    p.values.push_back(sum / (static_cast<int>(bottom.y) - static_cast<int>(top.y) - 1));
+  }
+  return p;
+}
+
 // Fraction of a unit step's light that a PSF of radius r has spread past offset t (the edge spread function).
 double EdgeSpread(double t, double r, Psf psf) {
   if (r <= 0) return t >= 0 ? 1 : 0;
@@ -214,6 +232,17 @@ INSTANTIATE_TEST_SUITE_P(SynthScene, RenderedBlur,
                                            BlurCase{1, Psf::kGaussian}, BlurCase{3, Psf::kDisc},
                                            BlurCase{3, Psf::kGaussian}, BlurCase{8, Psf::kDisc},
                                            BlurCase{8, Psf::kGaussian}));
+
+// The disc is as wide across columns as across rows (isotropic second moment), small kernels included.
+TEST(SynthScene, VerticalEdgesBlurLikeHorizontalOnes) {
+  for (double r : {0.6, 2.0}) {
+    SceneOptions o = FixedBlur(r, Psf::kDisc);
+    o.lateral_mm = 12.2;  // the line 0.3 mm off the axis: nearly an image column, off a pixel centre
+    const Profile p = ColumnProfile(RenderScene(o));
+    EXPECT_LT(RmsDifference(p.values, ExpectedProfile(p, r, Psf::kDisc, kBlack, kWhite)), 0.01 * (kWhite - kBlack));
+    EXPECT_NEAR(FittedRadius(p, Psf::kDisc, 2 * r + 2), r, 0.03 * r + 0.02) << "r " << r;
+  }
+}
 
 TEST(SynthScene, BlurKeepsTheLight) {
   const Scene sharp = RenderScene(FixedBlur(0, Psf::kDisc));
