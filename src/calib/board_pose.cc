@@ -63,15 +63,23 @@ BoardPose FindBoardPose(const cv::Mat& grey8, const Camera& camera, const Board&
   const int nx = board.InnerCornersX(), ny = board.InnerCornersY();
   const cv::Size pattern(nx, ny);
 
-  // Detection cost grows with pixels; the corners' rough places do not need them all.
-  const double scale = std::min(1.0, double(options.detect_max_side_px) / std::max(grey8.cols, grey8.rows));
-  cv::Mat small = grey8;
-  if (scale < 1.0) cv::resize(grey8, small, cv::Size(), scale, scale, cv::INTER_AREA);
+  // Detection cost grows with pixels, and the corners' rough places do not need them all: try small copies first
+  // (a few ms each) and larger ones only when the board is too small to be found there. Each size gets the classic
+  // detector (fast check first) and then the sector-based one, which copes better with blur; their successes
+  // differ from image to image, so both are tried.
   std::vector<cv::Point2f> found;
-  bool ok = cv::findChessboardCornersSB(small, pattern, found, cv::CALIB_CB_NORMALIZE_IMAGE);
-  if (!ok)
-    ok = cv::findChessboardCorners(small, pattern, found,
-                                   cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE);
+  double scale = 1.0;
+  bool ok = false;
+  const int longest = std::max(grey8.cols, grey8.rows);
+  for (int side : {480, 800, 1200, options.detect_max_side_px}) {
+    scale = std::min(1.0, double(side) / longest);
+    cv::Mat small = grey8;
+    if (scale < 1.0) cv::resize(grey8, small, cv::Size(), scale, scale, cv::INTER_AREA);
+    ok = cv::findChessboardCorners(small, pattern, found, cv::CALIB_CB_ADAPTIVE_THRESH |
+                                                              cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK) ||
+         cv::findChessboardCornersSB(small, pattern, found, cv::CALIB_CB_NORMALIZE_IMAGE);
+    if (ok || scale == 1.0) break;
+  }
   if (!ok || int(found.size()) != nx * ny)
     throw Error(ErrorKind::kNotFound, "no " + board.Name() + " checkerboard found (looked for " +
                                           std::to_string(nx) + "x" + std::to_string(ny) + " inner corners)");

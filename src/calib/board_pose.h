@@ -18,7 +18,7 @@ struct BoardPose {
 };
 
 struct DetectOptions {
-  int detect_max_side_px = 1400;  // detect on a copy no larger than this, then refine at full resolution
+  int detect_max_side_px = 1600;  // the largest copy detection tries (480, 800, 1200 px first); refined at full size
 };
 
 // Finds the board in an 8-bit grey photo, orders its corners in the board frame (edge 1 = nearest the camera)
