@@ -152,6 +152,27 @@ inline Hit Intersect(const View& v, double xn, double yn) {
 inline double SubToNormX(const View& v, double i) { return ((i + 0.5) / v.ss - 0.5 - v.cx) / v.fx; }
 inline double SubToNormY(const View& v, double j) { return ((j + 0.5) / v.ss - 0.5 - v.cy) / v.fy; }
 
+// Blur radius (px) of every sub-pixel of image sub-pixel row j. The inverse depth of a ray's hit on a plane is
+// linear in the image coordinates, and the nearer surface is the larger positive one, so a row costs no divisions.
+// Returns false if some ray meets nothing, or meets it no farther than the focal length.
+bool RadiusRow(const View& v, int j, int wss, float* r) {
+  const double yn = SubToNormY(v, j), x0 = SubToNormX(v, 0), dx = 1.0 / (v.fx * v.ss);
+  const double it = 1 / v.c_table, iw = 1 / v.c_wall, w_max = 1 / v.f;
+  const double t0 = (v.n_table[0] * x0 + v.n_table[1] * yn + v.n_table[2]) * it, t1 = v.n_table[0] * dx * it;
+  const double w0 = (v.n_wall[0] * x0 + v.n_wall[1] * yn + v.n_wall[2]) * iw, w1 = v.n_wall[0] * dx * iw;
+  bool ok = true;
+  for (int i = 0; i < wss; ++i) {
+    const double w = std::max(t0 + i * t1, w0 + i * w1);  // 1 / u
+    if (!(w > 0 && w < w_max)) {
+      ok = false;
+      r[i] = 0;
+      continue;
+    }
+    r[i] = static_cast<float>(v.fixed_r ? *v.fixed_r : std::abs(v.k * (v.a * (1 - v.f * w) - 1)) * v.gain);
+  }
+  return ok;
+}
+
 // ---------------------------------------------------------------------------------------------------------------
 // Appearance (linear light).
 
@@ -203,7 +224,9 @@ struct Wood {
   // (x, y): table frame, mm; (wx, wy): footprint widths.
   double operator()(double x, double y, double wx, double wy) const {
     const double warp = 3.0 * FastSin(2 * kPi * y / 190 + phase[0]) + 1.2 * FastSin(2 * kPi * y / 71 + phase[1]);
-    double g = 0.5 * FastSin(2 * kPi * (x + warp) / 9.0 + phase[2]) * BoxAtten(wx, 9.0);
+    // Ring spacing drifts across the board (x), as growth rings do.
+    const double drift = 1.6 * FastSin(2 * kPi * x / 53 + phase[6]) + 0.8 * FastSin(2 * kPi * x / 17 + phase[7]);
+    double g = 0.5 * FastSin(2 * kPi * (x + warp) / 9.0 + drift + phase[2]) * BoxAtten(wx, 6.0);
     g += 0.3 * FastSin(2 * kPi * (x + 0.7 * warp) / 23.0 + phase[3]) * BoxAtten(wx, 23.0);
     g += 0.35 * FastSin(2 * kPi * x / 260 + phase[4]) * FastSin(2 * kPi * y / 410 + phase[5]) * BoxAtten(wy, 410);
     return mean * (1 + 0.07 * g);
@@ -379,12 +402,11 @@ class RowRing {
   std::vector<int> tag_;
 };
 
-// Blurs the padded sharp image `sharp` (margin m on every side) with the per-sub-pixel radius map `radius`
-// (image sub-pixels, r in output pixels), mixing levels, and area-downsamples by ss. Output: CV_32F, H x W.
-cv::Mat BlurAndDownsample(const cv::Mat& sharp, const cv::Mat& radius, const std::vector<Level>& levels, int ss,
-                          int m) {
-  const int hss = radius.rows, wss = radius.cols, wp = sharp.cols;
-  const int H = hss / ss, W = wss / ss;
+// Blurs the padded sharp image `sharp` (margin m on every side) with the radius each image sub-pixel's ray calls
+// for (RadiusRow, r in output pixels), mixing levels, and area-downsamples by ss. Output: CV_32F, H x W.
+cv::Mat BlurAndDownsample(const cv::Mat& sharp, const View& view, int H, int W, const std::vector<Level>& levels,
+                          int ss, int m) {
+  const int wss = W * ss, wp = sharp.cols;
   cv::Mat out(H, W, CV_32F, cv::Scalar(0));
   std::vector<double> var(levels.size());
   int max_reach = 0;
@@ -400,6 +422,7 @@ cv::Mat BlurAndDownsample(const cv::Mat& sharp, const cv::Mat& radius, const std
         hrows[k] = std::make_unique<RowRing>(2 * levels[k].reach + 2, wp);
     std::vector<int> lo(wss);
     std::vector<double> wlo(wss), acc(wss), row_out(wss), blurred(wss);
+    std::vector<float> rr(wss);
 
     auto fill_prefix = [&](int row, double* p) {
       const float* s = sharp.ptr<float>(row);
@@ -413,7 +436,7 @@ cv::Mat BlurAndDownsample(const cv::Mat& sharp, const cv::Mat& radius, const std
       for (int y = Y * ss; y < (Y + 1) * ss; ++y) {
         const int py = y + m;  // padded row
         // Per sub-pixel: the level just below the wanted variance and its weight.
-        const float* rr = radius.ptr<float>(y);
+        RadiusRow(view, y, wss, rr.data());
         int lo_min = INT32_MAX, lo_max = -1;
         for (int x = 0; x < wss; ++x) {
           const double v = 0.25 * double(rr[x]) * ss * double(rr[x]) * ss;
@@ -628,27 +651,16 @@ Scene RenderScene(const SceneOptions& o) {
   v.gain = o.blur_gain;
   v.fixed_r = o.fixed_r_px;
 
-  // Pass 1: depth and blur radius of every image sub-pixel.
+  // Pass 1: the range of blur radii, row by row, to choose the levels and the margin.
   const int hss = H * ss, wss = W * ss;
-  cv::Mat radius(hss, wss, CV_32F);
   std::vector<float> row_min(hss), row_max(hss);
   std::atomic<bool> too_near{false};
   cv::parallel_for_(cv::Range(0, hss), [&](const cv::Range& range) {
+    std::vector<float> r(wss);
     for (int j = range.start; j < range.end; ++j) {
-      float* r = radius.ptr<float>(j);
-      const double yn = SubToNormY(v, j);
-      float lo = INFINITY, hi = 0;
-      for (int i = 0; i < wss; ++i) {
-        const Hit h = Intersect(v, SubToNormX(v, i), yn);
-        if (h.surface < 0 || h.s <= v.f) {
-          too_near = true;
-          r[i] = 0;
-          continue;
-        }
-        r[i] = static_cast<float>(v.RadiusPx(h.s));
-        lo = std::min(lo, r[i]), hi = std::max(hi, r[i]);
-      }
-      row_min[j] = lo, row_max[j] = hi;
+      if (!RadiusRow(v, j, wss, r.data())) too_near = true;
+      const auto [lo, hi] = std::minmax_element(r.begin(), r.end());
+      row_min[j] = *lo, row_max[j] = *hi;
     }
   });
   if (too_near)
@@ -757,6 +769,8 @@ Scene RenderScene(const SceneOptions& o) {
   cv::Mat sharp(hp, wp, CV_32F), sharp_no_board(hp, wp, CV_32F);
   const double bw = board.WidthMm(), bl = board.LengthMm();
   const double dn = 1.0 / (v.fx * ss), dm = 1.0 / (v.fy * ss);  // normalized step per sub-pixel
+  const double rt0[3] = {v.Rt(0, 0), v.Rt(0, 1), v.Rt(0, 2)}, rt1[3] = {v.Rt(1, 0), v.Rt(1, 1), v.Rt(1, 2)};
+  const cv::Vec3d tb = v.Rt * v.t;  // B = Rt (s d - t) = s (Rt d) - Rt t
   cv::parallel_for_(cv::Range(0, hp), [&](const cv::Range& range) {
     std::vector<double> bx(wp), by(wp), bwx(wp), bwy(wp);
     for (int J = range.start; J < range.end; ++J) {
@@ -774,17 +788,23 @@ Scene RenderScene(const SceneOptions& o) {
           s[I] = back;
           continue;
         }
-        const cv::Vec3d d(xn, yn, 1);
-        const cv::Vec3d B = v.Rt * (h.s * d - v.t);
-        // The sub-pixel's footprint on the table: d P / d(sub-pixel column, row), in the board frame.
-        const double q = v.n_table.dot(d);
-        const cv::Vec3d a = v.Rt * (h.s * (cv::Vec3d(1, 0, 0) - d * (v.n_table[0] / q))) * dn;
-        const cv::Vec3d b = v.Rt * (h.s * (cv::Vec3d(0, 1, 0) - d * (v.n_table[1] / q))) * dm;
-        const double wx = std::sqrt(a[0] * a[0] + b[0] * b[0]), wy = std::sqrt(a[1] * a[1] + b[1] * b[1]);
+        // Board coordinates of the hit, and the sub-pixel's footprint on the table (d P / d column, d row) in the
+        // board frame. Only x and y matter: Rt rows 0 and 1 applied to the ray (rd) and to the camera axes.
+        const double rdx = rt0[0] * xn + rt0[1] * yn + rt0[2], rdy = rt1[0] * xn + rt1[1] * yn + rt1[2];
+        const double X = h.s * rdx - tb[0], Y = h.s * rdy - tb[1];
+        const double q = v.n_table[0] * xn + v.n_table[1] * yn + v.n_table[2];
+        const double kx = v.n_table[0] / q, ky = v.n_table[1] / q, sa = h.s * dn, sb = h.s * dm;
+        const double ax = sa * (rt0[0] - rdx * kx), ay = sa * (rt1[0] - rdy * kx);
+        const double bxx = sb * (rt0[1] - rdx * ky), byy = sb * (rt1[1] - rdy * ky);
+        const double wx = std::sqrt(ax * ax + bxx * bxx), wy = std::sqrt(ay * ay + byy * byy);
+        bx[I] = X, by[I] = Y, bwx[I] = wx, bwy[I] = wy;
+        if (X + wx / 2 <= 0 || X - wx / 2 >= bw || Y + wy / 2 <= 0 || Y - wy / 2 >= bl) {
+          s[I] = back;  // off the board
+          continue;
+        }
         double cover, white_cover;
-        BoardCoverage(B[0], B[1], wx, wy, bw, bl, sq, &cover, &white_cover);
+        BoardCoverage(X, Y, wx, wy, bw, bl, sq, &cover, &white_cover);
         s[I] = static_cast<float>(o.black * (cover - white_cover) + o.white * white_cover + (1 - cover) * back);
-        bx[I] = B[0], by[I] = B[1], bwx[I] = wx, bwy[I] = wy;
       }
       for (const Flaw& fl : flaws) {
         if (J < fl.row0 || J > fl.row1) continue;
@@ -800,8 +820,8 @@ Scene RenderScene(const SceneOptions& o) {
   });
 
   // Pass 3: depth-varying blur, downsample; then noise, sRGB, JPEG.
-  cv::Mat linear = BlurAndDownsample(sharp, radius, levels, ss, m);
-  cv::Mat linear_no_board = BlurAndDownsample(sharp_no_board, radius, levels, ss, m);
+  cv::Mat linear = BlurAndDownsample(sharp, v, H, W, levels, ss, m);
+  cv::Mat linear_no_board = BlurAndDownsample(sharp_no_board, v, H, W, levels, ss, m);
   sharp.release(), sharp_no_board.release();
 
   Scene scene;
