@@ -19,6 +19,7 @@ struct MeasureRow {
   double within_target = 0;    // fraction of answered sections within max(0.25 px, 5 %)
   double time_us_per_section = 0;  // measurement methods: per section; estimators: per section from measured input
   bool meets_target = false;   // answered >= 50 % of sections and >= 90 % of them within target
+  bool board_found = true;     // false: detection failed here, and the blur was measured at the true pose
 };
 
 struct MeasureBenchOptions {

@@ -50,7 +50,7 @@ CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& b
 
   auto t0 = std::chrono::steady_clock::now();
   const cv::Mat grey8 = ToGrey8(photo);
-  result.pose = FindBoardPose(grey8, camera, board, options.detect);
+  result.pose = options.known_pose ? *options.known_pose : FindBoardPose(grey8, camera, board, options.detect);
   result.detect_ms = MsSince(t0);
 
   // Geometry of every section: end points in the photo and 3-D midpoint.

@@ -24,6 +24,8 @@ struct CalibrateOptions {
   ModelFitOptions model_fit;
   ThesisOptions thesis;
   optics::FitOptions optics_fit;
+  // Skip detection and use this pose (benchmarks: to measure blur where detection breaks first).
+  std::optional<BoardPose> known_pose;
 };
 
 struct SectionResult {
