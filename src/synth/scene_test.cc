@@ -393,6 +393,10 @@ TEST(SynthScene, LowTiltShowsTheBackWall) {
   const Scene s = RenderScene(o);
   EXPECT_EQ(s.sections.size(), 77u);
   EXPECT_GT(s.truth["r_range_px"][1].get<double>(), s.sections.back().r_px);
+  // The top rows see the pale wall (0.55), the bottom rows the table (0.30).
+  const cv::Mat lin = Linear(s.image_no_board);
+  EXPECT_NEAR(cv::mean(lin.rowRange(0, 5))[0], 0.55, 0.03);
+  EXPECT_NEAR(cv::mean(lin.rowRange(lin.rows - 5, lin.rows))[0], 0.30, 0.03);
 }
 
 }  // namespace
