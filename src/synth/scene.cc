@@ -120,10 +120,8 @@ struct View {
   double f = 0, k = 0, a = 1, gain = 1;
   std::optional<double> fixed_r;
 
-  double RadiusPx(double u) const {
-    if (fixed_r) return *fixed_r;
-    return std::abs(k * (a * (1 - f / u) - 1)) * gain;
-  }
+  // Blur radius (px) at inverse depth w = 1/u.
+  double RadiusPx(double w) const { return fixed_r ? *fixed_r : std::abs(k * (a * (1 - f * w) - 1)) * gain; }
 };
 
 // Where a ray through normalized image point (xn, yn) lands. surface: 0 table, 1 wall, -1 nothing.
@@ -168,7 +166,7 @@ bool RadiusRow(const View& v, int j, int wss, float* r) {
       r[i] = 0;
       continue;
     }
-    r[i] = static_cast<float>(v.fixed_r ? *v.fixed_r : std::abs(v.k * (v.a * (1 - v.f * w) - 1)) * v.gain);
+    r[i] = static_cast<float>(v.RadiusPx(w));
   }
   return ok;
 }
