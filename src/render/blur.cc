@@ -131,46 +131,58 @@ GlBlur::GlBlur()
 
 GlBlur::~GlBlur() = default;
 
+void GlBlur::BlurTexture(Texture& texture, const std::string& method, double r_px) {
+  const int w = texture.width_px(), h = texture.height_px();
+  Texture scratch(w, h);
+  if (method == "disc") {
+    if (r_px <= 0) return;
+    const double coverage_r = DiscCoverageRadiusPx(r_px);
+    {
+      Framebuffer to_scratch(scratch);
+      disc_->Use();
+      glUniform1i(disc_->Uniform("u_image"), 0);
+      glUniform1f(disc_->Uniform("u_radius_px"), float(coverage_r));
+      glUniform1i(disc_->Uniform("u_taps"), int(std::ceil(coverage_r + 0.5)));
+      to_scratch.Bind();
+      texture.Bind(0);
+      pass_->Draw();
+    }
+    std::swap(texture, scratch);
+  } else {
+    const double s = r_px / 2;
+    const int taps = GaussianTaps(s);
+    if (taps == 0) return;
+    gaussian_->Use();
+    glUniform1i(gaussian_->Uniform("u_image"), 0);
+    glUniform1f(gaussian_->Uniform("u_sigma_px"), float(s));
+    glUniform1i(gaussian_->Uniform("u_taps"), taps);
+    Framebuffer to_scratch(scratch), to_texture(texture);
+    to_scratch.Bind();
+    texture.Bind(0);
+    glUniform2f(gaussian_->Uniform("u_direction"), 1, 0);
+    pass_->Draw();
+    to_texture.Bind();
+    scratch.Bind(0);
+    glUniform2f(gaussian_->Uniform("u_direction"), 0, 1);
+    pass_->Draw();
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
 cv::Mat GlBlur::Gaussian(const cv::Mat& rgba, double r_px) {
   CV_Assert(rgba.type() == CV_32FC4);
-  const double s = r_px / 2;
-  const int taps = GaussianTaps(s);
-  if (taps == 0) return rgba.clone();
-  Texture source(rgba.cols, rgba.rows), middle(rgba.cols, rgba.rows), target(rgba.cols, rgba.rows);
-  source.Upload(rgba);
-  Framebuffer to_middle(middle), to_target(target);
-  gaussian_->Use();
-  glUniform1i(gaussian_->Uniform("u_image"), 0);
-  glUniform1f(gaussian_->Uniform("u_sigma_px"), float(s));
-  glUniform1i(gaussian_->Uniform("u_taps"), taps);
-  to_middle.Bind();
-  source.Bind(0);
-  glUniform2f(gaussian_->Uniform("u_direction"), 1, 0);
-  pass_->Draw();
-  to_target.Bind();
-  middle.Bind(0);
-  glUniform2f(gaussian_->Uniform("u_direction"), 0, 1);
-  pass_->Draw();
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  return target.Download();
+  Texture texture(rgba.cols, rgba.rows);
+  texture.Upload(rgba);
+  BlurTexture(texture, "gaussian", r_px);
+  return texture.Download();
 }
 
 cv::Mat GlBlur::Disc(const cv::Mat& rgba, double r_px) {
   CV_Assert(rgba.type() == CV_32FC4);
-  if (r_px <= 0) return rgba.clone();
-  Texture source(rgba.cols, rgba.rows), target(rgba.cols, rgba.rows);
-  source.Upload(rgba);
-  Framebuffer to_target(target);
-  disc_->Use();
-  glUniform1i(disc_->Uniform("u_image"), 0);
-  const double coverage_r = DiscCoverageRadiusPx(r_px);
-  glUniform1f(disc_->Uniform("u_radius_px"), float(coverage_r));
-  glUniform1i(disc_->Uniform("u_taps"), int(std::ceil(coverage_r + 0.5)));
-  to_target.Bind();
-  source.Bind(0);
-  pass_->Draw();
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  return target.Download();
+  Texture texture(rgba.cols, rgba.rows);
+  texture.Upload(rgba);
+  BlurTexture(texture, "disc", r_px);
+  return texture.Download();
 }
 
 }  // namespace blurcue::render

@@ -2,6 +2,7 @@
 // Blur of images in linear light with premultiplied alpha, on the GPU and as a CPU reference with the same kernel.
 // Radii are in the DESIGN.md unit: a Gaussian of std s has r = 2 s.
 #include <memory>
+#include <string>
 
 #include <opencv2/core.hpp>
 
@@ -30,6 +31,7 @@ cv::Mat ToLinearPremultiplied(const cv::Mat& image8);
 cv::Mat FromLinearPremultiplied(const cv::Mat& rgba, bool keep_alpha);
 
 class GlContext;
+class Texture;
 class Program;
 class FullscreenPass;
 
@@ -44,6 +46,8 @@ class GlBlur {
   cv::Mat Gaussian(const cv::Mat& rgba, double r_px);
   // One pass of the pillbox of radius r.
   cv::Mat Disc(const cv::Mat& rgba, double r_px);
+  // On the GPU, texture in and out (RGBA32F, same size): "gaussian" or "disc"; r <= 0 leaves it unchanged.
+  void BlurTexture(Texture& texture, const std::string& method, double r_px);
 
  private:
   std::unique_ptr<Program> gaussian_, disc_;

@@ -136,16 +136,25 @@ Footprint SceneRenderer::Measure(const VirtualObject& o) const {
 }
 
 Layer SceneRenderer::Draw(const VirtualObject& o, int margin_px) {
-  const Camera& cam = impl_->camera;
-  const Footprint f = Measure(o);
+  GpuLayer gpu = DrawToTexture(o, margin_px);
   Layer layer;
-  layer.roi = cv::Rect(f.bounds.x - margin_px, f.bounds.y - margin_px, f.bounds.width + 2 * margin_px,
-                       f.bounds.height + 2 * margin_px) &
-              cv::Rect(0, 0, cam.image_width_px, cam.image_height_px);
-  if (layer.roi.empty()) {
+  layer.roi = gpu.roi;
+  if (!gpu.texture) {
     layer.bgra = cv::Mat(0, 0, CV_32FC4);
     return layer;
   }
+  cv::cvtColor(gpu.texture->Download(), layer.bgra, cv::COLOR_RGBA2BGRA);
+  return layer;
+}
+
+GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px) {
+  const Camera& cam = impl_->camera;
+  const Footprint f = Measure(o);
+  GpuLayer layer;
+  layer.roi = cv::Rect(f.bounds.x - margin_px, f.bounds.y - margin_px, f.bounds.width + 2 * margin_px,
+                       f.bounds.height + 2 * margin_px) &
+              cv::Rect(0, 0, cam.image_width_px, cam.image_height_px);
+  if (layer.roi.empty()) return layer;
   const int w = layer.roi.width, h = layer.roi.height;
   const auto k = cam.Intrinsics();
   // Camera frame -> clip for this sub-window; framebuffer row r is image row roi.y + r (nothing is flipped).
@@ -165,8 +174,8 @@ Layer SceneRenderer::Draw(const VirtualObject& o, int margin_px) {
   }
 
   const std::vector<Vertex> tris = o.kind == VirtualObject::Kind::kBall ? SphereTriangles(o) : CardTriangles(o);
-  Texture target(w, h);
-  Framebuffer fb(target, /*with_depth=*/true);
+  layer.texture = std::make_unique<Texture>(w, h);
+  Framebuffer fb(*layer.texture, /*with_depth=*/true);
   fb.Bind();
   glClearColor(0, 0, 0, 0);
   glClearDepth(1.0);
@@ -193,7 +202,6 @@ Layer SceneRenderer::Draw(const VirtualObject& o, int margin_px) {
   glBindVertexArray(0);
   glDisable(GL_DEPTH_TEST);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  cv::cvtColor(target.Download(), layer.bgra, cv::COLOR_RGBA2BGRA);
   return layer;
 }
 

@@ -34,6 +34,13 @@ struct Layer {
   cv::Mat bgra;
 };
 
+class Texture;
+// The same on the GPU: linear premultiplied RGBA texture (GL row = image row) over `roi`; null when off-screen.
+struct GpuLayer {
+  cv::Rect roi;
+  std::unique_ptr<Texture> texture;
+};
+
 class SceneRenderer {
  public:
   // Needs a current GL context. rvec/tvec: board frame -> camera (mm).
@@ -45,6 +52,8 @@ class SceneRenderer {
   Footprint Measure(const VirtualObject& object) const;
   // Draws the object into a layer covering its bounds grown by margin_px, clipped to the image.
   Layer Draw(const VirtualObject& object, int margin_px);
+  // The same, left on the GPU for frame composition.
+  GpuLayer DrawToTexture(const VirtualObject& object, int margin_px);
 
  private:
   struct Impl;
