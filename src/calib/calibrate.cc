@@ -1,6 +1,7 @@
 #include "calib/calibrate.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -27,10 +28,22 @@ double Median(std::vector<double> v) {
 }  // namespace
 
 cv::Mat LinearGrey(const cv::Mat& photo) {
-  cv::Mat linear = DecodeSrgb8(photo);
-  if (linear.channels() == 1) return linear;
-  cv::Mat grey;
-  cv::cvtColor(linear, grey, linear.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+  CV_Assert(photo.depth() == CV_8U);
+  if (photo.channels() == 1) return DecodeSrgb8(photo);
+  // One fused pass (decode each channel by table, then mix with Rec. 601 weights as cv::cvtColor does): a 14 MP
+  // photo never becomes a 3-channel float image, which alone took most of a second.
+  static const std::array<float, 256> lut = [] {
+    std::array<float, 256> t{};
+    for (int i = 0; i < 256; ++i) t[i] = static_cast<float>(SrgbToLinear(i / 255.0));
+    return t;
+  }();
+  const int step = photo.channels();
+  cv::Mat grey(photo.size(), CV_32F);
+  for (int y = 0; y < photo.rows; ++y) {
+    const uint8_t* p = photo.ptr<uint8_t>(y);
+    float* g = grey.ptr<float>(y);
+    for (int x = 0; x < photo.cols; ++x, p += step) g[x] = 0.114f * lut[p[0]] + 0.587f * lut[p[1]] + 0.299f * lut[p[2]];
+  }
   return grey;
 }
 
