@@ -128,3 +128,57 @@ TEST(Composite, OverIsPremultipliedAndLinear) {
 
 }  // namespace
 }  // namespace blurcue::render
+
+#include "core/image.h"
+#include "render/frame_compositor.h"
+
+namespace blurcue::render {
+namespace {
+
+cv::Mat Photo(const Camera& c) {
+  cv::Mat photo(c.image_height_px, c.image_width_px, CV_8UC3);
+  cv::randu(photo, 60, 200);
+  cv::GaussianBlur(photo, photo, cv::Size(0, 0), 3);
+  return photo;
+}
+
+// The CPU path: draw, blur on the CPU, composite in linear light, encode.
+cv::Mat CpuFrame(SceneRenderer& renderer, const cv::Mat& photo, const std::vector<BlurredObject>& objects) {
+  cv::Mat linear = DecodeSrgb8(photo);
+  for (const auto& o : objects) {
+    Layer layer = renderer.Draw(o.object, KernelMarginPx(o.method, o.r_px) + 1);
+    BlurLayer(layer, o.method, o.r_px, nullptr);
+    CompositeOver(linear, layer);
+  }
+  return EncodeSrgb8(linear);
+}
+
+void ExpectClose(const cv::Mat& a, const cv::Mat& b, const char* what) {
+  cv::Mat diff;
+  cv::absdiff(a, b, diff);
+  const cv::Scalar mean = cv::mean(diff);
+  double max = 0;
+  cv::minMaxLoc(diff.reshape(1), nullptr, &max);
+  EXPECT_LE((mean[0] + mean[1] + mean[2]) / 3, 0.5) << what;
+  EXPECT_LE(max, 3) << what;
+}
+
+TEST_F(SceneRenderTest, GpuFrameMatchesCpuReferenceAndWholeFrameApproach) {
+  const View v;
+  const cv::Mat photo = Photo(v.camera);
+  FrameCompositor gpu(v.camera, v.rvec, v.tvec, photo);
+  std::vector<BlurredObject> balls = {{Ball(150), "gaussian", 3.0}, {Ball(200), "disc", 5.0}};
+  balls[1].object.center_board_mm[0] = 137.5;
+  gpu.Compose(balls);
+  const cv::Mat region = gpu.Read();
+  gpu.ComposeWholeFrame(balls);
+  const cv::Mat whole = gpu.Read();
+  const cv::Mat cpu = CpuFrame(gpu.renderer(), photo, balls);
+  ExpectClose(region, cpu, "region vs CPU");
+  ExpectClose(region, whole, "region vs whole frame");
+  // Something was drawn: the frame differs from the photo around the balls.
+  EXPECT_GT(cv::norm(region, photo, cv::NORM_L1), 1000);
+}
+
+}  // namespace
+}  // namespace blurcue::render

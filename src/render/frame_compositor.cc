@@ -1,0 +1,112 @@
+#include "render/frame_compositor.h"
+
+#include <opencv2/imgproc.hpp>
+
+#include "render/blur.h"
+#include "render/gl_objects.h"
+
+namespace blurcue::render {
+
+struct FrameCompositor::Impl {
+  int width = 0, height = 0;
+  SceneRenderer renderer;
+  GlBlur blur;
+  Program composite = Program::FromFiles(ShaderDir() / "fullscreen.vert", ShaderDir() / "composite.frag");
+  FullscreenPass pass;
+  Texture background, frame;
+  Framebuffer background_fb, frame_fb;
+
+  Impl(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec, const cv::Mat& photo)
+      : width(camera.image_width_px),
+        height(camera.image_height_px),
+        renderer(camera, rvec, tvec),
+        background(Texture::FromSrgbImage(photo)),
+        frame(camera.image_width_px, camera.image_height_px, GL_SRGB8_ALPHA8),
+        background_fb(background),
+        frame_fb(frame) {}
+
+  void StartFrame() {
+    // The photo's encoded bytes are copied as they are (both sRGB): no decode/encode round trip.
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, background_fb.id());
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, frame_fb.id());
+    glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  }
+
+  // Blends a layer (linear, premultiplied) over the frame at roi.
+  void Blend(const Texture& layer, const cv::Rect& roi) {
+    frame_fb.Bind();
+    glEnable(GL_FRAMEBUFFER_SRGB);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(roi.x, roi.y, roi.width, roi.height);
+    composite.Use();
+    glUniform1i(composite.Uniform("u_layer"), 0);
+    glUniform2i(composite.Uniform("u_origin"), roi.x, roi.y);
+    layer.Bind(0);
+    pass.Draw();
+    glDisable(GL_SCISSOR_TEST);
+    glDisable(GL_BLEND);
+    glDisable(GL_FRAMEBUFFER_SRGB);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  }
+};
+
+FrameCompositor::FrameCompositor(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec,
+                                 const cv::Mat& background)
+    : impl_(std::make_unique<Impl>(camera, rvec, tvec, background)) {
+  CV_Assert(background.cols == camera.image_width_px && background.rows == camera.image_height_px);
+}
+
+FrameCompositor::~FrameCompositor() = default;
+
+SceneRenderer& FrameCompositor::renderer() { return impl_->renderer; }
+
+void FrameCompositor::Compose(const std::vector<BlurredObject>& objects) {
+  impl_->StartFrame();
+  for (const BlurredObject& o : objects) {
+    GpuLayer layer = impl_->renderer.DrawToTexture(o.object, KernelMarginPx(o.method, o.r_px) + 1);
+    if (!layer.texture) continue;
+    impl_->blur.BlurTexture(*layer.texture, o.method, o.r_px);
+    impl_->Blend(*layer.texture, layer.roi);
+  }
+}
+
+void FrameCompositor::ComposeWholeFrame(const std::vector<BlurredObject>& objects) {
+  impl_->StartFrame();
+  for (const BlurredObject& o : objects) {
+    // The object drawn with a margin as large as the whole frame: a full-frame buffer, blurred whole.
+    GpuLayer layer = impl_->renderer.DrawToTexture(o.object, std::max(impl_->width, impl_->height));
+    if (!layer.texture) continue;
+    impl_->blur.BlurTexture(*layer.texture, o.method, o.r_px);
+    impl_->Blend(*layer.texture, layer.roi);
+  }
+}
+
+void FrameCompositor::Finish() { glFinish(); }
+
+cv::Mat FrameCompositor::Read() {
+  cv::Mat rgba(impl_->height, impl_->width, CV_8UC4);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, impl_->frame_fb.id());
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, impl_->width, impl_->height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  cv::Mat bgr;
+  cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
+  return bgr;
+}
+
+void FrameCompositor::Present(int width_px, int height_px) {
+  // Frame rows are image rows (top first); a window's rows count from the bottom, so the blit flips.
+  const double scale = std::min(double(width_px) / impl_->width, double(height_px) / impl_->height);
+  const int w = int(impl_->width * scale), h = int(impl_->height * scale);
+  const int x0 = (width_px - w) / 2, y0 = (height_px - h) / 2;
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, impl_->frame_fb.id());
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  glClearColor(0.5f, 0.5f, 0.5f, 1);
+  glClear(GL_COLOR_BUFFER_BIT);
+  glBlitFramebuffer(0, 0, impl_->width, impl_->height, x0, y0 + h, x0 + w, y0, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+}
+
+}  // namespace blurcue::render
