@@ -8,7 +8,7 @@ PACKAGES=(
   build-essential cmake pkg-config
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-calib3d-dev libopencv-videoio-dev
   nlohmann-json3-dev libcli11-dev libsqlite3-dev libgtest-dev
-  libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libglfw3-dev
+  libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libglfw3-dev libglm-dev xvfb xauth
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -9,7 +9,7 @@ set_tests_properties(cli_synth_scene PROPERTIES FIXTURES_SETUP scene)
 add_test(NAME cli_calibrate_scene
          COMMAND ${BC} calibrate ${T}/scene/scene.png --camera ${T}/scene/camera.json
                  --truth ${T}/scene/truth.json --out ${T}/calib.json)
-set_tests_properties(cli_calibrate_scene PROPERTIES FIXTURES_REQUIRED scene
+set_tests_properties(cli_calibrate_scene PROPERTIES FIXTURES_REQUIRED scene FIXTURES_SETUP calib
                      PASS_REGULAR_EXPRESSION "board 7x10 found.*edge +u/mm")
 
 # No board in the photo: exit 4 and a line naming the photo.
@@ -58,3 +58,33 @@ add_test(NAME cli_unknown_command
 add_test(NAME cli_bench_measure_quick
          COMMAND ${BC} bench measure --quick --no-full-res --out ${T}/bench/measure.csv)
 set_tests_properties(cli_bench_measure_quick PROPERTIES PASS_REGULAR_EXPRESSION "wrote .*measure.csv.*model_fit" LABELS slow)
+
+# Stimuli: one composited ball, a two-ball animation offscreen to video + log, and the same in a window under Xvfb.
+add_test(NAME cli_render_ball
+         COMMAND ${BC} render --calib ${T}/calib.json --background ${T}/scene/scene.png --object ball --at-edge 9
+                 --blur estimated --gain 2 --out ${T}/ball.png)
+set_tests_properties(cli_render_ball PROPERTIES FIXTURES_REQUIRED "scene;calib" LABELS gl
+                     PASS_REGULAR_EXPRESSION "ball at edge 9: depth [0-9.]+ mm, blur estimated")
+add_test(NAME cli_render_bad_source
+         COMMAND ${CMAKE_COMMAND} -DCMD=${BC} "-DARGS=render;--calib;${T}/calib.json;--background;${T}/scene/scene.png;--blur;blurry;--out;${T}/x.png"
+                 -DEXPECT_CODE=2 "-DEXPECT_TEXT=blur source must be none, measured, estimated, fitted or a radius"
+                 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+set_tests_properties(cli_render_bad_source PROPERTIES FIXTURES_REQUIRED "scene;calib")
+add_test(NAME cli_animate_video
+         COMMAND ${BC} animate --calib ${T}/calib.json --background ${T}/scene/scene.png --left measured --right none
+                 --speed-cm-s 50 --fps 30 --video ${T}/anim.avi --log ${T}/anim.csv)
+set_tests_properties(cli_animate_video PROPERTIES FIXTURES_REQUIRED "scene;calib" LABELS gl
+                     PASS_REGULAR_EXPRESSION "16 frames \\(0.5 s of motion at 50.0 cm/s, 30 fps\\)")
+find_program(XVFB_RUN xvfb-run)
+if(XVFB_RUN)
+  add_test(NAME cli_animate_window
+           COMMAND ${XVFB_RUN} -a -s "-screen 0 1280x1024x24" ${BC} animate --calib ${T}/calib.json
+                   --background ${T}/scene/scene.png --left estimated --right none --speed-cm-s 50 --window
+                   --log ${T}/window.csv)
+  set_tests_properties(cli_animate_window PROPERTIES FIXTURES_REQUIRED "scene;calib" LABELS "gl;window"
+                       PASS_REGULAR_EXPRESSION "31 frames")
+endif()
+add_test(NAME cli_blur_image
+         COMMAND ${BC} blur ${PROJECT_SOURCE_DIR}/stimuli/face.png --method disc --radius-px 6 --backend gl
+                 --out ${T}/face-r6.png)
+set_tests_properties(cli_blur_image PROPERTIES LABELS gl PASS_REGULAR_EXPRESSION "disc \\(gl, 800x1200\\)")

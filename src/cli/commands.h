@@ -11,6 +11,7 @@ void AddCalibrateCommand(CLI::App& app);    // calibrate_command.cc
 void AddBenchCommand(CLI::App& app);        // bench_command.cc
 void AddBlurCommand(CLI::App& app);         // blur_command.cc
 void AddRenderCommand(CLI::App& app);       // render_command.cc
+void AddAnimateCommand(CLI::App& app);      // animate_command.cc
 void AddMakeStimuliCommand(CLI::App& app);  // make_stimuli_command.cc
 
 }  // namespace blurcue::cli

@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
       {"estimate", &cli::AddEstimateCommand},
       {"blur", &cli::AddBlurCommand},
       {"render", &cli::AddRenderCommand},
+      {"animate", &cli::AddAnimateCommand},
       {"bench", &cli::AddBenchCommand},
       {"make-stimuli", &cli::AddMakeStimuliCommand},
   };

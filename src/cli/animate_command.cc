@@ -1,0 +1,183 @@
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+
+#include <unistd.h>
+
+#include <opencv2/videoio.hpp>
+
+#include "calib/scene_blur.h"
+#include "cli/commands.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "render/frame_compositor.h"
+#include "render/gl_context.h"
+#include "render/scene_render.h"
+
+namespace blurcue::cli {
+
+void AddAnimateCommand(CLI::App& app) {
+  struct Args {
+    std::string calib, background, left = "estimated", right = "none", texture = "soccer", method = "gaussian";
+    std::string video, frames_dir, log;
+    double speed_cm_s = 3, fps = 60, gain = 1;
+    int from_edge = 1, to_edge = 11, left_section = 3, right_section = 5;
+    bool window = false, fullscreen = false;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "animate",
+      "Two balls rolling side by side across the board (user tests 2 and 3), each re-blurred every frame for its\n"
+      "current depth by its own blur source. Renders offscreen to a video (MJPG .avi) and/or PNG frames for\n"
+      "inspection, or to a window at the display's refresh (--window; needs a display, e.g. Xvfb). Every frame's\n"
+      "timestamps, position and radii go to --log (CSV).\n"
+      "Example (pattern 1 of Table 5.1): blurcue animate --calib calib.json --background scene.png\n"
+      "         --left measured --right none --speed-cm-s 3 --video pattern1.avi --log pattern1.csv");
+  cmd->add_option("--calib", args->calib, "calib.json")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--background", args->background, "the scene photo")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--left", args->left, "blur source of the left ball: none|measured|estimated|fitted|R")
+      ->capture_default_str();
+  cmd->add_option("--right", args->right, "blur source of the right ball")->capture_default_str();
+  cmd->add_option("--texture", args->texture, "soccer, wood or an equirectangular image")->capture_default_str();
+  cmd->add_option("--method", args->method, "gaussian or disc")->capture_default_str()
+      ->check(CLI::IsMember({"gaussian", "disc"}));
+  cmd->add_option("--gain", args->gain, "multiplies both radii")->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--speed-cm-s", args->speed_cm_s, "rolling speed (the thesis: 3 and 1.8)")->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--fps", args->fps, "frames per second of the video (a window runs at its refresh)")
+      ->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--from-edge", args->from_edge, "start edge")->capture_default_str();
+  cmd->add_option("--to-edge", args->to_edge, "end edge")->capture_default_str();
+  cmd->add_option("--left-section", args->left_section, "section the left ball rolls along")->capture_default_str();
+  cmd->add_option("--right-section", args->right_section, "section the right ball rolls along")
+      ->capture_default_str();
+  cmd->add_option("--video", args->video, "write an MJPG .avi");
+  cmd->add_option("--frames", args->frames_dir, "write frame PNGs into this folder");
+  cmd->add_option("--log", args->log, "per-frame CSV: index, t_s, y_mm, r_left_px, r_right_px, render_ms, flip_s");
+  cmd->add_flag("--window", args->window, "show in a GLFW window (vsync)");
+  cmd->add_flag("--fullscreen", args->fullscreen, "with --window: fullscreen on the first monitor");
+  cmd->callback([args] {
+    const calib::SceneCalib scene = calib::LoadSceneCalib(args->calib);
+    const cv::Mat photo = ReadImage(args->background, 1);
+    if (photo.cols != scene.camera.image_width_px || photo.rows != scene.camera.image_height_px)
+      throw InputError(args->background, "is not the size " + args->calib + " was calibrated on");
+    const int edges = scene.board.EdgeCount(), sections = scene.board.SectionCount();
+    auto check = [](const char* name, int v, int lo, int hi) {
+      if (v < lo || v > hi)
+        throw Error(ErrorKind::kUsage, std::string(name) + " must be " + std::to_string(lo) + ".." +
+                                           std::to_string(hi) + ", got " + std::to_string(v));
+    };
+    check("--from-edge", args->from_edge, 1, edges);
+    check("--to-edge", args->to_edge, 1, edges);
+    check("--left-section", args->left_section, 1, sections);
+    check("--right-section", args->right_section, 1, sections);
+    if (args->video.empty() && args->frames_dir.empty() && !args->window)
+      throw Error(ErrorKind::kUsage, "say where the frames go: --video, --frames or --window");
+    double fixed_left = 0, fixed_right = 0;
+    const calib::BlurSource left = calib::ParseBlurSource(args->left, &fixed_left);
+    const calib::BlurSource right = calib::ParseBlurSource(args->right, &fixed_right);
+    std::filesystem::path texture_path = args->texture;
+    if (!std::filesystem::exists(texture_path))
+      texture_path = std::filesystem::path(BLURCUE_SOURCE_DIR) / "stimuli" / (args->texture + ".png");
+    const cv::Mat texture = ReadImage(texture_path);
+
+    std::unique_ptr<render::GlContext> context;
+    if (args->window) {
+      render::WindowOptions w;
+      w.width_px = std::min(photo.cols, 1280);
+      w.height_px = w.width_px * photo.rows / photo.cols;
+      w.fullscreen = args->fullscreen;
+      context = render::GlContext::CreateWindow(w);
+    } else {
+      context = render::GlContext::CreateOffscreen();
+    }
+    render::FrameCompositor compositor(scene.camera, scene.rvec, scene.tvec, photo);
+
+    const double s = scene.board.square_mm, radius = 10;
+    const double y0 = (args->from_edge - 1) * s, y1 = (args->to_edge - 1) * s;
+    const double speed_mm_s = args->speed_cm_s * 10;
+    const int frames = std::max(1, int(std::ceil(std::abs(y1 - y0) / speed_mm_s * args->fps)) + 1);
+    cv::VideoWriter video;
+    if (!args->video.empty()) {
+      if (std::filesystem::path(args->video).has_parent_path())
+        std::filesystem::create_directories(std::filesystem::path(args->video).parent_path());
+      video.open(args->video, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), args->fps, photo.size());
+      if (!video.isOpened()) throw InputError(args->video, "cannot open a video writer (MJPG .avi)");
+    }
+    std::ofstream log;
+    if (!args->log.empty()) {
+      log.open(args->log);
+      if (!log) throw InputError(args->log, "cannot write file");
+      log << "frame,t_s,y_mm,r_left_px,r_right_px,render_ms,flip_s\n";
+    }
+    using Clock = std::chrono::steady_clock;
+    {  // a warm-up frame uploads and mipmaps the texture, so frame 0 is not slower than the rest
+      render::BlurredObject b;
+      b.object.kind = render::VirtualObject::Kind::kBall;
+      b.object.center_board_mm = {(args->left_section - 0.5) * s, y0, radius};
+      b.object.texture = texture;
+      compositor.Compose({b});
+      compositor.Finish();
+    }
+    const bool tty = isatty(2);
+    const auto start = Clock::now();
+    double worst_ms = 0;
+    for (int i = 0; i < frames && !(context->ShouldClose()); ++i) {
+      const double t = i / args->fps;
+      const double y = y0 + (y1 > y0 ? 1 : -1) * std::min(std::abs(y1 - y0), speed_mm_s * t);
+      std::vector<render::BlurredObject> balls(2);
+      const int section[2] = {args->left_section, args->right_section};
+      const calib::BlurSource source[2] = {left, right};
+      const double fixed[2] = {fixed_left, fixed_right};
+      double r[2];
+      for (int b = 0; b < 2; ++b) {
+        render::VirtualObject& o = balls[b].object;
+        o.kind = render::VirtualObject::Kind::kBall;
+        o.size_mm = radius;
+        o.center_board_mm = {(section[b] - 0.5) * s, y, radius};
+        o.spin_deg = -(y - y0) / radius * 180 / M_PI;  // rolling without slipping away from the camera
+        o.texture = texture;
+        r[b] = args->gain * calib::BlurAtPx(scene, source[b], scene.ToCamera(o.center_board_mm), fixed[b]);
+        balls[b].r_px = r[b];
+        balls[b].method = args->method;
+      }
+      const auto t0 = Clock::now();
+      compositor.Compose(balls);
+      compositor.Finish();
+      const double render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+      worst_ms = std::max(worst_ms, render_ms);
+      double flip_s = std::chrono::duration<double>(Clock::now() - start).count();
+      if (args->window) {
+        compositor.Present(context->width_px(), context->height_px());
+        context->SwapBuffers();
+        flip_s = std::chrono::duration<double>(Clock::now() - start).count();
+      }
+      if (video.isOpened() || !args->frames_dir.empty()) {
+        const cv::Mat frame = compositor.Read();
+        if (video.isOpened()) video.write(frame);
+        if (!args->frames_dir.empty()) {
+          char name[32];
+          std::snprintf(name, sizeof name, "frame-%05d.png", i);
+          WriteImage(std::filesystem::path(args->frames_dir) / name, frame);
+        }
+      }
+      if (log) log << i << "," << t << "," << y << "," << r[0] << "," << r[1] << "," << render_ms << "," << flip_s << "\n";
+      if (tty || (i + 1) % std::max(1, frames / 4) == 0 || i + 1 == frames)
+        std::fprintf(stderr, "%sframe %d/%d  y %.1f mm  r %.2f | %.2f px  %.1f ms%s", tty ? "\r" : "", i + 1, frames,
+                     y, r[0], r[1], render_ms, tty ? "" : "\n");
+    }
+    if (tty) std::fprintf(stderr, "\n");
+    std::printf("%d frames (%.1f s of motion at %.1f cm/s, %.0f fps); slowest frame %.1f ms%s%s%s\n", frames,
+                (frames - 1) / args->fps, args->speed_cm_s, args->fps, worst_ms,
+                args->video.empty() ? "" : ("; video " + args->video).c_str(),
+                args->frames_dir.empty() ? "" : ("; frames in " + args->frames_dir).c_str(),
+                args->log.empty() ? "" : ("; log " + args->log).c_str());
+  });
+}
+
+}  // namespace blurcue::cli
