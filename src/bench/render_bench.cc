@@ -113,8 +113,9 @@ std::vector<RenderRow> RunRenderBench(const RenderBenchOptions& options) {
   const int repeats = options.quick ? 1 : 3;
   for (const cv::Size& size : sizes) {
     const cv::Mat frame = TestFrame(size.width, size.height);
-    // The first shape and its surroundings (192 px square or the frame, whichever is smaller).
-    const cv::Rect around(size.width / 7 - 96, size.height / 2 - size.height / 6 - 96, 192, 192);
+    // The right edge of the first disc and its surroundings (192 px square or the frame, whichever is smaller).
+    const int disc_radius = std::max(4, size.height / 12);
+    const cv::Rect around(size.width / 7 + disc_radius - 96, size.height / 2 - size.height / 6 - 96, 192, 192);
     const cv::Mat crop = frame(around & cv::Rect(0, 0, size.width, size.height)).clone();
     for (const std::string method : {"gaussian", "disc"})
       for (double r : radii) {

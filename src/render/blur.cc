@@ -133,7 +133,8 @@ GlBlur::~GlBlur() = default;
 
 void GlBlur::BlurTexture(Texture& texture, const std::string& method, double r_px) {
   const int w = texture.width_px(), h = texture.height_px();
-  Texture scratch(w, h);
+  if (!scratch_ || scratch_->width_px() != w || scratch_->height_px() != h) scratch_ = std::make_unique<Texture>(w, h);
+  Texture& scratch = *scratch_;
   if (method == "disc") {
     if (r_px <= 0) return;
     const double coverage_r = DiscCoverageRadiusPx(r_px);

@@ -51,6 +51,7 @@ class GlBlur {
 
  private:
   std::unique_ptr<Program> gaussian_, disc_;
+  std::unique_ptr<Texture> scratch_;  // re-used while the size stays: a frame loop allocates nothing
   std::unique_ptr<FullscreenPass> pass_;
 };
 
