@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -109,11 +110,18 @@ void AddRenderCommand(CLI::App& app) {
       p[2] = z;
       return args->gain * calib::BlurAtPx(scene, source, p, fixed_r);
     };
-    const double span = std::abs(at_depth(f.z_max_mm) - at_depth(f.z_min_mm));
-    render::Layer layer = renderer.Draw(object, render::KernelMarginPx(args->method, r) + 1);
+    const double r_far = at_depth(f.z_max_mm), r_near = at_depth(f.z_min_mm);
+    const double span = std::abs(r_far - r_near);
+    // Model no more than the scene needs: one radius while the object's depth span changes r by < 0.5 px,
+    // a per-pixel radius from depth where it does.
+    const bool varying = span >= 0.5;
+    render::Layer layer = renderer.Draw(object, render::KernelMarginPx(args->method, std::max({r, r_far, r_near})) + 1);
     std::unique_ptr<render::GlBlur> gl;
     if (args->backend == "gl") gl = std::make_unique<render::GlBlur>();
-    render::BlurLayer(layer, args->method, r, gl.get());
+    if (varying)
+      render::BlurLayerVarying(layer, args->method, at_depth, gl.get());
+    else
+      render::BlurLayer(layer, args->method, r, gl.get());
     cv::Mat background = DecodeSrgb8(photo);
     render::CompositeOver(background, layer);
     cv::Mat out = EncodeSrgb8(background);
@@ -130,9 +138,8 @@ void AddRenderCommand(CLI::App& app) {
                 args->object.c_str(), args->edge, f.z_center_mm, calib::ToString(source).c_str(), args->gain, r,
                 args->method.c_str(), args->backend.c_str(), layer.roi.width, layer.roi.height, photo.cols,
                 photo.rows, args->out.c_str(), ms);
-    if (span >= 0.5)
-      std::printf("note: the object's depth span changes r by %.2f px; it was rendered with the radius at its centre\n",
-                  span);
+    if (varying)
+      std::printf("its depth span changes r from %.2f to %.2f px: blurred per pixel by depth\n", r_near, r_far);
   });
 }
 

@@ -133,13 +133,18 @@ void Texture::Bind(int unit) const {
   glBindTexture(GL_TEXTURE_2D, name_.id());
 }
 
-Framebuffer::Framebuffer(const Texture& color, bool with_depth)
+Framebuffer::Framebuffer(const Texture& color, bool with_depth, const Texture* second_color)
     : width_(color.width_px()), height_(color.height_px()) {
   GLuint id = 0;
   glGenFramebuffers(1, &id);
   name_ = GlName(id, [](GLuint i) { glDeleteFramebuffers(1, &i); });
   glBindFramebuffer(GL_FRAMEBUFFER, id);
   glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, color.id(), 0);
+  if (second_color) {
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, second_color->id(), 0);
+    const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, buffers);
+  }
   if (with_depth) {
     GLuint rb = 0;
     glGenRenderbuffers(1, &rb);

@@ -80,8 +80,9 @@ class Texture {
 
 class Framebuffer {
  public:
-  // Renders into `color` (which must outlive this framebuffer), with a depth buffer when `with_depth`.
-  explicit Framebuffer(const Texture& color, bool with_depth = false);
+  // Renders into `color` (which must outlive this framebuffer), with a depth buffer when `with_depth`, and into
+  // `second_color` as draw buffer 1 when given.
+  explicit Framebuffer(const Texture& color, bool with_depth = false, const Texture* second_color = nullptr);
   void Bind() const;
   GLuint id() const { return name_.id(); }
 

@@ -144,6 +144,13 @@ Layer SceneRenderer::Draw(const VirtualObject& o, int margin_px) {
     return layer;
   }
   cv::cvtColor(gpu.texture->Download(), layer.bgra, cv::COLOR_RGBA2BGRA);
+  const cv::Mat depth = gpu.depth->Download();
+  layer.depth_mm = cv::Mat(depth.size(), CV_32F);
+  for (int y = 0; y < depth.rows; ++y)
+    for (int x = 0; x < depth.cols; ++x) {
+      const cv::Vec4f d = depth.at<cv::Vec4f>(y, x);
+      layer.depth_mm.at<float>(y, x) = d[3] > 1e-3f ? d[0] / d[3] : 0.f;
+    }
   return layer;
 }
 
@@ -175,8 +182,33 @@ GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px) {
 
   const std::vector<Vertex> tris = o.kind == VirtualObject::Kind::kBall ? SphereTriangles(o) : CardTriangles(o);
   layer.texture = std::make_unique<Texture>(w, h);
-  Framebuffer fb(*layer.texture, /*with_depth=*/true);
-  fb.Bind();
+  layer.depth = std::make_unique<Texture>(w, h);
+  // Drawn multisampled and resolved, so silhouettes carry their pixel coverage like a camera's edges do (an aliased
+  // silhouette is sharper than any optics and reads ~0.3 px too sharp under the calibration's measurement).
+  GLint max_samples = 1;
+  glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
+  const GLsizei samples = std::min<GLint>(8, max_samples);
+  auto renderbuffer = [&](GLenum format) {
+    GLuint id = 0;
+    glGenRenderbuffers(1, &id);
+    glBindRenderbuffer(GL_RENDERBUFFER, id);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, format, w, h);
+    return GlName(id, [](GLuint i) { glDeleteRenderbuffers(1, &i); });
+  };
+  GlName ms_color = renderbuffer(GL_RGBA32F), ms_depth_value = renderbuffer(GL_RGBA32F),
+         ms_depth = renderbuffer(GL_DEPTH_COMPONENT24);
+  GLuint ms_id = 0;
+  glGenFramebuffers(1, &ms_id);
+  GlName ms_fb(ms_id, [](GLuint i) { glDeleteFramebuffers(1, &i); });
+  glBindFramebuffer(GL_FRAMEBUFFER, ms_id);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, ms_color.id());
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_RENDERBUFFER, ms_depth_value.id());
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, ms_depth.id());
+  const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  glDrawBuffers(2, buffers);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    throw Error(ErrorKind::kInternal, "GL: multisample framebuffer incomplete");
+  glViewport(0, 0, w, h);
   glClearColor(0, 0, 0, 0);
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
@@ -201,6 +233,15 @@ GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px) {
   glDrawArrays(GL_TRIANGLES, 0, GLsizei(tris.size()));
   glBindVertexArray(0);
   glDisable(GL_DEPTH_TEST);
+  // Resolve: averaging the samples gives premultiplied colour x coverage, and depth x coverage in .r with the
+  // coverage in .a (the depth target writes alpha 1), so depth = r / a.
+  for (int i = 0; i < 2; ++i) {
+    Framebuffer resolved(i == 0 ? *layer.texture : *layer.depth);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, ms_id);
+    glReadBuffer(GL_COLOR_ATTACHMENT0 + i);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolved.id());
+    glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   return layer;
 }
@@ -220,6 +261,51 @@ void BlurLayer(Layer& layer, const std::string& method, double r_px, GlBlur* gl)
   } else {
     layer.bgra = disc ? DiscBlurCpu(layer.bgra, r_px) : GaussianBlurCpu(layer.bgra, r_px);
   }
+}
+
+void BlurLayerVarying(Layer& layer, const std::string& method, const std::function<double(double)>& r_of_depth,
+                      GlBlur* gl) {
+  if (layer.bgra.empty()) return;
+  CV_Assert(layer.depth_mm.size() == layer.bgra.size());
+  // Radius per covered pixel; uncovered pixels take their nearest covered pixel's radius.
+  const cv::Mat uncovered = layer.depth_mm <= 0;
+  if (cv::countNonZero(uncovered) == uncovered.total()) return;
+  cv::Mat distance, labels;
+  cv::distanceTransform(uncovered, distance, labels, cv::DIST_L2, cv::DIST_MASK_5, cv::DIST_LABEL_PIXEL);
+  std::vector<float> r_of_label(1, 0.f);  // labels number the covered pixels in raster order from 1
+  double r_lo = 1e300, r_hi = 0;
+  for (int y = 0; y < layer.depth_mm.rows; ++y)
+    for (int x = 0; x < layer.depth_mm.cols; ++x) {
+      const float z = layer.depth_mm.at<float>(y, x);
+      if (z <= 0) continue;
+      const double r = std::max(0.0, r_of_depth(z));
+      r_of_label.push_back(float(r));
+      r_lo = std::min(r_lo, r), r_hi = std::max(r_hi, r);
+    }
+  cv::Mat r_map(layer.bgra.size(), CV_32F);
+  for (int y = 0; y < r_map.rows; ++y)
+    for (int x = 0; x < r_map.cols; ++x) r_map.at<float>(y, x) = r_of_label[labels.at<int>(y, x)];
+  // Levels 0.5 px apart from r_lo to r_hi: finer than any participant tells apart (DESIGN.md).
+  std::vector<double> levels;
+  for (double r = r_lo; r < r_hi; r += 0.5) levels.push_back(r);
+  levels.push_back(r_hi);
+  std::vector<cv::Mat> blurred;
+  for (double r : levels) {
+    Layer copy{layer.roi, layer.bgra.clone(), {}};
+    BlurLayer(copy, method, r, gl);
+    blurred.push_back(copy.bgra);
+  }
+  for (int y = 0; y < r_map.rows; ++y)
+    for (int x = 0; x < r_map.cols; ++x) {
+      const double r = r_map.at<float>(y, x);
+      size_t k = 0;
+      while (k + 2 < levels.size() && levels[k + 1] < r) ++k;
+      const size_t k1 = std::min(k + 1, levels.size() - 1);
+      const double a = levels[k] * levels[k], b = levels[k1] * levels[k1];
+      const double w = b > a ? std::clamp((b - r * r) / (b - a), 0.0, 1.0) : 1.0;  // mix variances exactly
+      layer.bgra.at<cv::Vec4f>(y, x) =
+          float(w) * blurred[k].at<cv::Vec4f>(y, x) + float(1 - w) * blurred[k1].at<cv::Vec4f>(y, x);
+    }
 }
 
 void CompositeOver(cv::Mat& background, const Layer& layer) {

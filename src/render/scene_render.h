@@ -2,6 +2,7 @@
 // Virtual content placed in a calibrated scene's board frame (mm), drawn with GL into a layer that covers only the
 // object's pixels plus the blur kernel's margin (model no more than a scene needs), blurred, and composited over
 // the photo in linear light.
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -32,6 +33,7 @@ struct Footprint {
 struct Layer {
   cv::Rect roi;
   cv::Mat bgra;
+  cv::Mat depth_mm;  // CV_32F camera z of the object's surface per pixel, 0 where it does not cover
 };
 
 class Texture;
@@ -39,6 +41,7 @@ class Texture;
 struct GpuLayer {
   cv::Rect roi;
   std::unique_ptr<Texture> texture;
+  std::unique_ptr<Texture> depth;  // camera z (mm) in the red channel, 0 where empty
 };
 
 class SceneRenderer {
@@ -64,6 +67,12 @@ class SceneRenderer {
 // (CPU reference otherwise). The layer's margin must cover the kernel.
 class GlBlur;
 void BlurLayer(Layer& layer, const std::string& method, double r_px, GlBlur* gl);
+
+// Depth-varying blur: each pixel of the object gets r_of_depth(its camera z); pixels the blur spreads into take
+// the r of the nearest covered pixel. The layer is blurred at radius levels 0.5 px apart and each pixel mixes its
+// two nearest levels so the variance (r^2 / 4) is exact. Margin must cover r at the largest depth.
+void BlurLayerVarying(Layer& layer, const std::string& method, const std::function<double(double)>& r_of_depth,
+                      GlBlur* gl);
 
 // The margin (px) a blur of radius r needs around an object: the kernel's half-width.
 int KernelMarginPx(const std::string& method, double r_px);

@@ -182,3 +182,52 @@ TEST_F(SceneRenderTest, GpuFrameMatchesCpuReferenceAndWholeFrameApproach) {
 
 }  // namespace
 }  // namespace blurcue::render
+
+#include "calib/edge_blur.h"
+
+namespace blurcue::render {
+namespace {
+
+// A white card lying on the table spans depth; with a radius that grows steeply with depth its near edge must
+// measure as r(z_near) and its far edge as r(z_far), each by the calibration's own measurement.
+TEST_F(SceneRenderTest, DepthVaryingBlurFollowsEachEdgesDepth) {
+  const View v;
+  SceneRenderer renderer(v.camera, v.rvec, v.tvec);
+  VirtualObject card;
+  card.kind = VirtualObject::Kind::kCard;
+  card.size_mm = 60;
+  card.center_board_mm = {87.5, 125, 0};
+  card.texture = cv::Mat(64, 64, CV_8UC3, cv::Scalar(230, 230, 230));
+  const Footprint f = renderer.Measure(card);
+  const double z0 = f.z_min_mm, z1 = f.z_max_mm;
+  auto r_of_depth = [&](double z) { return 1.5 + 4.0 * (z - z0) / (z1 - z0); };  // 1.5 px near .. 5.5 px far
+  Layer layer = renderer.Draw(card, KernelMarginPx("gaussian", 6) + 2);
+  ASSERT_GT(cv::countNonZero(layer.depth_mm > 0), 100);
+  BlurLayerVarying(layer, "gaussian", r_of_depth, nullptr);
+  // The layer over a grey table, as linear grey (pure black would read as clipped).
+  cv::Mat table(layer.roi.size(), CV_32FC3, cv::Scalar(0.1, 0.1, 0.1));
+  Layer at_origin = layer;
+  at_origin.roi = cv::Rect(cv::Point(0, 0), layer.roi.size());
+  CompositeOver(table, at_origin);
+  cv::Mat grey;
+  cv::extractChannel(table, grey, 0);
+  auto project = [&](double x, double y) {
+    std::vector<cv::Point2d> px;
+    cv::projectPoints(std::vector<cv::Point3d>{{x, y, 0}}, v.rvec, v.tvec, cv::Matx33d(v.camera.Intrinsics().data()),
+                      cv::noArray(), px);
+    return px[0] - cv::Point2d(layer.roi.x, layer.roi.y);
+  };
+  const double h = card.size_mm / 2, cx = card.center_board_mm[0], cy = card.center_board_mm[1];
+  cv::Matx33d rot;
+  cv::Rodrigues(v.rvec, rot);
+  for (double y : {cy - h, cy + h}) {
+    const double z = (rot * cv::Vec3d(cx, y, 0) + v.tvec)[2];
+    const calib::EdgeSegment seg{project(cx - 0.6 * h, y), project(cx + 0.6 * h, y), 14};
+    const calib::ModelFit fit = calib::MeasureEdgeModel(grey, seg);
+    ASSERT_TRUE(fit.ok) << "edge at y = " << y << ": " << (fit.flags.empty() ? std::string() : fit.flags[0]) << " r " << fit.r_px << " roi " << layer.roi;
+    EXPECT_NEAR(fit.r_px, r_of_depth(z), 0.1 * r_of_depth(z)) << "edge at y = " << y;
+  }
+}
+
+}  // namespace
+}  // namespace blurcue::render
