@@ -88,3 +88,7 @@ add_test(NAME cli_blur_image
          COMMAND ${BC} blur ${PROJECT_SOURCE_DIR}/stimuli/face.png --method disc --radius-px 6 --backend gl
                  --out ${T}/face-r6.png)
 set_tests_properties(cli_blur_image PROPERTIES LABELS gl PASS_REGULAR_EXPRESSION "disc \\(gl, 800x1200\\)")
+add_test(NAME cli_render_picture
+         COMMAND ${BC} render --object picture --cutoff 6 --background ${T}/scene/scene.png --out ${T}/picture.png)
+set_tests_properties(cli_render_picture PROPERTIES FIXTURES_REQUIRED scene
+                     PASS_REGULAR_EXPRESSION "picture face, cut-off 6 cycles per picture width")

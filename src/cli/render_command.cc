@@ -28,8 +28,8 @@ std::filesystem::path StimulusPath(const std::string& name) {
 void AddRenderCommand(CLI::App& app) {
   struct Args {
     std::string calib, background, object = "ball", blur = "estimated", method = "gaussian", out, backend = "gl";
-    int edge = 1, section = 4, display_width = 0;
-    double gain = 1, brightness = 1, contrast = 1;
+    int edge = 1, section = 4, display_width = 0, picture_height = 0;
+    double gain = 1, brightness = 1, contrast = 1, cutoff = 0;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -38,13 +38,17 @@ void AddRenderCommand(CLI::App& app) {
       "  --object grid          a 50 mm card with a 5x5 grid lying on the table right of the board (test 1)\n"
       "  --object ball[:TEX]    a 10 mm-radius ball resting on the board (tests 2 and 3); TEX = soccer (default),\n"
       "                         wood, or an image file (equirectangular)\n"
+      "  --object picture[:IMG] the depth-matching study's frame (thesis 3.2): the picture (default: the face) low-\n"
+      "                         passed by a 2nd-order Butterworth at --cutoff (cycles per picture width) on a grey\n"
+      "                         upper half, the scene photo in the lower half; 960 x 720 unless --display-width\n"
       "  --blur none|measured|estimated|fitted|R\n"
       "      measured: r of the nearest usable measured section; estimated: eq. 3.7 from the reference edge;\n"
       "      fitted: the thin-lens model fitted to all sections; R: a fixed radius in px. --gain scales it.\n"
       "Only the object's pixels plus the kernel's margin are blurred; everything happens in linear light.\n"
       "Example: blurcue render --calib calib.json --background scene.png --object ball --at-edge 9 --blur estimated\n"
       "         --out ball-e9.png");
-  cmd->add_option("--calib", args->calib, "calib.json from blurcue calibrate")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--calib", args->calib, "calib.json from blurcue calibrate (not needed for a picture)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--background", args->background, "the scene photo (same camera)")->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--object", args->object, "grid or ball[:TEXTURE]")->capture_default_str();
@@ -60,9 +64,32 @@ void AddRenderCommand(CLI::App& app) {
   cmd->add_option("--backend", args->backend, "blur on gl or cpu")->capture_default_str()
       ->check(CLI::IsMember({"gl", "cpu"}));
   cmd->add_option("--display-width", args->display_width, "scale the output to this width (0 = full resolution)");
+  cmd->add_option("--cutoff", args->cutoff, "picture: Butterworth cut-off, cycles per picture width (0 = sharp)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--picture-height-px", args->picture_height, "picture: its height on screen (default 60 % of the "
+                                                                "grey half)");
   cmd->add_option("--out", args->out, "output PNG")->required();
   cmd->callback([args] {
     const auto t0 = std::chrono::steady_clock::now();
+    if (args->object.rfind("picture", 0) == 0) {
+      const std::string name = args->object.size() > 8 && args->object[7] == ':' ? args->object.substr(8) : "face";
+      const cv::Mat picture = ReadImage(StimulusPath(name));
+      const cv::Mat photo = ReadImage(args->background, 1);
+      const int w = args->display_width > 0 ? args->display_width : 960, h = w * 3 / 4, half = h / 2;
+      const int picture_h = args->picture_height > 0 ? args->picture_height : half * 6 / 10;
+      cv::Mat frame(h, w, CV_8UC3);
+      render::PictureOnGrey(picture, cv::Size(w, half), picture_h, args->cutoff).copyTo(frame.rowRange(0, half));
+      // The scene photo fills the lower half, cropped to its aspect.
+      const double scale = std::max(double(w) / photo.cols, double(h - half) / photo.rows);
+      cv::Mat scaled;
+      cv::resize(photo, scaled, cv::Size(), scale, scale, cv::INTER_AREA);
+      scaled(cv::Rect((scaled.cols - w) / 2, (scaled.rows - (h - half)) / 2, w, h - half)).copyTo(frame.rowRange(half, h));
+      WriteImage(args->out, frame);
+      std::printf("picture %s, cut-off %g cycles per picture width, %d px high on a %dx%d frame -> %s\n", name.c_str(),
+                  args->cutoff, picture_h, w, h, args->out.c_str());
+      return;
+    }
+    if (args->calib.empty()) throw Error(ErrorKind::kUsage, "--calib is required for a grid or a ball");
     const calib::SceneCalib scene = calib::LoadSceneCalib(args->calib);
     const cv::Mat photo = ReadImage(args->background, 1 /* colour */);
     if (photo.cols != scene.camera.image_width_px || photo.rows != scene.camera.image_height_px)

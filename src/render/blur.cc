@@ -83,6 +83,32 @@ cv::Mat ButterworthBlurCpu(const cv::Mat& rgba, double cutoff, int order) {
   return out(cv::Rect(0, 0, w, h)).clone();
 }
 
+cv::Mat PictureOnGrey(const cv::Mat& picture, cv::Size field, int height_px, double cutoff, double grey) {
+  CV_Assert(height_px > 0 && field.width > 0 && field.height > 0);
+  const int width_px = std::max(1, int(std::lround(double(picture.cols) * height_px / picture.rows)));
+  cv::Mat scaled;
+  cv::resize(picture, scaled, cv::Size(width_px, height_px), 0, 0, cv::INTER_AREA);
+  // A transparent margin of a quarter of the picture lets the low-pass spread past its outline.
+  const int margin = std::max(width_px, height_px) / 4;
+  cv::Mat layer;
+  cv::copyMakeBorder(ToLinearPremultiplied(scaled), layer, margin, margin, margin, margin, cv::BORDER_CONSTANT,
+                     cv::Scalar(0, 0, 0, 0));
+  // The cut-off is per picture width; the padded layer is wider, so scale it to the layer's width.
+  if (cutoff > 0) layer = ButterworthBlurCpu(layer, cutoff * layer.cols / width_px);
+  cv::Mat out(field, CV_32FC3, cv::Scalar(grey, grey, grey));
+  const cv::Rect at((field.width - layer.cols) / 2, (field.height - layer.rows) / 2, layer.cols, layer.rows);
+  const cv::Rect visible = at & cv::Rect(0, 0, field.width, field.height);
+  for (int y = visible.y; y < visible.y + visible.height; ++y)
+    for (int x = visible.x; x < visible.x + visible.width; ++x) {
+      const cv::Vec4f p = layer.at<cv::Vec4f>(y - at.y, x - at.x);
+      cv::Vec3f& o = out.at<cv::Vec3f>(y, x);
+      const float keep = 1.f - std::clamp(p[3], 0.f, 1.f);
+      o = cv::Vec3f(std::max(0.f, p[0] + keep * o[0]), std::max(0.f, p[1] + keep * o[1]),
+                    std::max(0.f, p[2] + keep * o[2]));
+    }
+  return EncodeSrgb8(out);
+}
+
 cv::Mat ToLinearPremultiplied(const cv::Mat& image8) {
   cv::Mat bgra;
   if (image8.channels() == 1) cv::cvtColor(image8, bgra, cv::COLOR_GRAY2BGRA);

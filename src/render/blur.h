@@ -26,6 +26,11 @@ cv::Mat DiscBlurCpu(const cv::Mat& rgba, double r_px);
 // The image is mirror-padded first so its borders do not wrap around.
 cv::Mat ButterworthBlurCpu(const cv::Mat& rgba, double cutoff_cycles_per_width, int order = 2);
 
+// The depth-matching study's stimulus (thesis 3.2): `picture` (8-bit sRGB, alpha = its shape) scaled to
+// `height_px`, low-passed by the 2nd-order Butterworth at `cutoff` cycles per picture width (0 = sharp), centred on
+// a uniform grey field of `field` size with linear grey level `grey`. Returns 8-bit BGR sRGB.
+cv::Mat PictureOnGrey(const cv::Mat& picture, cv::Size field, int height_px, double cutoff, double grey = 0.18);
+
 // 8-bit sRGB BGR/BGRA/grey -> CV_32FC4 linear premultiplied BGRA, and back (alpha kept when `keep_alpha`).
 cv::Mat ToLinearPremultiplied(const cv::Mat& image8);
 cv::Mat FromLinearPremultiplied(const cv::Mat& rgba, bool keep_alpha);

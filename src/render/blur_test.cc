@@ -201,3 +201,31 @@ TEST_F(GlTest, RenderedEdgeMeasuresAsTheRequestedRadius) {
 
 }  // namespace
 }  // namespace blurcue::render
+
+namespace blurcue::render {
+namespace {
+
+TEST(PictureOnGrey, FieldIsGreyAndLowerCutoffsSoftenThePicture) {
+  cv::Mat picture(120, 80, CV_8UC4, cv::Scalar(0, 0, 0, 0));
+  cv::ellipse(picture, cv::Point(40, 60), cv::Size(35, 55), 0, 0, 360, cv::Scalar(60, 120, 220, 255), cv::FILLED);
+  cv::rectangle(picture, cv::Rect(20, 40, 40, 10), cv::Scalar(20, 20, 20, 255), cv::FILLED);
+  const cv::Size field(320, 240);
+  const cv::Mat sharp = PictureOnGrey(picture, field, 120, 0), soft = PictureOnGrey(picture, field, 120, 3),
+                softer = PictureOnGrey(picture, field, 120, 1.5);
+  // The field away from the picture is the requested grey (linear 0.18 -> sRGB 118).
+  EXPECT_EQ(sharp.at<cv::Vec3b>(5, 5), cv::Vec3b(118, 118, 118));
+  EXPECT_EQ(soft.at<cv::Vec3b>(5, 5), cv::Vec3b(118, 118, 118));
+  // Sharper pictures have more edge energy; the low-pass keeps the picture's mean light.
+  auto energy = [](const cv::Mat& img) {
+    cv::Mat g, dx;
+    cv::cvtColor(img, g, cv::COLOR_BGR2GRAY);
+    cv::Sobel(g, dx, CV_32F, 1, 0);
+    return cv::norm(dx, cv::NORM_L2);
+  };
+  EXPECT_GT(energy(sharp), 1.5 * energy(soft));
+  EXPECT_GT(energy(soft), 1.2 * energy(softer));
+  EXPECT_NEAR(cv::mean(DecodeSrgb8(soft))[0], cv::mean(DecodeSrgb8(sharp))[0], 0.01);
+}
+
+}  // namespace
+}  // namespace blurcue::render
