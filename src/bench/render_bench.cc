@@ -47,41 +47,15 @@ cv::Mat TestFrame(int w, int h) {
 // The exact reference: the image taken as band-limited samples and multiplied in the frequency domain by the
 // continuous PSF's transfer function - exp(-2 pi^2 s^2 f^2) for the Gaussian of std s = r/2, the Airy-like
 // 2 J1(2 pi R f) / (2 pi R f) for the disc of radius R = r - so it carries neither the shader's sampled kernel nor
-// its coverage ramp. Mirror padding keeps the borders from wrapping.
+// its coverage ramp.
 cv::Mat ExactBlur(const cv::Mat& rgba, const std::string& method, double r) {
-  const int w = rgba.cols, h = rgba.rows;
-  const int pw = cv::getOptimalDFTSize(2 * w), ph = cv::getOptimalDFTSize(2 * h);
-  cv::Mat padded;
-  cv::copyMakeBorder(rgba, padded, 0, ph - h, 0, pw - w, cv::BORDER_REFLECT);
-  cv::Mat otf(ph, pw, CV_32F);
-  for (int v = 0; v < ph; ++v)
-    for (int u = 0; u < pw; ++u) {
-      const double fu = double(u <= pw / 2 ? u : u - pw) / pw, fv = double(v <= ph / 2 ? v : v - ph) / ph;
-      const double f = std::hypot(fu, fv);
-      double value = 1;
-      if (method == "disc") {
-        const double x = 2 * M_PI * r * f;
-        value = x < 1e-9 ? 1.0 : 2 * std::cyl_bessel_j(1.0, x) / x;
-      } else {
-        const double s = r / 2;
-        value = std::exp(-2 * M_PI * M_PI * s * s * f * f);
-      }
-      otf.at<float>(v, u) = float(value);
-    }
-  std::vector<cv::Mat> channels;
-  cv::split(padded, channels);
-  for (cv::Mat& c : channels) {
-    cv::Mat spectrum, planes[2];
-    cv::dft(c, spectrum, cv::DFT_COMPLEX_OUTPUT);
-    cv::split(spectrum, planes);
-    planes[0] = planes[0].mul(otf);
-    planes[1] = planes[1].mul(otf);
-    cv::merge(planes, 2, spectrum);
-    cv::dft(spectrum, c, cv::DFT_INVERSE | cv::DFT_SCALE | cv::DFT_REAL_OUTPUT);
-  }
-  cv::Mat out;
-  cv::merge(channels, out);
-  return out(cv::Rect(0, 0, w, h)).clone();
+  if (method == "disc")
+    return render::FilterInFrequency(rgba, [r](double f) {
+      const double x = 2 * M_PI * r * f;
+      return x < 1e-9 ? 1.0 : 2 * std::cyl_bessel_j(1.0, x) / x;
+    });
+  const double s = r / 2;
+  return render::FilterInFrequency(rgba, [s](double f) { return std::exp(-2 * M_PI * M_PI * s * s * f * f); });
 }
 
 // Mean and max |a - b| in 8-bit levels after sRGB encoding (what a participant would see), first channel.

@@ -32,11 +32,7 @@ cv::Mat LinearGrey(const cv::Mat& photo) {
   if (photo.channels() == 1) return DecodeSrgb8(photo);
   // One fused pass (decode each channel by table, then mix with Rec. 601 weights as cv::cvtColor does): a 14 MP
   // photo never becomes a 3-channel float image, which alone took most of a second.
-  static const std::array<float, 256> lut = [] {
-    std::array<float, 256> t{};
-    for (int i = 0; i < 256; ++i) t[i] = static_cast<float>(SrgbToLinear(i / 255.0));
-    return t;
-  }();
+  const std::array<float, 256>& lut = SrgbDecodeTable();
   const int step = photo.channels();
   cv::Mat grey(photo.size(), CV_32F);
   for (int y = 0; y < photo.rows; ++y) {

@@ -17,6 +17,7 @@
 #include "render/frame_compositor.h"
 #include "render/gl_context.h"
 #include "render/scene_render.h"
+#include "render/stimuli.h"
 
 namespace blurcue::cli {
 
@@ -81,10 +82,7 @@ void AddAnimateCommand(CLI::App& app) {
     double fixed_left = 0, fixed_right = 0;
     const calib::BlurSource left = calib::ParseBlurSource(args->left, &fixed_left);
     const calib::BlurSource right = calib::ParseBlurSource(args->right, &fixed_right);
-    std::filesystem::path texture_path = args->texture;
-    if (!std::filesystem::exists(texture_path))
-      texture_path = std::filesystem::path(BLURCUE_SOURCE_DIR) / "stimuli" / (args->texture + ".png");
-    const cv::Mat texture = ReadImage(texture_path);
+    const cv::Mat texture = ReadImage(render::ResolveStimulus(args->texture));
 
     std::unique_ptr<render::GlContext> context;
     if (args->window) {

@@ -14,17 +14,9 @@
 #include "render/gl_context.h"
 #include "render/gl_objects.h"
 #include "render/scene_render.h"
+#include "render/stimuli.h"
 
 namespace blurcue::cli {
-namespace {
-
-std::filesystem::path StimulusPath(const std::string& name) {
-  if (std::filesystem::exists(name)) return name;
-  return std::filesystem::path(BLURCUE_SOURCE_DIR) / "stimuli" / (name + ".png");
-}
-
-}  // namespace
-
 void AddRenderCommand(CLI::App& app) {
   struct Args {
     std::string calib, background, object = "ball", blur = "estimated", method = "gaussian", out, backend = "gl";
@@ -73,7 +65,7 @@ void AddRenderCommand(CLI::App& app) {
     const auto t0 = std::chrono::steady_clock::now();
     if (args->object.rfind("picture", 0) == 0) {
       const std::string name = args->object.size() > 8 && args->object[7] == ':' ? args->object.substr(8) : "face";
-      const cv::Mat picture = ReadImage(StimulusPath(name));
+      const cv::Mat picture = ReadImage(render::ResolveStimulus(name));
       const cv::Mat photo = ReadImage(args->background, 1);
       const int w = args->display_width > 0 ? args->display_width : 960, h = w * 3 / 4, half = h / 2;
       const int picture_h = args->picture_height > 0 ? args->picture_height : half * 6 / 10;
@@ -122,7 +114,7 @@ void AddRenderCommand(CLI::App& app) {
     } else {
       throw Error(ErrorKind::kUsage, "--object must be grid or ball[:TEXTURE], got '" + args->object + "'");
     }
-    object.texture = ReadImage(StimulusPath(texture_name));
+    object.texture = ReadImage(render::ResolveStimulus(texture_name));
     object.brightness = args->brightness;
     object.contrast = args->contrast;
 

@@ -40,13 +40,18 @@ double LinearToSrgb(double v) {
   return v <= 0.0031308 ? v * 12.92 : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
 }
 
-cv::Mat DecodeSrgb8(const cv::Mat& srgb8) {
-  CV_Assert(srgb8.depth() == CV_8U);
+const std::array<float, 256>& SrgbDecodeTable() {
   static const std::array<float, 256> lut = [] {
     std::array<float, 256> t{};
     for (int i = 0; i < 256; ++i) t[i] = static_cast<float>(SrgbToLinear(i / 255.0));
     return t;
   }();
+  return lut;
+}
+
+cv::Mat DecodeSrgb8(const cv::Mat& srgb8) {
+  CV_Assert(srgb8.depth() == CV_8U);
+  const std::array<float, 256>& lut = SrgbDecodeTable();
   cv::Mat out(srgb8.size(), CV_MAKETYPE(CV_32F, srgb8.channels()));
   const int n = srgb8.cols * srgb8.channels();
   for (int y = 0; y < srgb8.rows; ++y) {

@@ -1,5 +1,6 @@
 #pragma once
 // Images on disk and linear light. Blur and measurement happen in linear light (DESIGN.md): decode sRGB first.
+#include <array>
 #include <filesystem>
 
 #include <opencv2/core.hpp>
@@ -14,7 +15,9 @@ void WriteImage(const std::filesystem::path& path, const cv::Mat& image);
 // sRGB transfer function, one channel value in [0, 1].
 double SrgbToLinear(double v);
 double LinearToSrgb(double v);
-// 8-bit sRGB (any channel count) -> CV_32F linear in [0, 1] with a 256-entry table.
+// The 256-entry table 8-bit sRGB -> linear [0, 1].
+const std::array<float, 256>& SrgbDecodeTable();
+// 8-bit sRGB (any channel count) -> CV_32F linear in [0, 1] with that table.
 cv::Mat DecodeSrgb8(const cv::Mat& srgb8);
 // CV_32F linear (clamped to [0, 1]) -> 8-bit sRGB, rounded.
 cv::Mat EncodeSrgb8(const cv::Mat& linear);

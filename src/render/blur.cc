@@ -51,27 +51,24 @@ cv::Mat DiscBlurCpu(const cv::Mat& rgba, double r_px) {
   return out;
 }
 
-cv::Mat ButterworthBlurCpu(const cv::Mat& rgba, double cutoff, int order) {
-  CV_Assert(rgba.type() == CV_32FC4 && cutoff > 0 && order >= 1);
+cv::Mat FilterInFrequency(const cv::Mat& rgba, const std::function<double(double)>& transfer) {
+  CV_Assert(rgba.type() == CV_32FC4);
   const int w = rgba.cols, h = rgba.rows;
-  // Mirror padding to sizes the DFT likes.
+  // Mirror padding to sizes the DFT likes, so the borders do not wrap around.
   const int pw = cv::getOptimalDFTSize(2 * w), ph = cv::getOptimalDFTSize(2 * h);
   cv::Mat padded;
   cv::copyMakeBorder(rgba, padded, 0, ph - h, 0, pw - w, cv::BORDER_REFLECT);
-  // Transfer function on the padded grid; frequency in cycles per *original* width.
   cv::Mat H(ph, pw, CV_32F);
   for (int v = 0; v < ph; ++v)
     for (int u = 0; u < pw; ++u) {
-      const double fu = (u <= pw / 2 ? u : u - pw) / double(pw) * w;
-      const double fv = (v <= ph / 2 ? v : v - ph) / double(ph) * w;
-      H.at<float>(v, u) = float(1.0 / (1.0 + std::pow(std::hypot(fu, fv) / cutoff, 2 * order)));
+      const double fu = (u <= pw / 2 ? u : u - pw) / double(pw), fv = (v <= ph / 2 ? v : v - ph) / double(ph);
+      H.at<float>(v, u) = float(transfer(std::hypot(fu, fv)));
     }
   std::vector<cv::Mat> channels;
   cv::split(padded, channels);
   for (cv::Mat& c : channels) {
-    cv::Mat spectrum;
+    cv::Mat spectrum, planes[2];
     cv::dft(c, spectrum, cv::DFT_COMPLEX_OUTPUT);
-    cv::Mat planes[2];
     cv::split(spectrum, planes);
     planes[0] = planes[0].mul(H);
     planes[1] = planes[1].mul(H);
@@ -81,6 +78,12 @@ cv::Mat ButterworthBlurCpu(const cv::Mat& rgba, double cutoff, int order) {
   cv::Mat out;
   cv::merge(channels, out);
   return out(cv::Rect(0, 0, w, h)).clone();
+}
+
+cv::Mat ButterworthBlurCpu(const cv::Mat& rgba, double cutoff, int order) {
+  CV_Assert(cutoff > 0 && order >= 1);
+  const double w = rgba.cols;  // the cut-off counts cycles per image width
+  return FilterInFrequency(rgba, [&](double f) { return 1.0 / (1.0 + std::pow(f * w / cutoff, 2 * order)); });
 }
 
 cv::Mat PictureOnGrey(const cv::Mat& picture, cv::Size field, int height_px, double cutoff, double grey) {

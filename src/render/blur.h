@@ -1,6 +1,7 @@
 #pragma once
 // Blur of images in linear light with premultiplied alpha, on the GPU and as a CPU reference with the same kernel.
 // Radii are in the DESIGN.md unit: a Gaussian of std s has r = 2 s.
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -20,6 +21,10 @@ cv::Mat GaussianBlurCpu(const cv::Mat& rgba, double r_px);
 double DiscCoverageRadiusPx(double r_px);
 cv::Mat DiscKernel(double r_px);
 cv::Mat DiscBlurCpu(const cv::Mat& rgba, double r_px);
+
+// Multiplies the image's spectrum by transfer(f), f the radial frequency in cycles per pixel, after mirror padding
+// (the image is taken as band-limited samples). CV_32FC4 in and out.
+cv::Mat FilterInFrequency(const cv::Mat& rgba, const std::function<double(double)>& transfer);
 
 // Second-order Butterworth low-pass (the thesis's pre-research filter), in the frequency domain:
 // H = 1 / (1 + (D / D0)^(2 n)), D the distance from zero frequency in cycles per image width, D0 = cutoff.

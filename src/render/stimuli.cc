@@ -12,6 +12,14 @@
 #include "core/image.h"
 
 namespace blurcue::render {
+
+std::filesystem::path ResolveStimulus(const std::string& name) {
+  if (std::filesystem::exists(name)) return name;
+  const auto shipped = std::filesystem::path(BLURCUE_SOURCE_DIR) / "stimuli" / (name + ".png");
+  if (std::filesystem::exists(shipped)) return shipped;
+  throw InputError(name, "no such image, and no shipped stimulus " + shipped.string());
+}
+
 namespace {
 
 // Colours are linear-light BGR; the thesis's soccer pattern was "colour balanced", so neither panel colour clips.

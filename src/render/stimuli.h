@@ -4,11 +4,16 @@
 // W x H image (W = 2H) looks along theta = pi (y + 0.5) / H from +z, phi = 2 pi (x + 0.5) / W from +x towards +y.
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
 namespace blurcue::render {
+
+// A stimulus by name or path: an existing file as given, else the shipped stimuli/NAME.png (soccer, wood, grid,
+// face). Throws Error(kInput) naming both places when neither exists.
+std::filesystem::path ResolveStimulus(const std::string& name_or_path);
 
 // The unit direction a texel centre (x, y) of an equirectangular image of width_px x width_px / 2 looks along.
 cv::Vec3d EquirectDirection(double x, double y, int width_px);
