@@ -257,7 +257,15 @@ INSTANTIATE_TEST_SUITE_P(SynthScene, RenderedBlur,
                                            BlurCase{0.6, Psf::kGaussian}, BlurCase{1, Psf::kDisc},
                                            BlurCase{1, Psf::kGaussian}, BlurCase{3, Psf::kDisc},
                                            BlurCase{3, Psf::kGaussian}, BlurCase{8, Psf::kDisc},
-                                           BlurCase{8, Psf::kGaussian}));
+                                           BlurCase{8, Psf::kGaussian}),
+                         // Readable test names: disc_r0_3, gaussian_r8, ...
+                         [](const ::testing::TestParamInfo<BlurCase>& info) {
+                           std::string r = std::to_string(info.param.r);
+                           r.erase(r.find_last_not_of('0') + 1);
+                           if (r.back() == '.') r.pop_back();
+                           for (char& ch : r) ch = ch == '.' ? '_' : ch;
+                           return std::string(info.param.psf == Psf::kDisc ? "disc" : "gaussian") + "_r" + r;
+                         });
 
 // The disc is as wide across columns as across rows (isotropic second moment), small kernels included.
 TEST(SynthScene, VerticalEdgesBlurLikeHorizontalOnes) {
