@@ -223,6 +223,7 @@ struct BlurCase {
   double r;
   Psf psf;
 };
+void PrintTo(const BlurCase& c, std::ostream* os) { *os << (c.psf == Psf::kDisc ? "disc" : "gaussian") << " r=" << c.r; }
 
 class RenderedBlur : public ::testing::TestWithParam<BlurCase> {};
 
