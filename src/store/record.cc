@@ -1,0 +1,341 @@
+#include "store/record.h"
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <random>
+#include <utility>
+
+#include "core/error.h"
+#include "store/schema.h"
+
+#ifndef BLURCUE_VERSION
+#define BLURCUE_VERSION "unknown"
+#endif
+
+namespace blurcue::store {
+namespace {
+
+std::string HostName() {
+  char name[256] = {};
+  if (gethostname(name, sizeof(name) - 1) != 0) return "unknown-host";
+  return name;
+}
+
+int64_t NowMs() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+std::string NewToken() {
+  std::random_device device;
+  const uint64_t bits = (static_cast<uint64_t>(device()) << 32) ^ device();
+  char text[24];
+  std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(bits));
+  return text;
+}
+
+// True when `pid` is certainly gone on this host (kill(pid, 0) says no such process). EPERM means the process
+// exists under another user, so the lock is live.
+bool ProcessGone(int64_t pid) { return pid <= 0 || (kill(static_cast<pid_t>(pid), 0) == -1 && errno == ESRCH); }
+
+std::string SessionName(int64_t session) { return "session " + std::to_string(session); }
+
+}  // namespace
+
+const char* ToString(SessionStatus status) {
+  switch (status) {
+    case SessionStatus::kRunning: return "running";
+    case SessionStatus::kCompleted: return "completed";
+    case SessionStatus::kAborted: return "aborted";
+  }
+  return "running";
+}
+
+std::string Fnv1a64Hex(const std::string& text) {
+  uint64_t hash = 0xcbf29ce484222325ULL;
+  for (unsigned char c : text) {
+    hash ^= c;
+    hash *= 0x100000001b3ULL;
+  }
+  char hex[24];
+  std::snprintf(hex, sizeof(hex), "%016llx", static_cast<unsigned long long>(hash));
+  return hex;
+}
+
+std::string NowIso8601() {
+  const int64_t ms = NowMs();
+  const std::time_t seconds = static_cast<std::time_t>(ms / 1000);
+  std::tm utc{};
+  gmtime_r(&seconds, &utc);
+  char text[64];
+  std::snprintf(text, sizeof(text), "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", utc.tm_year + 1900, utc.tm_mon + 1,
+                utc.tm_mday, utc.tm_hour, utc.tm_min, utc.tm_sec, static_cast<int>(ms % 1000));
+  return text;
+}
+
+Record Record::Open(const std::filesystem::path& path, RecordOptions options) {
+  Database db(path);
+  Migrate(db);
+  return Record(std::move(db), options);
+}
+
+Record::Record(Database db, RecordOptions options)
+    : db_(std::move(db)), options_(options), lock_host_(HostName()), pid_(getpid()), token_(NewToken()) {}
+
+Record::Record(Record&& other) noexcept
+    : db_(std::move(other.db_)),
+      options_(other.options_),
+      lock_host_(std::move(other.lock_host_)),
+      pid_(other.pid_),
+      token_(std::exchange(other.token_, std::string())) {}
+
+Record::~Record() {
+  if (token_.empty() || !db_.handle()) return;
+  try {
+    Statement release(db_, "UPDATE sessions SET lock_host = NULL, lock_pid = NULL, lock_token = NULL, "
+                           "lock_heartbeat_ms = NULL WHERE lock_token = ?");
+    release.Bind(1, token_);
+    release.Run();
+  } catch (...) {
+    // A lock left behind names a pid that is gone by the next start, so it is taken over as stale.
+  }
+}
+
+void Record::TakeLock(int64_t session) {
+  Statement query(db_, "SELECT lock_host, lock_pid, lock_token, lock_heartbeat_ms FROM sessions WHERE id = ?");
+  query.Bind(1, session);
+  if (!query.Step()) throw InputError(db_.path(), SessionName(session) + " does not exist");
+  if (!query.IsNull(2) && query.GetText(2) != token_) {
+    const std::string host = query.GetText(0);
+    const int64_t pid = query.GetInt64(1);
+    const double age_s = static_cast<double>(NowMs() - query.GetInt64(3)) / 1000.0;
+    const bool stale = host == lock_host_ ? ProcessGone(pid) : age_s > options_.foreign_lock_stale_after_s;
+    if (!stale) {
+      std::string who = "pid " + std::to_string(pid) + " on host " + host;
+      if (host == lock_host_ && pid == pid_) who += " (this process, another Record)";
+      throw InputError(db_.path(), SessionName(session) + " is being written by " + who +
+                                       "; two stations cannot write one session (last heartbeat " +
+                                       std::to_string(static_cast<int64_t>(age_s)) + " s ago)");
+    }
+  }
+  Statement take(db_, "UPDATE sessions SET lock_host = ?, lock_pid = ?, lock_token = ?, lock_heartbeat_ms = ? "
+                      "WHERE id = ?");
+  take.Bind(1, lock_host_);
+  take.Bind(2, pid_);
+  take.Bind(3, token_);
+  take.Bind(4, NowMs());
+  take.Bind(5, session);
+  take.Run();
+}
+
+void Record::RequireLock(int64_t session) {
+  Statement query(db_, "SELECT status, lock_token, lock_host, lock_pid FROM sessions WHERE id = ?");
+  query.Bind(1, session);
+  if (!query.Step()) throw InputError(db_.path(), SessionName(session) + " does not exist");
+  const std::string status = query.GetText(0);
+  if (status != "running") throw InputError(db_.path(), SessionName(session) + " is " + status + ", not running");
+  if (query.IsNull(1) || query.GetText(1) != token_) {
+    throw InputError(db_.path(), SessionName(session) + " is not held by this writer" +
+                                     (query.IsNull(1) ? std::string(" (nobody holds it; start or resume it first)")
+                                                      : " (held by pid " + std::to_string(query.GetInt64(3)) +
+                                                            " on host " + query.GetText(2) + ")"));
+  }
+}
+
+int64_t Record::TrialId(int64_t session, int64_t trial_index) {
+  Statement query(db_, "SELECT id FROM trials WHERE session_id = ? AND trial_index = ?");
+  query.Bind(1, session);
+  query.Bind(2, trial_index);
+  if (!query.Step())
+    throw InputError(db_.path(), SessionName(session) + " has no trial " + std::to_string(trial_index));
+  return query.GetInt64(0);
+}
+
+SessionStart Record::StartOrResumeSession(const std::string& study, const std::string& participant,
+                                          const std::string& protocol_json, uint64_t seed, const SessionMeta& meta,
+                                          bool resume) {
+  const std::string now = NowIso8601();
+  const std::string hash = Fnv1a64Hex(protocol_json);
+  Transaction transaction(db_);
+
+  Statement insert_study(db_, "INSERT INTO studies (name, created) VALUES (?, ?) ON CONFLICT (name) DO NOTHING");
+  insert_study.Bind(1, study);
+  insert_study.Bind(2, now);
+  insert_study.Run();
+  Statement find_study(db_, "SELECT id FROM studies WHERE name = ?");
+  find_study.Bind(1, study);
+  find_study.Step();
+  const int64_t study_id = find_study.GetInt64(0);
+
+  Statement insert_participant(db_, "INSERT INTO participants (study_id, code, created) VALUES (?, ?, ?) "
+                                    "ON CONFLICT (study_id, code) DO NOTHING");
+  insert_participant.Bind(1, study_id);
+  insert_participant.Bind(2, participant);
+  insert_participant.Bind(3, now);
+  insert_participant.Run();
+  Statement find_participant(db_, "SELECT id FROM participants WHERE study_id = ? AND code = ?");
+  find_participant.Bind(1, study_id);
+  find_participant.Bind(2, participant);
+  find_participant.Step();
+  const int64_t participant_id = find_participant.GetInt64(0);
+
+  Statement running(db_, "SELECT s.id, s.seed, p.hash FROM sessions s JOIN protocol_versions p "
+                         "ON p.id = s.protocol_version_id WHERE s.participant_id = ? AND s.status = 'running' "
+                         "ORDER BY s.id DESC LIMIT 1");
+  running.Bind(1, participant_id);
+  SessionStart start;
+  start.seed = seed;
+  if (running.Step()) {
+    const int64_t session = running.GetInt64(0);
+    if (!resume)
+      throw InputError(db_.path(), "participant " + participant + " of study " + study + " has a running " +
+                                       SessionName(session) + "; resume it or finish it as aborted");
+    if (running.GetText(2) != hash)
+      throw InputError(db_.path(), SessionName(session) + " was started with protocol " + running.GetText(2) +
+                                       ", got protocol " + hash + "; finish it as aborted to start over");
+    const uint64_t stored_seed = static_cast<uint64_t>(running.GetInt64(1));
+    if (stored_seed != seed)
+      throw InputError(db_.path(), SessionName(session) + " was started with seed " + std::to_string(stored_seed) +
+                                       ", got seed " + std::to_string(seed));
+    TakeLock(session);
+    start.session_id = session;
+    start.resumed = true;
+  } else {
+    Statement insert_protocol(db_, "INSERT INTO protocol_versions (study_id, json, hash, created) "
+                                   "VALUES (?, ?, ?, ?) ON CONFLICT (study_id, hash) DO NOTHING");
+    insert_protocol.Bind(1, study_id);
+    insert_protocol.Bind(2, protocol_json);
+    insert_protocol.Bind(3, hash);
+    insert_protocol.Bind(4, now);
+    insert_protocol.Run();
+    Statement find_protocol(db_, "SELECT id, json FROM protocol_versions WHERE study_id = ? AND hash = ?");
+    find_protocol.Bind(1, study_id);
+    find_protocol.Bind(2, hash);
+    find_protocol.Step();
+    if (find_protocol.GetText(1) != protocol_json)  // a 64-bit hash collision: refuse rather than mix texts
+      throw Error(ErrorKind::kInternal, "protocol hash " + hash + " collides with another protocol text");
+    const int64_t protocol_id = find_protocol.GetInt64(0);
+
+    Statement insert(db_, "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, "
+                          "host, display, started, status, lock_host, lock_pid, lock_token, lock_heartbeat_ms) "
+                          "VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?)");
+    insert.Bind(1, participant_id);
+    insert.Bind(2, protocol_id);
+    insert.Bind(3, static_cast<int64_t>(seed));
+    insert.Bind(4, meta.software_version.empty() ? std::string(BLURCUE_VERSION) : meta.software_version);
+    insert.Bind(5, meta.host.empty() ? lock_host_ : meta.host);
+    insert.Bind(6, meta.display);
+    insert.Bind(7, now);
+    insert.Bind(8, lock_host_);
+    insert.Bind(9, pid_);
+    insert.Bind(10, token_);
+    insert.Bind(11, NowMs());
+    insert.Run();
+    start.session_id = db_.LastInsertRowId();
+  }
+  transaction.Commit();
+  start.trial_count = db_.QueryInt64("SELECT COUNT(*) FROM trials WHERE session_id = " +
+                                     std::to_string(start.session_id));
+  start.first_unanswered_trial = FirstUnansweredTrial(start.session_id);
+  return start;
+}
+
+void Record::SaveTrialList(int64_t session, const std::vector<TrialRecord>& trials) {
+  Transaction transaction(db_);
+  RequireLock(session);
+  if (db_.QueryInt64("SELECT COUNT(*) FROM trials WHERE session_id = " + std::to_string(session)) > 0)
+    throw InputError(db_.path(), SessionName(session) + " already has its trial list");
+  Statement insert(db_, "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, right_shown) "
+                        "VALUES (?, ?, ?, ?, ?, ?)");
+  for (const TrialRecord& trial : trials) {
+    insert.Bind(1, session);
+    insert.Bind(2, trial.index);
+    insert.Bind(3, trial.block);
+    insert.Bind(4, trial.factors_json);
+    insert.Bind(5, trial.left_json);
+    insert.Bind(6, trial.right_json);
+    insert.Run();
+    insert.Reset();
+  }
+  transaction.Commit();
+}
+
+void Record::RecordResponse(int64_t session, int64_t trial_index, const Response& response) {
+  Transaction transaction(db_);
+  RequireLock(session);
+  const int64_t trial_id = TrialId(session, trial_index);
+  Statement existing(db_, "SELECT answered_at FROM responses WHERE trial_id = ?");
+  existing.Bind(1, trial_id);
+  if (existing.Step())
+    throw InputError(db_.path(), SessionName(session) + " trial " + std::to_string(trial_index) +
+                                     " already has a response (answered at " + existing.GetText(0) + ")");
+  Statement insert(db_, "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at) "
+                        "VALUES (?, ?, ?, ?, ?)");
+  insert.Bind(1, trial_id);
+  insert.Bind(2, response.choice);
+  insert.Bind(3, response.rt_ms);
+  insert.Bind(4, response.adjustment_json);
+  insert.Bind(5, response.answered_at.empty() ? NowIso8601() : response.answered_at);
+  insert.Run();
+  Statement beat(db_, "UPDATE sessions SET lock_heartbeat_ms = ? WHERE id = ?");
+  beat.Bind(1, NowMs());
+  beat.Bind(2, session);
+  beat.Run();
+  transaction.Commit();
+}
+
+void Record::RecordFrames(int64_t session, int64_t trial_index, const std::vector<FrameRecord>& frames) {
+  Transaction transaction(db_);
+  RequireLock(session);
+  const int64_t trial_id = TrialId(session, trial_index);
+  Statement insert(db_, "INSERT INTO frames (trial_id, frame_index, flip_time_s, dropped) VALUES (?, ?, ?, ?)");
+  for (const FrameRecord& frame : frames) {
+    insert.Bind(1, trial_id);
+    insert.Bind(2, frame.frame_index);
+    insert.Bind(3, frame.flip_time_s);
+    insert.Bind(4, frame.dropped ? 1 : 0);
+    insert.Run();
+    insert.Reset();
+  }
+  transaction.Commit();
+}
+
+void Record::Heartbeat(int64_t session) {
+  Transaction transaction(db_);
+  RequireLock(session);
+  Statement beat(db_, "UPDATE sessions SET lock_heartbeat_ms = ? WHERE id = ?");
+  beat.Bind(1, NowMs());
+  beat.Bind(2, session);
+  beat.Run();
+  transaction.Commit();
+}
+
+void Record::FinishSession(int64_t session, SessionStatus status) {
+  if (status == SessionStatus::kRunning)
+    throw Error(ErrorKind::kInternal, "FinishSession: the final status must be completed or aborted");
+  Transaction transaction(db_);
+  RequireLock(session);
+  Statement finish(db_, "UPDATE sessions SET status = ?, ended = ?, lock_host = NULL, lock_pid = NULL, "
+                        "lock_token = NULL, lock_heartbeat_ms = NULL WHERE id = ?");
+  finish.Bind(1, ToString(status));
+  finish.Bind(2, NowIso8601());
+  finish.Bind(3, session);
+  finish.Run();
+  transaction.Commit();
+}
+
+int64_t Record::FirstUnansweredTrial(int64_t session) {
+  Statement query(db_, "SELECT MIN(t.trial_index) FROM trials t LEFT JOIN responses r ON r.trial_id = t.id "
+                       "WHERE t.session_id = ? AND r.id IS NULL");
+  query.Bind(1, session);
+  query.Step();
+  if (!query.IsNull(0)) return query.GetInt64(0);
+  return db_.QueryInt64("SELECT COUNT(*) FROM trials WHERE session_id = " + std::to_string(session));
+}
+
+}  // namespace blurcue::store

@@ -1,0 +1,120 @@
+#pragma once
+// The crash-safe record a session runner writes: one transaction per answer, resume at the first unanswered
+// trial, and one writer per running session (a lock row naming host, pid and a per-Record token).
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "store/sqlite.h"
+
+namespace blurcue::store {
+
+// Describes the station; host empty = this machine's host name.
+struct SessionMeta {
+  std::string software_version;  // empty = this build's BLURCUE_VERSION
+  std::string host;
+  std::string display;  // e.g. "1920x1080@60 DELL U2412M"
+};
+
+// One planned trial, saved up front. JSON members are compact JSON text.
+struct TrialRecord {
+  int64_t index = 0;
+  int64_t block = 0;
+  std::string factors_json = "{}";  // object: factor name -> level
+  std::string left_json = "null";   // what was shown on the left
+  std::string right_json = "null";
+};
+
+struct Response {
+  std::string choice;                // "left" | "right" | "cant_tell" | an adjustment level
+  double rt_ms = 0;
+  std::string adjustment_json = "[]";  // method of adjustment: the levels stepped through
+  std::string answered_at;           // ISO 8601 UTC; empty = now
+};
+
+struct FrameRecord {
+  int64_t frame_index = 0;
+  double flip_time_s = 0;
+  bool dropped = false;
+};
+
+enum class SessionStatus { kRunning, kCompleted, kAborted };
+const char* ToString(SessionStatus status);
+
+struct SessionStart {
+  int64_t session_id = 0;
+  int64_t first_unanswered_trial = 0;  // = trial_count when all are answered; 0 before SaveTrialList
+  int64_t trial_count = 0;
+  bool resumed = false;
+  uint64_t seed = 0;
+};
+
+struct RecordOptions {
+  // A lock held from another host is taken over only when its heartbeat is older than this (a pid cannot be
+  // checked across machines).
+  double foreign_lock_stale_after_s = 600;
+};
+
+class Record {
+ public:
+  // Opens or creates the record at `path` (":memory:" for tests) and migrates it to the current schema.
+  static Record Open(const std::filesystem::path& path, RecordOptions options = {});
+
+  // Releases the session locks this object holds (never throws).
+  ~Record();
+  Record(Record&& other) noexcept;
+  Record& operator=(Record&&) = delete;
+  Record(const Record&) = delete;
+  Record& operator=(const Record&) = delete;
+
+  // Starts a new running session and takes its lock, or with `resume` continues the participant's running
+  // session of `study` (starting a new one when there is none). Throws Error(kInput) when:
+  //  - resume is false but the participant has a running session (resume it or finish it as aborted),
+  //  - the resumed session was started with another protocol text or seed,
+  //  - another live process or Record holds the session.
+  SessionStart StartOrResumeSession(const std::string& study, const std::string& participant,
+                                    const std::string& protocol_json, uint64_t seed, const SessionMeta& meta,
+                                    bool resume);
+
+  // Saves the whole planned trial list once, up front; throws Error(kInput) when the session already has one.
+  void SaveTrialList(int64_t session, const std::vector<TrialRecord>& trials);
+
+  // Records one answer in its own transaction. Throws Error(kInput) when the trial does not exist or already
+  // has a response, or when this Record does not hold the running session.
+  void RecordResponse(int64_t session, int64_t trial_index, const Response& response);
+
+  // Records the display flips of one trial (its own transaction).
+  void RecordFrames(int64_t session, int64_t trial_index, const std::vector<FrameRecord>& frames);
+
+  // Refreshes this Record's lock heartbeat (RecordResponse does it too).
+  void Heartbeat(int64_t session);
+
+  // Marks the session completed or aborted, stamps its end and releases its lock.
+  void FinishSession(int64_t session, SessionStatus status);
+
+  // The smallest trial index without a response (= trial count when all are answered).
+  int64_t FirstUnansweredTrial(int64_t session);
+
+  Database& database() { return db_; }
+
+ private:
+  Record(Database db, RecordOptions options);
+  void TakeLock(int64_t session);
+  void RequireLock(int64_t session);
+  int64_t TrialId(int64_t session, int64_t trial_index);
+
+  Database db_;
+  RecordOptions options_;
+  std::string lock_host_;
+  int64_t pid_ = 0;
+  std::string token_;  // empty in a moved-from Record
+};
+
+// FNV-1a-64 of `text` as 16 lower-case hex digits (the protocol version's hash).
+std::string Fnv1a64Hex(const std::string& text);
+
+// Now as ISO 8601 UTC with milliseconds, e.g. "2024-05-01T12:00:00.123Z".
+std::string NowIso8601();
+
+}  // namespace blurcue::store

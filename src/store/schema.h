@@ -1,0 +1,26 @@
+#pragma once
+// The record's schema: a list of migrations applied in order, the count kept in PRAGMA user_version.
+#include <string>
+#include <vector>
+
+#include "store/sqlite.h"
+
+namespace blurcue::store {
+
+// The migrations, oldest first. A migration once shipped never changes: a new column is a new migration.
+const std::vector<std::string>& Migrations();
+
+// The schema version a fully migrated database reports (= Migrations().size()).
+int CurrentSchemaVersion();
+
+// PRAGMA user_version of `db`.
+int SchemaVersion(Database& db);
+
+// Applies the missing migrations in one transaction (nothing on an up-to-date database). Throws Error(kInput)
+// for a database written by a newer blurcue (a version above CurrentSchemaVersion()).
+void Migrate(Database& db);
+
+// Throws Error(kInput) unless `db` is at CurrentSchemaVersion() (for readers that must not write).
+void RequireCurrentSchema(Database& db);
+
+}  // namespace blurcue::store
