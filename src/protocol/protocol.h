@@ -1,0 +1,114 @@
+#pragma once
+// A study protocol: a JSON file (format in protocols/protocol.schema.json) parsed into a validated `Protocol`.
+// Validation reports every problem at once, each as "FILE: /json/pointer: what is wrong, got VALUE", so one run of
+// `blurcue validate` shows all typos, wrong types, missing fields, impossible values and missing files.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/json_io.h"
+
+namespace blurcue::protocol {
+
+enum class Task { kForcedChoice, kAdjustment };        // "forced_choice" | "adjustment"
+enum class Counterbalance { kNone, kSwapCopies, kByParticipant };  // "none" | "swap_copies" | "by_participant"
+
+std::string ToString(Task task);
+std::string ToString(Counterbalance counterbalance);
+
+// One factor: its name and its levels (numbers, strings or objects) in the order the file lists them.
+struct Factor {
+  std::string name;
+  std::vector<Json> levels;
+};
+
+// Method of adjustment: the participant steps through `levels` of `parameter` and accepts one.
+struct Adjustment {
+  std::string parameter = "cutoff";   // what the levels set, e.g. the Butterworth cut-off (cycles per picture width)
+  std::vector<double> levels;
+  std::string order = "shuffled";     // "shuffled" (a fresh random order per trial) | "ascending" | "descending"
+};
+
+// A block of trials with its own design; blocks run in file order, trials are randomised within a block.
+struct Block {
+  std::string name;
+  Task task = Task::kForcedChoice;
+  std::vector<Factor> factors;        // crossed in full; sorted by name (JSON object order)
+  int repetitions = 1;
+  Counterbalance counterbalance = Counterbalance::kNone;
+  Json sides;                         // {"left": SOURCE, "right": SOURCE} when no factor's levels carry the sides
+  std::optional<Adjustment> adjust;   // set for the adjustment task
+  bool shuffle = true;
+  std::string instructions;
+};
+
+struct Scene {
+  std::filesystem::path background;   // absolute, resolved against the protocol file's folder
+  std::filesystem::path board_free;   // empty when not given
+  std::filesystem::path calib;        // empty when not given (a picture needs none)
+  std::string show = "background";    // which photo the trials show: "background" | "board_free"
+};
+
+struct Content {
+  std::string type;                   // "grid" | "ball" | "picture"
+  int cells = 5;                      // grid: cells per side
+  double radius_mm = 10;              // ball
+  std::string texture = "soccer";     // ball: soccer | wood | an image path (resolved)
+  std::filesystem::path image;        // picture: the image (resolved)
+};
+
+struct Practice {
+  int count = 0;                      // 0: no practice
+  std::string block;                  // drawn from this block's design
+  std::string instructions;
+};
+
+struct Responses {
+  std::string left, right, cant_tell;   // forced choice
+  std::string previous, next, accept;   // adjustment
+};
+
+struct Timing {
+  double stimulus_ms = 0;             // 0: until the participant answers
+  double inter_trial_ms = 500;
+};
+
+struct Display {
+  int width_px = 1280, height_px = 720;
+  bool fullscreen = false;
+  int monitor = 0;
+};
+
+struct Protocol {
+  std::filesystem::path file;
+  std::string name, description;
+  int version = 1;
+  Scene scene;
+  Content content;
+  std::vector<Block> blocks;          // at least one; a file without "blocks" has one block named "main"
+  Practice practice;
+  std::string instructions;
+  int break_every_trials = 0;         // 0: no breaks
+  std::string break_text;
+  Responses responses;
+  Timing timing;
+  Display display;
+};
+
+struct ValidateOptions {
+  bool check_files = true;            // false: skip the existence checks of referenced files
+};
+
+// Every problem of `json` read from `file` (used in messages and to resolve relative paths), in document order;
+// empty when the protocol is valid.
+std::vector<std::string> Validate(const Json& json, const std::filesystem::path& file,
+                                  const ValidateOptions& options = {});
+
+// Parses and validates; throws one Error(kInput) whose message lists every problem, one per line.
+Protocol ParseProtocol(const Json& json, const std::filesystem::path& file, const ValidateOptions& options = {});
+
+// Reads `file` and parses it as above (Error(kInput) naming the file when it cannot be read or is not JSON).
+Protocol LoadProtocol(const std::filesystem::path& file, const ValidateOptions& options = {});
+
+}  // namespace blurcue::protocol

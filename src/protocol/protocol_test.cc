@@ -1,0 +1,222 @@
+#include "protocol/protocol.h"
+
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "protocol/trials.h"
+
+namespace blurcue::protocol {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A folder with a protocol's scene files, so file checks pass unless a test removes one.
+fs::path SceneFolder() {
+  const fs::path dir = fs::temp_directory_path() / "blurcue-protocol-test";
+  fs::create_directories(dir / "scene");
+  for (const char* name : {"scene/scene.png", "scene/scene-no-board.png", "calib.json"}) std::ofstream(dir / name) << "x";
+  return dir;
+}
+
+// A small valid moving-ball protocol in the shape of test 2.
+Json Valid() {
+  return Json::parse(R"({
+    "name": "small", "version": 1,
+    "scene": {"background": "scene/scene.png", "board_free": "scene/scene-no-board.png", "calib": "calib.json"},
+    "content": {"type": "ball", "texture": "soccer", "radius_mm": 10},
+    "task": "forced_choice", "counterbalance": "swap_copies",
+    "blocks": [
+      {"name": "task1", "factors": {"pattern": [{"id": 1, "speed_cm_s": 3, "left": "measured", "right": "none"},
+                                                {"id": 2, "speed_cm_s": 1.8, "left": "estimated", "right": "none"}]}},
+      {"name": "task2", "factors": {"pattern": [{"id": 2, "speed_cm_s": 1.8, "left": "measured", "right": "none"}],
+                                    "section": [1, 2, 3]}}
+    ]
+  })");
+}
+
+std::vector<std::string> Problems(const Json& json, bool check_files = true) {
+  return Validate(json, SceneFolder() / "p.json", ValidateOptions{check_files});
+}
+
+// The one problem reported, or a failure listing all of them.
+std::string OnlyProblem(const Json& json, bool check_files = true) {
+  const auto problems = Problems(json, check_files);
+  std::string all;
+  for (const auto& p : problems) all += p + "\n";
+  EXPECT_EQ(problems.size(), 1u) << all;
+  return problems.empty() ? "" : problems.front();
+}
+
+bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+TEST(ProtocolValidate, ValidProtocolHasNoProblems) {
+  const auto problems = Problems(Valid());
+  EXPECT_TRUE(problems.empty()) << problems.front();
+}
+
+TEST(ProtocolValidate, ProblemStartsWithFileAndPointer) {
+  Json j = Valid();
+  j["version"] = 0;
+  const std::string p = OnlyProblem(j);
+  EXPECT_EQ(p, (SceneFolder() / "p.json").string() + ": /version: must be >= 1, got 0");
+}
+
+TEST(ProtocolValidate, WrongTypeNamesPointer) {
+  Json j = Valid();
+  j["blocks"][0]["repetitions"] = "two";
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/0/repetitions: must be an integer, got \"two\"")) << OnlyProblem(j);
+}
+
+TEST(ProtocolValidate, UnknownKeyNamesPointerAndNearestKey) {
+  Json j = Valid();
+  j["blocks"][1]["factros"] = j["blocks"][1]["factors"];
+  j["blocks"][1].erase("factors");
+  const auto problems = Problems(j);
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_TRUE(Contains(problems[0], ": /blocks/1/factros: unknown key (did you mean \"factors\"?)")) << problems[0];
+  EXPECT_TRUE(Contains(problems[1], ": /blocks/1/factors: is required (here or at /factors) but missing")) << problems[1];
+}
+
+TEST(ProtocolValidate, MissingFieldNamesPointer) {
+  Json j = Valid();
+  j["content"].erase("type");
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /content/type: is required but missing")) << OnlyProblem(j);
+}
+
+TEST(ProtocolValidate, NonPositiveSpeedRejected) {
+  Json j = Valid();
+  j["blocks"][0]["factors"]["pattern"][1]["speed_cm_s"] = 0;
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/0/factors/pattern/1/speed_cm_s: a speed must be a number > 0, got 0"))
+      << OnlyProblem(j);
+}
+
+TEST(ProtocolValidate, SectionOutsideTheBoardRejected) {
+  Json j = Valid();
+  j["blocks"][1]["factors"]["section"][2] = 11;
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/1/factors/section/2: a section (edge s to s + 1) must be an integer "
+                                       "in 1..10, got 11")) << OnlyProblem(j);
+}
+
+TEST(ProtocolValidate, EdgeOutsideOneToElevenRejected) {
+  Json j = Valid();
+  j["blocks"][1]["factors"] = {{"edge", {1, 12}}};
+  j["blocks"][1]["sides"] = {{"left", "measured"}, {"right", "estimated"}};
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/1/factors/edge/1: an edge must be an integer in 1..11, got 12"))
+      << OnlyProblem(j);
+}
+
+TEST(ProtocolValidate, UnknownBlurSourceRejected) {
+  Json j = Valid();
+  j["blocks"][0]["factors"]["pattern"][0]["right"] = "blurry";
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/0/factors/pattern/0/right: a blur source must be none, measured, "
+                                       "estimated, fitted or a radius >= 0, got \"blurry\"")) << OnlyProblem(j);
+}
+
+TEST(ProtocolValidate, EmptyFactorRejected) {
+  Json j = Valid();
+  j["blocks"][1]["factors"]["section"] = Json::array();
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/1/factors/section: must list at least one level, got []"))
+      << OnlyProblem(j);
+}
+
+TEST(ProtocolValidate, MissingFileRejected) {
+  Json j = Valid();
+  j["scene"]["calib"] = "no-such-calib.json";
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /scene/calib: no such file: ")) << OnlyProblem(j);
+  EXPECT_TRUE(Contains(OnlyProblem(j), "got \"no-such-calib.json\"")) << OnlyProblem(j);
+}
+
+TEST(ProtocolValidate, MissingFileAcceptedWithoutFileChecks) {
+  Json j = Valid();
+  j["scene"]["calib"] = "no-such-calib.json";
+  EXPECT_TRUE(Problems(j, false).empty());
+}
+
+TEST(ProtocolValidate, ComparisonWithoutSidesRejected) {
+  Json j = Valid();
+  j["blocks"][1]["factors"] = {{"section", {1, 2}}};
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/1: needs what is shown left and right")) << OnlyProblem(j);
+}
+
+TEST(ProtocolValidate, DuplicateResponseKeysRejected) {
+  Json j = Valid();
+  j["responses"] = {{"left", "A"}, {"right", "A"}};
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /responses/right: is the same key as /responses/left, got \"A\""))
+      << OnlyProblem(j);
+}
+
+TEST(ProtocolValidate, InheritedProblemReportedOnce) {
+  Json j = Valid();
+  j["repetitions"] = -1;  // both blocks inherit it
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /repetitions: must be in 1..10000, got -1")) << OnlyProblem(j);
+}
+
+TEST(ProtocolValidate, SeveralProblemsThrownTogether) {
+  Json j = Valid();
+  j["name"] = 7;
+  j["scene"]["background"] = "missing.png";
+  j["blocks"][0]["factors"]["pattern"] = Json::array();
+  j["display"] = {{"width_px", -5}};
+  try {
+    ParseProtocol(j, SceneFolder() / "p.json");
+    FAIL() << "no exception";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    const std::string m = e.what();
+    EXPECT_TRUE(Contains(m, "/name: must be a string, got 7\n")) << m;
+    EXPECT_TRUE(Contains(m, "/scene/background: no such file")) << m;
+    EXPECT_TRUE(Contains(m, "/blocks/0/factors/pattern: must list at least one level")) << m;
+    EXPECT_TRUE(Contains(m, "/display/width_px: must be in 1..16384, got -5")) << m;
+    EXPECT_TRUE(Contains(m, "(4 problems)")) << m;
+  }
+}
+
+TEST(ProtocolValidate, NotAnObjectRejected) {
+  EXPECT_TRUE(Contains(OnlyProblem(Json::array()), ": /: must be an object, got []"));
+}
+
+// The four studies of the thesis, as shipped. Counts per participant (practice trials apart):
+//   pre-research: 27 distances x 1 = 27 adjustment trials (22 cut-offs in a fresh order each), + 1 practice;
+//   test 1: 11 edges = 11 (measured vs estimated, sides by participant parity), + 2 practice;
+//   test 2 and 3: task 1 6 patterns x 2 (swapped copy) = 12; task 2 3 patterns x 10 sections x 2 = 60; + 2 practice.
+struct Shipped {
+  const char* file;
+  size_t practice, main;
+};
+
+class ShippedProtocol : public testing::TestWithParam<Shipped> {};
+
+TEST_P(ShippedProtocol, ParsesAndHasTheThesisTrialCount) {
+  const fs::path file = fs::path(BLURCUE_SOURCE_DIR) / "protocols" / GetParam().file;
+  const Protocol p = LoadProtocol(file, ValidateOptions{false});
+  const auto trials = BuildTrials(p, "P1", 1);
+  size_t practice = 0;
+  for (const auto& t : trials) practice += t.practice;
+  EXPECT_EQ(practice, GetParam().practice);
+  EXPECT_EQ(trials.size() - practice, GetParam().main);
+}
+
+INSTANTIATE_TEST_SUITE_P(Thesis, ShippedProtocol,
+                         testing::Values(Shipped{"pre-research-depth-matching.json", 1, 27},
+                                         Shipped{"test1-static-grids.json", 2, 11},
+                                         Shipped{"test2-moving-balls.json", 2, 72},
+                                         Shipped{"test3-no-board.json", 2, 72}));
+
+TEST(ShippedProtocols, TestThreeShowsTheBoardFreePhoto) {
+  const fs::path dir = fs::path(BLURCUE_SOURCE_DIR) / "protocols";
+  EXPECT_EQ(LoadProtocol(dir / "test3-no-board.json", {false}).scene.show, "board_free");
+  EXPECT_EQ(LoadProtocol(dir / "test2-moving-balls.json", {false}).scene.show, "background");
+}
+
+TEST(ShippedProtocols, SceneFilesResolveToTheDemoOutput) {
+  const fs::path dir = fs::path(BLURCUE_SOURCE_DIR) / "protocols";
+  const Protocol p = LoadProtocol(dir / "test2-moving-balls.json", {false});
+  EXPECT_EQ(p.scene.background, (dir / "../results/demo/scene/scene.png").lexically_normal());
+  EXPECT_EQ(p.scene.calib, (dir / "../results/demo/calib.json").lexically_normal());
+}
+
+}  // namespace
+}  // namespace blurcue::protocol

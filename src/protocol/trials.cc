@@ -1,0 +1,159 @@
+#include "protocol/trials.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+
+#include "core/error.h"
+
+namespace blurcue::protocol {
+
+uint64_t UniformBelow(std::mt19937_64& rng, uint64_t n) {
+  // Reject the lowest 2^64 mod n outputs: the rest is a whole multiple of n, so every residue is equally likely.
+  const uint64_t threshold = (0 - n) % n;  // == 2^64 mod n in unsigned arithmetic
+  for (;;) {
+    const uint64_t x = rng();
+    if (x >= threshold) return x % n;
+  }
+}
+
+int ParticipantNumber(const std::string& participant) {
+  size_t start = participant.size();
+  while (start > 0 && std::isdigit(static_cast<unsigned char>(participant[start - 1]))) --start;
+  if (start == participant.size() || participant.size() - start > 9) return -1;
+  return std::stoi(participant.substr(start));
+}
+
+namespace {
+
+// The sides a design row shows: from the level object that carries left/right, else the block's "sides".
+void SetSides(const Block& block, Trial* t) {
+  for (const auto& [name, level] : t->levels.items())
+    if (level.is_object() && level.contains("left")) {
+      t->left = level["left"];
+      t->right = level["right"];
+      return;
+    }
+  if (block.sides.is_object()) {
+    t->left = block.sides.value("left", Json());
+    t->right = block.sides.value("right", Json());
+  }
+}
+
+// Full factorial x repetitions x counterbalancing, unshuffled.
+std::vector<Trial> Design(const Block& block, bool participant_even) {
+  std::vector<Trial> rows;
+  size_t combinations = 1;
+  for (const auto& f : block.factors) combinations *= f.levels.size();
+  if (block.factors.empty()) combinations = 0;
+  for (int rep = 0; rep < block.repetitions; ++rep) {
+    for (size_t c = 0; c < combinations; ++c) {
+      Trial t;
+      t.block = block.name;
+      t.task = block.task;
+      t.repetition = rep;
+      t.levels = Json::object();
+      // Mixed radix with the last factor fastest.
+      size_t rest = c;
+      for (size_t k = block.factors.size(); k-- > 0;) {
+        const auto& f = block.factors[k];
+        t.levels[f.name] = f.levels[rest % f.levels.size()];
+        rest /= f.levels.size();
+      }
+      SetSides(block, &t);
+      if (block.counterbalance == Counterbalance::kByParticipant && participant_even) {
+        std::swap(t.left, t.right);
+        t.swapped = true;
+      }
+      rows.push_back(t);
+      if (block.counterbalance == Counterbalance::kSwapCopies) {
+        std::swap(t.left, t.right);
+        t.swapped = true;
+        rows.push_back(std::move(t));
+      }
+    }
+  }
+  return rows;
+}
+
+void DrawAdjustment(const Block& block, std::mt19937_64& rng, Trial* t) {
+  if (block.task != Task::kAdjustment || !block.adjust) return;
+  t->adjust_levels = block.adjust->levels;
+  if (block.adjust->order == "shuffled") Shuffle(t->adjust_levels, rng);
+  else if (block.adjust->order == "ascending") std::sort(t->adjust_levels.begin(), t->adjust_levels.end());
+  else std::sort(t->adjust_levels.rbegin(), t->adjust_levels.rend());
+  t->start_index = static_cast<int>(UniformBelow(rng, t->adjust_levels.size()));
+}
+
+}  // namespace
+
+std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& participant, uint64_t seed) {
+  bool needs_number = false;
+  for (const auto& b : protocol.blocks) needs_number = needs_number || b.counterbalance == Counterbalance::kByParticipant;
+  const int number = ParticipantNumber(participant);
+  if (needs_number && number < 0)
+    throw InputError(protocol.file.string(), "by_participant counterbalancing needs a participant id ending in a "
+                                             "number (e.g. P7), got \"" + participant + "\"");
+  const bool even = number >= 0 && number % 2 == 0;
+
+  std::mt19937_64 rng(seed);
+  std::vector<Trial> trials;
+  if (protocol.practice.count > 0) {
+    for (const auto& b : protocol.blocks) {
+      if (b.name != protocol.practice.block) continue;
+      std::vector<Trial> pool = Design(b, even);
+      Shuffle(pool, rng);
+      if (pool.size() > static_cast<size_t>(protocol.practice.count)) pool.resize(protocol.practice.count);
+      for (auto& t : pool) {
+        t.practice = true;
+        DrawAdjustment(b, rng, &t);
+        trials.push_back(std::move(t));
+      }
+      break;
+    }
+  }
+  for (const auto& b : protocol.blocks) {
+    std::vector<Trial> rows = Design(b, even);
+    if (b.shuffle) Shuffle(rows, rng);
+    for (auto& t : rows) {
+      DrawAdjustment(b, rng, &t);
+      trials.push_back(std::move(t));
+    }
+  }
+  for (size_t i = 0; i < trials.size(); ++i) trials[i].index = static_cast<int>(i);
+  return trials;
+}
+
+Json ToJson(const Trial& t) {
+  Json j = {{"index", t.index},         {"block", t.block},     {"practice", t.practice},
+            {"task", ToString(t.task)}, {"repetition", t.repetition}, {"swapped", t.swapped},
+            {"levels", t.levels},       {"left", t.left},       {"right", t.right}};
+  if (t.task == Task::kAdjustment) {
+    j["adjust_levels"] = t.adjust_levels;
+    j["start_index"] = t.start_index;
+  }
+  return j;
+}
+
+Json ToJson(const std::vector<Trial>& trials) {
+  Json j = Json::array();
+  for (const auto& t : trials) j.push_back(ToJson(t));
+  return j;
+}
+
+uint64_t TrialsHash(const std::vector<Trial>& trials) {
+  uint64_t h = 14695981039346656037ull;
+  for (unsigned char c : ToJson(trials).dump()) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+std::string HashHex(uint64_t hash) {
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
+  return text;
+}
+
+}  // namespace blurcue::protocol

@@ -1,0 +1,61 @@
+#pragma once
+// The whole trial list of one session, made up front from a validated Protocol, a participant and a seed.
+// Reproducible on every standard library: the only randomness is raw std::mt19937_64 output (its sequence is fixed
+// by the C++ standard) turned into indices by our own rejection sampling and Fisher-Yates, never by
+// std::shuffle or std::uniform_int_distribution, whose results differ between libraries.
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "protocol/protocol.h"
+
+namespace blurcue::protocol {
+
+struct Trial {
+  int index = 0;             // 0-based position in the session, practice trials included
+  std::string block;
+  bool practice = false;
+  Task task = Task::kForcedChoice;
+  int repetition = 0;        // 0-based copy of the design within the block
+  bool swapped = false;      // left and right exchanged against the design (counterbalancing)
+  Json levels;               // factor name -> level, as designed (not swapped)
+  Json left, right;          // blur source shown on each side; null when the block shows no pair
+  // Adjustment only: the levels in the order the participant steps through them, and where stepping starts.
+  std::vector<double> adjust_levels;
+  int start_index = -1;
+};
+
+// Uniform integer in [0, n) from raw generator output by rejection (no modulo bias); n >= 1.
+uint64_t UniformBelow(std::mt19937_64& rng, uint64_t n);
+
+// Fisher-Yates: for i = n-1 down to 1, swap element i with element UniformBelow(rng, i + 1).
+template <typename T>
+void Shuffle(std::vector<T>& items, std::mt19937_64& rng) {
+  for (size_t i = items.size(); i > 1; --i) {
+    const size_t j = static_cast<size_t>(UniformBelow(rng, i));
+    if (j != i - 1) std::swap(items[i - 1], items[j]);
+  }
+}
+
+// The participant's number: the trailing digits of the id ("P7" -> 7); -1 when it has none.
+int ParticipantNumber(const std::string& participant);
+
+// Practice trials first, then the blocks in file order. Per block: the full factorial crossing of its factors
+// (factors in name order, the last varying fastest) x repetitions; with swap_copies each trial also appears with
+// left and right exchanged, with by_participant an even participant number sees every trial swapped; then the
+// block is shuffled (unless "shuffle": false). One generator seeded with `seed` is drawn from in this order:
+// the practice draw (a shuffled copy of the practice block's design, first `count` taken), each practice trial's
+// adjustment draws, then per block its shuffle and each of its trials' adjustment draws in trial order (a shuffle
+// of the levels when the order is "shuffled", then the start index). The order depends on the seed alone; give
+// each participant their own seed. Throws Error(kInput) for by_participant with a participant id without number.
+std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& participant, uint64_t seed);
+
+Json ToJson(const Trial& trial);
+Json ToJson(const std::vector<Trial>& trials);
+
+// FNV-1a 64 of ToJson(trials).dump(): one number that changes when anything in the list changes.
+uint64_t TrialsHash(const std::vector<Trial>& trials);
+std::string HashHex(uint64_t hash);  // 16 lowercase hex digits
+
+}  // namespace blurcue::protocol

@@ -1,0 +1,193 @@
+#include "protocol/trials.h"
+
+#include <map>
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+
+namespace blurcue::protocol {
+namespace {
+
+namespace fs = std::filesystem;
+
+Protocol Shipped(const char* name) {
+  return LoadProtocol(fs::path(BLURCUE_SOURCE_DIR) / "protocols" / name, ValidateOptions{false});
+}
+
+Protocol FromJson(const std::string& text) { return ParseProtocol(Json::parse(text), "inline.json", {false}); }
+
+// Four trials whose order is the only randomness: levels 0..3 of one factor.
+const char* kFour = R"({
+  "name": "four", "version": 1,
+  "scene": {"background": "s.png", "calib": "c.json"}, "content": {"type": "grid"},
+  "task": "forced_choice", "sides": {"left": "measured", "right": "estimated"},
+  "factors": {"edge": [1, 2, 3, 4]}
+})";
+
+std::vector<int> Edges(const std::vector<Trial>& trials) {
+  std::vector<int> edges;
+  for (const auto& t : trials) edges.push_back(t.levels["edge"].get<int>());
+  return edges;
+}
+
+TEST(TrialBuilder, GeneratorIsTheStandardMt19937_64) {
+  // The C++ standard fixes the 10000th output of a default-constructed mt19937_64.
+  std::mt19937_64 rng;
+  rng.discard(9999);
+  EXPECT_EQ(rng(), 9981545732273789042ull);
+}
+
+TEST(TrialBuilder, FisherYatesMatchesHandComputedPermutation) {
+  // Expected order from raw generator outputs: for i = 3, 2, 1 swap position i with x % (i + 1).
+  // (Rejection only skips outputs below 2^64 mod (i + 1), at most 3 of 2^64; checked, not assumed.)
+  std::mt19937_64 raw(42);
+  std::vector<int> expected = {1, 2, 3, 4};
+  for (int i = 3; i >= 1; --i) {
+    const uint64_t x = raw();
+    ASSERT_GE(x, 4u);
+    std::swap(expected[i], expected[x % (i + 1)]);
+  }
+  EXPECT_EQ(Edges(BuildTrials(FromJson(kFour), "P1", 42)), expected);
+}
+
+TEST(TrialBuilder, SameSeedSameOrder) {
+  const Protocol p = Shipped("test2-moving-balls.json");
+  const auto a = BuildTrials(p, "P3", 2024);
+  const auto b = BuildTrials(p, "P3", 2024);
+  EXPECT_EQ(ToJson(a), ToJson(b));
+  EXPECT_EQ(TrialsHash(a), TrialsHash(b));
+}
+
+TEST(TrialBuilder, RecordedHashIsStable) {
+  // Recorded from a first run; any change to the generator, the shuffle, the crossing order or the trial JSON
+  // changes it (and must be a deliberate, documented change: stored sessions name their hash).
+  EXPECT_EQ(HashHex(TrialsHash(BuildTrials(FromJson(kFour), "P1", 7))), "7ee6a5a1e18a2389");
+}
+
+TEST(TrialBuilder, DifferentSeedsDiffer) {
+  const Protocol p = Shipped("test2-moving-balls.json");
+  EXPECT_NE(TrialsHash(BuildTrials(p, "P1", 1)), TrialsHash(BuildTrials(p, "P1", 2)));
+  EXPECT_NE(ToJson(BuildTrials(p, "P1", 1)), ToJson(BuildTrials(p, "P1", 2)));
+}
+
+TEST(TrialBuilder, EveryLevelAppearsAsDesigned) {
+  // Test 2's task 2: patterns 2, 4, 6 x sections 1..10 x 2 sides: each (pattern, section) twice, once swapped.
+  const auto trials = BuildTrials(Shipped("test2-moving-balls.json"), "P1", 5);
+  std::map<std::pair<int, int>, int> plain, swapped;
+  for (const auto& t : trials) {
+    if (t.practice || t.block != "task2") continue;
+    auto& counts = t.swapped ? swapped : plain;
+    ++counts[{t.levels["pattern"]["id"].get<int>(), t.levels["section"].get<int>()}];
+  }
+  ASSERT_EQ(plain.size(), 30u);
+  ASSERT_EQ(swapped.size(), 30u);
+  for (int id : {2, 4, 6})
+    for (int s = 1; s <= 10; ++s) {
+      EXPECT_EQ((plain[{id, s}]), 1) << id << " " << s;
+      EXPECT_EQ((swapped[{id, s}]), 1) << id << " " << s;
+    }
+}
+
+TEST(TrialBuilder, SwapCopiesPutEachSourceOnEachSideEquallyOften) {
+  const auto trials = BuildTrials(Shipped("test2-moving-balls.json"), "P1", 9);
+  std::map<std::pair<int, std::string>, int> on_left;  // (pattern, source) -> times shown left
+  for (const auto& t : trials) {
+    if (t.practice || t.block != "task1") continue;
+    const Json& design = t.levels["pattern"];
+    EXPECT_EQ(t.left, t.swapped ? design["right"] : design["left"]);
+    EXPECT_EQ(t.right, t.swapped ? design["left"] : design["right"]);
+    ++on_left[{design["id"].get<int>(), t.left.get<std::string>()}];
+  }
+  const Protocol p = Shipped("test2-moving-balls.json");
+  ASSERT_EQ(p.blocks[0].factors[0].levels.size(), 6u);
+  for (const auto& level : p.blocks[0].factors[0].levels) {
+    const int id = level["id"].get<int>();
+    EXPECT_EQ((on_left[{id, level["left"].get<std::string>()}]), 1) << id;
+    EXPECT_EQ((on_left[{id, level["right"].get<std::string>()}]), 1) << id;
+  }
+}
+
+TEST(TrialBuilder, ByParticipantSwapsForEvenNumbers) {
+  const Protocol p = Shipped("test1-static-grids.json");
+  for (const auto& t : BuildTrials(p, "P7", 1)) {
+    EXPECT_FALSE(t.swapped);
+    EXPECT_EQ(t.left, "measured");
+  }
+  for (const auto& t : BuildTrials(p, "P8", 1)) {
+    EXPECT_TRUE(t.swapped);
+    EXPECT_EQ(t.left, "estimated");
+    EXPECT_EQ(t.right, "measured");
+  }
+}
+
+TEST(TrialBuilder, ByParticipantNeedsANumberedParticipant) {
+  EXPECT_THROW(BuildTrials(Shipped("test1-static-grids.json"), "anna", 1), Error);
+}
+
+TEST(TrialBuilder, ParticipantNumberIsTheTrailingDigits) {
+  EXPECT_EQ(ParticipantNumber("P12"), 12);
+  EXPECT_EQ(ParticipantNumber("7"), 7);
+  EXPECT_EQ(ParticipantNumber("P"), -1);
+}
+
+TEST(TrialBuilder, PracticeFirstThenBlocksInOrder) {
+  const auto trials = BuildTrials(Shipped("test2-moving-balls.json"), "P1", 3);
+  ASSERT_EQ(trials.size(), 74u);
+  for (size_t i = 0; i < trials.size(); ++i) {
+    EXPECT_EQ(trials[i].index, static_cast<int>(i));
+    EXPECT_EQ(trials[i].practice, i < 2);
+    EXPECT_EQ(trials[i].block, i < 14 ? "task1" : "task2") << i;
+  }
+}
+
+TEST(TrialBuilder, RepetitionsMultiplyTheDesign) {
+  Json j = Json::parse(kFour);
+  j["repetitions"] = 3;
+  const auto trials = BuildTrials(ParseProtocol(j, "inline.json", {false}), "P1", 1);
+  ASSERT_EQ(trials.size(), 12u);
+  std::map<int, int> counts;
+  for (const auto& t : trials) ++counts[t.levels["edge"].get<int>()];
+  for (int e = 1; e <= 4; ++e) EXPECT_EQ(counts[e], 3);
+}
+
+TEST(TrialBuilder, AdjustmentLevelsAndStartAreDrawnPerTrial) {
+  const Protocol p = Shipped("pre-research-depth-matching.json");
+  const auto trials = BuildTrials(p, "P1", 11);
+  std::vector<double> sorted_levels = p.blocks[0].adjust->levels;
+  std::sort(sorted_levels.begin(), sorted_levels.end());
+  std::set<std::vector<double>> orders;
+  std::set<int> starts;
+  std::set<double> distances;
+  for (const auto& t : trials) {
+    std::vector<double> levels = t.adjust_levels;
+    std::sort(levels.begin(), levels.end());
+    EXPECT_EQ(levels, sorted_levels);  // a permutation of the 22 cut-offs
+    ASSERT_GE(t.start_index, 0);
+    ASSERT_LT(t.start_index, 22);
+    orders.insert(t.adjust_levels);
+    starts.insert(t.start_index);
+    if (!t.practice) distances.insert(t.levels["distance_m"].get<double>());
+    EXPECT_EQ(ToJson(t)["start_index"], t.start_index);
+  }
+  EXPECT_EQ(distances.size(), 27u);
+  EXPECT_EQ(orders.size(), trials.size());  // 28 orders of 22 levels: a repeat would mean no fresh draw
+  EXPECT_GT(starts.size(), 5u);
+}
+
+TEST(TrialBuilder, UnshuffledBlockKeepsTheCrossingOrder) {
+  Json j = Json::parse(kFour);
+  j["blocks"] = {{{"name", "fixed"}, {"shuffle", false}}};
+  EXPECT_EQ(Edges(BuildTrials(ParseProtocol(j, "inline.json", {false}), "P1", 1)), (std::vector<int>{1, 2, 3, 4}));
+}
+
+TEST(TrialBuilder, UniformBelowStaysInRange) {
+  std::mt19937_64 rng(1);
+  std::vector<int> counts(3);
+  for (int i = 0; i < 3000; ++i) ++counts[UniformBelow(rng, 3)];
+  for (int c : counts) EXPECT_GT(c, 850);
+}
+
+}  // namespace
+}  // namespace blurcue::protocol
