@@ -1,0 +1,314 @@
+#include "store/export.h"
+
+#include <unistd.h>
+
+#include <charconv>
+#include <fstream>
+#include <map>
+#include <set>
+#include <string>
+
+#include "core/error.h"
+#include "core/json_io.h"
+#include "store/schema.h"
+#include "store/sqlite.h"
+
+namespace blurcue::store {
+namespace {
+
+const std::vector<std::string>& LeadingColumns() {
+  static const std::vector<std::string> columns = {"study", "protocol_hash", "participant", "session",
+                                                   "seed",  "trial_index",   "block"};
+  return columns;
+}
+
+const std::vector<std::string>& TrailingColumns() {
+  static const std::vector<std::string> columns = {"left", "right", "choice", "rt_ms", "answered_at"};
+  return columns;
+}
+
+// A JSON value as a cell: strings bare, null empty, anything else as compact JSON.
+std::string Cell(const Json& value) {
+  if (value.is_string()) return value.get<std::string>();
+  if (value.is_null()) return {};
+  return value.dump();
+}
+
+Json ParseColumn(const std::string& text, const std::string& where) {
+  try {
+    return Json::parse(text);
+  } catch (const Json::exception& e) {
+    throw InputError(where, std::string("not valid JSON: ") + e.what());
+  }
+}
+
+// Shortest text that reads back as the same double.
+std::string Number(double value) {
+  char text[64];
+  const auto result = std::to_chars(text, text + sizeof(text), value);
+  return std::string(text, result.ptr);
+}
+
+std::string Where(const std::filesystem::path& db, int64_t session, int64_t trial) {
+  return db.string() + ": session " + std::to_string(session) + " trial " + std::to_string(trial);
+}
+
+void RemoveDatabaseFiles(const std::filesystem::path& path) {
+  std::error_code ignored;
+  for (const char* suffix : {"", "-wal", "-shm", "-journal"})
+    std::filesystem::remove(path.string() + suffix, ignored);
+}
+
+}  // namespace
+
+std::string CsvField(const std::string& text) {
+  const bool quote = text.find_first_of(",\"\r\n") != std::string::npos ||
+                     (!text.empty() && (text.front() == ' ' || text.back() == ' '));
+  if (!quote) return text;
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
+int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::path& out_dir) {
+  Database db(db_path, OpenMode::kReadOnly);
+  RequireCurrentSchema(db);
+
+  // Pass 1: every factor key in the record, so every participant gets the same columns.
+  std::set<std::string> keys;
+  {
+    Statement factors(db, "SELECT session_id, trial_index, factors FROM trials");
+    while (factors.Step()) {
+      const Json object = ParseColumn(factors.GetText(2), Where(db_path, factors.GetInt64(0), factors.GetInt64(1)) +
+                                                              " factors");
+      if (!object.is_object())
+        throw InputError(Where(db_path, factors.GetInt64(0), factors.GetInt64(1)), "factors must be a JSON object");
+      for (const auto& item : object.items()) keys.insert(item.key());
+    }
+  }
+  std::set<std::string> fixed(LeadingColumns().begin(), LeadingColumns().end());
+  fixed.insert(TrailingColumns().begin(), TrailingColumns().end());
+
+  std::error_code error;
+  std::filesystem::create_directories(out_dir, error);
+  if (error) throw InputError(out_dir.string(), "cannot create the folder: " + error.message());
+  const std::filesystem::path final_path = out_dir / "trials.csv";
+  const std::filesystem::path temp_path = out_dir / ("trials.csv.tmp" + std::to_string(getpid()));
+  std::ofstream out(temp_path, std::ios::binary);
+  if (!out) throw InputError(temp_path.string(), "cannot write");
+
+  std::string header;
+  auto add = [&header](const std::string& name) {
+    if (!header.empty()) header += ',';
+    header += CsvField(name);
+  };
+  for (const auto& name : LeadingColumns()) add(name);
+  for (const auto& key : keys) add(fixed.count(key) ? std::string("factor_").append(key) : key);
+  for (const auto& name : TrailingColumns()) add(name);
+  out << header << "\r\n";
+
+  Statement rows(db,
+                 "SELECT st.name, pv.hash, p.code, s.id, s.seed, t.trial_index, t.block, t.factors, t.left_shown, "
+                 "t.right_shown, r.choice, r.rt_ms, r.answered_at, r.id IS NULL "
+                 "FROM trials t JOIN sessions s ON s.id = t.session_id "
+                 "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
+                 "JOIN protocol_versions pv ON pv.id = s.protocol_version_id "
+                 "LEFT JOIN responses r ON r.trial_id = t.id "
+                 "ORDER BY st.name, p.code, s.id, t.trial_index");
+  int64_t count = 0;
+  while (rows.Step()) {
+    const int64_t session = rows.GetInt64(3);
+    const int64_t trial = rows.GetInt64(5);
+    const std::string where = Where(db_path, session, trial);
+    std::vector<std::string> cells = {rows.GetText(0),
+                                      rows.GetText(1),
+                                      rows.GetText(2),
+                                      std::to_string(session),
+                                      std::to_string(static_cast<uint64_t>(rows.GetInt64(4))),
+                                      std::to_string(trial),
+                                      std::to_string(rows.GetInt64(6))};
+    const Json factors = ParseColumn(rows.GetText(7), where + " factors");
+    for (const auto& key : keys) cells.push_back(factors.contains(key) ? Cell(factors.at(key)) : std::string());
+    cells.push_back(Cell(ParseColumn(rows.GetText(8), where + " left")));
+    cells.push_back(Cell(ParseColumn(rows.GetText(9), where + " right")));
+    const bool answered = rows.GetInt64(13) == 0;
+    cells.push_back(answered ? rows.GetText(10) : "");
+    cells.push_back(answered && !rows.IsNull(11) ? Number(rows.GetDouble(11)) : "");
+    cells.push_back(answered ? rows.GetText(12) : "");
+    std::string line;
+    for (size_t i = 0; i < cells.size(); ++i) {
+      if (i) line += ',';
+      line += CsvField(cells[i]);
+    }
+    out << line << "\r\n";
+    ++count;
+  }
+  out.close();
+  if (!out) {
+    std::filesystem::remove(temp_path, error);
+    throw InputError(temp_path.string(), "write failed");
+  }
+  std::filesystem::rename(temp_path, final_path, error);
+  if (error) throw InputError(final_path.string(), "cannot replace: " + error.message());
+  return count;
+}
+
+void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out) {
+  if (std::filesystem::exists(out)) throw InputError(out.string(), "exists; merge refuses to overwrite it");
+  std::set<std::filesystem::path> seen;
+  for (const auto& input : inputs) {
+    if (!seen.insert(std::filesystem::weakly_canonical(input)).second)
+      throw InputError(input.string(), "listed twice among the merge inputs");
+  }
+  const std::filesystem::path temp = out.string() + ".partial" + std::to_string(getpid());
+  RemoveDatabaseFiles(temp);
+  try {
+    {
+      Database dst(temp);
+      Migrate(dst);
+      Transaction transaction(dst);
+      for (const auto& input : inputs) {
+        Database src(input, OpenMode::kReadOnly);
+        RequireCurrentSchema(src);
+        std::map<int64_t, int64_t> study_ids, protocol_ids, participant_ids, session_ids, trial_ids;
+
+        Statement studies(src, "SELECT id, name, created FROM studies");
+        Statement insert_study(dst, "INSERT INTO studies (name, created) VALUES (?, ?) ON CONFLICT (name) DO NOTHING");
+        Statement find_study(dst, "SELECT id FROM studies WHERE name = ?");
+        while (studies.Step()) {
+          insert_study.Bind(1, studies.GetText(1));
+          insert_study.Bind(2, studies.GetText(2));
+          insert_study.Run();
+          insert_study.Reset();
+          find_study.Bind(1, studies.GetText(1));
+          find_study.Step();
+          study_ids[studies.GetInt64(0)] = find_study.GetInt64(0);
+          find_study.Reset();
+        }
+
+        Statement protocols(src, "SELECT id, study_id, json, hash, created FROM protocol_versions");
+        Statement insert_protocol(dst, "INSERT INTO protocol_versions (study_id, json, hash, created) "
+                                       "VALUES (?, ?, ?, ?) ON CONFLICT (study_id, hash) DO NOTHING");
+        Statement find_protocol(dst, "SELECT id, json FROM protocol_versions WHERE study_id = ? AND hash = ?");
+        while (protocols.Step()) {
+          const int64_t study = study_ids.at(protocols.GetInt64(1));
+          insert_protocol.Bind(1, study);
+          insert_protocol.Bind(2, protocols.GetText(2));
+          insert_protocol.Bind(3, protocols.GetText(3));
+          insert_protocol.Bind(4, protocols.GetText(4));
+          insert_protocol.Run();
+          insert_protocol.Reset();
+          find_protocol.Bind(1, study);
+          find_protocol.Bind(2, protocols.GetText(3));
+          find_protocol.Step();
+          if (find_protocol.GetText(1) != protocols.GetText(2))
+            throw InputError(input.string(), "protocol hash " + protocols.GetText(3) +
+                                                 " names a different protocol text in another input");
+          protocol_ids[protocols.GetInt64(0)] = find_protocol.GetInt64(0);
+          find_protocol.Reset();
+        }
+
+        Statement participants(src, "SELECT id, study_id, code, created FROM participants");
+        Statement insert_participant(dst, "INSERT INTO participants (study_id, code, created) VALUES (?, ?, ?) "
+                                          "ON CONFLICT (study_id, code) DO NOTHING");
+        Statement find_participant(dst, "SELECT id FROM participants WHERE study_id = ? AND code = ?");
+        while (participants.Step()) {
+          const int64_t study = study_ids.at(participants.GetInt64(1));
+          insert_participant.Bind(1, study);
+          insert_participant.Bind(2, participants.GetText(2));
+          insert_participant.Bind(3, participants.GetText(3));
+          insert_participant.Run();
+          insert_participant.Reset();
+          find_participant.Bind(1, study);
+          find_participant.Bind(2, participants.GetText(2));
+          find_participant.Step();
+          participant_ids[participants.GetInt64(0)] = find_participant.GetInt64(0);
+          find_participant.Reset();
+        }
+
+        Statement sessions(src, "SELECT id, participant_id, protocol_version_id, seed, software_version, host, "
+                                "display, started, ended, status FROM sessions");
+        Statement duplicate(dst, "SELECT id FROM sessions WHERE participant_id = ? AND protocol_version_id = ? "
+                                 "AND seed = ? AND host = ? AND started = ?");
+        Statement insert_session(dst, "INSERT INTO sessions (participant_id, protocol_version_id, seed, "
+                                      "software_version, host, display, started, ended, status) "
+                                      "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
+        while (sessions.Step()) {
+          const int64_t participant = participant_ids.at(sessions.GetInt64(1));
+          const int64_t protocol = protocol_ids.at(sessions.GetInt64(2));
+          duplicate.Bind(1, participant);
+          duplicate.Bind(2, protocol);
+          duplicate.Bind(3, sessions.GetInt64(3));
+          duplicate.Bind(4, sessions.GetText(5));
+          duplicate.Bind(5, sessions.GetText(7));
+          if (duplicate.Step())
+            throw InputError(input.string(), "session " + std::to_string(sessions.GetInt64(0)) +
+                                                 " is already in the merge (an input merged twice?)");
+          duplicate.Reset();
+          insert_session.Bind(1, participant);
+          insert_session.Bind(2, protocol);
+          insert_session.Bind(3, sessions.GetInt64(3));
+          for (int column = 4; column <= 7; ++column) insert_session.Bind(column, sessions.GetText(column));
+          if (sessions.IsNull(8)) insert_session.BindNull(8);
+          else insert_session.Bind(8, sessions.GetText(8));
+          insert_session.Bind(9, sessions.GetText(9));
+          insert_session.Run();
+          insert_session.Reset();
+          session_ids[sessions.GetInt64(0)] = dst.LastInsertRowId();
+        }
+
+        Statement trials(src, "SELECT id, session_id, trial_index, block, factors, left_shown, right_shown FROM trials");
+        Statement insert_trial(dst, "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, "
+                                    "right_shown) VALUES (?, ?, ?, ?, ?, ?)");
+        while (trials.Step()) {
+          insert_trial.Bind(1, session_ids.at(trials.GetInt64(1)));
+          insert_trial.Bind(2, trials.GetInt64(2));
+          insert_trial.Bind(3, trials.GetInt64(3));
+          for (int column = 4; column <= 6; ++column) insert_trial.Bind(column, trials.GetText(column));
+          insert_trial.Run();
+          insert_trial.Reset();
+          trial_ids[trials.GetInt64(0)] = dst.LastInsertRowId();
+        }
+
+        Statement responses(src, "SELECT trial_id, choice, rt_ms, adjustment, answered_at FROM responses");
+        Statement insert_response(dst, "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at) "
+                                       "VALUES (?, ?, ?, ?, ?)");
+        while (responses.Step()) {
+          insert_response.Bind(1, trial_ids.at(responses.GetInt64(0)));
+          insert_response.Bind(2, responses.GetText(1));
+          if (responses.IsNull(2)) insert_response.BindNull(3);
+          else insert_response.Bind(3, responses.GetDouble(2));
+          insert_response.Bind(4, responses.GetText(3));
+          insert_response.Bind(5, responses.GetText(4));
+          insert_response.Run();
+          insert_response.Reset();
+        }
+
+        Statement frames(src, "SELECT trial_id, frame_index, flip_time_s, dropped FROM frames");
+        Statement insert_frame(dst, "INSERT INTO frames (trial_id, frame_index, flip_time_s, dropped) "
+                                    "VALUES (?, ?, ?, ?)");
+        while (frames.Step()) {
+          insert_frame.Bind(1, trial_ids.at(frames.GetInt64(0)));
+          insert_frame.Bind(2, frames.GetInt64(1));
+          insert_frame.Bind(3, frames.GetDouble(2));
+          insert_frame.Bind(4, frames.GetInt64(3));
+          insert_frame.Run();
+          insert_frame.Reset();
+        }
+      }
+      transaction.Commit();
+    }  // the last connection closes: the WAL is checkpointed into the file and removed
+    if (std::filesystem::exists(out)) throw InputError(out.string(), "appeared during the merge; not overwritten");
+    std::error_code error;
+    std::filesystem::rename(temp, out, error);
+    if (error) throw InputError(out.string(), "cannot write the merged record: " + error.message());
+  } catch (...) {
+    RemoveDatabaseFiles(temp);
+    throw;
+  }
+}
+
+}  // namespace blurcue::store

@@ -1,0 +1,27 @@
+#pragma once
+// Reading a record out: a long-format CSV for analysis, and merging the records of several stations.
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+namespace blurcue::store {
+
+// Writes `out_dir`/trials.csv (atomically): one row per planned trial, answered or not, ordered by study,
+// participant, session, trial index. Columns, the same for every participant:
+//   study, protocol_hash, participant, session, seed, trial_index, block, <every factor key found in the record,
+//   sorted>, left, right, choice, rt_ms, answered_at
+// A factor a trial lacks is an empty cell; a factor named like a fixed column is written as "factor_<name>".
+// Returns the number of rows. Throws Error(kInput) for a file that is not a current blurcue record.
+int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::path& out_dir);
+
+// Copies every study, protocol version, participant, session, trial, response and frame of `inputs` into a new
+// record at `out`, with fresh ids. Protocol versions are shared by (study, hash) and participants by (study,
+// participant code). Throws Error(kInput) when `out` exists, an input is listed twice, an input is not a current
+// record, or a session (same participant, protocol, seed, host and start) is already in the output. Nothing is
+// left at `out` on failure.
+void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out);
+
+// One CSV field, quoted when it holds a comma, quote, line break or leading/trailing space.
+std::string CsvField(const std::string& text);
+
+}  // namespace blurcue::store

@@ -1,0 +1,193 @@
+#include "store/export.h"
+
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "store/record.h"
+#include "store/test_util.h"
+
+namespace blurcue::store {
+namespace {
+
+using Rows = std::vector<std::vector<std::string>>;
+
+// A small RFC 4180 reader for checking the export.
+Rows ReadCsv(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string text = buffer.str();
+  Rows rows(1);
+  std::string field;
+  bool quoted = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < text.size() && text[i + 1] == '"') field += '"', ++i;
+      else if (c == '"') quoted = false;
+      else field += c;
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      rows.back().push_back(field), field.clear();
+    } else if (c == '\r') {
+    } else if (c == '\n') {
+      rows.back().push_back(field), field.clear();
+      rows.emplace_back();
+    } else {
+      field += c;
+    }
+  }
+  if (rows.back().empty()) rows.pop_back();
+  return rows;
+}
+
+size_t Column(const Rows& rows, const std::string& name) {
+  const auto& header = rows.at(0);
+  const auto it = std::find(header.begin(), header.end(), name);
+  EXPECT_NE(it, header.end()) << "no column " << name;
+  return static_cast<size_t>(it - header.begin());
+}
+
+// One participant's session: `n` trials with the given factors JSON, the first `answered` answered.
+void RunSession(Record& record, const std::string& participant, const std::string& factors_json, int n, int answered,
+                const std::string& study = "test1") {
+  const int64_t session =
+      record.StartOrResumeSession(study, participant, R"({"study":")" + study + R"("})", 42, {}, false).session_id;
+  std::vector<TrialRecord> trials;
+  for (int i = 0; i < n; ++i) {
+    TrialRecord t;
+    t.index = i;
+    t.block = i / 2;
+    t.factors_json = factors_json;
+    t.left_json = R"("measured")";
+    t.right_json = R"({"blur":"estimated","edge":3})";
+    trials.push_back(t);
+  }
+  record.SaveTrialList(session, trials);
+  for (int i = 0; i < answered; ++i) {
+    Response r;
+    r.choice = i % 2 ? "left" : "right";
+    r.rt_ms = 400.25 + i;
+    record.RecordResponse(session, i, r);
+  }
+  record.FinishSession(session, SessionStatus::kCompleted);
+}
+
+TEST(Export, ColumnsAreTheSameForParticipantsWithDifferentFactors) {
+  testing::TempDir dir;
+  {
+    Record record = Record::Open(dir / "r.sqlite");
+    RunSession(record, "P01", R"({"edge":3,"blur":"measured"})", 4, 4);
+    RunSession(record, "P02", R"({"speed_cm_s":1.8,"blur":"none"})", 3, 2);
+  }
+  EXPECT_EQ(ExportCsv(dir / "r.sqlite", dir / "out"), 7);
+  const Rows rows = ReadCsv(dir / "out" / "trials.csv");
+  ASSERT_EQ(rows.size(), 8u);
+  const std::vector<std::string> expected = {"study", "protocol_hash", "participant", "session", "seed",
+                                             "trial_index", "block", "blur", "edge", "speed_cm_s",
+                                             "left", "right", "choice", "rt_ms", "answered_at"};
+  EXPECT_EQ(rows[0], expected);
+  for (const auto& row : rows) EXPECT_EQ(row.size(), expected.size());
+  EXPECT_EQ(rows[1][Column(rows, "participant")], "P01");
+  EXPECT_EQ(rows[1][Column(rows, "edge")], "3");
+  EXPECT_EQ(rows[1][Column(rows, "speed_cm_s")], "");
+  EXPECT_EQ(rows[5][Column(rows, "participant")], "P02");
+  EXPECT_EQ(rows[5][Column(rows, "speed_cm_s")], "1.8");
+  EXPECT_EQ(rows[5][Column(rows, "edge")], "");
+  EXPECT_EQ(rows[1][Column(rows, "rt_ms")], "400.25");
+  EXPECT_EQ(rows[1][Column(rows, "seed")], "42");
+  // Unanswered trials are rows with empty answers.
+  EXPECT_EQ(rows[7][Column(rows, "choice")], "");
+  EXPECT_EQ(rows[7][Column(rows, "answered_at")], "");
+  // JSON with commas and quotes survives the quoting.
+  EXPECT_EQ(rows[1][Column(rows, "left")], "measured");
+  EXPECT_EQ(rows[1][Column(rows, "right")], R"({"blur":"estimated","edge":3})");
+}
+
+TEST(Export, ReadsARecordAWriterStillHasOpen) {
+  testing::TempDir dir;
+  Record record = Record::Open(dir / "r.sqlite");
+  RunSession(record, "P01", R"({"block":1})", 2, 1);  // a factor named like a fixed column
+  EXPECT_EQ(ExportCsv(dir / "r.sqlite", dir / "out"), 2);
+  const Rows rows = ReadCsv(dir / "out" / "trials.csv");
+  EXPECT_EQ(rows[1][Column(rows, "factor_block")], "1");
+}
+
+TEST(Export, QuotesFieldsThatNeedIt) {
+  EXPECT_EQ(CsvField("plain"), "plain");
+  EXPECT_EQ(CsvField("a,b"), "\"a,b\"");
+  EXPECT_EQ(CsvField("say \"hi\""), "\"say \"\"hi\"\"\"");
+  EXPECT_EQ(CsvField("two\nlines"), "\"two\nlines\"");
+  EXPECT_EQ(CsvField(" padded"), "\" padded\"");
+}
+
+TEST(Export, ForeignDatabaseIsInputError) {
+  testing::TempDir dir;
+  { Database(dir / "other.sqlite").Exec("CREATE TABLE x (y)"); }
+  try {
+    ExportCsv(dir / "other.sqlite", dir / "out");
+    FAIL() << "exported a database that is not a record";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+  }
+}
+
+TEST(Merge, KeepsAllRowsAndIdsStayConsistent) {
+  testing::TempDir dir;
+  {
+    Record a = Record::Open(dir / "a.sqlite");
+    RunSession(a, "P01", R"({"edge":1})", 4, 4);
+    RunSession(a, "P02", R"({"edge":2})", 3, 3);
+    Record b = Record::Open(dir / "b.sqlite");
+    RunSession(b, "P03", R"({"edge":3})", 5, 2);
+    RunSession(b, "P01", R"({"edge":4})", 2, 1);  // the same participant at a second station
+    RunSession(b, "Q01", R"({"edge":5})", 2, 2, "test2");
+  }
+  MergeDatabases({dir / "a.sqlite", dir / "b.sqlite"}, dir / "merged.sqlite");
+
+  Database db(dir / "merged.sqlite", OpenMode::kReadOnly);
+  EXPECT_EQ(db.QueryText("PRAGMA integrity_check"), "ok");
+  EXPECT_EQ(db.QueryInt64("SELECT COUNT(*) FROM pragma_foreign_key_check"), 0);
+  EXPECT_EQ(db.QueryInt64("SELECT COUNT(*) FROM studies"), 2);
+  EXPECT_EQ(db.QueryInt64("SELECT COUNT(*) FROM protocol_versions"), 2);  // same text shared by hash
+  EXPECT_EQ(db.QueryInt64("SELECT COUNT(*) FROM participants"), 4);       // P01 once
+  EXPECT_EQ(db.QueryInt64("SELECT COUNT(*) FROM sessions"), 5);
+  EXPECT_EQ(db.QueryInt64("SELECT COUNT(*) FROM trials"), 16);
+  EXPECT_EQ(db.QueryInt64("SELECT COUNT(*) FROM responses"), 12);
+  // Each response still belongs to the trial and participant it was given for: the factor says which session.
+  EXPECT_EQ(db.QueryText("SELECT group_concat(n, ' ') FROM (SELECT p.code || ':' || t.factors || ':' || COUNT(r.id) AS n "
+                         "FROM trials t JOIN sessions s ON s.id = t.session_id "
+                         "JOIN participants p ON p.id = s.participant_id LEFT JOIN responses r ON r.trial_id = t.id "
+                         "GROUP BY s.id ORDER BY p.code, t.factors)"),
+            R"(P01:{"edge":1}:4 P01:{"edge":4}:1 P02:{"edge":2}:3 P03:{"edge":3}:2 Q01:{"edge":5}:2)");
+  EXPECT_EQ(db.QueryInt64("SELECT COUNT(*) FROM sessions s JOIN participants p ON p.id = s.participant_id "
+                          "JOIN protocol_versions v ON v.id = s.protocol_version_id WHERE v.study_id != p.study_id"),
+            0);
+}
+
+TEST(Merge, RefusesToOverwriteAnExistingOutput) {
+  testing::TempDir dir;
+  { Record a = Record::Open(dir / "a.sqlite"); RunSession(a, "P01", "{}", 1, 1); }
+  std::ofstream(dir / "merged.sqlite") << "keep me";
+  EXPECT_THROW(MergeDatabases({dir / "a.sqlite"}, dir / "merged.sqlite"), Error);
+  std::ifstream in(dir / "merged.sqlite");
+  std::string text;
+  std::getline(in, text);
+  EXPECT_EQ(text, "keep me");
+}
+
+TEST(Merge, TheSameSessionTwiceIsRefusedAndLeavesNoOutput) {
+  testing::TempDir dir;
+  { Record a = Record::Open(dir / "a.sqlite"); RunSession(a, "P01", "{}", 1, 1); }
+  std::filesystem::copy_file(dir / "a.sqlite", dir / "copy.sqlite");
+  EXPECT_THROW(MergeDatabases({dir / "a.sqlite", dir / "copy.sqlite"}, dir / "merged.sqlite"), Error);
+  EXPECT_FALSE(std::filesystem::exists(dir / "merged.sqlite"));
+  EXPECT_THROW(MergeDatabases({dir / "a.sqlite", dir / "a.sqlite"}, dir / "merged.sqlite"), Error);
+}
+
+}  // namespace
+}  // namespace blurcue::store
