@@ -13,5 +13,6 @@ void AddBlurCommand(CLI::App& app);         // blur_command.cc
 void AddRenderCommand(CLI::App& app);       // render_command.cc
 void AddAnimateCommand(CLI::App& app);      // animate_command.cc
 void AddMakeStimuliCommand(CLI::App& app);  // make_stimuli_command.cc
+void AddValidateCommand(CLI::App& app);     // validate_command.cc
 
 }  // namespace blurcue::cli

@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
       {"animate", &cli::AddAnimateCommand},
       {"bench", &cli::AddBenchCommand},
       {"make-stimuli", &cli::AddMakeStimuliCommand},
+      {"validate", &cli::AddValidateCommand},
   };
   for (const auto& [name, add] : commands) add(app);
 

@@ -1,0 +1,26 @@
+# blurcue validate: the shipped protocols pass (without file checks: the demo scene may not exist yet), and a broken
+# protocol is rejected with exit 3 and every problem at once, each naming its JSON pointer.
+foreach(study pre-research-depth-matching test1-static-grids test2-moving-balls test3-no-board)
+  add_test(NAME cli_validate_${study}
+           COMMAND $<TARGET_FILE:blurcue> validate ${PROJECT_SOURCE_DIR}/protocols/${study}.json --no-files)
+endforeach()
+set_tests_properties(cli_validate_test2-moving-balls PROPERTIES
+                     PASS_REGULAR_EXPRESSION "ok: 74 trials for participant P1 with seed 1 \\(hash [0-9a-f]+\\)")
+set_tests_properties(cli_validate_test1-static-grids PROPERTIES PASS_REGULAR_EXPRESSION "ok: 13 trials")
+set_tests_properties(cli_validate_pre-research-depth-matching PROPERTIES PASS_REGULAR_EXPRESSION "ok: 28 trials")
+set_tests_properties(cli_validate_test3-no-board PROPERTIES PASS_REGULAR_EXPRESSION "ok: 74 trials")
+
+set(BROKEN_PROTOCOL ${PROJECT_SOURCE_DIR}/tests/data/broken-protocol.json)
+foreach(expect "/factors/pattern/0/speed_cm_s: a speed must be a number > 0, got -3"
+               "/factors/edge/1: an edge must be an integer in 1..11, got 12"
+               "/repetitons: unknown key (did you mean \"repetitions\"?), got 2"
+               "/scene/background: no such file")
+  string(MAKE_C_IDENTIFIER "${expect}" id)
+  add_test(NAME cli_validate_broken_${id}
+           COMMAND ${CMAKE_COMMAND} -DCMD=$<TARGET_FILE:blurcue> "-DARGS=validate;${BROKEN_PROTOCOL}" -DEXPECT_CODE=3
+                   "-DEXPECT_TEXT=broken-protocol.json: ${expect}" -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+endforeach()
+# Without file checks the missing scene is not a problem; the other three still are.
+add_test(NAME cli_validate_broken_no_files
+         COMMAND ${CMAKE_COMMAND} -DCMD=$<TARGET_FILE:blurcue> "-DARGS=validate;${BROKEN_PROTOCOL};--no-files"
+                 -DEXPECT_CODE=3 "-DEXPECT_TEXT=(3 problems)" -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
