@@ -24,3 +24,27 @@ endforeach()
 add_test(NAME cli_validate_broken_no_files
          COMMAND ${CMAKE_COMMAND} -DCMD=$<TARGET_FILE:blurcue> "-DARGS=validate;${BROKEN_PROTOCOL};--no-files"
                  -DEXPECT_CODE=3 "-DEXPECT_TEXT=(3 problems)" -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+
+# The JSON Schema is itself valid draft 2020-12, accepts the four shipped protocols and rejects the broken one
+# (only where python3 has jsonschema; the C++ validator above does not depend on it).
+find_package(Python3 COMPONENTS Interpreter QUIET)
+if(Python3_Interpreter_FOUND)
+  execute_process(COMMAND ${Python3_EXECUTABLE} -c "import jsonschema" RESULT_VARIABLE no_jsonschema
+                  OUTPUT_QUIET ERROR_QUIET)
+  if(no_jsonschema EQUAL 0)
+    set(check "import json, sys, jsonschema\n\
+V = jsonschema.Draft202012Validator\n\
+s = json.load(open(sys.argv[1])); V.check_schema(s)\n\
+errors = lambda f: list(V(s).iter_errors(json.load(open(f))))\n\
+bad = [f for f in sys.argv[2:-1] if errors(f)]\n\
+assert not bad, bad\n\
+assert errors(sys.argv[-1]), 'broken protocol accepted'\n\
+print('schema ok')")
+    set(P ${PROJECT_SOURCE_DIR}/protocols)
+    add_test(NAME protocol_schema
+             COMMAND ${Python3_EXECUTABLE} -c "${check}" ${P}/protocol.schema.json ${P}/pre-research-depth-matching.json
+                     ${P}/test1-static-grids.json ${P}/test2-moving-balls.json ${P}/test3-no-board.json
+                     ${BROKEN_PROTOCOL})
+    set_tests_properties(protocol_schema PROPERTIES PASS_REGULAR_EXPRESSION "schema ok")
+  endif()
+endif()
