@@ -269,7 +269,7 @@ void BlurLayerVarying(Layer& layer, const std::string& method, const std::functi
   CV_Assert(layer.depth_mm.size() == layer.bgra.size());
   // Radius per covered pixel; uncovered pixels take their nearest covered pixel's radius.
   const cv::Mat uncovered = layer.depth_mm <= 0;
-  if (cv::countNonZero(uncovered) == uncovered.total()) return;
+  if (size_t(cv::countNonZero(uncovered)) == uncovered.total()) return;
   cv::Mat distance, labels;
   cv::distanceTransform(uncovered, distance, labels, cv::DIST_L2, cv::DIST_MASK_5, cv::DIST_LABEL_PIXEL);
   std::vector<float> r_of_label(1, 0.f);  // labels number the covered pixels in raster order from 1
