@@ -84,6 +84,7 @@ std::vector<RenderRow> RunRenderBench(const RenderBenchOptions& options) {
   std::vector<cv::Size> sizes = {{1280, 720}, {1920, 1080}, {4592, 3056}};
   std::vector<double> radii = {1, 4, 8, 16};
   if (options.quick) sizes = {{640, 360}}, radii = {1, 8};
+  if (options.frames_only) sizes.clear();
   const int repeats = options.quick ? 1 : 3;
   for (const cv::Size& size : sizes) {
     const cv::Mat frame = TestFrame(size.width, size.height);

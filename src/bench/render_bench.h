@@ -22,7 +22,8 @@ struct RenderRow {
 };
 
 struct RenderBenchOptions {
-  bool quick = false;  // smaller sizes and fewer frames (a smoke run for CI)
+  bool quick = false;        // smaller sizes and fewer frames (a smoke run for CI)
+  bool frames_only = false;  // only the two-ball frame comparison
   std::function<void(const std::string&)> progress;
 };
 

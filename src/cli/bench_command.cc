@@ -62,7 +62,7 @@ void AddMeasure(CLI::App& bench) {
 void AddRender(CLI::App& bench) {
   struct Args {
     std::string out = "results/bench/render.csv";
-    bool quick = false;
+    bool quick = false, frames_only = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = bench.add_subcommand(
@@ -77,9 +77,11 @@ void AddRender(CLI::App& bench) {
       "Takes a few minutes; --quick uses small frames.");
   cmd->add_option("--out", args->out, "CSV, one row per measurement")->capture_default_str();
   cmd->add_flag("--quick", args->quick, "small sizes, few frames (smoke run)");
+  cmd->add_flag("--frames-only", args->frames_only, "only part 2, the two-ball frame");
   cmd->callback([args] {
     bench::RenderBenchOptions options;
     options.quick = args->quick;
+    options.frames_only = args->frames_only;
     options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
     const auto rows = bench::RunRenderBench(options);
     bench::WriteRenderCsv(rows, args->out);

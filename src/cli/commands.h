@@ -12,6 +12,8 @@ void AddBenchCommand(CLI::App& app);        // bench_command.cc
 void AddBlurCommand(CLI::App& app);         // blur_command.cc
 void AddRenderCommand(CLI::App& app);       // render_command.cc
 void AddAnimateCommand(CLI::App& app);      // animate_command.cc
+void AddExportCommand(CLI::App& app);       // record_commands.cc
+void AddMergeCommand(CLI::App& app);        // record_commands.cc
 void AddMakeStimuliCommand(CLI::App& app);  // make_stimuli_command.cc
 void AddValidateCommand(CLI::App& app);     // validate_command.cc
 

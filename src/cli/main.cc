@@ -14,7 +14,8 @@ int main(int argc, char** argv) {
   using namespace blurcue;
   CLI::App app{"blurcue " BLURCUE_VERSION
                " - blur as a depth cue: calibrate a scene's defocus blur, predict it anywhere, run studies.\n"
-               "Typical flow: synth-scene (or a photo + camera.json) -> calibrate -> estimate.\n"
+               "Typical flow: synth-scene (or a photo + camera.json) -> calibrate -> render / animate stimuli;\n"
+               "validate a study protocol; export and merge the SQLite records of sessions.\n"
                "Run 'blurcue COMMAND --help' for the options of one command."};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("blurcue ") + BLURCUE_VERSION);
@@ -24,12 +25,14 @@ int main(int argc, char** argv) {
       {"synth-scene", &cli::AddSynthSceneCommand},
       {"calibrate", &cli::AddCalibrateCommand},
       {"estimate", &cli::AddEstimateCommand},
+      {"make-stimuli", &cli::AddMakeStimuliCommand},
       {"blur", &cli::AddBlurCommand},
       {"render", &cli::AddRenderCommand},
       {"animate", &cli::AddAnimateCommand},
-      {"bench", &cli::AddBenchCommand},
-      {"make-stimuli", &cli::AddMakeStimuliCommand},
       {"validate", &cli::AddValidateCommand},
+      {"export", &cli::AddExportCommand},
+      {"merge", &cli::AddMergeCommand},
+      {"bench", &cli::AddBenchCommand},
   };
   for (const auto& [name, add] : commands) add(app);
 

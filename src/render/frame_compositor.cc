@@ -1,5 +1,7 @@
 #include "render/frame_compositor.h"
 
+#include <vector>
+
 #include <opencv2/imgproc.hpp>
 
 #include "render/blur.h"
@@ -15,6 +17,8 @@ struct FrameCompositor::Impl {
   FullscreenPass pass;
   Texture background, frame;
   Framebuffer background_fb, frame_fb;
+  // Where the last frame drew: only those rectangles need the photo back (the whole frame before the first).
+  std::vector<cv::Rect> dirty{cv::Rect(0, 0, width, height)};
 
   Impl(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec, const cv::Mat& photo)
       : width(camera.image_width_px),
@@ -29,11 +33,15 @@ struct FrameCompositor::Impl {
     // The photo's encoded bytes are copied as they are (both sRGB): no decode/encode round trip.
     glBindFramebuffer(GL_READ_FRAMEBUFFER, background_fb.id());
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, frame_fb.id());
-    glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    for (const cv::Rect& r : dirty)
+      glBlitFramebuffer(r.x, r.y, r.x + r.width, r.y + r.height, r.x, r.y, r.x + r.width, r.y + r.height,
+                        GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    dirty.clear();
   }
 
   // Blends a layer (linear, premultiplied) over the frame at roi.
   void Blend(const Texture& layer, const cv::Rect& roi) {
+    dirty.push_back(roi);
     frame_fb.Bind();
     glEnable(GL_FRAMEBUFFER_SRGB);
     glEnable(GL_BLEND);

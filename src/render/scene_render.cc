@@ -28,18 +28,15 @@ cv::Matx33d SpinAboutX(double deg) {
   return {1, 0, 0, 0, c, -s, 0, s, c};
 }
 
-// A UV sphere: longitude along u, latitude along v (v = 0 at the board's +z pole).
-std::vector<Vertex> SphereTriangles(const VirtualObject& o) {
+// The unit sphere as a UV sphere: longitude along u, latitude along v (v = 0 at the +z pole). Built once; each
+// object places it with its model matrix.
+std::vector<Vertex> UnitSphere() {
   const int n_lat = 48, n_lon = 96;
-  const cv::Matx33d spin = SpinAboutX(o.spin_deg);
   auto vertex = [&](int i, int j) {
     const double theta = M_PI * i / n_lat, phi = 2 * M_PI * j / n_lon;
-    const cv::Vec3d n = spin * cv::Vec3d(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
-                                         std::cos(theta));
-    const cv::Vec3d p = o.center_board_mm + o.size_mm * n;
-    return Vertex{{float(p[0]), float(p[1]), float(p[2])},
-                  {float(n[0]), float(n[1]), float(n[2])},
-                  {float(double(j) / n_lon), float(double(i) / n_lat)}};
+    const float x = float(std::sin(theta) * std::cos(phi)), y = float(std::sin(theta) * std::sin(phi)),
+                z = float(std::cos(theta));
+    return Vertex{{x, y, z}, {x, y, z}, {float(double(j) / n_lon), float(double(i) / n_lat)}};
   };
   std::vector<Vertex> tris;
   for (int i = 0; i < n_lat; ++i)
@@ -50,13 +47,23 @@ std::vector<Vertex> SphereTriangles(const VirtualObject& o) {
   return tris;
 }
 
-// A flat card on the table; texture row 0 (the image's top) on the far side (+y).
-std::vector<Vertex> CardTriangles(const VirtualObject& o) {
-  const float h = float(o.size_mm / 2), x = float(o.center_board_mm[0]), y = float(o.center_board_mm[1]),
-              z = float(o.center_board_mm[2]);
-  const Vertex a{{x - h, y + h, z}, {0, 0, 1}, {0, 0}}, b{{x + h, y + h, z}, {0, 0, 1}, {1, 0}},
-      c{{x + h, y - h, z}, {0, 0, 1}, {1, 1}}, d{{x - h, y - h, z}, {0, 0, 1}, {0, 1}};
+// The unit card (side 1, centred, in z = 0); texture row 0 (the image's top) on the far side (+y).
+std::vector<Vertex> UnitCard() {
+  const Vertex a{{-0.5f, 0.5f, 0}, {0, 0, 1}, {0, 0}}, b{{0.5f, 0.5f, 0}, {0, 0, 1}, {1, 0}},
+      c{{0.5f, -0.5f, 0}, {0, 0, 1}, {1, 1}}, d{{-0.5f, -0.5f, 0}, {0, 0, 1}, {0, 1}};
   return {a, b, c, a, c, d};
+}
+
+// Object -> board frame: translate to the centre, spin (balls roll about x), scale by the size.
+glm::mat4 ModelMatrix(const VirtualObject& o) {
+  const float scale = float(o.size_mm);
+  const cv::Matx33d spin = o.kind == VirtualObject::Kind::kBall ? SpinAboutX(o.spin_deg) : cv::Matx33d::eye();
+  glm::mat4 m(1.0f);
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) m[c][r] = float(spin(r, c)) * scale;
+    m[3][r] = float(o.center_board_mm[r]);
+  }
+  return m;
 }
 
 // The corners of the object's board-frame bounding box.
@@ -80,6 +87,7 @@ struct SceneRenderer::Impl {
   cv::Matx33d rotation;
   Program program = Program::FromFiles(ShaderDir() / "object.vert", ShaderDir() / "object.frag");
   GlName vao, vbo;
+  GLsizei sphere_vertices = 0, card_vertices = 0;
   // Textures by the address of their pixels: a moving ball re-uses its texture every frame.
   std::map<const uchar*, std::unique_ptr<Texture>> textures;
 
@@ -103,6 +111,13 @@ SceneRenderer::SceneRenderer(const Camera& camera, const cv::Vec3d& rvec, const 
   impl_->vbo = GlName(id, [](GLuint i) { glDeleteBuffers(1, &i); });
   glBindVertexArray(impl_->vao.id());
   glBindBuffer(GL_ARRAY_BUFFER, impl_->vbo.id());
+  // Both unit meshes in one buffer, uploaded once: a frame only sets matrices.
+  std::vector<Vertex> mesh = UnitSphere();
+  impl_->sphere_vertices = GLsizei(mesh.size());
+  const std::vector<Vertex> card = UnitCard();
+  impl_->card_vertices = GLsizei(card.size());
+  mesh.insert(mesh.end(), card.begin(), card.end());
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(mesh.size() * sizeof(Vertex)), mesh.data(), GL_STATIC_DRAW);
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, position)));
   glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, normal)));
   glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, uv)));
@@ -136,7 +151,7 @@ Footprint SceneRenderer::Measure(const VirtualObject& o) const {
 }
 
 Layer SceneRenderer::Draw(const VirtualObject& o, int margin_px) {
-  GpuLayer gpu = DrawToTexture(o, margin_px);
+  GpuLayer gpu = DrawToTexture(o, margin_px, /*depth_map=*/true);
   Layer layer;
   layer.roi = gpu.roi;
   if (!gpu.texture) {
@@ -154,7 +169,7 @@ Layer SceneRenderer::Draw(const VirtualObject& o, int margin_px) {
   return layer;
 }
 
-GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px) {
+GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px, bool depth_map) {
   const Camera& cam = impl_->camera;
   const Footprint f = Measure(o);
   GpuLayer layer;
@@ -180,14 +195,14 @@ GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px) {
     pose[3][r] = float(impl_->tvec[r]);
   }
 
-  const std::vector<Vertex> tris = o.kind == VirtualObject::Kind::kBall ? SphereTriangles(o) : CardTriangles(o);
   layer.texture = std::make_unique<Texture>(w, h);
-  layer.depth = std::make_unique<Texture>(w, h);
-  // Drawn multisampled and resolved, so silhouettes carry their pixel coverage like a camera's edges do (an aliased
+  if (depth_map) layer.depth = std::make_unique<Texture>(w, h);
+  // Drawn multisampled (4x) and resolved, so silhouettes carry their pixel coverage like a camera's edges do (an aliased
   // silhouette is sharper than any optics and reads ~0.3 px too sharp under the calibration's measurement).
   GLint max_samples = 1;
   glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
-  const GLsizei samples = std::min<GLint>(8, max_samples);
+  // 4 samples: coverage in quarters is plenty under any blur, and llvmpipe pays per sample.
+  const GLsizei samples = std::min<GLint>(4, max_samples);
   auto renderbuffer = [&](GLenum format) {
     GLuint id = 0;
     glGenRenderbuffers(1, &id);
@@ -195,17 +210,17 @@ GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px) {
     glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, format, w, h);
     return GlName(id, [](GLuint i) { glDeleteRenderbuffers(1, &i); });
   };
-  GlName ms_color = renderbuffer(GL_RGBA32F), ms_depth_value = renderbuffer(GL_RGBA32F),
-         ms_depth = renderbuffer(GL_DEPTH_COMPONENT24);
+  GlName ms_color = renderbuffer(GL_RGBA32F), ms_depth = renderbuffer(GL_DEPTH_COMPONENT24);
+  GlName ms_depth_value = depth_map ? renderbuffer(GL_RGBA32F) : GlName();
   GLuint ms_id = 0;
   glGenFramebuffers(1, &ms_id);
   GlName ms_fb(ms_id, [](GLuint i) { glDeleteFramebuffers(1, &i); });
   glBindFramebuffer(GL_FRAMEBUFFER, ms_id);
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, ms_color.id());
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_RENDERBUFFER, ms_depth_value.id());
+  if (depth_map) glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_RENDERBUFFER, ms_depth_value.id());
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, ms_depth.id());
   const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-  glDrawBuffers(2, buffers);
+  glDrawBuffers(depth_map ? 2 : 1, buffers);
   if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
     throw Error(ErrorKind::kInternal, "GL: multisample framebuffer incomplete");
   glViewport(0, 0, w, h);
@@ -227,15 +242,17 @@ GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px) {
   glUniform1f(p.Uniform("u_contrast"), float(o.contrast));
   glUniform1i(p.Uniform("u_texture"), 0);
   impl_->TextureFor(o.texture).Bind(0);
+  glUniformMatrix4fv(p.Uniform("u_model"), 1, GL_FALSE, glm::value_ptr(ModelMatrix(o)));
   glBindVertexArray(impl_->vao.id());
-  glBindBuffer(GL_ARRAY_BUFFER, impl_->vbo.id());
-  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(tris.size() * sizeof(Vertex)), tris.data(), GL_STREAM_DRAW);
-  glDrawArrays(GL_TRIANGLES, 0, GLsizei(tris.size()));
+  if (o.kind == VirtualObject::Kind::kBall)
+    glDrawArrays(GL_TRIANGLES, 0, impl_->sphere_vertices);
+  else
+    glDrawArrays(GL_TRIANGLES, impl_->sphere_vertices, impl_->card_vertices);
   glBindVertexArray(0);
   glDisable(GL_DEPTH_TEST);
   // Resolve: averaging the samples gives premultiplied colour x coverage, and depth x coverage in .r with the
   // coverage in .a (the depth target writes alpha 1), so depth = r / a.
-  for (int i = 0; i < 2; ++i) {
+  for (int i = 0; i < (depth_map ? 2 : 1); ++i) {
     Framebuffer resolved(i == 0 ? *layer.texture : *layer.depth);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, ms_id);
     glReadBuffer(GL_COLOR_ATTACHMENT0 + i);

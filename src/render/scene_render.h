@@ -55,8 +55,9 @@ class SceneRenderer {
   Footprint Measure(const VirtualObject& object) const;
   // Draws the object into a layer covering its bounds grown by margin_px, clipped to the image.
   Layer Draw(const VirtualObject& object, int margin_px);
-  // The same, left on the GPU for frame composition.
-  GpuLayer DrawToTexture(const VirtualObject& object, int margin_px);
+  // The same, left on the GPU for frame composition; the per-pixel depth texture only when `depth_map` (the
+  // depth-varying blur needs it; a frame of single-radius objects does not pay for it).
+  GpuLayer DrawToTexture(const VirtualObject& object, int margin_px, bool depth_map = false);
 
  private:
   struct Impl;

@@ -120,7 +120,7 @@ TEST_F(SceneRenderTest, BlurringTheLayerKeepsTheObjectsLight) {
 
 TEST(Composite, OverIsPremultipliedAndLinear) {
   cv::Mat background(4, 4, CV_32FC3, cv::Scalar(0.5, 0.5, 0.5));
-  Layer layer{cv::Rect(1, 1, 2, 2), cv::Mat(2, 2, CV_32FC4, cv::Scalar(0.2, 0.2, 0.2, 0.25))};
+  Layer layer{cv::Rect(1, 1, 2, 2), cv::Mat(2, 2, CV_32FC4, cv::Scalar(0.2, 0.2, 0.2, 0.25)), cv::Mat()};
   CompositeOver(background, layer);
   EXPECT_FLOAT_EQ(background.at<cv::Vec3f>(1, 1)[0], 0.2f + 0.75f * 0.5f);
   EXPECT_FLOAT_EQ(background.at<cv::Vec3f>(0, 0)[0], 0.5f);
