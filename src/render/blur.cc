@@ -199,19 +199,11 @@ void GlBlur::BlurTexture(Texture& texture, const std::string& method, double r_p
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
-cv::Mat GlBlur::Gaussian(const cv::Mat& rgba, double r_px) {
+cv::Mat GlBlur::BlurImage(const cv::Mat& rgba, const std::string& method, double r_px) {
   CV_Assert(rgba.type() == CV_32FC4);
   Texture texture(rgba.cols, rgba.rows);
   texture.Upload(rgba);
-  BlurTexture(texture, "gaussian", r_px);
-  return texture.Download();
-}
-
-cv::Mat GlBlur::Disc(const cv::Mat& rgba, double r_px) {
-  CV_Assert(rgba.type() == CV_32FC4);
-  Texture texture(rgba.cols, rgba.rows);
-  texture.Upload(rgba);
-  BlurTexture(texture, "disc", r_px);
+  BlurTexture(texture, method, r_px);
   return texture.Download();
 }
 

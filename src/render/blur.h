@@ -52,10 +52,12 @@ class GlBlur {
   ~GlBlur();
   GlBlur(const GlBlur&) = delete;
   GlBlur& operator=(const GlBlur&) = delete;
-  // Two passes (horizontal, vertical) of the Gaussian of r = 2 s; CV_32FC4 in and out.
-  cv::Mat Gaussian(const cv::Mat& rgba, double r_px);
+  // CV_32FC4 in and out through a texture: BlurTexture on a copy.
+  cv::Mat BlurImage(const cv::Mat& rgba, const std::string& method, double r_px);
+  // Two passes (horizontal, vertical) of the Gaussian of r = 2 s.
+  cv::Mat Gaussian(const cv::Mat& rgba, double r_px) { return BlurImage(rgba, "gaussian", r_px); }
   // One pass of the pillbox of radius r.
-  cv::Mat Disc(const cv::Mat& rgba, double r_px);
+  cv::Mat Disc(const cv::Mat& rgba, double r_px) { return BlurImage(rgba, "disc", r_px); }
   // On the GPU, texture in and out (RGBA32F, same size): "gaussian" or "disc"; r <= 0 leaves it unchanged.
   void BlurTexture(Texture& texture, const std::string& method, double r_px);
 
