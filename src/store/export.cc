@@ -176,58 +176,24 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
         std::map<int64_t, int64_t> study_ids, protocol_ids, participant_ids, session_ids, trial_ids;
 
         Statement studies(src, "SELECT id, name, created FROM studies");
-        Statement insert_study(dst, "INSERT INTO studies (name, created) VALUES (?, ?) ON CONFLICT (name) DO NOTHING");
-        Statement find_study(dst, "SELECT id FROM studies WHERE name = ?");
-        while (studies.Step()) {
-          insert_study.Bind(1, studies.GetText(1));
-          insert_study.Bind(2, studies.GetText(2));
-          insert_study.Run();
-          insert_study.Reset();
-          find_study.Bind(1, studies.GetText(1));
-          find_study.Step();
-          study_ids[studies.GetInt64(0)] = find_study.GetInt64(0);
-          find_study.Reset();
-        }
+        while (studies.Step())
+          study_ids[studies.GetInt64(0)] = EnsureStudy(dst, studies.GetText(1), studies.GetText(2));
 
         Statement protocols(src, "SELECT id, study_id, json, hash, created FROM protocol_versions");
-        Statement insert_protocol(dst, "INSERT INTO protocol_versions (study_id, json, hash, created) "
-                                       "VALUES (?, ?, ?, ?) ON CONFLICT (study_id, hash) DO NOTHING");
-        Statement find_protocol(dst, "SELECT id, json FROM protocol_versions WHERE study_id = ? AND hash = ?");
         while (protocols.Step()) {
-          const int64_t study = study_ids.at(protocols.GetInt64(1));
-          insert_protocol.Bind(1, study);
-          insert_protocol.Bind(2, protocols.GetText(2));
-          insert_protocol.Bind(3, protocols.GetText(3));
-          insert_protocol.Bind(4, protocols.GetText(4));
-          insert_protocol.Run();
-          insert_protocol.Reset();
-          find_protocol.Bind(1, study);
-          find_protocol.Bind(2, protocols.GetText(3));
-          find_protocol.Step();
-          if (find_protocol.GetText(1) != protocols.GetText(2))
+          std::string stored_json;
+          protocol_ids[protocols.GetInt64(0)] =
+              EnsureProtocolVersion(dst, study_ids.at(protocols.GetInt64(1)), protocols.GetText(2),
+                                    protocols.GetText(3), protocols.GetText(4), &stored_json);
+          if (stored_json != protocols.GetText(2))
             throw InputError(input.string(), "protocol hash " + protocols.GetText(3) +
                                                  " names a different protocol text in another input");
-          protocol_ids[protocols.GetInt64(0)] = find_protocol.GetInt64(0);
-          find_protocol.Reset();
         }
 
         Statement participants(src, "SELECT id, study_id, code, created FROM participants");
-        Statement insert_participant(dst, "INSERT INTO participants (study_id, code, created) VALUES (?, ?, ?) "
-                                          "ON CONFLICT (study_id, code) DO NOTHING");
-        Statement find_participant(dst, "SELECT id FROM participants WHERE study_id = ? AND code = ?");
-        while (participants.Step()) {
-          const int64_t study = study_ids.at(participants.GetInt64(1));
-          insert_participant.Bind(1, study);
-          insert_participant.Bind(2, participants.GetText(2));
-          insert_participant.Bind(3, participants.GetText(3));
-          insert_participant.Run();
-          insert_participant.Reset();
-          find_participant.Bind(1, study);
-          find_participant.Bind(2, participants.GetText(2));
-          find_participant.Step();
-          participant_ids[participants.GetInt64(0)] = find_participant.GetInt64(0);
-          find_participant.Reset();
-        }
+        while (participants.Step())
+          participant_ids[participants.GetInt64(0)] = EnsureParticipant(
+              dst, study_ids.at(participants.GetInt64(1)), participants.GetText(2), participants.GetText(3));
 
         Statement sessions(src, "SELECT id, participant_id, protocol_version_id, seed, software_version, host, "
                                 "display, started, ended, status FROM sessions");

@@ -163,26 +163,8 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
   const std::string hash = Fnv1a64Hex(protocol_json);
   Transaction transaction(db_);
 
-  Statement insert_study(db_, "INSERT INTO studies (name, created) VALUES (?, ?) ON CONFLICT (name) DO NOTHING");
-  insert_study.Bind(1, study);
-  insert_study.Bind(2, now);
-  insert_study.Run();
-  Statement find_study(db_, "SELECT id FROM studies WHERE name = ?");
-  find_study.Bind(1, study);
-  find_study.Step();
-  const int64_t study_id = find_study.GetInt64(0);
-
-  Statement insert_participant(db_, "INSERT INTO participants (study_id, code, created) VALUES (?, ?, ?) "
-                                    "ON CONFLICT (study_id, code) DO NOTHING");
-  insert_participant.Bind(1, study_id);
-  insert_participant.Bind(2, participant);
-  insert_participant.Bind(3, now);
-  insert_participant.Run();
-  Statement find_participant(db_, "SELECT id FROM participants WHERE study_id = ? AND code = ?");
-  find_participant.Bind(1, study_id);
-  find_participant.Bind(2, participant);
-  find_participant.Step();
-  const int64_t participant_id = find_participant.GetInt64(0);
+  const int64_t study_id = EnsureStudy(db_, study, now);
+  const int64_t participant_id = EnsureParticipant(db_, study_id, participant, now);
 
   Statement running(db_, "SELECT s.id, s.seed, p.hash FROM sessions s JOIN protocol_versions p "
                          "ON p.id = s.protocol_version_id WHERE s.participant_id = ? AND s.status = 'running' "
@@ -206,20 +188,10 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     start.session_id = session;
     start.resumed = true;
   } else {
-    Statement insert_protocol(db_, "INSERT INTO protocol_versions (study_id, json, hash, created) "
-                                   "VALUES (?, ?, ?, ?) ON CONFLICT (study_id, hash) DO NOTHING");
-    insert_protocol.Bind(1, study_id);
-    insert_protocol.Bind(2, protocol_json);
-    insert_protocol.Bind(3, hash);
-    insert_protocol.Bind(4, now);
-    insert_protocol.Run();
-    Statement find_protocol(db_, "SELECT id, json FROM protocol_versions WHERE study_id = ? AND hash = ?");
-    find_protocol.Bind(1, study_id);
-    find_protocol.Bind(2, hash);
-    find_protocol.Step();
-    if (find_protocol.GetText(1) != protocol_json)  // a 64-bit hash collision: refuse rather than mix texts
+    std::string stored_json;
+    const int64_t protocol_id = EnsureProtocolVersion(db_, study_id, protocol_json, hash, now, &stored_json);
+    if (stored_json != protocol_json)  // a 64-bit hash collision: refuse rather than mix texts
       throw Error(ErrorKind::kInternal, "protocol hash " + hash + " collides with another protocol text");
-    const int64_t protocol_id = find_protocol.GetInt64(0);
 
     Statement insert(db_, "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, "
                           "host, display, started, status, lock_host, lock_pid, lock_token, lock_heartbeat_ms) "

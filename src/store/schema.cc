@@ -106,4 +106,46 @@ void RequireCurrentSchema(Database& db) {
                                     (version == 0 ? " (an empty or foreign database)" : ""));
 }
 
+int64_t EnsureStudy(Database& db, const std::string& name, const std::string& created) {
+  Statement insert(db, "INSERT INTO studies (name, created) VALUES (?, ?) ON CONFLICT (name) DO NOTHING");
+  insert.Bind(1, name);
+  insert.Bind(2, created);
+  insert.Run();
+  Statement find(db, "SELECT id FROM studies WHERE name = ?");
+  find.Bind(1, name);
+  find.Step();
+  return find.GetInt64(0);
+}
+
+int64_t EnsureParticipant(Database& db, int64_t study_id, const std::string& code, const std::string& created) {
+  Statement insert(db, "INSERT INTO participants (study_id, code, created) VALUES (?, ?, ?) "
+                       "ON CONFLICT (study_id, code) DO NOTHING");
+  insert.Bind(1, study_id);
+  insert.Bind(2, code);
+  insert.Bind(3, created);
+  insert.Run();
+  Statement find(db, "SELECT id FROM participants WHERE study_id = ? AND code = ?");
+  find.Bind(1, study_id);
+  find.Bind(2, code);
+  find.Step();
+  return find.GetInt64(0);
+}
+
+int64_t EnsureProtocolVersion(Database& db, int64_t study_id, const std::string& json, const std::string& hash,
+                              const std::string& created, std::string* stored_json) {
+  Statement insert(db, "INSERT INTO protocol_versions (study_id, json, hash, created) VALUES (?, ?, ?, ?) "
+                       "ON CONFLICT (study_id, hash) DO NOTHING");
+  insert.Bind(1, study_id);
+  insert.Bind(2, json);
+  insert.Bind(3, hash);
+  insert.Bind(4, created);
+  insert.Run();
+  Statement find(db, "SELECT id, json FROM protocol_versions WHERE study_id = ? AND hash = ?");
+  find.Bind(1, study_id);
+  find.Bind(2, hash);
+  find.Step();
+  if (stored_json) *stored_json = find.GetText(1);
+  return find.GetInt64(0);
+}
+
 }  // namespace blurcue::store
