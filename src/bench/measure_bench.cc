@@ -89,29 +89,14 @@ MeasureRow Summarize(const std::string& method, const Condition& cond, const cal
   row.level = cond.level;
   row.sections = int(cmp.sections.size());
   row.time_us_per_section = time_us;
-  std::vector<double> abs_err;
-  double sum_signed = 0;
-  int within = 0;
-  for (const auto& s : cmp.sections) {
-    const calib::MethodError& e = s.*member;
-    if (!e.answered) continue;
-    abs_err.push_back(std::abs(e.error_px));
-    sum_signed += e.error_px;
-    within += std::abs(e.error_px) <= calib::MeasureTolerancePx(s.true_r_px);
-  }
-  row.answered = int(abs_err.size());
-  if (!abs_err.empty()) {
-    std::sort(abs_err.begin(), abs_err.end());
-    const size_t n = abs_err.size();
-    double sum = 0;
-    for (double v : abs_err) sum += v;
-    row.mean_abs_error_px = sum / n;
-    row.median_abs_error_px = abs_err[n / 2];
-    row.p90_abs_error_px = abs_err[std::min(n - 1, size_t(0.9 * n))];
-    row.max_abs_error_px = abs_err.back();
-    row.bias_px = sum_signed / n;
-    row.within_target = double(within) / n;
-  }
+  const calib::MethodSummary m = calib::SummarizeMethod(cmp, member);
+  row.answered = m.answered;
+  row.mean_abs_error_px = m.mean_abs_error_px;
+  row.median_abs_error_px = m.median_abs_error_px;
+  row.p90_abs_error_px = m.p90_abs_error_px;
+  row.max_abs_error_px = m.max_abs_error_px;
+  row.bias_px = m.bias_px;
+  row.within_target = m.answered ? double(m.within_target) / m.answered : 0;
   row.meets_target = row.answered * 2 >= row.sections && row.within_target >= 0.9;
   return row;
 }

@@ -75,7 +75,9 @@ TEST(Calibrate, ElevenEdgesOfSevenSectionsNearestFirst) {
   ASSERT_EQ(r.result.edges.size(), 11u);
   for (size_t e = 0; e < 11; ++e) {
     EXPECT_EQ(r.result.edges[e].sections.size(), 7u);
-    if (e > 0) EXPECT_GT(r.result.edges[e].u_mm, r.result.edges[e - 1].u_mm);
+    if (e > 0) {
+      EXPECT_GT(r.result.edges[e].u_mm, r.result.edges[e - 1].u_mm);
+    }
   }
   // Focus is on edge 1 (the thesis set-up), so edge 1 is nearly sharp and blur grows with depth.
   EXPECT_NEAR(r.result.edges[0].u_mm, 342.3, 1.0);

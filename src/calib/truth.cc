@@ -1,5 +1,6 @@
 #include "calib/truth.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -57,6 +58,32 @@ TruthComparison CompareToTruth(const CalibResult& result, const Json& truth, con
     c.true_r_per_edge.push_back(sum / edge.sections.size());
   }
   return c;
+}
+
+MethodSummary SummarizeMethod(const TruthComparison& comparison, MethodError SectionComparison::*method) {
+  MethodSummary m;
+  m.sections = int(comparison.sections.size());
+  std::vector<double> abs_err;
+  double sum_signed = 0;
+  for (const auto& s : comparison.sections) {
+    const MethodError& e = s.*method;
+    if (!e.answered) continue;
+    abs_err.push_back(std::abs(e.error_px));
+    sum_signed += e.error_px;
+    m.within_target += std::abs(e.error_px) <= MeasureTolerancePx(s.true_r_px);
+  }
+  m.answered = int(abs_err.size());
+  if (abs_err.empty()) return m;
+  std::sort(abs_err.begin(), abs_err.end());
+  const size_t n = abs_err.size();
+  double sum = 0;
+  for (double v : abs_err) sum += v;
+  m.mean_abs_error_px = sum / n;
+  m.median_abs_error_px = abs_err[n / 2];
+  m.p90_abs_error_px = abs_err[std::min(n - 1, size_t(0.9 * n))];
+  m.max_abs_error_px = abs_err.back();
+  m.bias_px = sum_signed / n;
+  return m;
 }
 
 }  // namespace blurcue::calib

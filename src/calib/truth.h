@@ -35,4 +35,12 @@ TruthComparison CompareToTruth(const CalibResult& result, const Json& truth, con
 // Tolerance of the model fit (issue target): max(0.25 px, 5 %) of the true radius.
 inline double MeasureTolerancePx(double true_r_px) { return true_r_px * 0.05 > 0.25 ? true_r_px * 0.05 : 0.25; }
 
+// One method's errors over all sections (answered ones only; zeros when none answered).
+struct MethodSummary {
+  int sections = 0, answered = 0, within_target = 0;  // within MeasureTolerancePx
+  double mean_abs_error_px = 0, median_abs_error_px = 0, p90_abs_error_px = 0, max_abs_error_px = 0;
+  double bias_px = 0;  // mean signed error
+};
+MethodSummary SummarizeMethod(const TruthComparison& comparison, MethodError SectionComparison::*method);
+
 }  // namespace blurcue::calib

@@ -83,19 +83,10 @@ void AddCalibrateCommand(CLI::App& app) {
       true_r = cmp.true_r_per_edge;
       std::printf("against truth: pose %.3f mm / %.3f deg, section depths within %.3f mm\n",
                   cmp.translation_error_mm, cmp.rotation_error_deg, cmp.max_depth_error_mm);
-      auto summary = [&](const char* name, calib::MethodError calib::SectionComparison::*m) {
-        int answered = 0, within = 0;
-        double sum_abs = 0, worst = 0;
-        for (const auto& row : cmp.sections) {
-          const calib::MethodError& e = row.*m;
-          if (!e.answered) continue;
-          ++answered;
-          sum_abs += std::abs(e.error_px);
-          worst = std::max(worst, std::abs(e.error_px));
-          within += std::abs(e.error_px) <= calib::MeasureTolerancePx(row.true_r_px);
-        }
-        std::printf("  %-22s answered %2d/%zu, mean |error| %.3f px, worst %.3f px, within max(0.25 px, 5%%): %d\n",
-                    name, answered, cmp.sections.size(), answered ? sum_abs / answered : 0.0, worst, within);
+      auto summary = [&](const char* name, calib::MethodError calib::SectionComparison::*method) {
+        const calib::MethodSummary m = calib::SummarizeMethod(cmp, method);
+        std::printf("  %-22s answered %2d/%d, mean |error| %.3f px, worst %.3f px, within max(0.25 px, 5%%): %d\n",
+                    name, m.answered, m.sections, m.mean_abs_error_px, m.max_abs_error_px, m.within_target);
       };
       summary("model fit (r_px)", &calib::SectionComparison::model);
       summary("thesis (r_thesis_px)", &calib::SectionComparison::thesis);
