@@ -31,6 +31,13 @@ cv::Vec3d SceneCalib::ToCamera(const cv::Vec3d& board_mm) const {
   return rot * board_mm + tvec;
 }
 
+void SceneCalib::RequireSameSize(const cv::Mat& photo, const std::string& photo_path) const {
+  if (photo.cols != camera.image_width_px || photo.rows != camera.image_height_px)
+    throw InputError(photo_path, "is " + std::to_string(photo.cols) + "x" + std::to_string(photo.rows) +
+                                     " but the scene was calibrated on " + std::to_string(camera.image_width_px) +
+                                     "x" + std::to_string(camera.image_height_px));
+}
+
 SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
   if (j.value("format", "") != "blurcue-calib")
     throw InputError(where + "/format", "must be \"blurcue-calib\" (a file written by blurcue calibrate)");

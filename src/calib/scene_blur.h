@@ -32,6 +32,8 @@ struct SceneCalib {
 
   // Board-frame point (mm) -> camera frame (mm).
   cv::Vec3d ToCamera(const cv::Vec3d& board_mm) const;
+  // Throws Error(kInput) naming `photo_path` unless the photo has the calibrated camera's size.
+  void RequireSameSize(const cv::Mat& photo, const std::string& photo_path) const;
 };
 
 // Reads calib.json as written by `blurcue calibrate`; errors name the file and the JSON pointer.

@@ -65,8 +65,7 @@ void AddAnimateCommand(CLI::App& app) {
   cmd->callback([args] {
     const calib::SceneCalib scene = calib::LoadSceneCalib(args->calib);
     const cv::Mat photo = ReadImage(args->background, 1);
-    if (photo.cols != scene.camera.image_width_px || photo.rows != scene.camera.image_height_px)
-      throw InputError(args->background, "is not the size " + args->calib + " was calibrated on");
+    scene.RequireSameSize(photo, args->background);
     const int edges = scene.board.EdgeCount(), sections = scene.board.SectionCount();
     auto check = [](const char* name, int v, int lo, int hi) {
       if (v < lo || v > hi)

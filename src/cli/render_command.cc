@@ -84,11 +84,7 @@ void AddRenderCommand(CLI::App& app) {
     if (args->calib.empty()) throw Error(ErrorKind::kUsage, "--calib is required for a grid or a ball");
     const calib::SceneCalib scene = calib::LoadSceneCalib(args->calib);
     const cv::Mat photo = ReadImage(args->background, 1 /* colour */);
-    if (photo.cols != scene.camera.image_width_px || photo.rows != scene.camera.image_height_px)
-      throw InputError(args->background, "is " + std::to_string(photo.cols) + "x" + std::to_string(photo.rows) +
-                                             " but " + args->calib + " was calibrated on " +
-                                             std::to_string(scene.camera.image_width_px) + "x" +
-                                             std::to_string(scene.camera.image_height_px));
+    scene.RequireSameSize(photo, args->background);
     if (args->edge < 1 || args->edge > scene.board.EdgeCount())
       throw Error(ErrorKind::kUsage, "--at-edge must be 1.." + std::to_string(scene.board.EdgeCount()) + ", got " +
                                          std::to_string(args->edge));

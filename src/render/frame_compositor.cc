@@ -1,5 +1,6 @@
 #include "render/frame_compositor.h"
 
+#include <algorithm>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -39,6 +40,19 @@ struct FrameCompositor::Impl {
     dirty.clear();
   }
 
+  // Per object: draw its layer, blur it, blend it. The region approach grows the layer by the kernel's margin;
+  // the thesis's approach by the whole frame (a full-frame buffer, blurred whole).
+  void Compose(const std::vector<BlurredObject>& objects, bool whole_frame) {
+    StartFrame();
+    for (const BlurredObject& o : objects) {
+      const int margin = whole_frame ? std::max(width, height) : KernelMarginPx(o.method, o.r_px) + 1;
+      GpuLayer layer = renderer.DrawToTexture(o.object, margin);
+      if (!layer.texture) continue;
+      blur.BlurTexture(*layer.texture, o.method, o.r_px);
+      Blend(*layer.texture, layer.roi);
+    }
+  }
+
   // Blends a layer (linear, premultiplied) over the frame at roi.
   void Blend(const Texture& layer, const cv::Rect& roi) {
     dirty.push_back(roi);
@@ -70,26 +84,9 @@ FrameCompositor::~FrameCompositor() = default;
 
 SceneRenderer& FrameCompositor::renderer() { return impl_->renderer; }
 
-void FrameCompositor::Compose(const std::vector<BlurredObject>& objects) {
-  impl_->StartFrame();
-  for (const BlurredObject& o : objects) {
-    GpuLayer layer = impl_->renderer.DrawToTexture(o.object, KernelMarginPx(o.method, o.r_px) + 1);
-    if (!layer.texture) continue;
-    impl_->blur.BlurTexture(*layer.texture, o.method, o.r_px);
-    impl_->Blend(*layer.texture, layer.roi);
-  }
-}
+void FrameCompositor::Compose(const std::vector<BlurredObject>& objects) { impl_->Compose(objects, false); }
 
-void FrameCompositor::ComposeWholeFrame(const std::vector<BlurredObject>& objects) {
-  impl_->StartFrame();
-  for (const BlurredObject& o : objects) {
-    // The object drawn with a margin as large as the whole frame: a full-frame buffer, blurred whole.
-    GpuLayer layer = impl_->renderer.DrawToTexture(o.object, std::max(impl_->width, impl_->height));
-    if (!layer.texture) continue;
-    impl_->blur.BlurTexture(*layer.texture, o.method, o.r_px);
-    impl_->Blend(*layer.texture, layer.roi);
-  }
-}
+void FrameCompositor::ComposeWholeFrame(const std::vector<BlurredObject>& objects) { impl_->Compose(objects, true); }
 
 void FrameCompositor::Finish() { glFinish(); }
 
