@@ -15,7 +15,7 @@ int main(int argc, char** argv) {
   CLI::App app{"blurcue " BLURCUE_VERSION
                " - blur as a depth cue: calibrate a scene's defocus blur, predict it anywhere, run studies.\n"
                "Typical flow: synth-scene (or a photo + camera.json) -> calibrate -> render / animate stimuli;\n"
-               "validate a study protocol; export and merge the SQLite records of sessions.\n"
+               "validate and preview a study protocol -> run sessions -> export, merge and report the records.\n"
                "Run 'blurcue COMMAND --help' for the options of one command."};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("blurcue ") + BLURCUE_VERSION);
@@ -30,6 +30,8 @@ int main(int argc, char** argv) {
       {"render", &cli::AddRenderCommand},
       {"animate", &cli::AddAnimateCommand},
       {"validate", &cli::AddValidateCommand},
+      {"preview", &cli::AddPreviewCommand},
+      {"run", &cli::AddRunCommand},
       {"export", &cli::AddExportCommand},
       {"merge", &cli::AddMergeCommand},
       {"bench", &cli::AddBenchCommand},

@@ -69,13 +69,8 @@ void AddRenderCommand(CLI::App& app) {
       const cv::Mat photo = ReadImage(args->background, 1);
       const int w = args->display_width > 0 ? args->display_width : 960, h = w * 3 / 4, half = h / 2;
       const int picture_h = args->picture_height > 0 ? args->picture_height : half * 6 / 10;
-      cv::Mat frame(h, w, CV_8UC3);
-      render::PictureOnGrey(picture, cv::Size(w, half), picture_h, args->cutoff).copyTo(frame.rowRange(0, half));
-      // The scene photo fills the lower half, cropped to its aspect.
-      const double scale = std::max(double(w) / photo.cols, double(h - half) / photo.rows);
-      cv::Mat scaled;
-      cv::resize(photo, scaled, cv::Size(), scale, scale, cv::INTER_AREA);
-      scaled(cv::Rect((scaled.cols - w) / 2, (scaled.rows - (h - half)) / 2, w, h - half)).copyTo(frame.rowRange(half, h));
+      const cv::Mat frame = render::DepthMatchingFrame(
+          render::PictureOnGrey(picture, cv::Size(w, half), picture_h, args->cutoff), photo, w);
       WriteImage(args->out, frame);
       std::printf("picture %s, cut-off %g cycles per picture width, %d px high on a %dx%d frame -> %s\n", name.c_str(),
                   args->cutoff, picture_h, w, h, args->out.c_str());

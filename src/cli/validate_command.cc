@@ -1,6 +1,7 @@
 // blurcue validate: check a protocol file and build its trial list, the way a session would.
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "cli/commands.h"
@@ -13,7 +14,7 @@ namespace blurcue::cli {
 void AddValidateCommand(CLI::App& app) {
   struct Args {
     std::string file, participant = "P1";
-    uint64_t seed = 1;
+    std::optional<uint64_t> seed;
     bool no_files = false, list = false;
   };
   auto args = std::make_shared<Args>();
@@ -28,7 +29,8 @@ void AddValidateCommand(CLI::App& app) {
   cmd->add_flag("--no-files", args->no_files, "skip the checks that referenced files (scene, calib, images) exist");
   cmd->add_option("--participant", args->participant, "participant id (its trailing number decides by_participant "
                                                       "counterbalancing)")->capture_default_str();
-  cmd->add_option("--seed", args->seed, "seed of the trial order")->capture_default_str();
+  cmd->add_option("--seed", args->seed, "seed of the trial order (default: the one blurcue run gives the participant, "
+                                        "derived from the study name and the participant id)");
   cmd->add_flag("--list", args->list, "print the trial list as JSON, one trial per line");
   cmd->callback([args] {
     protocol::ValidateOptions options;
@@ -42,11 +44,12 @@ void AddValidateCommand(CLI::App& app) {
       throw Error(e.kind(), message + "\n(scripts/demo.sh writes the demo scene the shipped protocols use; --no-files "
                                       "skips the file checks)");
     }
-    const auto trials = protocol::BuildTrials(p, args->participant, args->seed);
+    const uint64_t seed = args->seed ? *args->seed : protocol::DefaultSeed(p.name, args->participant);
+    const auto trials = protocol::BuildTrials(p, args->participant, seed);
     if (args->list)
       for (const auto& t : trials) std::cout << protocol::ToJson(t).dump() << "\n";
     std::cout << "ok: " << trials.size() << " trials for participant " << args->participant << " with seed "
-              << args->seed << " (hash " << protocol::HashHex(protocol::TrialsHash(trials)) << ")\n";
+              << seed << " (hash " << protocol::HashHex(protocol::TrialsHash(trials)) << ")\n";
     std::string counts;
     int practice = 0;
     for (const auto& t : trials) practice += t.practice ? 1 : 0;

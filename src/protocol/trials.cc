@@ -141,13 +141,19 @@ Json ToJson(const std::vector<Trial>& trials) {
   return j;
 }
 
-uint64_t TrialsHash(const std::vector<Trial>& trials) {
+uint64_t Fnv1a64(const std::string& text) {
   uint64_t h = 14695981039346656037ull;
-  for (unsigned char c : ToJson(trials).dump()) {
+  for (unsigned char c : text) {
     h ^= c;
     h *= 1099511628211ull;
   }
   return h;
+}
+
+uint64_t TrialsHash(const std::vector<Trial>& trials) { return Fnv1a64(ToJson(trials).dump()); }
+
+uint64_t DefaultSeed(const std::string& study, const std::string& participant) {
+  return Fnv1a64(study + "/" + participant);
 }
 
 std::string HashHex(uint64_t hash) {

@@ -112,6 +112,19 @@ cv::Mat PictureOnGrey(const cv::Mat& picture, cv::Size field, int height_px, dou
   return EncodeSrgb8(out);
 }
 
+cv::Mat DepthMatchingFrame(const cv::Mat& upper, const cv::Mat& photo, int width_px) {
+  const int h = width_px * 3 / 4, half = h / 2;
+  CV_Assert(upper.cols == width_px && upper.rows == half && upper.type() == CV_8UC3);
+  cv::Mat frame(h, width_px, CV_8UC3);
+  upper.copyTo(frame.rowRange(0, half));
+  const double scale = std::max(double(width_px) / photo.cols, double(h - half) / photo.rows);
+  cv::Mat scaled;
+  cv::resize(photo, scaled, cv::Size(), scale, scale, cv::INTER_AREA);
+  scaled(cv::Rect((scaled.cols - width_px) / 2, (scaled.rows - (h - half)) / 2, width_px, h - half))
+      .copyTo(frame.rowRange(half, h));
+  return frame;
+}
+
 cv::Mat ToLinearPremultiplied(const cv::Mat& image8) {
   cv::Mat bgra;
   if (image8.channels() == 1) cv::cvtColor(image8, bgra, cv::COLOR_GRAY2BGRA);

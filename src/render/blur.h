@@ -36,6 +36,11 @@ cv::Mat ButterworthBlurCpu(const cv::Mat& rgba, double cutoff_cycles_per_width, 
 // a uniform grey field of `field` size with linear grey level `grey`. Returns 8-bit BGR sRGB.
 cv::Mat PictureOnGrey(const cv::Mat& picture, cv::Size field, int height_px, double cutoff, double grey = 0.18);
 
+// The depth-matching study's frame (thesis 3.2), 8-bit sRGB BGR of width_px x 3/4 width_px: the upper half is
+// `upper` (a PictureOnGrey of width_px x half the height), the lower half the scene photo scaled to cover it and
+// cropped at its centre.
+cv::Mat DepthMatchingFrame(const cv::Mat& upper, const cv::Mat& photo, int width_px);
+
 // 8-bit sRGB BGR/BGRA/grey -> CV_32FC4 linear premultiplied BGRA, and back (alpha kept when `keep_alpha`).
 cv::Mat ToLinearPremultiplied(const cv::Mat& image8);
 cv::Mat FromLinearPremultiplied(const cv::Mat& rgba, bool keep_alpha);

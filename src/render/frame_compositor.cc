@@ -101,17 +101,30 @@ cv::Mat FrameCompositor::Read() {
   return bgr;
 }
 
-void FrameCompositor::Present(int width_px, int height_px) {
-  // Frame rows are image rows (top first); a window's rows count from the bottom, so the blit flips.
-  const double scale = std::min(double(width_px) / impl_->width, double(height_px) / impl_->height);
-  const int w = int(impl_->width * scale), h = int(impl_->height * scale);
+namespace {
+// Blits a framebuffer of src_w x src_h (image rows, top first) to the window's, letterboxed on grey; a window's
+// rows count from the bottom, so the blit flips.
+void BlitToWindow(GLuint read_fb, int src_w, int src_h, int width_px, int height_px) {
+  const double scale = std::min(double(width_px) / src_w, double(height_px) / src_h);
+  const int w = int(src_w * scale), h = int(src_h * scale);
   const int x0 = (width_px - w) / 2, y0 = (height_px - h) / 2;
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, impl_->frame_fb.id());
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, read_fb);
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
   glClearColor(0.5f, 0.5f, 0.5f, 1);
   glClear(GL_COLOR_BUFFER_BIT);
-  glBlitFramebuffer(0, 0, impl_->width, impl_->height, x0, y0 + h, x0 + w, y0, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+  glBlitFramebuffer(0, 0, src_w, src_h, x0, y0 + h, x0 + w, y0, GL_COLOR_BUFFER_BIT, GL_LINEAR);
   glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+}
+}  // namespace
+
+void FrameCompositor::Present(int width_px, int height_px) {
+  BlitToWindow(impl_->frame_fb.id(), impl_->width, impl_->height, width_px, height_px);
+}
+
+void PresentImage(const cv::Mat& image, int width_px, int height_px) {
+  const Texture texture = Texture::FromSrgbImage(image);
+  const Framebuffer fb(texture);
+  BlitToWindow(fb.id(), image.cols, image.rows, width_px, height_px);
 }
 
 }  // namespace blurcue::render

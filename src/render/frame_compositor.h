@@ -43,4 +43,8 @@ class FrameCompositor {
   std::unique_ptr<Impl> impl_;
 };
 
+// Shows an 8-bit sRGB image (instructions, a CPU-made stimulus) in the current window's default framebuffer,
+// scaled to fit width_px x height_px.
+void PresentImage(const cv::Mat& image, int width_px, int height_px);
+
 }  // namespace blurcue::render

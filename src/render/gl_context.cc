@@ -1,5 +1,6 @@
 #include "render/gl_context.h"
 
+#include <chrono>
 #include <cstdio>
 
 #include <epoxy/egl.h>
@@ -83,6 +84,25 @@ class GlfwContext final : public GlContext {
     }
     MakeCurrent();
     glfwSwapInterval(o.vsync ? 1 : 0);
+    const GLFWvidmode* mode = glfwGetVideoMode(monitor ? monitor : glfwGetPrimaryMonitor());
+    refresh_hz_ = mode ? mode->refreshRate : 0;
+    glfwSetWindowUserPointer(window_, this);
+    glfwSetKeyCallback(window_, [](GLFWwindow* w, int key, int, int action, int) {
+      if (action != GLFW_PRESS) return;  // presses only: a held key does not repeat an answer
+      auto* self = static_cast<GlfwContext*>(glfwGetWindowUserPointer(w));
+      const std::string name = KeyName(key);
+      if (!name.empty()) self->events_.push_back({name, glfwGetTime()});
+    });
+    glfwSetMouseButtonCallback(window_, [](GLFWwindow* w, int button, int action, int) {
+      if (action != GLFW_PRESS) return;
+      auto* self = static_cast<GlfwContext*>(glfwGetWindowUserPointer(w));
+      if (button == GLFW_MOUSE_BUTTON_LEFT) self->events_.push_back({"MouseLeft", glfwGetTime()});
+      if (button == GLFW_MOUSE_BUTTON_RIGHT) self->events_.push_back({"MouseRight", glfwGetTime()});
+    });
+    glfwSetScrollCallback(window_, [](GLFWwindow* w, double, double dy) {
+      auto* self = static_cast<GlfwContext*>(glfwGetWindowUserPointer(w));
+      if (dy != 0) self->events_.push_back({dy > 0 ? "WheelUp" : "WheelDown", glfwGetTime()});
+    });
   }
   ~GlfwContext() override {
     glfwDestroyWindow(window_);
@@ -94,6 +114,14 @@ class GlfwContext final : public GlContext {
     glfwPollEvents();
   }
   bool ShouldClose() const override { return glfwWindowShouldClose(window_); }
+  std::vector<InputEvent> TakeEvents() override {
+    glfwPollEvents();
+    std::vector<InputEvent> out;
+    out.swap(events_);
+    return out;
+  }
+  double Now() const override { return glfwGetTime(); }
+  double RefreshHz() const override { return refresh_hz_; }
   int width_px() const override {
     int w = 0, h = 0;
     glfwGetFramebufferSize(window_, &w, &h);
@@ -106,7 +134,30 @@ class GlfwContext final : public GlContext {
   }
 
  private:
+  // The protocol's name of a GLFW key ("" for keys it has no name for).
+  static std::string KeyName(int key) {
+    switch (key) {
+      case GLFW_KEY_LEFT: return "Left";
+      case GLFW_KEY_RIGHT: return "Right";
+      case GLFW_KEY_UP: return "Up";
+      case GLFW_KEY_DOWN: return "Down";
+      case GLFW_KEY_SPACE: return "Space";
+      case GLFW_KEY_ENTER: case GLFW_KEY_KP_ENTER: return "Return";
+      case GLFW_KEY_TAB: return "Tab";
+      case GLFW_KEY_BACKSPACE: return "Backspace";
+      case GLFW_KEY_ESCAPE: return "Escape";
+      default: break;
+    }
+    if (key >= GLFW_KEY_A && key <= GLFW_KEY_Z) return std::string(1, char('A' + key - GLFW_KEY_A));
+    if (key >= GLFW_KEY_0 && key <= GLFW_KEY_9) return std::string(1, char('0' + key - GLFW_KEY_0));
+    if (key >= GLFW_KEY_F1 && key <= GLFW_KEY_F12) return "F" + std::to_string(key - GLFW_KEY_F1 + 1);
+    if (key >= GLFW_KEY_KP_0 && key <= GLFW_KEY_KP_9) return "KP_" + std::to_string(key - GLFW_KEY_KP_0);
+    return "";
+  }
+
   GLFWwindow* window_ = nullptr;
+  std::vector<InputEvent> events_;
+  double refresh_hz_ = 0;
 };
 
 }  // namespace
@@ -114,6 +165,10 @@ class GlfwContext final : public GlContext {
 std::unique_ptr<GlContext> GlContext::CreateOffscreen() { return std::make_unique<EglContext>(); }
 std::unique_ptr<GlContext> GlContext::CreateWindow(const WindowOptions& options) {
   return std::make_unique<GlfwContext>(options);
+}
+
+double GlContext::Now() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 std::string GlContext::Describe() const {

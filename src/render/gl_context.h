@@ -3,6 +3,7 @@
 // and every test) or in a GLFW window for participants. GL calls go through libepoxy.
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace blurcue::render {
 
@@ -12,6 +13,15 @@ struct WindowOptions {
   int monitor = 0;      // which monitor when fullscreen
   bool vsync = true;
   std::string title = "blurcue";
+};
+
+// A key press, mouse click or wheel step in a window. `key` uses the protocol's key names ("Left", "Right", "Up",
+// "Down", "Space", "Return", "Tab", "Backspace", "Escape", "A".."Z", "0".."9", "F1".."F12", "KP_0".."KP_9") and
+// "MouseLeft", "MouseRight", "WheelUp", "WheelDown". time_s is the context's clock when the event was polled
+// (GLFW 3.3 gives events no timestamp of their own: the resolution is one poll, i.e. one refresh).
+struct InputEvent {
+  std::string key;
+  double time_s = 0;
 };
 
 class GlContext {
@@ -33,6 +43,12 @@ class GlContext {
   // Size of the default framebuffer in pixels (0 x 0 offscreen: render to framebuffers).
   virtual int width_px() const { return 0; }
   virtual int height_px() const { return 0; }
+  // Events since the last call (window); always empty offscreen.
+  virtual std::vector<InputEvent> TakeEvents() { return {}; }
+  // Seconds on a monotonic clock (the window's glfwGetTime, steady_clock offscreen).
+  virtual double Now() const;
+  // Window: the monitor's refresh rate in Hz (0 when unknown). Offscreen: 0.
+  virtual double RefreshHz() const { return 0; }
   // GL_RENDERER and GL_VERSION, for the session record.
   std::string Describe() const;
 

@@ -1,0 +1,108 @@
+// blurcue preview: a contact sheet of every distinct stimulus of a protocol, to check it by eye before any
+// participant sits down.
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+
+#include "cli/commands.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "protocol/protocol.h"
+#include "protocol/trials.h"
+#include "render/gl_context.h"
+#include "session/stimulus.h"
+
+namespace blurcue::cli {
+
+void AddPreviewCommand(CLI::App& app) {
+  struct Args {
+    std::string protocol, out, participant = "P1";
+    std::optional<uint64_t> seed;
+    int columns = 6, tile_width = 320;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "preview",
+      "Draw a contact sheet of every distinct stimulus a protocol shows (each at its onset), labelled with its\n"
+      "levels and the blur radius on each side, so a protocol can be checked by eye before a session.\n"
+      "Distinct: the same levels and sides drawn once (practice copies and repetitions are not repeated); for\n"
+      "depth matching, one tile per adjustment level.\n"
+      "Example: blurcue preview protocols/test1-static-grids.json --out results/preview-test1.png");
+  cmd->add_option("protocol", args->protocol, "the protocol JSON file")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--out", args->out, "the contact sheet PNG")->required();
+  cmd->add_option("--participant", args->participant, "whose trial list (by_participant sides)")
+      ->capture_default_str();
+  cmd->add_option("--seed", args->seed, "seed (default: as blurcue run)");
+  cmd->add_option("--columns", args->columns, "tiles per row")->capture_default_str()->check(CLI::Range(1, 20));
+  cmd->add_option("--tile-width", args->tile_width, "tile width in px")->capture_default_str()
+      ->check(CLI::Range(80, 2000));
+  cmd->callback([args] {
+    const protocol::Protocol p = protocol::LoadProtocol(args->protocol);
+    const uint64_t seed = args->seed ? *args->seed : protocol::DefaultSeed(p.name, args->participant);
+    const auto trials = protocol::BuildTrials(p, args->participant, seed);
+    const auto scene = session::LoadProtocolScene(p);
+    struct Tile {
+      const protocol::Trial* trial;
+      session::TrialScene scene;
+      double level;
+      std::string label;
+    };
+    std::vector<Tile> tiles;
+    std::map<std::string, bool> seen;
+    for (const auto& t : trials) {
+      const session::TrialScene s = session::DescribeTrial(p, t, scene ? &*scene : nullptr);
+      if (t.task == protocol::Task::kAdjustment) {
+        for (double level : t.adjust_levels) {
+          char label[64];
+          std::snprintf(label, sizeof label, "%s %g", p.blocks.front().adjust ? p.blocks.front().adjust->parameter.c_str()
+                                                                              : "level", level);
+          if (!seen.emplace(label, true).second) continue;
+          tiles.push_back({&t, s, level, label});
+        }
+        continue;
+      }
+      Json key = t.levels;
+      key["left"] = t.left;
+      key["right"] = t.right;
+      if (!seen.emplace(key.dump(), true).second) continue;
+      std::string levels;
+      for (const auto& [name, value] : t.levels.items())
+        levels += (levels.empty() ? "" : " ") + name + " " +
+                  (value.is_object() && value.contains("id") ? value["id"].dump() : value.dump());
+      char label[256];
+      std::snprintf(label, sizeof label, "%s | L %s %.2f px  R %s %.2f px", levels.c_str(),
+                    t.left.is_string() ? t.left.get<std::string>().c_str() : t.left.dump().c_str(), s.r_left_px,
+                    t.right.is_string() ? t.right.get<std::string>().c_str() : t.right.dump().c_str(), s.r_right_px);
+      tiles.push_back({&t, s, 0, label});
+    }
+    if (tiles.empty()) throw InputError(args->protocol, "the protocol makes no trials to preview");
+
+    auto context = render::GlContext::CreateOffscreen();
+    session::StimulusRenderer renderer(p, scene);
+    const cv::Size frame = renderer.FrameSize();
+    const int tw = args->tile_width, th = tw * frame.height / frame.width, strip = 22;
+    const int cols = std::min<int>(args->columns, int(tiles.size()));
+    const int rows = (int(tiles.size()) + cols - 1) / cols;
+    cv::Mat sheet(rows * (th + strip), cols * tw, CV_8UC3, cv::Scalar(40, 40, 40));
+    for (size_t i = 0; i < tiles.size(); ++i) {
+      renderer.Compose(tiles[i].scene, 0, tiles[i].level);
+      cv::Mat small;
+      cv::resize(renderer.Read(), small, cv::Size(tw, th), 0, 0, cv::INTER_AREA);
+      const int x = int(i % size_t(cols)) * tw, y = int(i / size_t(cols)) * (th + strip);
+      small.copyTo(sheet(cv::Rect(x, y, tw, th)));
+      cv::putText(sheet, "#" + std::to_string(i + 1) + " " + tiles[i].label, {x + 4, y + th + 15},
+                  cv::FONT_HERSHEY_SIMPLEX, 0.36, cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
+      std::fprintf(stderr, "\rpreview: %zu of %zu", i + 1, tiles.size());
+    }
+    std::fprintf(stderr, "\n");
+    WriteImage(args->out, sheet);
+    std::printf("%s: %zu distinct stimuli of %zu trials -> %s\n", args->protocol.c_str(), tiles.size(), trials.size(),
+                args->out.c_str());
+  });
+}
+
+}  // namespace blurcue::cli

@@ -1,0 +1,76 @@
+// blurcue run: one participant's session of a protocol, answered by a person at a window or by the simulated
+// observer, every answer committed to the SQLite record before the next trial.
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "cli/commands.h"
+#include "core/error.h"
+#include "session/runner.h"
+
+namespace blurcue::cli {
+
+void AddRunCommand(CLI::App& app) {
+  struct Args {
+    session::RunOptions options;
+    std::string protocol, db, observer;
+    std::optional<uint64_t> seed;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "run",
+      "Run one participant's session of a study protocol and record every answer in a SQLite file.\n"
+      "The whole trial list is made up front from the protocol, the participant and the seed, and saved; each\n"
+      "answer is committed in its own transaction before the next trial starts, so a crash or a kill loses nothing\n"
+      "already answered. --resume continues the participant's unfinished session at its first unanswered trial,\n"
+      "in the same order. One process at a time may write a session; a second is refused.\n"
+      "\n"
+      "With a person (no --observer): a window opens (the protocol's display size; fullscreen if it says so).\n"
+      "  forced choice: the protocol's left / right / can't-tell keys (default Left, Right, Down);\n"
+      "  adjustment:    previous / next keys or the mouse wheel step through the levels, Return or a click accepts;\n"
+      "  Escape pauses and asks whether to quit (Q) or go on (Return). Quitting keeps every answer so far.\n"
+      "Response times run from the first frame of the stimulus; every frame's flip time and dropped frames are\n"
+      "recorded. The terminal shows trial n of N, the time elapsed and an estimate of the time left.\n"
+      "\n"
+      "With --observer sim[:params] a simulated observer answers through the same key mapping, headless on a\n"
+      "simulated clock (add --window to watch it in real time). Its parameters:\n"
+      "  jnd=0.6     sd of its noise on the blur mismatch (px)    bias=0.2  preference for the more blurred side (px)\n"
+      "  lapse=0.04  rate of random answers                       rt=900    median response time (ms)\n"
+      "  cutoff1m=14, slope=-0.8, sdlog=0.15, tol=0.1, step=350: depth matching, the cut-off it aims at is\n"
+      "              cutoff1m * distance_m^slope (cycles per picture width)\n"
+      "\n"
+      "Examples:\n"
+      "  blurcue run protocols/test1-static-grids.json --participant P3 --db results/study.sqlite\n"
+      "  blurcue run protocols/test2-moving-balls.json --participant S1 --db sim.sqlite --observer sim:jnd=0.4\n"
+      "  blurcue run protocols/test1-static-grids.json --participant P3 --db results/study.sqlite --resume");
+  cmd->add_option("protocol", args->protocol, "the protocol JSON file")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--participant", args->options.participant, "participant id, e.g. P7 (its trailing number "
+                                                              "decides by_participant sides)")->required();
+  cmd->add_option("--db", args->db, "the SQLite record (created if missing)")->required();
+  cmd->add_option("--seed", args->seed, "seed of the trial order (default: derived from the study name and the "
+                                        "participant id; always recorded)");
+  cmd->add_option("--observer", args->observer, "sim or sim:NAME=VALUE,... - a simulated observer answers");
+  cmd->add_flag("--resume", args->options.resume, "continue the participant's unfinished session");
+  cmd->add_flag("--window", args->options.window, "with --observer: show the session in a window, in real time");
+  cmd->add_option("--sim-fps", args->options.sim_fps, "headless: frames rendered per simulated second")
+      ->capture_default_str();
+  cmd->add_option("--stop-after", args->options.stop_after, "leave the session after this many answers (it stays "
+                                                            "resumable; for tests and split sittings)");
+  cmd->callback([args] {
+    session::RunOptions options = args->options;
+    options.protocol_file = args->protocol;
+    options.db = args->db;
+    options.observer = args->observer;
+    options.seed = args->seed;
+    const session::RunResult r = session::RunSession(options);
+    std::printf("%s: participant %s, session %lld, seed %llu: %lld of %lld trials answered (%lld now%s)%s\n",
+                args->db.c_str(), options.participant.c_str(), static_cast<long long>(r.session_id),
+                static_cast<unsigned long long>(r.seed), static_cast<long long>(r.answered_before + r.answered_now),
+                static_cast<long long>(r.trial_count), static_cast<long long>(r.answered_now),
+                r.dropped_frames > 0 ? (", " + std::to_string(r.dropped_frames) + " dropped frames").c_str() : "",
+                r.completed ? "; completed" : "; not finished - continue with --resume");
+  });
+}
+
+}  // namespace blurcue::cli

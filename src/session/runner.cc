@@ -1,0 +1,441 @@
+#include "session/runner.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <deque>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include <opencv2/imgproc.hpp>
+
+#include "core/error.h"
+#include "protocol/protocol.h"
+#include "protocol/trials.h"
+#include "render/frame_compositor.h"
+#include "render/gl_context.h"
+#include "session/observer.h"
+#include "session/screens.h"
+#include "session/stimulus.h"
+#include "store/record.h"
+
+namespace blurcue::session {
+namespace {
+
+using protocol::Task;
+using render::InputEvent;
+
+// Where frames are shown and keys come from. A window runs on the real clock; headless runs on a simulated one
+// that moves a frame at a time, or to the next scripted key press when that comes first, so a simulated observer's
+// response times are exact and a session of minutes runs in seconds.
+class Station {
+ public:
+  Station(render::GlContext& context, bool window, double sim_fps)
+      : context_(context), window_(window), frame_s_(window ? 1.0 / (context.RefreshHz() > 0 ? context.RefreshHz()
+                                                                                             : 60.0)
+                                                            : 1.0 / sim_fps) {}
+
+  bool window() const { return window_; }
+  double frame_s() const { return frame_s_; }
+  double Now() const { return window_ ? context_.Now() : clock_s_; }
+
+  // Ends a frame and returns its flip time.
+  double Flip() {
+    if (!window_) {
+      const double next = scripted_.empty() ? clock_s_ + frame_s_ : std::min(clock_s_ + frame_s_, scripted_.front().time_s);
+      clock_s_ = std::max(clock_s_, next);
+      return clock_s_;
+    }
+    context_.SwapBuffers();
+    // Without vsync (e.g. under Xvfb) a swap returns at once: hold the refresh rate so a window shows what a
+    // participant's monitor would.
+    const double now = context_.Now();
+    if (last_flip_s_ > 0 && now - last_flip_s_ < frame_s_)
+      std::this_thread::sleep_for(std::chrono::duration<double>(frame_s_ - (now - last_flip_s_)));
+    last_flip_s_ = context_.Now();
+    return last_flip_s_;
+  }
+
+  // Keys pressed since the last call: the window's, and the scripted ones that are due.
+  std::vector<InputEvent> Poll() {
+    std::vector<InputEvent> events = context_.TakeEvents();
+    while (!scripted_.empty() && scripted_.front().time_s <= Now() + 1e-9) {
+      events.push_back(scripted_.front());
+      scripted_.pop_front();
+    }
+    return events;
+  }
+
+  // A key the simulated observer will press at `time_s` (on this station's clock); kept in time order.
+  void Script(const std::string& key, double time_s) {
+    auto at = std::upper_bound(scripted_.begin(), scripted_.end(), time_s,
+                               [](double t, const InputEvent& e) { return t < e.time_s; });
+    scripted_.insert(at, {key, time_s});
+  }
+  void ClearScript() { scripted_.clear(); }
+  bool Closed() const { return context_.ShouldClose(); }
+  void Wait(double seconds) {
+    if (window_)
+      std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+    else
+      clock_s_ += seconds;
+  }
+
+ private:
+  render::GlContext& context_;
+  bool window_;
+  double frame_s_;
+  double clock_s_ = 0, last_flip_s_ = 0;
+  std::deque<InputEvent> scripted_;
+};
+
+// Keys -> actions, as the protocol maps them. The mouse steps and accepts in adjustment.
+struct KeyMap {
+  const protocol::Responses& r;
+  std::string Action(const std::string& key, Task task) const {
+    if (key == "Escape") return "pause";
+    if (task == Task::kForcedChoice) {
+      if (key == r.left) return "left";
+      if (key == r.right) return "right";
+      if (key == r.cant_tell) return "cant_tell";
+    } else {
+      if (key == r.previous || key == "WheelDown") return "previous";
+      if (key == r.next || key == "WheelUp") return "next";
+      if (key == r.accept || key == "MouseLeft") return "accept";
+    }
+    return "";
+  }
+  std::string Key(const std::string& action) const {
+    if (action == "left") return r.left;
+    if (action == "right") return r.right;
+    if (action == "cant_tell") return r.cant_tell;
+    if (action == "previous") return r.previous;
+    if (action == "next") return r.next;
+    return r.accept;
+  }
+};
+
+std::string Clock(double seconds) {
+  const int s = std::max(0, int(std::lround(seconds)));
+  char text[32];
+  std::snprintf(text, sizeof text, "%d:%02d", s / 60, s % 60);
+  return text;
+}
+
+// The observer of one trial: seeded by the session seed and the trial index, so a resumed session answers
+// exactly as an uninterrupted one.
+uint64_t TrialSeed(uint64_t seed, int index) {
+  uint64_t z = seed + 0x9e3779b97f4a7c15ULL * uint64_t(index + 1);  // splitmix64
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+std::string ReadText(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string(), "cannot open file");
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+enum class Outcome { kAnswered, kQuit };
+
+class Runner {
+ public:
+  Runner(const RunOptions& options, const protocol::Protocol& protocol, render::GlContext& context,
+         StimulusRenderer& renderer, const std::vector<protocol::Trial>& trials,
+         const std::vector<TrialScene>& scenes, std::optional<ObserverParams> observer, uint64_t seed)
+      : options_(options), protocol_(protocol), context_(context), renderer_(renderer), trials_(trials),
+        scenes_(scenes), observer_(observer), seed_(seed), keys_{protocol.responses},
+        station_(context, !observer || options.window, options.sim_fps),
+        screen_size_(protocol.display.width_px, protocol.display.height_px) {}
+
+  // A text screen until Return, Space or a click (a simulated observer presses Return after a moment). Escape
+  // on it pauses like anywhere else. Returns false when the participant quits.
+  bool ShowScreen(const std::string& title, const std::string& body, const std::string& footer) {
+    const cv::Mat image = TextScreen(screen_size_, title, body, footer);
+    if (observer_) station_.Script("Return", station_.Now() + 0.6);
+    for (;;) {
+      if (station_.window()) render::PresentImage(image, context_.width_px(), context_.height_px());
+      station_.Flip();
+      if (station_.Closed()) return false;
+      for (const InputEvent& e : station_.Poll()) {
+        if (e.key == "Return" || e.key == "Space" || e.key == "MouseLeft") return true;
+        if (e.key == "Escape" && !Pause()) return false;
+      }
+    }
+  }
+
+  // Escape: asks whether to quit. Q quits (every answer so far is already saved), Return goes on.
+  bool Pause() {
+    const cv::Mat image = TextScreen(screen_size_, "Paused",
+                                     "Every answer so far is saved. Press Q to quit (the session can be continued "
+                                     "later with --resume), or Return to go on.",
+                                     "Q: quit    Return: go on");
+    for (;;) {
+      if (station_.window()) render::PresentImage(image, context_.width_px(), context_.height_px());
+      station_.Flip();
+      if (station_.Closed()) return false;
+      for (const InputEvent& e : station_.Poll()) {
+        if (e.key == "Q") return false;
+        if (e.key == "Return" || e.key == "Space") return true;
+      }
+    }
+  }
+
+  // Shows one trial until it is answered; fills the response and the frames.
+  Outcome RunTrial(const protocol::Trial& trial, const TrialScene& scene, store::Response* response,
+                   std::vector<store::FrameRecord>* frames) {
+    // Inter-trial interval: the grey field.
+    if (protocol_.timing.inter_trial_ms > 0) {
+      if (station_.window()) {
+        render::PresentImage(Blank(), context_.width_px(), context_.height_px());
+        station_.Flip();
+      }
+      station_.Wait(protocol_.timing.inter_trial_ms / 1000);
+    }
+    station_.ClearScript();
+    const double onset = station_.Now();
+    double paused_s = 0;  // time spent on the pause screen, not part of the response time
+    int level = trial.start_index;
+    const int levels = static_cast<int>(trial.adjust_levels.size());
+    Json steps = Json::array();
+    if (observer_) {
+      SimulatedObserver observer(*observer_, TrialSeed(seed_, trial.index));
+      if (trial.task == Task::kForcedChoice) {
+        const KeyPress press = observer.ChooseSide({scene.r_left_px, scene.r_right_px, scene.r_scene_px});
+        station_.Script(keys_.Key(press.action), onset + press.after_ms / 1000);
+      } else {
+        double t = onset;
+        for (const KeyPress& press : observer.Adjust(trial.adjust_levels, trial.start_index, scene.distance_m)) {
+          t += press.after_ms / 1000;
+          station_.Script(keys_.Key(press.action), t);
+        }
+      }
+    }
+    const double stimulus_s = protocol_.timing.stimulus_ms / 1000;
+    double last_flip = -1;
+    for (int frame = 0;; ++frame) {
+      const double t = station_.Now() - onset;
+      const bool shown = stimulus_s <= 0 || t < stimulus_s;
+      if (shown) renderer_.Compose(scene, t, levels > 0 ? trial.adjust_levels[size_t(level)] : 0);
+      if (station_.window()) {
+        if (shown)
+          renderer_.Present(context_.width_px(), context_.height_px());
+        else
+          render::PresentImage(Blank(), context_.width_px(), context_.height_px());
+      }
+      const double flip = station_.Flip();
+      const bool dropped = station_.window() && last_flip >= 0 && flip - last_flip > 1.5 * station_.frame_s();
+      frames->push_back({frame, flip - onset, dropped});
+      dropped_frames_ += dropped;
+      last_flip = flip;
+      if (station_.Closed()) return Outcome::kQuit;
+      for (const InputEvent& e : station_.Poll()) {
+        const std::string action = keys_.Action(e.key, trial.task);
+        const double t_ms = (std::max(e.time_s, onset) - onset - paused_s) * 1000;
+        if (action == "pause") {
+          const double paused_at = station_.Now();
+          if (!Pause()) return Outcome::kQuit;
+          paused_s += station_.Now() - paused_at;
+        } else if (action == "left" || action == "right" || action == "cant_tell") {
+          response->choice = action;
+          response->rt_ms = t_ms;
+          return Outcome::kAnswered;
+        } else if ((action == "previous" || action == "next") && levels > 0) {
+          level = (level + (action == "next" ? 1 : levels - 1)) % levels;
+          steps.push_back({{"level", trial.adjust_levels[size_t(level)]}, {"t_ms", std::round(t_ms * 10) / 10}});
+        } else if (action == "accept" && levels > 0) {
+          char text[32];
+          std::snprintf(text, sizeof text, "%g", trial.adjust_levels[size_t(level)]);
+          response->choice = text;
+          response->rt_ms = t_ms;
+          response->adjustment_json = steps.dump();
+          return Outcome::kAnswered;
+        }
+      }
+    }
+  }
+
+  RunResult Run(store::Record& record, const store::SessionStart& start) {
+    RunResult result;
+    result.session_id = start.session_id;
+    result.seed = seed_;
+    result.trial_count = static_cast<int64_t>(trials_.size());
+    result.answered_before = start.first_unanswered_trial;
+    const auto wall_start = std::chrono::steady_clock::now();
+    const bool tty = isatty(2);
+    auto progress = [&](int64_t done) {
+      if (!options_.progress) return;
+      const double elapsed =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+      const int64_t now = done - result.answered_before;
+      const double left = now > 0 ? elapsed / double(now) * double(result.trial_count - done) : 0;
+      std::fprintf(stderr, "%strial %lld of %lld  elapsed %s  remaining ~%s%s", tty ? "\r" : "",
+                   static_cast<long long>(done), static_cast<long long>(result.trial_count), Clock(elapsed).c_str(),
+                   Clock(left).c_str(), tty ? "   " : "\n");
+    };
+
+    const std::string welcome = start.resumed && start.first_unanswered_trial > 0 ? "Welcome back" : "Instructions";
+    if (!ShowScreen(welcome, protocol_.instructions, "Press Return to start")) return result;
+    std::string shown_block;
+    int main_answered = 0;
+    for (int64_t i = start.first_unanswered_trial; i < result.trial_count; ++i) {
+      const protocol::Trial& trial = trials_[size_t(i)];
+      // Instructions when the part changes: practice, then each block.
+      const std::string part = trial.practice ? std::string("practice") : trial.block;
+      if (part != shown_block) {
+        std::string text;
+        if (trial.practice) {
+          text = protocol_.practice.instructions;
+        } else {
+          for (const auto& b : protocol_.blocks)
+            if (b.name == trial.block) text = b.instructions;
+          if (text.empty() && shown_block == "practice") text = "The practice is over; the study starts now.";
+        }
+        if (!text.empty() &&
+            !ShowScreen(trial.practice ? "Practice" : "Part: " + trial.block, text, "Press Return to go on"))
+          return result;
+        shown_block = part;
+      }
+      store::Response response;
+      std::vector<store::FrameRecord> frames;
+      if (RunTrial(trial, scenes_[size_t(i)], &response, &frames) == Outcome::kQuit) break;
+      record.RecordResponse(start.session_id, i, response);  // committed before anything else happens
+      record.RecordFrames(start.session_id, i, frames);
+      ++result.answered_now;
+      progress(i + 1);
+      if (!trial.practice) ++main_answered;
+      if (options_.stop_after >= 0 && result.answered_now >= options_.stop_after) break;
+      if (protocol_.break_every_trials > 0 && !trial.practice && main_answered % protocol_.break_every_trials == 0 &&
+          i + 1 < result.trial_count &&
+          !ShowScreen("Break", protocol_.break_text.empty() ? "Take a short break." : protocol_.break_text,
+                      "Press Return to go on"))
+        break;
+    }
+    if (options_.progress && tty) std::fprintf(stderr, "\n");
+    result.completed = record.FirstUnansweredTrial(start.session_id) == result.trial_count;
+    if (result.completed) {
+      record.FinishSession(start.session_id, store::SessionStatus::kCompleted);
+      if (station_.window()) {
+        render::PresentImage(TextScreen(screen_size_, "Thank you", "The session is complete.", ""),
+                             context_.width_px(), context_.height_px());
+        station_.Flip();
+        station_.Wait(0.5);
+      }
+    }
+    result.dropped_frames = dropped_frames_;
+    return result;
+  }
+
+ private:
+  const cv::Mat& Blank() {
+    if (blank_.empty()) blank_ = TextScreen(screen_size_, "", "", "");
+    return blank_;
+  }
+
+  const RunOptions& options_;
+  const protocol::Protocol& protocol_;
+  render::GlContext& context_;
+  StimulusRenderer& renderer_;
+  const std::vector<protocol::Trial>& trials_;
+  const std::vector<TrialScene>& scenes_;
+  std::optional<ObserverParams> observer_;
+  uint64_t seed_;
+  KeyMap keys_;
+  Station station_;
+  cv::Size screen_size_;
+  cv::Mat blank_;
+  int64_t dropped_frames_ = 0;
+};
+
+}  // namespace
+
+RunResult RunSession(const RunOptions& options) {
+  if (options.participant.empty()) throw Error(ErrorKind::kUsage, "--participant must not be empty");
+  std::optional<ObserverParams> observer;
+  if (!options.observer.empty()) observer = ParseObserver(options.observer);
+  if (options.sim_fps <= 0) throw Error(ErrorKind::kUsage, "--sim-fps must be > 0");
+
+  const protocol::Protocol protocol = protocol::LoadProtocol(options.protocol_file);
+  const std::string protocol_text = ReadText(options.protocol_file);
+  const uint64_t seed = options.seed ? *options.seed : protocol::DefaultSeed(protocol.name, options.participant);
+  const std::vector<protocol::Trial> trials = protocol::BuildTrials(protocol, options.participant, seed);
+
+  // Every trial's scene and radii before anything is shown or saved: a source that cannot be evaluated stops
+  // the run here, not in front of a participant.
+  const std::optional<calib::SceneCalib> scene = LoadProtocolScene(protocol);
+  std::vector<TrialScene> scenes;
+  std::vector<store::TrialRecord> records;
+  for (const protocol::Trial& trial : trials) {
+    scenes.push_back(DescribeTrial(protocol, trial, scene ? &*scene : nullptr));
+    store::TrialRecord r;
+    r.index = trial.index;
+    for (size_t b = 0; b < protocol.blocks.size(); ++b)
+      if (protocol.blocks[b].name == trial.block) r.block = static_cast<int64_t>(b);
+    r.factors_json = TrialVariables(trial, scenes.back()).dump();
+    r.left_json = trial.left.dump();
+    r.right_json = trial.right.dump();
+    records.push_back(std::move(r));
+  }
+
+  std::unique_ptr<render::GlContext> context;
+  const bool window = !observer || options.window;
+  if (window) {
+    render::WindowOptions w;
+    w.width_px = protocol.display.width_px;
+    w.height_px = protocol.display.height_px;
+    w.fullscreen = protocol.display.fullscreen;
+    w.monitor = protocol.display.monitor;
+    w.title = "blurcue - " + protocol.name;
+    context = render::GlContext::CreateWindow(w);
+  } else {
+    context = render::GlContext::CreateOffscreen();
+  }
+  StimulusRenderer renderer(protocol, scene);
+
+  store::Record record = store::Record::Open(options.db);
+  store::SessionMeta meta;
+  char display[256];
+  std::snprintf(display, sizeof display, "%s %dx%d%s; %s%s", window ? "window" : "headless",
+                window ? context->width_px() : protocol.display.width_px,
+                window ? context->height_px() : protocol.display.height_px,
+                window && context->RefreshHz() > 0 ? ("@" + std::to_string(int(context->RefreshHz()))).c_str() : "",
+                context->Describe().c_str(), observer ? ("; observer " + ToString(*observer)).c_str() : "");
+  meta.display = display;
+  const store::SessionStart start = record.StartOrResumeSession(protocol.name, options.participant, protocol_text,
+                                                                seed, meta, options.resume);
+  if (start.trial_count == 0) {
+    record.SaveTrialList(start.session_id, records);
+  } else {
+    // A resumed session must show the same trials in the same order as the one it continues.
+    store::Statement saved(record.database(),
+                           "SELECT trial_index, factors, left_shown, right_shown FROM trials WHERE session_id = ? "
+                           "ORDER BY trial_index");
+    saved.Bind(1, start.session_id);
+    size_t n = 0;
+    while (saved.Step()) {
+      const size_t i = static_cast<size_t>(saved.GetInt64(0));
+      if (i >= records.size() || Json::parse(saved.GetText(1)) != Json::parse(records[i].factors_json) ||
+          saved.GetText(2) != records[i].left_json || saved.GetText(3) != records[i].right_json)
+        throw InputError(options.db.string(), "session " + std::to_string(start.session_id) + " trial " +
+                                                  std::to_string(i) +
+                                                  ": the saved trial differs from the one this protocol, participant "
+                                                  "and seed make now; it cannot be resumed with them");
+      ++n;
+    }
+    if (n != records.size())
+      throw InputError(options.db.string(), "session " + std::to_string(start.session_id) + " has " +
+                                                std::to_string(n) + " trials saved, the protocol makes " +
+                                                std::to_string(records.size()));
+  }
+  Runner runner(options, protocol, *context, renderer, trials, scenes, observer, seed);
+  return runner.Run(record, start);
+}
+
+}  // namespace blurcue::session

@@ -1,0 +1,220 @@
+#include "session/stimulus.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/error.h"
+#include "core/image.h"
+#include "render/blur.h"
+#include "render/frame_compositor.h"
+#include "render/scene_render.h"
+#include "render/stimuli.h"
+
+namespace blurcue::session {
+namespace {
+
+constexpr double kBallRadiusDefaultMm = 10;
+constexpr int kLeftSection = 3, kRightSection = 5;  // the balls roll side by side, one section apart
+
+// A level by name: a factor of its own, or a key of an object level (a pattern carries speed and sides).
+const Json* FindLevel(const Json& levels, const std::string& name) {
+  if (!levels.is_object()) return nullptr;
+  if (auto it = levels.find(name); it != levels.end()) return &*it;
+  for (const auto& [key, value] : levels.items())
+    if (value.is_object())
+      if (auto it = value.find(name); it != value.end()) return &*it;
+  return nullptr;
+}
+
+std::string Where(const protocol::Protocol& p, const protocol::Trial& t) {
+  return p.file.string() + ": trial " + std::to_string(t.index) + " (block " + t.block + ")";
+}
+
+calib::BlurSource Source(const Json& v, double* fixed, const std::string& where) {
+  if (v.is_number()) {
+    *fixed = v.get<double>();
+    return calib::BlurSource::kFixed;
+  }
+  if (!v.is_string()) throw InputError(where, "the trial shows no blur source on a side, got " + v.dump());
+  return calib::ParseBlurSource(v.get<std::string>(), fixed);
+}
+
+// Board-frame placement of the two objects of a pair.
+cv::Vec3d GridCentre(const calib::SceneCalib& s, int edge, bool left) {
+  const double size = 2 * s.board.square_mm, y = (edge - 1) * s.board.square_mm;
+  return {left ? -s.board.square_mm - size / 2 : s.board.WidthMm() + s.board.square_mm + size / 2, y, 0};
+}
+cv::Vec3d BallCentre(const calib::SceneCalib& s, double y_mm, double radius_mm, bool left) {
+  return {((left ? kLeftSection : kRightSection) - 0.5) * s.board.square_mm, y_mm, radius_mm};
+}
+
+}  // namespace
+
+double TrialScene::MotionS() const {
+  return speed_mm_s > 0 ? std::abs(to_y_mm - from_y_mm) / speed_mm_s : 0;
+}
+
+double TrialScene::BallYMm(double t_s) const {
+  const double run = std::abs(to_y_mm - from_y_mm);
+  const double travelled = speed_mm_s * std::max(0.0, t_s);
+  if (travelled >= run && wipe_at_end && speed_mm_s > 0) return -std::numeric_limits<double>::infinity();
+  return from_y_mm + (to_y_mm >= from_y_mm ? 1 : -1) * std::min(run, travelled);
+}
+
+TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Trial& trial,
+                         const calib::SceneCalib* scene) {
+  TrialScene t;
+  t.content = protocol.content.type;
+  const std::string where = Where(protocol, trial);
+  if (t.content == "picture") {
+    const Json* d = FindLevel(trial.levels, "distance_m");
+    t.distance_m = d && d->is_number() ? d->get<double>() : 1.0;
+    return t;
+  }
+  if (!scene) throw InputError(protocol.file.string(), "/scene/calib: a " + t.content + " needs a calibration");
+  t.left = Source(trial.left, &t.left_fixed_px, where);
+  t.right = Source(trial.right, &t.right_fixed_px, where);
+  const double s = scene->board.square_mm;
+  auto r_at = [&](const cv::Vec3d& board_mm, calib::BlurSource source, double fixed) {
+    try {
+      return calib::BlurAtPx(*scene, source, scene->ToCamera(board_mm), fixed);
+    } catch (const Error& e) {
+      throw Error(e.kind(), where + ": " + calib::ToString(source) + " blur: " + e.what());
+    }
+  };
+  if (t.content == "grid") {
+    const Json* edge = FindLevel(trial.levels, "edge");
+    if (!edge || !edge->is_number_integer()) throw InputError(where, "a grid trial needs an integer level 'edge'");
+    t.edge = edge->get<int>();
+    const cv::Vec3d l = GridCentre(*scene, t.edge, true), r = GridCentre(*scene, t.edge, false);
+    t.r_left_px = r_at(l, t.left, t.left_fixed_px);
+    t.r_right_px = r_at(r, t.right, t.right_fixed_px);
+    t.r_scene_px = 0.5 * (r_at(l, calib::BlurSource::kFitted, 0) + r_at(r, calib::BlurSource::kFitted, 0));
+    return t;
+  }
+  // Balls: a section run (edge s to s + 1, wiped on arrival), explicit edges, or the whole board.
+  int from = 1, to = scene->board.EdgeCount();
+  if (const Json* section = FindLevel(trial.levels, "section"); section && section->is_number_integer()) {
+    from = section->get<int>();
+    to = from + 1;
+    t.wipe_at_end = true;
+  } else {
+    if (const Json* f = FindLevel(trial.levels, "from_edge"); f && f->is_number_integer()) from = f->get<int>();
+    if (const Json* e = FindLevel(trial.levels, "to_edge"); e && e->is_number_integer()) to = e->get<int>();
+  }
+  t.from_y_mm = (from - 1) * s;
+  t.to_y_mm = (to - 1) * s;
+  const Json* speed = FindLevel(trial.levels, "speed_cm_s");
+  t.speed_mm_s = speed && speed->is_number() ? 10 * speed->get<double>() : 0;
+  // Radii averaged over the run (what the observer sees on the whole), sampled evenly along it.
+  const int samples = 21;
+  const double radius = protocol.content.radius_mm;
+  for (int i = 0; i < samples; ++i) {
+    const double y = t.from_y_mm + (t.to_y_mm - t.from_y_mm) * i / (samples - 1);
+    t.r_left_px += r_at(BallCentre(*scene, y, radius, true), t.left, t.left_fixed_px) / samples;
+    t.r_right_px += r_at(BallCentre(*scene, y, radius, false), t.right, t.right_fixed_px) / samples;
+    t.r_scene_px += 0.5 * (r_at(BallCentre(*scene, y, radius, true), calib::BlurSource::kFitted, 0) +
+                           r_at(BallCentre(*scene, y, radius, false), calib::BlurSource::kFitted, 0)) / samples;
+  }
+  return t;
+}
+
+Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene) {
+  Json v = trial.levels.is_object() ? trial.levels : Json::object();
+  v["practice"] = trial.practice ? 1 : 0;
+  v["block_name"] = trial.block;
+  v["swapped"] = trial.swapped ? 1 : 0;
+  if (trial.task == protocol::Task::kAdjustment) {
+    if (trial.start_index >= 0 && size_t(trial.start_index) < trial.adjust_levels.size())
+      v["start_level"] = trial.adjust_levels[size_t(trial.start_index)];
+  } else if (scene.content != "picture") {
+    // Rounded to 1e-4 px: the record is read by people and charts, not fed back.
+    auto round4 = [](double x) { return std::round(x * 1e4) / 1e4; };
+    v["r_left_px"] = round4(scene.r_left_px);
+    v["r_right_px"] = round4(scene.r_right_px);
+    v["r_scene_px"] = round4(scene.r_scene_px);
+  }
+  return v;
+}
+
+std::optional<calib::SceneCalib> LoadProtocolScene(const protocol::Protocol& protocol) {
+  if (protocol.content.type == "picture") return std::nullopt;
+  if (protocol.scene.calib.empty())
+    throw InputError(protocol.file.string(), "/scene/calib: a " + protocol.content.type + " needs a calibration");
+  return calib::LoadSceneCalib(protocol.scene.calib);
+}
+
+StimulusRenderer::StimulusRenderer(const protocol::Protocol& protocol, const std::optional<calib::SceneCalib>& scene)
+    : protocol_(protocol), scene_(scene) {
+  const auto& photo_path = protocol.scene.show == "board_free" && !protocol.scene.board_free.empty()
+                               ? protocol.scene.board_free
+                               : protocol.scene.background;
+  photo_ = ReadImage(photo_path, 1);
+  if (protocol.content.type == "picture") {
+    picture_ = ReadImage(protocol.content.image.empty() ? render::ResolveStimulus("face") : protocol.content.image);
+    picture_width_px_ = protocol.display.width_px;
+    return;
+  }
+  if (!scene_) scene_ = LoadProtocolScene(protocol);
+  scene_->RequireSameSize(photo_, photo_path.string());
+  texture_ = ReadImage(render::ResolveStimulus(protocol.content.type == "grid" ? "grid" : protocol.content.texture));
+  compositor_ = std::make_unique<render::FrameCompositor>(scene_->camera, scene_->rvec, scene_->tvec, photo_);
+}
+
+StimulusRenderer::~StimulusRenderer() = default;
+
+cv::Size StimulusRenderer::FrameSize() const {
+  if (compositor_) return photo_.size();
+  return {picture_width_px_, picture_width_px_ * 3 / 4};
+}
+
+void StimulusRenderer::Compose(const TrialScene& trial, double t_s, double level) {
+  if (!compositor_) {
+    auto cached = std::find_if(upper_cache_.begin(), upper_cache_.end(),
+                               [&](const auto& entry) { return entry.first == level; });
+    if (cached == upper_cache_.end()) {
+      const int w = picture_width_px_, half = w * 3 / 4 / 2;
+      upper_cache_.emplace_back(level, render::PictureOnGrey(picture_, cv::Size(w, half), half * 6 / 10, level));
+      cached = std::prev(upper_cache_.end());
+    }
+    picture_frame_ = render::DepthMatchingFrame(cached->second, photo_, picture_width_px_);
+    return;
+  }
+  std::vector<render::BlurredObject> objects;
+  const calib::SceneCalib& s = *scene_;
+  for (const bool left : {true, false}) {
+    render::BlurredObject b;
+    render::VirtualObject& o = b.object;
+    o.texture = texture_;
+    const calib::BlurSource source = left ? trial.left : trial.right;
+    const double fixed = left ? trial.left_fixed_px : trial.right_fixed_px;
+    if (trial.content == "grid") {
+      o.kind = render::VirtualObject::Kind::kCard;
+      o.size_mm = 2 * s.board.square_mm;
+      o.center_board_mm = GridCentre(s, trial.edge, left);
+    } else {
+      const double y = trial.BallYMm(t_s);
+      if (!std::isfinite(y)) continue;  // wiped at the end of a section
+      const double radius = protocol_.content.radius_mm > 0 ? protocol_.content.radius_mm : kBallRadiusDefaultMm;
+      o.kind = render::VirtualObject::Kind::kBall;
+      o.size_mm = radius;
+      o.center_board_mm = BallCentre(s, y, radius, left);
+      o.spin_deg = -(y - trial.from_y_mm) / radius * 180 / M_PI;  // rolling without slipping
+    }
+    b.r_px = calib::BlurAtPx(s, source, s.ToCamera(o.center_board_mm), fixed);
+    objects.push_back(std::move(b));
+  }
+  compositor_->Compose(objects);
+}
+
+void StimulusRenderer::Present(int width_px, int height_px) {
+  if (compositor_)
+    compositor_->Present(width_px, height_px);
+  else
+    render::PresentImage(picture_frame_, width_px, height_px);
+}
+
+cv::Mat StimulusRenderer::Read() { return compositor_ ? compositor_->Read() : picture_frame_.clone(); }
+
+}  // namespace blurcue::session

@@ -1,0 +1,89 @@
+#pragma once
+// What a trial shows, worked out from the protocol, the trial and the calibrated scene before anything is drawn
+// (TrialScene: pure, no GL), and the frames that show it (StimulusRenderer: GL).
+//   grid    - two 5x5 grid cards lying on the table beside the board, left and right of it, aligned with an edge
+//             (test 1), each blurred by its side's source at its own depth;
+//   ball    - two balls rolling side by side along sections 3 and 5 of the board (tests 2 and 3): edge 1 -> 11 at
+//             the pattern's speed, or with a `section` s only from edge s to s + 1 and then wiped;
+//   picture - the depth-matching frame (thesis 3.2): the picture low-passed at the adjusted cut-off on grey above,
+//             the scene photo below.
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "calib/scene_blur.h"
+#include "protocol/protocol.h"
+#include "protocol/trials.h"
+
+namespace blurcue::render {
+class FrameCompositor;
+}
+
+namespace blurcue::session {
+
+struct TrialScene {
+  std::string content;                // "grid" | "ball" | "picture"
+  // Pairs (grid, ball): the source on each side as shown (swaps applied).
+  calib::BlurSource left = calib::BlurSource::kNone, right = calib::BlurSource::kNone;
+  double left_fixed_px = 0, right_fixed_px = 0;
+  int edge = 1;                       // grid: the edge the cards are aligned with
+  double from_y_mm = 0, to_y_mm = 0;  // ball: along the board's y
+  double speed_mm_s = 0;              // ball: 0 = at rest at from_y_mm
+  bool wipe_at_end = false;           // ball: disappear on arrival (a section run)
+  double distance_m = 0;              // picture: the real picture's distance
+  // The radii rendered, averaged over the run for balls, and the scene's own blur (the fitted model) there.
+  double r_left_px = 0, r_right_px = 0, r_scene_px = 0;
+
+  // Seconds of motion (0 for a static stimulus).
+  double MotionS() const;
+  // The balls' y (board frame, mm) at t_s after onset; negative infinity when wiped.
+  double BallYMm(double t_s) const;
+};
+
+// Works out a trial's scene. `scene` may be null for a picture. Throws Error naming the protocol file and the
+// trial when a level needed is missing or a source cannot be evaluated (e.g. eq. 3.7 nearer than focus).
+TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Trial& trial,
+                         const calib::SceneCalib* scene);
+
+// The variables recorded with a trial beside its factor levels: practice, block_name, swapped, and r_left_px,
+// r_right_px, r_scene_px (pairs) or start_level (adjustment).
+Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene);
+
+// The protocol's calibration (none for a picture, which needs none).
+std::optional<calib::SceneCalib> LoadProtocolScene(const protocol::Protocol& protocol);
+
+class StimulusRenderer {
+ public:
+  // Needs a current GL context. Loads the photo the protocol shows and the textures; `scene` is the protocol's
+  // calibration (LoadProtocolScene), copied.
+  StimulusRenderer(const protocol::Protocol& protocol, const std::optional<calib::SceneCalib>& scene);
+  ~StimulusRenderer();
+  StimulusRenderer(const StimulusRenderer&) = delete;
+  StimulusRenderer& operator=(const StimulusRenderer&) = delete;
+
+  const calib::SceneCalib* scene() const { return scene_ ? &*scene_ : nullptr; }
+  // Size of the frames it makes (the photo's, or the depth-matching frame's).
+  cv::Size FrameSize() const;
+  // Composes the frame t_s after onset; `level` is the adjustment level shown (picture only).
+  void Compose(const TrialScene& trial, double t_s, double level);
+  // Shows the last composed frame in the current window, fitted to width x height.
+  void Present(int width_px, int height_px);
+  // The last composed frame, 8-bit sRGB BGR.
+  cv::Mat Read();
+
+ private:
+  const protocol::Protocol& protocol_;
+  std::optional<calib::SceneCalib> scene_;
+  cv::Mat photo_, texture_;
+  std::unique_ptr<render::FrameCompositor> compositor_;
+  // Picture: the upper halves by cut-off, made once each (the Butterworth runs on the CPU).
+  cv::Mat picture_;
+  std::vector<std::pair<double, cv::Mat>> upper_cache_;
+  cv::Mat picture_frame_;
+  int picture_width_px_ = 960;
+};
+
+}  // namespace blurcue::session
