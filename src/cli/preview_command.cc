@@ -1,5 +1,6 @@
 // blurcue preview: a contact sheet of every distinct stimulus of a protocol, to check it by eye before any
 // participant sits down.
+#include <algorithm>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -49,7 +50,8 @@ void AddPreviewCommand(CLI::App& app) {
       const protocol::Trial* trial;
       session::TrialScene scene;
       double level;
-      std::string label;
+      std::string label, label2;  // levels; the sides and their radii
+      Json key;                    // sorts the sheet by level
     };
     std::vector<Tile> tiles;
     std::map<std::string, bool> seen;
@@ -61,7 +63,7 @@ void AddPreviewCommand(CLI::App& app) {
           std::snprintf(label, sizeof label, "%s %g", p.blocks.front().adjust ? p.blocks.front().adjust->parameter.c_str()
                                                                               : "level", level);
           if (!seen.emplace(label, true).second) continue;
-          tiles.push_back({&t, s, level, label});
+          tiles.push_back({&t, s, level, label, "", Json(level)});
         }
         continue;
       }
@@ -73,18 +75,19 @@ void AddPreviewCommand(CLI::App& app) {
       for (const auto& [name, value] : t.levels.items())
         levels += (levels.empty() ? "" : " ") + name + " " +
                   (value.is_object() && value.contains("id") ? value["id"].dump() : value.dump());
-      char label[256];
-      std::snprintf(label, sizeof label, "%s | L %s %.2f px  R %s %.2f px", levels.c_str(),
+      char sides[256];
+      std::snprintf(sides, sizeof sides, "L %s %.2f px | R %s %.2f px",
                     t.left.is_string() ? t.left.get<std::string>().c_str() : t.left.dump().c_str(), s.r_left_px,
                     t.right.is_string() ? t.right.get<std::string>().c_str() : t.right.dump().c_str(), s.r_right_px);
-      tiles.push_back({&t, s, 0, label});
+      tiles.push_back({&t, s, 0, levels, sides, key});
     }
+    std::stable_sort(tiles.begin(), tiles.end(), [](const Tile& a, const Tile& b) { return a.key < b.key; });
     if (tiles.empty()) throw InputError(args->protocol, "the protocol makes no trials to preview");
 
     auto context = render::GlContext::CreateOffscreen();
     session::StimulusRenderer renderer(p, scene);
     const cv::Size frame = renderer.FrameSize();
-    const int tw = args->tile_width, th = tw * frame.height / frame.width, strip = 22;
+    const int tw = args->tile_width, th = tw * frame.height / frame.width, strip = 34;
     const int cols = std::min<int>(args->columns, int(tiles.size()));
     const int rows = (int(tiles.size()) + cols - 1) / cols;
     cv::Mat sheet(rows * (th + strip), cols * tw, CV_8UC3, cv::Scalar(40, 40, 40));
@@ -94,8 +97,10 @@ void AddPreviewCommand(CLI::App& app) {
       cv::resize(renderer.Read(), small, cv::Size(tw, th), 0, 0, cv::INTER_AREA);
       const int x = int(i % size_t(cols)) * tw, y = int(i / size_t(cols)) * (th + strip);
       small.copyTo(sheet(cv::Rect(x, y, tw, th)));
-      cv::putText(sheet, "#" + std::to_string(i + 1) + " " + tiles[i].label, {x + 4, y + th + 15},
+      cv::putText(sheet, "#" + std::to_string(i + 1) + " " + tiles[i].label, {x + 4, y + th + 14},
                   cv::FONT_HERSHEY_SIMPLEX, 0.36, cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
+      cv::putText(sheet, tiles[i].label2, {x + 4, y + th + 28}, cv::FONT_HERSHEY_SIMPLEX, 0.36,
+                  cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
       std::fprintf(stderr, "\rpreview: %zu of %zu", i + 1, tiles.size());
     }
     std::fprintf(stderr, "\n");

@@ -41,7 +41,7 @@ struct PairView {
   double r_left_px = 0, r_right_px = 0, r_scene_px = 0;
 };
 
-// One key press at a time offset from the moment the observer starts looking.
+// One key press, after_ms after the previous one (the first: after the observer starts looking).
 struct KeyPress {
   std::string action;  // "left" | "right" | "cant_tell" | "previous" | "next" | "accept"
   double after_ms = 0;

@@ -209,7 +209,8 @@ class Runner {
       SimulatedObserver observer(*observer_, TrialSeed(seed_, trial.index));
       if (trial.task == Task::kForcedChoice) {
         const KeyPress press = observer.ChooseSide({scene.r_left_px, scene.r_right_px, scene.r_scene_px});
-        station_.Script(keys_.Key(press.action), onset + press.after_ms / 1000);
+        // A moving stimulus is watched to its end before the answer (task 1 is one answer per run).
+        station_.Script(keys_.Key(press.action), onset + scene.MotionS() + press.after_ms / 1000);
       } else {
         double t = onset;
         for (const KeyPress& press : observer.Adjust(trial.adjust_levels, trial.start_index, scene.distance_m)) {
@@ -271,7 +272,10 @@ class Runner {
     const auto wall_start = std::chrono::steady_clock::now();
     const bool tty = isatty(2);
     auto progress = [&](int64_t done) {
-      if (!options_.progress) return;
+      // A terminal gets one line rewritten after every answer; a log gets about ten lines.
+      if (!options_.progress || (!tty && done % std::max<int64_t>(1, result.trial_count / 10) != 0 &&
+                                 done != result.trial_count))
+        return;
       const double elapsed =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
       const int64_t now = done - result.answered_before;
