@@ -1,0 +1,15 @@
+# The Python analysis package (analysis/): statistics against hand-computed answers, and report.py end to end on
+# synthetic inputs. Debian's interpreter on purpose: it is the one that sees python3-pandas, -scipy, -matplotlib and
+# -statsmodels. Included from the top CMakeLists.txt; run with `ctest -L analysis`.
+set(BLURCUE_ANALYSIS_PYTHON /usr/bin/python3 CACHE FILEPATH "Python with pandas, scipy, matplotlib, statsmodels")
+
+add_test(NAME analysis.stats
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_stats.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+add_test(NAME analysis.report
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_report.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(analysis.stats analysis.report PROPERTIES
+                     LABELS analysis TIMEOUT 180
+                     # Matplotlib writes its font cache under HOME; keep it out of a read-only or shared home.
+                     ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")

@@ -1,0 +1,11 @@
+# Copies the shipped protocols into OUT/protocols, pointed at the CLI tests' scene (OUT/scene, OUT/calib.json)
+# instead of the demo's, and at the shipped stimuli by absolute path.
+file(GLOB protocols ${SRC}/protocols/*.json)
+file(MAKE_DIRECTORY ${OUT}/protocols)
+foreach(p ${protocols})
+  get_filename_component(name ${p} NAME)
+  file(READ ${p} text)
+  string(REPLACE "../results/demo/" "../" text "${text}")
+  string(REPLACE "../stimuli/" "${SRC}/stimuli/" text "${text}")
+  file(WRITE ${OUT}/protocols/${name} "${text}")
+endforeach()

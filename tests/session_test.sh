@@ -1,0 +1,137 @@
+#!/usr/bin/env bash
+# End-to-end tests of `blurcue run` on real SQLite files: usage: session_test.sh CASE BLURCUE DIR
+# DIR holds protocols/ (tests/copy_protocols.cmake) and the scene they show. Each case prints what it checked and
+# exits non-zero on the first failure.
+set -euo pipefail
+CASE=$1 BC=$2 DIR=$3
+P=$DIR/protocols
+W=$DIR/session-$CASE
+rm -rf "$W" && mkdir -p "$W"
+PY=/usr/bin/python3
+fail() { echo "FAIL: $*" >&2; exit 1; }
+sql() { $PY - "$1" "$2" <<'PYEOF'
+import sqlite3, sys
+con = sqlite3.connect(sys.argv[1])
+for row in con.execute(sys.argv[2]):
+    print("|".join("" if v is None else str(v) for v in row))
+PYEOF
+}
+# Everything a session decided (not when it was answered): trials, choices, response times, steps, frames.
+fingerprint() {
+  sql "$1" "SELECT t.trial_index, t.block, t.factors, t.left_shown, t.right_shown, r.choice, printf('%.3f', r.rt_ms),
+            r.adjustment, (SELECT count(*) FROM frames f WHERE f.trial_id = t.id)
+            FROM trials t JOIN sessions s ON s.id = t.session_id JOIN participants p ON p.id = s.participant_id
+            LEFT JOIN responses r ON r.trial_id = t.id WHERE p.code = '$2' ORDER BY t.trial_index"
+}
+integrity() { [ "$(sql "$1" 'PRAGMA integrity_check')" = ok ] || fail "integrity_check of $1"; }
+
+case $CASE in
+complete)
+  # A whole session by the simulated observer: every trial answered once, every edge once per participant, and
+  # by_participant sides exact: odd numbers see measured on the left, even ones on the right.
+  for id in P1 P2; do $BC run "$P/test1-static-grids.json" --participant $id --db "$W/s.sqlite" --observer sim; done
+  integrity "$W/s.sqlite"
+  [ "$(sql "$W/s.sqlite" "SELECT count(*) FROM responses")" = 26 ] || fail "26 answers expected"
+  [ "$(sql "$W/s.sqlite" "SELECT group_concat(status) FROM sessions")" = "completed,completed" ] || fail "status"
+  edges=$(sql "$W/s.sqlite" "SELECT group_concat(e) FROM (SELECT json_extract(factors, '$.edge') e FROM trials t
+          JOIN sessions s ON s.id = t.session_id JOIN participants p ON p.id = s.participant_id
+          WHERE p.code = 'P1' AND json_extract(factors, '$.practice') = 0 ORDER BY e)")
+  [ "$edges" = "1,2,3,4,5,6,7,8,9,10,11" ] || fail "edges of P1: $edges"
+  sides=$(sql "$W/s.sqlite" "SELECT p.code, t.left_shown, count(*) FROM trials t JOIN sessions s ON s.id = t.session_id
+          JOIN participants p ON p.id = s.participant_id GROUP BY p.code, t.left_shown ORDER BY p.code")
+  [ "$sides" = $'P1|"measured"|13\nP2|"estimated"|13' ] || fail "sides: $sides"
+  [ "$(sql "$W/s.sqlite" "SELECT min(n) > 0 FROM (SELECT count(f.id) n FROM trials t LEFT JOIN frames f ON f.trial_id = t.id GROUP BY t.id)")" = 1 ] \
+    || fail "every trial records its frames"
+  $BC export --db "$W/s.sqlite" --out "$W/export"
+  head -1 "$W/export/trials.csv" | grep -q "edge,practice,r_left_px,r_right_px,r_scene_px,swapped,left,right,choice" \
+    || fail "export header: $(head -1 "$W/export/trials.csv")"
+  echo "ok: 2 participants x 13 trials, edges and sides as designed, frames recorded, exported" ;;
+same_seed)
+  # The same protocol, participant and seed give the same trials and (simulated) answers; another seed does not.
+  for db in a b; do $BC run "$P/test2-moving-balls.json" --participant S1 --db "$W/$db.sqlite" --observer sim --seed 11; done
+  $BC run "$P/test2-moving-balls.json" --participant S1 --db "$W/c.sqlite" --observer sim --seed 12
+  [ "$(fingerprint "$W/a.sqlite" S1)" = "$(fingerprint "$W/b.sqlite" S1)" ] || fail "same seed, different sessions"
+  [ "$(fingerprint "$W/a.sqlite" S1)" != "$(fingerprint "$W/c.sqlite" S1)" ] || fail "another seed, same session"
+  [ "$(fingerprint "$W/a.sqlite" S1 | wc -l)" = 74 ] || fail "74 trials expected"
+  echo "ok: same seed, same 74 trials and answers; seed 12 differs" ;;
+resume)
+  # Stopped after 20 answers and resumed equals uninterrupted, for the depth-matching adjustment too.
+  for proto in test2-moving-balls pre-research-depth-matching; do
+    $BC run "$P/$proto.json" --participant R2 --db "$W/whole.sqlite" --observer sim --seed 5
+    $BC run "$P/$proto.json" --participant R2 --db "$W/parts.sqlite" --observer sim --seed 5 --stop-after 20 \
+      | grep -q "not finished" || fail "$proto: stop-after did not leave the session open"
+    if $BC run "$P/$proto.json" --participant R2 --db "$W/parts.sqlite" --observer sim --seed 5 2>"$W/err"; then
+      fail "$proto: a second session started while one is running"
+    fi
+    grep -q "running session" "$W/err" || fail "$proto: message: $(cat "$W/err")"
+    $BC run "$P/$proto.json" --participant R2 --db "$W/parts.sqlite" --observer sim --seed 5 --resume | grep -q completed
+    [ "$(fingerprint "$W/whole.sqlite" R2)" = "$(fingerprint "$W/parts.sqlite" R2)" ] || fail "$proto: resumed differs"
+  done
+  integrity "$W/parts.sqlite"
+  echo "ok: stopped at 20 and resumed = uninterrupted (test 2, depth matching)" ;;
+kill9)
+  # kill -9 in the middle of a session, then --resume: nothing lost, nothing twice, same as uninterrupted.
+  $BC run "$P/test2-moving-balls.json" --participant K1 --db "$W/whole.sqlite" --observer sim --seed 9 --sim-fps 8
+  $BC run "$P/test2-moving-balls.json" --participant K1 --db "$W/killed.sqlite" --observer sim --seed 9 --sim-fps 8 \
+    > "$W/out" 2>&1 &
+  pid=$!
+  for _ in $(seq 1 600); do
+    n=$(sql "$W/killed.sqlite" "SELECT count(*) FROM responses" 2>/dev/null || echo 0)
+    [ "${n:-0}" -ge 8 ] && break
+    sleep 0.05
+  done
+  kill -9 $pid; wait $pid 2>/dev/null || true
+  answered=$(sql "$W/killed.sqlite" "SELECT count(*) FROM responses")
+  [ "$answered" -ge 8 ] && [ "$answered" -lt 74 ] || fail "killed after $answered answers, expected mid-session"
+  integrity "$W/killed.sqlite"
+  $BC run "$P/test2-moving-balls.json" --participant K1 --db "$W/killed.sqlite" --observer sim --seed 9 --sim-fps 8 --resume \
+    | grep -q "74 of 74 trials answered" || fail "resume did not complete"
+  [ "$(fingerprint "$W/whole.sqlite" K1)" = "$(fingerprint "$W/killed.sqlite" K1)" ] || fail "killed+resumed differs"
+  integrity "$W/killed.sqlite"
+  echo "ok: killed -9 after $answered answers, resumed: identical to the uninterrupted session" ;;
+second_writer)
+  # While one process runs a session, a second one resuming it is refused with a clear message (exit 3).
+  $BC run "$P/test2-moving-balls.json" --participant L1 --db "$W/s.sqlite" --observer sim --sim-fps 8 > /dev/null 2>&1 &
+  pid=$!
+  for _ in $(seq 1 600); do
+    n=$(sql "$W/s.sqlite" "SELECT count(*) FROM responses" 2>/dev/null || echo 0)
+    [ "${n:-0}" -ge 1 ] && break
+    sleep 0.05
+  done
+  set +e
+  $BC run "$P/test2-moving-balls.json" --participant L1 --db "$W/s.sqlite" --observer sim --resume 2> "$W/err"
+  code=$?
+  set -e
+  kill $pid 2>/dev/null; wait $pid 2>/dev/null || true
+  [ $code = 3 ] || fail "second writer exit $code: $(cat "$W/err")"
+  grep -q "is being written by pid" "$W/err" || fail "message: $(cat "$W/err")"
+  integrity "$W/s.sqlite"
+  echo "ok: second writer refused: $(cat "$W/err")" ;;
+window)
+  # A person at a real window under Xvfb: synthetic key presses (xdotool) answer test 1; the answers are in the
+  # record as pressed: Left = left, Right = right, Down = can't tell.
+  command -v xdotool >/dev/null || { echo "SKIP: xdotool missing"; exit 0; }
+  export DISPLAY=:$((90 + RANDOM % 100))
+  Xvfb $DISPLAY -screen 0 1280x1024x24 -nolisten tcp > "$W/xvfb.log" 2>&1 &
+  xvfb=$!
+  trap 'kill $xvfb 2>/dev/null || true' EXIT
+  sleep 1
+  $BC run "$P/test1-static-grids.json" --participant W1 --db "$W/s.sqlite" > "$W/out" 2> "$W/err" &
+  run=$!
+  wid=$(xdotool search --sync --name "blurcue - test1-static-grids" | head -1)
+  # welcome, practice screen, 2 practice answers, main-part screen, 11 answers.
+  keys=(Return Return Left Right Return Left Right Down Left Right Down Left Right Down Left Left)
+  for k in "${keys[@]}"; do
+    sleep 0.9
+    xdotool key --window "$wid" "$k" 2>/dev/null || xdotool key "$k"
+  done
+  wait $run || fail "run failed: $(cat "$W/err")"
+  got=$(sql "$W/s.sqlite" "SELECT group_concat(r.choice) FROM (SELECT r.choice FROM responses r JOIN trials t ON t.id = r.trial_id ORDER BY t.trial_index) r")
+  [ "$got" = "left,right,left,right,cant_tell,left,right,cant_tell,left,right,cant_tell,left,left" ] || fail "answers: $got"
+  [ "$(sql "$W/s.sqlite" "SELECT status FROM sessions")" = completed ] || fail "session not completed"
+  [ "$(sql "$W/s.sqlite" "SELECT min(rt_ms) > 100 FROM responses")" = 1 ] || fail "response times"
+  [ "$(sql "$W/s.sqlite" "SELECT count(*) > 13 FROM frames")" = 1 ] || fail "frames"
+  integrity "$W/s.sqlite"
+  echo "ok: 13 keys pressed in a window under Xvfb, 13 answers recorded as pressed: $(tail -1 "$W/out")" ;;
+*) fail "unknown case $CASE" ;;
+esac

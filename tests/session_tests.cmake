@@ -1,0 +1,28 @@
+# End-to-end tests of blurcue run / preview on real SQLite files, over the CLI tests' scene (fixtures scene, calib).
+set(BC $<TARGET_FILE:blurcue>)
+set(T ${PROJECT_BINARY_DIR}/cli-test)
+add_test(NAME session_protocols
+         COMMAND ${CMAKE_COMMAND} -DSRC=${PROJECT_SOURCE_DIR} -DOUT=${T} -P ${PROJECT_SOURCE_DIR}/tests/copy_protocols.cmake)
+set_tests_properties(session_protocols PROPERTIES FIXTURES_SETUP session_protocols)
+foreach(case complete same_seed resume kill9 second_writer window)
+  add_test(NAME session_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/session_test.sh ${case} ${BC} ${T})
+  set_tests_properties(session_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS "gl;session"
+                       PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+endforeach()
+set_tests_properties(session_window PROPERTIES LABELS "gl;session;window")
+
+add_test(NAME session_preview
+         COMMAND ${BC} preview ${T}/protocols/test1-static-grids.json --out ${T}/preview-test1.png)
+set_tests_properties(session_preview PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS gl
+                     PASS_REGULAR_EXPRESSION "11 distinct stimuli of 13 trials")
+add_test(NAME session_run_broken_protocol
+         COMMAND ${CMAKE_COMMAND} -DCMD=${BC}
+                 "-DARGS=run;${PROJECT_SOURCE_DIR}/tests/data/broken-protocol.json;--participant;P1;--db;${T}/broken.sqlite;--observer;sim"
+                 -DEXPECT_CODE=3 "-DEXPECT_TEXT=broken-protocol.json: /"
+                 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+add_test(NAME session_run_bad_observer
+         COMMAND ${CMAKE_COMMAND} -DCMD=${BC}
+                 "-DARGS=run;${T}/protocols/test1-static-grids.json;--participant;P1;--db;${T}/bad-observer.sqlite;--observer;sim:jdn=1"
+                 -DEXPECT_CODE=2 "-DEXPECT_TEXT=--observer: unknown parameter 'jdn'"
+                 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+set_tests_properties(session_run_bad_observer PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols")
