@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The main job: set up, make a ground-truth scene (the thesis's set-up), calibrate it, and compare the measured,
-# estimated and true blur of every edge. Everything lands in results/demo/.
+# The main job: set up, make a ground-truth scene (the thesis's set-up), calibrate it, render stimuli from it, run
+# the thesis's test 1 and test 2 with simulated observers into an SQLite record, export the tables and write the
+# report. Everything lands in results/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
@@ -16,4 +17,16 @@ $BC render --calib "$OUT/calib.json" --background "$OUT/scene/scene.png" --objec
     --blur estimated --out "$OUT/ball-edge9-estimated.png"
 $BC animate --calib "$OUT/calib.json" --background "$OUT/scene/scene.png" --left estimated --right none \
     --speed-cm-s 3 --fps 30 --video "$OUT/pattern3.avi" --log "$OUT/pattern3-frames.csv"
-echo "demo: results in $OUT/ (calib.json, ball-edge9-estimated.png, pattern3.avi)"
+# The studies: the shipped protocols (they point at this scene), checked by eye first, then run by simulated
+# observers - 6 participants of test 1 and 4 of test 2, each with their own recorded seed - into one record.
+# A fresh record each time: a demo run twice must not meet its own earlier sessions.
+$BC preview protocols/test1-static-grids.json --out "$OUT/preview-test1.png"
+rm -f "$OUT/study.sqlite" "$OUT/study.sqlite-wal" "$OUT/study.sqlite-shm"
+for i in 1 2 3 4 5 6; do
+  $BC run protocols/test1-static-grids.json --participant "P$i" --db "$OUT/study.sqlite" --observer sim
+done
+for i in 1 2 3 4; do
+  $BC run protocols/test2-moving-balls.json --participant "P$i" --db "$OUT/study.sqlite" --observer sim
+done
+$BC report --db "$OUT/study.sqlite" --out "$OUT/report"
+echo "demo: results in $OUT/ (calib.json, ball-edge9-estimated.png, pattern3.avi, study.sqlite, report/index.html)"

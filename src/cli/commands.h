@@ -18,5 +18,6 @@ void AddMakeStimuliCommand(CLI::App& app);  // make_stimuli_command.cc
 void AddValidateCommand(CLI::App& app);     // validate_command.cc
 void AddRunCommand(CLI::App& app);          // run_command.cc
 void AddPreviewCommand(CLI::App& app);      // preview_command.cc
+void AddReportCommand(CLI::App& app);       // report_command.cc
 
 }  // namespace blurcue::cli

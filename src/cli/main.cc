@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
       {"run", &cli::AddRunCommand},
       {"export", &cli::AddExportCommand},
       {"merge", &cli::AddMergeCommand},
+      {"report", &cli::AddReportCommand},
       {"bench", &cli::AddBenchCommand},
   };
   for (const auto& [name, add] : commands) add(app);

@@ -17,13 +17,17 @@ void AddExportCommand(CLI::App& app) {
       "export",
       "Write a record's answers as a long-format table: DIR/trials.csv, one row per planned trial (answered or\n"
       "not), the same columns for every participant (study, protocol_hash, participant, session, seed,\n"
-      "trial_index, block, every factor, left, right, choice, rt_ms, answered_at).\n"
+      "trial_index, block, every trial variable, left, right, choice, rt_ms, answered_at), and per study\n"
+      "DIR/summary-STUDY.csv: per session the trials planned and answered, the median response time and how often\n"
+      "each answer was given (the source chosen or cant_tell; the level accepted). Practice trials are left out\n"
+      "of the summaries.\n"
       "Example: blurcue export --db results/study.sqlite --out results/tables");
   cmd->add_option("--db", args->db, "the SQLite record")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "folder for the tables (created)")->required();
   cmd->callback([args] {
     const int64_t rows = store::ExportCsv(args->db, args->out);
-    std::printf("wrote %s/trials.csv (%lld rows)\n", args->out.c_str(), static_cast<long long>(rows));
+    std::printf("wrote %s/trials.csv (%lld rows) and the per-study summaries\n", args->out.c_str(),
+                static_cast<long long>(rows));
   });
 }
 

@@ -2,7 +2,10 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <charconv>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <set>
@@ -53,6 +56,98 @@ std::string Where(const std::filesystem::path& db, int64_t session, int64_t tria
   return db.string() + ": session " + std::to_string(session) + " trial " + std::to_string(trial);
 }
 
+// Writes `text` to `path` through a temporary file renamed over it: a reader sees the old file or the new one.
+void WriteAtomically(const std::filesystem::path& path, const std::string& text) {
+  const std::filesystem::path temp = path.string() + ".tmp" + std::to_string(getpid());
+  std::error_code error;
+  {
+    std::ofstream out(temp, std::ios::binary);
+    if (!out) throw InputError(temp.string(), "cannot write");
+    out << text;
+    out.close();
+    if (!out) {
+      std::filesystem::remove(temp, error);
+      throw InputError(temp.string(), "write failed");
+    }
+  }
+  std::filesystem::rename(temp, path, error);
+  if (error) throw InputError(path.string(), "cannot replace: " + error.message());
+}
+
+std::string CsvLine(const std::vector<std::string>& cells) {
+  std::string line;
+  for (size_t i = 0; i < cells.size(); ++i) {
+    if (i) line += ',';
+    line += CsvField(cells[i]);
+  }
+  return line + "\r\n";
+}
+
+// Per study, one row per session: trials planned and answered (practice apart), the median response time, and
+// how often each answer was given - for forced choice the source chosen (the one shown on the side picked) or
+// cant_tell, for adjustment the level accepted. Writes OUT/summary-STUDY.csv for every study; returns the files.
+std::vector<std::filesystem::path> WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
+  struct Row {
+    std::string participant, status;
+    int64_t planned = 0, answered = 0;
+    std::vector<double> rts;
+    std::map<std::string, int64_t> answers;
+  };
+  std::map<std::string, std::map<int64_t, Row>> studies;
+  // Answers in a natural order: numbers (adjustment levels) by value, then names.
+  struct Natural {
+    bool operator()(const std::string& a, const std::string& b) const {
+      char* ea = nullptr;
+      char* eb = nullptr;
+      const double x = std::strtod(a.c_str(), &ea), y = std::strtod(b.c_str(), &eb);
+      const bool na = !a.empty() && *ea == '\0', nb = !b.empty() && *eb == '\0';
+      if (na != nb) return na;
+      return na && x != y ? x < y : a < b;
+    }
+  };
+  std::map<std::string, std::set<std::string, Natural>> answer_names;
+  Statement rows(db,
+                 "SELECT st.name, p.code, s.id, s.status, r.id IS NOT NULL, r.choice, r.rt_ms, "
+                 "CASE r.choice WHEN 'left' THEN t.left_shown WHEN 'right' THEN t.right_shown END "
+                 "FROM trials t JOIN sessions s ON s.id = t.session_id "
+                 "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
+                 "LEFT JOIN responses r ON r.trial_id = t.id "
+                 "WHERE coalesce(json_extract(t.factors, '$.practice'), 0) = 0 ORDER BY st.name, p.code, s.id");
+  while (rows.Step()) {
+    Row& row = studies[rows.GetText(0)][rows.GetInt64(2)];
+    row.participant = rows.GetText(1);
+    row.status = rows.GetText(3);
+    ++row.planned;
+    if (rows.GetInt64(4) == 0) continue;
+    ++row.answered;
+    if (!rows.IsNull(6)) row.rts.push_back(rows.GetDouble(6));
+    const std::string answer = rows.IsNull(7) ? rows.GetText(5) : Cell(Json::parse(rows.GetText(7)));
+    ++row.answers[answer];
+    answer_names[rows.GetText(0)].insert(answer);
+  }
+  std::vector<std::filesystem::path> files;
+  for (auto& [study, sessions] : studies) {
+    std::vector<std::string> header = {"participant", "session", "status", "planned", "answered", "median_rt_ms"};
+    for (const auto& name : answer_names[study]) header.push_back("n_" + name);
+    std::string text = CsvLine(header);
+    for (auto& [session, row] : sessions) {
+      std::sort(row.rts.begin(), row.rts.end());
+      const size_t n = row.rts.size();
+      const std::string median = n == 0 ? "" : Number(n % 2 ? row.rts[n / 2] : 0.5 * (row.rts[n / 2 - 1] + row.rts[n / 2]));
+      std::vector<std::string> cells = {row.participant, std::to_string(session), row.status,
+                                        std::to_string(row.planned), std::to_string(row.answered), median};
+      for (const auto& name : answer_names[study]) cells.push_back(std::to_string(row.answers[name]));
+      text += CsvLine(cells);
+    }
+    std::string safe = study;
+    for (char& c : safe)
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+    files.push_back(out_dir / ("summary-" + safe + ".csv"));
+    WriteAtomically(files.back(), text);
+  }
+  return files;
+}
+
 void RemoveDatabaseFiles(const std::filesystem::path& path) {
   std::error_code ignored;
   for (const char* suffix : {"", "-wal", "-shm", "-journal"})
@@ -95,11 +190,7 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
   std::error_code error;
   std::filesystem::create_directories(out_dir, error);
   if (error) throw InputError(out_dir.string(), "cannot create the folder: " + error.message());
-  const std::filesystem::path final_path = out_dir / "trials.csv";
-  const std::filesystem::path temp_path = out_dir / ("trials.csv.tmp" + std::to_string(getpid()));
-  std::ofstream out(temp_path, std::ios::binary);
-  if (!out) throw InputError(temp_path.string(), "cannot write");
-
+  std::string text;
   std::string header;
   auto add = [&header](const std::string& name) {
     if (!header.empty()) header += ',';
@@ -108,7 +199,7 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
   for (const auto& name : LeadingColumns()) add(name);
   for (const auto& key : keys) add(fixed.count(key) ? std::string("factor_").append(key) : key);
   for (const auto& name : TrailingColumns()) add(name);
-  out << header << "\r\n";
+  text += header + "\r\n";
 
   Statement rows(db,
                  "SELECT st.name, pv.hash, p.code, s.id, s.seed, t.trial_index, t.block, t.factors, t.left_shown, "
@@ -138,21 +229,11 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
     cells.push_back(answered ? rows.GetText(10) : "");
     cells.push_back(answered && !rows.IsNull(11) ? Number(rows.GetDouble(11)) : "");
     cells.push_back(answered ? rows.GetText(12) : "");
-    std::string line;
-    for (size_t i = 0; i < cells.size(); ++i) {
-      if (i) line += ',';
-      line += CsvField(cells[i]);
-    }
-    out << line << "\r\n";
+    text += CsvLine(cells);
     ++count;
   }
-  out.close();
-  if (!out) {
-    std::filesystem::remove(temp_path, error);
-    throw InputError(temp_path.string(), "write failed");
-  }
-  std::filesystem::rename(temp_path, final_path, error);
-  if (error) throw InputError(final_path.string(), "cannot replace: " + error.message());
+  WriteAtomically(out_dir / "trials.csv", text);
+  WriteSummaries(db, out_dir);
   return count;
 }
 

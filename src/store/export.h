@@ -11,6 +11,9 @@ namespace blurcue::store {
 //   study, protocol_hash, participant, session, seed, trial_index, block, <every factor key found in the record,
 //   sorted>, left, right, choice, rt_ms, answered_at
 // A factor a trial lacks is an empty cell; a factor named like a fixed column is written as "factor_<name>".
+// Beside it, per study, `out_dir`/summary-STUDY.csv: one row per session with the trials planned and answered
+// (practice apart), the median response time and the count of every answer (forced choice: the source chosen, or
+// cant_tell; adjustment: the level accepted) as n_ANSWER columns.
 // Returns the number of rows. Throws Error(kInput) for a file that is not a current blurcue record.
 int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::path& out_dir);
 

@@ -1,0 +1,185 @@
+"""Shared helpers of the analysis scripts: reading trials.csv, the chart record, the paper style, saving figures."""
+import json
+import math
+import os
+from collections import namedtuple
+
+import matplotlib
+
+matplotlib.use("Agg")  # files only, no display
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from stats import wilson  # noqa: E402
+
+# What every chart function returns, one per chart: png/svg are None for a table-only entry or a skipped section.
+Chart = namedtuple("Chart", "name png svg table notes")
+
+STUDY_DEPTH = "pre-research-depth-matching"
+STUDY_TEST1 = "test1-static-grids"
+STUDY_TEST2 = "test2-moving-balls"
+STUDY_TEST3 = "test3-no-board"
+FORCED_CHOICE_STUDIES = (STUDY_TEST1, STUDY_TEST2, STUDY_TEST3)
+STUDY_TITLES = {
+    STUDY_DEPTH: "pre-research depth matching",
+    STUDY_TEST1: "test 1 (static grids)",
+    STUDY_TEST2: "test 2 (moving balls)",
+    STUDY_TEST3: "test 3 (no board)",
+}
+
+LEADING = ["study", "protocol_hash", "participant", "session", "seed", "trial_index", "block"]
+TRAILING = ["left", "right", "choice", "rt_ms", "answered_at"]
+NUMERIC = ["edge", "section", "distance_m", "r_left_px", "r_right_px", "r_scene_px", "start_level", "rt_ms",
+           "trial_index", "session"]
+
+# One colour per blur source, the same in every chart (colour-blind-safe Okabe-Ito hues).
+SOURCE_COLORS = {"measured": "#0072B2", "estimated": "#E69F00", "none": "#999999", "fitted": "#009E73",
+                 "cant_tell": "#CC79A7"}
+SOURCE_LABELS = {"measured": "measured", "estimated": "estimated", "none": "no blur", "fitted": "fitted model",
+                 "cant_tell": "can't tell"}
+
+
+class TrialsError(Exception):
+    """trials.csv is missing or unreadable; the message names the file."""
+
+
+class Skip(Exception):
+    """A section cannot be drawn from these data; the message says why (shown in index.html)."""
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# Reading
+
+
+def _flag(value):
+    """0/1 flags as the export writes them: '0'/'1', or JSON 'true'/'false' (a bool factor dumped as JSON)."""
+    text = str(value).strip().lower()
+    if text in ("1", "true", "1.0"):
+        return 1
+    if text in ("0", "false", "0.0", ""):
+        return 0
+    return np.nan
+
+
+def _json_object(text):
+    if not isinstance(text, str) or not text.strip():
+        return None
+    try:
+        value = json.loads(text)
+    except ValueError:
+        return None
+    return value if isinstance(value, dict) else None
+
+
+def load_trials(path):
+    """trials.csv -> DataFrame with typed columns; raises TrialsError naming the file when it cannot be used.
+
+    Cells are read as text first (an empty cell is 'not applicable', not 0), then the numeric columns are converted.
+    Adds: practice/swapped as 0/1, answered (bool), and for pattern cells pattern_id, speed_cm_s, pattern_left,
+    pattern_right.
+    """
+    path = str(path)
+    if not os.path.isfile(path):
+        raise TrialsError(f"{path}: no such file")
+    try:
+        df = pd.read_csv(path, dtype=str, keep_default_na=False, na_values=[], encoding="utf-8")
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError, OSError) as e:
+        first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+        raise TrialsError(f"{path}: not a readable CSV ({first})")
+    missing = [c for c in LEADING + TRAILING if c not in df.columns]
+    if missing:
+        raise TrialsError(f"{path}: not a blurcue trials.csv (missing column{'s' if len(missing) > 1 else ''} "
+                          f"{', '.join(missing)})")
+    for c in NUMERIC:
+        if c in df.columns:
+            df[c] = pd.to_numeric(df[c].replace("", np.nan), errors="coerce")
+    for c in ("practice", "swapped"):
+        df[c] = df[c].map(_flag) if c in df.columns else 0
+    df["answered"] = df["choice"].str.strip() != ""
+    if "pattern" in df.columns:
+        patterns = df["pattern"].map(_json_object)
+        df["pattern_id"] = patterns.map(lambda p: p.get("id") if p else None).astype(float)
+        df["speed_cm_s"] = patterns.map(lambda p: p.get("speed_cm_s") if p else None).astype(float)
+        df["pattern_left"] = patterns.map(lambda p: p.get("left") if p else None)
+        df["pattern_right"] = patterns.map(lambda p: p.get("right") if p else None)
+    return df
+
+
+def study_rows(df, study):
+    """The study's non-practice rows (practice == 1 is excluded from every analysis)."""
+    d = df[(df["study"] == study) & (df["practice"] != 1)]
+    return d.copy()
+
+
+def forced_choice(df):
+    """Adds chosen_source (the left/right column named by choice, or 'cant_tell') and decisive (left/right answer).
+
+    Answers other than left / right / cant_tell are treated as unanswered (and counted in 'invalid').
+    """
+    d = df.copy()
+    choice = d["choice"].str.strip()
+    d["chosen_source"] = np.where(choice == "left", d["left"],
+                                  np.where(choice == "right", d["right"],
+                                           np.where(choice == "cant_tell", "cant_tell", None)))
+    d["invalid"] = d["answered"] & ~choice.isin(["left", "right", "cant_tell"])
+    d["answered"] = d["answered"] & ~d["invalid"]
+    d["decisive"] = choice.isin(["left", "right"])
+    return d
+
+
+def participants_note(d):
+    n = d["participant"].nunique()
+    return f"{n} participant{'s' if n != 1 else ''}"
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# Drawing
+
+
+def setup_style():
+    """Paper style: readable fonts, light grid, no top/right spines; SVG text stays text (searchable, editable)."""
+    plt.rcParams.update({
+        "figure.dpi": 110, "savefig.dpi": 150, "font.size": 10.5, "axes.titlesize": 11.5, "axes.labelsize": 10.5,
+        "legend.fontsize": 9, "xtick.labelsize": 9.5, "ytick.labelsize": 9.5, "axes.spines.top": False,
+        "axes.spines.right": False, "axes.grid": True, "grid.alpha": 0.3, "grid.linewidth": 0.6,
+        "legend.frameon": False, "svg.fonttype": "none", "errorbar.capsize": 2.5,
+    })
+
+
+def save(fig, out_dir, name):
+    """Writes NAME.png and NAME.svg into out_dir; returns their paths and closes the figure."""
+    os.makedirs(out_dir, exist_ok=True)
+    png = os.path.join(out_dir, name + ".png")
+    svg = os.path.join(out_dir, name + ".svg")
+    fig.savefig(png, bbox_inches="tight")
+    fig.savefig(svg, bbox_inches="tight")
+    plt.close(fig)
+    return png, svg
+
+
+def wilson_columns(table, k_col, n_col, prefix):
+    """Adds PREFIX, PREFIX_low, PREFIX_high (Wilson 95 %) for k_col of n_col to a table, row by row."""
+    values = [wilson(k, n) for k, n in zip(table[k_col], table[n_col])]
+    table[prefix] = [v[0] for v in values]
+    table[prefix + "_low"] = [v[1] for v in values]
+    table[prefix + "_high"] = [v[2] for v in values]
+    return table
+
+
+def error_bars(p, lo, hi):
+    """Asymmetric error-bar lengths for matplotlib from a proportion and its interval (NaN -> 0)."""
+    p, lo, hi = (np.asarray(v, float) for v in (p, lo, hi))
+    return np.clip(np.vstack([np.nan_to_num(p - lo), np.nan_to_num(hi - p)]), 0, None)  # rounding dust at 0 and 1
+
+
+def p_text(p):
+    if p is None or (isinstance(p, float) and math.isnan(p)):
+        return ""
+    return "p < 0.001" if p < 0.001 else f"p = {p:.3f}"
+
+
+def stars(p):
+    if p is None or (isinstance(p, float) and math.isnan(p)):
+        return ""
+    return "***" if p < 0.001 else "**" if p < 0.01 else "*" if p < 0.05 else ""

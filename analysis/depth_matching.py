@@ -1,0 +1,131 @@
+"""Pre-research depth matching (thesis 3.2, Fig. 3.3): the accepted Butterworth cut-off against distance.
+
+Each observer accepted one of 22 cut-offs (cycles per picture width) at each of 27 distances (0.4-4 m). The chart
+shows every observer's answers, the pooled geometric mean per distance with its 95 % interval across observers, and
+a power law fitted to all answers: log c = a + b log d, i.e. c = e^a d^b (b < 0: more blur accepted farther away).
+
+Fits in the table:
+  per observer      ordinary least squares on that observer's answers
+  pooled OLS        all answers, standard errors clustered by observer (repeated answers are not independent)
+  mixed model       statsmodels MixedLM, random intercept per observer (>= 3 observers), REML
+"""
+import math
+import warnings
+
+import numpy as np
+import pandas as pd
+import matplotlib.pyplot as plt
+from matplotlib.ticker import FixedLocator, NullLocator
+from scipy import stats as sps
+
+from common import Chart, Skip, STUDY_DEPTH, participants_note, save, study_rows
+
+
+def _ols(x, y):
+    """Slope, intercept, R² of y on x; NaNs when x does not vary."""
+    if len(x) < 2 or np.ptp(x) == 0:
+        return math.nan, math.nan, math.nan
+    res = sps.linregress(x, y)
+    return res.intercept, res.slope, res.rvalue ** 2
+
+
+def charts(df, out_dir):
+    import statsmodels.formula.api as smf
+
+    d = study_rows(df, STUDY_DEPTH)
+    if d.empty:
+        raise Skip("depth matching: no trials in trials.csv")
+    d["cutoff"] = pd.to_numeric(d["choice"].replace("", np.nan), errors="coerce")
+    answered = d[d["answered"]]
+    bad = int(answered["cutoff"].isna().sum() + (answered["cutoff"] <= 0).sum())
+    a = answered[(answered["cutoff"] > 0) & answered["distance_m"].notna() & (answered["distance_m"] > 0)].copy()
+    if a.empty:
+        raise Skip(f"depth matching: 0 of {len(d)} trials answered with a cut-off")
+    a["log_d"] = np.log(a["distance_m"])
+    a["log_c"] = np.log(a["cutoff"])
+    observers = sorted(a["participant"].unique())
+    notes = [f"{participants_note(a)}; {len(a)} of {len(d)} planned trials answered (practice excluded)"]
+    if bad:
+        notes.append(f"{bad} answers without a positive numeric cut-off ignored")
+
+    rows = []
+    for p in observers:
+        g = a[a["participant"] == p]
+        icpt, slope, r2 = _ols(g["log_d"], g["log_c"])
+        rows.append({"fit": "per observer", "observer": p, "answers": len(g), "a": icpt, "b": slope, "r2": r2})
+
+    pooled = None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        if a["log_d"].nunique() >= 2:
+            if len(observers) >= 2:
+                pooled = smf.ols("log_c ~ log_d", a).fit(cov_type="cluster",
+                                                         cov_kwds={"groups": pd.factorize(a["participant"])[0]})
+                label = "pooled OLS, cluster-robust SE"
+            else:
+                pooled = smf.ols("log_c ~ log_d", a).fit()
+                label = "pooled OLS (one observer)"
+                notes.append("one participant: no fit across observers; the pooled line is that observer's")
+            ci = pooled.conf_int()
+            rows.append({"fit": label, "observer": "all", "answers": len(a),
+                         "a": pooled.params["Intercept"], "a_low": ci.loc["Intercept", 0], "a_high": ci.loc["Intercept", 1],
+                         "b": pooled.params["log_d"], "b_low": ci.loc["log_d", 0], "b_high": ci.loc["log_d", 1],
+                         "p_b": pooled.pvalues["log_d"], "r2": pooled.rsquared})
+        if len(observers) >= 3:
+            try:
+                mixed = smf.mixedlm("log_c ~ log_d", a, groups=a["participant"]).fit(reml=True)
+                ci = mixed.conf_int()
+                rows.append({"fit": "mixed model (random intercept)", "observer": "all", "answers": len(a),
+                             "a": mixed.fe_params["Intercept"], "a_low": ci.loc["Intercept", 0],
+                             "a_high": ci.loc["Intercept", 1], "b": mixed.fe_params["log_d"],
+                             "b_low": ci.loc["log_d", 0], "b_high": ci.loc["log_d", 1],
+                             "p_b": mixed.pvalues["log_d"], "observer_sd": float(np.sqrt(mixed.cov_re.iloc[0, 0]))})
+            except Exception as e:  # a singular fit on odd data: the pooled fit still stands
+                notes.append(f"mixed model not fitted: {type(e).__name__}")
+        elif len(observers) == 2:
+            notes.append("two participants: too few for a mixed model")
+    table = pd.DataFrame(rows)
+
+    # Per distance across observers: geometric mean (mean of log cut-off per observer, then across observers).
+    per_obs = a.groupby(["distance_m", "participant"])["log_c"].mean().reset_index()
+    summary = per_obs.groupby("distance_m")["log_c"].agg(["mean", "std", "count"]).reset_index()
+    tcrit = sps.t.ppf(0.975, np.maximum(summary["count"] - 1, 1))
+    half = np.where(summary["count"] >= 2, tcrit * summary["std"] / np.sqrt(summary["count"]), np.nan)
+    summary["geo_mean"] = np.exp(summary["mean"])
+    summary["low"] = np.exp(summary["mean"] - half)
+    summary["high"] = np.exp(summary["mean"] + half)
+
+    fig, ax = plt.subplots(figsize=(8, 4.8))
+    cmap = plt.get_cmap("tab10" if len(observers) <= 10 else "tab20")
+    for i, p in enumerate(observers):
+        g = a[a["participant"] == p].sort_values("distance_m")
+        ax.plot(g["distance_m"], g["cutoff"], "o-", ms=3, lw=0.7, alpha=0.55, color=cmap(i % cmap.N),
+                label=f"observer {p}" if len(observers) <= 12 else None)
+    ax.errorbar(summary["distance_m"], summary["geo_mean"],
+                yerr=np.vstack([np.nan_to_num(summary["geo_mean"] - summary["low"]),
+                                np.nan_to_num(summary["high"] - summary["geo_mean"])]),
+                fmt="s", color="black", ms=4.5, lw=1, zorder=5,
+                label="geometric mean" + (" (95 % CI across observers)" if len(observers) >= 2 else ""))
+    if pooled is not None:
+        grid = np.linspace(a["distance_m"].min(), a["distance_m"].max(), 200)
+        aa, bb = pooled.params["Intercept"], pooled.params["log_d"]
+        ax.plot(grid, np.exp(aa) * grid ** bb, color="#D55E00", lw=2, zorder=6,
+                label=f"fit: $c = {math.exp(aa):.1f}\\, d^{{{bb:.2f}}}$ (d in m)")
+    ax.set_yscale("log")
+    ticks = [t for t in (1, 2, 5, 10, 20, 50, 100) if a["cutoff"].min() / 1.5 <= t <= a["cutoff"].max() * 1.5]
+    ax.yaxis.set_major_locator(FixedLocator(ticks))
+    ax.yaxis.set_minor_locator(NullLocator())
+    ax.set_yticklabels([str(t) for t in ticks])
+    ax.set_xlabel("distance of the real picture from the observer (m)")
+    ax.set_ylabel("accepted cut-off (cycles / picture width)")
+    ax.set_title(f"Pre-research depth matching (cf. thesis Fig. 3.3)\n{participants_note(a)}, {len(a)} answers; "
+                 "lower cut-off = more blur", loc="left")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    png, svg = save(fig, out_dir, "depth-matching")
+    notes.append("fit: log c = a + b log d (natural logs, d in m, c in cycles per picture width); b < 0 means more "
+                 "blur is accepted farther away; CIs 95 %")
+    summary = summary.rename(columns={"mean": "mean_log_cutoff", "std": "sd_log_cutoff", "count": "observers"})
+    return [Chart("depth-matching", png, svg, table, notes),
+            Chart("depth-matching-per-distance", None, None, summary,
+                  ["geometric mean of the accepted cut-off per distance; low/high: 95 % t-interval across observers "
+                   "of the observers' log cut-offs"])]

@@ -1,0 +1,338 @@
+"""Forced-choice studies (tests 1-3): answers per edge, per pattern and per section, and a psychometric function.
+
+Figures (thesis chapter 5):
+  test 1 per edge             Fig. 5.2   measured / estimated / can't tell at each of the 11 edges
+  tests 2, 3 per pattern      Fig. 5.9, 5.13   task 1: the two sources of each of the 6 patterns, and can't tell
+  tests 2, 3 per section      Fig. 5.10-5.12   task 2: patterns 2, 4, 6 over sections 1-10
+  psychometric                share choosing the more-blurred stimulus against |r_left - r_right|, pooled
+
+Every bar is a share of the answered trials with its Wilson 95 % interval. The binomial test asks whether, among the
+answers that picked a side (not can't tell), the first source of the pair was chosen more or less often than half
+the time; p-values are exact, two-sided, and Holm-adjusted over the cells of one chart.
+"""
+import math
+
+import numpy as np
+import pandas as pd
+
+import matplotlib.pyplot as plt
+
+import stats
+from common import (Chart, Skip, SOURCE_COLORS, SOURCE_LABELS, STUDY_TEST1, STUDY_TEST2, STUDY_TEST3, STUDY_TITLES,
+                    FORCED_CHOICE_STUDIES, error_bars, forced_choice, participants_note, save, stars, study_rows,
+                    wilson_columns)
+
+SECTION_PATTERNS = (2, 4, 6)
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# Counting
+
+
+def _prepare(df, study):
+    """Non-practice forced-choice rows of one study; Skip when there are none or none answered."""
+    d = study_rows(df, study)
+    title = STUDY_TITLES[study]
+    if d.empty:
+        raise Skip(f"{title}: no trials in trials.csv")
+    d = forced_choice(d)
+    if not d["answered"].any():
+        raise Skip(f"{title}: 0 of {len(d)} trials answered")
+    return d
+
+
+def _notes(d):
+    notes = [f"{participants_note(d)}; {int(d['answered'].sum())} of {len(d)} planned trials answered "
+             f"(practice excluded)"]
+    if d["invalid"].any():
+        notes.append(f"{int(d['invalid'].sum())} answers other than left/right/cant_tell ignored")
+    return notes
+
+
+def count_table(d, key):
+    """Per value of `key`: planned, answered, answers for the pair's first and second source and can't tell, their
+    shares of the answered trials with Wilson 95 % intervals, and the binomial test of first vs second."""
+    rows = []
+    for value, g in d.groupby(key, sort=True):
+        a = g[g["answered"]]
+        first = g["first"].dropna().iloc[0] if g["first"].notna().any() else ""
+        second = g["second"].dropna().iloc[0] if g["second"].notna().any() else ""
+        n_first = int((a["chosen_source"] == first).sum())
+        n_second = int((a["chosen_source"] == second).sum())
+        rows.append({key: value, "first": first, "second": second, "planned": len(g), "answered": len(a),
+                     "n_first": n_first, "n_second": n_second, "n_cant_tell": int((a["chosen_source"] == "cant_tell").sum()),
+                     "observers": g["participant"].nunique()})
+    t = pd.DataFrame(rows)
+    for what in ("first", "second", "cant_tell"):
+        wilson_columns(t, f"n_{what}", "answered", f"share_{what}")
+    t["decisive"] = t["n_first"] + t["n_second"]
+    t["share_first_of_decisive"] = [k / n if n else math.nan for k, n in zip(t["n_first"], t["decisive"])]
+    t["p_binom"] = [stats.binom_p(k, n) for k, n in zip(t["n_first"], t["decisive"])]
+    t["p_holm"] = stats.holm(t["p_binom"])
+    return t
+
+
+def _bars(ax, t, key, xlabels):
+    """Three bars per cell (first source, second source, can't tell), coloured by source, with Wilson intervals."""
+    x = np.arange(len(t))
+    width = 0.26
+    handles = {}
+    for j, what in enumerate(("first", "second", "cant_tell")):
+        p, lo, hi = t[f"share_{what}"], t[f"share_{what}_low"], t[f"share_{what}_high"]
+        sources = t[what] if what != "cant_tell" else ["cant_tell"] * len(t)
+        colors = [SOURCE_COLORS.get(s, "#555555") for s in sources]
+        ax.bar(x + (j - 1) * width, p, width, color=colors, edgecolor="white", linewidth=0.5)
+        ax.errorbar(x + (j - 1) * width, p, yerr=error_bars(p, lo, hi), fmt="none", ecolor="#333333", lw=0.9)
+        for s in sources:
+            handles.setdefault(s, plt.Rectangle((0, 0), 1, 1, color=SOURCE_COLORS.get(s, "#555555")))
+    # Holm-adjusted significance of first vs second above each cell.
+    for xi, (p_adj, hi1, hi2) in enumerate(zip(t["p_holm"], t["share_first_high"], t["share_second_high"])):
+        mark = stars(p_adj)
+        if mark:
+            ax.text(xi, np.nanmax([hi1, hi2]) + 0.03, mark, ha="center", va="bottom", fontsize=10)
+    ax.set_xticks(x)
+    ax.set_xticklabels(xlabels)
+    ax.set_ylim(0, 1.12)
+    ax.set_yticks(np.linspace(0, 1, 6))
+    ax.set_ylabel("share of answers")
+    ax.grid(axis="x", visible=False)
+    order = [s for s in ("measured", "estimated", "fitted", "none", "cant_tell") if s in handles]
+    order += [s for s in handles if s not in order]
+    # Outside the axes, so it never covers a bar or a significance mark.
+    ax.legend([handles[s] for s in order], [SOURCE_LABELS.get(s, s) for s in order], title="answer",
+              loc="upper left", bbox_to_anchor=(1.01, 1.0), handlelength=1.2, alignment="left")
+
+
+def _caption_note():
+    return ("bars: share of answered trials with Wilson 95 % intervals; * p < 0.05, ** p < 0.01, *** p < 0.001: "
+            "exact binomial test of the first vs the second source among decisive answers (not can't tell) against "
+            "0.5, Holm-adjusted over the chart's cells")
+
+
+def _model(d, formula_rhs, title, extra=None):
+    """Logistic models across observers of 'chose the first source' among decisive answers (see stats.observer_models)."""
+    dec = d[d["answered"] & d["decisive"]].copy()
+    dec["chose_first"] = (dec["chosen_source"] == dec["first"]).astype(float)
+    table, notes = stats.observer_models(dec, "chose_first", formula_rhs)
+    if extra is not None and not table.empty:
+        for k, v in extra.items():
+            table.insert(0, k, v)
+    return table, [f"{title}: {n}" for n in notes]
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# Charts
+
+
+def test1_per_edge(df, out_dir):
+    """Fig. 5.2: test 1 answers per edge, and a model of 'chose measured' against edge across observers."""
+    d = _prepare(df, STUDY_TEST1)
+    d["first"], d["second"] = "measured", "estimated"
+    d = d[d["edge"].notna()]
+    t = count_table(d, "edge")
+    t["edge"] = t["edge"].astype(int)
+    fig, ax = plt.subplots(figsize=(9, 4.2))
+    _bars(ax, t, "edge", [str(e) for e in t["edge"]])
+    ax.set_xlabel("edge of the board (1 = nearest, in focus; 11 = farthest)")
+    ax.set_title(f"Test 1, static grids: which grid fits the scene? ({participants_note(d)}, "
+                 f"{int(t['answered'].sum())} answers)", loc="left")
+    png, svg = save(fig, out_dir, "test1-per-edge")
+    notes = _notes(d) + [_caption_note()]
+    # Edge centred at 6 so the intercept is the preference at the middle edge.
+    d["edge_c"] = d["edge"] - 6
+    model, model_notes = _model(d, "edge_c", "test 1")
+    charts = [Chart("test1-per-edge", png, svg, t, notes)]
+    charts.append(Chart("test1-model", None, None, model,
+                        ["logit P(chose measured | decisive) = Intercept + edge_c x (edge - 6); Intercept = log-odds "
+                         "at edge 6 (0 = no preference)"] + model_notes))
+    return charts
+
+
+def _pattern_frame(df, study):
+    d = _prepare(df, study)
+    # The designed pair from the pattern cell; without one, undo the swap of the on-screen sides.
+    first = d["pattern_left"] if "pattern_left" in d else pd.Series(None, index=d.index)
+    second = d["pattern_right"] if "pattern_right" in d else pd.Series(None, index=d.index)
+    swapped = d["swapped"] == 1
+    d["first"] = first.where(first.notna(), np.where(swapped, d["right"], d["left"]))
+    d["second"] = second.where(second.notna(), np.where(swapped, d["left"], d["right"]))
+    if "pattern_id" not in d or d["pattern_id"].isna().all():
+        raise Skip(f"{STUDY_TITLES[study]}: no readable pattern cells")
+    d = d[d["pattern_id"].notna()].copy()
+    d["pattern_id"] = d["pattern_id"].astype(int)
+    # Task 1 rows have no section (one answer per run); task 2 rows have sections 1-10.
+    d["task"] = np.where(d["section"].notna() if "section" in d else False, 2, 1)
+    return d
+
+
+def _pattern_label(row):
+    speed = f"{row['speed_cm_s']:g} cm/s" if not pd.isna(row.get("speed_cm_s", math.nan)) else ""
+    return f"{row['pattern_id']}\n{speed}\n{SOURCE_LABELS.get(row['first'], row['first'])} |\n" \
+           f"{SOURCE_LABELS.get(row['second'], row['second'])}"
+
+
+def per_pattern(df, out_dir, study):
+    """Fig. 5.9 (test 2) / 5.13 (test 3): task 1 answers per pattern."""
+    d = _pattern_frame(df, study)
+    d = d[d["task"] == 1]
+    if d.empty or not d["answered"].any():
+        raise Skip(f"{STUDY_TITLES[study]}: no answered task-1 trials")
+    t = count_table(d, "pattern_id")
+    speeds = d.groupby("pattern_id")["speed_cm_s"].first()
+    t.insert(1, "speed_cm_s", t["pattern_id"].map(speeds))
+    fig, ax = plt.subplots(figsize=(8.5, 4.6))
+    _bars(ax, t, "pattern_id", [_pattern_label(r) for _, r in t.iterrows()])
+    ax.set_xlabel("pattern (id, speed, the two blur sources compared)")
+    num = 5.9 if study == STUDY_TEST2 else 5.13
+    ax.set_title(f"{STUDY_TITLES[study].capitalize()}, task 1 (cf. thesis Fig. {num}): which ball fits the scene?\n"
+                 f"{participants_note(d)}, {int(t['answered'].sum())} answers", loc="left")
+    name = f"{study.split('-')[0]}-per-pattern"
+    png, svg = save(fig, out_dir, name)
+    notes = _notes(d) + [_caption_note(), "first source = the pattern's left source as designed (before swapping)"]
+    model, model_notes = _model(d, "0 + C(pattern_id)", f"{study} task 1")
+    return [Chart(name, png, svg, t, notes),
+            Chart(name + "-model", None, None, model,
+                  ["logit P(chose the first source | decisive) per pattern; 0 = no preference; SEs account for "
+                   "repeated answers of one observer"] + model_notes)]
+
+
+def per_section(df, out_dir, study):
+    """Fig. 5.10-5.12: task 2 answers per section for patterns 2, 4, 6 (one chart each) and a trend model."""
+    d = _pattern_frame(df, study)
+    d = d[d["task"] == 2]
+    if d.empty or not d["answered"].any():
+        raise Skip(f"{STUDY_TITLES[study]}: no answered task-2 (per section) trials")
+    charts = []
+    models, model_notes = [], []
+    prefix = study.split("-")[0]
+    for pattern in sorted(d["pattern_id"].unique()):
+        g = d[d["pattern_id"] == pattern].copy()
+        if not g["answered"].any():
+            charts.append(Chart(f"{prefix}-pattern{pattern}-per-section", None, None, pd.DataFrame(),
+                                [f"pattern {pattern}: no answered trials"]))
+            continue
+        t = count_table(g, "section")
+        t["section"] = t["section"].astype(int)
+        first, second = t["first"].iloc[0], t["second"].iloc[0]
+        fig, ax = plt.subplots(figsize=(9, 4.2))
+        _bars(ax, t, "section", [str(s) for s in t["section"]])
+        ax.set_xlabel("section (k = ball rolling from edge k to edge k + 1)")
+        fig_num = {2: "5.10", 4: "5.11", 6: "5.12"}.get(int(pattern))
+        ax.set_title(f"{STUDY_TITLES[study].capitalize()}, task 2, pattern {pattern}: "
+                     f"{SOURCE_LABELS.get(first, first)} vs {SOURCE_LABELS.get(second, second)}"
+                     f"{f' (cf. thesis Fig. {fig_num})' if fig_num and study == STUDY_TEST2 else ''}\n"
+                     f"{participants_note(g)}, {int(t['answered'].sum())} answers", loc="left")
+        name = f"{prefix}-pattern{pattern}-per-section"
+        png, svg = save(fig, out_dir, name)
+        charts.append(Chart(name, png, svg, t, _notes(g) + [_caption_note()]))
+        g["section_c"] = g["section"] - 5.5
+        m, n = _model(g, "section_c", f"pattern {pattern}", extra={"pattern": int(pattern)})
+        models.append(m)
+        model_notes += n
+    model = pd.concat([m for m in models if not m.empty], ignore_index=True) if any(
+        not m.empty for m in models) else pd.DataFrame()
+    charts.append(Chart(f"{prefix}-per-section-model", None, None, model,
+                        ["logit P(chose the first source | decisive) = Intercept + section_c x (section - 5.5), per "
+                         "pattern; section_c > 0: the first source is chosen more often farther away"] + model_notes))
+    return charts
+
+
+def psychometric(df, out_dir, n_boot=200, seed=1):
+    """Share choosing the more-blurred stimulus against the blur difference, pooled over the forced-choice studies.
+
+    Only decisive answers (left/right) with a non-zero difference count: can't tell is not a choice of either
+    stimulus, and with equal blur neither is the more blurred. Weibull and logistic are fitted with the guess rate
+    fixed at 0.5 (two alternatives) and a lapse rate in [0, 0.1]; the one with the lower AIC is drawn with its
+    parametric bootstrap 95 % band.
+    """
+    parts = [forced_choice(study_rows(df, s)) for s in FORCED_CHOICE_STUDIES if (df["study"] == s).any()]
+    if not parts:
+        raise Skip("psychometric function: no forced-choice trials")
+    d = pd.concat(parts, ignore_index=True)
+    if "r_left_px" not in d or "r_right_px" not in d:
+        raise Skip("psychometric function: trials.csv has no r_left_px / r_right_px columns")
+    a = d[d["answered"]]
+    dec = a[a["decisive"] & a["r_left_px"].notna() & a["r_right_px"].notna()].copy()
+    dec["diff"] = (dec["r_left_px"] - dec["r_right_px"]).abs()
+    ties = int((dec["diff"] < 1e-9).sum())
+    dec = dec[dec["diff"] >= 1e-9]
+    dec["more_blurred"] = np.where(dec["r_left_px"] > dec["r_right_px"], "left", "right")
+    dec["y"] = (dec["choice"].str.strip() == dec["more_blurred"]).astype(float)
+    n = len(dec)
+    if n < 20 or dec["diff"].nunique() < 3:
+        raise Skip(f"psychometric function: {n} decisive answers at {dec['diff'].nunique()} blur differences "
+                   f"(needs >= 20 at >= 3)")
+    x, y = dec["diff"].to_numpy(), dec["y"].to_numpy()
+    ones = np.ones_like(y)
+    fits = {kind: stats.fit_psychometric(x, y, ones, kind=kind, gamma=0.5, lam=(0.0, 0.1)) for kind in stats.KINDS}
+    best = min(fits.values(), key=lambda f: f.aic)
+    grid = np.linspace(0, x.max() * 1.02, 200)
+    _, band_lo, band_hi = stats.bootstrap(x, y, ones, best, method="parametric", n_boot=n_boot, seed=seed, grid=grid)
+    for f in fits.values():
+        if f is not best:
+            stats.bootstrap(x, y, ones, f, method="parametric", n_boot=max(50, n_boot // 2), seed=seed, grid=grid)
+
+    # Display bins: equal-count bins of the difference (the fit itself uses every trial).
+    n_bins = int(min(10, max(4, n // 40)))
+    dec["bin"] = pd.qcut(dec["diff"], n_bins, duplicates="drop")
+    b = dec.groupby("bin", observed=True).agg(diff_mean=("diff", "mean"), n=("y", "size"), k=("y", "sum")).reset_index()
+    b["k"] = b["k"].astype(int)
+    wilson_columns(b, "k", "n", "share")
+    b["bin"] = b["bin"].astype(str)
+
+    fig, ax = plt.subplots(figsize=(7.2, 4.6))
+    ax.axhline(0.5, color="#888888", lw=0.8, ls=":", label="chance (0.5)")
+    ax.fill_between(grid, band_lo, band_hi, color="#0072B2", alpha=0.18, lw=0,
+                    label=f"{best.kind} 95 % bootstrap band ({n_boot} samples)")
+    for kind, f in fits.items():
+        ax.plot(grid, f(grid), "-" if f is best else "--", color="#0072B2" if f is best else "#D55E00",
+                lw=1.8 if f is best else 1.2,
+                label=f"{kind} fit: α = {f.alpha:.2f} px, β = {f.beta:.2f}, λ = {f.lam:.3f} (AIC {f.aic:.1f})")
+    sizes = 15 + 60 * b["n"] / b["n"].max()
+    ax.errorbar(b["diff_mean"], b["share"], yerr=error_bars(b["share"], b["share_low"], b["share_high"]), fmt="none",
+                ecolor="#222222", lw=0.9, zorder=3)
+    ax.scatter(b["diff_mean"], b["share"], s=sizes, color="#222222", zorder=4,
+               label="answers, equal-count bins (Wilson 95 %; size ∝ n)")
+    ax.set_xlim(0, grid[-1])
+    ax.set_ylim(0.3, 1.02)
+    ax.set_xlabel("blur difference |r_left − r_right| (px)")
+    ax.set_ylabel("share choosing the more-blurred stimulus")
+    studies = ", ".join(sorted(dec["study"].unique()))
+    ax.set_title(f"Psychometric function, pooled over forced-choice studies\n{participants_note(dec)}, {n} decisive "
+                 f"answers", loc="left")
+    ax.legend(loc="lower right", fontsize=8)
+    png, svg = save(fig, out_dir, "psychometric")
+
+    rows = []
+    for kind, f in fits.items():
+        row = {"function": kind, "drawn": f is best, "trials": f.n_trials, "nll": f.nll, "aic": f.aic,
+               "converged": f.converged, "threshold_75_px": stats.threshold(f, 0.75)}
+        for p in ("alpha", "beta", "gamma", "lam"):
+            row[p] = getattr(f, p)
+            lo, hi = f.ci.get(p, (math.nan, math.nan))
+            row[p + "_low"], row[p + "_high"] = lo, hi
+        rows.append(row)
+    table = pd.DataFrame(rows)
+    notes = [f"studies pooled: {studies}",
+             f"{n} decisive answers used; {int((a['chosen_source'] == 'cant_tell').sum())} can't-tell answers and "
+             f"{ties} decisive answers with equal blur on both sides left out",
+             "ψ(x) = γ + (1 − γ − λ) F(x); γ = 0.5 fixed, λ in [0, 0.1]; Weibull F = 1 − exp(−(x/α)^β), logistic "
+             "F = 1/(1 + exp(−(x − α)/β)); maximum likelihood on single trials; CIs: parametric bootstrap "
+             f"percentiles (seed {seed})",
+             "threshold_75_px: difference at which 75 % choose the more-blurred stimulus"]
+    return [Chart("psychometric", png, svg, table, notes),
+            Chart("psychometric-bins", None, None, b, ["the binned points drawn in the psychometric chart"])]
+
+
+def charts(df, out_dir, n_boot=200):
+    """Every forced-choice chart (for callers that want them all at once; report.py runs them step by step)."""
+    out = []
+    for step in (lambda: test1_per_edge(df, out_dir),
+                 lambda: per_pattern(df, out_dir, STUDY_TEST2), lambda: per_pattern(df, out_dir, STUDY_TEST3),
+                 lambda: per_section(df, out_dir, STUDY_TEST2), lambda: per_section(df, out_dir, STUDY_TEST3),
+                 lambda: psychometric(df, out_dir, n_boot=n_boot)):
+        try:
+            out += step()
+        except Skip as e:
+            out.append(Chart("skipped", None, None, pd.DataFrame(), [str(e)]))
+    return out

@@ -1,0 +1,218 @@
+#!/usr/bin/python3
+"""Every chart and table of a blurcue run, and an index.html that shows them.
+
+  /usr/bin/python3 analysis/report.py --trials DIR/trials.csv [--bench results/bench] --out DIR [--boot 200]
+
+Writes DIR/<chart>.png, DIR/<chart>.svg, DIR/<table>.csv and DIR/index.html (self-contained, relative links).
+One progress line per step on stderr. A section that the data cannot support (a study nobody ran, no answers, no
+bench files) is skipped with a one-line message and a note in index.html.
+Exit codes: 0 report written; 2 usage; 3 trials.csv missing or unreadable, or the output folder cannot be written;
+10 a section failed unexpectedly (the rest of the report is still written, and the failure is named).
+"""
+import argparse
+import datetime
+import html
+import math
+import os
+import sys
+import warnings
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # the sibling modules, from any working directory
+
+
+import bench_charts  # noqa: E402
+import common  # noqa: E402
+import depth_matching  # noqa: E402
+import forced_choice  # noqa: E402
+from common import Skip, TrialsError  # noqa: E402
+
+EXIT_INPUT = 3
+EXIT_INTERNAL = 10
+
+
+def say(message):
+    print(f"report: {message}", file=sys.stderr, flush=True)
+
+
+def _warning_line(message, category, filename, lineno, file=None, line=None):
+    """Library warnings (a fit that did not converge, ...) as one prefixed line, not a two-line source dump."""
+    say(f"warning: {category.__name__}: {str(message).splitlines()[0] if str(message) else ''} "
+        f"({os.path.basename(filename)}:{lineno})")
+
+
+def _fmt(value):
+    """Table cells in HTML: 4 significant digits for floats, blanks for NaN."""
+    if isinstance(value, float):
+        if math.isnan(value):
+            return ""
+        return f"{value:.4g}"
+    return str(value)
+
+
+def _table_html(table):
+    if table is None or table.empty:
+        return ""
+    return table.to_html(index=False, na_rep="", formatters={c: _fmt for c in table.columns}, border=0,
+                         classes="data")
+
+
+def write_index(out_dir, sections, header):
+    """sections: list of (title, [Chart], [skip notes]); header: lines about the inputs."""
+    sections = [s for s in sections if s[1] or s[2]]  # a step with nothing to show (bench files read fine) is left out
+    parts = ["<!DOCTYPE html>", "<html lang='en'><head><meta charset='utf-8'>",
+             "<title>blurcue analysis report</title>",
+             "<style>body{font-family:sans-serif;max-width:1250px;margin:2em auto;padding:0 1em;color:#222}"
+             "h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:2em}img{max-width:100%;height:auto}"
+             "table.data{border-collapse:collapse;font-size:12px;margin:.6em 0}"
+             "table.data td,table.data th{border:1px solid #ddd;padding:2px 6px;text-align:right}"
+             "table.data th{background:#f3f3f3}.skip{background:#fff6d9;border-left:4px solid #e6b800;"
+             "padding:.4em .8em;margin:.6em 0}.notes{font-size:13px;color:#444}.links{font-size:13px}"
+             ".scroll{overflow-x:auto}</style></head><body>",
+             "<h1>blurcue analysis report</h1>", "<ul class='notes'>"]
+    parts += [f"<li>{html.escape(line)}</li>" for line in header]
+    parts.append("</ul><h3>Contents</h3><ol>")
+    for i, (title, _, _) in enumerate(sections):
+        parts.append(f"<li><a href='#s{i}'>{html.escape(title)}</a></li>")
+    parts.append("</ol>")
+    for i, (title, charts, skips) in enumerate(sections):
+        parts.append(f"<h2 id='s{i}'>{html.escape(title)}</h2>")
+        for s in skips:
+            parts.append(f"<div class='skip'>Skipped: {html.escape(s)}</div>")
+        for c in charts:
+            parts.append(f"<h3>{html.escape(c.name)}</h3>")
+            links = []
+            if c.png:
+                png = os.path.basename(c.png)
+                parts.append(f"<img src='{html.escape(png)}' alt='{html.escape(c.name)}'>")
+                links.append(f"<a href='{html.escape(os.path.basename(c.svg))}'>SVG</a>")
+            if c.table is not None and not c.table.empty:
+                links.append(f"<a href='{html.escape(c.name)}.csv'>table as CSV</a>")
+            if links:
+                parts.append(f"<p class='links'>{' | '.join(links)}</p>")
+            if c.notes:
+                parts.append("<ul class='notes'>" + "".join(f"<li>{html.escape(n)}</li>" for n in c.notes) + "</ul>")
+            table = _table_html(c.table)
+            if table:
+                parts.append(f"<div class='scroll'>{table}</div>")
+    parts.append("</body></html>")
+    path = os.path.join(out_dir, "index.html")
+    with open(path, "w", encoding="utf-8") as f:
+        f.write("\n".join(parts) + "\n")
+    return path
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description="Charts, tables and index.html from trials.csv and bench CSVs.")
+    parser.add_argument("--trials", required=True, help="trials.csv written by `blurcue export`")
+    parser.add_argument("--bench", default=os.path.join("results", "bench"),
+                        help="folder with measure.csv and render.csv (default results/bench)")
+    parser.add_argument("--out", required=True, help="output folder")
+    parser.add_argument("--boot", type=int, default=200, help="bootstrap samples for the psychometric band")
+    parser.add_argument("--seed", type=int, default=1, help="bootstrap seed")
+    parser.add_argument("--debug", action="store_true", help="let an unexpected error raise (with its traceback)")
+    args = parser.parse_args(argv)
+    warnings.showwarning = _warning_line
+
+    try:
+        os.makedirs(args.out, exist_ok=True)
+    except OSError as e:
+        say(f"{args.out}: cannot create the output folder ({e.strerror})")
+        return EXIT_INPUT
+    common.setup_style()
+
+    # The steps: (title shown in progress and index, function returning [Chart]). Data steps need trials.
+    holder = {}
+    bench = {}
+
+    def load_bench():
+        m, r, notes = bench_charts.load_bench(args.bench)
+        bench.update(measure=m, render=r)
+        if m is None and r is None:
+            raise Skip("; ".join(notes) + " - bench charts skipped")
+        for n in notes:
+            say(f"{n} - its charts are skipped")
+        bench["notes"] = notes
+        return []
+
+    def needs(key):
+        if bench.get(key) is None:
+            raise Skip(f"{os.path.join(args.bench, key + '.csv')}: not available")
+        return bench[key]
+
+    df = lambda: holder["trials"]  # noqa: E731
+    steps = [
+        ("pre-research depth matching (Fig. 3.3)", lambda: depth_matching.charts(df(), args.out)),
+        ("test 1 per edge (Fig. 5.2)", lambda: forced_choice.test1_per_edge(df(), args.out)),
+        ("test 2 per pattern (Fig. 5.9)", lambda: forced_choice.per_pattern(df(), args.out, common.STUDY_TEST2)),
+        ("test 3 per pattern (Fig. 5.13)", lambda: forced_choice.per_pattern(df(), args.out, common.STUDY_TEST3)),
+        ("test 2 per section, patterns 2, 4, 6 (Fig. 5.10-5.12)",
+         lambda: forced_choice.per_section(df(), args.out, common.STUDY_TEST2)),
+        ("test 3 per section, patterns 2, 4, 6", lambda: forced_choice.per_section(df(), args.out, common.STUDY_TEST3)),
+        ("psychometric function", lambda: forced_choice.psychometric(df(), args.out, n_boot=args.boot, seed=args.seed)),
+        ("bench files", load_bench),
+        ("bench: measurement speed vs accuracy",
+         lambda: bench_charts.measure_speed_accuracy(needs("measure"), args.out)),
+        ("bench: measurement stability", lambda: bench_charts.stability(needs("measure"), args.out)),
+        ("bench: rendering speed vs accuracy", lambda: bench_charts.render_speed_accuracy(needs("render"), args.out)),
+        ("bench: two-ball frame", lambda: bench_charts.render_frame(needs("render"), args.out)),
+    ]
+    total = len(steps) + 2  # + reading trials.csv + writing the index
+
+    try:
+        holder["trials"] = common.load_trials(args.trials)
+    except TrialsError as e:
+        say(str(e))  # the only line: the file and what is wrong with it
+        return EXIT_INPUT
+    trials = holder["trials"]
+    say(f"[1/{total}] read {args.trials}: {len(trials)} rows")
+    studies = trials["study"].value_counts().sort_index()
+    known = set(common.STUDY_TITLES)
+    header = [f"trials: {os.path.abspath(args.trials)} - {len(trials)} rows, "
+              f"{int(trials['answered'].sum())} answered, {trials['participant'].nunique()} participants",
+              "studies: " + (", ".join(f"{s} ({n} rows)" for s, n in studies.items()) or "none"),
+              f"bench: {os.path.abspath(args.bench)}",
+              f"written {datetime.datetime.now().strftime('%Y-%m-%d %H:%M')}; practice trials excluded everywhere"]
+    unknown = sorted(set(studies.index) - known)
+    if unknown:
+        say(f"{args.trials}: studies without an analysis here, ignored: {', '.join(unknown)}")
+        header.append(f"ignored (no analysis for these studies): {', '.join(unknown)}")
+    if trials.empty:
+        say(f"{args.trials}: no trials - every trial section is skipped")
+
+    sections = []
+    failed = []
+    for i, (title, run) in enumerate(steps, start=2):
+        say(f"[{i}/{total}] {title} ...")
+        charts, skips = [], []
+        try:
+            charts = run()
+        except Skip as e:
+            say(f"  skipped: {e}")
+            skips.append(str(e))
+        except Exception as e:  # a bug or data this code did not foresee: name it, keep the rest of the report
+            if args.debug:
+                raise
+            message = str(e).strip().splitlines()[0] if str(e).strip() else ""
+            say(f"  {title} failed: {type(e).__name__}: {message}")
+            skips.append(f"failed unexpectedly: {type(e).__name__}: {message}")
+            failed.append(title)
+        if title == "bench files":
+            skips += [n for n in bench.get("notes", [])]
+        for c in charts:
+            if c.table is not None and not c.table.empty:
+                c.table.to_csv(os.path.join(args.out, c.name + ".csv"), index=False)
+        sections.append((title, charts, skips))
+
+    say(f"[{total}/{total}] index.html ...")
+    path = write_index(args.out, sections, header)
+    n_charts = sum(1 for _, charts, _ in sections for c in charts if c.png)
+    n_skipped = sum(1 for _, _, skips in sections if skips)
+    say(f"wrote {path}: {n_charts} charts, {n_skipped} section{'s' if n_skipped != 1 else ''} with notes")
+    if failed:
+        say(f"{len(failed)} section(s) failed unexpectedly: {', '.join(failed)}")
+        return EXIT_INTERNAL
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

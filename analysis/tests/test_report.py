@@ -1,0 +1,173 @@
+"""report.py end to end on synthetic inputs, and its edge cases (run as a separate process: exit codes, stderr)."""
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+import xml.etree.ElementTree as ET
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+REPORT = os.path.join(os.path.dirname(HERE), "report.py")
+
+import synthetic  # noqa: E402
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def read(*parts):
+    with open(os.path.join(*parts), encoding="utf-8") as f:
+        return f.read()
+
+
+def run_report(trials, bench, out, *extra):
+    proc = subprocess.run([sys.executable, REPORT, "--trials", trials, "--bench", bench, "--out", out, "--boot", "30",
+                           *extra], capture_output=True, text=True, timeout=120)
+    return proc.returncode, proc.stdout, proc.stderr
+
+
+class ReportTestCase(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix="blurcue-report-")
+        self.addCleanup(shutil.rmtree, self.tmp, True)
+
+    def assertCleanStderr(self, stderr):
+        self.assertNotIn("Traceback", stderr)
+        for line in stderr.splitlines():
+            self.assertTrue(line.startswith("report: "), f"stderr line without the prefix: {line!r}")
+
+
+class EndToEndTest(ReportTestCase):
+    """All four studies, six participants, bench fixtures: every chart is written, linked and readable."""
+
+    def test_full_report(self):
+        trials = synthetic.write_trials_csv(os.path.join(self.tmp, "run", "trials.csv"), synthetic.trials_rows())
+        bench = synthetic.write_bench_fixtures(os.path.join(self.tmp, "bench"))
+        out = os.path.join(self.tmp, "report")
+        code, _, err = run_report(trials, bench, out)
+        self.assertEqual(code, 0, err)
+        self.assertCleanStderr(err)
+        self.assertRegex(err, r"report: \[3/\d+\] test 1 per edge")
+        self.assertNotIn("skipped", err)
+
+        index = read(out, "index.html")
+        pngs = sorted(f for f in os.listdir(out) if f.endswith(".png"))
+        expected = {"depth-matching", "test1-per-edge", "test2-per-pattern", "test3-per-pattern",
+                    "test2-pattern2-per-section", "test2-pattern4-per-section", "test2-pattern6-per-section",
+                    "test3-pattern2-per-section", "test3-pattern4-per-section", "test3-pattern6-per-section",
+                    "psychometric", "bench-measure-speed-accuracy", "bench-stability-within-target",
+                    "bench-stability-error", "bench-render-speed-accuracy", "bench-frame"}
+        self.assertEqual({p[:-4] for p in pngs}, expected)
+        linked = set(re.findall(r"<img src='([^']+)'", index))
+        self.assertEqual(linked, set(pngs), "index.html shows every PNG, and only existing ones")
+        for href in re.findall(r"href='([^'#]+)'", index):
+            self.assertFalse(os.path.isabs(href), href)
+            self.assertTrue(os.path.isfile(os.path.join(out, href)), f"index.html links a missing file {href}")
+
+        for png in pngs:
+            with open(os.path.join(out, png), "rb") as f:
+                data = f.read()
+            self.assertTrue(data.startswith(PNG_SIGNATURE), png)
+            self.assertGreater(len(data), 10000, png)
+            # IHDR: width and height of a readable chart
+            width, height = int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
+            self.assertGreater(width, 400, png)
+            self.assertGreater(height, 250, png)
+            svg = os.path.join(out, png[:-4] + ".svg")
+            root = ET.parse(svg).getroot()
+            self.assertTrue(root.tag.endswith("svg"), svg)
+
+        # Tables: one CSV per chart with a table; the numbers are there.
+        t1 = read(out, "test1-per-edge.csv").splitlines()
+        self.assertEqual(len(t1), 12)  # header + 11 edges
+        self.assertIn("p_binom", t1[0])
+        self.assertIn("GLMM (random intercept, VB)", read(out, "test1-model.csv"))
+
+
+class EdgeCaseTest(ReportTestCase):
+    def test_missing_trials_exits_3_with_one_line(self):
+        missing = os.path.join(self.tmp, "nope", "trials.csv")
+        code, _, err = run_report(missing, os.path.join(self.tmp, "bench"), os.path.join(self.tmp, "out"))
+        self.assertEqual(code, 3)
+        self.assertEqual(len(err.strip().splitlines()), 1, err)
+        self.assertRegex(err, r"^report: .*nope/trials\.csv: no such file")
+
+    def test_garbled_trials_exits_3(self):
+        path = os.path.join(self.tmp, "trials.csv")
+        with open(path, "wb") as f:
+            f.write(b"\x00\xff\xfe garbage\r\nnot,a,trials\"file\r\n")
+        code, _, err = run_report(path, os.path.join(self.tmp, "bench"), os.path.join(self.tmp, "out"))
+        self.assertEqual(code, 3)
+        self.assertEqual(len(err.strip().splitlines()), 1, err)
+        self.assertIn("trials.csv", err)
+        self.assertCleanStderr(err)
+
+    def test_zero_responses(self):
+        rows = synthetic.trials_rows(participants=("P1", "P2", "P3"), unanswered=1.0)
+        trials = synthetic.write_trials_csv(os.path.join(self.tmp, "trials.csv"), rows)
+        out = os.path.join(self.tmp, "out")
+        code, _, err = run_report(trials, os.path.join(self.tmp, "nobench"), out)
+        self.assertEqual(code, 0, err)
+        self.assertCleanStderr(err)
+        self.assertIn("0 of 33 trials answered", err)  # test 1: 3 participants x 11 edges
+        index = read(out, "index.html")
+        self.assertIn("Skipped:", index)
+        pngs = {f for f in os.listdir(out) if f.endswith(".png")}
+        self.assertEqual(pngs, set())
+
+    def test_header_only_trials(self):
+        path = os.path.join(self.tmp, "trials.csv")
+        with open(path, "w", newline="") as f:
+            f.write("study,protocol_hash,participant,session,seed,trial_index,block,left,right,choice,rt_ms,"
+                    "answered_at\r\n")
+        code, _, err = run_report(path, os.path.join(self.tmp, "nobench"), os.path.join(self.tmp, "out"))
+        self.assertEqual(code, 0, err)
+        self.assertCleanStderr(err)
+        self.assertTrue(os.path.isfile(os.path.join(self.tmp, "out", "index.html")))
+
+    def test_one_participant(self):
+        rows = synthetic.trials_rows(participants=("P1",), seed=3, unanswered=0)
+        trials = synthetic.write_trials_csv(os.path.join(self.tmp, "trials.csv"), rows)
+        out = os.path.join(self.tmp, "out")
+        code, _, err = run_report(trials, os.path.join(self.tmp, "nobench"), out)
+        self.assertEqual(code, 0, err)
+        self.assertCleanStderr(err)
+        index = read(out, "index.html")
+        self.assertIn("one participant", index)
+        for chart in ("depth-matching", "test1-per-edge", "test2-per-pattern"):
+            self.assertTrue(os.path.isfile(os.path.join(out, chart + ".png")), chart)
+        model = read(out, "depth-matching.csv")
+        self.assertIn("pooled OLS (one observer)", model)
+        self.assertNotIn("mixed model", model)
+
+    def test_missing_bench_folder(self):
+        rows = synthetic.trials_rows(participants=("P1", "P2"), studies=["pre-research-depth-matching"])
+        trials = synthetic.write_trials_csv(os.path.join(self.tmp, "trials.csv"), rows)
+        bench = os.path.join(self.tmp, "no-such-bench")
+        out = os.path.join(self.tmp, "out")
+        code, _, err = run_report(trials, bench, out)
+        self.assertEqual(code, 0, err)
+        self.assertCleanStderr(err)
+        self.assertIn(os.path.join(bench, "measure.csv") + ": no such file", err)
+        index = read(out, "index.html")
+        self.assertIn("measure.csv: no such file", index)
+        self.assertIn("test 1 (static grids): no trials in trials.csv", index)
+        self.assertFalse(any(f.startswith("bench") for f in os.listdir(out)))
+
+    def test_one_bench_file_only(self):
+        rows = synthetic.trials_rows(participants=("P1", "P2"), studies=["pre-research-depth-matching"])
+        trials = synthetic.write_trials_csv(os.path.join(self.tmp, "trials.csv"), rows)
+        bench = synthetic.write_bench_fixtures(os.path.join(self.tmp, "bench"))
+        os.remove(os.path.join(bench, "measure.csv"))
+        out = os.path.join(self.tmp, "out")
+        code, _, err = run_report(trials, bench, out)
+        self.assertEqual(code, 0, err)
+        self.assertIn("measure.csv: no such file", err)
+        self.assertTrue(os.path.isfile(os.path.join(out, "bench-frame.png")))
+        self.assertFalse(os.path.isfile(os.path.join(out, "bench-measure-speed-accuracy.png")))
+
+
+if __name__ == "__main__":
+    unittest.main()

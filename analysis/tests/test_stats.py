@@ -1,0 +1,218 @@
+"""Statistics against hand-computed answers, and a psychometric fit recovering known parameters."""
+import math
+import os
+import sys
+import tempfile
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.dirname(HERE))  # analysis/
+
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+import common  # noqa: E402
+import stats  # noqa: E402
+
+
+def binom_two_sided_half(k, n):
+    """Independent closed form for p = 0.5 (the distribution is symmetric, so 'as or less likely' = 'as or more
+    extreme'): P = 2 * sum_{i >= max(k, n-k)} C(n, i) / 2^n, capped at 1."""
+    m = max(k, n - k)
+    return min(1.0, 2 * sum(math.comb(n, i) for i in range(m, n + 1)) / 2 ** n)
+
+
+class WilsonTest(unittest.TestCase):
+    # Hand computation, z = 1.959963985 (z^2 = 3.841458821), p = k/n, d = 1 + z^2/n,
+    # centre = (p + z^2/(2n)) / d, half = (z/d) * sqrt(p(1-p)/n + z^2/(4n^2)):
+    #  7/10:  d = 1.384145882; centre = (0.7 + 0.192072941)/d = 0.644493048;
+    #         half = 1.416011 * sqrt(0.021 + 0.009603647) = 1.416011 * 0.174939 = 0.247715
+    #         -> [0.396778, 0.892209]
+    #  0/10:  centre = 0.192072941/d = 0.138766; half = 1.416011 * sqrt(0.009603647) = 0.138766 -> [0, 0.277533]
+    #  10/10: mirror image of 0/10 -> [0.722467, 1]
+    #  15/20: d = 1.192072941; centre = (0.75 + 0.096036470)/d = 0.709719;
+    #         half = 1.644162 * sqrt(0.009375 + 0.002400912) = 1.644162 * 0.108517 = 0.178420 -> [0.531299, 0.888138]
+    KNOWN = [((7, 10), (0.7, 0.396778, 0.892209)),
+             ((0, 10), (0.0, 0.0, 0.277533)),
+             ((10, 10), (1.0, 0.722467, 1.0)),
+             ((15, 20), (0.75, 0.531299, 0.888138))]
+
+    def test_known_intervals(self):
+        for (k, n), expected in self.KNOWN:
+            got = stats.wilson(k, n)
+            for g, e in zip(got, expected):
+                self.assertAlmostEqual(g, e, places=5, msg=f"Wilson {k}/{n}")
+
+    def test_bounds_exact_at_extremes(self):
+        self.assertEqual(stats.wilson(0, 10)[1], 0.0)
+        self.assertEqual(stats.wilson(10, 10)[2], 1.0)
+
+    def test_no_trials(self):
+        self.assertTrue(all(math.isnan(v) for v in stats.wilson(0, 0)))
+
+
+class BinomialTest(unittest.TestCase):
+    # Two-sided exact p against 0.5, by hand (2^10 = 1024):
+    #  9/10: P(X >= 9) = (C(10,9) + C(10,10))/1024 = 11/1024; two-sided 22/1024 = 0.021484375
+    #  7/10: (C(10,7)+C(10,8)+C(10,9)+C(10,10)) = 120+45+10+1 = 176; 2*176/1024 = 0.34375
+    #  0/10: 2 * 1/1024 = 0.001953125;  5/10: 1
+    #  15/20: C(20,15..20) = 15504+4845+1140+190+20+1 = 21700; 2*21700/2^20 = 0.04138946533203125
+    # Against p = 0.2 ('minlike': sum of every outcome no more likely than the observed one), 0 of 5:
+    #  P(0) = 0.8^5 = 0.32768, P(1) = 0.4096, P(2) = 0.2048, P(3) = 0.0512, P(4) = 0.0064, P(5) = 0.00032
+    #  outcomes with P <= 0.32768: 0, 2, 3, 4, 5 -> 0.32768 + 0.2048 + 0.0512 + 0.0064 + 0.00032 = 0.5904
+    KNOWN = [(9, 10, 0.5, 0.021484375), (7, 10, 0.5, 0.34375), (0, 10, 0.5, 0.001953125), (5, 10, 0.5, 1.0),
+             (15, 20, 0.5, 0.04138946533203125), (0, 5, 0.2, 0.5904)]
+
+    def test_known_p_values(self):
+        for k, n, p, expected in self.KNOWN:
+            self.assertAlmostEqual(stats.binom_p(k, n, p), expected, places=9, msg=f"{k}/{n} vs {p}")
+
+    def test_closed_form_agrees(self):
+        for n in (1, 6, 11, 20):
+            for k in range(n + 1):
+                self.assertAlmostEqual(stats.binom_p(k, n), binom_two_sided_half(k, n), places=12)
+
+    def test_no_trials(self):
+        self.assertTrue(math.isnan(stats.binom_p(0, 0)))
+
+    def test_holm(self):
+        # sorted 0.01, 0.03, 0.04 -> 3*0.01 = 0.03, 2*0.03 = 0.06, max(0.06, 1*0.04) = 0.06; NaN passes through
+        np.testing.assert_allclose(stats.holm([0.01, 0.04, math.nan, 0.03]), [0.03, 0.06, math.nan, 0.06])
+
+
+class PsychometricTest(unittest.TestCase):
+    def simulate(self, kind, alpha, beta, gamma, lam, levels, per_level, seed):
+        rng = np.random.default_rng(seed)
+        x = np.repeat(levels, per_level).astype(float)
+        y = rng.binomial(1, stats.psi(kind, x, alpha, beta, gamma, lam)).astype(float)
+        return x, y
+
+    def test_weibull_recovers_parameters(self):
+        x, y = self.simulate("weibull", 3.0, 2.5, 0.5, 0.02, [0.5, 1, 1.5, 2, 2.5, 3, 4, 5, 6], 150, seed=11)
+        f = stats.fit_psychometric(x, y, kind="weibull", gamma=0.5, lam=(0, 0.1))
+        self.assertTrue(f.converged)
+        self.assertAlmostEqual(f.alpha, 3.0, delta=0.3)
+        self.assertAlmostEqual(f.beta, 2.5, delta=0.8)
+        self.assertLess(f.lam, 0.06)
+        self.assertEqual(f.gamma, 0.5)
+
+    def test_logistic_with_free_guess_rate(self):
+        # A yes/no task: guess (false-alarm) rate 0.05, lapse 0.03, threshold 0, spread 1.
+        x, y = self.simulate("logistic", 0.0, 1.0, 0.05, 0.03, np.linspace(-4, 4, 9), 150, seed=5)
+        f = stats.fit_psychometric(x, y, kind="logistic", gamma=None, lam=(0, 0.1))
+        self.assertAlmostEqual(f.alpha, 0.0, delta=0.25)
+        self.assertAlmostEqual(f.beta, 1.0, delta=0.3)
+        self.assertAlmostEqual(f.gamma, 0.05, delta=0.05)
+        self.assertEqual(f.n_params, 4)
+
+    def test_wrong_model_fits_worse(self):
+        # Data from a steep Weibull: the logistic should not win by AIC by a wide margin (sanity of the likelihood).
+        x, y = self.simulate("weibull", 2.0, 4.0, 0.5, 0.0, [0.5, 1, 1.5, 2, 2.5, 3, 4], 200, seed=3)
+        w = stats.fit_psychometric(x, y, kind="weibull")
+        lg = stats.fit_psychometric(x, y, kind="logistic")
+        self.assertLess(w.aic, lg.aic + 2)
+
+    def test_bootstrap_covers_truth_and_is_seeded(self):
+        x, y = self.simulate("weibull", 3.0, 2.5, 0.5, 0.02, [0.5, 1, 1.5, 2, 2.5, 3, 4, 5, 6], 80, seed=21)
+        ones = np.ones_like(y)
+        for method in ("parametric", "nonparametric"):
+            f1 = stats.fit_psychometric(x, y, kind="weibull")
+            grid, lo, hi = stats.bootstrap(x, y, ones, f1, method=method, n_boot=60, seed=4)
+            f2 = stats.fit_psychometric(x, y, kind="weibull")
+            stats.bootstrap(x, y, ones, f2, method=method, n_boot=60, seed=4)
+            self.assertEqual(f1.ci, f2.ci, "same seed, same intervals")
+            a_lo, a_hi = f1.ci["alpha"]
+            self.assertLess(a_lo, 3.0)
+            self.assertGreater(a_hi, 3.0)
+            self.assertLess(a_hi - a_lo, 1.5, "interval should be informative")
+            self.assertTrue(np.all(lo <= hi))
+            inside = (lo <= f1(grid) + 1e-9) & (f1(grid) <= hi + 1e-9)
+            self.assertGreater(inside.mean(), 0.9, "the band should hold the fitted curve")
+
+    def test_threshold_inverts_psi(self):
+        f = stats.PsychometricFit("weibull", 3.0, 2.0, 0.5, 0.02, 0, 2, 100, True)
+        t = stats.threshold(f, 0.75)
+        self.assertAlmostEqual(float(f(t)), 0.75, places=9)
+        g = stats.PsychometricFit("logistic", 1.0, 0.5, 0.5, 0.0, 0, 2, 100, True)
+        self.assertAlmostEqual(stats.threshold(g, 0.75), 1.0, places=9)  # logistic midpoint of [0.5, 1]
+        self.assertTrue(math.isnan(stats.threshold(f, 0.4)))
+
+
+class ObserverModelTest(unittest.TestCase):
+    def frame(self, participants, per, seed=2):
+        rng = np.random.default_rng(seed)
+        d = pd.DataFrame({"participant": np.repeat(participants, per), "edge": np.tile(np.arange(1, 12), len(
+            participants) * per // 11 + 1)[:len(participants) * per]})
+        d["y"] = rng.binomial(1, 1 / (1 + np.exp(-(d["edge"] - 6) * 0.5))).astype(float)
+        return d
+
+    def test_several_observers(self):
+        table, notes = stats.observer_models(self.frame(list("ABCDEF"), 44), "y", "edge")
+        self.assertEqual(set(table["model"]), {"GLM, cluster-robust SE", "GLMM (random intercept, VB)"})
+        slope = table[(table["model"] == "GLM, cluster-robust SE") & (table["term"] == "edge")].iloc[0]
+        self.assertAlmostEqual(slope["estimate_logodds"], 0.5, delta=0.2)
+
+    def test_one_observer_falls_back_with_a_note(self):
+        table, notes = stats.observer_models(self.frame(["A"], 66), "y", "edge")
+        self.assertEqual(set(table["model"]), {"GLM (one observer)"})
+        self.assertTrue(any("one participant" in n for n in notes))
+
+    def test_too_few_answers(self):
+        table, notes = stats.observer_models(self.frame(list("AB"), 3), "y", "edge")
+        self.assertTrue(table.empty)
+        self.assertTrue(any("no model across observers" in n for n in notes))
+
+    def test_separation_is_not_an_estimate(self):
+        d = pd.DataFrame({"participant": np.repeat(list("ABCD"), 10), "cell": np.tile(["a", "b"], 20)})
+        d["y"] = np.where(d["cell"] == "a", 1.0, np.tile([0.0, 0.0, 1.0, 1.0], 10))  # a: every answer 1; b: mixed
+        table, _ = stats.observer_models(d, "y", "0 + C(cell)")
+        glm = table[table["model"] == "GLM, cluster-robust SE"]
+        a = glm[glm["term"].str.contains("a]")].iloc[0]
+        self.assertTrue(math.isnan(a["estimate_logodds"]))
+        self.assertIn("separation", a["note"])
+
+
+class LoadTrialsTest(unittest.TestCase):
+    def write(self, text):
+        f = tempfile.NamedTemporaryFile("w", suffix=".csv", delete=False, newline="")
+        f.write(text)
+        f.close()
+        self.addCleanup(os.unlink, f.name)
+        return f.name
+
+    HEADER = "study,protocol_hash,participant,session,seed,trial_index,block,edge,practice,swapped,left,right,choice," \
+             "rt_ms,answered_at\r\n"
+
+    def test_flags_as_numbers_or_json_booleans(self):
+        path = self.write(self.HEADER + "test1-static-grids,h,P1,1,5,0,0,3,true,false,measured,estimated,left,812,t\r\n"
+                                        "test1-static-grids,h,P1,1,5,1,0,4,0,1,estimated,measured,,,\r\n")
+        d = common.load_trials(path)
+        self.assertEqual(list(d["practice"]), [1, 0])
+        self.assertEqual(list(d["swapped"]), [0, 1])
+        self.assertEqual(list(d["answered"]), [True, False])
+        fc = common.forced_choice(d)
+        self.assertEqual(fc["chosen_source"].iloc[0], "measured")
+
+    def test_quoted_pattern_cells(self):
+        path = self.write(
+            "study,protocol_hash,participant,session,seed,trial_index,block,pattern,left,right,choice,rt_ms,"
+            "answered_at\r\n"
+            'test2-moving-balls,h,P1,1,5,0,0,"{""id"":3,""left"":""estimated"",""right"":""none"",""speed_cm_s"":3}",'
+            "none,estimated,right,900,t\r\n")
+        d = common.load_trials(path)
+        self.assertEqual(d["pattern_id"].iloc[0], 3)
+        self.assertEqual(d["pattern_left"].iloc[0], "estimated")
+
+    def test_missing_and_garbled(self):
+        with self.assertRaisesRegex(common.TrialsError, "nowhere.csv: no such file"):
+            common.load_trials("/nonexistent/nowhere.csv")
+        path = self.write("a,b\r\n1,2\r\n")
+        with self.assertRaisesRegex(common.TrialsError, "missing columns"):
+            common.load_trials(path)
+        path = self.write("")
+        with self.assertRaisesRegex(common.TrialsError, "not a readable CSV"):
+            common.load_trials(path)
+
+
+if __name__ == "__main__":
+    unittest.main()
