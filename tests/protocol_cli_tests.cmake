@@ -4,8 +4,14 @@ foreach(study pre-research-depth-matching test1-static-grids test2-moving-balls 
   add_test(NAME cli_validate_${study}
            COMMAND $<TARGET_FILE:blurcue> validate ${PROJECT_SOURCE_DIR}/protocols/${study}.json --no-files)
 endforeach()
+# Without --seed, the seed `blurcue run` gives P1 (FNV-1a 64 of "test2-moving-balls/P1"), so the hash is the run's.
 set_tests_properties(cli_validate_test2-moving-balls PROPERTIES
-                     PASS_REGULAR_EXPRESSION "ok: 74 trials for participant P1 with seed 1 \\(hash [0-9a-f]+\\)")
+                     PASS_REGULAR_EXPRESSION "ok: 74 trials for participant P1 with seed 12146811198788962045 \\(hash [0-9a-f]+\\)")
+add_test(NAME cli_validate_explicit_seed
+         COMMAND $<TARGET_FILE:blurcue> validate ${PROJECT_SOURCE_DIR}/protocols/test2-moving-balls.json --no-files
+                 --participant P4 --seed 4)
+set_tests_properties(cli_validate_explicit_seed PROPERTIES
+                     PASS_REGULAR_EXPRESSION "ok: 74 trials for participant P4 with seed 4 \\(hash [0-9a-f]+\\)")
 set_tests_properties(cli_validate_test1-static-grids PROPERTIES PASS_REGULAR_EXPRESSION "ok: 13 trials")
 set_tests_properties(cli_validate_pre-research-depth-matching PROPERTIES PASS_REGULAR_EXPRESSION "ok: 28 trials")
 set_tests_properties(cli_validate_test3-no-board PROPERTIES PASS_REGULAR_EXPRESSION "ok: 74 trials")
