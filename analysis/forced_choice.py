@@ -285,9 +285,11 @@ def psychometric(df, out_dir, n_boot=200, seed=1):
     ax.fill_between(grid, band_lo, band_hi, color="#0072B2", alpha=0.18, lw=0,
                     label=f"{best.kind} 95 % bootstrap band ({n_boot} samples)")
     for kind, f in fits.items():
+        at_bound = " (bound)" if "beta" in f.on_bound else ""
         ax.plot(grid, f(grid), "-" if f is best else "--", color="#0072B2" if f is best else "#D55E00",
                 lw=1.8 if f is best else 1.2,
-                label=f"{kind} fit: α = {f.alpha:.2f} px, β = {f.beta:.2f}, λ = {f.lam:.3f} (AIC {f.aic:.1f})")
+                label=f"{kind} fit: α = {f.alpha:.2f} px, β = {f.beta:.3g}{at_bound}, λ = {f.lam:.3f} "
+                      f"(AIC {f.aic:.1f})")
     sizes = 15 + 60 * b["n"] / b["n"].max()
     ax.errorbar(b["diff_mean"], b["share"], yerr=error_bars(b["share"], b["share_low"], b["share_high"]), fmt="none",
                 ecolor="#222222", lw=0.9, zorder=3)
@@ -311,6 +313,8 @@ def psychometric(df, out_dir, n_boot=200, seed=1):
             row[p] = getattr(f, p)
             lo, hi = f.ci.get(p, (math.nan, math.nan))
             row[p + "_low"], row[p + "_high"] = lo, hi
+        row["beta_min"], row["beta_max"] = f.options["beta_bounds"]
+        row["on_bound"] = "; ".join(f"{p} at {side} bound {v:.3g}" for p, (v, side) in f.on_bound.items())
         rows.append(row)
     table = pd.DataFrame(rows)
     notes = [f"studies pooled: {studies}",
@@ -319,7 +323,22 @@ def psychometric(df, out_dir, n_boot=200, seed=1):
              "ψ(x) = γ + (1 − γ − λ) F(x); γ = 0.5 fixed, λ in [0, 0.1]; Weibull F = 1 − exp(−(x/α)^β), logistic "
              "F = 1/(1 + exp(−(x − α)/β)); maximum likelihood on single trials; CIs: parametric bootstrap "
              f"percentiles (seed {seed})",
-             "threshold_75_px: difference at which 75 % choose the more-blurred stimulus"]
+             "threshold_75_px: difference at which 75 % choose the more-blurred stimulus",
+             f"β bounded so that a fit cannot collapse into a step between clustered differences: logistic spread "
+             f"β >= {stats.LOGISTIC_MIN_SPREAD:g} × (largest − smallest difference), Weibull shape β <= "
+             f"{stats.WEIBULL_MAX_SHAPE:g}; the bootstrap refits keep the same bounds"]
+    for kind, f in fits.items():
+        if f.on_bound:
+            notes.append(f"{kind}: " + ", ".join(f"{'β' if p == 'beta' else 'λ'} = {getattr(f, p):.3g} at its {side} "
+                                                 f"bound {v:.3g}" for p, (v, side) in f.on_bound.items())
+                         + (" - the data do not pin β down; its value is the bound's, not an estimate"
+                            if "beta" in f.on_bound else ""))
+        b_lo, b_hi = f.options["beta_bounds"]
+        ci_lo, ci_hi = f.ci.get("beta", (math.nan, math.nan))
+        reach = [f"{v:.3g}" for v, end in ((b_lo, ci_lo), (b_hi, ci_hi)) if math.isclose(v, end, rel_tol=1e-3)]
+        if reach and "beta" not in f.on_bound:
+            notes.append(f"{kind}: the bootstrap interval of β reaches its bound {' and '.join(reach)} "
+                         f"(that end of the interval is the bound's, not the data's)")
     return [Chart("psychometric", png, svg, table, notes),
             Chart("psychometric-bins", None, None, b, ["the binned points drawn in the psychometric chart"])]
 

@@ -67,8 +67,27 @@ def holm(pvalues):
 #   logistic: F = 1 / (1 + exp(-(x - alpha) / beta))   alpha = 50 % point of F, beta = spread (> 0)
 #   weibull:  F = 1 - exp(-(x / alpha) ** beta), x >= 0  alpha = 63 % point of F, beta = shape (> 0)
 # gamma is the guess rate (the floor), lam the lapse rate (1 - lam is the ceiling).
+#
+# beta is bounded: with stimulus levels in clusters, the likelihood keeps rising as the curve turns into a step that
+# falls between (or inside) clusters, and the ML fit runs off to beta -> 0 (logistic) or beta -> inf (Weibull).
+# Such a step is not a finding - the data cannot tell a transition much sharper than the level spacing from an
+# instant one, and no observer discriminates blur perfectly on one side of a value and not at all on the other. So:
+#   logistic: beta >= span of the levels / 50 (10-90 % of F then spans >= ~9 % of the tested range)
+#   Weibull:  beta <= 10 (10-90 % of F then spans >= ~29 % of alpha)
+# A fit that ends on a bound says so (PsychometricFit.on_bound).
 
 KINDS = ("logistic", "weibull")
+LOGISTIC_MIN_SPREAD = 1 / 50   # of the span of the stimulus levels
+WEIBULL_MAX_SHAPE = 10.0
+
+
+def default_beta_bounds(kind, x):
+    """(low, high) allowed for beta, given the stimulus levels x (see above)."""
+    x = np.asarray(x, float)
+    if kind == "logistic":
+        span = float(x.max() - x.min()) if len(x) else 0.0
+        return (LOGISTIC_MIN_SPREAD * (span or 1.0), math.inf)
+    return (0.0, WEIBULL_MAX_SHAPE)
 
 
 def core(kind, x, alpha, beta):
@@ -97,12 +116,31 @@ class PsychometricFit:
     n_params: int     # free parameters
     n_trials: int
     converged: bool
-    options: dict = field(default_factory=dict)  # the gamma / lam arguments of the fit, for refits
+    options: dict = field(default_factory=dict)  # the gamma / lam / beta_bounds arguments of the fit, for refits
     ci: dict = field(default_factory=dict)   # parameter -> (low, high), filled by bootstrap()
 
     @property
     def aic(self):
         return 2 * self.n_params + 2 * self.nll
+
+    @property
+    def on_bound(self):
+        """Fitted parameters that ended on a bound of their range: {name: (bound value, 'lower' or 'upper')}."""
+        out = {}
+        ranges = {"beta": self.options.get("beta_bounds")}
+        if not np.isscalar(self.options.get("lam", 0.0)):
+            ranges["lam"] = self.options["lam"]
+        for name, bounds in ranges.items():
+            if bounds is None:
+                continue
+            lo, hi = bounds
+            v = getattr(self, name)
+            tol = 1e-3 * max(abs(lo), abs(hi) if math.isfinite(hi) else 0.0, 1e-6)
+            if v <= lo + tol:
+                out[name] = (lo, "lower")
+            elif math.isfinite(hi) and v >= hi - tol:
+                out[name] = (hi, "upper")
+        return out
 
     def __call__(self, x):
         return psi(self.kind, x, self.alpha, self.beta, self.gamma, self.lam)
@@ -120,11 +158,12 @@ def _nll(p, k, n):
     return -float(np.sum(k * np.log(p) + (n - k) * np.log1p(-p)))
 
 
-def fit_psychometric(x, k, n=None, kind="weibull", gamma=0.5, lam=(0.0, 0.1), starts=None):
+def fit_psychometric(x, k, n=None, kind="weibull", gamma=0.5, lam=(0.0, 0.1), starts=None, beta_bounds=None):
     """Maximum-likelihood fit of psi to k successes of n at stimulus levels x.
 
     gamma: a number fixes the guess rate (0.5 for two alternatives); None fits it within [0, 0.95).
     lam:   a number fixes the lapse rate; a (low, high) pair fits it within those bounds.
+    beta_bounds: (low, high) for beta; None takes default_beta_bounds(kind, x) (bootstrap refits pass the original's).
     starts: optional list of (alpha, beta) starting points; by default a small grid over the data's range, since the
     likelihood of a psychometric function has flat regions where a single start can stall.
     """
@@ -140,12 +179,26 @@ def fit_psychometric(x, k, n=None, kind="weibull", gamma=0.5, lam=(0.0, 0.1), st
     fit_lam = not np.isscalar(lam)
     lam_lo, lam_hi = (lam if fit_lam else (lam, lam))
     gamma_hi = 0.95
+    b_lo, b_hi = beta_bounds if beta_bounds is not None else default_beta_bounds(kind, x)
+    b_lo, b_hi = float(b_lo), float(b_hi)
 
-    # Unconstrained coordinates: location (log for Weibull), log spread, logit-scaled gamma and lapse.
+    # beta in [b_lo, b_hi]: b_lo + exp(t) without an upper bound, else logit-scaled between the bounds.
+    def beta_of(t):
+        if math.isinf(b_hi):
+            return b_lo + math.exp(t)
+        return b_lo + (b_hi - b_lo) * special.expit(t)
+
+    def t_of(b):
+        if math.isinf(b_hi):
+            return math.log(max(b - b_lo, 1e-9 * max(b_lo, 1.0)))
+        f = min(max((b - b_lo) / (b_hi - b_lo), 1e-9), 1 - 1e-9)
+        return float(special.logit(f))
+
+    # Unconstrained coordinates: location (log for Weibull), bounded spread, logit-scaled gamma and lapse.
     def unpack(theta):
         i = 0
         a = math.exp(theta[i]) if kind == "weibull" else theta[i]
-        b = math.exp(theta[i + 1])
+        b = beta_of(theta[i + 1])
         i += 2
         g = gamma
         if fit_gamma:
@@ -173,7 +226,7 @@ def fit_psychometric(x, k, n=None, kind="weibull", gamma=0.5, lam=(0.0, 0.1), st
     extra = ([0.0] if fit_gamma else []) + ([-2.0] if fit_lam else [])
     best = None
     for a0, b0 in starts:
-        theta0 = [math.log(a0) if kind == "weibull" else a0, math.log(b0)] + extra
+        theta0 = [math.log(a0) if kind == "weibull" else a0, t_of(b0)] + extra
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             res = optimize.minimize(objective, theta0, method="Nelder-Mead",
@@ -183,7 +236,8 @@ def fit_psychometric(x, k, n=None, kind="weibull", gamma=0.5, lam=(0.0, 0.1), st
     a, b, g, l = unpack(best.x)
     return PsychometricFit(kind=kind, alpha=a, beta=b, gamma=g, lam=l, nll=float(best.fun),
                            n_params=2 + int(fit_gamma) + int(fit_lam), n_trials=int(n.sum()),
-                           converged=bool(best.success), options={"gamma": gamma, "lam": lam})
+                           converged=bool(best.success),
+                           options={"gamma": gamma, "lam": lam, "beta_bounds": (b_lo, b_hi)})
 
 
 def bootstrap(x, k, n, fit, method="parametric", n_boot=200, seed=0, grid=None, level=0.95, **fit_kwargs):

@@ -105,6 +105,24 @@ class PsychometricTest(unittest.TestCase):
         self.assertAlmostEqual(f.gamma, 0.05, delta=0.05)
         self.assertEqual(f.n_params, 4)
 
+    def test_clustered_levels_do_not_collapse_into_a_step(self):
+        # Four levels in two clusters with a gap across the transition of a smooth curve (spread 0.12). Unbounded,
+        # this seed's ML logistic fit is a step in the gap (beta ~ 6e-7); bounded, beta stays >= span / 50, the fit
+        # says when it sits on that bound, and the bootstrap refits keep to the same bound.
+        x, y = self.simulate("logistic", 0.6, 0.12, 0.5, 0.02, [0.2, 0.3, 0.9, 1.0], 80, seed=6)
+        f = stats.fit_psychometric(x, y, kind="logistic", gamma=0.5, lam=(0, 0.1))
+        b_lo, _ = f.options["beta_bounds"]
+        self.assertAlmostEqual(b_lo, 0.8 / 50)
+        self.assertGreater(f.beta, 0.01, "spread collapsed into a step")
+        self.assertGreaterEqual(f.beta, b_lo)
+        self.assertEqual("beta" in f.on_bound, f.beta < b_lo * 1.001)
+        self.assertTrue(0.3 < f.alpha < 0.9, "the transition belongs in the gap")
+        stats.bootstrap(x, y, np.ones_like(y), f, n_boot=30, seed=2)
+        self.assertGreaterEqual(f.ci["beta"][0], b_lo)
+        # The Weibull's shape is bounded too (<= 10).
+        w = stats.fit_psychometric(x, y, kind="weibull", gamma=0.5, lam=(0, 0.1))
+        self.assertLessEqual(w.beta, stats.WEIBULL_MAX_SHAPE)
+
     def test_wrong_model_fits_worse(self):
         # Data from a steep Weibull: the logistic should not win by AIC by a wide margin (sanity of the likelihood).
         x, y = self.simulate("weibull", 2.0, 4.0, 0.5, 0.0, [0.5, 1, 1.5, 2, 2.5, 3, 4], 200, seed=3)
