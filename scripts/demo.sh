@@ -18,15 +18,22 @@ $BC render --calib "$OUT/calib.json" --background "$OUT/scene/scene.png" --objec
 $BC animate --calib "$OUT/calib.json" --background "$OUT/scene/scene.png" --left estimated --right none \
     --speed-cm-s 3 --fps 30 --video "$OUT/pattern3.avi" --log "$OUT/pattern3-frames.csv"
 # The studies: the shipped protocols (they point at this scene), checked by eye first, then run by simulated
-# observers - 6 participants of test 1 and 4 of test 2, each with their own recorded seed - into one record.
-# A fresh record each time: a demo run twice must not meet its own earlier sessions.
+# observers, each participant with their own recorded seed, into one record: 6 through test 1, 4 through test 2,
+# 3 through test 3 and 3 through the pre-research depth matching. A fresh record each time: a demo run twice must
+# not meet its own earlier sessions.
 $BC preview protocols/test1-static-grids.json --out "$OUT/preview-test1.png"
 rm -f "$OUT/study.sqlite" "$OUT/study.sqlite-wal" "$OUT/study.sqlite-shm"
-for i in 1 2 3 4 5 6; do
-  $BC run protocols/test1-static-grids.json --participant "P$i" --db "$OUT/study.sqlite" --observer sim
-done
-for i in 1 2 3 4; do
-  $BC run protocols/test2-moving-balls.json --participant "P$i" --db "$OUT/study.sqlite" --observer sim
-done
-$BC report --db "$OUT/study.sqlite" --out "$OUT/report"
+run() {  # PROTOCOL PARTICIPANTS...
+  local protocol=$1
+  shift
+  for id in "$@"; do $BC run "protocols/$protocol.json" --participant "$id" --db "$OUT/study.sqlite" --observer sim; done
+}
+run test1-static-grids P1 P2 P3 P4 P5 P6
+run test2-moving-balls P1 P2 P3 P4
+run test3-no-board P1 P2 P3
+run pre-research-depth-matching P1 P2 P3
+# Speed against accuracy of every measurement and blur method (quick sweeps), for the report's charts.
+$BC bench measure --quick --out results/bench/measure.csv
+$BC bench render --quick --out results/bench/render.csv
+$BC report --db "$OUT/study.sqlite" --out "$OUT/report" --bench results/bench
 echo "demo: results in $OUT/ (calib.json, ball-edge9-estimated.png, pattern3.avi, study.sqlite, report/index.html)"

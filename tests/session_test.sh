@@ -133,5 +133,24 @@ window)
   [ "$(sql "$W/s.sqlite" "SELECT count(*) > 13 FROM frames")" = 1 ] || fail "frames"
   integrity "$W/s.sqlite"
   echo "ok: 13 keys pressed in a window under Xvfb, 13 answers recorded as pressed: $(tail -1 "$W/out")" ;;
+recover)
+  # Through the whole pipeline - trials, the observer's key presses, the record, export and the analysis - the
+  # depth-matching fit recovers the cut-off law the simulated observers were given: c = 20 d^-0.5.
+  for id in D1 D2 D3; do
+    $BC run "$P/pre-research-depth-matching.json" --participant $id --db "$W/s.sqlite" \
+      --observer sim:cutoff1m=20,slope=-0.5,sdlog=0.05,tol=0.05 > /dev/null
+  done
+  MPLCONFIGDIR=$W/mpl $BC report --db "$W/s.sqlite" --out "$W/report" --bench "$W/no-bench" --boot 20 2> "$W/err" \
+    || fail "report: $(cat "$W/err")"
+  fit=$(grep '^"pooled' "$W/report/depth-matching.csv") || fail "no pooled fit in depth-matching.csv"
+  $PY - "$fit" <<'PYEOF' || fail "fit: $fit"
+import csv, math, sys
+row = next(csv.reader([sys.argv[1]]))
+a, b = float(row[3]), float(row[4])   # log c = a + b log d
+print(f"recovered c = {math.exp(a):.2f} d^{b:.3f}")
+sys.exit(0 if abs(b + 0.5) < 0.08 and abs(math.exp(a) / 20 - 1) < 0.12 else 1)
+PYEOF
+  grep -q "bench" "$W/err" || fail "the missing bench folder is not named: $(cat "$W/err")"
+  echo "ok: depth matching through run, record, export and report recovers c = 20 d^-0.5" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -4,7 +4,7 @@ set(T ${PROJECT_BINARY_DIR}/cli-test)
 add_test(NAME session_protocols
          COMMAND ${CMAKE_COMMAND} -DSRC=${PROJECT_SOURCE_DIR} -DOUT=${T} -P ${PROJECT_SOURCE_DIR}/tests/copy_protocols.cmake)
 set_tests_properties(session_protocols PROPERTIES FIXTURES_SETUP session_protocols)
-foreach(case complete same_seed resume kill9 second_writer window)
+foreach(case complete same_seed resume kill9 second_writer window recover)
   add_test(NAME session_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/session_test.sh ${case} ${BC} ${T})
   set_tests_properties(session_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS "gl;session"
                        PASS_REGULAR_EXPRESSION "^ok:|\nok:")
