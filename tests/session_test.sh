@@ -45,7 +45,22 @@ complete)
   $BC export --db "$W/s.sqlite" --out "$W/export"
   head -1 "$W/export/trials.csv" | grep -q "edge,practice,r_left_px,r_right_px,r_scene_px,swapped,left,right,choice" \
     || fail "export header: $(head -1 "$W/export/trials.csv")"
-  echo "ok: 2 participants x 13 trials, edges and sides as designed, frames recorded, exported" ;;
+  # The per-study summary counts every answer once.
+  $PY - "$W/export/summary-test1-static-grids.csv" <<'PYEOF' || fail "summary"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert [r["participant"] for r in rows] == ["P1", "P2"], rows
+for r in rows:
+    assert r["planned"] == r["answered"] == "11", r
+    assert sum(int(v) for k, v in r.items() if k.startswith("n_")) == 11, r
+PYEOF
+  # A participant who completed the study is refused a second session unless --again says so.
+  if $BC run "$P/test1-static-grids.json" --participant P1 --db "$W/s.sqlite" --observer sim 2> "$W/err"; then
+    fail "a second session of a completed participant started"
+  fi
+  grep -q "participant P1 already completed test1-static-grids (session 1)" "$W/err" || fail "message: $(cat "$W/err")"
+  $BC run "$P/test1-static-grids.json" --participant P1 --db "$W/s.sqlite" --observer sim --again | grep -q completed
+  echo "ok: 2 participants x 13 trials, edges and sides as designed, frames recorded, exported and summarised" ;;
 same_seed)
   # The same protocol, participant and seed give the same trials and (simulated) answers; another seed does not.
   for db in a b; do $BC run "$P/test2-moving-balls.json" --participant S1 --db "$W/$db.sqlite" --observer sim --seed 11; done

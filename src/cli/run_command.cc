@@ -52,6 +52,8 @@ void AddRunCommand(CLI::App& app) {
                                         "participant id; always recorded)");
   cmd->add_option("--observer", args->observer, "sim or sim:NAME=VALUE,... - a simulated observer answers");
   cmd->add_flag("--resume", args->options.resume, "continue the participant's unfinished session");
+  cmd->add_flag("--again", args->options.again, "another session for a participant who completed the study (a "
+                                                "participant id seen before is refused otherwise)");
   cmd->add_flag("--window", args->options.window, "with --observer: show the session in a window, in real time");
   cmd->add_option("--sim-fps", args->options.sim_fps, "headless: frames rendered per simulated second")
       ->capture_default_str();

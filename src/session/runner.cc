@@ -200,6 +200,9 @@ class Runner {
       station_.Wait(protocol_.timing.inter_trial_ms / 1000);
     }
     station_.ClearScript();
+    // Keys pressed before the stimulus (during the interval) answer nothing: drop them. Escape still pauses.
+    for (const InputEvent& e : station_.Poll())
+      if (e.key == "Escape" && !Pause()) return Outcome::kQuit;
     const double onset = station_.Now();
     double paused_s = 0;  // time spent on the pause screen, not part of the response time
     int level = trial.start_index;
@@ -238,6 +241,7 @@ class Runner {
       last_flip = flip;
       if (station_.Closed()) return Outcome::kQuit;
       for (const InputEvent& e : station_.Poll()) {
+        if (e.time_s < onset) continue;
         const std::string action = keys_.Action(e.key, trial.task);
         const double t_ms = (std::max(e.time_s, onset) - onset - paused_s) * 1000;
         if (action == "pause") {
@@ -412,6 +416,19 @@ RunResult RunSession(const RunOptions& options) {
                 window && context->RefreshHz() > 0 ? ("@" + std::to_string(int(context->RefreshHz()))).c_str() : "",
                 context->Describe().c_str(), observer ? ("; observer " + ToString(*observer)).c_str() : "");
   meta.display = display;
+  if (!options.again && !options.resume) {
+    // Running a participant through a study they finished is usually a typo in the id: say so.
+    store::Statement done(record.database(),
+                          "SELECT s.id FROM sessions s JOIN participants p ON p.id = s.participant_id "
+                          "JOIN studies st ON st.id = p.study_id "
+                          "WHERE st.name = ? AND p.code = ? AND s.status = 'completed' ORDER BY s.id");
+    done.Bind(1, protocol.name);
+    done.Bind(2, options.participant);
+    if (done.Step())
+      throw InputError(options.db.string(), "participant " + options.participant + " already completed " +
+                                                protocol.name + " (session " + std::to_string(done.GetInt64(0)) +
+                                                "); check the id, or add --again for another session");
+  }
   const store::SessionStart start = record.StartOrResumeSession(protocol.name, options.participant, protocol_text,
                                                                 seed, meta, options.resume);
   if (start.trial_count == 0) {

@@ -18,6 +18,7 @@ struct RunOptions {
   std::optional<uint64_t> seed;  // unset: protocol::DefaultSeed(study, participant), recorded like any seed
   std::string observer;          // empty: a person at the window; "sim[:params]": the simulated observer
   bool resume = false;
+  bool again = false;            // allow another session for a participant who completed the study
   bool window = false;           // a simulated observer in a window, on the real clock (a person always has one)
   double sim_fps = 4;            // headless: frames rendered per second of simulated time
   int stop_after = -1;           // >= 0: leave the session (running, resumable) after this many new answers
