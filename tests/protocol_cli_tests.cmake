@@ -33,6 +33,10 @@ add_test(NAME cli_validate_broken_no_files
 
 # The JSON Schema is itself valid draft 2020-12, accepts the four shipped protocols and rejects the broken one
 # (only where python3 has jsonschema; the C++ validator above does not depend on it).
+# Debian's interpreter first: the one that sees python3-jsonschema (a python3 earlier on PATH may not).
+if(EXISTS /usr/bin/python3 AND NOT Python3_EXECUTABLE)
+  set(Python3_EXECUTABLE /usr/bin/python3)
+endif()
 find_package(Python3 COMPONENTS Interpreter QUIET)
 if(Python3_Interpreter_FOUND)
   execute_process(COMMAND ${Python3_EXECUTABLE} -c "import jsonschema" RESULT_VARIABLE no_jsonschema

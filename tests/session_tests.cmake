@@ -3,10 +3,17 @@ set(BC $<TARGET_FILE:blurcue>)
 set(T ${PROJECT_BINARY_DIR}/cli-test)
 add_test(NAME session_protocols
          COMMAND ${CMAKE_COMMAND} -DSRC=${PROJECT_SOURCE_DIR} -DOUT=${T} -P ${PROJECT_SOURCE_DIR}/tests/copy_protocols.cmake)
+# The depth-matching protocol's real photos, one per distance, by the thin lens.
+add_test(NAME session_pictures
+         COMMAND ${BC} synth-pictures --camera ${T}/scene/camera.json
+                 --protocol ${PROJECT_SOURCE_DIR}/protocols/pre-research-depth-matching.json --out ${T}/pictures)
+set_tests_properties(session_pictures PROPERTIES FIXTURES_REQUIRED scene FIXTURES_SETUP session_pictures
+                     PASS_REGULAR_EXPRESSION "wrote 27 photos")
 set_tests_properties(session_protocols PROPERTIES FIXTURES_SETUP session_protocols)
 foreach(case complete same_seed resume kill9 second_writer window recover)
   add_test(NAME session_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/session_test.sh ${case} ${BC} ${T})
-  set_tests_properties(session_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS "gl;session"
+  set_tests_properties(session_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures"
+                       LABELS "gl;session"
                        PASS_REGULAR_EXPRESSION "^ok:|\nok:")
 endforeach()
 set_tests_properties(session_window PROPERTIES LABELS "gl;session;window")

@@ -15,6 +15,7 @@ void AddAnimateCommand(CLI::App& app);      // animate_command.cc
 void AddExportCommand(CLI::App& app);       // record_commands.cc
 void AddMergeCommand(CLI::App& app);        // record_commands.cc
 void AddMakeStimuliCommand(CLI::App& app);  // make_stimuli_command.cc
+void AddSynthPicturesCommand(CLI::App& app);  // make_stimuli_command.cc
 void AddValidateCommand(CLI::App& app);     // validate_command.cc
 void AddRunCommand(CLI::App& app);          // run_command.cc
 void AddPreviewCommand(CLI::App& app);      // preview_command.cc

@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
       {"calibrate", &cli::AddCalibrateCommand},
       {"estimate", &cli::AddEstimateCommand},
       {"make-stimuli", &cli::AddMakeStimuliCommand},
+      {"synth-pictures", &cli::AddSynthPicturesCommand},
       {"blur", &cli::AddBlurCommand},
       {"render", &cli::AddRenderCommand},
       {"animate", &cli::AddAnimateCommand},

@@ -2,7 +2,15 @@
 #include <memory>
 #include <string>
 
+#include <filesystem>
+#include <set>
+#include <vector>
+
 #include "cli/commands.h"
+#include "core/camera.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "protocol/protocol.h"
 #include "render/stimuli.h"
 
 namespace blurcue::cli {
@@ -20,6 +28,66 @@ void AddMakeStimuliCommand(CLI::App& app) {
   cmd->add_option("--out", *out, "folder to write into (created if needed)")->capture_default_str();
   cmd->callback([out] {
     for (const auto& file : render::WriteStandardStimuli(*out)) std::printf("wrote %s\n", file.string().c_str());
+  });
+}
+
+void AddSynthPicturesCommand(CLI::App& app) {
+  struct Args {
+    std::string camera, protocol, out, picture = "face";
+    std::vector<double> distances_m;
+    double focus_m = 1.0, height_mm = 120, grey = 0.18;
+    int width_px = 960;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "synth-pictures",
+      "Photos of the depth-matching study's real picture at each distance, made with the thin lens, for trying\n"
+      "the study without a photo session: the picture (8 x 12 cm by default) faces the camera at distance d,\n"
+      "imaged at magnification f / (d - f), blurred by the thin-lens disc for the lens focused at --focus-m, on a\n"
+      "grey wall. Writes OUT/PICTURE-{d}m.png (d as %g) at --width-px wide with the camera's aspect, the names a\n"
+      "protocol's content.real_photos pattern (e.g. \"pictures/face-{distance_m}m.png\") finds.\n"
+      "Example: blurcue synth-pictures --camera results/demo/scene/camera.json\n"
+      "         --protocol protocols/pre-research-depth-matching.json --out results/demo/pictures");
+  cmd->add_option("--camera", args->camera, "camera.json (f, f-number, sensor)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--protocol", args->protocol, "take the distances from this protocol's distance_m levels")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--distances-m", args->distances_m, "distances (m), instead of --protocol");
+  cmd->add_option("--focus-m", args->focus_m, "focus distance (m)")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--picture", args->picture, "face or an image with alpha")->capture_default_str();
+  cmd->add_option("--height-mm", args->height_mm, "the real picture's height")->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--width-px", args->width_px, "photo width (the camera's sensor scaled to it)")
+      ->capture_default_str()->check(CLI::Range(16, 16384));
+  cmd->add_option("--out", args->out, "folder (created)")->required();
+  cmd->callback([args] {
+    std::set<double> distances(args->distances_m.begin(), args->distances_m.end());
+    if (!args->protocol.empty()) {
+      protocol::ValidateOptions no_files;
+      no_files.check_files = false;  // its real_photos may be what we are about to write
+      const protocol::Protocol p = protocol::LoadProtocol(args->protocol, no_files);
+      for (const auto& b : p.blocks)
+        for (const auto& f : b.factors)
+          if (f.name == "distance_m")
+            for (const auto& level : f.levels)
+              if (level.is_number()) distances.insert(level.get<double>());
+    }
+    if (distances.empty()) throw Error(ErrorKind::kUsage, "give --distances-m or a --protocol with distance_m levels");
+    const Camera camera = LoadCamera(args->camera);
+    const Camera scaled = camera.Resized(args->width_px, int(std::lround(double(args->width_px) *
+                                                                          camera.image_height_px /
+                                                                          camera.image_width_px)));
+    const cv::Mat picture = ReadImage(render::ResolveStimulus(args->picture), -1);
+    std::filesystem::create_directories(args->out);
+    const std::string stem = std::filesystem::path(args->picture).stem().string();
+    for (double d : distances) {
+      char name[64];
+      std::snprintf(name, sizeof name, "%s-%gm.png", stem.c_str(), d);
+      const auto path = std::filesystem::path(args->out) / name;
+      WriteImage(path, render::RealPicturePhoto(picture, scaled, args->focus_m * 1000, d * 1000, args->height_mm,
+                                                args->grey));
+    }
+    std::printf("wrote %zu photos (%s, %dx%d, focus %g m) to %s\n", distances.size(), stem.c_str(),
+                scaled.image_width_px, scaled.image_height_px, args->focus_m, args->out.c_str());
   });
 }
 

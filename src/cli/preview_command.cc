@@ -31,7 +31,7 @@ void AddPreviewCommand(CLI::App& app) {
       "Draw a contact sheet of every distinct stimulus a protocol shows (each at its onset), labelled with its\n"
       "levels and the blur radius on each side, so a protocol can be checked by eye before a session.\n"
       "Distinct: the same levels and sides drawn once (practice copies and repetitions are not repeated); for\n"
-      "depth matching, one tile per adjustment level.\n"
+      "depth matching, one tile per adjustment level and one per distance.\n"
       "Example: blurcue preview protocols/test1-static-grids.json --out results/preview-test1.png");
   cmd->add_option("protocol", args->protocol, "the protocol JSON file")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "the contact sheet PNG")->required();
@@ -58,12 +58,25 @@ void AddPreviewCommand(CLI::App& app) {
     for (const auto& t : trials) {
       const session::TrialScene s = session::DescribeTrial(p, t, scene ? &*scene : nullptr);
       if (t.task == protocol::Task::kAdjustment) {
+        // Every level once (at the first distance shown), and every distance once (at the middle level): the
+        // two halves of the frame vary apart, so together these show every distinct half.
+        const std::string parameter = p.blocks.front().adjust ? p.blocks.front().adjust->parameter : "level";
+        std::vector<double> sorted = t.adjust_levels;
+        std::sort(sorted.begin(), sorted.end());
         for (double level : t.adjust_levels) {
-          char label[64];
-          std::snprintf(label, sizeof label, "%s %g", p.blocks.front().adjust ? p.blocks.front().adjust->parameter.c_str()
-                                                                              : "level", level);
-          if (!seen.emplace(label, true).second) continue;
-          tiles.push_back({&t, s, level, label, "", Json(level)});
+          char label[96];
+          std::snprintf(label, sizeof label, "%s %g", parameter.c_str(), level);
+          if (seen.emplace(label, true).second)
+            tiles.push_back({&t, s, level, label, "distance " + Json(s.distance_m).dump() + " m",
+                             Json::array({0, level})});
+        }
+        if (!sorted.empty() && s.distance_m > 0) {
+          char label[96];
+          std::snprintf(label, sizeof label, "distance %g m", s.distance_m);
+          const double middle = sorted[sorted.size() / 2];
+          if (seen.emplace(label, true).second)
+            tiles.push_back({&t, s, middle, label, parameter + " " + Json(middle).dump(),
+                             Json::array({1, s.distance_m})});
         }
         continue;
       }

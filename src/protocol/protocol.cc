@@ -1,6 +1,8 @@
 #include "protocol/protocol.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <cstring>
 #include <cmath>
 #include <functional>
 #include <map>
@@ -250,8 +252,14 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
       else p->content.texture = Path(v, "texture", ptr, true).string();
     }
   } else {
-    Object(v, ptr, {"type", "image"});
+    Object(v, ptr, {"type", "image", "real_photos"});
     p->content.image = Path(v, "image", ptr, true);
+    if (auto pattern = String(v, "real_photos", ptr, false)) {
+      if (pattern->find("{distance_m}") == std::string::npos)
+        Problem(ptr + "/real_photos", "must contain {distance_m} (one photo per distance)", Json(*pattern));
+      else
+        p->content.real_photos = (base_ / *pattern).lexically_normal().string();
+    }
   }
 }
 
@@ -521,6 +529,22 @@ Protocol Parser::Parse(const Json& json) {
       if (auto s = String(*v, "text", "/breaks", false)) p.break_text = *s;
     }
   }
+  // The real photos: one per distance the design shows.
+  if (!p.content.real_photos.empty() && options_.check_files) {
+    std::set<double> distances;
+    for (const auto& b : p.blocks)
+      for (const auto& f : b.factors)
+        if (f.name == "distance_m")
+          for (const auto& level : f.levels)
+            if (level.is_number()) distances.insert(level.get<double>());
+    if (distances.empty())
+      Problem("/content/real_photos", "needs a factor distance_m to choose the photo by", Json(p.content.real_photos));
+    for (double d : distances)
+      if (!fs::is_regular_file(RealPhotoFor(p.content, d)))
+        Problem("/content/real_photos", "no photo for distance_m " + Json(d).dump() + ": " +
+                                            RealPhotoFor(p.content, d).string(),
+                json["content"]["real_photos"]);
+  }
   std::set<Task> tasks;
   for (const auto& b : p.blocks) tasks.insert(b.task);
   const Json* responses = Field(json, "responses", "", false);
@@ -573,6 +597,16 @@ Protocol ParseProtocol(const Json& json, const fs::path& file, const ValidateOpt
 
 Protocol LoadProtocol(const fs::path& file, const ValidateOptions& options) {
   return ParseProtocol(ReadJsonFile(file), file, options);
+}
+
+fs::path RealPhotoFor(const Content& content, double distance_m) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", distance_m);
+  std::string path = content.real_photos;
+  const std::string key = "{distance_m}";
+  for (size_t at = path.find(key); at != std::string::npos; at = path.find(key, at + std::strlen(text)))
+    path.replace(at, key.size(), text);
+  return path;
 }
 
 }  // namespace blurcue::protocol

@@ -56,7 +56,13 @@ struct Content {
   double radius_mm = 10;              // ball
   std::string texture = "soccer";     // ball: soccer | wood | an image path (resolved)
   std::filesystem::path image;        // picture: the image (resolved)
+  // picture: photos of the real picture, one per distance: a resolved path with "{distance_m}" standing for the
+  // level as %g (e.g. "photos/face-{distance_m}m.png" -> "photos/face-0.4m.png"); empty: the scene photo
+  std::string real_photos;
 };
+
+// The real photo of `content` for a distance (content.real_photos with {distance_m} replaced).
+std::filesystem::path RealPhotoFor(const Content& content, double distance_m);
 
 struct Practice {
   int count = 0;                      // 0: no practice

@@ -135,6 +135,35 @@ TEST(ProtocolValidate, MissingFileAcceptedWithoutFileChecks) {
   EXPECT_TRUE(Problems(j, false).empty());
 }
 
+// A depth-matching protocol with a photo of the real picture per distance.
+Json WithRealPhotos(const std::string& pattern) {
+  const fs::path dir = SceneFolder() / "photos";
+  fs::create_directories(dir);
+  for (const char* name : {"face-0.4m.png", "face-1.5m.png"}) std::ofstream(dir / name) << "x";
+  return Json::parse(R"({
+    "name": "dm", "version": 1, "scene": {"background": "scene/scene.png"},
+    "content": {"type": "picture", "image": "scene/scene.png", "real_photos": ")" + pattern + R"("},
+    "task": "adjustment", "adjust": {"levels": [2, 4, 8]}, "factors": {"distance_m": [0.4, 1.5]}
+  })");
+}
+
+TEST(ProtocolValidate, RealPhotosFoundPerDistance) {
+  const Json j = WithRealPhotos("photos/face-{distance_m}m.png");
+  EXPECT_TRUE(Problems(j).empty()) << OnlyProblem(j);
+  const Protocol p = ParseProtocol(j, SceneFolder() / "p.json");
+  EXPECT_EQ(RealPhotoFor(p.content, 0.4), SceneFolder() / "photos" / "face-0.4m.png");
+  EXPECT_EQ(RealPhotoFor(p.content, 1.5).filename(), "face-1.5m.png");
+}
+
+TEST(ProtocolValidate, RealPhotosMissingOrWithoutPlaceholderRejected) {
+  Json j = WithRealPhotos("photos/face-{distance_m}m.png");
+  j["factors"]["distance_m"].push_back(2.5);
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /content/real_photos: no photo for distance_m 2.5: ")) << OnlyProblem(j);
+  EXPECT_TRUE(Contains(OnlyProblem(j), "face-2.5m.png")) << OnlyProblem(j);
+  const Json k = WithRealPhotos("photos/face.png");
+  EXPECT_TRUE(Contains(OnlyProblem(k), ": /content/real_photos: must contain {distance_m}")) << OnlyProblem(k);
+}
+
 TEST(ProtocolValidate, ComparisonWithoutSidesRejected) {
   Json j = Valid();
   j["blocks"][1]["factors"] = {{"section", {1, 2}}};

@@ -86,18 +86,17 @@ cv::Mat ButterworthBlurCpu(const cv::Mat& rgba, double cutoff, int order) {
   return FilterInFrequency(rgba, [&](double f) { return 1.0 / (1.0 + std::pow(f * w / cutoff, 2 * order)); });
 }
 
-cv::Mat PictureOnGrey(const cv::Mat& picture, cv::Size field, int height_px, double cutoff, double grey) {
+cv::Mat PictureOnField(const cv::Mat& picture, cv::Size field, int height_px, int margin_px,
+                       const std::function<cv::Mat(const cv::Mat&, int)>& filter, double grey) {
   CV_Assert(height_px > 0 && field.width > 0 && field.height > 0);
   const int width_px = std::max(1, int(std::lround(double(picture.cols) * height_px / picture.rows)));
   cv::Mat scaled;
   cv::resize(picture, scaled, cv::Size(width_px, height_px), 0, 0, cv::INTER_AREA);
-  // A transparent margin of a quarter of the picture lets the low-pass spread past its outline.
-  const int margin = std::max(width_px, height_px) / 4;
+  // A transparent margin lets the blur spread past the picture's outline.
   cv::Mat layer;
-  cv::copyMakeBorder(ToLinearPremultiplied(scaled), layer, margin, margin, margin, margin, cv::BORDER_CONSTANT,
-                     cv::Scalar(0, 0, 0, 0));
-  // The cut-off is per picture width; the padded layer is wider, so scale it to the layer's width.
-  if (cutoff > 0) layer = ButterworthBlurCpu(layer, cutoff * layer.cols / width_px);
+  cv::copyMakeBorder(ToLinearPremultiplied(scaled), layer, margin_px, margin_px, margin_px, margin_px,
+                     cv::BORDER_CONSTANT, cv::Scalar(0, 0, 0, 0));
+  if (filter) layer = filter(layer, width_px);
   cv::Mat out(field, CV_32FC3, cv::Scalar(grey, grey, grey));
   const cv::Rect at((field.width - layer.cols) / 2, (field.height - layer.rows) / 2, layer.cols, layer.rows);
   const cv::Rect visible = at & cv::Rect(0, 0, field.width, field.height);
@@ -110,6 +109,15 @@ cv::Mat PictureOnGrey(const cv::Mat& picture, cv::Size field, int height_px, dou
                     std::max(0.f, p[2] + keep * o[2]));
     }
   return EncodeSrgb8(out);
+}
+
+cv::Mat PictureOnGrey(const cv::Mat& picture, cv::Size field, int height_px, double cutoff, double grey) {
+  const int width_px = std::max(1, int(std::lround(double(picture.cols) * height_px / picture.rows)));
+  // The cut-off is per picture width; the padded layer is wider, so scale it to the layer's width.
+  auto butterworth = [cutoff](const cv::Mat& layer, int picture_width_px) {
+    return cutoff > 0 ? ButterworthBlurCpu(layer, cutoff * layer.cols / picture_width_px) : layer;
+  };
+  return PictureOnField(picture, field, height_px, std::max(width_px, height_px) / 4, butterworth, grey);
 }
 
 cv::Mat DepthMatchingFrame(const cv::Mat& upper, const cv::Mat& photo, int width_px) {

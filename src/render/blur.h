@@ -36,6 +36,11 @@ cv::Mat ButterworthBlurCpu(const cv::Mat& rgba, double cutoff_cycles_per_width, 
 // a uniform grey field of `field` size with linear grey level `grey`. Returns 8-bit BGR sRGB.
 cv::Mat PictureOnGrey(const cv::Mat& picture, cv::Size field, int height_px, double cutoff, double grey = 0.18);
 
+// `picture` scaled to height_px with a transparent margin of margin_px, passed through filter(layer, picture width
+// in px) as CV_32FC4 linear premultiplied, and composited centred on a uniform field of linear grey. 8-bit BGR sRGB.
+cv::Mat PictureOnField(const cv::Mat& picture, cv::Size field, int height_px, int margin_px,
+                       const std::function<cv::Mat(const cv::Mat&, int)>& filter, double grey);
+
 // The depth-matching study's frame (thesis 3.2), 8-bit sRGB BGR of width_px x 3/4 width_px: the upper half is
 // `upper` (a PictureOnGrey of width_px x half the height), the lower half the scene photo scaled to cover it and
 // cropped at its centre.

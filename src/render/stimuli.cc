@@ -1,5 +1,8 @@
 #include "render/stimuli.h"
 
+#include "optics/thin_lens.h"
+#include "render/blur.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -411,6 +414,17 @@ std::vector<std::filesystem::path> WriteStandardStimuli(const std::filesystem::p
   write("grid.png", GridBoard(1024));
   write("face.png", FacePicture(800));
   return written;
+}
+
+cv::Mat RealPicturePhoto(const cv::Mat& picture, const Camera& camera, double focus_mm, double distance_mm,
+                         double picture_height_mm, double grey) {
+  const optics::Lens lens = optics::Lens::FromCamera(camera);
+  const double r_px = optics::BlurRadiusPx(lens, focus_mm, distance_mm);  // throws kDomain for u or focus <= f
+  const double magnification = lens.focal_length_mm / (distance_mm - lens.focal_length_mm);
+  const int height_px = std::max(2, int(std::lround(picture_height_mm * magnification / lens.pixel_pitch_mm)));
+  auto disc = [r_px](const cv::Mat& layer, int) { return r_px >= 0.5 ? DiscBlurCpu(layer, r_px) : layer; };
+  return PictureOnField(picture, cv::Size(camera.image_width_px, camera.image_height_px), height_px,
+                        int(std::ceil(r_px)) + 2, disc, grey);
 }
 
 }  // namespace blurcue::render

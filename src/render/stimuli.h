@@ -9,6 +9,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "core/camera.h"
+
 namespace blurcue::render {
 
 // A stimulus by name or path: an existing file as given, else the shipped stimuli/NAME.png (soccer, wood, grid,
@@ -40,6 +42,14 @@ double GridLineWidthPx(int size_px);
 // The depth-matching study's face-like picture (8 x 12 cm in the study): a drawn, softly shaded face with hair;
 // transparent outside the head. 8-bit sRGB BGRA, width_px x 1.5 width_px; width_px must be even and >= 16.
 cv::Mat FacePicture(int width_px);
+
+// A photo of the real picture in the depth-matching study, made with the thin lens (no photos needed to try the
+// study): `picture` (8-bit sRGB, alpha = its shape) picture_height_mm high, facing `camera` at distance_mm on the
+// optical axis, imaged at magnification f / (u - f) and blurred by the disc of the thin-lens radius for a lens
+// focused at focus_mm, over a uniform wall of linear grey `grey`, in linear light. 8-bit BGR sRGB at the camera's
+// resolution. Throws Error(kDomain) for a distance or focus not beyond the focal length.
+cv::Mat RealPicturePhoto(const cv::Mat& picture, const Camera& camera, double focus_mm, double distance_mm,
+                         double picture_height_mm = 120, double grey = 0.18);
 
 // Writes soccer.png (2048 x 1024), wood.png (2048 x 1024, seed 1), grid.png (1024 x 1024) and face.png
 // (800 x 1200) into dir (created if needed); returns the files written. Throws Error naming a file on failure.

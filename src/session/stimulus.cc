@@ -178,7 +178,15 @@ void StimulusRenderer::Compose(const TrialScene& trial, double t_s, double level
       upper_cache_.emplace_back(level, render::PictureOnGrey(picture_, cv::Size(w, half), half * 6 / 10, level));
       cached = std::prev(upper_cache_.end());
     }
-    picture_frame_ = render::DepthMatchingFrame(cached->second, photo_, picture_width_px_);
+    const cv::Mat* lower = &photo_;
+    if (!protocol_.content.real_photos.empty()) {
+      if (trial.distance_m != real_photo_distance_m_) {
+        real_photo_ = ReadImage(protocol::RealPhotoFor(protocol_.content, trial.distance_m), 1);
+        real_photo_distance_m_ = trial.distance_m;
+      }
+      lower = &real_photo_;
+    }
+    picture_frame_ = render::DepthMatchingFrame(cached->second, *lower, picture_width_px_);
     return;
   }
   std::vector<render::BlurredObject> objects;

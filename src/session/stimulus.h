@@ -6,7 +6,8 @@
 //   ball    - two balls rolling side by side along sections 3 and 5 of the board (tests 2 and 3): edge 1 -> 11 at
 //             the pattern's speed, or with a `section` s only from edge s to s + 1 and then wiped;
 //   picture - the depth-matching frame (thesis 3.2): the picture low-passed at the adjusted cut-off on grey above,
-//             the scene photo below.
+//             below the photo of the real picture at the trial's distance (content.real_photos), or the scene
+//             photo when the protocol names no real photos.
 #include <memory>
 #include <optional>
 #include <string>
@@ -83,6 +84,8 @@ class StimulusRenderer {
   cv::Mat picture_;
   std::vector<std::pair<double, cv::Mat>> upper_cache_;
   cv::Mat picture_frame_;
+  double real_photo_distance_m_ = -1;  // the real photo loaded (one at a time: 27 would hold ~50 MB)
+  cv::Mat real_photo_;
   int picture_width_px_ = 960;
 };
 
