@@ -23,6 +23,14 @@ fingerprint() {
             FROM trials t JOIN sessions s ON s.id = t.session_id JOIN participants p ON p.id = s.participant_id
             LEFT JOIN responses r ON r.trial_id = t.id WHERE p.code = '$2' ORDER BY t.trial_index"
 }
+# Waits (up to 30 s) until the record at $1 holds at least $2 answers.
+wait_for_answers() {
+  for _ in $(seq 1 600); do
+    n=$(sql "$1" "SELECT count(*) FROM responses" 2>/dev/null || echo 0)
+    [ "${n:-0}" -ge "$2" ] && return 0
+    sleep 0.05
+  done
+}
 integrity() { [ "$(sql "$1" 'PRAGMA integrity_check')" = ok ] || fail "integrity_check of $1"; }
 
 case $CASE in
@@ -90,11 +98,7 @@ kill9)
   $BC run "$P/test2-moving-balls.json" --participant K1 --db "$W/killed.sqlite" --observer sim --seed 9 --sim-fps 8 \
     > "$W/out" 2>&1 &
   pid=$!
-  for _ in $(seq 1 600); do
-    n=$(sql "$W/killed.sqlite" "SELECT count(*) FROM responses" 2>/dev/null || echo 0)
-    [ "${n:-0}" -ge 8 ] && break
-    sleep 0.05
-  done
+  wait_for_answers "$W/killed.sqlite" 8
   kill -9 $pid; wait $pid 2>/dev/null || true
   answered=$(sql "$W/killed.sqlite" "SELECT count(*) FROM responses")
   [ "$answered" -ge 8 ] && [ "$answered" -lt 74 ] || fail "killed after $answered answers, expected mid-session"
@@ -108,11 +112,7 @@ second_writer)
   # While one process runs a session, a second one resuming it is refused with a clear message (exit 3).
   $BC run "$P/test2-moving-balls.json" --participant L1 --db "$W/s.sqlite" --observer sim --sim-fps 8 > /dev/null 2>&1 &
   pid=$!
-  for _ in $(seq 1 600); do
-    n=$(sql "$W/s.sqlite" "SELECT count(*) FROM responses" 2>/dev/null || echo 0)
-    [ "${n:-0}" -ge 1 ] && break
-    sleep 0.05
-  done
+  wait_for_answers "$W/s.sqlite" 1
   set +e
   $BC run "$P/test2-moving-balls.json" --participant L1 --db "$W/s.sqlite" --observer sim --resume 2> "$W/err"
   code=$?

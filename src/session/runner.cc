@@ -43,12 +43,14 @@ class Station {
   double frame_s() const { return frame_s_; }
   double Now() const { return window_ ? context_.Now() : clock_s_; }
 
-  // Ends a frame and returns its flip time.
+  // Ends a frame and returns its flip time (when it reached the screen). Headless: the frame shows now, and the
+  // clock moves on to the next frame or the next scripted key, whichever comes first.
   double Flip() {
     if (!window_) {
-      const double next = scripted_.empty() ? clock_s_ + frame_s_ : std::min(clock_s_ + frame_s_, scripted_.front().time_s);
-      clock_s_ = std::max(clock_s_, next);
-      return clock_s_;
+      const double flip = clock_s_;
+      const double next = clock_s_ + frame_s_;
+      clock_s_ = scripted_.empty() ? next : std::max(clock_s_, std::min(next, scripted_.front().time_s));
+      return flip;
     }
     context_.SwapBuffers();
     // Without vsync (e.g. under Xvfb) a swap returns at once: hold the refresh rate so a window shows what a
@@ -155,19 +157,27 @@ class Runner {
         station_(context, !observer || options.window, options.sim_fps),
         screen_size_(protocol.display.width_px, protocol.display.height_px) {}
 
+  // Shows `image` until one of `keys` is pressed and returns it ("" when the window is closed).
+  std::string ShowUntil(const cv::Mat& image, const std::vector<std::string>& keys) {
+    for (;;) {
+      if (station_.window()) render::PresentImage(image, context_.width_px(), context_.height_px());
+      station_.Flip();
+      if (station_.Closed()) return "";
+      for (const InputEvent& e : station_.Poll())
+        if (std::find(keys.begin(), keys.end(), e.key) != keys.end()) return e.key;
+    }
+  }
+
   // A text screen until Return, Space or a click (a simulated observer presses Return after a moment). Escape
   // on it pauses like anywhere else. Returns false when the participant quits.
   bool ShowScreen(const std::string& title, const std::string& body, const std::string& footer) {
     const cv::Mat image = TextScreen(screen_size_, title, body, footer);
     if (observer_) station_.Script("Return", station_.Now() + 0.6);
     for (;;) {
-      if (station_.window()) render::PresentImage(image, context_.width_px(), context_.height_px());
-      station_.Flip();
-      if (station_.Closed()) return false;
-      for (const InputEvent& e : station_.Poll()) {
-        if (e.key == "Return" || e.key == "Space" || e.key == "MouseLeft") return true;
-        if (e.key == "Escape" && !Pause()) return false;
-      }
+      const std::string key = ShowUntil(image, {"Return", "Space", "MouseLeft", "Escape"});
+      if (key.empty()) return false;
+      if (key != "Escape") return true;
+      if (!Pause()) return false;
     }
   }
 
@@ -177,14 +187,23 @@ class Runner {
                                      "Every answer so far is saved. Press Q to quit (the session can be continued "
                                      "later with --resume), or Return to go on.",
                                      "Q: quit    Return: go on");
-    for (;;) {
-      if (station_.window()) render::PresentImage(image, context_.width_px(), context_.height_px());
-      station_.Flip();
-      if (station_.Closed()) return false;
-      for (const InputEvent& e : station_.Poll()) {
-        if (e.key == "Q") return false;
-        if (e.key == "Return" || e.key == "Space") return true;
-      }
+    const std::string key = ShowUntil(image, {"Q", "Return", "Space"});
+    return !key.empty() && key != "Q";
+  }
+
+  // The simulated observer's key presses for a trial whose stimulus appeared at `onset`.
+  void ScriptObserver(const protocol::Trial& trial, const TrialScene& scene, double onset) {
+    SimulatedObserver observer(*observer_, TrialSeed(seed_, trial.index));
+    if (trial.task == Task::kForcedChoice) {
+      const KeyPress press = observer.ChooseSide({scene.r_left_px, scene.r_right_px, scene.r_scene_px});
+      // A moving stimulus is watched to its end before the answer (task 1 is one answer per run).
+      station_.Script(keys_.Key(press.action), onset + scene.MotionS() + press.after_ms / 1000);
+      return;
+    }
+    double t = onset;
+    for (const KeyPress& press : observer.Adjust(trial.adjust_levels, trial.start_index, scene.distance_m)) {
+      t += press.after_ms / 1000;
+      station_.Script(keys_.Key(press.action), t);
     }
   }
 
@@ -203,29 +222,15 @@ class Runner {
     // Keys pressed before the stimulus (during the interval) answer nothing: drop them. Escape still pauses.
     for (const InputEvent& e : station_.Poll())
       if (e.key == "Escape" && !Pause()) return Outcome::kQuit;
-    const double onset = station_.Now();
-    double paused_s = 0;  // time spent on the pause screen, not part of the response time
+    double onset = -1;    // the first frame's flip: response times and motion run from it
+    double paused_s = 0;  // time spent on the pause screen: neither motion nor response time
     int level = trial.start_index;
     const int levels = static_cast<int>(trial.adjust_levels.size());
     Json steps = Json::array();
-    if (observer_) {
-      SimulatedObserver observer(*observer_, TrialSeed(seed_, trial.index));
-      if (trial.task == Task::kForcedChoice) {
-        const KeyPress press = observer.ChooseSide({scene.r_left_px, scene.r_right_px, scene.r_scene_px});
-        // A moving stimulus is watched to its end before the answer (task 1 is one answer per run).
-        station_.Script(keys_.Key(press.action), onset + scene.MotionS() + press.after_ms / 1000);
-      } else {
-        double t = onset;
-        for (const KeyPress& press : observer.Adjust(trial.adjust_levels, trial.start_index, scene.distance_m)) {
-          t += press.after_ms / 1000;
-          station_.Script(keys_.Key(press.action), t);
-        }
-      }
-    }
     const double stimulus_s = protocol_.timing.stimulus_ms / 1000;
     double last_flip = -1;
     for (int frame = 0;; ++frame) {
-      const double t = station_.Now() - onset;
+      const double t = onset < 0 ? 0 : station_.Now() - onset - paused_s;
       const bool shown = stimulus_s <= 0 || t < stimulus_s;
       if (shown) renderer_.Compose(scene, t, levels > 0 ? trial.adjust_levels[size_t(level)] : 0);
       if (station_.window()) {
@@ -235,15 +240,19 @@ class Runner {
           render::PresentImage(Blank(), context_.width_px(), context_.height_px());
       }
       const double flip = station_.Flip();
+      if (onset < 0) {
+        onset = flip;
+        if (observer_) ScriptObserver(trial, scene, onset);
+      }
       const bool dropped = station_.window() && last_flip >= 0 && flip - last_flip > 1.5 * station_.frame_s();
       frames->push_back({frame, flip - onset, dropped});
       dropped_frames_ += dropped;
       last_flip = flip;
       if (station_.Closed()) return Outcome::kQuit;
       for (const InputEvent& e : station_.Poll()) {
-        if (e.time_s < onset) continue;
+        if (e.time_s < onset) continue;  // pressed before the stimulus was on screen
         const std::string action = keys_.Action(e.key, trial.task);
-        const double t_ms = (std::max(e.time_s, onset) - onset - paused_s) * 1000;
+        const double t_ms = (e.time_s - onset - paused_s) * 1000;
         if (action == "pause") {
           const double paused_at = station_.Now();
           if (!Pause()) return Outcome::kQuit;
