@@ -303,6 +303,7 @@ class Runner {
     std::string shown_block;
     int main_answered = 0;
     for (int64_t i = start.first_unanswered_trial; i < result.trial_count; ++i) {
+      if (options_.stop_after >= 0 && result.answered_now >= options_.stop_after) break;
       const protocol::Trial& trial = trials_[size_t(i)];
       // Instructions when the part changes: practice, then each block.
       const std::string part = trial.practice ? std::string("practice") : trial.block;
@@ -328,7 +329,6 @@ class Runner {
       ++result.answered_now;
       progress(i + 1);
       if (!trial.practice) ++main_answered;
-      if (options_.stop_after >= 0 && result.answered_now >= options_.stop_after) break;
       if (protocol_.break_every_trials > 0 && !trial.practice && main_answered % protocol_.break_every_trials == 0 &&
           i + 1 < result.trial_count &&
           !ShowScreen("Break", protocol_.break_text.empty() ? "Take a short break." : protocol_.break_text,
