@@ -29,7 +29,7 @@ STUDY_TITLES = {
 }
 
 LEADING = ["study", "protocol_hash", "participant", "session", "seed", "trial_index", "block"]
-TRAILING = ["left", "right", "choice", "rt_ms", "answered_at"]
+TRAILING = ["left", "right", "choice", "rt_ms", "answered_at"]  # and "adjustment" (the steps), not needed here
 NUMERIC = ["edge", "section", "distance_m", "r_left_px", "r_right_px", "r_scene_px", "start_level", "rt_ms",
            "trial_index", "session"]
 

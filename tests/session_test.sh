@@ -166,6 +166,21 @@ print(f"recovered c = {math.exp(a):.2f} d^{b:.3f}")
 sys.exit(0 if abs(b + 0.5) < 0.08 and abs(math.exp(a) / 20 - 1) < 0.12 else 1)
 PYEOF
   grep -q "bench" "$W/err" || fail "the missing bench folder is not named: $(cat "$W/err")"
+  # Every answer is where its recorded steps end: the start level, then each step, the last one accepted.
+  $PY - "$W/report/tables/trials.csv" <<'PYEOF' || fail "adjustment paths"
+import csv, json, sys
+rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["choice"]]
+assert len(rows) == 3 * 28, len(rows)
+stepped = 0
+for r in rows:
+    steps = json.loads(r["adjustment"] or "[]")
+    assert all(b["t_ms"] >= a["t_ms"] for a, b in zip(steps, steps[1:])), r
+    last = steps[-1]["level"] if steps else float(r["start_level"])
+    assert abs(float(r["choice"]) - last) < 1e-9, (r["choice"], last)
+    assert not steps or float(r["rt_ms"]) >= steps[-1]["t_ms"], r
+    stepped += bool(steps)
+assert stepped > len(rows) // 2, stepped
+PYEOF
   echo "ok: depth matching through run, record, export and report recovers c = 20 d^-0.5" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -17,7 +17,8 @@ void AddExportCommand(CLI::App& app) {
       "export",
       "Write a record's answers as a long-format table: DIR/trials.csv, one row per planned trial (answered or\n"
       "not), the same columns for every participant (study, protocol_hash, participant, session, seed,\n"
-      "trial_index, block, every trial variable, left, right, choice, rt_ms, answered_at), and per study\n"
+      "trial_index, block, every trial variable, left, right, choice, rt_ms, adjustment (the steps of an adjustment\n"
+      "as JSON), answered_at), and per study\n"
       "DIR/summary-STUDY.csv: per session the trials planned and answered, the median response time and how often\n"
       "each answer was given (the source chosen or cant_tell; the level accepted). Practice trials are left out\n"
       "of the summaries.\n"

@@ -26,7 +26,7 @@ const std::vector<std::string>& LeadingColumns() {
 }
 
 const std::vector<std::string>& TrailingColumns() {
-  static const std::vector<std::string> columns = {"left", "right", "choice", "rt_ms", "answered_at"};
+  static const std::vector<std::string> columns = {"left", "right", "choice", "rt_ms", "adjustment", "answered_at"};
   return columns;
 }
 
@@ -203,7 +203,7 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
 
   Statement rows(db,
                  "SELECT st.name, pv.hash, p.code, s.id, s.seed, t.trial_index, t.block, t.factors, t.left_shown, "
-                 "t.right_shown, r.choice, r.rt_ms, r.answered_at, r.id IS NULL "
+                 "t.right_shown, r.choice, r.rt_ms, r.answered_at, r.id IS NULL, r.adjustment "
                  "FROM trials t JOIN sessions s ON s.id = t.session_id "
                  "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
                  "JOIN protocol_versions pv ON pv.id = s.protocol_version_id "
@@ -228,6 +228,9 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
     const bool answered = rows.GetInt64(13) == 0;
     cells.push_back(answered ? rows.GetText(10) : "");
     cells.push_back(answered && !rows.IsNull(11) ? Number(rows.GetDouble(11)) : "");
+    // The adjustment path (method of adjustment: every level stepped to, with its time); empty for none.
+    const std::string steps = answered ? rows.GetText(14) : "";
+    cells.push_back(steps == "[]" ? "" : steps);
     cells.push_back(answered ? rows.GetText(12) : "");
     text += CsvLine(cells);
     ++count;

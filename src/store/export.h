@@ -9,7 +9,7 @@ namespace blurcue::store {
 // Writes `out_dir`/trials.csv (atomically): one row per planned trial, answered or not, ordered by study,
 // participant, session, trial index. Columns, the same for every participant:
 //   study, protocol_hash, participant, session, seed, trial_index, block, <every factor key found in the record,
-//   sorted>, left, right, choice, rt_ms, answered_at
+//   sorted>, left, right, choice, rt_ms, adjustment (the JSON path of steps; empty when none), answered_at
 // A factor a trial lacks is an empty cell; a factor named like a fixed column is written as "factor_<name>".
 // Beside it, per study, `out_dir`/summary-STUDY.csv: one row per session with the trials planned and answered
 // (practice apart), the median response time and the count of every answer (forced choice: the source chosen, or

@@ -89,7 +89,7 @@ TEST(Export, ColumnsAreTheSameForParticipantsWithDifferentFactors) {
   ASSERT_EQ(rows.size(), 8u);
   const std::vector<std::string> expected = {"study", "protocol_hash", "participant", "session", "seed",
                                              "trial_index", "block", "blur", "edge", "speed_cm_s",
-                                             "left", "right", "choice", "rt_ms", "answered_at"};
+                                             "left", "right", "choice", "rt_ms", "adjustment", "answered_at"};
   EXPECT_EQ(rows[0], expected);
   for (const auto& row : rows) EXPECT_EQ(row.size(), expected.size());
   EXPECT_EQ(rows[1][Column(rows, "participant")], "P01");
