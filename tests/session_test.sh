@@ -69,6 +69,23 @@ PYEOF
   grep -q "participant P1 already completed test1-static-grids (session 1)" "$W/err" || fail "message: $(cat "$W/err")"
   $BC run "$P/test1-static-grids.json" --participant P1 --db "$W/s.sqlite" --observer sim --again | grep -q completed
   echo "ok: 2 participants x 13 trials, edges and sides as designed, frames recorded, exported and summarised" ;;
+merge)
+  # Two lab stations run different participants of two studies; the merged record holds both, and a session
+  # cannot be merged twice.
+  $BC run "$P/test1-static-grids.json" --participant A1 --db "$W/a.sqlite" --observer sim > /dev/null
+  $BC run "$P/test2-moving-balls.json" --participant A1 --db "$W/a.sqlite" --observer sim --stop-after 5 > /dev/null
+  $BC run "$P/test1-static-grids.json" --participant B1 --db "$W/b.sqlite" --observer sim > /dev/null
+  $BC merge "$W/a.sqlite" "$W/b.sqlite" --out "$W/all.sqlite"
+  integrity "$W/all.sqlite"
+  got=$(sql "$W/all.sqlite" "SELECT st.name, p.code, s.status, count(r.id) FROM sessions s
+        JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id
+        JOIN trials t ON t.session_id = s.id LEFT JOIN responses r ON r.trial_id = t.id
+        GROUP BY s.id ORDER BY st.name, p.code")
+  [ "$got" = $'test1-static-grids|A1|completed|13\ntest1-static-grids|B1|completed|13\ntest2-moving-balls|A1|running|5' ] \
+    || fail "merged: $got"
+  if $BC merge "$W/all.sqlite" "$W/a.sqlite" --out "$W/again.sqlite" 2> "$W/err"; then fail "a session merged twice"; fi
+  [ ! -e "$W/again.sqlite" ] || fail "a failed merge left its output"
+  echo "ok: two stations merged: $(echo "$got" | tr '\n' ' ')" ;;
 same_seed)
   # The same protocol, participant and seed give the same trials and (simulated) answers; another seed does not.
   for db in a b; do $BC run "$P/test2-moving-balls.json" --participant S1 --db "$W/$db.sqlite" --observer sim --seed 11; done
