@@ -1,4 +1,5 @@
 // blurcue: measure the defocus blur of a real scene, predict it anywhere, render and run depth-cue studies.
+#include <algorithm>
 #include <iostream>
 #include <string>
 #include <utility>
@@ -39,6 +40,25 @@ int main(int argc, char** argv) {
       {"bench", &cli::AddBenchCommand},
   };
   for (const auto& [name, add] : commands) add(app);
+  // 'blurcue --help' lists each command with its first sentence; the rest is its own --help's footer.
+  for (CLI::App* sub : app.get_subcommands({})) {
+    const std::string text = sub->get_description();
+    size_t cut = std::string::npos;
+    for (size_t i = 0; i < text.size() && cut == std::string::npos; ++i) {
+      if (text[i] != '.' || (i + 1 < text.size() && text[i + 1] != ' ' && text[i + 1] != '\n')) continue;
+      const size_t word = text.find_last_of(" \n(", i) + 1;  // npos + 1 = 0
+      const std::string before = text.substr(word, i - word);
+      if (before != "eq" && before != "Eq" && before != "e.g" && before != "i.e") cut = i + 1;
+    }
+    const bool long_sentence = cut == std::string::npos || cut > 160;
+    if (long_sentence) cut = text.find('\n');
+    if (cut == std::string::npos || cut >= text.size()) continue;
+    std::string first = text.substr(0, cut) + (long_sentence && text[cut - 1] != ':' ? " ..." : "");
+    std::replace(first.begin(), first.end(), '\n', ' ');
+    const size_t rest = text.find_first_not_of(" \n", cut);
+    sub->description(first);
+    if (rest != std::string::npos) sub->footer(text.substr(rest));
+  }
 
   // An unknown command says how to list the known ones (CLI11 alone would say "a subcommand is required").
   if (argc > 1 && argv[1][0] != '-') {
