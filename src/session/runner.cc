@@ -229,10 +229,15 @@ class Runner {
     Json steps = Json::array();
     const double stimulus_s = protocol_.timing.stimulus_ms / 1000;
     double last_flip = -1;
+    int composed_level = -2;  // none yet (-1 is the level of a trial without levels)
     for (int frame = 0;; ++frame) {
       const double t = onset < 0 ? 0 : station_.Now() - onset - paused_s;
       const bool shown = stimulus_s <= 0 || t < stimulus_s;
-      if (shown) renderer_.Compose(scene, t, levels > 0 ? trial.adjust_levels[size_t(level)] : 0);
+      // A still stimulus is composed once (and again when the adjusted level changes); a moving one every frame.
+      if (shown && (composed_level != level || scene.MotionS() > 0)) {
+        renderer_.Compose(scene, t, levels > 0 ? trial.adjust_levels[size_t(level)] : 0);
+        composed_level = level;
+      }
       if (station_.window()) {
         if (shown)
           renderer_.Present(context_.width_px(), context_.height_px());
