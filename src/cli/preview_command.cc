@@ -1,5 +1,7 @@
 // blurcue preview: a contact sheet of every distinct stimulus of a protocol, to check it by eye before any
 // participant sits down.
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <map>
@@ -104,6 +106,7 @@ void AddPreviewCommand(CLI::App& app) {
     const int cols = std::min<int>(args->columns, int(tiles.size()));
     const int rows = (int(tiles.size()) + cols - 1) / cols;
     cv::Mat sheet(rows * (th + strip), cols * tw, CV_8UC3, cv::Scalar(40, 40, 40));
+    const bool tty = isatty(2);  // a terminal gets a progress line; a log only the summary
     for (size_t i = 0; i < tiles.size(); ++i) {
       renderer.Compose(tiles[i].scene, 0, tiles[i].level);
       cv::Mat small;
@@ -114,9 +117,9 @@ void AddPreviewCommand(CLI::App& app) {
                   cv::FONT_HERSHEY_SIMPLEX, 0.36, cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
       cv::putText(sheet, tiles[i].label2, {x + 4, y + th + 28}, cv::FONT_HERSHEY_SIMPLEX, 0.36,
                   cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
-      std::fprintf(stderr, "\rpreview: %zu of %zu", i + 1, tiles.size());
+      if (tty) std::fprintf(stderr, "\rpreview: %zu of %zu", i + 1, tiles.size());
     }
-    std::fprintf(stderr, "\n");
+    if (tty) std::fprintf(stderr, "\n");
     WriteImage(args->out, sheet);
     std::printf("%s: %zu distinct stimuli of %zu trials -> %s\n", args->protocol.c_str(), tiles.size(), trials.size(),
                 args->out.c_str());
