@@ -139,6 +139,47 @@ second_writer)
   grep -q "is being written by pid" "$W/err" || fail "message: $(cat "$W/err")"
   integrity "$W/s.sqlite"
   echo "ok: second writer refused: $(cat "$W/err")" ;;
+window_adjust)
+  # Depth matching by a person in a window: arrow keys, the mouse wheel and a click step and accept; each answer
+  # is the level the presses reach in that trial's own level order (from blurcue validate --list).
+  command -v xdotool >/dev/null || { echo "SKIP: xdotool missing"; exit 0; }
+  export DISPLAY=:$((90 + RANDOM % 100))
+  Xvfb $DISPLAY -screen 0 1280x1024x24 -nolisten tcp > "$W/xvfb.log" 2>&1 &
+  xvfb=$!
+  trap 'kill $xvfb 2>/dev/null || true' EXIT
+  sleep 1
+  proto="$P/pre-research-depth-matching.json"
+  $BC validate "$proto" --participant W1 --list > "$W/trials.jsonl"
+  $BC run "$proto" --participant W1 --db "$W/s.sqlite" --stop-after 3 > "$W/out" 2> "$W/err" &
+  run=$!
+  wid=$(xdotool search --sync --name "blurcue - pre-research-depth-matching" | head -1)
+  press() { sleep 0.7; xdotool key --window "$wid" "$1"; }
+  click() { sleep 0.7; xdotool mousemove --window "$wid" 200 200 click "$1"; }
+  press Return; press Return                  # welcome, practice
+  press Right; press Right; press Return      # trial 0: two steps on
+  press Return                                # the main part starts
+  click 4; click 1                            # trial 1: wheel up (next), click accepts
+  press Left; click 5; click 5; press Return  # trial 2: three steps back
+  wait $run || fail "run failed: $(cat "$W/err")"
+  sql "$W/s.sqlite" "SELECT t.trial_index, r.choice, r.adjustment FROM responses r JOIN trials t ON t.id = r.trial_id
+                     ORDER BY t.trial_index" > "$W/answers"
+  $PY - "$W/trials.jsonl" "$W/answers" <<'PYEOF' || fail "answers: $(cat "$W/answers")"
+import json, sys
+trials = [json.loads(line) for line in open(sys.argv[1]) if line.startswith("{")]
+answers = [line.rstrip("\n").split("|", 2) for line in open(sys.argv[2])]
+moves = {0: 2, 1: 1, 2: -3}
+assert [int(a[0]) for a in answers] == [0, 1, 2], answers
+for index, choice, steps in answers:
+    t = trials[int(index)]
+    levels = t["adjust_levels"]
+    expected = levels[(t["start_index"] + moves[int(index)]) % len(levels)]
+    assert abs(float(choice) - expected) < 1e-9, (index, choice, expected)
+    assert len(json.loads(steps)) == abs(moves[int(index)]), steps
+print("answers as pressed:", [a[1] for a in answers])
+PYEOF
+  grep -q "3 of 28 trials answered" "$W/out" || fail "summary: $(cat "$W/out")"
+  integrity "$W/s.sqlite"
+  echo "ok: depth matching in a window: keys, wheel and click gave the levels pressed to" ;;
 window)
   # A person at a real window under Xvfb: synthetic key presses (xdotool) answer test 1; the answers are in the
   # record as pressed: Left = left, Right = right, Down = can't tell.
