@@ -306,7 +306,9 @@ class Runner {
     const std::string welcome = start.resumed && start.first_unanswered_trial > 0 ? "Welcome back" : "Instructions";
     if (!ShowScreen(welcome, protocol_.instructions, "Press Return to start")) return result;
     std::string shown_block;
-    int main_answered = 0;
+    // Breaks come every N answered main trials, counted over the whole session (a resumed one included).
+    int64_t main_answered = 0;
+    for (int64_t i = 0; i < start.first_unanswered_trial; ++i) main_answered += !trials_[size_t(i)].practice;
     for (int64_t i = start.first_unanswered_trial; i < result.trial_count; ++i) {
       if (options_.stop_after >= 0 && result.answered_now >= options_.stop_after) break;
       const protocol::Trial& trial = trials_[size_t(i)];
