@@ -14,7 +14,6 @@
 namespace blurcue::session {
 namespace {
 
-constexpr double kBallRadiusDefaultMm = 10;
 constexpr int kLeftSection = 3, kRightSection = 5;  // the balls roll side by side, one section apart
 
 // A level by name: a factor of its own, or a key of an object level (a pattern carries speed and sides).
@@ -204,7 +203,7 @@ void StimulusRenderer::Compose(const TrialScene& trial, double t_s, double level
     } else {
       const double y = trial.BallYMm(t_s);
       if (!std::isfinite(y)) continue;  // wiped at the end of a section
-      const double radius = protocol_.content.radius_mm > 0 ? protocol_.content.radius_mm : kBallRadiusDefaultMm;
+      const double radius = protocol_.content.radius_mm;  // validated > 0
       o.kind = render::VirtualObject::Kind::kBall;
       o.size_mm = radius;
       o.center_board_mm = BallCentre(s, y, radius, left);
