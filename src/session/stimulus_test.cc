@@ -1,0 +1,119 @@
+// What a trial shows, worked out without GL: placement, motion and radii per side.
+#include "session/stimulus.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <opencv2/calib3d.hpp>
+
+#include "core/error.h"
+
+namespace blurcue::session {
+namespace {
+
+// The thesis's view built by hand (camera pitched down 38 deg, 440 mm from the board's centre), a lens focused
+// at 342.3 mm with the nominal aperture, and one measured section at edge 1 reading 0.3 px.
+calib::SceneCalib ThesisScene() {
+  calib::SceneCalib s;
+  s.camera = ThesisCamera().Resized(1148, 764);
+  const double a = 38 * M_PI / 180, sn = std::sin(a), c = std::cos(a);
+  const cv::Matx33d r(1, 0, 0, 0, -sn, -c, 0, c, -sn);
+  const cv::Vec3d forward(0, c, -sn), target(87.5, 125, 0);
+  const cv::Vec3d centre = target - 440.0 * forward;
+  cv::Rodrigues(r, s.rvec);
+  s.tvec = -(r * centre);
+  s.reference_edge = 1;
+  s.reference_u_mm = s.ToCamera({87.5, 0, 0})[2];
+  s.reference_r_px = 0.0;
+  s.model.focus_mm = s.reference_u_mm;
+  s.model.aperture_mm = 21 / 5.6;
+  s.model.kind = "thin_lens";
+  calib::SceneCalib::Section section;
+  section.edge = 1;
+  section.section = 4;
+  section.midpoint_camera_mm = s.ToCamera({87.5, 0, 0});
+  section.r_px = 0.3;
+  section.ok = true;
+  s.sections.push_back(section);
+  return s;
+}
+
+protocol::Protocol BallProtocol() {
+  protocol::Protocol p;
+  p.file = "balls.json";
+  p.content.type = "ball";
+  p.content.radius_mm = 10;
+  return p;
+}
+
+protocol::Trial PairTrial(Json levels, Json left, Json right) {
+  protocol::Trial t;
+  t.block = "task2";
+  t.levels = std::move(levels);
+  t.left = std::move(left);
+  t.right = std::move(right);
+  return t;
+}
+
+TEST(DescribeTrial, SectionRunGoesEdgeToEdgeAtThePatternSpeedAndIsWiped) {
+  const calib::SceneCalib scene = ThesisScene();
+  const Json pattern = {{"id", 2}, {"speed_cm_s", 1.8}, {"left", "measured"}, {"right", "none"}};
+  const TrialScene t = DescribeTrial(BallProtocol(), PairTrial({{"pattern", pattern}, {"section", 3}}, 1.5, "none"),
+                                     &scene);
+  EXPECT_DOUBLE_EQ(t.from_y_mm, 50);  // edge 3 of 25 mm squares
+  EXPECT_DOUBLE_EQ(t.to_y_mm, 75);    // edge 4
+  EXPECT_NEAR(t.MotionS(), 25.0 / 18.0, 1e-12);
+  EXPECT_DOUBLE_EQ(t.BallYMm(0), 50);
+  EXPECT_NEAR(t.BallYMm(t.MotionS() / 2), 62.5, 1e-9);
+  EXPECT_TRUE(std::isinf(t.BallYMm(t.MotionS() + 0.01)));  // gone at the edge
+  EXPECT_DOUBLE_EQ(t.r_left_px, 1.5);                       // a fixed radius, the same all along
+  EXPECT_DOUBLE_EQ(t.r_right_px, 0);
+}
+
+TEST(DescribeTrial, WholeRunRestsAtTheFarEdgeAndAveragesTheGrowingBlur) {
+  const calib::SceneCalib scene = ThesisScene();
+  const Json pattern = {{"id", 3}, {"speed_cm_s", 3}, {"left", "estimated"}, {"right", "none"}};
+  const TrialScene t = DescribeTrial(BallProtocol(), PairTrial({{"pattern", pattern}}, "fitted", "none"), &scene);
+  EXPECT_DOUBLE_EQ(t.from_y_mm, 0);
+  EXPECT_DOUBLE_EQ(t.to_y_mm, 250);
+  EXPECT_NEAR(t.MotionS(), 250.0 / 30.0, 1e-12);
+  EXPECT_DOUBLE_EQ(t.BallYMm(100), 250);  // arrived, not wiped
+  // The fitted source is the scene's own blur: the two agree; the mean lies between the run's ends.
+  EXPECT_NEAR(t.r_left_px, t.r_scene_px, 0.05);
+  const double r0 = calib::BlurAtPx(scene, calib::BlurSource::kFitted, scene.ToCamera({62.5, 0, 10}));
+  const double r1 = calib::BlurAtPx(scene, calib::BlurSource::kFitted, scene.ToCamera({62.5, 250, 10}));
+  EXPECT_GT(t.r_left_px, std::min(r0, r1));
+  EXPECT_LT(t.r_left_px, std::max(r0, r1));
+}
+
+TEST(DescribeTrial, GridCardsSitBesideTheBoardAtTheirEdge) {
+  const calib::SceneCalib scene = ThesisScene();
+  protocol::Protocol p = BallProtocol();
+  p.content.type = "grid";
+  const TrialScene near = DescribeTrial(p, PairTrial({{"edge", 2}}, "measured", "fitted"), &scene);
+  const TrialScene far = DescribeTrial(p, PairTrial({{"edge", 11}}, "measured", "fitted"), &scene);
+  EXPECT_EQ(near.edge, 2);
+  EXPECT_DOUBLE_EQ(near.r_left_px, 0.3);  // the one measured section is the nearest for every card
+  EXPECT_GT(far.r_right_px, near.r_right_px + 1);  // fitted blur grows with distance from focus
+  const Json v = TrialVariables(PairTrial({{"edge", 2}}, "measured", "fitted"), near);
+  for (const char* key : {"edge", "practice", "block_name", "swapped", "r_left_px", "r_right_px", "r_scene_px"})
+    EXPECT_TRUE(v.contains(key)) << key;
+}
+
+TEST(DescribeTrial, MissingLevelOrCalibrationIsAnInputErrorNamingTheTrial) {
+  const calib::SceneCalib scene = ThesisScene();
+  protocol::Protocol p = BallProtocol();
+  p.content.type = "grid";
+  try {
+    DescribeTrial(p, PairTrial({{"distance_m", 1}}, "measured", "fitted"), &scene);
+    ADD_FAILURE() << "a grid without an edge was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    EXPECT_NE(std::string(e.what()).find("balls.json: trial 0 (block task2)"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(DescribeTrial(p, PairTrial({{"edge", 2}}, "measured", "fitted"), nullptr), Error);
+}
+
+}  // namespace
+}  // namespace blurcue::session
