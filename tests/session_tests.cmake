@@ -33,3 +33,16 @@ add_test(NAME session_run_bad_observer
                  -DEXPECT_CODE=2 "-DEXPECT_TEXT=--observer: unknown parameter 'jdn'"
                  -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
 set_tests_properties(session_run_bad_observer PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols")
+add_test(NAME session_run_negative_seed
+         COMMAND ${CMAKE_COMMAND} -DCMD=${BC}
+                 "-DARGS=run;${T}/protocols/test1-static-grids.json;--participant;P1;--db;${T}/seed.sqlite;--observer;sim;--seed;-3"
+                 -DEXPECT_CODE=2 "-DEXPECT_TEXT=--seed: must be a whole number from 0 to 18446744073709551615, got '-3'"
+                 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+set_tests_properties(session_run_negative_seed PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols")
+# A person needs a window: without a display, one line says so (and what to do) before anything is recorded.
+add_test(NAME session_run_person_without_display
+         COMMAND ${CMAKE_COMMAND} -E env --unset=DISPLAY ${CMAKE_COMMAND} -DCMD=${BC}
+                 "-DARGS=run;${T}/protocols/test1-static-grids.json;--participant;P1;--db;${T}/no-display.sqlite"
+                 -DEXPECT_CODE=10 "-DEXPECT_TEXT=GLFW: cannot open a window: "
+                 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+set_tests_properties(session_run_person_without_display PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols")

@@ -5,6 +5,18 @@
 
 namespace blurcue::cli {
 
+// --seed: a whole number 0 .. 2^64 - 1 (CLI11 alone would wrap "-3" into a huge unsigned number).
+inline CLI::Validator SeedValidator() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        const bool digits = !text.empty() && text.size() <= 20 &&
+                            text.find_first_not_of("0123456789") == std::string::npos &&
+                            (text.size() < 20 || text <= "18446744073709551615");
+        return digits ? "" : "must be a whole number from 0 to 18446744073709551615, got '" + text + "'";
+      },
+      "SEED");
+}
+
 void AddEstimateCommand(CLI::App& app);     // estimate_command.cc
 void AddSynthSceneCommand(CLI::App& app);   // synth_scene_command.cc
 void AddCalibrateCommand(CLI::App& app);    // calibrate_command.cc

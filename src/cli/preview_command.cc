@@ -39,7 +39,7 @@ void AddPreviewCommand(CLI::App& app) {
   cmd->add_option("--out", args->out, "the contact sheet PNG")->required();
   cmd->add_option("--participant", args->participant, "whose trial list (by_participant sides)")
       ->capture_default_str();
-  cmd->add_option("--seed", args->seed, "seed (default: as blurcue run)");
+  cmd->add_option("--seed", args->seed, "seed (default: as blurcue run)")->check(SeedValidator());
   cmd->add_option("--columns", args->columns, "tiles per row")->capture_default_str()->check(CLI::Range(1, 20));
   cmd->add_option("--tile-width", args->tile_width, "tile width in px")->capture_default_str()
       ->check(CLI::Range(80, 2000));

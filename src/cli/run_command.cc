@@ -49,7 +49,8 @@ void AddRunCommand(CLI::App& app) {
                                                               "decides by_participant sides)")->required();
   cmd->add_option("--db", args->db, "the SQLite record (created if missing)")->required();
   cmd->add_option("--seed", args->seed, "seed of the trial order (default: derived from the study name and the "
-                                        "participant id; always recorded)");
+                                        "participant id; always recorded)")
+      ->check(SeedValidator());
   cmd->add_option("--observer", args->observer, "sim or sim:NAME=VALUE,... - a simulated observer answers");
   cmd->add_flag("--resume", args->options.resume, "continue the participant's unfinished session");
   cmd->add_flag("--again", args->options.again, "another session for a participant who completed the study (a "

@@ -30,7 +30,8 @@ void AddValidateCommand(CLI::App& app) {
   cmd->add_option("--participant", args->participant, "participant id (its trailing number decides by_participant "
                                                       "counterbalancing)")->capture_default_str();
   cmd->add_option("--seed", args->seed, "seed of the trial order (default: the one blurcue run gives the participant, "
-                                        "derived from the study name and the participant id)");
+                                        "derived from the study name and the participant id)")
+      ->check(SeedValidator());
   cmd->add_flag("--list", args->list, "print the trial list as JSON, one trial per line");
   cmd->callback([args] {
     protocol::ValidateOptions options;

@@ -57,11 +57,19 @@ class EglContext final : public GlContext {
   EGLContext context_ = EGL_NO_CONTEXT;
 };
 
+std::string& LastGlfwError() {
+  static std::string text;
+  return text;
+}
+
 class GlfwContext final : public GlContext {
  public:
   explicit GlfwContext(const WindowOptions& o) {
-    glfwSetErrorCallback([](int code, const char* text) { std::fprintf(stderr, "GLFW %d: %s\n", code, text); });
-    if (!glfwInit()) throw Error(ErrorKind::kInternal, "GLFW: cannot initialise (no display? run under Xvfb)");
+    // GLFW's own words go into the one-line error rather than onto stderr.
+    glfwSetErrorCallback([](int, const char* text) { LastGlfwError() = text ? text : ""; });
+    if (!glfwInit())
+      throw Error(ErrorKind::kInternal, "GLFW: cannot open a window: " + LastGlfwError() +
+                                            " (a window needs a display: run under Xvfb, or use --observer sim)");
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
     glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
@@ -80,7 +88,7 @@ class GlfwContext final : public GlContext {
     window_ = glfwCreateWindow(o.width_px, o.height_px, o.title.c_str(), monitor, nullptr);
     if (!window_) {
       glfwTerminate();
-      throw Error(ErrorKind::kInternal, "GLFW: cannot open a GL 3.3 core window");
+      throw Error(ErrorKind::kInternal, "GLFW: cannot open a GL 3.3 core window: " + LastGlfwError());
     }
     MakeCurrent();
     glfwSwapInterval(o.vsync ? 1 : 0);
