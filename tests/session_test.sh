@@ -31,6 +31,18 @@ wait_for_answers() {
     sleep 0.05
   done
 }
+# Window tests: waits (up to 20 s) until the window's title ends with $1 (the runner names the screen or the trial
+# on show), then presses key $2 or clicks button $3 there.
+at() {
+  local wid
+  wid=$(timeout 20 xdotool search --sync --name "$1\$" | head -1) || fail "no window titled ...$1"
+  sleep 0.15
+  if [ -n "${3:-}" ]; then
+    xdotool mousemove --window "$wid" 200 200 click "$3" 2>> "$W/xdotool.log" || fail "click $3 at '$1': $(tail -1 "$W/err")"
+  else
+    xdotool key --window "$wid" "$2" 2>> "$W/xdotool.log" || fail "key $2 at '$1': $(tail -1 "$W/err")"
+  fi
+}
 integrity() { [ "$(sql "$1" 'PRAGMA integrity_check')" = ok ] || fail "integrity_check of $1"; }
 
 case $CASE in
@@ -152,14 +164,12 @@ window_adjust)
   $BC validate "$proto" --participant W1 --list > "$W/trials.jsonl"
   $BC run "$proto" --participant W1 --db "$W/s.sqlite" --stop-after 3 > "$W/out" 2> "$W/err" &
   run=$!
-  wid=$(xdotool search --sync --name "blurcue - pre-research-depth-matching" | head -1)
-  press() { sleep 0.7; xdotool key --window "$wid" "$1"; }
-  click() { sleep 0.7; xdotool mousemove --window "$wid" 200 200 click "$1"; }
-  press Return; press Return                  # welcome, practice
-  press Right; press Right; press Return      # trial 0: two steps on
-  press Return                                # the main part starts
-  click 4; click 1                            # trial 1: wheel up (next), click accepts
-  press Left; click 5; click 5; press Return  # trial 2: three steps back
+  at Instructions Return; at Practice Return
+  at "trial 1 of 28" Right; at "trial 1 of 28" Right; at "trial 1 of 28" Return   # two steps on
+  at "Part: main" Return
+  at "trial 2 of 28" "" 4; at "trial 2 of 28" "" 1                               # wheel up (next), click accepts
+  at "trial 3 of 28" Left; at "trial 3 of 28" "" 5; at "trial 3 of 28" "" 5       # three steps back
+  at "trial 3 of 28" Return
   wait $run || fail "run failed: $(cat "$W/err")"
   sql "$W/s.sqlite" "SELECT t.trial_index, r.choice, r.adjustment FROM responses r JOIN trials t ON t.id = r.trial_id
                      ORDER BY t.trial_index" > "$W/answers"
@@ -191,12 +201,12 @@ window)
   sleep 1
   $BC run "$P/test1-static-grids.json" --participant W1 --db "$W/s.sqlite" > "$W/out" 2> "$W/err" &
   run=$!
-  wid=$(xdotool search --sync --name "blurcue - test1-static-grids" | head -1)
   # welcome, practice screen, 2 practice answers, main-part screen, 11 answers.
-  keys=(Return Return Left Right Return Left Right Down Left Right Down Left Right Down Left Left)
-  for k in "${keys[@]}"; do
-    sleep 0.9
-    xdotool key --window "$wid" "$k" 2>/dev/null || xdotool key "$k"
+  at Instructions Return; at Practice Return
+  keys=(Left Right Left Right Down Left Right Down Left Right Down Left Left)
+  for i in "${!keys[@]}"; do
+    [ "$i" = 2 ] && at "Part: main" Return
+    at "trial $((i + 1)) of 13" "${keys[$i]}"
   done
   wait $run || fail "run failed: $(cat "$W/err")"
   got=$(sql "$W/s.sqlite" "SELECT group_concat(r.choice) FROM (SELECT r.choice FROM responses r JOIN trials t ON t.id = r.trial_id ORDER BY t.trial_index) r")

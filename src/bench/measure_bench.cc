@@ -195,7 +195,7 @@ void WriteMeasureCsv(const std::vector<MeasureRow>& rows, const std::filesystem:
            "max_abs_error_px,bias_px,within_target,time_us_per_section,meets_target,board_found\n";
     for (const auto& r : rows) {
       char line[512];
-      std::snprintf(line, sizeof line, "%s,%s,%g,%d,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.2f,%d,%d\n", r.method.c_str(),
+      std::snprintf(line, sizeof line, "%s,%s,%g,%d,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.2f,%d,%d\n", r.method.c_str(),
                     r.factor.c_str(), r.level, r.sections, r.answered, r.mean_abs_error_px, r.median_abs_error_px,
                     r.p90_abs_error_px, r.max_abs_error_px, r.bias_px, r.within_target, r.time_us_per_section,
                     int(r.meets_target), int(r.board_found));
@@ -233,7 +233,7 @@ std::string DescribeBreakpoints(const std::vector<MeasureRow>& rows) {
                     key.second.c_str(), held.str().c_str());
     } else {
       std::snprintf(line, sizeof line,
-                    "  %-12s %-8s breaks at %g: answered %d/%d, %.0f%% within target, mean |error| %.2f px%s%s\n",
+                    "  %-12s %-8s breaks at %g: answered %d/%d, %.1f%% within target, mean |error| %.2f px%s%s\n",
                     key.first.c_str(), key.second.c_str(), broke->level, broke->answered, broke->sections,
                     100 * broke->within_target, broke->mean_abs_error_px, held.tellp() > 0 ? "; holds at " : "",
                     held.str().c_str());

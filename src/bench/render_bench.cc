@@ -137,6 +137,7 @@ std::vector<RenderRow> RunRenderBench(const RenderBenchOptions& options) {
     render::ButterworthBlurCpu(frame, size.width / 40.0);
     row.median_ms = row.p99_ms = Ms(t0);
     row.samples = 1;
+    row.mean_abs_error = row.max_abs_error = NAN;  // not measured (no radius to hold it to): empty cells, not 0
     rows.push_back(row);
     say("blur butterworth cpu " + std::to_string(size.width) + "x" + std::to_string(size.height) + " " +
         std::to_string(int(row.median_ms)) + " ms");
@@ -223,10 +224,11 @@ void WriteRenderCsv(const std::vector<RenderRow>& rows, const std::filesystem::p
     out << "kind,method,backend,radius_px,width,height,samples,median_ms,p99_ms,mean_abs_error_levels,"
            "max_abs_error_levels\n";
     for (const auto& r : rows) {
-      char line[300];
-      std::snprintf(line, sizeof line, "%s,%s,%s,%g,%d,%d,%d,%.3f,%.3f,%.4f,%.1f\n", r.kind.c_str(), r.method.c_str(),
-                    r.backend.c_str(), r.radius_px, r.width, r.height, r.samples, r.median_ms, r.p99_ms,
-                    r.mean_abs_error, r.max_abs_error);
+      char line[300], mean[32] = "", max[32] = "";
+      if (!std::isnan(r.mean_abs_error)) std::snprintf(mean, sizeof mean, "%.4f", r.mean_abs_error);
+      if (!std::isnan(r.max_abs_error)) std::snprintf(max, sizeof max, "%.1f", r.max_abs_error);
+      std::snprintf(line, sizeof line, "%s,%s,%s,%g,%d,%d,%d,%.3f,%.3f,%s,%s\n", r.kind.c_str(), r.method.c_str(),
+                    r.backend.c_str(), r.radius_px, r.width, r.height, r.samples, r.median_ms, r.p99_ms, mean, max);
       out << line;
     }
   }

@@ -18,7 +18,7 @@ struct RenderRow {
   int samples = 0;
   double median_ms = 0, p99_ms = 0;
   double mean_abs_error = 0, max_abs_error = 0;  // 8-bit grey levels against the exact reference ("blur") or
-                                                 // against the region approach ("frame")
+                                                 // against the region approach ("frame"); NaN: not measured
 };
 
 struct RenderBenchOptions {

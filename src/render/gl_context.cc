@@ -129,6 +129,7 @@ class GlfwContext final : public GlContext {
     return out;
   }
   double Now() const override { return glfwGetTime(); }
+  void SetTitle(const std::string& title) override { glfwSetWindowTitle(window_, title.c_str()); }
   double RefreshHz() const override { return refresh_hz_; }
   int width_px() const override {
     int w = 0, h = 0;

@@ -43,6 +43,8 @@ class GlContext {
   // Size of the default framebuffer in pixels (0 x 0 offscreen: render to framebuffers).
   virtual int width_px() const { return 0; }
   virtual int height_px() const { return 0; }
+  // Window: sets its title (what is on screen; tests wait for it). Offscreen: nothing.
+  virtual void SetTitle(const std::string&) {}
   // Events since the last call (window); always empty offscreen.
   virtual std::vector<InputEvent> TakeEvents() { return {}; }
   // Seconds on a monotonic clock (the window's glfwGetTime, steady_clock offscreen).

@@ -158,7 +158,8 @@ class Runner {
         screen_size_(protocol.display.width_px, protocol.display.height_px) {}
 
   // Shows `image` until one of `keys` is pressed and returns it ("" when the window is closed).
-  std::string ShowUntil(const cv::Mat& image, const std::vector<std::string>& keys) {
+  std::string ShowUntil(const std::string& title, const cv::Mat& image, const std::vector<std::string>& keys) {
+    context_.SetTitle("blurcue - " + protocol_.name + " - " + title);
     for (;;) {
       if (station_.window()) render::PresentImage(image, context_.width_px(), context_.height_px());
       station_.Flip();
@@ -174,7 +175,7 @@ class Runner {
     const cv::Mat image = TextScreen(screen_size_, title, body, footer);
     if (observer_) station_.Script("Return", station_.Now() + 0.6);
     for (;;) {
-      const std::string key = ShowUntil(image, {"Return", "Space", "MouseLeft", "Escape"});
+      const std::string key = ShowUntil(title, image, {"Return", "Space", "MouseLeft", "Escape"});
       if (key.empty()) return false;
       if (key != "Escape") return true;
       if (!Pause()) return false;
@@ -187,8 +188,14 @@ class Runner {
                                      "Every answer so far is saved. Press Q to quit (the session can be continued "
                                      "later with --resume), or Return to go on.",
                                      "Q: quit    Return: go on");
-    const std::string key = ShowUntil(image, {"Q", "Return", "Space"});
+    const std::string key = ShowUntil("Paused", image, {"Q", "Return", "Space"});
     return !key.empty() && key != "Q";
+  }
+
+  // The window's title while a trial is on screen (the experimenter's view; tests wait for it).
+  std::string TrialTitle(const protocol::Trial& trial) const {
+    return "blurcue - " + protocol_.name + " - trial " + std::to_string(trial.index + 1) + " of " +
+           std::to_string(trials_.size());
   }
 
   // The simulated observer's key presses for a trial whose stimulus appeared at `onset`.
@@ -247,6 +254,7 @@ class Runner {
       const double flip = station_.Flip();
       if (onset < 0) {
         onset = flip;
+        context_.SetTitle(TrialTitle(trial));
         if (observer_) ScriptObserver(trial, scene, onset);
       }
       const bool dropped = station_.window() && last_flip >= 0 && flip - last_flip > 1.5 * station_.frame_s();
@@ -262,6 +270,7 @@ class Runner {
           const double paused_at = station_.Now();
           if (!Pause()) return Outcome::kQuit;
           paused_s += station_.Now() - paused_at;
+          context_.SetTitle(TrialTitle(trial));
         } else if (action == "left" || action == "right" || action == "cant_tell") {
           response->choice = action;
           response->rt_ms = t_ms;
