@@ -120,6 +120,10 @@ resume)
     [ "$(fingerprint "$W/whole.sqlite" R2)" = "$(fingerprint "$W/parts.sqlite" R2)" ] || fail "$proto: resumed differs"
   done
   integrity "$W/parts.sqlite"
+  # The record lists both participants' sessions as completed, every trial answered.
+  $BC sessions --db "$W/parts.sqlite" > "$W/sessions"
+  grep -Eq "pre-research-depth-matching +R2 +completed +28/28" "$W/sessions" || fail "sessions: $(cat "$W/sessions")"
+  grep -Eq "test2-moving-balls +R2 +completed +74/74" "$W/sessions" || fail "sessions: $(cat "$W/sessions")"
   echo "ok: stopped at 20 and resumed = uninterrupted (test 2, depth matching)" ;;
 kill9)
   # kill -9 in the middle of a session, then --resume: nothing lost, nothing twice, same as uninterrupted.
@@ -129,6 +133,9 @@ kill9)
   pid=$!
   wait_for_answers "$W/killed.sqlite" 8
   kill -9 $pid; wait $pid 2>/dev/null || true
+  # Killed: the session is still running (resumable) and its lock names the dead writer.
+  $BC sessions --db "$W/killed.sqlite" | grep -Eq "test2-moving-balls +K1 +running +[0-9]+/74 .*lock: pid $pid on .*gone" \
+    || fail "sessions after kill: $($BC sessions --db "$W/killed.sqlite")"
   answered=$(sql "$W/killed.sqlite" "SELECT count(*) FROM responses")
   [ "$answered" -ge 8 ] && [ "$answered" -lt 74 ] || fail "killed after $answered answers, expected mid-session"
   integrity "$W/killed.sqlite"

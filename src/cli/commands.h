@@ -26,6 +26,7 @@ void AddRenderCommand(CLI::App& app);       // render_command.cc
 void AddAnimateCommand(CLI::App& app);      // animate_command.cc
 void AddExportCommand(CLI::App& app);       // record_commands.cc
 void AddMergeCommand(CLI::App& app);        // record_commands.cc
+void AddSessionsCommand(CLI::App& app);     // record_commands.cc
 void AddMakeStimuliCommand(CLI::App& app);  // make_stimuli_command.cc
 void AddSynthPicturesCommand(CLI::App& app);  // make_stimuli_command.cc
 void AddValidateCommand(CLI::App& app);     // validate_command.cc

@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
       {"validate", &cli::AddValidateCommand},
       {"preview", &cli::AddPreviewCommand},
       {"run", &cli::AddRunCommand},
+      {"sessions", &cli::AddSessionsCommand},
       {"export", &cli::AddExportCommand},
       {"merge", &cli::AddMergeCommand},
       {"report", &cli::AddReportCommand},

@@ -52,4 +52,33 @@ void AddMergeCommand(CLI::App& app) {
   });
 }
 
+void AddSessionsCommand(CLI::App& app) {
+  auto db = std::make_shared<std::string>();
+  CLI::App* cmd = app.add_subcommand(
+      "sessions",
+      "List the sessions of a record: study, participant, status, trials answered of planned, seed, start and end,\n"
+      "host, and who holds its lock (a writer alive, or a stale lock left by a crash). An unfinished session continues with blurcue run ... --resume.\n"
+      "Example: blurcue sessions --db results/study.sqlite");
+  cmd->add_option("--db", *db, "the SQLite record")->required()->check(CLI::ExistingFile);
+  cmd->callback([db] {
+    const auto sessions = store::ListSessions(*db);
+    if (sessions.empty()) {
+      std::printf("%s: no sessions yet\n", db->c_str());
+      return;
+    }
+    std::printf("%4s  %-28s %-12s %-9s %9s  %-20s  %-24s %-24s %s\n", "id", "study", "participant", "status",
+                "answered", "seed", "started", "ended", "host");
+    int unfinished = 0;
+    for (const auto& s : sessions) {
+      const std::string answered = std::to_string(s.answered) + "/" + std::to_string(s.planned);
+      std::printf("%4lld  %-28s %-12s %-9s %9s  %-20llu  %-24s %-24s %s%s\n", static_cast<long long>(s.id),
+                  s.study.c_str(), s.participant.c_str(), s.status.c_str(), answered.c_str(),
+                  static_cast<unsigned long long>(s.seed), s.started.c_str(), s.ended.empty() ? "-" : s.ended.c_str(),
+                  s.host.c_str(), s.writer.empty() ? "" : ("  lock: " + s.writer).c_str());
+      unfinished += s.status == "running";
+    }
+    std::printf("%zu sessions, %d unfinished\n", sessions.size(), unfinished);
+  });
+}
+
 }  // namespace blurcue::cli

@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "core/json_io.h"
+#include "store/record.h"
 #include "store/schema.h"
 #include "store/sqlite.h"
 
@@ -238,6 +239,41 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
   WriteAtomically(out_dir / "trials.csv", text);
   WriteSummaries(db, out_dir);
   return count;
+}
+
+std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path) {
+  Database db(db_path, OpenMode::kReadOnly);
+  RequireCurrentSchema(db);
+  Statement rows(db,
+                 "SELECT s.id, st.name, p.code, s.status, s.started, coalesce(s.ended, ''), s.host, s.seed, "
+                 "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), "
+                 "(SELECT count(*) FROM trials t JOIN responses r ON r.trial_id = t.id WHERE t.session_id = s.id), "
+                 "s.lock_token IS NOT NULL, coalesce(s.lock_pid, 0), coalesce(s.lock_host, '') "
+                 "FROM sessions s JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
+                 "ORDER BY st.name, p.code, s.id");
+  std::vector<SessionSummary> sessions;
+  while (rows.Step()) {
+    SessionSummary s;
+    s.id = rows.GetInt64(0);
+    s.study = rows.GetText(1);
+    s.participant = rows.GetText(2);
+    s.status = rows.GetText(3);
+    s.started = rows.GetText(4);
+    s.ended = rows.GetText(5);
+    s.host = rows.GetText(6);
+    s.seed = static_cast<uint64_t>(rows.GetInt64(7));
+    s.planned = rows.GetInt64(8);
+    s.answered = rows.GetInt64(9);
+    if (rows.GetInt64(10) != 0) {
+      const int64_t pid = rows.GetInt64(11);
+      const std::string host = rows.GetText(12);
+      s.writer = "pid " + std::to_string(pid) + " on " + host;
+      if (host == HostName())
+        s.writer += ProcessGone(pid) ? " (gone: a stale lock, the next run takes it over)" : " (alive)";
+    }
+    sessions.push_back(std::move(s));
+  }
+  return sessions;
 }
 
 void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out) {

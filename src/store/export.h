@@ -2,6 +2,7 @@
 // Reading a record out: a long-format CSV for analysis, and merging the records of several stations.
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 namespace blurcue::store {
@@ -23,6 +24,21 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
 // record, or a session (same participant, protocol, seed, host and start) is already in the output. Nothing is
 // left at `out` on failure.
 void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out);
+
+// One session as the experimenter sees it: who, what, how far.
+struct SessionSummary {
+  int64_t id = 0;
+  std::string study, participant, status, started, ended, host;
+  uint64_t seed = 0;
+  int64_t planned = 0, answered = 0;  // practice included
+  // Who holds its lock: empty for nobody, else "pid P on HOST" with "(alive)" or "(gone: a stale lock, the next
+  // run takes it over)" when HOST is this machine.
+  std::string writer;
+};
+
+// Every session of the record, by study, participant and id. Throws Error(kInput) for a file that is not a
+// current blurcue record.
+std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path);
 
 // One CSV field, quoted when it holds a comma, quote, line break or leading/trailing space.
 std::string CsvField(const std::string& text);

@@ -20,11 +20,6 @@
 namespace blurcue::store {
 namespace {
 
-std::string HostName() {
-  char name[256] = {};
-  if (gethostname(name, sizeof(name) - 1) != 0) return "unknown-host";
-  return name;
-}
 
 int64_t NowMs() {
   return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch())
@@ -39,13 +34,19 @@ std::string NewToken() {
   return text;
 }
 
-// True when `pid` is certainly gone on this host (kill(pid, 0) says no such process). EPERM means the process
-// exists under another user, so the lock is live.
-bool ProcessGone(int64_t pid) { return pid <= 0 || (kill(static_cast<pid_t>(pid), 0) == -1 && errno == ESRCH); }
 
 std::string SessionName(int64_t session) { return "session " + std::to_string(session); }
 
 }  // namespace
+
+std::string HostName() {
+  char name[256] = {};
+  if (gethostname(name, sizeof(name) - 1) != 0) return "unknown-host";
+  return name;
+}
+
+// kill(pid, 0) says no such process; EPERM means the process exists under another user, so it is alive.
+bool ProcessGone(int64_t pid) { return pid <= 0 || (kill(static_cast<pid_t>(pid), 0) == -1 && errno == ESRCH); }
 
 const char* ToString(SessionStatus status) {
   switch (status) {

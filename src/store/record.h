@@ -111,6 +111,12 @@ class Record {
   std::string token_;  // empty in a moved-from Record
 };
 
+// This machine's host name ("unknown-host" when it has none).
+std::string HostName();
+
+// True when process `pid` is certainly gone on this host.
+bool ProcessGone(int64_t pid);
+
 // FNV-1a-64 of `text` as 16 lower-case hex digits (the protocol version's hash).
 std::string Fnv1a64Hex(const std::string& text);
 
