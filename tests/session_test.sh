@@ -222,6 +222,10 @@ window)
   [ "$(sql "$W/s.sqlite" "SELECT min(rt_ms) > 100 FROM responses")" = 1 ] || fail "response times"
   [ "$(sql "$W/s.sqlite" "SELECT count(*) > 13 FROM frames")" = 1 ] || fail "frames"
   integrity "$W/s.sqlite"
+  # The export carries every flip, marked as a real window's.
+  $BC export --db "$W/s.sqlite" --out "$W/export" > /dev/null
+  [ "$(($(wc -l < "$W/export/frames.csv") - 1))" = "$(sql "$W/s.sqlite" "SELECT count(*) FROM frames")" ] || fail "frames.csv rows"
+  [ "$(cut -d, -f4 "$W/export/frames.csv" | sort -u | tr '\n' ' ')" = "1 window " ] || fail "frames.csv window column"
   echo "ok: 13 keys pressed in a window under Xvfb, 13 answers recorded as pressed: $(tail -1 "$W/out")" ;;
 recover)
   # Through the whole pipeline - trials, the observer's key presses, the record, export and the analysis - the

@@ -21,7 +21,7 @@ void AddExportCommand(CLI::App& app) {
       "as JSON), answered_at), and per study\n"
       "DIR/summary-STUDY.csv: per session the trials planned and answered, the median response time and how often\n"
       "each answer was given (the source chosen or cant_tell; the level accepted). Practice trials are left out\n"
-      "of the summaries.\n"
+      "of the summaries. DIR/frames.csv holds every display flip (time from the trial's first flip, dropped or not).\n"
       "Example: blurcue export --db results/study.sqlite --out results/tables");
   cmd->add_option("--db", args->db, "the SQLite record")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "folder for the tables (created)")->required();

@@ -149,6 +149,25 @@ std::vector<std::filesystem::path> WriteSummaries(Database& db, const std::files
   return files;
 }
 
+// OUT/frames.csv: every recorded display flip, one row each: study, participant, session, window (1: a real window
+// on the real clock, 0: headless on a simulated clock), trial_index, frame_index, flip_time_s (from the trial's
+// first flip), dropped (0/1).
+void WriteFrames(Database& db, const std::filesystem::path& out_dir) {
+  std::string text = CsvLine({"study", "participant", "session", "window", "trial_index", "frame_index",
+                              "flip_time_s", "dropped"});
+  Statement rows(db,
+                 "SELECT st.name, p.code, s.id, t.trial_index, f.frame_index, f.flip_time_s, f.dropped, "
+                 "s.display LIKE 'window%' "
+                 "FROM frames f JOIN trials t ON t.id = f.trial_id JOIN sessions s ON s.id = t.session_id "
+                 "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
+                 "ORDER BY st.name, p.code, s.id, t.trial_index, f.frame_index");
+  while (rows.Step())
+    text += CsvLine({rows.GetText(0), rows.GetText(1), std::to_string(rows.GetInt64(2)),
+                     std::to_string(rows.GetInt64(7)), std::to_string(rows.GetInt64(3)), std::to_string(rows.GetInt64(4)), Number(rows.GetDouble(5)),
+                     std::to_string(rows.GetInt64(6))});
+  WriteAtomically(out_dir / "frames.csv", text);
+}
+
 void RemoveDatabaseFiles(const std::filesystem::path& path) {
   std::error_code ignored;
   for (const char* suffix : {"", "-wal", "-shm", "-journal"})
@@ -238,6 +257,7 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
   }
   WriteAtomically(out_dir / "trials.csv", text);
   WriteSummaries(db, out_dir);
+  WriteFrames(db, out_dir);
   return count;
 }
 

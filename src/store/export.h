@@ -14,7 +14,9 @@ namespace blurcue::store {
 // A factor a trial lacks is an empty cell; a factor named like a fixed column is written as "factor_<name>".
 // Beside it, per study, `out_dir`/summary-STUDY.csv: one row per session with the trials planned and answered
 // (practice apart), the median response time and the count of every answer (forced choice: the source chosen, or
-// cant_tell; adjustment: the level accepted) as n_ANSWER columns.
+// cant_tell; adjustment: the level accepted) as n_ANSWER columns. And `out_dir`/frames.csv: every recorded display
+// flip (study, participant, session, window: 1 for a real window, 0 headless; trial_index, frame_index, flip_time_s
+// from the trial's first flip, dropped).
 // Returns the number of rows. Throws Error(kInput) for a file that is not a current blurcue record.
 int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::path& out_dir);
 
