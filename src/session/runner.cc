@@ -11,7 +11,7 @@
 #include <sstream>
 #include <thread>
 
-#include <opencv2/imgproc.hpp>
+#include <opencv2/core.hpp>
 
 #include "core/error.h"
 #include "protocol/protocol.h"

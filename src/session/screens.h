@@ -1,6 +1,7 @@
 #pragma once
 // Text screens (instructions, breaks, pause) drawn with OpenCV's Hershey font on the study's grey.
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
