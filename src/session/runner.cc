@@ -271,6 +271,7 @@ class Runner {
           if (!Pause()) return Outcome::kQuit;
           paused_s += station_.Now() - paused_at;
           context_.SetTitle(TrialTitle(trial));
+          last_flip = -1;  // the gap is the pause, not a dropped frame
         } else if (action == "left" || action == "right" || action == "cant_tell") {
           response->choice = action;
           response->rt_ms = t_ms;
@@ -467,7 +468,8 @@ RunResult RunSession(const RunOptions& options) {
     size_t n = 0;
     while (saved.Step()) {
       const size_t i = static_cast<size_t>(saved.GetInt64(0));
-      if (i >= records.size() || Json::parse(saved.GetText(1)) != Json::parse(records[i].factors_json) ||
+      // The same dump() of the same values is the same text (object keys are sorted).
+      if (i >= records.size() || saved.GetText(1) != records[i].factors_json ||
           saved.GetText(2) != records[i].left_json || saved.GetText(3) != records[i].right_json)
         throw InputError(options.db.string(), "session " + std::to_string(start.session_id) + " trial " +
                                                   std::to_string(i) +
