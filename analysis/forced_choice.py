@@ -5,6 +5,8 @@ Figures (thesis chapter 5):
   tests 2, 3 per pattern      Fig. 5.9, 5.13   task 1: the two sources of each of the 6 patterns, and can't tell
   tests 2, 3 per section      Fig. 5.10-5.12   task 2: patterns 2, 4, 6 over sections 1-10
   psychometric                share choosing the more-blurred stimulus against |r_left - r_right|, pooled
+  side bias                   share of decisive answers choosing the LEFT side per study, pooled and per participant
+                              (the counterbalancing check: a side preference cancels out of the source comparisons)
 
 Every bar is a share of the answered trials with its Wilson 95 % interval. The binomial test asks whether, among the
 answers that picked a side (not can't tell), the first source of the pair was chosen more or less often than half
@@ -19,8 +21,8 @@ import matplotlib.pyplot as plt
 
 import stats
 from common import (Chart, Skip, SOURCE_COLORS, SOURCE_LABELS, STUDY_TEST1, STUDY_TEST2, STUDY_TEST3, STUDY_TITLES,
-                    FORCED_CHOICE_STUDIES, error_bars, forced_choice, participants_note, save, stars, study_rows,
-                    wilson_columns)
+                    FORCED_CHOICE_STUDIES, error_bars, forced_choice, p_text, participants_note, save, stars,
+                    study_rows, wilson_columns)
 
 SECTION_PATTERNS = (2, 4, 6)
 
@@ -148,14 +150,19 @@ def test1_per_edge(df, out_dir):
     return charts
 
 
-def _pattern_frame(df, study):
-    d = _prepare(df, study)
-    # The designed pair from the pattern cell; without one, undo the swap of the on-screen sides.
+def _designed_pair(d):
+    """Sets first/second for pattern rows: the designed pair from the pattern cell; without one, undo the swap of the
+    on-screen sides."""
     first = d["pattern_left"] if "pattern_left" in d else pd.Series(None, index=d.index)
     second = d["pattern_right"] if "pattern_right" in d else pd.Series(None, index=d.index)
     swapped = d["swapped"] == 1
     d["first"] = first.where(first.notna(), np.where(swapped, d["right"], d["left"]))
     d["second"] = second.where(second.notna(), np.where(swapped, d["left"], d["right"]))
+    return d
+
+
+def _pattern_frame(df, study):
+    d = _designed_pair(_prepare(df, study))
     if "pattern_id" not in d or d["pattern_id"].isna().all():
         raise Skip(f"{STUDY_TITLES[study]}: no readable pattern cells")
     d = d[d["pattern_id"].notna()].copy()
@@ -343,13 +350,139 @@ def psychometric(df, out_dir, n_boot=200, seed=1):
             Chart("psychometric-bins", None, None, b, ["the binned points drawn in the psychometric chart"])]
 
 
+SIDE_BIAS_POOLED = "pooled"
+
+
+def _side_frame(df):
+    """Decisive answers (left / right, practice excluded) of every forced-choice study in df, with chose_left (0/1)
+    and first_on_left (the pair's first source was the one shown on the left)."""
+    parts = []
+    for study in FORCED_CHOICE_STUDIES:
+        d = study_rows(df, study)
+        if d.empty:
+            continue
+        d = forced_choice(d)
+        d = d[d["answered"] & d["decisive"]].copy()
+        if study == STUDY_TEST1:
+            d["first"] = "measured"
+        else:
+            d = _designed_pair(d)
+        d["chose_left"] = (d["choice"].str.strip() == "left").astype(int)
+        d["first_on_left"] = (d["left"] == d["first"]).astype(int)
+        parts.append(d)
+    return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame()
+
+
+def side_table(dec, by):
+    """Per group of `by` (columns of the decisive answers): decisive, n_left, n_right, share_left with its Wilson
+    95 % interval, the exact two-sided binomial test of n_left against 0.5, and the share of the answers whose
+    left side showed the pair's first source (the counterbalancing of the design)."""
+    rows = []
+    for key, g in dec.groupby(by if len(by) > 1 else by[0], sort=False):
+        key = key if isinstance(key, tuple) else (key,)
+        n_left = int(g["chose_left"].sum())
+        rows.append({**dict(zip(by, key)), "participants": g["participant"].nunique(), "decisive": len(g),
+                     "n_left": n_left, "n_right": len(g) - n_left, "first_on_left": g["first_on_left"].mean()})
+    t = pd.DataFrame(rows)
+    wilson_columns(t, "n_left", "decisive", "share_left")
+    t["p_binom"] = [stats.binom_p(k, n) for k, n in zip(t["n_left"], t["decisive"])]
+    return t
+
+
+def side_bias(df, out_dir):
+    """Side bias: among decisive answers, the share choosing the LEFT side per forced-choice study and pooled (Wilson
+    95 %, exact binomial test against 0.5), and per participant.
+
+    The studies counterbalance the sides (test 1 by participant, tests 2 and 3 with swapped copies of every pair), so
+    a preference for one side cancels out of the source comparisons and shows up only here; `first_on_left` checks
+    that the counterbalancing held among the answers actually given.
+    """
+    dec = _side_frame(df)
+    if dec.empty:
+        present = [s for s in FORCED_CHOICE_STUDIES if (df["study"] == s).any()]
+        raise Skip("side bias: " + ("no forced-choice trials in trials.csv" if not present else
+                                    "no decisive (left / right) answers in the forced-choice studies"))
+    order = [s for s in FORCED_CHOICE_STUDIES if (dec["study"] == s).any()]
+    pooled = dec.assign(study=SIDE_BIAS_POOLED)
+    t = side_table(pd.concat([dec, pooled], ignore_index=True), ["study"])
+    t["p_holm"] = stats.holm(t["p_binom"])
+    per_p = side_table(pd.concat([dec, pooled], ignore_index=True).sort_values(["participant"], kind="stable"),
+                       ["study", "participant"])
+    per_p["p_holm"] = np.nan
+    for study, idx in per_p.groupby("study").groups.items():
+        per_p.loc[idx, "p_holm"] = stats.holm(per_p.loc[idx, "p_binom"])
+    rank = {s: i for i, s in enumerate(order + [SIDE_BIAS_POOLED])}
+    per_p = per_p.sort_values(["study", "participant"], key=lambda c: c.map(rank) if c.name == "study" else c)
+    per_p = per_p.drop(columns="participants").reset_index(drop=True)
+
+    fig, ax = plt.subplots(figsize=(6.6, 3.9))
+    x = np.arange(len(t))
+    ax.axhline(0.5, color="#888888", lw=0.9, ls="--", label="no side preference (0.5)", zorder=1)
+    rng = np.random.default_rng(0)  # a fixed jitter, so the chart does not change between runs
+    for xi, study in zip(x, t["study"]):
+        g = per_p[per_p["study"] == study]
+        ax.scatter(xi + rng.uniform(-0.17, 0.17, len(g)), g["share_left"],
+                   s=8 + 40 * g["decisive"] / per_p["decisive"].max(), color="#999999", alpha=0.6, lw=0, zorder=2,
+                   label="one participant (size ∝ answers)" if xi == 0 else None)
+    colors = ["#0072B2"] * (len(t) - 1) + ["#222222"]
+    bars = error_bars(t["share_left"], t["share_left_low"], t["share_left_high"])
+    for xi, color in zip(x, colors):
+        ax.errorbar([xi], t["share_left"].iloc[xi:xi + 1], yerr=bars[:, xi:xi + 1], fmt="none", ecolor=color, lw=1.4,
+                    capsize=4, zorder=3)
+    ax.scatter(x, t["share_left"], s=46, color=colors, zorder=4, label="study (Wilson 95 %)")
+    for xi, row in zip(x, t.itertuples()):
+        ax.text(xi, 0.97, f"{row.n_left}/{row.decisive} left\n{p_text(row.p_holm)} (Holm)", fontsize=8, va="top",
+                ha="center", color="#333333")
+    labels = {STUDY_TEST1: "test 1\nstatic grids", STUDY_TEST2: "test 2\nmoving balls",
+              STUDY_TEST3: "test 3\nno board", SIDE_BIAS_POOLED: "pooled"}
+    ax.set_xticks(x)
+    ax.set_xticklabels([labels.get(s, s) for s in t["study"]])
+    ax.set_xlim(-0.5, len(t) - 0.5)
+    ax.set_ylim(0, 1.02)
+    ax.set_yticks(np.linspace(0, 1, 6))
+    ax.set_ylabel("share choosing the left side")
+    ax.grid(axis="x", visible=False)
+    ax.set_title(f"Side bias among decisive answers (practice excluded)\n{participants_note(dec)}, "
+                 f"{len(dec)} decisive answers", loc="left")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), handlelength=1.2, alignment="left")
+    png, svg = save(fig, out_dir, "side-bias")
+
+    notes = [f"{participants_note(dec)}; {len(dec)} decisive answers (left / right; can't tell and practice left out)",
+             "share_left: share of the decisive answers choosing the left side, Wilson 95 % interval; p_binom: exact "
+             "two-sided binomial test against 0.5; p_holm: Holm-adjusted over the chart's rows (the pooled row "
+             "included); the chart prints the adjusted p",
+             "the studies counterbalance the sides (test 1 by participant, tests 2 and 3 with a swapped copy of every "
+             "pair), so a side preference cancels out of the source comparisons and shows up only here; "
+             "first_on_left: share of these answers whose left side showed the pair's first source (0.5 = balanced)"]
+    for row in t.itertuples():
+        if abs(row.first_on_left - 0.5) > 0.1:
+            notes.append(f"{row.study}: the first source was on the left in {row.first_on_left:.0%} of the decisive "
+                         f"answers - the sides are not balanced there, so a side preference would bias its source "
+                         f"comparison")
+        if row.p_holm < 0.05:
+            notes.append(f"{row.study}: {row.share_left:.0%} chose the left side ({p_text(row.p_holm)}, Holm) - "
+                         f"a side preference")
+    fixed = per_p[(per_p["study"] != SIDE_BIAS_POOLED) & per_p["first_on_left"].isin([0.0, 1.0])
+                  & (per_p["decisive"] > 1)]
+    participant_notes = []
+    for study, g in fixed.groupby("study", sort=False):
+        participant_notes.append(
+            f"{study}: {len(g)} participant{'s' if len(g) != 1 else ''} saw the first source always on the same side "
+            f"(counterbalanced across participants, not within): their share_left is their source preference as "
+            f"much as a side preference")
+    return [Chart("side-bias", png, svg, t, notes),
+            Chart("side-bias-per-participant", None, None, per_p,
+                  ["per participant within each study and pooled over the studies; p_holm: Holm-adjusted over the "
+                   "participants of one study (or of the pooled rows)"] + participant_notes)]
+
+
 def charts(df, out_dir, n_boot=200):
     """Every forced-choice chart (for callers that want them all at once; report.py runs them step by step)."""
     out = []
     for step in (lambda: test1_per_edge(df, out_dir),
                  lambda: per_pattern(df, out_dir, STUDY_TEST2), lambda: per_pattern(df, out_dir, STUDY_TEST3),
                  lambda: per_section(df, out_dir, STUDY_TEST2), lambda: per_section(df, out_dir, STUDY_TEST3),
-                 lambda: psychometric(df, out_dir, n_boot=n_boot)):
+                 lambda: psychometric(df, out_dir, n_boot=n_boot), lambda: side_bias(df, out_dir)):
         try:
             out += step()
         except Skip as e:

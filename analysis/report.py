@@ -4,6 +4,7 @@
   /usr/bin/python3 analysis/report.py --trials DIR/trials.csv [--bench results/bench] --out DIR [--boot 200]
 
 Writes DIR/<chart>.png, DIR/<chart>.svg, DIR/<table>.csv and DIR/index.html (self-contained, relative links).
+Display timing reads frames.csv from trials.csv's folder (written there by `blurcue export`; missing = skipped).
 One progress line per step on stderr. A section that the data cannot support (a study nobody ran, no answers, no
 bench files) is skipped with a one-line message and a note in index.html.
 Exit codes: 0 report written; 2 usage; 3 trials.csv missing or unreadable, or the output folder cannot be written;
@@ -24,6 +25,7 @@ import bench_charts  # noqa: E402
 import common  # noqa: E402
 import depth_matching  # noqa: E402
 import forced_choice  # noqa: E402
+import frame_timing  # noqa: E402
 from common import Skip, TrialsError  # noqa: E402
 
 EXIT_INPUT = 3
@@ -140,6 +142,7 @@ def main(argv=None):
         return bench[key]
 
     df = lambda: holder["trials"]  # noqa: E731
+    frames_path = os.path.join(os.path.dirname(args.trials), "frames.csv")  # written beside trials.csv by export
     steps = [
         ("pre-research depth matching (Fig. 3.3)", lambda: depth_matching.charts(df(), args.out)),
         ("test 1 per edge (Fig. 5.2)", lambda: forced_choice.test1_per_edge(df(), args.out)),
@@ -149,6 +152,8 @@ def main(argv=None):
          lambda: forced_choice.per_section(df(), args.out, common.STUDY_TEST2)),
         ("test 3 per section, patterns 2, 4, 6", lambda: forced_choice.per_section(df(), args.out, common.STUDY_TEST3)),
         ("psychometric function", lambda: forced_choice.psychometric(df(), args.out, n_boot=args.boot, seed=args.seed)),
+        ("side bias (counterbalancing check)", lambda: forced_choice.side_bias(df(), args.out)),
+        ("display timing", lambda: frame_timing.charts(frames_path, args.out)),
         ("bench files", load_bench),
         ("bench: measurement speed vs accuracy",
          lambda: bench_charts.measure_speed_accuracy(needs("measure"), args.out)),
@@ -170,6 +175,7 @@ def main(argv=None):
     header = [f"trials: {os.path.abspath(args.trials)} - {len(trials)} rows, "
               f"{int(trials['answered'].sum())} answered, {trials['participant'].nunique()} participants",
               "studies: " + (", ".join(f"{s} ({n} rows)" for s, n in studies.items()) or "none"),
+              f"frames: {os.path.abspath(frames_path)}",
               f"bench: {os.path.abspath(args.bench)}",
               f"written {datetime.datetime.now().strftime('%Y-%m-%d %H:%M')}; practice trials excluded everywhere"]
     unknown = sorted(set(studies.index) - known)

@@ -199,3 +199,49 @@ def write_bench_fixtures(folder):
     with open(os.path.join(folder, "render.csv"), "w") as f:
         f.write("\n".join(lines) + "\n")
     return folder
+
+
+FRAME_COLUMNS = ["study", "participant", "session", "window", "trial_index", "frame_index", "flip_time_s", "dropped"]
+REFRESH_MS = 1000 / 60
+
+
+def frames_rows(study, participant, session, window, trials):
+    """frames.csv rows of one session: `trials` is a list with, per trial, the intervals (ms) between its consecutive
+    flips (a trial of n intervals has n + 1 flips, the first at 0 s). dropped follows the runner: only in a window, an
+    interval > 1.5 refresh periods (60 Hz)."""
+    rows = []
+    for trial_index, intervals in enumerate(trials):
+        t = 0.0
+        rows.append({"study": study, "participant": participant, "session": session, "window": int(window),
+                     "trial_index": trial_index, "frame_index": 0, "flip_time_s": 0.0, "dropped": 0})
+        for k, ms in enumerate(intervals, start=1):
+            t += ms / 1000
+            rows.append({"study": study, "participant": participant, "session": session, "window": int(window),
+                         "trial_index": trial_index, "frame_index": k, "flip_time_s": t,
+                         "dropped": int(bool(window) and ms > 1.5 * REFRESH_MS)})
+    return rows
+
+
+def report_frames(seed=5):
+    """A frames.csv for the end-to-end report: two window sessions (jitter around 60 Hz, a few dropped frames) and a
+    headless one (evenly spaced at a simulated 4 Hz)."""
+    rng = np.random.default_rng(seed)
+    rows = []
+    for session, participant in ((101, "W1"), (102, "W2")):
+        trials = [list(REFRESH_MS + np.abs(rng.normal(0, 0.3, 40))) for _ in range(13)]
+        trials[3][10] = 2 * REFRESH_MS
+        trials[7][5] = 3 * REFRESH_MS
+        rows += frames_rows("test1-static-grids", participant, session, True, trials)
+    rows += frames_rows("test1-static-grids", "P1", 2, False, [[250.0] * 8 for _ in range(13)])
+    return rows
+
+
+def write_frames_csv(path, rows):
+    """Writes frames rows the way store/export.cc does (CRLF, the columns in FRAME_COLUMNS)."""
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    with open(path, "w", newline="", encoding="utf-8") as f:
+        w = csv.writer(f, lineterminator="\r\n")
+        w.writerow(FRAME_COLUMNS)
+        for r in rows:
+            w.writerow([repr(r[c]) if isinstance(r[c], float) else str(r[c]) for c in FRAME_COLUMNS])
+    return path

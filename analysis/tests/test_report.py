@@ -44,6 +44,7 @@ class EndToEndTest(ReportTestCase):
 
     def test_full_report(self):
         trials = synthetic.write_trials_csv(os.path.join(self.tmp, "run", "trials.csv"), synthetic.trials_rows())
+        synthetic.write_frames_csv(os.path.join(self.tmp, "run", "frames.csv"), synthetic.report_frames())
         bench = synthetic.write_bench_fixtures(os.path.join(self.tmp, "bench"))
         out = os.path.join(self.tmp, "report")
         code, _, err = run_report(trials, bench, out)
@@ -57,7 +58,7 @@ class EndToEndTest(ReportTestCase):
         expected = {"depth-matching", "test1-per-edge", "test2-per-pattern", "test3-per-pattern",
                     "test2-pattern2-per-section", "test2-pattern4-per-section", "test2-pattern6-per-section",
                     "test3-pattern2-per-section", "test3-pattern4-per-section", "test3-pattern6-per-section",
-                    "psychometric", "bench-measure-speed-accuracy", "bench-stability-within-target",
+                    "psychometric", "side-bias", "frame-intervals", "bench-measure-speed-accuracy", "bench-stability-within-target",
                     "bench-stability-error", "bench-render-speed-accuracy", "bench-frame"}
         self.assertEqual({p[:-4] for p in pngs}, expected)
         linked = set(re.findall(r"<img src='([^']+)'", index))
@@ -84,6 +85,21 @@ class EndToEndTest(ReportTestCase):
         self.assertEqual(len(t1), 12)  # header + 11 edges
         self.assertIn("p_binom", t1[0])
         self.assertIn("GLMM (random intercept, VB)", read(out, "test1-model.csv"))
+
+        # The two checks: side bias per study and pooled (+ per participant), display timing per window session.
+        self.assertRegex(err, r"report: \[\d+/\d+\] side bias \(counterbalancing check\) \.\.\.")
+        self.assertRegex(err, r"report: \[\d+/\d+\] display timing \.\.\.")
+        side = read(out, "side-bias.csv").splitlines()
+        self.assertIn("share_left_low", side[0])
+        self.assertEqual([line.split(",")[0] for line in side[1:]],
+                         ["test1-static-grids", "test2-moving-balls", "test3-no-board", "pooled"])
+        self.assertTrue(os.path.isfile(os.path.join(out, "side-bias-per-participant.csv")))
+        timing = read(out, "frame-intervals.csv").splitlines()
+        self.assertEqual(len(timing), 3, "two window sessions; the headless one is left out")
+        self.assertTrue(all(line.split(",")[1] in ("W1", "W2") for line in timing[1:]))
+        self.assertIn("side bias (counterbalancing check)", index)
+        self.assertIn("display timing", index)
+        self.assertIn("1 headless session left out", index)
 
 
 class EdgeCaseTest(ReportTestCase):
@@ -154,6 +170,10 @@ class EdgeCaseTest(ReportTestCase):
         index = read(out, "index.html")
         self.assertIn("measure.csv: no such file", index)
         self.assertIn("test 1 (static grids): no trials in trials.csv", index)
+        # No frames.csv beside trials.csv: display timing is skipped with a note naming the file.
+        frames = os.path.join(self.tmp, "frames.csv")
+        self.assertIn(f"skipped: {frames}: no such file", err)
+        self.assertIn(f"Skipped: {frames}: no such file", index)
         self.assertFalse(any(f.startswith("bench") for f in os.listdir(out)))
 
     def test_one_bench_file_only(self):

@@ -1,18 +1,24 @@
-"""Statistics against hand-computed answers, and a psychometric fit recovering known parameters."""
+"""Statistics against hand-computed answers, a psychometric fit recovering known parameters, and the side-bias and
+display-timing sections against hand-computed cases (in process, fast)."""
 import math
 import os
+import shutil
 import sys
 import tempfile
 import unittest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))  # analysis/
+sys.path.insert(0, HERE)  # synthetic.py
 
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 import common  # noqa: E402
+import forced_choice  # noqa: E402
+import frame_timing  # noqa: E402
 import stats  # noqa: E402
+import synthetic  # noqa: E402
 
 
 def binom_two_sided_half(k, n):
@@ -230,6 +236,170 @@ class LoadTrialsTest(unittest.TestCase):
         path = self.write("")
         with self.assertRaisesRegex(common.TrialsError, "not a readable CSV"):
             common.load_trials(path)
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# The side-bias (forced_choice.side_bias) and display-timing (frame_timing) sections
+
+
+def wilson_closed_form(k, n, z=1.959963984540054):
+    """Wilson score interval written out again, independently of stats.wilson."""
+    p = k / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z / (1 + z * z / n) * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n))
+    return centre - half, centre + half
+
+
+class TempDirCase(unittest.TestCase):
+    def setUp(self):
+        common.setup_style()
+        self.tmp = tempfile.mkdtemp(prefix="blurcue-sections-")
+        self.addCleanup(shutil.rmtree, self.tmp, True)
+
+
+def fc_rows(study, participant, choices, practice=0, swapped=0):
+    """Minimal forced-choice rows (the columns forced_choice.side_bias reads)."""
+    rows = []
+    for i, choice in enumerate(choices):
+        sw = swapped if swapped in (0, 1) else i % 2
+        left, right = ("estimated", "measured") if sw else ("measured", "estimated")
+        rows.append({"study": study, "participant": participant, "practice": practice, "swapped": sw,
+                     "left": left, "right": right, "choice": choice, "answered": choice != ""})
+    return rows
+
+
+class SideBiasTest(TempDirCase):
+    # Test 1: 20 decisive answers, 14 of them "left"; plus 3 can't tell, 2 unanswered and 4 practice "left" answers,
+    # which must not count. By hand (z^2 = 3.841458821, d = 1 + z^2/20 = 1.192072941):
+    #   centre = (0.7 + 0.096036470) / d = 0.667775; half = (z/d) sqrt(0.0105 + 0.002400912) = 1.644162 x 0.113582
+    #   = 0.186748  ->  [0.481027, 0.854523]
+    #   binomial: C(20, 14..20) = 38760 + 15504 + 4845 + 1140 + 190 + 20 + 1 = 60460; p = 2 x 60460 / 2^20 = 0.115318
+    # Test 2: 10 decisive, 5 left -> share 0.5, p = 1. Pooled: 19 of 30.
+    def frame(self):
+        t1 = fc_rows("test1-static-grids", "P1", ["left"] * 8 + ["right"] * 2 + ["cant_tell"] * 3 + [""] * 2,
+                     swapped=0)
+        t1 += fc_rows("test1-static-grids", "P2", ["left"] * 6 + ["right"] * 4, swapped=1)
+        t1 += fc_rows("test1-static-grids", "P1", ["left"] * 4, practice=1)
+        t2 = fc_rows("test2-moving-balls", "P1", ["left", "right"] * 5, swapped="alternate")
+        for r in t2:
+            r["pattern_left"], r["pattern_right"] = "measured", "estimated"
+        return pd.DataFrame(t1 + t2)
+
+    def test_hand_computed_case(self):
+        charts = forced_choice.side_bias(self.frame(), self.tmp)
+        self.assertEqual([c.name for c in charts], ["side-bias", "side-bias-per-participant"])
+        self.assertTrue(os.path.isfile(os.path.join(self.tmp, "side-bias.png")))
+        self.assertTrue(os.path.isfile(os.path.join(self.tmp, "side-bias.svg")))
+        t = charts[0].table.set_index("study")
+        self.assertEqual(list(t.index), ["test1-static-grids", "test2-moving-balls", "pooled"])
+
+        t1 = t.loc["test1-static-grids"]
+        self.assertEqual((t1["decisive"], t1["n_left"], t1["n_right"]), (20, 14, 6))
+        self.assertAlmostEqual(t1["share_left"], 0.7)
+        self.assertAlmostEqual(t1["share_left_low"], 0.481027, places=5)
+        self.assertAlmostEqual(t1["share_left_high"], 0.854523, places=5)
+        low, high = wilson_closed_form(14, 20)
+        self.assertAlmostEqual(t1["share_left_low"], low, places=10)
+        self.assertAlmostEqual(t1["share_left_high"], high, places=10)
+        self.assertAlmostEqual(t1["p_binom"], 2 * 60460 / 2 ** 20, places=12)
+        self.assertAlmostEqual(t1["p_binom"], binom_two_sided_half(14, 20), places=12)
+        # P1 (swapped = 0) had measured on the left for 10 answers, P2 (swapped = 1) for none of 10.
+        self.assertAlmostEqual(t1["first_on_left"], 0.5)
+
+        t2 = t.loc["test2-moving-balls"]
+        self.assertEqual((t2["decisive"], t2["n_left"]), (10, 5))
+        self.assertAlmostEqual(t2["p_binom"], 1.0)
+        pooled = t.loc["pooled"]
+        self.assertEqual((pooled["decisive"], pooled["n_left"]), (30, 19))
+        self.assertAlmostEqual(pooled["p_binom"], binom_two_sided_half(19, 30), places=12)
+        # Holm over the chart's three rows: the smallest p times 3.
+        self.assertAlmostEqual(t1["p_holm"], min(1.0, 3 * t.loc[:, "p_binom"].min()), places=12)
+
+        per_p = charts[1].table
+        p1 = per_p[(per_p["study"] == "test1-static-grids") & (per_p["participant"] == "P1")].iloc[0]
+        self.assertEqual((p1["decisive"], p1["n_left"]), (10, 8))
+        self.assertAlmostEqual(p1["p_binom"], binom_two_sided_half(8, 10), places=12)
+        self.assertEqual(set(per_p["study"]), {"test1-static-grids", "test2-moving-balls", "pooled"})
+        # Test 1 is counterbalanced by participant: each one saw measured on one side only, and a note says so.
+        self.assertTrue(any("always on the same side" in n for n in charts[1].notes), charts[1].notes)
+
+    def test_no_forced_choice_answers_is_a_skip(self):
+        df = pd.DataFrame(fc_rows("test1-static-grids", "P1", ["cant_tell", ""]))
+        with self.assertRaises(common.Skip) as e:
+            forced_choice.side_bias(df, self.tmp)
+        self.assertIn("no decisive", str(e.exception))
+        df = pd.DataFrame([{"study": "pre-research-depth-matching", "participant": "P1", "practice": 0}])
+        with self.assertRaises(common.Skip) as e:
+            forced_choice.side_bias(df, self.tmp)
+        self.assertIn("no forced-choice trials", str(e.exception))
+
+
+class FrameTimingTest(TempDirCase):
+    # Window session 7: two trials of 30 intervals each, 29 x 16.7 ms and one 50 ms in each -> 62 flips, 60
+    # intervals (the step from trial 0's last flip to trial 1's first is not one). Sorted: 58 x 16.7, 2 x 50.
+    #   median: 16.7; p95 at rank 0.95 x 59 = 56.05 -> between two 16.7s = 16.7;
+    #   p99 at rank 0.99 x 59 = 58.41 -> between ranks 58 and 59, both 50 -> 50; max 50;
+    #   dropped (> 25 ms): 2, share 2/60. The headless session 8 (250 ms flips) is left out.
+    # Window session 9: one trial, 99 x 16.7 ms and one 50 ms -> p99 at rank 0.99 x 99 = 98.01:
+    #   16.7 + 0.01 x (50 - 16.7) = 17.033 (linear interpolation between ranks).
+    def frames(self):
+        rows = synthetic.frames_rows("test1-static-grids", "W1", 7, True,
+                                     [[16.7] * 29 + [50.0], [16.7] * 10 + [50.0] + [16.7] * 19])
+        rows += synthetic.frames_rows("test1-static-grids", "P1", 8, False, [[250.0] * 20] * 3)
+        rows += synthetic.frames_rows("test2-moving-balls", "W2", 9, True, [[16.7] * 50 + [50.0] + [16.7] * 49])
+        return synthetic.write_frames_csv(os.path.join(self.tmp, "run", "frames.csv"), rows)
+
+    def test_summary_against_known_intervals(self):
+        frames = frame_timing.load_frames(self.frames())
+        t = frame_timing.summary(frames[frames["window"] == 1]).set_index("session")
+        s7 = t.loc[7]
+        self.assertEqual((s7["trials"], s7["frames"], s7["intervals"], s7["dropped"]), (2, 62, 60, 2))
+        self.assertAlmostEqual(s7["median_ms"], 16.7, places=6)
+        self.assertAlmostEqual(s7["p95_ms"], 16.7, places=6)
+        self.assertAlmostEqual(s7["p99_ms"], 50.0, places=6)
+        self.assertAlmostEqual(s7["max_ms"], 50.0, places=6)
+        self.assertAlmostEqual(s7["dropped_share"], 2 / 60)
+        self.assertEqual(s7["long_vs_median"], 2)
+        s9 = t.loc[9]
+        self.assertEqual((s9["intervals"], s9["dropped"]), (100, 1))
+        self.assertAlmostEqual(s9["p99_ms"], 16.7 + 0.01 * (50 - 16.7), places=6)
+        self.assertNotIn(8, t.index)
+
+    def test_chart_and_headless_left_out(self):
+        charts = frame_timing.charts(self.frames(), self.tmp)
+        self.assertEqual([c.name for c in charts], ["frame-intervals"])
+        self.assertTrue(os.path.isfile(os.path.join(self.tmp, "frame-intervals.png")))
+        self.assertTrue(os.path.isfile(os.path.join(self.tmp, "frame-intervals.svg")))
+        self.assertEqual(list(charts[0].table["session"]), [7, 9])
+        self.assertTrue(any("1 headless session left out" in n for n in charts[0].notes), charts[0].notes)
+
+    def test_gap_in_frame_index_is_not_an_interval(self):
+        rows = synthetic.frames_rows("test1-static-grids", "W1", 1, True, [[16.7] * 5])
+        del rows[3]  # frame 3: intervals 1-2 and 4-5 stay, 2-3 and 3-4 go
+        iv = frame_timing.intervals(pd.DataFrame(rows))
+        self.assertEqual(list(iv["frame_index"]), [1, 2, 5])
+
+    def test_headless_only_is_a_skip(self):
+        rows = synthetic.frames_rows("test1-static-grids", "P1", 8, False, [[250.0] * 20] * 3)
+        path = synthetic.write_frames_csv(os.path.join(self.tmp, "frames.csv"), rows)
+        with self.assertRaises(common.Skip) as e:
+            frame_timing.charts(path, self.tmp)
+        self.assertIn("no window sessions", str(e.exception))
+        self.assertIn("simulated clock", str(e.exception))
+
+    def test_missing_or_old_file_is_a_skip(self):
+        missing = os.path.join(self.tmp, "nope", "frames.csv")
+        with self.assertRaises(common.Skip) as e:
+            frame_timing.charts(missing, self.tmp)
+        self.assertIn(missing + ": no such file", str(e.exception))
+        old = os.path.join(self.tmp, "frames.csv")
+        with open(old, "w") as f:  # an export from before the window column
+            f.write("study,participant,session,trial_index,frame_index,flip_time_s,dropped\r\n"
+                    "test1-static-grids,P1,1,0,0,0,0\r\n")
+        with self.assertRaises(common.Skip) as e:
+            frame_timing.charts(old, self.tmp)
+        self.assertIn("no window column", str(e.exception))
+        self.assertFalse(os.path.isfile(os.path.join(self.tmp, "frame-intervals.png")))
 
 
 if __name__ == "__main__":
