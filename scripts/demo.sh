@@ -20,7 +20,7 @@ $BC animate --calib "$OUT/calib.json" --background "$OUT/scene/scene.png" --left
 # The studies: the shipped protocols (they point at this scene, and the depth matching at thin-lens photos of its
 # picture at each distance), checked by eye first, then run by simulated
 # observers, each participant with their own recorded seed, into one record: 6 through test 1, 4 through test 2,
-# 3 through test 3 and 3 through the pre-research depth matching. A fresh record each time: a demo run twice must
+# 3 through test 3 and 3 through the pre-research depth matching (headless, on a simulated clock). A fresh record each time: a demo run twice must
 # not meet its own earlier sessions.
 $BC synth-pictures --camera "$OUT/scene/camera.json" --protocol protocols/pre-research-depth-matching.json \
     --out "$OUT/pictures"
@@ -35,6 +35,11 @@ run test1-static-grids P1 P2 P3 P4 P5 P6
 run test2-moving-balls P1 P2 P3 P4
 run test3-no-board P1 P2 P3
 run pre-research-depth-matching P1 P2 P3
+# One more test-1 session in a real window on the real clock (under Xvfb when there is no screen), answered by the
+# simulated observer: its frame timing is the report's display-timing chart.
+WINDOW=()
+[ -n "${DISPLAY:-}" ] || WINDOW=(xvfb-run -a -s "-screen 0 1280x1024x24")
+"${WINDOW[@]}" $BC run protocols/test1-static-grids.json --participant W1 --db "$OUT/study.sqlite" --observer sim --window
 # Speed against accuracy of every measurement and blur method (quick sweeps), for the report's charts.
 $BC bench measure --quick --out results/bench/measure.csv
 $BC bench render --quick --out results/bench/render.csv
