@@ -38,11 +38,22 @@ at() {
   wid=$(timeout 20 xdotool search --sync --name "$1\$" | head -1) || fail "no window titled ...$1"
   sleep 0.15
   if [ -n "${3:-}" ]; then
-    xdotool mousemove --window "$wid" 200 200 click "$3" 2>> "$W/xdotool.log" || fail "click $3 at '$1': $(tail -1 "$W/err")"
+    xdotool mousemove --window "$wid" 200 200 click "$3" 2>> "$W/xdotool.log" || fail "click $3 at '$1': $(tail -1 "$W/err") $(run_status)"
   else
-    xdotool key --window "$wid" "$2" 2>> "$W/xdotool.log" || fail "key $2 at '$1': $(tail -1 "$W/err")"
+    xdotool key --window "$wid" "$2" 2>> "$W/xdotool.log" || fail "key $2 at '$1': $(tail -1 "$W/err") $(run_status)"
   fi
 }
+# An X server of its own on a display it picks itself (-displayfd: no clash with another test's server).
+start_xvfb() {
+  Xvfb -displayfd 3 -screen 0 1280x1024x24 -nolisten tcp 3> "$W/display" > "$W/xvfb.log" 2>&1 &
+  xvfb=$!
+  trap 'kill $xvfb 2>/dev/null || true' EXIT
+  for _ in $(seq 1 100); do [ -s "$W/display" ] && break; sleep 0.05; done
+  [ -s "$W/display" ] || fail "Xvfb did not start: $(cat "$W/xvfb.log")"
+  export DISPLAY=":$(head -1 "$W/display")"
+}
+# How the run in the background ended, when a window test finds its window gone.
+run_status() { if [ -n "${run:-}" ] && ! kill -0 "$run" 2>/dev/null; then wait "$run"; echo "(run exited with $?)"; fi; }
 integrity() { [ "$(sql "$1" 'PRAGMA integrity_check')" = ok ] || fail "integrity_check of $1"; }
 
 case $CASE in
@@ -162,11 +173,7 @@ window_adjust)
   # Depth matching by a person in a window: arrow keys, the mouse wheel and a click step and accept; each answer
   # is the level the presses reach in that trial's own level order (from blurcue validate --list).
   command -v xdotool >/dev/null || { echo "SKIP: xdotool missing"; exit 0; }
-  export DISPLAY=:$((90 + RANDOM % 100))
-  Xvfb $DISPLAY -screen 0 1280x1024x24 -nolisten tcp > "$W/xvfb.log" 2>&1 &
-  xvfb=$!
-  trap 'kill $xvfb 2>/dev/null || true' EXIT
-  sleep 1
+  start_xvfb
   proto="$P/pre-research-depth-matching.json"
   $BC validate "$proto" --participant W1 --list > "$W/trials.jsonl"
   $BC run "$proto" --participant W1 --db "$W/s.sqlite" --stop-after 3 > "$W/out" 2> "$W/err" &
@@ -201,11 +208,7 @@ window)
   # A person at a real window under Xvfb: synthetic key presses (xdotool) answer test 1; the answers are in the
   # record as pressed: Left = left, Right = right, Down = can't tell.
   command -v xdotool >/dev/null || { echo "SKIP: xdotool missing"; exit 0; }
-  export DISPLAY=:$((90 + RANDOM % 100))
-  Xvfb $DISPLAY -screen 0 1280x1024x24 -nolisten tcp > "$W/xvfb.log" 2>&1 &
-  xvfb=$!
-  trap 'kill $xvfb 2>/dev/null || true' EXIT
-  sleep 1
+  start_xvfb
   $BC run "$P/test1-static-grids.json" --participant W1 --db "$W/s.sqlite" > "$W/out" 2> "$W/err" &
   run=$!
   # welcome, practice screen, 2 practice answers, main-part screen, 11 answers.
