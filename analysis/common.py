@@ -72,6 +72,16 @@ def _json_object(text):
     return value if isinstance(value, dict) else None
 
 
+def read_text_csv(path):
+    """A CSV with every cell as text (an empty cell stays empty, never NaN or 0); ValueError with a one-line reason
+    when the file cannot be read as CSV."""
+    try:
+        return pd.read_csv(path, dtype=str, keep_default_na=False, na_values=[], encoding="utf-8")
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError, OSError) as e:
+        first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+        raise ValueError(f"not a readable CSV ({first})")
+
+
 def load_trials(path):
     """trials.csv -> DataFrame with typed columns; raises TrialsError naming the file when it cannot be used.
 
@@ -83,10 +93,9 @@ def load_trials(path):
     if not os.path.isfile(path):
         raise TrialsError(f"{path}: no such file")
     try:
-        df = pd.read_csv(path, dtype=str, keep_default_na=False, na_values=[], encoding="utf-8")
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError, OSError) as e:
-        first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
-        raise TrialsError(f"{path}: not a readable CSV ({first})")
+        df = read_text_csv(path)
+    except ValueError as e:
+        raise TrialsError(f"{path}: {e}")
     missing = [c for c in LEADING + TRAILING if c not in df.columns]
     if missing:
         raise TrialsError(f"{path}: not a blurcue trials.csv (missing column{'s' if len(missing) > 1 else ''} "

@@ -15,7 +15,7 @@ import pandas as pd
 
 import matplotlib.pyplot as plt
 
-from common import Chart, Skip, save
+from common import Chart, Skip, read_text_csv, save
 
 FRAME_COLUMNS = ["study", "participant", "session", "window", "trial_index", "frame_index", "flip_time_s", "dropped"]
 REFRESH_MS = 1000 / 60   # one refresh of a 60 Hz display
@@ -33,10 +33,9 @@ def load_frames(path):
     if not os.path.isfile(path):
         raise Skip(f"{path}: no such file - display timing skipped (written by `blurcue export` beside trials.csv)")
     try:
-        d = pd.read_csv(path, dtype=str, keep_default_na=False, na_values=[], encoding="utf-8")
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError, OSError) as e:
-        first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
-        raise Skip(f"{path}: not a readable CSV ({first}) - display timing skipped")
+        d = read_text_csv(path)
+    except ValueError as e:
+        raise Skip(f"{path}: {e} - display timing skipped")
     if "window" not in d.columns and all(c in d.columns for c in FRAME_COLUMNS if c != "window"):
         raise Skip(f"{path}: no window column (an export from before it was added?) - real-window sessions cannot be "
                    f"told from headless ones on a simulated clock; display timing skipped")

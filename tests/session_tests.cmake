@@ -22,23 +22,23 @@ add_test(NAME session_preview
          COMMAND ${BC} preview ${T}/protocols/test1-static-grids.json --out ${T}/preview-test1.png)
 set_tests_properties(session_preview PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS gl
                      PASS_REGULAR_EXPRESSION "11 distinct stimuli of 13 trials")
-add_test(NAME session_run_broken_protocol
-         COMMAND ${CMAKE_COMMAND} -DCMD=${BC}
-                 "-DARGS=run;${PROJECT_SOURCE_DIR}/tests/data/broken-protocol.json;--participant;P1;--db;${T}/broken.sqlite;--observer;sim"
-                 -DEXPECT_CODE=3 "-DEXPECT_TEXT=broken-protocol.json: /"
-                 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
-add_test(NAME session_run_bad_observer
-         COMMAND ${CMAKE_COMMAND} -DCMD=${BC}
-                 "-DARGS=run;${T}/protocols/test1-static-grids.json;--participant;P1;--db;${T}/bad-observer.sqlite;--observer;sim:jdn=1"
-                 -DEXPECT_CODE=2 "-DEXPECT_TEXT=--observer: unknown parameter 'jdn'"
-                 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
-set_tests_properties(session_run_bad_observer PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols")
-add_test(NAME session_run_negative_seed
-         COMMAND ${CMAKE_COMMAND} -DCMD=${BC}
-                 "-DARGS=run;${T}/protocols/test1-static-grids.json;--participant;P1;--db;${T}/seed.sqlite;--observer;sim;--seed;-3"
-                 -DEXPECT_CODE=2 "-DEXPECT_TEXT=--seed: must be a whole number from 0 to 18446744073709551615, got '-3'"
-                 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
-set_tests_properties(session_run_negative_seed PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols")
+# Bad input: exit code and one line naming what is wrong (tests/expect_failure.cmake). NAME CODE TEXT ARGS...
+function(add_run_failure_test name code text)
+  add_test(NAME ${name}
+           COMMAND ${CMAKE_COMMAND} -DCMD=${BC} "-DARGS=${ARGN}" -DEXPECT_CODE=${code} "-DEXPECT_TEXT=${text}"
+                   -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+  set_tests_properties(${name} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols")
+endfunction()
+add_run_failure_test(session_run_broken_protocol 3 "broken-protocol.json: /"
+                     run ${PROJECT_SOURCE_DIR}/tests/data/broken-protocol.json --participant P1 --db ${T}/broken.sqlite
+                     --observer sim)
+add_run_failure_test(session_run_bad_observer 2 "--observer: unknown parameter 'jdn'"
+                     run ${T}/protocols/test1-static-grids.json --participant P1 --db ${T}/bad-observer.sqlite
+                     --observer sim:jdn=1)
+add_run_failure_test(session_run_negative_seed 2
+                     "--seed: must be a whole number from 0 to 18446744073709551615, got '-3'"
+                     run ${T}/protocols/test1-static-grids.json --participant P1 --db ${T}/seed.sqlite --observer sim
+                     --seed -3)
 # A person needs a window: without a display, one line says so (and what to do) before anything is recorded.
 add_test(NAME session_run_person_without_display
          COMMAND ${CMAKE_COMMAND} -E env --unset=DISPLAY ${CMAKE_COMMAND} -DCMD=${BC}
