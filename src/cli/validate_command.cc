@@ -6,6 +6,7 @@
 
 #include "cli/commands.h"
 #include "core/error.h"
+#include "core/hash.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
 
@@ -50,7 +51,7 @@ void AddValidateCommand(CLI::App& app) {
     if (args->list)
       for (const auto& t : trials) std::cout << protocol::ToJson(t).dump() << "\n";
     std::cout << "ok: " << trials.size() << " trials for participant " << args->participant << " with seed "
-              << seed << " (hash " << protocol::HashHex(protocol::TrialsHash(trials)) << ")\n";
+              << seed << " (hash " << HashHex(protocol::TrialsHash(trials)) << ")\n";
     std::string counts;
     int practice = 0;
     for (const auto& t : trials) practice += t.practice ? 1 : 0;

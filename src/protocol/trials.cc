@@ -1,5 +1,7 @@
 #include "protocol/trials.h"
 
+#include "core/hash.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
@@ -141,25 +143,11 @@ Json ToJson(const std::vector<Trial>& trials) {
   return j;
 }
 
-uint64_t Fnv1a64(const std::string& text) {
-  uint64_t h = 14695981039346656037ull;
-  for (unsigned char c : text) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return h;
-}
-
 uint64_t TrialsHash(const std::vector<Trial>& trials) { return Fnv1a64(ToJson(trials).dump()); }
 
 uint64_t DefaultSeed(const std::string& study, const std::string& participant) {
   return Fnv1a64(study + "/" + participant);
 }
 
-std::string HashHex(uint64_t hash) {
-  char text[17];
-  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
-  return text;
-}
 
 }  // namespace blurcue::protocol

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/hash.h"
 #include "protocol/protocol.h"
 
 namespace blurcue::protocol {
@@ -54,15 +55,11 @@ std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& part
 Json ToJson(const Trial& trial);
 Json ToJson(const std::vector<Trial>& trials);
 
-// FNV-1a 64 of a text.
-uint64_t Fnv1a64(const std::string& text);
-
 // FNV-1a 64 of ToJson(trials).dump(): one number that changes when anything in the list changes.
 uint64_t TrialsHash(const std::vector<Trial>& trials);
 
 // The seed a participant gets when none is given: FNV-1a 64 of "STUDY/PARTICIPANT" (own per participant, recorded
 // with the session like any other seed).
 uint64_t DefaultSeed(const std::string& study, const std::string& participant);
-std::string HashHex(uint64_t hash);  // 16 lowercase hex digits
 
 }  // namespace blurcue::protocol

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "core/hash.h"
 #include "store/schema.h"
 
 #ifndef BLURCUE_VERSION
@@ -19,7 +20,6 @@
 
 namespace blurcue::store {
 namespace {
-
 
 int64_t NowMs() {
   return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch())
@@ -33,7 +33,6 @@ std::string NewToken() {
   std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(bits));
   return text;
 }
-
 
 std::string SessionName(int64_t session) { return "session " + std::to_string(session); }
 
@@ -57,16 +56,7 @@ const char* ToString(SessionStatus status) {
   return "running";
 }
 
-std::string Fnv1a64Hex(const std::string& text) {
-  uint64_t hash = 0xcbf29ce484222325ULL;
-  for (unsigned char c : text) {
-    hash ^= c;
-    hash *= 0x100000001b3ULL;
-  }
-  char hex[24];
-  std::snprintf(hex, sizeof(hex), "%016llx", static_cast<unsigned long long>(hash));
-  return hex;
-}
+std::string Fnv1a64Hex(const std::string& text) { return HashHex(Fnv1a64(text)); }
 
 std::string NowIso8601() {
   const int64_t ms = NowMs();
