@@ -341,8 +341,7 @@ class Runner {
       store::Response response;
       std::vector<store::FrameRecord> frames;
       if (RunTrial(trial, scenes_[size_t(i)], &response, &frames) == Outcome::kQuit) break;
-      record.RecordResponse(start.session_id, i, response);  // committed before anything else happens
-      record.RecordFrames(start.session_id, i, frames);
+      record.RecordResponse(start.session_id, i, response, frames);  // committed before anything else happens
       ++result.answered_now;
       progress(i + 1);
       if (!trial.practice) ++main_answered;
@@ -444,44 +443,19 @@ RunResult RunSession(const RunOptions& options) {
   meta.display = display;
   if (!options.again && !options.resume) {
     // Running a participant through a study they finished is usually a typo in the id: say so.
-    store::Statement done(record.database(),
-                          "SELECT s.id FROM sessions s JOIN participants p ON p.id = s.participant_id "
-                          "JOIN studies st ON st.id = p.study_id "
-                          "WHERE st.name = ? AND p.code = ? AND s.status = 'completed' ORDER BY s.id");
-    done.Bind(1, protocol.name);
-    done.Bind(2, options.participant);
-    if (done.Step())
+    const std::vector<int64_t> done = record.CompletedSessions(protocol.name, options.participant);
+    if (!done.empty())
       throw InputError(options.db.string(), "participant " + options.participant + " already completed " +
-                                                protocol.name + " (session " + std::to_string(done.GetInt64(0)) +
+                                                protocol.name + " (session " + std::to_string(done.front()) +
                                                 "); check the id, or add --again for another session");
   }
   const store::SessionStart start = record.StartOrResumeSession(protocol.name, options.participant, protocol_text,
                                                                 seed, meta, options.resume);
-  if (start.trial_count == 0) {
+  // A new session saves its list; a resumed one must show the same trials in the same order.
+  if (start.trial_count == 0)
     record.SaveTrialList(start.session_id, records);
-  } else {
-    // A resumed session must show the same trials in the same order as the one it continues.
-    store::Statement saved(record.database(),
-                           "SELECT trial_index, factors, left_shown, right_shown FROM trials WHERE session_id = ? "
-                           "ORDER BY trial_index");
-    saved.Bind(1, start.session_id);
-    size_t n = 0;
-    while (saved.Step()) {
-      const size_t i = static_cast<size_t>(saved.GetInt64(0));
-      // The same dump() of the same values is the same text (object keys are sorted).
-      if (i >= records.size() || saved.GetText(1) != records[i].factors_json ||
-          saved.GetText(2) != records[i].left_json || saved.GetText(3) != records[i].right_json)
-        throw InputError(options.db.string(), "session " + std::to_string(start.session_id) + " trial " +
-                                                  std::to_string(i) +
-                                                  ": the saved trial differs from the one this protocol, participant "
-                                                  "and seed make now; it cannot be resumed with them");
-      ++n;
-    }
-    if (n != records.size())
-      throw InputError(options.db.string(), "session " + std::to_string(start.session_id) + " has " +
-                                                std::to_string(n) + " trials saved, the protocol makes " +
-                                                std::to_string(records.size()));
-  }
+  else
+    record.CheckTrialList(start.session_id, records);
   Runner runner(options, protocol, *context, renderer, trials, scenes, observer, seed);
   return runner.Run(record, start);
 }

@@ -228,7 +228,38 @@ void Record::SaveTrialList(int64_t session, const std::vector<TrialRecord>& tria
   transaction.Commit();
 }
 
-void Record::RecordResponse(int64_t session, int64_t trial_index, const Response& response) {
+void Record::CheckTrialList(int64_t session, const std::vector<TrialRecord>& trials) {
+  Statement saved(db_, "SELECT trial_index, block, factors, left_shown, right_shown FROM trials "
+                       "WHERE session_id = ? ORDER BY trial_index");
+  saved.Bind(1, session);
+  size_t n = 0;
+  for (; saved.Step(); ++n) {
+    const size_t i = static_cast<size_t>(saved.GetInt64(0));
+    // The same values dumped the same way are the same text (JSON object keys are sorted).
+    if (i >= trials.size() || saved.GetInt64(1) != trials[i].block || saved.GetText(2) != trials[i].factors_json ||
+        saved.GetText(3) != trials[i].left_json || saved.GetText(4) != trials[i].right_json)
+      throw InputError(db_.path(), SessionName(session) + " trial " + std::to_string(i) +
+                                       ": the saved trial differs from the one made now (another calibration or "
+                                       "blurcue version?); it cannot be resumed with them");
+  }
+  if (n != trials.size())
+    throw InputError(db_.path(), SessionName(session) + " has " + std::to_string(n) + " trials saved, " +
+                                     std::to_string(trials.size()) + " were made now");
+}
+
+std::vector<int64_t> Record::CompletedSessions(const std::string& study, const std::string& participant) {
+  Statement done(db_, "SELECT s.id FROM sessions s JOIN participants p ON p.id = s.participant_id "
+                      "JOIN studies st ON st.id = p.study_id "
+                      "WHERE st.name = ? AND p.code = ? AND s.status = 'completed' ORDER BY s.id");
+  done.Bind(1, study);
+  done.Bind(2, participant);
+  std::vector<int64_t> ids;
+  while (done.Step()) ids.push_back(done.GetInt64(0));
+  return ids;
+}
+
+void Record::RecordResponse(int64_t session, int64_t trial_index, const Response& response,
+                            const std::vector<FrameRecord>& frames) {
   Transaction transaction(db_);
   RequireLock(session);
   const int64_t trial_id = TrialId(session, trial_index);
@@ -245,26 +276,19 @@ void Record::RecordResponse(int64_t session, int64_t trial_index, const Response
   insert.Bind(4, response.adjustment_json);
   insert.Bind(5, response.answered_at.empty() ? NowIso8601() : response.answered_at);
   insert.Run();
+  Statement frame(db_, "INSERT INTO frames (trial_id, frame_index, flip_time_s, dropped) VALUES (?, ?, ?, ?)");
+  for (const FrameRecord& f : frames) {
+    frame.Bind(1, trial_id);
+    frame.Bind(2, f.frame_index);
+    frame.Bind(3, f.flip_time_s);
+    frame.Bind(4, f.dropped ? 1 : 0);
+    frame.Run();
+    frame.Reset();
+  }
   Statement beat(db_, "UPDATE sessions SET lock_heartbeat_ms = ? WHERE id = ?");
   beat.Bind(1, NowMs());
   beat.Bind(2, session);
   beat.Run();
-  transaction.Commit();
-}
-
-void Record::RecordFrames(int64_t session, int64_t trial_index, const std::vector<FrameRecord>& frames) {
-  Transaction transaction(db_);
-  RequireLock(session);
-  const int64_t trial_id = TrialId(session, trial_index);
-  Statement insert(db_, "INSERT INTO frames (trial_id, frame_index, flip_time_s, dropped) VALUES (?, ?, ?, ?)");
-  for (const FrameRecord& frame : frames) {
-    insert.Bind(1, trial_id);
-    insert.Bind(2, frame.frame_index);
-    insert.Bind(3, frame.flip_time_s);
-    insert.Bind(4, frame.dropped ? 1 : 0);
-    insert.Run();
-    insert.Reset();
-  }
   transaction.Commit();
 }
 

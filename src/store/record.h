@@ -80,12 +80,18 @@ class Record {
   // Saves the whole planned trial list once, up front; throws Error(kInput) when the session already has one.
   void SaveTrialList(int64_t session, const std::vector<TrialRecord>& trials);
 
-  // Records one answer in its own transaction. Throws Error(kInput) when the trial does not exist or already
-  // has a response, or when this Record does not hold the running session.
-  void RecordResponse(int64_t session, int64_t trial_index, const Response& response);
+  // A resumed session's check: throws Error(kInput) naming the first trial whose saved factors or sides differ
+  // from `trials` (e.g. the calibration changed between sittings), or when the counts differ.
+  void CheckTrialList(int64_t session, const std::vector<TrialRecord>& trials);
 
-  // Records the display flips of one trial (its own transaction).
-  void RecordFrames(int64_t session, int64_t trial_index, const std::vector<FrameRecord>& frames);
+  // The ids of the participant's completed sessions of `study`, oldest first.
+  std::vector<int64_t> CompletedSessions(const std::string& study, const std::string& participant);
+
+  // Records one answer and the display flips of its trial in one transaction: both or neither. Throws
+  // Error(kInput) when the trial does not exist or already has a response, or when this Record does not hold the
+  // running session.
+  void RecordResponse(int64_t session, int64_t trial_index, const Response& response,
+                      const std::vector<FrameRecord>& frames = {});
 
   // Refreshes this Record's lock heartbeat (RecordResponse does it too).
   void Heartbeat(int64_t session);

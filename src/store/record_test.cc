@@ -51,6 +51,45 @@ TEST(Record, NewSessionStartsAtTrialZero) {
   EXPECT_EQ(record.FirstUnansweredTrial(start.session_id), 0);
 }
 
+TEST(Record, AnswerAndItsFramesAreOneTransaction) {
+  Record record = Record::Open(":memory:");
+  const int64_t session = record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, false).session_id;
+  record.SaveTrialList(session, Trials(3));
+  record.RecordResponse(session, 0, Answer("left"), {{0, 0.0, false}, {1, 0.0167, false}, {2, 0.05, true}});
+  EXPECT_EQ(record.database().QueryInt64("SELECT COUNT(*) FROM frames"), 3);
+  EXPECT_EQ(record.database().QueryInt64("SELECT SUM(dropped) FROM frames"), 1);
+  // A refused second answer adds no frames either: both roll back together.
+  EXPECT_THROW(record.RecordResponse(session, 0, Answer("right"), {{0, 0.0, false}}), Error);
+  EXPECT_EQ(record.database().QueryInt64("SELECT COUNT(*) FROM frames"), 3);
+}
+
+TEST(Record, ResumedTrialListIsCheckedAgainstTheSavedOne) {
+  Record record = Record::Open(":memory:");
+  const int64_t session = record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, false).session_id;
+  record.SaveTrialList(session, Trials(4));
+  EXPECT_NO_THROW(record.CheckTrialList(session, Trials(4)));
+  std::vector<TrialRecord> changed = Trials(4);
+  changed[2].factors_json = R"({"edge":3,"blur":"measured","r_left_px":1.5})";
+  try {
+    record.CheckTrialList(session, changed);
+    ADD_FAILURE() << "a changed trial was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("session 1 trial 2: the saved trial differs"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(record.CheckTrialList(session, Trials(5)), Error);
+}
+
+TEST(Record, CompletedSessionsOfAParticipant) {
+  Record record = Record::Open(":memory:");
+  const int64_t first = record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, false).session_id;
+  EXPECT_TRUE(record.CompletedSessions("test1", "P01").empty());
+  record.FinishSession(first, SessionStatus::kCompleted);
+  record.StartOrResumeSession("test2", "P01", kProtocol, 7, {}, false);
+  EXPECT_EQ(record.CompletedSessions("test1", "P01"), std::vector<int64_t>{first});
+  EXPECT_TRUE(record.CompletedSessions("test2", "P01").empty());
+  EXPECT_TRUE(record.CompletedSessions("test1", "P02").empty());
+}
+
 TEST(Record, ResponseRecordedTwiceIsRefused) {
   Record record = Record::Open(":memory:");
   const int64_t session = record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, false).session_id;
