@@ -121,10 +121,17 @@ void FrameCompositor::Present(int width_px, int height_px) {
   BlitToWindow(impl_->frame_fb.id(), impl_->width, impl_->height, width_px, height_px);
 }
 
-void PresentImage(const cv::Mat& image, int width_px, int height_px) {
-  const Texture texture = Texture::FromSrgbImage(image);
-  const Framebuffer fb(texture);
-  BlitToWindow(fb.id(), image.cols, image.rows, width_px, height_px);
+struct WindowImage::Impl {
+  Texture texture;
+  Framebuffer fb{texture};
+  explicit Impl(const cv::Mat& image) : texture(Texture::FromSrgbImage(image)) {}
+};
+
+WindowImage::WindowImage(const cv::Mat& image) : impl_(std::make_unique<Impl>(image)) {}
+WindowImage::~WindowImage() = default;
+
+void WindowImage::Present(int width_px, int height_px) const {
+  BlitToWindow(impl_->fb.id(), impl_->texture.width_px(), impl_->texture.height_px(), width_px, height_px);
 }
 
 }  // namespace blurcue::render

@@ -43,8 +43,20 @@ class FrameCompositor {
   std::unique_ptr<Impl> impl_;
 };
 
-// Shows an 8-bit sRGB image (instructions, a CPU-made stimulus) in the current window's default framebuffer,
-// scaled to fit width_px x height_px.
-void PresentImage(const cv::Mat& image, int width_px, int height_px);
+// An 8-bit sRGB image (a text screen, a CPU-made stimulus) uploaded once and shown in the current window as often
+// as needed: a frame costs a blit, not an upload. Needs a current GL context.
+class WindowImage {
+ public:
+  explicit WindowImage(const cv::Mat& image);
+  ~WindowImage();
+  WindowImage(const WindowImage&) = delete;
+  WindowImage& operator=(const WindowImage&) = delete;
+  // Draws it into the window's default framebuffer, scaled to fit width_px x height_px, letterboxed on grey.
+  void Present(int width_px, int height_px) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace blurcue::render

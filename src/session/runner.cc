@@ -159,9 +159,11 @@ class Runner {
 
   // Shows `image` until one of `keys` is pressed and returns it ("" when the window is closed).
   std::string ShowUntil(const std::string& title, const cv::Mat& image, const std::vector<std::string>& keys) {
-    context_.SetTitle("blurcue - " + protocol_.name + " - " + title);
+    context_.SetTitle(Title(title));
+    std::optional<render::WindowImage> shown;  // uploaded once, blitted every frame
+    if (station_.window()) shown.emplace(image);
     for (;;) {
-      if (station_.window()) render::PresentImage(image, context_.width_px(), context_.height_px());
+      if (shown) shown->Present(context_.width_px(), context_.height_px());
       station_.Flip();
       if (station_.Closed()) return "";
       for (const InputEvent& e : station_.Poll())
@@ -192,10 +194,10 @@ class Runner {
     return !key.empty() && key != "Q";
   }
 
-  // The window's title while a trial is on screen (the experimenter's view; tests wait for it).
+  // The window's title names what is on screen (the experimenter's view; tests wait for it).
+  std::string Title(const std::string& what) const { return "blurcue - " + protocol_.name + " - " + what; }
   std::string TrialTitle(const protocol::Trial& trial) const {
-    return "blurcue - " + protocol_.name + " - trial " + std::to_string(trial.index + 1) + " of " +
-           std::to_string(trials_.size());
+    return Title("trial " + std::to_string(trial.index + 1) + " of " + std::to_string(trials_.size()));
   }
 
   // The simulated observer's key presses for a trial whose stimulus appeared at `onset`.
@@ -220,7 +222,7 @@ class Runner {
     // Inter-trial interval: the grey field.
     if (protocol_.timing.inter_trial_ms > 0) {
       if (station_.window()) {
-        render::PresentImage(Blank(), context_.width_px(), context_.height_px());
+        Blank().Present(context_.width_px(), context_.height_px());
         station_.Flip();
       }
       station_.Wait(protocol_.timing.inter_trial_ms / 1000);
@@ -249,7 +251,7 @@ class Runner {
         if (shown)
           renderer_.Present(context_.width_px(), context_.height_px());
         else
-          render::PresentImage(Blank(), context_.width_px(), context_.height_px());
+          Blank().Present(context_.width_px(), context_.height_px());
       }
       const double flip = station_.Flip();
       if (onset < 0) {
@@ -356,8 +358,8 @@ class Runner {
     if (result.completed) {
       record.FinishSession(start.session_id, store::SessionStatus::kCompleted);
       if (station_.window()) {
-        render::PresentImage(TextScreen(screen_size_, "Thank you", "The session is complete.", ""),
-                             context_.width_px(), context_.height_px());
+        render::WindowImage(TextScreen(screen_size_, "Thank you", "The session is complete.", ""))
+            .Present(context_.width_px(), context_.height_px());
         station_.Flip();
         station_.Wait(0.5);
       }
@@ -367,9 +369,10 @@ class Runner {
   }
 
  private:
-  const cv::Mat& Blank() {
-    if (blank_.empty()) blank_ = TextScreen(screen_size_, "", "", "");
-    return blank_;
+  // The grey field between trials and after a timed stimulus (window only).
+  const render::WindowImage& Blank() {
+    if (!blank_) blank_ = std::make_unique<render::WindowImage>(TextScreen(screen_size_, "", "", ""));
+    return *blank_;
   }
 
   const RunOptions& options_;
@@ -383,7 +386,7 @@ class Runner {
   KeyMap keys_;
   Station station_;
   cv::Size screen_size_;
-  cv::Mat blank_;
+  std::unique_ptr<render::WindowImage> blank_;
   int64_t dropped_frames_ = 0;
 };
 
@@ -425,7 +428,7 @@ RunResult RunSession(const RunOptions& options) {
     w.height_px = protocol.display.height_px;
     w.fullscreen = protocol.display.fullscreen;
     w.monitor = protocol.display.monitor;
-    w.title = "blurcue - " + protocol.name;
+    w.title = "blurcue - " + protocol.name;  // then Runner::Title names what is on screen
     context = render::GlContext::CreateWindow(w);
   } else {
     context = render::GlContext::CreateOffscreen();

@@ -153,6 +153,11 @@ StimulusRenderer::StimulusRenderer(const protocol::Protocol& protocol, const std
   if (protocol.content.type == "picture") {
     picture_ = ReadImage(protocol.content.image.empty() ? render::ResolveStimulus("face") : protocol.content.image);
     picture_width_px_ = protocol.display.width_px;
+    // Every adjustment level's low-passed picture up front (~0.1 s each on the CPU): stepping through the levels
+    // in a trial then never stalls a frame on a Butterworth filter.
+    for (const auto& block : protocol.blocks)
+      if (block.adjust)
+        for (double level : block.adjust->levels) UpperHalf(level);
     return;
   }
   if (!scene_) scene_ = LoadProtocolScene(protocol);
@@ -163,6 +168,15 @@ StimulusRenderer::StimulusRenderer(const protocol::Protocol& protocol, const std
 
 StimulusRenderer::~StimulusRenderer() = default;
 
+const cv::Mat& StimulusRenderer::UpperHalf(double level) {
+  auto cached = std::find_if(upper_cache_.begin(), upper_cache_.end(),
+                             [&](const auto& entry) { return entry.first == level; });
+  if (cached != upper_cache_.end()) return cached->second;
+  const int w = picture_width_px_, half = w * 3 / 4 / 2;
+  upper_cache_.emplace_back(level, render::PictureOnGrey(picture_, cv::Size(w, half), half * 6 / 10, level));
+  return upper_cache_.back().second;
+}
+
 cv::Size StimulusRenderer::FrameSize() const {
   if (compositor_) return photo_.size();
   return {picture_width_px_, picture_width_px_ * 3 / 4};
@@ -170,13 +184,6 @@ cv::Size StimulusRenderer::FrameSize() const {
 
 void StimulusRenderer::Compose(const TrialScene& trial, double t_s, double level) {
   if (!compositor_) {
-    auto cached = std::find_if(upper_cache_.begin(), upper_cache_.end(),
-                               [&](const auto& entry) { return entry.first == level; });
-    if (cached == upper_cache_.end()) {
-      const int w = picture_width_px_, half = w * 3 / 4 / 2;
-      upper_cache_.emplace_back(level, render::PictureOnGrey(picture_, cv::Size(w, half), half * 6 / 10, level));
-      cached = std::prev(upper_cache_.end());
-    }
     const cv::Mat* lower = &photo_;
     if (!protocol_.content.real_photos.empty()) {
       if (trial.distance_m != real_photo_distance_m_) {
@@ -185,7 +192,8 @@ void StimulusRenderer::Compose(const TrialScene& trial, double t_s, double level
       }
       lower = &real_photo_;
     }
-    picture_frame_ = render::DepthMatchingFrame(cached->second, *lower, picture_width_px_);
+    picture_frame_ = render::DepthMatchingFrame(UpperHalf(level), *lower, picture_width_px_);
+    picture_shown_.reset();
     return;
   }
   std::vector<render::BlurredObject> objects;
@@ -216,10 +224,12 @@ void StimulusRenderer::Compose(const TrialScene& trial, double t_s, double level
 }
 
 void StimulusRenderer::Present(int width_px, int height_px) {
-  if (compositor_)
+  if (compositor_) {
     compositor_->Present(width_px, height_px);
-  else
-    render::PresentImage(picture_frame_, width_px, height_px);
+    return;
+  }
+  if (!picture_shown_) picture_shown_ = std::make_unique<render::WindowImage>(picture_frame_);
+  picture_shown_->Present(width_px, height_px);
 }
 
 cv::Mat StimulusRenderer::Read() { return compositor_ ? compositor_->Read() : picture_frame_.clone(); }

@@ -21,6 +21,7 @@
 
 namespace blurcue::render {
 class FrameCompositor;
+class WindowImage;
 }
 
 namespace blurcue::session {
@@ -80,10 +81,13 @@ class StimulusRenderer {
   std::optional<calib::SceneCalib> scene_;
   cv::Mat photo_, texture_;
   std::unique_ptr<render::FrameCompositor> compositor_;
-  // Picture: the upper halves by cut-off, made once each (the Butterworth runs on the CPU).
+  // Picture: the upper half at a cut-off, made once (the Butterworth runs on the CPU) and kept; every level of
+  // the protocol is made up front.
+  const cv::Mat& UpperHalf(double level);
   cv::Mat picture_;
-  std::vector<std::pair<double, cv::Mat>> upper_cache_;
+  std::vector<std::pair<double, cv::Mat>> upper_cache_;  // cut-off -> upper half
   cv::Mat picture_frame_;
+  std::unique_ptr<render::WindowImage> picture_shown_;  // picture_frame_ on the GPU, made when first presented
   double real_photo_distance_m_ = -1;  // the real photo loaded (one at a time: 27 would hold ~50 MB)
   cv::Mat real_photo_;
   int picture_width_px_ = 960;
