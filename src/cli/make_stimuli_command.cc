@@ -64,12 +64,7 @@ void AddSynthPicturesCommand(CLI::App& app) {
     if (!args->protocol.empty()) {
       protocol::ValidateOptions no_files;
       no_files.check_files = false;  // its real_photos may be what we are about to write
-      const protocol::Protocol p = protocol::LoadProtocol(args->protocol, no_files);
-      for (const auto& b : p.blocks)
-        for (const auto& f : b.factors)
-          if (f.name == "distance_m")
-            for (const auto& level : f.levels)
-              if (level.is_number()) distances.insert(level.get<double>());
+      distances.merge(protocol::NumericLevels(protocol::LoadProtocol(args->protocol, no_files), "distance_m"));
     }
     if (distances.empty()) throw Error(ErrorKind::kUsage, "give --distances-m or a --protocol with distance_m levels");
     const Camera camera = LoadCamera(args->camera);

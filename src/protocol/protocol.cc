@@ -531,18 +531,12 @@ Protocol Parser::Parse(const Json& json) {
   }
   // The real photos: one per distance the design shows.
   if (!p.content.real_photos.empty() && options_.check_files) {
-    std::set<double> distances;
-    for (const auto& b : p.blocks)
-      for (const auto& f : b.factors)
-        if (f.name == "distance_m")
-          for (const auto& level : f.levels)
-            if (level.is_number()) distances.insert(level.get<double>());
+    const std::set<double> distances = NumericLevels(p, "distance_m");
     if (distances.empty())
       Problem("/content/real_photos", "needs a factor distance_m to choose the photo by", Json(p.content.real_photos));
     for (double d : distances)
-      if (!fs::is_regular_file(RealPhotoFor(p.content, d)))
-        Problem("/content/real_photos", "no photo for distance_m " + Json(d).dump() + ": " +
-                                            RealPhotoFor(p.content, d).string(),
+      if (const fs::path photo = RealPhotoFor(p.content, d); !fs::is_regular_file(photo))
+        Problem("/content/real_photos", "no photo for distance_m " + Json(d).dump() + ": " + photo.string(),
                 json["content"]["real_photos"]);
   }
   std::set<Task> tasks;
@@ -597,6 +591,16 @@ Protocol ParseProtocol(const Json& json, const fs::path& file, const ValidateOpt
 
 Protocol LoadProtocol(const fs::path& file, const ValidateOptions& options) {
   return ParseProtocol(ReadJsonFile(file), file, options);
+}
+
+std::set<double> NumericLevels(const Protocol& protocol, const std::string& factor) {
+  std::set<double> values;
+  for (const auto& b : protocol.blocks)
+    for (const auto& f : b.factors)
+      if (f.name == factor)
+        for (const auto& level : f.levels)
+          if (level.is_number()) values.insert(level.get<double>());
+  return values;
 }
 
 fs::path RealPhotoFor(const Content& content, double distance_m) {

@@ -4,6 +4,7 @@
 // `blurcue validate` shows all typos, wrong types, missing fields, impossible values and missing files.
 #include <filesystem>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -101,6 +102,9 @@ struct Protocol {
   Timing timing;
   Display display;
 };
+
+// Every distinct number among the levels of the factor named `factor`, over all blocks, ascending.
+std::set<double> NumericLevels(const Protocol& protocol, const std::string& factor);
 
 struct ValidateOptions {
   bool check_files = true;            // false: skip the existence checks of referenced files
