@@ -303,8 +303,7 @@ class Runner {
     const bool tty = isatty(2);
     auto progress = [&](int64_t done) {
       // A terminal gets one line rewritten after every answer; a log gets about ten lines.
-      if (!options_.progress || (!tty && done % std::max<int64_t>(1, result.trial_count / 10) != 0 &&
-                                 done != result.trial_count))
+      if (!tty && done % std::max<int64_t>(1, result.trial_count / 10) != 0 && done != result.trial_count)
         return;
       const double elapsed =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
@@ -353,7 +352,7 @@ class Runner {
                       "Press Return to go on"))
         break;
     }
-    if (options_.progress && tty) std::fprintf(stderr, "\n");
+    if (tty) std::fprintf(stderr, "\n");
     result.completed = record.FirstUnansweredTrial(start.session_id) == result.trial_count;
     if (result.completed) {
       record.FinishSession(start.session_id, store::SessionStatus::kCompleted);

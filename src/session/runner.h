@@ -22,7 +22,6 @@ struct RunOptions {
   bool window = false;           // a simulated observer in a window, on the real clock (a person always has one)
   double sim_fps = 4;            // headless: frames rendered per second of simulated time
   int stop_after = -1;           // >= 0: leave the session (running, resumable) after this many new answers
-  bool progress = true;          // the progress line on stderr
 };
 
 struct RunResult {

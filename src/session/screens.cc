@@ -10,8 +10,8 @@ namespace {
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 const cv::Scalar kGrey(118, 118, 118);  // sRGB 118 = linear 0.18, the grey the depth-matching field uses
 const cv::Scalar kInk(245, 245, 245);
-}  // namespace
 
+// Splits `text` into lines no wider than width_px at `scale` of the plain Hershey font.
 std::vector<std::string> WrapText(const std::string& text, int width_px, double scale) {
   std::vector<std::string> lines;
   std::istringstream words(text);
@@ -29,6 +29,8 @@ std::vector<std::string> WrapText(const std::string& text, int width_px, double 
   if (!line.empty()) lines.push_back(line);
   return lines;
 }
+
+}  // namespace
 
 cv::Mat TextScreen(cv::Size size, const std::string& title, const std::string& body, const std::string& footer) {
   cv::Mat image(size, CV_8UC3, kGrey);

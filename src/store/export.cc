@@ -86,8 +86,8 @@ std::string CsvLine(const std::vector<std::string>& cells) {
 
 // Per study, one row per session: trials planned and answered (practice apart), the median response time, and
 // how often each answer was given - for forced choice the source chosen (the one shown on the side picked) or
-// cant_tell, for adjustment the level accepted. Writes OUT/summary-STUDY.csv for every study; returns the files.
-std::vector<std::filesystem::path> WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
+// cant_tell, for adjustment the level accepted. Writes OUT/summary-STUDY.csv for every study.
+void WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
   struct Row {
     std::string participant, status;
     int64_t planned = 0, answered = 0;
@@ -126,7 +126,6 @@ std::vector<std::filesystem::path> WriteSummaries(Database& db, const std::files
     ++row.answers[answer];
     answer_names[rows.GetText(0)].insert(answer);
   }
-  std::vector<std::filesystem::path> files;
   for (auto& [study, sessions] : studies) {
     std::vector<std::string> header = {"participant", "session", "status", "planned", "answered", "median_rt_ms"};
     for (const auto& name : answer_names[study]) header.push_back("n_" + name);
@@ -134,7 +133,8 @@ std::vector<std::filesystem::path> WriteSummaries(Database& db, const std::files
     for (auto& [session, row] : sessions) {
       std::sort(row.rts.begin(), row.rts.end());
       const size_t n = row.rts.size();
-      const std::string median = n == 0 ? "" : Number(n % 2 ? row.rts[n / 2] : 0.5 * (row.rts[n / 2 - 1] + row.rts[n / 2]));
+      const std::string median =
+          n == 0 ? "" : Number(n % 2 ? row.rts[n / 2] : 0.5 * (row.rts[n / 2 - 1] + row.rts[n / 2]));
       std::vector<std::string> cells = {row.participant, std::to_string(session), row.status,
                                         std::to_string(row.planned), std::to_string(row.answered), median};
       for (const auto& name : answer_names[study]) cells.push_back(std::to_string(row.answers[name]));
@@ -143,10 +143,8 @@ std::vector<std::filesystem::path> WriteSummaries(Database& db, const std::files
     std::string safe = study;
     for (char& c : safe)
       if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
-    files.push_back(out_dir / ("summary-" + safe + ".csv"));
-    WriteAtomically(files.back(), text);
+    WriteAtomically(out_dir / ("summary-" + safe + ".csv"), text);
   }
-  return files;
 }
 
 // OUT/frames.csv: every recorded display flip, one row each: study, participant, session, window (1: a real window
@@ -163,8 +161,8 @@ void WriteFrames(Database& db, const std::filesystem::path& out_dir) {
                  "ORDER BY st.name, p.code, s.id, t.trial_index, f.frame_index");
   while (rows.Step())
     text += CsvLine({rows.GetText(0), rows.GetText(1), std::to_string(rows.GetInt64(2)),
-                     std::to_string(rows.GetInt64(7)), std::to_string(rows.GetInt64(3)), std::to_string(rows.GetInt64(4)), Number(rows.GetDouble(5)),
-                     std::to_string(rows.GetInt64(6))});
+                     std::to_string(rows.GetInt64(7)), std::to_string(rows.GetInt64(3)),
+                     std::to_string(rows.GetInt64(4)), Number(rows.GetDouble(5)), std::to_string(rows.GetInt64(6))});
   WriteAtomically(out_dir / "frames.csv", text);
 }
 
@@ -210,16 +208,10 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
   std::error_code error;
   std::filesystem::create_directories(out_dir, error);
   if (error) throw InputError(out_dir.string(), "cannot create the folder: " + error.message());
-  std::string text;
-  std::string header;
-  auto add = [&header](const std::string& name) {
-    if (!header.empty()) header += ',';
-    header += CsvField(name);
-  };
-  for (const auto& name : LeadingColumns()) add(name);
-  for (const auto& key : keys) add(fixed.count(key) ? std::string("factor_").append(key) : key);
-  for (const auto& name : TrailingColumns()) add(name);
-  text += header + "\r\n";
+  std::vector<std::string> header = LeadingColumns();
+  for (const auto& key : keys) header.push_back(fixed.count(key) ? "factor_" + key : key);
+  header.insert(header.end(), TrailingColumns().begin(), TrailingColumns().end());
+  std::string text = CsvLine(header);
 
   Statement rows(db,
                  "SELECT st.name, pv.hash, p.code, s.id, s.seed, t.trial_index, t.block, t.factors, t.left_shown, "
