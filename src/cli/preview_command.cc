@@ -4,7 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <map>
+#include <set>
 #include <memory>
 #include <optional>
 #include <string>
@@ -49,14 +49,13 @@ void AddPreviewCommand(CLI::App& app) {
     const auto trials = protocol::BuildTrials(p, args->participant, seed);
     const auto scene = session::LoadProtocolScene(p);
     struct Tile {
-      const protocol::Trial* trial;
       session::TrialScene scene;
       double level;
       std::string label, label2;  // levels; the sides and their radii
       Json key;                    // sorts the sheet by level
     };
     std::vector<Tile> tiles;
-    std::map<std::string, bool> seen;
+    std::set<std::string> seen;  // labels or level keys already on the sheet
     for (const auto& t : trials) {
       const session::TrialScene s = session::DescribeTrial(p, t, scene ? &*scene : nullptr);
       if (t.task == protocol::Task::kAdjustment) {
@@ -68,16 +67,16 @@ void AddPreviewCommand(CLI::App& app) {
         for (double level : t.adjust_levels) {
           char label[96];
           std::snprintf(label, sizeof label, "%s %g", parameter.c_str(), level);
-          if (seen.emplace(label, true).second)
-            tiles.push_back({&t, s, level, label, "distance " + Json(s.distance_m).dump() + " m",
+          if (seen.insert(label).second)
+            tiles.push_back({s, level, label, "distance " + Json(s.distance_m).dump() + " m",
                              Json::array({0, level})});
         }
         if (!sorted.empty() && s.distance_m > 0) {
           char label[96];
           std::snprintf(label, sizeof label, "distance %g m", s.distance_m);
           const double middle = sorted[sorted.size() / 2];
-          if (seen.emplace(label, true).second)
-            tiles.push_back({&t, s, middle, label, parameter + " " + Json(middle).dump(),
+          if (seen.insert(label).second)
+            tiles.push_back({s, middle, label, parameter + " " + Json(middle).dump(),
                              Json::array({1, s.distance_m})});
         }
         continue;
@@ -85,16 +84,16 @@ void AddPreviewCommand(CLI::App& app) {
       Json key = t.levels;
       key["left"] = t.left;
       key["right"] = t.right;
-      if (!seen.emplace(key.dump(), true).second) continue;
+      if (!seen.insert(key.dump()).second) continue;
       std::string levels;
       for (const auto& [name, value] : t.levels.items())
         levels += (levels.empty() ? "" : " ") + name + " " +
                   (value.is_object() && value.contains("id") ? value["id"].dump() : value.dump());
+      auto source = [](const Json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); };
       char sides[256];
-      std::snprintf(sides, sizeof sides, "L %s %.2f px | R %s %.2f px",
-                    t.left.is_string() ? t.left.get<std::string>().c_str() : t.left.dump().c_str(), s.r_left_px,
-                    t.right.is_string() ? t.right.get<std::string>().c_str() : t.right.dump().c_str(), s.r_right_px);
-      tiles.push_back({&t, s, 0, levels, sides, key});
+      std::snprintf(sides, sizeof sides, "L %s %.2f px | R %s %.2f px", source(t.left).c_str(), s.r_left_px,
+                    source(t.right).c_str(), s.r_right_px);
+      tiles.push_back({s, 0, levels, sides, key});
     }
     std::stable_sort(tiles.begin(), tiles.end(), [](const Tile& a, const Tile& b) { return a.key < b.key; });
     if (tiles.empty()) throw InputError(args->protocol, "the protocol makes no trials to preview");
