@@ -4,9 +4,9 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <set>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 
 #include <opencv2/imgproc.hpp>

@@ -66,7 +66,6 @@ class StimulusRenderer {
   StimulusRenderer(const StimulusRenderer&) = delete;
   StimulusRenderer& operator=(const StimulusRenderer&) = delete;
 
-  const calib::SceneCalib* scene() const { return scene_ ? &*scene_ : nullptr; }
   // Size of the frames it makes (the photo's, or the depth-matching frame's).
   cv::Size FrameSize() const;
   // Composes the frame t_s after onset; `level` is the adjustment level shown (picture only).
