@@ -100,7 +100,7 @@ Record Record::Open(const std::filesystem::path& path, RecordOptions options) {
     const std::string check = db.QueryText("PRAGMA quick_check(1)");
     if (check != "ok") throw InputError(path.string(), "the record is damaged (SQLite's quick_check: " + check + ")");
   }
-  db.UseWal();
+  db.UseWal(options.durable);
   Migrate(db);
   return Record(std::move(db), options);
 }

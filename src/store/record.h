@@ -58,6 +58,9 @@ struct RecordOptions {
   // A lock held from another host is taken over only when its heartbeat is older than this (a pid cannot be
   // checked across machines, and their clocks may differ).
   double foreign_lock_stale_after_s = 600;
+  // true: synchronous=FULL, an answer once committed survives a power loss or an OS crash. false (NORMAL) only
+  // survives a killed process; kept for `blurcue bench record`, which measures what FULL costs.
+  bool durable = true;
 };
 
 // Who holds a session's lock, as the record names it, and whether it may be taken over.

@@ -127,7 +127,7 @@ Database::Database(const std::filesystem::path& path, OpenMode mode, int busy_ti
   }
 }
 
-void Database::UseWal() {
+void Database::UseWal(bool durable) {
   if (path_ == ":memory:") return;
   // Changing the journal mode needs the file to itself and does not wait on the busy handler: retry while another
   // connection (a second station starting at the same moment) holds it.
@@ -143,7 +143,7 @@ void Database::UseWal() {
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
   }
-  Exec("PRAGMA synchronous=FULL");
+  Exec(durable ? "PRAGMA synchronous=FULL" : "PRAGMA synchronous=NORMAL");
 }
 
 Database::~Database() {

@@ -31,10 +31,10 @@ class Database {
   Database(const Database&) = delete;
   Database& operator=(const Database&) = delete;
 
-  // WAL journaling and synchronous=FULL: a commit, once returned, survives a killed process, an OS crash and a power
-  // loss (NORMAL in WAL mode survives only the first). Retries while another connection holds the file (two first
-  // starts at once), up to the busy timeout.
-  void UseWal();
+  // WAL journaling with synchronous=FULL (`durable`): a commit, once returned, survives a killed process, an OS
+  // crash and a power loss; NORMAL in WAL mode survives only the first. Retries while another connection holds the
+  // file (two first starts at once), up to the busy timeout.
+  void UseWal(bool durable = true);
 
   // Runs one or more statements that return no rows.
   void Exec(const std::string& sql);
