@@ -47,3 +47,7 @@ add_test(NAME session_run_person_without_display
                  -DEXPECT_CODE=10 "-DEXPECT_TEXT=GLFW: cannot open a window: "
                  -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
 set_tests_properties(session_run_person_without_display PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols")
+
+# blurcue display check in a window (its own Xvfb): geometry, resolution check, honest timing without vsync.
+add_test(NAME display_check COMMAND bash ${PROJECT_SOURCE_DIR}/tests/display_test.sh ${BC} ${T})
+set_tests_properties(display_check PROPERTIES LABELS "gl;window" PASS_REGULAR_EXPRESSION "^ok:|\nok:")
