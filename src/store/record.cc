@@ -304,8 +304,8 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
       throw Error(ErrorKind::kInternal, "protocol hash " + hash + " collides with another protocol text");
 
     Statement insert(db_, "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, "
-                          "host, display, started, status, lock_host, lock_pid, lock_token, lock_heartbeat_ms) "
-                          "VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?)");
+                          "host, display, started, status, lock_host, lock_pid, lock_token, lock_heartbeat_ms, "
+                          "display_profile) VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?)");
     insert.Bind(1, participant_id);
     insert.Bind(2, protocol_id);
     insert.Bind(3, static_cast<int64_t>(seed));
@@ -317,6 +317,7 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     insert.Bind(9, pid_);
     insert.Bind(10, token_);
     insert.Bind(11, NowMs());
+    insert.Bind(12, meta.display_profile);
     insert.Run();
     start.session_id = db_.LastInsertRowId();
   }

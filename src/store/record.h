@@ -15,6 +15,7 @@ struct SessionMeta {
   std::string software_version;  // empty = this build's BLURCUE_VERSION
   std::string host;
   std::string display;  // e.g. "1920x1080@60 DELL U2412M"
+  std::string display_profile = "{}";  // the display profile as JSON (display::ToJson)
 };
 
 // One planned trial, saved up front. JSON members are compact JSON text.

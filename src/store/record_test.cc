@@ -491,6 +491,17 @@ TEST(Record, VersionOneRecordMigratesToCanonicalHashes) {
   EXPECT_EQ(record.database().QueryText("SELECT hash FROM protocol_versions"),
             ProtocolHash(CanonicalProtocolText(raw)));
   EXPECT_TRUE(record.StartOrResumeSession("test1", "P01", raw, 7, {}, true).resumed);
+  // Sessions from before display profiles read as '{}'.
+  EXPECT_EQ(record.database().QueryText("SELECT display_profile FROM sessions"), "{}");
+}
+
+TEST(Record, EachSessionKeepsTheDisplayProfileItRanWith) {
+  Record record = Record::Open(":memory:");
+  SessionMeta meta;
+  meta.display_profile = R"({"name":"lab 1","px_per_deg":33.87})";
+  const int64_t session = record.StartOrResumeSession("test1", "P01", kProtocol, 7, meta, false).session_id;
+  EXPECT_EQ(record.database().QueryText("SELECT display_profile FROM sessions WHERE id = " + std::to_string(session)),
+            meta.display_profile);
 }
 
 // A truncated record is an input error naming the file, never an internal one.

@@ -119,6 +119,8 @@ std::vector<Migration> MakeMigrations() {
       "  dropped INTEGER NOT NULL CHECK (dropped IN (0, 1)),"
       "  UNIQUE (trial_id, frame_index))" + strict + ";"});
   steps.push_back({"", &CanonicalProtocolHashes});
+  // 3: the display profile each session ran with (display/profile.h ToJson); '{}' for sessions from before.
+  steps.push_back({"ALTER TABLE sessions ADD COLUMN display_profile TEXT NOT NULL DEFAULT '{}';"});
   return steps;
 }
 
@@ -197,7 +199,8 @@ void RequireReadableRecord(Database& db) {
     throw InputError(db.path(), "record schema version " + std::to_string(version) +
                                     " is newer than this blurcue reads (" + std::to_string(CurrentSchemaVersion()) +
                                     "); update blurcue");
-  // Versions 1 and 2 have the same tables (2 only re-hashed protocol texts), so a read-only archive of either reads.
+  // Older versions lack only columns added since (readers take them where present), so a read-only archive of any
+  // version up to this one reads.
   const std::string check = db.QueryText("PRAGMA quick_check(1)");
   if (check != "ok") throw InputError(db.path(), "the record is damaged (SQLite's quick_check: " + check + ")");
 }
