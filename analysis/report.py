@@ -126,6 +126,13 @@ def main(argv=None):
             return args.final_out
         return path if rel.startswith(os.pardir) else os.path.join(args.final_out, rel)
 
+    def shown_text(text):
+        """A message with every path under --out named as under --final-out."""
+        if not args.final_out:
+            return text
+        text = text.replace(os.path.abspath(args.out), os.path.abspath(args.final_out))
+        return text.replace(args.out, args.final_out)
+
     try:
         os.makedirs(args.out, exist_ok=True)
     except OSError as e:
@@ -204,8 +211,8 @@ def main(argv=None):
         try:
             charts = run()
         except Skip as e:
-            say(f"  skipped: {e}")
-            skips.append(str(e))
+            say(f"  skipped: {shown_text(str(e))}")
+            skips.append(shown_text(str(e)))
         except Exception as e:  # a bug or data this code did not foresee: name it, keep the rest of the report
             if args.debug:
                 raise
@@ -215,6 +222,7 @@ def main(argv=None):
             failed.append(title)
         if title == "bench files":
             skips += [n for n in bench.get("notes", [])]
+        charts = [c._replace(notes=[shown_text(n) for n in c.notes]) if c.notes else c for c in charts]
         for c in charts:
             if c.table is not None and not c.table.empty:
                 c.table.to_csv(os.path.join(args.out, c.name + ".csv"), index=False)
