@@ -40,9 +40,9 @@ beside() { (cd "$W" && ls -A | grep -Ev '^(a|b|ab)\.sqlite(-wal|-shm)?$|^(ref|re
 dead_pid() { bash -c 'echo $$'; }
 # Waits (up to 30 s) until $1 exists or process $2 has ended.
 wait_for() { for _ in $(seq 1 3000); do [ -e "$1" ] && return 0; kill -0 "$2" 2>/dev/null || return 0; sleep 0.01; done; }
-# Waits (up to 10 s) for process $1 to be gone; fails naming $2 if it stays.
+# Waits (up to 30 s) for process $1 to be gone; fails naming $2 if it stays.
 wait_gone() {
-  for _ in $(seq 1 1000); do kill -0 "$1" 2>/dev/null || return 0; sleep 0.01; done
+  for _ in $(seq 1 3000); do kill -0 "$1" 2>/dev/null || return 0; sleep 0.01; done
   fail "$2 (pid $1) still running after its parent was killed: $(ps -o pid,ppid,comm -p "$1" | tail -1)"
 }
 # Whether $1 is a leftover .NAME.KIND-PID(-wal|-shm|-journal) of target $2 (KIND: partial, old) of a killed PID.
@@ -177,6 +177,8 @@ report)
     wait $pid 2>/dev/null || true
     killed="$killed$pid "
     wait_gone "$child" "the analysis of a report killed at '$when'"
+    # Killed with its parent, not ended on its own: an orphaned analysis would have finished its index.html.
+    [ ! -e "$W/.out.partial-$pid/index.html" ] || fail "the analysis ran on after report was killed at '$when'"
     children=$((children + 1))
     if [ $before = earlier ]; then
       [ "$(snapshot "$W/out")" = "$state" ] || fail "report killed at '$when' changed the earlier report"
