@@ -185,7 +185,7 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
                   const ProgressNote& note) {
   Note(note, RemoveStaleLeftovers(out_dir));
   Database db(db_path, OpenMode::kReadOnly);
-  RequireCurrentSchema(db);
+  RequireReadableRecord(db);
 
   // Pass 1: every factor key in the record, so every participant gets the same columns.
   std::set<std::string> keys;
@@ -256,12 +256,13 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
 
 std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path) {
   Database db(db_path, OpenMode::kReadOnly);
-  RequireCurrentSchema(db);
+  RequireReadableRecord(db);
   Statement rows(db,
                  "SELECT s.id, st.name, p.code, s.status, s.started, coalesce(s.ended, ''), s.host, s.seed, "
                  "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), "
                  "(SELECT count(*) FROM trials t JOIN responses r ON r.trial_id = t.id WHERE t.session_id = s.id), "
-                 "s.lock_token IS NOT NULL, coalesce(s.lock_pid, 0), coalesce(s.lock_host, '') "
+                 "s.lock_token IS NOT NULL, coalesce(s.lock_pid, 0), coalesce(s.lock_host, ''), "
+                 "coalesce(s.lock_heartbeat_ms, 0) "
                  "FROM sessions s JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
                  "ORDER BY st.name, p.code, s.id");
   std::vector<SessionSummary> sessions;
@@ -277,13 +278,7 @@ std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path) {
     s.seed = static_cast<uint64_t>(rows.GetInt64(7));
     s.planned = rows.GetInt64(8);
     s.answered = rows.GetInt64(9);
-    if (rows.GetInt64(10) != 0) {
-      const int64_t pid = rows.GetInt64(11);
-      const std::string host = rows.GetText(12);
-      s.writer = "pid " + std::to_string(pid) + " on " + host;
-      if (host == HostName())
-        s.writer += ProcessGone(pid) ? " (gone: a stale lock, the next run takes it over)" : " (alive)";
-    }
+    if (rows.GetInt64(10) != 0) s.writer = JudgeLock(rows.GetText(12), rows.GetInt64(11), rows.GetInt64(13)).text;
     sessions.push_back(std::move(s));
   }
   return sessions;
@@ -307,7 +302,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
       Transaction transaction(dst);
       for (const auto& input : inputs) {
         Database src(input, OpenMode::kReadOnly);
-        RequireCurrentSchema(src);
+        RequireReadableRecord(src);
         std::map<int64_t, int64_t> study_ids, protocol_ids, participant_ids, session_ids, trial_ids;
 
         Statement studies(src, "SELECT id, name, created FROM studies");

@@ -44,8 +44,8 @@ struct SessionSummary {
   std::string study, participant, status, started, ended, host;
   uint64_t seed = 0;
   int64_t planned = 0, answered = 0;  // practice included
-  // Who holds its lock: empty for nobody, else "pid P on HOST" with "(alive)" or "(gone: a stale lock, the next
-  // run takes it over)" when HOST is this machine.
+  // Who holds its lock: empty for nobody, else JudgeLock's text ("pid P on host H, heartbeat N s ago (alive)",
+  // or why it is stale).
   std::string writer;
 };
 
