@@ -23,6 +23,15 @@ fs::path Normal(const fs::path& path) {
   return p;
 }
 
+// A folder reached through a symlink is replaced where it really is: the link stays and shows the new folder.
+fs::path FolderTarget(const fs::path& path) {
+  const fs::path normal = Normal(path);
+  std::error_code error;
+  if (!fs::is_symlink(fs::symlink_status(normal, error)) || !fs::is_directory(normal, error)) return normal;
+  const fs::path real = fs::canonical(normal, error);
+  return error ? normal : real;
+}
+
 std::string Errno() { return std::strerror(errno); }
 
 // The folder a relative name lives in: "" means the current one.
@@ -92,7 +101,7 @@ fs::path TemporaryBeside(const fs::path& target, std::string_view kind) {
 void WriteFileAtomically(const fs::path& path, std::string_view bytes) {
   CreateFolderOf(path, path.string());
   const fs::path temp = TemporaryBeside(path, "tmp");
-  const int fd = open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  const int fd = open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);  // less the umask
   if (fd < 0) throw InputError(path.string(), "cannot write: " + Errno());
   const auto fail = [&](const std::string& what) {
     const std::string reason = what + Errno();
@@ -124,7 +133,7 @@ void WriteFileAtomically(const fs::path& path, std::string_view bytes) {
 
 void WriteFolderAtomically(const fs::path& dir, const std::function<void(const fs::path& partial)>& fill,
                            const std::function<bool(const std::string& name)>& ours) {
-  const fs::path target = Normal(dir);
+  const fs::path target = FolderTarget(dir);
   const std::string where = dir.string();
   CreateFolderOf(target, where);
   std::error_code error;
@@ -211,7 +220,7 @@ void MoveIntoPlace(const fs::path& temp, const fs::path& target) {
 }
 
 std::vector<fs::path> RemoveStaleLeftovers(const fs::path& target) {
-  const fs::path normal = Normal(target);
+  const fs::path normal = FolderTarget(target);
   const std::string name = normal.filename().string();
   const std::string dotted = "." + name + ".";
   std::vector<fs::path> stale, removed;

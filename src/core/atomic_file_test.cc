@@ -148,6 +148,18 @@ TEST_F(AtomicFileTest, FolderIsReplacedAsAWhole) {
   EXPECT_EQ(Names(dir_), std::set<std::string>{"tables"});
 }
 
+TEST_F(AtomicFileTest, FolderBehindASymlinkIsReplacedWhereItIs) {
+  fs::create_directories(dir_ / "real");
+  Write(dir_ / "real" / "old.csv", "old");
+  fs::create_directory_symlink("real", dir_ / "link");
+  WriteFolderAtomically(
+      dir_ / "link", [](const fs::path& partial) { Write(partial / "new.csv", "new"); },
+      [](const std::string&) { return true; });
+  EXPECT_TRUE(fs::is_symlink(dir_ / "link"));
+  EXPECT_EQ(Names(dir_ / "real"), std::set<std::string>{"new.csv"});
+  EXPECT_EQ(Names(dir_), (std::set<std::string>{"link", "real"}));
+}
+
 TEST_F(AtomicFileTest, NewFolderAppearsWithItsFiles) {
   WriteFolderAtomically(
       dir_ / "deeper" / "out" / "", [](const fs::path& partial) { Write(partial / "x.csv", "x"); },
