@@ -220,7 +220,8 @@ TEST_F(AtomicFileTest, KilledFolderWriteLeavesTheOldFolderAndALeftoverTheNextRun
     _exit(0);
   }
   const fs::path partial = dir_ / (".tables.partial-" + std::to_string(child));
-  for (int i = 0; i < 2000 && !fs::exists(partial / "ready"); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  for (int i = 0; i < 2000 && !fs::exists(partial / "ready"); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
   ASSERT_TRUE(fs::exists(partial / "ready"));
   kill(child, SIGKILL);
   waitpid(child, nullptr, 0);
