@@ -24,11 +24,16 @@ void AddExportCommand(CLI::App& app) {
       "DIR/summary-STUDY.csv: per session the trials planned and answered, the median response time and how often\n"
       "each answer was given (the source chosen or cant_tell; the level accepted). Practice trials are left out\n"
       "of the summaries. DIR/frames.csv holds every display flip (time from the trial's first flip, dropped or not).\n"
+      "The folder is written as a whole: built beside DIR as .DIR.partial-PID and swapped in at the end, so an\n"
+      "interrupted export leaves the previous tables complete (its leftovers are removed by the next export). An\n"
+      "existing DIR must hold only such tables: a folder of other files is refused, not replaced.\n"
       "Example: blurcue export --db results/study.sqlite --out results/tables");
   cmd->add_option("--db", args->db, "the SQLite record")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "folder for the tables (created)")->required();
   cmd->callback([args] {
-    const int64_t rows = store::ExportCsv(args->db, args->out);
+    const int64_t rows = store::ExportCsv(args->db, args->out, [](const std::string& line) {
+      std::fprintf(stderr, "export: %s\n", line.c_str());
+    });
     std::printf("wrote %s/trials.csv (%lld rows) and the per-study summaries\n", args->out.c_str(),
                 static_cast<long long>(rows));
   });
@@ -43,13 +48,17 @@ void AddMergeCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "merge",
       "Combine the records of several lab stations into a new one, with fresh ids (nothing collides); protocol\n"
-      "versions are shared by their hash and participants by their code. Refuses an existing --out.\n"
+      "versions are shared by their hash and participants by their code. Refuses an existing --out. The record is\n"
+      "built beside it as .OUT.partial-PID and renamed to OUT when complete; an interrupted merge's leftovers are\n"
+      "removed by the next merge to the same OUT.\n"
       "Example: blurcue merge station-a.sqlite station-b.sqlite --out all.sqlite");
   cmd->add_option("inputs", args->inputs, "records to combine")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "the new record")->required();
   cmd->callback([args] {
     std::vector<std::filesystem::path> inputs(args->inputs.begin(), args->inputs.end());
-    store::MergeDatabases(inputs, args->out);
+    store::MergeDatabases(inputs, args->out, [](const std::string& line) {
+      std::fprintf(stderr, "merge: %s\n", line.c_str());
+    });
     std::printf("merged %zu records into %s\n", inputs.size(), args->out.c_str());
   });
 }

@@ -1,16 +1,14 @@
 #include "store/export.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cstdlib>
-#include <fstream>
 #include <map>
 #include <set>
 #include <string>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/json_io.h"
 #include "store/record.h"
@@ -57,22 +55,19 @@ std::string Where(const std::filesystem::path& db, int64_t session, int64_t tria
   return db.string() + ": session " + std::to_string(session) + " trial " + std::to_string(trial);
 }
 
-// Writes `text` to `path` through a temporary file renamed over it: a reader sees the old file or the new one.
-void WriteAtomically(const std::filesystem::path& path, const std::string& text) {
-  const std::filesystem::path temp = path.string() + ".tmp" + std::to_string(getpid());
-  std::error_code error;
-  {
-    std::ofstream out(temp, std::ios::binary);
-    if (!out) throw InputError(temp.string(), "cannot write");
-    out << text;
-    out.close();
-    if (!out) {
-      std::filesystem::remove(temp, error);
-      throw InputError(temp.string(), "write failed");
-    }
-  }
-  std::filesystem::rename(temp, path, error);
-  if (error) throw InputError(path.string(), "cannot replace: " + error.message());
+// What an export folder may hold and still be replaced as a whole: the files an export writes, and the
+// temporaries an earlier version left beside them when killed (FILE.csv.tmpPID).
+bool IsExportFile(const std::string& name) {
+  const bool table = name == "trials.csv" || name == "frames.csv" || name.rfind("summary-", 0) == 0;
+  if (table && name.size() > 4 && name.compare(name.size() - 4, 4, ".csv") == 0) return true;
+  const size_t tmp = name.rfind(".csv.tmp");
+  return tmp != std::string::npos && tmp + 8 < name.size() &&
+         name.find_first_not_of("0123456789", tmp + 8) == std::string::npos;
+}
+
+void Note(const ProgressNote& note, const std::vector<std::filesystem::path>& removed) {
+  for (const auto& path : removed)
+    if (note) note("removed " + path.string() + ", left by an interrupted run");
 }
 
 std::string CsvLine(const std::vector<std::string>& cells) {
@@ -143,7 +138,7 @@ void WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
     std::string safe = study;
     for (char& c : safe)
       if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
-    WriteAtomically(out_dir / ("summary-" + safe + ".csv"), text);
+    WriteFileAtomically(out_dir / ("summary-" + safe + ".csv"), text);
   }
 }
 
@@ -163,7 +158,7 @@ void WriteFrames(Database& db, const std::filesystem::path& out_dir) {
     text += CsvLine({rows.GetText(0), rows.GetText(1), std::to_string(rows.GetInt64(2)),
                      std::to_string(rows.GetInt64(7)), std::to_string(rows.GetInt64(3)),
                      std::to_string(rows.GetInt64(4)), Number(rows.GetDouble(5)), std::to_string(rows.GetInt64(6))});
-  WriteAtomically(out_dir / "frames.csv", text);
+  WriteFileAtomically(out_dir / "frames.csv", text);
 }
 
 void RemoveDatabaseFiles(const std::filesystem::path& path) {
@@ -186,7 +181,9 @@ std::string CsvField(const std::string& text) {
   return out + "\"";
 }
 
-int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::path& out_dir) {
+int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::path& out_dir,
+                  const ProgressNote& note) {
+  Note(note, RemoveStaleLeftovers(out_dir));
   Database db(db_path, OpenMode::kReadOnly);
   RequireReadableRecord(db);
 
@@ -205,9 +202,6 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
   std::set<std::string> fixed(LeadingColumns().begin(), LeadingColumns().end());
   fixed.insert(TrailingColumns().begin(), TrailingColumns().end());
 
-  std::error_code error;
-  std::filesystem::create_directories(out_dir, error);
-  if (error) throw InputError(out_dir.string(), "cannot create the folder: " + error.message());
   std::vector<std::string> header = LeadingColumns();
   for (const auto& key : keys) header.push_back(fixed.count(key) ? "factor_" + key : key);
   header.insert(header.end(), TrailingColumns().begin(), TrailingColumns().end());
@@ -247,9 +241,16 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
     text += CsvLine(cells);
     ++count;
   }
-  WriteAtomically(out_dir / "trials.csv", text);
-  WriteSummaries(db, out_dir);
-  WriteFrames(db, out_dir);
+  // Every table of one export appears together: a kill leaves the previous export whole, never its frames.csv
+  // beside a new trials.csv.
+  WriteFolderAtomically(
+      out_dir,
+      [&](const std::filesystem::path& partial) {
+        WriteFileAtomically(partial / "trials.csv", text);
+        WriteSummaries(db, partial);
+        WriteFrames(db, partial);
+      },
+      IsExportFile);
   return count;
 }
 
@@ -283,14 +284,16 @@ std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path) {
   return sessions;
 }
 
-void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out) {
+void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out,
+                    const ProgressNote& note) {
+  Note(note, RemoveStaleLeftovers(out));
   if (std::filesystem::exists(out)) throw InputError(out.string(), "exists; merge refuses to overwrite it");
   std::set<std::filesystem::path> seen;
   for (const auto& input : inputs) {
     if (!seen.insert(std::filesystem::weakly_canonical(input)).second)
       throw InputError(input.string(), "listed twice among the merge inputs");
   }
-  const std::filesystem::path temp = out.string() + ".partial" + std::to_string(getpid());
+  const std::filesystem::path temp = TemporaryBeside(out, "partial");
   RemoveDatabaseFiles(temp);
   try {
     {
@@ -394,10 +397,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
       }
       transaction.Commit();
     }  // the last connection closes: the WAL is checkpointed into the file and removed
-    if (std::filesystem::exists(out)) throw InputError(out.string(), "appeared during the merge; not overwritten");
-    std::error_code error;
-    std::filesystem::rename(temp, out, error);
-    if (error) throw InputError(out.string(), "cannot write the merged record: " + error.message());
+    MoveIntoPlace(temp, out);
   } catch (...) {
     RemoveDatabaseFiles(temp);
     throw;
