@@ -311,13 +311,18 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
 
         Statement protocols(src, "SELECT id, study_id, json, hash, created FROM protocol_versions");
         while (protocols.Step()) {
+          // An input of schema 1 holds raw texts: the merged record keys them by their canonical text, as run does.
+          std::string json = protocols.GetText(2), hash = protocols.GetText(3);
+          try {
+            json = CanonicalProtocolText(json);
+            hash = ProtocolHash(json);
+          } catch (const Error&) {
+          }
           std::string stored_json;
-          protocol_ids[protocols.GetInt64(0)] =
-              EnsureProtocolVersion(dst, study_ids.at(protocols.GetInt64(1)), protocols.GetText(2),
-                                    protocols.GetText(3), protocols.GetText(4), &stored_json);
-          if (stored_json != protocols.GetText(2))
-            throw InputError(input.string(), "protocol hash " + protocols.GetText(3) +
-                                                 " names a different protocol text in another input");
+          protocol_ids[protocols.GetInt64(0)] = EnsureProtocolVersion(
+              dst, study_ids.at(protocols.GetInt64(1)), json, hash, protocols.GetText(4), &stored_json);
+          if (stored_json != json)
+            throw InputError(input.string(), "protocol hash " + hash + " names a different protocol text in another input");
         }
 
         Statement participants(src, "SELECT id, study_id, code, created FROM participants");
@@ -326,12 +331,13 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
               dst, study_ids.at(participants.GetInt64(1)), participants.GetText(2), participants.GetText(3));
 
         Statement sessions(src, "SELECT id, participant_id, protocol_version_id, seed, software_version, host, "
-                                "display, started, ended, status FROM sessions");
+                                "display, started, ended, status, " +
+                                std::string(SchemaVersion(src) >= 3 ? "display_profile" : "'{}'") + " FROM sessions");
         Statement duplicate(dst, "SELECT id FROM sessions WHERE participant_id = ? AND protocol_version_id = ? "
                                  "AND seed = ? AND host = ? AND started = ?");
         Statement insert_session(dst, "INSERT INTO sessions (participant_id, protocol_version_id, seed, "
-                                      "software_version, host, display, started, ended, status) "
-                                      "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
+                                      "software_version, host, display, started, ended, status, display_profile) "
+                                      "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
         while (sessions.Step()) {
           const int64_t participant = participant_ids.at(sessions.GetInt64(1));
           const int64_t protocol = protocol_ids.at(sessions.GetInt64(2));
@@ -351,6 +357,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
           if (sessions.IsNull(8)) insert_session.BindNull(8);
           else insert_session.Bind(8, sessions.GetText(8));
           insert_session.Bind(9, sessions.GetText(9));
+          insert_session.Bind(10, sessions.GetText(10));
           insert_session.Run();
           insert_session.Reset();
           session_ids[sessions.GetInt64(0)] = dst.LastInsertRowId();
