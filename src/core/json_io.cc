@@ -1,21 +1,122 @@
 #include "core/json_io.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <climits>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
 #include "core/error.h"
 
 namespace blurcue {
+namespace {
 
-Json ReadJsonFile(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path.string(), "cannot open file");
+// "line L, column C" of the 0-based byte offset `at` in `text`.
+std::string Position(const std::string& text, size_t at) {
+  size_t line = 1, column = 1;
+  for (size_t i = 0; i < at && i < text.size(); ++i) {
+    if (text[i] == '\n') ++line, column = 1;
+    else ++column;
+  }
+  return "line " + std::to_string(line) + ", column " + std::to_string(column);
+}
+
+// The offset of the first bracket nested deeper than kMaxJsonDepth (brackets inside strings do not count), or npos.
+// Runs before the parser, so no recursive code (dump, comparison, even the destructor of older nlohmann versions)
+// ever meets a deep value.
+size_t TooDeepAt(const std::string& text) {
+  int depth = 0;
+  bool in_string = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') ++i;
+      else if (c == '"') in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonDepth) return i;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return std::string::npos;
+}
+
+// nlohmann's message without its "[json.exception.NAME.ID] " prefix.
+std::string Plain(const char* what) {
+  const std::string text = what;
+  const size_t end = text.find("] ");
+  return text.rfind("[json.exception.", 0) == 0 && end != std::string::npos ? text.substr(end + 2) : text;
+}
+
+struct Fd {
+  int fd;
+  ~Fd() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+}  // namespace
+
+std::string ReadTextFile(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  // A JSON file is a regular file: a folder, a device (/dev/zero never ends), a FIFO (blocks until a writer
+  // comes) or a socket is refused before it is opened.
+  struct stat st;
+  if (::stat(name.c_str(), &st) != 0) throw InputError(name, std::string("cannot open file: ") + std::strerror(errno));
+  auto check_kind = [&](const struct stat& s) {
+    if (S_ISDIR(s.st_mode)) throw InputError(name, "is a folder, not a JSON file");
+    if (!S_ISREG(s.st_mode)) throw InputError(name, "is not a regular file (a device, FIFO or socket), not a JSON file");
+    if (s.st_size > static_cast<off_t>(kMaxJsonBytes))
+      throw InputError(name, "is " + std::to_string(s.st_size) + " bytes; a JSON file may have at most 16 MiB");
+  };
+  check_kind(st);
+  const Fd in{::open(name.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC)};
+  if (in.fd < 0) throw InputError(name, std::string("cannot open file: ") + std::strerror(errno));
+  if (::fstat(in.fd, &st) != 0) throw InputError(name, std::string("cannot read file: ") + std::strerror(errno));
+  check_kind(st);  // the file opened, not one swapped in since the first look
+  // Files of /proc and /sys say they are empty and are not: read up to one byte past the cap whatever the size says.
+  std::string text;
+  char buffer[65536];
+  for (;;) {
+    const ssize_t n = ::read(in.fd, buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw InputError(name, std::string("cannot read file: ") + std::strerror(errno));
+    if (n == 0) break;
+    text.append(buffer, static_cast<size_t>(n));
+    if (text.size() > kMaxJsonBytes) throw InputError(name, "is larger than 16 MiB, the most a JSON file may have");
+  }
+  return text;
+}
+
+Json ParseJson(const std::string& text, const std::string& name) {
+  if (const size_t at = TooDeepAt(text); at != std::string::npos)
+    throw InputError(name, "not valid JSON: nested deeper than " + std::to_string(kMaxJsonDepth) + " levels at " +
+                               Position(text, at));
   try {
-    return Json::parse(in);
+    return Json::parse(text);
   } catch (const Json::parse_error& e) {
-    throw InputError(path.string(), std::string("not valid JSON: ") + e.what());
+    throw InputError(name, "not valid JSON: " + Plain(e.what()));
+  } catch (const Json::out_of_range& e) {
+    // A number beyond double's range (1e400): nlohmann names the number but not where it is.
+    std::string where;
+    const std::string message = Plain(e.what());
+    const size_t open = message.find('\''), close = message.rfind('\'');
+    if (open != std::string::npos && close > open + 1)
+      if (const size_t at = text.find(message.substr(open + 1, close - open - 1)); at != std::string::npos)
+        where = " at " + Position(text, at);
+    throw InputError(name, "not valid JSON" + where + ": " + message);
+  } catch (const Json::exception& e) {
+    throw InputError(name, "not valid JSON: " + Plain(e.what()));
   }
 }
+
+Json ReadJsonFile(const std::filesystem::path& path) { return ParseJson(ReadTextFile(path), path.string()); }
 
 void WriteJsonFile(const std::filesystem::path& path, const Json& json) {
   std::error_code ec;
@@ -47,6 +148,10 @@ double RequireNumber(const Json& obj, const std::string& key, const std::string&
 int RequireInt(const Json& obj, const std::string& key, const std::string& where) {
   const Json& v = RequireField(obj, key, where);
   if (!v.is_number_integer()) throw InputError(where + "/" + key, "must be an integer, got " + v.dump());
+  // get<int> would wrap a larger number silently (2^32 + 1148 -> 1148).
+  if ((v.is_number_unsigned() && v.get<uint64_t>() > uint64_t(INT_MAX)) ||
+      (!v.is_number_unsigned() && (v.get<int64_t>() > INT_MAX || v.get<int64_t>() < INT_MIN)))
+    throw InputError(where + "/" + key, "is out of range for an integer, got " + v.dump());
   return v.get<int>();
 }
 
