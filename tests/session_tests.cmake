@@ -46,3 +46,15 @@ add_test(NAME session_run_person_without_display
                  -DEXPECT_CODE=10 "-DEXPECT_TEXT=GLFW: cannot open a window: "
                  -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
 set_tests_properties(session_run_person_without_display PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols")
+
+# Protocols that cannot crash, hang or lie: a seeded generator mutates the shipped protocols (deletions, wrong types,
+# extremes, deep nesting, odd strings, bad paths) and runs each through `blurcue validate`, and each one accepted
+# through a short simulated `blurcue run`: no signal, no exit 10, no timeout, nothing accepted that then fails, and
+# every rejection names the protocol file on each line. The counts are printed; the seed is fixed (change it to
+# explore, keep it to reproduce).
+add_test(NAME session_protocol_fuzz
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/fuzz_protocols.py ${BC} ${T}/protocols ${T}/fuzz
+                 --seed 20261123 --count 240)
+set_tests_properties(session_protocol_fuzz PROPERTIES
+                     FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures" LABELS "gl;session;fuzz"
+                     PASS_REGULAR_EXPRESSION "fuzz ok: 0 crashes" TIMEOUT 1200)

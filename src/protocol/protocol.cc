@@ -659,10 +659,12 @@ Protocol Parser::Parse(const Json& json) {
     const std::set<double> distances = NumericLevels(p, "distance_m");
     if (distances.empty())
       Problem("/content/real_photos", "needs a factor distance_m to choose the photo by", Json(p.content.real_photos));
-    for (double d : distances)
-      if (const fs::path photo = RealPhotoFor(p.content, d); !fs::is_regular_file(photo))
+    for (double d : distances) {
+      std::error_code ec;
+      if (const fs::path photo = RealPhotoFor(p.content, d); !fs::is_regular_file(photo, ec))
         Problem("/content/real_photos", "no photo for distance_m " + Json(d).dump() + ": " + photo.string(),
                 json["content"]["real_photos"]);
+    }
   }
   std::set<Task> tasks;
   for (const auto& b : p.blocks) tasks.insert(b.task);
