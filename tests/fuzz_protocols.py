@@ -7,8 +7,9 @@ usage: fuzz_protocols.py BLURCUE PROTOCOLS_DIR WORK_DIR [--seed N] [--count N] [
 PROTOCOLS_DIR holds the shipped protocols pointed at a real scene (tests/copy_protocols.cmake). Each mutant is one
 of them with 1-3 mutations: a deleted key, a wrong type, an extreme number (nan, 1e400, 1e308, 1e-300, -1, 0,
 2^64, ...), deep nesting (as written in the file, up to 100000 levels), an odd string (empty, NUL, unicode, 100 KB),
-a bad path (a folder, /dev/zero, /proc/self/mem, a FIFO, a missing file, a file that is not an image or not a
-calibration, an image of the wrong size), another valid enum value, a repeated or multiplied list.
+a file cut short or with bytes that are not UTF-8, a bad path (a folder, /dev/zero, /proc/self/mem, a FIFO, a
+missing file, a file that is not an image or not a calibration, an image of the wrong size), another valid enum
+value, a repeated or multiplied list.
 
 Must hold, for every mutant: no signal, no exit 10 (or any code but 0, 2, 3), no timeout; a rejection names the
 protocol file on every stderr line (libpng warnings aside); an accepted protocol runs 3 trials (--stop-after 3)
@@ -292,10 +293,26 @@ def main():
         text = json.dumps(doc, indent=1, ensure_ascii=rng.random() < 0.5)
         for key, raw in mutator.raw.items():
             text = text.replace(json.dumps(key), raw)
+        data = text.encode("utf-8", errors="surrogatepass")
+        if rng.random() < 0.08:
+            # The file itself: cut short, a byte that is not UTF-8, a byte-order mark, a duplicated key, or empty.
+            how = rng.choice(["truncate", "bad-utf8", "bom", "duplicate-key", "empty"])
+            at = rng.randrange(len(data) + 1)
+            if how == "truncate":
+                data = data[:at]
+            elif how == "bad-utf8":
+                data = data[:at] + rng.choice([b"\xff", b"\xc3", b"\xed\xa0\x80", b"\x00"]) + data[at:]
+            elif how == "bom":
+                data = b"\xef\xbb\xbf" + data
+            elif how == "duplicate-key":
+                data = data.replace(b'"name":', b'"name": "dup", "name":', 1)
+            else:
+                data = b""
+            mutations.append("file " + how)
         # Mutants live beside the shipped protocols so their relative paths still resolve.
         path = os.path.join(protocols_dir, "fuzz-%d.json" % index)
-        with open(path, "w", encoding="utf-8", errors="surrogatepass") as f:
-            f.write(text)
+        with open(path, "wb") as f:
+            f.write(data)
         counts["mutants"] += 1
         label = "mutant %d (seed %d) of %s: %s" % (index, args.seed, base, "; ".join(mutations))
 

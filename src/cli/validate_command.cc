@@ -24,8 +24,10 @@ void AddValidateCommand(CLI::App& app) {
       "validate",
       "Check a study protocol and build its trial list.\n"
       "Every problem is reported at once, one per line, as FILE: /json/pointer: what is wrong, got VALUE\n"
-      "(exit code 3). When the protocol is valid, prints the number of trials and the hash of the list that a\n"
-      "session with the same participant and seed would run.\n"
+      "(exit code 3). Then the checks blurcue run makes before its first trial, through the same code: the\n"
+      "calibration is read, every image decoded and its size checked, every trial's blur radii worked out - a\n"
+      "protocol that validates is one that runs. When the protocol is valid, prints the number of trials and the\n"
+      "hash of the list that a session with the same participant and seed would run.\n"
       "Example: blurcue validate protocols/test2-moving-balls.json --participant P4 --seed 4");
   cmd->add_option("protocol", args->file, "the protocol JSON file")->required();
   cmd->add_flag("--no-files", args->no_files, "check the protocol alone: skip the referenced files (scene, calib, "
