@@ -421,6 +421,7 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
     }
     Factor f{name, {}};
     bool sides = false;
+    std::map<std::string, size_t> seen;  // a level's text -> its first index
     for (size_t i = 0; i < levels.size(); ++i) {
       const Json& level = levels[i];
       const std::string lp = fp + "/" + std::to_string(i);
@@ -428,8 +429,10 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
         Problem(lp, "a level must be a number, a string or an object", level);
         continue;
       }
-      for (size_t j = 0; j < i; ++j)
-        if (levels[j] == level) Problem(lp, "repeats level " + std::to_string(j), level);
+      // Repeats found by the text of each level (numbers by value: 2 and 2.0 are one level), in linear time.
+      const std::string text = level.is_number() ? Json(level.get<double>()).dump() : level.dump();
+      if (const auto [first, fresh] = seen.emplace(text, i); !fresh)
+        Problem(lp, "repeats level " + std::to_string(first->second), level);
       if (level.is_object()) {
         for (const auto& [key, value] : level.items()) {
           if (value.is_object() || value.is_array()) Problem(lp + "/" + Escape(key), "must be a number or a string", value);

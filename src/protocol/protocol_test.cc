@@ -328,6 +328,15 @@ TEST(ProtocolValidate, KeyWithALineBreakIsNamedOnOneLine) {
   EXPECT_TRUE(Contains(p, "/bad\\u000akey: unknown key")) << p;
 }
 
+TEST(ProtocolValidate, RepeatedLevelNamesItsFirstOccurrence) {
+  Json j = Valid();
+  j["blocks"][1]["factors"]["size"] = {1, 2, 1.0, 3, 2};
+  const auto problems = Problems(j);
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_TRUE(Contains(problems[0], "/blocks/1/factors/size/2: repeats level 0, got 1.0")) << problems[0];
+  EXPECT_TRUE(Contains(problems[1], "/blocks/1/factors/size/4: repeats level 1, got 2")) << problems[1];
+}
+
 TEST(ProtocolValidate, NotAnObjectRejected) {
   EXPECT_TRUE(Contains(OnlyProblem(Json::array()), ": /: must be an object, got []"));
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <set>
 
@@ -32,16 +33,17 @@ std::string At(const protocol::Protocol& p, const std::string& pointer) {
   return p.file.string() + ": " + (pointer.empty() ? "/" : pointer);
 }
 
-calib::BlurSource Source(const Json& v, double* fixed, const std::string& where) {
+// `where` names the field that chose the source ("FILE: /pointer"), made only when there is a problem to name.
+calib::BlurSource Source(const Json& v, double* fixed, const std::function<std::string()>& where) {
   if (v.is_number()) {
     *fixed = v.get<double>();
     return calib::BlurSource::kFixed;
   }
-  if (!v.is_string()) throw InputError(where, "the trial shows no blur source on this side, got " + v.dump());
+  if (!v.is_string()) throw InputError(where(), "the trial shows no blur source on this side, got " + v.dump());
   try {
     return calib::ParseBlurSource(v.get<std::string>(), fixed);
   } catch (const Error& e) {
-    throw InputError(where, e.what());
+    throw InputError(where(), e.what());
   }
 }
 
@@ -79,24 +81,25 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
     return t;
   }
   if (!scene) throw InputError(protocol.file.string(), "/scene/calib: a " + t.content + " needs a calibration");
-  const std::string left_at = At(protocol, protocol::SidePointer(protocol, trial, "left"));
-  const std::string right_at = At(protocol, protocol::SidePointer(protocol, trial, "right"));
-  t.left = Source(trial.left, &t.left_fixed_px, left_at);
-  t.right = Source(trial.right, &t.right_fixed_px, right_at);
+  // Where a side's source was chosen ("" for the scene's own blur, the calibration's): looked up only for a message.
+  auto field = [&](const char* side) {
+    return At(protocol, side ? protocol::SidePointer(protocol, trial, side) : "/scene/calib");
+  };
+  t.left = Source(trial.left, &t.left_fixed_px, [&] { return field("left"); });
+  t.right = Source(trial.right, &t.right_fixed_px, [&] { return field("right"); });
   const double s = scene->board.square_mm;
   // A radius that cannot be evaluated (eq. 3.7 nearer than focus, no usable measured section) is a problem of the
   // source the protocol chose with this calibration: an input error naming that field.
-  auto r_at = [&](const cv::Vec3d& board_mm, calib::BlurSource source, double fixed, const std::string& at) {
+  auto r_at = [&](const cv::Vec3d& board_mm, calib::BlurSource source, double fixed, const char* side) {
     try {
       const double r = calib::BlurAtPx(*scene, source, scene->ToCamera(board_mm), fixed);
       if (!std::isfinite(r) || r < 0) throw Error(ErrorKind::kDomain, "radius " + std::to_string(r) + " px");
       return r;
     } catch (const Error& e) {
-      throw InputError(at, calib::ToString(source) + " blur cannot be evaluated with " +
-                               protocol.scene.calib.string() + trial_text + ": " + e.what());
+      throw InputError(field(side), calib::ToString(source) + " blur cannot be evaluated with " +
+                                        protocol.scene.calib.string() + trial_text + ": " + e.what());
     }
   };
-  const std::string calib_at = At(protocol, "/scene/calib");
   if (t.content == "grid") {
     const Json* edge = FindLevel(trial.levels, "edge");
     if (!edge || !edge->is_number_integer())
@@ -104,10 +107,10 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
                        "a grid needs an integer level edge" + trial_text);
     t.edge = edge->get<int>();
     const cv::Vec3d l = GridCentre(*scene, t.edge, true), r = GridCentre(*scene, t.edge, false);
-    t.r_left_px = r_at(l, t.left, t.left_fixed_px, left_at);
-    t.r_right_px = r_at(r, t.right, t.right_fixed_px, right_at);
-    t.r_scene_px = 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, calib_at) +
-                          r_at(r, calib::BlurSource::kFitted, 0, calib_at));
+    t.r_left_px = r_at(l, t.left, t.left_fixed_px, "left");
+    t.r_right_px = r_at(r, t.right, t.right_fixed_px, "right");
+    t.r_scene_px = 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, nullptr) +
+                          r_at(r, calib::BlurSource::kFitted, 0, nullptr));
     return t;
   }
   // Balls: a section run (edge s to s + 1, wiped on arrival), explicit edges, or the whole board.
@@ -129,10 +132,10 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   const double radius = protocol.content.radius_mm;
   for (int i = 0; i < samples; ++i) {
     const double y = t.from_y_mm + (t.to_y_mm - t.from_y_mm) * i / (samples - 1);
-    t.r_left_px += r_at(BallCentre(*scene, y, radius, true), t.left, t.left_fixed_px, left_at) / samples;
-    t.r_right_px += r_at(BallCentre(*scene, y, radius, false), t.right, t.right_fixed_px, right_at) / samples;
-    t.r_scene_px += 0.5 * (r_at(BallCentre(*scene, y, radius, true), calib::BlurSource::kFitted, 0, calib_at) +
-                           r_at(BallCentre(*scene, y, radius, false), calib::BlurSource::kFitted, 0, calib_at)) /
+    t.r_left_px += r_at(BallCentre(*scene, y, radius, true), t.left, t.left_fixed_px, "left") / samples;
+    t.r_right_px += r_at(BallCentre(*scene, y, radius, false), t.right, t.right_fixed_px, "right") / samples;
+    t.r_scene_px += 0.5 * (r_at(BallCentre(*scene, y, radius, true), calib::BlurSource::kFitted, 0, nullptr) +
+                           r_at(BallCentre(*scene, y, radius, false), calib::BlurSource::kFitted, 0, nullptr)) /
                     samples;
   }
   return t;
