@@ -95,7 +95,12 @@ std::string ReadTextFile(const std::filesystem::path& path) {
 }
 
 Json ParseJson(const std::string& text, const std::string& name) {
-  if (const size_t at = TooDeepAt(text); at != std::string::npos)
+  // Text that cannot start a JSON value (a PNG, say) is the parser's to report at its first byte; only what starts
+  // like JSON (after a byte-order mark, which the parser skips) is scanned for depth.
+  const size_t start = text.find_first_not_of(" \t\r\n", text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0);
+  const bool json_like =
+      start != std::string::npos && std::string("{[\"-0123456789tfn").find(text[start]) != std::string::npos;
+  if (const size_t at = json_like ? TooDeepAt(text) : std::string::npos; at != std::string::npos)
     throw InputError(name, "not valid JSON: nested deeper than " + std::to_string(kMaxJsonDepth) + " levels at " +
                                Position(text, at));
   try {

@@ -48,6 +48,11 @@ TEST(ReadJsonFile, DeepNestingIsRefusedBeforeParsing) {
   EXPECT_TRUE(Contains(message, "nested deeper than 64 levels at line 1, column 65")) << message;
 }
 
+TEST(ReadJsonFile, DeepNestingAfterAByteOrderMarkIsRefusedToo) {
+  const std::string deep = "\xEF\xBB\xBF" + std::string(100000, '[') + std::string(100000, ']');
+  EXPECT_TRUE(Contains(ReadError(TempFile("bom-deep.json", deep)), "nested deeper than 64 levels"));
+}
+
 TEST(ReadJsonFile, BracketsInsideStringsDoNotCountAsNesting) {
   const Json j = ReadJsonFile(TempFile("brackets.json", "{\"a\": \"" + std::string(1000, '[') + "\\\"{\"}"));
   EXPECT_EQ(j["a"].get<std::string>().size(), 1002u);
@@ -56,6 +61,11 @@ TEST(ReadJsonFile, BracketsInsideStringsDoNotCountAsNesting) {
 TEST(ReadJsonFile, NestingUpToTheLimitIsRead) {
   EXPECT_NO_THROW(ReadJsonFile(TempFile("64.json", std::string(64, '[') + std::string(64, ']'))));
   EXPECT_TRUE(Contains(ReadError(TempFile("65.json", std::string(65, '[') + std::string(65, ']'))), "deeper"));
+}
+
+TEST(ReadJsonFile, BinaryFileIsASyntaxErrorNotADepthError) {
+  const std::string message = ReadError(TempFile("image.png", "\x89PNG\r\n" + std::string(200, '[')));
+  EXPECT_TRUE(Contains(message, "not valid JSON: parse error at line 1, column 1")) << message;
 }
 
 TEST(ReadJsonFile, NumberBeyondDoubleNamesWhereItIs) {
