@@ -33,7 +33,7 @@ const size_t kMaxProblems = 50;         // reported; the rest are counted
 const size_t kMaxBlocks = 100;
 const size_t kMaxFactors = 16;
 const size_t kMaxLevels = 1000;         // per factor (levels are compared pairwise for repeats)
-const size_t kMaxAdjustLevels = 100;    // each is low-passed up front, ~0.1 s apiece
+const size_t kMaxAdjustLevels = 50;     // each is low-passed up front: ~0.1 s apiece at 1280 px, ~1 s at 4K
 const size_t kMaxNameChars = 100;       // names: one line in titles, records and exports
 const size_t kMaxTextChars = 2000;      // instructions: about what a screen holds
 const size_t kMaxPathChars = 4096;
@@ -686,9 +686,9 @@ Protocol Parser::Parse(const Json& json) {
   }
   if (const Json* v = Field(json, "display", "", false)) {
     if (Object(*v, "/display", {"width_px", "height_px", "fullscreen", "monitor"})) {
-      // From VGA's 320 x 240 to 8K.
-      if (auto n = Int(*v, "width_px", "/display", false, 320, 7680, "px")) p.display.width_px = *n;
-      if (auto n = Int(*v, "height_px", "/display", false, 240, 4320, "px")) p.display.height_px = *n;
+      // From VGA's 320 x 240 to 4K UHD (a depth-matching frame as wide as the display is filtered on the CPU).
+      if (auto n = Int(*v, "width_px", "/display", false, 320, 3840, "px")) p.display.width_px = *n;
+      if (auto n = Int(*v, "height_px", "/display", false, 240, 2160, "px")) p.display.height_px = *n;
       if (auto b = Bool(*v, "fullscreen", "/display")) p.display.fullscreen = *b;
       if (auto n = Int(*v, "monitor", "/display", false, 0, 16)) p.display.monitor = *n;
     }

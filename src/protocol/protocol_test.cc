@@ -198,7 +198,7 @@ TEST(ProtocolValidate, SeveralProblemsThrownTogether) {
     EXPECT_TRUE(Contains(m, "/name: must be a string, got 7\n")) << m;
     EXPECT_TRUE(Contains(m, "/scene/background: no such file")) << m;
     EXPECT_TRUE(Contains(m, "/blocks/0/factors/pattern: must list at least one level")) << m;
-    EXPECT_TRUE(Contains(m, "/display/width_px: must be an integer in [320, 7680] px, got -5")) << m;
+    EXPECT_TRUE(Contains(m, "/display/width_px: must be an integer in [320, 3840] px, got -5")) << m;
     EXPECT_TRUE(Contains(m, "(4 problems)")) << m;
   }
 }
