@@ -117,6 +117,13 @@ bool IsBlurSource(const Json& v) {
   return kNames.count(v.get<std::string>()) > 0;
 }
 
+// Names whose values CheckLevelValue knows: a level of a factor so named is that value, never an object.
+bool IsValueName(const std::string& name) {
+  static const std::set<std::string> kNames = {"edge",       "from_edge",  "to_edge", "section", "speed_cm_s",
+                                               "distance_m", "cutoff",     "left",    "right"};
+  return kNames.count(name) > 0;
+}
+
 bool IsKeyName(const std::string& key) {
   static const std::set<std::string> kNamed = {"Left", "Right", "Up", "Down", "Space", "Return", "Tab", "Backspace"};
   if (kNamed.count(key)) return true;
@@ -433,7 +440,9 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
       const std::string text = level.is_number() ? Json(level.get<double>()).dump() : level.dump();
       if (const auto [first, fresh] = seen.emplace(text, i); !fresh)
         Problem(lp, "repeats level " + std::to_string(first->second), level);
-      if (level.is_object()) {
+      // A factor named for a value (edge, speed_cm_s, ...) holds that value itself; any other factor's object
+      // levels carry named values.
+      if (level.is_object() && !IsValueName(name)) {
         for (const auto& [key, value] : level.items()) {
           if (value.is_object() || value.is_array()) Problem(lp + "/" + Escape(key), "must be a number or a string", value);
           else CheckLevelValue(key, value, lp + "/" + Escape(key));

@@ -337,6 +337,13 @@ TEST(ProtocolValidate, RepeatedLevelNamesItsFirstOccurrence) {
   EXPECT_TRUE(Contains(problems[1], "/blocks/1/factors/size/4: repeats level 1, got 2")) << problems[1];
 }
 
+TEST(ProtocolValidate, ObjectLevelOfAValueFactorRejected) {
+  Json j = Valid();
+  j["blocks"][1]["factors"]["section"][1] = Json::object();  // would show section "{}" as the whole run
+  EXPECT_TRUE(Contains(OnlyProblem(j), "/blocks/1/factors/section/1: a section (edge s to s + 1) must be an integer "
+                                       "in [1, 10], got {}")) << OnlyProblem(j);
+}
+
 TEST(ProtocolValidate, NotAnObjectRejected) {
   EXPECT_TRUE(Contains(OnlyProblem(Json::array()), ": /: must be an object, got []"));
 }
