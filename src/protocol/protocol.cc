@@ -32,7 +32,7 @@ const int kEdges = 11;  // parallel edges of the 7 x 10 board (thesis figure 4.1
 const size_t kMaxProblems = 50;         // reported; the rest are counted
 const size_t kMaxBlocks = 100;
 const size_t kMaxFactors = 16;
-const size_t kMaxLevels = 1000;         // per factor (levels are compared pairwise for repeats)
+const size_t kMaxLevels = 1000;         // per factor: more than a sitting could show
 const size_t kMaxAdjustLevels = 50;     // each is low-passed up front: ~0.1 s apiece at 1280 px, ~1 s at 4K
 const size_t kMaxNameChars = 100;       // names: one line in titles, records and exports
 const size_t kMaxTextChars = 2000;      // instructions: about what a screen holds
@@ -501,7 +501,7 @@ void Parser::ParseSides(const Json& v, const std::string& ptr) {
 
 void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top, Block* b) {
   // A field of the block, else of the protocol: the object that holds it and that object's pointer. Inherited
-  // fields are checked again per block; ParseProtocol drops the repeated messages.
+  // fields are checked again per block; Problem() keeps each message once.
   struct Source {
     const Json* holder = nullptr;
     std::string ptr;
