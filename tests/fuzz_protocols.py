@@ -135,7 +135,7 @@ class Mutator:
     def odd_string(self):
         return self.rng.choice([
             "", " ", "\u0000", "a\u0000b", "\n", "line\nbreak", "\t", "é漢字🙂", "\u202e", "\ufeff",
-            "a" * 100000, "x" * 5000, "../../../../../../etc/passwd", "%s%n%x", "{distance_m}", "~/~0/~1",
+            "a" * 100000, "x" * 5000, "\u6f22" * 30000, "é" * 41, "../../../../../../etc/passwd", "%s%n%x", "{distance_m}", "~/~0/~1",
             "soccer", "wood", "measured", "until_response", "Escape", "F13", "KP_10", "\\",
             "NaN", "1e400", "-1", "0",
         ])

@@ -56,17 +56,21 @@ void DumpBounded(const Json& value, size_t limit, std::string* out, int depth = 
       if (out->size() > limit) break;
       if (!first) *out += ',';
       first = false;
-      if (!array) *out += Json(key).dump() + ':';
+      if (!array) *out += Json(key).dump(-1, ' ', false, Json::error_handler_t::replace) + ':';
       DumpBounded(item, limit, out, depth + 1);
     }
     *out += array ? ']' : '}';
     return;
   }
   if (value.is_string() && value.get_ref<const std::string&>().size() > limit) {
-    *out += Json(value.get_ref<const std::string&>().substr(0, limit)).dump();
+    // Cut at a character boundary (UTF-8 continuation bytes are 10xxxxxx): half a character cannot be dumped.
+    const std::string& text = value.get_ref<const std::string&>();
+    size_t cut = limit;
+    while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) --cut;
+    *out += Json(text.substr(0, cut)).dump(-1, ' ', false, Json::error_handler_t::replace);
     return;
   }
-  *out += value.dump();
+  *out += value.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 
 std::string Got(const Json& value) {

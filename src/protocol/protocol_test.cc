@@ -344,6 +344,21 @@ TEST(ProtocolValidate, ObjectLevelOfAValueFactorRejected) {
                                        "in [1, 10], got {}")) << OnlyProblem(j);
 }
 
+TEST(ProtocolValidate, LongUnicodeValueIsQuotedCutAtACharacter) {
+  Json j = Valid();
+  std::string name;
+  for (int i = 0; i < 1000; ++i) name += "\u6f22";  // three bytes each: a cut at 80 bytes falls inside one
+  j["name"] = name;
+  const std::string p = OnlyProblem(j);
+  EXPECT_TRUE(Contains(p, "/name: must be at most 100 characters, got 3000")) << p;
+  j["name"] = 1;
+  j["unknown"] = name;
+  const auto problems = Problems(j);
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_TRUE(Contains(problems[0], "/unknown: unknown key")) << problems[0];
+  EXPECT_TRUE(Contains(problems[0], "...")) << problems[0];
+}
+
 TEST(ProtocolValidate, NotAnObjectRejected) {
   EXPECT_TRUE(Contains(OnlyProblem(Json::array()), ": /: must be an object, got []"));
 }
