@@ -62,10 +62,11 @@ void DumpBounded(const Json& value, size_t limit, std::string* out, int depth = 
     *out += array ? ']' : '}';
     return;
   }
-  if (value.is_string() && value.get_ref<const std::string&>().size() > limit) {
+  if (value.is_string() && value.get_ref<const std::string&>().size() > limit + 4) {
     // Cut at a character boundary (UTF-8 continuation bytes are 10xxxxxx): half a character cannot be dumped.
+    // Cut past the limit, so that the caller sees the value was longer than it shows.
     const std::string& text = value.get_ref<const std::string&>();
-    size_t cut = limit;
+    size_t cut = limit + 4;
     while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) --cut;
     *out += Json(text.substr(0, cut)).dump(-1, ' ', false, Json::error_handler_t::replace);
     return;
