@@ -6,7 +6,10 @@
 
 #include <cerrno>
 #include <climits>
+#include <cstdio>
 #include <cstring>
+#include <set>
+#include <vector>
 #include <fstream>
 #include <sstream>
 
@@ -52,6 +55,21 @@ std::string Plain(const char* what) {
   const std::string text = what;
   const size_t end = text.find("] ");
   return text.rfind("[json.exception.", 0) == 0 && end != std::string::npos ? text.substr(end + 2) : text;
+}
+
+// A key as a JSON pointer token (RFC 6901: '~' -> "~0", '/' -> "~1"), control characters as \uXXXX.
+std::string PointerToken(const std::string& key) {
+  std::string out;
+  for (char c : key) {
+    if (c == '~') out += "~0";
+    else if (c == '/') out += "~1";
+    else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      char text[8];
+      std::snprintf(text, sizeof text, "\\u%04x", static_cast<unsigned char>(c));
+      out += text;
+    } else out += c;
+  }
+  return out;
 }
 
 struct Fd {
@@ -103,8 +121,45 @@ Json ParseJson(const std::string& text, const std::string& name) {
   if (const size_t at = json_like ? TooDeepAt(text) : std::string::npos; at != std::string::npos)
     throw InputError(name, "not valid JSON: nested deeper than " + std::to_string(kMaxJsonDepth) + " levels at " +
                                Position(text, at));
+  // A key given twice in one object would silently lose one value (nlohmann keeps the last): refuse it, naming
+  // where. The parser reports each object and array as it starts and ends, each key, and each plain value.
+  struct Frame {
+    bool object;
+    std::set<std::string> keys;
+    std::string key;   // object: the key being read
+    size_t index = 0;  // array: the element being read
+  };
+  std::vector<Frame> stack;
+  std::string duplicate;  // pointer of the first key given twice
+  const Json::parser_callback_t check_keys = [&](int, Json::parse_event_t event, Json& parsed) {
+    using Event = Json::parse_event_t;
+    if (!duplicate.empty()) return false;
+    switch (event) {
+      case Event::object_start: stack.push_back({true, {}, {}, 0}); break;
+      case Event::array_start: stack.push_back({false, {}, {}, 0}); break;
+      case Event::key:
+        if (!stack.empty() && stack.back().object) {
+          stack.back().key = parsed.get<std::string>();
+          if (!stack.back().keys.insert(stack.back().key).second) {
+            for (const Frame& f : stack) duplicate += "/" + (f.object ? PointerToken(f.key) : std::to_string(f.index));
+          }
+        }
+        break;
+      case Event::object_end:
+      case Event::array_end:
+        if (!stack.empty()) stack.pop_back();
+        [[fallthrough]];
+      case Event::value:
+        if (!stack.empty() && !stack.back().object) ++stack.back().index;
+        break;
+    }
+    return true;
+  };
   try {
-    return Json::parse(text);
+    Json json = Json::parse(text, check_keys);
+    if (!duplicate.empty())
+      throw InputError(name, duplicate + ": is given twice in the same object (which value is meant?)");
+    return json;
   } catch (const Json::parse_error& e) {
     throw InputError(name, "not valid JSON: " + Plain(e.what()));
   } catch (const Json::out_of_range& e) {

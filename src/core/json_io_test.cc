@@ -68,6 +68,14 @@ TEST(ReadJsonFile, BinaryFileIsASyntaxErrorNotADepthError) {
   EXPECT_TRUE(Contains(message, "not valid JSON: parse error at line 1, column 1")) << message;
 }
 
+TEST(ReadJsonFile, KeyGivenTwiceIsRefusedNamingWhere) {
+  const std::string message = ReadError(TempFile(
+      "twice.json", R"({"a": [1, {"b": 2}, {"c": {"d": 1, "e/f": 2, "e/f": 3}}], "g": 1})"));
+  EXPECT_TRUE(Contains(message, ": /a/2/c/e~1f: is given twice in the same object")) << message;
+  // The same key in different objects is not a repeat.
+  EXPECT_NO_THROW(ReadJsonFile(TempFile("not-twice.json", R"({"a": {"x": 1}, "b": {"x": 2}, "x": [{"x": 3}]})")));
+}
+
 TEST(ReadJsonFile, NumberBeyondDoubleNamesWhereItIs) {
   const std::string message = ReadError(TempFile("huge.json", "{\n  \"speed_cm_s\": 1e400\n}"));
   EXPECT_TRUE(Contains(message, "at line 2, column 17")) << message;
