@@ -16,7 +16,8 @@ inline constexpr int kMaxJsonDepth = 64;
 
 // Parses a JSON file. Throws one Error(kInput) naming the file (and the line and column where it applies) for a
 // missing or unreadable file, anything but a regular file (a folder, /dev/zero, a FIFO), a file over 16 MiB,
-// nesting deeper than 64, a syntax error or a number beyond double's range (1e400).
+// nesting deeper than 64, a syntax error, a number beyond double's range (1e400) or a key given twice in one
+// object (named by its JSON pointer).
 Json ReadJsonFile(const std::filesystem::path& path);
 // The two halves of ReadJsonFile: the checked read of the text, and its parse (`name` names it in messages).
 std::string ReadTextFile(const std::filesystem::path& path);
