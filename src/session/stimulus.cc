@@ -197,7 +197,9 @@ cv::Mat ReadFieldImage(const protocol::Protocol& protocol, const std::string& po
   return image;
 }
 
-constexpr int kMaxPhotoSidePx = 16384, kMaxTextureSidePx = 8192;  // GL's guaranteed texture size is at least 8192
+// A photo up to 16384 px a side (Mesa's llvmpipe takes textures that large); a ball's or card's texture needs far
+// less than 8192.
+constexpr int kMaxPhotoSidePx = 16384, kMaxTextureSidePx = 8192;
 
 }  // namespace
 
