@@ -197,8 +197,8 @@ cv::Mat ReadFieldImage(const protocol::Protocol& protocol, const std::string& po
   return image;
 }
 
-// A photo up to 16384 px a side (Mesa's llvmpipe takes textures that large); a ball's or card's texture needs far
-// less than 8192.
+// Photos up to 16384 px a side (more than a 45 MP camera's 8256); a ball's or card's texture needs far less than
+// 8192.
 constexpr int kMaxPhotoSidePx = 16384, kMaxTextureSidePx = 8192;
 
 }  // namespace
