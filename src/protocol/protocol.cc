@@ -533,6 +533,7 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
     if (auto n = Int(*s.holder, "repetitions", s.ptr, true, 1, kMaxTrials, "repetitions")) b->repetitions = *n;
   }
   if (const Source s = pick("counterbalance"); s.holder) {
+    b->counterbalance_pointer = s.ptr + "/counterbalance";
     if (auto c = String(*s.holder, "counterbalance", s.ptr, true, {"swap_copies", "by_participant", "none"}))
       b->counterbalance = *c == "swap_copies"      ? Counterbalance::kSwapCopies
                           : *c == "by_participant" ? Counterbalance::kByParticipant

@@ -41,7 +41,7 @@ struct Block {
   std::string name;
   // JSON pointers of where the block's fields were read ("" is the top level for an inherited field), so a
   // problem found later (a source that cannot be evaluated) names the field that asked for it.
-  std::string pointer, task_pointer, factors_pointer, sides_pointer;
+  std::string pointer, task_pointer, factors_pointer, sides_pointer, counterbalance_pointer;
   Task task = Task::kForcedChoice;
   std::vector<Factor> factors;        // crossed in full; sorted by name (JSON object order)
   int repetitions = 1;

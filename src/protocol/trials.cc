@@ -90,11 +90,12 @@ void DrawAdjustment(const Block& block, std::mt19937_64& rng, Trial* t) {
 }  // namespace
 
 std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& participant, uint64_t seed) {
-  bool needs_number = false;
-  for (const auto& b : protocol.blocks) needs_number = needs_number || b.counterbalance == Counterbalance::kByParticipant;
+  const Block* by_participant = nullptr;
+  for (const auto& b : protocol.blocks)
+    if (!by_participant && b.counterbalance == Counterbalance::kByParticipant) by_participant = &b;
   const int number = ParticipantNumber(participant);
-  if (needs_number && number < 0)
-    throw InputError(protocol.file.string(), "by_participant counterbalancing needs a participant id ending in a "
+  if (by_participant && number < 0)
+    throw InputError(protocol.file.string() + ": " + by_participant->counterbalance_pointer, "by_participant counterbalancing needs a participant id ending in a "
                                              "number (e.g. P7), got \"" + participant + "\"");
   const bool even = number >= 0 && number % 2 == 0;
   // ParseProtocol refuses such designs; a Protocol made otherwise is refused here, before anything is allocated.

@@ -123,7 +123,15 @@ TEST(TrialBuilder, ByParticipantSwapsForEvenNumbers) {
 }
 
 TEST(TrialBuilder, ByParticipantNeedsANumberedParticipant) {
-  EXPECT_THROW(BuildTrials(Shipped("test1-static-grids.json"), "anna", 1), Error);
+  try {
+    BuildTrials(Shipped("test1-static-grids.json"), "anna", 1);
+    FAIL() << "built";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    // Names the field that asked for it.
+    EXPECT_NE(std::string(e.what()).find("test1-static-grids.json: /counterbalance: by_participant"),
+              std::string::npos) << e.what();
+  }
 }
 
 TEST(TrialBuilder, ParticipantNumberIsTheTrailingDigits) {
