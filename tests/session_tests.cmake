@@ -51,3 +51,58 @@ set_tests_properties(session_run_person_without_display PROPERTIES FIXTURES_REQU
 # blurcue display check in a window (its own Xvfb): geometry, resolution check, honest timing without vsync.
 add_test(NAME display_check COMMAND bash ${PROJECT_SOURCE_DIR}/tests/display_test.sh ${BC} ${T})
 set_tests_properties(display_check PROPERTIES LABELS "gl;window" PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+
+# Protocols that cannot crash, hang or lie: a seeded generator mutates the shipped protocols (deletions, wrong types,
+# extremes, deep nesting, odd strings, bad paths) and runs each through `blurcue validate`, and each one accepted
+# through a short simulated `blurcue run`: no signal, no exit 10, no timeout, nothing accepted that then fails, and
+# every rejection names the protocol file on each line. The counts are printed; the seed is fixed (change it to
+# explore, keep it to reproduce).
+add_test(NAME session_protocol_fuzz
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/fuzz_protocols.py ${BC} ${T}/protocols ${T}/fuzz
+                 --seed 20261123 --count 240)
+set_tests_properties(session_protocol_fuzz PROPERTIES
+                     FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures" LABELS "gl;session;fuzz"
+                     PASS_REGULAR_EXPRESSION "fuzz ok: 0 crashes" TIMEOUT 1200)
+
+# validate == run: protocols that used to crash, hang or pass validate and then fail run. Each is refused by both
+# commands with the same one line, naming the protocol file and the field. NAME TEXT PROTOCOL-JSON
+set(D ${PROJECT_BINARY_DIR}/cli-test-data)
+file(WRITE ${D}/not-an-image.png "hello")
+function(add_preflight_test name text json)
+  file(WRITE ${D}/${name}.json "${json}")
+  set(validate_args "validate;${D}/${name}.json")
+  set(run_args "run;${D}/${name}.json;--participant;P1;--db;${T}/preflight-${name}.sqlite;--observer;sim")
+  foreach(command validate run)
+    add_test(NAME session_${command}_${name}
+             COMMAND ${CMAKE_COMMAND} -DCMD=${BC} "-DARGS=${${command}_args}"
+                     -DEXPECT_CODE=3 "-DEXPECT_TEXT=${name}.json: ${text}"
+                     -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+    set_tests_properties(session_${command}_${name} PROPERTIES FIXTURES_REQUIRED "scene;calib")
+  endforeach()
+endfunction()
+set(ball_head "{\"name\": \"t\", \"version\": 1, \"content\": {\"type\": \"ball\"}, \"task\": \"forced_choice\",")
+set(ball_scene "\"scene\": {\"background\": \"${T}/scene/scene.png\", \"calib\": \"${T}/calib.json\"}")
+set(pattern "{\"speed_cm_s\": 3, \"left\": \"measured\", \"right\": \"none\"}")
+add_preflight_test(calib-proc-mem "/scene/calib: not a calibration from blurcue calibrate: /proc/self/mem: cannot read"
+                   "${ball_head} \"scene\": {\"background\": \"${T}/scene/scene.png\", \"calib\": \"/proc/self/mem\"}, \"factors\": {\"pattern\": [${pattern}]}}")
+add_preflight_test(calib-is-a-camera "/scene/calib: not a calibration from blurcue calibrate: "
+                   "${ball_head} \"scene\": {\"background\": \"${T}/scene/scene.png\", \"calib\": \"${T}/scene/camera.json\"}, \"factors\": {\"pattern\": [${pattern}]}}")
+add_preflight_test(texture-not-an-image "/content/texture: ${D}/not-an-image.png: not a readable image"
+                   "{\"name\": \"t\", \"version\": 1, \"content\": {\"type\": \"ball\", \"texture\": \"not-an-image.png\"}, \"task\": \"forced_choice\", ${ball_scene}, \"factors\": {\"pattern\": [${pattern}]}}")
+add_preflight_test(photo-of-another-size "/scene/background: "
+                   "${ball_head} \"scene\": {\"background\": \"${T}/pictures/face-0.4m.png\", \"calib\": \"${T}/calib.json\"}, \"factors\": {\"pattern\": [${pattern}]}}")
+set_tests_properties(session_validate_photo-of-another-size session_run_photo-of-another-size PROPERTIES
+                     FIXTURES_REQUIRED "scene;calib;session_pictures")
+add_preflight_test(speed-1e-300 "/factors/pattern/0/speed_cm_s: a speed must be a number in [0.1, 100] cm/s, got 1e-300"
+                   "${ball_head} ${ball_scene}, \"factors\": {\"pattern\": [{\"speed_cm_s\": 1e-300, \"left\": \"measured\", \"right\": \"none\"}]}}")
+add_preflight_test(inter-trial-1e308 "/timing/inter_trial_ms: must be a number in [0, 60000] ms, got 1e+308"
+                   "${ball_head} ${ball_scene}, \"factors\": {\"pattern\": [${pattern}]}, \"timing\": {\"inter_trial_ms\": 1e308}}")
+add_preflight_test(number-1e400 "not valid JSON at line 1, column "
+                   "${ball_head} ${ball_scene}, \"factors\": {\"pattern\": [${pattern}]}, \"repetitions\": 1e400}")
+string(REPEAT "[" 100000 open)
+string(REPEAT "]" 100000 close)
+add_preflight_test(nested-100000-deep "not valid JSON: nested deeper than 64 levels at line 1, column "
+                   "${ball_head} ${ball_scene}, \"factors\": {\"pattern\": [${pattern}]}, \"instructions\": ${open}${close}}")
+set(levels "[1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17,18,19,20,21,22,23,24,25,26,27,28,29,30]")
+add_preflight_test(eight-factors-of-30 "/factors: the session would have 656100000000 trials (30 a x 30 b x "
+                   "${ball_head} ${ball_scene}, \"factors\": {\"pattern\": [${pattern}], \"a\": ${levels}, \"b\": ${levels}, \"c\": ${levels}, \"d\": ${levels}, \"e\": ${levels}, \"f\": ${levels}, \"g\": ${levels}, \"h\": ${levels}}}")

@@ -17,6 +17,7 @@
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
 #include "render/gl_context.h"
+#include "session/prepare.h"
 #include "session/stimulus.h"
 
 namespace blurcue::cli {
@@ -44,10 +45,11 @@ void AddPreviewCommand(CLI::App& app) {
   cmd->add_option("--tile-width", args->tile_width, "tile width in px")->capture_default_str()
       ->check(CLI::Range(80, 2000));
   cmd->callback([args] {
-    const protocol::Protocol p = protocol::LoadProtocol(args->protocol);
-    const uint64_t seed = args->seed ? *args->seed : protocol::DefaultSeed(p.name, args->participant);
-    const auto trials = protocol::BuildTrials(p, args->participant, seed);
-    const auto scene = session::LoadProtocolScene(p);
+    // The pre-flight of blurcue run: the same checks, and every trial's scene already worked out.
+    const session::PreparedSession prepared = session::PrepareSession(args->protocol, args->participant, args->seed);
+    const protocol::Protocol& p = prepared.protocol;
+    const auto& trials = prepared.trials;
+    const auto& scene = prepared.scene;
     struct Tile {
       session::TrialScene scene;
       double level;
@@ -57,7 +59,7 @@ void AddPreviewCommand(CLI::App& app) {
     std::vector<Tile> tiles;
     std::set<std::string> seen;  // labels or level keys already on the sheet
     for (const auto& t : trials) {
-      const session::TrialScene s = session::DescribeTrial(p, t, scene ? &*scene : nullptr);
+      const session::TrialScene& s = prepared.scenes[size_t(t.index)];
       if (t.task == protocol::Task::kAdjustment) {
         // Every level once (at the first distance shown), and every distance once (at the middle level): the
         // two halves of the frame vary apart, so together these show every distinct half.
@@ -99,7 +101,7 @@ void AddPreviewCommand(CLI::App& app) {
     if (tiles.empty()) throw InputError(args->protocol, "the protocol makes no trials to preview");
 
     auto context = render::GlContext::CreateOffscreen();
-    session::StimulusRenderer renderer(p, scene);
+    session::StimulusRenderer renderer(p, scene, prepared.images);
     const cv::Size frame = renderer.FrameSize();
     const int tw = args->tile_width, th = tw * frame.height / frame.width, strip = 34;
     const int cols = std::min<int>(args->columns, int(tiles.size()));

@@ -1,4 +1,4 @@
-// blurcue validate: check a protocol file and build its trial list, the way a session would.
+// blurcue validate: check a protocol file and build its trial list, through the pre-flight a session runs.
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -9,6 +9,7 @@
 #include "core/hash.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
+#include "session/prepare.h"
 
 namespace blurcue::cli {
 
@@ -23,11 +24,14 @@ void AddValidateCommand(CLI::App& app) {
       "validate",
       "Check a study protocol and build its trial list.\n"
       "Every problem is reported at once, one per line, as FILE: /json/pointer: what is wrong, got VALUE\n"
-      "(exit code 3). When the protocol is valid, prints the number of trials and the hash of the list that a\n"
-      "session with the same participant and seed would run.\n"
+      "(exit code 3). Then the checks blurcue run makes before its first trial, through the same code: the\n"
+      "calibration is read, every image decoded and its size checked, every trial's blur radii worked out - a\n"
+      "protocol that validates is one that runs. When the protocol is valid, prints the number of trials and the\n"
+      "hash of the list that a session with the same participant and seed would run.\n"
       "Example: blurcue validate protocols/test2-moving-balls.json --participant P4 --seed 4");
   cmd->add_option("protocol", args->file, "the protocol JSON file")->required();
-  cmd->add_flag("--no-files", args->no_files, "skip the checks that referenced files (scene, calib, images) exist");
+  cmd->add_flag("--no-files", args->no_files, "check the protocol alone: skip the referenced files (scene, calib, "
+                                              "images) and the per-trial checks that need them");
   cmd->add_option("--participant", args->participant, "participant id (its trailing number decides by_participant "
                                                       "counterbalancing)")->capture_default_str();
   cmd->add_option("--seed", args->seed, "seed of the trial order (default: the one blurcue run gives the participant, "
@@ -35,19 +39,28 @@ void AddValidateCommand(CLI::App& app) {
       ->check(SeedValidator());
   cmd->add_flag("--list", args->list, "print the trial list as JSON, one trial per line");
   cmd->callback([args] {
-    protocol::ValidateOptions options;
-    options.check_files = !args->no_files;
     protocol::Protocol p;
-    try {
-      p = protocol::LoadProtocol(args->file, options);
-    } catch (const Error& e) {
-      const std::string message = e.what();
-      if (message.find(": no such file: ") == std::string::npos) throw;
-      throw Error(e.kind(), message + "\n(scripts/demo.sh writes the demo scene the shipped protocols use; --no-files "
-                                      "skips the file checks)");
+    uint64_t seed = 0;
+    std::vector<protocol::Trial> trials;
+    if (args->no_files) {
+      p = protocol::LoadProtocol(args->file, protocol::ValidateOptions{false});
+      seed = args->seed ? *args->seed : protocol::DefaultSeed(p.name, args->participant);
+      trials = protocol::BuildTrials(p, args->participant, seed);
+    } else {
+      // What `blurcue run` does before its first trial, through the same function: files decoded, the
+      // calibration read, every trial's scene and radii worked out.
+      try {
+        session::PreparedSession prepared = session::PrepareSession(args->file, args->participant, args->seed);
+        p = std::move(prepared.protocol);
+        seed = prepared.seed;
+        trials = std::move(prepared.trials);
+      } catch (const Error& e) {
+        const std::string message = e.what();
+        if (message.find(": no such file: ") == std::string::npos) throw;
+        throw Error(e.kind(), message + "\n(scripts/demo.sh writes the demo scene the shipped protocols use; "
+                                        "--no-files skips the file checks)");
+      }
     }
-    const uint64_t seed = args->seed ? *args->seed : protocol::DefaultSeed(p.name, args->participant);
-    const auto trials = protocol::BuildTrials(p, args->participant, seed);
     if (args->list)
       for (const auto& t : trials) std::cout << protocol::ToJson(t).dump() << "\n";
     std::cout << "ok: " << trials.size() << " trials for participant " << args->participant << " with seed "

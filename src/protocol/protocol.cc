@@ -28,21 +28,73 @@ namespace {
 
 const int kEdges = 11;  // parallel edges of the 7 x 10 board (thesis figure 4.10)
 
-// JSON pointer escaping (RFC 6901): '~' -> "~0", '/' -> "~1".
-std::string Escape(const std::string& key) {
-  std::string out;
-  for (char c : key) {
-    if (c == '~') out += "~0";
-    else if (c == '/') out += "~1";
-    else out += c;
+// Limits that keep validation itself linear and its report readable whatever the file holds.
+const size_t kMaxProblems = 50;         // reported; the rest are counted
+const size_t kMaxBlocks = 100;
+const size_t kMaxFactors = 16;
+const size_t kMaxLevels = 1000;         // per factor: more than a sitting could show
+const size_t kMaxAdjustLevels = 50;     // each is low-passed up front: ~0.1 s apiece at 1280 px, ~1 s at 4K
+const size_t kMaxNameChars = 100;       // names: one line in titles, records and exports
+const size_t kMaxTextChars = 2000;      // instructions: about what a screen holds
+const size_t kMaxPathChars = 4096;
+
+std::string Escape(const std::string& key) { return EscapePointer(key); }
+
+// Appends `value` as compact JSON, stopping once `out` is longer than `limit`: a problem quotes what it got
+// without writing out a 16 MiB value first.
+void DumpBounded(const Json& value, size_t limit, std::string* out, int depth = 0) {
+  if (out->size() > limit) return;
+  if (depth > kMaxJsonDepth) {
+    *out += "...";
+    return;
   }
-  return out;
+  if (value.is_array() || value.is_object()) {
+    const bool array = value.is_array();
+    *out += array ? '[' : '{';
+    bool first = true;
+    for (const auto& [key, item] : value.items()) {
+      if (out->size() > limit) break;
+      if (!first) *out += ',';
+      first = false;
+      if (!array) *out += Json(key).dump(-1, ' ', false, Json::error_handler_t::replace) + ':';
+      DumpBounded(item, limit, out, depth + 1);
+    }
+    *out += array ? ']' : '}';
+    return;
+  }
+  if (value.is_string() && value.get_ref<const std::string&>().size() > limit + 4) {
+    // Cut at a character boundary (UTF-8 continuation bytes are 10xxxxxx): half a character cannot be dumped.
+    // Cut past the limit, so that the caller sees the value was longer than it shows.
+    const std::string& text = value.get_ref<const std::string&>();
+    size_t cut = limit + 4;
+    while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) --cut;
+    *out += Json(text.substr(0, cut)).dump(-1, ' ', false, Json::error_handler_t::replace);
+    return;
+  }
+  *out += value.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 
 std::string Got(const Json& value) {
-  std::string text = value.dump();
-  if (text.size() > 80) text = text.substr(0, 77) + "...";
+  std::string text;
+  DumpBounded(value, 80, &text);
+  if (text.size() > 80) {
+    // Cut at a character boundary (UTF-8 continuation bytes are 10xxxxxx).
+    size_t cut = 77;
+    while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) --cut;
+    text = text.substr(0, cut) + "...";
+  }
   return text;
+}
+
+// "[0.1, 100] cm/s": a closed range and its unit.
+std::string Range(double lo, double hi, const std::string& unit) {
+  char text[96];
+  std::snprintf(text, sizeof text, "[%.10g, %.10g]", lo, hi);
+  return text + (unit.empty() ? "" : " " + unit);
+}
+
+bool HasControlCharacter(const std::string& s) {
+  return std::any_of(s.begin(), s.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; });
 }
 
 size_t EditDistance(const std::string& a, const std::string& b) {
@@ -60,11 +112,21 @@ size_t EditDistance(const std::string& a, const std::string& b) {
   return row[b.size()];
 }
 
+// A fixed blur radius: the thesis's measured radii reach ~17 px; 100 px blurs a whole object away.
+const double kMaxFixedRadiusPx = 100;
+
 bool IsBlurSource(const Json& v) {
-  if (v.is_number()) return v.get<double>() >= 0;
+  if (v.is_number()) return std::isfinite(v.get<double>()) && v.get<double>() >= 0 && v.get<double>() <= kMaxFixedRadiusPx;
   if (!v.is_string()) return false;
-  static const std::set<std::string> kNames = {"none", "measured", "estimated", "fitted"};
+  static const std::set<std::string> kNames = {"none", "measured", "measured_section", "estimated", "fitted"};
   return kNames.count(v.get<std::string>()) > 0;
+}
+
+// Names whose values CheckLevelValue knows: a level of a factor so named is that value, never an object.
+bool IsValueName(const std::string& name) {
+  static const std::set<std::string> kNames = {"edge",       "from_edge",  "to_edge", "section", "speed_cm_s",
+                                               "distance_m", "cutoff",     "left",    "right"};
+  return kNames.count(name) > 0;
 }
 
 bool IsKeyName(const std::string& key) {
@@ -85,10 +147,16 @@ class Parser {
     base_ = file.has_parent_path() ? file.parent_path() : fs::path(".");
   }
 
-  std::vector<std::string> problems;
+  std::vector<std::string> problems;  // each once, in first order, at most kMaxProblems
+  size_t more_problems = 0;           // found beyond kMaxProblems
 
+  // Fields inherited by several blocks are checked once per block: each message is kept once.
   void Problem(const std::string& ptr, const std::string& what) {
-    problems.push_back(file_.string() + ": " + (ptr.empty() ? "/" : ptr) + ": " + what);
+    ++calls_;
+    std::string line = file_.string() + ": " + (ptr.empty() ? "/" : ptr) + ": " + what;
+    if (!reported_.insert(line).second) return;
+    if (problems.size() < kMaxProblems) problems.push_back(std::move(line));
+    else ++more_problems;
   }
   void Problem(const std::string& ptr, const std::string& what, const Json& got) {
     Problem(ptr, what + ", got " + Got(got));
@@ -145,41 +213,64 @@ class Parser {
     return s;
   }
 
+  // An integer in [min, max]; `unit` (e.g. "px", "trials") goes into the message.
   std::optional<int> Int(const Json& obj, const std::string& key, const std::string& ptr, bool required, int min,
-                         int max = 1 << 30) {
+                         int max, const std::string& unit = "") {
     const Json* v = Field(obj, key, ptr, required);
     if (!v) return std::nullopt;
     const std::string p = ptr + "/" + Escape(key);
+    const std::string range = "an integer in " + Range(min, max, unit);
     if (!v->is_number_integer()) {
-      Problem(p, "must be an integer", *v);
+      Problem(p, "must be " + range, *v);
       return std::nullopt;
     }
-    const long long n = v->get<long long>();
-    if (n < min || n > max) {
-      Problem(p, max == (1 << 30) ? "must be >= " + std::to_string(min)
-                                  : "must be in " + std::to_string(min) + ".." + std::to_string(max),
-              *v);
+    if (!IntegerIn(*v, min, max)) {
+      Problem(p, "must be " + range, *v);
       return std::nullopt;
     }
-    return static_cast<int>(n);
+    return static_cast<int>(v->get<int64_t>());
   }
 
-  // A number > min (strict) or >= min.
+  // A finite number in [min, max]; `unit` goes into the message.
   std::optional<double> Number(const Json& obj, const std::string& key, const std::string& ptr, bool required,
-                               double min, bool strict) {
+                               double min, double max, const std::string& unit) {
     const Json* v = Field(obj, key, ptr, required);
     if (!v) return std::nullopt;
     const std::string p = ptr + "/" + Escape(key);
-    if (!v->is_number()) {
-      Problem(p, "must be a number", *v);
+    if (!NumberIn(*v, min, max)) {
+      Problem(p, "must be a number in " + Range(min, max, unit), *v);
       return std::nullopt;
     }
-    const double x = v->get<double>();
-    if (strict ? !(x > min) : !(x >= min)) {
-      Problem(p, std::string("must be ") + (strict ? "> " : ">= ") + Json(min).dump(), *v);
+    return v->get<double>();
+  }
+
+  // True for an integer in [min, max], whether stored signed or unsigned (never wrapped).
+  static bool IntegerIn(const Json& v, int64_t min, int64_t max) {
+    if (v.is_number_unsigned()) return v.get<uint64_t>() <= static_cast<uint64_t>(std::max<int64_t>(max, 0)) &&
+                                       static_cast<int64_t>(v.get<uint64_t>()) >= min;
+    return v.is_number_integer() && v.get<int64_t>() >= min && v.get<int64_t>() <= max;
+  }
+  static bool NumberIn(const Json& v, double min, double max) {
+    if (!v.is_number()) return false;
+    const double x = v.get<double>();
+    return std::isfinite(x) && x >= min && x <= max;
+  }
+
+  // A string of at most `max_chars` bytes; `one_line`: without control characters (names, keys, paths).
+  std::optional<std::string> Text(const Json& obj, const std::string& key, const std::string& ptr, bool required,
+                                  size_t max_chars, bool one_line) {
+    const auto s = String(obj, key, ptr, required);
+    if (!s) return std::nullopt;
+    const std::string p = ptr + "/" + Escape(key);
+    if (s->size() > max_chars) {
+      Problem(p, "must be at most " + std::to_string(max_chars) + " characters, got " + std::to_string(s->size()));
       return std::nullopt;
     }
-    return x;
+    if (one_line && HasControlCharacter(*s)) {
+      Problem(p, "must not contain control characters (line breaks, tabs, NUL)", Json(*s));
+      return std::nullopt;
+    }
+    return s;
   }
 
   std::optional<bool> Bool(const Json& obj, const std::string& key, const std::string& ptr) {
@@ -194,16 +285,33 @@ class Parser {
 
   // A path relative to the protocol file's folder; checked for existence unless options say otherwise.
   fs::path Path(const Json& obj, const std::string& key, const std::string& ptr, bool required) {
-    const auto s = String(obj, key, ptr, required);
+    const auto s = Text(obj, key, ptr, required, kMaxPathChars, true);
     if (!s) return {};
     if (s->empty()) {
       Problem(ptr + "/" + Escape(key), "must name a file", Json(*s));
       return {};
     }
     const fs::path resolved = (base_ / *s).lexically_normal();
-    if (options_.check_files && !fs::is_regular_file(resolved))
-      Problem(ptr + "/" + Escape(key), "no such file: " + resolved.string(), Json(*s));
+    if (options_.check_files) CheckFile(resolved, ptr + "/" + Escape(key), Json(*s));
     return resolved;
+  }
+
+  // A regular file: not missing, not a folder, not a device (/dev/zero) or FIFO that a reader would wait on.
+  // What is in it (an image that decodes, a calibration that parses) is checked before a session: PrepareSession.
+  bool CheckFile(const fs::path& resolved, const std::string& ptr, const Json& got) {
+    std::error_code ec;
+    const fs::file_status status = fs::status(resolved, ec);
+    if (status.type() == fs::file_type::not_found)
+      Problem(ptr, "no such file: " + resolved.string(), got);
+    else if (ec)
+      Problem(ptr, "cannot look at " + resolved.string() + ": " + ec.message(), got);
+    else if (status.type() == fs::file_type::directory)
+      Problem(ptr, "is a folder, not a file: " + resolved.string(), got);
+    else if (status.type() != fs::file_type::regular)
+      Problem(ptr, "is not a regular file (a device, FIFO or socket): " + resolved.string(), got);
+    else
+      return true;
+    return false;
   }
 
   Protocol Parse(const Json& json);
@@ -218,9 +326,13 @@ class Parser {
   // Fills `b` from `obj` at `ptr`, falling back to the protocol-level defaults in `top`.
   void ParseBlock(const Json& obj, const std::string& ptr, const Json& top, Block* b);
   void ParseResponses(const Json& v, const std::string& ptr, const std::set<Task>& tasks, Responses* r);
+  void CheckDesign(const Protocol& p);
+  static bool Provides(const Block& b, const std::string& name);
 
   fs::path file_, base_;
   ValidateOptions options_;
+  std::set<std::string> reported_;
+  size_t calls_ = 0;  // problems found, repeats included
 };
 
 void Parser::ParseScene(const Json& v, const std::string& ptr, Protocol* p) {
@@ -243,18 +355,19 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
   p->content.type = *type;
   if (*type == "grid") {
     Object(v, ptr, {"type", "cells"});
-    if (auto n = Int(v, "cells", ptr, false, 1, 100)) p->content.cells = *n;
+    if (auto n = Int(v, "cells", ptr, false, 1, 100, "cells per side")) p->content.cells = *n;
   } else if (*type == "ball") {
     Object(v, ptr, {"type", "texture", "radius_mm"});
-    if (auto r = Number(v, "radius_mm", ptr, false, 0, true)) p->content.radius_mm = *r;
-    if (auto t = String(v, "texture", ptr, false)) {
+    // A ball rolls on the board's 25 mm squares: from a marble to a football.
+    if (auto r = Number(v, "radius_mm", ptr, false, 1, 150, "mm")) p->content.radius_mm = *r;
+    if (auto t = Text(v, "texture", ptr, false, kMaxPathChars, true)) {
       if (*t == "soccer" || *t == "wood") p->content.texture = *t;
       else p->content.texture = Path(v, "texture", ptr, true).string();
     }
   } else {
     Object(v, ptr, {"type", "image", "real_photos"});
     p->content.image = Path(v, "image", ptr, true);
-    if (auto pattern = String(v, "real_photos", ptr, false)) {
+    if (auto pattern = Text(v, "real_photos", ptr, false, kMaxPathChars, true)) {
       if (pattern->find("{distance_m}") == std::string::npos)
         Problem(ptr + "/real_photos", "must contain {distance_m} (one photo per distance)", Json(*pattern));
       else
@@ -266,20 +379,24 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
 // Checks a value by the name it goes by (a factor's name, or a key of an object level).
 void Parser::CheckLevelValue(const std::string& name, const Json& v, const std::string& ptr) {
   auto integer_in = [&](int lo, int hi, const std::string& what) {
-    if (!v.is_number_integer() || v.get<long long>() < lo || v.get<long long>() > hi)
-      Problem(ptr, what + " must be an integer in " + std::to_string(lo) + ".." + std::to_string(hi), v);
+    if (!IntegerIn(v, lo, hi)) Problem(ptr, what + " must be an integer in " + Range(lo, hi, ""), v);
   };
-  auto positive = [&](const std::string& what) {
-    if (!v.is_number() || !(v.get<double>() > 0)) Problem(ptr, what + " must be a number > 0", v);
+  auto number_in = [&](double lo, double hi, const std::string& unit, const std::string& what) {
+    if (!NumberIn(v, lo, hi)) Problem(ptr, what + " must be a number in " + Range(lo, hi, unit), v);
   };
   if (name == "edge" || name == "from_edge" || name == "to_edge") integer_in(1, kEdges, "an edge");
   else if (name == "section") integer_in(1, kEdges - 1, "a section (edge s to s + 1)");
-  else if (name == "speed_cm_s") positive("a speed");
-  else if (name == "distance_m") positive("a distance");
-  else if (name == "cutoff") {
-    if (!v.is_number() || v.get<double>() < 0) Problem(ptr, "a cut-off must be a number >= 0", v);
-  } else if (name == "left" || name == "right") {
-    if (!IsBlurSource(v)) Problem(ptr, "a blur source must be none, measured, estimated, fitted or a radius >= 0", v);
+  // The thesis rolled at 1.8 and 3 cm/s; 1 mm/s takes 4 minutes over the board, 1 m/s a quarter second.
+  else if (name == "speed_cm_s") number_in(0.1, 100, "cm/s", "a speed");
+  else if (name == "distance_m") number_in(0.1, 100, "m", "a distance");
+  // Cycles per picture width; 0 shows the picture unfiltered.
+  else if (name == "cutoff") number_in(0, 1000, "cycles per picture width", "a cut-off");
+  else if (name == "left" || name == "right") {
+    if (!IsBlurSource(v))
+      Problem(ptr, "a blur source must be none, measured, measured_section, estimated, fitted or a radius in " +
+                       Range(0, kMaxFixedRadiusPx, "px"), v);
+  } else if (v.is_number() && !std::isfinite(v.get<double>())) {
+    Problem(ptr, "must be a finite number", v);
   }
 }
 
@@ -290,9 +407,18 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
     return factors;
   }
   if (v.empty()) Problem(ptr, "must name at least one factor", v);
+  if (v.size() > kMaxFactors) {
+    Problem(ptr, "may name at most " + std::to_string(kMaxFactors) + " factors, got " + std::to_string(v.size()));
+    return factors;
+  }
   int carrying_sides = 0;
   for (const auto& [name, levels] : v.items()) {
     const std::string fp = ptr + "/" + Escape(name);
+    if (name.empty() || name.size() > kMaxNameChars || HasControlCharacter(name)) {
+      Problem(fp, "a factor name must be 1 to " + std::to_string(kMaxNameChars) +
+                      " characters without control characters", Json(name));
+      continue;
+    }
     if (!levels.is_array()) {
       Problem(fp, "must be a list of levels", levels);
       continue;
@@ -301,8 +427,13 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
       Problem(fp, "must list at least one level", levels);
       continue;
     }
+    if (levels.size() > kMaxLevels) {
+      Problem(fp, "may list at most " + std::to_string(kMaxLevels) + " levels, got " + std::to_string(levels.size()));
+      continue;
+    }
     Factor f{name, {}};
     bool sides = false;
+    std::map<std::string, size_t> seen;  // a level's text -> its first index
     for (size_t i = 0; i < levels.size(); ++i) {
       const Json& level = levels[i];
       const std::string lp = fp + "/" + std::to_string(i);
@@ -310,10 +441,17 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
         Problem(lp, "a level must be a number, a string or an object", level);
         continue;
       }
-      for (size_t j = 0; j < i; ++j)
-        if (levels[j] == level) Problem(lp, "repeats level " + std::to_string(j), level);
-      if (level.is_object()) {
-        for (const auto& [key, value] : level.items()) CheckLevelValue(key, value, lp + "/" + Escape(key));
+      // Repeats found by the text of each level (numbers by value: 2 and 2.0 are one level), in linear time.
+      const std::string text = level.is_number() ? Json(level.get<double>()).dump() : level.dump();
+      if (const auto [first, fresh] = seen.emplace(text, i); !fresh)
+        Problem(lp, "repeats level " + std::to_string(first->second), level);
+      // A factor named for a value (edge, speed_cm_s, ...) holds that value itself; any other factor's object
+      // levels carry named values.
+      if (level.is_object() && !IsValueName(name)) {
+        for (const auto& [key, value] : level.items()) {
+          if (value.is_object() || value.is_array()) Problem(lp + "/" + Escape(key), "must be a number or a string", value);
+          else CheckLevelValue(key, value, lp + "/" + Escape(key));
+        }
         const bool l = level.contains("left"), r = level.contains("right");
         if (l != r) Problem(lp, std::string("has \"") + (l ? "left" : "right") + "\" but no \"" + (l ? "right" : "left") + "\"", level);
         if (l && r) sides = true;
@@ -335,12 +473,13 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
 std::optional<Adjustment> Parser::ParseAdjust(const Json& v, const std::string& ptr) {
   if (!Object(v, ptr, {"parameter", "levels", "order"})) return std::nullopt;
   Adjustment a;
-  if (auto s = String(v, "parameter", ptr, false)) a.parameter = *s;
+  // The renderer steps through Butterworth cut-offs of a picture; no other parameter is drawn.
+  if (auto s = String(v, "parameter", ptr, false, {"cutoff"})) a.parameter = *s;
   if (auto s = String(v, "order", ptr, false, {"shuffled", "ascending", "descending"})) a.order = *s;
   const Json* levels = Field(v, "levels", ptr, true);
   if (!levels) return a;
-  if (!levels->is_array() || levels->size() < 2) {
-    Problem(ptr + "/levels", "must be a list of at least 2 numbers", *levels);
+  if (!levels->is_array() || levels->size() < 2 || levels->size() > kMaxAdjustLevels) {
+    Problem(ptr + "/levels", "must be a list of 2 to " + std::to_string(kMaxAdjustLevels) + " numbers", *levels);
     return a;
   }
   for (size_t i = 0; i < levels->size(); ++i) {
@@ -367,7 +506,7 @@ void Parser::ParseSides(const Json& v, const std::string& ptr) {
 
 void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top, Block* b) {
   // A field of the block, else of the protocol: the object that holds it and that object's pointer. Inherited
-  // fields are checked again per block; ParseProtocol drops the repeated messages.
+  // fields are checked again per block; Problem() keeps each message once.
   struct Source {
     const Json* holder = nullptr;
     std::string ptr;
@@ -379,19 +518,22 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
   };
   if (const Source s = pick("task"); !s.holder) {
     Problem(ptr + "/task", "is required (here or at /task) but missing");
-  } else if (auto t = String(*s.holder, "task", s.ptr, true, {"forced_choice", "adjustment"})) {
+  } else if (b->task_pointer = s.ptr + "/task";
+             auto t = String(*s.holder, "task", s.ptr, true, {"forced_choice", "adjustment"})) {
     b->task = *t == "adjustment" ? Task::kAdjustment : Task::kForcedChoice;
   }
-  const size_t before_factors = problems.size();
+  b->pointer = ptr;
+  const size_t calls_before_factors = calls_;
   if (const Source s = pick("factors"); !s.holder)
     Problem(ptr + "/factors", "is required (here or at /factors) but missing");
   else
-    b->factors = ParseFactors((*s.holder)["factors"], s.ptr + "/factors");
-  const bool factors_ok = problems.size() == before_factors;
+    b->factors = ParseFactors((*s.holder)["factors"], s.ptr + "/factors"), b->factors_pointer = s.ptr + "/factors";
+  const bool factors_ok = calls_ == calls_before_factors;
   if (const Source s = pick("repetitions"); s.holder) {
-    if (auto n = Int(*s.holder, "repetitions", s.ptr, true, 1, 10000)) b->repetitions = *n;
+    if (auto n = Int(*s.holder, "repetitions", s.ptr, true, 1, kMaxTrials, "repetitions")) b->repetitions = *n;
   }
   if (const Source s = pick("counterbalance"); s.holder) {
+    b->counterbalance_pointer = s.ptr + "/counterbalance";
     if (auto c = String(*s.holder, "counterbalance", s.ptr, true, {"swap_copies", "by_participant", "none"}))
       b->counterbalance = *c == "swap_copies"      ? Counterbalance::kSwapCopies
                           : *c == "by_participant" ? Counterbalance::kByParticipant
@@ -401,11 +543,12 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
   if (sides.holder) {
     ParseSides((*sides.holder)["sides"], sides.ptr + "/sides");
     b->sides = (*sides.holder)["sides"];
+    b->sides_pointer = sides.ptr + "/sides";
   }
   const Source adjust = pick("adjust");
   if (adjust.holder && b->task == Task::kAdjustment)
     b->adjust = ParseAdjust((*adjust.holder)["adjust"], adjust.ptr + "/adjust");
-  if (auto s = String(obj, "instructions", ptr, false)) b->instructions = *s;
+  if (auto s = Text(obj, "instructions", ptr, false, kMaxTextChars, false)) b->instructions = *s;
   if (auto s = Bool(obj, "shuffle", ptr)) b->shuffle = *s;
 
   // What is shown left and right must be known for a comparison, and for any left/right counterbalancing.
@@ -461,13 +604,13 @@ Protocol Parser::Parse(const Json& json) {
                "counterbalance", "sides", "adjust", "blocks", "practice", "instructions", "breaks", "responses",
                "timing", "display"}))
     return p;
-  if (auto s = String(json, "name", "", true)) {
+  if (auto s = Text(json, "name", "", true, kMaxNameChars, true)) {
     if (s->empty()) Problem("/name", "must not be empty", Json(*s));
     p.name = *s;
   }
-  if (auto n = Int(json, "version", "", true, 1)) p.version = *n;
-  if (auto s = String(json, "description", "", false)) p.description = *s;
-  if (auto s = String(json, "instructions", "", false)) p.instructions = *s;
+  if (auto n = Int(json, "version", "", true, 1, 1000000)) p.version = *n;
+  if (auto s = Text(json, "description", "", false, 5 * kMaxTextChars, false)) p.description = *s;
+  if (auto s = Text(json, "instructions", "", false, kMaxTextChars, false)) p.instructions = *s;
   if (const Json* v = Field(json, "content", "", true)) ParseContent(*v, "/content", &p);
   if (const Json* v = Field(json, "scene", "", true)) ParseScene(*v, "/scene", &p);
   if (json.contains("scene") && json["scene"].is_object() && !json["scene"].contains("calib") &&
@@ -478,7 +621,7 @@ Protocol Parser::Parse(const Json& json) {
   if (json.contains("factors")) ParseFactors(json["factors"], "/factors");
   if (json.contains("sides")) ParseSides(json["sides"], "/sides");
   if (json.contains("adjust")) ParseAdjust(json["adjust"], "/adjust");
-  if (json.contains("repetitions")) Int(json, "repetitions", "", true, 1, 10000);
+  if (json.contains("repetitions")) Int(json, "repetitions", "", true, 1, kMaxTrials, "repetitions");
   if (json.contains("counterbalance"))
     String(json, "counterbalance", "", true, {"swap_copies", "by_participant", "none"});
   if (json.contains("task")) String(json, "task", "", true, {"forced_choice", "adjustment"});
@@ -489,8 +632,8 @@ Protocol Parser::Parse(const Json& json) {
     b.name = "main";
     ParseBlock(Json::object(), "", json, &b);
     p.blocks.push_back(std::move(b));
-  } else if (!blocks->is_array() || blocks->empty()) {
-    Problem("/blocks", "must be a non-empty list of blocks", *blocks);
+  } else if (!blocks->is_array() || blocks->empty() || blocks->size() > kMaxBlocks) {
+    Problem("/blocks", "must be a list of 1 to " + std::to_string(kMaxBlocks) + " blocks", *blocks);
   } else {
     for (size_t i = 0; i < blocks->size(); ++i) {
       const Json& obj = (*blocks)[i];
@@ -499,7 +642,7 @@ Protocol Parser::Parse(const Json& json) {
                             "instructions", "shuffle"}))
         continue;
       Block b;
-      if (auto s = String(obj, "name", bp, true)) {
+      if (auto s = Text(obj, "name", bp, true, kMaxNameChars, true)) {
         if (s->empty()) Problem(bp + "/name", "must not be empty", Json(*s));
         for (const auto& other : p.blocks)
           if (other.name == *s) Problem(bp + "/name", "repeats the name of an earlier block", Json(*s));
@@ -512,8 +655,8 @@ Protocol Parser::Parse(const Json& json) {
 
   if (const Json* v = Field(json, "practice", "", false)) {
     if (Object(*v, "/practice", {"count", "block", "instructions"})) {
-      if (auto n = Int(*v, "count", "/practice", true, 0)) p.practice.count = *n;
-      if (auto s = String(*v, "instructions", "/practice", false)) p.practice.instructions = *s;
+      if (auto n = Int(*v, "count", "/practice", true, 0, 1000, "trials")) p.practice.count = *n;
+      if (auto s = Text(*v, "instructions", "/practice", false, kMaxTextChars, false)) p.practice.instructions = *s;
       p.practice.block = p.blocks.empty() ? "" : p.blocks.front().name;
       if (auto s = String(*v, "block", "/practice", false)) {
         bool found = false;
@@ -525,8 +668,8 @@ Protocol Parser::Parse(const Json& json) {
   }
   if (const Json* v = Field(json, "breaks", "", false)) {
     if (Object(*v, "/breaks", {"every_trials", "text"})) {
-      if (auto n = Int(*v, "every_trials", "/breaks", true, 1)) p.break_every_trials = *n;
-      if (auto s = String(*v, "text", "/breaks", false)) p.break_text = *s;
+      if (auto n = Int(*v, "every_trials", "/breaks", true, 1, kMaxTrials, "trials")) p.break_every_trials = *n;
+      if (auto s = Text(*v, "text", "/breaks", false, kMaxTextChars, false)) p.break_text = *s;
     }
   }
   // The real photos: one per distance the design shows.
@@ -534,10 +677,12 @@ Protocol Parser::Parse(const Json& json) {
     const std::set<double> distances = NumericLevels(p, "distance_m");
     if (distances.empty())
       Problem("/content/real_photos", "needs a factor distance_m to choose the photo by", Json(p.content.real_photos));
-    for (double d : distances)
-      if (const fs::path photo = RealPhotoFor(p.content, d); !fs::is_regular_file(photo))
+    for (double d : distances) {
+      std::error_code ec;
+      if (const fs::path photo = RealPhotoFor(p.content, d); !fs::is_regular_file(photo, ec))
         Problem("/content/real_photos", "no photo for distance_m " + Json(d).dump() + ": " + photo.string(),
                 json["content"]["real_photos"]);
+    }
   }
   std::set<Task> tasks;
   for (const auto& b : p.blocks) tasks.insert(b.task);
@@ -546,27 +691,93 @@ Protocol Parser::Parse(const Json& json) {
   if (const Json* v = Field(json, "timing", "", false)) {
     if (Object(*v, "/timing", {"stimulus_ms", "inter_trial_ms"})) {
       if (const Json* s = Field(*v, "stimulus_ms", "/timing", false)) {
+        // From about a frame to a minute.
         if (s->is_string() && *s == "until_response") p.timing.stimulus_ms = 0;
-        else if (s->is_number() && s->get<double>() > 0) p.timing.stimulus_ms = s->get<double>();
-        else Problem("/timing/stimulus_ms", "must be a duration > 0 ms or \"until_response\"", *s);
+        else if (NumberIn(*s, 10, 60000)) p.timing.stimulus_ms = s->get<double>();
+        else Problem("/timing/stimulus_ms", "must be a duration in " + Range(10, 60000, "ms") + " or \"until_response\"", *s);
       }
-      if (auto x = Number(*v, "inter_trial_ms", "/timing", false, 0, false)) p.timing.inter_trial_ms = *x;
+      if (auto x = Number(*v, "inter_trial_ms", "/timing", false, 0, 60000, "ms")) p.timing.inter_trial_ms = *x;
     }
   }
   if (const Json* v = Field(json, "display", "", false)) {
     if (Object(*v, "/display", {"width_px", "height_px", "fullscreen", "monitor"})) {
-      if (auto n = Int(*v, "width_px", "/display", false, 1, 16384)) p.display.width_px = *n;
-      if (auto n = Int(*v, "height_px", "/display", false, 1, 16384)) p.display.height_px = *n;
+      // From VGA's 320 x 240 to 4K UHD (a depth-matching frame as wide as the display is filtered on the CPU).
+      if (auto n = Int(*v, "width_px", "/display", false, 320, 3840, "px")) p.display.width_px = *n;
+      if (auto n = Int(*v, "height_px", "/display", false, 240, 2160, "px")) p.display.height_px = *n;
       if (auto b = Bool(*v, "fullscreen", "/display")) p.display.fullscreen = *b;
       if (auto n = Int(*v, "monitor", "/display", false, 0, 16)) p.display.monitor = *n;
     }
   }
-  // Fields inherited by several blocks were checked once per block: keep each message once, in first order.
-  std::vector<std::string> unique;
-  for (const auto& line : problems)
-    if (std::find(unique.begin(), unique.end(), line) == unique.end()) unique.push_back(line);
-  problems = std::move(unique);
+  CheckDesign(p);
   return p;
+}
+
+// The design as a whole, once every field is valid: what each block shows fits the content, every trial has
+// the levels its content needs, and the session's size is within the cap.
+void Parser::CheckDesign(const Protocol& p) {
+  if (calls_ > 0) return;  // a design built from fields with problems would only repeat them
+  const std::string& type = p.content.type;
+  for (const auto& b : p.blocks) {
+    // The renderer draws a picture for adjustment (cut-offs) and a pair of grids or balls for forced choice.
+    if (type == "picture" && b.task != Task::kAdjustment)
+      Problem(b.task_pointer, "must be adjustment for a picture (forced_choice compares a pair of grids or balls)",
+              Json(ToString(b.task)));
+    if (type != "picture" && b.task == Task::kAdjustment)
+      Problem(b.task_pointer, "must be forced_choice for a " + type + " (adjustment steps through the cut-offs of a "
+                              "picture)", Json(ToString(b.task)));
+    if (type == "grid" && !Provides(b, "edge"))
+      Problem(b.factors_pointer, "a grid stands at an edge: needs a factor edge, or a factor whose every level has "
+                                 "an edge (1..11)");
+    if (type == "picture" && !p.content.real_photos.empty() && !Provides(b, "distance_m"))
+      Problem(b.factors_pointer, "content.real_photos chooses the photo by distance: needs a factor distance_m, or "
+                                 "a factor whose every level has a distance_m");
+  }
+  const int64_t trials = SessionTrials(p);
+  if (trials > kMaxTrials) {
+    // Where the trials come from: the biggest block, with its crossing spelled out (in floating point: the
+    // product may not fit in 64 bits).
+    const Block* biggest = nullptr;
+    double most = -1, total = 0;
+    std::string crossing;
+    for (const auto& b : p.blocks) {
+      double n = b.repetitions * (b.counterbalance == Counterbalance::kSwapCopies ? 2.0 : 1.0);
+      std::string spelled;
+      for (const auto& f : b.factors) {
+        n *= double(f.levels.size());
+        spelled += std::to_string(f.levels.size()) + " " + f.name + " x ";
+      }
+      total += n;
+      if (n > most) {
+        most = n, biggest = &b;
+        crossing = spelled + std::to_string(b.repetitions) + " repetitions" +
+                   (b.counterbalance == Counterbalance::kSwapCopies ? " x 2 (swap_copies)" : "");
+      }
+    }
+    char text[64];
+    std::snprintf(text, sizeof text, total < 1e15 ? "%.0f" : "%.3g", total);
+    Problem(biggest ? biggest->factors_pointer : "/",
+            "the session would have " + std::string(text) + " trials (" + crossing + "); a session may have at most " +
+                std::to_string(kMaxTrials) + " trials, practice included");
+  } else if (trials == 0) {
+    Problem("/", "makes no trials");
+  }
+  for (const auto& b : p.blocks)
+    if (b.name == p.practice.block && p.practice.count > DesignTrials(b) && DesignTrials(b) <= kMaxTrials)
+      Problem("/practice/count", "asks for " + std::to_string(p.practice.count) + " practice trials but block " +
+                                     b.name + " has only " + std::to_string(DesignTrials(b)),
+              Json(p.practice.count));
+}
+
+// True when every trial of `b` has a level `name`: a factor of that name, or a factor whose levels all carry it.
+bool Parser::Provides(const Block& b, const std::string& name) {
+  for (const auto& f : b.factors) {
+    if (f.name == name) return true;
+    if (!f.levels.empty() && std::all_of(f.levels.begin(), f.levels.end(), [&](const Json& level) {
+          return level.is_object() && level.contains(name);
+        }))
+      return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -574,6 +785,8 @@ Protocol Parser::Parse(const Json& json) {
 std::vector<std::string> Validate(const Json& json, const fs::path& file, const ValidateOptions& options) {
   Parser parser(file, options);
   parser.Parse(json);
+  if (parser.more_problems > 0)
+    parser.problems.push_back(file.string() + ": " + std::to_string(parser.more_problems) + " more problems not listed");
   return parser.problems;
 }
 
@@ -583,10 +796,48 @@ Protocol ParseProtocol(const Json& json, const fs::path& file, const ValidateOpt
   if (!parser.problems.empty()) {
     std::string message;
     for (const auto& line : parser.problems) message += (message.empty() ? "" : "\n") + line;
-    if (parser.problems.size() > 1) message += "\n(" + std::to_string(parser.problems.size()) + " problems)";
+    const size_t count = parser.problems.size() + parser.more_problems;
+    if (parser.more_problems > 0) message += "\n(" + std::to_string(count) + " problems, the first " +
+                                             std::to_string(parser.problems.size()) + " listed)";
+    else if (count > 1) message += "\n(" + std::to_string(count) + " problems)";
     throw Error(ErrorKind::kInput, message);
   }
   return p;
+}
+
+int64_t DesignTrials(const Block& block) {
+  if (block.factors.empty()) return 0;
+  // Saturating: once past the cap the exact number does not matter, and it can no longer overflow.
+  int64_t n = block.repetitions * (block.counterbalance == Counterbalance::kSwapCopies ? 2 : 1);
+  for (const auto& f : block.factors) {
+    n *= static_cast<int64_t>(f.levels.size());
+    if (n > kMaxTrials) return kMaxTrials + 1;
+  }
+  return n;
+}
+
+int64_t SessionTrials(const Protocol& protocol) {
+  int64_t n = 0;
+  for (const auto& b : protocol.blocks) {
+    n += DesignTrials(b);
+    if (b.name == protocol.practice.block) n += std::min<int64_t>(protocol.practice.count, DesignTrials(b));
+    if (n > kMaxTrials) return kMaxTrials + 1;
+  }
+  return n;
+}
+
+std::string EscapePointer(const std::string& key) {
+  std::string out;
+  for (char c : key) {
+    if (c == '~') out += "~0";
+    else if (c == '/') out += "~1";
+    else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      char text[8];
+      std::snprintf(text, sizeof text, "\\u%04x", static_cast<unsigned char>(c));
+      out += text;
+    } else out += c;
+  }
+  return out;
 }
 
 Protocol LoadProtocol(const fs::path& file, const ValidateOptions& options) {

@@ -2,6 +2,7 @@
 // A study protocol: a JSON file (format in protocols/protocol.schema.json) parsed into a validated `Protocol`.
 // Validation reports every problem at once, each as "FILE: /json/pointer: what is wrong, got VALUE", so one run of
 // `blurcue validate` shows all typos, wrong types, missing fields, impossible values and missing files.
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <set>
@@ -31,9 +32,16 @@ struct Adjustment {
   std::string order = "shuffled";     // "shuffled" (a fresh random order per trial) | "ascending" | "descending"
 };
 
+// The most trials a session may have, practice included: at ~2 s a trial, more than five hours. Checked (with
+// overflow-safe arithmetic) before a trial list is made, so no design can exhaust memory or wrap a count.
+inline constexpr int kMaxTrials = 10000;
+
 // A block of trials with its own design; blocks run in file order, trials are randomised within a block.
 struct Block {
   std::string name;
+  // JSON pointers of where the block's fields were read ("" is the top level for an inherited field), so a
+  // problem found later (a source that cannot be evaluated) names the field that asked for it.
+  std::string pointer, task_pointer, factors_pointer, sides_pointer, counterbalance_pointer;
   Task task = Task::kForcedChoice;
   std::vector<Factor> factors;        // crossed in full; sorted by name (JSON object order)
   int repetitions = 1;
@@ -102,6 +110,15 @@ struct Protocol {
   Timing timing;
   Display display;
 };
+
+// Trials of one block's design (crossing x repetitions x swapped copies), or kMaxTrials + 1 when it has more.
+int64_t DesignTrials(const Block& block);
+// Trials of a session (practice included), or kMaxTrials + 1 when it would have more.
+int64_t SessionTrials(const Protocol& protocol);
+
+// JSON pointer escaping (RFC 6901: '~' -> "~0", '/' -> "~1"); control characters are written as \uXXXX so a
+// message naming a key stays on one line.
+std::string EscapePointer(const std::string& key);
 
 // Every distinct number among the levels of the factor named `factor`, over all blocks, ascending.
 std::set<double> NumericLevels(const Protocol& protocol, const std::string& factor);

@@ -61,13 +61,13 @@ TEST(ProtocolValidate, ProblemStartsWithFileAndPointer) {
   Json j = Valid();
   j["version"] = 0;
   const std::string p = OnlyProblem(j);
-  EXPECT_EQ(p, (SceneFolder() / "p.json").string() + ": /version: must be >= 1, got 0");
+  EXPECT_EQ(p, (SceneFolder() / "p.json").string() + ": /version: must be an integer in [1, 1000000], got 0");
 }
 
 TEST(ProtocolValidate, WrongTypeNamesPointer) {
   Json j = Valid();
   j["blocks"][0]["repetitions"] = "two";
-  EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/0/repetitions: must be an integer, got \"two\"")) << OnlyProblem(j);
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/0/repetitions: must be an integer in [1, 10000] repetitions, got \"two\"")) << OnlyProblem(j);
 }
 
 TEST(ProtocolValidate, UnknownKeyNamesPointerAndNearestKey) {
@@ -89,7 +89,7 @@ TEST(ProtocolValidate, MissingFieldNamesPointer) {
 TEST(ProtocolValidate, NonPositiveSpeedRejected) {
   Json j = Valid();
   j["blocks"][0]["factors"]["pattern"][1]["speed_cm_s"] = 0;
-  EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/0/factors/pattern/1/speed_cm_s: a speed must be a number > 0, got 0"))
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/0/factors/pattern/1/speed_cm_s: a speed must be a number in [0.1, 100] cm/s, got 0"))
       << OnlyProblem(j);
 }
 
@@ -97,14 +97,14 @@ TEST(ProtocolValidate, SectionOutsideTheBoardRejected) {
   Json j = Valid();
   j["blocks"][1]["factors"]["section"][2] = 11;
   EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/1/factors/section/2: a section (edge s to s + 1) must be an integer "
-                                       "in 1..10, got 11")) << OnlyProblem(j);
+                                       "in [1, 10], got 11")) << OnlyProblem(j);
 }
 
 TEST(ProtocolValidate, EdgeOutsideOneToElevenRejected) {
   Json j = Valid();
   j["blocks"][1]["factors"] = {{"edge", {1, 12}}};
   j["blocks"][1]["sides"] = {{"left", "measured"}, {"right", "estimated"}};
-  EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/1/factors/edge/1: an edge must be an integer in 1..11, got 12"))
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/1/factors/edge/1: an edge must be an integer in [1, 11], got 12"))
       << OnlyProblem(j);
 }
 
@@ -112,7 +112,7 @@ TEST(ProtocolValidate, UnknownBlurSourceRejected) {
   Json j = Valid();
   j["blocks"][0]["factors"]["pattern"][0]["right"] = "blurry";
   EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/0/factors/pattern/0/right: a blur source must be none, measured, "
-                                       "estimated, fitted or a radius >= 0, got \"blurry\"")) << OnlyProblem(j);
+                                       "estimated, fitted or a radius in [0, 100] px, got \"blurry\"")) << OnlyProblem(j);
 }
 
 TEST(ProtocolValidate, EmptyFactorRejected) {
@@ -180,7 +180,7 @@ TEST(ProtocolValidate, DuplicateResponseKeysRejected) {
 TEST(ProtocolValidate, InheritedProblemReportedOnce) {
   Json j = Valid();
   j["repetitions"] = -1;  // both blocks inherit it
-  EXPECT_TRUE(Contains(OnlyProblem(j), ": /repetitions: must be in 1..10000, got -1")) << OnlyProblem(j);
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /repetitions: must be an integer in [1, 10000] repetitions, got -1")) << OnlyProblem(j);
 }
 
 TEST(ProtocolValidate, SeveralProblemsThrownTogether) {
@@ -198,9 +198,165 @@ TEST(ProtocolValidate, SeveralProblemsThrownTogether) {
     EXPECT_TRUE(Contains(m, "/name: must be a string, got 7\n")) << m;
     EXPECT_TRUE(Contains(m, "/scene/background: no such file")) << m;
     EXPECT_TRUE(Contains(m, "/blocks/0/factors/pattern: must list at least one level")) << m;
-    EXPECT_TRUE(Contains(m, "/display/width_px: must be in 1..16384, got -5")) << m;
+    EXPECT_TRUE(Contains(m, "/display/width_px: must be an integer in [320, 3840] px, got -5")) << m;
     EXPECT_TRUE(Contains(m, "(4 problems)")) << m;
   }
+}
+
+TEST(ProtocolValidate, SpeedTooSlowToEverArriveRejectedWithItsUnit) {
+  Json j = Valid();
+  j["blocks"][0]["factors"]["pattern"][0]["speed_cm_s"] = 1e-300;
+  EXPECT_TRUE(Contains(OnlyProblem(j), "/blocks/0/factors/pattern/0/speed_cm_s: a speed must be a number in "
+                                       "[0.1, 100] cm/s, got 1e-300")) << OnlyProblem(j);
+}
+
+TEST(ProtocolValidate, InterTrialIntervalBeyondAMinuteRejected) {
+  Json j = Valid();
+  j["timing"] = {{"inter_trial_ms", 1e308}, {"stimulus_ms", 5}};
+  const auto problems = Problems(j);
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_TRUE(Contains(problems[0], "/timing/stimulus_ms: must be a duration in [10, 60000] ms or \"until_response\", "
+                                    "got 5")) << problems[0];
+  EXPECT_TRUE(Contains(problems[1], "/timing/inter_trial_ms: must be a number in [0, 60000] ms, got 1e+308"))
+      << problems[1];
+}
+
+TEST(ProtocolValidate, FixedRadiusAndBallSizeHaveRanges) {
+  Json j = Valid();
+  j["blocks"][0]["factors"]["pattern"][0]["left"] = 1e6;
+  j["content"]["radius_mm"] = 0.001;
+  const auto problems = Problems(j);
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_TRUE(Contains(problems[0], "/content/radius_mm: must be a number in [1, 150] mm, got 0.001")) << problems[0];
+  EXPECT_TRUE(Contains(problems[1], "/blocks/0/factors/pattern/0/left: a blur source must be")) << problems[1];
+}
+
+TEST(ProtocolValidate, TrialCountOverTheCapRejectedNamingTheCap) {
+  Json j = Valid();
+  Json factors = Json::object();
+  for (int f = 0; f < 8; ++f) {
+    Json levels = Json::array();
+    for (int l = 0; l < 30; ++l) levels.push_back(l);
+    factors["f" + std::to_string(f)] = levels;
+  }
+  factors["pattern"] = j["blocks"][0]["factors"]["pattern"];
+  j["blocks"][0]["factors"] = factors;
+  const std::string p = OnlyProblem(j);
+  EXPECT_TRUE(Contains(p, "/blocks/0/factors: the session would have 2624400000006 trials (30 f0 x ")) << p;
+  EXPECT_TRUE(Contains(p, "a session may have at most 10000 trials, practice included")) << p;
+}
+
+TEST(ProtocolValidate, TrialCountBeyondSixtyFourBitsIsStillRefused) {
+  Json j = Valid();
+  Json factors = Json::object();
+  for (int f = 0; f < 15; ++f) {
+    Json levels = Json::array();
+    for (int l = 0; l < 1000; ++l) levels.push_back(l);
+    factors["f" + std::to_string(f)] = levels;  // 1000^15 = 1e45 trials
+  }
+  factors["pattern"] = j["blocks"][0]["factors"]["pattern"];
+  j["blocks"][0]["factors"] = factors;
+  EXPECT_TRUE(Contains(OnlyProblem(j), "a session may have at most 10000 trials")) << OnlyProblem(j);
+  j["repetitions"] = 10000;  // a small crossing, repeated past the cap
+  j["blocks"][0]["factors"] = {{"pattern", Valid()["blocks"][0]["factors"]["pattern"]}};
+  EXPECT_TRUE(Contains(OnlyProblem(j), "the session would have 100000 trials")) << OnlyProblem(j);
+}
+
+TEST(ProtocolValidate, TooManyLevelsRejectedBeforeComparingThem) {
+  Json j = Valid();
+  Json levels = Json::array();
+  for (int l = 0; l < 200000; ++l) levels.push_back(1);  // pairwise repeat checks would take minutes
+  j["blocks"][1]["factors"]["section"] = levels;
+  EXPECT_TRUE(Contains(OnlyProblem(j), "/blocks/1/factors/section: may list at most 1000 levels, got 200000"));
+}
+
+TEST(ProtocolValidate, ProblemsBeyondFiftyAreCounted) {
+  Json j = Valid();
+  for (int k = 0; k < 5000; ++k) j["extra" + std::to_string(k)] = k;
+  const auto problems = Problems(j);
+  ASSERT_EQ(problems.size(), 51u);
+  EXPECT_TRUE(Contains(problems.back(), "p.json: 4950 more problems not listed")) << problems.back();
+}
+
+TEST(ProtocolValidate, ContentAndTaskMustFit) {
+  Json j = Valid();
+  j["blocks"][1]["task"] = "adjustment";
+  j["blocks"][1]["adjust"] = {{"levels", {2, 4}}};
+  EXPECT_TRUE(Contains(OnlyProblem(j), "/blocks/1/task: must be forced_choice for a ball")) << OnlyProblem(j);
+}
+
+TEST(ProtocolValidate, GridWithoutEdgeRejected) {
+  Json j = Valid();
+  j["content"] = {{"type", "grid"}};
+  j["blocks"].erase(1);
+  EXPECT_TRUE(Contains(OnlyProblem(j), "/blocks/0/factors: a grid stands at an edge")) << OnlyProblem(j);
+}
+
+TEST(ProtocolValidate, MorePracticeThanTheDesignHasRejected) {
+  Json j = Valid();
+  j["practice"] = {{"count", 7}, {"block", "task2"}};
+  EXPECT_TRUE(Contains(OnlyProblem(j), "/practice/count: asks for 7 practice trials but block task2 has only 6"))
+      << OnlyProblem(j);
+}
+
+TEST(ProtocolValidate, FolderOrDeviceWhereAFileBelongsRejected) {
+  Json j = Valid();
+  j["scene"]["calib"] = ".";
+  j["scene"]["background"] = "/dev/zero";
+  const auto problems = Problems(j);
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_TRUE(Contains(problems[0], "/scene/background: is not a regular file (a device, FIFO or socket): /dev/zero"))
+      << problems[0];
+  EXPECT_TRUE(Contains(problems[1], "/scene/calib: is a folder, not a file: ")) << problems[1];
+}
+
+TEST(ProtocolValidate, ControlCharactersInNamesAndPathsRejected) {
+  Json j = Valid();
+  j["name"] = "two\nlines";
+  j["scene"]["background"] = std::string("scene/scene.png\0junk", 20);
+  const auto problems = Problems(j);
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_TRUE(Contains(problems[0], "/name: must not contain control characters")) << problems[0];
+  EXPECT_TRUE(Contains(problems[1], "/scene/background: must not contain control characters")) << problems[1];
+}
+
+TEST(ProtocolValidate, KeyWithALineBreakIsNamedOnOneLine) {
+  Json j = Valid();
+  j["bad\nkey"] = 1;
+  const std::string p = OnlyProblem(j);
+  EXPECT_EQ(p.find('\n'), std::string::npos) << p;
+  EXPECT_TRUE(Contains(p, "/bad\\u000akey: unknown key")) << p;
+}
+
+TEST(ProtocolValidate, RepeatedLevelNamesItsFirstOccurrence) {
+  Json j = Valid();
+  j["blocks"][1]["factors"]["size"] = {1, 2, 1.0, 3, 2};
+  const auto problems = Problems(j);
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_TRUE(Contains(problems[0], "/blocks/1/factors/size/2: repeats level 0, got 1.0")) << problems[0];
+  EXPECT_TRUE(Contains(problems[1], "/blocks/1/factors/size/4: repeats level 1, got 2")) << problems[1];
+}
+
+TEST(ProtocolValidate, ObjectLevelOfAValueFactorRejected) {
+  Json j = Valid();
+  j["blocks"][1]["factors"]["section"][1] = Json::object();  // would show section "{}" as the whole run
+  EXPECT_TRUE(Contains(OnlyProblem(j), "/blocks/1/factors/section/1: a section (edge s to s + 1) must be an integer "
+                                       "in [1, 10], got {}")) << OnlyProblem(j);
+}
+
+TEST(ProtocolValidate, LongUnicodeValueIsQuotedCutAtACharacter) {
+  Json j = Valid();
+  std::string name;
+  for (int i = 0; i < 1000; ++i) name += "\u6f22";  // three bytes each: a cut at 80 bytes falls inside one
+  j["name"] = name;
+  const std::string p = OnlyProblem(j);
+  EXPECT_TRUE(Contains(p, "/name: must be at most 100 characters, got 3000")) << p;
+  j["name"] = 1;
+  j["unknown"] = name;
+  const auto problems = Problems(j);
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_TRUE(Contains(problems[0], "/unknown: unknown key")) << problems[0];
+  EXPECT_TRUE(Contains(problems[0], "...")) << problems[0];
 }
 
 TEST(ProtocolValidate, NotAnObjectRejected) {

@@ -90,13 +90,19 @@ void DrawAdjustment(const Block& block, std::mt19937_64& rng, Trial* t) {
 }  // namespace
 
 std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& participant, uint64_t seed) {
-  bool needs_number = false;
-  for (const auto& b : protocol.blocks) needs_number = needs_number || b.counterbalance == Counterbalance::kByParticipant;
+  const Block* by_participant = nullptr;
+  for (const auto& b : protocol.blocks)
+    if (!by_participant && b.counterbalance == Counterbalance::kByParticipant) by_participant = &b;
   const int number = ParticipantNumber(participant);
-  if (needs_number && number < 0)
-    throw InputError(protocol.file.string(), "by_participant counterbalancing needs a participant id ending in a "
+  if (by_participant && number < 0)
+    throw InputError(protocol.file.string() + ": " + by_participant->counterbalance_pointer, "by_participant counterbalancing needs a participant id ending in a "
                                              "number (e.g. P7), got \"" + participant + "\"");
   const bool even = number >= 0 && number % 2 == 0;
+  // ParseProtocol refuses such designs; a Protocol made otherwise is refused here, before anything is allocated.
+  if (const int64_t n = SessionTrials(protocol); n > kMaxTrials || n == 0)
+    throw InputError(protocol.file.string(), n == 0 ? "/: the protocol makes no trials"
+                                                    : "/: the protocol makes more than " + std::to_string(kMaxTrials) +
+                                                          " trials, the most a session may have");
 
   std::mt19937_64 rng(seed);
   std::vector<Trial> trials;
@@ -124,6 +130,41 @@ std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& part
   }
   for (size_t i = 0; i < trials.size(); ++i) trials[i].index = static_cast<int>(i);
   return trials;
+}
+
+std::string SidePointer(const Protocol& protocol, const Trial& trial, const std::string& side) {
+  // A swapped trial shows the design's other side.
+  const std::string designed = trial.swapped ? (side == "left" ? "right" : "left") : side;
+  for (const auto& b : protocol.blocks) {
+    if (b.name != trial.block) continue;
+    for (const auto& f : b.factors) {
+      const Json* level = trial.levels.is_object() && trial.levels.contains(f.name) ? &trial.levels.at(f.name) : nullptr;
+      if (!level || !level->is_object() || !level->contains(designed)) continue;
+      const auto at = std::find(f.levels.begin(), f.levels.end(), *level);
+      return b.factors_pointer + "/" + EscapePointer(f.name) + "/" + std::to_string(at - f.levels.begin()) + "/" +
+             designed;
+    }
+    if (!b.sides_pointer.empty()) return b.sides_pointer + "/" + designed;
+    return b.pointer.empty() ? "/" : b.pointer;
+  }
+  return "/";
+}
+
+std::string LevelPointer(const Protocol& protocol, const Trial& trial, const std::string& name) {
+  for (const auto& b : protocol.blocks) {
+    if (b.name != trial.block) continue;
+    for (const auto& f : b.factors) {
+      const Json* level = trial.levels.is_object() && trial.levels.contains(f.name) ? &trial.levels.at(f.name) : nullptr;
+      if (!level || (f.name != name && !(level->is_object() && level->contains(name)))) continue;
+      const auto at = std::find(f.levels.begin(), f.levels.end(), *level);
+      std::string pointer = b.factors_pointer + "/" + EscapePointer(f.name) + "/" +
+                            std::to_string(at - f.levels.begin());
+      if (f.name != name) pointer += "/" + EscapePointer(name);
+      return pointer;
+    }
+    return b.factors_pointer.empty() ? "/" : b.factors_pointer;
+  }
+  return "/";
 }
 
 Json ToJson(const Trial& t) {

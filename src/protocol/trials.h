@@ -52,6 +52,13 @@ int ParticipantNumber(const std::string& participant);
 // each participant their own seed. Throws Error(kInput) for by_participant with a participant id without number.
 std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& participant, uint64_t seed);
 
+// The JSON pointer of the field that chose what `trial` shows on `side` ("left" | "right" as shown, swaps
+// applied): the side of a level object (/blocks/1/factors/pattern/2/left) or of the block's sides (/sides/left).
+std::string SidePointer(const Protocol& protocol, const Trial& trial, const std::string& side);
+// The JSON pointer of the level `name` of `trial` (/factors/edge/3, /blocks/0/factors/pattern/1/speed_cm_s), or
+// of its block's factors when no level has that name.
+std::string LevelPointer(const Protocol& protocol, const Trial& trial, const std::string& name);
+
 Json ToJson(const Trial& trial);
 Json ToJson(const std::vector<Trial>& trials);
 

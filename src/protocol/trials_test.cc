@@ -123,7 +123,15 @@ TEST(TrialBuilder, ByParticipantSwapsForEvenNumbers) {
 }
 
 TEST(TrialBuilder, ByParticipantNeedsANumberedParticipant) {
-  EXPECT_THROW(BuildTrials(Shipped("test1-static-grids.json"), "anna", 1), Error);
+  try {
+    BuildTrials(Shipped("test1-static-grids.json"), "anna", 1);
+    FAIL() << "built";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    // Names the field that asked for it.
+    EXPECT_NE(std::string(e.what()).find("test1-static-grids.json: /counterbalance: by_participant"),
+              std::string::npos) << e.what();
+  }
 }
 
 TEST(TrialBuilder, ParticipantNumberIsTheTrailingDigits) {
@@ -187,6 +195,52 @@ TEST(TrialBuilder, UniformBelowStaysInRange) {
   std::vector<int> counts(3);
   for (int i = 0; i < 3000; ++i) ++counts[UniformBelow(rng, 3)];
   for (int c : counts) EXPECT_GT(c, 850);
+}
+
+}  // namespace
+}  // namespace blurcue::protocol
+
+namespace blurcue::protocol {
+namespace {
+
+TEST(TrialPointers, SideNamesTheLevelThatChoseIt) {
+  const Protocol p = Shipped("test2-moving-balls.json");
+  bool saw_swapped = false, saw_plain = false;
+  for (const auto& t : BuildTrials(p, "P1", 3)) {
+    if (t.practice || t.block != "task2") continue;
+    const int at = t.levels["pattern"]["id"].get<int>() / 2 - 1;  // task 2 lists patterns 2, 4, 6
+    const std::string level = "/blocks/1/factors/pattern/" + std::to_string(at);
+    // A swapped copy shows the design's right source on the left.
+    EXPECT_EQ(SidePointer(p, t, "left"), level + (t.swapped ? "/right" : "/left"));
+    EXPECT_EQ(SidePointer(p, t, "right"), level + (t.swapped ? "/left" : "/right"));
+    EXPECT_EQ(LevelPointer(p, t, "section"),
+              "/blocks/1/factors/section/" + std::to_string(t.levels["section"].get<int>() - 1));
+    EXPECT_EQ(LevelPointer(p, t, "speed_cm_s"), level + "/speed_cm_s");
+    (t.swapped ? saw_swapped : saw_plain) = true;
+  }
+  EXPECT_TRUE(saw_swapped && saw_plain);
+}
+
+TEST(TrialPointers, SidesObjectOfTheProtocolWhenNoLevelCarriesThem) {
+  const Protocol p = Shipped("test1-static-grids.json");
+  const auto trials = BuildTrials(p, "P2", 1);  // even: every trial swapped
+  EXPECT_EQ(SidePointer(p, trials.back(), "left"), "/sides/right");
+  EXPECT_EQ(LevelPointer(p, trials.back(), "edge"),
+            "/factors/edge/" + std::to_string(trials.back().levels["edge"].get<int>() - 1));
+}
+
+TEST(TrialBuilder, ProtocolOverTheTrialCapIsRefusedBeforeBuilding) {
+  Protocol p = FromJson(kFour);
+  Factor big{"big", {}};
+  for (int i = 0; i < 1000; ++i) big.levels.push_back(i);
+  for (int k = 0; k < 8; ++k) p.blocks[0].factors.push_back(big);  // 4 x 1000^8: would never fit in memory
+  try {
+    BuildTrials(p, "P1", 1);
+    FAIL() << "built";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    EXPECT_NE(std::string(e.what()).find("more than 10000 trials"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -7,9 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <deque>
-#include <fstream>
 #include <functional>
-#include <sstream>
 #include <thread>
 
 #include <opencv2/core.hpp>
@@ -20,6 +18,7 @@
 #include "render/frame_compositor.h"
 #include "render/gl_context.h"
 #include "session/observer.h"
+#include "session/prepare.h"
 #include "session/screens.h"
 #include "session/stimulus.h"
 #include "store/record.h"
@@ -149,14 +148,6 @@ uint64_t TrialSeed(uint64_t seed, int index) {
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
   return z ^ (z >> 31);
-}
-
-std::string ReadText(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string(), "cannot open file");
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
 }
 
 enum class Outcome { kAnswered, kQuit };
@@ -417,23 +408,21 @@ RunResult RunSession(const RunOptions& options) {
   if (options.resume && !std::filesystem::exists(options.db))
     throw InputError(options.db.string(), "--resume: no such record, so there is no session to continue; leave out "
                                           "--resume to start one");
-  const protocol::Protocol protocol = protocol::LoadProtocol(options.protocol_file);
-  const std::string protocol_text = ReadText(options.protocol_file);
-  const uint64_t seed = options.seed ? *options.seed : protocol::DefaultSeed(protocol.name, options.participant);
-  const std::vector<protocol::Trial> trials = protocol::BuildTrials(protocol, options.participant, seed);
-
-  // Every trial's scene and radii before anything is shown or saved: a source that cannot be evaluated stops
-  // the run here, not in front of a participant.
-  const std::optional<calib::SceneCalib> scene = LoadProtocolScene(protocol);
-  std::vector<TrialScene> scenes;
+  // Everything checked before the first trial is what `blurcue validate` checks: the same function.
+  const PreparedSession prepared = PrepareSession(options.protocol_file, options.participant, options.seed);
+  const protocol::Protocol& protocol = prepared.protocol;
+  const std::string& protocol_text = prepared.protocol_text;
+  const uint64_t seed = prepared.seed;
+  const std::vector<protocol::Trial>& trials = prepared.trials;
+  const std::optional<calib::SceneCalib>& scene = prepared.scene;
+  const std::vector<TrialScene>& scenes = prepared.scenes;
   std::vector<store::TrialRecord> records;
   for (const protocol::Trial& trial : trials) {
-    scenes.push_back(DescribeTrial(protocol, trial, scene ? &*scene : nullptr));
     store::TrialRecord r;
     r.index = trial.index;
     for (size_t b = 0; b < protocol.blocks.size(); ++b)
       if (protocol.blocks[b].name == trial.block) r.block = static_cast<int64_t>(b);
-    r.factors_json = TrialVariables(trial, scenes.back()).dump();
+    r.factors_json = TrialVariables(trial, scenes[size_t(trial.index)]).dump();
     r.left_json = trial.left.dump();
     r.right_json = trial.right.dump();
     records.push_back(std::move(r));
@@ -452,7 +441,7 @@ RunResult RunSession(const RunOptions& options) {
   } else {
     context = render::GlContext::CreateOffscreen();
   }
-  StimulusRenderer renderer(protocol, scene);
+  StimulusRenderer renderer(protocol, scene, prepared.images);
 
   store::Record record = store::Record::Open(options.db);
   store::SessionMeta meta;

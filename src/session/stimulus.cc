@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <set>
 
 #include "core/error.h"
 #include "core/image.h"
@@ -26,17 +28,23 @@ const Json* FindLevel(const Json& levels, const std::string& name) {
   return nullptr;
 }
 
-std::string Where(const protocol::Protocol& p, const protocol::Trial& t) {
-  return p.file.string() + ": trial " + std::to_string(t.index) + " (block " + t.block + ")";
+// "FILE: /pointer": where a problem of a trial comes from in the protocol.
+std::string At(const protocol::Protocol& p, const std::string& pointer) {
+  return p.file.string() + ": " + (pointer.empty() ? "/" : pointer);
 }
 
-calib::BlurSource Source(const Json& v, double* fixed, const std::string& where) {
+// `where` names the field that chose the source ("FILE: /pointer"), made only when there is a problem to name.
+calib::BlurSource Source(const Json& v, double* fixed, const std::function<std::string()>& where) {
   if (v.is_number()) {
     *fixed = v.get<double>();
     return calib::BlurSource::kFixed;
   }
-  if (!v.is_string()) throw InputError(where, "the trial shows no blur source on a side, got " + v.dump());
-  return calib::ParseBlurSource(v.get<std::string>(), fixed);
+  if (!v.is_string()) throw InputError(where(), "the trial shows no blur source on this side, got " + v.dump());
+  try {
+    return calib::ParseBlurSource(v.get<std::string>(), fixed);
+  } catch (const Error& e) {
+    throw InputError(where(), e.what());
+  }
 }
 
 // Board-frame placement of the two objects of a pair.
@@ -65,31 +73,44 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
                          const calib::SceneCalib* scene) {
   TrialScene t;
   t.content = protocol.content.type;
-  const std::string where = Where(protocol, trial);
+  // Problems name the protocol field that asked for what cannot be shown, and the trial as a detail.
+  const std::string trial_text = " (trial " + std::to_string(trial.index) + ", block " + trial.block + ")";
   if (t.content == "picture") {
     const Json* d = FindLevel(trial.levels, "distance_m");
     t.distance_m = d && d->is_number() ? d->get<double>() : 1.0;
     return t;
   }
   if (!scene) throw InputError(protocol.file.string(), "/scene/calib: a " + t.content + " needs a calibration");
-  t.left = Source(trial.left, &t.left_fixed_px, where);
-  t.right = Source(trial.right, &t.right_fixed_px, where);
+  // Where a side's source was chosen ("" for the scene's own blur, the calibration's): looked up only for a message.
+  auto field = [&](const char* side) {
+    return At(protocol, side ? protocol::SidePointer(protocol, trial, side) : "/scene/calib");
+  };
+  t.left = Source(trial.left, &t.left_fixed_px, [&] { return field("left"); });
+  t.right = Source(trial.right, &t.right_fixed_px, [&] { return field("right"); });
   const double s = scene->board.square_mm;
-  auto r_at = [&](const cv::Vec3d& board_mm, calib::BlurSource source, double fixed) {
+  // A radius that cannot be evaluated (eq. 3.7 nearer than focus, no usable measured section) is a problem of the
+  // source the protocol chose with this calibration: an input error naming that field.
+  auto r_at = [&](const cv::Vec3d& board_mm, calib::BlurSource source, double fixed, const char* side) {
     try {
-      return calib::BlurAtPx(*scene, source, scene->ToCamera(board_mm), fixed);
+      const double r = calib::BlurAtPx(*scene, source, scene->ToCamera(board_mm), fixed);
+      if (!std::isfinite(r) || r < 0) throw Error(ErrorKind::kDomain, "radius " + std::to_string(r) + " px");
+      return r;
     } catch (const Error& e) {
-      throw Error(e.kind(), where + ": " + calib::ToString(source) + " blur: " + e.what());
+      throw InputError(field(side), calib::ToString(source) + " blur cannot be evaluated with " +
+                                        protocol.scene.calib.string() + trial_text + ": " + e.what());
     }
   };
   if (t.content == "grid") {
     const Json* edge = FindLevel(trial.levels, "edge");
-    if (!edge || !edge->is_number_integer()) throw InputError(where, "a grid trial needs an integer level 'edge'");
+    if (!edge || !edge->is_number_integer())
+      throw InputError(At(protocol, protocol::LevelPointer(protocol, trial, "edge")),
+                       "a grid needs an integer level edge" + trial_text);
     t.edge = edge->get<int>();
     const cv::Vec3d l = GridCentre(*scene, t.edge, true), r = GridCentre(*scene, t.edge, false);
-    t.r_left_px = r_at(l, t.left, t.left_fixed_px);
-    t.r_right_px = r_at(r, t.right, t.right_fixed_px);
-    t.r_scene_px = 0.5 * (r_at(l, calib::BlurSource::kFitted, 0) + r_at(r, calib::BlurSource::kFitted, 0));
+    t.r_left_px = r_at(l, t.left, t.left_fixed_px, "left");
+    t.r_right_px = r_at(r, t.right, t.right_fixed_px, "right");
+    t.r_scene_px = 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, nullptr) +
+                          r_at(r, calib::BlurSource::kFitted, 0, nullptr));
     return t;
   }
   // Balls: a section run (edge s to s + 1, wiped on arrival), explicit edges, or the whole board.
@@ -111,10 +132,11 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   const double radius = protocol.content.radius_mm;
   for (int i = 0; i < samples; ++i) {
     const double y = t.from_y_mm + (t.to_y_mm - t.from_y_mm) * i / (samples - 1);
-    t.r_left_px += r_at(BallCentre(*scene, y, radius, true), t.left, t.left_fixed_px) / samples;
-    t.r_right_px += r_at(BallCentre(*scene, y, radius, false), t.right, t.right_fixed_px) / samples;
-    t.r_scene_px += 0.5 * (r_at(BallCentre(*scene, y, radius, true), calib::BlurSource::kFitted, 0) +
-                           r_at(BallCentre(*scene, y, radius, false), calib::BlurSource::kFitted, 0)) / samples;
+    t.r_left_px += r_at(BallCentre(*scene, y, radius, true), t.left, t.left_fixed_px, "left") / samples;
+    t.r_right_px += r_at(BallCentre(*scene, y, radius, false), t.right, t.right_fixed_px, "right") / samples;
+    t.r_scene_px += 0.5 * (r_at(BallCentre(*scene, y, radius, true), calib::BlurSource::kFitted, 0, nullptr) +
+                           r_at(BallCentre(*scene, y, radius, false), calib::BlurSource::kFitted, 0, nullptr)) /
+                    samples;
   }
   return t;
 }
@@ -138,20 +160,105 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene) {
 }
 
 std::optional<calib::SceneCalib> LoadProtocolScene(const protocol::Protocol& protocol) {
-  if (protocol.content.type == "picture") return std::nullopt;
-  if (protocol.scene.calib.empty())
-    throw InputError(protocol.file.string(), "/scene/calib: a " + protocol.content.type + " needs a calibration");
-  return calib::LoadSceneCalib(protocol.scene.calib);
+  if (protocol.scene.calib.empty()) {
+    if (protocol.content.type == "picture") return std::nullopt;
+    throw InputError(At(protocol, "/scene/calib"), "a " + protocol.content.type + " needs a calibration");
+  }
+  try {
+    return calib::LoadSceneCalib(protocol.scene.calib);
+  } catch (const std::exception& e) {
+    throw InputError(At(protocol, "/scene/calib"), std::string("not a calibration from blurcue calibrate: ") + e.what());
+  }
+}
+
+namespace {
+
+// Reads the image a field names, as 8-bit with 1, 3 or 4 channels; every failure is an input error naming the
+// protocol field first. `max_aspect`: how much wider than tall (or taller than wide) its use can show it.
+cv::Mat ReadFieldImage(const protocol::Protocol& protocol, const std::string& pointer, const std::filesystem::path& path,
+                       int flags, double max_aspect, int max_side_px) {
+  cv::Mat image;
+  try {
+    image = ReadImage(path, flags);
+    if (image.depth() == CV_16U) image.convertTo(image, CV_8U, 1 / 257.0);
+    else if (image.depth() == CV_32F || image.depth() == CV_64F) image.convertTo(image, CV_8U, 255);
+  } catch (const std::exception& e) {  // Error, cv::Exception, std::filesystem::filesystem_error
+    throw InputError(At(protocol, pointer), e.what());
+  }
+  const int w = image.cols, h = image.rows;
+  if (image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3 && image.channels() != 4))
+    throw InputError(At(protocol, pointer), path.string() + ": an image must be 8 or 16 bit grey, colour or colour "
+                                                            "with alpha");
+  if (w < 2 || h < 2 || w > max_side_px || h > max_side_px || w > max_aspect * h || h > max_aspect * w)
+    throw InputError(At(protocol, pointer), path.string() + ": is " + std::to_string(w) + " x " + std::to_string(h) +
+                                                " px; it must be 2 to " + std::to_string(max_side_px) +
+                                                " px a side and at most " + std::to_string(int(max_aspect)) +
+                                                " times as wide as tall or as tall as wide");
+  return image;
+}
+
+// Photos up to 16384 px a side (more than a 45 MP camera's 8256); a ball's or card's texture needs far less than
+// 8192.
+constexpr int kMaxPhotoSidePx = 16384, kMaxTextureSidePx = 8192;
+
+}  // namespace
+
+StimulusImages LoadStimulusImages(const protocol::Protocol& protocol, const std::optional<calib::SceneCalib>& scene) {
+  StimulusImages images;
+  const bool board_free = protocol.scene.show == "board_free" && !protocol.scene.board_free.empty();
+  const std::string photo_field = board_free ? "/scene/board_free" : "/scene/background";
+  const auto& photo_path = board_free ? protocol.scene.board_free : protocol.scene.background;
+  images.photo = ReadFieldImage(protocol, photo_field, photo_path, 1, 10, kMaxPhotoSidePx);
+  // The photo not shown is still a photo of the scene: check it decodes too.
+  if (!protocol.scene.board_free.empty() && !board_free)
+    ReadFieldImage(protocol, "/scene/board_free", protocol.scene.board_free, 1, 10, kMaxPhotoSidePx);
+  if (board_free) ReadFieldImage(protocol, "/scene/background", protocol.scene.background, 1, 10, kMaxPhotoSidePx);
+  if (protocol.content.type == "picture") {
+    images.picture = ReadFieldImage(protocol, "/content/image",
+                                    protocol.content.image.empty() ? render::ResolveStimulus("face")
+                                                                   : protocol.content.image,
+                                    -1, 10, kMaxPhotoSidePx);
+    return images;
+  }
+  if (!scene) throw InputError(At(protocol, "/scene/calib"), "a " + protocol.content.type + " needs a calibration");
+  // The objects are drawn in the calibrated camera's view of this photo.
+  try {
+    scene->RequireSameSize(images.photo, photo_path.string());
+  } catch (const std::exception& e) {
+    throw InputError(At(protocol, photo_field), std::string(e.what()) + " (the calibration " +
+                                                    protocol.scene.calib.string() + " is of another photo)");
+  }
+  const bool shipped = protocol.content.type == "grid" || protocol.content.texture == "soccer" ||
+                       protocol.content.texture == "wood";
+  std::filesystem::path texture;
+  try {
+    texture = render::ResolveStimulus(protocol.content.type == "grid" ? "grid" : protocol.content.texture);
+  } catch (const std::exception& e) {
+    throw InputError(At(protocol, shipped ? "/content/type" : "/content/texture"), e.what());
+  }
+  images.texture = ReadFieldImage(protocol, shipped ? "/content/type" : "/content/texture", texture, -1, 64,
+                                  kMaxTextureSidePx);
+  return images;
+}
+
+void CheckRealPhotos(const protocol::Protocol& protocol, const std::vector<TrialScene>& scenes) {
+  if (protocol.content.real_photos.empty()) return;
+  std::set<double> checked;
+  for (const TrialScene& scene : scenes)
+    if (scene.content == "picture" && checked.insert(scene.distance_m).second)
+      ReadFieldImage(protocol, "/content/real_photos", protocol::RealPhotoFor(protocol.content, scene.distance_m), 1,
+                     10, kMaxPhotoSidePx);
 }
 
 StimulusRenderer::StimulusRenderer(const protocol::Protocol& protocol, const std::optional<calib::SceneCalib>& scene)
+    : StimulusRenderer(protocol, scene, LoadStimulusImages(protocol, scene)) {}
+
+StimulusRenderer::StimulusRenderer(const protocol::Protocol& protocol, const std::optional<calib::SceneCalib>& scene,
+                                   const StimulusImages& images)
     : protocol_(protocol), scene_(scene) {
-  const auto& photo_path = protocol.scene.show == "board_free" && !protocol.scene.board_free.empty()
-                               ? protocol.scene.board_free
-                               : protocol.scene.background;
-  photo_ = ReadImage(photo_path, 1);
+  photo_ = images.photo;
   if (protocol.content.type == "picture") {
-    picture_ = ReadImage(protocol.content.image.empty() ? render::ResolveStimulus("face") : protocol.content.image);
+    picture_ = images.picture;
     picture_width_px_ = protocol.display.width_px;
     // Every adjustment level's low-passed picture up front (~0.1 s each on the CPU): stepping through the levels
     // in a trial then never stalls a frame on a Butterworth filter.
@@ -161,8 +268,7 @@ StimulusRenderer::StimulusRenderer(const protocol::Protocol& protocol, const std
     return;
   }
   if (!scene_) scene_ = LoadProtocolScene(protocol);
-  scene_->RequireSameSize(photo_, photo_path.string());
-  texture_ = ReadImage(render::ResolveStimulus(protocol.content.type == "grid" ? "grid" : protocol.content.texture));
+  texture_ = images.texture;
   compositor_ = std::make_unique<render::FrameCompositor>(scene_->camera, scene_->rvec, scene_->tvec, photo_);
 }
 

@@ -54,14 +54,33 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
 // r_right_px, r_scene_px (pairs) or start_level (adjustment).
 Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene);
 
-// The protocol's calibration (none for a picture, which needs none).
+// The protocol's calibration (none for a picture without one). Throws Error(kInput) naming the protocol file and
+// /scene/calib when the file is not a calibration written by `blurcue calibrate`.
 std::optional<calib::SceneCalib> LoadProtocolScene(const protocol::Protocol& protocol);
+
+// The images a protocol's trials show, decoded (8-bit) and checked against what shows them.
+struct StimulusImages {
+  cv::Mat photo;    // the scene photo shown (BGR; for a grid or ball the calibrated camera's size)
+  cv::Mat picture;  // picture: the picture (alpha kept)
+  cv::Mat texture;  // grid or ball: the card's or the ball's texture
+};
+
+// Reads every image the protocol names: each must decode as an image of a size its use can show. Throws
+// Error(kInput) naming the protocol file and the field (/scene/background, /content/texture, ...). No GL.
+StimulusImages LoadStimulusImages(const protocol::Protocol& protocol, const std::optional<calib::SceneCalib>& scene);
+
+// Decodes the real photo (content.real_photos) of every distance the trials show; throws naming
+// /content/real_photos. No GL.
+void CheckRealPhotos(const protocol::Protocol& protocol, const std::vector<TrialScene>& scenes);
 
 class StimulusRenderer {
  public:
   // Needs a current GL context. Loads the photo the protocol shows and the textures; `scene` is the protocol's
   // calibration (LoadProtocolScene), copied.
   StimulusRenderer(const protocol::Protocol& protocol, const std::optional<calib::SceneCalib>& scene);
+  // The same with the images already loaded (LoadStimulusImages).
+  StimulusRenderer(const protocol::Protocol& protocol, const std::optional<calib::SceneCalib>& scene,
+                   const StimulusImages& images);
   ~StimulusRenderer();
   StimulusRenderer(const StimulusRenderer&) = delete;
   StimulusRenderer& operator=(const StimulusRenderer&) = delete;

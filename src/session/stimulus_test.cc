@@ -101,16 +101,21 @@ TEST(DescribeTrial, GridCardsSitBesideTheBoardAtTheirEdge) {
     EXPECT_TRUE(v.contains(key)) << key;
 }
 
-TEST(DescribeTrial, MissingLevelOrCalibrationIsAnInputErrorNamingTheTrial) {
+TEST(DescribeTrial, MissingLevelOrCalibrationIsAnInputErrorNamingTheField) {
   const calib::SceneCalib scene = ThesisScene();
   protocol::Protocol p = BallProtocol();
   p.content.type = "grid";
+  protocol::Block block;
+  block.name = "task2";
+  block.factors_pointer = "/blocks/1/factors";
+  p.blocks.push_back(block);
   try {
     DescribeTrial(p, PairTrial({{"distance_m", 1}}, "measured", "fitted"), &scene);
     ADD_FAILURE() << "a grid without an edge was accepted";
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::kInput);
-    EXPECT_NE(std::string(e.what()).find("balls.json: trial 0 (block task2)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("balls.json: /blocks/1/factors: a grid needs an integer level edge (trial 0, "
+                                         "block task2)"), std::string::npos) << e.what();
   }
   EXPECT_THROW(DescribeTrial(p, PairTrial({{"edge", 2}}, "measured", "fitted"), nullptr), Error);
 }

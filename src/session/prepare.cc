@@ -1,0 +1,27 @@
+#include "session/prepare.h"
+
+#include "core/error.h"
+#include "core/json_io.h"
+
+namespace blurcue::session {
+
+PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const std::string& participant,
+                               std::optional<uint64_t> seed) {
+  PreparedSession s;
+  // Read once: the text recorded with the session is the text that was validated.
+  s.protocol_text = ReadTextFile(protocol_file);
+  s.protocol = protocol::ParseProtocol(ParseJson(s.protocol_text, protocol_file.string()), protocol_file);
+  s.seed = seed ? *seed : protocol::DefaultSeed(s.protocol.name, participant);
+  s.trials = protocol::BuildTrials(s.protocol, participant, s.seed);
+  s.scene = LoadProtocolScene(s.protocol);
+  s.images = LoadStimulusImages(s.protocol, s.scene);
+  // Every trial's radii before anything is shown or saved: a source that cannot be evaluated stops here, not in
+  // front of a participant.
+  s.scenes.reserve(s.trials.size());
+  for (const protocol::Trial& trial : s.trials)
+    s.scenes.push_back(DescribeTrial(s.protocol, trial, s.scene ? &*s.scene : nullptr));
+  CheckRealPhotos(s.protocol, s.scenes);
+  return s;
+}
+
+}  // namespace blurcue::session

@@ -1,0 +1,34 @@
+#pragma once
+// Everything a session decides and checks before its first trial, without GL: the protocol, the trial list, the
+// calibration, the images and every trial's scene. `blurcue run` starts from it and `blurcue validate` runs it in
+// full, so a protocol that validates is one that runs, and every problem is reported the same way by both.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "calib/scene_blur.h"
+#include "protocol/protocol.h"
+#include "protocol/trials.h"
+#include "session/stimulus.h"
+
+namespace blurcue::session {
+
+struct PreparedSession {
+  protocol::Protocol protocol;
+  std::string protocol_text;              // the file as read and parsed (recorded with the session)
+  uint64_t seed = 0;                      // as given, else protocol::DefaultSeed(study, participant)
+  std::vector<protocol::Trial> trials;
+  std::optional<calib::SceneCalib> scene;
+  StimulusImages images;
+  std::vector<TrialScene> scenes;         // one per trial
+};
+
+// Reads and validates the protocol, builds the participant's trial list, loads the calibration and every image
+// the trials show (each must decode, at a size its use can show), and works out every trial's scene and radii.
+// Throws Error(kInput) whose lines each name the protocol file and the JSON pointer of the field at fault.
+PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const std::string& participant,
+                               std::optional<uint64_t> seed);
+
+}  // namespace blurcue::session
