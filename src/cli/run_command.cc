@@ -56,6 +56,10 @@ void AddRunCommand(CLI::App& app) {
                                         "participant id; always recorded)")
       ->check(SeedValidator());
   cmd->add_option("--observer", args->observer, "sim or sim:NAME=VALUE,... - a simulated observer answers");
+  cmd->add_option("--display", args->options.display_profile,
+                  "the monitor's display profile (overrides the protocol's display.profile; recorded with the "
+                  "session, with each radius in screen px and arcmin)")
+      ->check(CLI::ExistingFile);
   cmd->add_flag("--resume", args->options.resume, "continue the participant's unfinished session");
   cmd->add_flag("--again", args->options.again, "another session for a participant who completed the study (a "
                                                 "participant id seen before is refused otherwise)");

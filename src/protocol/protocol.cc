@@ -700,12 +700,13 @@ Protocol Parser::Parse(const Json& json) {
     }
   }
   if (const Json* v = Field(json, "display", "", false)) {
-    if (Object(*v, "/display", {"width_px", "height_px", "fullscreen", "monitor"})) {
+    if (Object(*v, "/display", {"width_px", "height_px", "fullscreen", "monitor", "profile"})) {
       // From VGA's 320 x 240 to 4K UHD (a depth-matching frame as wide as the display is filtered on the CPU).
       if (auto n = Int(*v, "width_px", "/display", false, 320, 3840, "px")) p.display.width_px = *n;
       if (auto n = Int(*v, "height_px", "/display", false, 240, 2160, "px")) p.display.height_px = *n;
       if (auto b = Bool(*v, "fullscreen", "/display")) p.display.fullscreen = *b;
       if (auto n = Int(*v, "monitor", "/display", false, 0, 16)) p.display.monitor = *n;
+      p.display.profile = Path(*v, "profile", "/display", false);
     }
   }
   CheckDesign(p);

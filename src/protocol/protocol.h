@@ -93,6 +93,7 @@ struct Display {
   int width_px = 1280, height_px = 720;
   bool fullscreen = false;
   int monitor = 0;
+  std::filesystem::path profile;      // the monitor's display profile (display/profile.h), resolved; empty: none
 };
 
 struct Protocol {

@@ -106,7 +106,7 @@ namespace {
 // rows count from the bottom, so the blit flips.
 void BlitToWindow(GLuint read_fb, int src_w, int src_h, int width_px, int height_px) {
   const double scale = std::min(double(width_px) / src_w, double(height_px) / src_h);
-  const int w = int(src_w * scale), h = int(src_h * scale);
+  const int w = int(src_w * scale), h = int(src_h * scale);  // FitScale: w / src_w
   const int x0 = (width_px - w) / 2, y0 = (height_px - h) / 2;
   glBindFramebuffer(GL_READ_FRAMEBUFFER, read_fb);
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
@@ -116,6 +116,11 @@ void BlitToWindow(GLuint read_fb, int src_w, int src_h, int width_px, int height
   glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
 }
 }  // namespace
+
+double FitScale(int src_w, int src_h, int width_px, int height_px) {
+  const double scale = std::min(double(width_px) / src_w, double(height_px) / src_h);
+  return double(int(src_w * scale)) / src_w;
+}
 
 void FrameCompositor::Present(int width_px, int height_px) {
   BlitToWindow(impl_->frame_fb.id(), impl_->width, impl_->height, width_px, height_px);

@@ -45,6 +45,10 @@ class FrameCompositor {
 
 // An 8-bit sRGB image (a text screen, a CPU-made stimulus) uploaded once and shown in the current window as often
 // as needed: a frame costs a blit, not an upload. Needs a current GL context.
+// The scale at which a src_w x src_h frame is shown in a width_px x height_px window: fitted whole, letterboxed,
+// its shown width floored to whole pixels (screen px per frame px). What BlitToWindow does, and what the record says.
+double FitScale(int src_w, int src_h, int width_px, int height_px);
+
 class WindowImage {
  public:
   explicit WindowImage(const cv::Mat& image);

@@ -6,7 +6,7 @@
 namespace blurcue::session {
 
 PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const std::string& participant,
-                               std::optional<uint64_t> seed) {
+                               std::optional<uint64_t> seed, const std::filesystem::path& display_profile) {
   PreparedSession s;
   // Read once: the text recorded with the session is the text that was validated.
   s.protocol_text = ReadTextFile(protocol_file);
@@ -21,6 +21,16 @@ PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const
   for (const protocol::Trial& trial : s.trials)
     s.scenes.push_back(DescribeTrial(s.protocol, trial, s.scene ? &*s.scene : nullptr));
   CheckRealPhotos(s.protocol, s.scenes);
+  if (!display_profile.empty()) {
+    s.display = display::LoadProfile(display_profile);
+  } else if (!s.protocol.display.profile.empty()) {
+    try {
+      s.display = display::LoadProfile(s.protocol.display.profile);
+    } catch (const Error& e) {
+      throw InputError(protocol_file.string() + ": /display/profile", e.what());
+    }
+  }
+  s.presentation = Presentation::Of(s.protocol, s.images, s.display);
   return s;
 }
 

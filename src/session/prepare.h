@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "calib/scene_blur.h"
+#include "display/profile.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
 #include "session/stimulus.h"
@@ -23,12 +24,15 @@ struct PreparedSession {
   std::optional<calib::SceneCalib> scene;
   StimulusImages images;
   std::vector<TrialScene> scenes;         // one per trial
+  display::Profile display;               // --display, else the protocol's display.profile, else the default
+  Presentation presentation;              // how a frame maps to the screen and the eye
 };
 
 // Reads and validates the protocol, builds the participant's trial list, loads the calibration and every image
 // the trials show (each must decode, at a size its use can show), and works out every trial's scene and radii.
 // Throws Error(kInput) whose lines each name the protocol file and the JSON pointer of the field at fault.
+// `display_profile` (--display) overrides the protocol's display.profile.
 PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const std::string& participant,
-                               std::optional<uint64_t> seed);
+                               std::optional<uint64_t> seed, const std::filesystem::path& display_profile = {});
 
 }  // namespace blurcue::session

@@ -409,7 +409,8 @@ RunResult RunSession(const RunOptions& options) {
     throw InputError(options.db.string(), "--resume: no such record, so there is no session to continue; leave out "
                                           "--resume to start one");
   // Everything checked before the first trial is what `blurcue validate` checks: the same function.
-  const PreparedSession prepared = PrepareSession(options.protocol_file, options.participant, options.seed);
+  const PreparedSession prepared =
+      PrepareSession(options.protocol_file, options.participant, options.seed, options.display_profile);
   const protocol::Protocol& protocol = prepared.protocol;
   const std::string& protocol_text = prepared.protocol_text;
   const uint64_t seed = prepared.seed;
@@ -422,7 +423,7 @@ RunResult RunSession(const RunOptions& options) {
     r.index = trial.index;
     for (size_t b = 0; b < protocol.blocks.size(); ++b)
       if (protocol.blocks[b].name == trial.block) r.block = static_cast<int64_t>(b);
-    r.factors_json = TrialVariables(trial, scenes[size_t(trial.index)]).dump();
+    r.factors_json = TrialVariables(trial, scenes[size_t(trial.index)], prepared.presentation).dump();
     r.left_json = trial.left.dump();
     r.right_json = trial.right.dump();
     records.push_back(std::move(r));
@@ -452,6 +453,15 @@ RunResult RunSession(const RunOptions& options) {
                 window && context->RefreshHz() > 0 ? ("@" + std::to_string(int(context->RefreshHz()))).c_str() : "",
                 context->Describe().c_str(), observer ? ("; observer " + ToString(*observer)).c_str() : "");
   meta.display = display;
+  meta.display_profile = display::ToJson(prepared.display).dump();
+  // The record states what the window shows: a window of another size than the protocol's display (a window
+  // manager's choice, a full screen of another mode) would show every radius at another scale.
+  if (window && (context->width_px() != protocol.display.width_px || context->height_px() != protocol.display.height_px))
+    throw InputError(options.protocol_file.string() + ": /display",
+                     "the window opened at " + std::to_string(context->width_px()) + " x " +
+                         std::to_string(context->height_px()) + " px, the protocol's display says " +
+                         std::to_string(protocol.display.width_px) + " x " + std::to_string(protocol.display.height_px) +
+                         " px; set width_px/height_px to the screen's (full screen: the monitor's mode)");
   if (!options.again && !options.resume) {
     // Running a participant through a study they finished is usually a typo in the id: say so.
     const std::vector<int64_t> done = record.CompletedSessions(protocol.name, options.participant);

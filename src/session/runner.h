@@ -14,6 +14,7 @@ namespace blurcue::session {
 struct RunOptions {
   std::filesystem::path protocol_file;
   std::filesystem::path db;
+  std::filesystem::path display_profile;  // --display: overrides the protocol's display.profile
   std::string participant;
   std::optional<uint64_t> seed;  // unset: protocol::DefaultSeed(study, participant), recorded like any seed
   std::string observer;          // empty: a person at the window; "sim[:params]": the simulated observer

@@ -141,7 +141,27 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   return t;
 }
 
-Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene) {
+Presentation Presentation::Of(const protocol::Protocol& protocol, const StimulusImages& images,
+                              const display::Profile& profile) {
+  Presentation p;
+  if (protocol.content.type == "picture") {
+    // The depth-matching frame is as wide as the display, 4:3 (StimulusRenderer::FrameSize).
+    p.frame_width_px = protocol.display.width_px;
+    p.frame_height_px = protocol.display.width_px * 3 / 4;
+  } else {
+    p.frame_width_px = images.photo.cols;
+    p.frame_height_px = images.photo.rows;
+  }
+  p.window_width_px = protocol.display.width_px;
+  p.window_height_px = protocol.display.height_px;
+  p.scale = p.frame_width_px > 0 && p.frame_height_px > 0
+                ? render::FitScale(p.frame_width_px, p.frame_height_px, p.window_width_px, p.window_height_px)
+                : 1;
+  p.profile = profile;
+  return p;
+}
+
+Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation) {
   Json v = trial.levels.is_object() ? trial.levels : Json::object();
   v["practice"] = trial.practice ? 1 : 0;
   v["block_name"] = trial.block;
@@ -152,9 +172,14 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene) {
   } else if (scene.content != "picture") {
     // Rounded to 1e-4 px: the record is read by people and charts, not fed back.
     auto round4 = [](double x) { return std::round(x * 1e4) / 1e4; };
-    v["r_left_px"] = round4(scene.r_left_px);
-    v["r_right_px"] = round4(scene.r_right_px);
-    v["r_scene_px"] = round4(scene.r_scene_px);
+    // Each radius as the camera made it (photo px), as the window shows it (screen px) and as the eye gets it.
+    for (const auto& [name, r] : {std::pair<const char*, double>{"left", scene.r_left_px},
+                                  {"right", scene.r_right_px}, {"scene", scene.r_scene_px}}) {
+      v[std::string("r_") + name + "_px"] = round4(r);
+      v[std::string("r_") + name + "_screen_px"] = round4(presentation.ScreenPx(r));
+      v[std::string("r_") + name + "_arcmin"] = round4(presentation.Arcmin(r));
+    }
+    v["screen_px_per_photo_px"] = std::round(presentation.scale * 1e6) / 1e6;
   }
   return v;
 }

@@ -16,6 +16,7 @@
 #include <opencv2/core.hpp>
 
 #include "calib/scene_blur.h"
+#include "display/profile.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
 
@@ -50,9 +51,12 @@ struct TrialScene {
 TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Trial& trial,
                          const calib::SceneCalib* scene);
 
-// The variables recorded with a trial beside its factor levels: practice, block_name, swapped, and r_left_px,
-// r_right_px, r_scene_px (pairs) or start_level (adjustment).
-Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene);
+struct Presentation;
+
+// The variables recorded with a trial beside its factor levels: practice, block_name, swapped, and for pairs each
+// radius in photo px, screen px and arcmin (r_left_px, r_left_screen_px, r_left_arcmin; the same for right and
+// scene) with the presentation's screen_px_per_photo_px, or start_level (adjustment).
+Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation);
 
 // The protocol's calibration (none for a picture without one). Throws Error(kInput) naming the protocol file and
 // /scene/calib when the file is not a calibration written by `blurcue calibrate`.
@@ -63,6 +67,21 @@ struct StimulusImages {
   cv::Mat photo;    // the scene photo shown (BGR; for a grid or ball the calibrated camera's size)
   cv::Mat picture;  // picture: the picture (alpha kept)
   cv::Mat texture;  // grid or ball: the card's or the ball's texture
+};
+
+// How a composed frame reaches the screen and the eye: the frame (the photo, or the depth-matching frame) is fitted
+// whole into the protocol's display size, so one frame px is `scale` screen px (render::FitScale); the display
+// profile turns screen px into visual angle. A radius is recorded in all three units.
+struct Presentation {
+  int frame_width_px = 0, frame_height_px = 0;
+  int window_width_px = 0, window_height_px = 0;
+  double scale = 1;  // screen px per frame (photo) px
+  display::Profile profile;
+
+  double ScreenPx(double frame_px) const { return frame_px * scale; }
+  double Arcmin(double frame_px) const { return display::ArcminOfScreenPx(profile, ScreenPx(frame_px)); }
+  static Presentation Of(const protocol::Protocol& protocol, const StimulusImages& images,
+                         const display::Profile& profile);
 };
 
 // Reads every image the protocol names: each must decode as an image of a size its use can show. Throws

@@ -1,6 +1,8 @@
 // What a trial shows, worked out without GL: placement, motion and radii per side.
 #include "session/stimulus.h"
 
+#include "render/frame_compositor.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -96,9 +98,21 @@ TEST(DescribeTrial, GridCardsSitBesideTheBoardAtTheirEdge) {
   EXPECT_EQ(near.edge, 2);
   EXPECT_DOUBLE_EQ(near.r_left_px, 0.3);  // the one measured section is the nearest for every card
   EXPECT_GT(far.r_right_px, near.r_right_px + 1);  // fitted blur grows with distance from focus
-  const Json v = TrialVariables(PairTrial({{"edge", 2}}, "measured", "fitted"), near);
-  for (const char* key : {"edge", "practice", "block_name", "swapped", "r_left_px", "r_right_px", "r_scene_px"})
+  // A 4592 x 3056 photo fitted into a 1920 x 1080 window: 1080 / 3056 of a photo px per screen px, floored to
+  // whole shown pixels (1622 of 1622.8); on the default monitor (37.84 px per degree) that is the arcmin.
+  Presentation shown;
+  shown.frame_width_px = 4592, shown.frame_height_px = 3056, shown.window_width_px = 1920, shown.window_height_px = 1080;
+  shown.scale = render::FitScale(4592, 3056, 1920, 1080);
+  EXPECT_DOUBLE_EQ(shown.scale, 1622.0 / 4592.0);
+  const Json v = TrialVariables(PairTrial({{"edge", 2}}, "measured", "fitted"), far, shown);
+  for (const char* key : {"edge", "practice", "block_name", "swapped", "r_left_px", "r_right_px", "r_scene_px",
+                          "r_left_screen_px", "r_right_arcmin", "r_scene_arcmin", "screen_px_per_photo_px"})
     EXPECT_TRUE(v.contains(key)) << key;
+  const double r = far.r_right_px;
+  EXPECT_NEAR(v["r_right_screen_px"].get<double>(), r * 1622.0 / 4592.0, 1e-4);
+  const double pitch_mm = 531.4 / 1920, deg = 180 / 3.14159265358979323846;
+  EXPECT_NEAR(v["r_right_arcmin"].get<double>(), 2 * std::atan(0.5 * r * 1622.0 / 4592.0 * pitch_mm / 600) * deg * 60,
+              1e-4);
 }
 
 TEST(DescribeTrial, MissingLevelOrCalibrationIsAnInputErrorNamingTheField) {
