@@ -76,8 +76,31 @@ complete)
   [ "$(sql "$W/s.sqlite" "SELECT min(n) > 0 FROM (SELECT count(f.id) n FROM trials t LEFT JOIN frames f ON f.trial_id = t.id GROUP BY t.id)")" = 1 ] \
     || fail "every trial records its frames"
   $BC export --db "$W/s.sqlite" --out "$W/export"
-  head -1 "$W/export/trials.csv" | grep -q "edge,practice,r_left_px,r_right_px,r_scene_px,swapped,left,right,choice" \
+  head -1 "$W/export/trials.csv" | grep -q "edge,practice,r_left_arcmin,r_left_px,r_left_screen_px,r_right_arcmin,r_right_px,r_right_screen_px,r_scene_arcmin,r_scene_px,r_scene_screen_px,screen_px_per_photo_px,swapped,left,right,choice" \
     || fail "export header: $(head -1 "$W/export/trials.csv")"
+  # Every radius in three units: the screen px follow the fit of the photo into the protocol's display (its size read
+  # from the PNG header here), the arcmin follow the display profile the session recorded.
+  $PY - "$W/export/trials.csv" "$W/s.sqlite" "$P/test1-static-grids.json" <<'PYEOF' || fail "radii in screen px and arcmin"
+import csv, json, math, sqlite3, struct, sys
+rows = [r for r in csv.DictReader(open(sys.argv[1]))]
+profile = json.loads(sqlite3.connect(sys.argv[2]).execute("SELECT display_profile FROM sessions LIMIT 1").fetchone()[0])
+protocol = json.load(open(sys.argv[3]))
+import os
+photo = os.path.join(os.path.dirname(sys.argv[3]), protocol["scene"]["background"])
+w, h = struct.unpack(">II", open(photo, "rb").read()[16:24])
+dw, dh = protocol.get("display", {}).get("width_px", 1280), protocol.get("display", {}).get("height_px", 720)
+s = math.floor(w * min(dw / w, dh / h)) / w
+pitch, d = profile["width_mm"] / profile["width_px"], profile["distance_mm"]
+assert profile["name"].startswith("default"), profile
+for r in rows:
+    assert abs(float(r["screen_px_per_photo_px"]) - s) < 1e-6, (r["screen_px_per_photo_px"], s)
+    for side in ("left", "right", "scene"):
+        px = float(r[f"r_{side}_px"])
+        assert abs(float(r[f"r_{side}_screen_px"]) - px * s) < 2e-4, r
+        arcmin = 2 * math.degrees(math.atan(px * s * pitch / 2 / d)) * 60
+        assert abs(float(r[f"r_{side}_arcmin"]) - arcmin) < 2e-4, (r, arcmin)
+print(f"{len(rows)} trials: {w}x{h} photo at {s:.4f} screen px per photo px, {profile['name']}")
+PYEOF
   # The per-study summary counts every answer once.
   $PY - "$W/export/summary-test1-static-grids.csv" <<'PYEOF' || fail "summary"
 import csv, sys

@@ -1,4 +1,5 @@
 // blurcue validate: check a protocol file and build its trial list, through the pre-flight a session runs.
+#include <cstdio>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -15,7 +16,7 @@ namespace blurcue::cli {
 
 void AddValidateCommand(CLI::App& app) {
   struct Args {
-    std::string file, participant = "P1";
+    std::string file, participant = "P1", display;
     std::optional<uint64_t> seed;
     bool no_files = false, list = false;
   };
@@ -37,11 +38,14 @@ void AddValidateCommand(CLI::App& app) {
   cmd->add_option("--seed", args->seed, "seed of the trial order (default: the one blurcue run gives the participant, "
                                         "derived from the study name and the participant id)")
       ->check(SeedValidator());
+  cmd->add_option("--display", args->display, "the monitor's display profile, as blurcue run --display")
+      ->check(CLI::ExistingFile);
   cmd->add_flag("--list", args->list, "print the trial list as JSON, one trial per line");
   cmd->callback([args] {
     protocol::Protocol p;
     uint64_t seed = 0;
     std::vector<protocol::Trial> trials;
+    std::string shown;  // how a frame reaches the screen and the eye
     if (args->no_files) {
       p = protocol::LoadProtocol(args->file, protocol::ValidateOptions{false});
       seed = args->seed ? *args->seed : protocol::DefaultSeed(p.name, args->participant);
@@ -50,7 +54,16 @@ void AddValidateCommand(CLI::App& app) {
       // What `blurcue run` does before its first trial, through the same function: files decoded, the
       // calibration read, every trial's scene and radii worked out.
       try {
-        session::PreparedSession prepared = session::PrepareSession(args->file, args->participant, args->seed);
+        session::PreparedSession prepared =
+            session::PrepareSession(args->file, args->participant, args->seed, args->display);
+        const session::Presentation& at = prepared.presentation;
+        char line[300];
+        std::snprintf(line, sizeof line,
+                      "  shown: a %d x %d frame in a %d x %d window at %.4f screen px per photo px; %s: %.2f px per "
+                      "degree, 1 photo px = %.3f arcmin\n",
+                      at.frame_width_px, at.frame_height_px, at.window_width_px, at.window_height_px, at.scale,
+                      at.profile.name.c_str(), display::PxPerDeg(at.profile), at.Arcmin(1));
+        shown = line;
         p = std::move(prepared.protocol);
         seed = prepared.seed;
         trials = std::move(prepared.trials);
@@ -75,7 +88,7 @@ void AddValidateCommand(CLI::App& app) {
       counts += (counts.empty() ? "" : ", ") + b.name + " " + std::to_string(n) + " (" + protocol::ToString(b.task) +
                 ", " + protocol::ToString(b.counterbalance) + ")";
     }
-    std::cout << "  " << counts << "\n";
+    std::cout << "  " << counts << "\n" << shown;
   });
 }
 

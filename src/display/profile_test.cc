@@ -39,12 +39,13 @@ TEST(Profile, ArcminAndScreenPixelsAreInverses) {
   EXPECT_NEAR(ArcminOfScreenPx(p, 1000), 2 * std::atan(0.5 * 1000 * 531.4 / 1920 / 450) * 180 / kPi * 60, 1e-9);
 }
 
-// The thesis's 4 px (at 4592 px across) shown 1920 px wide on the default monitor: 1.672 screen px, 2.65 arcmin.
+// The README's worked example: the thesis's 4 px on a 4592 x 3056 photo fitted into a 1920 x 1080 window (shown
+// 1622 px wide) on the default monitor: 1.413 screen px, 2.241 arcmin.
 TEST(Profile, WorkedExampleOfTheReadme) {
   const Profile p = DefaultProfile();
-  const double screen_px = 4 * 1920.0 / 4592.0;
-  EXPECT_NEAR(screen_px, 1.672, 0.001);
-  EXPECT_NEAR(ArcminOfScreenPx(p, screen_px), 2.651, 0.002);
+  const double screen_px = 4 * 1622.0 / 4592.0;
+  EXPECT_NEAR(screen_px, 1.413, 0.001);
+  EXPECT_NEAR(ArcminOfScreenPx(p, screen_px), 2.241, 0.001);
 }
 
 TEST(Profile, SrgbTransferIsTheStandardCurve) {
