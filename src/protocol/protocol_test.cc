@@ -112,7 +112,7 @@ TEST(ProtocolValidate, UnknownBlurSourceRejected) {
   Json j = Valid();
   j["blocks"][0]["factors"]["pattern"][0]["right"] = "blurry";
   EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/0/factors/pattern/0/right: a blur source must be none, measured, "
-                                       "estimated, fitted or a radius in [0, 100] px, got \"blurry\"")) << OnlyProblem(j);
+                                       "measured_section, estimated, fitted or a radius in [0, 100] px, got \"blurry\"")) << OnlyProblem(j);
 }
 
 TEST(ProtocolValidate, EmptyFactorRejected) {
