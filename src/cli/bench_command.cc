@@ -28,7 +28,8 @@ void AddMeasure(CLI::App& bench) {
       "Then times the whole calibration of one full-resolution 4592 x 3056 photo.\n"
       "Takes a few minutes; --quick runs two levels per factor.");
   cmd->add_option("--out", args->out, "CSV, one row per (method, condition)")->capture_default_str();
-  cmd->add_option("--seed", args->seed, "seed of the scenes' noise, texture and flaws")->capture_default_str();
+  cmd->add_option("--seed", args->seed, "seed of the scenes' noise, texture and flaws")->capture_default_str()
+      ->check(SeedValidator());
   cmd->add_flag("--quick", args->quick, "two levels per factor (smoke run)");
   cmd->add_flag("--no-full-res", args->no_full_res, "skip the full-resolution timing");
   cmd->callback([args] {
