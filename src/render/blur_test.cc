@@ -282,5 +282,19 @@ TEST_F(GlTest, RefusesNonFiniteNegativeAndHugeRadii) {
   }
 }
 
+TEST_F(GlTest, ImageWiderThanTheLargestTextureIsRefused) {
+  GLint max_side = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_side);
+  GlBlur blur;
+  const cv::Mat wide(2, max_side + 1, CV_32FC4, cv::Scalar(0.5, 0.5, 0.5, 1));
+  try {
+    blur.Gaussian(wide, 2);
+    FAIL() << "a " << wide.cols << " px wide image was blurred on a GL whose textures end at " << max_side;
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    EXPECT_NE(std::string(e.what()).find("does not fit this GL's textures"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace blurcue::render
