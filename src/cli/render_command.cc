@@ -117,6 +117,11 @@ void AddRenderCommand(CLI::App& app) {
     auto context = render::GlContext::CreateOffscreen();
     render::SceneRenderer renderer(scene.camera, scene.rvec, scene.tvec);
     const render::Footprint f = renderer.Measure(object);
+    // An object outside the photo would leave the photo as it was, written as if it were the stimulus.
+    if ((f.bounds & cv::Rect(0, 0, photo.cols, photo.rows)).empty())
+      throw Error(ErrorKind::kUsage, "the " + args->object + " at --at-edge " + std::to_string(args->edge) +
+                                         " lies outside the " + std::to_string(photo.cols) + "x" +
+                                         std::to_string(photo.rows) + " photo; nothing would be drawn");
     const cv::Vec3d centre = scene.ToCamera(object.center_board_mm);
     const double r = args->gain * calib::BlurAtPx(scene, source, centre, fixed_r);
     // One radius serves while the object's depth span changes r by less than half a pixel.
