@@ -39,6 +39,9 @@ else
   ASAN_OPTIONS="$ASAN_OPTIONS:detect_leaks=0" run gl "${GL_TESTS[@]}" || status=1
 fi
 echo "== cli: hostile input"
-(cd "$BUILD" && ctest -R '^cli_hostile_' -j2 --output-on-failure) || status=1
+# The same driver preload for blurcue's GL commands; ctest and cmake in between are not instrumented, so the
+# preload cannot put the ASan runtime first: blurcue links it anyway, and the link-order check is off.
+(cd "$BUILD" && LD_PRELOAD="$DRI" ASAN_OPTIONS="$ASAN_OPTIONS:verify_asan_link_order=0" \
+   ctest -R '^cli_hostile_' -j2 --output-on-failure) || status=1
 echo "sanitized tests: $(( $(date +%s) - start )) s, $([ $status = 0 ] && echo 'no findings' || echo 'FAILED')"
 exit $status

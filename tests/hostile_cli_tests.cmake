@@ -121,3 +121,7 @@ hostile_test(cli_hostile_bench_seed_negative 2 "--seed: must be a whole number f
              bench measure --seed=-3)
 hostile_test(cli_hostile_preview_columns_octal_looking 2 "--columns: must be a whole number in [1, 20], got '0x10'"
              preview ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --out ${H}/x.png --columns 0x10)
+hostile_test(cli_hostile_board_wraps 2 "--board: expected COLSxROWS in squares such as 7x10, got '4294967303x10'"
+             synth-scene --out ${H}/scene --board 4294967303x10)
+hostile_test(cli_hostile_board_too_many_squares 2 "--board 500x10: a board needs 2 to 100 squares a side"
+             synth-scene --out ${H}/scene --board 500x10)
