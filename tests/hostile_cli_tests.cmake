@@ -125,3 +125,6 @@ hostile_test(cli_hostile_board_wraps 2 "--board: expected COLSxROWS in squares s
              synth-scene --out ${H}/scene --board 4294967303x10)
 hostile_test(cli_hostile_board_too_many_squares 2 "--board 500x10: a board needs 2 to 100 squares a side"
              synth-scene --out ${H}/scene --board 500x10)
+# A distance just beyond the focal length: a model limit (exit 5), said before it reaches an int or an allocation.
+hostile_test(cli_hostile_synth_pictures_at_focal_length 5 "would be imaged"
+             synth-pictures --camera ${D}/thesis-camera.json --distances-m 0.021001 --out ${H}/pictures)

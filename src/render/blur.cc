@@ -26,7 +26,11 @@ void CheckBlurRadius(double r_px) {
     throw Error(ErrorKind::kDomain, "blur radius must be in [0, " + Num(kMaxBlurRadiusPx) + "] px, got " + Num(r_px));
 }
 
-int GaussianTaps(double sigma_px) { return sigma_px <= 0 ? 0 : int(std::ceil(3 * sigma_px)); }
+int GaussianTaps(double sigma_px) {
+  if (sigma_px <= 0) return 0;
+  CheckBlurRadius(2 * sigma_px);  // a NaN or huge sigma has no tap count an int holds
+  return int(std::ceil(3 * sigma_px));
+}
 
 cv::Mat GaussianBlurCpu(const cv::Mat& rgba, double r_px) {
   CV_Assert(rgba.type() == CV_32FC4);
