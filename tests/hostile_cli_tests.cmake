@@ -128,3 +128,6 @@ hostile_test(cli_hostile_board_too_many_squares 2 "--board 500x10: a board needs
 # A distance just beyond the focal length: a model limit (exit 5), said before it reaches an int or an allocation.
 hostile_test(cli_hostile_synth_pictures_at_focal_length 5 "would be imaged"
              synth-pictures --camera ${D}/thesis-camera.json --distances-m 0.021001 --out ${H}/pictures)
+hostile_test(cli_hostile_render_picture_taller_than_frame 2
+             "--picture-height-px 5000 is taller than the grey half of the frame (360 px)"
+             render --object picture --background ${D}/small.png --picture-height-px 5000 --out ${H}/x.png)

@@ -59,12 +59,12 @@ void AddRenderCommand(CLI::App& app) {
   cmd->add_option("--backend", args->backend, "blur on gl or cpu")->capture_default_str()
       ->check(CLI::IsMember({"gl", "cpu"}));
   cmd->add_option("--display-width", args->display_width, "scale the output to this width (0 = full resolution)")
-      ->check(IntRange(0, 16384, "px"));
+      ->check(IntRange(0, 7680, "px"));
   cmd->add_option("--cutoff", args->cutoff, "picture: Butterworth cut-off, cycles per picture width (0 = sharp)")
       ->check(FiniteRange(0, render::kMaxCutoffCyclesPerWidth, "cycles per picture width"));
   cmd->add_option("--picture-height-px", args->picture_height, "picture: its height on screen (default 60 % of the "
                                                                 "grey half)")
-      ->check(IntRange(0, 16384, "px"));
+      ->check(IntRange(0, 7680, "px"));
   cmd->add_option("--out", args->out, "output PNG")->required();
   cmd->callback([args] {
     const auto t0 = std::chrono::steady_clock::now();
@@ -74,6 +74,10 @@ void AddRenderCommand(CLI::App& app) {
       const cv::Mat photo = ReadImage(args->background, 1);
       const int w = args->display_width > 0 ? args->display_width : 960, h = w * 3 / 4, half = h / 2;
       const int picture_h = args->picture_height > 0 ? args->picture_height : half * 6 / 10;
+      if (picture_h > half)
+        throw Error(ErrorKind::kUsage, "--picture-height-px " + std::to_string(picture_h) +
+                                           " is taller than the grey half of the frame (" + std::to_string(half) +
+                                           " px)");
       const cv::Mat frame = render::DepthMatchingFrame(
           render::PictureOnGrey(picture, cv::Size(w, half), picture_h, args->cutoff), photo, w);
       WriteImage(args->out, frame);
