@@ -109,11 +109,29 @@ def main(argv=None):
     parser.add_argument("--bench", default=os.path.join("results", "bench"),
                         help="folder with measure.csv and render.csv (default results/bench)")
     parser.add_argument("--out", required=True, help="output folder")
+    parser.add_argument("--final-out", help="where --out is renamed to once complete (blurcue report builds the "
+                        "folder beside its target): index.html and messages name paths there")
     parser.add_argument("--boot", type=int, default=200, help="bootstrap samples for the psychometric band")
     parser.add_argument("--seed", type=int, default=1, help="bootstrap seed")
     parser.add_argument("--debug", action="store_true", help="let an unexpected error raise (with its traceback)")
     args = parser.parse_args(argv)
     warnings.showwarning = _warning_line
+
+    def shown(path):
+        """A path as the reader will find it: under --final-out when it lies under --out."""
+        if not args.final_out:
+            return path
+        rel = os.path.relpath(os.path.abspath(path), os.path.abspath(args.out))
+        if rel == os.curdir:
+            return args.final_out
+        return path if rel.startswith(os.pardir) else os.path.join(args.final_out, rel)
+
+    def shown_text(text):
+        """A message with every path under --out named as under --final-out."""
+        if not args.final_out:
+            return text
+        text = text.replace(os.path.abspath(args.out), os.path.abspath(args.final_out))
+        return text.replace(args.out, args.final_out)
 
     try:
         os.makedirs(args.out, exist_ok=True)
@@ -169,13 +187,13 @@ def main(argv=None):
         say(str(e))  # the only line: the file and what is wrong with it
         return EXIT_INPUT
     trials = holder["trials"]
-    say(f"[1/{total}] read {args.trials}: {len(trials)} rows")
+    say(f"[1/{total}] read {shown(args.trials)}: {len(trials)} rows")
     studies = trials["study"].value_counts().sort_index()
     known = set(common.STUDY_TITLES)
-    header = [f"trials: {os.path.abspath(args.trials)} - {len(trials)} rows, "
+    header = [f"trials: {os.path.abspath(shown(args.trials))} - {len(trials)} rows, "
               f"{int(trials['answered'].sum())} answered, {trials['participant'].nunique()} participants",
               "studies: " + (", ".join(f"{s} ({n} rows)" for s, n in studies.items()) or "none"),
-              f"frames: {os.path.abspath(frames_path)}",
+              f"frames: {os.path.abspath(shown(frames_path))}",
               f"bench: {os.path.abspath(args.bench)}",
               f"written {datetime.datetime.now().strftime('%Y-%m-%d %H:%M')}; practice trials excluded everywhere"]
     unknown = sorted(set(studies.index) - known)
@@ -193,8 +211,8 @@ def main(argv=None):
         try:
             charts = run()
         except Skip as e:
-            say(f"  skipped: {e}")
-            skips.append(str(e))
+            say(f"  skipped: {shown_text(str(e))}")
+            skips.append(shown_text(str(e)))
         except Exception as e:  # a bug or data this code did not foresee: name it, keep the rest of the report
             if args.debug:
                 raise
@@ -204,6 +222,7 @@ def main(argv=None):
             failed.append(title)
         if title == "bench files":
             skips += [n for n in bench.get("notes", [])]
+        charts = [c._replace(notes=[shown_text(n) for n in c.notes]) if c.notes else c for c in charts]
         for c in charts:
             if c.table is not None and not c.table.empty:
                 c.table.to_csv(os.path.join(args.out, c.name + ".csv"), index=False)
@@ -213,7 +232,7 @@ def main(argv=None):
     path = write_index(args.out, sections, header)
     n_charts = sum(1 for _, charts, _ in sections for c in charts if c.png)
     n_skipped = sum(1 for _, _, skips in sections if skips)
-    say(f"wrote {path}: {n_charts} charts, {n_skipped} section{'s' if n_skipped != 1 else ''} with notes")
+    say(f"wrote {shown(path)}: {n_charts} charts, {n_skipped} section{'s' if n_skipped != 1 else ''} with notes")
     if failed:
         say(f"{len(failed)} section(s) failed unexpectedly: {', '.join(failed)}")
         return EXIT_INTERNAL

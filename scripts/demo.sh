@@ -43,5 +43,6 @@ WINDOW=()
 # Speed against accuracy of every measurement and blur method (quick sweeps), for the report's charts.
 $BC bench measure --quick --out results/bench/measure.csv
 $BC bench render --quick --out results/bench/render.csv
+$BC bench record --trials 100 --folder results/bench   # what a power-loss-safe commit costs per answer
 $BC report --db "$OUT/study.sqlite" --out "$OUT/report" --bench results/bench
 echo "demo: results in $OUT/ (calib.json, ball-edge9-estimated.png, pattern3.avi, study.sqlite, report/index.html)"

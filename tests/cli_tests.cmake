@@ -92,3 +92,8 @@ add_test(NAME cli_render_picture
          COMMAND ${BC} render --object picture --cutoff 6 --background ${T}/scene/scene.png --out ${T}/picture.png)
 set_tests_properties(cli_render_picture PROPERTIES FIXTURES_REQUIRED scene
                      PASS_REGULAR_EXPRESSION "picture face, cut-off 6 cycles per picture width")
+
+# What FULL durability costs per answer: both arms measured in one run, the ratio printed.
+add_test(NAME cli_bench_record COMMAND ${BC} bench record --trials 20 --folder ${T}/bench-record)
+set_tests_properties(cli_bench_record PROPERTIES
+                     PASS_REGULAR_EXPRESSION "synchronous=FULL +median [0-9.]+ ms.*synchronous=NORMAL +median [0-9.]+ ms.*FULL costs")

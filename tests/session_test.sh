@@ -128,7 +128,7 @@ resume)
     if $BC run "$P/$proto.json" --participant R2 --db "$W/parts.sqlite" --observer sim --seed 5 2>"$W/err"; then
       fail "$proto: a second session started while one is running"
     fi
-    grep -q "running session" "$W/err" || fail "$proto: message: $(cat "$W/err")"
+    grep -q "has an unfinished session" "$W/err" || fail "$proto: message: $(cat "$W/err")"
     $BC run "$P/$proto.json" --participant R2 --db "$W/parts.sqlite" --observer sim --seed 5 --resume | grep -q completed
     [ "$(fingerprint "$W/whole.sqlite" R2)" = "$(fingerprint "$W/parts.sqlite" R2)" ] || fail "$proto: resumed differs"
   done
@@ -266,5 +266,111 @@ for r in rows:
 assert stepped > len(rows) // 2, stepped
 PYEOF
   echo "ok: depth matching through run, record, export and report recovers c = 20 d^-0.5" ;;
+resume_guards)
+  # --resume with nothing to resume says what it found, exits 3 and starts nothing (issue 9).
+  T1=$P/test1-static-grids.json
+  if $BC run "$T1" --participant G1 --db "$W/none.sqlite" --observer sim --resume 2> "$W/err"; then fail "resumed a missing record"; fi
+  grep -q "none.sqlite: --resume: no such record" "$W/err" || fail "missing record: $(cat "$W/err")"
+  [ ! -e "$W/none.sqlite" ] || fail "--resume created the record it did not find"
+  $BC run "$T1" --participant G1 --db "$W/r.sqlite" --observer sim > /dev/null 2>&1
+  set +e; $BC run "$T1" --participant G1 --db "$W/r.sqlite" --observer sim --resume 2> "$W/err"; code=$?; set -e
+  [ $code = 3 ] || fail "--resume of a completed participant: exit $code"
+  grep -q "has no unfinished session to continue (1 completed (last: session 1)); leave out --resume to start a new session, with --again" "$W/err" \
+    || fail "completed participant: $(cat "$W/err")"
+  [ "$(sql "$W/r.sqlite" "SELECT count(*) FROM sessions")" = 1 ] || fail "a session was started"
+  # An empty file is a new record; --resume on it finds nothing and leaves it empty.
+  : > "$W/empty.sqlite"
+  set +e; $BC run "$T1" --participant G1 --db "$W/empty.sqlite" --observer sim --resume 2> "$W/err"; code=$?; set -e
+  [ $code = 3 ] && grep -q "no sessions at all" "$W/err" || fail "empty record: exit $code $(cat "$W/err")"
+  # Another program's SQLite file: refused, byte for byte untouched, no WAL beside it.
+  $PY -c "import sqlite3; c = sqlite3.connect('$W/customers.sqlite'); c.execute('CREATE TABLE customers (id, name)'); c.commit()"
+  before=$(sha256sum < "$W/customers.sqlite")
+  set +e; $BC run "$T1" --participant G1 --db "$W/customers.sqlite" --observer sim 2> "$W/err"; code=$?; set -e
+  [ $code = 3 ] && grep -q "customers.sqlite: not a blurcue record: it holds 1 tables (customers)" "$W/err" \
+    || fail "foreign database: exit $code $(cat "$W/err")"
+  [ "$(sha256sum < "$W/customers.sqlite")" = "$before" ] && [ ! -e "$W/customers.sqlite-wal" ] || fail "foreign file touched"
+  for cmd in sessions export; do
+    set +e; $BC $cmd --db "$W/customers.sqlite" $([ $cmd = export ] && echo --out "$W/x") 2> "$W/err"; code=$?; set -e
+    [ $code = 3 ] && grep -q "not a blurcue record" "$W/err" || fail "$cmd of a foreign file: exit $code $(cat "$W/err")"
+  done
+  # A truncated record: exit 3 naming the file, for the runner and the readers alike.
+  cp "$W/r.sqlite" "$W/cut.sqlite"
+  size=$(stat -c %s "$W/cut.sqlite"); truncate -s $((size / 2)) "$W/cut.sqlite"
+  for args in "run $T1 --participant G2 --db $W/cut.sqlite --observer sim" "sessions --db $W/cut.sqlite" \
+              "export --db $W/cut.sqlite --out $W/cut-tables"; do
+    set +e; $BC $args 2> "$W/err"; code=$?; set -e
+    [ $code = 3 ] && grep -q "cut.sqlite: the record is damaged" "$W/err" && [ "$(wc -l < "$W/err")" = 1 ] \
+      || fail "truncated record, $args: exit $code $(cat "$W/err")"
+  done
+  # Two stations starting on one new file at the same moment: both proceed, every time.
+  for round in 1 2 3 4 5 6; do
+    $BC run "$T1" --participant A$round --db "$W/twin-$round.sqlite" --observer sim > /dev/null 2> "$W/twin-a" & a=$!
+    $BC run "$T1" --participant B$round --db "$W/twin-$round.sqlite" --observer sim > /dev/null 2> "$W/twin-b" & b=$!
+    wait $a || fail "round $round, first station: $(cat "$W/twin-a")"
+    wait $b || fail "round $round, second station: $(cat "$W/twin-b")"
+  done
+  echo "ok: --resume with nothing to resume, foreign, empty, truncated records and twin first starts" ;;
+stranded)
+  # A protocol reformatted by an editor (CRLF, a trailing newline, indentation) still resumes its session; a real
+  # change is refused naming what changed and the command that closes the session, which keeps its answers.
+  $BC run "$P/test1-static-grids.json" --participant S1 --db "$W/s.sqlite" --observer sim --stop-after 4 > /dev/null 2>&1
+  $PY - "$P/test1-static-grids.json" "$P/test1-crlf.json" <<'PYEOF'
+import json, sys
+text = json.dumps(json.load(open(sys.argv[1])), indent=4)
+open(sys.argv[2], "w", newline="").write(text.replace("\n", "\r\n") + "\r\n\r\n")
+PYEOF
+  $BC run "$P/test1-crlf.json" --participant S1 --db "$W/s.sqlite" --observer sim --stop-after 2 --resume \
+    | grep -q "6 of 13 trials answered" || fail "a reformatted protocol did not resume"
+  sed 's/"inter_trial_ms": 500/"inter_trial_ms": 800/' "$P/test1-static-grids.json" > "$P/test1-changed.json"
+  set +e; $BC run "$P/test1-changed.json" --participant S1 --db "$W/s.sqlite" --observer sim --resume 2> "$W/err"; code=$?; set -e
+  [ $code = 3 ] || fail "a changed protocol resumed: exit $code"
+  grep -q "session 1 was started with another version of the protocol (/timing/inter_trial_ms 500 -> 800)" "$W/err" \
+    || fail "changed protocol: $(cat "$W/err")"
+  grep -q "blurcue sessions --db $W/s.sqlite --abort 1 (its answers are kept)" "$W/err" || fail "no way out: $(cat "$W/err")"
+  $BC sessions --db "$W/s.sqlite" --abort 1 | grep -q "session 1 closed as aborted; its answers are kept" || fail "abort"
+  $BC sessions --db "$W/s.sqlite" | grep -Eq "test1-static-grids +S1 +aborted +6/13" || fail "sessions: $($BC sessions --db "$W/s.sqlite")"
+  set +e; $BC sessions --db "$W/s.sqlite" --abort 1 2> "$W/err"; code=$?; set -e
+  [ $code = 3 ] && grep -q "session 1 is aborted; only a running session can be aborted" "$W/err" || fail "abort twice: $(cat "$W/err")"
+  $BC run "$P/test1-changed.json" --participant S1 --db "$W/s.sqlite" --observer sim | grep -q "session 2, .* 13 of 13" \
+    || fail "no new session after the abort"
+  integrity "$W/s.sqlite"
+  echo "ok: CRLF-reformatted protocol resumes; a changed one names the change; --abort closes it, answers kept" ;;
+stale_lock)
+  # A crashed writer's pid reused by a live program (pid 1 here) with an old heartbeat is a stale lock; a fresh
+  # heartbeat is a live one, until the experimenter breaks it.
+  $BC run "$P/test1-static-grids.json" --participant L1 --db "$W/l.sqlite" --observer sim --stop-after 3 > /dev/null 2>&1
+  plant() { $PY -c "import sqlite3; c = sqlite3.connect('$W/l.sqlite'); c.execute(\"UPDATE sessions SET lock_host = '$(hostname)', lock_pid = 1, lock_token = 'x', lock_heartbeat_ms = CAST(strftime('%s', 'now') AS INTEGER) * 1000 - $1 * 1000\"); c.commit()"; }
+  plant 5
+  set +e; $BC run "$P/test1-static-grids.json" --participant L1 --db "$W/l.sqlite" --observer sim --resume 2> "$W/err"; code=$?; set -e
+  [ $code = 3 ] && grep -q "is being written by pid 1 on host $(hostname), heartbeat [0-9]* s ago (alive)" "$W/err" \
+    || fail "live lock: exit $code $(cat "$W/err")"
+  $BC sessions --db "$W/l.sqlite" --break-lock 1 | grep -q "broke the lock of pid 1 on host" || fail "break-lock"
+  plant 120
+  $BC sessions --db "$W/l.sqlite" | grep -q "lock: pid 1 on host .*(silent for over 60 s: a stale lock" \
+    || fail "sessions: $($BC sessions --db "$W/l.sqlite")"
+  $BC run "$P/test1-static-grids.json" --participant L1 --db "$W/l.sqlite" --observer sim --resume \
+    | grep -q "13 of 13 trials answered" || fail "the stale lock was not taken over"
+  echo "ok: a reused pid with an old heartbeat is stale; a fresh one is live until --break-lock" ;;
+readonly)
+  # An archived record in a read-only folder opens for sessions, export and report (as an unprivileged user, for
+  # whom permissions hold; root ignores them).
+  mkdir -p "$W/arch"
+  $BC run "$P/test1-static-grids.json" --participant A1 --db "$W/arch/study.sqlite" --observer sim > /dev/null 2>&1
+  [ ! -e "$W/arch/study.sqlite-wal" ] || fail "the writer left a WAL behind"
+  chmod 444 "$W/arch/study.sqlite"; chmod 555 "$W/arch"
+  mkdir -p "$W/out"; chmod 777 "$W/out"
+  as_nobody() { setpriv --reuid=65534 --regid=65534 --clear-groups env HOME="$W/out" MPLCONFIGDIR="$W/out/mpl" "$@"; }
+  as_nobody $BC sessions --db "$W/arch/study.sqlite" | grep -Eq "test1-static-grids +A1 +completed +13/13" \
+    || fail "sessions of a read-only record: $(as_nobody $BC sessions --db "$W/arch/study.sqlite" 2>&1)"
+  as_nobody $BC export --db "$W/arch/study.sqlite" --out "$W/out/tables" > /dev/null 2> "$W/err" || fail "export: $(cat "$W/err")"
+  [ "$(wc -l < "$W/out/tables/trials.csv")" = 14 ] || fail "export of a read-only record: $(wc -l < "$W/out/tables/trials.csv") lines"
+  as_nobody $BC report --db "$W/arch/study.sqlite" --out "$W/out/report" --bench "$W/no-bench" --boot 20 > /dev/null 2> "$W/err" \
+    || fail "report of a read-only record: $(tail -3 "$W/err")"
+  [ -s "$W/out/report/index.html" ] || fail "no index.html"
+  # A writer is refused with one line: the folder is read-only.
+  set +e; as_nobody $BC run "$P/test1-static-grids.json" --participant A2 --db "$W/arch/study.sqlite" --observer sim 2> "$W/err"; code=$?; set -e
+  [ $code = 3 ] && [ "$(wc -l < "$W/err")" = 1 ] && grep -q "study.sqlite: " "$W/err" || fail "writer on a read-only record: exit $code $(cat "$W/err")"
+  chmod 755 "$W/arch"; chmod 644 "$W/arch/study.sqlite"
+  echo "ok: a read-only archived record lists, exports and reports; a writer is refused in one line" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -10,7 +10,8 @@ add_test(NAME session_pictures
 set_tests_properties(session_pictures PROPERTIES FIXTURES_REQUIRED scene FIXTURES_SETUP session_pictures
                      PASS_REGULAR_EXPRESSION "wrote 27 photos")
 set_tests_properties(session_protocols PROPERTIES FIXTURES_SETUP session_protocols)
-foreach(case complete same_seed resume kill9 second_writer window window_adjust recover merge)
+foreach(case complete same_seed resume kill9 second_writer window window_adjust recover merge resume_guards stranded
+             stale_lock readonly)
   add_test(NAME session_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/session_test.sh ${case} ${BC} ${T})
   set_tests_properties(session_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures"
                        LABELS "gl;session"
@@ -46,3 +47,7 @@ add_test(NAME session_run_person_without_display
                  -DEXPECT_CODE=10 "-DEXPECT_TEXT=GLFW: cannot open a window: "
                  -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
 set_tests_properties(session_run_person_without_display PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols")
+
+# blurcue display check in a window (its own Xvfb): geometry, resolution check, honest timing without vsync.
+add_test(NAME display_check COMMAND bash ${PROJECT_SOURCE_DIR}/tests/display_test.sh ${BC} ${T})
+set_tests_properties(display_check PROPERTIES LABELS "gl;window" PASS_REGULAR_EXPRESSION "^ok:|\nok:")

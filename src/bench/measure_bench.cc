@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <map>
 #include <sstream>
 
@@ -12,6 +11,7 @@
 
 #include "calib/calibrate.h"
 #include "calib/truth.h"
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "synth/scene.h"
@@ -186,23 +186,18 @@ std::vector<MeasureRow> RunMeasureBench(const MeasureBenchOptions& options) {
 }
 
 void WriteMeasureCsv(const std::vector<MeasureRow>& rows, const std::filesystem::path& path) {
-  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
-  const auto tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw InputError(path.string(), "cannot write file");
-    out << "method,factor,level,sections,answered,mean_abs_error_px,median_abs_error_px,p90_abs_error_px,"
-           "max_abs_error_px,bias_px,within_target,time_us_per_section,meets_target,board_found\n";
-    for (const auto& r : rows) {
-      char line[512];
-      std::snprintf(line, sizeof line, "%s,%s,%g,%d,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.2f,%d,%d\n", r.method.c_str(),
-                    r.factor.c_str(), r.level, r.sections, r.answered, r.mean_abs_error_px, r.median_abs_error_px,
-                    r.p90_abs_error_px, r.max_abs_error_px, r.bias_px, r.within_target, r.time_us_per_section,
-                    int(r.meets_target), int(r.board_found));
-      out << line;
-    }
+  std::string text =
+      "method,factor,level,sections,answered,mean_abs_error_px,median_abs_error_px,p90_abs_error_px,"
+      "max_abs_error_px,bias_px,within_target,time_us_per_section,meets_target,board_found\n";
+  for (const auto& r : rows) {
+    char line[512];
+    std::snprintf(line, sizeof line, "%s,%s,%g,%d,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.2f,%d,%d\n", r.method.c_str(),
+                  r.factor.c_str(), r.level, r.sections, r.answered, r.mean_abs_error_px, r.median_abs_error_px,
+                  r.p90_abs_error_px, r.max_abs_error_px, r.bias_px, r.within_target, r.time_us_per_section,
+                  int(r.meets_target), int(r.board_found));
+    text += line;
   }
-  std::filesystem::rename(tmp, path);
+  WriteFileAtomically(path, text);
 }
 
 std::string DescribeBreakpoints(const std::vector<MeasureRow>& rows) {

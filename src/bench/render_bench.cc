@@ -4,12 +4,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "optics/thin_lens.h"
@@ -216,23 +216,18 @@ std::vector<RenderRow> RunRenderBench(const RenderBenchOptions& options) {
 }
 
 void WriteRenderCsv(const std::vector<RenderRow>& rows, const std::filesystem::path& path) {
-  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
-  const auto tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw InputError(path.string(), "cannot write file");
-    out << "kind,method,backend,radius_px,width,height,samples,median_ms,p99_ms,mean_abs_error_levels,"
-           "max_abs_error_levels\n";
-    for (const auto& r : rows) {
-      char line[300], mean[32] = "", max[32] = "";
-      if (!std::isnan(r.mean_abs_error)) std::snprintf(mean, sizeof mean, "%.4f", r.mean_abs_error);
-      if (!std::isnan(r.max_abs_error)) std::snprintf(max, sizeof max, "%.1f", r.max_abs_error);
-      std::snprintf(line, sizeof line, "%s,%s,%s,%g,%d,%d,%d,%.3f,%.3f,%s,%s\n", r.kind.c_str(), r.method.c_str(),
-                    r.backend.c_str(), r.radius_px, r.width, r.height, r.samples, r.median_ms, r.p99_ms, mean, max);
-      out << line;
-    }
+  std::string text =
+      "kind,method,backend,radius_px,width,height,samples,median_ms,p99_ms,mean_abs_error_levels,"
+      "max_abs_error_levels\n";
+  for (const auto& r : rows) {
+    char line[300], mean[32] = "", max[32] = "";
+    if (!std::isnan(r.mean_abs_error)) std::snprintf(mean, sizeof mean, "%.4f", r.mean_abs_error);
+    if (!std::isnan(r.max_abs_error)) std::snprintf(max, sizeof max, "%.1f", r.max_abs_error);
+    std::snprintf(line, sizeof line, "%s,%s,%s,%g,%d,%d,%d,%.3f,%.3f,%s,%s\n", r.kind.c_str(), r.method.c_str(),
+                  r.backend.c_str(), r.radius_px, r.width, r.height, r.samples, r.median_ms, r.p99_ms, mean, max);
+    text += line;
   }
-  std::filesystem::rename(tmp, path);
+  WriteFileAtomically(path, text);
 }
 
 std::string SummarizeRender(const std::vector<RenderRow>& rows) {

@@ -180,9 +180,24 @@ TEST(SceneCalib, ReadsBackCalibJsonAndAnswersEverySource) {
   const double truth = r.cmp.sections[8 * 7 + 3].true_r_px;
   double fixed = 0;
   EXPECT_EQ(BlurAtPx(scene, ParseBlurSource("none", nullptr), s.midpoint_camera_mm), 0.0);
+  EXPECT_EQ(ParseBlurSource("measured_section", nullptr), BlurSource::kMeasuredSection);
   const BlurSource fixed_source = ParseBlurSource("2.5", &fixed);
   EXPECT_EQ(BlurAtPx(scene, fixed_source, s.midpoint_camera_mm, fixed), 2.5);
-  EXPECT_NEAR(BlurAtPx(scene, BlurSource::kMeasured, s.midpoint_camera_mm), s.fit.r_px, 1e-9);
+  EXPECT_NEAR(BlurAtPx(scene, BlurSource::kMeasuredSection, s.midpoint_camera_mm), s.fit.r_px, 1e-9);
+  // "measured" is the edge's value, the mean of its usable sections (thesis Fig. 4.11), the same at either end of
+  // the edge and beside the board on its line: a left and a right card get one value.
+  double sum = 0;
+  int usable = 0;
+  for (const SectionResult& section : r.result.edges[8].sections)
+    if (section.fit.ok) sum += section.fit.r_px, ++usable;
+  ASSERT_GT(usable, 3);
+  const double edge_mean = sum / usable;
+  EXPECT_NEAR(edge_mean, r.result.edges[8].r_px, 1e-9);  // the calibration's own edge table says the same
+  const cv::Vec3d first = r.result.edges[8].sections.front().midpoint_camera_mm;
+  const cv::Vec3d last = r.result.edges[8].sections.back().midpoint_camera_mm;
+  for (const cv::Vec3d& at : {s.midpoint_camera_mm, first, last, first + 0.8 * (first - last), last + 0.8 * (last - first)})
+    EXPECT_NEAR(BlurAtPx(scene, BlurSource::kMeasured, at), edge_mean, 1e-9);
+  EXPECT_NEAR(edge_mean, truth, 0.15 * truth);
   EXPECT_NEAR(BlurAtPx(scene, BlurSource::kEstimated, s.midpoint_camera_mm), truth, 0.15 * truth);
   EXPECT_NEAR(BlurAtPx(scene, BlurSource::kFitted, s.midpoint_camera_mm), truth, 0.15 * truth);
   // A point off the board, beyond edge 11, still gets an estimate: that is the point of the model.

@@ -1,6 +1,8 @@
 #include "calib/scene_blur.h"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <limits>
 #include <sstream>
 
@@ -130,6 +132,7 @@ SceneCalib LoadSceneCalib(const std::filesystem::path& path) {
 BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px) {
   if (text == "none") return BlurSource::kNone;
   if (text == "measured") return BlurSource::kMeasured;
+  if (text == "measured_section") return BlurSource::kMeasuredSection;
   if (text == "estimated") return BlurSource::kEstimated;
   if (text == "fitted") return BlurSource::kFitted;
   char* end = nullptr;
@@ -139,14 +142,15 @@ BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px) {
     return BlurSource::kFixed;
   }
   throw Error(ErrorKind::kUsage,
-              "blur source must be none, measured, estimated, fitted or a radius in [0, " +
-                                        std::to_string(int(optics::kMaxBlurRadiusPx)) + "] px, got '" + text + "'");
+              "blur source must be none, measured, measured_section, estimated, fitted or a radius in [0, " +
+                  std::to_string(int(optics::kMaxBlurRadiusPx)) + "] px, got '" + text + "'");
 }
 
 std::string ToString(BlurSource source) {
   switch (source) {
     case BlurSource::kNone: return "none";
     case BlurSource::kMeasured: return "measured";
+    case BlurSource::kMeasuredSection: return "measured_section";
     case BlurSource::kEstimated: return "estimated";
     case BlurSource::kFitted: return "fitted";
     case BlurSource::kFixed: return "fixed";
@@ -161,7 +165,7 @@ double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& p, 
     case BlurSource::kFixed: return fixed_r_px;
     case BlurSource::kEstimated: return optics::Eq37Px(lens, scene.reference_u_mm, scene.reference_r_px, p[2]);
     case BlurSource::kFitted: return scene.model.PredictPx(lens, p[2]);
-    case BlurSource::kMeasured: {
+    case BlurSource::kMeasuredSection: {
       const SceneCalib::Section* best = nullptr;
       double best_d = 1e300;
       for (const auto& s : scene.sections) {
@@ -171,6 +175,25 @@ double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& p, 
       }
       if (!best) throw Error(ErrorKind::kNotFound, "the calibration has no usable measured section");
       return best->r_px;
+    }
+    case BlurSource::kMeasured: {
+      // Per edge: the usable sections' midpoints (in section order) and their mean r. The edge's line runs from the
+      // first midpoint to the last; with one usable section the line is that point.
+      std::map<int, std::vector<const SceneCalib::Section*>> edges;
+      for (const auto& s : scene.sections)
+        if (s.ok) edges[s.edge].push_back(&s);
+      double best_d = 1e300, best_r = 0;
+      for (auto& [edge, sections] : edges) {
+        std::sort(sections.begin(), sections.end(), [](auto* a, auto* b) { return a->section < b->section; });
+        const cv::Vec3d a = sections.front()->midpoint_camera_mm, b = sections.back()->midpoint_camera_mm;
+        const double length = cv::norm(b - a);
+        const double d = length > 1e-9 ? cv::norm((p - a).cross((b - a) / length)) : cv::norm(p - a);
+        double r = 0;
+        for (const auto* s : sections) r += s->r_px;
+        if (d < best_d) best_d = d, best_r = r / static_cast<double>(sections.size());
+      }
+      if (edges.empty()) throw Error(ErrorKind::kNotFound, "the calibration has no usable measured section");
+      return best_r;
     }
   }
   return 0;

@@ -40,13 +40,17 @@ struct SceneCalib {
 SceneCalib LoadSceneCalib(const std::filesystem::path& path);
 SceneCalib SceneCalibFromJson(const Json& json, const std::string& where);
 
-enum class BlurSource { kNone, kMeasured, kEstimated, kFitted, kFixed };
-// "none", "measured", "estimated", "fitted", or a number (a fixed radius in px). Throws Error(kUsage) otherwise.
+enum class BlurSource { kNone, kMeasured, kMeasuredSection, kEstimated, kFitted, kFixed };
+// "none", "measured", "measured_section", "estimated", "fitted", or a number (a fixed radius in px). Throws
+// Error(kUsage) otherwise.
 BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px);
 std::string ToString(BlurSource source);
 
 // Blur radius (px) the scene calls for at a camera-frame point:
-//   measured  - r_px of the nearest usable measured section (3-D distance between midpoints);
+//   measured  - the thesis's edge value (its Fig. 4.11): the mean r_px of the usable sections of the edge whose
+//               line (through its section midpoints) passes nearest the point; a card beside the board aligned
+//               with edge k gets edge k's value whichever side it is on;
+//   measured_section - r_px of the nearest usable measured section alone (3-D distance between midpoints);
 //   estimated - eq. 3.7 from the reference edge at the point's depth (Error(kDomain) nearer than focus);
 //   fitted    - the fitted thin-lens model at the point's depth;
 //   fixed     - fixed_r_px; none - 0.

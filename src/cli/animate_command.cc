@@ -41,7 +41,7 @@ void AddAnimateCommand(CLI::App& app) {
       "         --left measured --right none --speed-cm-s 3 --video pattern1.avi --log pattern1.csv");
   cmd->add_option("--calib", args->calib, "calib.json")->required()->check(CLI::ExistingFile);
   cmd->add_option("--background", args->background, "the scene photo")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--left", args->left, "blur source of the left ball: none|measured|estimated|fitted|R")
+  cmd->add_option("--left", args->left, "blur source of the left ball: none|measured|measured_section|estimated|fitted|R")
       ->capture_default_str();
   cmd->add_option("--right", args->right, "blur source of the right ball")->capture_default_str();
   cmd->add_option("--texture", args->texture, "soccer, wood or an equirectangular image")->capture_default_str();

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "bench/measure_bench.h"
+#include "bench/record_bench.h"
 #include "bench/render_bench.h"
 #include "cli/commands.h"
 
@@ -90,6 +91,40 @@ void AddRender(CLI::App& bench) {
   });
 }
 
+void AddRecord(CLI::App& bench) {
+  struct Args {
+    std::string folder = "results/bench";
+    int trials = 200, frames = 60;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = bench.add_subcommand(
+      "record",
+      "What each answer's durability costs, on this disk, in one run.\n"
+      "Records the same session twice, interleaved answer by answer: synchronous=FULL (what blurcue run uses: an\n"
+      "answer once committed survives a power loss or an OS crash) and NORMAL (survives only a killed process).\n"
+      "Each answer carries a second of display flips (60 frames), committed with it in one transaction.\n"
+      "Prints the time per answer (median, 99th percentile) of each and their ratio. Run it on the disk the lab's\n"
+      "records live on: --folder names it.");
+  cmd->add_option("--folder", args->folder, "where the two scratch records are written (removed after)")
+      ->capture_default_str();
+  cmd->add_option("--trials", args->trials, "answers per record")->capture_default_str()->check(CLI::Range(10, 100000));
+  cmd->add_option("--frames", args->frames, "display flips per answer")->capture_default_str()->check(CLI::Range(0, 10000));
+  cmd->callback([args] {
+    bench::RecordBenchOptions options;
+    options.folder = args->folder;
+    options.trials = args->trials;
+    options.frames_per_trial = args->frames;
+    options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+    const bench::RecordBenchResult r = bench::RunRecordBench(options);
+    std::printf("per answer with %d frames, %d answers each, in %s:\n"
+                "  synchronous=FULL   median %.2f ms  p99 %.2f ms\n"
+                "  synchronous=NORMAL median %.2f ms  p99 %.2f ms\n"
+                "  FULL costs %.2f ms more per answer (median), %.1fx NORMAL\n",
+                args->frames, args->trials, args->folder.c_str(), r.full_median_ms, r.full_p99_ms, r.normal_median_ms,
+                r.normal_p99_ms, r.full_median_ms - r.normal_median_ms, r.full_median_ms / r.normal_median_ms);
+  });
+}
+
 }  // namespace
 
 void AddBenchCommand(CLI::App& app) {
@@ -97,6 +132,7 @@ void AddBenchCommand(CLI::App& app) {
   bench->require_subcommand(1);
   AddMeasure(*bench);
   AddRender(*bench);
+  AddRecord(*bench);
 }
 
 }  // namespace blurcue::cli

@@ -95,5 +95,6 @@ void AddValidateCommand(CLI::App& app);     // validate_command.cc
 void AddRunCommand(CLI::App& app);          // run_command.cc
 void AddPreviewCommand(CLI::App& app);      // preview_command.cc
 void AddReportCommand(CLI::App& app);       // report_command.cc
+void AddDisplayCommand(CLI::App& app);      // display_command.cc
 
 }  // namespace blurcue::cli

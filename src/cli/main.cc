@@ -38,6 +38,7 @@ int main(int argc, char** argv) {
       {"export", &cli::AddExportCommand},
       {"merge", &cli::AddMergeCommand},
       {"report", &cli::AddReportCommand},
+      {"display", &cli::AddDisplayCommand},
       {"bench", &cli::AddBenchCommand},
   };
   for (const auto& [name, add] : commands) add(app);

@@ -1,10 +1,12 @@
 // blurcue export / merge: the SQLite record out to analysis tables, and several stations' records into one.
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "cli/commands.h"
 #include "store/export.h"
+#include "store/record.h"
 
 namespace blurcue::cli {
 
@@ -22,11 +24,16 @@ void AddExportCommand(CLI::App& app) {
       "DIR/summary-STUDY.csv: per session the trials planned and answered, the median response time and how often\n"
       "each answer was given (the source chosen or cant_tell; the level accepted). Practice trials are left out\n"
       "of the summaries. DIR/frames.csv holds every display flip (time from the trial's first flip, dropped or not).\n"
+      "The folder is written as a whole: built beside DIR as .DIR.partial-PID and swapped in at the end, so an\n"
+      "interrupted export leaves the previous tables complete (its leftovers are removed by the next export). An\n"
+      "existing DIR must hold only such tables: a folder of other files is refused, not replaced.\n"
       "Example: blurcue export --db results/study.sqlite --out results/tables");
   cmd->add_option("--db", args->db, "the SQLite record")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "folder for the tables (created)")->required();
   cmd->callback([args] {
-    const int64_t rows = store::ExportCsv(args->db, args->out);
+    const int64_t rows = store::ExportCsv(args->db, args->out, [](const std::string& line) {
+      std::fprintf(stderr, "export: %s\n", line.c_str());
+    });
     std::printf("wrote %s/trials.csv (%lld rows) and the per-study summaries\n", args->out.c_str(),
                 static_cast<long long>(rows));
   });
@@ -41,29 +48,64 @@ void AddMergeCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "merge",
       "Combine the records of several lab stations into a new one, with fresh ids (nothing collides); protocol\n"
-      "versions are shared by their hash and participants by their code. Refuses an existing --out.\n"
+      "versions are shared by their hash and participants by their code. Refuses an existing --out. The record is\n"
+      "built beside it as .OUT.partial-PID and renamed to OUT when complete; an interrupted merge's leftovers are\n"
+      "removed by the next merge to the same OUT.\n"
       "Example: blurcue merge station-a.sqlite station-b.sqlite --out all.sqlite");
   cmd->add_option("inputs", args->inputs, "records to combine")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "the new record")->required();
   cmd->callback([args] {
     std::vector<std::filesystem::path> inputs(args->inputs.begin(), args->inputs.end());
-    store::MergeDatabases(inputs, args->out);
+    store::MergeDatabases(inputs, args->out, [](const std::string& line) {
+      std::fprintf(stderr, "merge: %s\n", line.c_str());
+    });
     std::printf("merged %zu records into %s\n", inputs.size(), args->out.c_str());
   });
 }
 
 void AddSessionsCommand(CLI::App& app) {
-  auto db = std::make_shared<std::string>();
+  struct Args {
+    std::string db;
+    std::optional<int64_t> abort, break_lock;
+  };
+  auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "sessions",
       "List the sessions of a record: study, participant, status, trials answered of planned, seed, start and end,\n"
-      "host, and who holds its lock (a writer alive, or a stale lock left by a crash). An unfinished session continues with blurcue run ... --resume.\n"
-      "Example: blurcue sessions --db results/study.sqlite");
-  cmd->add_option("--db", *db, "the SQLite record")->required()->check(CLI::ExistingFile);
-  cmd->callback([db] {
-    const auto sessions = store::ListSessions(*db);
+      "host, and who holds its lock (a writer alive, or a stale lock left by a crash). An unfinished session\n"
+      "continues with blurcue run ... --resume. A read-only record (an archive, a read-only mount) lists too.\n"
+      "\n"
+      "Two repairs, each the experimenter's explicit call:\n"
+      "  --abort ID       close an unfinished session as aborted, keeping every answer (e.g. its protocol was\n"
+      "                   changed, so it cannot be resumed); refused while a live writer holds it.\n"
+      "  --break-lock ID  clear a session's lock whoever holds it (a station that died holding it; a lock of this\n"
+      "                   host whose process is gone, or silent for 60 s, is taken over by the next run anyway).\n"
+      "\n"
+      "Examples:\n"
+      "  blurcue sessions --db results/study.sqlite\n"
+      "  blurcue sessions --db results/study.sqlite --abort 12");
+  cmd->add_option("--db", args->db, "the SQLite record")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--abort", args->abort, "close this unfinished session as aborted (answers kept)");
+  cmd->add_option("--break-lock", args->break_lock, "clear this session's lock");
+  cmd->callback([args] {
+    if (args->abort || args->break_lock) {
+      store::Record record = store::Record::Open(args->db);
+      if (args->break_lock) {
+        const store::LockState lock = record.BreakLock(*args->break_lock);
+        std::printf("%s: session %lld: broke the lock of %s\n", args->db.c_str(),
+                    static_cast<long long>(*args->break_lock), lock.text.c_str());
+      }
+      if (args->abort) {
+        record.AbortSession(*args->abort);
+        std::printf("%s: session %lld closed as aborted; its answers are kept\n", args->db.c_str(),
+                    static_cast<long long>(*args->abort));
+      }
+      return;
+    }
+    const auto sessions = store::ListSessions(args->db);
+    const std::string& db = args->db;
     if (sessions.empty()) {
-      std::printf("%s: no sessions yet\n", db->c_str());
+      std::printf("%s: no sessions yet\n", db.c_str());
       return;
     }
     std::printf("%4s  %-28s %-12s %-9s %9s  %-20s  %-24s %-24s %s\n", "id", "study", "participant", "status",

@@ -1,24 +1,49 @@
 // blurcue report: the record exported to tables, then every chart and an index.html (analysis/report.py).
+#include <sys/prctl.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "cli/commands.h"
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "store/export.h"
 
 namespace blurcue::cli {
 namespace {
 
-// A shell word: single-quoted, with single quotes escaped.
-std::string Quote(const std::string& text) {
-  std::string out = "'";
-  for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
+// Runs `argv` (argv[0] looked up on PATH) and returns its wait status. The child dies with this process: a kill
+// of `blurcue report`, -9 included, must not leave Python running on to write into a folder nobody will use.
+int RunChild(const std::vector<std::string>& argv) {
+  std::vector<char*> args;
+  for (const auto& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
+  args.push_back(nullptr);
+  const pid_t parent = getpid();
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const pid_t child = fork();
+  if (child < 0) throw Error(ErrorKind::kInternal, "cannot start " + argv[0] + ": " + std::strerror(errno));
+  if (child == 0) {
+    // Only async-signal-safe calls here. PR_SET_PDEATHSIG sends SIGKILL when the parent dies; a parent that died
+    // before the prctl took effect is caught by getppid() no longer being it.
+    if (prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || getppid() != parent) _exit(126);
+    execvp(args[0], args.data());
+    _exit(127);
+  }
+  int status = 0;
+  while (waitpid(child, &status, 0) < 0) {
+    if (errno != EINTR) throw Error(ErrorKind::kInternal, "cannot wait for " + argv[0] + ": " + std::strerror(errno));
+  }
+  return status;
 }
 
 }  // namespace
@@ -41,6 +66,9 @@ void AddReportCommand(CLI::App& app) {
       "          (from --bench: measure.csv and render.csv of blurcue bench)\n"
       "Sections without data are skipped with a note. Needs Debian's python3-pandas, -scipy, -matplotlib and\n"
       "-statsmodels (scripts/setup.sh installs them).\n"
+      "The folder is built beside DIR as .DIR.partial-PID and swapped in only when the analysis succeeded: an\n"
+      "interrupted or failed report leaves the previous one (or none), never half of one, and the analysis dies\n"
+      "with blurcue. An existing DIR must be an earlier report (index.html or tables/trials.csv) or empty.\n"
       "Example: blurcue report --db results/demo/study.sqlite --out results/demo/report");
   cmd->add_option("--db", args->db, "the SQLite record")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "folder for the report (created)")->required();
@@ -49,22 +77,38 @@ void AddReportCommand(CLI::App& app) {
       ->check(IntRange(10, 100000));
   cmd->add_option("--python", args->python, "the Python that sees the analysis packages")->capture_default_str();
   cmd->callback([args] {
-    const std::filesystem::path tables = std::filesystem::path(args->out) / "tables";
-    const int64_t rows = store::ExportCsv(args->db, tables);
-    std::fprintf(stderr, "report: exported %lld trials to %s\n", static_cast<long long>(rows), tables.c_str());
+    const std::filesystem::path out = args->out;
     const std::filesystem::path script = std::filesystem::path(BLURCUE_SOURCE_DIR) / "analysis" / "report.py";
     if (!std::filesystem::exists(script)) throw InputError(script.string(), "the analysis script is missing");
-    const std::string command = Quote(args->python) + " " + Quote(script.string()) + " --trials " +
-                                Quote((tables / "trials.csv").string()) + " --bench " + Quote(args->bench) +
-                                " --out " + Quote(args->out) + " --boot " + std::to_string(args->boot);
-    std::fflush(stdout);
-    const int status = std::system(command.c_str());
-    if (status == -1 || !WIFEXITED(status))
-      throw Error(ErrorKind::kInternal, "cannot run " + args->python + " " + script.string());
-    const int code = WEXITSTATUS(status);
-    if (code == 127) throw Error(ErrorKind::kUsage, "--python " + args->python + ": not found");
-    if (code != 0) throw Error(code == 3 ? ErrorKind::kInput : ErrorKind::kInternal,
-                               "the analysis stopped (exit " + std::to_string(code) + "); its message is above");
+    for (const auto& path : RemoveStaleLeftovers(out))
+      std::fprintf(stderr, "report: removed %s, left by an interrupted run\n", path.c_str());
+    // An earlier report is replaced as a whole; a folder of something else is not ours to replace.
+    std::error_code ignored;
+    const bool earlier_report = std::filesystem::exists(out / "index.html", ignored) ||
+                                std::filesystem::exists(out / "tables" / "trials.csv", ignored);
+    WriteFolderAtomically(
+        out,
+        [&](const std::filesystem::path& partial) {
+          const int64_t rows = store::ExportCsv(args->db, partial / "tables", [](const std::string& line) {
+            std::fprintf(stderr, "report: %s\n", line.c_str());
+          });
+          std::fprintf(stderr, "report: exported %lld trials to %s\n", static_cast<long long>(rows),
+                       (out / "tables").c_str());
+          const int status =
+              RunChild({args->python, script.string(), "--trials", (partial / "tables" / "trials.csv").string(),
+                        "--bench", args->bench, "--out", partial.string(), "--final-out", out.string(), "--boot",
+                        std::to_string(args->boot)});
+          if (WIFSIGNALED(status))
+            throw Error(ErrorKind::kInternal, "the analysis was killed by signal " + std::to_string(WTERMSIG(status)) +
+                                                  "; " + out.string() + " is unchanged");
+          const int code = WEXITSTATUS(status);
+          if (code == 127) throw Error(ErrorKind::kUsage, "--python " + args->python + ": not found");
+          if (code != 0)
+            throw Error(code == 3 ? ErrorKind::kInput : ErrorKind::kInternal,
+                        "the analysis stopped (exit " + std::to_string(code) + "; its message is above); " +
+                            out.string() + " is unchanged");
+        },
+        [earlier_report](const std::string&) { return earlier_report; });
     std::printf("wrote %s/index.html\n", args->out.c_str());
   });
 }

@@ -15,6 +15,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/limits.h"
 
@@ -171,19 +172,16 @@ cv::Mat ReadImage(const std::filesystem::path& path, int flags) {
 }
 
 void WriteImage(const std::filesystem::path& path, const cv::Mat& image) {
-  std::error_code ec;
-  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path(), ec);
-  if (ec) throw InputError(path.string(), "cannot create its folder: " + ec.message());
-  // Keep the extension on the temporary name: OpenCV picks the encoder from it.
-  const std::filesystem::path tmp = path.parent_path() / (".tmp-" + path.filename().string());
+  // Encoded in memory (OpenCV picks the encoder from the target's extension), then one atomic write.
+  std::vector<uchar> bytes;
   bool ok = false;
   try {
-    ok = cv::imwrite(tmp.string(), image);
+    ok = cv::imencode(path.extension().string(), image, bytes);
   } catch (const cv::Exception& e) {
     throw InputError(path.string(), std::string("cannot encode image: ") + e.what());
   }
-  if (!ok) throw InputError(path.string(), "cannot write image");
-  std::filesystem::rename(tmp, path);
+  if (!ok) throw InputError(path.string(), "cannot encode image");
+  WriteFileAtomically(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 double SrgbToLinear(double v) { return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4); }

@@ -9,7 +9,7 @@ namespace blurcue {
 
 // Reads an image as 8-bit BGR or grey as stored; throws Error(kInput) naming the file when unreadable.
 cv::Mat ReadImage(const std::filesystem::path& path, int flags = -1 /* cv::IMREAD_UNCHANGED */);
-// Writes via a temporary file and rename; creates the folder; throws naming the file on failure.
+// Writes atomically (core/atomic_file.h); creates the folder; throws naming the file on failure.
 void WriteImage(const std::filesystem::path& path, const cv::Mat& image);
 
 // sRGB transfer function, one channel value in [0, 1].

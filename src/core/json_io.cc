@@ -3,6 +3,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 
 namespace blurcue {
@@ -18,17 +19,7 @@ Json ReadJsonFile(const std::filesystem::path& path) {
 }
 
 void WriteJsonFile(const std::filesystem::path& path, const Json& json) {
-  std::error_code ec;
-  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path(), ec);
-  if (ec) throw InputError(path.string(), "cannot create its folder: " + ec.message());
-  const std::filesystem::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw InputError(path.string(), "cannot write file");
-    out << json.dump(2) << "\n";
-    if (!out) throw InputError(path.string(), "write failed");
-  }
-  std::filesystem::rename(tmp, path);
+  WriteFileAtomically(path, json.dump(2) + "\n");
 }
 
 static const Json& RequireField(const Json& obj, const std::string& key, const std::string& where) {

@@ -12,7 +12,7 @@ using Json = nlohmann::json;
 // Parses a JSON file; throws Error(kInput) naming the file on a missing file or a syntax error.
 Json ReadJsonFile(const std::filesystem::path& path);
 
-// Writes atomically (temp file + rename) so a crash never leaves half a file; 2-space indent.
+// Writes atomically (core/atomic_file.h) so a crash never leaves half a file; 2-space indent.
 void WriteJsonFile(const std::filesystem::path& path, const Json& json);
 
 // Required number at `key` of `obj`; `where` is "file: /pointer". Throws naming the field on absence or type.

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <deque>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <thread>
 
@@ -43,9 +44,20 @@ class Station {
   double frame_s() const { return frame_s_; }
   double Now() const { return window_ ? context_.Now() : clock_s_; }
 
+  // Called after a flip at most every few seconds of real time (the record's lock heartbeat).
+  void OnBeat(std::function<void()> beat) { beat_ = std::move(beat); }
+
   // Ends a frame and returns its flip time (when it reached the screen). Headless: the frame shows now, and the
   // clock moves on to the next frame or the next scripted key, whichever comes first.
   double Flip() {
+    if (beat_) {
+      // A participant may sit on a screen for minutes: the lock must still show a live writer.
+      const auto now = std::chrono::steady_clock::now();
+      if (now - last_beat_ > std::chrono::seconds(5)) {
+        last_beat_ = now;
+        beat_();
+      }
+    }
     if (!window_) {
       const double flip = clock_s_;
       const double next = clock_s_ + frame_s_;
@@ -93,6 +105,8 @@ class Station {
   double frame_s_;
   double clock_s_ = 0, last_flip_s_ = 0;
   std::deque<InputEvent> scripted_;
+  std::function<void()> beat_;
+  std::chrono::steady_clock::time_point last_beat_ = std::chrono::steady_clock::now();
 };
 
 // Keys -> actions, as the protocol maps them. The mouse steps and accepts in adjustment.
@@ -299,6 +313,7 @@ class Runner {
     result.seed = seed_;
     result.trial_count = static_cast<int64_t>(trials_.size());
     result.answered_before = start.first_unanswered_trial;
+    station_.OnBeat([&] { record.Heartbeat(start.session_id); });
     const auto wall_start = std::chrono::steady_clock::now();
     const bool tty = isatty(2);
     auto progress = [&](int64_t done) {
@@ -354,6 +369,7 @@ class Runner {
     }
     if (tty) std::fprintf(stderr, "\n");
     result.completed = record.FirstUnansweredTrial(start.session_id) == result.trial_count;
+    station_.OnBeat(nullptr);  // the session's lock is released below or by the Record
     if (result.completed) {
       record.FinishSession(start.session_id, store::SessionStatus::kCompleted);
       if (station_.window()) {
@@ -397,6 +413,10 @@ RunResult RunSession(const RunOptions& options) {
   if (!options.observer.empty()) observer = ParseObserver(options.observer);
   if (options.sim_fps <= 0) throw Error(ErrorKind::kUsage, "--sim-fps must be > 0");
 
+  // --resume continues what a record holds: a missing record holds nothing (and is not created).
+  if (options.resume && !std::filesystem::exists(options.db))
+    throw InputError(options.db.string(), "--resume: no such record, so there is no session to continue; leave out "
+                                          "--resume to start one");
   const protocol::Protocol protocol = protocol::LoadProtocol(options.protocol_file);
   const std::string protocol_text = ReadText(options.protocol_file);
   const uint64_t seed = options.seed ? *options.seed : protocol::DefaultSeed(protocol.name, options.participant);

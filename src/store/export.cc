@@ -1,16 +1,14 @@
 #include "store/export.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cstdlib>
-#include <fstream>
 #include <map>
 #include <set>
 #include <string>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/json_io.h"
 #include "store/record.h"
@@ -57,22 +55,19 @@ std::string Where(const std::filesystem::path& db, int64_t session, int64_t tria
   return db.string() + ": session " + std::to_string(session) + " trial " + std::to_string(trial);
 }
 
-// Writes `text` to `path` through a temporary file renamed over it: a reader sees the old file or the new one.
-void WriteAtomically(const std::filesystem::path& path, const std::string& text) {
-  const std::filesystem::path temp = path.string() + ".tmp" + std::to_string(getpid());
-  std::error_code error;
-  {
-    std::ofstream out(temp, std::ios::binary);
-    if (!out) throw InputError(temp.string(), "cannot write");
-    out << text;
-    out.close();
-    if (!out) {
-      std::filesystem::remove(temp, error);
-      throw InputError(temp.string(), "write failed");
-    }
-  }
-  std::filesystem::rename(temp, path, error);
-  if (error) throw InputError(path.string(), "cannot replace: " + error.message());
+// What an export folder may hold and still be replaced as a whole: the files an export writes, and the
+// temporaries an earlier version left beside them when killed (FILE.csv.tmpPID).
+bool IsExportFile(const std::string& name) {
+  const bool table = name == "trials.csv" || name == "frames.csv" || name.rfind("summary-", 0) == 0;
+  if (table && name.size() > 4 && name.compare(name.size() - 4, 4, ".csv") == 0) return true;
+  const size_t tmp = name.rfind(".csv.tmp");
+  return tmp != std::string::npos && tmp + 8 < name.size() &&
+         name.find_first_not_of("0123456789", tmp + 8) == std::string::npos;
+}
+
+void Note(const ProgressNote& note, const std::vector<std::filesystem::path>& removed) {
+  for (const auto& path : removed)
+    if (note) note("removed " + path.string() + ", left by an interrupted run");
 }
 
 std::string CsvLine(const std::vector<std::string>& cells) {
@@ -143,7 +138,7 @@ void WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
     std::string safe = study;
     for (char& c : safe)
       if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
-    WriteAtomically(out_dir / ("summary-" + safe + ".csv"), text);
+    WriteFileAtomically(out_dir / ("summary-" + safe + ".csv"), text);
   }
 }
 
@@ -163,7 +158,7 @@ void WriteFrames(Database& db, const std::filesystem::path& out_dir) {
     text += CsvLine({rows.GetText(0), rows.GetText(1), std::to_string(rows.GetInt64(2)),
                      std::to_string(rows.GetInt64(7)), std::to_string(rows.GetInt64(3)),
                      std::to_string(rows.GetInt64(4)), Number(rows.GetDouble(5)), std::to_string(rows.GetInt64(6))});
-  WriteAtomically(out_dir / "frames.csv", text);
+  WriteFileAtomically(out_dir / "frames.csv", text);
 }
 
 void RemoveDatabaseFiles(const std::filesystem::path& path) {
@@ -186,9 +181,11 @@ std::string CsvField(const std::string& text) {
   return out + "\"";
 }
 
-int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::path& out_dir) {
+int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::path& out_dir,
+                  const ProgressNote& note) {
+  Note(note, RemoveStaleLeftovers(out_dir));
   Database db(db_path, OpenMode::kReadOnly);
-  RequireCurrentSchema(db);
+  RequireReadableRecord(db);
 
   // Pass 1: every factor key in the record, so every participant gets the same columns.
   std::set<std::string> keys;
@@ -205,9 +202,6 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
   std::set<std::string> fixed(LeadingColumns().begin(), LeadingColumns().end());
   fixed.insert(TrailingColumns().begin(), TrailingColumns().end());
 
-  std::error_code error;
-  std::filesystem::create_directories(out_dir, error);
-  if (error) throw InputError(out_dir.string(), "cannot create the folder: " + error.message());
   std::vector<std::string> header = LeadingColumns();
   for (const auto& key : keys) header.push_back(fixed.count(key) ? "factor_" + key : key);
   header.insert(header.end(), TrailingColumns().begin(), TrailingColumns().end());
@@ -247,20 +241,28 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
     text += CsvLine(cells);
     ++count;
   }
-  WriteAtomically(out_dir / "trials.csv", text);
-  WriteSummaries(db, out_dir);
-  WriteFrames(db, out_dir);
+  // Every table of one export appears together: a kill leaves the previous export whole, never its frames.csv
+  // beside a new trials.csv.
+  WriteFolderAtomically(
+      out_dir,
+      [&](const std::filesystem::path& partial) {
+        WriteFileAtomically(partial / "trials.csv", text);
+        WriteSummaries(db, partial);
+        WriteFrames(db, partial);
+      },
+      IsExportFile);
   return count;
 }
 
 std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path) {
   Database db(db_path, OpenMode::kReadOnly);
-  RequireCurrentSchema(db);
+  RequireReadableRecord(db);
   Statement rows(db,
                  "SELECT s.id, st.name, p.code, s.status, s.started, coalesce(s.ended, ''), s.host, s.seed, "
                  "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), "
                  "(SELECT count(*) FROM trials t JOIN responses r ON r.trial_id = t.id WHERE t.session_id = s.id), "
-                 "s.lock_token IS NOT NULL, coalesce(s.lock_pid, 0), coalesce(s.lock_host, '') "
+                 "s.lock_token IS NOT NULL, coalesce(s.lock_pid, 0), coalesce(s.lock_host, ''), "
+                 "coalesce(s.lock_heartbeat_ms, 0) "
                  "FROM sessions s JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
                  "ORDER BY st.name, p.code, s.id");
   std::vector<SessionSummary> sessions;
@@ -276,26 +278,22 @@ std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path) {
     s.seed = static_cast<uint64_t>(rows.GetInt64(7));
     s.planned = rows.GetInt64(8);
     s.answered = rows.GetInt64(9);
-    if (rows.GetInt64(10) != 0) {
-      const int64_t pid = rows.GetInt64(11);
-      const std::string host = rows.GetText(12);
-      s.writer = "pid " + std::to_string(pid) + " on " + host;
-      if (host == HostName())
-        s.writer += ProcessGone(pid) ? " (gone: a stale lock, the next run takes it over)" : " (alive)";
-    }
+    if (rows.GetInt64(10) != 0) s.writer = JudgeLock(rows.GetText(12), rows.GetInt64(11), rows.GetInt64(13)).text;
     sessions.push_back(std::move(s));
   }
   return sessions;
 }
 
-void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out) {
+void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out,
+                    const ProgressNote& note) {
+  Note(note, RemoveStaleLeftovers(out));
   if (std::filesystem::exists(out)) throw InputError(out.string(), "exists; merge refuses to overwrite it");
   std::set<std::filesystem::path> seen;
   for (const auto& input : inputs) {
     if (!seen.insert(std::filesystem::weakly_canonical(input)).second)
       throw InputError(input.string(), "listed twice among the merge inputs");
   }
-  const std::filesystem::path temp = out.string() + ".partial" + std::to_string(getpid());
+  const std::filesystem::path temp = TemporaryBeside(out, "partial");
   RemoveDatabaseFiles(temp);
   try {
     {
@@ -304,7 +302,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
       Transaction transaction(dst);
       for (const auto& input : inputs) {
         Database src(input, OpenMode::kReadOnly);
-        RequireCurrentSchema(src);
+        RequireReadableRecord(src);
         std::map<int64_t, int64_t> study_ids, protocol_ids, participant_ids, session_ids, trial_ids;
 
         Statement studies(src, "SELECT id, name, created FROM studies");
@@ -313,13 +311,18 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
 
         Statement protocols(src, "SELECT id, study_id, json, hash, created FROM protocol_versions");
         while (protocols.Step()) {
+          // An input of schema 1 holds raw texts: the merged record keys them by their canonical text, as run does.
+          std::string json = protocols.GetText(2), hash = protocols.GetText(3);
+          try {
+            json = CanonicalProtocolText(json);
+            hash = ProtocolHash(json);
+          } catch (const Error&) {
+          }
           std::string stored_json;
-          protocol_ids[protocols.GetInt64(0)] =
-              EnsureProtocolVersion(dst, study_ids.at(protocols.GetInt64(1)), protocols.GetText(2),
-                                    protocols.GetText(3), protocols.GetText(4), &stored_json);
-          if (stored_json != protocols.GetText(2))
-            throw InputError(input.string(), "protocol hash " + protocols.GetText(3) +
-                                                 " names a different protocol text in another input");
+          protocol_ids[protocols.GetInt64(0)] = EnsureProtocolVersion(
+              dst, study_ids.at(protocols.GetInt64(1)), json, hash, protocols.GetText(4), &stored_json);
+          if (stored_json != json)
+            throw InputError(input.string(), "protocol hash " + hash + " names a different protocol text in another input");
         }
 
         Statement participants(src, "SELECT id, study_id, code, created FROM participants");
@@ -328,12 +331,13 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
               dst, study_ids.at(participants.GetInt64(1)), participants.GetText(2), participants.GetText(3));
 
         Statement sessions(src, "SELECT id, participant_id, protocol_version_id, seed, software_version, host, "
-                                "display, started, ended, status FROM sessions");
+                                "display, started, ended, status, " +
+                                std::string(SchemaVersion(src) >= 3 ? "display_profile" : "'{}'") + " FROM sessions");
         Statement duplicate(dst, "SELECT id FROM sessions WHERE participant_id = ? AND protocol_version_id = ? "
                                  "AND seed = ? AND host = ? AND started = ?");
         Statement insert_session(dst, "INSERT INTO sessions (participant_id, protocol_version_id, seed, "
-                                      "software_version, host, display, started, ended, status) "
-                                      "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
+                                      "software_version, host, display, started, ended, status, display_profile) "
+                                      "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
         while (sessions.Step()) {
           const int64_t participant = participant_ids.at(sessions.GetInt64(1));
           const int64_t protocol = protocol_ids.at(sessions.GetInt64(2));
@@ -353,6 +357,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
           if (sessions.IsNull(8)) insert_session.BindNull(8);
           else insert_session.Bind(8, sessions.GetText(8));
           insert_session.Bind(9, sessions.GetText(9));
+          insert_session.Bind(10, sessions.GetText(10));
           insert_session.Run();
           insert_session.Reset();
           session_ids[sessions.GetInt64(0)] = dst.LastInsertRowId();
@@ -399,10 +404,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
       }
       transaction.Commit();
     }  // the last connection closes: the WAL is checkpointed into the file and removed
-    if (std::filesystem::exists(out)) throw InputError(out.string(), "appeared during the merge; not overwritten");
-    std::error_code error;
-    std::filesystem::rename(temp, out, error);
-    if (error) throw InputError(out.string(), "cannot write the merged record: " + error.message());
+    MoveIntoPlace(temp, out);
   } catch (...) {
     RemoveDatabaseFiles(temp);
     throw;

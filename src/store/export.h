@@ -2,12 +2,16 @@
 // Reading a record out: a long-format CSV for analysis, and merging the records of several stations.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
 namespace blurcue::store {
 
-// Writes `out_dir`/trials.csv (atomically): one row per planned trial, answered or not, ordered by study,
+// Receives one line for the user (what was cleaned up); the caller decides where to print it.
+using ProgressNote = std::function<void(const std::string&)>;
+
+// Writes `out_dir`/trials.csv: one row per planned trial, answered or not, ordered by study,
 // participant, session, trial index. Columns, the same for every participant:
 //   study, protocol_hash, participant, session, seed, trial_index, block, <every factor key found in the record,
 //   sorted>, left, right, choice, rt_ms, adjustment (the JSON path of steps; empty when none), answered_at
@@ -17,15 +21,22 @@ namespace blurcue::store {
 // cant_tell; adjustment: the level accepted) as n_ANSWER columns. And `out_dir`/frames.csv: every recorded display
 // flip (study, participant, session, window: 1 for a real window, 0 headless; trial_index, frame_index, flip_time_s
 // from the trial's first flip, dropped).
+// The folder is written as a whole (core/atomic_file.h WriteFolderAtomically): built beside `out_dir`, swapped in
+// by one rename, so a kill leaves the previous export complete and never a mix of old and new tables. An existing
+// `out_dir` holding anything but these tables is refused. Leftovers of a killed export beside `out_dir` are
+// removed first, each one told to `note`.
 // Returns the number of rows. Throws Error(kInput) for a file that is not a current blurcue record.
-int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::path& out_dir);
+int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::path& out_dir,
+                  const ProgressNote& note = {});
 
 // Copies every study, protocol version, participant, session, trial, response and frame of `inputs` into a new
 // record at `out`, with fresh ids. Protocol versions are shared by (study, hash) and participants by (study,
 // participant code). Throws Error(kInput) when `out` exists, an input is listed twice, an input is not a current
 // record, or a session (same participant, protocol, seed, host and start) is already in the output. Nothing is
-// left at `out` on failure.
-void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out);
+// left at `out` on failure. The record is built beside `out` as DIR/.NAME.partial-PID and renamed to `out` when
+// complete; leftovers of a killed merge to the same `out` are removed first, each one told to `note`.
+void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out,
+                    const ProgressNote& note = {});
 
 // One session as the experimenter sees it: who, what, how far.
 struct SessionSummary {
@@ -33,8 +44,8 @@ struct SessionSummary {
   std::string study, participant, status, started, ended, host;
   uint64_t seed = 0;
   int64_t planned = 0, answered = 0;  // practice included
-  // Who holds its lock: empty for nobody, else "pid P on HOST" with "(alive)" or "(gone: a stale lock, the next
-  // run takes it over)" when HOST is this machine.
+  // Who holds its lock: empty for nobody, else JudgeLock's text ("pid P on host H, heartbeat N s ago (alive)",
+  // or why it is stale).
   std::string writer;
 };
 

@@ -169,6 +169,20 @@ TEST(Merge, KeepsAllRowsAndIdsStayConsistent) {
             0);
 }
 
+// Every session field survives a merge, the display profile it ran with included.
+TEST(Merge, KeepsEachSessionsDisplayProfile) {
+  testing::TempDir dir;
+  {
+    Record a = Record::Open(dir / "a.sqlite");
+    SessionMeta meta;
+    meta.display_profile = R"({"name":"booth 2"})";
+    a.StartOrResumeSession("test1", "P01", "{}", 1, meta, false);
+  }
+  MergeDatabases({dir / "a.sqlite"}, dir / "merged.sqlite");
+  Database db(dir / "merged.sqlite", OpenMode::kReadOnly);
+  EXPECT_EQ(db.QueryText("SELECT display_profile FROM sessions"), R"({"name":"booth 2"})");
+}
+
 TEST(Merge, RefusesToOverwriteAnExistingOutput) {
   testing::TempDir dir;
   { Record a = Record::Open(dir / "a.sqlite"); RunSession(a, "P01", "{}", 1, 1); }

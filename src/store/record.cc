@@ -5,13 +5,14 @@
 
 #include <cerrno>
 #include <chrono>
+#include <algorithm>
 #include <cstdio>
 #include <ctime>
 #include <random>
 #include <utility>
 
 #include "core/error.h"
-#include "core/hash.h"
+#include "core/json_io.h"
 #include "store/schema.h"
 
 #ifndef BLURCUE_VERSION
@@ -56,7 +57,29 @@ const char* ToString(SessionStatus status) {
   return "running";
 }
 
-std::string Fnv1a64Hex(const std::string& text) { return HashHex(Fnv1a64(text)); }
+LockState JudgeLock(const std::string& host, int64_t pid, int64_t heartbeat_ms, const RecordOptions& options) {
+  LockState lock;
+  lock.held = true;
+  const double age_s = static_cast<double>(NowMs() - heartbeat_ms) / 1000.0;
+  const bool here = host == HostName();
+  const bool gone = here && ProcessGone(pid);
+  const double limit_s = here ? options.local_lock_stale_after_s : options.foreign_lock_stale_after_s;
+  lock.stale = gone || age_s > limit_s;
+  char beat[64];
+  std::snprintf(beat, sizeof beat, "heartbeat %.0f s ago", std::max(0.0, age_s));
+  lock.text = "pid " + std::to_string(pid) + " on host " + host + ", " + beat;
+  if (gone)
+    lock.text += " (gone: a stale lock, the next run takes it over)";
+  else if (lock.stale)
+    lock.text += here ? " (silent for over " + std::to_string(static_cast<int>(limit_s)) +
+                            " s: a stale lock, its pid reused or the writer hung; the next run takes it over)"
+                      : " (silent for over " + std::to_string(static_cast<int>(limit_s)) +
+                            " s: a stale lock, the next run takes it over)";
+  else
+    lock.text += here ? " (alive)" : " (on another host; taken over when silent for " +
+                                         std::to_string(static_cast<int>(limit_s)) + " s)";
+  return lock;
+}
 
 std::string NowIso8601() {
   const int64_t ms = NowMs();
@@ -71,6 +94,13 @@ std::string NowIso8601() {
 
 Record Record::Open(const std::filesystem::path& path, RecordOptions options) {
   Database db(path);
+  // Another program's database is refused before anything is written to it (no tables, no WAL switch).
+  RequireRecordOrEmpty(db);
+  if (SchemaVersion(db) > 0) {
+    const std::string check = db.QueryText("PRAGMA quick_check(1)");
+    if (check != "ok") throw InputError(path.string(), "the record is damaged (SQLite's quick_check: " + check + ")");
+  }
+  db.UseWal(options.durable);
   Migrate(db);
   return Record(std::move(db), options);
 }
@@ -98,21 +128,14 @@ Record::~Record() {
 }
 
 void Record::TakeLock(int64_t session) {
-  Statement query(db_, "SELECT lock_host, lock_pid, lock_token, lock_heartbeat_ms FROM sessions WHERE id = ?");
-  query.Bind(1, session);
-  if (!query.Step()) throw InputError(db_.path(), SessionName(session) + " does not exist");
-  if (!query.IsNull(2) && query.GetText(2) != token_) {
-    const std::string host = query.GetText(0);
-    const int64_t pid = query.GetInt64(1);
-    const double age_s = static_cast<double>(NowMs() - query.GetInt64(3)) / 1000.0;
-    const bool stale = host == lock_host_ ? ProcessGone(pid) : age_s > options_.foreign_lock_stale_after_s;
-    if (!stale) {
-      std::string who = "pid " + std::to_string(pid) + " on host " + host;
-      if (host == lock_host_ && pid == pid_) who += " (this process, another Record)";
-      throw InputError(db_.path(), SessionName(session) + " is being written by " + who +
-                                       "; two stations cannot write one session (last heartbeat " +
-                                       std::to_string(static_cast<int64_t>(age_s)) + " s ago)");
-    }
+  const LockState lock = Lock(session);
+  if (lock.held && !lock.stale && !lock.mine) {
+    std::string who = lock.text;
+    if (lock.text.rfind("pid " + std::to_string(pid_) + " on host " + lock_host_ + ",", 0) == 0)
+      who += " (this process, another Record)";
+    throw InputError(db_.path(), SessionName(session) + " is being written by " + who +
+                                     "; two stations cannot write one session (if that writer is dead: blurcue "
+                                     "sessions --db " + db_.path() + " --break-lock " + std::to_string(session) + ")");
   }
   Statement take(db_, "UPDATE sessions SET lock_host = ?, lock_pid = ?, lock_token = ?, lock_heartbeat_ms = ? "
                       "WHERE id = ?");
@@ -122,6 +145,45 @@ void Record::TakeLock(int64_t session) {
   take.Bind(4, NowMs());
   take.Bind(5, session);
   take.Run();
+}
+
+LockState Record::Lock(int64_t session) {
+  Statement query(db_, "SELECT lock_host, lock_pid, lock_token, lock_heartbeat_ms FROM sessions WHERE id = ?");
+  query.Bind(1, session);
+  if (!query.Step()) throw InputError(db_.path(), SessionName(session) + " does not exist");
+  if (query.IsNull(2)) return {};
+  // Our own token is never stale to ourselves.
+  if (query.GetText(2) == token_) return {true, false, true, "this writer"};
+  return JudgeLock(query.GetText(0), query.GetInt64(1), query.GetInt64(3), options_);
+}
+
+void Record::AbortSession(int64_t session) {
+  Transaction transaction(db_);
+  Statement query(db_, "SELECT status FROM sessions WHERE id = ?");
+  query.Bind(1, session);
+  if (!query.Step()) throw InputError(db_.path(), SessionName(session) + " does not exist");
+  const std::string status = query.GetText(0);
+  if (status != "running")
+    throw InputError(db_.path(), SessionName(session) + " is " + status + "; only a running session can be aborted");
+  TakeLock(session);
+  Statement finish(db_, "UPDATE sessions SET status = 'aborted', ended = ?, lock_host = NULL, lock_pid = NULL, "
+                        "lock_token = NULL, lock_heartbeat_ms = NULL WHERE id = ?");
+  finish.Bind(1, NowIso8601());
+  finish.Bind(2, session);
+  finish.Run();
+  transaction.Commit();
+}
+
+LockState Record::BreakLock(int64_t session) {
+  Transaction transaction(db_);
+  const LockState lock = Lock(session);
+  if (!lock.held) throw InputError(db_.path(), SessionName(session) + " holds no lock; nothing to break");
+  Statement release(db_, "UPDATE sessions SET lock_host = NULL, lock_pid = NULL, lock_token = NULL, "
+                         "lock_heartbeat_ms = NULL WHERE id = ?");
+  release.Bind(1, session);
+  release.Run();
+  transaction.Commit();
+  return lock;
 }
 
 void Record::RequireLock(int64_t session) {
@@ -147,30 +209,74 @@ int64_t Record::TrialId(int64_t session, int64_t trial_index) {
   return query.GetInt64(0);
 }
 
+namespace {
+
+// What differs between two protocol texts (canonical JSON), as JSON pointers with the old and new values.
+std::string ProtocolChanges(const std::string& before, const std::string& after) {
+  Json a, b;
+  try {
+    a = Json::parse(before);
+    b = Json::parse(after);
+  } catch (const Json::exception&) {
+    return "the recorded text is not JSON";
+  }
+  const Json patch = Json::diff(a, b);
+  std::string text;
+  int shown = 0;
+  for (const Json& op : patch) {
+    if (++shown > 4) {
+      text += ", and " + std::to_string(patch.size() - 4) + " more";
+      break;
+    }
+    const std::string path = op.at("path").get<std::string>();
+    const std::string pointer = path.empty() ? "/" : path;
+    auto value = [](const Json& v) {
+      std::string t = v.dump();
+      return t.size() > 40 ? t.substr(0, 37) + "..." : t;
+    };
+    const std::string kind = op.at("op").get<std::string>();
+    if (!text.empty()) text += ", ";
+    if (kind == "add")
+      text += pointer + " added (" + value(op.at("value")) + ")";
+    else if (kind == "remove")
+      text += pointer + " removed (was " + value(a.at(Json::json_pointer(path))) + ")";
+    else
+      text += pointer + " " + value(a.at(Json::json_pointer(path))) + " -> " + value(op.at("value"));
+  }
+  return text;
+}
+
+}  // namespace
+
 SessionStart Record::StartOrResumeSession(const std::string& study, const std::string& participant,
                                           const std::string& protocol_json, uint64_t seed, const SessionMeta& meta,
                                           bool resume) {
   const std::string now = NowIso8601();
-  const std::string hash = Fnv1a64Hex(protocol_json);
+  const std::string canonical = CanonicalProtocolText(protocol_json);
+  const std::string hash = ProtocolHash(canonical);
   Transaction transaction(db_);
 
   const int64_t study_id = EnsureStudy(db_, study, now);
   const int64_t participant_id = EnsureParticipant(db_, study_id, participant, now);
 
-  Statement running(db_, "SELECT s.id, s.seed, p.hash FROM sessions s JOIN protocol_versions p "
+  Statement running(db_, "SELECT s.id, s.seed, p.hash, p.json FROM sessions s JOIN protocol_versions p "
                          "ON p.id = s.protocol_version_id WHERE s.participant_id = ? AND s.status = 'running' "
                          "ORDER BY s.id DESC LIMIT 1");
   running.Bind(1, participant_id);
   SessionStart start;
   start.seed = seed;
+  const std::string abort_hint = "blurcue sessions --db " + db_.path() + " --abort ";
   if (running.Step()) {
     const int64_t session = running.GetInt64(0);
     if (!resume)
-      throw InputError(db_.path(), "participant " + participant + " of study " + study + " has a running " +
-                                       SessionName(session) + "; resume it or finish it as aborted");
+      throw InputError(db_.path(), "participant " + participant + " of study " + study + " has an unfinished " +
+                                       SessionName(session) + "; continue it with --resume, or close it with " +
+                                       abort_hint + std::to_string(session) + " (its answers are kept)");
     if (running.GetText(2) != hash)
-      throw InputError(db_.path(), SessionName(session) + " was started with protocol " + running.GetText(2) +
-                                       ", got protocol " + hash + "; finish it as aborted to start over");
+      throw InputError(db_.path(), SessionName(session) + " was started with another version of the protocol (" +
+                                       ProtocolChanges(running.GetText(3), canonical) +
+                                       "); run it with the protocol it started with, or close it with " +
+                                       abort_hint + std::to_string(session) + " (its answers are kept)");
     const uint64_t stored_seed = static_cast<uint64_t>(running.GetInt64(1));
     if (stored_seed != seed)
       throw InputError(db_.path(), SessionName(session) + " was started with seed " + std::to_string(stored_seed) +
@@ -178,15 +284,28 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     TakeLock(session);
     start.session_id = session;
     start.resumed = true;
+  } else if (resume) {
+    // Nothing to continue: say what there is instead of starting a whole new session unasked.
+    Statement past(db_, "SELECT status, count(*), max(id) FROM sessions WHERE participant_id = ? GROUP BY status");
+    past.Bind(1, participant_id);
+    std::string found;
+    while (past.Step())
+      found += std::string(found.empty() ? "" : ", ") + std::to_string(past.GetInt64(1)) + " " + past.GetText(0) +
+               " (last: session " + std::to_string(past.GetInt64(2)) + ")";
+    throw InputError(db_.path(), "--resume: participant " + participant + " of study " + study +
+                                     " has no unfinished session to continue (" +
+                                     (found.empty() ? std::string("no sessions at all") : found) +
+                                     "); leave out --resume to start a new session" +
+                                     (found.find("completed") != std::string::npos ? ", with --again" : ""));
   } else {
     std::string stored_json;
-    const int64_t protocol_id = EnsureProtocolVersion(db_, study_id, protocol_json, hash, now, &stored_json);
-    if (stored_json != protocol_json)  // a 64-bit hash collision: refuse rather than mix texts
+    const int64_t protocol_id = EnsureProtocolVersion(db_, study_id, canonical, hash, now, &stored_json);
+    if (stored_json != canonical)  // a 64-bit hash collision: refuse rather than mix texts
       throw Error(ErrorKind::kInternal, "protocol hash " + hash + " collides with another protocol text");
 
     Statement insert(db_, "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, "
-                          "host, display, started, status, lock_host, lock_pid, lock_token, lock_heartbeat_ms) "
-                          "VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?)");
+                          "host, display, started, status, lock_host, lock_pid, lock_token, lock_heartbeat_ms, "
+                          "display_profile) VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?)");
     insert.Bind(1, participant_id);
     insert.Bind(2, protocol_id);
     insert.Bind(3, static_cast<int64_t>(seed));
@@ -198,6 +317,7 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     insert.Bind(9, pid_);
     insert.Bind(10, token_);
     insert.Bind(11, NowMs());
+    insert.Bind(12, meta.display_profile);
     insert.Run();
     start.session_id = db_.LastInsertRowId();
   }

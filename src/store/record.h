@@ -15,6 +15,7 @@ struct SessionMeta {
   std::string software_version;  // empty = this build's BLURCUE_VERSION
   std::string host;
   std::string display;  // e.g. "1920x1080@60 DELL U2412M"
+  std::string display_profile = "{}";  // the display profile as JSON (display::ToJson)
 };
 
 // One planned trial, saved up front. JSON members are compact JSON text.
@@ -51,9 +52,24 @@ struct SessionStart {
 };
 
 struct RecordOptions {
+  // A lock of this host is stale when its process is gone, or when its heartbeat is older than this: a running
+  // session beats every few seconds (RecordResponse and Heartbeat), so an old heartbeat under a live pid means the
+  // pid was reused by another program after a crash (or the writer hangs).
+  double local_lock_stale_after_s = 60;
   // A lock held from another host is taken over only when its heartbeat is older than this (a pid cannot be
-  // checked across machines).
+  // checked across machines, and their clocks may differ).
   double foreign_lock_stale_after_s = 600;
+  // true: synchronous=FULL, an answer once committed survives a power loss or an OS crash. false (NORMAL) only
+  // survives a killed process; kept for `blurcue bench record`, which measures what FULL costs.
+  bool durable = true;
+};
+
+// Who holds a session's lock, as the record names it, and whether it may be taken over.
+struct LockState {
+  bool held = false;   // false: nobody holds it
+  bool stale = false;  // the holder is gone (or silent too long): the next start takes it over
+  bool mine = false;   // held by the Record asking
+  std::string text;    // e.g. "pid 412 on host lab-3, heartbeat 3 s ago (alive)"; empty when not held
 };
 
 class Record {
@@ -69,9 +85,11 @@ class Record {
   Record& operator=(const Record&) = delete;
 
   // Starts a new running session and takes its lock, or with `resume` continues the participant's running
-  // session of `study` (starting a new one when there is none). Throws Error(kInput) when:
-  //  - resume is false but the participant has a running session (resume it or finish it as aborted),
-  //  - the resumed session was started with another protocol text or seed,
+  // session of `study`. The protocol is recorded by its canonical text (CanonicalProtocolText). Throws
+  // Error(kInput) when:
+  //  - resume is false but the participant has a running session (resume it, or close it with AbortSession),
+  //  - resume is true but there is no running session to continue (saying what the participant has instead),
+  //  - the resumed session was started with another protocol (naming what changed) or seed,
   //  - another live process or Record holds the session.
   SessionStart StartOrResumeSession(const std::string& study, const std::string& participant,
                                     const std::string& protocol_json, uint64_t seed, const SessionMeta& meta,
@@ -102,6 +120,18 @@ class Record {
   // The smallest trial index without a response (= trial count when all are answered).
   int64_t FirstUnansweredTrial(int64_t session);
 
+  // Closes a running session as aborted, keeping its answers (a session that can no longer be resumed, e.g. its
+  // protocol changed). Refused, naming the holder, while a live writer holds it; a stale lock is taken over.
+  void AbortSession(int64_t session);
+
+  // Clears the session's lock whoever holds it (the experimenter's call, e.g. a station that died with the lock
+  // within the foreign-host wait); a writer still running loses the session at its next answer or heartbeat.
+  // Returns the lock as it was; throws Error(kInput) when the session does not exist or nobody holds it.
+  LockState BreakLock(int64_t session);
+
+  // The lock of a session as the record holds it, judged by this Record's options.
+  LockState Lock(int64_t session);
+
   Database& database() { return db_; }
 
  private:
@@ -123,8 +153,8 @@ std::string HostName();
 // True when process `pid` is certainly gone on this host.
 bool ProcessGone(int64_t pid);
 
-// FNV-1a-64 of `text` as 16 lower-case hex digits (the protocol version's hash).
-std::string Fnv1a64Hex(const std::string& text);
+// Judges a lock row (host, pid, heartbeat time in ms since the epoch) against the staleness rules.
+LockState JudgeLock(const std::string& host, int64_t pid, int64_t heartbeat_ms, const RecordOptions& options = {});
 
 // Now as ISO 8601 UTC with milliseconds, e.g. "2024-05-01T12:00:00.123Z".
 std::string NowIso8601();

@@ -4,9 +4,17 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <fstream>
+#include <sstream>
+
 #include <gtest/gtest.h>
 
+#include <functional>
+
 #include "core/error.h"
+#include "core/hash.h"
+#include "store/schema.h"
 #include "store/test_util.h"
 
 namespace blurcue::store {
@@ -160,7 +168,8 @@ TEST(Record, FinishedSessionTakesNoMoreAnswersAndANewOneStarts) {
   record.FinishSession(session, SessionStatus::kAborted);
   EXPECT_THROW(record.RecordResponse(session, 0, Answer("left")), Error);
   EXPECT_EQ(record.database().QueryText("SELECT status FROM sessions"), "aborted");
-  const SessionStart next = record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, true);
+  EXPECT_THROW(record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, true), Error);  // nothing to resume
+  const SessionStart next = record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, false);
   EXPECT_FALSE(next.resumed);
   EXPECT_NE(next.session_id, session);
   // The same protocol text is one protocol version.
@@ -292,9 +301,275 @@ TEST(Record, SecondProcessIsRefusedUntilTheFirstIsGone) {
   record.RecordResponse(start.session_id, 1, Answer("right"));
 }
 
+std::string ErrorOf(const std::function<void()>& action) {
+  try {
+    action();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput) << e.what();
+    return e.what();
+  }
+  ADD_FAILURE() << "no error";
+  return {};
+}
+
+bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+std::string FileBytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
+
+const char* kFullProtocol = R"({"name":"test1","timing":{"inter_trial_ms":500,"stimulus_ms":0},"trials":4})";
+
+// --resume with nothing to resume says what it found and starts nothing: no session appears.
+TEST(Record, ResumeWithNothingToResumeIsRefusedAndStartsNothing) {
+  Record record = Record::Open(":memory:");
+  EXPECT_TRUE(Contains(ErrorOf([&] { record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, true); }),
+                       "--resume: participant P01 of study test1 has no unfinished session to continue (no sessions "
+                       "at all); leave out --resume"));
+  const int64_t session = record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, false).session_id;
+  record.SaveTrialList(session, Trials(1));
+  record.RecordResponse(session, 0, Answer("left"));
+  record.FinishSession(session, SessionStatus::kCompleted);
+  const std::string message =
+      ErrorOf([&] { record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, true); });
+  EXPECT_TRUE(Contains(message, "(1 completed (last: session 1)); leave out --resume to start a new session, with "
+                                "--again")) << message;
+  EXPECT_EQ(record.database().QueryInt64("SELECT count(*) FROM sessions"), 1);
+}
+
+// An editor's newline, CRLF line ends, indentation and key order are the same protocol: the session resumes.
+TEST(Record, ReformattedProtocolResumesTheSameSession) {
+  testing::TempDir dir;
+  int64_t session = 0;
+  {
+    Record first = Record::Open(dir / "r.sqlite");
+    session = first.StartOrResumeSession("test1", "P01", kFullProtocol, 7, {}, false).session_id;
+    first.SaveTrialList(session, Trials(4));
+    first.RecordResponse(session, 0, Answer("left"));
+  }
+  const std::string reformatted =
+      "{\r\n  \"trials\": 4,\r\n  \"timing\": {\"stimulus_ms\": 0, \"inter_trial_ms\": 500},\r\n"
+      "  \"name\": \"test1\"\r\n}\r\n\n";
+  Record second = Record::Open(dir / "r.sqlite");
+  const SessionStart start = second.StartOrResumeSession("test1", "P01", reformatted, 7, {}, true);
+  EXPECT_TRUE(start.resumed);
+  EXPECT_EQ(start.session_id, session);
+  EXPECT_EQ(start.first_unanswered_trial, 1);
+}
+
+// A protocol that really changed is refused naming the change and the command that closes the session; the
+// abort keeps its answers and a new session can start.
+TEST(Record, ChangedProtocolNamesTheChangeAndAbortKeepsTheAnswers) {
+  testing::TempDir dir;
+  int64_t session = 0;
+  {
+    Record first = Record::Open(dir / "r.sqlite");
+    session = first.StartOrResumeSession("test1", "P01", kFullProtocol, 7, {}, false).session_id;
+    first.SaveTrialList(session, Trials(4));
+    first.RecordResponse(session, 0, Answer("left"));
+    first.RecordResponse(session, 1, Answer("right"));
+  }
+  const std::string changed = R"({"name":"test1","timing":{"inter_trial_ms":800,"stimulus_ms":0},"trials":4})";
+  Record record = Record::Open(dir / "r.sqlite");
+  const std::string message = ErrorOf([&] { record.StartOrResumeSession("test1", "P01", changed, 7, {}, true); });
+  EXPECT_TRUE(Contains(message, "session 1 was started with another version of the protocol "
+                                "(/timing/inter_trial_ms 500 -> 800)")) << message;
+  EXPECT_TRUE(Contains(message, "blurcue sessions --db " + (dir / "r.sqlite").string() + " --abort 1")) << message;
+  // Neither does a plain run go on: it points at the same way out.
+  EXPECT_TRUE(Contains(ErrorOf([&] { record.StartOrResumeSession("test1", "P01", changed, 7, {}, false); }),
+                       "--abort 1 (its answers are kept)"));
+  record.AbortSession(session);
+  EXPECT_EQ(record.database().QueryText("SELECT status FROM sessions WHERE id = 1"), "aborted");
+  EXPECT_EQ(record.database().QueryInt64("SELECT count(*) FROM responses"), 2);
+  EXPECT_TRUE(Contains(ErrorOf([&] { record.AbortSession(session); }), "session 1 is aborted; only a running"));
+  const SessionStart fresh = record.StartOrResumeSession("test1", "P01", changed, 7, {}, false);
+  EXPECT_NE(fresh.session_id, session);
+}
+
+// Abort is refused while a live writer holds the session.
+TEST(Record, AbortIsRefusedWhileALiveWriterHoldsTheSession) {
+  testing::TempDir dir;
+  Record writer = Record::Open(dir / "r.sqlite");
+  const int64_t session = writer.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, false).session_id;
+  Record other = Record::Open(dir / "r.sqlite");
+  EXPECT_TRUE(Contains(ErrorOf([&] { other.AbortSession(session); }), "is being written by pid"));
+  EXPECT_EQ(other.database().QueryText("SELECT status FROM sessions"), "running");
+}
+
+// Sets the session's lock row as another writer would have left it.
+void PlantLock(Database& db, int64_t session, const std::string& host, int64_t pid, double age_s) {
+  const int64_t now_ms = std::chrono::duration_cast<std::chrono::milliseconds>(
+                             std::chrono::system_clock::now().time_since_epoch()).count();
+  Statement plant(db, "UPDATE sessions SET lock_host = ?, lock_pid = ?, lock_token = 'planted', "
+                      "lock_heartbeat_ms = ? WHERE id = ?");
+  plant.Bind(1, host);
+  plant.Bind(2, pid);
+  plant.Bind(3, now_ms - static_cast<int64_t>(age_s * 1000));
+  plant.Bind(4, session);
+  plant.Run();
+}
+
+// A crashed writer's pid reused by another live program on this host: a fresh heartbeat keeps the lock, an old
+// one (the runner beats every 5 s) makes it stale.
+TEST(Record, LockOfAReusedPidIsStaleByItsHeartbeatAge) {
+  testing::TempDir dir;
+  int64_t session = 0;
+  {
+    Record first = Record::Open(dir / "r.sqlite");
+    session = first.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, false).session_id;
+  }
+  Record record = Record::Open(dir / "r.sqlite");
+  // pid 1 is always alive: the reused pid.
+  PlantLock(record.database(), session, HostName(), 1, 5);
+  EXPECT_TRUE(Contains(ErrorOf([&] { record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, true); }),
+                       "is being written by pid 1 on host " + HostName() + ", heartbeat 5 s ago (alive)"));
+  PlantLock(record.database(), session, HostName(), 1, 61);
+  EXPECT_TRUE(Contains(record.Lock(session).text, "(silent for over 60 s: a stale lock"));
+  EXPECT_TRUE(record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, true).resumed);
+}
+
+// A lock from another host is kept for 10 minutes; the experimenter can break it explicitly.
+TEST(Record, BreakLockFreesASessionHeldFromAnotherHost) {
+  testing::TempDir dir;
+  int64_t session = 0;
+  {
+    Record first = Record::Open(dir / "r.sqlite");
+    session = first.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, false).session_id;
+  }
+  Record record = Record::Open(dir / "r.sqlite");
+  PlantLock(record.database(), session, "other-station", 4242, 30);
+  EXPECT_TRUE(Contains(ErrorOf([&] { record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, true); }),
+                       "--break-lock 1"));
+  const LockState broken = record.BreakLock(session);
+  EXPECT_TRUE(Contains(broken.text, "pid 4242 on host other-station, heartbeat 30 s ago")) << broken.text;
+  EXPECT_TRUE(Contains(ErrorOf([&] { record.BreakLock(session); }), "holds no lock"));
+  EXPECT_TRUE(record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, true).resumed);
+}
+
+// Another program's SQLite file is refused and left byte for byte as it was, with no WAL beside it.
+TEST(Record, ForeignDatabaseIsRefusedUntouched) {
+  testing::TempDir dir;
+  const auto path = dir / "customers.sqlite";
+  {
+    Database db(path);
+    db.Exec("CREATE TABLE customers (id INTEGER PRIMARY KEY, name TEXT); INSERT INTO customers (name) VALUES ('x')");
+  }
+  const std::string before = FileBytes(path);
+  const std::string message = ErrorOf([&] { Record::Open(path); });
+  EXPECT_TRUE(Contains(message, "customers.sqlite: not a blurcue record: it holds 1 tables (customers)")) << message;
+  EXPECT_EQ(FileBytes(path), before);
+  EXPECT_FALSE(std::filesystem::exists(path.string() + "-wal"));
+  // An empty file is a new record; so is a record stamped before (only its tables tell).
+  std::ofstream(dir / "empty.sqlite").close();
+  EXPECT_NO_THROW(Record::Open(dir / "empty.sqlite"));
+}
+
+// A record of schema version 1 (raw-text hashes, no application id) migrates: its protocol hashes become those of
+// the canonical text, so its running sessions resume with the same protocol file.
+TEST(Record, VersionOneRecordMigratesToCanonicalHashes) {
+  testing::TempDir dir;
+  const auto path = dir / "old.sqlite";
+  const std::string raw = "{\n  \"name\": \"test1\",\n  \"trials\": 4\n}\n";
+  {
+    Database db(path);
+    db.Exec(Migrations()[0].sql);
+    db.Exec("PRAGMA user_version = 1");
+    db.Exec("INSERT INTO studies VALUES (1, 'test1', 'then'); INSERT INTO participants VALUES (1, 1, 'P01', 'then')");
+    Statement protocol(db, "INSERT INTO protocol_versions VALUES (1, 1, ?, ?, 'then')");
+    protocol.Bind(1, raw);
+    protocol.Bind(2, HashHex(Fnv1a64(raw)));
+    protocol.Run();
+    db.Exec("INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, host, display, "
+            "started, status) VALUES (1, 1, 7, 'old', 'h', 'd', 'then', 'running')");
+  }
+  Record record = Record::Open(path);
+  EXPECT_EQ(SchemaVersion(record.database()), CurrentSchemaVersion());
+  EXPECT_EQ(record.database().QueryInt64("PRAGMA application_id"), kApplicationId);
+  EXPECT_EQ(record.database().QueryText("SELECT hash FROM protocol_versions"),
+            ProtocolHash(CanonicalProtocolText(raw)));
+  EXPECT_TRUE(record.StartOrResumeSession("test1", "P01", raw, 7, {}, true).resumed);
+  // Sessions from before display profiles read as '{}'.
+  EXPECT_EQ(record.database().QueryText("SELECT display_profile FROM sessions"), "{}");
+}
+
+TEST(Record, EachSessionKeepsTheDisplayProfileItRanWith) {
+  Record record = Record::Open(":memory:");
+  SessionMeta meta;
+  meta.display_profile = R"({"name":"lab 1","px_per_deg":33.87})";
+  const int64_t session = record.StartOrResumeSession("test1", "P01", kProtocol, 7, meta, false).session_id;
+  EXPECT_EQ(record.database().QueryText("SELECT display_profile FROM sessions WHERE id = " + std::to_string(session)),
+            meta.display_profile);
+}
+
+// A truncated record is an input error naming the file, never an internal one.
+TEST(Record, TruncatedRecordIsAnInputErrorNamingTheFile) {
+  testing::TempDir dir;
+  const auto path = dir / "r.sqlite";
+  {
+    Record record = Record::Open(path);
+    const int64_t session = record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, false).session_id;
+    record.SaveTrialList(session, Trials(400));
+    for (int i = 0; i < 400; ++i) record.RecordResponse(session, i, Answer("left"), {{0, 0.0, false}, {1, 0.017, false}});
+  }  // the last connection checkpoints the WAL into the file
+  const auto size = std::filesystem::file_size(path);
+  ASSERT_GT(size, 16384u);
+  std::filesystem::resize_file(path, size / 2);
+  const std::string message = ErrorOf([&] { Record::Open(path); });
+  EXPECT_TRUE(Contains(message, path.string() + ": ")) << message;
+  EXPECT_TRUE(Contains(message, "damaged")) << message;
+  EXPECT_TRUE(Contains(ErrorOf([&] {
+                         Database reader(path, OpenMode::kReadOnly);
+                         RequireReadableRecord(reader);
+                       }),
+                       "damaged"));
+}
+
+// Two stations starting on the same new file at the same moment: both proceed (the WAL switch waits its turn).
+TEST(Record, ConcurrentFirstStartsOnANewFileBothProceed) {
+  testing::TempDir dir;
+  for (int round = 0; round < 10; ++round) {
+    const auto path = dir / ("new-" + std::to_string(round) + ".sqlite");
+    int go[2];
+    ASSERT_EQ(pipe(go), 0);
+    std::vector<pid_t> children;
+    for (int c = 0; c < 2; ++c) {
+      const pid_t child = fork();
+      ASSERT_GE(child, 0);
+      if (child == 0) {
+        char byte;
+        if (read(go[0], &byte, 1) != 1) _exit(5);
+        try {
+          Record record = Record::Open(path);
+          const std::string participant = "P" + std::to_string(c);
+          const int64_t session = record.StartOrResumeSession("test1", participant, kProtocol, 7, {}, false).session_id;
+          record.SaveTrialList(session, Trials(3));
+          record.RecordResponse(session, 0, Answer("left"));
+        } catch (const Error& e) {
+          std::fprintf(stderr, "child %d: %s\n", c, e.what());
+          _exit(e.exit_code());
+        }
+        _exit(0);
+      }
+      children.push_back(child);
+    }
+    ASSERT_EQ(write(go[1], "gg", 2), 2);
+    for (pid_t child : children) {
+      const int status = Wait(child);
+      EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "round " << round << ": status " << status;
+    }
+    close(go[0]);
+    close(go[1]);
+    Record record = Record::Open(path);
+    EXPECT_EQ(record.database().QueryInt64("SELECT count(*) FROM responses"), 2) << "round " << round;
+  }
+}
+
 TEST(Record, Fnv1a64MatchesTheReferenceValues) {
-  EXPECT_EQ(Fnv1a64Hex(""), "cbf29ce484222325");
-  EXPECT_EQ(Fnv1a64Hex("a"), "af63dc4c8601ec8c");
+  EXPECT_EQ(ProtocolHash(""), "cbf29ce484222325");
+  EXPECT_EQ(ProtocolHash("a"), "af63dc4c8601ec8c");
 }
 
 }  // namespace

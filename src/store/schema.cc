@@ -1,6 +1,10 @@
 #include "store/schema.h"
 
+#include <cstdio>
+
 #include "core/error.h"
+#include "core/hash.h"
+#include "core/json_io.h"
 
 namespace blurcue::store {
 namespace {
@@ -9,11 +13,55 @@ namespace {
 // it quietly. On an older library the same schema is created without the keyword.
 std::string Strict() { return SqliteVersionNumber() >= 3037000 ? " STRICT" : ""; }
 
-std::vector<std::string> MakeMigrations() {
+// Version 2: a protocol's hash is that of its canonical text (it was the raw file's bytes). Versions whose texts
+// differ only in formatting become one; their sessions then share it.
+void CanonicalProtocolHashes(Database& db) {
+  Statement rows(db, "SELECT id, study_id, json FROM protocol_versions ORDER BY id");
+  Statement same(db, "SELECT id FROM protocol_versions WHERE study_id = ? AND hash = ? AND id <> ?");
+  Statement repoint(db, "UPDATE sessions SET protocol_version_id = ? WHERE protocol_version_id = ?");
+  Statement drop(db, "DELETE FROM protocol_versions WHERE id = ?");
+  Statement update(db, "UPDATE protocol_versions SET json = ?, hash = ? WHERE id = ?");
+  struct Row {
+    int64_t id, study;
+    std::string json;
+  };
+  std::vector<Row> all;
+  while (rows.Step()) all.push_back({rows.GetInt64(0), rows.GetInt64(1), rows.GetText(2)});
+  for (const Row& row : all) {
+    std::string canonical;
+    try {
+      canonical = CanonicalProtocolText(row.json);
+    } catch (const Error&) {
+      continue;  // a text that is not JSON keeps its old hash: nothing can resume it anyway
+    }
+    const std::string hash = ProtocolHash(canonical);
+    same.Bind(1, row.study);
+    same.Bind(2, hash);
+    same.Bind(3, row.id);
+    if (same.Step()) {
+      repoint.Bind(1, same.GetInt64(0));
+      repoint.Bind(2, row.id);
+      repoint.Run();
+      repoint.Reset();
+      drop.Bind(1, row.id);
+      drop.Run();
+      drop.Reset();
+    } else {
+      update.Bind(1, canonical);
+      update.Bind(2, hash);
+      update.Bind(3, row.id);
+      update.Run();
+      update.Reset();
+    }
+    same.Reset();
+  }
+}
+
+std::vector<Migration> MakeMigrations() {
   const std::string strict = Strict();
-  std::vector<std::string> steps;
+  std::vector<Migration> steps;
   // 1: the whole record. Times are ISO 8601 UTC text; JSON columns hold compact JSON text.
-  steps.push_back(
+  steps.push_back({
       "CREATE TABLE studies ("
       "  id INTEGER PRIMARY KEY,"
       "  name TEXT NOT NULL UNIQUE,"
@@ -22,7 +70,7 @@ std::vector<std::string> MakeMigrations() {
       "  id INTEGER PRIMARY KEY,"
       "  study_id INTEGER NOT NULL REFERENCES studies(id),"
       "  json TEXT NOT NULL,"
-      "  hash TEXT NOT NULL,"  // FNV-1a-64 of the JSON text, 16 hex digits
+      "  hash TEXT NOT NULL,"  // FNV-1a-64 of the JSON text, 16 hex digits (version 2: of its canonical text)
       "  created TEXT NOT NULL,"
       "  UNIQUE (study_id, hash))" + strict + ";"
       "CREATE TABLE participants ("
@@ -69,14 +117,17 @@ std::vector<std::string> MakeMigrations() {
       "  frame_index INTEGER NOT NULL,"
       "  flip_time_s REAL NOT NULL,"
       "  dropped INTEGER NOT NULL CHECK (dropped IN (0, 1)),"
-      "  UNIQUE (trial_id, frame_index))" + strict + ";");
+      "  UNIQUE (trial_id, frame_index))" + strict + ";"});
+  steps.push_back({"", &CanonicalProtocolHashes});
+  // 3: the display profile each session ran with (display/profile.h ToJson); '{}' for sessions from before.
+  steps.push_back({"ALTER TABLE sessions ADD COLUMN display_profile TEXT NOT NULL DEFAULT '{}';"});
   return steps;
 }
 
 }  // namespace
 
-const std::vector<std::string>& Migrations() {
-  static const std::vector<std::string> steps = MakeMigrations();
+const std::vector<Migration>& Migrations() {
+  static const std::vector<Migration> steps = MakeMigrations();
   return steps;
 }
 
@@ -93,18 +144,76 @@ void Migrate(Database& db) {
     throw InputError(db.path(), "record schema version " + std::to_string(version) +
                                     " is newer than this blurcue understands (" +
                                     std::to_string(CurrentSchemaVersion()) + ")");
-  for (int i = version; i < CurrentSchemaVersion(); ++i) db.Exec(Migrations()[static_cast<size_t>(i)]);
+  for (int i = version; i < CurrentSchemaVersion(); ++i) {
+    const Migration& step = Migrations()[static_cast<size_t>(i)];
+    if (!step.sql.empty()) db.Exec(step.sql);
+    if (step.data) step.data(db);
+  }
   db.Exec("PRAGMA user_version = " + std::to_string(CurrentSchemaVersion()));
+  db.Exec("PRAGMA application_id = " + std::to_string(kApplicationId));
   transaction.Commit();
 }
 
-void RequireCurrentSchema(Database& db) {
-  const int version = SchemaVersion(db);
-  if (version != CurrentSchemaVersion())
-    throw InputError(db.path(), "not a blurcue record at schema version " + std::to_string(CurrentSchemaVersion()) +
-                                    ", got version " + std::to_string(version) +
-                                    (version == 0 ? " (an empty or foreign database)" : ""));
+namespace {
+
+// What the file holds, for the message that refuses it: its application id and its first tables.
+std::string Contents(Database& db) {
+  std::string tables = db.QueryText("SELECT coalesce(group_concat(name, ', '), '') FROM (SELECT name FROM "
+                                    "sqlite_schema WHERE type = 'table' ORDER BY name LIMIT 6)");
+  const int64_t count = db.QueryInt64("SELECT count(*) FROM sqlite_schema WHERE type = 'table'");
+  if (count > 6) tables += ", ...";
+  const int64_t id = db.QueryInt64("PRAGMA application_id");
+  char text[32];
+  std::snprintf(text, sizeof text, "%08llx", static_cast<unsigned long long>(static_cast<uint32_t>(id)));
+  return std::to_string(count) + " tables (" + tables + ")" + (id != 0 ? ", application id 0x" + std::string(text) : "");
 }
+
+// A record written before the application id was stamped: version 1 and the record's own tables.
+bool IsUnstampedRecord(Database& db) {
+  return SchemaVersion(db) >= 1 &&
+         db.QueryInt64("SELECT count(*) FROM sqlite_schema WHERE type = 'table' AND name IN ('studies', "
+                       "'protocol_versions', 'participants', 'sessions', 'trials', 'responses', 'frames')") == 7;
+}
+
+}  // namespace
+
+void RequireRecordOrEmpty(Database& db) {
+  const int64_t id = db.QueryInt64("PRAGMA application_id");
+  if (id == kApplicationId) return;
+  const int64_t objects = db.QueryInt64("SELECT count(*) FROM sqlite_schema");
+  if (id == 0 && objects == 0 && SchemaVersion(db) == 0) return;  // new or empty: it becomes a record
+  if (id == 0 && IsUnstampedRecord(db)) return;
+  throw InputError(db.path(), "not a blurcue record: it holds " + Contents(db) +
+                                  "; it was left untouched (give a new file or an existing record)");
+}
+
+void RequireReadableRecord(Database& db) {
+  const int64_t id = db.QueryInt64("PRAGMA application_id");
+  if (id != kApplicationId && !(id == 0 && IsUnstampedRecord(db))) {
+    const bool empty = db.QueryInt64("SELECT count(*) FROM sqlite_schema") == 0;
+    throw InputError(db.path(), empty ? std::string("not a blurcue record: the database is empty")
+                                      : "not a blurcue record: it holds " + Contents(db));
+  }
+  const int version = SchemaVersion(db);
+  if (version > CurrentSchemaVersion())
+    throw InputError(db.path(), "record schema version " + std::to_string(version) +
+                                    " is newer than this blurcue reads (" + std::to_string(CurrentSchemaVersion()) +
+                                    "); update blurcue");
+  // Older versions lack only columns added since (readers take them where present), so a read-only archive of any
+  // version up to this one reads.
+  const std::string check = db.QueryText("PRAGMA quick_check(1)");
+  if (check != "ok") throw InputError(db.path(), "the record is damaged (SQLite's quick_check: " + check + ")");
+}
+
+std::string CanonicalProtocolText(const std::string& json) {
+  try {
+    return Json::parse(json).dump();
+  } catch (const Json::exception& e) {
+    throw InputError("protocol", std::string("not valid JSON: ") + e.what());
+  }
+}
+
+std::string ProtocolHash(const std::string& canonical_text) { return HashHex(Fnv1a64(canonical_text)); }
 
 int64_t EnsureStudy(Database& db, const std::string& name, const std::string& created) {
   Statement insert(db, "INSERT INTO studies (name, created) VALUES (?, ?) ON CONFLICT (name) DO NOTHING");

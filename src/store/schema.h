@@ -1,5 +1,6 @@
 #pragma once
 // The record's schema: a list of migrations applied in order, the count kept in PRAGMA user_version.
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -7,8 +8,26 @@
 
 namespace blurcue::store {
 
+// One step of the schema: SQL, then (optionally) a data change that SQL alone cannot make.
+struct Migration {
+  std::string sql;
+  void (*data)(Database& db) = nullptr;
+};
+
 // The migrations, oldest first. A migration once shipped never changes: a new column is a new migration.
-const std::vector<std::string>& Migrations();
+const std::vector<Migration>& Migrations();
+
+// PRAGMA application_id of every blurcue record ("BLcu"): SQLite's header field for telling file kinds apart.
+inline constexpr int64_t kApplicationId = 0x424c6375;
+
+// Refuses, before anything is written, a file that is neither empty nor a blurcue record (another program's
+// database gets no tables and no WAL), naming what it holds. A record from before the application id is known by
+// its tables.
+void RequireRecordOrEmpty(Database& db);
+
+// For readers (sessions, export, report, merge inputs): a blurcue record at a schema version this build reads,
+// whose pages pass SQLite's quick_check (a truncated or overwritten file is refused, naming it, not half read).
+void RequireReadableRecord(Database& db);
 
 // The schema version a fully migrated database reports (= Migrations().size()).
 int CurrentSchemaVersion();
@@ -16,12 +35,16 @@ int CurrentSchemaVersion();
 // PRAGMA user_version of `db`.
 int SchemaVersion(Database& db);
 
-// Applies the missing migrations in one transaction (nothing on an up-to-date database). Throws Error(kInput)
-// for a database written by a newer blurcue (a version above CurrentSchemaVersion()).
+// Applies the missing migrations in one transaction (nothing on an up-to-date database) and stamps the
+// application id. Throws Error(kInput) for a database written by a newer blurcue (a version above
+// CurrentSchemaVersion()).
 void Migrate(Database& db);
 
-// Throws Error(kInput) unless `db` is at CurrentSchemaVersion() (for readers that must not write).
-void RequireCurrentSchema(Database& db);
+// A protocol's version: FNV-1a-64 (16 hex digits) of its canonical text, the parsed JSON dumped compact with
+// sorted keys, so an editor's newline, a CRLF checkout, indentation or key order do not make a new version.
+// Throws Error(kInput) when `json` is not JSON.
+std::string CanonicalProtocolText(const std::string& json);
+std::string ProtocolHash(const std::string& canonical_text);
 
 // Get-or-insert by each table's natural key (the record and the merge share these rules); each returns the row id.
 int64_t EnsureStudy(Database& db, const std::string& name, const std::string& created);

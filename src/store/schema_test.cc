@@ -59,10 +59,17 @@ TEST(Schema, ForeignKeysAreEnforced) {
   EXPECT_THROW(db.Exec("INSERT INTO participants (study_id, code, created) VALUES (99, 'p', 'now')"), Error);
 }
 
-TEST(Schema, RequireCurrentSchemaRefusesAForeignDatabase) {
+TEST(Schema, ReadersRefuseAForeignDatabase) {
   Database db(":memory:");
   db.Exec("CREATE TABLE other (x)");
-  EXPECT_THROW(RequireCurrentSchema(db), Error);
+  try {
+    RequireReadableRecord(db);
+    FAIL() << "a foreign database read as a record";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    EXPECT_NE(std::string(e.what()).find("not a blurcue record: it holds 1 tables (other)"), std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

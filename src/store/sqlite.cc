@@ -2,6 +2,10 @@
 
 #include <sqlite3.h>
 
+#include <cctype>
+#include <chrono>
+#include <cstdio>
+#include <thread>
 #include <utility>
 
 #include "core/error.h"
@@ -9,19 +13,53 @@
 namespace blurcue::store {
 namespace {
 
-// A file that cannot be opened or is not a database is the user's input; anything else is unexpected.
-ErrorKind KindOf(int rc) {
-  const int primary = rc & 0xff;
-  return (primary == SQLITE_NOTADB || primary == SQLITE_CANTOPEN) ? ErrorKind::kInput : ErrorKind::kInternal;
+// What is wrong with the file, in words an experimenter can act on; null for failures that are bugs (a bad
+// statement, a constraint the code should have kept), which stay kInternal.
+const char* FileProblem(int rc) {
+  switch (rc & 0xff) {
+    case SQLITE_NOTADB: return "not a SQLite database";
+    case SQLITE_CORRUPT: return "the record is damaged (truncated or overwritten)";
+    case SQLITE_CANTOPEN: return "cannot open the file";
+    case SQLITE_BUSY:
+    case SQLITE_LOCKED: return "busy: another process kept the file locked past the timeout; try again";
+    case SQLITE_READONLY: return "the file or its folder is read-only";
+    case SQLITE_IOERR: return "cannot read or write the file";
+    case SQLITE_FULL: return "the disk is full";
+    case SQLITE_PERM:
+    case SQLITE_AUTH: return "permission denied";
+  }
+  return nullptr;
 }
 
-[[noreturn]] void Throw(sqlite3* db, int rc, const std::string& what, const std::string& sql) {
-  std::string message = "sqlite: ";
+// A file's problem is the user's input (exit 3, the file named, no SQL); anything else is unexpected.
+[[noreturn]] void Throw(sqlite3* db, int rc, const std::string& what, const std::string& sql,
+                        const std::string& path = {}) {
   const char* file = db ? sqlite3_db_filename(db, "main") : nullptr;
-  if (file && *file) message = std::string(file) + ": " + message;
-  message += what + " failed: " + (db ? sqlite3_errmsg(db) : sqlite3_errstr(rc));
+  std::string where = file && *file ? std::string(file) : path;
+  const std::string detail = db ? sqlite3_errmsg(db) : sqlite3_errstr(rc);
+  if (const char* problem = FileProblem(rc))
+    throw Error(ErrorKind::kInput, (where.empty() ? std::string("sqlite") : where) + ": " + problem + " (sqlite: " +
+                                       detail + ")");
+  std::string message = "sqlite: " + what + " failed: " + detail;
+  if (!where.empty()) message = where + ": " + message;
   if (!sql.empty()) message += " (SQL: " + sql + ")";
-  throw Error(KindOf(rc), message);
+  throw Error(ErrorKind::kInternal, message);
+}
+
+// A path as a file: URI (RFC 3986 percent-encoding of everything but unreserved characters and '/').
+std::string FileUri(const std::filesystem::path& path) {
+  const std::string text = std::filesystem::absolute(path).string();
+  std::string uri = "file:";
+  for (unsigned char c : text) {
+    if (std::isalnum(c) || c == '/' || c == '-' || c == '_' || c == '.' || c == '~') {
+      uri += static_cast<char>(c);
+    } else {
+      char hex[4];
+      std::snprintf(hex, sizeof hex, "%%%02X", c);
+      uri += hex;
+    }
+  }
+  return uri;
 }
 
 }  // namespace
@@ -30,38 +68,82 @@ int SqliteVersionNumber() { return sqlite3_libversion_number(); }
 
 // ---------------------------------------------------------------------------------------------- Database
 
-Database::Database(const std::filesystem::path& path, OpenMode mode, int busy_timeout_ms) : path_(path.string()) {
+Database::Database(const std::filesystem::path& path, OpenMode mode, int busy_timeout_ms)
+    : path_(path.string()), busy_timeout_ms_(busy_timeout_ms) {
   const bool memory = path_ == ":memory:";
-  const int flags = (mode == OpenMode::kReadOnly ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE) |
-                    SQLITE_OPEN_NOMUTEX;
-  sqlite3* db = nullptr;
-  const int rc = sqlite3_open_v2(path_.c_str(), &db, flags, nullptr);
-  if (rc != SQLITE_OK) {
-    const std::string text = db ? sqlite3_errmsg(db) : sqlite3_errstr(rc);
-    sqlite3_close(db);  // a handle is returned even on failure and must be released
-    throw Error(ErrorKind::kInput, path_ + ": cannot open SQLite database: " + text);
+  if (!memory) {
+    std::error_code error;
+    const auto status = std::filesystem::status(path, error);
+    if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+      throw InputError(path_, std::string("not a record file (") +
+                                  (std::filesystem::is_directory(status) ? "a folder" : "a device or pipe") +
+                                  "); a record is one SQLite file");
   }
-  db_ = db;
-  sqlite3_extended_result_codes(db_, 1);
-  try {
-    if (!memory) {
-      const int busy = sqlite3_busy_timeout(db_, busy_timeout_ms);
-      if (busy != SQLITE_OK) Throw(db_, busy, "busy_timeout", "");
-      // The first read of the header: a file that is not a database is reported here, as kInput.
-      QueryInt64("PRAGMA schema_version");
-      if (mode == OpenMode::kReadWrite) {
-        if (QueryText("PRAGMA journal_mode=WAL") != "wal")
-          throw Error(ErrorKind::kInternal, path_ + ": sqlite: could not switch to WAL journaling");
-        Exec("PRAGMA synchronous=NORMAL");
-      }
+  auto open = [&](const std::string& name, int flags) {
+    sqlite3* db = nullptr;
+    const int rc = sqlite3_open_v2(name.c_str(), &db, flags | SQLITE_OPEN_NOMUTEX, nullptr);
+    if (rc != SQLITE_OK) {
+      const std::string text = db ? sqlite3_errmsg(db) : sqlite3_errstr(rc);
+      sqlite3_close(db);  // a handle is returned even on failure and must be released
+      throw Error(ErrorKind::kInput, path_ + ": cannot open the record: " + text);
     }
-    Exec("PRAGMA foreign_keys=ON");
-  } catch (const Error& e) {
+    db_ = db;
+    sqlite3_extended_result_codes(db_, 1);
+    if (memory) return;
+    const int busy = sqlite3_busy_timeout(db_, busy_timeout_ms);
+    if (busy != SQLITE_OK) Throw(db_, busy, "busy_timeout", "");
+    // The first read of the header: a file that is not a database, or is damaged, is reported here as kInput.
+    QueryInt64("PRAGMA schema_version");
+  };
+  auto close = [&] {
     sqlite3_close(db_);
     db_ = nullptr;
-    if (e.kind() == ErrorKind::kInput) throw Error(ErrorKind::kInput, path_ + ": not a SQLite database (" + e.what() + ")");
+  };
+  try {
+    open(path_, mode == OpenMode::kReadOnly ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
+  } catch (const Error& e) {
+    close();
+    // A WAL record in a read-only folder (an archive, a read-only mount): SQLite cannot create the WAL index beside
+    // it. Without a -wal file holding unmerged commits, the file alone is the whole record: open it as immutable.
+    std::error_code error;
+    const bool wal_pending = std::filesystem::file_size(path_ + "-wal", error) > 0 && !error;
+    if (mode != OpenMode::kReadOnly || memory || e.kind() != ErrorKind::kInput) throw;
+    if (wal_pending)
+      throw InputError(path_, "read-only, and its write-ahead log " + path_ +
+                                  "-wal holds commits not yet merged into it; copy both files to a writable folder "
+                                  "and open the copy");
+    try {
+      open(FileUri(path_) + "?immutable=1", SQLITE_OPEN_READONLY | SQLITE_OPEN_URI);
+    } catch (...) {
+      close();
+      throw e;
+    }
+  }
+  try {
+    Exec("PRAGMA foreign_keys=ON");
+  } catch (...) {
+    close();
     throw;
   }
+}
+
+void Database::UseWal(bool durable) {
+  if (path_ == ":memory:") return;
+  // Changing the journal mode needs the file to itself and does not wait on the busy handler: retry while another
+  // connection (a second station starting at the same moment) holds it.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(busy_timeout_ms_);
+  for (;;) {
+    try {
+      if (QueryText("PRAGMA journal_mode=WAL") != "wal") throw InputError(path_, "cannot switch the record to WAL "
+                                                                                 "journaling (a read-only file?)");
+      break;
+    } catch (const Error& e) {
+      const int code = sqlite3_errcode(db_) & 0xff;
+      if ((code != SQLITE_BUSY && code != SQLITE_LOCKED) || std::chrono::steady_clock::now() >= deadline) throw;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  }
+  Exec(durable ? "PRAGMA synchronous=FULL" : "PRAGMA synchronous=NORMAL");
 }
 
 Database::~Database() {
@@ -84,13 +166,8 @@ Database& Database::operator=(Database&& other) noexcept {
 void Database::Exec(const std::string& sql) {
   char* error = nullptr;
   const int rc = sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &error);
-  if (rc != SQLITE_OK) {
-    std::string text = error ? error : sqlite3_errstr(rc);
-    sqlite3_free(error);
-    std::string message = "sqlite: exec failed: " + text + " (SQL: " + sql + ")";
-    if (!path_.empty() && path_ != ":memory:") message = path_ + ": " + message;
-    throw Error(KindOf(rc), message);
-  }
+  sqlite3_free(error);  // sqlite3_errmsg holds the same text
+  if (rc != SQLITE_OK) Throw(db_, rc, "exec", sql, path_);
 }
 
 int64_t Database::QueryInt64(const std::string& sql) {

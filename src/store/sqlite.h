@@ -15,9 +15,12 @@ namespace blurcue::store {
 
 enum class OpenMode { kReadWrite, kReadOnly };
 
-// One connection. Files get WAL journaling, synchronous=NORMAL (a commit survives a process crash) and a busy
-// timeout; every connection gets foreign_keys=ON. ":memory:" opens a private in-memory database.
-// Throws Error(kInput) for a file that cannot be opened or is not a database.
+// One connection with a busy timeout and foreign_keys=ON; ":memory:" opens a private in-memory database. Opening
+// only reads the header: a writer switches the file to WAL with UseWal() once it knows the file is its own.
+// Read-only opening works on a read-only folder or mount too (an archived record): when SQLite cannot make the WAL
+// index beside the file, the file is opened as immutable, unless an unmerged -wal file lies beside it (its answers
+// would be missed silently), which is refused.
+// Throws Error(kInput) for a file that cannot be opened, is not a database, or stays busy past the timeout.
 class Database {
  public:
   explicit Database(const std::filesystem::path& path, OpenMode mode = OpenMode::kReadWrite,
@@ -27,6 +30,11 @@ class Database {
   Database& operator=(Database&& other) noexcept;
   Database(const Database&) = delete;
   Database& operator=(const Database&) = delete;
+
+  // WAL journaling with synchronous=FULL (`durable`): a commit, once returned, survives a killed process, an OS
+  // crash and a power loss; NORMAL in WAL mode survives only the first. Retries while another connection holds the
+  // file (two first starts at once), up to the busy timeout.
+  void UseWal(bool durable = true);
 
   // Runs one or more statements that return no rows.
   void Exec(const std::string& sql);
@@ -43,6 +51,7 @@ class Database {
  private:
   sqlite3* db_ = nullptr;
   std::string path_;
+  int busy_timeout_ms_ = 0;
 };
 
 // A prepared statement; finalizes itself. Indices are 1-based for Bind and 0-based for columns, as in SQLite.

@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# blurcue display check in a real window on an X server of its own: usage display_test.sh BLURCUE DIR
+set -euo pipefail
+BC=$1 W=$2/display-check
+DATA=$(cd "$(dirname "$0")/data" && pwd)
+rm -rf "$W" && mkdir -p "$W"
+fail() { echo "FAIL: $*" >&2; exit 1; }
+Xvfb -displayfd 3 -screen 0 1280x1024x24 -nolisten tcp 3> "$W/display" > "$W/xvfb.log" 2>&1 &
+xvfb=$!
+trap 'kill $xvfb 2>/dev/null || true' EXIT
+for _ in $(seq 1 100); do [ -s "$W/display" ] && break; sleep 0.05; done
+export DISPLAY=":$(head -1 "$W/display")"
+# The lab's 1280 x 1024 monitor (376 mm wide at 570 mm): 2 * 570 * tan(0.5 deg) / (376 / 1280) = 33.87 px/deg.
+$BC display check --profile "$DATA/lab-monitor.json" --fullscreen --frames 30 --screenshot "$W/check.png" > "$W/out" \
+  || fail "check: $(cat "$W/out")"
+grep -q "lab 1: 1280 x 1024 px window, 33.87 px per degree at 570 mm" "$W/out" || fail "geometry: $(cat "$W/out")"
+grep -Eq "flip interval over 30 flips: median [0-9.]+ ms" "$W/out" || fail "timing: $(cat "$W/out")"
+# Xvfb has no vsync: the check must say it measured nothing rather than report a refresh rate.
+grep -q "NOT MEASURED: the flips are not paced by a refresh" "$W/out" || fail "Xvfb reported as a refresh: $(cat "$W/out")"
+[ -s "$W/check.png" ] || fail "no screenshot"
+# A profile whose resolution is not the monitor's, full screen: exit 3 naming both.
+set +e; $BC display check --fullscreen --frames 10 2> "$W/err"; code=$?; set -e
+[ $code = 3 ] && grep -q "the default profile: the monitor shows 1280 x 1024 px, the profile says 1920 x 1080" "$W/err" \
+  || fail "resolution mismatch: exit $code $(cat "$W/err")"
+# A broken profile: every problem named with the file and the field.
+echo '{"width_px": 1280, "height_px": 1024, "distance_mm": 0}' > "$W/bad.json"
+set +e; $BC display check --profile "$W/bad.json" 2> "$W/err"; code=$?; set -e
+[ $code = 3 ] && grep -q "bad.json: /distance_mm: must be in \[100, 20000\] mm, got 0" "$W/err" || fail "bad profile: $(cat "$W/err")"
+echo "ok: display check shows the profile's geometry, refuses a wrong resolution and says Xvfb has no refresh to measure"
