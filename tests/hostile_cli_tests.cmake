@@ -131,3 +131,8 @@ hostile_test(cli_hostile_synth_pictures_at_focal_length 5 "would be imaged"
 hostile_test(cli_hostile_render_picture_taller_than_frame 2
              "--picture-height-px 5000 is taller than the grey half of the frame (360 px)"
              render --object picture --background ${D}/small.png --picture-height-px 5000 --out ${H}/x.png)
+hostile_test(cli_hostile_sessions_abort_wraps 2
+             "--abort: must be a whole number in [1, 9223372036854775807], got 18446744073709551617"
+             sessions --db ${D}/small.png --abort 18446744073709551617)
+hostile_test(cli_hostile_display_frames_nan 2 "--frames: must be a whole number in [10, 100000], got 'nan'"
+             display check --frames nan)

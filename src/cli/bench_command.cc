@@ -107,8 +107,8 @@ void AddRecord(CLI::App& bench) {
       "records live on: --folder names it.");
   cmd->add_option("--folder", args->folder, "where the two scratch records are written (removed after)")
       ->capture_default_str();
-  cmd->add_option("--trials", args->trials, "answers per record")->capture_default_str()->check(CLI::Range(10, 100000));
-  cmd->add_option("--frames", args->frames, "display flips per answer")->capture_default_str()->check(CLI::Range(0, 10000));
+  cmd->add_option("--trials", args->trials, "answers per record")->capture_default_str()->check(IntRange(10, 100000));
+  cmd->add_option("--frames", args->frames, "display flips per answer")->capture_default_str()->check(IntRange(0, 10000));
   cmd->callback([args] {
     bench::RecordBenchOptions options;
     options.folder = args->folder;
