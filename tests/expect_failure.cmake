@@ -1,4 +1,5 @@
 # Runs CMD with ARGS and checks it fails with exit code EXPECT_CODE and one line on stderr containing EXPECT_TEXT.
+# With -DONE_LINE=1 stderr must also be exactly that one line (no library chatter before or after it).
 execute_process(COMMAND ${CMD} ${ARGS} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
 string(STRIP "${err}" err)
 if(NOT code EQUAL EXPECT_CODE)
@@ -7,5 +8,11 @@ endif()
 string(FIND "${err}" "${EXPECT_TEXT}" at)
 if(at EQUAL -1)
   message(FATAL_ERROR "stderr lacks '${EXPECT_TEXT}':\n${err}")
+endif()
+if(ONE_LINE)
+  string(FIND "${err}" "\n" newline)
+  if(NOT newline EQUAL -1)
+    message(FATAL_ERROR "stderr has more than one line:\n${err}")
+  endif()
 endif()
 message(STATUS "ok: exit ${code}: ${err}")

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <limits>
+#include <sstream>
 
 #include <opencv2/calib3d.hpp>
 
@@ -13,12 +14,47 @@
 namespace blurcue::calib {
 namespace {
 
-cv::Vec3d Vec3(const Json& obj, const std::string& key, const std::string& where) {
+std::string Num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// A number of calib.json in [lo, hi] (unit for the message); NaN and infinity fail too.
+double Ranged(const Json& obj, const std::string& key, const std::string& where, double lo, double hi,
+              const std::string& unit) {
+  const double v = RequireNumber(obj, key, where);
+  if (!(v >= lo && v <= hi))
+    throw InputError(where + "/" + key, "must be in [" + Num(lo) + ", " + Num(hi) + "]" +
+                                            (unit.empty() ? "" : " " + unit) + ", got " + Num(v));
+  return v;
+}
+
+// A whole number of calib.json in [lo, hi], compared before it is narrowed, so 4294967303 is refused, not wrapped.
+int RangedInt(const Json& obj, const std::string& key, const std::string& where, int lo, int hi) {
+  const double v = Ranged(obj, key, where, lo, hi, "");
+  if (!obj[key].is_number_integer()) throw InputError(where + "/" + key, "must be an integer, got " + obj[key].dump());
+  return static_cast<int>(v);
+}
+
+// Three numbers, each in [-limit, limit] (a rotation vector in radians, a translation or point in mm).
+cv::Vec3d Vec3(const Json& obj, const std::string& key, const std::string& where, double limit,
+               const std::string& unit) {
   const Json& v = obj.contains(key) ? obj[key] : Json();
   if (!v.is_array() || v.size() != 3 || !v[0].is_number() || !v[1].is_number() || !v[2].is_number())
     throw InputError(where + "/" + key, "must be an array of 3 numbers, got " + v.dump());
-  return {v[0].get<double>(), v[1].get<double>(), v[2].get<double>()};
+  cv::Vec3d out;
+  for (int i = 0; i < 3; ++i) {
+    out[i] = v[i].get<double>();
+    if (!(std::abs(out[i]) <= limit))
+      throw InputError(where + "/" + key + "/" + std::to_string(i),
+                       "must be in [" + Num(-limit) + ", " + Num(limit) + "] " + unit + ", got " + Num(out[i]));
+  }
+  return out;
 }
+
+// Depths and distances in calib.json: at most 1000 m, far beyond any table-top scene.
+constexpr double kMaxDistanceMm = 1e6;
 
 const Json& Object(const Json& obj, const std::string& key, const std::string& where) {
   if (!obj.contains(key) || !obj[key].is_object()) throw InputError(where + "/" + key, "must be an object");
@@ -46,29 +82,31 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
   SceneCalib s;
   s.camera = CameraFromJson(Object(j, "camera", where), where + "/camera");
   const Json& board = Object(j, "board", where);
-  s.board.cols = RequireInt(board, "cols", where + "/board");
-  s.board.rows = RequireInt(board, "rows", where + "/board");
-  s.board.square_mm = RequireNumber(board, "square_mm", where + "/board");
+  s.board.cols = RangedInt(board, "cols", where + "/board", 2, 100);
+  s.board.rows = RangedInt(board, "rows", where + "/board", 2, 100);
+  s.board.square_mm = Ranged(board, "square_mm", where + "/board", 1, 1000, "mm");
   s.board.Validate(where + "/board");
   const Json& pose = Object(j, "pose", where);
-  s.rvec = Vec3(pose, "rvec", where + "/pose");
-  s.tvec = Vec3(pose, "tvec", where + "/pose");
-  s.reference_edge = RequireInt(j, "reference_edge", where);
+  s.rvec = Vec3(pose, "rvec", where + "/pose", 4 * M_PI, "rad");
+  s.tvec = Vec3(pose, "tvec", where + "/pose", kMaxDistanceMm, "mm");
+  s.reference_edge = RangedInt(j, "reference_edge", where, 1, s.board.EdgeCount());
   const Json& ref = Object(j, "reference", where);
-  s.reference_u_mm = RequireNumber(ref, "u_mm", where + "/reference");
-  s.reference_r_px = RequireNumber(ref, "r_px", where + "/reference");
+  s.reference_u_mm = Ranged(ref, "u_mm", where + "/reference", 0, kMaxDistanceMm, "mm");
+  s.reference_r_px = Ranged(ref, "r_px", where + "/reference", 0, optics::kMaxBlurRadiusPx, "px");
   const Json& model = Object(j, "model", where);
   s.model.kind = model.value("kind", "thin_lens");
   s.model.focus_mm = model.contains("focus_mm") && model["focus_mm"] == "infinity"
                          ? std::numeric_limits<double>::infinity()
-                         : RequireNumber(model, "focus_mm", where + "/model");
-  s.model.aperture_mm = RequireNumber(model, "aperture_mm", where + "/model");
-  s.model.floor_px = model.value("floor_px", 0.0);
+                         : Ranged(model, "focus_mm", where + "/model", 0, kMaxDistanceMm, "mm");
+  s.model.aperture_mm = Ranged(model, "aperture_mm", where + "/model", 0, 1000, "mm");
+  s.model.floor_px = model.contains("floor_px")
+                         ? Ranged(model, "floor_px", where + "/model", 0, optics::kMaxBlurRadiusPx, "px")
+                         : 0.0;
   if (!j.contains("edges") || !j["edges"].is_array()) throw InputError(where + "/edges", "must be an array");
   for (size_t e = 0; e < j["edges"].size(); ++e) {
     const Json& edge = j["edges"][e];
     const std::string ew = where + "/edges/" + std::to_string(e);
-    const int index = RequireInt(edge, "index", ew);
+    const int index = RangedInt(edge, "index", ew, 1, s.board.EdgeCount());
     if (!edge.contains("sections") || !edge["sections"].is_array())
       throw InputError(ew + "/sections", "must be an array");
     for (size_t k = 0; k < edge["sections"].size(); ++k) {
@@ -76,10 +114,11 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
       const std::string sw = ew + "/sections/" + std::to_string(k);
       SceneCalib::Section out;
       out.edge = index;
-      out.section = RequireInt(sec, "index", sw);
-      out.midpoint_camera_mm = Vec3(sec, "midpoint_camera_mm", sw);
-      out.r_px = RequireNumber(sec, "r_px", sw);
+      out.section = RangedInt(sec, "index", sw, 1, s.board.SectionCount());
+      out.midpoint_camera_mm = Vec3(sec, "midpoint_camera_mm", sw, kMaxDistanceMm, "mm");
       out.ok = sec.value("ok", false);
+      // A section the fit gave up on keeps whatever number it had; only usable ones feed a blur.
+      out.r_px = out.ok ? Ranged(sec, "r_px", sw, 0, optics::kMaxBlurRadiusPx, "px") : RequireNumber(sec, "r_px", sw);
       s.sections.push_back(out);
     }
   }
@@ -98,13 +137,13 @@ BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px) {
   if (text == "fitted") return BlurSource::kFitted;
   char* end = nullptr;
   const double r = std::strtod(text.c_str(), &end);
-  if (end != text.c_str() && *end == '\0' && r >= 0 && std::isfinite(r)) {
+  if (end != text.c_str() && *end == '\0' && r >= 0 && r <= optics::kMaxBlurRadiusPx) {
     if (fixed_r_px) *fixed_r_px = r;
     return BlurSource::kFixed;
   }
   throw Error(ErrorKind::kUsage,
-              "blur source must be none, measured, measured_section, estimated, fitted or a radius in px >= 0, got '" +
-                  text + "'");
+              "blur source must be none, measured, measured_section, estimated, fitted or a radius in [0, " +
+                  std::to_string(int(optics::kMaxBlurRadiusPx)) + "] px, got '" + text + "'");
 }
 
 std::string ToString(BlurSource source) {

@@ -14,6 +14,7 @@
 #include "cli/commands.h"
 #include "core/error.h"
 #include "core/image.h"
+#include "render/blur.h"
 #include "render/frame_compositor.h"
 #include "render/gl_context.h"
 #include "render/scene_render.h"
@@ -46,17 +47,17 @@ void AddAnimateCommand(CLI::App& app) {
   cmd->add_option("--texture", args->texture, "soccer, wood or an equirectangular image")->capture_default_str();
   cmd->add_option("--method", args->method, "gaussian or disc")->capture_default_str()
       ->check(CLI::IsMember({"gaussian", "disc"}));
-  cmd->add_option("--gain", args->gain, "multiplies both radii")->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--gain", args->gain, "multiplies both radii")->capture_default_str()->check(FiniteRange(0, 100, ""));
   cmd->add_option("--speed-cm-s", args->speed_cm_s, "rolling speed (the thesis: 3 and 1.8)")->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(FiniteRange(0.1, 1000, "cm/s"));
   cmd->add_option("--fps", args->fps, "frames per second of the video (a window runs at its refresh)")
-      ->capture_default_str()->check(CLI::PositiveNumber);
-  cmd->add_option("--from-edge", args->from_edge, "start edge")->capture_default_str();
-  cmd->add_option("--to-edge", args->to_edge, "end edge")->capture_default_str();
-  cmd->add_option("--left-section", args->left_section, "section the left ball rolls along")->capture_default_str();
+      ->capture_default_str()->check(FiniteRange(1, 1000, "frames per second"));
+  cmd->add_option("--from-edge", args->from_edge, "start edge")->capture_default_str()->check(IntRange(1, 1000));
+  cmd->add_option("--to-edge", args->to_edge, "end edge")->capture_default_str()->check(IntRange(1, 1000));
+  cmd->add_option("--left-section", args->left_section, "section the left ball rolls along")->capture_default_str()
+      ->check(IntRange(1, 1000));
   cmd->add_option("--right-section", args->right_section, "section the right ball rolls along")
-      ->capture_default_str();
+      ->capture_default_str()->check(IntRange(1, 1000));
   cmd->add_option("--video", args->video, "write an MJPG .avi");
   cmd->add_option("--frames", args->frames_dir, "write frame PNGs into this folder");
   cmd->add_option("--log", args->log, "per-frame CSV: index, t_s, y_mm, r_left_px, r_right_px, render_ms, flip_s");
@@ -98,7 +99,13 @@ void AddAnimateCommand(CLI::App& app) {
     const double s = scene.board.square_mm, radius = 10;
     const double y0 = (args->from_edge - 1) * s, y1 = (args->to_edge - 1) * s;
     const double speed_mm_s = args->speed_cm_s * 10;
-    const int frames = std::max(1, int(std::ceil(std::abs(y1 - y0) / speed_mm_s * args->fps)) + 1);
+    const double frame_count = std::ceil(std::abs(y1 - y0) / speed_mm_s * args->fps) + 1;
+    constexpr double kMaxFrames = 36000;  // ten minutes at 60 fps
+    if (frame_count > kMaxFrames)
+      throw Error(ErrorKind::kUsage, "--speed-cm-s " + BoundText(args->speed_cm_s) + " and --fps " +
+                                         BoundText(args->fps) + " make " + BoundText(frame_count) +
+                                         " frames; at most " + BoundText(kMaxFrames) + " (go faster or lower --fps)");
+    const int frames = std::max(1, int(frame_count));
     cv::VideoWriter video;
     if (!args->video.empty()) {
       if (std::filesystem::path(args->video).has_parent_path())
@@ -140,6 +147,11 @@ void AddAnimateCommand(CLI::App& app) {
         o.spin_deg = -(y - y0) / radius * 180 / M_PI;  // rolling without slipping away from the camera
         o.texture = texture;
         r[b] = args->gain * calib::BlurAtPx(scene, source[b], scene.ToCamera(o.center_board_mm), fixed[b]);
+        if (!(r[b] >= 0 && r[b] <= render::kMaxBlurRadiusPx))
+          throw Error(ErrorKind::kUsage, std::string(b == 0 ? "--left " + args->left : "--right " + args->right) +
+                                             " x --gain " + BoundText(args->gain) + " gives " + BoundText(r[b]) +
+                                             " px at frame " + std::to_string(i) + "; the blur radius must be in [0, " +
+                                             BoundText(render::kMaxBlurRadiusPx) + "] px");
         balls[b].r_px = r[b];
         balls[b].method = args->method;
       }

@@ -29,7 +29,8 @@ void AddMeasure(CLI::App& bench) {
       "Then times the whole calibration of one full-resolution 4592 x 3056 photo.\n"
       "Takes a few minutes; --quick runs two levels per factor.");
   cmd->add_option("--out", args->out, "CSV, one row per (method, condition)")->capture_default_str();
-  cmd->add_option("--seed", args->seed, "seed of the scenes' noise, texture and flaws")->capture_default_str();
+  cmd->add_option("--seed", args->seed, "seed of the scenes' noise, texture and flaws")->capture_default_str()
+      ->check(SeedValidator());
   cmd->add_flag("--quick", args->quick, "two levels per factor (smoke run)");
   cmd->add_flag("--no-full-res", args->no_full_res, "skip the full-resolution timing");
   cmd->callback([args] {
@@ -106,8 +107,8 @@ void AddRecord(CLI::App& bench) {
       "records live on: --folder names it.");
   cmd->add_option("--folder", args->folder, "where the two scratch records are written (removed after)")
       ->capture_default_str();
-  cmd->add_option("--trials", args->trials, "answers per record")->capture_default_str()->check(CLI::Range(10, 100000));
-  cmd->add_option("--frames", args->frames, "display flips per answer")->capture_default_str()->check(CLI::Range(0, 10000));
+  cmd->add_option("--trials", args->trials, "answers per record")->capture_default_str()->check(IntRange(10, 100000));
+  cmd->add_option("--frames", args->frames, "display flips per answer")->capture_default_str()->check(IntRange(0, 10000));
   cmd->callback([args] {
     bench::RecordBenchOptions options;
     options.folder = args->folder;

@@ -39,9 +39,9 @@ void AddCalibrateCommand(CLI::App& app) {
       ->required()->check(CLI::ExistingFile);
   cmd->add_option("--board", args->board, "board size in squares, COLSxROWS")->capture_default_str();
   cmd->add_option("--square-mm", args->square_mm, "side of one square in mm")->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(FiniteRange(1, 1000, "mm"));
   cmd->add_option("--reference-edge", args->reference_edge, "edge whose measured blur feeds eq. 3.7")
-      ->capture_default_str();
+      ->capture_default_str()->check(IntRange(1, 1000));
   cmd->add_option("--out", args->out, "where to write calib.json")->capture_default_str();
   cmd->add_option("--truth", args->truth,
                   "truth.json of a ground-truth scene (blurcue synth-scene): adds the true radius to the table\n"

@@ -1,9 +1,71 @@
 #pragma once
 // The subcommands of `blurcue`. Each Add* registers one CLI11 subcommand whose callback does the work and throws
 // blurcue::Error on failure; main() turns that into one line on stderr and the error's exit code.
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <iomanip>
+#include <sstream>
+#include <string>
+
 #include <CLI/CLI.hpp>
 
 namespace blurcue::cli {
+
+// A bound as the messages print it: 500, 0.001, 10000000.
+inline std::string BoundText(double v) {
+  std::ostringstream s;
+  s << std::setprecision(12) << v;
+  return s.str();
+}
+
+// A number option's range with its unit: "--radius-px: must be in [0, 500] px, got nan". CLI11 alone takes "nan",
+// "inf" and "1e308" as doubles and lets them through NonNegativeNumber; every numeric option of every command
+// names its range here instead. `note` (optional) is added in brackets after the range; `open_low` excludes lo
+// ("(0, 1000] m").
+inline CLI::Validator FiniteRange(double lo, double hi, const std::string& unit, const std::string& note = "",
+                                  bool open_low = false) {
+  const std::string range = "in " + std::string(open_low ? "(" : "[") + BoundText(lo) + ", " + BoundText(hi) + "]" +
+                            (unit.empty() ? "" : " " + unit);
+  const std::string what = "must be " + std::string(unit.empty() ? "a number " : "") + range +
+                           (note.empty() ? "" : " (" + note + ")") + ", got ";
+  return CLI::Validator(
+      [lo, hi, open_low, what](std::string& text) -> std::string {
+        char* end = nullptr;
+        errno = 0;
+        const double v = std::strtod(text.c_str(), &end);
+        const bool parsed = !text.empty() && end == text.c_str() + text.size() && !std::isspace(text[0]);
+        if (!parsed) return what + "'" + text + "'";
+        const bool above = open_low ? v > lo : v >= lo;
+        return std::isfinite(v) && errno != ERANGE && above && v <= hi ? "" : what + text;
+      },
+      range);
+}
+
+// FiniteRange without its lower bound: (0, hi].
+inline CLI::Validator FinitePositive(double hi, const std::string& unit, const std::string& note = "") {
+  return FiniteRange(0, hi, unit, note, true);
+}
+
+// A whole-number option's range: "--columns: must be a whole number in [1, 20], got '1e3'". Decimal only: the
+// text is rewritten to plain digits, because CLI11 would read "010" as octal 8 and "0x10" as 16.
+inline CLI::Validator IntRange(long long lo, long long hi, const std::string& unit = "") {
+  const std::string range = "in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]" +
+                            (unit.empty() ? "" : " " + unit);
+  const std::string what = "must be a whole number " + range + ", got ";
+  return CLI::Validator(
+      [lo, hi, what](std::string& text) -> std::string {
+        const size_t sign = !text.empty() && (text[0] == '-' || text[0] == '+') ? 1 : 0;
+        const bool whole = text.size() > sign && text.find_first_not_of("0123456789", sign) == std::string::npos;
+        if (!whole) return what + "'" + text + "'";
+        errno = 0;
+        const long long v = std::strtoll(text.c_str(), nullptr, 10);
+        if (errno == ERANGE || v < lo || v > hi) return what + text;
+        text = std::to_string(v);
+        return "";
+      },
+      range);
+}
 
 // --seed: a whole number 0 .. 2^64 - 1 (CLI11 alone would wrap "-3" into a huge unsigned number).
 inline CLI::Validator SeedValidator() {

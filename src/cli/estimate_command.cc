@@ -156,24 +156,25 @@ void AddEstimateCommand(CLI::App& app) {
       ->required();
   // No CLI11 validators on the camera and u1: a missing file and a u1 inside the focal length are errors of the
   // input (exit 3) and of the model (exit 5), each one line naming what is wrong, like every other command's.
+  // Their ranges are what a number can mean at all (finite, a depth of at most 1000 m); whether u1 lies beyond
+  // f is the model's to say.
   cmd->add_option("--ref-u-mm", args->ref_u_mm, "u1: depth of the reference point in mm (must exceed f)")
-      ->required();
-  cmd->add_option("--ref-r-px", args->ref_r_px, "r1: measured blur radius at u1 in px (>= 0)")->required();
+      ->required()->check(FiniteRange(0, 1e6, "mm"));
+  cmd->add_option("--ref-r-px", args->ref_r_px, "r1: measured blur radius at u1 in px (>= 0)")->required()
+      ->check(FiniteRange(0, optics::kMaxBlurRadiusPx, "px", "for a reference in front of focus add "
+                                                              "--ref-nearer-than-focus"));
   cmd->add_option("--u-mm", args->u_mm, "u2: one or more depths in mm to predict the blur at")
-      ->required()->check(CLI::PositiveNumber);
+      ->required()->check(FinitePositive(1e6, "mm"));
   cmd->add_flag("--ref-nearer-than-focus", args->ref_nearer,
                 "the reference lies in front of the focus plane (its signed radius is -r1)");
   cmd->add_option("--pixel-pitch-mm", args->pixel_pitch_mm,
                   "sigma in mm per pixel instead of sensor_width_mm / image_width_px (the thesis rounded it to\n"
                   "5.1e-3; its camera's 23.4 mm / 4592 px is 5.096e-3)")
-      ->check(CLI::PositiveNumber);
+      ->check(FinitePositive(1, "mm"));
   cmd->add_flag("--json", args->json, "print JSON instead of a table; a model that does not hold gives null and a "
                                       "reason");
   cmd->callback([args] {
     const EstimateArgs& a = *args;
-    if (!(a.ref_r_px >= 0) || !std::isfinite(a.ref_r_px))
-      throw Error(ErrorKind::kUsage, "--ref-r-px: must be a radius >= 0 px (for a reference in front of focus add "
-                                     "--ref-nearer-than-focus), got " + Num(a.ref_r_px));
     const Camera camera = LoadCamera(a.camera);
     optics::Lens lens = optics::Lens::FromCamera(camera);
     if (a.pixel_pitch_mm > 0) lens.pixel_pitch_mm = a.pixel_pitch_mm;

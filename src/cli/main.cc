@@ -75,9 +75,10 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() != 0) std::cerr << "blurcue: ";
-    const int code = app.exit(e);
-    return code == 0 ? 0 : static_cast<int>(ErrorKind::kUsage);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // One line like every other error (CLI11's own printer adds "Run with --help for more information.").
+    std::cerr << "blurcue: " << e.what() << "\n";
+    return static_cast<int>(ErrorKind::kUsage);
   } catch (const Error& e) {
     std::cerr << "blurcue: " << e.what() << "\n";
     return e.exit_code();

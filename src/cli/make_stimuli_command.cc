@@ -51,13 +51,15 @@ void AddSynthPicturesCommand(CLI::App& app) {
   cmd->add_option("--camera", args->camera, "camera.json (f, f-number, sensor)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--protocol", args->protocol, "take the distances from this protocol's distance_m levels")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--distances-m", args->distances_m, "distances (m), instead of --protocol");
-  cmd->add_option("--focus-m", args->focus_m, "focus distance (m)")->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--distances-m", args->distances_m, "distances (m), instead of --protocol")
+      ->check(FinitePositive(1000, "m"));
+  cmd->add_option("--focus-m", args->focus_m, "focus distance (m)")->capture_default_str()
+      ->check(FinitePositive(1000, "m"));
   cmd->add_option("--picture", args->picture, "face or an image with alpha")->capture_default_str();
   cmd->add_option("--height-mm", args->height_mm, "the real picture's height")->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(FinitePositive(10000, "mm"));
   cmd->add_option("--width-px", args->width_px, "photo width (the camera's sensor scaled to it)")
-      ->capture_default_str()->check(CLI::Range(16, 16384));
+      ->capture_default_str()->check(IntRange(16, 16384, "px"));
   cmd->add_option("--out", args->out, "folder (created)")->required();
   cmd->callback([args] {
     std::set<double> distances(args->distances_m.begin(), args->distances_m.end());

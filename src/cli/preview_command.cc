@@ -41,9 +41,9 @@ void AddPreviewCommand(CLI::App& app) {
   cmd->add_option("--participant", args->participant, "whose trial list (by_participant sides)")
       ->capture_default_str();
   cmd->add_option("--seed", args->seed, "seed (default: as blurcue run)")->check(SeedValidator());
-  cmd->add_option("--columns", args->columns, "tiles per row")->capture_default_str()->check(CLI::Range(1, 20));
+  cmd->add_option("--columns", args->columns, "tiles per row")->capture_default_str()->check(IntRange(1, 20));
   cmd->add_option("--tile-width", args->tile_width, "tile width in px")->capture_default_str()
-      ->check(CLI::Range(80, 2000));
+      ->check(IntRange(80, 2000, "px"));
   cmd->callback([args] {
     // The pre-flight of blurcue run: the same checks, and every trial's scene already worked out.
     const session::PreparedSession prepared = session::PrepareSession(args->protocol, args->participant, args->seed);

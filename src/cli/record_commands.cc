@@ -1,4 +1,5 @@
 // blurcue export / merge: the SQLite record out to analysis tables, and several stations' records into one.
+#include <cstdint>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -85,8 +86,10 @@ void AddSessionsCommand(CLI::App& app) {
       "  blurcue sessions --db results/study.sqlite\n"
       "  blurcue sessions --db results/study.sqlite --abort 12");
   cmd->add_option("--db", args->db, "the SQLite record")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--abort", args->abort, "close this unfinished session as aborted (answers kept)");
-  cmd->add_option("--break-lock", args->break_lock, "clear this session's lock");
+  // Session ids are SQLite rowids: 1 and up.
+  cmd->add_option("--abort", args->abort, "close this unfinished session as aborted (answers kept)")
+      ->check(IntRange(1, INT64_MAX));
+  cmd->add_option("--break-lock", args->break_lock, "clear this session's lock")->check(IntRange(1, INT64_MAX));
   cmd->callback([args] {
     if (args->abort || args->break_lock) {
       store::Record record = store::Record::Open(args->db);

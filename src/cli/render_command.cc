@@ -46,22 +46,27 @@ void AddRenderCommand(CLI::App& app) {
   cmd->add_option("--background", args->background, "the scene photo (same camera)")->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--object", args->object, "grid or ball[:TEXTURE]")->capture_default_str();
-  cmd->add_option("--at-edge", args->edge, "edge the object is aligned with (1 = nearest)")->capture_default_str();
-  cmd->add_option("--section", args->section, "section along the edge for a ball (1..7)")->capture_default_str();
+  cmd->add_option("--at-edge", args->edge, "edge the object is aligned with (1 = nearest)")->capture_default_str()
+      ->check(IntRange(1, 1000));
+  cmd->add_option("--section", args->section, "section along the edge for a ball (1..7)")->capture_default_str()
+      ->check(IntRange(1, 1000));
   cmd->add_option("--blur", args->blur, "blur source")->capture_default_str();
-  cmd->add_option("--gain", args->gain, "multiplies the radius")->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--gain", args->gain, "multiplies the radius")->capture_default_str()->check(FiniteRange(0, 100, ""));
   cmd->add_option("--method", args->method, "gaussian or disc")->capture_default_str()
       ->check(CLI::IsMember({"gaussian", "disc"}));
-  cmd->add_option("--brightness", args->brightness, "multiplies the object's linear colour")->capture_default_str();
-  cmd->add_option("--contrast", args->contrast, "scales the object's texture around mid grey")->capture_default_str();
+  cmd->add_option("--brightness", args->brightness, "multiplies the object's linear colour")->capture_default_str()
+      ->check(FiniteRange(0, 100, ""));
+  cmd->add_option("--contrast", args->contrast, "scales the object's texture around mid grey")->capture_default_str()
+      ->check(FiniteRange(0, 100, ""));
   cmd->add_option("--backend", args->backend, "blur on gl or cpu")->capture_default_str()
       ->check(CLI::IsMember({"gl", "cpu"}));
-  cmd->add_option("--display-width", args->display_width, "scale the output to this width (0 = full resolution)");
+  cmd->add_option("--display-width", args->display_width, "scale the output to this width (0 = full resolution)")
+      ->check(IntRange(0, 7680, "px"));
   cmd->add_option("--cutoff", args->cutoff, "picture: Butterworth cut-off, cycles per picture width (0 = sharp)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(FiniteRange(0, render::kMaxCutoffCyclesPerWidth, "cycles per picture width"));
   cmd->add_option("--picture-height-px", args->picture_height, "picture: its height on screen (default 60 % of the "
-                                                                "grey half)");
+                                                                "grey half)")
+      ->check(IntRange(0, 7680, "px"));
   cmd->add_option("--out", args->out, "output PNG")->required();
   cmd->callback([args] {
     const auto t0 = std::chrono::steady_clock::now();
@@ -71,6 +76,10 @@ void AddRenderCommand(CLI::App& app) {
       const cv::Mat photo = ReadImage(args->background, 1);
       const int w = args->display_width > 0 ? args->display_width : 960, h = w * 3 / 4, half = h / 2;
       const int picture_h = args->picture_height > 0 ? args->picture_height : half * 6 / 10;
+      if (picture_h > half)
+        throw Error(ErrorKind::kUsage, "--picture-height-px " + std::to_string(picture_h) +
+                                           " is taller than the grey half of the frame (" + std::to_string(half) +
+                                           " px)");
       const cv::Mat frame = render::DepthMatchingFrame(
           render::PictureOnGrey(picture, cv::Size(w, half), picture_h, args->cutoff), photo, w);
       WriteImage(args->out, frame);
@@ -114,6 +123,11 @@ void AddRenderCommand(CLI::App& app) {
     auto context = render::GlContext::CreateOffscreen();
     render::SceneRenderer renderer(scene.camera, scene.rvec, scene.tvec);
     const render::Footprint f = renderer.Measure(object);
+    // An object outside the photo would leave the photo as it was, written as if it were the stimulus.
+    if ((f.bounds & cv::Rect(0, 0, photo.cols, photo.rows)).empty())
+      throw Error(ErrorKind::kUsage, "the " + args->object + " at --at-edge " + std::to_string(args->edge) +
+                                         " lies outside the " + std::to_string(photo.cols) + "x" +
+                                         std::to_string(photo.rows) + " photo; nothing would be drawn");
     const cv::Vec3d centre = scene.ToCamera(object.center_board_mm);
     const double r = args->gain * calib::BlurAtPx(scene, source, centre, fixed_r);
     // One radius serves while the object's depth span changes r by less than half a pixel.
@@ -123,6 +137,12 @@ void AddRenderCommand(CLI::App& app) {
       return args->gain * calib::BlurAtPx(scene, source, p, fixed_r);
     };
     const double r_far = at_depth(f.z_max_mm), r_near = at_depth(f.z_min_mm);
+    // Say which option made an impossible radius before the blur refuses it without knowing why.
+    for (const double v : {r, r_far, r_near})
+      if (!(v >= 0 && v <= render::kMaxBlurRadiusPx))
+        throw Error(ErrorKind::kUsage, "--blur " + args->blur + " x --gain " + BoundText(args->gain) + " gives " +
+                                           BoundText(v) + " px at the object; the blur radius must be in [0, " +
+                                           BoundText(render::kMaxBlurRadiusPx) + "] px");
     const double span = std::abs(r_far - r_near);
     // Model no more than the scene needs: one radius while the object's depth span changes r by < 0.5 px,
     // a per-pixel radius from depth where it does.

@@ -74,7 +74,7 @@ void AddReportCommand(CLI::App& app) {
   cmd->add_option("--out", args->out, "folder for the report (created)")->required();
   cmd->add_option("--bench", args->bench, "folder of the benchmark CSVs")->capture_default_str();
   cmd->add_option("--boot", args->boot, "bootstrap samples of the psychometric fit")->capture_default_str()
-      ->check(CLI::Range(10, 100000));
+      ->check(IntRange(10, 100000));
   cmd->add_option("--python", args->python, "the Python that sees the analysis packages")->capture_default_str();
   cmd->callback([args] {
     const std::filesystem::path out = args->out;

@@ -65,9 +65,10 @@ void AddRunCommand(CLI::App& app) {
                                                 "participant id seen before is refused otherwise)");
   cmd->add_flag("--window", args->options.window, "with --observer: show the session in a window, in real time");
   cmd->add_option("--sim-fps", args->options.sim_fps, "headless: frames rendered per simulated second")
-      ->capture_default_str();
+      ->capture_default_str()->check(FiniteRange(0.1, 1000, "frames per second"));
   cmd->add_option("--stop-after", args->options.stop_after, "leave the session after this many answers (it stays "
-                                                            "resumable; for tests and split sittings)");
+                                                            "resumable; for tests and split sittings)")
+      ->check(IntRange(0, 1000000));
   cmd->callback([args] {
     session::RunOptions options = args->options;
     options.protocol_file = args->protocol;

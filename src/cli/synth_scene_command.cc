@@ -10,7 +10,9 @@
 #include <string>
 
 #include "cli/commands.h"
+#include "core/camera.h"
 #include "core/error.h"
+#include "optics/thin_lens.h"
 #include "synth/scene.h"
 
 namespace blurcue::cli {
@@ -20,16 +22,16 @@ Error UsageError(const std::string& option, const std::string& what) {
   return Error(ErrorKind::kUsage, option + ": " + what);
 }
 
-// "inf" / "infinity" or a number of mm.
+// "inf" / "infinity" or a number of mm. A "nan" would stand for the default (focus on edge 1) without saying so.
 double ParseFocus(const std::string& text) {
   if (text == "inf" || text == "infinity") return std::numeric_limits<double>::infinity();
   try {
     size_t used = 0;
     const double v = std::stod(text, &used);
-    if (used == text.size()) return v;
+    if (used == text.size() && v > 0 && v <= 1e6) return v;
   } catch (const std::exception&) {
   }
-  throw UsageError("--focus-mm", "must be a distance in mm or 'inf', got '" + text + "'");
+  throw UsageError("--focus-mm", "must be a distance in (0, 1000000] mm or 'inf', got '" + text + "'");
 }
 
 // RenderScene names SceneOptions fields; say them as the options a user typed.
@@ -90,41 +92,51 @@ void AddSynthSceneCommand(CLI::App& app) {
       "Same options + seed give the same bytes.\n"
       "Example: blurcue synth-scene --out scenes/a --seed 7 --noise 0.004 --focus-mm 260");
   cmd->add_option("--out", args->out, "folder to write the four files to (created)")->required();
-  cmd->add_option("--seed", args->seed, "seed of the texture, flaws and noise")->capture_default_str();
+  cmd->add_option("--seed", args->seed, "seed of the texture, flaws and noise")->capture_default_str()
+      ->check(SeedValidator());
   cmd->add_option("--preset", args->preset,
                   "quarter: thesis set-up at 1148 x 764 (default); thesis: full 4592 x 3056 (supersample 2)")
       ->check(CLI::IsMember({"quarter", "thesis"}))->capture_default_str();
   cmd->add_option("--camera", args->camera, "camera.json to shoot with instead of the preset's camera")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--width", args->width, "image width in px (the sensor is resampled; height follows the aspect)");
-  cmd->add_option("--height", args->height, "image height in px (with --width: both exactly)");
+  cmd->add_option("--width", args->width, "image width in px (the sensor is resampled; height follows the aspect)")
+      ->check(IntRange(32, kMaxImageSidePx, "px"));
+  cmd->add_option("--height", args->height, "image height in px (with --width: both exactly)")
+      ->check(IntRange(32, kMaxImageSidePx, "px"));
   cmd->add_option("--board", args->board, "board size in squares, COLSxROWS")->capture_default_str();
-  cmd->add_option("--square-mm", args->square_mm, "side of one square in mm")->capture_default_str();
-  cmd->add_option("--tilt-deg", o.tilt_deg, "camera pitched down from the horizontal, degrees")->capture_default_str();
+  cmd->add_option("--square-mm", args->square_mm, "side of one square in mm")->capture_default_str()
+      ->check(FiniteRange(1, 1000, "mm"));
+  cmd->add_option("--tilt-deg", o.tilt_deg, "camera pitched down from the horizontal, degrees")->capture_default_str()
+      ->check(FinitePositive(90, "degrees"));
   cmd->add_option("--edge1-u-mm", o.edge1_u_mm, "depth (camera z) of the midpoint of edge 1, mm")
-      ->capture_default_str();
+      ->capture_default_str()->check(FinitePositive(1e6, "mm"));
   cmd->add_option("--lateral-mm", o.lateral_mm, "board shifted sideways from the optical axis, mm")
-      ->capture_default_str();
+      ->capture_default_str()->check(FiniteRange(-1e4, 1e4, "mm"));
   cmd->add_option("--yaw-deg", o.yaw_deg, "board turned about the table normal, degrees (0: edges are image rows)")
-      ->capture_default_str();
+      ->capture_default_str()->check(FiniteRange(-89.9, 89.9, "degrees"));
   cmd->add_option("--focus-mm", args->focus, "focus distance in mm, or 'inf' (default: edge 1's midpoint)");
   cmd->add_option("--psf", args->psf, "point-spread function: disc (thin lens) or gaussian")
       ->check(CLI::IsMember({"disc", "gaussian"}))->capture_default_str();
-  cmd->add_option("--fixed-r-px", args->fixed_r_px, "one blur radius everywhere instead of the thin lens's, px");
+  cmd->add_option("--fixed-r-px", args->fixed_r_px, "one blur radius everywhere instead of the thin lens's, px")
+      ->check(FiniteRange(0, optics::kMaxBlurRadiusPx, "px"));
   cmd->add_option("--blur-gain", o.blur_gain, "multiplies every thin-lens radius (a lens blurrier than ideal)")
-      ->capture_default_str();
+      ->capture_default_str()->check(FiniteRange(0, 100, ""));
   cmd->add_option("--noise", o.noise_std,
                   "sensor noise std in linear units (plus shot noise of the same size at white), e.g. 0.004")
-      ->capture_default_str();
+      ->capture_default_str()->check(FiniteRange(0, 1, "linear units"));
   cmd->add_option("--jpeg-quality", args->jpeg_quality, "JPEG round trip at this quality (1-100); 0: none")
-      ->capture_default_str();
+      ->capture_default_str()->check(IntRange(0, 100));
   cmd->add_option("--flaws", args->flaws, "dark printing spots on white squares near edges (recorded in truth.json)")
-      ->capture_default_str();
-  cmd->add_option("--white", o.white, "linear reflectance x exposure of the white squares")->capture_default_str();
-  cmd->add_option("--black", o.black, "... of the black squares")->capture_default_str();
-  cmd->add_option("--table", o.table, "... mean of the wooden table")->capture_default_str();
+      ->capture_default_str()->check(IntRange(0, 10000));
+  cmd->add_option("--white", o.white, "linear reflectance x exposure of the white squares")->capture_default_str()
+      ->check(FiniteRange(0, 1, "linear reflectance"));
+  cmd->add_option("--black", o.black, "... of the black squares")->capture_default_str()
+      ->check(FiniteRange(0, 1, "linear reflectance"));
+  cmd->add_option("--table", o.table, "... mean of the wooden table")->capture_default_str()
+      ->check(FiniteRange(0, 1, "linear reflectance"));
   cmd->add_option("--supersample", args->supersample,
-                  "sub-pixels per pixel side for shading and blur (default 4; 2 for --preset thesis)");
+                  "sub-pixels per pixel side for shading and blur (default 4; 2 for --preset thesis)")
+      ->check(IntRange(1, 16));
   cmd->add_flag("--quiet", args->quiet, "print only errors");
 
   cmd->callback([args] {
@@ -151,8 +163,9 @@ void AddSynthSceneCommand(CLI::App& app) {
       const double aspect = double(camera.image_height_px) / camera.image_width_px;
       if (h == 0) h = std::max(1, static_cast<int>(std::lround(w * aspect)));
       if (w == 0) w = std::max(1, static_cast<int>(std::lround(h / aspect)));
-      if (w < 32 || h < 32 || w > 20000 || h > 20000)
-        throw UsageError("--width/--height", "must be 32..20000 px, got " + std::to_string(w) + " x " + std::to_string(h));
+      if (w < 32 || h < 32 || w > kMaxImageSidePx || h > kMaxImageSidePx)
+        throw UsageError("--width/--height", "must be 32.." + std::to_string(kMaxImageSidePx) + " px, got " +
+                                                 std::to_string(w) + " x " + std::to_string(h));
       camera = camera.Resized(w, h);
     }
     o.camera = camera;

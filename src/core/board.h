@@ -35,8 +35,9 @@ struct Board {
   }
   bool IsBlack(int col, int row) const { return (col + row) % 2 == 0; }
 
-  // Throws Error(kInput) naming `where` for fewer than 2 x 3 squares, a square board (pose would be ambiguous)
-  // or square_mm <= 0.
+  static constexpr int kMaxSquares = 100;  // a side; the study's board is 7 x 10
+  // Throws Error(kInput) naming `where` for fewer than 2 x 3 squares or more than kMaxSquares a side, a square
+  // board (pose would be ambiguous) or square_mm <= 0.
   void Validate(const std::string& where) const;
   // Parses "7x10" (cols x rows, in squares); throws Error(kUsage) naming the text.
   static Board Parse(const std::string& cols_x_rows, double square_mm);

@@ -33,16 +33,41 @@ Camera Camera::Resized(int width_px, int height_px) const {
   return c;
 }
 
+namespace {
+
+std::string Range(double lo, double hi, const char* unit) {
+  return "in [" + Num(lo) + ", " + Num(hi) + "]" + (*unit ? std::string(" ") + unit : "");
+}
+
+// Written so that NaN fails: every comparison with NaN is false.
+void RequireIn(const std::string& where, const char* field, double v, const double (&range)[2], const char* unit) {
+  if (!(v >= range[0] && v <= range[1]))
+    throw InputError(where + "/" + field, "must be " + Range(range[0], range[1], unit) + ", got " + Num(v));
+}
+
+// An image side in px, read as the JSON's own integer (signed or unsigned, any width) before it is narrowed to an
+// int, so 4294968444 is refused rather than wrapped to 1148.
+int ImageSidePx(const Json& json, const char* key, const std::string& where) {
+  const std::string field = where + "/" + key;
+  if (!json.contains(key)) throw InputError(field, "is required but missing");
+  const Json& v = json[key];
+  if (!v.is_number_integer()) throw InputError(field, "must be an integer, got " + v.dump());
+  const bool in = v.is_number_unsigned() ? v.get<uint64_t>() >= 1 && v.get<uint64_t>() <= uint64_t(kMaxImageSidePx)
+                                         : v.get<int64_t>() >= 1 && v.get<int64_t>() <= kMaxImageSidePx;
+  if (!in) throw InputError(field, "must be " + Range(1, kMaxImageSidePx, "px") + ", got " + v.dump());
+  return static_cast<int>(v.get<int64_t>());
+}
+
+}  // namespace
+
 void Camera::Validate(const std::string& where) const {
-  auto positive = [&](const char* field, double v) {
-    if (!(v > 0) || !std::isfinite(v)) throw InputError(where + "/" + field, "must be > 0, got " + Num(v));
-  };
-  positive("focal_length_mm", focal_length_mm);
-  positive("f_number", f_number);
-  positive("sensor_width_mm", sensor_width_mm);
-  positive("sensor_height_mm", sensor_height_mm);
-  positive("image_width_px", image_width_px);
-  positive("image_height_px", image_height_px);
+  RequireIn(where, "focal_length_mm", focal_length_mm, CameraLimits::kFocalLengthMm, "mm");
+  RequireIn(where, "f_number", f_number, CameraLimits::kFNumber, "");
+  RequireIn(where, "sensor_width_mm", sensor_width_mm, CameraLimits::kSensorMm, "mm");
+  RequireIn(where, "sensor_height_mm", sensor_height_mm, CameraLimits::kSensorMm, "mm");
+  const double side[2] = {1, kMaxImageSidePx};
+  RequireIn(where, "image_width_px", image_width_px, side, "px");
+  RequireIn(where, "image_height_px", image_height_px, side, "px");
   // Square pixels: the two pitches may differ by rounding of the resolution, not by more.
   const double pitch_w = sensor_width_mm / image_width_px, pitch_h = sensor_height_mm / image_height_px;
   if (std::abs(pitch_w - pitch_h) > 0.02 * pitch_w)
@@ -51,12 +76,27 @@ void Camera::Validate(const std::string& where) const {
                                                      " mm (non-square pixels are not supported)");
   if (camera_matrix) {
     const auto& k = *camera_matrix;
-    if (!(k[0] > 0) || !(k[4] > 0) || k[8] != 1)
-      throw InputError(where + "/camera_matrix", "must be [[fx,0,cx],[0,fy,cy],[0,0,1]] with fx, fy > 0");
+    for (int i = 0; i < 9; ++i)
+      if (!std::isfinite(k[i]))
+        throw InputError(where + "/camera_matrix/" + std::to_string(i / 3) + "/" + std::to_string(i % 3),
+                         "must be finite, got " + Num(k[i]));
+    if (!(k[3] == 0 && k[6] == 0 && k[7] == 0 && k[8] == 1))
+      throw InputError(where + "/camera_matrix", "must be [[fx,s,cx],[0,fy,cy],[0,0,1]]");
+    RequireIn(where, "camera_matrix/0/0", k[0], CameraLimits::kFocalLengthPx, "px");
+    RequireIn(where, "camera_matrix/1/1", k[4], CameraLimits::kFocalLengthPx, "px");
+    if (!(std::abs(k[1]) <= k[0]))
+      throw InputError(where + "/camera_matrix/0/1", "(skew) must be in [-fx, fx], got " + Num(k[1]));
+    // The principal point lies on the sensor: anything else is a matrix for another image size.
+    const double cx[2] = {0, double(image_width_px)}, cy[2] = {0, double(image_height_px)};
+    RequireIn(where, "camera_matrix/0/2", k[2], cx, "px");
+    RequireIn(where, "camera_matrix/1/2", k[5], cy, "px");
   }
   const size_t n = dist_coeffs.size();
   if (n != 0 && n != 4 && n != 5 && n != 8 && n != 12 && n != 14)
     throw InputError(where + "/dist_coeffs", "must have 4, 5, 8, 12 or 14 values, got " + std::to_string(n));
+  const double coeff[2] = {-CameraLimits::kDistCoeff, CameraLimits::kDistCoeff};
+  for (size_t i = 0; i < n; ++i)
+    RequireIn(where, ("dist_coeffs/" + std::to_string(i)).c_str(), dist_coeffs[i], coeff, "");
 }
 
 Camera CameraFromJson(const Json& json, const std::string& where) {
@@ -65,8 +105,8 @@ Camera CameraFromJson(const Json& json, const std::string& where) {
   c.f_number = RequireNumber(json, "f_number", where);
   c.sensor_width_mm = RequireNumber(json, "sensor_width_mm", where);
   c.sensor_height_mm = RequireNumber(json, "sensor_height_mm", where);
-  c.image_width_px = RequireInt(json, "image_width_px", where);
-  c.image_height_px = RequireInt(json, "image_height_px", where);
+  c.image_width_px = ImageSidePx(json, "image_width_px", where);
+  c.image_height_px = ImageSidePx(json, "image_height_px", where);
   static const char* kKnown[] = {"focal_length_mm", "f_number", "sensor_width_mm", "sensor_height_mm",
                                  "image_width_px", "image_height_px", "camera_matrix", "dist_coeffs", "name"};
   for (auto it = json.begin(); it != json.end(); ++it) {

@@ -7,8 +7,19 @@
 #include <vector>
 
 #include "core/json_io.h"
+#include "core/limits.h"
 
 namespace blurcue {
+
+// What a camera's numbers can physically be. Wider than any real camera, narrow enough that a typo (a focal length
+// in metres, a sensor in pixels) or an overflowed integer is refused instead of calibrated.
+struct CameraLimits {
+  static constexpr double kFocalLengthMm[2] = {0.5, 2000};     // phone ultra-wide .. long telephoto
+  static constexpr double kFNumber[2] = {0.5, 256};            // the physical limit .. pinhole-like
+  static constexpr double kSensorMm[2] = {0.5, 500};           // a phone sensor's side .. large format
+  static constexpr double kFocalLengthPx[2] = {1, 1e6};        // camera_matrix fx, fy
+  static constexpr double kDistCoeff = 1e4;                    // |each dist_coeffs value|
+};
 
 struct Camera {
   double focal_length_mm = 0;
@@ -30,10 +41,13 @@ struct Camera {
   // The same camera with the image resampled to width x height (intrinsics scaled, optics unchanged).
   Camera Resized(int width_px, int height_px) const;
 
-  // Throws Error(kInput) "where/field: must be ..., got ..." for the first impossible value.
+  // Throws Error(kInput) "where/field: must be in [lo, hi] unit, got ..." for the first value outside
+  // CameraLimits, an image side outside [1, kMaxImageSidePx] px, or a camera_matrix / dist_coeffs that is not
+  // finite and shaped as OpenCV's.
   void Validate(const std::string& where) const;
 };
 
+// Integers are read without wrapping: 4294968444 px is refused, not taken as 1148.
 Camera CameraFromJson(const Json& json, const std::string& where);
 Json CameraToJson(const Camera& camera);
 // Reads and validates camera.json; errors name the file and the field.

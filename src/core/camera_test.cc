@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <string>
+
 #include "core/error.h"
 
 namespace blurcue {
@@ -37,7 +40,7 @@ TEST(Camera, RoundTripsThroughJson) {
 TEST(Camera, RejectsNonPositiveFNumberNamingTheField) {
   Json j = ThesisJson();
   j["f_number"] = -1;
-  EXPECT_EQ(ErrorOf(j), "cam.json: /f_number: must be > 0, got -1");
+  EXPECT_EQ(ErrorOf(j), "cam.json: /f_number: must be in [0.5, 256], got -1");
 }
 
 TEST(Camera, RejectsMissingAndMistypedFields) {
@@ -55,7 +58,7 @@ TEST(Camera, RejectsMissingAndMistypedFields) {
 TEST(Camera, RejectsZeroSensorAndNonSquarePixels) {
   Json j = ThesisJson();
   j["sensor_height_mm"] = 0;
-  EXPECT_NE(ErrorOf(j).find("/sensor_height_mm: must be > 0, got 0"), std::string::npos);
+  EXPECT_NE(ErrorOf(j).find("/sensor_height_mm: must be in [0.5, 500] mm, got 0"), std::string::npos);
   j = ThesisJson();
   j["sensor_height_mm"] = 20;
   EXPECT_NE(ErrorOf(j).find("non-square"), std::string::npos);
@@ -65,6 +68,61 @@ TEST(Camera, ResizedScalesIntrinsicsNotOptics) {
   Camera c = ThesisCamera().Resized(1148, 764);
   EXPECT_NEAR(c.PixelPitchMm(), 4 * ThesisCamera().PixelPitchMm(), 1e-12);
   EXPECT_DOUBLE_EQ(c.focal_length_mm, 21);
+}
+
+TEST(Camera, ImageSizeOverflowIsRefusedNotWrapped) {
+  // 4294968444 = 2^32 + 1148: read as a 32-bit int it would wrap to a plausible 1148.
+  Json j = ThesisJson();
+  j["image_width_px"] = 4294968444ULL;
+  EXPECT_EQ(ErrorOf(j), "cam.json: /image_width_px: must be in [1, 20000] px, got 4294968444");
+  for (long long bad : {0LL, -1148LL, 20001LL, -4294967296LL + 1148}) {
+    j["image_width_px"] = bad;
+    EXPECT_EQ(ErrorOf(j), "cam.json: /image_width_px: must be in [1, 20000] px, got " + std::to_string(bad));
+  }
+  j = ThesisJson();
+  j["image_height_px"] = 18446744073709551615ULL;
+  EXPECT_EQ(ErrorOf(j), "cam.json: /image_height_px: must be in [1, 20000] px, got 18446744073709551615");
+}
+
+TEST(Camera, EveryNumberHasAPhysicalRangeWithItsUnit) {
+  const struct {
+    const char* field;
+    double value;
+    const char* message;
+  } cases[] = {
+      {"focal_length_mm", 1e308, "/focal_length_mm: must be in [0.5, 2000] mm, got 1e+308"},
+      {"focal_length_mm", 21000, "/focal_length_mm: must be in [0.5, 2000] mm, got 21000"},
+      {"f_number", 0.1, "/f_number: must be in [0.5, 256], got 0.1"},
+      {"sensor_width_mm", -23.4, "/sensor_width_mm: must be in [0.5, 500] mm, got -23.4"},
+      {"sensor_height_mm", 1e308, "/sensor_height_mm: must be in [0.5, 500] mm, got 1e+308"},
+  };
+  for (const auto& c : cases) {
+    Json j = ThesisJson();
+    j[c.field] = c.value;
+    EXPECT_EQ(ErrorOf(j), std::string("cam.json: ") + c.message);
+  }
+}
+
+TEST(Camera, NonFiniteValuesAreRefused) {
+  // JSON has no NaN, but a camera built in code can: Validate names the field.
+  Camera c = ThesisCamera();
+  c.f_number = std::nan("");
+  try {
+    c.Validate("camera");
+    FAIL() << "NaN f-number accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), "camera/f_number: must be in [0.5, 256], got nan");
+  }
+  Json j = ThesisJson();
+  j["camera_matrix"] = {{4000.0, 0.0, 2296.0}, {0.0, 4000.0, 1528.0}, {0.0, 0.0, 1.0}};
+  EXPECT_EQ(ErrorOf(j), "");
+  j["camera_matrix"][0][2] = INFINITY;
+  EXPECT_EQ(ErrorOf(j), "cam.json: /camera_matrix/0/2: must be finite, got inf");
+  j["camera_matrix"][0][2] = 1e9;
+  EXPECT_EQ(ErrorOf(j), "cam.json: /camera_matrix/0/2: must be in [0, 4592] px, got 1e+09");
+  j = ThesisJson();
+  j["dist_coeffs"] = {0.1, -0.2, 0.0, 0.0, 1e308};
+  EXPECT_EQ(ErrorOf(j), "cam.json: /dist_coeffs/4: must be in [-10000, 10000], got 1e+308");
 }
 
 }  // namespace

@@ -3,19 +3,171 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <unistd.h>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/limits.h"
 
 namespace blurcue {
 
+namespace {
+
+// What a path is when it is not a regular file, for the message.
+std::string KindOfNonRegular(std::filesystem::file_type type) {
+  switch (type) {
+    case std::filesystem::file_type::directory: return "a directory";
+    case std::filesystem::file_type::character: return "a character device";
+    case std::filesystem::file_type::block: return "a block device";
+    case std::filesystem::file_type::fifo: return "a pipe";
+    case std::filesystem::file_type::socket: return "a socket";
+    default: return "not a regular file";
+  }
+}
+
+uint32_t BigEndian(const std::vector<uint8_t>& b, size_t at, int bytes) {
+  uint32_t v = 0;
+  for (int i = 0; i < bytes; ++i) v = (v << 8) | b[at + i];
+  return v;
+}
+
+// Width and height from a PNG's IHDR or a JPEG's start-of-frame, without decoding; {0, 0} for other formats or
+// a header too short to say (the decoder then has its say, and the size is checked after decoding).
+std::pair<uint32_t, uint32_t> HeaderSizePx(const std::vector<uint8_t>& b) {
+  static const uint8_t kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (b.size() >= 24 && std::equal(kPng, kPng + 8, b.begin()) && std::equal(b.begin() + 12, b.begin() + 16, "IHDR"))
+    return {BigEndian(b, 16, 4), BigEndian(b, 20, 4)};
+  if (b.size() < 4 || b[0] != 0xff || b[1] != 0xd8) return {0, 0};
+  // JPEG: walk the marker segments up to the first start-of-frame (C0..CF but DHT C4, JPG C8, DAC CC).
+  size_t i = 2;
+  while (i + 4 <= b.size()) {
+    if (b[i] != 0xff) return {0, 0};
+    const uint8_t marker = b[i + 1];
+    if (marker == 0xff) { ++i; continue; }  // fill byte
+    if (marker == 0x01 || (marker >= 0xd0 && marker <= 0xd7)) { i += 2; continue; }  // no length
+    if (marker == 0xda || marker == 0xd9) return {0, 0};  // scan data or end before any frame header
+    const uint32_t length = BigEndian(b, i + 2, 2);
+    const bool sof = marker >= 0xc0 && marker <= 0xcf && marker != 0xc4 && marker != 0xc8 && marker != 0xcc;
+    if (sof && i + 9 <= b.size()) return {BigEndian(b, i + 7, 2), BigEndian(b, i + 5, 2)};
+    i += 2 + length;
+  }
+  return {0, 0};
+}
+
+std::string SizeLimitText() {
+  return "images are read up to " + std::to_string(kMaxImageSidePx) + " px a side and " +
+         std::to_string(kMaxImagePixels / 1'000'000) + " Mpx";
+}
+
+void RequireSizeWithinLimits(const std::filesystem::path& path, uint64_t w, uint64_t h) {
+  if (w > uint64_t(kMaxImageSidePx) || h > uint64_t(kMaxImageSidePx) || w * h > uint64_t(kMaxImagePixels))
+    throw InputError(path.string(), "is " + std::to_string(w) + " x " + std::to_string(h) + " px; " + SizeLimitText());
+}
+
+// Redirects fd 2 into a temporary file while it lives. OpenCV's PNG decoder lets libpng print its warnings
+// ("libpng warning: iCCP: known incorrect sRGB profile") straight to stderr, and the JPEG decoder does the same with
+// libjpeg's; a command's output must stay its own lines and an error one line. Release() restores fd 2 and returns
+// what was written meanwhile. Images are read on one thread at a time here (the mutex makes sure of it).
+class CapturedStderr {
+ public:
+  CapturedStderr() : lock_(Mutex()) {
+    std::fflush(stderr);
+    file_ = std::tmpfile();
+    saved_ = file_ ? dup(2) : -1;
+    if (saved_ >= 0 && dup2(fileno(file_), 2) < 0) close(saved_), saved_ = -1;
+  }
+  ~CapturedStderr() { Release(); }
+  CapturedStderr(const CapturedStderr&) = delete;
+  CapturedStderr& operator=(const CapturedStderr&) = delete;
+
+  std::string Release() {
+    std::string text;
+    if (saved_ >= 0) {
+      std::fflush(stderr);
+      dup2(saved_, 2);
+      close(saved_);
+      saved_ = -1;
+      std::rewind(file_);
+      char buffer[512];
+      size_t n;
+      while (text.size() < 4096 && (n = std::fread(buffer, 1, sizeof buffer, file_)) > 0) text.append(buffer, n);
+    }
+    if (file_) std::fclose(file_), file_ = nullptr;
+    return text;
+  }
+
+ private:
+  static std::mutex& Mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::lock_guard<std::mutex> lock_;
+  std::FILE* file_ = nullptr;
+  int saved_ = -1;
+};
+
+// The decoder's own words as one clause: lines joined by "; ", at most 300 characters.
+std::string OneLine(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '\n' || c == '\r') {
+      if (!out.empty() && out.back() != ' ') out += "; ";
+    } else {
+      out += c;
+    }
+  }
+  while (!out.empty() && (out.back() == ' ' || out.back() == ';')) out.pop_back();
+  return out.size() > 300 ? out.substr(0, 297) + "..." : out;
+}
+
+}  // namespace
+
 cv::Mat ReadImage(const std::filesystem::path& path, int flags) {
-  if (!std::filesystem::exists(path)) throw InputError(path.string(), "no such file");
-  cv::Mat image = cv::imread(path.string(), flags);
-  if (image.empty()) throw InputError(path.string(), "not a readable image (PNG, JPEG, TIFF, ...)");
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status)) throw InputError(path.string(), "no such file");
+  // A directory, /dev/zero or a pipe is no image: refuse it before a decoder reads forever or says nothing useful.
+  if (!std::filesystem::is_regular_file(status))
+    throw InputError(path.string(), "is " + KindOfNonRegular(status.type()) + ", not an image file");
+  const uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (ec) throw InputError(path.string(), "cannot read file: " + ec.message());
+  if (bytes > uintmax_t(kMaxImageFileBytes))
+    throw InputError(path.string(), "is " + std::to_string(bytes) + " bytes; image files are read up to " +
+                                        std::to_string(kMaxImageFileBytes) + " bytes");
+  // The size from the header first, so a hostile 65535 x 65535 PNG is refused before it is decoded.
+  {
+    std::ifstream in(path, std::ios::binary);
+    std::vector<uint8_t> head(std::min<uintmax_t>(bytes, 1 << 20));
+    if (!in.read(reinterpret_cast<char*>(head.data()), std::streamsize(head.size())))
+      throw InputError(path.string(), "cannot read file");
+    const auto [w, h] = HeaderSizePx(head);
+    RequireSizeWithinLimits(path, w, h);
+  }
+  cv::Mat image;
+  std::string decoder_said;
+  {
+    CapturedStderr captured;
+    try {
+      image = cv::imread(path.string(), flags);
+    } catch (const cv::Exception& e) {
+      decoder_said = e.err;
+    }
+    decoder_said = OneLine(captured.Release() + decoder_said);
+  }
+  if (image.empty())
+    throw InputError(path.string(), "not a readable image (PNG, JPEG, TIFF, ...)" +
+                                        (decoder_said.empty() ? "" : ": " + decoder_said));
+  RequireSizeWithinLimits(path, image.cols, image.rows);
   return image;
 }
 

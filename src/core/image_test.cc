@@ -45,5 +45,49 @@ TEST(ImageFile, WritesAndReadsBack) {
   std::filesystem::remove_all(path.parent_path());
 }
 
+std::string ReadError(const std::filesystem::path& path) {
+  try {
+    ReadImage(path);
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput) << e.what();
+    return e.what();
+  }
+  return "";
+}
+
+const std::filesystem::path kData = std::filesystem::path(BLURCUE_SOURCE_DIR) / "tests" / "data";
+
+TEST(ImageFile, DirectoryAndDeviceAreRefusedNamingThePath) {
+  const auto dir = std::filesystem::temp_directory_path();
+  EXPECT_EQ(ReadError(dir), dir.string() + ": is a directory, not an image file");
+  EXPECT_EQ(ReadError("/dev/zero"), "/dev/zero: is a character device, not an image file");
+}
+
+TEST(ImageFile, HugeHeaderIsRefusedBeforeDecoding) {
+  // 66 bytes whose IHDR claims 65535 x 65535 px (tests/data/make_hostile_images.py).
+  EXPECT_EQ(ReadError(kData / "huge-header.png"),
+            (kData / "huge-header.png").string() +
+                ": is 65535 x 65535 px; images are read up to 20000 px a side and 120 Mpx");
+}
+
+TEST(ImageFile, LibpngWarningsDoNotReachStderr) {
+  // A valid image with a broken iCCP profile: libpng warns about it on fd 2 unless ReadImage keeps it off.
+  testing::internal::CaptureStderr();
+  const cv::Mat image = ReadImage(kData / "bad-iccp.png");
+  const std::string said = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(image.cols, 16);
+  EXPECT_EQ(image.rows, 12);
+  EXPECT_EQ(said, "");
+}
+
+TEST(ImageFile, UndecodableImageIsOneLineWithTheDecodersWords) {
+  testing::internal::CaptureStderr();
+  const std::string what = ReadError(kData / "bad-iccp-truncated.png");
+  const std::string said = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(said, "");
+  EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  EXPECT_NE(what.find("bad-iccp-truncated.png: not a readable image"), std::string::npos) << what;
+}
+
 }  // namespace
 }  // namespace blurcue

@@ -5,6 +5,11 @@
 
 namespace blurcue::optics {
 
+// The largest blur radius anything renders or accepts as a fixed radius, px. A disc of radius r costs (2 r + 2)^2
+// taps a pixel (a million at 500 px) and a Gaussian 3 r taps a pass; no stimulus of a photo's size needs more,
+// and a NaN or 1e9 radius would otherwise crash a CPU blur or hang a GPU one.
+constexpr double kMaxBlurRadiusPx = 500;
+
 struct Lens {
   double focal_length_mm = 0;  // f
   double aperture_mm = 0;      // D = f / N

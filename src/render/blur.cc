@@ -2,19 +2,39 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/error.h"
 #include "core/image.h"
 #include "render/gl_objects.h"
 
 namespace blurcue::render {
 
-int GaussianTaps(double sigma_px) { return sigma_px <= 0 ? 0 : int(std::ceil(3 * sigma_px)); }
+static std::string Num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+void CheckBlurRadius(double r_px) {
+  // Written so that NaN fails too: every comparison with NaN is false.
+  if (!(r_px >= 0 && r_px <= kMaxBlurRadiusPx))
+    throw Error(ErrorKind::kDomain, "blur radius must be in [0, " + Num(kMaxBlurRadiusPx) + "] px, got " + Num(r_px));
+}
+
+int GaussianTaps(double sigma_px) {
+  if (sigma_px <= 0) return 0;
+  CheckBlurRadius(2 * sigma_px);  // a NaN or huge sigma has no tap count an int holds
+  return int(std::ceil(3 * sigma_px));
+}
 
 cv::Mat GaussianBlurCpu(const cv::Mat& rgba, double r_px) {
   CV_Assert(rgba.type() == CV_32FC4);
+  CheckBlurRadius(r_px);
   const double s = r_px / 2;
   const int taps = GaussianTaps(s);
   if (taps == 0) return rgba.clone();
@@ -34,6 +54,7 @@ double DiscCoverageRadiusPx(double r_px) {
 }
 
 cv::Mat DiscKernel(double requested_r_px) {
+  CheckBlurRadius(requested_r_px);
   const double r_px = DiscCoverageRadiusPx(requested_r_px);
   const int t = int(std::ceil(r_px + 0.5));
   cv::Mat k(2 * t + 1, 2 * t + 1, CV_32F);
@@ -45,6 +66,7 @@ cv::Mat DiscKernel(double requested_r_px) {
 
 cv::Mat DiscBlurCpu(const cv::Mat& rgba, double r_px) {
   CV_Assert(rgba.type() == CV_32FC4);
+  CheckBlurRadius(r_px);
   if (r_px <= 0) return rgba.clone();
   cv::Mat out;
   cv::filter2D(rgba, out, CV_32F, DiscKernel(r_px), cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
@@ -81,7 +103,11 @@ cv::Mat FilterInFrequency(const cv::Mat& rgba, const std::function<double(double
 }
 
 cv::Mat ButterworthBlurCpu(const cv::Mat& rgba, double cutoff, int order) {
-  CV_Assert(cutoff > 0 && order >= 1);
+  if (!(cutoff > 0 && cutoff <= kMaxCutoffCyclesPerWidth))
+    throw Error(ErrorKind::kDomain, "Butterworth cut-off must be in (0, " + Num(kMaxCutoffCyclesPerWidth) +
+                                        "] cycles per image width, got " + Num(cutoff));
+  if (order < 1 || order > 16)
+    throw Error(ErrorKind::kDomain, "Butterworth order must be in [1, 16], got " + std::to_string(order));
   const double w = rgba.cols;  // the cut-off counts cycles per image width
   return FilterInFrequency(rgba, [&](double f) { return 1.0 / (1.0 + std::pow(f * w / cutoff, 2 * order)); });
 }
@@ -112,6 +138,10 @@ cv::Mat PictureOnField(const cv::Mat& picture, cv::Size field, int height_px, in
 }
 
 cv::Mat PictureOnGrey(const cv::Mat& picture, cv::Size field, int height_px, double cutoff, double grey) {
+  // 0 is sharp; a NaN must not pass for it.
+  if (!(cutoff >= 0 && cutoff <= kMaxCutoffCyclesPerWidth))
+    throw Error(ErrorKind::kDomain, "Butterworth cut-off must be in [0, " + Num(kMaxCutoffCyclesPerWidth) +
+                                        "] cycles per picture width (0 = sharp), got " + Num(cutoff));
   const int width_px = std::max(1, int(std::lround(double(picture.cols) * height_px / picture.rows)));
   // The cut-off is per picture width; the padded layer is wider, so scale it to the layer's width.
   auto butterworth = [cutoff](const cv::Mat& layer, int picture_width_px) {
@@ -182,6 +212,7 @@ GlBlur::GlBlur()
 GlBlur::~GlBlur() = default;
 
 void GlBlur::BlurTexture(Texture& texture, const std::string& method, double r_px) {
+  CheckBlurRadius(r_px);  // before anything: a NaN radius would otherwise skip the blur and return the image as is
   const int w = texture.width_px(), h = texture.height_px();
   if (!scratch_ || scratch_->width_px() != w || scratch_->height_px() != h) scratch_ = std::make_unique<Texture>(w, h);
   Texture& scratch = *scratch_;

@@ -7,12 +7,24 @@
 
 #include <opencv2/core.hpp>
 
+#include "optics/thin_lens.h"
+
 namespace blurcue::render {
+
+// The largest blur radius the blur functions take (optics::kMaxBlurRadiusPx, 500 px).
+using optics::kMaxBlurRadiusPx;
+// Throws Error(kDomain) "blur radius must be in [0, 500] px, got nan" unless r_px is finite and in that range.
+void CheckBlurRadius(double r_px);
+
+// The Butterworth cut-off's range, cycles per image width: above it the filter passes every frequency an image of
+// any size holds, so a larger value only hides a mistake.
+constexpr double kMaxCutoffCyclesPerWidth = 1e5;
 
 // Half-width of the discrete Gaussian for std s: ceil(3 s), as wide as s needs and no wider.
 int GaussianTaps(double sigma_px);
 
 // CPU reference: the shader's separable kernel (normalised, clamp-to-edge) on CV_32FC4 premultiplied linear RGBA.
+// Every blur function here (CPU and GL) refuses a radius CheckBlurRadius refuses; r = 0 leaves the image as it is.
 cv::Mat GaussianBlurCpu(const cv::Mat& rgba, double r_px);
 
 // The pillbox kernel for radius r (px): weight clamp(R + 0.5 - distance, 0, 1), normalised, (2 t + 1)^2 taps with
@@ -28,7 +40,8 @@ cv::Mat FilterInFrequency(const cv::Mat& rgba, const std::function<double(double
 
 // Second-order Butterworth low-pass (the thesis's pre-research filter), in the frequency domain:
 // H = 1 / (1 + (D / D0)^(2 n)), D the distance from zero frequency in cycles per image width, D0 = cutoff.
-// The image is mirror-padded first so its borders do not wrap around.
+// The image is mirror-padded first so its borders do not wrap around. Throws Error(kDomain) unless the cut-off is
+// in (0, kMaxCutoffCyclesPerWidth] and the order in 1..16.
 cv::Mat ButterworthBlurCpu(const cv::Mat& rgba, double cutoff_cycles_per_width, int order = 2);
 
 // The depth-matching study's stimulus (thesis 3.2): `picture` (8-bit sRGB, alpha = its shape) scaled to

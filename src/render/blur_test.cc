@@ -3,6 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <functional>
+#include <string>
+
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
@@ -225,6 +229,71 @@ TEST(PictureOnGrey, FieldIsGreyAndLowerCutoffsSoftenThePicture) {
   EXPECT_GT(energy(sharp), 1.5 * energy(soft));
   EXPECT_GT(energy(soft), 1.2 * energy(softer));
   EXPECT_NEAR(cv::mean(DecodeSrgb8(soft))[0], cv::mean(DecodeSrgb8(sharp))[0], 0.01);
+}
+
+// NaN, infinity, negative and absurd radii are refused with the value in the message, never a crash, a hang or
+// an image returned unblurred.
+const double kBadRadii[] = {std::nan(""), INFINITY, -1.0, 500.5, 1e9, 1e308};
+
+void ExpectRefused(const std::function<void()>& call, double r, const std::string& text) {
+  try {
+    call();
+    ADD_FAILURE() << "r = " << r << " was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kDomain) << e.what();
+    EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+  }
+}
+
+TEST(CpuBlur, RefusesNonFiniteNegativeAndHugeRadii) {
+  const cv::Mat img = Square(32, 24);
+  for (double r : kBadRadii) {
+    ExpectRefused([&] { GaussianBlurCpu(img, r); }, r, "blur radius must be in [0, 500] px, got ");
+    ExpectRefused([&] { DiscBlurCpu(img, r); }, r, "blur radius must be in [0, 500] px, got ");
+  }
+  ExpectRefused([&] { GaussianBlurCpu(img, std::nan("")); }, 0, "got nan");
+}
+
+TEST(CpuBlur, LargestRadiusBlursAndZeroKeepsTheImage) {
+  const cv::Mat img = Square(32, 24);
+  const cv::Mat same = GaussianBlurCpu(img, 0), wide = GaussianBlurCpu(img, kMaxBlurRadiusPx);
+  EXPECT_EQ(cv::norm(same, img, cv::NORM_INF), 0);
+  // r = 500 px on a 32 px image: nearly flat, the square's colour spread over the whole image.
+  double lo = 0, hi = 0;
+  cv::minMaxLoc(wide.reshape(1), &lo, &hi);
+  EXPECT_GT(lo, 0.0);
+  EXPECT_LT(hi, 0.8);
+}
+
+TEST(CpuBlur, ButterworthRefusesNonFiniteZeroAndHugeCutoffs) {
+  const cv::Mat img = Square(32, 24);
+  for (double cutoff : {std::nan(""), double(INFINITY), 0.0, -2.0, 1e308})
+    ExpectRefused([&] { ButterworthBlurCpu(img, cutoff); }, cutoff, "Butterworth cut-off must be in (0, ");
+  cv::Mat picture(40, 30, CV_8UC4, cv::Scalar(40, 80, 120, 255));
+  ExpectRefused([&] { PictureOnGrey(picture, cv::Size(64, 48), 20, std::nan("")); }, 0, "got nan");
+}
+
+TEST_F(GlTest, RefusesNonFiniteNegativeAndHugeRadii) {
+  GlBlur blur;
+  const cv::Mat img = Square(32, 24);
+  for (double r : kBadRadii) {
+    ExpectRefused([&] { blur.Gaussian(img, r); }, r, "blur radius must be in [0, 500] px, got ");
+    ExpectRefused([&] { blur.Disc(img, r); }, r, "blur radius must be in [0, 500] px, got ");
+  }
+}
+
+TEST_F(GlTest, ImageWiderThanTheLargestTextureIsRefused) {
+  GLint max_side = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_side);
+  GlBlur blur;
+  const cv::Mat wide(2, max_side + 1, CV_32FC4, cv::Scalar(0.5, 0.5, 0.5, 1));
+  try {
+    blur.Gaussian(wide, 2);
+    FAIL() << "a " << wide.cols << " px wide image was blurred on a GL whose textures end at " << max_side;
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    EXPECT_NE(std::string(e.what()).find("does not fit this GL's textures"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

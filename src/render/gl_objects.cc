@@ -79,6 +79,13 @@ Program Program::FromSource(const std::string& vertex, const std::string& fragme
 
 Texture::Texture(int width_px, int height_px, GLenum internal_format)
     : width_(width_px), height_(height_px), format_(internal_format) {
+  // GL refuses a larger texture with no more than an error flag, and every later pass would read nothing: say so.
+  GLint max_side = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_side);
+  if (width_px < 1 || height_px < 1 || width_px > max_side || height_px > max_side)
+    throw Error(ErrorKind::kInput, "an image of " + std::to_string(width_px) + " x " + std::to_string(height_px) +
+                                       " px does not fit this GL's textures (1 to " + std::to_string(max_side) +
+                                       " px a side); use the CPU back end (--backend cpu)");
   GLuint id = 0;
   glGenTextures(1, &id);
   name_ = GlName(id, [](GLuint i) { glDeleteTextures(1, &i); });

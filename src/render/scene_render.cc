@@ -266,11 +266,13 @@ GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px, boo
 }
 
 int KernelMarginPx(const std::string& method, double r_px) {
+  CheckBlurRadius(r_px);  // a NaN or huge radius would make the margin (an int) undefined
   if (r_px <= 0) return 0;
   return method == "disc" ? int(std::ceil(r_px + 0.5)) : GaussianTaps(r_px / 2);
 }
 
 void BlurLayer(Layer& layer, const std::string& method, double r_px, GlBlur* gl) {
+  CheckBlurRadius(r_px);
   if (r_px <= 0 || layer.bgra.empty()) return;
   if (method != "gaussian" && method != "disc")
     throw Error(ErrorKind::kUsage, "blur method for objects must be gaussian or disc, got '" + method + "'");

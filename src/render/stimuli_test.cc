@@ -289,5 +289,20 @@ TEST(RealPicturePhoto, SizeAndBlurFollowTheThinLens) {
   EXPECT_GT(r_px, 2.0);  // the case means something: a visible blur
 }
 
+// A picture just beyond the focal length would be imaged millions of px tall and blurred by as many: refused with
+// the distance, before any of it reaches an int or an allocation.
+TEST(RealPicturePhoto, PictureAtTheFocalLengthIsRefused) {
+  const Camera camera = ThesisCamera().Resized(960, 640);
+  const cv::Mat square(40, 40, CV_8UC4, cv::Scalar(255, 255, 255, 255));
+  try {
+    RealPicturePhoto(square, camera, 1000, 21.001, 120, 0.18);
+    FAIL() << "a picture 1 um beyond f was imaged";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kDomain);
+    EXPECT_NE(std::string(e.what()).find("a 120 mm picture at 21 mm would be imaged"), std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace blurcue::render

@@ -572,6 +572,17 @@ void ValidateOptions(const SceneOptions& o) {
   if (o.flaws < 0 || o.flaws > 10000) throw InputError("flaws", "must be in [0, 10000], got " + std::to_string(o.flaws));
   if (o.supersample < 1 || o.supersample > 16)
     throw InputError("supersample", "must be in [1, 16] sub-pixels per side, got " + std::to_string(o.supersample));
+  // The scene is shaded and blurred at sub-pixel resolution in a few float buffers of that size: cap it where the
+  // thesis preset (4592 x 3056 px at 2 x 2, 56 M) still fits and a hostile size cannot exhaust memory.
+  constexpr double kMaxSubPixels = 64e6;
+  const double sub_pixels = double(o.camera.image_width_px) * o.camera.image_height_px * o.supersample * o.supersample;
+  if (sub_pixels > kMaxSubPixels)
+    throw InputError("supersample", std::to_string(o.camera.image_width_px) + " x " +
+                                        std::to_string(o.camera.image_height_px) + " px at " +
+                                        std::to_string(o.supersample) + " x " + std::to_string(o.supersample) +
+                                        " sub-pixels is " + Num(sub_pixels / 1e6) +
+                                        " M sub-pixels; the most a scene renders is " + Num(kMaxSubPixels / 1e6) +
+                                        " M (lower --supersample or the size)");
 }
 
 Json OptionsToJson(const SceneOptions& o) {

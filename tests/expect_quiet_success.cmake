@@ -1,0 +1,13 @@
+# Runs CMD with ARGS and checks it succeeds (exit 0), prints EXPECT_TEXT on stdout and nothing at all on stderr.
+execute_process(COMMAND ${CMD} ${ARGS} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT code EQUAL 0)
+  message(FATAL_ERROR "exit code ${code}, expected 0\nstdout: ${out}\nstderr: ${err}")
+endif()
+string(FIND "${out}" "${EXPECT_TEXT}" at)
+if(at EQUAL -1)
+  message(FATAL_ERROR "stdout lacks '${EXPECT_TEXT}':\n${out}")
+endif()
+if(NOT "${err}" STREQUAL "")
+  message(FATAL_ERROR "stderr should be empty, got:\n${err}")
+endif()
+message(STATUS "ok: ${out}")

@@ -1,0 +1,138 @@
+# Hostile command lines, files and images (issue 9): every one ends in one line on stderr naming the option or
+# file, the field and the value, and exit 2 (command line) or 3 (file) - never a signal, exit 10, a hang or an
+# output written as if nothing were wrong. tests/data/make_hostile_images.py wrote the PNGs.
+set(D ${PROJECT_SOURCE_DIR}/tests/data)
+set(H ${PROJECT_BINARY_DIR}/cli-test-hostile)
+file(MAKE_DIRECTORY ${H})
+
+# hostile_test(NAME CODE TEXT ARG...): blurcue ARG... exits CODE with exactly one stderr line containing TEXT.
+function(hostile_test name code text)
+  add_test(NAME ${name}
+           COMMAND ${CMAKE_COMMAND} -DCMD=$<TARGET_FILE:blurcue> "-DARGS=${ARGN}" -DEXPECT_CODE=${code}
+                   "-DEXPECT_TEXT=${text}" -DONE_LINE=1 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+endfunction()
+
+# blur: NaN, huge, infinite and negative radii on both back ends (the CPU path used to crash, GL to hang or to
+# write the image unblurred).
+foreach(backend cpu gl)
+  foreach(pair "nan;nan" "1e308;1e308" "1e9;1e9" "inf;inf" "minus1;-1")
+    list(GET pair 0 tag)
+    list(GET pair 1 value)
+    hostile_test(cli_hostile_blur_${backend}_radius_${tag} 2 "--radius-px: must be in [0, 500] px, got ${value}"
+                 blur ${D}/small.png --backend ${backend} --radius-px=${value} --out ${H}/x.png)
+  endforeach()
+endforeach()
+hostile_test(cli_hostile_blur_radius_not_a_number 2 "--radius-px: must be in [0, 500] px, got '3px'"
+             blur ${D}/small.png --radius-px 3px --out ${H}/x.png)
+hostile_test(cli_hostile_blur_cutoff_nan 2 "--cutoff: must be in (0, 100000] cycles per image width, got nan"
+             blur ${D}/small.png --method butterworth --cutoff nan --out ${H}/x.png)
+hostile_test(cli_hostile_blur_cutoff_zero 2 "--cutoff: must be in (0, 100000] cycles per image width, got 0"
+             blur ${D}/small.png --method butterworth --cutoff 0 --out ${H}/x.png)
+
+# Images that are no image: a device, a directory, a header claiming 65535 x 65535 px, a truncated PNG.
+hostile_test(cli_hostile_image_dev_zero 3 "/dev/zero: is a character device, not an image file"
+             blur /dev/zero --radius-px 2 --out ${H}/x.png)
+hostile_test(cli_hostile_image_directory_option 2 "File is actually a directory: ${D}"
+             blur ${D} --radius-px 2 --out ${H}/x.png)
+hostile_test(cli_hostile_image_directory 3 "${D}: is a directory, not an image file"
+             render --object picture:${D} --background ${D}/small.png --out ${H}/x.png)
+hostile_test(cli_hostile_image_huge_header 3
+             "huge-header.png: is 65535 x 65535 px; images are read up to 20000 px a side and 120 Mpx"
+             blur ${D}/huge-header.png --backend cpu --radius-px 2 --out ${H}/x.png)
+hostile_test(cli_hostile_image_truncated 3 "bad-iccp-truncated.png: not a readable image"
+             blur ${D}/bad-iccp-truncated.png --backend cpu --radius-px 2 --out ${H}/x.png)
+# A valid PNG with a broken iCCP profile: libpng's warning must not reach stderr.
+add_test(NAME cli_hostile_image_bad_iccp_is_quiet
+         COMMAND ${CMAKE_COMMAND} -DCMD=$<TARGET_FILE:blurcue>
+                 "-DARGS=blur;${D}/bad-iccp.png;--backend;cpu;--radius-px;2;--out;${H}/iccp.png"
+                 "-DEXPECT_TEXT=gaussian (cpu, 16x12) -> ${H}/iccp.png"
+                 -P ${PROJECT_SOURCE_DIR}/tests/expect_quiet_success.cmake)
+
+# render: a fixed radius of 1e9 and a NaN gain used to write the photo without the object and exit 0.
+hostile_test(cli_hostile_render_blur_1e9 2
+             "fitted or a radius in [0, 500] px, got '1e9'"
+             render --calib ${T}/calib.json --background ${T}/scene/scene.png --blur 1e9 --out ${H}/x.png)
+hostile_test(cli_hostile_render_gain_nan 2 "--gain: must be a number in [0, 100], got nan"
+             render --calib ${T}/calib.json --background ${T}/scene/scene.png --gain nan --out ${H}/x.png)
+set_tests_properties(cli_hostile_render_blur_1e9 cli_hostile_render_gain_nan PROPERTIES
+                     FIXTURES_REQUIRED "scene;calib")
+hostile_test(cli_hostile_render_radius_times_gain 2
+             "--blur 400 x --gain 2 gives 800 px at the object; the blur radius must be in [0, 500] px"
+             render --calib ${T}/calib.json --background ${T}/scene/scene.png --blur 400 --gain 2 --out ${H}/x.png)
+set_tests_properties(cli_hostile_render_radius_times_gain PROPERTIES FIXTURES_REQUIRED "scene;calib" LABELS gl)
+hostile_test(cli_hostile_render_cutoff_nan 2 "--cutoff: must be in [0, 100000] cycles per picture width, got nan"
+             render --object picture --background ${D}/small.png --cutoff nan --out ${H}/x.png)
+
+# camera.json: a width of 2^32 + 1148 used to wrap to 1148 and calibrate; every number has a physical range.
+set(CAMERA_REST "\"sensor_width_mm\": 23.4, \"sensor_height_mm\": 15.6, \"image_height_px\": 764")
+file(WRITE ${H}/camera-wrapped-width.json
+     "{\"focal_length_mm\": 21, \"f_number\": 5.6, ${CAMERA_REST}, \"image_width_px\": 4294968444}")
+file(WRITE ${H}/camera-nan-focal.json
+     "{\"focal_length_mm\": \"nan\", \"f_number\": 5.6, ${CAMERA_REST}, \"image_width_px\": 1148}")
+file(WRITE ${H}/camera-negative-f-number.json
+     "{\"focal_length_mm\": 21, \"f_number\": -5.6, ${CAMERA_REST}, \"image_width_px\": 1148}")
+file(WRITE ${H}/camera-huge-focal.json
+     "{\"focal_length_mm\": 1e308, \"f_number\": 5.6, ${CAMERA_REST}, \"image_width_px\": 1148}")
+hostile_test(cli_hostile_camera_wrapped_width 3
+             "camera-wrapped-width.json: /image_width_px: must be in [1, 20000] px, got 4294968444"
+             calibrate ${T}/scene/scene.png --camera ${H}/camera-wrapped-width.json --out ${H}/calib.json)
+set_tests_properties(cli_hostile_camera_wrapped_width PROPERTIES FIXTURES_REQUIRED scene)
+set(ESTIMATE_ARGS --ref-u-mm 342.3 --ref-r-px 8 --u-mm 527.3)
+hostile_test(cli_hostile_camera_nan_focal 3 "camera-nan-focal.json: /focal_length_mm: must be a number, got \"nan\""
+             estimate --camera ${H}/camera-nan-focal.json ${ESTIMATE_ARGS})
+hostile_test(cli_hostile_camera_negative_f_number 3
+             "camera-negative-f-number.json: /f_number: must be in [0.5, 256], got -5.6"
+             estimate --camera ${H}/camera-negative-f-number.json ${ESTIMATE_ARGS})
+hostile_test(cli_hostile_camera_huge_focal 3
+             "camera-huge-focal.json: /focal_length_mm: must be in [0.5, 2000] mm, got 1e+308"
+             estimate --camera ${H}/camera-huge-focal.json ${ESTIMATE_ARGS})
+
+# The numeric options of the other commands: each names its range and unit.
+hostile_test(cli_hostile_estimate_u_nan 2 "--u-mm: must be in (0, 1000000] mm, got nan"
+             estimate --camera ${D}/thesis-camera.json --ref-u-mm 342.3 --ref-r-px 8 --u-mm nan)
+hostile_test(cli_hostile_estimate_ref_u_inf 2 "--ref-u-mm: must be in [0, 1000000] mm, got inf"
+             estimate --camera ${D}/thesis-camera.json --ref-u-mm inf --ref-r-px 8 --u-mm 500)
+hostile_test(cli_hostile_synth_scene_width_wraps 2 "--width: must be a whole number in [32, 20000] px, got 4294968444"
+             synth-scene --out ${H}/scene --width 4294968444)
+hostile_test(cli_hostile_synth_scene_supersample_cap 2
+             "--supersample: 1148 x 764 px at 16 x 16 sub-pixels is 224.53 M sub-pixels; the most a scene renders is 64 M"
+             synth-scene --out ${H}/scene --supersample 16)
+hostile_test(cli_hostile_synth_scene_focus_nan 2 "--focus-mm: must be a distance in (0, 1000000] mm or 'inf', got 'nan'"
+             synth-scene --out ${H}/scene --focus-mm nan)
+hostile_test(cli_hostile_synth_scene_noise_nan 2 "--noise: must be in [0, 1] linear units, got nan"
+             synth-scene --out ${H}/scene --noise nan)
+hostile_test(cli_hostile_synth_scene_seed_negative 2 "--seed: must be a whole number from 0 to 18446744073709551615, got '-3'"
+             synth-scene --out ${H}/scene --seed=-3)
+hostile_test(cli_hostile_synth_pictures_focus_inf 2 "--focus-m: must be in (0, 1000] m, got inf"
+             synth-pictures --camera ${D}/thesis-camera.json --distances-m 1 --focus-m inf --out ${H}/pictures)
+hostile_test(cli_hostile_calibrate_square_nan 2 "--square-mm: must be in [1, 1000] mm, got nan"
+             calibrate ${D}/small.png --camera ${D}/thesis-camera.json --square-mm nan)
+hostile_test(cli_hostile_animate_fps_nan 2 "--fps: must be in [1, 1000] frames per second, got nan"
+             animate --calib ${D}/thesis-camera.json --background ${D}/small.png --fps nan --video ${H}/x.avi)
+hostile_test(cli_hostile_run_sim_fps_nan 2 "--sim-fps: must be in [0.1, 1000] frames per second, got nan"
+             run ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --participant P1 --db ${H}/x.sqlite
+             --sim-fps nan)
+hostile_test(cli_hostile_run_stop_after_negative 2 "--stop-after: must be a whole number in [0, 1000000], got -5"
+             run ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --participant P1 --db ${H}/x.sqlite
+             --stop-after=-5)
+hostile_test(cli_hostile_report_boot_huge 2 "--boot: must be a whole number in [10, 100000], got '1e9'"
+             report --db ${D}/small.png --out ${H}/report --boot 1e9)
+hostile_test(cli_hostile_bench_seed_negative 2 "--seed: must be a whole number from 0 to 18446744073709551615"
+             bench measure --seed=-3)
+hostile_test(cli_hostile_preview_columns_octal_looking 2 "--columns: must be a whole number in [1, 20], got '0x10'"
+             preview ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --out ${H}/x.png --columns 0x10)
+hostile_test(cli_hostile_board_wraps 2 "--board: expected COLSxROWS in squares such as 7x10, got '4294967303x10'"
+             synth-scene --out ${H}/scene --board 4294967303x10)
+hostile_test(cli_hostile_board_too_many_squares 2 "--board 500x10: a board needs 2 to 100 squares a side"
+             synth-scene --out ${H}/scene --board 500x10)
+# A distance just beyond the focal length: a model limit (exit 5), said before it reaches an int or an allocation.
+hostile_test(cli_hostile_synth_pictures_at_focal_length 5 "would be imaged"
+             synth-pictures --camera ${D}/thesis-camera.json --distances-m 0.021001 --out ${H}/pictures)
+hostile_test(cli_hostile_render_picture_taller_than_frame 2
+             "--picture-height-px 5000 is taller than the grey half of the frame (360 px)"
+             render --object picture --background ${D}/small.png --picture-height-px 5000 --out ${H}/x.png)
+hostile_test(cli_hostile_sessions_abort_wraps 2
+             "--abort: must be a whole number in [1, 9223372036854775807], got 18446744073709551617"
+             sessions --db ${D}/small.png --abort 18446744073709551617)
+hostile_test(cli_hostile_display_frames_nan 2 "--frames: must be a whole number in [10, 100000], got 'nan'"
+             display check --frames nan)
