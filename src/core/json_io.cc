@@ -58,21 +58,6 @@ std::string Plain(const char* what) {
   return text.rfind("[json.exception.", 0) == 0 && end != std::string::npos ? text.substr(end + 2) : text;
 }
 
-// A key as a JSON pointer token (RFC 6901: '~' -> "~0", '/' -> "~1"), control characters as \uXXXX.
-std::string PointerToken(const std::string& key) {
-  std::string out;
-  for (char c : key) {
-    if (c == '~') out += "~0";
-    else if (c == '/') out += "~1";
-    else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
-      char text[8];
-      std::snprintf(text, sizeof text, "\\u%04x", static_cast<unsigned char>(c));
-      out += text;
-    } else out += c;
-  }
-  return out;
-}
-
 struct Fd {
   int fd;
   ~Fd() {
@@ -142,7 +127,7 @@ Json ParseJson(const std::string& text, const std::string& name) {
         if (!stack.empty() && stack.back().object) {
           stack.back().key = parsed.get<std::string>();
           if (!stack.back().keys.insert(stack.back().key).second) {
-            for (const Frame& f : stack) duplicate += "/" + (f.object ? PointerToken(f.key) : std::to_string(f.index));
+            for (const Frame& f : stack) duplicate += "/" + (f.object ? JsonPointerToken(f.key) : std::to_string(f.index));
           }
         }
         break;
@@ -205,5 +190,20 @@ int RequireInt(const Json& obj, const std::string& key, const std::string& where
     throw InputError(where + "/" + key, "is out of range for an integer, got " + v.dump());
   return v.get<int>();
 }
+
+std::string JsonPointerToken(const std::string& key) {
+  std::string out;
+  for (char c : key) {
+    if (c == '~') out += "~0";
+    else if (c == '/') out += "~1";
+    else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      char text[8];
+      std::snprintf(text, sizeof text, "\\u%04x", static_cast<unsigned char>(c));
+      out += text;
+    } else out += c;
+  }
+  return out;
+}
+
 
 }  // namespace blurcue

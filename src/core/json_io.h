@@ -30,4 +30,8 @@ void WriteJsonFile(const std::filesystem::path& path, const Json& json);
 double RequireNumber(const Json& obj, const std::string& key, const std::string& where);
 int RequireInt(const Json& obj, const std::string& key, const std::string& where);
 
+// A key as a JSON pointer token (RFC 6901: '~' -> "~0", '/' -> "~1"), control characters as \uXXXX so a message
+// stays one readable line.
+std::string JsonPointerToken(const std::string& key);
+
 }  // namespace blurcue

@@ -38,7 +38,7 @@ const size_t kMaxNameChars = 100;       // names: one line in titles, records an
 const size_t kMaxTextChars = 2000;      // instructions: about what a screen holds
 const size_t kMaxPathChars = 4096;
 
-std::string Escape(const std::string& key) { return EscapePointer(key); }
+std::string Escape(const std::string& key) { return JsonPointerToken(key); }
 
 // Appends `value` as compact JSON, stopping once `out` is longer than `limit`: a problem quotes what it got
 // without writing out a 16 MiB value first.
@@ -825,20 +825,6 @@ int64_t SessionTrials(const Protocol& protocol) {
     if (n > kMaxTrials) return kMaxTrials + 1;
   }
   return n;
-}
-
-std::string EscapePointer(const std::string& key) {
-  std::string out;
-  for (char c : key) {
-    if (c == '~') out += "~0";
-    else if (c == '/') out += "~1";
-    else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
-      char text[8];
-      std::snprintf(text, sizeof text, "\\u%04x", static_cast<unsigned char>(c));
-      out += text;
-    } else out += c;
-  }
-  return out;
 }
 
 Protocol LoadProtocol(const fs::path& file, const ValidateOptions& options) {

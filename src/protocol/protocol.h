@@ -117,9 +117,6 @@ int64_t DesignTrials(const Block& block);
 // Trials of a session (practice included), or kMaxTrials + 1 when it would have more.
 int64_t SessionTrials(const Protocol& protocol);
 
-// JSON pointer escaping (RFC 6901: '~' -> "~0", '/' -> "~1"); control characters are written as \uXXXX so a
-// message naming a key stays on one line.
-std::string EscapePointer(const std::string& key);
 
 // Every distinct number among the levels of the factor named `factor`, over all blocks, ascending.
 std::set<double> NumericLevels(const Protocol& protocol, const std::string& factor);

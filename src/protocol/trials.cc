@@ -141,7 +141,7 @@ std::string SidePointer(const Protocol& protocol, const Trial& trial, const std:
       const Json* level = trial.levels.is_object() && trial.levels.contains(f.name) ? &trial.levels.at(f.name) : nullptr;
       if (!level || !level->is_object() || !level->contains(designed)) continue;
       const auto at = std::find(f.levels.begin(), f.levels.end(), *level);
-      return b.factors_pointer + "/" + EscapePointer(f.name) + "/" + std::to_string(at - f.levels.begin()) + "/" +
+      return b.factors_pointer + "/" + JsonPointerToken(f.name) + "/" + std::to_string(at - f.levels.begin()) + "/" +
              designed;
     }
     if (!b.sides_pointer.empty()) return b.sides_pointer + "/" + designed;
@@ -157,9 +157,9 @@ std::string LevelPointer(const Protocol& protocol, const Trial& trial, const std
       const Json* level = trial.levels.is_object() && trial.levels.contains(f.name) ? &trial.levels.at(f.name) : nullptr;
       if (!level || (f.name != name && !(level->is_object() && level->contains(name)))) continue;
       const auto at = std::find(f.levels.begin(), f.levels.end(), *level);
-      std::string pointer = b.factors_pointer + "/" + EscapePointer(f.name) + "/" +
+      std::string pointer = b.factors_pointer + "/" + JsonPointerToken(f.name) + "/" +
                             std::to_string(at - f.levels.begin());
-      if (f.name != name) pointer += "/" + EscapePointer(name);
+      if (f.name != name) pointer += "/" + JsonPointerToken(name);
       return pointer;
     }
     return b.factors_pointer.empty() ? "/" : b.factors_pointer;

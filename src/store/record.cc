@@ -166,11 +166,7 @@ void Record::AbortSession(int64_t session) {
   if (status != "running")
     throw InputError(db_.path(), SessionName(session) + " is " + status + "; only a running session can be aborted");
   TakeLock(session);
-  Statement finish(db_, "UPDATE sessions SET status = 'aborted', ended = ?, lock_host = NULL, lock_pid = NULL, "
-                        "lock_token = NULL, lock_heartbeat_ms = NULL WHERE id = ?");
-  finish.Bind(1, NowIso8601());
-  finish.Bind(2, session);
-  finish.Run();
+  Close(session, SessionStatus::kAborted);
   transaction.Commit();
 }
 
@@ -427,13 +423,17 @@ void Record::FinishSession(int64_t session, SessionStatus status) {
     throw Error(ErrorKind::kInternal, "FinishSession: the final status must be completed or aborted");
   Transaction transaction(db_);
   RequireLock(session);
+  Close(session, status);
+  transaction.Commit();
+}
+
+void Record::Close(int64_t session, SessionStatus status) {
   Statement finish(db_, "UPDATE sessions SET status = ?, ended = ?, lock_host = NULL, lock_pid = NULL, "
                         "lock_token = NULL, lock_heartbeat_ms = NULL WHERE id = ?");
   finish.Bind(1, ToString(status));
   finish.Bind(2, NowIso8601());
   finish.Bind(3, session);
   finish.Run();
-  transaction.Commit();
 }
 
 int64_t Record::FirstUnansweredTrial(int64_t session) {

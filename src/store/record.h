@@ -138,6 +138,8 @@ class Record {
   Record(Database db, RecordOptions options);
   void TakeLock(int64_t session);
   void RequireLock(int64_t session);
+  // Stamps the final status and end and releases the lock, inside the caller's transaction.
+  void Close(int64_t session, SessionStatus status);
   int64_t TrialId(int64_t session, int64_t trial_index);
 
   Database db_;
