@@ -9,15 +9,7 @@ CASE=$1 BC=$2 DIR=$3
 P=$DIR/protocols
 W=$DIR/outputs-$CASE
 rm -rf "$W" && mkdir -p "$W"
-PY=/usr/bin/python3
-fail() { echo "FAIL: $*" >&2; exit 1; }
-sql() { $PY - "$1" "$2" <<'PYEOF'
-import sqlite3, sys
-con = sqlite3.connect(sys.argv[1])
-for row in con.execute(sys.argv[2]):
-    print("|".join("" if v is None else str(v) for v in row))
-PYEOF
-}
+source "$(dirname "$0")/lib.sh"
 # A record of participant $2 in $1, grown by $3 extra display flips so that merge and export take a moment.
 record() {
   $BC run "$P/test1-static-grids.json" --participant "$2" --db "$1" --observer sim > /dev/null 2>&1

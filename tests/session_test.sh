@@ -7,15 +7,7 @@ CASE=$1 BC=$2 DIR=$3
 P=$DIR/protocols
 W=$DIR/session-$CASE
 rm -rf "$W" && mkdir -p "$W"
-PY=/usr/bin/python3
-fail() { echo "FAIL: $*" >&2; exit 1; }
-sql() { $PY - "$1" "$2" <<'PYEOF'
-import sqlite3, sys
-con = sqlite3.connect(sys.argv[1])
-for row in con.execute(sys.argv[2]):
-    print("|".join("" if v is None else str(v) for v in row))
-PYEOF
-}
+source "$(dirname "$0")/lib.sh"
 # Everything a session decided (not when it was answered): trials, choices, response times, steps, frames.
 fingerprint() {
   sql "$1" "SELECT t.trial_index, t.block, t.factors, t.left_shown, t.right_shown, r.choice, printf('%.3f', r.rt_ms),
