@@ -442,6 +442,14 @@ RunResult RunSession(const RunOptions& options) {
   } else {
     context = render::GlContext::CreateOffscreen();
   }
+  // The record states what the window shows: a window of another size than the protocol's display (a window
+  // manager's choice, a full screen of another mode) would show every radius at another scale.
+  if (window && (context->width_px() != protocol.display.width_px || context->height_px() != protocol.display.height_px))
+    throw InputError(options.protocol_file.string() + ": /display",
+                     "the window opened at " + std::to_string(context->width_px()) + " x " +
+                         std::to_string(context->height_px()) + " px, the protocol's display says " +
+                         std::to_string(protocol.display.width_px) + " x " + std::to_string(protocol.display.height_px) +
+                         " px; set width_px/height_px to the screen's (full screen: the monitor's mode)");
   StimulusRenderer renderer(protocol, scene, prepared.images);
 
   store::Record record = store::Record::Open(options.db);
@@ -454,14 +462,6 @@ RunResult RunSession(const RunOptions& options) {
                 context->Describe().c_str(), observer ? ("; observer " + ToString(*observer)).c_str() : "");
   meta.display = display;
   meta.display_profile = display::ToJson(prepared.display).dump();
-  // The record states what the window shows: a window of another size than the protocol's display (a window
-  // manager's choice, a full screen of another mode) would show every radius at another scale.
-  if (window && (context->width_px() != protocol.display.width_px || context->height_px() != protocol.display.height_px))
-    throw InputError(options.protocol_file.string() + ": /display",
-                     "the window opened at " + std::to_string(context->width_px()) + " x " +
-                         std::to_string(context->height_px()) + " px, the protocol's display says " +
-                         std::to_string(protocol.display.width_px) + " x " + std::to_string(protocol.display.height_px) +
-                         " px; set width_px/height_px to the screen's (full screen: the monitor's mode)");
   if (!options.again && !options.resume) {
     // Running a participant through a study they finished is usually a typo in the id: say so.
     const std::vector<int64_t> done = record.CompletedSessions(protocol.name, options.participant);
