@@ -26,4 +26,16 @@ set +e; $BC display check --fullscreen --frames 10 2> "$W/err"; code=$?; set -e
 echo '{"width_px": 1280, "height_px": 1024, "distance_mm": 0}' > "$W/bad.json"
 set +e; $BC display check --profile "$W/bad.json" 2> "$W/err"; code=$?; set -e
 [ $code = 3 ] && grep -q "bad.json: /distance_mm: must be in \[100, 20000\] mm, got 0" "$W/err" || fail "bad profile: $(cat "$W/err")"
+# A session whose window cannot be the protocol's display size (full screen on this 1280 x 1024 screen, the protocol
+# says 1280 x 720) is refused before anything is recorded: the record would state another scale than the one shown.
+/usr/bin/python3 - "$2/protocols/test1-static-grids.json" "$2/protocols/test1-fullscreen.json" <<'PYEOF'
+import json, sys
+p = json.load(open(sys.argv[1]))
+p["display"]["fullscreen"] = True
+json.dump(p, open(sys.argv[2], "w"))
+PYEOF
+set +e; $BC run "$2/protocols/test1-fullscreen.json" --participant P1 --db "$W/fs.sqlite" --observer sim --window 2> "$W/err"; code=$?; set -e
+[ $code = 3 ] && grep -q "test1-fullscreen.json: /display: the window opened at 1280 x 1024 px, the protocol's display says 1280 x 720 px" "$W/err" \
+  || fail "window of another size: exit $code $(cat "$W/err")"
+[ ! -e "$W/fs.sqlite" ] || fail "the refused session created its record"
 echo "ok: display check shows the profile's geometry, refuses a wrong resolution and says Xvfb has no refresh to measure"

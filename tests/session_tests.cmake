@@ -50,7 +50,8 @@ set_tests_properties(session_run_person_without_display PROPERTIES FIXTURES_REQU
 
 # blurcue display check in a window (its own Xvfb): geometry, resolution check, honest timing without vsync.
 add_test(NAME display_check COMMAND bash ${PROJECT_SOURCE_DIR}/tests/display_test.sh ${BC} ${T})
-set_tests_properties(display_check PROPERTIES LABELS "gl;window" PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+set_tests_properties(display_check PROPERTIES LABELS "gl;window" PASS_REGULAR_EXPRESSION "^ok:|\nok:"
+                     FIXTURES_REQUIRED "scene;calib;session_protocols")
 
 # Protocols that cannot crash, hang or lie: a seeded generator mutates the shipped protocols (deletions, wrong types,
 # extremes, deep nesting, odd strings, bad paths) and runs each through `blurcue validate`, and each one accepted
