@@ -311,11 +311,16 @@ resume_guards)
   # A truncated record: exit 3 naming the file, for the runner and the readers alike.
   cp "$W/r.sqlite" "$W/cut.sqlite"
   size=$(stat -c %s "$W/cut.sqlite"); truncate -s $((size / 2)) "$W/cut.sqlite"
-  for args in "run $T1 --participant G2 --db $W/cut.sqlite --observer sim" "sessions --db $W/cut.sqlite" \
-              "export --db $W/cut.sqlite --out $W/cut-tables"; do
-    set +e; $BC $args 2> "$W/err"; code=$?; set -e
-    [ $code = 3 ] && grep -q "cut.sqlite: the record is damaged" "$W/err" && [ "$(wc -l < "$W/err")" = 1 ] \
-      || fail "truncated record, $args: exit $code $(cat "$W/err")"
+  # A garbled one: 4 KiB of noise in the middle of the file.
+  cp "$W/r.sqlite" "$W/noise.sqlite"
+  $PY -c "import os; f = open('$W/noise.sqlite', 'r+b'); f.seek(os.path.getsize('$W/noise.sqlite') // 2); f.write(os.urandom(4096))"
+  for db in cut noise; do
+    for args in "run $T1 --participant G2 --db $W/$db.sqlite --observer sim" "sessions --db $W/$db.sqlite" \
+                "export --db $W/$db.sqlite --out $W/$db-tables"; do
+      set +e; $BC $args 2> "$W/err"; code=$?; set -e
+      [ $code = 3 ] && grep -q "$db.sqlite: the record is damaged" "$W/err" && [ "$(wc -l < "$W/err")" = 1 ] \
+        || fail "damaged record ($db), $args: exit $code $(cat "$W/err")"
+    done
   done
   # Two stations starting on one new file at the same moment: both proceed, every time.
   for round in 1 2 3 4 5 6; do

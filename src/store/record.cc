@@ -96,10 +96,7 @@ Record Record::Open(const std::filesystem::path& path, RecordOptions options) {
   Database db(path);
   // Another program's database is refused before anything is written to it (no tables, no WAL switch).
   RequireRecordOrEmpty(db);
-  if (SchemaVersion(db) > 0) {
-    const std::string check = db.QueryText("PRAGMA quick_check(1)");
-    if (check != "ok") throw InputError(path.string(), "the record is damaged (SQLite's quick_check: " + check + ")");
-  }
+  if (SchemaVersion(db) > 0) RequireIntactPages(db);
   db.UseWal(options.durable);
   Migrate(db);
   return Record(std::move(db), options);

@@ -201,8 +201,14 @@ void RequireReadableRecord(Database& db) {
                                     "); update blurcue");
   // Older versions lack only columns added since (readers take them where present), so a read-only archive of any
   // version up to this one reads.
-  const std::string check = db.QueryText("PRAGMA quick_check(1)");
-  if (check != "ok") throw InputError(db.path(), "the record is damaged (SQLite's quick_check: " + check + ")");
+  RequireIntactPages(db);
+}
+
+void RequireIntactPages(Database& db) {
+  std::string check = db.QueryText("PRAGMA quick_check(1)");
+  if (check == "ok") return;
+  for (size_t at = check.find('\n'); at != std::string::npos; at = check.find('\n', at)) check.replace(at, 1, "; ");
+  throw InputError(db.path(), "the record is damaged (SQLite's quick_check: " + check + ")");
 }
 
 std::string CanonicalProtocolText(const std::string& json) {

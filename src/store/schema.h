@@ -29,6 +29,9 @@ void RequireRecordOrEmpty(Database& db);
 // whose pages pass SQLite's quick_check (a truncated or overwritten file is refused, naming it, not half read).
 void RequireReadableRecord(Database& db);
 
+// SQLite's quick_check of every page, refused as one line naming the file (a truncated or overwritten record).
+void RequireIntactPages(Database& db);
+
 // The schema version a fully migrated database reports (= Migrations().size()).
 int CurrentSchemaVersion();
 
