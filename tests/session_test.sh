@@ -392,5 +392,44 @@ readonly)
   [ $code = 3 ] && [ "$(wc -l < "$W/err")" = 1 ] && grep -q "study.sqlite: " "$W/err" || fail "writer on a read-only record: exit $code $(cat "$W/err")"
   chmod 755 "$W/arch"; chmod 644 "$W/arch/study.sqlite"
   echo "ok: a read-only archived record lists, exports and reports; a writer is refused in one line" ;;
+frames_shown)
+  # Each frame of a moving pair records what it showed: the balls' place (advancing at the pattern's speed) and
+  # each side's radius there; the trial's recorded radius is the mean over the run (thesis Table 5.1 patterns).
+  $BC run "$P/test2-moving-balls.json" --participant F1 --db "$W/f.sqlite" --observer sim --seed 3 --stop-after 4 > /dev/null 2>&1
+  $BC export --db "$W/f.sqlite" --out "$W/tables" > /dev/null
+  $PY - "$W/tables/trials.csv" "$W/tables/frames.csv" <<'PYEOF' || fail "per-frame radii"
+import csv, json, sys
+trials = {int(r["trial_index"]): r for r in csv.DictReader(open(sys.argv[1])) if r["choice"]}
+frames = {}
+for f in csv.DictReader(open(sys.argv[2])):
+    frames.setdefault(int(f["trial_index"]), []).append(f)
+checked = 0
+for i, t in trials.items():
+    pattern = json.loads(t["pattern"]) if t.get("pattern", "").startswith("{") else None
+    shown = [f for f in frames[i] if f["y_mm"]]
+    assert shown, f"trial {i}: no frame records what it showed"
+    ys = [float(f["y_mm"]) for f in shown]
+    ts = [float(f["flip_time_s"]) for f in shown]
+    speed = float(pattern["speed_cm_s"]) * 10 if pattern else None
+    if speed and len(shown) > 2:
+        for k in range(1, len(shown)):
+            v = (ys[k] - ys[k - 1]) / (ts[k] - ts[k - 1])
+            if ys[k] < max(ys) - 1e-9:  # still rolling (a whole run rests at the far edge on arrival)
+                assert abs(v - speed) < 1e-6 * speed + 1e-6, (i, k, v, speed)
+            else:
+                assert -1e-9 <= v <= speed + 1e-6, (i, k, v, speed)
+        assert ys[-1] > ys[0], (i, ys)
+    for side in ("left", "right"):
+        rs = [float(f[f"r_{side}_px"]) for f in shown if f[f"r_{side}_px"]]
+        assert rs, (i, side)
+        if t["section"] in ("", None) and pattern:  # a whole run: the trial's mean over the run (frames evenly spaced)
+            rolling = [float(f[f"r_{side}_px"]) for f, y in zip(shown, ys) if y < max(ys) - 1e-9]
+            mean = sum(rolling) / len(rolling)
+            assert abs(mean - float(t[f"r_{side}_px"])) <= 0.05 * max(1.0, float(t[f"r_{side}_px"])), (i, side, mean, t[f"r_{side}_px"])
+    checked += 1
+assert checked == len(trials) >= 4, checked
+print(f"{checked} trials: every frame records its radii and place")
+PYEOF
+  echo "ok: moving balls record each frame's radius and place" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -141,6 +141,34 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   return t;
 }
 
+std::array<std::optional<render::BlurredObject>, 2> ObjectsAt(const protocol::Protocol& protocol,
+                                                              const calib::SceneCalib& s, const TrialScene& trial,
+                                                              double t_s) {
+  std::array<std::optional<render::BlurredObject>, 2> shown;
+  for (const bool left : {true, false}) {
+    render::BlurredObject b;
+    render::VirtualObject& o = b.object;
+    const calib::BlurSource source = left ? trial.left : trial.right;
+    const double fixed = left ? trial.left_fixed_px : trial.right_fixed_px;
+    if (trial.content == "grid") {
+      o.kind = render::VirtualObject::Kind::kCard;
+      o.size_mm = 2 * s.board.square_mm;
+      o.center_board_mm = GridCentre(s, trial.edge, left);
+    } else {
+      const double y = trial.BallYMm(t_s);
+      if (!std::isfinite(y)) continue;  // wiped at the end of a section
+      const double radius = protocol.content.radius_mm;  // validated > 0
+      o.kind = render::VirtualObject::Kind::kBall;
+      o.size_mm = radius;
+      o.center_board_mm = BallCentre(s, y, radius, left);
+      o.spin_deg = -(y - trial.from_y_mm) / radius * 180 / M_PI;  // rolling without slipping
+    }
+    b.r_px = calib::BlurAtPx(s, source, s.ToCamera(o.center_board_mm), fixed);
+    shown[left ? 0 : 1] = std::move(b);
+  }
+  return shown;
+}
+
 Presentation Presentation::Of(const protocol::Protocol& protocol, const StimulusImages& images,
                               const display::Profile& profile) {
   Presentation p;
@@ -328,28 +356,10 @@ void StimulusRenderer::Compose(const TrialScene& trial, double t_s, double level
     return;
   }
   std::vector<render::BlurredObject> objects;
-  const calib::SceneCalib& s = *scene_;
-  for (const bool left : {true, false}) {
-    render::BlurredObject b;
-    render::VirtualObject& o = b.object;
-    o.texture = texture_;
-    const calib::BlurSource source = left ? trial.left : trial.right;
-    const double fixed = left ? trial.left_fixed_px : trial.right_fixed_px;
-    if (trial.content == "grid") {
-      o.kind = render::VirtualObject::Kind::kCard;
-      o.size_mm = 2 * s.board.square_mm;
-      o.center_board_mm = GridCentre(s, trial.edge, left);
-    } else {
-      const double y = trial.BallYMm(t_s);
-      if (!std::isfinite(y)) continue;  // wiped at the end of a section
-      const double radius = protocol_.content.radius_mm;  // validated > 0
-      o.kind = render::VirtualObject::Kind::kBall;
-      o.size_mm = radius;
-      o.center_board_mm = BallCentre(s, y, radius, left);
-      o.spin_deg = -(y - trial.from_y_mm) / radius * 180 / M_PI;  // rolling without slipping
-    }
-    b.r_px = calib::BlurAtPx(s, source, s.ToCamera(o.center_board_mm), fixed);
-    objects.push_back(std::move(b));
+  for (auto& shown : ObjectsAt(protocol_, *scene_, trial, t_s)) {
+    if (!shown) continue;
+    shown->object.texture = texture_;
+    objects.push_back(std::move(*shown));
   }
   compositor_->Compose(objects);
 }

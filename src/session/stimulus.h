@@ -8,6 +8,7 @@
 //   picture - the depth-matching frame (thesis 3.2): the picture low-passed at the adjusted cut-off on grey above,
 //             below the photo of the real picture at the trial's distance (content.real_photos), or the scene
 //             photo when the protocol names no real photos.
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -20,10 +21,7 @@
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
 
-namespace blurcue::render {
-class FrameCompositor;
-class WindowImage;
-}
+#include "render/frame_compositor.h"
 
 namespace blurcue::session {
 
@@ -50,6 +48,13 @@ struct TrialScene {
 // trial when a level needed is missing or a source cannot be evaluated (e.g. eq. 3.7 nearer than focus).
 TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Trial& trial,
                          const calib::SceneCalib* scene);
+
+// What a pair trial (grid or ball) shows t_s after onset: each side's object where it is at that moment and the blur
+// radius (photo px) it gets there; [0] left, [1] right, empty for a ball wiped at the end of its section. No GL:
+// StimulusRenderer::Compose draws exactly these, and the runner records each frame's radii from them.
+std::array<std::optional<render::BlurredObject>, 2> ObjectsAt(const protocol::Protocol& protocol,
+                                                              const calib::SceneCalib& scene, const TrialScene& trial,
+                                                              double t_s);
 
 struct Presentation;
 

@@ -144,20 +144,25 @@ void WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
 
 // OUT/frames.csv: every recorded display flip, one row each: study, participant, session, window (1: a real window
 // on the real clock, 0: headless on a simulated clock), trial_index, frame_index, flip_time_s (from the trial's
-// first flip), dropped (0/1).
+// first flip), dropped (0/1), and what the frame showed of a pair: r_left_px, r_right_px (photo px) and y_mm (the
+// objects' place along the board; empty where nothing was shown, for pictures, and in records before schema 4).
 void WriteFrames(Database& db, const std::filesystem::path& out_dir) {
   std::string text = CsvLine({"study", "participant", "session", "window", "trial_index", "frame_index",
-                              "flip_time_s", "dropped"});
+                              "flip_time_s", "dropped", "r_left_px", "r_right_px", "y_mm"});
+  const bool shown = SchemaVersion(db) >= 4;
   Statement rows(db,
                  "SELECT st.name, p.code, s.id, t.trial_index, f.frame_index, f.flip_time_s, f.dropped, "
-                 "s.display LIKE 'window%' "
-                 "FROM frames f JOIN trials t ON t.id = f.trial_id JOIN sessions s ON s.id = t.session_id "
-                 "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
-                 "ORDER BY st.name, p.code, s.id, t.trial_index, f.frame_index");
+                 "s.display LIKE 'window%', " +
+                     std::string(shown ? "f.r_left_px, f.r_right_px, f.y_mm " : "NULL, NULL, NULL ") +
+                     "FROM frames f JOIN trials t ON t.id = f.trial_id JOIN sessions s ON s.id = t.session_id "
+                     "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
+                     "ORDER BY st.name, p.code, s.id, t.trial_index, f.frame_index");
+  auto optional = [&](int column) { return rows.IsNull(column) ? std::string() : Number(rows.GetDouble(column)); };
   while (rows.Step())
     text += CsvLine({rows.GetText(0), rows.GetText(1), std::to_string(rows.GetInt64(2)),
                      std::to_string(rows.GetInt64(7)), std::to_string(rows.GetInt64(3)),
-                     std::to_string(rows.GetInt64(4)), Number(rows.GetDouble(5)), std::to_string(rows.GetInt64(6))});
+                     std::to_string(rows.GetInt64(4)), Number(rows.GetDouble(5)), std::to_string(rows.GetInt64(6)),
+                     optional(8), optional(9), optional(10)});
   WriteFileAtomically(out_dir / "frames.csv", text);
 }
 
@@ -390,14 +395,20 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
           insert_response.Reset();
         }
 
-        Statement frames(src, "SELECT trial_id, frame_index, flip_time_s, dropped FROM frames");
-        Statement insert_frame(dst, "INSERT INTO frames (trial_id, frame_index, flip_time_s, dropped) "
-                                    "VALUES (?, ?, ?, ?)");
+        Statement frames(src, "SELECT trial_id, frame_index, flip_time_s, dropped, " +
+                                  std::string(SchemaVersion(src) >= 4 ? "r_left_px, r_right_px, y_mm"
+                                                                      : "NULL, NULL, NULL") + " FROM frames");
+        Statement insert_frame(dst, "INSERT INTO frames (trial_id, frame_index, flip_time_s, dropped, r_left_px, "
+                                    "r_right_px, y_mm) VALUES (?, ?, ?, ?, ?, ?, ?)");
         while (frames.Step()) {
           insert_frame.Bind(1, trial_ids.at(frames.GetInt64(0)));
           insert_frame.Bind(2, frames.GetInt64(1));
           insert_frame.Bind(3, frames.GetDouble(2));
           insert_frame.Bind(4, frames.GetInt64(3));
+          for (int column = 4; column <= 6; ++column) {
+            if (frames.IsNull(column)) insert_frame.BindNull(column + 1);
+            else insert_frame.Bind(column + 1, frames.GetDouble(column));
+          }
           insert_frame.Run();
           insert_frame.Reset();
         }

@@ -3,6 +3,7 @@
 // trial, and one writer per running session (a lock row naming host, pid and a per-Record token).
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,9 @@ struct FrameRecord {
   int64_t frame_index = 0;
   double flip_time_s = 0;
   bool dropped = false;
+  // What the frame showed of a pair: each side's blur radius (photo px) and the objects' place along the board's y
+  // (mm); empty for a side not shown (a ball wiped at the end of its section) and for pictures.
+  std::optional<double> r_left_px, r_right_px, y_mm;
 };
 
 enum class SessionStatus { kRunning, kCompleted, kAborted };

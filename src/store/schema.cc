@@ -121,6 +121,11 @@ std::vector<Migration> MakeMigrations() {
   steps.push_back({"", &CanonicalProtocolHashes});
   // 3: the display profile each session ran with (display/profile.h ToJson); '{}' for sessions from before.
   steps.push_back({"ALTER TABLE sessions ADD COLUMN display_profile TEXT NOT NULL DEFAULT '{}';"});
+  // 4: what each frame showed of a pair (moving balls change radius from frame to frame): each side's radius in
+  // photo px and the objects' place along the board's y in mm; NULL where nothing was shown and before version 4.
+  steps.push_back({"ALTER TABLE frames ADD COLUMN r_left_px REAL;"
+                   "ALTER TABLE frames ADD COLUMN r_right_px REAL;"
+                   "ALTER TABLE frames ADD COLUMN y_mm REAL;"});
   return steps;
 }
 
