@@ -353,11 +353,19 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
   const auto type = String(v, "type", ptr, true, {"grid", "ball", "picture"});
   if (!type) return;
   p->content.type = *type;
+  if (*type == "grid" || *type == "ball") {
+    if (auto k = String(v, "kernel", ptr, false, {"gaussian", "disc"})) p->content.kernel = *k;
+    // The thesis matched the virtual object to the scene by eye; a factor of 4 either way is far beyond that.
+    if (auto x = Number(v, "brightness", ptr, false, 0.25, 4, "(a factor)")) p->content.brightness = *x;
+    if (auto x = Number(v, "contrast", ptr, false, 0.25, 4, "(a factor)")) p->content.contrast = *x;
+  }
   if (*type == "grid") {
-    Object(v, ptr, {"type", "cells"});
-    if (auto n = Int(v, "cells", ptr, false, 1, 100, "cells per side")) p->content.cells = *n;
+    Object(v, ptr, {"type", "cells", "kernel", "brightness", "contrast"});
+    // Only the shipped 5 x 5 card is drawn: another count would be recorded but not shown.
+    if (auto n = Int(v, "cells", ptr, false, 5, 5, "cells per side (only the shipped 5 x 5 card is drawn)"))
+      p->content.cells = *n;
   } else if (*type == "ball") {
-    Object(v, ptr, {"type", "texture", "radius_mm"});
+    Object(v, ptr, {"type", "texture", "radius_mm", "kernel", "brightness", "contrast"});
     // A ball rolls on the board's 25 mm squares: from a marble to a football.
     if (auto r = Number(v, "radius_mm", ptr, false, 1, 150, "mm")) p->content.radius_mm = *r;
     if (auto t = Text(v, "texture", ptr, false, kMaxPathChars, true)) {

@@ -61,7 +61,11 @@ struct Scene {
 
 struct Content {
   std::string type;                   // "grid" | "ball" | "picture"
-  int cells = 5;                      // grid: cells per side
+  int cells = 5;                      // grid: cells per side (only the shipped 5 x 5 card is drawn)
+  // grid and ball: the blur kernel and the thesis's brightness/contrast matching of the virtual object (5.3.1.3),
+  // applied in linear light (factors of the texture's values; 1 = as the texture is).
+  std::string kernel = "gaussian";    // "gaussian" | "disc"
+  double brightness = 1, contrast = 1;
   double radius_mm = 10;              // ball
   std::string texture = "soccer";     // ball: soccer | wood | an image path (resolved)
   std::filesystem::path image;        // picture: the image (resolved)

@@ -57,6 +57,29 @@ TEST(ProtocolValidate, ValidProtocolHasNoProblems) {
   EXPECT_TRUE(problems.empty()) << problems.front();
 }
 
+// The kernel and the brightness/contrast matching are protocol fields with ranges; a grid count other than the
+// shipped card's would be recorded but not drawn, so it is refused.
+TEST(ProtocolValidate, KernelBrightnessContrastAndCellsAreCheckedNotIgnored) {
+  Json j = Valid();
+  j["content"]["kernel"] = "disc";
+  j["content"]["brightness"] = 1.2;
+  j["content"]["contrast"] = 0.9;
+  EXPECT_TRUE(Problems(j).empty());
+  const Protocol p = ParseProtocol(j, SceneFolder() / "p.json");
+  EXPECT_EQ(p.content.kernel, "disc");
+  EXPECT_DOUBLE_EQ(p.content.brightness, 1.2);
+  j["content"]["kernel"] = "box";
+  EXPECT_TRUE(Contains(OnlyProblem(j), "/content/kernel")) << OnlyProblem(j);
+  j["content"]["kernel"] = "gaussian";
+  j["content"]["contrast"] = 10;
+  EXPECT_TRUE(Contains(OnlyProblem(j), "/content/contrast")) << OnlyProblem(j);
+  Json grid = Valid();
+  grid["content"] = {{"type", "grid"}, {"cells", 7}};
+  bool named = false;
+  for (const auto& problem : Problems(grid)) named = named || Contains(problem, "/content/cells");
+  EXPECT_TRUE(named);
+}
+
 TEST(ProtocolValidate, ProblemStartsWithFileAndPointer) {
   Json j = Valid();
   j["version"] = 0;

@@ -73,6 +73,9 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
                          const calib::SceneCalib* scene) {
   TrialScene t;
   t.content = protocol.content.type;
+  t.kernel = protocol.content.kernel;
+  t.brightness = protocol.content.brightness;
+  t.contrast = protocol.content.contrast;
   // Problems name the protocol field that asked for what cannot be shown, and the trial as a detail.
   const std::string trial_text = " (trial " + std::to_string(trial.index) + ", block " + trial.block + ")";
   if (t.content == "picture") {
@@ -163,6 +166,9 @@ std::array<std::optional<render::BlurredObject>, 2> ObjectsAt(const protocol::Pr
       o.center_board_mm = BallCentre(s, y, radius, left);
       o.spin_deg = -(y - trial.from_y_mm) / radius * 180 / M_PI;  // rolling without slipping
     }
+    o.brightness = trial.brightness;
+    o.contrast = trial.contrast;
+    b.method = trial.kernel;
     b.r_px = calib::BlurAtPx(s, source, s.ToCamera(o.center_board_mm), fixed);
     shown[left ? 0 : 1] = std::move(b);
   }
@@ -208,6 +214,9 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
       v[std::string("r_") + name + "_arcmin"] = round4(presentation.Arcmin(r));
     }
     v["screen_px_per_photo_px"] = std::round(presentation.scale * 1e6) / 1e6;
+    v["kernel"] = scene.kernel;
+    v["brightness"] = scene.brightness;
+    v["contrast"] = scene.contrast;
   }
   return v;
 }

@@ -35,6 +35,8 @@ struct TrialScene {
   double speed_mm_s = 0;              // ball: 0 = at rest at from_y_mm
   bool wipe_at_end = false;           // ball: disappear on arrival (a section run)
   double distance_m = 0;              // picture: the real picture's distance
+  std::string kernel = "gaussian";    // pairs: the blur kernel, and the object's brightness/contrast matching
+  double brightness = 1, contrast = 1;
   // The radii rendered, averaged over the run for balls, and the scene's own blur (the fitted model) there.
   double r_left_px = 0, r_right_px = 0, r_scene_px = 0;
 

@@ -89,6 +89,32 @@ TEST(DescribeTrial, WholeRunRestsAtTheFarEdgeAndAveragesTheGrowingBlur) {
   EXPECT_LT(t.r_left_px, std::max(r0, r1));
 }
 
+// What Compose draws comes from ObjectsAt: the protocol's kernel and brightness/contrast reach every object, and the
+// radius is the side's own source at the object's place.
+TEST(ObjectsAt, CarryTheProtocolsKernelAndMatchingAndEachSidesRadius) {
+  const calib::SceneCalib scene = ThesisScene();
+  protocol::Protocol p = BallProtocol();
+  p.content.kernel = "disc";
+  p.content.brightness = 1.3;
+  p.content.contrast = 0.8;
+  const Json pattern = {{"id", 2}, {"speed_cm_s", 1.8}, {"left", "measured"}, {"right", "none"}};
+  const TrialScene t = DescribeTrial(p, PairTrial({{"pattern", pattern}, {"section", 3}}, 1.5, "fitted"), &scene);
+  const auto shown = ObjectsAt(p, scene, t, 0.5);
+  ASSERT_TRUE(shown[0] && shown[1]);
+  for (const auto& o : shown) {
+    EXPECT_EQ(o->method, "disc");
+    EXPECT_DOUBLE_EQ(o->object.brightness, 1.3);
+    EXPECT_DOUBLE_EQ(o->object.contrast, 0.8);
+    EXPECT_NEAR(o->object.center_board_mm[1], t.BallYMm(0.5), 1e-9);
+  }
+  EXPECT_DOUBLE_EQ(shown[0]->r_px, 1.5);
+  EXPECT_DOUBLE_EQ(shown[1]->r_px,
+                   calib::BlurAtPx(scene, calib::BlurSource::kFitted, scene.ToCamera(shown[1]->object.center_board_mm)));
+  // Wiped at the end of the section: nothing is shown.
+  const auto gone = ObjectsAt(p, scene, t, t.MotionS() + 0.01);
+  EXPECT_FALSE(gone[0] || gone[1]);
+}
+
 TEST(DescribeTrial, GridCardsSitBesideTheBoardAtTheirEdge) {
   const calib::SceneCalib scene = ThesisScene();
   protocol::Protocol p = BallProtocol();
