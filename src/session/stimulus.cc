@@ -116,9 +116,20 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
                           r_at(r, calib::BlurSource::kFitted, 0, nullptr));
     return t;
   }
-  // Balls: a section run (edge s to s + 1, wiped on arrival), explicit edges, or the whole board.
+  // Balls: a section run (edge s to s + 1, wiped on arrival), explicit edges, the whole board, or at rest at an
+  // edge. A ball without a speed rests where it starts, and its radii are those of that place, not of a run.
   int from = 1, to = scene->board.EdgeCount();
-  if (const Json* section = FindLevel(trial.levels, "section"); section && section->is_number_integer()) {
+  const Json* speed = FindLevel(trial.levels, "speed_cm_s");
+  t.speed_mm_s = speed && speed->is_number() ? 10 * speed->get<double>() : 0;
+  const Json* edge = FindLevel(trial.levels, "edge");
+  if (edge && edge->is_number_integer()) {
+    if (t.speed_mm_s > 0 || FindLevel(trial.levels, "section") || FindLevel(trial.levels, "from_edge") ||
+        FindLevel(trial.levels, "to_edge"))
+      throw InputError(At(protocol, protocol::LevelPointer(protocol, trial, "edge")),
+                       "a ball at an edge rests there: it takes no speed_cm_s, section, from_edge or to_edge" +
+                           trial_text);
+    from = to = edge->get<int>();
+  } else if (const Json* section = FindLevel(trial.levels, "section"); section && section->is_number_integer()) {
     from = section->get<int>();
     to = from + 1;
     t.wipe_at_end = true;
@@ -126,10 +137,9 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
     if (const Json* f = FindLevel(trial.levels, "from_edge"); f && f->is_number_integer()) from = f->get<int>();
     if (const Json* e = FindLevel(trial.levels, "to_edge"); e && e->is_number_integer()) to = e->get<int>();
   }
+  if (t.speed_mm_s <= 0) to = from;
   t.from_y_mm = (from - 1) * s;
   t.to_y_mm = (to - 1) * s;
-  const Json* speed = FindLevel(trial.levels, "speed_cm_s");
-  t.speed_mm_s = speed && speed->is_number() ? 10 * speed->get<double>() : 0;
   // Radii averaged over the run (what the observer sees on the whole), sampled evenly along it.
   const int samples = 21;
   const double radius = protocol.content.radius_mm;

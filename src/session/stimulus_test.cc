@@ -115,6 +115,27 @@ TEST(ObjectsAt, CarryTheProtocolsKernelAndMatchingAndEachSidesRadius) {
   EXPECT_FALSE(gone[0] || gone[1]);
 }
 
+// A ball at an edge rests there, and the record holds the blur of that place (it used to rest at edge 1 while the
+// record held the mean of a run from edge 1 to 11).
+TEST(DescribeTrial, BallAtAnEdgeRestsThereWithThatPlacesBlur) {
+  const calib::SceneCalib scene = ThesisScene();
+  const TrialScene t = DescribeTrial(BallProtocol(), PairTrial({{"edge", 9}}, "fitted", "none"), &scene);
+  EXPECT_DOUBLE_EQ(t.from_y_mm, 200);  // edge 9 of 25 mm squares
+  EXPECT_DOUBLE_EQ(t.to_y_mm, 200);
+  EXPECT_DOUBLE_EQ(t.MotionS(), 0);
+  const auto shown = ObjectsAt(BallProtocol(), scene, t, 3.0);
+  ASSERT_TRUE(shown[0]);
+  EXPECT_DOUBLE_EQ(shown[0]->object.center_board_mm[1], 200);
+  EXPECT_NEAR(t.r_left_px, shown[0]->r_px, 1e-9);  // the record is what the frame shows
+  // Without a speed a ball rests where it starts, and is recorded there too.
+  const TrialScene still = DescribeTrial(BallProtocol(), PairTrial(Json::object(), "fitted", "none"), &scene);
+  const auto at_rest = ObjectsAt(BallProtocol(), scene, still, 0);
+  EXPECT_NEAR(still.r_left_px, at_rest[0]->r_px, 1e-9);
+  // An edge with a speed is a contradiction, named at the field.
+  EXPECT_THROW(DescribeTrial(BallProtocol(), PairTrial({{"edge", 9}, {"speed_cm_s", 3}}, "fitted", "none"), &scene),
+               Error);
+}
+
 TEST(DescribeTrial, GridCardsSitBesideTheBoardAtTheirEdge) {
   const calib::SceneCalib scene = ThesisScene();
   protocol::Protocol p = BallProtocol();
