@@ -6,17 +6,10 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/stats.h"
 #include "store/record.h"
 
 namespace blurcue::bench {
-namespace {
-
-double Percentile(std::vector<double> values, double q) {
-  std::sort(values.begin(), values.end());
-  return values[std::min(values.size() - 1, static_cast<size_t>(q * static_cast<double>(values.size())))];
-}
-
-}  // namespace
 
 RecordBenchResult RunRecordBench(const RecordBenchOptions& options) {
   if (options.trials < 1 || options.frames_per_trial < 0)
@@ -47,7 +40,15 @@ RecordBenchResult RunRecordBench(const RecordBenchOptions& options) {
     arm.record->SaveTrialList(arm.session, trials);
   }
   std::vector<store::FrameRecord> frames(static_cast<size_t>(options.frames_per_trial));
-  for (int f = 0; f < options.frames_per_trial; ++f) frames[size_t(f)] = {f, f / 60.0, false};
+  // As a moving pair records them: each flip with both sides' radii and the balls' place.
+  for (int f = 0; f < options.frames_per_trial; ++f) {
+    store::FrameRecord& frame = frames[size_t(f)];
+    frame.frame_index = f;
+    frame.flip_time_s = f / 60.0;
+    frame.r_left_px = 1.5 + 0.01 * f;
+    frame.r_right_px = 2.5 + 0.01 * f;
+    frame.y_mm = 0.5 * f;
+  }
   // Interleaved, so both arms meet the same moments of a shared, noisy machine.
   for (int i = 0; i < options.trials; ++i) {
     for (Arm& arm : arms) {

@@ -11,6 +11,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/stats.h"
 #include "core/image.h"
 #include "optics/thin_lens.h"
 #include "render/blur.h"
@@ -25,11 +26,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double Ms(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
-
-double Percentile(std::vector<double> v, double p) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0 : v[std::min(v.size() - 1, size_t(p * (v.size() - 1) + 0.5))];
-}
 
 // A frame-sized test image: a few bright shapes on a dark field, linear premultiplied, opaque.
 cv::Mat TestFrame(int w, int h) {

@@ -11,6 +11,7 @@
 
 #include "cli/commands.h"
 #include "core/error.h"
+#include "core/stats.h"
 #include "core/image.h"
 #include "display/profile.h"
 #include "render/frame_compositor.h"
@@ -56,11 +57,6 @@ cv::Mat TestScreen(const display::Profile& profile, int width, int height) {
   text("relative luminance 0 .. 1 in 8 steps through the " + display::ToString(profile.transfer.kind) +
            " transfer; a photometer should read a straight line", height - 25, 0.6);
   return image;
-}
-
-double Percentile(std::vector<double> v, double q) {
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())))];
 }
 
 }  // namespace
