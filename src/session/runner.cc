@@ -154,10 +154,10 @@ enum class Outcome { kAnswered, kQuit };
 
 class Runner {
  public:
-  Runner(const RunOptions& options, const protocol::Protocol& protocol, const std::optional<calib::SceneCalib>& calib,
-         render::GlContext& context, StimulusRenderer& renderer, const std::vector<protocol::Trial>& trials,
+  Runner(const RunOptions& options, const protocol::Protocol& protocol, render::GlContext& context,
+         StimulusRenderer& renderer, const std::vector<protocol::Trial>& trials,
          const std::vector<TrialScene>& scenes, std::optional<ObserverParams> observer, uint64_t seed)
-      : options_(options), protocol_(protocol), calib_(calib), context_(context), renderer_(renderer), trials_(trials),
+      : options_(options), protocol_(protocol), context_(context), renderer_(renderer), trials_(trials),
         scenes_(scenes), observer_(observer), seed_(seed), keys_{protocol.responses},
         station_(context, !observer || options.window, options.sim_fps),
         screen_size_(protocol.display.width_px, protocol.display.height_px) {}
@@ -266,9 +266,9 @@ class Runner {
       }
       const bool dropped = station_.window() && last_flip >= 0 && flip - last_flip > 1.5 * station_.frame_s();
       store::FrameRecord shown_frame{frame, flip - onset, dropped, {}, {}, {}};
-      if (shown && calib_ && scene.content != "picture") {
-        // What this frame showed, worked out as Compose drew it: the radius of each side where it stood.
-        const auto objects = ObjectsAt(protocol_, *calib_, scene, t);
+      if (shown) {
+        // What this frame showed, as Compose drew it (a still stimulus is composed once and shown unchanged).
+        const auto& objects = renderer_.Shown();
         if (objects[0]) shown_frame.r_left_px = objects[0]->r_px;
         if (objects[1]) shown_frame.r_right_px = objects[1]->r_px;
         for (const auto& o : objects)
@@ -392,7 +392,6 @@ class Runner {
 
   const RunOptions& options_;
   const protocol::Protocol& protocol_;
-  const std::optional<calib::SceneCalib>& calib_;
   render::GlContext& context_;
   StimulusRenderer& renderer_;
   const std::vector<protocol::Trial>& trials_;
@@ -487,7 +486,7 @@ RunResult RunSession(const RunOptions& options) {
     record.SaveTrialList(start.session_id, records);
   else
     record.CheckTrialList(start.session_id, records);
-  Runner runner(options, protocol, scene, *context, renderer, trials, scenes, observer, seed);
+  Runner runner(options, protocol, *context, renderer, trials, scenes, observer, seed);
   return runner.Run(record, start);
 }
 

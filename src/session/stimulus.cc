@@ -374,11 +374,12 @@ void StimulusRenderer::Compose(const TrialScene& trial, double t_s, double level
     picture_shown_.reset();
     return;
   }
+  shown_ = ObjectsAt(protocol_, *scene_, trial, t_s);
   std::vector<render::BlurredObject> objects;
-  for (auto& shown : ObjectsAt(protocol_, *scene_, trial, t_s)) {
+  for (const auto& shown : shown_) {
     if (!shown) continue;
-    shown->object.texture = texture_;
-    objects.push_back(std::move(*shown));
+    objects.push_back(*shown);
+    objects.back().object.texture = texture_;
   }
   compositor_->Compose(objects);
 }

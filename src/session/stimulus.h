@@ -115,6 +115,8 @@ class StimulusRenderer {
   cv::Size FrameSize() const;
   // Composes the frame t_s after onset; `level` is the adjustment level shown (picture only).
   void Compose(const TrialScene& trial, double t_s, double level);
+  // What the last composed frame showed of a pair (ObjectsAt, as drawn): empty sides for pictures and wiped balls.
+  const std::array<std::optional<render::BlurredObject>, 2>& Shown() const { return shown_; }
   // Shows the last composed frame in the current window, fitted to width x height.
   void Present(int width_px, int height_px);
   // The last composed frame, 8-bit sRGB BGR.
@@ -135,6 +137,7 @@ class StimulusRenderer {
   double real_photo_distance_m_ = -1;  // the real photo loaded (one at a time: 27 would hold ~50 MB)
   cv::Mat real_photo_;
   int picture_width_px_ = 960;
+  std::array<std::optional<render::BlurredObject>, 2> shown_;
 };
 
 }  // namespace blurcue::session
