@@ -4,13 +4,8 @@ set -euo pipefail
 BC=$1 W=$2/display-check
 DATA=$(cd "$(dirname "$0")/data" && pwd)
 rm -rf "$W" && mkdir -p "$W"
-fail() { echo "FAIL: $*" >&2; exit 1; }
-Xvfb -displayfd 3 -screen 0 1280x1024x24 -nolisten tcp 3> "$W/display" > "$W/xvfb.log" 2>&1 &
-xvfb=$!
-trap 'kill $xvfb 2>/dev/null || true' EXIT
-for _ in $(seq 1 400); do [ -s "$W/display" ] && break; sleep 0.05; done
-[ -s "$W/display" ] || fail "Xvfb did not start in 20 s: $(cat "$W/xvfb.log")"
-export DISPLAY=":$(head -1 "$W/display")"
+source "$(dirname "$0")/lib.sh"
+start_xvfb
 # The lab's 1280 x 1024 monitor (376 mm wide at 570 mm): 2 * 570 * tan(0.5 deg) / (376 / 1280) = 33.87 px/deg.
 $BC display check --profile "$DATA/lab-monitor.json" --fullscreen --frames 30 --screenshot "$W/check.png" > "$W/out" \
   || fail "check: $(cat "$W/out")"

@@ -37,15 +37,6 @@ at() {
       fail "key $2 at '$1': $(tail -1 "$W/err") $(run_status)"
   fi
 }
-# An X server of its own on a display it picks itself (-displayfd: no clash with another test's server).
-start_xvfb() {
-  Xvfb -displayfd 3 -screen 0 1280x1024x24 -nolisten tcp 3> "$W/display" > "$W/xvfb.log" 2>&1 &
-  xvfb=$!
-  trap 'kill $xvfb 2>/dev/null || true' EXIT
-  for _ in $(seq 1 100); do [ -s "$W/display" ] && break; sleep 0.05; done
-  [ -s "$W/display" ] || fail "Xvfb did not start: $(cat "$W/xvfb.log")"
-  export DISPLAY=":$(head -1 "$W/display")"
-}
 # How the run in the background ended, when a window test finds its window gone.
 run_status() { if [ -n "${run:-}" ] && ! kill -0 "$run" 2>/dev/null; then wait "$run"; echo "(run exited with $?)"; fi; }
 integrity() { [ "$(sql "$1" 'PRAGMA integrity_check')" = ok ] || fail "integrity_check of $1"; }
