@@ -88,7 +88,7 @@ std::string ToString(TransferKind kind) {
 Profile DefaultProfile() { return Profile{}; }
 
 GammaFit FitGamma(const std::vector<LuminancePoint>& points) {
-  if (points.size() < 3) throw InputError("transfer", "a measured transfer needs at least 3 points");
+  if (points.size() < 3) throw Error(ErrorKind::kInput, "a measured transfer needs at least 3 points");
   // The sum of squares is smooth and unimodal in gamma over the range displays have: a coarse scan, then golden
   // section around the best grid point.
   auto sse_at = [&](double gamma) {
@@ -110,7 +110,7 @@ GammaFit FitGamma(const std::vector<LuminancePoint>& points) {
   fit.gamma = 0.5 * (lo + hi);
   double sse;
   LinearFit(points, fit.gamma, &fit.a, &fit.k, &sse);
-  if (!(fit.k > 0)) throw InputError("transfer", "the measured luminance does not rise with the drive level");
+  if (!(fit.k > 0)) throw Error(ErrorKind::kInput, "the measured luminance does not rise with the drive level");
   fit.rms_cd_m2 = std::sqrt(sse / static_cast<double>(points.size()));
   return fit;
 }
