@@ -101,7 +101,7 @@ void AddPreviewCommand(CLI::App& app) {
     if (tiles.empty()) throw InputError(args->protocol, "the protocol makes no trials to preview");
 
     auto context = render::GlContext::CreateOffscreen();
-    session::StimulusRenderer renderer(p, scene, prepared.images);
+    session::StimulusRenderer renderer(p, scene, prepared.images, prepared.presentation);
     const cv::Size frame = renderer.FrameSize();
     const int tw = args->tile_width, th = tw * frame.height / frame.width, strip = 34;
     const int cols = std::min<int>(args->columns, int(tiles.size()));

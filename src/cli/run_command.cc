@@ -47,7 +47,8 @@ void AddRunCommand(CLI::App& app) {
       "Examples:\n"
       "  blurcue run protocols/test1-static-grids.json --participant P3 --db results/study.sqlite\n"
       "  blurcue run protocols/test2-moving-balls.json --participant S1 --db sim.sqlite --observer sim:jnd=0.4\n"
-      "  blurcue run protocols/test1-static-grids.json --participant P3 --db results/study.sqlite --resume");
+      "  blurcue run protocols/test1-static-grids.json --participant P3 --db results/study.sqlite --resume\n"
+      "  blurcue run protocols/test1-static-grids.json --participant T1 --db t.sqlite --observer sim --capture shots");
   cmd->add_option("protocol", args->protocol, "the protocol JSON file")->required()->check(CLI::ExistingFile);
   cmd->add_option("--participant", args->options.participant, "participant id, e.g. P7 (its trailing number "
                                                               "decides by_participant sides)")->required();
@@ -66,6 +67,10 @@ void AddRunCommand(CLI::App& app) {
   cmd->add_flag("--window", args->options.window, "with --observer: show the session in a window, in real time");
   cmd->add_option("--sim-fps", args->options.sim_fps, "headless: frames rendered per simulated second")
       ->capture_default_str()->check(FiniteRange(0.1, 1000, "frames per second"));
+  cmd->add_option("--capture", args->options.capture_dir,
+                  "save each trial's first frame exactly as presented (DIR/trial-NNNN.png, the window's size) and "
+                  "what it shows (DIR/trial-NNNN.json: the display, the photo's place, each object's centre, screen "
+                  "outline, radius in photo px, screen px and arcmin, size in degrees)");
   cmd->add_option("--stop-after", args->options.stop_after, "leave the session after this many answers (it stays "
                                                             "resumable; for tests and split sittings)")
       ->check(IntRange(0, 1000000));

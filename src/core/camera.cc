@@ -19,6 +19,20 @@ std::array<double, 9> Camera::Intrinsics() const {
   return {fpx, 0, image_width_px / 2.0, 0, fpx, image_height_px / 2.0, 0, 0, 1};
 }
 
+Camera Camera::Viewed(double sx, double sy, double dx, double dy, int width_px, int height_px) const {
+  Camera c = *this;
+  auto k = Intrinsics();
+  k[0] *= sx, k[1] *= sx, k[4] *= sy;
+  k[2] = sx * (k[2] + 0.5) - 0.5 + dx;
+  k[5] = sy * (k[5] + 0.5) - 0.5 + dy;
+  c.camera_matrix = k;
+  c.sensor_width_mm = PixelPitchMm() / sx * width_px;
+  c.sensor_height_mm = sensor_height_mm / image_height_px / sy * height_px;
+  c.image_width_px = width_px;
+  c.image_height_px = height_px;
+  return c;
+}
+
 Camera Camera::Resized(int width_px, int height_px) const {
   Camera c = *this;
   const double sx = static_cast<double>(width_px) / image_width_px;

@@ -40,6 +40,10 @@ struct Camera {
   std::array<double, 9> Intrinsics() const;
   // The same camera with the image resampled to width x height (intrinsics scaled, optics unchanged).
   Camera Resized(int width_px, int height_px) const;
+  // The camera that sees this one's image resampled by (sx, sy) with an area filter (pixel centres at integers:
+  // x' = sx (x + 0.5) - 0.5) and then shifted by (dx, dy) px into a width x height image, cropped or letterboxed:
+  // what a screen showing the photo at that scale and place shows. Optics and pixel pitch follow the image.
+  Camera Viewed(double sx, double sy, double dx, double dy, int width_px, int height_px) const;
 
   // Throws Error(kInput) "where/field: must be in [lo, hi] unit, got ..." for the first value outside
   // CameraLimits, an image side outside [1, kMaxImageSidePx] px, or a camera_matrix / dist_coeffs that is not

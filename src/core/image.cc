@@ -235,6 +235,14 @@ cv::Mat EncodeSrgb8(const cv::Mat& linear) {
   return out;
 }
 
+cv::Mat ResampleSrgb8(const cv::Mat& srgb8, cv::Size size) {
+  CV_Assert(srgb8.depth() == CV_8U && srgb8.channels() != 4 && size.width > 0 && size.height > 0);  // no alpha
+  if (srgb8.size() == size) return srgb8.clone();
+  cv::Mat resampled;
+  cv::resize(DecodeSrgb8(srgb8), resampled, size, 0, 0, cv::INTER_AREA);
+  return EncodeSrgb8(resampled);
+}
+
 cv::Mat ToGrey8(const cv::Mat& image) {
   if (image.channels() == 1) return image;
   cv::Mat grey;

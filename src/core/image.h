@@ -21,6 +21,10 @@ const std::array<float, 256>& SrgbDecodeTable();
 cv::Mat DecodeSrgb8(const cv::Mat& srgb8);
 // CV_32F linear (clamped to [0, 1]) -> 8-bit sRGB, rounded.
 cv::Mat EncodeSrgb8(const cv::Mat& linear);
+// An 8-bit sRGB image resampled to `size` in linear light with an area (box) filter: each output pixel is the mean
+// light of the input area it covers, so a downscale neither aliases fine detail nor darkens it (a gamma-encoded
+// average would). 8-bit grey or BGR sRGB in and out.
+cv::Mat ResampleSrgb8(const cv::Mat& srgb8, cv::Size size);
 // 8-bit BGR/BGRA/grey -> one-channel 8-bit grey (as stored: gamma-encoded).
 cv::Mat ToGrey8(const cv::Mat& image);
 

@@ -708,13 +708,28 @@ Protocol Parser::Parse(const Json& json) {
     }
   }
   if (const Json* v = Field(json, "display", "", false)) {
-    if (Object(*v, "/display", {"width_px", "height_px", "fullscreen", "monitor", "profile"})) {
+    if (Object(*v, "/display", {"width_px", "height_px", "fullscreen", "monitor", "profile", "scale", "width_deg"})) {
       // From VGA's 320 x 240 to 4K UHD (a depth-matching frame as wide as the display is filtered on the CPU).
       if (auto n = Int(*v, "width_px", "/display", false, 320, 3840, "px")) p.display.width_px = *n;
       if (auto n = Int(*v, "height_px", "/display", false, 240, 2160, "px")) p.display.height_px = *n;
       if (auto b = Bool(*v, "fullscreen", "/display")) p.display.fullscreen = *b;
       if (auto n = Int(*v, "monitor", "/display", false, 0, 16)) p.display.monitor = *n;
       p.display.profile = Path(*v, "profile", "/display", false);
+      // How the photo maps to the screen: fitted whole (the default), 1:1, a scale, or a width in degrees.
+      if (const Json* s = Field(*v, "scale", "/display", false)) {
+        if (s->is_string() && *s == "fit") p.display.scaling = Scaling::kFit;
+        else if (s->is_string() && *s == "native") p.display.scaling = Scaling::kNative;
+        else if (NumberIn(*s, 0.05, 8)) p.display.scaling = Scaling::kScale, p.display.scale = s->get<double>();
+        else Problem("/display/scale", "must be \"fit\", \"native\" or screen px per photo px in " + Range(0.05, 8, ""), *s);
+      }
+      if (auto x = Number(*v, "width_deg", "/display", false, 0.5, 180, "deg")) {
+        if (v->contains("scale")) Problem("/display/width_deg", "give either scale or width_deg, not both", *x);
+        else p.display.scaling = Scaling::kDegrees, p.display.width_deg = *x;
+      }
+      if ((v->contains("scale") || v->contains("width_deg")) && p.content.type == "picture")
+        Problem(v->contains("scale") ? "/display/scale" : "/display/width_deg",
+                "a picture's frame is always fitted to the window at one screen px per frame px; leave it out",
+                v->contains("scale") ? (*v)["scale"] : (*v)["width_deg"]);
     }
   }
   CheckDesign(p);

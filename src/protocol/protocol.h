@@ -93,8 +93,18 @@ struct Timing {
   double inter_trial_ms = 500;
 };
 
+// How a grid or ball trial's photo maps to the screen (a picture's frame is always fitted, 4:3, at 1 screen px per
+// frame px).
+enum class Scaling { kFit, kNative, kScale, kDegrees };  // "fit" | "native" | a number | width_deg
+
 struct Display {
   int width_px = 1280, height_px = 720;
+  // kFit: the whole photo, letterboxed; kNative: 1 screen px per photo px; kScale: `scale` screen px per photo px;
+  // kDegrees: the photo's width spans `width_deg` of visual angle (the display profile's px per degree). A photo
+  // larger than the window is cropped around what the trial shows.
+  Scaling scaling = Scaling::kFit;
+  double scale = 1;                   // kScale
+  double width_deg = 0;               // kDegrees
   bool fullscreen = false;
   int monitor = 0;
   std::filesystem::path profile;      // the monitor's display profile (display/profile.h), resolved; empty: none

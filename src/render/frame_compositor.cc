@@ -5,34 +5,62 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/image.h"
 #include "render/blur.h"
 #include "render/gl_objects.h"
 
 namespace blurcue::render {
 
 struct FrameCompositor::Impl {
+  Camera camera;
+  FrameView view;
   int width = 0, height = 0;
   SceneRenderer renderer;
   GlBlur blur;
   Program composite = Program::FromFiles(ShaderDir() / "fullscreen.vert", ShaderDir() / "composite.frag");
   FullscreenPass pass;
-  Texture background, frame;
-  Framebuffer background_fb, frame_fb;
-  // Where the last frame drew: only those rectangles need the photo back (the whole frame before the first).
-  std::vector<cv::Rect> dirty{cv::Rect(0, 0, width, height)};
+  Texture photo, base, frame;  // the photo resampled; the frame without objects (photo placed, grey around); the frame
+  Framebuffer photo_fb, base_fb, frame_fb;
+  // Where the last frame drew: only those rectangles need the base back (the whole frame before the first).
+  std::vector<cv::Rect> dirty;
 
-  Impl(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec, const cv::Mat& photo)
-      : width(camera.image_width_px),
-        height(camera.image_height_px),
-        renderer(camera, rvec, tvec),
-        background(Texture::FromSrgbImage(photo)),
-        frame(camera.image_width_px, camera.image_height_px, GL_SRGB8_ALPHA8),
-        background_fb(background),
-        frame_fb(frame) {}
+  Impl(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec, const cv::Mat& photo_srgb,
+       const FrameView& view)
+      : camera(camera),
+        view(view),
+        width(view.width_px),
+        height(view.height_px),
+        renderer(view.CameraOf(camera), rvec, tvec),
+        photo(Texture::FromSrgbImage(ResampleSrgb8(photo_srgb, {view.photo_width_px, view.photo_height_px}))),
+        base(view.width_px, view.height_px, GL_SRGB8_ALPHA8),
+        frame(view.width_px, view.height_px, GL_SRGB8_ALPHA8),
+        photo_fb(photo),
+        base_fb(base),
+        frame_fb(frame) {
+    Place(view.x_px, view.y_px);
+  }
+
+  // The base frame: grey (sRGB 128, as the text screens' field), the photo at (x, y), cut by the frame's edges.
+  void Place(int x, int y) {
+    view.x_px = x, view.y_px = y;
+    renderer.SetCamera(view.CameraOf(camera));
+    base_fb.Bind();
+    glClearColor(0.5f, 0.5f, 0.5f, 1);
+    glClear(GL_COLOR_BUFFER_BIT);
+    const cv::Rect to = cv::Rect(x, y, view.photo_width_px, view.photo_height_px) & cv::Rect(0, 0, width, height);
+    if (!to.empty()) {
+      glBindFramebuffer(GL_READ_FRAMEBUFFER, photo_fb.id());
+      glBindFramebuffer(GL_DRAW_FRAMEBUFFER, base_fb.id());
+      glBlitFramebuffer(to.x - x, to.y - y, to.x - x + to.width, to.y - y + to.height, to.x, to.y, to.x + to.width,
+                        to.y + to.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    dirty.assign(1, cv::Rect(0, 0, width, height));
+  }
 
   void StartFrame() {
-    // The photo's encoded bytes are copied as they are (both sRGB): no decode/encode round trip.
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, background_fb.id());
+    // The base's encoded bytes are copied as they are (both sRGB): no decode/encode round trip.
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, base_fb.id());
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, frame_fb.id());
     for (const cv::Rect& r : dirty)
       glBlitFramebuffer(r.x, r.y, r.x + r.width, r.y + r.height, r.x, r.y, r.x + r.width, r.y + r.height,
@@ -44,11 +72,13 @@ struct FrameCompositor::Impl {
   // the thesis's approach by the whole frame (a full-frame buffer, blurred whole).
   void Compose(const std::vector<BlurredObject>& objects, bool whole_frame) {
     StartFrame();
+    const double scale = view.Scale(camera);
     for (const BlurredObject& o : objects) {
-      const int margin = whole_frame ? std::max(width, height) : KernelMarginPx(o.method, o.r_px) + 1;
+      const double r = o.r_px * scale;  // at screen resolution
+      const int margin = whole_frame ? std::max(width, height) : KernelMarginPx(o.method, r) + 1;
       GpuLayer layer = renderer.DrawToTexture(o.object, margin);
       if (!layer.texture) continue;
-      blur.BlurTexture(*layer.texture, o.method, o.r_px);
+      blur.BlurTexture(*layer.texture, o.method, r);
       Blend(*layer.texture, layer.roi);
     }
   }
@@ -74,11 +104,27 @@ struct FrameCompositor::Impl {
   }
 };
 
+FrameView FrameView::Identity(int photo_width_px, int photo_height_px) {
+  return {photo_width_px, photo_height_px, photo_width_px, photo_height_px, 0, 0};
+}
+
+Camera FrameView::CameraOf(const Camera& c) const {
+  return c.Viewed(double(photo_width_px) / c.image_width_px, double(photo_height_px) / c.image_height_px, x_px, y_px,
+                  width_px, height_px);
+}
+
 FrameCompositor::FrameCompositor(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec,
-                                 const cv::Mat& background)
-    : impl_(std::make_unique<Impl>(camera, rvec, tvec, background)) {
+                                 const cv::Mat& background, std::optional<FrameView> view)
+    : impl_(std::make_unique<Impl>(camera, rvec, tvec, background,
+                                   view ? *view : FrameView::Identity(camera.image_width_px, camera.image_height_px))) {
   CV_Assert(background.cols == camera.image_width_px && background.rows == camera.image_height_px);
 }
+
+void FrameCompositor::Place(int x_px, int y_px) {
+  if (x_px != impl_->view.x_px || y_px != impl_->view.y_px) impl_->Place(x_px, y_px);
+}
+
+const FrameView& FrameCompositor::view() const { return impl_->view; }
 
 FrameCompositor::~FrameCompositor() = default;
 
@@ -120,6 +166,18 @@ void BlitToWindow(GLuint read_fb, int src_w, int src_h, int width_px, int height
 double FitScale(int src_w, int src_h, int width_px, int height_px) {
   const double scale = std::min(double(width_px) / src_w, double(height_px) / src_h);
   return double(int(src_w * scale)) / src_w;
+}
+
+cv::Mat ReadWindow(int width_px, int height_px) {
+  cv::Mat rgba(height_px, width_px, CV_8UC4);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  glReadBuffer(GL_BACK);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, width_px, height_px, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
+  cv::Mat bgr;
+  cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
+  cv::flip(bgr, bgr, 0);  // a window's rows count from the bottom
+  return bgr;
 }
 
 void FrameCompositor::Present(int width_px, int height_px) {

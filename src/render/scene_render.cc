@@ -129,28 +129,68 @@ SceneRenderer::SceneRenderer(const Camera& camera, const cv::Vec3d& rvec, const 
 
 SceneRenderer::~SceneRenderer() = default;
 
-Footprint SceneRenderer::Measure(const VirtualObject& o) const {
+Footprint FootprintOf(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec, const VirtualObject& o) {
   const auto corners = BoxCorners(o);
   std::vector<cv::Point2d> px;
-  cv::projectPoints(corners, impl_->rvec, impl_->tvec, cv::Matx33d(impl_->camera.Intrinsics().data()),
-                    impl_->camera.dist_coeffs, px);
+  cv::projectPoints(corners, rvec, tvec, cv::Matx33d(camera.Intrinsics().data()), camera.dist_coeffs, px);
+  cv::Matx33d rotation;
+  cv::Rodrigues(rvec, rotation);
   Footprint f;
   double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
   f.z_min_mm = 1e300, f.z_max_mm = -1e300;
   for (size_t i = 0; i < corners.size(); ++i) {
     x0 = std::min(x0, px[i].x), x1 = std::max(x1, px[i].x), y0 = std::min(y0, px[i].y), y1 = std::max(y1, px[i].y);
-    const double z = (impl_->rotation * cv::Vec3d(corners[i]) + impl_->tvec)[2];
+    const double z = (rotation * cv::Vec3d(corners[i]) + tvec)[2];
     f.z_min_mm = std::min(f.z_min_mm, z), f.z_max_mm = std::max(f.z_max_mm, z);
   }
   f.bounds = cv::Rect(cv::Point(int(std::floor(x0)) - 1, int(std::floor(y0)) - 1),
                       cv::Point(int(std::ceil(x1)) + 2, int(std::ceil(y1)) + 2));
-  f.z_center_mm = (impl_->rotation * o.center_board_mm + impl_->tvec)[2];
+  f.z_center_mm = (rotation * o.center_board_mm + tvec)[2];
   if (o.kind == VirtualObject::Kind::kBall) {  // a sphere spans its diameter in depth, not its box's diagonal
     f.z_min_mm = f.z_center_mm - o.size_mm;
     f.z_max_mm = f.z_center_mm + o.size_mm;
   }
   return f;
 }
+
+std::vector<cv::Point2d> OutlineOf(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec,
+                                   const VirtualObject& o, int points) {
+  std::vector<cv::Point3d> rim;
+  const cv::Vec3d c = o.center_board_mm;
+  if (o.kind == VirtualObject::Kind::kCard) {
+    const double h = o.size_mm / 2;
+    for (const auto& [sx, sy] : {std::pair{-1, 1}, {1, 1}, {1, -1}, {-1, -1}})
+      rim.emplace_back(c[0] + sx * h, c[1] + sy * h, c[2]);
+  } else {
+    // The rim the camera's centre sees: the circle where lines from the eye touch the sphere.
+    cv::Matx33d rotation;
+    cv::Rodrigues(rvec, rotation);
+    const cv::Vec3d eye = -(rotation.t() * tvec);
+    const cv::Vec3d to = c - eye;
+    const double d = cv::norm(to), rho = o.size_mm;
+    const cv::Vec3d u = to / d;
+    const cv::Vec3d centre = c - u * (rho * rho / d);
+    const double radius = rho * std::sqrt(std::max(0.0, 1 - rho * rho / (d * d)));
+    cv::Vec3d a = u.cross(cv::Vec3d(1, 0, 0));
+    if (cv::norm(a) < 1e-6) a = u.cross(cv::Vec3d(0, 1, 0));
+    a = cv::normalize(a);
+    const cv::Vec3d b = u.cross(a);
+    for (int i = 0; i < points; ++i) {
+      const double phi = 2 * M_PI * i / points;
+      const cv::Vec3d p = centre + radius * (std::cos(phi) * a + std::sin(phi) * b);
+      rim.emplace_back(p[0], p[1], p[2]);
+    }
+  }
+  std::vector<cv::Point2d> px;
+  cv::projectPoints(rim, rvec, tvec, cv::Matx33d(camera.Intrinsics().data()), camera.dist_coeffs, px);
+  return px;
+}
+
+Footprint SceneRenderer::Measure(const VirtualObject& o) const {
+  return FootprintOf(impl_->camera, impl_->rvec, impl_->tvec, o);
+}
+
+void SceneRenderer::SetCamera(const Camera& camera) { impl_->camera = camera; }
 
 Layer SceneRenderer::Draw(const VirtualObject& o, int margin_px) {
   GpuLayer gpu = DrawToTexture(o, margin_px, /*depth_map=*/true);

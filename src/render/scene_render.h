@@ -5,6 +5,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -36,6 +37,13 @@ struct Layer {
   cv::Mat depth_mm;  // CV_32F camera z of the object's surface per pixel, 0 where it does not cover
 };
 
+// Where `object` lands in `camera`'s image (board frame -> camera by rvec/tvec), without GL.
+Footprint FootprintOf(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec, const VirtualObject& object);
+// The object's silhouette in `camera`'s image as a polygon (image px, centres at integers): a card's four corners,
+// a ball's outline circle (the sphere's rim as seen from the camera's centre) at `points` points. No GL.
+std::vector<cv::Point2d> OutlineOf(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec,
+                                   const VirtualObject& object, int points = 64);
+
 class Texture;
 // The same on the GPU: linear premultiplied RGBA texture (GL row = image row) over `roi`; null when off-screen.
 struct GpuLayer {
@@ -53,6 +61,8 @@ class SceneRenderer {
   SceneRenderer& operator=(const SceneRenderer&) = delete;
 
   Footprint Measure(const VirtualObject& object) const;
+  // Draws from now on as `camera` sees (the same pose): a view of the photo scaled and placed (Camera::Viewed).
+  void SetCamera(const Camera& camera);
   // Draws the object into a layer covering its bounds grown by margin_px, clipped to the image.
   Layer Draw(const VirtualObject& object, int margin_px);
   // The same, left on the GPU for frame composition; the per-pixel depth texture only when `depth_map` (the

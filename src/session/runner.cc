@@ -12,7 +12,9 @@
 
 #include <opencv2/core.hpp>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/image.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
 #include "render/frame_compositor.h"
@@ -154,13 +156,30 @@ enum class Outcome { kAnswered, kQuit };
 
 class Runner {
  public:
-  Runner(const RunOptions& options, const protocol::Protocol& protocol, render::GlContext& context,
-         StimulusRenderer& renderer, const std::vector<protocol::Trial>& trials,
-         const std::vector<TrialScene>& scenes, std::optional<ObserverParams> observer, uint64_t seed)
-      : options_(options), protocol_(protocol), context_(context), renderer_(renderer), trials_(trials),
-        scenes_(scenes), observer_(observer), seed_(seed), keys_{protocol.responses},
-        station_(context, !observer || options.window, options.sim_fps),
-        screen_size_(protocol.display.width_px, protocol.display.height_px) {}
+  Runner(const RunOptions& options, const PreparedSession& prepared, render::GlContext& context,
+         StimulusRenderer& renderer, std::optional<ObserverParams> observer)
+      : options_(options), prepared_(prepared), protocol_(prepared.protocol), context_(context), renderer_(renderer),
+        trials_(prepared.trials), scenes_(prepared.scenes), observer_(observer), seed_(prepared.seed),
+        keys_{protocol_.responses}, station_(context, !observer || options.window, options.sim_fps),
+        screen_size_(protocol_.display.width_px, protocol_.display.height_px) {}
+
+  // --capture: the trial's first frame as the swap shows it (read back from the window, or the frame composed
+  // headless: the same pixels) and what it shows in screen terms (DescribeFrame), before the frame is flipped.
+  void Capture(const protocol::Trial& trial, const TrialScene& scene) {
+    const cv::Mat image =
+        station_.window() ? render::ReadWindow(context_.width_px(), context_.height_px()) : renderer_.Read();
+    char name[32];
+    std::snprintf(name, sizeof name, "trial-%04d", trial.index + 1);
+    Json frame = DescribeFrame(prepared_.scene ? &*prepared_.scene : nullptr, scene, prepared_.presentation,
+                               renderer_.View(), renderer_.Shown());
+    frame["protocol"] = protocol_.name;
+    frame["participant"] = options_.participant;
+    frame["trial_index"] = trial.index;
+    frame["block"] = trial.block;
+    frame["practice"] = trial.practice;
+    WriteImage(options_.capture_dir / (std::string(name) + ".png"), image);
+    WriteFileAtomically(options_.capture_dir / (std::string(name) + ".json"), frame.dump(1) + "\n");
+  }
 
   // Shows `image` until one of `keys` is pressed and returns it ("" when the window is closed).
   std::string ShowUntil(const std::string& title, const cv::Mat& image, const std::vector<std::string>& keys) {
@@ -258,6 +277,7 @@ class Runner {
         else
           Blank().Present(context_.width_px(), context_.height_px());
       }
+      if (frame == 0 && !options_.capture_dir.empty()) Capture(trial, scene);
       const double flip = station_.Flip();
       if (onset < 0) {
         onset = flip;
@@ -391,6 +411,7 @@ class Runner {
   }
 
   const RunOptions& options_;
+  const PreparedSession& prepared_;
   const protocol::Protocol& protocol_;
   render::GlContext& context_;
   StimulusRenderer& renderer_;
@@ -459,7 +480,15 @@ RunResult RunSession(const RunOptions& options) {
                          std::to_string(context->height_px()) + " px, the protocol's display says " +
                          std::to_string(protocol.display.width_px) + " x " + std::to_string(protocol.display.height_px) +
                          " px; set width_px/height_px to the screen's (full screen: the monitor's mode)");
-  StimulusRenderer renderer(protocol, scene, prepared.images);
+  StimulusRenderer renderer(protocol, scene, prepared.images, prepared.presentation);
+  // The capture folder is made before the session starts: a path that cannot hold captures stops here.
+  if (!options.capture_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(options.capture_dir, ec);
+    if (ec || !std::filesystem::is_directory(options.capture_dir))
+      throw InputError(options.capture_dir.string(), "--capture: cannot make a folder here (" +
+                                                         (ec ? ec.message() : std::string("not a folder")) + ")");
+  }
 
   store::Record record = store::Record::Open(options.db);
   store::SessionMeta meta;
@@ -486,7 +515,7 @@ RunResult RunSession(const RunOptions& options) {
     record.SaveTrialList(start.session_id, records);
   else
     record.CheckTrialList(start.session_id, records);
-  Runner runner(options, protocol, *context, renderer, trials, scenes, observer, seed);
+  Runner runner(options, prepared, *context, renderer, observer);
   return runner.Run(record, start);
 }
 

@@ -22,6 +22,7 @@ struct RunOptions {
   bool again = false;            // allow another session for a participant who completed the study
   bool window = false;           // a simulated observer in a window, on the real clock (a person always has one)
   double sim_fps = 4;            // headless: frames rendered per second of simulated time
+  std::filesystem::path capture_dir;      // --capture: each trial's first frame as shown, and what it shows
   int stop_after = -1;           // >= 0: leave the session (running, resumable) after this many new answers
 };
 

@@ -6,6 +6,9 @@
 #include <limits>
 #include <set>
 
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
 #include "core/error.h"
 #include "core/image.h"
 #include "render/blur.h"
@@ -188,21 +191,72 @@ std::array<std::optional<render::BlurredObject>, 2> ObjectsAt(const protocol::Pr
 Presentation Presentation::Of(const protocol::Protocol& protocol, const StimulusImages& images,
                               const display::Profile& profile) {
   Presentation p;
-  if (protocol.content.type == "picture") {
-    // The depth-matching frame is as wide as the display, 4:3 (StimulusRenderer::FrameSize).
-    p.frame_width_px = protocol.display.width_px;
-    p.frame_height_px = protocol.display.width_px * 3 / 4;
-  } else {
-    p.frame_width_px = images.photo.cols;
-    p.frame_height_px = images.photo.rows;
-  }
   p.window_width_px = protocol.display.width_px;
   p.window_height_px = protocol.display.height_px;
-  p.scale = p.frame_width_px > 0 && p.frame_height_px > 0
-                ? render::FitScale(p.frame_width_px, p.frame_height_px, p.window_width_px, p.window_height_px)
-                : 1;
   p.profile = profile;
+  const int W = p.window_width_px, H = p.window_height_px;
+  if (protocol.content.type == "picture") {
+    // The depth-matching frame, 4:3, as large as the window holds (the thesis's 960 x 720 in a 1280 x 720 one).
+    p.frame_width_px = std::min(W, H * 4 / 3);
+    p.frame_height_px = p.frame_width_px * 3 / 4;
+    p.scaling = "fit";
+    p.view = {W, H, p.frame_width_px, p.frame_height_px, (W - p.frame_width_px) / 2, (H - p.frame_height_px) / 2};
+    return p;
+  }
+  p.frame_width_px = images.photo.cols;
+  p.frame_height_px = images.photo.rows;
+  const int w = p.frame_width_px, h = p.frame_height_px;
+  if (w <= 0 || h <= 0) return p;
+  using protocol::Scaling;
+  const Scaling scaling = protocol.display.scaling;
+  double scale = 1;
+  switch (scaling) {
+    case Scaling::kFit: scale = render::FitScale(w, h, W, H), p.scaling = "fit"; break;
+    case Scaling::kNative: scale = 1, p.scaling = "native"; break;
+    case Scaling::kScale: scale = protocol.display.scale, p.scaling = "scale"; break;
+    case Scaling::kDegrees:
+      scale = protocol.display.width_deg * display::PxPerDeg(profile) / w, p.scaling = "degrees";
+      break;
+  }
+  // Whole screen px: the photo's shown width sets the scale recorded, its height follows.
+  const double shown_w = std::round(w * scale);
+  if (!(shown_w >= 8 && shown_w <= 16384 && h * scale >= 8 && h * scale <= 16384)) {
+    const bool degrees = scaling == Scaling::kDegrees;
+    throw InputError(protocol.file.string() + (degrees ? ": /display/width_deg" : ": /display/scale"),
+                     "shows the " + std::to_string(w) + " x " + std::to_string(h) + " px photo " +
+                         std::to_string(int(shown_w)) + " px wide" +
+                         (degrees ? " (at " + std::to_string(display::PxPerDeg(profile)) + " px/deg)" : "") +
+                         "; it must be 8 to 16384 px on screen");
+  }
+  p.scale = shown_w / w;
+  const int pw = int(shown_w), ph = int(std::lround(h * p.scale));
+  p.view = {W, H, pw, ph, (W - pw) / 2, (H - ph) / 2};
   return p;
+}
+
+render::FrameView Presentation::ViewFor(const protocol::Protocol& protocol, const calib::SceneCalib& scene,
+                                        const TrialScene& trial) const {
+  render::FrameView v = view;
+  if (v.photo_width_px <= v.width_px && v.photo_height_px <= v.height_px) return v;
+  // What the trial shows, in photo px: both objects at the start and at the end of their run.
+  cv::Rect shows;
+  for (const double t : {0.0, trial.MotionS()})
+    for (const auto& object : ObjectsAt(protocol, scene, trial, std::min(t, std::max(0.0, trial.MotionS() - 1e-6))))
+      if (object) {
+        const cv::Rect b = render::FootprintOf(scene.camera, scene.rvec, scene.tvec, object->object).bounds;
+        shows = shows.empty() ? b : (shows | b);
+      }
+  if (shows.empty()) return v;
+  // Centre it, then keep the window covered by the photo along any side where the photo is the larger.
+  auto place = [](double centre_photo_px, double scale, int photo_px, int window_px) {
+    if (photo_px <= window_px) return (window_px - photo_px) / 2;
+    const int x = int(std::lround(window_px / 2.0 - (scale * (centre_photo_px + 0.5) - 0.5)));
+    return std::clamp(x, window_px - photo_px, 0);
+  };
+  const double sx = double(v.photo_width_px) / frame_width_px, sy = double(v.photo_height_px) / frame_height_px;
+  v.x_px = place(shows.x + shows.width / 2.0, sx, v.photo_width_px, v.width_px);
+  v.y_px = place(shows.y + shows.height / 2.0, sy, v.photo_height_px, v.height_px);
+  return v;
 }
 
 Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation) {
@@ -229,6 +283,52 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
     v["contrast"] = scene.contrast;
   }
   return v;
+}
+
+Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, const Presentation& presentation,
+                   const render::FrameView& view, const std::array<std::optional<render::BlurredObject>, 2>& shown) {
+  const display::Profile& profile = presentation.profile;
+  auto round = [](double x, double unit) {  // to a decimal unit, printed as such
+    const double per = std::round(1 / unit);
+    return std::round(x * per) / per;
+  };
+  Json frame = {
+      {"display",
+       {{"width_px", view.width_px}, {"height_px", view.height_px}, {"width_mm", profile.width_mm},
+        {"height_mm", profile.height_mm}, {"distance_mm", profile.distance_mm},
+        {"px_per_deg", round(display::PxPerDeg(profile), 1e-4)}, {"profile", profile.name}}},
+      {"scaling", presentation.scaling},
+      {"screen_px_per_photo_px", round(presentation.scale, 1e-6)},
+      {"photo_rect_px", {view.x_px, view.y_px, view.photo_width_px, view.photo_height_px}},
+      {"objects", Json::array()}};
+  if (!scene) return frame;
+  const Camera camera = view.CameraOf(scene->camera);
+  for (int side = 0; side < 2; ++side) {
+    if (!shown[size_t(side)]) continue;
+    const render::BlurredObject& b = *shown[size_t(side)];
+    const std::vector<cv::Point2d> outline = render::OutlineOf(camera, scene->rvec, scene->tvec, b.object);
+    std::vector<cv::Point2d> centre;
+    cv::projectPoints(std::vector<cv::Point3d>{cv::Point3d(b.object.center_board_mm)}, scene->rvec, scene->tvec,
+                      cv::Matx33d(camera.Intrinsics().data()), camera.dist_coeffs, centre);
+    double extent = 0;
+    Json polygon = Json::array();
+    for (const cv::Point2d& p : outline) {
+      polygon.push_back({round(p.x, 1e-3), round(p.y, 1e-3)});
+      for (const cv::Point2d& q : outline) extent = std::max(extent, cv::norm(p - q));
+    }
+    frame["objects"].push_back(
+        {{"side", side == 0 ? "left" : "right"},
+         {"kind", b.object.kind == render::VirtualObject::Kind::kBall ? "ball" : "card"},
+         {"source", calib::ToString(side == 0 ? trial.left : trial.right)},
+         {"kernel", b.method},
+         {"center_px", {round(centre[0].x, 1e-3), round(centre[0].y, 1e-3)}},
+         {"outline_px", polygon},
+         {"r_camera_px", round(b.r_px, 1e-4)},
+         {"r_screen_px", round(presentation.ScreenPx(b.r_px), 1e-4)},
+         {"r_arcmin", round(presentation.Arcmin(b.r_px), 1e-4)},
+         {"size_deg", round(display::ArcminOfScreenPx(profile, extent) / 60, 1e-4)}});
+  }
+  return frame;
 }
 
 std::optional<calib::SceneCalib> LoadProtocolScene(const protocol::Protocol& protocol) {
@@ -322,16 +422,13 @@ void CheckRealPhotos(const protocol::Protocol& protocol, const std::vector<Trial
                      10, kMaxPhotoSidePx);
 }
 
-StimulusRenderer::StimulusRenderer(const protocol::Protocol& protocol, const std::optional<calib::SceneCalib>& scene)
-    : StimulusRenderer(protocol, scene, LoadStimulusImages(protocol, scene)) {}
-
 StimulusRenderer::StimulusRenderer(const protocol::Protocol& protocol, const std::optional<calib::SceneCalib>& scene,
-                                   const StimulusImages& images)
-    : protocol_(protocol), scene_(scene) {
+                                   const StimulusImages& images, const Presentation& presentation)
+    : protocol_(protocol), scene_(scene), presentation_(presentation) {
   photo_ = images.photo;
   if (protocol.content.type == "picture") {
     picture_ = images.picture;
-    picture_width_px_ = protocol.display.width_px;
+    picture_width_px_ = presentation.frame_width_px;
     // Every adjustment level's low-passed picture up front (~0.1 s each on the CPU): stepping through the levels
     // in a trial then never stalls a frame on a Butterworth filter.
     for (const auto& block : protocol.blocks)
@@ -341,7 +438,8 @@ StimulusRenderer::StimulusRenderer(const protocol::Protocol& protocol, const std
   }
   if (!scene_) scene_ = LoadProtocolScene(protocol);
   texture_ = images.texture;
-  compositor_ = std::make_unique<render::FrameCompositor>(scene_->camera, scene_->rvec, scene_->tvec, photo_);
+  compositor_ = std::make_unique<render::FrameCompositor>(scene_->camera, scene_->rvec, scene_->tvec, photo_,
+                                                          presentation.view);
 }
 
 StimulusRenderer::~StimulusRenderer() = default;
@@ -356,8 +454,12 @@ const cv::Mat& StimulusRenderer::UpperHalf(double level) {
 }
 
 cv::Size StimulusRenderer::FrameSize() const {
-  if (compositor_) return photo_.size();
+  if (compositor_) return {presentation_.window_width_px, presentation_.window_height_px};
   return {picture_width_px_, picture_width_px_ * 3 / 4};
+}
+
+render::FrameView StimulusRenderer::View() const {
+  return compositor_ ? compositor_->view() : presentation_.view;
 }
 
 void StimulusRenderer::Compose(const TrialScene& trial, double t_s, double level) {
@@ -373,6 +475,10 @@ void StimulusRenderer::Compose(const TrialScene& trial, double t_s, double level
     picture_frame_ = render::DepthMatchingFrame(UpperHalf(level), *lower, picture_width_px_);
     picture_shown_.reset();
     return;
+  }
+  if (t_s <= 0) {  // a trial's first frame: the photo where this trial shows it
+    const render::FrameView v = presentation_.ViewFor(protocol_, *scene_, trial);
+    compositor_->Place(v.x_px, v.y_px);
   }
   shown_ = ObjectsAt(protocol_, *scene_, trial, t_s);
   std::vector<render::BlurredObject> objects;
@@ -393,6 +499,16 @@ void StimulusRenderer::Present(int width_px, int height_px) {
   picture_shown_->Present(width_px, height_px);
 }
 
-cv::Mat StimulusRenderer::Read() { return compositor_ ? compositor_->Read() : picture_frame_.clone(); }
+cv::Mat StimulusRenderer::Read() {
+  if (compositor_) return compositor_->Read();
+  // The picture's frame where the window shows it, on the grey field.
+  const render::FrameView& v = presentation_.view;
+  cv::Mat window(v.height_px, v.width_px, CV_8UC3, cv::Scalar::all(128));
+  cv::Mat bgr = picture_frame_;
+  if (bgr.channels() == 4) cv::cvtColor(bgr, bgr, cv::COLOR_BGRA2BGR);
+  else if (bgr.channels() == 1) cv::cvtColor(bgr, bgr, cv::COLOR_GRAY2BGR);
+  bgr.copyTo(window(cv::Rect(v.x_px, v.y_px, bgr.cols, bgr.rows)));
+  return window;
+}
 
 }  // namespace blurcue::session

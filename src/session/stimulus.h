@@ -76,20 +76,38 @@ struct StimulusImages {
   cv::Mat texture;  // grid or ball: the card's or the ball's texture
 };
 
-// How a composed frame reaches the screen and the eye: the frame (the photo, or the depth-matching frame) is fitted
-// whole into the protocol's display size, so one frame px is `scale` screen px (render::FitScale); the display
-// profile turns screen px into visual angle. A radius is recorded in all three units.
+// How a frame reaches the screen and the eye. A grid or ball trial is composed at the window's size: the photo
+// resampled (linear light, area filter) by `scale` screen px per photo px, as the protocol's display.scale or
+// width_deg says, and the objects drawn and blurred at screen resolution; a photo larger than the window is cropped
+// around what the trial shows (ViewFor). A picture's frame is fitted 4:3 into the window at one screen px per frame
+// px. The display profile turns screen px into visual angle; a radius is recorded in all three units.
 struct Presentation {
-  int frame_width_px = 0, frame_height_px = 0;
+  int frame_width_px = 0, frame_height_px = 0;  // the photo, or the picture's frame
   int window_width_px = 0, window_height_px = 0;
-  double scale = 1;  // screen px per frame (photo) px
+  double scale = 1;         // screen px per frame (photo) px
+  std::string scaling;      // "fit" | "native" | "scale" | "degrees"
+  render::FrameView view;   // the photo's place before a trial moves it (centred, or letterboxed when it fits)
   display::Profile profile;
 
   double ScreenPx(double frame_px) const { return frame_px * scale; }
   double Arcmin(double frame_px) const { return display::ArcminOfScreenPx(profile, ScreenPx(frame_px)); }
+  // Where a pair trial shows the photo: `view` when the scaled photo fits the window; else cropped so that what the
+  // trial shows (both objects over their whole run) is centred, as far as the photo reaches.
+  render::FrameView ViewFor(const protocol::Protocol& protocol, const calib::SceneCalib& scene,
+                            const TrialScene& trial) const;
+  // Throws Error(kInput) naming /display/width_deg or /display/scale when the photo would be smaller than 8 px or
+  // larger than 16384 px on screen.
   static Presentation Of(const protocol::Protocol& protocol, const StimulusImages& images,
                          const display::Profile& profile);
 };
+
+// What a frame shows, in screen terms (run --capture's trial-NNNN.json): the display (width_px, height_px,
+// width_mm, height_mm, distance_mm, px_per_deg), where the photo sits (scaling, screen_px_per_photo_px,
+// photo_rect_px) and every object on it: side, kind, source, kernel, center_px (its pose's centre), outline_px (the
+// screen polygon of its silhouette), r_camera_px, r_screen_px, r_arcmin and size_deg (the outline's largest extent).
+// `scene` may be null for a picture (no objects).
+Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, const Presentation& presentation,
+                   const render::FrameView& view, const std::array<std::optional<render::BlurredObject>, 2>& shown);
 
 // Reads every image the protocol names: each must decode as an image of a size its use can show. Throws
 // Error(kInput) naming the protocol file and the field (/scene/background, /content/texture, ...). No GL.
@@ -101,12 +119,10 @@ void CheckRealPhotos(const protocol::Protocol& protocol, const std::vector<Trial
 
 class StimulusRenderer {
  public:
-  // Needs a current GL context. Loads the photo the protocol shows and the textures; `scene` is the protocol's
-  // calibration (LoadProtocolScene), copied.
-  StimulusRenderer(const protocol::Protocol& protocol, const std::optional<calib::SceneCalib>& scene);
-  // The same with the images already loaded (LoadStimulusImages).
+  // Needs a current GL context. `scene` is the protocol's calibration (LoadProtocolScene), `images` its images
+  // (LoadStimulusImages), both copied; frames are composed as `presentation` says (the window's size).
   StimulusRenderer(const protocol::Protocol& protocol, const std::optional<calib::SceneCalib>& scene,
-                   const StimulusImages& images);
+                   const StimulusImages& images, const Presentation& presentation);
   ~StimulusRenderer();
   StimulusRenderer(const StimulusRenderer&) = delete;
   StimulusRenderer& operator=(const StimulusRenderer&) = delete;
@@ -115,8 +131,11 @@ class StimulusRenderer {
   cv::Size FrameSize() const;
   // Composes the frame t_s after onset; `level` is the adjustment level shown (picture only).
   void Compose(const TrialScene& trial, double t_s, double level);
-  // What the last composed frame showed of a pair (ObjectsAt, as drawn): empty sides for pictures and wiped balls.
+  // What the last composed frame showed of a pair (ObjectsAt, as drawn; radii in photo px): empty sides for
+  // pictures and wiped balls.
   const std::array<std::optional<render::BlurredObject>, 2>& Shown() const { return shown_; }
+  // Where the last composed frame showed the photo (pairs; the identity of the frame for a picture).
+  render::FrameView View() const;
   // Shows the last composed frame in the current window, fitted to width x height.
   void Present(int width_px, int height_px);
   // The last composed frame, 8-bit sRGB BGR.
@@ -125,6 +144,7 @@ class StimulusRenderer {
  private:
   const protocol::Protocol& protocol_;
   std::optional<calib::SceneCalib> scene_;
+  Presentation presentation_;
   cv::Mat photo_, texture_;
   std::unique_ptr<render::FrameCompositor> compositor_;
   // Picture: the upper half at a cut-off, made once (the Butterworth runs on the CPU) and kept; every level of
