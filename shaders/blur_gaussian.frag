@@ -4,8 +4,8 @@
 // Texels are fetched exactly; outside the image the border texel repeats (clamp to edge).
 uniform sampler2D u_image;     // linear, premultiplied RGBA
 uniform vec2 u_direction;      // (1, 0) horizontal pass, (0, 1) vertical pass
-uniform float u_sigma_px;      // s = r / 2
-uniform int u_taps;            // kernel half-width, ceil(3 s): as wide as s needs and no wider
+uniform float u_sigma_px;      // GaussianKernelSigma(r / 2): the width whose discrete kernel has variance (r / 2)^2
+uniform int u_taps;            // kernel half-width, ceil(3 r / 2): as wide as it needs and no wider
 out vec4 o_color;
 void main() {
   ivec2 size = textureSize(u_image, 0);

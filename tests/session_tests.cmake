@@ -107,3 +107,8 @@ add_preflight_test(nested-100000-deep "not valid JSON: nested deeper than 64 lev
 set(levels "[1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17,18,19,20,21,22,23,24,25,26,27,28,29,30]")
 add_preflight_test(eight-factors-of-30 "/factors: the session would have 656100000000 trials (30 a x 30 b x "
                    "${ball_head} ${ball_scene}, \"factors\": {\"pattern\": [${pattern}], \"a\": ${levels}, \"b\": ${levels}, \"c\": ${levels}, \"d\": ${levels}, \"e\": ${levels}, \"f\": ${levels}, \"g\": ${levels}, \"h\": ${levels}}}")
+
+# What the screen shows, measured on captured frames (run --capture) with the calibration's edge fit: each object's
+# blur against its recorded r_screen_px and its edges against its recorded outline (tests/capture_measure.cc).
+add_executable(capture_measure ${PROJECT_SOURCE_DIR}/tests/capture_measure.cc)
+target_link_libraries(capture_measure PRIVATE blurcue_calib blurcue_core)

@@ -359,8 +359,17 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
     if (auto x = Number(v, "brightness", ptr, false, 0.25, 4, "(a factor)")) p->content.brightness = *x;
     if (auto x = Number(v, "contrast", ptr, false, 0.25, 4, "(a factor)")) p->content.contrast = *x;
   }
+  if (*type == "grid" || *type == "ball") {
+    // The card's face or the ball's surface: a shipped texture by name, or an image file.
+    const bool grid = *type == "grid";
+    p->content.texture = grid ? "grid" : "soccer";
+    if (auto t = Text(v, "texture", ptr, false, kMaxPathChars, true)) {
+      if (grid ? *t == "grid" : (*t == "soccer" || *t == "wood")) p->content.texture = *t;
+      else p->content.texture = Path(v, "texture", ptr, true).string();
+    }
+  }
   if (*type == "grid") {
-    Object(v, ptr, {"type", "cells", "kernel", "brightness", "contrast"});
+    Object(v, ptr, {"type", "cells", "texture", "kernel", "brightness", "contrast"});
     // Only the shipped 5 x 5 card is drawn: another count would be recorded but not shown.
     if (auto n = Int(v, "cells", ptr, false, 5, 5, "cells per side (only the shipped 5 x 5 card is drawn)"))
       p->content.cells = *n;
@@ -368,10 +377,6 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
     Object(v, ptr, {"type", "texture", "radius_mm", "kernel", "brightness", "contrast"});
     // A ball rolls on the board's 25 mm squares: from a marble to a football.
     if (auto r = Number(v, "radius_mm", ptr, false, 1, 150, "mm")) p->content.radius_mm = *r;
-    if (auto t = Text(v, "texture", ptr, false, kMaxPathChars, true)) {
-      if (*t == "soccer" || *t == "wood") p->content.texture = *t;
-      else p->content.texture = Path(v, "texture", ptr, true).string();
-    }
   } else {
     Object(v, ptr, {"type", "image", "real_photos"});
     p->content.image = Path(v, "image", ptr, true);

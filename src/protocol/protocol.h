@@ -67,7 +67,7 @@ struct Content {
   std::string kernel = "gaussian";    // "gaussian" | "disc"
   double brightness = 1, contrast = 1;
   double radius_mm = 10;              // ball
-  std::string texture = "soccer";     // ball: soccer | wood | an image path (resolved)
+  std::string texture = "soccer";     // grid: grid (the 5 x 5 card) | an image path; ball: soccer | wood | a path
   std::filesystem::path image;        // picture: the image (resolved)
   // picture: photos of the real picture, one per distance: a resolved path with "{distance_m}" standing for the
   // level as %g (e.g. "photos/face-{distance_m}m.png" -> "photos/face-0.4m.png"); empty: the scene photo

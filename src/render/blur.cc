@@ -29,7 +29,28 @@ void CheckBlurRadius(double r_px) {
 int GaussianTaps(double sigma_px) {
   if (sigma_px <= 0) return 0;
   CheckBlurRadius(2 * sigma_px);  // a NaN or huge sigma has no tap count an int holds
-  return int(std::ceil(3 * sigma_px));
+  return std::max(1, int(std::ceil(3 * sigma_px)));
+}
+
+double GaussianKernelSigma(double s) {
+  const int taps = GaussianTaps(s);
+  if (taps == 0) return 0;
+  auto variance = [taps](double t) {
+    double sum = 1, moment = 0;
+    for (int i = 1; i <= taps; ++i) {
+      const double w = std::exp(-0.5 * i * i / (t * t));
+      sum += 2 * w, moment += 2 * w * i * i;
+    }
+    return moment / sum;
+  };
+  // The variance grows with t towards the flat kernel's taps (taps + 1) / 3 >= 3 s^2: bisect.
+  double lo = 1e-3, hi = s;
+  while (variance(hi) < s * s) hi *= 2;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (variance(mid) < s * s ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
 }
 
 cv::Mat GaussianBlurCpu(const cv::Mat& rgba, double r_px) {
@@ -38,9 +59,10 @@ cv::Mat GaussianBlurCpu(const cv::Mat& rgba, double r_px) {
   const double s = r_px / 2;
   const int taps = GaussianTaps(s);
   if (taps == 0) return rgba.clone();
+  const double t = GaussianKernelSigma(s);
   cv::Mat kernel(2 * taps + 1, 1, CV_32F);
   double sum = 0;
-  for (int i = -taps; i <= taps; ++i) sum += kernel.at<float>(i + taps) = float(std::exp(-0.5 * i * i / (s * s)));
+  for (int i = -taps; i <= taps; ++i) sum += kernel.at<float>(i + taps) = float(std::exp(-0.5 * i * i / (t * t)));
   kernel /= sum;
   cv::Mat out;
   cv::sepFilter2D(rgba, out, CV_32F, kernel, kernel, cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
@@ -236,7 +258,7 @@ void GlBlur::BlurTexture(Texture& texture, const std::string& method, double r_p
     if (taps == 0) return;
     gaussian_->Use();
     glUniform1i(gaussian_->Uniform("u_image"), 0);
-    glUniform1f(gaussian_->Uniform("u_sigma_px"), float(s));
+    glUniform1f(gaussian_->Uniform("u_sigma_px"), float(GaussianKernelSigma(s)));  // variance exactly s^2
     glUniform1i(gaussian_->Uniform("u_taps"), taps);
     Framebuffer to_scratch(scratch), to_texture(texture);
     to_scratch.Bind();

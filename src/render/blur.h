@@ -20,8 +20,12 @@ void CheckBlurRadius(double r_px);
 // any size holds, so a larger value only hides a mistake.
 constexpr double kMaxCutoffCyclesPerWidth = 1e5;
 
-// Half-width of the discrete Gaussian for std s: ceil(3 s), as wide as s needs and no wider.
+// Half-width of the discrete Gaussian for std s: ceil(3 s) (at least 1), as wide as s needs and no wider.
 int GaussianTaps(double sigma_px);
+// The width t of the discrete kernel exp(-i^2 / 2 t^2), |i| <= GaussianTaps(s), normalised, whose variance is
+// exactly s^2. Sampling a narrow Gaussian at whole pixels loses most of its variance (s = 0.3 px would keep a tenth:
+// r 0.6 px drawn as 0.18) and truncating it at 3 s a little, so t > s; from s = 1 px on they differ by ~1 %.
+double GaussianKernelSigma(double sigma_px);
 
 // CPU reference: the shader's separable kernel (normalised, clamp-to-edge) on CV_32FC4 premultiplied linear RGBA.
 // Every blur function here (CPU and GL) refuses a radius CheckBlurRadius refuses; r = 0 leaves the image as it is.

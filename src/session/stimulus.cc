@@ -400,11 +400,11 @@ StimulusImages LoadStimulusImages(const protocol::Protocol& protocol, const std:
     throw InputError(At(protocol, photo_field), std::string(e.what()) + " (the calibration " +
                                                     protocol.scene.calib.string() + " is of another photo)");
   }
-  const bool shipped = protocol.content.type == "grid" || protocol.content.texture == "soccer" ||
-                       protocol.content.texture == "wood";
+  const std::string& name = protocol.content.texture;
+  const bool shipped = name == "grid" || name == "soccer" || name == "wood";
   std::filesystem::path texture;
   try {
-    texture = render::ResolveStimulus(protocol.content.type == "grid" ? "grid" : protocol.content.texture);
+    texture = render::ResolveStimulus(name);
   } catch (const std::exception& e) {
     throw InputError(At(protocol, shipped ? "/content/type" : "/content/texture"), e.what());
   }
