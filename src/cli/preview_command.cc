@@ -27,6 +27,7 @@ void AddPreviewCommand(CLI::App& app) {
     std::string protocol, out, participant = "P1";
     std::optional<uint64_t> seed;
     int columns = 6, tile_width = 320;
+    bool list = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -41,6 +42,8 @@ void AddPreviewCommand(CLI::App& app) {
   cmd->add_option("--participant", args->participant, "whose trial list (by_participant sides)")
       ->capture_default_str();
   cmd->add_option("--seed", args->seed, "seed (default: as blurcue run)")->check(SeedValidator());
+  cmd->add_flag("--list", args->list, "also print each tile's label (its levels, each side's source and radius in "
+                                      "photo px, screen px and arcmin), one line per tile");
   cmd->add_option("--columns", args->columns, "tiles per row")->capture_default_str()->check(IntRange(1, 20));
   cmd->add_option("--tile-width", args->tile_width, "tile width in px")->capture_default_str()
       ->check(IntRange(80, 2000, "px"));
@@ -92,9 +95,13 @@ void AddPreviewCommand(CLI::App& app) {
         levels += (levels.empty() ? "" : " ") + name + " " +
                   (value.is_object() && value.contains("id") ? value["id"].dump() : value.dump());
       auto source = [](const Json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); };
+      // Each side's radius as the camera made it (photo px) and as the screen shows it (screen px, arcmin): the
+      // numbers the record keeps for these trials.
+      const session::Presentation& at = prepared.presentation;
       char sides[256];
-      std::snprintf(sides, sizeof sides, "L %s %.2f px | R %s %.2f px", source(t.left).c_str(), s.r_left_px,
-                    source(t.right).c_str(), s.r_right_px);
+      std::snprintf(sides, sizeof sides, "L %s %.2f px = %.2f scr px %.2f' | R %s %.2f px = %.2f scr px %.2f'",
+                    source(t.left).c_str(), s.r_left_px, at.ScreenPx(s.r_left_px), at.Arcmin(s.r_left_px),
+                    source(t.right).c_str(), s.r_right_px, at.ScreenPx(s.r_right_px), at.Arcmin(s.r_right_px));
       tiles.push_back({s, 0, levels, sides, key});
     }
     std::stable_sort(tiles.begin(), tiles.end(), [](const Tile& a, const Tile& b) { return a.key < b.key; });
@@ -118,6 +125,7 @@ void AddPreviewCommand(CLI::App& app) {
                   cv::FONT_HERSHEY_SIMPLEX, 0.36, cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
       cv::putText(sheet, tiles[i].label2, {x + 4, y + th + 28}, cv::FONT_HERSHEY_SIMPLEX, 0.36,
                   cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
+      if (args->list) std::printf("#%zu %s: %s\n", i + 1, tiles[i].label.c_str(), tiles[i].label2.c_str());
       if (tty) std::fprintf(stderr, "\rpreview: %zu of %zu", i + 1, tiles.size());
     }
     if (tty) std::fprintf(stderr, "\n");

@@ -1,0 +1,166 @@
+#!/usr/bin/env bash
+# The record equals the screen: `blurcue run --capture` frames measured with the calibration's edge fit
+# (tests/capture_measure.cc), and the preview, the record and the capture compared.
+# usage: capture_test.sh CASE BLURCUE CAPTURE_MEASURE DIR   (DIR holds protocols/ and the scene they show)
+set -euo pipefail
+CASE=$1 BC=$2 MEASURE=$3 DIR=$4
+P=$DIR/protocols
+W=$DIR/capture-$CASE
+rm -rf "$W" && mkdir -p "$W"
+source "$(dirname "$0")/lib.sh"
+# A uniform card face and ball surface (a PPM: no image library needed): their silhouettes are clean step edges.
+printf 'P6 8 8 255\n' > "$W/white.ppm"
+head -c 192 /dev/zero | tr '\0' '\353' >> "$W/white.ppm"
+# variant SRC OUT KEY=JSON...: the protocol SRC with fields set (dotted paths), paths resolved against SRC's folder.
+variant() {
+  $PY - "$@" <<'PYEOF'
+import json, os, sys
+src, out = sys.argv[1], sys.argv[2]
+p = json.load(open(src))
+base = os.path.dirname(os.path.abspath(src))
+for k in ("background", "board_free", "calib"):
+    if k in p.get("scene", {}):
+        p["scene"][k] = os.path.normpath(os.path.join(base, p["scene"][k]))
+for kv in sys.argv[3:]:
+    key, value = kv.split("=", 1)
+    node = p
+    *path, last = key.split(".")
+    for part in path:
+        node = node.setdefault(part, {})
+    if value == "DELETE":
+        node.pop(last, None)
+    else:
+        node[last] = json.loads(value)
+json.dump(p, open(out, "w"), indent=1)
+PYEOF
+}
+# capture PROTOCOL NAME [ARGS...]: runs it with the simulated observer (fixed seed) into $W/NAME/.
+capture() {
+  local protocol=$1 name=$2
+  shift 2
+  $BC run "$protocol" --participant C1 --seed 11 --db "$W/$name.sqlite" --observer sim --capture "$W/$name" "$@" \
+      > "$W/$name.out" 2> "$W/$name.err" || fail "$name: $(tail -1 "$W/$name.err")"
+}
+
+case $CASE in
+blur)
+  # Every object of every trial: the blur measured on the captured frame matches the recorded r_screen_px within
+  # max(0.25 px, 5 %), and its edges lie on the recorded outline within 1 px. Test 1's geometry and sides with a
+  # plain card; a static ball 2AFC at edges 3, 6 and 9 against its unblurred twin (a lit ball's rim is not a step).
+  variant "$P/test1-static-grids.json" "$W/grid.json" "content.texture=\"$W/white.ppm\""
+  capture "$W/grid.json" grid
+  "$MEASURE" "$W/grid" > "$W/grid.txt" || fail "test 1 captures: $(grep BAD "$W/grid.txt" | head -3) $(tail -1 "$W/grid.txt")"
+  tail -1 "$W/grid.txt"
+  variant "$P/test1-static-grids.json" "$W/ball.json" "content={\"type\": \"ball\", \"texture\": \"$W/white.ppm\"}" \
+      'factors={"edge": [3, 6, 9]}' 'scene.show="board_free"' 'practice={"count": 0}'
+  variant "$W/ball.json" "$W/ball-sharp.json" 'sides={"left": 0, "right": 0}'
+  capture "$W/ball.json" ball
+  capture "$W/ball-sharp.json" ball-sharp
+  "$MEASURE" "$W/ball" --sharp "$W/ball-sharp" > "$W/ball.txt" ||
+    fail "static balls: $(grep BAD "$W/ball.txt" | head -3) $(tail -1 "$W/ball.txt")"
+  tail -1 "$W/ball.txt"
+  echo "ok: captured blur and place of every object match the record"
+  ;;
+place)
+  # Objects land where their pose says at one screen px per photo px (a crop of the photo around the trial) and at a
+  # 0.25 scale of the thesis's full-resolution photo: every edge of every card within 1 px of its outline.
+  variant "$P/test1-static-grids.json" "$W/native.json" "content.texture=\"$W/white.ppm\"" 'display.scale="native"'
+  capture "$W/native.json" native
+  "$MEASURE" "$W/native" > "$W/native.txt" || fail "native: $(grep BAD "$W/native.txt" | head -3)"
+  tail -1 "$W/native.txt"
+  $PY - "$W/native" <<'PYEOF' || fail "native captures are not 1 screen px per photo px"
+import json, glob, sys
+for f in glob.glob(sys.argv[1] + "/*.json"):
+    d = json.load(open(f))
+    assert d["scaling"] == "native" and d["screen_px_per_photo_px"] == 1, f
+    assert d["photo_rect_px"][2:] == [1148, 764], d["photo_rect_px"]
+PYEOF
+  $BC synth-scene --out "$W/full" --preset thesis --seed 3 > /dev/null
+  $BC calibrate "$W/full/scene.png" --camera "$W/full/camera.json" --out "$W/full/calib.json" > /dev/null
+  variant "$P/test1-static-grids.json" "$W/quarter.json" "content.texture=\"$W/white.ppm\"" 'display.scale=0.25' \
+      "scene={\"background\": \"$W/full/scene.png\", \"calib\": \"$W/full/calib.json\"}"
+  capture "$W/quarter.json" quarter
+  # Place only: below a screen px of blur the edge fit on drawn edges scatters by up to 0.3 px (README).
+  "$MEASURE" "$W/quarter" --tolerance-px 1e9 > "$W/quarter.txt" || fail "0.25 scale: $(grep BAD "$W/quarter.txt" | head -3)"
+  tail -1 "$W/quarter.txt"
+  echo "ok: objects land on their outlines at native and 0.25 scale"
+  ;;
+window)
+  # Headless and in a window, the same pixels: the window's back buffer read before the swap equals the frame
+  # composed headless, for a still trial.
+  start_xvfb
+  variant "$P/test1-static-grids.json" "$W/grid.json" 'practice={"count": 0}' 'factors={"edge": [4, 9]}'
+  capture "$W/grid.json" headless
+  capture "$W/grid.json" window --window
+  $PY - "$W/headless" "$W/window" <<'PYEOF' || fail "window and headless captures differ"
+import glob, os, sys
+import numpy as np
+from PIL import Image
+files = sorted(glob.glob(sys.argv[1] + "/*.png"))
+assert len(files) == 2, files
+for f in files:
+    a = np.asarray(Image.open(f), dtype=int)
+    b = np.asarray(Image.open(os.path.join(sys.argv[2], os.path.basename(f))), dtype=int)
+    assert a.shape == b.shape == (720, 1280, 3), (a.shape, b.shape)
+    diff = np.abs(a - b)
+    assert diff.max() <= 1, (f, diff.max(), (diff > 1).sum())
+    print(os.path.basename(f), "max difference", diff.max())
+PYEOF
+  echo "ok: a window shows the pixels composed headless"
+  ;;
+agree)
+  # The preview's labels, the record (trials.csv; for a moving stimulus the frames table's first frame) and the
+  # capture JSON say the same radii for every trial.
+  variant "$P/test1-static-grids.json" "$W/t1.json"
+  capture "$W/t1.json" t1
+  $BC preview "$W/t1.json" --participant C1 --seed 11 --out "$W/t1-preview.png" --list > "$W/t1-preview.txt"
+  capture "$P/test2-moving-balls.json" t2 --stop-after 6
+  for name in t1 t2; do $BC export --db "$W/$name.sqlite" --out "$W/$name-tables" > /dev/null; done
+  $PY - "$W" <<'PYEOF' || fail "preview, record and capture disagree"
+import csv, json, re, sys
+w = sys.argv[1]
+def capture(name, index):
+    return json.load(open(f"{w}/{name}/trial-{index + 1:04d}.json"))
+# Test 1 (still): trials.csv's per-trial radii equal the capture's, in all three units, and the preview's label.
+labels = {}
+for line in open(f"{w}/t1-preview.txt"):
+    if not line.startswith("#"):
+        continue
+    m = re.match(r"#\d+ edge (\d+): L (\S+) ([\d.]+) px = ([\d.]+) scr px ([\d.]+)' \| R (\S+) ([\d.]+) px = ([\d.]+) scr px ([\d.]+)'", line)
+    assert m, line
+    labels[(int(m[1]), m[2], m[6])] = [float(x) for x in (m[3], m[4], m[5], m[7], m[8], m[9])]
+n = 0
+for t in csv.DictReader(open(f"{w}/t1-tables/trials.csv")):
+    c = capture("t1", int(t["trial_index"]))
+    sides = {o["side"]: o for o in c["objects"]}
+    for side in ("left", "right"):
+        o = sides[side]
+        assert abs(float(t[f"r_{side}_px"]) - o["r_camera_px"]) < 2e-4, (t["trial_index"], side)
+        assert abs(float(t[f"r_{side}_screen_px"]) - o["r_screen_px"]) < 2e-4, (t["trial_index"], side)
+        assert abs(float(t[f"r_{side}_arcmin"]) - o["r_arcmin"]) < 2e-4, (t["trial_index"], side)
+        assert o["source"] == t[side], (t["trial_index"], side, o["source"], t[side])
+    assert abs(float(t["screen_px_per_photo_px"]) - c["screen_px_per_photo_px"]) < 1e-6
+    label = labels[(int(t["edge"]), sides["left"]["source"], sides["right"]["source"])]
+    got = [sides["left"]["r_camera_px"], sides["left"]["r_screen_px"], sides["left"]["r_arcmin"],
+           sides["right"]["r_camera_px"], sides["right"]["r_screen_px"], sides["right"]["r_arcmin"]]
+    assert all(abs(a - b) <= 0.0051 for a, b in zip(label, got)), (label, got)
+    n += 1
+assert n == 13, n
+# Test 2 (moving): the capture is the first frame; the frames table's first frame records the same radii.
+frames = {}
+for f in csv.DictReader(open(f"{w}/t2-tables/frames.csv")):
+    frames.setdefault(int(f["trial_index"]), []).append(f)
+m = 0
+for i, fs in frames.items():
+    first = min(fs, key=lambda f: int(f["frame_index"]))
+    c = capture("t2", i)
+    for o in c["objects"]:
+        assert abs(float(first[f"r_{o['side']}_px"]) - o["r_camera_px"]) < 2e-4, (i, o["side"])
+    m += 1
+assert m == 6, m
+print(f"{n} still trials and {m} moving ones agree")
+PYEOF
+  echo "ok: preview, trials.csv and capture agree"
+  ;;
+*) fail "unknown case $CASE" ;;
+esac
