@@ -52,7 +52,7 @@ Fits MeasureCard(const cv::Mat& linear, const std::vector<cv::Point2d>& outline)
   for (size_t i = 0; i < outline.size(); ++i)
     shortest = std::min(shortest, cv::norm(outline[(i + 1) % outline.size()] - outline[i]));
   for (size_t i = 0; i < outline.size(); ++i) {
-    EdgeSegment s{outline[i], outline[(i + 1) % outline.size()], std::clamp(shortest / 4, 3.0, 10.0)};
+    EdgeSegment s{outline[i], outline[(i + 1) % outline.size()], std::clamp(shortest / 3, 3.0, 20.0)};
     const ModelFit f = MeasureEdgeModel(linear, s);
     if (std::getenv("CAPTURE_MEASURE_VERBOSE")) std::printf("  side %zu: r %.3f offset %.3f ok %d rms %.3f step %.3f psf %s\n", i, f.r_px, f.offset_px, f.ok, f.rms_rel, f.step, f.psf.c_str());
     fits.Add(f);
