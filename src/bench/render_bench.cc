@@ -163,10 +163,7 @@ std::vector<RenderRow> RunRenderBench(const RenderBenchOptions& options) {
       std::vector<render::BlurredObject> balls(2);
       for (int b = 0; b < 2; ++b) {
         auto& o = balls[b].object;
-        o.kind = render::VirtualObject::Kind::kBall;
-        o.size_mm = 10;
-        o.center_board_mm = {b == 0 ? 62.5 : 112.5, y, 10};
-        o.spin_deg = y / 10 * 180 / M_PI;
+        o = render::BallOnBoard(scene.board, b == 0 ? 3 : 5, y, 10, 0);  // test 2's balls on sections 3 and 5
         o.texture = soccer;
         cv::Matx33d rot;
         cv::Rodrigues(scene.rvec, rot);

@@ -122,8 +122,7 @@ void AddAnimateCommand(CLI::App& app) {
     using Clock = std::chrono::steady_clock;
     {  // a warm-up frame uploads and mipmaps the texture, so frame 0 is not slower than the rest
       render::BlurredObject b;
-      b.object.kind = render::VirtualObject::Kind::kBall;
-      b.object.center_board_mm = {(args->left_section - 0.5) * s, y0, radius};
+      b.object = render::BallOnBoard(scene.board, args->left_section, y0, radius, y0);
       b.object.texture = texture;
       compositor.Compose({b});
       compositor.Finish();
@@ -141,10 +140,7 @@ void AddAnimateCommand(CLI::App& app) {
       double r[2];
       for (int b = 0; b < 2; ++b) {
         render::VirtualObject& o = balls[b].object;
-        o.kind = render::VirtualObject::Kind::kBall;
-        o.size_mm = radius;
-        o.center_board_mm = {(section[b] - 0.5) * s, y, radius};
-        o.spin_deg = -(y - y0) / radius * 180 / M_PI;  // rolling without slipping away from the camera
+        o = render::BallOnBoard(scene.board, section[b], y, radius, y0);
         o.texture = texture;
         r[b] = args->gain * calib::BlurAtPx(scene, source[b], scene.ToCamera(o.center_board_mm), fixed[b]);
         if (!(r[b] >= 0 && r[b] <= render::kMaxBlurRadiusPx))

@@ -101,17 +101,13 @@ void AddRenderCommand(CLI::App& app) {
     const calib::BlurSource source = calib::ParseBlurSource(args->blur, &fixed_r);
 
     render::VirtualObject object;
-    const double s = scene.board.square_mm, y = (args->edge - 1) * s;
+    const double y = (args->edge - 1) * scene.board.square_mm;
     std::string texture_name;
     if (args->object == "grid") {
-      object.kind = render::VirtualObject::Kind::kCard;
-      object.size_mm = 2 * s;
-      object.center_board_mm = {scene.board.WidthMm() + s + object.size_mm / 2, y, 0};
+      object = render::CardBesideBoard(scene.board, args->edge, /*left=*/false);
       texture_name = "grid";
     } else if (args->object.rfind("ball", 0) == 0) {
-      object.kind = render::VirtualObject::Kind::kBall;
-      object.size_mm = 10;
-      object.center_board_mm = {(args->section - 0.5) * s, y, object.size_mm};
+      object = render::BallOnBoard(scene.board, args->section, y, 10, y);
       texture_name = args->object.size() > 5 && args->object[4] == ':' ? args->object.substr(5) : "soccer";
     } else {
       throw Error(ErrorKind::kUsage, "--object must be grid or ball[:TEXTURE], got '" + args->object + "'");

@@ -129,6 +129,24 @@ SceneRenderer::SceneRenderer(const Camera& camera, const cv::Vec3d& rvec, const 
 
 SceneRenderer::~SceneRenderer() = default;
 
+VirtualObject CardBesideBoard(const Board& board, int edge, bool left) {
+  VirtualObject o;
+  o.kind = VirtualObject::Kind::kCard;
+  const double s = board.square_mm;
+  o.size_mm = 2 * s;
+  o.center_board_mm = {left ? -s - o.size_mm / 2 : board.WidthMm() + s + o.size_mm / 2, (edge - 1) * s, 0};
+  return o;
+}
+
+VirtualObject BallOnBoard(const Board& board, int section, double y_mm, double radius_mm, double from_y_mm) {
+  VirtualObject o;
+  o.kind = VirtualObject::Kind::kBall;
+  o.size_mm = radius_mm;
+  o.center_board_mm = {(section - 0.5) * board.square_mm, y_mm, radius_mm};
+  o.spin_deg = -(y_mm - from_y_mm) / radius_mm * 180 / M_PI;  // rolling away from the camera without slipping
+  return o;
+}
+
 Footprint FootprintOf(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec, const VirtualObject& o) {
   const auto corners = BoxCorners(o);
   std::vector<cv::Point2d> px;

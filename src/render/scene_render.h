@@ -9,6 +9,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "core/board.h"
 #include "core/camera.h"
 
 namespace blurcue::render {
@@ -23,6 +24,14 @@ struct VirtualObject {
   double brightness = 1.0, contrast = 1.0;
   double spin_deg = 0;  // rotation of a ball about the board's x axis (rolling along y)
 };
+
+// Poses on the calibrated board (board frame, mm): the one definition every command places objects with (run,
+// preview, render, animate, bench). A 2 x 2-square card lying on the table beside the board, left or right of it, its
+// centre on edge `edge`'s line (test 1); a ball of `radius_mm` resting on section `section` (1-based, centred
+// across it) at y_mm along the board, turned as if rolled there from from_y_mm without slipping (tests 2 and 3).
+// Texture, brightness and contrast are left to the caller.
+VirtualObject CardBesideBoard(const Board& board, int edge, bool left);
+VirtualObject BallOnBoard(const Board& board, int section, double y_mm, double radius_mm, double from_y_mm);
 
 // Where the object lands in the photo, and how far it spans in depth.
 struct Footprint {

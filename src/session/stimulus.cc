@@ -50,13 +50,12 @@ calib::BlurSource Source(const Json& v, double* fixed, const std::function<std::
   }
 }
 
-// Board-frame placement of the two objects of a pair.
+// Board-frame placement of the two objects of a pair (render's poses on the board).
 cv::Vec3d GridCentre(const calib::SceneCalib& s, int edge, bool left) {
-  const double size = 2 * s.board.square_mm, y = (edge - 1) * s.board.square_mm;
-  return {left ? -s.board.square_mm - size / 2 : s.board.WidthMm() + s.board.square_mm + size / 2, y, 0};
+  return render::CardBesideBoard(s.board, edge, left).center_board_mm;
 }
 cv::Vec3d BallCentre(const calib::SceneCalib& s, double y_mm, double radius_mm, bool left) {
-  return {((left ? kLeftSection : kRightSection) - 0.5) * s.board.square_mm, y_mm, radius_mm};
+  return render::BallOnBoard(s.board, left ? kLeftSection : kRightSection, y_mm, radius_mm, 0).center_board_mm;
 }
 
 }  // namespace
@@ -167,17 +166,12 @@ std::array<std::optional<render::BlurredObject>, 2> ObjectsAt(const protocol::Pr
     const calib::BlurSource source = left ? trial.left : trial.right;
     const double fixed = left ? trial.left_fixed_px : trial.right_fixed_px;
     if (trial.content == "grid") {
-      o.kind = render::VirtualObject::Kind::kCard;
-      o.size_mm = 2 * s.board.square_mm;
-      o.center_board_mm = GridCentre(s, trial.edge, left);
+      o = render::CardBesideBoard(s.board, trial.edge, left);
     } else {
       const double y = trial.BallYMm(t_s);
       if (!std::isfinite(y)) continue;  // wiped at the end of a section
-      const double radius = protocol.content.radius_mm;  // validated > 0
-      o.kind = render::VirtualObject::Kind::kBall;
-      o.size_mm = radius;
-      o.center_board_mm = BallCentre(s, y, radius, left);
-      o.spin_deg = -(y - trial.from_y_mm) / radius * 180 / M_PI;  // rolling without slipping
+      o = render::BallOnBoard(s.board, left ? kLeftSection : kRightSection, y, protocol.content.radius_mm,
+                              trial.from_y_mm);
     }
     o.brightness = trial.brightness;
     o.contrast = trial.contrast;
