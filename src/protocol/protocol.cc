@@ -358,6 +358,15 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
     // The thesis matched the virtual object to the scene by eye; a factor of 4 either way is far beyond that.
     if (auto x = Number(v, "brightness", ptr, false, 0.25, 4, "(a factor)")) p->content.brightness = *x;
     if (auto x = Number(v, "contrast", ptr, false, 0.25, 4, "(a factor)")) p->content.contrast = *x;
+    if (const Json* wb = Field(v, "white_balance", ptr, false)) {
+      if (wb->is_array() && wb->size() == 3 && std::all_of(wb->begin(), wb->end(), [](const Json& g) {
+            return NumberIn(g, 0.25, 4);
+          }))
+        for (size_t c = 0; c < 3; ++c) p->content.white_balance[c] = (*wb)[c].get<double>();
+      else
+        Problem(ptr + "/white_balance", "must be [red, green, blue] gains, each in " + Range(0.25, 4, "(a factor)"),
+                *wb);
+    }
   }
   if (*type == "grid" || *type == "ball") {
     // The card's face or the ball's surface: a shipped texture by name, or an image file.
@@ -369,12 +378,12 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
     }
   }
   if (*type == "grid") {
-    Object(v, ptr, {"type", "cells", "texture", "kernel", "brightness", "contrast"});
+    Object(v, ptr, {"type", "cells", "texture", "kernel", "brightness", "contrast", "white_balance"});
     // Only the shipped 5 x 5 card is drawn: another count would be recorded but not shown.
     if (auto n = Int(v, "cells", ptr, false, 5, 5, "cells per side (only the shipped 5 x 5 card is drawn)"))
       p->content.cells = *n;
   } else if (*type == "ball") {
-    Object(v, ptr, {"type", "texture", "radius_mm", "kernel", "brightness", "contrast"});
+    Object(v, ptr, {"type", "texture", "radius_mm", "kernel", "brightness", "contrast", "white_balance"});
     // A ball rolls on the board's 25 mm squares: from a marble to a football.
     if (auto r = Number(v, "radius_mm", ptr, false, 1, 150, "mm")) p->content.radius_mm = *r;
   } else {

@@ -2,6 +2,7 @@
 // A study protocol: a JSON file (format in protocols/protocol.schema.json) parsed into a validated `Protocol`.
 // Validation reports every problem at once, each as "FILE: /json/pointer: what is wrong, got VALUE", so one run of
 // `blurcue validate` shows all typos, wrong types, missing fields, impossible values and missing files.
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -66,6 +67,8 @@ struct Content {
   // applied in linear light (factors of the texture's values; 1 = as the texture is).
   std::string kernel = "gaussian";    // "gaussian" | "disc"
   double brightness = 1, contrast = 1;
+  // grid and ball: the thesis's "white balance" (5.3.1.3): gains of the object's red, green and blue in linear light.
+  std::array<double, 3> white_balance{1, 1, 1};
   double radius_mm = 10;              // ball
   std::string texture = "soccer";     // grid: grid (the 5 x 5 card) | an image path; ball: soccer | wood | a path
   std::filesystem::path image;        // picture: the image (resolved)

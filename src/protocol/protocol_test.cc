@@ -59,7 +59,7 @@ TEST(ProtocolValidate, ValidProtocolHasNoProblems) {
 
 // The kernel and the brightness/contrast matching are protocol fields with ranges; a grid count other than the
 // shipped card's would be recorded but not drawn, so it is refused.
-TEST(ProtocolValidate, KernelBrightnessContrastAndCellsAreCheckedNotIgnored) {
+TEST(ProtocolValidate, KernelBrightnessContrastWhiteBalanceScaleAndCellsAreCheckedNotIgnored) {
   Json j = Valid();
   j["content"]["kernel"] = "disc";
   j["content"]["brightness"] = 1.2;
@@ -73,6 +73,24 @@ TEST(ProtocolValidate, KernelBrightnessContrastAndCellsAreCheckedNotIgnored) {
   j["content"]["kernel"] = "gaussian";
   j["content"]["contrast"] = 10;
   EXPECT_TRUE(Contains(OnlyProblem(j), "/content/contrast")) << OnlyProblem(j);
+  j["content"]["contrast"] = 1;
+  j["content"]["white_balance"] = {1.0, 0.9, 1.1};
+  EXPECT_TRUE(Problems(j).empty());
+  EXPECT_DOUBLE_EQ(ParseProtocol(j, SceneFolder() / "p.json").content.white_balance[2], 1.1);
+  for (const Json& bad : {Json::array({1, 1}), Json::array({1, 1, 9}), Json(1.0), Json::array({1, "1", 1})}) {
+    j["content"]["white_balance"] = bad;
+    EXPECT_TRUE(Contains(OnlyProblem(j), "/content/white_balance: must be [red, green, blue] gains")) << OnlyProblem(j);
+  }
+  j["content"].erase("white_balance");
+  // A display scale or width in degrees is for a photo's grid or ball; each is checked, and not both at once.
+  Json shown = Valid();
+  shown["display"] = {{"scale", "native"}};
+  EXPECT_TRUE(Problems(shown).empty());
+  EXPECT_EQ(ParseProtocol(shown, SceneFolder() / "p.json").display.scaling, Scaling::kNative);
+  shown["display"] = {{"scale", 0.01}};
+  EXPECT_TRUE(Contains(OnlyProblem(shown), "/display/scale: must be \"fit\", \"native\"")) << OnlyProblem(shown);
+  shown["display"] = {{"scale", 0.5}, {"width_deg", 20}};
+  EXPECT_TRUE(Contains(OnlyProblem(shown), "/display/width_deg: give either")) << OnlyProblem(shown);
   Json grid = Valid();
   grid["content"] = {{"type", "grid"}, {"cells", 7}};
   bool named = false;

@@ -300,6 +300,8 @@ GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px, boo
   glUniform1f(p.Uniform("u_lit"), o.kind == VirtualObject::Kind::kBall ? 1.0f : 0.0f);
   glUniform1f(p.Uniform("u_brightness"), float(o.brightness));
   glUniform1f(p.Uniform("u_contrast"), float(o.contrast));
+  glUniform3f(p.Uniform("u_white_balance"), float(o.white_balance[0]), float(o.white_balance[1]),
+              float(o.white_balance[2]));
   glUniform1i(p.Uniform("u_texture"), 0);
   impl_->TextureFor(o.texture).Bind(0);
   glUniformMatrix4fv(p.Uniform("u_model"), 1, GL_FALSE, glm::value_ptr(ModelMatrix(o)));

@@ -22,6 +22,7 @@ struct VirtualObject {
   double size_mm = 10;  // card: side; ball: radius
   cv::Mat texture;      // 8-bit sRGB BGR/BGRA: equirectangular for a ball, the card's face for a card
   double brightness = 1.0, contrast = 1.0;
+  cv::Vec3d white_balance{1, 1, 1};  // gains of red, green, blue in linear light (after brightness and contrast)
   double spin_deg = 0;  // rotation of a ball about the board's x axis (rolling along y)
 };
 

@@ -126,6 +126,35 @@ TEST(Composite, OverIsPremultipliedAndLinear) {
   EXPECT_FLOAT_EQ(background.at<cv::Vec3f>(0, 0)[0], 0.5f);
 }
 
+TEST_F(SceneRenderTest, WhiteBalanceScalesEachChannelInLinearLight) {
+  // A flat white card (texture sRGB 200 = 0.578 linear) drawn plain and with gains (red 1, green 0.5, blue 2):
+  // covered pixels keep their coverage and carry the texture's linear value times each gain.
+  const View v;
+  SceneRenderer renderer(v.camera, v.rvec, v.tvec);
+  VirtualObject card;
+  card.kind = VirtualObject::Kind::kCard;
+  card.size_mm = 50;
+  card.center_board_mm = {87.5, 125, 0};
+  card.texture = cv::Mat(32, 32, CV_8UC3, cv::Scalar(200, 200, 200));
+  const Layer plain = renderer.Draw(card, 1);
+  card.white_balance = {1, 0.5, 2};
+  const Layer balanced = renderer.Draw(card, 1);
+  const double linear = std::pow((200 / 255.0 + 0.055) / 1.055, 2.4);
+  int inside = 0;
+  for (int y = 0; y < plain.bgra.rows; ++y)
+    for (int x = 0; x < plain.bgra.cols; ++x) {
+      const cv::Vec4f p = plain.bgra.at<cv::Vec4f>(y, x), b = balanced.bgra.at<cv::Vec4f>(y, x);
+      ASSERT_FLOAT_EQ(p[3], b[3]);
+      if (p[3] < 1) continue;
+      ++inside;
+      EXPECT_NEAR(p[2], linear, 2e-3);        // red (BGRA order)
+      EXPECT_NEAR(b[2], linear, 2e-3);
+      EXPECT_NEAR(b[1], 0.5 * linear, 2e-3);  // green
+      EXPECT_NEAR(b[0], 2 * linear, 4e-3);    // blue
+    }
+  EXPECT_GT(inside, 500);
+}
+
 }  // namespace
 }  // namespace blurcue::render
 

@@ -78,6 +78,7 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   t.kernel = protocol.content.kernel;
   t.brightness = protocol.content.brightness;
   t.contrast = protocol.content.contrast;
+  t.white_balance = protocol.content.white_balance;
   // Problems name the protocol field that asked for what cannot be shown, and the trial as a detail.
   const std::string trial_text = " (trial " + std::to_string(trial.index) + ", block " + trial.block + ")";
   if (t.content == "picture") {
@@ -175,6 +176,7 @@ std::array<std::optional<render::BlurredObject>, 2> ObjectsAt(const protocol::Pr
     }
     o.brightness = trial.brightness;
     o.contrast = trial.contrast;
+    o.white_balance = {trial.white_balance[0], trial.white_balance[1], trial.white_balance[2]};
     b.method = trial.kernel;
     b.r_px = calib::BlurAtPx(s, source, s.ToCamera(o.center_board_mm), fixed);
     shown[left ? 0 : 1] = std::move(b);
@@ -275,6 +277,9 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
     v["kernel"] = scene.kernel;
     v["brightness"] = scene.brightness;
     v["contrast"] = scene.contrast;
+    v["white_balance_r"] = scene.white_balance[0];
+    v["white_balance_g"] = scene.white_balance[1];
+    v["white_balance_b"] = scene.white_balance[2];
   }
   return v;
 }

@@ -37,6 +37,7 @@ struct TrialScene {
   double distance_m = 0;              // picture: the real picture's distance
   std::string kernel = "gaussian";    // pairs: the blur kernel, and the object's brightness/contrast matching
   double brightness = 1, contrast = 1;
+  std::array<double, 3> white_balance{1, 1, 1};  // red, green, blue gains
   // The radii rendered, averaged over the run for balls, and the scene's own blur (the fitted model) there.
   double r_left_px = 0, r_right_px = 0, r_scene_px = 0;
 
