@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -32,8 +33,11 @@ void AddPreviewCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "preview",
-      "Draw a contact sheet of every distinct stimulus a protocol shows (each at its onset), labelled with its\n"
-      "levels and the blur radius on each side, so a protocol can be checked by eye before a session.\n"
+      "Draw a contact sheet of every distinct stimulus a protocol shows (each at its onset, as the window shows it),\n"
+      "labelled with its levels, the blur radius on each side in photo px, screen px and arcmin, and its blur plan\n"
+      "(one radius, or per pixel by depth where the object's depth span changes r by the protocol's\n"
+      "content.depth_blur_threshold) with what a frame of it costs to compose here, so a protocol can be checked by\n"
+      "eye before a session.\n"
       "Distinct: the same levels and sides drawn once (practice copies and repetitions are not repeated); for\n"
       "depth matching, one tile per adjustment level and one per distance.\n"
       "Example: blurcue preview protocols/test1-static-grids.json --out results/preview-test1.png");
@@ -110,22 +114,42 @@ void AddPreviewCommand(CLI::App& app) {
     auto context = render::GlContext::CreateOffscreen();
     session::StimulusRenderer renderer(p, scene, prepared.images, prepared.presentation);
     const cv::Size frame = renderer.FrameSize();
-    const int tw = args->tile_width, th = tw * frame.height / frame.width, strip = 34;
+    const int tw = args->tile_width, th = tw * frame.height / frame.width, strip = 62;
     const int cols = std::min<int>(args->columns, int(tiles.size()));
     const int rows = (int(tiles.size()) + cols - 1) / cols;
     cv::Mat sheet(rows * (th + strip), cols * tw, CV_8UC3, cv::Scalar(40, 40, 40));
     const bool tty = isatty(2);  // a terminal gets a progress line; a log only the summary
     for (size_t i = 0; i < tiles.size(); ++i) {
+      // Composed twice: the second time is what a frame of it costs in a session (textures already uploaded).
       renderer.Compose(tiles[i].scene, 0, tiles[i].level);
-      cv::Mat small;
-      cv::resize(renderer.Read(), small, cv::Size(tw, th), 0, 0, cv::INTER_AREA);
+      renderer.Finish();
+      const auto t0 = std::chrono::steady_clock::now();
+      renderer.Compose(tiles[i].scene, 0, tiles[i].level);
+      renderer.Finish();
+      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      std::string plan;
+      if (tiles[i].scene.content != "picture") {
+        char text[128];
+        std::snprintf(text, sizeof text, "plan: %s, span %.2f scr px, %.1f ms/frame",
+                      tiles[i].scene.per_pixel ? "per pixel" : "one radius", tiles[i].scene.r_span_screen_px, ms);
+        plan = text;
+      }
+      const cv::Mat small = ResampleSrgb8(renderer.Read(), cv::Size(tw, th));
       const int x = int(i % size_t(cols)) * tw, y = int(i / size_t(cols)) * (th + strip);
       small.copyTo(sheet(cv::Rect(x, y, tw, th)));
-      cv::putText(sheet, "#" + std::to_string(i + 1) + " " + tiles[i].label, {x + 4, y + th + 14},
-                  cv::FONT_HERSHEY_SIMPLEX, 0.36, cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
-      cv::putText(sheet, tiles[i].label2, {x + 4, y + th + 28}, cv::FONT_HERSHEY_SIMPLEX, 0.36,
-                  cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
-      if (args->list) std::printf("#%zu %s: %s\n", i + 1, tiles[i].label.c_str(), tiles[i].label2.c_str());
+      // One line each: the levels, each side, the plan (a tile is ~45 characters wide).
+      std::vector<std::string> lines{"#" + std::to_string(i + 1) + " " + tiles[i].label};
+      for (size_t at = 0, bar; at != std::string::npos; at = bar == std::string::npos ? bar : bar + 3) {
+        bar = tiles[i].label2.find(" | ", at);
+        lines.push_back(tiles[i].label2.substr(at, bar == std::string::npos ? bar : bar - at));
+      }
+      if (!plan.empty()) lines.push_back(plan.substr(6));  // without "plan: "
+      for (size_t k = 0; k < lines.size(); ++k)
+        cv::putText(sheet, lines[k], {x + 4, y + th + 14 * int(k + 1)}, cv::FONT_HERSHEY_SIMPLEX, 0.36,
+                    cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
+      if (args->list)
+        std::printf("#%zu %s: %s%s%s\n", i + 1, tiles[i].label.c_str(), tiles[i].label2.c_str(),
+                    plan.empty() ? "" : " | ", plan.c_str());
       if (tty) std::fprintf(stderr, "\rpreview: %zu of %zu", i + 1, tiles.size());
     }
     if (tty) std::fprintf(stderr, "\n");

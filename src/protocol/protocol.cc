@@ -358,6 +358,16 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
     // The thesis matched the virtual object to the scene by eye; a factor of 4 either way is far beyond that.
     if (auto x = Number(v, "brightness", ptr, false, 0.25, 4, "(a factor)")) p->content.brightness = *x;
     if (auto x = Number(v, "contrast", ptr, false, 0.25, 4, "(a factor)")) p->content.contrast = *x;
+    if (const Json* t = Field(v, "depth_blur_threshold", ptr, false)) {
+      const std::string at = ptr + "/depth_blur_threshold";
+      if (t->is_object() && t->size() == 1 && (t->contains("screen_px") || t->contains("arcmin"))) {
+        const bool px = t->contains("screen_px");
+        if (auto x = Number(*t, px ? "screen_px" : "arcmin", at, true, 0, px ? 100 : 600, px ? "screen px" : "arcmin"))
+          p->content.depth_blur_threshold = *x, p->content.depth_blur_threshold_unit = px ? "screen_px" : "arcmin";
+      } else {
+        Problem(at, "must be {\"screen_px\": N} or {\"arcmin\": N}", *t);
+      }
+    }
     if (const Json* wb = Field(v, "white_balance", ptr, false)) {
       if (wb->is_array() && wb->size() == 3 && std::all_of(wb->begin(), wb->end(), [](const Json& g) {
             return NumberIn(g, 0.25, 4);
@@ -378,12 +388,14 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
     }
   }
   if (*type == "grid") {
-    Object(v, ptr, {"type", "cells", "texture", "kernel", "brightness", "contrast", "white_balance"});
+    Object(v, ptr, {"type", "cells", "texture", "kernel", "brightness", "contrast", "white_balance",
+                    "depth_blur_threshold"});
     // Only the shipped 5 x 5 card is drawn: another count would be recorded but not shown.
     if (auto n = Int(v, "cells", ptr, false, 5, 5, "cells per side (only the shipped 5 x 5 card is drawn)"))
       p->content.cells = *n;
   } else if (*type == "ball") {
-    Object(v, ptr, {"type", "texture", "radius_mm", "kernel", "brightness", "contrast", "white_balance"});
+    Object(v, ptr, {"type", "texture", "radius_mm", "kernel", "brightness", "contrast", "white_balance",
+                    "depth_blur_threshold"});
     // A ball rolls on the board's 25 mm squares: from a marble to a football.
     if (auto r = Number(v, "radius_mm", ptr, false, 1, 150, "mm")) p->content.radius_mm = *r;
   } else {

@@ -69,6 +69,11 @@ struct Content {
   double brightness = 1, contrast = 1;
   // grid and ball: the thesis's "white balance" (5.3.1.3): gains of the object's red, green and blue in linear light.
   std::array<double, 3> white_balance{1, 1, 1};
+  // grid and ball: how far the blur may change across an object's depth before it is blurred per pixel by depth
+  // instead of with one radius at its centre (model no more than the scene needs): {"screen_px": 0.5} (the default)
+  // or {"arcmin": 1}; 0 blurs every object per pixel.
+  double depth_blur_threshold = 0.5;
+  std::string depth_blur_threshold_unit = "screen_px";  // "screen_px" | "arcmin"
   double radius_mm = 10;              // ball
   std::string texture = "soccer";     // grid: grid (the 5 x 5 card) | an image path; ball: soccer | wood | a path
   std::filesystem::path image;        // picture: the image (resolved)

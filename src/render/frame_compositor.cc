@@ -74,6 +74,10 @@ struct FrameCompositor::Impl {
     StartFrame();
     const double scale = view.Scale(camera);
     for (const BlurredObject& o : objects) {
+      if (o.r_of_depth_px && !whole_frame) {
+        ComposeVarying(o, scale);
+        continue;
+      }
       const double r = o.r_px * scale;  // at screen resolution
       const int margin = whole_frame ? std::max(width, height) : KernelMarginPx(o.method, r) + 1;
       GpuLayer layer = renderer.DrawToTexture(o.object, margin);
@@ -81,6 +85,22 @@ struct FrameCompositor::Impl {
       blur.BlurTexture(*layer.texture, o.method, r);
       Blend(*layer.texture, layer.roi);
     }
+  }
+
+  // The per-pixel plan: the layer and its depth read back, each pixel blurred by the radius of its own depth on the
+  // CPU (levels 0.5 px apart, each a GL blur), and blended back. Only objects whose depth span asks for it pay this.
+  void ComposeVarying(const BlurredObject& o, double scale) {
+    const Footprint f = renderer.Measure(o.object);
+    auto r_screen = [&](double z) { return std::max(0.0, o.r_of_depth_px(z) * scale); };
+    const double r_max = std::max({o.r_px * scale, r_screen(f.z_min_mm), r_screen(f.z_max_mm)});
+    Layer layer = renderer.Draw(o.object, KernelMarginPx(o.method, r_max) + 1);
+    if (layer.bgra.empty()) return;
+    BlurLayerVarying(layer, o.method, r_screen, &blur);
+    cv::Mat rgba;
+    cv::cvtColor(layer.bgra, rgba, cv::COLOR_BGRA2RGBA);
+    Texture texture(rgba.cols, rgba.rows);
+    texture.Upload(rgba);
+    Blend(texture, layer.roi);
   }
 
   // Blends a layer (linear, premultiplied) over the frame at roi.

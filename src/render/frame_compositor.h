@@ -2,6 +2,7 @@
 // Composing whole stimulus frames on the GPU: the photo stays in a texture, each virtual object is drawn into a
 // layer covering its pixels plus the kernel margin, blurred there, and blended over the frame in linear light.
 // The thesis's way - blur a whole-frame buffer holding the object - is kept beside it for the benchmark.
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -18,6 +19,9 @@ struct BlurredObject {
   VirtualObject object;
   std::string method = "gaussian";  // "gaussian" or "disc"
   double r_px = 0;                  // in the camera's (photo) px; drawn at r_px x the view's scale in screen px
+  // The per-pixel plan: the radius (photo px) at a camera depth (mm), each pixel blurred by its own depth
+  // (BlurLayerVarying); empty: r_px everywhere.
+  std::function<double(double)> r_of_depth_px;
 };
 
 // Where a composed frame (the window, in screen px) shows the camera's photo: resampled in linear light with an area

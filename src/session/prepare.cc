@@ -31,6 +31,9 @@ PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const
     }
   }
   s.presentation = Presentation::Of(s.protocol, s.images, s.display);
+  // Each pair trial's blur plan on that screen: one radius, or per pixel by depth where the object's depth asks.
+  if (s.scene)
+    for (TrialScene& scene : s.scenes) PlanBlur(s.protocol, *s.scene, s.presentation, &scene);
   return s;
 }
 

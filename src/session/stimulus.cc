@@ -58,6 +58,18 @@ cv::Vec3d BallCentre(const calib::SceneCalib& s, double y_mm, double radius_mm, 
   return render::BallOnBoard(s.board, left ? kLeftSection : kRightSection, y_mm, radius_mm, 0).center_board_mm;
 }
 
+// A source's radius (photo px) on the line of sight through an object's centre (camera frame) at camera depth z: what
+// a pixel of the object at that depth gets under the per-pixel plan. Where the source cannot be evaluated there
+// (eq. 3.7 as published, in front of the focus plane) the centre's radius stands in.
+double RadiusAlongSight(const calib::SceneCalib& s, calib::BlurSource source, double fixed, const cv::Vec3d& centre,
+                        double z) {
+  try {
+    return calib::BlurAtPx(s, source, centre * (z / centre[2]), fixed);
+  } catch (const Error&) {
+    return calib::BlurAtPx(s, source, centre, fixed);
+  }
+}
+
 }  // namespace
 
 double TrialScene::MotionS() const {
@@ -174,6 +186,11 @@ std::array<std::optional<render::BlurredObject>, 2> ObjectsAt(const protocol::Pr
       o = render::BallOnBoard(s.board, left ? kLeftSection : kRightSection, y, protocol.content.radius_mm,
                               trial.from_y_mm);
     }
+    if (trial.per_pixel) {
+      // The radius along the object's line of sight at each depth: the source evaluated where the pixel's surface is.
+      const cv::Vec3d centre = s.ToCamera(o.center_board_mm);
+      b.r_of_depth_px = [&s, source, fixed, centre](double z) { return RadiusAlongSight(s, source, fixed, centre, z); };
+    }
     o.brightness = trial.brightness;
     o.contrast = trial.contrast;
     o.white_balance = {trial.white_balance[0], trial.white_balance[1], trial.white_balance[2]};
@@ -255,6 +272,32 @@ render::FrameView Presentation::ViewFor(const protocol::Protocol& protocol, cons
   return v;
 }
 
+void PlanBlur(const protocol::Protocol& protocol, const calib::SceneCalib& s, const Presentation& presentation,
+              TrialScene* trial) {
+  if (trial->content == "picture") return;
+  const protocol::Content& c = protocol.content;
+  const double threshold = c.depth_blur_threshold_unit == "arcmin"
+                               ? display::ScreenPxOfArcmin(presentation.profile, c.depth_blur_threshold)
+                               : c.depth_blur_threshold;
+  TrialScene one = *trial;
+  one.per_pixel = false;
+  double span = 0;
+  for (const double t : {0.0, std::max(0.0, trial->MotionS() - 1e-6)}) {
+    const auto shown = ObjectsAt(protocol, s, one, t);
+    for (size_t side = 0; side < 2; ++side) {
+      if (!shown[side]) continue;
+      const render::Footprint f = render::FootprintOf(s.camera, s.rvec, s.tvec, shown[side]->object);
+      const cv::Vec3d centre = s.ToCamera(shown[side]->object.center_board_mm);
+      const calib::BlurSource source = side == 0 ? trial->left : trial->right;
+      const double fixed = side == 0 ? trial->left_fixed_px : trial->right_fixed_px;
+      auto r_at = [&](double z) { return RadiusAlongSight(s, source, fixed, centre, z); };
+      span = std::max(span, presentation.ScreenPx(std::abs(r_at(f.z_max_mm) - r_at(f.z_min_mm))));
+    }
+  }
+  trial->r_span_screen_px = span;
+  trial->per_pixel = span >= threshold;
+}
+
 Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation) {
   Json v = trial.levels.is_object() ? trial.levels : Json::object();
   v["practice"] = trial.practice ? 1 : 0;
@@ -275,6 +318,8 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
     }
     v["screen_px_per_photo_px"] = std::round(presentation.scale * 1e6) / 1e6;
     v["kernel"] = scene.kernel;
+    v["blur_plan"] = scene.per_pixel ? "per_pixel" : "one_radius";
+    v["r_span_screen_px"] = round4(scene.r_span_screen_px);
     v["brightness"] = scene.brightness;
     v["contrast"] = scene.contrast;
     v["white_balance_r"] = scene.white_balance[0];
@@ -299,6 +344,8 @@ Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, cons
       {"scaling", presentation.scaling},
       {"screen_px_per_photo_px", round(presentation.scale, 1e-6)},
       {"photo_rect_px", {view.x_px, view.y_px, view.photo_width_px, view.photo_height_px}},
+      {"blur_plan", trial.content == "picture" ? "none" : trial.per_pixel ? "per_pixel" : "one_radius"},
+      {"r_span_screen_px", std::round(trial.r_span_screen_px * 1e4) / 1e4},
       {"objects", Json::array()}};
   if (!scene) return frame;
   const Camera camera = view.CameraOf(scene->camera);
@@ -496,6 +543,10 @@ void StimulusRenderer::Present(int width_px, int height_px) {
   }
   if (!picture_shown_) picture_shown_ = std::make_unique<render::WindowImage>(picture_frame_);
   picture_shown_->Present(width_px, height_px);
+}
+
+void StimulusRenderer::Finish() {
+  if (compositor_) compositor_->Finish();
 }
 
 cv::Mat StimulusRenderer::Read() {

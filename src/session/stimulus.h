@@ -41,6 +41,11 @@ struct TrialScene {
   // The radii rendered, averaged over the run for balls, and the scene's own blur (the fitted model) there.
   double r_left_px = 0, r_right_px = 0, r_scene_px = 0;
 
+  // The blur plan (PlanBlur): per pixel by depth when an object's depth span changes its radius on screen by at least
+  // the protocol's depth_blur_threshold, else one radius at its centre.
+  bool per_pixel = false;
+  double r_span_screen_px = 0;  // the largest change of r across an object's depth, both sides, start and end of a run
+
   // Seconds of motion (0 for a static stimulus).
   double MotionS() const;
   // The balls' y (board frame, mm) at t_s after onset; negative infinity when wiped.
@@ -61,9 +66,16 @@ std::array<std::optional<render::BlurredObject>, 2> ObjectsAt(const protocol::Pr
 
 struct Presentation;
 
+// Decides a pair trial's blur plan on the screen `presentation` shows: each object's radius at its nearest and
+// farthest depth (along its line of sight), at the start and the end of its run, against the protocol's
+// depth_blur_threshold (arcmin converted by the display profile). Sets per_pixel and r_span_screen_px.
+void PlanBlur(const protocol::Protocol& protocol, const calib::SceneCalib& scene, const Presentation& presentation,
+              TrialScene* trial);
+
 // The variables recorded with a trial beside its factor levels: practice, block_name, swapped, and for pairs each
 // radius in photo px, screen px and arcmin (r_left_px, r_left_screen_px, r_left_arcmin; the same for right and
-// scene) with the presentation's screen_px_per_photo_px, or start_level (adjustment).
+// scene) with the presentation's screen_px_per_photo_px and the blur plan (blur_plan: one_radius | per_pixel,
+// r_span_screen_px), or start_level (adjustment).
 Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation);
 
 // The protocol's calibration (none for a picture without one). Throws Error(kInput) naming the protocol file and
@@ -104,7 +116,7 @@ struct Presentation {
 
 // What a frame shows, in screen terms (run --capture's trial-NNNN.json): the display (width_px, height_px,
 // width_mm, height_mm, distance_mm, px_per_deg), where the photo sits (scaling, screen_px_per_photo_px,
-// photo_rect_px) and every object on it: side, kind, source, kernel, center_px (its pose's centre), outline_px (the
+// photo_rect_px), the blur plan (blur_plan, r_span_screen_px) and every object on it: side, kind, source, kernel, center_px (its pose's centre), outline_px (the
 // screen polygon of its silhouette), r_camera_px, r_screen_px, r_arcmin and size_deg (the outline's largest extent).
 // `scene` may be null for a picture (no objects).
 Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, const Presentation& presentation,
@@ -139,6 +151,8 @@ class StimulusRenderer {
   render::FrameView View() const;
   // Shows the last composed frame in the current window, fitted to width x height.
   void Present(int width_px, int height_px);
+  // Waits until the last composed frame is drawn (for timing).
+  void Finish();
   // The last composed frame, 8-bit sRGB BGR.
   cv::Mat Read();
 
