@@ -199,4 +199,13 @@ double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& p, 
   return 0;
 }
 
+double BlurAlongSightPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& centre, double z_mm,
+                        double fixed_r_px) {
+  try {
+    return BlurAtPx(scene, source, centre * (z_mm / centre[2]), fixed_r_px);
+  } catch (const Error&) {
+    return BlurAtPx(scene, source, centre, fixed_r_px);
+  }
+}
+
 }  // namespace blurcue::calib

@@ -56,4 +56,10 @@ std::string ToString(BlurSource source);
 //   fixed     - fixed_r_px; none - 0.
 double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& point_camera_mm, double fixed_r_px = 0);
 
+// The source's radius on the line of sight through an object's centre (camera frame, mm) at camera depth z_mm: what
+// a pixel of the object at that depth gets when it is blurred per pixel by depth. Where the source cannot be
+// evaluated there (eq. 3.7 as published, in front of the focus plane) the centre's radius stands in.
+double BlurAlongSightPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& centre_camera_mm, double z_mm,
+                        double fixed_r_px = 0);
+
 }  // namespace blurcue::calib

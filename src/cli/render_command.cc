@@ -126,12 +126,9 @@ void AddRenderCommand(CLI::App& app) {
                                          std::to_string(photo.rows) + " photo; nothing would be drawn");
     const cv::Vec3d centre = scene.ToCamera(object.center_board_mm);
     const double r = args->gain * calib::BlurAtPx(scene, source, centre, fixed_r);
-    // One radius serves while the object's depth span changes r by less than half a pixel.
-    auto at_depth = [&](double z) {
-      cv::Vec3d p = centre;
-      p[2] = z;
-      return args->gain * calib::BlurAtPx(scene, source, p, fixed_r);
-    };
+    // One radius serves while the object's depth span changes r by less than half a pixel (a session's default
+    // content.depth_blur_threshold; here the image is the photo, so photo px are screen px).
+    auto at_depth = [&](double z) { return args->gain * calib::BlurAlongSightPx(scene, source, centre, z, fixed_r); };
     const double r_far = at_depth(f.z_max_mm), r_near = at_depth(f.z_min_mm);
     // Say which option made an impossible radius before the blur refuses it without knowing why.
     for (const double v : {r, r_far, r_near})

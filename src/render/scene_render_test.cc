@@ -192,6 +192,34 @@ void ExpectClose(const cv::Mat& a, const cv::Mat& b, const char* what) {
   EXPECT_LE(max, 3) << what;
 }
 
+TEST_F(SceneRenderTest, FramesBlurPerPixelByDepthWhenTheObjectCarriesThatPlan) {
+  // The compositor's per-pixel plan equals the CPU reference (draw, BlurLayerVarying, composite) and differs from one
+  // radius at the centre.
+  const View v;
+  const cv::Mat photo = Photo(v.camera);
+  FrameCompositor gpu(v.camera, v.rvec, v.tvec, photo);
+  BlurredObject card;
+  card.object.kind = VirtualObject::Kind::kCard;
+  card.object.size_mm = 60;
+  card.object.center_board_mm = {87.5, 125, 0};
+  card.object.texture = cv::Mat(64, 64, CV_8UC3, cv::Scalar(230, 230, 230));
+  const Footprint f = gpu.renderer().Measure(card.object);
+  const double z0 = f.z_min_mm, z1 = f.z_max_mm;
+  card.r_px = 3.5;
+  card.r_of_depth_px = [&](double z) { return 1.5 + 4.0 * (z - z0) / (z1 - z0); };
+  gpu.Compose({card});
+  const cv::Mat varying = gpu.Read();
+  Layer layer = gpu.renderer().Draw(card.object, KernelMarginPx("gaussian", 5.5) + 1);
+  BlurLayerVarying(layer, "gaussian", card.r_of_depth_px, nullptr);
+  cv::Mat linear = DecodeSrgb8(photo);
+  CompositeOver(linear, layer);
+  ExpectClose(varying, EncodeSrgb8(linear), "per pixel: compositor vs CPU");
+  BlurredObject one = card;
+  one.r_of_depth_px = nullptr;
+  gpu.Compose({one});
+  EXPECT_GT(cv::norm(gpu.Read(), varying, cv::NORM_L1), 2000) << "per pixel looks like one radius";
+}
+
 TEST_F(SceneRenderTest, GpuFrameMatchesCpuReferenceAndWholeFrameApproach) {
   const View v;
   const cv::Mat photo = Photo(v.camera);

@@ -58,18 +58,6 @@ cv::Vec3d BallCentre(const calib::SceneCalib& s, double y_mm, double radius_mm, 
   return render::BallOnBoard(s.board, left ? kLeftSection : kRightSection, y_mm, radius_mm, 0).center_board_mm;
 }
 
-// A source's radius (photo px) on the line of sight through an object's centre (camera frame) at camera depth z: what
-// a pixel of the object at that depth gets under the per-pixel plan. Where the source cannot be evaluated there
-// (eq. 3.7 as published, in front of the focus plane) the centre's radius stands in.
-double RadiusAlongSight(const calib::SceneCalib& s, calib::BlurSource source, double fixed, const cv::Vec3d& centre,
-                        double z) {
-  try {
-    return calib::BlurAtPx(s, source, centre * (z / centre[2]), fixed);
-  } catch (const Error&) {
-    return calib::BlurAtPx(s, source, centre, fixed);
-  }
-}
-
 }  // namespace
 
 double TrialScene::MotionS() const {
@@ -189,7 +177,7 @@ std::array<std::optional<render::BlurredObject>, 2> ObjectsAt(const protocol::Pr
     if (trial.per_pixel) {
       // The radius along the object's line of sight at each depth: the source evaluated where the pixel's surface is.
       const cv::Vec3d centre = s.ToCamera(o.center_board_mm);
-      b.r_of_depth_px = [&s, source, fixed, centre](double z) { return RadiusAlongSight(s, source, fixed, centre, z); };
+      b.r_of_depth_px = [&s, source, fixed, centre](double z) { return calib::BlurAlongSightPx(s, source, centre, z, fixed); };
     }
     o.brightness = trial.brightness;
     o.contrast = trial.contrast;
@@ -290,7 +278,7 @@ void PlanBlur(const protocol::Protocol& protocol, const calib::SceneCalib& s, co
       const cv::Vec3d centre = s.ToCamera(shown[side]->object.center_board_mm);
       const calib::BlurSource source = side == 0 ? trial->left : trial->right;
       const double fixed = side == 0 ? trial->left_fixed_px : trial->right_fixed_px;
-      auto r_at = [&](double z) { return RadiusAlongSight(s, source, fixed, centre, z); };
+      auto r_at = [&](double z) { return calib::BlurAlongSightPx(s, source, centre, z, fixed); };
       span = std::max(span, presentation.ScreenPx(std::abs(r_at(f.z_max_mm) - r_at(f.z_min_mm))));
     }
   }

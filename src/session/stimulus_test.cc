@@ -162,6 +162,46 @@ TEST(DescribeTrial, GridCardsSitBesideTheBoardAtTheirEdge) {
               1e-4);
 }
 
+TEST(PlanBlur, PerPixelExactlyWhenTheObjectsDepthSpanReachesTheThresholdOnScreen) {
+  // Grid cards at edge 2 with the fitted (depth-only) model on both sides: the span is the radius at the card's far
+  // corners minus that at its near ones (z of the corners, the model evaluated there), times the screen scale.
+  const calib::SceneCalib scene = ThesisScene();
+  protocol::Protocol p = BallProtocol();
+  p.content.type = "grid";
+  TrialScene t = DescribeTrial(p, PairTrial({{"edge", 2}}, "fitted", "fitted"), &scene);
+  Presentation shown;
+  shown.scale = 0.5;
+  const render::VirtualObject card = render::CardBesideBoard(scene.board, 2, true);
+  auto r_at = [&](double y) {
+    return calib::BlurAtPx(scene, calib::BlurSource::kFitted, scene.ToCamera({card.center_board_mm[0], y, 0}));
+  };
+  const double span = 0.5 * std::abs(r_at(50) - r_at(0));  // the card spans y 0..50 mm at edge 2
+  ASSERT_GT(span, 0.05);
+  p.content.depth_blur_threshold = span * 1.01;
+  PlanBlur(p, scene, shown, &t);
+  EXPECT_NEAR(t.r_span_screen_px, span, 1e-6 + 1e-3 * span);
+  EXPECT_FALSE(t.per_pixel);
+  EXPECT_FALSE(ObjectsAt(p, scene, t, 0)[0]->r_of_depth_px);
+  p.content.depth_blur_threshold = span * 0.99;
+  PlanBlur(p, scene, shown, &t);
+  EXPECT_TRUE(t.per_pixel);
+  const auto objects = ObjectsAt(p, scene, t, 0);
+  ASSERT_TRUE(objects[0]->r_of_depth_px);
+  // Per pixel, each depth gets the model's radius there; the centre's depth gets the one radius.
+  const double z_centre = scene.ToCamera(card.center_board_mm)[2];
+  EXPECT_NEAR(objects[0]->r_of_depth_px(z_centre), objects[0]->r_px, 1e-9);
+  EXPECT_NEAR(objects[0]->r_of_depth_px(scene.ToCamera({card.center_board_mm[0], 50, 0})[2]), r_at(50), 1e-2);
+  // In arcmin, converted by the profile: the same span is 0.5 x span screen px x arcmin per px.
+  p.content.depth_blur_threshold_unit = "arcmin";
+  p.content.depth_blur_threshold = display::ArcminOfScreenPx(shown.profile, span) * 1.01;
+  PlanBlur(p, scene, shown, &t);
+  EXPECT_FALSE(t.per_pixel);
+  p.content.depth_blur_threshold = display::ArcminOfScreenPx(shown.profile, span) * 0.99;
+  PlanBlur(p, scene, shown, &t);
+  EXPECT_TRUE(t.per_pixel);
+  EXPECT_EQ(TrialVariables(PairTrial({{"edge", 2}}, "fitted", "fitted"), t, shown)["blur_plan"], "per_pixel");
+}
+
 TEST(DescribeTrial, MissingLevelOrCalibrationIsAnInputErrorNamingTheField) {
   const calib::SceneCalib scene = ThesisScene();
   protocol::Protocol p = BallProtocol();
