@@ -57,13 +57,23 @@ void AddValidateCommand(CLI::App& app) {
         session::PreparedSession prepared =
             session::PrepareSession(args->file, args->participant, args->seed, args->display);
         const session::Presentation& at = prepared.presentation;
-        char line[300];
+        char line[400];
         std::snprintf(line, sizeof line,
-                      "  shown: a %d x %d frame in a %d x %d window at %.4f screen px per photo px; %s: %.2f px per "
+                      "  shown: a %d x %d %s in a %d x %d window (%s) at %.4f screen px per photo px; %s: %.2f px per "
                       "degree, 1 photo px = %.3f arcmin\n",
-                      at.frame_width_px, at.frame_height_px, at.window_width_px, at.window_height_px, at.scale,
-                      at.profile.name.c_str(), display::PxPerDeg(at.profile), at.Arcmin(1));
+                      at.frame_width_px, at.frame_height_px, prepared.scene ? "photo" : "frame", at.window_width_px,
+                      at.window_height_px, at.scaling.c_str(), at.scale, at.profile.name.c_str(),
+                      display::PxPerDeg(at.profile), at.Arcmin(1));
         shown = line;
+        if (prepared.scene) {
+          size_t per_pixel = 0;
+          for (const auto& scene : prepared.scenes) per_pixel += scene.per_pixel;
+          std::snprintf(line, sizeof line,
+                        "  blur plan: %zu of %zu trials per pixel by depth (depth span >= %g %s), the rest one radius\n",
+                        per_pixel, prepared.scenes.size(), prepared.protocol.content.depth_blur_threshold,
+                        prepared.protocol.content.depth_blur_threshold_unit == "arcmin" ? "arcmin" : "screen px");
+          shown += line;
+        }
         p = std::move(prepared.protocol);
         seed = prepared.seed;
         trials = std::move(prepared.trials);

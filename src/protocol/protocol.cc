@@ -775,6 +775,30 @@ void Parser::CheckDesign(const Protocol& p) {
     if (type != "picture" && b.task == Task::kAdjustment)
       Problem(b.task_pointer, "must be forced_choice for a " + type + " (adjustment steps through the cut-offs of a "
                               "picture)", Json(ToString(b.task)));
+    // A level that places or moves a stimulus is read only by the content it is for: anywhere else it would be
+    // recorded but not shown.
+    static const std::map<std::string, std::set<std::string>> kUses = {
+        {"grid", {"edge"}},
+        {"ball", {"edge", "from_edge", "to_edge", "section", "speed_cm_s"}},
+        {"picture", {"distance_m"}}};
+    static const std::set<std::string> kStimulusLevels = {"edge", "from_edge", "to_edge", "section", "speed_cm_s",
+                                                          "distance_m"};
+    const auto uses = kUses.find(type);
+    for (const auto& f : b.factors) {
+      std::set<std::string> names{f.name};
+      for (const auto& level : f.levels)
+        if (level.is_object())
+          for (const auto& [key, value] : level.items()) names.insert(key);
+      for (const auto& name : names)
+        if (kStimulusLevels.count(name) && uses != kUses.end() && !uses->second.count(name))
+          Problem(b.factors_pointer + "/" + f.name,
+                  "a " + type + " does not use " + name + " (it would be recorded but not shown); a " + type +
+                      " uses " + [&] {
+                        std::string list;
+                        for (const auto& u : uses->second) list += (list.empty() ? "" : ", ") + u;
+                        return list;
+                      }());
+    }
     if (type == "grid" && !Provides(b, "edge"))
       Problem(b.factors_pointer, "a grid stands at an edge: needs a factor edge, or a factor whose every level has "
                                  "an edge (1..11)");

@@ -91,6 +91,16 @@ TEST(ProtocolValidate, KernelBrightnessContrastWhiteBalanceScaleAndCellsAreCheck
   EXPECT_TRUE(Contains(OnlyProblem(shown), "/display/scale: must be \"fit\", \"native\"")) << OnlyProblem(shown);
   shown["display"] = {{"scale", 0.5}, {"width_deg", 20}};
   EXPECT_TRUE(Contains(OnlyProblem(shown), "/display/width_deg: give either")) << OnlyProblem(shown);
+  // A level that places or moves a stimulus is refused where the content does not read it.
+  Json still = Valid();
+  still["content"] = {{"type", "grid"}};
+  still["factors"] = {{"edge", {1, 2}}, {"speed_cm_s", {3}}};
+  still["sides"] = {{"left", "measured"}, {"right", "estimated"}};
+  still.erase("blocks");
+  bool unused = false;
+  for (const auto& problem : Problems(still))
+    unused = unused || Contains(problem, "/factors/speed_cm_s: a grid does not use speed_cm_s");
+  EXPECT_TRUE(unused) << Problems(still).front();
   Json grid = Valid();
   grid["content"] = {{"type", "grid"}, {"cells", 7}};
   bool named = false;
@@ -330,7 +340,11 @@ TEST(ProtocolValidate, GridWithoutEdgeRejected) {
   Json j = Valid();
   j["content"] = {{"type", "grid"}};
   j["blocks"].erase(1);
-  EXPECT_TRUE(Contains(OnlyProblem(j), "/blocks/0/factors: a grid stands at an edge")) << OnlyProblem(j);
+  // The block's pattern levels carry a speed (a ball's) and no edge: both are said.
+  const auto problems = Problems(j);
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_TRUE(Contains(problems[0], "/blocks/0/factors/pattern: a grid does not use speed_cm_s")) << problems[0];
+  EXPECT_TRUE(Contains(problems[1], "/blocks/0/factors: a grid stands at an edge")) << problems[1];
 }
 
 TEST(ProtocolValidate, MorePracticeThanTheDesignHasRejected) {
