@@ -117,6 +117,13 @@ const double kMaxFixedRadiusPx = 100;
 
 bool IsBlurSource(const Json& v) {
   if (v.is_number()) return std::isfinite(v.get<double>()) && v.get<double>() >= 0 && v.get<double>() <= kMaxFixedRadiusPx;
+  // A fixed radius on the screen: {"screen_px": r} or {"arcmin": r} (converted by the presentation and the profile).
+  if (v.is_object() && v.size() == 1) {
+    const bool arcmin = v.contains("arcmin");
+    const Json& r = arcmin ? v["arcmin"] : v.contains("screen_px") ? v["screen_px"] : v.front();
+    return (arcmin || v.contains("screen_px")) && r.is_number() && std::isfinite(r.get<double>()) &&
+           r.get<double>() >= 0 && r.get<double>() <= (arcmin ? 600 : kMaxFixedRadiusPx);
+  }
   if (!v.is_string()) return false;
   static const std::set<std::string> kNames = {"none", "measured", "measured_section", "estimated", "fitted"};
   return kNames.count(v.get<std::string>()) > 0;
@@ -427,8 +434,9 @@ void Parser::CheckLevelValue(const std::string& name, const Json& v, const std::
   else if (name == "cutoff") number_in(0, 1000, "cycles per picture width", "a cut-off");
   else if (name == "left" || name == "right") {
     if (!IsBlurSource(v))
-      Problem(ptr, "a blur source must be none, measured, measured_section, estimated, fitted or a radius in " +
-                       Range(0, kMaxFixedRadiusPx, "px"), v);
+      Problem(ptr, "a blur source must be none, measured, measured_section, estimated, fitted, a radius in " +
+                       Range(0, kMaxFixedRadiusPx, "photo px") + ", {\"screen_px\": r} with r in " +
+                       Range(0, kMaxFixedRadiusPx, "") + " or {\"arcmin\": r} with r in " + Range(0, 600, ""), v);
   } else if (v.is_number() && !std::isfinite(v.get<double>())) {
     Problem(ptr, "must be a finite number", v);
   }

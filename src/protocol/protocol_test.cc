@@ -82,6 +82,18 @@ TEST(ProtocolValidate, KernelBrightnessContrastWhiteBalanceScaleAndCellsAreCheck
     EXPECT_TRUE(Contains(OnlyProblem(j), "/content/white_balance: must be [red, green, blue] gains")) << OnlyProblem(j);
   }
   j["content"].erase("white_balance");
+  // A fixed radius on the screen, in screen px or arcmin, is a blur source; other units are not.
+  Json sized = Valid();
+  sized["sides"] = {{"left", {{"arcmin", 2}}}, {"right", {{"screen_px", 1.5}}}};
+  sized["blocks"][0]["factors"]["pattern"] = {{{"id", 1}, {"speed_cm_s", 3}}};
+  sized["blocks"][1]["factors"]["pattern"] = {{{"id", 2}, {"speed_cm_s", 3}}};
+  EXPECT_TRUE(Problems(sized).empty()) << Problems(sized).front();
+  for (const Json& bad : {Json{{"arcmin", -1}}, Json{{"deg", 1}}, Json{{"arcmin", 1}, {"screen_px", 1}}}) {
+    sized["sides"]["left"] = bad;
+    bool named = false;
+    for (const auto& problem : Problems(sized)) named = named || Contains(problem, "/sides/left: a blur source must be");
+    EXPECT_TRUE(named) << bad.dump() << ": " << Problems(sized).front();
+  }
   // A display scale or width in degrees is for a photo's grid or ball; each is checked, and not both at once.
   Json shown = Valid();
   shown["display"] = {{"scale", "native"}};
@@ -163,7 +175,8 @@ TEST(ProtocolValidate, UnknownBlurSourceRejected) {
   Json j = Valid();
   j["blocks"][0]["factors"]["pattern"][0]["right"] = "blurry";
   EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/0/factors/pattern/0/right: a blur source must be none, measured, "
-                                       "measured_section, estimated, fitted or a radius in [0, 100] px, got \"blurry\"")) << OnlyProblem(j);
+                                       "measured_section, estimated, fitted, a radius in [0, 100] photo px, {\"screen_px\": r} with r in [0, 100] "
+                       "or {\"arcmin\": r} with r in [0, 600], got \"blurry\"")) << OnlyProblem(j);
 }
 
 TEST(ProtocolValidate, EmptyFactorRejected) {

@@ -15,12 +15,6 @@ PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const
   s.trials = protocol::BuildTrials(s.protocol, participant, s.seed);
   s.scene = LoadProtocolScene(s.protocol);
   s.images = LoadStimulusImages(s.protocol, s.scene);
-  // Every trial's radii before anything is shown or saved: a source that cannot be evaluated stops here, not in
-  // front of a participant.
-  s.scenes.reserve(s.trials.size());
-  for (const protocol::Trial& trial : s.trials)
-    s.scenes.push_back(DescribeTrial(s.protocol, trial, s.scene ? &*s.scene : nullptr));
-  CheckRealPhotos(s.protocol, s.scenes);
   if (!display_profile.empty()) {
     s.display = display::LoadProfile(display_profile);
   } else if (!s.protocol.display.profile.empty()) {
@@ -31,9 +25,15 @@ PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const
     }
   }
   s.presentation = Presentation::Of(s.protocol, s.images, s.display);
+  // Every trial's radii before anything is shown or saved: a source that cannot be evaluated stops here, not in
+  // front of a participant.
+  s.scenes.reserve(s.trials.size());
+  for (const protocol::Trial& trial : s.trials)
+    s.scenes.push_back(DescribeTrial(s.protocol, trial, s.scene ? &*s.scene : nullptr, &s.presentation));
+  CheckRealPhotos(s.protocol, s.scenes);
   // Each pair trial's blur plan on that screen: one radius, or per pixel by depth where the object's depth asks.
   if (s.scene)
-    for (TrialScene& scene : s.scenes) PlanBlur(s.protocol, *s.scene, s.presentation, &scene);
+    for (TrialScene& scene : s.scenes) PlanOnScreen(s.protocol, *s.scene, s.presentation, &scene);
   return s;
 }
 

@@ -36,10 +36,20 @@ std::string At(const protocol::Protocol& p, const std::string& pointer) {
   return p.file.string() + ": " + (pointer.empty() ? "/" : pointer);
 }
 
-// `where` names the field that chose the source ("FILE: /pointer"), made only when there is a problem to name.
-calib::BlurSource Source(const Json& v, double* fixed, const std::function<std::string()>& where) {
+// `where` names the field that chose the source ("FILE: /pointer"), made only when there is a problem to name. A
+// fixed radius on the screen is converted to photo px by `presentation`.
+calib::BlurSource Source(const Json& v, double* fixed, const std::function<std::string()>& where,
+                         const Presentation* presentation) {
   if (v.is_number()) {
     *fixed = v.get<double>();
+    return calib::BlurSource::kFixed;
+  }
+  if (v.is_object() && v.size() == 1 && (v.contains("screen_px") || v.contains("arcmin")) && v.front().is_number()) {
+    if (!presentation || presentation->scale <= 0)
+      throw InputError(where(), "a radius on the screen needs the display it is shown on, got " + v.dump());
+    const double r = v.front().get<double>();
+    const double screen_px = v.contains("arcmin") ? display::ScreenPxOfArcmin(presentation->profile, r) : r;
+    *fixed = screen_px / presentation->scale;
     return calib::BlurSource::kFixed;
   }
   if (!v.is_string()) throw InputError(where(), "the trial shows no blur source on this side, got " + v.dump());
@@ -58,6 +68,14 @@ cv::Vec3d BallCentre(const calib::SceneCalib& s, double y_mm, double radius_mm, 
   return render::BallOnBoard(s.board, left ? kLeftSection : kRightSection, y_mm, radius_mm, 0).center_board_mm;
 }
 
+// The largest distance between two points of an outline (px).
+double ExtentPx(const std::vector<cv::Point2d>& outline) {
+  double extent = 0;
+  for (const cv::Point2d& p : outline)
+    for (const cv::Point2d& q : outline) extent = std::max(extent, cv::norm(p - q));
+  return extent;
+}
+
 }  // namespace
 
 double TrialScene::MotionS() const {
@@ -72,7 +90,7 @@ double TrialScene::BallYMm(double t_s) const {
 }
 
 TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Trial& trial,
-                         const calib::SceneCalib* scene) {
+                         const calib::SceneCalib* scene, const Presentation* presentation) {
   TrialScene t;
   t.content = protocol.content.type;
   t.kernel = protocol.content.kernel;
@@ -91,8 +109,8 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   auto field = [&](const char* side) {
     return At(protocol, side ? protocol::SidePointer(protocol, trial, side) : "/scene/calib");
   };
-  t.left = Source(trial.left, &t.left_fixed_px, [&] { return field("left"); });
-  t.right = Source(trial.right, &t.right_fixed_px, [&] { return field("right"); });
+  t.left = Source(trial.left, &t.left_fixed_px, [&] { return field("left"); }, presentation);
+  t.right = Source(trial.right, &t.right_fixed_px, [&] { return field("right"); }, presentation);
   const double s = scene->board.square_mm;
   // A radius that cannot be evaluated (eq. 3.7 nearer than focus, no usable measured section) is a problem of the
   // source the protocol chose with this calibration: an input error naming that field.
@@ -260,7 +278,7 @@ render::FrameView Presentation::ViewFor(const protocol::Protocol& protocol, cons
   return v;
 }
 
-void PlanBlur(const protocol::Protocol& protocol, const calib::SceneCalib& s, const Presentation& presentation,
+void PlanOnScreen(const protocol::Protocol& protocol, const calib::SceneCalib& s, const Presentation& presentation,
               TrialScene* trial) {
   if (trial->content == "picture") return;
   const protocol::Content& c = protocol.content;
@@ -284,6 +302,14 @@ void PlanBlur(const protocol::Protocol& protocol, const calib::SceneCalib& s, co
   }
   trial->r_span_screen_px = span;
   trial->per_pixel = span >= threshold;
+  const auto onset = ObjectsAt(protocol, s, one, 0);
+  for (size_t side = 0; side < 2; ++side)
+    (side == 0 ? trial->size_left_deg : trial->size_right_deg) =
+        onset[side] ? display::ArcminOfScreenPx(presentation.profile,
+                                                presentation.ScreenPx(ExtentPx(render::OutlineOf(
+                                                    s.camera, s.rvec, s.tvec, onset[side]->object)))) /
+                          60
+                    : 0;
 }
 
 Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation) {
@@ -308,6 +334,8 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
     v["kernel"] = scene.kernel;
     v["blur_plan"] = scene.per_pixel ? "per_pixel" : "one_radius";
     v["r_span_screen_px"] = round4(scene.r_span_screen_px);
+    v["size_left_deg"] = round4(scene.size_left_deg);
+    v["size_right_deg"] = round4(scene.size_right_deg);
     v["brightness"] = scene.brightness;
     v["contrast"] = scene.contrast;
     v["white_balance_r"] = scene.white_balance[0];
@@ -344,12 +372,8 @@ Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, cons
     std::vector<cv::Point2d> centre;
     cv::projectPoints(std::vector<cv::Point3d>{cv::Point3d(b.object.center_board_mm)}, scene->rvec, scene->tvec,
                       cv::Matx33d(camera.Intrinsics().data()), camera.dist_coeffs, centre);
-    double extent = 0;
     Json polygon = Json::array();
-    for (const cv::Point2d& p : outline) {
-      polygon.push_back({round(p.x, 1e-3), round(p.y, 1e-3)});
-      for (const cv::Point2d& q : outline) extent = std::max(extent, cv::norm(p - q));
-    }
+    for (const cv::Point2d& p : outline) polygon.push_back({round(p.x, 1e-3), round(p.y, 1e-3)});
     frame["objects"].push_back(
         {{"side", side == 0 ? "left" : "right"},
          {"kind", b.object.kind == render::VirtualObject::Kind::kBall ? "ball" : "card"},
@@ -360,7 +384,7 @@ Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, cons
          {"r_camera_px", round(b.r_px, 1e-4)},
          {"r_screen_px", round(presentation.ScreenPx(b.r_px), 1e-4)},
          {"r_arcmin", round(presentation.Arcmin(b.r_px), 1e-4)},
-         {"size_deg", round(display::ArcminOfScreenPx(profile, extent) / 60, 1e-4)}});
+         {"size_deg", round(display::ArcminOfScreenPx(profile, ExtentPx(outline)) / 60, 1e-4)}});
   }
   return frame;
 }

@@ -41,10 +41,11 @@ struct TrialScene {
   // The radii rendered, averaged over the run for balls, and the scene's own blur (the fitted model) there.
   double r_left_px = 0, r_right_px = 0, r_scene_px = 0;
 
-  // The blur plan (PlanBlur): per pixel by depth when an object's depth span changes its radius on screen by at least
+  // The blur plan (PlanOnScreen): per pixel by depth when an object's depth span changes its radius on screen by at least
   // the protocol's depth_blur_threshold, else one radius at its centre.
   bool per_pixel = false;
   double r_span_screen_px = 0;  // the largest change of r across an object's depth, both sides, start and end of a run
+  double size_left_deg = 0, size_right_deg = 0;  // each object's largest extent on screen at onset, visual angle
 
   // Seconds of motion (0 for a static stimulus).
   double MotionS() const;
@@ -54,8 +55,11 @@ struct TrialScene {
 
 // Works out a trial's scene. `scene` may be null for a picture. Throws Error naming the protocol file and the
 // trial when a level needed is missing or a source cannot be evaluated (e.g. eq. 3.7 nearer than focus).
+// A side's fixed radius given on the screen ({"screen_px": r} or {"arcmin": r}) is turned into photo px by
+// `presentation` (and its profile): without one it is an input error.
+struct Presentation;
 TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Trial& trial,
-                         const calib::SceneCalib* scene);
+                         const calib::SceneCalib* scene, const Presentation* presentation = nullptr);
 
 // What a pair trial (grid or ball) shows t_s after onset: each side's object where it is at that moment and the blur
 // radius (photo px) it gets there; [0] left, [1] right, empty for a ball wiped at the end of its section. No GL:
@@ -66,16 +70,17 @@ std::array<std::optional<render::BlurredObject>, 2> ObjectsAt(const protocol::Pr
 
 struct Presentation;
 
-// Decides a pair trial's blur plan on the screen `presentation` shows: each object's radius at its nearest and
-// farthest depth (along its line of sight), at the start and the end of its run, against the protocol's
-// depth_blur_threshold (arcmin converted by the display profile). Sets per_pixel and r_span_screen_px.
-void PlanBlur(const protocol::Protocol& protocol, const calib::SceneCalib& scene, const Presentation& presentation,
+// Works out what the screen `presentation` shows of a pair trial: each object's size in degrees at onset
+// (size_left_deg, size_right_deg) and the blur plan - each object's radius at its nearest and farthest depth (along
+// its line of sight), at the start and the end of its run, against the protocol's depth_blur_threshold (arcmin
+// converted by the display profile), setting per_pixel and r_span_screen_px.
+void PlanOnScreen(const protocol::Protocol& protocol, const calib::SceneCalib& scene, const Presentation& presentation,
               TrialScene* trial);
 
 // The variables recorded with a trial beside its factor levels: practice, block_name, swapped, and for pairs each
 // radius in photo px, screen px and arcmin (r_left_px, r_left_screen_px, r_left_arcmin; the same for right and
 // scene) with the presentation's screen_px_per_photo_px and the blur plan (blur_plan: one_radius | per_pixel,
-// r_span_screen_px), or start_level (adjustment).
+// r_span_screen_px) and each object's size_left_deg / size_right_deg, or start_level (adjustment).
 Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation);
 
 // The protocol's calibration (none for a picture without one). Throws Error(kInput) naming the protocol file and

@@ -162,7 +162,7 @@ TEST(DescribeTrial, GridCardsSitBesideTheBoardAtTheirEdge) {
               1e-4);
 }
 
-TEST(PlanBlur, PerPixelExactlyWhenTheObjectsDepthSpanReachesTheThresholdOnScreen) {
+TEST(PlanOnScreen, PerPixelExactlyWhenTheObjectsDepthSpanReachesTheThresholdOnScreen) {
   // Grid cards at edge 2 with the fitted (depth-only) model on both sides: the span is the radius at the card's far
   // corners minus that at its near ones (z of the corners, the model evaluated there), times the screen scale.
   const calib::SceneCalib scene = ThesisScene();
@@ -178,12 +178,12 @@ TEST(PlanBlur, PerPixelExactlyWhenTheObjectsDepthSpanReachesTheThresholdOnScreen
   const double span = 0.5 * std::abs(r_at(50) - r_at(0));  // the card spans y 0..50 mm at edge 2
   ASSERT_GT(span, 0.05);
   p.content.depth_blur_threshold = span * 1.01;
-  PlanBlur(p, scene, shown, &t);
+  PlanOnScreen(p, scene, shown, &t);
   EXPECT_NEAR(t.r_span_screen_px, span, 1e-6 + 1e-3 * span);
   EXPECT_FALSE(t.per_pixel);
   EXPECT_FALSE(ObjectsAt(p, scene, t, 0)[0]->r_of_depth_px);
   p.content.depth_blur_threshold = span * 0.99;
-  PlanBlur(p, scene, shown, &t);
+  PlanOnScreen(p, scene, shown, &t);
   EXPECT_TRUE(t.per_pixel);
   const auto objects = ObjectsAt(p, scene, t, 0);
   ASSERT_TRUE(objects[0]->r_of_depth_px);
@@ -194,12 +194,35 @@ TEST(PlanBlur, PerPixelExactlyWhenTheObjectsDepthSpanReachesTheThresholdOnScreen
   // In arcmin, converted by the profile: the same span is 0.5 x span screen px x arcmin per px.
   p.content.depth_blur_threshold_unit = "arcmin";
   p.content.depth_blur_threshold = display::ArcminOfScreenPx(shown.profile, span) * 1.01;
-  PlanBlur(p, scene, shown, &t);
+  PlanOnScreen(p, scene, shown, &t);
   EXPECT_FALSE(t.per_pixel);
   p.content.depth_blur_threshold = display::ArcminOfScreenPx(shown.profile, span) * 0.99;
-  PlanBlur(p, scene, shown, &t);
+  PlanOnScreen(p, scene, shown, &t);
   EXPECT_TRUE(t.per_pixel);
   EXPECT_EQ(TrialVariables(PairTrial({{"edge", 2}}, "fitted", "fitted"), t, shown)["blur_plan"], "per_pixel");
+}
+
+TEST(DescribeTrial, ARadiusGivenOnTheScreenIsTurnedIntoPhotoPxByThePresentation) {
+  // 2 arcmin at 600 mm on the default monitor (0.2768 mm a px): 2 x 600 x tan(1 arcmin) / 0.2768 = 1.2614 screen
+  // px; at 0.5 screen px per photo px, 2.5228 photo px. 1.5 screen px is 3 photo px.
+  const calib::SceneCalib scene = ThesisScene();
+  protocol::Protocol p = BallProtocol();
+  p.content.type = "grid";
+  Presentation shown;
+  shown.scale = 0.5;
+  const TrialScene t = DescribeTrial(p, PairTrial({{"edge", 3}}, Json{{"arcmin", 2}}, Json{{"screen_px", 1.5}}),
+                                     &scene, &shown);
+  const double pitch = 531.4 / 1920, screen = 2 * 600 * std::tan(M_PI / 180 / 60) / pitch;
+  EXPECT_NEAR(t.r_left_px, screen / 0.5, 1e-3);
+  EXPECT_NEAR(t.r_right_px, 3.0, 1e-12);
+  EXPECT_NEAR(shown.Arcmin(t.r_left_px), 2.0, 1e-3);
+  try {
+    DescribeTrial(p, PairTrial({{"edge", 3}}, Json{{"arcmin", 2}}, "none"), &scene);
+    ADD_FAILURE() << "an arcmin radius without a display was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    EXPECT_NE(std::string(e.what()).find("needs the display"), std::string::npos) << e.what();
+  }
 }
 
 TEST(DescribeTrial, MissingLevelOrCalibrationIsAnInputErrorNamingTheField) {
