@@ -163,6 +163,52 @@ kill9)
   [ "$(fingerprint "$W/whole.sqlite" K1)" = "$(fingerprint "$W/killed.sqlite" K1)" ] || fail "killed+resumed differs"
   integrity "$W/killed.sqlite"
   echo "ok: killed -9 after $answered answers, resumed: identical to the uninterrupted session" ;;
+adaptive)
+  # Adaptive procedures decide each trial from the answers so far; stopped (QUEST+) or killed -9 (the staircase on
+  # moving balls) and resumed, the session equals an uninterrupted one with the same seed: the same levels shown,
+  # the same answers. A record whose level was tampered with is refused rather than continued from a wrong state.
+  shown() {
+    sql "$1" "SELECT t.trial_index, t.factors, r.choice, r.shown FROM trials t JOIN sessions s ON s.id = t.session_id
+              JOIN participants p ON p.id = s.participant_id JOIN responses r ON r.trial_id = t.id
+              WHERE p.code = '$2' ORDER BY t.trial_index"
+  }
+  $BC run "$P/quest-blur-difference.json" --participant A1 --db "$W/whole.sqlite" --observer sim --seed 4 > /dev/null 2>&1
+  $BC run "$P/quest-blur-difference.json" --participant A1 --db "$W/parts.sqlite" --observer sim --seed 4 \
+      --stop-after 13 2>/dev/null | grep -q "not finished" || fail "quest: stop-after did not leave the session open"
+  $BC run "$P/quest-blur-difference.json" --participant A1 --db "$W/parts.sqlite" --observer sim --seed 4 --resume \
+      2>/dev/null | grep -q "40 of 40" || fail "quest: resume did not complete"
+  [ "$(shown "$W/whole.sqlite" A1)" = "$(shown "$W/parts.sqlite" A1)" ] || fail "quest: resumed differs"
+  levels=$(sql "$W/parts.sqlite" "SELECT count(DISTINCT json_extract(shown, '$.level')) FROM responses")
+  [ "$levels" -ge 3 ] || fail "quest showed only $levels levels"
+  $BC run "$P/staircase-ball-gain.json" --participant A2 --db "$W/whole.sqlite" --observer sim --seed 6 --sim-fps 2 \
+      > /dev/null 2>&1
+  $BC run "$P/staircase-ball-gain.json" --participant A2 --db "$W/killed.sqlite" --observer sim --seed 6 --sim-fps 2 \
+      > "$W/out" 2>&1 &
+  pid=$!
+  wait_for_answers "$W/killed.sqlite" 9
+  kill -9 $pid; wait $pid 2>/dev/null || true
+  answered=$(sql "$W/killed.sqlite" "SELECT count(*) FROM responses")
+  [ "$answered" -ge 9 ] && [ "$answered" -lt 60 ] || fail "killed after $answered answers, expected mid-session"
+  $BC run "$P/staircase-ball-gain.json" --participant A2 --db "$W/killed.sqlite" --observer sim --seed 6 --sim-fps 2 \
+      --resume 2>/dev/null | grep -q "60 of 60" || fail "staircase: resume did not complete"
+  [ "$(shown "$W/whole.sqlite" A2)" = "$(shown "$W/killed.sqlite" A2)" ] || fail "staircase: killed+resumed differs"
+  integrity "$W/killed.sqlite"
+  # Tampered: a recorded level that the answers before it do not give.
+  $BC run "$P/quest-blur-difference.json" --participant A3 --db "$W/tampered.sqlite" --observer sim --seed 4 \
+      --stop-after 5 > /dev/null 2>&1
+  $PY - "$W/tampered.sqlite" <<'PYEOF'
+import sqlite3, sys
+con = sqlite3.connect(sys.argv[1])
+con.execute("UPDATE responses SET shown = json_set(shown, '$.level', 99) WHERE id = 3")
+con.commit()
+PYEOF
+  set +e
+  $BC run "$P/quest-blur-difference.json" --participant A3 --db "$W/tampered.sqlite" --observer sim --seed 4 --resume \
+      > /dev/null 2> "$W/err"
+  code=$?
+  set -e
+  [ $code = 3 ] && grep -q "trial 2: the record's procedure level 99" "$W/err" || fail "tampered: exit $code: $(cat "$W/err")"
+  echo "ok: QUEST+ stopped and the staircase killed -9 after $answered answers resumed identical to uninterrupted runs" ;;
 second_writer)
   # While one process runs a session, a second one resuming it is refused with a clear message (exit 3).
   $BC run "$P/test2-moving-balls.json" --participant L1 --db "$W/s.sqlite" --observer sim --sim-fps 8 > /dev/null 2>&1 &

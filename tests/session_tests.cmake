@@ -11,7 +11,7 @@ set_tests_properties(session_pictures PROPERTIES FIXTURES_REQUIRED scene FIXTURE
                      PASS_REGULAR_EXPRESSION "wrote 27 photos")
 set_tests_properties(session_protocols PROPERTIES FIXTURES_SETUP session_protocols)
 foreach(case complete same_seed resume kill9 second_writer window window_adjust recover merge resume_guards stranded
-             stale_lock readonly frames_shown)
+             stale_lock readonly frames_shown adaptive)
   add_test(NAME session_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/session_test.sh ${case} ${BC} ${T})
   set_tests_properties(session_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures"
                        LABELS "gl;session"
@@ -119,3 +119,11 @@ foreach(case blur place window agree thesis aliasing)
                        LABELS "gl;session;capture" PASS_REGULAR_EXPRESSION "^ok:|\nok:")
 endforeach()
 set_tests_properties(capture_window PROPERTIES LABELS "gl;session;capture;window")
+
+# QUEST+ against python3-questplus, an independent implementation (Debian's).
+add_executable(quest_trace ${PROJECT_SOURCE_DIR}/tests/quest_trace.cc)
+target_link_libraries(quest_trace PRIVATE blurcue_session)
+add_test(NAME quest_agreement
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/quest_agreement.py $<TARGET_FILE:quest_trace>
+                 ${PROJECT_BINARY_DIR}/quest-agreement)
+set_tests_properties(quest_agreement PROPERTIES PASS_REGULAR_EXPRESSION "ok: blurcue's QUEST\\+ agrees")

@@ -15,6 +15,10 @@ namespace fs = std::filesystem;
 
 std::string ToString(Task task) { return task == Task::kAdjustment ? "adjustment" : "forced_choice"; }
 
+std::string ToString(Procedure::Kind kind) {
+  return kind == Procedure::Kind::kQuestPlus ? "quest_plus" : "staircase";
+}
+
 std::string ToString(Counterbalance counterbalance) {
   switch (counterbalance) {
     case Counterbalance::kSwapCopies: return "swap_copies";
@@ -329,6 +333,7 @@ class Parser {
   std::vector<Factor> ParseFactors(const Json& v, const std::string& ptr);
   void CheckLevelValue(const std::string& name, const Json& v, const std::string& ptr);
   std::optional<Adjustment> ParseAdjust(const Json& v, const std::string& ptr);
+  std::optional<Procedure> ParseProcedure(const Json& v, const std::string& ptr);
   void ParseSides(const Json& v, const std::string& ptr);
   // Fills `b` from `obj` at `ptr`, falling back to the protocol-level defaults in `top`.
   void ParseBlock(const Json& obj, const std::string& ptr, const Json& top, Block* b);
@@ -539,6 +544,79 @@ std::optional<Adjustment> Parser::ParseAdjust(const Json& v, const std::string& 
   return a;
 }
 
+std::optional<Procedure> Parser::ParseProcedure(const Json& v, const std::string& ptr) {
+  if (!v.is_object()) {
+    Problem(ptr, "must be an object (type staircase or quest_plus)", v);
+    return std::nullopt;
+  }
+  const auto type = String(v, "type", ptr, true, {"staircase", "quest_plus"});
+  if (!type) return std::nullopt;
+  Procedure pr;
+  pr.kind = *type == "quest_plus" ? Procedure::Kind::kQuestPlus : Procedure::Kind::kStaircase;
+  const bool quest = pr.kind == Procedure::Kind::kQuestPlus;
+  if (quest)
+    Object(v, ptr, {"type", "variable", "reference", "trials", "stimuli", "threshold", "slope", "lapse", "guess"});
+  else
+    Object(v, ptr, {"type", "variable", "reference", "trials", "start", "min", "max", "up", "down", "steps"});
+  if (auto s = String(v, "variable", ptr, true, {"relative_difference", "difference_arcmin"})) pr.variable = *s;
+  // What the level can be: up to 20 times more blur, or up to 10 degrees more.
+  const bool relative = pr.variable == "relative_difference";
+  const double hi = relative ? 20 : 600;
+  const std::string unit = relative ? "(times the reference)" : "arcmin";
+  if (const Json* r = Field(v, "reference", ptr, true)) {
+    CheckLevelValue("left", *r, ptr + "/reference");
+    pr.reference = *r;
+  }
+  if (auto n = Int(v, "trials", ptr, true, 1, 1000, "trials per crossing")) pr.trials = *n;
+  // A list of 1 to `most` numbers in [lo, hi], ascending when `ascending`.
+  auto numbers = [&](const std::string& key, size_t most, double lo, double hi_, bool ascending,
+                     std::vector<double>* out) {
+    const Json* a = Field(v, key, ptr, true);
+    if (!a) return;
+    const std::string at = ptr + "/" + key;
+    if (!a->is_array() || a->empty() || a->size() > most) {
+      Problem(at, "must be a list of 1 to " + std::to_string(most) + " numbers", *a);
+      return;
+    }
+    for (size_t i = 0; i < a->size(); ++i) {
+      const Json& x = (*a)[i];
+      if (!NumberIn(x, lo, hi_)) {
+        Problem(at + "/" + std::to_string(i), "must be a number in " + Range(lo, hi_, ""), x);
+        return;
+      }
+      if (ascending && !out->empty() && x.get<double>() <= out->back()) {
+        Problem(at + "/" + std::to_string(i), "must be larger than the one before (ascending, no repeats)", x);
+        return;
+      }
+      out->push_back(x.get<double>());
+    }
+  };
+  if (quest) {
+    numbers("stimuli", 200, 0, hi, true, &pr.stimuli);
+    numbers("threshold", 100, 1e-6, hi, true, &pr.thresholds);
+    numbers("slope", 50, 0.1, 50, true, &pr.slopes);
+    numbers("lapse", 20, 0, 0.5, true, &pr.lapses);
+    if (auto g = Number(v, "guess", ptr, false, 0, 0.99, "")) pr.guess = *g;
+    const double grid = double(pr.thresholds.size()) * double(pr.slopes.size()) * double(pr.lapses.size());
+    if (grid * double(pr.stimuli.size()) > 2e6)
+      Problem(ptr, "the parameter grid (" + std::to_string(int64_t(grid)) + " points) x " +
+                       std::to_string(pr.stimuli.size()) + " stimuli exceeds 2,000,000 (each trial weighs all)");
+    for (double lapse : pr.lapses)
+      if (pr.guess + lapse >= 1) Problem(ptr + "/lapse", "guess + lapse must be below 1", Json(lapse));
+  } else {
+    if (auto x = Number(v, "min", ptr, true, 0, hi, unit)) pr.min = *x;
+    if (auto x = Number(v, "max", ptr, true, 0, hi, unit)) pr.max = *x;
+    if (auto x = Number(v, "start", ptr, true, 0, hi, unit)) pr.start = *x;
+    if (pr.min >= pr.max) Problem(ptr + "/max", "must be larger than min", v.value("max", Json()));
+    else if (pr.start < pr.min || pr.start > pr.max)
+      Problem(ptr + "/start", "must lie in [min, max]", v.value("start", Json()));
+    if (auto n = Int(v, "up", ptr, false, 1, 5, "wrong answers in a row")) pr.up = *n;
+    if (auto n = Int(v, "down", ptr, false, 1, 5, "correct answers in a row")) pr.down = *n;
+    numbers("steps", 20, 1e-6, hi, false, &pr.steps);
+  }
+  return pr;
+}
+
 void Parser::ParseSides(const Json& v, const std::string& ptr) {
   if (!Object(v, ptr, {"left", "right"})) return;
   for (const char* side : {"left", "right"}) {
@@ -590,6 +668,20 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
   const Source adjust = pick("adjust");
   if (adjust.holder && b->task == Task::kAdjustment)
     b->adjust = ParseAdjust((*adjust.holder)["adjust"], adjust.ptr + "/adjust");
+  if (obj.is_object() && obj.contains("procedure")) {
+    b->procedure = ParseProcedure(obj["procedure"], ptr + "/procedure");
+    // The procedure says what each side shows and how often: the design fields that would say it too are refused.
+    if (b->task != Task::kForcedChoice)
+      Problem(b->task_pointer, "must be forced_choice for a procedure (which side is more blurred?)",
+              Json(ToString(b->task)));
+    if (sides.holder) Problem(sides.ptr + "/sides", "is given but the procedure shows its reference on both sides",
+                              (*sides.holder)["sides"]);
+    if (b->repetitions != 1) Problem(ptr + "/procedure/trials", "sets how often each crossing runs: leave out "
+                                                                "repetitions", Json(b->repetitions));
+    if (b->counterbalance != Counterbalance::kNone)
+      Problem(b->counterbalance_pointer, "must be none for a procedure (the test side is drawn at random per trial)",
+              Json(ToString(b->counterbalance)));
+  }
   if (auto s = Text(obj, "instructions", ptr, false, kMaxTextChars, false)) b->instructions = *s;
   if (auto s = Bool(obj, "shuffle", ptr)) b->shuffle = *s;
 
@@ -601,7 +693,8 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
   if (factor_sides && sides.holder)
     Problem(sides.ptr + "/sides", "is given but a factor's levels already carry left and right",
             (*sides.holder)["sides"]);
-  const bool needs_sides = b->task == Task::kForcedChoice || b->counterbalance != Counterbalance::kNone;
+  const bool needs_sides =
+      !b->procedure && (b->task == Task::kForcedChoice || b->counterbalance != Counterbalance::kNone);
   if (needs_sides && factors_ok && !factor_sides && !sides.holder)
     Problem(where, "needs what is shown left and right: a \"sides\" object or a factor whose levels have left and "
                    "right (a forced choice or left/right counterbalancing compares two sides)");
@@ -681,7 +774,7 @@ Protocol Parser::Parse(const Json& json) {
       const Json& obj = (*blocks)[i];
       const std::string bp = "/blocks/" + std::to_string(i);
       if (!Object(obj, bp, {"name", "task", "factors", "repetitions", "counterbalance", "sides", "adjust",
-                            "instructions", "shuffle"}))
+                            "procedure", "instructions", "shuffle"}))
         continue;
       Block b;
       if (auto s = Text(obj, "name", bp, true, kMaxNameChars, true)) {
@@ -844,6 +937,10 @@ void Parser::CheckDesign(const Protocol& p) {
     Problem("/", "makes no trials");
   }
   for (const auto& b : p.blocks)
+    if (b.name == p.practice.block && p.practice.count > 0 && b.procedure)
+      Problem("/practice/block", "names block " + b.name + ", whose trials its procedure decides from the answers; "
+                                 "practise on a block without a procedure", Json(b.name));
+  for (const auto& b : p.blocks)
     if (b.name == p.practice.block && p.practice.count > DesignTrials(b) && DesignTrials(b) <= kMaxTrials)
       Problem("/practice/count", "asks for " + std::to_string(p.practice.count) + " practice trials but block " +
                                      b.name + " has only " + std::to_string(DesignTrials(b)),
@@ -890,7 +987,8 @@ Protocol ParseProtocol(const Json& json, const fs::path& file, const ValidateOpt
 int64_t DesignTrials(const Block& block) {
   if (block.factors.empty()) return 0;
   // Saturating: once past the cap the exact number does not matter, and it can no longer overflow.
-  int64_t n = block.repetitions * (block.counterbalance == Counterbalance::kSwapCopies ? 2 : 1);
+  int64_t n = block.procedure ? block.procedure->trials
+                              : block.repetitions * (block.counterbalance == Counterbalance::kSwapCopies ? 2 : 1);
   for (const auto& f : block.factors) {
     n *= static_cast<int64_t>(f.levels.size());
     if (n > kMaxTrials) return kMaxTrials + 1;

@@ -33,6 +33,31 @@ struct Adjustment {
   std::string order = "shuffled";     // "shuffled" (a fresh random order per trial) | "ascending" | "descending"
 };
 
+// An adaptive procedure (a block's "procedure"): the stimulus of each trial is decided from the answers so far.
+// Both sides show `reference`; on the test side (left or right at random, seeded) the procedure's level adds blur -
+// "relative_difference": the test radius is (1 + level) x the reference's (a blur gain of 1 + level);
+// "difference_arcmin": the test radius on screen is the reference's plus level arcmin. Level 0 is no difference. The participant says which side is more blurred; choosing the test side is
+// correct (can't tell is not). Each crossing of the block's factors runs its own procedure for `trials` trials, all
+// interleaved in the block's shuffled order (like PsychoPy's MultiStairHandler).
+struct Procedure {
+  enum class Kind { kStaircase, kQuestPlus };
+  Kind kind = Kind::kStaircase;
+  std::string variable = "relative_difference";  // "relative_difference" | "difference_arcmin"
+  Json reference;                    // the blur source both sides start from
+  int trials = 30;                   // per crossing of the block's factors
+  // Staircase: n-up/m-down (down correct answers in a row step the level down, up wrong ones step it up); the step
+  // is steps[k] after k reversals (the last one kept); the level stays in [min, max].
+  double start = 1, min = 0, max = 1;
+  int up = 1, down = 2;
+  std::vector<double> steps;
+  // QUEST+ (Watson 2017) with the Weibull p = 1 - lapse - (1 - guess - lapse) exp(-(x / threshold)^slope): the
+  // stimulus of least expected posterior entropy among `stimuli`, over a uniform prior on the parameter grid.
+  std::vector<double> stimuli, thresholds, slopes, lapses;
+  double guess = 0.5;
+};
+
+std::string ToString(Procedure::Kind kind);
+
 // The most trials a session may have, practice included: at ~2 s a trial, more than five hours. Checked (with
 // overflow-safe arithmetic) before a trial list is made, so no design can exhaust memory or wrap a count.
 inline constexpr int kMaxTrials = 10000;
@@ -49,6 +74,7 @@ struct Block {
   Counterbalance counterbalance = Counterbalance::kNone;
   Json sides;                         // {"left": SOURCE, "right": SOURCE} when no factor's levels carry the sides
   std::optional<Adjustment> adjust;   // set for the adjustment task
+  std::optional<Procedure> procedure; // set for an adaptive block
   bool shuffle = true;
   std::string instructions;
 };

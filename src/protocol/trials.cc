@@ -48,12 +48,14 @@ std::vector<Trial> Design(const Block& block, bool participant_even) {
   size_t combinations = 1;
   for (const auto& f : block.factors) combinations *= f.levels.size();
   if (block.factors.empty()) combinations = 0;
-  for (int rep = 0; rep < block.repetitions; ++rep) {
+  const int copies = block.procedure ? block.procedure->trials : block.repetitions;
+  for (int rep = 0; rep < copies; ++rep) {
     for (size_t c = 0; c < combinations; ++c) {
       Trial t;
       t.block = block.name;
       t.task = block.task;
       t.repetition = rep;
+      if (block.procedure) t.cell = static_cast<int>(c);
       t.levels = Json::object();
       // Mixed radix with the last factor fastest.
       size_t rest = c;
@@ -63,6 +65,7 @@ std::vector<Trial> Design(const Block& block, bool participant_even) {
         rest /= f.levels.size();
       }
       SetSides(block, &t);
+      if (block.procedure) t.left = t.right = block.procedure->reference;
       if (block.counterbalance == Counterbalance::kByParticipant && participant_even) {
         std::swap(t.left, t.right);
         t.swapped = true;
@@ -79,6 +82,10 @@ std::vector<Trial> Design(const Block& block, bool participant_even) {
 }
 
 void DrawAdjustment(const Block& block, std::mt19937_64& rng, Trial* t) {
+  if (block.procedure) {
+    t->test_side = UniformBelow(rng, 2) == 0 ? "left" : "right";
+    return;
+  }
   if (block.task != Task::kAdjustment || !block.adjust) return;
   t->adjust_levels = block.adjust->levels;
   if (block.adjust->order == "shuffled") Shuffle(t->adjust_levels, rng);
@@ -174,6 +181,10 @@ Json ToJson(const Trial& t) {
   if (t.task == Task::kAdjustment) {
     j["adjust_levels"] = t.adjust_levels;
     j["start_index"] = t.start_index;
+  }
+  if (t.cell >= 0) {
+    j["cell"] = t.cell;
+    j["test_side"] = t.test_side;
   }
   return j;
 }

@@ -25,6 +25,10 @@ struct Trial {
   // Adjustment only: the levels in the order the participant steps through them, and where stepping starts.
   std::vector<double> adjust_levels;
   int start_index = -1;
+  // A procedure block's trial: which crossing of the block's factors (whose own procedure it feeds; -1 otherwise)
+  // and the side that shows the procedure's level ("left" | "right", drawn with the seed).
+  int cell = -1;
+  std::string test_side;
 };
 
 // Uniform integer in [0, n) from raw generator output by rejection (no modulo bias); n >= 1.
@@ -48,7 +52,8 @@ int ParticipantNumber(const std::string& participant);
 // block is shuffled (unless "shuffle": false). One generator seeded with `seed` is drawn from in this order:
 // the practice draw (a shuffled copy of the practice block's design, first `count` taken), each practice trial's
 // adjustment draws, then per block its shuffle and each of its trials' adjustment draws in trial order (a shuffle
-// of the levels when the order is "shuffled", then the start index). The order depends on the seed alone; give
+// of the levels when the order is "shuffled", then the start index) or, in a procedure block (procedure.trials
+// copies of each crossing, the reference on both sides), its test side. The order depends on the seed alone; give
 // each participant their own seed. Throws Error(kInput) for by_participant with a participant id without number.
 std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& participant, uint64_t seed);
 

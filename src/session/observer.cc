@@ -73,6 +73,13 @@ KeyPress SimulatedObserver::ChooseSide(const PairView& v) {
   return {d > criterion ? "left" : d < -criterion ? "right" : "cant_tell", rt};
 }
 
+KeyPress SimulatedObserver::ChooseBlurrier(const PairView& v) {
+  const double noise = Normal(), lapse_draw = Uniform(), lapse_pick = Uniform();
+  const double rt = ResponseTimeMs(params_.rt_ms);
+  if (lapse_draw < params_.lapse) return {lapse_pick < 0.5 ? "left" : "right", rt};
+  return {v.r_left_px - v.r_right_px + params_.jnd_px * noise > 0 ? "left" : "right", rt};
+}
+
 double SimulatedObserver::TargetCutoff(double distance_m) const {
   return params_.cutoff_1m * std::pow(distance_m, params_.slope);
 }

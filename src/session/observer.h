@@ -53,6 +53,10 @@ class SimulatedObserver {
 
   // The single key press answering a forced-choice trial.
   KeyPress ChooseSide(const PairView& view);
+  // "Which side is more blurred?" (an adaptive procedure's question): D = r_left - r_right + noise, noise ~
+  // N(0, jnd_px); left when D > 0, else right - a forced guess, never can't tell; a lapse is a coin flip. Its
+  // probability of choosing the more blurred side is Phi(|difference| / jnd_px) (1 - lapse) + lapse / 2.
+  KeyPress ChooseBlurrier(const PairView& view);
   // The presses answering an adjustment trial: levels in the order the participant steps through them (cyclic),
   // the index shown first, the distance of the real object.
   std::vector<KeyPress> Adjust(const std::vector<double>& levels, int start_index, double distance_m);

@@ -19,6 +19,7 @@
 #include "protocol/trials.h"
 #include "render/frame_compositor.h"
 #include "render/gl_context.h"
+#include "session/adaptive.h"
 #include "session/observer.h"
 #include "session/prepare.h"
 #include "session/screens.h"
@@ -228,7 +229,8 @@ class Runner {
   void ScriptObserver(const protocol::Trial& trial, const TrialScene& scene, double onset) {
     SimulatedObserver observer(*observer_, TrialSeed(seed_, trial.index));
     if (trial.task == Task::kForcedChoice) {
-      const KeyPress press = observer.ChooseSide({scene.r_left_px, scene.r_right_px, scene.r_scene_px});
+      const PairView view{scene.r_left_px, scene.r_right_px, scene.r_scene_px};
+      const KeyPress press = trial.cell >= 0 ? observer.ChooseBlurrier(view) : observer.ChooseSide(view);
       // A moving stimulus is watched to its end before the answer (task 1 is one answer per run).
       station_.Script(keys_.Key(press.action), onset + scene.MotionS() + press.after_ms / 1000);
       return;
@@ -351,6 +353,28 @@ class Runner {
 
     const std::string welcome = start.resumed && start.first_unanswered_trial > 0 ? "Welcome back" : "Instructions";
     if (!ShowScreen(welcome, protocol_.instructions, "Press Return to start")) return result;
+    // Adaptive procedures: their state rebuilt by replaying the answers the record holds, so a resumed session
+    // continues exactly where it was; each replayed level must be the one the record says was shown.
+    AdaptiveState adaptive(protocol_);
+    if (start.first_unanswered_trial > 0) {
+      const auto answered = record.AnsweredTrials(start.session_id);
+      for (int64_t i = 0; i < start.first_unanswered_trial; ++i) {
+        const protocol::Trial& t = trials_[size_t(i)];
+        if (t.cell < 0) continue;
+        const auto it = answered.find(i);
+        const Json shown = it == answered.end() ? Json() : ParseJson(it->second.shown_json, options_.db.string());
+        const double level = adaptive.Level(t);
+        if (!shown.is_object() || !shown.contains("level") || !shown["level"].is_number() ||
+            std::abs(shown["level"].get<double>() - level) > 1e-9 * std::max(1.0, std::abs(level)))
+          throw InputError(options_.db.string(), "session " + std::to_string(start.session_id) + " trial " +
+                                                     std::to_string(i) + ": the record's procedure level " +
+                                                     (shown.is_object() && shown.contains("level")
+                                                          ? shown["level"].dump() : std::string("(none)")) +
+                                                     " is not the " + std::to_string(level) +
+                                                     " its answers give; it cannot be resumed");
+        adaptive.Answer(t, level, it->second.choice == t.test_side);
+      }
+    }
     std::string shown_block;
     // Breaks come every N answered main trials, counted over the whole session (a resumed one included).
     int64_t main_answered = 0;
@@ -374,10 +398,25 @@ class Runner {
           return result;
         shown_block = part;
       }
+      // A procedure's trial shows the level its answers so far give, on its test side.
+      TrialScene scene = scenes_[size_t(i)];
+      double level = 0;
+      if (trial.cell >= 0) {
+        level = adaptive.Level(trial);
+        ApplyLevel(ProcedureOf(trial), trial, level, prepared_.presentation, &scene);
+        PlanOnScreen(protocol_, *prepared_.scene, prepared_.presentation, &scene);
+      }
       store::Response response;
       std::vector<store::FrameRecord> frames;
-      if (RunTrial(trial, scenes_[size_t(i)], &response, &frames) == Outcome::kQuit) break;
+      if (RunTrial(trial, scene, &response, &frames) == Outcome::kQuit) break;
+      const bool correct = response.choice == trial.test_side;
+      if (trial.cell >= 0) {
+        Json shown = TrialVariables(trial, scene, prepared_.presentation);
+        shown["correct"] = correct ? 1 : 0;
+        response.shown_json = shown.dump();
+      }
       record.RecordResponse(start.session_id, i, response, frames);  // committed before anything else happens
+      if (trial.cell >= 0) adaptive.Answer(trial, level, correct);
       ++result.answered_now;
       progress(i + 1);
       if (!trial.practice) ++main_answered;
@@ -404,6 +443,12 @@ class Runner {
   }
 
  private:
+  const protocol::Procedure& ProcedureOf(const protocol::Trial& trial) const {
+    for (const auto& b : protocol_.blocks)
+      if (b.name == trial.block && b.procedure) return *b.procedure;
+    throw Error(ErrorKind::kInternal, "trial " + std::to_string(trial.index) + " belongs to no procedure block");
+  }
+
   // The grey field between trials and after a timed stimulus (window only).
   const render::WindowImage& Blank() {
     if (!blank_) blank_ = std::make_unique<render::WindowImage>(TextScreen(screen_size_, "", "", ""));

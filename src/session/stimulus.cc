@@ -184,6 +184,7 @@ std::array<std::optional<render::BlurredObject>, 2> ObjectsAt(const protocol::Pr
     render::VirtualObject& o = b.object;
     const calib::BlurSource source = left ? trial.left : trial.right;
     const double fixed = left ? trial.left_fixed_px : trial.right_fixed_px;
+    const double gain = left ? trial.left_gain : trial.right_gain, add = left ? trial.left_add_px : trial.right_add_px;
     if (trial.content == "grid") {
       o = render::CardBesideBoard(s.board, trial.edge, left);
     } else {
@@ -195,13 +196,15 @@ std::array<std::optional<render::BlurredObject>, 2> ObjectsAt(const protocol::Pr
     if (trial.per_pixel) {
       // The radius along the object's line of sight at each depth: the source evaluated where the pixel's surface is.
       const cv::Vec3d centre = s.ToCamera(o.center_board_mm);
-      b.r_of_depth_px = [&s, source, fixed, centre](double z) { return calib::BlurAlongSightPx(s, source, centre, z, fixed); };
+      b.r_of_depth_px = [&s, source, fixed, centre, gain, add](double z) {
+        return gain * calib::BlurAlongSightPx(s, source, centre, z, fixed) + add;
+      };
     }
     o.brightness = trial.brightness;
     o.contrast = trial.contrast;
     o.white_balance = {trial.white_balance[0], trial.white_balance[1], trial.white_balance[2]};
     b.method = trial.kernel;
-    b.r_px = calib::BlurAtPx(s, source, s.ToCamera(o.center_board_mm), fixed);
+    b.r_px = gain * calib::BlurAtPx(s, source, s.ToCamera(o.center_board_mm), fixed) + add;
     shown[left ? 0 : 1] = std::move(b);
   }
   return shown;
@@ -278,6 +281,23 @@ render::FrameView Presentation::ViewFor(const protocol::Protocol& protocol, cons
   return v;
 }
 
+void ApplyLevel(const protocol::Procedure& procedure, const protocol::Trial& trial, double level,
+                const Presentation& presentation, TrialScene* scene) {
+  const bool left = trial.test_side == "left";
+  double& gain = left ? scene->left_gain : scene->right_gain;
+  double& add = left ? scene->left_add_px : scene->right_add_px;
+  double& r = left ? scene->r_left_px : scene->r_right_px;
+  const double reference = (r - add) / gain;  // as DescribeTrial made it
+  if (procedure.variable == "relative_difference") {
+    gain = 1 + level, add = 0;
+  } else {
+    gain = 1;
+    add = presentation.scale > 0 ? display::ScreenPxOfArcmin(presentation.profile, level) / presentation.scale : 0;
+  }
+  r = gain * reference + add;
+  scene->level = level;
+}
+
 void PlanOnScreen(const protocol::Protocol& protocol, const calib::SceneCalib& s, const Presentation& presentation,
               TrialScene* trial) {
   if (trial->content == "picture") return;
@@ -317,6 +337,11 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
   v["practice"] = trial.practice ? 1 : 0;
   v["block_name"] = trial.block;
   v["swapped"] = trial.swapped ? 1 : 0;
+  if (trial.cell >= 0) {  // a procedure's trial: which of its block's procedures, the test side, the level shown
+    v["procedure_cell"] = trial.cell;
+    v["test_side"] = trial.test_side;
+    if (!std::isnan(scene.level)) v["level"] = scene.level;
+  }
   if (trial.task == protocol::Task::kAdjustment) {
     if (trial.start_index >= 0 && size_t(trial.start_index) < trial.adjust_levels.size())
       v["start_level"] = trial.adjust_levels[size_t(trial.start_index)];

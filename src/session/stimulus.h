@@ -9,6 +9,7 @@
 //             below the photo of the real picture at the trial's distance (content.real_photos), or the scene
 //             photo when the protocol names no real photos.
 #include <array>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -38,6 +39,9 @@ struct TrialScene {
   std::string kernel = "gaussian";    // pairs: the blur kernel, and the object's brightness/contrast matching
   double brightness = 1, contrast = 1;
   std::array<double, 3> white_balance{1, 1, 1};  // red, green, blue gains
+  // A procedure's level on the test side (ApplyLevel): each side's radius is gain x its source's + add_px.
+  double left_gain = 1, right_gain = 1, left_add_px = 0, right_add_px = 0;
+  double level = std::numeric_limits<double>::quiet_NaN();  // the procedure's level shown; NaN: none (yet)
   // The radii rendered, averaged over the run for balls, and the scene's own blur (the fitted model) there.
   double r_left_px = 0, r_right_px = 0, r_scene_px = 0;
 
@@ -69,6 +73,13 @@ std::array<std::optional<render::BlurredObject>, 2> ObjectsAt(const protocol::Pr
                                                               double t_s);
 
 struct Presentation;
+
+// A procedure block's trial at `level` (protocol::Procedure): its test side's radius becomes (1 + level) x the
+// reference's (relative_difference), or the reference's plus level arcmin on the screen (difference_arcmin; the
+// arcmin turned into photo px by the presentation). Updates the side's gain or add_px and the recorded radii; run
+// PlanOnScreen after it.
+void ApplyLevel(const protocol::Procedure& procedure, const protocol::Trial& trial, double level,
+                const Presentation& presentation, TrialScene* scene);
 
 // Works out what the screen `presentation` shows of a pair trial: each object's size in degrees at onset
 // (size_left_deg, size_right_deg) and the blur plan - each object's radius at its nearest and farthest depth (along

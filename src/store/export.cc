@@ -192,16 +192,20 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
   Database db(db_path, OpenMode::kReadOnly);
   RequireReadableRecord(db);
 
-  // Pass 1: every factor key in the record, so every participant gets the same columns.
+  // Pass 1: every factor key in the record (and every key an answer's shown object adds), so every participant gets
+  // the same columns.
   std::set<std::string> keys;
   {
-    Statement factors(db, "SELECT session_id, trial_index, factors FROM trials");
+    Statement factors(db, "SELECT t.session_id, t.trial_index, t.factors, coalesce(r.shown, '{}') FROM trials t "
+                          "LEFT JOIN responses r ON r.trial_id = t.id");
     while (factors.Step()) {
-      const Json object = ParseColumn(factors.GetText(2), Where(db_path, factors.GetInt64(0), factors.GetInt64(1)) +
-                                                              " factors");
-      if (!object.is_object())
-        throw InputError(Where(db_path, factors.GetInt64(0), factors.GetInt64(1)), "factors must be a JSON object");
-      for (const auto& item : object.items()) keys.insert(item.key());
+      const std::string where = Where(db_path, factors.GetInt64(0), factors.GetInt64(1));
+      for (int column : {2, 3}) {
+        const Json object = ParseColumn(factors.GetText(column), where + (column == 2 ? " factors" : " shown"));
+        if (!object.is_object())
+          throw InputError(where, std::string(column == 2 ? "factors" : "shown") + " must be a JSON object");
+        for (const auto& item : object.items()) keys.insert(item.key());
+      }
     }
   }
   std::set<std::string> fixed(LeadingColumns().begin(), LeadingColumns().end());
@@ -214,7 +218,8 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
 
   Statement rows(db,
                  "SELECT st.name, pv.hash, p.code, s.id, s.seed, t.trial_index, t.block, t.factors, t.left_shown, "
-                 "t.right_shown, r.choice, r.rt_ms, r.answered_at, r.id IS NULL, r.adjustment "
+                 "t.right_shown, r.choice, r.rt_ms, r.answered_at, r.id IS NULL, r.adjustment, "
+                 "coalesce(r.shown, '{}') "
                  "FROM trials t JOIN sessions s ON s.id = t.session_id "
                  "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
                  "JOIN protocol_versions pv ON pv.id = s.protocol_version_id "
@@ -232,7 +237,11 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
                                       std::to_string(static_cast<uint64_t>(rows.GetInt64(4))),
                                       std::to_string(trial),
                                       std::to_string(rows.GetInt64(6))};
-    const Json factors = ParseColumn(rows.GetText(7), where + " factors");
+    // The plan's variables, with what the trial showed when it was shown laid over them (adaptive levels).
+    Json factors = ParseColumn(rows.GetText(7), where + " factors");
+    const Json shown = ParseColumn(rows.GetText(15), where + " shown");
+    if (factors.is_object() && shown.is_object())
+      for (const auto& [key, value] : shown.items()) factors[key] = value;
     for (const auto& key : keys) cells.push_back(factors.contains(key) ? Cell(factors.at(key)) : std::string());
     cells.push_back(Cell(ParseColumn(rows.GetText(8), where + " left")));
     cells.push_back(Cell(ParseColumn(rows.GetText(9), where + " right")));
@@ -381,9 +390,10 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
           trial_ids[trials.GetInt64(0)] = dst.LastInsertRowId();
         }
 
-        Statement responses(src, "SELECT trial_id, choice, rt_ms, adjustment, answered_at FROM responses");
-        Statement insert_response(dst, "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at) "
-                                       "VALUES (?, ?, ?, ?, ?)");
+        Statement responses(src, "SELECT trial_id, choice, rt_ms, adjustment, answered_at, " +
+                                     std::string(SchemaVersion(src) >= 5 ? "shown" : "'{}'") + " FROM responses");
+        Statement insert_response(dst, "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at, "
+                                       "shown) VALUES (?, ?, ?, ?, ?, ?)");
         while (responses.Step()) {
           insert_response.Bind(1, trial_ids.at(responses.GetInt64(0)));
           insert_response.Bind(2, responses.GetText(1));
@@ -391,6 +401,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
           else insert_response.Bind(3, responses.GetDouble(2));
           insert_response.Bind(4, responses.GetText(3));
           insert_response.Bind(5, responses.GetText(4));
+          insert_response.Bind(6, responses.GetText(5));
           insert_response.Run();
           insert_response.Reset();
         }

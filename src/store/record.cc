@@ -371,6 +371,15 @@ std::vector<int64_t> Record::CompletedSessions(const std::string& study, const s
   return ids;
 }
 
+std::map<int64_t, Record::Answered> Record::AnsweredTrials(int64_t session) {
+  Statement rows(db_, "SELECT t.trial_index, r.choice, r.shown FROM responses r JOIN trials t ON t.id = r.trial_id "
+                      "WHERE t.session_id = ? ORDER BY t.trial_index");
+  rows.Bind(1, session);
+  std::map<int64_t, Answered> answered;
+  while (rows.Step()) answered[rows.GetInt64(0)] = {rows.GetText(1), rows.GetText(2)};
+  return answered;
+}
+
 void Record::RecordResponse(int64_t session, int64_t trial_index, const Response& response,
                             const std::vector<FrameRecord>& frames) {
   Transaction transaction(db_);
@@ -381,13 +390,14 @@ void Record::RecordResponse(int64_t session, int64_t trial_index, const Response
   if (existing.Step())
     throw InputError(db_.path(), SessionName(session) + " trial " + std::to_string(trial_index) +
                                      " already has a response (answered at " + existing.GetText(0) + ")");
-  Statement insert(db_, "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at) "
-                        "VALUES (?, ?, ?, ?, ?)");
+  Statement insert(db_, "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at, shown) "
+                        "VALUES (?, ?, ?, ?, ?, ?)");
   insert.Bind(1, trial_id);
   insert.Bind(2, response.choice);
   insert.Bind(3, response.rt_ms);
   insert.Bind(4, response.adjustment_json);
   insert.Bind(5, response.answered_at.empty() ? NowIso8601() : response.answered_at);
+  insert.Bind(6, response.shown_json);
   insert.Run();
   Statement frame(db_, "INSERT INTO frames (trial_id, frame_index, flip_time_s, dropped, r_left_px, r_right_px, "
                       "y_mm) VALUES (?, ?, ?, ?, ?, ?, ?)");

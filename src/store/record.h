@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,9 @@ struct Response {
   std::string choice;                // "left" | "right" | "cant_tell" | an adjustment level
   double rt_ms = 0;
   std::string adjustment_json = "[]";  // method of adjustment: the levels stepped through
+  // What the trial showed as decided when it was shown (an adaptive procedure's level, the radii it made, whether
+  // the answer was correct): a JSON object of trial variables that export lays over the planned ones.
+  std::string shown_json = "{}";
   std::string answered_at;           // ISO 8601 UTC; empty = now
 };
 
@@ -123,6 +127,13 @@ class Record {
 
   // The smallest trial index without a response (= trial count when all are answered).
   int64_t FirstUnansweredTrial(int64_t session);
+  // The answered trials' shown objects (Response::shown_json) and choices, by trial index: what a resumed adaptive
+  // procedure replays.
+  struct Answered {
+    std::string choice;
+    std::string shown_json;
+  };
+  std::map<int64_t, Answered> AnsweredTrials(int64_t session);
 
   // Closes a running session as aborted, keeping its answers (a session that can no longer be resumed, e.g. its
   // protocol changed). Refused, naming the holder, while a live writer holds it; a stale lock is taken over.

@@ -126,6 +126,9 @@ std::vector<Migration> MakeMigrations() {
   steps.push_back({"ALTER TABLE frames ADD COLUMN r_left_px REAL;"
                    "ALTER TABLE frames ADD COLUMN r_right_px REAL;"
                    "ALTER TABLE frames ADD COLUMN y_mm REAL;"});
+  // 5: what a trial showed as decided when it was shown (an adaptive procedure's level and the radii it made, the
+  // answer's correctness): a JSON object of trial variables export lays over the planned ones; '{}' otherwise.
+  steps.push_back({"ALTER TABLE responses ADD COLUMN shown TEXT NOT NULL DEFAULT '{}';"});
   return steps;
 }
 
