@@ -18,6 +18,7 @@
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
 #include "render/gl_context.h"
+#include "session/adaptive.h"
 #include "session/prepare.h"
 #include "session/stimulus.h"
 
@@ -65,9 +66,11 @@ void AddPreviewCommand(CLI::App& app) {
     };
     std::vector<Tile> tiles;
     std::set<std::string> seen;  // labels or level keys already on the sheet
+    session::AdaptiveState adaptive(p);  // no answers yet: each procedure's first level
     for (const auto& t : trials) {
-      const session::TrialScene& s = prepared.scenes[size_t(t.index)];
+      const session::TrialScene& s_planned = prepared.scenes[size_t(t.index)];
       if (t.task == protocol::Task::kAdjustment) {
+        const session::TrialScene& s = s_planned;
         // Every level once (at the first distance shown), and every distance once (at the middle level): the
         // two halves of the frame vary apart, so together these show every distinct half.
         const std::string parameter = p.blocks.front().adjust ? p.blocks.front().adjust->parameter : "level";
@@ -94,6 +97,19 @@ void AddPreviewCommand(CLI::App& app) {
       key["left"] = t.left;
       key["right"] = t.right;
       if (!seen.insert(key.dump()).second) continue;
+      // A procedure's crossing is shown at its first trial's level, on that trial's test side.
+      session::TrialScene s = s_planned;
+      std::string first;
+      if (t.cell >= 0) {
+        const double level = adaptive.Level(t);
+        for (const auto& b : p.blocks)
+          if (b.name == t.block && b.procedure) {
+            session::ApplyLevel(*b.procedure, t, level, prepared.presentation, &s);
+            first = " (" + protocol::ToString(b.procedure->kind) + ": " + b.procedure->variable + " " +
+                    Json(level).dump() + " on the " + t.test_side + " at first)";
+          }
+        session::PlanOnScreen(p, *scene, prepared.presentation, &s);
+      }
       std::string levels;
       for (const auto& [name, value] : t.levels.items())
         levels += (levels.empty() ? "" : " ") + name + " " +
@@ -106,7 +122,7 @@ void AddPreviewCommand(CLI::App& app) {
       std::snprintf(sides, sizeof sides, "L %s %.2f px = %.2f scr px %.2f' | R %s %.2f px = %.2f scr px %.2f'",
                     source(t.left).c_str(), s.r_left_px, at.ScreenPx(s.r_left_px), at.Arcmin(s.r_left_px),
                     source(t.right).c_str(), s.r_right_px, at.ScreenPx(s.r_right_px), at.Arcmin(s.r_right_px));
-      tiles.push_back({s, 0, levels, sides, key});
+      tiles.push_back({s, 0, levels + first, sides, key});
     }
     std::stable_sort(tiles.begin(), tiles.end(), [](const Tile& a, const Tile& b) { return a.key < b.key; });
     if (tiles.empty()) throw InputError(args->protocol, "the protocol makes no trials to preview");

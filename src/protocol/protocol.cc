@@ -711,6 +711,11 @@ void Parser::ParseResponses(const Json& v, const std::string& ptr, const std::se
                                                {"cant_tell", &r->cant_tell}, {"previous", &r->previous},
                                                {"next", &r->next},         {"accept", &r->accept}};
   for (auto& [key, slot] : slots) {
+    // "cant_tell": null makes a strict 2AFC: no key answers can't tell.
+    if (key == "cant_tell" && v.contains(key) && v[key].is_null()) {
+      *slot = "";
+      continue;
+    }
     const auto s = String(v, key, ptr, false);
     if (!s) continue;
     if (*s == "Escape") Problem(ptr + "/" + key, "Escape is reserved for pausing a session", Json(*s));
@@ -726,7 +731,9 @@ void Parser::ParseResponses(const Json& v, const std::string& ptr, const std::se
           Problem(ptr + "/" + set[i].first, "is the same key as /responses/" + set[j].first, Json(set[i].second));
   };
   if (tasks.count(Task::kForcedChoice))
-    distinct({{"left", r->left}, {"right", r->right}, {"cant_tell", r->cant_tell}});
+    distinct(r->cant_tell.empty() ? std::vector<std::pair<std::string, std::string>>{{"left", r->left}, {"right", r->right}}
+                                  : std::vector<std::pair<std::string, std::string>>{
+                                        {"left", r->left}, {"right", r->right}, {"cant_tell", r->cant_tell}});
   if (tasks.count(Task::kAdjustment))
     distinct({{"previous", r->previous}, {"next", r->next}, {"accept", r->accept}});
 }

@@ -118,7 +118,7 @@ struct Practice {
 };
 
 struct Responses {
-  std::string left, right, cant_tell;   // forced choice
+  std::string left, right, cant_tell;   // forced choice; cant_tell empty: a strict 2AFC (JSON null)
   std::string previous, next, accept;   // adjustment
 };
 

@@ -120,6 +120,65 @@ TEST(ProtocolValidate, KernelBrightnessContrastWhiteBalanceScaleAndCellsAreCheck
   EXPECT_TRUE(named);
 }
 
+// An adaptive block: each field of its procedure checked with its pointer, and the design fields the procedure
+// decides refused there.
+TEST(ProtocolValidate, ProceduresAreCheckedAndOwnTheirSidesAndCounts) {
+  Json j = Json::parse(R"({
+    "name": "adaptive", "version": 1,
+    "scene": {"background": "scene/scene.png", "calib": "calib.json"},
+    "content": {"type": "grid"}, "task": "forced_choice",
+    "blocks": [
+      {"name": "quest", "factors": {"edge": [5, 9]},
+       "procedure": {"type": "quest_plus", "variable": "difference_arcmin", "reference": "measured", "trials": 20,
+                     "stimuli": [0.5, 1, 2, 4], "threshold": [0.5, 1, 2], "slope": [2, 3.5], "lapse": [0, 0.02]}},
+      {"name": "stairs", "factors": {"edge": [3]},
+       "procedure": {"type": "staircase", "variable": "relative_difference", "reference": "fitted", "trials": 10,
+                     "start": 1, "min": 0.05, "max": 2, "steps": [0.4, 0.2]}}
+    ],
+    "responses": {"left": "Left", "right": "Right", "cant_tell": null}
+  })");
+  EXPECT_TRUE(Problems(j).empty()) << Problems(j).front();
+  const Protocol p = ParseProtocol(j, SceneFolder() / "p.json");
+  ASSERT_TRUE(p.blocks[0].procedure && p.blocks[1].procedure);
+  EXPECT_EQ(p.blocks[0].procedure->kind, Procedure::Kind::kQuestPlus);
+  EXPECT_EQ(p.blocks[1].procedure->steps, (std::vector<double>{0.4, 0.2}));
+  EXPECT_EQ(SessionTrials(p), 2 * 20 + 10);  // each crossing runs its own procedure
+  EXPECT_TRUE(p.responses.cant_tell.empty());  // a strict 2AFC
+  auto problem_at = [&](Json changed, const std::string& text) {
+    bool found = false;
+    std::string all;
+    for (const auto& problem : Problems(changed)) found = found || Contains(problem, text), all += problem + "\n";
+    EXPECT_TRUE(found) << "expected '" << text << "' among:\n" << all;
+  };
+  Json bad = j;
+  bad["blocks"][0]["procedure"]["variable"] = "gain";
+  problem_at(bad, "/blocks/0/procedure/variable: must be one of");
+  bad = j;
+  bad["blocks"][0]["procedure"]["stimuli"] = {1, 0.5};
+  problem_at(bad, "/blocks/0/procedure/stimuli/1: must be larger than the one before");
+  bad = j;
+  bad["blocks"][0]["procedure"]["lapse"] = {0.6};
+  problem_at(bad, "/blocks/0/procedure/lapse/0: must be a number in [0, 0.5]");
+  bad = j;
+  bad["blocks"][1]["procedure"]["start"] = 3;
+  problem_at(bad, "/blocks/1/procedure/start: must lie in [min, max]");
+  bad = j;
+  bad["blocks"][1]["procedure"].erase("steps");
+  problem_at(bad, "/blocks/1/procedure/steps: is required");
+  bad = j;
+  bad["blocks"][1]["procedure"]["tries"] = 3;
+  problem_at(bad, "/blocks/1/procedure/tries: unknown key");
+  bad = j;
+  bad["blocks"][1]["sides"] = {{"left", "measured"}, {"right", "none"}};
+  problem_at(bad, "/blocks/1/sides: is given but the procedure shows its reference on both sides");
+  bad = j;
+  bad["blocks"][1]["repetitions"] = 2;
+  problem_at(bad, "/blocks/1/procedure/trials: sets how often each crossing runs");
+  bad = j;
+  bad["practice"] = {{"count", 2}, {"block", "stairs"}};
+  problem_at(bad, "/practice/block: names block stairs, whose trials its procedure decides");
+}
+
 TEST(ProtocolValidate, ProblemStartsWithFileAndPointer) {
   Json j = Valid();
   j["version"] = 0;

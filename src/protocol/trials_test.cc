@@ -32,6 +32,40 @@ std::vector<int> Edges(const std::vector<Trial>& trials) {
   return edges;
 }
 
+// A procedure block: procedure.trials copies of each crossing, the reference on both sides, a seeded test side
+// per trial, shuffled together so the crossings' procedures interleave.
+TEST(TrialBuilder, ProcedureBlocksInterleaveTheirCrossingsWithSeededTestSides) {
+  const Protocol p = FromJson(R"({
+    "name": "adaptive", "version": 1, "scene": {"background": "s.png", "calib": "c.json"},
+    "content": {"type": "grid"}, "task": "forced_choice",
+    "factors": {"edge": [4, 8]},
+    "blocks": [{"name": "stairs", "procedure": {"type": "staircase", "variable": "difference_arcmin",
+                "reference": "measured", "trials": 25, "start": 2, "min": 0, "max": 6, "steps": [1, 0.5]}}]
+  })");
+  const auto a = BuildTrials(p, "P1", 42), b = BuildTrials(p, "P1", 42), c = BuildTrials(p, "P1", 43);
+  ASSERT_EQ(a.size(), 50u);
+  EXPECT_EQ(TrialsHash(a), TrialsHash(b));
+  EXPECT_NE(TrialsHash(a), TrialsHash(c));
+  int per_cell[2] = {0, 0}, left = 0, switches = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    const Trial& t = a[i];
+    ASSERT_TRUE(t.cell == 0 || t.cell == 1);
+    ++per_cell[t.cell];
+    EXPECT_EQ(t.levels["edge"], t.cell == 0 ? 4 : 8);
+    EXPECT_EQ(t.left, "measured");
+    EXPECT_EQ(t.right, "measured");
+    ASSERT_TRUE(t.test_side == "left" || t.test_side == "right");
+    left += t.test_side == "left";
+    if (i > 0 && a[i - 1].cell != t.cell) ++switches;
+  }
+  EXPECT_EQ(per_cell[0], 25);
+  EXPECT_EQ(per_cell[1], 25);
+  EXPECT_GT(left, 12);  // about half, drawn with the seed
+  EXPECT_LT(left, 38);
+  EXPECT_GT(switches, 10);  // interleaved, not one crossing after the other
+  EXPECT_EQ(ToJson(a[0])["test_side"], a[0].test_side);
+}
+
 TEST(TrialBuilder, GeneratorIsTheStandardMt19937_64) {
   // The C++ standard fixes the 10000th output of a default-constructed mt19937_64.
   std::mt19937_64 rng;

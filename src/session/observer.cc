@@ -59,17 +59,18 @@ double SimulatedObserver::Normal() {
 
 double SimulatedObserver::ResponseTimeMs(double median_ms) { return median_ms * std::exp(0.3 * Normal()); }
 
-KeyPress SimulatedObserver::ChooseSide(const PairView& v) {
+KeyPress SimulatedObserver::ChooseSide(const PairView& v, bool cant_tell) {
   const double noise = Normal(), lapse_draw = Uniform(), lapse_pick = Uniform();
   const double rt = ResponseTimeMs(params_.rt_ms);
   if (lapse_draw < params_.lapse) {
     static const char* kActions[] = {"left", "right", "cant_tell"};
-    return {kActions[std::min(2, int(lapse_pick * 3))], rt};
+    const int choices = cant_tell ? 3 : 2;
+    return {kActions[std::min(choices - 1, int(lapse_pick * choices))], rt};
   }
   const double m_left = std::abs(v.r_left_px - v.r_scene_px), m_right = std::abs(v.r_right_px - v.r_scene_px);
   const double more_blurred = v.r_left_px > v.r_right_px ? 1 : v.r_left_px < v.r_right_px ? -1 : 0;
   const double d = (m_right - m_left) + params_.bias_px * more_blurred + params_.jnd_px * noise;
-  const double criterion = params_.jnd_px / 2;
+  const double criterion = cant_tell ? params_.jnd_px / 2 : 0;
   return {d > criterion ? "left" : d < -criterion ? "right" : "cant_tell", rt};
 }
 

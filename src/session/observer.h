@@ -51,8 +51,9 @@ class SimulatedObserver {
  public:
   SimulatedObserver(const ObserverParams& params, uint64_t seed) : params_(params), rng_(seed) {}
 
-  // The single key press answering a forced-choice trial.
-  KeyPress ChooseSide(const PairView& view);
+  // The single key press answering a forced-choice trial; without `cant_tell` (a strict 2AFC) it guesses instead:
+  // the criterion is 0 and a lapse picks one of the two sides.
+  KeyPress ChooseSide(const PairView& view, bool cant_tell = true);
   // "Which side is more blurred?" (an adaptive procedure's question): D = r_left - r_right + noise, noise ~
   // N(0, jnd_px); left when D > 0, else right - a forced guess, never can't tell; a lapse is a coin flip. Its
   // probability of choosing the more blurred side is Phi(|difference| / jnd_px) (1 - lapse) + lapse / 2.

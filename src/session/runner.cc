@@ -230,7 +230,8 @@ class Runner {
     SimulatedObserver observer(*observer_, TrialSeed(seed_, trial.index));
     if (trial.task == Task::kForcedChoice) {
       const PairView view{scene.r_left_px, scene.r_right_px, scene.r_scene_px};
-      const KeyPress press = trial.cell >= 0 ? observer.ChooseBlurrier(view) : observer.ChooseSide(view);
+      const KeyPress press = trial.cell >= 0 ? observer.ChooseBlurrier(view)
+                                             : observer.ChooseSide(view, !protocol_.responses.cant_tell.empty());
       // A moving stimulus is watched to its end before the answer (task 1 is one answer per run).
       station_.Script(keys_.Key(press.action), onset + scene.MotionS() + press.after_ms / 1000);
       return;
