@@ -342,3 +342,76 @@ def render_frame(render, out_dir):
     notes.append("error columns of the whole_frame row: difference to the region approach's output, not to an exact "
                  "reference")
     return [Chart("bench-frame", png, svg, table, notes)]
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# Procedures (`blurcue bench procedures`): which one to choose
+
+PROCEDURE_COLUMNS = ["procedure", "condition", "trials", "runs", "failed", "truth", "bias", "sd", "rmse",
+                     "us_per_trial"]
+PROCEDURE_LABELS = {"constant_stimuli": "constant stimuli (8 levels, ML fit)", "staircase_1u2d": "1-up/2-down",
+                    "staircase_1u3d": "1-up/3-down", "quest_plus": "QUEST+"}
+PROCEDURE_COLORS = {"constant_stimuli": "#999999", "staircase_1u2d": "#E69F00", "staircase_1u3d": "#D55E00",
+                    "quest_plus": "#0072B2"}
+CONDITION_LABELS = {"nominal": "nominal observer", "lapses": "5 % lapses", "side_bias": "25 % side bias",
+                    "steep_slope": "slope 8 (outside QUEST+'s prior)", "beyond_range": "threshold beyond the range"}
+PRECISION = 0.10  # the stated precision: RMSE within 10 % of the target
+
+
+def load_procedures(folder):
+    """(procedures DataFrame or None, note)."""
+    return _read(os.path.join(folder, "procedures.csv"), PROCEDURE_COLUMNS)
+
+
+def procedures(df, out_dir):
+    conditions = [c for c in CONDITION_LABELS if c in set(df["condition"])]
+    if not conditions:
+        raise Skip("bench procedures: no known conditions in procedures.csv")
+    fig, axes = plt.subplots(1, len(conditions), figsize=(3.0 * len(conditions), 3.4), sharey=True, squeeze=False)
+    notes = []
+    for ax, condition in zip(axes[0], conditions):
+        part = df[df["condition"] == condition]
+        for name, label in PROCEDURE_LABELS.items():
+            rows = part[part["procedure"] == name].sort_values("trials")
+            if rows.empty:
+                continue
+            rel = 100 * rows["rmse"] / rows["truth"]
+            ax.plot(rows["trials"], rel, marker="o", ms=3.5, color=PROCEDURE_COLORS[name], label=label)
+            bias = 100 * rows["bias"] / rows["truth"]
+            ax.plot(rows["trials"], bias.abs().clip(lower=0.5), ls=":", lw=1, color=PROCEDURE_COLORS[name])
+        ax.axhline(100 * PRECISION, color="#444444", ls="--", lw=0.8)
+        ax.set_xscale("log", base=2)
+        ax.set_yscale("log")
+        ax.set_ylim(0.5, 300)  # a |bias| below half a percent is drawn at the floor
+        ax.set_xticks(sorted(part["trials"].unique()))
+        ax.set_xticklabels([str(t) for t in sorted(part["trials"].unique())])
+        ax.set_title(CONDITION_LABELS[condition], loc="left", fontsize=9)
+        ax.set_xlabel("trials (the participant's time)")
+        # Per condition: who first meets the precision, and who fails (|bias| > 15 % at the most trials).
+        met = []
+        for name in PROCEDURE_LABELS:
+            rows = part[part["procedure"] == name].sort_values("trials")
+            ok = rows[(rows["failed"] == 0) & (rows["rmse"] <= PRECISION * rows["truth"])]
+            if len(ok):
+                met.append((int(ok["trials"].iloc[0]), PROCEDURE_LABELS[name]))
+            last = rows.iloc[-1] if len(rows) else None
+            if last is not None and abs(last["bias"]) > 0.15 * last["truth"]:
+                notes.append(f"{CONDITION_LABELS[condition]}: {PROCEDURE_LABELS[name]} fails - bias "
+                             f"{100 * last['bias'] / last['truth']:+.0f} % after {int(last['trials'])} trials")
+        if met:
+            n, who = min(met)
+            notes.append(f"{CONDITION_LABELS[condition]}: RMSE within {100 * PRECISION:.0f} % first by {who} "
+                         f"({n} trials)")
+        else:
+            notes.append(f"{CONDITION_LABELS[condition]}: no procedure reaches {100 * PRECISION:.0f} % RMSE within "
+                         f"{int(part['trials'].max())} trials")
+    axes[0][0].set_ylabel("threshold error (% of target)\nsolid: RMSE, dotted: |bias|")
+    axes[0][-1].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    runs = int(df["runs"].iloc[0])
+    fig.suptitle(f"Which procedure: speed (trials) against accuracy, {runs} simulated 2AFC runs each", x=0.01,
+                 y=1.02, ha="left", fontsize=10)
+    png, svg = save(fig, out_dir, "bench-procedures")
+    table = df[PROCEDURE_COLUMNS].copy()
+    notes.append("target: the Weibull threshold for QUEST+ and constant stimuli, the 70.7 % / 79.4 % point of the "
+                 "observer's sensory function for the staircases; dashed line: the stated precision")
+    return [Chart("bench-procedures", png, svg, table, notes)]

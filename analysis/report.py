@@ -107,7 +107,7 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description="Charts, tables and index.html from trials.csv and bench CSVs.")
     parser.add_argument("--trials", required=True, help="trials.csv written by `blurcue export`")
     parser.add_argument("--bench", default=os.path.join("results", "bench"),
-                        help="folder with measure.csv and render.csv (default results/bench)")
+                        help="folder with measure.csv, render.csv and procedures.csv (default results/bench)")
     parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--final-out", help="where --out is renamed to once complete (blurcue report builds the "
                         "folder beside its target): index.html and messages name paths there")
@@ -159,6 +159,12 @@ def main(argv=None):
             raise Skip(f"{os.path.join(args.bench, key + '.csv')}: not available")
         return bench[key]
 
+    def procedures_csv():
+        table, note = bench_charts.load_procedures(args.bench)
+        if table is None:
+            raise Skip(note + " - the procedures chart is skipped")
+        return table
+
     df = lambda: holder["trials"]  # noqa: E731
     frames_path = os.path.join(os.path.dirname(args.trials), "frames.csv")  # written beside trials.csv by export
     steps = [
@@ -178,6 +184,7 @@ def main(argv=None):
         ("bench: measurement stability", lambda: bench_charts.stability(needs("measure"), args.out)),
         ("bench: rendering speed vs accuracy", lambda: bench_charts.render_speed_accuracy(needs("render"), args.out)),
         ("bench: two-ball frame", lambda: bench_charts.render_frame(needs("render"), args.out)),
+        ("bench: which procedure", lambda: bench_charts.procedures(procedures_csv(), args.out)),
     ]
     total = len(steps) + 2  # + reading trials.csv + writing the index
 

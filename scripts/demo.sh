@@ -35,6 +35,10 @@ run test1-static-grids P1 P2 P3 P4 P5 P6
 run test2-moving-balls P1 P2 P3 P4
 run test3-no-board P1 P2 P3
 run pre-research-depth-matching P1 P2 P3
+# Beyond the thesis: adaptive procedures (QUEST+ on the blur difference a person notices, a staircase on a moving
+# ball's relative blur), answered by the simulated observer.
+run quest-blur-difference P1 P2
+run staircase-ball-gain P1
 # One more test-1 session in a real window on the real clock (under Xvfb when there is no screen), answered by the
 # simulated observer: its frame timing is the report's display-timing chart.
 WINDOW=()
@@ -44,5 +48,6 @@ WINDOW=()
 $BC bench measure --quick --out results/bench/measure.csv
 $BC bench render --quick --out results/bench/render.csv
 $BC bench record --trials 100 --folder results/bench   # what a power-loss-safe commit costs per answer
+$BC bench procedures --quick --out results/bench/procedures.csv   # which adaptive procedure to choose
 $BC report --db "$OUT/study.sqlite" --out "$OUT/report" --bench results/bench
 echo "demo: results in $OUT/ (calib.json, ball-edge9-estimated.png, pattern3.avi, study.sqlite, report/index.html)"

@@ -97,3 +97,14 @@ set_tests_properties(cli_render_picture PROPERTIES FIXTURES_REQUIRED scene
 add_test(NAME cli_bench_record COMMAND ${BC} bench record --trials 20 --folder ${T}/bench-record)
 set_tests_properties(cli_bench_record PROPERTIES
                      PASS_REGULAR_EXPRESSION "synchronous=FULL +median [0-9.]+ ms.*synchronous=NORMAL +median [0-9.]+ ms.*FULL costs")
+
+# Which procedure: 40 seeded runs each; the CSV must show what the procedures are known to do - every one gets
+# better with trials for a nominal observer, QUEST+ is the least biased and the first within 10 % RMSE there, and a
+# side bias or a threshold beyond the stimulus range defeats the adaptive ones (tests/procedure_bench_check.py).
+add_test(NAME cli_bench_procedures
+         COMMAND ${BC} bench procedures --quick --out ${T}/bench/procedures.csv)
+set_tests_properties(cli_bench_procedures PROPERTIES PASS_REGULAR_EXPRESSION "wrote .*procedures.csv \\(80 rows")
+add_test(NAME cli_bench_procedures_check
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/procedure_bench_check.py ${T}/bench/procedures.csv)
+set_tests_properties(cli_bench_procedures_check PROPERTIES DEPENDS cli_bench_procedures
+                     PASS_REGULAR_EXPRESSION "ok: ")
