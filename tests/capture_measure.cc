@@ -196,8 +196,9 @@ int main(int argc, char** argv) {
       if (!sharp_dir.empty()) {
         const Fits sharp = measure(sharp_linear, sharp_frame["objects"][k]);
         for (size_t i = 0; i < fits.r.size(); ++i)
-          if (!std::isnan(fits.r[i]))  // NaN (unusable in either) stays NaN
-            fits.r[i] = std::sqrt(std::max(0.0, fits.r[i] * fits.r[i] - sharp.r[i] * sharp.r[i])) + 0 * sharp.r[i];
+          fits.r[i] = std::isnan(fits.r[i]) || std::isnan(sharp.r[i])  // unusable in either: unusable
+                          ? NAN
+                          : std::sqrt(std::max(0.0, fits.r[i] * fits.r[i] - sharp.r[i] * sharp.r[i]));
       }
       const double recorded = o["r_screen_px"].get<double>();
       ++objects;

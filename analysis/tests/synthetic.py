@@ -145,7 +145,8 @@ def write_trials_csv(path, rows):
 
 
 def write_bench_fixtures(folder):
-    """measure.csv and render.csv with realistic values (columns exactly as the C++ writers print them)."""
+    """measure.csv, render.csv and procedures.csv with realistic values (columns exactly as the C++ writers print
+    them)."""
     os.makedirs(folder, exist_ok=True)
     sweeps = [("base", [0]), ("noise", [0.0, 0.002, 0.005, 0.01, 0.02, 0.04]),
               ("contrast", [0.9, 0.5, 0.2, 0.1, 0.05, 0.02]), ("jpeg", [95, 80, 60, 40, 20, 10]),
@@ -197,6 +198,21 @@ def write_bench_fixtures(folder):
     lines.append("frame,region,gl,0,1920,1080,120,6.900,11.000,0.0000,0.0")
     lines.append("frame,whole_frame,gl,0,1920,1080,120,1256.000,1301.000,0.0000,6.0")
     with open(os.path.join(folder, "render.csv"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+    # procedures.csv (`blurcue bench procedures`): errors that shrink as 1 / sqrt(trials), the failures it finds.
+    lines = ["procedure,condition,trials,runs,failed,truth,bias,sd,rmse,us_per_trial"]
+    truths = {"constant_stimuli": 1.0, "staircase_1u2d": 0.84, "staircase_1u3d": 0.9, "quest_plus": 1.0}
+    spread = {"constant_stimuli": 1.6, "staircase_1u2d": 1.6, "staircase_1u3d": 1.15, "quest_plus": 1.0}
+    biases = {"side_bias": 0.45, "beyond_range": -0.25}
+    for condition in ("nominal", "lapses", "side_bias", "steep_slope", "beyond_range"):
+        for procedure, truth in truths.items():
+            for n in (20, 40, 80, 160):
+                sd = 0.85 * spread[procedure] * truth / n ** 0.5
+                bias = biases.get(condition, 0.01) * truth
+                rmse = (sd * sd + bias * bias) ** 0.5
+                lines.append(f"{procedure},{condition},{n},200,0,{truth},{bias:.5f},{sd:.5f},{rmse:.5f},35")
+    with open(os.path.join(folder, "procedures.csv"), "w") as f:
         f.write("\n".join(lines) + "\n")
     return folder
 
