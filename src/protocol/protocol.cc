@@ -743,7 +743,8 @@ Protocol Parser::Parse(const Json& json) {
   p.file = file_;
   if (!Object(json, "",
               {"$schema", "name", "version", "description", "scene", "content", "task", "factors", "repetitions",
-               "counterbalance", "sides", "adjust", "blocks", "practice", "instructions", "breaks", "responses",
+               "counterbalance", "sides", "adjust", "blocks", "block_order", "practice", "instructions", "breaks",
+               "responses",
                "timing", "display"}))
     return p;
   if (auto s = Text(json, "name", "", true, kMaxNameChars, true)) {
@@ -808,6 +809,8 @@ Protocol Parser::Parse(const Json& json) {
       }
     }
   }
+  if (auto order = String(json, "block_order", "", false, {"fixed", "random", "latin_square"}))
+    p.block_order = *order;
   if (const Json* v = Field(json, "breaks", "", false)) {
     if (Object(*v, "/breaks", {"every_trials", "text"})) {
       if (auto n = Int(*v, "every_trials", "/breaks", true, 1, kMaxTrials, "trials")) p.break_every_trials = *n;

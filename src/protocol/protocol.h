@@ -151,6 +151,9 @@ struct Protocol {
   Scene scene;
   Content content;
   std::vector<Block> blocks;          // at least one; a file without "blocks" has one block named "main"
+  // The order blocks run in: "fixed" (file order), "random" (drawn with the seed) or "latin_square" (a balanced
+  // Latin square over participants by their number: each block equally often in each place, and after each other).
+  std::string block_order = "fixed";
   Practice practice;
   std::string instructions;
   int break_every_trials = 0;         // 0: no breaks

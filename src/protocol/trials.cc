@@ -112,6 +112,7 @@ std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& part
                                                           " trials, the most a session may have");
 
   std::mt19937_64 rng(seed);
+  const std::vector<size_t> order = BlockOrder(protocol, participant, rng);
   std::vector<Trial> trials;
   if (protocol.practice.count > 0) {
     for (const auto& b : protocol.blocks) {
@@ -127,7 +128,8 @@ std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& part
       break;
     }
   }
-  for (const auto& b : protocol.blocks) {
+  for (const size_t k : order) {
+    const Block& b = protocol.blocks[k];
     std::vector<Trial> rows = Design(b, even);
     if (b.shuffle) Shuffle(rows, rng);
     for (auto& t : rows) {
@@ -137,6 +139,29 @@ std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& part
   }
   for (size_t i = 0; i < trials.size(); ++i) trials[i].index = static_cast<int>(i);
   return trials;
+}
+
+std::vector<size_t> BlockOrder(const Protocol& protocol, const std::string& participant, std::mt19937_64& rng) {
+  const size_t n = protocol.blocks.size();
+  std::vector<size_t> order(n);
+  for (size_t i = 0; i < n; ++i) order[i] = i;
+  if (protocol.block_order == "random") {
+    Shuffle(order, rng);
+  } else if (protocol.block_order == "latin_square" && n > 1) {
+    const int number = ParticipantNumber(participant);
+    if (number < 0)
+      throw InputError(protocol.file.string() + ": /block_order",
+                       "latin_square needs a participant id ending in a number (e.g. P7), got \"" + participant + "\"");
+    // Williams: 0, 1, n-1, 2, n-2, ... shifted by the row; an odd n needs the reversed rows too.
+    const size_t rows = n % 2 == 0 ? n : 2 * n;
+    const size_t row = size_t(number) % rows, shift = row % n;
+    for (size_t j = 0; j < n; ++j) {
+      const size_t base = j % 2 == 1 ? (j + 1) / 2 : (n - j / 2) % n;
+      order[j] = (base + shift) % n;
+    }
+    if (row >= n) std::reverse(order.begin(), order.end());
+  }
+  return order;
 }
 
 std::string SidePointer(const Protocol& protocol, const Trial& trial, const std::string& side) {

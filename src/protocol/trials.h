@@ -46,7 +46,12 @@ void Shuffle(std::vector<T>& items, std::mt19937_64& rng) {
 // The participant's number: the trailing digits of the id ("P7" -> 7); -1 when it has none.
 int ParticipantNumber(const std::string& participant);
 
-// Practice trials first, then the blocks in file order. Per block: the full factorial crossing of its factors
+// The order a participant runs the blocks in (indices into protocol.blocks): file order, a seeded shuffle (the
+// generator's first draw), or row (participant number mod n, or mod 2n for an odd n) of a Williams balanced Latin
+// square. Throws Error(kInput) for latin_square with a participant id without number.
+std::vector<size_t> BlockOrder(const Protocol& protocol, const std::string& participant, std::mt19937_64& rng);
+
+// Practice trials first, then the blocks in BlockOrder (file order unless block_order says otherwise). Per block: the full factorial crossing of its factors
 // (factors in name order, the last varying fastest) x repetitions; with swap_copies each trial also appears with
 // left and right exchanged, with by_participant an even participant number sees every trial swapped; then the
 // block is shuffled (unless "shuffle": false). One generator seeded with `seed` is drawn from in this order:

@@ -66,6 +66,51 @@ TEST(TrialBuilder, ProcedureBlocksInterleaveTheirCrossingsWithSeededTestSides) {
   EXPECT_EQ(ToJson(a[0])["test_side"], a[0].test_side);
 }
 
+// Block order: a Williams balanced Latin square over participant numbers - each block once in each place, each
+// block right after each other equally often - and a seeded random order.
+TEST(TrialBuilder, BlockOrderIsABalancedLatinSquareOrSeeded) {
+  for (int n : {2, 3, 4, 5}) {
+    Json j = Json::parse(R"({"name": "order", "version": 1, "scene": {"background": "s.png", "calib": "c.json"},
+                             "content": {"type": "grid"}, "task": "forced_choice", "factors": {"edge": [1]},
+                             "sides": {"left": "measured", "right": "estimated"}, "block_order": "latin_square",
+                             "blocks": []})");
+    for (int b = 0; b < n; ++b) j["blocks"].push_back({{"name", "b" + std::to_string(b)}});
+    const Protocol p = ParseProtocol(j, "inline.json", {false});
+    const int rows = n % 2 == 0 ? n : 2 * n;
+    std::map<std::pair<int, int>, int> place, follows;
+    std::mt19937_64 rng(1);
+    for (int participant = 0; participant < rows; ++participant) {
+      const auto order = BlockOrder(p, "P" + std::to_string(participant), rng);
+      ASSERT_EQ(order.size(), size_t(n));
+      for (int k = 0; k < n; ++k) {
+        ++place[{int(order[size_t(k)]), k}];
+        if (k > 0) ++follows[{int(order[size_t(k) - 1]), int(order[size_t(k)])}];
+      }
+      // The trial list runs the blocks in that order.
+      const auto trials = BuildTrials(p, "P" + std::to_string(participant), 7);
+      for (int k = 0; k < n; ++k) EXPECT_EQ(trials[size_t(k)].block, "b" + std::to_string(order[size_t(k)]));
+    }
+    for (int b = 0; b < n; ++b)
+      for (int k = 0; k < n; ++k) EXPECT_EQ((place[{b, k}]), rows / n) << "n " << n << " block " << b << " place " << k;
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b < n; ++b)
+        if (a != b) EXPECT_EQ((follows[{a, b}]), rows / n) << "n " << n << ": " << a << " then " << b;
+    EXPECT_THROW(BuildTrials(p, "anonymous", 7), Error);
+    j["block_order"] = "random";
+    const Protocol r = ParseProtocol(j, "inline.json", {false});
+    std::set<std::vector<std::string>> seen;
+    for (uint64_t seed = 0; seed < 40; ++seed) {
+      std::vector<std::string> names;
+      for (const auto& t : BuildTrials(r, "P1", seed)) names.push_back(t.block);
+      seen.insert(names);
+      std::vector<std::string> again;
+      for (const auto& t : BuildTrials(r, "P1", seed)) again.push_back(t.block);
+      EXPECT_EQ(names, again);
+    }
+    EXPECT_GT(seen.size(), size_t(n == 2 ? 1 : 3));
+  }
+}
+
 TEST(TrialBuilder, GeneratorIsTheStandardMt19937_64) {
   // The C++ standard fixes the 10000th output of a default-constructed mt19937_64.
   std::mt19937_64 rng;
