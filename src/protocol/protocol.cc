@@ -334,6 +334,7 @@ class Parser {
   void CheckLevelValue(const std::string& name, const Json& v, const std::string& ptr);
   std::optional<Adjustment> ParseAdjust(const Json& v, const std::string& ptr);
   std::optional<Procedure> ParseProcedure(const Json& v, const std::string& ptr);
+  std::vector<Factor> ParseConditions(const Json& v, const std::string& ptr);
   void ParseSides(const Json& v, const std::string& ptr);
   // Fills `b` from `obj` at `ptr`, falling back to the protocol-level defaults in `top`.
   void ParseBlock(const Json& obj, const std::string& ptr, const Json& top, Block* b);
@@ -544,6 +545,88 @@ std::optional<Adjustment> Parser::ParseAdjust(const Json& v, const std::string& 
   return a;
 }
 
+// A conditions table instead of factors: a CSV file whose header names the levels (edge, speed_cm_s, left, right,
+// any label) and whose every row is one design row - for designs that are not full crossings. It becomes one factor
+// "row" whose levels are the rows as objects (numbers read as numbers), checked like any level: a problem names
+// /.../conditions/row/K/COLUMN, K counting the table's data rows from 0.
+std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& ptr) {
+  const auto text = Text(v, "conditions", ptr.substr(0, ptr.rfind('/')), true, kMaxPathChars, true);
+  if (!text) return {};
+  const fs::path file = (base_ / *text).lexically_normal();
+  if (!CheckFile(file, ptr, Json(*text))) return {};
+  std::string csv;
+  try {
+    csv = ReadTextFile(file);
+  } catch (const std::exception& e) {
+    Problem(ptr, e.what(), Json(*text));
+    return {};
+  }
+  // Comma-separated, double quotes around a field that holds commas or quotes ("" for one quote).
+  auto split = [](const std::string& line) {
+    std::vector<std::string> fields(1);
+    bool quoted = false;
+    for (size_t i = 0; i < line.size(); ++i) {
+      const char c = line[i];
+      if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"') fields.back() += '"', ++i;
+      else if (c == '"') quoted = !quoted;
+      else if (c == ',' && !quoted) fields.emplace_back();
+      else fields.back() += c;
+    }
+    return fields;
+  };
+  std::vector<std::vector<std::string>> rows;
+  size_t start = 0;
+  while (start <= csv.size()) {
+    size_t end = csv.find('\n', start);
+    if (end == std::string::npos) end = csv.size();
+    std::string line = csv.substr(start, end - start);
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (!line.empty()) rows.push_back(split(line));
+    start = end + 1;
+    if (rows.size() > size_t(kMaxTrials) + 1) break;
+  }
+  const std::string where = file.string();
+  if (rows.size() < 2) {
+    Problem(ptr, where + ": needs a header and at least one row", Json(*text));
+    return {};
+  }
+  if (rows.size() > size_t(kMaxTrials) + 1) {
+    Problem(ptr, where + ": more than " + std::to_string(kMaxTrials) + " rows", Json(*text));
+    return {};
+  }
+  const std::vector<std::string>& header = rows.front();
+  std::set<std::string> names;
+  for (const auto& name : header)
+    if (name.empty() || name.size() > kMaxNameChars || HasControlCharacter(name) || !names.insert(name).second) {
+      Problem(ptr, where + ": the header must name each column once, 1-100 characters, got \"" + name + "\"",
+              Json(*text));
+      return {};
+    }
+  Factor factor;
+  factor.name = "row";
+  for (size_t r = 1; r < rows.size(); ++r) {
+    if (rows[r].size() != header.size()) {
+      Problem(ptr + "/row/" + std::to_string(r - 1), where + " line " + std::to_string(r + 1) + ": has " +
+                                                         std::to_string(rows[r].size()) + " fields, the header " +
+                                                         std::to_string(header.size()), Json(*text));
+      continue;
+    }
+    Json level = Json::object();
+    for (size_t c = 0; c < header.size(); ++c) {
+      const std::string& cell = rows[r][c];
+      char* end = nullptr;
+      const double number = std::strtod(cell.c_str(), &end);
+      const bool is_number = !cell.empty() && end == cell.c_str() + cell.size() && std::isfinite(number);
+      const bool integer = is_number && cell.find_first_of(".eE") == std::string::npos;
+      level[header[c]] = integer ? Json(int64_t(number)) : is_number ? Json(number) : Json(cell);
+      if (cell.empty()) Problem(ptr + "/row/" + std::to_string(r - 1) + "/" + Escape(header[c]), "is empty", Json(cell));
+      else CheckLevelValue(header[c], level[header[c]], ptr + "/row/" + std::to_string(r - 1) + "/" + Escape(header[c]));
+    }
+    factor.levels.push_back(std::move(level));
+  }
+  return {factor};
+}
+
 std::optional<Procedure> Parser::ParseProcedure(const Json& v, const std::string& ptr) {
   if (!v.is_object()) {
     Problem(ptr, "must be an object (type staircase or quest_plus)", v);
@@ -644,10 +727,18 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
   }
   b->pointer = ptr;
   const size_t calls_before_factors = calls_;
-  if (const Source s = pick("factors"); !s.holder)
-    Problem(ptr + "/factors", "is required (here or at /factors) but missing");
+  const Source factors = pick("factors"), conditions = pick("conditions");
+  if (factors.holder && conditions.holder)
+    Problem(conditions.ptr + "/conditions", "give either factors or a conditions table, not both",
+            (*conditions.holder)["conditions"]);
+  else if (conditions.holder)
+    b->factors = ParseConditions(*conditions.holder, conditions.ptr + "/conditions"),
+    b->factors_pointer = conditions.ptr + "/conditions";
+  else if (!factors.holder)
+    Problem(ptr + "/factors", "is required (here or at /factors; or a conditions table) but missing");
   else
-    b->factors = ParseFactors((*s.holder)["factors"], s.ptr + "/factors"), b->factors_pointer = s.ptr + "/factors";
+    b->factors = ParseFactors((*factors.holder)["factors"], factors.ptr + "/factors"),
+    b->factors_pointer = factors.ptr + "/factors";
   const bool factors_ok = calls_ == calls_before_factors;
   if (const Source s = pick("repetitions"); s.holder) {
     if (auto n = Int(*s.holder, "repetitions", s.ptr, true, 1, kMaxTrials, "repetitions")) b->repetitions = *n;
@@ -742,10 +833,9 @@ Protocol Parser::Parse(const Json& json) {
   Protocol p;
   p.file = file_;
   if (!Object(json, "",
-              {"$schema", "name", "version", "description", "scene", "content", "task", "factors", "repetitions",
-               "counterbalance", "sides", "adjust", "blocks", "block_order", "practice", "instructions", "breaks",
-               "responses",
-               "timing", "display"}))
+              {"$schema", "name", "version", "description", "scene", "content", "task", "factors", "conditions",
+               "repetitions", "counterbalance", "sides", "adjust", "blocks", "block_order", "practice", "instructions",
+               "breaks", "responses", "timing", "display"}))
     return p;
   if (auto s = Text(json, "name", "", true, kMaxNameChars, true)) {
     if (s->empty()) Problem("/name", "must not be empty", Json(*s));
@@ -781,8 +871,8 @@ Protocol Parser::Parse(const Json& json) {
     for (size_t i = 0; i < blocks->size(); ++i) {
       const Json& obj = (*blocks)[i];
       const std::string bp = "/blocks/" + std::to_string(i);
-      if (!Object(obj, bp, {"name", "task", "factors", "repetitions", "counterbalance", "sides", "adjust",
-                            "procedure", "instructions", "shuffle"}))
+      if (!Object(obj, bp, {"name", "task", "factors", "conditions", "repetitions", "counterbalance", "sides",
+                            "adjust", "procedure", "instructions", "shuffle"}))
         continue;
       Block b;
       if (auto s = Text(obj, "name", bp, true, kMaxNameChars, true)) {

@@ -179,6 +179,35 @@ TEST(ProtocolValidate, ProceduresAreCheckedAndOwnTheirSidesAndCounts) {
   problem_at(bad, "/practice/block: names block stairs, whose trials its procedure decides");
 }
 
+// A conditions table instead of factors: each CSV row one design row (not a full crossing), numbers read as
+// numbers, sides from its left/right columns, every cell checked with a pointer to its row and column.
+TEST(ProtocolValidate, ConditionsTableGivesTheDesignRowByRow) {
+  const fs::path dir = SceneFolder();
+  std::ofstream(dir / "rows.csv") << "edge,speed_cm_s,left,right,label\r\n1,3,measured,none,\"near, fast\"\r\n"
+                                     "9,1.8,estimated,none,far\r\n";
+  Json j = Valid();
+  j["blocks"] = {{{"name", "rows"}, {"conditions", "rows.csv"}}};
+  EXPECT_TRUE(Problems(j).empty()) << Problems(j).front();
+  const Protocol p = ParseProtocol(j, dir / "p.json");
+  ASSERT_EQ(p.blocks[0].factors.size(), 1u);
+  EXPECT_EQ(p.blocks[0].factors[0].levels.size(), 2u);
+  EXPECT_EQ(p.blocks[0].factors[0].levels[0]["label"], "near, fast");
+  EXPECT_EQ(p.blocks[0].factors[0].levels[1]["speed_cm_s"], 1.8);
+  EXPECT_EQ(DesignTrials(p.blocks[0]), 2 * 2);  // two rows x the protocol's swap_copies
+  std::ofstream(dir / "bad.csv") << "edge,left,right\n12,measured,none\n3,measured\n";
+  j["blocks"][0]["conditions"] = "bad.csv";
+  const auto problems = Problems(j);
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_TRUE(Contains(problems[0], "/blocks/0/conditions/row/0/edge: an edge must be an integer in [1, 11], got 12"))
+      << problems[0];
+  EXPECT_TRUE(Contains(problems[1], "bad.csv line 3: has 2 fields, the header 3")) << problems[1];
+  j["blocks"][0]["factors"] = {{"edge", {1}}};
+  EXPECT_TRUE(Contains(Problems(j).front(), "give either factors or a conditions table")) << Problems(j).front();
+  j["blocks"][0].erase("factors");
+  j["blocks"][0]["conditions"] = "missing.csv";
+  EXPECT_TRUE(Contains(OnlyProblem(j), "/blocks/0/conditions: no such file")) << OnlyProblem(j);
+}
+
 TEST(ProtocolValidate, ProblemStartsWithFileAndPointer) {
   Json j = Valid();
   j["version"] = 0;

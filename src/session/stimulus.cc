@@ -334,6 +334,13 @@ void PlanOnScreen(const protocol::Protocol& protocol, const calib::SceneCalib& s
 
 Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation) {
   Json v = trial.levels.is_object() ? trial.levels : Json::object();
+  // A level object's values get columns of their own (a pattern's speed_cm_s, a conditions table's edge); the sides
+  // are recorded as such. A conditions table's row object itself is no factor of the design: only its columns stay.
+  for (const auto& [name, level] : trial.levels.items())
+    if (level.is_object())
+      for (const auto& [key, value] : level.items())
+        if (key != "left" && key != "right" && !v.contains(key)) v[key] = value;
+  if (v.contains("row") && v["row"].is_object()) v.erase("row");
   v["practice"] = trial.practice ? 1 : 0;
   v["block_name"] = trial.block;
   v["swapped"] = trial.swapped ? 1 : 0;
