@@ -19,6 +19,7 @@ on any failure. Reproduce one mutant with --seed S --count 1 --first K (K is its
 import argparse
 import copy
 import json
+import math
 import os
 import random
 import shutil
@@ -351,9 +352,19 @@ def main():
             for suffix in ("", "-wal", "-shm", "-journal"):
                 if os.path.exists(db + suffix):
                     os.remove(db + suffix)
+            # Participant information the mutant asks for: a valid answer to each field (its own range or choices).
+            info = []
+            fields = doc.get("participant_info") if isinstance(doc, dict) else None
+            for f in fields if isinstance(fields, list) else []:
+                if not isinstance(f, dict) or "key" not in f:
+                    continue
+                kind = f.get("type", "text")
+                value = ("%d" % math.ceil(f["min"]) if kind == "integer" else repr(f["min"])) \
+                    if kind in ("integer", "number") else f["choices"][0] if kind == "choice" else "x"
+                info += ["--info", "%s=%s" % (f["key"], value)]
             try:
                 r = subprocess.run([args.blurcue, "run", path, "--participant", "P1", "--db", db, "--observer", "sim",
-                                    "--stop-after", "3", "--sim-fps", "2"],
+                                    "--stop-after", "3", "--sim-fps", "2"] + info,
                                    capture_output=True, text=True, errors="replace", timeout=RUN_TIMEOUT_S, env=env)
                 if r.returncode != 0:
                     counts["accepted_then_failed"] += 1

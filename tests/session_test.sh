@@ -209,6 +209,49 @@ PYEOF
   set -e
   [ $code = 3 ] && grep -q "trial 2: the record's procedure level 99" "$W/err" || fail "tampered: exit $code: $(cat "$W/err")"
   echo "ok: QUEST+ stopped and the staircase killed -9 after $answered answers resumed identical to uninterrupted runs" ;;
+groups_info)
+  # Between-subject groups in balance over the record, participant information recorded and exported, refused
+  # when wrong or missing (no terminal to ask in), kept by a resumed session and by merge.
+  G="$P/groups-and-info.json"
+  info=(--info age=30 --info handedness=right --info vision=normal)
+  for id in G1 G2 G3 G4; do $BC run "$G" --participant $id --db "$W/g.sqlite" --observer sim "${info[@]}" > /dev/null 2>&1; done
+  $BC run "$G" --participant G5 --db "$W/g.sqlite" --observer sim "${info[@]}" --info notes="glasses, fine" \
+      --stop-after 3 > /dev/null 2>&1
+  set +e
+  $BC run "$G" --participant G5 --db "$W/g.sqlite" --observer sim --resume --info age=31 > /dev/null 2> "$W/err1"
+  c1=$?
+  $BC run "$G" --participant G6 --db "$W/g.sqlite" --observer sim --info age=30 < /dev/null > /dev/null 2> "$W/err2"
+  c2=$?
+  $BC run "$G" --participant G6 --db "$W/g.sqlite" --observer sim "${info[@]}" --info shoe=42 > /dev/null 2> "$W/err3"
+  c3=$?
+  $BC run "$G" --participant G6 --db "$W/g.sqlite" --observer sim --info age=12 --info handedness=right \
+      --info vision=normal > /dev/null 2> "$W/err4"
+  c4=$?
+  set -e
+  [ $c1 = 3 ] && grep -q "info age: the unfinished session recorded 30, got 31" "$W/err1" || fail "changed info on resume: $c1 $(cat "$W/err1")"
+  [ $c2 = 2 ] && grep -q "asks for handedness (left / right / both); give --info handedness=VALUE" "$W/err2" || fail "missing info: $c2 $(cat "$W/err2")"
+  [ $c3 = 2 ] && grep -q "asks for age, handedness, vision, notes (participant_info), not shoe" "$W/err3" || fail "unknown info: $c3 $(cat "$W/err3")"
+  [ $c4 = 2 ] && grep -q "info age=12: must be a whole number in \[16, 99\]" "$W/err4" || fail "bad info: $c4 $(cat "$W/err4")"
+  $BC run "$G" --participant G5 --db "$W/g.sqlite" --observer sim --resume > /dev/null 2>&1 || fail "resume with the recorded info"
+  $BC export --db "$W/g.sqlite" --out "$W/tables" > /dev/null
+  $PY - "$W/tables/trials.csv" <<'PYEOF' || fail "groups and info in trials.csv"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+group = {}
+for r in rows:
+    group.setdefault(r["participant"], set()).add((r["group"], r["block_name"]))
+    assert r["info_age"] and r["info_handedness"] == "right" and r["info_vision"] == "normal", r
+assert {p: len(g) for p, g in group.items()} == {f"G{i}": 1 for i in range(1, 6)}, group
+names = [next(iter(group[f"G{i}"]))[0] for i in range(1, 6)]
+assert names == ["estimated", "no_blur", "estimated", "no_blur", "estimated"], names  # balanced, in turn
+assert all((g == "estimated") == (b == "measured-vs-estimated") for p in group for g, b in group[p]), group
+assert {r["info_notes"] for r in rows if r["participant"] == "G5"} == {"glasses, fine"}
+print("groups", names)
+PYEOF
+  $BC merge "$W/g.sqlite" --out "$W/merged.sqlite" > /dev/null
+  $BC export --db "$W/merged.sqlite" --out "$W/merged-tables" > /dev/null
+  cmp "$W/tables/trials.csv" "$W/merged-tables/trials.csv" || fail "merge lost groups or info"
+  echo "ok: groups balanced over the record, participant information checked, recorded, kept on resume and merge" ;;
 second_writer)
   # While one process runs a session, a second one resuming it is refused with a clear message (exit 3).
   $BC run "$P/test2-moving-balls.json" --participant L1 --db "$W/s.sqlite" --observer sim --sim-fps 8 > /dev/null 2>&1 &

@@ -16,6 +16,7 @@ void AddRunCommand(CLI::App& app) {
     session::RunOptions options;
     std::string protocol, db, observer;
     std::optional<uint64_t> seed;
+    std::vector<std::string> info;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -67,6 +68,9 @@ void AddRunCommand(CLI::App& app) {
   cmd->add_flag("--window", args->options.window, "with --observer: show the session in a window, in real time");
   cmd->add_option("--sim-fps", args->options.sim_fps, "headless: frames rendered per simulated second")
       ->capture_default_str()->check(FiniteRange(0.1, 1000, "frames per second"));
+  cmd->add_option("--info", args->info,
+                  "KEY=VALUE: participant information the protocol asks for (participant_info), repeatable; missing "
+                  "required ones are asked for in the terminal");
   cmd->add_option("--capture", args->options.capture_dir,
                   "save each trial's first frame exactly as presented (DIR/trial-NNNN.png, the window's size) and "
                   "what it shows (DIR/trial-NNNN.json: the display, the photo's place, each object's centre, screen "
@@ -80,6 +84,12 @@ void AddRunCommand(CLI::App& app) {
     options.db = args->db;
     options.observer = args->observer;
     options.seed = args->seed;
+    for (const std::string& item : args->info) {
+      const size_t eq = item.find('=');
+      if (eq == std::string::npos || eq == 0)
+        throw Error(ErrorKind::kUsage, "--info: must be KEY=VALUE, got '" + item + "'");
+      options.info.emplace_back(item.substr(0, eq), item.substr(eq + 1));
+    }
     const session::RunResult r = session::RunSession(options);
     std::printf("%s: participant %s, session %lld, seed %llu: %lld of %lld trials answered (%lld now%s)%s\n",
                 args->db.c_str(), options.participant.c_str(), static_cast<long long>(r.session_id),

@@ -65,6 +65,11 @@ void AddValidateCommand(CLI::App& app) {
                       at.window_height_px, at.scaling.c_str(), at.scale, at.profile.name.c_str(),
                       display::PxPerDeg(at.profile), at.Arcmin(1));
         shown = line;
+        if (prepared.protocol.groups)
+          shown += "  group: " + prepared.group +
+                   (prepared.protocol.groups->assign == "balanced"
+                        ? " (balanced: a run takes the group with the fewest sessions in its record)\n"
+                        : " (by participant number)\n");
         if (prepared.scene) {
           size_t per_pixel = 0;
           for (const auto& scene : prepared.scenes) per_pixel += scene.per_pixel;

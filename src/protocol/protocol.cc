@@ -335,6 +335,8 @@ class Parser {
   std::optional<Adjustment> ParseAdjust(const Json& v, const std::string& ptr);
   std::optional<Procedure> ParseProcedure(const Json& v, const std::string& ptr);
   std::vector<Factor> ParseConditions(const Json& v, const std::string& ptr);
+  void ParseInfo(const Json& v, const std::string& ptr, Protocol* p);
+  void ParseGroups(const Json& v, const Json& top, const std::string& ptr, Protocol* p);
   void ParseSides(const Json& v, const std::string& ptr);
   // Fills `b` from `obj` at `ptr`, falling back to the protocol-level defaults in `top`.
   void ParseBlock(const Json& obj, const std::string& ptr, const Json& top, Block* b);
@@ -627,6 +629,81 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
   return {factor};
 }
 
+void Parser::ParseInfo(const Json& v, const std::string& ptr, Protocol* p) {
+  if (!v.is_array() || v.size() > 20) {
+    Problem(ptr, "must be a list of at most 20 fields ({\"key\": ..., \"type\": ...})", v);
+    return;
+  }
+  std::set<std::string> keys;
+  for (size_t i = 0; i < v.size(); ++i) {
+    const std::string fp = ptr + "/" + std::to_string(i);
+    const Json& f = v[i];
+    if (!Object(f, fp, {"key", "type", "min", "max", "choices", "required", "prompt"})) continue;
+    InfoField field;
+    if (auto k = Text(f, "key", fp, true, 40, true)) {
+      const bool ok = !k->empty() && std::all_of(k->begin(), k->end(), [](char c) {
+        return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+      });
+      if (!ok) Problem(fp + "/key", "must be 1-40 characters of a-z, 0-9 and _", Json(*k));
+      else if (!keys.insert(*k).second) Problem(fp + "/key", "repeats an earlier key", Json(*k));
+      field.key = *k;
+    }
+    if (auto t = String(f, "type", fp, false, {"integer", "number", "choice", "text"})) field.type = *t;
+    const bool numeric = field.type == "integer" || field.type == "number";
+    if (numeric) {
+      auto lo = Number(f, "min", fp, true, -1e9, 1e9, ""), hi = Number(f, "max", fp, true, -1e9, 1e9, "");
+      if (lo && hi && *lo >= *hi) Problem(fp + "/max", "must be larger than min", f["max"]);
+      field.min = lo.value_or(0), field.max = hi.value_or(0);
+    } else {
+      for (const char* k : {"min", "max"})
+        if (f.contains(k)) Problem(fp + "/" + k, "is for an integer or number field, not " + field.type, f[k]);
+    }
+    if (field.type == "choice") {
+      const Json* c = Field(f, "choices", fp, true);
+      if (c && (!c->is_array() || c->empty() || c->size() > 20))
+        Problem(fp + "/choices", "must be a list of 1 to 20 answers", *c);
+      else if (c)
+        for (size_t k = 0; k < c->size(); ++k) {
+          const Json& choice = (*c)[k];
+          if (!choice.is_string() || choice.get<std::string>().empty() || choice.get<std::string>().size() > 100 ||
+              HasControlCharacter(choice.get<std::string>()) ||
+              std::count(field.choices.begin(), field.choices.end(), choice.get<std::string>()))
+            Problem(fp + "/choices/" + std::to_string(k), "must be a new answer of 1-100 characters", choice);
+          else
+            field.choices.push_back(choice.get<std::string>());
+        }
+    } else if (f.contains("choices")) {
+      Problem(fp + "/choices", "is for a choice field, not " + field.type, f["choices"]);
+    }
+    if (auto r = Bool(f, "required", fp)) field.required = *r;
+    if (auto s = Text(f, "prompt", fp, false, 200, true)) field.prompt = *s;
+    p->participant_info.push_back(std::move(field));
+  }
+}
+
+void Parser::ParseGroups(const Json& v, const Json& top, const std::string& ptr, Protocol* p) {
+  if (!Object(v, ptr, {"names", "assign"})) return;
+  Groups g;
+  if (auto a = String(v, "assign", ptr, false, {"by_number", "balanced"})) g.assign = *a;
+  const Json* names = Field(v, "names", ptr, true);
+  if (names && (!names->is_array() || names->size() < 2 || names->size() > 20)) {
+    Problem(ptr + "/names", "must be a list of 2 to 20 group names", *names);
+    return;
+  }
+  if (names)
+    for (size_t i = 0; i < names->size(); ++i) {
+      const Json& n = (*names)[i];
+      if (!n.is_string() || n.get<std::string>().empty() || n.get<std::string>().size() > kMaxNameChars ||
+          HasControlCharacter(n.get<std::string>()) ||
+          std::count(g.names.begin(), g.names.end(), n.get<std::string>()))
+        Problem(ptr + "/names/" + std::to_string(i), "must be a new name of 1-100 characters", n);
+      else
+        g.names.push_back(n.get<std::string>());
+    }
+  p->groups = g;
+  (void)top;
+}
+
 std::optional<Procedure> Parser::ParseProcedure(const Json& v, const std::string& ptr) {
   if (!v.is_object()) {
     Problem(ptr, "must be an object (type staircase or quest_plus)", v);
@@ -775,6 +852,15 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
   }
   if (auto s = Text(obj, "instructions", ptr, false, kMaxTextChars, false)) b->instructions = *s;
   if (auto s = Bool(obj, "shuffle", ptr)) b->shuffle = *s;
+  if (const Json* g = Field(obj, "groups", ptr, false)) {
+    if (!g->is_array() || g->empty())
+      Problem(ptr + "/groups", "must be a list of the protocol's group names", *g);
+    else
+      for (size_t i = 0; i < g->size(); ++i) {
+        if ((*g)[i].is_string()) b->groups.push_back((*g)[i].get<std::string>());
+        else Problem(ptr + "/groups/" + std::to_string(i), "must be a group name", (*g)[i]);
+      }
+  }
 
   // What is shown left and right must be known for a comparison, and for any left/right counterbalancing.
   bool factor_sides = false;
@@ -835,7 +921,7 @@ Protocol Parser::Parse(const Json& json) {
   if (!Object(json, "",
               {"$schema", "name", "version", "description", "scene", "content", "task", "factors", "conditions",
                "repetitions", "counterbalance", "sides", "adjust", "blocks", "block_order", "practice", "instructions",
-               "breaks", "responses", "timing", "display"}))
+               "breaks", "responses", "timing", "display", "participant_info", "groups"}))
     return p;
   if (auto s = Text(json, "name", "", true, kMaxNameChars, true)) {
     if (s->empty()) Problem("/name", "must not be empty", Json(*s));
@@ -872,7 +958,7 @@ Protocol Parser::Parse(const Json& json) {
       const Json& obj = (*blocks)[i];
       const std::string bp = "/blocks/" + std::to_string(i);
       if (!Object(obj, bp, {"name", "task", "factors", "conditions", "repetitions", "counterbalance", "sides",
-                            "adjust", "procedure", "instructions", "shuffle"}))
+                            "adjust", "procedure", "instructions", "shuffle", "groups"}))
         continue;
       Block b;
       if (auto s = Text(obj, "name", bp, true, kMaxNameChars, true)) {
@@ -901,6 +987,8 @@ Protocol Parser::Parse(const Json& json) {
   }
   if (auto order = String(json, "block_order", "", false, {"fixed", "random", "latin_square"}))
     p.block_order = *order;
+  if (const Json* v = Field(json, "participant_info", "", false)) ParseInfo(*v, "/participant_info", &p);
+  if (const Json* v = Field(json, "groups", "", false)) ParseGroups(*v, json, "/groups", &p);
   if (const Json* v = Field(json, "breaks", "", false)) {
     if (Object(*v, "/breaks", {"every_trials", "text"})) {
       if (auto n = Int(*v, "every_trials", "/breaks", true, 1, kMaxTrials, "trials")) p.break_every_trials = *n;
@@ -968,6 +1056,19 @@ Protocol Parser::Parse(const Json& json) {
 void Parser::CheckDesign(const Protocol& p) {
   if (calls_ > 0) return;  // a design built from fields with problems would only repeat them
   const std::string& type = p.content.type;
+  // Groups: a block names only the protocol's groups, and every group runs at least one block.
+  for (const auto& b : p.blocks)
+    for (size_t i = 0; i < b.groups.size(); ++i)
+      if (!p.groups || std::find(p.groups->names.begin(), p.groups->names.end(), b.groups[i]) == p.groups->names.end())
+        Problem((b.pointer.empty() ? std::string() : b.pointer) + "/groups/" + std::to_string(i),
+                p.groups ? "names no group of /groups/names" : "names a group but the protocol declares no /groups",
+                Json(b.groups[i]));
+  if (p.groups)
+    for (const auto& g : p.groups->names)
+      if (std::none_of(p.blocks.begin(), p.blocks.end(), [&](const Block& b) {
+            return b.groups.empty() || std::count(b.groups.begin(), b.groups.end(), g);
+          }))
+        Problem("/groups/names", "group " + g + " runs no block", Json(g));
   for (const auto& b : p.blocks) {
     // The renderer draws a picture for adjustment (cut-offs) and a pair of grids or balls for forced choice.
     if (type == "picture" && b.task != Task::kAdjustment)
@@ -1060,6 +1161,30 @@ bool Parser::Provides(const Block& b, const std::string& name) {
 }
 
 }  // namespace
+
+std::string CheckInfoValue(const InfoField& f, const std::string& value) {
+  if (f.type == "integer" || f.type == "number") {
+    char* end = nullptr;
+    const double x = std::strtod(value.c_str(), &end);
+    const bool number = !value.empty() && end == value.c_str() + value.size() && std::isfinite(x);
+    if (!number || (f.type == "integer" && x != std::floor(x)) || x < f.min || x > f.max) {
+      char range[96];
+      std::snprintf(range, sizeof range, "%s in [%g, %g]", f.type == "integer" ? "a whole number" : "a number", f.min,
+                    f.max);
+      return std::string("must be ") + range;
+    }
+    return "";
+  }
+  if (f.type == "choice") {
+    if (std::find(f.choices.begin(), f.choices.end(), value) != f.choices.end()) return "";
+    std::string list;
+    for (const auto& c : f.choices) list += (list.empty() ? "" : ", ") + c;
+    return "must be one of " + list;
+  }
+  if (value.size() > 200 || HasControlCharacter(value)) return "must be one line of at most 200 characters";
+  return "";
+}
+
 
 std::vector<std::string> Validate(const Json& json, const fs::path& file, const ValidateOptions& options) {
   Parser parser(file, options);

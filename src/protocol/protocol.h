@@ -77,6 +77,7 @@ struct Block {
   std::optional<Procedure> procedure; // set for an adaptive block
   bool shuffle = true;
   std::string instructions;
+  std::vector<std::string> groups;    // the groups that run this block; empty: every group
 };
 
 struct Scene {
@@ -144,6 +145,27 @@ struct Display {
   std::filesystem::path profile;      // the monitor's display profile (display/profile.h), resolved; empty: none
 };
 
+// A piece of participant information the protocol asks for (PsychoPy's expInfo): recorded with the session.
+struct InfoField {
+  std::string key;                   // [a-z0-9_], 1-40 characters
+  std::string type = "text";         // "integer" | "number" | "choice" | "text"
+  double min = 0, max = 0;           // integer, number
+  std::vector<std::string> choices;  // choice
+  bool required = true;
+  std::string prompt;                // what the terminal asks; default: the key
+};
+
+// Between-subject groups: each participant runs the blocks of one group (a block's "groups"; none: every group).
+struct Groups {
+  std::vector<std::string> names;
+  std::string assign = "by_number";  // "by_number": names[(number - 1) mod n]; "balanced": the group with the fewest
+                                     // sessions in the record so far (the first of equals)
+};
+
+// Why `value` is not an answer to `field` ("" when it is one): a whole number in [min, max], a number, one of the
+// choices, text of at most 200 characters without control characters.
+std::string CheckInfoValue(const InfoField& field, const std::string& value);
+
 struct Protocol {
   std::filesystem::path file;
   std::string name, description;
@@ -154,6 +176,8 @@ struct Protocol {
   // The order blocks run in: "fixed" (file order), "random" (drawn with the seed) or "latin_square" (a balanced
   // Latin square over participants by their number: each block equally often in each place, and after each other).
   std::string block_order = "fixed";
+  std::vector<InfoField> participant_info;
+  std::optional<Groups> groups;
   Practice practice;
   std::string instructions;
   int break_every_trials = 0;         // 0: no breaks

@@ -208,6 +208,50 @@ TEST(ProtocolValidate, ConditionsTableGivesTheDesignRowByRow) {
   EXPECT_TRUE(Contains(OnlyProblem(j), "/blocks/0/conditions: no such file")) << OnlyProblem(j);
 }
 
+// Participant information and between-subject groups: every field checked with its pointer; a block names only
+// declared groups; every group runs a block.
+TEST(ProtocolValidate, ParticipantInfoAndGroupsAreChecked) {
+  Json j = Valid();
+  j["participant_info"] = Json::parse(R"([{"key": "age", "type": "integer", "min": 16, "max": 99},
+                                          {"key": "hand", "type": "choice", "choices": ["left", "right"]},
+                                          {"key": "notes", "required": false}])");
+  j["groups"] = {{"names", {"a", "b"}}, {"assign", "balanced"}};
+  j["blocks"][0]["groups"] = {"a"};
+  j["blocks"][1]["groups"] = {"b"};
+  EXPECT_TRUE(Problems(j).empty()) << Problems(j).front();
+  const Protocol p = ParseProtocol(j, SceneFolder() / "p.json");
+  ASSERT_EQ(p.participant_info.size(), 3u);
+  EXPECT_EQ(CheckInfoValue(p.participant_info[0], "34"), "");
+  EXPECT_EQ(CheckInfoValue(p.participant_info[0], "34.5"), "must be a whole number in [16, 99]");
+  EXPECT_EQ(CheckInfoValue(p.participant_info[0], "nan"), "must be a whole number in [16, 99]");
+  EXPECT_EQ(CheckInfoValue(p.participant_info[1], "up"), "must be one of left, right");
+  EXPECT_EQ(CheckInfoValue(p.participant_info[2], "bad\nline"), "must be one line of at most 200 characters");
+  auto problem_at = [&](Json changed, const std::string& text) {
+    bool found = false;
+    std::string all;
+    for (const auto& problem : Problems(changed)) found = found || Contains(problem, text), all += problem + "\n";
+    EXPECT_TRUE(found) << "expected '" << text << "' among:\n" << all;
+  };
+  Json bad = j;
+  bad["participant_info"][0]["key"] = "Age!";
+  problem_at(bad, "/participant_info/0/key: must be 1-40 characters of a-z, 0-9 and _");
+  bad = j;
+  bad["participant_info"][1]["min"] = 1;
+  problem_at(bad, "/participant_info/1/min: is for an integer or number field, not choice");
+  bad = j;
+  bad["participant_info"][0]["max"] = 10;
+  problem_at(bad, "/participant_info/0/max: must be larger than min");
+  bad = j;
+  bad["blocks"][1]["groups"] = {"c"};
+  problem_at(bad, "/blocks/1/groups/0: names no group of /groups/names");
+  bad = j;
+  bad["blocks"][1]["groups"] = {"a"};
+  problem_at(bad, "/groups/names: group b runs no block");
+  bad = j;
+  bad["groups"]["names"] = {"a"};
+  problem_at(bad, "/groups/names: must be a list of 2 to 20 group names");
+}
+
 TEST(ProtocolValidate, ProblemStartsWithFileAndPointer) {
   Json j = Valid();
   j["version"] = 0;
@@ -228,7 +272,8 @@ TEST(ProtocolValidate, UnknownKeyNamesPointerAndNearestKey) {
   const auto problems = Problems(j);
   ASSERT_EQ(problems.size(), 2u);
   EXPECT_TRUE(Contains(problems[0], ": /blocks/1/factros: unknown key (did you mean \"factors\"?)")) << problems[0];
-  EXPECT_TRUE(Contains(problems[1], ": /blocks/1/factors: is required (here or at /factors) but missing")) << problems[1];
+  EXPECT_TRUE(Contains(problems[1], ": /blocks/1/factors: is required (here or at /factors; or a conditions table) "
+                                    "but missing")) << problems[1];
 }
 
 TEST(ProtocolValidate, MissingFieldNamesPointer) {

@@ -96,7 +96,29 @@ void DrawAdjustment(const Block& block, std::mt19937_64& rng, Trial* t) {
 
 }  // namespace
 
-std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& participant, uint64_t seed) {
+std::string AssignGroup(const Protocol& protocol, const std::string& participant,
+                        const std::map<std::string, int64_t>& sessions) {
+  if (!protocol.groups || protocol.groups->names.empty()) return "";
+  const auto& names = protocol.groups->names;
+  if (protocol.groups->assign == "balanced") {
+    std::string best = names.front();
+    int64_t fewest = INT64_MAX;
+    for (const auto& name : names) {
+      const auto it = sessions.find(name);
+      const int64_t n = it == sessions.end() ? 0 : it->second;
+      if (n < fewest) fewest = n, best = name;
+    }
+    return best;
+  }
+  const int number = ParticipantNumber(participant);
+  if (number < 0)
+    throw InputError(protocol.file.string() + ": /groups/assign",
+                     "by_number needs a participant id ending in a number (e.g. P7), got \"" + participant + "\"");
+  return names[size_t((number + int(names.size()) - 1) % int(names.size()))];
+}
+
+std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& participant, uint64_t seed,
+                               const std::string& group) {
   const Block* by_participant = nullptr;
   for (const auto& b : protocol.blocks)
     if (!by_participant && b.counterbalance == Counterbalance::kByParticipant) by_participant = &b;
@@ -130,6 +152,8 @@ std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& part
   }
   for (const size_t k : order) {
     const Block& b = protocol.blocks[k];
+    if (!group.empty() && !b.groups.empty() && std::find(b.groups.begin(), b.groups.end(), group) == b.groups.end())
+      continue;  // another group's block
     std::vector<Trial> rows = Design(b, even);
     if (b.shuffle) Shuffle(rows, rng);
     for (auto& t : rows) {

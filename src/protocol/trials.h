@@ -4,6 +4,7 @@
 // by the C++ standard) turned into indices by our own rejection sampling and Fisher-Yates, never by
 // std::shuffle or std::uniform_int_distribution, whose results differ between libraries.
 #include <cstdint>
+#include <map>
 #include <random>
 #include <string>
 #include <vector>
@@ -60,7 +61,15 @@ std::vector<size_t> BlockOrder(const Protocol& protocol, const std::string& part
 // of the levels when the order is "shuffled", then the start index) or, in a procedure block (procedure.trials
 // copies of each crossing, the reference on both sides), its test side. The order depends on the seed alone; give
 // each participant their own seed. Throws Error(kInput) for by_participant with a participant id without number.
-std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& participant, uint64_t seed);
+// With groups, only the blocks of `group` (protocol.groups; a block without "groups" runs for every group).
+std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& participant, uint64_t seed,
+                               const std::string& group = "");
+
+// The group a new session of `participant` runs: by_number - names[(number - 1) mod n] (Error(kInput) for an id
+// without number); balanced - the group with the fewest sessions so far (`sessions`: group -> count; the first of
+// equals). "" when the protocol has no groups.
+std::string AssignGroup(const Protocol& protocol, const std::string& participant,
+                        const std::map<std::string, int64_t>& sessions);
 
 // The JSON pointer of the field that chose what `trial` shows on `side` ("left" | "right" as shown, swaps
 // applied): the side of a level object (/blocks/1/factors/pattern/2/left) or of the block's sides (/sides/left).

@@ -111,6 +111,34 @@ TEST(TrialBuilder, BlockOrderIsABalancedLatinSquareOrSeeded) {
   }
 }
 
+// Groups: by participant number in turn, or the group with the fewest sessions so far; a session's trials are
+// its group's blocks (and the blocks of every group).
+TEST(TrialBuilder, GroupsAreAssignedAndSelectTheirBlocks) {
+  const Protocol p = FromJson(R"({
+    "name": "groups", "version": 1, "scene": {"background": "s.png", "calib": "c.json"},
+    "content": {"type": "grid"}, "task": "forced_choice", "factors": {"edge": [1, 2]},
+    "sides": {"left": "measured", "right": "none"},
+    "groups": {"names": ["a", "b", "c"]},
+    "blocks": [{"name": "all"}, {"name": "for-a", "groups": ["a"]}, {"name": "for-bc", "groups": ["b", "c"]}]
+  })");
+  EXPECT_EQ(AssignGroup(p, "P1", {}), "a");
+  EXPECT_EQ(AssignGroup(p, "P2", {}), "b");
+  EXPECT_EQ(AssignGroup(p, "P3", {}), "c");
+  EXPECT_EQ(AssignGroup(p, "P4", {}), "a");
+  EXPECT_EQ(AssignGroup(p, "P0", {}), "c");
+  EXPECT_THROW(AssignGroup(p, "anonymous", {}), Error);
+  Protocol balanced = p;
+  balanced.groups->assign = "balanced";
+  EXPECT_EQ(AssignGroup(balanced, "anonymous", {}), "a");
+  EXPECT_EQ(AssignGroup(balanced, "x", {{"a", 3}, {"b", 2}, {"c", 2}}), "b");
+  EXPECT_EQ(AssignGroup(balanced, "x", {{"a", 1}, {"b", 2}, {"c", 2}}), "a");
+  std::set<std::string> blocks_a, blocks_b;
+  for (const auto& t : BuildTrials(p, "P1", 5, "a")) blocks_a.insert(t.block);
+  for (const auto& t : BuildTrials(p, "P1", 5, "b")) blocks_b.insert(t.block);
+  EXPECT_EQ(blocks_a, (std::set<std::string>{"all", "for-a"}));
+  EXPECT_EQ(blocks_b, (std::set<std::string>{"all", "for-bc"}));
+}
+
 TEST(TrialBuilder, GeneratorIsTheStandardMt19937_64) {
   // The C++ standard fixes the 10000th output of a default-constructed mt19937_64.
   std::mt19937_64 rng;

@@ -1,18 +1,25 @@
 #include "session/prepare.h"
 
+#include <algorithm>
+
 #include "core/error.h"
 #include "core/json_io.h"
 
 namespace blurcue::session {
 
 PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const std::string& participant,
-                               std::optional<uint64_t> seed, const std::filesystem::path& display_profile) {
+                               std::optional<uint64_t> seed, const std::filesystem::path& display_profile,
+                               const std::string& group) {
   PreparedSession s;
   // Read once: the text recorded with the session is the text that was validated.
   s.protocol_text = ReadTextFile(protocol_file);
   s.protocol = protocol::ParseProtocol(ParseJson(s.protocol_text, protocol_file.string()), protocol_file);
   s.seed = seed ? *seed : protocol::DefaultSeed(s.protocol.name, participant);
-  s.trials = protocol::BuildTrials(s.protocol, participant, s.seed);
+  s.group = !group.empty() ? group : protocol::AssignGroup(s.protocol, participant, {});
+  if (s.protocol.groups && std::find(s.protocol.groups->names.begin(), s.protocol.groups->names.end(), s.group) ==
+                               s.protocol.groups->names.end())
+    throw InputError(protocol_file.string() + ": /groups/names", "has no group \"" + s.group + "\"");
+  s.trials = protocol::BuildTrials(s.protocol, participant, s.seed, s.group);
   s.scene = LoadProtocolScene(s.protocol);
   s.images = LoadStimulusImages(s.protocol, s.scene);
   if (!display_profile.empty()) {

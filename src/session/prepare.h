@@ -20,6 +20,7 @@ struct PreparedSession {
   protocol::Protocol protocol;
   std::string protocol_text;              // the file as read and parsed (recorded with the session)
   uint64_t seed = 0;                      // as given, else protocol::DefaultSeed(study, participant)
+  std::string group;                      // the between-subject group whose blocks the trials hold ("": none)
   std::vector<protocol::Trial> trials;
   std::optional<calib::SceneCalib> scene;
   StimulusImages images;
@@ -31,8 +32,11 @@ struct PreparedSession {
 // Reads and validates the protocol, builds the participant's trial list, loads the calibration and every image
 // the trials show (each must decode, at a size its use can show), and works out every trial's scene and radii.
 // Throws Error(kInput) whose lines each name the protocol file and the JSON pointer of the field at fault.
-// `display_profile` (--display) overrides the protocol's display.profile.
+// `display_profile` (--display) overrides the protocol's display.profile. `group`: the group to run (a resumed
+// session's, or one assigned from the record); empty: assigned as if the record were empty (by_number, or the
+// first group when balanced).
 PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const std::string& participant,
-                               std::optional<uint64_t> seed, const std::filesystem::path& display_profile = {});
+                               std::optional<uint64_t> seed, const std::filesystem::path& display_profile = {},
+                               const std::string& group = "");
 
 }  // namespace blurcue::session

@@ -474,6 +474,75 @@ class Runner {
 
 }  // namespace
 
+// The participant information a session records: --info values checked against the protocol's fields, the
+// required ones that are missing asked for in the terminal (stdin a terminal) or refused; a resumed session's
+// recorded information, which --info may repeat but not change.
+Json CollectInfo(const protocol::Protocol& p, const RunOptions& options, const store::GroupsSoFar& so_far) {
+  auto field_of = [&](const std::string& key) -> const protocol::InfoField* {
+    for (const auto& f : p.participant_info)
+      if (f.key == key) return &f;
+    return nullptr;
+  };
+  auto value_of = [](const protocol::InfoField& f, const std::string& text) {
+    return f.type == "integer" ? Json(int64_t(std::strtod(text.c_str(), nullptr)))
+           : f.type == "number" ? Json(std::strtod(text.c_str(), nullptr))
+                                : Json(text);
+  };
+  auto describe = [](const protocol::InfoField& f) {
+    if (f.type == "choice") {
+      std::string list;
+      for (const auto& c : f.choices) list += (list.empty() ? "" : " / ") + c;
+      return list;
+    }
+    char range[64];
+    std::snprintf(range, sizeof range, "%g-%g", f.min, f.max);
+    return f.type == "text" ? std::string("text") : std::string(range);
+  };
+  std::string asked;
+  for (const auto& f : p.participant_info) asked += (asked.empty() ? "" : ", ") + f.key;
+  Json info = Json::object();
+  for (const auto& [key, text] : options.info) {
+    const protocol::InfoField* f = field_of(key);
+    if (!f)
+      throw Error(ErrorKind::kUsage, "--info " + key + ": " + options.protocol_file.string() +
+                                         (asked.empty() ? " asks for no participant information"
+                                                        : " asks for " + asked + " (participant_info), not " + key));
+    if (const std::string why = protocol::CheckInfoValue(*f, text); !why.empty())
+      throw Error(ErrorKind::kUsage, "--info " + key + "=" + text + ": " + why);
+    info[key] = value_of(*f, text);
+  }
+  if (options.resume && so_far.unfinished) {
+    const Json recorded = ParseJson(so_far.unfinished_info, options.db.string());
+    for (const auto& [key, value] : info.items())
+      if (!recorded.contains(key) || recorded[key] != value)
+        throw InputError(options.db.string(), "--info " + key + ": the unfinished session recorded " +
+                                                  (recorded.contains(key) ? recorded[key].dump() : "nothing") +
+                                                  ", got " + value.dump() + "; a session keeps what it recorded");
+    return recorded;
+  }
+  for (const auto& f : p.participant_info) {
+    if (info.contains(f.key) || !f.required) continue;
+    if (!isatty(0))
+      throw Error(ErrorKind::kUsage, "--info: " + options.protocol_file.string() + " asks for " + f.key + " (" +
+                                         describe(f) + "); give --info " + f.key + "=VALUE");
+    for (int tries = 0;; ++tries) {
+      std::fprintf(stderr, "%s (%s): ", f.prompt.empty() ? f.key.c_str() : f.prompt.c_str(), describe(f).c_str());
+      std::string line;
+      int c;
+      while ((c = std::getchar()) != EOF && c != '\n') line += char(c);
+      if (c == EOF && line.empty()) throw Error(ErrorKind::kUsage, "--info: no answer for " + f.key);
+      const std::string why = protocol::CheckInfoValue(f, line);
+      if (why.empty()) {
+        info[f.key] = value_of(f, line);
+        break;
+      }
+      std::fprintf(stderr, "  %s %s\n", f.key.c_str(), why.c_str());
+      if (tries >= 4) throw Error(ErrorKind::kUsage, "--info " + f.key + ": " + why);
+    }
+  }
+  return info;
+}
+
 RunResult RunSession(const RunOptions& options) {
   if (options.participant.empty()) throw Error(ErrorKind::kUsage, "--participant must not be empty");
   std::optional<ObserverParams> observer;
@@ -484,9 +553,19 @@ RunResult RunSession(const RunOptions& options) {
   if (options.resume && !std::filesystem::exists(options.db))
     throw InputError(options.db.string(), "--resume: no such record, so there is no session to continue; leave out "
                                           "--resume to start one");
+  // Groups and participant information: what the record already says (a resumed session keeps its group and its
+  // information), then the group a new session gets and the information it is given.
+  const protocol::Protocol head = protocol::LoadProtocol(options.protocol_file);
+  store::GroupsSoFar so_far;
+  if (head.groups || !head.participant_info.empty())
+    so_far = store::PeekGroups(options.db, head.name, options.participant);
+  const std::string group = !head.groups       ? ""
+                            : so_far.unfinished ? so_far.unfinished_group
+                                                : protocol::AssignGroup(head, options.participant, so_far.sessions);
+  const Json info = CollectInfo(head, options, so_far);
   // Everything checked before the first trial is what `blurcue validate` checks: the same function.
   const PreparedSession prepared =
-      PrepareSession(options.protocol_file, options.participant, options.seed, options.display_profile);
+      PrepareSession(options.protocol_file, options.participant, options.seed, options.display_profile, group);
   const protocol::Protocol& protocol = prepared.protocol;
   const std::string& protocol_text = prepared.protocol_text;
   const uint64_t seed = prepared.seed;
@@ -546,6 +625,8 @@ RunResult RunSession(const RunOptions& options) {
                 context->Describe().c_str(), observer ? ("; observer " + ToString(*observer)).c_str() : "");
   meta.display = display;
   meta.display_profile = display::ToJson(prepared.display).dump();
+  meta.group = prepared.group;
+  meta.participant_info = info.dump();
   if (!options.again && !options.resume) {
     // Running a participant through a study they finished is usually a typo in the id: say so.
     const std::vector<int64_t> done = record.CompletedSessions(protocol.name, options.participant);

@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace blurcue::session {
 
@@ -23,6 +25,9 @@ struct RunOptions {
   bool window = false;           // a simulated observer in a window, on the real clock (a person always has one)
   double sim_fps = 4;            // headless: frames rendered per second of simulated time
   std::filesystem::path capture_dir;      // --capture: each trial's first frame as shown, and what it shows
+  // --info KEY=VALUE: the participant information the protocol asks for (participant_info). Missing required
+  // fields are asked for in the terminal when stdin is one, else refused; a resumed session keeps what it recorded.
+  std::vector<std::pair<std::string, std::string>> info;
   int stop_after = -1;           // >= 0: leave the session (running, resumable) after this many new answers
 };
 

@@ -208,10 +208,26 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
       }
     }
   }
+  // Between-subject groups and participant information, when any session has them: a column "group" and one
+  // "info_KEY" per key given anywhere.
+  bool groups = false;
+  std::set<std::string> info_keys;
+  if (SchemaVersion(db) >= 6) {
+    Statement sessions(db, "SELECT id, group_name, participant_info FROM sessions");
+    while (sessions.Step()) {
+      groups = groups || !sessions.GetText(1).empty();
+      const Json info = ParseColumn(sessions.GetText(2), db_path.string() + ": session " +
+                                                             std::to_string(sessions.GetInt64(0)) + " participant_info");
+      if (info.is_object())
+        for (const auto& item : info.items()) info_keys.insert(item.key());
+    }
+  }
   std::set<std::string> fixed(LeadingColumns().begin(), LeadingColumns().end());
   fixed.insert(TrailingColumns().begin(), TrailingColumns().end());
 
   std::vector<std::string> header = LeadingColumns();
+  if (groups) header.push_back("group");
+  for (const auto& key : info_keys) header.push_back("info_" + key);
   for (const auto& key : keys) header.push_back(fixed.count(key) ? "factor_" + key : key);
   header.insert(header.end(), TrailingColumns().begin(), TrailingColumns().end());
   std::string text = CsvLine(header);
@@ -219,7 +235,8 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
   Statement rows(db,
                  "SELECT st.name, pv.hash, p.code, s.id, s.seed, t.trial_index, t.block, t.factors, t.left_shown, "
                  "t.right_shown, r.choice, r.rt_ms, r.answered_at, r.id IS NULL, r.adjustment, "
-                 "coalesce(r.shown, '{}') "
+                 "coalesce(r.shown, '{}'), " +
+                     std::string(SchemaVersion(db) >= 6 ? "s.group_name, s.participant_info " : "'', '{}' ") +
                  "FROM trials t JOIN sessions s ON s.id = t.session_id "
                  "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
                  "JOIN protocol_versions pv ON pv.id = s.protocol_version_id "
@@ -237,6 +254,12 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
                                       std::to_string(static_cast<uint64_t>(rows.GetInt64(4))),
                                       std::to_string(trial),
                                       std::to_string(rows.GetInt64(6))};
+    if (groups) cells.push_back(rows.GetText(16));
+    if (!info_keys.empty()) {
+      const Json info = ParseColumn(rows.GetText(17), where + " participant_info");
+      for (const auto& key : info_keys)
+        cells.push_back(info.is_object() && info.contains(key) ? Cell(info.at(key)) : std::string());
+    }
     // The plan's variables, with what the trial showed when it was shown laid over them (adaptive levels).
     Json factors = ParseColumn(rows.GetText(7), where + " factors");
     const Json shown = ParseColumn(rows.GetText(15), where + " shown");
@@ -346,12 +369,14 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
 
         Statement sessions(src, "SELECT id, participant_id, protocol_version_id, seed, software_version, host, "
                                 "display, started, ended, status, " +
-                                std::string(SchemaVersion(src) >= 3 ? "display_profile" : "'{}'") + " FROM sessions");
+                                std::string(SchemaVersion(src) >= 3 ? "display_profile" : "'{}'") + ", " +
+                                std::string(SchemaVersion(src) >= 6 ? "group_name, participant_info" : "'', '{}'") +
+                                " FROM sessions");
         Statement duplicate(dst, "SELECT id FROM sessions WHERE participant_id = ? AND protocol_version_id = ? "
                                  "AND seed = ? AND host = ? AND started = ?");
         Statement insert_session(dst, "INSERT INTO sessions (participant_id, protocol_version_id, seed, "
-                                      "software_version, host, display, started, ended, status, display_profile) "
-                                      "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+                                      "software_version, host, display, started, ended, status, display_profile, "
+                                      "group_name, participant_info) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
         while (sessions.Step()) {
           const int64_t participant = participant_ids.at(sessions.GetInt64(1));
           const int64_t protocol = protocol_ids.at(sessions.GetInt64(2));
@@ -372,6 +397,8 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
           else insert_session.Bind(8, sessions.GetText(8));
           insert_session.Bind(9, sessions.GetText(9));
           insert_session.Bind(10, sessions.GetText(10));
+          insert_session.Bind(11, sessions.GetText(11));
+          insert_session.Bind(12, sessions.GetText(12));
           insert_session.Run();
           insert_session.Reset();
           session_ids[sessions.GetInt64(0)] = dst.LastInsertRowId();

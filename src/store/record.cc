@@ -298,7 +298,8 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
 
     Statement insert(db_, "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, "
                           "host, display, started, status, lock_host, lock_pid, lock_token, lock_heartbeat_ms, "
-                          "display_profile) VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?)");
+                          "display_profile, group_name, participant_info) "
+                          "VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?)");
     insert.Bind(1, participant_id);
     insert.Bind(2, protocol_id);
     insert.Bind(3, static_cast<int64_t>(seed));
@@ -311,6 +312,8 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     insert.Bind(10, token_);
     insert.Bind(11, NowMs());
     insert.Bind(12, meta.display_profile);
+    insert.Bind(13, meta.group);
+    insert.Bind(14, meta.participant_info);
     insert.Run();
     start.session_id = db_.LastInsertRowId();
   }
@@ -457,6 +460,31 @@ int64_t Record::FirstUnansweredTrial(int64_t session) {
   query.Step();
   if (!query.IsNull(0)) return query.GetInt64(0);
   return db_.QueryInt64("SELECT COUNT(*) FROM trials WHERE session_id = " + std::to_string(session));
+}
+
+GroupsSoFar PeekGroups(const std::filesystem::path& db_path, const std::string& study, const std::string& participant) {
+  GroupsSoFar so_far;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(db_path, ec) || std::filesystem::file_size(db_path, ec) == 0) return so_far;
+  Database db(db_path, OpenMode::kReadOnly);
+  RequireReadableRecord(db);
+  if (SchemaVersion(db) < 6) return so_far;  // no groups recorded before version 6
+  Statement counts(db, "SELECT s.group_name, count(*) FROM sessions s JOIN participants p ON p.id = s.participant_id "
+                       "JOIN studies st ON st.id = p.study_id WHERE st.name = ? AND s.status != 'aborted' "
+                       "GROUP BY s.group_name");
+  counts.Bind(1, study);
+  while (counts.Step()) so_far.sessions[counts.GetText(0)] = counts.GetInt64(1);
+  Statement running(db, "SELECT s.group_name, s.participant_info FROM sessions s JOIN participants p "
+                        "ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
+                        "WHERE st.name = ? AND p.code = ? AND s.status = 'running' ORDER BY s.id DESC LIMIT 1");
+  running.Bind(1, study);
+  running.Bind(2, participant);
+  if (running.Step()) {
+    so_far.unfinished = true;
+    so_far.unfinished_group = running.GetText(0);
+    so_far.unfinished_info = running.GetText(1);
+  }
+  return so_far;
 }
 
 }  // namespace blurcue::store

@@ -18,7 +18,18 @@ struct SessionMeta {
   std::string host;
   std::string display;  // e.g. "1920x1080@60 DELL U2412M"
   std::string display_profile = "{}";  // the display profile as JSON (display::ToJson)
+  std::string group;                    // the between-subject group the session runs ("" without groups)
+  std::string participant_info = "{}";  // the participant information given: a JSON object key -> value
 };
+
+// What a record already says about a study's groups and a participant's unfinished session, read without writing
+// (a missing file says nothing): how to assign the next group, and what a resumed session must keep.
+struct GroupsSoFar {
+  std::map<std::string, int64_t> sessions;  // group -> sessions of the study that were not aborted
+  bool unfinished = false;                  // the participant has a running session
+  std::string unfinished_group, unfinished_info = "{}";
+};
+GroupsSoFar PeekGroups(const std::filesystem::path& db, const std::string& study, const std::string& participant);
 
 // One planned trial, saved up front. JSON members are compact JSON text.
 struct TrialRecord {

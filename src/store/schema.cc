@@ -129,6 +129,9 @@ std::vector<Migration> MakeMigrations() {
   // 5: what a trial showed as decided when it was shown (an adaptive procedure's level and the radii it made, the
   // answer's correctness): a JSON object of trial variables export lays over the planned ones; '{}' otherwise.
   steps.push_back({"ALTER TABLE responses ADD COLUMN shown TEXT NOT NULL DEFAULT '{}';"});
+  // 6: the between-subject group a session ran ('' without groups) and the participant information given (JSON).
+  steps.push_back({"ALTER TABLE sessions ADD COLUMN group_name TEXT NOT NULL DEFAULT '';"
+                   "ALTER TABLE sessions ADD COLUMN participant_info TEXT NOT NULL DEFAULT '{}';"});
   return steps;
 }
 
