@@ -252,6 +252,37 @@ PYEOF
   $BC export --db "$W/merged.sqlite" --out "$W/merged-tables" > /dev/null
   cmp "$W/tables/trials.csv" "$W/merged-tables/trials.csv" || fail "merge lost groups or info"
   echo "ok: groups balanced over the record, participant information checked, recorded, kept on resume and merge" ;;
+two_intervals)
+  # 2IFC: each trial's frames show the first side's object alone for interval_ms, grey for isi_ms, then the second
+  # side's alone - what frames.csv records of each frame - and the answer comes after both.
+  $BC run "$P/2ifc-grids.json" --participant I1 --db "$W/i.sqlite" --observer sim --sim-fps 20 > /dev/null 2>&1
+  $BC export --db "$W/i.sqlite" --out "$W/tables" > /dev/null
+  $PY - "$W/tables" <<'PYEOF' || fail "two intervals"
+import csv, sys
+trials = {int(r["trial_index"]): r for r in csv.DictReader(open(sys.argv[1] + "/trials.csv"))}
+frames = {}
+for f in csv.DictReader(open(sys.argv[1] + "/frames.csv")):
+    frames.setdefault(int(f["trial_index"]), []).append(f)
+for i, fs in frames.items():
+    t = trials[i]
+    for f in fs:
+        s = float(f["flip_time_s"])
+        if min(abs(s - b) for b in (0.8, 1.2, 2.0)) < 1e-6:
+            continue  # a frame on a boundary (its time in floating point) may fall either way
+        left, right = f["r_left_px"], f["r_right_px"]
+        if s < 0.8:
+            assert left and not right and abs(float(left) - float(t["r_left_px"])) < 1e-3, (i, f)
+        elif s < 1.2:
+            assert not left and not right, (i, f)
+        elif s < 2.0:
+            assert right and not left and abs(float(right) - float(t["r_right_px"])) < 1e-3, (i, f)
+        else:
+            assert not left and not right, (i, f)
+    assert float(t["rt_ms"]) > 2000, t["rt_ms"]  # answered after both intervals
+    assert t["choice"] in ("left", "right"), t["choice"]  # a strict choice
+print(len(trials), "trials")
+PYEOF
+  echo "ok: two intervals shown in turn, each frame recording its interval, answers after both" ;;
 second_writer)
   # While one process runs a session, a second one resuming it is refused with a clear message (exit 3).
   $BC run "$P/test2-moving-balls.json" --participant L1 --db "$W/s.sqlite" --observer sim --sim-fps 8 > /dev/null 2>&1 &

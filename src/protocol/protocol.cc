@@ -921,7 +921,7 @@ Protocol Parser::Parse(const Json& json) {
   if (!Object(json, "",
               {"$schema", "name", "version", "description", "scene", "content", "task", "factors", "conditions",
                "repetitions", "counterbalance", "sides", "adjust", "blocks", "block_order", "practice", "instructions",
-               "breaks", "responses", "timing", "display", "participant_info", "groups"}))
+               "breaks", "responses", "timing", "display", "participant_info", "groups", "layout"}))
     return p;
   if (auto s = Text(json, "name", "", true, kMaxNameChars, true)) {
     if (s->empty()) Problem("/name", "must not be empty", Json(*s));
@@ -987,6 +987,11 @@ Protocol Parser::Parse(const Json& json) {
   }
   if (auto order = String(json, "block_order", "", false, {"fixed", "random", "latin_square"}))
     p.block_order = *order;
+  if (auto layout = String(json, "layout", "", false, {"side_by_side", "two_intervals"})) {
+    p.layout = *layout;
+    if (p.layout == "two_intervals" && p.content.type == "picture")
+      Problem("/layout", "two intervals show a pair of grids or balls, not a picture", Json(*layout));
+  }
   if (const Json* v = Field(json, "participant_info", "", false)) ParseInfo(*v, "/participant_info", &p);
   if (const Json* v = Field(json, "groups", "", false)) ParseGroups(*v, json, "/groups", &p);
   if (const Json* v = Field(json, "breaks", "", false)) {
@@ -1012,7 +1017,7 @@ Protocol Parser::Parse(const Json& json) {
   const Json* responses = Field(json, "responses", "", false);
   ParseResponses(responses ? *responses : Json(), "/responses", tasks, &p.responses);
   if (const Json* v = Field(json, "timing", "", false)) {
-    if (Object(*v, "/timing", {"stimulus_ms", "inter_trial_ms"})) {
+    if (Object(*v, "/timing", {"stimulus_ms", "inter_trial_ms", "interval_ms", "isi_ms"})) {
       if (const Json* s = Field(*v, "stimulus_ms", "/timing", false)) {
         // From about a frame to a minute.
         if (s->is_string() && *s == "until_response") p.timing.stimulus_ms = 0;
@@ -1020,6 +1025,13 @@ Protocol Parser::Parse(const Json& json) {
         else Problem("/timing/stimulus_ms", "must be a duration in " + Range(10, 60000, "ms") + " or \"until_response\"", *s);
       }
       if (auto x = Number(*v, "inter_trial_ms", "/timing", false, 0, 60000, "ms")) p.timing.inter_trial_ms = *x;
+      if (auto x = Number(*v, "interval_ms", "/timing", false, 100, 10000, "ms")) p.timing.interval_ms = *x;
+      if (auto x = Number(*v, "isi_ms", "/timing", false, 0, 10000, "ms")) p.timing.isi_ms = *x;
+      for (const char* key : {"interval_ms", "isi_ms"})
+        if (v->contains(key) && p.layout != "two_intervals")
+          Problem(std::string("/timing/") + key, "is for the layout two_intervals", (*v)[key]);
+      if (v->contains("stimulus_ms") && p.layout == "two_intervals")
+        Problem("/timing/stimulus_ms", "two intervals are timed by interval_ms and isi_ms", (*v)["stimulus_ms"]);
     }
   }
   if (const Json* v = Field(json, "display", "", false)) {
@@ -1101,6 +1113,8 @@ void Parser::CheckDesign(const Protocol& p) {
                         return list;
                       }());
     }
+    if (p.layout == "two_intervals" && Provides(b, "speed_cm_s"))
+      Problem(b.factors_pointer, "two intervals show still objects: a speed_cm_s level would move them");
     if (type == "grid" && !Provides(b, "edge"))
       Problem(b.factors_pointer, "a grid stands at an edge: needs a factor edge, or a factor whose every level has "
                                  "an edge (1..11)");

@@ -126,6 +126,7 @@ struct Responses {
 struct Timing {
   double stimulus_ms = 0;             // 0: until the participant answers
   double inter_trial_ms = 500;
+  double interval_ms = 1000, isi_ms = 500;  // layout two_intervals: each interval, and the grey between them
 };
 
 // How a grid or ball trial's photo maps to the screen (a picture's frame is always fitted, 4:3, at 1 screen px per
@@ -176,6 +177,10 @@ struct Protocol {
   // The order blocks run in: "fixed" (file order), "random" (drawn with the seed) or "latin_square" (a balanced
   // Latin square over participants by their number: each block equally often in each place, and after each other).
   std::string block_order = "fixed";
+  // How a pair is shown: "side_by_side" (both at once, left and right) or "two_intervals" (2IFC: the left side's
+  // object for timing.interval_ms, grey for timing.isi_ms, then the right side's, both at the left object's place;
+  // the left / right keys answer first / second interval). Still pairs only.
+  std::string layout = "side_by_side";
   std::vector<InfoField> participant_info;
   std::optional<Groups> groups;
   Practice practice;

@@ -252,6 +252,21 @@ TEST(ProtocolValidate, ParticipantInfoAndGroupsAreChecked) {
   problem_at(bad, "/groups/names: must be a list of 2 to 20 group names");
 }
 
+// Two intervals: timed by interval_ms and isi_ms (which a side-by-side protocol refuses), still pairs only.
+TEST(ProtocolValidate, TwoIntervalsAreTimedAndStill) {
+  Json j = Valid();
+  j["timing"] = {{"interval_ms", 800}};
+  EXPECT_TRUE(Contains(OnlyProblem(j), "/timing/interval_ms: is for the layout two_intervals")) << OnlyProblem(j);
+  j["layout"] = "two_intervals";
+  bool moving = false;  // the valid protocol's balls roll at a speed
+  for (const auto& problem : Problems(j)) moving = moving || Contains(problem, "two intervals show still objects");
+  EXPECT_TRUE(moving);
+  j["timing"]["stimulus_ms"] = 500;
+  bool timed = false;
+  for (const auto& problem : Problems(j)) timed = timed || Contains(problem, "/timing/stimulus_ms: two intervals");
+  EXPECT_TRUE(timed);
+}
+
 TEST(ProtocolValidate, ProblemStartsWithFileAndPointer) {
   Json j = Valid();
   j["version"] = 0;

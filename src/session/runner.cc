@@ -232,8 +232,11 @@ class Runner {
       const PairView view{scene.r_left_px, scene.r_right_px, scene.r_scene_px};
       const KeyPress press = trial.cell >= 0 ? observer.ChooseBlurrier(view)
                                              : observer.ChooseSide(view, !protocol_.responses.cant_tell.empty());
-      // A moving stimulus is watched to its end before the answer (task 1 is one answer per run).
-      station_.Script(keys_.Key(press.action), onset + scene.MotionS() + press.after_ms / 1000);
+      // A moving stimulus is watched to its end before the answer (task 1 is one answer per run); two intervals too.
+      const double watched = TwoIntervals(scene) ? 2 * protocol_.timing.interval_ms / 1000 +
+                                                       protocol_.timing.isi_ms / 1000
+                                                 : scene.MotionS();
+      station_.Script(keys_.Key(press.action), onset + watched + press.after_ms / 1000);
       return;
     }
     double t = onset;
@@ -266,11 +269,25 @@ class Runner {
     const double stimulus_s = protocol_.timing.stimulus_ms / 1000;
     double last_flip = -1;
     int composed_level = -2;  // none yet (-1 is the level of a trial without levels)
+    // Two intervals (2IFC): the left side's object, grey, the right side's, then grey until the answer.
+    const bool two = TwoIntervals(scene);
+    const double interval_s = protocol_.timing.interval_ms / 1000, isi_s = protocol_.timing.isi_ms / 1000;
+    const TrialScene first = two ? IntervalScene(scene, false) : scene;
+    const TrialScene second = two ? IntervalScene(scene, true) : scene;
+    int composed_phase = 0;
     for (int frame = 0;; ++frame) {
       const double t = onset < 0 ? 0 : station_.Now() - onset - paused_s;
-      const bool shown = stimulus_s <= 0 || t < stimulus_s;
-      // A still stimulus is composed once (and again when the adjusted level changes); a moving one every frame.
-      if (shown && (composed_level != level || scene.MotionS() > 0)) {
+      const int phase = !two                          ? 0
+                        : t < interval_s               ? 1
+                        : t < interval_s + isi_s       ? 2
+                        : t < 2 * interval_s + isi_s   ? 3
+                                                       : 4;
+      const bool shown = two ? phase == 1 || phase == 3 : stimulus_s <= 0 || t < stimulus_s;
+      if (two) {
+        if (shown && composed_phase != phase) renderer_.Compose(phase == 1 ? first : second, 0, 0);
+        composed_phase = phase;
+      } else if (shown && (composed_level != level || scene.MotionS() > 0)) {
+        // A still stimulus is composed once (and again when the adjusted level changes); a moving one every frame.
         renderer_.Compose(scene, t, levels > 0 ? trial.adjust_levels[size_t(level)] : 0);
         composed_level = level;
       }
@@ -280,7 +297,7 @@ class Runner {
         else
           Blank().Present(context_.width_px(), context_.height_px());
       }
-      if (frame == 0 && !options_.capture_dir.empty()) Capture(trial, scene);
+      if (frame == 0 && !options_.capture_dir.empty()) Capture(trial, first);
       const double flip = station_.Flip();
       if (onset < 0) {
         onset = flip;
@@ -292,7 +309,7 @@ class Runner {
       if (shown) {
         // What this frame showed, as Compose drew it (a still stimulus is composed once and shown unchanged).
         const auto& objects = renderer_.Shown();
-        if (objects[0]) shown_frame.r_left_px = objects[0]->r_px;
+        if (objects[0]) (phase == 3 ? shown_frame.r_right_px : shown_frame.r_left_px) = objects[0]->r_px;
         if (objects[1]) shown_frame.r_right_px = objects[1]->r_px;
         for (const auto& o : objects)
           if (o && !shown_frame.y_mm) shown_frame.y_mm = o->object.center_board_mm[1];
@@ -444,6 +461,10 @@ class Runner {
   }
 
  private:
+  bool TwoIntervals(const TrialScene& scene) const {
+    return protocol_.layout == "two_intervals" && scene.content != "picture";
+  }
+
   const protocol::Procedure& ProcedureOf(const protocol::Trial& trial) const {
     for (const auto& b : protocol_.blocks)
       if (b.name == trial.block && b.procedure) return *b.procedure;

@@ -180,6 +180,7 @@ std::array<std::optional<render::BlurredObject>, 2> ObjectsAt(const protocol::Pr
                                                               double t_s) {
   std::array<std::optional<render::BlurredObject>, 2> shown;
   for (const bool left : {true, false}) {
+    if (!left && trial.left_only) continue;
     render::BlurredObject b;
     render::VirtualObject& o = b.object;
     const calib::BlurSource source = left ? trial.left : trial.right;
@@ -279,6 +280,19 @@ render::FrameView Presentation::ViewFor(const protocol::Protocol& protocol, cons
   v.x_px = place(shows.x + shows.width / 2.0, sx, v.photo_width_px, v.width_px);
   v.y_px = place(shows.y + shows.height / 2.0, sy, v.photo_height_px, v.height_px);
   return v;
+}
+
+TrialScene IntervalScene(const TrialScene& scene, bool second) {
+  TrialScene s = scene;
+  s.left_only = true;
+  if (second) {
+    s.left = s.right;
+    s.left_fixed_px = s.right_fixed_px;
+    s.left_gain = s.right_gain;
+    s.left_add_px = s.right_add_px;
+    s.r_left_px = s.r_right_px;
+  }
+  return s;
 }
 
 void ApplyLevel(const protocol::Procedure& procedure, const protocol::Trial& trial, double level,

@@ -42,6 +42,7 @@ struct TrialScene {
   // A procedure's level on the test side (ApplyLevel): each side's radius is gain x its source's + add_px.
   double left_gain = 1, right_gain = 1, left_add_px = 0, right_add_px = 0;
   double level = std::numeric_limits<double>::quiet_NaN();  // the procedure's level shown; NaN: none (yet)
+  bool left_only = false;  // one interval of a two-interval trial: only the left object (IntervalScene)
   // The radii rendered, averaged over the run for balls, and the scene's own blur (the fitted model) there.
   double r_left_px = 0, r_right_px = 0, r_scene_px = 0;
 
@@ -80,6 +81,10 @@ struct Presentation;
 // PlanOnScreen after it.
 void ApplyLevel(const protocol::Procedure& procedure, const protocol::Trial& trial, double level,
                 const Presentation& presentation, TrialScene* scene);
+
+// One interval of a two-interval (2IFC) pair trial: the first shows the left side's object, the second the right
+// side's, each alone at the left object's place.
+TrialScene IntervalScene(const TrialScene& scene, bool second);
 
 // Works out what the screen `presentation` shows of a pair trial: each object's size in degrees at onset
 // (size_left_deg, size_right_deg) and the blur plan - each object's radius at its nearest and farthest depth (along
