@@ -18,7 +18,7 @@ set_tests_properties(cli_validate_test3-no-board PROPERTIES PASS_REGULAR_EXPRESS
 
 set(BROKEN_PROTOCOL ${PROJECT_SOURCE_DIR}/tests/data/broken-protocol.json)
 foreach(expect "/factors/pattern/0/speed_cm_s: a speed must be a number in [0.1, 100] cm/s, got -3"
-               "/factors/edge/1: an edge must be an integer in [1, 11], got 12"
+               "/factors/edge/1: an edge must be an integer in [1, 101], got 102"
                "/repetitons: unknown key (did you mean \"repetitions\"?), got 2"
                "/scene/background: no such file")
   string(MAKE_C_IDENTIFIER "${expect}" id)

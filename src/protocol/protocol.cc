@@ -30,7 +30,9 @@ std::string ToString(Counterbalance counterbalance) {
 
 namespace {
 
-const int kEdges = 11;  // parallel edges of the 7 x 10 board (thesis figure 4.10)
+// Edges a board can have: 101 for a board 100 squares long (the thesis's 7 x 10 board has 11, figure 4.10). A
+// session checks its levels against the calibrated board's own count (session/stimulus.cc DescribeTrial).
+const int kEdges = 101;
 
 // Limits that keep validation itself linear and its report readable whatever the file holds.
 const size_t kMaxProblems = 50;         // reported; the rest are counted
@@ -135,8 +137,9 @@ bool IsBlurSource(const Json& v) {
 
 // Names whose values CheckLevelValue knows: a level of a factor so named is that value, never an object.
 bool IsValueName(const std::string& name) {
-  static const std::set<std::string> kNames = {"edge",       "from_edge",  "to_edge", "section", "speed_cm_s",
-                                               "distance_m", "cutoff",     "left",    "right"};
+  static const std::set<std::string> kNames = {"edge",       "from_edge",  "to_edge", "section",   "speed_cm_s",
+                                               "distance_m", "cutoff",     "left",    "right",     "y_mm",
+                                               "from_y_mm",  "to_y_mm",    "left_x_mm", "right_x_mm"};
   return kNames.count(name) > 0;
 }
 
@@ -435,6 +438,9 @@ void Parser::CheckLevelValue(const std::string& name, const Json& v, const std::
   };
   if (name == "edge" || name == "from_edge" || name == "to_edge") integer_in(1, kEdges, "an edge");
   else if (name == "section") integer_in(1, kEdges - 1, "a section (edge s to s + 1)");
+  // A place on the board in mm (x across it from its left edge, y along it from edge 1): up to 10 m away.
+  else if (name == "y_mm" || name == "from_y_mm" || name == "to_y_mm" || name == "left_x_mm" || name == "right_x_mm")
+    number_in(-10000, 10000, "mm", "a place on the board");
   // The thesis rolled at 1.8 and 3 cm/s; 1 mm/s takes 4 minutes over the board, 1 m/s a quarter second.
   else if (name == "speed_cm_s") number_in(0.1, 100, "cm/s", "a speed");
   else if (name == "distance_m") number_in(0.1, 100, "m", "a distance");
@@ -1092,11 +1098,13 @@ void Parser::CheckDesign(const Protocol& p) {
     // A level that places or moves a stimulus is read only by the content it is for: anywhere else it would be
     // recorded but not shown.
     static const std::map<std::string, std::set<std::string>> kUses = {
-        {"grid", {"edge"}},
-        {"ball", {"edge", "from_edge", "to_edge", "section", "speed_cm_s"}},
+        {"grid", {"edge", "y_mm", "left_x_mm", "right_x_mm"}},
+        {"ball", {"edge", "from_edge", "to_edge", "section", "speed_cm_s", "y_mm", "from_y_mm", "to_y_mm",
+                  "left_x_mm", "right_x_mm"}},
         {"picture", {"distance_m"}}};
-    static const std::set<std::string> kStimulusLevels = {"edge", "from_edge", "to_edge", "section", "speed_cm_s",
-                                                          "distance_m"};
+    static const std::set<std::string> kStimulusLevels = {"edge",      "from_edge",  "to_edge",   "section",
+                                                          "speed_cm_s", "distance_m", "y_mm",      "from_y_mm",
+                                                          "to_y_mm",   "left_x_mm",  "right_x_mm"};
     const auto uses = kUses.find(type);
     for (const auto& f : b.factors) {
       std::set<std::string> names{f.name};
@@ -1115,9 +1123,9 @@ void Parser::CheckDesign(const Protocol& p) {
     }
     if (p.layout == "two_intervals" && Provides(b, "speed_cm_s"))
       Problem(b.factors_pointer, "two intervals show still objects: a speed_cm_s level would move them");
-    if (type == "grid" && !Provides(b, "edge"))
-      Problem(b.factors_pointer, "a grid stands at an edge: needs a factor edge, or a factor whose every level has "
-                                 "an edge (1..11)");
+    if (type == "grid" && !Provides(b, "edge") && !Provides(b, "y_mm"))
+      Problem(b.factors_pointer, "a grid stands at an edge: needs a factor edge (or y_mm), or a factor whose every "
+                                 "level has an edge (1..11 on the thesis's board)");
     if (type == "picture" && !p.content.real_photos.empty() && !Provides(b, "distance_m"))
       Problem(b.factors_pointer, "content.real_photos chooses the photo by distance: needs a factor distance_m, or "
                                  "a factor whose every level has a distance_m");

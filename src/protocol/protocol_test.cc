@@ -194,11 +194,11 @@ TEST(ProtocolValidate, ConditionsTableGivesTheDesignRowByRow) {
   EXPECT_EQ(p.blocks[0].factors[0].levels[0]["label"], "near, fast");
   EXPECT_EQ(p.blocks[0].factors[0].levels[1]["speed_cm_s"], 1.8);
   EXPECT_EQ(DesignTrials(p.blocks[0]), 2 * 2);  // two rows x the protocol's swap_copies
-  std::ofstream(dir / "bad.csv") << "edge,left,right\n12,measured,none\n3,measured\n";
+  std::ofstream(dir / "bad.csv") << "edge,left,right\n102,measured,none\n3,measured\n";
   j["blocks"][0]["conditions"] = "bad.csv";
   const auto problems = Problems(j);
   ASSERT_EQ(problems.size(), 2u);
-  EXPECT_TRUE(Contains(problems[0], "/blocks/0/conditions/row/0/edge: an edge must be an integer in [1, 11], got 12"))
+  EXPECT_TRUE(Contains(problems[0], "/blocks/0/conditions/row/0/edge: an edge must be an integer in [1, 101], got 102"))
       << problems[0];
   EXPECT_TRUE(Contains(problems[1], "bad.csv line 3: has 2 fields, the header 3")) << problems[1];
   j["blocks"][0]["factors"] = {{"edge", {1}}};
@@ -306,16 +306,16 @@ TEST(ProtocolValidate, NonPositiveSpeedRejected) {
 
 TEST(ProtocolValidate, SectionOutsideTheBoardRejected) {
   Json j = Valid();
-  j["blocks"][1]["factors"]["section"][2] = 11;
+  j["blocks"][1]["factors"]["section"][2] = 101;
   EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/1/factors/section/2: a section (edge s to s + 1) must be an integer "
-                                       "in [1, 10], got 11")) << OnlyProblem(j);
+                                       "in [1, 100], got 101")) << OnlyProblem(j);
 }
 
-TEST(ProtocolValidate, EdgeOutsideOneToElevenRejected) {
+TEST(ProtocolValidate, EdgeOutsideAnyBoardRejected) {
   Json j = Valid();
-  j["blocks"][1]["factors"] = {{"edge", {1, 12}}};
+  j["blocks"][1]["factors"] = {{"edge", {1, 102}}};
   j["blocks"][1]["sides"] = {{"left", "measured"}, {"right", "estimated"}};
-  EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/1/factors/edge/1: an edge must be an integer in [1, 11], got 12"))
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/1/factors/edge/1: an edge must be an integer in [1, 101], got 102"))
       << OnlyProblem(j);
 }
 
@@ -557,7 +557,7 @@ TEST(ProtocolValidate, ObjectLevelOfAValueFactorRejected) {
   Json j = Valid();
   j["blocks"][1]["factors"]["section"][1] = Json::object();  // would show section "{}" as the whole run
   EXPECT_TRUE(Contains(OnlyProblem(j), "/blocks/1/factors/section/1: a section (edge s to s + 1) must be an integer "
-                                       "in [1, 10], got {}")) << OnlyProblem(j);
+                                       "in [1, 100], got {}")) << OnlyProblem(j);
 }
 
 TEST(ProtocolValidate, LongUnicodeValueIsQuotedCutAtACharacter) {

@@ -60,12 +60,20 @@ calib::BlurSource Source(const Json& v, double* fixed, const std::function<std::
   }
 }
 
-// Board-frame placement of the two objects of a pair (render's poses on the board).
-cv::Vec3d GridCentre(const calib::SceneCalib& s, int edge, bool left) {
-  return render::CardBesideBoard(s.board, edge, left).center_board_mm;
+// Board-frame placement of the two objects of a pair (render's poses on the board; x and y in mm where the trial
+// says so).
+render::VirtualObject Card(const calib::SceneCalib& s, const TrialScene& t, bool left) {
+  render::VirtualObject o = render::CardBesideBoard(s.board, 1, left);
+  const double x = left ? t.left_x_mm : t.right_x_mm;
+  o.center_board_mm = {std::isnan(x) ? o.center_board_mm[0] : x, t.from_y_mm, 0};
+  return o;
 }
-cv::Vec3d BallCentre(const calib::SceneCalib& s, double y_mm, double radius_mm, bool left) {
-  return render::BallOnBoard(s.board, left ? kLeftSection : kRightSection, y_mm, radius_mm, 0).center_board_mm;
+render::VirtualObject Ball(const calib::SceneCalib& s, const TrialScene& t, double y_mm, double radius_mm, bool left) {
+  render::VirtualObject o =
+      render::BallOnBoard(s.board, left ? kLeftSection : kRightSection, y_mm, radius_mm, t.from_y_mm);
+  const double x = left ? t.left_x_mm : t.right_x_mm;
+  if (!std::isnan(x)) o.center_board_mm[0] = x;
+  return o;
 }
 
 // The largest distance between two points of an outline (px).
@@ -88,6 +96,33 @@ double TrialScene::BallYMm(double t_s) const {
   if (travelled >= run && wipe_at_end && speed_mm_s > 0) return -std::numeric_limits<double>::infinity();
   return from_y_mm + (to_y_mm >= from_y_mm ? 1 : -1) * std::min(run, travelled);
 }
+
+namespace {
+
+// A placement must show: each object, at the start and at the end of its run, must land in the photo.
+void CheckInPhoto(const protocol::Protocol& protocol, const protocol::Trial& trial, const calib::SceneCalib& scene,
+                  const TrialScene& t) {
+  const cv::Rect photo(0, 0, scene.camera.image_width_px, scene.camera.image_height_px);
+  for (const double at : {0.0, std::max(0.0, t.MotionS() - 1e-6)}) {
+    const auto objects = ObjectsAt(protocol, scene, t, at);
+    for (size_t side = 0; side < 2; ++side) {
+      if (!objects[side]) continue;
+      if ((render::FootprintOf(scene.camera, scene.rvec, scene.tvec, objects[side]->object).bounds & photo).empty()) {
+        const char* level = t.content == "grid" ? (std::isnan(side == 0 ? t.left_x_mm : t.right_x_mm) ? "edge"
+                                                   : side == 0 ? "left_x_mm" : "right_x_mm")
+                                                : "speed_cm_s";
+        throw InputError(protocol.file.string() + ": " + protocol::LevelPointer(protocol, trial, level),
+                         std::string("the ") + (side == 0 ? "left" : "right") + " " + t.content + " at (" +
+                             std::to_string(int(std::lround(objects[side]->object.center_board_mm[0]))) + ", " +
+                             std::to_string(int(std::lround(objects[side]->object.center_board_mm[1]))) +
+                             ") mm on the board lies outside the " + std::to_string(photo.width) + " x " +
+                             std::to_string(photo.height) + " photo (trial " + std::to_string(trial.index) + ")");
+      }
+    }
+  }
+}
+
+}  // namespace
 
 TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Trial& trial,
                          const calib::SceneCalib* scene, const Presentation* presentation) {
@@ -124,17 +159,40 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
                                         protocol.scene.calib.string() + trial_text + ": " + e.what());
     }
   };
+  // Edges and sections are the calibrated board's: its own count, whatever its size.
+  const int edges = scene->board.EdgeCount();
+  auto board_level = [&](const char* name, int most) -> std::optional<int> {
+    const Json* v = FindLevel(trial.levels, name);
+    if (!v || !v->is_number_integer()) return std::nullopt;
+    const int n = v->get<int>();
+    if (n < 1 || n > most)
+      throw InputError(At(protocol, protocol::LevelPointer(protocol, trial, name)),
+                       std::string(name) + " " + std::to_string(n) + " is not on the calibrated board (" +
+                           std::to_string(scene->board.cols) + " x " + std::to_string(scene->board.rows) +
+                           " squares: edges 1-" + std::to_string(edges) + ", sections 1-" + std::to_string(edges - 1) +
+                           ")" + trial_text);
+    return n;
+  };
+  auto mm_level = [&](const char* name) {
+    const Json* v = FindLevel(trial.levels, name);
+    return v && v->is_number() ? std::optional<double>(v->get<double>()) : std::nullopt;
+  };
+  if (auto x = mm_level("left_x_mm")) t.left_x_mm = *x;
+  if (auto x = mm_level("right_x_mm")) t.right_x_mm = *x;
   if (t.content == "grid") {
-    const Json* edge = FindLevel(trial.levels, "edge");
-    if (!edge || !edge->is_number_integer())
+    const auto edge = board_level("edge", edges);
+    const auto y = mm_level("y_mm");
+    if (!edge && !y)
       throw InputError(At(protocol, protocol::LevelPointer(protocol, trial, "edge")),
-                       "a grid needs an integer level edge" + trial_text);
-    t.edge = edge->get<int>();
-    const cv::Vec3d l = GridCentre(*scene, t.edge, true), r = GridCentre(*scene, t.edge, false);
+                       "a grid needs an integer level edge or a y_mm" + trial_text);
+    t.edge = edge ? *edge : 0;
+    t.from_y_mm = t.to_y_mm = y ? *y : (*edge - 1) * s;
+    const cv::Vec3d l = Card(*scene, t, true).center_board_mm, r = Card(*scene, t, false).center_board_mm;
     t.r_left_px = r_at(l, t.left, t.left_fixed_px, "left");
     t.r_right_px = r_at(r, t.right, t.right_fixed_px, "right");
     t.r_scene_px = 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, nullptr) +
                           r_at(r, calib::BlurSource::kFitted, 0, nullptr));
+    CheckInPhoto(protocol, trial, *scene, t);
     return t;
   }
   // Balls: a section run (edge s to s + 1, wiped on arrival), explicit edges, the whole board, or at rest at an
@@ -142,36 +200,40 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   int from = 1, to = scene->board.EdgeCount();
   const Json* speed = FindLevel(trial.levels, "speed_cm_s");
   t.speed_mm_s = speed && speed->is_number() ? 10 * speed->get<double>() : 0;
-  const Json* edge = FindLevel(trial.levels, "edge");
-  if (edge && edge->is_number_integer()) {
+  const auto edge = board_level("edge", edges);
+  const auto rest_y = mm_level("y_mm");
+  if (edge || rest_y) {
     if (t.speed_mm_s > 0 || FindLevel(trial.levels, "section") || FindLevel(trial.levels, "from_edge") ||
-        FindLevel(trial.levels, "to_edge"))
-      throw InputError(At(protocol, protocol::LevelPointer(protocol, trial, "edge")),
-                       "a ball at an edge rests there: it takes no speed_cm_s, section, from_edge or to_edge" +
-                           trial_text);
-    from = to = edge->get<int>();
-  } else if (const Json* section = FindLevel(trial.levels, "section"); section && section->is_number_integer()) {
-    from = section->get<int>();
+        FindLevel(trial.levels, "to_edge") || FindLevel(trial.levels, "from_y_mm") ||
+        FindLevel(trial.levels, "to_y_mm") || (edge && rest_y))
+      throw InputError(At(protocol, protocol::LevelPointer(protocol, trial, edge ? "edge" : "y_mm")),
+                       "a ball at an edge (or y_mm) rests there: it takes no speed_cm_s, section, from/to edge or "
+                       "y_mm, and not both edge and y_mm" + trial_text);
+    if (edge) from = to = *edge;
+  } else if (const auto section = board_level("section", edges - 1)) {
+    from = *section;
     to = from + 1;
     t.wipe_at_end = true;
   } else {
-    if (const Json* f = FindLevel(trial.levels, "from_edge"); f && f->is_number_integer()) from = f->get<int>();
-    if (const Json* e = FindLevel(trial.levels, "to_edge"); e && e->is_number_integer()) to = e->get<int>();
+    if (const auto f = board_level("from_edge", edges)) from = *f;
+    if (const auto e = board_level("to_edge", edges)) to = *e;
   }
-  if (t.speed_mm_s <= 0) to = from;
-  t.from_y_mm = (from - 1) * s;
-  t.to_y_mm = (to - 1) * s;
+  t.from_y_mm = rest_y ? *rest_y : mm_level("from_y_mm").value_or((from - 1) * s);
+  t.to_y_mm = rest_y ? *rest_y : mm_level("to_y_mm").value_or((to - 1) * s);
+  if (t.speed_mm_s <= 0) t.to_y_mm = t.from_y_mm;
   // Radii averaged over the run (what the observer sees on the whole), sampled evenly along it.
   const int samples = 21;
   const double radius = protocol.content.radius_mm;
   for (int i = 0; i < samples; ++i) {
     const double y = t.from_y_mm + (t.to_y_mm - t.from_y_mm) * i / (samples - 1);
-    t.r_left_px += r_at(BallCentre(*scene, y, radius, true), t.left, t.left_fixed_px, "left") / samples;
-    t.r_right_px += r_at(BallCentre(*scene, y, radius, false), t.right, t.right_fixed_px, "right") / samples;
-    t.r_scene_px += 0.5 * (r_at(BallCentre(*scene, y, radius, true), calib::BlurSource::kFitted, 0, nullptr) +
-                           r_at(BallCentre(*scene, y, radius, false), calib::BlurSource::kFitted, 0, nullptr)) /
-                    samples;
+    const cv::Vec3d l = Ball(*scene, t, y, radius, true).center_board_mm;
+    const cv::Vec3d r = Ball(*scene, t, y, radius, false).center_board_mm;
+    t.r_left_px += r_at(l, t.left, t.left_fixed_px, "left") / samples;
+    t.r_right_px += r_at(r, t.right, t.right_fixed_px, "right") / samples;
+    t.r_scene_px += 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, nullptr) +
+                           r_at(r, calib::BlurSource::kFitted, 0, nullptr)) / samples;
   }
+  CheckInPhoto(protocol, trial, *scene, t);
   return t;
 }
 
@@ -187,12 +249,11 @@ std::array<std::optional<render::BlurredObject>, 2> ObjectsAt(const protocol::Pr
     const double fixed = left ? trial.left_fixed_px : trial.right_fixed_px;
     const double gain = left ? trial.left_gain : trial.right_gain, add = left ? trial.left_add_px : trial.right_add_px;
     if (trial.content == "grid") {
-      o = render::CardBesideBoard(s.board, trial.edge, left);
+      o = Card(s, trial, left);
     } else {
       const double y = trial.BallYMm(t_s);
       if (!std::isfinite(y)) continue;  // wiped at the end of a section
-      o = render::BallOnBoard(s.board, left ? kLeftSection : kRightSection, y, protocol.content.radius_mm,
-                              trial.from_y_mm);
+      o = Ball(s, trial, y, protocol.content.radius_mm, left);
     }
     if (trial.per_pixel) {
       // The radius along the object's line of sight at each depth: the source evaluated where the pixel's surface is.

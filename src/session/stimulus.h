@@ -31,8 +31,11 @@ struct TrialScene {
   // Pairs (grid, ball): the source on each side as shown (swaps applied).
   calib::BlurSource left = calib::BlurSource::kNone, right = calib::BlurSource::kNone;
   double left_fixed_px = 0, right_fixed_px = 0;
-  int edge = 1;                       // grid: the edge the cards are aligned with
-  double from_y_mm = 0, to_y_mm = 0;  // ball: along the board's y
+  int edge = 1;                       // grid: the edge the cards are aligned with (0: placed by y_mm)
+  double from_y_mm = 0, to_y_mm = 0;  // along the board's y (0 at edge 1): a ball's run, a card's place
+  // Across the board (x, 0 at its left edge), per side: NaN for the default place - a card beside the board, a ball
+  // on section 3 (left) or 5 (right). From the levels left_x_mm / right_x_mm.
+  double left_x_mm = std::numeric_limits<double>::quiet_NaN(), right_x_mm = std::numeric_limits<double>::quiet_NaN();
   double speed_mm_s = 0;              // ball: 0 = at rest at from_y_mm
   bool wipe_at_end = false;           // ball: disappear on arrival (a section run)
   double distance_m = 0;              // picture: the real picture's distance

@@ -225,6 +225,41 @@ TEST(DescribeTrial, ARadiusGivenOnTheScreenIsTurnedIntoPhotoPxByThePresentation)
   }
 }
 
+// Placement in millimetres: a card's centre at (x, y) on the board where the levels say, a ball's x per side and its
+// run in mm; edges checked against the calibrated board's own count; a place outside the photo refused.
+TEST(DescribeTrial, PlacesInMillimetresAndChecksTheBoardAndThePhoto) {
+  const calib::SceneCalib scene = ThesisScene();
+  protocol::Protocol p = BallProtocol();
+  p.content.type = "grid";
+  const TrialScene card = DescribeTrial(p, PairTrial({{"y_mm", 60}, {"left_x_mm", -40}, {"right_x_mm", 230}},
+                                                     "fitted", "fitted"), &scene);
+  const auto cards = ObjectsAt(p, scene, card, 0);
+  EXPECT_EQ(cards[0]->object.center_board_mm, cv::Vec3d(-40, 60, 0));
+  EXPECT_EQ(cards[1]->object.center_board_mm, cv::Vec3d(230, 60, 0));
+  EXPECT_NEAR(card.r_left_px, calib::BlurAtPx(scene, calib::BlurSource::kFitted, scene.ToCamera({-40, 60, 0})), 1e-9);
+  p.content.type = "ball";
+  const TrialScene ball = DescribeTrial(p, PairTrial({{"from_y_mm", 10}, {"to_y_mm", 110}, {"speed_cm_s", 2},
+                                                      {"left_x_mm", 50}}, "fitted", "none"), &scene);
+  EXPECT_DOUBLE_EQ(ball.MotionS(), 5.0);  // 100 mm at 20 mm/s
+  EXPECT_EQ(ObjectsAt(p, scene, ball, 0)[0]->object.center_board_mm, cv::Vec3d(50, 10, 10));
+  EXPECT_EQ(ObjectsAt(p, scene, ball, 5)[1]->object.center_board_mm, cv::Vec3d(4.5 * 25, 110, 10));  // section 5
+  try {
+    DescribeTrial(p, PairTrial({{"edge", 12}}, "fitted", "none"), &scene);
+    ADD_FAILURE() << "edge 12 of a board with 11 edges was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("edge 12 is not on the calibrated board (7 x 10 squares: edges 1-11"),
+              std::string::npos) << e.what();
+  }
+  p.content.type = "grid";
+  try {
+    DescribeTrial(p, PairTrial({{"y_mm", 60}, {"right_x_mm", 5000}}, "fitted", "fitted"), &scene);
+    ADD_FAILURE() << "a card 5 m off the board was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("the right grid at (5000, 60) mm on the board lies outside the 1148 x 764 "
+                                         "photo"), std::string::npos) << e.what();
+  }
+}
+
 TEST(DescribeTrial, MissingLevelOrCalibrationIsAnInputErrorNamingTheField) {
   const calib::SceneCalib scene = ThesisScene();
   protocol::Protocol p = BallProtocol();
@@ -238,7 +273,7 @@ TEST(DescribeTrial, MissingLevelOrCalibrationIsAnInputErrorNamingTheField) {
     ADD_FAILURE() << "a grid without an edge was accepted";
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::kInput);
-    EXPECT_NE(std::string(e.what()).find("balls.json: /blocks/1/factors: a grid needs an integer level edge (trial 0, "
+    EXPECT_NE(std::string(e.what()).find("balls.json: /blocks/1/factors: a grid needs an integer level edge or a y_mm (trial 0, "
                                          "block task2)"), std::string::npos) << e.what();
   }
   EXPECT_THROW(DescribeTrial(p, PairTrial({{"edge", 2}}, "measured", "fitted"), nullptr), Error);
