@@ -283,6 +283,34 @@ for i, fs in frames.items():
 print(len(trials), "trials")
 PYEOF
   echo "ok: two intervals shown in turn, each frame recording its interval, answers after both" ;;
+deadline)
+  # A deadline: no answer within it records the choice "none" with no response time, and a procedure counts it
+  # wrong (its level climbs); feedback after each procedure trial; feedback without a procedure is refused.
+  $PY - "$P/quest-blur-difference.json" "$W/fast.json" <<'PYEOF'
+import json, sys
+p = json.load(open(sys.argv[1]))
+p["timing"]["deadline_ms"] = 300  # the simulated observer takes ~900 ms
+json.dump(p, open(sys.argv[2], "w"))
+PYEOF
+  sed -i "s|\"\.\./|\"$P/../|g" "$W/fast.json"
+  $BC run "$W/fast.json" --participant D1 --db "$W/d.sqlite" --observer sim > /dev/null 2>&1 || fail "deadline run"
+  [ "$(sql "$W/d.sqlite" "SELECT count(*) FROM responses WHERE choice = 'none' AND rt_ms IS NULL")" = 40 ] \
+    || fail "deadline: $(sql "$W/d.sqlite" "SELECT choice, rt_ms FROM responses LIMIT 3")"
+  [ "$(sql "$W/d.sqlite" "SELECT count(*) FROM responses WHERE json_extract(shown, '$.correct') = 0")" = 40 ] \
+    || fail "deadline: a timeout must count wrong"
+  $PY - "$P/test1-static-grids.json" "$W/feedback.json" <<'PYEOF'
+import json, sys
+p = json.load(open(sys.argv[1]))
+p["timing"]["feedback_ms"] = 500
+json.dump(p, open(sys.argv[2], "w"))
+PYEOF
+  sed -i "s|\"\.\./|\"$P/../|g" "$W/feedback.json"
+  set +e
+  $BC validate "$W/feedback.json" > /dev/null 2> "$W/err"
+  code=$?
+  set -e
+  [ $code = 3 ] && grep -q "/timing/feedback_ms: needs a correct answer" "$W/err" || fail "feedback without a procedure: $(cat "$W/err")"
+  echo "ok: a missed deadline records none without a time and counts wrong; feedback needs a procedure" ;;
 second_writer)
   # While one process runs a session, a second one resuming it is refused with a clear message (exit 3).
   $BC run "$P/test2-moving-balls.json" --participant L1 --db "$W/s.sqlite" --observer sim --sim-fps 8 > /dev/null 2>&1 &

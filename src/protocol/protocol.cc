@@ -1023,7 +1023,7 @@ Protocol Parser::Parse(const Json& json) {
   const Json* responses = Field(json, "responses", "", false);
   ParseResponses(responses ? *responses : Json(), "/responses", tasks, &p.responses);
   if (const Json* v = Field(json, "timing", "", false)) {
-    if (Object(*v, "/timing", {"stimulus_ms", "inter_trial_ms", "interval_ms", "isi_ms"})) {
+    if (Object(*v, "/timing", {"stimulus_ms", "inter_trial_ms", "interval_ms", "isi_ms", "deadline_ms", "feedback_ms"})) {
       if (const Json* s = Field(*v, "stimulus_ms", "/timing", false)) {
         // From about a frame to a minute.
         if (s->is_string() && *s == "until_response") p.timing.stimulus_ms = 0;
@@ -1033,6 +1033,18 @@ Protocol Parser::Parse(const Json& json) {
       if (auto x = Number(*v, "inter_trial_ms", "/timing", false, 0, 60000, "ms")) p.timing.inter_trial_ms = *x;
       if (auto x = Number(*v, "interval_ms", "/timing", false, 100, 10000, "ms")) p.timing.interval_ms = *x;
       if (auto x = Number(*v, "isi_ms", "/timing", false, 0, 10000, "ms")) p.timing.isi_ms = *x;
+      if (auto x = Number(*v, "deadline_ms", "/timing", false, 100, 60000, "ms")) p.timing.deadline_ms = *x;
+      if (auto x = Number(*v, "feedback_ms", "/timing", false, 100, 5000, "ms")) p.timing.feedback_ms = *x;
+      // Feedback needs a correct answer, which only a procedure defines; a deadline needs a forced choice.
+      const bool procedure = std::any_of(p.blocks.begin(), p.blocks.end(), [](const Block& b) { return b.procedure; });
+      if (v->contains("feedback_ms") && !procedure)
+        Problem("/timing/feedback_ms", "needs a correct answer: only a block with a procedure defines one",
+                (*v)["feedback_ms"]);
+      const bool adjustment = std::any_of(p.blocks.begin(), p.blocks.end(),
+                                          [](const Block& b) { return b.task == Task::kAdjustment; });
+      if (v->contains("deadline_ms") && adjustment)
+        Problem("/timing/deadline_ms", "is for a forced choice; adjustment runs until a level is accepted",
+                (*v)["deadline_ms"]);
       for (const char* key : {"interval_ms", "isi_ms"})
         if (v->contains(key) && p.layout != "two_intervals")
           Problem(std::string("/timing/") + key, "is for the layout two_intervals", (*v)[key]);

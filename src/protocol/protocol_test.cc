@@ -52,6 +52,14 @@ std::string OnlyProblem(const Json& json, bool check_files = true) {
 
 bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
+// `json` has a problem containing `text` (among any others).
+void ExpectProblem(const Json& json, const std::string& text) {
+  bool found = false;
+  std::string all;
+  for (const auto& problem : Problems(json)) found = found || Contains(problem, text), all += problem + "\n";
+  EXPECT_TRUE(found) << "expected '" << text << "' among:\n" << all;
+}
+
 TEST(ProtocolValidate, ValidProtocolHasNoProblems) {
   const auto problems = Problems(Valid());
   EXPECT_TRUE(problems.empty()) << problems.front();
@@ -144,39 +152,33 @@ TEST(ProtocolValidate, ProceduresAreCheckedAndOwnTheirSidesAndCounts) {
   EXPECT_EQ(p.blocks[1].procedure->steps, (std::vector<double>{0.4, 0.2}));
   EXPECT_EQ(SessionTrials(p), 2 * 20 + 10);  // each crossing runs its own procedure
   EXPECT_TRUE(p.responses.cant_tell.empty());  // a strict 2AFC
-  auto problem_at = [&](Json changed, const std::string& text) {
-    bool found = false;
-    std::string all;
-    for (const auto& problem : Problems(changed)) found = found || Contains(problem, text), all += problem + "\n";
-    EXPECT_TRUE(found) << "expected '" << text << "' among:\n" << all;
-  };
   Json bad = j;
   bad["blocks"][0]["procedure"]["variable"] = "gain";
-  problem_at(bad, "/blocks/0/procedure/variable: must be one of");
+  ExpectProblem(bad, "/blocks/0/procedure/variable: must be one of");
   bad = j;
   bad["blocks"][0]["procedure"]["stimuli"] = {1, 0.5};
-  problem_at(bad, "/blocks/0/procedure/stimuli/1: must be larger than the one before");
+  ExpectProblem(bad, "/blocks/0/procedure/stimuli/1: must be larger than the one before");
   bad = j;
   bad["blocks"][0]["procedure"]["lapse"] = {0.6};
-  problem_at(bad, "/blocks/0/procedure/lapse/0: must be a number in [0, 0.5]");
+  ExpectProblem(bad, "/blocks/0/procedure/lapse/0: must be a number in [0, 0.5]");
   bad = j;
   bad["blocks"][1]["procedure"]["start"] = 3;
-  problem_at(bad, "/blocks/1/procedure/start: must lie in [min, max]");
+  ExpectProblem(bad, "/blocks/1/procedure/start: must lie in [min, max]");
   bad = j;
   bad["blocks"][1]["procedure"].erase("steps");
-  problem_at(bad, "/blocks/1/procedure/steps: is required");
+  ExpectProblem(bad, "/blocks/1/procedure/steps: is required");
   bad = j;
   bad["blocks"][1]["procedure"]["tries"] = 3;
-  problem_at(bad, "/blocks/1/procedure/tries: unknown key");
+  ExpectProblem(bad, "/blocks/1/procedure/tries: unknown key");
   bad = j;
   bad["blocks"][1]["sides"] = {{"left", "measured"}, {"right", "none"}};
-  problem_at(bad, "/blocks/1/sides: is given but the procedure shows its reference on both sides");
+  ExpectProblem(bad, "/blocks/1/sides: is given but the procedure shows its reference on both sides");
   bad = j;
   bad["blocks"][1]["repetitions"] = 2;
-  problem_at(bad, "/blocks/1/procedure/trials: sets how often each crossing runs");
+  ExpectProblem(bad, "/blocks/1/procedure/trials: sets how often each crossing runs");
   bad = j;
   bad["practice"] = {{"count", 2}, {"block", "stairs"}};
-  problem_at(bad, "/practice/block: names block stairs, whose trials its procedure decides");
+  ExpectProblem(bad, "/practice/block: names block stairs, whose trials its procedure decides");
 }
 
 // A conditions table instead of factors: each CSV row one design row (not a full crossing), numbers read as
@@ -226,30 +228,24 @@ TEST(ProtocolValidate, ParticipantInfoAndGroupsAreChecked) {
   EXPECT_EQ(CheckInfoValue(p.participant_info[0], "nan"), "must be a whole number in [16, 99]");
   EXPECT_EQ(CheckInfoValue(p.participant_info[1], "up"), "must be one of left, right");
   EXPECT_EQ(CheckInfoValue(p.participant_info[2], "bad\nline"), "must be one line of at most 200 characters");
-  auto problem_at = [&](Json changed, const std::string& text) {
-    bool found = false;
-    std::string all;
-    for (const auto& problem : Problems(changed)) found = found || Contains(problem, text), all += problem + "\n";
-    EXPECT_TRUE(found) << "expected '" << text << "' among:\n" << all;
-  };
   Json bad = j;
   bad["participant_info"][0]["key"] = "Age!";
-  problem_at(bad, "/participant_info/0/key: must be 1-40 characters of a-z, 0-9 and _");
+  ExpectProblem(bad, "/participant_info/0/key: must be 1-40 characters of a-z, 0-9 and _");
   bad = j;
   bad["participant_info"][1]["min"] = 1;
-  problem_at(bad, "/participant_info/1/min: is for an integer or number field, not choice");
+  ExpectProblem(bad, "/participant_info/1/min: is for an integer or number field, not choice");
   bad = j;
   bad["participant_info"][0]["max"] = 10;
-  problem_at(bad, "/participant_info/0/max: must be larger than min");
+  ExpectProblem(bad, "/participant_info/0/max: must be larger than min");
   bad = j;
   bad["blocks"][1]["groups"] = {"c"};
-  problem_at(bad, "/blocks/1/groups/0: names no group of /groups/names");
+  ExpectProblem(bad, "/blocks/1/groups/0: names no group of /groups/names");
   bad = j;
   bad["blocks"][1]["groups"] = {"a"};
-  problem_at(bad, "/groups/names: group b runs no block");
+  ExpectProblem(bad, "/groups/names: group b runs no block");
   bad = j;
   bad["groups"]["names"] = {"a"};
-  problem_at(bad, "/groups/names: must be a list of 2 to 20 group names");
+  ExpectProblem(bad, "/groups/names: must be a list of 2 to 20 group names");
 }
 
 // Two intervals: timed by interval_ms and isi_ms (which a side-by-side protocol refuses), still pairs only.

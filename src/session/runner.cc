@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <deque>
 #include <functional>
+#include <limits>
 #include <thread>
 
 #include <opencv2/core.hpp>
@@ -209,6 +210,20 @@ class Runner {
     }
   }
 
+  // A text shown for a fixed time (feedback): in a window its frames, headless the simulated clock's time.
+  void ShowFor(const std::string& title, double seconds) {
+    if (station_.window()) {
+      const render::WindowImage shown(TextScreen(screen_size_, title, "", ""));
+      const double until = station_.Now() + seconds;
+      while (station_.Now() < until && !station_.Closed()) {
+        shown.Present(context_.width_px(), context_.height_px());
+        station_.Flip();
+      }
+    } else {
+      station_.Wait(seconds);
+    }
+  }
+
   // Escape: asks whether to quit. Q quits (every answer so far is already saved), Return goes on.
   bool Pause() {
     const cv::Mat image = TextScreen(screen_size_, "Paused",
@@ -318,6 +333,13 @@ class Runner {
       dropped_frames_ += dropped;
       last_flip = flip;
       if (station_.Closed()) return Outcome::kQuit;
+      // A deadline: no answer this long after onset is recorded as "none", without a response time.
+      if (protocol_.timing.deadline_ms > 0 && trial.task == Task::kForcedChoice &&
+          (station_.Now() - onset - paused_s) * 1000 >= protocol_.timing.deadline_ms) {
+        response->choice = "none";
+        response->rt_ms = std::numeric_limits<double>::quiet_NaN();
+        return Outcome::kAnswered;
+      }
       for (const InputEvent& e : station_.Poll()) {
         if (e.time_s < onset) continue;  // pressed before the stimulus was on screen
         const std::string action = keys_.Action(e.key, trial.task);
@@ -435,6 +457,9 @@ class Runner {
       }
       record.RecordResponse(start.session_id, i, response, frames);  // committed before anything else happens
       if (trial.cell >= 0) adaptive.Answer(trial, level, correct);
+      if (trial.cell >= 0 && protocol_.timing.feedback_ms > 0)
+        ShowFor(response.choice == "none" ? "Too slow" : correct ? "Correct" : "Wrong",
+                protocol_.timing.feedback_ms / 1000);
       ++result.answered_now;
       progress(i + 1);
       if (!trial.practice) ++main_answered;

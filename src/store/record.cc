@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <chrono>
 #include <algorithm>
 #include <cstdio>
@@ -397,7 +398,8 @@ void Record::RecordResponse(int64_t session, int64_t trial_index, const Response
                         "VALUES (?, ?, ?, ?, ?, ?)");
   insert.Bind(1, trial_id);
   insert.Bind(2, response.choice);
-  insert.Bind(3, response.rt_ms);
+  if (std::isnan(response.rt_ms)) insert.BindNull(3);  // no answer before the deadline: no response time
+  else insert.Bind(3, response.rt_ms);
   insert.Bind(4, response.adjustment_json);
   insert.Bind(5, response.answered_at.empty() ? NowIso8601() : response.answered_at);
   insert.Bind(6, response.shown_json);

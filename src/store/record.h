@@ -41,8 +41,8 @@ struct TrialRecord {
 };
 
 struct Response {
-  std::string choice;                // "left" | "right" | "cant_tell" | an adjustment level
-  double rt_ms = 0;
+  std::string choice;                // "left" | "right" | "cant_tell" | an adjustment level | "none" (deadline)
+  double rt_ms = 0;                  // NaN: none (recorded NULL)
   std::string adjustment_json = "[]";  // method of adjustment: the levels stepped through
   // What the trial showed as decided when it was shown (an adaptive procedure's level, the radii it made, whether
   // the answer was correct): a JSON object of trial variables that export lays over the planned ones.
