@@ -1023,7 +1023,8 @@ Protocol Parser::Parse(const Json& json) {
   const Json* responses = Field(json, "responses", "", false);
   ParseResponses(responses ? *responses : Json(), "/responses", tasks, &p.responses);
   if (const Json* v = Field(json, "timing", "", false)) {
-    if (Object(*v, "/timing", {"stimulus_ms", "inter_trial_ms", "interval_ms", "isi_ms", "deadline_ms", "feedback_ms"})) {
+    if (Object(*v, "/timing", {"stimulus_ms", "inter_trial_ms", "interval_ms", "isi_ms", "deadline_ms", "feedback_ms",
+                               "fixation_ms"})) {
       if (const Json* s = Field(*v, "stimulus_ms", "/timing", false)) {
         // From about a frame to a minute.
         if (s->is_string() && *s == "until_response") p.timing.stimulus_ms = 0;
@@ -1035,6 +1036,7 @@ Protocol Parser::Parse(const Json& json) {
       if (auto x = Number(*v, "isi_ms", "/timing", false, 0, 10000, "ms")) p.timing.isi_ms = *x;
       if (auto x = Number(*v, "deadline_ms", "/timing", false, 100, 60000, "ms")) p.timing.deadline_ms = *x;
       if (auto x = Number(*v, "feedback_ms", "/timing", false, 100, 5000, "ms")) p.timing.feedback_ms = *x;
+      if (auto x = Number(*v, "fixation_ms", "/timing", false, 100, 5000, "ms")) p.timing.fixation_ms = *x;
       // Feedback needs a correct answer, which only a procedure defines; a deadline needs a forced choice.
       const bool procedure = std::any_of(p.blocks.begin(), p.blocks.end(), [](const Block& b) { return b.procedure; });
       if (v->contains("feedback_ms") && !procedure)

@@ -129,6 +129,7 @@ struct Timing {
   double interval_ms = 1000, isi_ms = 500;  // layout two_intervals: each interval, and the grey between them
   double deadline_ms = 0;             // forced choice: no answer this long after onset records "none"; 0: no deadline
   double feedback_ms = 0;             // procedure trials: "Correct" / "Wrong" / "Too slow" shown this long; 0: none
+  double fixation_ms = 0;             // a fixation mark (+) on grey before each stimulus; 0: none
 };
 
 // How a grid or ball trial's photo maps to the screen (a picture's frame is always fitted, 4:3, at 1 screen px per

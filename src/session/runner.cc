@@ -210,10 +210,10 @@ class Runner {
     }
   }
 
-  // A text shown for a fixed time (feedback): in a window its frames, headless the simulated clock's time.
-  void ShowFor(const std::string& title, double seconds) {
+  // A screen shown for a fixed time (feedback, fixation): in a window its frames, headless the simulated clock's time.
+  void ShowFor(const cv::Mat& image, double seconds) {
     if (station_.window()) {
-      const render::WindowImage shown(TextScreen(screen_size_, title, "", ""));
+      const render::WindowImage shown(image);
       const double until = station_.Now() + seconds;
       while (station_.Now() < until && !station_.Closed()) {
         shown.Present(context_.width_px(), context_.height_px());
@@ -272,6 +272,8 @@ class Runner {
       }
       station_.Wait(protocol_.timing.inter_trial_ms / 1000);
     }
+    // A fixation mark before the stimulus, where the participant should look.
+    if (protocol_.timing.fixation_ms > 0) ShowFor(FixationScreen(screen_size_), protocol_.timing.fixation_ms / 1000);
     station_.ClearScript();
     // Keys pressed before the stimulus (during the interval) answer nothing: drop them. Escape still pauses.
     for (const InputEvent& e : station_.Poll())
@@ -458,7 +460,8 @@ class Runner {
       record.RecordResponse(start.session_id, i, response, frames);  // committed before anything else happens
       if (trial.cell >= 0) adaptive.Answer(trial, level, correct);
       if (trial.cell >= 0 && protocol_.timing.feedback_ms > 0)
-        ShowFor(response.choice == "none" ? "Too slow" : correct ? "Correct" : "Wrong",
+        ShowFor(TextScreen(screen_size_, response.choice == "none" ? "Too slow" : correct ? "Correct" : "Wrong", "",
+                           ""),
                 protocol_.timing.feedback_ms / 1000);
       ++result.answered_now;
       progress(i + 1);

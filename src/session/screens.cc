@@ -58,4 +58,13 @@ cv::Mat TextScreen(cv::Size size, const std::string& title, const std::string& b
   return image;
 }
 
+cv::Mat FixationScreen(cv::Size size) {
+  cv::Mat image(size, CV_8UC3, kGrey);
+  const int arm = std::max(4, size.height / 54), thick = std::max(1, size.height / 360);
+  const cv::Point c(size.width / 2, size.height / 2);
+  cv::line(image, c - cv::Point(arm, 0), c + cv::Point(arm, 0), kInk, thick, cv::LINE_AA);
+  cv::line(image, c - cv::Point(0, arm), c + cv::Point(0, arm), kInk, thick, cv::LINE_AA);
+  return image;
+}
+
 }  // namespace blurcue::session

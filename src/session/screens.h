@@ -8,5 +8,8 @@ namespace blurcue::session {
 
 // 8-bit sRGB BGR of `size`: a title, a body wrapped to the width, a footer line; empty texts are left out.
 cv::Mat TextScreen(cv::Size size, const std::string& title, const std::string& body, const std::string& footer);
+// The grey field with a fixation cross at its centre (about 0.5 deg on a 24-inch screen at 60 cm: 20 px a arm at
+// 1080 px high, scaled with the display).
+cv::Mat FixationScreen(cv::Size size);
 
 }  // namespace blurcue::session
