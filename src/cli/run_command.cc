@@ -74,7 +74,8 @@ void AddRunCommand(CLI::App& app) {
   cmd->add_option("--capture", args->options.capture_dir,
                   "save each trial's first frame exactly as presented (DIR/trial-NNNN.png, the window's size) and "
                   "what it shows (DIR/trial-NNNN.json: the display, the photo's place, each object's centre, screen "
-                  "outline, radius in photo px, screen px and arcmin, size in degrees)");
+                  "outline, radius in photo px, screen px and arcmin, size in degrees); writing them delays that "
+                  "frame's flip, so a capture run is for checking a set-up, not for data");
   cmd->add_option("--stop-after", args->options.stop_after, "leave the session after this many answers (it stays "
                                                             "resumable; for tests and split sittings)")
       ->check(IntRange(0, 1000000));
