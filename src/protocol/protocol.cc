@@ -858,6 +858,7 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
   }
   if (auto s = Text(obj, "instructions", ptr, false, kMaxTextChars, false)) b->instructions = *s;
   if (auto s = Bool(obj, "shuffle", ptr)) b->shuffle = *s;
+  if (auto s = Bool(obj, "practice", ptr)) b->practice = *s;
   if (const Json* g = Field(obj, "groups", ptr, false)) {
     if (!g->is_array() || g->empty())
       Problem(ptr + "/groups", "must be a list of the protocol's group names", *g);
@@ -964,7 +965,7 @@ Protocol Parser::Parse(const Json& json) {
       const Json& obj = (*blocks)[i];
       const std::string bp = "/blocks/" + std::to_string(i);
       if (!Object(obj, bp, {"name", "task", "factors", "conditions", "repetitions", "counterbalance", "sides",
-                            "adjust", "procedure", "instructions", "shuffle", "groups"}))
+                            "adjust", "procedure", "instructions", "shuffle", "groups", "practice"}))
         continue;
       Block b;
       if (auto s = Text(obj, "name", bp, true, kMaxNameChars, true)) {
@@ -1173,6 +1174,12 @@ void Parser::CheckDesign(const Protocol& p) {
   } else if (trials == 0) {
     Problem("/", "makes no trials");
   }
+  if (!p.blocks.empty() && std::all_of(p.blocks.begin(), p.blocks.end(), [](const Block& b) { return b.practice; }))
+    Problem("/blocks", "every block is a practice block: nothing would be scored");
+  for (const auto& b : p.blocks)
+    if (b.practice && b.procedure)
+      Problem(b.pointer + "/practice", "a procedure's block is scored by its procedure; practise in a block without one",
+              Json(true));
   for (const auto& b : p.blocks)
     if (b.name == p.practice.block && p.practice.count > 0 && b.procedure)
       Problem("/practice/block", "names block " + b.name + ", whose trials its procedure decides from the answers; "

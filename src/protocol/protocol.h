@@ -78,6 +78,7 @@ struct Block {
   bool shuffle = true;
   std::string instructions;
   std::vector<std::string> groups;    // the groups that run this block; empty: every group
+  bool practice = false;              // a practice block: its trials are recorded as practice (not scored)
 };
 
 struct Scene {

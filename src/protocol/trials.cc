@@ -157,6 +157,7 @@ std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& part
     std::vector<Trial> rows = Design(b, even);
     if (b.shuffle) Shuffle(rows, rng);
     for (auto& t : rows) {
+      t.practice = b.practice;  // a practice block's trials are recorded as practice
       DrawAdjustment(b, rng, &t);
       trials.push_back(std::move(t));
     }

@@ -139,6 +139,22 @@ TEST(TrialBuilder, GroupsAreAssignedAndSelectTheirBlocks) {
   EXPECT_EQ(blocks_b, (std::set<std::string>{"all", "for-bc"}));
 }
 
+// A practice block: its own design, its trials recorded as practice; a protocol of practice blocks alone is refused.
+TEST(TrialBuilder, PracticeBlocksAreRecordedAsPractice) {
+  const char* text = R"({"name": "practice", "version": 1, "scene": {"background": "s.png", "calib": "c.json"},
+    "content": {"type": "grid"}, "task": "forced_choice", "sides": {"left": "measured", "right": "none"},
+    "blocks": [{"name": "warm-up", "practice": true, "factors": {"edge": [11]}},
+               {"name": "main", "factors": {"edge": [2, 5, 8]}}]})";
+  const auto trials = BuildTrials(FromJson(text), "P1", 3);
+  ASSERT_EQ(trials.size(), 4u);
+  EXPECT_TRUE(trials[0].practice);
+  EXPECT_EQ(trials[0].block, "warm-up");
+  for (size_t i = 1; i < trials.size(); ++i) EXPECT_FALSE(trials[i].practice);
+  Json only = Json::parse(text);
+  only["blocks"].erase(1);
+  EXPECT_THROW(ParseProtocol(only, "inline.json", {false}), Error);
+}
+
 TEST(TrialBuilder, GeneratorIsTheStandardMt19937_64) {
   // The C++ standard fixes the 10000th output of a default-constructed mt19937_64.
   std::mt19937_64 rng;

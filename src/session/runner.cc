@@ -418,6 +418,7 @@ class Runner {
       }
     }
     std::string shown_block;
+    bool shown_practice = false;  // the trial before was practice (the next main one says the practice is over)
     // Breaks come every N answered main trials, counted over the whole session (a resumed one included).
     int64_t main_answered = 0;
     for (int64_t i = 0; i < start.first_unanswered_trial; ++i) main_answered += !trials_[size_t(i)].practice;
@@ -425,21 +426,26 @@ class Runner {
       if (options_.stop_after >= 0 && result.answered_now >= options_.stop_after) break;
       const protocol::Trial& trial = trials_[size_t(i)];
       // Instructions when the part changes: practice, then each block.
-      const std::string part = trial.practice ? std::string("practice") : trial.block;
+      // A practice block is a part of its own; practice drawn from a main block is the part "practice".
+      const protocol::Block* block = nullptr;
+      for (const auto& b : protocol_.blocks)
+        if (b.name == trial.block) block = &b;
+      const bool practice_block = block && block->practice;
+      const std::string part = trial.practice && !practice_block ? std::string("practice") : trial.block;
       if (part != shown_block) {
         std::string text;
-        if (trial.practice) {
+        if (part == "practice" && !practice_block) {
           text = protocol_.practice.instructions;
         } else {
-          for (const auto& b : protocol_.blocks)
-            if (b.name == trial.block) text = b.instructions;
-          if (text.empty() && shown_block == "practice") text = "The practice is over; the study starts now.";
+          if (block) text = block->instructions;
+          if (text.empty() && shown_practice && !trial.practice) text = "The practice is over; the study starts now.";
         }
-        if (!text.empty() &&
-            !ShowScreen(trial.practice ? "Practice" : "Part: " + trial.block, text, "Press Return to go on"))
+        if (!text.empty() && !ShowScreen(trial.practice ? "Practice" : "Part: " + trial.block, text,
+                                         "Press Return to go on"))
           return result;
         shown_block = part;
       }
+      shown_practice = trial.practice;
       // A procedure's trial shows the level its answers so far give, on its test side.
       TrialScene scene = scenes_[size_t(i)];
       double level = 0;
