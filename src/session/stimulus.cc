@@ -99,12 +99,20 @@ double TrialScene::BallYMm(double t_s) const {
 
 namespace {
 
+// What a pair trial shows at the start and at the end of its run (the same twice for a still one; the end taken just
+// before a section run's wipe): where a check of its whole extent looks.
+std::array<std::array<std::optional<render::BlurredObject>, 2>, 2> RunEnds(const protocol::Protocol& protocol,
+                                                                         const calib::SceneCalib& scene,
+                                                                         const TrialScene& trial) {
+  return {ObjectsAt(protocol, scene, trial, 0),
+          ObjectsAt(protocol, scene, trial, std::max(0.0, trial.MotionS() - 1e-6))};
+}
+
 // A placement must show: each object, at the start and at the end of its run, must land in the photo.
 void CheckInPhoto(const protocol::Protocol& protocol, const protocol::Trial& trial, const calib::SceneCalib& scene,
                   const TrialScene& t) {
   const cv::Rect photo(0, 0, scene.camera.image_width_px, scene.camera.image_height_px);
-  for (const double at : {0.0, std::max(0.0, t.MotionS() - 1e-6)}) {
-    const auto objects = ObjectsAt(protocol, scene, t, at);
+  for (const auto& objects : RunEnds(protocol, scene, t)) {
     for (size_t side = 0; side < 2; ++side) {
       if (!objects[side]) continue;
       if ((render::FootprintOf(scene.camera, scene.rvec, scene.tvec, objects[side]->object).bounds & photo).empty()) {
@@ -324,8 +332,8 @@ render::FrameView Presentation::ViewFor(const protocol::Protocol& protocol, cons
   if (v.photo_width_px <= v.width_px && v.photo_height_px <= v.height_px) return v;
   // What the trial shows, in photo px: both objects at the start and at the end of their run.
   cv::Rect shows;
-  for (const double t : {0.0, trial.MotionS()})
-    for (const auto& object : ObjectsAt(protocol, scene, trial, std::min(t, std::max(0.0, trial.MotionS() - 1e-6))))
+  for (const auto& objects : RunEnds(protocol, scene, trial))
+    for (const auto& object : objects)
       if (object) {
         const cv::Rect b = render::FootprintOf(scene.camera, scene.rvec, scene.tvec, object->object).bounds;
         shows = shows.empty() ? b : (shows | b);
@@ -380,24 +388,22 @@ void PlanOnScreen(const protocol::Protocol& protocol, const calib::SceneCalib& s
   const double threshold = c.depth_blur_threshold_unit == "arcmin"
                                ? display::ScreenPxOfArcmin(presentation.profile, c.depth_blur_threshold)
                                : c.depth_blur_threshold;
-  TrialScene one = *trial;
-  one.per_pixel = false;
+  // The objects as the per-pixel plan would draw them: each one's radius at its nearest and farthest depth is what
+  // that plan would give those pixels (a procedure's gain included).
+  TrialScene as_per_pixel = *trial;
+  as_per_pixel.per_pixel = true;
+  const auto ends = RunEnds(protocol, s, as_per_pixel);
   double span = 0;
-  for (const double t : {0.0, std::max(0.0, trial->MotionS() - 1e-6)}) {
-    const auto shown = ObjectsAt(protocol, s, one, t);
-    for (size_t side = 0; side < 2; ++side) {
-      if (!shown[side]) continue;
-      const render::Footprint f = render::FootprintOf(s.camera, s.rvec, s.tvec, shown[side]->object);
-      const cv::Vec3d centre = s.ToCamera(shown[side]->object.center_board_mm);
-      const calib::BlurSource source = side == 0 ? trial->left : trial->right;
-      const double fixed = side == 0 ? trial->left_fixed_px : trial->right_fixed_px;
-      auto r_at = [&](double z) { return calib::BlurAlongSightPx(s, source, centre, z, fixed); };
-      span = std::max(span, presentation.ScreenPx(std::abs(r_at(f.z_max_mm) - r_at(f.z_min_mm))));
+  for (const auto& shown : ends)
+    for (const auto& object : shown) {
+      if (!object) continue;
+      const render::Footprint f = render::FootprintOf(s.camera, s.rvec, s.tvec, object->object);
+      span = std::max(span, presentation.ScreenPx(std::abs(object->r_of_depth_px(f.z_max_mm) -
+                                                           object->r_of_depth_px(f.z_min_mm))));
     }
-  }
   trial->r_span_screen_px = span;
   trial->per_pixel = span >= threshold;
-  const auto onset = ObjectsAt(protocol, s, one, 0);
+  const auto& onset = ends[0];
   for (size_t side = 0; side < 2; ++side)
     (side == 0 ? trial->size_left_deg : trial->size_right_deg) =
         onset[side] ? display::ArcminOfScreenPx(presentation.profile,

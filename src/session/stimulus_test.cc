@@ -200,6 +200,10 @@ TEST(PlanOnScreen, PerPixelExactlyWhenTheObjectsDepthSpanReachesTheThresholdOnSc
   PlanOnScreen(p, scene, shown, &t);
   EXPECT_TRUE(t.per_pixel);
   EXPECT_EQ(TrialVariables(PairTrial({{"edge", 2}}, "fitted", "fitted"), t, shown)["blur_plan"], "per_pixel");
+  // A procedure's gain on a side scales its radius at every depth, and so its span.
+  t.left_gain = 3;
+  PlanOnScreen(p, scene, shown, &t);
+  EXPECT_NEAR(t.r_span_screen_px, 3 * span, 1e-6 + 3e-3 * span);
 }
 
 TEST(DescribeTrial, ARadiusGivenOnTheScreenIsTurnedIntoPhotoPxByThePresentation) {
