@@ -102,12 +102,10 @@ void AddPreviewCommand(CLI::App& app) {
       std::string first;
       if (t.cell >= 0) {
         const double level = adaptive.Level(t);
-        for (const auto& b : p.blocks)
-          if (b.name == t.block && b.procedure) {
-            session::ApplyLevel(*b.procedure, t, level, prepared.presentation, &s);
-            first = " (" + protocol::ToString(b.procedure->kind) + ": " + b.procedure->variable + " " +
-                    Json(level).dump() + " on the " + t.test_side + " at first)";
-          }
+        const protocol::Procedure& procedure = *protocol::BlockOf(p, t)->procedure;  // t.cell >= 0: it has one
+        session::ApplyLevel(procedure, t, level, prepared.presentation, &s);
+        first = " (" + protocol::ToString(procedure.kind) + ": " + procedure.variable + " " + Json(level).dump() +
+                " on the " + t.test_side + " at first)";
         session::PlanOnScreen(p, *scene, prepared.presentation, &s);
       }
       std::string levels;

@@ -189,6 +189,12 @@ std::vector<size_t> BlockOrder(const Protocol& protocol, const std::string& part
   return order;
 }
 
+const Block* BlockOf(const Protocol& protocol, const Trial& trial) {
+  for (const auto& b : protocol.blocks)
+    if (b.name == trial.block) return &b;
+  return nullptr;
+}
+
 std::string SidePointer(const Protocol& protocol, const Trial& trial, const std::string& side) {
   // A swapped trial shows the design's other side.
   const std::string designed = trial.swapped ? (side == "left" ? "right" : "left") : side;

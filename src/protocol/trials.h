@@ -71,6 +71,9 @@ std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& part
 std::string AssignGroup(const Protocol& protocol, const std::string& participant,
                         const std::map<std::string, int64_t>& sessions);
 
+// The block `trial` belongs to (null for a trial made from another protocol).
+const Block* BlockOf(const Protocol& protocol, const Trial& trial);
+
 // The JSON pointer of the field that chose what `trial` shows on `side` ("left" | "right" as shown, swaps
 // applied): the side of a level object (/blocks/1/factors/pattern/2/left) or of the block's sides (/sides/left).
 std::string SidePointer(const Protocol& protocol, const Trial& trial, const std::string& side);

@@ -92,12 +92,12 @@ AdaptiveState::State& AdaptiveState::StateOf(const protocol::Trial& trial) {
   const auto key = std::make_pair(trial.block, trial.cell);
   auto it = states_.find(key);
   if (it != states_.end()) return it->second;
-  for (const auto& b : protocol_.blocks)
-    if (b.name == trial.block && b.procedure && trial.cell >= 0) {
-      if (b.procedure->kind == protocol::Procedure::Kind::kQuestPlus)
-        return states_.emplace(key, QuestPlus(*b.procedure)).first->second;
-      return states_.emplace(key, Staircase(*b.procedure)).first->second;
-    }
+  const protocol::Block* b = protocol::BlockOf(protocol_, trial);
+  if (b && b->procedure && trial.cell >= 0) {
+    if (b->procedure->kind == protocol::Procedure::Kind::kQuestPlus)
+      return states_.emplace(key, QuestPlus(*b->procedure)).first->second;
+    return states_.emplace(key, Staircase(*b->procedure)).first->second;
+  }
   throw Error(ErrorKind::kInternal, "trial " + std::to_string(trial.index) + " belongs to no procedure");
 }
 

@@ -427,9 +427,7 @@ class Runner {
       const protocol::Trial& trial = trials_[size_t(i)];
       // Instructions when the part changes: practice, then each block.
       // A practice block is a part of its own; practice drawn from a main block is the part "practice".
-      const protocol::Block* block = nullptr;
-      for (const auto& b : protocol_.blocks)
-        if (b.name == trial.block) block = &b;
+      const protocol::Block* block = protocol::BlockOf(protocol_, trial);
       const bool practice_block = block && block->practice;
       const std::string part = trial.practice && !practice_block ? std::string("practice") : trial.block;
       if (part != shown_block) {
@@ -500,8 +498,7 @@ class Runner {
   }
 
   const protocol::Procedure& ProcedureOf(const protocol::Trial& trial) const {
-    for (const auto& b : protocol_.blocks)
-      if (b.name == trial.block && b.procedure) return *b.procedure;
+    if (const protocol::Block* b = protocol::BlockOf(protocol_, trial); b && b->procedure) return *b->procedure;
     throw Error(ErrorKind::kInternal, "trial " + std::to_string(trial.index) + " belongs to no procedure block");
   }
 
