@@ -46,6 +46,16 @@ VirtualObject Ball(double y_mm) {
   return o;
 }
 
+// A flat card of uniform grey (sRGB `grey`) lying on the table at the board's centre.
+VirtualObject FlatCard(double size_mm, int grey) {
+  VirtualObject card;
+  card.kind = VirtualObject::Kind::kCard;
+  card.size_mm = size_mm;
+  card.center_board_mm = {87.5, 125, 0};
+  card.texture = cv::Mat(32, 32, CV_8UC3, cv::Scalar::all(grey));
+  return card;
+}
+
 cv::Point2d AlphaCentroid(const Layer& layer, double* area) {
   cv::Mat alpha;
   cv::extractChannel(layer.bgra, alpha, 3);
@@ -131,11 +141,7 @@ TEST_F(SceneRenderTest, WhiteBalanceScalesEachChannelInLinearLight) {
   // covered pixels keep their coverage and carry the texture's linear value times each gain.
   const View v;
   SceneRenderer renderer(v.camera, v.rvec, v.tvec);
-  VirtualObject card;
-  card.kind = VirtualObject::Kind::kCard;
-  card.size_mm = 50;
-  card.center_board_mm = {87.5, 125, 0};
-  card.texture = cv::Mat(32, 32, CV_8UC3, cv::Scalar(200, 200, 200));
+  VirtualObject card = FlatCard(50, 200);
   const Layer plain = renderer.Draw(card, 1);
   card.white_balance = {1, 0.5, 2};
   const Layer balanced = renderer.Draw(card, 1);
@@ -199,10 +205,7 @@ TEST_F(SceneRenderTest, FramesBlurPerPixelByDepthWhenTheObjectCarriesThatPlan) {
   const cv::Mat photo = Photo(v.camera);
   FrameCompositor gpu(v.camera, v.rvec, v.tvec, photo);
   BlurredObject card;
-  card.object.kind = VirtualObject::Kind::kCard;
-  card.object.size_mm = 60;
-  card.object.center_board_mm = {87.5, 125, 0};
-  card.object.texture = cv::Mat(64, 64, CV_8UC3, cv::Scalar(230, 230, 230));
+  card.object = FlatCard(60, 230);
   const Footprint f = gpu.renderer().Measure(card.object);
   const double z0 = f.z_min_mm, z1 = f.z_max_mm;
   card.r_px = 3.5;
@@ -250,11 +253,7 @@ namespace {
 TEST_F(SceneRenderTest, DepthVaryingBlurFollowsEachEdgesDepth) {
   const View v;
   SceneRenderer renderer(v.camera, v.rvec, v.tvec);
-  VirtualObject card;
-  card.kind = VirtualObject::Kind::kCard;
-  card.size_mm = 60;
-  card.center_board_mm = {87.5, 125, 0};
-  card.texture = cv::Mat(64, 64, CV_8UC3, cv::Scalar(230, 230, 230));
+  const VirtualObject card = FlatCard(60, 230);
   const Footprint f = renderer.Measure(card);
   const double z0 = f.z_min_mm, z1 = f.z_max_mm;
   auto r_of_depth = [&](double z) { return 1.5 + 4.0 * (z - z0) / (z1 - z0); };  // 1.5 px near .. 5.5 px far
