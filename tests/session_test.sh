@@ -283,6 +283,82 @@ for i, fs in frames.items():
 print(len(trials), "trials")
 PYEOF
   echo "ok: two intervals shown in turn, each frame recording its interval, answers after both" ;;
+layouts)
+  # One object (yes/no, rating) and odd one out, answered by the simulated observer: the choices are the tasks' own
+  # answers, each odd-one-out frame records the side its interval showed, answers come only after the intervals
+  # (after_motion), the prompt's band is in the captured frame once answering is open, and a session stopped midway
+  # and resumed equals an uninterrupted one.
+  $BC run "$P/odd-one-out-grids.json" --participant O1 --db "$W/o.sqlite" --observer sim --sim-fps 20 \
+      --capture "$W/odd-capture" > /dev/null 2>&1 || fail "odd one out did not run"
+  $BC run "$P/yes-no-ball.json" --participant Y1 --db "$W/o.sqlite" --observer sim --capture "$W/yes-capture" \
+      > /dev/null 2>&1 || fail "yes/no did not run"
+  $BC export --db "$W/o.sqlite" --out "$W/tables" > /dev/null
+  $PY - "$W/tables" "$W/odd-capture" "$W/yes-capture" <<'PYEOF' || fail "layouts"
+import csv, json, sys
+import numpy as np
+from PIL import Image
+rows = list(csv.DictReader(open(sys.argv[1] + "/trials.csv")))
+odd = {int(r["trial_index"]): r for r in rows if r["study"] == "odd-one-out-grids"}
+one = [r for r in rows if r["study"] == "yes-no-ball"]
+frames = {}
+for f in csv.DictReader(open(sys.argv[1] + "/frames.csv")):
+    if f["study"] == "odd-one-out-grids":
+        frames.setdefault(int(f["trial_index"]), []).append(f)
+# 3 intervals of 600 ms with 300 ms between: interval k runs from 0.9 k to 0.9 k + 0.6 s.
+right_shown = 0
+for i, t in odd.items():
+    assert t["choice"] in ("1", "2", "3"), t["choice"]
+    assert t["odd_interval"] in ("1", "2", "3") and t["intervals"] == "3", t
+    assert float(t["rt_ms"]) > 2400, t["rt_ms"]  # after the last interval
+    k_odd = int(t["odd_interval"]) - 1
+    for f in frames[i]:
+        s = float(f["flip_time_s"])
+        k = int(s // 0.9)
+        if min(abs(s - b) for b in (0.6, 0.9, 1.5, 1.8, 2.4)) < 1e-6:
+            continue
+        on = k < 3 and s - 0.9 * k < 0.6
+        left, right = f["r_left_px"], f["r_right_px"]
+        if not on:
+            assert not left and not right, (i, f)
+        elif k == k_odd:
+            assert right and not left and abs(float(right) - float(t["r_right_px"])) < 1e-3, (i, f)
+            right_shown += 1
+        else:
+            assert left and not right and abs(float(left) - float(t["r_left_px"])) < 1e-3, (i, f)
+assert right_shown > 0
+# The odd grid has no blur, the others the scene's: found more often where the scene blurs more (edge 9 vs 3).
+hit = lambda e: np.mean([t["choice"] == t["odd_interval"] for t in odd.values() if t["edge"] == str(e)])
+assert hit(9) >= hit(3), (hit(9), hit(3))
+for r in one:
+    if r["block_name"] == "yes_no":
+        assert r["choice"] in ("yes", "no"), r["choice"]
+    else:
+        assert r["choice"] in ("1", "2", "3", "4", "5"), r["choice"]
+    assert r["r_left_px"] and not r["r_right_px"], r  # one object, recorded as the left side
+# A 4 px ball stands out from the scene more often than one with the scene's own blur.
+yes = lambda src: np.mean([r["choice"] == "yes" for r in one if r["block_name"] == "yes_no" and r["blur"] == src])
+assert yes('{"object":4}') > yes('{"object":"measured"}'), (yes('{"object":4}'), yes('{"object":"measured"}'))
+# The prompt: not in an odd-one-out trial's first frame (answers open after the intervals); in a yes/no trial's, in
+# a band of its own at the bottom, the photo above it.
+o = json.load(open(sys.argv[2] + "/trial-0001.json"))
+assert o["prompt"] is None, o["prompt"]
+y = json.load(open(sys.argv[3] + "/trial-0001.json"))
+x0, y0, w, h = y["prompt_rect_px"]
+px, py, pw, ph = y["photo_rect_px"]
+assert y0 + h == y["display"]["height_px"] and py + ph <= y0, (y["prompt_rect_px"], y["photo_rect_px"])
+img = np.asarray(Image.open(sys.argv[3] + "/trial-0001.png").convert("L")).astype(float)
+band = img[y0:y0 + h]
+assert band.max() - band.min() > 80, "no text in the prompt band"
+assert (band > 200).mean() < 0.2, "the band is not mostly grey"
+print(len(odd), "odd-one-out and", len(one), "one-object trials")
+PYEOF
+  # Stopped after 5 answers and resumed: the same record as one run through.
+  $BC run "$P/odd-one-out-grids.json" --participant O2 --db "$W/split.sqlite" --observer sim --stop-after 5 \
+      > /dev/null 2>&1
+  $BC run "$P/odd-one-out-grids.json" --participant O2 --db "$W/split.sqlite" --observer sim --resume > /dev/null 2>&1
+  $BC run "$P/odd-one-out-grids.json" --participant O2 --db "$W/whole.sqlite" --observer sim > /dev/null 2>&1
+  [ "$(fingerprint "$W/split.sqlite" O2)" = "$(fingerprint "$W/whole.sqlite" O2)" ] || fail "resumed odd one out differs"
+  echo "ok: yes/no, rating and odd-one-out trials answered and recorded as shown, the prompt in its band, resumable" ;;
 deadline)
   # A deadline: no answer within it records the choice "none" with no response time, and a procedure counts it
   # wrong (its level climbs); feedback after each procedure trial; feedback without a procedure is refused.

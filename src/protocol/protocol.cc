@@ -13,7 +13,14 @@
 namespace blurcue::protocol {
 namespace fs = std::filesystem;
 
-std::string ToString(Task task) { return task == Task::kAdjustment ? "adjustment" : "forced_choice"; }
+std::string ToString(Task task) {
+  switch (task) {
+    case Task::kAdjustment: return "adjustment";
+    case Task::kYesNo: return "yes_no";
+    case Task::kRating: return "rating";
+    default: return "forced_choice";
+  }
+}
 
 std::string ToString(Procedure::Kind kind) {
   return kind == Procedure::Kind::kQuestPlus ? "quest_plus" : "staircase";
@@ -138,7 +145,7 @@ bool IsBlurSource(const Json& v) {
 // Names whose values CheckLevelValue knows: a level of a factor so named is that value, never an object.
 bool IsValueName(const std::string& name) {
   static const std::set<std::string> kNames = {"edge",       "from_edge",  "to_edge", "section",   "speed_cm_s",
-                                               "distance_m", "cutoff",     "left",    "right",     "y_mm",
+                                               "distance_m", "cutoff",     "left",    "right",     "y_mm",   "object",
                                                "from_y_mm",  "to_y_mm",    "left_x_mm", "right_x_mm"};
   return kNames.count(name) > 0;
 }
@@ -343,7 +350,8 @@ class Parser {
   void ParseSides(const Json& v, const std::string& ptr);
   // Fills `b` from `obj` at `ptr`, falling back to the protocol-level defaults in `top`.
   void ParseBlock(const Json& obj, const std::string& ptr, const Json& top, Block* b);
-  void ParseResponses(const Json& v, const std::string& ptr, const std::set<Task>& tasks, Responses* r);
+  void ParseResponses(const Json& v, const std::string& ptr, const std::set<Task>& tasks, const Protocol& p,
+                      Responses* r);
   void CheckDesign(const Protocol& p);
   static bool Provides(const Block& b, const std::string& name);
 
@@ -446,7 +454,7 @@ void Parser::CheckLevelValue(const std::string& name, const Json& v, const std::
   else if (name == "distance_m") number_in(0.1, 100, "m", "a distance");
   // Cycles per picture width; 0 shows the picture unfiltered.
   else if (name == "cutoff") number_in(0, 1000, "cycles per picture width", "a cut-off");
-  else if (name == "left" || name == "right") {
+  else if (name == "left" || name == "right" || name == "object") {
     if (!IsBlurSource(v))
       Problem(ptr, "a blur source must be none, measured, measured_section, estimated, fitted, a radius in " +
                        Range(0, kMaxFixedRadiusPx, "photo px") + ", {\"screen_px\": r} with r in " +
@@ -510,7 +518,9 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
         }
         const bool l = level.contains("left"), r = level.contains("right");
         if (l != r) Problem(lp, std::string("has \"") + (l ? "left" : "right") + "\" but no \"" + (l ? "right" : "left") + "\"", level);
-        if (l && r) sides = true;
+        if (level.contains("object") && (l || r))
+          Problem(lp, "has an \"object\" (layout single) and left/right (a pair): give one or the other", level);
+        if ((l && r) || level.contains("object")) sides = true;
         if (level.contains("from_edge") && level.contains("to_edge") && level["from_edge"].is_number_integer() &&
             level["to_edge"].is_number_integer() && level["from_edge"] == level["to_edge"])
           Problem(lp, "from_edge and to_edge must differ", level);
@@ -784,7 +794,12 @@ std::optional<Procedure> Parser::ParseProcedure(const Json& v, const std::string
 }
 
 void Parser::ParseSides(const Json& v, const std::string& ptr) {
-  if (!Object(v, ptr, {"left", "right"})) return;
+  // The single layout shows one "object"; the others a pair, left and right.
+  if (v.is_object() && v.contains("object")) {
+    if (Object(v, ptr, {"object"})) CheckLevelValue("object", v["object"], ptr + "/object");
+    return;
+  }
+  if (!Object(v, ptr, {"left", "right", "object"})) return;
   for (const char* side : {"left", "right"}) {
     if (const Json* s = Field(v, side, ptr, true)) CheckLevelValue(side, *s, ptr + "/" + side);
   }
@@ -805,8 +820,11 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
   if (const Source s = pick("task"); !s.holder) {
     Problem(ptr + "/task", "is required (here or at /task) but missing");
   } else if (b->task_pointer = s.ptr + "/task";
-             auto t = String(*s.holder, "task", s.ptr, true, {"forced_choice", "adjustment"})) {
-    b->task = *t == "adjustment" ? Task::kAdjustment : Task::kForcedChoice;
+             auto t = String(*s.holder, "task", s.ptr, true, {"forced_choice", "adjustment", "yes_no", "rating"})) {
+    b->task = *t == "adjustment" ? Task::kAdjustment
+              : *t == "yes_no"   ? Task::kYesNo
+              : *t == "rating"   ? Task::kRating
+                                 : Task::kForcedChoice;
   }
   b->pointer = ptr;
   const size_t calls_before_factors = calls_;
@@ -872,42 +890,85 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
   // What is shown left and right must be known for a comparison, and for any left/right counterbalancing.
   bool factor_sides = false;
   for (const auto& f : b->factors)
-    for (const auto& level : f.levels) factor_sides = factor_sides || (level.is_object() && level.contains("left"));
+    for (const auto& level : f.levels)
+      factor_sides = factor_sides || (level.is_object() && (level.contains("left") || level.contains("object")));
   const std::string where = ptr.empty() ? "/" : ptr;
   if (factor_sides && sides.holder)
-    Problem(sides.ptr + "/sides", "is given but a factor's levels already carry left and right",
+    Problem(sides.ptr + "/sides", "is given but a factor's levels already carry the sides (left and right, or object)",
             (*sides.holder)["sides"]);
   const bool needs_sides =
       !b->procedure && (b->task == Task::kForcedChoice || b->counterbalance != Counterbalance::kNone);
   if (needs_sides && factors_ok && !factor_sides && !sides.holder)
     Problem(where, "needs what is shown left and right: a \"sides\" object or a factor whose levels have left and "
                    "right (a forced choice or left/right counterbalancing compares two sides)");
+  if ((b->task == Task::kYesNo || b->task == Task::kRating) && factors_ok && !factor_sides && !sides.holder)
+    Problem(where, "needs the object shown: \"sides\": {\"object\": SOURCE} or a factor whose levels have an object "
+                   "(a " + ToString(b->task) + " trial shows one object)");
   if (b->task == Task::kAdjustment && !adjust.holder)
     Problem(ptr + "/adjust", "is required for the adjustment task (here or at /adjust) but missing");
 }
 
-void Parser::ParseResponses(const Json& v, const std::string& ptr, const std::set<Task>& tasks, Responses* r) {
-  // Defaults that suit a keyboard: arrows to choose or step, Return to accept.
+void Parser::ParseResponses(const Json& v, const std::string& ptr, const std::set<Task>& tasks, const Protocol& p,
+                            Responses* r) {
+  // Defaults that suit a keyboard: arrows to choose or step, Return to accept, Y / N, digits for scales and intervals.
   *r = Responses{"Left", "Right", "Down", "Left", "Right", "Return"};
+  r->rating = {"1", "2", "3", "4", "5"};
+  for (int i = 1; i <= p.alternatives; ++i) r->alternatives.push_back(std::to_string(i));
+  // Odd one out names one of its intervals: there is no "can't tell" unless a key is given for it.
+  if (p.layout == "odd_one_out") r->cant_tell = "";
   if (v.is_null()) return;
-  if (!Object(v, ptr, {"left", "right", "cant_tell", "previous", "next", "accept"})) return;
+  if (!Object(v, ptr, {"left", "right", "cant_tell", "previous", "next", "accept", "yes", "no", "rating",
+                       "alternatives", "prompt", "after_motion"}))
+    return;
+  auto key_name = [&](const Json& value, const std::string& at) -> std::optional<std::string> {
+    if (!value.is_string()) return Problem(at, "must be a key name", value), std::nullopt;
+    const std::string s = value.get<std::string>();
+    if (s == "Escape") return Problem(at, "Escape is reserved for pausing a session", value), std::nullopt;
+    if (!IsKeyName(s))
+      return Problem(at, "must be a key name: A-Z, 0-9, Left, Right, Up, Down, Space, Return, Tab, Backspace, F1-F12 "
+                         "or KP_0-KP_9", value), std::nullopt;
+    return s;
+  };
   std::map<std::string, std::string*> slots = {{"left", &r->left},         {"right", &r->right},
                                                {"cant_tell", &r->cant_tell}, {"previous", &r->previous},
-                                               {"next", &r->next},         {"accept", &r->accept}};
+                                               {"next", &r->next},         {"accept", &r->accept},
+                                               {"yes", &r->yes},           {"no", &r->no}};
   for (auto& [key, slot] : slots) {
+    if (!v.contains(key)) continue;
     // "cant_tell": null makes a strict 2AFC: no key answers can't tell.
-    if (key == "cant_tell" && v.contains(key) && v[key].is_null()) {
+    if (key == "cant_tell" && v[key].is_null()) {
       *slot = "";
       continue;
     }
-    const auto s = String(v, key, ptr, false);
-    if (!s) continue;
-    if (*s == "Escape") Problem(ptr + "/" + key, "Escape is reserved for pausing a session", Json(*s));
-    else if (!IsKeyName(*s))
-      Problem(ptr + "/" + key, "must be a key name: A-Z, 0-9, Left, Right, Up, Down, Space, Return, Tab, "
-                               "Backspace, F1-F12 or KP_0-KP_9", Json(*s));
-    else *slot = *s;
+    if (auto s = key_name(v[key], ptr + "/" + key)) *slot = *s;
   }
+  // Key lists: one key per point of a rating scale (2 to 9), one per interval of an odd-one-out trial.
+  auto key_list = [&](const char* key, size_t min, size_t max, std::vector<std::string>* out) {
+    if (!v.contains(key)) return;
+    const Json& list = v[key];
+    const std::string at = ptr + "/" + key;
+    if (!list.is_array() || list.size() < min || list.size() > max)
+      return Problem(at, "must be a list of " + std::to_string(min) + (min == max ? "" : " to " + std::to_string(max)) +
+                             " key names", list);
+    out->clear();
+    for (size_t i = 0; i < list.size(); ++i)
+      if (auto s = key_name(list[i], at + "/" + std::to_string(i))) out->push_back(*s);
+  };
+  key_list("rating", 2, 9, &r->rating);
+  key_list("alternatives", size_t(std::max(p.alternatives, 1)), size_t(std::max(p.alternatives, 1)), &r->alternatives);
+  if (auto s = Text(v, "prompt", ptr, false, 200, true)) {
+    if (s->empty()) Problem(ptr + "/prompt", "must not be empty (leave it out for no prompt)", Json(*s));
+    r->prompt = *s;
+  }
+  if (auto b = Bool(v, "after_motion", ptr)) r->after_motion = *b;
+  // Keys for a task no block has would be read by nothing.
+  auto unused = [&](const char* key, bool used, const std::string& why) {
+    if (v.contains(key) && !used) Problem(ptr + "/" + key, why, v[key]);
+  };
+  unused("yes", tasks.count(Task::kYesNo), "is for the task yes_no, which no block has");
+  unused("no", tasks.count(Task::kYesNo), "is for the task yes_no, which no block has");
+  unused("rating", tasks.count(Task::kRating), "is for the task rating, which no block has");
+  unused("alternatives", p.layout == "odd_one_out", "is for the layout odd_one_out");
   auto distinct = [&](const std::vector<std::pair<std::string, std::string>>& set) {
     for (size_t i = 0; i < set.size(); ++i)
       for (size_t j = 0; j < i; ++j)
@@ -920,6 +981,16 @@ void Parser::ParseResponses(const Json& v, const std::string& ptr, const std::se
                                         {"left", r->left}, {"right", r->right}, {"cant_tell", r->cant_tell}});
   if (tasks.count(Task::kAdjustment))
     distinct({{"previous", r->previous}, {"next", r->next}, {"accept", r->accept}});
+  if (tasks.count(Task::kYesNo)) distinct({{"yes", r->yes}, {"no", r->no}});
+  auto distinct_list = [&](const char* key, const std::vector<std::string>& keys) {
+    for (size_t i = 0; i < keys.size(); ++i)
+      for (size_t j = 0; j < i; ++j)
+        if (keys[i] == keys[j])
+          Problem(ptr + "/" + key + "/" + std::to_string(i), "is the same key as /responses/" + std::string(key) + "/" + std::to_string(j),
+                  Json(keys[i]));
+  };
+  if (tasks.count(Task::kRating)) distinct_list("rating", r->rating);
+  if (p.layout == "odd_one_out") distinct_list("alternatives", r->alternatives);
 }
 
 Protocol Parser::Parse(const Json& json) {
@@ -928,7 +999,7 @@ Protocol Parser::Parse(const Json& json) {
   if (!Object(json, "",
               {"$schema", "name", "version", "description", "scene", "content", "task", "factors", "conditions",
                "repetitions", "counterbalance", "sides", "adjust", "blocks", "block_order", "practice", "instructions",
-               "breaks", "responses", "timing", "display", "participant_info", "groups", "layout"}))
+               "breaks", "responses", "timing", "display", "participant_info", "groups", "layout", "alternatives"}))
     return p;
   if (auto s = Text(json, "name", "", true, kMaxNameChars, true)) {
     if (s->empty()) Problem("/name", "must not be empty", Json(*s));
@@ -950,7 +1021,7 @@ Protocol Parser::Parse(const Json& json) {
   if (json.contains("repetitions")) Int(json, "repetitions", "", true, 1, kMaxTrials, "repetitions");
   if (json.contains("counterbalance"))
     String(json, "counterbalance", "", true, {"swap_copies", "by_participant", "none"});
-  if (json.contains("task")) String(json, "task", "", true, {"forced_choice", "adjustment"});
+  if (json.contains("task")) String(json, "task", "", true, {"forced_choice", "adjustment", "yes_no", "rating"});
 
   const Json* blocks = Field(json, "blocks", "", false);
   if (!blocks) {
@@ -994,11 +1065,28 @@ Protocol Parser::Parse(const Json& json) {
   }
   if (auto order = String(json, "block_order", "", false, {"fixed", "random", "latin_square"}))
     p.block_order = *order;
-  if (auto layout = String(json, "layout", "", false, {"side_by_side", "two_intervals"})) {
+  if (auto layout = String(json, "layout", "", false, {"side_by_side", "two_intervals", "single", "odd_one_out"})) {
     p.layout = *layout;
-    if (p.layout == "two_intervals" && p.content.type == "picture")
-      Problem("/layout", "two intervals show a pair of grids or balls, not a picture", Json(*layout));
+    if (p.layout != "side_by_side" && p.content.type == "picture")
+      Problem("/layout", "is for grids and balls; a picture is shown in its depth-matching frame", Json(*layout));
   }
+  if (p.layout == "odd_one_out") p.alternatives = 3;
+  if (json.contains("alternatives")) {
+    if (auto n = Int(json, "alternatives", "", true, 3, 6, "intervals")) p.alternatives = *n;
+    if (p.layout != "odd_one_out")
+      Problem("/alternatives", "is for the layout odd_one_out (the intervals of an odd-one-out trial)", json["alternatives"]);
+  }
+  // QUEST+'s guess rate is the chance of a right answer by guessing: 1/n of an odd-one-out trial's n intervals.
+  if (p.layout == "odd_one_out")
+    for (auto& b : p.blocks)
+      if (b.procedure && b.procedure->kind == Procedure::Kind::kQuestPlus) {
+        const Json& pj = json["blocks"][std::stoi(b.pointer.substr(8))]["procedure"];
+        if (!pj.contains("guess")) b.procedure->guess = 1.0 / p.alternatives;
+        else if (std::abs(b.procedure->guess - 1.0 / p.alternatives) > 1e-3)
+          Problem(b.pointer + "/procedure/guess", "an odd-one-out trial of " + std::to_string(p.alternatives) +
+                                                      " intervals is guessed right 1/" + std::to_string(p.alternatives) +
+                                                      " of the time; leave guess out", pj["guess"]);
+      }
   if (const Json* v = Field(json, "participant_info", "", false)) ParseInfo(*v, "/participant_info", &p);
   if (const Json* v = Field(json, "groups", "", false)) ParseGroups(*v, json, "/groups", &p);
   if (const Json* v = Field(json, "breaks", "", false)) {
@@ -1022,7 +1110,7 @@ Protocol Parser::Parse(const Json& json) {
   std::set<Task> tasks;
   for (const auto& b : p.blocks) tasks.insert(b.task);
   const Json* responses = Field(json, "responses", "", false);
-  ParseResponses(responses ? *responses : Json(), "/responses", tasks, &p.responses);
+  ParseResponses(responses ? *responses : Json(), "/responses", tasks, p, &p.responses);
   if (const Json* v = Field(json, "timing", "", false)) {
     if (Object(*v, "/timing", {"stimulus_ms", "inter_trial_ms", "interval_ms", "isi_ms", "deadline_ms", "feedback_ms",
                                "fixation_ms"})) {
@@ -1046,13 +1134,13 @@ Protocol Parser::Parse(const Json& json) {
       const bool adjustment = std::any_of(p.blocks.begin(), p.blocks.end(),
                                           [](const Block& b) { return b.task == Task::kAdjustment; });
       if (v->contains("deadline_ms") && adjustment)
-        Problem("/timing/deadline_ms", "is for a forced choice; adjustment runs until a level is accepted",
-                (*v)["deadline_ms"]);
+        Problem("/timing/deadline_ms", "is for a forced choice, yes/no or rating; adjustment runs until a level is "
+                                       "accepted", (*v)["deadline_ms"]);
       for (const char* key : {"interval_ms", "isi_ms"})
-        if (v->contains(key) && p.layout != "two_intervals")
-          Problem(std::string("/timing/") + key, "is for the layout two_intervals", (*v)[key]);
-      if (v->contains("stimulus_ms") && p.layout == "two_intervals")
-        Problem("/timing/stimulus_ms", "two intervals are timed by interval_ms and isi_ms", (*v)["stimulus_ms"]);
+        if (v->contains(key) && IntervalCount(p) == 0)
+          Problem(std::string("/timing/") + key, "is for the layouts two_intervals and odd_one_out", (*v)[key]);
+      if (v->contains("stimulus_ms") && IntervalCount(p) > 0)
+        Problem("/timing/stimulus_ms", "intervals are timed by interval_ms and isi_ms", (*v)["stimulus_ms"]);
     }
   }
   if (const Json* v = Field(json, "display", "", false)) {
@@ -1136,8 +1224,35 @@ void Parser::CheckDesign(const Protocol& p) {
                         return list;
                       }());
     }
-    if (p.layout == "two_intervals" && Provides(b, "speed_cm_s"))
-      Problem(b.factors_pointer, "two intervals show still objects: a speed_cm_s level would move them");
+    if (IntervalCount(p) > 0 && Provides(b, "speed_cm_s"))
+      Problem(b.factors_pointer, "intervals show still objects: a speed_cm_s level would move them");
+    // The layout decides the question: one object is answered yes/no or rated, a pair or N intervals chosen from.
+    const bool one = b.task == Task::kYesNo || b.task == Task::kRating;
+    if (p.layout == "single" && type != "picture" && !one)
+      Problem(b.task_pointer, "must be yes_no or rating for the layout single (one object: nothing to choose between)",
+              Json(ToString(b.task)));
+    if (p.layout != "single" && one)
+      Problem(b.task_pointer, "is for the layout single (one object); a " + p.layout + " trial is a forced choice",
+              Json(ToString(b.task)));
+    if (p.layout == "single" && b.counterbalance != Counterbalance::kNone)
+      Problem(b.counterbalance_pointer, "must be none for the layout single (one object: no sides to swap)",
+              Json(ToString(b.counterbalance)));
+    if (p.layout == "single" && b.procedure)
+      Problem(b.pointer + "/procedure", "needs a forced choice (layouts side_by_side, two_intervals, odd_one_out)");
+    // "object" is the single layout's one source; a pair layout reads left and right.
+    bool object = b.sides.is_object() && b.sides.contains("object");
+    bool pair = b.sides.is_object() && (b.sides.contains("left") || b.sides.contains("right"));
+    for (const auto& f : b.factors)
+      for (const auto& level : f.levels) {
+        object = object || (level.is_object() && level.contains("object"));
+        pair = pair || (level.is_object() && level.contains("left"));
+      }
+    if (p.layout == "single" && pair)
+      Problem(b.sides.is_object() ? b.sides_pointer : b.factors_pointer,
+              "the layout single shows one object: give \"object\", not left and right");
+    if (p.layout != "single" && object)
+      Problem(b.sides.is_object() ? b.sides_pointer : b.factors_pointer,
+              "\"object\" is for the layout single; a " + p.layout + " trial shows left and right");
     if (type == "grid" && !Provides(b, "edge") && !Provides(b, "y_mm"))
       Problem(b.factors_pointer, "a grid stands at an edge: needs a factor edge (or y_mm), or a factor whose every "
                                  "level has an edge (1..11 on the thesis's board)");
@@ -1176,6 +1291,11 @@ void Parser::CheckDesign(const Protocol& p) {
   }
   if (!p.blocks.empty() && std::all_of(p.blocks.begin(), p.blocks.end(), [](const Block& b) { return b.practice; }))
     Problem("/blocks", "every block is a practice block: nothing would be scored");
+  // Answering only after the motion needs something that moves or runs in intervals.
+  if (p.responses.after_motion && IntervalCount(p) == 0 &&
+      std::none_of(p.blocks.begin(), p.blocks.end(), [&](const Block& b) { return Provides(b, "speed_cm_s"); }))
+    Problem("/responses/after_motion", "no block moves its objects (a speed_cm_s level) and the layout has no "
+                                       "intervals: there is no motion to wait for", Json(true));
   for (const auto& b : p.blocks)
     if (b.practice && b.procedure)
       Problem(b.pointer + "/practice", "a procedure's block is scored by its procedure; practise in a block without one",
@@ -1250,6 +1370,10 @@ Protocol ParseProtocol(const Json& json, const fs::path& file, const ValidateOpt
     throw Error(ErrorKind::kInput, message);
   }
   return p;
+}
+
+int IntervalCount(const Protocol& protocol) {
+  return protocol.layout == "two_intervals" ? 2 : protocol.layout == "odd_one_out" ? protocol.alternatives : 0;
 }
 
 int64_t DesignTrials(const Block& block) {

@@ -14,7 +14,10 @@
 
 namespace blurcue::protocol {
 
-enum class Task { kForcedChoice, kAdjustment };        // "forced_choice" | "adjustment"
+// "forced_choice": which of two sides or intervals (or, odd one out, which of N intervals); "adjustment": step through
+// levels and accept one; "yes_no" and "rating" (layout single): one object, answered yes or no, or on a scale of
+// responses.rating's keys.
+enum class Task { kForcedChoice, kAdjustment, kYesNo, kRating };
 enum class Counterbalance { kNone, kSwapCopies, kByParticipant };  // "none" | "swap_copies" | "by_participant"
 
 std::string ToString(Task task);
@@ -122,6 +125,15 @@ struct Practice {
 struct Responses {
   std::string left, right, cant_tell;   // forced choice; cant_tell empty: a strict 2AFC (JSON null)
   std::string previous, next, accept;   // adjustment
+  std::string yes = "Y", no = "N";      // yes_no
+  std::vector<std::string> rating;      // rating: one key per point of the scale, lowest first (recorded "1".."n")
+  std::vector<std::string> alternatives;  // odd_one_out: one key per interval, first first (recorded "1".."n")
+  // Shown on screen while an answer is taken, in a band below the stimulus (e.g. "Which side is more blurred?
+  // Left or Right arrow"); empty: no band.
+  std::string prompt;
+  // Answers count only after the stimulus's motion (or its intervals) ended; keys pressed before are ignored and
+  // the prompt appears then. false: answering any time after onset.
+  bool after_motion = false;
 };
 
 struct Timing {
@@ -184,7 +196,12 @@ struct Protocol {
   // How a pair is shown: "side_by_side" (both at once, left and right) or "two_intervals" (2IFC: the left side's
   // object for timing.interval_ms, grey for timing.isi_ms, then the right side's, both at the left object's place;
   // the left / right keys answer first / second interval). Still pairs only.
+  // "single": one object (the sides' or levels' "object"), for yes_no or rating. "odd_one_out": `alternatives` intervals
+  // (timing.interval_ms each, isi_ms between) at the left object's place, one of them - drawn with the seed, the
+  // trial's test_side "1".."n" - showing the right side's object, the others the left side's; the participant names the
+  // odd interval with responses.alternatives.
   std::string layout = "side_by_side";
+  int alternatives = 0;               // odd_one_out: intervals per trial (3-6)
   std::vector<InfoField> participant_info;
   std::optional<Groups> groups;
   Practice practice;
@@ -195,6 +212,9 @@ struct Protocol {
   Timing timing;
   Display display;
 };
+
+// The intervals a pair trial shows one after the other: 2 (two_intervals), alternatives (odd_one_out), else 0.
+int IntervalCount(const Protocol& protocol);
 
 // Trials of one block's design (crossing x repetitions x swapped copies), or kMaxTrials + 1 when it has more.
 int64_t DesignTrials(const Block& block);

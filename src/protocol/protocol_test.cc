@@ -252,15 +252,152 @@ TEST(ProtocolValidate, ParticipantInfoAndGroupsAreChecked) {
 TEST(ProtocolValidate, TwoIntervalsAreTimedAndStill) {
   Json j = Valid();
   j["timing"] = {{"interval_ms", 800}};
-  EXPECT_TRUE(Contains(OnlyProblem(j), "/timing/interval_ms: is for the layout two_intervals")) << OnlyProblem(j);
+  EXPECT_TRUE(Contains(OnlyProblem(j), "/timing/interval_ms: is for the layouts two_intervals and odd_one_out")) << OnlyProblem(j);
   j["layout"] = "two_intervals";
   bool moving = false;  // the valid protocol's balls roll at a speed
-  for (const auto& problem : Problems(j)) moving = moving || Contains(problem, "two intervals show still objects");
+  for (const auto& problem : Problems(j)) moving = moving || Contains(problem, "intervals show still objects");
   EXPECT_TRUE(moving);
   j["timing"]["stimulus_ms"] = 500;
   bool timed = false;
-  for (const auto& problem : Problems(j)) timed = timed || Contains(problem, "/timing/stimulus_ms: two intervals");
+  for (const auto& problem : Problems(j)) timed = timed || Contains(problem, "/timing/stimulus_ms: intervals are timed");
   EXPECT_TRUE(timed);
+}
+
+// One object (layout single): answered yes/no or rated, its source an "object"; a pair's fields are refused there and
+// the single layout's everywhere else.
+Json Single() {
+  Json j = Valid();
+  j["layout"] = "single";
+  j.erase("counterbalance");
+  j["task"] = "yes_no";
+  j["blocks"] = Json::parse(R"([{"name": "a", "factors": {"section": [1, 2]}, "sides": {"object": "measured"}},
+                                {"name": "b", "task": "rating", "factors": {"blur": [{"object": "none"},
+                                                                                      {"object": 2.5}]}}])");
+  return j;
+}
+
+TEST(ProtocolValidate, SingleLayoutShowsOneObjectAnsweredYesNoOrRated) {
+  EXPECT_TRUE(Problems(Single()).empty()) << Problems(Single()).front();
+  const Protocol p = ParseProtocol(Single(), SceneFolder() / "p.json");
+  EXPECT_EQ(p.blocks[0].task, Task::kYesNo);
+  EXPECT_EQ(p.blocks[1].task, Task::kRating);
+  EXPECT_EQ(p.responses.yes, "Y");
+  EXPECT_EQ(p.responses.rating.size(), 5u);
+  Json bad = Single();
+  bad["task"] = "forced_choice";
+  ExpectProblem(bad, "/task: must be yes_no or rating for the layout single");
+  bad = Single();
+  bad["blocks"][0]["sides"] = {{"left", "measured"}, {"right", "none"}};
+  ExpectProblem(bad, "/blocks/0/sides: the layout single shows one object");
+  bad = Single();
+  bad["blocks"][0]["sides"] = {{"object", "measured"}, {"left", "none"}};
+  ExpectProblem(bad, "/blocks/0/sides/left: unknown key (known: object)");
+  bad = Single();
+  bad["counterbalance"] = "swap_copies";
+  ExpectProblem(bad, "/counterbalance: must be none for the layout single");
+  bad = Single();
+  bad["blocks"][0].erase("sides");
+  ExpectProblem(bad, "/blocks/0: needs the object shown");
+  bad = Single();
+  bad["blocks"][1]["factors"]["blur"][1] = {{"object", 2.5}, {"left", "none"}};
+  ExpectProblem(bad, "/blocks/1/factors/blur/1: has an \"object\" (layout single) and left/right");
+  bad = Single();
+  bad["blocks"][1]["factors"]["blur"][1]["object"] = -1;
+  ExpectProblem(bad, "/blocks/1/factors/blur/1/object: a blur source must be");
+  // The pair layouts refuse "object" and one-object tasks.
+  bad = Valid();
+  bad["blocks"][0]["factors"]["pattern"][0] = {{"id", 1}, {"speed_cm_s", 3}, {"object", "none"}};
+  bad["blocks"][0]["factors"]["pattern"][1] = {{"id", 2}, {"speed_cm_s", 3}, {"object", "none"}};
+  ExpectProblem(bad, "\"object\" is for the layout single");
+  bad = Valid();
+  bad["blocks"][1]["task"] = "rating";
+  ExpectProblem(bad, "/blocks/1/task: is for the layout single");
+}
+
+TEST(ProtocolValidate, ResponseKeysOfYesNoAndRating) {
+  Json j = Single();
+  j["responses"] = {{"yes", "J"}, {"no", "F"}, {"rating", {"1", "2", "3", "4", "5", "6", "7"}}};
+  const Protocol p = ParseProtocol(j, SceneFolder() / "p.json");
+  EXPECT_EQ(p.responses.yes, "J");
+  EXPECT_EQ(p.responses.rating.back(), "7");
+  j["responses"] = {{"yes", "J"}, {"no", "J"}};
+  ExpectProblem(j, "/responses/no: is the same key as /responses/yes");
+  j["responses"] = {{"rating", {"1"}}};
+  ExpectProblem(j, "/responses/rating: must be a list of 2 to 9 key names, got [\"1\"]");
+  j["responses"] = {{"rating", {"1", "1"}}};
+  ExpectProblem(j, "/responses/rating/1: is the same key as /responses/rating/0");
+  j["responses"] = {{"rating", {"1", "Escape"}}};
+  ExpectProblem(j, "/responses/rating/1: Escape is reserved");
+  j["responses"] = {{"rating", {"1", 2}}};
+  ExpectProblem(j, "/responses/rating/1: must be a key name, got 2");
+  Json pair = Valid();
+  pair["responses"] = {{"yes", "Y"}};
+  ExpectProblem(pair, "/responses/yes: is for the task yes_no, which no block has");
+  pair["responses"] = {{"alternatives", {"1", "2", "3"}}};
+  ExpectProblem(pair, "/responses/alternatives: is for the layout odd_one_out");
+}
+
+TEST(ProtocolValidate, PromptAndAnsweringAfterTheMotion) {
+  Json j = Valid();
+  j["responses"] = {{"prompt", "Which ball is more blurred?"}, {"after_motion", true}};
+  const Protocol p = ParseProtocol(j, SceneFolder() / "p.json");
+  EXPECT_EQ(p.responses.prompt, "Which ball is more blurred?");
+  EXPECT_TRUE(p.responses.after_motion);
+  j["responses"]["prompt"] = std::string(201, 'x');
+  ExpectProblem(j, "/responses/prompt:");
+  j["responses"]["prompt"] = "";
+  ExpectProblem(j, "/responses/prompt:");
+  j["responses"]["prompt"] = "ok";
+  j["responses"]["after_motion"] = "yes";
+  ExpectProblem(j, "/responses/after_motion:");
+  // Nothing moves: nothing to wait for.
+  Json still = Single();
+  still["responses"] = {{"after_motion", true}};
+  ExpectProblem(still, "/responses/after_motion: no block moves its objects");
+}
+
+// Odd one out: `alternatives` intervals (3 by default), named by their keys; QUEST+ guesses 1/n.
+Json OddOneOut() {
+  Json j = Valid();
+  j["layout"] = "odd_one_out";
+  j["blocks"] = Json::parse(R"([{"name": "a", "factors": {"section": [1, 2]},
+                                 "sides": {"left": "measured", "right": "none"}}])");
+  return j;
+}
+
+TEST(ProtocolValidate, OddOneOutHasAlternativesNamedByTheirKeys) {
+  EXPECT_TRUE(Problems(OddOneOut()).empty()) << Problems(OddOneOut()).front();
+  Protocol p = ParseProtocol(OddOneOut(), SceneFolder() / "p.json");
+  EXPECT_EQ(p.alternatives, 3);
+  EXPECT_EQ(IntervalCount(p), 3);
+  EXPECT_EQ(p.responses.alternatives, (std::vector<std::string>{"1", "2", "3"}));
+  EXPECT_TRUE(p.responses.cant_tell.empty());  // no "can't tell" unless a key is given for it
+  Json j = OddOneOut();
+  j["alternatives"] = 5;
+  j["responses"] = {{"alternatives", {"A", "S", "D", "F", "G"}}};
+  p = ParseProtocol(j, SceneFolder() / "p.json");
+  EXPECT_EQ(IntervalCount(p), 5);
+  EXPECT_EQ(p.responses.alternatives[4], "G");
+  j["responses"] = {{"alternatives", {"A", "S", "D"}}};
+  ExpectProblem(j, "/responses/alternatives: must be a list of 5 key names");
+  j = OddOneOut();
+  j["alternatives"] = 7;
+  ExpectProblem(j, "/alternatives: must be an integer in [3, 6]");
+  j["alternatives"] = 2.5;
+  ExpectProblem(j, "/alternatives:");
+  Json pair = Valid();
+  pair["alternatives"] = 3;
+  ExpectProblem(pair, "/alternatives: is for the layout odd_one_out");
+  // A procedure's QUEST+ guesses right 1/n of the time: the default, and nothing else is accepted.
+  j = OddOneOut();
+  j.erase("counterbalance");
+  j["blocks"] = Json::parse(R"([{"name": "q", "factors": {"section": [1]}, "procedure": {"type": "quest_plus",
+      "variable": "relative_difference", "reference": "measured", "trials": 10, "stimuli": [0, 0.5, 1], "threshold": [0.2, 0.5], "slope": [2],
+      "lapse": [0.02]}}])");
+  p = ParseProtocol(j, SceneFolder() / "p.json");
+  EXPECT_NEAR(p.blocks[0].procedure->guess, 1.0 / 3, 1e-12);
+  j["blocks"][0]["procedure"]["guess"] = 0.5;
+  ExpectProblem(j, "/blocks/0/procedure/guess: an odd-one-out trial of 3 intervals is guessed right 1/3");
 }
 
 TEST(ProtocolValidate, ProblemStartsWithFileAndPointer) {

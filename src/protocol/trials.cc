@@ -28,18 +28,16 @@ int ParticipantNumber(const std::string& participant) {
 
 namespace {
 
-// The sides a design row shows: from the level object that carries left/right, else the block's "sides".
+// The sides a design row shows: from the level object that carries left/right, else the block's "sides". The
+// single layout's one "object" is shown as the left side (and recorded on both).
 void SetSides(const Block& block, Trial* t) {
+  auto set = [&](const Json& from) {
+    t->left = from.contains("object") ? from["object"] : from.value("left", Json());
+    t->right = from.contains("object") ? from["object"] : from.value("right", Json());
+  };
   for (const auto& [name, level] : t->levels.items())
-    if (level.is_object() && level.contains("left")) {
-      t->left = level["left"];
-      t->right = level["right"];
-      return;
-    }
-  if (block.sides.is_object()) {
-    t->left = block.sides.value("left", Json());
-    t->right = block.sides.value("right", Json());
-  }
+    if (level.is_object() && (level.contains("left") || level.contains("object"))) return set(level);
+  if (block.sides.is_object()) set(block.sides);
 }
 
 // Full factorial x repetitions x counterbalancing, unshuffled.
@@ -81,7 +79,11 @@ std::vector<Trial> Design(const Block& block, bool participant_even) {
   return rows;
 }
 
-void DrawAdjustment(const Block& block, std::mt19937_64& rng, Trial* t) {
+void DrawAdjustment(const Block& block, int alternatives, std::mt19937_64& rng, Trial* t) {
+  if (alternatives > 0 && block.task == Task::kForcedChoice) {
+    t->test_side = std::to_string(1 + UniformBelow(rng, uint64_t(alternatives)));
+    return;
+  }
   if (block.procedure) {
     t->test_side = UniformBelow(rng, 2) == 0 ? "left" : "right";
     return;
@@ -144,7 +146,7 @@ std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& part
       if (pool.size() > static_cast<size_t>(protocol.practice.count)) pool.resize(protocol.practice.count);
       for (auto& t : pool) {
         t.practice = true;
-        DrawAdjustment(b, rng, &t);
+        DrawAdjustment(b, protocol.alternatives, rng, &t);
         trials.push_back(std::move(t));
       }
       break;
@@ -158,7 +160,7 @@ std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& part
     if (b.shuffle) Shuffle(rows, rng);
     for (auto& t : rows) {
       t.practice = b.practice;  // a practice block's trials are recorded as practice
-      DrawAdjustment(b, rng, &t);
+      DrawAdjustment(b, protocol.alternatives, rng, &t);
       trials.push_back(std::move(t));
     }
   }

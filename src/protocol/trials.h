@@ -27,7 +27,9 @@ struct Trial {
   std::vector<double> adjust_levels;
   int start_index = -1;
   // A procedure block's trial: which crossing of the block's factors (whose own procedure it feeds; -1 otherwise)
-  // and the side that shows the procedure's level ("left" | "right", drawn with the seed).
+  // and the side that shows the procedure's level ("left" | "right", drawn with the seed). In the odd_one_out layout
+  // every trial's test_side is the interval ("1".."n", drawn with the seed) that shows the right side's object (and a
+  // procedure's level): the correct answer.
   int cell = -1;
   std::string test_side;
 };
@@ -59,7 +61,7 @@ std::vector<size_t> BlockOrder(const Protocol& protocol, const std::string& part
 // the practice draw (a shuffled copy of the practice block's design, first `count` taken), each practice trial's
 // adjustment draws, then per block its shuffle and each of its trials' adjustment draws in trial order (a shuffle
 // of the levels when the order is "shuffled", then the start index) or, in a procedure block (procedure.trials
-// copies of each crossing, the reference on both sides), its test side. The order depends on the seed alone; give
+// copies of each crossing, the reference on both sides), its test side (odd_one_out: every forced-choice trial's odd interval instead). The order depends on the seed alone; give
 // each participant their own seed. Throws Error(kInput) for by_participant with a participant id without number.
 // With groups, only the blocks of `group` (protocol.groups; a block without "groups" runs for every group).
 std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& participant, uint64_t seed,

@@ -66,6 +66,47 @@ TEST(TrialBuilder, ProcedureBlocksInterleaveTheirCrossingsWithSeededTestSides) {
   EXPECT_EQ(ToJson(a[0])["test_side"], a[0].test_side);
 }
 
+// Odd one out: every forced-choice trial's odd interval ("1".."n") drawn with the seed, about equally often each.
+TEST(TrialBuilder, OddOneOutDrawsEachTrialsOddInterval) {
+  const Protocol p = FromJson(R"({
+    "name": "odd", "version": 1, "scene": {"background": "s.png", "calib": "c.json"},
+    "content": {"type": "grid"}, "task": "forced_choice", "layout": "odd_one_out", "alternatives": 4,
+    "sides": {"left": "measured", "right": "none"}, "factors": {"edge": [2, 5, 8]}, "repetitions": 40
+  })");
+  const auto a = BuildTrials(p, "P1", 42), b = BuildTrials(p, "P1", 42), c = BuildTrials(p, "P1", 43);
+  ASSERT_EQ(a.size(), 120u);
+  EXPECT_EQ(TrialsHash(a), TrialsHash(b));
+  EXPECT_NE(TrialsHash(a), TrialsHash(c));
+  int count[5] = {0, 0, 0, 0, 0};
+  for (const Trial& t : a) {
+    ASSERT_TRUE(t.test_side == "1" || t.test_side == "2" || t.test_side == "3" || t.test_side == "4") << t.test_side;
+    ++count[std::stoi(t.test_side)];
+    EXPECT_EQ(t.left, "measured");
+    EXPECT_EQ(t.right, "none");
+  }
+  for (int k = 1; k <= 4; ++k) {
+    EXPECT_GT(count[k], 15) << k;  // 30 expected
+    EXPECT_LT(count[k], 45) << k;
+  }
+}
+
+// The single layout's "object" is shown as the left side and recorded on both.
+TEST(TrialBuilder, SingleLayoutShowsItsObject) {
+  const Protocol p = FromJson(R"({
+    "name": "one", "version": 1, "scene": {"background": "s.png", "calib": "c.json"},
+    "content": {"type": "grid"}, "task": "yes_no", "layout": "single",
+    "factors": {"edge": [2, 5], "blur": [{"object": "measured"}, {"object": 3}]}
+  })");
+  const auto trials = BuildTrials(p, "P1", 1);
+  ASSERT_EQ(trials.size(), 4u);
+  for (const Trial& t : trials) {
+    EXPECT_EQ(t.left, t.levels["blur"]["object"]);
+    EXPECT_EQ(t.right, t.left);
+    EXPECT_EQ(t.task, Task::kYesNo);
+    EXPECT_TRUE(t.test_side.empty());
+  }
+}
+
 // Block order: a Williams balanced Latin square over participant numbers - each block once in each place, each
 // block right after each other equally often - and a seeded random order.
 TEST(TrialBuilder, BlockOrderIsABalancedLatinSquareOrSeeded) {

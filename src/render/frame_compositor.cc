@@ -217,4 +217,13 @@ void WindowImage::Present(int width_px, int height_px) const {
   BlitToWindow(impl_->fb.id(), impl_->texture.width_px(), impl_->texture.height_px(), width_px, height_px);
 }
 
+void WindowImage::PresentAt(int x_px, int y_px, int height_px) const {
+  const int w = impl_->texture.width_px(), h = impl_->texture.height_px();
+  const int y0 = height_px - y_px - h;  // GL counts rows from the bottom
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, impl_->fb.id());
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  glBlitFramebuffer(0, 0, w, h, x_px, y0 + h, x_px + w, y0, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+}
+
 }  // namespace blurcue::render

@@ -1,5 +1,6 @@
 #include "session/observer.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -79,6 +80,45 @@ KeyPress SimulatedObserver::ChooseBlurrier(const PairView& v) {
   const double rt = ResponseTimeMs(params_.rt_ms);
   if (lapse_draw < params_.lapse) return {lapse_pick < 0.5 ? "left" : "right", rt};
   return {v.r_left_px - v.r_right_px + params_.jnd_px * noise > 0 ? "left" : "right", rt};
+}
+
+KeyPress SimulatedObserver::ChooseOdd(const PairView& v, int intervals, int odd) {
+  // Every interval is seen with its own noise; the odd one is the one farthest from the mean of the others.
+  std::vector<double> seen(size_t(std::max(intervals, 1)));
+  for (size_t i = 0; i < seen.size(); ++i)
+    seen[i] = (int(i) + 1 == odd ? v.r_right_px : v.r_left_px) + params_.jnd_px * Normal();
+  const double lapse_draw = Uniform(), lapse_pick = Uniform();
+  const double rt = ResponseTimeMs(params_.rt_ms);
+  const int n = int(seen.size());
+  if (lapse_draw < params_.lapse) return {std::to_string(1 + std::min(n - 1, int(lapse_pick * n))), rt};
+  double total = 0;
+  for (double x : seen) total += x;
+  int best = 0;
+  double farthest = -1;
+  for (int i = 0; i < n; ++i) {
+    const double others = (total - seen[size_t(i)]) / std::max(1, n - 1);
+    if (std::abs(seen[size_t(i)] - others) > farthest) farthest = std::abs(seen[size_t(i)] - others), best = i;
+  }
+  return {std::to_string(best + 1), rt};
+}
+
+KeyPress SimulatedObserver::SayYesNo(const PairView& v) {
+  const double evidence = std::abs(v.r_left_px - v.r_scene_px) + params_.jnd_px * Normal();
+  const double lapse_draw = Uniform(), lapse_pick = Uniform();
+  const double rt = ResponseTimeMs(params_.rt_ms);
+  if (lapse_draw < params_.lapse) return {lapse_pick < 0.5 ? "yes" : "no", rt};
+  return {evidence > params_.jnd_px / 2 ? "yes" : "no", rt};
+}
+
+KeyPress SimulatedObserver::Rate(const PairView& v, int points) {
+  const double evidence = std::abs(v.r_left_px - v.r_scene_px) + params_.jnd_px * Normal();
+  const double lapse_draw = Uniform(), lapse_pick = Uniform();
+  const double rt = ResponseTimeMs(params_.rt_ms);
+  const int n = std::max(points, 1);
+  if (lapse_draw < params_.lapse) return {std::to_string(1 + std::min(n - 1, int(lapse_pick * n))), rt};
+  int rating = 1;
+  for (int j = 1; j < n; ++j) rating += evidence > j * params_.jnd_px / 2;
+  return {std::to_string(rating), rt};
 }
 
 double SimulatedObserver::TargetCutoff(double distance_m) const {

@@ -43,7 +43,7 @@ struct PairView {
 
 // One key press, after_ms after the previous one (the first: after the observer starts looking).
 struct KeyPress {
-  std::string action;  // "left" | "right" | "cant_tell" | "previous" | "next" | "accept"
+  std::string action;  // "left" | "right" | "cant_tell" | "previous" | "next" | "accept" | "yes" | "no" | "1".."9"
   double after_ms = 0;
 };
 
@@ -58,6 +58,16 @@ class SimulatedObserver {
   // N(0, jnd_px); left when D > 0, else right - a forced guess, never can't tell; a lapse is a coin flip. Its
   // probability of choosing the more blurred side is Phi(|difference| / jnd_px) (1 - lapse) + lapse / 2.
   KeyPress ChooseBlurrier(const PairView& view);
+  // Odd one out: each of `intervals` intervals seen as its radius + N(0, jnd_px) (interval `odd`, 1-based, shows
+  // r_right_px, the others r_left_px); the answer ("1".."n") is the one farthest from the mean of the others. A lapse
+  // names an interval at random. By guessing it is right 1/n of the time.
+  KeyPress ChooseOdd(const PairView& view, int intervals, int odd);
+  // One object (layout single), seen as its mismatch with the scene's blur, e = |r_left_px - r_scene_px| + N(0,
+  // jnd_px): "yes" (it looks out of place) when e > jnd_px / 2, else "no"; a lapse is a coin flip.
+  KeyPress SayYesNo(const PairView& view);
+  // The same evidence on a scale of `points`: 1 + the number of criteria jnd_px / 2, 2 jnd_px / 2, ... (n - 1 of
+  // them) that e exceeds ("1".."n"); a lapse is a uniform draw.
+  KeyPress Rate(const PairView& view, int points);
   // The presses answering an adjustment trial: levels in the order the participant steps through them (cyclic),
   // the index shown first, the distance of the real object.
   std::vector<KeyPress> Adjust(const std::vector<double>& levels, int start_index, double distance_m);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <random>
 
 #include "core/error.h"
 
@@ -68,6 +69,62 @@ TEST(SimulatedObserver, ChoiceRatesMatchTheModel) {
     EXPECT_NEAR(n["left"] / double(draws), left, 4 * se) << "delta " << delta;
     EXPECT_NEAR(n["right"] / double(draws), right, 4 * se) << "delta " << delta;
   }
+}
+
+// One object: yes when e = m + N(0, jnd) exceeds jnd / 2 (m its mismatch with the scene), so P(yes) =
+// 1 - Phi((jnd / 2 - m) / jnd); a rating counts the criteria k jnd / 2 that e exceeds.
+TEST(SimulatedObserver, YesNoAndRatingRatesMatchTheModel) {
+  ObserverParams p;
+  p.jnd_px = 0.6;
+  p.lapse = 0;
+  SimulatedObserver o(p, 11);
+  const int draws = 6000;
+  const double se = std::sqrt(0.25 / draws);
+  for (double m : {0.0, 0.4, 1.2}) {
+    const PairView v{2.0 + m, 0, 2.0};
+    int yes = 0, lowest = 0, highest = 0;
+    for (int i = 0; i < draws; ++i) yes += o.SayYesNo(v).action == "yes";
+    for (int i = 0; i < draws; ++i) {
+      const std::string r = o.Rate(v, 5).action;
+      lowest += r == "1";
+      highest += r == "5";
+    }
+    EXPECT_NEAR(yes / double(draws), 1 - Phi((p.jnd_px / 2 - m) / p.jnd_px), 4 * se) << "m " << m;
+    EXPECT_NEAR(lowest / double(draws), Phi((p.jnd_px / 2 - m) / p.jnd_px), 4 * se) << "m " << m;
+    EXPECT_NEAR(highest / double(draws), 1 - Phi((4 * p.jnd_px / 2 - m) / p.jnd_px), 4 * se) << "m " << m;
+  }
+}
+
+// Odd one out: with no difference every interval is named 1/n of the time; with a difference the odd one is found as
+// often as an independent simulation of the same rule finds it, and more often the larger the difference.
+TEST(SimulatedObserver, OddOneOutRatesMatchAnIndependentSimulation) {
+  ObserverParams p;
+  p.jnd_px = 0.5;
+  p.lapse = 0;
+  SimulatedObserver o(p, 5);
+  const int draws = 6000, n = 3;
+  const double se = std::sqrt(0.25 / draws);
+  std::mt19937_64 rng(99);
+  std::normal_distribution<double> noise(0, p.jnd_px);
+  double previous = 0;
+  for (double delta : {0.0, 0.5, 1.5}) {
+    const PairView v{1.0, 1.0 + delta, 1.0};
+    int named[4] = {0, 0, 0, 0}, found = 0;
+    for (int i = 0; i < draws; ++i) ++named[std::stoi(o.ChooseOdd(v, n, 2).action)];
+    for (int i = 0; i < draws; ++i) {
+      // The rule by hand: the interval farthest from the mean of the other two.
+      const double x[3] = {1.0 + noise(rng), 1.0 + delta + noise(rng), 1.0 + noise(rng)};
+      const double d1 = std::abs(x[0] - (x[1] + x[2]) / 2), d2 = std::abs(x[1] - (x[0] + x[2]) / 2),
+                   d3 = std::abs(x[2] - (x[0] + x[1]) / 2);
+      found += d2 > d1 && d2 > d3;
+    }
+    EXPECT_NEAR(named[2] / double(draws), found / double(draws), 6 * se) << "delta " << delta;
+    if (delta == 0)
+      for (int k = 1; k <= 3; ++k) EXPECT_NEAR(named[k] / double(draws), 1.0 / 3, 4 * se);
+    EXPECT_GE(named[2] / double(draws), previous);
+    previous = named[2] / double(draws);
+  }
+  EXPECT_GT(previous, 0.7);  // 3 jnd: found most of the time
 }
 
 TEST(SimulatedObserver, LapsesAnswerAtRandomAndBiasFavoursTheBlurredSide) {

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -112,29 +113,53 @@ class Station {
   std::chrono::steady_clock::time_point last_beat_ = std::chrono::steady_clock::now();
 };
 
-// Keys -> actions, as the protocol maps them. The mouse steps and accepts in adjustment.
+// Keys -> actions, as the protocol maps them: left / right / cant_tell, an odd-one-out interval or a rating point
+// ("1".."n"), yes / no, or the adjustment's steps (the mouse steps and accepts too).
 struct KeyMap {
   const protocol::Responses& r;
+  bool odd_one_out;
+  // The keys whose position names the answer ("1".."n"): a rating's points, an odd-one-out trial's intervals.
+  const std::vector<std::string>* Numbered(Task task) const {
+    return task == Task::kRating ? &r.rating : task == Task::kForcedChoice && odd_one_out ? &r.alternatives : nullptr;
+  }
   std::string Action(const std::string& key, Task task) const {
     if (key == "Escape") return "pause";
+    if (const auto* keys = Numbered(task)) {
+      const auto it = std::find(keys->begin(), keys->end(), key);
+      if (it != keys->end()) return std::to_string(it - keys->begin() + 1);
+      if (task == Task::kForcedChoice && !r.cant_tell.empty() && key == r.cant_tell) return "cant_tell";
+      return "";
+    }
     if (task == Task::kForcedChoice) {
       if (key == r.left) return "left";
       if (key == r.right) return "right";
       if (key == r.cant_tell) return "cant_tell";
-    } else {
+    } else if (task == Task::kYesNo) {
+      if (key == r.yes) return "yes";
+      if (key == r.no) return "no";
+    } else if (task == Task::kAdjustment) {
       if (key == r.previous || key == "WheelDown") return "previous";
       if (key == r.next || key == "WheelUp") return "next";
       if (key == r.accept || key == "MouseLeft") return "accept";
     }
     return "";
   }
-  std::string Key(const std::string& action) const {
+  std::string Key(const std::string& action, Task task) const {
+    if (const auto* keys = Numbered(task); keys && !action.empty() && std::isdigit(unsigned(action[0])))
+      return (*keys)[size_t(std::stoi(action) - 1)];
     if (action == "left") return r.left;
     if (action == "right") return r.right;
     if (action == "cant_tell") return r.cant_tell;
+    if (action == "yes") return r.yes;
+    if (action == "no") return r.no;
     if (action == "previous") return r.previous;
     if (action == "next") return r.next;
     return r.accept;
+  }
+  // An action that answers a trial (not a step of an adjustment, not the pause).
+  static bool Answers(const std::string& action) {
+    return action == "left" || action == "right" || action == "cant_tell" || action == "yes" || action == "no" ||
+           (!action.empty() && std::isdigit(unsigned(action[0])));
   }
 };
 
@@ -162,14 +187,18 @@ class Runner {
          StimulusRenderer& renderer, std::optional<ObserverParams> observer)
       : options_(options), prepared_(prepared), protocol_(prepared.protocol), context_(context), renderer_(renderer),
         trials_(prepared.trials), scenes_(prepared.scenes), observer_(observer), seed_(prepared.seed),
-        keys_{protocol_.responses}, station_(context, !observer || options.window, options.sim_fps),
+        keys_{protocol_.responses, protocol_.layout == "odd_one_out"}, station_(context, !observer || options.window, options.sim_fps),
         screen_size_(protocol_.display.width_px, protocol_.display.height_px) {}
 
   // --capture: the trial's first frame as the swap shows it (read back from the window, or the frame composed
   // headless: the same pixels) and what it shows in screen terms (DescribeFrame), before the frame is flipped.
-  void Capture(const protocol::Trial& trial, const TrialScene& scene) {
-    const cv::Mat image =
+  void Capture(const protocol::Trial& trial, const TrialScene& scene, bool prompt) {
+    cv::Mat image =
         station_.window() ? render::ReadWindow(context_.width_px(), context_.height_px()) : renderer_.Read();
+    // Headless the prompt is not drawn into a window: put its band where the window shows it.
+    const int band = prepared_.presentation.prompt_band_px;
+    if (prompt && !station_.window() && band > 0 && band <= image.rows)
+      PromptBand(image.cols, band, protocol_.responses.prompt).copyTo(image.rowRange(image.rows - band, image.rows));
     char name[32];
     std::snprintf(name, sizeof name, "trial-%04d", trial.index + 1);
     Json frame = DescribeFrame(prepared_.scene ? &*prepared_.scene : nullptr, scene, prepared_.presentation,
@@ -179,6 +208,8 @@ class Runner {
     frame["trial_index"] = trial.index;
     frame["block"] = trial.block;
     frame["practice"] = trial.practice;
+    frame["prompt"] = prompt ? Json(protocol_.responses.prompt) : Json();
+    if (prompt) frame["prompt_rect_px"] = {0, image.rows - band, image.cols, band};
     WriteImage(options_.capture_dir / (std::string(name) + ".png"), image);
     WriteFileAtomically(options_.capture_dir / (std::string(name) + ".json"), frame.dump(1) + "\n");
   }
@@ -243,21 +274,21 @@ class Runner {
   // The simulated observer's key presses for a trial whose stimulus appeared at `onset`.
   void ScriptObserver(const protocol::Trial& trial, const TrialScene& scene, double onset) {
     SimulatedObserver observer(*observer_, TrialSeed(seed_, trial.index));
-    if (trial.task == Task::kForcedChoice) {
+    if (trial.task != Task::kAdjustment) {
       const PairView view{scene.r_left_px, scene.r_right_px, scene.r_scene_px};
-      const KeyPress press = trial.cell >= 0 ? observer.ChooseBlurrier(view)
-                                             : observer.ChooseSide(view, !protocol_.responses.cant_tell.empty());
-      // A moving stimulus is watched to its end before the answer (task 1 is one answer per run); two intervals too.
-      const double watched = TwoIntervals(scene) ? 2 * protocol_.timing.interval_ms / 1000 +
-                                                       protocol_.timing.isi_ms / 1000
-                                                 : scene.MotionS();
-      station_.Script(keys_.Key(press.action), onset + watched + press.after_ms / 1000);
+      const KeyPress press = trial.task == Task::kYesNo    ? observer.SayYesNo(view)
+                             : trial.task == Task::kRating ? observer.Rate(view, int(protocol_.responses.rating.size()))
+                             : scene.intervals > 2 ? observer.ChooseOdd(view, scene.intervals, std::stoi(trial.test_side))
+                             : trial.cell >= 0     ? observer.ChooseBlurrier(view)
+                                                   : observer.ChooseSide(view, !protocol_.responses.cant_tell.empty());
+      // A moving stimulus is watched to its end before the answer (task 1 is one answer per run); intervals too.
+      station_.Script(keys_.Key(press.action, trial.task), onset + StimulusEndS(scene) + press.after_ms / 1000);
       return;
     }
     double t = onset;
     for (const KeyPress& press : observer.Adjust(trial.adjust_levels, trial.start_index, scene.distance_m)) {
       t += press.after_ms / 1000;
-      station_.Script(keys_.Key(press.action), t);
+      station_.Script(keys_.Key(press.action, trial.task), t);
     }
   }
 
@@ -286,35 +317,39 @@ class Runner {
     const double stimulus_s = protocol_.timing.stimulus_ms / 1000;
     double last_flip = -1;
     int composed_level = -2;  // none yet (-1 is the level of a trial without levels)
-    // Two intervals (2IFC): the left side's object, grey, the right side's, then grey until the answer.
-    const bool two = TwoIntervals(scene);
+    // Intervals (2IFC, odd one out): each interval's object for interval_ms, grey for isi_ms between them, then grey
+    // until the answer.
+    const int n = scene.intervals;
     const double interval_s = protocol_.timing.interval_ms / 1000, isi_s = protocol_.timing.isi_ms / 1000;
-    const TrialScene first = two ? IntervalScene(scene, false) : scene;
-    const TrialScene second = two ? IntervalScene(scene, true) : scene;
-    int composed_phase = 0;
+    std::vector<TrialScene> intervals;
+    for (int k = 0; k < n; ++k) intervals.push_back(IntervalScene(scene, IntervalShowsRight(trial, scene, k)));
+    // With responses.after_motion keys count (and the prompt shows) only once the motion or the intervals are over.
+    const double answer_from_s = protocol_.responses.after_motion ? StimulusEndS(scene) : 0;
+    int composed_interval = -1;
     for (int frame = 0;; ++frame) {
       const double t = onset < 0 ? 0 : station_.Now() - onset - paused_s;
-      const int phase = !two                          ? 0
-                        : t < interval_s               ? 1
-                        : t < interval_s + isi_s       ? 2
-                        : t < 2 * interval_s + isi_s   ? 3
-                                                       : 4;
-      const bool shown = two ? phase == 1 || phase == 3 : stimulus_s <= 0 || t < stimulus_s;
-      if (two) {
-        if (shown && composed_phase != phase) renderer_.Compose(phase == 1 ? first : second, 0, 0);
-        composed_phase = phase;
+      // The interval on screen (-1 between and after them).
+      const int k = n == 0 || t >= n * interval_s + (n - 1) * isi_s ? -1 : int(t / (interval_s + isi_s));
+      const int on = k >= 0 && t - k * (interval_s + isi_s) < interval_s ? k : -1;
+      const bool shown = n > 0 ? on >= 0 : stimulus_s <= 0 || t < stimulus_s;
+      if (n > 0) {
+        if (shown && composed_interval != on) renderer_.Compose(intervals[size_t(on)], 0, 0);
+        composed_interval = on;
       } else if (shown && (composed_level != level || scene.MotionS() > 0)) {
         // A still stimulus is composed once (and again when the adjusted level changes); a moving one every frame.
         renderer_.Compose(scene, t, levels > 0 ? trial.adjust_levels[size_t(level)] : 0);
         composed_level = level;
       }
+      // The prompt shows while an answer is taken.
+      const bool prompt = prepared_.presentation.prompt_band_px > 0 && t >= answer_from_s;
       if (station_.window()) {
         if (shown)
           renderer_.Present(context_.width_px(), context_.height_px());
         else
           Blank().Present(context_.width_px(), context_.height_px());
+        if (prompt) Prompt().PresentAt(0, context_.height_px() - prepared_.presentation.prompt_band_px, context_.height_px());
       }
-      if (frame == 0 && !options_.capture_dir.empty()) Capture(trial, first);
+      if (frame == 0 && !options_.capture_dir.empty()) Capture(trial, n > 0 ? intervals[0] : scene, prompt);
       const double flip = station_.Flip();
       if (onset < 0) {
         onset = flip;
@@ -326,7 +361,9 @@ class Runner {
       if (shown) {
         // What this frame showed, as Compose drew it (a still stimulus is composed once and shown unchanged).
         const auto& objects = renderer_.Shown();
-        if (objects[0]) (phase == 3 ? shown_frame.r_right_px : shown_frame.r_left_px) = objects[0]->r_px;
+        if (objects[0])
+          (n > 0 && IntervalShowsRight(trial, scene, on) ? shown_frame.r_right_px : shown_frame.r_left_px) =
+              objects[0]->r_px;
         if (objects[1]) shown_frame.r_right_px = objects[1]->r_px;
         for (const auto& o : objects)
           if (o && !shown_frame.y_mm) shown_frame.y_mm = o->object.center_board_mm[1];
@@ -336,7 +373,7 @@ class Runner {
       last_flip = flip;
       if (station_.Closed()) return Outcome::kQuit;
       // A deadline: no answer this long after onset is recorded as "none", without a response time.
-      if (protocol_.timing.deadline_ms > 0 && trial.task == Task::kForcedChoice &&
+      if (protocol_.timing.deadline_ms > 0 && trial.task != Task::kAdjustment &&
           (station_.Now() - onset - paused_s) * 1000 >= protocol_.timing.deadline_ms) {
         response->choice = "none";
         response->rt_ms = std::numeric_limits<double>::quiet_NaN();
@@ -346,13 +383,14 @@ class Runner {
         if (e.time_s < onset) continue;  // pressed before the stimulus was on screen
         const std::string action = keys_.Action(e.key, trial.task);
         const double t_ms = (e.time_s - onset - paused_s) * 1000;
+        if (action != "pause" && t_ms < answer_from_s * 1000) continue;  // before the motion ended
         if (action == "pause") {
           const double paused_at = station_.Now();
           if (!Pause()) return Outcome::kQuit;
           paused_s += station_.Now() - paused_at;
           context_.SetTitle(TrialTitle(trial));
           last_flip = -1;  // the gap is the pause, not a dropped frame
-        } else if (action == "left" || action == "right" || action == "cant_tell") {
+        } else if (KeyMap::Answers(action)) {
           response->choice = action;
           response->rt_ms = t_ms;
           return Outcome::kAnswered;
@@ -493,8 +531,10 @@ class Runner {
   }
 
  private:
-  bool TwoIntervals(const TrialScene& scene) const {
-    return protocol_.layout == "two_intervals" && scene.content != "picture";
+  // When a trial's stimulus has run its course: the end of its motion, or of its last interval.
+  double StimulusEndS(const TrialScene& scene) const {
+    const int n = scene.intervals;
+    return n > 0 ? (n * protocol_.timing.interval_ms + (n - 1) * protocol_.timing.isi_ms) / 1000 : scene.MotionS();
   }
 
   const protocol::Procedure& ProcedureOf(const protocol::Trial& trial) const {
@@ -506,6 +546,14 @@ class Runner {
   const render::WindowImage& Blank() {
     if (!blank_) blank_ = std::make_unique<render::WindowImage>(TextScreen(screen_size_, "", "", ""));
     return *blank_;
+  }
+
+  // The response prompt's band (window only), made once.
+  const render::WindowImage& Prompt() {
+    if (!prompt_)
+      prompt_ = std::make_unique<render::WindowImage>(
+          PromptBand(context_.width_px(), prepared_.presentation.prompt_band_px, protocol_.responses.prompt));
+    return *prompt_;
   }
 
   const RunOptions& options_;
@@ -520,7 +568,7 @@ class Runner {
   KeyMap keys_;
   Station station_;
   cv::Size screen_size_;
-  std::unique_ptr<render::WindowImage> blank_;
+  std::unique_ptr<render::WindowImage> blank_, prompt_;
   int64_t dropped_frames_ = 0;
 };
 

@@ -67,4 +67,18 @@ cv::Mat FixationScreen(cv::Size size) {
   return image;
 }
 
+cv::Mat PromptBand(int width_px, int height_px, const std::string& text) {
+  cv::Mat image(height_px, width_px, CV_8UC3, kGrey);
+  int baseline = 0;
+  double scale = 0.8 * height_px / 60.0;
+  cv::Size t = cv::getTextSize(text, kFont, scale, 1, &baseline);
+  if (t.width > width_px * 0.95) {
+    scale *= width_px * 0.95 / t.width;
+    t = cv::getTextSize(text, kFont, scale, 1, &baseline);
+  }
+  cv::putText(image, text, {(width_px - t.width) / 2, (height_px + t.height) / 2}, kFont, scale, kInk,
+              std::max(1, int(scale + 0.5)), cv::LINE_AA);
+  return image;
+}
+
 }  // namespace blurcue::session

@@ -12,4 +12,8 @@ cv::Mat TextScreen(cv::Size size, const std::string& title, const std::string& b
 // 1080 px high, scaled with the display).
 cv::Mat FixationScreen(cv::Size size);
 
+// The response prompt's band (responses.prompt): `text` centred in light grey ink on the grey field, width_px x
+// height_px (Presentation::prompt_band_px), shrunk to fit the width.
+cv::Mat PromptBand(int width_px, int height_px, const std::string& text);
+
 }  // namespace blurcue::session

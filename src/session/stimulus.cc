@@ -1,6 +1,7 @@
 #include "session/stimulus.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -136,6 +137,8 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
                          const calib::SceneCalib* scene, const Presentation* presentation) {
   TrialScene t;
   t.content = protocol.content.type;
+  t.left_only = protocol.layout == "single";
+  t.intervals = protocol::IntervalCount(protocol);
   t.kernel = protocol.content.kernel;
   t.brightness = protocol.content.brightness;
   t.contrast = protocol.content.contrast;
@@ -286,13 +289,17 @@ Presentation Presentation::Of(const protocol::Protocol& protocol, const Stimulus
   p.window_width_px = protocol.display.width_px;
   p.window_height_px = protocol.display.height_px;
   p.profile = profile;
-  const int W = p.window_width_px, H = p.window_height_px;
+  // The prompt's band: a line of text at the display's scale (TextScreen's unit).
+  if (!protocol.responses.prompt.empty()) p.prompt_band_px = std::max(32, protocol.display.height_px / 12);
+  // The stimulus has the window above the prompt's band.
+  const int W = p.window_width_px, H = p.window_height_px - p.prompt_band_px;
   if (protocol.content.type == "picture") {
     // The depth-matching frame, 4:3, as large as the window holds (the thesis's 960 x 720 in a 1280 x 720 one).
     p.frame_width_px = std::min(W, H * 4 / 3);
     p.frame_height_px = p.frame_width_px * 3 / 4;
     p.scaling = "fit";
-    p.view = {W, H, p.frame_width_px, p.frame_height_px, (W - p.frame_width_px) / 2, (H - p.frame_height_px) / 2};
+    p.view = {W, p.window_height_px, p.frame_width_px, p.frame_height_px, (W - p.frame_width_px) / 2,
+              (H - p.frame_height_px) / 2};
     return p;
   }
   p.frame_width_px = images.photo.cols;
@@ -322,14 +329,14 @@ Presentation Presentation::Of(const protocol::Protocol& protocol, const Stimulus
   }
   p.scale = shown_w / w;
   const int pw = int(shown_w), ph = int(std::lround(h * p.scale));
-  p.view = {W, H, pw, ph, (W - pw) / 2, (H - ph) / 2};
+  p.view = {W, p.window_height_px, pw, ph, (W - pw) / 2, (H - ph) / 2};
   return p;
 }
 
 render::FrameView Presentation::ViewFor(const protocol::Protocol& protocol, const calib::SceneCalib& scene,
                                         const TrialScene& trial) const {
   render::FrameView v = view;
-  if (v.photo_width_px <= v.width_px && v.photo_height_px <= v.height_px) return v;
+  if (v.photo_width_px <= v.width_px && v.photo_height_px <= v.height_px - prompt_band_px) return v;
   // What the trial shows, in photo px: both objects at the start and at the end of their run.
   cv::Rect shows;
   for (const auto& objects : RunEnds(protocol, scene, trial))
@@ -347,14 +354,20 @@ render::FrameView Presentation::ViewFor(const protocol::Protocol& protocol, cons
   };
   const double sx = double(v.photo_width_px) / frame_width_px, sy = double(v.photo_height_px) / frame_height_px;
   v.x_px = place(shows.x + shows.width / 2.0, sx, v.photo_width_px, v.width_px);
-  v.y_px = place(shows.y + shows.height / 2.0, sy, v.photo_height_px, v.height_px);
+  v.y_px = place(shows.y + shows.height / 2.0, sy, v.photo_height_px, v.height_px - prompt_band_px);
   return v;
 }
 
-TrialScene IntervalScene(const TrialScene& scene, bool second) {
+bool IntervalShowsRight(const protocol::Trial& trial, const TrialScene& scene, int i) {
+  if (scene.intervals == 2) return i == 1;
+  return trial.task == protocol::Task::kForcedChoice && !trial.test_side.empty() &&
+         std::isdigit(static_cast<unsigned char>(trial.test_side[0])) && std::stoi(trial.test_side) == i + 1;
+}
+
+TrialScene IntervalScene(const TrialScene& scene, bool right) {
   TrialScene s = scene;
   s.left_only = true;
-  if (second) {
+  if (right) {
     s.left = s.right;
     s.left_fixed_px = s.right_fixed_px;
     s.left_gain = s.right_gain;
@@ -420,7 +433,7 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
   for (const auto& [name, level] : trial.levels.items())
     if (level.is_object())
       for (const auto& [key, value] : level.items())
-        if (key != "left" && key != "right" && !v.contains(key)) v[key] = value;
+        if (key != "left" && key != "right" && key != "object" && !v.contains(key)) v[key] = value;
   if (v.contains("row") && v["row"].is_object()) v.erase("row");
   v["practice"] = trial.practice ? 1 : 0;
   v["block_name"] = trial.block;
@@ -430,6 +443,11 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
     v["test_side"] = trial.test_side;
     if (!std::isnan(scene.level)) v["level"] = scene.level;
   }
+  // Odd one out: the interval that showed the right side's object (the correct answer), and how many there were.
+  if (scene.intervals > 2 && trial.task == protocol::Task::kForcedChoice) {
+    v["odd_interval"] = std::stoi(trial.test_side);
+    v["intervals"] = scene.intervals;
+  }
   if (trial.task == protocol::Task::kAdjustment) {
     if (trial.start_index >= 0 && size_t(trial.start_index) < trial.adjust_levels.size())
       v["start_level"] = trial.adjust_levels[size_t(trial.start_index)];
@@ -437,8 +455,10 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
     // Rounded to 1e-4 px: the record is read by people and charts, not fed back.
     auto round4 = [](double x) { return std::round(x * 1e4) / 1e4; };
     // Each radius as the camera made it (photo px), as the window shows it (screen px) and as the eye gets it.
+    // The single layout shows only its object, recorded as the left side.
     for (const auto& [name, r] : {std::pair<const char*, double>{"left", scene.r_left_px},
                                   {"right", scene.r_right_px}, {"scene", scene.r_scene_px}}) {
+      if (scene.left_only && name == std::string("right")) continue;
       v[std::string("r_") + name + "_px"] = round4(r);
       v[std::string("r_") + name + "_screen_px"] = round4(presentation.ScreenPx(r));
       v[std::string("r_") + name + "_arcmin"] = round4(presentation.Arcmin(r));
@@ -448,7 +468,7 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
     v["blur_plan"] = scene.per_pixel ? "per_pixel" : "one_radius";
     v["r_span_screen_px"] = round4(scene.r_span_screen_px);
     v["size_left_deg"] = round4(scene.size_left_deg);
-    v["size_right_deg"] = round4(scene.size_right_deg);
+    if (!scene.left_only) v["size_right_deg"] = round4(scene.size_right_deg);
     v["brightness"] = scene.brightness;
     v["contrast"] = scene.contrast;
     v["white_balance_r"] = scene.white_balance[0];

@@ -45,7 +45,9 @@ struct TrialScene {
   // A procedure's level on the test side (ApplyLevel): each side's radius is gain x its source's + add_px.
   double left_gain = 1, right_gain = 1, left_add_px = 0, right_add_px = 0;
   double level = std::numeric_limits<double>::quiet_NaN();  // the procedure's level shown; NaN: none (yet)
-  bool left_only = false;  // one interval of a two-interval trial: only the left object (IntervalScene)
+  // Only the left object: the layout single's one object, or one interval of an intervals trial (IntervalScene).
+  bool left_only = false;
+  int intervals = 0;       // the intervals a pair trial shows one after the other (protocol::IntervalCount), else 0
   // The radii rendered, averaged over the run for balls, and the scene's own blur (the fitted model) there.
   double r_left_px = 0, r_right_px = 0, r_scene_px = 0;
 
@@ -85,9 +87,13 @@ struct Presentation;
 void ApplyLevel(const protocol::Procedure& procedure, const protocol::Trial& trial, double level,
                 const Presentation& presentation, TrialScene* scene);
 
-// One interval of a two-interval (2IFC) pair trial: the first shows the left side's object, the second the right
-// side's, each alone at the left object's place.
-TrialScene IntervalScene(const TrialScene& scene, bool second);
+// One interval of an intervals trial (two_intervals, odd_one_out): the left side's object, or with `right` the right
+// side's, alone at the left object's place.
+TrialScene IntervalScene(const TrialScene& scene, bool right);
+
+// Whether interval `i` (0-based) of `trial` shows the right side's object: the second of two intervals; in an
+// odd-one-out trial the odd one (test_side "1".."n").
+bool IntervalShowsRight(const protocol::Trial& trial, const TrialScene& scene, int i);
 
 // Works out what the screen `presentation` shows of a pair trial: each object's size in degrees at onset
 // (size_left_deg, size_right_deg) and the blur plan - each object's radius at its nearest and farthest depth (along
@@ -123,6 +129,9 @@ struct Presentation {
   int window_width_px = 0, window_height_px = 0;
   double scale = 1;         // screen px per frame (photo) px
   std::string scaling;      // "fit" | "native" | "scale" | "degrees"
+  // A band this high at the bottom of the window holds the response prompt (responses.prompt; 0: none): the
+  // stimulus is fitted, centred and cropped in the window above it.
+  int prompt_band_px = 0;
   render::FrameView view;   // the photo's place before a trial moves it (centred, or letterboxed when it fits)
   display::Profile profile;
 
