@@ -116,11 +116,29 @@ void AddPreviewCommand(CLI::App& app) {
       // Each side's radius as the camera made it (photo px) and as the screen shows it (screen px, arcmin): the
       // numbers the record keeps for these trials.
       const session::Presentation& at = prepared.presentation;
-      char sides[256];
-      std::snprintf(sides, sizeof sides, "L %s %.2f px = %.2f scr px %.2f' | R %s %.2f px = %.2f scr px %.2f'",
-                    source(t.left).c_str(), s.r_left_px, at.ScreenPx(s.r_left_px), at.Arcmin(s.r_left_px),
-                    source(t.right).c_str(), s.r_right_px, at.ScreenPx(s.r_right_px), at.Arcmin(s.r_right_px));
-      tiles.push_back({s, 0, levels + first, sides, key});
+      auto side = [&](const char* name, const Json& v, double r) {
+        char text[160];
+        std::snprintf(text, sizeof text, "%s %s %.2f px = %.2f scr px %.2f'", name, source(v).c_str(), r,
+                      at.ScreenPx(r), at.Arcmin(r));
+        return std::string(text);
+      };
+      if (s.left_only) {  // layout single: its one object
+        tiles.push_back({s, 0, levels + first, side("object", t.left, s.r_left_px), key});
+      } else if (s.intervals > 0) {
+        // Intervals show one object at a time, at the left object's place: a tile for each kind of interval.
+        const bool odd = s.intervals > 2;
+        Json first_key = key;
+        first_key["interval"] = 1;
+        tiles.push_back({session::IntervalScene(s, false), 0, levels + first,
+                         side(odd ? "the others: L" : "1st interval: L", t.left, s.r_left_px), first_key});
+        Json second = key;
+        second["interval"] = 2;
+        tiles.push_back({session::IntervalScene(s, true), 0, levels + first,
+                         side(odd ? "the odd one: R" : "2nd interval: R", t.right, s.r_right_px), second});
+      } else {
+        tiles.push_back({s, 0, levels + first, side("L", t.left, s.r_left_px) + " | " + side("R", t.right, s.r_right_px),
+                         key});
+      }
     }
     std::stable_sort(tiles.begin(), tiles.end(), [](const Tile& a, const Tile& b) { return a.key < b.key; });
     if (tiles.empty()) throw InputError(args->protocol, "the protocol makes no trials to preview");
