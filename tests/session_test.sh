@@ -462,6 +462,29 @@ window)
   [ "$(($(wc -l < "$W/export/frames.csv") - 1))" = "$(sql "$W/s.sqlite" "SELECT count(*) FROM frames")" ] || fail "frames.csv rows"
   [ "$(cut -d, -f4 "$W/export/frames.csv" | sort -u | tr '\n' ' ')" = "1 window " ] || fail "frames.csv window column"
   echo "ok: 13 keys pressed in a window under Xvfb, 13 answers recorded as pressed: $(tail -1 "$W/out")" ;;
+window_after_motion)
+  # A person at a window presses an interval's key while the intervals still run: with responses.after_motion it is
+  # ignored; the key pressed after the last interval answers, its response time after the intervals' 2.4 s.
+  command -v xdotool >/dev/null || { echo "SKIP: xdotool missing"; exit 0; }
+  $PY - "$P/odd-one-out-grids.json" "$W/one.json" <<'PYEOF'
+import json, sys
+p = json.load(open(sys.argv[1]))
+p["factors"] = {"edge": [6]}
+p["repetitions"] = 1
+json.dump(p, open(sys.argv[2], "w"))
+PYEOF
+  sed -i "s|\"\.\./|\"$P/../|g" "$W/one.json"
+  start_xvfb
+  $BC run "$W/one.json" --participant A1 --db "$W/s.sqlite" > "$W/out" 2> "$W/err" &
+  run=$!
+  at Instructions Return
+  at "trial 1 of 1" 1
+  sleep 2.6
+  last=1 at "trial 1 of 1" 3
+  wait $run || fail "run failed: $(cat "$W/err")"
+  got=$(sql "$W/s.sqlite" "SELECT choice || ' ' || (rt_ms > 2400) FROM responses")
+  [ "$got" = "3 1" ] || fail "answer: $got (the key pressed during the intervals must not count)"
+  echo "ok: a key during the intervals ignored, the one after them recorded: $got" ;;
 recover)
   # Through the whole pipeline - trials, the observer's key presses, the record, export and the analysis - the
   # depth-matching fit recovers the cut-off law the simulated observers were given: c = 20 d^-0.5.
