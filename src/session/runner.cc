@@ -498,6 +498,10 @@ class Runner {
         Json shown = TrialVariables(trial, scene, prepared_.presentation);
         shown["correct"] = correct ? 1 : 0;
         response.shown_json = shown.dump();
+        response.level = level;
+        response.correct = correct;
+        response.r_left_px = scene.r_left_px;
+        response.r_right_px = scene.r_right_px;
       }
       record.RecordResponse(start.session_id, i, response, frames);  // committed before anything else happens
       if (trial.cell >= 0) adaptive.Answer(trial, level, correct);
@@ -678,9 +682,18 @@ RunResult RunSession(const RunOptions& options) {
     r.index = trial.index;
     for (size_t b = 0; b < protocol.blocks.size(); ++b)
       if (protocol.blocks[b].name == trial.block) r.block = static_cast<int64_t>(b);
-    r.factors_json = TrialVariables(trial, scenes[size_t(trial.index)], prepared.presentation).dump();
+    const TrialScene& planned = scenes[size_t(trial.index)];
+    r.factors_json = TrialVariables(trial, planned, prepared.presentation).dump();
     r.left_json = trial.left.dump();
     r.right_json = trial.right.dump();
+    r.block_name = trial.block;
+    r.practice = trial.practice;
+    r.swapped = trial.swapped;
+    if (planned.content != "picture" && trial.task != protocol::Task::kAdjustment) {
+      r.r_left_px = planned.r_left_px;
+      if (!planned.left_only) r.r_right_px = planned.r_right_px;
+      r.r_scene_px = planned.r_scene_px;
+    }
     records.push_back(std::move(r));
   }
 
@@ -727,6 +740,9 @@ RunResult RunSession(const RunOptions& options) {
   meta.display_profile = display::ToJson(prepared.display).dump();
   meta.group = prepared.group;
   meta.participant_info = info.dump();
+  meta.simulated = observer.has_value();
+  meta.observer_params = observer ? ToString(*observer) : "";
+  meta.window = window;
   if (!options.again && !options.resume) {
     // Running a participant through a study they finished is usually a typo in the id: say so.
     const std::vector<int64_t> done = record.CompletedSessions(protocol.name, options.participant);

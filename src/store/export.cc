@@ -166,6 +166,48 @@ void WriteFrames(Database& db, const std::filesystem::path& out_dir) {
   WriteFileAtomically(out_dir / "frames.csv", text);
 }
 
+// Schema 7's typed columns, by table, each with its SQLite type: copied as they are from an input of version 7 or
+// later; derived from the texts (DeriveTypedColumns) for an older one.
+struct TypedColumn {
+  const char* name;
+  char type;  // 't' text, 'r' real, 'i' integer
+};
+const std::vector<TypedColumn>& TypedColumns(const std::string& table) {
+  static const std::map<std::string, std::vector<TypedColumn>> columns = {
+      {"sessions",
+       {{"observer", 't'}, {"observer_params", 't'}, {"window", 'i'}, {"profile_name", 't'}, {"screen_width_mm", 'r'},
+        {"screen_height_mm", 'r'}, {"viewing_distance_mm", 'r'}, {"px_per_deg", 'r'}}},
+      {"trials",
+       {{"block_name", 't'}, {"practice", 'i'}, {"swapped", 'i'}, {"left_source", 't'}, {"left_fixed", 'r'},
+        {"right_source", 't'}, {"right_fixed", 'r'}, {"r_left_px", 'r'}, {"r_right_px", 'r'}, {"r_scene_px", 'r'}}},
+      {"responses", {{"level", 'r'}, {"correct", 'i'}, {"r_left_px", 'r'}, {"r_right_px", 'r'}}}};
+  return columns.at(table);
+}
+// ", a, b, c" for a SELECT or INSERT column list; empty for an input before version 7.
+std::string TypedList(const std::string& table, bool typed) {
+  std::string list;
+  if (typed)
+    for (const auto& c : TypedColumns(table)) list += std::string(", ") + c.name;
+  return list;
+}
+std::string TypedPlaceholders(const std::string& table, bool typed) {
+  std::string list;
+  if (typed)
+    for (size_t i = 0; i < TypedColumns(table).size(); ++i) list += ", ?";
+  return list;
+}
+// Binds the typed columns read from `from` (starting at column `first`) to `to` (starting at parameter `at`).
+void CopyTyped(const std::string& table, bool typed, Statement& from, int first, Statement& to, int at) {
+  if (!typed) return;
+  for (const auto& c : TypedColumns(table)) {
+    if (from.IsNull(first)) to.BindNull(at);
+    else if (c.type == 't') to.Bind(at, from.GetText(first));
+    else if (c.type == 'r') to.Bind(at, from.GetDouble(first));
+    else to.Bind(at, from.GetInt64(first));
+    ++first, ++at;
+  }
+}
+
 void RemoveDatabaseFiles(const std::filesystem::path& path) {
   std::error_code ignored;
   for (const char* suffix : {"", "-wal", "-shm", "-journal"})
@@ -341,6 +383,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
         Database src(input, OpenMode::kReadOnly);
         RequireReadableRecord(src);
         std::map<int64_t, int64_t> study_ids, protocol_ids, participant_ids, session_ids, trial_ids;
+        const bool typed = SchemaVersion(src) >= 7;
 
         Statement studies(src, "SELECT id, name, created FROM studies");
         while (studies.Step())
@@ -371,12 +414,14 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
                                 "display, started, ended, status, " +
                                 std::string(SchemaVersion(src) >= 3 ? "display_profile" : "'{}'") + ", " +
                                 std::string(SchemaVersion(src) >= 6 ? "group_name, participant_info" : "'', '{}'") +
-                                " FROM sessions");
+                                TypedList("sessions", typed) + " FROM sessions");
         Statement duplicate(dst, "SELECT id FROM sessions WHERE participant_id = ? AND protocol_version_id = ? "
                                  "AND seed = ? AND host = ? AND started = ?");
         Statement insert_session(dst, "INSERT INTO sessions (participant_id, protocol_version_id, seed, "
                                       "software_version, host, display, started, ended, status, display_profile, "
-                                      "group_name, participant_info) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+                                      "group_name, participant_info" + TypedList("sessions", typed) +
+                                      ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?" +
+                                      TypedPlaceholders("sessions", typed) + ")");
         while (sessions.Step()) {
           const int64_t participant = participant_ids.at(sessions.GetInt64(1));
           const int64_t protocol = protocol_ids.at(sessions.GetInt64(2));
@@ -399,28 +444,45 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
           insert_session.Bind(10, sessions.GetText(10));
           insert_session.Bind(11, sessions.GetText(11));
           insert_session.Bind(12, sessions.GetText(12));
+          CopyTyped("sessions", typed, sessions, 13, insert_session, 13);
           insert_session.Run();
           insert_session.Reset();
           session_ids[sessions.GetInt64(0)] = dst.LastInsertRowId();
         }
+        if (typed) {
+          Statement info(src, "SELECT session_id, key, value FROM session_info");
+          Statement insert_info(dst, "INSERT INTO session_info (session_id, key, value) VALUES (?, ?, ?)");
+          while (info.Step()) {
+            insert_info.Bind(1, session_ids.at(info.GetInt64(0)));
+            insert_info.Bind(2, info.GetText(1));
+            insert_info.Bind(3, info.GetText(2));
+            insert_info.Run();
+            insert_info.Reset();
+          }
+        }
 
-        Statement trials(src, "SELECT id, session_id, trial_index, block, factors, left_shown, right_shown FROM trials");
+        Statement trials(src, "SELECT id, session_id, trial_index, block, factors, left_shown, right_shown" +
+                                  TypedList("trials", typed) + " FROM trials");
         Statement insert_trial(dst, "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, "
-                                    "right_shown) VALUES (?, ?, ?, ?, ?, ?)");
+                                    "right_shown" + TypedList("trials", typed) + ") VALUES (?, ?, ?, ?, ?, ?" +
+                                    TypedPlaceholders("trials", typed) + ")");
         while (trials.Step()) {
           insert_trial.Bind(1, session_ids.at(trials.GetInt64(1)));
           insert_trial.Bind(2, trials.GetInt64(2));
           insert_trial.Bind(3, trials.GetInt64(3));
           for (int column = 4; column <= 6; ++column) insert_trial.Bind(column, trials.GetText(column));
+          CopyTyped("trials", typed, trials, 7, insert_trial, 7);
           insert_trial.Run();
           insert_trial.Reset();
           trial_ids[trials.GetInt64(0)] = dst.LastInsertRowId();
         }
 
         Statement responses(src, "SELECT trial_id, choice, rt_ms, adjustment, answered_at, " +
-                                     std::string(SchemaVersion(src) >= 5 ? "shown" : "'{}'") + " FROM responses");
+                                     std::string(SchemaVersion(src) >= 5 ? "shown" : "'{}'") +
+                                     TypedList("responses", typed) + " FROM responses");
         Statement insert_response(dst, "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at, "
-                                       "shown) VALUES (?, ?, ?, ?, ?, ?)");
+                                       "shown" + TypedList("responses", typed) + ") VALUES (?, ?, ?, ?, ?, ?" +
+                                       TypedPlaceholders("responses", typed) + ")");
         while (responses.Step()) {
           insert_response.Bind(1, trial_ids.at(responses.GetInt64(0)));
           insert_response.Bind(2, responses.GetText(1));
@@ -429,6 +491,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
           insert_response.Bind(4, responses.GetText(3));
           insert_response.Bind(5, responses.GetText(4));
           insert_response.Bind(6, responses.GetText(5));
+          CopyTyped("responses", typed, responses, 6, insert_response, 7);
           insert_response.Run();
           insert_response.Reset();
         }
@@ -451,6 +514,8 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
           insert_frame.Reset();
         }
       }
+      // Inputs from before the typed record: their typed columns from their texts, as a migration would.
+      DeriveTypedColumns(dst);
       transaction.Commit();
     }  // the last connection closes: the WAL is checkpointed into the file and removed
     MoveIntoPlace(temp, out);

@@ -299,8 +299,9 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
 
     Statement insert(db_, "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, "
                           "host, display, started, status, lock_host, lock_pid, lock_token, lock_heartbeat_ms, "
-                          "display_profile, group_name, participant_info) "
-                          "VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?)");
+                          "display_profile, group_name, participant_info, observer, observer_params, window, "
+                          "profile_name, screen_width_mm, screen_height_mm, viewing_distance_mm, px_per_deg) "
+                          "VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
     insert.Bind(1, participant_id);
     insert.Bind(2, protocol_id);
     insert.Bind(3, static_cast<int64_t>(seed));
@@ -315,8 +316,39 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     insert.Bind(12, meta.display_profile);
     insert.Bind(13, meta.group);
     insert.Bind(14, meta.participant_info);
+    insert.Bind(15, meta.simulated ? "simulated" : "person");
+    insert.Bind(16, meta.observer_params);
+    insert.Bind(17, meta.window ? 1 : 0);
+    // The display profile's geometry, typed, from the profile the session records whole.
+    const Json profile = ParseJson(meta.display_profile, "display profile");
+    auto number = [&](int column, const char* key) {
+      if (profile.is_object() && profile.contains(key) && profile[key].is_number())
+        insert.Bind(column, profile[key].get<double>());
+      else
+        insert.BindNull(column);
+    };
+    if (profile.is_object() && profile.contains("name") && profile["name"].is_string())
+      insert.Bind(18, profile["name"].get<std::string>());
+    else
+      insert.BindNull(18);
+    number(19, "width_mm");
+    number(20, "height_mm");
+    number(21, "distance_mm");
+    number(22, "px_per_deg");
     insert.Run();
     start.session_id = db_.LastInsertRowId();
+    // The participant information, one row per key (text as given; numbers as JSON text).
+    const Json info = ParseJson(meta.participant_info, "participant information");
+    if (info.is_object()) {
+      Statement row(db_, "INSERT INTO session_info (session_id, key, value) VALUES (?, ?, ?)");
+      for (const auto& [key, value] : info.items()) {
+        row.Bind(1, start.session_id);
+        row.Bind(2, key);
+        row.Bind(3, value.is_string() ? value.get<std::string>() : value.dump());
+        row.Run();
+        row.Reset();
+      }
+    }
   }
   transaction.Commit();
   start.trial_count = db_.QueryInt64("SELECT COUNT(*) FROM trials WHERE session_id = " +
@@ -325,13 +357,28 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
   return start;
 }
 
+SourceColumns SourceColumns::Of(const std::string& source_json) {
+  const Json v = ParseJson(source_json, "a side's source");
+  if (v.is_string()) return {v.get<std::string>(), std::nullopt};
+  if (v.is_number()) return {"fixed_px", v.get<double>()};
+  if (v.is_object() && v.contains("screen_px") && v["screen_px"].is_number())
+    return {"fixed_screen_px", v["screen_px"].get<double>()};
+  if (v.is_object() && v.contains("arcmin") && v["arcmin"].is_number()) return {"fixed_arcmin", v["arcmin"].get<double>()};
+  return {};
+}
+
 void Record::SaveTrialList(int64_t session, const std::vector<TrialRecord>& trials) {
   Transaction transaction(db_);
   RequireLock(session);
   if (db_.QueryInt64("SELECT COUNT(*) FROM trials WHERE session_id = " + std::to_string(session)) > 0)
     throw InputError(db_.path(), SessionName(session) + " already has its trial list");
-  Statement insert(db_, "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, right_shown) "
-                        "VALUES (?, ?, ?, ?, ?, ?)");
+  Statement insert(db_, "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, right_shown, "
+                        "block_name, practice, swapped, left_source, left_fixed, right_source, right_fixed, "
+                        "r_left_px, r_right_px, r_scene_px) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  auto optional = [&](int column, const std::optional<double>& value) {
+    if (value) insert.Bind(column, *value);
+    else insert.BindNull(column);
+  };
   for (const TrialRecord& trial : trials) {
     insert.Bind(1, session);
     insert.Bind(2, trial.index);
@@ -339,6 +386,18 @@ void Record::SaveTrialList(int64_t session, const std::vector<TrialRecord>& tria
     insert.Bind(4, trial.factors_json);
     insert.Bind(5, trial.left_json);
     insert.Bind(6, trial.right_json);
+    insert.Bind(7, trial.block_name);
+    insert.Bind(8, trial.practice ? 1 : 0);
+    insert.Bind(9, trial.swapped ? 1 : 0);
+    for (const auto& [column, json] : {std::pair<int, const std::string*>{10, &trial.left_json}, {12, &trial.right_json}}) {
+      const SourceColumns side = SourceColumns::Of(*json);
+      if (side.source.empty()) insert.BindNull(column);
+      else insert.Bind(column, side.source);
+      optional(column + 1, side.fixed);
+    }
+    optional(14, trial.r_left_px);
+    optional(15, trial.r_right_px);
+    optional(16, trial.r_scene_px);
     insert.Run();
     insert.Reset();
   }
@@ -394,8 +453,8 @@ void Record::RecordResponse(int64_t session, int64_t trial_index, const Response
   if (existing.Step())
     throw InputError(db_.path(), SessionName(session) + " trial " + std::to_string(trial_index) +
                                      " already has a response (answered at " + existing.GetText(0) + ")");
-  Statement insert(db_, "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at, shown) "
-                        "VALUES (?, ?, ?, ?, ?, ?)");
+  Statement insert(db_, "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at, shown, level, "
+                        "correct, r_left_px, r_right_px) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
   insert.Bind(1, trial_id);
   insert.Bind(2, response.choice);
   if (std::isnan(response.rt_ms)) insert.BindNull(3);  // no answer before the deadline: no response time
@@ -403,6 +462,15 @@ void Record::RecordResponse(int64_t session, int64_t trial_index, const Response
   insert.Bind(4, response.adjustment_json);
   insert.Bind(5, response.answered_at.empty() ? NowIso8601() : response.answered_at);
   insert.Bind(6, response.shown_json);
+  auto optional = [&](int column, const std::optional<double>& value) {
+    if (value) insert.Bind(column, *value);
+    else insert.BindNull(column);
+  };
+  optional(7, response.level);
+  if (response.correct) insert.Bind(8, *response.correct ? 1 : 0);
+  else insert.BindNull(8);
+  optional(9, response.r_left_px);
+  optional(10, response.r_right_px);
   insert.Run();
   Statement frame(db_, "INSERT INTO frames (trial_id, frame_index, flip_time_s, dropped, r_left_px, r_right_px, "
                       "y_mm) VALUES (?, ?, ?, ?, ?, ?, ?)");

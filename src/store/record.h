@@ -20,6 +20,11 @@ struct SessionMeta {
   std::string display_profile = "{}";  // the display profile as JSON (display::ToJson)
   std::string group;                    // the between-subject group the session runs ("" without groups)
   std::string participant_info = "{}";  // the participant information given: a JSON object key -> value
+  // Who answers and where (typed columns of schema 7): a person or a simulated observer (its canonical parameters,
+  // session::ToString(ObserverParams)), in a real window on the real clock or headless on a simulated clock.
+  bool simulated = false;
+  std::string observer_params;
+  bool window = true;
 };
 
 // What a record already says about a study's groups and a participant's unfinished session, read without writing
@@ -35,9 +40,23 @@ GroupsSoFar PeekGroups(const std::filesystem::path& db, const std::string& study
 struct TrialRecord {
   int64_t index = 0;
   int64_t block = 0;
-  std::string factors_json = "{}";  // object: factor name -> level
+  std::string factors_json = "{}";  // object: factor name -> level, and the trial's other variables
   std::string left_json = "null";   // what was shown on the left
   std::string right_json = "null";
+  // Typed (schema 7): the block's name, practice (not scored), left and right exchanged against the design, and the
+  // radii planned in photo px (none for a picture). Each side's source and fixed radius are read from left_json /
+  // right_json by the record itself (SourceColumns).
+  std::string block_name;
+  bool practice = false, swapped = false;
+  std::optional<double> r_left_px, r_right_px, r_scene_px;
+};
+
+// A side's source as typed columns: its name (none, measured, measured_section, estimated, fitted, fixed_px,
+// fixed_screen_px, fixed_arcmin; empty for null) and the fixed radius in that unit.
+struct SourceColumns {
+  std::string source;
+  std::optional<double> fixed;
+  static SourceColumns Of(const std::string& source_json);
 };
 
 struct Response {
@@ -48,6 +67,10 @@ struct Response {
   // the answer was correct): a JSON object of trial variables that export lays over the planned ones.
   std::string shown_json = "{}";
   std::string answered_at;           // ISO 8601 UTC; empty = now
+  // Typed (schema 7): an adaptive procedure's level shown and whether the answer was correct, and the radii shown
+  // when they were decided at the trial (photo px); empty otherwise.
+  std::optional<double> level, r_left_px, r_right_px;
+  std::optional<bool> correct;
 };
 
 struct FrameRecord {

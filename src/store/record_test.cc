@@ -71,6 +71,47 @@ TEST(Record, AnswerAndItsFramesAreOneTransaction) {
   EXPECT_EQ(record.database().QueryInt64("SELECT COUNT(*) FROM frames"), 3);
 }
 
+// The typed record: who answered, where, and what each trial showed, in columns of their own, exactly as given.
+TEST(Record, WritesTheTypedColumns) {
+  Record record = Record::Open(":memory:");
+  SessionMeta meta;
+  meta.simulated = true;
+  meta.observer_params = "sim:jnd=0.5";
+  meta.window = false;
+  meta.display_profile = R"({"name":"lab","width_mm":531.4,"height_mm":298.9,"distance_mm":600,"px_per_deg":37.83})";
+  meta.participant_info = R"({"age":31,"hand":"left"})";
+  const int64_t session = record.StartOrResumeSession("test1", "P01", kProtocol, 7, meta, false).session_id;
+  std::vector<TrialRecord> trials = Trials(2);
+  trials[0].block_name = "main";
+  trials[0].practice = true;
+  trials[0].r_left_px = 1.23456789;
+  trials[0].r_scene_px = 0.5;
+  trials[1].swapped = true;
+  trials[1].left_json = "2.5";
+  trials[1].right_json = R"({"arcmin":3})";
+  record.SaveTrialList(session, trials);
+  Response answer = Answer("left");
+  answer.level = 0.125;
+  answer.correct = false;
+  answer.r_right_px = 9.87654321;
+  record.RecordResponse(session, 1, answer);
+  Database& db = record.database();
+  EXPECT_EQ(db.QueryText("SELECT observer || '|' || observer_params || '|' || window || '|' || profile_name || '|' || "
+                         "px_per_deg FROM sessions"),
+            "simulated|sim:jnd=0.5|0|lab|37.83");
+  EXPECT_EQ(db.QueryText("SELECT group_concat(key || '=' || value, ',') FROM session_info"), "age=31,hand=left");
+  EXPECT_EQ(db.QueryText("SELECT block_name || '|' || practice || '|' || swapped || '|' || left_source || '|' || "
+                         "right_source || '|' || coalesce(r_right_px, 'null') FROM trials WHERE trial_index = 0"),
+            "main|1|0|measured|estimated|null");
+  EXPECT_EQ(db.QueryText("SELECT printf('%.8f', r_left_px) FROM trials WHERE trial_index = 0"), "1.23456789");
+  EXPECT_EQ(db.QueryText("SELECT left_source || '|' || left_fixed || '|' || right_source || '|' || right_fixed || "
+                         "'|' || swapped FROM trials WHERE trial_index = 1"),
+            "fixed_px|2.5|fixed_arcmin|3.0|1");
+  EXPECT_EQ(db.QueryText("SELECT level || '|' || correct || '|' || coalesce(r_left_px, 'null') FROM responses"),
+            "0.125|0|null");
+  EXPECT_EQ(db.QueryText("SELECT printf('%.8f', r_right_px) FROM responses"), "9.87654321");
+}
+
 TEST(Record, ResumedTrialListIsCheckedAgainstTheSavedOne) {
   Record record = Record::Open(":memory:");
   const int64_t session = record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, false).session_id;

@@ -132,10 +132,91 @@ std::vector<Migration> MakeMigrations() {
   // 6: the between-subject group a session ran ('' without groups) and the participant information given (JSON).
   steps.push_back({"ALTER TABLE sessions ADD COLUMN group_name TEXT NOT NULL DEFAULT '';"
                    "ALTER TABLE sessions ADD COLUMN participant_info TEXT NOT NULL DEFAULT '{}';"});
+  // 7: the typed record - what earlier versions kept only in JSON texts or free text, in columns of one type each
+  // (NULL where a record of an earlier version did not say; DeriveTypedColumns fills them from those texts).
+  //  sessions: who answered (observer: person | simulated, and the simulated observer's parameters), where (window:
+  //  1 a real window on the real clock, 0 headless on a simulated one), and the display profile's geometry;
+  //  session_info: the participant information given, one row per key;
+  //  trials: the block's name, practice and swapped flags, each side's source (none, measured, measured_section,
+  //  estimated, fitted, fixed_px, fixed_screen_px, fixed_arcmin) and fixed radius, the radii planned (photo px);
+  //  responses: what an adaptive procedure showed and scored (level, correct) and the radii shown (photo px).
+  steps.push_back({"ALTER TABLE sessions ADD COLUMN observer TEXT CHECK (observer IN ('person', 'simulated'));"
+                   "ALTER TABLE sessions ADD COLUMN observer_params TEXT;"
+                   "ALTER TABLE sessions ADD COLUMN window INTEGER CHECK (window IN (0, 1));"
+                   "ALTER TABLE sessions ADD COLUMN profile_name TEXT;"
+                   "ALTER TABLE sessions ADD COLUMN screen_width_mm REAL;"
+                   "ALTER TABLE sessions ADD COLUMN screen_height_mm REAL;"
+                   "ALTER TABLE sessions ADD COLUMN viewing_distance_mm REAL;"
+                   "ALTER TABLE sessions ADD COLUMN px_per_deg REAL;"
+                   "CREATE TABLE session_info ("
+                   "  session_id INTEGER NOT NULL REFERENCES sessions(id),"
+                   "  key TEXT NOT NULL,"
+                   "  value TEXT NOT NULL,"
+                   "  PRIMARY KEY (session_id, key))" + strict + ";"
+                   "ALTER TABLE trials ADD COLUMN block_name TEXT;"
+                   "ALTER TABLE trials ADD COLUMN practice INTEGER CHECK (practice IN (0, 1));"
+                   "ALTER TABLE trials ADD COLUMN swapped INTEGER CHECK (swapped IN (0, 1));"
+                   "ALTER TABLE trials ADD COLUMN left_source TEXT;"
+                   "ALTER TABLE trials ADD COLUMN left_fixed REAL;"
+                   "ALTER TABLE trials ADD COLUMN right_source TEXT;"
+                   "ALTER TABLE trials ADD COLUMN right_fixed REAL;"
+                   "ALTER TABLE trials ADD COLUMN r_left_px REAL;"
+                   "ALTER TABLE trials ADD COLUMN r_right_px REAL;"
+                   "ALTER TABLE trials ADD COLUMN r_scene_px REAL;"
+                   "ALTER TABLE responses ADD COLUMN level REAL;"
+                   "ALTER TABLE responses ADD COLUMN correct INTEGER CHECK (correct IN (0, 1));"
+                   "ALTER TABLE responses ADD COLUMN r_left_px REAL;"
+                   "ALTER TABLE responses ADD COLUMN r_right_px REAL;",
+                   &DeriveTypedColumns});
   return steps;
 }
 
 }  // namespace
+
+void DeriveTypedColumns(Database& db) {
+  // Sessions: the free-text display said "window ..." or "headless ..." and, for a simulated observer, "; observer
+  // sim:..." at its end.
+  db.Exec("UPDATE sessions SET window = (display LIKE 'window%'), "
+          "observer = CASE WHEN instr(display, '; observer ') > 0 THEN 'simulated' ELSE 'person' END, "
+          "observer_params = CASE WHEN instr(display, '; observer ') > 0 "
+          "  THEN substr(display, instr(display, '; observer ') + 11) ELSE '' END, "
+          "profile_name = json_extract(display_profile, '$.name'), "
+          "screen_width_mm = json_extract(display_profile, '$.width_mm'), "
+          "screen_height_mm = json_extract(display_profile, '$.height_mm'), "
+          "viewing_distance_mm = json_extract(display_profile, '$.distance_mm'), "
+          "px_per_deg = json_extract(display_profile, '$.px_per_deg') "
+          "WHERE observer IS NULL");
+  db.Exec("INSERT OR IGNORE INTO session_info (session_id, key, value) "
+          "SELECT s.id, j.key, CASE j.type WHEN 'text' THEN j.value ELSE json_quote(j.value) END "
+          "FROM sessions s, json_each(s.participant_info) j "
+          "WHERE json_valid(s.participant_info) AND json_type(s.participant_info) = 'object'");
+  // Trials: the variables the runner wrote into the factors text, and each side's source from what was shown.
+  auto source = [](const std::string& column) {
+    return "CASE json_type(" + column + ") WHEN 'text' THEN json_extract(" + column + ", '$') "
+           "WHEN 'integer' THEN 'fixed_px' WHEN 'real' THEN 'fixed_px' "
+           "WHEN 'object' THEN CASE WHEN json_extract(" + column + ", '$.screen_px') IS NOT NULL "
+           "THEN 'fixed_screen_px' ELSE 'fixed_arcmin' END END";
+  };
+  auto fixed = [](const std::string& column) {
+    return "CASE json_type(" + column + ") WHEN 'integer' THEN json_extract(" + column + ", '$') "
+           "WHEN 'real' THEN json_extract(" + column + ", '$') "
+           "WHEN 'object' THEN coalesce(json_extract(" + column + ", '$.screen_px'), json_extract(" + column +
+           ", '$.arcmin')) END";
+  };
+  db.Exec("UPDATE trials SET "
+          "block_name = coalesce(json_extract(factors, '$.block_name'), ''), "
+          "practice = coalesce(json_extract(factors, '$.practice'), 0) <> 0, "
+          "swapped = coalesce(json_extract(factors, '$.swapped'), 0) <> 0, "
+          "left_source = " + source("left_shown") + ", left_fixed = " + fixed("left_shown") + ", "
+          "right_source = " + source("right_shown") + ", right_fixed = " + fixed("right_shown") + ", "
+          "r_left_px = json_extract(factors, '$.r_left_px'), r_right_px = json_extract(factors, '$.r_right_px'), "
+          "r_scene_px = json_extract(factors, '$.r_scene_px') "
+          "WHERE block_name IS NULL AND json_valid(factors) AND json_valid(left_shown) AND json_valid(right_shown)");
+  db.Exec("UPDATE responses SET level = json_extract(shown, '$.level'), "
+          "correct = json_extract(shown, '$.correct'), "
+          "r_left_px = json_extract(shown, '$.r_left_px'), r_right_px = json_extract(shown, '$.r_right_px') "
+          "WHERE json_valid(shown) AND shown <> '{}' AND level IS NULL AND correct IS NULL");
+}
 
 const std::vector<Migration>& Migrations() {
   static const std::vector<Migration> steps = MakeMigrations();

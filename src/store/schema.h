@@ -35,6 +35,11 @@ void RequireIntactPages(Database& db);
 // The schema version a fully migrated database reports (= Migrations().size()).
 int CurrentSchemaVersion();
 
+// Fills the typed columns of version 7 that are NULL (rows written before it, or merged from a record before it) from
+// the texts earlier versions kept: the session's display text and profile JSON, the participant information JSON, a
+// trial's factors and shown sides, a response's shown object. Rows written at version 7 have them already.
+void DeriveTypedColumns(Database& db);
+
 // PRAGMA user_version of `db`.
 int SchemaVersion(Database& db);
 

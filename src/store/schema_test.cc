@@ -38,6 +38,52 @@ TEST(Schema, ReopenAndMigrateAgainChangesNothing) {
   EXPECT_EQ(db.QueryInt64("SELECT COUNT(*) FROM studies"), 1);
 }
 
+// A record of version 6 kept who answered in free text and a trial's variables in JSON texts: migrating it fills the
+// typed columns of version 7 from them.
+TEST(Schema, AVersionSixRecordGetsItsTypedColumns) {
+  Database db(":memory:");
+  for (int i = 0; i < 6; ++i) {
+    const Migration& step = Migrations()[size_t(i)];
+    if (!step.sql.empty()) db.Exec(step.sql);
+    if (step.data) step.data(db);
+  }
+  db.Exec("PRAGMA user_version = 6");
+  db.Exec("INSERT INTO studies (name, created) VALUES ('s', 'now');"
+          "INSERT INTO protocol_versions (study_id, json, hash, created) VALUES (1, '{}', 'h', 'now');"
+          "INSERT INTO participants (study_id, code, created) VALUES (1, 'P1', 'now');"
+          "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, host, display, started, "
+          "  status, display_profile, group_name, participant_info) VALUES (1, 1, 7, 'v', 'h', "
+          "  'headless 1280x720; llvmpipe (LLVM 15); observer sim:jnd=0.6,bias=0.2', 'now', 'completed', "
+          "  '{\"name\": \"lab\", \"width_mm\": 531.4, \"height_mm\": 298.9, \"distance_mm\": 600, "
+          "\"px_per_deg\": 37.8}', 'a', '{\"age\": 31, \"hand\": \"left\"}'),"
+          "  (1, 1, 8, 'v', 'h', 'window 1920x1080@60; Mesa', 'now', 'completed', '{}', '', '{}');"
+          "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, right_shown) VALUES "
+          "  (1, 0, 0, '{\"block_name\": \"b\", \"practice\": 1, \"swapped\": 0, \"r_left_px\": 1.25, "
+          "\"r_right_px\": 0, \"r_scene_px\": 1.1}', '\"measured\"', '{\"screen_px\": 4}'),"
+          "  (1, 1, 0, '{\"block_name\": \"b\", \"practice\": 0, \"swapped\": 1}', '2.5', '{\"arcmin\": 3}');"
+          "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at, shown) VALUES "
+          "  (2, 'left', 800, '[]', 'now', '{\"level\": 0.5, \"correct\": 1, \"r_left_px\": 3.75}');");
+  Migrate(db);
+  EXPECT_EQ(SchemaVersion(db), CurrentSchemaVersion());
+  EXPECT_EQ(db.QueryText("SELECT observer || '|' || observer_params || '|' || window || '|' || profile_name || '|' || "
+                         "viewing_distance_mm FROM sessions WHERE id = 1"),
+            "simulated|sim:jnd=0.6,bias=0.2|0|lab|600.0");
+  EXPECT_EQ(db.QueryText("SELECT observer || '|' || observer_params || '|' || window FROM sessions WHERE id = 2"),
+            "person||1");
+  EXPECT_EQ(db.QueryText("SELECT group_concat(key || '=' || value, ',') FROM (SELECT * FROM session_info ORDER BY key)"),
+            "age=31,hand=left");
+  EXPECT_EQ(db.QueryText("SELECT block_name || '|' || practice || '|' || swapped || '|' || left_source || '|' || "
+                         "coalesce(left_fixed, '') || '|' || right_source || '|' || right_fixed || '|' || r_left_px "
+                         "FROM trials WHERE trial_index = 0"),
+            "b|1|0|measured||fixed_screen_px|4.0|1.25");
+  EXPECT_EQ(db.QueryText("SELECT left_source || '|' || left_fixed || '|' || right_source || '|' || right_fixed || '|' || "
+                         "swapped || '|' || coalesce(r_left_px, 'null') FROM trials WHERE trial_index = 1"),
+            "fixed_px|2.5|fixed_arcmin|3.0|1|null");
+  EXPECT_EQ(db.QueryText("SELECT level || '|' || correct || '|' || r_left_px || '|' || coalesce(r_right_px, 'null') "
+                         "FROM responses"),
+            "0.5|1|3.75|null");
+}
+
 TEST(Schema, NewerVersionIsRefused) {
   Database db(":memory:");
   Migrate(db);
