@@ -28,10 +28,13 @@ STUDY_TITLES = {
     STUDY_TEST3: "test 3 (no board)",
 }
 
-LEADING = ["study", "protocol_hash", "participant", "session", "seed", "trial_index", "block"]
-TRAILING = ["left", "right", "choice", "rt_ms", "answered_at"]  # and "adjustment" (the steps), not needed here
+# trials.csv as `blurcue export` writes it (codebook.csv beside it says what each column holds).
+REQUIRED = ["study", "participant", "observer", "session_id", "trial_index", "block_name", "task", "practice",
+            "swapped", "left_source", "left_fixed", "right_source", "right_fixed", "status", "chosen_side",
+            "chosen_interval", "yes_no", "rating", "adjusted_level", "rt_ms"]
 NUMERIC = ["edge", "section", "distance_m", "r_left_px", "r_right_px", "r_scene_px", "start_level", "rt_ms",
-           "trial_index", "session"]
+           "trial_index", "session", "speed_cm_s", "level", "adjusted_level"]
+FIXED_UNITS = {"fixed_px": "px", "fixed_screen_px": "screen px", "fixed_arcmin": "arcmin"}
 
 # One colour per blur source, the same in every chart (colour-blind-safe Okabe-Ito hues).
 SOURCE_COLORS = {"measured": "#0072B2", "estimated": "#E69F00", "none": "#999999", "fitted": "#009E73",
@@ -62,16 +65,6 @@ def _flag(value):
     return np.nan
 
 
-def _json_object(text):
-    if not isinstance(text, str) or not text.strip():
-        return None
-    try:
-        value = json.loads(text)
-    except ValueError:
-        return None
-    return value if isinstance(value, dict) else None
-
-
 def read_text_csv(path):
     """A CSV with every cell as text (an empty cell stays empty, never NaN or 0); ValueError with a one-line reason
     when the file cannot be read as CSV."""
@@ -86,8 +79,9 @@ def load_trials(path):
     """trials.csv -> DataFrame with typed columns; raises TrialsError naming the file when it cannot be used.
 
     Cells are read as text first (an empty cell is 'not applicable', not 0), then the numeric columns are converted.
-    Adds: practice/swapped as 0/1, answered (bool), and for pattern cells pattern_id, speed_cm_s, pattern_left,
-    pattern_right.
+    The analysis's working columns are made here, in one place, from the tidy ones: session (session_id), left and
+    right (a side's source, or "fixed R UNIT"), choice (the answer of whatever kind, "none" past a deadline),
+    answered (bool), practice/swapped as 0/1, and pattern_id from a pattern factor.
     """
     path = str(path)
     if not os.path.isfile(path):
@@ -96,22 +90,29 @@ def load_trials(path):
         df = read_text_csv(path)
     except ValueError as e:
         raise TrialsError(f"{path}: {e}")
-    missing = [c for c in LEADING + TRAILING if c not in df.columns]
+    missing = [c for c in REQUIRED if c not in df.columns]
     if missing:
         raise TrialsError(f"{path}: not a blurcue trials.csv (missing column{'s' if len(missing) > 1 else ''} "
                           f"{', '.join(missing)})")
+    df["session"] = df["session_id"]
     for c in NUMERIC:
         if c in df.columns:
             df[c] = pd.to_numeric(df[c].replace("", np.nan), errors="coerce")
     for c in ("practice", "swapped"):
         df[c] = df[c].map(_flag) if c in df.columns else 0
-    df["answered"] = df["choice"].str.strip() != ""
+    for side in ("left", "right"):
+        source, fixed = df[f"{side}_source"], df[f"{side}_fixed"]
+        df[side] = [f"fixed {v} {FIXED_UNITS[s]}" if s in FIXED_UNITS else s for s, v in zip(source, fixed)]
+    # The answer, whatever its kind (each has its own column in the export).
+    choice = df["status"].map({"timed_out": "none"}).fillna("")
+    for column in ("chosen_side", "chosen_interval", "yes_no", "rating", "adjusted_level"):
+        text = df[column].astype(str).str.strip() if df[column].dtype == object else df[column].astype(str)
+        text = text.replace("nan", "")
+        choice = choice.where(choice != "", text)
+    df["choice"] = choice
+    df["answered"] = df["status"].isin(["answered", "timed_out"])
     if "pattern" in df.columns:
-        patterns = df["pattern"].map(_json_object)
-        df["pattern_id"] = patterns.map(lambda p: p.get("id") if p else None).astype(float)
-        df["speed_cm_s"] = patterns.map(lambda p: p.get("speed_cm_s") if p else None).astype(float)
-        df["pattern_left"] = patterns.map(lambda p: p.get("left") if p else None)
-        df["pattern_right"] = patterns.map(lambda p: p.get("right") if p else None)
+        df["pattern_id"] = pd.to_numeric(df["pattern"].replace("", np.nan), errors="coerce")
     return df
 
 

@@ -3,7 +3,7 @@
   frame intervals     histogram of the intervals between consecutive flips of a trial, per session, against one
                       60 Hz refresh (16.7 ms) and the runner's dropped-frame threshold (1.5 refresh periods)
 
-frames.csv (`blurcue export`, beside trials.csv): study, participant, session, window, trial_index, frame_index,
+frames.csv (`blurcue export`, beside trials.csv; columns in codebook.csv): study, participant, session_id, window, trial_index, frame_index,
 flip_time_s, dropped; one row per recorded flip, flip_time_s from the trial's first flip, dropped = the runner's
 verdict (an interval > 1.5 refresh periods). Only sessions with window = 1 are timed: a headless session (window = 0)
 runs on a simulated clock, whose flips are spaced by the simulation and say nothing about the display.
@@ -36,6 +36,7 @@ def load_frames(path):
         d = read_text_csv(path)
     except ValueError as e:
         raise Skip(f"{path}: {e} - display timing skipped")
+    d = d.rename(columns={"session_id": "session"})  # the record's session id (codebook.csv)
     if "window" not in d.columns and all(c in d.columns for c in FRAME_COLUMNS if c != "window"):
         raise Skip(f"{path}: no window column (an export from before it was added?) - real-window sessions cannot be "
                    f"told from headless ones on a simulated clock; display timing skipped")

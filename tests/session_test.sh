@@ -59,7 +59,7 @@ complete)
   [ "$(sql "$W/s.sqlite" "SELECT min(n) > 0 FROM (SELECT count(f.id) n FROM trials t LEFT JOIN frames f ON f.trial_id = t.id GROUP BY t.id)")" = 1 ] \
     || fail "every trial records its frames"
   $BC export --db "$W/s.sqlite" --out "$W/export"
-  head -1 "$W/export/trials.csv" | grep -q "block_name,blur_plan,brightness,contrast,edge,kernel,practice,r_left_arcmin,r_left_px,r_left_screen_px,r_right_arcmin,r_right_px,r_right_screen_px,r_scene_arcmin,r_scene_px,r_scene_screen_px,r_span_screen_px,screen_px_per_photo_px,size_left_deg,size_right_deg,swapped,white_balance_b,white_balance_g,white_balance_r,left,right,choice" \
+  head -1 "$W/export/trials.csv" | grep -q "block_name,task,practice,swapped,blur_plan,brightness,contrast,edge,kernel,r_left_arcmin,r_left_px,r_left_screen_px,r_right_arcmin,r_right_px,r_right_screen_px,r_scene_arcmin,r_scene_px,r_scene_screen_px,r_span_screen_px,screen_px_per_photo_px,size_left_deg,size_right_deg,white_balance_b,white_balance_g,white_balance_r,left_source,left_fixed,right_source,right_fixed,status,chosen_side" \
     || fail "export header: $(head -1 "$W/export/trials.csv")"
   # Every radius in three units: the screen px follow the fit of the photo into the protocol's display (its size read
   # from the PNG header here), the arcmin follow the display profile the session recorded.
@@ -279,7 +279,7 @@ for i, fs in frames.items():
         else:
             assert not left and not right, (i, f)
     assert float(t["rt_ms"]) > 2000, t["rt_ms"]  # answered after both intervals
-    assert t["choice"] in ("left", "right"), t["choice"]  # a strict choice
+    assert t["chosen_side"] in ("left", "right"), t["chosen_side"]  # a strict choice
 print(len(trials), "trials")
 PYEOF
   echo "ok: two intervals shown in turn, each frame recording its interval, answers after both" ;;
@@ -307,7 +307,7 @@ for f in csv.DictReader(open(sys.argv[1] + "/frames.csv")):
 # 3 intervals of 600 ms with 300 ms between: interval k runs from 0.9 k to 0.9 k + 0.6 s.
 right_shown = 0
 for i, t in odd.items():
-    assert t["choice"] in ("1", "2", "3"), t["choice"]
+    assert t["chosen_interval"] in ("1", "2", "3") and not t["chosen_side"], t
     assert t["odd_interval"] in ("1", "2", "3") and t["intervals"] == "3", t
     assert float(t["rt_ms"]) > 2400, t["rt_ms"]  # after the last interval
     k_odd = int(t["odd_interval"]) - 1
@@ -327,17 +327,18 @@ for i, t in odd.items():
             assert left and not right and abs(float(left) - float(t["r_left_px"])) < 1e-3, (i, f)
 assert right_shown > 0
 # The odd grid has no blur, the others the scene's: found more often where the scene blurs more (edge 9 vs 3).
-hit = lambda e: np.mean([t["choice"] == t["odd_interval"] for t in odd.values() if t["edge"] == str(e)])
+assert all(t["correct"] == str(int(t["chosen_interval"] == t["odd_interval"])) for t in odd.values())
+hit = lambda e: np.mean([t["correct"] == "1" for t in odd.values() if t["edge"] == str(e)])
 assert hit(9) >= hit(3), (hit(9), hit(3))
 for r in one:
     if r["block_name"] == "yes_no":
-        assert r["choice"] in ("yes", "no"), r["choice"]
+        assert r["yes_no"] in ("yes", "no") and r["task"] == "yes_no" and not r["rating"], r
     else:
-        assert r["choice"] in ("1", "2", "3", "4", "5"), r["choice"]
+        assert r["rating"] in ("1", "2", "3", "4", "5") and r["task"] == "rating" and not r["yes_no"], r
     assert r["r_left_px"] and not r["r_right_px"], r  # one object, recorded as the left side
 # A 4 px ball stands out from the scene more often than one with the scene's own blur.
-yes = lambda src: np.mean([r["choice"] == "yes" for r in one if r["block_name"] == "yes_no" and r["blur"] == src])
-assert yes('{"object":4}') > yes('{"object":"measured"}'), (yes('{"object":4}'), yes('{"object":"measured"}'))
+yes = lambda src: np.mean([r["yes_no"] == "yes" for r in one if r["block_name"] == "yes_no" and r["blur"] == src])
+assert yes("object=4") > yes("object=measured"), (yes("object=4"), yes("object=measured"))
 # The prompt: not in an odd-one-out trial's first frame (answers open after the intervals); in a yes/no trial's, in
 # a band of its own at the bottom, the photo above it.
 o = json.load(open(sys.argv[2] + "/trial-0001.json"))
@@ -359,6 +360,18 @@ PYEOF
   $BC run "$P/odd-one-out-grids.json" --participant O2 --db "$W/whole.sqlite" --observer sim > /dev/null 2>&1
   [ "$(fingerprint "$W/split.sqlite" O2)" = "$(fingerprint "$W/whole.sqlite" O2)" ] || fail "resumed odd one out differs"
   echo "ok: yes/no, rating and odd-one-out trials answered and recorded as shown, the prompt in its band, resumable" ;;
+codebook)
+  # Every exported table, read with pandas by the types of the export's own codebook: every column is in it, every
+  # value reads back as what was written, every seed (most are above 2^53) is the record's digit for digit.
+  for p in test1-static-grids quest-blur-difference odd-one-out-grids yes-no-ball pre-research-depth-matching; do
+    $BC run "$P/$p.json" --participant C1 --db "$W/c.sqlite" --observer sim > /dev/null 2>&1 || fail "$p did not run"
+  done
+  $BC run "$P/groups-and-info.json" --participant C2 --db "$W/c.sqlite" --observer sim --info age=33 \
+      --info handedness=left --info vision=normal --info "notes=reads, with glasses" > /dev/null 2>&1 || fail "groups"
+  $BC export --db "$W/c.sqlite" --out "$W/tables" > /dev/null
+  $PY "$(dirname "$0")/codebook_check.py" "$W/tables" "$W/c.sqlite" > "$W/out" || fail "$(cat "$W/out")"
+  grep -q "adjustments.csv" "$W/tables/codebook.csv" || fail "adjustments.csv not in the codebook"
+  echo "ok: $(tail -1 "$W/out" | sed 's/^ok: //'); $(grep seeds "$W/out" | head -1)" ;;
 deadline)
   # A deadline: no answer within it records the choice "none" with no response time, and a procedure counts it
   # wrong (its level climbs); feedback after each procedure trial; feedback without a procedure is refused.
@@ -503,18 +516,23 @@ print(f"recovered c = {math.exp(a):.2f} d^{b:.3f}")
 sys.exit(0 if abs(b + 0.5) < 0.08 and abs(math.exp(a) / 20 - 1) < 0.12 else 1)
 PYEOF
   grep -q "bench" "$W/err" || fail "the missing bench folder is not named: $(cat "$W/err")"
-  # Every answer is where its recorded steps end: the start level, then each step, the last one accepted.
-  $PY - "$W/report/tables/trials.csv" <<'PYEOF' || fail "adjustment paths"
-import csv, json, sys
-rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["choice"]]
+  # Every answer is where its recorded steps end: the start level, then each step (adjustments.csv, one row per step),
+  # the last one accepted.
+  $PY - "$W/report/tables/trials.csv" "$W/report/tables/adjustments.csv" <<'PYEOF' || fail "adjustment paths"
+import csv, sys
+rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["status"] == "answered"]
 assert len(rows) == 3 * 28, len(rows)
+paths = {}
+for s in csv.DictReader(open(sys.argv[2])):
+    paths.setdefault((s["session_id"], s["trial_index"]), []).append(s)
 stepped = 0
 for r in rows:
-    steps = json.loads(r["adjustment"] or "[]")
-    assert all(b["t_ms"] >= a["t_ms"] for a, b in zip(steps, steps[1:])), r
-    last = steps[-1]["level"] if steps else float(r["start_level"])
-    assert abs(float(r["choice"]) - last) < 1e-9, (r["choice"], last)
-    assert not steps or float(r["rt_ms"]) >= steps[-1]["t_ms"], r
+    steps = sorted(paths.get((r["session_id"], r["trial_index"]), []), key=lambda s: int(s["step"]))
+    assert [int(s["step"]) for s in steps] == list(range(1, len(steps) + 1)), steps
+    assert all(float(b["t_ms"]) >= float(a["t_ms"]) for a, b in zip(steps, steps[1:])), r
+    last = float(steps[-1]["level"]) if steps else float(r["start_level"])
+    assert abs(float(r["adjusted_level"]) - last) < 1e-9, (r["adjusted_level"], last)
+    assert not steps or float(r["rt_ms"]) >= float(steps[-1]["t_ms"]), r
     stepped += bool(steps)
 assert stepped > len(rows) // 2, stepped
 PYEOF
@@ -637,13 +655,13 @@ frames_shown)
   $BC export --db "$W/f.sqlite" --out "$W/tables" > /dev/null
   $PY - "$W/tables/trials.csv" "$W/tables/frames.csv" <<'PYEOF' || fail "per-frame radii"
 import csv, json, sys
-trials = {int(r["trial_index"]): r for r in csv.DictReader(open(sys.argv[1])) if r["choice"]}
+trials = {int(r["trial_index"]): r for r in csv.DictReader(open(sys.argv[1])) if r["status"] == "answered"}
 frames = {}
 for f in csv.DictReader(open(sys.argv[2])):
     frames.setdefault(int(f["trial_index"]), []).append(f)
 checked = 0
 for i, t in trials.items():
-    pattern = json.loads(t["pattern"]) if t.get("pattern", "").startswith("{") else None
+    pattern = {"speed_cm_s": t["speed_cm_s"]} if t.get("speed_cm_s") else None
     shown = [f for f in frames[i] if f["y_mm"]]
     assert shown, f"trial {i}: no frame records what it showed"
     ys = [float(f["y_mm"]) for f in shown]

@@ -24,8 +24,11 @@ PATTERNS = [
     {"id": 5, "speed_cm_s": 3, "left": "measured", "right": "estimated"},
     {"id": 6, "speed_cm_s": 1.8, "left": "measured", "right": "estimated"},
 ]
-LEADING = ["study", "protocol_hash", "participant", "session", "seed", "trial_index", "block"]
-TRAILING = ["left", "right", "choice", "rt_ms", "answered_at"]
+# The fixed columns of a tidy trials.csv (store/export.cc; codebook.csv says what each holds), around the design's.
+LEADING = ["study", "protocol_hash", "participant", "observer", "observer_params", "window", "session_id",
+           "session_number", "seed", "trial_index", "block", "block_name", "task", "practice", "swapped"]
+TRAILING = ["left_source", "left_fixed", "right_source", "right_fixed", "status", "chosen_side", "chose_more_blurred",
+            "chosen_interval", "yes_no", "rating", "adjusted_level", "correct", "rt_ms", "answered_at"]
 
 
 def r_measured(edge):
@@ -132,8 +135,37 @@ def trials_rows(participants=("P1", "P2", "P3", "P4", "P5", "P6"), studies=None,
     return rows
 
 
+def tidy(row):
+    """One synthetic row (session, left, right, choice, pattern object) as `blurcue export` writes it: the session id,
+    each side's source, the answer split by kind, a pattern by its id with its speed beside it."""
+    r = dict(row)
+    r["session_id"] = r.pop("session")
+    r["session_number"] = 1
+    r["seed"] = "s%d" % r["seed"]
+    r["observer"] = "simulated"
+    r["window"] = 0
+    adjustment = r["study"] == "pre-research-depth-matching"
+    r["task"] = "adjustment" if adjustment else "forced_choice"
+    for side in ("left", "right"):
+        r[side + "_source"] = r.pop(side, None)
+    choice = r.pop("choice", None)
+    r["status"] = "unanswered" if choice is None else "answered"
+    if choice is not None:
+        r["adjusted_level" if adjustment else "chosen_side"] = choice
+        if not adjustment and choice in ("left", "right") and r.get("r_left_px") is not None and \
+                r["r_left_px"] != r["r_right_px"]:
+            r["chose_more_blurred"] = int((choice == "left") == (r["r_left_px"] > r["r_right_px"]))
+    for flag in ("practice", "swapped"):
+        r[flag] = int(bool(r.get(flag, 0)))
+    if isinstance(r.get("pattern"), dict):
+        p = r["pattern"]
+        r["pattern"], r["id"], r["speed_cm_s"] = p["id"], p["id"], p["speed_cm_s"]
+    return r
+
+
 def write_trials_csv(path, rows):
     """Writes rows the way store/export.cc does: every key as a column, sorted between the fixed ones, CRLF."""
+    rows = [tidy(r) for r in rows]
     keys = sorted({k for r in rows for k in r} - set(LEADING) - set(TRAILING))
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     with open(path, "w", newline="", encoding="utf-8") as f:
@@ -217,7 +249,8 @@ def write_bench_fixtures(folder):
     return folder
 
 
-FRAME_COLUMNS = ["study", "participant", "session", "window", "trial_index", "frame_index", "flip_time_s", "dropped"]
+FRAME_COLUMNS = ["study", "participant", "session_id", "window", "trial_index", "frame_index", "flip_time_s",
+                 "dropped"]
 REFRESH_MS = 1000 / 60
 
 
@@ -228,11 +261,11 @@ def frames_rows(study, participant, session, window, trials):
     rows = []
     for trial_index, intervals in enumerate(trials):
         t = 0.0
-        rows.append({"study": study, "participant": participant, "session": session, "window": int(window),
+        rows.append({"study": study, "participant": participant, "session_id": session, "window": int(window),
                      "trial_index": trial_index, "frame_index": 0, "flip_time_s": 0.0, "dropped": 0})
         for k, ms in enumerate(intervals, start=1):
             t += ms / 1000
-            rows.append({"study": study, "participant": participant, "session": session, "window": int(window),
+            rows.append({"study": study, "participant": participant, "session_id": session, "window": int(window),
                          "trial_index": trial_index, "frame_index": k, "flip_time_s": t,
                          "dropped": int(bool(window) and ms > 1.5 * REFRESH_MS)})
     return rows

@@ -136,8 +136,7 @@ class EdgeCaseTest(ReportTestCase):
     def test_header_only_trials(self):
         path = os.path.join(self.tmp, "trials.csv")
         with open(path, "w", newline="") as f:
-            f.write("study,protocol_hash,participant,session,seed,trial_index,block,left,right,choice,rt_ms,"
-                    "answered_at\r\n")
+            f.write(",".join(synthetic.LEADING + synthetic.TRAILING) + "\r\n")
         code, _, err = run_report(path, os.path.join(self.tmp, "nobench"), os.path.join(self.tmp, "out"))
         self.assertEqual(code, 0, err)
         self.assertCleanStderr(err)

@@ -204,28 +204,33 @@ class LoadTrialsTest(unittest.TestCase):
         self.addCleanup(os.unlink, f.name)
         return f.name
 
-    HEADER = "study,protocol_hash,participant,session,seed,trial_index,block,edge,practice,swapped,left,right,choice," \
-             "rt_ms,answered_at\r\n"
+    HEADER = "study,participant,observer,session_id,trial_index,block_name,task,practice,swapped,edge,left_source," \
+             "left_fixed,right_source,right_fixed,status,chosen_side,chosen_interval,yes_no,rating,adjusted_level," \
+             "rt_ms\r\n"
 
-    def test_flags_as_numbers_or_json_booleans(self):
-        path = self.write(self.HEADER + "test1-static-grids,h,P1,1,5,0,0,3,true,false,measured,estimated,left,812,t\r\n"
-                                        "test1-static-grids,h,P1,1,5,1,0,4,0,1,estimated,measured,,,\r\n")
+    def test_flags_and_answers_of_the_tidy_table(self):
+        path = self.write(self.HEADER +
+                          "test1-static-grids,P1,person,1,0,b,forced_choice,1,0,3,measured,,estimated,,answered,left,,,,,"
+                          "812\r\n"
+                          "test1-static-grids,P1,person,1,1,b,forced_choice,0,1,4,fixed_arcmin,2.5,measured,,"
+                          "unanswered,,,,,,\r\n"
+                          "test1-static-grids,P1,person,1,2,b,forced_choice,0,0,5,measured,,none,,timed_out,,,,,,\r\n")
         d = common.load_trials(path)
-        self.assertEqual(list(d["practice"]), [1, 0])
-        self.assertEqual(list(d["swapped"]), [0, 1])
-        self.assertEqual(list(d["answered"]), [True, False])
+        self.assertEqual(list(d["practice"]), [1, 0, 0])
+        self.assertEqual(list(d["swapped"]), [0, 1, 0])
+        self.assertEqual(list(d["answered"]), [True, False, True])
+        self.assertEqual(list(d["choice"]), ["left", "", "none"])
+        self.assertEqual(d["left"].iloc[1], "fixed 2.5 arcmin")
         fc = common.forced_choice(d)
         self.assertEqual(fc["chosen_source"].iloc[0], "measured")
 
-    def test_quoted_pattern_cells(self):
-        path = self.write(
-            "study,protocol_hash,participant,session,seed,trial_index,block,pattern,left,right,choice,rt_ms,"
-            "answered_at\r\n"
-            'test2-moving-balls,h,P1,1,5,0,0,"{""id"":3,""left"":""estimated"",""right"":""none"",""speed_cm_s"":3}",'
-            "none,estimated,right,900,t\r\n")
+    def test_pattern_by_its_id(self):
+        path = self.write(self.HEADER.replace(",edge,", ",pattern,speed_cm_s,") +
+                          "test2-moving-balls,P1,person,1,0,b,forced_choice,0,0,3,3,none,,estimated,,answered,right,,,,,"
+                          "900\r\n")
         d = common.load_trials(path)
         self.assertEqual(d["pattern_id"].iloc[0], 3)
-        self.assertEqual(d["pattern_left"].iloc[0], "estimated")
+        self.assertEqual(d["speed_cm_s"].iloc[0], 3)
 
     def test_missing_and_garbled(self):
         with self.assertRaisesRegex(common.TrialsError, "nowhere.csv: no such file"):
@@ -376,7 +381,7 @@ class FrameTimingTest(TempDirCase):
     def test_gap_in_frame_index_is_not_an_interval(self):
         rows = synthetic.frames_rows("test1-static-grids", "W1", 1, True, [[16.7] * 5])
         del rows[3]  # frame 3: intervals 1-2 and 4-5 stay, 2-3 and 3-4 go
-        iv = frame_timing.intervals(pd.DataFrame(rows))
+        iv = frame_timing.intervals(pd.DataFrame(rows).rename(columns={"session_id": "session"}))
         self.assertEqual(list(iv["frame_index"]), [1, 2, 5])
 
     def test_headless_only_is_a_skip(self):

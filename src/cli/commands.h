@@ -67,10 +67,13 @@ inline CLI::Validator IntRange(long long lo, long long hi, const std::string& un
       range);
 }
 
-// --seed: a whole number 0 .. 2^64 - 1 (CLI11 alone would wrap "-3" into a huge unsigned number).
+// --seed: a whole number 0 .. 2^64 - 1 (CLI11 alone would wrap "-3" into a huge unsigned number), as typed or as
+// export writes it (a leading "s").
 inline CLI::Validator SeedValidator() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
+        // An exported seed is written "s123...": a number no spreadsheet or R can round.
+        if (text.size() > 1 && text[0] == 's') text.erase(0, 1);
         const bool digits = !text.empty() && text.size() <= 20 &&
                             text.find_first_not_of("0123456789") == std::string::npos &&
                             (text.size() < 20 || text <= "18446744073709551615");

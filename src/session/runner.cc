@@ -687,6 +687,7 @@ RunResult RunSession(const RunOptions& options) {
     r.left_json = trial.left.dump();
     r.right_json = trial.right.dump();
     r.block_name = trial.block;
+    r.task = protocol::ToString(trial.task);
     r.practice = trial.practice;
     r.swapped = trial.swapped;
     if (planned.content != "picture" && trial.task != protocol::Task::kAdjustment) {

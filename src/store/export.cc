@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstdlib>
 #include <map>
 #include <set>
@@ -18,16 +19,12 @@
 namespace blurcue::store {
 namespace {
 
-const std::vector<std::string>& LeadingColumns() {
-  static const std::vector<std::string> columns = {"study", "protocol_hash", "participant", "session",
-                                                   "seed",  "trial_index",   "block"};
-  return columns;
-}
-
-const std::vector<std::string>& TrailingColumns() {
-  static const std::vector<std::string> columns = {"left", "right", "choice", "rt_ms", "adjustment", "answered_at"};
-  return columns;
-}
+// What the codebook says of a column: its type (string, integer, number, boolean - 0 or 1 -, datetime - ISO 8601
+// UTC), unit, allowed values and meaning. The tables are written from these definitions and the codebook is written
+// from the same ones, so the two cannot drift.
+struct ColumnDef {
+  std::string name, type, unit, allowed, meaning;
+};
 
 // A JSON value as a cell: strings bare, null empty, anything else as compact JSON.
 std::string Cell(const Json& value) {
@@ -58,7 +55,8 @@ std::string Where(const std::filesystem::path& db, int64_t session, int64_t tria
 // What an export folder may hold and still be replaced as a whole: the files an export writes, and the
 // temporaries an earlier version left beside them when killed (FILE.csv.tmpPID).
 bool IsExportFile(const std::string& name) {
-  const bool table = name == "trials.csv" || name == "frames.csv" || name.rfind("summary-", 0) == 0;
+  const bool table = name == "trials.csv" || name == "frames.csv" || name == "adjustments.csv" ||
+                     name == "codebook.csv" || name.rfind("summary-", 0) == 0;
   if (table && name.size() > 4 && name.compare(name.size() - 4, 4, ".csv") == 0) return true;
   const size_t tmp = name.rfind(".csv.tmp");
   return tmp != std::string::npos && tmp + 8 < name.size() &&
@@ -108,7 +106,7 @@ void WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
                  "FROM trials t JOIN sessions s ON s.id = t.session_id "
                  "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
                  "LEFT JOIN responses r ON r.trial_id = t.id "
-                 "WHERE coalesce(json_extract(t.factors, '$.practice'), 0) = 0 ORDER BY st.name, p.code, s.id");
+                 "WHERE coalesce(t.practice, 0) = 0 AND coalesce(r.choice, '') <> 'skipped' ORDER BY st.name, p.code, s.id");
   while (rows.Step()) {
     Row& row = studies[rows.GetText(0)][rows.GetInt64(2)];
     row.participant = rows.GetText(1);
@@ -142,21 +140,48 @@ void WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
   }
 }
 
-// OUT/frames.csv: every recorded display flip, one row each: study, participant, session, window (1: a real window
-// on the real clock, 0: headless on a simulated clock), trial_index, frame_index, flip_time_s (from the trial's
-// first flip), dropped (0/1), and what the frame showed of a pair: r_left_px, r_right_px (photo px) and y_mm (the
-// objects' place along the board; empty where nothing was shown, for pictures, and in records before schema 4).
+// The columns of adjustments.csv and frames.csv, for their writers and the codebook.
+const std::vector<ColumnDef>& AdjustmentColumns() {
+  static const std::vector<ColumnDef> columns = {
+      {"study", "string", "", "", "the protocol's name"},
+      {"participant", "string", "", "", "the participant's id"},
+      {"session_id", "integer", "", ">= 1", "the session's id in this record (as in trials.csv)"},
+      {"trial_index", "integer", "", ">= 0", "the trial (as in trials.csv)"},
+      {"step", "integer", "", ">= 1", "the step's place in the trial's adjustment, from 1"},
+      {"level", "number", "the adjusted parameter's unit", "", "the level stepped to"},
+      {"t_ms", "number", "ms", ">= 0", "when, from the stimulus's first frame"},
+  };
+  return columns;
+}
+const std::vector<ColumnDef>& FrameColumns() {
+  static const std::vector<ColumnDef> columns = {
+      {"study", "string", "", "", "the protocol's name"},
+      {"participant", "string", "", "", "the participant's id"},
+      {"session_id", "integer", "", ">= 1", "the session's id in this record (as in trials.csv)"},
+      {"window", "boolean", "", "0|1", "1: a real window on the real clock; 0: headless on a simulated clock"},
+      {"trial_index", "integer", "", ">= 0", "the trial (as in trials.csv)"},
+      {"frame_index", "integer", "", ">= 0", "the frame's place in the trial"},
+      {"flip_time_s", "number", "s", ">= 0", "when the frame reached the screen, from the trial's first flip"},
+      {"dropped", "boolean", "", "0|1", "1: more than 1.5 refresh periods after the frame before (window only)"},
+      {"r_left_px", "number", "photo px", ">= 0", "the left object's blur radius in this frame; empty: not shown"},
+      {"r_right_px", "number", "photo px", ">= 0", "the right object's blur radius in this frame; empty: not shown"},
+      {"y_mm", "number", "mm", "", "the objects' place along the board's y in this frame (0 at edge 1)"},
+  };
+  return columns;
+}
+
+// OUT/frames.csv: every recorded display flip, one row each (FrameColumns): what each frame showed of a pair, empty
+// where nothing was shown and for pictures.
 void WriteFrames(Database& db, const std::filesystem::path& out_dir) {
-  std::string text = CsvLine({"study", "participant", "session", "window", "trial_index", "frame_index",
-                              "flip_time_s", "dropped", "r_left_px", "r_right_px", "y_mm"});
-  const bool shown = SchemaVersion(db) >= 4;
+  std::vector<std::string> header;
+  for (const auto& c : FrameColumns()) header.push_back(c.name);
+  std::string text = CsvLine(header);
   Statement rows(db,
                  "SELECT st.name, p.code, s.id, t.trial_index, f.frame_index, f.flip_time_s, f.dropped, "
-                 "s.display LIKE 'window%', " +
-                     std::string(shown ? "f.r_left_px, f.r_right_px, f.y_mm " : "NULL, NULL, NULL ") +
-                     "FROM frames f JOIN trials t ON t.id = f.trial_id JOIN sessions s ON s.id = t.session_id "
-                     "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
-                     "ORDER BY st.name, p.code, s.id, t.trial_index, f.frame_index");
+                 "coalesce(s.window, s.display LIKE 'window%'), f.r_left_px, f.r_right_px, f.y_mm "
+                 "FROM frames f JOIN trials t ON t.id = f.trial_id JOIN sessions s ON s.id = t.session_id "
+                 "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
+                 "ORDER BY st.name, p.code, s.id, t.trial_index, f.frame_index");
   auto optional = [&](int column) { return rows.IsNull(column) ? std::string() : Number(rows.GetDouble(column)); };
   while (rows.Step())
     text += CsvLine({rows.GetText(0), rows.GetText(1), std::to_string(rows.GetInt64(2)),
@@ -179,7 +204,7 @@ const std::vector<TypedColumn>& TypedColumns(const std::string& table) {
         {"screen_height_mm", 'r'}, {"viewing_distance_mm", 'r'}, {"px_per_deg", 'r'}}},
       {"trials",
        {{"block_name", 't'}, {"practice", 'i'}, {"swapped", 'i'}, {"left_source", 't'}, {"left_fixed", 'r'},
-        {"right_source", 't'}, {"right_fixed", 'r'}, {"r_left_px", 'r'}, {"r_right_px", 'r'}, {"r_scene_px", 'r'}}},
+        {"right_source", 't'}, {"right_fixed", 'r'}, {"r_left_px", 'r'}, {"r_right_px", 'r'}, {"r_scene_px", 'r'}, {"task", 't'}}},
       {"responses", {{"level", 'r'}, {"correct", 'i'}, {"r_left_px", 'r'}, {"r_right_px", 'r'}}}};
   return columns.at(table);
 }
@@ -228,15 +253,159 @@ std::string CsvField(const std::string& text) {
   return out + "\"";
 }
 
+namespace {
+
+// The fixed columns of trials.csv before the design's variables, and after them.
+const std::vector<ColumnDef>& TrialColumnsBefore() {
+  static const std::vector<ColumnDef> columns = {
+      {"study", "string", "", "", "the protocol's name"},
+      {"protocol_hash", "string", "", "16 hex digits", "FNV-1a-64 of the protocol's canonical text: its version"},
+      {"participant", "string", "", "", "the participant's id"},
+      {"observer", "string", "", "person|simulated", "who answered: a person, or blurcue's simulated observer"},
+      {"observer_params", "string", "", "", "the simulated observer's parameters (sim:jnd=...); empty for a person"},
+      {"window", "boolean", "", "0|1", "1: shown in a real window on the real clock; 0: headless on a simulated clock"},
+      {"session_id", "integer", "", ">= 1", "the session's id in this record (merged records renumber it)"},
+      {"session_number", "integer", "", ">= 1", "the participant's n-th session of this study, in the order started"},
+      {"seed", "string", "", "s followed by 1-20 digits",
+       "the seed of the session's trial order, a 64-bit unsigned integer written with a leading s so that spreadsheets, "
+       "R and JavaScript keep every digit; blurcue run --seed takes it as written"},
+  };
+  return columns;
+}
+
+const std::vector<ColumnDef>& TrialColumnsDesign() {
+  static const std::vector<ColumnDef> columns = {
+      {"trial_index", "integer", "", ">= 0", "the trial's place in the session, practice included, from 0"},
+      {"block", "integer", "", ">= 0", "the block's place in the protocol's list of blocks, from 0"},
+      {"block_name", "string", "", "", "the block's name"},
+      {"task", "string", "", "forced_choice|adjustment|yes_no|rating", "the trial's task"},
+      {"practice", "boolean", "", "0|1", "1: a practice trial (not scored)"},
+      {"swapped", "boolean", "", "0|1", "1: left and right exchanged against the design (counterbalancing)"},
+  };
+  return columns;
+}
+
+const std::vector<ColumnDef>& TrialColumnsAfter() {
+  static const std::string sources = "none|measured|measured_section|estimated|fitted|fixed_px|fixed_screen_px|fixed_arcmin";
+  static const std::vector<ColumnDef> columns = {
+      {"left_source", "string", "", sources, "the left side's blur source (the single layout's object); empty: none shown"},
+      {"left_fixed", "number", "the source's unit", ">= 0", "a fixed_* left source's radius, in the unit its name says"},
+      {"right_source", "string", "", sources, "the right side's blur source; empty: none shown"},
+      {"right_fixed", "number", "the source's unit", ">= 0", "a fixed_* right source's radius, in the unit its name says"},
+      {"status", "string", "", "answered|timed_out|skipped|unanswered",
+       "answered; timed_out: no answer before the deadline; skipped: not shown (a stopped procedure, a practice "
+       "criterion met); unanswered: not reached"},
+      {"chosen_side", "string", "", "left|right|cant_tell",
+       "forced choice of a pair: the side chosen (two intervals: left = the first, right = the second)"},
+      {"chose_more_blurred", "boolean", "", "0|1",
+       "forced choice of a pair: 1 when the side chosen showed the larger blur radius; empty when the radii were "
+       "equal or no side was chosen"},
+      {"chosen_interval", "integer", "", "1..alternatives", "odd one out: the interval named"},
+      {"yes_no", "string", "", "yes|no", "yes_no task: the answer"},
+      {"rating", "integer", "", "1..points", "rating task: the point of the scale chosen (1 the lowest)"},
+      {"adjusted_level", "number", "the adjusted parameter's unit", "", "adjustment: the level accepted"},
+      {"correct", "boolean", "", "0|1", "1: the answer was correct (procedure trials, odd one out); empty where no answer is correct"},
+      {"rt_ms", "number", "ms", ">= 0", "response time from the stimulus's first frame; empty without an answer"},
+      {"answered_at", "datetime", "", "", "when the answer was recorded (UTC)"},
+  };
+  return columns;
+}
+
+// What the runner records beside the factor levels (session/stimulus.h TrialVariables): the codebook's words for
+// them. Any other column is a factor of the protocol (or a column of its conditions table, or a level's value).
+const std::map<std::string, ColumnDef>& KnownVariables() {
+  static const std::map<std::string, ColumnDef> known = [] {
+    std::map<std::string, ColumnDef> m;
+    auto add = [&](const std::string& name, const std::string& type, const std::string& unit, const std::string& meaning) {
+      m[name] = {name, type, unit, "", meaning};
+    };
+    for (const std::string side : {"left", "right", "scene"}) {
+      const std::string what = side == "scene" ? "the scene's own blur at the object's place (the fitted model)"
+                                               : "the " + side + " object's blur radius";
+      add("r_" + side + "_px", "number", "photo px", what + ", as the camera makes it (moving: averaged over the run)");
+      add("r_" + side + "_screen_px", "number", "screen px", what + ", on the screen");
+      add("r_" + side + "_arcmin", "number", "arcmin", what + ", at the eye");
+    }
+    add("screen_px_per_photo_px", "number", "screen px / photo px", "how the photo was scaled onto the screen");
+    add("kernel", "string", "", "the blur kernel (gaussian | disc)");
+    add("blur_plan", "string", "", "one_radius: each object blurred with one radius; per_pixel: by depth");
+    add("r_span_screen_px", "number", "screen px", "the largest change of a radius across an object's depth");
+    add("size_left_deg", "number", "deg", "the left object's largest extent on screen at onset");
+    add("size_right_deg", "number", "deg", "the right object's largest extent on screen at onset");
+    add("brightness", "number", "", "the object's brightness matching (factor of its texture's values)");
+    add("contrast", "number", "", "the object's contrast matching");
+    add("white_balance_r", "number", "", "the object's red gain in linear light");
+    add("white_balance_g", "number", "", "the object's green gain in linear light");
+    add("white_balance_b", "number", "", "the object's blue gain in linear light");
+    add("start_level", "number", "the adjusted parameter's unit", "adjustment: the level shown first");
+    add("procedure_cell", "integer", "", "a procedure trial: which crossing of its block's factors (its own procedure)");
+    add("test_side", "string", "", "a procedure trial: the side (or odd-one-out interval) showing the procedure's level");
+    add("level", "number", "the procedure's variable", "a procedure trial: the level shown");
+    add("odd_interval", "integer", "", "odd one out: the interval that showed the right side's object (the correct answer)");
+    add("intervals", "integer", "", "odd one out: intervals per trial");
+    return m;
+  }();
+  return known;
+}
+
+// Columns of the design written from the record's typed columns, not from the factors' text.
+bool TypedVariable(const std::string& key) {
+  return key == "practice" || key == "swapped" || key == "block_name" || key == "correct";
+}
+
+// A variable's cell: strings bare, null empty, numbers as JSON; an object level (a pattern) by its id, else its
+// scalar members as key=value;... - never JSON.
+std::string TidyCell(const Json& value) {
+  if (value.is_object()) {
+    if (value.contains("id") && !value["id"].is_structured()) return Cell(value["id"]);
+    std::string text;
+    for (const auto& [key, member] : value.items())
+      if (!member.is_structured()) text += (text.empty() ? "" : ";") + key + "=" + Cell(member);
+    return text;
+  }
+  return value.is_array() ? std::string() : Cell(value);
+}
+
+// The codebook's type of a design column from its values: integer, number, or string.
+struct TypeOf {
+  bool any = false, numbers = true, integers = true;
+  std::set<std::string> values;
+  void Add(const Json& v) {
+    if (v.is_null()) return;
+    any = true;
+    if (!v.is_number()) numbers = integers = false;
+    else if (!v.is_number_integer() && !(std::isfinite(v.get<double>()) && v.get<double>() == std::floor(v.get<double>())))
+      integers = false;
+    if (values.size() <= 20) values.insert(TidyCell(v));
+  }
+  std::string Type() const { return !any ? "string" : integers ? "integer" : numbers ? "number" : "string"; }
+  std::string Allowed() const {
+    if (values.size() > 20 || values.empty()) return "";
+    std::string text;
+    for (const auto& v : values) text += (text.empty() ? "" : "|") + v;
+    return text;
+  }
+};
+
+bool AllDigits(const std::string& text) {
+  return !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+}
+
+}  // namespace
+
 int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::path& out_dir,
                   const ProgressNote& note) {
   Note(note, RemoveStaleLeftovers(out_dir));
   Database db(db_path, OpenMode::kReadOnly);
   RequireReadableRecord(db);
+  if (SchemaVersion(db) < 7)
+    throw InputError(db_path.string(), "record schema version " + std::to_string(SchemaVersion(db)) +
+                                           " has no typed columns yet: open it once with this blurcue (blurcue "
+                                           "sessions --db FILE migrates it) or merge it into a new record");
 
-  // Pass 1: every factor key in the record (and every key an answer's shown object adds), so every participant gets
-  // the same columns.
-  std::set<std::string> keys;
+  // Pass 1: every design variable in the record (factor levels and the variables recorded with them, planned and as
+  // shown), with the codebook's type of each, so every participant gets the same columns.
+  std::map<std::string, TypeOf> keys;
   {
     Statement factors(db, "SELECT t.session_id, t.trial_index, t.factors, coalesce(r.shown, '{}') FROM trials t "
                           "LEFT JOIN responses r ON r.trial_id = t.id");
@@ -246,45 +415,82 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
         const Json object = ParseColumn(factors.GetText(column), where + (column == 2 ? " factors" : " shown"));
         if (!object.is_object())
           throw InputError(where, std::string(column == 2 ? "factors" : "shown") + " must be a JSON object");
-        for (const auto& item : object.items()) keys.insert(item.key());
+        for (const auto& item : object.items())
+          if (!TypedVariable(item.key())) keys[item.key()].Add(item.value());
       }
     }
   }
   // Between-subject groups and participant information, when any session has them: a column "group" and one
   // "info_KEY" per key given anywhere.
-  bool groups = false;
-  std::set<std::string> info_keys;
-  if (SchemaVersion(db) >= 6) {
-    Statement sessions(db, "SELECT id, group_name, participant_info FROM sessions");
-    while (sessions.Step()) {
-      groups = groups || !sessions.GetText(1).empty();
-      const Json info = ParseColumn(sessions.GetText(2), db_path.string() + ": session " +
-                                                             std::to_string(sessions.GetInt64(0)) + " participant_info");
-      if (info.is_object())
-        for (const auto& item : info.items()) info_keys.insert(item.key());
+  const bool groups = db.QueryInt64("SELECT count(*) FROM sessions WHERE group_name <> ''") > 0;
+  std::map<std::string, TypeOf> info_keys;
+  {
+    Statement info(db, "SELECT key, value FROM session_info");
+    while (info.Step()) {
+      const std::string value = info.GetText(1);
+      Json parsed;
+      try {
+        parsed = Json::parse(value);
+      } catch (const Json::exception&) {
+        parsed = value;
+      }
+      info_keys[info.GetText(0)].Add(parsed.is_number() ? parsed : Json(value));
     }
   }
-  std::set<std::string> fixed(LeadingColumns().begin(), LeadingColumns().end());
-  fixed.insert(TrailingColumns().begin(), TrailingColumns().end());
 
-  std::vector<std::string> header = LeadingColumns();
-  if (groups) header.push_back("group");
-  for (const auto& key : info_keys) header.push_back("info_" + key);
-  for (const auto& key : keys) header.push_back(fixed.count(key) ? "factor_" + key : key);
-  header.insert(header.end(), TrailingColumns().begin(), TrailingColumns().end());
+  // The header and the codebook, from the same definitions.
+  std::vector<ColumnDef> columns = TrialColumnsBefore();
+  std::set<std::string> fixed;
+  for (const auto* list : {&TrialColumnsBefore(), &TrialColumnsDesign(), &TrialColumnsAfter()})
+    for (const auto& c : *list) fixed.insert(c.name);
+  if (groups) columns.push_back({"group", "string", "", "", "the between-subject group the session ran"}), fixed.insert("group");
+  for (const auto& [key, type] : info_keys)
+    columns.push_back({"info_" + key, type.Type(), "", type.Allowed(), "participant information: " + key});
+  columns.insert(columns.end(), TrialColumnsDesign().begin(), TrialColumnsDesign().end());
+  std::vector<std::string> variable_names;
+  for (const auto& [key, type] : keys) {
+    const std::string name = fixed.count(key) ? "factor_" + key : key;
+    variable_names.push_back(key);
+    const auto known = KnownVariables().find(key);
+    // A recorded measurement takes any value; a name (kernel, plan) or a level of the design one of those seen.
+    if (known != KnownVariables().end())
+      columns.push_back({name, known->second.type, known->second.unit,
+                         known->second.type == "string" ? type.Allowed() : "", known->second.meaning});
+    else
+      columns.push_back({name, type.Type(), "", type.Allowed(),
+                         "a level of the protocol's design: factor " + key + " (or a column of a level or of the "
+                         "conditions table)"});
+  }
+  columns.insert(columns.end(), TrialColumnsAfter().begin(), TrialColumnsAfter().end());
+  std::vector<std::string> header;
+  for (const auto& c : columns) header.push_back(c.name);
   std::string text = CsvLine(header);
+  std::string adjustments = CsvLine({"study", "participant", "session_id", "trial_index", "step", "level", "t_ms"});
 
   Statement rows(db,
-                 "SELECT st.name, pv.hash, p.code, s.id, s.seed, t.trial_index, t.block, t.factors, t.left_shown, "
-                 "t.right_shown, r.choice, r.rt_ms, r.answered_at, r.id IS NULL, r.adjustment, "
-                 "coalesce(r.shown, '{}'), " +
-                     std::string(SchemaVersion(db) >= 6 ? "s.group_name, s.participant_info " : "'', '{}' ") +
+                 "SELECT st.name, pv.hash, p.code, s.id, s.seed, t.trial_index, t.block, t.factors, "
+                 "t.block_name, t.task, t.practice, t.swapped, t.left_source, t.left_fixed, t.right_source, "
+                 "t.right_fixed, coalesce(r.r_left_px, t.r_left_px), coalesce(r.r_right_px, t.r_right_px), "
+                 "r.id IS NULL, r.choice, r.rt_ms, r.answered_at, r.adjustment, coalesce(r.shown, '{}'), r.correct, "
+                 "s.group_name, s.observer, s.observer_params, s.window "
                  "FROM trials t JOIN sessions s ON s.id = t.session_id "
                  "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
                  "JOIN protocol_versions pv ON pv.id = s.protocol_version_id "
                  "LEFT JOIN responses r ON r.trial_id = t.id "
                  "ORDER BY st.name, p.code, s.id, t.trial_index");
+  // The participant's n-th session (of the study: a participant belongs to one study).
+  std::map<int64_t, int64_t> session_number;
+  {
+    Statement numbers(db, "SELECT s.id, row_number() OVER (PARTITION BY s.participant_id ORDER BY s.id) FROM sessions s");
+    while (numbers.Step()) session_number[numbers.GetInt64(0)] = numbers.GetInt64(1);
+  }
+  std::map<int64_t, std::map<std::string, std::string>> info_of;
+  {
+    Statement info(db, "SELECT session_id, key, value FROM session_info");
+    while (info.Step()) info_of[info.GetInt64(0)][info.GetText(1)] = info.GetText(2);
+  }
   int64_t count = 0;
+  auto optional_number = [&](int column) { return rows.IsNull(column) ? std::string() : Number(rows.GetDouble(column)); };
   while (rows.Step()) {
     const int64_t session = rows.GetInt64(3);
     const int64_t trial = rows.GetInt64(5);
@@ -292,40 +498,84 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
     std::vector<std::string> cells = {rows.GetText(0),
                                       rows.GetText(1),
                                       rows.GetText(2),
+                                      rows.IsNull(26) ? "person" : rows.GetText(26),
+                                      rows.IsNull(27) ? "" : rows.GetText(27),
+                                      rows.IsNull(28) ? "" : std::to_string(rows.GetInt64(28)),
                                       std::to_string(session),
-                                      std::to_string(static_cast<uint64_t>(rows.GetInt64(4))),
-                                      std::to_string(trial),
-                                      std::to_string(rows.GetInt64(6))};
-    if (groups) cells.push_back(rows.GetText(16));
-    if (!info_keys.empty()) {
-      const Json info = ParseColumn(rows.GetText(17), where + " participant_info");
-      for (const auto& key : info_keys)
-        cells.push_back(info.is_object() && info.contains(key) ? Cell(info.at(key)) : std::string());
+                                      std::to_string(session_number[session]),
+                                      "s" + std::to_string(static_cast<uint64_t>(rows.GetInt64(4)))};
+    if (groups) cells.push_back(rows.GetText(25));
+    for (const auto& [key, type] : info_keys) {
+      const auto& info = info_of[session];
+      const auto it = info.find(key);
+      cells.push_back(it == info.end() ? std::string() : it->second);
     }
+    cells.push_back(std::to_string(trial));
+    cells.push_back(std::to_string(rows.GetInt64(6)));
+    cells.push_back(rows.IsNull(8) ? "" : rows.GetText(8));
+    const std::string task = rows.IsNull(9) ? "" : rows.GetText(9);
+    cells.push_back(task);
+    cells.push_back(rows.IsNull(10) ? "0" : std::to_string(rows.GetInt64(10)));
+    cells.push_back(rows.IsNull(11) ? "0" : std::to_string(rows.GetInt64(11)));
     // The plan's variables, with what the trial showed when it was shown laid over them (adaptive levels).
     Json factors = ParseColumn(rows.GetText(7), where + " factors");
-    const Json shown = ParseColumn(rows.GetText(15), where + " shown");
+    const Json shown = ParseColumn(rows.GetText(23), where + " shown");
     if (factors.is_object() && shown.is_object())
       for (const auto& [key, value] : shown.items()) factors[key] = value;
-    for (const auto& key : keys) cells.push_back(factors.contains(key) ? Cell(factors.at(key)) : std::string());
-    cells.push_back(Cell(ParseColumn(rows.GetText(8), where + " left")));
-    cells.push_back(Cell(ParseColumn(rows.GetText(9), where + " right")));
-    const bool answered = rows.GetInt64(13) == 0;
-    cells.push_back(answered ? rows.GetText(10) : "");
-    cells.push_back(answered && !rows.IsNull(11) ? Number(rows.GetDouble(11)) : "");
-    // The adjustment path (method of adjustment: every level stepped to, with its time); empty for none.
-    const std::string steps = answered ? rows.GetText(14) : "";
-    cells.push_back(steps == "[]" ? "" : steps);
-    cells.push_back(answered ? rows.GetText(12) : "");
+    for (const auto& key : variable_names)
+      cells.push_back(factors.contains(key) ? TidyCell(factors.at(key)) : std::string());
+    cells.push_back(rows.IsNull(12) ? "" : rows.GetText(12));
+    cells.push_back(optional_number(13));
+    cells.push_back(rows.IsNull(14) ? "" : rows.GetText(14));
+    cells.push_back(optional_number(15));
+    // The answer, split by what it is: one column per kind of answer, each of one type.
+    const bool answered = rows.GetInt64(18) == 0;
+    const std::string choice = answered ? rows.GetText(19) : "";
+    std::string status = !answered ? "unanswered" : choice == "none" ? "timed_out" : choice == "skipped" ? "skipped" : "answered";
+    std::string side, more_blurred, interval, yes_no, rating, level;
+    if (status == "answered") {
+      if (task == "adjustment") level = choice;
+      else if (task == "yes_no") yes_no = choice;
+      else if (task == "rating") rating = choice;
+      else if (AllDigits(choice)) interval = choice;
+      else side = choice;
+    }
+    if ((side == "left" || side == "right") && !rows.IsNull(16) && !rows.IsNull(17)) {
+      const double l = rows.GetDouble(16), r = rows.GetDouble(17);
+      if (std::abs(l - r) > 1e-9) more_blurred = ((side == "left") == (l > r)) ? "1" : "0";
+    }
+    std::string correct = rows.IsNull(24) ? "" : std::to_string(rows.GetInt64(24));
+    if (correct.empty() && !interval.empty() && factors.contains("odd_interval"))
+      correct = TidyCell(factors["odd_interval"]) == interval ? "1" : "0";
+    for (const std::string& cell : {status, side, more_blurred, interval, yes_no, rating, level, correct})
+      cells.push_back(cell);
+    cells.push_back(answered && !rows.IsNull(20) ? Number(rows.GetDouble(20)) : "");
+    cells.push_back(answered ? rows.GetText(21) : "");
     text += CsvLine(cells);
+    // The adjustment path, long: one row per step.
+    if (answered && !rows.IsNull(22)) {
+      const Json steps = ParseColumn(rows.GetText(22), where + " adjustment");
+      if (steps.is_array())
+        for (size_t i = 0; i < steps.size(); ++i)
+          adjustments += CsvLine({rows.GetText(0), rows.GetText(2), std::to_string(session), std::to_string(trial),
+                                  std::to_string(i + 1), steps[i].is_object() ? TidyCell(steps[i].value("level", Json())) : "",
+                                  steps[i].is_object() ? TidyCell(steps[i].value("t_ms", Json())) : ""});
+    }
     ++count;
   }
+  // The codebook: every column of every table this export writes.
+  std::string codebook = CsvLine({"table", "column", "type", "unit", "allowed", "meaning"});
+  for (const auto& c : columns) codebook += CsvLine({"trials.csv", c.name, c.type, c.unit, c.allowed, c.meaning});
+  for (const auto& c : AdjustmentColumns()) codebook += CsvLine({"adjustments.csv", c.name, c.type, c.unit, c.allowed, c.meaning});
+  for (const auto& c : FrameColumns()) codebook += CsvLine({"frames.csv", c.name, c.type, c.unit, c.allowed, c.meaning});
   // Every table of one export appears together: a kill leaves the previous export whole, never its frames.csv
   // beside a new trials.csv.
   WriteFolderAtomically(
       out_dir,
       [&](const std::filesystem::path& partial) {
         WriteFileAtomically(partial / "trials.csv", text);
+        WriteFileAtomically(partial / "adjustments.csv", adjustments);
+        WriteFileAtomically(partial / "codebook.csv", codebook);
         WriteSummaries(db, partial);
         WriteFrames(db, partial);
       },

@@ -64,7 +64,7 @@ void RunSession(Record& record, const std::string& participant, const std::strin
     t.block = i / 2;
     t.factors_json = factors_json;
     t.left_json = R"("measured")";
-    t.right_json = R"({"blur":"estimated","edge":3})";
+    t.right_json = R"({"screen_px":2.5})";
     trials.push_back(t);
   }
   record.SaveTrialList(session, trials);
@@ -87,9 +87,13 @@ TEST(Export, ColumnsAreTheSameForParticipantsWithDifferentFactors) {
   EXPECT_EQ(ExportCsv(dir / "r.sqlite", dir / "out"), 7);
   const Rows rows = ReadCsv(dir / "out" / "trials.csv");
   ASSERT_EQ(rows.size(), 8u);
-  const std::vector<std::string> expected = {"study", "protocol_hash", "participant", "session", "seed",
-                                             "trial_index", "block", "blur", "edge", "speed_cm_s",
-                                             "left", "right", "choice", "rt_ms", "adjustment", "answered_at"};
+  const std::vector<std::string> expected = {
+      "study",       "protocol_hash", "participant", "observer",    "observer_params",    "window",
+      "session_id",  "session_number", "seed",       "trial_index", "block",              "block_name",
+      "task",        "practice",      "swapped",     "blur",        "edge",               "speed_cm_s",
+      "left_source", "left_fixed",    "right_source", "right_fixed", "status",            "chosen_side",
+      "chose_more_blurred", "chosen_interval", "yes_no", "rating",   "adjusted_level",    "correct",
+      "rt_ms",       "answered_at"};
   EXPECT_EQ(rows[0], expected);
   for (const auto& row : rows) EXPECT_EQ(row.size(), expected.size());
   EXPECT_EQ(rows[1][Column(rows, "participant")], "P01");
@@ -99,13 +103,25 @@ TEST(Export, ColumnsAreTheSameForParticipantsWithDifferentFactors) {
   EXPECT_EQ(rows[5][Column(rows, "speed_cm_s")], "1.8");
   EXPECT_EQ(rows[5][Column(rows, "edge")], "");
   EXPECT_EQ(rows[1][Column(rows, "rt_ms")], "400.25");
-  EXPECT_EQ(rows[1][Column(rows, "seed")], "42");
+  EXPECT_EQ(rows[1][Column(rows, "seed")], "s42");  // never a number a spreadsheet could round
+  EXPECT_EQ(rows[1][Column(rows, "status")], "answered");
+  EXPECT_EQ(rows[1][Column(rows, "chosen_side")], "right");
+  EXPECT_EQ(rows[5][Column(rows, "session_number")], "1");
   // Unanswered trials are rows with empty answers.
-  EXPECT_EQ(rows[7][Column(rows, "choice")], "");
+  EXPECT_EQ(rows[7][Column(rows, "status")], "unanswered");
+  EXPECT_EQ(rows[7][Column(rows, "chosen_side")], "");
   EXPECT_EQ(rows[7][Column(rows, "answered_at")], "");
-  // JSON with commas and quotes survives the quoting.
-  EXPECT_EQ(rows[1][Column(rows, "left")], "measured");
-  EXPECT_EQ(rows[1][Column(rows, "right")], R"({"blur":"estimated","edge":3})");
+  // Each side's source and fixed radius in columns of their own, no JSON.
+  EXPECT_EQ(rows[1][Column(rows, "left_source")], "measured");
+  EXPECT_EQ(rows[1][Column(rows, "left_fixed")], "");
+  EXPECT_EQ(rows[1][Column(rows, "right_source")], "fixed_screen_px");
+  EXPECT_EQ(rows[1][Column(rows, "right_fixed")], "2.5");
+  // The codebook names every column of trials.csv, in order.
+  const Rows codebook = ReadCsv(dir / "out" / "codebook.csv");
+  std::vector<std::string> named;
+  for (const auto& row : codebook)
+    if (row[0] == "trials.csv") named.push_back(row[1]);
+  EXPECT_EQ(named, expected);
 }
 
 TEST(Export, ReadsARecordAWriterStillHasOpen) {

@@ -374,7 +374,8 @@ void Record::SaveTrialList(int64_t session, const std::vector<TrialRecord>& tria
     throw InputError(db_.path(), SessionName(session) + " already has its trial list");
   Statement insert(db_, "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, right_shown, "
                         "block_name, practice, swapped, left_source, left_fixed, right_source, right_fixed, "
-                        "r_left_px, r_right_px, r_scene_px) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+                        "r_left_px, r_right_px, r_scene_px, task) "
+                        "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
   auto optional = [&](int column, const std::optional<double>& value) {
     if (value) insert.Bind(column, *value);
     else insert.BindNull(column);
@@ -398,6 +399,7 @@ void Record::SaveTrialList(int64_t session, const std::vector<TrialRecord>& tria
     optional(14, trial.r_left_px);
     optional(15, trial.r_right_px);
     optional(16, trial.r_scene_px);
+    insert.Bind(17, trial.task);
     insert.Run();
     insert.Reset();
   }

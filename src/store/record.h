@@ -46,7 +46,7 @@ struct TrialRecord {
   // Typed (schema 7): the block's name, practice (not scored), left and right exchanged against the design, and the
   // radii planned in photo px (none for a picture). Each side's source and fixed radius are read from left_json /
   // right_json by the record itself (SourceColumns).
-  std::string block_name;
+  std::string block_name, task;  // task: forced_choice | adjustment | yes_no | rating
   bool practice = false, swapped = false;
   std::optional<double> r_left_px, r_right_px, r_scene_px;
 };

@@ -137,7 +137,7 @@ std::vector<Migration> MakeMigrations() {
   //  sessions: who answered (observer: person | simulated, and the simulated observer's parameters), where (window:
   //  1 a real window on the real clock, 0 headless on a simulated one), and the display profile's geometry;
   //  session_info: the participant information given, one row per key;
-  //  trials: the block's name, practice and swapped flags, each side's source (none, measured, measured_section,
+  //  trials: the block's name and task (forced_choice, adjustment, yes_no, rating), practice and swapped flags, each side's source (none, measured, measured_section,
   //  estimated, fitted, fixed_px, fixed_screen_px, fixed_arcmin) and fixed radius, the radii planned (photo px);
   //  responses: what an adaptive procedure showed and scored (level, correct) and the radii shown (photo px).
   steps.push_back({"ALTER TABLE sessions ADD COLUMN observer TEXT CHECK (observer IN ('person', 'simulated'));"
@@ -154,6 +154,7 @@ std::vector<Migration> MakeMigrations() {
                    "  value TEXT NOT NULL,"
                    "  PRIMARY KEY (session_id, key))" + strict + ";"
                    "ALTER TABLE trials ADD COLUMN block_name TEXT;"
+                   "ALTER TABLE trials ADD COLUMN task TEXT;"
                    "ALTER TABLE trials ADD COLUMN practice INTEGER CHECK (practice IN (0, 1));"
                    "ALTER TABLE trials ADD COLUMN swapped INTEGER CHECK (swapped IN (0, 1));"
                    "ALTER TABLE trials ADD COLUMN left_source TEXT;"
@@ -205,6 +206,8 @@ void DeriveTypedColumns(Database& db) {
   };
   db.Exec("UPDATE trials SET "
           "block_name = coalesce(json_extract(factors, '$.block_name'), ''), "
+          "task = CASE WHEN json_extract(factors, '$.start_level') IS NOT NULL THEN 'adjustment' "
+          "  ELSE 'forced_choice' END, "
           "practice = coalesce(json_extract(factors, '$.practice'), 0) <> 0, "
           "swapped = coalesce(json_extract(factors, '$.swapped'), 0) <> 0, "
           "left_source = " + source("left_shown") + ", left_fixed = " + fixed("left_shown") + ", "
