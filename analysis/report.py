@@ -21,6 +21,7 @@ import warnings
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # the sibling modules, from any working directory
 
 
+import any_study  # noqa: E402
 import bench_charts  # noqa: E402
 import common  # noqa: E402
 import depth_matching  # noqa: E402
@@ -58,11 +59,13 @@ def _table_html(table):
                          classes="data")
 
 
-def write_index(out_dir, sections, header):
-    """sections: list of (title, [Chart], [skip notes]); header: lines about the inputs."""
+def write_index(out_dir, sections, header, name="index.html", title="blurcue analysis report", summary=None,
+                links=None):
+    """sections: list of (title, [Chart], [skip notes]); header: lines about the inputs; summary: (study, finding)
+    pairs shown first; links: (href, text) to the report's other pages."""
     sections = [s for s in sections if s[1] or s[2]]  # a step with nothing to show (bench files read fine) is left out
     parts = ["<!DOCTYPE html>", "<html lang='en'><head><meta charset='utf-8'>",
-             "<title>blurcue analysis report</title>",
+             f"<title>{html.escape(title)}</title>",
              "<style>body{font-family:sans-serif;max-width:1250px;margin:2em auto;padding:0 1em;color:#222}"
              "h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:2em}img{max-width:100%;height:auto}"
              "table.data{border-collapse:collapse;font-size:12px;margin:.6em 0}"
@@ -70,7 +73,16 @@ def write_index(out_dir, sections, header):
              "table.data th{background:#f3f3f3}.skip{background:#fff6d9;border-left:4px solid #e6b800;"
              "padding:.4em .8em;margin:.6em 0}.notes{font-size:13px;color:#444}.links{font-size:13px}"
              ".scroll{overflow-x:auto}</style></head><body>",
-             "<h1>blurcue analysis report</h1>", "<ul class='notes'>"]
+             f"<h1>{html.escape(title)}</h1>"]
+    if links:
+        parts.append("<p class='links'>" + " | ".join(f"<a href='{html.escape(h)}'>{html.escape(t)}</a>"
+                                                      for h, t in links) + "</p>")
+    if summary:
+        parts.append("<h3>Summary</h3><table class='data'><tr><th>study</th><th>what it found</th></tr>")
+        parts += [f"<tr><td style='text-align:left'>{html.escape(s)}</td><td style='text-align:left'>"
+                  f"{html.escape(f)}</td></tr>" for s, f in summary]
+        parts.append("</table>")
+    parts.append("<ul class='notes'>")
     parts += [f"<li>{html.escape(line)}</li>" for line in header]
     parts.append("</ul><h3>Contents</h3><ol>")
     for i, (title, _, _) in enumerate(sections):
@@ -97,7 +109,7 @@ def write_index(out_dir, sections, header):
             if table:
                 parts.append(f"<div class='scroll'>{table}</div>")
     parts.append("</body></html>")
-    path = os.path.join(out_dir, "index.html")
+    path = os.path.join(out_dir, name)
     with open(path, "w", encoding="utf-8") as f:
         f.write("\n".join(parts) + "\n")
     return path
@@ -114,6 +126,8 @@ def main(argv=None):
     parser.add_argument("--boot", type=int, default=200, help="bootstrap samples for the psychometric band")
     parser.add_argument("--seed", type=int, default=1, help="bootstrap seed")
     parser.add_argument("--debug", action="store_true", help="let an unexpected error raise (with its traceback)")
+    parser.add_argument("--pool-simulated", action="store_true",
+                        help="analyse people and simulated observers together (by default apart)")
     args = parser.parse_args(argv)
     warnings.showwarning = _warning_line
 
@@ -178,6 +192,8 @@ def main(argv=None):
         ("psychometric function", lambda: forced_choice.psychometric(df(), args.out, n_boot=args.boot, seed=args.seed)),
         ("side bias (counterbalancing check)", lambda: forced_choice.side_bias(df(), args.out)),
         ("display timing", lambda: frame_timing.charts(frames_path, args.out)),
+    ]
+    bench_steps = [
         ("bench files", load_bench),
         ("bench: measurement speed vs accuracy",
          lambda: bench_charts.measure_speed_accuracy(needs("measure"), args.out)),
@@ -186,14 +202,46 @@ def main(argv=None):
         ("bench: two-ball frame", lambda: bench_charts.render_frame(needs("render"), args.out)),
         ("bench: which procedure", lambda: bench_charts.procedures(procedures_csv(), args.out)),
     ]
-    total = len(steps) + 2  # + reading trials.csv + writing the index
-
     try:
         holder["trials"] = common.load_trials(args.trials)
     except TrialsError as e:
         say(str(e))  # the only line: the file and what is wrong with it
         return EXIT_INPUT
     trials = holder["trials"]
+    codebook = any_study.load_codebook(args.trials)
+
+    # Every other study, analysed from what its trials declare (any_study.py); people and simulated observers apart
+    # unless --pool-simulated.
+    known = set(common.STUDY_TITLES)
+    findings = {}  # step title -> one line for the summary
+
+    def study_step(study, rows, group):
+        def run():
+            charts, finding = any_study.analyse(rows, study, codebook, args.out, n_boot=args.boot, seed=args.seed,
+                                                group=group)
+            findings[title] = finding
+            return charts
+        title = f"study {study}" + (f" ({group})" if group else "")
+        return title, run
+
+    study_steps = []
+    for study in sorted(set(trials["study"]) - known):
+        rows = trials[trials["study"] == study]
+        kinds = sorted(set(rows["observer"])) if not args.pool_simulated else ["all"]
+        for kind in kinds:
+            part = rows if kind == "all" else rows[rows["observer"] == kind]
+            group = "" if kind == "all" or kinds == ["person"] else \
+                ("simulated observers" if kind == "simulated" else "people")
+            study_steps.append(study_step(study, part, group))
+    # The thesis's views of the thesis's studies that are in the record (none is a box saying it is missing).
+    present = set(trials["study"])
+    uses = [{common.STUDY_DEPTH}, {common.STUDY_TEST1}, {common.STUDY_TEST2}, {common.STUDY_TEST3},
+            {common.STUDY_TEST2}, {common.STUDY_TEST3}, set(common.FORCED_CHOICE_STUDIES),
+            set(common.FORCED_CHOICE_STUDIES)]
+    thesis_steps = [step for step, studies in zip(steps[:8], uses) if studies & present]
+    steps = thesis_steps + study_steps + steps[8:] + bench_steps
+    n_data_steps = len(steps) - len(bench_steps)
+    total = len(steps) + 2  # + reading trials.csv + writing the index
     say(f"[1/{total}] read {shown(args.trials)}: {len(trials)} rows")
     studies = trials["study"].value_counts().sort_index()
     known = set(common.STUDY_TITLES)
@@ -203,10 +251,10 @@ def main(argv=None):
               f"frames: {os.path.abspath(shown(frames_path))}",
               f"bench: {os.path.abspath(args.bench)}",
               f"written {datetime.datetime.now().strftime('%Y-%m-%d %H:%M')}; practice trials excluded everywhere"]
-    unknown = sorted(set(studies.index) - known)
-    if unknown:
-        say(f"{args.trials}: studies without an analysis here, ignored: {', '.join(unknown)}")
-        header.append(f"ignored (no analysis for these studies): {', '.join(unknown)}")
+    observers = trials.groupby("observer")["participant"].nunique()
+    header.insert(1, "participants: " + ", ".join(f"{n} {'people' if k == 'person' else 'simulated'}"
+                                                    for k, n in observers.items()) +
+                  ("; analysed apart" if len(observers) > 1 and not args.pool_simulated else ""))
     if trials.empty:
         say(f"{args.trials}: no trials - every trial section is skipped")
 
@@ -220,6 +268,8 @@ def main(argv=None):
         except Skip as e:
             say(f"  skipped: {shown_text(str(e))}")
             skips.append(shown_text(str(e)))
+            if title.startswith("study "):
+                findings[title] = "not analysed: " + shown_text(str(e))
         except Exception as e:  # a bug or data this code did not foresee: name it, keep the rest of the report
             if args.debug:
                 raise
@@ -236,7 +286,18 @@ def main(argv=None):
         sections.append((title, charts, skips))
 
     say(f"[{total}/{total}] index.html ...")
-    path = write_index(args.out, sections, header)
+    # The summary: what each study found (the thesis's studies point at their figures).
+    summary = []
+    for study in sorted(set(trials["study"]) & known):
+        d = trials[(trials["study"] == study) & (trials["practice"] != 1)]
+        summary.append((study, f"{common.STUDY_TITLES[study]}: {int(d['answered'].sum())} of {len(d)} trials "
+                               f"answered - the thesis's figures below"))
+    summary += [(title[len("study "):], finding) for title, finding in findings.items()]
+    data_sections, bench_sections = sections[:n_data_steps], sections[n_data_steps:]
+    write_index(args.out, bench_sections, [f"bench: {os.path.abspath(args.bench)}"], name="bench.html",
+                title="blurcue software benchmarks", links=[("index.html", "the studies")])
+    path = write_index(args.out, data_sections, header, summary=summary,
+                       links=[("bench.html", "software benchmarks (speed against accuracy)")])
     n_charts = sum(1 for _, charts, _ in sections for c in charts if c.png)
     n_skipped = sum(1 for _, _, skips in sections if skips)
     say(f"wrote {shown(path)}: {n_charts} charts, {n_skipped} section{'s' if n_skipped != 1 else ''} with notes")

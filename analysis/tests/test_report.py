@@ -61,11 +61,15 @@ class EndToEndTest(ReportTestCase):
                     "psychometric", "side-bias", "frame-intervals", "bench-measure-speed-accuracy", "bench-stability-within-target",
                     "bench-stability-error", "bench-render-speed-accuracy", "bench-frame", "bench-procedures"}
         self.assertEqual({p[:-4] for p in pngs}, expected)
+        bench_page = read(out, "bench.html")
         linked = set(re.findall(r"<img src='([^']+)'", index))
-        self.assertEqual(linked, set(pngs), "index.html shows every PNG, and only existing ones")
-        for href in re.findall(r"href='([^'#]+)'", index):
-            self.assertFalse(os.path.isabs(href), href)
-            self.assertTrue(os.path.isfile(os.path.join(out, href)), f"index.html links a missing file {href}")
+        bench_linked = set(re.findall(r"<img src='([^']+)'", bench_page))
+        self.assertEqual(linked | bench_linked, set(pngs), "the pages show every PNG, and only existing ones")
+        self.assertEqual(bench_linked, {p for p in pngs if p.startswith("bench-")}, "benchmarks on their own page")
+        for page in (index, bench_page):
+            for href in re.findall(r"href='([^'#]+)'", page):
+                self.assertFalse(os.path.isabs(href), href)
+                self.assertTrue(os.path.isfile(os.path.join(out, href)), f"a page links a missing file {href}")
 
         for png in pngs:
             with open(os.path.join(out, png), "rb") as f:
@@ -167,13 +171,13 @@ class EdgeCaseTest(ReportTestCase):
         self.assertCleanStderr(err)
         self.assertIn(os.path.join(bench, "measure.csv") + ": no such file", err)
         index = read(out, "index.html")
-        self.assertIn("measure.csv: no such file", index)
-        self.assertIn("test 1 (static grids): no trials in trials.csv", index)
+        self.assertIn("measure.csv: no such file", read(out, "bench.html"))
+        self.assertNotIn("test 1 (static grids)", index)  # a study nobody ran gets no section
         # No frames.csv beside trials.csv: display timing is skipped with a note naming the file.
         frames = os.path.join(self.tmp, "frames.csv")
         self.assertIn(f"skipped: {frames}: no such file", err)
         self.assertIn(f"Skipped: {frames}: no such file", index)
-        self.assertFalse(any(f.startswith("bench") for f in os.listdir(out)))
+        self.assertFalse(any(f.startswith("bench-") for f in os.listdir(out)))
 
     def test_one_bench_file_only(self):
         rows = synthetic.trials_rows(participants=("P1", "P2"), studies=["pre-research-depth-matching"])
