@@ -185,7 +185,7 @@ def fit_psychometric(x, k, n=None, kind="weibull", gamma=0.5, lam=(0.0, 0.1), st
     # beta in [b_lo, b_hi]: b_lo + exp(t) without an upper bound, else logit-scaled between the bounds.
     def beta_of(t):
         if math.isinf(b_hi):
-            return b_lo + math.exp(t)
+            return b_lo + math.exp(min(t, 700.0))  # a search that runs off (all answers one way) stays finite
         return b_lo + (b_hi - b_lo) * special.expit(t)
 
     def t_of(b):
@@ -197,7 +197,7 @@ def fit_psychometric(x, k, n=None, kind="weibull", gamma=0.5, lam=(0.0, 0.1), st
     # Unconstrained coordinates: location (log for Weibull), bounded spread, logit-scaled gamma and lapse.
     def unpack(theta):
         i = 0
-        a = math.exp(theta[i]) if kind == "weibull" else theta[i]
+        a = math.exp(min(theta[i], 700.0)) if kind == "weibull" else theta[i]
         b = beta_of(theta[i + 1])
         i += 2
         g = gamma

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs the Debian packages blurcue needs (only those missing) and builds it (Release) into build/.
-# Usage: scripts/setup.sh            (as root, or with sudo available)
+# Usage: scripts/setup.sh [--tests]    (as root, or with sudo available; --tests adds what only the tests need)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -12,6 +12,8 @@ PACKAGES=(
   python3-pandas python3-matplotlib python3-scipy python3-statsmodels python3-jsonschema python3-numpy python3-pil
   python3-questplus
 )
+# --tests: what only the tests need besides - a real browser to open the report as a reader would.
+[ "${1:-}" = "--tests" ] && PACKAGES+=(chromium)
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -372,6 +372,56 @@ codebook)
   $PY "$(dirname "$0")/codebook_check.py" "$W/tables" "$W/c.sqlite" > "$W/out" || fail "$(cat "$W/out")"
   grep -q "adjustments.csv" "$W/tables/codebook.csv" || fail "adjustments.csv not in the codebook"
   echo "ok: $(tail -1 "$W/out" | sed 's/^ok: //'); $(grep seeds "$W/out" | head -1)" ;;
+report_any_study)
+  # Studies unlike the thesis's - QUEST+ on a blur difference, an odd one out, yes/no and rating, a 2IFC - run by
+  # simulated observers of known parameters: the report gives each a section with charts and statistics (none is
+  # "ignored"), and the QUEST+ threshold's interval holds the threshold the observers were given. The pages then open
+  # in a real browser without a broken image, a missing link or a console message.
+  for id in Q1 Q2 Q3 Q4 Q5; do
+    $BC run "$P/quest-blur-difference.json" --participant $id --db "$W/s.sqlite" --observer sim:jnd=1.4,lapse=0.02,bias=0 \
+      > /dev/null 2>&1 || fail "quest $id"
+  done
+  for id in S1 S2; do
+    for p in odd-one-out-grids yes-no-ball 2ifc-grids; do
+      $BC run "$P/$p.json" --participant $id --db "$W/s.sqlite" --observer sim > /dev/null 2>&1 || fail "$p $id"
+    done
+  done
+  MPLCONFIGDIR=$W/mpl $BC report --db "$W/s.sqlite" --out "$W/report" --bench "$W/no-bench" --boot 60 2> "$W/err" \
+    || fail "report: $(tail -3 "$W/err")"
+  grep -q "ignored" "$W/err" && fail "a study was ignored: $(grep ignored "$W/err")"
+  $PY - "$W/report" "$W/report/tables/trials.csv" > "$W/fit" <<'PYEOF' || fail "report for any study: $(cat "$W/fit")"
+import csv, math, os, sys
+from statistics import NormalDist
+out, trials = sys.argv[1], sys.argv[2]
+index = open(os.path.join(out, "index.html"), encoding="utf-8").read()
+for study in ("quest-blur-difference", "odd-one-out-grids", "yes-no-ball", "2ifc-grids"):
+    assert f"study {study}" in index, f"no section for {study}"
+for png in ("quest-blur-difference-simulated-psychometric.png", "quest-blur-difference-simulated-tracks.png",
+            "odd-one-out-grids-simulated-per-edge.png", "yes-no-ball-yes_no-simulated-per-blur.png",
+            "yes-no-ball-rating-simulated-rating-per-blur.png", "2ifc-grids-simulated-per-edge.png"):
+    assert os.path.isfile(os.path.join(out, png)), png
+    assert f"<img src='{png}'" in index, png
+# The truth: the observer picks the more blurred side with P = Phi(d / jnd) (1 - lapse) + lapse / 2, d the radius
+# difference in photo px; 75 % correct at d = jnd * Phi^-1((0.75 - lapse / 2) / (1 - lapse)), in arcmin via the
+# display's arcmin per photo px (the export's r_left_arcmin / r_left_px).
+rows = [r for r in csv.DictReader(open(trials)) if r["study"] == "quest-blur-difference" and r["r_left_px"]
+        and float(r["r_left_px"]) > 0]
+arcmin_per_px = float(rows[0]["r_left_arcmin"]) / float(rows[0]["r_left_px"])
+jnd, lapse = 1.4, 0.02
+truth = jnd * NormalDist().inv_cdf((0.75 - lapse / 2) / (1 - lapse)) * arcmin_per_px
+fit = next(csv.DictReader(open(os.path.join(out, "quest-blur-difference-simulated-psychometric.csv"))))
+lo, th, hi = float(fit["threshold_low"]), float(fit["threshold"]), float(fit["threshold_high"])
+print(f"QUEST+ threshold {th:.3f} [{lo:.3f}, {hi:.3f}] arcmin; the observers' {truth:.3f}")
+assert lo <= truth <= hi, (lo, th, hi, truth)
+# The odd one out is found above chance (1/3) where the odd card differs most (edge 9), with its test.
+odd = list(csv.DictReader(open(os.path.join(out, "odd-one-out-grids-simulated-per-edge.csv"))))
+nine = next(r for r in odd if r["edge"] == "9")
+assert float(nine["share"]) > 1 / 3 and float(nine["p_binomial"]) < 0.05, nine
+# The summary says what each study found.
+assert "Summary" in index and "threshold" in index and "chance 0.33" in index, "summary"
+PYEOF
+  $PY "$(dirname "$0")/browser_check.py" "$W/report" index.html bench.html > "$W/browser" || fail "$(cat "$W/browser")"
+  echo "ok: every study has its section; $(cat "$W/fit"); $(cat "$W/browser" | sed 's/^ok: //')" ;;
 deadline)
   # A deadline: no answer within it records the choice "none" with no response time, and a procedure counts it
   # wrong (its level climbs); feedback after each procedure trial; feedback without a procedure is refused.
