@@ -13,3 +13,7 @@ set_tests_properties(analysis.stats analysis.report PROPERTIES
                      LABELS analysis TIMEOUT 180
                      # Matplotlib writes its font cache under HOME; keep it out of a read-only or shared home.
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
+
+# The psychometric fit against psignifit 4, where it is installed (from PyPI; a SKIP line where it is not).
+add_test(NAME analysis.psignifit COMMAND ${BLURCUE_ANALYSIS_PYTHON} ${CMAKE_SOURCE_DIR}/tests/psignifit_agreement.py)
+set_tests_properties(analysis.psignifit PROPERTIES LABELS analysis PASS_REGULAR_EXPRESSION "^ok:|\nok:|^SKIP:")
