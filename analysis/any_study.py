@@ -187,19 +187,6 @@ def value_chart(m, factor, what, study, out_dir, name, group_note):
     return Chart(name, png, svg, t, ["points: every answer; blue: the mean with its t 95 % interval"])
 
 
-def term_words(term, m, factors):
-    """A model term in words: 'C(edge)[T.6]' -> 'edge 6 (against edge 3)', 'Intercept' -> 'baseline (...)'."""
-    if term == "Intercept":
-        base = ", ".join(f"{f} {_label(_sorted_levels(list(m[f].map(_label).unique()))[0])}" for f in factors)
-        return f"baseline log-odds ({base})" if base else "log-odds"
-    match = re.fullmatch(r"C\((\w+)\)\[T\.(.+)\]", term)
-    if match:
-        f, level = match.groups()
-        base = _sorted_levels(list(m[f].map(_label).unique()))[0]
-        return f"{f} {_label(level)} (against {f} {base})"
-    return term
-
-
 def models(m, factors, study, group_note, what):
     """Logistic models across participants of the 0/1 measure against the factors, terms in words, and which to
     trust where the GLM and the GLMM disagree."""
@@ -210,7 +197,6 @@ def models(m, factors, study, group_note, what):
     table, notes = stats.observer_models(d, "y", rhs)
     if table.empty:
         return Chart(f"{study}-models", None, None, table, notes)
-    table["term"] = [term_words(re.sub(r", levels=\[.*?\]\)", ")", t), d, factors) for t in table["term"]]
     glm = table[table["model"].str.startswith("GLM")]
     glmm = table[table["model"].str.startswith("GLMM")]
     for term in set(glm["term"]) & set(glmm["term"]):

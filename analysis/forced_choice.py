@@ -145,8 +145,9 @@ def test1_per_edge(df, out_dir):
     model, model_notes = _model(d, "edge_c", "test 1")
     charts = [Chart("test1-per-edge", png, svg, t, notes)]
     charts.append(Chart("test1-model", None, None, model,
-                        ["logit P(chose measured | decisive) = Intercept + edge_c x (edge - 6); Intercept = log-odds "
-                         "at edge 6 (0 = no preference)"] + model_notes))
+                        ["log-odds of choosing measured among decisive answers = baseline + (per edge) x (edge - 6); "
+                         "the baseline is the log-odds at edge 6 (0 = no preference), 'per edge' the change from one "
+                         "edge to the next"] + model_notes))
     return charts
 
 

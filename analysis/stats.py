@@ -304,6 +304,36 @@ MIN_EACH_OUTCOME = 2    # and at least this many of each outcome (else the log-o
 SEPARATION_LOGODDS = 10  # |log-odds| beyond this (odds 22000:1) from a GLM means separation, not an estimate
 
 
+# What the model terms mean, in words, for the page (patsy's names are for programs): centred covariates by their
+# centring, factors by level against their baseline.
+CENTRED = {"edge_c": "per edge (edge centred at 6)", "section_c": "per section (section centred at 5.5)"}
+
+
+def term_in_words(term, data):
+    """'C(pattern_id)[1]' -> 'pattern_id 1'; 'C(edge, levels=[3, 6])[T.6]' -> 'edge 6 (against edge 3)';
+    'Intercept' -> 'baseline (intercept)'; a centred covariate -> what one step of it means."""
+    import re
+    if term == "Intercept":
+        return "baseline (intercept)"
+    if term in CENTRED:
+        return CENTRED[term]
+    match = re.fullmatch(r"C\((\w+)(?:, levels=\[(.*)\])?\)\[(T\.)?(.+)\]", term)
+    if not match:
+        return term
+    name, levels, treatment, level = match.groups()
+    level = level[:-2] if level.endswith(".0") else level
+    if not treatment:
+        return f"{name} {level}"
+    if levels:
+        base = levels.split(",")[0].strip().strip("'\"")
+    else:
+        values = sorted(data[name].dropna().unique(), key=lambda v: (not isinstance(v, (int, float)), v)) \
+            if name in data else []
+        base = str(values[0]) if len(values) else "its first level"
+    base = base[:-2] if base.endswith(".0") else base
+    return f"{name} {level} (against {name} {base})"
+
+
 def observer_models(data, response, formula_rhs, group="participant"):
     """Logistic models of a 0/1 response across observers; returns (table, notes).
 
@@ -378,4 +408,7 @@ def observer_models(data, response, formula_rhs, group="participant"):
                 notes.append(f"GLMM not fitted: {type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''}")
         elif n_groups == 2:
             notes.append("two participants: too few for a random-intercept GLMM; cluster-robust GLM only")
-    return pd.DataFrame(rows), notes
+    table = pd.DataFrame(rows)
+    if not table.empty:
+        table["term"] = [term_in_words(t, d) for t in table["term"]]
+    return table, notes

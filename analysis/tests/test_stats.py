@@ -191,9 +191,17 @@ class ObserverModelTest(unittest.TestCase):
         d["y"] = np.where(d["cell"] == "a", 1.0, np.tile([0.0, 0.0, 1.0, 1.0], 10))  # a: every answer 1; b: mixed
         table, _ = stats.observer_models(d, "y", "0 + C(cell)")
         glm = table[table["model"] == "GLM, cluster-robust SE"]
-        a = glm[glm["term"].str.contains("a]")].iloc[0]
+        a = glm[glm["term"] == "cell a"].iloc[0]  # patsy's C(cell)[a], in words
         self.assertTrue(math.isnan(a["estimate_logodds"]))
         self.assertIn("separation", a["note"])
+
+    def test_terms_in_words(self):
+        d = pd.DataFrame({"edge": [3, 6, 9]})
+        self.assertEqual(stats.term_in_words("C(pattern_id)[1]", d), "pattern_id 1")
+        self.assertEqual(stats.term_in_words("C(edge)[T.6]", d), "edge 6 (against edge 3)")
+        self.assertEqual(stats.term_in_words("C(edge, levels=['9', '3'])[T.3]", d), "edge 3 (against edge 9)")
+        self.assertEqual(stats.term_in_words("Intercept", d), "baseline (intercept)")
+        self.assertEqual(stats.term_in_words("edge_c", d), "per edge (edge centred at 6)")
 
 
 class LoadTrialsTest(unittest.TestCase):
