@@ -138,7 +138,7 @@ for t in csv.DictReader(open(f"{w}/t1-tables/trials.csv")):
         assert abs(float(t[f"r_{side}_px"]) - o["r_camera_px"]) < 2e-4, (t["trial_index"], side)
         assert abs(float(t[f"r_{side}_screen_px"]) - o["r_screen_px"]) < 2e-4, (t["trial_index"], side)
         assert abs(float(t[f"r_{side}_arcmin"]) - o["r_arcmin"]) < 2e-4, (t["trial_index"], side)
-        assert o["source"] == t[side], (t["trial_index"], side, o["source"], t[side])
+        assert o["source"] == t[f"{side}_source"], (t["trial_index"], side, o["source"], t[f"{side}_source"])
         assert abs(float(t[f"size_{side}_deg"]) - o["size_deg"]) < 2e-3, (t["trial_index"], side)
     assert c["blur_plan"] == t["blur_plan"] and abs(c["r_span_screen_px"] - float(t["r_span_screen_px"])) < 2e-4
     assert abs(float(t["screen_px_per_photo_px"]) - c["screen_px_per_photo_px"]) < 1e-6

@@ -52,12 +52,20 @@ void AddReportCommand(CLI::App& app) {
   struct Args {
     std::string db, out, bench = "results/bench", python = "/usr/bin/python3";
     int boot = 200;
+    bool pool_simulated = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "report",
-      "Write the report of a record: the tables (DIR/tables/trials.csv and per-study summaries, as blurcue export),\n"
-      "then every chart as PNG and SVG with its numbers beside it, and DIR/index.html showing them:\n"
+      "Write the report of a record: the tables (DIR/tables/, as blurcue export, with their codebook), then every\n"
+      "chart as PNG and SVG with its numbers beside it, DIR/index.html (a summary of what each study found, then a\n"
+      "section per study) and DIR/bench.html (the software benchmarks):\n"
+      "  any study, from what its trials declare: per condition the share with Wilson intervals and exact binomial\n"
+      "          tests against chance (Holm), a chart per factor, a psychometric function over a procedure's level or\n"
+      "          the blur difference on screen (Weibull, guess and lapse, bootstrap band and threshold interval),\n"
+      "          procedure tracks, models across participants (GLMM from three), side bias, ratings, adjusted levels;\n"
+      "          people and simulated observers apart (--pool-simulated pools them)\n"
+      "  the thesis's studies, besides:\n"
       "  depth matching: chosen cut-off vs distance per observer and pooled, with a fitted curve (thesis Fig. 3.3)\n"
       "  test 1: answers per edge (Fig. 5.2); tests 2 and 3: per pattern (Fig. 5.9, 5.13) and per section\n"
       "          (Fig. 5.10-5.12); 95 % Wilson intervals, binomial tests against chance, a GLMM across observers\n"
@@ -76,6 +84,8 @@ void AddReportCommand(CLI::App& app) {
   cmd->add_option("--boot", args->boot, "bootstrap samples of the psychometric fit")->capture_default_str()
       ->check(IntRange(10, 100000));
   cmd->add_option("--python", args->python, "the Python that sees the analysis packages")->capture_default_str();
+  cmd->add_flag("--pool-simulated", args->pool_simulated,
+                "analyse people and simulated observers together (by default each study reports them apart)");
   cmd->callback([args] {
     const std::filesystem::path out = args->out;
     const std::filesystem::path script = std::filesystem::path(BLURCUE_SOURCE_DIR) / "analysis" / "report.py";
@@ -94,10 +104,12 @@ void AddReportCommand(CLI::App& app) {
           });
           std::fprintf(stderr, "report: exported %lld trials to %s\n", static_cast<long long>(rows),
                        (out / "tables").c_str());
-          const int status =
-              RunChild({args->python, script.string(), "--trials", (partial / "tables" / "trials.csv").string(),
-                        "--bench", args->bench, "--out", partial.string(), "--final-out", out.string(), "--boot",
-                        std::to_string(args->boot)});
+          std::vector<std::string> argv = {args->python, script.string(), "--trials",
+                                           (partial / "tables" / "trials.csv").string(), "--bench", args->bench,
+                                           "--out", partial.string(), "--final-out", out.string(), "--boot",
+                                           std::to_string(args->boot)};
+          if (args->pool_simulated) argv.push_back("--pool-simulated");
+          const int status = RunChild(argv);
           if (WIFSIGNALED(status))
             throw Error(ErrorKind::kInternal, "the analysis was killed by signal " + std::to_string(WTERMSIG(status)) +
                                                   "; " + out.string() + " is unchanged");

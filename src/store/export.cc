@@ -1,11 +1,14 @@
 #include "store/export.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -396,12 +399,29 @@ bool AllDigits(const std::string& text) {
 int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::path& out_dir,
                   const ProgressNote& note) {
   Note(note, RemoveStaleLeftovers(out_dir));
-  Database db(db_path, OpenMode::kReadOnly);
-  RequireReadableRecord(db);
-  if (SchemaVersion(db) < 7)
-    throw InputError(db_path.string(), "record schema version " + std::to_string(SchemaVersion(db)) +
-                                           " has no typed columns yet: open it once with this blurcue (blurcue "
-                                           "sessions --db FILE migrates it) or merge it into a new record");
+  Database source(db_path, OpenMode::kReadOnly);
+  RequireReadableRecord(source);
+  // A record of an earlier version is exported from a migrated copy (the record itself is only read: it may be a
+  // read-only archive): VACUUM INTO writes the copy, the migration derives its typed columns.
+  std::optional<Database> copy;
+  std::filesystem::path copy_path;
+  struct RemoveCopy {
+    std::filesystem::path* path;
+    ~RemoveCopy() {
+      if (!path->empty()) RemoveDatabaseFiles(*path);
+    }
+  } remove_copy{&copy_path};
+  if (SchemaVersion(source) < CurrentSchemaVersion()) {
+    copy_path = std::filesystem::temp_directory_path() /
+                ("blurcue-export-" + std::to_string(getpid()) + "-" + db_path.filename().string());
+    RemoveDatabaseFiles(copy_path);
+    Statement vacuum(source, "VACUUM INTO ?");
+    vacuum.Bind(1, copy_path.string());
+    vacuum.Run();
+    copy.emplace(copy_path);
+    Migrate(*copy);
+  }
+  Database& db = copy ? *copy : source;
 
   // Pass 1: every design variable in the record (factor levels and the variables recorded with them, planned and as
   // shown), with the codebook's type of each, so every participant gets the same columns.

@@ -7,6 +7,8 @@
 
 #include "core/error.h"
 #include "store/record.h"
+#include "store/schema.h"
+#include "store/sqlite.h"
 #include "store/test_util.h"
 
 namespace blurcue::store {
@@ -122,6 +124,43 @@ TEST(Export, ColumnsAreTheSameForParticipantsWithDifferentFactors) {
   for (const auto& row : codebook)
     if (row[0] == "trials.csv") named.push_back(row[1]);
   EXPECT_EQ(named, expected);
+}
+
+// A record of schema 6 (its typed columns still in JSON texts and free text) exports the same tidy table from a
+// migrated copy, and is itself left as it was.
+TEST(Export, AnOlderRecordExportsFromAMigratedCopy) {
+  testing::TempDir dir;
+  {
+    Database db(dir / "old.sqlite");
+    for (int i = 0; i < 6; ++i) {
+      const Migration& step = Migrations()[size_t(i)];
+      if (!step.sql.empty()) db.Exec(step.sql);
+      if (step.data) step.data(db);
+    }
+    db.Exec("PRAGMA user_version = 6; PRAGMA application_id = " + std::to_string(kApplicationId) + ";"
+            "INSERT INTO studies (name, created) VALUES ('s', 'now');"
+            "INSERT INTO protocol_versions (study_id, json, hash, created) VALUES (1, '{}', 'h', 'now');"
+            "INSERT INTO participants (study_id, code, created) VALUES (1, 'P1', 'now');"
+            "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, host, display, "
+            "  started, status) VALUES (1, 1, -2, 'v', 'h', 'headless 1280x720; llvmpipe; observer sim:jnd=0.6', "
+            "  'now', 'completed');"
+            "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, right_shown) VALUES "
+            "  (1, 0, 0, '{\"block_name\": \"b\", \"edge\": 3, \"r_left_px\": 2, \"r_right_px\": 1}', "
+            "'\"measured\"', '\"none\"');"
+            "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at) VALUES "
+            "  (1, 'left', 700, '[]', 'now');");
+  }
+  EXPECT_EQ(ExportCsv(dir / "old.sqlite", dir / "out"), 1);
+  const Rows rows = ReadCsv(dir / "out" / "trials.csv");
+  EXPECT_EQ(rows[1][Column(rows, "observer")], "simulated");
+  EXPECT_EQ(rows[1][Column(rows, "observer_params")], "sim:jnd=0.6");
+  EXPECT_EQ(rows[1][Column(rows, "window")], "0");
+  EXPECT_EQ(rows[1][Column(rows, "seed")], "s18446744073709551614");  // 2^64 - 2, stored as -2
+  EXPECT_EQ(rows[1][Column(rows, "left_source")], "measured");
+  EXPECT_EQ(rows[1][Column(rows, "chosen_side")], "left");
+  EXPECT_EQ(rows[1][Column(rows, "chose_more_blurred")], "1");
+  Database old(dir / "old.sqlite", OpenMode::kReadOnly);
+  EXPECT_EQ(SchemaVersion(old), 6);  // the record itself is only read
 }
 
 TEST(Export, ReadsARecordAWriterStillHasOpen) {
