@@ -192,6 +192,30 @@ adaptive)
   $BC run "$P/staircase-ball-gain.json" --participant A2 --db "$W/killed.sqlite" --observer sim --seed 6 --sim-fps 2 \
       --resume 2>/dev/null | grep -q "60 of 60" || fail "staircase: resume did not complete"
   [ "$(shown "$W/whole.sqlite" A2)" = "$(shown "$W/killed.sqlite" A2)" ] || fail "staircase: killed+resumed differs"
+  # The staircases stop at their 6th reversal (stop rule): every later trial of that staircase is recorded as
+  # skipped, not shown - the same ones in the killed and resumed session.
+  $PY - "$W/killed.sqlite" <<'PYEOF' || fail "staircase stop rule"
+import json, sqlite3, sys
+con = sqlite3.connect(sys.argv[1])
+rows = con.execute("SELECT t.trial_index, r.choice, r.shown FROM trials t JOIN responses r ON r.trial_id = t.id "
+                   "ORDER BY t.trial_index").fetchall()
+cells, skipped = {}, 0
+for index, choice, shown in rows:
+    shown = json.loads(shown)
+    cell = cells.setdefault(json.loads(con.execute("SELECT factors FROM trials WHERE trial_index = ?",
+                                                   (index,)).fetchone()[0]).get("speed_cm_s"), [])
+    cell.append((choice, shown))
+for speed, trials in cells.items():
+    first = next((i for i, (c, _) in enumerate(trials) if c == "skipped"), None)
+    if first is None:
+        continue
+    assert all(c == "skipped" for c, _ in trials[first:]), speed
+    assert all(s["reversals"] == 6 for _, s in trials[first:]), (speed, trials[first])
+    assert trials[first - 1][1]["reversals"] in (5, 6), trials[first - 1]
+    skipped += len(trials) - first
+assert skipped > 0, "no staircase reached its stop rule"
+print(skipped, "trials skipped")
+PYEOF
   integrity "$W/killed.sqlite"
   # Tampered: a recorded level that the answers before it do not give.
   $BC run "$P/quest-blur-difference.json" --participant A3 --db "$W/tampered.sqlite" --observer sim --seed 4 \

@@ -92,10 +92,15 @@ void AddRunCommand(CLI::App& app) {
       options.info.emplace_back(item.substr(0, eq), item.substr(eq + 1));
     }
     const session::RunResult r = session::RunSession(options);
-    std::printf("%s: participant %s, session %lld, seed %llu: %lld of %lld trials answered (%lld now%s)%s\n",
+    // Trials a stopped procedure skipped are recorded too: counted as done, and said apart.
+    const std::string skipped =
+        r.skipped_now > 0 ? ", " + std::to_string(r.skipped_now) + " skipped now: their staircase had stopped" : "";
+    std::printf("%s: participant %s, session %lld, seed %llu: %lld of %lld trials %s (%lld answered now%s%s)%s\n",
                 args->db.c_str(), options.participant.c_str(), static_cast<long long>(r.session_id),
-                static_cast<unsigned long long>(r.seed), static_cast<long long>(r.answered_before + r.answered_now),
-                static_cast<long long>(r.trial_count), static_cast<long long>(r.answered_now),
+                static_cast<unsigned long long>(r.seed),
+                static_cast<long long>(r.answered_before + r.answered_now + r.skipped_now),
+                static_cast<long long>(r.trial_count), r.skipped_now > 0 ? "done" : "answered",
+                static_cast<long long>(r.answered_now), skipped.c_str(),
                 r.dropped_frames > 0 ? (", " + std::to_string(r.dropped_frames) + " dropped frames").c_str() : "",
                 r.completed ? "; completed" : "; not finished - continue with --resume");
   });

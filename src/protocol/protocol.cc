@@ -733,7 +733,7 @@ std::optional<Procedure> Parser::ParseProcedure(const Json& v, const std::string
   if (quest)
     Object(v, ptr, {"type", "variable", "reference", "trials", "stimuli", "threshold", "slope", "lapse", "guess"});
   else
-    Object(v, ptr, {"type", "variable", "reference", "trials", "start", "min", "max", "up", "down", "steps"});
+    Object(v, ptr, {"type", "variable", "reference", "trials", "start", "min", "max", "up", "down", "steps", "stop"});
   if (auto s = String(v, "variable", ptr, true, {"relative_difference", "difference_arcmin"})) pr.variable = *s;
   // What the level can be: up to 20 times more blur, or up to 10 degrees more.
   const bool relative = pr.variable == "relative_difference";
@@ -789,6 +789,16 @@ std::optional<Procedure> Parser::ParseProcedure(const Json& v, const std::string
     if (auto n = Int(v, "up", ptr, false, 1, 5, "wrong answers in a row")) pr.up = *n;
     if (auto n = Int(v, "down", ptr, false, 1, 5, "correct answers in a row")) pr.down = *n;
     numbers("steps", 20, 1e-6, hi, false, &pr.steps);
+    // A stop rule: the staircase ends after this many reversals; its remaining trials are recorded as skipped.
+    if (const Json* stop = Field(v, "stop", ptr, false)) {
+      if (Object(*stop, ptr + "/stop", {"reversals"}))
+        if (auto n = Int(*stop, "reversals", ptr + "/stop", true, 1, 100, "reversals")) {
+          pr.stop_reversals = *n;
+          if (*n >= pr.trials)
+            Problem(ptr + "/stop/reversals", "can never be reached within " + std::to_string(pr.trials) +
+                                                 " trials (a reversal needs a trial)", Json(*n));
+        }
+    }
   }
   return pr;
 }

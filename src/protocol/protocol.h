@@ -53,6 +53,7 @@ struct Procedure {
   double start = 1, min = 0, max = 1;
   int up = 1, down = 2;
   std::vector<double> steps;
+  int stop_reversals = 0;            // "stop": {"reversals": n}: ends after n reversals (0: runs all its trials)
   // QUEST+ (Watson 2017) with the Weibull p = 1 - lapse - (1 - guess - lapse) exp(-(x / threshold)^slope): the
   // stimulus of least expected posterior entropy among `stimuli`, over a uniform prior on the parameter grid.
   std::vector<double> stimuli, thresholds, slopes, lapses;

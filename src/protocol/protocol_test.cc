@@ -400,6 +400,23 @@ TEST(ProtocolValidate, OddOneOutHasAlternativesNamedByTheirKeys) {
   ExpectProblem(j, "/blocks/0/procedure/guess: an odd-one-out trial of 3 intervals is guessed right 1/3");
 }
 
+TEST(ProtocolValidate, AStaircaseStopRule) {
+  Json j = Valid();
+  j.erase("counterbalance");
+  j["blocks"] = Json::parse(R"([{"name": "s", "factors": {"section": [1]}, "procedure": {"type": "staircase",
+      "variable": "relative_difference", "reference": "measured", "trials": 20, "start": 1, "min": 0, "max": 2,
+      "steps": [0.2], "stop": {"reversals": 8}}}])");
+  EXPECT_EQ(ParseProtocol(j, SceneFolder() / "p.json").blocks[0].procedure->stop_reversals, 8);
+  j["blocks"][0]["procedure"]["stop"]["reversals"] = 20;
+  ExpectProblem(j, "/blocks/0/procedure/stop/reversals: can never be reached within 20 trials");
+  j["blocks"][0]["procedure"]["stop"]["reversals"] = 0;
+  ExpectProblem(j, "/blocks/0/procedure/stop/reversals: must be an integer in [1, 100]");
+  j["blocks"][0]["procedure"]["stop"] = {{"trials", 3}};
+  ExpectProblem(j, "/blocks/0/procedure/stop/trials: unknown key");
+  j["blocks"][0]["procedure"]["stop"] = nullptr;
+  ExpectProblem(j, "/blocks/0/procedure/stop:");
+}
+
 TEST(ProtocolValidate, ProblemStartsWithFileAndPointer) {
   Json j = Valid();
   j["version"] = 0;

@@ -107,6 +107,19 @@ double AdaptiveState::Level(const protocol::Trial& trial) {
   return std::get<QuestPlus>(state).Next();
 }
 
+bool AdaptiveState::Stopped(const protocol::Trial& trial) {
+  const State& state = StateOf(trial);
+  const protocol::Block* block = protocol::BlockOf(protocol_, trial);
+  const int stop = block && block->procedure ? block->procedure->stop_reversals : 0;
+  const auto* s = std::get_if<Staircase>(&state);
+  return stop > 0 && s && s->Reversals() >= stop;
+}
+
+int AdaptiveState::Reversals(const protocol::Trial& trial) {
+  const auto* s = std::get_if<Staircase>(&StateOf(trial));
+  return s ? s->Reversals() : 0;
+}
+
 void AdaptiveState::Answer(const protocol::Trial& trial, double level, bool correct) {
   auto& state = StateOf(trial);
   if (auto* s = std::get_if<Staircase>(&state)) s->Update(correct);

@@ -61,6 +61,11 @@ class AdaptiveState {
   explicit AdaptiveState(const protocol::Protocol& protocol);
   // The level `trial` shows now (its procedure's next); the trial must belong to a procedure block.
   double Level(const protocol::Trial& trial);
+  // Whether `trial`'s procedure has ended by its stop rule (a staircase's reversals): its remaining trials are not
+  // shown but recorded as skipped. A pure function of the answers so far, so a resumed session skips the same ones.
+  bool Stopped(const protocol::Trial& trial);
+  // The reversals `trial`'s staircase has made so far (0 for QUEST+).
+  int Reversals(const protocol::Trial& trial);
   void Answer(const protocol::Trial& trial, double level, bool correct);
 
  private:

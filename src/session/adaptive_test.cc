@@ -107,5 +107,31 @@ TEST(AdaptiveState, EachCrossingRunsItsOwnProcedure) {
   EXPECT_THROW(state.Level(stray), Error);
 }
 
+// A stop rule: the staircase ends at its second reversal, by hand: down after two correct (0.6), up after a wrong
+// one (reversal 1), down after two correct (reversal 2) - stopped there, and not a trial earlier. Its other
+// crossing, untouched, has not stopped.
+TEST(AdaptiveState, AStaircaseStopsAtItsReversal) {
+  protocol::Protocol protocol;
+  protocol::Block block;
+  block.name = "stairs";
+  block.procedure = Stairs();
+  block.procedure->stop_reversals = 2;
+  protocol.blocks.push_back(block);
+  AdaptiveState state(protocol);
+  protocol::Trial a, b;
+  a.block = b.block = "stairs";
+  a.cell = 0, b.cell = 1;
+  for (bool correct : {true, true, false, true}) {
+    EXPECT_FALSE(state.Stopped(a));
+    state.Answer(a, state.Level(a), correct);
+  }
+  EXPECT_EQ(state.Reversals(a), 1);
+  EXPECT_FALSE(state.Stopped(a));
+  state.Answer(a, state.Level(a), true);  // the second reversal
+  EXPECT_EQ(state.Reversals(a), 2);
+  EXPECT_TRUE(state.Stopped(a));
+  EXPECT_FALSE(state.Stopped(b));
+}
+
 }  // namespace
 }  // namespace blurcue::session

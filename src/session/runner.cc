@@ -181,6 +181,10 @@ uint64_t TrialSeed(uint64_t seed, int index) {
 
 enum class Outcome { kAnswered, kQuit };
 
+// The choice recorded for a trial that was not shown (a procedure ended by its stop rule, a practice round not
+// needed): the record stays aligned with the trial list, and export calls it status "skipped".
+constexpr const char* kSkipped = "skipped";
+
 class Runner {
  public:
   Runner(const RunOptions& options, const PreparedSession& prepared, render::GlContext& context,
@@ -442,6 +446,14 @@ class Runner {
         const protocol::Trial& t = trials_[size_t(i)];
         if (t.cell < 0) continue;
         const auto it = answered.find(i);
+        // A trial its procedure's stop rule skipped: the replayed answers must have stopped it there too.
+        if (it != answered.end() && it->second.choice == kSkipped) {
+          if (!adaptive.Stopped(t))
+            throw InputError(options_.db.string(), "session " + std::to_string(start.session_id) + " trial " +
+                                                       std::to_string(i) + ": the record skips it, but its " +
+                                                       "procedure had not stopped; it cannot be resumed");
+          continue;
+        }
         const Json shown = it == answered.end() ? Json() : ParseJson(it->second.shown_json, options_.db.string());
         const double level = adaptive.Level(t);
         if (!shown.is_object() || !shown.contains("level") || !shown["level"].is_number() ||
@@ -482,6 +494,17 @@ class Runner {
         shown_block = part;
       }
       shown_practice = trial.practice;
+      // A procedure ended by its stop rule shows no more trials: each is recorded as skipped, not shown.
+      if (trial.cell >= 0 && adaptive.Stopped(trial)) {
+        store::Response skipped;
+        skipped.choice = kSkipped;
+        skipped.rt_ms = std::numeric_limits<double>::quiet_NaN();
+        skipped.shown_json = Json{{"skipped", "stop rule"}, {"reversals", adaptive.Reversals(trial)}}.dump();
+        record.RecordResponse(start.session_id, i, skipped);
+        ++result.skipped_now;
+        progress(i + 1);
+        continue;
+      }
       // A procedure's trial shows the level its answers so far give, on its test side.
       TrialScene scene = scenes_[size_t(i)];
       double level = 0;
@@ -497,6 +520,8 @@ class Runner {
       if (trial.cell >= 0) {
         Json shown = TrialVariables(trial, scene, prepared_.presentation);
         shown["correct"] = correct ? 1 : 0;
+        if (ProcedureOf(trial).kind == protocol::Procedure::Kind::kStaircase)
+          shown["reversals"] = adaptive.Reversals(trial);  // before this answer
         response.shown_json = shown.dump();
         response.level = level;
         response.correct = correct;

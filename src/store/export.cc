@@ -344,6 +344,8 @@ const std::map<std::string, ColumnDef>& KnownVariables() {
     add("procedure_cell", "integer", "", "a procedure trial: which crossing of its block's factors (its own procedure)");
     add("test_side", "string", "", "a procedure trial: the side (or odd-one-out interval) showing the procedure's level");
     add("level", "number", "the procedure's variable", "a procedure trial: the level shown");
+    add("reversals", "integer", "", "a staircase trial: the staircase's reversals before this answer (or when it stopped)");
+    add("skipped", "string", "", "why a trial was not shown (stop rule: its staircase had ended)");
     add("odd_interval", "integer", "", "odd one out: the interval that showed the right side's object (the correct answer)");
     add("intervals", "integer", "", "odd one out: intervals per trial");
     return m;
