@@ -446,6 +446,50 @@ assert "Summary" in index and "threshold" in index and "chance 0.33" in index, "
 PYEOF
   $PY "$(dirname "$0")/browser_check.py" "$W/report" index.html bench.html > "$W/browser" || fail "$(cat "$W/browser")"
   echo "ok: every study has its section; $(cat "$W/fit"); $(cat "$W/browser" | sed 's/^ok: //')" ;;
+practice_criterion)
+  # A practice block run until a criterion (80 % correct in one run of its design, at most 3 runs): an observer who
+  # sees every difference meets it in the first run and the two runs after it are recorded as skipped; one who
+  # guesses (jnd 50 px, 6 answers a run, criterion 100 %) runs all three. Stopped mid-way and resumed, the record is
+  # the uninterrupted one.
+  $PY - "$P/test1-static-grids.json" "$W/p.json" <<'PYEOF'
+import json, sys
+t = json.load(open(sys.argv[1]))
+p = {"name": "practice-criterion", "version": 1, "scene": t["scene"], "content": {"type": "grid"},
+     "task": "forced_choice", "sides": {"left": "measured", "right": "none"}, "counterbalance": "swap_copies",
+     "blocks": [{"name": "warmup", "practice": True, "criterion": {"correct": 0.8, "max_repeats": 3},
+                 "factors": {"edge": [4, 7, 10]}, "instructions": "Which grid is more blurred?"},
+                {"name": "main", "factors": {"edge": [3, 9]}}],
+     "timing": {"feedback_ms": 300}}
+json.dump(p, open(sys.argv[2], "w"))
+PYEOF
+  sed -i "s|\"\.\./|\"$P/../|g" "$W/p.json"
+  $BC run "$W/p.json" --participant G1 --db "$W/s.sqlite" --observer sim:jnd=0.05,lapse=0 > "$W/out" 2>&1 \
+    || fail "good observer: $(tail -1 "$W/out")"
+  grep -q "12 skipped now" "$W/out" || fail "good observer: $(tail -1 "$W/out")"
+  sed 's/"correct": 0.8/"correct": 1/' "$W/p.json" > "$W/strict.json"
+  $BC run "$W/strict.json" --participant B1 --db "$W/s.sqlite" --observer sim:jnd=50,lapse=0 > "$W/out" 2>&1 \
+    || fail "guessing observer: $(tail -1 "$W/out")"
+  grep -q "22 of 22 trials answered" "$W/out" || fail "guessing observer: $(tail -1 "$W/out")"
+  $BC export --db "$W/s.sqlite" --out "$W/tables" > /dev/null
+  $PY - "$W/tables/trials.csv" <<'PYEOF' || fail "practice runs in the record"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+good = [r for r in rows if r["participant"] == "G1" and r["block_name"] == "warmup"]
+assert [r["round"] for r in good] == ["1"] * 6 + ["2"] * 6 + ["3"] * 6, [r["round"] for r in good]
+assert all(r["status"] == "answered" and r["correct"] == "1" for r in good[:6]), good[:6]
+assert all(r["status"] == "skipped" and not r["chosen_side"] for r in good[6:]), good[6:]
+bad = [r for r in rows if r["participant"] == "B1" and r["block_name"] == "warmup"]
+assert all(r["status"] == "answered" for r in bad) and len(bad) == 18
+for run in ("1", "2", "3"):
+    assert sum(r["correct"] == "1" for r in bad if r["round"] == run) < 6, run  # never all six
+print("ok")
+PYEOF
+  $BC run "$W/p.json" --participant G2 --db "$W/split.sqlite" --observer sim:jnd=0.05,lapse=0 --stop-after 4 \
+    > /dev/null 2>&1
+  $BC run "$W/p.json" --participant G2 --db "$W/split.sqlite" --observer sim:jnd=0.05,lapse=0 --resume > /dev/null 2>&1
+  $BC run "$W/p.json" --participant G2 --db "$W/whole.sqlite" --observer sim:jnd=0.05,lapse=0 > /dev/null 2>&1
+  [ "$(fingerprint "$W/split.sqlite" G2)" = "$(fingerprint "$W/whole.sqlite" G2)" ] || fail "resumed practice differs"
+  echo "ok: a practice run that met its criterion skipped the runs after it; a guessing observer ran all three; resumable" ;;
 deadline)
   # A deadline: no answer within it records the choice "none" with no response time, and a procedure counts it
   # wrong (its level climbs); feedback after each procedure trial; feedback without a procedure is refused.

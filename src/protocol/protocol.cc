@@ -887,6 +887,19 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
   if (auto s = Text(obj, "instructions", ptr, false, kMaxTextChars, false)) b->instructions = *s;
   if (auto s = Bool(obj, "shuffle", ptr)) b->shuffle = *s;
   if (auto s = Bool(obj, "practice", ptr)) b->practice = *s;
+  // Practice until a criterion: the share correct in one run of the design, and how many runs at most.
+  if (const Json* c = Field(obj, "criterion", ptr, false)) {
+    const std::string at = ptr + "/criterion";
+    if (Object(*c, at, {"correct", "max_repeats"})) {
+      Block::Criterion criterion;
+      if (auto x = Number(*c, "correct", at, true, 0.01, 1, "")) criterion.correct = *x;
+      if (auto n = Int(*c, "max_repeats", at, true, 2, 20, "runs of the design")) criterion.max_repeats = *n;
+      b->criterion = criterion;
+    }
+    if (!b->practice) Problem(at, "is for a practice block (\"practice\": true): a scored block runs once", *c);
+    if (b->task != Task::kForcedChoice || b->procedure)
+      Problem(at, "needs answers that are right or wrong: a forced choice without a procedure", *c);
+  }
   if (const Json* g = Field(obj, "groups", ptr, false)) {
     if (!g->is_array() || g->empty())
       Problem(ptr + "/groups", "must be a list of the protocol's group names", *g);
@@ -1046,7 +1059,7 @@ Protocol Parser::Parse(const Json& json) {
       const Json& obj = (*blocks)[i];
       const std::string bp = "/blocks/" + std::to_string(i);
       if (!Object(obj, bp, {"name", "task", "factors", "conditions", "repetitions", "counterbalance", "sides",
-                            "adjust", "procedure", "instructions", "shuffle", "groups", "practice"}))
+                            "adjust", "procedure", "instructions", "shuffle", "groups", "practice", "criterion"}))
         continue;
       Block b;
       if (auto s = Text(obj, "name", bp, true, kMaxNameChars, true)) {
@@ -1136,11 +1149,13 @@ Protocol Parser::Parse(const Json& json) {
       if (auto x = Number(*v, "deadline_ms", "/timing", false, 100, 60000, "ms")) p.timing.deadline_ms = *x;
       if (auto x = Number(*v, "feedback_ms", "/timing", false, 100, 5000, "ms")) p.timing.feedback_ms = *x;
       if (auto x = Number(*v, "fixation_ms", "/timing", false, 100, 5000, "ms")) p.timing.fixation_ms = *x;
-      // Feedback needs a correct answer, which only a procedure defines; a deadline needs a forced choice.
-      const bool procedure = std::any_of(p.blocks.begin(), p.blocks.end(), [](const Block& b) { return b.procedure; });
-      if (v->contains("feedback_ms") && !procedure)
-        Problem("/timing/feedback_ms", "needs a correct answer: only a block with a procedure defines one",
-                (*v)["feedback_ms"]);
+      // Feedback needs a correct answer: a procedure's, an odd one out's, or a practice run to a criterion's.
+      const bool correct = p.layout == "odd_one_out" ||
+                           std::any_of(p.blocks.begin(), p.blocks.end(),
+                                       [](const Block& b) { return b.procedure || b.criterion; });
+      if (v->contains("feedback_ms") && !correct)
+        Problem("/timing/feedback_ms", "needs a correct answer: a block with a procedure or a criterion, or the "
+                                       "layout odd_one_out, defines one", (*v)["feedback_ms"]);
       const bool adjustment = std::any_of(p.blocks.begin(), p.blocks.end(),
                                           [](const Block& b) { return b.task == Task::kAdjustment; });
       if (v->contains("deadline_ms") && adjustment)
@@ -1401,7 +1416,7 @@ int64_t DesignTrials(const Block& block) {
 int64_t SessionTrials(const Protocol& protocol) {
   int64_t n = 0;
   for (const auto& b : protocol.blocks) {
-    n += DesignTrials(b);
+    n += DesignTrials(b) * (b.criterion ? b.criterion->max_repeats : 1);
     if (b.name == protocol.practice.block) n += std::min<int64_t>(protocol.practice.count, DesignTrials(b));
     if (n > kMaxTrials) return kMaxTrials + 1;
   }

@@ -83,6 +83,14 @@ struct Block {
   std::string instructions;
   std::vector<std::string> groups;    // the groups that run this block; empty: every group
   bool practice = false;              // a practice block: its trials are recorded as practice (not scored)
+  // A practice block repeated until a criterion ("criterion"): its design up to max_repeats times, each round in its
+  // own shuffled order; once a round's share of correct answers reaches `correct`, the rounds after it are recorded
+  // as skipped. Correct: the side showing the larger radius on screen (equal radii: can't tell), the odd interval.
+  struct Criterion {
+    double correct = 0.8;
+    int max_repeats = 3;
+  };
+  std::optional<Criterion> criterion;
 };
 
 struct Scene {

@@ -417,6 +417,34 @@ TEST(ProtocolValidate, AStaircaseStopRule) {
   ExpectProblem(j, "/blocks/0/procedure/stop:");
 }
 
+TEST(ProtocolValidate, PracticeUntilACriterion) {
+  Json j = Valid();
+  j["blocks"][0]["practice"] = true;
+  j["blocks"][0]["criterion"] = {{"correct", 0.8}, {"max_repeats", 3}};
+  const Protocol p = ParseProtocol(j, SceneFolder() / "p.json");
+  ASSERT_TRUE(p.blocks[0].criterion);
+  EXPECT_DOUBLE_EQ(p.blocks[0].criterion->correct, 0.8);
+  EXPECT_EQ(p.blocks[0].criterion->max_repeats, 3);
+  EXPECT_EQ(SessionTrials(p), 3 * DesignTrials(p.blocks[0]) + DesignTrials(p.blocks[1]));
+  Json bad = j;
+  bad["blocks"][0]["practice"] = false;
+  ExpectProblem(bad, "/blocks/0/criterion: is for a practice block");
+  bad = j;
+  bad["blocks"][0]["criterion"]["correct"] = 1.5;
+  ExpectProblem(bad, "/blocks/0/criterion/correct: must be a number in [0.01, 1]");
+  bad["blocks"][0]["criterion"]["correct"] = "nan";
+  ExpectProblem(bad, "/blocks/0/criterion/correct:");
+  bad = j;
+  bad["blocks"][0]["criterion"]["max_repeats"] = 1;
+  ExpectProblem(bad, "/blocks/0/criterion/max_repeats: must be an integer in [2, 20]");
+  bad = j;
+  bad["blocks"][0]["criterion"] = {{"correct", 0.8}};
+  ExpectProblem(bad, "/blocks/0/criterion/max_repeats: is required");
+  bad = j;
+  bad["blocks"][0]["criterion"]["until"] = 3;
+  ExpectProblem(bad, "/blocks/0/criterion/until: unknown key");
+}
+
 TEST(ProtocolValidate, ProblemStartsWithFileAndPointer) {
   Json j = Valid();
   j["version"] = 0;

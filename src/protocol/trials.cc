@@ -156,12 +156,17 @@ std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& part
     const Block& b = protocol.blocks[k];
     if (!group.empty() && !b.groups.empty() && std::find(b.groups.begin(), b.groups.end(), group) == b.groups.end())
       continue;  // another group's block
-    std::vector<Trial> rows = Design(b, even);
-    if (b.shuffle) Shuffle(rows, rng);
-    for (auto& t : rows) {
-      t.practice = b.practice;  // a practice block's trials are recorded as practice
-      DrawAdjustment(b, protocol.alternatives, rng, &t);
-      trials.push_back(std::move(t));
+    // A practice block with a criterion runs its design up to max_repeats times, each round shuffled on its own.
+    const int rounds = b.criterion ? b.criterion->max_repeats : 1;
+    for (int round = 0; round < rounds; ++round) {
+      std::vector<Trial> rows = Design(b, even);
+      if (b.shuffle) Shuffle(rows, rng);
+      for (auto& t : rows) {
+        t.practice = b.practice;  // a practice block's trials are recorded as practice
+        t.round = b.criterion ? round : -1;
+        DrawAdjustment(b, protocol.alternatives, rng, &t);
+        trials.push_back(std::move(t));
+      }
     }
   }
   for (size_t i = 0; i < trials.size(); ++i) trials[i].index = static_cast<int>(i);
@@ -240,10 +245,9 @@ Json ToJson(const Trial& t) {
     j["adjust_levels"] = t.adjust_levels;
     j["start_index"] = t.start_index;
   }
-  if (t.cell >= 0) {
-    j["cell"] = t.cell;
-    j["test_side"] = t.test_side;
-  }
+  if (t.cell >= 0) j["cell"] = t.cell;
+  if (!t.test_side.empty()) j["test_side"] = t.test_side;  // a procedure's test side, an odd one out's interval
+  if (t.round >= 0) j["round"] = t.round;
   return j;
 }
 

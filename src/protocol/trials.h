@@ -20,6 +20,7 @@ struct Trial {
   bool practice = false;
   Task task = Task::kForcedChoice;
   int repetition = 0;        // 0-based copy of the design within the block
+  int round = -1;            // a practice block with a criterion: which run of its design (0-based); -1 otherwise
   bool swapped = false;      // left and right exchanged against the design (counterbalancing)
   Json levels;               // factor name -> level, as designed (not swapped)
   Json left, right;          // blur source shown on each side; null when the block shows no pair

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "core/error.h"
 
 namespace blurcue::protocol {
@@ -105,6 +107,34 @@ TEST(TrialBuilder, SingleLayoutShowsItsObject) {
     EXPECT_EQ(t.task, Task::kYesNo);
     EXPECT_TRUE(t.test_side.empty());
   }
+}
+
+// A practice block run until a criterion: its design max_repeats times, each run its own shuffle, numbered.
+TEST(TrialBuilder, PracticeToACriterionRunsItsDesignInRounds) {
+  const Protocol p = FromJson(R"({
+    "name": "rounds", "version": 1, "scene": {"background": "s.png", "calib": "c.json"},
+    "content": {"type": "grid"}, "task": "forced_choice", "sides": {"left": "measured", "right": "none"},
+    "blocks": [{"name": "warmup", "practice": true, "criterion": {"correct": 0.75, "max_repeats": 3},
+                "factors": {"edge": [2, 4, 6, 8, 10]}},
+               {"name": "main", "factors": {"edge": [1, 2, 3]}}]
+  })");
+  const auto trials = BuildTrials(p, "P1", 5);
+  ASSERT_EQ(trials.size(), 18u);
+  std::vector<std::vector<int>> runs(3);
+  for (size_t i = 0; i < 15; ++i) {
+    EXPECT_EQ(trials[i].block, "warmup");
+    EXPECT_TRUE(trials[i].practice);
+    EXPECT_EQ(trials[i].round, int(i / 5));
+    runs[size_t(trials[i].round)].push_back(trials[i].levels["edge"].get<int>());
+  }
+  for (auto& run : runs) {
+    std::vector<int> sorted = run;
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_EQ(sorted, (std::vector<int>{2, 4, 6, 8, 10}));  // every run is the whole design
+  }
+  EXPECT_TRUE(runs[0] != runs[1] || runs[1] != runs[2]);  // each run shuffled on its own
+  EXPECT_EQ(trials[15].round, -1);
+  EXPECT_EQ(ToJson(trials[3])["round"], 0);
 }
 
 // Block order: a Williams balanced Latin square over participant numbers - each block once in each place, each

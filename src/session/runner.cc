@@ -9,6 +9,8 @@
 #include <cstdio>
 #include <deque>
 #include <functional>
+#include <map>
+#include <optional>
 #include <limits>
 #include <thread>
 
@@ -185,6 +187,53 @@ enum class Outcome { kAnswered, kQuit };
 // needed): the record stays aligned with the trial list, and export calls it status "skipped".
 constexpr const char* kSkipped = "skipped";
 
+// Whether `choice` answered `trial` correctly, where a trial has a correct answer: a procedure's test side or an odd
+// one out's interval; for a practice pair, the side showing the larger radius (equal radii: can't tell). Empty
+// where nothing is correct (yes/no, rating, adjustment).
+std::optional<bool> CorrectOf(const protocol::Trial& trial, const TrialScene& scene, const std::string& choice) {
+  if (!trial.test_side.empty()) return choice == trial.test_side;
+  if (trial.task != Task::kForcedChoice || scene.content == "picture") return std::nullopt;
+  if (std::abs(scene.r_left_px - scene.r_right_px) <= 1e-9) return choice == "cant_tell";
+  return choice == (scene.r_left_px > scene.r_right_px ? "left" : "right");
+}
+
+// Practice blocks run until a criterion: per block, per run of its design, the answers and the correct ones; a run
+// is over when all its trials are answered. A pure function of the answers, so a resumed session decides the same.
+class PracticeRounds {
+ public:
+  explicit PracticeRounds(const protocol::Protocol& protocol, const std::vector<protocol::Trial>& trials)
+      : protocol_(protocol) {
+    for (const auto& t : trials)
+      if (t.round >= 0) ++size_[{t.block, t.round}];
+  }
+  // The run in which `trial`'s block met its criterion before `trial`'s run (-1: not yet): its trial is skipped.
+  int MetBefore(const protocol::Trial& trial) const {
+    if (trial.round < 0) return -1;
+    for (int r = 0; r < trial.round; ++r)
+      if (Met(trial.block, r)) return r;
+    return -1;
+  }
+  void Answer(const protocol::Trial& trial, bool correct) {
+    auto& [right, answered] = counts_[{trial.block, trial.round}];
+    right += correct, ++answered;
+  }
+  // Whether run `round` of `block` is over and its share of correct answers reached the criterion.
+  bool Met(const std::string& block, int round) const {
+    const auto it = counts_.find({block, round});
+    const auto size = size_.find({block, round});
+    const protocol::Block* b = nullptr;
+    for (const auto& candidate : protocol_.blocks)
+      if (candidate.name == block) b = &candidate;
+    return it != counts_.end() && size != size_.end() && b && b->criterion && it->second.second == size->second &&
+           it->second.first >= b->criterion->correct * it->second.second - 1e-9;
+  }
+
+ private:
+  const protocol::Protocol& protocol_;
+  std::map<std::pair<std::string, int>, int> size_;
+  std::map<std::pair<std::string, int>, std::pair<int, int>> counts_;  // (block, run) -> (correct, answered)
+};
+
 class Runner {
  public:
   Runner(const RunOptions& options, const PreparedSession& prepared, render::GlContext& context,
@@ -283,7 +332,8 @@ class Runner {
       const KeyPress press = trial.task == Task::kYesNo    ? observer.SayYesNo(view)
                              : trial.task == Task::kRating ? observer.Rate(view, int(protocol_.responses.rating.size()))
                              : scene.intervals > 2 ? observer.ChooseOdd(view, scene.intervals, std::stoi(trial.test_side))
-                             : trial.cell >= 0     ? observer.ChooseBlurrier(view)
+                             // A procedure, or practice scored by a criterion: "which side is more blurred?"
+                             : trial.cell >= 0 || trial.round >= 0 ? observer.ChooseBlurrier(view)
                                                    : observer.ChooseSide(view, !protocol_.responses.cant_tell.empty());
       // A moving stimulus is watched to its end before the answer (task 1 is one answer per run); intervals too.
       station_.Script(keys_.Key(press.action, trial.task), onset + StimulusEndS(scene) + press.after_ms / 1000);
@@ -440,12 +490,25 @@ class Runner {
     // Adaptive procedures: their state rebuilt by replaying the answers the record holds, so a resumed session
     // continues exactly where it was; each replayed level must be the one the record says was shown.
     AdaptiveState adaptive(protocol_);
+    PracticeRounds rounds(protocol_, trials_);
     if (start.first_unanswered_trial > 0) {
       const auto answered = record.AnsweredTrials(start.session_id);
       for (int64_t i = 0; i < start.first_unanswered_trial; ++i) {
         const protocol::Trial& t = trials_[size_t(i)];
-        if (t.cell < 0) continue;
         const auto it = answered.find(i);
+        // A practice run until a criterion: skipped only after a run that met it, else counted.
+        if (t.round >= 0 && it != answered.end()) {
+          const bool skipped = it->second.choice == kSkipped;
+          if (skipped != (rounds.MetBefore(t) >= 0))
+            throw InputError(options_.db.string(), "session " + std::to_string(start.session_id) + " trial " +
+                                                       std::to_string(i) + ": the record " +
+                                                       (skipped ? "skips" : "shows") + " this practice trial, but " +
+                                                       "its answers say the criterion was " + (skipped ? "not " : "") +
+                                                       "met before it; it cannot be resumed");
+          if (!skipped) rounds.Answer(t, CorrectOf(t, scenes_[size_t(i)], it->second.choice).value_or(false));
+          continue;
+        }
+        if (t.cell < 0) continue;
         // A trial its procedure's stop rule skipped: the replayed answers must have stopped it there too.
         if (it != answered.end() && it->second.choice == kSkipped) {
           if (!adaptive.Stopped(t))
@@ -505,6 +568,17 @@ class Runner {
         progress(i + 1);
         continue;
       }
+      // A practice run after the run that met its block's criterion: not shown, recorded as skipped.
+      if (const int met = rounds.MetBefore(trial); met >= 0) {
+        store::Response skipped;
+        skipped.choice = kSkipped;
+        skipped.rt_ms = std::numeric_limits<double>::quiet_NaN();
+        skipped.shown_json = Json{{"skipped", "criterion met in run " + std::to_string(met + 1)}}.dump();
+        record.RecordResponse(start.session_id, i, skipped);
+        ++result.skipped_now;
+        progress(i + 1);
+        continue;
+      }
       // A procedure's trial shows the level its answers so far give, on its test side.
       TrialScene scene = scenes_[size_t(i)];
       double level = 0;
@@ -516,7 +590,9 @@ class Runner {
       store::Response response;
       std::vector<store::FrameRecord> frames;
       if (RunTrial(trial, scene, &response, &frames) == Outcome::kQuit) break;
-      const bool correct = response.choice == trial.test_side;
+      const std::optional<bool> right = CorrectOf(trial, scene, response.choice);
+      const bool correct = right.value_or(false);
+      response.correct = right;
       if (trial.cell >= 0) {
         Json shown = TrialVariables(trial, scene, prepared_.presentation);
         shown["correct"] = correct ? 1 : 0;
@@ -524,13 +600,15 @@ class Runner {
           shown["reversals"] = adaptive.Reversals(trial);  // before this answer
         response.shown_json = shown.dump();
         response.level = level;
-        response.correct = correct;
         response.r_left_px = scene.r_left_px;
         response.r_right_px = scene.r_right_px;
       }
       record.RecordResponse(start.session_id, i, response, frames);  // committed before anything else happens
       if (trial.cell >= 0) adaptive.Answer(trial, level, correct);
-      if (trial.cell >= 0 && protocol_.timing.feedback_ms > 0)
+      if (trial.round >= 0) rounds.Answer(trial, correct);
+      // Feedback where an answer is right or wrong: procedure trials, odd one out, practice run to a criterion.
+      if (right && (trial.cell >= 0 || !trial.test_side.empty() || trial.round >= 0) &&
+          protocol_.timing.feedback_ms > 0)
         ShowFor(TextScreen(screen_size_, response.choice == "none" ? "Too slow" : correct ? "Correct" : "Wrong", "",
                            ""),
                 protocol_.timing.feedback_ms / 1000);

@@ -438,6 +438,7 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
   v["practice"] = trial.practice ? 1 : 0;
   v["block_name"] = trial.block;
   v["swapped"] = trial.swapped ? 1 : 0;
+  if (trial.round >= 0) v["round"] = trial.round + 1;  // a practice block run until a criterion: which run
   if (trial.cell >= 0) {  // a procedure's trial: which of its block's procedures, the test side, the level shown
     v["procedure_cell"] = trial.cell;
     v["test_side"] = trial.test_side;
