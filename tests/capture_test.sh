@@ -47,7 +47,7 @@ blur)
   # Every object of every trial: the blur measured on the captured frame matches the recorded r_screen_px within
   # max(0.25 px, 5 %), and its edges lie on the recorded outline within 1 px. Test 1's geometry and sides with a
   # plain card; a static ball 2AFC at edges 3, 6 and 9 against its unblurred twin (a lit ball's rim is not a step).
-  variant "$P/test1-static-grids.json" "$W/grid.json" "content.texture=\"$W/white.ppm\""
+  variant "$P/test1-static-grids.json" "$W/grid.json" "content.texture=\"$W/white.ppm\"" content.cells=DELETE
   capture "$W/grid.json" grid
   "$MEASURE" "$W/grid" > "$W/grid.txt" || fail "test 1 captures: $(grep BAD "$W/grid.txt" | head -3) $(tail -1 "$W/grid.txt")"
   tail -1 "$W/grid.txt"
@@ -64,7 +64,7 @@ blur)
 place)
   # Objects land where their pose says at one screen px per photo px (a crop of the photo around the trial) and at a
   # 0.25 scale of the thesis's full-resolution photo: every edge of every card within 1 px of its outline.
-  variant "$P/test1-static-grids.json" "$W/native.json" "content.texture=\"$W/white.ppm\"" 'display.scale="native"'
+  variant "$P/test1-static-grids.json" "$W/native.json" "content.texture=\"$W/white.ppm\"" content.cells=DELETE 'display.scale="native"'
   capture "$W/native.json" native
   "$MEASURE" "$W/native" > "$W/native.txt" || fail "native: $(grep BAD "$W/native.txt" | head -3)"
   tail -1 "$W/native.txt"
@@ -77,13 +77,48 @@ for f in glob.glob(sys.argv[1] + "/*.json"):
 PYEOF
   $BC synth-scene --out "$W/full" --preset thesis --seed 3 > /dev/null
   $BC calibrate "$W/full/scene.png" --camera "$W/full/camera.json" --out "$W/full/calib.json" > /dev/null
-  variant "$P/test1-static-grids.json" "$W/quarter.json" "content.texture=\"$W/white.ppm\"" 'display.scale=0.25' \
+  variant "$P/test1-static-grids.json" "$W/quarter.json" "content.texture=\"$W/white.ppm\"" content.cells=DELETE 'display.scale=0.25' \
       "scene={\"background\": \"$W/full/scene.png\", \"calib\": \"$W/full/calib.json\"}"
   capture "$W/quarter.json" quarter
   # Place only: below a screen px of blur the edge fit on drawn edges scatters by up to 0.3 px (README).
   "$MEASURE" "$W/quarter" --tolerance-px 1e9 > "$W/quarter.txt" || fail "0.25 scale: $(grep BAD "$W/quarter.txt" | head -3)"
   tail -1 "$W/quarter.txt"
   echo "ok: objects land on their outlines at native and 0.25 scale"
+  ;;
+pose)
+  # Cards of another size, standing upright, turned and raised above the table (content.size_mm, pose, height_mm and
+  # a rotation_deg factor): measured in the captured frames with the edge fit, each edge lies on the outline the
+  # record gives and carries the blur it says.
+  variant "$P/test1-static-grids.json" "$W/pose.json" "content.texture=\"$W/white.ppm\"" content.cells=DELETE 'content.size_mm=80' \
+      'content.pose="standing"' 'content.height_mm=12' 'factors={"edge": [4, 8], "rotation_deg": [-25, 0, 35]}' \
+      'practice={"count": 0}' 'counterbalance="none"' 'sides={"left": "measured", "right": {"screen_px": 2}}'
+  capture "$W/pose.json" pose
+  "$MEASURE" "$W/pose" > "$W/pose.txt" || fail "standing cards: $(grep BAD "$W/pose.txt" | head -3)"
+  $PY - "$W/pose" <<'PYEOF' || fail "the capture does not describe standing cards"
+import glob, json, sys
+n = 0
+for f in glob.glob(sys.argv[1] + "/*.json"):
+    for o in json.load(open(f))["objects"]:
+        xs = [p[0] for p in o["outline_px"]]
+        ys = [p[1] for p in o["outline_px"]]
+        # Upright, an 80 mm card is taller on screen than the 50 mm one lying flat (about 30 px at this view).
+        assert max(ys) - min(ys) > 40, (f, o["outline_px"])
+        n += 1
+assert n == 12, n
+PYEOF
+  tail -1 "$W/pose.txt"
+  # Any image as a card of a given size: one that would stretch the image is refused, naming the field.
+  variant "$P/test1-static-grids.json" "$W/photo-card.json" "content.texture=\"$W/../scene/scene.png\"" \
+      content.cells=DELETE 'content.size_mm=80'
+  set +e
+  $BC validate "$W/photo-card.json" > /dev/null 2> "$W/err"
+  code=$?
+  set -e
+  [ $code = 3 ] && grep -q "/content/size_mm: a card of 80 x 80 mm would stretch the" "$W/err" \
+    || fail "a stretched image card: exit $code $(cat "$W/err")"
+  variant "$W/photo-card.json" "$W/photo-card.json" 'content.size_mm=[80, 53.3]'
+  $BC validate "$W/photo-card.json" > /dev/null || fail "an image card in its proportions was refused"
+  echo "ok: standing, turned, raised cards lie on their recorded outlines with their recorded blur; image cards keep their proportions"
   ;;
 window)
   # Headless and in a window, the same pixels: the window's back buffer read before the swap equals the frame
@@ -171,7 +206,7 @@ thesis)
   # recorded screen px per photo px, as measured on the captured frame.
   $BC synth-scene --out "$W/full" --preset thesis --seed 3 > /dev/null
   $BC calibrate "$W/full/scene.png" --camera "$W/full/camera.json" --out "$W/full/calib.json" > /dev/null
-  variant "$P/test1-static-grids.json" "$W/t1.json" "content.texture=\"$W/white.ppm\"" 'practice={"count": 0}' \
+  variant "$P/test1-static-grids.json" "$W/t1.json" "content.texture=\"$W/white.ppm\"" content.cells=DELETE 'practice={"count": 0}' \
       'factors={"edge": [11]}' 'sides={"left": 16.61, "right": 12.61}' 'display={"width_px": 1920, "height_px": 1080}' \
       "scene={\"background\": \"$W/full/scene.png\", \"calib\": \"$W/full/calib.json\"}"
   capture "$W/t1.json" t1

@@ -146,7 +146,8 @@ bool IsBlurSource(const Json& v) {
 bool IsValueName(const std::string& name) {
   static const std::set<std::string> kNames = {"edge",       "from_edge",  "to_edge", "section",   "speed_cm_s",
                                                "distance_m", "cutoff",     "left",    "right",     "y_mm",   "object",
-                                               "from_y_mm",  "to_y_mm",    "left_x_mm", "right_x_mm"};
+                                               "from_y_mm",  "to_y_mm",    "left_x_mm", "right_x_mm",
+                                               "height_mm",  "rotation_deg"};
   return kNames.count(name) > 0;
 }
 
@@ -413,15 +414,30 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
       else p->content.texture = Path(v, "texture", ptr, true).string();
     }
   }
+  if (*type == "grid" || *type == "ball") {
+    // Raised above the table: up to a metre.
+    if (auto h = Number(v, "height_mm", ptr, false, 0, 1000, "mm")) p->content.height_mm = *h;
+  }
   if (*type == "grid") {
     Object(v, ptr, {"type", "cells", "texture", "kernel", "brightness", "contrast", "white_balance",
-                    "depth_blur_threshold"});
-    // Only the shipped 5 x 5 card is drawn: another count would be recorded but not shown.
-    if (auto n = Int(v, "cells", ptr, false, 5, 5, "cells per side (only the shipped 5 x 5 card is drawn)"))
-      p->content.cells = *n;
+                    "depth_blur_threshold", "size_mm", "pose", "rotation_deg", "height_mm"});
+    if (auto n = Int(v, "cells", ptr, false, 1, 20, "cells per side")) p->content.cells = *n;
+    if (v.contains("cells") && p->content.texture != "grid")
+      Problem(ptr + "/cells", "draws the grid card; an image texture has no cells", v["cells"]);
+    // A card from 5 mm to half a metre: one side (a square), or [width, height].
+    if (const Json* size = Field(v, "size_mm", ptr, false)) {
+      if (NumberIn(*size, 5, 500))
+        p->content.size_mm = size->get<double>();
+      else if (size->is_array() && size->size() == 2 && NumberIn((*size)[0], 5, 500) && NumberIn((*size)[1], 5, 500))
+        p->content.size_mm = (*size)[0].get<double>(), p->content.card_height_mm = (*size)[1].get<double>();
+      else
+        Problem(ptr + "/size_mm", "must be the card's side in " + Range(5, 500, "mm") + " or [width, height]", *size);
+    }
+    if (auto pose = String(v, "pose", ptr, false, {"lying", "standing"})) p->content.standing = *pose == "standing";
+    if (auto r = Number(v, "rotation_deg", ptr, false, -180, 180, "deg")) p->content.rotation_deg = *r;
   } else if (*type == "ball") {
     Object(v, ptr, {"type", "texture", "radius_mm", "kernel", "brightness", "contrast", "white_balance",
-                    "depth_blur_threshold"});
+                    "depth_blur_threshold", "height_mm"});
     // A ball rolls on the board's 25 mm squares: from a marble to a football.
     if (auto r = Number(v, "radius_mm", ptr, false, 1, 150, "mm")) p->content.radius_mm = *r;
   } else {
@@ -451,6 +467,8 @@ void Parser::CheckLevelValue(const std::string& name, const Json& v, const std::
     number_in(-10000, 10000, "mm", "a place on the board");
   // The thesis rolled at 1.8 and 3 cm/s; 1 mm/s takes 4 minutes over the board, 1 m/s a quarter second.
   else if (name == "speed_cm_s") number_in(0.1, 100, "cm/s", "a speed");
+  else if (name == "height_mm") number_in(0, 1000, "mm", "a height above the table");
+  else if (name == "rotation_deg") number_in(-180, 180, "deg", "a rotation about the vertical");
   else if (name == "distance_m") number_in(0.1, 100, "m", "a distance");
   // Cycles per picture width; 0 shows the picture unfiltered.
   else if (name == "cutoff") number_in(0, 1000, "cycles per picture width", "a cut-off");
@@ -1226,13 +1244,14 @@ void Parser::CheckDesign(const Protocol& p) {
     // A level that places or moves a stimulus is read only by the content it is for: anywhere else it would be
     // recorded but not shown.
     static const std::map<std::string, std::set<std::string>> kUses = {
-        {"grid", {"edge", "y_mm", "left_x_mm", "right_x_mm"}},
+        {"grid", {"edge", "y_mm", "left_x_mm", "right_x_mm", "height_mm", "rotation_deg"}},
         {"ball", {"edge", "from_edge", "to_edge", "section", "speed_cm_s", "y_mm", "from_y_mm", "to_y_mm",
-                  "left_x_mm", "right_x_mm"}},
+                  "left_x_mm", "right_x_mm", "height_mm"}},
         {"picture", {"distance_m"}}};
     static const std::set<std::string> kStimulusLevels = {"edge",      "from_edge",  "to_edge",   "section",
                                                           "speed_cm_s", "distance_m", "y_mm",      "from_y_mm",
-                                                          "to_y_mm",   "left_x_mm",  "right_x_mm"};
+                                                          "to_y_mm",   "left_x_mm",  "right_x_mm", "height_mm",
+                                                          "rotation_deg"};
     const auto uses = kUses.find(type);
     for (const auto& f : b.factors) {
       std::set<std::string> names{f.name};

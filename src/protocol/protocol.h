@@ -102,7 +102,13 @@ struct Scene {
 
 struct Content {
   std::string type;                   // "grid" | "ball" | "picture"
-  int cells = 5;                      // grid: cells per side (only the shipped 5 x 5 card is drawn)
+  int cells = 5;                      // grid: cells per side of the drawn grid card (1-20)
+  // grid: the card's width and height in mm (0: two board squares; a height of 0: square), upright on the table
+  // facing the camera ("standing") or flat on it ("lying"), turned about the vertical axis by rotation_deg.
+  double size_mm = 0, card_height_mm = 0, rotation_deg = 0;
+  bool standing = false;
+  double height_mm = 0;               // grid and ball: raised this far above the table (a card's lowest edge, a
+                                      // ball's lowest point); a level height_mm (rotation_deg) sets it per trial
   // grid and ball: the blur kernel and the thesis's brightness/contrast matching of the virtual object (5.3.1.3),
   // applied in linear light (factors of the texture's values; 1 = as the texture is).
   std::string kernel = "gaussian";    // "gaussian" | "disc"

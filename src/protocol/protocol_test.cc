@@ -122,7 +122,7 @@ TEST(ProtocolValidate, KernelBrightnessContrastWhiteBalanceScaleAndCellsAreCheck
     unused = unused || Contains(problem, "/factors/speed_cm_s: a grid does not use speed_cm_s");
   EXPECT_TRUE(unused) << Problems(still).front();
   Json grid = Valid();
-  grid["content"] = {{"type", "grid"}, {"cells", 7}};
+  grid["content"] = {{"type", "grid"}, {"cells", 25}};  // 1-20 cells are drawn; 25 would be recorded but not shown
   bool named = false;
   for (const auto& problem : Problems(grid)) named = named || Contains(problem, "/content/cells");
   EXPECT_TRUE(named);
@@ -443,6 +443,55 @@ TEST(ProtocolValidate, PracticeUntilACriterion) {
   bad = j;
   bad["blocks"][0]["criterion"]["until"] = 3;
   ExpectProblem(bad, "/blocks/0/criterion/until: unknown key");
+}
+
+// Objects: a grid card of any size, cells, standing or lying, turned and raised; a ball raised; fields a content does
+// not take are refused, and levels height_mm / rotation_deg place each trial.
+TEST(ProtocolValidate, CardsAndBallsInAnyPose) {
+  Json grid = Valid();
+  grid["content"] = {{"type", "grid"}, {"size_mm", {80, 60}}, {"cells", 8}, {"pose", "standing"},
+                     {"rotation_deg", 30}, {"height_mm", 12}};
+  grid["blocks"] = Json::parse(R"([{"name": "a", "factors": {"edge": [2, 5], "rotation_deg": [-30, 0, 30],
+                                    "height_mm": [0, 20]}, "sides": {"left": "measured", "right": "none"}}])");
+  const Protocol p = ParseProtocol(grid, SceneFolder() / "p.json");
+  EXPECT_EQ(p.content.size_mm, 80);
+  EXPECT_EQ(p.content.card_height_mm, 60);
+  EXPECT_EQ(p.content.cells, 8);
+  EXPECT_TRUE(p.content.standing);
+  EXPECT_EQ(p.content.rotation_deg, 30);
+  EXPECT_EQ(p.content.height_mm, 12);
+  Json bad = grid;
+  bad["content"]["size_mm"] = 4;
+  ExpectProblem(bad, "/content/size_mm: must be the card's side in [5, 500] mm or [width, height]");
+  bad["content"]["size_mm"] = {80, "x"};
+  ExpectProblem(bad, "/content/size_mm:");
+  bad = grid;
+  bad["content"]["cells"] = 21;
+  ExpectProblem(bad, "/content/cells: must be an integer in [1, 20]");
+  bad = grid;
+  bad["content"]["pose"] = "hanging";
+  ExpectProblem(bad, "/content/pose: must be one of");
+  bad = grid;
+  bad["content"]["rotation_deg"] = 1e308;
+  ExpectProblem(bad, "/content/rotation_deg:");
+  bad = grid;
+  bad["content"]["radius_mm"] = 10;
+  ExpectProblem(bad, "/content/radius_mm: unknown key");
+  bad = grid;
+  bad["blocks"][0]["factors"]["height_mm"] = {-1, 20};
+  ExpectProblem(bad, "/blocks/0/factors/height_mm/0: a height above the table must be a number in [0, 1000] mm");
+  bad = grid;
+  bad["content"]["texture"] = "scene/scene.png";
+  ExpectProblem(bad, "/content/cells: draws the grid card; an image texture has no cells");
+  // A ball takes a height but no card's pose, and no turn per trial.
+  Json ball = Valid();
+  ball["content"]["height_mm"] = 5;
+  EXPECT_EQ(ParseProtocol(ball, SceneFolder() / "p.json").content.height_mm, 5);
+  ball["content"]["pose"] = "standing";
+  ExpectProblem(ball, "/content/pose: unknown key");
+  ball = Valid();
+  ball["blocks"][1]["factors"]["rotation_deg"] = {0, 30};
+  ExpectProblem(ball, "a ball does not use rotation_deg");
 }
 
 TEST(ProtocolValidate, ProblemStartsWithFileAndPointer) {

@@ -56,28 +56,46 @@ std::vector<Vertex> UnitCard() {
   return {a, b, c, a, c, d};
 }
 
-// Object -> board frame: translate to the centre, spin (balls roll about x), scale by the size.
+// A card's axes in the board frame, each scaled to its extent: along its width (u), towards its texture's top (v),
+// and its unit normal (n).
+struct CardAxes {
+  cv::Vec3d u, v, n;
+};
+CardAxes AxesOf(const VirtualObject& o) {
+  const double a = o.rotation_deg * M_PI / 180, c = std::cos(a), s = std::sin(a);
+  const cv::Vec3d x(c, s, 0), y(-s, c, 0), z(0, 0, 1);
+  const double w = o.size_mm, h = o.card_height_mm > 0 ? o.card_height_mm : o.size_mm;
+  return o.standing ? CardAxes{w * x, h * z, -y} : CardAxes{w * x, h * y, z};
+}
+
+// Object -> board frame: translate to the centre; a ball spun (rolling about x) and scaled by its radius, a card's
+// unit square stretched along its axes.
 glm::mat4 ModelMatrix(const VirtualObject& o) {
-  const float scale = float(o.size_mm);
-  const cv::Matx33d spin = o.kind == VirtualObject::Kind::kBall ? SpinAboutX(o.spin_deg) : cv::Matx33d::eye();
+  cv::Matx33d m3;
+  if (o.kind == VirtualObject::Kind::kBall) {
+    m3 = SpinAboutX(o.spin_deg) * o.size_mm;
+  } else {
+    const CardAxes a = AxesOf(o);
+    for (int r = 0; r < 3; ++r) m3(r, 0) = a.u[r], m3(r, 1) = a.v[r], m3(r, 2) = a.n[r];
+  }
   glm::mat4 m(1.0f);
   for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) m[c][r] = float(spin(r, c)) * scale;
+    for (int c = 0; c < 3; ++c) m[c][r] = float(m3(r, c));
     m[3][r] = float(o.center_board_mm[r]);
   }
   return m;
 }
 
-// The corners of the object's board-frame bounding box.
+// The corners of the object's board-frame bounding box (a card's own four corners).
 std::vector<cv::Point3d> BoxCorners(const VirtualObject& o) {
-  const double h = o.size_mm, hz = o.kind == VirtualObject::Kind::kCard ? 0 : o.size_mm;
-  const double hx = o.kind == VirtualObject::Kind::kCard ? o.size_mm / 2 : h;
+  if (o.kind == VirtualObject::Kind::kCard) return CardCorners(o);
+  const double h = o.size_mm;
   std::vector<cv::Point3d> corners;
   for (int sx : {-1, 1})
     for (int sy : {-1, 1})
       for (int sz : {-1, 1})
-        corners.emplace_back(o.center_board_mm[0] + sx * hx, o.center_board_mm[1] + sy * hx,
-                             o.center_board_mm[2] + sz * hz);
+        corners.emplace_back(o.center_board_mm[0] + sx * h, o.center_board_mm[1] + sy * h,
+                             o.center_board_mm[2] + sz * h);
   return corners;
 }
 
@@ -129,11 +147,22 @@ SceneRenderer::SceneRenderer(const Camera& camera, const cv::Vec3d& rvec, const 
 
 SceneRenderer::~SceneRenderer() = default;
 
-VirtualObject CardBesideBoard(const Board& board, int edge, bool left) {
+std::vector<cv::Point3d> CardCorners(const VirtualObject& o) {
+  const CardAxes a = AxesOf(o);
+  const cv::Vec3d c = o.center_board_mm;
+  std::vector<cv::Point3d> corners;
+  for (const auto& [su, sv] : {std::pair{-0.5, 0.5}, {0.5, 0.5}, {0.5, -0.5}, {-0.5, -0.5}}) {
+    const cv::Vec3d p = c + su * a.u + sv * a.v;
+    corners.emplace_back(p[0], p[1], p[2]);
+  }
+  return corners;
+}
+
+VirtualObject CardBesideBoard(const Board& board, int edge, bool left, double size_mm) {
   VirtualObject o;
   o.kind = VirtualObject::Kind::kCard;
   const double s = board.square_mm;
-  o.size_mm = 2 * s;
+  o.size_mm = size_mm > 0 ? size_mm : 2 * s;
   o.center_board_mm = {left ? -s - o.size_mm / 2 : board.WidthMm() + s + o.size_mm / 2, (edge - 1) * s, 0};
   return o;
 }
@@ -176,9 +205,7 @@ std::vector<cv::Point2d> OutlineOf(const Camera& camera, const cv::Vec3d& rvec, 
   std::vector<cv::Point3d> rim;
   const cv::Vec3d c = o.center_board_mm;
   if (o.kind == VirtualObject::Kind::kCard) {
-    const double h = o.size_mm / 2;
-    for (const auto& [sx, sy] : {std::pair{-1, 1}, {1, 1}, {1, -1}, {-1, -1}})
-      rim.emplace_back(c[0] + sx * h, c[1] + sy * h, c[2]);
+    rim = CardCorners(o);
   } else {
     // The rim the camera's centre sees: the circle where lines from the eye touch the sphere.
     cv::Matx33d rotation;

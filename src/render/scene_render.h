@@ -17,9 +17,15 @@ namespace blurcue::render {
 struct VirtualObject {
   enum class Kind { kCard, kBall };
   Kind kind = Kind::kBall;
-  // Card: centre of a flat square card lying on the table (z = 0); ball: centre of the sphere.
+  // Card: centre of the card; ball: centre of the sphere.
   cv::Vec3d center_board_mm{0, 0, 10};
-  double size_mm = 10;  // card: side; ball: radius
+  double size_mm = 10;  // card: its width; ball: radius
+  // Card: its height along its texture's rows (0: square); upright on the table facing the camera (its face towards
+  // -y, its texture's top up) or lying flat (texture's top towards +y); turned about the vertical axis by
+  // rotation_deg (counter-clockwise seen from above).
+  double card_height_mm = 0;
+  bool standing = false;
+  double rotation_deg = 0;
   cv::Mat texture;      // 8-bit sRGB BGR/BGRA: equirectangular for a ball, the card's face for a card
   double brightness = 1.0, contrast = 1.0;
   cv::Vec3d white_balance{1, 1, 1};  // gains of red, green, blue in linear light (after brightness and contrast)
@@ -31,7 +37,12 @@ struct VirtualObject {
 // centre on edge `edge`'s line (test 1); a ball of `radius_mm` resting on section `section` (1-based, centred
 // across it) at y_mm along the board, turned as if rolled there from from_y_mm without slipping (tests 2 and 3).
 // Texture, brightness and contrast are left to the caller.
-VirtualObject CardBesideBoard(const Board& board, int edge, bool left);
+// `size_mm` > 0: a card of that width (its centre as far beside the board); 0: two squares wide.
+VirtualObject CardBesideBoard(const Board& board, int edge, bool left, double size_mm = 0);
+
+// A card's four corners in the board frame (mm): top-left, top-right, bottom-right, bottom-left of its texture - the
+// one definition of its pose that drawing, footprints and outlines use.
+std::vector<cv::Point3d> CardCorners(const VirtualObject& card);
 VirtualObject BallOnBoard(const Board& board, int section, double y_mm, double radius_mm, double from_y_mm);
 
 // Where the object lands in the photo, and how far it spans in depth.

@@ -81,6 +81,56 @@ TEST_F(SceneRenderTest, BallLandsWhereThePoseProjectsIt) {
   }
 }
 
+// A card's corners from its pose, worked out by hand: an 80 x 60 mm card standing at (100, 50) with its lowest edge
+// 10 mm above the table, turned 90 deg (its width along +y, facing +x), and one lying flat, unturned.
+TEST(CardCorners, FollowItsPoseByHand) {
+  VirtualObject card;
+  card.kind = VirtualObject::Kind::kCard;
+  card.size_mm = 80, card.card_height_mm = 60;
+  card.standing = true, card.rotation_deg = 90;
+  card.center_board_mm = {100, 50, 40};
+  const std::vector<cv::Point3d> expected = {{100, 10, 70}, {100, 90, 70}, {100, 90, 10}, {100, 10, 10}};
+  const auto corners = CardCorners(card);
+  ASSERT_EQ(corners.size(), 4u);
+  for (size_t i = 0; i < 4; ++i) EXPECT_LT(cv::norm(corners[i] - expected[i]), 1e-9) << i;
+  card.standing = false, card.rotation_deg = 0;
+  card.center_board_mm = {0, 0, 0};
+  const std::vector<cv::Point3d> lying = {{-40, 30, 0}, {40, 30, 0}, {40, -30, 0}, {-40, -30, 0}};
+  const auto flat = CardCorners(card);
+  for (size_t i = 0; i < 4; ++i) EXPECT_LT(cv::norm(flat[i] - lying[i]), 1e-9) << i;
+}
+
+// Drawn by GL, a standing, turned, raised card covers the polygon its hand-made corners project to: the same area
+// within 2 % and the same centroid within a quarter of a pixel, at three turns.
+TEST_F(SceneRenderTest, AStandingTurnedCardCoversItsProjectedCorners) {
+  const View v;
+  SceneRenderer renderer(v.camera, v.rvec, v.tvec);
+  for (double turn : {0.0, 30.0, -60.0}) {
+    VirtualObject card = FlatCard(80, 200);
+    card.card_height_mm = 60;
+    card.standing = true;
+    card.rotation_deg = turn;
+    card.center_board_mm = {87.5, 125, 15 + 30};  // lowest edge 15 mm above the table
+    const double a = turn * M_PI / 180;
+    const cv::Vec3d u(40 * std::cos(a), 40 * std::sin(a), 0), up(0, 0, 30), c = card.center_board_mm;
+    std::vector<cv::Point3d> hand;
+    for (const cv::Vec3d& p : {c - u + up, c + u + up, c + u - up, c - u - up}) hand.emplace_back(p[0], p[1], p[2]);
+    std::vector<cv::Point2d> px;
+    cv::projectPoints(hand, v.rvec, v.tvec, cv::Matx33d(v.camera.Intrinsics().data()), cv::noArray(), px);
+    std::vector<cv::Point2f> polygon(px.begin(), px.end());
+    const cv::Moments m = cv::moments(polygon);
+    // The layer's coverage (alpha, 0-1) as a density over pixel centres, which sit at integer image coordinates as
+    // projectPoints has them.
+    const Layer layer = renderer.Draw(card, 2);
+    cv::Mat alpha;
+    cv::extractChannel(layer.bgra, alpha, 3);
+    const cv::Moments drawn = cv::moments(alpha);
+    EXPECT_NEAR(drawn.m00, std::abs(m.m00), 0.02 * std::abs(m.m00)) << turn;
+    EXPECT_NEAR(layer.roi.x + drawn.m10 / drawn.m00, m.m10 / m.m00, 0.25) << turn;
+    EXPECT_NEAR(layer.roi.y + drawn.m01 / drawn.m00, m.m01 / m.m00, 0.25) << turn;
+  }
+}
+
 TEST_F(SceneRenderTest, BallShrinksWithDistance) {
   const View v;
   SceneRenderer renderer(v.camera, v.rvec, v.tvec);

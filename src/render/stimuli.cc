@@ -361,16 +361,20 @@ cv::Mat WoodTexture(int width_px, uint64_t seed) {
   return Encode(linear);
 }
 
-double GridLineWidthPx(int size_px) { return size_px / 40.0; }
-double GridLinePositionPx(int size_px, int i) { return i * (size_px - GridLineWidthPx(size_px)) / 5.0; }
+double GridLineWidthPx(int size_px, int cells) { return size_px / (8.0 * cells); }
+double GridLinePositionPx(int size_px, int i, int cells) {
+  return i * (size_px - GridLineWidthPx(size_px, cells)) / double(cells);
+}
 
-cv::Mat GridBoard(int size_px) {
-  CheckWidth("GridBoard", size_px, 40, false);
-  const double w = GridLineWidthPx(size_px);
-  // Exact ink coverage of each pixel column (row) by the six lines, so edges are anti-aliased in linear light.
+cv::Mat GridBoard(int size_px, int cells) {
+  if (cells < 1 || cells > 100) throw Error(ErrorKind::kDomain, "GridBoard: cells must be 1-100, got " +
+                                                                    std::to_string(cells));
+  CheckWidth("GridBoard", size_px, std::max(40, 8 * cells), false);
+  const double w = GridLineWidthPx(size_px, cells);
+  // Exact ink coverage of each pixel column (row) by the cells + 1 lines, so edges are anti-aliased in linear light.
   std::vector<double> ink(size_px, 0.0);
-  for (int i = 0; i <= 5; ++i) {
-    const double a = GridLinePositionPx(size_px, i), b = a + w;
+  for (int i = 0; i <= cells; ++i) {
+    const double a = GridLinePositionPx(size_px, i, cells), b = a + w;
     for (int p = std::max(0, int(std::floor(a))); p < std::min(size_px, int(std::ceil(b))); ++p)
       ink[p] += std::max(0.0, std::min(b, p + 1.0) - std::max(a, double(p)));
   }

@@ -31,13 +31,14 @@ cv::Mat SoccerTexture(int width_px, double seam_width_deg = 1.6);
 // same image. 8-bit sRGB BGR, width_px x width_px / 2; width_px must be even and >= 16.
 cv::Mat WoodTexture(int width_px, uint64_t seed);
 
-// User test 1's 5 x 5 grid board: a white square card, black lines (outer border included, width size_px / 40)
-// bounding 5 x 5 equal cells. 8-bit sRGB BGRA, opaque; size_px >= 40.
-cv::Mat GridBoard(int size_px);
+// User test 1's 5 x 5 grid board, or one of `cells` x `cells`: a white square card, black lines (outer border
+// included, width size_px / (8 cells)) bounding equal cells. 8-bit sRGB BGRA, opaque; size_px >= 8 cells.
+cv::Mat GridBoard(int size_px, int cells = 5);
 
-// Where line i (0..5) of a GridBoard(size_px) starts, in pixels from the card's edge (width GridLineWidthPx).
-double GridLinePositionPx(int size_px, int i);
-double GridLineWidthPx(int size_px);
+// Where line i (0..cells) of a GridBoard(size_px, cells) starts, in pixels from the card's edge (width
+// GridLineWidthPx).
+double GridLinePositionPx(int size_px, int i, int cells = 5);
+double GridLineWidthPx(int size_px, int cells = 5);
 
 // The depth-matching study's face-like picture (8 x 12 cm in the study): a drawn, softly shaded face with hair;
 // transparent outside the head. 8-bit sRGB BGRA, width_px x 1.5 width_px; width_px must be even and >= 16.

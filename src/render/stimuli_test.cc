@@ -204,6 +204,26 @@ TEST(GridBoard, SixDarkLinesEachWayAtTheExpectedPositions) {
   }
 }
 
+// Another count of cells: n + 1 dark lines each way, evenly spaced by (size - width) / n, each size / (8 n) wide.
+TEST(GridBoard, AnyCountOfCellsHasItsLines) {
+  const int size = 480;
+  for (int cells : {1, 3, 8, 12}) {
+    const cv::Mat board = GridBoard(size, cells);
+    const double w = size / (8.0 * cells), step = (size - w) / cells;
+    const int through = int(w + step / 2);  // the middle of the first cell
+    std::vector<double> centres;
+    int start = -1;
+    for (int i = 0; i <= size; ++i) {
+      const bool dark = i < size && board.at<cv::Vec4b>(through, i)[1] < 128;
+      if (dark && start < 0) start = i;
+      if (!dark && start >= 0) centres.push_back((start + i) / 2.0), start = -1;
+    }
+    ASSERT_EQ(centres.size(), size_t(cells + 1)) << cells << " cells";
+    for (int k = 0; k <= cells; ++k) EXPECT_NEAR(centres[size_t(k)], k * step + w / 2, 1.0) << cells << " line " << k;
+  }
+  EXPECT_THROW(GridBoard(size, 0), Error);
+}
+
 TEST(GridBoard, IsAnOpaqueCard) {
   std::vector<cv::Mat> planes;
   cv::split(GridBoard(120), planes);

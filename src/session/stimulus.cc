@@ -64,9 +64,14 @@ calib::BlurSource Source(const Json& v, double* fixed, const std::function<std::
 // Board-frame placement of the two objects of a pair (render's poses on the board; x and y in mm where the trial
 // says so).
 render::VirtualObject Card(const calib::SceneCalib& s, const TrialScene& t, bool left) {
-  render::VirtualObject o = render::CardBesideBoard(s.board, 1, left);
+  render::VirtualObject o = render::CardBesideBoard(s.board, 1, left, t.card_width_mm);
+  o.card_height_mm = t.card_height_mm;
+  o.standing = t.standing;
+  o.rotation_deg = t.rotation_deg;
   const double x = left ? t.left_x_mm : t.right_x_mm;
-  o.center_board_mm = {std::isnan(x) ? o.center_board_mm[0] : x, t.from_y_mm, 0};
+  // Its centre at the placement; a standing card's lowest edge rests at height_mm above the table.
+  const double h = o.card_height_mm > 0 ? o.card_height_mm : o.size_mm;
+  o.center_board_mm = {std::isnan(x) ? o.center_board_mm[0] : x, t.from_y_mm, t.height_mm + (t.standing ? h / 2 : 0)};
   return o;
 }
 render::VirtualObject Ball(const calib::SceneCalib& s, const TrialScene& t, double y_mm, double radius_mm, bool left) {
@@ -74,6 +79,7 @@ render::VirtualObject Ball(const calib::SceneCalib& s, const TrialScene& t, doub
       render::BallOnBoard(s.board, left ? kLeftSection : kRightSection, y_mm, radius_mm, t.from_y_mm);
   const double x = left ? t.left_x_mm : t.right_x_mm;
   if (!std::isnan(x)) o.center_board_mm[0] = x;
+  o.center_board_mm[2] += t.height_mm;
   return o;
 }
 
@@ -190,6 +196,13 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   };
   if (auto x = mm_level("left_x_mm")) t.left_x_mm = *x;
   if (auto x = mm_level("right_x_mm")) t.right_x_mm = *x;
+  t.height_mm = mm_level("height_mm").value_or(protocol.content.height_mm);
+  if (t.content == "grid") {
+    t.card_width_mm = protocol.content.size_mm;
+    t.card_height_mm = protocol.content.card_height_mm;
+    t.standing = protocol.content.standing;
+    t.rotation_deg = mm_level("rotation_deg").value_or(protocol.content.rotation_deg);
+  }
   if (t.content == "grid") {
     const auto edge = board_level("edge", edges);
     const auto y = mm_level("y_mm");
@@ -602,6 +615,28 @@ StimulusImages LoadStimulusImages(const protocol::Protocol& protocol, const std:
   }
   images.texture = ReadFieldImage(protocol, shipped ? "/content/type" : "/content/texture", texture, -1, 64,
                                   kMaxTextureSidePx);
+  // A grid card of another count of cells than the shipped 5 x 5 is drawn here, at the shipped card's resolution.
+  if (name == "grid" && protocol.content.cells != 5)
+    images.texture = render::GridBoard(images.texture.cols, protocol.content.cells);
+  // An image on a card of a given size: its pixels keep their shape, or the card says another.
+  if (protocol.content.type == "grid" && !shipped) {
+    const protocol::Content& c = protocol.content;
+    const double w = c.size_mm > 0 ? c.size_mm : 2 * scene->board.square_mm, h = c.card_height_mm > 0 ? c.card_height_mm : w;
+    const double image = double(images.texture.rows) / images.texture.cols;
+    if (std::abs(h / w - image) > 0.02 * image)
+    {
+      auto mm = [](double v) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%g", v);
+        return std::string(text);
+      };
+      throw InputError(At(protocol, "/content/size_mm"),
+                       "a card of " + mm(w) + " x " + mm(h) + " mm would stretch the " +
+                           std::to_string(images.texture.cols) + " x " + std::to_string(images.texture.rows) +
+                           " px texture; give \"size_mm\": [width, height] in its proportions (height = " +
+                           mm(std::round(w * image * 10) / 10) + " mm at this width)");
+    }
+  }
   return images;
 }
 

@@ -36,6 +36,10 @@ struct TrialScene {
   // Across the board (x, 0 at its left edge), per side: NaN for the default place - a card beside the board, a ball
   // on section 3 (left) or 5 (right). From the levels left_x_mm / right_x_mm.
   double left_x_mm = std::numeric_limits<double>::quiet_NaN(), right_x_mm = std::numeric_limits<double>::quiet_NaN();
+  // Grid: the card's width and height (mm; 0: two board squares, square), upright or flat, turned about the
+  // vertical; grid and ball: raised above the table (content defaults, or the levels height_mm / rotation_deg).
+  double card_width_mm = 0, card_height_mm = 0, rotation_deg = 0, height_mm = 0;
+  bool standing = false;
   double speed_mm_s = 0;              // ball: 0 = at rest at from_y_mm
   bool wipe_at_end = false;           // ball: disappear on arrival (a section run)
   double distance_m = 0;              // picture: the real picture's distance
