@@ -197,17 +197,6 @@ def models(m, factors, study, group_note, what):
     table, notes = stats.observer_models(d, "y", rhs)
     if table.empty:
         return Chart(f"{study}-models", None, None, table, notes)
-    glm = table[table["model"].str.startswith("GLM")]
-    glmm = table[table["model"].str.startswith("GLMM")]
-    for term in set(glm["term"]) & set(glmm["term"]):
-        a, b = glm[glm["term"] == term].iloc[0], glmm[glmm["term"] == term].iloc[0]
-        sep_a = "separation" in str(a.get("note", ""))
-        pa, pb = a.get("p", math.nan), b.get("p", math.nan)
-        if sep_a or (not math.isnan(pa) and not math.isnan(pb) and (pa < 0.05) != (pb < 0.05)):
-            notes.append(f"{term}: the GLM and the GLMM disagree ({'no finite GLM estimate' if sep_a else p_text(pa)} "
-                         f"vs GLMM {p_text(pb)}); trust the GLMM - it shrinks each participant's estimate toward the "
-                         f"group, so it has an estimate where every answer of a cell went one way, and it does not "
-                         f"count repeated answers of one participant as independent")
     notes.insert(0, f"{group_note}: logistic models of '{what}' across participants; estimates in log-odds, each "
                     f"term against the baseline it names")
     return Chart(f"{study}-models", None, None, table, notes)

@@ -411,4 +411,26 @@ def observer_models(data, response, formula_rhs, group="participant"):
     table = pd.DataFrame(rows)
     if not table.empty:
         table["term"] = [term_in_words(t, d) for t in table["term"]]
+        notes += disagreements(table)
     return table, notes
+
+
+def disagreements(table):
+    """Where the GLM and the GLMM disagree on a term (one has no finite estimate, or one is significant at 0.05 and the
+    other not), a note saying which to trust and why."""
+    out = []
+    glm = table[table["model"].str.startswith("GLM,") | table["model"].str.startswith("GLM (")]
+    glmm = table[table["model"].str.startswith("GLMM")]
+    for term in [t for t in glm["term"] if t in set(glmm["term"])]:
+        a, b = glm[glm["term"] == term].iloc[0], glmm[glmm["term"] == term].iloc[0]
+        separation = "separation" in str(a.get("note", ""))
+        pa, pb = a.get("p", math.nan), b.get("p", math.nan)
+        split = not separation and not (pd.isna(pa) or pd.isna(pb)) and (pa < 0.05) != (pb < 0.05)
+        if separation or split:
+            glm_text = "no finite estimate (every answer behind it went one way)" if separation else \
+                ("p < 0.001" if pa < 0.001 else f"p = {pa:.3f}")
+            glmm_text = "p < 0.001" if pb < 0.001 else f"p = {pb:.3f}"
+            out.append(f"{term}: the GLM says {glm_text}, the GLMM {glmm_text} - trust the GLMM: it shrinks each "
+                       f"participant's estimate toward the group, so it has an estimate where every answer of a cell "
+                       f"went one way, and it does not count one participant's repeated answers as independent")
+    return out

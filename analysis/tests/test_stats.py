@@ -195,6 +195,17 @@ class ObserverModelTest(unittest.TestCase):
         self.assertTrue(math.isnan(a["estimate_logodds"]))
         self.assertIn("separation", a["note"])
 
+    def test_disagreeing_models_say_which_to_trust(self):
+        table = pd.DataFrame([
+            {"model": "GLM, cluster-robust SE", "term": "pattern_id 3", "note": "separation: all answers one way"},
+            {"model": "GLMM (random intercept, VB)", "term": "pattern_id 3", "p": 0.035, "note": ""},
+            {"model": "GLM, cluster-robust SE", "term": "pattern_id 4", "p": 0.2, "note": ""},
+            {"model": "GLMM (random intercept, VB)", "term": "pattern_id 4", "p": 0.3, "note": ""}])
+        notes = stats.disagreements(table)
+        self.assertEqual(len(notes), 1, notes)
+        self.assertIn("pattern_id 3: the GLM says no finite estimate", notes[0])
+        self.assertIn("the GLMM p = 0.035 - trust the GLMM", notes[0])
+
     def test_terms_in_words(self):
         d = pd.DataFrame({"edge": [3, 6, 9]})
         self.assertEqual(stats.term_in_words("C(pattern_id)[1]", d), "pattern_id 1")
