@@ -16,6 +16,7 @@ import os
 import numpy as np
 import pandas as pd
 import matplotlib.pyplot as plt
+from matplotlib import ticker
 
 from common import Chart, Skip, save
 
@@ -28,6 +29,7 @@ RENDER_COLUMNS = ["kind", "method", "backend", "radius_px", "width", "height", "
 WITHIN_TARGET = 0.9      # README: within max(0.25 px, 5 %) on >= 90 % of sections
 ERROR_FLOOR_PX = 0.25    # the target's absolute part
 REFRESH_MS = 1000 / 60   # one 60 Hz refresh
+REFRESH_120_MS = 1000 / 120  # one 120 Hz refresh: the frame budget of a 120 Hz display
 ONE_LEVEL = 1.0          # README: GL and CPU within 1 level of the exact convolution for r >= 4
 
 METHOD_LABELS = {"model_fit": "model fit (r_px)", "thesis": "thesis threshold count (r_thesis_px)",
@@ -55,6 +57,26 @@ def _read(path, columns):
     if df.empty:
         return None, f"{path}: no rows"
     return df, None
+
+
+def quick_note(df, sep=" - "):
+    """'a --quick run ...' after `sep` when the bench CSV says its rows come from one (its quick column), else ''."""
+    return sep + "a --quick run (few levels, small frames: a smoke test, not the full benchmark)" \
+        if "quick" in df.columns and (df["quick"] == 1).any() else ""
+
+
+def plain_log_ticks(axis):
+    """Log-axis ticks as plain numbers (0.1, 1, 10, 100), not 10^-1 powers or crowded minor labels."""
+    axis.set_major_locator(ticker.LogLocator(base=10, numticks=12))
+    axis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+    axis.set_minor_formatter(ticker.NullFormatter())
+
+
+def better_arrow(ax, text="better: faster and more accurate", start=(0.30, 0.30)):
+    """An arrow toward the lower left (less time, less error), where a method would rather be."""
+    ax.annotate(text, xy=(0.04, 0.04), xytext=start, xycoords="axes fraction", textcoords="axes fraction",
+                arrowprops={"arrowstyle": "->", "color": "#444444", "lw": 1.2}, fontsize=8.5, color="#444444",
+                ha="left", va="bottom")
 
 
 def load_bench(folder):
@@ -134,10 +156,13 @@ def measure_speed_accuracy(measure, out_dir):
     ax.axhline(ERROR_FLOOR_PX, color="#888888", ls=":", lw=1, label="0.25 px (the target's absolute floor)")
     ax.set_xscale("log")
     ax.set_yscale("log")
+    plain_log_ticks(ax.xaxis)
+    plain_log_ticks(ax.yaxis)
+    better_arrow(ax)
     ax.set_xlabel("time per board-edge section (µs, log)")
     ax.set_ylabel("mean |error| against ground truth (px, log)")
-    ax.set_title("Blur measurement: speed against accuracy\nbase scene (large), every swept condition (faint)",
-                 loc="left")
+    ax.set_title("Blur measurement: speed against accuracy" + quick_note(measure) +
+                 "\nbase scene (large), every swept condition (faint)", loc="left")
     ax.scatter([], [], s=220, facecolor="none", edgecolor="black", lw=0.8, label="Pareto front (base scene)")
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     png, svg = save(fig, out_dir, "bench-measure-speed-accuracy")
@@ -208,7 +233,7 @@ def stability(measure, out_dir):
                 # Hollow: the board was not found, so the bench measured at the true pose.
                 ax.scatter(g.loc[~found, "x"], y[~found], s=18, facecolor="white", edgecolor=color, zorder=3)
                 fails = g[g["meets_target"] == 0]
-                if len(fails) and len(fails) < len(g):  # mark where a method that held somewhere first breaks
+                if len(fails):  # where the method first misses - its first level when it never meets the target
                     first = fails.iloc[0]
                     ax.scatter([first["x"]], [y[first.name]], marker="X", s=110, color=color, edgecolor="black",
                                lw=0.6, zorder=5)
@@ -233,11 +258,15 @@ def stability(measure, out_dir):
                    fontsize=9)
         title = ("Where each measurement method breaks: share of sections within target" if what == "within-target"
                  else "Where each measurement method breaks: mean |error| against ground truth")
-        fig.suptitle(title + " (one factor swept at a time from the base scene)", x=0.01, ha="left", fontsize=12)
+        fig.suptitle(title + " (one factor swept at a time from the base scene)" + quick_note(measure, "\n"),
+                     x=0.01, ha="left", fontsize=12)
         fig.tight_layout(rect=(0, 0.06, 1, 1))
         name = f"bench-stability-{what}"
         png, svg = save(fig, out_dir, name)
-        notes = ["x: the factor's levels in sweep order, from the base scene's value to the hardest",
+        never = table[table["holds_at"] == ""]
+        notes = ["x: the factor's levels in sweep order, from the base scene's value to the hardest"] + \
+                [f"{METHOD_LABELS.get(method, method)} misses the target from the first level of "
+                 f"{', '.join(g['factor'])} (marked there)" for method, g in never.groupby("method", sort=False)] + [
                  "table: levels where each method meets the README's target and the first where it does not "
                  "(answered >= 50 % of sections and >= 90 % of them within max(0.25 px, 5 %))"]
         charts.append(Chart(name, png, svg, table if what == "within-target" else pd.DataFrame(), notes))
@@ -275,6 +304,8 @@ def render_speed_accuracy(render, out_dir):
                    edgecolor="black", lw=0.8, zorder=2)
         ax.axhline(ONE_LEVEL, color="#888888", ls=":", lw=1)
         ax.set_xscale("log")
+        plain_log_ticks(ax.xaxis)
+        better_arrow(ax, "better", start=(0.45, 0.12))
         ax.set_title(f"{w} x {h}", fontsize=10.5)
         ax.set_xlabel("time per whole-frame blur (ms, log)")
         for (_, r), on_front in zip(g.iterrows(), front.to_numpy()):
@@ -284,15 +315,20 @@ def render_speed_accuracy(render, out_dir):
                                "max_abs_error_levels": r["max_abs_error_levels"], "pareto_front": bool(on_front)})
         ax.set_ylim(-0.2, top)
     axes.flat[0].set_ylabel("max |error| vs exact convolution\n(8-bit levels)")
+    # A legend entry only for what the chart draws.
+    drawn = set(zip(measured["method"], measured["backend"]))
+    radii = {int(r) for r in measured["radius_px"]}
     handles = [plt.Line2D([], [], marker="s", ls="none", color=c, ms=8, label=f"{m} ({b.upper()})")
-               for (m, b), c in RENDER_COLORS.items()]
+               for (m, b), c in RENDER_COLORS.items() if (m, b) in drawn]
     handles += [plt.Line2D([], [], marker=mk, ls="none", color="#555555", ms=7, label=f"r = {r} px")
-                for r, mk in RADIUS_MARKERS.items()]
+                for r, mk in RADIUS_MARKERS.items() if r in radii]
     handles += [plt.Line2D([], [], marker="o", ls="--", color="black", markerfacecolor="none", ms=11, lw=0.8,
                            label="Pareto front at one radius"),
                 plt.Line2D([], [], ls=":", color="#888888", label="1 level (README: reached for r >= 4)")]
     axes.flat[-1].legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8)
-    fig.suptitle("Blur rendering: speed against accuracy, per frame size", x=0.01, ha="left", fontsize=12)
+    where = "per frame size" if len(sizes) > 1 else f"at {sizes[0][0]} x {sizes[0][1]}"
+    fig.suptitle(f"Blur rendering: speed against accuracy {where}" + quick_note(render, "\n"), x=0.01, ha="left",
+                 fontsize=12)
     fig.tight_layout()
     png, svg = save(fig, out_dir, "bench-render-speed-accuracy")
     notes = ["error: 8-bit sRGB levels against the continuous PSF applied exactly in the frequency domain, on a crop",
@@ -319,13 +355,14 @@ def render_frame(render, out_dir):
         ax.text(r["median_ms"] * 1.1, yi + 0.18, f"{r['median_ms']:.1f} ms", va="center", fontsize=8.5)
         ax.text(r["p99_ms"] * 1.1, yi - 0.18, f"{r['p99_ms']:.1f} ms", va="center", fontsize=8.5)
     ax.axvline(REFRESH_MS, color="#D55E00", ls="--", lw=1, label="one 60 Hz refresh (16.7 ms)")
+    ax.axvline(REFRESH_120_MS, color="#CC79A7", ls=":", lw=1.2, label="one 120 Hz refresh (8.3 ms)")
     ax.set_xscale("log")
     ax.set_xlim(right=frames["p99_ms"].max() * 4)
     ax.set_yticks(y)
     ax.set_yticklabels([labels.get(m, m) for m in frames["method"]])
     ax.set_xlabel("time per frame (ms, log)")
     w, h = int(frames["width"].iloc[0]), int(frames["height"].iloc[0])
-    ax.set_title(f"Two rolling balls, {w} x {h}: time per frame", loc="left")
+    ax.set_title(f"Two rolling balls, {w} x {h}: time per frame" + quick_note(render), loc="left")
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     ax.grid(axis="y", visible=False)
     png, svg = save(fig, out_dir, "bench-frame")
@@ -334,10 +371,16 @@ def render_frame(render, out_dir):
     notes = []
     region = frames[frames["method"] == "region"]
     whole = frames[frames["method"] == "whole_frame"]
+    if len(region):
+        # The frame budget, from the numbers drawn: a frame whose p99 exceeds a refresh misses that refresh.
+        p99 = float(region["p99_ms"].iloc[0])
+        verdict = lambda budget: "within it" if p99 <= budget else f"NOT within it ({p99 / budget:.1f} x over)"
+        notes.append(f"frame budget: the region approach's p99 is {p99:.1f} ms - one 60 Hz refresh (16.7 ms): "
+                     f"{verdict(REFRESH_MS)}; one 120 Hz refresh (8.3 ms): {verdict(REFRESH_120_MS)}")
     if len(region) and len(whole):
         speedup = whole["median_ms"].iloc[0] / region["median_ms"].iloc[0]
-        notes.append(f"region approach {speedup:.0f} x faster than the whole-frame blur (README target >= 10 x: "
-                     f"{'met' if speedup >= 10 else 'NOT met'}); outputs differ by at most "
+        notes.append(f"speed-up: the region approach is {speedup:.0f} x faster than the whole-frame blur (README "
+                     f"target >= 10 x: {'met' if speedup >= 10 else 'NOT met'}); outputs differ by at most "
                      f"{whole['max_abs_error_levels'].iloc[0]:.0f} levels")
     notes.append("error columns of the whole_frame row: difference to the region approach's output, not to an exact "
                  "reference")
@@ -408,8 +451,8 @@ def procedures(df, out_dir):
     axes[0][0].set_ylabel("threshold error (% of target)\nsolid: RMSE, dotted: |bias|")
     axes[0][-1].legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     runs = int(df["runs"].iloc[0])
-    fig.suptitle(f"Which procedure: speed (trials) against accuracy, {runs} simulated 2AFC runs each", x=0.01,
-                 y=1.02, ha="left", fontsize=10)
+    fig.suptitle(f"Which procedure: speed (trials) against accuracy, {runs} simulated 2AFC runs each" +
+                 quick_note(df), x=0.01, y=1.02, ha="left", fontsize=10)
     png, svg = save(fig, out_dir, "bench-procedures")
     table = df[PROCEDURE_COLUMNS].copy()
     notes.append("target: the Weibull threshold for QUEST+ and constant stimuli, the 70.7 % / 79.4 % point of the "

@@ -185,16 +185,16 @@ std::vector<MeasureRow> RunMeasureBench(const MeasureBenchOptions& options) {
   return rows;
 }
 
-void WriteMeasureCsv(const std::vector<MeasureRow>& rows, const std::filesystem::path& path) {
+void WriteMeasureCsv(const std::vector<MeasureRow>& rows, const std::filesystem::path& path, bool quick) {
   std::string text =
       "method,factor,level,sections,answered,mean_abs_error_px,median_abs_error_px,p90_abs_error_px,"
-      "max_abs_error_px,bias_px,within_target,time_us_per_section,meets_target,board_found\n";
+      "max_abs_error_px,bias_px,within_target,time_us_per_section,meets_target,board_found,quick\n";
   for (const auto& r : rows) {
     char line[512];
-    std::snprintf(line, sizeof line, "%s,%s,%g,%d,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.2f,%d,%d\n", r.method.c_str(),
+    std::snprintf(line, sizeof line, "%s,%s,%g,%d,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.2f,%d,%d,%d\n", r.method.c_str(),
                   r.factor.c_str(), r.level, r.sections, r.answered, r.mean_abs_error_px, r.median_abs_error_px,
                   r.p90_abs_error_px, r.max_abs_error_px, r.bias_px, r.within_target, r.time_us_per_section,
-                  int(r.meets_target), int(r.board_found));
+                  int(r.meets_target), int(r.board_found), int(quick));
     text += line;
   }
   WriteFileAtomically(path, text);

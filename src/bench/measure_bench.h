@@ -29,7 +29,9 @@ struct MeasureBenchOptions {
 };
 
 std::vector<MeasureRow> RunMeasureBench(const MeasureBenchOptions& options);
-void WriteMeasureCsv(const std::vector<MeasureRow>& rows, const std::filesystem::path& path);
+// The last column, quick, says a --quick (smoke) run made the rows: charts say so.
+void WriteMeasureCsv(const std::vector<MeasureRow>& rows, const std::filesystem::path& path,
+                     bool quick = false);
 // For each (method, factor): the levels where the method meets its target and where it first fails.
 std::string DescribeBreakpoints(const std::vector<MeasureRow>& rows);
 

@@ -186,13 +186,14 @@ std::vector<ProcedureRow> RunProcedureBench(const ProcedureBenchOptions& options
   return rows;
 }
 
-void WriteProcedureCsv(const std::vector<ProcedureRow>& rows, const std::filesystem::path& path) {
+void WriteProcedureCsv(const std::vector<ProcedureRow>& rows, const std::filesystem::path& path, bool quick) {
   std::ostringstream out;
-  out << "procedure,condition,trials,runs,failed,truth,bias,sd,rmse,us_per_trial\n";
+  out << "procedure,condition,trials,runs,failed,truth,bias,sd,rmse,us_per_trial,quick\n";
   for (const auto& r : rows) {
     char line[256];
-    std::snprintf(line, sizeof line, "%s,%s,%d,%d,%d,%.6g,%.6g,%.6g,%.6g,%.4g\n", r.procedure.c_str(),
-                  r.condition.c_str(), r.trials, r.runs, r.failed, r.truth, r.bias, r.sd, r.rmse, r.us_per_trial);
+    std::snprintf(line, sizeof line, "%s,%s,%d,%d,%d,%.6g,%.6g,%.6g,%.6g,%.4g,%d\n", r.procedure.c_str(),
+                  r.condition.c_str(), r.trials, r.runs, r.failed, r.truth, r.bias, r.sd, r.rmse, r.us_per_trial,
+                  int(quick));
     out << line;
   }
   WriteFileAtomically(path, out.str());

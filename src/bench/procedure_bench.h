@@ -29,7 +29,9 @@ struct ProcedureRow {
 };
 
 std::vector<ProcedureRow> RunProcedureBench(const ProcedureBenchOptions& options);
-void WriteProcedureCsv(const std::vector<ProcedureRow>& rows, const std::filesystem::path& path);
+// The last column, quick, says a --quick (smoke) run made the rows: charts say so.
+void WriteProcedureCsv(const std::vector<ProcedureRow>& rows, const std::filesystem::path& path,
+                     bool quick = false);
 // Per condition, the trials each procedure needs for an RMSE within 10 % of its target (bias and spread together)
 // and its bias and SD at the most trials.
 std::string SummarizeProcedures(const std::vector<ProcedureRow>& rows);

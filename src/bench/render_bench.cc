@@ -208,16 +208,17 @@ std::vector<RenderRow> RunRenderBench(const RenderBenchOptions& options) {
   return rows;
 }
 
-void WriteRenderCsv(const std::vector<RenderRow>& rows, const std::filesystem::path& path) {
+void WriteRenderCsv(const std::vector<RenderRow>& rows, const std::filesystem::path& path, bool quick) {
   std::string text =
       "kind,method,backend,radius_px,width,height,samples,median_ms,p99_ms,mean_abs_error_levels,"
-      "max_abs_error_levels\n";
+      "max_abs_error_levels,quick\n";
   for (const auto& r : rows) {
     char line[300], mean[32] = "", max[32] = "";
     if (!std::isnan(r.mean_abs_error)) std::snprintf(mean, sizeof mean, "%.4f", r.mean_abs_error);
     if (!std::isnan(r.max_abs_error)) std::snprintf(max, sizeof max, "%.1f", r.max_abs_error);
-    std::snprintf(line, sizeof line, "%s,%s,%s,%g,%d,%d,%d,%.3f,%.3f,%s,%s\n", r.kind.c_str(), r.method.c_str(),
-                  r.backend.c_str(), r.radius_px, r.width, r.height, r.samples, r.median_ms, r.p99_ms, mean, max);
+    std::snprintf(line, sizeof line, "%s,%s,%s,%g,%d,%d,%d,%.3f,%.3f,%s,%s,%d\n", r.kind.c_str(), r.method.c_str(),
+                  r.backend.c_str(), r.radius_px, r.width, r.height, r.samples, r.median_ms, r.p99_ms, mean, max,
+                  int(quick));
     text += line;
   }
   WriteFileAtomically(path, text);

@@ -28,7 +28,9 @@ struct RenderBenchOptions {
 };
 
 std::vector<RenderRow> RunRenderBench(const RenderBenchOptions& options);
-void WriteRenderCsv(const std::vector<RenderRow>& rows, const std::filesystem::path& path);
+// The last column, quick, says a --quick (smoke) run made the rows: charts say so.
+void WriteRenderCsv(const std::vector<RenderRow>& rows, const std::filesystem::path& path,
+                     bool quick = false);
 // The ratios the issue asks for, measured in this run.
 std::string SummarizeRender(const std::vector<RenderRow>& rows);
 

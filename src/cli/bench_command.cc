@@ -40,7 +40,7 @@ void AddMeasure(CLI::App& bench) {
     options.seed = args->seed;
     options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
     const auto rows = bench::RunMeasureBench(options);
-    bench::WriteMeasureCsv(rows, args->out);
+    bench::WriteMeasureCsv(rows, args->out, args->quick);
     std::printf("wrote %s (%zu rows)\n\nwhere each method breaks (target: max(0.25 px, 5 %%) on >= 90 %% of answered "
                 "sections, >= 50 %% answered):\n%s",
                 args->out.c_str(), rows.size(), bench::DescribeBreakpoints(rows).c_str());
@@ -87,7 +87,7 @@ void AddRender(CLI::App& bench) {
     options.frames_only = args->frames_only;
     options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
     const auto rows = bench::RunRenderBench(options);
-    bench::WriteRenderCsv(rows, args->out);
+    bench::WriteRenderCsv(rows, args->out, args->quick);
     std::printf("wrote %s (%zu rows)\n%s", args->out.c_str(), rows.size(), bench::SummarizeRender(rows).c_str());
   });
 }
@@ -155,7 +155,7 @@ void AddProcedures(CLI::App& bench) {
     options.seed = args->seed;
     options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
     const auto rows = bench::RunProcedureBench(options);
-    bench::WriteProcedureCsv(rows, args->out);
+    bench::WriteProcedureCsv(rows, args->out, args->quick);
     std::printf("wrote %s (%zu rows, %d runs each)\n%s", args->out.c_str(), rows.size(), options.runs,
                 bench::SummarizeProcedures(rows).c_str());
   });

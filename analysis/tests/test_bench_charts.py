@@ -1,0 +1,123 @@
+"""The benchmark charts say what they draw: titles and legends match the data, every method gets a mark where it
+fails (also from the first level), the frame budget verdict follows the numbers drawn, and a --quick run says so.
+The figures are caught before they are saved, so their titles and legends can be read."""
+import os
+import sys
+import tempfile
+import unittest
+
+import pandas as pd
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.dirname(HERE))
+
+import bench_charts  # noqa: E402
+import common  # noqa: E402
+
+
+class Caught:
+    """Stands in for bench_charts.save: keeps each figure open for the test instead of writing it."""
+
+    def __init__(self):
+        self.figures = {}
+
+    def __call__(self, fig, out_dir, name):
+        self.figures[name] = fig
+        return os.path.join(out_dir, name + ".png"), os.path.join(out_dir, name + ".svg")
+
+
+def render_rows(sizes=((640, 360),), quick=1, p99=19.6):
+    rows = []
+    for w, h in sizes:
+        for method, backend, r, ms, err in (("gaussian", "gl", 1, 11.5, 2.0), ("disc", "cpu", 8, 15.0, 1.0)):
+            rows.append(dict(kind="blur", method=method, backend=backend, radius_px=r, width=w, height=h, samples=3,
+                             median_ms=ms, p99_ms=ms, mean_abs_error_levels=0.1, max_abs_error_levels=err,
+                             quick=quick))
+    rows.append(dict(kind="frame", method="region", backend="gl", radius_px=0, width=640, height=360, samples=30,
+                     median_ms=p99 / 2, p99_ms=p99, mean_abs_error_levels=None, max_abs_error_levels=None, quick=quick))
+    rows.append(dict(kind="frame", method="whole_frame", backend="gl", radius_px=0, width=640, height=360, samples=30,
+                     median_ms=20 * p99, p99_ms=25 * p99, mean_abs_error_levels=0.5, max_abs_error_levels=6,
+                     quick=quick))
+    return pd.DataFrame(rows)
+
+
+def measure_rows(quick=0):
+    rows = []
+    for method, ok in (("model_fit", [1, 1, 0]), ("thesis", [0, 0, 0])):
+        rows.append(dict(method=method, factor="base", level=0, sections=10, answered=10, mean_abs_error_px=0.05,
+                         median_abs_error_px=0.05, p90_abs_error_px=0.1, max_abs_error_px=0.2, bias_px=0,
+                         within_target=1.0, time_us_per_section=100 if method == "model_fit" else 1, meets_target=1,
+                         board_found=1, quick=quick))
+        for level, meets in zip((0.0, 0.02, 0.04), ok):
+            rows.append(dict(method=method, factor="noise", level=level, sections=10, answered=10,
+                             mean_abs_error_px=0.1 if meets else 2, median_abs_error_px=0.1, p90_abs_error_px=0.2,
+                             max_abs_error_px=0.3, bias_px=0, within_target=0.95 if meets else 0.2,
+                             time_us_per_section=100, meets_target=meets, board_found=1, quick=quick))
+    return pd.DataFrame(rows)
+
+
+class BenchChartsTest(unittest.TestCase):
+    def setUp(self):
+        common.setup_style()
+        self.caught = Caught()
+        self.saved = bench_charts.save
+        bench_charts.save = self.caught
+        self.out = tempfile.mkdtemp()
+
+    def tearDown(self):
+        bench_charts.save = self.saved
+
+    def test_one_frame_size_is_named_and_the_legend_lists_only_what_is_drawn(self):
+        bench_charts.render_speed_accuracy(render_rows(), self.out)
+        fig = self.caught.figures["bench-render-speed-accuracy"]
+        self.assertEqual(len(fig.axes), 1)
+        title = fig._suptitle.get_text()
+        self.assertIn("at 640 x 360", title)
+        self.assertNotIn("per frame size", title)
+        labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+        self.assertIn("gaussian (GL)", labels)
+        self.assertIn("disc (CPU)", labels)
+        self.assertNotIn("gaussian (CPU)", labels)  # not in the data: not in the legend
+        self.assertNotIn("r = 4 px", labels)
+        self.assertIn("--quick", title)
+
+    def test_two_sizes_get_two_panels(self):
+        bench_charts.render_speed_accuracy(render_rows(((640, 360), (1920, 1080)), quick=0), self.out)
+        fig = self.caught.figures["bench-render-speed-accuracy"]
+        self.assertEqual(len([a for a in fig.axes if a.get_visible()]), 2)
+        self.assertIn("per frame size", fig._suptitle.get_text())
+        self.assertNotIn("--quick", fig._suptitle.get_text())
+
+    def test_frame_budget_verdict_follows_the_numbers(self):
+        over = bench_charts.render_frame(render_rows(p99=56.9), self.out)[0]
+        self.assertTrue(any("p99 is 56.9 ms" in n and "NOT within it" in n for n in over.notes), over.notes)
+        self.assertFalse(any("target met" in n for n in over.notes))
+        under = bench_charts.render_frame(render_rows(p99=6.0), self.out)[0]
+        self.assertTrue(any("120 Hz refresh (8.3 ms): within it" in n for n in under.notes), under.notes)
+
+    def test_a_method_that_fails_from_the_first_level_gets_a_mark(self):
+        charts = bench_charts.stability(measure_rows(), self.out)
+        notes = charts[0].notes
+        self.assertTrue(any("thesis threshold count" in n and "from the first level of noise" in n for n in notes),
+                        notes)
+        fig = self.caught.figures["bench-stability-within-target"]
+        ax = fig.axes[0]
+        # The X marks: one per failing method - the thesis count's at the first level (x = 0), the model fit's at
+        # the third (x = 2).
+        marks = [c.get_offsets().tolist() for c in ax.collections if c.get_sizes().size and c.get_sizes()[0] == 110]
+        xs = sorted(p[0][0] for p in marks)
+        self.assertEqual(xs, [0.0, 2.0])
+
+    def test_speed_accuracy_has_a_better_direction_and_plain_ticks(self):
+        bench_charts.measure_speed_accuracy(measure_rows(quick=1), self.out)
+        fig = self.caught.figures["bench-measure-speed-accuracy"]
+        ax = fig.axes[0]
+        self.assertTrue(any("better" in t.get_text() for t in ax.texts))
+        fig.canvas.draw()
+        ticks = [t.get_text() for t in ax.get_xticklabels() if t.get_text()]
+        self.assertTrue(ticks and all("^" not in t and "$" not in t for t in ticks), ticks)
+        self.assertIn("--quick", ax.get_title(loc="left"))
+
+
+if __name__ == "__main__":
+    unittest.main()
