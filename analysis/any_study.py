@@ -253,8 +253,9 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
 
 
 def tracks_chart(m, study, out_dir, name, group_note):
-    """The level each adaptive procedure showed, trial after trial, with the answers; threshold estimates per track
-    (the mean of the last 6 reversals for a staircase-like track, else the mean of the last 10 levels)."""
+    """The level each adaptive procedure showed, trial after trial, with the answers, and its threshold estimate:
+    QUEST+'s posterior mean after the last answer (its running posterior mean drawn dashed), a staircase's mean of
+    its last 6 reversal levels (or of its last 10 levels with fewer than 4 reversals)."""
     d = m.dropna(subset=["level"]).copy()
     d["level"] = d["level"].astype(float)
     fig, ax = plt.subplots(figsize=(6.5, 3.8))
@@ -268,19 +269,27 @@ def tracks_chart(m, study, out_dir, name, group_note):
         ok = g["y"].to_numpy() == 1
         ax.plot(step[ok], levels[ok], "o", color=c, ms=3.5)
         ax.plot(step[~ok], levels[~ok], "x", color=c, ms=4)
+        posterior = _num(g["posterior_threshold"]) if "posterior_threshold" in g else pd.Series(dtype=float)
         moves = np.sign(np.diff(levels))
         moves = moves[moves != 0]
         reversals = [levels[1:][np.diff(levels) != 0][j] for j in range(1, len(moves)) if moves[j] != moves[j - 1]]
-        estimate = float(np.mean(reversals[-6:])) if len(reversals) >= 4 else float(np.mean(levels[-10:]))
+        if posterior.notna().any():
+            ax.plot(step, posterior.to_numpy(), "--", color=c, lw=1)
+            estimate, by = float(posterior.dropna().iloc[-1]), "QUEST+ posterior mean after the last answer"
+        elif len(reversals) >= 4:
+            estimate, by = float(np.mean(reversals[-6:])), "mean of the last 6 reversal levels"
+        else:
+            estimate, by = float(np.mean(levels[-10:])), "mean of the last 10 levels"
         rows.append({"participant": participant, "procedure_cell": _label(cell), "trials": len(levels),
-                     "reversals": len(reversals), "estimate": estimate,
-                     "by": "last 6 reversals" if len(reversals) >= 4 else "last 10 levels",
+                     "reversals": len(reversals), "estimate": estimate, "by": by,
                      "share_correct": float(ok.mean())})
     ax.set_xlabel("trial of the procedure")
     ax.set_ylabel("level shown")
-    ax.set_title(f"{study}: procedure tracks (o correct, x wrong)\n{group_note}", loc="left")
+    ax.set_title(f"{study}: procedure tracks (o correct, x wrong; dashed: QUEST+'s posterior mean threshold)\n"
+                 f"{group_note}", loc="left")
     png, svg = save(fig, out_dir, name)
-    return Chart(name, png, svg, pd.DataFrame(rows), ["one line per participant and crossing of the block's factors"])
+    return Chart(name, png, svg, pd.DataFrame(rows), ["one line per participant and crossing of the block's factors; "
+                                                       "estimate: each track's threshold as its procedure gives it"])
 
 
 def side_bias_table(m, study, group_note):

@@ -39,6 +39,11 @@ run pre-research-depth-matching P1 P2 P3
 # ball's relative blur), answered by the simulated observer.
 run quest-blur-difference P1 P2
 run staircase-ball-gain P1
+# Other layouts and tasks: an odd one out of three intervals, one ball answered yes/no and rated, a 2IFC; the report
+# analyses each from what its trials declare.
+run odd-one-out-grids P1 P2
+run yes-no-ball P1 P2
+run 2ifc-grids P1 P2
 # One more test-1 session in a real window on the real clock (under Xvfb when there is no screen), answered by the
 # simulated observer: its frame timing is the report's display-timing chart.
 WINDOW=()

@@ -115,6 +115,12 @@ bool AdaptiveState::Stopped(const protocol::Trial& trial) {
   return stop > 0 && s && s->Reversals() >= stop;
 }
 
+std::optional<std::pair<double, double>> AdaptiveState::Posterior(const protocol::Trial& trial) {
+  const auto* q = std::get_if<QuestPlus>(&StateOf(trial));
+  if (!q) return std::nullopt;
+  return std::make_pair(q->MeanThreshold(), q->MeanSlope());
+}
+
 int AdaptiveState::Reversals(const protocol::Trial& trial) {
   const auto* s = std::get_if<Staircase>(&StateOf(trial));
   return s ? s->Reversals() : 0;

@@ -3,6 +3,7 @@
 // them per crossing of a procedure block's factors. Pure and deterministic: the same answers give the same levels,
 // so a resumed session rebuilds its state by replaying the answers its record holds. No GL, no SQL.
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <variant>
@@ -66,6 +67,9 @@ class AdaptiveState {
   bool Stopped(const protocol::Trial& trial);
   // The reversals `trial`'s staircase has made so far (0 for QUEST+).
   int Reversals(const protocol::Trial& trial);
+  // QUEST+'s posterior means of threshold and slope for `trial`'s crossing, from the answers so far (empty for a
+  // staircase): its estimate, recorded with each answer.
+  std::optional<std::pair<double, double>> Posterior(const protocol::Trial& trial);
   void Answer(const protocol::Trial& trial, double level, bool correct);
 
  private:

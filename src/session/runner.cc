@@ -598,13 +598,19 @@ class Runner {
         shown["correct"] = correct ? 1 : 0;
         if (ProcedureOf(trial).kind == protocol::Procedure::Kind::kStaircase)
           shown["reversals"] = adaptive.Reversals(trial);  // before this answer
+        // The procedure takes the answer now (its state is only in memory; a resume replays the record): QUEST+'s
+        // posterior after it is recorded with it, its running estimate.
+        adaptive.Answer(trial, level, correct);
+        if (const auto posterior = adaptive.Posterior(trial)) {
+          shown["posterior_threshold"] = posterior->first;
+          shown["posterior_slope"] = posterior->second;
+        }
         response.shown_json = shown.dump();
         response.level = level;
         response.r_left_px = scene.r_left_px;
         response.r_right_px = scene.r_right_px;
       }
       record.RecordResponse(start.session_id, i, response, frames);  // committed before anything else happens
-      if (trial.cell >= 0) adaptive.Answer(trial, level, correct);
       if (trial.round >= 0) rounds.Answer(trial, correct);
       // Feedback where an answer is right or wrong: procedure trials, odd one out, practice run to a criterion.
       if (right && (trial.cell >= 0 || !trial.test_side.empty() || trial.round >= 0) &&

@@ -346,6 +346,9 @@ const std::map<std::string, ColumnDef>& KnownVariables() {
     add("level", "number", "the procedure's variable", "a procedure trial: the level shown");
     add("reversals", "integer", "", "a staircase trial: the staircase's reversals before this answer (or when it stopped)");
     add("skipped", "string", "", "why a trial was not shown (stop rule: its staircase had ended)");
+    add("posterior_threshold", "number", "the procedure's variable",
+        "a QUEST+ trial: the posterior mean of the threshold after this answer (its running estimate)");
+    add("posterior_slope", "number", "", "a QUEST+ trial: the posterior mean of the slope after this answer");
     add("round", "integer", "", "a practice block run until a criterion: which run of its design (from 1)");
     add("odd_interval", "integer", "", "odd one out: the interval that showed the right side's object (the correct answer)");
     add("intervals", "integer", "", "odd one out: intervals per trial");
