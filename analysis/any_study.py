@@ -244,12 +244,16 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
                        "alpha": fit.alpha, "beta_slope": fit.beta, "beta_low": fit.ci.get("beta", (math.nan,))[0],
                        "beta_high": fit.ci.get("beta", (math.nan, math.nan))[1], "guess": fit.gamma,
                        "lapse": fit.lam, "answers": len(x)}])
+    inside = not math.isnan(th) and x.min() <= th <= x.max()
     notes = [f"Weibull with the guess rate fixed at chance ({chance:.3g}) and a lapse rate fitted in [0, 0.1]; "
-             f"threshold = the stimulus at {p_mid:.0%}: {th:.3g} [{th_lo:.3g}, {th_hi:.3g}] (parametric bootstrap, "
-             f"{n_boot} samples); slope {fit.beta:.3g}"]
+             f"threshold = the stimulus at {p_mid:.0%}: " +
+             (f"{th:.3g} [{th_lo:.3g}, {th_hi:.3g}] (parametric bootstrap, {n_boot} samples)" if inside else
+              f"beyond the tested range {x.min():.3g} to {x.max():.3g} (an extrapolation, not an estimate)") +
+             f"; slope {fit.beta:.3g}"]
     if fit.on_bound:
         notes.append("on a bound of its range: " + ", ".join(f"{k} ({v[1]})" for k, v in fit.on_bound.items()))
-    return Chart(name, png, svg, t, notes), (th, th_lo, th_hi, fit.beta)
+    return Chart(name, png, svg, t, notes), ((th, th_lo, th_hi, fit.beta) if inside else
+                                             (math.nan, x.min(), x.max(), fit.beta))
 
 
 def tracks_chart(m, study, out_dir, name, group_note):
@@ -374,7 +378,8 @@ def _analyse(d, study, codebook, out_dir, n_boot, seed, group, part):
                                                                    f"{slug}-psychometric", group_note, n_boot, seed,
                                                                    what)
             charts.append(chart)
-            finding += f"; threshold {th:.3g} [{th_lo:.3g}, {th_hi:.3g}]"
+            finding += f"; threshold {th:.3g} [{th_lo:.3g}, {th_hi:.3g}]" if not math.isnan(th) else \
+                f"; threshold beyond the tested range {th_lo:.3g} to {th_hi:.3g}"
         except Skip as e:
             charts.append(Chart(f"{slug}-psychometric", None, None, None, [str(e)]))
         except ValueError as e:

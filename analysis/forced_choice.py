@@ -152,13 +152,10 @@ def test1_per_edge(df, out_dir):
 
 
 def _designed_pair(d):
-    """Sets first/second for pattern rows: the designed pair from the pattern cell; without one, undo the swap of the
-    on-screen sides."""
-    first = d["pattern_left"] if "pattern_left" in d else pd.Series(None, index=d.index)
-    second = d["pattern_right"] if "pattern_right" in d else pd.Series(None, index=d.index)
+    """Sets first/second for pattern rows: the designed pair, the on-screen sides with their swap undone."""
     swapped = d["swapped"] == 1
-    d["first"] = first.where(first.notna(), np.where(swapped, d["right"], d["left"]))
-    d["second"] = second.where(second.notna(), np.where(swapped, d["left"], d["right"]))
+    d["first"] = np.where(swapped, d["right"], d["left"])
+    d["second"] = np.where(swapped, d["left"], d["right"])
     return d
 
 
