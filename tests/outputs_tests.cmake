@@ -16,3 +16,8 @@ add_test(NAME outputs_json_onto_a_folder
                  -DEXPECT_CODE=3 "-DEXPECT_TEXT=cli-test/scene: cannot replace: Is a directory"
                  -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
 set_tests_properties(outputs_json_onto_a_folder PROPERTIES FIXTURES_REQUIRED scene)
+
+# Installed into a temporary prefix and moved: the binary finds what it ships beside itself (tests/install_test.sh).
+add_test(NAME install_relocatable
+         COMMAND bash ${PROJECT_SOURCE_DIR}/tests/install_test.sh ${PROJECT_BINARY_DIR} ${PROJECT_BINARY_DIR}/install-test)
+set_tests_properties(install_relocatable PROPERTIES LABELS gl PASS_REGULAR_EXPRESSION "^ok:|\nok:")

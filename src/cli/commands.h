@@ -99,5 +99,6 @@ void AddRunCommand(CLI::App& app);          // run_command.cc
 void AddPreviewCommand(CLI::App& app);      // preview_command.cc
 void AddReportCommand(CLI::App& app);       // report_command.cc
 void AddDisplayCommand(CLI::App& app);      // display_command.cc
+void AddInfoCommand(CLI::App& app);         // info_command.cc
 
 }  // namespace blurcue::cli

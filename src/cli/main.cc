@@ -40,6 +40,7 @@ int main(int argc, char** argv) {
       {"report", &cli::AddReportCommand},
       {"display", &cli::AddDisplayCommand},
       {"bench", &cli::AddBenchCommand},
+      {"info", &cli::AddInfoCommand},
   };
   for (const auto& [name, add] : commands) add(app);
   // 'blurcue --help' lists each command with its first sentence; the rest is its own --help's footer.

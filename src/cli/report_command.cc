@@ -15,6 +15,7 @@
 
 #include "cli/commands.h"
 #include "core/atomic_file.h"
+#include "core/data_dir.h"
 #include "core/error.h"
 #include "store/export.h"
 
@@ -88,7 +89,7 @@ void AddReportCommand(CLI::App& app) {
                 "analyse people and simulated observers together (by default each study reports them apart)");
   cmd->callback([args] {
     const std::filesystem::path out = args->out;
-    const std::filesystem::path script = std::filesystem::path(BLURCUE_SOURCE_DIR) / "analysis" / "report.py";
+    const std::filesystem::path script = DataDir().path / "analysis" / "report.py";
     if (!std::filesystem::exists(script)) throw InputError(script.string(), "the analysis script is missing");
     for (const auto& path : RemoveStaleLeftovers(out))
       std::fprintf(stderr, "report: removed %s, left by an interrupted run\n", path.c_str());

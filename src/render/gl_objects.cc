@@ -7,6 +7,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/data_dir.h"
 #include "core/error.h"
 
 namespace blurcue::render {
@@ -42,7 +43,7 @@ GLuint Compile(GLenum type, const std::string& source, const std::string& name) 
 
 std::filesystem::path ShaderDir() {
   if (const char* dir = std::getenv("BLURCUE_SHADER_DIR")) return dir;
-  return std::filesystem::path(BLURCUE_SOURCE_DIR) / "shaders";
+  return DataDir().path / "shaders";
 }
 
 Program Program::FromFiles(const std::filesystem::path& vertex, const std::filesystem::path& fragment) {

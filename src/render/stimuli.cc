@@ -11,6 +11,7 @@
 
 #include <opencv2/core/utility.hpp>
 
+#include "core/data_dir.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "core/limits.h"
@@ -19,7 +20,7 @@ namespace blurcue::render {
 
 std::filesystem::path ResolveStimulus(const std::string& name) {
   if (std::filesystem::exists(name)) return name;
-  const auto shipped = std::filesystem::path(BLURCUE_SOURCE_DIR) / "stimuli" / (name + ".png");
+  const auto shipped = DataDir().path / "stimuli" / (name + ".png");
   if (std::filesystem::exists(shipped)) return shipped;
   throw InputError(name, "no such image, and no shipped stimulus " + shipped.string());
 }

@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Installed and moved: `cmake --install` into a temporary prefix, the prefix moved elsewhere (relocatable), and the
+# installed binary run from another folder finds its shaders, stimuli and analysis beside itself (blurcue info says
+# "installed"), and makes a scene, a render, a validated protocol, a simulated session and a report.
+# usage: install_test.sh BUILD_DIR WORK_DIR
+set -euo pipefail
+BUILD=$1 W=$2
+rm -rf "$W" && mkdir -p "$W/elsewhere"
+fail() { echo "FAIL: $*"; exit 1; }
+cmake --install "$BUILD" --prefix "$W/prefix" > "$W/install.log" || fail "install: $(tail -3 "$W/install.log")"
+mv "$W/prefix" "$W/moved"
+BC=$W/moved/bin/blurcue
+cd "$W/elsewhere"
+unset BLURCUE_DATA_DIR BLURCUE_SHADER_DIR
+$BC info > info.txt || fail "info: $(cat info.txt)"
+grep -q "^data: *$W/moved/share/blurcue (installed)" info.txt || fail "not found beside the binary: $(cat info.txt)"
+$BC synth-scene --out scene --seed 5 > /dev/null
+$BC calibrate scene/scene.png --camera scene/camera.json --out calib.json > /dev/null
+$BC render --calib calib.json --background scene/scene.png --object ball --at-edge 9 --blur estimated \
+    --out ball.png > /dev/null || fail "render"
+[ -s ball.png ] || fail "no render"
+sed 's|"\.\./results/demo/|"'"$PWD"'/|g' "$W/moved/share/blurcue/protocols/test1-static-grids.json" > p.json
+$BC validate p.json > /dev/null || fail "validate: $($BC validate p.json 2>&1 | tail -2)"
+$BC run p.json --participant P1 --db s.sqlite --observer sim > /dev/null 2>&1 || fail "run"
+MPLCONFIGDIR=$W/mpl $BC report --db s.sqlite --out report --bench nowhere > /dev/null 2> report.err \
+    || fail "report: $(tail -2 report.err)"
+[ -s report/index.html ] && [ -s report/test1-per-edge.png ] || fail "no report"
+echo "ok: installed to a prefix, moved, and run from elsewhere: info, scene, render, validate, session and report"
