@@ -116,6 +116,38 @@ struct SceneRenderer::Impl {
     if (!slot) slot = std::make_unique<Texture>(Texture::FromSrgbImage(image));
     return *slot;
   }
+
+  // The multisample targets objects are drawn into: made once and grown (to multiples of 64 px) when a layer is
+  // larger, never per frame; a layer of w x h uses their bottom-left w x h.
+  GlName ms_fb, ms_color, ms_depth_value, ms_depth;
+  int ms_w = 0, ms_h = 0;
+  GLuint Targets(int w, int h) {
+    if (w <= ms_w && h <= ms_h) return ms_fb.id();
+    ms_w = std::max(ms_w, (w + 63) / 64 * 64), ms_h = std::max(ms_h, (h + 63) / 64 * 64);
+    GLint max_samples = 1;
+    glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
+    // 4 samples: coverage in quarters is plenty under any blur, and llvmpipe pays per sample.
+    const GLsizei samples = std::min<GLint>(4, max_samples);
+    auto renderbuffer = [&](GLenum format) {
+      GLuint id = 0;
+      glGenRenderbuffers(1, &id);
+      glBindRenderbuffer(GL_RENDERBUFFER, id);
+      glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, format, ms_w, ms_h);
+      return GlName(id, [](GLuint i) { glDeleteRenderbuffers(1, &i); });
+    };
+    ms_color = renderbuffer(GL_RGBA32F), ms_depth_value = renderbuffer(GL_RGBA32F);
+    ms_depth = renderbuffer(GL_DEPTH_COMPONENT24);
+    GLuint id = 0;
+    glGenFramebuffers(1, &id);
+    ms_fb = GlName(id, [](GLuint i) { glDeleteFramebuffers(1, &i); });
+    glBindFramebuffer(GL_FRAMEBUFFER, id);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, ms_color.id());
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_RENDERBUFFER, ms_depth_value.id());
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, ms_depth.id());
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      throw Error(ErrorKind::kInternal, "GL: multisample framebuffer incomplete");
+    return id;
+  }
 };
 
 SceneRenderer::SceneRenderer(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec)
@@ -285,32 +317,15 @@ GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px, boo
   layer.texture = std::make_unique<Texture>(w, h);
   if (depth_map) layer.depth = std::make_unique<Texture>(w, h);
   // Drawn multisampled (4x) and resolved, so silhouettes carry their pixel coverage like a camera's edges do (an aliased
-  // silhouette is sharper than any optics and reads ~0.3 px too sharp under the calibration's measurement).
-  GLint max_samples = 1;
-  glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
-  // 4 samples: coverage in quarters is plenty under any blur, and llvmpipe pays per sample.
-  const GLsizei samples = std::min<GLint>(4, max_samples);
-  auto renderbuffer = [&](GLenum format) {
-    GLuint id = 0;
-    glGenRenderbuffers(1, &id);
-    glBindRenderbuffer(GL_RENDERBUFFER, id);
-    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, format, w, h);
-    return GlName(id, [](GLuint i) { glDeleteRenderbuffers(1, &i); });
-  };
-  GlName ms_color = renderbuffer(GL_RGBA32F), ms_depth = renderbuffer(GL_DEPTH_COMPONENT24);
-  GlName ms_depth_value = depth_map ? renderbuffer(GL_RGBA32F) : GlName();
-  GLuint ms_id = 0;
-  glGenFramebuffers(1, &ms_id);
-  GlName ms_fb(ms_id, [](GLuint i) { glDeleteFramebuffers(1, &i); });
+  // silhouette is sharper than any optics and reads ~0.3 px too sharp under the calibration's measurement). The
+  // targets are the renderer's own, made once; the scissor keeps the clear to this layer's part of them.
+  const GLuint ms_id = impl_->Targets(w, h);
   glBindFramebuffer(GL_FRAMEBUFFER, ms_id);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, ms_color.id());
-  if (depth_map) glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_RENDERBUFFER, ms_depth_value.id());
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, ms_depth.id());
   const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
   glDrawBuffers(depth_map ? 2 : 1, buffers);
-  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-    throw Error(ErrorKind::kInternal, "GL: multisample framebuffer incomplete");
   glViewport(0, 0, w, h);
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(0, 0, w, h);
   glClearColor(0, 0, 0, 0);
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
@@ -339,6 +354,7 @@ GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px, boo
     glDrawArrays(GL_TRIANGLES, impl_->sphere_vertices, impl_->card_vertices);
   glBindVertexArray(0);
   glDisable(GL_DEPTH_TEST);
+  glDisable(GL_SCISSOR_TEST);
   // Resolve: averaging the samples gives premultiplied colour x coverage, and depth x coverage in .r with the
   // coverage in .a (the depth target writes alpha 1), so depth = r / a.
   for (int i = 0; i < (depth_map ? 2 : 1); ++i) {
