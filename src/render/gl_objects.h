@@ -2,6 +2,7 @@
 // Move-only RAII handles for the GL objects blurcue uses (after Magnum's GL layer): no copies, destroyed with the
 // context current, errors that name the shader file and carry the driver's log.
 #include <filesystem>
+#include <map>
 #include <string>
 #include <utility>
 
@@ -47,12 +48,18 @@ class Program {
   static Program FromFiles(const std::filesystem::path& vertex, const std::filesystem::path& fragment);
   static Program FromSource(const std::string& vertex, const std::string& fragment, const std::string& name);
   void Use() const { glUseProgram(name_.id()); }
-  // -1 when the uniform is absent or optimised out (setting it is then a no-op, as in GL).
-  GLint Uniform(const char* name) const { return glGetUniformLocation(name_.id(), name); }
+  // -1 when the uniform is absent or optimised out (setting it is then a no-op, as in GL). Looked up in GL once per
+  // name, then from the program's own table: a frame loop makes no glGetUniformLocation calls.
+  GLint Uniform(const char* name) const {
+    const auto it = uniforms_.find(name);
+    if (it != uniforms_.end()) return it->second;
+    return uniforms_.emplace(name, glGetUniformLocation(name_.id(), name)).first->second;
+  }
   GLuint id() const { return name_.id(); }
 
  private:
   GlName name_;
+  mutable std::map<std::string, GLint, std::less<>> uniforms_;
 };
 
 class Texture {

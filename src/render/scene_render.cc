@@ -108,13 +108,23 @@ struct SceneRenderer::Impl {
   Program program = Program::FromFiles(ShaderDir() / "object.vert", ShaderDir() / "object.frag");
   GlName vao, vbo;
   GLsizei sphere_vertices = 0, card_vertices = 0;
-  // Textures by the address of their pixels: a moving ball re-uses its texture every frame.
-  std::map<const uchar*, std::unique_ptr<Texture>> textures;
+  // Textures by their image: a moving ball re-uses its texture every frame. Each entry holds its image (a cv::Mat
+  // shares the pixels), so those pixels stay allocated and their address cannot come back as another image's.
+  struct CachedTexture {
+    cv::Mat image;
+    std::unique_ptr<Texture> texture;
+  };
+  std::map<const uchar*, CachedTexture> textures;
 
   const Texture& TextureFor(const cv::Mat& image) {
+    // A caller that made a new image every frame would grow the cache without end: past 64 images it starts over.
+    if (textures.size() > 64 && !textures.count(image.data)) textures.clear();
     auto& slot = textures[image.data];
-    if (!slot) slot = std::make_unique<Texture>(Texture::FromSrgbImage(image));
-    return *slot;
+    if (!slot.texture || slot.image.size() != image.size() || slot.image.type() != image.type()) {
+      slot.image = image;
+      slot.texture = std::make_unique<Texture>(Texture::FromSrgbImage(image));
+    }
+    return *slot.texture;
   }
 
   // The multisample targets objects are drawn into: made once and grown (to multiples of 64 px) when a layer is
