@@ -24,7 +24,7 @@ MEASURE_COLUMNS = ["method", "factor", "level", "sections", "answered", "mean_ab
                    "p90_abs_error_px", "max_abs_error_px", "bias_px", "within_target", "time_us_per_section",
                    "meets_target", "board_found"]
 RENDER_COLUMNS = ["kind", "method", "backend", "radius_px", "width", "height", "samples", "median_ms", "p99_ms",
-                  "mean_abs_error_levels", "max_abs_error_levels"]
+                  "mean_abs_error_levels", "max_abs_error_levels"]  # and objects (frame and growth rows), quick
 
 WITHIN_TARGET = 0.9      # README: within max(0.25 px, 5 %) on >= 90 % of sections
 ERROR_FLOOR_PX = 0.25    # the target's absolute part
@@ -67,7 +67,7 @@ def quick_note(df, sep=" - "):
 
 def plain_log_ticks(axis):
     """Log-axis ticks as plain numbers (0.1, 1, 10, 100), not 10^-1 powers or crowded minor labels."""
-    axis.set_major_locator(ticker.LogLocator(base=10, numticks=12))
+    axis.set_major_locator(ticker.LogLocator(base=10, subs=(1.0, 2.0, 5.0), numticks=12))
     axis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
     axis.set_minor_formatter(ticker.NullFormatter())
 
@@ -385,6 +385,57 @@ def render_frame(render, out_dir):
     notes.append("error columns of the whole_frame row: difference to the region approach's output, not to an exact "
                  "reference")
     return [Chart("bench-frame", png, svg, table, notes)]
+
+
+def render_growth(render, out_dir):
+    """How a region-by-region frame's cost grows with the balls in it, the frame's size and the blur radius (one
+    swept at a time from the two-ball frame), median and p99, against one 120 Hz and one 60 Hz refresh."""
+    growth = render[render["kind"] == "growth"] if "kind" in render else render.iloc[0:0]
+    if growth.empty:
+        raise Skip("bench render: no growth rows in render.csv (written by blurcue bench render since it sweeps "
+                   "balls, frame size and radius)")
+    panels = [("objects", "balls in the frame", lambda g: g["objects"]),
+              ("size", "frame size (megapixels)", lambda g: g["width"] * g["height"] / 1e6),
+              ("radius", "blur radius (px)", lambda g: g["radius_px"])]
+    panels = [p for p in panels if (growth["method"] == p[0]).any()]
+    fig, axes = plt.subplots(1, len(panels), figsize=(4.2 * len(panels) + 1.5, 3.8), sharey=True, squeeze=False)
+    notes = []
+    for ax, (swept, label, x_of) in zip(axes[0], panels):
+        g = growth[growth["method"] == swept].copy()
+        g["x"] = x_of(g)
+        g = g.sort_values("x")
+        ax.plot(g["x"], g["median_ms"], "o-", color="#0072B2", label="median")
+        ax.plot(g["x"], g["p99_ms"], "s--", color="#56B4E9", label="99th percentile")
+        for budget, name, color in ((REFRESH_120_MS, "120 Hz", "#CC79A7"), (REFRESH_MS, "60 Hz", "#D55E00")):
+            ax.axhline(budget, color=color, ls=":", lw=1.1, label=f"one {name} refresh ({budget:.1f} ms)")
+        if swept == "objects":
+            ax.set_xscale("log", base=2)
+            ax.set_xticks(list(g["x"]))
+            ax.set_xticklabels([f"{int(v)}" for v in g["x"]])
+            slope = np.polyfit(g["x"], g["median_ms"], 1)[0] if len(g) > 1 else float("nan")
+            notes.append(f"each ball adds about {slope:.2f} ms a frame (median, a straight line through the sweep)")
+            within = g[g["p99_ms"] <= REFRESH_MS]
+            notes.append("p99 within one 60 Hz refresh up to " +
+                         (f"{int(within['x'].max())} balls" if len(within) else "no number of balls swept"))
+        elif swept == "size":
+            for _, r in g.iterrows():
+                ax.annotate(f"{int(r['width'])}x{int(r['height'])}", (r["x"], r["median_ms"]), fontsize=7.5,
+                            textcoords="offset points", xytext=(4, -10))
+        ax.set_yscale("log")
+        plain_log_ticks(ax.yaxis)
+        ax.set_xlabel(label)
+        ax.set_title(f"{swept} swept", loc="left", fontsize=10)
+    axes[0][0].set_ylabel("time per frame (ms, log)")
+    axes[0][-1].legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8)
+    base = growth.iloc[0]
+    fig.suptitle("How a frame's cost grows, region by region (one thing swept at a time from two balls at "
+                 f"{int(base['width'])}x{int(base['height'])})" + quick_note(render, "\n"), x=0.01, ha="left",
+                 fontsize=11)
+    fig.tight_layout()
+    png, svg = save(fig, out_dir, "bench-frame-growth")
+    table = growth[["method", "objects", "width", "height", "radius_px", "samples", "median_ms", "p99_ms"]].rename(
+        columns={"method": "swept"})
+    return [Chart("bench-frame-growth", png, svg, table, notes)]
 
 
 # --------------------------------------------------------------------------------------------------------------------

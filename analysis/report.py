@@ -200,6 +200,7 @@ def main(argv=None):
         ("bench: measurement stability", lambda: bench_charts.stability(needs("measure"), args.out)),
         ("bench: rendering speed vs accuracy", lambda: bench_charts.render_speed_accuracy(needs("render"), args.out)),
         ("bench: two-ball frame", lambda: bench_charts.render_frame(needs("render"), args.out)),
+        ("bench: how a frame's cost grows", lambda: bench_charts.render_growth(needs("render"), args.out)),
         ("bench: which procedure", lambda: bench_charts.procedures(procedures_csv(), args.out)),
     ]
     try:

@@ -212,7 +212,7 @@ def write_bench_fixtures(folder):
         f.write("\n".join(lines) + "\n")
 
     lines = ["kind,method,backend,radius_px,width,height,samples,median_ms,p99_ms,mean_abs_error_levels,"
-             "max_abs_error_levels"]
+             "max_abs_error_levels,objects"]
     for w, h in ((1280, 720), (1920, 1080), (4592, 3056)):
         scale = w * h / (1920 * 1080)
         for method in ("gaussian", "disc"):
@@ -225,10 +225,17 @@ def write_bench_fixtures(folder):
                     mean = 0.1 if r == 1 else 0.02 if r == 4 else 0.01
                     mx = 3 if r == 1 else 1
                     lines.append(f"blur,{method},{backend},{r},{w},{h},{1 if w > 2000 else 3},{ms:.3f},"
-                                 f"{ms * 1.1:.3f},{mean:.4f},{mx:.1f}")
-        lines.append(f"blur,butterworth,cpu,0,{w},{h},1,{60 * scale:.3f},{60 * scale:.3f},0.0000,0.0")
-    lines.append("frame,region,gl,0,1920,1080,120,6.900,11.000,0.0000,0.0")
-    lines.append("frame,whole_frame,gl,0,1920,1080,120,1256.000,1301.000,0.0000,6.0")
+                                 f"{ms * 1.1:.3f},{mean:.4f},{mx:.1f},0")
+        lines.append(f"blur,butterworth,cpu,0,{w},{h},1,{60 * scale:.3f},{60 * scale:.3f},0.0000,0.0,0")
+    lines.append("frame,region,gl,0,1920,1080,120,6.900,11.000,0.0000,0.0,2")
+    lines.append("frame,whole_frame,gl,0,1920,1080,120,1256.000,1301.000,0.0000,6.0,2")
+    # How a frame's cost grows: 2 ms a ball, a little with size and radius.
+    for n in (1, 2, 8, 32):
+        lines.append(f"growth,objects,gl,3,1920,1080,40,{1 + 2 * n:.3f},{1.3 + 2.2 * n:.3f},,,{n}")
+    for r in (1, 4, 8, 16):
+        lines.append(f"growth,radius,gl,{r},1920,1080,40,{5 + 0.1 * r:.3f},{6 + 0.1 * r:.3f},,,2")
+    for w, h in ((1280, 720), (1920, 1080), (3840, 2160)):
+        lines.append(f"growth,size,gl,3,{w},{h},40,{3 + w * h / 1e6:.3f},{4 + w * h / 1e6:.3f},,,2")
     with open(os.path.join(folder, "render.csv"), "w") as f:
         f.write("\n".join(lines) + "\n")
 

@@ -108,6 +108,19 @@ class BenchChartsTest(unittest.TestCase):
         xs = sorted(p[0][0] for p in marks)
         self.assertEqual(xs, [0.0, 2.0])
 
+    def test_frame_growth_charts_each_sweep_and_says_what_fits_a_refresh(self):
+        rows = [dict(kind="growth", method="objects", backend="gl", radius_px=3, width=1920, height=1080, samples=40,
+                     median_ms=1 + 2 * n, p99_ms=1.5 + 2 * n, objects=n, quick=0) for n in (1, 2, 8, 32)]
+        rows += [dict(kind="growth", method="radius", backend="gl", radius_px=r, width=1920, height=1080, samples=40,
+                      median_ms=5, p99_ms=6, objects=2, quick=0) for r in (1, 4, 8, 16)]
+        chart = bench_charts.render_growth(pd.DataFrame(rows), self.out)[0]
+        self.assertTrue(any("each ball adds about 2.00 ms" in n for n in chart.notes), chart.notes)
+        self.assertTrue(any("up to 2 balls" in n for n in chart.notes), chart.notes)  # p99 of 8 balls: 17.5 ms
+        fig = self.caught.figures["bench-frame-growth"]
+        self.assertEqual(len(fig.axes), 2)  # no size rows: no size panel
+        with self.assertRaises(common.Skip):
+            bench_charts.render_growth(render_rows(), self.out)
+
     def test_speed_accuracy_has_a_better_direction_and_plain_ticks(self):
         bench_charts.measure_speed_accuracy(measure_rows(quick=1), self.out)
         fig = self.caught.figures["bench-measure-speed-accuracy"]

@@ -59,7 +59,8 @@ class EndToEndTest(ReportTestCase):
                     "test2-pattern2-per-section", "test2-pattern4-per-section", "test2-pattern6-per-section",
                     "test3-pattern2-per-section", "test3-pattern4-per-section", "test3-pattern6-per-section",
                     "psychometric", "side-bias", "frame-intervals", "bench-measure-speed-accuracy", "bench-stability-within-target",
-                    "bench-stability-error", "bench-render-speed-accuracy", "bench-frame", "bench-procedures"}
+                    "bench-stability-error", "bench-render-speed-accuracy", "bench-frame", "bench-frame-growth",
+                    "bench-procedures"}
         self.assertEqual({p[:-4] for p in pngs}, expected)
         bench_page = read(out, "bench.html")
         linked = set(re.findall(r"<img src='([^']+)'", index))

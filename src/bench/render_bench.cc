@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <sstream>
 
@@ -194,6 +195,7 @@ std::vector<RenderRow> RunRenderBench(const RenderBenchOptions& options) {
       }
     }
     RenderRow row{"frame", approach, "gl", 0, frame_size.width, frame_size.height};
+    row.objects = 2;
     row.samples = frames;
     row.median_ms = Percentile(times, 0.5);
     row.p99_ms = Percentile(times, 0.99);
@@ -205,20 +207,77 @@ std::vector<RenderRow> RunRenderBench(const RenderBenchOptions& options) {
                   frame_size.width, frame_size.height, row.median_ms, row.p99_ms, frames);
     say(line);
   }
+
+  // 3. How a frame's cost grows: balls per frame, frame size, blur radius - one swept at a time from the two-ball
+  //    frame above, region by region.
+  const int growth_frames = options.quick ? 5 : 40;
+  auto time_frames = [&](const synth::Scene& s, render::FrameCompositor& c, int objects, double fixed_r_px) {
+    const optics::Lens l = optics::Lens::FromCamera(s.camera);
+    cv::Matx33d rot;
+    cv::Rodrigues(s.rvec, rot);
+    std::vector<double> times;
+    double r_sum = 0;
+    for (int i = 0; i <= growth_frames; ++i) {  // frame 0 uploads the texture: not timed
+      std::vector<render::BlurredObject> balls(static_cast<size_t>(objects));
+      for (int b = 0; b < objects; ++b) {
+        // Spread over the board's 7 sections and along it, rolling.
+        const double y = std::fmod(250.0 * i / growth_frames + 37.0 * b, 250.0);
+        auto& o = balls[size_t(b)].object;
+        o = render::BallOnBoard(s.board, 1 + b % 7, y, 10, 0);
+        o.texture = soccer;
+        const double z = (rot * o.center_board_mm + s.tvec)[2];
+        balls[size_t(b)].r_px = fixed_r_px > 0 ? fixed_r_px : 3 * optics::BlurRadiusPx(l, s.focus_mm, z);
+        if (i > 0) r_sum += balls[size_t(b)].r_px;
+      }
+      glFinish();
+      const auto t0 = Clock::now();
+      c.Compose(balls);
+      c.Finish();
+      if (i > 0) times.push_back(Ms(t0));
+    }
+    return std::make_pair(times, r_sum / (growth_frames * objects));
+  };
+  auto add = [&](const std::string& swept, const synth::Scene& s, int objects, const std::pair<std::vector<double>, double>& t) {
+    RenderRow row{"growth", swept, "gl", t.second, s.camera.image_width_px, s.camera.image_height_px};
+    row.objects = objects;
+    row.samples = int(t.first.size());
+    row.median_ms = Percentile(t.first, 0.5);
+    row.p99_ms = Percentile(t.first, 0.99);
+    row.mean_abs_error = row.max_abs_error = std::numeric_limits<double>::quiet_NaN();
+    rows.push_back(row);
+    char line[200];
+    std::snprintf(line, sizeof line, "growth %-7s %2d balls %dx%d r %.1f px: median %.1f ms, p99 %.1f ms",
+                  swept.c_str(), objects, row.width, row.height, row.radius_px, row.median_ms, row.p99_ms);
+    say(line);
+  };
+  for (const int objects : {1, 2, 8, 32}) add("objects", scene, objects, time_frames(scene, compositor, objects, 0));
+  for (const double r : {1.0, 4.0, 8.0, 16.0}) add("radius", scene, 2, time_frames(scene, compositor, 2, r));
+  const std::vector<cv::Size> growth_sizes = options.quick ? std::vector<cv::Size>{{640, 360}, {960, 540}}
+                                                           : std::vector<cv::Size>{{1280, 720}, {1920, 1080}, {3840, 2160}};
+  for (const cv::Size& size : growth_sizes) {
+    synth::SceneOptions o = scene_options;
+    o.camera.image_width_px = size.width;
+    o.camera.image_height_px = size.height;
+    o.supersample = 1;  // the background's quality does not change what a frame costs
+    say("rendering the background scene " + std::to_string(size.width) + "x" + std::to_string(size.height));
+    const synth::Scene s = synth::RenderScene(o);
+    render::FrameCompositor c(s.camera, s.rvec, s.tvec, s.image);
+    add("size", s, 2, time_frames(s, c, 2, 0));
+  }
   return rows;
 }
 
 void WriteRenderCsv(const std::vector<RenderRow>& rows, const std::filesystem::path& path, bool quick) {
   std::string text =
       "kind,method,backend,radius_px,width,height,samples,median_ms,p99_ms,mean_abs_error_levels,"
-      "max_abs_error_levels,quick\n";
+      "max_abs_error_levels,objects,quick\n";
   for (const auto& r : rows) {
     char line[300], mean[32] = "", max[32] = "";
     if (!std::isnan(r.mean_abs_error)) std::snprintf(mean, sizeof mean, "%.4f", r.mean_abs_error);
     if (!std::isnan(r.max_abs_error)) std::snprintf(max, sizeof max, "%.1f", r.max_abs_error);
-    std::snprintf(line, sizeof line, "%s,%s,%s,%g,%d,%d,%d,%.3f,%.3f,%s,%s,%d\n", r.kind.c_str(), r.method.c_str(),
-                  r.backend.c_str(), r.radius_px, r.width, r.height, r.samples, r.median_ms, r.p99_ms, mean, max,
-                  int(quick));
+    std::snprintf(line, sizeof line, "%s,%s,%s,%g,%d,%d,%d,%.3f,%.3f,%s,%s,%d,%d\n", r.kind.c_str(),
+                  r.method.c_str(), r.backend.c_str(), r.radius_px, r.width, r.height, r.samples, r.median_ms, r.p99_ms,
+                  mean, max, r.objects, int(quick));
     text += line;
   }
   WriteFileAtomically(path, text);

@@ -10,8 +10,10 @@
 namespace blurcue::bench {
 
 struct RenderRow {
-  std::string kind;     // "blur": one blur of a whole frame; "frame": a composed two-ball frame
-  std::string method;   // gaussian, disc, butterworth; for frames: region or whole_frame
+  // "blur": one blur of a whole frame; "frame": a composed two-ball frame; "growth": how a region-by-region frame's
+  // cost grows with one thing swept (method "objects", "size" or "radius"), the rest as in the two-ball frame.
+  std::string kind;
+  std::string method;   // gaussian, disc, butterworth; for frames: region or whole_frame; for growth: what is swept
   std::string backend;  // gl or cpu
   double radius_px = 0;
   int width = 0, height = 0;
@@ -19,6 +21,7 @@ struct RenderRow {
   double median_ms = 0, p99_ms = 0;
   double mean_abs_error = 0, max_abs_error = 0;  // 8-bit grey levels against the exact reference ("blur") or
                                                  // against the region approach ("frame"); NaN: not measured
+  int objects = 0;      // balls in the frame (frame and growth rows)
 };
 
 struct RenderBenchOptions {
