@@ -126,30 +126,60 @@ TEST(Export, ColumnsAreTheSameForParticipantsWithDifferentFactors) {
   EXPECT_EQ(named, expected);
 }
 
+// A record of schema 6, as that version wrote it: one simulated session, one answered trial.
+void WriteVersionSixRecord(const std::filesystem::path& path) {
+  Database db(path);
+  for (int i = 0; i < 6; ++i) {
+    const Migration& step = Migrations()[size_t(i)];
+    if (!step.sql.empty()) db.Exec(step.sql);
+    if (step.data) step.data(db);
+  }
+  db.Exec("PRAGMA user_version = 6; PRAGMA application_id = " + std::to_string(kApplicationId) + ";"
+          "INSERT INTO studies (name, created) VALUES ('s', 'now');"
+          "INSERT INTO protocol_versions (study_id, json, hash, created) VALUES (1, '{}', 'h', 'now');"
+          "INSERT INTO participants (study_id, code, created) VALUES (1, 'P1', 'now');"
+          "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, host, display, "
+          "  started, status) VALUES (1, 1, -2, 'v', 'h', 'headless 1280x720; llvmpipe; observer sim:jnd=0.6', "
+          "  'now', 'completed');"
+          "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, right_shown) VALUES "
+          "  (1, 0, 0, '{\"block_name\": \"b\", \"edge\": 3, \"r_left_px\": 2, \"r_right_px\": 1}', "
+          "'\"measured\"', '\"none\"');"
+          "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at) VALUES "
+          "  (1, 'left', 700, '[]', 'now');");
+}
+
+// Merged: a record of schema 6 and one of the current schema give one record whose typed columns hold both - the old
+// one's derived from its texts, the new one's copied as written.
+TEST(Merge, AnOlderAndANewRecordMergeWithTheirTypedColumns) {
+  testing::TempDir dir;
+  WriteVersionSixRecord(dir / "old.sqlite");
+  {
+    Record record = Record::Open(dir / "new.sqlite");
+    SessionMeta meta;
+    meta.simulated = false;
+    meta.window = true;
+    const int64_t session = record.StartOrResumeSession("s", "P2", "{}", 9, meta, false).session_id;
+    std::vector<TrialRecord> trials(1);
+    trials[0].block_name = "b";
+    trials[0].r_left_px = 1.23456789;
+    trials[0].left_json = R"("estimated")";
+    record.SaveTrialList(session, trials);
+  }
+  MergeDatabases({dir / "old.sqlite", dir / "new.sqlite"}, dir / "all.sqlite");
+  Database all(dir / "all.sqlite", OpenMode::kReadOnly);
+  EXPECT_EQ(all.QueryText("SELECT group_concat(observer || ':' || window, ',') FROM (SELECT * FROM sessions "
+                          "ORDER BY id)"),
+            "simulated:0,person:1");
+  EXPECT_EQ(all.QueryText("SELECT group_concat(left_source || ':' || printf('%.8f', r_left_px), ',') FROM "
+                          "(SELECT * FROM trials ORDER BY id)"),
+            "measured:2.00000000,estimated:1.23456789");
+}
+
 // A record of schema 6 (its typed columns still in JSON texts and free text) exports the same tidy table from a
 // migrated copy, and is itself left as it was.
 TEST(Export, AnOlderRecordExportsFromAMigratedCopy) {
   testing::TempDir dir;
-  {
-    Database db(dir / "old.sqlite");
-    for (int i = 0; i < 6; ++i) {
-      const Migration& step = Migrations()[size_t(i)];
-      if (!step.sql.empty()) db.Exec(step.sql);
-      if (step.data) step.data(db);
-    }
-    db.Exec("PRAGMA user_version = 6; PRAGMA application_id = " + std::to_string(kApplicationId) + ";"
-            "INSERT INTO studies (name, created) VALUES ('s', 'now');"
-            "INSERT INTO protocol_versions (study_id, json, hash, created) VALUES (1, '{}', 'h', 'now');"
-            "INSERT INTO participants (study_id, code, created) VALUES (1, 'P1', 'now');"
-            "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, host, display, "
-            "  started, status) VALUES (1, 1, -2, 'v', 'h', 'headless 1280x720; llvmpipe; observer sim:jnd=0.6', "
-            "  'now', 'completed');"
-            "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, right_shown) VALUES "
-            "  (1, 0, 0, '{\"block_name\": \"b\", \"edge\": 3, \"r_left_px\": 2, \"r_right_px\": 1}', "
-            "'\"measured\"', '\"none\"');"
-            "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at) VALUES "
-            "  (1, 'left', 700, '[]', 'now');");
-  }
+  WriteVersionSixRecord(dir / "old.sqlite");
   EXPECT_EQ(ExportCsv(dir / "old.sqlite", dir / "out"), 1);
   const Rows rows = ReadCsv(dir / "out" / "trials.csv");
   EXPECT_EQ(rows[1][Column(rows, "observer")], "simulated");
