@@ -395,6 +395,13 @@ codebook)
   $BC export --db "$W/c.sqlite" --out "$W/tables" > /dev/null
   $PY "$(dirname "$0")/codebook_check.py" "$W/tables" "$W/c.sqlite" > "$W/out" || fail "$(cat "$W/out")"
   grep -q "adjustments.csv" "$W/tables/codebook.csv" || fail "adjustments.csv not in the codebook"
+  # "Which fits the scene better?" has no correct answer: test 1's rows leave correct empty; QUEST+'s fill it.
+  $PY - "$W/tables/trials.csv" <<'PYEOF' || fail "correct where nothing is correct"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert all(r["correct"] == "" for r in rows if r["study"] == "test1-static-grids"), "test 1 scored"
+assert all(r["correct"] in ("0", "1") for r in rows if r["study"] == "quest-blur-difference" and r["status"] == "answered")
+PYEOF
   echo "ok: $(tail -1 "$W/out" | sed 's/^ok: //'); $(grep seeds "$W/out" | head -1)" ;;
 report_any_study)
   # Studies unlike the thesis's - QUEST+ on a blur difference, an odd one out, yes/no and rating, a 2IFC - run by

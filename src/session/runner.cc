@@ -590,7 +590,10 @@ class Runner {
       store::Response response;
       std::vector<store::FrameRecord> frames;
       if (RunTrial(trial, scene, &response, &frames) == Outcome::kQuit) break;
-      const std::optional<bool> right = CorrectOf(trial, scene, response.choice);
+      // Scored where the design defines a correct answer: a procedure's, an odd one out's, a practice run to a
+      // criterion's ("which fits the scene better?" has none, whatever the radii).
+      const bool scored = trial.cell >= 0 || !trial.test_side.empty() || trial.round >= 0;
+      const std::optional<bool> right = scored ? CorrectOf(trial, scene, response.choice) : std::nullopt;
       const bool correct = right.value_or(false);
       response.correct = right;
       if (trial.cell >= 0) {
@@ -613,8 +616,7 @@ class Runner {
       record.RecordResponse(start.session_id, i, response, frames);  // committed before anything else happens
       if (trial.round >= 0) rounds.Answer(trial, correct);
       // Feedback where an answer is right or wrong: procedure trials, odd one out, practice run to a criterion.
-      if (right && (trial.cell >= 0 || !trial.test_side.empty() || trial.round >= 0) &&
-          protocol_.timing.feedback_ms > 0)
+      if (right && protocol_.timing.feedback_ms > 0)
         ShowFor(TextScreen(screen_size_, response.choice == "none" ? "Too slow" : correct ? "Correct" : "Wrong", "",
                            ""),
                 protocol_.timing.feedback_ms / 1000);
