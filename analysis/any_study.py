@@ -30,7 +30,7 @@ from common import Chart, Skip, error_bars, p_text, participants_note, save, sta
 DESIGN_MEANING = "a level of the protocol's design"
 # Columns that identify a level rather than vary the stimulus (a pattern's id beside the pattern itself).
 NOT_FACTORS = {"id"}
-KIND_TITLES = {"pair": "which side is more blurred (forced choice)", "odd": "odd one out",
+KIND_TITLES = {"pair": "forced choice between two", "odd": "odd one out",
                "procedure": "adaptive procedure", "yes_no": "yes / no", "rating": "rating",
                "adjustment": "method of adjustment"}
 

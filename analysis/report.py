@@ -115,6 +115,42 @@ def write_index(out_dir, sections, header, name="index.html", title="blurcue ana
     return path
 
 
+def thesis_findings(trials, sections):
+    """One line per thesis study for the summary: the depth matching's pooled slope of log cut-off on log distance
+    (from its chart's table), and for the forced-choice tests how often measured was chosen over estimated where the
+    two were shown side by side (Wilson 95 % interval, exact binomial test against 0.5)."""
+    import stats
+    out = {}
+    charts = {c.name: c for _, cs, _ in sections for c in cs}
+    dm = charts.get("depth-matching")
+    if dm is not None and dm.table is not None and not dm.table.empty and "b_low" in dm.table:
+        pooled = dm.table[dm.table["fit"].astype(str).str.startswith("pooled")]
+        if len(pooled):
+            r = pooled.iloc[0]
+            out[common.STUDY_DEPTH] = (f"accepted cut-off against distance: c ~ d^b with b = {r['b']:.2f} "
+                                       f"[{r['b_low']:.2f}, {r['b_high']:.2f}] ({common.p_text(r['p_b'])}); b < 0: "
+                                       f"more blur accepted farther away")
+    for study in common.FORCED_CHOICE_STUDIES:
+        d = common.study_rows(trials, study)
+        if d.empty:
+            continue
+        d = common.forced_choice(d)
+        pair = d[d["answered"] & d["decisive"] &
+                 (((d["left"] == "measured") & (d["right"] == "estimated")) |
+                  ((d["left"] == "estimated") & (d["right"] == "measured")))]
+        cant = d[d["answered"]]
+        share_cant = (cant["chosen_source"] == "cant_tell").mean() if len(cant) else float("nan")
+        if len(pair):
+            k, n = int((pair["chosen_source"] == "measured").sum()), len(pair)
+            p, lo, hi = stats.wilson(k, n)
+            out[study] = (f"measured chosen over estimated {p:.2f} [{lo:.2f}, {hi:.2f}] of {n} decisive answers "
+                          f"({common.p_text(stats.binom_p(k, n, 0.5))} against 0.5); can't tell {share_cant:.0%} "
+                          f"of all answers")
+        else:
+            out[study] = f"no measured-vs-estimated pairs answered; can't tell {share_cant:.0%} of all answers"
+    return out
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description="Charts, tables and index.html from trials.csv and bench CSVs.")
     parser.add_argument("--trials", required=True, help="trials.csv written by `blurcue export`")
@@ -289,10 +325,11 @@ def main(argv=None):
     say(f"[{total}/{total}] index.html ...")
     # The summary: what each study found (the thesis's studies point at their figures).
     summary = []
+    thesis = thesis_findings(trials, sections)
     for study in sorted(set(trials["study"]) & known):
         d = trials[(trials["study"] == study) & (trials["practice"] != 1)]
         summary.append((study, f"{common.STUDY_TITLES[study]}: {int(d['answered'].sum())} of {len(d)} trials "
-                               f"answered - the thesis's figures below"))
+                               f"answered; " + thesis.get(study, "see its figures below")))
     summary += [(title[len("study "):], finding) for title, finding in findings.items()]
     data_sections, bench_sections = sections[:n_data_steps], sections[n_data_steps:]
     write_index(args.out, bench_sections, [f"bench: {os.path.abspath(args.bench)}"], name="bench.html",

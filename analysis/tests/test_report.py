@@ -54,6 +54,9 @@ class EndToEndTest(ReportTestCase):
         self.assertNotIn("skipped", err)
 
         index = read(out, "index.html")
+        # The summary says what each thesis study found.
+        self.assertIn("measured chosen over estimated", index)
+        self.assertRegex(index, r"c ~ d\^b with b = -?[0-9.]+ \[")
         pngs = sorted(f for f in os.listdir(out) if f.endswith(".png"))
         expected = {"depth-matching", "test1-per-edge", "test2-per-pattern", "test3-per-pattern",
                     "test2-pattern2-per-section", "test2-pattern4-per-section", "test2-pattern6-per-section",
