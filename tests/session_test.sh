@@ -367,6 +367,10 @@ assert yes("object=4") > yes("object=measured"), (yes("object=4"), yes("object=m
 # a band of its own at the bottom, the photo above it.
 o = json.load(open(sys.argv[2] + "/trial-0001.json"))
 assert o["prompt"] is None, o["prompt"]
+# The capture says which side's object the first interval shows: the right side's when it is the odd one.
+first = odd[o["trial_index"]]
+assert o["first_interval_shows"] == ("right" if first["odd_interval"] == "1" else "left"), (o, first)
+assert o["objects"][0]["source"] == first[o["first_interval_shows"] + "_source"], (o["objects"][0], first)
 y = json.load(open(sys.argv[3] + "/trial-0001.json"))
 x0, y0, w, h = y["prompt_rect_px"]
 px, py, pw, ph = y["photo_rect_px"]

@@ -262,6 +262,9 @@ class Runner {
     frame["block"] = trial.block;
     frame["practice"] = trial.practice;
     frame["prompt"] = prompt ? Json(protocol_.responses.prompt) : Json();
+    // Intervals show one object at a time at the left object's place: which side's object the first interval shows
+    // (its "side" below is the slot it is drawn in).
+    if (scene.intervals > 0) frame["first_interval_shows"] = IntervalShowsRight(trial, scene, 0) ? "right" : "left";
     if (prompt) frame["prompt_rect_px"] = {0, image.rows - band, image.cols, band};
     WriteImage(options_.capture_dir / (std::string(name) + ".png"), image);
     WriteFileAtomically(options_.capture_dir / (std::string(name) + ".json"), frame.dump(1) + "\n");
