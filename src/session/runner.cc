@@ -537,7 +537,14 @@ class Runner {
     bool shown_practice = false;  // the trial before was practice (the next main one says the practice is over)
     // Breaks come every N answered main trials, counted over the whole session (a resumed one included).
     int64_t main_answered = 0;
-    for (int64_t i = 0; i < start.first_unanswered_trial; ++i) main_answered += !trials_[size_t(i)].practice;
+    // Trials a stopped procedure skipped are no answers: they count toward no break, as in an uninterrupted run.
+    if (start.first_unanswered_trial > 0) {
+      const auto answered = record.AnsweredTrials(start.session_id);
+      for (int64_t i = 0; i < start.first_unanswered_trial; ++i) {
+        const auto it = answered.find(i);
+        main_answered += !trials_[size_t(i)].practice && (it == answered.end() || it->second.choice != kSkipped);
+      }
+    }
     for (int64_t i = start.first_unanswered_trial; i < result.trial_count; ++i) {
       if (options_.stop_after >= 0 && result.answered_now >= options_.stop_after) break;
       const protocol::Trial& trial = trials_[size_t(i)];
