@@ -194,43 +194,35 @@ void WriteFrames(Database& db, const std::filesystem::path& out_dir) {
   WriteFileAtomically(out_dir / "frames.csv", text);
 }
 
-// Schema 7's typed columns, by table, each with its SQLite type: copied as they are from an input of version 7 or
+// Schema 7's typed columns of one table (schema.h TypedColumns): copied as they are from an input of version 7 or
 // later; derived from the texts (DeriveTypedColumns) for an older one.
-struct TypedColumn {
-  const char* name;
-  char type;  // 't' text, 'r' real, 'i' integer
-};
-const std::vector<TypedColumn>& TypedColumns(const std::string& table) {
-  static const std::map<std::string, std::vector<TypedColumn>> columns = {
-      {"sessions",
-       {{"observer", 't'}, {"observer_params", 't'}, {"window", 'i'}, {"profile_name", 't'}, {"screen_width_mm", 'r'},
-        {"screen_height_mm", 'r'}, {"viewing_distance_mm", 'r'}, {"px_per_deg", 'r'}}},
-      {"trials",
-       {{"block_name", 't'}, {"practice", 'i'}, {"swapped", 'i'}, {"left_source", 't'}, {"left_fixed", 'r'},
-        {"right_source", 't'}, {"right_fixed", 'r'}, {"r_left_px", 'r'}, {"r_right_px", 'r'}, {"r_scene_px", 'r'}, {"task", 't'}}},
-      {"responses", {{"level", 'r'}, {"correct", 'i'}, {"r_left_px", 'r'}, {"r_right_px", 'r'}}}};
-  return columns.at(table);
+std::vector<TypedColumn> TypedColumnsOf(const std::string& table) {
+  std::vector<TypedColumn> out;
+  for (const TypedColumn& c : TypedColumns())
+    if (table == c.table) out.push_back(c);
+  return out;
 }
 // ", a, b, c" for a SELECT or INSERT column list; empty for an input before version 7.
 std::string TypedList(const std::string& table, bool typed) {
   std::string list;
   if (typed)
-    for (const auto& c : TypedColumns(table)) list += std::string(", ") + c.name;
+    for (const auto& c : TypedColumnsOf(table)) list += std::string(", ") + c.name;
   return list;
 }
 std::string TypedPlaceholders(const std::string& table, bool typed) {
   std::string list;
   if (typed)
-    for (size_t i = 0; i < TypedColumns(table).size(); ++i) list += ", ?";
+    for (size_t i = 0; i < TypedColumnsOf(table).size(); ++i) list += ", ?";
   return list;
 }
 // Binds the typed columns read from `from` (starting at column `first`) to `to` (starting at parameter `at`).
 void CopyTyped(const std::string& table, bool typed, Statement& from, int first, Statement& to, int at) {
   if (!typed) return;
-  for (const auto& c : TypedColumns(table)) {
+  for (const auto& c : TypedColumnsOf(table)) {
+    const std::string type = c.type;
     if (from.IsNull(first)) to.BindNull(at);
-    else if (c.type == 't') to.Bind(at, from.GetText(first));
-    else if (c.type == 'r') to.Bind(at, from.GetDouble(first));
+    else if (type == "TEXT") to.Bind(at, from.GetText(first));
+    else if (type == "REAL") to.Bind(at, from.GetDouble(first));
     else to.Bind(at, from.GetInt64(first));
     ++first, ++at;
   }

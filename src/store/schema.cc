@@ -140,39 +140,51 @@ std::vector<Migration> MakeMigrations() {
   //  trials: the block's name and task (forced_choice, adjustment, yes_no, rating), practice and swapped flags, each side's source (none, measured, measured_section,
   //  estimated, fitted, fixed_px, fixed_screen_px, fixed_arcmin) and fixed radius, the radii planned (photo px);
   //  responses: what an adaptive procedure showed and scored (level, correct) and the radii shown (photo px).
-  steps.push_back({"ALTER TABLE sessions ADD COLUMN observer TEXT CHECK (observer IN ('person', 'simulated'));"
-                   "ALTER TABLE sessions ADD COLUMN observer_params TEXT;"
-                   "ALTER TABLE sessions ADD COLUMN window INTEGER CHECK (window IN (0, 1));"
-                   "ALTER TABLE sessions ADD COLUMN profile_name TEXT;"
-                   "ALTER TABLE sessions ADD COLUMN screen_width_mm REAL;"
-                   "ALTER TABLE sessions ADD COLUMN screen_height_mm REAL;"
-                   "ALTER TABLE sessions ADD COLUMN viewing_distance_mm REAL;"
-                   "ALTER TABLE sessions ADD COLUMN px_per_deg REAL;"
-                   "CREATE TABLE session_info ("
-                   "  session_id INTEGER NOT NULL REFERENCES sessions(id),"
-                   "  key TEXT NOT NULL,"
-                   "  value TEXT NOT NULL,"
-                   "  PRIMARY KEY (session_id, key))" + strict + ";"
-                   "ALTER TABLE trials ADD COLUMN block_name TEXT;"
-                   "ALTER TABLE trials ADD COLUMN task TEXT;"
-                   "ALTER TABLE trials ADD COLUMN practice INTEGER CHECK (practice IN (0, 1));"
-                   "ALTER TABLE trials ADD COLUMN swapped INTEGER CHECK (swapped IN (0, 1));"
-                   "ALTER TABLE trials ADD COLUMN left_source TEXT;"
-                   "ALTER TABLE trials ADD COLUMN left_fixed REAL;"
-                   "ALTER TABLE trials ADD COLUMN right_source TEXT;"
-                   "ALTER TABLE trials ADD COLUMN right_fixed REAL;"
-                   "ALTER TABLE trials ADD COLUMN r_left_px REAL;"
-                   "ALTER TABLE trials ADD COLUMN r_right_px REAL;"
-                   "ALTER TABLE trials ADD COLUMN r_scene_px REAL;"
-                   "ALTER TABLE responses ADD COLUMN level REAL;"
-                   "ALTER TABLE responses ADD COLUMN correct INTEGER CHECK (correct IN (0, 1));"
-                   "ALTER TABLE responses ADD COLUMN r_left_px REAL;"
-                   "ALTER TABLE responses ADD COLUMN r_right_px REAL;",
-                   &DeriveTypedColumns});
+  std::string typed;
+  for (const TypedColumn& c : TypedColumns()) {
+    typed += std::string("ALTER TABLE ") + c.table + " ADD COLUMN " + c.name + " " + c.type +
+             (*c.check ? std::string(" CHECK (") + c.check + ")" : std::string()) + ";";
+    if (std::string(c.name) == "px_per_deg")  // after the sessions' columns: the participant information
+      typed += "CREATE TABLE session_info ("
+               "  session_id INTEGER NOT NULL REFERENCES sessions(id),"
+               "  key TEXT NOT NULL,"
+               "  value TEXT NOT NULL,"
+               "  PRIMARY KEY (session_id, key))" + strict + ";";
+  }
+  steps.push_back({typed, &DeriveTypedColumns});
   return steps;
 }
 
 }  // namespace
+
+const std::vector<TypedColumn>& TypedColumns() {
+  static const std::vector<TypedColumn> columns = {
+      {"sessions", "observer", "TEXT", "observer IN ('person', 'simulated')"},
+      {"sessions", "observer_params", "TEXT", ""},
+      {"sessions", "window", "INTEGER", "window IN (0, 1)"},
+      {"sessions", "profile_name", "TEXT", ""},
+      {"sessions", "screen_width_mm", "REAL", ""},
+      {"sessions", "screen_height_mm", "REAL", ""},
+      {"sessions", "viewing_distance_mm", "REAL", ""},
+      {"sessions", "px_per_deg", "REAL", ""},
+      {"trials", "block_name", "TEXT", ""},
+      {"trials", "task", "TEXT", ""},
+      {"trials", "practice", "INTEGER", "practice IN (0, 1)"},
+      {"trials", "swapped", "INTEGER", "swapped IN (0, 1)"},
+      {"trials", "left_source", "TEXT", ""},
+      {"trials", "left_fixed", "REAL", ""},
+      {"trials", "right_source", "TEXT", ""},
+      {"trials", "right_fixed", "REAL", ""},
+      {"trials", "r_left_px", "REAL", ""},
+      {"trials", "r_right_px", "REAL", ""},
+      {"trials", "r_scene_px", "REAL", ""},
+      {"responses", "level", "REAL", ""},
+      {"responses", "correct", "INTEGER", "correct IN (0, 1)"},
+      {"responses", "r_left_px", "REAL", ""},
+      {"responses", "r_right_px", "REAL", ""},
+  };
+  return columns;
+}
 
 void DeriveTypedColumns(Database& db) {
   // Sessions: the free-text display said "window ..." or "headless ..." and, for a simulated observer, "; observer
