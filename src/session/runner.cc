@@ -183,10 +183,6 @@ uint64_t TrialSeed(uint64_t seed, int index) {
 
 enum class Outcome { kAnswered, kQuit };
 
-// The choice recorded for a trial that was not shown (a procedure ended by its stop rule, a practice round not
-// needed): the record stays aligned with the trial list, and export calls it status "skipped".
-constexpr const char* kSkipped = "skipped";
-
 // Whether `choice` answered `trial` correctly, where a trial has a correct answer: a procedure's test side or an odd
 // one out's interval; for a practice pair, the side showing the larger radius (equal radii: can't tell). Empty
 // where nothing is correct (yes/no, rating, adjustment).
@@ -432,7 +428,7 @@ class Runner {
       // A deadline: no answer this long after onset is recorded as "none", without a response time.
       if (protocol_.timing.deadline_ms > 0 && trial.task != Task::kAdjustment &&
           (station_.Now() - onset - paused_s) * 1000 >= protocol_.timing.deadline_ms) {
-        response->choice = "none";
+        response->choice = store::kChoiceNone;
         response->rt_ms = std::numeric_limits<double>::quiet_NaN();
         return Outcome::kAnswered;
       }
@@ -501,7 +497,7 @@ class Runner {
         const auto it = answered.find(i);
         // A practice run until a criterion: skipped only after a run that met it, else counted.
         if (t.round >= 0 && it != answered.end()) {
-          const bool skipped = it->second.choice == kSkipped;
+          const bool skipped = it->second.choice == store::kChoiceSkipped;
           if (skipped != (rounds.MetBefore(t) >= 0))
             throw InputError(options_.db.string(), "session " + std::to_string(start.session_id) + " trial " +
                                                        std::to_string(i) + ": the record " +
@@ -513,7 +509,7 @@ class Runner {
         }
         if (t.cell < 0) continue;
         // A trial its procedure's stop rule skipped: the replayed answers must have stopped it there too.
-        if (it != answered.end() && it->second.choice == kSkipped) {
+        if (it != answered.end() && it->second.choice == store::kChoiceSkipped) {
           if (!adaptive.Stopped(t))
             throw InputError(options_.db.string(), "session " + std::to_string(start.session_id) + " trial " +
                                                        std::to_string(i) + ": the record skips it, but its " +
@@ -542,7 +538,7 @@ class Runner {
       const auto answered = record.AnsweredTrials(start.session_id);
       for (int64_t i = 0; i < start.first_unanswered_trial; ++i) {
         const auto it = answered.find(i);
-        main_answered += !trials_[size_t(i)].practice && (it == answered.end() || it->second.choice != kSkipped);
+        main_answered += !trials_[size_t(i)].practice && (it == answered.end() || it->second.choice != store::kChoiceSkipped);
       }
     }
     for (int64_t i = start.first_unanswered_trial; i < result.trial_count; ++i) {
@@ -567,23 +563,18 @@ class Runner {
         shown_block = part;
       }
       shown_practice = trial.practice;
-      // A procedure ended by its stop rule shows no more trials: each is recorded as skipped, not shown.
-      if (trial.cell >= 0 && adaptive.Stopped(trial)) {
+      // Not shown, recorded as skipped: a procedure ended by its stop rule, a practice run after the run that met
+      // its block's criterion.
+      Json why;
+      if (trial.cell >= 0 && adaptive.Stopped(trial))
+        why = {{"skipped", "stop rule"}, {"reversals", adaptive.Reversals(trial)}};
+      else if (const int met = rounds.MetBefore(trial); met >= 0)
+        why = {{"skipped", "criterion met in run " + std::to_string(met + 1)}};
+      if (!why.is_null()) {
         store::Response skipped;
-        skipped.choice = kSkipped;
+        skipped.choice = store::kChoiceSkipped;
         skipped.rt_ms = std::numeric_limits<double>::quiet_NaN();
-        skipped.shown_json = Json{{"skipped", "stop rule"}, {"reversals", adaptive.Reversals(trial)}}.dump();
-        record.RecordResponse(start.session_id, i, skipped);
-        ++result.skipped_now;
-        progress(i + 1);
-        continue;
-      }
-      // A practice run after the run that met its block's criterion: not shown, recorded as skipped.
-      if (const int met = rounds.MetBefore(trial); met >= 0) {
-        store::Response skipped;
-        skipped.choice = kSkipped;
-        skipped.rt_ms = std::numeric_limits<double>::quiet_NaN();
-        skipped.shown_json = Json{{"skipped", "criterion met in run " + std::to_string(met + 1)}}.dump();
+        skipped.shown_json = why.dump();
         record.RecordResponse(start.session_id, i, skipped);
         ++result.skipped_now;
         progress(i + 1);
@@ -627,7 +618,7 @@ class Runner {
       if (trial.round >= 0) rounds.Answer(trial, correct);
       // Feedback where an answer is right or wrong: procedure trials, odd one out, practice run to a criterion.
       if (right && protocol_.timing.feedback_ms > 0)
-        ShowFor(TextScreen(screen_size_, response.choice == "none" ? "Too slow" : correct ? "Correct" : "Wrong", "",
+        ShowFor(TextScreen(screen_size_, response.choice == store::kChoiceNone ? "Too slow" : correct ? "Correct" : "Wrong", "",
                            ""),
                 protocol_.timing.feedback_ms / 1000);
       ++result.answered_now;

@@ -109,7 +109,8 @@ void WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
                  "FROM trials t JOIN sessions s ON s.id = t.session_id "
                  "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
                  "LEFT JOIN responses r ON r.trial_id = t.id "
-                 "WHERE coalesce(t.practice, 0) = 0 AND coalesce(r.choice, '') <> 'skipped' ORDER BY st.name, p.code, s.id");
+                 "WHERE coalesce(t.practice, 0) = 0 AND coalesce(r.choice, '') <> '" + std::string(kChoiceSkipped) +
+                 "' ORDER BY st.name, p.code, s.id");
   while (rows.Step()) {
     Row& row = studies[rows.GetText(0)][rows.GetInt64(2)];
     row.participant = rows.GetText(1);
@@ -549,7 +550,10 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
     // The answer, split by what it is: one column per kind of answer, each of one type.
     const bool answered = rows.GetInt64(18) == 0;
     const std::string choice = answered ? rows.GetText(19) : "";
-    std::string status = !answered ? "unanswered" : choice == "none" ? "timed_out" : choice == "skipped" ? "skipped" : "answered";
+    const std::string status = !answered                  ? "unanswered"
+                               : choice == kChoiceNone    ? "timed_out"
+                               : choice == kChoiceSkipped ? "skipped"
+                                                          : "answered";
     std::string side, more_blurred, interval, yes_no, rating, level;
     if (status == "answered") {
       if (task == "adjustment") level = choice;

@@ -59,8 +59,14 @@ struct SourceColumns {
   static SourceColumns Of(const std::string& source_json);
 };
 
+// The choices a record holds besides the answers themselves: no answer before the deadline, and a trial not shown
+// (a procedure ended by its stop rule, a practice run after the one that met its criterion), so that the record
+// stays one response per planned trial. Export calls them status timed_out and skipped.
+inline constexpr const char* kChoiceNone = "none";
+inline constexpr const char* kChoiceSkipped = "skipped";
+
 struct Response {
-  std::string choice;                // "left" | "right" | "cant_tell" | an adjustment level | "none" (deadline)
+  std::string choice;                // "left" | "right" | "cant_tell" | an adjustment level | kChoiceNone | kChoiceSkipped
   double rt_ms = 0;                  // NaN: none (recorded NULL)
   std::string adjustment_json = "[]";  // method of adjustment: the levels stepped through
   // What the trial showed as decided when it was shown (an adaptive procedure's level, the radii it made, whether
