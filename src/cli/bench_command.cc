@@ -3,10 +3,12 @@
 #include <string>
 
 #include "bench/measure_bench.h"
+#include "bench/plan_bench.h"
 #include "bench/procedure_bench.h"
 #include "bench/record_bench.h"
 #include "bench/render_bench.h"
 #include "cli/commands.h"
+#include "core/data_dir.h"
 
 namespace blurcue::cli {
 
@@ -161,6 +163,42 @@ void AddProcedures(CLI::App& bench) {
   });
 }
 
+void AddPlan(CLI::App& bench) {
+  struct Args {
+    std::string out = "results/bench/plan.csv", protocol;
+    bench::PlanBenchOptions options;
+    bool quick = false;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = bench.add_subcommand(
+      "plan",
+      "What 'blurcue plan' costs: the time per simulated participant, and how it scales with cores.\n"
+      "Simulates --studies studies of --participants participants of a protocol (default: the shipped test 1, which\n"
+      "needs the demo's calibration) with 1 thread and with 2, interleaved, --rounds times each, in one run; prints\n"
+      "the median time per participant for each and the speed-up of 2 threads over 1 (and its share of the ideal 2x).\n"
+      "Every run must give the same answers (it stops if not). --quick: 1 round of 2 studies.");
+  cmd->add_option("--out", args->out, "CSV, one row per timed run")->capture_default_str();
+  cmd->add_option("--protocol", args->protocol, "the protocol to simulate (default protocols/test1-static-grids.json)");
+  cmd->add_option("--participants", args->options.participants, "participants per study")->capture_default_str()
+      ->check(IntRange(1, 10000));
+  cmd->add_option("--studies", args->options.studies, "studies per timed run")->capture_default_str()
+      ->check(IntRange(1, 10000));
+  cmd->add_option("--rounds", args->options.rounds, "timed runs per thread count")->capture_default_str()
+      ->check(IntRange(1, 100));
+  cmd->add_option("--observer", args->options.observer, "the simulated observer")->capture_default_str();
+  cmd->add_flag("--quick", args->quick, "1 round of 2 studies (smoke run)");
+  cmd->callback([args] {
+    bench::PlanBenchOptions options = args->options;
+    options.protocol_file = args->protocol.empty() ? DataDir().path / "protocols" / "test1-static-grids.json"
+                                                   : std::filesystem::path(args->protocol);
+    if (args->quick) options.rounds = 1, options.studies = 2;
+    options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+    const auto rows = bench::RunPlanBench(options);
+    bench::WritePlanBenchCsv(rows, args->out);
+    std::printf("wrote %s (%zu rows)\n%s", args->out.c_str(), rows.size(), bench::SummarizePlanBench(rows).c_str());
+  });
+}
+
 }  // namespace
 
 void AddBenchCommand(CLI::App& app) {
@@ -170,6 +208,7 @@ void AddBenchCommand(CLI::App& app) {
   AddRender(*bench);
   AddRecord(*bench);
   AddProcedures(*bench);
+  AddPlan(*bench);
 }
 
 }  // namespace blurcue::cli

@@ -100,5 +100,6 @@ void AddPreviewCommand(CLI::App& app);      // preview_command.cc
 void AddReportCommand(CLI::App& app);       // report_command.cc
 void AddDisplayCommand(CLI::App& app);      // display_command.cc
 void AddInfoCommand(CLI::App& app);         // info_command.cc
+void AddPlanCommand(CLI::App& app);         // plan_command.cc
 
 }  // namespace blurcue::cli

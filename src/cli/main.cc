@@ -38,6 +38,7 @@ int main(int argc, char** argv) {
       {"export", &cli::AddExportCommand},
       {"merge", &cli::AddMergeCommand},
       {"report", &cli::AddReportCommand},
+      {"plan", &cli::AddPlanCommand},
       {"display", &cli::AddDisplayCommand},
       {"bench", &cli::AddBenchCommand},
       {"info", &cli::AddInfoCommand},

@@ -1,18 +1,12 @@
 // blurcue report: the record exported to tables, then every chart and an index.html (analysis/report.py).
-#include <sys/prctl.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <csignal>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "cli/child.h"
 #include "cli/commands.h"
 #include "core/atomic_file.h"
 #include "core/data_dir.h"
@@ -20,34 +14,6 @@
 #include "store/export.h"
 
 namespace blurcue::cli {
-namespace {
-
-// Runs `argv` (argv[0] looked up on PATH) and returns its wait status. The child dies with this process: a kill
-// of `blurcue report`, -9 included, must not leave Python running on to write into a folder nobody will use.
-int RunChild(const std::vector<std::string>& argv) {
-  std::vector<char*> args;
-  for (const auto& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
-  args.push_back(nullptr);
-  const pid_t parent = getpid();
-  std::fflush(stdout);
-  std::fflush(stderr);
-  const pid_t child = fork();
-  if (child < 0) throw Error(ErrorKind::kInternal, "cannot start " + argv[0] + ": " + std::strerror(errno));
-  if (child == 0) {
-    // Only async-signal-safe calls here. PR_SET_PDEATHSIG sends SIGKILL when the parent dies; a parent that died
-    // before the prctl took effect is caught by getppid() no longer being it.
-    if (prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || getppid() != parent) _exit(126);
-    execvp(args[0], args.data());
-    _exit(127);
-  }
-  int status = 0;
-  while (waitpid(child, &status, 0) < 0) {
-    if (errno != EINTR) throw Error(ErrorKind::kInternal, "cannot wait for " + argv[0] + ": " + std::strerror(errno));
-  }
-  return status;
-}
-
-}  // namespace
 
 void AddReportCommand(CLI::App& app) {
   struct Args {
@@ -110,16 +76,7 @@ void AddReportCommand(CLI::App& app) {
                                            "--out", partial.string(), "--final-out", out.string(), "--boot",
                                            std::to_string(args->boot)};
           if (args->pool_simulated) argv.push_back("--pool-simulated");
-          const int status = RunChild(argv);
-          if (WIFSIGNALED(status))
-            throw Error(ErrorKind::kInternal, "the analysis was killed by signal " + std::to_string(WTERMSIG(status)) +
-                                                  "; " + out.string() + " is unchanged");
-          const int code = WEXITSTATUS(status);
-          if (code == 127) throw Error(ErrorKind::kUsage, "--python " + args->python + ": not found");
-          if (code != 0)
-            throw Error(code == 3 ? ErrorKind::kInput : ErrorKind::kInternal,
-                        "the analysis stopped (exit " + std::to_string(code) + "; its message is above); " +
-                            out.string() + " is unchanged");
+          RunAnalysis(argv, "the analysis", out.string());
         },
         [earlier_report](const std::string&) { return earlier_report; });
     std::printf("wrote %s/index.html\n", args->out.c_str());

@@ -39,4 +39,12 @@ PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const
                                std::optional<uint64_t> seed, const std::filesystem::path& display_profile = {},
                                const std::string& group = "");
 
+// PrepareSession in two parts, for many participants of one study (blurcue plan): what every participant shares
+// (the protocol, the calibration, the images, the display and the presentation; no trials yet), then one
+// participant's seed, group, trials and scenes into it (replacing any before). Throw as PrepareSession.
+PreparedSession PrepareStudy(const std::filesystem::path& protocol_file,
+                             const std::filesystem::path& display_profile = {});
+void PrepareParticipant(PreparedSession* study, const std::string& participant, std::optional<uint64_t> seed,
+                        const std::string& group = "");
+
 }  // namespace blurcue::session

@@ -28,6 +28,7 @@
 #include "session/prepare.h"
 #include "session/screens.h"
 #include "session/stimulus.h"
+#include "session/trial_logic.h"
 #include "store/record.h"
 
 namespace blurcue::session {
@@ -172,63 +173,7 @@ std::string Clock(double seconds) {
   return text;
 }
 
-// The observer of one trial: seeded by the session seed and the trial index, so a resumed session answers
-// exactly as an uninterrupted one.
-uint64_t TrialSeed(uint64_t seed, int index) {
-  uint64_t z = seed + 0x9e3779b97f4a7c15ULL * uint64_t(index + 1);  // splitmix64
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-
 enum class Outcome { kAnswered, kQuit };
-
-// Whether `choice` answered `trial` correctly, where a trial has a correct answer: a procedure's test side or an odd
-// one out's interval; for a practice pair, the side showing the larger radius (equal radii: can't tell). Empty
-// where nothing is correct (yes/no, rating, adjustment).
-std::optional<bool> CorrectOf(const protocol::Trial& trial, const TrialScene& scene, const std::string& choice) {
-  if (!trial.test_side.empty()) return choice == trial.test_side;
-  if (trial.task != Task::kForcedChoice || scene.content == "picture") return std::nullopt;
-  if (std::abs(scene.r_left_px - scene.r_right_px) <= 1e-9) return choice == "cant_tell";
-  return choice == (scene.r_left_px > scene.r_right_px ? "left" : "right");
-}
-
-// Practice blocks run until a criterion: per block, per run of its design, the answers and the correct ones; a run
-// is over when all its trials are answered. A pure function of the answers, so a resumed session decides the same.
-class PracticeRounds {
- public:
-  explicit PracticeRounds(const protocol::Protocol& protocol, const std::vector<protocol::Trial>& trials)
-      : protocol_(protocol) {
-    for (const auto& t : trials)
-      if (t.round >= 0) ++size_[{t.block, t.round}];
-  }
-  // The run in which `trial`'s block met its criterion before `trial`'s run (-1: not yet): its trial is skipped.
-  int MetBefore(const protocol::Trial& trial) const {
-    if (trial.round < 0) return -1;
-    for (int r = 0; r < trial.round; ++r)
-      if (Met(trial.block, r)) return r;
-    return -1;
-  }
-  void Answer(const protocol::Trial& trial, bool correct) {
-    auto& [right, answered] = counts_[{trial.block, trial.round}];
-    right += correct, ++answered;
-  }
-  // Whether run `round` of `block` is over and its share of correct answers reached the criterion.
-  bool Met(const std::string& block, int round) const {
-    const auto it = counts_.find({block, round});
-    const auto size = size_.find({block, round});
-    const protocol::Block* b = nullptr;
-    for (const auto& candidate : protocol_.blocks)
-      if (candidate.name == block) b = &candidate;
-    return it != counts_.end() && size != size_.end() && b && b->criterion && it->second.second == size->second &&
-           it->second.first >= b->criterion->correct * it->second.second - 1e-9;
-  }
-
- private:
-  const protocol::Protocol& protocol_;
-  std::map<std::pair<std::string, int>, int> size_;
-  std::map<std::pair<std::string, int>, std::pair<int, int>> counts_;  // (block, run) -> (correct, answered)
-};
 
 class Runner {
  public:
@@ -325,21 +270,15 @@ class Runner {
 
   // The simulated observer's key presses for a trial whose stimulus appeared at `onset`.
   void ScriptObserver(const protocol::Trial& trial, const TrialScene& scene, double onset) {
-    SimulatedObserver observer(*observer_, TrialSeed(seed_, trial.index));
+    const std::vector<KeyPress> presses = ObserverPresses(*observer_, seed_, protocol_, trial, scene, prepared_.presentation);
     if (trial.task != Task::kAdjustment) {
-      const PairView view{scene.r_left_px, scene.r_right_px, scene.r_scene_px};
-      const KeyPress press = trial.task == Task::kYesNo    ? observer.SayYesNo(view)
-                             : trial.task == Task::kRating ? observer.Rate(view, int(protocol_.responses.rating.size()))
-                             : scene.intervals > 2 ? observer.ChooseOdd(view, scene.intervals, std::stoi(trial.test_side))
-                             // A procedure, or practice scored by a criterion: "which side is more blurred?"
-                             : trial.cell >= 0 || trial.round >= 0 ? observer.ChooseBlurrier(view)
-                                                   : observer.ChooseSide(view, !protocol_.responses.cant_tell.empty());
       // A moving stimulus is watched to its end before the answer (task 1 is one answer per run); intervals too.
-      station_.Script(keys_.Key(press.action, trial.task), onset + StimulusEndS(scene) + press.after_ms / 1000);
+      for (const KeyPress& press : presses)
+        station_.Script(keys_.Key(press.action, trial.task), onset + StimulusEndS(protocol_, scene) + press.after_ms / 1000);
       return;
     }
     double t = onset;
-    for (const KeyPress& press : observer.Adjust(trial.adjust_levels, trial.start_index, scene.distance_m)) {
+    for (const KeyPress& press : presses) {
       t += press.after_ms / 1000;
       station_.Script(keys_.Key(press.action, trial.task), t);
     }
@@ -377,7 +316,7 @@ class Runner {
     std::vector<TrialScene> intervals;
     for (int k = 0; k < n; ++k) intervals.push_back(IntervalScene(scene, IntervalShowsRight(trial, scene, k)));
     // With responses.after_motion keys count (and the prompt shows) only once the motion or the intervals are over.
-    const double answer_from_s = protocol_.responses.after_motion ? StimulusEndS(scene) : 0;
+    const double answer_from_s = protocol_.responses.after_motion ? StimulusEndS(protocol_, scene) : 0;
     int composed_interval = -1;
     for (int frame = 0;; ++frame) {
       const double t = onset < 0 ? 0 : station_.Now() - onset - paused_s;
@@ -488,8 +427,9 @@ class Runner {
     if (!ShowScreen(welcome, protocol_.instructions, "Press Return to start")) return result;
     // Adaptive procedures: their state rebuilt by replaying the answers the record holds, so a resumed session
     // continues exactly where it was; each replayed level must be the one the record says was shown.
-    AdaptiveState adaptive(protocol_);
-    PracticeRounds rounds(protocol_, trials_);
+    SessionLogic logic(prepared_);
+    AdaptiveState& adaptive = logic.adaptive();
+    PracticeRounds& rounds = logic.rounds();
     if (start.first_unanswered_trial > 0) {
       const auto answered = record.AnsweredTrials(start.session_id);
       for (int64_t i = 0; i < start.first_unanswered_trial; ++i) {
@@ -565,12 +505,7 @@ class Runner {
       shown_practice = trial.practice;
       // Not shown, recorded as skipped: a procedure ended by its stop rule, a practice run after the run that met
       // its block's criterion.
-      Json why;
-      if (trial.cell >= 0 && adaptive.Stopped(trial))
-        why = {{"skipped", "stop rule"}, {"reversals", adaptive.Reversals(trial)}};
-      else if (const int met = rounds.MetBefore(trial); met >= 0)
-        why = {{"skipped", "criterion met in run " + std::to_string(met + 1)}};
-      if (!why.is_null()) {
+      if (const Json why = logic.SkipReason(trial); !why.is_null()) {
         store::Response skipped;
         skipped.choice = store::kChoiceSkipped;
         skipped.rt_ms = std::numeric_limits<double>::quiet_NaN();
@@ -581,33 +516,24 @@ class Runner {
         continue;
       }
       // A procedure's trial shows the level its answers so far give, on its test side.
-      TrialScene scene = scenes_[size_t(i)];
       double level = 0;
-      if (trial.cell >= 0) {
-        level = adaptive.Level(trial);
-        ApplyLevel(ProcedureOf(trial), trial, level, prepared_.presentation, &scene);
-        PlanOnScreen(protocol_, *prepared_.scene, prepared_.presentation, &scene);
-      }
+      const TrialScene scene = logic.SceneOf(trial, &level);
       store::Response response;
       std::vector<store::FrameRecord> frames;
       if (RunTrial(trial, scene, &response, &frames) == Outcome::kQuit) break;
-      // Scored where the design defines a correct answer: a procedure's, an odd one out's, a practice run to a
-      // criterion's ("which fits the scene better?" has none, whatever the radii).
-      const bool scored = trial.cell >= 0 || !trial.test_side.empty() || trial.round >= 0;
-      const std::optional<bool> right = scored ? CorrectOf(trial, scene, response.choice) : std::nullopt;
+      // Scored, and taken by the procedure and the practice run (their state is only in memory; a resume replays
+      // the record): a staircase's reversals before the answer and QUEST+'s posterior after it are recorded with it.
+      const Scored scored = logic.Answer(trial, scene, level, response.choice);
+      const std::optional<bool> right = scored.correct;
       const bool correct = right.value_or(false);
       response.correct = right;
       if (trial.cell >= 0) {
         Json shown = TrialVariables(trial, scene, prepared_.presentation);
         shown["correct"] = correct ? 1 : 0;
-        if (ProcedureOf(trial).kind == protocol::Procedure::Kind::kStaircase)
-          shown["reversals"] = adaptive.Reversals(trial);  // before this answer
-        // The procedure takes the answer now (its state is only in memory; a resume replays the record): QUEST+'s
-        // posterior after it is recorded with it, its running estimate.
-        adaptive.Answer(trial, level, correct);
-        if (const auto posterior = adaptive.Posterior(trial)) {
-          shown["posterior_threshold"] = posterior->first;
-          shown["posterior_slope"] = posterior->second;
+        if (scored.reversals_before) shown["reversals"] = *scored.reversals_before;
+        if (scored.posterior) {
+          shown["posterior_threshold"] = scored.posterior->first;
+          shown["posterior_slope"] = scored.posterior->second;
         }
         response.shown_json = shown.dump();
         response.level = level;
@@ -615,7 +541,6 @@ class Runner {
         response.r_right_px = scene.r_right_px;
       }
       record.RecordResponse(start.session_id, i, response, frames);  // committed before anything else happens
-      if (trial.round >= 0) rounds.Answer(trial, correct);
       // Feedback where an answer is right or wrong: procedure trials, odd one out, practice run to a criterion.
       if (right && protocol_.timing.feedback_ms > 0)
         ShowFor(TextScreen(screen_size_, response.choice == store::kChoiceNone ? "Too slow" : correct ? "Correct" : "Wrong", "",
@@ -647,17 +572,6 @@ class Runner {
   }
 
  private:
-  // When a trial's stimulus has run its course: the end of its motion, or of its last interval.
-  double StimulusEndS(const TrialScene& scene) const {
-    const int n = scene.intervals;
-    return n > 0 ? (n * protocol_.timing.interval_ms + (n - 1) * protocol_.timing.isi_ms) / 1000 : scene.MotionS();
-  }
-
-  const protocol::Procedure& ProcedureOf(const protocol::Trial& trial) const {
-    if (const protocol::Block* b = protocol::BlockOf(protocol_, trial); b && b->procedure) return *b->procedure;
-    throw Error(ErrorKind::kInternal, "trial " + std::to_string(trial.index) + " belongs to no procedure block");
-  }
-
   // The grey field between trials and after a timed stimulus (window only).
   const render::WindowImage& Blank() {
     if (!blank_) blank_ = std::make_unique<render::WindowImage>(TextScreen(screen_size_, "", "", ""));

@@ -1,0 +1,101 @@
+#include "bench/plan_bench.h"
+
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <thread>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/stats.h"
+#include "plan/plan.h"
+
+namespace blurcue::bench {
+
+std::vector<PlanBenchRow> RunPlanBench(const PlanBenchOptions& options) {
+  std::vector<PlanBenchRow> rows;
+  plan::PlanOptions p;
+  p.protocol_file = options.protocol_file;
+  p.observer = options.observer;
+  p.participants = options.participants;
+  p.studies = options.studies;
+  p.seed = options.seed;
+  // One untimed run first: files read, caches and pages warm for every timed run alike.
+  {
+    std::vector<plan::Condition> conditions;
+    std::vector<std::string> notes;
+    int used = 0;
+    p.threads = 1;
+    p.studies = 1;
+    plan::SimulateStudies(p, &conditions, &notes, &used);
+    p.studies = options.studies;
+  }
+  std::vector<std::vector<std::pair<int, std::string>>> reference;
+  for (int round = 0; round < options.rounds; ++round) {
+    // Interleaved: every thread count in each round, so a change of machine load falls on all of them.
+    for (int threads : options.threads) {
+      p.threads = threads;
+      std::vector<plan::Condition> conditions;
+      std::vector<std::string> notes;
+      int used = 0;
+      const auto start = std::chrono::steady_clock::now();
+      const auto studies = plan::SimulateStudies(p, &conditions, &notes, &used);
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::vector<std::vector<std::pair<int, std::string>>> answers;
+      for (const auto& participant : studies.front()) answers.push_back(participant.answers);
+      if (reference.empty()) reference = answers;
+      if (answers != reference)
+        throw Error(ErrorKind::kInternal, "bench plan: " + std::to_string(threads) +
+                                              " threads gave other answers than the first run");
+      PlanBenchRow row;
+      row.threads = used;
+      row.round = round;
+      row.participants = options.participants * options.studies;
+      row.seconds = seconds;
+      row.ms_per_participant = 1000 * seconds / row.participants;
+      rows.push_back(row);
+      if (options.progress) {
+        char line[160];
+        std::snprintf(line, sizeof line, "bench plan: round %d, %d thread%s: %d participants in %.3f s (%.3f ms each)",
+                      round + 1, used, used == 1 ? "" : "s", row.participants, seconds, row.ms_per_participant);
+        options.progress(line);
+      }
+    }
+  }
+  return rows;
+}
+
+void WritePlanBenchCsv(const std::vector<PlanBenchRow>& rows, const std::filesystem::path& path) {
+  std::string out = "threads,round,participants,seconds,ms_per_participant\n";
+  char line[160];
+  for (const auto& r : rows) {
+    std::snprintf(line, sizeof line, "%d,%d,%d,%.6f,%.6f\n", r.threads, r.round, r.participants, r.seconds,
+                  r.ms_per_participant);
+    out += line;
+  }
+  WriteFileAtomically(path, out);
+}
+
+std::string SummarizePlanBench(const std::vector<PlanBenchRow>& rows) {
+  std::map<int, std::vector<double>> per;
+  for (const auto& r : rows) per[r.threads].push_back(r.ms_per_participant);
+  std::string out;
+  char line[256];
+  const double one = per.count(1) ? Percentile(per[1], 0.5) : 0;
+  for (const auto& [threads, times] : per) {
+    const double median = Percentile(times, 0.5);
+    if (threads == 1 || one <= 0)
+      std::snprintf(line, sizeof line, "%d thread%s: %.3f ms per simulated participant (median of %zu runs)\n", threads,
+                    threads == 1 ? "" : "s", median, times.size());
+    else
+      std::snprintf(line, sizeof line,
+                    "%d threads: %.3f ms per simulated participant (median of %zu runs); speed-up over 1 thread %.2fx "
+                    "(%.0f %% of the ideal %dx)\n",
+                    threads, median, times.size(), one / median, 100 * one / median / threads, threads);
+    out += line;
+  }
+  std::snprintf(line, sizeof line, "this machine has %u hardware threads\n", std::thread::hardware_concurrency());
+  return out + line;
+}
+
+}  // namespace blurcue::bench

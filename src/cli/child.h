@@ -1,0 +1,17 @@
+#pragma once
+// Starting the analysis's Python from a command (report, plan).
+#include <string>
+#include <vector>
+
+namespace blurcue::cli {
+
+// Runs `argv` (argv[0] looked up on PATH) and returns its wait status. The child dies with this process: a kill
+// of the command, -9 included, must not leave Python running on to write into a folder nobody will use.
+int RunChild(const std::vector<std::string>& argv);
+
+// Runs the analysis script `argv` as RunChild and turns a failure into an Error that names `what` and says that
+// `unchanged` (the output folder) is left as it was: killed -> kInternal, exit 127 (no such program) -> kUsage naming
+// --python, exit 3 -> kInput, other exits -> kInternal.
+void RunAnalysis(const std::vector<std::string>& argv, const std::string& what, const std::string& unchanged);
+
+}  // namespace blurcue::cli

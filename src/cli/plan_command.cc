@@ -1,0 +1,136 @@
+// blurcue plan: power analysis of a protocol by simulated studies (src/plan/plan.h), its chart by the analysis's
+// Python (analysis/plan_chart.py).
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cli/child.h"
+#include "cli/commands.h"
+#include "core/atomic_file.h"
+#include "core/data_dir.h"
+#include "core/error.h"
+#include "core/hash.h"
+#include "core/json_io.h"
+#include "plan/plan.h"
+
+namespace blurcue::cli {
+
+void AddPlanCommand(CLI::App& app) {
+  struct Args {
+    plan::PlanOptions options;
+    std::string protocol, display, out = "results/plan", python = "/usr/bin/python3";
+    bool no_chart = false;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "plan",
+      "Plan a study before anyone sits down: how many participants does a protocol need?\n"
+      "Simulates --studies whole studies of --participants participants each, every participant answered by the\n"
+      "simulated observer (--observer, as 'blurcue run --observer') through the runner's own decisions - the same trial\n"
+      "list, scenes on --display, staircases and QUEST+, stop rules, practice criteria and deadlines - headless, without\n"
+      "GL, on every core. Participant i of study s is P<i+1> with seed DeriveSeed(DeriveSeed(--seed, s), i): the same\n"
+      "plan on any machine and with any --threads, and each simulated participant can be rerun with blurcue run\n"
+      "(DIR/answers.csv lists study 1's participants, their seeds and answers).\n"
+      "\n"
+      "Reported per condition (a crossing of a block's factors; a pair's sides as designed, swaps undone):\n"
+      "  share    the expected share: a pair - the design's first (left) source among decisive answers, with all its\n"
+      "           answers' shares (first / second / can't tell / none past a deadline); a procedure or odd one out -\n"
+      "           correct; yes/no - yes\n"
+      "  width    the mean width of its 95 % Wilson interval with N participants\n"
+      "  power    against N = 1 .. --participants, of the report's tests:\n"
+      "           binomial        per condition, the exact two-sided binomial test against chance (0.5; 1/n odd one\n"
+      "                           out), p < --alpha, unadjusted\n"
+      "           participants_t  a one-sample t-test of each participant's share against chance: a stand-in for the\n"
+      "                           report's GLMM (a random-intercept logistic model, too slow to fit per simulated\n"
+      "                           study); it tests the population-level effect, not the GLMM's per-level terms\n"
+      "  N(80%)   the smallest N whose power reaches --power\n"
+      "Adjustment and rating trials have no chance level and are not planned (a note says so).\n"
+      "\n"
+      "Writes DIR (--out, built beside it and swapped in whole): plan.csv (one row per test, condition and N),\n"
+      "answers.csv, plan.json (the settings and the smallest N per test) and power.png / power.svg (power against\n"
+      "participants, drawn by analysis/plan_chart.py; --no-chart skips it). A summary goes to stdout, progress to stderr.\n"
+      "Example (the thesis's test 1 on a 24-inch 1920x1080 monitor at 60 cm, the default display):\n"
+      "  blurcue plan protocols/test1-static-grids.json --participants 30 --studies 400 --seed 1 --out results/plan");
+  cmd->add_option("protocol", args->protocol, "the protocol JSON file")->required();
+  cmd->add_option("--display", args->display,
+                  "the monitor's display profile (default: the protocol's display.profile, else a 24-inch 1920x1080 "
+                  "monitor at 60 cm)");
+  cmd->add_option("--participants", args->options.participants,
+                  "participants per simulated study; power is reported for every N from 1 to this")
+      ->capture_default_str()->check(IntRange(1, 10000));
+  cmd->add_option("--studies", args->options.studies, "simulated studies (more: power known more precisely; its "
+                                                      "standard error is at most 0.5 / sqrt(studies))")
+      ->capture_default_str()->check(IntRange(1, 100000));
+  cmd->add_option("--observer", args->options.observer, "the simulated observer, sim or sim:NAME=VALUE,... (see "
+                                                        "'blurcue run --help')")
+      ->capture_default_str();
+  cmd->add_option("--seed", args->options.seed, "the plan's seed (every participant's seed is derived from it)")
+      ->capture_default_str()->check(SeedValidator());
+  cmd->add_option("--threads", args->options.threads, "worker threads (0: every core); the results do not depend on it")
+      ->capture_default_str()->check(IntRange(0, 256));
+  cmd->add_option("--alpha", args->options.alpha, "level of the tests")->capture_default_str()
+      ->check(FiniteRange(0, 0.5, "", "", true));
+  cmd->add_option("--power", args->options.target_power, "the power N(80%) asks for")->capture_default_str()
+      ->check(FiniteRange(0, 1, "", "", true));
+  cmd->add_option("--out", args->out, "output folder (created; an earlier plan there is replaced)")
+      ->capture_default_str();
+  cmd->add_option("--python", args->python, "the Python that draws the chart")->capture_default_str();
+  cmd->add_flag("--no-chart", args->no_chart, "write the tables only");
+  cmd->callback([args] {
+    plan::PlanOptions options = args->options;
+    options.protocol_file = args->protocol;
+    options.display_profile = args->display;
+    options.progress = [](const std::string& line) { std::fprintf(stderr, "plan: %s\n", line.c_str()); };
+    const std::filesystem::path out = args->out;
+    const std::filesystem::path script = DataDir().path / "analysis" / "plan_chart.py";
+    if (!args->no_chart && !std::filesystem::exists(script))
+      throw InputError(script.string(), "the chart script is missing (--no-chart writes the tables only)");
+    // A Python named by path that is not there fails now, not after the simulation.
+    if (!args->no_chart && args->python.find('/') != std::string::npos && access(args->python.c_str(), X_OK) != 0)
+      throw Error(ErrorKind::kUsage, "--python " + args->python + ": not found");
+    std::error_code ignored;
+    if (std::filesystem::exists(out, ignored) && !std::filesystem::is_directory(out, ignored))
+      throw InputError(out.string(), "--out: is a file, not a folder");
+    const plan::PlanResult result = plan::RunPlan(options);
+    std::fprintf(stderr, "plan: %zu participants in %.2f s on %d threads (%.2f ms per participant)\n",
+                 static_cast<size_t>(options.studies) * static_cast<size_t>(options.participants), result.seconds,
+                 result.threads_used,
+                 1000 * result.seconds / (double(options.studies) * options.participants));
+    Json settings = {{"protocol", std::filesystem::absolute(args->protocol).string()},
+                     {"protocol_hash", HashHex(Fnv1a64(ReadTextFile(args->protocol)))},
+                     {"study", result.study},
+                     {"display", args->display},
+                     {"participants", options.participants},
+                     {"studies", options.studies},
+                     {"seed", "s" + std::to_string(options.seed)},
+                     {"observer", result.observer},
+                     {"alpha", options.alpha},
+                     {"target_power", options.target_power},
+                     {"smallest_n", result.smallest_n},
+                     {"notes", result.notes}};
+    for (const auto& path : RemoveStaleLeftovers(out))
+      std::fprintf(stderr, "plan: removed %s, left by an interrupted run\n", path.c_str());
+    const bool earlier = std::filesystem::exists(out / "plan.csv", ignored);
+    WriteFolderAtomically(
+        out,
+        [&](const std::filesystem::path& partial) {
+          WriteFileAtomically(partial / "plan.csv", plan::PlanCsv(result));
+          WriteFileAtomically(partial / "answers.csv", plan::AnswersCsv(result));
+          WriteFileAtomically(partial / "plan.json", settings.dump(2) + "\n");
+          if (!args->no_chart)
+            RunAnalysis({args->python, script.string(), "--plan", (partial / "plan.csv").string(), "--out",
+                         partial.string(), "--title", result.study, "--target", std::to_string(options.target_power)},
+                        "the chart", out.string());
+        },
+        [earlier](const std::string&) { return earlier; });
+    std::printf("%s", plan::Summary(result, options).c_str());
+    std::printf("wrote %s (plan.csv, answers.csv, plan.json%s)\n", out.c_str(),
+                args->no_chart ? "" : ", power.png, power.svg");
+  });
+}
+
+}  // namespace blurcue::cli

@@ -1,0 +1,397 @@
+#include "plan/plan.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <limits>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include "core/error.h"
+#include "core/json_io.h"
+#include "core/seed.h"
+#include "plan/power.h"
+#include "protocol/trials.h"
+#include "session/observer.h"
+#include "session/prepare.h"
+#include "session/trial_logic.h"
+#include "store/record.h"
+
+namespace blurcue::plan {
+namespace {
+
+using protocol::Task;
+
+std::string SourceText(const Json& source) { return source.is_string() ? source.get<std::string>() : source.dump(); }
+
+// A level as a label shows it: a number as %g, a string as itself, an object by its id or name.
+std::string LevelText(const Json& level) {
+  if (level.is_number()) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", level.get<double>());
+    return text;
+  }
+  if (level.is_string()) return level.get<std::string>();
+  for (const char* name : {"id", "name"})
+    if (level.is_object() && level.contains(name)) return LevelText(level[name]);
+  return level.dump();
+}
+
+// The condition of a main (not practice) trial and the measure its tests use; nullopt for what is not planned.
+std::optional<Condition> ConditionOf(const protocol::Protocol& protocol, const protocol::Trial& trial,
+                                     const session::TrialScene& scene, bool several_blocks) {
+  Condition c;
+  for (size_t b = 0; b < protocol.blocks.size(); ++b)
+    if (protocol.blocks[b].name == trial.block) c.block = static_cast<int>(b);
+  c.levels = trial.levels.dump();
+  c.key = trial.block + "\n" + c.levels;
+  std::string label;
+  if (trial.levels.is_object())
+    for (const auto& [name, value] : trial.levels.items()) label += (label.empty() ? "" : " ") + name + "=" + LevelText(value);
+  c.label = (several_blocks ? trial.block + (label.empty() ? "" : ": ") : "") + (label.empty() && !several_blocks ? "all" : label);
+  if (trial.task == Task::kYesNo) {
+    c.measure = "yes";
+  } else if (trial.cell >= 0 || !trial.test_side.empty()) {
+    c.measure = "correct";
+    c.chance = scene.intervals > 2 ? 1.0 / scene.intervals : 0.5;
+  } else if (trial.task == Task::kForcedChoice && scene.content != "picture") {
+    c.measure = "first_source";
+    c.chance = 0.5;
+    // The design's sides: a swapped trial shows them exchanged.
+    c.first = SourceText(trial.swapped ? trial.right : trial.left);
+    c.second = SourceText(trial.swapped ? trial.left : trial.right);
+  } else {
+    return std::nullopt;
+  }
+  return c;
+}
+
+// One simulated participant through the session's own decisions (what `blurcue run --observer sim` does headless).
+SimParticipant Simulate(session::PreparedSession& study, const session::ObserverParams& observer, const std::string& id,
+                        uint64_t seed, const std::string& group, bool keep_answers, bool several_blocks,
+                        std::map<std::string, Condition>* conditions, std::set<std::string>* unplanned) {
+  session::PrepareParticipant(&study, id, seed, group);
+  SimParticipant p;
+  p.id = id;
+  p.seed = seed;
+  p.group = study.group;
+  const protocol::Protocol& protocol = study.protocol;
+  session::SessionLogic logic(study);
+  for (const protocol::Trial& trial : study.trials) {
+    if (const Json why = logic.SkipReason(trial); !why.is_null()) {
+      if (keep_answers) p.answers.emplace_back(trial.index, store::kChoiceSkipped);
+      continue;
+    }
+    double level = 0;
+    const session::TrialScene scene = logic.SceneOf(trial, &level);
+    const auto presses = session::ObserverPresses(observer, study.seed, protocol, trial, scene, study.presentation);
+    const std::string choice = session::HeadlessAnswer(protocol, trial, scene, presses).first;
+    const session::Scored scored = logic.Answer(trial, scene, level, choice);
+    if (keep_answers) p.answers.emplace_back(trial.index, choice);
+    if (trial.practice) continue;
+    const std::optional<Condition> c = ConditionOf(protocol, trial, scene, several_blocks);
+    if (!c) {
+      unplanned->insert(protocol::ToString(trial.task));
+      continue;
+    }
+    conditions->emplace(c->key, *c);
+    Tally& t = p.tallies[c->key];
+    ++t.shown;
+    const bool none = choice == store::kChoiceNone;
+    t.none += none;
+    if (c->measure == "first_source") {
+      const bool left = choice == "left", right = choice == "right";
+      const bool first = trial.swapped ? right : left, second = trial.swapped ? left : right;
+      t.first += first, t.second += second, t.cant_tell += choice == "cant_tell";
+      t.k += first, t.n += first || second;
+    } else if (c->measure == "correct") {
+      // The report counts answers (a missed deadline is no answer), correct against the guess rate.
+      if (!none) t.k += scored.correct.value_or(false), ++t.n;
+    } else if (!none) {
+      t.k += choice == "yes", ++t.n;
+    }
+  }
+  return p;
+}
+
+std::string Number(double v, const char* format = "%.6f") {
+  if (!std::isfinite(v)) return "";
+  char text[48];
+  std::snprintf(text, sizeof text, format, v);
+  return text;
+}
+
+std::string Quoted(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string out = "\"";
+  for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+}  // namespace
+
+std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& options, std::vector<Condition>* conditions,
+                                                         std::vector<std::string>* notes, int* threads_used,
+                                                         std::string* study_name) {
+  if (options.participants < 1 || options.studies < 1)
+    throw Error(ErrorKind::kUsage, "--participants and --studies must be at least 1");
+  if (double(options.participants) * options.studies > 2e7)
+    throw Error(ErrorKind::kUsage, "--participants x --studies must be at most 20000000 simulated participants, got " +
+                                       std::to_string(options.participants) + " x " + std::to_string(options.studies));
+  const session::ObserverParams observer = session::ParseObserver(options.observer);
+  const session::PreparedSession study = session::PrepareStudy(options.protocol_file, options.display_profile);
+  const protocol::Protocol& protocol = study.protocol;
+  if (study_name) *study_name = protocol.name;
+  int main_blocks = 0;
+  for (const auto& b : protocol.blocks) main_blocks += !b.practice;
+  const bool several_blocks = main_blocks > 1;
+  // Groups as a study would assign them, participant after participant (balanced: the fewest so far).
+  const int n = options.participants;
+  std::vector<std::string> ids(static_cast<size_t>(n)), groups(static_cast<size_t>(n));
+  std::map<std::string, int64_t> sessions;
+  for (int i = 0; i < n; ++i) {
+    ids[size_t(i)] = "P" + std::to_string(i + 1);
+    groups[size_t(i)] = protocol::AssignGroup(protocol, ids[size_t(i)], sessions);
+    if (!groups[size_t(i)].empty()) ++sessions[groups[size_t(i)]];
+  }
+  const int64_t total = int64_t(n) * options.studies;
+  int threads = options.threads > 0 ? options.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+  threads = int(std::min<int64_t>(threads, total));
+  *threads_used = threads;
+  std::vector<std::vector<SimParticipant>> out(static_cast<size_t>(options.studies),
+                                                std::vector<SimParticipant>(static_cast<size_t>(n)));
+  std::vector<std::map<std::string, Condition>> found(static_cast<size_t>(threads));
+  std::vector<std::set<std::string>> unplanned(static_cast<size_t>(threads));
+  std::atomic<int64_t> next{0}, done{0};
+  std::atomic<bool> failed{false};
+  std::mutex mutex;
+  std::exception_ptr error;
+  int64_t error_at = total;
+  auto work = [&](int worker) {
+    session::PreparedSession mine = study;  // each worker's own copy (images are shared, read only)
+    for (int64_t index; !failed && (index = next++) < total;) {
+      const int s = int(index / n), i = int(index % n);
+      try {
+        out[size_t(s)][size_t(i)] = Simulate(mine, observer, ids[size_t(i)], DeriveSeed(DeriveSeed(options.seed, s), i),
+                                             groups[size_t(i)], s == 0, several_blocks, &found[size_t(worker)],
+                                             &unplanned[size_t(worker)]);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex);
+        // The first failing participant in order, whatever the thread count.
+        if (index < error_at) error = std::current_exception(), error_at = index;
+        failed = true;
+      }
+      const int64_t d = ++done;
+      if (options.progress && (d * 10 / total != (d - 1) * 10 / total || d == total)) {
+        std::lock_guard<std::mutex> lock(mutex);
+        options.progress("simulated " + std::to_string(d) + " of " + std::to_string(total) + " participants");
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work, t);
+  work(0);
+  for (auto& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
+  std::map<std::string, Condition> all;
+  std::set<std::string> skipped_tasks;
+  for (int t = 0; t < threads; ++t) {
+    all.insert(found[size_t(t)].begin(), found[size_t(t)].end());
+    skipped_tasks.insert(unplanned[size_t(t)].begin(), unplanned[size_t(t)].end());
+  }
+  conditions->clear();
+  for (const auto& [key, c] : all) conditions->push_back(c);
+  std::sort(conditions->begin(), conditions->end(), [](const Condition& a, const Condition& b) {
+    if (a.block != b.block) return a.block < b.block;
+    return Json::parse(a.levels) < Json::parse(b.levels);
+  });
+  for (const std::string& task : skipped_tasks)
+    notes->push_back(task + " trials are not planned: they have no share to test against a chance level");
+  return out;
+}
+
+PlanResult RunPlan(const PlanOptions& options) {
+  if (!(options.alpha > 0 && options.alpha < 1)) throw Error(ErrorKind::kUsage, "--alpha must be in (0, 1)");
+  PlanResult r;
+  const auto start = std::chrono::steady_clock::now();
+  r.studies = SimulateStudies(options, &r.conditions, &r.notes, &r.threads_used, &r.study);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.observer = session::ToString(session::ParseObserver(options.observer));
+  const int N = options.participants, S = options.studies;
+  if (r.conditions.empty())
+    throw InputError(options.protocol_file.string(),
+                     "nothing to plan: no main trial has a share to test (forced choice, a procedure, odd one out or "
+                     "yes/no)");
+  // p-values of the exact test are a function of (k, n, chance): each (n, chance) computed once.
+  std::map<std::pair<int, double>, std::vector<double>> p_cache;
+  auto p_of = [&](int k, int n, double chance) {
+    auto& v = p_cache[{n, chance}];
+    if (v.empty()) {
+      v.resize(size_t(n) + 1);
+      for (int j = 0; j <= n; ++j) v[size_t(j)] = BinomialTestP(j, n, chance);
+    }
+    return v[size_t(k)];
+  };
+  for (const Condition& c : r.conditions) {
+    // The expected shares over every study and participant.
+    Tally all;
+    for (const auto& study : r.studies)
+      for (const auto& p : study)
+        if (const auto it = p.tallies.find(c.key); it != p.tallies.end()) {
+          const Tally& t = it->second;
+          all.k += t.k, all.n += t.n, all.first += t.first, all.second += t.second, all.cant_tell += t.cant_tell,
+              all.none += t.none, all.shown += t.shown;
+        }
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const double shown = all.shown > 0 ? all.shown : nan;
+    std::vector<int> k(static_cast<size_t>(S), 0), n(static_cast<size_t>(S), 0);
+    for (int m = 1; m <= N; ++m) {
+      PowerRow row;
+      row.test = c.chance >= 0 ? "binomial" : "none";
+      row.condition = c.label;
+      row.measure = c.measure;
+      row.chance = c.chance >= 0 ? c.chance : nan;
+      row.participants = m;
+      row.expected_share = all.n > 0 ? double(all.k) / all.n : nan;
+      if (c.measure == "first_source") {
+        row.share_first = all.first / shown, row.share_second = all.second / shown;
+        row.share_cant_tell = all.cant_tell / shown, row.share_none = all.none / shown;
+      } else {
+        row.share_first = row.share_second = row.share_cant_tell = nan;
+        row.share_none = all.none / shown;
+      }
+      double width = 0, trials = 0;
+      int rejected = 0;
+      for (int s = 0; s < S; ++s) {
+        if (const auto it = r.studies[size_t(s)][size_t(m - 1)].tallies.find(c.key);
+            it != r.studies[size_t(s)][size_t(m - 1)].tallies.end())
+          k[size_t(s)] += it->second.k, n[size_t(s)] += it->second.n;
+        const auto [lo, hi] = Wilson95(k[size_t(s)], n[size_t(s)]);
+        width += hi - lo;
+        trials += n[size_t(s)];
+        if (c.chance >= 0 && n[size_t(s)] > 0 && p_of(k[size_t(s)], n[size_t(s)], c.chance) < options.alpha) ++rejected;
+      }
+      row.wilson_width = width / S;
+      row.mean_trials = trials / S;
+      row.power = c.chance >= 0 ? double(rejected) / S : nan;
+      r.rows.push_back(row);
+    }
+  }
+  // Across participants: each participant's share over all the trials of one measure, against its chance level.
+  std::set<std::pair<std::string, double>> measures;
+  for (const Condition& c : r.conditions)
+    if (c.chance >= 0) measures.insert({c.measure, c.chance});
+  for (const auto& [measure, chance] : measures) {
+    std::vector<std::vector<double>> shares(static_cast<size_t>(S));
+    double sum = 0;
+    int count = 0;
+    for (int s = 0; s < S; ++s)
+      for (const auto& p : r.studies[size_t(s)]) {
+        int k = 0, n = 0;
+        for (const Condition& c : r.conditions)
+          if (c.measure == measure && c.chance == chance)
+            if (const auto it = p.tallies.find(c.key); it != p.tallies.end()) k += it->second.k, n += it->second.n;
+        // A participant with no counting answer (every one can't tell) has no share: left out, as the report's
+        // models leave out rows without a decisive answer.
+        shares[size_t(s)].push_back(n > 0 ? double(k) / n : std::numeric_limits<double>::quiet_NaN());
+        if (n > 0) sum += double(k) / n, ++count;
+      }
+    for (int m = 1; m <= N; ++m) {
+      PowerRow row;
+      row.test = "participants_t";
+      row.condition = "all";
+      row.measure = measure;
+      row.chance = chance;
+      row.participants = m;
+      row.expected_share = count > 0 ? sum / count : std::numeric_limits<double>::quiet_NaN();
+      row.share_first = row.share_second = row.share_cant_tell = row.share_none = row.wilson_width =
+          std::numeric_limits<double>::quiet_NaN();
+      int rejected = 0;
+      double used = 0;
+      for (int s = 0; s < S; ++s) {
+        std::vector<double> values;
+        for (int i = 0; i < m; ++i)
+          if (std::isfinite(shares[size_t(s)][size_t(i)])) values.push_back(shares[size_t(s)][size_t(i)]);
+        used += double(values.size());
+        rejected += values.size() >= 2 && OneSampleTTestP(values, chance) < options.alpha;
+      }
+      row.mean_trials = used / S;  // here: participants with a share
+      row.power = double(rejected) / S;
+      r.rows.push_back(row);
+    }
+  }
+  for (const PowerRow& row : r.rows) {
+    const std::string name = row.test + " " + row.condition + (row.test == "participants_t" ? " " + row.measure : "");
+    if (row.test != "none" && row.power >= options.target_power && !r.smallest_n.count(name))
+      r.smallest_n[name] = row.participants;
+  }
+  return r;
+}
+
+std::string PlanCsv(const PlanResult& r) {
+  std::string out =
+      "test,condition,measure,chance,participants,expected_share,share_first,share_second,share_cant_tell,share_none,"
+      "mean_trials,wilson_width,power\n";
+  for (const PowerRow& row : r.rows)
+    out += row.test + "," + Quoted(row.condition) + "," + row.measure + "," + Number(row.chance, "%.6g") + "," +
+           std::to_string(row.participants) + "," + Number(row.expected_share) + "," + Number(row.share_first) + "," +
+           Number(row.share_second) + "," + Number(row.share_cant_tell) + "," + Number(row.share_none) + "," +
+           Number(row.mean_trials, "%.3f") + "," + Number(row.wilson_width) + "," + Number(row.power) + "\n";
+  return out;
+}
+
+std::string AnswersCsv(const PlanResult& r) {
+  std::string out = "participant,seed,group,trial_index,choice\n";
+  if (r.studies.empty()) return out;
+  for (const SimParticipant& p : r.studies.front())
+    for (const auto& [index, choice] : p.answers)
+      out += p.id + ",s" + std::to_string(p.seed) + "," + Quoted(p.group) + "," + std::to_string(index) + "," +
+             Quoted(choice) + "\n";
+  return out;
+}
+
+std::string Summary(const PlanResult& r, const PlanOptions& o) {
+  std::string out;
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "plan of %s: %d simulated studies of %d participants (seed %llu), observer %s\n"
+                "per condition at N = %d: the expected share (first_source: the design's first source among decisive "
+                "answers; correct; yes), the mean width of its 95 %% Wilson interval, the power of the exact binomial "
+                "test against chance (alpha %g) and the smallest N reaching %g %%\n",
+                r.study.c_str(), o.studies, o.participants, static_cast<unsigned long long>(o.seed), r.observer.c_str(),
+                o.participants, o.alpha, 100 * o.target_power);
+  out += line;
+  std::snprintf(line, sizeof line, "  %-28s %-13s %7s %8s %8s %7s  %s\n", "condition", "measure", "share", "width",
+                "power", "N", "answers (first / second / can't tell / none)");
+  out += line;
+  for (const PowerRow& row : r.rows) {
+    if (row.participants != o.participants) continue;
+    const std::string name = row.test + " " + row.condition + (row.test == "participants_t" ? " " + row.measure : "");
+    const auto it = r.smallest_n.find(name);
+    const std::string reached = row.test == "none" ? "-" : it != r.smallest_n.end() ? std::to_string(it->second)
+                                                                                      : "> " + std::to_string(o.participants);
+    std::string shares;
+    if (std::isfinite(row.share_first))
+      shares = Number(row.share_first, "%.2f") + " / " + Number(row.share_second, "%.2f") + " / " +
+               Number(row.share_cant_tell, "%.2f") + " / " + Number(row.share_none, "%.2f");
+    if (row.test == "participants_t")
+      std::snprintf(line, sizeof line, "  %-28s %-13s %7.3f %8s %8.3f %7s  %s\n",
+                    "all: t across participants", row.measure.c_str(), row.expected_share, "",
+                    row.power, reached.c_str(), "");
+    else
+      std::snprintf(line, sizeof line, "  %-28s %-13s %7.3f %8.3f %8s %7s  %s\n", row.condition.c_str(),
+                    row.measure.c_str(), row.expected_share, row.wilson_width,
+                    std::isfinite(row.power) ? Number(row.power, "%.3f").c_str() : "-", reached.c_str(), shares.c_str());
+    out += line;
+  }
+  out += "all: t across participants = a one-sample t-test of each participant's share against chance, the stand-in "
+         "for the report's GLMM (its intercept), whose fit per simulated study would be too slow\n";
+  for (const std::string& note : r.notes) out += "note: " + note + "\n";
+  return out;
+}
+
+}  // namespace blurcue::plan

@@ -1,0 +1,105 @@
+#pragma once
+// Plan a study before anyone sits down: many seeded simulated studies of a protocol, each participant answered by
+// the simulated observer through the session's own decisions (session/trial_logic.h: the same trial list, scenes,
+// procedures, stop rules, practice criteria and answers as `blurcue run --observer sim`), headless and without GL,
+// in parallel. From them, per condition, the expected share and how wide its 95 % interval would be, and the power
+// of the protocol's tests against the number of participants:
+//   binomial       per condition, the exact two-sided binomial test against chance the report runs (a pair: the
+//                  design's first source among decisive answers against 0.5; a procedure or odd one out: correct
+//                  against its guess rate), at alpha;
+//   participants_t across participants, a one-sample t-test of each participant's share (over all their scored
+//                  trials) against chance: a stand-in for the report's GLMM (random intercept per participant), whose
+//                  fit per simulated study would take minutes; it tests the same population-level effect (the
+//                  intercept), not the GLMM's per-level terms.
+// Deterministic: participant i of study s is "P<i+1>" with seed DeriveSeed(DeriveSeed(seed, s), i), whatever the
+// thread count, so the first n participants of a study of N are the study of n, and every simulated participant can
+// be rerun with `blurcue run --participant P<i+1> --seed <its seed> --observer <the same>`.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace blurcue::plan {
+
+struct PlanOptions {
+  std::filesystem::path protocol_file;
+  std::filesystem::path display_profile;  // empty: the protocol's display.profile, else the default monitor
+  int participants = 20;                  // per simulated study; power is reported for 1 .. participants
+  int studies = 200;                      // simulated studies
+  uint64_t seed = 1;
+  std::string observer = "sim";           // session::ParseObserver's form
+  int threads = 0;                        // 0: every core (std::thread::hardware_concurrency)
+  double alpha = 0.05;                    // the tests' level
+  double target_power = 0.8;              // smallest N reaching this
+  std::function<void(const std::string&)> progress;  // about every 10 % of the participants
+};
+
+// One condition: a crossing of a block's factors (as designed, swaps undone), with the measure its tests use.
+struct Condition {
+  std::string key;        // block + levels (JSON), unique
+  int block = 0;          // index in protocol.blocks (conditions are ordered by block, then levels)
+  std::string levels;     // the levels as JSON
+  std::string label;      // "edge=3" (and the block's name when the protocol has several)
+  std::string measure;    // "first_source" (a pair) | "correct" | "yes"
+  std::string first, second;  // a pair: the design's left and right source
+  double chance = -1;     // the test's null share; < 0: no test (yes/no)
+};
+
+// What one simulated participant answered: per condition (by Condition::key) the counts.
+struct Tally {
+  int k = 0, n = 0;       // successes (first source, correct, yes) of the trials that count (decisive, answered)
+  int first = 0, second = 0, cant_tell = 0, none = 0, shown = 0;  // a pair's answers (none: past the deadline)
+};
+
+struct SimParticipant {
+  std::string id, group;
+  uint64_t seed = 0;
+  std::vector<std::pair<int, std::string>> answers;  // (trial index, choice as the record stores it), every trial
+  std::map<std::string, Tally> tallies;               // by condition key
+};
+
+// One row of the plan: a test of a condition (or of all the participants' trials) at a number of participants.
+struct PowerRow {
+  std::string test;        // "binomial" | "participants_t" | "none" (a condition without a chance level)
+  std::string condition;   // its label; "all" for participants_t
+  std::string measure;
+  double chance = -1;
+  int participants = 0;
+  double expected_share = 0;   // over every simulated study and participant
+  double share_first = 0, share_second = 0, share_cant_tell = 0, share_none = 0;  // a pair's answers, of shown
+  double mean_trials = 0;      // counting trials per study at this N (mean)
+  double wilson_width = 0;     // mean width of the 95 % Wilson interval at this N
+  double power = 0;            // share of studies whose test has p < alpha (NaN for "none")
+};
+
+struct PlanResult {
+  std::vector<Condition> conditions;
+  std::vector<std::vector<SimParticipant>> studies;  // [study][participant]
+  std::vector<PowerRow> rows;
+  std::map<std::string, int> smallest_n;   // "binomial edge=3" -> smallest N with power >= target (absent: none)
+  std::vector<std::string> notes;          // what is not planned and why
+  int threads_used = 0;
+  double seconds = 0;                      // wall time of the simulation
+  std::string observer;                    // canonical form
+  std::string study;                       // the protocol's name
+};
+
+// Throws Error(kInput) for a protocol that cannot be prepared (as `blurcue validate`), kUsage for bad options.
+PlanResult RunPlan(const PlanOptions& options);
+
+// Only the simulation: the participants of options.studies studies x options.participants, on options.threads
+// workers; the conditions found (ordered), notes on what is not planned, the workers used and the protocol's name.
+std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& options, std::vector<Condition>* conditions,
+                                                         std::vector<std::string>* notes, int* threads_used,
+                                                         std::string* study_name = nullptr);
+
+// plan.csv: one row per PowerRow, fixed formatting (the same plan gives the same bytes).
+std::string PlanCsv(const PlanResult& result);
+// answers.csv: study 1's participants, one row per trial: participant, seed (s-prefixed), group, trial_index, choice.
+std::string AnswersCsv(const PlanResult& result);
+// The summary printed on stdout.
+std::string Summary(const PlanResult& result, const PlanOptions& options);
+
+}  // namespace blurcue::plan

@@ -1,0 +1,98 @@
+#include "plan/power.h"
+
+#include <cmath>
+#include <limits>
+
+namespace blurcue::plan {
+
+double BinomialPmf(int k, int n, double p) {
+  if (k < 0 || k > n) return 0;
+  if (p <= 0) return k == 0 ? 1 : 0;
+  if (p >= 1) return k == n ? 1 : 0;
+  const double log_choose = std::lgamma(n + 1.0) - std::lgamma(k + 1.0) - std::lgamma(n - k + 1.0);
+  return std::exp(log_choose + k * std::log(p) + (n - k) * std::log1p(-p));
+}
+
+double BinomialTestP(int k, int n, double p) {
+  if (n <= 0) return 1;
+  // scipy.stats.binomtest, alternative "two-sided": the outcomes whose probability is at most d * (1 + 1e-7).
+  const double d = BinomialPmf(k, n, p);
+  const double bound = d * (1 + 1e-7);
+  double total = 0;
+  for (int j = 0; j <= n; ++j) {
+    const double q = BinomialPmf(j, n, p);
+    if (q <= bound) total += q;
+  }
+  return std::min(1.0, total);
+}
+
+std::pair<double, double> Wilson95(int k, int n) {
+  if (n <= 0) return {0, 1};
+  const double z = 1.959963984540054;  // the 97.5 % point of the standard normal
+  const double p = double(k) / n, denom = 1 + z * z / n;
+  const double centre = (p + z * z / (2.0 * n)) / denom;
+  const double half = z / denom * std::sqrt(p * (1 - p) / n + z * z / (4.0 * n * n));
+  // At k = 0 and k = n the bound is exactly 0 or 1, as the report's stats.wilson.
+  return {k == 0 ? 0.0 : std::max(0.0, centre - half), k == n ? 1.0 : std::min(1.0, centre + half)};
+}
+
+namespace {
+
+// Lentz's continued fraction for I_x(a, b) (Numerical Recipes 6.4), converging for x < (a + 1) / (a + b + 2).
+double BetaContinuedFraction(double a, double b, double x) {
+  const double tiny = 1e-300;
+  double c = 1, d = 1 - (a + b) * x / (a + 1);
+  if (std::abs(d) < tiny) d = tiny;
+  d = 1 / d;
+  double h = d;
+  for (int m = 1; m <= 500; ++m) {
+    const double m2 = 2.0 * m;
+    double aa = m * (b - m) * x / ((a + m2 - 1) * (a + m2));
+    d = 1 + aa * d;
+    if (std::abs(d) < tiny) d = tiny;
+    c = 1 + aa / c;
+    if (std::abs(c) < tiny) c = tiny;
+    d = 1 / d;
+    h *= d * c;
+    aa = -(a + m) * (a + b + m) * x / ((a + m2) * (a + m2 + 1));
+    d = 1 + aa * d;
+    if (std::abs(d) < tiny) d = tiny;
+    c = 1 + aa / c;
+    if (std::abs(c) < tiny) c = tiny;
+    d = 1 / d;
+    const double step = d * c;
+    h *= step;
+    if (std::abs(step - 1) < 1e-15) break;
+  }
+  return h;
+}
+
+}  // namespace
+
+double IncompleteBeta(double a, double b, double x) {
+  if (x <= 0) return 0;
+  if (x >= 1) return 1;
+  const double front =
+      std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x));
+  // The fraction converges fast on one side of the mean; use the symmetry I_x(a, b) = 1 - I_{1-x}(b, a) on the other.
+  if (x < (a + 1) / (a + b + 2)) return front * BetaContinuedFraction(a, b, x) / a;
+  return 1 - front * BetaContinuedFraction(b, a, 1 - x) / b;
+}
+
+double OneSampleTTestP(const std::vector<double>& values, double mu) {
+  const size_t n = values.size();
+  if (n < 2) return 1;
+  double mean = 0;
+  for (double v : values) mean += v;
+  mean /= double(n);
+  double ss = 0;
+  for (double v : values) ss += (v - mean) * (v - mean);
+  const double sd = std::sqrt(ss / double(n - 1));
+  if (!(sd > 1e-12)) return std::abs(mean - mu) > 1e-12 ? 0 : 1;
+  const double t = (mean - mu) / (sd / std::sqrt(double(n)));
+  const double df = double(n - 1);
+  // P(|T| > |t|) = I_{df / (df + t^2)}(df / 2, 1 / 2).
+  return IncompleteBeta(df / 2, 0.5, df / (df + t * t));
+}
+
+}  // namespace blurcue::plan

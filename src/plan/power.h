@@ -1,0 +1,27 @@
+#pragma once
+// The statistics a plan needs to say how often a study's tests would succeed: the exact binomial test the report
+// runs per condition (scipy's two-sided "minlike" rule, as analysis/stats.py binom_p), the Wilson interval it draws,
+// and a one-sample t-test across participants. Closed forms only; no randomness here.
+#include <utility>
+#include <vector>
+
+namespace blurcue::plan {
+
+// P(X = k) for X ~ Binomial(n, p), from log-gamma (exact to ~1e-13 relative for n up to millions).
+double BinomialPmf(int k, int n, double p);
+
+// Exact two-sided binomial test of k of n against p: the summed probability of every outcome no more likely than k
+// (relative tolerance 1e-7, as scipy.stats.binomtest). 1 when n == 0.
+double BinomialTestP(int k, int n, double p);
+
+// Wilson score interval (95 %) of k of n: (low, high); (0, 1) when n == 0.
+std::pair<double, double> Wilson95(int k, int n);
+
+// The regularized incomplete beta function I_x(a, b) (continued fraction, Numerical Recipes' betacf).
+double IncompleteBeta(double a, double b, double x);
+
+// Two-sided p of a one-sample t-test of `values` against `mu`: 1 for fewer than two values; 0 or 1 when they do not
+// vary (0 when their mean differs from mu).
+double OneSampleTTestP(const std::vector<double>& values, double mu);
+
+}  // namespace blurcue::plan

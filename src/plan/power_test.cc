@@ -1,0 +1,53 @@
+// The plan's statistics against closed forms worked by hand (the arithmetic in the comments).
+#include "plan/power.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+namespace blurcue::plan {
+namespace {
+
+TEST(BinomialTest, SymmetricNullSumsBothTails) {
+  // 7 of 10 against 0.5: P(X <= 3) + P(X >= 7) = 2 (1 + 10 + 45 + 120) / 1024 = 352 / 1024.
+  EXPECT_NEAR(BinomialTestP(7, 10, 0.5), 352.0 / 1024, 1e-12);
+  // 0 of 5: both extremes, 2 / 32.
+  EXPECT_NEAR(BinomialTestP(0, 5, 0.5), 2.0 / 32, 1e-12);
+}
+
+TEST(BinomialTest, AsymmetricNullSumsTheOutcomesNoMoreLikely) {
+  // 3 of 10 against 0.2 (scipy's two-sided rule): P(X = 3) = 0.201326592; only X = 1 (0.268435456) and X = 2
+  // (0.301989888) are more likely, so p = 1 - 0.268435456 - 0.301989888 = 0.429574656.
+  EXPECT_NEAR(BinomialTestP(3, 10, 0.2), 0.429574656, 1e-9);
+  EXPECT_EQ(BinomialTestP(0, 0, 0.5), 1);
+}
+
+TEST(Wilson, FourteenOfTwentyByTheClosedForm) {
+  // p = 0.7, z = 1.959964: centre (p + z^2 / 2n) / (1 + z^2 / n) = 0.667775, half-width 0.186748.
+  const auto [lo, hi] = Wilson95(14, 20);
+  EXPECT_NEAR(lo, 0.4810271816464765, 1e-12);
+  EXPECT_NEAR(hi, 0.8545227551323956, 1e-12);
+  EXPECT_EQ(Wilson95(0, 12).first, 0);
+  EXPECT_EQ(Wilson95(12, 12).second, 1);
+}
+
+TEST(IncompleteBeta, IntegerParametersAreABinomialTail) {
+  // I_x(2, 3) = P(Binomial(4, x) >= 2) = 6 x^2 (1-x)^2 + 4 x^3 (1-x) + x^4; at 0.4: 0.3456 + 0.1536 + 0.0256.
+  EXPECT_NEAR(IncompleteBeta(2, 3, 0.4), 0.5248, 1e-12);
+  // Past the mean the symmetry branch: I_0.9(2, 3) = 1 - P(Binomial(4, 0.9) <= 1) = 1 - 0.0001 - 0.0036.
+  EXPECT_NEAR(IncompleteBeta(2, 3, 0.9), 0.9963, 1e-12);
+}
+
+TEST(OneSampleT, SmallSamplesMatchTheClosedFormTails) {
+  // {1, 2, 3} against 1: t = 1 / (1 / sqrt 3) = sqrt 3 with 2 df, whose two-sided tail is 1 - t / sqrt(2 + t^2).
+  EXPECT_NEAR(OneSampleTTestP({1, 2, 3}, 1), 1 - std::sqrt(3.0 / 5), 1e-12);
+  // {0, 1} against 0: t = 1 with 1 df (Cauchy): 1 - 2 atan(1) / pi = 0.5.
+  EXPECT_NEAR(OneSampleTTestP({0, 1}, 0), 0.5, 1e-12);
+  // No spread: decided by the mean alone; one value: no test.
+  EXPECT_EQ(OneSampleTTestP({0.7, 0.7, 0.7}, 0.5), 0);
+  EXPECT_EQ(OneSampleTTestP({0.5, 0.5}, 0.5), 1);
+  EXPECT_EQ(OneSampleTTestP({0.9}, 0.5), 1);
+}
+
+}  // namespace
+}  // namespace blurcue::plan

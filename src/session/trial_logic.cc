@@ -1,0 +1,145 @@
+#include "session/trial_logic.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "core/error.h"
+#include "store/record.h"
+
+namespace blurcue::session {
+
+using protocol::Task;
+
+double StimulusEndS(const protocol::Protocol& protocol, const TrialScene& scene) {
+  const int n = scene.intervals;
+  return n > 0 ? (n * protocol.timing.interval_ms + (n - 1) * protocol.timing.isi_ms) / 1000 : scene.MotionS();
+}
+
+std::optional<bool> CorrectOf(const protocol::Trial& trial, const TrialScene& scene, const std::string& choice) {
+  if (!trial.test_side.empty()) return choice == trial.test_side;
+  if (trial.task != Task::kForcedChoice || scene.content == "picture") return std::nullopt;
+  if (std::abs(scene.r_left_px - scene.r_right_px) <= 1e-9) return choice == "cant_tell";
+  return choice == (scene.r_left_px > scene.r_right_px ? "left" : "right");
+}
+
+PracticeRounds::PracticeRounds(const protocol::Protocol& protocol, const std::vector<protocol::Trial>& trials)
+    : protocol_(protocol) {
+  for (const auto& t : trials)
+    if (t.round >= 0) ++size_[{t.block, t.round}];
+}
+
+int PracticeRounds::MetBefore(const protocol::Trial& trial) const {
+  if (trial.round < 0) return -1;
+  for (int r = 0; r < trial.round; ++r)
+    if (Met(trial.block, r)) return r;
+  return -1;
+}
+
+void PracticeRounds::Answer(const protocol::Trial& trial, bool correct) {
+  auto& [right, answered] = counts_[{trial.block, trial.round}];
+  right += correct, ++answered;
+}
+
+bool PracticeRounds::Met(const std::string& block, int round) const {
+  const auto it = counts_.find({block, round});
+  const auto size = size_.find({block, round});
+  const protocol::Block* b = nullptr;
+  for (const auto& candidate : protocol_.blocks)
+    if (candidate.name == block) b = &candidate;
+  return it != counts_.end() && size != size_.end() && b && b->criterion && it->second.second == size->second &&
+         it->second.first >= b->criterion->correct * it->second.second - 1e-9;
+}
+
+namespace {
+
+const protocol::Procedure& ProcedureOf(const protocol::Protocol& protocol, const protocol::Trial& trial) {
+  if (const protocol::Block* b = protocol::BlockOf(protocol, trial); b && b->procedure) return *b->procedure;
+  throw Error(ErrorKind::kInternal, "trial " + std::to_string(trial.index) + " belongs to no procedure block");
+}
+
+}  // namespace
+
+SessionLogic::SessionLogic(const PreparedSession& prepared)
+    : prepared_(prepared), adaptive_(prepared.protocol), rounds_(prepared.protocol, prepared.trials) {}
+
+Json SessionLogic::SkipReason(const protocol::Trial& trial) {
+  if (trial.cell >= 0 && adaptive_.Stopped(trial))
+    return {{"skipped", "stop rule"}, {"reversals", adaptive_.Reversals(trial)}};
+  if (const int met = rounds_.MetBefore(trial); met >= 0)
+    return {{"skipped", "criterion met in run " + std::to_string(met + 1)}};
+  return Json();
+}
+
+TrialScene SessionLogic::SceneOf(const protocol::Trial& trial, double* level) {
+  TrialScene scene = prepared_.scenes[size_t(trial.index)];
+  *level = 0;
+  if (trial.cell >= 0) {
+    *level = adaptive_.Level(trial);
+    ApplyLevel(ProcedureOf(prepared_.protocol, trial), trial, *level, prepared_.presentation, &scene);
+    PlanOnScreen(prepared_.protocol, *prepared_.scene, prepared_.presentation, &scene);
+  }
+  return scene;
+}
+
+Scored SessionLogic::Answer(const protocol::Trial& trial, const TrialScene& shown, double level,
+                            const std::string& choice) {
+  Scored s;
+  // Scored where the design defines a correct answer: a procedure's, an odd one out's, a practice run to a
+  // criterion's ("which fits the scene better?" has none, whatever the radii).
+  const bool scored = trial.cell >= 0 || !trial.test_side.empty() || trial.round >= 0;
+  s.correct = scored ? CorrectOf(trial, shown, choice) : std::nullopt;
+  const bool correct = s.correct.value_or(false);
+  if (trial.cell >= 0) {
+    if (ProcedureOf(prepared_.protocol, trial).kind == protocol::Procedure::Kind::kStaircase)
+      s.reversals_before = adaptive_.Reversals(trial);
+    adaptive_.Answer(trial, level, correct);
+    s.posterior = adaptive_.Posterior(trial);
+  }
+  if (trial.round >= 0) rounds_.Answer(trial, correct);
+  return s;
+}
+
+std::vector<KeyPress> ObserverPresses(const ObserverParams& params, uint64_t seed, const protocol::Protocol& protocol,
+                                      const protocol::Trial& trial, const TrialScene& scene,
+                                      const Presentation& presentation) {
+  (void)presentation;  // the observer in visual angle will need it
+  SimulatedObserver observer(params, TrialSeed(seed, trial.index));
+  if (trial.task == Task::kAdjustment) return observer.Adjust(trial.adjust_levels, trial.start_index, scene.distance_m);
+  const PairView view{scene.r_left_px, scene.r_right_px, scene.r_scene_px};
+  return {trial.task == Task::kYesNo    ? observer.SayYesNo(view)
+          : trial.task == Task::kRating ? observer.Rate(view, int(protocol.responses.rating.size()))
+          : scene.intervals > 2         ? observer.ChooseOdd(view, scene.intervals, std::stoi(trial.test_side))
+          // A procedure, or practice scored by a criterion: "which side is more blurred?"
+          : trial.cell >= 0 || trial.round >= 0 ? observer.ChooseBlurrier(view)
+                                                : observer.ChooseSide(view, !protocol.responses.cant_tell.empty())};
+}
+
+std::pair<std::string, double> HeadlessAnswer(const protocol::Protocol& protocol, const protocol::Trial& trial,
+                                              const TrialScene& scene, const std::vector<KeyPress>& presses) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (trial.task != Task::kAdjustment) {
+    if (presses.empty()) return {store::kChoiceNone, nan};
+    const double t_ms = (StimulusEndS(protocol, scene) + presses.front().after_ms / 1000) * 1000;
+    if (protocol.timing.deadline_ms > 0 && t_ms >= protocol.timing.deadline_ms) return {store::kChoiceNone, nan};
+    return {presses.front().action, t_ms};
+  }
+  // The adjustment's steps through the levels (cyclic), as the runner applies them, to the one accepted.
+  const int levels = static_cast<int>(trial.adjust_levels.size());
+  int level = trial.start_index;
+  double t_ms = 0;
+  for (const KeyPress& press : presses) {
+    t_ms += press.after_ms;
+    if (levels == 0) break;
+    if (press.action == "next" || press.action == "previous") {
+      level = (level + (press.action == "next" ? 1 : levels - 1)) % levels;
+    } else if (press.action == "accept") {
+      char text[32];
+      std::snprintf(text, sizeof text, "%g", trial.adjust_levels[size_t(level)]);
+      return {text, t_ms};
+    }
+  }
+  return {store::kChoiceNone, nan};
+}
+
+}  // namespace blurcue::session

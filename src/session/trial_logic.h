@@ -1,0 +1,98 @@
+#pragma once
+// What a session decides between its trials, apart from how anything is shown or stored: which trials are skipped
+// (a procedure's stop rule, a practice criterion met), what a procedure's trial shows now, how an answer is scored
+// and fed to the procedures and practice runs, and - for a simulated observer - which answer its key presses give.
+// Pure and deterministic: `blurcue run` presents and records around it, `blurcue plan` simulates whole studies
+// with it, so a planned participant answers exactly as the same participant run through the runner. No GL, no SQL.
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/json_io.h"
+#include "core/seed.h"
+#include "protocol/protocol.h"
+#include "protocol/trials.h"
+#include "session/adaptive.h"
+#include "session/observer.h"
+#include "session/prepare.h"
+#include "session/stimulus.h"
+
+namespace blurcue::session {
+
+// The simulated observer of one trial is seeded by the session seed and the trial index, so a resumed session
+// answers exactly as an uninterrupted one.
+inline uint64_t TrialSeed(uint64_t seed, int index) { return DeriveSeed(seed, static_cast<uint64_t>(index)); }
+
+// When a trial's stimulus has run its course, in seconds after onset: the end of its motion, or of its last interval.
+double StimulusEndS(const protocol::Protocol& protocol, const TrialScene& scene);
+
+// Whether `choice` answered `trial` correctly, where a trial has a correct answer: a procedure's test side or an odd
+// one out's interval; for a practice pair, the side showing the larger radius (equal radii: can't tell). Empty
+// where nothing is correct (yes/no, rating, adjustment).
+std::optional<bool> CorrectOf(const protocol::Trial& trial, const TrialScene& scene, const std::string& choice);
+
+// Practice blocks run until a criterion: per block, per run of its design, the answers and the correct ones; a run
+// is over when all its trials are answered. A pure function of the answers, so a resumed session decides the same.
+class PracticeRounds {
+ public:
+  PracticeRounds(const protocol::Protocol& protocol, const std::vector<protocol::Trial>& trials);
+  // The run in which `trial`'s block met its criterion before `trial`'s run (-1: not yet): its trial is skipped.
+  int MetBefore(const protocol::Trial& trial) const;
+  void Answer(const protocol::Trial& trial, bool correct);
+  // Whether run `round` of `block` is over and its share of correct answers reached the criterion.
+  bool Met(const std::string& block, int round) const;
+
+ private:
+  const protocol::Protocol& protocol_;
+  std::map<std::pair<std::string, int>, int> size_;
+  std::map<std::pair<std::string, int>, std::pair<int, int>> counts_;  // (block, run) -> (correct, answered)
+};
+
+// An answer as scored: whether it was correct (where the design defines a correct answer), a staircase's reversals
+// before it and QUEST+'s posterior means of threshold and slope after it (procedure trials).
+struct Scored {
+  std::optional<bool> correct;
+  std::optional<int> reversals_before;
+  std::optional<std::pair<double, double>> posterior;
+};
+
+// The decisions of one session, trial by trial in order. Holds references into `prepared`, which must outlive it.
+class SessionLogic {
+ public:
+  explicit SessionLogic(const PreparedSession& prepared);
+  // Why `trial` is not shown but recorded as skipped ({"skipped": why, ...}); null when it is shown.
+  Json SkipReason(const protocol::Trial& trial);
+  // The scene `trial` shows now: its planned scene, with a procedure's level from the answers so far applied and
+  // planned on the screen (`*level`: that level, 0 for a trial without one).
+  TrialScene SceneOf(const protocol::Trial& trial, double* level);
+  // Scores `choice` (what the record stores: "left", "3", kChoiceNone, ...) to `trial` shown as `shown` at `level`,
+  // and feeds it to the trial's procedure and practice run.
+  Scored Answer(const protocol::Trial& trial, const TrialScene& shown, double level, const std::string& choice);
+  // The state behind the decisions (a resumed session replays its record's answers into them).
+  AdaptiveState& adaptive() { return adaptive_; }
+  PracticeRounds& rounds() { return rounds_; }
+
+ private:
+  const PreparedSession& prepared_;
+  AdaptiveState adaptive_;
+  PracticeRounds rounds_;
+};
+
+// The key presses the simulated observer `params` makes for `trial` showing `scene` in a session seeded `seed`
+// (one press for an answer; the steps and the accept of an adjustment), each after_ms after the previous one. An
+// answer's press counts from the end of the stimulus (StimulusEndS: a moving stimulus is watched to its end, intervals
+// too), an adjustment's first step from onset.
+std::vector<KeyPress> ObserverPresses(const ObserverParams& params, uint64_t seed, const protocol::Protocol& protocol,
+                                      const protocol::Trial& trial, const TrialScene& scene,
+                                      const Presentation& presentation);
+
+// What a headless session records for those presses (the answering action, the adjustment's accepted level as %g),
+// and its response time in ms from onset; kChoiceNone (response time NaN) when the answer comes at or after the
+// protocol's deadline.
+std::pair<std::string, double> HeadlessAnswer(const protocol::Protocol& protocol, const protocol::Trial& trial,
+                                              const TrialScene& scene, const std::vector<KeyPress>& presses);
+
+}  // namespace blurcue::session

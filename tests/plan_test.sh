@@ -1,0 +1,122 @@
+#!/usr/bin/env bash
+# End-to-end tests of `blurcue plan`: usage: plan_test.sh CASE BLURCUE DIR
+# DIR holds protocols/ (tests/copy_protocols.cmake) and the scene they show. Each case prints what it checked and
+# exits non-zero on the first failure.
+set -euo pipefail
+CASE=$1 BC=$2 DIR=$3
+P=$DIR/protocols
+W=$DIR/plan-$CASE
+rm -rf "$W" && mkdir -p "$W"
+source "$(dirname "$0")/lib.sh"
+# A copy of protocol $1 changed by the Python statement $3 (on the parsed protocol p) into $2, paths kept.
+variant() {
+  $PY - "$1" "$2" "$3" <<'PYEOF'
+import json, sys
+p = json.load(open(sys.argv[1]))
+exec(sys.argv[3])
+json.dump(p, open(sys.argv[2], "w"), indent=1)
+PYEOF
+  sed -i "s|\"\.\./|\"$P/../|g" "$2"
+}
+# Every answer the plan's study 1 gave ($1: answers.csv) against what `blurcue run` records for the same
+# participants and seeds (through export's trials.csv), protocol $2, observer $3.
+same_as_run() {
+  local answers=$1 protocol=$2 observer=$3 db=$W/run-$(basename "$2" .json).sqlite
+  tail -n +2 "$answers" | cut -d, -f1,2 | sort -u | while IFS=, read -r id seed; do
+    # (run --seed takes the digits; the 's' keeps spreadsheets from rounding them)
+    $BC run "$protocol" --participant "$id" --seed "${seed#s}" --db "$db" --observer "$observer" > /dev/null 2>&1 \
+      || fail "run $id $seed"
+  done
+  $BC export --db "$db" --out "$W/tables-$(basename "$2" .json)" > /dev/null 2>&1 || fail "export"
+  $PY - "$answers" "$W/tables-$(basename "$2" .json)/trials.csv" <<'PYEOF' || fail "answers differ ($protocol)"
+import csv, sys
+plan = {(r["participant"], int(r["trial_index"])): r["choice"] for r in csv.DictReader(open(sys.argv[1]))}
+run = {}
+for r in csv.DictReader(open(sys.argv[2])):
+    status = r["status"]
+    choice = {"timed_out": "none", "skipped": "skipped"}.get(status) or next(
+        (r[c] for c in ("chosen_side", "chosen_interval", "yes_no", "rating", "adjusted_level") if r[c]), "")
+    run[(r["participant"], int(r["trial_index"]))] = choice
+if set(plan) != set(run):
+    sys.exit(f"trials differ: plan {len(plan)}, run {len(run)}")
+bad = [(k, plan[k], run[k]) for k in sorted(plan) if plan[k] != run[k]]
+if bad:
+    sys.exit(f"{len(bad)} of {len(plan)} answers differ, first {bad[:3]}")
+kinds = sorted(set(plan.values()))
+print(f"  {len(plan)} answers of {len({k[0] for k in plan})} participants identical; answers seen: {kinds}")
+PYEOF
+}
+
+case $CASE in
+same_as_run)
+  # A plan's simulated participant answers exactly as `blurcue run --observer ... --seed` records: a pair with
+  # can't tell and swapped sides (test 1), a QUEST+ whose deadline some answers miss (levels follow the answers), a
+  # staircase with a stop rule (skipped trials) over moving balls, and a practice block run to a criterion.
+  $BC plan "$P/test1-static-grids.json" --participants 3 --studies 1 --seed 7 --no-chart --out "$W/t1" > /dev/null 2>&1 \
+    || fail "plan test1"
+  same_as_run "$W/t1/answers.csv" "$P/test1-static-grids.json" sim
+  variant "$P/quest-blur-difference.json" "$W/quest-deadline.json" 'p["timing"]["deadline_ms"] = 1000'
+  $BC plan "$W/quest-deadline.json" --participants 2 --studies 1 --seed 8 --observer sim:lapse=0.1 --no-chart \
+    --out "$W/q" > /dev/null 2>&1 || fail "plan quest"
+  grep -q ",none$" "$W/q/answers.csv" || fail "the deadline case has no missed deadline"
+  same_as_run "$W/q/answers.csv" "$W/quest-deadline.json" sim:lapse=0.1
+  $BC plan "$P/staircase-ball-gain.json" --participants 2 --studies 1 --seed 9 --no-chart --out "$W/s" > /dev/null 2>&1 \
+    || fail "plan staircase"
+  grep -q ",skipped$" "$W/s/answers.csv" || fail "the staircase case skips nothing"
+  same_as_run "$W/s/answers.csv" "$P/staircase-ball-gain.json" sim
+  echo "ok: plan's simulated participants answer as blurcue run records them (pair, QUEST+ with deadline, staircase with stop rule)" ;;
+power_exact)
+  # A design whose answers are binomial with a known p: one condition (edge 5), 10 repetitions, a strict 2AFC
+  # between no blur and 30 px (the observer's noise 0.001 px: it always prefers the side nearer the scene's own
+  # blur, except in a lapse, a coin flip with probability 0.7): P(first source) = 0.7 / 2 + 0.3 x [first preferred],
+  # 0.65 or 0.35. Power of the exact two-sided binomial test at 0.05 with 10 N answers, by the closed form:
+  # P(X <= c) + P(X >= 10N - c) at the critical value c (the largest with 2 P0(X <= c) < 0.05 under p0 = 0.5),
+  # computed here independently, against 4000 simulated studies (4.5 standard errors).
+  variant "$P/test1-static-grids.json" "$W/binomial.json" '
+p["factors"] = {"edge": [5]}; p["repetitions"] = 10; p["practice"] = {"count": 0}
+p["sides"] = {"left": "none", "right": 30}; p["responses"]["cant_tell"] = None'
+  $BC plan "$W/binomial.json" --participants 6 --studies 4000 --seed 3 --observer sim:jnd=0.001,bias=0,lapse=0.7 \
+    --no-chart --out "$W/p" > "$W/out" 2> "$W/err" || fail "plan: $(tail -1 "$W/err")"
+  $PY - "$W/p/plan.csv" <<'PYEOF' || fail "power differs from the closed form"
+import csv, math, sys
+rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["test"] == "binomial"]
+assert len(rows) == 6, rows
+share = float(rows[0]["expected_share"])
+p = 0.65 if share > 0.5 else 0.35
+assert abs(share - p) < 0.005, f"expected share {share}, closed form {p}"
+pmf = lambda k, n, q: math.comb(n, k) * q ** k * (1 - q) ** (n - k)
+for r in rows:
+    n = 10 * int(r["participants"])
+    c = max([c for c in range(n // 2) if 2 * sum(pmf(j, n, 0.5) for j in range(c + 1)) < 0.05], default=-1)
+    exact = sum(pmf(j, n, p) for j in range(c + 1)) + sum(pmf(j, n, p) for j in range(n - c, n + 1)) if c >= 0 else 0.0
+    se = math.sqrt(max(exact * (1 - exact), 1e-4) / 4000)
+    got = float(r["power"])
+    print(f"  N = {r['participants']}: {n} answers, critical value {c}, power {got:.4f}, closed form {exact:.4f}")
+    assert abs(got - exact) < 4.5 * se, f"N = {r['participants']}: {got} vs {exact} (se {se:.4f})"
+PYEOF
+  echo "ok: the plan's power matches the exact binomial power at every N" ;;
+same_seed)
+  # The same seed gives the same plan, byte for byte, whatever the thread count; another seed another plan.
+  for t in 1 2 3; do
+    $BC plan "$P/test1-static-grids.json" --participants 5 --studies 20 --seed 11 --threads $t --no-chart \
+      --out "$W/t$t" > "$W/out$t" 2> "$W/err$t" || fail "plan --threads $t: $(tail -1 "$W/err$t")"
+  done
+  for t in 2 3; do
+    cmp "$W/t1/plan.csv" "$W/t$t/plan.csv" || fail "plan.csv with $t threads differs"
+    cmp "$W/t1/answers.csv" "$W/t$t/answers.csv" || fail "answers.csv with $t threads differs"
+    cmp <(head -n -1 "$W/out1") <(head -n -1 "$W/out$t") || fail "the summary with $t threads differs"
+  done
+  $BC plan "$P/test1-static-grids.json" --participants 5 --studies 20 --seed 12 --no-chart --out "$W/other" > /dev/null 2>&1
+  cmp -s "$W/t1/plan.csv" "$W/other/plan.csv" && fail "another seed gave the same plan"
+  echo "ok: seed 11 gives byte-identical plan.csv, answers.csv and summary with 1, 2 and 3 threads; seed 12 another" ;;
+chart)
+  # The chart through the analysis's Python: a real PNG, and the plan folder replaced whole by a second run.
+  $BC plan "$P/test1-static-grids.json" --participants 4 --studies 10 --out "$W/c" > "$W/out" 2> "$W/err" \
+    || fail "plan: $(tail -1 "$W/err")"
+  [ "$(head -c 8 "$W/c/power.png" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] || fail "power.png is no PNG"
+  $PY -c "import xml.dom.minidom, sys; xml.dom.minidom.parse(sys.argv[1])" "$W/c/power.svg" || fail "power.svg"
+  grep -q "stand-in for the report.s GLMM" "$W/out" || fail "summary names the stand-in"
+  grep -q "smallest_n" "$W/c/plan.json" || fail "plan.json"
+  echo "ok: power.png and power.svg drawn; plan.json written" ;;
+*) fail "unknown case $CASE" ;;
+esac

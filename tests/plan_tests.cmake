@@ -1,0 +1,46 @@
+# blurcue plan end to end over the CLI tests' scene (fixtures scene, calib, session_protocols): tests/plan_test.sh.
+set(BC $<TARGET_FILE:blurcue>)
+set(T ${PROJECT_BINARY_DIR}/cli-test)
+foreach(case same_as_run power_exact same_seed chart)
+  add_test(NAME plan_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/plan_test.sh ${case} ${BC} ${T})
+  set_tests_properties(plan_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS "gl;plan"
+                       PASS_REGULAR_EXPRESSION "^ok:|\nok:" TIMEOUT 600)
+endforeach()
+set_tests_properties(plan_chart PROPERTIES ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig")
+
+# Bad input: exit code and one line naming the option or file (tests/expect_failure.cmake). NAME CODE TEXT ARGS...
+function(add_plan_failure_test name code text)
+  add_test(NAME ${name}
+           COMMAND ${CMAKE_COMMAND} -DCMD=${BC} "-DARGS=${ARGN}" -DEXPECT_CODE=${code} "-DEXPECT_TEXT=${text}"
+                   -DONE_LINE=1 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+  set_tests_properties(${name} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS plan)
+endfunction()
+set(P1 ${T}/protocols/test1-static-grids.json)
+add_plan_failure_test(plan_bad_n_zero 2 "--participants: must be a whole number in [1, 10000], got 0"
+                      plan ${P1} --participants 0 --no-chart --out ${T}/plan-bad)
+add_plan_failure_test(plan_bad_n_negative 2 "--participants: must be a whole number in [1, 10000], got -1"
+                      plan ${P1} --participants=-1 --no-chart --out ${T}/plan-bad)
+add_plan_failure_test(plan_bad_n_huge 2 "--participants: must be a whole number in [1, 10000], got '1e308'"
+                      plan ${P1} --participants 1e308 --no-chart --out ${T}/plan-bad)
+add_plan_failure_test(plan_bad_n_nan 2 "--participants: must be a whole number in [1, 10000], got 'nan'"
+                      plan ${P1} --participants nan --no-chart --out ${T}/plan-bad)
+add_plan_failure_test(plan_bad_studies 2 "--studies: must be a whole number in [1, 100000], got 0"
+                      plan ${P1} --studies 0 --no-chart --out ${T}/plan-bad)
+add_plan_failure_test(plan_bad_alpha 2 "--alpha: must be a number in (0, 0.5], got nan"
+                      plan ${P1} --alpha nan --no-chart --out ${T}/plan-bad)
+add_plan_failure_test(plan_bad_observer 2 "--observer: unknown parameter 'jdn'"
+                      plan ${P1} --observer sim:jdn=1 --no-chart --out ${T}/plan-bad)
+add_plan_failure_test(plan_missing_protocol 3 "no-such-protocol.json: cannot open file"
+                      plan ${T}/no-such-protocol.json --no-chart --out ${T}/plan-bad)
+add_plan_failure_test(plan_protocol_is_a_folder 3 "protocols: is a folder, not a JSON file"
+                      plan ${T}/protocols --no-chart --out ${T}/plan-bad)
+add_plan_failure_test(plan_display_is_a_folder 3 "protocols: is a folder"
+                      plan ${P1} --display ${T}/protocols --no-chart --out ${T}/plan-bad)
+add_plan_failure_test(plan_missing_display 3 "no-such-display.json: cannot open file"
+                      plan ${P1} --display ${T}/no-such-display.json --no-chart --out ${T}/plan-bad)
+add_plan_failure_test(plan_out_is_a_file 3 "test1-static-grids.json: --out: is a file, not a folder"
+                      plan ${P1} --no-chart --out ${P1})
+add_plan_failure_test(plan_too_many 2 "--participants x --studies must be at most 20000000"
+                      plan ${P1} --participants 10000 --studies 100000 --no-chart --out ${T}/plan-bad)
+add_plan_failure_test(plan_bad_python 2 "--python /no/such/python: not found"
+                      plan ${P1} --participants 2 --studies 1 --python /no/such/python --out ${T}/plan-bad)
