@@ -14,8 +14,10 @@ namespace {
 
 double Phi(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
 
+// The pixel model's parameters (every record before model= existed names jnd): read as model=pixel.
 TEST(ObserverParams, ParsesNamesAndKeepsDefaults) {
   const ObserverParams p = ParseObserver("sim:jnd=0.4,lapse=0,rt=700");
+  EXPECT_EQ(p.model, ObserverModel::kPixel);
   EXPECT_DOUBLE_EQ(p.jnd_px, 0.4);
   EXPECT_DOUBLE_EQ(p.lapse, 0);
   EXPECT_DOUBLE_EQ(p.rt_ms, 700);
@@ -36,8 +38,15 @@ TEST(ObserverParams, RejectsUnknownNamesAndImpossibleValues) {
   }
 }
 
+// Pixel-model parameter set for the tests of the old model.
+ObserverParams Pixel() {
+  ObserverParams p;
+  p.model = ObserverModel::kPixel;
+  return p;
+}
+
 TEST(SimulatedObserver, SameSeedSameAnswers) {
-  const ObserverParams p;
+  const ObserverParams p = Pixel();
   SimulatedObserver a(p, 42), b(p, 42), c(p, 43);
   int differ = 0;
   for (int i = 0; i < 200; ++i) {
@@ -52,7 +61,7 @@ TEST(SimulatedObserver, SameSeedSameAnswers) {
 
 // The choice probabilities match the model's closed form: P(left) = P(D > c) with D ~ N(delta, jnd), c = jnd / 2.
 TEST(SimulatedObserver, ChoiceRatesMatchTheModel) {
-  ObserverParams p;
+  ObserverParams p = Pixel();
   p.jnd_px = 0.6;
   p.bias_px = 0;
   p.lapse = 0;
@@ -74,7 +83,7 @@ TEST(SimulatedObserver, ChoiceRatesMatchTheModel) {
 // One object: yes when e = m + N(0, jnd) exceeds jnd / 2 (m its mismatch with the scene), so P(yes) =
 // 1 - Phi((jnd / 2 - m) / jnd); a rating counts the criteria k jnd / 2 that e exceeds.
 TEST(SimulatedObserver, YesNoAndRatingRatesMatchTheModel) {
-  ObserverParams p;
+  ObserverParams p = Pixel();
   p.jnd_px = 0.6;
   p.lapse = 0;
   SimulatedObserver o(p, 11);
@@ -98,7 +107,7 @@ TEST(SimulatedObserver, YesNoAndRatingRatesMatchTheModel) {
 // Odd one out: with no difference every interval is named 1/n of the time; with a difference the odd one is found as
 // often as an independent simulation of the same rule finds it, and more often the larger the difference.
 TEST(SimulatedObserver, OddOneOutRatesMatchAnIndependentSimulation) {
-  ObserverParams p;
+  ObserverParams p = Pixel();
   p.jnd_px = 0.5;
   p.lapse = 0;
   SimulatedObserver o(p, 5);
@@ -119,8 +128,9 @@ TEST(SimulatedObserver, OddOneOutRatesMatchAnIndependentSimulation) {
       found += d2 > d1 && d2 > d3;
     }
     EXPECT_NEAR(named[2] / double(draws), found / double(draws), 6 * se) << "delta " << delta;
-    if (delta == 0)
+    if (delta == 0) {
       for (int k = 1; k <= 3; ++k) EXPECT_NEAR(named[k] / double(draws), 1.0 / 3, 4 * se);
+    }
     EXPECT_GE(named[2] / double(draws), previous);
     previous = named[2] / double(draws);
   }
@@ -128,7 +138,7 @@ TEST(SimulatedObserver, OddOneOutRatesMatchAnIndependentSimulation) {
 }
 
 TEST(SimulatedObserver, LapsesAnswerAtRandomAndBiasFavoursTheBlurredSide) {
-  ObserverParams p;
+  ObserverParams p = Pixel();
   p.jnd_px = 0.01;  // practically noiseless
   p.bias_px = 0;
   p.lapse = 0.3;
