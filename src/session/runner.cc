@@ -24,6 +24,7 @@
 #include "render/frame_compositor.h"
 #include "render/gl_context.h"
 #include "session/adaptive.h"
+#include "session/answer.h"
 #include "session/observer.h"
 #include "session/prepare.h"
 #include "session/screens.h"
@@ -268,7 +269,7 @@ class Runner {
     return Title("trial " + std::to_string(trial.index + 1) + " of " + std::to_string(trials_.size()));
   }
 
-  // The simulated observer's key presses for a trial whose stimulus appeared at `onset`.
+  // The simulated observer's key presses for a trial whose stimulus appeared at `onset` (ObserverPresses, as a plan).
   void ScriptObserver(const protocol::Trial& trial, const TrialScene& scene, double onset) {
     const std::vector<KeyPress> presses = ObserverPresses(*observer_, seed_, protocol_, trial, scene, prepared_.presentation);
     if (trial.task != Task::kAdjustment) {

@@ -103,16 +103,8 @@ Scored SessionLogic::Answer(const protocol::Trial& trial, const TrialScene& show
 std::vector<KeyPress> ObserverPresses(const ObserverParams& params, uint64_t seed, const protocol::Protocol& protocol,
                                       const protocol::Trial& trial, const TrialScene& scene,
                                       const Presentation& presentation) {
-  (void)presentation;  // the observer in visual angle will need it
   SimulatedObserver observer(params, TrialSeed(seed, trial.index));
-  if (trial.task == Task::kAdjustment) return observer.Adjust(trial.adjust_levels, trial.start_index, scene.distance_m);
-  const PairView view{scene.r_left_px, scene.r_right_px, scene.r_scene_px};
-  return {trial.task == Task::kYesNo    ? observer.SayYesNo(view)
-          : trial.task == Task::kRating ? observer.Rate(view, int(protocol.responses.rating.size()))
-          : scene.intervals > 2         ? observer.ChooseOdd(view, scene.intervals, std::stoi(trial.test_side))
-          // A procedure, or practice scored by a criterion: "which side is more blurred?"
-          : trial.cell >= 0 || trial.round >= 0 ? observer.ChooseBlurrier(view)
-                                                : observer.ChooseSide(view, !protocol.responses.cant_tell.empty())};
+  return AnswerTrial(observer, protocol, trial, scene, presentation);
 }
 
 std::pair<std::string, double> HeadlessAnswer(const protocol::Protocol& protocol, const protocol::Trial& trial,

@@ -12,19 +12,15 @@
 #include <vector>
 
 #include "core/json_io.h"
-#include "core/seed.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
 #include "session/adaptive.h"
+#include "session/answer.h"
 #include "session/observer.h"
 #include "session/prepare.h"
 #include "session/stimulus.h"
 
 namespace blurcue::session {
-
-// The simulated observer of one trial is seeded by the session seed and the trial index, so a resumed session
-// answers exactly as an uninterrupted one.
-inline uint64_t TrialSeed(uint64_t seed, int index) { return DeriveSeed(seed, static_cast<uint64_t>(index)); }
 
 // When a trial's stimulus has run its course, in seconds after onset: the end of its motion, or of its last interval.
 double StimulusEndS(const protocol::Protocol& protocol, const TrialScene& scene);
@@ -81,8 +77,9 @@ class SessionLogic {
   PracticeRounds rounds_;
 };
 
-// The key presses the simulated observer `params` makes for `trial` showing `scene` in a session seeded `seed`
-// (one press for an answer; the steps and the accept of an adjustment), each after_ms after the previous one. An
+// The key presses the simulated observer `params` makes for `trial` showing `scene` in a session seeded `seed`: its
+// observer seeded TrialSeed(seed, trial.index), answering through AnswerTrial (one press for an answer; the steps and
+// the accept of an adjustment), each after_ms after the previous one. An
 // answer's press counts from the end of the stimulus (StimulusEndS: a moving stimulus is watched to its end, intervals
 // too), an adjustment's first step from onset.
 std::vector<KeyPress> ObserverPresses(const ObserverParams& params, uint64_t seed, const protocol::Protocol& protocol,
