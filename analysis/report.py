@@ -23,6 +23,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # the sibling mo
 
 import any_study  # noqa: E402
 import bench_charts  # noqa: E402
+import prediction  # noqa: E402
 import common  # noqa: E402
 import depth_matching  # noqa: E402
 import forced_choice  # noqa: E402
@@ -276,7 +277,10 @@ def main(argv=None):
             {common.STUDY_TEST2}, {common.STUDY_TEST3}, set(common.FORCED_CHOICE_STUDIES),
             set(common.FORCED_CHOICE_STUDIES)]
     thesis_steps = [step for step, studies in zip(steps[:8], uses) if studies & present]
-    steps = thesis_steps + study_steps + steps[8:] + bench_steps
+    # Every study's answers beside the simulated observer's prediction for the same trials (prediction.py).
+    predict_step = ("observed vs the observer model",
+                    lambda: prediction.charts(df(), args.out, codebook, pool_simulated=args.pool_simulated))
+    steps = thesis_steps + study_steps + [predict_step] + steps[8:] + bench_steps
     n_data_steps = len(steps) - len(bench_steps)
     total = len(steps) + 2  # + reading trials.csv + writing the index
     say(f"[1/{total}] read {shown(args.trials)}: {len(trials)} rows")

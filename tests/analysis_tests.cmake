@@ -12,7 +12,10 @@ add_test(NAME analysis.report
 add_test(NAME analysis.bench_charts
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_bench_charts.py
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
-set_tests_properties(analysis.stats analysis.report analysis.bench_charts PROPERTIES
+add_test(NAME analysis.prediction
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_prediction.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(analysis.stats analysis.report analysis.bench_charts analysis.prediction PROPERTIES
                      LABELS analysis TIMEOUT 180
                      # Matplotlib writes its font cache under HOME; keep it out of a read-only or shared home.
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")

@@ -118,5 +118,33 @@ chart)
   grep -q "stand-in for the report.s GLMM" "$W/out" || fail "summary names the stand-in"
   grep -q "smallest_n" "$W/c/plan.json" || fail "plan.json"
   echo "ok: power.png and power.svg drawn; plan.json written" ;;
+prediction)
+  # The report's Python prediction (analysis/prediction.py, the model's closed form) against the plan's simulated
+  # answers to test 1 (the C++ observer, 4000 participants per edge): each edge's shares of first source, second
+  # source and can't tell within 4.5 standard errors. The radii come from a run's own record of the same protocol.
+  $BC plan "$P/test1-static-grids.json" --participants 20 --studies 200 --no-chart --out "$W/p" > /dev/null 2>&1 \
+    || fail "plan"
+  $BC run "$P/test1-static-grids.json" --participant P1 --db "$W/r.sqlite" --observer sim > /dev/null 2>&1 || fail "run"
+  $BC export --db "$W/r.sqlite" --out "$W/tables" > /dev/null 2>&1 || fail "export"
+  $PY - "$W/tables/trials.csv" "$W/p/plan.csv" "$(dirname "$0")/../analysis" <<'PYEOF' || fail "prediction"
+import math, sys
+import numpy as np, pandas as pd
+sys.path.insert(0, sys.argv[3])
+import prediction
+t = pd.read_csv(sys.argv[1])
+t = t[(t.practice == 0) & (t.swapped == 0)]
+plan = pd.read_csv(sys.argv[2])
+plan = plan[(plan.test == "binomial") & (plan.participants == 20)]
+worst = 0
+for _, r in t.iterrows():
+    shares = prediction.pair_choice(np.array([r.r_left_arcmin]), np.array([r.r_right_arcmin]), np.array([r.r_scene_arcmin]))
+    p = plan[plan.condition == f"edge={int(r.edge)}"].iloc[0]
+    for predicted, got in zip(shares, (p.share_first, p.share_second, p.share_cant_tell)):
+        z = abs(got - predicted[0]) / math.sqrt(predicted[0] * (1 - predicted[0]) / 4000)
+        worst = max(worst, z)
+        assert z < 4.5, f"edge {r.edge}: plan {got:.4f}, predicted {predicted[0]:.4f} ({z:.1f} SE)"
+print(f"  11 edges x 3 shares: the largest difference {worst:.1f} standard errors")
+PYEOF
+  echo "ok: the report's prediction matches the plan's simulated observer on every edge of test 1" ;;
 *) fail "unknown case $CASE" ;;
 esac

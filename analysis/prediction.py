@@ -1,0 +1,166 @@
+"""Observed against predicted: real participants beside what blurcue's simulated observer would answer to the same
+trials, per condition, so an experimenter sees where people depart from the model.
+
+The model (src/session/observer.h, model=arcmin, its default parameters) is implemented here independently, from
+the radii the export writes in visual angle (r_left_arcmin, r_right_arcmin, r_scene_arcmin; blurcue's radius r is
+twice the line-spread function's std, so the literature's Gaussian s = r / 2). A blur is seen as
+E(s) = (s^p + s_i^p)^(1/p); a comparison of two blurs has noise sd = ln(1 + weber) / z75 on ln E, so a 2AFC "which is
+more blurred?" is right with probability Phi(z75 |ln E(a) - ln E(b)| / ln(1 + weber)) (ProbabilityCorrect2afc in the
+C++; tests/data/observer-2afc.csv holds values both implementations must give). Per trial:
+  procedure / more blurred (a procedure's or 2IFC's question): P(correct) = lapse / 2 + (1 - lapse) P2afc
+  "which fits the scene?" (a pair): mismatch m = |ln E(side) - ln E(scene)| per side; D = m_right - m_left
+      + sd (blurrier x sign(r_left - r_right) + side) + sd N(0, 1); left when D > c, right when D < -c, else can't
+      tell (c = sd / 2 with a can't-tell key, 0 without); a lapse answers uniformly among the choices.
+The measure is the one the study's own analysis reports (any_study.py): a pair - chose the more blurred side among
+decisive answers between unequal radii; a procedure - correct. The predicted share of a condition is the mean of its
+trials' predicted probabilities; 'departs' marks a condition whose observed 95 % Wilson interval excludes it.
+"""
+import math
+import re
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+from scipy.stats import norm
+
+import stats
+from common import Chart, Skip, error_bars, participants_note, save
+
+Z75 = 0.6744897501960817  # Phi^-1(0.75)
+# The C++ model's defaults (session/observer.h ObserverParams, model=arcmin).
+DEFAULTS = {"intrinsic_arcmin": 0.6, "weber": 0.35, "exponent": 2.0, "side_bias": 0.0, "blurrier_bias": 0.3,
+            "lapse": 0.04}
+
+
+def log_seen(s_arcmin, p=DEFAULTS):
+    """ln E(s), E(s) = (s^p + s_i^p)^(1/p), for a Gaussian blur std s (arcmin; negative taken as 0)."""
+    s = np.maximum(np.asarray(s_arcmin, float), 0.0)
+    e, si = p["exponent"], p["intrinsic_arcmin"]
+    return np.log(s ** e + si ** e) / e
+
+
+def compare_sd(p=DEFAULTS):
+    return math.log1p(p["weber"]) / Z75
+
+
+def p_correct_2afc(r_a_arcmin, r_b_arcmin, p=DEFAULTS):
+    """The probability of telling radii a and b (arcmin, blurcue's r) apart in a 2AFC, no lapse or bias."""
+    d = np.abs(log_seen(np.asarray(r_a_arcmin, float) / 2, p) - log_seen(np.asarray(r_b_arcmin, float) / 2, p))
+    return norm.cdf(d / compare_sd(p))
+
+
+def pair_choice(r_left, r_right, r_scene, cant_tell=True, p=DEFAULTS):
+    """'Which fits the scene?': probabilities of left, right and can't tell (arrays of arcmin radii)."""
+    sd = compare_sd(p)
+    t = lambda r: log_seen(np.asarray(r, float) / 2, p)  # noqa: E731
+    m_left, m_right = np.abs(t(r_left) - t(r_scene)), np.abs(t(r_right) - t(r_scene))
+    more = np.sign(np.asarray(r_left, float) - np.asarray(r_right, float))
+    mu = m_right - m_left + sd * (p["blurrier_bias"] * more + p["side_bias"])
+    c = sd / 2 if cant_tell else 0.0
+    lapse, k = p["lapse"], 3 if cant_tell else 2
+    left = lapse / k + (1 - lapse) * norm.cdf((mu - c) / sd)
+    right = lapse / k + (1 - lapse) * norm.cdf((-mu - c) / sd)
+    return left, right, 1 - left - right
+
+
+def _num(series):
+    return pd.to_numeric(series.astype(str).replace({"": np.nan, "nan": np.nan}), errors="coerce")
+
+
+def predicted(d):
+    """Per answered pair or procedure row: y (observed 0/1) and predicted (the model's probability of y = 1), with kind;
+    rows the model does not cover are dropped."""
+    a = d[(d["status"] == "answered") & (d["task"] == "forced_choice")].copy()
+    if a.empty or "r_left_arcmin" not in a:
+        return a.assign(y=[], predicted=[], kind=[])
+    rl, rr = _num(a["r_left_arcmin"]), _num(a["r_right_arcmin"])
+    rs = _num(a["r_scene_arcmin"]) if "r_scene_arcmin" in a else pd.Series(np.nan, index=a.index)
+    procedure = _num(a["level"]).notna() if "level" in a else pd.Series(False, index=a.index)
+    odd = a["chosen_interval"].astype(str).str.strip().replace("nan", "").ne("")
+    # Whether a study offers can't tell is in its protocol, not its table: taken as offered when anyone used it.
+    offers = a.groupby("study")["chosen_side"].transform(lambda c: (c == "cant_tell").any())
+    out = []
+    # A procedure's trial: correct = chose the test side, the more blurred one.
+    pr = a[procedure & ~odd & rl.notna() & rr.notna()].copy()
+    if len(pr):
+        p2 = p_correct_2afc(rl[pr.index], rr[pr.index])
+        pr["predicted"] = DEFAULTS["lapse"] / 2 + (1 - DEFAULTS["lapse"]) * p2
+        pr["y"] = _num(pr["correct"])
+        pr["kind"] = "procedure: correct"
+        out.append(pr)
+    # A pair: chose the more blurred side, among decisive answers between unequal radii.
+    pa = a[~procedure & ~odd & a["chosen_side"].isin(["left", "right"]) & rl.notna() & rr.notna() & rs.notna() &
+           ((rl - rr).abs() > 1e-9)].copy()
+    if len(pa):
+        left, right, _ = pair_choice(rl[pa.index], rr[pa.index], rs[pa.index], cant_tell=False)
+        left_c, right_c, _ = pair_choice(rl[pa.index], rr[pa.index], rs[pa.index], cant_tell=True)
+        with_cant = offers[pa.index].to_numpy(bool)
+        left, right = np.where(with_cant, left_c, left), np.where(with_cant, right_c, right)
+        left_blurrier = (rl[pa.index] > rr[pa.index]).to_numpy()
+        pa["predicted"] = np.where(left_blurrier, left, right) / (left + right)
+        pa["y"] = _num(pa["chose_more_blurred"])
+        pa["kind"] = "pair: chose the more blurred side"
+        out.append(pa)
+    if not out:
+        return a.iloc[0:0].assign(y=[], predicted=[], kind=[])
+    return pd.concat(out).dropna(subset=["y", "predicted"])
+
+
+def condition_table(m, factors):
+    keys = None if not factors else factors[0] if len(factors) == 1 else factors
+    groups = m.groupby(keys, dropna=False) if keys else [((), m)]
+    rows = []
+    for key, g in groups:
+        key = key if isinstance(key, tuple) else (key,)
+        row = {f: (str(v)[:-2] if str(v).endswith(".0") else str(v)) for f, v in zip(factors, key)}
+        n, k = len(g), int(g["y"].sum())
+        share, lo, hi = stats.wilson(k, n)
+        pred = float(g["predicted"].mean())
+        row.update(n=n, k=k, observed=share, observed_low=lo, observed_high=hi, predicted=pred,
+                   departs=bool(n and not (lo <= pred <= hi)), participants=g["participant"].nunique())
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def charts(df, out_dir, codebook, pool_simulated=False):
+    """One chart and table per study and measure (people and simulated observers apart unless pooled)."""
+    import any_study
+    d = df[df["practice"] != 1]
+    m_all = predicted(d)
+    if m_all.empty:
+        raise Skip("no answered forced-choice trial with radii in arcmin (r_left_arcmin, r_right_arcmin): nothing "
+                   "to predict")
+    out = []
+    for (study, kind), m in m_all.groupby(["study", "kind"]):
+        kinds = ["all"] if pool_simulated else sorted(set(m["observer"]))
+        for who in kinds:
+            part = m if who == "all" else m[m["observer"] == who]
+            factors = [f for f in any_study.design_factors(part, codebook)]
+            t = condition_table(part, factors)
+            label = "all" if who == "all" else ("people" if who == "person" else "simulated observers")
+            slug = re.sub(r"[^A-Za-z0-9_-]", "_", f"{study}-predicted-{kind.split(':')[0]}-{label.split()[0]}")
+            fig, ax = plt.subplots(figsize=(max(5.0, 0.6 * len(t) + 3), 3.8))
+            x = np.arange(len(t))
+            ax.bar(x, t["observed"], 0.6, color="#0072B2", edgecolor="white", label="observed (95 % Wilson)")
+            ax.errorbar(x, t["observed"], yerr=error_bars(t["observed"], t["observed_low"], t["observed_high"]),
+                        fmt="none", ecolor="#333333", lw=0.9)
+            ax.plot(x, t["predicted"], "D", color="#D55E00", ms=6, label="the observer model predicts")
+            for xi, dep in zip(x, t["departs"]):
+                if dep:
+                    ax.text(xi, 1.04, "!", ha="center", va="bottom", color="#D55E00", fontsize=11, fontweight="bold")
+            labels = [" ".join(str(r[f]) for f in factors) or "all" for _, r in t.iterrows()]
+            ax.set_xticks(x)
+            ax.set_xticklabels(labels, rotation=45 if len(labels) > 8 else 0, ha="right" if len(labels) > 8 else "center")
+            ax.set_xlabel(", ".join(factors) or "all trials")
+            ax.set_ylim(0, 1.12)
+            ax.set_ylabel(f"share: {kind.split(': ')[1]}")
+            ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0))
+            ax.set_title(f"{study}: observed vs predicted ({label}, {participants_note(part)})", loc="left")
+            png, svg = save(fig, out_dir, slug)
+            departs = int(t["departs"].sum())
+            notes = [f"{label}: {kind} per condition; bars observed with 95 % Wilson intervals, diamonds the "
+                     f"simulated observer's prediction for the same trials (model=arcmin, default parameters: "
+                     + ", ".join(f"{k} {v:g}" for k, v in DEFAULTS.items()) + "); ! where the interval excludes it",
+                     f"{departs} of {len(t)} conditions depart from the model"]
+            out.append(Chart(slug, png, svg, t, notes))
+    return out
