@@ -1,5 +1,7 @@
 #include "bench/plan_bench.h"
 
+#include <time.h>
+
 #include <chrono>
 #include <cstdio>
 #include <map>
@@ -9,8 +11,19 @@
 #include "core/error.h"
 #include "core/stats.h"
 #include "plan/plan.h"
+#include "session/prepare.h"
 
 namespace blurcue::bench {
+namespace {
+
+// CPU time of the whole process (every thread), seconds.
+double CpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+}  // namespace
 
 std::vector<PlanBenchRow> RunPlanBench(const PlanBenchOptions& options) {
   std::vector<PlanBenchRow> rows;
@@ -20,14 +33,16 @@ std::vector<PlanBenchRow> RunPlanBench(const PlanBenchOptions& options) {
   p.participants = options.participants;
   p.studies = options.studies;
   p.seed = options.seed;
-  // One untimed run first: files read, caches and pages warm for every timed run alike.
+  // The study is prepared once (protocol, calibration, images: not what a participant costs), then one untimed run:
+  // caches and pages warm for every timed run alike.
+  const session::PreparedSession study = session::PrepareStudy(options.protocol_file);
   {
     std::vector<plan::Condition> conditions;
     std::vector<std::string> notes;
     int used = 0;
     p.threads = 1;
     p.studies = 1;
-    plan::SimulateStudies(p, &conditions, &notes, &used);
+    plan::SimulateStudies(p, study, &conditions, &notes, &used);
     p.studies = options.studies;
   }
   std::vector<std::vector<std::pair<int, std::string>>> reference;
@@ -38,9 +53,11 @@ std::vector<PlanBenchRow> RunPlanBench(const PlanBenchOptions& options) {
       std::vector<plan::Condition> conditions;
       std::vector<std::string> notes;
       int used = 0;
+      const double cpu_start = CpuSeconds();
       const auto start = std::chrono::steady_clock::now();
-      const auto studies = plan::SimulateStudies(p, &conditions, &notes, &used);
+      const auto studies = plan::SimulateStudies(p, study, &conditions, &notes, &used);
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double cpu = CpuSeconds() - cpu_start;
       std::vector<std::vector<std::pair<int, std::string>>> answers;
       for (const auto& participant : studies.front()) answers.push_back(participant.answers);
       if (reference.empty()) reference = answers;
@@ -53,11 +70,13 @@ std::vector<PlanBenchRow> RunPlanBench(const PlanBenchOptions& options) {
       row.participants = options.participants * options.studies;
       row.seconds = seconds;
       row.ms_per_participant = 1000 * seconds / row.participants;
+      row.cpu_seconds = cpu;
       rows.push_back(row);
       if (options.progress) {
         char line[160];
-        std::snprintf(line, sizeof line, "bench plan: round %d, %d thread%s: %d participants in %.3f s (%.3f ms each)",
-                      round + 1, used, used == 1 ? "" : "s", row.participants, seconds, row.ms_per_participant);
+        std::snprintf(line, sizeof line, "bench plan: round %d, %d thread%s: %d participants in %.3f s (%.3f ms each; %.2f cores busy)",
+                      round + 1, used, used == 1 ? "" : "s", row.participants, seconds, row.ms_per_participant,
+                      cpu / seconds);
         options.progress(line);
       }
     }
@@ -66,19 +85,22 @@ std::vector<PlanBenchRow> RunPlanBench(const PlanBenchOptions& options) {
 }
 
 void WritePlanBenchCsv(const std::vector<PlanBenchRow>& rows, const std::filesystem::path& path) {
-  std::string out = "threads,round,participants,seconds,ms_per_participant\n";
+  std::string out = "threads,round,participants,seconds,ms_per_participant,cpu_seconds\n";
   char line[160];
   for (const auto& r : rows) {
-    std::snprintf(line, sizeof line, "%d,%d,%d,%.6f,%.6f\n", r.threads, r.round, r.participants, r.seconds,
-                  r.ms_per_participant);
+    std::snprintf(line, sizeof line, "%d,%d,%d,%.6f,%.6f,%.6f\n", r.threads, r.round, r.participants, r.seconds,
+                  r.ms_per_participant, r.cpu_seconds);
     out += line;
   }
   WriteFileAtomically(path, out);
 }
 
 std::string SummarizePlanBench(const std::vector<PlanBenchRow>& rows) {
-  std::map<int, std::vector<double>> per;
-  for (const auto& r : rows) per[r.threads].push_back(r.ms_per_participant);
+  std::map<int, std::vector<double>> per, busy;
+  for (const auto& r : rows) {
+    per[r.threads].push_back(r.ms_per_participant);
+    busy[r.threads].push_back(r.seconds > 0 ? r.cpu_seconds / r.seconds : 0);
+  }
   std::string out;
   char line[256];
   const double one = per.count(1) ? Percentile(per[1], 0.5) : 0;
@@ -93,8 +115,13 @@ std::string SummarizePlanBench(const std::vector<PlanBenchRow>& rows) {
                     "(%.0f %% of the ideal %dx)\n",
                     threads, median, times.size(), one / median, 100 * one / median / threads, threads);
     out += line;
+    std::snprintf(line, sizeof line, "  cores it got: %.2f (CPU time / wall time, median)\n", Percentile(busy[threads], 0.5));
+    out += line;
   }
-  std::snprintf(line, sizeof line, "this machine has %u hardware threads\n", std::thread::hardware_concurrency());
+  std::snprintf(line, sizeof line,
+                "this machine has %u hardware threads; a speed-up below the cores it got means the work itself does "
+                "not scale, below the threads asked for that other processes held the cores\n",
+                std::thread::hardware_concurrency());
   return out + line;
 }
 

@@ -22,6 +22,7 @@ struct PlanBenchOptions {
 struct PlanBenchRow {
   int threads = 0, round = 0, participants = 0;  // participants: simulated in the run
   double seconds = 0, ms_per_participant = 0;
+  double cpu_seconds = 0;  // the process's CPU time in the run: cpu_seconds / seconds is the cores it really got
 };
 
 std::vector<PlanBenchRow> RunPlanBench(const PlanBenchOptions& options);

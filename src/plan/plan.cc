@@ -134,18 +134,35 @@ std::string Quoted(const std::string& text) {
 
 }  // namespace
 
-std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& options, std::vector<Condition>* conditions,
-                                                         std::vector<std::string>* notes, int* threads_used,
-                                                         std::string* study_name) {
+namespace {
+
+void CheckSizes(const PlanOptions& options) {
   if (options.participants < 1 || options.studies < 1)
     throw Error(ErrorKind::kUsage, "--participants and --studies must be at least 1");
   if (double(options.participants) * options.studies > 2e7)
     throw Error(ErrorKind::kUsage, "--participants x --studies must be at most 20000000 simulated participants, got " +
                                        std::to_string(options.participants) + " x " + std::to_string(options.studies));
-  const session::ObserverParams observer = session::ParseObserver(options.observer);
+}
+
+}  // namespace
+
+std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& options, std::vector<Condition>* conditions,
+                                                         std::vector<std::string>* notes, int* threads_used,
+                                                         std::string* study_name) {
+  CheckSizes(options);
+  (void)session::ParseObserver(options.observer);  // a bad --observer before any file is read
   const session::PreparedSession study = session::PrepareStudy(options.protocol_file, options.display_profile);
+  if (study_name) *study_name = study.protocol.name;
+  return SimulateStudies(options, study, conditions, notes, threads_used);
+}
+
+std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& options,
+                                                         const session::PreparedSession& study,
+                                                         std::vector<Condition>* conditions,
+                                                         std::vector<std::string>* notes, int* threads_used) {
+  CheckSizes(options);
+  const session::ObserverParams observer = session::ParseObserver(options.observer);
   const protocol::Protocol& protocol = study.protocol;
-  if (study_name) *study_name = protocol.name;
   int main_blocks = 0;
   for (const auto& b : protocol.blocks) main_blocks += !b.practice;
   const bool several_blocks = main_blocks > 1;
@@ -217,8 +234,11 @@ std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& opti
 PlanResult RunPlan(const PlanOptions& options) {
   if (!(options.alpha > 0 && options.alpha < 1)) throw Error(ErrorKind::kUsage, "--alpha must be in (0, 1)");
   PlanResult r;
+  (void)session::ParseObserver(options.observer);  // a bad --observer before any file is read
+  const session::PreparedSession study = session::PrepareStudy(options.protocol_file, options.display_profile);
+  r.study = study.protocol.name;
   const auto start = std::chrono::steady_clock::now();
-  r.studies = SimulateStudies(options, &r.conditions, &r.notes, &r.threads_used, &r.study);
+  r.studies = SimulateStudies(options, study, &r.conditions, &r.notes, &r.threads_used);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   r.observer = session::ToString(session::ParseObserver(options.observer));
   const int N = options.participants, S = options.studies;

@@ -21,6 +21,10 @@
 #include <string>
 #include <vector>
 
+namespace blurcue::session {
+struct PreparedSession;
+}
+
 namespace blurcue::plan {
 
 struct PlanOptions {
@@ -94,6 +98,12 @@ PlanResult RunPlan(const PlanOptions& options);
 std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& options, std::vector<Condition>* conditions,
                                                          std::vector<std::string>* notes, int* threads_used,
                                                          std::string* study_name = nullptr);
+// The same from a study already prepared (session::PrepareStudy of options.protocol_file and display_profile): only
+// the simulation, as the benchmark times it.
+std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& options,
+                                                         const session::PreparedSession& study,
+                                                         std::vector<Condition>* conditions,
+                                                         std::vector<std::string>* notes, int* threads_used);
 
 // plan.csv: one row per PowerRow, fixed formatting (the same plan gives the same bytes).
 std::string PlanCsv(const PlanResult& result);
