@@ -74,7 +74,7 @@ def main(argv=None):
         return 3
     common.setup_style()
     png, _ = chart(plan, args.out, args.title, args.target)
-    print(f"plan_chart: wrote {png}", file=sys.stderr)
+    print(f"plan_chart: drew {os.path.basename(png)} and power.svg", file=sys.stderr)
     return 0
 
 
