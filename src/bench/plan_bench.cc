@@ -16,6 +16,12 @@
 namespace blurcue::bench {
 namespace {
 
+std::string Number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2f", v);
+  return text;
+}
+
 // CPU time of the whole process (every thread), seconds.
 double CpuSeconds() {
   timespec t{};
@@ -96,10 +102,11 @@ void WritePlanBenchCsv(const std::vector<PlanBenchRow>& rows, const std::filesys
 }
 
 std::string SummarizePlanBench(const std::vector<PlanBenchRow>& rows) {
-  std::map<int, std::vector<double>> per, busy;
+  std::map<int, std::vector<double>> per, busy, cpu;
   for (const auto& r : rows) {
     per[r.threads].push_back(r.ms_per_participant);
     busy[r.threads].push_back(r.seconds > 0 ? r.cpu_seconds / r.seconds : 0);
+    cpu[r.threads].push_back(1000 * r.cpu_seconds / r.participants);
   }
   std::string out;
   char line[256];
@@ -115,7 +122,12 @@ std::string SummarizePlanBench(const std::vector<PlanBenchRow>& rows) {
                     "(%.0f %% of the ideal %dx)\n",
                     threads, median, times.size(), one / median, 100 * one / median / threads, threads);
     out += line;
-    std::snprintf(line, sizeof line, "  cores it got: %.2f (CPU time / wall time, median)\n", Percentile(busy[threads], 0.5));
+    std::snprintf(line, sizeof line,
+                  "  cores it got: %.2f (CPU time / wall time, median); CPU time per participant %.3f ms%s\n",
+                  Percentile(busy[threads], 0.5), Percentile(cpu[threads], 0.5),
+                  threads == 1 || !cpu.count(1) ? ""
+                                                : (" (" + Number(Percentile(cpu[threads], 0.5) / Percentile(cpu[1], 0.5)) +
+                                                   "x 1 thread's: the cost of running in parallel)").c_str());
     out += line;
   }
   std::snprintf(line, sizeof line,
