@@ -72,7 +72,7 @@ def predicted(d):
     rows the model does not cover are dropped."""
     a = d[(d["status"] == "answered") & (d["task"] == "forced_choice")].copy()
     if a.empty or "r_left_arcmin" not in a:
-        return a.assign(y=[], predicted=[], kind=[])
+        return a.iloc[0:0].assign(y=[], predicted=[], kind=[])
     rl, rr = _num(a["r_left_arcmin"]), _num(a["r_right_arcmin"])
     rs = _num(a["r_scene_arcmin"]) if "r_scene_arcmin" in a else pd.Series(np.nan, index=a.index)
     procedure = _num(a["level"]).notna() if "level" in a else pd.Series(False, index=a.index)

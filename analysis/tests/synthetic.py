@@ -157,6 +157,10 @@ def tidy(row):
             r["chose_more_blurred"] = int((choice == "left") == (r["r_left_px"] > r["r_right_px"]))
     for flag in ("practice", "swapped"):
         r[flag] = int(bool(r.get(flag, 0)))
+    # Each radius in visual angle too, as the export writes it (a photo px here is 1.5 arcmin on the screen).
+    for side in ("left", "right", "scene"):
+        if r.get(f"r_{side}_px") is not None:
+            r[f"r_{side}_arcmin"] = round(r[f"r_{side}_px"] * 1.5, 4)
     if isinstance(r.get("pattern"), dict):
         p = r["pattern"]
         r["pattern"], r["id"], r["speed_cm_s"] = p["id"], p["id"], p["speed_cm_s"]

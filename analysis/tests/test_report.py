@@ -63,8 +63,11 @@ class EndToEndTest(ReportTestCase):
                     "test3-pattern2-per-section", "test3-pattern4-per-section", "test3-pattern6-per-section",
                     "psychometric", "side-bias", "frame-intervals", "bench-measure-speed-accuracy", "bench-stability-within-target",
                     "bench-stability-error", "bench-render-speed-accuracy", "bench-frame", "bench-frame-growth",
-                    "bench-procedures"}
+                    "bench-procedures", "test1-static-grids-predicted-pair-simulated",
+                    "test2-moving-balls-predicted-pair-simulated", "test3-no-board-predicted-pair-simulated"}
         self.assertEqual({p[:-4] for p in pngs}, expected)
+        # Observed beside the observer model's prediction, per condition, with the departures counted.
+        self.assertIn("conditions depart from the model", index)
         bench_page = read(out, "bench.html")
         linked = set(re.findall(r"<img src='([^']+)'", index))
         bench_linked = set(re.findall(r"<img src='([^']+)'", bench_page))
