@@ -245,8 +245,7 @@ TEST(ArcminObserver, DipperMatchesItsClosedForm) {
 //
 // The points (Gaussian std, arcmin: reference blur -> 75 % discrimination increment) are approximate values of the
 // dipper in Mather & Smith 2002 (Perception 31:1211-1219, their figure of blur-discrimination threshold against
-// reference blur, edges, observers' mean) and of the summary fit Watson & Ahumada 2011 (J. Vision 11(5):10) give of
-// the blur-discrimination literature: a threshold of about 0.5 arcmin on a sharp edge, a dip to about 0.3-0.4 arcmin
+// reference blur, edges, observers' mean) and of the data Watson & Ahumada 2011 (J. Vision 11(5):10) review: a threshold of about 0.5 arcmin on a sharp edge, a dip to about 0.3-0.4 arcmin
 // near a reference of 0.5 arcmin, then a near-Weber rise to about 1.5 arcmin at 4 arcmin. They were typed in from
 // the shape of those figures as we recall it, without the papers at hand to digitise - not measured values: check
 // them against the figures before citing this test as a validation. The tolerance, a factor of 1.5 either way, is
