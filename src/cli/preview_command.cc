@@ -141,7 +141,8 @@ void AddPreviewCommand(CLI::App& app) {
       if (s.left_only) view.r_right_px = view.r_scene_px;
       const double p_correct = session::ProbabilityCorrect2afc(observer, view);
       char seen[96];
-      std::snprintf(seen, sizeof seen, "%s %.0f %% seen%s", s.left_only ? "vs scene:" : "L vs R:", 100 * p_correct,
+      std::snprintf(seen, sizeof seen, "%s told apart %.0f %% (2AFC)%s", s.left_only ? "vs scene:" : "L vs R:",
+                    100 * p_correct,
                     p_correct < args->visible ? " - INVISIBLE" : "");
       const size_t first_tile = tiles.size();
       if (s.left_only) {  // layout single: its one object

@@ -5,12 +5,14 @@
 // Two models, named by `model`:
 //
 // model=arcmin (the default): blur discrimination in visual angle, the "dipper" of the blur-discrimination
-// literature (Watson & Ahumada 2011, "Blur clarified: a review and synthesis of blur discrimination", J. Vision
-// 11(5):10; Mather & Smith 2002, "Blur discrimination and its relation to blur-mediated depth perception",
-// Perception 31:1211-1219). The literature states blur as the standard deviation s of a Gaussian (arcmin); blurcue's
+// literature that Watson & Ahumada 2011 ("Blur clarified: a review and synthesis of blur discrimination", J. Vision
+// 11(5):10) review, with data such as Mather & Smith 2002 ("Blur discrimination and its relation to blur-mediated
+// depth perception", Perception 31:1211-1219). The form used is the classic equivalent-intrinsic-blur account of
+// the dipper (intrinsic blur plus Weber's law), not W&A's own contrast-energy model (ViCE), which needs the image
+// and is not implemented here. The literature states blur as the standard deviation s of a Gaussian (arcmin); blurcue's
 // radius r is 2 x the std of the line-spread function (DESIGN.md), so s = r / 2. The eye adds its own equivalent
 // (intrinsic) blur s_i; a blur is seen as
-//     E(s) = (s^p + s_i^p)^(1/p)                     (p = exponent; 2: the two add in quadrature, as in W&A)
+//     E(s) = (s^p + s_i^p)^(1/p)                     (p = exponent; 2: the two add in quadrature)
 // and two blurs are told apart by Weber's law on E: each look at a blur gives ln E(s) + N(0, sigma), with sigma set so
 // that a 2AFC "which is more blurred?" is 75 % correct when E(b) / E(a) = 1 + weber:
 //     P(correct) = Phi(z75 |ln E(s_a) - ln E(s_b)| / ln(1 + weber)),   z75 = Phi^-1(0.75),   sigma = ln(1+w) / (sqrt 2 z75)
