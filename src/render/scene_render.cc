@@ -29,47 +29,13 @@ cv::Matx33d SpinAboutX(double deg) {
   return {1, 0, 0, 0, c, -s, 0, s, c};
 }
 
-// A mesh drawn with indices: a vertex shared by several triangles is shaded once (llvmpipe shades vertices on the
-// CPU, one thread, so this is most of an object's cost).
+// A mesh drawn with indices (a vertex shared by triangles is shaded once). A card is one; a ball is traced
+// (shaders/ball.frag), not tessellated: llvmpipe shades vertices on the CPU, one thread, and a sphere fine enough
+// for a 0.1 px silhouette was most of a ball's cost.
 struct Mesh {
   std::vector<Vertex> vertices;
   std::vector<GLuint> indices;
 };
-
-// The unit sphere as a UV sphere of n_lon x n_lon / 2 facets: longitude along u, latitude along v (v = 0 at the +z
-// pole). Built once; each object places it with its model matrix. Its triangles turn counter-clockwise seen from
-// outside.
-Mesh UnitSphere(int n_lon) {
-  const int n_lat = n_lon / 2;
-  Mesh m;
-  for (int i = 0; i <= n_lat; ++i)
-    for (int j = 0; j <= n_lon; ++j) {  // the seam's column twice, once at u = 0 and once at u = 1
-      const double theta = M_PI * i / n_lat, phi = 2 * M_PI * j / n_lon;
-      const float x = float(std::sin(theta) * std::cos(phi)), y = float(std::sin(theta) * std::sin(phi)),
-                  z = float(std::cos(theta));
-      m.vertices.push_back(Vertex{{x, y, z}, {x, y, z}, {float(double(j) / n_lon), float(double(i) / n_lat)}});
-    }
-  auto at = [&](int i, int j) { return GLuint(i * (n_lon + 1) + j); };
-  for (int i = 0; i < n_lat; ++i)
-    for (int j = 0; j < n_lon; ++j)
-      m.indices.insert(m.indices.end(), {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1),
-                                         at(i, j + 1)});
-  return m;
-}
-
-// The spheres a ball may be drawn with, by facets around: each ball gets the coarsest whose silhouette stays within
-// 0.1 px of its circle (SphereFacetsFor) - llvmpipe shades every vertex on the CPU, so a ball 60 px across costs a
-// third of one 200 px across, and a large one is not drawn as a polygon.
-constexpr int kSphereFacets[] = {16, 24, 32, 40, 48, 64, 80, 96, 128, 160};
-
-// A polygon of n sides inscribed in a circle of R px falls inside it by at most R (1 - cos(pi / n)) ~ R pi^2 / 2n^2
-// (the sagitta): the n that keeps it under 0.1 px, from the list (the finest for a larger ball).
-int SphereFacetsFor(double radius_px) {
-  const double needed = M_PI * std::sqrt(std::max(radius_px, 0.0) / (2 * 0.1));
-  for (int n : kSphereFacets)
-    if (n >= needed) return n;
-  return kSphereFacets[std::size(kSphereFacets) - 1];
-}
 
 // The unit card (side 1, centred, in z = 0); texture row 0 (the image's top) on the far side (+y).
 Mesh UnitCard() {
@@ -131,14 +97,11 @@ struct SceneRenderer::Impl {
   cv::Matx33d rotation;
   ObjectShader shader;
   GrowingTarget color, depth;  // the resolved layers, made once and grown
-  GlName vao, vbo, ebo;
-  // Where each mesh's indices lie in the one index buffer: the spheres in kSphereFacets' order, then the card.
-  struct Range {
-    size_t first = 0;
-    GLsizei count = 0;
-  };
-  std::vector<Range> spheres;
-  Range card;
+  GlName vao, vbo, ebo;  // the unit card, indexed
+  GLsizei card_indices = 0;
+  BallShader ball_shader;
+  FullscreenPass pass;                  // a ball covers its layer with one triangle
+  std::vector<glm::vec2> sample_at;     // the multisample targets' sample positions in a pixel
   // Textures by their image: a moving ball re-uses its texture every frame. Each entry holds its image (a cv::Mat
   // shares the pixels), so those pixels stay allocated and their address cannot come back as another image's.
   struct CachedTexture {
@@ -187,6 +150,15 @@ struct SceneRenderer::Impl {
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, ms_depth.id());
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
       throw Error(ErrorKind::kInternal, "GL: multisample framebuffer incomplete");
+    // Where the samples lie in a pixel, as this GL places them: a traced ball tests its rays there.
+    GLint count = 1;
+    glGetIntegerv(GL_SAMPLES, &count);
+    sample_at.clear();
+    for (GLint i = 0; i < std::max(count, 1); ++i) {
+      GLfloat at[2] = {0.5f, 0.5f};
+      if (count > 1) glGetMultisamplefv(GL_SAMPLE_POSITION, GLuint(i), at);
+      sample_at.emplace_back(at[0], at[1]);
+    }
     return id;
   }
 };
@@ -207,17 +179,9 @@ SceneRenderer::SceneRenderer(const Camera& camera, const cv::Vec3d& rvec, const 
   glBindVertexArray(impl_->vao.id());
   glBindBuffer(GL_ARRAY_BUFFER, impl_->vbo.id());
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, impl_->ebo.id());
-  // Every unit mesh in one buffer, uploaded once: a frame only sets matrices.
-  Mesh mesh;
-  auto append = [&](const Mesh& part) {
-    const GLuint base = GLuint(mesh.vertices.size());
-    const Impl::Range range{mesh.indices.size(), GLsizei(part.indices.size())};
-    mesh.vertices.insert(mesh.vertices.end(), part.vertices.begin(), part.vertices.end());
-    for (GLuint i : part.indices) mesh.indices.push_back(base + i);
-    return range;
-  };
-  for (int n : kSphereFacets) impl_->spheres.push_back(append(UnitSphere(n)));
-  impl_->card = append(UnitCard());
+  // The unit card, uploaded once: a frame only sets matrices.
+  const Mesh mesh = UnitCard();
+  impl_->card_indices = GLsizei(mesh.indices.size());
   glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(mesh.vertices.size() * sizeof(Vertex)), mesh.vertices.data(),
                GL_STATIC_DRAW);
   glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(mesh.indices.size() * sizeof(GLuint)), mesh.indices.data(),
@@ -382,33 +346,32 @@ GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px, boo
   glClearColor(0, 0, 0, 0);
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  glEnable(GL_DEPTH_TEST);
-  // A ball's far side is hidden by its near side: not drawn at all. Image rows run down the framebuffer's y, which
-  // mirrors the picture, so a triangle that turns counter-clockwise seen from outside turns clockwise here. A card
-  // has two faces (a standing one may be seen from behind).
-  const bool ball = o.kind == VirtualObject::Kind::kBall;
-  if (ball) glEnable(GL_CULL_FACE), glFrontFace(GL_CW), glCullFace(GL_BACK);
-  // Object -> camera in one matrix, made here once rather than per vertex; its rotation part turns normals (the
-  // fragment shader normalises).
   const glm::mat4 model_to_camera = pose * ModelMatrix(o);
   // Light from above the table and behind the camera: camera frame has y down.
-  impl_->shader.Use()
-      .SetModelToCamera(model_to_camera)
-      .SetProjection(projection)
-      .SetLight(glm::normalize(glm::vec3(-0.3f, -1.0f, -0.6f)), 0.45f, ball)
-      .SetColour(float(o.brightness), float(o.contrast),
-                 glm::vec3(float(o.white_balance[0]), float(o.white_balance[1]), float(o.white_balance[2])));
+  const glm::vec3 light = glm::normalize(glm::vec3(-0.3f, -1.0f, -0.6f));
+  const float ambient = 0.45f;
+  const glm::vec3 white_balance(float(o.white_balance[0]), float(o.white_balance[1]), float(o.white_balance[2]));
   impl_->TextureFor(o.texture).Bind(0);
-  glBindVertexArray(impl_->vao.id());
-  Impl::Range range = impl_->card;
-  if (ball) {
-    const double radius_px = k[0] * o.size_mm / std::max(f.z_center_mm, 1e-6);
-    const int facets = SphereFacetsFor(radius_px);
-    range = impl_->spheres[size_t(std::find(std::begin(kSphereFacets), std::end(kSphereFacets), facets) -
-                                  std::begin(kSphereFacets))];
+  if (o.kind == VirtualObject::Kind::kBall) {
+    // Traced over the whole layer: the sphere's centre and the rotation back to its texture's frame (the spin).
+    impl_->ball_shader.Use()
+        .SetCamera(glm::vec4(float(k[0]), float(k[4]), float(k[2]), float(k[5])),
+                   glm::vec2(float(layer.roi.x), float(layer.roi.y)))
+        .SetSphere(glm::vec3(model_to_camera[3]), float(o.size_mm), glm::inverse(glm::mat3(model_to_camera)))
+        .SetSamples(impl_->sample_at)
+        .SetLight(light, ambient)
+        .SetColour(float(o.brightness), float(o.contrast), white_balance);
+    impl_->pass.Draw();
+  } else {
+    glEnable(GL_DEPTH_TEST);
+    impl_->shader.Use()
+        .SetModelToCamera(model_to_camera)  // one matrix made here, not per vertex
+        .SetProjection(projection)
+        .SetLight(light, ambient, false)
+        .SetColour(float(o.brightness), float(o.contrast), white_balance);
+    glBindVertexArray(impl_->vao.id());
+    glDrawElements(GL_TRIANGLES, impl_->card_indices, GL_UNSIGNED_INT, nullptr);
   }
-  glDrawElements(GL_TRIANGLES, range.count, GL_UNSIGNED_INT, reinterpret_cast<void*>(range.first * sizeof(GLuint)));
-  glDisable(GL_CULL_FACE);
   glBindVertexArray(0);
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_SCISSOR_TEST);

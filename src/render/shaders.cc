@@ -1,5 +1,7 @@
 #include "render/shaders.h"
 
+#include <algorithm>
+
 #include <glm/gtc/type_ptr.hpp>
 
 namespace blurcue::render {
@@ -46,6 +48,55 @@ ObjectShader& ObjectShader::SetLight(const glm::vec3& direction, float ambient, 
   return *this;
 }
 ObjectShader& ObjectShader::SetColour(float brightness, float contrast, const glm::vec3& white_balance) {
+  glUniform1f(brightness_, brightness);
+  glUniform1f(contrast_, contrast);
+  glUniform3f(white_balance_, white_balance.x, white_balance.y, white_balance.z);
+  return *this;
+}
+
+BallShader::BallShader()
+    : program_(FullscreenProgram("ball.frag")),
+      intrinsics_(program_.Uniform("u_intrinsics")),
+      origin_(program_.Uniform("u_origin")),
+      center_(program_.Uniform("u_center")),
+      radius_(program_.Uniform("u_radius")),
+      camera_to_object_(program_.Uniform("u_camera_to_object")),
+      samples_(program_.Uniform("u_samples")),
+      sample_at_(program_.Uniform("u_sample_at")),
+      light_dir_(program_.Uniform("u_light_dir")),
+      ambient_(program_.Uniform("u_ambient")),
+      brightness_(program_.Uniform("u_brightness")),
+      contrast_(program_.Uniform("u_contrast")),
+      white_balance_(program_.Uniform("u_white_balance")) {
+  ImageOnUnitZero(program_, "u_texture");
+}
+BallShader& BallShader::Use() {
+  program_.Use();
+  return *this;
+}
+BallShader& BallShader::SetCamera(const glm::vec4& k, const glm::vec2& origin) {
+  glUniform4f(intrinsics_, k.x, k.y, k.z, k.w);
+  glUniform2f(origin_, origin.x, origin.y);
+  return *this;
+}
+BallShader& BallShader::SetSphere(const glm::vec3& center, float radius_mm, const glm::mat3& camera_to_object) {
+  glUniform3f(center_, center.x, center.y, center.z);
+  glUniform1f(radius_, radius_mm);
+  glUniformMatrix3fv(camera_to_object_, 1, GL_FALSE, glm::value_ptr(camera_to_object));
+  return *this;
+}
+BallShader& BallShader::SetSamples(const std::vector<glm::vec2>& positions) {
+  const GLsizei n = GLsizei(std::min<size_t>(positions.size(), 16));
+  glUniform1i(samples_, n);
+  glUniform2fv(sample_at_, n, glm::value_ptr(positions[0]));
+  return *this;
+}
+BallShader& BallShader::SetLight(const glm::vec3& direction, float ambient) {
+  glUniform3f(light_dir_, direction.x, direction.y, direction.z);
+  glUniform1f(ambient_, ambient);
+  return *this;
+}
+BallShader& BallShader::SetColour(float brightness, float contrast, const glm::vec3& white_balance) {
   glUniform1f(brightness_, brightness);
   glUniform1f(contrast_, contrast);
   glUniform3f(white_balance_, white_balance.x, white_balance.y, white_balance.z);
