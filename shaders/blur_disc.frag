@@ -2,11 +2,12 @@
 // The thin-lens pillbox: every texel within radius R (= r, DESIGN.md) of the pixel, weighted by how much of it the
 // disc covers (1 inside, a linear ramp over the last pixel, 0 outside), normalised. Linear, premultiplied RGBA.
 uniform sampler2D u_image;
+uniform ivec2 u_region;        // the image: the texture's bottom-left w x h (outside it the border texel repeats)
 uniform float u_radius_px;
 uniform int u_taps;            // ceil(R + 0.5)
 out vec4 o_color;
 void main() {
-  ivec2 size = textureSize(u_image, 0);
+  ivec2 size = u_region;
   ivec2 p = ivec2(gl_FragCoord.xy);
   vec4 sum = vec4(0.0);
   float weight_sum = 0.0;

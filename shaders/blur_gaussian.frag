@@ -1,16 +1,17 @@
 #version 330 core
 // One pass of the separable Gaussian (the thesis's appendix A shader, in linear light with premultiplied alpha).
 // Weights exp(-i^2 / (2 s^2)) for |i| <= u_taps, normalised by their sum (eq. 4.6) so brightness is kept.
-// Texels are fetched exactly; outside the image the border texel repeats (clamp to edge).
+// Texels are fetched exactly; outside the region the border texel repeats (clamp to edge).
 uniform sampler2D u_image;     // linear, premultiplied RGBA
-uniform vec2 u_direction;      // (1, 0) horizontal pass, (0, 1) vertical pass
+uniform ivec2 u_region;        // the image: the texture's bottom-left w x h (a pooled texture may be larger)
+uniform ivec2 u_direction;     // (1, 0) horizontal pass, (0, 1) vertical pass
 uniform float u_sigma_px;      // GaussianKernelSigma(r / 2): the width whose discrete kernel has variance (r / 2)^2
 uniform int u_taps;            // kernel half-width, ceil(3 r / 2): as wide as it needs and no wider
 out vec4 o_color;
 void main() {
-  ivec2 size = textureSize(u_image, 0);
+  ivec2 size = u_region;
   ivec2 p = ivec2(gl_FragCoord.xy);
-  ivec2 step = ivec2(u_direction);
+  ivec2 step = u_direction;
   vec4 sum = texelFetch(u_image, p, 0);
   float weight_sum = 1.0;
   float k = -0.5 / (u_sigma_px * u_sigma_px);

@@ -790,7 +790,7 @@ std::optional<Procedure> Parser::ParseProcedure(const Json& v, const std::string
     numbers("threshold", 100, 1e-6, hi, true, &pr.thresholds);
     numbers("slope", 50, 0.1, 50, true, &pr.slopes);
     numbers("lapse", 20, 0, 0.5, true, &pr.lapses);
-    if (auto g = Number(v, "guess", ptr, false, 0, 0.99, "")) pr.guess = *g;
+    if (auto g = Number(v, "guess", ptr, false, 0, 0.99, "")) pr.guess = *g, pr.guess_given = true;
     const double grid = double(pr.thresholds.size()) * double(pr.slopes.size()) * double(pr.lapses.size());
     if (grid * double(pr.stimuli.size()) > 2e6)
       Problem(ptr, "the parameter grid (" + std::to_string(int64_t(grid)) + " points) x " +
@@ -1121,12 +1121,11 @@ Protocol Parser::Parse(const Json& json) {
   if (p.layout == "odd_one_out")
     for (auto& b : p.blocks)
       if (b.procedure && b.procedure->kind == Procedure::Kind::kQuestPlus) {
-        const Json& pj = json["blocks"][std::stoi(b.pointer.substr(8))]["procedure"];
-        if (!pj.contains("guess")) b.procedure->guess = 1.0 / p.alternatives;
+        if (!b.procedure->guess_given) b.procedure->guess = 1.0 / p.alternatives;
         else if (std::abs(b.procedure->guess - 1.0 / p.alternatives) > 1e-3)
           Problem(b.pointer + "/procedure/guess", "an odd-one-out trial of " + std::to_string(p.alternatives) +
                                                       " intervals is guessed right 1/" + std::to_string(p.alternatives) +
-                                                      " of the time; leave guess out", pj["guess"]);
+                                                      " of the time; leave guess out", Json(b.procedure->guess));
       }
   if (const Json* v = Field(json, "participant_info", "", false)) ParseInfo(*v, "/participant_info", &p);
   if (const Json* v = Field(json, "groups", "", false)) ParseGroups(*v, json, "/groups", &p);

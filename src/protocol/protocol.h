@@ -58,6 +58,7 @@ struct Procedure {
   // stimulus of least expected posterior entropy among `stimuli`, over a uniform prior on the parameter grid.
   std::vector<double> stimuli, thresholds, slopes, lapses;
   double guess = 0.5;
+  bool guess_given = false;          // the file gave guess (else it is chance: 0.5, or 1/n for an odd one out)
 };
 
 std::string ToString(Procedure::Kind kind);

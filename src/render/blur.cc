@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "render/gl_objects.h"
+#include "render/shaders.h"
 
 namespace blurcue::render {
 
@@ -93,30 +94,102 @@ cv::Mat DiscBlurCpu(const cv::Mat& rgba, double r_px) {
   return out;
 }
 
+namespace {
+
+// A side OpenCV's DCT takes fast: even, with no prime factor above 5 (cv::getOptimalDFTSize).
+int FastEvenSize(int n) {
+  int p = cv::getOptimalDFTSize(n);
+  while (p % 2) p = cv::getOptimalDFTSize(p + 1);
+  return p;
+}
+
+// How far (px) the line-spread function of `transfer` reaches: the smallest m with the LSF's absolute mass beyond
+// |x| > m below 1e-4 of the total (a quarter of an 8-bit level even next to black, where sRGB is steepest), found
+// from the LSF itself - the inverse DFT of transfer along one frequency axis - over a period of 4 n samples.
+int LsfReachPx(const std::function<double(double)>& transfer, int n) {
+  int period = cv::getOptimalDFTSize(4 * n);
+  while (period % 2) period = cv::getOptimalDFTSize(period + 1);
+  // A real, even spectrum in OpenCV's packed form for a real inverse DFT: Re 0, (Re k, Im k = 0)..., Re N/2.
+  cv::Mat spectrum = cv::Mat::zeros(1, period, CV_64F);
+  spectrum.at<double>(0) = transfer(0);
+  for (int k = 1; k < period / 2; ++k) spectrum.at<double>(2 * k - 1) = transfer(double(k) / period);
+  spectrum.at<double>(period - 1) = transfer(0.5);
+  cv::Mat lsf;
+  cv::dft(spectrum, lsf, cv::DFT_INVERSE | cv::DFT_SCALE | cv::DFT_REAL_OUTPUT);
+  double total = 0;
+  for (int x = 0; x < period; ++x) total += std::abs(lsf.at<double>(x));
+  double beyond = total - std::abs(lsf.at<double>(0));
+  for (int m = 1; m < period / 2; ++m) {
+    if (beyond < 1e-4 * total) return m - 1;
+    beyond -= std::abs(lsf.at<double>(m)) + std::abs(lsf.at<double>(period - m));
+  }
+  return period / 2;
+}
+
+}  // namespace
+
 cv::Mat FilterInFrequency(const cv::Mat& rgba, const std::function<double(double)>& transfer) {
   CV_Assert(rgba.type() == CV_32FC4);
+  // The image is taken as band-limited samples mirrored about its borders (half-sample symmetric, OpenCV's
+  // BORDER_REFLECT), so nothing wraps round. The DFT of that extension, of period 2w x 2h, is the image's DCT-II: a
+  // real, even transfer function multiplies its coefficients, coefficient (u, v) lying at (u / 2w, v / 2h) cycles per
+  // px. One real DCT per channel does what a complex DFT of the mirrored 2w x 2h image does, with about a sixteenth
+  // of the work; the channels run in parallel, and a constant channel (an opaque image's alpha) is not transformed.
   const int w = rgba.cols, h = rgba.rows;
-  // Mirror padding to sizes the DFT likes, so the borders do not wrap around.
-  const int pw = cv::getOptimalDFTSize(2 * w), ph = cv::getOptimalDFTSize(2 * h);
-  cv::Mat padded;
-  cv::copyMakeBorder(rgba, padded, 0, ph - h, 0, pw - w, cv::BORDER_REFLECT);
-  cv::Mat H(ph, pw, CV_32F);
-  for (int v = 0; v < ph; ++v)
-    for (int u = 0; u < pw; ++u) {
-      const double fu = (u <= pw / 2 ? u : u - pw) / double(pw), fv = (v <= ph / 2 ? v : v - ph) / double(ph);
-      H.at<float>(v, u) = float(transfer(std::hypot(fu, fv)));
+  // The DCT's side: the image's own when OpenCV transforms it fast (exact). Otherwise the image mirrored out to the
+  // next fast even side past the reach of the kernel (a 4592 x 3056 photo's 41 and 191 would take OpenCV's DCT
+  // four times as long): beyond that reach the extension differs from the true mirror, but the kernel no longer
+  // sees it (LsfReachPx: below 1e-4 of its mass). An odd side with no fast padding is mirrored whole (2w, exact).
+  auto side = [&](int n) {
+    if (n % 2 == 0 && FastEvenSize(n) == n) return n;
+    const int padded = FastEvenSize(n + LsfReachPx(transfer, n));
+    return padded < 2 * n ? padded : n % 2 ? 2 * n : n;
+  };
+  const int ew = side(w), eh = side(h);
+  cv::Mat even;
+  cv::copyMakeBorder(rgba, even, 0, eh - h, 0, ew - w, cv::BORDER_REFLECT);
+  // The transfer function tabulated along the radial frequency (2^18 steps up to the corner's sqrt(1/2) cycles/px;
+  // linear interpolation is off by (step^2 / 8) |H''|: below 4e-5 for a 2nd-order Butterworth down to a cut-off of
+  // 1 cycle per 4592 px) and looked up per coefficient.
+  constexpr int kSteps = 1 << 18;
+  const double f_max = std::sqrt(0.5);
+  std::vector<float> table(kSteps + 2);
+  cv::parallel_for_(cv::Range(0, kSteps + 2), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) table[size_t(i)] = float(transfer(f_max * i / kSteps));
+  });
+  cv::Mat H(eh, ew, CV_32F);
+  std::vector<double> fu2(size_t(ew), 0.0);
+  for (int u = 0; u < ew; ++u) fu2[size_t(u)] = (u / (2.0 * ew)) * (u / (2.0 * ew));
+  cv::parallel_for_(cv::Range(0, eh), [&](const cv::Range& rows) {
+    for (int v = rows.start; v < rows.end; ++v) {
+      float* row = H.ptr<float>(v);
+      const double fv2 = (v / (2.0 * eh)) * (v / (2.0 * eh));
+      for (int u = 0; u < ew; ++u) {
+        const double at = std::sqrt(fu2[size_t(u)] + fv2) * (kSteps / f_max);
+        const int i = int(at);
+        const float t = float(at - i);
+        row[u] = table[size_t(i)] + t * (table[size_t(i) + 1] - table[size_t(i)]);
+      }
     }
+  });
   std::vector<cv::Mat> channels;
-  cv::split(padded, channels);
-  for (cv::Mat& c : channels) {
-    cv::Mat spectrum, planes[2];
-    cv::dft(c, spectrum, cv::DFT_COMPLEX_OUTPUT);
-    cv::split(spectrum, planes);
-    planes[0] = planes[0].mul(H);
-    planes[1] = planes[1].mul(H);
-    cv::merge(planes, 2, spectrum);
-    cv::dft(spectrum, c, cv::DFT_INVERSE | cv::DFT_SCALE | cv::DFT_REAL_OUTPUT);
-  }
+  cv::split(even, channels);
+  const float gain_at_zero = table[0];
+  cv::parallel_for_(cv::Range(0, int(channels.size())), [&](const cv::Range& range) {
+    for (int c = range.start; c < range.end; ++c) {
+      cv::Mat& channel = channels[size_t(c)];
+      double lo = 0, hi = 0;
+      cv::minMaxLoc(channel, &lo, &hi);
+      if (lo == hi) {  // only the zero frequency: the filter scales it by transfer(0)
+        channel = cv::Scalar(lo * gain_at_zero);
+        continue;
+      }
+      cv::Mat coefficients;
+      cv::dct(channel, coefficients);
+      cv::multiply(coefficients, H, coefficients);
+      cv::dct(coefficients, channel, cv::DCT_INVERSE);
+    }
+  });
   cv::Mat out;
   cv::merge(channels, out);
   return out(cv::Rect(0, 0, w, h)).clone();
@@ -170,16 +243,26 @@ cv::Mat PictureOnGrey(const cv::Mat& picture, cv::Size field, int height_px, dou
   return PictureOnField(picture, field, height_px, std::max(width_px, height_px) / 4, butterworth, grey);
 }
 
+cv::Mat DepthMatchingLowerHalf(const cv::Mat& photo, int width_px) {
+  const int h = width_px * 3 / 4, lower = h - h / 2;
+  const double scale = std::max(double(width_px) / photo.cols, double(lower) / photo.rows);
+  cv::Mat scaled;
+  cv::resize(photo, scaled, cv::Size(), scale, scale, cv::INTER_AREA);
+  return scaled(cv::Rect((scaled.cols - width_px) / 2, (scaled.rows - lower) / 2, width_px, lower)).clone();
+}
+
+void StackDepthMatchingFrame(const cv::Mat& upper, const cv::Mat& lower, cv::Mat* frame) {
+  CV_Assert(upper.type() == CV_8UC3 && lower.type() == CV_8UC3 && upper.cols == lower.cols);
+  frame->create(upper.rows + lower.rows, upper.cols, CV_8UC3);  // allocates only the first time
+  upper.copyTo(frame->rowRange(0, upper.rows));
+  lower.copyTo(frame->rowRange(upper.rows, frame->rows));
+}
+
 cv::Mat DepthMatchingFrame(const cv::Mat& upper, const cv::Mat& photo, int width_px) {
   const int h = width_px * 3 / 4, half = h / 2;
   CV_Assert(upper.cols == width_px && upper.rows == half && upper.type() == CV_8UC3);
-  cv::Mat frame(h, width_px, CV_8UC3);
-  upper.copyTo(frame.rowRange(0, half));
-  const double scale = std::max(double(width_px) / photo.cols, double(h - half) / photo.rows);
-  cv::Mat scaled;
-  cv::resize(photo, scaled, cv::Size(), scale, scale, cv::INTER_AREA);
-  scaled(cv::Rect((scaled.cols - width_px) / 2, (scaled.rows - (h - half)) / 2, width_px, h - half))
-      .copyTo(frame.rowRange(half, h));
+  cv::Mat frame;
+  StackDepthMatchingFrame(upper, DepthMatchingLowerHalf(photo, width_px), &frame);
   return frame;
 }
 
@@ -223,49 +306,52 @@ cv::Mat FromLinearPremultiplied(const cv::Mat& rgba, bool keep_alpha) {
 }
 
 GlBlur::GlBlur()
-    : gaussian_(std::make_unique<Program>(
-          Program::FromFiles(ShaderDir() / "fullscreen.vert", ShaderDir() / "blur_gaussian.frag"))),
-      disc_(std::make_unique<Program>(
-          Program::FromFiles(ShaderDir() / "fullscreen.vert", ShaderDir() / "blur_disc.frag"))),
+    : gaussian_(std::make_unique<GaussianBlurShader>()),
+      disc_(std::make_unique<DiscBlurShader>()),
+      scratch_(std::make_unique<GrowingTarget>()),
       pass_(std::make_unique<FullscreenPass>()) {}
 
 GlBlur::~GlBlur() = default;
 
 void GlBlur::BlurTexture(Texture& texture, const std::string& method, double r_px) {
   CheckBlurRadius(r_px);  // before anything: a NaN radius would otherwise skip the blur and return the image as is
-  const int w = texture.width_px(), h = texture.height_px();
-  if (!scratch_ || scratch_->width_px() != w || scratch_->height_px() != h) scratch_ = std::make_unique<Texture>(w, h);
-  Texture& scratch = *scratch_;
+  const Framebuffer framebuffer(texture);
+  Blur(texture, framebuffer.id(), texture.width_px(), texture.height_px(), method, r_px);
+}
+
+void GlBlur::BlurRegion(GrowingTarget& target, int w, int h, const std::string& method, double r_px) {
+  CheckBlurRadius(r_px);
+  target.Reserve(w, h);
+  Blur(target.texture(), target.framebuffer(), w, h, method, r_px);
+}
+
+void GlBlur::Blur(const Texture& texture, GLuint framebuffer, int w, int h, const std::string& method, double r_px) {
+  CheckBlurRadius(r_px);
+  GrowingTarget& scratch = *scratch_;
   if (method == "disc") {
     if (r_px <= 0) return;
+    // One pass into the scratch target, copied back: a pass cannot read the texture it writes.
     const double coverage_r = DiscCoverageRadiusPx(r_px);
-    {
-      Framebuffer to_scratch(scratch);
-      disc_->Use();
-      glUniform1i(disc_->Uniform("u_image"), 0);
-      glUniform1f(disc_->Uniform("u_radius_px"), float(coverage_r));
-      glUniform1i(disc_->Uniform("u_taps"), int(std::ceil(coverage_r + 0.5)));
-      to_scratch.Bind();
-      texture.Bind(0);
-      pass_->Draw();
-    }
-    std::swap(texture, scratch);
+    disc_->Use().SetRegion(w, h).SetKernel(float(coverage_r), int(std::ceil(coverage_r + 0.5)));
+    scratch.BindFor(w, h);
+    texture.Bind(0);
+    pass_->Draw();
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, scratch.framebuffer());
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer);
+    glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   } else {
     const double s = r_px / 2;
     const int taps = GaussianTaps(s);
     if (taps == 0) return;
-    gaussian_->Use();
-    glUniform1i(gaussian_->Uniform("u_image"), 0);
-    glUniform1f(gaussian_->Uniform("u_sigma_px"), float(GaussianKernelSigma(s)));  // variance exactly s^2
-    glUniform1i(gaussian_->Uniform("u_taps"), taps);
-    Framebuffer to_scratch(scratch), to_texture(texture);
-    to_scratch.Bind();
+    // GaussianKernelSigma: the discrete kernel's variance is exactly s^2.
+    gaussian_->Use().SetRegion(w, h).SetKernel(float(GaussianKernelSigma(s)), taps).SetDirection(1, 0);
+    scratch.BindFor(w, h);
     texture.Bind(0);
-    glUniform2f(gaussian_->Uniform("u_direction"), 1, 0);
     pass_->Draw();
-    to_texture.Bind();
-    scratch.Bind(0);
-    glUniform2f(gaussian_->Uniform("u_direction"), 0, 1);
+    gaussian_->SetDirection(0, 1);
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    glViewport(0, 0, w, h);
+    scratch.texture().Bind(0);
     pass_->Draw();
   }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);

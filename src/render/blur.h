@@ -7,6 +7,8 @@
 
 #include <opencv2/core.hpp>
 
+#include <epoxy/gl.h>
+
 #include "optics/thin_lens.h"
 
 namespace blurcue::render {
@@ -38,8 +40,9 @@ double DiscCoverageRadiusPx(double r_px);
 cv::Mat DiscKernel(double r_px);
 cv::Mat DiscBlurCpu(const cv::Mat& rgba, double r_px);
 
-// Multiplies the image's spectrum by transfer(f), f the radial frequency in cycles per pixel, after mirror padding
-// (the image is taken as band-limited samples). CV_32FC4 in and out.
+// Multiplies the image's spectrum by transfer(f), f the radial frequency in cycles per pixel, the image taken as
+// band-limited samples mirrored about its borders (through its DCT: no padding, no wrap-around). `transfer` must be
+// real and even (a symmetric PSF) and is called from several threads. CV_32FC4 in and out.
 cv::Mat FilterInFrequency(const cv::Mat& rgba, const std::function<double(double)>& transfer);
 
 // Second-order Butterworth low-pass (the thesis's pre-research filter), in the frequency domain:
@@ -62,17 +65,23 @@ cv::Mat PictureOnField(const cv::Mat& picture, cv::Size field, int height_px, in
 // `upper` (a PictureOnGrey of width_px x half the height), the lower half the scene photo scaled to cover it and
 // cropped at its centre.
 cv::Mat DepthMatchingFrame(const cv::Mat& upper, const cv::Mat& photo, int width_px);
+// Its parts: the lower half (the photo scaled and cropped, 8-bit BGR, width_px x 3/4 width_px - half of it), and
+// the two stacked into `frame` (allocated only when its size changes: a trial stepping through levels reuses it).
+cv::Mat DepthMatchingLowerHalf(const cv::Mat& photo, int width_px);
+void StackDepthMatchingFrame(const cv::Mat& upper, const cv::Mat& lower, cv::Mat* frame);
 
 // 8-bit sRGB BGR/BGRA/grey -> CV_32FC4 linear premultiplied BGRA, and back (alpha kept when `keep_alpha`).
 cv::Mat ToLinearPremultiplied(const cv::Mat& image8);
 cv::Mat FromLinearPremultiplied(const cv::Mat& rgba, bool keep_alpha);
 
-class GlContext;
 class Texture;
-class Program;
+class GrowingTarget;
 class FullscreenPass;
+class GaussianBlurShader;
+class DiscBlurShader;
 
-// The GPU path. Needs a current GL context; loads its shaders from ShaderDir().
+// The GPU path. Needs a current GL context; loads its shaders from ShaderDir(). Its scratch texture is made once and
+// grown, so blurring layer after layer in a frame loop allocates nothing.
 class GlBlur {
  public:
   GlBlur();
@@ -87,10 +96,14 @@ class GlBlur {
   cv::Mat Disc(const cv::Mat& rgba, double r_px) { return BlurImage(rgba, "disc", r_px); }
   // On the GPU, texture in and out (RGBA32F, same size): "gaussian" or "disc"; r <= 0 leaves it unchanged.
   void BlurTexture(Texture& texture, const std::string& method, double r_px);
+  // The same on the bottom-left w x h of a pooled target (a layer), in place; outside it nothing is read or written.
+  void BlurRegion(GrowingTarget& target, int width_px, int height_px, const std::string& method, double r_px);
 
  private:
-  std::unique_ptr<Program> gaussian_, disc_;
-  std::unique_ptr<Texture> scratch_;  // re-used while the size stays: a frame loop allocates nothing
+  void Blur(const Texture& texture, GLuint framebuffer, int w, int h, const std::string& method, double r_px);
+  std::unique_ptr<GaussianBlurShader> gaussian_;
+  std::unique_ptr<DiscBlurShader> disc_;
+  std::unique_ptr<GrowingTarget> scratch_;
   std::unique_ptr<FullscreenPass> pass_;
 };
 

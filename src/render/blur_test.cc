@@ -64,6 +64,31 @@ TEST_F(GlTest, GaussianMatchesCpuReference) {
   }
 }
 
+TEST_F(GlTest, PooledTargetKeepsItsTextureAndBlursOnlyItsRegion) {
+  // A layer in the bottom-left of a larger pooled target blurs exactly as the layer alone would (the CPU reference,
+  // clamp at the layer's border): whatever lies beyond the region - here 1000, which would show at once - is neither
+  // read nor written. And a smaller region reuses the target's texture: a frame loop allocates nothing.
+  GrowingTarget target;
+  target.Reserve(200, 150);
+  const GLuint id = target.texture().id();
+  cv::Mat garbage(target.texture().height_px(), target.texture().width_px(), CV_32FC4, cv::Scalar::all(1000));
+  target.Upload(garbage);
+  const cv::Mat img = Square(96, 70);
+  target.Upload(img);
+  target.Reserve(96, 70);
+  EXPECT_EQ(target.texture().id(), id);
+  GlBlur blur;
+  for (const std::string method : {"gaussian", "disc"}) {
+    target.Upload(img);
+    blur.BlurRegion(target, img.cols, img.rows, method, 6.0);
+    const cv::Mat cpu = method == "disc" ? DiscBlurCpu(img, 6.0) : GaussianBlurCpu(img, 6.0);
+    EXPECT_LE(cv::norm(target.Download(img.cols, img.rows), cpu, cv::NORM_INF), 3.0 / 255) << method;
+    const cv::Mat beyond = target.Download(target.texture().width_px(), target.texture().height_px());
+    EXPECT_EQ(beyond.at<cv::Vec4f>(100, 150)[0], 1000.f) << method;  // outside the region: untouched
+  }
+  EXPECT_EQ(target.texture().id(), id);
+}
+
 TEST(CpuBlur, GaussianKeepsBrightness) {
   // Normalised kernel (eq. 4.6): the sum of light is unchanged away from the borders.
   const cv::Mat img = Square(200, 200);
@@ -145,6 +170,23 @@ TEST(CpuBlur, ButterworthKeepsMeanAndSoftensMoreAtLowerCutoff) {
     return x90 - x10;
   };
   EXPECT_GT(rise(soft), 3 * rise(sharp));
+}
+
+TEST(CpuBlur, FrequencyFilterIsConvolutionWithTheMirroredImage) {
+  // A Gaussian transfer exp(-2 pi^2 s^2 f^2) through the DCT must equal the spatial convolution with the sampled
+  // Gaussian over the mirrored image (cv::GaussianBlur, BORDER_REFLECT, kernel to 6 s): at s = 3 px the two differ
+  // only by the kernel's truncation and aliasing (< 1e-5), so any error in the frequency mapping or the extension
+  // shows: sides OpenCV transforms fast (exact), odd ones (mirrored whole), and ones padded to a fast side past the
+  // kernel's reach (82 = 2 x 41, 38 = 2 x 19).
+  for (const cv::Size size : {cv::Size(64, 48), cv::Size(63, 37), cv::Size(82, 38)}) {
+    cv::Mat img(size, CV_32FC4);
+    cv::randu(img, 0.f, 1.f);
+    const double s = 3;
+    const cv::Mat freq = FilterInFrequency(img, [s](double f) { return std::exp(-2 * M_PI * M_PI * s * s * f * f); });
+    cv::Mat spatial;
+    cv::GaussianBlur(img, spatial, cv::Size(37, 37), s, s, cv::BORDER_REFLECT);
+    EXPECT_LT(cv::norm(freq, spatial, cv::NORM_INF), 1e-4) << size;
+  }
 }
 
 TEST(LinearPremultiplied, RoundTripsEightBitImages) {

@@ -8,6 +8,7 @@
 #include "core/image.h"
 #include "render/blur.h"
 #include "render/gl_objects.h"
+#include "render/shaders.h"
 
 namespace blurcue::render {
 
@@ -17,7 +18,8 @@ struct FrameCompositor::Impl {
   int width = 0, height = 0;
   SceneRenderer renderer;
   GlBlur blur;
-  Program composite = Program::FromFiles(ShaderDir() / "fullscreen.vert", ShaderDir() / "composite.frag");
+  CompositeShader composite;
+  GrowingTarget uploaded;  // a depth-varying layer blurred on the CPU, back on the GPU (made once and grown)
   FullscreenPass pass;
   Texture photo, base, frame;  // the photo resampled; the frame without objects (photo placed, grey around); the frame
   Framebuffer photo_fb, base_fb, frame_fb;
@@ -80,10 +82,10 @@ struct FrameCompositor::Impl {
       }
       const double r = o.r_px * scale;  // at screen resolution
       const int margin = whole_frame ? std::max(width, height) : KernelMarginPx(o.method, r) + 1;
-      GpuLayer layer = renderer.DrawToTexture(o.object, margin);
-      if (!layer.texture) continue;
-      blur.BlurTexture(*layer.texture, o.method, r);
-      Blend(*layer.texture, layer.roi);
+      const GpuLayer layer = renderer.DrawToTexture(o.object, margin);
+      if (!layer.color) continue;
+      blur.BlurRegion(*layer.color, layer.roi.width, layer.roi.height, o.method, r);
+      Blend(layer.color->texture(), layer.roi);
     }
   }
 
@@ -98,9 +100,8 @@ struct FrameCompositor::Impl {
     BlurLayerVarying(layer, o.method, r_screen, &blur);
     cv::Mat rgba;
     cv::cvtColor(layer.bgra, rgba, cv::COLOR_BGRA2RGBA);
-    Texture texture(rgba.cols, rgba.rows);
-    texture.Upload(rgba);
-    Blend(texture, layer.roi);
+    uploaded.Upload(rgba);
+    Blend(uploaded.texture(), layer.roi);
   }
 
   // Blends a layer (linear, premultiplied) over the frame at roi.
@@ -112,9 +113,7 @@ struct FrameCompositor::Impl {
     glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
     glEnable(GL_SCISSOR_TEST);
     glScissor(roi.x, roi.y, roi.width, roi.height);
-    composite.Use();
-    glUniform1i(composite.Uniform("u_layer"), 0);
-    glUniform2i(composite.Uniform("u_origin"), roi.x, roi.y);
+    composite.Use().SetOrigin(roi.x, roi.y);
     layer.Bind(0);
     pass.Draw();
     glDisable(GL_SCISSOR_TEST);
@@ -216,6 +215,8 @@ WindowImage::~WindowImage() = default;
 void WindowImage::Present(int width_px, int height_px) const {
   BlitToWindow(impl_->fb.id(), impl_->texture.width_px(), impl_->texture.height_px(), width_px, height_px);
 }
+
+void WindowImage::Update(const cv::Mat& image) { impl_->texture.UploadSrgb(image); }
 
 void WindowImage::PresentAt(int x_px, int y_px, int height_px) const {
   const int w = impl_->texture.width_px(), h = impl_->texture.height_px();

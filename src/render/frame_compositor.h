@@ -85,6 +85,8 @@ class WindowImage {
   WindowImage& operator=(const WindowImage&) = delete;
   // Draws it into the window's default framebuffer, scaled to fit width_px x height_px, letterboxed on grey.
   void Present(int width_px, int height_px) const;
+  // Shows `image` (the same size and type) from now on: an upload into the texture it has, no new one.
+  void Update(const cv::Mat& image);
   // Draws it 1:1 over what the window already shows, its top-left corner at (x_px, y_px) (y down from the top) of a
   // window height_px high.
   void PresentAt(int x_px, int y_px, int height_px) const;

@@ -1,5 +1,6 @@
 #include "render/gl_objects.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -50,6 +51,12 @@ Program Program::FromFiles(const std::filesystem::path& vertex, const std::files
   return FromSource(ReadText(vertex), ReadText(fragment), vertex.string() + " + " + fragment.string());
 }
 
+GLint Program::Uniform(const char* name) const {
+  const GLint location = glGetUniformLocation(name_.id(), name);
+  if (location < 0) throw Error(ErrorKind::kInternal, files_ + ": no active uniform '" + std::string(name) + "'");
+  return location;
+}
+
 Program Program::FromSource(const std::string& vertex, const std::string& fragment, const std::string& name) {
   const GLuint vs = Compile(GL_VERTEX_SHADER, vertex, name + " (vertex)");
   GLuint fs = 0;
@@ -60,6 +67,7 @@ Program Program::FromSource(const std::string& vertex, const std::string& fragme
     throw;
   }
   Program p;
+  p.files_ = name;
   p.name_ = GlName(glCreateProgram(), [](GLuint id) { glDeleteProgram(id); });
   glAttachShader(p.id(), vs);
   glAttachShader(p.id(), fs);
@@ -100,22 +108,27 @@ Texture::Texture(int width_px, int height_px, GLenum internal_format)
 }
 
 Texture Texture::FromSrgbImage(const cv::Mat& image) {
-  CV_Assert(image.depth() == CV_8U && (image.channels() == 3 || image.channels() == 4 || image.channels() == 1));
-  cv::Mat rgba;
-  const int code = image.channels() == 1 ? cv::COLOR_GRAY2RGBA
-                   : image.channels() == 3 ? cv::COLOR_BGR2RGBA : cv::COLOR_BGRA2RGBA;
-  cv::cvtColor(image, rgba, code);
-  Texture t(rgba.cols, rgba.rows, GL_SRGB8_ALPHA8);
-  glBindTexture(GL_TEXTURE_2D, t.id());
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, rgba.cols, rgba.rows, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
-  glGenerateMipmap(GL_TEXTURE_2D);
+  Texture t(image.cols, image.rows, GL_SRGB8_ALPHA8);
+  t.UploadSrgb(image);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   // Longitude wraps around a sphere; latitude and card edges clamp.
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
   return t;
+}
+
+void Texture::UploadSrgb(const cv::Mat& image) {
+  CV_Assert(image.depth() == CV_8U && (image.channels() == 3 || image.channels() == 4 || image.channels() == 1));
+  CV_Assert(image.cols == width_ && image.rows == height_ && format_ == GL_SRGB8_ALPHA8);
+  cv::Mat rgba;
+  const int code = image.channels() == 1 ? cv::COLOR_GRAY2RGBA
+                   : image.channels() == 3 ? cv::COLOR_BGR2RGBA : cv::COLOR_BGRA2RGBA;
+  cv::cvtColor(image, rgba, code);
+  glBindTexture(GL_TEXTURE_2D, name_.id());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, rgba.cols, rgba.rows, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
+  glGenerateMipmap(GL_TEXTURE_2D);
 }
 
 void Texture::Upload(const cv::Mat& rgba) {
@@ -169,6 +182,41 @@ Framebuffer::Framebuffer(const Texture& color, bool with_depth, const Texture* s
 void Framebuffer::Bind() const {
   glBindFramebuffer(GL_FRAMEBUFFER, name_.id());
   glViewport(0, 0, width_, height_);
+}
+
+void GrowingTarget::Reserve(int w, int h) {
+  if (texture_ && w <= texture_->width_px() && h <= texture_->height_px()) return;
+  const int grown_w = std::max(texture_ ? texture_->width_px() : 0, (w + 63) / 64 * 64);
+  const int grown_h = std::max(texture_ ? texture_->height_px() : 0, (h + 63) / 64 * 64);
+  framebuffer_.reset();
+  texture_ = std::make_unique<Texture>(grown_w, grown_h, format_);
+  framebuffer_ = std::make_unique<Framebuffer>(*texture_);
+}
+
+void GrowingTarget::BindFor(int w, int h) {
+  Reserve(w, h);
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_->id());
+  glViewport(0, 0, w, h);
+}
+
+cv::Mat GrowingTarget::Download(int w, int h) const {
+  CV_Assert(texture_ && w <= texture_->width_px() && h <= texture_->height_px());
+  cv::Mat out(h, w, CV_32FC4);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer_->id());
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, out.data);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  return out;
+}
+
+void GrowingTarget::Upload(const cv::Mat& rgba) {
+  CV_Assert(rgba.type() == CV_32FC4);
+  Reserve(rgba.cols, rgba.rows);
+  const cv::Mat data = rgba.isContinuous() ? rgba : rgba.clone();
+  glBindTexture(GL_TEXTURE_2D, texture_->id());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, rgba.cols, rgba.rows, GL_RGBA, GL_FLOAT, data.data);
 }
 
 FullscreenPass::FullscreenPass() {

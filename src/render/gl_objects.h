@@ -2,7 +2,7 @@
 // Move-only RAII handles for the GL objects blurcue uses (after Magnum's GL layer): no copies, destroyed with the
 // context current, errors that name the shader file and carry the driver's log.
 #include <filesystem>
-#include <map>
+#include <memory>
 #include <string>
 #include <utility>
 
@@ -48,18 +48,14 @@ class Program {
   static Program FromFiles(const std::filesystem::path& vertex, const std::filesystem::path& fragment);
   static Program FromSource(const std::string& vertex, const std::string& fragment, const std::string& name);
   void Use() const { glUseProgram(name_.id()); }
-  // -1 when the uniform is absent or optimised out (setting it is then a no-op, as in GL). Looked up in GL once per
-  // name, then from the program's own table: a frame loop makes no glGetUniformLocation calls.
-  GLint Uniform(const char* name) const {
-    const auto it = uniforms_.find(name);
-    if (it != uniforms_.end()) return it->second;
-    return uniforms_.emplace(name, glGetUniformLocation(name_.id(), name)).first->second;
-  }
+  // The uniform's location, looked up in GL: once, when a typed shader (shaders.h) is made. Throws Error(kInternal)
+  // naming the program's files when the program has no such active uniform.
+  GLint Uniform(const char* name) const;
   GLuint id() const { return name_.id(); }
 
  private:
   GlName name_;
-  mutable std::map<std::string, GLint, std::less<>> uniforms_;
+  std::string files_;  // what it was made from, for errors
 };
 
 class Texture {
@@ -69,6 +65,8 @@ class Texture {
   // An sRGB texture (sampling decodes to linear) from an 8-bit BGR/BGRA image, mipmapped and trilinear, for
   // object surfaces seen smaller than their texture.
   static Texture FromSrgbImage(const cv::Mat& bgr_or_bgra);
+  // Replaces an sRGB texture's image (8-bit BGR/BGRA/grey of its size) and its mipmaps.
+  void UploadSrgb(const cv::Mat& bgr_or_bgra);
   // Uploads CV_32FC4 (or CV_8UC4) rows top-down; row 0 of the Mat is texture row 0. Everything in blurcue keeps
   // that convention (image row = texture row = gl_FragCoord.y), so nothing is ever flipped.
   void Upload(const cv::Mat& rgba);
@@ -96,6 +94,28 @@ class Framebuffer {
  private:
   GlName name_, depth_;
   int width_ = 0, height_ = 0;
+};
+
+// A colour texture with its framebuffer, made once and grown (to multiples of 64 px, never shrunk) when a larger
+// region is asked for: a frame loop draws into its bottom-left w x h (image row = texture row) and, once the target
+// has the size the session needs, allocates nothing.
+class GrowingTarget {
+ public:
+  explicit GrowingTarget(GLenum internal_format = GL_RGBA32F) : format_(internal_format) {}
+  // Makes room for w x h: a new texture and framebuffer only when the present ones are smaller.
+  void Reserve(int width_px, int height_px);
+  // Reserves w x h and binds the framebuffer with a w x h viewport.
+  void BindFor(int width_px, int height_px);
+  const Texture& texture() const { return *texture_; }
+  GLuint framebuffer() const { return framebuffer_->id(); }
+  // The bottom-left w x h read back as CV_32FC4, and written from one.
+  cv::Mat Download(int width_px, int height_px) const;
+  void Upload(const cv::Mat& rgba);
+
+ private:
+  GLenum format_;
+  std::unique_ptr<Texture> texture_;
+  std::unique_ptr<Framebuffer> framebuffer_;
 };
 
 // A full-screen triangle for image passes (vertex shader derives positions from gl_VertexID).

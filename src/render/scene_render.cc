@@ -2,17 +2,18 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <map>
 #include <vector>
 
 #include <glm/glm.hpp>
-#include <glm/gtc/type_ptr.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
 #include "render/blur.h"
 #include "render/gl_objects.h"
+#include "render/shaders.h"
 
 namespace blurcue::render {
 namespace {
@@ -28,32 +29,21 @@ cv::Matx33d SpinAboutX(double deg) {
   return {1, 0, 0, 0, c, -s, 0, s, c};
 }
 
-// The unit sphere as a UV sphere: longitude along u, latitude along v (v = 0 at the +z pole). Built once; each
-// object places it with its model matrix.
-std::vector<Vertex> UnitSphere() {
-  // 24 x 48 facets: the silhouette of a ball 100 px across deviates from a circle by < 0.1 px, and llvmpipe
-  // shades vertices on the CPU, so no more.
-  const int n_lat = 24, n_lon = 48;
-  auto vertex = [&](int i, int j) {
-    const double theta = M_PI * i / n_lat, phi = 2 * M_PI * j / n_lon;
-    const float x = float(std::sin(theta) * std::cos(phi)), y = float(std::sin(theta) * std::sin(phi)),
-                z = float(std::cos(theta));
-    return Vertex{{x, y, z}, {x, y, z}, {float(double(j) / n_lon), float(double(i) / n_lat)}};
-  };
-  std::vector<Vertex> tris;
-  for (int i = 0; i < n_lat; ++i)
-    for (int j = 0; j < n_lon; ++j) {
-      const Vertex a = vertex(i, j), b = vertex(i + 1, j), c = vertex(i + 1, j + 1), d = vertex(i, j + 1);
-      tris.insert(tris.end(), {a, b, c, a, c, d});
-    }
-  return tris;
-}
+// A mesh drawn with indices (a vertex shared by triangles is shaded once). A card is one; a ball is traced
+// (shaders/ball.frag), not tessellated: llvmpipe shades vertices on the CPU, one thread, and a sphere fine enough
+// for a 0.1 px silhouette was most of a ball's cost.
+struct Mesh {
+  std::vector<Vertex> vertices;
+  std::vector<GLuint> indices;
+};
 
 // The unit card (side 1, centred, in z = 0); texture row 0 (the image's top) on the far side (+y).
-std::vector<Vertex> UnitCard() {
-  const Vertex a{{-0.5f, 0.5f, 0}, {0, 0, 1}, {0, 0}}, b{{0.5f, 0.5f, 0}, {0, 0, 1}, {1, 0}},
-      c{{0.5f, -0.5f, 0}, {0, 0, 1}, {1, 1}}, d{{-0.5f, -0.5f, 0}, {0, 0, 1}, {0, 1}};
-  return {a, b, c, a, c, d};
+Mesh UnitCard() {
+  return {{{{-0.5f, 0.5f, 0}, {0, 0, 1}, {0, 0}},
+           {{0.5f, 0.5f, 0}, {0, 0, 1}, {1, 0}},
+           {{0.5f, -0.5f, 0}, {0, 0, 1}, {1, 1}},
+           {{-0.5f, -0.5f, 0}, {0, 0, 1}, {0, 1}}},
+          {0, 1, 2, 0, 2, 3}};
 }
 
 // A card's axes in the board frame, each scaled to its extent: along its width (u), towards its texture's top (v),
@@ -105,9 +95,13 @@ struct SceneRenderer::Impl {
   Camera camera;
   cv::Vec3d rvec, tvec;
   cv::Matx33d rotation;
-  Program program = Program::FromFiles(ShaderDir() / "object.vert", ShaderDir() / "object.frag");
-  GlName vao, vbo;
-  GLsizei sphere_vertices = 0, card_vertices = 0;
+  ObjectShader shader;
+  GrowingTarget color, depth;  // the resolved layers, made once and grown
+  GlName vao, vbo, ebo;  // the unit card, indexed
+  GLsizei card_indices = 0;
+  BallShader ball_shader;
+  FullscreenPass pass;                  // a ball covers its layer with one triangle
+  std::vector<glm::vec2> sample_at;     // the multisample targets' sample positions in a pixel
   // Textures by their image: a moving ball re-uses its texture every frame. Each entry holds its image (a cv::Mat
   // shares the pixels), so those pixels stay allocated and their address cannot come back as another image's.
   struct CachedTexture {
@@ -156,6 +150,15 @@ struct SceneRenderer::Impl {
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, ms_depth.id());
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
       throw Error(ErrorKind::kInternal, "GL: multisample framebuffer incomplete");
+    // Where the samples lie in a pixel, as this GL places them: a traced ball tests its rays there.
+    GLint count = 1;
+    glGetIntegerv(GL_SAMPLES, &count);
+    sample_at.clear();
+    for (GLint i = 0; i < std::max(count, 1); ++i) {
+      GLfloat at[2] = {0.5f, 0.5f};
+      if (count > 1) glGetMultisamplefv(GL_SAMPLE_POSITION, GLuint(i), at);
+      sample_at.emplace_back(at[0], at[1]);
+    }
     return id;
   }
 };
@@ -171,15 +174,18 @@ SceneRenderer::SceneRenderer(const Camera& camera, const cv::Vec3d& rvec, const 
   impl_->vao = GlName(id, [](GLuint i) { glDeleteVertexArrays(1, &i); });
   glGenBuffers(1, &id);
   impl_->vbo = GlName(id, [](GLuint i) { glDeleteBuffers(1, &i); });
+  glGenBuffers(1, &id);
+  impl_->ebo = GlName(id, [](GLuint i) { glDeleteBuffers(1, &i); });
   glBindVertexArray(impl_->vao.id());
   glBindBuffer(GL_ARRAY_BUFFER, impl_->vbo.id());
-  // Both unit meshes in one buffer, uploaded once: a frame only sets matrices.
-  std::vector<Vertex> mesh = UnitSphere();
-  impl_->sphere_vertices = GLsizei(mesh.size());
-  const std::vector<Vertex> card = UnitCard();
-  impl_->card_vertices = GLsizei(card.size());
-  mesh.insert(mesh.end(), card.begin(), card.end());
-  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(mesh.size() * sizeof(Vertex)), mesh.data(), GL_STATIC_DRAW);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, impl_->ebo.id());
+  // The unit card, uploaded once: a frame only sets matrices.
+  const Mesh mesh = UnitCard();
+  impl_->card_indices = GLsizei(mesh.indices.size());
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(mesh.vertices.size() * sizeof(Vertex)), mesh.vertices.data(),
+               GL_STATIC_DRAW);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(mesh.indices.size() * sizeof(GLuint)), mesh.indices.data(),
+               GL_STATIC_DRAW);
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, position)));
   glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, normal)));
   glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, uv)));
@@ -283,12 +289,12 @@ Layer SceneRenderer::Draw(const VirtualObject& o, int margin_px) {
   GpuLayer gpu = DrawToTexture(o, margin_px, /*depth_map=*/true);
   Layer layer;
   layer.roi = gpu.roi;
-  if (!gpu.texture) {
+  if (!gpu.color) {
     layer.bgra = cv::Mat(0, 0, CV_32FC4);
     return layer;
   }
-  cv::cvtColor(gpu.texture->Download(), layer.bgra, cv::COLOR_RGBA2BGRA);
-  const cv::Mat depth = gpu.depth->Download();
+  cv::cvtColor(gpu.color->Download(gpu.roi.width, gpu.roi.height), layer.bgra, cv::COLOR_RGBA2BGRA);
+  const cv::Mat depth = gpu.depth->Download(gpu.roi.width, gpu.roi.height);
   layer.depth_mm = cv::Mat(depth.size(), CV_32F);
   for (int y = 0; y < depth.rows; ++y)
     for (int x = 0; x < depth.cols; ++x) {
@@ -324,8 +330,9 @@ GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px, boo
     pose[3][r] = float(impl_->tvec[r]);
   }
 
-  layer.texture = std::make_unique<Texture>(w, h);
-  if (depth_map) layer.depth = std::make_unique<Texture>(w, h);
+  impl_->color.Reserve(w, h);
+  layer.color = &impl_->color;
+  if (depth_map) impl_->depth.Reserve(w, h), layer.depth = &impl_->depth;
   // Drawn multisampled (4x) and resolved, so silhouettes carry their pixel coverage like a camera's edges do (an aliased
   // silhouette is sharper than any optics and reads ~0.3 px too sharp under the calibration's measurement). The
   // targets are the renderer's own, made once; the scissor keeps the clear to this layer's part of them.
@@ -339,39 +346,41 @@ GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px, boo
   glClearColor(0, 0, 0, 0);
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  glEnable(GL_DEPTH_TEST);
-  glDisable(GL_CULL_FACE);  // the unflipped image-row convention mirrors winding
-  Program& p = impl_->program;
-  p.Use();
-  glUniformMatrix4fv(p.Uniform("u_board_to_camera"), 1, GL_FALSE, glm::value_ptr(pose));
-  glUniformMatrix4fv(p.Uniform("u_projection"), 1, GL_FALSE, glm::value_ptr(projection));
+  const glm::mat4 model_to_camera = pose * ModelMatrix(o);
   // Light from above the table and behind the camera: camera frame has y down.
   const glm::vec3 light = glm::normalize(glm::vec3(-0.3f, -1.0f, -0.6f));
-  glUniform3f(p.Uniform("u_light_dir"), light.x, light.y, light.z);
-  glUniform1f(p.Uniform("u_ambient"), 0.45f);
-  glUniform1f(p.Uniform("u_lit"), o.kind == VirtualObject::Kind::kBall ? 1.0f : 0.0f);
-  glUniform1f(p.Uniform("u_brightness"), float(o.brightness));
-  glUniform1f(p.Uniform("u_contrast"), float(o.contrast));
-  glUniform3f(p.Uniform("u_white_balance"), float(o.white_balance[0]), float(o.white_balance[1]),
-              float(o.white_balance[2]));
-  glUniform1i(p.Uniform("u_texture"), 0);
+  const float ambient = 0.45f;
+  const glm::vec3 white_balance(float(o.white_balance[0]), float(o.white_balance[1]), float(o.white_balance[2]));
   impl_->TextureFor(o.texture).Bind(0);
-  glUniformMatrix4fv(p.Uniform("u_model"), 1, GL_FALSE, glm::value_ptr(ModelMatrix(o)));
-  glBindVertexArray(impl_->vao.id());
-  if (o.kind == VirtualObject::Kind::kBall)
-    glDrawArrays(GL_TRIANGLES, 0, impl_->sphere_vertices);
-  else
-    glDrawArrays(GL_TRIANGLES, impl_->sphere_vertices, impl_->card_vertices);
+  if (o.kind == VirtualObject::Kind::kBall) {
+    // Traced over the whole layer: the sphere's centre and the rotation back to its texture's frame (the spin).
+    impl_->ball_shader.Use()
+        .SetCamera(glm::vec4(float(k[0]), float(k[4]), float(k[2]), float(k[5])),
+                   glm::vec2(float(layer.roi.x), float(layer.roi.y)))
+        .SetSphere(glm::vec3(model_to_camera[3]), float(o.size_mm), glm::inverse(glm::mat3(model_to_camera)))
+        .SetSamples(impl_->sample_at)
+        .SetLight(light, ambient)
+        .SetColour(float(o.brightness), float(o.contrast), white_balance);
+    impl_->pass.Draw();
+  } else {
+    glEnable(GL_DEPTH_TEST);
+    impl_->shader.Use()
+        .SetModelToCamera(model_to_camera)  // one matrix made here, not per vertex
+        .SetProjection(projection)
+        .SetLight(light, ambient, false)
+        .SetColour(float(o.brightness), float(o.contrast), white_balance);
+    glBindVertexArray(impl_->vao.id());
+    glDrawElements(GL_TRIANGLES, impl_->card_indices, GL_UNSIGNED_INT, nullptr);
+  }
   glBindVertexArray(0);
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_SCISSOR_TEST);
   // Resolve: averaging the samples gives premultiplied colour x coverage, and depth x coverage in .r with the
   // coverage in .a (the depth target writes alpha 1), so depth = r / a.
   for (int i = 0; i < (depth_map ? 2 : 1); ++i) {
-    Framebuffer resolved(i == 0 ? *layer.texture : *layer.depth);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, ms_id);
     glReadBuffer(GL_COLOR_ATTACHMENT0 + i);
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolved.id());
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, (i == 0 ? layer.color : layer.depth)->framebuffer());
     glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);

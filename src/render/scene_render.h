@@ -65,12 +65,13 @@ Footprint FootprintOf(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec
 std::vector<cv::Point2d> OutlineOf(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec,
                                    const VirtualObject& object, int points = 64);
 
-class Texture;
-// The same on the GPU: linear premultiplied RGBA texture (GL row = image row) over `roi`; null when off-screen.
+class GrowingTarget;
+// The same on the GPU: linear premultiplied RGBA in the bottom-left roi.width x roi.height of one of the renderer's
+// pooled targets (GL row = image row); `color` null when off-screen. Valid until the renderer's next DrawToTexture.
 struct GpuLayer {
   cv::Rect roi;
-  std::unique_ptr<Texture> texture;
-  std::unique_ptr<Texture> depth;  // camera z (mm) in the red channel, 0 where empty
+  GrowingTarget* color = nullptr;
+  GrowingTarget* depth = nullptr;  // camera z (mm) x coverage in red, the coverage in alpha; null unless asked for
 };
 
 class SceneRenderer {
@@ -86,8 +87,9 @@ class SceneRenderer {
   void SetCamera(const Camera& camera);
   // Draws the object into a layer covering its bounds grown by margin_px, clipped to the image.
   Layer Draw(const VirtualObject& object, int margin_px);
-  // The same, left on the GPU for frame composition; the per-pixel depth texture only when `depth_map` (the
-  // depth-varying blur needs it; a frame of single-radius objects does not pay for it).
+  // The same, left on the GPU for frame composition, in targets the renderer made once and grows (a frame loop
+  // allocates nothing); the per-pixel depth only when `depth_map` (the depth-varying blur needs it; a frame of
+  // single-radius objects does not pay for it).
   GpuLayer DrawToTexture(const VirtualObject& object, int margin_px, bool depth_map = false);
 
  private:

@@ -288,6 +288,8 @@ class Runner {
   // Shows one trial until it is answered; fills the response and the frames.
   Outcome RunTrial(const protocol::Trial& trial, const TrialScene& scene, store::Response* response,
                    std::vector<store::FrameRecord>* frames) {
+    // Whatever the trial's frames need from disk or a resampling, now, not in its first frame.
+    renderer_.Prepare(scene.intervals > 0 ? IntervalScene(scene, IntervalShowsRight(trial, scene, 0)) : scene);
     // Inter-trial interval: the grey field.
     if (protocol_.timing.inter_trial_ms > 0) {
       if (station_.window()) {

@@ -689,23 +689,28 @@ render::FrameView StimulusRenderer::View() const {
   return compositor_ ? compositor_->view() : presentation_.view;
 }
 
-void StimulusRenderer::Compose(const TrialScene& trial, double t_s, double level) {
+void StimulusRenderer::Prepare(const TrialScene& trial) {
   if (!compositor_) {
-    const cv::Mat* lower = &photo_;
-    if (!protocol_.content.real_photos.empty()) {
-      if (trial.distance_m != real_photo_distance_m_) {
-        real_photo_ = ReadImage(protocol::RealPhotoFor(protocol_.content, trial.distance_m), 1);
-        real_photo_distance_m_ = trial.distance_m;
-      }
-      lower = &real_photo_;
+    const double distance_m = protocol_.content.real_photos.empty() ? 0 : trial.distance_m;
+    if (lower_.empty() || distance_m != lower_distance_m_) {
+      const cv::Mat photo = protocol_.content.real_photos.empty()
+                                ? photo_
+                                : ReadImage(protocol::RealPhotoFor(protocol_.content, trial.distance_m), 1);
+      lower_ = render::DepthMatchingLowerHalf(photo, picture_width_px_);
+      lower_distance_m_ = distance_m;
     }
-    picture_frame_ = render::DepthMatchingFrame(UpperHalf(level), *lower, picture_width_px_);
-    picture_shown_.reset();
     return;
   }
-  if (t_s <= 0) {  // a trial's first frame: the photo where this trial shows it
-    const render::FrameView v = presentation_.ViewFor(protocol_, *scene_, trial);
-    compositor_->Place(v.x_px, v.y_px);
+  const render::FrameView v = presentation_.ViewFor(protocol_, *scene_, trial);
+  compositor_->Place(v.x_px, v.y_px);  // redraws the base only when the place changed
+}
+
+void StimulusRenderer::Compose(const TrialScene& trial, double t_s, double level) {
+  if (t_s <= 0) Prepare(trial);  // a trial's first frame: nothing to do when the runner prepared it
+  if (!compositor_) {
+    render::StackDepthMatchingFrame(UpperHalf(level), lower_, &picture_frame_);
+    picture_stale_ = true;
+    return;
   }
   shown_ = ObjectsAt(protocol_, *scene_, trial, t_s);
   std::vector<render::BlurredObject> objects;
@@ -723,6 +728,8 @@ void StimulusRenderer::Present(int width_px, int height_px) {
     return;
   }
   if (!picture_shown_) picture_shown_ = std::make_unique<render::WindowImage>(picture_frame_);
+  else if (picture_stale_) picture_shown_->Update(picture_frame_);
+  picture_stale_ = false;
   picture_shown_->Present(width_px, height_px);
 }
 

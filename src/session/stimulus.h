@@ -179,6 +179,10 @@ class StimulusRenderer {
 
   // Size of the frames it makes (the photo's, or the depth-matching frame's).
   cv::Size FrameSize() const;
+  // What a trial's frames need besides their own drawing, done before its first frame so that the frame loop reads
+  // no file and resamples no photo: the photo placed where the trial shows it (pairs), the real photo at the trial's
+  // distance read and scaled (picture). Cheap when nothing changed; Compose at t_s = 0 calls it too.
+  void Prepare(const TrialScene& trial);
   // Composes the frame t_s after onset; `level` is the adjustment level shown (picture only).
   void Compose(const TrialScene& trial, double t_s, double level);
   // What the last composed frame showed of a pair (ObjectsAt, as drawn; radii in photo px): empty sides for
@@ -205,9 +209,10 @@ class StimulusRenderer {
   cv::Mat picture_;
   std::vector<std::pair<double, cv::Mat>> upper_cache_;  // cut-off -> upper half
   cv::Mat picture_frame_;
-  std::unique_ptr<render::WindowImage> picture_shown_;  // picture_frame_ on the GPU, made when first presented
-  double real_photo_distance_m_ = -1;  // the real photo loaded (one at a time: 27 would hold ~50 MB)
-  cv::Mat real_photo_;
+  std::unique_ptr<render::WindowImage> picture_shown_;  // picture_frame_ on the GPU, updated in place
+  bool picture_stale_ = true;                          // picture_frame_ changed since it was last uploaded
+  double lower_distance_m_ = -1;  // the distance whose real photo lower_ shows (one at a time: 27 would hold ~50 MB)
+  cv::Mat lower_;                 // the frame's lower half, scaled once per trial
   int picture_width_px_ = 960;
   std::array<std::optional<render::BlurredObject>, 2> shown_;
 };

@@ -1,7 +1,5 @@
 #include "store/export.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -18,6 +16,8 @@
 #include "store/record.h"
 #include "store/schema.h"
 #include "store/sqlite.h"
+
+#include <sqlite3.h>
 
 namespace blurcue::store {
 namespace {
@@ -400,24 +400,18 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
   Note(note, RemoveStaleLeftovers(out_dir));
   Database source(db_path, OpenMode::kReadOnly);
   RequireReadableRecord(source);
-  // A record of an earlier version is exported from a migrated copy (the record itself is only read: it may be a
-  // read-only archive): VACUUM INTO writes the copy, the migration derives its typed columns.
+  // A record of an earlier version is exported from a migrated copy in memory (the record itself is only read: it may
+  // be a read-only archive; and a killed export leaves no copy behind): SQLite's backup copies it, the migration
+  // derives its typed columns.
   std::optional<Database> copy;
-  std::filesystem::path copy_path;
-  struct RemoveCopy {
-    std::filesystem::path* path;
-    ~RemoveCopy() {
-      if (!path->empty()) RemoveDatabaseFiles(*path);
-    }
-  } remove_copy{&copy_path};
   if (SchemaVersion(source) < CurrentSchemaVersion()) {
-    copy_path = std::filesystem::temp_directory_path() /
-                ("blurcue-export-" + std::to_string(getpid()) + "-" + db_path.filename().string());
-    RemoveDatabaseFiles(copy_path);
-    Statement vacuum(source, "VACUUM INTO ?");
-    vacuum.Bind(1, copy_path.string());
-    vacuum.Run();
-    copy.emplace(copy_path);
+    copy.emplace(":memory:");
+    sqlite3_backup* backup = sqlite3_backup_init(copy->handle(), "main", source.handle(), "main");
+    const int step = backup ? sqlite3_backup_step(backup, -1) : SQLITE_ERROR;
+    const int finish = backup ? sqlite3_backup_finish(backup) : SQLITE_ERROR;
+    if (step != SQLITE_DONE || finish != SQLITE_OK)
+      throw InputError(db_path.string(), std::string("cannot copy the record to migrate it for export: ") +
+                                             sqlite3_errmsg(copy->handle()));
     Migrate(*copy);
   }
   Database& db = copy ? *copy : source;
@@ -442,18 +436,21 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
   // Between-subject groups and participant information, when any session has them: a column "group" and one
   // "info_KEY" per key given anywhere.
   const bool groups = db.QueryInt64("SELECT count(*) FROM sessions WHERE group_name <> ''") > 0;
+  // Read once: each session's answers, and per key the codebook's type of them.
   std::map<std::string, TypeOf> info_keys;
+  std::map<int64_t, std::map<std::string, std::string>> info_of;
   {
-    Statement info(db, "SELECT key, value FROM session_info");
+    Statement info(db, "SELECT session_id, key, value FROM session_info");
     while (info.Step()) {
-      const std::string value = info.GetText(1);
+      const std::string key = info.GetText(1), value = info.GetText(2);
+      info_of[info.GetInt64(0)][key] = value;
       Json parsed;
       try {
         parsed = Json::parse(value);
       } catch (const Json::exception&) {
         parsed = value;
       }
-      info_keys[info.GetText(0)].Add(parsed.is_number() ? parsed : Json(value));
+      info_keys[key].Add(parsed.is_number() ? parsed : Json(value));
     }
   }
 
@@ -502,11 +499,6 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
   {
     Statement numbers(db, "SELECT s.id, row_number() OVER (PARTITION BY s.participant_id ORDER BY s.id) FROM sessions s");
     while (numbers.Step()) session_number[numbers.GetInt64(0)] = numbers.GetInt64(1);
-  }
-  std::map<int64_t, std::map<std::string, std::string>> info_of;
-  {
-    Statement info(db, "SELECT session_id, key, value FROM session_info");
-    while (info.Step()) info_of[info.GetInt64(0)][info.GetText(1)] = info.GetText(2);
   }
   int64_t count = 0;
   auto optional_number = [&](int column) { return rows.IsNull(column) ? std::string() : Number(rows.GetDouble(column)); };

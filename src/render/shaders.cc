@@ -1,0 +1,166 @@
+#include "render/shaders.h"
+
+#include <algorithm>
+
+#include <glm/gtc/type_ptr.hpp>
+
+namespace blurcue::render {
+namespace {
+Program FullscreenProgram(const char* fragment) {
+  return Program::FromFiles(ShaderDir() / "fullscreen.vert", ShaderDir() / fragment);
+}
+// Every program here samples one texture, from unit 0.
+void ImageOnUnitZero(const Program& program, const char* sampler) {
+  program.Use();
+  glUniform1i(program.Uniform(sampler), 0);
+}
+}  // namespace
+
+ObjectShader::ObjectShader()
+    : program_(Program::FromFiles(ShaderDir() / "object.vert", ShaderDir() / "object.frag")),
+      model_to_camera_(program_.Uniform("u_model_to_camera")),
+      projection_(program_.Uniform("u_projection")),
+      light_dir_(program_.Uniform("u_light_dir")),
+      ambient_(program_.Uniform("u_ambient")),
+      lit_(program_.Uniform("u_lit")),
+      brightness_(program_.Uniform("u_brightness")),
+      contrast_(program_.Uniform("u_contrast")),
+      white_balance_(program_.Uniform("u_white_balance")) {
+  ImageOnUnitZero(program_, "u_texture");
+}
+
+ObjectShader& ObjectShader::Use() {
+  program_.Use();
+  return *this;
+}
+ObjectShader& ObjectShader::SetModelToCamera(const glm::mat4& model_to_camera) {
+  glUniformMatrix4fv(model_to_camera_, 1, GL_FALSE, glm::value_ptr(model_to_camera));
+  return *this;
+}
+ObjectShader& ObjectShader::SetProjection(const glm::mat4& projection) {
+  glUniformMatrix4fv(projection_, 1, GL_FALSE, glm::value_ptr(projection));
+  return *this;
+}
+ObjectShader& ObjectShader::SetLight(const glm::vec3& direction, float ambient, bool lit) {
+  glUniform3f(light_dir_, direction.x, direction.y, direction.z);
+  glUniform1f(ambient_, ambient);
+  glUniform1f(lit_, lit ? 1.0f : 0.0f);
+  return *this;
+}
+ObjectShader& ObjectShader::SetColour(float brightness, float contrast, const glm::vec3& white_balance) {
+  glUniform1f(brightness_, brightness);
+  glUniform1f(contrast_, contrast);
+  glUniform3f(white_balance_, white_balance.x, white_balance.y, white_balance.z);
+  return *this;
+}
+
+BallShader::BallShader()
+    : program_(FullscreenProgram("ball.frag")),
+      intrinsics_(program_.Uniform("u_intrinsics")),
+      origin_(program_.Uniform("u_origin")),
+      center_(program_.Uniform("u_center")),
+      radius_(program_.Uniform("u_radius")),
+      camera_to_object_(program_.Uniform("u_camera_to_object")),
+      samples_(program_.Uniform("u_samples")),
+      sample_at_(program_.Uniform("u_sample_at")),
+      light_dir_(program_.Uniform("u_light_dir")),
+      ambient_(program_.Uniform("u_ambient")),
+      brightness_(program_.Uniform("u_brightness")),
+      contrast_(program_.Uniform("u_contrast")),
+      white_balance_(program_.Uniform("u_white_balance")) {
+  ImageOnUnitZero(program_, "u_texture");
+}
+BallShader& BallShader::Use() {
+  program_.Use();
+  return *this;
+}
+BallShader& BallShader::SetCamera(const glm::vec4& k, const glm::vec2& origin) {
+  glUniform4f(intrinsics_, k.x, k.y, k.z, k.w);
+  glUniform2f(origin_, origin.x, origin.y);
+  return *this;
+}
+BallShader& BallShader::SetSphere(const glm::vec3& center, float radius_mm, const glm::mat3& camera_to_object) {
+  glUniform3f(center_, center.x, center.y, center.z);
+  glUniform1f(radius_, radius_mm);
+  glUniformMatrix3fv(camera_to_object_, 1, GL_FALSE, glm::value_ptr(camera_to_object));
+  return *this;
+}
+BallShader& BallShader::SetSamples(const std::vector<glm::vec2>& positions) {
+  const GLsizei n = GLsizei(std::min<size_t>(positions.size(), 16));
+  glUniform1i(samples_, n);
+  glUniform2fv(sample_at_, n, glm::value_ptr(positions[0]));
+  return *this;
+}
+BallShader& BallShader::SetLight(const glm::vec3& direction, float ambient) {
+  glUniform3f(light_dir_, direction.x, direction.y, direction.z);
+  glUniform1f(ambient_, ambient);
+  return *this;
+}
+BallShader& BallShader::SetColour(float brightness, float contrast, const glm::vec3& white_balance) {
+  glUniform1f(brightness_, brightness);
+  glUniform1f(contrast_, contrast);
+  glUniform3f(white_balance_, white_balance.x, white_balance.y, white_balance.z);
+  return *this;
+}
+
+GaussianBlurShader::GaussianBlurShader()
+    : program_(FullscreenProgram("blur_gaussian.frag")),
+      region_(program_.Uniform("u_region")),
+      sigma_(program_.Uniform("u_sigma_px")),
+      taps_(program_.Uniform("u_taps")),
+      direction_(program_.Uniform("u_direction")) {
+  ImageOnUnitZero(program_, "u_image");
+}
+GaussianBlurShader& GaussianBlurShader::Use() {
+  program_.Use();
+  return *this;
+}
+GaussianBlurShader& GaussianBlurShader::SetRegion(int width_px, int height_px) {
+  glUniform2i(region_, width_px, height_px);
+  return *this;
+}
+GaussianBlurShader& GaussianBlurShader::SetKernel(float sigma_px, int taps) {
+  glUniform1f(sigma_, sigma_px);
+  glUniform1i(taps_, taps);
+  return *this;
+}
+GaussianBlurShader& GaussianBlurShader::SetDirection(int dx, int dy) {
+  glUniform2i(direction_, dx, dy);
+  return *this;
+}
+
+DiscBlurShader::DiscBlurShader()
+    : program_(FullscreenProgram("blur_disc.frag")),
+      region_(program_.Uniform("u_region")),
+      radius_(program_.Uniform("u_radius_px")),
+      taps_(program_.Uniform("u_taps")) {
+  ImageOnUnitZero(program_, "u_image");
+}
+DiscBlurShader& DiscBlurShader::Use() {
+  program_.Use();
+  return *this;
+}
+DiscBlurShader& DiscBlurShader::SetRegion(int width_px, int height_px) {
+  glUniform2i(region_, width_px, height_px);
+  return *this;
+}
+DiscBlurShader& DiscBlurShader::SetKernel(float coverage_radius_px, int taps) {
+  glUniform1f(radius_, coverage_radius_px);
+  glUniform1i(taps_, taps);
+  return *this;
+}
+
+CompositeShader::CompositeShader()
+    : program_(FullscreenProgram("composite.frag")), origin_(program_.Uniform("u_origin")) {
+  ImageOnUnitZero(program_, "u_layer");
+}
+CompositeShader& CompositeShader::Use() {
+  program_.Use();
+  return *this;
+}
+CompositeShader& CompositeShader::SetOrigin(int x_px, int y_px) {
+  glUniform2i(origin_, x_px, y_px);
+  return *this;
+}
+
+}  // namespace blurcue::render

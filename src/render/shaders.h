@@ -1,0 +1,96 @@
+#pragma once
+// Typed shader programs (after Magnum's Shaders::): each owns its Program, looks its uniform locations up once when
+// it is made, and offers setters in the shader's own units - a frame sets numbers, never names. Shaders are the files
+// in shaders/ (ShaderDir()); a missing uniform is a compile-time mistake of the file, refused when the program is made.
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "render/gl_objects.h"
+
+namespace blurcue::render {
+
+// shaders/object.{vert,frag}: a textured, simply lit object in the board frame, drawn into a layer.
+class ObjectShader {
+ public:
+  ObjectShader();
+  ObjectShader& Use();
+  // Object -> camera frame (mm): the calibrated pose times the object's model matrix.
+  ObjectShader& SetModelToCamera(const glm::mat4& model_to_camera);
+  // Camera frame -> clip space.
+  ObjectShader& SetProjection(const glm::mat4& projection);
+  // Light towards `direction` (camera frame, unit) with `ambient` of it undirected; `lit` false draws flat.
+  ObjectShader& SetLight(const glm::vec3& direction, float ambient, bool lit);
+  // Brightness multiplies, contrast scales about mid grey (0.18), white balance multiplies red, green, blue.
+  ObjectShader& SetColour(float brightness, float contrast, const glm::vec3& white_balance);
+
+ private:
+  Program program_;
+  GLint model_to_camera_, projection_, light_dir_, ambient_, lit_, brightness_, contrast_, white_balance_;
+};
+
+// shaders/ball.frag (over fullscreen.vert): a ball ray-traced into a multisampled layer - the exact sphere, each
+// sample's coverage its own ray's hit.
+class BallShader {
+ public:
+  BallShader();
+  BallShader& Use();
+  // The pinhole camera (px) and the layer's top-left pixel in its image.
+  BallShader& SetCamera(const glm::vec4& fx_fy_cx_cy, const glm::vec2& layer_origin_px);
+  // The sphere in the camera frame (mm), and the rotation from the camera frame to its texture's frame.
+  BallShader& SetSphere(const glm::vec3& center_camera_mm, float radius_mm, const glm::mat3& camera_to_object);
+  // The framebuffer's sample positions within a pixel (0..1 from its lower-left corner), at most 16.
+  BallShader& SetSamples(const std::vector<glm::vec2>& positions);
+  BallShader& SetLight(const glm::vec3& direction, float ambient);
+  BallShader& SetColour(float brightness, float contrast, const glm::vec3& white_balance);
+
+ private:
+  Program program_;
+  GLint intrinsics_, origin_, center_, radius_, camera_to_object_, samples_, sample_at_, light_dir_, ambient_,
+      brightness_, contrast_, white_balance_;
+};
+
+// shaders/blur_gaussian.frag: one pass of the separable Gaussian over the bottom-left w x h of a texture.
+class GaussianBlurShader {
+ public:
+  GaussianBlurShader();
+  GaussianBlurShader& Use();
+  // The region read (texels outside it repeat its border, as an image's would).
+  GaussianBlurShader& SetRegion(int width_px, int height_px);
+  GaussianBlurShader& SetKernel(float sigma_px, int taps);
+  GaussianBlurShader& SetDirection(int dx, int dy);
+
+ private:
+  Program program_;
+  GLint region_, sigma_, taps_, direction_;
+};
+
+// shaders/blur_disc.frag: the pillbox over the bottom-left w x h of a texture.
+class DiscBlurShader {
+ public:
+  DiscBlurShader();
+  DiscBlurShader& Use();
+  DiscBlurShader& SetRegion(int width_px, int height_px);
+  DiscBlurShader& SetKernel(float coverage_radius_px, int taps);
+
+ private:
+  Program program_;
+  GLint region_, radius_, taps_;
+};
+
+// shaders/composite.frag: a layer blended over the frame with its top-left pixel at `origin`.
+class CompositeShader {
+ public:
+  CompositeShader();
+  CompositeShader& Use();
+  CompositeShader& SetOrigin(int x_px, int y_px);
+
+ private:
+  Program program_;
+  GLint origin_;
+};
+
+static_assert(!std::is_copy_constructible_v<ObjectShader>);
+static_assert(!std::is_copy_constructible_v<GaussianBlurShader>);
+
+}  // namespace blurcue::render
