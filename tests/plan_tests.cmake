@@ -44,3 +44,10 @@ add_plan_failure_test(plan_too_many 2 "--participants x --studies must be at mos
                       plan ${P1} --participants 10000 --studies 100000 --no-chart --out ${T}/plan-bad)
 add_plan_failure_test(plan_bad_python 2 "--python /no/such/python: not found"
                       plan ${P1} --participants 2 --studies 1 --python /no/such/python --out ${T}/plan-bad)
+
+# Numbers as typed: a leading zero is decimal (CLI11 alone reads 010 as octal 8), a seed as export writes it
+# (s<digits>) is that seed - both options rewrite their text, which CLI11 keeps only from a transform, not a check.
+add_test(NAME plan_leading_zero_is_decimal
+         COMMAND ${BC} plan ${P1} --participants 010 --studies 1 --seed s5 --no-chart --out ${T}/plan-leading-zero)
+set_tests_properties(plan_leading_zero_is_decimal PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
+                     LABELS plan PASS_REGULAR_EXPRESSION "1 simulated studies of 10 participants \\(seed 5\\)")

@@ -52,12 +52,12 @@ void AddAnimateCommand(CLI::App& app) {
       ->check(FiniteRange(0.1, 1000, "cm/s"));
   cmd->add_option("--fps", args->fps, "frames per second of the video (a window runs at its refresh)")
       ->capture_default_str()->check(FiniteRange(1, 1000, "frames per second"));
-  cmd->add_option("--from-edge", args->from_edge, "start edge")->capture_default_str()->check(IntRange(1, 1000));
-  cmd->add_option("--to-edge", args->to_edge, "end edge")->capture_default_str()->check(IntRange(1, 1000));
+  cmd->add_option("--from-edge", args->from_edge, "start edge")->capture_default_str()->transform(IntRange(1, 1000));
+  cmd->add_option("--to-edge", args->to_edge, "end edge")->capture_default_str()->transform(IntRange(1, 1000));
   cmd->add_option("--left-section", args->left_section, "section the left ball rolls along")->capture_default_str()
-      ->check(IntRange(1, 1000));
+      ->transform(IntRange(1, 1000));
   cmd->add_option("--right-section", args->right_section, "section the right ball rolls along")
-      ->capture_default_str()->check(IntRange(1, 1000));
+      ->capture_default_str()->transform(IntRange(1, 1000));
   cmd->add_option("--video", args->video, "write an MJPG .avi");
   cmd->add_option("--frames", args->frames_dir, "write frame PNGs into this folder");
   cmd->add_option("--log", args->log, "per-frame CSV: index, t_s, y_mm, r_left_px, r_right_px, render_ms, flip_s");

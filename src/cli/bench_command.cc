@@ -33,7 +33,7 @@ void AddMeasure(CLI::App& bench) {
       "Takes a few minutes; --quick runs two levels per factor.");
   cmd->add_option("--out", args->out, "CSV, one row per (method, condition)")->capture_default_str();
   cmd->add_option("--seed", args->seed, "seed of the scenes' noise, texture and flaws")->capture_default_str()
-      ->check(SeedValidator());
+      ->transform(SeedValidator());
   cmd->add_flag("--quick", args->quick, "two levels per factor (smoke run)");
   cmd->add_flag("--no-full-res", args->no_full_res, "skip the full-resolution timing");
   cmd->callback([args] {
@@ -110,8 +110,8 @@ void AddRecord(CLI::App& bench) {
       "records live on: --folder names it.");
   cmd->add_option("--folder", args->folder, "where the two scratch records are written (removed after)")
       ->capture_default_str();
-  cmd->add_option("--trials", args->trials, "answers per record")->capture_default_str()->check(IntRange(10, 100000));
-  cmd->add_option("--frames", args->frames, "display flips per answer")->capture_default_str()->check(IntRange(0, 10000));
+  cmd->add_option("--trials", args->trials, "answers per record")->capture_default_str()->transform(IntRange(10, 100000));
+  cmd->add_option("--frames", args->frames, "display flips per answer")->capture_default_str()->transform(IntRange(0, 10000));
   cmd->callback([args] {
     bench::RecordBenchOptions options;
     options.folder = args->folder;
@@ -148,8 +148,8 @@ void AddProcedures(CLI::App& bench) {
       "The report charts it. --quick runs 40 runs.");
   cmd->add_option("--out", args->out, "CSV, one row per (procedure, condition, trials)")->capture_default_str();
   cmd->add_option("--runs", args->runs, "seeded runs per procedure and condition")->capture_default_str()
-      ->check(IntRange(2, 100000));
-  cmd->add_option("--seed", args->seed, "seed of the runs")->capture_default_str()->check(SeedValidator());
+      ->transform(IntRange(2, 100000));
+  cmd->add_option("--seed", args->seed, "seed of the runs")->capture_default_str()->transform(SeedValidator());
   cmd->add_flag("--quick", args->quick, "40 runs (smoke run)");
   cmd->callback([args] {
     bench::ProcedureBenchOptions options;
@@ -180,11 +180,11 @@ void AddPlan(CLI::App& bench) {
   cmd->add_option("--out", args->out, "CSV, one row per timed run")->capture_default_str();
   cmd->add_option("--protocol", args->protocol, "the protocol to simulate (default protocols/test1-static-grids.json)");
   cmd->add_option("--participants", args->options.participants, "participants per study")->capture_default_str()
-      ->check(IntRange(1, 10000));
+      ->transform(IntRange(1, 10000));
   cmd->add_option("--studies", args->options.studies, "studies per timed run")->capture_default_str()
-      ->check(IntRange(1, 10000));
+      ->transform(IntRange(1, 10000));
   cmd->add_option("--rounds", args->options.rounds, "timed runs per thread count")->capture_default_str()
-      ->check(IntRange(1, 100));
+      ->transform(IntRange(1, 100));
   cmd->add_option("--observer", args->options.observer, "the simulated observer")->capture_default_str();
   cmd->add_flag("--quick", args->quick, "1 round of 2 studies (smoke run)");
   cmd->callback([args] {

@@ -41,7 +41,7 @@ void AddCalibrateCommand(CLI::App& app) {
   cmd->add_option("--square-mm", args->square_mm, "side of one square in mm")->capture_default_str()
       ->check(FiniteRange(1, 1000, "mm"));
   cmd->add_option("--reference-edge", args->reference_edge, "edge whose measured blur feeds eq. 3.7")
-      ->capture_default_str()->check(IntRange(1, 1000));
+      ->capture_default_str()->transform(IntRange(1, 1000));
   cmd->add_option("--out", args->out, "where to write calib.json")->capture_default_str();
   cmd->add_option("--truth", args->truth,
                   "truth.json of a ground-truth scene (blurcue synth-scene): adds the true radius to the table\n"

@@ -85,10 +85,10 @@ void AddDisplayCommand(CLI::App& app) {
       "  blurcue display check --frames 600 --screenshot check.png");
   cmd->add_option("--profile", args->profile, "the display profile JSON (see README: describing a monitor)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--frames", args->frames, "flips to time")->capture_default_str()->check(IntRange(10, 100000));
+  cmd->add_option("--frames", args->frames, "flips to time")->capture_default_str()->transform(IntRange(10, 100000));
   cmd->add_flag("--fullscreen", args->fullscreen, "fill the monitor (and check its resolution against the profile)");
   cmd->add_option("--monitor", args->monitor, "which monitor with --fullscreen")->capture_default_str()
-      ->check(IntRange(0, 16));
+      ->transform(IntRange(0, 16));
   cmd->add_option("--screenshot", args->screenshot, "also write the test screen as a PNG");
   cmd->callback([args] {
     const display::Profile profile =

@@ -59,7 +59,7 @@ void AddSynthPicturesCommand(CLI::App& app) {
   cmd->add_option("--height-mm", args->height_mm, "the real picture's height")->capture_default_str()
       ->check(FinitePositive(10000, "mm"));
   cmd->add_option("--width-px", args->width_px, "photo width (the camera's sensor scaled to it)")
-      ->capture_default_str()->check(IntRange(16, 16384, "px"));
+      ->capture_default_str()->transform(IntRange(16, 16384, "px"));
   cmd->add_option("--out", args->out, "folder (created)")->required();
   cmd->callback([args] {
     std::set<double> distances(args->distances_m.begin(), args->distances_m.end());

@@ -61,17 +61,17 @@ void AddPlanCommand(CLI::App& app) {
                   "monitor at 60 cm)");
   cmd->add_option("--participants", args->options.participants,
                   "participants per simulated study; power is reported for every N from 1 to this")
-      ->capture_default_str()->check(IntRange(1, 10000));
+      ->capture_default_str()->transform(IntRange(1, 10000));
   cmd->add_option("--studies", args->options.studies, "simulated studies (more: power known more precisely; its "
                                                       "standard error is at most 0.5 / sqrt(studies))")
-      ->capture_default_str()->check(IntRange(1, 100000));
+      ->capture_default_str()->transform(IntRange(1, 100000));
   cmd->add_option("--observer", args->options.observer, "the simulated observer, sim or sim:NAME=VALUE,... (see "
                                                         "'blurcue run --help')")
       ->capture_default_str();
   cmd->add_option("--seed", args->options.seed, "the plan's seed (every participant's seed is derived from it)")
-      ->capture_default_str()->check(SeedValidator());
+      ->capture_default_str()->transform(SeedValidator());
   cmd->add_option("--threads", args->options.threads, "worker threads (0: every core); the results do not depend on it")
-      ->capture_default_str()->check(IntRange(0, 256));
+      ->capture_default_str()->transform(IntRange(0, 256));
   cmd->add_option("--alpha", args->options.alpha, "level of the tests")->capture_default_str()
       ->check(FiniteRange(0, 0.5, "", "", true));
   cmd->add_option("--power", args->options.target_power, "the power N(80%) asks for")->capture_default_str()

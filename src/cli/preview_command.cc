@@ -53,7 +53,7 @@ void AddPreviewCommand(CLI::App& app) {
   cmd->add_option("--out", args->out, "the contact sheet PNG")->required();
   cmd->add_option("--participant", args->participant, "whose trial list (by_participant sides)")
       ->capture_default_str();
-  cmd->add_option("--seed", args->seed, "seed (default: as blurcue run)")->check(SeedValidator());
+  cmd->add_option("--seed", args->seed, "seed (default: as blurcue run)")->transform(SeedValidator());
   cmd->add_flag("--list", args->list, "also print each tile's label (its levels, each side's source and radius in "
                                       "photo px, screen px and arcmin), one line per tile");
   cmd->add_option("--display", args->display, "the monitor's display profile, as blurcue run --display")
@@ -63,9 +63,9 @@ void AddPreviewCommand(CLI::App& app) {
   cmd->add_option("--visible", args->visible, "the predicted share correct (2AFC) below which a pair is flagged "
                                               "invisible")
       ->capture_default_str()->check(FiniteRange(0.5, 1, "share correct"));
-  cmd->add_option("--columns", args->columns, "tiles per row")->capture_default_str()->check(IntRange(1, 20));
+  cmd->add_option("--columns", args->columns, "tiles per row")->capture_default_str()->transform(IntRange(1, 20));
   cmd->add_option("--tile-width", args->tile_width, "tile width in px")->capture_default_str()
-      ->check(IntRange(80, 2000, "px"));
+      ->transform(IntRange(80, 2000, "px"));
   cmd->callback([args] {
     // The pre-flight of blurcue run: the same checks, and every trial's scene already worked out.
     const session::ObserverParams observer = session::ParseObserver(args->observer);

@@ -96,8 +96,8 @@ void AddSessionsCommand(CLI::App& app) {
   cmd->add_option("--db", args->db, "the SQLite record")->required()->check(CLI::ExistingFile);
   // Session ids are SQLite rowids: 1 and up.
   cmd->add_option("--abort", args->abort, "close this unfinished session as aborted (answers kept)")
-      ->check(IntRange(1, INT64_MAX));
-  cmd->add_option("--break-lock", args->break_lock, "clear this session's lock")->check(IntRange(1, INT64_MAX));
+      ->transform(IntRange(1, INT64_MAX));
+  cmd->add_option("--break-lock", args->break_lock, "clear this session's lock")->transform(IntRange(1, INT64_MAX));
   cmd->callback([args] {
     if (args->abort || args->break_lock) {
       store::Record record = store::Record::Open(args->db);

@@ -47,9 +47,9 @@ void AddRenderCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--object", args->object, "grid or ball[:TEXTURE]")->capture_default_str();
   cmd->add_option("--at-edge", args->edge, "edge the object is aligned with (1 = nearest)")->capture_default_str()
-      ->check(IntRange(1, 1000));
+      ->transform(IntRange(1, 1000));
   cmd->add_option("--section", args->section, "section along the edge for a ball (1..7)")->capture_default_str()
-      ->check(IntRange(1, 1000));
+      ->transform(IntRange(1, 1000));
   cmd->add_option("--blur", args->blur, "blur source")->capture_default_str();
   cmd->add_option("--gain", args->gain, "multiplies the radius")->capture_default_str()->check(FiniteRange(0, 100, ""));
   cmd->add_option("--method", args->method, "gaussian or disc")->capture_default_str()
@@ -61,12 +61,12 @@ void AddRenderCommand(CLI::App& app) {
   cmd->add_option("--backend", args->backend, "blur on gl or cpu")->capture_default_str()
       ->check(CLI::IsMember({"gl", "cpu"}));
   cmd->add_option("--display-width", args->display_width, "scale the output to this width (0 = full resolution)")
-      ->check(IntRange(0, 7680, "px"));
+      ->transform(IntRange(0, 7680, "px"));
   cmd->add_option("--cutoff", args->cutoff, "picture: Butterworth cut-off, cycles per picture width (0 = sharp)")
       ->check(FiniteRange(0, render::kMaxCutoffCyclesPerWidth, "cycles per picture width"));
   cmd->add_option("--picture-height-px", args->picture_height, "picture: its height on screen (default 60 % of the "
                                                                 "grey half)")
-      ->check(IntRange(0, 7680, "px"));
+      ->transform(IntRange(0, 7680, "px"));
   cmd->add_option("--out", args->out, "output PNG")->required();
   cmd->callback([args] {
     const auto t0 = std::chrono::steady_clock::now();

@@ -49,7 +49,7 @@ void AddReportCommand(CLI::App& app) {
   cmd->add_option("--out", args->out, "folder for the report (created)")->required();
   cmd->add_option("--bench", args->bench, "folder of the benchmark CSVs")->capture_default_str();
   cmd->add_option("--boot", args->boot, "bootstrap samples of the psychometric fit")->capture_default_str()
-      ->check(IntRange(10, 100000));
+      ->transform(IntRange(10, 100000));
   cmd->add_option("--python", args->python, "the Python that sees the analysis packages")->capture_default_str();
   cmd->add_flag("--pool-simulated", args->pool_simulated,
                 "analyse people and simulated observers together (by default each study reports them apart)");

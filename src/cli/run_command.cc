@@ -67,7 +67,7 @@ void AddRunCommand(CLI::App& app) {
   cmd->add_option("--db", args->db, "the SQLite record (created if missing)")->required();
   cmd->add_option("--seed", args->seed, "seed of the trial order (default: derived from the study name and the "
                                         "participant id; always recorded)")
-      ->check(SeedValidator());
+      ->transform(SeedValidator());
   cmd->add_option("--observer", args->observer, "sim or sim:NAME=VALUE,... - a simulated observer answers");
   cmd->add_option("--display", args->options.display_profile,
                   "the monitor's display profile (overrides the protocol's display.profile; recorded with the "
@@ -89,7 +89,7 @@ void AddRunCommand(CLI::App& app) {
                   "frame's flip, so a capture run is for checking a set-up, not for data");
   cmd->add_option("--stop-after", args->options.stop_after, "leave the session after this many answers (it stays "
                                                             "resumable; for tests and split sittings)")
-      ->check(IntRange(0, 1000000));
+      ->transform(IntRange(0, 1000000));
   cmd->callback([args] {
     session::RunOptions options = args->options;
     options.protocol_file = args->protocol;

@@ -93,16 +93,16 @@ void AddSynthSceneCommand(CLI::App& app) {
       "Example: blurcue synth-scene --out scenes/a --seed 7 --noise 0.004 --focus-mm 260");
   cmd->add_option("--out", args->out, "folder to write the four files to (created)")->required();
   cmd->add_option("--seed", args->seed, "seed of the texture, flaws and noise")->capture_default_str()
-      ->check(SeedValidator());
+      ->transform(SeedValidator());
   cmd->add_option("--preset", args->preset,
                   "quarter: thesis set-up at 1148 x 764 (default); thesis: full 4592 x 3056 (supersample 2)")
       ->check(CLI::IsMember({"quarter", "thesis"}))->capture_default_str();
   cmd->add_option("--camera", args->camera, "camera.json to shoot with instead of the preset's camera")
       ->check(CLI::ExistingFile);
   cmd->add_option("--width", args->width, "image width in px (the sensor is resampled; height follows the aspect)")
-      ->check(IntRange(32, kMaxImageSidePx, "px"));
+      ->transform(IntRange(32, kMaxImageSidePx, "px"));
   cmd->add_option("--height", args->height, "image height in px (with --width: both exactly)")
-      ->check(IntRange(32, kMaxImageSidePx, "px"));
+      ->transform(IntRange(32, kMaxImageSidePx, "px"));
   cmd->add_option("--board", args->board, "board size in squares, COLSxROWS")->capture_default_str();
   cmd->add_option("--square-mm", args->square_mm, "side of one square in mm")->capture_default_str()
       ->check(FiniteRange(1, 1000, "mm"));
@@ -125,9 +125,9 @@ void AddSynthSceneCommand(CLI::App& app) {
                   "sensor noise std in linear units (plus shot noise of the same size at white), e.g. 0.004")
       ->capture_default_str()->check(FiniteRange(0, 1, "linear units"));
   cmd->add_option("--jpeg-quality", args->jpeg_quality, "JPEG round trip at this quality (1-100); 0: none")
-      ->capture_default_str()->check(IntRange(0, 100));
+      ->capture_default_str()->transform(IntRange(0, 100));
   cmd->add_option("--flaws", args->flaws, "dark printing spots on white squares near edges (recorded in truth.json)")
-      ->capture_default_str()->check(IntRange(0, 10000));
+      ->capture_default_str()->transform(IntRange(0, 10000));
   cmd->add_option("--white", o.white, "linear reflectance x exposure of the white squares")->capture_default_str()
       ->check(FiniteRange(0, 1, "linear reflectance"));
   cmd->add_option("--black", o.black, "... of the black squares")->capture_default_str()
@@ -136,7 +136,7 @@ void AddSynthSceneCommand(CLI::App& app) {
       ->check(FiniteRange(0, 1, "linear reflectance"));
   cmd->add_option("--supersample", args->supersample,
                   "sub-pixels per pixel side for shading and blur (default 4; 2 for --preset thesis)")
-      ->check(IntRange(1, 16));
+      ->transform(IntRange(1, 16));
   cmd->add_flag("--quiet", args->quiet, "print only errors");
 
   cmd->callback([args] {

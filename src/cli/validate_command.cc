@@ -43,7 +43,7 @@ void AddValidateCommand(CLI::App& app) {
                                                       "counterbalancing)")->capture_default_str();
   cmd->add_option("--seed", args->seed, "seed of the trial order (default: the one blurcue run gives the participant, "
                                         "derived from the study name and the participant id)")
-      ->check(SeedValidator());
+      ->transform(SeedValidator());
   cmd->add_option("--display", args->display, "the monitor's display profile, as blurcue run --display")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--list", args->list, "print the trial list as JSON, one trial per line");
