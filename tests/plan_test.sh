@@ -23,8 +23,8 @@ PYEOF
 same_as_run() {
   local answers=$1 protocol=$2 observer=$3 db=$W/run-$(basename "$2" .json).sqlite
   tail -n +2 "$answers" | cut -d, -f1,2 | sort -u | while IFS=, read -r id seed; do
-    # (run --seed takes the digits; the 's' keeps spreadsheets from rounding them)
-    $BC run "$protocol" --participant "$id" --seed "${seed#s}" --db "$db" --observer "$observer" > /dev/null 2>&1 \
+    # The seed as answers.csv writes it (s<digits>, as export does): run takes it as written.
+    $BC run "$protocol" --participant "$id" --seed "$seed" --db "$db" --observer "$observer" > /dev/null 2>&1 \
       || fail "run $id $seed"
   done
   $BC export --db "$db" --out "$W/tables-$(basename "$2" .json)" > /dev/null 2>&1 || fail "export"
