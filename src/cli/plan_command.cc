@@ -103,7 +103,7 @@ void AddPlanCommand(CLI::App& app) {
     Json settings = {{"protocol", std::filesystem::absolute(args->protocol).string()},
                      {"protocol_hash", HashHex(Fnv1a64(ReadTextFile(args->protocol)))},
                      {"study", result.study},
-                     {"display", args->display},
+                     {"display", args->display.empty() ? result.display : args->display},
                      {"participants", options.participants},
                      {"studies", options.studies},
                      {"seed", "s" + std::to_string(options.seed)},

@@ -237,6 +237,7 @@ PlanResult RunPlan(const PlanOptions& options) {
   (void)session::ParseObserver(options.observer);  // a bad --observer before any file is read
   const session::PreparedSession study = session::PrepareStudy(options.protocol_file, options.display_profile);
   r.study = study.protocol.name;
+  r.display = study.display.name;
   const auto start = std::chrono::steady_clock::now();
   r.studies = SimulateStudies(options, study, &r.conditions, &r.notes, &r.threads_used);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -376,13 +377,13 @@ std::string AnswersCsv(const PlanResult& r) {
 
 std::string Summary(const PlanResult& r, const PlanOptions& o) {
   std::string out;
-  char line[512];
+  char line[1024];
   std::snprintf(line, sizeof line,
-                "plan of %s: %d simulated studies of %d participants (seed %llu), observer %s\n"
+                "plan of %s: %d simulated studies of %d participants (seed %llu), observer %s, display %s\n"
                 "per condition at N = %d: the expected share (first_source: the design's first source among decisive "
                 "answers; correct; yes), the mean width of its 95 %% Wilson interval, the power of the exact binomial "
                 "test against chance (alpha %g) and the smallest N reaching %g %%\n",
-                r.study.c_str(), o.studies, o.participants, static_cast<unsigned long long>(o.seed), r.observer.c_str(),
+                r.study.c_str(), o.studies, o.participants, static_cast<unsigned long long>(o.seed), r.observer.c_str(), r.display.c_str(),
                 o.participants, o.alpha, 100 * o.target_power);
   out += line;
   std::snprintf(line, sizeof line, "  %-28s %-13s %7s %8s %8s %7s  %s\n", "condition", "measure", "share", "width",

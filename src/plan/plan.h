@@ -88,6 +88,7 @@ struct PlanResult {
   double seconds = 0;                      // wall time of the simulation
   std::string observer;                    // canonical form
   std::string study;                       // the protocol's name
+  std::string display;                     // the display profile's name (--display, the protocol's, or the default)
 };
 
 // Throws Error(kInput) for a protocol that cannot be prepared (as `blurcue validate`), kUsage for bad options.
