@@ -136,3 +136,24 @@ hostile_test(cli_hostile_sessions_abort_wraps 2
              sessions --db ${D}/small.png --abort 18446744073709551617)
 hostile_test(cli_hostile_display_frames_nan 2 "--frames: must be a whole number in [10, 100000], got 'nan'"
              display check --frames nan)
+# The simulated observer's parameters (issue 14): NaN, huge, negative and empty values, the other model's names, and
+# the visibility level of validate --plan and preview - one line naming the parameter and the value, exit 2, before
+# any file is read.
+hostile_test(cli_hostile_observer_weber_nan 2 "--observer weber must be a number, got 'nan'"
+             run ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --participant P1 --db ${H}/x.sqlite
+             --observer sim:weber=nan)
+hostile_test(cli_hostile_observer_intrinsic_huge 2 "--observer intrinsic must be in (0, 60] arcmin (a Gaussian std), got '1e308'"
+             run ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --participant P1 --db ${H}/x.sqlite
+             --observer sim:intrinsic=1e308)
+hostile_test(cli_hostile_observer_lapse_negative 2 "--observer lapse must be in 0..1, got '-1'"
+             run ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --participant P1 --db ${H}/x.sqlite
+             --observer sim:lapse=-1)
+hostile_test(cli_hostile_observer_rt_empty 2 "--observer rt must be a number, got ''"
+             run ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --participant P1 --db ${H}/x.sqlite
+             --observer sim:rt=)
+hostile_test(cli_hostile_observer_other_model 2 "--observer jnd belongs to model=pixel, not model=arcmin"
+             validate ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --plan --observer sim:model=arcmin,jnd=1)
+hostile_test(cli_hostile_validate_visible_nan 2 "--visible: must be in [0.5, 1] share correct, got nan"
+             validate ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --plan --visible nan)
+hostile_test(cli_hostile_preview_observer_model 2 "--observer model must be arcmin or pixel, got 'eye'"
+             preview ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --out ${H}/x.png --observer sim:model=eye)

@@ -820,5 +820,56 @@ assert checked == len(trials) >= 4, checked
 print(f"{checked} trials: every frame records its radii and place")
 PYEOF
   echo "ok: moving balls record each frame's radius and place" ;;
+visibility)
+  # What a participant can see, before anyone sits down (validate --plan, preview): a protocol built to be invisible
+  # (measured vs estimated at edges 1-2, whose radii differ by a fraction of an arcmin, on a monitor seen from 3 m)
+  # has every pair flagged; one built to be visible (1 vs 8 arcmin) has none. Each predicted share is checked against
+  # the closed form computed here from the radii the line prints: Phi(z75 |ln E(a/2) - ln E(b/2)| / ln(1 + w)),
+  # E(s) = sqrt(s^2 + s_i^2) with the defaults s_i = 0.6', w = 0.35 (r = 2 s).
+  $PY - "$P/test1-static-grids.json" "$W" <<'PYEOF'
+import json, sys
+t = json.load(open(sys.argv[1]))
+t["factors"] = {"edge": [1, 2]}
+t.pop("practice", None)
+json.dump(t, open(sys.argv[2] + "/invisible.json", "w"))
+t["factors"] = {"edge": [5]}
+t["sides"] = {"left": {"arcmin": 1}, "right": {"arcmin": 8}}
+json.dump(t, open(sys.argv[2] + "/visible.json", "w"))
+json.dump({"name": "far", "width_px": 1920, "height_px": 1080, "width_mm": 531.4, "height_mm": 298.9,
+           "distance_mm": 3000}, open(sys.argv[2] + "/far.json", "w"))
+PYEOF
+  sed -i "s|\"\.\./|\"$P/../|g" "$W/invisible.json" "$W/visible.json"
+  $BC validate "$W/invisible.json" --plan --display "$W/far.json" > "$W/invisible.out" || fail "validate invisible"
+  $BC validate "$W/visible.json" --plan --display "$W/far.json" > "$W/visible.out" || fail "validate visible"
+  grep -q "2 distinct pairs, 2 invisible" "$W/invisible.out" || fail "invisible: $(cat "$W/invisible.out")"
+  [ "$(grep -c 'invisible at 300 cm on this monitor' "$W/invisible.out")" = 2 ] || fail "invisible: $(cat "$W/invisible.out")"
+  grep -q "1 distinct pairs, 0 invisible" "$W/visible.out" || fail "visible: $(cat "$W/visible.out")"
+  grep -q "invisible at" "$W/visible.out" && fail "visible flagged: $(cat "$W/visible.out")"
+  # The same protocol at 60 cm seen by a far poorer observer (a Weber fraction of 6): the flag follows the model.
+  $BC validate "$W/visible.json" --plan --observer sim:weber=6 > "$W/strict.out" || fail "validate strict"
+  grep -q "1 distinct pairs, 1 invisible" "$W/strict.out" || fail "weber=6: $(cat "$W/strict.out")"
+  $BC preview "$W/invisible.json" --display "$W/far.json" --out "$W/sheet.png" --list > "$W/preview.out" \
+    || fail "preview: $(tail -2 "$W/preview.out")"
+  grep -q "2 distinct pairs, 2 invisible" "$W/preview.out" || fail "preview: $(cat "$W/preview.out")"
+  [ "$(grep -c 'INVISIBLE' "$W/preview.out")" -ge 2 ] || fail "preview tiles: $(cat "$W/preview.out")"
+  $PY - "$W/invisible.out" "$W/visible.out" "$W/strict.out" <<'PYEOF' || fail "predicted shares"
+import math, re, sys
+from statistics import NormalDist
+checked = 0
+for path, w in ((sys.argv[1], 0.35), (sys.argv[2], 0.35), (sys.argv[3], 6.0)):
+    for line in open(path):
+        m = re.search(r"\(([\d.]+)' vs ([\d.]+)'\), predicted (\d+) % correct", line)
+        if not m:
+            continue
+        a, b, shown = float(m[1]), float(m[2]), int(m[3])
+        e = lambda r: math.sqrt((r / 2) ** 2 + 0.6 ** 2)
+        truth = NormalDist().cdf(NormalDist().inv_cdf(0.75) * abs(math.log(e(a) / e(b))) / math.log(1 + w))
+        # The printed radii are rounded to 0.01': allow the share that rounding can move.
+        assert abs(100 * truth - shown) <= 1.5, (line, truth)
+        checked += 1
+assert checked == 4, checked
+print(checked)
+PYEOF
+  echo "ok: $(grep -o '[0-9]* distinct pairs, [0-9]* invisible' "$W/invisible.out") at 3 m; visible: $(grep -o '[0-9]* distinct pairs, [0-9]* invisible' "$W/visible.out"); predicted shares match the closed form" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -19,16 +19,20 @@
 #include "protocol/trials.h"
 #include "render/gl_context.h"
 #include "session/adaptive.h"
+#include "session/answer.h"
+#include "session/observer.h"
 #include "session/prepare.h"
 #include "session/stimulus.h"
+#include "session/visibility.h"
 
 namespace blurcue::cli {
 
 void AddPreviewCommand(CLI::App& app) {
   struct Args {
-    std::string protocol, out, participant = "P1";
+    std::string protocol, out, participant = "P1", display, observer = "sim";
     std::optional<uint64_t> seed;
     int columns = 6, tile_width = 320;
+    double visible = 0.75;
     bool list = false;
   };
   auto args = std::make_shared<Args>();
@@ -41,6 +45,9 @@ void AddPreviewCommand(CLI::App& app) {
       "eye before a session.\n"
       "Distinct: the same levels and sides drawn once (practice copies and repetitions are not repeated); for\n"
       "depth matching, one tile per adjustment level and one per distance.\n"
+      "Each pair's tile says the probability that an observer (--observer's model, no lapses or bias) tells its two\n"
+      "sides apart on the display (--display) in a 2AFC; below --visible it is flagged invisible, and every distinct\n"
+      "pair is listed so (as blurcue validate --plan).\n"
       "Example: blurcue preview protocols/test1-static-grids.json --out results/preview-test1.png");
   cmd->add_option("protocol", args->protocol, "the protocol JSON file")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "the contact sheet PNG")->required();
@@ -49,12 +56,21 @@ void AddPreviewCommand(CLI::App& app) {
   cmd->add_option("--seed", args->seed, "seed (default: as blurcue run)")->check(SeedValidator());
   cmd->add_flag("--list", args->list, "also print each tile's label (its levels, each side's source and radius in "
                                       "photo px, screen px and arcmin), one line per tile");
+  cmd->add_option("--display", args->display, "the monitor's display profile, as blurcue run --display")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--observer", args->observer, "the observer model that predicts what is visible, as blurcue run "
+                                                "--observer")->capture_default_str();
+  cmd->add_option("--visible", args->visible, "the predicted share correct (2AFC) below which a pair is flagged "
+                                              "invisible")
+      ->capture_default_str()->check(FiniteRange(0.5, 1, "share correct"));
   cmd->add_option("--columns", args->columns, "tiles per row")->capture_default_str()->check(IntRange(1, 20));
   cmd->add_option("--tile-width", args->tile_width, "tile width in px")->capture_default_str()
       ->check(IntRange(80, 2000, "px"));
   cmd->callback([args] {
     // The pre-flight of blurcue run: the same checks, and every trial's scene already worked out.
-    const session::PreparedSession prepared = session::PrepareSession(args->protocol, args->participant, args->seed);
+    const session::ObserverParams observer = session::ParseObserver(args->observer);
+    const session::PreparedSession prepared =
+        session::PrepareSession(args->protocol, args->participant, args->seed, args->display);
     const protocol::Protocol& p = prepared.protocol;
     const auto& trials = prepared.trials;
     const auto& scene = prepared.scene;
@@ -63,6 +79,7 @@ void AddPreviewCommand(CLI::App& app) {
       double level;
       std::string label, label2;  // levels; the sides and their radii
       Json key;                    // sorts the sheet by level
+      std::string seen;            // pairs: the predicted share correct, and invisible below --visible
     };
     std::vector<Tile> tiles;
     std::set<std::string> seen;  // labels or level keys already on the sheet
@@ -108,10 +125,7 @@ void AddPreviewCommand(CLI::App& app) {
                 " on the " + t.test_side + " at first)";
         session::PlanOnScreen(p, *scene, prepared.presentation, &s);
       }
-      std::string levels;
-      for (const auto& [name, value] : t.levels.items())
-        levels += (levels.empty() ? "" : " ") + name + " " +
-                  (value.is_object() && value.contains("id") ? value["id"].dump() : value.dump());
+      const std::string levels = session::LevelsLabel(t);
       auto source = [](const Json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); };
       // Each side's radius as the camera made it (photo px) and as the screen shows it (screen px, arcmin): the
       // numbers the record keeps for these trials.
@@ -122,6 +136,15 @@ void AddPreviewCommand(CLI::App& app) {
                       at.ScreenPx(r), at.Arcmin(r));
         return std::string(text);
       };
+      // What an observer makes of the pair on this display: the object against the scene's blur for one object.
+      session::PairView view = session::ViewOf(s, at);
+      if (s.left_only) view.r_right_px = view.r_scene_px;
+      const double p_correct = session::ProbabilityCorrect2afc(observer, view);
+      char seen[96];
+      std::snprintf(seen, sizeof seen, "%s told apart %.0f %% (2AFC)%s", s.left_only ? "vs scene:" : "L vs R:",
+                    100 * p_correct,
+                    p_correct < args->visible ? " - INVISIBLE" : "");
+      const size_t first_tile = tiles.size();
       if (s.left_only) {  // layout single: its one object
         tiles.push_back({s, 0, levels + first, side("object", t.left, s.r_left_px), key});
       } else if (s.intervals > 0) {
@@ -139,6 +162,7 @@ void AddPreviewCommand(CLI::App& app) {
         tiles.push_back({s, 0, levels + first, side("L", t.left, s.r_left_px) + " | " + side("R", t.right, s.r_right_px),
                          key});
       }
+      for (size_t k = first_tile; k < tiles.size(); ++k) tiles[k].seen = seen;
     }
     std::stable_sort(tiles.begin(), tiles.end(), [](const Tile& a, const Tile& b) { return a.key < b.key; });
     if (tiles.empty()) throw InputError(args->protocol, "the protocol makes no trials to preview");
@@ -146,7 +170,7 @@ void AddPreviewCommand(CLI::App& app) {
     auto context = render::GlContext::CreateOffscreen();
     session::StimulusRenderer renderer(p, scene, prepared.images, prepared.presentation);
     const cv::Size frame = renderer.FrameSize();
-    const int tw = args->tile_width, th = tw * frame.height / frame.width, strip = 62;
+    const int tw = args->tile_width, th = tw * frame.height / frame.width, strip = 76;
     const int cols = std::min<int>(args->columns, int(tiles.size()));
     const int rows = (int(tiles.size()) + cols - 1) / cols;
     cv::Mat sheet(rows * (th + strip), cols * tw, CV_8UC3, cv::Scalar(40, 40, 40));
@@ -176,18 +200,31 @@ void AddPreviewCommand(CLI::App& app) {
         lines.push_back(tiles[i].label2.substr(at, bar == std::string::npos ? bar : bar - at));
       }
       if (!plan.empty()) lines.push_back(plan.substr(6));  // without "plan: "
-      for (size_t k = 0; k < lines.size(); ++k)
+      if (!tiles[i].seen.empty()) lines.push_back(tiles[i].seen);
+      for (size_t k = 0; k < lines.size(); ++k) {
+        const bool flagged = k + 1 == lines.size() && tiles[i].seen.find("INVISIBLE") != std::string::npos;
         cv::putText(sheet, lines[k], {x + 4, y + th + 14 * int(k + 1)}, cv::FONT_HERSHEY_SIMPLEX, 0.36,
-                    cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
+                    flagged ? cv::Scalar(90, 90, 255) : cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
+      }
       if (args->list)
-        std::printf("#%zu %s: %s%s%s\n", i + 1, tiles[i].label.c_str(), tiles[i].label2.c_str(),
-                    plan.empty() ? "" : " | ", plan.c_str());
+        std::printf("#%zu %s: %s%s%s%s%s\n", i + 1, tiles[i].label.c_str(), tiles[i].label2.c_str(),
+                    plan.empty() ? "" : " | ", plan.c_str(), tiles[i].seen.empty() ? "" : " | ",
+                    tiles[i].seen.c_str());
       if (tty) std::fprintf(stderr, "\rpreview: %zu of %zu", i + 1, tiles.size());
     }
     if (tty) std::fprintf(stderr, "\n");
     WriteImage(args->out, sheet);
     std::printf("%s: %zu distinct stimuli of %zu trials -> %s\n", args->protocol.c_str(), tiles.size(), trials.size(),
                 args->out.c_str());
+    // What a participant can see of it, pair by pair (as blurcue validate --plan).
+    const auto pairs = session::PairVisibilities(prepared, observer, args->visible);
+    size_t invisible = 0;
+    for (const auto& pair : pairs) invisible += !pair.visible;
+    if (!pairs.empty())
+      std::printf("visibility (%s; flagged below %g %% correct): %zu distinct pairs, %zu invisible\n",
+                  session::ToString(observer).c_str(), 100 * args->visible, pairs.size(), invisible);
+    for (const auto& pair : pairs)
+      if (!pair.visible) std::printf("  %s\n", session::Describe(pair, prepared.display).c_str());
   });
 }
 

@@ -10,15 +10,18 @@
 #include "core/hash.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
+#include "session/observer.h"
 #include "session/prepare.h"
+#include "session/visibility.h"
 
 namespace blurcue::cli {
 
 void AddValidateCommand(CLI::App& app) {
   struct Args {
-    std::string file, participant = "P1", display;
+    std::string file, participant = "P1", display, observer = "sim";
     std::optional<uint64_t> seed;
-    bool no_files = false, list = false;
+    bool no_files = false, list = false, plan = false;
+    double visible = 0.75;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -29,6 +32,9 @@ void AddValidateCommand(CLI::App& app) {
       "calibration is read, every image decoded and its size checked, every trial's blur radii worked out - a\n"
       "protocol that validates is one that runs. When the protocol is valid, prints the number of trials and the\n"
       "hash of the list that a session with the same participant and seed would run.\n"
+      "--plan adds what a participant can see: for every distinct stimulus pair, on the display profile, the\n"
+      "probability that an observer (--observer's model, without lapses or bias) tells its two sides apart in a\n"
+      "2AFC, and the pairs below --visible flagged as invisible at that viewing distance.\n"
       "Example: blurcue validate protocols/test2-moving-balls.json --participant P4 --seed 4");
   cmd->add_option("protocol", args->file, "the protocol JSON file")->required();
   cmd->add_flag("--no-files", args->no_files, "check the protocol alone: skip the referenced files (scene, calib, "
@@ -41,7 +47,21 @@ void AddValidateCommand(CLI::App& app) {
   cmd->add_option("--display", args->display, "the monitor's display profile, as blurcue run --display")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--list", args->list, "print the trial list as JSON, one trial per line");
+  cmd->add_flag("--plan", args->plan, "also predict, per distinct stimulus pair, whether an observer can tell its "
+                                      "two sides apart on this display (flags the invisible ones)");
+  cmd->add_option("--observer", args->observer, "with --plan: the observer model, as blurcue run --observer "
+                                                "(sim: the arcmin model's defaults)")->capture_default_str();
+  cmd->add_option("--visible", args->visible, "with --plan: the predicted share correct (2AFC) below which a pair "
+                                              "is flagged invisible")
+      ->capture_default_str()->check(FiniteRange(0.5, 1, "share correct"));
   cmd->callback([args] {
+    // The observer is checked before any file is read: a typo in it is a usage error, whatever the protocol.
+    std::optional<session::ObserverParams> observer;
+    if (args->plan) {
+      if (args->no_files)
+        throw Error(ErrorKind::kUsage, "--plan needs the radii the files give; it cannot go with --no-files");
+      observer = session::ParseObserver(args->observer);
+    }
     protocol::Protocol p;
     uint64_t seed = 0;
     std::vector<protocol::Trial> trials;
@@ -78,6 +98,16 @@ void AddValidateCommand(CLI::App& app) {
                         per_pixel, prepared.scenes.size(), prepared.protocol.content.depth_blur_threshold,
                         prepared.protocol.content.depth_blur_threshold_unit == "arcmin" ? "arcmin" : "screen px");
           shown += line;
+        }
+        if (observer) {
+          const auto pairs = session::PairVisibilities(prepared, *observer, args->visible);
+          size_t invisible = 0;
+          for (const auto& pair : pairs) invisible += !pair.visible;
+          std::snprintf(line, sizeof line, "  visibility (%s; flagged below %g %% correct): %zu distinct pairs, %zu invisible\n",
+                        session::ToString(*observer).c_str(), 100 * args->visible, pairs.size(), invisible);
+          shown += line;
+          if (pairs.empty()) shown += "    no pairs to compare (adjustment trials)\n";
+          for (const auto& pair : pairs) shown += "    " + session::Describe(pair, at.profile) + "\n";
         }
         p = std::move(prepared.protocol);
         seed = prepared.seed;

@@ -4,50 +4,145 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <set>
 #include <sstream>
 
 #include "core/error.h"
 
 namespace blurcue::session {
+namespace {
+
+constexpr double kZ75 = 0.6744897501960817;  // Phi^-1(0.75)
+
+double Phi(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
+
+// ln E(s) = ln (s^p + s_i^p)^(1/p), scaled by the larger term so that neither power overflows.
+double LogSeenBlur(const ObserverParams& p, double s_arcmin) {
+  const double s = std::max(0.0, s_arcmin), big = std::max(s, p.intrinsic_arcmin);
+  return std::log(big) + std::log(std::pow(s / big, p.exponent) + std::pow(p.intrinsic_arcmin / big, p.exponent)) /
+                             p.exponent;
+}
+
+// The shortest text that reads back as exactly `v`: the recorded observer is the one that answered.
+std::string Number(double v) {
+  char text[40];
+  for (int digits = 6; digits <= 17; ++digits) {
+    std::snprintf(text, sizeof text, "%.*g", digits, v);
+    if (std::strtod(text, nullptr) == v) break;
+  }
+  return text;
+}
+
+}  // namespace
 
 ObserverParams ParseObserver(const std::string& spec) {
   ObserverParams p;
   if (spec == "sim") return p;
   if (spec.rfind("sim:", 0) != 0)
     throw Error(ErrorKind::kUsage, "--observer must be sim or sim:NAME=VALUE,..., got '" + spec + "'");
-  std::stringstream items(spec.substr(4));
-  std::string item;
-  while (std::getline(items, item, ',')) {
-    const size_t eq = item.find('=');
-    const std::string name = item.substr(0, eq);
-    const std::string text = eq == std::string::npos ? "" : item.substr(eq + 1);
+  std::vector<std::pair<std::string, std::string>> items;
+  {
+    std::stringstream list(spec.substr(4));
+    std::string item;
+    while (std::getline(list, item, ',')) {
+      const size_t eq = item.find('=');
+      items.emplace_back(item.substr(0, eq), eq == std::string::npos ? "" : item.substr(eq + 1));
+    }
+    if (items.empty() || spec.back() == ',')
+      throw Error(ErrorKind::kUsage, "--observer: an empty parameter in '" + spec + "' (sim:NAME=VALUE,...)");
+  }
+  // The model first: it decides which names belong. Without model=, jnd or bias name the pixel model (the form every
+  // record before model= existed holds).
+  bool named_model = false;
+  for (const auto& [name, text] : items)
+    if (name == "model") {
+      if (text != "arcmin" && text != "pixel")
+        throw Error(ErrorKind::kUsage, "--observer model must be arcmin or pixel, got '" + text + "'");
+      p.model = text == "pixel" ? ObserverModel::kPixel : ObserverModel::kArcmin;
+      named_model = true;
+    }
+  if (!named_model)
+    for (const auto& item : items)
+      if (item.first == "jnd" || item.first == "bias") p.model = ObserverModel::kPixel;
+  const bool pixel = p.model == ObserverModel::kPixel;
+  static const std::set<std::string> kArcminOnly = {"intrinsic", "weber", "exponent", "side", "blurrier", "rthard"};
+  static const std::set<std::string> kPixelOnly = {"jnd", "bias"};
+  std::set<std::string> seen;
+  for (const auto& [name, text] : items) {
+    if (!seen.insert(name).second)
+      throw Error(ErrorKind::kUsage, "--observer " + name + " is given twice in '" + spec + "'");
+    if (name == "model") continue;
+    if ((pixel ? kArcminOnly : kPixelOnly).count(name))
+      throw Error(ErrorKind::kUsage, "--observer " + name + " belongs to model=" + (pixel ? "arcmin" : "pixel") +
+                                         ", not model=" + (pixel ? "pixel" : "arcmin") + " (got '" + text + "')");
     char* end = nullptr;
     const double v = std::strtod(text.c_str(), &end);
     auto bad = [&](const std::string& what) {
       throw Error(ErrorKind::kUsage, "--observer " + name + " " + what + ", got '" + text + "'");
     };
+    auto in = [&](double lo, double hi, bool open_lo, const char* what) {
+      if (v > hi || v < lo || (open_lo && v == lo)) bad(what);
+      return v;
+    };
+    if (!kArcminOnly.count(name) && !kPixelOnly.count(name) &&
+        !std::set<std::string>{"lapse", "rt", "step", "cutoff1m", "slope", "sdlog", "tol"}.count(name))
+      throw Error(ErrorKind::kUsage, "--observer: unknown parameter '" + name + "' (known: model, " +
+                                         (pixel ? "jnd, bias" : "intrinsic, weber, exponent, side, blurrier, rthard") +
+                                         ", lapse, rt, step, cutoff1m, slope, sdlog, tol)");
     if (text.empty() || *end != '\0' || !std::isfinite(v)) bad("must be a number");
-    if (name == "jnd") { if (v <= 0) bad("must be > 0"); p.jnd_px = v; }
-    else if (name == "bias") p.bias_px = v;
-    else if (name == "lapse") { if (v < 0 || v > 1) bad("must be in 0..1"); p.lapse = v; }
-    else if (name == "rt") { if (v <= 0) bad("must be > 0"); p.rt_ms = v; }
-    else if (name == "step") { if (v <= 0) bad("must be > 0"); p.step_ms = v; }
-    else if (name == "cutoff1m") { if (v <= 0) bad("must be > 0"); p.cutoff_1m = v; }
-    else if (name == "slope") p.slope = v;
-    else if (name == "sdlog") { if (v < 0) bad("must be >= 0"); p.sd_log = v; }
-    else if (name == "tol") { if (v < 0) bad("must be >= 0"); p.tolerance_log = v; }
-    else
-      throw Error(ErrorKind::kUsage, "--observer: unknown parameter '" + name +
-                                         "' (known: jnd, bias, lapse, rt, step, cutoff1m, slope, sdlog, tol)");
+    // Ranges: what a human observer could be, so a typo (1e308, a missing decimal point) is refused, not simulated.
+    if (name == "intrinsic") p.intrinsic_arcmin = in(0, 60, true, "must be in (0, 60] arcmin (a Gaussian std)");
+    else if (name == "weber") p.weber = in(0, 10, true, "must be in (0, 10]");
+    else if (name == "exponent") p.exponent = in(0.5, 20, false, "must be in [0.5, 20]");
+    else if (name == "side") p.side_bias = in(-10, 10, false, "must be in -10..10 (noise sds)");
+    else if (name == "blurrier") p.blurrier_bias = in(-10, 10, false, "must be in -10..10 (noise sds)");
+    else if (name == "rthard") p.rt_hard = in(0, 100, false, "must be in 0..100");
+    else if (name == "jnd") p.jnd_px = in(0, 1e4, true, "must be in (0, 10000] px");
+    else if (name == "bias") p.bias_px = in(-1e4, 1e4, false, "must be in -10000..10000 px");
+    else if (name == "lapse") p.lapse = in(0, 1, false, "must be in 0..1");
+    else if (name == "rt") p.rt_ms = in(0, 600000, true, "must be in (0, 600000] ms");
+    else if (name == "step") p.step_ms = in(0, 600000, true, "must be in (0, 600000] ms");
+    else if (name == "cutoff1m") p.cutoff_1m = in(0, 1e6, true, "must be in (0, 1e6] cycles per picture width");
+    else if (name == "slope") p.slope = in(-100, 100, false, "must be in -100..100");
+    else if (name == "sdlog") p.sd_log = in(0, 100, false, "must be in 0..100");
+    else if (name == "tol") p.tolerance_log = in(0, 100, false, "must be in 0..100");
   }
   return p;
 }
 
 std::string ToString(const ObserverParams& p) {
-  char text[256];
-  std::snprintf(text, sizeof text, "sim:jnd=%g,bias=%g,lapse=%g,rt=%g,step=%g,cutoff1m=%g,slope=%g,sdlog=%g,tol=%g",
-                p.jnd_px, p.bias_px, p.lapse, p.rt_ms, p.step_ms, p.cutoff_1m, p.slope, p.sd_log, p.tolerance_log);
-  return text;
+  std::string text = "sim:model=";
+  if (p.model == ObserverModel::kPixel)
+    text += "pixel,jnd=" + Number(p.jnd_px) + ",bias=" + Number(p.bias_px);
+  else
+    text += "arcmin,intrinsic=" + Number(p.intrinsic_arcmin) + ",weber=" + Number(p.weber) + ",exponent=" +
+            Number(p.exponent) + ",side=" + Number(p.side_bias) + ",blurrier=" + Number(p.blurrier_bias) +
+            ",rthard=" + Number(p.rt_hard);
+  return text + ",lapse=" + Number(p.lapse) + ",rt=" + Number(p.rt_ms) + ",step=" + Number(p.step_ms) +
+         ",cutoff1m=" + Number(p.cutoff_1m) + ",slope=" + Number(p.slope) + ",sdlog=" + Number(p.sd_log) +
+         ",tol=" + Number(p.tolerance_log);
+}
+
+double ProbabilityCorrect2afc(const ObserverParams& p, double r_a_arcmin, double r_b_arcmin) {
+  if (p.model != ObserverModel::kArcmin)
+    throw Error(ErrorKind::kUsage, "--observer model=pixel answers in photo px: it has no probability for radii in "
+                                   "arcmin (use model=arcmin)");
+  // r = 2 s (DESIGN.md: blurcue's radius is twice the line-spread function's std).
+  const double d = std::abs(LogSeenBlur(p, r_a_arcmin / 2) - LogSeenBlur(p, r_b_arcmin / 2));
+  return Phi(kZ75 * d / std::log1p(p.weber));
+}
+
+double ProbabilityCorrect2afc(const ObserverParams& p, const PairView& v) {
+  if (p.model == ObserverModel::kPixel) return Phi(std::abs(v.r_left_px - v.r_right_px) / p.jnd_px);
+  if (!(v.arcmin_per_px > 0))
+    throw Error(ErrorKind::kInternal, "the arcmin observer was given a pair without its arcmin per photo px");
+  return ProbabilityCorrect2afc(p, v.r_left_px * v.arcmin_per_px, v.r_right_px * v.arcmin_per_px);
+}
+
+double DiscriminationThresholdArcmin(const ObserverParams& p, double r_ref_arcmin) {
+  const double s = std::max(0.0, r_ref_arcmin / 2), e = p.exponent, si = p.intrinsic_arcmin;
+  const double seen = std::pow(1 + p.weber, e) * (std::pow(s, e) + std::pow(si, e)) - std::pow(si, e);
+  return 2 * (std::pow(seen, 1 / e) - s);
 }
 
 double SimulatedObserver::Uniform() { return double(rng_() >> 11) * 0x1.0p-53; }
@@ -58,37 +153,66 @@ double SimulatedObserver::Normal() {
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
 }
 
-double SimulatedObserver::ResponseTimeMs(double median_ms) { return median_ms * std::exp(0.3 * Normal()); }
+double SimulatedObserver::ResponseTimeMs(double median_ms, double d_prime) {
+  // Harder discriminations take longer (the arcmin model): up to (1 + rt_hard) x the median at d' = 0.
+  if (params_.model == ObserverModel::kArcmin) median_ms *= 1 + params_.rt_hard * std::exp(-d_prime * d_prime / 2);
+  return median_ms * std::exp(0.3 * Normal());
+}
 
+double SimulatedObserver::Seen(double r_px, const PairView& v) const {
+  if (params_.model == ObserverModel::kPixel) return r_px;
+  if (!(v.arcmin_per_px > 0) || !std::isfinite(v.arcmin_per_px))
+    throw Error(ErrorKind::kInternal, "the arcmin observer was given a trial without its arcmin per photo px");
+  return LogSeenBlur(params_, r_px * v.arcmin_per_px / 2);  // r = 2 s
+}
+
+double SimulatedObserver::LookSd() const {
+  return params_.model == ObserverModel::kPixel ? params_.jnd_px : std::log1p(params_.weber) / (std::sqrt(2.0) * kZ75);
+}
+
+double SimulatedObserver::CompareSd() const {
+  return params_.model == ObserverModel::kPixel ? params_.jnd_px : std::log1p(params_.weber) / kZ75;
+}
+
+// The draws of every answer come in one order (decision noise, lapse, lapse pick, response time), the pixel model's
+// of old: a seed answers as it did before the arcmin model existed.
 KeyPress SimulatedObserver::ChooseSide(const PairView& v, bool cant_tell) {
+  const double sd = CompareSd();
+  const double m_left = std::abs(Seen(v.r_left_px, v) - Seen(v.r_scene_px, v)),
+               m_right = std::abs(Seen(v.r_right_px, v) - Seen(v.r_scene_px, v));
+  const double more_blurred = v.r_left_px > v.r_right_px ? 1 : v.r_left_px < v.r_right_px ? -1 : 0;
+  const double bias = params_.model == ObserverModel::kPixel
+                          ? params_.bias_px * more_blurred
+                          : (params_.blurrier_bias * more_blurred + params_.side_bias) * sd;
   const double noise = Normal(), lapse_draw = Uniform(), lapse_pick = Uniform();
-  const double rt = ResponseTimeMs(params_.rt_ms);
+  const double rt = ResponseTimeMs(params_.rt_ms, (m_right - m_left) / sd);
   if (lapse_draw < params_.lapse) {
     static const char* kActions[] = {"left", "right", "cant_tell"};
     const int choices = cant_tell ? 3 : 2;
     return {kActions[std::min(choices - 1, int(lapse_pick * choices))], rt};
   }
-  const double m_left = std::abs(v.r_left_px - v.r_scene_px), m_right = std::abs(v.r_right_px - v.r_scene_px);
-  const double more_blurred = v.r_left_px > v.r_right_px ? 1 : v.r_left_px < v.r_right_px ? -1 : 0;
-  const double d = (m_right - m_left) + params_.bias_px * more_blurred + params_.jnd_px * noise;
-  const double criterion = cant_tell ? params_.jnd_px / 2 : 0;
+  const double d = (m_right - m_left) + bias + sd * noise;
+  const double criterion = cant_tell ? sd / 2 : 0;
   return {d > criterion ? "left" : d < -criterion ? "right" : "cant_tell", rt};
 }
 
 KeyPress SimulatedObserver::ChooseBlurrier(const PairView& v) {
+  const double sd = CompareSd();
+  const double difference = Seen(v.r_left_px, v) - Seen(v.r_right_px, v);
+  const double side = params_.model == ObserverModel::kPixel ? 0 : params_.side_bias * sd;
   const double noise = Normal(), lapse_draw = Uniform(), lapse_pick = Uniform();
-  const double rt = ResponseTimeMs(params_.rt_ms);
+  const double rt = ResponseTimeMs(params_.rt_ms, difference / sd);
   if (lapse_draw < params_.lapse) return {lapse_pick < 0.5 ? "left" : "right", rt};
-  return {v.r_left_px - v.r_right_px + params_.jnd_px * noise > 0 ? "left" : "right", rt};
+  return {difference + side + sd * noise > 0 ? "left" : "right", rt};
 }
 
 KeyPress SimulatedObserver::ChooseOdd(const PairView& v, int intervals, int odd) {
   // Every interval is seen with its own noise; the odd one is the one farthest from the mean of the others.
+  const double look = LookSd(), odd_seen = Seen(v.r_right_px, v), other_seen = Seen(v.r_left_px, v);
   std::vector<double> seen(size_t(std::max(intervals, 1)));
-  for (size_t i = 0; i < seen.size(); ++i)
-    seen[i] = (int(i) + 1 == odd ? v.r_right_px : v.r_left_px) + params_.jnd_px * Normal();
+  for (size_t i = 0; i < seen.size(); ++i) seen[i] = (int(i) + 1 == odd ? odd_seen : other_seen) + look * Normal();
   const double lapse_draw = Uniform(), lapse_pick = Uniform();
-  const double rt = ResponseTimeMs(params_.rt_ms);
+  const double rt = ResponseTimeMs(params_.rt_ms, (odd_seen - other_seen) / CompareSd());
   const int n = int(seen.size());
   if (lapse_draw < params_.lapse) return {std::to_string(1 + std::min(n - 1, int(lapse_pick * n))), rt};
   double total = 0;
@@ -103,21 +227,23 @@ KeyPress SimulatedObserver::ChooseOdd(const PairView& v, int intervals, int odd)
 }
 
 KeyPress SimulatedObserver::SayYesNo(const PairView& v) {
-  const double evidence = std::abs(v.r_left_px - v.r_scene_px) + params_.jnd_px * Normal();
+  const double sd = CompareSd(), mismatch = std::abs(Seen(v.r_left_px, v) - Seen(v.r_scene_px, v));
+  const double evidence = mismatch + sd * Normal();
   const double lapse_draw = Uniform(), lapse_pick = Uniform();
-  const double rt = ResponseTimeMs(params_.rt_ms);
+  const double rt = ResponseTimeMs(params_.rt_ms, mismatch / sd);
   if (lapse_draw < params_.lapse) return {lapse_pick < 0.5 ? "yes" : "no", rt};
-  return {evidence > params_.jnd_px / 2 ? "yes" : "no", rt};
+  return {evidence > sd / 2 ? "yes" : "no", rt};
 }
 
 KeyPress SimulatedObserver::Rate(const PairView& v, int points) {
-  const double evidence = std::abs(v.r_left_px - v.r_scene_px) + params_.jnd_px * Normal();
+  const double sd = CompareSd(), mismatch = std::abs(Seen(v.r_left_px, v) - Seen(v.r_scene_px, v));
+  const double evidence = mismatch + sd * Normal();
   const double lapse_draw = Uniform(), lapse_pick = Uniform();
-  const double rt = ResponseTimeMs(params_.rt_ms);
+  const double rt = ResponseTimeMs(params_.rt_ms, mismatch / sd);
   const int n = std::max(points, 1);
   if (lapse_draw < params_.lapse) return {std::to_string(1 + std::min(n - 1, int(lapse_pick * n))), rt};
   int rating = 1;
-  for (int j = 1; j < n; ++j) rating += evidence > j * params_.jnd_px / 2;
+  for (int j = 1; j < n; ++j) rating += evidence > j * sd / 2;
   return {std::to_string(rating), rt};
 }
 

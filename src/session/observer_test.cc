@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <random>
 
@@ -14,8 +15,10 @@ namespace {
 
 double Phi(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
 
+// The pixel model's parameters (every record before model= existed names jnd): read as model=pixel.
 TEST(ObserverParams, ParsesNamesAndKeepsDefaults) {
   const ObserverParams p = ParseObserver("sim:jnd=0.4,lapse=0,rt=700");
+  EXPECT_EQ(p.model, ObserverModel::kPixel);
   EXPECT_DOUBLE_EQ(p.jnd_px, 0.4);
   EXPECT_DOUBLE_EQ(p.lapse, 0);
   EXPECT_DOUBLE_EQ(p.rt_ms, 700);
@@ -36,8 +39,15 @@ TEST(ObserverParams, RejectsUnknownNamesAndImpossibleValues) {
   }
 }
 
+// Pixel-model parameter set for the tests of the old model.
+ObserverParams Pixel() {
+  ObserverParams p;
+  p.model = ObserverModel::kPixel;
+  return p;
+}
+
 TEST(SimulatedObserver, SameSeedSameAnswers) {
-  const ObserverParams p;
+  const ObserverParams p = Pixel();
   SimulatedObserver a(p, 42), b(p, 42), c(p, 43);
   int differ = 0;
   for (int i = 0; i < 200; ++i) {
@@ -52,7 +62,7 @@ TEST(SimulatedObserver, SameSeedSameAnswers) {
 
 // The choice probabilities match the model's closed form: P(left) = P(D > c) with D ~ N(delta, jnd), c = jnd / 2.
 TEST(SimulatedObserver, ChoiceRatesMatchTheModel) {
-  ObserverParams p;
+  ObserverParams p = Pixel();
   p.jnd_px = 0.6;
   p.bias_px = 0;
   p.lapse = 0;
@@ -74,7 +84,7 @@ TEST(SimulatedObserver, ChoiceRatesMatchTheModel) {
 // One object: yes when e = m + N(0, jnd) exceeds jnd / 2 (m its mismatch with the scene), so P(yes) =
 // 1 - Phi((jnd / 2 - m) / jnd); a rating counts the criteria k jnd / 2 that e exceeds.
 TEST(SimulatedObserver, YesNoAndRatingRatesMatchTheModel) {
-  ObserverParams p;
+  ObserverParams p = Pixel();
   p.jnd_px = 0.6;
   p.lapse = 0;
   SimulatedObserver o(p, 11);
@@ -98,7 +108,7 @@ TEST(SimulatedObserver, YesNoAndRatingRatesMatchTheModel) {
 // Odd one out: with no difference every interval is named 1/n of the time; with a difference the odd one is found as
 // often as an independent simulation of the same rule finds it, and more often the larger the difference.
 TEST(SimulatedObserver, OddOneOutRatesMatchAnIndependentSimulation) {
-  ObserverParams p;
+  ObserverParams p = Pixel();
   p.jnd_px = 0.5;
   p.lapse = 0;
   SimulatedObserver o(p, 5);
@@ -119,8 +129,9 @@ TEST(SimulatedObserver, OddOneOutRatesMatchAnIndependentSimulation) {
       found += d2 > d1 && d2 > d3;
     }
     EXPECT_NEAR(named[2] / double(draws), found / double(draws), 6 * se) << "delta " << delta;
-    if (delta == 0)
+    if (delta == 0) {
       for (int k = 1; k <= 3; ++k) EXPECT_NEAR(named[k] / double(draws), 1.0 / 3, 4 * se);
+    }
     EXPECT_GE(named[2] / double(draws), previous);
     previous = named[2] / double(draws);
   }
@@ -128,7 +139,7 @@ TEST(SimulatedObserver, OddOneOutRatesMatchAnIndependentSimulation) {
 }
 
 TEST(SimulatedObserver, LapsesAnswerAtRandomAndBiasFavoursTheBlurredSide) {
-  ObserverParams p;
+  ObserverParams p = Pixel();
   p.jnd_px = 0.01;  // practically noiseless
   p.bias_px = 0;
   p.lapse = 0.3;
@@ -179,6 +190,248 @@ TEST(SimulatedObserver, AdjustmentAcceptsTheLevelNearestItsTarget) {
       EXPECT_LE(presses.size(), levels.size() * 3 / 2 + 1);
     }
   }
+}
+
+// ---- model=arcmin ----
+
+// The model's closed form written out here, apart from observer.cc: s the Gaussian std (arcmin), E the seen blur.
+double SeenBlur(double s, double s_i, double p) { return std::pow(std::pow(s, p) + std::pow(s_i, p), 1 / p); }
+double Correct2afc(double s_a, double s_b, double s_i, double w, double p) {
+  return Phi(0.6744897501960817 * std::abs(std::log(SeenBlur(s_a, s_i, p) / SeenBlur(s_b, s_i, p))) / std::log(1 + w));
+}
+
+TEST(ArcminObserver, ProbabilityIsTheClosedFormOnRadiiTwiceTheStd) {
+  for (double p_exp : {1.0, 2.0, 3.5}) {
+    ObserverParams p;
+    p.exponent = p_exp;
+    p.intrinsic_arcmin = 0.8;
+    p.weber = 0.4;
+    for (double a : {0.0, 0.3, 1.0, 2.5, 9.0})
+      for (double b : {0.0, 0.2, 1.1, 4.0, 12.0})
+        // r = 2 s: the radii given are twice the stds the literature's law is written in.
+        EXPECT_NEAR(ProbabilityCorrect2afc(p, a, b), Correct2afc(a / 2, b / 2, 0.8, 0.4, p_exp), 1e-12)
+            << a << " vs " << b << ", exponent " << p_exp;
+    EXPECT_DOUBLE_EQ(ProbabilityCorrect2afc(p, 3, 3), 0.5);
+  }
+}
+
+// The dipper: P = 75 % exactly at the threshold increment; for p = 2 the threshold at zero reference is
+// 2 s_i sqrt((1+w)^2 - 1), the dip lies at s = s_i / (1+w) with depth 2 s_i ((1+w) - 1/(1+w)) (in r = 2 s), and far
+// above the intrinsic blur the threshold grows as w times the reference (Weber's law).
+TEST(ArcminObserver, DipperMatchesItsClosedForm) {
+  ObserverParams p;
+  p.intrinsic_arcmin = 0.7;
+  p.weber = 0.35;
+  const double si = 0.7, w = 0.35;
+  for (double exponent : {1.5, 2.0, 3.0}) {
+    p.exponent = exponent;
+    for (double r : {0.0, 0.4, 1.0, 3.0, 10.0, 40.0})
+      EXPECT_NEAR(ProbabilityCorrect2afc(p, r, r + DiscriminationThresholdArcmin(p, r)), 0.75, 1e-9) << r;
+  }
+  p.exponent = 2;
+  EXPECT_NEAR(DiscriminationThresholdArcmin(p, 0), 2 * si * std::sqrt((1 + w) * (1 + w) - 1), 1e-12);
+  // The dip found by a scan of the function, against the closed form.
+  double best_r = 0, best = 1e9;
+  for (double r = 0; r < 5; r += 1e-4)
+    if (const double t = DiscriminationThresholdArcmin(p, r); t < best) best = t, best_r = r;
+  EXPECT_NEAR(best_r, 2 * si / (1 + w), 2e-4);
+  EXPECT_NEAR(best, 2 * si * ((1 + w) - 1 / (1 + w)), 1e-7);
+  EXPECT_LT(best, DiscriminationThresholdArcmin(p, 0));  // a dip below the detection threshold ...
+  EXPECT_NEAR(DiscriminationThresholdArcmin(p, 2000) / 2000, w, 1e-3);  // ... and Weber's law far above it
+}
+
+// Published threshold-vs-reference-blur points: the model with its default parameters reproduces them within the
+// scatter between observers.
+//
+// The points (Gaussian std, arcmin: reference blur -> 75 % discrimination increment) are approximate values of the
+// dipper in Mather & Smith 2002 (Perception 31:1211-1219, their figure of blur-discrimination threshold against
+// reference blur, edges, observers' mean) and of the data Watson & Ahumada 2011 (J. Vision 11(5):10) review: a threshold of about 0.5 arcmin on a sharp edge, a dip to about 0.3-0.4 arcmin
+// near a reference of 0.5 arcmin, then a near-Weber rise to about 1.5 arcmin at 4 arcmin. They were typed in from
+// the shape of those figures as we recall it, without the papers at hand to digitise - not measured values: check
+// them against the figures before citing this test as a validation. The tolerance, a factor of 1.5 either way, is
+// about the spread between observers in such data; the unit matters: the model is given blurcue radii r = 2 s and its
+// increments are halved back to stds, so confusing r with s (a factor 2) fails here.
+TEST(ArcminObserver, ReproducesPublishedThresholdsWithinTheirScatter) {
+  const ObserverParams p;  // the defaults
+  struct Point {
+    double reference_std, threshold_std;
+  };
+  const Point points[] = {{0.0, 0.5}, {0.5, 0.35}, {1.0, 0.45}, {2.0, 0.8}, {4.0, 1.5}};
+  for (const Point& pt : points) {
+    const double model_std = DiscriminationThresholdArcmin(p, 2 * pt.reference_std) / 2;
+    EXPECT_LE(model_std, pt.threshold_std * 1.5) << "reference " << pt.reference_std << " arcmin";
+    EXPECT_GE(model_std, pt.threshold_std / 1.5) << "reference " << pt.reference_std << " arcmin";
+  }
+  // The defaults sit in the ranges the literature gives: intrinsic blur 0.5-1 arcmin, Weber fraction 0.3-0.6.
+  EXPECT_GE(p.intrinsic_arcmin, 0.5);
+  EXPECT_LE(p.intrinsic_arcmin, 1.0);
+  EXPECT_GE(p.weber, 0.3);
+  EXPECT_LE(p.weber, 0.6);
+}
+
+// Simulated "which is more blurred?" answers against the analytic probability: P(1 - lapse) + lapse / 2.
+TEST(ArcminObserver, ChoiceRatesMatchTheAnalyticProbability) {
+  ObserverParams p;
+  p.lapse = 0.06;
+  SimulatedObserver o(p, 21);
+  const double arcmin_per_px = 0.8;
+  const int draws = 8000;
+  const double se = std::sqrt(0.25 / draws);
+  for (const auto& [a, b] : {std::pair{1.0, 1.0}, {1.0, 1.5}, {2.0, 3.0}, {6.0, 7.0}, {0.2, 2.0}}) {
+    const PairView v{b, a, 0, arcmin_per_px};  // left the more blurred (or equal)
+    int left = 0;
+    for (int i = 0; i < draws; ++i) left += o.ChooseBlurrier(v).action == "left";
+    const double truth = Correct2afc(b * arcmin_per_px / 2, a * arcmin_per_px / 2, p.intrinsic_arcmin, p.weber, 2);
+    EXPECT_NEAR(left / double(draws), truth * (1 - p.lapse) + p.lapse / 2, 4 * se) << a << " vs " << b << " px";
+  }
+}
+
+// "Which fits the scene?" in arcmin: each side's mismatch m = |ln E(side) - ln E(scene)|; left when D = m_right -
+// m_left + blurrier bias + noise exceeds half the comparison's noise sd ln(1+w) / z75, right below minus half.
+TEST(ArcminObserver, MismatchChoiceRatesMatchTheModel) {
+  ObserverParams p;
+  p.lapse = 0;
+  p.blurrier_bias = 0;
+  SimulatedObserver o(p, 17);
+  const double sd = std::log(1 + p.weber) / 0.6744897501960817, k = 1.25;  // k arcmin per px
+  const int draws = 8000;
+  const double se = std::sqrt(0.25 / draws);
+  auto ln_e = [&](double r_px) { return std::log(SeenBlur(r_px * k / 2, p.intrinsic_arcmin, 2)); };
+  for (double off : {0.0, 0.6, 2.0}) {
+    const PairView v{2.0, 2.0 + off, 2.0, k};  // left matches the scene
+    std::map<std::string, int> n;
+    for (int i = 0; i < draws; ++i) ++n[o.ChooseSide(v).action];
+    const double delta = std::abs(ln_e(2.0 + off) - ln_e(2.0));
+    EXPECT_NEAR(n["left"] / double(draws), 1 - Phi((sd / 2 - delta) / sd), 4 * se) << off;
+    EXPECT_NEAR(n["right"] / double(draws), Phi((-sd / 2 - delta) / sd), 4 * se) << off;
+  }
+}
+
+// What the eye gets decides: the same arcmin shown with other px (a photo scaled down, a monitor farther away) is
+// answered the same, seed for seed; the same px at a third of the angle is harder
+// where the blurs are near the intrinsic blur.
+TEST(ArcminObserver, AnswersDependOnVisualAngleNotPixels) {
+  const ObserverParams p;
+  SimulatedObserver a(p, 5), b(p, 5);
+  for (int i = 0; i < 300; ++i) {
+    const KeyPress x = a.ChooseBlurrier({4.0, 3.0, 0, 0.5}), y = b.ChooseBlurrier({2.0, 1.5, 0, 1.0});
+    EXPECT_EQ(x.action, y.action);
+    EXPECT_NEAR(x.after_ms, y.after_ms, 1e-9);
+  }
+  // Near the intrinsic blur a third of the angle sinks the difference into it (66 % -> 52 %).
+  EXPECT_GT(ProbabilityCorrect2afc(p, {1.0, 0.5, 0, 1.0}), ProbabilityCorrect2afc(p, {1.0, 0.5, 0, 1.0 / 3}) + 0.1);
+  EXPECT_THROW(ProbabilityCorrect2afc(p, {4.0, 3.0, 0, 0}), Error);  // the angle unknown: no answer in arcmin
+}
+
+TEST(ArcminObserver, SideBiasFavoursTheLeftByItsNoiseSds) {
+  ObserverParams p;
+  p.lapse = 0;
+  p.side_bias = 1;
+  SimulatedObserver o(p, 3);
+  const int draws = 8000;
+  int left = 0;
+  for (int i = 0; i < draws; ++i) left += o.ChooseBlurrier({2.0, 2.0, 0, 1.0}).action == "left";
+  EXPECT_NEAR(left / double(draws), Phi(1), 4 * std::sqrt(0.25 / draws));  // equal blurs: bias over unit noise
+}
+
+// Response times: log-normal around rt for an easy trial, (1 + rthard) rt for one it cannot see (d' = 0).
+TEST(ArcminObserver, HardTrialsTakeLonger) {
+  ObserverParams p;
+  p.lapse = 0;
+  SimulatedObserver o(p, 8);
+  std::vector<double> hard, easy;
+  for (int i = 0; i < 4001; ++i) {
+    hard.push_back(o.ChooseBlurrier({2.0, 2.0, 0, 1.0}).after_ms);
+    easy.push_back(o.ChooseBlurrier({40.0, 2.0, 0, 1.0}).after_ms);
+  }
+  std::nth_element(hard.begin(), hard.begin() + 2000, hard.end());
+  std::nth_element(easy.begin(), easy.begin() + 2000, easy.end());
+  // The median of 4001 log-normal draws (sd 0.3) is within 3 % of the true median with high probability.
+  EXPECT_NEAR(hard[2000] / (p.rt_ms * (1 + p.rt_hard)), 1, 0.03);
+  EXPECT_NEAR(easy[2000] / p.rt_ms, 1, 0.03);
+}
+
+TEST(ObserverParams, ArcminModelIsTheDefaultAndEveryFormReadsBack) {
+  const ObserverParams d = ParseObserver("sim");
+  EXPECT_EQ(d.model, ObserverModel::kArcmin);
+  EXPECT_EQ(ToString(d), "sim:model=arcmin,intrinsic=0.6,weber=0.35,exponent=2,side=0,blurrier=0.3,rthard=0.5,"
+                         "lapse=0.04,rt=900,step=350,cutoff1m=14,slope=-0.8,sdlog=0.15,tol=0.1");
+  const ObserverParams q = ParseObserver("sim:intrinsic=0.9,weber=0.123456789,exponent=3,side=-0.5,lapse=0");
+  EXPECT_EQ(q.model, ObserverModel::kArcmin);
+  EXPECT_DOUBLE_EQ(q.weber, 0.123456789);
+  EXPECT_EQ(ToString(ParseObserver(ToString(q))), ToString(q));
+  EXPECT_DOUBLE_EQ(ParseObserver(ToString(q)).weber, 0.123456789);  // the recorded text is the observer that ran
+  const ObserverParams px = ParseObserver("sim:model=pixel");
+  EXPECT_EQ(ToString(px), "sim:model=pixel,jnd=0.6,bias=0.2,lapse=0.04,rt=900,step=350,cutoff1m=14,slope=-0.8,"
+                          "sdlog=0.15,tol=0.1");
+  // The form every record before model= existed holds reads as the pixel observer it was.
+  EXPECT_EQ(ToString(ParseObserver("sim:jnd=0.6,bias=0.2,lapse=0.04,rt=900,step=350,cutoff1m=14,slope=-0.8,"
+                                   "sdlog=0.15,tol=0.1")),
+            ToString(px));
+}
+
+TEST(ObserverParams, RejectsEveryBadValueWithOneLineNamingIt) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"sim:intrinsic=0", "--observer intrinsic must be in (0, 60]"},
+      {"sim:intrinsic=nan", "--observer intrinsic must be a number, got 'nan'"},
+      {"sim:weber=1e308", "--observer weber must be in (0, 10], got '1e308'"},
+      {"sim:weber=-1", "--observer weber must be in (0, 10], got '-1'"},
+      {"sim:exponent=", "--observer exponent must be a number, got ''"},
+      {"sim:side=inf", "--observer side must be a number"},
+      {"sim:rthard=-1", "--observer rthard must be in 0..100"},
+      {"sim:rt=1e308", "--observer rt must be in (0, 600000] ms, got '1e308'"},
+      {"sim:model=pixel,weber=0.3", "--observer weber belongs to model=arcmin, not model=pixel"},
+      {"sim:model=arcmin,jnd=0.3", "--observer jnd belongs to model=pixel, not model=arcmin"},
+      {"sim:model=retina", "--observer model must be arcmin or pixel, got 'retina'"},
+      {"sim:lapse=0.1,lapse=0.2", "--observer lapse is given twice"},
+      {"sim:", "--observer: an empty parameter"},
+      {"sim:lapse=0,", "--observer: an empty parameter"},
+      {"sim:weber", "--observer weber must be a number, got ''"},
+      {"sim:sharpness=2", "--observer: unknown parameter 'sharpness'"},
+  };
+  for (const auto& [spec, message] : cases) {
+    try {
+      ParseObserver(spec);
+      ADD_FAILURE() << spec << " was accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::kUsage) << spec;
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << spec << ": " << e.what();
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << spec;
+    }
+  }
+}
+
+// model=pixel is the observer of old, answer for answer: every task's presses over a grid of views and seeds, as text,
+// against the hash of the same text from the observer as it was before model= existed (observer.cc at commit afd7490,
+// built apart with this very loop: 8772 characters, FNV-1a ee6e6e56d9f704ca). A record made with a seed then is the
+// record the pixel model makes now.
+TEST(SimulatedObserver, PixelModelAnswersAsTheObserverBeforeIt) {
+  ObserverParams p;
+  p.model = ObserverModel::kPixel;
+  std::string out;
+  char text[64];
+  auto add = [&](const KeyPress& k) {
+    std::snprintf(text, sizeof text, "%s@%.6f;", k.action.c_str(), k.after_ms);
+    out += text;
+  };
+  for (uint64_t seed = 1; seed <= 40; ++seed) {
+    SimulatedObserver o(p, seed);
+    const double d = 0.1 * double(seed % 9);
+    const PairView v{1.5 + d, 1.5 + d * d, 1.5 + 0.2 * d};
+    add(o.ChooseSide(v));
+    add(o.ChooseSide(v, false));
+    add(o.ChooseBlurrier(v));
+    add(o.ChooseOdd(v, 3, 2));
+    add(o.ChooseOdd(v, 4, 1));
+    add(o.SayYesNo(v));
+    add(o.Rate(v, 5));
+    for (const KeyPress& k : o.Adjust({11.6, 2.0, 47.2, 4.8, 80.0, 8.2, 23.4}, int(seed % 7), 0.4 + 0.1 * double(seed)))
+      add(k);
+  }
+  uint64_t hash = 1469598103934665603ULL;
+  for (unsigned char c : out) hash = (hash ^ c) * 1099511628211ULL;
+  EXPECT_EQ(out.size(), 8772u);
+  EXPECT_EQ(hash, 0xee6e6e56d9f704caULL) << out.substr(0, 200);
 }
 
 }  // namespace

@@ -24,6 +24,7 @@
 #include "render/frame_compositor.h"
 #include "render/gl_context.h"
 #include "session/adaptive.h"
+#include "session/answer.h"
 #include "session/observer.h"
 #include "session/prepare.h"
 #include "session/screens.h"
@@ -172,15 +173,6 @@ std::string Clock(double seconds) {
   return text;
 }
 
-// The observer of one trial: seeded by the session seed and the trial index, so a resumed session answers
-// exactly as an uninterrupted one.
-uint64_t TrialSeed(uint64_t seed, int index) {
-  uint64_t z = seed + 0x9e3779b97f4a7c15ULL * uint64_t(index + 1);  // splitmix64
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-
 enum class Outcome { kAnswered, kQuit };
 
 // Whether `choice` answered `trial` correctly, where a trial has a correct answer: a procedure's test side or an odd
@@ -323,23 +315,18 @@ class Runner {
     return Title("trial " + std::to_string(trial.index + 1) + " of " + std::to_string(trials_.size()));
   }
 
-  // The simulated observer's key presses for a trial whose stimulus appeared at `onset`.
+  // The simulated observer's key presses for a trial whose stimulus appeared at `onset` (AnswerTrial, as a plan).
   void ScriptObserver(const protocol::Trial& trial, const TrialScene& scene, double onset) {
     SimulatedObserver observer(*observer_, TrialSeed(seed_, trial.index));
+    const std::vector<KeyPress> presses = AnswerTrial(observer, protocol_, trial, scene, prepared_.presentation);
     if (trial.task != Task::kAdjustment) {
-      const PairView view{scene.r_left_px, scene.r_right_px, scene.r_scene_px};
-      const KeyPress press = trial.task == Task::kYesNo    ? observer.SayYesNo(view)
-                             : trial.task == Task::kRating ? observer.Rate(view, int(protocol_.responses.rating.size()))
-                             : scene.intervals > 2 ? observer.ChooseOdd(view, scene.intervals, std::stoi(trial.test_side))
-                             // A procedure, or practice scored by a criterion: "which side is more blurred?"
-                             : trial.cell >= 0 || trial.round >= 0 ? observer.ChooseBlurrier(view)
-                                                   : observer.ChooseSide(view, !protocol_.responses.cant_tell.empty());
       // A moving stimulus is watched to its end before the answer (task 1 is one answer per run); intervals too.
-      station_.Script(keys_.Key(press.action, trial.task), onset + StimulusEndS(scene) + press.after_ms / 1000);
+      for (const KeyPress& press : presses)
+        station_.Script(keys_.Key(press.action, trial.task), onset + StimulusEndS(scene) + press.after_ms / 1000);
       return;
     }
     double t = onset;
-    for (const KeyPress& press : observer.Adjust(trial.adjust_levels, trial.start_index, scene.distance_m)) {
+    for (const KeyPress& press : presses) {
       t += press.after_ms / 1000;
       station_.Script(keys_.Key(press.action, trial.task), t);
     }

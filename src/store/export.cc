@@ -258,7 +258,7 @@ const std::vector<ColumnDef>& TrialColumnsBefore() {
       {"protocol_hash", "string", "", "16 hex digits", "FNV-1a-64 of the protocol's canonical text: its version"},
       {"participant", "string", "", "", "the participant's id"},
       {"observer", "string", "", "person|simulated", "who answered: a person, or blurcue's simulated observer"},
-      {"observer_params", "string", "", "", "the simulated observer's parameters (sim:jnd=...); empty for a person"},
+      {"observer_params", "string", "", "", "the simulated observer's parameters (sim:model=arcmin,... or sim:model=pixel,...; before model= existed sim:jnd=..., the pixel model); empty for a person"},
       {"window", "boolean", "", "0|1", "1: shown in a real window on the real clock; 0: headless on a simulated clock"},
       {"session_id", "integer", "", ">= 1", "the session's id in this record (merged records renumber it)"},
       {"session_number", "integer", "", ">= 1", "the participant's n-th session of this study, in the order started"},

@@ -1,0 +1,31 @@
+#pragma once
+// What a simulated observer answers to a trial, from the trial and what it shows - the one place `blurcue run`
+// (headless or in a window) and `blurcue plan` (many simulated sessions, no GL) get their simulated answers from, so
+// a plan predicts the answers a run records.
+#include <cstdint>
+#include <vector>
+
+#include "protocol/protocol.h"
+#include "protocol/trials.h"
+#include "session/observer.h"
+#include "session/stimulus.h"
+
+namespace blurcue::session {
+
+// The seed of the observer of one trial: from the session seed and the trial index (splitmix64), so a resumed
+// session answers exactly as an uninterrupted one, and a plan as a run.
+uint64_t TrialSeed(uint64_t session_seed, int trial_index);
+
+// The key presses a simulated observer makes for a trial whose stimulus is `scene` (after ApplyLevel for a procedure's
+// trial): the single answer, or the adjustment's presses. The task decides the question: yes/no and rating judge the
+// one object against the scene; an odd-one-out trial names an interval; a procedure's trial or a practice run to a
+// criterion asks "which side is more blurred?"; other pairs "which fits the scene?" (with can't tell when the
+// protocol has its key). The presentation gives the arcmin per photo px the arcmin model sees.
+std::vector<KeyPress> AnswerTrial(SimulatedObserver& observer, const protocol::Protocol& protocol,
+                                  const protocol::Trial& trial, const TrialScene& scene,
+                                  const Presentation& presentation);
+
+// What the observer sees of a trial's pair: its radii (photo px) and arcmin per photo px on this presentation.
+PairView ViewOf(const TrialScene& scene, const Presentation& presentation);
+
+}  // namespace blurcue::session

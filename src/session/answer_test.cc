@@ -1,0 +1,93 @@
+#include "session/answer.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace blurcue::session {
+namespace {
+
+double Phi(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
+
+// A presentation of `scale` screen px per photo px on the default monitor (24-inch 1920 x 1080 at 60 cm).
+Presentation At(double scale) {
+  Presentation p;
+  p.scale = scale;
+  return p;
+}
+
+// The task decides the question: each trial gets the answer of the observer method its task names, from the same
+// seed, and nothing else.
+TEST(AnswerTrial, EachTaskAsksItsQuestion) {
+  protocol::Protocol protocol;
+  protocol.responses.cant_tell = "Down";
+  protocol.responses.rating = {"1", "2", "3", "4", "5"};
+  TrialScene scene;
+  scene.r_left_px = 2.0, scene.r_right_px = 2.6, scene.r_scene_px = 2.1;
+  const Presentation shown = At(0.9);
+  const PairView view = ViewOf(scene, shown);
+  EXPECT_DOUBLE_EQ(view.arcmin_per_px, shown.Arcmin(1));
+  const ObserverParams params;
+  for (uint64_t seed = 1; seed <= 30; ++seed) {
+    protocol::Trial trial;
+    auto answer = [&](const protocol::Trial& t, const TrialScene& s) {
+      SimulatedObserver o(params, seed);
+      const auto presses = AnswerTrial(o, protocol, t, s, shown);
+      EXPECT_EQ(presses.size(), 1u);
+      return presses.front().action;
+    };
+    trial.task = protocol::Task::kForcedChoice;  // "which fits the scene?", can't tell allowed
+    EXPECT_EQ(answer(trial, scene), SimulatedObserver(params, seed).ChooseSide(view, true).action);
+    trial.cell = 0;  // a procedure's trial: "which is more blurred?"
+    EXPECT_EQ(answer(trial, scene), SimulatedObserver(params, seed).ChooseBlurrier(view).action);
+    trial.cell = -1;
+    trial.task = protocol::Task::kYesNo;
+    EXPECT_EQ(answer(trial, scene), SimulatedObserver(params, seed).SayYesNo(view).action);
+    trial.task = protocol::Task::kRating;
+    EXPECT_EQ(answer(trial, scene), SimulatedObserver(params, seed).Rate(view, 5).action);
+    trial.task = protocol::Task::kForcedChoice;
+    trial.test_side = "3";
+    TrialScene odd = scene;
+    odd.intervals = 4;
+    EXPECT_EQ(answer(trial, odd), SimulatedObserver(params, seed).ChooseOdd(view, 4, 3).action);
+  }
+}
+
+// Through AnswerTrial the arcmin observer sees what the presentation shows: the same photo radii shown at a quarter of
+// the scale are told apart less often, and each rate is the model's probability.
+TEST(AnswerTrial, SeesTheRadiiAtThePresentationsScale) {
+  protocol::Protocol protocol;
+  protocol::Trial trial;
+  trial.cell = 0;
+  TrialScene scene;
+  scene.r_left_px = 1.0, scene.r_right_px = 0.5;
+  ObserverParams params;
+  params.lapse = 0;
+  const int draws = 6000;
+  const double se = std::sqrt(0.25 / draws);
+  double rate[2];
+  for (int k = 0; k < 2; ++k) {
+    const Presentation shown = At(k == 0 ? 1.0 : 0.25);
+    int left = 0;
+    for (int i = 0; i < draws; ++i) {
+      SimulatedObserver o(params, TrialSeed(11, i));
+      left += AnswerTrial(o, protocol, trial, scene, shown).front().action == "left";
+    }
+    rate[k] = left / double(draws);
+    // The model written out: s = r / 2 in arcmin, E = sqrt(s^2 + s_i^2), P = Phi(z75 ln(E_l / E_r) / ln(1 + w)).
+    const double k_arcmin = shown.Arcmin(1);
+    auto e = [&](double r_px) { return std::hypot(r_px * k_arcmin / 2, params.intrinsic_arcmin); };
+    const double truth = Phi(0.6744897501960817 * std::log(e(1.0) / e(0.5)) / std::log(1 + params.weber));
+    EXPECT_NEAR(rate[k], truth, 4 * se) << "scale " << shown.scale;
+  }
+  EXPECT_GT(rate[0], rate[1] + 0.05);
+}
+
+TEST(AnswerTrial, SeedsDifferPerTrialAndRepeat) {
+  EXPECT_EQ(TrialSeed(5, 3), TrialSeed(5, 3));
+  EXPECT_NE(TrialSeed(5, 3), TrialSeed(5, 4));
+  EXPECT_NE(TrialSeed(5, 3), TrialSeed(6, 3));
+}
+
+}  // namespace
+}  // namespace blurcue::session

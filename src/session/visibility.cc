@@ -1,0 +1,89 @@
+#include "session/visibility.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include "session/adaptive.h"
+#include "session/answer.h"
+
+namespace blurcue::session {
+
+std::string LevelsLabel(const protocol::Trial& t) {
+  std::string levels;
+  for (const auto& [name, value] : t.levels.items())
+    levels += (levels.empty() ? "" : " ") + name + " " +
+              (value.is_object() && value.contains("id") ? value["id"].dump() : value.dump());
+  return levels;
+}
+
+std::vector<PairVisibility> PairVisibilities(const PreparedSession& prepared, const ObserverParams& observer,
+                                             double level) {
+  const protocol::Protocol& p = prepared.protocol;
+  auto source = [](const Json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); };
+  std::vector<PairVisibility> pairs;
+  std::map<std::string, size_t> index;  // the pair's key -> its place in `pairs`
+  std::vector<Json> keys;                // per pair: its levels and sources, the order they are listed in
+  AdaptiveState adaptive(p);             // no answers yet: each procedure's first level
+  for (const protocol::Trial& t : prepared.trials) {
+    TrialScene s = prepared.scenes[size_t(t.index)];
+    if (t.task == protocol::Task::kAdjustment || s.content == "picture") continue;
+    // Either side order is one pair: a swapped copy shows the same two blurs.
+    const std::string a = source(t.left), b = source(t.right);
+    Json key = t.levels;
+    key["sources"] = s.left_only ? Json::array({a}) : Json::array({std::min(a, b), std::max(a, b)});
+    if (const auto it = index.find(key.dump()); it != index.end()) {
+      ++pairs[it->second].trials;
+      continue;
+    }
+    std::string at = LevelsLabel(t);
+    if (t.cell >= 0) {
+      const protocol::Procedure& procedure = *protocol::BlockOf(p, t)->procedure;  // t.cell >= 0: it has one
+      const double first = adaptive.Level(t);
+      ApplyLevel(procedure, t, first, prepared.presentation, &s);
+      PlanOnScreen(p, *prepared.scene, prepared.presentation, &s);
+      at += (at.empty() ? "" : ", ") + std::string("the first ") + procedure.variable + " " + Json(first).dump();
+    }
+    PairVisibility pair;
+    PairView view = ViewOf(s, prepared.presentation);
+    if (s.left_only) {
+      // One object: does it look out of place - its blur against the scene's own there.
+      pair.what = "object " + a + " vs the scene";
+      view.r_right_px = view.r_scene_px;
+    } else {
+      pair.what = a + " vs " + b;
+    }
+    if (!at.empty()) pair.what += " at " + at;
+    pair.r_a_arcmin = prepared.presentation.Arcmin(view.r_left_px);
+    pair.r_b_arcmin = prepared.presentation.Arcmin(view.r_right_px);
+    pair.p_correct = ProbabilityCorrect2afc(observer, view);
+    pair.visible = pair.p_correct >= level;
+    pair.trials = 1;
+    index[key.dump()] = pairs.size();
+    pairs.push_back(pair);
+    keys.push_back(key);
+  }
+  // Listed by level (numbers as numbers: edge 2 before edge 10), not in the trial list's random order.
+  std::vector<size_t> order(pairs.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return keys[a] < keys[b]; });
+  std::vector<PairVisibility> sorted;
+  for (size_t i : order) sorted.push_back(pairs[i]);
+  return sorted;
+}
+
+std::string Describe(const PairVisibility& pair, const display::Profile& profile) {
+  char text[512];
+  std::snprintf(text, sizeof text, "%s: %.2f arcmin apart (%.2f' vs %.2f'), predicted %.0f %% correct%s",
+                pair.what.c_str(), std::abs(pair.r_a_arcmin - pair.r_b_arcmin), pair.r_a_arcmin, pair.r_b_arcmin,
+                100 * pair.p_correct, pair.visible ? "" : " - invisible at ");
+  std::string line = text;
+  if (!pair.visible) {
+    std::snprintf(text, sizeof text, "%g cm on this monitor", profile.distance_mm / 10);
+    line += text;
+  }
+  return line;
+}
+
+}  // namespace blurcue::session
