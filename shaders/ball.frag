@@ -22,12 +22,13 @@ layout(location = 0) out vec4 o_color;
 layout(location = 1) out vec4 o_depth;   // camera z (mm) of the surface, 0 where nothing is drawn
 
 // Where the ray through image point `px` (pixel centres at integers) meets the sphere: x = distance along the ray
-// direction (z = 1 units), y = the discriminant (< 0: a miss).
+// direction (z = 1 units), y = the discriminant (< 0: a miss; also when the sphere is not in front of the eye).
 vec2 Hit(vec2 px) {
   vec3 d = vec3((px - u_intrinsics.zw) / u_intrinsics.xy, 1.0);
   float b = dot(d, u_center), a = dot(d, d);
   float disc = b * b - a * (dot(u_center, u_center) - u_radius * u_radius);
-  return vec2((b - sqrt(max(disc, 0.0))) / a, disc);
+  float t = (b - sqrt(max(disc, 0.0))) / a;
+  return vec2(t, t > 0.0 ? disc : -1.0);  // a sphere behind the eye, or around it, is not seen
 }
 
 // The texture coordinates of the surface the ray through `px` meets (the nearest rim point where it misses):
