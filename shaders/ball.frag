@@ -4,6 +4,7 @@
 // its own ray's hit (gl_SampleMask), as a 4x multisampled mesh would give. The surface is shaded once per pixel from
 // the ray through its centre (or, where that misses, the nearest point of the rim): textured by the sphere's
 // longitude and latitude, simply lit; linear light, premultiplied alpha (the same colour terms as object.frag).
+// Nothing here depends on where the layer lies or on its neighbours: a pixel is the same in any layer.
 uniform sampler2D u_texture;     // sRGB equirectangular texture: sampling returns linear values
 uniform vec4 u_intrinsics;       // fx, fy, cx, cy (px)
 uniform vec2 u_origin;           // the layer's top-left pixel in the image (framebuffer row = image row)
@@ -21,12 +22,24 @@ layout(location = 0) out vec4 o_color;
 layout(location = 1) out vec4 o_depth;   // camera z (mm) of the surface, 0 where nothing is drawn
 
 // Where the ray through image point `px` (pixel centres at integers) meets the sphere: x = distance along the ray
-// direction (z = 1 units), y = the discriminant (< 0: a miss).
+// direction (z = 1 units), y = the discriminant (< 0: a miss; also when the sphere is not in front of the eye).
 vec2 Hit(vec2 px) {
   vec3 d = vec3((px - u_intrinsics.zw) / u_intrinsics.xy, 1.0);
   float b = dot(d, u_center), a = dot(d, d);
   float disc = b * b - a * (dot(u_center, u_center) - u_radius * u_radius);
-  return vec2((b - sqrt(max(disc, 0.0))) / a, disc);
+  float t = (b - sqrt(max(disc, 0.0))) / a;
+  return vec2(t, t > 0.0 ? disc : -1.0);  // a sphere behind the eye, or around it, is not seen
+}
+
+// The texture coordinates of the surface the ray through `px` meets (the nearest rim point where it misses):
+// longitude along u (its seam at u = 0 = 1), latitude along v (0 at the +z pole), as the texture is laid out; and in
+// .zw the camera-frame point's z and the discriminant.
+vec4 SurfaceAt(vec2 px, out vec3 p) {
+  vec3 d = vec3((px - u_intrinsics.zw) / u_intrinsics.xy, 1.0);
+  vec2 hit = Hit(px);
+  p = hit.x * d;
+  vec3 o = normalize(u_camera_to_object * (p - u_center));
+  return vec4(fract(atan(o.y, o.x) / 6.28318530718), acos(clamp(o.z, -1.0, 1.0)) / 3.14159265359, p.z, hit.y);
 }
 
 void main() {
@@ -34,23 +47,19 @@ void main() {
   int mask = 0;
   for (int i = 0; i < u_samples; ++i)
     if (Hit(corner + u_sample_at[i]).y >= 0.0) mask |= 1 << i;
-  vec2 centre = corner + 0.5;
-  vec3 d = vec3((centre - u_intrinsics.zw) / u_intrinsics.xy, 1.0);
-  vec3 p = Hit(centre).x * d;
-  vec3 n = normalize(p - u_center);
-  vec3 o = normalize(u_camera_to_object * (p - u_center));
-  // Longitude along u (its seam at u = 0 = 1), latitude along v (0 at the +z pole), as the texture is laid out. The
-  // mip level comes from u's derivative on whichever side of the seam it is continuous (Tarini's two
-  // parameterisations), so no line of the smallest mip shows along the seam.
-  float u1 = atan(o.y, o.x) / 6.28318530718;
-  float u0 = fract(u1);
-  float v = acos(clamp(o.z, -1.0, 1.0)) / 3.14159265359;
-  vec2 uv = vec2(u0, v), uv_alt = vec2(fract(u0 + 0.5) - 0.5, v);
-  vec2 dx = dFdx(uv), dy = dFdy(uv), dx_alt = dFdx(uv_alt), dy_alt = dFdy(uv_alt);
-  if (abs(dx_alt.x) + abs(dy_alt.x) < abs(dx.x) + abs(dy.x)) dx = dx_alt, dy = dy_alt;
-  vec4 t = textureGrad(u_texture, uv, dx, dy);
-  gl_SampleMask[0] = mask;
   if (mask == 0) discard;
+  gl_SampleMask[0] = mask;
+  vec2 centre = corner + 0.5;
+  vec3 p, p_x, p_y;
+  vec4 s = SurfaceAt(centre, p);
+  // The texture's footprint from the rays one pixel over, not from the GPU's 2 x 2 quads: a pixel's colour then
+  // depends on nothing but its own place (a ball drawn in a small layer and in a whole frame match), and u's step
+  // is taken the short way round the seam.
+  vec2 sx = SurfaceAt(centre + vec2(1.0, 0.0), p_x).xy - s.xy, sy = SurfaceAt(centre + vec2(0.0, 1.0), p_y).xy - s.xy;
+  sx.x = fract(sx.x + 0.5) - 0.5;
+  sy.x = fract(sy.x + 0.5) - 0.5;
+  vec4 t = textureGrad(u_texture, s.xy, sx, sy);
+  vec3 n = normalize(p - u_center);
   vec3 c = max((t.rgb - 0.18) * u_contrast + 0.18, 0.0) * u_brightness * u_white_balance;
   float shade = u_ambient + (1.0 - u_ambient) * max(dot(n, u_light_dir), 0.0);
   o_color = vec4(c * shade * t.a, t.a);

@@ -314,19 +314,17 @@ GlBlur::GlBlur()
 GlBlur::~GlBlur() = default;
 
 void GlBlur::BlurTexture(Texture& texture, const std::string& method, double r_px) {
-  CheckBlurRadius(r_px);  // before anything: a NaN radius would otherwise skip the blur and return the image as is
   const Framebuffer framebuffer(texture);
   Blur(texture, framebuffer.id(), texture.width_px(), texture.height_px(), method, r_px);
 }
 
 void GlBlur::BlurRegion(GrowingTarget& target, int w, int h, const std::string& method, double r_px) {
-  CheckBlurRadius(r_px);
   target.Reserve(w, h);
   Blur(target.texture(), target.framebuffer(), w, h, method, r_px);
 }
 
 void GlBlur::Blur(const Texture& texture, GLuint framebuffer, int w, int h, const std::string& method, double r_px) {
-  CheckBlurRadius(r_px);
+  CheckBlurRadius(r_px);  // before anything: a NaN radius would otherwise skip the blur and return the image as is
   GrowingTarget& scratch = *scratch_;
   if (method == "disc") {
     if (r_px <= 0) return;
