@@ -1,7 +1,8 @@
 #version 400 core
-// A ball traced, not tessellated: each pixel of the layer casts the camera's rays through its multisample positions
-// at the exact sphere, so the silhouette is the true projected outline (no polygon) and each sample's coverage is
-// its own ray's hit (gl_SampleMask), as a 4x multisampled mesh would give. The surface is shaded once per pixel from
+// A ball traced, not tessellated: each pixel of the layer casts the camera's rays through 4 x 4 points spread over
+// it at the exact sphere, so the silhouette is the true projected outline (no polygon) and the pixel's coverage is
+// the share of its rays that hit - what a 16x multisampled mesh would resolve to, with no multisample buffer to
+// clear or resolve. Every pixel of the layer is written (0 where nothing is hit). The surface is shaded once per pixel from
 // the ray through its centre (or, where that misses, the nearest point of the rim): textured by the sphere's
 // longitude and latitude, simply lit; linear light, premultiplied alpha (the same colour terms as object.frag).
 // Nothing here depends on where the layer lies or on its neighbours: a pixel is the same in any layer.
@@ -11,15 +12,13 @@ uniform vec2 u_origin;           // the layer's top-left pixel in the image (fra
 uniform vec3 u_center;           // the sphere's centre, camera frame (mm)
 uniform float u_radius;          // mm
 uniform mat3 u_camera_to_object; // camera-frame offsets from the centre -> the unit sphere's frame (spin undone)
-uniform int u_samples;           // samples per pixel
-uniform vec2 u_sample_at[16];    // each sample's position in its pixel (0..1 from the pixel's lower-left corner)
+uniform bool u_write_depth;      // write the depth layer (camera z x coverage, coverage) instead of the colour
 uniform vec3 u_light_dir;        // towards the light, camera frame, unit
 uniform float u_ambient;
 uniform float u_brightness;
 uniform float u_contrast;
 uniform vec3 u_white_balance;
-layout(location = 0) out vec4 o_color;
-layout(location = 1) out vec4 o_depth;   // camera z (mm) of the surface, 0 where nothing is drawn
+layout(location = 0) out vec4 o_layer;  // premultiplied colour x coverage; or camera z (mm) x coverage in .r
 
 // Where the ray through image point `px` (pixel centres at integers) meets the sphere: x = distance along the ray
 // direction (z = 1 units), y = the discriminant (< 0: a miss; also when the sphere is not in front of the eye).
@@ -44,14 +43,22 @@ vec4 SurfaceAt(vec2 px, out vec3 p) {
 
 void main() {
   vec2 corner = u_origin + floor(gl_FragCoord.xy) - 0.5;  // the pixel's lower-left corner in image coordinates
-  int mask = 0;
-  for (int i = 0; i < u_samples; ++i)
-    if (Hit(corner + u_sample_at[i]).y >= 0.0) mask |= 1 << i;
-  if (mask == 0) discard;
-  gl_SampleMask[0] = mask;
+  int hits = 0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+      if (Hit(corner + (vec2(i, j) + 0.5) / 4.0).y >= 0.0) ++hits;
+  float coverage = float(hits) / 16.0;
+  if (hits == 0) {
+    o_layer = vec4(0.0);
+    return;
+  }
   vec2 centre = corner + 0.5;
   vec3 p, p_x, p_y;
   vec4 s = SurfaceAt(centre, p);
+  if (u_write_depth) {
+    o_layer = vec4(p.z * coverage, 0.0, 0.0, coverage);
+    return;
+  }
   // The texture's footprint from the rays one pixel over, not from the GPU's 2 x 2 quads: a pixel's colour then
   // depends on nothing but its own place (a ball drawn in a small layer and in a whole frame match), and u's step
   // is taken the short way round the seam.
@@ -62,6 +69,5 @@ void main() {
   vec3 n = normalize(p - u_center);
   vec3 c = max((t.rgb - 0.18) * u_contrast + 0.18, 0.0) * u_brightness * u_white_balance;
   float shade = u_ambient + (1.0 - u_ambient) * max(dot(n, u_light_dir), 0.0);
-  o_color = vec4(c * shade * t.a, t.a);
-  o_depth = vec4(p.z, 0.0, 0.0, 1.0);
+  o_layer = vec4(c * shade * t.a, t.a) * coverage;
 }

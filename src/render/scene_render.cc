@@ -100,8 +100,7 @@ struct SceneRenderer::Impl {
   GlName vao, vbo, ebo;  // the unit card, indexed
   GLsizei card_indices = 0;
   BallShader ball_shader;
-  FullscreenPass pass;                  // a ball covers its layer with one triangle
-  std::vector<glm::vec2> sample_at;     // the multisample targets' sample positions in a pixel
+  FullscreenPass pass;  // a ball covers its layer with one triangle
   // Textures by their image: a moving ball re-uses its texture every frame. Each entry holds its image (a cv::Mat
   // shares the pixels), so those pixels stay allocated and their address cannot come back as another image's.
   struct CachedTexture {
@@ -150,15 +149,6 @@ struct SceneRenderer::Impl {
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, ms_depth.id());
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
       throw Error(ErrorKind::kInternal, "GL: multisample framebuffer incomplete");
-    // Where the samples lie in a pixel, as this GL places them: a traced ball tests its rays there.
-    GLint count = 1;
-    glGetIntegerv(GL_SAMPLES, &count);
-    sample_at.clear();
-    for (GLint i = 0; i < std::max(count, 1); ++i) {
-      GLfloat at[2] = {0.5f, 0.5f};
-      if (count > 1) glGetMultisamplefv(GL_SAMPLE_POSITION, GLuint(i), at);
-      sample_at.emplace_back(at[0], at[1]);
-    }
     return id;
   }
 };
@@ -333,9 +323,34 @@ GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px, boo
   impl_->color.Reserve(w, h);
   layer.color = &impl_->color;
   if (depth_map) impl_->depth.Reserve(w, h), layer.depth = &impl_->depth;
-  // Drawn multisampled (4x) and resolved, so silhouettes carry their pixel coverage like a camera's edges do (an aliased
-  // silhouette is sharper than any optics and reads ~0.3 px too sharp under the calibration's measurement). The
-  // targets are the renderer's own, made once; the scissor keeps the clear to this layer's part of them.
+  const glm::mat4 model_to_camera = pose * ModelMatrix(o);
+  // Light from above the table and behind the camera: camera frame has y down.
+  const glm::vec3 light = glm::normalize(glm::vec3(-0.3f, -1.0f, -0.6f));
+  const float ambient = 0.45f;
+  const glm::vec3 white_balance(float(o.white_balance[0]), float(o.white_balance[1]), float(o.white_balance[2]));
+  impl_->TextureFor(o.texture).Bind(0);
+  if (o.kind == VirtualObject::Kind::kBall) {
+    // Traced straight into the layer (its pixels' coverage from 16 rays each, no multisample buffer): the sphere's
+    // centre and the rotation back to its texture's frame (the spin); the depth layer in a second pass when asked.
+    BallShader& shader = impl_->ball_shader;
+    shader.Use()
+        .SetCamera(glm::vec4(float(k[0]), float(k[4]), float(k[2]), float(k[5])),
+                   glm::vec2(float(layer.roi.x), float(layer.roi.y)))
+        .SetSphere(glm::vec3(model_to_camera[3]), float(o.size_mm), glm::inverse(glm::mat3(model_to_camera)))
+        .SetLight(light, ambient)
+        .SetColour(float(o.brightness), float(o.contrast), white_balance);
+    for (GrowingTarget* target : {layer.color, layer.depth}) {
+      if (!target) continue;
+      shader.SetWriteDepth(target == layer.depth);
+      target->BindFor(w, h);
+      impl_->pass.Draw();
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    return layer;
+  }
+  // A card is drawn multisampled (4x) and resolved, so its outline carries its pixel coverage like a camera's edges
+  // do (an aliased outline is sharper than any optics and reads ~0.3 px too sharp under the calibration's
+  // measurement). The targets are the renderer's own, made once; the scissor keeps the clear to this layer's part.
   const GLuint ms_id = impl_->Targets(w, h);
   glBindFramebuffer(GL_FRAMEBUFFER, ms_id);
   const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
@@ -346,32 +361,14 @@ GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px, boo
   glClearColor(0, 0, 0, 0);
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  const glm::mat4 model_to_camera = pose * ModelMatrix(o);
-  // Light from above the table and behind the camera: camera frame has y down.
-  const glm::vec3 light = glm::normalize(glm::vec3(-0.3f, -1.0f, -0.6f));
-  const float ambient = 0.45f;
-  const glm::vec3 white_balance(float(o.white_balance[0]), float(o.white_balance[1]), float(o.white_balance[2]));
-  impl_->TextureFor(o.texture).Bind(0);
-  if (o.kind == VirtualObject::Kind::kBall) {
-    // Traced over the whole layer: the sphere's centre and the rotation back to its texture's frame (the spin).
-    impl_->ball_shader.Use()
-        .SetCamera(glm::vec4(float(k[0]), float(k[4]), float(k[2]), float(k[5])),
-                   glm::vec2(float(layer.roi.x), float(layer.roi.y)))
-        .SetSphere(glm::vec3(model_to_camera[3]), float(o.size_mm), glm::inverse(glm::mat3(model_to_camera)))
-        .SetSamples(impl_->sample_at)
-        .SetLight(light, ambient)
-        .SetColour(float(o.brightness), float(o.contrast), white_balance);
-    impl_->pass.Draw();
-  } else {
-    glEnable(GL_DEPTH_TEST);
-    impl_->shader.Use()
-        .SetModelToCamera(model_to_camera)  // one matrix made here, not per vertex
-        .SetProjection(projection)
-        .SetLight(light, ambient, false)
-        .SetColour(float(o.brightness), float(o.contrast), white_balance);
-    glBindVertexArray(impl_->vao.id());
-    glDrawElements(GL_TRIANGLES, impl_->card_indices, GL_UNSIGNED_INT, nullptr);
-  }
+  glEnable(GL_DEPTH_TEST);
+  impl_->shader.Use()
+      .SetModelToCamera(model_to_camera)  // one matrix made here, not per vertex
+      .SetProjection(projection)
+      .SetLight(light, ambient, false)
+      .SetColour(float(o.brightness), float(o.contrast), white_balance);
+  glBindVertexArray(impl_->vao.id());
+  glDrawElements(GL_TRIANGLES, impl_->card_indices, GL_UNSIGNED_INT, nullptr);
   glBindVertexArray(0);
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_SCISSOR_TEST);

@@ -1,7 +1,5 @@
 #include "render/shaders.h"
 
-#include <algorithm>
-
 #include <glm/gtc/type_ptr.hpp>
 
 namespace blurcue::render {
@@ -61,8 +59,7 @@ BallShader::BallShader()
       center_(program_.Uniform("u_center")),
       radius_(program_.Uniform("u_radius")),
       camera_to_object_(program_.Uniform("u_camera_to_object")),
-      samples_(program_.Uniform("u_samples")),
-      sample_at_(program_.Uniform("u_sample_at")),
+      write_depth_(program_.Uniform("u_write_depth")),
       light_dir_(program_.Uniform("u_light_dir")),
       ambient_(program_.Uniform("u_ambient")),
       brightness_(program_.Uniform("u_brightness")),
@@ -85,10 +82,8 @@ BallShader& BallShader::SetSphere(const glm::vec3& center, float radius_mm, cons
   glUniformMatrix3fv(camera_to_object_, 1, GL_FALSE, glm::value_ptr(camera_to_object));
   return *this;
 }
-BallShader& BallShader::SetSamples(const std::vector<glm::vec2>& positions) {
-  const GLsizei n = GLsizei(std::min<size_t>(positions.size(), 16));
-  glUniform1i(samples_, n);
-  glUniform2fv(sample_at_, n, glm::value_ptr(positions[0]));
+BallShader& BallShader::SetWriteDepth(bool depth) {
+  glUniform1i(write_depth_, depth ? 1 : 0);
   return *this;
 }
 BallShader& BallShader::SetLight(const glm::vec3& direction, float ambient) {

@@ -2,8 +2,6 @@
 // Typed shader programs (after Magnum's Shaders::): each owns its Program, looks its uniform locations up once when
 // it is made, and offers setters in the shader's own units - a frame sets numbers, never names. Shaders are the files
 // in shaders/ (ShaderDir()); a missing uniform is a compile-time mistake of the file, refused when the program is made.
-#include <vector>
-
 #include <glm/glm.hpp>
 
 #include "render/gl_objects.h"
@@ -29,8 +27,8 @@ class ObjectShader {
   GLint model_to_camera_, projection_, light_dir_, ambient_, lit_, brightness_, contrast_, white_balance_;
 };
 
-// shaders/ball.frag (over fullscreen.vert): a ball ray-traced into a multisampled layer - the exact sphere, each
-// sample's coverage its own ray's hit.
+// shaders/ball.frag (over fullscreen.vert): a ball ray-traced into a layer - the exact sphere, each pixel's coverage
+// the share of its 16 rays that hit it; the colour layer, or with SetWriteDepth(true) the depth layer.
 class BallShader {
  public:
   BallShader();
@@ -39,14 +37,13 @@ class BallShader {
   BallShader& SetCamera(const glm::vec4& fx_fy_cx_cy, const glm::vec2& layer_origin_px);
   // The sphere in the camera frame (mm), and the rotation from the camera frame to its texture's frame.
   BallShader& SetSphere(const glm::vec3& center_camera_mm, float radius_mm, const glm::mat3& camera_to_object);
-  // The framebuffer's sample positions within a pixel (0..1 from its lower-left corner), at most 16.
-  BallShader& SetSamples(const std::vector<glm::vec2>& positions);
+  BallShader& SetWriteDepth(bool depth);
   BallShader& SetLight(const glm::vec3& direction, float ambient);
   BallShader& SetColour(float brightness, float contrast, const glm::vec3& white_balance);
 
  private:
   Program program_;
-  GLint intrinsics_, origin_, center_, radius_, camera_to_object_, samples_, sample_at_, light_dir_, ambient_,
+  GLint intrinsics_, origin_, center_, radius_, camera_to_object_, write_depth_, light_dir_, ambient_,
       brightness_, contrast_, white_balance_;
 };
 
