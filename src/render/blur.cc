@@ -315,41 +315,58 @@ GlBlur::~GlBlur() = default;
 
 void GlBlur::BlurTexture(Texture& texture, const std::string& method, double r_px) {
   const Framebuffer framebuffer(texture);
-  Blur(texture, framebuffer.id(), texture.width_px(), texture.height_px(), method, r_px);
+  Blur(texture, framebuffer.id(), {{cv::Rect(0, 0, texture.width_px(), texture.height_px()), method, r_px}});
 }
 
 void GlBlur::BlurRegion(GrowingTarget& target, int w, int h, const std::string& method, double r_px) {
-  target.Reserve(w, h);
-  Blur(target.texture(), target.framebuffer(), w, h, method, r_px);
+  BlurRegions(target, {{cv::Rect(0, 0, w, h), method, r_px}});
 }
 
-void GlBlur::Blur(const Texture& texture, GLuint framebuffer, int w, int h, const std::string& method, double r_px) {
-  CheckBlurRadius(r_px);  // before anything: a NaN radius would otherwise skip the blur and return the image as is
+void GlBlur::BlurRegions(GrowingTarget& target, const std::vector<Region>& regions) {
+  if (regions.empty()) return;
+  for (const Region& region : regions) target.Reserve(region.rect.x + region.rect.width, region.rect.y + region.rect.height);
+  Blur(target.texture(), target.framebuffer(), regions);
+}
+
+void GlBlur::Blur(const Texture& texture, GLuint framebuffer, const std::vector<Region>& regions) {
+  // Before anything: a NaN radius would otherwise skip the blur and return the image as is.
+  for (const Region& region : regions) CheckBlurRadius(region.r_px);
   GrowingTarget& scratch = *scratch_;
-  if (method == "disc") {
-    if (r_px <= 0) return;
-    // One pass into the scratch target, copied back: a pass cannot read the texture it writes.
-    const double coverage_r = DiscCoverageRadiusPx(r_px);
-    disc_->Use().SetRegion(w, h).SetKernel(float(coverage_r), int(std::ceil(coverage_r + 0.5)));
-    scratch.BindFor(w, h);
-    texture.Bind(0);
+  scratch.Reserve(texture.width_px(), texture.height_px());
+  // The first pass of every region into the scratch target: the Gaussian's horizontal pass, or the whole disc.
+  glBindFramebuffer(GL_FRAMEBUFFER, scratch.framebuffer());
+  texture.Bind(0);
+  auto viewport = [](const cv::Rect& r) { glViewport(r.x, r.y, r.width, r.height); };
+  auto taps = [](const Region& region) { return GaussianTaps(region.r_px / 2); };
+  auto blurs = [&](const Region& region) { return region.method == "disc" ? region.r_px > 0 : taps(region) > 0; };
+  for (const Region& region : regions) {
+    if (!blurs(region)) continue;
+    const cv::Rect& r = region.rect;
+    viewport(r);
+    if (region.method == "disc") {
+      const double coverage_r = DiscCoverageRadiusPx(region.r_px);
+      disc_->Use().SetRegion(r.x, r.y, r.br().x, r.br().y).SetKernel(float(coverage_r), int(std::ceil(coverage_r + 0.5)));
+    } else {
+      // GaussianKernelSigma: the discrete kernel's variance is exactly s^2.
+      const double s = region.r_px / 2;
+      gaussian_->Use().SetRegion(r.x, r.y, r.br().x, r.br().y).SetKernel(float(GaussianKernelSigma(s)), taps(region))
+          .SetDirection(1, 0);
+    }
     pass_->Draw();
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, scratch.framebuffer());
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer);
-    glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
-  } else {
-    const double s = r_px / 2;
-    const int taps = GaussianTaps(s);
-    if (taps == 0) return;
-    // GaussianKernelSigma: the discrete kernel's variance is exactly s^2.
-    gaussian_->Use().SetRegion(w, h).SetKernel(float(GaussianKernelSigma(s)), taps).SetDirection(1, 0);
-    scratch.BindFor(w, h);
-    texture.Bind(0);
-    pass_->Draw();
-    gaussian_->SetDirection(0, 1);
-    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
-    glViewport(0, 0, w, h);
-    scratch.texture().Bind(0);
+  }
+  // The second pass of every region back into the texture: the Gaussian's vertical pass, or the disc's result
+  // copied (a pass of no taps is an exact copy).
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+  scratch.texture().Bind(0);
+  gaussian_->Use();
+  for (const Region& region : regions) {
+    if (!blurs(region)) continue;
+    const cv::Rect& r = region.rect;
+    viewport(r);
+    const bool disc = region.method == "disc";
+    gaussian_->SetRegion(r.x, r.y, r.br().x, r.br().y)
+        .SetKernel(disc ? 1.0f : float(GaussianKernelSigma(region.r_px / 2)), disc ? 0 : taps(region))
+        .SetDirection(0, 1);
     pass_->Draw();
   }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);

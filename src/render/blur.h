@@ -4,6 +4,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -96,11 +97,21 @@ class GlBlur {
   cv::Mat Disc(const cv::Mat& rgba, double r_px) { return BlurImage(rgba, "disc", r_px); }
   // On the GPU, texture in and out (RGBA32F, same size): "gaussian" or "disc"; r <= 0 leaves it unchanged.
   void BlurTexture(Texture& texture, const std::string& method, double r_px);
-  // The same on the bottom-left w x h of a pooled target (a layer), in place; outside it nothing is read or written.
+  // One layer's blur: a rectangle of a texture (its own image: the kernel clamps at its border) and its kernel.
+  struct Region {
+    cv::Rect rect;
+    std::string method = "gaussian";
+    double r_px = 0;
+  };
+  // Blurs each region of `target` in place; regions must not overlap, and outside them nothing is read or written.
+  // Every region's first pass runs, then every region's second, so llvmpipe renders each stage of a frame's layers
+  // in one go (its cost is per pass, not per layer).
+  void BlurRegions(GrowingTarget& target, const std::vector<Region>& regions);
+  // One region: the bottom-left w x h of a pooled target (a layer).
   void BlurRegion(GrowingTarget& target, int width_px, int height_px, const std::string& method, double r_px);
 
  private:
-  void Blur(const Texture& texture, GLuint framebuffer, int w, int h, const std::string& method, double r_px);
+  void Blur(const Texture& texture, GLuint framebuffer, const std::vector<Region>& regions);
   std::unique_ptr<GaussianBlurShader> gaussian_;
   std::unique_ptr<DiscBlurShader> disc_;
   std::unique_ptr<GrowingTarget> scratch_;

@@ -70,23 +70,49 @@ struct FrameCompositor::Impl {
     dirty.clear();
   }
 
-  // Per object: draw its layer, blur it, blend it. The region approach grows the layer by the kernel's margin;
-  // the thesis's approach by the whole frame (a full-frame buffer, blurred whole).
+  // Each object's layer, grown by the kernel's margin (the region approach) or by the whole frame (the thesis's),
+  // laid side by side in the atlas, then drawn, blurred and blended stage by stage: llvmpipe pays per pass, so a frame
+  // of eight objects costs few more passes than a frame of one. Blended in the objects' order.
+  struct Placed {
+    const BlurredObject* object;
+    cv::Rect roi;  // where it lands in the frame; empty: composed on its own (the per-pixel plan)
+    cv::Point at;  // its layer's place in the atlas
+  };
+  std::vector<Placed> placed;              // this frame's layers (kept: a frame loop allocates nothing)
+  std::vector<GlBlur::Region> regions;     // and their blurs
+  GrowingTarget atlas;
+
   void Compose(const std::vector<BlurredObject>& objects, bool whole_frame) {
     StartFrame();
     const double scale = view.Scale(camera);
+    placed.clear(), regions.clear();
+    int x = 0, y = 0, row = 0;
     for (const BlurredObject& o : objects) {
       if (o.r_of_depth_px && !whole_frame) {
-        ComposeVarying(o, scale);
+        placed.push_back({&o, {}, {}});
         continue;
       }
       const double r = o.r_px * scale;  // at screen resolution
       const int margin = whole_frame ? std::max(width, height) : KernelMarginPx(o.method, r) + 1;
-      const GpuLayer layer = renderer.DrawToTexture(o.object, margin);
-      if (!layer.color) continue;
-      blur.BlurRegion(*layer.color, layer.roi.width, layer.roi.height, o.method, r);
-      Blend(layer.color->texture(), layer.roi);
+      const cv::Rect roi = renderer.LayerRoi(o.object, margin);
+      if (roi.empty()) continue;
+      if (x > 0 && x + roi.width > width) x = 0, y += row, row = 0;  // rows as wide as the frame
+      placed.push_back({&o, roi, {x, y}});
+      regions.push_back({cv::Rect(x, y, roi.width, roi.height), o.method, r});
+      x += roi.width, row = std::max(row, roi.height);
     }
+    if (regions.empty() && placed.empty()) return;
+    if (!regions.empty()) atlas.Reserve(width, y + row);  // grown before the first layer: growing loses the texture's content
+    for (const Placed& p : placed)
+      if (!p.roi.empty()) renderer.DrawLayerAt(p.object->object, p.roi, atlas, nullptr, p.at);
+    blur.BlurRegions(atlas, regions);
+    for (const Placed& p : placed) {
+      if (p.roi.empty())
+        ComposeVarying(*p.object, scale);
+      else
+        Blend(atlas.texture(), p.roi, p.at);
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
   }
 
   // The per-pixel plan: the layer and its depth read back, each pixel blurred by the radius of its own depth on the
@@ -101,11 +127,12 @@ struct FrameCompositor::Impl {
     cv::Mat rgba;
     cv::cvtColor(layer.bgra, rgba, cv::COLOR_BGRA2RGBA);
     uploaded.Upload(rgba);
-    Blend(uploaded.texture(), layer.roi);
+    Blend(uploaded.texture(), layer.roi, cv::Point(0, 0));
   }
 
-  // Blends a layer (linear, premultiplied) over the frame at roi.
-  void Blend(const Texture& layer, const cv::Rect& roi) {
+  // Blends a layer (linear, premultiplied; its top-left pixel at texel `at` of `layer`) over the frame at roi. The
+  // frame stays bound: the next layer's blend goes into the same pass.
+  void Blend(const Texture& layer, const cv::Rect& roi, cv::Point at) {
     dirty.push_back(roi);
     frame_fb.Bind();
     glEnable(GL_FRAMEBUFFER_SRGB);
@@ -113,13 +140,12 @@ struct FrameCompositor::Impl {
     glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
     glEnable(GL_SCISSOR_TEST);
     glScissor(roi.x, roi.y, roi.width, roi.height);
-    composite.Use().SetOrigin(roi.x, roi.y);
+    composite.Use().SetOrigin(roi.x - at.x, roi.y - at.y);
     layer.Bind(0);
     pass.Draw();
     glDisable(GL_SCISSOR_TEST);
     glDisable(GL_BLEND);
     glDisable(GL_FRAMEBUFFER_SRGB);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
   }
 };
 

@@ -102,7 +102,8 @@ class Framebuffer {
 class GrowingTarget {
  public:
   explicit GrowingTarget(GLenum internal_format = GL_RGBA32F) : format_(internal_format) {}
-  // Makes room for w x h: a new texture and framebuffer only when the present ones are smaller.
+  // Makes room for w x h: a new texture and framebuffer only when the present ones are smaller (what the old one
+  // held is then gone: reserve before drawing).
   void Reserve(int width_px, int height_px);
   // Reserves w x h and binds the framebuffer with a w x h viewport.
   void BindFor(int width_px, int height_px);

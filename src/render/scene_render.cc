@@ -294,23 +294,39 @@ Layer SceneRenderer::Draw(const VirtualObject& o, int margin_px) {
   return layer;
 }
 
-GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px, bool depth_map) {
-  const Camera& cam = impl_->camera;
+cv::Rect SceneRenderer::LayerRoi(const VirtualObject& o, int margin_px) const {
   const Footprint f = Measure(o);
+  return cv::Rect(f.bounds.x - margin_px, f.bounds.y - margin_px, f.bounds.width + 2 * margin_px,
+                  f.bounds.height + 2 * margin_px) &
+         cv::Rect(0, 0, impl_->camera.image_width_px, impl_->camera.image_height_px);
+}
+
+GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px, bool depth_map) {
   GpuLayer layer;
-  layer.roi = cv::Rect(f.bounds.x - margin_px, f.bounds.y - margin_px, f.bounds.width + 2 * margin_px,
-                       f.bounds.height + 2 * margin_px) &
-              cv::Rect(0, 0, cam.image_width_px, cam.image_height_px);
+  layer.roi = LayerRoi(o, margin_px);
   if (layer.roi.empty()) return layer;
-  const int w = layer.roi.width, h = layer.roi.height;
+  impl_->color.Reserve(layer.roi.width, layer.roi.height);
+  layer.color = &impl_->color;
+  if (depth_map) impl_->depth.Reserve(layer.roi.width, layer.roi.height), layer.depth = &impl_->depth;
+  DrawLayerAt(o, layer.roi, *layer.color, layer.depth, cv::Point(0, 0));
+  return layer;
+}
+
+void SceneRenderer::DrawLayerAt(const VirtualObject& o, const cv::Rect& roi, GrowingTarget& color,
+                                GrowingTarget* depth, cv::Point at) {
+  const Camera& cam = impl_->camera;
+  const int w = roi.width, h = roi.height;
+  const bool depth_map = depth != nullptr;
+  color.Reserve(at.x + w, at.y + h);
+  if (depth) depth->Reserve(at.x + w, at.y + h);
   const auto k = cam.Intrinsics();
   // Camera frame -> clip for this sub-window; framebuffer row r is image row roi.y + r (nothing is flipped).
   const double n = 1.0, far = 1e5;
   glm::mat4 projection(0.0f);  // column-major: projection[col][row]
   projection[0][0] = float(2 * k[0] / w);
   projection[1][1] = float(2 * k[4] / h);
-  projection[2][0] = float(2 * (k[2] + 0.5 - layer.roi.x) / w - 1);
-  projection[2][1] = float(2 * (k[5] + 0.5 - layer.roi.y) / h - 1);
+  projection[2][0] = float(2 * (k[2] + 0.5 - roi.x) / w - 1);
+  projection[2][1] = float(2 * (k[5] + 0.5 - roi.y) / h - 1);
   projection[2][2] = float((far + n) / (far - n));
   projection[3][2] = float(-2 * far * n / (far - n));
   projection[2][3] = 1.0f;
@@ -319,10 +335,6 @@ GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px, boo
     for (int c = 0; c < 3; ++c) pose[c][r] = float(impl_->rotation(r, c));
     pose[3][r] = float(impl_->tvec[r]);
   }
-
-  impl_->color.Reserve(w, h);
-  layer.color = &impl_->color;
-  if (depth_map) impl_->depth.Reserve(w, h), layer.depth = &impl_->depth;
   const glm::mat4 model_to_camera = pose * ModelMatrix(o);
   // Light from above the table and behind the camera: camera frame has y down.
   const glm::vec3 light = glm::normalize(glm::vec3(-0.3f, -1.0f, -0.6f));
@@ -335,18 +347,18 @@ GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px, boo
     BallShader& shader = impl_->ball_shader;
     shader.Use()
         .SetCamera(glm::vec4(float(k[0]), float(k[4]), float(k[2]), float(k[5])),
-                   glm::vec2(float(layer.roi.x), float(layer.roi.y)))
+                   glm::vec2(float(roi.x - at.x), float(roi.y - at.y)))  // framebuffer pixel -> image pixel
         .SetSphere(glm::vec3(model_to_camera[3]), float(o.size_mm), glm::inverse(glm::mat3(model_to_camera)))
         .SetLight(light, ambient)
         .SetColour(float(o.brightness), float(o.contrast), white_balance);
-    for (GrowingTarget* target : {layer.color, layer.depth}) {
+    for (GrowingTarget* target : {&color, depth}) {
       if (!target) continue;
-      shader.SetWriteDepth(target == layer.depth);
-      target->BindFor(w, h);
+      shader.SetWriteDepth(target == depth);
+      glBindFramebuffer(GL_FRAMEBUFFER, target->framebuffer());
+      glViewport(at.x, at.y, w, h);
       impl_->pass.Draw();
     }
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    return layer;
+    return;  // the target stays bound: the next layer into it joins the same pass
   }
   // A card is drawn multisampled (4x) and resolved, so its outline carries its pixel coverage like a camera's edges
   // do (an aliased outline is sharper than any optics and reads ~0.3 px too sharp under the calibration's
@@ -377,11 +389,10 @@ GpuLayer SceneRenderer::DrawToTexture(const VirtualObject& o, int margin_px, boo
   for (int i = 0; i < (depth_map ? 2 : 1); ++i) {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, ms_id);
     glReadBuffer(GL_COLOR_ATTACHMENT0 + i);
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, (i == 0 ? layer.color : layer.depth)->framebuffer());
-    glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, (i == 0 ? &color : depth)->framebuffer());
+    glBlitFramebuffer(0, 0, w, h, at.x, at.y, at.x + w, at.y + h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  return layer;
 }
 
 int KernelMarginPx(const std::string& method, double r_px) {

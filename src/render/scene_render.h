@@ -91,6 +91,12 @@ class SceneRenderer {
   // allocates nothing); the per-pixel depth only when `depth_map` (the depth-varying blur needs it; a frame of
   // single-radius objects does not pay for it).
   GpuLayer DrawToTexture(const VirtualObject& object, int margin_px, bool depth_map = false);
+  // Where a layer of the object with that margin lies in the image (its bounds grown, clipped; empty: off-screen).
+  cv::Rect LayerRoi(const VirtualObject& object, int margin_px) const;
+  // Draws the object's layer over image rectangle `roi` into `color` (and its depth into `depth` when given) with its
+  // top-left image pixel at texel `at`: many layers side by side in one target, drawn in one go.
+  void DrawLayerAt(const VirtualObject& object, const cv::Rect& roi, GrowingTarget& color, GrowingTarget* depth,
+                   cv::Point at);
 
  private:
   struct Impl;

@@ -300,6 +300,26 @@ namespace {
 
 // A white card lying on the table spans depth; with a radius that grows steeply with depth its near edge must
 // measure as r(z_near) and its far edge as r(z_far), each by the calibration's own measurement.
+TEST_F(SceneRenderTest, AFrameWithoutObjectsIsThePhotoExactlyAfterFramesWithThem) {
+  // What the last frame drew is put back from the photo byte for byte before the next: a frame with no objects
+  // after frames with balls (blurred by either kernel, and the whole-frame approach's full-frame layers) shows the
+  // photo itself, not a re-encoded copy of it.
+  const View v;
+  const cv::Mat photo = Photo(v.camera);
+  FrameCompositor gpu(v.camera, v.rvec, v.tvec, photo);
+  std::vector<BlurredObject> balls = {{Ball(150), "gaussian", 3.0}, {Ball(200), "disc", 5.0}};
+  balls[1].object.center_board_mm[0] = 137.5;
+  gpu.Compose({});
+  const cv::Mat empty = gpu.Read();
+  EXPECT_EQ(cv::norm(empty, photo, cv::NORM_INF), 0);
+  gpu.Compose(balls);
+  gpu.ComposeWholeFrame(balls);
+  gpu.Compose(balls);
+  EXPECT_GT(cv::norm(gpu.Read(), photo, cv::NORM_INF), 10);
+  gpu.Compose({});
+  EXPECT_EQ(cv::norm(gpu.Read(), photo, cv::NORM_INF), 0);
+}
+
 TEST_F(SceneRenderTest, DepthVaryingBlurFollowsEachEdgesDepth) {
   const View v;
   SceneRenderer renderer(v.camera, v.rvec, v.tvec);

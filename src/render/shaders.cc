@@ -110,8 +110,8 @@ GaussianBlurShader& GaussianBlurShader::Use() {
   program_.Use();
   return *this;
 }
-GaussianBlurShader& GaussianBlurShader::SetRegion(int width_px, int height_px) {
-  glUniform2i(region_, width_px, height_px);
+GaussianBlurShader& GaussianBlurShader::SetRegion(int x0, int y0, int x1, int y1) {
+  glUniform4i(region_, x0, y0, x1, y1);
   return *this;
 }
 GaussianBlurShader& GaussianBlurShader::SetKernel(float sigma_px, int taps) {
@@ -135,8 +135,8 @@ DiscBlurShader& DiscBlurShader::Use() {
   program_.Use();
   return *this;
 }
-DiscBlurShader& DiscBlurShader::SetRegion(int width_px, int height_px) {
-  glUniform2i(region_, width_px, height_px);
+DiscBlurShader& DiscBlurShader::SetRegion(int x0, int y0, int x1, int y1) {
+  glUniform4i(region_, x0, y0, x1, y1);
   return *this;
 }
 DiscBlurShader& DiscBlurShader::SetKernel(float coverage_radius_px, int taps) {

@@ -47,13 +47,13 @@ class BallShader {
       brightness_, contrast_, white_balance_;
 };
 
-// shaders/blur_gaussian.frag: one pass of the separable Gaussian over the bottom-left w x h of a texture.
+// shaders/blur_gaussian.frag: one pass of the separable Gaussian over a rectangle of a texture (no taps: a copy).
 class GaussianBlurShader {
  public:
   GaussianBlurShader();
   GaussianBlurShader& Use();
-  // The region read (texels outside it repeat its border, as an image's would).
-  GaussianBlurShader& SetRegion(int width_px, int height_px);
+  // The region read, texels x0 <= x < x1, y0 <= y < y1 (texels outside it repeat its border, as an image's would).
+  GaussianBlurShader& SetRegion(int x0, int y0, int x1, int y1);
   GaussianBlurShader& SetKernel(float sigma_px, int taps);
   GaussianBlurShader& SetDirection(int dx, int dy);
 
@@ -62,12 +62,12 @@ class GaussianBlurShader {
   GLint region_, sigma_, taps_, direction_;
 };
 
-// shaders/blur_disc.frag: the pillbox over the bottom-left w x h of a texture.
+// shaders/blur_disc.frag: the pillbox over a rectangle of a texture.
 class DiscBlurShader {
  public:
   DiscBlurShader();
   DiscBlurShader& Use();
-  DiscBlurShader& SetRegion(int width_px, int height_px);
+  DiscBlurShader& SetRegion(int x0, int y0, int x1, int y1);
   DiscBlurShader& SetKernel(float coverage_radius_px, int taps);
 
  private:
@@ -75,7 +75,7 @@ class DiscBlurShader {
   GLint region_, radius_, taps_;
 };
 
-// shaders/composite.frag: a layer blended over the frame with its top-left pixel at `origin`.
+// shaders/composite.frag: a layer blended over the frame, texel (0, 0) of its texture landing on frame pixel `origin`.
 class CompositeShader {
  public:
   CompositeShader();
