@@ -349,7 +349,7 @@ void GlBlur::Blur(const Texture& texture, GLuint framebuffer, const std::vector<
     } else {
       // GaussianKernelSigma: the discrete kernel's variance is exactly s^2.
       const double s = region.r_px / 2;
-      gaussian_->Use().SetRegion(r.x, r.y, r.br().x, r.br().y).SetKernel(float(GaussianKernelSigma(s)), taps(region))
+      gaussian_->Use().SetRegion(r.x, r.y, r.br().x, r.br().y).SetKernel(GaussianKernelSigma(s), taps(region))
           .SetDirection(1, 0);
     }
     pass_->Draw();
@@ -365,7 +365,7 @@ void GlBlur::Blur(const Texture& texture, GLuint framebuffer, const std::vector<
     viewport(r);
     const bool disc = region.method == "disc";
     gaussian_->SetRegion(r.x, r.y, r.br().x, r.br().y)
-        .SetKernel(disc ? 1.0f : float(GaussianKernelSigma(region.r_px / 2)), disc ? 0 : taps(region))
+        .SetKernel(disc ? 1.0 : GaussianKernelSigma(region.r_px / 2), disc ? 0 : taps(region))
         .SetDirection(0, 1);
     pass_->Draw();
   }

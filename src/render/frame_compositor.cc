@@ -61,12 +61,15 @@ struct FrameCompositor::Impl {
   }
 
   void StartFrame() {
-    // The base's encoded bytes are copied as they are (both sRGB): no decode/encode round trip.
+    // The base's encoded bytes are copied as they are (both sRGB): no decode/encode round trip. One blit of the
+    // rectangle around all of the last frame's layers: llvmpipe pays per blit more than per pixel copied.
+    if (dirty.empty()) return;
+    cv::Rect r = dirty.front();
+    for (const cv::Rect& d : dirty) r |= d;
     glBindFramebuffer(GL_READ_FRAMEBUFFER, base_fb.id());
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, frame_fb.id());
-    for (const cv::Rect& r : dirty)
-      glBlitFramebuffer(r.x, r.y, r.x + r.width, r.y + r.height, r.x, r.y, r.x + r.width, r.y + r.height,
-                        GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBlitFramebuffer(r.x, r.y, r.x + r.width, r.y + r.height, r.x, r.y, r.x + r.width, r.y + r.height,
+                      GL_COLOR_BUFFER_BIT, GL_NEAREST);
     dirty.clear();
   }
 

@@ -1,5 +1,7 @@
 #include "render/shaders.h"
 
+#include <cmath>
+
 #include <glm/gtc/type_ptr.hpp>
 
 namespace blurcue::render {
@@ -101,8 +103,8 @@ BallShader& BallShader::SetColour(float brightness, float contrast, const glm::v
 GaussianBlurShader::GaussianBlurShader()
     : program_(FullscreenProgram("blur_gaussian.frag")),
       region_(program_.Uniform("u_region")),
-      sigma_(program_.Uniform("u_sigma_px")),
       taps_(program_.Uniform("u_taps")),
+      weights_(program_.Uniform("u_weights")),
       direction_(program_.Uniform("u_direction")) {
   ImageOnUnitZero(program_, "u_image");
 }
@@ -114,9 +116,14 @@ GaussianBlurShader& GaussianBlurShader::SetRegion(int x0, int y0, int x1, int y1
   glUniform4i(region_, x0, y0, x1, y1);
   return *this;
 }
-GaussianBlurShader& GaussianBlurShader::SetKernel(float sigma_px, int taps) {
-  glUniform1f(sigma_, sigma_px);
+GaussianBlurShader& GaussianBlurShader::SetKernel(double sigma_px, int taps) {
+  CV_Assert(taps >= 0 && taps <= kMaxTaps);
+  float weights[kMaxTaps + 1];
+  double sum = 1;
+  for (int i = 1; i <= taps; ++i) sum += 2 * std::exp(-0.5 * i * i / (sigma_px * sigma_px));
+  for (int i = 0; i <= taps; ++i) weights[i] = float(std::exp(-0.5 * i * i / (sigma_px * sigma_px)) / sum);
   glUniform1i(taps_, taps);
+  glUniform1fv(weights_, taps + 1, weights);
   return *this;
 }
 GaussianBlurShader& GaussianBlurShader::SetDirection(int dx, int dy) {

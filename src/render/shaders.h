@@ -54,12 +54,14 @@ class GaussianBlurShader {
   GaussianBlurShader& Use();
   // The region read, texels x0 <= x < x1, y0 <= y < y1 (texels outside it repeat its border, as an image's would).
   GaussianBlurShader& SetRegion(int x0, int y0, int x1, int y1);
-  GaussianBlurShader& SetKernel(float sigma_px, int taps);
+  // The kernel exp(-i^2 / 2 sigma^2), |i| <= taps (at most kMaxTaps), normalised; taps 0 copies.
+  GaussianBlurShader& SetKernel(double sigma_px, int taps);
+  static constexpr int kMaxTaps = 1023;
   GaussianBlurShader& SetDirection(int dx, int dy);
 
  private:
   Program program_;
-  GLint region_, sigma_, taps_, direction_;
+  GLint region_, taps_, weights_, direction_;
 };
 
 // shaders/blur_disc.frag: the pillbox over a rectangle of a texture.
