@@ -269,6 +269,30 @@ TEST(ArcminObserver, ReproducesPublishedThresholdsWithinTheirScatter) {
   EXPECT_LE(p.weber, 0.6);
 }
 
+// Two published numbers the model must honour, quoted from the papers' abstracts (not read off a figure):
+// - Mather & Smith 2002 (Perception 31:1211): "Weber fractions for blur discrimination ranged from 0.28 to 0.56" -
+//   the model's threshold over its reference, well above the intrinsic blur (references of 2-8 arcmin std), lies there;
+// - Levi & Klein 1990 (Vision Res. 30:1971, "Equivalent intrinsic blur in spatial vision"): the fovea's equivalent
+//   intrinsic blur is about 0.5 arcmin (std) - below it, added blur hardly changes what is seen. The model's dip, the
+//   reference at which added blur is best told apart, lies below the intrinsic blur and its unblurred threshold at
+//   the intrinsic blur's scale: between 0.5 and 2 x 0.5 arcmin x sqrt((1+w)^2 - 1) for s_i from 0.5 to 1.
+TEST(ArcminObserver, HonoursPublishedWeberFractionsAndIntrinsicBlur) {
+  const ObserverParams p;
+  for (double reference_std : {2.0, 4.0, 8.0}) {
+    const double weber = DiscriminationThresholdArcmin(p, 2 * reference_std) / (2 * reference_std);  // r = 2 s
+    EXPECT_GE(weber, 0.28) << reference_std;
+    EXPECT_LE(weber, 0.56) << reference_std;
+  }
+  // The threshold at no reference blur: s_i sqrt((1+w)^2 - 1) for the model; for s_i in Levi & Klein's 0.5 to the
+  // literature's 1 arcmin and this w, between these bounds.
+  const double at_zero_std = DiscriminationThresholdArcmin(p, 0) / 2;
+  const double scale = std::sqrt((1 + p.weber) * (1 + p.weber) - 1);
+  EXPECT_GE(at_zero_std, 0.5 * scale);
+  EXPECT_LE(at_zero_std, 1.0 * scale);
+  // Below the intrinsic blur, a little added blur is told apart no worse than none: the dipper's dip lies there.
+  EXPECT_LT(DiscriminationThresholdArcmin(p, 2 * 0.4), DiscriminationThresholdArcmin(p, 0));
+}
+
 // Simulated "which is more blurred?" answers against the analytic probability: P(1 - lapse) + lapse / 2.
 TEST(ArcminObserver, ChoiceRatesMatchTheAnalyticProbability) {
   ObserverParams p;
