@@ -146,8 +146,6 @@ cv::Mat FilterInFrequency(const cv::Mat& rgba, const std::function<double(double
     return padded < 2 * n ? padded : n % 2 ? 2 * n : n;
   };
   const int ew = side(w), eh = side(h);
-  cv::Mat even;
-  cv::copyMakeBorder(rgba, even, 0, eh - h, 0, ew - w, cv::BORDER_REFLECT);
   // The transfer function tabulated along the radial frequency (2^18 steps up to the corner's sqrt(1/2) cycles/px;
   // linear interpolation is off by (step^2 / 8) |H''|: below 4e-5 for a 2nd-order Butterworth down to a cut-off of
   // 1 cycle per 4592 px) and looked up per coefficient.
@@ -172,27 +170,31 @@ cv::Mat FilterInFrequency(const cv::Mat& rgba, const std::function<double(double
       }
     }
   });
-  std::vector<cv::Mat> channels;
-  cv::split(even, channels);
+  // Each channel on its own (taken out, mirrored out, transformed, filtered, transformed back), the channels in
+  // parallel; the result is put together once from the channels' image parts (no whole padded copy is made).
+  std::vector<cv::Mat> channels(size_t(rgba.channels()));
   const float gain_at_zero = table[0];
   cv::parallel_for_(cv::Range(0, int(channels.size())), [&](const cv::Range& range) {
     for (int c = range.start; c < range.end; ++c) {
-      cv::Mat& channel = channels[size_t(c)];
+      cv::Mat channel;
+      cv::extractChannel(rgba, channel, c);
       double lo = 0, hi = 0;
       cv::minMaxLoc(channel, &lo, &hi);
       if (lo == hi) {  // only the zero frequency: the filter scales it by transfer(0)
-        channel = cv::Scalar(lo * gain_at_zero);
+        channels[size_t(c)] = cv::Mat(h, w, CV_32F, cv::Scalar(lo * gain_at_zero));
         continue;
       }
-      cv::Mat coefficients;
-      cv::dct(channel, coefficients);
+      cv::Mat padded, coefficients;
+      cv::copyMakeBorder(channel, padded, 0, eh - h, 0, ew - w, cv::BORDER_REFLECT);
+      cv::dct(padded, coefficients);
       cv::multiply(coefficients, H, coefficients);
-      cv::dct(coefficients, channel, cv::DCT_INVERSE);
+      cv::dct(coefficients, padded, cv::DCT_INVERSE);
+      channels[size_t(c)] = padded(cv::Rect(0, 0, w, h));
     }
   });
   cv::Mat out;
   cv::merge(channels, out);
-  return out(cv::Rect(0, 0, w, h)).clone();
+  return out;
 }
 
 cv::Mat ButterworthBlurCpu(const cv::Mat& rgba, double cutoff, int order) {
@@ -316,10 +318,6 @@ GlBlur::~GlBlur() = default;
 void GlBlur::BlurTexture(Texture& texture, const std::string& method, double r_px) {
   const Framebuffer framebuffer(texture);
   Blur(texture, framebuffer.id(), {{cv::Rect(0, 0, texture.width_px(), texture.height_px()), method, r_px}});
-}
-
-void GlBlur::BlurRegion(GrowingTarget& target, int w, int h, const std::string& method, double r_px) {
-  BlurRegions(target, {{cv::Rect(0, 0, w, h), method, r_px}});
 }
 
 void GlBlur::BlurRegions(GrowingTarget& target, const std::vector<Region>& regions) {

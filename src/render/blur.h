@@ -107,8 +107,6 @@ class GlBlur {
   // Every region's first pass runs, then every region's second, so llvmpipe renders each stage of a frame's layers
   // in one go (its cost is per pass, not per layer).
   void BlurRegions(GrowingTarget& target, const std::vector<Region>& regions);
-  // One region: the bottom-left w x h of a pooled target (a layer).
-  void BlurRegion(GrowingTarget& target, int width_px, int height_px, const std::string& method, double r_px);
 
  private:
   void Blur(const Texture& texture, GLuint framebuffer, const std::vector<Region>& regions);

@@ -80,7 +80,7 @@ TEST_F(GlTest, PooledTargetKeepsItsTextureAndBlursOnlyItsRegion) {
   GlBlur blur;
   for (const std::string method : {"gaussian", "disc"}) {
     target.Upload(img);
-    blur.BlurRegion(target, img.cols, img.rows, method, 6.0);
+    blur.BlurRegions(target, {{cv::Rect(0, 0, img.cols, img.rows), method, 6.0}});
     const cv::Mat cpu = method == "disc" ? DiscBlurCpu(img, 6.0) : GaussianBlurCpu(img, 6.0);
     EXPECT_LE(cv::norm(target.Download(img.cols, img.rows), cpu, cv::NORM_INF), 3.0 / 255) << method;
     const cv::Mat beyond = target.Download(target.texture().width_px(), target.texture().height_px());
