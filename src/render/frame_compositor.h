@@ -51,7 +51,8 @@ class FrameCompositor {
   FrameCompositor(const FrameCompositor&) = delete;
   FrameCompositor& operator=(const FrameCompositor&) = delete;
 
-  // Object-region approach: per object, a layer of its bounds + kernel margin is drawn, blurred and blended.
+  // Object-region approach: per object, a layer of its bounds + kernel margin is drawn, blurred and blended - the
+  // frame's layers side by side in one atlas, each stage for all of them at once (llvmpipe pays per pass).
   void Compose(const std::vector<BlurredObject>& objects);
   // The thesis's approach: each object drawn into a whole-frame buffer, the whole buffer blurred, then blended.
   void ComposeWholeFrame(const std::vector<BlurredObject>& objects);

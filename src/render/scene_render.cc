@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iterator>
 #include <map>
 #include <vector>
 
@@ -295,8 +294,10 @@ Layer SceneRenderer::Draw(const VirtualObject& o, int margin_px) {
 }
 
 cv::Rect SceneRenderer::LayerRoi(const VirtualObject& o, int margin_px) const {
-  cv::Rect bounds = Measure(o).bounds;
-  if (o.kind == VirtualObject::Kind::kBall) {
+  cv::Rect bounds;
+  if (o.kind != VirtualObject::Kind::kBall) {
+    bounds = Measure(o).bounds;
+  } else {
     // A ball's layer hugs its outline, not its bounding box's projection (whose near corners reach far wider): the
     // layer is blurred whole, so its area is the frame's cost. The outline polygon's points lie on the rim; the pad
     // covers the polygon's sagitta (< 0.01 of the radius at 64 points) as the box's pad covers rounding.
