@@ -79,7 +79,7 @@ void AddPreviewCommand(CLI::App& app) {
       double level;
       std::string label, label2;  // levels; the sides and their radii
       Json key;                    // sorts the sheet by level
-      std::string seen;            // pairs: the predicted share correct, and invisible below --visible
+      std::string seen = {};       // pairs: the predicted share correct, and invisible below --visible
     };
     std::vector<Tile> tiles;
     std::set<std::string> seen;  // labels or level keys already on the sheet

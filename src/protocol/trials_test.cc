@@ -165,7 +165,9 @@ TEST(TrialBuilder, BlockOrderIsABalancedLatinSquareOrSeeded) {
       for (int k = 0; k < n; ++k) EXPECT_EQ((place[{b, k}]), rows / n) << "n " << n << " block " << b << " place " << k;
     for (int a = 0; a < n; ++a)
       for (int b = 0; b < n; ++b)
-        if (a != b) EXPECT_EQ((follows[{a, b}]), rows / n) << "n " << n << ": " << a << " then " << b;
+        if (a != b) {
+          EXPECT_EQ((follows[{a, b}]), rows / n) << "n " << n << ": " << a << " then " << b;
+        }
     EXPECT_THROW(BuildTrials(p, "anonymous", 7), Error);
     j["block_order"] = "random";
     const Protocol r = ParseProtocol(j, "inline.json", {false});
