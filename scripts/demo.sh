@@ -18,12 +18,11 @@ $BC render --calib "$OUT/calib.json" --background "$OUT/scene/scene.png" --objec
 $BC animate --calib "$OUT/calib.json" --background "$OUT/scene/scene.png" --left estimated --right none \
     --speed-cm-s 3 --fps 30 --video "$OUT/pattern3.avi" --log "$OUT/pattern3-frames.csv"
 # The studies: the shipped protocols (they point at this scene, and the depth matching at thin-lens photos of its
-# picture at each distance), checked by eye first, then run by simulated
+# picture at each distance, taken with the camera and focus the protocol names), checked by eye first, then run by simulated
 # observers, each participant with their own recorded seed, into one record: 6 through test 1, 4 through test 2,
 # 3 through test 3 and 3 through the pre-research depth matching (headless, on a simulated clock). A fresh record each time: a demo run twice must
 # not meet its own earlier sessions.
-$BC synth-pictures --camera "$OUT/scene/camera.json" --protocol protocols/pre-research-depth-matching.json \
-    --out "$OUT/pictures"
+$BC synth-pictures --protocol protocols/pre-research-depth-matching.json --out "$OUT/pictures"
 $BC preview protocols/test1-static-grids.json --out "$OUT/preview-test1.png"
 rm -f "$OUT/study.sqlite" "$OUT/study.sqlite-wal" "$OUT/study.sqlite-shm"
 run() {  # PROTOCOL PARTICIPANTS...

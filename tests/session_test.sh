@@ -631,6 +631,71 @@ PYEOF
   got=$(sql "$W/s.sqlite" "SELECT choice || ' ' || (rt_ms > 2400) FROM responses")
   [ "$got" = "3 1" ] || fail "answer: $got (the key pressed during the intervals must not count)"
   echo "ok: a key during the intervals ignored, the one after them recorded: $got" ;;
+depth_arcmin)
+  # Depth matching in visual angle (issue 14): each trial records the real picture's blur, worked out here apart from
+  # blurcue - the thin lens of content.real_camera (1 m focus), the lower half's scale, 2 atan on the recorded display -
+  # and the picture's width in arcmin; the simulated observer (model=arcmin) sets levels whose equivalent blur follows
+  # the real one. Without real_camera that observer refuses to start, naming the field.
+  for id in D1 D2 D3; do
+    $BC run "$P/pre-research-depth-matching.json" --participant $id --db "$W/s.sqlite" --observer sim > /dev/null
+  done
+  sql "$W/s.sqlite" "SELECT t.factors || '|' || r.choice FROM trials t JOIN responses r ON r.trial_id = t.id
+                     WHERE t.practice = 0" > "$W/rows"
+  sql "$W/s.sqlite" "SELECT display_profile FROM sessions LIMIT 1" > "$W/display.json"
+  $PY - "$W/rows" "$W/display.json" "$DIR/scene/camera.json" "$P/../stimuli/face.png" "$(dirname "$0")/../stimuli/face.png" > "$W/fit" 2>&1 <<'PYEOF' || fail "depth matching in arcmin: $(cat "$W/fit")"
+import json, math, os, struct, sys
+rows = [line.rstrip("\n").rsplit("|", 1) for line in open(sys.argv[1])]
+disp = json.load(open(sys.argv[2]))
+cam = json.load(open(sys.argv[3]))
+face = sys.argv[4] if os.path.exists(sys.argv[4]) else sys.argv[5]
+w_img, h_img = struct.unpack(">II", open(face, "rb").read()[16:24])  # the PNG's IHDR
+def arcmin(px):
+    return 2 * math.atan(0.5 * px * disp["width_mm"] / disp["width_px"] / disp["distance_mm"]) * 180 / math.pi * 60
+f, N = cam["focal_length_mm"], cam["f_number"]
+pitch = cam["sensor_width_mm"] / cam["image_width_px"]
+frame_w = 960  # the protocol's 960 x 720 window: a 960 x 720 frame, its lower half 360 px high
+scale = max(frame_w / cam["image_width_px"], 360 / cam["image_height_px"])
+picture_w = round(w_img * (frame_w * 3 // 4 // 2 * 6 // 10) / h_img)
+pairs = []
+assert len(rows) == 3 * 27, len(rows)
+for text, choice in rows:
+    v = json.loads(text)
+    u, u0 = v["distance_m"] * 1000, 1000.0
+    R = (f / N) * f / 2 * abs(u - u0) / (u * (u0 - f))  # the thin-lens blur circle (mm)
+    r_arcmin = arcmin(R / pitch * scale)
+    assert abs(v["r_scene_arcmin"] - r_arcmin) < 2e-3, (v, r_arcmin)
+    assert abs(v["picture_width_arcmin"] - arcmin(picture_w)) < 2e-3, (v["picture_width_arcmin"], arcmin(picture_w))
+    c = float(choice)
+    pairs.append((r_arcmin, 2 * math.sqrt(math.log(2) / 2) / (math.pi * c) * v["picture_width_arcmin"]))
+# The set blur follows the real one: rank correlation across the trials; where the real picture is blurred (r >=
+# 1.5', above the eye's intrinsic 1.2') the median set blur is within a factor 1.5 of the median real one and over
+# 1.2 x the median set where it is sharp (r < 1').
+def ranks(x):
+    order = sorted(range(len(x)), key=lambda i: x[i])
+    r = [0] * len(x)
+    for k, i in enumerate(order): r[i] = k
+    return r
+a, b = ranks([p[0] for p in pairs]), ranks([p[1] for p in pairs])
+n = len(a); ma, mb = sum(a) / n, sum(b) / n
+rho = sum((x - ma) * (y - mb) for x, y in zip(a, b)) / math.sqrt(sum((x - ma) ** 2 for x in a) * sum((y - mb) ** 2 for y in b))
+med = lambda x: sorted(x)[len(x) // 2]
+blurred = [p for p in pairs if p[0] >= 1.5]
+sharp = [p[1] for p in pairs if p[0] < 1]
+ratio = med([s for _, s in blurred]) / med([r for r, _ in blurred])
+print(f"rank correlation {rho:.2f} over {n} trials; real blurred: median set / real {ratio:.2f} ({len(blurred)} trials); "
+      f"median set {med([s for _, s in blurred]):.2f}' there, {med(sharp):.2f}' where the real one is sharp ({len(sharp)})")
+assert rho > 0.3 and len(blurred) >= 20 and len(sharp) >= 10, rho
+assert 1 / 1.5 < ratio < 1.5 and med([s for _, s in blurred]) > 1.2 * med(sharp)
+PYEOF
+  sed 's/"real_camera"/"no_camera_here"/' "$P/pre-research-depth-matching.json" |
+    $PY -c 'import json,sys; p=json.load(sys.stdin); p["content"].pop("no_camera_here"); json.dump(p, sys.stdout)' > "$P/dm-no-camera.json"
+  set +e; $BC run "$P/dm-no-camera.json" --participant X --db "$W/x.sqlite" --observer sim 2> "$W/err"; code=$?; set -e
+  rm -f "$P/dm-no-camera.json"
+  [ $code = 2 ] || [ $code = 3 ] || fail "exit $code without real_camera: $(cat "$W/err")"
+  grep -q "dm-no-camera.json: /content/real_camera: is needed by the simulated observer" "$W/err" || fail "error: $(cat "$W/err")"
+  [ "$(wc -l < "$W/err")" = 1 ] || fail "more than one line: $(cat "$W/err")"
+  [ ! -e "$W/x.sqlite" ] || [ "$(sql "$W/x.sqlite" "SELECT count(*) FROM sessions")" = 0 ] || fail "a session was started"
+  echo "ok: depth matching records the real blur in arcmin (thin lens, worked out apart) and the observer follows it: $(cat "$W/fit")" ;;
 recover)
   # Through the whole pipeline - trials, the observer's key presses, the record, export and the analysis - the
   # depth-matching fit recovers the cut-off law the simulated observers were given: c = 20 d^-0.5.

@@ -45,30 +45,38 @@ void AddSynthPicturesCommand(CLI::App& app) {
       "the study without a photo session: the picture (8 x 12 cm by default) faces the camera at distance d,\n"
       "imaged at magnification f / (d - f), blurred by the thin-lens disc for the lens focused at --focus-m, on a\n"
       "grey wall. Writes OUT/PICTURE-{d}m.png (d as %g) at --width-px wide with the camera's aspect, the names a\n"
-      "protocol's content.real_photos pattern (e.g. \"pictures/face-{distance_m}m.png\") finds.\n"
+      "protocol's content.real_photos pattern (e.g. \"pictures/face-{distance_m}m.png\") finds. With --protocol, the\n"
+      "camera and focus default to its content.real_camera (the ones its trials record the real blur from).\n"
       "Example: blurcue synth-pictures --camera results/demo/scene/camera.json\n"
       "         --protocol protocols/pre-research-depth-matching.json --out results/demo/pictures");
-  cmd->add_option("--camera", args->camera, "camera.json (f, f-number, sensor)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--camera", args->camera, "camera.json (f, f-number, sensor); default: the protocol's real_camera")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--protocol", args->protocol, "take the distances from this protocol's distance_m levels")
       ->check(CLI::ExistingFile);
   cmd->add_option("--distances-m", args->distances_m, "distances (m), instead of --protocol")
       ->check(FinitePositive(1000, "m"));
-  cmd->add_option("--focus-m", args->focus_m, "focus distance (m)")->capture_default_str()
-      ->check(FinitePositive(1000, "m"));
+  CLI::Option* focus = cmd->add_option("--focus-m", args->focus_m, "focus distance (m); default: the protocol's "
+                                                                    "real_camera focus_m, else 1")
+                           ->check(FinitePositive(1000, "m"));
   cmd->add_option("--picture", args->picture, "face or an image with alpha")->capture_default_str();
   cmd->add_option("--height-mm", args->height_mm, "the real picture's height")->capture_default_str()
       ->check(FinitePositive(10000, "mm"));
   cmd->add_option("--width-px", args->width_px, "photo width (the camera's sensor scaled to it)")
       ->capture_default_str()->transform(IntRange(16, 16384, "px"));
   cmd->add_option("--out", args->out, "folder (created)")->required();
-  cmd->callback([args] {
+  cmd->callback([args, focus] {
     std::set<double> distances(args->distances_m.begin(), args->distances_m.end());
     if (!args->protocol.empty()) {
       protocol::ValidateOptions no_files;
       no_files.check_files = false;  // its real_photos may be what we are about to write
-      distances.merge(protocol::NumericLevels(protocol::LoadProtocol(args->protocol, no_files), "distance_m"));
+      const protocol::Protocol p = protocol::LoadProtocol(args->protocol, no_files);
+      distances.merge(protocol::NumericLevels(p, "distance_m"));
+      if (args->camera.empty()) args->camera = p.content.real_camera_file.string();
+      if (!focus->count() && p.content.real_focus_m > 0) args->focus_m = p.content.real_focus_m;
     }
     if (distances.empty()) throw Error(ErrorKind::kUsage, "give --distances-m or a --protocol with distance_m levels");
+    if (args->camera.empty())
+      throw Error(ErrorKind::kUsage, "give --camera, or a --protocol whose content.real_camera names one");
     const Camera camera = LoadCamera(args->camera);
     const Camera scaled = camera.Resized(args->width_px, int(std::lround(double(args->width_px) *
                                                                           camera.image_height_px /

@@ -163,6 +163,7 @@ std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& opti
   CheckSizes(options);
   const session::ObserverParams observer = session::ParseObserver(options.observer);
   const protocol::Protocol& protocol = study.protocol;
+  session::CheckObserverCanAnswer(observer, protocol);
   int main_blocks = 0;
   for (const auto& b : protocol.blocks) main_blocks += !b.practice;
   const bool several_blocks = main_blocks > 1;

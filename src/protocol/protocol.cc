@@ -344,6 +344,7 @@ class Parser {
   std::vector<Factor> ParseFactors(const Json& v, const std::string& ptr);
   void CheckLevelValue(const std::string& name, const Json& v, const std::string& ptr);
   std::optional<Adjustment> ParseAdjust(const Json& v, const std::string& ptr);
+  void ParseRealCamera(const Json& v, const std::string& ptr, const Json& content, Protocol* p);
   std::optional<Procedure> ParseProcedure(const Json& v, const std::string& ptr);
   std::vector<Factor> ParseConditions(const Json& v, const std::string& ptr);
   void ParseInfo(const Json& v, const std::string& ptr, Protocol* p);
@@ -441,7 +442,7 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
     // A ball rolls on the board's 25 mm squares: from a marble to a football.
     if (auto r = Number(v, "radius_mm", ptr, false, 1, 150, "mm")) p->content.radius_mm = *r;
   } else {
-    Object(v, ptr, {"type", "image", "real_photos"});
+    Object(v, ptr, {"type", "image", "real_photos", "real_camera"});
     p->content.image = Path(v, "image", ptr, true);
     if (auto pattern = Text(v, "real_photos", ptr, false, kMaxPathChars, true)) {
       if (pattern->find("{distance_m}") == std::string::npos)
@@ -449,6 +450,27 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
       else
         p->content.real_photos = (base_ / *pattern).lexically_normal().string();
     }
+    if (const Json* real = Field(v, "real_camera", ptr, false)) ParseRealCamera(*real, ptr + "/real_camera", v, p);
+  }
+}
+
+// content.real_camera: the camera (camera.json) that took the real photos and its focus distance.
+void Parser::ParseRealCamera(const Json& v, const std::string& ptr, const Json& content, Protocol* p) {
+  if (!content.contains("real_photos")) {
+    Problem(ptr, "describes the camera of content.real_photos, which this protocol does not name", v);
+    return;
+  }
+  if (!Object(v, ptr, {"camera", "focus_m"})) return;
+  const int problems_before = calls_;
+  p->content.real_camera_file = Path(v, "camera", ptr, true);
+  const bool camera_file_ok = calls_ == problems_before;
+  // From a hand's breadth to a kilometre (the thin lens needs it beyond the focal length: checked per distance).
+  if (auto focus = Number(v, "focus_m", ptr, true, 0.01, 1000, "m")) p->content.real_focus_m = *focus;
+  if (!options_.check_files || p->content.real_camera_file.empty() || !camera_file_ok) return;
+  try {
+    p->content.real_camera = LoadCamera(p->content.real_camera_file);
+  } catch (const Error& e) {
+    Problem(ptr + "/camera", e.what(), v["camera"]);
   }
 }
 

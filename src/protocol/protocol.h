@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/camera.h"
 #include "core/json_io.h"
 
 namespace blurcue::protocol {
@@ -127,6 +128,12 @@ struct Content {
   // picture: photos of the real picture, one per distance: a resolved path with "{distance_m}" standing for the
   // level as %g (e.g. "photos/face-{distance_m}m.png" -> "photos/face-0.4m.png"); empty: the scene photo
   std::string real_photos;
+  // picture with real_photos: the camera that took them and where it was focused (content.real_camera {camera,
+  // focus_m}), so each distance's real picture has a known blur - the thin lens's - that a trial records in arcmin
+  // and the simulated observer matches. real_camera_file empty: not given (the real blur is unknown).
+  std::filesystem::path real_camera_file;
+  std::optional<Camera> real_camera;  // read when the protocol's files are checked
+  double real_focus_m = 0;
 };
 
 // The real photo of `content` for a distance (content.real_photos with {distance_m} replaced).

@@ -603,6 +603,39 @@ TEST(ProtocolValidate, RealPhotosMissingOrWithoutPlaceholderRejected) {
   EXPECT_TRUE(Contains(OnlyProblem(k), ": /content/real_photos: must contain {distance_m}")) << OnlyProblem(k);
 }
 
+// content.real_camera: the camera (read and validated) and focus of the real photos; refused without real_photos, with
+// a camera file that is not one, a focus that is not a distance, or a field it does not know.
+TEST(ProtocolValidate, RealCameraReadOrRejectedNamingItsField) {
+  std::ofstream(SceneFolder() / "camera.json") << R"({"focal_length_mm": 21, "f_number": 5.6, "sensor_width_mm": 23.4,
+    "sensor_height_mm": 15.6, "image_width_px": 1148, "image_height_px": 764})";
+  std::ofstream(SceneFolder() / "not-a-camera.json") << R"({"focal_length_mm": -1})";
+  Json j = WithRealPhotos("photos/face-{distance_m}m.png");
+  j["content"]["real_camera"] = {{"camera", "camera.json"}, {"focus_m", 1.5}};
+  EXPECT_TRUE(Problems(j).empty()) << OnlyProblem(j);
+  const Protocol p = ParseProtocol(j, SceneFolder() / "p.json");
+  ASSERT_TRUE(p.content.real_camera.has_value());
+  EXPECT_EQ(p.content.real_camera->image_width_px, 1148);
+  EXPECT_DOUBLE_EQ(p.content.real_focus_m, 1.5);
+  const std::pair<Json, std::string> cases[] = {
+      {{{"camera", "camera.json"}, {"focus_m", -1}}, ": /content/real_camera/focus_m: must be a number in [0.01, 1000] m"},
+      {{{"camera", "camera.json"}, {"focus_m", "1"}}, ": /content/real_camera/focus_m: must be a number"},
+      {{{"camera", "camera.json"}}, ": /content/real_camera/focus_m: is required"},
+      {{{"camera", "not-a-camera.json"}, {"focus_m", 1}}, ": /content/real_camera/camera: "},
+      {{{"camera", "."}, {"focus_m", 1}}, ": /content/real_camera/camera: is a folder"},
+      {{{"camera", "camera.json"}, {"focus_m", 1}, {"aperture", 2}}, ": /content/real_camera/aperture: "},
+  };
+  for (const auto& [real, text] : cases) {
+    Json k = j;
+    k["content"]["real_camera"] = real;
+    EXPECT_TRUE(Contains(OnlyProblem(k), text)) << real << ": " << OnlyProblem(k);
+  }
+  Json none = j;
+  none["content"].erase("real_photos");
+  none["factors"] = {{"distance_m", {0.4}}};
+  EXPECT_TRUE(Contains(OnlyProblem(none), ": /content/real_camera: describes the camera of content.real_photos"))
+      << OnlyProblem(none);
+}
+
 TEST(ProtocolValidate, ComparisonWithoutSidesRejected) {
   Json j = Valid();
   j["blocks"][1]["factors"] = {{"section", {1, 2}}};

@@ -207,10 +207,16 @@ cv::Mat ButterworthBlurCpu(const cv::Mat& rgba, double cutoff, int order) {
   return FilterInFrequency(rgba, [&](double f) { return 1.0 / (1.0 + std::pow(f * w / cutoff, 2 * order)); });
 }
 
+double ButterworthEquivalentSigma(double cutoff) { return std::sqrt(std::log(2.0) / 2) / (M_PI * cutoff); }
+
+int ScaledWidthPx(cv::Size picture, int height_px) {
+  return std::max(1, int(std::lround(double(picture.width) * height_px / picture.height)));
+}
+
 cv::Mat PictureOnField(const cv::Mat& picture, cv::Size field, int height_px, int margin_px,
                        const std::function<cv::Mat(const cv::Mat&, int)>& filter, double grey) {
   CV_Assert(height_px > 0 && field.width > 0 && field.height > 0);
-  const int width_px = std::max(1, int(std::lround(double(picture.cols) * height_px / picture.rows)));
+  const int width_px = ScaledWidthPx(picture.size(), height_px);
   cv::Mat scaled;
   cv::resize(picture, scaled, cv::Size(width_px, height_px), 0, 0, cv::INTER_AREA);
   // A transparent margin lets the blur spread past the picture's outline.
@@ -237,7 +243,7 @@ cv::Mat PictureOnGrey(const cv::Mat& picture, cv::Size field, int height_px, dou
   if (!(cutoff >= 0 && cutoff <= kMaxCutoffCyclesPerWidth))
     throw Error(ErrorKind::kDomain, "Butterworth cut-off must be in [0, " + Num(kMaxCutoffCyclesPerWidth) +
                                         "] cycles per picture width (0 = sharp), got " + Num(cutoff));
-  const int width_px = std::max(1, int(std::lround(double(picture.cols) * height_px / picture.rows)));
+  const int width_px = ScaledWidthPx(picture.size(), height_px);
   // The cut-off is per picture width; the padded layer is wider, so scale it to the layer's width.
   auto butterworth = [cutoff](const cv::Mat& layer, int picture_width_px) {
     return cutoff > 0 ? ButterworthBlurCpu(layer, cutoff * layer.cols / picture_width_px) : layer;
@@ -245,9 +251,16 @@ cv::Mat PictureOnGrey(const cv::Mat& picture, cv::Size field, int height_px, dou
   return PictureOnField(picture, field, height_px, std::max(width_px, height_px) / 4, butterworth, grey);
 }
 
+int DepthMatchingPictureHeightPx(int width_px) { return width_px * 3 / 4 / 2 * 6 / 10; }
+
+double DepthMatchingLowerScale(cv::Size photo, int width_px) {
+  const int h = width_px * 3 / 4, lower = h - h / 2;
+  return std::max(double(width_px) / photo.width, double(lower) / photo.height);
+}
+
 cv::Mat DepthMatchingLowerHalf(const cv::Mat& photo, int width_px) {
   const int h = width_px * 3 / 4, lower = h - h / 2;
-  const double scale = std::max(double(width_px) / photo.cols, double(lower) / photo.rows);
+  const double scale = DepthMatchingLowerScale(photo.size(), width_px);
   cv::Mat scaled;
   cv::resize(photo, scaled, cv::Size(), scale, scale, cv::INTER_AREA);
   return scaled(cv::Rect((scaled.cols - width_px) / 2, (scaled.rows - lower) / 2, width_px, lower)).clone();

@@ -51,11 +51,20 @@ cv::Mat FilterInFrequency(const cv::Mat& rgba, const std::function<double(double
 // The image is mirror-padded first so its borders do not wrap around. Throws Error(kDomain) unless the cut-off is
 // in (0, kMaxCutoffCyclesPerWidth] and the order in 1..16.
 cv::Mat ButterworthBlurCpu(const cv::Mat& rgba, double cutoff_cycles_per_width, int order = 2);
+// The std of the Gaussian equivalent to a Butterworth low-pass at `cutoff` cycles per width, in widths: the Gaussian
+// that also halves contrast at the cut-off (H(cutoff) = 1/2 for every order; exp(-2 pi^2 s^2 f^2) = 1/2 there), so
+// s = sqrt(ln 2 / 2) / (pi cutoff) ~ 0.187 / cutoff; its blurcue radius is r = 2 s. The Butterworth's line-spread
+// function has no usable second moment (a 2nd-order one's is zero: H = 1 - (f/fc)^4 + ...), so r = 2 std cannot
+// define it; other equivalences land within 7 % of this one (equal area under the transfer: 0.180 / cutoff; the
+// same 10-90 % edge rise: 0.175 / cutoff, checked against ButterworthBlurCpu in render_test).
+double ButterworthEquivalentSigma(double cutoff_cycles_per_width);
 
 // The depth-matching study's stimulus (thesis 3.2): `picture` (8-bit sRGB, alpha = its shape) scaled to
 // `height_px`, low-passed by the 2nd-order Butterworth at `cutoff` cycles per picture width (0 = sharp), centred on
 // a uniform grey field of `field` size with linear grey level `grey`. Returns 8-bit BGR sRGB.
 cv::Mat PictureOnGrey(const cv::Mat& picture, cv::Size field, int height_px, double cutoff, double grey = 0.18);
+// A picture's width when scaled to height_px (its aspect kept, rounded, at least 1 px).
+int ScaledWidthPx(cv::Size picture, int height_px);
 
 // `picture` scaled to height_px with a transparent margin of margin_px, passed through filter(layer, picture width
 // in px) as CV_32FC4 linear premultiplied, and composited centred on a uniform field of linear grey. 8-bit BGR sRGB.
@@ -66,6 +75,10 @@ cv::Mat PictureOnField(const cv::Mat& picture, cv::Size field, int height_px, in
 // `upper` (a PictureOnGrey of width_px x half the height), the lower half the scene photo scaled to cover it and
 // cropped at its centre.
 cv::Mat DepthMatchingFrame(const cv::Mat& upper, const cv::Mat& photo, int width_px);
+// Its geometry: the picture's height in the upper half (0.6 of it), and the scale (frame px per photo px) at which
+// the lower half shows a photo of `photo` size.
+int DepthMatchingPictureHeightPx(int width_px);
+double DepthMatchingLowerScale(cv::Size photo, int width_px);
 // Its parts: the lower half (the photo scaled and cropped, 8-bit BGR, width_px x 3/4 width_px - half of it), and
 // the two stacked into `frame` (allocated only when its size changes: a trial stepping through levels reuses it).
 cv::Mat DepthMatchingLowerHalf(const cv::Mat& photo, int width_px);

@@ -172,6 +172,32 @@ TEST(CpuBlur, ButterworthKeepsMeanAndSoftensMoreAtLowerCutoff) {
   EXPECT_GT(rise(soft), 3 * rise(sharp));
 }
 
+TEST(CpuBlur, ButterworthEquivalentGaussianHasItsEdgeRise) {
+  // The equivalent Gaussian of a Butterworth cut-off (the one that halves contrast at the cut-off) against the
+  // Butterworth as filtered: the 10-90 % rise of a step (interpolated, in px) through ButterworthBlurCpu and through
+  // GaussianBlurCpu at r = 2 s agree within 10 % (the closed forms say 6.5 %); and the area under the two transfer
+  // functions (pi fc / sqrt 2 and 1 / (sqrt(2 pi) s)) within 5 %.
+  cv::Mat step(9, 1024, CV_32FC4, cv::Scalar(0, 0, 0, 1));
+  step.colRange(512, 1024).setTo(cv::Scalar(1, 1, 1, 1));
+  auto rise = [](const cv::Mat& out) {
+    auto at = [&](int x) { return double(out.at<cv::Vec4f>(out.rows / 2, x)[0]); };
+    auto cross = [&](double level) {
+      for (int x = 1; x < out.cols; ++x)
+        if (at(x) >= level && at(x - 1) < level) return x - 1 + (level - at(x - 1)) / (at(x) - at(x - 1));
+      return -1.0;
+    };
+    return cross(0.9) - cross(0.1);
+  };
+  for (double cutoff : {16.0, 32.0}) {
+    const double s_px = ButterworthEquivalentSigma(cutoff) * step.cols;
+    const double butterworth = rise(ButterworthBlurCpu(step, cutoff)), gaussian = rise(GaussianBlurCpu(step, 2 * s_px));
+    EXPECT_NEAR(butterworth / gaussian, 1.0, 0.10) << cutoff << ": " << butterworth << " vs " << gaussian << " px";
+    EXPECT_NEAR(gaussian, 2 * 1.2815515655 * s_px, 0.03 * gaussian) << cutoff;  // the sampled Gaussian is one
+    const double area_butterworth = M_PI * cutoff / std::sqrt(2.0), area_gaussian = 1 / (std::sqrt(2 * M_PI) * s_px);
+    EXPECT_NEAR(area_butterworth / step.cols / area_gaussian, 1.0, 0.05) << cutoff;
+  }
+}
+
 TEST(CpuBlur, FrequencyFilterIsConvolutionWithTheMirroredImage) {
   // A Gaussian transfer exp(-2 pi^2 s^2 f^2) through the DCT must equal the spatial convolution with the sampled
   // Gaussian over the mirrored image (cv::GaussianBlur, BORDER_REFLECT, kernel to 6 s): at s = 3 px the two differ

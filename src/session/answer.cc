@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "core/error.h"
 #include "core/seed.h"
 
 namespace blurcue::session {
@@ -14,11 +15,32 @@ PairView ViewOf(const TrialScene& scene, const Presentation& presentation) {
   return {scene.r_left_px, scene.r_right_px, scene.r_scene_px, presentation.Arcmin(1)};
 }
 
+AdjustView AdjustViewOf(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation) {
+  AdjustView view;
+  view.distance_m = scene.distance_m;
+  if (scene.content != "picture") return view;
+  if (presentation.real_frame_px_per_px > 0) view.r_real_arcmin = presentation.RealArcmin(scene.r_scene_px);
+  for (double level : trial.adjust_levels) view.level_r_arcmin.push_back(presentation.LevelArcmin(level));
+  return view;
+}
+
+void CheckObserverCanAnswer(const ObserverParams& observer, const protocol::Protocol& protocol) {
+  if (observer.model != ObserverModel::kArcmin || protocol.content.type != "picture" ||
+      !protocol.content.real_camera_file.empty())
+    return;
+  for (const auto& block : protocol.blocks)
+    if (block.task == protocol::Task::kAdjustment)
+      throw InputError(protocol.file.string() + ": /content/real_camera",
+                       "is needed by the simulated observer (model=arcmin), which sets the picture to the real "
+                       "picture's blur in visual angle: name the camera and focus of the real photos, or use --observer "
+                       "sim:model=pixel (a cut-off per distance)");
+}
+
 std::vector<KeyPress> AnswerTrial(SimulatedObserver& observer, const protocol::Protocol& protocol,
                                   const protocol::Trial& trial, const TrialScene& scene,
                                   const Presentation& presentation) {
   using protocol::Task;
-  if (trial.task == Task::kAdjustment) return observer.Adjust(trial.adjust_levels, trial.start_index, scene.distance_m);
+  if (trial.task == Task::kAdjustment) return observer.Adjust(trial.adjust_levels, trial.start_index, AdjustViewOf(trial, scene, presentation));
   const PairView view = ViewOf(scene, presentation);
   const KeyPress press =
       trial.task == Task::kYesNo    ? observer.SayYesNo(view)

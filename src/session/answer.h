@@ -25,6 +25,14 @@ std::vector<KeyPress> AnswerTrial(SimulatedObserver& observer, const protocol::P
                                   const protocol::Trial& trial, const TrialScene& scene,
                                   const Presentation& presentation);
 
+// What the observer sees of an adjustment trial: the distance, and for a picture the real picture's blur (when the
+// protocol names its camera) and each level's blur in arcmin as this presentation shows them.
+AdjustView AdjustViewOf(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation);
+
+// Throws Error(kInput) naming /content/real_camera when `observer` cannot answer the protocol's trials: the arcmin
+// model in a depth-matching (adjustment) block without the real photos' camera. Run and plan check before any trial.
+void CheckObserverCanAnswer(const ObserverParams& observer, const protocol::Protocol& protocol);
+
 // What the observer sees of a trial's pair: its radii (photo px) and arcmin per photo px on this presentation.
 PairView ViewOf(const TrialScene& scene, const Presentation& presentation);
 

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -61,12 +63,12 @@ ObserverParams ParseObserver(const std::string& spec) {
       p.model = text == "pixel" ? ObserverModel::kPixel : ObserverModel::kArcmin;
       named_model = true;
     }
+  static const std::set<std::string> kArcminOnly = {"intrinsic", "weber", "exponent", "side", "blurrier", "rthard"};
+  static const std::set<std::string> kPixelOnly = {"jnd", "bias", "cutoff1m", "slope", "sdlog", "tol"};
   if (!named_model)
     for (const auto& item : items)
-      if (item.first == "jnd" || item.first == "bias") p.model = ObserverModel::kPixel;
+      if (kPixelOnly.count(item.first)) p.model = ObserverModel::kPixel;
   const bool pixel = p.model == ObserverModel::kPixel;
-  static const std::set<std::string> kArcminOnly = {"intrinsic", "weber", "exponent", "side", "blurrier", "rthard"};
-  static const std::set<std::string> kPixelOnly = {"jnd", "bias"};
   std::set<std::string> seen;
   for (const auto& [name, text] : items) {
     if (!seen.insert(name).second)
@@ -84,11 +86,11 @@ ObserverParams ParseObserver(const std::string& spec) {
       if (v > hi || v < lo || (open_lo && v == lo)) bad(what);
       return v;
     };
-    if (!kArcminOnly.count(name) && !kPixelOnly.count(name) &&
-        !std::set<std::string>{"lapse", "rt", "step", "cutoff1m", "slope", "sdlog", "tol"}.count(name))
-      throw Error(ErrorKind::kUsage, "--observer: unknown parameter '" + name + "' (known: model, " +
-                                         (pixel ? "jnd, bias" : "intrinsic, weber, exponent, side, blurrier, rthard") +
-                                         ", lapse, rt, step, cutoff1m, slope, sdlog, tol)");
+    if (!kArcminOnly.count(name) && !kPixelOnly.count(name) && !std::set<std::string>{"lapse", "rt", "step"}.count(name))
+      throw Error(ErrorKind::kUsage,
+                  "--observer: unknown parameter '" + name + "' (known: model, " +
+                      (pixel ? "jnd, bias, cutoff1m, slope, sdlog, tol" : "intrinsic, weber, exponent, side, blurrier, rthard") +
+                      ", lapse, rt, step)");
     if (text.empty() || *end != '\0' || !std::isfinite(v)) bad("must be a number");
     // Ranges: what a human observer could be, so a typo (1e308, a missing decimal point) is refused, not simulated.
     if (name == "intrinsic") p.intrinsic_arcmin = in(0, 60, true, "must be in (0, 60] arcmin (a Gaussian std)");
@@ -118,9 +120,11 @@ std::string ToString(const ObserverParams& p) {
     text += "arcmin,intrinsic=" + Number(p.intrinsic_arcmin) + ",weber=" + Number(p.weber) + ",exponent=" +
             Number(p.exponent) + ",side=" + Number(p.side_bias) + ",blurrier=" + Number(p.blurrier_bias) +
             ",rthard=" + Number(p.rt_hard);
-  return text + ",lapse=" + Number(p.lapse) + ",rt=" + Number(p.rt_ms) + ",step=" + Number(p.step_ms) +
-         ",cutoff1m=" + Number(p.cutoff_1m) + ",slope=" + Number(p.slope) + ",sdlog=" + Number(p.sd_log) +
-         ",tol=" + Number(p.tolerance_log);
+  text += ",lapse=" + Number(p.lapse) + ",rt=" + Number(p.rt_ms) + ",step=" + Number(p.step_ms);
+  if (p.model == ObserverModel::kPixel)
+    text += ",cutoff1m=" + Number(p.cutoff_1m) + ",slope=" + Number(p.slope) + ",sdlog=" + Number(p.sd_log) +
+            ",tol=" + Number(p.tolerance_log);
+  return text;
 }
 
 double ProbabilityCorrect2afc(const ObserverParams& p, double r_a_arcmin, double r_b_arcmin) {
@@ -252,17 +256,35 @@ double SimulatedObserver::TargetCutoff(double distance_m) const {
 }
 
 std::vector<KeyPress> SimulatedObserver::Adjust(const std::vector<double>& levels, int start_index,
-                                                double distance_m) {
+                                                const AdjustView& view) {
   std::vector<KeyPress> presses;
   const int n = static_cast<int>(levels.size());
   if (n == 0) return presses;
-  const double target = std::log(TargetCutoff(distance_m)) + params_.sd_log * Normal();
-  auto miss = [&](int i) { return std::abs(std::log(std::max(levels[size_t(i)], 1e-9)) - target); };
+  // How far level i is from what the observer wants (looked at once, when first shown), and the most it accepts.
+  std::function<double(int)> look;
+  double accept_within = 0;
+  if (params_.model == ObserverModel::kPixel) {
+    const double target = std::log(TargetCutoff(view.distance_m)) + params_.sd_log * Normal();
+    look = [&levels, target](int i) { return std::abs(std::log(std::max(levels[size_t(i)], 1e-9)) - target); };
+    accept_within = params_.tolerance_log;
+  } else {
+    if (!(view.r_real_arcmin >= 0) || view.level_r_arcmin.size() != levels.size())
+      throw Error(ErrorKind::kUsage, "the arcmin observer matches the real picture's blur in visual angle: the "
+                                     "protocol must name the camera of its real photos (content.real_camera), or use "
+                                     "--observer sim:model=pixel");
+    const double real = LogSeenBlur(params_, view.r_real_arcmin / 2), sd = CompareSd();
+    look = [this, &view, real, sd](int i) {
+      return std::abs(LogSeenBlur(params_, view.level_r_arcmin[size_t(i)] / 2) - real + sd * Normal());
+    };
+    accept_within = -1;  // every level is seen; the closest-looking one is taken
+  }
   double first = ResponseTimeMs(params_.rt_ms);  // looking at the first level shown
   int at = ((start_index % n) + n) % n, best = at;
+  double best_miss = std::numeric_limits<double>::infinity();
   for (int seen = 1;; ++seen) {
-    if (miss(at) < miss(best)) best = at;
-    if (miss(at) <= params_.tolerance_log || seen == n) break;
+    const double miss = look(at);
+    if (miss < best_miss) best = at, best_miss = miss;
+    if (miss <= accept_within || seen == n) break;
     presses.push_back({"next", first + ResponseTimeMs(params_.step_ms)});
     first = 0;
     at = (at + 1) % n;

@@ -32,9 +32,15 @@
 // side with the smaller mismatch; "can't tell" when the difference is within half the comparison's noise sd. With
 // probability `lapse` the answer is a uniform draw of the choices instead.
 //
-// Adjustment (both). The observer wants the cut-off cutoff_1m * distance_m ^ slope * exp(N(0, sd_log)) (a straight
-// line in log-log, the shape of the thesis's Fig. 3.3). It steps "next" through the levels as shown, accepting the
-// first one within tolerance_log of its target in log units; after seeing them all it steps back the shorter way to
+// Adjustment (depth matching: the real picture below, the virtual one above at the level shown). model=arcmin: the
+// observer sets the virtual picture to the blur it cannot tell from the real picture's, both in visual angle - each
+// level's blur as its equivalent Gaussian (render::ButterworthEquivalentSigma) and the real one as its camera made it
+// (content.real_camera). It steps "next" through every level, comparing each once with the real picture,
+// D = ln E(level) - ln E(real) + N(0, compare sd), then steps back the shorter way to the level with the smallest |D|
+// and accepts it. Through the dipper, levels all sharper than the eye's intrinsic blur look alike, so for a sharp
+// real picture it takes any of them. model=pixel (of old): it wants the cut-off cutoff_1m * distance_m ^ slope *
+// exp(N(0, sd_log)), a straight line in log-log (the shape of the thesis's Fig. 3.3), steps "next" until a level is
+// within tolerance_log of it in log units and accepts that; after seeing them all it steps back the shorter way to
 // the closest one seen and accepts it.
 #include <cstdint>
 #include <random>
@@ -62,15 +68,16 @@ struct ObserverParams {
   double lapse = 0.04;        // probability of a random answer
   double rt_ms = 900;         // median response time (arcmin: of an easy trial); log-normal with sd_log 0.3
   double step_ms = 350;       // median time between adjustment steps
-  double cutoff_1m = 14;      // adjustment: preferred cut-off at 1 m (cycles per picture width)
-  double slope = -0.8;        // adjustment: d log(cut-off) / d log(distance)
-  double sd_log = 0.15;       // adjustment: sd of the target in natural-log units
-  double tolerance_log = 0.1; // adjustment: accept a level this close to the target (natural-log units)
+  // model=pixel's adjustment
+  double cutoff_1m = 14;      // preferred cut-off at 1 m (cycles per picture width)
+  double slope = -0.8;        // d log(cut-off) / d log(distance)
+  double sd_log = 0.15;       // sd of the target in natural-log units
+  double tolerance_log = 0.1; // accept a level this close to the target (natural-log units)
 };
 
 // "sim" (model=arcmin, defaults) or "sim:NAME=VALUE,...": model=arcmin|pixel; arcmin: intrinsic, weber, exponent,
-// side, blurrier, rthard; pixel: jnd, bias; both: lapse, rt, step, cutoff1m, slope, sdlog, tol. A spec without model=
-// that names jnd or bias is model=pixel (every record before model= existed holds such a spec). Throws Error(kUsage)
+// side, blurrier, rthard; pixel: jnd, bias, cutoff1m, slope, sdlog, tol; both: lapse, rt, step. A spec without model=
+// that names a pixel-only parameter is model=pixel (every record before model= existed holds such a spec). Throws Error(kUsage)
 // naming the parameter and the value for an unknown name, a parameter of the other model or an impossible value.
 ObserverParams ParseObserver(const std::string& spec);
 // The canonical "sim:model=...,..." form (every parameter of its model), recorded with the session; parses back to
@@ -92,6 +99,13 @@ double ProbabilityCorrect2afc(const ObserverParams& p, const PairView& view);
 // model=arcmin: the increment (arcmin, blurcue's r) a 2AFC tells from `r_ref_arcmin` 75 % of the time: the dipper,
 // 2 (((1+w)^p ((r/2)^p + s_i^p) - s_i^p)^(1/p) - r/2).
 double DiscriminationThresholdArcmin(const ObserverParams& p, double r_ref_arcmin);
+
+// What the observer sees of an adjustment trial.
+struct AdjustView {
+  double distance_m = 0;               // the real picture's distance (model=pixel aims at a cut-off for it)
+  double r_real_arcmin = -1;           // model=arcmin: the real picture's blur as shown (blurcue's r); < 0: unknown
+  std::vector<double> level_r_arcmin;  // model=arcmin: each level's blur as shown, in the order of the levels
+};
 
 // One key press, after_ms after the previous one (the first: after the observer starts looking).
 struct KeyPress {
@@ -122,10 +136,10 @@ class SimulatedObserver {
   // exceeds ("1".."n"); a lapse is a uniform draw.
   KeyPress Rate(const PairView& view, int points);
   // The presses answering an adjustment trial: levels in the order the participant steps through them (cyclic),
-  // the index shown first, the distance of the real object.
-  std::vector<KeyPress> Adjust(const std::vector<double>& levels, int start_index, double distance_m);
+  // the index shown first, what is seen. model=arcmin throws Error(kUsage) without the real blur or a level's blur.
+  std::vector<KeyPress> Adjust(const std::vector<double>& levels, int start_index, const AdjustView& view);
 
-  // The cut-off this observer aims at for a distance, before its per-trial noise.
+  // model=pixel: the cut-off this observer aims at for a distance, before its per-trial noise.
   double TargetCutoff(double distance_m) const;
   const ObserverParams& params() const { return params_; }
 

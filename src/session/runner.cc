@@ -700,6 +700,7 @@ RunResult RunSession(const RunOptions& options) {
   const PreparedSession prepared =
       PrepareSession(options.protocol_file, options.participant, options.seed, options.display_profile, group);
   const protocol::Protocol& protocol = prepared.protocol;
+  if (observer) CheckObserverCanAnswer(*observer, protocol);
   const std::string& protocol_text = prepared.protocol_text;
   const uint64_t seed = prepared.seed;
   const std::vector<protocol::Trial>& trials = prepared.trials;

@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "core/image.h"
+#include "optics/thin_lens.h"
 #include "render/blur.h"
 #include "render/frame_compositor.h"
 #include "render/scene_render.h"
@@ -154,6 +155,15 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   if (t.content == "picture") {
     const Json* d = FindLevel(trial.levels, "distance_m");
     t.distance_m = d && d->is_number() ? d->get<double>() : 1.0;
+    // The real picture's blur: the thin lens of the camera that took its photo (content.real_camera).
+    if (const auto& camera = protocol.content.real_camera) {
+      try {
+        t.r_scene_px = optics::BlurRadiusPx(optics::Lens::FromCamera(*camera), protocol.content.real_focus_m * 1000,
+                                            t.distance_m * 1000);
+      } catch (const Error& e) {
+        throw InputError(At(protocol, "/content/real_camera"), std::string(e.what()) + trial_text);
+      }
+    }
     return t;
   }
   if (!scene) throw InputError(protocol.file.string(), "/scene/calib: a " + t.content + " needs a calibration");
@@ -313,6 +323,12 @@ Presentation Presentation::Of(const protocol::Protocol& protocol, const Stimulus
     p.scaling = "fit";
     p.view = {W, p.window_height_px, p.frame_width_px, p.frame_height_px, (W - p.frame_width_px) / 2,
               (H - p.frame_height_px) / 2};
+    if (!images.picture.empty())
+      p.picture_width_px =
+          render::ScaledWidthPx(images.picture.size(), render::DepthMatchingPictureHeightPx(p.frame_width_px));
+    if (const auto& camera = protocol.content.real_camera)
+      p.real_frame_px_per_px = render::DepthMatchingLowerScale(
+          cv::Size(camera->image_width_px, camera->image_height_px), p.frame_width_px);
     return p;
   }
   p.frame_width_px = images.photo.cols;
@@ -344,6 +360,10 @@ Presentation Presentation::Of(const protocol::Protocol& protocol, const Stimulus
   const int pw = int(shown_w), ph = int(std::lround(h * p.scale));
   p.view = {W, p.window_height_px, pw, ph, (W - pw) / 2, (H - ph) / 2};
   return p;
+}
+
+double Presentation::LevelArcmin(double cutoff) const {
+  return cutoff > 0 ? Arcmin(2 * render::ButterworthEquivalentSigma(cutoff) * picture_width_px) : 0;
 }
 
 render::FrameView Presentation::ViewFor(const protocol::Protocol& protocol, const calib::SceneCalib& scene,
@@ -462,12 +482,22 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
     v["odd_interval"] = std::stoi(trial.test_side);
     v["intervals"] = scene.intervals;
   }
+  // Rounded to 1e-4 px: the record is read by people and charts, not fed back.
+  auto round4 = [](double x) { return std::round(x * 1e4) / 1e4; };
   if (trial.task == protocol::Task::kAdjustment) {
     if (trial.start_index >= 0 && size_t(trial.start_index) < trial.adjust_levels.size())
       v["start_level"] = trial.adjust_levels[size_t(trial.start_index)];
-  } else if (scene.content != "picture") {
-    // Rounded to 1e-4 px: the record is read by people and charts, not fed back.
-    auto round4 = [](double x) { return std::round(x * 1e4) / 1e4; };
+  }
+  if (scene.content == "picture") {
+    // The virtual picture's width as shown (a level c's blur is r = 2 x 0.1874 x this / c arcmin), and the real
+    // picture's blur when its camera is known: in its camera's px, on the screen and on the eye.
+    v["picture_width_arcmin"] = round4(presentation.Arcmin(presentation.picture_width_px));
+    if (presentation.real_frame_px_per_px > 0) {
+      v["r_scene_px"] = round4(scene.r_scene_px);
+      v["r_scene_screen_px"] = round4(presentation.ScreenPx(scene.r_scene_px * presentation.real_frame_px_per_px));
+      v["r_scene_arcmin"] = round4(presentation.RealArcmin(scene.r_scene_px));
+    }
+  } else if (trial.task != protocol::Task::kAdjustment) {
     // Each radius as the camera made it (photo px), as the window shows it (screen px) and as the eye gets it.
     // The single layout shows only its object, recorded as the left side.
     for (const auto& [name, r] : {std::pair<const char*, double>{"left", scene.r_left_px},
@@ -644,9 +674,22 @@ void CheckRealPhotos(const protocol::Protocol& protocol, const std::vector<Trial
   if (protocol.content.real_photos.empty()) return;
   std::set<double> checked;
   for (const TrialScene& scene : scenes)
-    if (scene.content == "picture" && checked.insert(scene.distance_m).second)
-      ReadFieldImage(protocol, "/content/real_photos", protocol::RealPhotoFor(protocol.content, scene.distance_m), 1,
-                     10, kMaxPhotoSidePx);
+    if (scene.content == "picture" && checked.insert(scene.distance_m).second) {
+      const cv::Mat photo = ReadFieldImage(protocol, "/content/real_photos",
+                                           protocol::RealPhotoFor(protocol.content, scene.distance_m), 1, 10,
+                                           kMaxPhotoSidePx);
+      // The real blur is worked out on the camera's whole image: a photo of another shape is not that image.
+      if (const auto& camera = protocol.content.real_camera;
+          camera && std::abs(double(photo.cols) / photo.rows -
+                             double(camera->image_width_px) / camera->image_height_px) >
+                        0.01 * camera->image_width_px / camera->image_height_px)
+        throw InputError(At(protocol, "/content/real_camera/camera"),
+                         "its image is " + std::to_string(camera->image_width_px) + "x" +
+                             std::to_string(camera->image_height_px) + " px, but the real photo " +
+                             protocol::RealPhotoFor(protocol.content, scene.distance_m).string() + " is " +
+                             std::to_string(photo.cols) + "x" + std::to_string(photo.rows) +
+                             " (another shape: not a whole photo of that camera)");
+    }
 }
 
 StimulusRenderer::StimulusRenderer(const protocol::Protocol& protocol, const std::optional<calib::SceneCalib>& scene,
@@ -676,7 +719,8 @@ const cv::Mat& StimulusRenderer::UpperHalf(double level) {
                              [&](const auto& entry) { return entry.first == level; });
   if (cached != upper_cache_.end()) return cached->second;
   const int w = picture_width_px_, half = w * 3 / 4 / 2;
-  upper_cache_.emplace_back(level, render::PictureOnGrey(picture_, cv::Size(w, half), half * 6 / 10, level));
+  upper_cache_.emplace_back(level,
+                            render::PictureOnGrey(picture_, cv::Size(w, half), render::DepthMatchingPictureHeightPx(w), level));
   return upper_cache_.back().second;
 }
 

@@ -139,8 +139,17 @@ struct Presentation {
   render::FrameView view;   // the photo's place before a trial moves it (centred, or letterboxed when it fits)
   display::Profile profile;
 
+  // picture: the virtual picture's width on the frame (px), and the frame px per px of the real photos' camera
+  // (content.real_camera, the lower half's scale; 0 without one).
+  double picture_width_px = 0, real_frame_px_per_px = 0;
+
   double ScreenPx(double frame_px) const { return frame_px * scale; }
   double Arcmin(double frame_px) const { return display::ArcminOfScreenPx(profile, ScreenPx(frame_px)); }
+  // picture: the blur as shown (blurcue's r, arcmin) of the virtual picture low-passed at `cutoff` cycles per picture
+  // width (its equivalent Gaussian, render::ButterworthEquivalentSigma; 0 = sharp), and of the real picture blurred
+  // by r_camera_px (px of the real camera's full image).
+  double LevelArcmin(double cutoff) const;
+  double RealArcmin(double r_camera_px) const { return Arcmin(r_camera_px * real_frame_px_per_px); }
   // Where a pair trial shows the photo: `view` when the scaled photo fits the window; else cropped so that what the
   // trial shows (both objects over their whole run) is centred, as far as the photo reaches.
   render::FrameView ViewFor(const protocol::Protocol& protocol, const calib::SceneCalib& scene,
