@@ -1,7 +1,7 @@
-#version 330 core
+#version 420 core
 // The thin-lens pillbox: every texel within radius R (= r, DESIGN.md) of the pixel, weighted by how much of it the
 // disc covers (1 inside, a linear ramp over the last pixel, 0 outside), normalised. Linear, premultiplied RGBA.
-uniform sampler2D u_image;
+layout(rgba32f, binding = 0) uniform readonly image2D u_image;  // read as an image, as the Gaussian's
 uniform ivec4 u_region;        // the image: texels x0 <= x < x1, y0 <= y < y1 (outside it the border texel repeats)
 uniform float u_radius_px;
 uniform int u_taps;            // ceil(R + 0.5)
@@ -15,7 +15,7 @@ void main() {
     for (int dx = -u_taps; dx <= u_taps; ++dx) {
       float w = clamp(u_radius_px + 0.5 - length(vec2(dx, dy)), 0.0, 1.0);
       if (w > 0.0) {
-        sum += w * texelFetch(u_image, clamp(p + ivec2(dx, dy), lo, hi), 0);
+        sum += w * imageLoad(u_image, clamp(p + ivec2(dx, dy), lo, hi));
         weight_sum += w;
       }
     }

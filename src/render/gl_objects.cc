@@ -154,6 +154,12 @@ void Texture::Bind(int unit) const {
   glBindTexture(GL_TEXTURE_2D, name_.id());
 }
 
+void Texture::BindImageForReading(int unit) const {
+  if (format_ != GL_RGBA32F)
+    throw Error(ErrorKind::kInternal, "an image read as rgba32f must be a GL_RGBA32F texture");
+  glBindImageTexture(GLuint(unit), name_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+}
+
 Framebuffer::Framebuffer(const Texture& color, bool with_depth, const Texture* second_color)
     : width_(color.width_px()), height_(color.height_px()) {
   GLuint id = 0;

@@ -73,6 +73,8 @@ class Texture {
   // Reads the whole texture back as CV_32FC4.
   cv::Mat Download() const;
   void Bind(int unit) const;
+  // Binds level 0 to image unit `unit` for imageLoad (a GL_RGBA32F texture only; throws Error(kInternal) else).
+  void BindImageForReading(int unit) const;
   int width_px() const { return width_; }
   int height_px() const { return height_; }
   GLuint id() const { return name_.id(); }

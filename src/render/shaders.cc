@@ -106,7 +106,6 @@ GaussianBlurShader::GaussianBlurShader()
       taps_(program_.Uniform("u_taps")),
       weights_(program_.Uniform("u_weights")),
       direction_(program_.Uniform("u_direction")) {
-  ImageOnUnitZero(program_, "u_image");
 }
 GaussianBlurShader& GaussianBlurShader::Use() {
   program_.Use();
@@ -136,7 +135,6 @@ DiscBlurShader::DiscBlurShader()
       region_(program_.Uniform("u_region")),
       radius_(program_.Uniform("u_radius_px")),
       taps_(program_.Uniform("u_taps")) {
-  ImageOnUnitZero(program_, "u_image");
 }
 DiscBlurShader& DiscBlurShader::Use() {
   program_.Use();
