@@ -687,6 +687,36 @@ print(f"rank correlation {rho:.2f} over {n} trials; real blurred: median set / r
 assert rho > 0.3 and len(blurred) >= 20 and len(sharp) >= 10, rho
 assert 1 / 1.5 < ratio < 1.5 and med([s for _, s in blurred]) > 1.2 * med(sharp)
 PYEOF
+  # validate --plan: per distance, the levels this observer cannot tell from the real picture - counted here from the
+  # thin lens, the equivalent Gaussian and the dipper's closed form (defaults s_i = 0.6', w = 0.35).
+  $BC validate "$P/pre-research-depth-matching.json" --plan > "$W/plan.out" || fail "validate --plan: $(cat "$W/plan.out")"
+  $PY - "$W/plan.out" "$DIR/scene/camera.json" "$P/../stimuli/face.png" "$(dirname "$0")/../stimuli/face.png" > "$W/alike" 2>&1 <<'PYEOF' || fail "levels alike: $(cat "$W/alike")"
+import json, math, os, re, struct, sys
+from statistics import NormalDist
+cam = json.load(open(sys.argv[2]))
+face = sys.argv[3] if os.path.exists(sys.argv[3]) else sys.argv[4]
+w_img, h_img = struct.unpack(">II", open(face, "rb").read()[16:24])
+arcmin = lambda px: 2 * math.atan(0.5 * px * 531.4 / 1920 / 600) * 180 / math.pi * 60  # the default monitor
+f, N, pitch = cam["focal_length_mm"], cam["f_number"], cam["sensor_width_mm"] / cam["image_width_px"]
+scale = max(960 / cam["image_width_px"], 360 / cam["image_height_px"])
+width_arcmin = arcmin(round(w_img * 216 / h_img))
+levels = [2.0, 2.4, 2.8, 3.4, 4.0, 4.8, 5.7, 6.8, 8.2, 9.7, 11.6, 13.8, 16.5, 19.6, 23.4, 27.9, 33.2, 39.6, 47.2, 56.3, 67.1, 80.0]
+ln_e = lambda r: 0.5 * math.log((r / 2) ** 2 + 0.6 ** 2)
+phi = NormalDist().cdf
+seen = 0
+for line in open(sys.argv[1]):
+    m = re.search(r"depth matching at ([\d.]+) m: the real picture's blur [\d.]+' - (\d+) of 22 levels", line)
+    if not m:
+        continue
+    u = float(m.group(1)) * 1000
+    real = arcmin((f / N) * f / 2 * abs(u - 1000) / (u * (1000 - f)) / pitch * scale)
+    alike = sum(phi(0.6744897501960817 * abs(ln_e(2 * 0.18739 * width_arcmin / c) - ln_e(real)) / math.log(1.35)) < 0.75
+                for c in levels)
+    assert alike == int(m.group(2)), (line, alike)
+    seen += 1
+assert seen == 27, seen
+print(f"{seen} distances: the levels alike counted apart agree")
+PYEOF
   sed 's/"real_camera"/"no_camera_here"/' "$P/pre-research-depth-matching.json" |
     $PY -c 'import json,sys; p=json.load(sys.stdin); p["content"].pop("no_camera_here"); json.dump(p, sys.stdout)' > "$P/dm-no-camera.json"
   set +e; $BC run "$P/dm-no-camera.json" --participant X --db "$W/x.sqlite" --observer sim 2> "$W/err"; code=$?; set -e
@@ -695,7 +725,7 @@ PYEOF
   grep -q "dm-no-camera.json: /content/real_camera: is needed by the simulated observer" "$W/err" || fail "error: $(cat "$W/err")"
   [ "$(wc -l < "$W/err")" = 1 ] || fail "more than one line: $(cat "$W/err")"
   [ ! -e "$W/x.sqlite" ] || [ "$(sql "$W/x.sqlite" "SELECT count(*) FROM sessions")" = 0 ] || fail "a session was started"
-  echo "ok: depth matching records the real blur in arcmin (thin lens, worked out apart) and the observer follows it: $(cat "$W/fit")" ;;
+  echo "ok: depth matching records the real blur in arcmin (thin lens, worked out apart) and the observer follows it: $(cat "$W/fit"); validate --plan: $(cat "$W/alike")" ;;
 recover)
   # Through the whole pipeline - trials, the observer's key presses, the record, export and the analysis - the
   # depth-matching fit recovers the cut-off law the simulated observers were given: c = 20 d^-0.5.

@@ -106,8 +106,17 @@ void AddValidateCommand(CLI::App& app) {
           std::snprintf(line, sizeof line, "  visibility (%s; flagged below %g %% correct): %zu distinct pairs, %zu invisible\n",
                         session::ToString(*observer).c_str(), 100 * args->visible, pairs.size(), invisible);
           shown += line;
-          if (pairs.empty()) shown += "    no pairs to compare (adjustment trials)\n";
           for (const auto& pair : pairs) shown += "    " + session::Describe(pair, at.profile) + "\n";
+          // Depth matching: per distance, the levels this observer cannot tell from the real picture.
+          if (observer->model == session::ObserverModel::kArcmin) {
+            const auto matches = session::MatchVisibilities(prepared, *observer, args->visible);
+            for (const auto& match : matches) shown += "    " + session::Describe(match, args->visible) + "\n";
+            if (pairs.empty() && matches.empty())
+              shown += "    nothing to compare: adjustment trials without content.real_camera (the real blur is "
+                       "unknown)\n";
+          } else if (pairs.empty()) {
+            shown += "    nothing to compare: model=pixel has no visual angle for adjustment trials\n";
+          }
         }
         p = std::move(prepared.protocol);
         seed = prepared.seed;

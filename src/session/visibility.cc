@@ -73,6 +73,50 @@ std::vector<PairVisibility> PairVisibilities(const PreparedSession& prepared, co
   return sorted;
 }
 
+std::vector<MatchVisibility> MatchVisibilities(const PreparedSession& prepared, const ObserverParams& observer,
+                                               double level) {
+  std::map<double, MatchVisibility> by_distance;
+  const Presentation& shown = prepared.presentation;
+  if (!(shown.real_frame_px_per_px > 0)) return {};
+  for (const protocol::Trial& t : prepared.trials) {
+    const TrialScene& s = prepared.scenes[size_t(t.index)];
+    if (t.task != protocol::Task::kAdjustment || s.content != "picture") continue;
+    MatchVisibility& m = by_distance[s.distance_m];
+    if (m.trials++ > 0) continue;
+    m.distance_m = s.distance_m;
+    m.r_real_arcmin = shown.RealArcmin(s.r_scene_px);
+    std::vector<double> levels = t.adjust_levels;
+    std::sort(levels.begin(), levels.end());
+    levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+    m.levels = int(levels.size());
+    double nearest = 2;  // the smallest share correct so far: the level that looks most like the real picture
+    for (double c : levels) {
+      const double r = shown.LevelArcmin(c), p = ProbabilityCorrect2afc(observer, r, m.r_real_arcmin);
+      if (p < nearest) nearest = p, m.closest = c, m.closest_r_arcmin = r, m.closest_p = p;
+      if (p >= level) continue;
+      m.alike.push_back(c);
+      m.alike_r_min = m.alike.size() == 1 ? r : std::min(m.alike_r_min, r);
+      m.alike_r_max = std::max(m.alike_r_max, r);
+    }
+  }
+  std::vector<MatchVisibility> out;
+  for (auto& [distance, m] : by_distance) out.push_back(m);
+  return out;
+}
+
+std::string Describe(const MatchVisibility& m, double level) {
+  char text[512];
+  int n = std::snprintf(text, sizeof text, "depth matching at %g m: the real picture's blur %.2f' - %zu of %d levels look "
+                                           "the same (under %.0f %% correct)",
+                        m.distance_m, m.r_real_arcmin, m.alike.size(), m.levels, 100 * level);
+  if (!m.alike.empty())
+    n += std::snprintf(text + n, sizeof text - size_t(n), ": cut-offs %g-%g (%.2f'-%.2f')", m.alike.front(),
+                       m.alike.back(), m.alike_r_min, m.alike_r_max);
+  std::snprintf(text + n, sizeof text - size_t(n), "; the closest, %g (%.2f'), %.0f %% correct", m.closest,
+                m.closest_r_arcmin, 100 * m.closest_p);
+  return text;
+}
+
 std::string Describe(const PairVisibility& pair, const display::Profile& profile) {
   char text[512];
   std::snprintf(text, sizeof text, "%s: %.2f arcmin apart (%.2f' vs %.2f'), predicted %.0f %% correct%s",

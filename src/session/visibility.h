@@ -31,6 +31,25 @@ std::string LevelsLabel(const protocol::Trial& trial);
 std::vector<PairVisibility> PairVisibilities(const PreparedSession& prepared, const ObserverParams& observer,
                                              double level);
 
+// Depth matching (adjustment trials of a picture whose real photos' camera is known, content.real_camera): per
+// distance, the real picture's blur and which of the levels the observer cannot tell from it - the levels whose
+// 2AFC share correct against the real blur is below `level`. Many such levels at a distance mean the match there
+// cannot say which of them was meant. Empty for other protocols, or without real_camera; model=pixel has no arcmin
+// and throws Error(kUsage).
+struct MatchVisibility {
+  double distance_m = 0, r_real_arcmin = 0;
+  int levels = 0;                        // distinct levels offered
+  std::vector<double> alike;             // the levels (cut-offs) that look like the real picture, ascending
+  double alike_r_min = 0, alike_r_max = 0;  // their blurs (arcmin, blurcue's r)
+  double closest = 0, closest_r_arcmin = 0, closest_p = 0.5;  // the level nearest in seen blur, and its share correct
+  int trials = 0;
+};
+std::vector<MatchVisibility> MatchVisibilities(const PreparedSession& prepared, const ObserverParams& observer,
+                                               double level);
+// "depth matching at 1 m: the real picture's blur 0.00' - 9 of 22 levels look the same (under 75 % correct):
+// cut-offs 16.5-80 (0.53'-2.59'); the closest, 80 (1.07'), 51 % correct"
+std::string Describe(const MatchVisibility& match, double level);
+
 // "measured vs estimated at edge 2: 0.30 arcmin apart (0.50' vs 0.80'), predicted 53 % correct - invisible at 60 cm on
 // this monitor" (the profile's distance), or "... predicted 91 % correct".
 std::string Describe(const PairVisibility& pair, const display::Profile& profile);
