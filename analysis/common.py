@@ -33,7 +33,7 @@ REQUIRED = ["study", "participant", "observer", "session_id", "trial_index", "bl
             "swapped", "left_source", "left_fixed", "right_source", "right_fixed", "status", "chosen_side",
             "chosen_interval", "yes_no", "rating", "adjusted_level", "rt_ms"]
 NUMERIC = ["edge", "section", "distance_m", "r_left_px", "r_right_px", "r_scene_px", "start_level", "rt_ms",
-           "trial_index", "session", "speed_cm_s", "level", "adjusted_level"]
+           "trial_index", "session", "speed_cm_s", "level", "adjusted_level", "r_scene_arcmin", "picture_width_arcmin"]
 FIXED_UNITS = {"fixed_px": "px", "fixed_screen_px": "screen px", "fixed_arcmin": "arcmin"}
 
 # One colour per blur source, the same in every chart (colour-blind-safe Okabe-Ito hues).

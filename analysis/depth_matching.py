@@ -125,7 +125,48 @@ def charts(df, out_dir):
     notes.append("fit: log c = a + b log d (natural logs, d in m, c in cycles per picture width); b < 0 means more "
                  "blur is accepted farther away; CIs 95 %")
     summary = summary.rename(columns={"mean": "mean_log_cutoff", "std": "sd_log_cutoff", "count": "observers"})
-    return [Chart("depth-matching", png, svg, table, notes),
-            Chart("depth-matching-per-distance", None, None, summary,
-                  ["geometric mean of the accepted cut-off per distance; low/high: 95 % t-interval across observers "
-                   "of the observers' log cut-offs"])]
+    out = [Chart("depth-matching", png, svg, table, notes),
+           Chart("depth-matching-per-distance", None, None, summary,
+                 ["geometric mean of the accepted cut-off per distance; low/high: 95 % t-interval across observers "
+                  "of the observers' log cut-offs"])]
+    arcmin = _in_visual_angle(a, out_dir)
+    if arcmin is not None:
+        out.append(arcmin)
+    return out
+
+
+# A Butterworth level c's blur as the equivalent Gaussian's (the one that halves contrast at the cut-off, s =
+# sqrt(ln 2 / 2) / (pi c) picture widths; blurcue's r = 2 s), as render::ButterworthEquivalentSigma states it.
+EQUIVALENT_S = math.sqrt(math.log(2) / 2) / math.pi
+
+
+def _in_visual_angle(a, out_dir):
+    """The set blur against the real picture's, both in arcmin at the eye, where the record holds the real blur
+    (content.real_camera): the match a blur-only observer would make lies on the diagonal above the eye's intrinsic
+    blur and anywhere below it."""
+    if "r_scene_arcmin" not in a or "picture_width_arcmin" not in a:
+        return None
+    v = a[a["r_scene_arcmin"].notna() & a["picture_width_arcmin"].notna()].copy()
+    if v.empty:
+        return None
+    v["set_arcmin"] = 2 * EQUIVALENT_S * v["picture_width_arcmin"] / v["cutoff"]
+    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    top = max(v["set_arcmin"].max(), v["r_scene_arcmin"].max()) * 1.1
+    ax.axvspan(0, 1.2, color="#dddddd", zorder=0, label="below the eye's intrinsic blur (r 1.2')")
+    ax.plot([0, top], [0, top], color="#D55E00", lw=1.5, label="set = real (the dipper's match above 1.2')")
+    ax.scatter(v["r_scene_arcmin"], v["set_arcmin"], s=12, alpha=0.5, color="#0072B2", label="answers")
+    med = v.groupby("distance_m").agg(real=("r_scene_arcmin", "first"), set_median=("set_arcmin", "median"),
+                                      answers=("set_arcmin", "size")).reset_index()
+    ax.plot(med["real"], med["set_median"], "s", color="black", ms=4, label="median per distance")
+    ax.set_xlim(0, top)
+    ax.set_ylim(0, top)
+    ax.set_xlabel("the real picture's blur r (arcmin at the eye)")
+    ax.set_ylabel("the accepted level's blur r (arcmin, equivalent Gaussian)")
+    ax.set_title(f"Depth matching in visual angle\n{participants_note(v)}, {len(v)} answers", loc="left")
+    ax.legend(loc="upper left", fontsize=8)
+    png, svg = save(fig, out_dir, "depth-matching-arcmin")
+    rho = sps.spearmanr(v["r_scene_arcmin"], v["set_arcmin"]).correlation if len(v) > 2 else math.nan
+    notes = [f"a level c's blur r = 2 x {EQUIVALENT_S:.4f} x the picture's width (arcmin) / c: the Gaussian that also "
+             "halves contrast at the cut-off; the real blur is the thin lens of the protocol's content.real_camera",
+             f"rank correlation of set and real blur over the answers: {rho:.2f}"]
+    return Chart("depth-matching-arcmin", png, svg, med, notes)

@@ -687,6 +687,12 @@ print(f"rank correlation {rho:.2f} over {n} trials; real blurred: median set / r
 assert rho > 0.3 and len(blurred) >= 20 and len(sharp) >= 10, rho
 assert 1 / 1.5 < ratio < 1.5 and med([s for _, s in blurred]) > 1.2 * med(sharp)
 PYEOF
+  # The report charts set against real blur in arcmin: one row per distance, the real blur as recorded.
+  MPLCONFIGDIR=$W/mpl $BC report --db "$W/s.sqlite" --out "$W/report" --bench "$W/no-bench" --boot 20 > /dev/null 2>&1 \
+    || fail "report"
+  [ -s "$W/report/depth-matching-arcmin.png" ] || fail "no depth-matching-arcmin chart"
+  [ "$(($(wc -l < "$W/report/depth-matching-arcmin.csv") - 1))" = 27 ] || fail "depth-matching-arcmin.csv rows"
+  grep -q "^0.4,3.9249," "$W/report/depth-matching-arcmin.csv" || fail "real blur at 0.4 m: $(head -2 "$W/report/depth-matching-arcmin.csv")"
   # validate --plan: per distance, the levels this observer cannot tell from the real picture - counted here from the
   # thin lens, the equivalent Gaussian and the dipper's closed form (defaults s_i = 0.6', w = 0.35).
   $BC validate "$P/pre-research-depth-matching.json" --plan > "$W/plan.out" || fail "validate --plan: $(cat "$W/plan.out")"

@@ -316,7 +316,8 @@ const std::map<std::string, ColumnDef>& KnownVariables() {
       m[name] = {name, type, unit, "", meaning};
     };
     for (const std::string side : {"left", "right", "scene"}) {
-      const std::string what = side == "scene" ? "the scene's own blur at the object's place (the fitted model)"
+      const std::string what = side == "scene" ? "the scene's own blur at the object's place (the fitted model; depth "
+                                                 "matching: the real picture's, the thin lens of content.real_camera)"
                                                : "the " + side + " object's blur radius";
       add("r_" + side + "_px", "number", "photo px", what + ", as the camera makes it (moving: averaged over the run)");
       add("r_" + side + "_screen_px", "number", "screen px", what + ", on the screen");
@@ -334,6 +335,8 @@ const std::map<std::string, ColumnDef>& KnownVariables() {
     add("white_balance_g", "number", "", "the object's green gain in linear light");
     add("white_balance_b", "number", "", "the object's blue gain in linear light");
     add("start_level", "number", "the adjusted parameter's unit", "adjustment: the level shown first");
+    add("picture_width_arcmin", "number", "arcmin",
+        "depth matching: the virtual picture's width at the eye (a cut-off c's blur is r = 2 x 0.1874 x this / c)");
     add("procedure_cell", "integer", "", "a procedure trial: which crossing of its block's factors (its own procedure)");
     add("test_side", "string", "", "a procedure trial: the side (or odd-one-out interval) showing the procedure's level");
     add("level", "number", "the procedure's variable", "a procedure trial: the level shown");
