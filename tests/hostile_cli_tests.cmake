@@ -105,6 +105,8 @@ hostile_test(cli_hostile_synth_scene_seed_negative 2 "--seed: must be a whole nu
              synth-scene --out ${H}/scene --seed=-3)
 hostile_test(cli_hostile_synth_pictures_focus_inf 2 "--focus-m: must be in (0, 1000] m, got inf"
              synth-pictures --camera ${D}/thesis-camera.json --distances-m 1 --focus-m inf --out ${H}/pictures)
+hostile_test(cli_hostile_synth_pictures_no_camera 2 "give --camera, or a --protocol whose content.real_camera names one"
+             synth-pictures --distances-m 1 --out ${H}/pictures)
 hostile_test(cli_hostile_calibrate_square_nan 2 "--square-mm: must be in [1, 1000] mm, got nan"
              calibrate ${D}/small.png --camera ${D}/thesis-camera.json --square-mm nan)
 hostile_test(cli_hostile_animate_fps_nan 2 "--fps: must be in [1, 1000] frames per second, got nan"

@@ -183,7 +183,7 @@ std::vector<RenderRow> RunRenderBench(const RenderBenchOptions& options) {
   const synth::Scene scene = synth::RenderScene(scene_options);
   const optics::Lens lens = optics::Lens::FromCamera(scene.camera);
   render::FrameCompositor compositor(scene.camera, scene.rvec, scene.tvec, scene.image);
-  const cv::Mat soccer = render::SoccerTexture(1024);
+  const render::SurfaceTexture soccer(render::SoccerTexture(1024));
   const int frames = options.quick ? 10 : 120;
   for (const std::string approach : {"region", "whole_frame"}) {
     std::vector<double> times;

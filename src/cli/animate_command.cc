@@ -82,7 +82,7 @@ void AddAnimateCommand(CLI::App& app) {
     double fixed_left = 0, fixed_right = 0;
     const calib::BlurSource left = calib::ParseBlurSource(args->left, &fixed_left);
     const calib::BlurSource right = calib::ParseBlurSource(args->right, &fixed_right);
-    const cv::Mat texture = ReadImage(render::ResolveStimulus(args->texture));
+    const render::SurfaceTexture texture(ReadImage(render::ResolveStimulus(args->texture)));
 
     std::unique_ptr<render::GlContext> context;
     if (args->window) {

@@ -112,7 +112,7 @@ void AddRenderCommand(CLI::App& app) {
     } else {
       throw Error(ErrorKind::kUsage, "--object must be grid or ball[:TEXTURE], got '" + args->object + "'");
     }
-    object.texture = ReadImage(render::ResolveStimulus(texture_name));
+    object.texture = render::SurfaceTexture(ReadImage(render::ResolveStimulus(texture_name)));
     object.brightness = args->brightness;
     object.contrast = args->contrast;
 

@@ -1,6 +1,8 @@
 #include "render/scene_render.h"
 
 #include <algorithm>
+#include <atomic>
+#include <utility>
 #include <cmath>
 #include <map>
 #include <vector>
@@ -15,6 +17,11 @@
 #include "render/shaders.h"
 
 namespace blurcue::render {
+
+SurfaceTexture::SurfaceTexture(cv::Mat image) : image_(std::move(image)) {
+  static std::atomic<uint64_t> next{1};
+  id_ = next.fetch_add(1);
+}
 namespace {
 
 struct Vertex {
@@ -100,23 +107,16 @@ struct SceneRenderer::Impl {
   GLsizei card_indices = 0;
   BallShader ball_shader;
   FullscreenPass pass;  // a ball covers its layer with one triangle
-  // Textures by their image: a moving ball re-uses its texture every frame. Each entry holds its image (a cv::Mat
-  // shares the pixels), so those pixels stay allocated and their address cannot come back as another image's.
-  struct CachedTexture {
-    cv::Mat image;
-    std::unique_ptr<Texture> texture;
-  };
-  std::map<const uchar*, CachedTexture> textures;
+  // Textures by their identity (SurfaceTexture::id): a moving ball re-uses its texture every frame.
+  std::map<uint64_t, std::unique_ptr<Texture>> textures;
 
-  const Texture& TextureFor(const cv::Mat& image) {
-    // A caller that made a new image every frame would grow the cache without end: past 64 images it starts over.
-    if (textures.size() > 64 && !textures.count(image.data)) textures.clear();
-    auto& slot = textures[image.data];
-    if (!slot.texture || slot.image.size() != image.size() || slot.image.type() != image.type()) {
-      slot.image = image;
-      slot.texture = std::make_unique<Texture>(Texture::FromSrgbImage(image));
-    }
-    return *slot.texture;
+  const Texture& TextureFor(const SurfaceTexture& surface) {
+    if (surface.empty()) throw Error(ErrorKind::kInternal, "an object without a texture was drawn");
+    // A caller that made a new SurfaceTexture every frame would grow the cache without end: past 64 it starts over.
+    if (textures.size() > 64 && !textures.count(surface.id())) textures.clear();
+    std::unique_ptr<Texture>& slot = textures[surface.id()];
+    if (!slot) slot = std::make_unique<Texture>(Texture::FromSrgbImage(surface.image()));
+    return *slot;
   }
 
   // The multisample targets objects are drawn into: made once and grown (to multiples of 64 px) when a layer is

@@ -2,6 +2,7 @@
 // Virtual content placed in a calibrated scene's board frame (mm), drawn with GL into a layer that covers only the
 // object's pixels plus the blur kernel's margin (model no more than a scene needs), blurred, and composited over
 // the photo in linear light.
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -13,6 +14,23 @@
 #include "core/camera.h"
 
 namespace blurcue::render {
+
+// An object's surface texture: an 8-bit sRGB image (BGR/BGRA) with an identity of its own. The renderer keeps one GL
+// texture per identity, made the first time it is drawn; an image's address is no identity (freed pixels come back
+// as another image's), an id is never handed out twice in a process. Make one per image, once, and copy it freely
+// (the pixels are shared); a new SurfaceTexture of the same pixels is a new texture to the renderer.
+class SurfaceTexture {
+ public:
+  SurfaceTexture() = default;
+  explicit SurfaceTexture(cv::Mat image);
+  const cv::Mat& image() const { return image_; }
+  uint64_t id() const { return id_; }
+  bool empty() const { return image_.empty(); }
+
+ private:
+  cv::Mat image_;
+  uint64_t id_ = 0;
+};
 
 struct VirtualObject {
   enum class Kind { kCard, kBall };
@@ -26,7 +44,7 @@ struct VirtualObject {
   double card_height_mm = 0;
   bool standing = false;
   double rotation_deg = 0;
-  cv::Mat texture;      // 8-bit sRGB BGR/BGRA: equirectangular for a ball, the card's face for a card
+  SurfaceTexture texture;  // equirectangular for a ball, the card's face for a card
   double brightness = 1.0, contrast = 1.0;
   cv::Vec3d white_balance{1, 1, 1};  // gains of red, green, blue in linear light (after brightness and contrast)
   double spin_deg = 0;  // rotation of a ball about the board's x axis (rolling along y)

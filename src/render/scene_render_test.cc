@@ -41,8 +41,9 @@ VirtualObject Ball(double y_mm) {
   o.kind = VirtualObject::Kind::kBall;
   o.size_mm = 10;
   o.center_board_mm = {87.5, y_mm, 10};
-  o.texture = cv::Mat(64, 128, CV_8UC3, cv::Scalar(200, 200, 200));
-  o.texture(cv::Rect(0, 0, 64, 32)).setTo(cv::Scalar(30, 30, 30));
+  cv::Mat texture(64, 128, CV_8UC3, cv::Scalar(200, 200, 200));
+  texture(cv::Rect(0, 0, 64, 32)).setTo(cv::Scalar(30, 30, 30));
+  o.texture = SurfaceTexture(texture);
   return o;
 }
 
@@ -52,7 +53,7 @@ VirtualObject FlatCard(double size_mm, int grey) {
   card.kind = VirtualObject::Kind::kCard;
   card.size_mm = size_mm;
   card.center_board_mm = {87.5, 125, 0};
-  card.texture = cv::Mat(32, 32, CV_8UC3, cv::Scalar::all(grey));
+  card.texture = SurfaceTexture(cv::Mat(32, 32, CV_8UC3, cv::Scalar::all(grey)));
   return card;
 }
 
@@ -62,6 +63,25 @@ cv::Point2d AlphaCentroid(const Layer& layer, double* area) {
   const cv::Moments m = cv::moments(alpha);
   *area = m.m00;
   return {layer.roi.x + m.m10 / m.m00 - 0.5, layer.roi.y + m.m01 / m.m00 - 0.5};
+}
+
+// Textures are kept by their SurfaceTexture's identity, not by the image's address: a new texture whose pixels land
+// where a freed one's were is drawn as itself, and copies of one SurfaceTexture share its id.
+TEST_F(SceneRenderTest, TexturesAreKeptByIdentityNotByAddress) {
+  const View v;
+  SceneRenderer renderer(v.camera, v.rvec, v.tvec);
+  auto mean_blue = [&](const VirtualObject& card) { return cv::mean(renderer.Draw(card, 2).bgra)[0]; };
+  VirtualObject card = FlatCard(50, 0);
+  cv::Mat pixels(32, 32, CV_8UC3, cv::Scalar::all(40));
+  card.texture = SurfaceTexture(pixels);
+  const double dark = mean_blue(card);
+  pixels.setTo(cv::Scalar::all(220));  // the same pixels, the same address: another image now
+  card.texture = SurfaceTexture(pixels);
+  const double light = mean_blue(card);
+  EXPECT_GT(light, 5 * dark) << dark << " vs " << light << ": the renderer drew the old texture for a new one";
+  const SurfaceTexture a(pixels), copy = a, b(pixels);
+  EXPECT_EQ(copy.id(), a.id());
+  EXPECT_NE(b.id(), a.id());
 }
 
 TEST_F(SceneRenderTest, BallLandsWhereThePoseProjectsIt) {

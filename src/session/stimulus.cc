@@ -707,7 +707,7 @@ StimulusRenderer::StimulusRenderer(const protocol::Protocol& protocol, const std
     return;
   }
   if (!scene_) scene_ = LoadProtocolScene(protocol);
-  texture_ = images.texture;
+  texture_ = render::SurfaceTexture(images.texture);
   compositor_ = std::make_unique<render::FrameCompositor>(scene_->camera, scene_->rvec, scene_->tvec, photo_,
                                                           presentation.view);
 }

@@ -210,7 +210,8 @@ class StimulusRenderer {
   const protocol::Protocol& protocol_;
   std::optional<calib::SceneCalib> scene_;
   Presentation presentation_;
-  cv::Mat photo_, texture_;
+  cv::Mat photo_;
+  render::SurfaceTexture texture_;  // the objects' texture: one GL texture for the session
   std::unique_ptr<render::FrameCompositor> compositor_;
   // Picture: the upper half at a cut-off, made once (the Butterworth runs on the CPU) and kept; every level of
   // the protocol is made up front.
