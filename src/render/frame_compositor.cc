@@ -119,14 +119,15 @@ struct FrameCompositor::Impl {
   }
 
   // The per-pixel plan: the layer and its depth read back, each pixel blurred by the radius of its own depth on the
-  // CPU (levels 0.5 px apart, each a GL blur), and blended back. Only objects whose depth span asks for it pay this.
+  // CPU (levels 0.5 px apart, each through the CPU blur - the GL one would make a texture and a framebuffer per level
+  // and frame for a layer this small), and blended back. Only objects whose depth span asks for it pay this.
   void ComposeVarying(const BlurredObject& o, double scale) {
     const Footprint f = renderer.Measure(o.object);
     auto r_screen = [&](double z) { return std::max(0.0, o.r_of_depth_px(z) * scale); };
     const double r_max = std::max({o.r_px * scale, r_screen(f.z_min_mm), r_screen(f.z_max_mm)});
     Layer layer = renderer.Draw(o.object, KernelMarginPx(o.method, r_max) + 1);
     if (layer.bgra.empty()) return;
-    BlurLayerVarying(layer, o.method, r_screen, &blur);
+    BlurLayerVarying(layer, o.method, r_screen, nullptr);
     cv::Mat rgba;
     cv::cvtColor(layer.bgra, rgba, cv::COLOR_BGRA2RGBA);
     uploaded.Upload(rgba);
