@@ -64,7 +64,36 @@ same_as_run)
     || fail "plan staircase"
   grep -q ",skipped$" "$W/s/answers.csv" || fail "the staircase case skips nothing"
   same_as_run "$W/s/answers.csv" "$P/staircase-ball-gain.json" sim
-  echo "ok: plan's simulated participants answer as blurcue run records them (pair, QUEST+ with deadline, staircase with stop rule)" ;;
+  $BC plan "$P/pre-research-depth-matching.json" --participants 2 --studies 1 --seed 10 --no-chart --out "$W/d" \
+    > /dev/null 2>&1 || fail "plan depth matching"
+  same_as_run "$W/d/answers.csv" "$P/pre-research-depth-matching.json" sim
+  echo "ok: plan's simulated participants answer as blurcue run records them (pair, QUEST+ with deadline, staircase with stop rule, depth matching in arcmin)" ;;
+depth_slope)
+  # Depth matching's slope test: observers given the power law c = 20 d^-0.5 (model=pixel) give a mean slope of -0.5
+  # and a test that finds it; observers given no slope (0) are rejected at the test's level, alpha = 0.05, at every
+  # N (within 3 binomial sds of 400 studies: 0.05 +- 0.033) - the t-test's size, not assumed but counted.
+  $BC plan "$P/pre-research-depth-matching.json" --participants 6 --studies 400 --seed 3 --no-chart --out "$W/slope" \
+    --observer sim:cutoff1m=20,slope=-0.5,sdlog=0.3,tol=0.05 > "$W/slope.out" 2>&1 || fail "plan: $(tail -2 "$W/slope.out")"
+  $BC plan "$P/pre-research-depth-matching.json" --participants 6 --studies 400 --seed 4 --no-chart --out "$W/flat" \
+    --observer sim:cutoff1m=20,slope=0,sdlog=0.3,tol=0.05 > "$W/flat.out" 2>&1 || fail "plan: $(tail -2 "$W/flat.out")"
+  $PY - "$W/slope/plan.csv" "$W/flat/plan.csv" <<'PYEOF' || fail "slope rows"
+import csv, sys
+def rows(path):
+    return [r for r in csv.DictReader(open(path)) if r["test"] == "slope_t"]
+slope, flat = rows(sys.argv[1]), rows(sys.argv[2])
+assert len(slope) == 6 and len(flat) == 6, (len(slope), len(flat))
+b = float(slope[0]["expected_share"])
+assert abs(b + 0.5) < 0.03, b
+assert float(slope[1]["power"]) > 0.2 and float(slope[5]["power"]) > 0.95, [r["power"] for r in slope]
+assert float(slope[0]["power"]) == 0 and slope[0]["wilson_width"] == "", slope[0]  # one participant: no test
+for r in flat[1:]:
+    assert abs(float(r["power"]) - 0.05) < 0.033, r
+assert abs(float(flat[0]["expected_share"])) < 0.03, flat[0]
+print(f"slope -0.5: mean b {b:.3f}, power at N = 2..6 {[r['power'][:5] for r in slope[1:]]}; slope 0: rejected "
+      f"{[r['power'][:5] for r in flat[1:]]}")
+PYEOF
+  grep -q "cut-off ~ distance = depth matching" "$W/slope.out" || fail "summary: $(cat "$W/slope.out")"
+  echo "ok: depth matching's slope test finds c = 20 d^-0.5 and keeps its level when there is no slope" ;;
 power_exact)
   # A design whose answers are binomial with a known p: one condition (edge 5), 10 repetitions, a strict 2AFC
   # between no blur and 30 px (the observer's noise 0.001 px: it always prefers the side nearer the scene's own

@@ -93,6 +93,29 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
     const session::Scored scored = logic.Answer(trial, scene, level, choice);
     if (keep_answers) p.answers.emplace_back(trial.index, choice);
     if (trial.practice) continue;
+    if (trial.task == Task::kAdjustment && scene.content == "picture") {
+      // Depth matching: one condition per block, the slope of the accepted cut-off on distance across its trials.
+      Condition c;
+      for (size_t b = 0; b < protocol.blocks.size(); ++b)
+        if (protocol.blocks[b].name == trial.block) c.block = static_cast<int>(b);
+      c.key = trial.block + "\nslope";
+      c.levels = "{}";
+      c.label = (several_blocks ? trial.block + ": " : std::string()) + "cut-off ~ distance";
+      c.measure = "log_cutoff_slope";
+      c.chance = 0;
+      conditions->emplace(c.key, c);
+      Tally& t = p.tallies[c.key];
+      ++t.shown;
+      char* end = nullptr;
+      const double cutoff = std::strtod(choice.c_str(), &end);
+      if (choice.empty() || *end != '\0' || !(cutoff > 0) || !(scene.distance_m > 0)) {
+        ++t.none;
+        continue;
+      }
+      ++t.n;
+      p.matches[c.key].emplace_back(std::log(scene.distance_m), std::log(cutoff));
+      continue;
+    }
     const std::optional<Condition> c = ConditionOf(protocol, trial, scene, several_blocks);
     if (!c) {
       unplanned->insert(protocol::ToString(trial.task));
@@ -232,6 +255,61 @@ std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& opti
   return out;
 }
 
+namespace {
+
+// Depth matching's rows: per N, the mean slope, the mean width of its 95 % t interval across N participants, and the
+// power of the t-test of the slopes against 0.
+void AddSlopeRows(PlanResult& r, const Condition& c, const PlanOptions& options) {
+  const int N = options.participants, S = options.studies;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::vector<double>> slopes(static_cast<size_t>(S));
+  double sum = 0, matches = 0, shown = 0, none = 0;  // matches, shown, none: over participants 1 .. m
+  int count = 0;
+  for (int s = 0; s < S; ++s)
+    for (const SimParticipant& p : r.studies[size_t(s)]) {
+      const auto it = p.matches.find(c.key);
+      const double b = it == p.matches.end() ? nan : OlsSlope(it->second);
+      slopes[size_t(s)].push_back(b);
+      if (std::isfinite(b)) sum += b, ++count;
+    }
+  for (int m = 1; m <= N; ++m) {
+    PowerRow row;
+    row.test = "slope_t";
+    row.condition = c.label;
+    row.measure = c.measure;
+    row.chance = 0;
+    row.participants = m;
+    row.expected_share = count > 0 ? sum / count : nan;
+    row.share_first = row.share_second = row.share_cant_tell = nan;
+    double width = 0;
+    int rejected = 0, widths = 0;
+    for (int s = 0; s < S; ++s) {
+      const SimParticipant& p = r.studies[size_t(s)][size_t(m - 1)];
+      if (const auto it = p.tallies.find(c.key); it != p.tallies.end()) shown += it->second.shown, none += it->second.none;
+      if (const auto it = p.matches.find(c.key); it != p.matches.end()) matches += double(it->second.size());
+      std::vector<double> values;
+      for (int i = 0; i < m; ++i)
+        if (std::isfinite(slopes[size_t(s)][size_t(i)])) values.push_back(slopes[size_t(s)][size_t(i)]);
+      if (values.size() >= 2) {
+        double mean = 0, ss = 0;
+        for (double v : values) mean += v;
+        mean /= double(values.size());
+        for (double v : values) ss += (v - mean) * (v - mean);
+        width += 2 * StudentT975(int(values.size()) - 1) * std::sqrt(ss / double(values.size() - 1) / double(values.size()));
+        ++widths;
+      }
+      rejected += values.size() >= 2 && OneSampleTTestP(values, 0) < options.alpha;
+    }
+    row.share_none = shown > 0 ? none / shown : nan;
+    row.mean_trials = matches / S;  // answered matches per study at this N
+    row.wilson_width = widths > 0 ? width / widths : nan;
+    row.power = double(rejected) / S;
+    r.rows.push_back(row);
+  }
+}
+
+}  // namespace
+
 PlanResult RunPlan(const PlanOptions& options) {
   if (!(options.alpha > 0 && options.alpha < 1)) throw Error(ErrorKind::kUsage, "--alpha must be in (0, 1)");
   PlanResult r;
@@ -247,7 +325,7 @@ PlanResult RunPlan(const PlanOptions& options) {
   if (r.conditions.empty())
     throw InputError(options.protocol_file.string(),
                      "nothing to plan: no main trial has a share to test (forced choice, a procedure, odd one out or "
-                     "yes/no)");
+                     "yes/no) or a depth matching over distances");
   // p-values of the exact test are a function of (k, n, chance): each (n, chance) computed once.
   std::map<std::pair<int, double>, std::vector<double>> p_cache;
   auto p_of = [&](int k, int n, double chance) {
@@ -259,6 +337,10 @@ PlanResult RunPlan(const PlanOptions& options) {
     return v[size_t(k)];
   };
   for (const Condition& c : r.conditions) {
+    if (c.measure == "log_cutoff_slope") {
+      AddSlopeRows(r, c, options);
+      continue;
+    }
     // The expected shares over every study and participant.
     Tally all;
     for (const auto& study : r.studies)
@@ -306,7 +388,7 @@ PlanResult RunPlan(const PlanOptions& options) {
   // Across participants: each participant's share over all the trials of one measure, against its chance level.
   std::set<std::pair<std::string, double>> measures;
   for (const Condition& c : r.conditions)
-    if (c.chance >= 0) measures.insert({c.measure, c.chance});
+    if (c.chance >= 0 && c.measure != "log_cutoff_slope") measures.insert({c.measure, c.chance});
   for (const auto& [measure, chance] : measures) {
     std::vector<std::vector<double>> shares(static_cast<size_t>(S));
     double sum = 0;
@@ -412,6 +494,13 @@ std::string Summary(const PlanResult& r, const PlanOptions& o) {
   }
   out += "all: t across participants = a one-sample t-test of each participant's share against chance, the stand-in "
          "for the report's GLMM (its intercept), whose fit per simulated study would be too slow\n";
+  for (const PowerRow& row : r.rows)
+    if (row.test == "slope_t") {
+      out += "cut-off ~ distance = depth matching: share is the mean slope b of log(accepted cut-off) on log(distance) "
+             "per participant (the report's c = e^a d^b), width its 95 % t interval's across the N participants, power "
+             "that of a t-test of the slopes against 0\n";
+      break;
+    }
   for (const std::string& note : r.notes) out += "note: " + note + "\n";
   return out;
 }

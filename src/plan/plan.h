@@ -11,6 +11,10 @@
 //                  trials) against chance: a stand-in for the report's GLMM (random intercept per participant), whose
 //                  fit per simulated study would take minutes; it tests the same population-level effect (the
 //                  intercept), not the GLMM's per-level terms.
+//   slope_t        depth matching (an adjustment block over two or more distances): each participant's least-squares
+//                  slope b of log(accepted cut-off) on log(distance) - the report's power law c = e^a d^b - and a
+//                  one-sample t-test of the slopes against 0 across participants (the report's mixed model's slope
+//                  with a random intercept, in the same stand-in spirit).
 // Deterministic: participant i of study s is "P<i+1>" with seed DeriveSeed(DeriveSeed(seed, s), i), whatever the
 // thread count, so the first n participants of a study of N are the study of n, and every simulated participant can
 // be rerun with `blurcue run --participant P<i+1> --seed <its seed> --observer <the same>`.
@@ -46,7 +50,7 @@ struct Condition {
   int block = 0;          // index in protocol.blocks (conditions are ordered by block, then levels)
   std::string levels;     // the levels as JSON
   std::string label;      // "edge=3" (and the block's name when the protocol has several)
-  std::string measure;    // "first_source" (a pair) | "correct" | "yes"
+  std::string measure;    // "first_source" (a pair) | "correct" | "yes" | "log_cutoff_slope" (depth matching)
   std::string first, second;  // a pair: the design's left and right source
   double chance = -1;     // the test's null share; < 0: no test (yes/no)
 };
@@ -62,19 +66,21 @@ struct SimParticipant {
   uint64_t seed = 0;
   std::vector<std::pair<int, std::string>> answers;  // (trial index, choice as the record stores it), every trial
   std::map<std::string, Tally> tallies;               // by condition key
+  // Depth matching, by condition key: (log distance, log accepted cut-off) of each answered trial.
+  std::map<std::string, std::vector<std::pair<double, double>>> matches;
 };
 
 // One row of the plan: a test of a condition (or of all the participants' trials) at a number of participants.
 struct PowerRow {
-  std::string test;        // "binomial" | "participants_t" | "none" (a condition without a chance level)
+  std::string test;        // "binomial" | "participants_t" | "slope_t" | "none" (a condition without a chance level)
   std::string condition;   // its label; "all" for participants_t
   std::string measure;
   double chance = -1;
   int participants = 0;
-  double expected_share = 0;   // over every simulated study and participant
+  double expected_share = 0;   // over every simulated study and participant (slope_t: the mean slope b)
   double share_first = 0, share_second = 0, share_cant_tell = 0, share_none = 0;  // a pair's answers, of shown
   double mean_trials = 0;      // counting trials per study at this N (mean)
-  double wilson_width = 0;     // mean width of the 95 % Wilson interval at this N
+  double wilson_width = 0;     // mean width of the 95 % Wilson interval at this N (slope_t: of the mean slope's t interval)
   double power = 0;            // share of studies whose test has p < alpha (NaN for "none")
 };
 

@@ -95,4 +95,24 @@ double OneSampleTTestP(const std::vector<double>& values, double mu) {
   return IncompleteBeta(df / 2, 0.5, df / (df + t * t));
 }
 
+double StudentT975(int df) {
+  // Two-sided P(|T| > t) = I_{df / (df + t^2)}(df / 2, 1 / 2) falls from 1 at t = 0: find where it is 0.05.
+  double lo = 0, hi = 1e6;
+  for (int i = 0; i < 200 && hi - lo > 1e-10; ++i) {
+    const double t = (lo + hi) / 2;
+    (IncompleteBeta(df / 2.0, 0.5, df / (df + t * t)) > 0.05 ? lo : hi) = t;
+  }
+  return (lo + hi) / 2;
+}
+
+double OlsSlope(const std::vector<std::pair<double, double>>& points) {
+  const double n = double(points.size());
+  double mx = 0, my = 0;
+  for (const auto& [x, y] : points) mx += x, my += y;
+  mx /= n, my /= n;
+  double sxx = 0, sxy = 0;
+  for (const auto& [x, y] : points) sxx += (x - mx) * (x - mx), sxy += (x - mx) * (y - my);
+  return points.size() >= 2 && sxx > 1e-12 ? sxy / sxx : std::numeric_limits<double>::quiet_NaN();
+}
+
 }  // namespace blurcue::plan

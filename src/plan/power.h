@@ -24,4 +24,11 @@ double IncompleteBeta(double a, double b, double x);
 // vary (0 when their mean differs from mu).
 double OneSampleTTestP(const std::vector<double>& values, double mu);
 
+// The 97.5 % quantile of Student's t with df degrees of freedom (df >= 1; bisection on IncompleteBeta to 1e-10):
+// a 95 % interval of a mean of n values is mean +- StudentT975(n - 1) sd / sqrt(n).
+double StudentT975(int df);
+
+// The least-squares slope of y on x over the points (x, y); NaN for fewer than two distinct x.
+double OlsSlope(const std::vector<std::pair<double, double>>& points);
+
 }  // namespace blurcue::plan

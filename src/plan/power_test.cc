@@ -49,5 +49,21 @@ TEST(OneSampleT, SmallSamplesMatchTheClosedFormTails) {
   EXPECT_EQ(OneSampleTTestP({0.9}, 0.5), 1);
 }
 
+TEST(StudentT, QuantilesMatchTheTable) {
+  // t(0.975) from the standard table; df = 1 is the Cauchy's tan(0.475 pi), df = 2 is 2 / sqrt(0.95^2 ... ) closed.
+  EXPECT_NEAR(StudentT975(1), std::tan(0.475 * M_PI), 1e-6);
+  EXPECT_NEAR(StudentT975(2), 4.302652729, 1e-6);
+  EXPECT_NEAR(StudentT975(10), 2.228138852, 1e-6);
+  EXPECT_NEAR(StudentT975(30), 2.042272456, 1e-6);
+  EXPECT_NEAR(StudentT975(100000), 1.959963985, 1e-4);
+}
+
+TEST(OlsSlope, ExactLineAndDegenerateX) {
+  EXPECT_NEAR(OlsSlope({{0, 1}, {1, 3}, {2, 5}}), 2, 1e-12);
+  EXPECT_NEAR(OlsSlope({{0, 0}, {1, 1}, {2, 0}, {3, 1}}), 0.2, 1e-12);  // sxy 1 / sxx 5
+  EXPECT_TRUE(std::isnan(OlsSlope({{1, 0}, {1, 5}})));
+  EXPECT_TRUE(std::isnan(OlsSlope({{1, 0}})));
+}
+
 }  // namespace
 }  // namespace blurcue::plan

@@ -42,7 +42,7 @@ void PrepareParticipant(PreparedSession* s, const std::string& participant, std:
   s->scenes.reserve(s->trials.size());
   for (const protocol::Trial& trial : s->trials)
     s->scenes.push_back(DescribeTrial(s->protocol, trial, s->scene ? &*s->scene : nullptr, &s->presentation));
-  CheckRealPhotos(s->protocol, s->scenes);
+  CheckRealPhotos(s->protocol, s->scenes, &s->real_photos_checked);
   // Each pair trial's blur plan on that screen: one radius, or per pixel by depth where the object's depth asks.
   if (s->scene)
     for (TrialScene& scene : s->scenes) PlanOnScreen(s->protocol, *s->scene, s->presentation, &scene);

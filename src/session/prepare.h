@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,7 @@ struct PreparedSession {
   std::vector<TrialScene> scenes;         // one per trial
   display::Profile display;               // --display, else the protocol's display.profile, else the default
   Presentation presentation;              // how a frame maps to the screen and the eye
+  std::set<double> real_photos_checked;   // the distances whose real photo has been decoded (CheckRealPhotos)
 };
 
 // Reads and validates the protocol, builds the participant's trial list, loads the calibration and every image

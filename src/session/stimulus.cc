@@ -670,11 +670,11 @@ StimulusImages LoadStimulusImages(const protocol::Protocol& protocol, const std:
   return images;
 }
 
-void CheckRealPhotos(const protocol::Protocol& protocol, const std::vector<TrialScene>& scenes) {
+void CheckRealPhotos(const protocol::Protocol& protocol, const std::vector<TrialScene>& scenes,
+                     std::set<double>* checked) {
   if (protocol.content.real_photos.empty()) return;
-  std::set<double> checked;
   for (const TrialScene& scene : scenes)
-    if (scene.content == "picture" && checked.insert(scene.distance_m).second) {
+    if (scene.content == "picture" && checked->insert(scene.distance_m).second) {
       const cv::Mat photo = ReadFieldImage(protocol, "/content/real_photos",
                                            protocol::RealPhotoFor(protocol.content, scene.distance_m), 1, 10,
                                            kMaxPhotoSidePx);

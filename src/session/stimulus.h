@@ -12,6 +12,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -172,9 +173,11 @@ Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, cons
 // Error(kInput) naming the protocol file and the field (/scene/background, /content/texture, ...). No GL.
 StimulusImages LoadStimulusImages(const protocol::Protocol& protocol, const std::optional<calib::SceneCalib>& scene);
 
-// Decodes the real photo (content.real_photos) of every distance the trials show; throws naming
+// Decodes the real photo (content.real_photos) of every distance the trials show that is not in `checked` yet, and
+// adds it there (a study's participants share their photos: each is decoded once); throws naming
 // /content/real_photos. No GL.
-void CheckRealPhotos(const protocol::Protocol& protocol, const std::vector<TrialScene>& scenes);
+void CheckRealPhotos(const protocol::Protocol& protocol, const std::vector<TrialScene>& scenes,
+                     std::set<double>* checked);
 
 class StimulusRenderer {
  public:
