@@ -216,15 +216,9 @@ void AddPreviewCommand(CLI::App& app) {
     WriteImage(args->out, sheet);
     std::printf("%s: %zu distinct stimuli of %zu trials -> %s\n", args->protocol.c_str(), tiles.size(), trials.size(),
                 args->out.c_str());
-    // What a participant can see of it, pair by pair (as blurcue validate --plan).
-    const auto pairs = session::PairVisibilities(prepared, observer, args->visible);
-    size_t invisible = 0;
-    for (const auto& pair : pairs) invisible += !pair.visible;
-    if (!pairs.empty())
-      std::printf("visibility (%s; flagged below %g %% correct): %zu distinct pairs, %zu invisible\n",
-                  session::ToString(observer).c_str(), 100 * args->visible, pairs.size(), invisible);
-    for (const auto& pair : pairs)
-      if (!pair.visible) std::printf("  %s\n", session::Describe(pair, prepared.display).c_str());
+    // What a participant can see of it (as blurcue validate --plan): the invisible pairs, each depth-matching distance.
+    for (const std::string& text : session::VisibilityLines(prepared, observer, args->visible, true))
+      std::printf("%s\n", text.c_str());
   });
 }
 

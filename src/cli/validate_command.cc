@@ -99,25 +99,9 @@ void AddValidateCommand(CLI::App& app) {
                         prepared.protocol.content.depth_blur_threshold_unit == "arcmin" ? "arcmin" : "screen px");
           shown += line;
         }
-        if (observer) {
-          const auto pairs = session::PairVisibilities(prepared, *observer, args->visible);
-          size_t invisible = 0;
-          for (const auto& pair : pairs) invisible += !pair.visible;
-          std::snprintf(line, sizeof line, "  visibility (%s; flagged below %g %% correct): %zu distinct pairs, %zu invisible\n",
-                        session::ToString(*observer).c_str(), 100 * args->visible, pairs.size(), invisible);
-          shown += line;
-          for (const auto& pair : pairs) shown += "    " + session::Describe(pair, at.profile) + "\n";
-          // Depth matching: per distance, the levels this observer cannot tell from the real picture.
-          if (observer->model == session::ObserverModel::kArcmin) {
-            const auto matches = session::MatchVisibilities(prepared, *observer, args->visible);
-            for (const auto& match : matches) shown += "    " + session::Describe(match, args->visible) + "\n";
-            if (pairs.empty() && matches.empty())
-              shown += "    nothing to compare: adjustment trials without content.real_camera (the real blur is "
-                       "unknown)\n";
-          } else if (pairs.empty()) {
-            shown += "    nothing to compare: model=pixel has no visual angle for adjustment trials\n";
-          }
-        }
+        if (observer)
+          for (const std::string& text : session::VisibilityLines(prepared, *observer, args->visible, false))
+            shown += "  " + text + "\n";
         p = std::move(prepared.protocol);
         seed = prepared.seed;
         trials = std::move(prepared.trials);

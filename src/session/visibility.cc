@@ -117,6 +117,28 @@ std::string Describe(const MatchVisibility& m, double level) {
   return text;
 }
 
+std::vector<std::string> VisibilityLines(const PreparedSession& prepared, const ObserverParams& observer, double level,
+                                         bool invisible_only) {
+  const auto pairs = PairVisibilities(prepared, observer, level);
+  const bool arcmin = observer.model == ObserverModel::kArcmin;
+  const auto matches = arcmin ? MatchVisibilities(prepared, observer, level) : std::vector<MatchVisibility>{};
+  size_t invisible = 0;
+  for (const auto& pair : pairs) invisible += !pair.visible;
+  char line[600];
+  std::snprintf(line, sizeof line, "visibility (%s; flagged below %g %% correct): %zu distinct pairs, %zu invisible",
+                ToString(observer).c_str(), 100 * level, pairs.size(), invisible);
+  std::vector<std::string> lines = {line};
+  if (!matches.empty()) lines.back() += "; " + std::to_string(matches.size()) + " depth-matching distances";
+  for (const auto& pair : pairs)
+    if (!invisible_only || !pair.visible) lines.push_back("  " + Describe(pair, prepared.display));
+  for (const auto& match : matches) lines.push_back("  " + Describe(match, level));
+  if (pairs.empty() && matches.empty())
+    lines.push_back(arcmin ? "  nothing to compare: adjustment trials without content.real_camera (the real blur is "
+                             "unknown)"
+                           : "  nothing to compare: model=pixel has no visual angle for adjustment trials");
+  return lines;
+}
+
 std::string Describe(const PairVisibility& pair, const display::Profile& profile) {
   char text[512];
   std::snprintf(text, sizeof text, "%s: %.2f arcmin apart (%.2f' vs %.2f'), predicted %.0f %% correct%s",

@@ -50,6 +50,12 @@ std::vector<MatchVisibility> MatchVisibilities(const PreparedSession& prepared, 
 // cut-offs 16.5-80 (0.53'-2.59'); the closest, 80 (1.07'), 51 % correct"
 std::string Describe(const MatchVisibility& match, double level);
 
+// What `blurcue validate --plan` and `blurcue preview` print of it: a header naming the observer, the level and the
+// counts, then every pair (or with `invisible_only` only the invisible ones) and every distance of a depth matching
+// (model=arcmin; model=pixel has no visual angle for it and says so).
+std::vector<std::string> VisibilityLines(const PreparedSession& prepared, const ObserverParams& observer, double level,
+                                         bool invisible_only);
+
 // "measured vs estimated at edge 2: 0.30 arcmin apart (0.50' vs 0.80'), predicted 53 % correct - invisible at 60 cm on
 // this monitor" (the profile's distance), or "... predicted 91 % correct".
 std::string Describe(const PairVisibility& pair, const display::Profile& profile);
