@@ -285,7 +285,8 @@ void AddSlopeRows(PlanResult& r, const Condition& c, const PlanOptions& options)
     int rejected = 0, widths = 0;
     for (int s = 0; s < S; ++s) {
       const SimParticipant& p = r.studies[size_t(s)][size_t(m - 1)];
-      if (const auto it = p.tallies.find(c.key); it != p.tallies.end()) shown += it->second.shown, none += it->second.none;
+      if (const auto it = p.tallies.find(c.key); it != p.tallies.end())
+        shown += it->second.shown, none += it->second.none;
       if (const auto it = p.matches.find(c.key); it != p.matches.end()) matches += double(it->second.size());
       std::vector<double> values;
       for (int i = 0; i < m; ++i)
@@ -295,7 +296,8 @@ void AddSlopeRows(PlanResult& r, const Condition& c, const PlanOptions& options)
         for (double v : values) mean += v;
         mean /= double(values.size());
         for (double v : values) ss += (v - mean) * (v - mean);
-        width += 2 * StudentT975(int(values.size()) - 1) * std::sqrt(ss / double(values.size() - 1) / double(values.size()));
+        const double n_values = double(values.size());
+        width += 2 * StudentT975(int(values.size()) - 1) * std::sqrt(ss / (n_values - 1) / n_values);
         ++widths;
       }
       rejected += values.size() >= 2 && OneSampleTTestP(values, 0) < options.alpha;

@@ -80,7 +80,7 @@ struct PowerRow {
   double expected_share = 0;   // over every simulated study and participant (slope_t: the mean slope b)
   double share_first = 0, share_second = 0, share_cant_tell = 0, share_none = 0;  // a pair's answers, of shown
   double mean_trials = 0;      // counting trials per study at this N (mean)
-  double wilson_width = 0;     // mean width of the 95 % Wilson interval at this N (slope_t: of the mean slope's t interval)
+  double wilson_width = 0;     // mean width of the 95 % Wilson interval at this N (slope_t: of the slope's t interval)
   double power = 0;            // share of studies whose test has p < alpha (NaN for "none")
 };
 

@@ -461,7 +461,7 @@ void Parser::ParseRealCamera(const Json& v, const std::string& ptr, const Json& 
     return;
   }
   if (!Object(v, ptr, {"camera", "focus_m"})) return;
-  const int problems_before = calls_;
+  const size_t problems_before = calls_;
   p->content.real_camera_file = Path(v, "camera", ptr, true);
   const bool camera_file_ok = calls_ == problems_before;
   // From a hand's breadth to a kilometre (the thin lens needs it beyond the focal length: checked per distance).
@@ -974,7 +974,9 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
 void Parser::ParseResponses(const Json& v, const std::string& ptr, const std::set<Task>& tasks, const Protocol& p,
                             Responses* r) {
   // Defaults that suit a keyboard: arrows to choose or step, Return to accept, Y / N, digits for scales and intervals.
-  *r = Responses{"Left", "Right", "Down", "Left", "Right", "Return"};
+  *r = Responses{};
+  r->left = "Left", r->right = "Right", r->cant_tell = "Down", r->previous = "Left", r->next = "Right",
+  r->accept = "Return";
   r->rating = {"1", "2", "3", "4", "5"};
   for (int i = 1; i <= p.alternatives; ++i) r->alternatives.push_back(std::to_string(i));
   // Odd one out names one of its intervals: there is no "can't tell" unless a key is given for it.

@@ -617,7 +617,8 @@ TEST(ProtocolValidate, RealCameraReadOrRejectedNamingItsField) {
   EXPECT_EQ(p.content.real_camera->image_width_px, 1148);
   EXPECT_DOUBLE_EQ(p.content.real_focus_m, 1.5);
   const std::pair<Json, std::string> cases[] = {
-      {{{"camera", "camera.json"}, {"focus_m", -1}}, ": /content/real_camera/focus_m: must be a number in [0.01, 1000] m"},
+      {{{"camera", "camera.json"}, {"focus_m", -1}},
+       ": /content/real_camera/focus_m: must be a number in [0.01, 1000] m"},
       {{{"camera", "camera.json"}, {"focus_m", "1"}}, ": /content/real_camera/focus_m: must be a number"},
       {{{"camera", "camera.json"}}, ": /content/real_camera/focus_m: is required"},
       {{{"camera", "not-a-camera.json"}, {"focus_m", 1}}, ": /content/real_camera/camera: "},

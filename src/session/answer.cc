@@ -32,15 +32,16 @@ void CheckObserverCanAnswer(const ObserverParams& observer, const protocol::Prot
     if (block.task == protocol::Task::kAdjustment)
       throw InputError(protocol.file.string() + ": /content/real_camera",
                        "is needed by the simulated observer (model=arcmin), which sets the picture to the real "
-                       "picture's blur in visual angle: name the camera and focus of the real photos, or use --observer "
-                       "sim:model=pixel (a cut-off per distance)");
+                       "picture's blur in visual angle: name the camera and focus of the real photos, or use "
+                       "--observer sim:model=pixel (a cut-off per distance)");
 }
 
 std::vector<KeyPress> AnswerTrial(SimulatedObserver& observer, const protocol::Protocol& protocol,
                                   const protocol::Trial& trial, const TrialScene& scene,
                                   const Presentation& presentation) {
   using protocol::Task;
-  if (trial.task == Task::kAdjustment) return observer.Adjust(trial.adjust_levels, trial.start_index, AdjustViewOf(trial, scene, presentation));
+  if (trial.task == Task::kAdjustment)
+    return observer.Adjust(trial.adjust_levels, trial.start_index, AdjustViewOf(trial, scene, presentation));
   const PairView view = ViewOf(scene, presentation);
   const KeyPress press =
       trial.task == Task::kYesNo    ? observer.SayYesNo(view)

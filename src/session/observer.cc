@@ -86,11 +86,12 @@ ObserverParams ParseObserver(const std::string& spec) {
       if (v > hi || v < lo || (open_lo && v == lo)) bad(what);
       return v;
     };
-    if (!kArcminOnly.count(name) && !kPixelOnly.count(name) && !std::set<std::string>{"lapse", "rt", "step"}.count(name))
-      throw Error(ErrorKind::kUsage,
-                  "--observer: unknown parameter '" + name + "' (known: model, " +
-                      (pixel ? "jnd, bias, cutoff1m, slope, sdlog, tol" : "intrinsic, weber, exponent, side, blurrier, rthard") +
-                      ", lapse, rt, step)");
+    static const std::set<std::string> kBoth = {"lapse", "rt", "step"};
+    if (!kArcminOnly.count(name) && !kPixelOnly.count(name) && !kBoth.count(name))
+      throw Error(ErrorKind::kUsage, "--observer: unknown parameter '" + name + "' (known: model, " +
+                                         (pixel ? "jnd, bias, cutoff1m, slope, sdlog, tol"
+                                                : "intrinsic, weber, exponent, side, blurrier, rthard") +
+                                         ", lapse, rt, step)");
     if (text.empty() || *end != '\0' || !std::isfinite(v)) bad("must be a number");
     // Ranges: what a human observer could be, so a typo (1e308, a missing decimal point) is refused, not simulated.
     if (name == "intrinsic") p.intrinsic_arcmin = in(0, 60, true, "must be in (0, 60] arcmin (a Gaussian std)");

@@ -77,8 +77,9 @@ struct ObserverParams {
 
 // "sim" (model=arcmin, defaults) or "sim:NAME=VALUE,...": model=arcmin|pixel; arcmin: intrinsic, weber, exponent,
 // side, blurrier, rthard; pixel: jnd, bias, cutoff1m, slope, sdlog, tol; both: lapse, rt, step. A spec without model=
-// that names a pixel-only parameter is model=pixel (every record before model= existed holds such a spec). Throws Error(kUsage)
-// naming the parameter and the value for an unknown name, a parameter of the other model or an impossible value.
+// that names a pixel-only parameter is model=pixel (every record before model= existed holds such a spec).
+// Throws Error(kUsage) naming the parameter and the value for an unknown name, a parameter of the other model or an
+// impossible value.
 ObserverParams ParseObserver(const std::string& spec);
 // The canonical "sim:model=...,..." form (every parameter of its model), recorded with the session; parses back to
 // the same observer.

@@ -95,9 +95,9 @@ TEST(SimulatedObserver, YesNoAndRatingRatesMatchTheModel) {
     int yes = 0, lowest = 0, highest = 0;
     for (int i = 0; i < draws; ++i) yes += o.SayYesNo(v).action == "yes";
     for (int i = 0; i < draws; ++i) {
-      const std::string r = o.Rate(v, 5).action;
-      lowest += r == "1";
-      highest += r == "5";
+      const KeyPress k = o.Rate(v, 5);
+      lowest += k.action == "1";
+      highest += k.action == "5";
     }
     EXPECT_NEAR(yes / double(draws), 1 - Phi((p.jnd_px / 2 - m) / p.jnd_px), 4 * se) << "m " << m;
     EXPECT_NEAR(lowest / double(draws), Phi((p.jnd_px / 2 - m) / p.jnd_px), 4 * se) << "m " << m;
@@ -159,6 +159,15 @@ TEST(SimulatedObserver, LapsesAnswerAtRandomAndBiasFavoursTheBlurredSide) {
 }
 
 // Steps through cyclic levels as the runner does and returns the accepted level.
+// What an adjustment trial shows: the distance, and for model=arcmin the real blur and each level's (arcmin).
+AdjustView AdjustAt(double distance_m, double r_real_arcmin = -1, std::vector<double> level_r_arcmin = {}) {
+  AdjustView v;
+  v.distance_m = distance_m;
+  v.r_real_arcmin = r_real_arcmin;
+  v.level_r_arcmin = std::move(level_r_arcmin);
+  return v;
+}
+
 double Accepted(const std::vector<double>& levels, int start, const std::vector<KeyPress>& presses) {
   int at = start;
   const int n = static_cast<int>(levels.size());
@@ -179,7 +188,7 @@ TEST(SimulatedObserver, PixelAdjustmentAcceptsTheLevelNearestItsTarget) {
   for (double distance : {0.4, 1.0, 2.5, 4.0}) {
     for (int start : {0, 5, 10}) {
       SimulatedObserver o(p, 3);
-      const auto presses = o.Adjust(levels, start, AdjustView{distance});
+      const auto presses = o.Adjust(levels, start, AdjustAt(distance));
       ASSERT_FALSE(presses.empty());
       EXPECT_EQ(presses.back().action, "accept");
       const double target = p.cutoff_1m * std::pow(distance, p.slope);
@@ -463,10 +472,11 @@ TEST(SimulatedObserver, ArcminAdjustmentTakesTheLevelThatLooksClosest) {
     for (uint64_t seed = 1; seed <= uint64_t(n); ++seed) {
       SimulatedObserver o(p, seed);
       const int start = int(seed % 22);
-      const auto presses = o.Adjust(levels, start, AdjustView{1.0, real, level_r});
+      const auto presses = o.Adjust(levels, start, AdjustAt(1.0, real, level_r));
       ASSERT_EQ(presses.back().action, "accept");
       ASSERT_GE(presses.size(), levels.size());  // every level seen before the choice
-      share[size_t(std::find(levels.begin(), levels.end(), Accepted(levels, start, presses)) - levels.begin())] += 1.0 / n;
+      const auto chosen = std::find(levels.begin(), levels.end(), Accepted(levels, start, presses));
+      share[size_t(chosen - levels.begin())] += 1.0 / n;
     }
     double total = 0;
     for (size_t i = 0; i < levels.size(); ++i) {
@@ -477,7 +487,7 @@ TEST(SimulatedObserver, ArcminAdjustmentTakesTheLevelThatLooksClosest) {
   }
   // Without the real blur the arcmin model cannot answer: a usage error, not a guess.
   SimulatedObserver o(p, 1);
-  EXPECT_THROW(o.Adjust(levels, 0, AdjustView{1.0}), Error);
+  EXPECT_THROW(o.Adjust(levels, 0, AdjustAt(1.0)), Error);
 }
 
 // model=pixel is the observer of old, answer for answer: every task's presses over a grid of views and seeds, as text,
@@ -505,7 +515,7 @@ TEST(SimulatedObserver, PixelModelAnswersAsTheObserverBeforeIt) {
     add(o.SayYesNo(v));
     add(o.Rate(v, 5));
     for (const KeyPress& k :
-         o.Adjust({11.6, 2.0, 47.2, 4.8, 80.0, 8.2, 23.4}, int(seed % 7), AdjustView{0.4 + 0.1 * double(seed)}))
+         o.Adjust({11.6, 2.0, 47.2, 4.8, 80.0, 8.2, 23.4}, int(seed % 7), AdjustAt(0.4 + 0.1 * double(seed))))
       add(k);
   }
   uint64_t hash = 1469598103934665603ULL;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <limits>
 #include <set>
@@ -683,12 +684,14 @@ void CheckRealPhotos(const protocol::Protocol& protocol, const std::vector<Trial
           camera && std::abs(double(photo.cols) / photo.rows -
                              double(camera->image_width_px) / camera->image_height_px) >
                         0.01 * camera->image_width_px / camera->image_height_px)
+      {
+        char sizes[160];
+        std::snprintf(sizes, sizeof sizes, "its image is %dx%d px, but the real photo is %dx%d", camera->image_width_px,
+                      camera->image_height_px, photo.cols, photo.rows);
         throw InputError(At(protocol, "/content/real_camera/camera"),
-                         "its image is " + std::to_string(camera->image_width_px) + "x" +
-                             std::to_string(camera->image_height_px) + " px, but the real photo " +
-                             protocol::RealPhotoFor(protocol.content, scene.distance_m).string() + " is " +
-                             std::to_string(photo.cols) + "x" + std::to_string(photo.rows) +
-                             " (another shape: not a whole photo of that camera)");
+                         std::string(sizes) + " (another shape: not a whole photo of that camera): " +
+                             protocol::RealPhotoFor(protocol.content, scene.distance_m).string());
+      }
     }
 }
 
@@ -719,8 +722,8 @@ const cv::Mat& StimulusRenderer::UpperHalf(double level) {
                              [&](const auto& entry) { return entry.first == level; });
   if (cached != upper_cache_.end()) return cached->second;
   const int w = picture_width_px_, half = w * 3 / 4 / 2;
-  upper_cache_.emplace_back(level,
-                            render::PictureOnGrey(picture_, cv::Size(w, half), render::DepthMatchingPictureHeightPx(w), level));
+  upper_cache_.emplace_back(
+      level, render::PictureOnGrey(picture_, cv::Size(w, half), render::DepthMatchingPictureHeightPx(w), level));
   return upper_cache_.back().second;
 }
 

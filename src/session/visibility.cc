@@ -106,8 +106,9 @@ std::vector<MatchVisibility> MatchVisibilities(const PreparedSession& prepared, 
 
 std::string Describe(const MatchVisibility& m, double level) {
   char text[512];
-  int n = std::snprintf(text, sizeof text, "depth matching at %g m: the real picture's blur %.2f' - %zu of %d levels look "
-                                           "the same (under %.0f %% correct)",
+  int n = std::snprintf(text, sizeof text,
+                        "depth matching at %g m: the real picture's blur %.2f' - %zu of %d levels look the same (under "
+                        "%.0f %% correct)",
                         m.distance_m, m.r_real_arcmin, m.alike.size(), m.levels, 100 * level);
   if (!m.alike.empty())
     n += std::snprintf(text + n, sizeof text - size_t(n), ": cut-offs %g-%g (%.2f'-%.2f')", m.alike.front(),

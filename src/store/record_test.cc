@@ -20,6 +20,13 @@
 namespace blurcue::store {
 namespace {
 
+// A frame of a trial: its index, flip time and whether it was dropped (no radii: a picture's).
+FrameRecord Frame(int64_t index, double flip_time_s, bool dropped) {
+  FrameRecord f;
+  f.frame_index = index, f.flip_time_s = flip_time_s, f.dropped = dropped;
+  return f;
+}
+
 const char* kProtocol = R"({"name":"test1","trials":4})";
 
 std::vector<TrialRecord> Trials(int n) {
@@ -63,11 +70,12 @@ TEST(Record, AnswerAndItsFramesAreOneTransaction) {
   Record record = Record::Open(":memory:");
   const int64_t session = record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, false).session_id;
   record.SaveTrialList(session, Trials(3));
-  record.RecordResponse(session, 0, Answer("left"), {{0, 0.0, false}, {1, 0.0167, false}, {2, 0.05, true}});
+  record.RecordResponse(session, 0, Answer("left"),
+                        {Frame(0, 0.0, false), Frame(1, 0.0167, false), Frame(2, 0.05, true)});
   EXPECT_EQ(record.database().QueryInt64("SELECT COUNT(*) FROM frames"), 3);
   EXPECT_EQ(record.database().QueryInt64("SELECT SUM(dropped) FROM frames"), 1);
   // A refused second answer adds no frames either: both roll back together.
-  EXPECT_THROW(record.RecordResponse(session, 0, Answer("right"), {{0, 0.0, false}}), Error);
+  EXPECT_THROW(record.RecordResponse(session, 0, Answer("right"), {Frame(0, 0.0, false)}), Error);
   EXPECT_EQ(record.database().QueryInt64("SELECT COUNT(*) FROM frames"), 3);
 }
 
@@ -553,7 +561,8 @@ TEST(Record, TruncatedRecordIsAnInputErrorNamingTheFile) {
     Record record = Record::Open(path);
     const int64_t session = record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, false).session_id;
     record.SaveTrialList(session, Trials(400));
-    for (int i = 0; i < 400; ++i) record.RecordResponse(session, i, Answer("left"), {{0, 0.0, false}, {1, 0.017, false}});
+    for (int i = 0; i < 400; ++i)
+      record.RecordResponse(session, i, Answer("left"), {Frame(0, 0.0, false), Frame(1, 0.017, false)});
   }  // the last connection checkpoints the WAL into the file
   const auto size = std::filesystem::file_size(path);
   ASSERT_GT(size, 16384u);
