@@ -48,7 +48,8 @@ void AddValidateCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_flag("--list", args->list, "print the trial list as JSON, one trial per line");
   cmd->add_flag("--plan", args->plan, "also predict, per distinct stimulus pair, whether an observer can tell its "
-                                      "two sides apart on this display (flags the invisible ones)");
+                                      "two sides apart on this display (flags the invisible ones), and per "
+                                      "depth-matching distance which levels it cannot tell from the real picture");
   cmd->add_option("--observer", args->observer, "with --plan: the observer model, as blurcue run --observer "
                                                 "(sim: the arcmin model's defaults)")->capture_default_str();
   cmd->add_option("--visible", args->visible, "with --plan: the predicted share correct (2AFC) below which a pair "
