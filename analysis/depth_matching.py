@@ -18,6 +18,7 @@ import matplotlib.pyplot as plt
 from matplotlib.ticker import FixedLocator, NullLocator
 from scipy import stats as sps
 
+import prediction
 from common import Chart, Skip, STUDY_DEPTH, participants_note, save, study_rows
 
 
@@ -135,6 +136,30 @@ def charts(df, out_dir):
     return out
 
 
+def _model_median(v):
+    """Per distance, the median set blur (arcmin) the arcmin observer's closed form predicts from each trial's own
+    levels (adjust_levels, as recorded), its probabilities averaged over the distance's trials; None without them."""
+    if "adjust_levels" not in v:
+        return None
+    rows = []
+    for distance, g in v.groupby("distance_m"):
+        mixture = {}
+        for _, t in g.iterrows():
+            try:
+                cutoffs = np.array([float(c) for c in str(t["adjust_levels"]).split(";")])
+            except ValueError:
+                return None
+            if not np.all(cutoffs > 0):
+                return None
+            level_r = 2 * EQUIVALENT_S * t["picture_width_arcmin"] / cutoffs
+            for r, p in zip(level_r, prediction.match_choice(level_r, t["r_scene_arcmin"])):
+                mixture[round(float(r), 9)] = mixture.get(round(float(r), 9), 0.0) + p / len(g)
+        rs = np.array(sorted(mixture))
+        cumulative = np.cumsum([mixture[r] for r in rs])
+        rows.append({"distance_m": distance, "model_median": float(rs[np.searchsorted(cumulative, 0.5)])})
+    return pd.DataFrame(rows)
+
+
 # A Butterworth level c's blur as the equivalent Gaussian's (the one that halves contrast at the cut-off, s =
 # sqrt(ln 2 / 2) / (pi c) picture widths; blurcue's r = 2 s), as render::ButterworthEquivalentSigma states it.
 EQUIVALENT_S = math.sqrt(math.log(2) / 2) / math.pi
@@ -157,6 +182,12 @@ def _in_visual_angle(a, out_dir):
     ax.scatter(v["r_scene_arcmin"], v["set_arcmin"], s=12, alpha=0.5, color="#0072B2", label="answers")
     med = v.groupby("distance_m").agg(real=("r_scene_arcmin", "first"), set_median=("set_arcmin", "median"),
                                       answers=("set_arcmin", "size")).reset_index()
+    model = _model_median(v)
+    if model is not None:
+        med = med.merge(model, on="distance_m", how="left")
+        order = med.sort_values("real")
+        ax.plot(order["real"], order["model_median"], "-", color="#009E73", lw=1.5, zorder=4,
+                label="the model's median (arcmin observer, defaults)")
     ax.plot(med["real"], med["set_median"], "s", color="black", ms=4, label="median per distance")
     ax.set_xlim(0, top)
     ax.set_ylim(0, top)
@@ -169,4 +200,8 @@ def _in_visual_angle(a, out_dir):
     notes = [f"a level c's blur r = 2 x {EQUIVALENT_S:.4f} x the picture's width (arcmin) / c: the Gaussian that also "
              "halves contrast at the cut-off; the real blur is the thin lens of the protocol's content.real_camera",
              f"rank correlation of set and real blur over the answers: {rho:.2f}"]
+    if model is not None:
+        notes.append("model_median: the median blur the simulated observer (model=arcmin, its default parameters) "
+                     "would set at that distance from the same levels - each level compared once with the real "
+                     "picture, the closest-looking one taken (analysis/prediction.py match_choice, the closed form)")
     return Chart("depth-matching-arcmin", png, svg, med, notes)

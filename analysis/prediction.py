@@ -49,6 +49,27 @@ def p_correct_2afc(r_a_arcmin, r_b_arcmin, p=DEFAULTS):
     return norm.cdf(d / compare_sd(p))
 
 
+def match_choice(level_r_arcmin, real_r_arcmin, p=DEFAULTS, steps=4000):
+    """Depth matching: the probability that the observer takes each level, levels' blurs and the real picture's
+    (arcmin, blurcue's r). It compares every level once with the real picture, |D_i| with D_i = ln E(level i) -
+    ln E(real) + sd N(0, 1), and takes the smallest: P_i = integral f_i(x) prod_(j != i) (1 - F_j(x)) dx over x >= 0,
+    |D_j| folded normal (SimulatedObserver::Adjust; no lapse there). Simpson's rule on [0, max |mu| + 10 sd]."""
+    sd = compare_sd(p)
+    mu = log_seen(np.asarray(level_r_arcmin, float) / 2, p) - log_seen(float(real_r_arcmin) / 2, p)
+    top = float(np.max(np.abs(mu))) + 10 * sd
+    x = np.linspace(0, top, steps + 1)
+    w = np.full(x.size, 2.0)
+    w[1::2] = 4.0
+    w[0] = w[-1] = 1.0
+    w *= (top / steps) / 3
+    z_hi, z_lo = (x[None, :] - mu[:, None]) / sd, (-x[None, :] - mu[:, None]) / sd
+    survive = 1 - (norm.cdf(z_hi) - norm.cdf(z_lo))          # P(|D_j| > x), per level
+    density = (norm.pdf(z_hi) + norm.pdf(z_lo)) / sd          # the density of |D_i| at x
+    log_all = np.sum(np.log(np.maximum(survive, 1e-300)), axis=0)
+    others = np.exp(log_all[None, :] - np.log(np.maximum(survive, 1e-300)))
+    return np.sum(density * others * w[None, :], axis=1)
+
+
 def pair_choice(r_left, r_right, r_scene, cant_tell=True, p=DEFAULTS):
     """'Which fits the scene?': probabilities of left, right and can't tell (arrays of arcmin radii)."""
     sd = compare_sd(p)

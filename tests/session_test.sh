@@ -693,6 +693,40 @@ PYEOF
   [ -s "$W/report/depth-matching-arcmin.png" ] || fail "no depth-matching-arcmin chart"
   [ "$(($(wc -l < "$W/report/depth-matching-arcmin.csv") - 1))" = 27 ] || fail "depth-matching-arcmin.csv rows"
   grep -q "^0.4,3.9249," "$W/report/depth-matching-arcmin.csv" || fail "real blur at 0.4 m: $(head -2 "$W/report/depth-matching-arcmin.csv")"
+  # The report's closed form of the arcmin observer's choice (analysis/prediction.py match_choice, Python) against the
+  # C++ observer's answers: 20 participants, per distance the mean set blur against the closed form's mean, within 4
+  # standard errors (the closed form's own spread over sqrt 20), and the 27 squared z's summing to less than 60.
+  for i in $(seq 1 20); do
+    $BC run "$P/pre-research-depth-matching.json" --participant "M$i" --db "$W/many.sqlite" --observer sim > /dev/null \
+      || fail "run M$i"
+  done
+  $BC export --db "$W/many.sqlite" --out "$W/many" > /dev/null 2>&1 || fail "export"
+  $PY - "$W/many/trials.csv" "$(dirname "$0")/../analysis" > "$W/model" 2>&1 <<'PYEOF' || fail "closed form: $(cat "$W/model")"
+import math, sys
+import numpy as np, pandas as pd
+sys.path.insert(0, sys.argv[2])
+import prediction
+t = pd.read_csv(sys.argv[1])
+t = t[(t.practice == 0) & (t.status == "answered")]
+k = 2 * math.sqrt(math.log(2) / 2) / math.pi
+chi2, worst = 0.0, 0.0
+for d, g in t.groupby("distance_m"):
+    means, variances, got = [], [], []
+    for _, r in g.iterrows():
+        cutoffs = np.array([float(c) for c in r.adjust_levels.split(";")])
+        level_r = k * r.picture_width_arcmin / cutoffs
+        p = prediction.match_choice(level_r, r.r_scene_arcmin)
+        assert abs(p.sum() - 1) < 1e-6, p.sum()
+        means.append(float(np.sum(p * level_r)))
+        variances.append(float(np.sum(p * level_r ** 2)) - means[-1] ** 2)
+        got.append(k * r.picture_width_arcmin / float(r.adjusted_level))
+    z = (np.mean(got) - np.mean(means)) / math.sqrt(np.sum(variances)) * len(got)
+    chi2 += z * z
+    worst = max(worst, abs(z))
+    assert abs(z) < 4, (d, np.mean(got), np.mean(means), z)
+assert chi2 < 60, chi2
+print(f"27 distances x 20 answers: worst |z| {worst:.1f}, sum of z^2 {chi2:.1f}")
+PYEOF
   # validate --plan: per distance, the levels this observer cannot tell from the real picture - counted here from the
   # thin lens, the equivalent Gaussian and the dipper's closed form (defaults s_i = 0.6', w = 0.35).
   $BC validate "$P/pre-research-depth-matching.json" --plan > "$W/plan.out" || fail "validate --plan: $(cat "$W/plan.out")"
@@ -731,7 +765,7 @@ PYEOF
   grep -q "dm-no-camera.json: /content/real_camera: is needed by the simulated observer" "$W/err" || fail "error: $(cat "$W/err")"
   [ "$(wc -l < "$W/err")" = 1 ] || fail "more than one line: $(cat "$W/err")"
   [ ! -e "$W/x.sqlite" ] || [ "$(sql "$W/x.sqlite" "SELECT count(*) FROM sessions")" = 0 ] || fail "a session was started"
-  echo "ok: depth matching records the real blur in arcmin (thin lens, worked out apart) and the observer follows it: $(cat "$W/fit"); validate --plan: $(cat "$W/alike")" ;;
+  echo "ok: depth matching records the real blur in arcmin (thin lens, worked out apart) and the observer follows it: $(cat "$W/fit"); validate --plan: $(cat "$W/alike"); closed form: $(cat "$W/model")" ;;
 recover)
   # Through the whole pipeline - trials, the observer's key presses, the record, export and the analysis - the
   # depth-matching fit recovers the cut-off law the simulated observers were given: c = 20 d^-0.5.

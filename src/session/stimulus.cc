@@ -488,6 +488,14 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
   if (trial.task == protocol::Task::kAdjustment) {
     if (trial.start_index >= 0 && size_t(trial.start_index) < trial.adjust_levels.size())
       v["start_level"] = trial.adjust_levels[size_t(trial.start_index)];
+    // The levels in the order "next" steps through them (cyclic): what the participant could reach, as shown.
+    std::string levels;
+    char text[32];
+    for (double level : trial.adjust_levels) {
+      std::snprintf(text, sizeof text, "%g", level);
+      levels += (levels.empty() ? "" : ";") + std::string(text);
+    }
+    v["adjust_levels"] = levels;
   }
   if (scene.content == "picture") {
     // The virtual picture's width as shown (a level c's blur is r = 2 x 0.1874 x this / c arcmin), and the real

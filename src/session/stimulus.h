@@ -110,7 +110,8 @@ void PlanOnScreen(const protocol::Protocol& protocol, const calib::SceneCalib& s
 // The variables recorded with a trial beside its factor levels: practice, block_name, swapped, and for pairs each
 // radius in photo px, screen px and arcmin (r_left_px, r_left_screen_px, r_left_arcmin; the same for right and
 // scene) with the presentation's screen_px_per_photo_px and the blur plan (blur_plan: one_radius | per_pixel,
-// r_span_screen_px) and each object's size_left_deg / size_right_deg, or start_level (adjustment).
+// r_span_screen_px) and each object's size_left_deg / size_right_deg, or start_level and adjust_levels (adjustment;
+// a picture: picture_width_arcmin, and the real picture's r_scene_* when content.real_camera names its camera).
 Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation);
 
 // The protocol's calibration (none for a picture without one). Throws Error(kInput) naming the protocol file and

@@ -335,6 +335,8 @@ const std::map<std::string, ColumnDef>& KnownVariables() {
     add("white_balance_g", "number", "", "the object's green gain in linear light");
     add("white_balance_b", "number", "", "the object's blue gain in linear light");
     add("start_level", "number", "the adjusted parameter's unit", "adjustment: the level shown first");
+    add("adjust_levels", "string", "the adjusted parameter's unit",
+        "adjustment: the levels in the order the next key steps through them (cyclic), separated by ;");
     add("picture_width_arcmin", "number", "arcmin",
         "depth matching: the virtual picture's width at the eye (a cut-off c's blur is r = 2 x 0.1874 x this / c)");
     add("procedure_cell", "integer", "", "a procedure trial: which crossing of its block's factors (its own procedure)");
