@@ -14,6 +14,9 @@ namespace blurcue::cli {
 
 namespace {
 
+// A bench's progress: one line on stderr (stdout carries its results).
+void ProgressLine(const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); }
+
 void AddMeasure(CLI::App& bench) {
   struct Args {
     std::string out = "results/bench/measure.csv";
@@ -40,7 +43,7 @@ void AddMeasure(CLI::App& bench) {
     bench::MeasureBenchOptions options;
     options.quick = args->quick;
     options.seed = args->seed;
-    options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+    options.progress = ProgressLine;
     const auto rows = bench::RunMeasureBench(options);
     bench::WriteMeasureCsv(rows, args->out, args->quick);
     std::printf("wrote %s (%zu rows)\n\nwhere each method breaks (target: max(0.25 px, 5 %%) on >= 90 %% of answered "
@@ -92,7 +95,7 @@ void AddRender(CLI::App& bench) {
     bench::RenderBenchOptions options;
     options.quick = args->quick;
     options.frames_only = args->frames_only;
-    options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+    options.progress = ProgressLine;
     const auto rows = bench::RunRenderBench(options);
     bench::WriteRenderCsv(rows, args->out, args->quick);
     std::printf("wrote %s (%zu rows)\n%s", args->out.c_str(), rows.size(), bench::SummarizeRender(rows).c_str());
@@ -122,7 +125,7 @@ void AddRecord(CLI::App& bench) {
     options.folder = args->folder;
     options.trials = args->trials;
     options.frames_per_trial = args->frames;
-    options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+    options.progress = ProgressLine;
     const bench::RecordBenchResult r = bench::RunRecordBench(options);
     std::printf("per answer with %d frames, %d answers each, in %s:\n"
                 "  synchronous=FULL   median %.2f ms  p99 %.2f ms\n"
@@ -160,7 +163,7 @@ void AddProcedures(CLI::App& bench) {
     bench::ProcedureBenchOptions options;
     options.runs = args->quick ? 40 : args->runs;
     options.seed = args->seed;
-    options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+    options.progress = ProgressLine;
     const auto rows = bench::RunProcedureBench(options);
     bench::WriteProcedureCsv(rows, args->out, args->quick);
     std::printf("wrote %s (%zu rows, %d runs each)\n%s", args->out.c_str(), rows.size(), options.runs,
@@ -197,7 +200,7 @@ void AddPlan(CLI::App& bench) {
     options.protocol_file = args->protocol.empty() ? DataDir().path / "protocols" / "test1-static-grids.json"
                                                    : std::filesystem::path(args->protocol);
     if (args->quick) options.rounds = 1, options.studies = 2;
-    options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+    options.progress = ProgressLine;
     const auto rows = bench::RunPlanBench(options);
     bench::WritePlanBenchCsv(rows, args->out);
     std::printf("wrote %s (%zu rows)\n%s", args->out.c_str(), rows.size(), bench::SummarizePlanBench(rows).c_str());

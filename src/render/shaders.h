@@ -8,6 +8,19 @@
 
 namespace blurcue::render {
 
+// The uniforms of an object's surface that object.frag and ball.frag share: the light and the thesis's colour matching.
+class SurfaceUniforms {
+ public:
+  explicit SurfaceUniforms(const Program& program);
+  // Light towards `direction` (camera frame, unit) with `ambient` of it undirected.
+  void SetLight(const glm::vec3& direction, float ambient) const;
+  // Brightness multiplies, contrast scales about mid grey (0.18), white balance multiplies red, green, blue.
+  void SetColour(float brightness, float contrast, const glm::vec3& white_balance) const;
+
+ private:
+  GLint light_dir_, ambient_, brightness_, contrast_, white_balance_;
+};
+
 // shaders/object.{vert,frag}: a textured, simply lit object in the board frame, drawn into a layer.
 class ObjectShader {
  public:
@@ -17,14 +30,14 @@ class ObjectShader {
   ObjectShader& SetModelToCamera(const glm::mat4& model_to_camera);
   // Camera frame -> clip space.
   ObjectShader& SetProjection(const glm::mat4& projection);
-  // Light towards `direction` (camera frame, unit) with `ambient` of it undirected; `lit` false draws flat.
+  // SurfaceUniforms::SetLight; `lit` false draws flat.
   ObjectShader& SetLight(const glm::vec3& direction, float ambient, bool lit);
-  // Brightness multiplies, contrast scales about mid grey (0.18), white balance multiplies red, green, blue.
   ObjectShader& SetColour(float brightness, float contrast, const glm::vec3& white_balance);
 
  private:
   Program program_;
-  GLint model_to_camera_, projection_, light_dir_, ambient_, lit_, brightness_, contrast_, white_balance_;
+  SurfaceUniforms surface_;
+  GLint model_to_camera_, projection_, lit_;
 };
 
 // shaders/ball.frag (over fullscreen.vert): a ball ray-traced into a layer - the exact sphere, each pixel's coverage
@@ -43,8 +56,8 @@ class BallShader {
 
  private:
   Program program_;
-  GLint intrinsics_, origin_, center_, radius_, camera_to_object_, write_depth_, light_dir_, ambient_,
-      brightness_, contrast_, white_balance_;
+  SurfaceUniforms surface_;
+  GLint intrinsics_, origin_, center_, radius_, camera_to_object_, write_depth_;
 };
 
 // shaders/blur_gaussian.frag: one pass of the separable Gaussian over a rectangle of a texture (no taps: a copy).
