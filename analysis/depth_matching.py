@@ -177,8 +177,10 @@ def _in_visual_angle(a, out_dir):
     v["set_arcmin"] = 2 * EQUIVALENT_S * v["picture_width_arcmin"] / v["cutoff"]
     fig, ax = plt.subplots(figsize=(6.4, 4.8))
     top = max(v["set_arcmin"].max(), v["r_scene_arcmin"].max()) * 1.1
-    ax.axvspan(0, 1.2, facecolor="#dddddd", edgecolor="#aaaaaa", zorder=0, label="below the eye's intrinsic blur (r 1.2')")
-    ax.plot([0, top], [0, top], color="#D55E00", lw=1.5, label="set = real (the dipper's match above 1.2')")
+    intrinsic_r = 2 * prediction.DEFAULTS["intrinsic_arcmin"]  # blurcue's r of the eye's intrinsic blur
+    ax.axvspan(0, intrinsic_r, facecolor="#dddddd", edgecolor="#aaaaaa", zorder=0,
+               label=f"below the eye's intrinsic blur (r {intrinsic_r:g}')")
+    ax.plot([0, top], [0, top], color="#D55E00", lw=1.5, label=f"set = real (the dipper's match above {intrinsic_r:g}')")
     ax.scatter(v["r_scene_arcmin"], v["set_arcmin"], s=12, alpha=0.5, color="#0072B2", label="answers")
     med = v.groupby("distance_m").agg(real=("r_scene_arcmin", "first"), set_median=("set_arcmin", "median"),
                                       answers=("set_arcmin", "size")).reset_index()

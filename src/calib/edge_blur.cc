@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/image.h"
+#include "core/stats.h"
 
 namespace blurcue::calib {
 namespace {
@@ -42,8 +43,6 @@ Frame MakeFrame(const EdgeSegment& s) {
 // boxes of widths |n.x| and |n.y| (a trapezoid; variance 1/12 at any angle). Averaging the ESF over two boxes
 // is a second divided difference of F2, so the whole model stays in closed form.
 
-double StdNormalPdf(double z) { return 0.3989422804014327 * std::exp(-0.5 * z * z); }
-double StdNormalCdf(double z) { return 0.5 * std::erfc(-z * 0.7071067811865476); }
 
 double F1Gauss(double x, double s) {
   const double z = x / s;

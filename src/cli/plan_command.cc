@@ -104,7 +104,7 @@ void AddPlanCommand(CLI::App& app) {
                  result.threads_used,
                  1000 * result.seconds / (double(options.studies) * options.participants));
     Json settings = {{"protocol", std::filesystem::absolute(args->protocol).string()},
-                     {"protocol_hash", HashHex(Fnv1a64(ReadTextFile(args->protocol)))},
+                     {"protocol_hash", result.protocol_hash},
                      {"study", result.study},
                      {"display", args->display.empty() ? result.display : args->display},
                      {"participants", options.participants},

@@ -19,22 +19,19 @@
 #include "session/observer.h"
 #include "session/prepare.h"
 #include "session/trial_logic.h"
+#include "store/export.h"
 #include "store/record.h"
+#include "store/schema.h"
 
 namespace blurcue::plan {
 namespace {
 
 using protocol::Task;
 
-std::string SourceText(const Json& source) { return source.is_string() ? source.get<std::string>() : source.dump(); }
 
 // A level as a label shows it: a number as %g, a string as itself, an object by its id or name.
 std::string LevelText(const Json& level) {
-  if (level.is_number()) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%g", level.get<double>());
-    return text;
-  }
+  if (level.is_number()) return protocol::LevelText(level.get<double>());
   if (level.is_string()) return level.get<std::string>();
   for (const char* name : {"id", "name"})
     if (level.is_object() && level.contains(name)) return LevelText(level[name]);
@@ -45,8 +42,7 @@ std::string LevelText(const Json& level) {
 std::optional<Condition> ConditionOf(const protocol::Protocol& protocol, const protocol::Trial& trial,
                                      const session::TrialScene& scene, bool several_blocks) {
   Condition c;
-  for (size_t b = 0; b < protocol.blocks.size(); ++b)
-    if (protocol.blocks[b].name == trial.block) c.block = static_cast<int>(b);
+  c.block = protocol::BlockIndex(protocol, trial);
   c.levels = trial.levels.dump();
   c.key = trial.block + "\n" + c.levels;
   std::string label;
@@ -61,9 +57,6 @@ std::optional<Condition> ConditionOf(const protocol::Protocol& protocol, const p
   } else if (trial.task == Task::kForcedChoice && scene.content != "picture") {
     c.measure = "first_source";
     c.chance = 0.5;
-    // The design's sides: a swapped trial shows them exchanged.
-    c.first = SourceText(trial.swapped ? trial.right : trial.left);
-    c.second = SourceText(trial.swapped ? trial.left : trial.right);
   } else {
     return std::nullopt;
   }
@@ -96,8 +89,7 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
     if (trial.task == Task::kAdjustment && scene.content == "picture") {
       // Depth matching: one condition per block, the slope of the accepted cut-off on distance across its trials.
       Condition c;
-      for (size_t b = 0; b < protocol.blocks.size(); ++b)
-        if (protocol.blocks[b].name == trial.block) c.block = static_cast<int>(b);
+      c.block = protocol::BlockIndex(protocol, trial);
       c.key = trial.block + "\nslope";
       c.levels = "{}";
       c.label = (several_blocks ? trial.block + ": " : std::string()) + "cut-off ~ distance";
@@ -148,12 +140,6 @@ std::string Number(double v, const char* format = "%.6f") {
   return text;
 }
 
-std::string Quoted(const std::string& text) {
-  if (text.find_first_of(",\"\n") == std::string::npos) return text;
-  std::string out = "\"";
-  for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
-}
 
 }  // namespace
 
@@ -168,16 +154,6 @@ void CheckSizes(const PlanOptions& options) {
 }
 
 }  // namespace
-
-std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& options, std::vector<Condition>* conditions,
-                                                         std::vector<std::string>* notes, int* threads_used,
-                                                         std::string* study_name) {
-  CheckSizes(options);
-  (void)session::ParseObserver(options.observer);  // a bad --observer before any file is read
-  const session::PreparedSession study = session::PrepareStudy(options.protocol_file, options.display_profile);
-  if (study_name) *study_name = study.protocol.name;
-  return SimulateStudies(options, study, conditions, notes, threads_used);
-}
 
 std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& options,
                                                          const session::PreparedSession& study,
@@ -262,16 +238,16 @@ namespace {
 void AddSlopeRows(PlanResult& r, const Condition& c, const PlanOptions& options) {
   const int N = options.participants, S = options.studies;
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  std::vector<std::vector<double>> slopes(static_cast<size_t>(S));
-  double sum = 0, matches = 0, shown = 0, none = 0;  // matches, shown, none: over participants 1 .. m
+  // Over every study and participant, as the binomial rows: the mean slope and the share without an answer.
+  double sum = 0, shown = 0, none = 0;
   int count = 0;
-  for (int s = 0; s < S; ++s)
-    for (const SimParticipant& p : r.studies[size_t(s)]) {
-      const auto it = p.matches.find(c.key);
-      const double b = it == p.matches.end() ? nan : OlsSlope(it->second);
-      slopes[size_t(s)].push_back(b);
-      if (std::isfinite(b)) sum += b, ++count;
-    }
+  for (const auto& study : r.studies)
+    for (const SimParticipant& p : study)
+      if (const auto it = p.tallies.find(c.key); it != p.tallies.end()) shown += it->second.shown, none += it->second.none;
+  // Per study, the slopes of participants 1 .. m so far (those with one), grown with m.
+  std::vector<std::vector<double>> slopes(static_cast<size_t>(S));
+  std::vector<double> t975(1, nan);  // by degrees of freedom, worked out once each
+  double matches = 0;                // answered matches of participants 1 .. m, over the studies
   for (int m = 1; m <= N; ++m) {
     PowerRow row;
     row.test = "slope_t";
@@ -279,35 +255,35 @@ void AddSlopeRows(PlanResult& r, const Condition& c, const PlanOptions& options)
     row.measure = c.measure;
     row.chance = 0;
     row.participants = m;
-    row.expected_share = count > 0 ? sum / count : nan;
     row.share_first = row.share_second = row.share_cant_tell = nan;
+    row.share_none = shown > 0 ? none / shown : nan;
     double width = 0;
     int rejected = 0, widths = 0;
     for (int s = 0; s < S; ++s) {
       const SimParticipant& p = r.studies[size_t(s)][size_t(m - 1)];
-      if (const auto it = p.tallies.find(c.key); it != p.tallies.end())
-        shown += it->second.shown, none += it->second.none;
-      if (const auto it = p.matches.find(c.key); it != p.matches.end()) matches += double(it->second.size());
-      std::vector<double> values;
-      for (int i = 0; i < m; ++i)
-        if (std::isfinite(slopes[size_t(s)][size_t(i)])) values.push_back(slopes[size_t(s)][size_t(i)]);
-      if (values.size() >= 2) {
-        double mean = 0, ss = 0;
-        for (double v : values) mean += v;
-        mean /= double(values.size());
-        for (double v : values) ss += (v - mean) * (v - mean);
-        const double n_values = double(values.size());
-        width += 2 * StudentT975(int(values.size()) - 1) * std::sqrt(ss / (n_values - 1) / n_values);
-        ++widths;
+      std::vector<double>& values = slopes[size_t(s)];
+      if (const auto it = p.matches.find(c.key); it != p.matches.end()) {
+        matches += double(it->second.size());
+        if (const double b = OlsSlope(it->second); std::isfinite(b)) values.push_back(b), sum += b, ++count;
       }
-      rejected += values.size() >= 2 && OneSampleTTestP(values, 0) < options.alpha;
+      if (values.size() < 2) continue;
+      const double n = double(values.size());
+      double mean = 0, ss = 0;
+      for (double v : values) mean += v;
+      mean /= n;
+      for (double v : values) ss += (v - mean) * (v - mean);
+      while (t975.size() < values.size()) t975.push_back(StudentT975(int(t975.size())));
+      width += 2 * t975[values.size() - 1] * std::sqrt(ss / (n - 1) / n);
+      ++widths;
+      rejected += OneSampleTTestP(values, 0) < options.alpha;
     }
-    row.share_none = shown > 0 ? none / shown : nan;
     row.mean_trials = matches / S;  // answered matches per study at this N
     row.wilson_width = widths > 0 ? width / widths : nan;
     row.power = double(rejected) / S;
     r.rows.push_back(row);
   }
+  // The mean slope over every study and participant, now that all are counted.
+  for (auto row = r.rows.end() - N; row != r.rows.end(); ++row) row->expected_share = count > 0 ? sum / count : nan;
 }
 
 }  // namespace
@@ -319,6 +295,7 @@ PlanResult RunPlan(const PlanOptions& options) {
   const session::PreparedSession study = session::PrepareStudy(options.protocol_file, options.display_profile);
   r.study = study.protocol.name;
   r.display = study.display.name;
+  r.protocol_hash = store::ProtocolHash(store::CanonicalProtocolText(study.protocol_text));
   const auto start = std::chrono::steady_clock::now();
   r.studies = SimulateStudies(options, study, &r.conditions, &r.notes, &r.threads_used);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -443,7 +420,7 @@ std::string PlanCsv(const PlanResult& r) {
       "test,condition,measure,chance,participants,expected_share,share_first,share_second,share_cant_tell,share_none,"
       "mean_trials,wilson_width,power\n";
   for (const PowerRow& row : r.rows)
-    out += row.test + "," + Quoted(row.condition) + "," + row.measure + "," + Number(row.chance, "%.6g") + "," +
+    out += row.test + "," + store::CsvField(row.condition) + "," + row.measure + "," + Number(row.chance, "%.6g") + "," +
            std::to_string(row.participants) + "," + Number(row.expected_share) + "," + Number(row.share_first) + "," +
            Number(row.share_second) + "," + Number(row.share_cant_tell) + "," + Number(row.share_none) + "," +
            Number(row.mean_trials, "%.3f") + "," + Number(row.wilson_width) + "," + Number(row.power) + "\n";
@@ -455,8 +432,8 @@ std::string AnswersCsv(const PlanResult& r) {
   if (r.studies.empty()) return out;
   for (const SimParticipant& p : r.studies.front())
     for (const auto& [index, choice] : p.answers)
-      out += p.id + ",s" + std::to_string(p.seed) + "," + Quoted(p.group) + "," + std::to_string(index) + "," +
-             Quoted(choice) + "\n";
+      out += p.id + ",s" + std::to_string(p.seed) + "," + store::CsvField(p.group) + "," + std::to_string(index) + "," +
+             store::CsvField(choice) + "\n";
   return out;
 }
 

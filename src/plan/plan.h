@@ -51,7 +51,6 @@ struct Condition {
   std::string levels;     // the levels as JSON
   std::string label;      // "edge=3" (and the block's name when the protocol has several)
   std::string measure;    // "first_source" (a pair) | "correct" | "yes" | "log_cutoff_slope" (depth matching)
-  std::string first, second;  // a pair: the design's left and right source
   double chance = -1;     // the test's null share; < 0: no test (yes/no)
 };
 
@@ -95,18 +94,15 @@ struct PlanResult {
   std::string observer;                    // canonical form
   std::string study;                       // the protocol's name
   std::string display;                     // the display profile's name (--display, the protocol's, or the default)
+  std::string protocol_hash;               // as the record hashes it (store::ProtocolHash of its canonical text)
 };
 
 // Throws Error(kInput) for a protocol that cannot be prepared (as `blurcue validate`), kUsage for bad options.
 PlanResult RunPlan(const PlanOptions& options);
 
-// Only the simulation: the participants of options.studies studies x options.participants, on options.threads
-// workers; the conditions found (ordered), notes on what is not planned, the workers used and the protocol's name.
-std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& options, std::vector<Condition>* conditions,
-                                                         std::vector<std::string>* notes, int* threads_used,
-                                                         std::string* study_name = nullptr);
-// The same from a study already prepared (session::PrepareStudy of options.protocol_file and display_profile): only
-// the simulation, as the benchmark times it.
+// Only the simulation, of a study already prepared (session::PrepareStudy of options.protocol_file and
+// display_profile), as the benchmark times it: the participants of options.studies studies x options.participants,
+// on options.threads workers; the conditions found (ordered), notes on what is not planned and the workers used.
 std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& options,
                                                          const session::PreparedSession& study,
                                                          std::vector<Condition>* conditions,

@@ -1479,12 +1479,17 @@ std::set<double> NumericLevels(const Protocol& protocol, const std::string& fact
   return values;
 }
 
-fs::path RealPhotoFor(const Content& content, double distance_m) {
+std::string LevelText(double level) {
   char text[32];
-  std::snprintf(text, sizeof text, "%g", distance_m);
+  std::snprintf(text, sizeof text, "%g", level);
+  return text;
+}
+
+fs::path RealPhotoFor(const Content& content, double distance_m) {
+  const std::string text = LevelText(distance_m);
   std::string path = content.real_photos;
   const std::string key = "{distance_m}";
-  for (size_t at = path.find(key); at != std::string::npos; at = path.find(key, at + std::strlen(text)))
+  for (size_t at = path.find(key); at != std::string::npos; at = path.find(key, at + text.size()))
     path.replace(at, key.size(), text);
   return path;
 }

@@ -136,6 +136,9 @@ struct Content {
   double real_focus_m = 0;
 };
 
+// A numeric level as text, as the record writes it (%g): an adjusted level's answer, a real photo's {distance_m}.
+std::string LevelText(double level);
+
 // The real photo of `content` for a distance (content.real_photos with {distance_m} replaced).
 std::filesystem::path RealPhotoFor(const Content& content, double distance_m);
 

@@ -202,6 +202,11 @@ const Block* BlockOf(const Protocol& protocol, const Trial& trial) {
   return nullptr;
 }
 
+int BlockIndex(const Protocol& protocol, const Trial& trial) {
+  const Block* block = BlockOf(protocol, trial);
+  return block ? static_cast<int>(block - protocol.blocks.data()) : 0;
+}
+
 std::string SidePointer(const Protocol& protocol, const Trial& trial, const std::string& side) {
   // A swapped trial shows the design's other side.
   const std::string designed = trial.swapped ? (side == "left" ? "right" : "left") : side;

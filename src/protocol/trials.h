@@ -76,6 +76,8 @@ std::string AssignGroup(const Protocol& protocol, const std::string& participant
 
 // The block `trial` belongs to (null for a trial made from another protocol).
 const Block* BlockOf(const Protocol& protocol, const Trial& trial);
+// Its place in protocol.blocks (0 when no block has the trial's name, as for a trial made by hand).
+int BlockIndex(const Protocol& protocol, const Trial& trial);
 
 // The JSON pointer of the field that chose what `trial` shows on `side` ("left" | "right" as shown, swaps
 // applied): the side of a level object (/blocks/1/factors/pattern/2/left) or of the block's sides (/sides/left).

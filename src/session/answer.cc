@@ -25,8 +25,7 @@ AdjustView AdjustViewOf(const protocol::Trial& trial, const TrialScene& scene, c
 }
 
 void CheckObserverCanAnswer(const ObserverParams& observer, const protocol::Protocol& protocol) {
-  if (observer.model != ObserverModel::kArcmin || protocol.content.type != "picture" ||
-      !protocol.content.real_camera_file.empty())
+  if (observer.model != ObserverModel::kArcmin || protocol.content.type != "picture" || protocol.content.real_camera)
     return;
   for (const auto& block : protocol.blocks)
     if (block.task == protocol::Task::kAdjustment)

@@ -10,13 +10,13 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/stats.h"
 
 namespace blurcue::session {
 namespace {
 
 constexpr double kZ75 = 0.6744897501960817;  // Phi^-1(0.75)
 
-double Phi(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
 
 // ln E(s) = ln (s^p + s_i^p)^(1/p), scaled by the larger term so that neither power overflows.
 double LogSeenBlur(const ObserverParams& p, double s_arcmin) {
@@ -134,11 +134,11 @@ double ProbabilityCorrect2afc(const ObserverParams& p, double r_a_arcmin, double
                                    "arcmin (use model=arcmin)");
   // r = 2 s (DESIGN.md: blurcue's radius is twice the line-spread function's std).
   const double d = std::abs(LogSeenBlur(p, r_a_arcmin / 2) - LogSeenBlur(p, r_b_arcmin / 2));
-  return Phi(kZ75 * d / std::log1p(p.weber));
+  return StdNormalCdf(kZ75 * d / std::log1p(p.weber));
 }
 
 double ProbabilityCorrect2afc(const ObserverParams& p, const PairView& v) {
-  if (p.model == ObserverModel::kPixel) return Phi(std::abs(v.r_left_px - v.r_right_px) / p.jnd_px);
+  if (p.model == ObserverModel::kPixel) return StdNormalCdf(std::abs(v.r_left_px - v.r_right_px) / p.jnd_px);
   if (!(v.arcmin_per_px > 0))
     throw Error(ErrorKind::kInternal, "the arcmin observer was given a pair without its arcmin per photo px");
   return ProbabilityCorrect2afc(p, v.r_left_px * v.arcmin_per_px, v.r_right_px * v.arcmin_per_px);

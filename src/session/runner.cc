@@ -390,12 +390,10 @@ class Runner {
           response->rt_ms = t_ms;
           return Outcome::kAnswered;
         } else if ((action == "previous" || action == "next") && levels > 0) {
-          level = (level + (action == "next" ? 1 : levels - 1)) % levels;
+          level = StepLevel(level, action, levels);
           steps.push_back({{"level", trial.adjust_levels[size_t(level)]}, {"t_ms", std::round(t_ms * 10) / 10}});
         } else if (action == "accept" && levels > 0) {
-          char text[32];
-          std::snprintf(text, sizeof text, "%g", trial.adjust_levels[size_t(level)]);
-          response->choice = text;
+          response->choice = protocol::LevelText(trial.adjust_levels[size_t(level)]);
           response->rt_ms = t_ms;
           response->adjustment_json = steps.dump();
           return Outcome::kAnswered;
@@ -710,8 +708,7 @@ RunResult RunSession(const RunOptions& options) {
   for (const protocol::Trial& trial : trials) {
     store::TrialRecord r;
     r.index = trial.index;
-    for (size_t b = 0; b < protocol.blocks.size(); ++b)
-      if (protocol.blocks[b].name == trial.block) r.block = static_cast<int64_t>(b);
+    r.block = protocol::BlockIndex(protocol, trial);
     const TrialScene& planned = scenes[size_t(trial.index)];
     r.factors_json = TrialVariables(trial, planned, prepared.presentation).dump();
     r.left_json = trial.left.dump();

@@ -490,11 +490,7 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
       v["start_level"] = trial.adjust_levels[size_t(trial.start_index)];
     // The levels in the order "next" steps through them (cyclic): what the participant could reach, as shown.
     std::string levels;
-    char text[32];
-    for (double level : trial.adjust_levels) {
-      std::snprintf(text, sizeof text, "%g", level);
-      levels += (levels.empty() ? "" : ";") + std::string(text);
-    }
+    for (double level : trial.adjust_levels) levels += (levels.empty() ? "" : ";") + protocol::LevelText(level);
     v["adjust_levels"] = levels;
   }
   if (scene.content == "picture") {

@@ -107,6 +107,13 @@ std::vector<KeyPress> ObserverPresses(const ObserverParams& params, uint64_t see
   return AnswerTrial(observer, protocol, trial, scene, presentation);
 }
 
+int StepLevel(int level, const std::string& action, int levels) {
+  if (levels <= 0) return level;
+  if (action == "next") return (level + 1) % levels;
+  if (action == "previous") return (level + levels - 1) % levels;
+  return level;
+}
+
 std::pair<std::string, double> HeadlessAnswer(const protocol::Protocol& protocol, const protocol::Trial& trial,
                                               const TrialScene& scene, const std::vector<KeyPress>& presses) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -124,11 +131,9 @@ std::pair<std::string, double> HeadlessAnswer(const protocol::Protocol& protocol
     t_ms += press.after_ms;
     if (levels == 0) break;
     if (press.action == "next" || press.action == "previous") {
-      level = (level + (press.action == "next" ? 1 : levels - 1)) % levels;
+      level = StepLevel(level, press.action, levels);
     } else if (press.action == "accept") {
-      char text[32];
-      std::snprintf(text, sizeof text, "%g", trial.adjust_levels[size_t(level)]);
-      return {text, t_ms};
+      return {protocol::LevelText(trial.adjust_levels[size_t(level)]), t_ms};
     }
   }
   return {store::kChoiceNone, nan};

@@ -86,6 +86,9 @@ std::vector<KeyPress> ObserverPresses(const ObserverParams& params, uint64_t see
                                       const protocol::Trial& trial, const TrialScene& scene,
                                       const Presentation& presentation);
 
+// An adjustment's level after a "next" or "previous" key (any other action leaves it): cyclic over `levels`.
+int StepLevel(int level, const std::string& action, int levels);
+
 // What a headless session records for those presses (the answering action, the adjustment's accepted level as %g),
 // and its response time in ms from onset; kChoiceNone (response time NaN) when the answer comes at or after the
 // protocol's deadline.
