@@ -47,6 +47,11 @@ def chart(plan, out_dir, title, target):
                 label=f"t-test across participants ({measure}; GLMM stand-in)" + (f" (N = {n})" if n else ""))
         if n:
             ax.plot([n], [g[g["participants"] == n]["power"].iloc[0]], "o", color="#D55E00", ms=6)
+    for condition, g in tested[tested["test"] == "slope_t"].groupby("condition"):
+        g = g.sort_values("participants")
+        n = smallest_n(g, target)
+        ax.plot(g["participants"], g["power"], lw=2.6, color="#0072B2",
+                label=f"slope t-test, {condition} (depth matching)" + (f" (N = {n})" if n else ""))
     ax.axhline(target, color="#555555", ls="--", lw=1)
     ax.set_xlabel("participants (N)")
     ax.set_ylabel("power (share of simulated studies with p < alpha)")
