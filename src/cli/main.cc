@@ -74,6 +74,18 @@ int main(int argc, char** argv) {
     }
   }
 
+  // An empty value names nothing (no file, folder, number or spec): refused for every option and argument alike,
+  // before a command reads or writes anything ("--out ''" used to reach std::filesystem and end as an internal error).
+  for (int i = 2; i < argc; ++i) {
+    const std::string arg = argv[i], before = argv[i - 1];
+    const bool empty_value = arg.empty() || (arg.rfind("--", 0) == 0 && arg.back() == '=');
+    if (!empty_value) continue;
+    const std::string option =
+        !arg.empty() ? arg.substr(0, arg.size() - 1) : before.rfind("-", 0) == 0 ? before : "an argument";
+    std::cerr << "blurcue: " << option << ": must not be empty\n";
+    return static_cast<int>(ErrorKind::kUsage);
+  }
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -66,13 +66,14 @@ void AddSynthPicturesCommand(CLI::App& app) {
   cmd->add_option("--out", args->out, "folder (created)")->required();
   cmd->callback([args, focus] {
     std::set<double> distances(args->distances_m.begin(), args->distances_m.end());
+    bool focus_from_protocol = false;
     if (!args->protocol.empty()) {
       protocol::ValidateOptions no_files;
       no_files.check_files = false;  // its real_photos may be what we are about to write
       const protocol::Protocol p = protocol::LoadProtocol(args->protocol, no_files);
       distances.merge(protocol::NumericLevels(p, "distance_m"));
       if (args->camera.empty()) args->camera = p.content.real_camera_file.string();
-      if (!focus->count() && p.content.real_focus_m > 0) args->focus_m = p.content.real_focus_m;
+      if (!focus->count() && p.content.real_focus_m > 0) args->focus_m = p.content.real_focus_m, focus_from_protocol = true;
     }
     if (distances.empty()) throw Error(ErrorKind::kUsage, "give --distances-m or a --protocol with distance_m levels");
     if (args->camera.empty())
@@ -88,8 +89,16 @@ void AddSynthPicturesCommand(CLI::App& app) {
       char name[64];
       std::snprintf(name, sizeof name, "%s-%gm.png", stem.c_str(), d);
       const auto path = std::filesystem::path(args->out) / name;
-      WriteImage(path, render::RealPicturePhoto(picture, scaled, args->focus_m * 1000, d * 1000, args->height_mm,
-                                                args->grey));
+      cv::Mat photo;
+      try {
+        photo = render::RealPicturePhoto(picture, scaled, args->focus_m * 1000, d * 1000, args->height_mm, args->grey);
+      } catch (const Error& e) {
+        // A focus, distance or size the thin lens cannot image: the field or option that chose it.
+        if (e.kind() != ErrorKind::kDomain) throw;
+        if (focus_from_protocol) throw InputError(args->protocol + ": /content/real_camera", e.what());
+        throw Error(ErrorKind::kDomain, "--focus-m, --distances-m or --height-mm: " + std::string(e.what()));
+      }
+      WriteImage(path, photo);
     }
     std::printf("wrote %zu photos (%s, %dx%d, focus %g m) to %s\n", distances.size(), stem.c_str(),
                 scaled.image_width_px, scaled.image_height_px, args->focus_m, args->out.c_str());

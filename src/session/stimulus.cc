@@ -161,6 +161,12 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
       try {
         t.r_scene_px = optics::BlurRadiusPx(optics::Lens::FromCamera(*camera), protocol.content.real_focus_m * 1000,
                                             t.distance_m * 1000);
+        // As synth-pictures refuses to make such a photo: a blur past any kernel is a wrong focus or camera.
+        if (!(t.r_scene_px <= optics::kMaxBlurRadiusPx))
+          throw Error(ErrorKind::kDomain, "the real picture at " + protocol::LevelText(t.distance_m) +
+                                              " m would be blurred by " + std::to_string(std::lround(t.r_scene_px)) +
+                                              " px, more than the largest blur (" +
+                                              std::to_string(int(optics::kMaxBlurRadiusPx)) + " px)");
       } catch (const Error& e) {
         throw InputError(At(protocol, "/content/real_camera"), std::string(e.what()) + trial_text);
       }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <cstdio>
 #include <map>
 
@@ -89,10 +90,13 @@ std::vector<MatchVisibility> MatchVisibilities(const PreparedSession& prepared, 
     std::sort(levels.begin(), levels.end());
     levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
     m.levels = int(levels.size());
-    double nearest = 2;  // the smallest share correct so far: the level that looks most like the real picture
+    // The level that looks most like the real picture: the smallest share correct, and where shares tie (all 100 %
+    // for a keen observer) the nearest blur.
+    std::pair<double, double> nearest{2, 0};
     for (double c : levels) {
       const double r = shown.LevelArcmin(c), p = ProbabilityCorrect2afc(observer, r, m.r_real_arcmin);
-      if (p < nearest) nearest = p, m.closest = c, m.closest_r_arcmin = r, m.closest_p = p;
+      if (const std::pair<double, double> key{p, std::abs(r - m.r_real_arcmin)}; key < nearest)
+        nearest = key, m.closest = c, m.closest_r_arcmin = r, m.closest_p = p;
       if (p >= level) continue;
       m.alike.push_back(c);
       m.alike_r_min = m.alike.size() == 1 ? r : std::min(m.alike_r_min, r);
