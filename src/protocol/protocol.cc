@@ -1034,6 +1034,14 @@ void Parser::ParseResponses(const Json& v, const std::string& ptr, const std::se
   unused("no", tasks.count(Task::kYesNo), "is for the task yes_no, which no block has");
   unused("rating", tasks.count(Task::kRating), "is for the task rating, which no block has");
   unused("alternatives", p.layout == "odd_one_out", "is for the layout odd_one_out");
+  const bool choice = tasks.count(Task::kForcedChoice) > 0, sides = choice && p.layout != "odd_one_out";
+  unused("left", sides, choice ? "is not read by the layout odd_one_out (its intervals have /responses/alternatives)"
+                               : "is for the task forced_choice, which no block has");
+  unused("right", sides, choice ? "is not read by the layout odd_one_out (its intervals have /responses/alternatives)"
+                                : "is for the task forced_choice, which no block has");
+  unused("cant_tell", choice, "is for the task forced_choice, which no block has");
+  for (const char* key : {"previous", "next", "accept"})
+    unused(key, tasks.count(Task::kAdjustment) > 0, "is for the task adjustment, which no block has");
   auto distinct = [&](const std::vector<std::pair<std::string, std::string>>& set) {
     for (size_t i = 0; i < set.size(); ++i)
       for (size_t j = 0; j < i; ++j)
@@ -1074,7 +1082,19 @@ Protocol Parser::Parse(const Json& json) {
   if (auto s = Text(json, "description", "", false, 5 * kMaxTextChars, false)) p.description = *s;
   if (auto s = Text(json, "instructions", "", false, kMaxTextChars, false)) p.instructions = *s;
   if (const Json* v = Field(json, "content", "", true)) ParseContent(*v, "/content", &p);
-  if (const Json* v = Field(json, "scene", "", true)) ParseScene(*v, "/scene", &p);
+  // A depth matching with real photos shows no scene photo: its lower half is the real photo of each distance.
+  const bool real_photos = p.content.type == "picture" && json.contains("content") && json["content"].is_object() &&
+                           json["content"].contains("real_photos");
+  if (const Json* v = Field(json, "scene", "", !real_photos)) {
+    if (real_photos)
+      Problem("/scene", "is not shown: with content.real_photos the lower half shows the real photo of each distance", *v);
+    else
+      ParseScene(*v, "/scene", &p);
+  }
+  if (p.content.type == "picture" && json.contains("scene") && json["scene"].is_object() &&
+      json["scene"].contains("calib"))
+    Problem("/scene/calib", "is not read by a picture (the real picture's blur comes from /content/real_camera)",
+            json["scene"]["calib"]);
   if (json.contains("scene") && json["scene"].is_object() && !json["scene"].contains("calib") &&
       (p.content.type == "grid" || p.content.type == "ball"))
     Problem("/scene/calib", "is required for a " + p.content.type + " (its blur comes from the calibration) but missing");

@@ -335,6 +335,8 @@ TEST(ProtocolValidate, ResponseKeysOfYesNoAndRating) {
   ExpectProblem(pair, "/responses/yes: is for the task yes_no, which no block has");
   pair["responses"] = {{"alternatives", {"1", "2", "3"}}};
   ExpectProblem(pair, "/responses/alternatives: is for the layout odd_one_out");
+  pair["responses"] = {{"accept", "Return"}};  // a pair protocol reads no stepping key
+  ExpectProblem(pair, "/responses/accept: is for the task adjustment, which no block has");
 }
 
 TEST(ProtocolValidate, PromptAndAnsweringAfterTheMotion) {
@@ -580,10 +582,27 @@ Json WithRealPhotos(const std::string& pattern) {
   fs::create_directories(dir);
   for (const char* name : {"face-0.4m.png", "face-1.5m.png"}) std::ofstream(dir / name) << "x";
   return Json::parse(R"({
-    "name": "dm", "version": 1, "scene": {"background": "scene/scene.png"},
+    "name": "dm", "version": 1,
     "content": {"type": "picture", "image": "scene/scene.png", "real_photos": ")" + pattern + R"("},
     "task": "adjustment", "adjust": {"levels": [2, 4, 8]}, "factors": {"distance_m": [0.4, 1.5]}
   })");
+}
+
+// Every field a depth matching would not read is refused: keys of another task, a scene photo when its real photos
+// are shown, a calibration (a picture's real blur comes from content.real_camera).
+TEST(ProtocolValidate, DepthMatchingRefusesWhatItWouldNotRead) {
+  Json adjust = WithRealPhotos("photos/face-{distance_m}m.png");
+  for (const char* key : {"left", "right", "cant_tell"}) {
+    adjust["responses"] = {{key, "Return"}};
+    ExpectProblem(adjust, "/responses/" + std::string(key) + ": is for the task forced_choice, which no block has");
+  }
+  Json scene = WithRealPhotos("photos/face-{distance_m}m.png");
+  scene["scene"] = {{"background", "scene/scene.png"}};
+  ExpectProblem(scene, "/scene: is not shown: with content.real_photos the lower half shows the real photo");
+  Json calib = WithRealPhotos("photos/face-{distance_m}m.png");
+  calib["content"].erase("real_photos");
+  calib["scene"] = {{"background", "scene/scene.png"}, {"calib", "scene/scene.png"}};
+  ExpectProblem(calib, "/scene/calib: is not read by a picture");
 }
 
 TEST(ProtocolValidate, RealPhotosFoundPerDistance) {
@@ -632,6 +651,7 @@ TEST(ProtocolValidate, RealCameraReadOrRejectedNamingItsField) {
   }
   Json none = j;
   none["content"].erase("real_photos");
+  none["scene"] = {{"background", "scene/scene.png"}};  // without real photos the lower half shows the scene
   none["factors"] = {{"distance_m", {0.4}}};
   EXPECT_TRUE(Contains(OnlyProblem(none), ": /content/real_camera: describes the camera of content.real_photos"))
       << OnlyProblem(none);

@@ -623,14 +623,17 @@ constexpr int kMaxPhotoSidePx = 16384, kMaxTextureSidePx = 8192;
 
 StimulusImages LoadStimulusImages(const protocol::Protocol& protocol, const std::optional<calib::SceneCalib>& scene) {
   StimulusImages images;
+  // A depth matching with real photos shows no scene photo (the protocol has no scene).
   const bool board_free = protocol.scene.show == "board_free" && !protocol.scene.board_free.empty();
   const std::string photo_field = board_free ? "/scene/board_free" : "/scene/background";
   const auto& photo_path = board_free ? protocol.scene.board_free : protocol.scene.background;
-  images.photo = ReadFieldImage(protocol, photo_field, photo_path, 1, 10, kMaxPhotoSidePx);
-  // The photo not shown is still a photo of the scene: check it decodes too.
-  if (!protocol.scene.board_free.empty() && !board_free)
-    ReadFieldImage(protocol, "/scene/board_free", protocol.scene.board_free, 1, 10, kMaxPhotoSidePx);
-  if (board_free) ReadFieldImage(protocol, "/scene/background", protocol.scene.background, 1, 10, kMaxPhotoSidePx);
+  if (protocol.content.type != "picture" || protocol.content.real_photos.empty()) {
+    images.photo = ReadFieldImage(protocol, photo_field, photo_path, 1, 10, kMaxPhotoSidePx);
+    // The photo not shown is still a photo of the scene: check it decodes too.
+    if (!protocol.scene.board_free.empty() && !board_free)
+      ReadFieldImage(protocol, "/scene/board_free", protocol.scene.board_free, 1, 10, kMaxPhotoSidePx);
+    if (board_free) ReadFieldImage(protocol, "/scene/background", protocol.scene.background, 1, 10, kMaxPhotoSidePx);
+  }
   if (protocol.content.type == "picture") {
     images.picture = ReadFieldImage(protocol, "/content/image",
                                     protocol.content.image.empty() ? render::ResolveStimulus("face")
