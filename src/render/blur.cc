@@ -352,7 +352,9 @@ void GlBlur::Blur(const Texture& texture, GLuint framebuffer, const std::vector<
   auto viewport = [](const cv::Rect& r) { glViewport(r.x, r.y, r.width, r.height); };
   auto taps = [](const Region& region) { return GaussianTaps(region.r_px / 2); };
   auto blurs = [&](const Region& region) { return region.method == "disc" ? region.r_px > 0 : taps(region) > 0; };
-  for (const Region& region : regions) {
+  kernel_sigma_.assign(regions.size(), 1.0);  // a disc's second pass is a copy: any width
+  for (size_t k = 0; k < regions.size(); ++k) {
+    const Region& region = regions[k];
     if (!blurs(region)) continue;
     const cv::Rect& r = region.rect;
     viewport(r);
@@ -360,9 +362,10 @@ void GlBlur::Blur(const Texture& texture, GLuint framebuffer, const std::vector<
       const double coverage_r = DiscCoverageRadiusPx(region.r_px);
       disc_->Use().SetRegion(r.x, r.y, r.br().x, r.br().y).SetKernel(float(coverage_r), int(std::ceil(coverage_r + 0.5)));
     } else {
-      // GaussianKernelSigma: the discrete kernel's variance is exactly s^2.
-      const double s = region.r_px / 2;
-      gaussian_->Use().SetRegion(r.x, r.y, r.br().x, r.br().y).SetKernel(GaussianKernelSigma(s), taps(region))
+      // GaussianKernelSigma (a root search): the discrete kernel's variance is exactly s^2; worked out once for both
+      // passes.
+      kernel_sigma_[k] = GaussianKernelSigma(region.r_px / 2);
+      gaussian_->Use().SetRegion(r.x, r.y, r.br().x, r.br().y).SetKernel(kernel_sigma_[k], taps(region))
           .SetDirection(1, 0);
     }
     pass_->Draw();
@@ -372,13 +375,14 @@ void GlBlur::Blur(const Texture& texture, GLuint framebuffer, const std::vector<
   glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
   scratch.texture().BindImageForReading(0);
   gaussian_->Use();
-  for (const Region& region : regions) {
+  for (size_t k = 0; k < regions.size(); ++k) {
+    const Region& region = regions[k];
     if (!blurs(region)) continue;
     const cv::Rect& r = region.rect;
     viewport(r);
     const bool disc = region.method == "disc";
     gaussian_->SetRegion(r.x, r.y, r.br().x, r.br().y)
-        .SetKernel(disc ? 1.0 : GaussianKernelSigma(region.r_px / 2), disc ? 0 : taps(region))
+        .SetKernel(kernel_sigma_[k], disc ? 0 : taps(region))
         .SetDirection(0, 1);
     pass_->Draw();
   }

@@ -127,6 +127,7 @@ class GlBlur {
   std::unique_ptr<DiscBlurShader> disc_;
   std::unique_ptr<GrowingTarget> scratch_;
   std::unique_ptr<FullscreenPass> pass_;
+  std::vector<double> kernel_sigma_;  // per region of a Blur call, the Gaussian's kernel width (kept: no frame allocates)
 };
 
 }  // namespace blurcue::render

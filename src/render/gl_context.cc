@@ -13,6 +13,9 @@
 namespace blurcue::render {
 namespace {
 
+// The GL every context asks for: 4.2 core, the first with the image loads the blur shaders read their texels by.
+constexpr int kGlMajor = 4, kGlMinor = 2;
+
 std::string Hex(int v) {
   char b[16];
   std::snprintf(b, sizeof b, "0x%04x", v);
@@ -31,13 +34,13 @@ class EglContext final : public GlContext {
       throw Error(ErrorKind::kInternal, "EGL: cannot initialise the surfaceless display, error " + Hex(eglGetError()) +
                                             " (is Mesa's libegl1 installed?)");
     eglBindAPI(EGL_OPENGL_API);
-    const EGLint attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3,
+    const EGLint attributes[] = {EGL_CONTEXT_MAJOR_VERSION, kGlMajor, EGL_CONTEXT_MINOR_VERSION, kGlMinor,
                                  EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
     context_ = eglCreateContext(display_, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attributes);
     if (context_ == EGL_NO_CONTEXT) {
       const int err = eglGetError();
       eglTerminate(display_);
-      throw Error(ErrorKind::kInternal, "EGL: cannot create a GL 3.3 core context, error " + Hex(err));
+      throw Error(ErrorKind::kInternal, "EGL: cannot create a GL 4.2 core context, error " + Hex(err));
     }
     MakeCurrent();
   }
@@ -70,8 +73,8 @@ class GlfwContext final : public GlContext {
     if (!glfwInit())
       throw Error(ErrorKind::kInternal, "GLFW: cannot open a window: " + LastGlfwError() +
                                             " (a window needs a display: run under Xvfb, or use --observer sim)");
-    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
-    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, kGlMajor);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, kGlMinor);
     glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
     glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
     GLFWmonitor* monitor = nullptr;
@@ -88,7 +91,7 @@ class GlfwContext final : public GlContext {
     window_ = glfwCreateWindow(o.width_px, o.height_px, o.title.c_str(), monitor, nullptr);
     if (!window_) {
       glfwTerminate();
-      throw Error(ErrorKind::kInternal, "GLFW: cannot open a GL 3.3 core window: " + LastGlfwError());
+      throw Error(ErrorKind::kInternal, "GLFW: cannot open a GL 4.2 core window: " + LastGlfwError());
     }
     MakeCurrent();
     glfwSwapInterval(o.vsync ? 1 : 0);

@@ -119,10 +119,11 @@ GaussianBlurShader& GaussianBlurShader::SetRegion(int x0, int y0, int x1, int y1
 }
 GaussianBlurShader& GaussianBlurShader::SetKernel(double sigma_px, int taps) {
   CV_Assert(taps >= 0 && taps <= kMaxTaps);
+  double raw[kMaxTaps + 1];
   float weights[kMaxTaps + 1];
-  double sum = 1;
-  for (int i = 1; i <= taps; ++i) sum += 2 * std::exp(-0.5 * i * i / (sigma_px * sigma_px));
-  for (int i = 0; i <= taps; ++i) weights[i] = float(std::exp(-0.5 * i * i / (sigma_px * sigma_px)) / sum);
+  double sum = 0;
+  for (int i = 0; i <= taps; ++i) raw[i] = std::exp(-0.5 * i * i / (sigma_px * sigma_px)), sum += i ? 2 * raw[i] : raw[i];
+  for (int i = 0; i <= taps; ++i) weights[i] = float(raw[i] / sum);
   glUniform1i(taps_, taps);
   glUniform1fv(weights_, taps + 1, weights);
   return *this;

@@ -773,13 +773,13 @@ void StimulusRenderer::Compose(const TrialScene& trial, double t_s, double level
     return;
   }
   shown_ = ObjectsAt(protocol_, *scene_, trial, t_s);
-  std::vector<render::BlurredObject> objects;
-  for (const auto& shown : shown_) {
+  objects_.clear();  // kept between frames: its storage is reused
+  for (auto& shown : shown_) {
     if (!shown) continue;
-    objects.push_back(*shown);
-    objects.back().object.texture = texture_;
+    shown->object.texture = texture_;
+    objects_.push_back(*shown);
   }
-  compositor_->Compose(objects);
+  compositor_->Compose(objects_);
 }
 
 void StimulusRenderer::Present(int width_px, int height_px) {

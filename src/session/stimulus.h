@@ -215,7 +215,8 @@ class StimulusRenderer {
   std::optional<calib::SceneCalib> scene_;
   Presentation presentation_;
   cv::Mat photo_;
-  render::SurfaceTexture texture_;  // the objects' texture: one GL texture for the session
+  render::SurfaceTexture texture_;
+  std::vector<render::BlurredObject> objects_;  // the frame's objects for the compositor, kept between frames  // the objects' texture: one GL texture for the session
   std::unique_ptr<render::FrameCompositor> compositor_;
   // Picture: the upper half at a cut-off, made once (the Butterworth runs on the CPU) and kept; every level of
   // the protocol is made up front.
