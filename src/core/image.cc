@@ -177,8 +177,10 @@ void WriteImage(const std::filesystem::path& path, const cv::Mat& image) {
   bool ok = false;
   try {
     ok = cv::imencode(path.extension().string(), image, bytes);
-  } catch (const cv::Exception& e) {
-    throw InputError(path.string(), std::string("cannot encode image: ") + e.what());
+  } catch (const cv::Exception&) {
+    // OpenCV's own text runs over several lines and names its source file: say what the user can change instead.
+    throw InputError(path.string(), "cannot encode an image as '" + path.extension().string() +
+                                        "': name the file .png, .jpg, .tif or .bmp");
   }
   if (!ok) throw InputError(path.string(), "cannot encode image");
   WriteFileAtomically(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
