@@ -15,16 +15,18 @@ endfunction()
 # blur: NaN, huge, infinite and negative radii on both back ends (the CPU path used to crash, GL to hang or to
 # write the image unblurred).
 foreach(backend cpu gl)
-  foreach(pair "nan;nan" "1e308;1e308" "1e9;1e9" "inf;inf" "minus1;-1")
+  # Text that is no decimal number is quoted as typed; a number out of range is not.
+  foreach(pair "nan;nan;'nan'" "1e308;1e308;1e308" "1e9;1e9;1e9" "inf;inf;'inf'" "minus1;-1;-1")
     list(GET pair 0 tag)
     list(GET pair 1 value)
-    hostile_test(cli_hostile_blur_${backend}_radius_${tag} 2 "--radius-px: must be in [0, 500] px, got ${value}"
+    list(GET pair 2 shown)
+    hostile_test(cli_hostile_blur_${backend}_radius_${tag} 2 "--radius-px: must be in [0, 500] px, got ${shown}"
                  blur ${D}/small.png --backend ${backend} --radius-px=${value} --out ${H}/x.png)
   endforeach()
 endforeach()
 hostile_test(cli_hostile_blur_radius_not_a_number 2 "--radius-px: must be in [0, 500] px, got '3px'"
              blur ${D}/small.png --radius-px 3px --out ${H}/x.png)
-hostile_test(cli_hostile_blur_cutoff_nan 2 "--cutoff: must be in (0, 100000] cycles per image width, got nan"
+hostile_test(cli_hostile_blur_cutoff_nan 2 "--cutoff: must be in (0, 100000] cycles per image width, got 'nan'"
              blur ${D}/small.png --method butterworth --cutoff nan --out ${H}/x.png)
 hostile_test(cli_hostile_blur_cutoff_zero 2 "--cutoff: must be in (0, 100000] cycles per image width, got 0"
              blur ${D}/small.png --method butterworth --cutoff 0 --out ${H}/x.png)
@@ -52,7 +54,7 @@ add_test(NAME cli_hostile_image_bad_iccp_is_quiet
 hostile_test(cli_hostile_render_blur_1e9 2
              "fitted or a radius in [0, 500] px, got '1e9'"
              render --calib ${T}/calib.json --background ${T}/scene/scene.png --blur 1e9 --out ${H}/x.png)
-hostile_test(cli_hostile_render_gain_nan 2 "--gain: must be a number in [0, 100], got nan"
+hostile_test(cli_hostile_render_gain_nan 2 "--gain: must be a number in [0, 100], got 'nan'"
              render --calib ${T}/calib.json --background ${T}/scene/scene.png --gain nan --out ${H}/x.png)
 set_tests_properties(cli_hostile_render_blur_1e9 cli_hostile_render_gain_nan PROPERTIES
                      FIXTURES_REQUIRED "scene;calib")
@@ -60,7 +62,7 @@ hostile_test(cli_hostile_render_radius_times_gain 2
              "--blur 400 x --gain 2 gives 800 px at the object; the blur radius must be in [0, 500] px"
              render --calib ${T}/calib.json --background ${T}/scene/scene.png --blur 400 --gain 2 --out ${H}/x.png)
 set_tests_properties(cli_hostile_render_radius_times_gain PROPERTIES FIXTURES_REQUIRED "scene;calib" LABELS gl)
-hostile_test(cli_hostile_render_cutoff_nan 2 "--cutoff: must be in [0, 100000] cycles per picture width, got nan"
+hostile_test(cli_hostile_render_cutoff_nan 2 "--cutoff: must be in [0, 100000] cycles per picture width, got 'nan'"
              render --object picture --background ${D}/small.png --cutoff nan --out ${H}/x.png)
 
 # camera.json: a width of 2^32 + 1148 used to wrap to 1148 and calibrate; every number has a physical range.
@@ -88,9 +90,9 @@ hostile_test(cli_hostile_camera_huge_focal 3
              estimate --camera ${H}/camera-huge-focal.json ${ESTIMATE_ARGS})
 
 # The numeric options of the other commands: each names its range and unit.
-hostile_test(cli_hostile_estimate_u_nan 2 "--u-mm: must be in (0, 1000000] mm, got nan"
+hostile_test(cli_hostile_estimate_u_nan 2 "--u-mm: must be in (0, 1000000] mm, got 'nan'"
              estimate --camera ${D}/thesis-camera.json --ref-u-mm 342.3 --ref-r-px 8 --u-mm nan)
-hostile_test(cli_hostile_estimate_ref_u_inf 2 "--ref-u-mm: must be in [0, 1000000] mm, got inf"
+hostile_test(cli_hostile_estimate_ref_u_inf 2 "--ref-u-mm: must be in [0, 1000000] mm, got 'inf'"
              estimate --camera ${D}/thesis-camera.json --ref-u-mm inf --ref-r-px 8 --u-mm 500)
 hostile_test(cli_hostile_synth_scene_width_wraps 2 "--width: must be a whole number in [32, 20000] px, got 4294968444"
              synth-scene --out ${H}/scene --width 4294968444)
@@ -99,19 +101,19 @@ hostile_test(cli_hostile_synth_scene_supersample_cap 2
              synth-scene --out ${H}/scene --supersample 16)
 hostile_test(cli_hostile_synth_scene_focus_nan 2 "--focus-mm: must be a distance in (0, 1000000] mm or 'inf', got 'nan'"
              synth-scene --out ${H}/scene --focus-mm nan)
-hostile_test(cli_hostile_synth_scene_noise_nan 2 "--noise: must be in [0, 1] linear units, got nan"
+hostile_test(cli_hostile_synth_scene_noise_nan 2 "--noise: must be in [0, 1] linear units, got 'nan'"
              synth-scene --out ${H}/scene --noise nan)
 hostile_test(cli_hostile_synth_scene_seed_negative 2 "--seed: must be a whole number from 0 to 18446744073709551615, got '-3'"
              synth-scene --out ${H}/scene --seed=-3)
-hostile_test(cli_hostile_synth_pictures_focus_inf 2 "--focus-m: must be in (0, 1000] m, got inf"
+hostile_test(cli_hostile_synth_pictures_focus_inf 2 "--focus-m: must be in (0, 1000] m, got 'inf'"
              synth-pictures --camera ${D}/thesis-camera.json --distances-m 1 --focus-m inf --out ${H}/pictures)
 hostile_test(cli_hostile_synth_pictures_no_camera 2 "give --camera, or a --protocol whose content.real_camera names one"
              synth-pictures --distances-m 1 --out ${H}/pictures)
-hostile_test(cli_hostile_calibrate_square_nan 2 "--square-mm: must be in [1, 1000] mm, got nan"
+hostile_test(cli_hostile_calibrate_square_nan 2 "--square-mm: must be in [1, 1000] mm, got 'nan'"
              calibrate ${D}/small.png --camera ${D}/thesis-camera.json --square-mm nan)
-hostile_test(cli_hostile_animate_fps_nan 2 "--fps: must be in [1, 1000] frames per second, got nan"
+hostile_test(cli_hostile_animate_fps_nan 2 "--fps: must be in [1, 1000] frames per second, got 'nan'"
              animate --calib ${D}/thesis-camera.json --background ${D}/small.png --fps nan --video ${H}/x.avi)
-hostile_test(cli_hostile_run_sim_fps_nan 2 "--sim-fps: must be in [0.1, 1000] frames per second, got nan"
+hostile_test(cli_hostile_run_sim_fps_nan 2 "--sim-fps: must be in [0.1, 1000] frames per second, got 'nan'"
              run ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --participant P1 --db ${H}/x.sqlite
              --sim-fps nan)
 hostile_test(cli_hostile_run_stop_after_negative 2 "--stop-after: must be a whole number in [0, 1000000], got -5"
@@ -155,7 +157,7 @@ hostile_test(cli_hostile_observer_rt_empty 2 "--observer rt must be a number, go
              --observer sim:rt=)
 hostile_test(cli_hostile_observer_other_model 2 "--observer jnd belongs to model=pixel, not model=arcmin"
              validate ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --plan --observer sim:model=arcmin,jnd=1)
-hostile_test(cli_hostile_validate_visible_nan 2 "--visible: must be in [0.5, 1] share correct, got nan"
+hostile_test(cli_hostile_validate_visible_nan 2 "--visible: must be in [0.5, 1] share correct, got 'nan'"
              validate ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --plan --visible nan)
 hostile_test(cli_hostile_preview_observer_model 2 "--observer model must be arcmin or pixel, got 'eye'"
              preview ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --out ${H}/x.png --observer sim:model=eye)

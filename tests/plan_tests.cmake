@@ -26,7 +26,7 @@ add_plan_failure_test(plan_bad_n_nan 2 "--participants: must be a whole number i
                       plan ${P1} --participants nan --no-chart --out ${T}/plan-bad)
 add_plan_failure_test(plan_bad_studies 2 "--studies: must be a whole number in [1, 100000], got 0"
                       plan ${P1} --studies 0 --no-chart --out ${T}/plan-bad)
-add_plan_failure_test(plan_bad_alpha 2 "--alpha: must be a number in (0, 0.5], got nan"
+add_plan_failure_test(plan_bad_alpha 2 "--alpha: must be a number in (0, 0.5], got 'nan'"
                       plan ${P1} --alpha nan --no-chart --out ${T}/plan-bad)
 add_plan_failure_test(plan_bad_observer 2 "--observer: unknown parameter 'jdn'"
                       plan ${P1} --observer sim:jdn=1 --no-chart --out ${T}/plan-bad)

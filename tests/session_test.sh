@@ -504,7 +504,32 @@ PYEOF
   $BC run "$W/p.json" --participant G2 --db "$W/split.sqlite" --observer sim:jnd=0.05,lapse=0 --resume > /dev/null 2>&1
   $BC run "$W/p.json" --participant G2 --db "$W/whole.sqlite" --observer sim:jnd=0.05,lapse=0 > /dev/null 2>&1
   [ "$(fingerprint "$W/split.sqlite" G2)" = "$(fingerprint "$W/whole.sqlite" G2)" ] || fail "resumed practice differs"
-  echo "ok: a practice run that met its criterion skipped the runs after it; a guessing observer ran all three; resumable" ;;
+  # Tampered records whose skips the answers before them do not give are refused on resume, exit 3, nothing added:
+  # a skipped practice trial recorded as shown, and a shown one recorded as skipped.
+  for tamper in "6 left|trial 6: the record shows it, but the answers before it skip it (criterion met in run 1)" \
+                "2 skipped|trial 2: the record skips it, but the answers before it show it"; do
+    index=${tamper%% *}; rest=${tamper#* }; choice=${rest%%|*}; message=${tamper#*|}
+    rm -f "$W/t.sqlite"
+    $BC run "$W/p.json" --participant G3 --db "$W/t.sqlite" --observer sim:jnd=0.05,lapse=0 --stop-after 8 \
+      > /dev/null 2>&1
+    $PY - "$W/t.sqlite" "$index" "$choice" <<'PYEOF'
+import sqlite3, sys
+con = sqlite3.connect(sys.argv[1])
+n = con.execute("UPDATE responses SET choice = ? WHERE trial_id = (SELECT id FROM trials WHERE trial_index = ?)",
+                (sys.argv[3], int(sys.argv[2]))).rowcount
+assert n == 1, n
+con.commit()
+PYEOF
+    before=$($PY -c "import sqlite3,sys; print(sqlite3.connect(sys.argv[1]).execute('SELECT COUNT(*) FROM responses').fetchone()[0])" "$W/t.sqlite")
+    set +e
+    $BC run "$W/p.json" --participant G3 --db "$W/t.sqlite" --observer sim:jnd=0.05,lapse=0 --resume \
+      > /dev/null 2> "$W/err"
+    code=$?
+    set -e
+    [ $code = 3 ] && grep -qF "$message" "$W/err" && grep -q "it cannot be resumed$" "$W/err" || fail "tampered ($tamper): exit $code: $(cat "$W/err")"
+    [ "$($PY -c "import sqlite3,sys; print(sqlite3.connect(sys.argv[1]).execute('SELECT COUNT(*) FROM responses').fetchone()[0])" "$W/t.sqlite")" = "$before" ] || fail "tampered ($tamper): answers added"
+  done
+  echo "ok: a practice run that met its criterion skipped the runs after it; a guessing observer ran all three; resumable; tampered skips refused" ;;
 deadline)
   # A deadline: no answer within it records the choice "none" with no response time, and a procedure counts it
   # wrong (its level climbs); feedback after each procedure trial; feedback without a procedure is refused.
@@ -631,6 +656,87 @@ PYEOF
   got=$(sql "$W/s.sqlite" "SELECT choice || ' ' || (rt_ms > 2400) FROM responses")
   [ "$got" = "3 1" ] || fail "answer: $got (the key pressed during the intervals must not count)"
   echo "ok: a key during the intervals ignored, the one after them recorded: $got" ;;
+depth_capture)
+  # A depth-matching frame shows what its record and its capture say. The shipped protocol with a plain white 4:3
+  # picture, captured at each trial's first frame (its start level). Measured on each captured PNG, apart from
+  # blurcue: the picture's edges (where the linear-light profile through its centre crosses half-way from the grey
+  # field to white) lie on the capture's rect_px within 1 px; its width in arcmin (2 atan on the recorded display)
+  # is the record's picture_width_arcmin; where the level's blur is measurable (2-12 px std on screen) the left
+  # edge's 10-90 % rise is that of the Gaussian the capture's r_screen_px names (r = 2 s, rise 2.563 s) times 0.90
+  # to 0.97 (the Butterworth's own rise is 0.175 / 0.187 = 0.936 of its equivalent Gaussian's, by the closed form;
+  # measured here 0.928-0.940); a factor 2 (r taken for s) fails. The real picture's blur and photo are the record's.
+  printf 'P6 64 48 255\n' > "$W/white.ppm"
+  head -c $((64 * 48 * 3)) /dev/zero | tr '\0' '\353' >> "$W/white.ppm"
+  $PY - "$P/pre-research-depth-matching.json" "$W/p.json" "$W/white.ppm" <<'PYEOF'
+import json, os, sys
+p = json.load(open(sys.argv[1]))
+base = os.path.dirname(os.path.abspath(sys.argv[1]))
+p["content"]["image"] = sys.argv[3]
+p["content"]["real_photos"] = os.path.normpath(os.path.join(base, p["content"]["real_photos"]))
+p["content"]["real_camera"]["camera"] = os.path.normpath(os.path.join(base, p["content"]["real_camera"]["camera"]))
+json.dump(p, open(sys.argv[2], "w"))
+PYEOF
+  $BC run "$W/p.json" --participant C1 --db "$W/c.sqlite" --observer sim --seed 3 --capture "$W/shots" > /dev/null \
+    2> "$W/err" || fail "capture run: $(tail -1 "$W/err")"
+  sql "$W/c.sqlite" "SELECT trial_index || '|' || factors FROM trials" > "$W/factors"
+  $PY - "$W/shots" "$W/factors" > "$W/measured" 2>&1 <<'PYEOF' || fail "depth-matching capture: $(tail -3 "$W/measured")"
+import glob, json, math, os, sys
+import numpy as np
+from PIL import Image
+factors = {int(i): json.loads(f) for i, f in (line.rstrip("\n").split("|", 1) for line in open(sys.argv[2]))}
+def linear(v):  # sRGB -> linear light
+    v = v / 255.0
+    return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
+def crossing(profile, level, start):  # first x >= start where profile rises through level, linearly interpolated
+    for x in range(start, len(profile) - 1):
+        if profile[x] < level <= profile[x + 1]:
+            return x + (level - profile[x]) / (profile[x + 1] - profile[x])
+    raise AssertionError(f"no crossing of {level}")
+shots = sorted(glob.glob(os.path.join(sys.argv[1], "trial-*.json")))
+assert len(shots) == 28, len(shots)
+rises = 0
+for path in shots:
+    cap = json.load(open(path))
+    rec = factors[cap["trial_index"]]
+    disp = cap["display"]
+    def arcmin(px):
+        return 2 * math.atan(0.5 * px * disp["width_mm"] / disp["width_px"] / disp["distance_mm"]) * 180 / math.pi * 60
+    img = linear(np.asarray(Image.open(path[:-5] + ".png").convert("L"), dtype=float))
+    x, y, w, h = cap["picture"]["rect_px"]
+    fx, fy, fw, fh = cap["photo_rect_px"]
+    grey, white = img[fy + 2, fx + 2], linear(np.float64(235))
+    row = (img[y + h // 2, :] - grey) / (white - grey)
+    col = (img[:, x + w // 2] - grey) / (white - grey)
+    left = crossing(row, 0.5, fx) + 0.5            # pixel centres at +0.5: an edge at x lies between x-1 and x
+    right = len(row) - (crossing(row[::-1], 0.5, len(row) - (fx + fw)) + 0.5)
+    top = crossing(col, 0.5, fy) + 0.5
+    tag = f"trial {cap['trial_index']} cut-off {cap['picture']['cutoff']}"
+    for got, want, what in ((left, x, "left"), (right, x + w, "right"), (top, y, "top")):
+        assert abs(got - want) <= 1, (tag, what, got, want)
+    assert abs(arcmin(right - left) - rec["picture_width_arcmin"]) <= 0.01 * rec["picture_width_arcmin"], \
+        (tag, arcmin(right - left), rec["picture_width_arcmin"])
+    assert abs(cap["picture"]["width_arcmin"] - rec["picture_width_arcmin"]) < 1e-3, tag
+    s = cap["picture"]["r_screen_px"] / 2
+    assert abs(arcmin(cap["picture"]["r_screen_px"]) - cap["picture"]["r_arcmin"]) < 2e-3 * max(1, cap["picture"]["r_arcmin"]), tag
+    if 2 <= s <= 12:
+        rise = crossing(row, 0.9, fx) - crossing(row, 0.1, fx)
+        ratio = rise / (2.563 * s)
+        assert 0.90 <= ratio <= 0.97, (tag, rise, 2.563 * s, ratio)
+        rises += 1
+        print(f"{tag}: rise {rise:.2f} px, the recorded blur's {2.563 * s:.2f} px (ratio {ratio:.3f})")
+    real = cap["real_picture"]
+    assert real["rect_px"] == [fx, fy + fh // 2, fw, fh - fh // 2], (tag, real["rect_px"], cap["photo_rect_px"])
+    assert abs(real["distance_m"] - rec["distance_m"]) < 1e-12, tag
+    for k in ("r_camera_px", "r_screen_px", "r_arcmin"):
+        key = {"r_camera_px": "r_scene_px", "r_screen_px": "r_scene_screen_px", "r_arcmin": "r_scene_arcmin"}[k]
+        assert abs(real[k] - rec[key]) < 2e-4, (tag, k, real[k], rec[key])
+    assert os.path.isfile(real["photo"]) and f"-{rec['distance_m']:g}m." in os.path.basename(real["photo"]), (tag, real["photo"])
+assert rises >= 5, f"only {rises} trials at a measurable level"
+print(f"ok: {len(shots)} frames, picture edges on rect_px, width = picture_width_arcmin; {rises} level blurs measured")
+PYEOF
+  tail -1 "$W/measured" | grep -q "^ok:" || fail "$(tail -1 "$W/measured")"
+  grep "rise" "$W/measured" | head -3
+  echo "ok: depth-matching captures: $(tail -1 "$W/measured" | cut -c5-)" ;;
 depth_arcmin)
   # Depth matching in visual angle (issue 14): each trial records the real picture's blur, worked out here apart from
   # blurcue - the thin lens of content.real_camera (1 m focus), the lower half's scale, 2 atan on the recorded display -

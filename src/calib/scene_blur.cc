@@ -9,6 +9,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "core/error.h"
+#include "core/typed.h"
 #include "optics/thin_lens.h"
 
 namespace blurcue::calib {
@@ -135,10 +136,9 @@ BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px) {
   if (text == "measured_section") return BlurSource::kMeasuredSection;
   if (text == "estimated") return BlurSource::kEstimated;
   if (text == "fitted") return BlurSource::kFitted;
-  char* end = nullptr;
-  const double r = std::strtod(text.c_str(), &end);
-  if (end != text.c_str() && *end == '\0' && r >= 0 && r <= optics::kMaxBlurRadiusPx) {
-    if (fixed_r_px) *fixed_r_px = r;
+  const std::optional<double> r = ParseDecimal(text);
+  if (r && *r >= 0 && *r <= optics::kMaxBlurRadiusPx) {
+    if (fixed_r_px) *fixed_r_px = *r;
     return BlurSource::kFixed;
   }
   throw Error(ErrorKind::kUsage,

@@ -5,10 +5,13 @@
 #include <cmath>
 #include <cstdlib>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 #include <string>
 
 #include <CLI/CLI.hpp>
+
+#include "core/typed.h"
 
 namespace blurcue::cli {
 
@@ -31,13 +34,10 @@ inline CLI::Validator FiniteRange(double lo, double hi, const std::string& unit,
                            (note.empty() ? "" : " (" + note + ")") + ", got ";
   return CLI::Validator(
       [lo, hi, open_low, what](std::string& text) -> std::string {
-        char* end = nullptr;
-        errno = 0;
-        const double v = std::strtod(text.c_str(), &end);
-        const bool parsed = !text.empty() && end == text.c_str() + text.size() && !std::isspace(text[0]);
-        if (!parsed) return what + "'" + text + "'";
-        const bool above = open_low ? v > lo : v >= lo;
-        return std::isfinite(v) && errno != ERANGE && above && v <= hi ? "" : what + text;
+        const std::optional<double> v = ParseDecimal(text);
+        if (!v) return what + "'" + text + "'";
+        const bool above = open_low ? *v > lo : *v >= lo;
+        return above && *v <= hi ? "" : what + text;
       },
       range);
 }

@@ -74,14 +74,16 @@ void AddRenderCommand(CLI::App& app) {
       const std::string name = args->object.size() > 8 && args->object[7] == ':' ? args->object.substr(8) : "face";
       const cv::Mat picture = ReadImage(render::ResolveStimulus(name));
       const cv::Mat photo = ReadImage(args->background, 1);
-      const int w = args->display_width > 0 ? args->display_width : 960, h = w * 3 / 4, half = h / 2;
-      const int picture_h = args->picture_height > 0 ? args->picture_height : half * 6 / 10;
+      const int w = args->display_width > 0 ? args->display_width : 960;
+      const render::DepthMatchingLayout l = render::DepthMatchingLayout::Of(w, picture.size());
+      const int h = l.frame.height, half = l.upper.height;
+      const int picture_h = args->picture_height > 0 ? args->picture_height : l.picture.height;
       if (picture_h > half)
         throw Error(ErrorKind::kUsage, "--picture-height-px " + std::to_string(picture_h) +
                                            " is taller than the grey half of the frame (" + std::to_string(half) +
                                            " px)");
       const cv::Mat frame = render::DepthMatchingFrame(
-          render::PictureOnGrey(picture, cv::Size(w, half), picture_h, args->cutoff), photo, w);
+          render::PictureOnGrey(picture, l.upper.size(), picture_h, args->cutoff), photo, w);
       WriteImage(args->out, frame);
       std::printf("picture %s, cut-off %g cycles per picture width, %d px high on a %dx%d frame -> %s\n", name.c_str(),
                   args->cutoff, picture_h, w, h, args->out.c_str());

@@ -12,6 +12,7 @@
 #include "cli/commands.h"
 #include "core/camera.h"
 #include "core/error.h"
+#include "core/typed.h"
 #include "optics/thin_lens.h"
 #include "synth/scene.h"
 
@@ -25,12 +26,7 @@ Error UsageError(const std::string& option, const std::string& what) {
 // "inf" / "infinity" or a number of mm. A "nan" would stand for the default (focus on edge 1) without saying so.
 double ParseFocus(const std::string& text) {
   if (text == "inf" || text == "infinity") return std::numeric_limits<double>::infinity();
-  try {
-    size_t used = 0;
-    const double v = std::stod(text, &used);
-    if (used == text.size() && v > 0 && v <= 1e6) return v;
-  } catch (const std::exception&) {
-  }
+  if (const std::optional<double> v = ParseDecimal(text); v && *v > 0 && *v <= 1e6) return *v;
   throw UsageError("--focus-mm", "must be a distance in (0, 1000000] mm or 'inf', got '" + text + "'");
 }
 

@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "core/error.h"
+#include "core/typed.h"
 #include "core/json_io.h"
 #include "core/seed.h"
 #include "plan/power.h"
@@ -98,9 +99,8 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
       conditions->emplace(c.key, c);
       Tally& t = p.tallies[c.key];
       ++t.shown;
-      char* end = nullptr;
-      const double cutoff = std::strtod(choice.c_str(), &end);
-      if (choice.empty() || *end != '\0' || !(cutoff > 0) || !(scene.distance_m > 0)) {
+      const double cutoff = ParseDecimal(choice).value_or(0);  // a level as the record writes it
+      if (!(cutoff > 0) || !(scene.distance_m > 0)) {
         ++t.none;
         continue;
       }

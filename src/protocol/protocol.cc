@@ -9,6 +9,7 @@
 #include <set>
 
 #include "core/error.h"
+#include "core/typed.h"
 
 namespace blurcue::protocol {
 namespace fs = std::filesystem;
@@ -104,10 +105,6 @@ std::string Range(double lo, double hi, const std::string& unit) {
   char text[96];
   std::snprintf(text, sizeof text, "[%.10g, %.10g]", lo, hi);
   return text + (unit.empty() ? "" : " " + unit);
-}
-
-bool HasControlCharacter(const std::string& s) {
-  return std::any_of(s.begin(), s.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; });
 }
 
 size_t EditDistance(const std::string& a, const std::string& b) {
@@ -288,7 +285,7 @@ class Parser {
       Problem(p, "must be at most " + std::to_string(max_chars) + " characters, got " + std::to_string(s->size()));
       return std::nullopt;
     }
-    if (one_line && HasControlCharacter(*s)) {
+    if (one_line && !IsPrintableUtf8(*s)) {
       Problem(p, "must not contain control characters (line breaks, tabs, NUL)", Json(*s));
       return std::nullopt;
     }
@@ -518,7 +515,7 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
   int carrying_sides = 0;
   for (const auto& [name, levels] : v.items()) {
     const std::string fp = ptr + "/" + Escape(name);
-    if (name.empty() || name.size() > kMaxNameChars || HasControlCharacter(name)) {
+    if (name.empty() || name.size() > kMaxNameChars || !IsPrintableUtf8(name)) {
       Problem(fp, "a factor name must be 1 to " + std::to_string(kMaxNameChars) +
                       " characters without control characters", Json(name));
       continue;
@@ -655,7 +652,7 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
   const std::vector<std::string>& header = rows.front();
   std::set<std::string> names;
   for (const auto& name : header)
-    if (name.empty() || name.size() > kMaxNameChars || HasControlCharacter(name) || !names.insert(name).second) {
+    if (name.empty() || name.size() > kMaxNameChars || !IsPrintableUtf8(name) || !names.insert(name).second) {
       Problem(ptr, where + ": the header must name each column once, 1-100 characters, got \"" + name + "\"",
               Json(*text));
       return {};
@@ -672,11 +669,10 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
     Json level = Json::object();
     for (size_t c = 0; c < header.size(); ++c) {
       const std::string& cell = rows[r][c];
-      char* end = nullptr;
-      const double number = std::strtod(cell.c_str(), &end);
-      const bool is_number = !cell.empty() && end == cell.c_str() + cell.size() && std::isfinite(number);
-      const bool integer = is_number && cell.find_first_of(".eE") == std::string::npos;
-      level[header[c]] = integer ? Json(int64_t(number)) : is_number ? Json(number) : Json(cell);
+      const std::optional<double> number = ParseDecimal(cell);
+      level[header[c]] = IsWholeDecimal(cell) && std::abs(*number) < 9e15 ? Json(int64_t(*number))
+                         : number                                       ? Json(*number)
+                                                                        : Json(cell);
       if (cell.empty()) Problem(ptr + "/row/" + std::to_string(r - 1) + "/" + Escape(header[c]), "is empty", Json(cell));
       else CheckLevelValue(header[c], level[header[c]], ptr + "/row/" + std::to_string(r - 1) + "/" + Escape(header[c]));
     }
@@ -722,7 +718,7 @@ void Parser::ParseInfo(const Json& v, const std::string& ptr, Protocol* p) {
         for (size_t k = 0; k < c->size(); ++k) {
           const Json& choice = (*c)[k];
           if (!choice.is_string() || choice.get<std::string>().empty() || choice.get<std::string>().size() > 100 ||
-              HasControlCharacter(choice.get<std::string>()) ||
+              !IsPrintableUtf8(choice.get<std::string>()) ||
               std::count(field.choices.begin(), field.choices.end(), choice.get<std::string>()))
             Problem(fp + "/choices/" + std::to_string(k), "must be a new answer of 1-100 characters", choice);
           else
@@ -750,7 +746,7 @@ void Parser::ParseGroups(const Json& v, const Json& top, const std::string& ptr,
     for (size_t i = 0; i < names->size(); ++i) {
       const Json& n = (*names)[i];
       if (!n.is_string() || n.get<std::string>().empty() || n.get<std::string>().size() > kMaxNameChars ||
-          HasControlCharacter(n.get<std::string>()) ||
+          !IsPrintableUtf8(n.get<std::string>()) ||
           std::count(g.names.begin(), g.names.end(), n.get<std::string>()))
         Problem(ptr + "/names/" + std::to_string(i), "must be a new name of 1-100 characters", n);
       else
@@ -1414,10 +1410,8 @@ bool Parser::Provides(const Block& b, const std::string& name) {
 
 std::string CheckInfoValue(const InfoField& f, const std::string& value) {
   if (f.type == "integer" || f.type == "number") {
-    char* end = nullptr;
-    const double x = std::strtod(value.c_str(), &end);
-    const bool number = !value.empty() && end == value.c_str() + value.size() && std::isfinite(x);
-    if (!number || (f.type == "integer" && x != std::floor(x)) || x < f.min || x > f.max) {
+    const std::optional<double> x = ParseDecimal(value);
+    if (!x || (f.type == "integer" && *x != std::floor(*x)) || *x < f.min || *x > f.max) {
       char range[96];
       std::snprintf(range, sizeof range, "%s in [%g, %g]", f.type == "integer" ? "a whole number" : "a number", f.min,
                     f.max);
@@ -1431,7 +1425,7 @@ std::string CheckInfoValue(const InfoField& f, const std::string& value) {
     for (const auto& c : f.choices) list += (list.empty() ? "" : ", ") + c;
     return "must be one of " + list;
   }
-  if (value.size() > 200 || HasControlCharacter(value)) return "must be one line of at most 200 characters";
+  if (value.size() > 200 || !IsPrintableUtf8(value)) return "must be one line of printable text, at most 200 bytes";
   return "";
 }
 

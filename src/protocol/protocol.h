@@ -100,6 +100,9 @@ struct Scene {
   std::filesystem::path board_free;   // empty when not given
   std::filesystem::path calib;        // empty when not given (a picture needs none)
   std::string show = "background";    // which photo the trials show: "background" | "board_free"
+  // The photo the trials show, as `show` says (the background when there is no board_free).
+  bool ShowsBoardFree() const { return show == "board_free" && !board_free.empty(); }
+  const std::filesystem::path& ShownPhoto() const { return ShowsBoardFree() ? board_free : background; }
 };
 
 struct Content {

@@ -203,6 +203,13 @@ TEST(ProtocolValidate, ConditionsTableGivesTheDesignRowByRow) {
   EXPECT_TRUE(Contains(problems[0], "/blocks/0/conditions/row/0/edge: an edge must be an integer in [1, 101], got 102"))
       << problems[0];
   EXPECT_TRUE(Contains(problems[1], "bad.csv line 3: has 2 fields, the header 3")) << problems[1];
+  // A cell is a number only as a decimal: "0x9" (which strtod reads as edge 9) and " 9" are text, refused as edges.
+  for (const char* edge : {"0x9", " 9", "9 ", "nan"}) {
+    std::ofstream(dir / "odd.csv") << "edge,left,right\n" << edge << ",measured,none\n";
+    j["blocks"][0]["conditions"] = "odd.csv";
+    EXPECT_TRUE(Contains(OnlyProblem(j), "/blocks/0/conditions/row/0/edge: an edge must be an integer")) << edge;
+  }
+  j["blocks"][0]["conditions"] = "bad.csv";
   j["blocks"][0]["factors"] = {{"edge", {1}}};
   EXPECT_TRUE(Contains(Problems(j).front(), "give either factors or a conditions table")) << Problems(j).front();
   j["blocks"][0].erase("factors");
@@ -227,7 +234,14 @@ TEST(ProtocolValidate, ParticipantInfoAndGroupsAreChecked) {
   EXPECT_EQ(CheckInfoValue(p.participant_info[0], "34.5"), "must be a whole number in [16, 99]");
   EXPECT_EQ(CheckInfoValue(p.participant_info[0], "nan"), "must be a whole number in [16, 99]");
   EXPECT_EQ(CheckInfoValue(p.participant_info[1], "up"), "must be one of left, right");
-  EXPECT_EQ(CheckInfoValue(p.participant_info[2], "bad\nline"), "must be one line of at most 200 characters");
+  EXPECT_EQ(CheckInfoValue(p.participant_info[2], "bad\nline"), "must be one line of printable text, at most 200 bytes");
+  // One reading of a typed number everywhere: hex, a space and "inf" are not an age; broken bytes are not notes.
+  for (const char* age : {"0x20", " 34", "34 ", "1e1x", "inf", "3.4e1"})
+    EXPECT_EQ(CheckInfoValue(p.participant_info[0], age), age == std::string("3.4e1") ? ""
+                                                                                    : "must be a whole number in [16, 99]")
+        << age;
+  EXPECT_NE(CheckInfoValue(p.participant_info[2], "caf\xe9"), "");  // Latin-1, not UTF-8
+  EXPECT_EQ(CheckInfoValue(p.participant_info[2], "café"), "");
   Json bad = j;
   bad["participant_info"][0]["key"] = "Age!";
   ExpectProblem(bad, "/participant_info/0/key: must be 1-40 characters of a-z, 0-9 and _");

@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "core/error.h"
+#include "core/typed.h"
 
 namespace blurcue::protocol {
 
@@ -17,6 +18,23 @@ uint64_t UniformBelow(std::mt19937_64& rng, uint64_t n) {
     const uint64_t x = rng();
     if (x >= threshold) return x % n;
   }
+}
+
+void CheckParticipantId(const std::string& participant) {
+  std::string why;
+  if (participant.empty()) why = "must not be empty";
+  else if (participant.size() > kMaxParticipantIdBytes)
+    why = "must be at most " + std::to_string(kMaxParticipantIdBytes) + " bytes (it has " +
+          std::to_string(participant.size()) + ")";
+  else if (!IsPrintableUtf8(participant))
+    why = "must be printable UTF-8 text (no newline, tab, escape or broken bytes)";
+  else if (participant.front() == ' ' || participant.back() == ' ')
+    why = "must not begin or end with a space";
+  if (why.empty()) return;
+  // The id as JSON text: control characters escaped, broken bytes replaced, cut short - one line whatever it held.
+  std::string shown = Json(participant.substr(0, 40)).dump(-1, ' ', false, Json::error_handler_t::replace);
+  if (participant.size() > 40) shown.insert(shown.size() - 1, "...");
+  throw Error(ErrorKind::kUsage, "--participant " + why + ", got " + shown);
 }
 
 int ParticipantNumber(const std::string& participant) {
@@ -121,6 +139,7 @@ std::string AssignGroup(const Protocol& protocol, const std::string& participant
 
 std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& participant, uint64_t seed,
                                const std::string& group) {
+  CheckParticipantId(participant);
   const Block* by_participant = nullptr;
   for (const auto& b : protocol.blocks)
     if (!by_participant && b.counterbalance == Counterbalance::kByParticipant) by_participant = &b;

@@ -34,6 +34,36 @@ std::vector<int> Edges(const std::vector<Trial>& trials) {
   return edges;
 }
 
+// A participant id is what the record, the tables and the report hold as one line: any script, but no newline,
+// escape or broken bytes, no space at either end, at most 64 bytes; refused with the id shown on one line.
+TEST(TrialBuilder, ParticipantIdsAreOnePrintableLine) {
+  const Protocol p = FromJson(kFour);
+  for (const char* id : {"P1", "S-01_b", "Zoë 3", "参加者7", "x"}) EXPECT_EQ(BuildTrials(p, id, 1).size(), 4u) << id;
+  EXPECT_NO_THROW(BuildTrials(p, std::string(kMaxParticipantIdBytes, 'a'), 1));
+  const std::pair<std::string, std::string> bad[] = {
+      {"", "must not be empty"},
+      {std::string(100000, 'a'), "must be at most 64 bytes (it has 100000)"},
+      {"P\n1", "must be printable UTF-8"},
+      {"P\t1", "must be printable UTF-8"},
+      {"\x1b[2JP1", "must be printable UTF-8"},
+      {"P\xff", "must be printable UTF-8"},
+      {" P1", "must not begin or end with a space"},
+      {"P1 ", "must not begin or end with a space"},
+  };
+  for (const auto& [id, why] : bad) {
+    try {
+      BuildTrials(p, id, 1);
+      ADD_FAILURE() << "accepted " << id.substr(0, 20);
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_EQ(e.kind(), ErrorKind::kUsage);
+      EXPECT_NE(message.find("--participant " + why), std::string::npos) << message;
+      EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+      EXPECT_LT(message.size(), 200u) << message;
+    }
+  }
+}
+
 // A procedure block: procedure.trials copies of each crossing, the reference on both sides, a seeded test side
 // per trial, shuffled together so the crossings' procedures interleave.
 TEST(TrialBuilder, ProcedureBlocksInterleaveTheirCrossingsWithSeededTestSides) {

@@ -213,6 +213,18 @@ int ScaledWidthPx(cv::Size picture, int height_px) {
   return std::max(1, int(std::lround(double(picture.width) * height_px / picture.height)));
 }
 
+namespace {
+
+// Where PictureOnField puts a layer of `layer` size: centred on the field (it may overhang).
+cv::Rect LayerOnField(cv::Size field, cv::Size layer) {
+  return {(field.width - layer.width) / 2, (field.height - layer.height) / 2, layer.width, layer.height};
+}
+
+// PictureOnGrey's transparent margin around a picture of `scaled` size: room for its blur to spread.
+int GreyMarginPx(cv::Size scaled) { return std::max(scaled.width, scaled.height) / 4; }
+
+}  // namespace
+
 cv::Mat PictureOnField(const cv::Mat& picture, cv::Size field, int height_px, int margin_px,
                        const std::function<cv::Mat(const cv::Mat&, int)>& filter, double grey) {
   CV_Assert(height_px > 0 && field.width > 0 && field.height > 0);
@@ -225,7 +237,7 @@ cv::Mat PictureOnField(const cv::Mat& picture, cv::Size field, int height_px, in
                      cv::BORDER_CONSTANT, cv::Scalar(0, 0, 0, 0));
   if (filter) layer = filter(layer, width_px);
   cv::Mat out(field, CV_32FC3, cv::Scalar(grey, grey, grey));
-  const cv::Rect at((field.width - layer.cols) / 2, (field.height - layer.rows) / 2, layer.cols, layer.rows);
+  const cv::Rect at = LayerOnField(field, layer.size());
   const cv::Rect visible = at & cv::Rect(0, 0, field.width, field.height);
   for (int y = visible.y; y < visible.y + visible.height; ++y)
     for (int x = visible.x; x < visible.x + visible.width; ++x) {
@@ -248,7 +260,24 @@ cv::Mat PictureOnGrey(const cv::Mat& picture, cv::Size field, int height_px, dou
   auto butterworth = [cutoff](const cv::Mat& layer, int picture_width_px) {
     return cutoff > 0 ? ButterworthBlurCpu(layer, cutoff * layer.cols / picture_width_px) : layer;
   };
-  return PictureOnField(picture, field, height_px, std::max(width_px, height_px) / 4, butterworth, grey);
+  return PictureOnField(picture, field, height_px, GreyMarginPx({width_px, height_px}), butterworth, grey);
+}
+
+cv::Rect PictureRectOnGrey(cv::Size picture, cv::Size field, int height_px) {
+  const cv::Size scaled(ScaledWidthPx(picture, height_px), height_px);
+  const int m = GreyMarginPx(scaled);
+  const cv::Rect layer = LayerOnField(field, {scaled.width + 2 * m, scaled.height + 2 * m});
+  return {layer.x + m, layer.y + m, scaled.width, scaled.height};
+}
+
+DepthMatchingLayout DepthMatchingLayout::Of(int width_px, cv::Size picture) {
+  DepthMatchingLayout l;
+  const int h = width_px * 3 / 4, half = h / 2;
+  l.frame = {width_px, h};
+  l.upper = {0, 0, width_px, half};
+  l.picture = PictureRectOnGrey(picture, l.upper.size(), DepthMatchingPictureHeightPx(width_px));
+  l.lower = {0, half, width_px, h - half};
+  return l;
 }
 
 int DepthMatchingPictureHeightPx(int width_px) { return width_px * 3 / 4 / 2 * 6 / 10; }

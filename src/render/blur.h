@@ -79,6 +79,16 @@ cv::Mat DepthMatchingFrame(const cv::Mat& upper, const cv::Mat& photo, int width
 // the lower half shows a photo of `photo` size.
 int DepthMatchingPictureHeightPx(int width_px);
 double DepthMatchingLowerScale(cv::Size photo, int width_px);
+// Where PictureOnGrey puts a picture of `picture` size scaled to height_px on a `field`: its outline before the
+// blur spreads it, with the drawing's own rounding.
+cv::Rect PictureRectOnGrey(cv::Size picture, cv::Size field, int height_px);
+// The depth-matching frame of width_px showing a picture of `picture` size, in frame px: the frame, its upper half
+// (grey, the virtual picture's field), the virtual picture's outline in it, and the lower half (the real photo).
+struct DepthMatchingLayout {
+  cv::Size frame;
+  cv::Rect upper, picture, lower;
+  static DepthMatchingLayout Of(int width_px, cv::Size picture);
+};
 // Its parts: the lower half (the photo scaled and cropped, 8-bit BGR, width_px x 3/4 width_px - half of it), and
 // the two stacked into `frame` (allocated only when its size changes: a trial stepping through levels reuses it).
 cv::Mat DepthMatchingLowerHalf(const cv::Mat& photo, int width_px);

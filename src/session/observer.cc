@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/typed.h"
 #include "core/stats.h"
 
 namespace blurcue::session {
@@ -77,8 +78,8 @@ ObserverParams ParseObserver(const std::string& spec) {
     if ((pixel ? kArcminOnly : kPixelOnly).count(name))
       throw Error(ErrorKind::kUsage, "--observer " + name + " belongs to model=" + (pixel ? "arcmin" : "pixel") +
                                          ", not model=" + (pixel ? "pixel" : "arcmin") + " (got '" + text + "')");
-    char* end = nullptr;
-    const double v = std::strtod(text.c_str(), &end);
+    const std::optional<double> parsed = ParseDecimal(text);
+    const double v = parsed.value_or(0);
     auto bad = [&](const std::string& what) {
       throw Error(ErrorKind::kUsage, "--observer " + name + " " + what + ", got '" + text + "'");
     };
@@ -92,7 +93,7 @@ ObserverParams ParseObserver(const std::string& spec) {
                                          (pixel ? "jnd, bias, cutoff1m, slope, sdlog, tol"
                                                 : "intrinsic, weber, exponent, side, blurrier, rthard") +
                                          ", lapse, rt, step)");
-    if (text.empty() || *end != '\0' || !std::isfinite(v)) bad("must be a number");
+    if (!parsed) bad("must be a number");
     // Ranges: what a human observer could be, so a typo (1e308, a missing decimal point) is refused, not simulated.
     if (name == "intrinsic") p.intrinsic_arcmin = in(0, 60, true, "must be in (0, 60] arcmin (a Gaussian std)");
     else if (name == "weber") p.weber = in(0, 10, true, "must be in (0, 10]");

@@ -422,6 +422,9 @@ TEST(ObserverParams, RejectsEveryBadValueWithOneLineNamingIt) {
       {"sim:lapse=0,", "--observer: an empty parameter"},
       {"sim:weber", "--observer weber must be a number, got ''"},
       {"sim:sharpness=2", "--observer: unknown parameter 'sharpness'"},
+      {"sim:weber=0x10", "--observer weber must be a number, got '0x10'"},  // not 16: decimal only
+      {"sim:weber= 0.3", "--observer weber must be a number, got ' 0.3'"},
+      {"sim:lapse=0.1 ", "--observer lapse must be a number, got '0.1 '"},
   };
   for (const auto& [spec, message] : cases) {
     try {

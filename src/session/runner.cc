@@ -18,6 +18,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/typed.h"
 #include "core/image.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
@@ -187,7 +188,7 @@ class Runner {
 
   // --capture: the trial's first frame as the swap shows it (read back from the window, or the frame composed
   // headless: the same pixels) and what it shows in screen terms (DescribeFrame), before the frame is flipped.
-  void Capture(const protocol::Trial& trial, const TrialScene& scene, bool prompt) {
+  void Capture(const protocol::Trial& trial, const TrialScene& scene, bool prompt, double cutoff) {
     cv::Mat image =
         station_.window() ? render::ReadWindow(context_.width_px(), context_.height_px()) : renderer_.Read();
     // Headless the prompt is not drawn into a window: put its band where the window shows it.
@@ -197,13 +198,17 @@ class Runner {
     char name[32];
     std::snprintf(name, sizeof name, "trial-%04d", trial.index + 1);
     Json frame = DescribeFrame(prepared_.scene ? &*prepared_.scene : nullptr, scene, prepared_.presentation,
-                               renderer_.View(), renderer_.Shown());
+                               renderer_.View(), renderer_.Shown(), cutoff);
     frame["protocol"] = protocol_.name;
     frame["participant"] = options_.participant;
     frame["trial_index"] = trial.index;
     frame["block"] = trial.block;
     frame["practice"] = trial.practice;
     frame["prompt"] = prompt ? Json(protocol_.responses.prompt) : Json();
+    if (scene.content == "picture")
+      frame["real_picture"]["photo"] = protocol_.content.real_photos.empty()
+                                           ? protocol_.scene.ShownPhoto().string()
+                                           : protocol::RealPhotoFor(protocol_.content, scene.distance_m).string();
     // Intervals show one object at a time at the left object's place: which side's object the first interval shows
     // (its "side" below is the slot it is drawn in).
     if (scene.intervals > 0) frame["first_interval_shows"] = IntervalShowsRight(trial, scene, 0) ? "right" : "left";
@@ -344,7 +349,8 @@ class Runner {
           Blank().Present(context_.width_px(), context_.height_px());
         if (prompt) Prompt().PresentAt(0, context_.height_px() - prepared_.presentation.prompt_band_px, context_.height_px());
       }
-      if (frame == 0 && !options_.capture_dir.empty()) Capture(trial, n > 0 ? intervals[0] : scene, prompt);
+      if (frame == 0 && !options_.capture_dir.empty())
+        Capture(trial, n > 0 ? intervals[0] : scene, prompt, levels > 0 ? trial.adjust_levels[size_t(level)] : 0);
       const double flip = station_.Flip();
       if (onset < 0) {
         onset = flip;
@@ -426,62 +432,49 @@ class Runner {
 
     const std::string welcome = start.resumed && start.first_unanswered_trial > 0 ? "Welcome back" : "Instructions";
     if (!ShowScreen(welcome, protocol_.instructions, "Press Return to start")) return result;
-    // Adaptive procedures: their state rebuilt by replaying the answers the record holds, so a resumed session
-    // continues exactly where it was; each replayed level must be the one the record says was shown.
+    // What the answers so far decided (procedures' levels and stop rules, practice runs, breaks): rebuilt by
+    // replaying the record's answers through the same decisions a live session takes, so a resumed session
+    // continues exactly where it was. Each replayed decision must be the one the record says was taken.
     SessionLogic logic(prepared_);
-    AdaptiveState& adaptive = logic.adaptive();
-    PracticeRounds& rounds = logic.rounds();
+    // Breaks come every N answered main trials, counted over the whole session (a resumed one included); trials
+    // skipped by a stop rule or a met criterion are no answers.
+    int64_t main_answered = 0;
     if (start.first_unanswered_trial > 0) {
       const auto answered = record.AnsweredTrials(start.session_id);
+      auto cannot = [&](int64_t i, const std::string& why) {
+        return InputError(options_.db.string(), "session " + std::to_string(start.session_id) + " trial " +
+                                                    std::to_string(i) + ": " + why + "; it cannot be resumed");
+      };
       for (int64_t i = 0; i < start.first_unanswered_trial; ++i) {
         const protocol::Trial& t = trials_[size_t(i)];
         const auto it = answered.find(i);
-        // A practice run until a criterion: skipped only after a run that met it, else counted.
-        if (t.round >= 0 && it != answered.end()) {
-          const bool skipped = it->second.choice == store::kChoiceSkipped;
-          if (skipped != (rounds.MetBefore(t) >= 0))
-            throw InputError(options_.db.string(), "session " + std::to_string(start.session_id) + " trial " +
-                                                       std::to_string(i) + ": the record " +
-                                                       (skipped ? "skips" : "shows") + " this practice trial, but " +
-                                                       "its answers say the criterion was " + (skipped ? "not " : "") +
-                                                       "met before it; it cannot be resumed");
-          if (!skipped) rounds.Answer(t, CorrectOf(t, scenes_[size_t(i)], it->second.choice).value_or(false));
-          continue;
+        if (it == answered.end()) throw cannot(i, "the record has no answer for it but has answers after it");
+        const bool recorded_skip = it->second.choice == store::kChoiceSkipped;
+        const Json why = logic.SkipReason(t);
+        if (recorded_skip && why.is_null())
+          throw cannot(i, "the record skips it, but the answers before it show it (its procedure had not stopped, "
+                          "its practice criterion was not met)");
+        if (!recorded_skip && !why.is_null())
+          throw cannot(i, "the record shows it, but the answers before it skip it (" +
+                              why["skipped"].get<std::string>() + ")");
+        if (recorded_skip) continue;
+        main_answered += !t.practice;
+        double level = 0;
+        const TrialScene scene = logic.SceneOf(t, &level);
+        if (t.cell >= 0) {
+          const Json shown = ParseJson(it->second.shown_json, options_.db.string());
+          if (!shown.is_object() || !shown.contains("level") || !shown["level"].is_number() ||
+              std::abs(shown["level"].get<double>() - level) > 1e-9 * std::max(1.0, std::abs(level)))
+            throw cannot(i, "the record's procedure level " +
+                                (shown.is_object() && shown.contains("level") ? shown["level"].dump()
+                                                                              : std::string("(none)")) +
+                                " is not the " + std::to_string(level) + " its answers give");
         }
-        if (t.cell < 0) continue;
-        // A trial its procedure's stop rule skipped: the replayed answers must have stopped it there too.
-        if (it != answered.end() && it->second.choice == store::kChoiceSkipped) {
-          if (!adaptive.Stopped(t))
-            throw InputError(options_.db.string(), "session " + std::to_string(start.session_id) + " trial " +
-                                                       std::to_string(i) + ": the record skips it, but its " +
-                                                       "procedure had not stopped; it cannot be resumed");
-          continue;
-        }
-        const Json shown = it == answered.end() ? Json() : ParseJson(it->second.shown_json, options_.db.string());
-        const double level = adaptive.Level(t);
-        if (!shown.is_object() || !shown.contains("level") || !shown["level"].is_number() ||
-            std::abs(shown["level"].get<double>() - level) > 1e-9 * std::max(1.0, std::abs(level)))
-          throw InputError(options_.db.string(), "session " + std::to_string(start.session_id) + " trial " +
-                                                     std::to_string(i) + ": the record's procedure level " +
-                                                     (shown.is_object() && shown.contains("level")
-                                                          ? shown["level"].dump() : std::string("(none)")) +
-                                                     " is not the " + std::to_string(level) +
-                                                     " its answers give; it cannot be resumed");
-        adaptive.Answer(t, level, it->second.choice == t.test_side);
+        logic.Answer(t, scene, level, it->second.choice);
       }
     }
     std::string shown_block;
     bool shown_practice = false;  // the trial before was practice (the next main one says the practice is over)
-    // Breaks come every N answered main trials, counted over the whole session (a resumed one included).
-    int64_t main_answered = 0;
-    // Trials a stopped procedure skipped are no answers: they count toward no break, as in an uninterrupted run.
-    if (start.first_unanswered_trial > 0) {
-      const auto answered = record.AnsweredTrials(start.session_id);
-      for (int64_t i = 0; i < start.first_unanswered_trial; ++i) {
-        const auto it = answered.find(i);
-        main_answered += !trials_[size_t(i)].practice && (it == answered.end() || it->second.choice != store::kChoiceSkipped);
-      }
-    }
     for (int64_t i = start.first_unanswered_trial; i < result.trial_count; ++i) {
       if (options_.stop_after >= 0 && result.answered_now >= options_.stop_after) break;
       const protocol::Trial& trial = trials_[size_t(i)];
@@ -615,8 +608,9 @@ Json CollectInfo(const protocol::Protocol& p, const RunOptions& options, const s
     return nullptr;
   };
   auto value_of = [](const protocol::InfoField& f, const std::string& text) {
-    return f.type == "integer" ? Json(int64_t(std::strtod(text.c_str(), nullptr)))
-           : f.type == "number" ? Json(std::strtod(text.c_str(), nullptr))
+    // Checked by CheckInfoValue before: a decimal number in the field's range.
+    return f.type == "integer" ? Json(int64_t(*ParseDecimal(text)))
+           : f.type == "number" ? Json(*ParseDecimal(text))
                                 : Json(text);
   };
   auto describe = [](const protocol::InfoField& f) {
@@ -675,7 +669,7 @@ Json CollectInfo(const protocol::Protocol& p, const RunOptions& options, const s
 }
 
 RunResult RunSession(const RunOptions& options) {
-  if (options.participant.empty()) throw Error(ErrorKind::kUsage, "--participant must not be empty");
+  protocol::CheckParticipantId(options.participant);
   std::optional<ObserverParams> observer;
   if (!options.observer.empty()) observer = ParseObserver(options.observer);
   if (options.sim_fps <= 0) throw Error(ErrorKind::kUsage, "--sim-fps must be > 0");

@@ -330,9 +330,7 @@ Presentation Presentation::Of(const protocol::Protocol& protocol, const Stimulus
     p.scaling = "fit";
     p.view = {W, p.window_height_px, p.frame_width_px, p.frame_height_px, (W - p.frame_width_px) / 2,
               (H - p.frame_height_px) / 2};
-    if (!images.picture.empty())
-      p.picture_width_px =
-          render::ScaledWidthPx(images.picture.size(), render::DepthMatchingPictureHeightPx(p.frame_width_px));
+    if (!images.picture.empty()) p.layout = render::DepthMatchingLayout::Of(p.frame_width_px, images.picture.size());
     if (const auto& camera = protocol.content.real_camera)
       p.real_frame_px_per_px = render::DepthMatchingLowerScale(
           cv::Size(camera->image_width_px, camera->image_height_px), p.frame_width_px);
@@ -369,8 +367,8 @@ Presentation Presentation::Of(const protocol::Protocol& protocol, const Stimulus
   return p;
 }
 
-double Presentation::LevelArcmin(double cutoff) const {
-  return cutoff > 0 ? Arcmin(2 * render::ButterworthEquivalentSigma(cutoff) * picture_width_px) : 0;
+double Presentation::LevelScreenPx(double cutoff) const {
+  return cutoff > 0 ? ScreenPx(2 * render::ButterworthEquivalentSigma(cutoff) * layout.picture.width) : 0;
 }
 
 render::FrameView Presentation::ViewFor(const protocol::Protocol& protocol, const calib::SceneCalib& scene,
@@ -502,7 +500,7 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
   if (scene.content == "picture") {
     // The virtual picture's width as shown (a level c's blur is r = 2 x 0.1874 x this / c arcmin), and the real
     // picture's blur when its camera is known: in its camera's px, on the screen and on the eye.
-    v["picture_width_arcmin"] = round4(presentation.Arcmin(presentation.picture_width_px));
+    v["picture_width_arcmin"] = round4(presentation.Arcmin(presentation.layout.picture.width));
     if (presentation.real_frame_px_per_px > 0) {
       v["r_scene_px"] = round4(scene.r_scene_px);
       v["r_scene_screen_px"] = round4(presentation.ScreenPx(scene.r_scene_px * presentation.real_frame_px_per_px));
@@ -534,7 +532,8 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
 }
 
 Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, const Presentation& presentation,
-                   const render::FrameView& view, const std::array<std::optional<render::BlurredObject>, 2>& shown) {
+                   const render::FrameView& view, const std::array<std::optional<render::BlurredObject>, 2>& shown,
+                   double cutoff) {
   const display::Profile& profile = presentation.profile;
   auto round = [](double x, double unit) {  // to a decimal unit, printed as such
     const double per = std::round(1 / unit);
@@ -542,15 +541,35 @@ Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, cons
   };
   Json frame = {
       {"display",
-       {{"width_px", view.width_px}, {"height_px", view.height_px}, {"width_mm", profile.width_mm},
+       // The monitor (its px go with its mm) and the window on it.
+       {{"width_px", profile.width_px}, {"height_px", profile.height_px}, {"width_mm", profile.width_mm},
         {"height_mm", profile.height_mm}, {"distance_mm", profile.distance_mm},
-        {"px_per_deg", round(display::PxPerDeg(profile), 1e-4)}, {"profile", profile.name}}},
+        {"px_per_deg", round(display::PxPerDeg(profile), 1e-4)}, {"profile", profile.name},
+        {"window_px", {view.width_px, view.height_px}}}},
       {"scaling", presentation.scaling},
       {"screen_px_per_photo_px", round(presentation.scale, 1e-6)},
       {"photo_rect_px", {view.x_px, view.y_px, view.photo_width_px, view.photo_height_px}},
       {"blur_plan", trial.content == "picture" ? "none" : trial.per_pixel ? "per_pixel" : "one_radius"},
       {"r_span_screen_px", std::round(trial.r_span_screen_px * 1e4) / 1e4},
       {"objects", Json::array()}};
+  if (trial.content == "picture") {
+    // The frame is shown at one screen px per frame px where `view` places it.
+    const render::DepthMatchingLayout& l = presentation.layout;
+    auto on_screen = [&](const cv::Rect& r) { return Json{view.x_px + r.x, view.y_px + r.y, r.width, r.height}; };
+    frame["picture"] = {{"rect_px", on_screen(l.picture)},
+                        {"cutoff", cutoff},
+                        {"r_screen_px", round(presentation.LevelScreenPx(cutoff), 1e-4)},
+                        {"r_arcmin", round(presentation.LevelArcmin(cutoff), 1e-4)},
+                        {"width_arcmin", round(presentation.Arcmin(l.picture.width), 1e-4)}};
+    Json real = {{"rect_px", on_screen(l.lower)}, {"distance_m", trial.distance_m}};
+    if (presentation.real_frame_px_per_px > 0) {
+      real["r_camera_px"] = round(trial.r_scene_px, 1e-4);
+      real["r_screen_px"] = round(presentation.ScreenPx(trial.r_scene_px * presentation.real_frame_px_per_px), 1e-4);
+      real["r_arcmin"] = round(presentation.RealArcmin(trial.r_scene_px), 1e-4);
+    }
+    frame["real_picture"] = real;
+    return frame;
+  }
   if (!scene) return frame;
   const Camera camera = view.CameraOf(scene->camera);
   for (int side = 0; side < 2; ++side) {
@@ -624,9 +643,9 @@ constexpr int kMaxPhotoSidePx = 16384, kMaxTextureSidePx = 8192;
 StimulusImages LoadStimulusImages(const protocol::Protocol& protocol, const std::optional<calib::SceneCalib>& scene) {
   StimulusImages images;
   // A depth matching with real photos shows no scene photo (the protocol has no scene).
-  const bool board_free = protocol.scene.show == "board_free" && !protocol.scene.board_free.empty();
+  const bool board_free = protocol.scene.ShowsBoardFree();
   const std::string photo_field = board_free ? "/scene/board_free" : "/scene/background";
-  const auto& photo_path = board_free ? protocol.scene.board_free : protocol.scene.background;
+  const auto& photo_path = protocol.scene.ShownPhoto();
   if (protocol.content.type != "picture" || protocol.content.real_photos.empty()) {
     images.photo = ReadFieldImage(protocol, photo_field, photo_path, 1, 10, kMaxPhotoSidePx);
     // The photo not shown is still a photo of the scene: check it decodes too.
@@ -714,7 +733,6 @@ StimulusRenderer::StimulusRenderer(const protocol::Protocol& protocol, const std
   photo_ = images.photo;
   if (protocol.content.type == "picture") {
     picture_ = images.picture;
-    picture_width_px_ = presentation.frame_width_px;
     // Every adjustment level's low-passed picture up front (~0.1 s each on the CPU): stepping through the levels
     // in a trial then never stalls a frame on a Butterworth filter.
     for (const auto& block : protocol.blocks)
@@ -734,15 +752,14 @@ const cv::Mat& StimulusRenderer::UpperHalf(double level) {
   auto cached = std::find_if(upper_cache_.begin(), upper_cache_.end(),
                              [&](const auto& entry) { return entry.first == level; });
   if (cached != upper_cache_.end()) return cached->second;
-  const int w = picture_width_px_, half = w * 3 / 4 / 2;
-  upper_cache_.emplace_back(
-      level, render::PictureOnGrey(picture_, cv::Size(w, half), render::DepthMatchingPictureHeightPx(w), level));
+  const render::DepthMatchingLayout& l = presentation_.layout;
+  upper_cache_.emplace_back(level, render::PictureOnGrey(picture_, l.upper.size(), l.picture.height, level));
   return upper_cache_.back().second;
 }
 
 cv::Size StimulusRenderer::FrameSize() const {
   if (compositor_) return {presentation_.window_width_px, presentation_.window_height_px};
-  return {picture_width_px_, picture_width_px_ * 3 / 4};
+  return presentation_.layout.frame;
 }
 
 render::FrameView StimulusRenderer::View() const {
@@ -756,7 +773,7 @@ void StimulusRenderer::Prepare(const TrialScene& trial) {
       const cv::Mat photo = protocol_.content.real_photos.empty()
                                 ? photo_
                                 : ReadImage(protocol::RealPhotoFor(protocol_.content, trial.distance_m), 1);
-      lower_ = render::DepthMatchingLowerHalf(photo, picture_width_px_);
+      lower_ = render::DepthMatchingLowerHalf(photo, presentation_.layout.frame.width);
       lower_distance_m_ = distance_m;
     }
     return;

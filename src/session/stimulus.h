@@ -23,6 +23,7 @@
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
 
+#include "render/blur.h"
 #include "render/frame_compositor.h"
 
 namespace blurcue::session {
@@ -141,16 +142,18 @@ struct Presentation {
   render::FrameView view;   // the photo's place before a trial moves it (centred, or letterboxed when it fits)
   display::Profile profile;
 
-  // picture: the virtual picture's width on the frame (px), and the frame px per px of the real photos' camera
-  // (content.real_camera, the lower half's scale; 0 without one).
-  double picture_width_px = 0, real_frame_px_per_px = 0;
+  // picture: the frame's parts (frame px; the virtual picture's outline among them), and the frame px per px of the
+  // real photos' camera (content.real_camera, the lower half's scale; 0 without one).
+  render::DepthMatchingLayout layout;
+  double real_frame_px_per_px = 0;
 
   double ScreenPx(double frame_px) const { return frame_px * scale; }
   double Arcmin(double frame_px) const { return display::ArcminOfScreenPx(profile, ScreenPx(frame_px)); }
   // picture: the blur as shown (blurcue's r, arcmin) of the virtual picture low-passed at `cutoff` cycles per picture
   // width (its equivalent Gaussian, render::ButterworthEquivalentSigma; 0 = sharp), and of the real picture blurred
   // by r_camera_px (px of the real camera's full image).
-  double LevelArcmin(double cutoff) const;
+  double LevelArcmin(double cutoff) const { return display::ArcminOfScreenPx(profile, LevelScreenPx(cutoff)); }
+  double LevelScreenPx(double cutoff) const;
   double RealArcmin(double r_camera_px) const { return Arcmin(r_camera_px * real_frame_px_per_px); }
   // Where a pair trial shows the photo: `view` when the scaled photo fits the window; else cropped so that what the
   // trial shows (both objects over their whole run) is centred, as far as the photo reaches.
@@ -162,13 +165,16 @@ struct Presentation {
                          const display::Profile& profile);
 };
 
-// What a frame shows, in screen terms (run --capture's trial-NNNN.json): the display (width_px, height_px,
-// width_mm, height_mm, distance_mm, px_per_deg), where the photo sits (scaling, screen_px_per_photo_px,
+// What a frame shows, in screen terms (run --capture's trial-NNNN.json): the display (the monitor's width_px,
+// height_px, width_mm, height_mm, distance_mm, px_per_deg, and window_px, the window's size), where the photo sits (scaling, screen_px_per_photo_px,
 // photo_rect_px), the blur plan (blur_plan, r_span_screen_px) and every object on it: side, kind, source, kernel, center_px (its pose's centre), outline_px (the
 // screen polygon of its silhouette), r_camera_px, r_screen_px, r_arcmin and size_deg (the outline's largest extent).
-// `scene` may be null for a picture (no objects).
+// A picture's frame (`scene` may be null; no objects) instead: the virtual picture (rect_px, its outline before the
+// blur; cutoff, the level shown; its blur as r_screen_px and r_arcmin; width_arcmin) and the real one (rect_px, the
+// lower half; distance_m; with content.real_camera its blur as r_camera_px, r_screen_px and r_arcmin).
 Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, const Presentation& presentation,
-                   const render::FrameView& view, const std::array<std::optional<render::BlurredObject>, 2>& shown);
+                   const render::FrameView& view, const std::array<std::optional<render::BlurredObject>, 2>& shown,
+                   double cutoff = 0);
 
 // Reads every image the protocol names: each must decode as an image of a size its use can show. Throws
 // Error(kInput) naming the protocol file and the field (/scene/background, /content/texture, ...). No GL.
@@ -228,7 +234,6 @@ class StimulusRenderer {
   bool picture_stale_ = true;                          // picture_frame_ changed since it was last uploaded
   double lower_distance_m_ = -1;  // the distance whose real photo lower_ shows (one at a time: 27 would hold ~50 MB)
   cv::Mat lower_;                 // the frame's lower half, scaled once per trial
-  int picture_width_px_ = 960;
   std::array<std::optional<render::BlurredObject>, 2> shown_;
 };
 

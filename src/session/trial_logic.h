@@ -67,9 +67,6 @@ class SessionLogic {
   // Scores `choice` (what the record stores: "left", "3", kChoiceNone, ...) to `trial` shown as `shown` at `level`,
   // and feeds it to the trial's procedure and practice run.
   Scored Answer(const protocol::Trial& trial, const TrialScene& shown, double level, const std::string& choice);
-  // The state behind the decisions (a resumed session replays its record's answers into them).
-  AdaptiveState& adaptive() { return adaptive_; }
-  PracticeRounds& rounds() { return rounds_; }
 
  private:
   const PreparedSession& prepared_;

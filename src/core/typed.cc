@@ -1,0 +1,73 @@
+#include "core/typed.h"
+
+#include <cctype>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <string>
+
+namespace blurcue {
+namespace {
+
+// The length of the run of ASCII digits at `i`.
+size_t Digits(std::string_view text, size_t i) {
+  size_t n = 0;
+  while (i + n < text.size() && std::isdigit(static_cast<unsigned char>(text[i + n]))) ++n;
+  return n;
+}
+
+size_t Sign(std::string_view text, size_t i) { return i < text.size() && (text[i] == '+' || text[i] == '-'); }
+
+}  // namespace
+
+std::optional<double> ParseDecimal(std::string_view text) {
+  // The grammar first: strtod alone would take hex, inf, nan and leading space.
+  size_t i = Sign(text, 0);
+  const size_t whole = Digits(text, i);
+  i += whole;
+  size_t fraction = 0;
+  if (i < text.size() && text[i] == '.') fraction = Digits(text, ++i), i += fraction;
+  if (whole + fraction == 0) return std::nullopt;
+  if (i < text.size() && (text[i] == 'e' || text[i] == 'E')) {
+    i += 1 + Sign(text, i + 1);
+    const size_t exponent = Digits(text, i);
+    if (exponent == 0) return std::nullopt;
+    i += exponent;
+  }
+  if (i != text.size()) return std::nullopt;
+  const std::string copy(text);  // strtod needs a terminated string
+  const double v = std::strtod(copy.c_str(), nullptr);  // overflow gives inf
+  if (!std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+bool IsPrintableUtf8(std::string_view text) {
+  for (size_t i = 0; i < text.size();) {
+    const unsigned char c = text[i];
+    if (c < 0x20 || c == 0x7f) return false;
+    if (c < 0x80) {
+      ++i;
+      continue;
+    }
+    // Lead byte: how many continuation bytes follow, and the smallest code point that length may encode.
+    const int more = c >= 0xf0 ? 3 : c >= 0xe0 ? 2 : c >= 0xc0 ? 1 : -1;
+    if (more < 0 || c > 0xf4 || i + more >= text.size()) return false;
+    uint32_t cp = c & (0x3f >> more);
+    for (int k = 1; k <= more; ++k) {
+      const unsigned char b = text[i + k];
+      if ((b & 0xc0) != 0x80) return false;
+      cp = cp << 6 | (b & 0x3f);
+    }
+    static constexpr uint32_t kMin[] = {0, 0x80, 0x800, 0x10000};
+    if (cp < kMin[more] || cp > 0x10ffff || (cp >= 0xd800 && cp <= 0xdfff)) return false;
+    if (cp <= 0x9f) return false;  // the C1 controls, U+0080 to U+009F
+    i += more + 1;
+  }
+  return true;
+}
+
+bool IsWholeDecimal(std::string_view text) {
+  return ParseDecimal(text) && text.find_first_of(".eE") == std::string_view::npos;
+}
+
+}  // namespace blurcue

@@ -1,0 +1,23 @@
+#pragma once
+// Values a person types: numbers on the command line, in an --observer spec, a --info value or a levels CSV cell,
+// and names such as a participant id. One reading for all of them, so that "0x10" is not 16 in one place and an
+// error in another.
+#include <optional>
+#include <string_view>
+
+namespace blurcue {
+
+// `text` as a decimal number, exactly as written: an optional sign, digits with an optional point, an optional
+// exponent, and nothing else - no space before or after, no hex ("0x10", which strtod reads as 16), no "inf" or
+// "nan", no value past a double's range ("1e999"). nullopt for anything else. A value too small for a double
+// ("1e-999") reads as 0 or the nearest subnormal, as strtod gives it.
+std::optional<double> ParseDecimal(std::string_view text);
+
+// ParseDecimal that is also a whole number written without a point or exponent ("12", "-3"; not "12.0", "1e3").
+bool IsWholeDecimal(std::string_view text);
+
+// Valid UTF-8 (no overlong forms, surrogates or code points past U+10FFFF) without control characters (U+0000 to
+// U+001F, U+007F to U+009F): text a record, a CSV cell, a terminal line and the report can all hold as it is.
+bool IsPrintableUtf8(std::string_view text);
+
+}  // namespace blurcue

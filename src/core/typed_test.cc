@@ -1,0 +1,48 @@
+#include "core/typed.h"
+
+#include <limits>
+
+#include <gtest/gtest.h>
+
+namespace blurcue {
+namespace {
+
+TEST(ParseDecimal, ReadsDecimalNumbersAsWritten) {
+  const std::pair<const char*, double> cases[] = {
+      {"0", 0},      {"12", 12},       {"-3", -3},     {"+4", 4},       {"0.5", 0.5},  {".5", 0.5},
+      {"5.", 5},     {"-0.25", -0.25}, {"1e3", 1000},  {"1E-2", 0.01},  {"2.5e+1", 25}, {"010", 10},
+      {"1e308", 1e308}, {"4.9e-324", std::numeric_limits<double>::denorm_min()}, {"1e-999", 0},
+  };
+  for (const auto& [text, value] : cases) {
+    const std::optional<double> v = ParseDecimal(text);
+    ASSERT_TRUE(v) << text;
+    EXPECT_EQ(*v, value) << text;
+  }
+}
+
+// Each of these strtod would take (or take the start of): hex as 16, "inf", "nan", a leading space.
+TEST(ParseDecimal, RefusesWhatIsNotADecimalNumber) {
+  for (const char* text : {"", " ", "+", "-", ".", "e3", "1e", "1e+", "0x10", "0X1p3", "inf", "-inf", "infinity",
+                           "nan", "NaN", " 1", "1 ", "1\n", "\t2", "1,5", "1.2.3", "--1", "+-1", "1e3.5", "1e999",
+                           "-1e400", "１", "1f", "1d", "0b1"})
+    EXPECT_FALSE(ParseDecimal(text)) << "'" << text << "'";
+  EXPECT_FALSE(ParseDecimal(std::string_view("12\0" "3", 4)));  // a NUL inside is not the end of the number
+}
+
+TEST(ParseDecimal, WholeNumbersHaveNoPointOrExponent) {
+  for (const char* text : {"0", "12", "-3", "+7", "007"}) EXPECT_TRUE(IsWholeDecimal(text)) << text;
+  for (const char* text : {"12.0", "1e3", "1.", "0x10", "", "1.5", " 3"}) EXPECT_FALSE(IsWholeDecimal(text)) << text;
+}
+
+TEST(IsPrintableUtf8, TakesTextInAnyScriptAndRefusesControlsAndBrokenBytes) {
+  for (const char* text : {"", "P7", "S-01_a.b", "Zoë", "参加者12", "участник 3", "\xf0\x9f\x98\x80" /* U+1F600 */})
+    EXPECT_TRUE(IsPrintableUtf8(text)) << text;
+  for (const char* text : {"P\n7", "P7\r", "\tP", "a\x7f", "\x1b[31mred", "\xc2\x85" /* U+0085 NEL */,
+                           "\xff", "\xc3", "\xc3(", "\xc0\xaf" /* overlong '/' */, "\xe0\x80\xaf",
+                           "\xed\xa0\x80" /* a surrogate */, "\xf4\x90\x80\x80" /* past U+10FFFF */, "\xf8\x88\x80\x80\x80"})
+    EXPECT_FALSE(IsPrintableUtf8(text)) << text;
+  EXPECT_FALSE(IsPrintableUtf8(std::string_view("P\0" "7", 3)));
+}
+
+}  // namespace
+}  // namespace blurcue
