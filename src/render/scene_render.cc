@@ -26,7 +26,6 @@ namespace {
 
 struct Vertex {
   float position[3];
-  float normal[3];
   float uv[2];
 };
 
@@ -45,10 +44,7 @@ struct Mesh {
 
 // The unit card (side 1, centred, in z = 0); texture row 0 (the image's top) on the far side (+y).
 Mesh UnitCard() {
-  return {{{{-0.5f, 0.5f, 0}, {0, 0, 1}, {0, 0}},
-           {{0.5f, 0.5f, 0}, {0, 0, 1}, {1, 0}},
-           {{0.5f, -0.5f, 0}, {0, 0, 1}, {1, 1}},
-           {{-0.5f, -0.5f, 0}, {0, 0, 1}, {0, 1}}},
+  return {{{{-0.5f, 0.5f, 0}, {0, 0}}, {{0.5f, 0.5f, 0}, {1, 0}}, {{0.5f, -0.5f, 0}, {1, 1}}, {{-0.5f, -0.5f, 0}, {0, 1}}},
           {0, 1, 2, 0, 2, 3}};
 }
 
@@ -176,9 +172,8 @@ SceneRenderer::SceneRenderer(const Camera& camera, const cv::Vec3d& rvec, const 
   glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(mesh.indices.size() * sizeof(GLuint)), mesh.indices.data(),
                GL_STATIC_DRAW);
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, position)));
-  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, normal)));
-  glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, uv)));
-  for (int i = 0; i < 3; ++i) glEnableVertexAttribArray(i);
+  glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<void*>(offsetof(Vertex, uv)));
+  for (int i = 0; i < 2; ++i) glEnableVertexAttribArray(i);
   glBindVertexArray(0);
 }
 
@@ -348,14 +343,14 @@ void SceneRenderer::DrawLayerAt(const VirtualObject& o, const cv::Rect& roi, Gro
     pose[3][r] = float(impl_->tvec[r]);
   }
   const glm::mat4 model_to_camera = pose * ModelMatrix(o);
-  // Light from above the table and behind the camera: camera frame has y down.
-  const glm::vec3 light = glm::normalize(glm::vec3(-0.3f, -1.0f, -0.6f));
-  const float ambient = 0.45f;
   const glm::vec3 white_balance(float(o.white_balance[0]), float(o.white_balance[1]), float(o.white_balance[2]));
   impl_->TextureFor(o.texture).Bind(0);
   if (o.kind == VirtualObject::Kind::kBall) {
     // Traced straight into the layer (its pixels' coverage from 16 rays each, no multisample buffer): the sphere's
     // centre and the rotation back to its texture's frame (the spin); the depth layer in a second pass when asked.
+    // Light from above the table and behind the camera: camera frame has y down.
+    const glm::vec3 light = glm::normalize(glm::vec3(-0.3f, -1.0f, -0.6f));
+    const float ambient = 0.45f;
     BallShader& shader = impl_->ball_shader;
     shader.Use()
         .SetCamera(glm::vec4(float(k[0]), float(k[4]), float(k[2]), float(k[5])),
@@ -389,7 +384,6 @@ void SceneRenderer::DrawLayerAt(const VirtualObject& o, const cv::Rect& roi, Gro
   impl_->shader.Use()
       .SetModelToCamera(model_to_camera)  // one matrix made here, not per vertex
       .SetProjection(projection)
-      .SetLight(light, ambient, false)
       .SetColour(float(o.brightness), float(o.contrast), white_balance);
   glBindVertexArray(impl_->vao.id());
   glDrawElements(GL_TRIANGLES, impl_->card_indices, GL_UNSIGNED_INT, nullptr);

@@ -16,17 +16,11 @@ void ImageOnUnitZero(const Program& program, const char* sampler) {
 }
 }  // namespace
 
-SurfaceUniforms::SurfaceUniforms(const Program& program)
-    : light_dir_(program.Uniform("u_light_dir")),
-      ambient_(program.Uniform("u_ambient")),
-      brightness_(program.Uniform("u_brightness")),
+ColourUniforms::ColourUniforms(const Program& program)
+    : brightness_(program.Uniform("u_brightness")),
       contrast_(program.Uniform("u_contrast")),
       white_balance_(program.Uniform("u_white_balance")) {}
-void SurfaceUniforms::SetLight(const glm::vec3& direction, float ambient) const {
-  glUniform3f(light_dir_, direction.x, direction.y, direction.z);
-  glUniform1f(ambient_, ambient);
-}
-void SurfaceUniforms::SetColour(float brightness, float contrast, const glm::vec3& white_balance) const {
+void ColourUniforms::SetColour(float brightness, float contrast, const glm::vec3& white_balance) const {
   glUniform1f(brightness_, brightness);
   glUniform1f(contrast_, contrast);
   glUniform3f(white_balance_, white_balance.x, white_balance.y, white_balance.z);
@@ -34,10 +28,9 @@ void SurfaceUniforms::SetColour(float brightness, float contrast, const glm::vec
 
 ObjectShader::ObjectShader()
     : program_(Program::FromFiles(ShaderDir() / "object.vert", ShaderDir() / "object.frag")),
-      surface_(program_),
+      colour_(program_),
       model_to_camera_(program_.Uniform("u_model_to_camera")),
-      projection_(program_.Uniform("u_projection")),
-      lit_(program_.Uniform("u_lit")) {
+      projection_(program_.Uniform("u_projection")) {
   ImageOnUnitZero(program_, "u_texture");
 }
 
@@ -53,25 +46,22 @@ ObjectShader& ObjectShader::SetProjection(const glm::mat4& projection) {
   glUniformMatrix4fv(projection_, 1, GL_FALSE, glm::value_ptr(projection));
   return *this;
 }
-ObjectShader& ObjectShader::SetLight(const glm::vec3& direction, float ambient, bool lit) {
-  surface_.SetLight(direction, ambient);
-  glUniform1f(lit_, lit ? 1.0f : 0.0f);
-  return *this;
-}
 ObjectShader& ObjectShader::SetColour(float brightness, float contrast, const glm::vec3& white_balance) {
-  surface_.SetColour(brightness, contrast, white_balance);
+  colour_.SetColour(brightness, contrast, white_balance);
   return *this;
 }
 
 BallShader::BallShader()
     : program_(FullscreenProgram("ball.frag")),
-      surface_(program_),
+      colour_(program_),
       intrinsics_(program_.Uniform("u_intrinsics")),
       origin_(program_.Uniform("u_origin")),
       center_(program_.Uniform("u_center")),
       radius_(program_.Uniform("u_radius")),
       camera_to_object_(program_.Uniform("u_camera_to_object")),
-      write_depth_(program_.Uniform("u_write_depth")) {
+      write_depth_(program_.Uniform("u_write_depth")),
+      light_dir_(program_.Uniform("u_light_dir")),
+      ambient_(program_.Uniform("u_ambient")) {
   ImageOnUnitZero(program_, "u_texture");
 }
 BallShader& BallShader::Use() {
@@ -94,11 +84,12 @@ BallShader& BallShader::SetWriteDepth(bool depth) {
   return *this;
 }
 BallShader& BallShader::SetLight(const glm::vec3& direction, float ambient) {
-  surface_.SetLight(direction, ambient);
+  glUniform3f(light_dir_, direction.x, direction.y, direction.z);
+  glUniform1f(ambient_, ambient);
   return *this;
 }
 BallShader& BallShader::SetColour(float brightness, float contrast, const glm::vec3& white_balance) {
-  surface_.SetColour(brightness, contrast, white_balance);
+  colour_.SetColour(brightness, contrast, white_balance);
   return *this;
 }
 

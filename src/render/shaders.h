@@ -8,20 +8,18 @@
 
 namespace blurcue::render {
 
-// The uniforms of an object's surface that object.frag and ball.frag share: the light and the thesis's colour matching.
-class SurfaceUniforms {
+// The uniforms of an object's surface that object.frag and ball.frag share: the thesis's colour matching.
+class ColourUniforms {
  public:
-  explicit SurfaceUniforms(const Program& program);
-  // Light towards `direction` (camera frame, unit) with `ambient` of it undirected.
-  void SetLight(const glm::vec3& direction, float ambient) const;
+  explicit ColourUniforms(const Program& program);
   // Brightness multiplies, contrast scales about mid grey (0.18), white balance multiplies red, green, blue.
   void SetColour(float brightness, float contrast, const glm::vec3& white_balance) const;
 
  private:
-  GLint light_dir_, ambient_, brightness_, contrast_, white_balance_;
+  GLint brightness_, contrast_, white_balance_;
 };
 
-// shaders/object.{vert,frag}: a textured, simply lit object in the board frame, drawn into a layer.
+// shaders/object.{vert,frag}: a textured card in the board frame, unlit, drawn into a layer.
 class ObjectShader {
  public:
   ObjectShader();
@@ -30,14 +28,12 @@ class ObjectShader {
   ObjectShader& SetModelToCamera(const glm::mat4& model_to_camera);
   // Camera frame -> clip space.
   ObjectShader& SetProjection(const glm::mat4& projection);
-  // SurfaceUniforms::SetLight; `lit` false draws flat.
-  ObjectShader& SetLight(const glm::vec3& direction, float ambient, bool lit);
   ObjectShader& SetColour(float brightness, float contrast, const glm::vec3& white_balance);
 
  private:
   Program program_;
-  SurfaceUniforms surface_;
-  GLint model_to_camera_, projection_, lit_;
+  ColourUniforms colour_;
+  GLint model_to_camera_, projection_;
 };
 
 // shaders/ball.frag (over fullscreen.vert): a ball ray-traced into a layer - the exact sphere, each pixel's coverage
@@ -51,13 +47,14 @@ class BallShader {
   // The sphere in the camera frame (mm), and the rotation from the camera frame to its texture's frame.
   BallShader& SetSphere(const glm::vec3& center_camera_mm, float radius_mm, const glm::mat3& camera_to_object);
   BallShader& SetWriteDepth(bool depth);
+  // Lambert light towards `direction` (camera frame, unit) with `ambient` of it undirected.
   BallShader& SetLight(const glm::vec3& direction, float ambient);
   BallShader& SetColour(float brightness, float contrast, const glm::vec3& white_balance);
 
  private:
   Program program_;
-  SurfaceUniforms surface_;
-  GLint intrinsics_, origin_, center_, radius_, camera_to_object_, write_depth_;
+  ColourUniforms colour_;
+  GLint intrinsics_, origin_, center_, radius_, camera_to_object_, write_depth_, light_dir_, ambient_;
 };
 
 // shaders/blur_gaussian.frag: one pass of the separable Gaussian over a rectangle of a texture (no taps: a copy).
