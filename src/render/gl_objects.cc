@@ -191,7 +191,7 @@ void Framebuffer::Bind() const {
 }
 
 void GrowingTarget::Reserve(int w, int h) {
-  if (texture_ && w <= texture_->width_px() && h <= texture_->height_px()) return;
+  if (Holds(w, h)) return;
   const int grown_w = std::max(texture_ ? texture_->width_px() : 0, (w + 63) / 64 * 64);
   const int grown_h = std::max(texture_ ? texture_->height_px() : 0, (h + 63) / 64 * 64);
   framebuffer_.reset();

@@ -107,6 +107,10 @@ class GrowingTarget {
   // Makes room for w x h: a new texture and framebuffer only when the present ones are smaller (what the old one
   // held is then gone: reserve before drawing).
   void Reserve(int width_px, int height_px);
+  // Whether w x h fits without growing.
+  bool Holds(int width_px, int height_px) const {
+    return texture_ && width_px <= texture_->width_px() && height_px <= texture_->height_px();
+  }
   // Reserves w x h and binds the framebuffer with a w x h viewport.
   void BindFor(int width_px, int height_px);
   const Texture& texture() const { return *texture_; }

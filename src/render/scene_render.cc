@@ -324,8 +324,10 @@ void SceneRenderer::DrawLayerAt(const VirtualObject& o, const cv::Rect& roi, Gro
   const Camera& cam = impl_->camera;
   const int w = roi.width, h = roi.height;
   const bool depth_map = depth != nullptr;
-  color.Reserve(at.x + w, at.y + h);
-  if (depth) depth->Reserve(at.x + w, at.y + h);
+  // The targets may hold the frame's other layers (an atlas): growing them here would lose those without a word, so
+  // the caller reserves the whole frame's room first.
+  if (!color.Holds(at.x + w, at.y + h) || (depth && !depth->Holds(at.x + w, at.y + h)))
+    throw Error(ErrorKind::kInternal, "a layer was drawn past its target's reserved room (reserve before drawing)");
   const auto k = cam.Intrinsics();
   // Camera frame -> clip for this sub-window; framebuffer row r is image row roi.y + r (nothing is flipped).
   const double n = 1.0, far = 1e5;

@@ -112,7 +112,8 @@ class SceneRenderer {
   // Where a layer of the object with that margin lies in the image (its bounds grown, clipped; empty: off-screen).
   cv::Rect LayerRoi(const VirtualObject& object, int margin_px) const;
   // Draws the object's layer over image rectangle `roi` into `color` (and its depth into `depth` when given) with its
-  // top-left image pixel at texel `at`: many layers side by side in one target, drawn in one go.
+  // top-left image pixel at texel `at`: many layers side by side in one target, drawn in one go. The targets must
+  // already hold at + roi's size (GrowingTarget::Reserve first): growing one would lose the layers it holds.
   void DrawLayerAt(const VirtualObject& object, const cv::Rect& roi, GrowingTarget& color, GrowingTarget* depth,
                    cv::Point at);
 

@@ -9,7 +9,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "render/blur.h"
+#include "core/error.h"
 #include "render/gl_context.h"
+#include "render/gl_objects.h"
 
 namespace blurcue::render {
 namespace {
@@ -82,6 +84,28 @@ TEST_F(SceneRenderTest, TexturesAreKeptByIdentityNotByAddress) {
   const SurfaceTexture a(pixels), copy = a, b(pixels);
   EXPECT_EQ(copy.id(), a.id());
   EXPECT_NE(b.id(), a.id());
+}
+
+// Layers side by side in one target (the compositor's atlas): a layer past the room reserved is refused, not drawn
+// after growing the target - which would silently drop the layers drawn into it before.
+TEST_F(SceneRenderTest, ALayerPastItsTargetsReservedRoomIsRefused) {
+  const View v;
+  SceneRenderer renderer(v.camera, v.rvec, v.tvec);
+  const VirtualObject ball = Ball(150);
+  const cv::Rect roi = renderer.LayerRoi(ball, 2);
+  ASSERT_FALSE(roi.empty());
+  GrowingTarget atlas;
+  atlas.Reserve(2 * roi.width, roi.height);  // room for two layers in a row
+  EXPECT_NO_THROW(renderer.DrawLayerAt(ball, roi, atlas, nullptr, {0, 0}));
+  const cv::Mat first = atlas.Download(roi.width, roi.height);
+  try {
+    renderer.DrawLayerAt(ball, roi, atlas, nullptr, {0, roi.height});  // below the room
+    ADD_FAILURE() << "drawn past the reserved room";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInternal) << e.what();
+  }
+  EXPECT_EQ(cv::norm(atlas.Download(roi.width, roi.height), first, cv::NORM_INF), 0)
+      << "the first layer was lost";
 }
 
 TEST_F(SceneRenderTest, BallLandsWhereThePoseProjectsIt) {
