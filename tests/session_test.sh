@@ -374,7 +374,7 @@ assert o["objects"][0]["source"] == first[o["first_interval_shows"] + "_source"]
 y = json.load(open(sys.argv[3] + "/trial-0001.json"))
 x0, y0, w, h = y["prompt_rect_px"]
 px, py, pw, ph = y["photo_rect_px"]
-assert y0 + h == y["display"]["height_px"] and py + ph <= y0, (y["prompt_rect_px"], y["photo_rect_px"])
+assert y0 + h == y["display"]["window_px"][1] and py + ph <= y0, (y["prompt_rect_px"], y["photo_rect_px"])
 img = np.asarray(Image.open(sys.argv[3] + "/trial-0001.png").convert("L")).astype(float)
 band = img[y0:y0 + h]
 assert band.max() - band.min() > 80, "no text in the prompt band"

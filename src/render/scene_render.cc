@@ -222,13 +222,21 @@ Footprint FootprintOf(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec
     const double z = (rotation * cv::Vec3d(corners[i]) + tvec)[2];
     f.z_min_mm = std::min(f.z_min_mm, z), f.z_max_mm = std::max(f.z_max_mm, z);
   }
-  f.bounds = cv::Rect(cv::Point(int(std::floor(x0)) - 1, int(std::floor(y0)) - 1),
-                      cv::Point(int(std::ceil(x1)) + 2, int(std::ceil(y1)) + 2));
+  double pad = 0;
   f.z_center_mm = (rotation * o.center_board_mm + tvec)[2];
-  if (o.kind == VirtualObject::Kind::kBall) {  // a sphere spans its diameter in depth, not its box's diagonal
+  if (o.kind == VirtualObject::Kind::kBall) {
+    // A sphere spans its diameter in depth, not its box's diagonal, and its pixels hug its outline, not its box's
+    // projection (whose near corners reach far wider; a layer is blurred whole, so its area is a frame's cost). The
+    // outline polygon's points lie on the rim; the pad covers its sagitta (< 0.01 of the radius at 64 points).
     f.z_min_mm = f.z_center_mm - o.size_mm;
     f.z_max_mm = f.z_center_mm + o.size_mm;
+    x0 = y0 = 1e300, x1 = y1 = -1e300;
+    for (const cv::Point2d& p : OutlineOf(camera, rvec, tvec, o, 64))
+      x0 = std::min(x0, p.x), y0 = std::min(y0, p.y), x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
+    pad = 0.01 * std::max(x1 - x0, y1 - y0);
   }
+  f.bounds = cv::Rect(cv::Point(int(std::floor(x0 - pad)) - 1, int(std::floor(y0 - pad)) - 1),
+                      cv::Point(int(std::ceil(x1 + pad)) + 2, int(std::ceil(y1 + pad)) + 2));
   return f;
 }
 
@@ -289,20 +297,7 @@ Layer SceneRenderer::Draw(const VirtualObject& o, int margin_px) {
 }
 
 cv::Rect SceneRenderer::LayerRoi(const VirtualObject& o, int margin_px) const {
-  cv::Rect bounds;
-  if (o.kind != VirtualObject::Kind::kBall) {
-    bounds = Measure(o).bounds;
-  } else {
-    // A ball's layer hugs its outline, not its bounding box's projection (whose near corners reach far wider): the
-    // layer is blurred whole, so its area is the frame's cost. The outline polygon's points lie on the rim; the pad
-    // covers the polygon's sagitta (< 0.01 of the radius at 64 points) as the box's pad covers rounding.
-    const std::vector<cv::Point2d> rim = OutlineOf(impl_->camera, impl_->rvec, impl_->tvec, o, 64);
-    double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
-    for (const cv::Point2d& p : rim) x0 = std::min(x0, p.x), y0 = std::min(y0, p.y), x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
-    const double pad = 0.01 * std::max(x1 - x0, y1 - y0);
-    bounds = cv::Rect(cv::Point(int(std::floor(x0 - pad)) - 1, int(std::floor(y0 - pad)) - 1),
-                      cv::Point(int(std::ceil(x1 + pad)) + 2, int(std::ceil(y1 + pad)) + 2));
-  }
+  const cv::Rect bounds = Measure(o).bounds;
   return cv::Rect(bounds.x - margin_px, bounds.y - margin_px, bounds.width + 2 * margin_px,
                   bounds.height + 2 * margin_px) &
          cv::Rect(0, 0, impl_->camera.image_width_px, impl_->camera.image_height_px);

@@ -65,7 +65,7 @@ VirtualObject BallOnBoard(const Board& board, int section, double y_mm, double r
 
 // Where the object lands in the photo, and how far it spans in depth.
 struct Footprint {
-  cv::Rect bounds;             // projected bounding box in image pixels (not clipped)
+  cv::Rect bounds;  // the image pixels it may cover (not clipped): its corners' box (card), its outline's box (ball)
   double z_min_mm = 0, z_max_mm = 0, z_center_mm = 0;
 };
 
