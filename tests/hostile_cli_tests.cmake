@@ -115,7 +115,12 @@ hostile_test(cli_hostile_animate_fps_nan 2 "--fps: must be in [1, 1000] frames p
              animate --calib ${D}/thesis-camera.json --background ${D}/small.png --fps nan --video ${H}/x.avi)
 hostile_test(cli_hostile_run_sim_fps_nan 2 "--sim-fps: must be in [0.1, 1000] frames per second, got 'nan'"
              run ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --participant P1 --db ${H}/x.sqlite
-             --sim-fps nan)
+             --observer sim --sim-fps nan)
+hostile_test(cli_hostile_run_sim_fps_alone 2 "--sim-fps requires --observer"
+             run ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --participant P1 --db ${H}/x.sqlite
+             --sim-fps 30)
+hostile_test(cli_hostile_validate_visible_alone 2 "--visible requires --plan"
+             validate ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --visible 0.7)
 hostile_test(cli_hostile_run_stop_after_negative 2 "--stop-after: must be a whole number in [0, 1000000], got -5"
              run ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --participant P1 --db ${H}/x.sqlite
              --stop-after=-5)

@@ -506,8 +506,11 @@ PYEOF
   [ "$(fingerprint "$W/split.sqlite" G2)" = "$(fingerprint "$W/whole.sqlite" G2)" ] || fail "resumed practice differs"
   # Tampered records whose skips the answers before them do not give are refused on resume, exit 3, nothing added:
   # a skipped practice trial recorded as shown, and a shown one recorded as skipped.
+  # An answer no key gives, and an answer deleted from the middle (a gap), are refused too.
   for tamper in "6 left|trial 6: the record shows it, but the answers before it skip it (criterion met in run 1)" \
-                "2 skipped|trial 2: the record skips it, but the answers before it show it"; do
+                "2 skipped|trial 2: the record skips it, but the answers before it show it" \
+                "3 bogus|trial 3: the record's answer 'bogus' is none this trial can have" \
+                "2 DELETE|its first unanswered trial is 2, but the record holds answers or frames of trials after it"; do
     index=${tamper%% *}; rest=${tamper#* }; choice=${rest%%|*}; message=${tamper#*|}
     rm -f "$W/t.sqlite"
     $BC run "$W/p.json" --participant G3 --db "$W/t.sqlite" --observer sim:jnd=0.05,lapse=0 --stop-after 8 \
@@ -515,8 +518,12 @@ PYEOF
     $PY - "$W/t.sqlite" "$index" "$choice" <<'PYEOF'
 import sqlite3, sys
 con = sqlite3.connect(sys.argv[1])
-n = con.execute("UPDATE responses SET choice = ? WHERE trial_id = (SELECT id FROM trials WHERE trial_index = ?)",
-                (sys.argv[3], int(sys.argv[2]))).rowcount
+if sys.argv[3] == "DELETE":
+    n = con.execute("DELETE FROM responses WHERE trial_id = (SELECT id FROM trials WHERE trial_index = ?)",
+                    (int(sys.argv[2]),)).rowcount
+else:
+    n = con.execute("UPDATE responses SET choice = ? WHERE trial_id = (SELECT id FROM trials WHERE trial_index = ?)",
+                    (sys.argv[3], int(sys.argv[2]))).rowcount
 assert n == 1, n
 con.commit()
 PYEOF
@@ -959,7 +966,14 @@ resume_guards)
     wait $a || fail "round $round, first station: $(cat "$W/twin-a")"
     wait $b || fail "round $round, second station: $(cat "$W/twin-b")"
   done
-  echo "ok: --resume with nothing to resume, foreign, empty, truncated records and twin first starts" ;;
+  # A value echoed in an error stays one line and cannot drive the terminal: a newline, an escape, a broken byte.
+  for bad in $'--seed=3\n' $'--participant=P\x1b[2J1' $'--observer=sim:weber=3\n' $'--sim-fps=\xff' $'--info=a\n=1'; do
+    set +e; $BC run "$T1" --participant P1 --db "$W/echo.sqlite" --observer sim "$bad" > /dev/null 2> "$W/err"; code=$?
+    set -e
+    [ $code = 2 ] && [ "$(wc -l < "$W/err")" = 1 ] && ! grep -q $'\x1b' "$W/err" && [ ! -e "$W/echo.sqlite" ] \
+      || fail "$(printf %q "$bad"): exit $code, $(wc -l < "$W/err") lines: $(cat -v "$W/err")"
+  done
+  echo "ok: --resume with nothing to resume, foreign, empty, truncated records and twin first starts; one-line errors" ;;
 stranded)
   # A protocol reformatted by an editor (CRLF, a trailing newline, indentation) still resumes its session; a real
   # change is refused naming what changed and the command that closes the session, which keeps its answers.

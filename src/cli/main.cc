@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
     bool known = false;
     for (const auto& [name, add] : commands) known = known || name == std::string(argv[1]);
     if (!known) {
-      std::cerr << "blurcue: unknown command '" << argv[1] << "'; 'blurcue --help' lists the commands\n";
+      std::cerr << "blurcue: unknown command '" << OneLine(argv[1]) << "'; 'blurcue --help' lists the commands\n";
       return static_cast<int>(ErrorKind::kUsage);
     }
   }
@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
     if (!empty_value) continue;
     const std::string option =
         !arg.empty() ? arg.substr(0, arg.size() - 1) : before.rfind("-", 0) == 0 ? before : "an argument";
-    std::cerr << "blurcue: " << option << ": must not be empty\n";
+    std::cerr << "blurcue: " << OneLine(option) << ": must not be empty\n";
     return static_cast<int>(ErrorKind::kUsage);
   }
 
@@ -91,16 +91,16 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     // One line like every other error (CLI11's own printer adds "Run with --help for more information.").
-    std::cerr << "blurcue: " << e.what() << "\n";
+    std::cerr << "blurcue: " << OneLine(e.what()) << "\n";
     return static_cast<int>(ErrorKind::kUsage);
   } catch (const Error& e) {
-    std::cerr << "blurcue: " << e.what() << "\n";
+    std::cerr << "blurcue: " << OneLine(e.what()) << "\n";
     return e.exit_code();
   } catch (const cv::Exception& e) {
     std::cerr << "blurcue: OpenCV: " << e.err << " (" << e.func << ")\n";
     return static_cast<int>(ErrorKind::kInternal);
   } catch (const std::exception& e) {
-    std::cerr << "blurcue: " << e.what() << "\n";
+    std::cerr << "blurcue: " << OneLine(e.what()) << "\n";
     return static_cast<int>(ErrorKind::kInternal);
   }
   return 0;

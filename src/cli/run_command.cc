@@ -74,7 +74,8 @@ void AddRunCommand(CLI::App& app) {
   cmd->add_option("--seed", args->seed, "seed of the trial order (default: derived from the study name and the "
                                         "participant id; always recorded)")
       ->transform(SeedValidator());
-  cmd->add_option("--observer", args->observer, "sim or sim:NAME=VALUE,... - a simulated observer answers");
+  CLI::Option* observer =
+      cmd->add_option("--observer", args->observer, "sim or sim:NAME=VALUE,... - a simulated observer answers");
   cmd->add_option("--display", args->options.display_profile,
                   "the monitor's display profile (overrides the protocol's display.profile; recorded with the "
                   "session, with each radius in screen px and arcmin)")
@@ -82,9 +83,12 @@ void AddRunCommand(CLI::App& app) {
   cmd->add_flag("--resume", args->options.resume, "continue the participant's unfinished session");
   cmd->add_flag("--again", args->options.again, "another session for a participant who completed the study (a "
                                                 "participant id seen before is refused otherwise)");
-  cmd->add_flag("--window", args->options.window, "with --observer: show the session in a window, in real time");
-  cmd->add_option("--sim-fps", args->options.sim_fps, "headless: frames rendered per simulated second")
-      ->capture_default_str()->check(FiniteRange(0.1, 1000, "frames per second"));
+  // Options nothing would read are refused: --window and --sim-fps are the simulated observer's, --sim-fps headless.
+  CLI::Option* window =
+      cmd->add_flag("--window", args->options.window, "with --observer: show the session in a window, in real time")
+          ->needs(observer);
+  cmd->add_option("--sim-fps", args->options.sim_fps, "with --observer, headless: frames rendered per simulated second")
+      ->capture_default_str()->check(FiniteRange(0.1, 1000, "frames per second"))->needs(observer)->excludes(window);
   cmd->add_option("--info", args->info,
                   "KEY=VALUE: participant information the protocol asks for (participant_info), repeatable; missing "
                   "required ones are asked for in the terminal");

@@ -47,14 +47,15 @@ void AddValidateCommand(CLI::App& app) {
   cmd->add_option("--display", args->display, "the monitor's display profile, as blurcue run --display")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--list", args->list, "print the trial list as JSON, one trial per line");
-  cmd->add_flag("--plan", args->plan, "also predict, per distinct stimulus pair, whether an observer can tell its "
+  CLI::Option* plan = cmd->add_flag("--plan", args->plan, "also predict, per distinct stimulus pair, whether an observer can tell its "
                                       "two sides apart on this display (flags the invisible ones), and per "
                                       "depth-matching distance which levels it cannot tell from the real picture");
   cmd->add_option("--observer", args->observer, "with --plan: the observer model, as blurcue run --observer "
-                                                "(sim: the arcmin model's defaults)")->capture_default_str();
+                                                "(sim: the arcmin model's defaults)")
+      ->capture_default_str()->needs(plan);  // an option nothing would read is refused
   cmd->add_option("--visible", args->visible, "with --plan: the predicted share correct (2AFC) below which a pair "
                                               "is flagged invisible")
-      ->capture_default_str()->check(FiniteRange(0.5, 1, "share correct"));
+      ->capture_default_str()->check(FiniteRange(0.5, 1, "share correct"))->needs(plan);
   cmd->callback([args] {
     // The observer is checked before any file is read: a typo in it is a usage error, whatever the protocol.
     std::optional<session::ObserverParams> observer;

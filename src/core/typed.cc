@@ -3,6 +3,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 
@@ -41,29 +42,60 @@ std::optional<double> ParseDecimal(std::string_view text) {
   return v;
 }
 
+namespace {
+
+// The length of the printable UTF-8 character at text[i] (1 to 4 bytes), or 0 when a control character or a broken,
+// overlong or surrogate sequence starts there.
+size_t PrintableCharAt(std::string_view text, size_t i) {
+  const unsigned char c = text[i];
+  if (c < 0x20 || c == 0x7f) return 0;
+  if (c < 0x80) return 1;
+  // Lead byte: how many continuation bytes follow, and the smallest code point that length may encode.
+  const int more = c >= 0xf0 ? 3 : c >= 0xe0 ? 2 : c >= 0xc0 ? 1 : -1;
+  if (more < 0 || c > 0xf4 || i + more >= text.size()) return 0;
+  uint32_t cp = c & (0x3f >> more);
+  for (int k = 1; k <= more; ++k) {
+    const unsigned char b = text[i + k];
+    if ((b & 0xc0) != 0x80) return 0;
+    cp = cp << 6 | (b & 0x3f);
+  }
+  static constexpr uint32_t kMin[] = {0, 0x80, 0x800, 0x10000};
+  if (cp < kMin[more] || cp > 0x10ffff || (cp >= 0xd800 && cp <= 0xdfff)) return 0;
+  if (cp <= 0x9f) return 0;  // the C1 controls, U+0080 to U+009F
+  return size_t(more) + 1;
+}
+
+}  // namespace
+
 bool IsPrintableUtf8(std::string_view text) {
   for (size_t i = 0; i < text.size();) {
-    const unsigned char c = text[i];
-    if (c < 0x20 || c == 0x7f) return false;
-    if (c < 0x80) {
-      ++i;
-      continue;
-    }
-    // Lead byte: how many continuation bytes follow, and the smallest code point that length may encode.
-    const int more = c >= 0xf0 ? 3 : c >= 0xe0 ? 2 : c >= 0xc0 ? 1 : -1;
-    if (more < 0 || c > 0xf4 || i + more >= text.size()) return false;
-    uint32_t cp = c & (0x3f >> more);
-    for (int k = 1; k <= more; ++k) {
-      const unsigned char b = text[i + k];
-      if ((b & 0xc0) != 0x80) return false;
-      cp = cp << 6 | (b & 0x3f);
-    }
-    static constexpr uint32_t kMin[] = {0, 0x80, 0x800, 0x10000};
-    if (cp < kMin[more] || cp > 0x10ffff || (cp >= 0xd800 && cp <= 0xdfff)) return false;
-    if (cp <= 0x9f) return false;  // the C1 controls, U+0080 to U+009F
-    i += more + 1;
+    const size_t n = PrintableCharAt(text, i);
+    if (n == 0) return false;
+    i += n;
   }
   return true;
+}
+
+std::string OneLine(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (size_t i = 0; i < text.size();) {
+    if (const size_t n = PrintableCharAt(text, i)) {
+      out.append(text.substr(i, n));
+      i += n;
+      continue;
+    }
+    const unsigned char c = text[i++];
+    if (c == '\n') out += "\\n";
+    else if (c == '\r') out += "\\r";
+    else if (c == '\t') out += "\\t";
+    else {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02x", c);
+      out += hex;
+    }
+  }
+  return out;
 }
 
 bool IsWholeDecimal(std::string_view text) {

@@ -3,6 +3,7 @@
 // and names such as a participant id. One reading for all of them, so that "0x10" is not 16 in one place and an
 // error in another.
 #include <optional>
+#include <string>
 #include <string_view>
 
 namespace blurcue {
@@ -19,5 +20,9 @@ bool IsWholeDecimal(std::string_view text);
 // Valid UTF-8 (no overlong forms, surrogates or code points past U+10FFFF) without control characters (U+0000 to
 // U+001F, U+007F to U+009F): text a record, a CSV cell, a terminal line and the report can all hold as it is.
 bool IsPrintableUtf8(std::string_view text);
+
+// `text` as one printable line: what IsPrintableUtf8 takes kept as it is, a newline, return or tab written \n, \r,
+// \t, any other control or broken byte \xNN. For messages that echo what someone typed.
+std::string OneLine(std::string_view text);
 
 }  // namespace blurcue

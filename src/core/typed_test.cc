@@ -44,5 +44,14 @@ TEST(IsPrintableUtf8, TakesTextInAnyScriptAndRefusesControlsAndBrokenBytes) {
   EXPECT_FALSE(IsPrintableUtf8(std::string_view("P\0" "7", 3)));
 }
 
+// What someone typed, echoed in a message, stays one line and cannot drive the terminal.
+TEST(OneLine, EscapesControlsAndBrokenBytesAndKeepsText) {
+  EXPECT_EQ(OneLine("--seed: must be a number, got '3\n'"), "--seed: must be a number, got '3\\n'");
+  EXPECT_EQ(OneLine("a\tb\rc\x1b[2Jd\xff" "e"), "a\\tb\\rc\\x1b[2Jd\\xffe");
+  EXPECT_EQ(OneLine("Zoë 参加者 \xf0\x9f\x98\x80"), "Zoë 参加者 \xf0\x9f\x98\x80");
+  EXPECT_EQ(OneLine(std::string_view("a\0b", 3)), "a\\x00b");
+  for (const char* text : {"x\n", "\x1b", "\xc3(", "\xc2\x85"}) EXPECT_TRUE(IsPrintableUtf8(OneLine(text))) << text;
+}
+
 }  // namespace
 }  // namespace blurcue

@@ -1411,7 +1411,7 @@ bool Parser::Provides(const Block& b, const std::string& name) {
 std::string CheckInfoValue(const InfoField& f, const std::string& value) {
   if (f.type == "integer" || f.type == "number") {
     const std::optional<double> x = ParseDecimal(value);
-    if (!x || (f.type == "integer" && *x != std::floor(*x)) || *x < f.min || *x > f.max) {
+    if (!x || (f.type == "integer" && !IsWholeDecimal(value)) || *x < f.min || *x > f.max) {
       char range[96];
       std::snprintf(range, sizeof range, "%s in [%g, %g]", f.type == "integer" ? "a whole number" : "a number", f.min,
                     f.max);

@@ -161,6 +161,23 @@ struct KeyMap {
     if (action == "next") return r.next;
     return r.accept;
   }
+  // Whether `choice` is an answer a session can record for `trial`: one of its task's actions as these keys give
+  // them, an adjustment's level (as the record writes it), or no answer (a deadline passed).
+  bool CanRecord(const std::string& choice, const protocol::Trial& trial) const {
+    if (choice == store::kChoiceNone) return true;
+    if (trial.task == Task::kAdjustment)
+      return std::any_of(trial.adjust_levels.begin(), trial.adjust_levels.end(),
+                         [&](double level) { return protocol::LevelText(level) == choice; });
+    const bool cant_tell = trial.task == Task::kForcedChoice && !r.cant_tell.empty() && choice == "cant_tell";
+    if (const auto* keys = Numbered(trial.task)) {
+      for (size_t i = 0; i < keys->size(); ++i)
+        if (choice == std::to_string(i + 1)) return true;
+      return cant_tell;
+    }
+    if (trial.task == Task::kForcedChoice) return choice == "left" || choice == "right" || cant_tell;
+    if (trial.task == Task::kYesNo) return choice == "yes" || choice == "no";
+    return false;
+  }
   // An action that answers a trial (not a step of an adjustment, not the pause).
   static bool Answers(const std::string& action) {
     return action == "left" || action == "right" || action == "cant_tell" || action == "yes" || action == "no" ||
@@ -458,11 +475,15 @@ class Runner {
           throw cannot(i, "the record shows it, but the answers before it skip it (" +
                               why["skipped"].get<std::string>() + ")");
         if (recorded_skip) continue;
+        if (!keys_.CanRecord(it->second.choice, t))
+          throw cannot(i, "the record's answer '" + it->second.choice + "' is none this trial can have");
         main_answered += !t.practice;
         double level = 0;
         const TrialScene scene = logic.SceneOf(t, &level);
         if (t.cell >= 0) {
-          const Json shown = ParseJson(it->second.shown_json, options_.db.string());
+          const Json shown = ParseJson(it->second.shown_json, options_.db.string() + " session " +
+                                                                  std::to_string(start.session_id) + " trial " +
+                                                                  std::to_string(i));
           if (!shown.is_object() || !shown.contains("level") || !shown["level"].is_number() ||
               std::abs(shown["level"].get<double>() - level) > 1e-9 * std::max(1.0, std::abs(level)))
             throw cannot(i, "the record's procedure level " +

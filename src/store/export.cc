@@ -13,6 +13,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/json_io.h"
+#include "core/typed.h"
 #include "store/record.h"
 #include "store/schema.h"
 #include "store/sqlite.h"
@@ -94,12 +95,9 @@ void WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
   // Answers in a natural order: numbers (adjustment levels) by value, then names.
   struct Natural {
     bool operator()(const std::string& a, const std::string& b) const {
-      char* ea = nullptr;
-      char* eb = nullptr;
-      const double x = std::strtod(a.c_str(), &ea), y = std::strtod(b.c_str(), &eb);
-      const bool na = !a.empty() && *ea == '\0', nb = !b.empty() && *eb == '\0';
-      if (na != nb) return na;
-      return na && x != y ? x < y : a < b;
+      const std::optional<double> x = ParseDecimal(a), y = ParseDecimal(b);
+      if (x.has_value() != y.has_value()) return x.has_value();
+      return x && *x != *y ? *x < *y : a < b;
     }
   };
   std::map<std::string, std::set<std::string, Natural>> answer_names;

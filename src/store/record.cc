@@ -354,6 +354,19 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
   start.trial_count = db_.QueryInt64("SELECT COUNT(*) FROM trials WHERE session_id = " +
                                      std::to_string(start.session_id));
   start.first_unanswered_trial = FirstUnansweredTrial(start.session_id);
+  if (start.resumed) {
+    // A session continues at its first unanswered trial; answers or frames past it mean the record was changed
+    // outside blurcue (a deleted answer leaves a gap), and resuming would write over them or beside them.
+    const std::string s = std::to_string(start.session_id), f = std::to_string(start.first_unanswered_trial);
+    const int64_t past = db_.QueryInt64(
+        "SELECT (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE t.session_id = " + s +
+        " AND t.trial_index >= " + f + ") + (SELECT COUNT(*) FROM frames fr JOIN trials t ON t.id = fr.trial_id "
+        "WHERE t.session_id = " + s + " AND t.trial_index >= " + f + ")");
+    if (past > 0)
+      throw InputError(db_.path(), SessionName(start.session_id) + ": its first unanswered trial is " + f +
+                                       ", but the record holds answers or frames of trials after it (changed "
+                                       "outside blurcue?); it cannot be resumed");
+  }
   return start;
 }
 
