@@ -1483,13 +1483,24 @@ Protocol LoadProtocol(const fs::path& file, const ValidateOptions& options) {
   return ParseProtocol(ReadJsonFile(file), file, options);
 }
 
+const Json* FindLevel(const Json& levels, const std::string& name) {
+  if (!levels.is_object()) return nullptr;
+  if (auto it = levels.find(name); it != levels.end()) return &*it;
+  for (const auto& [key, value] : levels.items())
+    if (value.is_object())
+      if (auto it = value.find(name); it != value.end()) return &*it;
+  return nullptr;
+}
+
 std::set<double> NumericLevels(const Protocol& protocol, const std::string& factor) {
   std::set<double> values;
   for (const auto& b : protocol.blocks)
     for (const auto& f : b.factors)
-      if (f.name == factor)
-        for (const auto& level : f.levels)
-          if (level.is_number()) values.insert(level.get<double>());
+      for (const auto& level : f.levels) {
+        Json levels = Json::object();
+        levels[f.name] = level;
+        if (const Json* v = FindLevel(levels, factor); v && v->is_number()) values.insert(v->get<double>());
+      }
   return values;
 }
 

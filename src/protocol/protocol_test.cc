@@ -217,6 +217,25 @@ TEST(ProtocolValidate, ConditionsTableGivesTheDesignRowByRow) {
   EXPECT_TRUE(Contains(OnlyProblem(j), "/blocks/0/conditions: no such file")) << OnlyProblem(j);
 }
 
+// The real photos of a depth matching are chosen by distance_m wherever a trial finds it: its own factor, a key of
+// an object level, or a conditions table's column (the table was refused: "needs a factor distance_m").
+TEST(ProtocolValidate, RealPhotoDistancesComeFromFactorsObjectLevelsAndConditionsTables) {
+  const fs::path dir = SceneFolder();
+  std::ofstream(dir / "dm.csv") << "distance_m\n0.4\n1.092\n";
+  auto distances = [&](const Json& design) {
+    Json j = Json::parse(R"({"name": "dm", "version": 1, "scene": {"background": "s.png"},
+                             "content": {"type": "picture", "image": "face.png"},
+                             "task": "adjustment", "adjust": {"parameter": "cutoff", "levels": [2, 4, 8]}})");
+    for (const auto& [k, v] : design.items()) j[k] = v;
+    return NumericLevels(ParseProtocol(j, dir / "p.json", ValidateOptions{false}), "distance_m");
+  };
+  const std::set<double> want = {0.4, 1.092};
+  EXPECT_EQ(distances(Json::parse(R"({"factors": {"distance_m": [0.4, 1.092]}})")), want);
+  EXPECT_EQ(distances(Json::parse(R"({"factors": {"place": [{"distance_m": 0.4}, {"distance_m": 1.092}]}})")), want);
+  EXPECT_EQ(distances(Json::parse(R"({"blocks": [{"name": "b", "conditions": "dm.csv"}]})")), want);
+  EXPECT_TRUE(distances(Json::parse(R"({"factors": {"other": [1, 2]}})")).empty());
+}
+
 // Participant information and between-subject groups: every field checked with its pointer; a block names only
 // declared groups; every group runs a block.
 TEST(ProtocolValidate, ParticipantInfoAndGroupsAreChecked) {

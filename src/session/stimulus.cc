@@ -24,15 +24,7 @@ namespace {
 
 constexpr int kLeftSection = 3, kRightSection = 5;  // the balls roll side by side, one section apart
 
-// A level by name: a factor of its own, or a key of an object level (a pattern carries speed and sides).
-const Json* FindLevel(const Json& levels, const std::string& name) {
-  if (!levels.is_object()) return nullptr;
-  if (auto it = levels.find(name); it != levels.end()) return &*it;
-  for (const auto& [key, value] : levels.items())
-    if (value.is_object())
-      if (auto it = value.find(name); it != value.end()) return &*it;
-  return nullptr;
-}
+using protocol::FindLevel;
 
 // "FILE: /pointer": where a problem of a trial comes from in the protocol.
 std::string At(const protocol::Protocol& p, const std::string& pointer) {

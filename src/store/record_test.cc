@@ -184,7 +184,7 @@ TEST(Record, ResumeReturnsTheFirstUnansweredTrial) {
     Record record = Record::Open(dir / "r.sqlite");
     session = record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, false).session_id;
     record.SaveTrialList(session, Trials(10));
-    for (int i : {0, 1, 2, 4}) record.RecordResponse(session, i, Answer("left"));
+    for (int i : {0, 1, 2}) record.RecordResponse(session, i, Answer("left"));
   }
   Record record = Record::Open(dir / "r.sqlite");
   const SessionStart start = record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, true);
@@ -193,7 +193,28 @@ TEST(Record, ResumeReturnsTheFirstUnansweredTrial) {
   EXPECT_EQ(start.trial_count, 10);
   EXPECT_EQ(start.first_unanswered_trial, 3);
   record.RecordResponse(session, 3, Answer("right"));
-  EXPECT_EQ(record.FirstUnansweredTrial(session), 5);
+  EXPECT_EQ(record.FirstUnansweredTrial(session), 4);
+}
+
+// A session runs its trials in order, so an answer past the first unanswered trial means a record changed outside
+// blurcue (an answer deleted from the middle): resuming it is refused, not continued over the gap.
+TEST(Record, ResumeOverAGapInTheAnswersIsRefused) {
+  testing::TempDir dir;
+  {
+    Record record = Record::Open(dir / "r.sqlite");
+    const int64_t session = record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, false).session_id;
+    record.SaveTrialList(session, Trials(10));
+    for (int i : {0, 1, 2, 4}) record.RecordResponse(session, i, Answer("left"));
+  }
+  Record record = Record::Open(dir / "r.sqlite");
+  try {
+    record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, true);
+    ADD_FAILURE() << "resumed over a gap";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    EXPECT_NE(std::string(e.what()).find("its first unanswered trial is 3, but the record holds answers"),
+              std::string::npos) << e.what();
+  }
 }
 
 TEST(Record, StartingAfreshOverARunningSessionIsRefused) {
