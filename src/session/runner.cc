@@ -18,8 +18,8 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
-#include "core/typed.h"
 #include "core/image.h"
+#include "core/typed.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
 #include "render/frame_compositor.h"
