@@ -22,6 +22,7 @@ import json
 import math
 import os
 import random
+import re
 import shutil
 import struct
 import subprocess
@@ -343,6 +344,10 @@ def main():
                 line.startswith(path + ": ") or (line.startswith("(") and "problems" in line) or
                 line.startswith("(scripts/demo.sh")
                 for line in lines[1:])
+            # Several problems come one per line: "(N problems)" closes N lines (an escaped "\n" would join them).
+            m = re.fullmatch(r"\((\d+) problems\)", lines[-1]) if lines else None
+            ok = ok and (m is None or len(lines) == int(m.group(1)) + 1) and not any(
+                "\\n" + path in line or "\\n(" in line for line in lines)
             if not ok:
                 counts["unnamed_message"] += 1
                 fail("rejection does not name the protocol file on every line", v.stderr)

@@ -94,7 +94,9 @@ int main(int argc, char** argv) {
     std::cerr << "blurcue: " << OneLine(e.what()) << "\n";
     return static_cast<int>(ErrorKind::kUsage);
   } catch (const Error& e) {
-    std::cerr << "blurcue: " << OneLine(e.what()) << "\n";
+    // Each problem on its own line (a protocol's every problem at once), each line escaped.
+    const std::vector<std::string> lines = e.lines();
+    for (size_t i = 0; i < lines.size(); ++i) std::cerr << (i == 0 ? "blurcue: " : "") << OneLine(lines[i]) << "\n";
     return e.exit_code();
   } catch (const cv::Exception& e) {
     std::cerr << "blurcue: OpenCV: " << e.err << " (" << e.func << ")\n";

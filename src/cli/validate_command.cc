@@ -110,8 +110,8 @@ void AddValidateCommand(CLI::App& app) {
       } catch (const Error& e) {
         const std::string message = e.what();
         if (message.find(": no such file: ") == std::string::npos) throw;
-        throw Error(e.kind(), message + "\n(scripts/demo.sh writes the demo scene the shipped protocols use; "
-                                        "--no-files skips the file checks)");
+        throw e.Wrapped(e.kind(), "", "(scripts/demo.sh writes the demo scene the shipped protocols use; --no-files "
+                                      "skips the file checks)");
       }
     }
     if (args->list)

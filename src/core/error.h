@@ -3,6 +3,7 @@
 // so scripts can tell a typo in a command line from a bad file from a failed computation.
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace blurcue {
 
@@ -17,11 +18,31 @@ enum class ErrorKind {
 class Error : public std::runtime_error {
  public:
   Error(ErrorKind kind, const std::string& message) : std::runtime_error(message), kind_(kind) {}
+  // Several problems at once (a protocol's, a display profile's), one line each; what() joins them with newlines.
+  Error(ErrorKind kind, std::vector<std::string> lines)
+      : std::runtime_error(Join(lines)), kind_(kind), lines_(std::move(lines)) {}
   ErrorKind kind() const { return kind_; }
   int exit_code() const { return static_cast<int>(kind_); }
+  // The lines to print: what() for an ordinary error, each problem's own for a list. A newline inside one of them
+  // came from a value it echoes, not from the list (main prints each line escaped, core/typed.h OneLine).
+  std::vector<std::string> lines() const { return lines_.empty() ? std::vector<std::string>{what()} : lines_; }
+  // The same error of `kind` with `prefix` before its first line and `after` (when not empty) as a last line: how a
+  // caller says where it came from, or what to do, without joining a list into one line.
+  Error Wrapped(ErrorKind kind, const std::string& prefix, const std::string& after = "") const {
+    std::vector<std::string> all = lines();
+    all.front() = prefix + all.front();
+    if (!after.empty()) all.push_back(after);
+    return Error(kind, std::move(all));
+  }
 
  private:
+  static std::string Join(const std::vector<std::string>& lines) {
+    std::string text;
+    for (const auto& line : lines) text += (text.empty() ? "" : "\n") + line;
+    return text;
+  }
   ErrorKind kind_;
+  std::vector<std::string> lines_;
 };
 
 // A bad file or value: message is "where: what, got what".

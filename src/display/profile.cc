@@ -231,10 +231,8 @@ Profile ParseProfile(const Json& json, const std::filesystem::path& file) {
     }
   }
   if (!problems.empty()) {
-    std::string message = problems.front();
-    for (size_t i = 1; i < problems.size(); ++i) message += "\n" + problems[i];
-    if (problems.size() > 1) message += "\n(" + std::to_string(problems.size()) + " problems)";
-    throw Error(ErrorKind::kInput, message);
+    if (problems.size() > 1) problems.push_back("(" + std::to_string(problems.size()) + " problems)");
+    throw Error(ErrorKind::kInput, std::move(problems));
   }
   return p;
 }

@@ -1442,13 +1442,13 @@ Protocol ParseProtocol(const Json& json, const fs::path& file, const ValidateOpt
   Parser parser(file, options);
   Protocol p = parser.Parse(json);
   if (!parser.problems.empty()) {
-    std::string message;
-    for (const auto& line : parser.problems) message += (message.empty() ? "" : "\n") + line;
+    std::vector<std::string> lines = parser.problems;
     const size_t count = parser.problems.size() + parser.more_problems;
-    if (parser.more_problems > 0) message += "\n(" + std::to_string(count) + " problems, the first " +
-                                             std::to_string(parser.problems.size()) + " listed)";
-    else if (count > 1) message += "\n(" + std::to_string(count) + " problems)";
-    throw Error(ErrorKind::kInput, message);
+    if (parser.more_problems > 0)
+      lines.push_back("(" + std::to_string(count) + " problems, the first " + std::to_string(parser.problems.size()) +
+                      " listed)");
+    else if (count > 1) lines.push_back("(" + std::to_string(count) + " problems)");
+    throw Error(ErrorKind::kInput, std::move(lines));
   }
   return p;
 }

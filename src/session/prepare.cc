@@ -20,7 +20,7 @@ PreparedSession PrepareStudy(const std::filesystem::path& protocol_file, const s
     try {
       s.display = display::LoadProfile(s.protocol.display.profile);
     } catch (const Error& e) {
-      throw InputError(protocol_file.string() + ": /display/profile", e.what());
+      throw e.Wrapped(ErrorKind::kInput, protocol_file.string() + ": /display/profile: ");
     }
   }
   s.presentation = Presentation::Of(s.protocol, s.images, s.display);
