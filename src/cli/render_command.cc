@@ -82,8 +82,9 @@ void AddRenderCommand(CLI::App& app) {
         throw Error(ErrorKind::kUsage, "--picture-height-px " + std::to_string(picture_h) +
                                            " is taller than the grey half of the frame (" + std::to_string(half) +
                                            " px)");
-      const cv::Mat frame = render::DepthMatchingFrame(
-          render::PictureOnGrey(picture, l.upper.size(), picture_h, args->cutoff), photo, w);
+      cv::Mat frame;
+      render::StackDepthMatchingFrame(render::PictureOnGrey(picture, l.upper.size(), picture_h, args->cutoff),
+                                      l.LowerHalf(photo), &frame);
       WriteImage(args->out, frame);
       std::printf("picture %s, cut-off %g cycles per picture width, %d px high on a %dx%d frame -> %s\n", name.c_str(),
                   args->cutoff, picture_h, w, h, args->out.c_str());

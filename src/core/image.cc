@@ -117,7 +117,7 @@ class CapturedStderr {
 };
 
 // The decoder's own words as one clause: lines joined by "; ", at most 300 characters.
-std::string OneLine(const std::string& text) {
+std::string DecoderClause(const std::string& text) {
   std::string out;
   for (char c : text) {
     if (c == '\n' || c == '\r') {
@@ -162,7 +162,7 @@ cv::Mat ReadImage(const std::filesystem::path& path, int flags) {
     } catch (const cv::Exception& e) {
       decoder_said = e.err;
     }
-    decoder_said = OneLine(captured.Release() + decoder_said);
+    decoder_said = DecoderClause(captured.Release() + decoder_said);
   }
   if (image.empty())
     throw InputError(path.string(), "not a readable image (PNG, JPEG, TIFF, ...)" +

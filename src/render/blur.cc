@@ -209,11 +209,12 @@ cv::Mat ButterworthBlurCpu(const cv::Mat& rgba, double cutoff, int order) {
 
 double ButterworthEquivalentSigma(double cutoff) { return std::sqrt(std::log(2.0) / 2) / (M_PI * cutoff); }
 
+namespace {
+
+// A picture's width when scaled to height_px (its aspect kept, rounded, at least 1 px).
 int ScaledWidthPx(cv::Size picture, int height_px) {
   return std::max(1, int(std::lround(double(picture.width) * height_px / picture.height)));
 }
-
-namespace {
 
 // Where PictureOnField puts a layer of `layer` size: centred on the field (it may overhang).
 cv::Rect LayerOnField(cv::Size field, cv::Size layer) {
@@ -222,6 +223,15 @@ cv::Rect LayerOnField(cv::Size field, cv::Size layer) {
 
 // PictureOnGrey's transparent margin around a picture of `scaled` size: room for its blur to spread.
 int GreyMarginPx(cv::Size scaled) { return std::max(scaled.width, scaled.height) / 4; }
+
+// Where PictureOnGrey puts a picture of `picture` size scaled to height_px on a `field`: its outline before the blur
+// spreads it, with the drawing's own rounding.
+cv::Rect PictureRectOnGrey(cv::Size picture, cv::Size field, int height_px) {
+  const cv::Size scaled(ScaledWidthPx(picture, height_px), height_px);
+  const int m = GreyMarginPx(scaled);
+  const cv::Rect layer = LayerOnField(field, {scaled.width + 2 * m, scaled.height + 2 * m});
+  return {layer.x + m, layer.y + m, scaled.width, scaled.height};
+}
 
 }  // namespace
 
@@ -263,36 +273,26 @@ cv::Mat PictureOnGrey(const cv::Mat& picture, cv::Size field, int height_px, dou
   return PictureOnField(picture, field, height_px, GreyMarginPx({width_px, height_px}), butterworth, grey);
 }
 
-cv::Rect PictureRectOnGrey(cv::Size picture, cv::Size field, int height_px) {
-  const cv::Size scaled(ScaledWidthPx(picture, height_px), height_px);
-  const int m = GreyMarginPx(scaled);
-  const cv::Rect layer = LayerOnField(field, {scaled.width + 2 * m, scaled.height + 2 * m});
-  return {layer.x + m, layer.y + m, scaled.width, scaled.height};
-}
-
 DepthMatchingLayout DepthMatchingLayout::Of(int width_px, cv::Size picture) {
   DepthMatchingLayout l;
   const int h = width_px * 3 / 4, half = h / 2;
   l.frame = {width_px, h};
   l.upper = {0, 0, width_px, half};
-  l.picture = PictureRectOnGrey(picture, l.upper.size(), DepthMatchingPictureHeightPx(width_px));
+  if (!picture.empty()) l.picture = PictureRectOnGrey(picture, l.upper.size(), half * 6 / 10);
   l.lower = {0, half, width_px, h - half};
   return l;
 }
 
-int DepthMatchingPictureHeightPx(int width_px) { return width_px * 3 / 4 / 2 * 6 / 10; }
-
-double DepthMatchingLowerScale(cv::Size photo, int width_px) {
-  const int h = width_px * 3 / 4, lower = h - h / 2;
-  return std::max(double(width_px) / photo.width, double(lower) / photo.height);
+double DepthMatchingLayout::LowerScale(cv::Size photo) const {
+  return std::max(double(lower.width) / photo.width, double(lower.height) / photo.height);
 }
 
-cv::Mat DepthMatchingLowerHalf(const cv::Mat& photo, int width_px) {
-  const int h = width_px * 3 / 4, lower = h - h / 2;
-  const double scale = DepthMatchingLowerScale(photo.size(), width_px);
+cv::Mat DepthMatchingLayout::LowerHalf(const cv::Mat& photo) const {
+  const double scale = LowerScale(photo.size());
   cv::Mat scaled;
   cv::resize(photo, scaled, cv::Size(), scale, scale, cv::INTER_AREA);
-  return scaled(cv::Rect((scaled.cols - width_px) / 2, (scaled.rows - lower) / 2, width_px, lower)).clone();
+  return scaled(cv::Rect((scaled.cols - lower.width) / 2, (scaled.rows - lower.height) / 2, lower.width,
+                         lower.height)).clone();
 }
 
 void StackDepthMatchingFrame(const cv::Mat& upper, const cv::Mat& lower, cv::Mat* frame) {
@@ -300,14 +300,6 @@ void StackDepthMatchingFrame(const cv::Mat& upper, const cv::Mat& lower, cv::Mat
   frame->create(upper.rows + lower.rows, upper.cols, CV_8UC3);  // allocates only the first time
   upper.copyTo(frame->rowRange(0, upper.rows));
   lower.copyTo(frame->rowRange(upper.rows, frame->rows));
-}
-
-cv::Mat DepthMatchingFrame(const cv::Mat& upper, const cv::Mat& photo, int width_px) {
-  const int h = width_px * 3 / 4, half = h / 2;
-  CV_Assert(upper.cols == width_px && upper.rows == half && upper.type() == CV_8UC3);
-  cv::Mat frame;
-  StackDepthMatchingFrame(upper, DepthMatchingLowerHalf(photo, width_px), &frame);
-  return frame;
 }
 
 cv::Mat ToLinearPremultiplied(const cv::Mat& image8) {

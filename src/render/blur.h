@@ -63,35 +63,27 @@ double ButterworthEquivalentSigma(double cutoff_cycles_per_width);
 // `height_px`, low-passed by the 2nd-order Butterworth at `cutoff` cycles per picture width (0 = sharp), centred on
 // a uniform grey field of `field` size with linear grey level `grey`. Returns 8-bit BGR sRGB.
 cv::Mat PictureOnGrey(const cv::Mat& picture, cv::Size field, int height_px, double cutoff, double grey = 0.18);
-// A picture's width when scaled to height_px (its aspect kept, rounded, at least 1 px).
-int ScaledWidthPx(cv::Size picture, int height_px);
 
 // `picture` scaled to height_px with a transparent margin of margin_px, passed through filter(layer, picture width
 // in px) as CV_32FC4 linear premultiplied, and composited centred on a uniform field of linear grey. 8-bit BGR sRGB.
 cv::Mat PictureOnField(const cv::Mat& picture, cv::Size field, int height_px, int margin_px,
                        const std::function<cv::Mat(const cv::Mat&, int)>& filter, double grey);
 
-// The depth-matching study's frame (thesis 3.2), 8-bit sRGB BGR of width_px x 3/4 width_px: the upper half is
-// `upper` (a PictureOnGrey of width_px x half the height), the lower half the scene photo scaled to cover it and
-// cropped at its centre.
-cv::Mat DepthMatchingFrame(const cv::Mat& upper, const cv::Mat& photo, int width_px);
-// Its geometry: the picture's height in the upper half (0.6 of it), and the scale (frame px per photo px) at which
-// the lower half shows a photo of `photo` size.
-int DepthMatchingPictureHeightPx(int width_px);
-double DepthMatchingLowerScale(cv::Size photo, int width_px);
-// Where PictureOnGrey puts a picture of `picture` size scaled to height_px on a `field`: its outline before the
-// blur spreads it, with the drawing's own rounding.
-cv::Rect PictureRectOnGrey(cv::Size picture, cv::Size field, int height_px);
-// The depth-matching frame of width_px showing a picture of `picture` size, in frame px: the frame, its upper half
-// (grey, the virtual picture's field), the virtual picture's outline in it, and the lower half (the real photo).
+// The depth-matching study's frame (thesis 3.2) of width_px showing a picture of `picture` size, in frame px: the
+// frame (width x 3/4 width); its upper half, grey, with the virtual picture's outline (before the blur spreads it)
+// centred in it at 0.6 of its height (PictureOnGrey's place, with its rounding); its lower half, the real photo
+// scaled to cover it and cropped at its centre.
 struct DepthMatchingLayout {
   cv::Size frame;
-  cv::Rect upper, picture, lower;
+  cv::Rect upper, picture, lower;  // `picture` empty for an empty picture size
   static DepthMatchingLayout Of(int width_px, cv::Size picture);
+  // The scale (frame px per photo px) at which the lower half shows a photo of `photo` size, and that photo there
+  // (8-bit BGR of lower's size).
+  double LowerScale(cv::Size photo) const;
+  cv::Mat LowerHalf(const cv::Mat& photo) const;
 };
-// Its parts: the lower half (the photo scaled and cropped, 8-bit BGR, width_px x 3/4 width_px - half of it), and
-// the two stacked into `frame` (allocated only when its size changes: a trial stepping through levels reuses it).
-cv::Mat DepthMatchingLowerHalf(const cv::Mat& photo, int width_px);
+// The frame: `upper` (a PictureOnGrey of the upper half's size) over `lower` (a LowerHalf), stacked into `frame`
+// (allocated only when its size changes: a trial stepping through levels reuses it). 8-bit BGR.
 void StackDepthMatchingFrame(const cv::Mat& upper, const cv::Mat& lower, cv::Mat* frame);
 
 // 8-bit sRGB BGR/BGRA/grey -> CV_32FC4 linear premultiplied BGRA, and back (alpha kept when `keep_alpha`).

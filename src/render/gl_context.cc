@@ -15,6 +15,7 @@ namespace {
 
 // The GL every context asks for: 4.2 core, the first with the image loads the blur shaders read their texels by.
 constexpr int kGlMajor = 4, kGlMinor = 2;
+const std::string kGlName = "GL " + std::to_string(kGlMajor) + "." + std::to_string(kGlMinor) + " core";
 
 std::string Hex(int v) {
   char b[16];
@@ -40,7 +41,7 @@ class EglContext final : public GlContext {
     if (context_ == EGL_NO_CONTEXT) {
       const int err = eglGetError();
       eglTerminate(display_);
-      throw Error(ErrorKind::kInternal, "EGL: cannot create a GL 4.2 core context, error " + Hex(err));
+      throw Error(ErrorKind::kInternal, "EGL: cannot create a " + kGlName + " context, error " + Hex(err));
     }
     MakeCurrent();
   }
@@ -91,7 +92,7 @@ class GlfwContext final : public GlContext {
     window_ = glfwCreateWindow(o.width_px, o.height_px, o.title.c_str(), monitor, nullptr);
     if (!window_) {
       glfwTerminate();
-      throw Error(ErrorKind::kInternal, "GLFW: cannot open a GL 4.2 core window: " + LastGlfwError());
+      throw Error(ErrorKind::kInternal, "GLFW: cannot open a " + kGlName + " window: " + LastGlfwError());
     }
     MakeCurrent();
     glfwSwapInterval(o.vsync ? 1 : 0);

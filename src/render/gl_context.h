@@ -1,6 +1,7 @@
 #pragma once
-// An OpenGL 3.3 core context, offscreen through EGL on Mesa's surfaceless platform (no display: batch rendering
-// and every test) or in a GLFW window for participants. GL calls go through libepoxy.
+// An OpenGL 4.2 core context (the blur shaders' image loads need it), offscreen through EGL on Mesa's surfaceless
+// platform (no display: batch rendering and every test) or in a GLFW window for participants. GL calls go through
+// libepoxy.
 #include <memory>
 #include <string>
 #include <vector>
@@ -26,7 +27,7 @@ struct InputEvent {
 
 class GlContext {
  public:
-  // Throws Error(kInternal) with the EGL error code when no surfaceless GL 3.3 core context can be made.
+  // Throws Error(kInternal) with the EGL error code when no surfaceless GL 4.2 core context can be made.
   static std::unique_ptr<GlContext> CreateOffscreen();
   // Throws Error(kInternal) when GLFW cannot open a window (no display: run under Xvfb).
   static std::unique_ptr<GlContext> CreateWindow(const WindowOptions& options);

@@ -199,12 +199,6 @@ void GrowingTarget::Reserve(int w, int h) {
   framebuffer_ = std::make_unique<Framebuffer>(*texture_);
 }
 
-void GrowingTarget::BindFor(int w, int h) {
-  Reserve(w, h);
-  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_->id());
-  glViewport(0, 0, w, h);
-}
-
 cv::Mat GrowingTarget::Download(int w, int h) const {
   CV_Assert(texture_ && w <= texture_->width_px() && h <= texture_->height_px());
   cv::Mat out(h, w, CV_32FC4);

@@ -111,8 +111,6 @@ class GrowingTarget {
   bool Holds(int width_px, int height_px) const {
     return texture_ && width_px <= texture_->width_px() && height_px <= texture_->height_px();
   }
-  // Reserves w x h and binds the framebuffer with a w x h viewport.
-  void BindFor(int width_px, int height_px);
   const Texture& texture() const { return *texture_; }
   GLuint framebuffer() const { return framebuffer_->id(); }
   // The bottom-left w x h read back as CV_32FC4, and written from one.

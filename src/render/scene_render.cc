@@ -78,19 +78,6 @@ glm::mat4 ModelMatrix(const VirtualObject& o) {
   return m;
 }
 
-// The corners of the object's board-frame bounding box (a card's own four corners).
-std::vector<cv::Point3d> BoxCorners(const VirtualObject& o) {
-  if (o.kind == VirtualObject::Kind::kCard) return CardCorners(o);
-  const double h = o.size_mm;
-  std::vector<cv::Point3d> corners;
-  for (int sx : {-1, 1})
-    for (int sy : {-1, 1})
-      for (int sz : {-1, 1})
-        corners.emplace_back(o.center_board_mm[0] + sx * h, o.center_board_mm[1] + sy * h,
-                             o.center_board_mm[2] + sz * h);
-  return corners;
-}
-
 }  // namespace
 
 struct SceneRenderer::Impl {
@@ -209,32 +196,32 @@ VirtualObject BallOnBoard(const Board& board, int section, double y_mm, double r
 }
 
 Footprint FootprintOf(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec, const VirtualObject& o) {
-  const auto corners = BoxCorners(o);
-  std::vector<cv::Point2d> px;
-  cv::projectPoints(corners, rvec, tvec, cv::Matx33d(camera.Intrinsics().data()), camera.dist_coeffs, px);
   cv::Matx33d rotation;
   cv::Rodrigues(rvec, rotation);
   Footprint f;
-  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
-  f.z_min_mm = 1e300, f.z_max_mm = -1e300;
-  for (size_t i = 0; i < corners.size(); ++i) {
-    x0 = std::min(x0, px[i].x), x1 = std::max(x1, px[i].x), y0 = std::min(y0, px[i].y), y1 = std::max(y1, px[i].y);
-    const double z = (rotation * cv::Vec3d(corners[i]) + tvec)[2];
-    f.z_min_mm = std::min(f.z_min_mm, z), f.z_max_mm = std::max(f.z_max_mm, z);
-  }
-  double pad = 0;
   f.z_center_mm = (rotation * o.center_board_mm + tvec)[2];
+  std::vector<cv::Point2d> px;
   if (o.kind == VirtualObject::Kind::kBall) {
-    // A sphere spans its diameter in depth, not its box's diagonal, and its pixels hug its outline, not its box's
-    // projection (whose near corners reach far wider; a layer is blurred whole, so its area is a frame's cost). The
-    // outline polygon's points lie on the rim; the pad covers its sagitta (< 0.01 of the radius at 64 points).
+    // A sphere spans its diameter in depth, and its pixels hug its outline (its bounding box's projection reaches
+    // far wider; a layer is blurred whole, so its area is a frame's cost).
     f.z_min_mm = f.z_center_mm - o.size_mm;
     f.z_max_mm = f.z_center_mm + o.size_mm;
-    x0 = y0 = 1e300, x1 = y1 = -1e300;
-    for (const cv::Point2d& p : OutlineOf(camera, rvec, tvec, o, 64))
-      x0 = std::min(x0, p.x), y0 = std::min(y0, p.y), x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
-    pad = 0.01 * std::max(x1 - x0, y1 - y0);
+    px = OutlineOf(camera, rvec, tvec, o, 64);
+  } else {
+    const std::vector<cv::Point3d> corners = CardCorners(o);
+    cv::projectPoints(corners, rvec, tvec, cv::Matx33d(camera.Intrinsics().data()), camera.dist_coeffs, px);
+    f.z_min_mm = 1e300, f.z_max_mm = -1e300;
+    for (const cv::Point3d& c : corners) {
+      const double z = (rotation * cv::Vec3d(c) + tvec)[2];
+      f.z_min_mm = std::min(f.z_min_mm, z), f.z_max_mm = std::max(f.z_max_mm, z);
+    }
   }
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+  for (const cv::Point2d& p : px)
+    x0 = std::min(x0, p.x), y0 = std::min(y0, p.y), x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
+  // A ball's outline polygon has its points on the rim: the pad covers its sagitta (< 0.01 of the radius at 64
+  // points). A card's corners are its extent.
+  const double pad = o.kind == VirtualObject::Kind::kBall ? 0.01 * std::max(x1 - x0, y1 - y0) : 0;
   f.bounds = cv::Rect(cv::Point(int(std::floor(x0 - pad)) - 1, int(std::floor(y0 - pad)) - 1),
                       cv::Point(int(std::ceil(x1 + pad)) + 2, int(std::ceil(y1 + pad)) + 2));
   return f;

@@ -317,15 +317,14 @@ Presentation Presentation::Of(const protocol::Protocol& protocol, const Stimulus
   const int W = p.window_width_px, H = p.window_height_px - p.prompt_band_px;
   if (protocol.content.type == "picture") {
     // The depth-matching frame, 4:3, as large as the window holds (the thesis's 960 x 720 in a 1280 x 720 one).
-    p.frame_width_px = std::min(W, H * 4 / 3);
-    p.frame_height_px = p.frame_width_px * 3 / 4;
+    p.layout = render::DepthMatchingLayout::Of(std::min(W, H * 4 / 3), images.picture.size());
+    p.frame_width_px = p.layout.frame.width;
+    p.frame_height_px = p.layout.frame.height;
     p.scaling = "fit";
     p.view = {W, p.window_height_px, p.frame_width_px, p.frame_height_px, (W - p.frame_width_px) / 2,
               (H - p.frame_height_px) / 2};
-    if (!images.picture.empty()) p.layout = render::DepthMatchingLayout::Of(p.frame_width_px, images.picture.size());
     if (const auto& camera = protocol.content.real_camera)
-      p.real_frame_px_per_px = render::DepthMatchingLowerScale(
-          cv::Size(camera->image_width_px, camera->image_height_px), p.frame_width_px);
+      p.real_frame_px_per_px = p.layout.LowerScale(cv::Size(camera->image_width_px, camera->image_height_px));
     return p;
   }
   p.frame_width_px = images.photo.cols;
@@ -765,7 +764,7 @@ void StimulusRenderer::Prepare(const TrialScene& trial) {
       const cv::Mat photo = protocol_.content.real_photos.empty()
                                 ? photo_
                                 : ReadImage(protocol::RealPhotoFor(protocol_.content, trial.distance_m), 1);
-      lower_ = render::DepthMatchingLowerHalf(photo, presentation_.layout.frame.width);
+      lower_ = presentation_.layout.LowerHalf(photo);
       lower_distance_m_ = distance_m;
     }
     return;
