@@ -205,6 +205,49 @@ TEST(SceneCalib, ReadsBackCalibJsonAndAnswersEverySource) {
   EXPECT_GT(BlurAtPx(scene, BlurSource::kFitted, beyond), r.cmp.true_r_per_edge[10]);
 }
 
+// "measured" is the nearest edge's own value or an error: an edge with no usable section (all flagged, or not in
+// the file) must not borrow the next edge's value, which the record would then state as this edge's.
+TEST(SceneCalib, MeasuredIsTheNearestEdgesOwnValueOrAnError) {
+  const Calibration& r = Calibrated(Blurry());
+  Json j = CalibToJson(r.result);
+  for (Json& section : j["edges"][8]["sections"]) section["ok"] = false;  // edge 9: every section flagged
+  j["edges"].erase(9);                                                   // edge 10: not in the file at all
+  const SceneCalib scene = SceneCalibFromJson(j, "calib.json: ");
+  const auto midpoint = [&](int edge) { return r.result.edges[edge - 1].sections[3].midpoint_camera_mm; };
+  for (int edge : {9, 10}) {
+    try {
+      BlurAtPx(scene, BlurSource::kMeasured, midpoint(edge));
+      ADD_FAILURE() << "edge " << edge << " has no usable section, yet measured gave a value";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("edge " + std::to_string(edge) + " (the nearest) has no usable"),
+                std::string::npos) << e.what();
+    }
+  }
+  // Its neighbours keep their own values, and the other sources still answer at edge 9.
+  for (int edge : {8, 11}) EXPECT_NEAR(BlurAtPx(scene, BlurSource::kMeasured, midpoint(edge)), r.result.edges[edge - 1].r_px, 1e-9);
+  EXPECT_GT(BlurAtPx(scene, BlurSource::kFitted, midpoint(9)), 0);
+  EXPECT_GT(BlurAtPx(scene, BlurSource::kMeasuredSection, midpoint(9)), 0);
+}
+
+// An edge or a section listed twice would be averaged with its copy or stand in for a missing one: refused, named.
+TEST(SceneCalib, EdgeOrSectionListedTwiceIsRefused) {
+  const Calibration& r = Calibrated(Blurry());
+  Json twice_edge = CalibToJson(r.result);
+  twice_edge["edges"][1]["index"] = 1;
+  Json twice_section = CalibToJson(r.result);
+  twice_section["edges"][2]["sections"][4]["index"] = 2;
+  for (const auto& [j, expected] : {std::pair{twice_edge, "calib.json: /edges/1/index: edge 1 is listed twice (also at /edges/0)"},
+                                    {twice_section, "calib.json: /edges/2/sections/4/index: section 2 of edge 3 is listed twice (also at /sections/1)"}}) {
+    try {
+      SceneCalibFromJson(j, "calib.json: ");
+      ADD_FAILURE() << expected;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::kInput);
+      EXPECT_EQ(std::string(e.what()), expected);
+    }
+  }
+}
+
 TEST(SceneCalib, BadFieldIsNamed) {
   const Calibration& r = Calibrated(Thesis());
   Json j = CalibToJson(r.result);

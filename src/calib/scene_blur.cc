@@ -104,18 +104,28 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
                          ? Ranged(model, "floor_px", where + "/model", 0, optics::kMaxBlurRadiusPx, "px")
                          : 0.0;
   if (!j.contains("edges") || !j["edges"].is_array()) throw InputError(where + "/edges", "must be an array");
+  // An edge or a section listed twice would be averaged with the other copy, or stand in for a missing one: both
+  // are refused, so each edge's measured blur is its own sections' and nothing else's.
+  std::map<int, std::string> edge_seen;
   for (size_t e = 0; e < j["edges"].size(); ++e) {
     const Json& edge = j["edges"][e];
     const std::string ew = where + "/edges/" + std::to_string(e);
     const int index = RangedInt(edge, "index", ew, 1, s.board.EdgeCount());
+    if (const auto [it, fresh] = edge_seen.emplace(index, "/edges/" + std::to_string(e)); !fresh)
+      throw InputError(ew + "/index", "edge " + std::to_string(index) + " is listed twice (also at " + it->second +
+                                          ")");
     if (!edge.contains("sections") || !edge["sections"].is_array())
       throw InputError(ew + "/sections", "must be an array");
+    std::map<int, std::string> section_seen;
     for (size_t k = 0; k < edge["sections"].size(); ++k) {
       const Json& sec = edge["sections"][k];
       const std::string sw = ew + "/sections/" + std::to_string(k);
       SceneCalib::Section out;
       out.edge = index;
       out.section = RangedInt(sec, "index", sw, 1, s.board.SectionCount());
+      if (const auto [it, fresh] = section_seen.emplace(out.section, "/sections/" + std::to_string(k)); !fresh)
+        throw InputError(sw + "/index", "section " + std::to_string(out.section) + " of edge " +
+                                            std::to_string(index) + " is listed twice (also at " + it->second + ")");
       out.midpoint_camera_mm = Vec3(sec, "midpoint_camera_mm", sw, kMaxDistanceMm, "mm");
       out.ok = sec.value("ok", false);
       // A section the fit gave up on keeps whatever number it had; only usable ones feed a blur.
@@ -177,23 +187,27 @@ double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& p, 
       return best->r_px;
     }
     case BlurSource::kMeasured: {
-      // Per edge: the usable sections' midpoints (in section order) and their mean r. The edge's line runs from the
-      // first midpoint to the last; with one usable section the line is that point.
-      std::map<int, std::vector<const SceneCalib::Section*>> edges;
-      for (const auto& s : scene.sections)
-        if (s.ok) edges[s.edge].push_back(&s);
-      double best_d = 1e300, best_r = 0;
-      for (auto& [edge, sections] : edges) {
-        std::sort(sections.begin(), sections.end(), [](auto* a, auto* b) { return a->section < b->section; });
-        const cv::Vec3d a = sections.front()->midpoint_camera_mm, b = sections.back()->midpoint_camera_mm;
-        const double length = cv::norm(b - a);
-        const double d = length > 1e-9 ? cv::norm((p - a).cross((b - a) / length)) : cv::norm(p - a);
-        double r = 0;
-        for (const auto* s : sections) r += s->r_px;
-        if (d < best_d) best_d = d, best_r = r / static_cast<double>(sections.size());
+      // The edge whose line passes nearest the point, from the board and its pose (every edge the board has, measured
+      // or not); its value is the mean r of its usable sections. An edge with none has no measured value: another
+      // edge's would be recorded as this one's, so it is an error, not a fallback.
+      const Board& board = scene.board;
+      int nearest = 0;
+      double best_d = 1e300;
+      for (int edge = 1; edge <= board.EdgeCount(); ++edge) {
+        const cv::Vec3d a = scene.ToCamera(cv::Vec3d(board.SectionStart(edge, 1).data()));
+        const cv::Vec3d b = scene.ToCamera(cv::Vec3d(board.SectionEnd(edge, board.SectionCount()).data()));
+        const double d = cv::norm((p - a).cross((b - a) / cv::norm(b - a)));
+        if (d < best_d) best_d = d, nearest = edge;
       }
-      if (edges.empty()) throw Error(ErrorKind::kNotFound, "the calibration has no usable measured section");
-      return best_r;
+      double sum = 0;
+      int usable = 0, listed = 0;
+      for (const auto& s : scene.sections)
+        if (s.edge == nearest) ++listed, usable += s.ok, sum += s.ok ? s.r_px : 0;
+      if (usable == 0)
+        throw Error(ErrorKind::kNotFound, "edge " + std::to_string(nearest) + " (the nearest) has no usable measured "
+                                          "section (" + std::to_string(listed) + " listed, none usable), so its "
+                                          "measured blur is unknown; measured_section, estimated or fitted give one");
+      return sum / usable;
     }
   }
   return 0;

@@ -266,6 +266,14 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
     t.r_scene_px += 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, nullptr) +
                            r_at(r, calib::BlurSource::kFitted, 0, nullptr)) / samples;
   }
+  // Every edge the run passes, too: the samples step over edges on a long board, and a frame there must have a
+  // radius (a measured source is its nearest edge's value, refused for an edge with no usable section).
+  for (int k = 1; k <= edges; ++k) {
+    const double y = (k - 1) * s;
+    if (y < std::min(t.from_y_mm, t.to_y_mm) || y > std::max(t.from_y_mm, t.to_y_mm)) continue;
+    r_at(Ball(*scene, t, y, radius, true).center_board_mm, t.left, t.left_fixed_px, "left");
+    r_at(Ball(*scene, t, y, radius, false).center_board_mm, t.right, t.right_fixed_px, "right");
+  }
   CheckInPhoto(protocol, trial, *scene, t);
   return t;
 }

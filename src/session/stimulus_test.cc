@@ -137,13 +137,27 @@ TEST(DescribeTrial, BallAtAnEdgeRestsThereWithThatPlacesBlur) {
 }
 
 TEST(DescribeTrial, GridCardsSitBesideTheBoardAtTheirEdge) {
-  const calib::SceneCalib scene = ThesisScene();
+  calib::SceneCalib scene = ThesisScene();
+  calib::SceneCalib::Section edge2 = scene.sections.front();  // edge 2 gets a measured section of its own
+  edge2.edge = 2;
+  edge2.midpoint_camera_mm = scene.ToCamera({87.5, 25, 0});
+  edge2.r_px = 0.45;
+  scene.sections.push_back(edge2);
   protocol::Protocol p = BallProtocol();
   p.content.type = "grid";
   const TrialScene near = DescribeTrial(p, PairTrial({{"edge", 2}}, "measured", "fitted"), &scene);
-  const TrialScene far = DescribeTrial(p, PairTrial({{"edge", 11}}, "measured", "fitted"), &scene);
+  const TrialScene far = DescribeTrial(p, PairTrial({{"edge", 11}}, "estimated", "fitted"), &scene);
   EXPECT_EQ(near.edge, 2);
-  EXPECT_DOUBLE_EQ(near.r_left_px, 0.3);  // the one measured section is the nearest for every card
+  EXPECT_DOUBLE_EQ(near.r_left_px, 0.45);  // its own edge's measured value, beside the board on the edge's line
+  // Edge 11 has no measured section: "measured" there is refused, naming the side's field, not given edge 2's value.
+  try {
+    DescribeTrial(p, PairTrial({{"edge", 11}}, "measured", "fitted"), &scene);
+    ADD_FAILURE() << "measured at an edge without a usable section was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    EXPECT_NE(std::string(e.what()).find("edge 11 (the nearest) has no usable measured section"), std::string::npos)
+        << e.what();
+  }
   EXPECT_GT(far.r_right_px, near.r_right_px + 1);  // fitted blur grows with distance from focus
   // A 4592 x 3056 photo fitted into a 1920 x 1080 window: 1080 / 3056 of a photo px per screen px, floored to
   // whole shown pixels (1622 of 1622.8); on the default monitor (37.84 px per degree) that is the arcmin.
