@@ -47,9 +47,10 @@ BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px);
 std::string ToString(BlurSource source);
 
 // Blur radius (px) the scene calls for at a camera-frame point:
-//   measured  - the thesis's edge value (its Fig. 4.11): the mean r_px of the usable sections of the edge whose
-//               line (through its section midpoints) passes nearest the point; a card beside the board aligned
-//               with edge k gets edge k's value whichever side it is on;
+//   measured  - the thesis's edge value (its Fig. 4.11): the mean r_px of the usable sections of the board edge
+//               whose line (from the board and its pose) passes nearest the point; a card beside the board aligned
+//               with edge k gets edge k's value whichever side it is on; Error(kNotFound) naming the edge when it
+//               has no usable section (never another edge's value);
 //   measured_section - r_px of the nearest usable measured section alone (3-D distance between midpoints);
 //   estimated - eq. 3.7 from the reference edge at the point's depth (Error(kDomain) nearer than focus);
 //   fitted    - the fitted thin-lens model at the point's depth;
