@@ -27,7 +27,7 @@ PYEOF
 counts() { sql "$1" "SELECT (SELECT count(*) FROM sessions), (SELECT count(*) FROM trials),
                             (SELECT count(*) FROM responses), (SELECT count(*) FROM frames)"; }
 # Names in $W beside the output (everything but the inputs and the references).
-beside() { (cd "$W" && ls -A | grep -Ev '^(a|b|ab)\.sqlite(-wal|-shm)?$|^(ref|ref-a|ref-b|mpl|no-bench|err|out\.log)$' || true); }
+beside() { (cd "$W" && ls -A | grep -Ev '^(a|b|ab)\.sqlite(-wal|-shm)?$|^(ref|ref-a|ref-b|mpl|no-bench|err|out\.log|failing-python)$' || true); }
 # A PID no process has: a shell that has exited.
 dead_pid() { bash -c 'echo $$'; }
 # Waits (up to 30 s) until $1 exists or process $2 has ended.
@@ -135,10 +135,17 @@ report)
   record "$W/a.sqlite" A1 2000
   report() { $BC report --db "$W/a.sqlite" --out "$W/$1" --bench "$W/no-bench" --boot 20 "${@:2}"; }
   report ref > "$W/out.log" 2> "$W/err" || fail "report: $(cat "$W/err")"
-  # The analysis failing (here: not Python at all) leaves no report, and nothing beside where it would be.
-  if report out --python /bin/false > /dev/null 2> "$W/err"; then fail "a failed analysis passed"; fi
+  # The analysis failing (here: a Python that passes report's check, then fails on the script) leaves no report,
+  # and nothing beside where it would be; one that is no Python at all is refused before anything is written.
+  printf '#!/bin/sh\n[ "$1" = -c ] && exec /usr/bin/python3 "$@"\nexit 1\n' > "$W/failing-python"
+  chmod +x "$W/failing-python"
+  if report out --python "$W/failing-python" > /dev/null 2> "$W/err"; then fail "a failed analysis passed"; fi
   grep -q "out is unchanged" "$W/err" || fail "message: $(cat "$W/err")"
   [ "$(beside)" = "" ] || fail "a failed analysis left $(beside | tr '\n' ' ')"
+  code=0
+  report out --python /bin/false > /dev/null 2> "$W/err" || code=$?
+  [ $code = 2 ] && grep -q "not a Python 3" "$W/err" || fail "/bin/false as --python: exit $code, $(cat "$W/err")"
+  [ "$(beside)" = "" ] || fail "a refused --python left $(beside | tr '\n' ' ')"
   children=0
   # Killed as soon as Python runs with no earlier report; then over an earlier one, as soon as Python runs and
   # once it has written a chart.

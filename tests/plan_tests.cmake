@@ -44,6 +44,19 @@ add_plan_failure_test(plan_too_many 2 "--participants x --studies must be at mos
                       plan ${P1} --participants 10000 --studies 100000 --no-chart --out ${T}/plan-bad)
 add_plan_failure_test(plan_bad_python 2 "--python /no/such/python: not found"
                       plan ${P1} --participants 2 --studies 1 --python /no/such/python --out ${T}/plan-bad)
+# A --python that starts but is no Python 3 is refused before the simulation (it ended in exit 10, "its message is
+# above" with nothing above, or in exit 0 with no chart), and so is an --out holding files of something else.
+foreach(fake true false)
+  add_plan_failure_test(plan_python_${fake} 2 "--python /bin/${fake}: not a Python 3"
+                        plan ${P1} --participants 2 --studies 1 --python /bin/${fake} --out ${T}/plan-bad)
+endforeach()
+add_test(NAME report_python_false
+         COMMAND ${CMAKE_COMMAND} -DCMD=${BC} "-DARGS=report;--db;${P1};--python;/bin/false;--out;${T}/report-bad"
+                 -DEXPECT_CODE=2 "-DEXPECT_TEXT=--python /bin/false: not a Python 3" -DONE_LINE=1
+                 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+set_tests_properties(report_python_false PROPERTIES FIXTURES_REQUIRED session_protocols LABELS plan)
+add_plan_failure_test(plan_out_holds_other_files 3 "protocols: holds "
+                      plan ${P1} --participants 2 --studies 1 --no-chart --out ${T}/protocols)
 
 # Numbers as typed: a leading zero is decimal (CLI11 alone reads 010 as octal 8), a seed as export writes it
 # (s<digits>) is that seed - both options rewrite their text, which CLI11 keeps only from a transform, not a check.

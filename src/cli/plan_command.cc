@@ -1,6 +1,5 @@
 // blurcue plan: power analysis of a protocol by simulated studies (src/plan/plan.h), its chart by the analysis's
 // Python (analysis/plan_chart.py).
-#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -92,12 +91,14 @@ void AddPlanCommand(CLI::App& app) {
     const std::filesystem::path script = DataDir().path / "analysis" / "plan_chart.py";
     if (!args->no_chart && !std::filesystem::exists(script))
       throw InputError(script.string(), "the chart script is missing (--no-chart writes the tables only)");
-    // A Python named by path that is not there fails now, not after the simulation.
-    if (!args->no_chart && args->python.find('/') != std::string::npos && access(args->python.c_str(), X_OK) != 0)
-      throw Error(ErrorKind::kUsage, "--python " + args->python + ": not found");
+    // What would stop the writing stops it now, not after the simulation: a --python that is no Python 3, an --out
+    // that is a file or a folder of something other than an earlier plan.
+    if (!args->no_chart) RequirePython3(args->python, {"matplotlib", "pandas"});
     std::error_code ignored;
     if (std::filesystem::exists(out, ignored) && !std::filesystem::is_directory(out, ignored))
       throw InputError(out.string(), "--out: is a file, not a folder");
+    const bool earlier = std::filesystem::exists(out / "plan.csv", ignored);
+    RequireReplaceableFolder(out, [earlier](const std::string&) { return earlier; });
     const plan::PlanResult result = plan::RunPlan(options);
     std::fprintf(stderr, "plan: %zu participants in %.2f s on %d threads (%.2f ms per participant)\n",
                  static_cast<size_t>(options.studies) * static_cast<size_t>(options.participants), result.seconds,
@@ -117,7 +118,6 @@ void AddPlanCommand(CLI::App& app) {
                      {"notes", result.notes}};
     for (const auto& path : RemoveStaleLeftovers(out))
       std::fprintf(stderr, "plan: removed %s, left by an interrupted run\n", path.c_str());
-    const bool earlier = std::filesystem::exists(out / "plan.csv", ignored);
     WriteFolderAtomically(
         out,
         [&](const std::filesystem::path& partial) {
@@ -127,7 +127,8 @@ void AddPlanCommand(CLI::App& app) {
           if (!args->no_chart)
             RunAnalysis({args->python, script.string(), "--plan", (partial / "plan.csv").string(), "--out",
                          partial.string(), "--title", result.study, "--target", std::to_string(options.target_power)},
-                        "the chart", out.string());
+                        "the chart", out.string(),
+                        {(partial / "power.png").string(), (partial / "power.svg").string()});
         },
         [earlier](const std::string&) { return earlier; });
     std::printf("%s", plan::Summary(result, options).c_str());

@@ -57,6 +57,7 @@ void AddReportCommand(CLI::App& app) {
     const std::filesystem::path out = args->out;
     const std::filesystem::path script = DataDir().path / "analysis" / "report.py";
     if (!std::filesystem::exists(script)) throw InputError(script.string(), "the analysis script is missing");
+    RequirePython3(args->python, {"numpy", "pandas", "matplotlib", "scipy", "statsmodels"});
     for (const auto& path : RemoveStaleLeftovers(out))
       std::fprintf(stderr, "report: removed %s, left by an interrupted run\n", path.c_str());
     // An earlier report is replaced as a whole; a folder of something else is not ours to replace.
@@ -76,7 +77,7 @@ void AddReportCommand(CLI::App& app) {
                                            "--out", partial.string(), "--final-out", out.string(), "--boot",
                                            std::to_string(args->boot)};
           if (args->pool_simulated) argv.push_back("--pool-simulated");
-          RunAnalysis(argv, "the analysis", out.string());
+          RunAnalysis(argv, "the analysis", out.string(), {(partial / "index.html").string()});
         },
         [earlier_report](const std::string&) { return earlier_report; });
     std::printf("wrote %s/index.html\n", args->out.c_str());

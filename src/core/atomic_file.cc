@@ -131,25 +131,31 @@ void WriteFileAtomically(const fs::path& path, std::string_view bytes) {
   SyncFolderOf(path);
 }
 
+void RequireReplaceableFolder(const fs::path& dir, const std::function<bool(const std::string& name)>& ours) {
+  const fs::path target = FolderTarget(dir);
+  const std::string where = dir.string();
+  std::error_code error;
+  const fs::file_status status = fs::symlink_status(target, error);
+  if (!fs::exists(status)) return;
+  if (!fs::is_directory(status)) throw InputError(where, "exists and is not a folder; not replaced");
+  for (fs::directory_iterator it(target, error), end; !error && it != end; it.increment(error)) {
+    const std::string name = it->path().filename().string();
+    if (!ours(name))
+      throw InputError(where, "holds " + name +
+                                  ", which this command did not write; the folder is replaced as a whole, so give "
+                                  "a new or empty one (nothing was written)");
+  }
+  if (error) throw InputError(where, "cannot list the folder: " + error.message());
+}
+
 void WriteFolderAtomically(const fs::path& dir, const std::function<void(const fs::path& partial)>& fill,
                            const std::function<bool(const std::string& name)>& ours) {
   const fs::path target = FolderTarget(dir);
   const std::string where = dir.string();
   CreateFolderOf(target, where);
+  RequireReplaceableFolder(dir, ours);
   std::error_code error;
-  const fs::file_status status = fs::symlink_status(target, error);
-  const bool replacing = fs::exists(status);
-  if (replacing && !fs::is_directory(status)) throw InputError(where, "exists and is not a folder; not replaced");
-  if (replacing) {
-    for (fs::directory_iterator it(target, error), end; !error && it != end; it.increment(error)) {
-      const std::string name = it->path().filename().string();
-      if (!ours(name))
-        throw InputError(where, "holds " + name +
-                                    ", which this command did not write; the folder is replaced as a whole, so give "
-                                    "a new or empty one (nothing was written)");
-    }
-    if (error) throw InputError(where, "cannot list the folder: " + error.message());
-  }
+  const bool replacing = fs::exists(fs::symlink_status(target, error));
 
   const fs::path partial = TemporaryBeside(target, "partial");
   fs::remove_all(partial, error);  // a leftover of a dead process that had our PID

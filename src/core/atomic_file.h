@@ -28,6 +28,9 @@ void WriteFileAtomically(const std::filesystem::path& path, std::string_view byt
 // entries for which `ours(name)` is true: a folder of other files is refused (Error(kInput) naming the first
 // stranger) rather than replaced. When `fill` throws, the partial folder is removed and the exception passes on.
 // Other failures throw Error(kInput) naming `dir`.
+// WriteFolderAtomically's check before it writes, alone: throws its Error(kInput) when `dir` exists and is not a
+// folder or holds an entry `ours` does not claim. For a command to refuse such a folder before long work.
+void RequireReplaceableFolder(const std::filesystem::path& dir, const std::function<bool(const std::string& name)>& ours);
 void WriteFolderAtomically(const std::filesystem::path& dir,
                            const std::function<void(const std::filesystem::path& partial)>& fill,
                            const std::function<bool(const std::string& name)>& ours);
