@@ -166,3 +166,18 @@ hostile_test(cli_hostile_validate_visible_nan 2 "--visible: must be in [0.5, 1] 
              validate ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --plan --visible nan)
 hostile_test(cli_hostile_preview_observer_model 2 "--observer model must be arcmin or pixel, got 'eye'"
              preview ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --out ${H}/x.png --observer sim:model=eye)
+
+# Outputs that are not regular files: an atomic write renames over its target, so a FIFO (or, as root, a device
+# such as /dev/full) would be replaced by a plain file; opening a FIFO to write waits for a reader forever. A FIFO
+# made here stands for them all (a test must not risk /dev/null on the machine that runs it).
+execute_process(COMMAND mkfifo ${H}/fifo.png ${H}/fifo.csv RESULT_VARIABLE ignored ERROR_QUIET)
+hostile_test(cli_hostile_out_is_a_fifo 3 "fifo.png: is not a regular file (a device, FIFO or socket); not replaced"
+             blur ${D}/small.png --radius-px 2 --out ${H}/fifo.png)
+set(C ${PROJECT_BINARY_DIR}/cli-test)
+set(ANIMATE animate --calib ${C}/calib.json --background ${C}/scene/scene.png --left estimated --right none
+            --speed-cm-s 50 --fps 10)
+hostile_test(cli_hostile_animate_log_is_a_fifo 3 "fifo.csv: is not a regular file" ${ANIMATE} --video ${H}/v.avi
+             --log ${H}/fifo.csv)
+hostile_test(cli_hostile_animate_video_not_avi 2 "--video ${H}/v.mp4: must end in .avi" ${ANIMATE} --video ${H}/v.mp4)
+set_tests_properties(cli_hostile_animate_log_is_a_fifo cli_hostile_animate_video_not_avi PROPERTIES
+                     FIXTURES_REQUIRED "scene;calib" TIMEOUT 60)

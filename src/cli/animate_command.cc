@@ -2,7 +2,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <cctype>
+#include <sstream>
 #include <string>
 #include <thread>
 
@@ -12,6 +13,7 @@
 
 #include "calib/scene_blur.h"
 #include "cli/commands.h"
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "render/blur.h"
@@ -79,6 +81,17 @@ void AddAnimateCommand(CLI::App& app) {
     check("--right-section", args->right_section, 1, sections);
     if (args->video.empty() && args->frames_dir.empty() && !args->window)
       throw Error(ErrorKind::kUsage, "say where the frames go: --video, --frames or --window");
+    // Outputs checked before any frame is drawn: OpenCV's writer picks its container by the extension (and prints
+    // its own multi-line warnings for one it does not know), and a device or FIFO is not a file to replace (opening
+    // a FIFO to write waits for a reader forever).
+    if (!args->video.empty()) {
+      std::string extension = std::filesystem::path(args->video).extension().string();
+      for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+      if (extension != ".avi")
+        throw Error(ErrorKind::kUsage, "--video " + args->video + ": must end in .avi (it writes an MJPG AVI)");
+      RequireReplaceableFile(args->video);
+    }
+    if (!args->log.empty()) RequireReplaceableFile(args->log);
     double fixed_left = 0, fixed_right = 0;
     const calib::BlurSource left = calib::ParseBlurSource(args->left, &fixed_left);
     const calib::BlurSource right = calib::ParseBlurSource(args->right, &fixed_right);
@@ -113,12 +126,9 @@ void AddAnimateCommand(CLI::App& app) {
       video.open(args->video, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), args->fps, photo.size());
       if (!video.isOpened()) throw InputError(args->video, "cannot open a video writer (MJPG .avi)");
     }
-    std::ofstream log;
-    if (!args->log.empty()) {
-      log.open(args->log);
-      if (!log) throw InputError(args->log, "cannot write file");
-      log << "frame,t_s,y_mm,r_left_px,r_right_px,render_ms,flip_s\n";
-    }
+    // The log is written whole at the end (WriteFileAtomically): a run cut short leaves no half log.
+    std::ostringstream log;
+    log << "frame,t_s,y_mm,r_left_px,r_right_px,render_ms,flip_s\n";
     using Clock = std::chrono::steady_clock;
     {  // a warm-up frame uploads and mipmaps the texture, so frame 0 is not slower than the rest
       render::BlurredObject b;
@@ -171,12 +181,13 @@ void AddAnimateCommand(CLI::App& app) {
           WriteImage(std::filesystem::path(args->frames_dir) / name, frame);
         }
       }
-      if (log) log << i << "," << t << "," << y << "," << r[0] << "," << r[1] << "," << render_ms << "," << flip_s << "\n";
+      log << i << "," << t << "," << y << "," << r[0] << "," << r[1] << "," << render_ms << "," << flip_s << "\n";
       if (tty || (i + 1) % std::max(1, frames / 4) == 0 || i + 1 == frames)
         std::fprintf(stderr, "%sframe %d/%d  y %.1f mm  r %.2f | %.2f px  %.1f ms%s", tty ? "\r" : "", i + 1, frames,
                      y, r[0], r[1], render_ms, tty ? "" : "\n");
     }
     if (tty) std::fprintf(stderr, "\n");
+    if (!args->log.empty()) WriteFileAtomically(args->log, log.str());
     std::printf("%d frames (%.1f s of motion at %.1f cm/s, %.0f fps); slowest frame %.1f ms%s%s%s\n", frames,
                 (frames - 1) / args->fps, args->speed_cm_s, args->fps, worst_ms,
                 args->video.empty() ? "" : ("; video " + args->video).c_str(),

@@ -98,7 +98,18 @@ fs::path TemporaryBeside(const fs::path& target, std::string_view kind) {
   return normal.parent_path() / name;
 }
 
+void RequireReplaceableFile(const fs::path& path) {
+  std::error_code error;
+  const fs::file_status status = fs::status(path, error);
+  if (fs::is_directory(status)) throw InputError(path.string(), "is a folder, not a file; not replaced");
+  if (fs::exists(status) && !fs::is_regular_file(status))
+    throw InputError(path.string(), "is not a regular file (a device, FIFO or socket); not replaced");
+}
+
 void WriteFileAtomically(const fs::path& path, std::string_view bytes) {
+  // The rename below replaces whatever has the name: a device (/dev/full, /dev/null as root), a FIFO or a socket
+  // would be swapped for a plain file.
+  RequireReplaceableFile(path);
   CreateFolderOf(path, path.string());
   const fs::path temp = TemporaryBeside(path, "tmp");
   const int fd = open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);  // less the umask

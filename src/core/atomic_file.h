@@ -19,8 +19,13 @@ std::filesystem::path TemporaryBeside(const std::filesystem::path& target, std::
 
 // Writes `bytes` to `path` through DIR/.NAME.tmp-PID: written, fsynced, renamed over `path`, the folder fsynced (the
 // rename survives a power loss). Creates the folder. On any failure the temporary is removed, `path` is untouched,
-// and Error(kInput) names `path`.
+// and Error(kInput) names `path`; so it is when `path` exists and is not a regular file (a folder, a device such as
+// /dev/full, a FIFO): the rename would replace it.
 void WriteFileAtomically(const std::filesystem::path& path, std::string_view bytes);
+// Throws Error(kInput) naming `path` when it exists and is not a regular file (or a link to one): a folder, a device,
+// a FIFO or a socket is not an output to replace. WriteFileAtomically's own check, for a writer that opens `path`
+// itself (a video), before its work.
+void RequireReplaceableFile(const std::filesystem::path& path);
 
 // Builds the folder `dir` as a whole: `fill` writes into an empty DIR/../.NAME.partial-PID, every file in it is
 // fsynced, and it is swapped with `dir` in one rename (the old folder, if any, is removed after). A reader of `dir`

@@ -1,6 +1,7 @@
 #include "core/atomic_file.h"
 
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -93,6 +94,19 @@ TEST_F(AtomicFileTest, FailedRenameRemovesTheTemporary) {
   ExpectInputErrorNaming([&] { WriteFileAtomically(path, "text"); }, path.string());
   EXPECT_EQ(Names(dir_), std::set<std::string>{"taken"});
   EXPECT_TRUE(fs::is_directory(path / "inside"));
+}
+
+// The rename would replace whatever has the name: a FIFO or a device (as root, --out /dev/full became a plain file)
+// is refused and stays what it was, and nothing is written beside it.
+TEST_F(AtomicFileTest, SpecialFileIsRefusedNotReplaced) {
+  const fs::path fifo = dir_ / "pipe";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  ExpectInputErrorNaming([&] { WriteFileAtomically(fifo, "text"); }, fifo.string() + ": is not a regular file");
+  EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
+  EXPECT_EQ(Names(dir_), std::set<std::string>{"pipe"});
+  fs::create_directory(dir_ / "empty");
+  ExpectInputErrorNaming([&] { WriteFileAtomically(dir_ / "empty", "text"); }, "empty: is a folder");
+  EXPECT_TRUE(fs::is_directory(dir_ / "empty"));
 }
 
 TEST_F(AtomicFileTest, FailedWriteLeavesTheOldFileWholeAndNoTemporary) {
