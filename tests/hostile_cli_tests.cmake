@@ -166,3 +166,7 @@ hostile_test(cli_hostile_validate_visible_nan 2 "--visible: must be in [0.5, 1] 
              validate ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --plan --visible nan)
 hostile_test(cli_hostile_preview_observer_model 2 "--observer model must be arcmin or pixel, got 'eye'"
              preview ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --out ${H}/x.png --observer sim:model=eye)
+# A participant information key given twice: refused naming the key and both values, not the last one kept.
+hostile_test(cli_hostile_run_info_given_twice 2 "--info age is given twice ('age=34' and 'age=35')"
+             run ${PROJECT_SOURCE_DIR}/protocols/groups-and-info.json --participant P1 --db ${H}/info-twice.sqlite
+             --observer sim --info age=34 --info handedness=right --info vision=normal --info age=35)
