@@ -1126,5 +1126,21 @@ assert checked == 4, checked
 print(checked)
 PYEOF
   echo "ok: $(grep -o '[0-9]* distinct pairs, [0-9]* invisible' "$W/invisible.out") at 3 m; visible: $(grep -o '[0-9]* distinct pairs, [0-9]* invisible' "$W/visible.out"); predicted shares match the closed form" ;;
+resume_observer)
+  # The session row names one observer: resuming with another is refused (exit 3, one line naming both) and adds
+  # nothing; the same observer spelled another way (the same canonical form) resumes.
+  T1=$P/test1-static-grids.json
+  $BC run "$T1" --participant O1 --db "$W/o.sqlite" --observer sim:lapse=1 --stop-after 1 > /dev/null 2>&1
+  set +e
+  $BC run "$T1" --participant O1 --db "$W/o.sqlite" --observer sim:weber=0.5 --resume > /dev/null 2> "$W/err"; code=$?
+  set -e
+  [ $code = 3 ] && [ "$(wc -l < "$W/err")" = 1 ] &&
+    grep -q "session 1 was started with --observer sim:model=arcmin,[^ ]*,lapse=1,[^ ]*, got --observer sim:model=arcmin,[^ ]*weber=0.5,[^ ]*lapse=0.04,[^ ]*; resume it with the observer it started with" "$W/err" \
+    || fail "another observer on resume: exit $code $(cat "$W/err")"
+  [ "$(sql "$W/o.sqlite" "SELECT count(*) FROM responses")" = 1 ] || fail "another observer answered"
+  $BC run "$T1" --participant O1 --db "$W/o.sqlite" --observer sim:model=arcmin,lapse=1.0 --resume | grep -q completed \
+    || fail "an equivalent observer spec did not resume"
+  [ "$(sql "$W/o.sqlite" "SELECT count(*), count(DISTINCT observer_params) FROM sessions")" = "1|1" ] || fail "sessions"
+  echo "ok: another observer on resume refused naming both; an equivalent spec resumes" ;;
 *) fail "unknown case $CASE" ;;
 esac

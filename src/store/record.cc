@@ -253,7 +253,8 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
   const int64_t study_id = EnsureStudy(db_, study, now);
   const int64_t participant_id = EnsureParticipant(db_, study_id, participant, now);
 
-  Statement running(db_, "SELECT s.id, s.seed, p.hash, p.json FROM sessions s JOIN protocol_versions p "
+  Statement running(db_, "SELECT s.id, s.seed, p.hash, p.json, s.observer, s.observer_params FROM sessions s "
+                         "JOIN protocol_versions p "
                          "ON p.id = s.protocol_version_id WHERE s.participant_id = ? AND s.status = 'running' "
                          "ORDER BY s.id DESC LIMIT 1");
   running.Bind(1, participant_id);
@@ -275,6 +276,21 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     if (stored_seed != seed)
       throw InputError(db_.path(), SessionName(session) + " was started with seed " + std::to_string(stored_seed) +
                                        ", got seed " + std::to_string(seed));
+    // The session row names one observer: a resumed session answered by another would be recorded as the first.
+    // Parameters are compared in their canonical form (session::ToString), so an equivalent spec resumes.
+    if (!running.IsNull(4)) {
+      auto observer = [](bool simulated, const std::string& params) {
+        return simulated ? "--observer " + params : std::string("a person (no --observer)");
+      };
+      const bool stored_simulated = running.GetText(4) == "simulated";
+      const std::string stored_params = running.IsNull(5) ? "" : running.GetText(5);
+      if (stored_simulated != meta.simulated || (meta.simulated && stored_params != meta.observer_params))
+        throw InputError(db_.path(), SessionName(session) + " was started with " +
+                                         observer(stored_simulated, stored_params) + ", got " +
+                                         observer(meta.simulated, meta.observer_params) +
+                                         "; resume it with the observer it started with, or close it with " +
+                                         abort_hint + std::to_string(session) + " (its answers are kept)");
+    }
     TakeLock(session);
     start.session_id = session;
     start.resumed = true;

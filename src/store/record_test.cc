@@ -410,6 +410,27 @@ TEST(Record, ResumeWithNothingToResumeIsRefusedAndStartsNothing) {
   EXPECT_EQ(record.database().QueryInt64("SELECT count(*) FROM sessions"), 1);
 }
 
+// A resumed session is answered by the observer it started with: the session row names one. Another simulated
+// observer, or a person for a simulated one, is refused naming both; the same canonical parameters resume.
+TEST(Record, ResumeWithAnotherObserverIsRefusedNamingBoth) {
+  testing::TempDir dir;
+  SessionMeta lapse;
+  lapse.simulated = true;
+  lapse.observer_params = "sim:model=arcmin,weber=0.35,lapse=1";
+  { Record::Open(dir / "r.sqlite").StartOrResumeSession("test1", "P01", kProtocol, 7, lapse, false); }
+  Record record = Record::Open(dir / "r.sqlite");
+  SessionMeta weber = lapse;
+  weber.observer_params = "sim:model=arcmin,weber=0.5,lapse=0.04";
+  const std::string message = ErrorOf([&] { record.StartOrResumeSession("test1", "P01", kProtocol, 7, weber, true); });
+  EXPECT_TRUE(Contains(message, "session 1 was started with --observer sim:model=arcmin,weber=0.35,lapse=1, got "
+                                "--observer sim:model=arcmin,weber=0.5,lapse=0.04; resume it with the observer it "
+                                "started with, or close it with blurcue sessions --db "))
+      << message;
+  EXPECT_TRUE(Contains(ErrorOf([&] { record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, true); }),
+                       "got a person (no --observer)"));
+  EXPECT_TRUE(record.StartOrResumeSession("test1", "P01", kProtocol, 7, lapse, true).resumed);
+}
+
 // An editor's newline, CRLF line ends, indentation and key order are the same protocol: the session resumes.
 TEST(Record, ReformattedProtocolResumesTheSameSession) {
   testing::TempDir dir;
