@@ -1142,5 +1142,24 @@ resume_observer)
     || fail "an equivalent observer spec did not resume"
   [ "$(sql "$W/o.sqlite" "SELECT count(*), count(DISTINCT observer_params) FROM sessions")" = "1|1" ] || fail "sessions"
   echo "ok: another observer on resume refused naming both; an equivalent spec resumes" ;;
+resume_display)
+  # A session resumed on another display profile is refused naming both profiles and what differs (not "another
+  # calibration or blurcue version?"); the same profile named by another path resumes.
+  T1=$P/test1-static-grids.json
+  LAB=$(cd "$(dirname "$0")/data" && pwd)/lab-monitor.json
+  $BC run "$T1" --participant D1 --db "$W/d.sqlite" --observer sim --stop-after 2 > /dev/null 2>&1
+  set +e
+  $BC run "$T1" --participant D1 --db "$W/d.sqlite" --observer sim --resume --display "$LAB" > /dev/null 2> "$W/err"
+  code=$?
+  set -e
+  [ $code = 3 ] && [ "$(wc -l < "$W/err")" = 1 ] &&
+    grep -qF 'session 1 was started with display profile "default (24-inch 16:9 at 60 cm)", got "lab 1" (/distance_mm 600.0 -> 570.0, ' "$W/err" &&
+    grep -qF "resume it with the --display (or the protocol's display.profile) it started with" "$W/err" \
+    || fail "another display on resume: exit $code $(cat "$W/err")"
+  [ "$(sql "$W/d.sqlite" "SELECT count(*) FROM responses")" = 2 ] || fail "answers were added on another display"
+  $BC run "$T1" --participant D2 --db "$W/d.sqlite" --observer sim --stop-after 2 --display "$LAB" > /dev/null 2>&1
+  (cd "$(dirname "$LAB")" && $BC run "$T1" --participant D2 --db "$W/d.sqlite" --observer sim --resume \
+     --display ./lab-monitor.json) | grep -q completed || fail "the same profile by another path did not resume"
+  echo "ok: another display profile on resume refused naming what differs; the same one by another path resumes" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -205,15 +205,8 @@ int64_t Record::TrialId(int64_t session, int64_t trial_index) {
 
 namespace {
 
-// What differs between two protocol texts (canonical JSON), as JSON pointers with the old and new values.
-std::string ProtocolChanges(const std::string& before, const std::string& after) {
-  Json a, b;
-  try {
-    a = Json::parse(before);
-    b = Json::parse(after);
-  } catch (const Json::exception&) {
-    return "the recorded text is not JSON";
-  }
+// What differs between two JSON values, as JSON pointers with the old and new values.
+std::string JsonChanges(const Json& a, const Json& b) {
   const Json patch = Json::diff(a, b);
   std::string text;
   int shown = 0;
@@ -240,6 +233,40 @@ std::string ProtocolChanges(const std::string& before, const std::string& after)
   return text;
 }
 
+// What differs between two protocol texts (canonical JSON).
+std::string ProtocolChanges(const std::string& before, const std::string& after) {
+  Json a, b;
+  try {
+    a = Json::parse(before);
+    b = Json::parse(after);
+  } catch (const Json::exception&) {
+    return "the recorded text is not JSON";
+  }
+  return JsonChanges(a, b);
+}
+
+// How the display profile a session recorded and the one given now (display::ToJson) differ: both names, then what
+// changed ("default ..." -> "lab 1" (/distance_mm 600.0 -> 570.0, ...)), or "" when they are the same display. The
+// file it was read from is not compared: the same profile may be named by another path (another working
+// directory). A session from before display profiles were recorded ("{}") is not compared.
+std::string DisplayChanges(const std::string& recorded, const std::string& given) {
+  Json a, b;
+  try {
+    a = Json::parse(recorded);
+    b = Json::parse(given);
+  } catch (const Json::exception&) {
+    return "";
+  }
+  if (!a.is_object() || !b.is_object() || a.empty()) return "";
+  a.erase("file");
+  b.erase("file");
+  if (a == b) return "";
+  const Json name_a = a.value("name", Json()), name_b = b.value("name", Json());
+  a.erase("name");
+  b.erase("name");
+  return name_a.dump() + ", got " + name_b.dump() + " (" + (a == b ? "the same values" : JsonChanges(a, b)) + ")";
+}
+
 }  // namespace
 
 SessionStart Record::StartOrResumeSession(const std::string& study, const std::string& participant,
@@ -253,7 +280,8 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
   const int64_t study_id = EnsureStudy(db_, study, now);
   const int64_t participant_id = EnsureParticipant(db_, study_id, participant, now);
 
-  Statement running(db_, "SELECT s.id, s.seed, p.hash, p.json, s.observer, s.observer_params FROM sessions s "
+  Statement running(db_, "SELECT s.id, s.seed, p.hash, p.json, s.observer, s.observer_params, s.display_profile "
+                         "FROM sessions s "
                          "JOIN protocol_versions p "
                          "ON p.id = s.protocol_version_id WHERE s.participant_id = ? AND s.status = 'running' "
                          "ORDER BY s.id DESC LIMIT 1");
@@ -291,6 +319,13 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
                                          "; resume it with the observer it started with, or close it with " +
                                          abort_hint + std::to_string(session) + " (its answers are kept)");
     }
+    // Every radius in screen px and arcmin follows the display profile: another one would make other trials.
+    if (const std::string changes = DisplayChanges(running.IsNull(6) ? "{}" : running.GetText(6), meta.display_profile);
+        !changes.empty())
+      throw InputError(db_.path(), SessionName(session) + " was started with display profile " + changes +
+                                       "; resume it with the --display (or the protocol's display.profile) it "
+                                       "started with, or close it with " + abort_hint + std::to_string(session) +
+                                       " (its answers are kept)");
     TakeLock(session);
     start.session_id = session;
     start.resumed = true;

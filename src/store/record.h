@@ -138,7 +138,8 @@ class Record {
   //  - resume is false but the participant has a running session (resume it, or close it with AbortSession),
   //  - resume is true but there is no running session to continue (saying what the participant has instead),
   //  - the resumed session was started with another protocol (naming what changed) or seed, or with another
-  //    observer (meta.simulated and meta.observer_params, compared as recorded: both named),
+  //    observer (meta.simulated and meta.observer_params, compared as recorded: both named), or with another
+  //    display profile (meta.display_profile but for the file it was read from: both named, and what differs),
   //  - another live process or Record holds the session.
   SessionStart StartOrResumeSession(const std::string& study, const std::string& participant,
                                     const std::string& protocol_json, uint64_t seed, const SessionMeta& meta,

@@ -431,6 +431,30 @@ TEST(Record, ResumeWithAnotherObserverIsRefusedNamingBoth) {
   EXPECT_TRUE(record.StartOrResumeSession("test1", "P01", kProtocol, 7, lapse, true).resumed);
 }
 
+// Every radius in screen px and arcmin follows the display profile: a session resumed on another is refused naming
+// both profiles and what differs; the same profile read from another path resumes.
+TEST(Record, ResumeOnAnotherDisplayProfileIsRefusedNamingWhatDiffers) {
+  testing::TempDir dir;
+  SessionMeta lab;
+  lab.display_profile = R"({"distance_mm":570.0,"file":"lab-1.json","name":"lab 1","width_mm":376.0})";
+  { Record::Open(dir / "r.sqlite").StartOrResumeSession("test1", "P01", kProtocol, 7, lab, false); }
+  Record record = Record::Open(dir / "r.sqlite");
+  SessionMeta moved = lab;
+  moved.display_profile = R"({"distance_mm":600.0,"file":"lab-1.json","name":"lab 1","width_mm":376.0})";
+  const std::string message = ErrorOf([&] { record.StartOrResumeSession("test1", "P01", kProtocol, 7, moved, true); });
+  EXPECT_TRUE(Contains(message, "session 1 was started with display profile \"lab 1\", got \"lab 1\" (/distance_mm "
+                                "570.0 -> 600.0); resume it with the --display (or the protocol's display.profile) it "
+                                "started with, or close it with blurcue sessions --db "))
+      << message;
+  SessionMeta other = lab;
+  other.display_profile = R"({"distance_mm":570.0,"file":"lab-2.json","name":"lab 2","width_mm":520.0})";
+  EXPECT_TRUE(Contains(ErrorOf([&] { record.StartOrResumeSession("test1", "P01", kProtocol, 7, other, true); }),
+                       "display profile \"lab 1\", got \"lab 2\" (/width_mm 376.0 -> 520.0)"));
+  SessionMeta elsewhere = lab;
+  elsewhere.display_profile = R"({"distance_mm":570.0,"file":"../lab/lab-1.json","name":"lab 1","width_mm":376.0})";
+  EXPECT_TRUE(record.StartOrResumeSession("test1", "P01", kProtocol, 7, elsewhere, true).resumed);
+}
+
 // An editor's newline, CRLF line ends, indentation and key order are the same protocol: the session resumes.
 TEST(Record, ReformattedProtocolResumesTheSameSession) {
   testing::TempDir dir;
