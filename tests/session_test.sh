@@ -1161,5 +1161,27 @@ resume_display)
   (cd "$(dirname "$LAB")" && $BC run "$T1" --participant D2 --db "$W/d.sqlite" --observer sim --resume \
      --display ./lab-monitor.json) | grep -q completed || fail "the same profile by another path did not resume"
   echo "ok: another display profile on resume refused naming what differs; the same one by another path resumes" ;;
+groups_concurrent)
+  # Four stations starting participants at the same moment on one new record: the balanced groups count each other's
+  # sessions (the count and the session's insert are one transaction), so two get each group, and each session's
+  # trials are its group's blocks. Run one after another they alternate (groups_info); started together they all got
+  # the first group before.
+  G="$P/groups-and-info.json"
+  info=(--info age=30 --info handedness=right --info vision=normal)
+  for round in 1 2 3; do
+    pids=()
+    for id in B1 B2 B3 B4; do
+      $BC run "$G" --participant $id --db "$W/c-$round.sqlite" --observer sim "${info[@]}" > /dev/null 2> "$W/$id.err" &
+      pids+=($!)
+    done
+    for i in 0 1 2 3; do wait ${pids[$i]} || fail "round $round, station $((i + 1)): $(grep -v '^trial' "$W/B$((i + 1)).err")"; done
+    integrity "$W/c-$round.sqlite"
+    got=$(sql "$W/c-$round.sqlite" "SELECT group_name, count(*) FROM sessions GROUP BY group_name ORDER BY group_name")
+    [ "$got" = $'estimated|2\nno_blur|2' ] || fail "round $round: groups $(echo "$got" | tr '\n' ' ')"
+    wrong=$(sql "$W/c-$round.sqlite" "SELECT count(*) FROM trials t JOIN sessions s ON s.id = t.session_id
+            WHERE (s.group_name = 'estimated') != (t.block_name = 'measured-vs-estimated')")
+    [ "$wrong" = 0 ] || fail "round $round: $wrong trials of another group's block"
+  done
+  echo "ok: 3 rounds of 4 stations started at once: 2 sessions per group each time, each with its group's trials" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -38,6 +38,17 @@ std::string NewToken() {
 
 std::string SessionName(int64_t session) { return "session " + std::to_string(session); }
 
+// The study's sessions per group, aborted ones left out: what a balanced assignment counts.
+std::map<std::string, int64_t> SessionsPerGroup(Database& db, const std::string& study) {
+  Statement counts(db, "SELECT s.group_name, count(*) FROM sessions s JOIN participants p ON p.id = s.participant_id "
+                       "JOIN studies st ON st.id = p.study_id WHERE st.name = ? AND s.status != 'aborted' "
+                       "GROUP BY s.group_name");
+  counts.Bind(1, study);
+  std::map<std::string, int64_t> sessions;
+  while (counts.Step()) sessions[counts.GetText(0)] = counts.GetInt64(1);
+  return sessions;
+}
+
 }  // namespace
 
 std::string HostName() {
@@ -280,7 +291,7 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
   const int64_t study_id = EnsureStudy(db_, study, now);
   const int64_t participant_id = EnsureParticipant(db_, study_id, participant, now);
 
-  Statement running(db_, "SELECT s.id, s.seed, p.hash, p.json, s.observer, s.observer_params, s.display_profile "
+  Statement running(db_, "SELECT s.id, s.seed, p.hash, p.json, s.observer, s.observer_params, s.display_profile, s.group_name "
                          "FROM sessions s "
                          "JOIN protocol_versions p "
                          "ON p.id = s.protocol_version_id WHERE s.participant_id = ? AND s.status = 'running' "
@@ -329,6 +340,7 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     TakeLock(session);
     start.session_id = session;
     start.resumed = true;
+    start.group = running.IsNull(7) ? "" : running.GetText(7);
   } else if (resume) {
     // Nothing to continue: say what there is instead of starting a whole new session unasked.
     Statement past(db_, "SELECT status, count(*), max(id) FROM sessions WHERE participant_id = ? GROUP BY status");
@@ -347,6 +359,9 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     const int64_t protocol_id = EnsureProtocolVersion(db_, study_id, canonical, hash, now, &stored_json);
     if (stored_json != canonical)  // a 64-bit hash collision: refuse rather than mix texts
       throw Error(ErrorKind::kInternal, "protocol hash " + hash + " collides with another protocol text");
+    // Counted and inserted in one transaction (BEGIN IMMEDIATE): a station starting at the same moment waits for
+    // this one's session and counts it.
+    start.group = meta.assign_group ? meta.assign_group(SessionsPerGroup(db_, study)) : meta.group;
 
     Statement insert(db_, "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, "
                           "host, display, started, status, lock_host, lock_pid, lock_token, lock_heartbeat_ms, "
@@ -365,7 +380,7 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     insert.Bind(10, token_);
     insert.Bind(11, NowMs());
     insert.Bind(12, meta.display_profile);
-    insert.Bind(13, meta.group);
+    insert.Bind(13, start.group);
     insert.Bind(14, meta.participant_info);
     insert.Bind(15, meta.simulated ? "simulated" : "person");
     insert.Bind(16, meta.observer_params);
@@ -603,13 +618,11 @@ GroupsSoFar PeekGroups(const std::filesystem::path& db_path, const std::string& 
   std::error_code ec;
   if (!std::filesystem::is_regular_file(db_path, ec) || std::filesystem::file_size(db_path, ec) == 0) return so_far;
   Database db(db_path, OpenMode::kReadOnly);
+  // Nothing in it yet: a station starting at the same moment is making it (its schema not yet committed).
+  if (db.QueryInt64("SELECT count(*) FROM sqlite_schema") == 0) return so_far;
   RequireReadableRecord(db);
   if (SchemaVersion(db) < 6) return so_far;  // no groups recorded before version 6
-  Statement counts(db, "SELECT s.group_name, count(*) FROM sessions s JOIN participants p ON p.id = s.participant_id "
-                       "JOIN studies st ON st.id = p.study_id WHERE st.name = ? AND s.status != 'aborted' "
-                       "GROUP BY s.group_name");
-  counts.Bind(1, study);
-  while (counts.Step()) so_far.sessions[counts.GetText(0)] = counts.GetInt64(1);
+  so_far.sessions = SessionsPerGroup(db, study);
   Statement running(db, "SELECT s.group_name, s.participant_info FROM sessions s JOIN participants p "
                         "ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
                         "WHERE st.name = ? AND p.code = ? AND s.status = 'running' ORDER BY s.id DESC LIMIT 1");

@@ -683,6 +683,56 @@ TEST(Record, ConcurrentFirstStartsOnANewFileBothProceed) {
   }
 }
 
+// Stations starting at once on one file see each other's sessions when they decide a balanced group: the count and
+// the insert are one transaction, so four starts give two sessions to each of two groups, every time.
+TEST(Record, ConcurrentStartsCountEachOtherForABalancedGroup) {
+  testing::TempDir dir;
+  for (int round = 0; round < 5; ++round) {
+    const auto path = dir / ("groups-" + std::to_string(round) + ".sqlite");
+    int go[2];
+    ASSERT_EQ(pipe(go), 0);
+    std::vector<pid_t> children;
+    for (int c = 0; c < 4; ++c) {
+      const pid_t child = fork();
+      ASSERT_GE(child, 0);
+      if (child == 0) {
+        char byte;
+        if (read(go[0], &byte, 1) != 1) _exit(5);
+        try {
+          Record record = Record::Open(path);
+          SessionMeta meta;
+          meta.assign_group = [](const std::map<std::string, int64_t>& sessions) {
+            const auto count = [&](const char* g) { return sessions.count(g) ? sessions.at(g) : 0; };
+            return count("a") <= count("b") ? std::string("a") : std::string("b");
+          };
+          const SessionStart start =
+              record.StartOrResumeSession("test1", "P" + std::to_string(c), kProtocol, 7, meta, false);
+          if (start.group != record.database().QueryText("SELECT group_name FROM sessions WHERE id = " +
+                                                          std::to_string(start.session_id)))
+            _exit(6);
+        } catch (const Error& e) {
+          std::fprintf(stderr, "child %d: %s\n", c, e.what());
+          _exit(e.exit_code());
+        }
+        _exit(0);
+      }
+      children.push_back(child);
+    }
+    ASSERT_EQ(write(go[1], "gggg", 4), 4);
+    for (pid_t child : children) {
+      const int status = Wait(child);
+      EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "round " << round << ": status " << status;
+    }
+    close(go[0]);
+    close(go[1]);
+    Record record = Record::Open(path);
+    EXPECT_EQ(record.database().QueryText("SELECT group_concat(g) FROM (SELECT group_name || '=' || count(*) g "
+                                          "FROM sessions GROUP BY group_name ORDER BY group_name)"),
+              "a=2,b=2")
+        << "round " << round;
+  }
+}
+
 TEST(Record, Fnv1a64MatchesTheReferenceValues) {
   EXPECT_EQ(ProtocolHash(""), "cbf29ce484222325");
   EXPECT_EQ(ProtocolHash("a"), "af63dc4c8601ec8c");
