@@ -100,6 +100,15 @@ class Station {
     scripted_.insert(at, {key, time_s});
   }
   void ClearScript() { scripted_.clear(); }
+  // Headless, a trial's simulated clock starts at 0: its times (response times, flips) are then the same sums
+  // whatever came before it, so a resumed session's are bit-identical to an uninterrupted one's. Carried over from
+  // the session's start, the same durations added to a larger clock and taken off its onset again rounded
+  // differently (a resumed session's clock had not run through the trials before it, nor the same screens).
+  void StartTrial() {
+    if (window_) return;
+    clock_s_ = 0;
+    scripted_.clear();
+  }
   bool Closed() const { return context_.ShouldClose(); }
   void Wait(double seconds) {
     if (window_)
@@ -310,6 +319,7 @@ class Runner {
   // Shows one trial until it is answered; fills the response and the frames.
   Outcome RunTrial(const protocol::Trial& trial, const TrialScene& scene, store::Response* response,
                    std::vector<store::FrameRecord>* frames) {
+    station_.StartTrial();
     // Whatever the trial's frames need from disk or a resampling, now, not in its first frame.
     renderer_.Prepare(scene.intervals > 0 ? IntervalScene(scene, IntervalShowsRight(trial, scene, 0)) : scene);
     // Inter-trial interval: the grey field.
