@@ -181,3 +181,8 @@ hostile_test(cli_hostile_animate_log_is_a_fifo 3 "fifo.csv: is not a regular fil
 hostile_test(cli_hostile_animate_video_not_avi 2 "--video ${H}/v.mp4: must end in .avi" ${ANIMATE} --video ${H}/v.mp4)
 set_tests_properties(cli_hostile_animate_log_is_a_fifo cli_hostile_animate_video_not_avi PROPERTIES
                      FIXTURES_REQUIRED "scene;calib" TIMEOUT 60)
+
+# A participant information key given twice: refused naming the key and both values, not the last one kept.
+hostile_test(cli_hostile_run_info_given_twice 2 "--info age is given twice ('age=34' and 'age=35')"
+             run ${PROJECT_SOURCE_DIR}/protocols/groups-and-info.json --participant P1 --db ${H}/info-twice.sqlite
+             --observer sim --info age=34 --info handedness=right --info vision=normal --info age=35)

@@ -1126,5 +1126,85 @@ assert checked == 4, checked
 print(checked)
 PYEOF
   echo "ok: $(grep -o '[0-9]* distinct pairs, [0-9]* invisible' "$W/invisible.out") at 3 m; visible: $(grep -o '[0-9]* distinct pairs, [0-9]* invisible' "$W/visible.out"); predicted shares match the closed form" ;;
+resume_observer)
+  # The session row names one observer: resuming with another is refused (exit 3, one line naming both) and adds
+  # nothing; the same observer spelled another way (the same canonical form) resumes.
+  T1=$P/test1-static-grids.json
+  $BC run "$T1" --participant O1 --db "$W/o.sqlite" --observer sim:lapse=1 --stop-after 1 > /dev/null 2>&1
+  set +e
+  $BC run "$T1" --participant O1 --db "$W/o.sqlite" --observer sim:weber=0.5 --resume > /dev/null 2> "$W/err"; code=$?
+  set -e
+  [ $code = 3 ] && [ "$(wc -l < "$W/err")" = 1 ] &&
+    grep -q "session 1 was started with --observer sim:model=arcmin,[^ ]*,lapse=1,[^ ]*, got --observer sim:model=arcmin,[^ ]*weber=0.5,[^ ]*lapse=0.04,[^ ]*; resume it with the observer it started with" "$W/err" \
+    || fail "another observer on resume: exit $code $(cat "$W/err")"
+  [ "$(sql "$W/o.sqlite" "SELECT count(*) FROM responses")" = 1 ] || fail "another observer answered"
+  $BC run "$T1" --participant O1 --db "$W/o.sqlite" --observer sim:model=arcmin,lapse=1.0 --resume | grep -q completed \
+    || fail "an equivalent observer spec did not resume"
+  [ "$(sql "$W/o.sqlite" "SELECT count(*), count(DISTINCT observer_params) FROM sessions")" = "1|1" ] || fail "sessions"
+  echo "ok: another observer on resume refused naming both; an equivalent spec resumes" ;;
+resume_display)
+  # A session resumed on another display profile is refused naming both profiles and what differs (not "another
+  # calibration or blurcue version?"); the same profile named by another path resumes.
+  T1=$P/test1-static-grids.json
+  LAB=$(cd "$(dirname "$0")/data" && pwd)/lab-monitor.json
+  $BC run "$T1" --participant D1 --db "$W/d.sqlite" --observer sim --stop-after 2 > /dev/null 2>&1
+  set +e
+  $BC run "$T1" --participant D1 --db "$W/d.sqlite" --observer sim --resume --display "$LAB" > /dev/null 2> "$W/err"
+  code=$?
+  set -e
+  [ $code = 3 ] && [ "$(wc -l < "$W/err")" = 1 ] &&
+    grep -qF 'session 1 was started with display profile "default (24-inch 16:9 at 60 cm)", got "lab 1" (/distance_mm 600.0 -> 570.0, ' "$W/err" &&
+    grep -qF "resume it with the --display (or the protocol's display.profile) it started with" "$W/err" \
+    || fail "another display on resume: exit $code $(cat "$W/err")"
+  [ "$(sql "$W/d.sqlite" "SELECT count(*) FROM responses")" = 2 ] || fail "answers were added on another display"
+  $BC run "$T1" --participant D2 --db "$W/d.sqlite" --observer sim --stop-after 2 --display "$LAB" > /dev/null 2>&1
+  (cd "$(dirname "$LAB")" && $BC run "$T1" --participant D2 --db "$W/d.sqlite" --observer sim --resume \
+     --display ./lab-monitor.json) | grep -q completed || fail "the same profile by another path did not resume"
+  echo "ok: another display profile on resume refused naming what differs; the same one by another path resumes" ;;
+groups_concurrent)
+  # Four stations starting participants at the same moment on one new record: the balanced groups count each other's
+  # sessions (the count and the session's insert are one transaction), so two get each group, and each session's
+  # trials are its group's blocks. Run one after another they alternate (groups_info); started together they all got
+  # the first group before.
+  G="$P/groups-and-info.json"
+  info=(--info age=30 --info handedness=right --info vision=normal)
+  for round in 1 2 3; do
+    pids=()
+    for id in B1 B2 B3 B4; do
+      $BC run "$G" --participant $id --db "$W/c-$round.sqlite" --observer sim "${info[@]}" > /dev/null 2> "$W/$id.err" &
+      pids+=($!)
+    done
+    for i in 0 1 2 3; do wait ${pids[$i]} || fail "round $round, station $((i + 1)): $(grep -v '^trial' "$W/B$((i + 1)).err")"; done
+    integrity "$W/c-$round.sqlite"
+    got=$(sql "$W/c-$round.sqlite" "SELECT group_name, count(*) FROM sessions GROUP BY group_name ORDER BY group_name")
+    [ "$got" = $'estimated|2\nno_blur|2' ] || fail "round $round: groups $(echo "$got" | tr '\n' ' ')"
+    wrong=$(sql "$W/c-$round.sqlite" "SELECT count(*) FROM trials t JOIN sessions s ON s.id = t.session_id
+            WHERE (s.group_name = 'estimated') != (t.block_name = 'measured-vs-estimated')")
+    [ "$wrong" = 0 ] || fail "round $round: $wrong trials of another group's block"
+  done
+  echo "ok: 3 rounds of 4 stations started at once: 2 sessions per group each time, each with its group's trials" ;;
+resume_exact)
+  # A resumed simulated session is bit-identical to an uninterrupted one: every answer's response time and every
+  # frame's flip time to the last digit (sql prints floats round-trip), not only to the 3 decimals of fingerprint.
+  # Before, the simulated clock ran on from the session's start and ~22 of test 2's 74 response times differed in
+  # their last digits.
+  exact() {
+    sql "$1" "SELECT t.trial_index, r.choice, r.rt_ms, r.adjustment, r.level FROM trials t
+              JOIN responses r ON r.trial_id = t.id ORDER BY t.trial_index"
+    sql "$1" "SELECT t.trial_index, f.frame_index, f.flip_time_s, f.dropped FROM trials t
+              JOIN frames f ON f.trial_id = t.id ORDER BY t.trial_index, f.frame_index"
+  }
+  for proto in test2-moving-balls pre-research-depth-matching; do
+    $BC run "$P/$proto.json" --participant K1 --db "$W/$proto-whole.sqlite" --observer sim > /dev/null 2>&1
+    $BC run "$P/$proto.json" --participant K1 --db "$W/$proto-parts.sqlite" --observer sim --stop-after 5 > /dev/null 2>&1
+    $BC run "$P/$proto.json" --participant K1 --db "$W/$proto-parts.sqlite" --observer sim --resume 2> /dev/null |
+      grep -q completed || fail "$proto: resume did not complete"
+    exact "$W/$proto-whole.sqlite" > "$W/$proto-whole.txt"
+    exact "$W/$proto-parts.sqlite" > "$W/$proto-parts.txt"
+    [ -s "$W/$proto-whole.txt" ] || fail "$proto: nothing recorded"
+    diff "$W/$proto-whole.txt" "$W/$proto-parts.txt" > "$W/$proto.diff" ||
+      fail "$proto: resumed differs from uninterrupted in $(grep -c '^<' "$W/$proto.diff") rows, e.g. $(grep -m2 '^[<>]' "$W/$proto.diff" | tr '\n' ' ')"
+  done
+  echo "ok: stopped after 5 and resumed = uninterrupted to the last digit of every response and flip time (test 2, depth matching)" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -11,7 +11,8 @@ set_tests_properties(session_pictures PROPERTIES FIXTURES_REQUIRED scene FIXTURE
                      PASS_REGULAR_EXPRESSION "wrote 27 photos")
 set_tests_properties(session_protocols PROPERTIES FIXTURES_SETUP session_protocols)
 foreach(case complete same_seed resume kill9 second_writer window window_adjust recover depth_arcmin merge resume_guards stranded
-             stale_lock readonly frames_shown adaptive groups_info two_intervals deadline layouts window_after_motion codebook report_any_study practice_criterion visibility depth_capture)
+             stale_lock readonly frames_shown adaptive groups_info two_intervals deadline layouts window_after_motion codebook report_any_study practice_criterion visibility depth_capture
+             resume_observer resume_display groups_concurrent resume_exact)
   add_test(NAME session_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/session_test.sh ${case} ${BC} ${T})
   set_tests_properties(session_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures"
                        LABELS "gl;session"
@@ -40,11 +41,12 @@ add_run_failure_test(session_run_negative_seed 2
                      "--seed: must be a whole number from 0 to 18446744073709551615, got '-3'"
                      run ${T}/protocols/test1-static-grids.json --participant P1 --db ${T}/seed.sqlite --observer sim
                      --seed -3)
-# A person needs a window: without a display, one line says so (and what to do) before anything is recorded.
+# A person needs a window: without a display, one line says so (and what to do) before anything is recorded. No
+# display is the station's set-up, a usage error (exit 2), not an internal one.
 add_test(NAME session_run_person_without_display
          COMMAND ${CMAKE_COMMAND} -E env --unset=DISPLAY ${CMAKE_COMMAND} -DCMD=${BC}
                  "-DARGS=run;${T}/protocols/test1-static-grids.json;--participant;P1;--db;${T}/no-display.sqlite"
-                 -DEXPECT_CODE=10 "-DEXPECT_TEXT=GLFW: cannot open a window: "
+                 -DEXPECT_CODE=2 "-DEXPECT_TEXT=GLFW: cannot open a window: "
                  -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
 set_tests_properties(session_run_person_without_display PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols")
 

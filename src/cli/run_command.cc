@@ -110,7 +110,13 @@ void AddRunCommand(CLI::App& app) {
       const size_t eq = item.find('=');
       if (eq == std::string::npos || eq == 0)
         throw Error(ErrorKind::kUsage, "--info: must be KEY=VALUE, got '" + item + "'");
-      options.info.emplace_back(item.substr(0, eq), item.substr(eq + 1));
+      const std::string key = item.substr(0, eq);
+      // A key given twice would keep one of its values unsaid: which one was meant is the experimenter's to say.
+      for (const auto& given : options.info)
+        if (given.first == key)
+          throw Error(ErrorKind::kUsage, "--info " + key + " is given twice ('" + given.first + "=" + given.second +
+                                             "' and '" + item + "')");
+      options.info.emplace_back(key, item.substr(eq + 1));
     }
     const session::RunResult r = session::RunSession(options);
     // Trials a stopped procedure skipped are recorded too: counted as done, and said apart.

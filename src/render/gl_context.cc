@@ -71,8 +71,9 @@ class GlfwContext final : public GlContext {
   explicit GlfwContext(const WindowOptions& o) {
     // GLFW's own words go into the one-line error rather than onto stderr.
     glfwSetErrorCallback([](int, const char* text) { LastGlfwError() = text ? text : ""; });
+    // No display to open a window on is the station's set-up, not a bug: a usage error like a bad option.
     if (!glfwInit())
-      throw Error(ErrorKind::kInternal, "GLFW: cannot open a window: " + LastGlfwError() +
+      throw Error(ErrorKind::kUsage, "GLFW: cannot open a window: " + LastGlfwError() +
                                             " (a window needs a display: run under Xvfb, or use --observer sim)");
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, kGlMajor);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, kGlMinor);

@@ -29,7 +29,8 @@ class GlContext {
  public:
   // Throws Error(kInternal) with the EGL error code when no surfaceless GL 4.2 core context can be made.
   static std::unique_ptr<GlContext> CreateOffscreen();
-  // Throws Error(kInternal) when GLFW cannot open a window (no display: run under Xvfb).
+  // Throws Error(kUsage) when GLFW finds no display to open a window on (run under one or Xvfb), Error(kInternal)
+  // when it has one but cannot open the window there.
   static std::unique_ptr<GlContext> CreateWindow(const WindowOptions& options);
 
   virtual ~GlContext() = default;

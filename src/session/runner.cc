@@ -100,6 +100,15 @@ class Station {
     scripted_.insert(at, {key, time_s});
   }
   void ClearScript() { scripted_.clear(); }
+  // Headless, a trial's simulated clock starts at 0: its times (response times, flips) are then the same sums
+  // whatever came before it, so a resumed session's are bit-identical to an uninterrupted one's. Carried over from
+  // the session's start, the same durations added to a larger clock and taken off its onset again rounded
+  // differently (a resumed session's clock had not run through the trials before it, nor the same screens).
+  void StartTrial() {
+    if (window_) return;
+    clock_s_ = 0;
+    scripted_.clear();
+  }
   bool Closed() const { return context_.ShouldClose(); }
   void Wait(double seconds) {
     if (window_)
@@ -310,6 +319,7 @@ class Runner {
   // Shows one trial until it is answered; fills the response and the frames.
   Outcome RunTrial(const protocol::Trial& trial, const TrialScene& scene, store::Response* response,
                    std::vector<store::FrameRecord>* frames) {
+    station_.StartTrial();
     // Whatever the trial's frames need from disk or a resampling, now, not in its first frame.
     renderer_.Prepare(scene.intervals > 0 ? IntervalScene(scene, IntervalShowsRight(trial, scene, 0)) : scene);
     // Inter-trial interval: the grey field.
@@ -714,31 +724,44 @@ RunResult RunSession(const RunOptions& options) {
       PrepareSession(options.protocol_file, options.participant, options.seed, options.display_profile, group);
   const protocol::Protocol& protocol = prepared.protocol;
   if (observer) CheckObserverCanAnswer(*observer, protocol);
+  // A new session's balanced group is decided again in the transaction that starts it: a station starting at the
+  // same moment may take the group peeked above. So each group it may get is prepared (and checked) now.
+  const bool balanced = protocol.groups && protocol.groups->assign == "balanced" && !options.resume;
+  std::map<std::string, PreparedSession> other_groups;
+  if (balanced)
+    for (const std::string& name : protocol.groups->names)
+      if (name != prepared.group) {
+        PreparedSession other = prepared;
+        PrepareParticipant(&other, options.participant, options.seed, name);
+        other_groups.emplace(name, std::move(other));
+      }
   const std::string& protocol_text = prepared.protocol_text;
   const uint64_t seed = prepared.seed;
-  const std::vector<protocol::Trial>& trials = prepared.trials;
   const std::optional<calib::SceneCalib>& scene = prepared.scene;
-  const std::vector<TrialScene>& scenes = prepared.scenes;
-  std::vector<store::TrialRecord> records;
-  for (const protocol::Trial& trial : trials) {
-    store::TrialRecord r;
-    r.index = trial.index;
-    r.block = protocol::BlockIndex(protocol, trial);
-    const TrialScene& planned = scenes[size_t(trial.index)];
-    r.factors_json = TrialVariables(trial, planned, prepared.presentation).dump();
-    r.left_json = trial.left.dump();
-    r.right_json = trial.right.dump();
-    r.block_name = trial.block;
-    r.task = protocol::ToString(trial.task);
-    r.practice = trial.practice;
-    r.swapped = trial.swapped;
-    if (planned.content != "picture" && trial.task != protocol::Task::kAdjustment) {
-      r.r_left_px = planned.r_left_px;
-      if (!planned.left_only) r.r_right_px = planned.r_right_px;
-      r.r_scene_px = planned.r_scene_px;
+  // The trial list as saved: one record per trial, with its planned radii.
+  auto trial_records = [&](const PreparedSession& s) {
+    std::vector<store::TrialRecord> records;
+    for (const protocol::Trial& trial : s.trials) {
+      store::TrialRecord r;
+      r.index = trial.index;
+      r.block = protocol::BlockIndex(protocol, trial);
+      const TrialScene& planned = s.scenes[size_t(trial.index)];
+      r.factors_json = TrialVariables(trial, planned, s.presentation).dump();
+      r.left_json = trial.left.dump();
+      r.right_json = trial.right.dump();
+      r.block_name = trial.block;
+      r.task = protocol::ToString(trial.task);
+      r.practice = trial.practice;
+      r.swapped = trial.swapped;
+      if (planned.content != "picture" && trial.task != protocol::Task::kAdjustment) {
+        r.r_left_px = planned.r_left_px;
+        if (!planned.left_only) r.r_right_px = planned.r_right_px;
+        r.r_scene_px = planned.r_scene_px;
+      }
+      records.push_back(std::move(r));
     }
-    records.push_back(std::move(r));
-  }
+    return records;
+  };
 
   std::unique_ptr<render::GlContext> context;
   const bool window = !observer || options.window;
@@ -782,6 +805,10 @@ RunResult RunSession(const RunOptions& options) {
   meta.display = display;
   meta.display_profile = display::ToJson(prepared.display).dump();
   meta.group = prepared.group;
+  if (balanced)
+    meta.assign_group = [&](const std::map<std::string, int64_t>& sessions) {
+      return protocol::AssignGroup(protocol, options.participant, sessions);
+    };
   meta.participant_info = info.dump();
   meta.simulated = observer.has_value();
   meta.observer_params = observer ? ToString(*observer) : "";
@@ -796,12 +823,15 @@ RunResult RunSession(const RunOptions& options) {
   }
   const store::SessionStart start = record.StartOrResumeSession(protocol.name, options.participant, protocol_text,
                                                                 seed, meta, options.resume);
+  // The group the record gave (another than the one peeked when a station started at the same moment).
+  const auto given = other_groups.find(start.group);
+  const PreparedSession& chosen = given == other_groups.end() ? prepared : given->second;
   // A new session saves its list; a resumed one must show the same trials in the same order.
   if (start.trial_count == 0)
-    record.SaveTrialList(start.session_id, records);
+    record.SaveTrialList(start.session_id, trial_records(chosen));
   else
-    record.CheckTrialList(start.session_id, records);
-  Runner runner(options, prepared, *context, renderer, observer);
+    record.CheckTrialList(start.session_id, trial_records(chosen));
+  Runner runner(options, chosen, *context, renderer, observer);
   return runner.Run(record, start);
 }
 

@@ -38,6 +38,17 @@ std::string NewToken() {
 
 std::string SessionName(int64_t session) { return "session " + std::to_string(session); }
 
+// The study's sessions per group, aborted ones left out: what a balanced assignment counts.
+std::map<std::string, int64_t> SessionsPerGroup(Database& db, const std::string& study) {
+  Statement counts(db, "SELECT s.group_name, count(*) FROM sessions s JOIN participants p ON p.id = s.participant_id "
+                       "JOIN studies st ON st.id = p.study_id WHERE st.name = ? AND s.status != 'aborted' "
+                       "GROUP BY s.group_name");
+  counts.Bind(1, study);
+  std::map<std::string, int64_t> sessions;
+  while (counts.Step()) sessions[counts.GetText(0)] = counts.GetInt64(1);
+  return sessions;
+}
+
 }  // namespace
 
 std::string HostName() {
@@ -205,15 +216,8 @@ int64_t Record::TrialId(int64_t session, int64_t trial_index) {
 
 namespace {
 
-// What differs between two protocol texts (canonical JSON), as JSON pointers with the old and new values.
-std::string ProtocolChanges(const std::string& before, const std::string& after) {
-  Json a, b;
-  try {
-    a = Json::parse(before);
-    b = Json::parse(after);
-  } catch (const Json::exception&) {
-    return "the recorded text is not JSON";
-  }
+// What differs between two JSON values, as JSON pointers with the old and new values.
+std::string JsonChanges(const Json& a, const Json& b) {
   const Json patch = Json::diff(a, b);
   std::string text;
   int shown = 0;
@@ -240,6 +244,40 @@ std::string ProtocolChanges(const std::string& before, const std::string& after)
   return text;
 }
 
+// What differs between two protocol texts (canonical JSON).
+std::string ProtocolChanges(const std::string& before, const std::string& after) {
+  Json a, b;
+  try {
+    a = Json::parse(before);
+    b = Json::parse(after);
+  } catch (const Json::exception&) {
+    return "the recorded text is not JSON";
+  }
+  return JsonChanges(a, b);
+}
+
+// How the display profile a session recorded and the one given now (display::ToJson) differ: both names, then what
+// changed ("default ..." -> "lab 1" (/distance_mm 600.0 -> 570.0, ...)), or "" when they are the same display. The
+// file it was read from is not compared: the same profile may be named by another path (another working
+// directory). A session from before display profiles were recorded ("{}") is not compared.
+std::string DisplayChanges(const std::string& recorded, const std::string& given) {
+  Json a, b;
+  try {
+    a = Json::parse(recorded);
+    b = Json::parse(given);
+  } catch (const Json::exception&) {
+    return "";
+  }
+  if (!a.is_object() || !b.is_object() || a.empty()) return "";
+  a.erase("file");
+  b.erase("file");
+  if (a == b) return "";
+  const Json name_a = a.value("name", Json()), name_b = b.value("name", Json());
+  a.erase("name");
+  b.erase("name");
+  return name_a.dump() + ", got " + name_b.dump() + " (" + (a == b ? "the same values" : JsonChanges(a, b)) + ")";
+}
+
 }  // namespace
 
 SessionStart Record::StartOrResumeSession(const std::string& study, const std::string& participant,
@@ -253,7 +291,9 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
   const int64_t study_id = EnsureStudy(db_, study, now);
   const int64_t participant_id = EnsureParticipant(db_, study_id, participant, now);
 
-  Statement running(db_, "SELECT s.id, s.seed, p.hash, p.json FROM sessions s JOIN protocol_versions p "
+  Statement running(db_, "SELECT s.id, s.seed, p.hash, p.json, s.observer, s.observer_params, s.display_profile, s.group_name "
+                         "FROM sessions s "
+                         "JOIN protocol_versions p "
                          "ON p.id = s.protocol_version_id WHERE s.participant_id = ? AND s.status = 'running' "
                          "ORDER BY s.id DESC LIMIT 1");
   running.Bind(1, participant_id);
@@ -275,9 +315,32 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     if (stored_seed != seed)
       throw InputError(db_.path(), SessionName(session) + " was started with seed " + std::to_string(stored_seed) +
                                        ", got seed " + std::to_string(seed));
+    // The session row names one observer: a resumed session answered by another would be recorded as the first.
+    // Parameters are compared in their canonical form (session::ToString), so an equivalent spec resumes.
+    if (!running.IsNull(4)) {
+      auto observer = [](bool simulated, const std::string& params) {
+        return simulated ? "--observer " + params : std::string("a person (no --observer)");
+      };
+      const bool stored_simulated = running.GetText(4) == "simulated";
+      const std::string stored_params = running.IsNull(5) ? "" : running.GetText(5);
+      if (stored_simulated != meta.simulated || (meta.simulated && stored_params != meta.observer_params))
+        throw InputError(db_.path(), SessionName(session) + " was started with " +
+                                         observer(stored_simulated, stored_params) + ", got " +
+                                         observer(meta.simulated, meta.observer_params) +
+                                         "; resume it with the observer it started with, or close it with " +
+                                         abort_hint + std::to_string(session) + " (its answers are kept)");
+    }
+    // Every radius in screen px and arcmin follows the display profile: another one would make other trials.
+    if (const std::string changes = DisplayChanges(running.IsNull(6) ? "{}" : running.GetText(6), meta.display_profile);
+        !changes.empty())
+      throw InputError(db_.path(), SessionName(session) + " was started with display profile " + changes +
+                                       "; resume it with the --display (or the protocol's display.profile) it "
+                                       "started with, or close it with " + abort_hint + std::to_string(session) +
+                                       " (its answers are kept)");
     TakeLock(session);
     start.session_id = session;
     start.resumed = true;
+    start.group = running.IsNull(7) ? "" : running.GetText(7);
   } else if (resume) {
     // Nothing to continue: say what there is instead of starting a whole new session unasked.
     Statement past(db_, "SELECT status, count(*), max(id) FROM sessions WHERE participant_id = ? GROUP BY status");
@@ -296,6 +359,9 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     const int64_t protocol_id = EnsureProtocolVersion(db_, study_id, canonical, hash, now, &stored_json);
     if (stored_json != canonical)  // a 64-bit hash collision: refuse rather than mix texts
       throw Error(ErrorKind::kInternal, "protocol hash " + hash + " collides with another protocol text");
+    // Counted and inserted in one transaction (BEGIN IMMEDIATE): a station starting at the same moment waits for
+    // this one's session and counts it.
+    start.group = meta.assign_group ? meta.assign_group(SessionsPerGroup(db_, study)) : meta.group;
 
     Statement insert(db_, "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, "
                           "host, display, started, status, lock_host, lock_pid, lock_token, lock_heartbeat_ms, "
@@ -314,7 +380,7 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     insert.Bind(10, token_);
     insert.Bind(11, NowMs());
     insert.Bind(12, meta.display_profile);
-    insert.Bind(13, meta.group);
+    insert.Bind(13, start.group);
     insert.Bind(14, meta.participant_info);
     insert.Bind(15, meta.simulated ? "simulated" : "person");
     insert.Bind(16, meta.observer_params);
@@ -552,13 +618,11 @@ GroupsSoFar PeekGroups(const std::filesystem::path& db_path, const std::string& 
   std::error_code ec;
   if (!std::filesystem::is_regular_file(db_path, ec) || std::filesystem::file_size(db_path, ec) == 0) return so_far;
   Database db(db_path, OpenMode::kReadOnly);
+  // Nothing in it yet: a station starting at the same moment is making it (its schema not yet committed).
+  if (db.QueryInt64("SELECT count(*) FROM sqlite_schema") == 0) return so_far;
   RequireReadableRecord(db);
   if (SchemaVersion(db) < 6) return so_far;  // no groups recorded before version 6
-  Statement counts(db, "SELECT s.group_name, count(*) FROM sessions s JOIN participants p ON p.id = s.participant_id "
-                       "JOIN studies st ON st.id = p.study_id WHERE st.name = ? AND s.status != 'aborted' "
-                       "GROUP BY s.group_name");
-  counts.Bind(1, study);
-  while (counts.Step()) so_far.sessions[counts.GetText(0)] = counts.GetInt64(1);
+  so_far.sessions = SessionsPerGroup(db, study);
   Statement running(db, "SELECT s.group_name, s.participant_info FROM sessions s JOIN participants p "
                         "ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
                         "WHERE st.name = ? AND p.code = ? AND s.status = 'running' ORDER BY s.id DESC LIMIT 1");

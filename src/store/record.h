@@ -3,6 +3,7 @@
 // trial, and one writer per running session (a lock row naming host, pid and a per-Record token).
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <map>
 #include <string>
@@ -19,6 +20,10 @@ struct SessionMeta {
   std::string display;  // e.g. "1920x1080@60 DELL U2412M"
   std::string display_profile = "{}";  // the display profile as JSON (display::ToJson)
   std::string group;                    // the between-subject group the session runs ("" without groups)
+  // Set: a new session's group is decided by this from the study's sessions per group that were not aborted (as
+  // GroupsSoFar::sessions), inside the transaction that inserts the session, replacing `group`; stations starting at
+  // once then see each other's sessions. SessionStart::group says which it gave.
+  std::function<std::string(const std::map<std::string, int64_t>&)> assign_group;
   std::string participant_info = "{}";  // the participant information given: a JSON object key -> value
   // Who answers and where (typed columns of schema 7): a person or a simulated observer (its canonical parameters,
   // session::ToString(ObserverParams)), in a real window on the real clock or headless on a simulated clock.
@@ -97,6 +102,7 @@ struct SessionStart {
   int64_t trial_count = 0;
   bool resumed = false;
   uint64_t seed = 0;
+  std::string group;  // the session's group: as recorded (resumed), or as given or assigned (new)
 };
 
 struct RecordOptions {
@@ -137,7 +143,9 @@ class Record {
   // Error(kInput) when:
   //  - resume is false but the participant has a running session (resume it, or close it with AbortSession),
   //  - resume is true but there is no running session to continue (saying what the participant has instead),
-  //  - the resumed session was started with another protocol (naming what changed) or seed,
+  //  - the resumed session was started with another protocol (naming what changed) or seed, or with another
+  //    observer (meta.simulated and meta.observer_params, compared as recorded: both named), or with another
+  //    display profile (meta.display_profile but for the file it was read from: both named, and what differs),
   //  - another live process or Record holds the session.
   SessionStart StartOrResumeSession(const std::string& study, const std::string& participant,
                                     const std::string& protocol_json, uint64_t seed, const SessionMeta& meta,

@@ -410,6 +410,51 @@ TEST(Record, ResumeWithNothingToResumeIsRefusedAndStartsNothing) {
   EXPECT_EQ(record.database().QueryInt64("SELECT count(*) FROM sessions"), 1);
 }
 
+// A resumed session is answered by the observer it started with: the session row names one. Another simulated
+// observer, or a person for a simulated one, is refused naming both; the same canonical parameters resume.
+TEST(Record, ResumeWithAnotherObserverIsRefusedNamingBoth) {
+  testing::TempDir dir;
+  SessionMeta lapse;
+  lapse.simulated = true;
+  lapse.observer_params = "sim:model=arcmin,weber=0.35,lapse=1";
+  { Record::Open(dir / "r.sqlite").StartOrResumeSession("test1", "P01", kProtocol, 7, lapse, false); }
+  Record record = Record::Open(dir / "r.sqlite");
+  SessionMeta weber = lapse;
+  weber.observer_params = "sim:model=arcmin,weber=0.5,lapse=0.04";
+  const std::string message = ErrorOf([&] { record.StartOrResumeSession("test1", "P01", kProtocol, 7, weber, true); });
+  EXPECT_TRUE(Contains(message, "session 1 was started with --observer sim:model=arcmin,weber=0.35,lapse=1, got "
+                                "--observer sim:model=arcmin,weber=0.5,lapse=0.04; resume it with the observer it "
+                                "started with, or close it with blurcue sessions --db "))
+      << message;
+  EXPECT_TRUE(Contains(ErrorOf([&] { record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, true); }),
+                       "got a person (no --observer)"));
+  EXPECT_TRUE(record.StartOrResumeSession("test1", "P01", kProtocol, 7, lapse, true).resumed);
+}
+
+// Every radius in screen px and arcmin follows the display profile: a session resumed on another is refused naming
+// both profiles and what differs; the same profile read from another path resumes.
+TEST(Record, ResumeOnAnotherDisplayProfileIsRefusedNamingWhatDiffers) {
+  testing::TempDir dir;
+  SessionMeta lab;
+  lab.display_profile = R"({"distance_mm":570.0,"file":"lab-1.json","name":"lab 1","width_mm":376.0})";
+  { Record::Open(dir / "r.sqlite").StartOrResumeSession("test1", "P01", kProtocol, 7, lab, false); }
+  Record record = Record::Open(dir / "r.sqlite");
+  SessionMeta moved = lab;
+  moved.display_profile = R"({"distance_mm":600.0,"file":"lab-1.json","name":"lab 1","width_mm":376.0})";
+  const std::string message = ErrorOf([&] { record.StartOrResumeSession("test1", "P01", kProtocol, 7, moved, true); });
+  EXPECT_TRUE(Contains(message, "session 1 was started with display profile \"lab 1\", got \"lab 1\" (/distance_mm "
+                                "570.0 -> 600.0); resume it with the --display (or the protocol's display.profile) it "
+                                "started with, or close it with blurcue sessions --db "))
+      << message;
+  SessionMeta other = lab;
+  other.display_profile = R"({"distance_mm":570.0,"file":"lab-2.json","name":"lab 2","width_mm":520.0})";
+  EXPECT_TRUE(Contains(ErrorOf([&] { record.StartOrResumeSession("test1", "P01", kProtocol, 7, other, true); }),
+                       "display profile \"lab 1\", got \"lab 2\" (/width_mm 376.0 -> 520.0)"));
+  SessionMeta elsewhere = lab;
+  elsewhere.display_profile = R"({"distance_mm":570.0,"file":"../lab/lab-1.json","name":"lab 1","width_mm":376.0})";
+  EXPECT_TRUE(record.StartOrResumeSession("test1", "P01", kProtocol, 7, elsewhere, true).resumed);
+}
+
 // An editor's newline, CRLF line ends, indentation and key order are the same protocol: the session resumes.
 TEST(Record, ReformattedProtocolResumesTheSameSession) {
   testing::TempDir dir;
@@ -635,6 +680,56 @@ TEST(Record, ConcurrentFirstStartsOnANewFileBothProceed) {
     close(go[1]);
     Record record = Record::Open(path);
     EXPECT_EQ(record.database().QueryInt64("SELECT count(*) FROM responses"), 2) << "round " << round;
+  }
+}
+
+// Stations starting at once on one file see each other's sessions when they decide a balanced group: the count and
+// the insert are one transaction, so four starts give two sessions to each of two groups, every time.
+TEST(Record, ConcurrentStartsCountEachOtherForABalancedGroup) {
+  testing::TempDir dir;
+  for (int round = 0; round < 5; ++round) {
+    const auto path = dir / ("groups-" + std::to_string(round) + ".sqlite");
+    int go[2];
+    ASSERT_EQ(pipe(go), 0);
+    std::vector<pid_t> children;
+    for (int c = 0; c < 4; ++c) {
+      const pid_t child = fork();
+      ASSERT_GE(child, 0);
+      if (child == 0) {
+        char byte;
+        if (read(go[0], &byte, 1) != 1) _exit(5);
+        try {
+          Record record = Record::Open(path);
+          SessionMeta meta;
+          meta.assign_group = [](const std::map<std::string, int64_t>& sessions) {
+            const auto count = [&](const char* g) { return sessions.count(g) ? sessions.at(g) : 0; };
+            return count("a") <= count("b") ? std::string("a") : std::string("b");
+          };
+          const SessionStart start =
+              record.StartOrResumeSession("test1", "P" + std::to_string(c), kProtocol, 7, meta, false);
+          if (start.group != record.database().QueryText("SELECT group_name FROM sessions WHERE id = " +
+                                                          std::to_string(start.session_id)))
+            _exit(6);
+        } catch (const Error& e) {
+          std::fprintf(stderr, "child %d: %s\n", c, e.what());
+          _exit(e.exit_code());
+        }
+        _exit(0);
+      }
+      children.push_back(child);
+    }
+    ASSERT_EQ(write(go[1], "gggg", 4), 4);
+    for (pid_t child : children) {
+      const int status = Wait(child);
+      EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "round " << round << ": status " << status;
+    }
+    close(go[0]);
+    close(go[1]);
+    Record record = Record::Open(path);
+    EXPECT_EQ(record.database().QueryText("SELECT group_concat(g) FROM (SELECT group_name || '=' || count(*) g "
+                                          "FROM sessions GROUP BY group_name ORDER BY group_name)"),
+              "a=2,b=2")
+        << "round " << round;
   }
 }
 
