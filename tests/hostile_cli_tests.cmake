@@ -166,3 +166,12 @@ hostile_test(cli_hostile_validate_visible_nan 2 "--visible: must be in [0.5, 1] 
              validate ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --plan --visible nan)
 hostile_test(cli_hostile_preview_observer_model 2 "--observer model must be arcmin or pixel, got 'eye'"
              preview ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --out ${H}/x.png --observer sim:model=eye)
+# A 100,000-digit value is quoted by its first 60 characters and its length, not written out whole (core/typed.h Echo).
+string(REPEAT "1" 100000 digits)
+string(REPEAT "1" 60 shown)
+hostile_test(cli_hostile_observer_weber_100000_digits 2
+             "--observer weber must be a number, got '${shown}...' (100000 characters)"
+             run ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --participant P1 --db ${H}/x.sqlite
+             --observer sim:weber=${digits})
+hostile_test(cli_hostile_radius_100000_digits 2 "--radius-px: must be in [0, 500] px, got '${shown}...' (100000 characters)"
+             blur ${D}/small.png --radius-px ${digits} --out ${H}/x.png)

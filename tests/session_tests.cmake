@@ -40,6 +40,13 @@ add_run_failure_test(session_run_negative_seed 2
                      "--seed: must be a whole number from 0 to 18446744073709551615, got '-3'"
                      run ${T}/protocols/test1-static-grids.json --participant P1 --db ${T}/seed.sqlite --observer sim
                      --seed -3)
+# A --info value of 100,000 characters is quoted by its first 60 and its length (core/typed.h Echo).
+string(REPEAT "a" 100000 notes)
+string(REPEAT "a" 60 shown)
+add_run_failure_test(session_run_info_100000_characters 2
+                     "--info notes=${shown}... (100000 characters): must be one line of printable text, at most 200 bytes"
+                     run ${T}/protocols/groups-and-info.json --participant P1 --db ${T}/info-long.sqlite --observer sim
+                     --info notes=${notes})
 # A person needs a window: without a display, one line says so (and what to do) before anything is recorded.
 add_test(NAME session_run_person_without_display
          COMMAND ${CMAKE_COMMAND} -E env --unset=DISPLAY ${CMAKE_COMMAND} -DCMD=${BC}

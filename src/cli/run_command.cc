@@ -7,6 +7,7 @@
 
 #include "cli/commands.h"
 #include "core/error.h"
+#include "core/typed.h"
 #include "session/runner.h"
 
 namespace blurcue::cli {
@@ -109,7 +110,7 @@ void AddRunCommand(CLI::App& app) {
     for (const std::string& item : args->info) {
       const size_t eq = item.find('=');
       if (eq == std::string::npos || eq == 0)
-        throw Error(ErrorKind::kUsage, "--info: must be KEY=VALUE, got '" + item + "'");
+        throw Error(ErrorKind::kUsage, "--info: must be KEY=VALUE, got " + Echo(item));
       options.info.emplace_back(item.substr(0, eq), item.substr(eq + 1));
     }
     const session::RunResult r = session::RunSession(options);
