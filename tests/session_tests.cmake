@@ -115,6 +115,18 @@ set(levels "[1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17,18,19,20,21,22,23,24,25,2
 add_preflight_test(eight-factors-of-30 "/factors: the session would have 656100000000 trials (30 a x 30 b x "
                    "${ball_head} ${ball_scene}, \"factors\": {\"pattern\": [${pattern}], \"a\": ${levels}, \"b\": ${levels}, \"c\": ${levels}, \"d\": ${levels}, \"e\": ${levels}, \"f\": ${levels}, \"g\": ${levels}, \"h\": ${levels}}}")
 
+# A conditions table's cell of Latin-1 bytes or with an escape byte: exit 3 naming the CSV file, its line and column
+# (it used to be exit 10, "invalid UTF-8 byte", or an escape written raw into the record).
+string(ASCII 255 254 latin1)
+string(ASCII 27 escape)
+file(WRITE ${D}/latin1-cell.csv "edge,left,right,label\n1,measured,none,caf${latin1}\n")
+file(WRITE ${D}/escape-cell.csv "edge,left,right,label\n1,measured,none,ok\n2,measured,none,a${escape}[2Jb\n")
+set(grid_head "{\"name\": \"t\", \"version\": 1, \"content\": {\"type\": \"grid\"}, \"task\": \"forced_choice\", ${ball_scene},")
+add_preflight_test(latin1-cell "/conditions/row/0/label: ${D}/latin1-cell.csv line 2, column 4 (label): must be printable UTF-8 text"
+                   "${grid_head} \"conditions\": \"latin1-cell.csv\"}")
+add_preflight_test(escape-cell "/conditions/row/1/label: ${D}/escape-cell.csv line 3, column 4 (label): must be printable UTF-8 text"
+                   "${grid_head} \"conditions\": \"escape-cell.csv\"}")
+
 # What the screen shows, measured on captured frames (run --capture) with the calibration's edge fit: each object's
 # blur against its recorded r_screen_px and its edges against its recorded outline (tests/capture_measure.cc).
 add_executable(capture_measure ${PROJECT_SOURCE_DIR}/tests/capture_measure.cc)

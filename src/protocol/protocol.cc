@@ -617,26 +617,32 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
     return {};
   }
   // Comma-separated, double quotes around a field that holds commas or quotes ("" for one quote).
-  auto split = [](const std::string& line) {
-    std::vector<std::string> fields(1);
+  struct Row {
+    std::vector<std::string> fields{1};
+    size_t line = 0;  // in the file, from 1
+  };
+  auto split = [](const std::string& line, size_t number) {
+    Row row;
+    row.line = number;
     bool quoted = false;
     for (size_t i = 0; i < line.size(); ++i) {
       const char c = line[i];
-      if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"') fields.back() += '"', ++i;
+      if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"') row.fields.back() += '"', ++i;
       else if (c == '"') quoted = !quoted;
-      else if (c == ',' && !quoted) fields.emplace_back();
-      else fields.back() += c;
+      else if (c == ',' && !quoted) row.fields.emplace_back();
+      else row.fields.back() += c;
     }
-    return fields;
+    return row;
   };
-  std::vector<std::vector<std::string>> rows;
-  size_t start = 0;
+  std::vector<Row> rows;
+  size_t start = 0, number = 0;
   while (start <= csv.size()) {
     size_t end = csv.find('\n', start);
     if (end == std::string::npos) end = csv.size();
     std::string line = csv.substr(start, end - start);
+    ++number;
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (!line.empty()) rows.push_back(split(line));
+    if (!line.empty()) rows.push_back(split(line, number));
     start = end + 1;
     if (rows.size() > size_t(kMaxTrials) + 1) break;
   }
@@ -649,7 +655,7 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
     Problem(ptr, where + ": more than " + std::to_string(kMaxTrials) + " rows", Json(*text));
     return {};
   }
-  const std::vector<std::string>& header = rows.front();
+  const std::vector<std::string>& header = rows.front().fields;
   std::set<std::string> names;
   for (const auto& name : header)
     if (name.empty() || name.size() > kMaxNameChars || !IsPrintableUtf8(name) || !names.insert(name).second) {
@@ -660,22 +666,35 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
   Factor factor;
   factor.name = "row";
   for (size_t r = 1; r < rows.size(); ++r) {
-    if (rows[r].size() != header.size()) {
-      Problem(ptr + "/row/" + std::to_string(r - 1), where + " line " + std::to_string(r + 1) + ": has " +
-                                                         std::to_string(rows[r].size()) + " fields, the header " +
-                                                         std::to_string(header.size()), Json(*text));
+    const std::string rp = ptr + "/row/" + std::to_string(r - 1);
+    const std::string line = where + " line " + std::to_string(rows[r].line);
+    if (rows[r].fields.size() != header.size()) {
+      Problem(rp, line + ": has " + std::to_string(rows[r].fields.size()) + " fields, the header " +
+                      std::to_string(header.size()), Json(*text));
       continue;
     }
     Json level = Json::object();
+    bool printable = true;
     for (size_t c = 0; c < header.size(); ++c) {
-      const std::string& cell = rows[r][c];
+      const std::string& cell = rows[r].fields[c];
+      const std::string cp = rp + "/" + Escape(header[c]);
+      // A cell becomes a level, a label in the record, the tables and the report: text they can all hold as it
+      // is. A Latin-1 byte or a NUL used to reach the record raw, or to stop validate with a JSON library error.
+      if (!IsPrintableUtf8(cell)) {
+        Problem(cp, line + ", column " + std::to_string(c + 1) + " (" + header[c] +
+                        "): must be printable UTF-8 text (no control characters; save the file as UTF-8), got " +
+                        Echo(cell));
+        printable = false;
+        continue;
+      }
       const std::optional<double> number = ParseDecimal(cell);
       level[header[c]] = IsWholeDecimal(cell) && std::abs(*number) < 9e15 ? Json(int64_t(*number))
                          : number                                       ? Json(*number)
                                                                         : Json(cell);
-      if (cell.empty()) Problem(ptr + "/row/" + std::to_string(r - 1) + "/" + Escape(header[c]), "is empty", Json(cell));
-      else CheckLevelValue(header[c], level[header[c]], ptr + "/row/" + std::to_string(r - 1) + "/" + Escape(header[c]));
+      if (cell.empty()) Problem(cp, "is empty", Json(cell));
+      else CheckLevelValue(header[c], level[header[c]], cp);
     }
+    if (!printable) continue;
     factor.levels.push_back(std::move(level));
   }
   return {factor};

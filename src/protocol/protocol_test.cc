@@ -217,6 +217,44 @@ TEST(ProtocolValidate, ConditionsTableGivesTheDesignRowByRow) {
   EXPECT_TRUE(Contains(OnlyProblem(j), "/blocks/0/conditions: no such file")) << OnlyProblem(j);
 }
 
+// A conditions table's cell that is not UTF-8 (a Latin-1 file's "é" or stray bytes) is a problem naming the CSV
+// file, its line and column, and the cell's pointer; it used to pass and stop validate, run, preview and plan with
+// the JSON library's "invalid UTF-8 byte" (exit 10) when the trial list was hashed.
+TEST(ProtocolValidate, ConditionsTableCellThatIsNotUtf8IsRefusedNamingFileLineAndColumn) {
+  const fs::path dir = SceneFolder();
+  std::ofstream(dir / "latin1.csv") << "edge,left,right,label\n1,measured,none,ok\n2,measured,none,caf\xe9\xff\xfe\n";
+  Json j = Valid();
+  j["blocks"] = {{{"name", "rows"}, {"conditions", "latin1.csv"}}};
+  const std::string problem = OnlyProblem(j);
+  EXPECT_TRUE(Contains(problem, "p.json: /blocks/0/conditions/row/1/label: ")) << problem;
+  EXPECT_TRUE(Contains(problem, "latin1.csv line 3, column 4 (label): must be printable UTF-8 text")) << problem;
+  EXPECT_TRUE(Contains(problem, "got 'caf\\xe9\\xff\\xfe'")) << problem;
+  try {
+    ParseProtocol(j, dir / "p.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+  }
+}
+
+// A NUL, escape or other control byte in a cell is refused as in a protocol's own names: it used to be written raw
+// into the record's trials.
+TEST(ProtocolValidate, ConditionsTableCellWithAControlByteIsRefused) {
+  const fs::path dir = SceneFolder();
+  const char text[] = "edge,left,right,label\n1,measured,none,o\0k\n2,measured,none,a\x1b[2Jb\n3,measured,none,\"tab\there\"\n";
+  std::ofstream(dir / "controls.csv") << std::string(text, sizeof text - 1);
+  Json j = Valid();
+  j["blocks"] = {{{"name", "rows"}, {"conditions", "controls.csv"}}};
+  const auto problems = Problems(j);
+  ASSERT_EQ(problems.size(), 3u);
+  EXPECT_TRUE(Contains(problems[0], "/row/0/label: " + (dir / "controls.csv").string() + " line 2, column 4 (label): "
+                                    "must be printable UTF-8 text")) << problems[0];
+  EXPECT_TRUE(Contains(problems[0], "got 'o\\x00k'")) << problems[0];
+  EXPECT_TRUE(Contains(problems[1], "/row/1/label: ")) << problems[1];
+  EXPECT_TRUE(Contains(problems[1], "got 'a\\x1b[2Jb'")) << problems[1];
+  EXPECT_TRUE(Contains(problems[2], "/row/2/label: ")) << problems[2];
+}
+
 // The real photos of a depth matching are chosen by distance_m wherever a trial finds it: its own factor, a key of
 // an object level, or a conditions table's column (the table was refused: "needs a factor distance_m").
 TEST(ProtocolValidate, RealPhotoDistancesComeFromFactorsObjectLevelsAndConditionsTables) {
