@@ -126,6 +126,10 @@ add_preflight_test(latin1-cell "/conditions/row/0/label: ${D}/latin1-cell.csv li
                    "${grid_head} \"conditions\": \"latin1-cell.csv\"}")
 add_preflight_test(escape-cell "/conditions/row/1/label: ${D}/escape-cell.csv line 3, column 4 (label): must be printable UTF-8 text"
                    "${grid_head} \"conditions\": \"escape-cell.csv\"}")
+# A quote left open at a line's end: the label "ab" used to be recorded.
+file(WRITE ${D}/open-quote.csv "edge,left,right,label\n1,measured,none,ok\n2,measured,none,\"ab\n")
+add_preflight_test(open-quote "/conditions/row/1: ${D}/open-quote.csv line 3: a quoted field is not closed"
+                   "${grid_head} \"conditions\": \"open-quote.csv\"}")
 
 # What the screen shows, measured on captured frames (run --capture) with the calibration's edge fit: each object's
 # blur against its recorded r_screen_px and its edges against its recorded outline (tests/capture_measure.cc).

@@ -616,10 +616,12 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
     Problem(ptr, e.what(), Json(*text));
     return {};
   }
-  // Comma-separated, double quotes around a field that holds commas or quotes ("" for one quote).
+  // Comma-separated, double quotes around a field that holds commas or quotes ("" for one quote); a field does not
+  // span lines, so a quote still open at the line's end is an error (it used to swallow the rest of the line).
   struct Row {
     std::vector<std::string> fields{1};
-    size_t line = 0;  // in the file, from 1
+    size_t line = 0;      // in the file, from 1
+    bool closed = true;   // every quote closed
   };
   auto split = [](const std::string& line, size_t number) {
     Row row;
@@ -632,6 +634,7 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
       else if (c == ',' && !quoted) row.fields.emplace_back();
       else row.fields.back() += c;
     }
+    row.closed = !quoted;
     return row;
   };
   std::vector<Row> rows;
@@ -655,6 +658,11 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
     Problem(ptr, where + ": more than " + std::to_string(kMaxTrials) + " rows", Json(*text));
     return {};
   }
+  const std::string unclosed = ": a quoted field is not closed (a field cannot span lines; write \"\" for a quote)";
+  if (!rows.front().closed) {
+    Problem(ptr, where + " line " + std::to_string(rows.front().line) + unclosed, Json(*text));
+    return {};
+  }
   const std::vector<std::string>& header = rows.front().fields;
   std::set<std::string> names;
   for (const auto& name : header)
@@ -668,6 +676,10 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
   for (size_t r = 1; r < rows.size(); ++r) {
     const std::string rp = ptr + "/row/" + std::to_string(r - 1);
     const std::string line = where + " line " + std::to_string(rows[r].line);
+    if (!rows[r].closed) {
+      Problem(rp, line + unclosed, Json(*text));
+      continue;
+    }
     if (rows[r].fields.size() != header.size()) {
       Problem(rp, line + ": has " + std::to_string(rows[r].fields.size()) + " fields, the header " +
                       std::to_string(header.size()), Json(*text));

@@ -255,6 +255,26 @@ TEST(ProtocolValidate, ConditionsTableCellWithAControlByteIsRefused) {
   EXPECT_TRUE(Contains(problems[2], "/row/2/label: ")) << problems[2];
 }
 
+// A quote left open at a line's end is a problem naming the file and the line (a field cannot span lines): the
+// table `2,measured,none,"ab` used to validate and record the label `ab`. The line counts the file's lines, blank
+// ones included.
+TEST(ProtocolValidate, ConditionsTableUnclosedQuoteIsRefusedNamingTheLine) {
+  const fs::path dir = SceneFolder();
+  std::ofstream(dir / "open.csv") << "edge,left,right,label\n1,measured,none,\"a \"\"b\"\"\"\n\n2,measured,none,\"ab\n";
+  Json j = Valid();
+  j["blocks"] = {{{"name", "rows"}, {"conditions", "open.csv"}}};
+  const std::string problem = OnlyProblem(j);
+  EXPECT_TRUE(Contains(problem, "/blocks/0/conditions/row/1: " + (dir / "open.csv").string() +
+                                    " line 4: a quoted field is not closed")) << problem;
+  std::ofstream(dir / "open-header.csv") << "edge,left,right,\"label\n1,measured,none,x\n";
+  j["blocks"][0]["conditions"] = "open-header.csv";
+  EXPECT_TRUE(Contains(OnlyProblem(j), "open-header.csv line 1: a quoted field is not closed")) << OnlyProblem(j);
+  // Closed quotes still read as before: "" is one quote.
+  std::ofstream(dir / "open.csv") << "edge,left,right,label\n1,measured,none,\"a \"\"b\"\"\"\n";
+  j["blocks"][0]["conditions"] = "open.csv";
+  EXPECT_EQ(ParseProtocol(j, dir / "p.json").blocks[0].factors[0].levels[0]["label"], "a \"b\"");
+}
+
 // The real photos of a depth matching are chosen by distance_m wherever a trial finds it: its own factor, a key of
 // an object level, or a conditions table's column (the table was refused: "needs a factor distance_m").
 TEST(ProtocolValidate, RealPhotoDistancesComeFromFactorsObjectLevelsAndConditionsTables) {
