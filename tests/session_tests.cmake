@@ -130,6 +130,25 @@ add_preflight_test(escape-cell "/conditions/row/1/label: ${D}/escape-cell.csv li
 file(WRITE ${D}/open-quote.csv "edge,left,right,label\n1,measured,none,ok\n2,measured,none,\"ab\n")
 add_preflight_test(open-quote "/conditions/row/1: ${D}/open-quote.csv line 3: a quoted field is not closed"
                    "${grid_head} \"conditions\": \"open-quote.csv\"}")
+# A display profile's name is one line of at most 100 characters: a 100,000-character name and one with an escape
+# and a newline used to be recorded and printed as they were.
+string(REPEAT "x" 100000 long_name)
+file(WRITE ${D}/long-name-display.json "{\"name\": \"${long_name}\"}")
+file(WRITE ${D}/escape-name-display.json "{\"name\": \"booth\\u001b[2J\\n1\"}")
+add_test(NAME session_validate_display_name_long
+         COMMAND ${CMAKE_COMMAND} -DCMD=${BC}
+                 "-DARGS=validate;${T}/protocols/test1-static-grids.json;--display;${D}/long-name-display.json"
+                 -DEXPECT_CODE=3 -DONE_LINE=1
+                 "-DEXPECT_TEXT=long-name-display.json: /name: must be at most 100 characters, got 'xxxxxxxxxx"
+                 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+add_test(NAME session_run_display_name_escape
+         COMMAND ${CMAKE_COMMAND} -DCMD=${BC}
+                 "-DARGS=run;${T}/protocols/test1-static-grids.json;--participant;P1;--db;${T}/display-name.sqlite;--observer;sim;--display;${D}/escape-name-display.json"
+                 -DEXPECT_CODE=3 -DONE_LINE=1
+                 "-DEXPECT_TEXT=escape-name-display.json: /name: must not contain control characters (line breaks, tabs, escapes), got 'booth\\x1b[2J\\n1'"
+                 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+set_tests_properties(session_validate_display_name_long session_run_display_name_escape PROPERTIES
+                     FIXTURES_REQUIRED "scene;calib;session_protocols")
 
 # What the screen shows, measured on captured frames (run --capture) with the calibration's edge fit: each object's
 # blur against its recorded r_screen_px and its edges against its recorded outline (tests/capture_measure.cc).

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "core/typed.h"
 
 namespace blurcue::protocol {
@@ -48,7 +49,6 @@ const size_t kMaxBlocks = 100;
 const size_t kMaxFactors = 16;
 const size_t kMaxLevels = 1000;         // per factor: more than a sitting could show
 const size_t kMaxAdjustLevels = 50;     // each is low-passed up front: ~0.1 s apiece at 1280 px, ~1 s at 4K
-const size_t kMaxNameChars = 100;       // names: one line in titles, records and exports
 const size_t kMaxTextChars = 2000;      // instructions: about what a screen holds
 const size_t kMaxPathChars = 4096;
 
