@@ -149,6 +149,12 @@ add_test(NAME session_run_display_name_escape
                  -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
 set_tests_properties(session_validate_display_name_long session_run_display_name_escape PROPERTIES
                      FIXTURES_REQUIRED "scene;calib;session_protocols")
+# Over the cap with a practice criterion: test 1's edges in a warm-up of 495 trials a run, up to 11 runs, and a main
+# block of 4950. The message said 5445 trials (one run of each block), below the cap it broke.
+set(edges "[1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11]")
+add_preflight_test(criterion-10395
+                   "/blocks/0/factors: the session would have up to 10395 trials (11 runs (criterion max_repeats) x 11 edge x 45 repetitions = 5445 in block warm-up + 11 edge x 450 repetitions = 4950 in block main); a session may have at most 10000 trials"
+                   "${grid_head} \"sides\": {\"left\": \"measured\", \"right\": \"estimated\"}, \"blocks\": [{\"name\": \"warm-up\", \"practice\": true, \"criterion\": {\"correct\": 0.8, \"max_repeats\": 11}, \"sides\": {\"left\": \"measured\", \"right\": \"none\"}, \"factors\": {\"edge\": ${edges}}, \"repetitions\": 45}, {\"name\": \"main\", \"factors\": {\"edge\": ${edges}}, \"repetitions\": 450}]}")
 
 # What the screen shows, measured on captured frames (run --capture) with the calibration's edge fit: each object's
 # blur against its recorded r_screen_px and its edges against its recorded outline (tests/capture_measure.cc).

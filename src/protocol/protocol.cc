@@ -1376,30 +1376,68 @@ void Parser::CheckDesign(const Protocol& p) {
   }
   const int64_t trials = SessionTrials(p);
   if (trials > kMaxTrials) {
-    // Where the trials come from: the biggest block, with its crossing spelled out (in floating point: the
-    // product may not fit in 64 bits).
-    const Block* biggest = nullptr;
-    double most = -1, total = 0;
-    std::string crossing;
-    for (const auto& b : p.blocks) {
-      double n = b.repetitions * (b.counterbalance == Counterbalance::kSwapCopies ? 2.0 : 1.0);
+    // Where the trials come from: every block's share counted as SessionTrials counts it - a practice criterion's
+    // max_repeats runs, a procedure's trials per crossing, the protocol's practice drawn from its block - the
+    // biggest first, each with its crossing spelled out (in floating point: the product may not fit in 64 bits).
+    // The message used to add up one run of each block and spell out the block with the most trials per run, so a
+    // criterion's repeats were left out of a total that then lay below the cap it broke.
+    struct Share {
+      double n = 0;
+      const Block* block = nullptr;
       std::string spelled;
+    };
+    std::vector<Share> shares;
+    double total = 0;
+    bool worst_case = false;
+    for (const auto& b : p.blocks) {
+      Share share{1, &b, ""};
+      if (b.criterion) {
+        share.n = b.criterion->max_repeats;
+        share.spelled = std::to_string(b.criterion->max_repeats) + " runs (criterion max_repeats) x ";
+        worst_case = true;
+      }
       for (const auto& f : b.factors) {
-        n *= double(f.levels.size());
-        spelled += std::to_string(f.levels.size()) + " " + f.name + " x ";
+        share.n *= double(f.levels.size());
+        share.spelled += std::to_string(f.levels.size()) + " " + f.name + " x ";
       }
-      total += n;
-      if (n > most) {
-        most = n, biggest = &b;
-        crossing = spelled + std::to_string(b.repetitions) + " repetitions" +
-                   (b.counterbalance == Counterbalance::kSwapCopies ? " x 2 (swap_copies)" : "");
+      if (b.factors.empty()) share.n = 0;
+      if (b.procedure) {
+        share.n *= b.procedure->trials;
+        share.spelled += std::to_string(b.procedure->trials) + " trials (procedure)";
+      } else {
+        share.n *= b.repetitions * (b.counterbalance == Counterbalance::kSwapCopies ? 2.0 : 1.0);
+        share.spelled += std::to_string(b.repetitions) + " repetitions" +
+                         (b.counterbalance == Counterbalance::kSwapCopies ? " x 2 (swap_copies)" : "");
       }
+      if (b.name == p.practice.block && p.practice.count > 0) {
+        const double drawn = std::min<double>(p.practice.count, double(DesignTrials(b)));
+        share.n += drawn;
+        share.spelled += " + " + std::to_string(int64_t(drawn)) + " practice";
+      }
+      total += share.n;
+      if (share.n > 0) shares.push_back(std::move(share));
     }
-    char text[64];
-    std::snprintf(text, sizeof text, total < 1e15 ? "%.0f" : "%.3g", total);
-    Problem(biggest ? biggest->factors_pointer : "/",
-            "the session would have " + std::string(text) + " trials (" + crossing + "); a session may have at most " +
-                std::to_string(kMaxTrials) + " trials, practice included");
+    std::stable_sort(shares.begin(), shares.end(), [](const Share& a, const Share& b) { return a.n > b.n; });
+    auto count = [](double n) {
+      char text[64];
+      std::snprintf(text, sizeof text, n < 1e15 ? "%.0f" : "%.3g", n);
+      return std::string(text);
+    };
+    const size_t kShown = 3;
+    std::string parts;
+    double rest = 0;
+    for (size_t i = 0; i < shares.size(); ++i) {
+      if (i >= kShown) {
+        rest += shares[i].n;
+        continue;
+      }
+      parts += (i ? " + " : "") + shares[i].spelled + " = " + count(shares[i].n) + " in block " + shares[i].block->name;
+    }
+    if (shares.size() > kShown)
+      parts += " + " + count(rest) + " in " + std::to_string(shares.size() - kShown) + " more blocks";
+    Problem(shares.empty() ? "/" : shares.front().block->factors_pointer,
+            "the session would have " + std::string(worst_case ? "up to " : "") + count(total) + " trials (" + parts +
+                "); a session may have at most " + std::to_string(kMaxTrials) + " trials, practice included");
   } else if (trials == 0) {
     Problem("/", "makes no trials");
   }

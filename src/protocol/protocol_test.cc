@@ -845,6 +845,58 @@ TEST(ProtocolValidate, TrialCountBeyondSixtyFourBitsIsStillRefused) {
   EXPECT_TRUE(Contains(OnlyProblem(j), "the session would have 100000 trials")) << OnlyProblem(j);
 }
 
+// Over the cap, the message counts what SessionTrials counts - a practice criterion's max_repeats runs, a procedure's
+// trials - and spells out the blocks that make the total, the biggest first. It used to add one run of each block
+// (5445 < 10000 for the refused 10395) and spell out the block with the most trials per run.
+TEST(ProtocolValidate, TrialCountOverTheCapCountsCriterionRunsAndNamesTheBlocksThatMakeIt) {
+  Json j = Valid();
+  j["counterbalance"] = "none";
+  Json levels = Json::array();
+  for (int l = 0; l < 45; ++l) levels.push_back(l);
+  const Json pattern = {Valid()["blocks"][0]["factors"]["pattern"][0]};
+  j["blocks"] = Json::array({
+      {{"name", "warm-up"}, {"practice", true}, {"criterion", {{"correct", 0.8}, {"max_repeats", 11}}},
+       {"factors", {{"pattern", pattern}, {"f", levels}}}, {"repetitions", 11}},  // 495 a run
+      {{"name", "main"}, {"factors", {{"pattern", pattern}, {"f", levels}}}, {"repetitions", 110}}});  // 4950
+  std::string p = OnlyProblem(j);
+  EXPECT_TRUE(Contains(p, "/blocks/0/factors: the session would have up to 10395 trials (11 runs (criterion "
+                          "max_repeats) x 45 f x 1 pattern x 11 repetitions = 5445 in block warm-up + 45 f x 1 pattern "
+                          "x 110 repetitions = 4950 in block main); a session may have at most 10000 trials")) << p;
+  // The block with the most trials per run is not the one that makes most of the total: the criterion's is named
+  // first, and its pointer given.
+  j["blocks"][1]["repetitions"] = 200;  // 9000 a run, once
+  j["blocks"][0]["repetitions"] = 2;    // 90 a run, up to 11 times: 990
+  EXPECT_TRUE(Problems(j).empty()) << Problems(j).front();  // 9990
+  j["blocks"][0]["criterion"]["max_repeats"] = 20;  // 1800 + 9000
+  p = OnlyProblem(j);
+  EXPECT_TRUE(Contains(p, "/blocks/1/factors: the session would have up to 10800 trials (45 f x 1 pattern x 200 "
+                          "repetitions = 9000 in block main + 20 runs (criterion max_repeats) x 45 f x 1 pattern x 2 "
+                          "repetitions = 1800 in block warm-up)")) << p;
+  // The practice drawn from a block is added to it.
+  j = Valid();
+  levels.erase(levels.begin());
+  levels.push_back(45);  // sections 1..45
+  j["practice"] = {{"count", 4}, {"block", "task2"}};
+  j["blocks"][1]["factors"]["section"] = levels;
+  j["blocks"][1]["repetitions"] = 120;  // 45 x 120 x 2 = 10800, + 4 practice
+  p = OnlyProblem(j);
+  EXPECT_TRUE(Contains(p, "/blocks/1/factors: the session would have 10808 trials (1 pattern x 45 section x 120 "
+                          "repetitions x 2 (swap_copies) + 4 practice = 10804 in block task2 + 2 pattern x 1 "
+                          "repetitions x 2 (swap_copies) = 4 in block task1)")) << p;
+  // A procedure's block counts its trials per crossing (they were counted as its repetitions: 11).
+  j = Json::parse(R"({
+    "name": "adaptive", "version": 1,
+    "scene": {"background": "scene/scene.png", "calib": "calib.json"},
+    "content": {"type": "grid"}, "task": "forced_choice",
+    "blocks": [{"name": "stairs", "factors": {"edge": [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11]},
+                "procedure": {"type": "staircase", "variable": "relative_difference", "reference": "fitted",
+                              "trials": 1000, "start": 1, "min": 0.05, "max": 2, "steps": [0.4, 0.2]}}]
+  })");
+  p = OnlyProblem(j);
+  EXPECT_TRUE(Contains(p, "/blocks/0/factors: the session would have 11000 trials (11 edge x 1000 trials (procedure) = "
+                          "11000 in block stairs)")) << p;
+}
+
 TEST(ProtocolValidate, TooManyLevelsRejectedBeforeComparingThem) {
   Json j = Valid();
   Json levels = Json::array();
