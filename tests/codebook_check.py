@@ -24,8 +24,7 @@ def fail(message):
 
 def main(export_dir, db_path):
     codebook = pd.read_csv(os.path.join(export_dir, "codebook.csv"), dtype=str, keep_default_na=False)
-    tables = sorted(f for f in os.listdir(export_dir) if f.endswith(".csv") and not f.startswith("summary-")
-                    and f != "codebook.csv")
+    tables = sorted(f for f in os.listdir(export_dir) if f.endswith(".csv") and f != "codebook.csv")
     checked = 0
     for table in tables:
         book = codebook[codebook["table"] == table]

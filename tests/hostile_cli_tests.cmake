@@ -186,3 +186,12 @@ set_tests_properties(cli_hostile_animate_log_is_a_fifo cli_hostile_animate_video
 hostile_test(cli_hostile_run_info_given_twice 2 "--info age is given twice ('age=34' and 'age=35')"
              run ${PROJECT_SOURCE_DIR}/protocols/groups-and-info.json --participant P1 --db ${H}/info-twice.sqlite
              --observer sim --info age=34 --info handedness=right --info vision=normal --info age=35)
+# A 100,000-digit value is quoted by its first 60 characters and its length, not written out whole (core/typed.h Echo).
+string(REPEAT "1" 100000 digits)
+string(REPEAT "1" 60 shown)
+hostile_test(cli_hostile_observer_weber_100000_digits 2
+             "--observer weber must be a number, got '${shown}...' (100000 characters)"
+             run ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --participant P1 --db ${H}/x.sqlite
+             --observer sim:weber=${digits})
+hostile_test(cli_hostile_radius_100000_digits 2 "--radius-px: must be in [0, 500] px, got '${shown}...' (100000 characters)"
+             blur ${D}/small.png --radius-px ${digits} --out ${H}/x.png)

@@ -41,6 +41,13 @@ add_run_failure_test(session_run_negative_seed 2
                      "--seed: must be a whole number from 0 to 18446744073709551615, got '-3'"
                      run ${T}/protocols/test1-static-grids.json --participant P1 --db ${T}/seed.sqlite --observer sim
                      --seed -3)
+# A --info value of 100,000 characters is quoted by its first 60 and its length (core/typed.h Echo).
+string(REPEAT "a" 100000 notes)
+string(REPEAT "a" 60 shown)
+add_run_failure_test(session_run_info_100000_characters 2
+                     "--info notes=${shown}... (100000 characters): must be one line of printable text, at most 200 bytes"
+                     run ${T}/protocols/groups-and-info.json --participant P1 --db ${T}/info-long.sqlite --observer sim
+                     --info notes=${notes})
 # A person needs a window: without a display, one line says so (and what to do) before anything is recorded. No
 # display is the station's set-up, a usage error (exit 2), not an internal one.
 add_test(NAME session_run_person_without_display
@@ -109,6 +116,47 @@ add_preflight_test(nested-100000-deep "not valid JSON: nested deeper than 64 lev
 set(levels "[1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17,18,19,20,21,22,23,24,25,26,27,28,29,30]")
 add_preflight_test(eight-factors-of-30 "/factors: the session would have 656100000000 trials (30 a x 30 b x "
                    "${ball_head} ${ball_scene}, \"factors\": {\"pattern\": [${pattern}], \"a\": ${levels}, \"b\": ${levels}, \"c\": ${levels}, \"d\": ${levels}, \"e\": ${levels}, \"f\": ${levels}, \"g\": ${levels}, \"h\": ${levels}}}")
+
+# A conditions table's cell of Latin-1 bytes or with an escape byte: exit 3 naming the CSV file, its line and column
+# (it used to be exit 10, "invalid UTF-8 byte", or an escape written raw into the record).
+string(ASCII 255 254 latin1)
+string(ASCII 27 escape)
+file(WRITE ${D}/latin1-cell.csv "edge,left,right,label\n1,measured,none,caf${latin1}\n")
+file(WRITE ${D}/escape-cell.csv "edge,left,right,label\n1,measured,none,ok\n2,measured,none,a${escape}[2Jb\n")
+set(grid_head "{\"name\": \"t\", \"version\": 1, \"content\": {\"type\": \"grid\"}, \"task\": \"forced_choice\", ${ball_scene},")
+add_preflight_test(latin1-cell "/conditions/row/0/label: ${D}/latin1-cell.csv line 2, column 4 (label): must be printable UTF-8 text"
+                   "${grid_head} \"conditions\": \"latin1-cell.csv\"}")
+add_preflight_test(escape-cell "/conditions/row/1/label: ${D}/escape-cell.csv line 3, column 4 (label): must be printable UTF-8 text"
+                   "${grid_head} \"conditions\": \"escape-cell.csv\"}")
+# A quote left open at a line's end: the label "ab" used to be recorded.
+file(WRITE ${D}/open-quote.csv "edge,left,right,label\n1,measured,none,ok\n2,measured,none,\"ab\n")
+add_preflight_test(open-quote "/conditions/row/1: ${D}/open-quote.csv line 3: a quoted field is not closed"
+                   "${grid_head} \"conditions\": \"open-quote.csv\"}")
+# A display profile's name is one line of at most 100 characters: a 100,000-character name and one with an escape
+# and a newline used to be recorded and printed as they were.
+string(REPEAT "x" 100000 long_name)
+file(WRITE ${D}/long-name-display.json "{\"name\": \"${long_name}\"}")
+file(WRITE ${D}/escape-name-display.json "{\"name\": \"booth\\u001b[2J\\n1\"}")
+add_test(NAME session_validate_display_name_long
+         COMMAND ${CMAKE_COMMAND} -DCMD=${BC}
+                 "-DARGS=validate;${T}/protocols/test1-static-grids.json;--display;${D}/long-name-display.json"
+                 -DEXPECT_CODE=3 -DONE_LINE=1
+                 "-DEXPECT_TEXT=long-name-display.json: /name: must be at most 100 characters, got 'xxxxxxxxxx"
+                 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+add_test(NAME session_run_display_name_escape
+         COMMAND ${CMAKE_COMMAND} -DCMD=${BC}
+                 "-DARGS=run;${T}/protocols/test1-static-grids.json;--participant;P1;--db;${T}/display-name.sqlite;--observer;sim;--display;${D}/escape-name-display.json"
+                 -DEXPECT_CODE=3 -DONE_LINE=1
+                 "-DEXPECT_TEXT=escape-name-display.json: /name: must not contain control characters (line breaks, tabs, escapes), got 'booth\\x1b[2J\\n1'"
+                 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+set_tests_properties(session_validate_display_name_long session_run_display_name_escape PROPERTIES
+                     FIXTURES_REQUIRED "scene;calib;session_protocols")
+# Over the cap with a practice criterion: test 1's edges in a warm-up of 495 trials a run, up to 11 runs, and a main
+# block of 4950. The message said 5445 trials (one run of each block), below the cap it broke.
+set(edges "[1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11]")
+add_preflight_test(criterion-10395
+                   "/blocks/0/factors: the session would have up to 10395 trials (11 runs (criterion max_repeats) x 11 edge x 45 repetitions = 5445 in block warm-up + 11 edge x 450 repetitions = 4950 in block main); a session may have at most 10000 trials"
+                   "${grid_head} \"sides\": {\"left\": \"measured\", \"right\": \"estimated\"}, \"blocks\": [{\"name\": \"warm-up\", \"practice\": true, \"criterion\": {\"correct\": 0.8, \"max_repeats\": 11}, \"sides\": {\"left\": \"measured\", \"right\": \"none\"}, \"factors\": {\"edge\": ${edges}}, \"repetitions\": 45}, {\"name\": \"main\", \"factors\": {\"edge\": ${edges}}, \"repetitions\": 450}]}")
 
 # What the screen shows, measured on captured frames (run --capture) with the calibration's edge fit: each object's
 # blur against its recorded r_screen_px and its edges against its recorded outline (tests/capture_measure.cc).

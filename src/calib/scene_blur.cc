@@ -153,7 +153,7 @@ BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px) {
   }
   throw Error(ErrorKind::kUsage,
               "blur source must be none, measured, measured_section, estimated, fitted or a radius in [0, " +
-                  std::to_string(int(optics::kMaxBlurRadiusPx)) + "] px, got '" + text + "'");
+                  std::to_string(int(optics::kMaxBlurRadiusPx)) + "] px, got " + Echo(text));
 }
 
 std::string ToString(BlurSource source) {

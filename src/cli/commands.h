@@ -35,9 +35,9 @@ inline CLI::Validator FiniteRange(double lo, double hi, const std::string& unit,
   return CLI::Validator(
       [lo, hi, open_low, what](std::string& text) -> std::string {
         const std::optional<double> v = ParseDecimal(text);
-        if (!v) return what + "'" + text + "'";
+        if (!v) return what + Echo(text);
         const bool above = open_low ? *v > lo : *v >= lo;
-        return above && *v <= hi ? "" : what + text;
+        return above && *v <= hi ? "" : what + Echo(text, false);
       },
       range);
 }
@@ -57,10 +57,10 @@ inline CLI::Validator IntRange(long long lo, long long hi, const std::string& un
       [lo, hi, what](std::string& text) -> std::string {
         const size_t sign = !text.empty() && (text[0] == '-' || text[0] == '+') ? 1 : 0;
         const bool whole = text.size() > sign && text.find_first_not_of("0123456789", sign) == std::string::npos;
-        if (!whole) return what + "'" + text + "'";
+        if (!whole) return what + Echo(text);
         errno = 0;
         const long long v = std::strtoll(text.c_str(), nullptr, 10);
-        if (errno == ERANGE || v < lo || v > hi) return what + text;
+        if (errno == ERANGE || v < lo || v > hi) return what + Echo(text, false);
         text = std::to_string(v);
         return "";
       },
@@ -77,7 +77,7 @@ inline CLI::Validator SeedValidator() {
         const bool digits = !text.empty() && text.size() <= 20 &&
                             text.find_first_not_of("0123456789") == std::string::npos &&
                             (text.size() < 20 || text <= "18446744073709551615");
-        return digits ? "" : "must be a whole number from 0 to 18446744073709551615, got '" + text + "'";
+        return digits ? "" : "must be a whole number from 0 to 18446744073709551615, got " + Echo(text);
       },
       "SEED");
 }

@@ -9,6 +9,7 @@
 #include "calib/scene_blur.h"
 #include "cli/commands.h"
 #include "core/error.h"
+#include "core/typed.h"
 #include "core/image.h"
 #include "render/blur.h"
 #include "render/gl_context.h"
@@ -113,7 +114,7 @@ void AddRenderCommand(CLI::App& app) {
       object = render::BallOnBoard(scene.board, args->section, y, 10, y);
       texture_name = args->object.size() > 5 && args->object[4] == ':' ? args->object.substr(5) : "soccer";
     } else {
-      throw Error(ErrorKind::kUsage, "--object must be grid or ball[:TEXTURE], got '" + args->object + "'");
+      throw Error(ErrorKind::kUsage, "--object must be grid or ball[:TEXTURE], got " + Echo(args->object));
     }
     object.texture = render::SurfaceTexture(ReadImage(render::ResolveStimulus(texture_name)));
     object.brightness = args->brightness;

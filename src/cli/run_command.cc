@@ -7,6 +7,7 @@
 
 #include "cli/commands.h"
 #include "core/error.h"
+#include "core/typed.h"
 #include "session/runner.h"
 
 namespace blurcue::cli {
@@ -109,13 +110,13 @@ void AddRunCommand(CLI::App& app) {
     for (const std::string& item : args->info) {
       const size_t eq = item.find('=');
       if (eq == std::string::npos || eq == 0)
-        throw Error(ErrorKind::kUsage, "--info: must be KEY=VALUE, got '" + item + "'");
+        throw Error(ErrorKind::kUsage, "--info: must be KEY=VALUE, got " + Echo(item));
       const std::string key = item.substr(0, eq);
       // A key given twice would keep one of its values unsaid: which one was meant is the experimenter's to say.
       for (const auto& given : options.info)
         if (given.first == key)
-          throw Error(ErrorKind::kUsage, "--info " + key + " is given twice ('" + given.first + "=" + given.second +
-                                             "' and '" + item + "')");
+          throw Error(ErrorKind::kUsage, "--info " + Echo(key, false) + " is given twice (" +
+                                             Echo(given.first + "=" + given.second) + " and " + Echo(item) + ")");
       options.info.emplace_back(key, item.substr(eq + 1));
     }
     const session::RunResult r = session::RunSession(options);

@@ -27,7 +27,7 @@ Error UsageError(const std::string& option, const std::string& what) {
 double ParseFocus(const std::string& text) {
   if (text == "inf" || text == "infinity") return std::numeric_limits<double>::infinity();
   if (const std::optional<double> v = ParseDecimal(text); v && *v > 0 && *v <= 1e6) return *v;
-  throw UsageError("--focus-mm", "must be a distance in (0, 1000000] mm or 'inf', got '" + text + "'");
+  throw UsageError("--focus-mm", "must be a distance in (0, 1000000] mm or 'inf', got " + Echo(text));
 }
 
 // RenderScene names SceneOptions fields; say them as the options a user typed.

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/typed.h"
 
 namespace blurcue {
 
@@ -29,7 +30,7 @@ Board Board::Parse(const std::string& text, double square_mm) {
   b.cols = x == std::string::npos ? -1 : side(0, x);
   b.rows = x == std::string::npos ? -1 : side(x + 1, text.size());
   if (b.cols < 0 || b.rows < 0)
-    throw Error(ErrorKind::kUsage, "--board: expected COLSxROWS in squares such as 7x10, got '" + text + "'");
+    throw Error(ErrorKind::kUsage, "--board: expected COLSxROWS in squares such as 7x10, got " + Echo(text));
   b.square_mm = square_mm;
   try {
     b.Validate("--board " + text);

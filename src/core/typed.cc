@@ -1,5 +1,6 @@
 #include "core/typed.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
@@ -96,6 +97,17 @@ std::string OneLine(std::string_view text) {
     }
   }
   return out;
+}
+
+std::string Echo(std::string_view text, bool quoted) {
+  const std::string quote = quoted ? "'" : "";
+  size_t chars = 0, cut = text.size();
+  for (size_t i = 0; i < text.size(); ++chars) {
+    if (chars == kMaxEchoChars) cut = i;
+    i += std::max<size_t>(PrintableCharAt(text, i), 1);
+  }
+  if (chars <= kMaxEchoChars) return quote + OneLine(text) + quote;
+  return quote + OneLine(text.substr(0, cut)) + "..." + quote + " (" + std::to_string(chars) + " characters)";
 }
 
 bool IsWholeDecimal(std::string_view text) {

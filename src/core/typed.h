@@ -25,4 +25,13 @@ bool IsPrintableUtf8(std::string_view text);
 // \t, any other control or broken byte \xNN. For messages that echo what someone typed.
 std::string OneLine(std::string_view text);
 
+// The most characters of a value a message quotes (Echo).
+inline constexpr size_t kMaxEchoChars = 60;
+
+// `text` as a message quotes what someone typed: OneLine of it, cut after kMaxEchoChars characters (a control or
+// broken byte counts as one) with "..." and the whole length: 'abc...' (100000 characters). Between single quotes
+// when `quoted`, bare otherwise (111... (100000 characters)). Every message that echoes a typed value uses it, so
+// a 100,000-digit option is one short line.
+std::string Echo(std::string_view text, bool quoted = true);
+
 }  // namespace blurcue

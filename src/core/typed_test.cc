@@ -53,5 +53,20 @@ TEST(OneLine, EscapesControlsAndBrokenBytesAndKeepsText) {
   for (const char* text : {"x\n", "\x1b", "\xc3(", "\xc2\x85"}) EXPECT_TRUE(IsPrintableUtf8(OneLine(text))) << text;
 }
 
+// A typed value a message quotes is cut after 60 characters, with its whole length said; short values stay whole.
+TEST(Echo, CutsLongValuesAndSaysTheirLength) {
+  EXPECT_EQ(Echo("nan"), "'nan'");
+  EXPECT_EQ(Echo("1e308", false), "1e308");
+  EXPECT_EQ(Echo(""), "''");
+  EXPECT_EQ(Echo(std::string(60, '7')), "'" + std::string(60, '7') + "'");
+  EXPECT_EQ(Echo(std::string(100000, '1')), "'" + std::string(60, '1') + "...' (100000 characters)");
+  EXPECT_EQ(Echo(std::string(61, '1'), false), std::string(60, '1') + "... (61 characters)");
+  // Characters, not bytes: a cut never splits one, and controls are escaped as OneLine does.
+  std::string zoe;
+  for (int i = 0; i < 70; ++i) zoe += "\xc3\xab";
+  EXPECT_EQ(Echo(zoe), "'" + zoe.substr(0, 120) + "...' (70 characters)");
+  EXPECT_EQ(Echo("a\nb\x1b"), "'a\\nb\\x1b'");
+}
+
 }  // namespace
 }  // namespace blurcue

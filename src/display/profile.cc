@@ -6,6 +6,8 @@
 #include <type_traits>
 
 #include "core/error.h"
+#include "core/limits.h"
+#include "core/typed.h"
 
 namespace blurcue::display {
 namespace {
@@ -128,8 +130,17 @@ std::vector<std::string> ValidateProfile(const Json& json, const std::filesystem
       check.Problem("/" + item.key(), "unknown key (known: name, width_px, height_px, width_mm, height_mm, "
                                       "distance_mm, refresh_hz, transfer), got " + Got(item.value()));
   Profile p;
-  if (json.contains("name") && (!json["name"].is_string() || json["name"].get<std::string>().empty()))
+  if (json.contains("name") && (!json["name"].is_string() || json["name"].get<std::string>().empty())) {
     check.Problem("/name", "must be a non-empty string, got " + Got(json["name"]));
+  } else if (json.contains("name")) {
+    // The name is recorded with every session and printed by validate, run and sessions: one line of text, as a
+    // protocol's name. A 100,000-character name or one holding a newline or an escape was taken as it was.
+    const std::string& name = json["name"].get_ref<const std::string&>();
+    if (name.size() > kMaxNameChars)
+      check.Problem("/name", "must be at most " + std::to_string(kMaxNameChars) + " characters, got " + Echo(name));
+    else if (!IsPrintableUtf8(name))
+      check.Problem("/name", "must not contain control characters (line breaks, tabs, escapes), got " + Echo(name));
+  }
   check.Number(json, "width_px", 320, 16384, "px", &p.width_px);
   check.Number(json, "height_px", 200, 16384, "px", &p.height_px);
   check.Number(json, "width_mm", 50, 20000, "mm", &p.width_mm);

@@ -110,6 +110,23 @@ TEST(Profile, EveryProblemAtOnceWithFilePointerAndValue) {
   EXPECT_TRUE(Contains(text, "lab.json: /transfer/gamma: is required for a gamma transfer")) << text;
 }
 
+// A profile's name is recorded with every session and printed: one line of at most 100 bytes, as a protocol's name.
+// A 100,000-character name, or one with a newline or an escape, used to be taken and printed raw.
+TEST(Profile, NameIsOneLineOfAtMost100Characters) {
+  EXPECT_EQ(ParseProfile({{"name", std::string(100, 'x')}}, "lab.json").name, std::string(100, 'x'));
+  EXPECT_EQ(ParseProfile({{"name", "booth 1, Zoë's room"}}, "lab.json").name, "booth 1, Zoë's room");
+  const std::string longer = ProblemsOf({{"name", std::string(100000, 'x')}});
+  EXPECT_TRUE(Contains(longer, "lab.json: /name: must be at most 100 characters, got 'xxx")) << longer;
+  EXPECT_TRUE(Contains(longer, "...' (100000 characters)\n")) << longer;
+  EXPECT_LT(longer.size(), 200u);
+  for (const char* name : {"booth\n1", "booth\x1b[2J", "tab\there"}) {
+    const std::string text = ProblemsOf({{"name", name}});
+    EXPECT_TRUE(Contains(text, "lab.json: /name: must not contain control characters")) << text;
+    EXPECT_EQ(text.find('\n'), text.size() - 1) << text;  // one line: the value is escaped
+    EXPECT_THROW(ParseProfile({{"name", name}}, "lab.json"), Error);
+  }
+}
+
 TEST(Profile, InconsistentOrPartialSizesAreRefused) {
   EXPECT_TRUE(Contains(ProblemsOf({{"width_px", 1920}, {"height_px", 1080}, {"width_mm", 531.4}, {"height_mm", 400}}),
                        "not square"));

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "core/typed.h"
 
 namespace blurcue::protocol {
@@ -48,7 +49,6 @@ const size_t kMaxBlocks = 100;
 const size_t kMaxFactors = 16;
 const size_t kMaxLevels = 1000;         // per factor: more than a sitting could show
 const size_t kMaxAdjustLevels = 50;     // each is low-passed up front: ~0.1 s apiece at 1280 px, ~1 s at 4K
-const size_t kMaxNameChars = 100;       // names: one line in titles, records and exports
 const size_t kMaxTextChars = 2000;      // instructions: about what a screen holds
 const size_t kMaxPathChars = 4096;
 
@@ -616,27 +616,36 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
     Problem(ptr, e.what(), Json(*text));
     return {};
   }
-  // Comma-separated, double quotes around a field that holds commas or quotes ("" for one quote).
-  auto split = [](const std::string& line) {
-    std::vector<std::string> fields(1);
+  // Comma-separated, double quotes around a field that holds commas or quotes ("" for one quote); a field does not
+  // span lines, so a quote still open at the line's end is an error (it used to swallow the rest of the line).
+  struct Row {
+    std::vector<std::string> fields{1};
+    size_t line = 0;      // in the file, from 1
+    bool closed = true;   // every quote closed
+  };
+  auto split = [](const std::string& line, size_t number) {
+    Row row;
+    row.line = number;
     bool quoted = false;
     for (size_t i = 0; i < line.size(); ++i) {
       const char c = line[i];
-      if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"') fields.back() += '"', ++i;
+      if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"') row.fields.back() += '"', ++i;
       else if (c == '"') quoted = !quoted;
-      else if (c == ',' && !quoted) fields.emplace_back();
-      else fields.back() += c;
+      else if (c == ',' && !quoted) row.fields.emplace_back();
+      else row.fields.back() += c;
     }
-    return fields;
+    row.closed = !quoted;
+    return row;
   };
-  std::vector<std::vector<std::string>> rows;
-  size_t start = 0;
+  std::vector<Row> rows;
+  size_t start = 0, number = 0;
   while (start <= csv.size()) {
     size_t end = csv.find('\n', start);
     if (end == std::string::npos) end = csv.size();
     std::string line = csv.substr(start, end - start);
+    ++number;
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (!line.empty()) rows.push_back(split(line));
+    if (!line.empty()) rows.push_back(split(line, number));
     start = end + 1;
     if (rows.size() > size_t(kMaxTrials) + 1) break;
   }
@@ -649,7 +658,12 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
     Problem(ptr, where + ": more than " + std::to_string(kMaxTrials) + " rows", Json(*text));
     return {};
   }
-  const std::vector<std::string>& header = rows.front();
+  const std::string unclosed = ": a quoted field is not closed (a field cannot span lines; write \"\" for a quote)";
+  if (!rows.front().closed) {
+    Problem(ptr, where + " line " + std::to_string(rows.front().line) + unclosed, Json(*text));
+    return {};
+  }
+  const std::vector<std::string>& header = rows.front().fields;
   std::set<std::string> names;
   for (const auto& name : header)
     if (name.empty() || name.size() > kMaxNameChars || !IsPrintableUtf8(name) || !names.insert(name).second) {
@@ -660,22 +674,39 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
   Factor factor;
   factor.name = "row";
   for (size_t r = 1; r < rows.size(); ++r) {
-    if (rows[r].size() != header.size()) {
-      Problem(ptr + "/row/" + std::to_string(r - 1), where + " line " + std::to_string(r + 1) + ": has " +
-                                                         std::to_string(rows[r].size()) + " fields, the header " +
-                                                         std::to_string(header.size()), Json(*text));
+    const std::string rp = ptr + "/row/" + std::to_string(r - 1);
+    const std::string line = where + " line " + std::to_string(rows[r].line);
+    if (!rows[r].closed) {
+      Problem(rp, line + unclosed, Json(*text));
+      continue;
+    }
+    if (rows[r].fields.size() != header.size()) {
+      Problem(rp, line + ": has " + std::to_string(rows[r].fields.size()) + " fields, the header " +
+                      std::to_string(header.size()), Json(*text));
       continue;
     }
     Json level = Json::object();
+    bool printable = true;
     for (size_t c = 0; c < header.size(); ++c) {
-      const std::string& cell = rows[r][c];
+      const std::string& cell = rows[r].fields[c];
+      const std::string cp = rp + "/" + Escape(header[c]);
+      // A cell becomes a level, a label in the record, the tables and the report: text they can all hold as it
+      // is. A Latin-1 byte or a NUL used to reach the record raw, or to stop validate with a JSON library error.
+      if (!IsPrintableUtf8(cell)) {
+        Problem(cp, line + ", column " + std::to_string(c + 1) + " (" + header[c] +
+                        "): must be printable UTF-8 text (no control characters; save the file as UTF-8), got " +
+                        Echo(cell));
+        printable = false;
+        continue;
+      }
       const std::optional<double> number = ParseDecimal(cell);
       level[header[c]] = IsWholeDecimal(cell) && std::abs(*number) < 9e15 ? Json(int64_t(*number))
                          : number                                       ? Json(*number)
                                                                         : Json(cell);
-      if (cell.empty()) Problem(ptr + "/row/" + std::to_string(r - 1) + "/" + Escape(header[c]), "is empty", Json(cell));
-      else CheckLevelValue(header[c], level[header[c]], ptr + "/row/" + std::to_string(r - 1) + "/" + Escape(header[c]));
+      if (cell.empty()) Problem(cp, "is empty", Json(cell));
+      else CheckLevelValue(header[c], level[header[c]], cp);
     }
+    if (!printable) continue;
     factor.levels.push_back(std::move(level));
   }
   return {factor};
@@ -1345,30 +1376,68 @@ void Parser::CheckDesign(const Protocol& p) {
   }
   const int64_t trials = SessionTrials(p);
   if (trials > kMaxTrials) {
-    // Where the trials come from: the biggest block, with its crossing spelled out (in floating point: the
-    // product may not fit in 64 bits).
-    const Block* biggest = nullptr;
-    double most = -1, total = 0;
-    std::string crossing;
-    for (const auto& b : p.blocks) {
-      double n = b.repetitions * (b.counterbalance == Counterbalance::kSwapCopies ? 2.0 : 1.0);
+    // Where the trials come from: every block's share counted as SessionTrials counts it - a practice criterion's
+    // max_repeats runs, a procedure's trials per crossing, the protocol's practice drawn from its block - the
+    // biggest first, each with its crossing spelled out (in floating point: the product may not fit in 64 bits).
+    // The message used to add up one run of each block and spell out the block with the most trials per run, so a
+    // criterion's repeats were left out of a total that then lay below the cap it broke.
+    struct Share {
+      double n = 0;
+      const Block* block = nullptr;
       std::string spelled;
+    };
+    std::vector<Share> shares;
+    double total = 0;
+    bool worst_case = false;
+    for (const auto& b : p.blocks) {
+      Share share{1, &b, ""};
+      if (b.criterion) {
+        share.n = b.criterion->max_repeats;
+        share.spelled = std::to_string(b.criterion->max_repeats) + " runs (criterion max_repeats) x ";
+        worst_case = true;
+      }
       for (const auto& f : b.factors) {
-        n *= double(f.levels.size());
-        spelled += std::to_string(f.levels.size()) + " " + f.name + " x ";
+        share.n *= double(f.levels.size());
+        share.spelled += std::to_string(f.levels.size()) + " " + f.name + " x ";
       }
-      total += n;
-      if (n > most) {
-        most = n, biggest = &b;
-        crossing = spelled + std::to_string(b.repetitions) + " repetitions" +
-                   (b.counterbalance == Counterbalance::kSwapCopies ? " x 2 (swap_copies)" : "");
+      if (b.factors.empty()) share.n = 0;
+      if (b.procedure) {
+        share.n *= b.procedure->trials;
+        share.spelled += std::to_string(b.procedure->trials) + " trials (procedure)";
+      } else {
+        share.n *= b.repetitions * (b.counterbalance == Counterbalance::kSwapCopies ? 2.0 : 1.0);
+        share.spelled += std::to_string(b.repetitions) + " repetitions" +
+                         (b.counterbalance == Counterbalance::kSwapCopies ? " x 2 (swap_copies)" : "");
       }
+      if (b.name == p.practice.block && p.practice.count > 0) {
+        const double drawn = std::min<double>(p.practice.count, double(DesignTrials(b)));
+        share.n += drawn;
+        share.spelled += " + " + std::to_string(int64_t(drawn)) + " practice";
+      }
+      total += share.n;
+      if (share.n > 0) shares.push_back(std::move(share));
     }
-    char text[64];
-    std::snprintf(text, sizeof text, total < 1e15 ? "%.0f" : "%.3g", total);
-    Problem(biggest ? biggest->factors_pointer : "/",
-            "the session would have " + std::string(text) + " trials (" + crossing + "); a session may have at most " +
-                std::to_string(kMaxTrials) + " trials, practice included");
+    std::stable_sort(shares.begin(), shares.end(), [](const Share& a, const Share& b) { return a.n > b.n; });
+    auto count = [](double n) {
+      char text[64];
+      std::snprintf(text, sizeof text, n < 1e15 ? "%.0f" : "%.3g", n);
+      return std::string(text);
+    };
+    const size_t kShown = 3;
+    std::string parts;
+    double rest = 0;
+    for (size_t i = 0; i < shares.size(); ++i) {
+      if (i >= kShown) {
+        rest += shares[i].n;
+        continue;
+      }
+      parts += (i ? " + " : "") + shares[i].spelled + " = " + count(shares[i].n) + " in block " + shares[i].block->name;
+    }
+    if (shares.size() > kShown)
+      parts += " + " + count(rest) + " in " + std::to_string(shares.size() - kShown) + " more blocks";
+    Problem(shares.empty() ? "/" : shares.front().block->factors_pointer,
+            "the session would have " + std::string(worst_case ? "up to " : "") + count(total) + " trials (" + parts +
+                "); a session may have at most " + std::to_string(kMaxTrials) + " trials, practice included");
   } else if (trials == 0) {
     Problem("/", "makes no trials");
   }

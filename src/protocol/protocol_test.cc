@@ -217,6 +217,64 @@ TEST(ProtocolValidate, ConditionsTableGivesTheDesignRowByRow) {
   EXPECT_TRUE(Contains(OnlyProblem(j), "/blocks/0/conditions: no such file")) << OnlyProblem(j);
 }
 
+// A conditions table's cell that is not UTF-8 (a Latin-1 file's "é" or stray bytes) is a problem naming the CSV
+// file, its line and column, and the cell's pointer; it used to pass and stop validate, run, preview and plan with
+// the JSON library's "invalid UTF-8 byte" (exit 10) when the trial list was hashed.
+TEST(ProtocolValidate, ConditionsTableCellThatIsNotUtf8IsRefusedNamingFileLineAndColumn) {
+  const fs::path dir = SceneFolder();
+  std::ofstream(dir / "latin1.csv") << "edge,left,right,label\n1,measured,none,ok\n2,measured,none,caf\xe9\xff\xfe\n";
+  Json j = Valid();
+  j["blocks"] = {{{"name", "rows"}, {"conditions", "latin1.csv"}}};
+  const std::string problem = OnlyProblem(j);
+  EXPECT_TRUE(Contains(problem, "p.json: /blocks/0/conditions/row/1/label: ")) << problem;
+  EXPECT_TRUE(Contains(problem, "latin1.csv line 3, column 4 (label): must be printable UTF-8 text")) << problem;
+  EXPECT_TRUE(Contains(problem, "got 'caf\\xe9\\xff\\xfe'")) << problem;
+  try {
+    ParseProtocol(j, dir / "p.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+  }
+}
+
+// A NUL, escape or other control byte in a cell is refused as in a protocol's own names: it used to be written raw
+// into the record's trials.
+TEST(ProtocolValidate, ConditionsTableCellWithAControlByteIsRefused) {
+  const fs::path dir = SceneFolder();
+  const char text[] = "edge,left,right,label\n1,measured,none,o\0k\n2,measured,none,a\x1b[2Jb\n3,measured,none,\"tab\there\"\n";
+  std::ofstream(dir / "controls.csv") << std::string(text, sizeof text - 1);
+  Json j = Valid();
+  j["blocks"] = {{{"name", "rows"}, {"conditions", "controls.csv"}}};
+  const auto problems = Problems(j);
+  ASSERT_EQ(problems.size(), 3u);
+  EXPECT_TRUE(Contains(problems[0], "/row/0/label: " + (dir / "controls.csv").string() + " line 2, column 4 (label): "
+                                    "must be printable UTF-8 text")) << problems[0];
+  EXPECT_TRUE(Contains(problems[0], "got 'o\\x00k'")) << problems[0];
+  EXPECT_TRUE(Contains(problems[1], "/row/1/label: ")) << problems[1];
+  EXPECT_TRUE(Contains(problems[1], "got 'a\\x1b[2Jb'")) << problems[1];
+  EXPECT_TRUE(Contains(problems[2], "/row/2/label: ")) << problems[2];
+}
+
+// A quote left open at a line's end is a problem naming the file and the line (a field cannot span lines): the
+// table `2,measured,none,"ab` used to validate and record the label `ab`. The line counts the file's lines, blank
+// ones included.
+TEST(ProtocolValidate, ConditionsTableUnclosedQuoteIsRefusedNamingTheLine) {
+  const fs::path dir = SceneFolder();
+  std::ofstream(dir / "open.csv") << "edge,left,right,label\n1,measured,none,\"a \"\"b\"\"\"\n\n2,measured,none,\"ab\n";
+  Json j = Valid();
+  j["blocks"] = {{{"name", "rows"}, {"conditions", "open.csv"}}};
+  const std::string problem = OnlyProblem(j);
+  EXPECT_TRUE(Contains(problem, "/blocks/0/conditions/row/1: " + (dir / "open.csv").string() +
+                                    " line 4: a quoted field is not closed")) << problem;
+  std::ofstream(dir / "open-header.csv") << "edge,left,right,\"label\n1,measured,none,x\n";
+  j["blocks"][0]["conditions"] = "open-header.csv";
+  EXPECT_TRUE(Contains(OnlyProblem(j), "open-header.csv line 1: a quoted field is not closed")) << OnlyProblem(j);
+  // Closed quotes still read as before: "" is one quote.
+  std::ofstream(dir / "open.csv") << "edge,left,right,label\n1,measured,none,\"a \"\"b\"\"\"\n";
+  j["blocks"][0]["conditions"] = "open.csv";
+  EXPECT_EQ(ParseProtocol(j, dir / "p.json").blocks[0].factors[0].levels[0]["label"], "a \"b\"");
+}
+
 // The real photos of a depth matching are chosen by distance_m wherever a trial finds it: its own factor, a key of
 // an object level, or a conditions table's column (the table was refused: "needs a factor distance_m").
 TEST(ProtocolValidate, RealPhotoDistancesComeFromFactorsObjectLevelsAndConditionsTables) {
@@ -785,6 +843,58 @@ TEST(ProtocolValidate, TrialCountBeyondSixtyFourBitsIsStillRefused) {
   j["repetitions"] = 10000;  // a small crossing, repeated past the cap
   j["blocks"][0]["factors"] = {{"pattern", Valid()["blocks"][0]["factors"]["pattern"]}};
   EXPECT_TRUE(Contains(OnlyProblem(j), "the session would have 100000 trials")) << OnlyProblem(j);
+}
+
+// Over the cap, the message counts what SessionTrials counts - a practice criterion's max_repeats runs, a procedure's
+// trials - and spells out the blocks that make the total, the biggest first. It used to add one run of each block
+// (5445 < 10000 for the refused 10395) and spell out the block with the most trials per run.
+TEST(ProtocolValidate, TrialCountOverTheCapCountsCriterionRunsAndNamesTheBlocksThatMakeIt) {
+  Json j = Valid();
+  j["counterbalance"] = "none";
+  Json levels = Json::array();
+  for (int l = 0; l < 45; ++l) levels.push_back(l);
+  const Json pattern = {Valid()["blocks"][0]["factors"]["pattern"][0]};
+  j["blocks"] = Json::array({
+      {{"name", "warm-up"}, {"practice", true}, {"criterion", {{"correct", 0.8}, {"max_repeats", 11}}},
+       {"factors", {{"pattern", pattern}, {"f", levels}}}, {"repetitions", 11}},  // 495 a run
+      {{"name", "main"}, {"factors", {{"pattern", pattern}, {"f", levels}}}, {"repetitions", 110}}});  // 4950
+  std::string p = OnlyProblem(j);
+  EXPECT_TRUE(Contains(p, "/blocks/0/factors: the session would have up to 10395 trials (11 runs (criterion "
+                          "max_repeats) x 45 f x 1 pattern x 11 repetitions = 5445 in block warm-up + 45 f x 1 pattern "
+                          "x 110 repetitions = 4950 in block main); a session may have at most 10000 trials")) << p;
+  // The block with the most trials per run is not the one that makes most of the total: the criterion's is named
+  // first, and its pointer given.
+  j["blocks"][1]["repetitions"] = 200;  // 9000 a run, once
+  j["blocks"][0]["repetitions"] = 2;    // 90 a run, up to 11 times: 990
+  EXPECT_TRUE(Problems(j).empty()) << Problems(j).front();  // 9990
+  j["blocks"][0]["criterion"]["max_repeats"] = 20;  // 1800 + 9000
+  p = OnlyProblem(j);
+  EXPECT_TRUE(Contains(p, "/blocks/1/factors: the session would have up to 10800 trials (45 f x 1 pattern x 200 "
+                          "repetitions = 9000 in block main + 20 runs (criterion max_repeats) x 45 f x 1 pattern x 2 "
+                          "repetitions = 1800 in block warm-up)")) << p;
+  // The practice drawn from a block is added to it.
+  j = Valid();
+  levels.erase(levels.begin());
+  levels.push_back(45);  // sections 1..45
+  j["practice"] = {{"count", 4}, {"block", "task2"}};
+  j["blocks"][1]["factors"]["section"] = levels;
+  j["blocks"][1]["repetitions"] = 120;  // 45 x 120 x 2 = 10800, + 4 practice
+  p = OnlyProblem(j);
+  EXPECT_TRUE(Contains(p, "/blocks/1/factors: the session would have 10808 trials (1 pattern x 45 section x 120 "
+                          "repetitions x 2 (swap_copies) + 4 practice = 10804 in block task2 + 2 pattern x 1 "
+                          "repetitions x 2 (swap_copies) = 4 in block task1)")) << p;
+  // A procedure's block counts its trials per crossing (they were counted as its repetitions: 11).
+  j = Json::parse(R"({
+    "name": "adaptive", "version": 1,
+    "scene": {"background": "scene/scene.png", "calib": "calib.json"},
+    "content": {"type": "grid"}, "task": "forced_choice",
+    "blocks": [{"name": "stairs", "factors": {"edge": [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11]},
+                "procedure": {"type": "staircase", "variable": "relative_difference", "reference": "fitted",
+                              "trials": 1000, "start": 1, "min": 0.05, "max": 2, "steps": [0.4, 0.2]}}]
+  })");
+  p = OnlyProblem(j);
+  EXPECT_TRUE(Contains(p, "/blocks/0/factors: the session would have 11000 trials (11 edge x 1000 trials (procedure) = "
+                          "11000 in block stairs)")) << p;
 }
 
 TEST(ProtocolValidate, TooManyLevelsRejectedBeforeComparingThem) {

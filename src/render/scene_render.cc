@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "core/typed.h"
 #include "render/blur.h"
 #include "render/gl_objects.h"
 #include "render/shaders.h"
@@ -395,7 +396,7 @@ void BlurLayer(Layer& layer, const std::string& method, double r_px, GlBlur* gl)
   CheckBlurRadius(r_px);
   if (r_px <= 0 || layer.bgra.empty()) return;
   if (method != "gaussian" && method != "disc")
-    throw Error(ErrorKind::kUsage, "blur method for objects must be gaussian or disc, got '" + method + "'");
+    throw Error(ErrorKind::kUsage, "blur method for objects must be gaussian or disc, got " + Echo(method));
   const bool disc = method == "disc";
   if (gl) {
     layer.bgra = disc ? gl->Disc(layer.bgra, r_px) : gl->Gaussian(layer.bgra, r_px);

@@ -42,7 +42,7 @@ ObserverParams ParseObserver(const std::string& spec) {
   ObserverParams p;
   if (spec == "sim") return p;
   if (spec.rfind("sim:", 0) != 0)
-    throw Error(ErrorKind::kUsage, "--observer must be sim or sim:NAME=VALUE,..., got '" + spec + "'");
+    throw Error(ErrorKind::kUsage, "--observer must be sim or sim:NAME=VALUE,..., got " + Echo(spec));
   std::vector<std::pair<std::string, std::string>> items;
   {
     std::stringstream list(spec.substr(4));
@@ -52,7 +52,7 @@ ObserverParams ParseObserver(const std::string& spec) {
       items.emplace_back(item.substr(0, eq), eq == std::string::npos ? "" : item.substr(eq + 1));
     }
     if (items.empty() || spec.back() == ',')
-      throw Error(ErrorKind::kUsage, "--observer: an empty parameter in '" + spec + "' (sim:NAME=VALUE,...)");
+      throw Error(ErrorKind::kUsage, "--observer: an empty parameter in " + Echo(spec) + " (sim:NAME=VALUE,...)");
   }
   // The model first: it decides which names belong. Without model=, jnd or bias name the pixel model (the form every
   // record before model= existed holds).
@@ -60,7 +60,7 @@ ObserverParams ParseObserver(const std::string& spec) {
   for (const auto& [name, text] : items)
     if (name == "model") {
       if (text != "arcmin" && text != "pixel")
-        throw Error(ErrorKind::kUsage, "--observer model must be arcmin or pixel, got '" + text + "'");
+        throw Error(ErrorKind::kUsage, "--observer model must be arcmin or pixel, got " + Echo(text));
       p.model = text == "pixel" ? ObserverModel::kPixel : ObserverModel::kArcmin;
       named_model = true;
     }
@@ -73,15 +73,15 @@ ObserverParams ParseObserver(const std::string& spec) {
   std::set<std::string> seen;
   for (const auto& [name, text] : items) {
     if (!seen.insert(name).second)
-      throw Error(ErrorKind::kUsage, "--observer " + name + " is given twice in '" + spec + "'");
+      throw Error(ErrorKind::kUsage, "--observer " + Echo(name, false) + " is given twice in " + Echo(spec));
     if (name == "model") continue;
     if ((pixel ? kArcminOnly : kPixelOnly).count(name))
       throw Error(ErrorKind::kUsage, "--observer " + name + " belongs to model=" + (pixel ? "arcmin" : "pixel") +
-                                         ", not model=" + (pixel ? "pixel" : "arcmin") + " (got '" + text + "')");
+                                         ", not model=" + (pixel ? "pixel" : "arcmin") + " (got " + Echo(text) + ")");
     const std::optional<double> parsed = ParseDecimal(text);
     const double v = parsed.value_or(0);
     auto bad = [&](const std::string& what) {
-      throw Error(ErrorKind::kUsage, "--observer " + name + " " + what + ", got '" + text + "'");
+      throw Error(ErrorKind::kUsage, "--observer " + name + " " + what + ", got " + Echo(text));
     };
     auto in = [&](double lo, double hi, bool open_lo, const char* what) {
       if (v > hi || v < lo || (open_lo && v == lo)) bad(what);
@@ -89,7 +89,7 @@ ObserverParams ParseObserver(const std::string& spec) {
     };
     static const std::set<std::string> kBoth = {"lapse", "rt", "step"};
     if (!kArcminOnly.count(name) && !kPixelOnly.count(name) && !kBoth.count(name))
-      throw Error(ErrorKind::kUsage, "--observer: unknown parameter '" + name + "' (known: model, " +
+      throw Error(ErrorKind::kUsage, "--observer: unknown parameter " + Echo(name) + " (known: model, " +
                                          (pixel ? "jnd, bias, cutoff1m, slope, sdlog, tol"
                                                 : "intrinsic, weber, exponent, side, blurrier, rthard") +
                                          ", lapse, rt, step)");

@@ -660,11 +660,12 @@ Json CollectInfo(const protocol::Protocol& p, const RunOptions& options, const s
   for (const auto& [key, text] : options.info) {
     const protocol::InfoField* f = field_of(key);
     if (!f)
-      throw Error(ErrorKind::kUsage, "--info " + key + ": " + options.protocol_file.string() +
+      throw Error(ErrorKind::kUsage, "--info " + Echo(key, false) + ": " + options.protocol_file.string() +
                                          (asked.empty() ? " asks for no participant information"
-                                                        : " asks for " + asked + " (participant_info), not " + key));
+                                                        : " asks for " + asked + " (participant_info), not " +
+                                                              Echo(key, false)));
     if (const std::string why = protocol::CheckInfoValue(*f, text); !why.empty())
-      throw Error(ErrorKind::kUsage, "--info " + key + "=" + text + ": " + why);
+      throw Error(ErrorKind::kUsage, "--info " + key + "=" + Echo(text, false) + ": " + why);
     info[key] = value_of(*f, text);
   }
   if (options.resume && so_far.unfinished) {

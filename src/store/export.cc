@@ -4,6 +4,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <map>
 #include <optional>
@@ -12,6 +13,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/hash.h"
 #include "core/json_io.h"
 #include "core/typed.h"
 #include "store/record.h"
@@ -83,8 +85,9 @@ std::string CsvLine(const std::vector<std::string>& cells) {
 
 // Per study, one row per session: trials planned and answered (practice apart), the median response time, and
 // how often each answer was given - for forced choice the source chosen (the one shown on the side picked) or
-// cant_tell, for adjustment the level accepted. Writes OUT/summary-STUDY.csv for every study.
-void WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
+// cant_tell, for adjustment the level accepted. Writes OUT/SummaryFileName(STUDY) for every study and returns the
+// codebook's rows for them.
+std::string WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
   struct Row {
     std::string participant, status;
     int64_t planned = 0, answered = 0;
@@ -121,9 +124,32 @@ void WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
     ++row.answers[answer];
     answer_names[rows.GetText(0)].insert(answer);
   }
+  std::string codebook;
+  // File names folded to lower case: two studies' summaries must not share a name on a case-insensitive file system
+  // either.
+  std::map<std::string, std::string> files;
   for (auto& [study, sessions] : studies) {
+    const std::string file = SummaryFileName(study);
+    std::string folded = file;
+    for (char& c : folded) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (const auto [it, fresh] = files.emplace(folded, study); !fresh)
+      throw InputError(db.path(), "the studies " + Echo(it->second) + " and " + Echo(study) +
+                                               " would both be summarised as " + file);
     std::vector<std::string> header = {"participant", "session", "status", "planned", "answered", "median_rt_ms"};
     for (const auto& name : answer_names[study]) header.push_back("n_" + name);
+    const std::string of = " (study " + study + ")";
+    const std::vector<ColumnDef> columns = {
+        {"participant", "string", "", "", "the participant's id" + of},
+        {"session", "integer", "", ">= 1", "the session's id in this record (session_id in trials.csv)"},
+        {"status", "string", "", "", "the session's status"},
+        {"planned", "integer", "", ">= 0", "trials planned, practice apart"},
+        {"answered", "integer", "", ">= 0", "trials answered, practice apart"},
+        {"median_rt_ms", "number", "ms", ">= 0", "the median response time of the answered trials"}};
+    for (const auto& c : columns) codebook += CsvLine({file, c.name, c.type, c.unit, c.allowed, c.meaning});
+    for (const auto& name : answer_names[study])
+      codebook += CsvLine({file, "n_" + name, "integer", "", ">= 0",
+                           "how often the answer " + name + " was given (forced choice: the source chosen, or "
+                           "cant_tell; adjustment: the level accepted)"});
     std::string text = CsvLine(header);
     for (auto& [session, row] : sessions) {
       std::sort(row.rts.begin(), row.rts.end());
@@ -135,11 +161,9 @@ void WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
       for (const auto& name : answer_names[study]) cells.push_back(std::to_string(row.answers[name]));
       text += CsvLine(cells);
     }
-    std::string safe = study;
-    for (char& c : safe)
-      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
-    WriteFileAtomically(out_dir / ("summary-" + safe + ".csv"), text);
+    WriteFileAtomically(out_dir / file, text);
   }
+  return codebook;
 }
 
 // The columns of adjustments.csv and frames.csv, for their writers and the codebook.
@@ -592,12 +616,29 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
       [&](const std::filesystem::path& partial) {
         WriteFileAtomically(partial / "trials.csv", text);
         WriteFileAtomically(partial / "adjustments.csv", adjustments);
+        codebook += WriteSummaries(db, partial);
         WriteFileAtomically(partial / "codebook.csv", codebook);
-        WriteSummaries(db, partial);
         WriteFrames(db, partial);
       },
       IsExportFile);
   return count;
+}
+
+std::string SummaryFileName(const std::string& study) {
+  // Plain: what needs no change on any file system and cannot be mistaken for a name with a suffix.
+  const bool plain =
+      !study.empty() && std::all_of(study.begin(), study.end(), [](char c) {
+        return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' || c == '_';
+      });
+  const bool looks_suffixed = study.size() > 17 && study[study.size() - 17] == '-' &&
+                              study.find_first_not_of("0123456789abcdef", study.size() - 16) == std::string::npos;
+  if (plain && !looks_suffixed) return "summary-" + study + ".csv";
+  std::string safe = study;
+  for (char& c : safe)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+  char hash[17];
+  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(Fnv1a64(study)));
+  return "summary-" + safe + "-" + hash + ".csv";
 }
 
 std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path) {

@@ -16,7 +16,7 @@ using ProgressNote = std::function<void(const std::string&)>;
 //   study, protocol_hash, participant, session, seed, trial_index, block, <every factor key found in the record,
 //   sorted>, left, right, choice, rt_ms, adjustment (the JSON path of steps; empty when none), answered_at
 // A factor a trial lacks is an empty cell; a factor named like a fixed column is written as "factor_<name>".
-// Beside it, per study, `out_dir`/summary-STUDY.csv: one row per session with the trials planned and answered
+// Beside it, per study, `out_dir`/SummaryFileName(STUDY): one row per session with the trials planned and answered
 // (practice apart), the median response time and the count of every answer (forced choice: the source chosen, or
 // cant_tell; adjustment: the level accepted) as n_ANSWER columns. And `out_dir`/frames.csv: every recorded display
 // flip (study, participant, session, window: 1 for a real window, 0 headless; trial_index, frame_index, flip_time_s
@@ -52,6 +52,12 @@ struct SessionSummary {
 // Every session of the record, by study, participant and id. Throws Error(kInput) for a file that is not a
 // current blurcue record.
 std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path);
+
+// The file name of a study's summary, the same for the study in any record: summary-STUDY.csv when the name is
+// lower-case ASCII letters, digits, '-' and '_' only (and does not itself end in '-' and 16 hex digits); otherwise
+// summary-SAFE-HASH.csv, SAFE the name with every other byte written '_' and HASH the 16 hex digits of FNV-1a 64 of
+// the name as recorded. So "a<b", "a>b", "a b" and "A<B" get four files, none differing from another by case only.
+std::string SummaryFileName(const std::string& study);
 
 // One CSV field, quoted when it holds a comma, quote, line break or leading/trailing space.
 std::string CsvField(const std::string& text);

@@ -1,6 +1,8 @@
 #include "store/export.h"
 
+#include <cctype>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -124,6 +126,50 @@ TEST(Export, ColumnsAreTheSameForParticipantsWithDifferentFactors) {
   for (const auto& row : codebook)
     if (row[0] == "trials.csv") named.push_back(row[1]);
   EXPECT_EQ(named, expected);
+}
+
+// Studies whose names differ only in what a file name cannot hold, or only in case, each keep their summary: "a<b",
+// "a>b", "a b" and "A<B" used to be written to summary-a_b.csv (three of them, two overwritten) and summary-A_B.csv
+// (one file with it on a case-insensitive file system). A plain name keeps its plain file; the codebook lists each
+// summary's columns, naming its study.
+TEST(Export, SummariesOfStudiesWhoseNamesCollideAsFileNamesAreEachKept) {
+  testing::TempDir dir;
+  const std::vector<std::string> studies = {"a<b", "a>b", "a b", "A<B", "test1-static-grids"};
+  {
+    Record record = Record::Open(dir / "r.sqlite");
+    for (size_t i = 0; i < studies.size(); ++i)
+      RunSession(record, "P1", R"({"edge":3})", int(i) + 1, int(i) + 1, studies[i]);
+  }
+  ExportCsv(dir / "r.sqlite", dir / "out");
+  std::set<std::string> folded;
+  for (size_t i = 0; i < studies.size(); ++i) {
+    const std::string file = SummaryFileName(studies[i]);
+    std::string lower = file;
+    for (char& c : lower) c = char(std::tolower(static_cast<unsigned char>(c)));
+    EXPECT_TRUE(folded.insert(lower).second) << file;
+    const Rows rows = ReadCsv(dir / "out" / file);
+    ASSERT_EQ(rows.size(), 2u) << file;
+    EXPECT_EQ(rows[1][Column(rows, "planned")], std::to_string(i + 1)) << file;  // its own study's session
+  }
+  EXPECT_EQ(SummaryFileName("test1-static-grids"), "summary-test1-static-grids.csv");
+  EXPECT_EQ(SummaryFileName("a<b"), SummaryFileName("a<b"));  // the same in every export
+  EXPECT_EQ(SummaryFileName("a<b").rfind("summary-a_b-", 0), 0u) << SummaryFileName("a<b");
+  EXPECT_EQ(SummaryFileName("A<B").rfind("summary-A_B-", 0), 0u) << SummaryFileName("A<B");
+  EXPECT_EQ(SummaryFileName("a<b").size(), std::string("summary-a_b-0123456789abcdef.csv").size());
+  // A plain name that looks like a suffixed one gets a suffix too, so it cannot meet another study's file.
+  const std::string suffixed = SummaryFileName("a<b").substr(8, 28);  // "a_b-" and the 16 hex digits
+  EXPECT_NE(SummaryFileName(suffixed), SummaryFileName("a<b"));
+  EXPECT_NE(SummaryFileName("Test"), SummaryFileName("test"));
+  size_t files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir / "out"))
+    files += entry.path().filename().string().rfind("summary-", 0) == 0;
+  EXPECT_EQ(files, studies.size());
+  const Rows codebook = ReadCsv(dir / "out" / "codebook.csv");
+  bool named = false;
+  for (const auto& row : codebook)
+    named = named || (row[0] == SummaryFileName("a b") && row[1] == "participant" &&
+                      row[5].find("(study a b)") != std::string::npos);
+  EXPECT_TRUE(named);
 }
 
 // A record of schema 6, as that version wrote it: one simulated session, one answered trial.
