@@ -13,7 +13,7 @@ endforeach()
 add_test(NAME outputs_json_onto_a_folder
          COMMAND ${CMAKE_COMMAND} -DCMD=$<TARGET_FILE:blurcue>
                  "-DARGS=calibrate;${PROJECT_BINARY_DIR}/cli-test/scene/scene.png;--camera;${PROJECT_BINARY_DIR}/cli-test/scene/camera.json;--out;${PROJECT_BINARY_DIR}/cli-test/scene"
-                 -DEXPECT_CODE=3 "-DEXPECT_TEXT=cli-test/scene: cannot replace: Is a directory"
+                 -DEXPECT_CODE=3 "-DEXPECT_TEXT=cli-test/scene: is a folder, not a file; not replaced"
                  -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
 set_tests_properties(outputs_json_onto_a_folder PROPERTIES FIXTURES_REQUIRED scene)
 

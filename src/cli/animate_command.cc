@@ -16,6 +16,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/image.h"
+#include "core/typed.h"
 #include "render/blur.h"
 #include "render/frame_compositor.h"
 #include "render/gl_context.h"
@@ -88,7 +89,7 @@ void AddAnimateCommand(CLI::App& app) {
       std::string extension = std::filesystem::path(args->video).extension().string();
       for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
       if (extension != ".avi")
-        throw Error(ErrorKind::kUsage, "--video " + args->video + ": must end in .avi (it writes an MJPG AVI)");
+        throw Error(ErrorKind::kUsage, "--video " + Echo(args->video, false) + ": must end in .avi (it writes an MJPG AVI)");
       RequireReplaceableFile(args->video);
     }
     if (!args->log.empty()) RequireReplaceableFile(args->log);

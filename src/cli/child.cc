@@ -10,6 +10,7 @@
 #include <cstring>
 
 #include "core/error.h"
+#include "core/typed.h"
 
 namespace blurcue::cli {
 
@@ -62,7 +63,7 @@ void RequirePython3(const std::string& python, const std::vector<std::string>& m
   const int status = RunChild({python, "-c", script});
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   if (code == 42) return;
-  const std::string name = "--python " + python + ": ";
+  const std::string name = "--python " + Echo(python, false) + ": ";
   if (code == 127) throw Error(ErrorKind::kUsage, name + "not found");
   if (code >= 43 && code < 43 + int(modules.size()))
     throw Error(ErrorKind::kUsage, name + "cannot import " + modules[code - 43] + " (the analysis needs " +

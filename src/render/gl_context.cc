@@ -74,7 +74,7 @@ class GlfwContext final : public GlContext {
     // No display to open a window on is the station's set-up, not a bug: a usage error like a bad option.
     if (!glfwInit())
       throw Error(ErrorKind::kUsage, "GLFW: cannot open a window: " + LastGlfwError() +
-                                            " (a window needs a display: run under Xvfb, or use --observer sim)");
+                                            " (a window needs a display: set DISPLAY, or run under xvfb-run)");
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, kGlMajor);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, kGlMinor);
     glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);

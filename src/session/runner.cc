@@ -773,7 +773,14 @@ RunResult RunSession(const RunOptions& options) {
     w.fullscreen = protocol.display.fullscreen;
     w.monitor = protocol.display.monitor;
     w.title = "blurcue - " + protocol.name;  // then Runner::Title names what is on screen
-    context = render::GlContext::CreateWindow(w);
+    try {
+      context = render::GlContext::CreateWindow(w);
+    } catch (const Error& e) {
+      // Only run knows the way round a missing display: a simulated observer needs no window.
+      if (e.kind() != ErrorKind::kUsage || observer) throw;
+      throw Error(ErrorKind::kUsage, std::string(e.what()) + "; to try the protocol without a participant, run it "
+                                                              "with --observer sim");
+    }
   } else {
     context = render::GlContext::CreateOffscreen();
   }
