@@ -291,7 +291,8 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
   const int64_t study_id = EnsureStudy(db_, study, now);
   const int64_t participant_id = EnsureParticipant(db_, study_id, participant, now);
 
-  Statement running(db_, "SELECT s.id, s.seed, p.hash, p.json, s.observer, s.observer_params, s.display_profile, s.group_name "
+  Statement running(db_, "SELECT s.id, s.seed, p.hash, p.json, s.observer, s.observer_params, s.display_profile, s.group_name, "
+                         "s.window "
                          "FROM sessions s "
                          "JOIN protocol_versions p "
                          "ON p.id = s.protocol_version_id WHERE s.participant_id = ? AND s.status = 'running' "
@@ -329,6 +330,14 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
                                          observer(meta.simulated, meta.observer_params) +
                                          "; resume it with the observer it started with, or close it with " +
                                          abort_hint + std::to_string(session) + " (its answers are kept)");
+    }
+    // A simulated observer answers headless on a simulated clock or in a window on the real one: its times (rt_ms,
+    // flips) are of one kind or the other, never both in one session.
+    if (!running.IsNull(8) && meta.simulated && (running.GetInt64(8) != 0) != meta.window) {
+      auto where = [](bool window) { return window ? std::string("in a window (--window)") : std::string("headless"); };
+      throw InputError(db_.path(), SessionName(session) + " was started " + where(running.GetInt64(8) != 0) +
+                                       ", got " + where(meta.window) + "; resume it the way it started, or close it "
+                                       "with " + abort_hint + std::to_string(session) + " (its answers are kept)");
     }
     // Every radius in screen px and arcmin follows the display profile: another one would make other trials.
     if (const std::string changes = DisplayChanges(running.IsNull(6) ? "{}" : running.GetText(6), meta.display_profile);

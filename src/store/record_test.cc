@@ -431,6 +431,26 @@ TEST(Record, ResumeWithAnotherObserverIsRefusedNamingBoth) {
   EXPECT_TRUE(record.StartOrResumeSession("test1", "P01", kProtocol, 7, lapse, true).resumed);
 }
 
+// A simulated observer's times are of its clock: a session started headless (simulated clock) and resumed in a
+// window (real clock), or the other way, is refused naming both; resumed as it started, it resumes.
+TEST(Record, ResumeInAWindowOfAHeadlessSessionIsRefused) {
+  testing::TempDir dir;
+  SessionMeta headless;
+  headless.simulated = true;
+  headless.observer_params = "sim:model=arcmin,weber=0.35,lapse=0.04";
+  headless.window = false;
+  { Record::Open(dir / "r.sqlite").StartOrResumeSession("test1", "P01", kProtocol, 7, headless, false); }
+  Record record = Record::Open(dir / "r.sqlite");
+  SessionMeta windowed = headless;
+  windowed.window = true;
+  const std::string message =
+      ErrorOf([&] { record.StartOrResumeSession("test1", "P01", kProtocol, 7, windowed, true); });
+  EXPECT_TRUE(Contains(message, "session 1 was started headless, got in a window (--window); resume it the way it "
+                                "started, or close it with blurcue sessions --db "))
+      << message;
+  EXPECT_TRUE(record.StartOrResumeSession("test1", "P01", kProtocol, 7, headless, true).resumed);
+}
+
 // Every radius in screen px and arcmin follows the display profile: a session resumed on another is refused naming
 // both profiles and what differs; the same profile read from another path resumes.
 TEST(Record, ResumeOnAnotherDisplayProfileIsRefusedNamingWhatDiffers) {
