@@ -663,41 +663,49 @@ TEST(Record, TruncatedRecordIsAnInputErrorNamingTheFile) {
                        "damaged"));
 }
 
+// Forks `n` stations that wait on one pipe, then run station(c) at the same moment; each must end without an Error
+// (a station exits with its Error's code, or with its own code to fail a check of its own).
+void AtTheSameMoment(int n, const std::string& round, const std::function<void(int station)>& station) {
+  int go[2];
+  ASSERT_EQ(pipe(go), 0);
+  std::vector<pid_t> children;
+  for (int c = 0; c < n; ++c) {
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      char byte;
+      if (read(go[0], &byte, 1) != 1) _exit(5);
+      try {
+        station(c);
+      } catch (const Error& e) {
+        std::fprintf(stderr, "station %d: %s\n", c, e.what());
+        _exit(e.exit_code());
+      }
+      _exit(0);
+    }
+    children.push_back(child);
+  }
+  ASSERT_EQ(write(go[1], std::string(n, 'g').data(), n), n);
+  for (pid_t child : children) {
+    const int status = Wait(child);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << round << ": status " << status;
+  }
+  close(go[0]);
+  close(go[1]);
+}
+
 // Two stations starting on the same new file at the same moment: both proceed (the WAL switch waits its turn).
 TEST(Record, ConcurrentFirstStartsOnANewFileBothProceed) {
   testing::TempDir dir;
   for (int round = 0; round < 10; ++round) {
     const auto path = dir / ("new-" + std::to_string(round) + ".sqlite");
-    int go[2];
-    ASSERT_EQ(pipe(go), 0);
-    std::vector<pid_t> children;
-    for (int c = 0; c < 2; ++c) {
-      const pid_t child = fork();
-      ASSERT_GE(child, 0);
-      if (child == 0) {
-        char byte;
-        if (read(go[0], &byte, 1) != 1) _exit(5);
-        try {
-          Record record = Record::Open(path);
-          const std::string participant = "P" + std::to_string(c);
-          const int64_t session = record.StartOrResumeSession("test1", participant, kProtocol, 7, {}, false).session_id;
-          record.SaveTrialList(session, Trials(3));
-          record.RecordResponse(session, 0, Answer("left"));
-        } catch (const Error& e) {
-          std::fprintf(stderr, "child %d: %s\n", c, e.what());
-          _exit(e.exit_code());
-        }
-        _exit(0);
-      }
-      children.push_back(child);
-    }
-    ASSERT_EQ(write(go[1], "gg", 2), 2);
-    for (pid_t child : children) {
-      const int status = Wait(child);
-      EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "round " << round << ": status " << status;
-    }
-    close(go[0]);
-    close(go[1]);
+    AtTheSameMoment(2, "round " + std::to_string(round), [&](int c) {
+      Record record = Record::Open(path);
+      const std::string participant = "P" + std::to_string(c);
+      const int64_t session = record.StartOrResumeSession("test1", participant, kProtocol, 7, {}, false).session_id;
+      record.SaveTrialList(session, Trials(3));
+      record.RecordResponse(session, 0, Answer("left"));
+    });
     Record record = Record::Open(path);
     EXPECT_EQ(record.database().QueryInt64("SELECT count(*) FROM responses"), 2) << "round " << round;
   }
@@ -709,42 +717,18 @@ TEST(Record, ConcurrentStartsCountEachOtherForABalancedGroup) {
   testing::TempDir dir;
   for (int round = 0; round < 5; ++round) {
     const auto path = dir / ("groups-" + std::to_string(round) + ".sqlite");
-    int go[2];
-    ASSERT_EQ(pipe(go), 0);
-    std::vector<pid_t> children;
-    for (int c = 0; c < 4; ++c) {
-      const pid_t child = fork();
-      ASSERT_GE(child, 0);
-      if (child == 0) {
-        char byte;
-        if (read(go[0], &byte, 1) != 1) _exit(5);
-        try {
-          Record record = Record::Open(path);
-          SessionMeta meta;
-          meta.assign_group = [](const std::map<std::string, int64_t>& sessions) {
-            const auto count = [&](const char* g) { return sessions.count(g) ? sessions.at(g) : 0; };
-            return count("a") <= count("b") ? std::string("a") : std::string("b");
-          };
-          const SessionStart start =
-              record.StartOrResumeSession("test1", "P" + std::to_string(c), kProtocol, 7, meta, false);
-          if (start.group != record.database().QueryText("SELECT group_name FROM sessions WHERE id = " +
-                                                          std::to_string(start.session_id)))
-            _exit(6);
-        } catch (const Error& e) {
-          std::fprintf(stderr, "child %d: %s\n", c, e.what());
-          _exit(e.exit_code());
-        }
-        _exit(0);
-      }
-      children.push_back(child);
-    }
-    ASSERT_EQ(write(go[1], "gggg", 4), 4);
-    for (pid_t child : children) {
-      const int status = Wait(child);
-      EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "round " << round << ": status " << status;
-    }
-    close(go[0]);
-    close(go[1]);
+    AtTheSameMoment(4, "round " + std::to_string(round), [&](int c) {
+      Record record = Record::Open(path);
+      SessionMeta meta;
+      meta.assign_group = [](const std::map<std::string, int64_t>& sessions) {
+        const auto count = [&](const char* g) { return sessions.count(g) ? sessions.at(g) : 0; };
+        return count("a") <= count("b") ? std::string("a") : std::string("b");
+      };
+      const SessionStart start = record.StartOrResumeSession("test1", "P" + std::to_string(c), kProtocol, 7, meta, false);
+      if (start.group != record.database().QueryText("SELECT group_name FROM sessions WHERE id = " +
+                                                      std::to_string(start.session_id)))
+        _exit(6);
+    });
     Record record = Record::Open(path);
     EXPECT_EQ(record.database().QueryText("SELECT group_concat(g) FROM (SELECT group_name || '=' || count(*) g "
                                           "FROM sessions GROUP BY group_name ORDER BY group_name)"),
