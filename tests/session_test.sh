@@ -480,7 +480,8 @@ PYEOF
   sed -i "s|\"\.\./|\"$P/../|g" "$W/p.json"
   $BC run "$W/p.json" --participant G1 --db "$W/s.sqlite" --observer sim:jnd=0.05,lapse=0 > "$W/out" 2>&1 \
     || fail "good observer: $(tail -1 "$W/out")"
-  grep -q "12 skipped now" "$W/out" || fail "good observer: $(tail -1 "$W/out")"
+  grep -q "12 practice trials skipped now: the criterion was met" "$W/out" || fail "good observer: $(tail -1 "$W/out")"
+  grep -q "procedure had stopped" "$W/out" && fail "good observer: a stop rule named where none ran: $(tail -1 "$W/out")"
   sed 's/"correct": 0.8/"correct": 1/' "$W/p.json" > "$W/strict.json"
   $BC run "$W/strict.json" --participant B1 --db "$W/s.sqlite" --observer sim:jnd=50,lapse=0 > "$W/out" 2>&1 \
     || fail "guessing observer: $(tail -1 "$W/out")"

@@ -121,8 +121,11 @@ void AddRunCommand(CLI::App& app) {
     }
     const session::RunResult r = session::RunSession(options);
     // Trials a stopped procedure skipped are recorded too: counted as done, and said apart.
-    const std::string skipped =
-        r.skipped_now > 0 ? ", " + std::to_string(r.skipped_now) + " skipped now: their staircase had stopped" : "";
+    const int64_t by_stop_rule = r.skipped_now - r.skipped_by_criterion_now;
+    std::string skipped;
+    if (by_stop_rule > 0) skipped += ", " + std::to_string(by_stop_rule) + " skipped now: their procedure had stopped";
+    if (r.skipped_by_criterion_now > 0)
+      skipped += ", " + std::to_string(r.skipped_by_criterion_now) + " practice trials skipped now: the criterion was met";
     std::printf("%s: participant %s, session %lld, seed %llu: %lld of %lld trials %s (%lld answered now%s%s)%s\n",
                 args->db.c_str(), options.participant.c_str(), static_cast<long long>(r.session_id),
                 static_cast<unsigned long long>(r.seed),

@@ -537,6 +537,7 @@ class Runner {
         skipped.shown_json = why.dump();
         record.RecordResponse(start.session_id, i, skipped);
         ++result.skipped_now;
+        result.skipped_by_criterion_now += trial.practice && why.value("skipped", "").rfind("criterion", 0) == 0;
         progress(i + 1);
         continue;
       }

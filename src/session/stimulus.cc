@@ -173,6 +173,10 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   t.left = Source(trial.left, &t.left_fixed_px, [&] { return field("left"); }, presentation);
   t.right = Source(trial.right, &t.right_fixed_px, [&] { return field("right"); }, presentation);
   const double s = scene->board.square_mm;
+  // Where the right side's object is shown, so where its radius is evaluated: its own place, or in an intervals
+  // trial the left object's (IntervalScene shows each side alone there). Evaluated at its own place, a place-dependent
+  // source (measured_section, estimated, fitted) gave the right interval a radius of somewhere not shown.
+  const bool right_place = t.intervals > 0;  // Card / Ball: true = the left object's place
   // A radius that cannot be evaluated (eq. 3.7 nearer than focus, no usable measured section) is a problem of the
   // source the protocol chose with this calibration: an input error naming that field.
   auto r_at = [&](const cv::Vec3d& board_mm, calib::BlurSource source, double fixed, const char* side) {
@@ -220,7 +224,7 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
                        "a grid needs an integer level edge or a y_mm" + trial_text);
     t.edge = edge ? *edge : 0;
     t.from_y_mm = t.to_y_mm = y ? *y : (*edge - 1) * s;
-    const cv::Vec3d l = Card(*scene, t, true).center_board_mm, r = Card(*scene, t, false).center_board_mm;
+    const cv::Vec3d l = Card(*scene, t, true).center_board_mm, r = Card(*scene, t, right_place).center_board_mm;
     t.r_left_px = r_at(l, t.left, t.left_fixed_px, "left");
     t.r_right_px = r_at(r, t.right, t.right_fixed_px, "right");
     t.r_scene_px = 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, nullptr) +
@@ -260,7 +264,7 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   for (int i = 0; i < samples; ++i) {
     const double y = t.from_y_mm + (t.to_y_mm - t.from_y_mm) * i / (samples - 1);
     const cv::Vec3d l = Ball(*scene, t, y, radius, true).center_board_mm;
-    const cv::Vec3d r = Ball(*scene, t, y, radius, false).center_board_mm;
+    const cv::Vec3d r = Ball(*scene, t, y, radius, right_place).center_board_mm;
     t.r_left_px += r_at(l, t.left, t.left_fixed_px, "left") / samples;
     t.r_right_px += r_at(r, t.right, t.right_fixed_px, "right") / samples;
     t.r_scene_px += 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, nullptr) +
@@ -272,7 +276,7 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
     const double y = (k - 1) * s;
     if (y < std::min(t.from_y_mm, t.to_y_mm) || y > std::max(t.from_y_mm, t.to_y_mm)) continue;
     r_at(Ball(*scene, t, y, radius, true).center_board_mm, t.left, t.left_fixed_px, "left");
-    r_at(Ball(*scene, t, y, radius, false).center_board_mm, t.right, t.right_fixed_px, "right");
+    r_at(Ball(*scene, t, y, radius, right_place).center_board_mm, t.right, t.right_fixed_px, "right");
   }
   CheckInPhoto(protocol, trial, *scene, t);
   return t;

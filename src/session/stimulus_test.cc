@@ -136,6 +136,33 @@ TEST(DescribeTrial, BallAtAnEdgeRestsThereWithThatPlacesBlur) {
                Error);
 }
 
+// In an intervals trial each side's object is shown alone at the left object's place (IntervalScene): the right
+// side's recorded radius is the one its interval draws, evaluated there, not at the right object's unshown place.
+TEST(DescribeTrial, IntervalsRecordTheRightSidesRadiusWhereItsIntervalShowsIt) {
+  calib::SceneCalib scene = ThesisScene();  // edge 6 measured at its first and last sections only: 0.5 and 1.5 px
+  for (const auto& [section, r] : {std::pair{1, 0.5}, {7, 1.5}}) {
+    calib::SceneCalib::Section measured = scene.sections.front();
+    measured.edge = 6, measured.section = section, measured.r_px = r;
+    measured.midpoint_camera_mm = scene.ToCamera({(section - 0.5) * 25, 125, 0});
+    scene.sections.push_back(measured);
+  }
+  protocol::Protocol pair = BallProtocol();
+  pair.layout = "pair";
+  protocol::Protocol intervals = BallProtocol();
+  intervals.layout = "two_intervals";
+  const protocol::Trial trial = PairTrial({{"edge", 6}, {"left_x_mm", -30}}, "measured_section", "measured_section");
+  const TrialScene side_by_side = DescribeTrial(pair, trial, &scene);
+  EXPECT_DOUBLE_EQ(side_by_side.r_left_px, 0.5);   // nearest the left ball: section 1
+  EXPECT_DOUBLE_EQ(side_by_side.r_right_px, 1.5);  // nearest the right ball on section 5: section 7
+  const TrialScene t = DescribeTrial(intervals, trial, &scene);
+  ASSERT_EQ(t.intervals, 2);
+  const auto shown = ObjectsAt(intervals, scene, IntervalScene(t, true), 0);
+  ASSERT_TRUE(shown[0]);
+  EXPECT_NEAR(shown[0]->object.center_board_mm[0], -30, 1e-9);  // the right side's interval, at the left's place
+  EXPECT_NEAR(t.r_right_px, shown[0]->r_px, 1e-9);                // recorded as drawn
+  EXPECT_NEAR(t.r_right_px, t.r_left_px, 1e-9);                   // the same source at the same place
+}
+
 TEST(DescribeTrial, GridCardsSitBesideTheBoardAtTheirEdge) {
   calib::SceneCalib scene = ThesisScene();
   calib::SceneCalib::Section edge2 = scene.sections.front();  // edge 2 gets a measured section of its own
