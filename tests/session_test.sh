@@ -117,6 +117,47 @@ merge)
   if $BC merge "$W/all.sqlite" "$W/a.sqlite" --out "$W/again.sqlite" 2> "$W/err"; then fail "a session merged twice"; fi
   [ ! -e "$W/again.sqlite" ] || fail "a failed merge left its output"
   echo "ok: two stations merged: $(echo "$got" | tr '\n' ' ')" ;;
+merge_live_writer)
+  # A session a live run is still writing is refused, exit 3, one line naming the file, the session and the run's
+  # pid, and what to do; nothing is written. (It used to be copied as running: both copies could then be resumed,
+  # and the two finished copies never merged again.)
+  $BC run "$P/test1-static-grids.json" --participant B1 --db "$W/b.sqlite" --observer sim > /dev/null 2>&1
+  $BC run "$P/test2-moving-balls.json" --participant L1 --db "$W/a.sqlite" --observer sim --sim-fps 8 > /dev/null 2>&1 &
+  pid=$!
+  wait_for_answers "$W/a.sqlite" 1
+  set +e
+  $BC merge "$W/b.sqlite" "$W/a.sqlite" --out "$W/all.sqlite" > "$W/out" 2> "$W/err"
+  code=$?
+  set -e
+  kill -0 $pid 2>/dev/null || fail "the run ended before the merge was tried: $(cat "$W/err")"
+  kill -9 $pid; wait $pid 2>/dev/null || true
+  [ $code = 3 ] || fail "merge of a session being written: exit $code: $(cat "$W/err")"
+  [ "$(wc -l < "$W/err")" = 1 ] || fail "more than one line: $(cat "$W/err")"
+  grep -Eq "$W/a.sqlite: session 1 \(study test2-moving-balls, participant L1, [0-9]+ of 74 trials answered\) is being written by pid $pid on host $(hostname), heartbeat [0-9]+ s ago \(alive\); merge it once that session has ended \(to give it up instead: stop that run, then blurcue sessions --db $W/a.sqlite --abort 1\)" "$W/err" \
+    || fail "message: $(cat "$W/err")"
+  [ -z "$(ls -A "$W" | grep all.sqlite)" ] || fail "a refused merge left $(ls -A "$W" | grep all.sqlite)"
+  echo "ok: a session being written is refused: $(cat "$W/err")" ;;
+merge_killed_session)
+  # A session whose run was killed (-9) has no live writer: merge copies it as running, and says so in one line
+  # naming the file and the session, and that it is to be resumed in one record only; resumed there, it completes.
+  $BC run "$P/test1-static-grids.json" --participant B1 --db "$W/b.sqlite" --observer sim > /dev/null 2>&1
+  $BC run "$P/test2-moving-balls.json" --participant K1 --db "$W/a.sqlite" --observer sim --seed 9 --sim-fps 8 \
+    > /dev/null 2>&1 &
+  pid=$!
+  wait_for_answers "$W/a.sqlite" 4
+  kill -9 $pid; wait $pid 2>/dev/null || true
+  answered=$(sql "$W/a.sqlite" "SELECT count(*) FROM responses")
+  $BC merge "$W/b.sqlite" "$W/a.sqlite" --out "$W/all.sqlite" > "$W/out" 2> "$W/err" || fail "merge: $(cat "$W/err")"
+  [ "$(cat "$W/err")" = "merge: $W/a.sqlite: session 1 (study test2-moving-balls, participant K1, $answered of 74 trials answered) is unfinished, with no live writer: copied as running; resume it in one record only (this one, then merge again into a new file, or the merged one), never both: the two copies could not be merged again" ] \
+    || fail "merge said: $(cat "$W/err")"
+  integrity "$W/all.sqlite"
+  got=$(sql "$W/all.sqlite" "SELECT p.code, s.status, s.lock_token IS NULL, (SELECT count(*) FROM trials t JOIN responses r
+        ON r.trial_id = t.id WHERE t.session_id = s.id) FROM sessions s JOIN participants p ON p.id = s.participant_id
+        ORDER BY p.code")
+  [ "$got" = $'B1|completed|1|13\nK1|running|1|'"$answered" ] || fail "merged: $got"
+  $BC run "$P/test2-moving-balls.json" --participant K1 --db "$W/all.sqlite" --observer sim --seed 9 --sim-fps 8 --resume \
+    | grep -q "74 of 74 trials answered" || fail "the merged copy did not resume"
+  echo "ok: a killed session ($answered of 74) merged as running with one line saying so, resumed in the merged record" ;;
 same_seed)
   # The same protocol, participant and seed give the same trials and (simulated) answers; another seed does not.
   for db in a b; do $BC run "$P/test2-moving-balls.json" --participant S1 --db "$W/$db.sqlite" --observer sim --seed 11; done

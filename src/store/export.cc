@@ -671,6 +671,43 @@ std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path) {
   return sessions;
 }
 
+namespace {
+
+// Refuses an input whose session a live writer holds (the record's own rule, JudgeLock: a copy taken now would miss
+// the answers still coming, and the two copies could each be resumed and never merged again). Adds one line to
+// `unfinished` per running session with no live writer (a killed or stopped one): copied as it is, and it must be
+// resumed in one record only.
+void CheckSessionsToMerge(Database& src, const std::filesystem::path& input, std::vector<std::string>* unfinished) {
+  Statement sessions(src,
+                     "SELECT s.id, st.name, p.code, s.status, "
+                     "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), "
+                     "(SELECT count(*) FROM trials t JOIN responses r ON r.trial_id = t.id WHERE t.session_id = s.id), "
+                     "s.lock_token IS NOT NULL, coalesce(s.lock_host, ''), coalesce(s.lock_pid, 0), "
+                     "coalesce(s.lock_heartbeat_ms, 0) "
+                     "FROM sessions s JOIN participants p ON p.id = s.participant_id "
+                     "JOIN studies st ON st.id = p.study_id ORDER BY s.id");
+  while (sessions.Step()) {
+    const std::string id = std::to_string(sessions.GetInt64(0));
+    const std::string who = "session " + id + " (study " + sessions.GetText(1) + ", participant " +
+                            sessions.GetText(2) + ", " + std::to_string(sessions.GetInt64(5)) + " of " +
+                            std::to_string(sessions.GetInt64(4)) + " trials answered)";
+    if (sessions.GetInt64(6) != 0) {
+      const LockState lock = JudgeLock(sessions.GetText(7), sessions.GetInt64(8), sessions.GetInt64(9));
+      if (!lock.stale)
+        throw InputError(input.string(),
+                         who + " is being written by " + lock.text + "; merge it once that session has ended (to "
+                         "give it up instead: stop that run, then blurcue sessions --db " + input.string() +
+                         " --abort " + id + ")");
+    }
+    if (sessions.GetText(3) == "running")
+      unfinished->push_back(input.string() + ": " + who + " is unfinished, with no live writer: copied as running; "
+                            "resume it in one record only (this one, then merge again into a new file, or the "
+                            "merged one), never both: the two copies could not be merged again");
+  }
+}
+
+}  // namespace
+
 void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out,
                     const ProgressNote& note) {
   Note(note, RemoveStaleLeftovers(out));
@@ -682,6 +719,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
   }
   const std::filesystem::path temp = TemporaryBeside(out, "partial");
   RemoveDatabaseFiles(temp);
+  std::vector<std::string> unfinished;
   try {
     {
       Database dst(temp);
@@ -690,6 +728,9 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
       for (const auto& input : inputs) {
         Database src(input, OpenMode::kReadOnly);
         RequireReadableRecord(src);
+        // One snapshot of the input: the sessions judged below are the ones copied, with the answers they had then.
+        src.Exec("BEGIN");
+        CheckSessionsToMerge(src, input, &unfinished);
         std::map<int64_t, int64_t> study_ids, protocol_ids, participant_ids, session_ids, trial_ids;
         const bool typed = SchemaVersion(src) >= 7;
 
@@ -821,12 +862,15 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
           insert_frame.Run();
           insert_frame.Reset();
         }
+        src.Exec("COMMIT");
       }
       // Inputs from before the typed record: their typed columns from their texts, as a migration would.
       DeriveTypedColumns(dst);
       transaction.Commit();
     }  // the last connection closes: the WAL is checkpointed into the file and removed
     MoveIntoPlace(temp, out);
+    if (note)
+      for (const auto& line : unfinished) note(line);
   } catch (...) {
     RemoveDatabaseFiles(temp);
     throw;
