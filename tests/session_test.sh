@@ -448,6 +448,48 @@ assert all(r["correct"] == "" for r in rows if r["study"] == "test1-static-grids
 assert all(r["correct"] in ("0", "1") for r in rows if r["study"] == "quest-blur-difference" and r["status"] == "answered")
 PYEOF
   echo "ok: $(tail -1 "$W/out" | sed 's/^ok: //'); $(grep seeds "$W/out" | head -1)" ;;
+report_aborted)
+  # A participant's first session given up (sessions --abort) and a new one with the same seed, so the same first
+  # trials: the report leaves the aborted answers out and its summary says how many (they used to be counted with
+  # the new session's); --include-aborted counts them and says so. A record holding only an aborted session is not
+  # analysed as if it were the study's: its report says "aborted".
+  $BC run "$P/test1-static-grids.json" --participant P1 --db "$W/s.sqlite" --observer sim --stop-after 8 > /dev/null 2>&1
+  $BC sessions --db "$W/s.sqlite" --abort 1 | grep -q "session 1 closed as aborted" || fail "abort"
+  $BC run "$P/test1-static-grids.json" --participant P1 --db "$W/s.sqlite" --observer sim > /dev/null 2>&1 || fail "P1 again"
+  $BC run "$P/test1-static-grids.json" --participant P2 --db "$W/s.sqlite" --observer sim > /dev/null 2>&1 || fail "P2"
+  # From the export, apart from the report: the aborted session's answers and the decisive measured-vs-estimated
+  # answers with and without it.
+  counts() {
+    $PY - "$1" <<'PYEOF'
+import csv, sys
+rows = [r for r in csv.DictReader(open(sys.argv[1], encoding="utf-8")) if r["practice"] == "0"]
+aborted = [r for r in rows if r["session_status"] == "aborted"]
+def decisive(rows):
+    return sum(1 for r in rows if r["chosen_side"] in ("left", "right")
+               and {r["left_source"], r["right_source"]} == {"measured", "estimated"})
+print(sum(r["status"] == "answered" for r in aborted), decisive([r for r in rows if r not in aborted]), decisive(rows))
+PYEOF
+  }
+  MPLCONFIGDIR=$W/mpl $BC report --db "$W/s.sqlite" --out "$W/report" --bench "$W/no-bench" --boot 20 > /dev/null 2> "$W/err" \
+    || fail "report: $(tail -3 "$W/err")"
+  read -r answers kept all <<< "$(counts "$W/report/tables/trials.csv")"
+  [ "$answers" -gt 0 ] && [ "$all" -gt "$kept" ] || fail "the aborted session has no decisive answers: $answers $kept $all"
+  grep -q "left out 1 aborted session (P1 (session 1)) with $answers answers: closed with blurcue sessions --abort" \
+    "$W/report/index.html" || fail "the summary does not say what it left out: $(grep -o 'aborted[^<]*' "$W/report/index.html")"
+  grep -q "report: left out 1 aborted session" "$W/err" || fail "stderr: $(cat "$W/err")"
+  grep -q "of $kept decisive answers" "$W/report/index.html" || fail "not $kept decisive answers: $(grep -o 'of [0-9]* decisive answers' "$W/report/index.html")"
+  MPLCONFIGDIR=$W/mpl $BC report --db "$W/s.sqlite" --out "$W/report-all" --bench "$W/no-bench" --boot 20 --include-aborted \
+    > /dev/null 2> "$W/err" || fail "report --include-aborted: $(tail -3 "$W/err")"
+  grep -q "included 1 aborted session (P1 (session 1)) with $answers answers" "$W/report-all/index.html" || fail "--include-aborted not said"
+  grep -q "of $all decisive answers" "$W/report-all/index.html" || fail "--include-aborted: not $all decisive answers"
+  # Only an aborted session.
+  $BC run "$P/test1-static-grids.json" --participant P9 --db "$W/o.sqlite" --observer sim --stop-after 8 > /dev/null 2>&1
+  $BC sessions --db "$W/o.sqlite" --abort 1 > /dev/null
+  MPLCONFIGDIR=$W/mpl $BC report --db "$W/o.sqlite" --out "$W/report-only" --bench "$W/no-bench" --boot 20 > /dev/null 2> "$W/err" \
+    || fail "report of an aborted session only: $(tail -3 "$W/err")"
+  grep -q "left out 1 aborted session (P9 (session 1))" "$W/report-only/index.html" || fail "the report does not say aborted"
+  grep -q "decisive answers" "$W/report-only/index.html" && fail "an aborted session only was analysed"
+  echo "ok: an aborted session's $answers answers left out and said ($kept decisive answers, $all with --include-aborted)" ;;
 report_any_study)
   # Studies unlike the thesis's - QUEST+ on a blur difference, an odd one out, yes/no and rating, a 2IFC - run by
   # simulated observers of known parameters: the report gives each a section with charts and statistics (none is

@@ -284,6 +284,10 @@ const std::vector<ColumnDef>& TrialColumnsBefore() {
       {"window", "boolean", "", "0|1", "1: shown in a real window on the real clock; 0: headless on a simulated clock"},
       {"session_id", "integer", "", ">= 1", "the session's id in this record (merged records renumber it)"},
       {"session_number", "integer", "", ">= 1", "the participant's n-th session of this study, in the order started"},
+      {"session_status", "string", "", "running|completed|aborted",
+       "the session's status when exported: running (unfinished: stopped, killed or still being written), "
+       "completed, or aborted (closed with blurcue sessions --abort; blurcue report leaves its answers out unless "
+       "--include-aborted)"},
       {"seed", "string", "", "s followed by 1-20 digits",
        "the seed of the session's trial order, a 64-bit unsigned integer written with a leading s so that spreadsheets, "
        "R and JavaScript keep every digit; blurcue run --seed takes it as written"},
@@ -515,7 +519,7 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
                  "t.block_name, t.task, t.practice, t.swapped, t.left_source, t.left_fixed, t.right_source, "
                  "t.right_fixed, coalesce(r.r_left_px, t.r_left_px), coalesce(r.r_right_px, t.r_right_px), "
                  "r.id IS NULL, r.choice, r.rt_ms, r.answered_at, r.adjustment, coalesce(r.shown, '{}'), r.correct, "
-                 "s.group_name, s.observer, s.observer_params, s.window "
+                 "s.group_name, s.observer, s.observer_params, s.window, s.status "
                  "FROM trials t JOIN sessions s ON s.id = t.session_id "
                  "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
                  "JOIN protocol_versions pv ON pv.id = s.protocol_version_id "
@@ -541,6 +545,7 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
                                       rows.IsNull(28) ? "" : std::to_string(rows.GetInt64(28)),
                                       std::to_string(session),
                                       std::to_string(session_number[session]),
+                                      rows.GetText(29),
                                       "s" + std::to_string(static_cast<uint64_t>(rows.GetInt64(4)))};
     if (groups) cells.push_back(rows.GetText(25));
     for (const auto& [key, type] : info_keys) {

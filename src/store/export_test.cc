@@ -96,7 +96,7 @@ TEST(Export, ColumnsAreTheSameForParticipantsWithDifferentFactors) {
   ASSERT_EQ(rows.size(), 8u);
   const std::vector<std::string> expected = {
       "study",       "protocol_hash", "participant", "observer",    "observer_params",    "window",
-      "session_id",  "session_number", "seed",       "trial_index", "block",              "block_name",
+      "session_id",  "session_number", "session_status", "seed", "trial_index", "block",            "block_name",
       "task",        "practice",      "swapped",     "blur",        "edge",               "speed_cm_s",
       "left_source", "left_fixed",    "right_source", "right_fixed", "status",            "chosen_side",
       "chose_more_blurred", "chosen_interval", "yes_no", "rating",   "adjusted_level",    "correct",
@@ -114,6 +114,7 @@ TEST(Export, ColumnsAreTheSameForParticipantsWithDifferentFactors) {
   EXPECT_EQ(rows[1][Column(rows, "status")], "answered");
   EXPECT_EQ(rows[1][Column(rows, "chosen_side")], "right");
   EXPECT_EQ(rows[5][Column(rows, "session_number")], "1");
+  EXPECT_EQ(rows[5][Column(rows, "session_status")], "completed");
   // Unanswered trials are rows with empty answers.
   EXPECT_EQ(rows[7][Column(rows, "status")], "unanswered");
   EXPECT_EQ(rows[7][Column(rows, "chosen_side")], "");
@@ -240,6 +241,33 @@ TEST(Export, AnOlderRecordExportsFromAMigratedCopy) {
   EXPECT_EQ(rows[1][Column(rows, "chose_more_blurred")], "1");
   Database old(dir / "old.sqlite", OpenMode::kReadOnly);
   EXPECT_EQ(SchemaVersion(old), 6);  // the record itself is only read
+}
+
+// Every row says its session's status, so an analysis can tell an aborted session's answers from the study's.
+TEST(Export, EveryRowCarriesItsSessionsStatusAbortedIncluded) {
+  testing::TempDir dir;
+  {
+    Record record = Record::Open(dir / "r.sqlite");
+    const int64_t first = record.StartOrResumeSession("test1", "P01", "{}", 1, {}, false).session_id;
+    TrialRecord trial;
+    record.SaveTrialList(first, {trial});
+    Response r;
+    r.choice = "left";
+    record.RecordResponse(first, 0, r);
+    record.AbortSession(first);
+    RunSession(record, "P01", "{}", 2, 2);  // the same participant again, completed
+    RunSession(record, "P02", "{}", 2, 1);
+    const int64_t running = record.StartOrResumeSession("test1", "P03", "{}", 1, {}, false).session_id;
+    record.SaveTrialList(running, {trial});
+  }
+  ExportCsv(dir / "r.sqlite", dir / "out");
+  const Rows rows = ReadCsv(dir / "out" / "trials.csv");
+  std::vector<std::string> got;
+  for (size_t i = 1; i < rows.size(); ++i)
+    got.push_back(rows[i][Column(rows, "participant")] + ":" + rows[i][Column(rows, "session_id")] + ":" +
+                  rows[i][Column(rows, "session_status")]);
+  EXPECT_EQ(got, (std::vector<std::string>{"P01:1:aborted", "P01:2:completed", "P01:2:completed", "P02:3:completed",
+                                           "P02:3:completed", "P03:4:running"}));
 }
 
 TEST(Export, ReadsARecordAWriterStillHasOpen) {
