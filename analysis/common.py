@@ -116,6 +116,20 @@ def load_trials(path):
     return df
 
 
+def aborted_rows(df):
+    """The rows of aborted sessions (session_status, as `blurcue export` writes it; none in an export without it)."""
+    if "session_status" not in df.columns:
+        return df.iloc[0:0]
+    return df[df["session_status"] == "aborted"]
+
+
+def without_aborted(df):
+    """trials without the rows of aborted sessions (closed with blurcue sessions --abort: given up, not data)."""
+    if "session_status" not in df.columns:
+        return df
+    return df[df["session_status"] != "aborted"].copy()
+
+
 def study_rows(df, study):
     """The study's non-practice rows (practice == 1 is excluded from every analysis)."""
     d = df[(df["study"] == study) & (df["practice"] != 1)]

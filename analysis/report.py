@@ -152,6 +152,25 @@ def thesis_findings(trials, sections):
     return out
 
 
+def aborted_sessions(trials, included):
+    """(study, line) per study holding aborted sessions: how many sessions and answers (practice apart) the report
+    leaves out, or with `included` analyses, and why. Empty for a trials.csv without session_status (an export from
+    before it): nothing is known to be aborted there."""
+    aborted = common.aborted_rows(trials)
+    out = []
+    for study, d in aborted.groupby("study", sort=True):
+        sessions = d.drop_duplicates("session_id")
+        who = ", ".join(f"{p} (session {s})" for p, s in zip(sessions["participant"], sessions["session_id"]))
+        n, answers = len(sessions), int((d["answered"] & (d["practice"] != 1)).sum())
+        what = f"{n} aborted session{'s' if n != 1 else ''} ({who}) with {answers} answer{'s' if answers != 1 else ''}"
+        if included:
+            out.append((study, f"included {what} (--include-aborted): sessions closed with blurcue sessions --abort"))
+        else:
+            out.append((study, f"left out {what}: closed with blurcue sessions --abort, they are not part of the "
+                               f"study; blurcue report --include-aborted analyses them"))
+    return out
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description="Charts, tables and index.html from trials.csv and bench CSVs.")
     parser.add_argument("--trials", required=True, help="trials.csv written by `blurcue export`")
@@ -165,6 +184,9 @@ def main(argv=None):
     parser.add_argument("--debug", action="store_true", help="let an unexpected error raise (with its traceback)")
     parser.add_argument("--pool-simulated", action="store_true",
                         help="analyse people and simulated observers together (by default apart)")
+    parser.add_argument("--include-aborted", action="store_true",
+                        help="analyse the answers of aborted sessions too (by default they are left out, and the "
+                             "summary says how many)")
     args = parser.parse_args(argv)
     warnings.showwarning = _warning_line
 
@@ -245,6 +267,10 @@ def main(argv=None):
     except TrialsError as e:
         say(str(e))  # the only line: the file and what is wrong with it
         return EXIT_INPUT
+    # An aborted session was given up (sessions --abort): its answers are not the study's unless asked for.
+    aborted_lines = aborted_sessions(holder["trials"], args.include_aborted)
+    if not args.include_aborted:
+        holder["trials"] = common.without_aborted(holder["trials"])
     trials = holder["trials"]
     codebook = any_study.load_codebook(args.trials)
 
@@ -292,6 +318,9 @@ def main(argv=None):
               f"frames: {os.path.abspath(shown(frames_path))}",
               f"bench: {os.path.abspath(args.bench)}",
               f"written {datetime.datetime.now().strftime('%Y-%m-%d %H:%M')}; practice trials excluded everywhere"]
+    header[1:1] = [line for _, line in aborted_lines]
+    for _, line in aborted_lines:
+        say(line)
     observers = trials.groupby("observer")["participant"].nunique()
     header.insert(1, "participants: " + ", ".join(f"{n} {'people' if k == 'person' else 'simulated'}"
                                                     for k, n in observers.items()) +
@@ -328,7 +357,7 @@ def main(argv=None):
 
     say(f"[{total}/{total}] index.html ...")
     # The summary: what each study found (the thesis's studies point at their figures).
-    summary = []
+    summary = list(aborted_lines)
     thesis = thesis_findings(trials, sections)
     for study in sorted(set(trials["study"]) & known):
         d = trials[(trials["study"] == study) & (trials["practice"] != 1)]

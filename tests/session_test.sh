@@ -117,6 +117,47 @@ merge)
   if $BC merge "$W/all.sqlite" "$W/a.sqlite" --out "$W/again.sqlite" 2> "$W/err"; then fail "a session merged twice"; fi
   [ ! -e "$W/again.sqlite" ] || fail "a failed merge left its output"
   echo "ok: two stations merged: $(echo "$got" | tr '\n' ' ')" ;;
+merge_live_writer)
+  # A session a live run is still writing is refused, exit 3, one line naming the file, the session and the run's
+  # pid, and what to do; nothing is written. (It used to be copied as running: both copies could then be resumed,
+  # and the two finished copies never merged again.)
+  $BC run "$P/test1-static-grids.json" --participant B1 --db "$W/b.sqlite" --observer sim > /dev/null 2>&1
+  $BC run "$P/test2-moving-balls.json" --participant L1 --db "$W/a.sqlite" --observer sim --sim-fps 8 > /dev/null 2>&1 &
+  pid=$!
+  wait_for_answers "$W/a.sqlite" 1
+  set +e
+  $BC merge "$W/b.sqlite" "$W/a.sqlite" --out "$W/all.sqlite" > "$W/out" 2> "$W/err"
+  code=$?
+  set -e
+  kill -0 $pid 2>/dev/null || fail "the run ended before the merge was tried: $(cat "$W/err")"
+  kill -9 $pid; wait $pid 2>/dev/null || true
+  [ $code = 3 ] || fail "merge of a session being written: exit $code: $(cat "$W/err")"
+  [ "$(wc -l < "$W/err")" = 1 ] || fail "more than one line: $(cat "$W/err")"
+  grep -Eq "$W/a.sqlite: session 1 \(study test2-moving-balls, participant L1, [0-9]+ of 74 trials answered\) is being written by pid $pid on host $(hostname), heartbeat [0-9]+ s ago \(alive\); merge it once that session has ended \(to give it up instead: stop that run, then blurcue sessions --db $W/a.sqlite --abort 1\)" "$W/err" \
+    || fail "message: $(cat "$W/err")"
+  [ -z "$(ls -A "$W" | grep all.sqlite)" ] || fail "a refused merge left $(ls -A "$W" | grep all.sqlite)"
+  echo "ok: a session being written is refused: $(cat "$W/err")" ;;
+merge_killed_session)
+  # A session whose run was killed (-9) has no live writer: merge copies it as running, and says so in one line
+  # naming the file and the session, and that it is to be resumed in one record only; resumed there, it completes.
+  $BC run "$P/test1-static-grids.json" --participant B1 --db "$W/b.sqlite" --observer sim > /dev/null 2>&1
+  $BC run "$P/test2-moving-balls.json" --participant K1 --db "$W/a.sqlite" --observer sim --seed 9 --sim-fps 8 \
+    > /dev/null 2>&1 &
+  pid=$!
+  wait_for_answers "$W/a.sqlite" 4
+  kill -9 $pid; wait $pid 2>/dev/null || true
+  answered=$(sql "$W/a.sqlite" "SELECT count(*) FROM responses")
+  $BC merge "$W/b.sqlite" "$W/a.sqlite" --out "$W/all.sqlite" > "$W/out" 2> "$W/err" || fail "merge: $(cat "$W/err")"
+  [ "$(cat "$W/err")" = "merge: $W/a.sqlite: session 1 (study test2-moving-balls, participant K1, $answered of 74 trials answered) is unfinished, with no live writer: copied as running; resume it in one record only (this one, then merge again into a new file, or the merged one), never both: the two copies could not be merged again" ] \
+    || fail "merge said: $(cat "$W/err")"
+  integrity "$W/all.sqlite"
+  got=$(sql "$W/all.sqlite" "SELECT p.code, s.status, s.lock_token IS NULL, (SELECT count(*) FROM trials t JOIN responses r
+        ON r.trial_id = t.id WHERE t.session_id = s.id) FROM sessions s JOIN participants p ON p.id = s.participant_id
+        ORDER BY p.code")
+  [ "$got" = $'B1|completed|1|13\nK1|running|1|'"$answered" ] || fail "merged: $got"
+  $BC run "$P/test2-moving-balls.json" --participant K1 --db "$W/all.sqlite" --observer sim --seed 9 --sim-fps 8 --resume \
+    | grep -q "74 of 74 trials answered" || fail "the merged copy did not resume"
+  echo "ok: a killed session ($answered of 74) merged as running with one line saying so, resumed in the merged record" ;;
 same_seed)
   # The same protocol, participant and seed give the same trials and (simulated) answers; another seed does not.
   for db in a b; do $BC run "$P/test2-moving-balls.json" --participant S1 --db "$W/$db.sqlite" --observer sim --seed 11; done
@@ -407,6 +448,48 @@ assert all(r["correct"] == "" for r in rows if r["study"] == "test1-static-grids
 assert all(r["correct"] in ("0", "1") for r in rows if r["study"] == "quest-blur-difference" and r["status"] == "answered")
 PYEOF
   echo "ok: $(tail -1 "$W/out" | sed 's/^ok: //'); $(grep seeds "$W/out" | head -1)" ;;
+report_aborted)
+  # A participant's first session given up (sessions --abort) and a new one with the same seed, so the same first
+  # trials: the report leaves the aborted answers out and its summary says how many (they used to be counted with
+  # the new session's); --include-aborted counts them and says so. A record holding only an aborted session is not
+  # analysed as if it were the study's: its report says "aborted".
+  $BC run "$P/test1-static-grids.json" --participant P1 --db "$W/s.sqlite" --observer sim --stop-after 8 > /dev/null 2>&1
+  $BC sessions --db "$W/s.sqlite" --abort 1 | grep -q "session 1 closed as aborted" || fail "abort"
+  $BC run "$P/test1-static-grids.json" --participant P1 --db "$W/s.sqlite" --observer sim > /dev/null 2>&1 || fail "P1 again"
+  $BC run "$P/test1-static-grids.json" --participant P2 --db "$W/s.sqlite" --observer sim > /dev/null 2>&1 || fail "P2"
+  # From the export, apart from the report: the aborted session's answers and the decisive measured-vs-estimated
+  # answers with and without it.
+  counts() {
+    $PY - "$1" <<'PYEOF'
+import csv, sys
+rows = [r for r in csv.DictReader(open(sys.argv[1], encoding="utf-8")) if r["practice"] == "0"]
+aborted = [r for r in rows if r["session_status"] == "aborted"]
+def decisive(rows):
+    return sum(1 for r in rows if r["chosen_side"] in ("left", "right")
+               and {r["left_source"], r["right_source"]} == {"measured", "estimated"})
+print(sum(r["status"] == "answered" for r in aborted), decisive([r for r in rows if r not in aborted]), decisive(rows))
+PYEOF
+  }
+  MPLCONFIGDIR=$W/mpl $BC report --db "$W/s.sqlite" --out "$W/report" --bench "$W/no-bench" --boot 20 > /dev/null 2> "$W/err" \
+    || fail "report: $(tail -3 "$W/err")"
+  read -r answers kept all <<< "$(counts "$W/report/tables/trials.csv")"
+  [ "$answers" -gt 0 ] && [ "$all" -gt "$kept" ] || fail "the aborted session has no decisive answers: $answers $kept $all"
+  grep -q "left out 1 aborted session (P1 (session 1)) with $answers answers: closed with blurcue sessions --abort" \
+    "$W/report/index.html" || fail "the summary does not say what it left out: $(grep -o 'aborted[^<]*' "$W/report/index.html")"
+  grep -q "report: left out 1 aborted session" "$W/err" || fail "stderr: $(cat "$W/err")"
+  grep -q "of $kept decisive answers" "$W/report/index.html" || fail "not $kept decisive answers: $(grep -o 'of [0-9]* decisive answers' "$W/report/index.html")"
+  MPLCONFIGDIR=$W/mpl $BC report --db "$W/s.sqlite" --out "$W/report-all" --bench "$W/no-bench" --boot 20 --include-aborted \
+    > /dev/null 2> "$W/err" || fail "report --include-aborted: $(tail -3 "$W/err")"
+  grep -q "included 1 aborted session (P1 (session 1)) with $answers answers" "$W/report-all/index.html" || fail "--include-aborted not said"
+  grep -q "of $all decisive answers" "$W/report-all/index.html" || fail "--include-aborted: not $all decisive answers"
+  # Only an aborted session.
+  $BC run "$P/test1-static-grids.json" --participant P9 --db "$W/o.sqlite" --observer sim --stop-after 8 > /dev/null 2>&1
+  $BC sessions --db "$W/o.sqlite" --abort 1 > /dev/null
+  MPLCONFIGDIR=$W/mpl $BC report --db "$W/o.sqlite" --out "$W/report-only" --bench "$W/no-bench" --boot 20 > /dev/null 2> "$W/err" \
+    || fail "report of an aborted session only: $(tail -3 "$W/err")"
+  grep -q "left out 1 aborted session (P9 (session 1))" "$W/report-only/index.html" || fail "the report does not say aborted"
+  grep -q "decisive answers" "$W/report-only/index.html" && fail "an aborted session only was analysed"
+  echo "ok: an aborted session's $answers answers left out and said ($kept decisive answers, $all with --include-aborted)" ;;
 report_any_study)
   # Studies unlike the thesis's - QUEST+ on a blur difference, an odd one out, yes/no and rating, a 2IFC - run by
   # simulated observers of known parameters: the report gives each a section with charts and statistics (none is

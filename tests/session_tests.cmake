@@ -10,8 +10,9 @@ add_test(NAME session_pictures
 set_tests_properties(session_pictures PROPERTIES FIXTURES_REQUIRED scene FIXTURES_SETUP session_pictures
                      PASS_REGULAR_EXPRESSION "wrote 27 photos")
 set_tests_properties(session_protocols PROPERTIES FIXTURES_SETUP session_protocols)
-foreach(case complete same_seed resume kill9 second_writer window window_adjust recover depth_arcmin merge resume_guards stranded
-             stale_lock readonly frames_shown adaptive groups_info two_intervals deadline layouts window_after_motion codebook report_any_study practice_criterion visibility depth_capture
+foreach(case complete same_seed resume kill9 second_writer window window_adjust recover depth_arcmin merge merge_live_writer
+             merge_killed_session resume_guards stranded
+             stale_lock readonly frames_shown adaptive groups_info two_intervals deadline layouts window_after_motion codebook report_any_study report_aborted practice_criterion visibility depth_capture
              resume_observer resume_display groups_concurrent resume_exact)
   add_test(NAME session_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/session_test.sh ${case} ${BC} ${T})
   set_tests_properties(session_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures"

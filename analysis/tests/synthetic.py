@@ -26,7 +26,7 @@ PATTERNS = [
 ]
 # The fixed columns of a tidy trials.csv (store/export.cc; codebook.csv says what each holds), around the design's.
 LEADING = ["study", "protocol_hash", "participant", "observer", "observer_params", "window", "session_id",
-           "session_number", "seed", "trial_index", "block", "block_name", "task", "practice", "swapped"]
+           "session_number", "session_status", "seed", "trial_index", "block", "block_name", "task", "practice", "swapped"]
 TRAILING = ["left_source", "left_fixed", "right_source", "right_fixed", "status", "chosen_side", "chose_more_blurred",
             "chosen_interval", "yes_no", "rating", "adjusted_level", "correct", "rt_ms", "answered_at"]
 
@@ -141,6 +141,7 @@ def tidy(row):
     r = dict(row)
     r["session_id"] = r.pop("session")
     r["session_number"] = 1
+    r["session_status"] = r.get("session_status", "completed")
     r["seed"] = "s%d" % r["seed"]
     r["observer"] = "simulated"
     r["window"] = 0

@@ -1,4 +1,5 @@
 """report.py end to end on synthetic inputs, and its edge cases (run as a separate process: exit codes, stderr)."""
+import html
 import os
 import re
 import shutil
@@ -197,6 +198,53 @@ class EdgeCaseTest(ReportTestCase):
         self.assertIn("measure.csv: no such file", err)
         self.assertTrue(os.path.isfile(os.path.join(out, "bench-frame.png")))
         self.assertFalse(os.path.isfile(os.path.join(out, "bench-measure-speed-accuracy.png")))
+
+
+class AbortedSessionsTest(ReportTestCase):
+    """An aborted session (blurcue sessions --abort) is left out by default and the summary says so; a participant
+    who started again answered the same first trials, which used to be counted twice."""
+
+    def rows(self):
+        rows = synthetic.trials_rows(participants=("P1", "P2", "P3"), studies=["test1-static-grids"], unanswered=0)
+        # P1's first session, given up after 6 answers and aborted: the same trials as P1's complete session.
+        first = [dict(r, session=99, session_status="aborted") for r in rows if r["participant"] == "P1"][:6]
+        return rows, first
+
+    @staticmethod
+    def decisive(rows):
+        return sum(1 for r in rows if not r.get("practice") and r["choice"] in ("left", "right"))
+
+    def report(self, rows, *extra):
+        trials = synthetic.write_trials_csv(os.path.join(self.tmp, "trials.csv"), rows)
+        out = os.path.join(self.tmp, "out")
+        shutil.rmtree(out, ignore_errors=True)
+        code, _, err = run_report(trials, os.path.join(self.tmp, "nobench"), out, *extra)
+        self.assertEqual(code, 0, err)
+        self.assertCleanStderr(err)
+        return read(out, "index.html"), err
+
+    def test_left_out_by_default_and_said_in_the_summary(self):
+        rows, first = self.rows()
+        index, err = self.report(rows + first)
+        answers = sum(1 for r in first if not r.get("practice"))
+        said = (f"left out 1 aborted session (P1 (session 99)) with {answers} answers: closed with blurcue sessions "
+                f"--abort, they are not part of the study; blurcue report --include-aborted analyses them")
+        self.assertIn(html.escape(said), index)
+        self.assertIn(said, err)
+        self.assertIn(f"of {self.decisive(rows)} decisive answers", index)
+        self.assertNotIn(f"of {self.decisive(rows + first)} decisive answers", index)
+
+    def test_include_aborted_counts_them_and_says_so(self):
+        rows, first = self.rows()
+        index, _ = self.report(rows + first, "--include-aborted")
+        self.assertIn("included 1 aborted session (P1 (session 99))", index)
+        self.assertIn(f"of {self.decisive(rows + first)} decisive answers", index)
+
+    def test_a_record_of_an_aborted_session_only_says_aborted(self):
+        _, first = self.rows()
+        index, _ = self.report(first)
+        self.assertIn("left out 1 aborted session (P1 (session 99))", index)
+        self.assertNotIn("decisive answers", index)
 
 
 if __name__ == "__main__":

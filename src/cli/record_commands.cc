@@ -21,8 +21,8 @@ void AddExportCommand(CLI::App& app) {
       "Write a record's answers as tidy tables, one row per planned trial (answered or not), one column per\n"
       "variable and one type per column, no JSON in any cell; DIR/codebook.csv says every column's type, unit,\n"
       "allowed values and meaning (written from the same definitions as the tables):\n"
-      "  trials.csv       who (observer person|simulated, its parameters, window or headless), the session (its id\n"
-      "                   and the participant's session number), the seed (s<digits>: exact in R, spreadsheets and\n"
+      "  trials.csv       who (observer person|simulated, its parameters, window or headless), the session (its id,\n"
+      "                   the participant's session number and its status: running|completed|aborted), the seed (s<digits>: exact in R, spreadsheets and\n"
       "                   JavaScript; run --seed takes it), the trial's block, task, practice, swap and every design\n"
       "                   variable, each side's source and fixed radius, and the answer split by kind: status,\n"
       "                   chosen_side, chose_more_blurred, chosen_interval, yes_no, rating, adjusted_level, correct,\n"
@@ -62,6 +62,11 @@ void AddMergeCommand(CLI::App& app) {
       "versions are shared by their hash and participants by their code. Refuses an existing --out. The record is\n"
       "built beside it as .OUT.partial-PID and renamed to OUT when complete; an interrupted merge's leftovers are\n"
       "removed by the next merge to the same OUT.\n"
+      "A session still being written (its lock held by a live run, as blurcue sessions shows it) is refused, exit 3,\n"
+      "naming the file, the session and its writer: merge once it has ended (or stop that run and close the session\n"
+      "with blurcue sessions --db FILE --abort ID). An unfinished session nobody is writing (a run killed or stopped)\n"
+      "is copied as running, and one line on stderr per such session says so: resume it in one record only - its\n"
+      "own (then merge again into a new OUT) or the merged one - never both, or the two copies cannot be merged again.\n"
       "Example: blurcue merge station-a.sqlite station-b.sqlite --out all.sqlite");
   cmd->add_option("inputs", args->inputs, "records to combine")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "the new record")->required();

@@ -19,7 +19,7 @@ void AddReportCommand(CLI::App& app) {
   struct Args {
     std::string db, out, bench = "results/bench", python = "/usr/bin/python3";
     int boot = 200;
-    bool pool_simulated = false;
+    bool pool_simulated = false, include_aborted = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -39,6 +39,8 @@ void AddReportCommand(CLI::App& app) {
       "  psychometric: choosing the more blurred side vs the blur difference, logistic/Weibull, bootstrap band\n"
       "  speed vs accuracy of every blur and measurement method with the Pareto front, and where each breaks\n"
       "          (from --bench: measure.csv and render.csv of blurcue bench)\n"
+      "Aborted sessions (closed with blurcue sessions --abort) are left out of every analysis, and the summary says\n"
+      "how many sessions and answers per study (--include-aborted analyses them too).\n"
       "Sections without data are skipped with a note. Needs Debian's python3-pandas, -scipy, -matplotlib and\n"
       "-statsmodels (scripts/setup.sh installs them).\n"
       "The folder is built beside DIR as .DIR.partial-PID and swapped in only when the analysis succeeded: an\n"
@@ -53,6 +55,8 @@ void AddReportCommand(CLI::App& app) {
   cmd->add_option("--python", args->python, "the Python that sees the analysis packages")->capture_default_str();
   cmd->add_flag("--pool-simulated", args->pool_simulated,
                 "analyse people and simulated observers together (by default each study reports them apart)");
+  cmd->add_flag("--include-aborted", args->include_aborted,
+                "analyse the answers of aborted sessions too (by default they are left out, and the summary says so)");
   cmd->callback([args] {
     const std::filesystem::path out = args->out;
     const std::filesystem::path script = DataDir().path / "analysis" / "report.py";
@@ -77,6 +81,7 @@ void AddReportCommand(CLI::App& app) {
                                            "--out", partial.string(), "--final-out", out.string(), "--boot",
                                            std::to_string(args->boot)};
           if (args->pool_simulated) argv.push_back("--pool-simulated");
+          if (args->include_aborted) argv.push_back("--include-aborted");
           RunAnalysis(argv, "the analysis", out.string(), {(partial / "index.html").string()});
         },
         [earlier_report](const std::string&) { return earlier_report; });

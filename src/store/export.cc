@@ -284,6 +284,10 @@ const std::vector<ColumnDef>& TrialColumnsBefore() {
       {"window", "boolean", "", "0|1", "1: shown in a real window on the real clock; 0: headless on a simulated clock"},
       {"session_id", "integer", "", ">= 1", "the session's id in this record (merged records renumber it)"},
       {"session_number", "integer", "", ">= 1", "the participant's n-th session of this study, in the order started"},
+      {"session_status", "string", "", "running|completed|aborted",
+       "the session's status when exported: running (unfinished: stopped, killed or still being written), "
+       "completed, or aborted (closed with blurcue sessions --abort; blurcue report leaves its answers out unless "
+       "--include-aborted)"},
       {"seed", "string", "", "s followed by 1-20 digits",
        "the seed of the session's trial order, a 64-bit unsigned integer written with a leading s so that spreadsheets, "
        "R and JavaScript keep every digit; blurcue run --seed takes it as written"},
@@ -515,7 +519,7 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
                  "t.block_name, t.task, t.practice, t.swapped, t.left_source, t.left_fixed, t.right_source, "
                  "t.right_fixed, coalesce(r.r_left_px, t.r_left_px), coalesce(r.r_right_px, t.r_right_px), "
                  "r.id IS NULL, r.choice, r.rt_ms, r.answered_at, r.adjustment, coalesce(r.shown, '{}'), r.correct, "
-                 "s.group_name, s.observer, s.observer_params, s.window "
+                 "s.group_name, s.observer, s.observer_params, s.window, s.status "
                  "FROM trials t JOIN sessions s ON s.id = t.session_id "
                  "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
                  "JOIN protocol_versions pv ON pv.id = s.protocol_version_id "
@@ -541,6 +545,7 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
                                       rows.IsNull(28) ? "" : std::to_string(rows.GetInt64(28)),
                                       std::to_string(session),
                                       std::to_string(session_number[session]),
+                                      rows.GetText(29),
                                       "s" + std::to_string(static_cast<uint64_t>(rows.GetInt64(4)))};
     if (groups) cells.push_back(rows.GetText(25));
     for (const auto& [key, type] : info_keys) {
@@ -671,6 +676,43 @@ std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path) {
   return sessions;
 }
 
+namespace {
+
+// Refuses an input whose session a live writer holds (the record's own rule, JudgeLock: a copy taken now would miss
+// the answers still coming, and the two copies could each be resumed and never merged again). Adds one line to
+// `unfinished` per running session with no live writer (a killed or stopped one): copied as it is, and it must be
+// resumed in one record only.
+void CheckSessionsToMerge(Database& src, const std::filesystem::path& input, std::vector<std::string>* unfinished) {
+  Statement sessions(src,
+                     "SELECT s.id, st.name, p.code, s.status, "
+                     "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), "
+                     "(SELECT count(*) FROM trials t JOIN responses r ON r.trial_id = t.id WHERE t.session_id = s.id), "
+                     "s.lock_token IS NOT NULL, coalesce(s.lock_host, ''), coalesce(s.lock_pid, 0), "
+                     "coalesce(s.lock_heartbeat_ms, 0) "
+                     "FROM sessions s JOIN participants p ON p.id = s.participant_id "
+                     "JOIN studies st ON st.id = p.study_id ORDER BY s.id");
+  while (sessions.Step()) {
+    const std::string id = std::to_string(sessions.GetInt64(0));
+    const std::string who = "session " + id + " (study " + sessions.GetText(1) + ", participant " +
+                            sessions.GetText(2) + ", " + std::to_string(sessions.GetInt64(5)) + " of " +
+                            std::to_string(sessions.GetInt64(4)) + " trials answered)";
+    if (sessions.GetInt64(6) != 0) {
+      const LockState lock = JudgeLock(sessions.GetText(7), sessions.GetInt64(8), sessions.GetInt64(9));
+      if (!lock.stale)
+        throw InputError(input.string(),
+                         who + " is being written by " + lock.text + "; merge it once that session has ended (to "
+                         "give it up instead: stop that run, then blurcue sessions --db " + input.string() +
+                         " --abort " + id + ")");
+    }
+    if (sessions.GetText(3) == "running")
+      unfinished->push_back(input.string() + ": " + who + " is unfinished, with no live writer: copied as running; "
+                            "resume it in one record only (this one, then merge again into a new file, or the "
+                            "merged one), never both: the two copies could not be merged again");
+  }
+}
+
+}  // namespace
+
 void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out,
                     const ProgressNote& note) {
   Note(note, RemoveStaleLeftovers(out));
@@ -682,6 +724,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
   }
   const std::filesystem::path temp = TemporaryBeside(out, "partial");
   RemoveDatabaseFiles(temp);
+  std::vector<std::string> unfinished;
   try {
     {
       Database dst(temp);
@@ -690,6 +733,9 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
       for (const auto& input : inputs) {
         Database src(input, OpenMode::kReadOnly);
         RequireReadableRecord(src);
+        // One snapshot of the input: the sessions judged below are the ones copied, with the answers they had then.
+        src.Exec("BEGIN");
+        CheckSessionsToMerge(src, input, &unfinished);
         std::map<int64_t, int64_t> study_ids, protocol_ids, participant_ids, session_ids, trial_ids;
         const bool typed = SchemaVersion(src) >= 7;
 
@@ -821,12 +867,15 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
           insert_frame.Run();
           insert_frame.Reset();
         }
+        src.Exec("COMMIT");
       }
       // Inputs from before the typed record: their typed columns from their texts, as a migration would.
       DeriveTypedColumns(dst);
       transaction.Commit();
     }  // the last connection closes: the WAL is checkpointed into the file and removed
     MoveIntoPlace(temp, out);
+    if (note)
+      for (const auto& line : unfinished) note(line);
   } catch (...) {
     RemoveDatabaseFiles(temp);
     throw;

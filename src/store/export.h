@@ -8,7 +8,7 @@
 
 namespace blurcue::store {
 
-// Receives one line for the user (what was cleaned up); the caller decides where to print it.
+// Receives one line for the user (what was cleaned up, what needs care); the caller decides where to print it.
 using ProgressNote = std::function<void(const std::string&)>;
 
 // Writes `out_dir`/trials.csv: one row per planned trial, answered or not, ordered by study,
@@ -32,9 +32,13 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
 // Copies every study, protocol version, participant, session, trial, response and frame of `inputs` into a new
 // record at `out`, with fresh ids. Protocol versions are shared by (study, hash) and participants by (study,
 // participant code). Throws Error(kInput) when `out` exists, an input is listed twice, an input is not a current
-// record, or a session (same participant, protocol, seed, host and start) is already in the output. Nothing is
-// left at `out` on failure. The record is built beside `out` as DIR/.NAME.partial-PID and renamed to `out` when
-// complete; leftovers of a killed merge to the same `out` are removed first, each one told to `note`.
+// record, a session of an input is held by a live writer (JudgeLock: not stale; the message names the file, the
+// session and the writer), or a session (same participant, protocol, seed, host and start) is already in the output.
+// Nothing is left at `out` on failure. Each input is read in one snapshot. A running session no live writer holds
+// (killed, stopped or stale) is copied as running, and one line per such session, told to `note` once `out` is in
+// place, says so and that it must be resumed in one record only. The record is built beside `out` as
+// DIR/.NAME.partial-PID and renamed to `out` when complete; leftovers of a killed merge to the same `out` are removed
+// first, each one told to `note`.
 void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out,
                     const ProgressNote& note = {});
 

@@ -1,5 +1,8 @@
 #include "store/export.h"
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <cctype>
 #include <fstream>
 #include <set>
@@ -93,7 +96,7 @@ TEST(Export, ColumnsAreTheSameForParticipantsWithDifferentFactors) {
   ASSERT_EQ(rows.size(), 8u);
   const std::vector<std::string> expected = {
       "study",       "protocol_hash", "participant", "observer",    "observer_params",    "window",
-      "session_id",  "session_number", "seed",       "trial_index", "block",              "block_name",
+      "session_id",  "session_number", "session_status", "seed", "trial_index", "block",            "block_name",
       "task",        "practice",      "swapped",     "blur",        "edge",               "speed_cm_s",
       "left_source", "left_fixed",    "right_source", "right_fixed", "status",            "chosen_side",
       "chose_more_blurred", "chosen_interval", "yes_no", "rating",   "adjusted_level",    "correct",
@@ -111,6 +114,7 @@ TEST(Export, ColumnsAreTheSameForParticipantsWithDifferentFactors) {
   EXPECT_EQ(rows[1][Column(rows, "status")], "answered");
   EXPECT_EQ(rows[1][Column(rows, "chosen_side")], "right");
   EXPECT_EQ(rows[5][Column(rows, "session_number")], "1");
+  EXPECT_EQ(rows[5][Column(rows, "session_status")], "completed");
   // Unanswered trials are rows with empty answers.
   EXPECT_EQ(rows[7][Column(rows, "status")], "unanswered");
   EXPECT_EQ(rows[7][Column(rows, "chosen_side")], "");
@@ -239,6 +243,33 @@ TEST(Export, AnOlderRecordExportsFromAMigratedCopy) {
   EXPECT_EQ(SchemaVersion(old), 6);  // the record itself is only read
 }
 
+// Every row says its session's status, so an analysis can tell an aborted session's answers from the study's.
+TEST(Export, EveryRowCarriesItsSessionsStatusAbortedIncluded) {
+  testing::TempDir dir;
+  {
+    Record record = Record::Open(dir / "r.sqlite");
+    const int64_t first = record.StartOrResumeSession("test1", "P01", "{}", 1, {}, false).session_id;
+    TrialRecord trial;
+    record.SaveTrialList(first, {trial});
+    Response r;
+    r.choice = "left";
+    record.RecordResponse(first, 0, r);
+    record.AbortSession(first);
+    RunSession(record, "P01", "{}", 2, 2);  // the same participant again, completed
+    RunSession(record, "P02", "{}", 2, 1);
+    const int64_t running = record.StartOrResumeSession("test1", "P03", "{}", 1, {}, false).session_id;
+    record.SaveTrialList(running, {trial});
+  }
+  ExportCsv(dir / "r.sqlite", dir / "out");
+  const Rows rows = ReadCsv(dir / "out" / "trials.csv");
+  std::vector<std::string> got;
+  for (size_t i = 1; i < rows.size(); ++i)
+    got.push_back(rows[i][Column(rows, "participant")] + ":" + rows[i][Column(rows, "session_id")] + ":" +
+                  rows[i][Column(rows, "session_status")]);
+  EXPECT_EQ(got, (std::vector<std::string>{"P01:1:aborted", "P01:2:completed", "P01:2:completed", "P02:3:completed",
+                                           "P02:3:completed", "P03:4:running"}));
+}
+
 TEST(Export, ReadsARecordAWriterStillHasOpen) {
   testing::TempDir dir;
   Record record = Record::Open(dir / "r.sqlite");
@@ -332,6 +363,90 @@ TEST(Merge, TheSameSessionTwiceIsRefusedAndLeavesNoOutput) {
   EXPECT_THROW(MergeDatabases({dir / "a.sqlite", dir / "copy.sqlite"}, dir / "merged.sqlite"), Error);
   EXPECT_FALSE(std::filesystem::exists(dir / "merged.sqlite"));
   EXPECT_THROW(MergeDatabases({dir / "a.sqlite", dir / "a.sqlite"}, dir / "merged.sqlite"), Error);
+}
+
+// Starts participant P01's session of 4 trials in `db` and answers 2 of them, leaving it running.
+int64_t StartHalfASession(Record& record) {
+  const int64_t session = record.StartOrResumeSession("test1", "P01", R"({"study":"test1"})", 42, {}, false).session_id;
+  std::vector<TrialRecord> trials(4);
+  for (int i = 0; i < 4; ++i) {
+    trials[i].index = i;
+    trials[i].factors_json = "{}";
+    trials[i].left_json = R"("measured")";
+    trials[i].right_json = R"("none")";
+  }
+  record.SaveTrialList(session, trials);
+  for (int i = 0; i < 2; ++i) {
+    Response r;
+    r.choice = "left";
+    record.RecordResponse(session, i, r);
+  }
+  return session;
+}
+
+// A session a live writer holds is refused, naming the file, the session and the writer: a copy taken now would
+// miss the answers still coming, and both copies could be resumed and never merged again.
+TEST(Merge, ASessionALiveWriterHoldsIsRefusedNamingItsWriter) {
+  testing::TempDir dir;
+  Record writer = Record::Open(dir / "a.sqlite");
+  StartHalfASession(writer);
+  try {
+    MergeDatabases({dir / "a.sqlite"}, dir / "merged.sqlite");
+    FAIL() << "merged a session that is still being written";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    const std::string message = e.what();
+    EXPECT_NE(message.find((dir / "a.sqlite").string() + ": session 1 (study test1, participant P01, 2 of 4 trials "
+                           "answered) is being written by pid " + std::to_string(getpid())),
+              std::string::npos) << message;
+    EXPECT_NE(message.find("(alive)"), std::string::npos) << message;
+    EXPECT_NE(message.find("--abort 1"), std::string::npos) << message;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "merged.sqlite"));
+}
+
+// A session whose writer was killed (its lock names a pid that is gone) is copied as running, and one line says it
+// is unfinished and must be resumed in one record only.
+TEST(Merge, AKilledWritersSessionIsCopiedAndNamedAsUnfinished) {
+  testing::TempDir dir;
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    // Dies holding the lock, as a killed run does: _exit runs no destructor to release it.
+    try {
+      Record writer = Record::Open(dir / "a.sqlite");
+      StartHalfASession(writer);
+      _exit(0);
+    } catch (...) {
+      _exit(1);
+    }
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  {
+    Database a(dir / "a.sqlite", OpenMode::kReadOnly);
+    ASSERT_EQ(a.QueryInt64("SELECT lock_pid FROM sessions"), child);  // the lock outlived its writer
+  }
+  std::vector<std::string> notes;
+  MergeDatabases({dir / "a.sqlite"}, dir / "merged.sqlite", [&](const std::string& line) { notes.push_back(line); });
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_EQ(notes[0].rfind((dir / "a.sqlite").string() + ": session 1 (study test1, participant P01, 2 of 4 trials "
+                           "answered) is unfinished, with no live writer: copied as running; resume it in one record "
+                           "only", 0), 0u) << notes[0];
+  Database db(dir / "merged.sqlite", OpenMode::kReadOnly);
+  EXPECT_EQ(db.QueryText("SELECT status FROM sessions"), "running");
+  EXPECT_EQ(db.QueryInt64("SELECT count(*) FROM responses"), 2);
+  EXPECT_EQ(db.QueryInt64("SELECT count(*) FROM sessions WHERE lock_token IS NOT NULL"), 0);
+}
+
+// Completed sessions are merged without a word.
+TEST(Merge, CompletedSessionsSayNothing) {
+  testing::TempDir dir;
+  { Record a = Record::Open(dir / "a.sqlite"); RunSession(a, "P01", "{}", 2, 2); }
+  std::vector<std::string> notes;
+  MergeDatabases({dir / "a.sqlite"}, dir / "merged.sqlite", [&](const std::string& line) { notes.push_back(line); });
+  EXPECT_TRUE(notes.empty());
 }
 
 }  // namespace
