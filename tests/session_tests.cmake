@@ -12,7 +12,7 @@ set_tests_properties(session_pictures PROPERTIES FIXTURES_REQUIRED scene FIXTURE
 set_tests_properties(session_protocols PROPERTIES FIXTURES_SETUP session_protocols)
 foreach(case complete same_seed resume kill9 second_writer window window_adjust recover depth_arcmin merge resume_guards stranded
              stale_lock readonly frames_shown adaptive groups_info two_intervals deadline layouts window_after_motion codebook report_any_study practice_criterion visibility depth_capture
-             resume_observer resume_display groups_concurrent resume_exact)
+             resume_observer resume_display groups_concurrent resume_exact level_names)
   add_test(NAME session_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/session_test.sh ${case} ${BC} ${T})
   set_tests_properties(session_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures"
                        LABELS "gl;session"
