@@ -1290,5 +1290,61 @@ resume_exact)
       fail "$proto: resumed differs from uninterrupted in $(grep -c '^<' "$W/$proto.diff") rows, e.g. $(grep -m2 '^[<>]' "$W/$proto.diff" | tr '\n' ' ')"
   done
   echo "ok: stopped after 5 and resumed = uninterrupted to the last digit of every response and flip time (test 2, depth matching)" ;;
+level_names)
+  # A design's levels named like what trials.csv records of its own - a conditions table's status, participant,
+  # r_left_px and info_age; a staircase table's level, test_side and correct - validate, run and come out of export as
+  # factor_NAME with the table's values, beside the columns the record fills (the radius shown, the staircase's level,
+  # the participant's age). r_left_px, level, test_side and correct used to lose the table's values, and info_age
+  # made two columns of one name.
+  $PY - "$P/test1-static-grids.json" "$W" <<'PYEOF'
+import json, sys
+t, w = json.load(open(sys.argv[1])), sys.argv[2]
+open(w + "/rows.csv", "w").write("edge,status,participant,r_left_px,info_age\n3,answered,P9,7.5,41\n6,x,P8,1,42\n")
+open(w + "/stairs.csv", "w").write("edge,level,test_side,correct\n6,99,left,1\n3,98,right,0\n")
+common = {"version": 1, "scene": t["scene"], "content": {"type": "grid"}, "task": "forced_choice"}
+json.dump(dict(common, name="clash-table", participant_info=[{"key": "age", "type": "integer", "min": 16, "max": 99}],
+               blocks=[{"name": "tab", "conditions": "rows.csv", "sides": {"left": "measured", "right": "none"}}]),
+          open(w + "/table.json", "w"))
+json.dump(dict(common, name="clash-stairs", responses={"cant_tell": None},
+               blocks=[{"name": "st", "conditions": "stairs.csv",
+                        "procedure": {"type": "staircase", "variable": "relative_difference", "reference": "measured",
+                                      "trials": 3, "start": 1, "min": 0.1, "max": 2, "up": 1, "down": 2,
+                                      "steps": [0.5]}}]),
+          open(w + "/stairs.json", "w"))
+PYEOF
+  sed -i "s|\"\.\./|\"$P/../|g" "$W/table.json" "$W/stairs.json"
+  for p in table stairs; do
+    $BC validate "$W/$p.json" > "$W/out" 2>&1 || fail "validate $p: $(tail -1 "$W/out")"
+  done
+  $BC run "$W/table.json" --participant P1 --db "$W/s.sqlite" --observer sim --info age=30 > "$W/out" 2>&1 ||
+    fail "run table: $(tail -1 "$W/out")"
+  $BC run "$W/stairs.json" --participant P2 --db "$W/s.sqlite" --observer sim > "$W/out" 2>&1 ||
+    fail "run stairs: $(tail -1 "$W/out")"
+  $BC export --db "$W/s.sqlite" --out "$W/tables" > /dev/null
+  $PY - "$W/tables" <<'PYEOF' || fail "levels named like recorded columns"
+import csv, sys
+d = sys.argv[1]
+header = next(csv.reader(open(d + "/trials.csv")))
+assert len(header) == len(set(header)), sorted(h for h in header if header.count(h) > 1)
+rows = list(csv.DictReader(open(d + "/trials.csv")))
+table = [r for r in rows if r["study"] == "clash-table"]
+assert len(table) == 2, len(table)
+for r in table:
+    designed = {"3": ("answered", "P9", "7.5", "41"), "6": ("x", "P8", "1", "42")}[r["edge"]]
+    got = (r["factor_status"], r["factor_participant"], r["factor_r_left_px"], r["factor_info_age"])
+    assert got == designed, (r["edge"], got)
+    assert (r["participant"], r["status"], r["info_age"]) == ("P1", "answered", "30"), r
+    assert r["r_left_px"] and r["r_left_px"] != r["factor_r_left_px"], r["r_left_px"]  # the radius shown
+stairs = [r for r in rows if r["study"] == "clash-stairs"]
+assert len(stairs) == 6, len(stairs)
+for r in stairs:
+    designed = {"6": ("99", "left", "1"), "3": ("98", "right", "0")}[r["edge"]]
+    assert (r["factor_level"], r["factor_test_side"], r["factor_correct"]) == designed, r
+    assert 0.1 <= float(r["level"]) <= 2 and r["test_side"] in ("left", "right") and r["correct"] in ("0", "1"), r
+codebook = {row["column"]: row["meaning"] for row in csv.DictReader(open(d + "/codebook.csv")) if row["table"] == "trials.csv"}
+assert "factor r_left_px" in codebook["factor_r_left_px"], codebook["factor_r_left_px"]
+print("ok")
+PYEOF
+  echo "ok: a table's status, participant, r_left_px, info_age and a staircase table's level, test_side, correct come out as factor_NAME with their values, beside the recorded columns" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -13,7 +13,7 @@ set_tests_properties(session_protocols PROPERTIES FIXTURES_SETUP session_protoco
 foreach(case complete same_seed resume kill9 second_writer window window_adjust recover depth_arcmin merge merge_live_writer
              merge_killed_session resume_guards stranded
              stale_lock readonly frames_shown adaptive groups_info two_intervals deadline layouts window_after_motion codebook report_any_study report_aborted practice_criterion visibility depth_capture
-             resume_observer resume_display groups_concurrent resume_exact)
+             resume_observer resume_display groups_concurrent resume_exact level_names)
   add_test(NAME session_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/session_test.sh ${case} ${BC} ${T})
   set_tests_properties(session_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures"
                        LABELS "gl;session"
@@ -133,6 +133,11 @@ add_preflight_test(escape-cell "/conditions/row/1/label: ${D}/escape-cell.csv li
 file(WRITE ${D}/open-quote.csv "edge,left,right,label\n1,measured,none,ok\n2,measured,none,\"ab\n")
 add_preflight_test(open-quote "/conditions/row/1: ${D}/open-quote.csv line 3: a quoted field is not closed"
                    "${grid_head} \"conditions\": \"open-quote.csv\"}")
+# A place no layout draws: the single object (and every interval's) stands at the left one's place, so a right_x_mm
+# level was recorded on every row though nothing was drawn there.
+add_preflight_test(single-right-x-mm
+                   "/blocks/0/factors/right_x_mm: the layout single shows every object at the left one's place (move it with left_x_mm): a right_x_mm level would be recorded but not shown, got [100]"
+                   "{\"name\": \"t\", \"version\": 1, \"content\": {\"type\": \"grid\"}, \"task\": \"yes_no\", \"layout\": \"single\", ${ball_scene}, \"blocks\": [{\"name\": \"s\", \"factors\": {\"edge\": [3, 7], \"right_x_mm\": [100]}, \"sides\": {\"object\": \"measured\"}}]}")
 # A display profile's name is one line of at most 100 characters: a 100,000-character name and one with an escape
 # and a newline used to be recorded and printed as they were.
 string(REPEAT "x" 100000 long_name)

@@ -1338,6 +1338,31 @@ void Parser::CheckDesign(const Protocol& p) {
                         return list;
                       }());
     }
+    // Every layout but side_by_side draws its objects - the single one, each interval's - at the left one's place,
+    // and intervals hold them still: a level that places the right object, or ends a run in intervals, would be
+    // recorded but not shown. Named at the factor, or at the first level (a conditions table's row) that gives it.
+    if (uses != kUses.end() && type != "picture" && p.layout != "side_by_side") {
+      std::vector<std::pair<std::string, std::string>> unshown = {
+          {"right_x_mm", "the layout " + p.layout + " shows every object at the left one's place (move it with "
+                         "left_x_mm): a right_x_mm level would be recorded but not shown"}};
+      if (IntervalCount(p) > 0)
+        for (const char* end : {"to_edge", "to_y_mm"})
+          unshown.push_back({end, std::string("intervals show still objects, where a run would start: a ") + end +
+                                      " level would be recorded but not shown"});
+      for (const auto& [name, why] : unshown)
+        for (const auto& f : b.factors) {
+          if (f.name == name) {
+            Problem(b.factors_pointer + "/" + JsonPointerToken(f.name), why, Json(f.levels));
+            continue;
+          }
+          for (size_t i = 0; i < f.levels.size(); ++i)
+            if (f.levels[i].is_object() && f.levels[i].contains(name)) {
+              Problem(b.factors_pointer + "/" + JsonPointerToken(f.name) + "/" + std::to_string(i) + "/" + name, why,
+                      f.levels[i][name]);
+              break;
+            }
+        }
+    }
     if (IntervalCount(p) > 0 && Provides(b, "speed_cm_s"))
       Problem(b.factors_pointer, "intervals show still objects: a speed_cm_s level would move them");
     // The layout decides the question: one object is answered yes/no or rated, a pair or N intervals chosen from.

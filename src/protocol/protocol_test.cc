@@ -492,6 +492,48 @@ TEST(ProtocolValidate, OddOneOutHasAlternativesNamedByTheirKeys) {
   ExpectProblem(j, "/blocks/0/procedure/guess: an odd-one-out trial of 3 intervals is guessed right 1/3");
 }
 
+// Every layout but side_by_side draws its objects at the left one's place, and intervals hold them still: a level
+// placing the right object (right_x_mm), or ending a run in intervals (to_edge, to_y_mm), would be recorded on every
+// row but not shown. Refused, naming the factor, the level object or the conditions table's row that gives it; the
+// side-by-side pair reads them.
+TEST(ProtocolValidate, PlaceALayoutDoesNotDrawIsRefused) {
+  Json single = Single();
+  single["blocks"][0]["factors"]["right_x_mm"] = {100};
+  EXPECT_TRUE(Contains(OnlyProblem(single), "/blocks/0/factors/right_x_mm: the layout single shows every object at "
+                                            "the left one's place (move it with left_x_mm): a right_x_mm level would "
+                                            "be recorded but not shown, got [100]"))
+      << OnlyProblem(single);
+  single["blocks"][0]["factors"].erase("right_x_mm");
+  single["blocks"][0]["factors"]["left_x_mm"] = {100};
+  EXPECT_TRUE(Problems(single).empty()) << Problems(single).front();
+  Json odd = OddOneOut();
+  odd["blocks"][0]["factors"]["place"] = Json::parse(R"([{"left_x_mm": -30}, {"left_x_mm": -30, "right_x_mm": 120}])");
+  EXPECT_TRUE(Contains(OnlyProblem(odd), "/blocks/0/factors/place/1/right_x_mm: the layout odd_one_out shows every "
+                                         "object at the left one's place"))
+      << OnlyProblem(odd);
+  Json two = OddOneOut();
+  two["layout"] = "two_intervals";
+  two["blocks"][0]["factors"] = Json::parse(R"({"from_edge": [2], "to_edge": [9]})");
+  EXPECT_TRUE(Contains(OnlyProblem(two), "/blocks/0/factors/to_edge: intervals show still objects, where a run would "
+                                         "start: a to_edge level would be recorded but not shown, got [9]"))
+      << OnlyProblem(two);
+  const fs::path dir = SceneFolder();
+  std::ofstream(dir / "places.csv") << "edge,left_x_mm,right_x_mm\n3,-30,110\n5,-30,120\n";
+  Json table = OddOneOut();
+  table["content"] = {{"type", "grid"}};
+  table["blocks"][0].erase("factors");
+  table["blocks"][0]["conditions"] = "places.csv";
+  EXPECT_TRUE(Contains(OnlyProblem(table), "/blocks/0/conditions/row/0/right_x_mm: the layout odd_one_out shows "
+                                           "every object at the left one's place"))
+      << OnlyProblem(table);
+  // Side by side, the right object stands where right_x_mm puts it, and a rolling ball ends its run at to_edge.
+  Json pair = Valid();
+  pair["blocks"][1]["factors"] = Json::parse(R"({"pattern": [{"id": 2, "speed_cm_s": 1.8, "left": "measured",
+                                                 "right": "none"}], "from_edge": [2], "to_edge": [9],
+                                                 "right_x_mm": [120]})");
+  EXPECT_TRUE(Problems(pair).empty()) << Problems(pair).front();
+}
+
 TEST(ProtocolValidate, AStaircaseStopRule) {
   Json j = Valid();
   j.erase("counterbalance");

@@ -194,24 +194,35 @@ std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& part
 
 std::vector<size_t> BlockOrder(const Protocol& protocol, const std::string& participant, std::mt19937_64& rng) {
   const size_t n = protocol.blocks.size();
-  std::vector<size_t> order(n);
-  for (size_t i = 0; i < n; ++i) order[i] = i;
-  if (protocol.block_order == "random") {
-    Shuffle(order, rng);
-  } else if (protocol.block_order == "latin_square" && n > 1) {
+  std::vector<size_t> all(n);
+  for (size_t i = 0; i < n; ++i) all[i] = i;
+  // Practice comes first whatever the order, in the file's order; only the scored blocks are ordered. The random
+  // order still shuffles every block (the same draws as before practice blocks were lifted out, so the generator
+  // is where it was for everything drawn after) and keeps the scored blocks in the order that shuffle gives them.
+  if (protocol.block_order == "random") Shuffle(all, rng);
+  std::vector<size_t> order, scored;
+  for (size_t i = 0; i < n; ++i)
+    if (protocol.blocks[i].practice) order.push_back(i);
+  for (const size_t k : all)
+    if (!protocol.blocks[k].practice) scored.push_back(k);
+  const size_t m = scored.size();
+  if (protocol.block_order == "latin_square" && m > 1) {
     const int number = ParticipantNumber(participant);
     if (number < 0)
       throw InputError(protocol.file.string() + ": /block_order",
                        "latin_square needs a participant id ending in a number (e.g. P7), got \"" + participant + "\"");
-    // Williams: 0, 1, n-1, 2, n-2, ... shifted by the row; an odd n needs the reversed rows too.
-    const size_t rows = n % 2 == 0 ? n : 2 * n;
-    const size_t row = size_t(number) % rows, shift = row % n;
-    for (size_t j = 0; j < n; ++j) {
-      const size_t base = j % 2 == 1 ? (j + 1) / 2 : (n - j / 2) % n;
-      order[j] = (base + shift) % n;
+    // Williams over the scored blocks: 0, 1, m-1, 2, m-2, ... shifted by the row; an odd m needs the reversed rows too.
+    const size_t rows = m % 2 == 0 ? m : 2 * m;
+    const size_t row = size_t(number) % rows, shift = row % m;
+    std::vector<size_t> square(m);
+    for (size_t j = 0; j < m; ++j) {
+      const size_t base = j % 2 == 1 ? (j + 1) / 2 : (m - j / 2) % m;
+      square[j] = scored[(base + shift) % m];
     }
-    if (row >= n) std::reverse(order.begin(), order.end());
+    if (row >= m) std::reverse(square.begin(), square.end());
+    scored = square;
   }
+  order.insert(order.end(), scored.begin(), scored.end());
   return order;
 }
 

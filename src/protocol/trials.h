@@ -58,12 +58,15 @@ void CheckParticipantId(const std::string& participant);
 // The participant's number: the trailing digits of the id ("P7" -> 7); -1 when it has none.
 int ParticipantNumber(const std::string& participant);
 
-// The order a participant runs the blocks in (indices into protocol.blocks): file order, a seeded shuffle (the
-// generator's first draw), or row (participant number mod n, or mod 2n for an odd n) of a Williams balanced Latin
-// square. Throws Error(kInput) for latin_square with a participant id without number.
+// The order a participant runs the blocks in (indices into protocol.blocks): the practice blocks first, in file
+// order, under every block_order; then the scored blocks in file order, in the order a seeded shuffle of all n
+// blocks gives them (the generator's first draws: Fisher-Yates over n, as before practice was lifted out), or in
+// row (participant number mod m, or mod 2m for an odd m) of a Williams balanced Latin square over the m scored
+// blocks. Throws Error(kInput) for latin_square over two or more scored blocks with a participant id without number.
 std::vector<size_t> BlockOrder(const Protocol& protocol, const std::string& participant, std::mt19937_64& rng);
 
-// Practice trials first, then the blocks in BlockOrder (file order unless block_order says otherwise). Per block: the full factorial crossing of its factors
+// The protocol's practice trials first, then the blocks in BlockOrder (practice blocks, then the scored blocks in
+// file order unless block_order says otherwise). Per block: the full factorial crossing of its factors
 // (factors in name order, the last varying fastest) x repetitions; with swap_copies each trial also appears with
 // left and right exchanged, with by_participant an even participant number sees every trial swapped; then the
 // block is shuffled (unless "shuffle": false). One generator seeded with `seed` is drawn from in this order:

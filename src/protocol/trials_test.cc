@@ -214,6 +214,52 @@ TEST(TrialBuilder, BlockOrderIsABalancedLatinSquareOrSeeded) {
   }
 }
 
+// Practice blocks run first, in the order the file gives them, under every block order; random and latin_square
+// order only the scored blocks. The random order's draws are those of a shuffle of every block, so the scored blocks
+// keep the order the same seed gave them before, and a Latin square balances the scored blocks among themselves.
+TEST(TrialBuilder, PracticeBlocksComeFirstUnderEveryBlockOrder) {
+  Json j = Json::parse(R"({"name": "order", "version": 1, "scene": {"background": "s.png", "calib": "c.json"},
+    "content": {"type": "grid"}, "task": "forced_choice", "factors": {"edge": [1]},
+    "sides": {"left": "measured", "right": "estimated"},
+    "blocks": [{"name": "a"}, {"name": "warm", "practice": true}, {"name": "b"}, {"name": "c"},
+               {"name": "warm2", "practice": true}]})");
+  auto blocks_of = [](const std::vector<Trial>& trials) {
+    std::vector<std::string> names;
+    for (const auto& t : trials) names.push_back(t.block);
+    return names;
+  };
+  auto scored_of = [](std::vector<std::string> names) {
+    names.erase(std::remove_if(names.begin(), names.end(), [](const std::string& n) { return n.rfind("warm", 0) == 0; }),
+                names.end());
+    return names;
+  };
+  for (const char* order : {"fixed", "random", "latin_square"}) {
+    j["block_order"] = order;
+    const Protocol p = ParseProtocol(j, "inline.json", {false});
+    std::map<std::pair<std::string, int>, int> place;
+    for (int participant = 1; participant <= 12; ++participant) {
+      const std::string id = "P" + std::to_string(participant);
+      const auto names = blocks_of(BuildTrials(p, id, uint64_t(participant)));
+      ASSERT_EQ(names.size(), 5u) << order;
+      EXPECT_EQ(names[0], "warm") << order << " " << id;
+      EXPECT_EQ(names[1], "warm2") << order << " " << id;
+      for (int k = 2; k < 5; ++k) ++place[{names[size_t(k)], k}];
+      if (std::string(order) == "fixed") EXPECT_EQ(scored_of(names), (std::vector<std::string>{"a", "b", "c"}));
+      if (std::string(order) == "random") {
+        // The same seed orders the scored blocks as it does with no practice blocks among them.
+        Json plain = j;
+        for (auto& b : plain["blocks"]) b.erase("practice");
+        const Protocol q = ParseProtocol(plain, "inline.json", {false});
+        EXPECT_EQ(scored_of(names), scored_of(blocks_of(BuildTrials(q, id, uint64_t(participant))))) << id;
+      }
+    }
+    // Three scored blocks: a Williams square of 6 rows, each block twice in each place over 12 participants.
+    if (std::string(order) == "latin_square")
+      for (const char* b : {"a", "b", "c"})
+        for (int k = 2; k < 5; ++k) EXPECT_EQ((place[{b, k}]), 4) << b << " place " << k;
+  }
+}
+
 // Groups: by participant number in turn, or the group with the fewest sessions so far; a session's trials are
 // its group's blocks (and the blocks of every group).
 TEST(TrialBuilder, GroupsAreAssignedAndSelectTheirBlocks) {

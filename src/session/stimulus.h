@@ -113,6 +113,8 @@ void PlanOnScreen(const protocol::Protocol& protocol, const calib::SceneCalib& s
 // scene) with the presentation's screen_px_per_photo_px and the blur plan (blur_plan: one_radius | per_pixel,
 // r_span_screen_px) and each object's size_left_deg / size_right_deg, or start_level and adjust_levels (adjustment;
 // a picture: picture_width_arcmin, and the real picture's r_scene_* when content.real_camera names its camera).
+// Each level is recorded under store::DesignColumn(name): factor_NAME for one named like any of those or like a
+// column of trials.csv (store::IsRecordedName), so nothing recorded takes a level's place.
 Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation);
 
 // The protocol's calibration (none for a picture without one). Throws Error(kInput) naming the protocol file and

@@ -10,6 +10,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "core/error.h"
+#include "store/export.h"
 
 namespace blurcue::session {
 namespace {
@@ -201,6 +202,48 @@ TEST(DescribeTrial, GridCardsSitBesideTheBoardAtTheirEdge) {
   const double pitch_mm = 531.4 / 1920, deg = 180 / 3.14159265358979323846;
   EXPECT_NEAR(v["r_right_arcmin"].get<double>(), 2 * std::atan(0.5 * r * 1622.0 / 4592.0 * pitch_mm / 600) * deg * 60,
               1e-4);
+}
+
+// A level named like something the record or trials.csv holds of its own (a conditions table's r_left_px, status or
+// participant; a staircase block's level, test_side or correct) is recorded as factor_NAME with its own value, and
+// the variable recorded under that name is the one the trial showed: neither overwrites the other. Every name
+// recorded beside the levels is one store::IsRecordedName reserves, so no future variable can take a level's place.
+TEST(TrialVariables, LevelsNamedLikeRecordedVariablesKeepTheirValuesUnderFactorNames) {
+  const calib::SceneCalib scene = ThesisScene();
+  protocol::Protocol p = BallProtocol();
+  p.content.type = "grid";
+  const Json row = {{"edge", 2}, {"status", "x"}, {"participant", "P8"}, {"r_left_px", 7.5}, {"info_age", 40},
+                    {"level", 99}, {"test_side", "left"}, {"correct", 1}, {"label", "near"}};
+  protocol::Trial trial = PairTrial({{"row", row}, {"group", "g"}}, "fitted", "fitted");
+  trial.cell = 0;  // a procedure's trial: level, test_side and the procedure cell are recorded
+  trial.test_side = "right";
+  TrialScene t = DescribeTrial(p, trial, &scene);
+  t.level = 0.4;
+  Presentation shown;
+  shown.scale = 0.5;
+  const Json v = TrialVariables(trial, t, shown);
+  EXPECT_EQ(v["factor_status"], "x");
+  EXPECT_EQ(v["factor_participant"], "P8");
+  EXPECT_EQ(v["factor_r_left_px"], 7.5);
+  EXPECT_EQ(v["factor_info_age"], 40);
+  EXPECT_EQ(v["factor_level"], 99);
+  EXPECT_EQ(v["factor_test_side"], "left");
+  EXPECT_EQ(v["factor_correct"], 1);
+  EXPECT_EQ(v["factor_group"], "g");
+  EXPECT_EQ(v["edge"], 2);
+  EXPECT_EQ(v["label"], "near");
+  EXPECT_NEAR(v["r_left_px"].get<double>(), t.r_left_px, 1e-4);  // the radius shown, not the table's 7.5
+  EXPECT_NE(v["r_left_px"], 7.5);
+  EXPECT_EQ(v["level"], 0.4);
+  EXPECT_EQ(v["test_side"], "right");
+  for (const auto& [key, value] : v.items())
+    if (!row.contains(key) && key != "group" && key.rfind("factor_", 0) != 0)
+      EXPECT_TRUE(store::IsRecordedName(key)) << key << " is recorded but not reserved for it";
+  for (const char* name : {"status", "participant", "r_left_px", "level", "test_side", "correct", "practice",
+                           "swapped", "block_name", "info_age", "group", "round", "odd_interval"})
+    EXPECT_TRUE(store::IsRecordedName(name)) << name;
+  for (const char* name : {"edge", "label", "speed_cm_s", "right_x_mm", "factor_status"})
+    EXPECT_FALSE(store::IsRecordedName(name)) << name;
 }
 
 TEST(PlanOnScreen, PerPixelExactlyWhenTheObjectsDepthSpanReachesTheThresholdOnScreen) {

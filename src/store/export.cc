@@ -426,6 +426,21 @@ bool AllDigits(const std::string& text) {
 
 }  // namespace
 
+bool IsRecordedName(const std::string& name) {
+  // The names trials.csv writes itself and the runner records beside the levels - read off the very definitions
+  // the table and its codebook are written from, so a column added there is reserved here without another list.
+  static const std::set<std::string> names = [] {
+    std::set<std::string> n = {"group"};
+    for (const auto* list : {&TrialColumnsBefore(), &TrialColumnsDesign(), &TrialColumnsAfter()})
+      for (const auto& c : *list) n.insert(c.name);
+    for (const auto& [name, definition] : KnownVariables()) n.insert(name);
+    return n;
+  }();
+  return names.count(name) > 0 || name.rfind("info_", 0) == 0;
+}
+
+std::string DesignColumn(const std::string& name) { return IsRecordedName(name) ? "factor_" + name : name; }
+
 int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::path& out_dir,
                   const ProgressNote& note) {
   Note(note, RemoveStaleLeftovers(out_dir));
@@ -487,26 +502,27 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
 
   // The header and the codebook, from the same definitions.
   std::vector<ColumnDef> columns = TrialColumnsBefore();
-  std::set<std::string> fixed;
-  for (const auto* list : {&TrialColumnsBefore(), &TrialColumnsDesign(), &TrialColumnsAfter()})
-    for (const auto& c : *list) fixed.insert(c.name);
-  if (groups) columns.push_back({"group", "string", "", "", "the between-subject group the session ran"}), fixed.insert("group");
+  if (groups) columns.push_back({"group", "string", "", "", "the between-subject group the session ran"});
   for (const auto& [key, type] : info_keys)
     columns.push_back({"info_" + key, type.Type(), "", type.Allowed(), "participant information: " + key});
   columns.insert(columns.end(), TrialColumnsDesign().begin(), TrialColumnsDesign().end());
   std::vector<std::string> variable_names;
   for (const auto& [key, type] : keys) {
-    const std::string name = fixed.count(key) ? "factor_" + key : key;
-    variable_names.push_back(key);
+    // A recorded variable keeps its name; a level named like one (the runner records it as factor_NAME; a record of
+    // before that holds it under its own name where no recorded variable took it) gets the same prefix.
     const auto known = KnownVariables().find(key);
+    const std::string name = known != KnownVariables().end() ? key : DesignColumn(key);
+    variable_names.push_back(key);
+    const std::string level = key.rfind("factor_", 0) == 0 && IsRecordedName(key.substr(7)) ? key.substr(7) : key;
     // A recorded measurement takes any value; a name (kernel, plan) or a level of the design one of those seen.
     if (known != KnownVariables().end())
       columns.push_back({name, known->second.type, known->second.unit,
                          known->second.type == "string" ? type.Allowed() : "", known->second.meaning});
     else
       columns.push_back({name, type.Type(), "", type.Allowed(),
-                         "a level of the protocol's design: factor " + key + " (or a column of a level or of the "
-                         "conditions table)"});
+                         "a level of the protocol's design: factor " + level + " (or a column of a level or of the "
+                         "conditions table)" + (name == key && level == key ? "" : "; named " + name +
+                         " because trials.csv has a column " + level + " of its own")});
   }
   columns.insert(columns.end(), TrialColumnsAfter().begin(), TrialColumnsAfter().end());
   std::vector<std::string> header;

@@ -15,7 +15,8 @@ using ProgressNote = std::function<void(const std::string&)>;
 // participant, session, trial index. Columns, the same for every participant:
 //   study, protocol_hash, participant, session, seed, trial_index, block, <every factor key found in the record,
 //   sorted>, left, right, choice, rt_ms, adjustment (the JSON path of steps; empty when none), answered_at
-// A factor a trial lacks is an empty cell; a factor named like a fixed column is written as "factor_<name>".
+// A factor a trial lacks is an empty cell; a factor named like a column of trials.csv or a recorded variable
+// (IsRecordedName) is written as "factor_<name>".
 // Beside it, per study, `out_dir`/SummaryFileName(STUDY): one row per session with the trials planned and answered
 // (practice apart), the median response time and the count of every answer (forced choice: the source chosen, or
 // cant_tell; adjustment: the level accepted) as n_ANSWER columns. And `out_dir`/frames.csv: every recorded display
@@ -28,6 +29,15 @@ using ProgressNote = std::function<void(const std::string&)>;
 // Returns the number of rows. Throws Error(kInput) for a file that is not a current blurcue record.
 int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::path& out_dir,
                   const ProgressNote& note = {});
+
+// Whether trials.csv or the record gives `name` a meaning of its own, so that no level of a design may take it: a
+// fixed column of trials.csv (participant, status, correct, ...), group, an info_KEY column, or a variable the runner
+// records beside a trial's levels (r_left_px, level, test_side, ...: session/stimulus.h TrialVariables). Read off the
+// definitions trials.csv and its codebook are written from.
+bool IsRecordedName(const std::string& name);
+// The name a design's level `name` is recorded and exported under: "factor_<name>" when IsRecordedName(name) (so it
+// can never be overwritten by, or mistaken for, what the runner records), else `name`.
+std::string DesignColumn(const std::string& name);
 
 // Copies every study, protocol version, participant, session, trial, response and frame of `inputs` into a new
 // record at `out`, with fresh ids. Protocol versions are shared by (study, hash) and participants by (study,
