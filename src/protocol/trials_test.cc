@@ -244,7 +244,9 @@ TEST(TrialBuilder, PracticeBlocksComeFirstUnderEveryBlockOrder) {
       EXPECT_EQ(names[0], "warm") << order << " " << id;
       EXPECT_EQ(names[1], "warm2") << order << " " << id;
       for (int k = 2; k < 5; ++k) ++place[{names[size_t(k)], k}];
-      if (std::string(order) == "fixed") EXPECT_EQ(scored_of(names), (std::vector<std::string>{"a", "b", "c"}));
+      if (std::string(order) == "fixed") {
+        EXPECT_EQ(scored_of(names), (std::vector<std::string>{"a", "b", "c"}));
+      }
       if (std::string(order) == "random") {
         // The same seed orders the scored blocks as it does with no practice blocks among them.
         Json plain = j;
@@ -254,9 +256,10 @@ TEST(TrialBuilder, PracticeBlocksComeFirstUnderEveryBlockOrder) {
       }
     }
     // Three scored blocks: a Williams square of 6 rows, each block twice in each place over 12 participants.
-    if (std::string(order) == "latin_square")
+    if (std::string(order) == "latin_square") {
       for (const char* b : {"a", "b", "c"})
         for (int k = 2; k < 5; ++k) EXPECT_EQ((place[{b, k}]), 4) << b << " place " << k;
+    }
   }
 }
 

@@ -237,8 +237,9 @@ TEST(TrialVariables, LevelsNamedLikeRecordedVariablesKeepTheirValuesUnderFactorN
   EXPECT_EQ(v["level"], 0.4);
   EXPECT_EQ(v["test_side"], "right");
   for (const auto& [key, value] : v.items())
-    if (!row.contains(key) && key != "group" && key.rfind("factor_", 0) != 0)
+    if (!row.contains(key) && key != "group" && key.rfind("factor_", 0) != 0) {
       EXPECT_TRUE(store::IsRecordedName(key)) << key << " is recorded but not reserved for it";
+    }
   for (const char* name : {"status", "participant", "r_left_px", "level", "test_side", "correct", "practice",
                            "swapped", "block_name", "info_age", "group", "round", "odd_interval"})
     EXPECT_TRUE(store::IsRecordedName(name)) << name;
