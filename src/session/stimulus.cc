@@ -256,6 +256,15 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
     if (const auto f = board_level("from_edge", edges)) from = *f;
     if (const auto e = board_level("to_edge", edges)) to = *e;
   }
+  // Without a speed the ball rests where it starts: an end or a section it would run to is never shown (it would be
+  // recorded all the same).
+  if (t.speed_mm_s <= 0)
+    for (const char* run_level : {"section", "to_edge", "to_y_mm"})
+      if (FindLevel(trial.levels, run_level))
+        throw InputError(At(protocol, protocol::LevelPointer(protocol, trial, run_level)),
+                         std::string("a ball without a speed_cm_s rests where it starts: ") + run_level +
+                             " describes a run it never makes (give a speed, or place it with edge, y_mm or "
+                             "from_edge)" + trial_text);
   t.from_y_mm = rest_y ? *rest_y : mm_level("from_y_mm").value_or((from - 1) * s);
   t.to_y_mm = rest_y ? *rest_y : mm_level("to_y_mm").value_or((to - 1) * s);
   if (t.speed_mm_s <= 0) t.to_y_mm = t.from_y_mm;

@@ -135,6 +135,20 @@ TEST(DescribeTrial, BallAtAnEdgeRestsThereWithThatPlacesBlur) {
   // An edge with a speed is a contradiction, named at the field.
   EXPECT_THROW(DescribeTrial(BallProtocol(), PairTrial({{"edge", 9}, {"speed_cm_s", 3}}, "fitted", "none"), &scene),
                Error);
+  // So is a run's end or section without a speed: the ball rests at its start, and the level would be recorded
+  // though never shown.
+  for (const Json& levels : {Json{{"section", 3}}, Json{{"from_edge", 2}, {"to_edge", 5}}, Json{{"to_y_mm", 90}}}) {
+    try {
+      DescribeTrial(BallProtocol(), PairTrial(levels, "fitted", "none"), &scene);
+      ADD_FAILURE() << levels.dump() << " without a speed was accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::kInput);
+      EXPECT_NE(std::string(e.what()).find("rests where it starts"), std::string::npos) << e.what();
+    }
+  }
+  const TrialScene from_only = DescribeTrial(BallProtocol(), PairTrial({{"from_edge", 4}}, "fitted", "none"), &scene);
+  EXPECT_DOUBLE_EQ(from_only.from_y_mm, 75);  // a start alone places a resting ball
+  EXPECT_DOUBLE_EQ(from_only.to_y_mm, 75);
 }
 
 // In an intervals trial each side's object is shown alone at the left object's place (IntervalScene): the right
