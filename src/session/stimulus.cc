@@ -116,7 +116,8 @@ void CheckInPhoto(const protocol::Protocol& protocol, const protocol::Trial& tri
   const cv::Rect photo(0, 0, scene.camera.image_width_px, scene.camera.image_height_px);
   for (const auto& objects : RunEnds(protocol, scene, t)) {
     for (size_t side = 0; side < 2; ++side) {
-      if (!objects[side]) continue;
+      // An intervals trial shows the right side's object at the left's place (IntervalScene): side 0's check is its.
+      if (!objects[side] || (side == 1 && t.intervals > 0)) continue;
       if ((render::FootprintOf(scene.camera, scene.rvec, scene.tvec, objects[side]->object).bounds & photo).empty()) {
         const char* level = t.content == "grid" ? (std::isnan(side == 0 ? t.left_x_mm : t.right_x_mm) ? "edge"
                                                    : side == 0 ? "left_x_mm" : "right_x_mm")

@@ -176,6 +176,11 @@ TEST(DescribeTrial, IntervalsRecordTheRightSidesRadiusWhereItsIntervalShowsIt) {
   EXPECT_NEAR(shown[0]->object.center_board_mm[0], -30, 1e-9);  // the right side's interval, at the left's place
   EXPECT_NEAR(t.r_right_px, shown[0]->r_px, 1e-9);                // recorded as drawn
   EXPECT_NEAR(t.r_right_px, t.r_left_px, 1e-9);                   // the same source at the same place
+  // Nor is the photo checked at the right object's unshown place: only where the intervals draw (the parser refuses
+  // a right_x_mm with intervals; here it stands for a right default place off the photo).
+  const protocol::Trial off = PairTrial({{"edge", 6}, {"left_x_mm", -30}, {"right_x_mm", 5000}}, "fitted", "fitted");
+  EXPECT_NO_THROW(DescribeTrial(intervals, off, &scene));
+  EXPECT_THROW(DescribeTrial(pair, off, &scene), Error);  // side by side, it would be shown off the photo
 }
 
 TEST(DescribeTrial, GridCardsSitBesideTheBoardAtTheirEdge) {
