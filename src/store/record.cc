@@ -244,15 +244,21 @@ std::string JsonChanges(const Json& a, const Json& b) {
   return text;
 }
 
+// Two recorded-or-given JSON texts, parsed; false when either is not JSON (a damaged record).
+bool ParseBoth(const std::string& first, const std::string& second, Json* a, Json* b) {
+  try {
+    *a = Json::parse(first);
+    *b = Json::parse(second);
+    return true;
+  } catch (const Json::exception&) {
+    return false;
+  }
+}
+
 // What differs between two protocol texts (canonical JSON).
 std::string ProtocolChanges(const std::string& before, const std::string& after) {
   Json a, b;
-  try {
-    a = Json::parse(before);
-    b = Json::parse(after);
-  } catch (const Json::exception&) {
-    return "the recorded text is not JSON";
-  }
+  if (!ParseBoth(before, after, &a, &b)) return "the recorded text is not JSON";
   return JsonChanges(a, b);
 }
 
@@ -262,12 +268,8 @@ std::string ProtocolChanges(const std::string& before, const std::string& after)
 // directory). A session from before display profiles were recorded ("{}") is not compared.
 std::string DisplayChanges(const std::string& recorded, const std::string& given) {
   Json a, b;
-  try {
-    a = Json::parse(recorded);
-    b = Json::parse(given);
-  } catch (const Json::exception&) {
-    return "";
-  }
+  // A recorded profile that is not JSON is a damaged record: refused, not taken for the same display.
+  if (!ParseBoth(recorded, given, &a, &b)) return "(unreadable: the record's display_profile is not JSON)";
   if (!a.is_object() || !b.is_object() || a.empty()) return "";
   a.erase("file");
   b.erase("file");

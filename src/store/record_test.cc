@@ -473,6 +473,10 @@ TEST(Record, ResumeOnAnotherDisplayProfileIsRefusedNamingWhatDiffers) {
   SessionMeta elsewhere = lab;
   elsewhere.display_profile = R"({"distance_mm":570.0,"file":"../lab/lab-1.json","name":"lab 1","width_mm":376.0})";
   EXPECT_TRUE(record.StartOrResumeSession("test1", "P01", kProtocol, 7, elsewhere, true).resumed);
+  // A recorded profile that is not JSON (a damaged record) is refused, not taken for the same display.
+  record.database().Exec("UPDATE sessions SET display_profile = '{\"distance_mm\": 57' WHERE id = 1");
+  EXPECT_TRUE(Contains(ErrorOf([&] { record.StartOrResumeSession("test1", "P01", kProtocol, 7, lab, true); }),
+                       "display profile (unreadable: the record's display_profile is not JSON)"));
 }
 
 // An editor's newline, CRLF line ends, indentation and key order are the same protocol: the session resumes.
