@@ -1,4 +1,5 @@
 #include "core/data_dir.h"
+#include "blurcue/source_dir.h"
 
 #include <cstdlib>
 #include <system_error>

@@ -1,4 +1,5 @@
 #include "core/image.h"
+#include "blurcue/source_dir.h"
 
 #include <gtest/gtest.h>
 

@@ -2,6 +2,7 @@
 // independent Python implementation (analysis/prediction.py) is checked against too: the plan and the report's
 // prediction speak of one model.
 #include <cstdio>
+#include "blurcue/source_dir.h"
 #include <fstream>
 #include <sstream>
 #include <string>

@@ -1,4 +1,5 @@
 #include "protocol/protocol.h"
+#include "blurcue/source_dir.h"
 
 #include <fstream>
 #include <string>

@@ -1,4 +1,5 @@
 #include "protocol/trials.h"
+#include "blurcue/source_dir.h"
 
 #include <map>
 #include <set>
