@@ -15,7 +15,9 @@
 #include "core/typed.h"
 #include "core/json_io.h"
 #include "core/seed.h"
+#include "plan/comparisons.h"
 #include "plan/power.h"
+#include "plan/threshold.h"
 #include "protocol/trials.h"
 #include "session/observer.h"
 #include "session/prepare.h"
@@ -52,7 +54,12 @@ std::optional<Condition> ConditionOf(const protocol::Protocol& protocol, const p
   c.label = (several_blocks ? trial.block + (label.empty() ? "" : ": ") : "") + (label.empty() && !several_blocks ? "all" : label);
   if (trial.task == Task::kYesNo) {
     c.measure = "yes";
-  } else if (trial.cell >= 0 || !trial.test_side.empty()) {
+  } else if (trial.cell >= 0) {
+    // A procedure sets how often its trials are right (it moves the level to its target share): what it measures is
+    // the threshold, so that is what is planned, not its share correct against chance.
+    c.measure = "threshold";
+    c.units = protocol::BlockOf(protocol, trial)->procedure->variable;
+  } else if (!trial.test_side.empty()) {
     c.measure = "correct";
     c.chance = scene.intervals > 2 ? 1.0 / scene.intervals : 0.5;
   } else if (trial.task == Task::kForcedChoice && scene.content != "picture") {
@@ -67,14 +74,22 @@ std::optional<Condition> ConditionOf(const protocol::Protocol& protocol, const p
 // One simulated participant through the session's own decisions (what `blurcue run --observer sim` does headless).
 SimParticipant Simulate(session::PreparedSession& study, const session::ObserverParams& observer, const std::string& id,
                         uint64_t seed, const std::string& group, bool keep_answers, bool several_blocks,
-                        std::map<std::string, Condition>* conditions, std::set<std::string>* unplanned) {
-  session::PrepareParticipant(&study, id, seed, group);
+                        session::SceneCache* cache, std::map<std::string, Condition>* conditions,
+                        std::set<std::string>* unplanned) {
+  session::PrepareParticipant(&study, id, seed, group, cache);
   SimParticipant p;
   p.id = id;
   p.seed = seed;
   p.group = study.group;
   const protocol::Protocol& protocol = study.protocol;
-  session::SessionLogic logic(study);
+  session::SessionLogic logic(study, cache);
+  // A procedure cell's track: the levels shown, and QUEST+'s posterior mean threshold after the last answer.
+  struct Track {
+    protocol::Procedure::Kind kind;
+    std::vector<double> levels;
+    std::optional<double> posterior;
+  };
+  std::map<std::string, Track> tracks;
   for (const protocol::Trial& trial : study.trials) {
     if (const Json why = logic.SkipReason(trial); !why.is_null()) {
       if (keep_answers) p.answers.emplace_back(trial.index, store::kChoiceSkipped);
@@ -113,6 +128,24 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
       unplanned->insert(protocol::ToString(trial.task));
       continue;
     }
+    if (c->measure == "threshold") {
+      if (!conditions->count(c->key)) {
+        // The truth from the observer model's own psychometric function at the scene as planned (no answers yet).
+        Condition with_truth = *c;
+        const protocol::Procedure& procedure = *protocol::BlockOf(protocol, trial)->procedure;
+        const TrueThreshold truth =
+            ObserverThreshold(observer, procedure, trial, study.scenes[size_t(trial.index)], study.presentation);
+        with_truth.truth_determined = truth.determined;
+        with_truth.truth = truth.level;
+        with_truth.truth_why = truth.why;
+        conditions->emplace(c->key, with_truth);
+      }
+      Track& track = tracks.try_emplace(c->key, Track{protocol::BlockOf(protocol, trial)->procedure->kind, {}, {}})
+                         .first->second;
+      track.levels.push_back(level);
+      if (scored.posterior) track.posterior = scored.posterior->first;
+      continue;
+    }
     conditions->emplace(c->key, *c);
     Tally& t = p.tallies[c->key];
     ++t.shown;
@@ -130,6 +163,8 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
       t.k += choice == "yes", ++t.n;
     }
   }
+  for (const auto& [key, track] : tracks)
+    if (const auto estimate = TrackEstimate(track.kind, track.levels, track.posterior)) p.thresholds[key] = *estimate;
   return p;
 }
 
@@ -190,11 +225,12 @@ std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& opti
   int64_t error_at = total;
   auto work = [&](int worker) {
     session::PreparedSession mine = study;  // each worker's own copy (images are shared, read only)
+    session::SceneCache cache;              // and its own scenes, reused by its participants
     for (int64_t index; !failed && (index = next++) < total;) {
       const int s = int(index / n), i = int(index % n);
       try {
         out[size_t(s)][size_t(i)] = Simulate(mine, observer, ids[size_t(i)], DeriveSeed(DeriveSeed(options.seed, s), i),
-                                             groups[size_t(i)], s == 0, several_blocks, &found[size_t(worker)],
+                                             groups[size_t(i)], s == 0, several_blocks, &cache, &found[size_t(worker)],
                                              &unplanned[size_t(worker)]);
       } catch (...) {
         std::lock_guard<std::mutex> lock(mutex);
@@ -295,6 +331,7 @@ PlanResult RunPlan(const PlanOptions& options) {
   const session::PreparedSession study = session::PrepareStudy(options.protocol_file, options.display_profile);
   r.study = study.protocol.name;
   r.display = study.display.name;
+  if (study.protocol.groups) r.groups = study.protocol.groups->names;
   r.protocol_hash = store::ProtocolHash(store::CanonicalProtocolText(study.protocol_text));
   const auto start = std::chrono::steady_clock::now();
   r.studies = SimulateStudies(options, study, &r.conditions, &r.notes, &r.threads_used);
@@ -320,6 +357,7 @@ PlanResult RunPlan(const PlanOptions& options) {
       AddSlopeRows(r, c, options);
       continue;
     }
+    if (c.measure == "threshold") continue;  // comparisons.h
     // The expected shares over every study and participant.
     Tally all;
     for (const auto& study : r.studies)
@@ -367,7 +405,7 @@ PlanResult RunPlan(const PlanOptions& options) {
   // Across participants: each participant's share over all the trials of one measure, against its chance level.
   std::set<std::pair<std::string, double>> measures;
   for (const Condition& c : r.conditions)
-    if (c.chance >= 0 && c.measure != "log_cutoff_slope") measures.insert({c.measure, c.chance});
+    if (c.chance >= 0 && c.measure != "log_cutoff_slope" && r.groups.size() < 2) measures.insert({c.measure, c.chance});
   for (const auto& [measure, chance] : measures) {
     std::vector<std::vector<double>> shares(static_cast<size_t>(S));
     double sum = 0;
@@ -407,6 +445,9 @@ PlanResult RunPlan(const PlanOptions& options) {
       r.rows.push_back(row);
     }
   }
+  // Groups are compared, not pooled: each group's own test against chance and the between-group test.
+  AddGroupShareRows(r, options);
+  AddThresholdRows(r, options);
   for (const PowerRow& row : r.rows) {
     const std::string name = row.test + " " + row.condition + (row.test == "participants_t" ? " " + row.measure : "");
     if (row.test != "none" && row.power >= options.target_power && !r.smallest_n.count(name))
@@ -418,13 +459,27 @@ PlanResult RunPlan(const PlanOptions& options) {
 std::string PlanCsv(const PlanResult& r) {
   std::string out =
       "test,condition,measure,chance,participants,expected_share,share_first,share_second,share_cant_tell,share_none,"
-      "mean_trials,wilson_width,power\n";
+      "mean_trials,wilson_width,power,true_threshold,mean_estimate,bias,sd_estimate,interval_width,difference\n";
   for (const PowerRow& row : r.rows)
     out += row.test + "," + store::CsvField(row.condition) + "," + row.measure + "," + Number(row.chance, "%.6g") + "," +
            std::to_string(row.participants) + "," + Number(row.expected_share) + "," + Number(row.share_first) + "," +
            Number(row.share_second) + "," + Number(row.share_cant_tell) + "," + Number(row.share_none) + "," +
-           Number(row.mean_trials, "%.3f") + "," + Number(row.wilson_width) + "," + Number(row.power) + "\n";
+           Number(row.mean_trials, "%.3f") + "," + Number(row.wilson_width) + "," + Number(row.power) + "," +
+           Number(row.true_threshold) + "," + Number(row.mean_estimate) + "," + Number(row.bias) + "," +
+           Number(row.sd_estimate) + "," + Number(row.interval_width) + "," + Number(row.difference) + "\n";
   return out;
+}
+
+Difference ParseDifference(const std::string& text) {
+  Difference d;
+  std::string number = text;
+  if (!number.empty() && number.back() == '%') d.relative = true, number.pop_back();
+  const std::optional<double> value = ParseDecimal(number);
+  if (!value || !std::isfinite(*value) || *value == 0)
+    throw Error(ErrorKind::kUsage, "--difference: must be a non-zero number in the procedure's units (0.5) or a "
+                                   "percentage of the true threshold (20%), got '" + text + "'");
+  d.value = d.relative ? *value / 100 : *value;
+  return d;
 }
 
 std::string AnswersCsv(const PlanResult& r) {
@@ -441,38 +496,54 @@ std::string Summary(const PlanResult& r, const PlanOptions& o) {
   std::string out;
   char line[1024];
   std::snprintf(line, sizeof line,
-                "plan of %s: %d simulated studies of %d participants (seed %llu), observer %s, display %s\n"
-                "per condition at N = %d: the expected share (first_source: the design's first source among decisive "
-                "answers; correct; yes), the mean width of its 95 %% Wilson interval, the power of the exact binomial "
-                "test against chance (alpha %g) and the smallest N reaching %g %%\n",
-                r.study.c_str(), o.studies, o.participants, static_cast<unsigned long long>(o.seed), r.observer.c_str(), r.display.c_str(),
-                o.participants, o.alpha, 100 * o.target_power);
+                "plan of %s: %d simulated studies of %d participants (seed %llu), observer %s, display %s\n",
+                r.study.c_str(), o.studies, o.participants, static_cast<unsigned long long>(o.seed),
+                r.observer.c_str(), r.display.c_str());
   out += line;
-  std::snprintf(line, sizeof line, "  %-28s %-13s %7s %8s %8s %7s  %s\n", "condition", "measure", "share", "width",
-                "power", "N", "answers (first / second / can't tell / none)");
-  out += line;
+  bool shares = false;
+  for (const PowerRow& row : r.rows) shares = shares || row.measure != "threshold";
+  if (shares) {
+    std::snprintf(line, sizeof line,
+                  "per condition at N = %d: the expected share (first_source: the design's first source among "
+                  "decisive answers; correct; yes), the mean width of its 95 %% Wilson interval, the power of the exact "
+                  "binomial test against chance (alpha %g) and the smallest N reaching %g %%\n",
+                  o.participants, o.alpha, 100 * o.target_power);
+    out += line;
+    std::snprintf(line, sizeof line, "  %-28s %-13s %7s %8s %8s %7s  %s\n", "condition", "measure", "share", "width",
+                  "power", "N", "answers (first / second / can't tell / none)");
+    out += line;
+  }
   for (const PowerRow& row : r.rows) {
-    if (row.participants != o.participants) continue;
+    if (row.participants != o.participants || row.measure == "threshold") continue;  // ThresholdSummary
     const std::string name = row.test + " " + row.condition + (row.test == "participants_t" ? " " + row.measure : "");
     const auto it = r.smallest_n.find(name);
     const std::string reached = row.test == "none" ? "-" : it != r.smallest_n.end() ? std::to_string(it->second)
                                                                                       : "> " + std::to_string(o.participants);
-    std::string shares;
+    std::string shown;
     if (std::isfinite(row.share_first))
-      shares = Number(row.share_first, "%.2f") + " / " + Number(row.share_second, "%.2f") + " / " +
-               Number(row.share_cant_tell, "%.2f") + " / " + Number(row.share_none, "%.2f");
-    if (row.test == "participants_t")
-      std::snprintf(line, sizeof line, "  %-28s %-13s %7.3f %8s %8.3f %7s  %s\n",
-                    "all: t across participants", row.measure.c_str(), row.expected_share, "",
-                    row.power, reached.c_str(), "");
-    else
+      shown = Number(row.share_first, "%.2f") + " / " + Number(row.share_second, "%.2f") + " / " +
+              Number(row.share_cant_tell, "%.2f") + " / " + Number(row.share_none, "%.2f");
+    if (row.test == "participants_t" || row.test == "groups_t") {
+      const std::string label = row.test == "groups_t"   ? row.condition + ": Welch t"
+                                : row.condition == "all" ? std::string("all: t across participants")
+                                                         : row.condition + ": t";
+      std::snprintf(line, sizeof line, "  %-28s %-13s %7s %8s %8.3f %7s\n", label.c_str(), row.measure.c_str(),
+                    std::isfinite(row.expected_share) ? Number(row.expected_share, "%.3f").c_str() : "-", "",
+                    row.power, reached.c_str());
+    } else {
       std::snprintf(line, sizeof line, "  %-28s %-13s %7.3f %8.3f %8s %7s  %s\n", row.condition.c_str(),
                     row.measure.c_str(), row.expected_share, row.wilson_width,
-                    std::isfinite(row.power) ? Number(row.power, "%.3f").c_str() : "-", reached.c_str(), shares.c_str());
+                    std::isfinite(row.power) ? Number(row.power, "%.3f").c_str() : "-", reached.c_str(), shown.c_str());
+    }
     out += line;
   }
-  out += "all: t across participants = a one-sample t-test of each participant's share against chance, the stand-in "
-         "for the report's GLMM (its intercept), whose fit per simulated study would be too slow\n";
+  if (shares && r.groups.size() < 2)
+    out += "all: t across participants = a one-sample t-test of each participant's share against chance, the "
+           "stand-in for the report's GLMM (its intercept), whose fit per simulated study would be too slow\n";
+  if (shares && r.groups.size() >= 2)
+    out += "groups are compared, not pooled: group=NAME: t = each group's participants' shares against chance; "
+           "group B - group A: Welch t = Welch's two-sample t-test of the participants' shares between the groups "
+           "(share: the difference of the groups' mean shares)\n";
   for (const PowerRow& row : r.rows)
     if (row.test == "slope_t") {
       out += "cut-off ~ distance = depth matching: share is the mean slope b of log(accepted cut-off) on log(distance) "
@@ -480,6 +551,7 @@ std::string Summary(const PlanResult& r, const PlanOptions& o) {
              "that of a t-test of the slopes against 0\n";
       break;
     }
+  out += ThresholdSummary(r, o);
   for (const std::string& note : r.notes) out += "note: " + note + "\n";
   return out;
 }

@@ -22,6 +22,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,14 @@ struct PreparedSession;
 }
 
 namespace blurcue::plan {
+
+// A difference between thresholds to plan for (--difference): in the procedure's units, or relative to the true one.
+struct Difference {
+  double value = 0;
+  bool relative = false;  // value is a fraction of each cell's true threshold ("20%" -> 0.2)
+};
+// "0.5" (the procedure's units) or "20%" (of the true threshold); throws Error(kUsage) naming --difference otherwise.
+Difference ParseDifference(const std::string& text);
 
 struct PlanOptions {
   std::filesystem::path protocol_file;
@@ -41,6 +50,7 @@ struct PlanOptions {
   int threads = 0;                        // 0: every core (std::thread::hardware_concurrency)
   double alpha = 0.05;                    // the tests' level
   double target_power = 0.8;              // smallest N reaching this
+  std::optional<Difference> difference;   // procedure cells: the difference whose power is planned (none: not planned)
   std::function<void(const std::string&)> progress;  // about every 10 % of the participants
 };
 
@@ -51,7 +61,13 @@ struct Condition {
   std::string levels;     // the levels as JSON
   std::string label;      // "edge=3" (and the block's name when the protocol has several)
   std::string measure;    // "first_source" (a pair) | "correct" | "yes" | "log_cutoff_slope" (depth matching)
-  double chance = -1;     // the test's null share; < 0: no test (yes/no)
+                          // | "threshold" (a procedure cell: what it estimates, not its share correct)
+  double chance = -1;     // the test's null share; < 0: no test (yes/no, threshold)
+  // A procedure cell: its variable (the threshold's unit) and the simulated observer's true threshold (threshold.h).
+  std::string units;
+  bool truth_determined = false;
+  double truth = 0;
+  std::string truth_why;  // why there is no truth, in words
 };
 
 // What one simulated participant answered: per condition (by Condition::key) the counts.
@@ -67,11 +83,16 @@ struct SimParticipant {
   std::map<std::string, Tally> tallies;               // by condition key
   // Depth matching, by condition key: (log distance, log accepted cut-off) of each answered trial.
   std::map<std::string, std::vector<std::pair<double, double>>> matches;
+  // A procedure cell's threshold estimate, as the report takes it from the track (threshold.h TrackEstimate).
+  std::map<std::string, double> thresholds;
 };
+
+inline constexpr double kNoValue = __builtin_nan("");
 
 // One row of the plan: a test of a condition (or of all the participants' trials) at a number of participants.
 struct PowerRow {
-  std::string test;        // "binomial" | "participants_t" | "slope_t" | "none" (a condition without a chance level)
+  std::string test;        // "binomial" | "participants_t" | "slope_t" | "none" (a condition without a chance level) |
+                           // "threshold" | "paired_t" | "second_cell_t" | "groups_t" (comparisons.h)
   std::string condition;   // its label; "all" for participants_t
   std::string measure;
   double chance = -1;
@@ -81,6 +102,11 @@ struct PowerRow {
   double mean_trials = 0;      // counting trials per study at this N (mean)
   double wilson_width = 0;     // mean width of the 95 % Wilson interval at this N (slope_t: of the slope's t interval)
   double power = 0;            // share of studies whose test has p < alpha (NaN for "none")
+  // Procedure cells (NaN elsewhere): the observer's true threshold, the mean estimate (a comparison: of the
+  // differences), bias = mean - truth, the estimates' sd across participants, the mean width of the 95 % t interval
+  // of the mean of N estimates, and a comparison's true (or declared) difference.
+  double true_threshold = kNoValue, mean_estimate = kNoValue, bias = kNoValue, sd_estimate = kNoValue;
+  double interval_width = kNoValue, difference = kNoValue;
 };
 
 struct PlanResult {
@@ -89,6 +115,7 @@ struct PlanResult {
   std::vector<PowerRow> rows;
   std::map<std::string, int> smallest_n;   // "binomial edge=3" -> smallest N with power >= target (absent: none)
   std::vector<std::string> notes;          // what is not planned and why
+  std::vector<std::string> groups;         // the protocol's between-subject groups (empty: none)
   int threads_used = 0;
   double seconds = 0;                      // wall time of the simulation
   std::string observer;                    // canonical form

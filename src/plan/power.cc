@@ -95,6 +95,24 @@ double OneSampleTTestP(const std::vector<double>& values, double mu) {
   return IncompleteBeta(df / 2, 0.5, df / (df + t * t));
 }
 
+double WelchTTestP(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.size() < 2 || b.size() < 2) return 1;
+  auto moments = [](const std::vector<double>& v) {
+    double mean = 0, ss = 0;
+    for (double x : v) mean += x;
+    mean /= double(v.size());
+    for (double x : v) ss += (x - mean) * (x - mean);
+    return std::pair<double, double>{mean, ss / double(v.size() - 1) / double(v.size())};  // mean, its variance
+  };
+  const auto [ma, va] = moments(a);
+  const auto [mb, vb] = moments(b);
+  const double se2 = va + vb;
+  if (!(se2 > 1e-24)) return std::abs(ma - mb) > 1e-12 ? 0 : 1;
+  const double t = (ma - mb) / std::sqrt(se2);
+  const double df = se2 * se2 / (va * va / double(a.size() - 1) + vb * vb / double(b.size() - 1));
+  return IncompleteBeta(df / 2, 0.5, df / (df + t * t));
+}
+
 double StudentT975(int df) {
   // Two-sided P(|T| > t) = I_{df / (df + t^2)}(df / 2, 1 / 2) falls from 1 at t = 0: find where it is 0.05.
   double lo = 0, hi = 1e6;

@@ -24,6 +24,10 @@ double IncompleteBeta(double a, double b, double x);
 // vary (0 when their mean differs from mu).
 double OneSampleTTestP(const std::vector<double>& values, double mu);
 
+// Two-sided p of Welch's two-sample t-test of a against b (unequal variances, Welch-Satterthwaite df): 1 when either
+// has fewer than two values; 0 or 1 when neither varies (0 when their means differ).
+double WelchTTestP(const std::vector<double>& a, const std::vector<double>& b);
+
 // The 97.5 % quantile of Student's t with df degrees of freedom (df >= 1; bisection on IncompleteBeta to 1e-10):
 // a 95 % interval of a mean of n values is mean +- StudentT975(n - 1) sd / sqrt(n).
 double StudentT975(int df);

@@ -49,6 +49,17 @@ TEST(OneSampleT, SmallSamplesMatchTheClosedFormTails) {
   EXPECT_EQ(OneSampleTTestP({0.9}, 0.5), 1);
 }
 
+TEST(WelchT, EqualSpreadsByTheClosedFormOfFourDf) {
+  // {1, 2, 3} vs {4, 5, 6}: each mean's variance 1/3, t = -3 / sqrt(2/3), Welch's df (2/3)^2 / (2 (1/9)^2 / 2) = 4;
+  // with 4 df the two-sided tail is 1 - 1.5 u (1 - u^2 / 3), u = |t| / sqrt(4 + t^2).
+  const double t = 3 / std::sqrt(2.0 / 3), u = t / std::sqrt(4 + t * t);
+  EXPECT_NEAR(WelchTTestP({1, 2, 3}, {4, 5, 6}), 1 - 1.5 * u * (1 - u * u / 3), 1e-12);
+  EXPECT_NEAR(WelchTTestP({4, 5, 6}, {1, 2, 3}), WelchTTestP({1, 2, 3}, {4, 5, 6}), 1e-15);
+  EXPECT_EQ(WelchTTestP({1}, {4, 5, 6}), 1);               // one value: no test
+  EXPECT_EQ(WelchTTestP({2, 2}, {3, 3}), 0);               // no spread, different means
+  EXPECT_EQ(WelchTTestP({2, 2}, {2, 2}), 1);
+}
+
 TEST(StudentT, QuantilesMatchTheTable) {
   // t(0.975) from the standard table; df = 1 is the Cauchy's tan(0.475 pi), df = 2 is 2 / sqrt(0.95^2 ... ) closed.
   EXPECT_NEAR(StudentT975(1), std::tan(0.475 * M_PI), 1e-6);

@@ -27,8 +27,17 @@ PreparedSession PrepareStudy(const std::filesystem::path& protocol_file, const s
   return s;
 }
 
+std::string SceneKey(const protocol::Trial& t) {
+  std::string key = t.block + '\n' + std::to_string(int(t.task)) + ' ' + std::to_string(t.practice) + ' ' +
+                    std::to_string(t.round) + ' ' + std::to_string(t.swapped) + ' ' + std::to_string(t.cell) + ' ' +
+                    t.test_side + ' ' + std::to_string(t.start_index) + '\n' + t.levels.dump() + '\n' +
+                    t.left.dump() + '\n' + t.right.dump() + '\n';
+  for (double level : t.adjust_levels) key += std::to_string(level) + ' ';
+  return key;
+}
+
 void PrepareParticipant(PreparedSession* s, const std::string& participant, std::optional<uint64_t> seed,
-                        const std::string& group) {
+                        const std::string& group, SceneCache* cache) {
   const std::string file = s->protocol.file.string();
   s->seed = seed ? *seed : protocol::DefaultSeed(s->protocol.name, participant);
   s->group = !group.empty() ? group : protocol::AssignGroup(s->protocol, participant, {});
@@ -40,6 +49,22 @@ void PrepareParticipant(PreparedSession* s, const std::string& participant, std:
   // front of a participant.
   s->scenes.clear();
   s->scenes.reserve(s->trials.size());
+  if (cache) {
+    // A scene is a function of the trial's content, the protocol, calibration and presentation: a trial seen before
+    // (it checked then) is the scene made then.
+    for (const protocol::Trial& trial : s->trials) {
+      const std::string key = SceneKey(trial);
+      auto it = cache->planned.find(key);
+      if (it == cache->planned.end()) {
+        TrialScene scene = DescribeTrial(s->protocol, trial, s->scene ? &*s->scene : nullptr, &s->presentation);
+        CheckRealPhotos(s->protocol, {scene}, &s->real_photos_checked);
+        if (s->scene) PlanOnScreen(s->protocol, *s->scene, s->presentation, &scene);
+        it = cache->planned.emplace(key, std::move(scene)).first;
+      }
+      s->scenes.push_back(it->second);
+    }
+    return;
+  }
   for (const protocol::Trial& trial : s->trials)
     s->scenes.push_back(DescribeTrial(s->protocol, trial, s->scene ? &*s->scene : nullptr, &s->presentation));
   CheckRealPhotos(s->protocol, s->scenes, &s->real_photos_checked);

@@ -4,6 +4,7 @@
 // full, so a protocol that validates is one that runs, and every problem is reported the same way by both.
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -41,12 +42,24 @@ PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const
                                std::optional<uint64_t> seed, const std::filesystem::path& display_profile = {},
                                const std::string& group = "");
 
+// Scenes already worked out, by what a trial shows (SceneKey) and a procedure's level: the participants of one study
+// repeat the same trials in other orders, so `blurcue plan` describes and plans each once. One per thread.
+struct SceneCache {
+  std::map<std::string, TrialScene> planned;                    // DescribeTrial + PlanOnScreen, by SceneKey
+  std::map<std::pair<std::string, double>, TrialScene> leveled;  // a procedure trial at a level (SessionLogic::SceneOf)
+};
+
+// Every field of a trial that its scene depends on (all but its index and repetition, which DescribeTrial reads only
+// for its error messages), as one string.
+std::string SceneKey(const protocol::Trial& trial);
+
 // PrepareSession in two parts, for many participants of one study (blurcue plan): what every participant shares
 // (the protocol, the calibration, the images, the display and the presentation; no trials yet), then one
 // participant's seed, group, trials and scenes into it (replacing any before). Throw as PrepareSession.
 PreparedSession PrepareStudy(const std::filesystem::path& protocol_file,
                              const std::filesystem::path& display_profile = {});
+// `cache`: scenes of earlier participants of the same study (PrepareStudy's, unchanged since) to reuse.
 void PrepareParticipant(PreparedSession* study, const std::string& participant, std::optional<uint64_t> seed,
-                        const std::string& group = "");
+                        const std::string& group = "", SceneCache* cache = nullptr);
 
 }  // namespace blurcue::session

@@ -60,8 +60,8 @@ const protocol::Procedure& ProcedureOf(const protocol::Protocol& protocol, const
 
 }  // namespace
 
-SessionLogic::SessionLogic(const PreparedSession& prepared)
-    : prepared_(prepared), adaptive_(prepared.protocol), rounds_(prepared.protocol, prepared.trials) {}
+SessionLogic::SessionLogic(const PreparedSession& prepared, SceneCache* cache)
+    : prepared_(prepared), cache_(cache), adaptive_(prepared.protocol), rounds_(prepared.protocol, prepared.trials) {}
 
 Json SessionLogic::SkipReason(const protocol::Trial& trial) {
   if (trial.cell >= 0 && adaptive_.Stopped(trial))
@@ -76,8 +76,14 @@ TrialScene SessionLogic::SceneOf(const protocol::Trial& trial, double* level) {
   *level = 0;
   if (trial.cell >= 0) {
     *level = adaptive_.Level(trial);
+    // The same trial at the same level plans the same scene: a plan's participants reuse it (PlanOnScreen is most
+    // of a simulated trial's cost).
+    const auto key = cache_ ? std::make_pair(SceneKey(trial), *level) : std::make_pair(std::string(), 0.0);
+    if (cache_)
+      if (const auto it = cache_->leveled.find(key); it != cache_->leveled.end()) return it->second;
     ApplyLevel(ProcedureOf(prepared_.protocol, trial), trial, *level, prepared_.presentation, &scene);
     PlanOnScreen(prepared_.protocol, *prepared_.scene, prepared_.presentation, &scene);
+    if (cache_) cache_->leveled.emplace(key, scene);
   }
   return scene;
 }

@@ -58,7 +58,8 @@ struct Scored {
 // The decisions of one session, trial by trial in order. Holds references into `prepared`, which must outlive it.
 class SessionLogic {
  public:
-  explicit SessionLogic(const PreparedSession& prepared);
+  // `cache`: procedure trials' scenes at their levels from earlier participants of the same study (blurcue plan).
+  explicit SessionLogic(const PreparedSession& prepared, SceneCache* cache = nullptr);
   // Why `trial` is not shown but recorded as skipped ({"skipped": why, ...}); null when it is shown.
   Json SkipReason(const protocol::Trial& trial);
   // The scene `trial` shows now: its planned scene, with a procedure's level from the answers so far applied and
@@ -70,6 +71,7 @@ class SessionLogic {
 
  private:
   const PreparedSession& prepared_;
+  SceneCache* cache_;
   AdaptiveState adaptive_;
   PracticeRounds rounds_;
 };

@@ -1,0 +1,386 @@
+#include "plan/comparisons.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <set>
+
+#include "plan/power.h"
+#include "protocol/protocol.h"
+
+namespace blurcue::plan {
+namespace {
+
+const double kNan = std::numeric_limits<double>::quiet_NaN();
+
+// A row with nothing but its names filled: every statistic NaN (written as an empty field).
+PowerRow Row(const std::string& test, const std::string& condition, const std::string& measure, int m) {
+  PowerRow row;
+  row.test = test;
+  row.condition = condition;
+  row.measure = measure;
+  row.chance = kNan;
+  row.participants = m;
+  row.expected_share = row.share_first = row.share_second = row.share_cant_tell = row.share_none = kNan;
+  row.mean_trials = row.wilson_width = row.power = kNan;
+  return row;
+}
+
+struct Moments {
+  double mean = kNan, sd = kNan;
+  int n = 0;
+};
+
+Moments MomentsOf(const std::vector<double>& v) {
+  Moments m;
+  double sum = 0;
+  for (double x : v)
+    if (std::isfinite(x)) sum += x, ++m.n;
+  if (m.n == 0) return m;
+  m.mean = sum / m.n;
+  double ss = 0;
+  for (double x : v)
+    if (std::isfinite(x)) ss += (x - m.mean) * (x - m.mean);
+  m.sd = m.n > 1 ? std::sqrt(ss / (m.n - 1)) : kNan;
+  return m;
+}
+
+// [study][participant] -> the participant's estimate for `key` (NaN: none).
+using Grid = std::vector<std::vector<double>>;
+
+Grid EstimatesOf(const PlanResult& r, const std::string& key) {
+  Grid g(r.studies.size());
+  for (size_t s = 0; s < r.studies.size(); ++s)
+    for (const SimParticipant& p : r.studies[s]) {
+      const auto it = p.thresholds.find(key);
+      g[s].push_back(it != p.thresholds.end() ? it->second : kNan);
+    }
+  return g;
+}
+
+std::vector<double> Flat(const Grid& g) {
+  std::vector<double> all;
+  for (const auto& study : g) all.insert(all.end(), study.begin(), study.end());
+  return all;
+}
+
+// The power at each N of a test whose p-value per study comes from `p_of(s, m)` (NaN: no test in that study),
+// with `fill` naming the rows; appended to r.rows.
+template <typename PValue>
+void AddPowerRows(PlanResult& r, const PlanOptions& o, const PowerRow& named, PValue p_of) {
+  for (int m = 1; m <= o.participants; ++m) {
+    PowerRow row = named;
+    row.participants = m;
+    int rejected = 0;
+    for (int s = 0; s < o.studies; ++s) {
+      const double p = p_of(s, m);
+      rejected += std::isfinite(p) && p < o.alpha;
+    }
+    row.power = double(rejected) / o.studies;
+    r.rows.push_back(row);
+  }
+}
+
+std::string Signed(double v) { return (v >= 0 ? "+" : "") + protocol::LevelText(v); }
+
+}  // namespace
+
+std::string DifferenceText(const Difference& d, const std::string& units) {
+  return d.relative ? Signed(100 * d.value) + " % of the true threshold" : Signed(d.value) + " " + units;
+}
+
+void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
+  const int N = o.participants, S = o.studies;
+  std::vector<const Condition*> cells;
+  for (const Condition& c : r.conditions)
+    if (c.measure == "threshold") cells.push_back(&c);
+  if (cells.empty()) return;
+  std::map<std::string, Grid> est;
+  std::map<std::string, Moments> overall;
+  for (const Condition* c : cells) {
+    est[c->key] = EstimatesOf(r, c->key);
+    overall[c->key] = MomentsOf(Flat(est[c->key]));
+  }
+  std::vector<double> t975(1, kNan);
+  auto t_of = [&](size_t df) {
+    while (t975.size() <= df) t975.push_back(StudentT975(int(t975.size())));
+    return t975[df];
+  };
+  // Precision: over the simulated participants, the estimates against the observer's true threshold, and how wide
+  // the 95 % t interval of their mean is with N of them.
+  for (const Condition* c : cells) {
+    const Moments& all = overall[c->key];
+    const Grid& g = est[c->key];
+    for (int m = 1; m <= N; ++m) {
+      PowerRow row = Row("threshold", c->label, "threshold", m);
+      row.true_threshold = c->truth_determined ? c->truth : kNan;
+      row.mean_estimate = all.mean;
+      row.bias = c->truth_determined ? all.mean - c->truth : kNan;
+      row.sd_estimate = all.sd;
+      double width = 0, count = 0;
+      int widths = 0;
+      for (int s = 0; s < S; ++s) {
+        std::vector<double> values;
+        for (int i = 0; i < m; ++i)
+          if (std::isfinite(g[size_t(s)][size_t(i)])) values.push_back(g[size_t(s)][size_t(i)]);
+        count += double(values.size());
+        const Moments here = MomentsOf(values);
+        if (here.n < 2) continue;
+        width += 2 * t_of(size_t(here.n - 1)) * here.sd / std::sqrt(double(here.n));
+        ++widths;
+      }
+      row.mean_trials = count / S;  // here: participants with an estimate
+      row.interval_width = widths > 0 ? width / widths : kNan;
+      r.rows.push_back(row);
+    }
+  }
+  // The declared difference in the procedure's units for a cell (NaN when relative to a truth that is not known).
+  auto declared = [&](const Condition& c) {
+    if (!o.difference) return kNan;
+    if (!o.difference->relative) return o.difference->value;
+    return c.truth_determined ? o.difference->value * c.truth : kNan;
+  };
+  auto no_truth_note = [&](const Condition& c) {
+    r.notes.push_back("--difference " + DifferenceText(*o.difference, c.units) + " is not planned for " + c.label +
+                      ": its true threshold is " + c.truth_why);
+  };
+  // Between two cells of the same participants: the paired t-test of per-participant thresholds the report would run.
+  std::set<std::string> paired;
+  for (size_t a = 0; a < cells.size(); ++a)
+    for (size_t b = a + 1; b < cells.size(); ++b) {
+      const Condition &A = *cells[a], &B = *cells[b];
+      const Grid &ga = est[A.key], &gb = est[B.key];
+      bool both = false;
+      for (int s = 0; s < S && !both; ++s)
+        for (int i = 0; i < N && !both; ++i) both = std::isfinite(ga[size_t(s)][size_t(i)]) && std::isfinite(gb[size_t(s)][size_t(i)]);
+      if (!both) continue;
+      paired.insert(A.key), paired.insert(B.key);
+      const std::string name = B.label + " - " + A.label;
+      auto differences = [&](int s, int m, double shift_a, double shift_b) {
+        std::vector<double> d;
+        for (int i = 0; i < m; ++i) {
+          const double x = ga[size_t(s)][size_t(i)], y = gb[size_t(s)][size_t(i)];
+          if (std::isfinite(x) && std::isfinite(y)) d.push_back((y - shift_b) - (x - shift_a));
+        }
+        return d;
+      };
+      PowerRow own = Row("paired_t", name + " (the model's own)", "threshold", 0);
+      own.difference = A.truth_determined && B.truth_determined ? B.truth - A.truth : kNan;
+      own.mean_estimate = overall[B.key].mean - overall[A.key].mean;
+      AddPowerRows(r, o, own, [&](int s, int m) { return OneSampleTTestP(differences(s, m, 0, 0), 0); });
+      if (!o.difference) continue;
+      const double delta = declared(A);
+      if (!std::isfinite(delta)) {
+        no_truth_note(A);
+        continue;
+      }
+      // The estimates' scatter as simulated, each cell centred on its own mean estimate, the second shifted by delta.
+      PowerRow shifted = Row("paired_t", name + " (declared " + DifferenceText(*o.difference, A.units) + ")",
+                             "threshold", 0);
+      shifted.difference = delta;
+      const double ma = overall[A.key].mean, mb = overall[B.key].mean - delta;
+      AddPowerRows(r, o, shifted, [&](int s, int m) { return OneSampleTTestP(differences(s, m, ma, mb), 0); });
+    }
+  // Groups: the same cell (its levels) in two groups, Welch's t-test of the groups' thresholds.
+  bool compared_groups = false;
+  for (size_t g1 = 0; g1 < r.groups.size(); ++g1)
+    for (size_t g2 = g1 + 1; g2 < r.groups.size(); ++g2) {
+      std::set<std::string> levels;
+      for (const Condition* c : cells) levels.insert(c->levels);
+      for (const std::string& level : levels) {
+        // Per group, the cell of those levels its participants run (its block may be the group's own).
+        const Condition *A = nullptr, *B = nullptr;
+        for (const auto& study : r.studies)
+          for (const SimParticipant& p : study)
+            for (const Condition* c : cells)
+              if (c->levels == level && p.thresholds.count(c->key)) {
+                if (p.group == r.groups[g1] && !A) A = c;
+                if (p.group == r.groups[g2] && !B) B = c;
+              }
+        if (!A || !B) continue;
+        compared_groups = true;
+        const Grid &ga = est[A->key], &gb = est[B->key];
+        auto values = [&](const Grid& g, const std::string& group, int s, int m, double shift) {
+          std::vector<double> v;
+          for (int i = 0; i < m; ++i)
+            if (r.studies[size_t(s)][size_t(i)].group == group && std::isfinite(g[size_t(s)][size_t(i)]))
+              v.push_back(g[size_t(s)][size_t(i)] - shift);
+          return v;
+        };
+        const std::string name = "group " + r.groups[g2] + " - " + r.groups[g1] + ": " +
+                                 (A->label == B->label ? A->label : B->label + " - " + A->label);
+        PowerRow own = Row("groups_t", name + " (the model's own)", "threshold", 0);
+        own.difference = A->truth_determined && B->truth_determined ? B->truth - A->truth : kNan;
+        own.mean_estimate = overall[B->key].mean - overall[A->key].mean;
+        AddPowerRows(r, o, own, [&](int s, int m) {
+          return WelchTTestP(values(gb, r.groups[g2], s, m, 0), values(ga, r.groups[g1], s, m, 0));
+        });
+        if (!o.difference) continue;
+        const double delta = declared(*A);
+        if (!std::isfinite(delta)) {
+          no_truth_note(*A);
+          continue;
+        }
+        PowerRow shifted = Row("groups_t", name + " (declared " + DifferenceText(*o.difference, A->units) + ")",
+                               "threshold", 0);
+        shifted.difference = delta;
+        const double ma = overall[A->key].mean, mb = overall[B->key].mean - delta;
+        AddPowerRows(r, o, shifted, [&](int s, int m) {
+          return WelchTTestP(values(gb, r.groups[g2], s, m, mb), values(ga, r.groups[g1], s, m, ma));
+        });
+      }
+    }
+  if (!o.difference) {
+    r.notes.push_back("the power to detect a difference between thresholds is planned with --difference (e.g. "
+                      "--difference 0.5 in the procedure's units, or --difference 20%)");
+    return;
+  }
+  if (compared_groups) return;
+  // A cell with no partner: the power of a paired t-test against a second cell like it in the same participants,
+  // differing by the declared amount. Participant i's second track is participant i's in the next study (every
+  // simulated participant is the same observer with its own seed, so the two are independent draws).
+  for (const Condition* c : cells) {
+    if (paired.count(c->key)) continue;
+    const double delta = declared(*c);
+    if (!std::isfinite(delta)) {
+      no_truth_note(*c);
+      continue;
+    }
+    if (S < 2) {
+      r.notes.push_back("--difference for " + c->label + " needs --studies 2 or more (a second cell's track comes "
+                        "from the next study)");
+      continue;
+    }
+    const Grid& g = est[c->key];
+    PowerRow row = Row("second_cell_t", c->label + " vs a second cell " + DifferenceText(*o.difference, c->units),
+                       "threshold", 0);
+    row.difference = delta;
+    AddPowerRows(r, o, row, [&](int s, int m) {
+      std::vector<double> d;
+      for (int i = 0; i < m; ++i) {
+        const double x = g[size_t(s)][size_t(i)], y = g[size_t((s + 1) % S)][size_t(i)];
+        if (std::isfinite(x) && std::isfinite(y)) d.push_back(y + delta - x);
+      }
+      return OneSampleTTestP(d, 0);
+    });
+  }
+}
+
+void AddGroupShareRows(PlanResult& r, const PlanOptions& o) {
+  if (r.groups.size() < 2) return;
+  const int S = o.studies;
+  std::set<std::pair<std::string, double>> measures;
+  for (const Condition& c : r.conditions)
+    if (c.chance >= 0 && c.measure != "log_cutoff_slope" && c.measure != "threshold") measures.insert({c.measure, c.chance});
+  for (const auto& [measure, chance] : measures) {
+    // Each participant's share over all their trials of this measure (NaN: no counting answer).
+    Grid share(static_cast<size_t>(S));
+    for (int s = 0; s < S; ++s)
+      for (const SimParticipant& p : r.studies[size_t(s)]) {
+        int k = 0, n = 0;
+        for (const Condition& c : r.conditions)
+          if (c.measure == measure && c.chance == chance)
+            if (const auto it = p.tallies.find(c.key); it != p.tallies.end()) k += it->second.k, n += it->second.n;
+        share[size_t(s)].push_back(n > 0 ? double(k) / n : kNan);
+      }
+    auto values = [&](const std::string& group, int s, int m) {
+      std::vector<double> v;
+      for (int i = 0; i < m; ++i)
+        if (r.studies[size_t(s)][size_t(i)].group == group && std::isfinite(share[size_t(s)][size_t(i)]))
+          v.push_back(share[size_t(s)][size_t(i)]);
+      return v;
+    };
+    auto mean_of = [&](const std::string& group) {
+      std::vector<double> all;
+      for (int s = 0; s < S; ++s) {
+        const auto v = values(group, s, o.participants);
+        all.insert(all.end(), v.begin(), v.end());
+      }
+      return MomentsOf(all).mean;
+    };
+    for (const std::string& group : r.groups) {
+      PowerRow row = Row("participants_t", "group=" + group, measure, 0);
+      row.chance = chance;
+      row.expected_share = mean_of(group);
+      AddPowerRows(r, o, row, [&](int s, int m) {
+        const auto v = values(group, s, m);
+        return v.size() >= 2 ? OneSampleTTestP(v, chance) : kNan;
+      });
+    }
+    for (size_t g1 = 0; g1 < r.groups.size(); ++g1)
+      for (size_t g2 = g1 + 1; g2 < r.groups.size(); ++g2) {
+        PowerRow row = Row("groups_t", "group " + r.groups[g2] + " - " + r.groups[g1], measure, 0);
+        row.chance = chance;
+        row.expected_share = mean_of(r.groups[g2]) - mean_of(r.groups[g1]);
+        AddPowerRows(r, o, row, [&](int s, int m) {
+          return WelchTTestP(values(r.groups[g2], s, m), values(r.groups[g1], s, m));
+        });
+      }
+  }
+}
+
+std::string ThresholdSummary(const PlanResult& r, const PlanOptions& o) {
+  std::vector<const Condition*> cells;
+  for (const Condition& c : r.conditions)
+    if (c.measure == "threshold") cells.push_back(&c);
+  if (cells.empty()) return "";
+  auto number = [](double v, const char* format = "%.3f") {
+    if (!std::isfinite(v)) return std::string("-");
+    char text[48];
+    std::snprintf(text, sizeof text, format, v);
+    return std::string(text);
+  };
+  std::string out;
+  char line[1024];
+  std::snprintf(line, sizeof line,
+                "procedure cells: the threshold each estimates (QUEST+: its posterior mean after the last answer; a "
+                "staircase: the mean of its last 6 reversal levels, as the report takes them), over every simulated "
+                "participant, against the simulated observer's true threshold (its psychometric function's point the "
+                "procedure aims at: QUEST+'s Weibull threshold, a staircase's convergence point), and the mean width "
+                "of the 95 %% t interval of the mean of N = %d participants' estimates\n",
+                o.participants);
+  out += line;
+  std::snprintf(line, sizeof line, "  %-28s %-18s %8s %8s %8s %8s %9s\n", "cell", "units", "truth", "mean", "bias",
+                "sd", "width");
+  out += line;
+  for (const Condition* c : cells)
+    for (const PowerRow& row : r.rows)
+      if (row.test == "threshold" && row.condition == c->label && row.participants == o.participants) {
+        std::snprintf(line, sizeof line, "  %-28s %-18s %8s %8s %8s %8s %9s\n", c->label.c_str(), c->units.c_str(),
+                      number(row.true_threshold).c_str(), number(row.mean_estimate).c_str(),
+                      number(row.bias, "%+.3f").c_str(), number(row.sd_estimate).c_str(),
+                      number(row.interval_width).c_str());
+        out += line;
+        if (!c->truth_determined)
+          out += "  " + c->label + ": the true threshold is " + c->truth_why + ", so no bias is given\n";
+      }
+  bool header = false;
+  for (const PowerRow& row : r.rows) {
+    if (row.measure != "threshold" || row.test == "threshold" || row.participants != o.participants) continue;
+    if (!header) {
+      std::snprintf(line, sizeof line,
+                    "power at N = %d of the t-test the report would run on per-participant thresholds (paired_t: "
+                    "paired, between two cells of the same participants; second_cell_t: paired, against a second cell "
+                    "like it; groups_t: Welch, between groups), alpha %g, and the smallest N reaching %g %%\n",
+                    o.participants, o.alpha, 100 * o.target_power);
+      out += line;
+      std::snprintf(line, sizeof line, "  %-14s %-62s %10s %8s %7s\n", "test", "comparison", "difference", "power",
+                    "N");
+      out += line;
+      header = true;
+    }
+    const auto it = r.smallest_n.find(row.test + " " + row.condition);
+    const std::string reached =
+        it != r.smallest_n.end() ? std::to_string(it->second) : "> " + std::to_string(o.participants);
+    std::snprintf(line, sizeof line, "  %-14s %-62s %10s %8.3f %7s\n", row.test.c_str(), row.condition.c_str(),
+                  number(row.difference, "%+.3f").c_str(), row.power, reached.c_str());
+    out += line;
+  }
+  if (header)
+    out += "difference: the true difference (the model's own: from the observer's true thresholds; '-' where one is "
+           "not determined) or the declared one (--difference): the estimates' scatter as simulated, shifted by it\n";
+  return out;
+}
+
+}  // namespace blurcue::plan

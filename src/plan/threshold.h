@@ -1,0 +1,47 @@
+#pragma once
+// What an adaptive procedure measures, for a plan: the threshold the simulated observer really has (from its model's
+// closed-form psychometric function, never from the procedure's own estimator), and the estimate the report takes
+// from one participant's track (analysis/any_study.py tracks_chart). No randomness here.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "protocol/protocol.h"
+#include "protocol/trials.h"
+#include "session/observer.h"
+#include "session/stimulus.h"
+
+namespace blurcue::plan {
+
+// P(`down` correct answers in a row come before `up` wrong ones in a row) when each answer is correct with
+// probability p, independently: p^(d-1) (1 - q^u) / (p^(d-1) + q^(u-1) - p^(d-1) q^(u-1)), q = 1 - p.
+double DownRunFirst(double p, int up, int down);
+
+// The share of all answers (lapses included) at which a procedure's estimate sits for an observer who misses
+// `miss` of the easiest trials: QUEST+ - its Weibull's threshold point guess + (1 - guess - miss) (1 - 1/e);
+// an up/down staircase - where a down step is as likely as an up step (DownRunFirst = 1/2, Levitt 1971).
+double TargetShare(const protocol::Procedure& procedure, double miss);
+
+// The simulated observer's true threshold for one procedure cell, in the procedure's units (its level).
+struct TrueThreshold {
+  bool determined = false;
+  double level = 0;     // when determined
+  std::string why;      // when not: said in words ("beyond the tested range 0.25 to 6", ...)
+};
+
+// The level at which the observer's probability of a correct answer (ProbabilityCorrect2afc on the pair as the trial
+// shows it at that level, with its lapses: (1 - lapse) P + lapse / 2) reaches TargetShare, found by bisection on the
+// level; `planned` is the trial's scene as planned (before any level). Not determined - with the reason - for a task
+// the closed form does not cover (odd one out), an observer whose lapses keep it below the target share, or a level
+// outside what the procedure can show (a staircase's [min, max], QUEST+'s threshold grid).
+TrueThreshold ObserverThreshold(const session::ObserverParams& observer, const protocol::Procedure& procedure,
+                                const protocol::Trial& trial, const session::TrialScene& planned,
+                                const session::Presentation& presentation);
+
+// One participant's threshold estimate for one track, as the report takes it: QUEST+'s posterior mean after the last
+// answer; a staircase's mean of its last 6 reversal levels, or of its last 10 levels with fewer than 4 reversals
+// (a reversal: a change of direction of the levels shown). Empty for an empty track.
+std::optional<double> TrackEstimate(protocol::Procedure::Kind kind, const std::vector<double>& levels,
+                                    std::optional<double> last_posterior);
+
+}  // namespace blurcue::plan
