@@ -175,5 +175,113 @@ for _, r in t.iterrows():
 print(f"  11 edges x 3 shares: the largest difference {worst:.1f} standard errors")
 PYEOF
   echo "ok: the report's prediction matches the plan's simulated observer on every edge of test 1" ;;
+threshold_truth)
+  # QUEST+ plans its threshold, not its share correct: the observer's true threshold against the closed form worked
+  # here from the observer model (the Weibull's threshold point of a 2AFC, P = 1 - 0.5 / e before lapses: the seen
+  # blur E = sqrt((r / 2)^2 + 0.6^2) grows by (1 + 0.35)^(z(P) / z(0.75)) from the reference's, which a run records
+  # in arcmin), the bias as mean - truth, the interval width as 2 t(0.975, N - 1) sd / sqrt(N) within the spread of
+  # the studies' sds, and no share-correct binomial row (it had power 1 at N = 1: the procedure sets the share).
+  $BC plan "$P/quest-blur-difference.json" --participants 8 --studies 60 --seed 5 --no-chart --out "$W/q" \
+    > "$W/q.out" 2>&1 || fail "plan: $(tail -2 "$W/q.out")"
+  $BC run "$P/quest-blur-difference.json" --participant P1 --db "$W/r.sqlite" --observer sim > /dev/null 2>&1 || fail "run"
+  $BC export --db "$W/r.sqlite" --out "$W/tables" > /dev/null 2>&1 || fail "export"
+  $PY - "$W/q/plan.csv" "$W/tables/trials.csv" <<'PYEOF' || fail "threshold rows"
+import csv, math, sys
+from scipy.stats import norm, t as student
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert not [r for r in rows if r["test"] in ("binomial", "participants_t")], "a procedure cell's share was tested"
+th = [r for r in rows if r["test"] == "threshold"]
+assert len(th) == 8 and th[0]["condition"] == "edge=9", [r["condition"] for r in th]
+trials = [r for r in csv.DictReader(open(sys.argv[2])) if r["practice"] == "0"]
+ref = {float(r["r_right_arcmin"] if r["test_side"] == "left" else r["r_left_arcmin"]) for r in trials}
+assert len(ref) == 1, ref
+r_ref = ref.pop()
+k = norm.ppf(1 - 0.5 / math.e) / norm.ppf(0.75)
+e_test = math.hypot(r_ref / 2, 0.6) * 1.35 ** k
+truth = 2 * math.sqrt(e_test ** 2 - 0.36) - r_ref
+got = float(th[0]["true_threshold"])
+assert abs(got - truth) < 2e-4, (got, truth)  # the record rounds the reference to 1e-4 arcmin
+mean, bias, sd = (float(th[0][c]) for c in ("mean_estimate", "bias", "sd_estimate"))
+assert abs(bias - (mean - got)) < 1e-5 and sd > 0.05, th[0]
+for r in th[2:]:
+    n = int(r["participants"])
+    width = 2 * student.ppf(0.975, n - 1) * sd / math.sqrt(n)
+    assert abs(float(r["interval_width"]) - width) < 0.35 * width, (n, r["interval_width"], width)
+print(f"  truth {got:.4f} arcmin (closed form {truth:.4f} from r_ref {r_ref}), mean estimate {mean:.3f}, "
+      f"bias {bias:+.3f}, sd {sd:.3f}")
+PYEOF
+  grep -q "procedure cells: the threshold each estimates" "$W/q.out" || fail "summary: $(cat "$W/q.out")"
+  # A truth outside the tested range is said in words, and no bias is printed or written.
+  variant "$P/quest-blur-difference.json" "$W/narrow.json" 'p["blocks"][0]["procedure"]["threshold"] = [0.25, 0.5, 0.75, 1]'
+  $BC plan "$W/narrow.json" --participants 3 --studies 2 --no-chart --out "$W/n" > "$W/n.out" 2>&1 \
+    || fail "plan narrow: $(tail -2 "$W/n.out")"
+  grep -q "edge=9: the true threshold is above the tested range (0.25 to 1), so no bias is given" "$W/n.out" \
+    || fail "narrow summary: $(cat "$W/n.out")"
+  $PY - "$W/n/plan.csv" <<'PYEOF' || fail "narrow rows"
+import csv, sys
+th = [r for r in csv.DictReader(open(sys.argv[1])) if r["test"] == "threshold"]
+assert th and all(r["true_threshold"] == "" and r["bias"] == "" and r["mean_estimate"] != "" for r in th), th[0]
+PYEOF
+  echo "ok: QUEST+ plans its threshold: the observer's truth by the closed form, bias, sd and interval width; a truth beyond the range in words" ;;
+difference_power)
+  # The power of a declared difference: a second cell like edge=9 in the same participants, 0.5 arcmin more. Its
+  # paired differences have sd sqrt(2) x the estimates' sd, so the t-test's power is the noncentral t's (df N - 1,
+  # noncentrality 0.5 sqrt(N) / (sqrt 2 sd)) - estimates are not quite normal, so within 0.08; a declared difference
+  # of 1e-9 is rejected at alpha (0.05 within 3 standard errors of 300 studies). A staircase's two speeds have one
+  # true threshold (the relative level scales both radii alike): the model's own paired difference keeps alpha too.
+  for d in 0.5 1e-9; do
+    $BC plan "$P/quest-blur-difference.json" --participants 12 --studies 300 --seed 6 --difference $d --no-chart \
+      --out "$W/d$d" > "$W/d$d.out" 2>&1 || fail "plan --difference $d: $(tail -2 "$W/d$d.out")"
+  done
+  $BC plan "$P/staircase-ball-gain.json" --participants 8 --studies 300 --seed 7 --no-chart --out "$W/s" \
+    > "$W/s.out" 2>&1 || fail "plan staircase: $(tail -2 "$W/s.out")"
+  $PY - "$W/d0.5/plan.csv" "$W/d1e-9/plan.csv" "$W/s/plan.csv" <<'PYEOF' || fail "difference power"
+import csv, math, sys
+from scipy.stats import nct, t as student
+def rows(path, test):
+    return [r for r in csv.DictReader(open(path)) if r["test"] == test]
+sd = float(rows(sys.argv[1], "threshold")[0]["sd_estimate"])
+power = rows(sys.argv[1], "second_cell_t")
+assert len(power) == 12 and float(power[0]["difference"]) == 0.5, power[0]
+for r in power[3:]:
+    n = int(r["participants"])
+    crit = student.ppf(0.975, n - 1)
+    nc = 0.5 * math.sqrt(n) / (math.sqrt(2) * sd)
+    expected = nct.sf(crit, n - 1, nc) + nct.cdf(-crit, n - 1, nc)
+    assert abs(float(r["power"]) - expected) < 0.08, (n, r["power"], expected)
+se = math.sqrt(0.05 * 0.95 / 300)
+for r in rows(sys.argv[2], "second_cell_t")[1:]:
+    assert abs(float(r["power"]) - 0.05) < 3 * se + 0.005, ("size", r["participants"], r["power"])
+own = [r for r in rows(sys.argv[3], "paired_t") if "model's own" in r["condition"]]
+assert len(own) == 8 and abs(float(own[0]["difference"])) < 1e-9, own[0]
+for r in own[1:]:
+    assert abs(float(r["power"]) - 0.05) < 3 * se + 0.005, ("staircase size", r["participants"], r["power"])
+print(f"  sd {sd:.3f}; power at N = 12 {power[-1]['power']} (noncentral t {expected:.3f}); size "
+      f"{[r['power'][:5] for r in rows(sys.argv[2], 'second_cell_t')[1:]]}")
+PYEOF
+  echo "ok: a declared difference's power matches the noncentral t; a null difference keeps alpha" ;;
+groups)
+  # A between-subject design is compared, not pooled: each group's own t-test against chance and Welch's t-test of
+  # the participants' shares between the groups; no pooled row. Participants alternate groups (balanced), so with 2
+  # participants each group has one and no test can run (power 0); the Welch row's share is the groups' difference.
+  $BC plan "$P/groups-and-info.json" --participants 6 --studies 100 --seed 8 --no-chart --out "$W/g" > "$W/g.out" 2>&1 \
+    || fail "plan: $(tail -2 "$W/g.out")"
+  $PY - "$W/g/plan.csv" <<'PYEOF' || fail "group rows"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert not [r for r in rows if r["condition"] == "all"], "pooled over the groups"
+est = [r for r in rows if r["test"] == "participants_t" and r["condition"] == "group=estimated"]
+none = [r for r in rows if r["test"] == "participants_t" and r["condition"] == "group=no_blur"]
+welch = [r for r in rows if r["test"] == "groups_t"]
+assert len(est) == len(none) == len(welch) == 6, (len(est), len(none), len(welch))
+assert welch[0]["condition"] == "group no_blur - estimated", welch[0]
+assert float(welch[1]["power"]) == 0 and float(est[1]["power"]) == 0, (welch[1], est[1])
+diff = float(none[0]["expected_share"]) - float(est[0]["expected_share"])
+assert abs(float(welch[0]["expected_share"]) - diff) < 1e-5, (welch[0], diff)
+assert float(welch[-1]["power"]) > float(welch[2]["power"]), [r["power"] for r in welch]
+print(f"  groups' difference {diff:.3f}; Welch power at N = 3..6 {[r['power'][:5] for r in welch[2:]]}")
+PYEOF
+  grep -q "groups are compared, not pooled" "$W/g.out" || fail "summary: $(cat "$W/g.out")"
+  echo "ok: groups are compared (per group and Welch between them), not pooled" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -1,7 +1,7 @@
 # blurcue plan end to end over the CLI tests' scene (fixtures scene, calib, session_protocols): tests/plan_test.sh.
 set(BC $<TARGET_FILE:blurcue>)
 set(T ${PROJECT_BINARY_DIR}/cli-test)
-foreach(case same_as_run power_exact same_seed chart prediction depth_slope)
+foreach(case same_as_run power_exact same_seed chart prediction depth_slope threshold_truth difference_power groups)
   add_test(NAME plan_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/plan_test.sh ${case} ${BC} ${T})
   set_tests_properties(plan_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures" LABELS "gl;plan"
                        PASS_REGULAR_EXPRESSION "^ok:|\nok:" TIMEOUT 600)
@@ -64,3 +64,7 @@ add_test(NAME plan_leading_zero_is_decimal
          COMMAND ${BC} plan ${P1} --participants 010 --studies 1 --seed s5 --no-chart --out ${T}/plan-leading-zero)
 set_tests_properties(plan_leading_zero_is_decimal PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
                      LABELS plan PASS_REGULAR_EXPRESSION "1 simulated studies of 10 participants \\(seed 5\\)")
+add_plan_failure_test(plan_bad_difference 2 "--difference: must be a non-zero number in the procedure's units (0.5) or a percentage of the true threshold (20%), got 'abc'"
+                      plan ${T}/protocols/quest-blur-difference.json --difference abc --no-chart --out ${T}/plan-bad)
+add_plan_failure_test(plan_zero_difference 2 "--difference: must be a non-zero number"
+                      plan ${T}/protocols/quest-blur-difference.json --difference 0% --no-chart --out ${T}/plan-bad)

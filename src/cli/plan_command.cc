@@ -21,7 +21,7 @@ namespace blurcue::cli {
 void AddPlanCommand(CLI::App& app) {
   struct Args {
     plan::PlanOptions options;
-    std::string protocol, display, out = "results/plan", python = "/usr/bin/python3";
+    std::string protocol, display, out = "results/plan", python = "/usr/bin/python3", difference;
     bool no_chart = false;
   };
   auto args = std::make_shared<Args>();
@@ -52,11 +52,30 @@ void AddPlanCommand(CLI::App& app) {
       "                           b, width its 95 % t interval's, power that of a t-test of the slopes against 0\n"
       "Rating trials have no chance level and are not planned (a note says so).\n"
       "\n"
+      "An adaptive block (a staircase or QUEST+) sets how often its trials are right, so its share correct is not\n"
+      "tested; per procedure cell (a crossing of the block's factors, e.g. edge=9) the plan reports what it measures:\n"
+      "  threshold      the participants' estimates as the report takes them (QUEST+: the posterior mean after the\n"
+      "                 last answer; a staircase: the mean of its last 6 reversal levels) against the simulated\n"
+      "                 observer's true threshold, worked out from the observer model's own psychometric function (the\n"
+      "                 point the procedure aims at: QUEST+'s Weibull threshold, a staircase's convergence point):\n"
+      "                 truth, mean, bias, sd and the width of the 95 % t interval of the mean of N estimates. A truth\n"
+      "                 outside the procedure's range is said in words, and no bias is given.\n"
+      "  paired_t       two cells of the same participants: the paired t-test of their thresholds the report would\n"
+      "                 run - the difference the model itself predicts, and with --difference a declared one\n"
+      "  groups_t       the same cell in two groups (protocol 'groups'): Welch's t-test between the groups\n"
+      "  second_cell_t  one cell alone, with --difference: against a second cell like it in the same participants\n"
+      "--difference D declares the difference to plan for, in the procedure's units (its variable: 0.5 is half an\n"
+      "arcmin for difference_arcmin, 0.5 x the reference for relative_difference), or relative to each cell's true\n"
+      "threshold with a percent sign (20%): the estimates' scatter as simulated, one side shifted by D.\n"
+      "With groups, every share is tested per group and between groups (Welch), never pooled over them.\n"
+      "\n"
       "Writes DIR (--out, built beside it and swapped in whole): plan.csv (one row per test, condition and N),\n"
       "answers.csv, plan.json (the settings and the smallest N per test) and power.png / power.svg (power against\n"
       "participants, drawn by analysis/plan_chart.py; --no-chart skips it). A summary goes to stdout, progress to stderr.\n"
       "Example (the thesis's test 1 on a 24-inch 1920x1080 monitor at 60 cm, the default display):\n"
-      "  blurcue plan protocols/test1-static-grids.json --participants 30 --studies 400 --seed 1 --out results/plan");
+      "  blurcue plan protocols/test1-static-grids.json --participants 30 --studies 400 --seed 1 --out results/plan\n"
+      "QUEST+ on the blur difference, planning for a 0.5 arcmin difference between two cells:\n"
+      "  blurcue plan protocols/quest-blur-difference.json --participants 20 --difference 0.5 --out results/plan-quest");
   cmd->add_option("protocol", args->protocol, "the protocol JSON file")->required();
   cmd->add_option("--display", args->display,
                   "the monitor's display profile (default: the protocol's display.profile, else a 24-inch 1920x1080 "
@@ -78,6 +97,9 @@ void AddPlanCommand(CLI::App& app) {
       ->check(FiniteRange(0, 0.5, "", "", true));
   cmd->add_option("--power", args->options.target_power, "the power N(80%) asks for")->capture_default_str()
       ->check(FiniteRange(0, 1, "", "", true));
+  cmd->add_option("--difference", args->difference,
+                  "procedure cells: the threshold difference to plan the power for, in the procedure's units (0.5) "
+                  "or relative to the true threshold (20%)");
   cmd->add_option("--out", args->out, "output folder (created; an earlier plan there is replaced)")
       ->capture_default_str();
   cmd->add_option("--python", args->python, "the Python that draws the chart")->capture_default_str();
@@ -86,6 +108,7 @@ void AddPlanCommand(CLI::App& app) {
     plan::PlanOptions options = args->options;
     options.protocol_file = args->protocol;
     options.display_profile = args->display;
+    if (!args->difference.empty()) options.difference = plan::ParseDifference(args->difference);
     options.progress = [](const std::string& line) { std::fprintf(stderr, "plan: %s\n", line.c_str()); };
     const std::filesystem::path out = args->out;
     const std::filesystem::path script = DataDir().path / "analysis" / "plan_chart.py";
@@ -114,6 +137,7 @@ void AddPlanCommand(CLI::App& app) {
                      {"observer", result.observer},
                      {"alpha", options.alpha},
                      {"target_power", options.target_power},
+                     {"difference", args->difference.empty() ? Json() : Json(args->difference)},
                      {"smallest_n", result.smallest_n},
                      {"notes", result.notes}};
     for (const auto& path : RemoveStaleLeftovers(out))

@@ -1,0 +1,95 @@
+// The plan's truth about thresholds against hand-worked cases: Levitt's convergence points, the Weibull's threshold
+// point, the report's reversal rule and the pixel observer's closed form Phi(dr / jnd) solved by hand.
+#include "plan/threshold.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+namespace blurcue::plan {
+namespace {
+
+TEST(DownRunFirst, OneUpIsPToTheDownAndOneDownIsOneMinusQToTheUp) {
+  EXPECT_NEAR(DownRunFirst(0.6, 1, 2), 0.36, 1e-12);          // two right in a row before one wrong: p^2
+  EXPECT_NEAR(DownRunFirst(0.6, 2, 1), 1 - 0.16, 1e-12);      // one right before two wrong in a row: 1 - q^2
+  EXPECT_NEAR(DownRunFirst(0.5, 2, 2), 0.5, 1e-12);           // symmetric rule at p = 1/2
+}
+
+TEST(TargetShare, LevittPointsAndTheWeibullThreshold) {
+  protocol::Procedure staircase;
+  staircase.up = 1, staircase.down = 2;
+  EXPECT_NEAR(TargetShare(staircase, 0), std::sqrt(0.5), 1e-9);  // 70.7 %
+  staircase.down = 3;
+  EXPECT_NEAR(TargetShare(staircase, 0), std::cbrt(0.5), 1e-9);  // 79.4 %
+  protocol::Procedure quest;
+  quest.kind = protocol::Procedure::Kind::kQuestPlus;
+  quest.guess = 0.5;
+  EXPECT_NEAR(TargetShare(quest, 0), 1 - 0.5 / M_E, 1e-12);      // 81.6 %
+  EXPECT_NEAR(TargetShare(quest, 0.02), 0.5 + 0.48 * (1 - 1 / M_E), 1e-12);
+}
+
+TEST(TrackEstimate, TheReportsReversalRule) {
+  // Moves D D U D U D U D; the levels after them .6 .4 .6 .4 .6 .5 .6 .5; reversals at moves 3..8: .6 .4 .6 .5 .6 .5,
+  // whose mean is 3.2 / 6 (analysis/any_study.py gives 0.5333 for the same list).
+  const std::vector<double> levels = {1.0, 0.6, 0.6, 0.4, 0.6, 0.4, 0.6, 0.5, 0.6, 0.5};
+  EXPECT_NEAR(*TrackEstimate(protocol::Procedure::Kind::kStaircase, levels, std::nullopt), 3.2 / 6, 1e-12);
+  // Fewer than 4 reversals (one): the mean of the last 10 levels, .6 + .4 + .2 + 7 x .4 = 4.0.
+  const std::vector<double> few = {1, 0.8, 0.6, 0.4, 0.2, 0.4, 0.4, 0.4, 0.4, 0.4, 0.4, 0.4};
+  EXPECT_NEAR(*TrackEstimate(protocol::Procedure::Kind::kStaircase, few, std::nullopt), 4.0 / 10, 1e-12);
+  // QUEST+: its posterior mean, whatever the levels.
+  EXPECT_EQ(*TrackEstimate(protocol::Procedure::Kind::kQuestPlus, levels, 1.25), 1.25);
+  EXPECT_FALSE(TrackEstimate(protocol::Procedure::Kind::kStaircase, {}, std::nullopt));
+}
+
+// A pair at 2 px both sides, the right one the test side, seen by the pixel observer (jnd 0.6 px): a relative level
+// x makes the right side 2 (1 + x) px, and P(correct) = Phi(2 x / 0.6) before lapses.
+struct PixelPair {
+  session::ObserverParams observer = session::ParseObserver("sim:model=pixel,jnd=0.6,lapse=0");
+  protocol::Trial trial;
+  session::TrialScene scene;
+  session::Presentation presentation;
+  PixelPair() {
+    trial.cell = 0, trial.test_side = "right";
+    scene.r_left_px = scene.r_right_px = 2;
+  }
+};
+
+TEST(ObserverThreshold, PixelObserverByTheClosedForm) {
+  PixelPair pair;
+  protocol::Procedure quest;
+  quest.kind = protocol::Procedure::Kind::kQuestPlus;
+  quest.thresholds = {0.05, 0.1, 0.5, 1};
+  // QUEST+: Phi(x / 0.3) = 1 - 0.5 / e, x = 0.3 x 0.9004525966 (scipy norm.ppf).
+  TrueThreshold t = ObserverThreshold(pair.observer, quest, pair.trial, pair.scene, pair.presentation);
+  ASSERT_TRUE(t.determined) << t.why;
+  EXPECT_NEAR(t.level, 0.3 * 0.9004525966377902, 1e-9);
+  // A 1-up/2-down staircase with 4 % lapses: (1 - 0.04) Phi(x / 0.3) + 0.02 = sqrt(1/2), x = 0.3 x 0.5702214.
+  protocol::Procedure staircase;
+  staircase.min = 0.01, staircase.max = 3;
+  pair.observer.lapse = 0.04;
+  t = ObserverThreshold(pair.observer, staircase, pair.trial, pair.scene, pair.presentation);
+  ASSERT_TRUE(t.determined) << t.why;
+  EXPECT_NEAR(t.level, 0.17106642182615864, 1e-9);
+}
+
+TEST(ObserverThreshold, OutsideTheRangeIsSaidInWords) {
+  PixelPair pair;
+  protocol::Procedure quest;
+  quest.kind = protocol::Procedure::Kind::kQuestPlus;
+  quest.thresholds = {0.5, 1, 2};  // the truth, 0.27, is below
+  TrueThreshold t = ObserverThreshold(pair.observer, quest, pair.trial, pair.scene, pair.presentation);
+  EXPECT_FALSE(t.determined);
+  EXPECT_EQ(t.why, "below the tested range (0.5 to 2)");
+  quest.thresholds = {0.01, 0.1};
+  t = ObserverThreshold(pair.observer, quest, pair.trial, pair.scene, pair.presentation);
+  EXPECT_EQ(t.why, "above the tested range (0.01 to 0.1)");
+  // Lapses that keep the observer below the staircase's 70.7 %: never reached.
+  protocol::Procedure staircase;
+  pair.observer.lapse = 0.9;
+  t = ObserverThreshold(pair.observer, staircase, pair.trial, pair.scene, pair.presentation);
+  EXPECT_FALSE(t.determined);
+  EXPECT_NE(t.why.find("never reached"), std::string::npos) << t.why;
+}
+
+}  // namespace
+}  // namespace blurcue::plan
