@@ -173,7 +173,7 @@ void AddProcedures(CLI::App& bench) {
 
 void AddPlan(CLI::App& bench) {
   struct Args {
-    std::string out = "results/bench/plan.csv", protocol;
+    std::string out = "results/bench/plan.csv", protocol, adaptive;
     bench::PlanBenchOptions options;
     bool quick = false;
   };
@@ -184,9 +184,13 @@ void AddPlan(CLI::App& bench) {
       "Simulates --studies studies of --participants participants of a protocol (default: the shipped test 1, which\n"
       "needs the demo's calibration) with 1 thread and with 2, interleaved, --rounds times each, in one run; prints\n"
       "the median time per participant for each and the speed-up of 2 threads over 1 (and its share of the ideal 2x).\n"
+      "The shipped QUEST+ protocol (quest-blur-difference) is timed in the same rounds (--adaptive-protocol), and its\n"
+      "time per participant given beside test 1's.\n"
       "Every run must give the same answers (it stops if not). --quick: 1 round of 2 studies.");
   cmd->add_option("--out", args->out, "CSV, one row per timed run")->capture_default_str();
   cmd->add_option("--protocol", args->protocol, "the protocol to simulate (default protocols/test1-static-grids.json)");
+  cmd->add_option("--adaptive-protocol", args->adaptive,
+                  "the adaptive protocol timed beside it (default protocols/quest-blur-difference.json; 'none': none)");
   cmd->add_option("--participants", args->options.participants, "participants per study")->capture_default_str()
       ->transform(IntRange(1, 10000));
   cmd->add_option("--studies", args->options.studies, "studies per timed run")->capture_default_str()
@@ -199,6 +203,9 @@ void AddPlan(CLI::App& bench) {
     bench::PlanBenchOptions options = args->options;
     options.protocol_file = args->protocol.empty() ? DataDir().path / "protocols" / "test1-static-grids.json"
                                                    : std::filesystem::path(args->protocol);
+    options.adaptive_file = args->adaptive.empty() ? DataDir().path / "protocols" / "quest-blur-difference.json"
+                            : args->adaptive == "none" ? std::filesystem::path()
+                                                       : std::filesystem::path(args->adaptive);
     if (args->quick) options.rounds = 1, options.studies = 2;
     options.progress = ProgressLine;
     const auto rows = bench::RunPlanBench(options);
