@@ -68,3 +68,33 @@ add_plan_failure_test(plan_bad_difference 2 "--difference: must be a non-zero nu
                       plan ${T}/protocols/quest-blur-difference.json --difference abc --no-chart --out ${T}/plan-bad)
 add_plan_failure_test(plan_zero_difference 2 "--difference: must be a non-zero number"
                       plan ${T}/protocols/quest-blur-difference.json --difference 0% --no-chart --out ${T}/plan-bad)
+
+# Every group checked: validate, validate --plan and preview cover each group of a protocol with groups (groups-and-info:
+# 6 edges x 2 swapped copies = 12 trials in each group's own block), or only --group's; an unknown group is a usage
+# error with the nearest name.
+set(G ${T}/protocols/groups-and-info.json)
+add_test(NAME validate_every_group COMMAND ${BC} validate ${G})
+set_tests_properties(validate_every_group PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS plan
+  PASS_REGULAR_EXPRESSION "ok: 12 trials [^\n]*, group estimated\n  measured-vs-estimated 12 [^\n]*\n.*ok: 12 trials [^\n]*, group no_blur\n  measured-vs-none 12 ")
+add_test(NAME validate_plan_every_group COMMAND ${BC} validate ${G} --plan)
+set_tests_properties(validate_plan_every_group PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS plan
+  PASS_REGULAR_EXPRESSION "group: estimated [^\n]*\n.*visibility [^\n]*6 distinct pairs.*group: no_blur [^\n]*\n.*visibility [^\n]*6 distinct pairs")
+add_test(NAME validate_one_group COMMAND ${BC} validate ${G} --group no_blur)
+set_tests_properties(validate_one_group PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS plan
+  PASS_REGULAR_EXPRESSION "ok: 12 trials [^\n]*, group no_blur\n  measured-vs-none 12 " FAIL_REGULAR_EXPRESSION "group estimated")
+add_test(NAME validate_every_group_no_files COMMAND ${BC} validate ${PROJECT_SOURCE_DIR}/protocols/groups-and-info.json --no-files)
+set_tests_properties(validate_every_group_no_files PROPERTIES LABELS plan
+  PASS_REGULAR_EXPRESSION "group estimated\n  measured-vs-estimated 12 [^\n]*\nok: 12 trials [^\n]*, group no_blur\n  measured-vs-none 12 ")
+add_plan_failure_test(validate_unknown_group 2
+                      "--group no_blr: ${G} has no such group (did you mean no_blur? its groups: estimated, no_blur)"
+                      validate ${G} --group no_blr)
+add_plan_failure_test(validate_group_without_groups 2 "--group estimated: ${P1} has no groups"
+                      validate ${P1} --group estimated)
+add_test(NAME preview_every_group COMMAND ${BC} preview ${G} --list --out ${T}/preview-groups.png)
+set_tests_properties(preview_every_group PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS "gl;plan"
+  PASS_REGULAR_EXPRESSION "#1 group estimated: edge 1: .*#13 group no_blur: edge 1: .*24 distinct stimuli of 24 trials \\(groups estimated, no_blur\\)")
+add_test(NAME preview_one_group COMMAND ${BC} preview ${G} --group no_blur --list --out ${T}/preview-group.png)
+set_tests_properties(preview_one_group PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS "gl;plan"
+  PASS_REGULAR_EXPRESSION "12 distinct stimuli of 12 trials \\(groups no_blur\\)" FAIL_REGULAR_EXPRESSION "group estimated")
+add_plan_failure_test(preview_unknown_group 2 "--group estimatd: ${G} has no such group (did you mean estimated?"
+                      preview ${G} --group estimatd --out ${T}/preview-bad.png)

@@ -13,6 +13,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "cli/commands.h"
+#include "cli/groups.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "protocol/protocol.h"
@@ -29,7 +30,7 @@ namespace blurcue::cli {
 
 void AddPreviewCommand(CLI::App& app) {
   struct Args {
-    std::string protocol, out, participant = "P1", display, observer = "sim";
+    std::string protocol, out, participant = "P1", display, observer = "sim", group;
     std::optional<uint64_t> seed;
     int columns = 6, tile_width = 320;
     double visible = 0.75;
@@ -48,12 +49,14 @@ void AddPreviewCommand(CLI::App& app) {
       "Each pair's tile says the probability that an observer (--observer's model, no lapses or bias) tells its two\n"
       "sides apart on the display (--display) in a 2AFC; below --visible it is flagged invisible, and every distinct\n"
       "pair is listed so (as blurcue validate --plan).\n"
+      "A protocol with between-subject groups gets each group's tiles (labelled with the group), or only --group's.\n"
       "Example: blurcue preview protocols/test1-static-grids.json --out results/preview-test1.png");
   cmd->add_option("protocol", args->protocol, "the protocol JSON file")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "the contact sheet PNG")->required();
   cmd->add_option("--participant", args->participant, "whose trial list (by_participant sides)")
       ->capture_default_str();
   cmd->add_option("--seed", args->seed, "seed (default: as blurcue run)")->transform(SeedValidator());
+  cmd->add_option("--group", args->group, "a protocol with groups: only this group's tiles (default: every group's)");
   cmd->add_flag("--list", args->list, "also print each tile's label (its levels, each side's source and radius in "
                                       "photo px, screen px and arcmin), one line per tile");
   cmd->add_option("--display", args->display, "the monitor's display profile, as blurcue run --display")
@@ -69,10 +72,9 @@ void AddPreviewCommand(CLI::App& app) {
   cmd->callback([args] {
     // The pre-flight of blurcue run: the same checks, and every trial's scene already worked out.
     const session::ObserverParams observer = session::ParseObserver(args->observer);
-    const session::PreparedSession prepared =
-        session::PrepareSession(args->protocol, args->participant, args->seed, args->display);
+    session::PreparedSession prepared = session::PrepareStudy(args->protocol, args->display);
+    const std::vector<std::string> groups = GroupsToCheck(prepared.protocol, args->group);
     const protocol::Protocol& p = prepared.protocol;
-    const auto& trials = prepared.trials;
     const auto& scene = prepared.scene;
     struct Tile {
       session::TrialScene scene;
@@ -82,87 +84,101 @@ void AddPreviewCommand(CLI::App& app) {
       std::string seen = {};       // pairs: the predicted share correct, and invisible below --visible
     };
     std::vector<Tile> tiles;
-    std::set<std::string> seen;  // labels or level keys already on the sheet
-    session::AdaptiveState adaptive(p);  // no answers yet: each procedure's first level
-    for (const auto& t : trials) {
-      const session::TrialScene& s_planned = prepared.scenes[size_t(t.index)];
-      if (t.task == protocol::Task::kAdjustment) {
-        const session::TrialScene& s = s_planned;
-        // Every level once (at the first distance shown), and every distance once (at the middle level): the
-        // two halves of the frame vary apart, so together these show every distinct half.
-        const std::string parameter = p.blocks.front().adjust ? p.blocks.front().adjust->parameter : "level";
-        std::vector<double> sorted = t.adjust_levels;
-        std::sort(sorted.begin(), sorted.end());
-        for (double level : t.adjust_levels) {
-          char label[96];
-          std::snprintf(label, sizeof label, "%s %g", parameter.c_str(), level);
-          if (seen.insert(label).second)
-            tiles.push_back({s, level, label, "distance " + Json(s.distance_m).dump() + " m",
-                             Json::array({0, level})});
+    std::vector<std::string> visibility;  // what an observer can see, per group
+    size_t trial_count = 0;
+    for (size_t g = 0; g < groups.size(); ++g) {
+      // Each group's own trials: its blocks, checked and drawn (a group's tiles together, labelled with its name).
+      session::PrepareParticipant(&prepared, args->participant, args->seed, groups[g]);
+      const auto& trials = prepared.trials;
+      trial_count += trials.size();
+      const size_t group_start = tiles.size();
+      std::set<std::string> seen;  // labels or level keys already on the sheet
+      session::AdaptiveState adaptive(p);  // no answers yet: each procedure's first level
+      for (const auto& t : trials) {
+        const session::TrialScene& s_planned = prepared.scenes[size_t(t.index)];
+        if (t.task == protocol::Task::kAdjustment) {
+          const session::TrialScene& s = s_planned;
+          // Every level once (at the first distance shown), and every distance once (at the middle level): the
+          // two halves of the frame vary apart, so together these show every distinct half.
+          const std::string parameter = p.blocks.front().adjust ? p.blocks.front().adjust->parameter : "level";
+          std::vector<double> sorted = t.adjust_levels;
+          std::sort(sorted.begin(), sorted.end());
+          for (double level : t.adjust_levels) {
+            char label[96];
+            std::snprintf(label, sizeof label, "%s %g", parameter.c_str(), level);
+            if (seen.insert(label).second)
+              tiles.push_back({s, level, label, "distance " + Json(s.distance_m).dump() + " m",
+                               Json::array({0, level})});
+          }
+          if (!sorted.empty() && s.distance_m > 0) {
+            char label[96];
+            std::snprintf(label, sizeof label, "distance %g m", s.distance_m);
+            const double middle = sorted[sorted.size() / 2];
+            if (seen.insert(label).second)
+              tiles.push_back({s, middle, label, parameter + " " + Json(middle).dump(),
+                               Json::array({1, s.distance_m})});
+          }
+          continue;
         }
-        if (!sorted.empty() && s.distance_m > 0) {
-          char label[96];
-          std::snprintf(label, sizeof label, "distance %g m", s.distance_m);
-          const double middle = sorted[sorted.size() / 2];
-          if (seen.insert(label).second)
-            tiles.push_back({s, middle, label, parameter + " " + Json(middle).dump(),
-                             Json::array({1, s.distance_m})});
+        Json key = t.levels;
+        key["left"] = t.left;
+        key["right"] = t.right;
+        if (!seen.insert(key.dump()).second) continue;
+        // A procedure's crossing is shown at its first trial's level, on that trial's test side.
+        session::TrialScene s = s_planned;
+        std::string first;
+        if (t.cell >= 0) {
+          const double level = adaptive.Level(t);
+          const protocol::Procedure& procedure = *protocol::BlockOf(p, t)->procedure;  // t.cell >= 0: it has one
+          session::ApplyLevel(procedure, t, level, prepared.presentation, &s);
+          first = " (" + protocol::ToString(procedure.kind) + ": " + procedure.variable + " " + Json(level).dump() +
+                  " on the " + t.test_side + " at first)";
+          session::PlanOnScreen(p, *scene, prepared.presentation, &s);
         }
-        continue;
+        const std::string levels = session::LevelsLabel(t);
+        auto source = [](const Json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); };
+        // Each side's radius as the camera made it (photo px) and as the screen shows it (screen px, arcmin): the
+        // numbers the record keeps for these trials.
+        const session::Presentation& at = prepared.presentation;
+        auto side = [&](const char* name, const Json& v, double r) {
+          char text[160];
+          std::snprintf(text, sizeof text, "%s %s %.2f px = %.2f scr px %.2f'", name, source(v).c_str(), r,
+                        at.ScreenPx(r), at.Arcmin(r));
+          return std::string(text);
+        };
+        // What an observer makes of the pair on this display: the object against the scene's blur for one object.
+        session::PairView view = session::ViewOf(s, at);
+        if (s.left_only) view.r_right_px = view.r_scene_px;
+        const double p_correct = session::ProbabilityCorrect2afc(observer, view);
+        char seen[96];
+        std::snprintf(seen, sizeof seen, "%s told apart %.0f %% (2AFC)%s", s.left_only ? "vs scene:" : "L vs R:",
+                      100 * p_correct,
+                      p_correct < args->visible ? " - INVISIBLE" : "");
+        const size_t first_tile = tiles.size();
+        if (s.left_only) {  // layout single: its one object
+          tiles.push_back({s, 0, levels + first, side("object", t.left, s.r_left_px), key});
+        } else if (s.intervals > 0) {
+          // Intervals show one object at a time, at the left object's place: a tile for each kind of interval.
+          const bool odd = s.intervals > 2;
+          Json first_key = key;
+          first_key["interval"] = 1;
+          tiles.push_back({session::IntervalScene(s, false), 0, levels + first,
+                           side(odd ? "the others: L" : "1st interval: L", t.left, s.r_left_px), first_key});
+          Json second = key;
+          second["interval"] = 2;
+          tiles.push_back({session::IntervalScene(s, true), 0, levels + first,
+                           side(odd ? "the odd one: R" : "2nd interval: R", t.right, s.r_right_px), second});
+        } else {
+          tiles.push_back({s, 0, levels + first, side("L", t.left, s.r_left_px) + " | " + side("R", t.right, s.r_right_px),
+                           key});
+        }
+        for (size_t k = first_tile; k < tiles.size(); ++k) tiles[k].seen = seen;
       }
-      Json key = t.levels;
-      key["left"] = t.left;
-      key["right"] = t.right;
-      if (!seen.insert(key.dump()).second) continue;
-      // A procedure's crossing is shown at its first trial's level, on that trial's test side.
-      session::TrialScene s = s_planned;
-      std::string first;
-      if (t.cell >= 0) {
-        const double level = adaptive.Level(t);
-        const protocol::Procedure& procedure = *protocol::BlockOf(p, t)->procedure;  // t.cell >= 0: it has one
-        session::ApplyLevel(procedure, t, level, prepared.presentation, &s);
-        first = " (" + protocol::ToString(procedure.kind) + ": " + procedure.variable + " " + Json(level).dump() +
-                " on the " + t.test_side + " at first)";
-        session::PlanOnScreen(p, *scene, prepared.presentation, &s);
-      }
-      const std::string levels = session::LevelsLabel(t);
-      auto source = [](const Json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); };
-      // Each side's radius as the camera made it (photo px) and as the screen shows it (screen px, arcmin): the
-      // numbers the record keeps for these trials.
-      const session::Presentation& at = prepared.presentation;
-      auto side = [&](const char* name, const Json& v, double r) {
-        char text[160];
-        std::snprintf(text, sizeof text, "%s %s %.2f px = %.2f scr px %.2f'", name, source(v).c_str(), r,
-                      at.ScreenPx(r), at.Arcmin(r));
-        return std::string(text);
-      };
-      // What an observer makes of the pair on this display: the object against the scene's blur for one object.
-      session::PairView view = session::ViewOf(s, at);
-      if (s.left_only) view.r_right_px = view.r_scene_px;
-      const double p_correct = session::ProbabilityCorrect2afc(observer, view);
-      char seen[96];
-      std::snprintf(seen, sizeof seen, "%s told apart %.0f %% (2AFC)%s", s.left_only ? "vs scene:" : "L vs R:",
-                    100 * p_correct,
-                    p_correct < args->visible ? " - INVISIBLE" : "");
-      const size_t first_tile = tiles.size();
-      if (s.left_only) {  // layout single: its one object
-        tiles.push_back({s, 0, levels + first, side("object", t.left, s.r_left_px), key});
-      } else if (s.intervals > 0) {
-        // Intervals show one object at a time, at the left object's place: a tile for each kind of interval.
-        const bool odd = s.intervals > 2;
-        Json first_key = key;
-        first_key["interval"] = 1;
-        tiles.push_back({session::IntervalScene(s, false), 0, levels + first,
-                         side(odd ? "the others: L" : "1st interval: L", t.left, s.r_left_px), first_key});
-        Json second = key;
-        second["interval"] = 2;
-        tiles.push_back({session::IntervalScene(s, true), 0, levels + first,
-                         side(odd ? "the odd one: R" : "2nd interval: R", t.right, s.r_right_px), second});
-      } else {
-        tiles.push_back({s, 0, levels + first, side("L", t.left, s.r_left_px) + " | " + side("R", t.right, s.r_right_px),
-                         key});
-      }
-      for (size_t k = first_tile; k < tiles.size(); ++k) tiles[k].seen = seen;
+      const std::string prefix = groups[g].empty() ? "" : "group " + groups[g] + ": ";
+      for (size_t k = group_start; k < tiles.size(); ++k)
+        tiles[k].label = prefix + tiles[k].label, tiles[k].key = Json::array({int(g), tiles[k].key});
+      for (const std::string& text : session::VisibilityLines(prepared, observer, args->visible, true))
+        visibility.push_back(prefix + text);
     }
     std::stable_sort(tiles.begin(), tiles.end(), [](const Tile& a, const Tile& b) { return a.key < b.key; });
     if (tiles.empty()) throw InputError(args->protocol, "the protocol makes no trials to preview");
@@ -214,11 +230,13 @@ void AddPreviewCommand(CLI::App& app) {
     }
     if (tty) std::fprintf(stderr, "\n");
     WriteImage(args->out, sheet);
-    std::printf("%s: %zu distinct stimuli of %zu trials -> %s\n", args->protocol.c_str(), tiles.size(), trials.size(),
-                args->out.c_str());
+    std::string in_groups;
+    for (const std::string& group : groups)
+      if (!group.empty()) in_groups += (in_groups.empty() ? " (groups " : ", ") + group;
+    std::printf("%s: %zu distinct stimuli of %zu trials%s -> %s\n", args->protocol.c_str(), tiles.size(), trial_count,
+                in_groups.empty() ? "" : (in_groups + ")").c_str(), args->out.c_str());
     // What a participant can see of it (as blurcue validate --plan): the invisible pairs, each depth-matching distance.
-    for (const std::string& text : session::VisibilityLines(prepared, observer, args->visible, true))
-      std::printf("%s\n", text.c_str());
+    for (const std::string& text : visibility) std::printf("%s\n", text.c_str());
   });
 }
 

@@ -1,11 +1,13 @@
 // blurcue validate: check a protocol file and build its trial list, through the pre-flight a session runs.
 #include <cstdio>
+#include <algorithm>
 #include <iostream>
 #include <memory>
 #include <optional>
 #include <string>
 
 #include "cli/commands.h"
+#include "cli/groups.h"
 #include "core/error.h"
 #include "core/hash.h"
 #include "protocol/protocol.h"
@@ -18,7 +20,7 @@ namespace blurcue::cli {
 
 void AddValidateCommand(CLI::App& app) {
   struct Args {
-    std::string file, participant = "P1", display, observer = "sim";
+    std::string file, participant = "P1", display, observer = "sim", group;
     std::optional<uint64_t> seed;
     bool no_files = false, list = false, plan = false;
     double visible = 0.75;
@@ -35,6 +37,8 @@ void AddValidateCommand(CLI::App& app) {
       "--plan adds what a participant can see: for every distinct stimulus pair, on the display profile, the\n"
       "probability that an observer (--observer's model, without lapses or bias) tells its two sides apart in a\n"
       "2AFC, and the pairs below --visible flagged as invisible at that viewing distance.\n"
+      "A protocol with between-subject groups is checked for every group (each group's trial count, checks and\n"
+      "--plan), or for the one --group names.\n"
       "Example: blurcue validate protocols/test2-moving-balls.json --participant P4 --seed 4");
   cmd->add_option("protocol", args->file, "the protocol JSON file")->required();
   cmd->add_flag("--no-files", args->no_files, "check the protocol alone: skip the referenced files (scene, calib, "
@@ -47,6 +51,7 @@ void AddValidateCommand(CLI::App& app) {
   cmd->add_option("--display", args->display, "the monitor's display profile, as blurcue run --display")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--list", args->list, "print the trial list as JSON, one trial per line");
+  cmd->add_option("--group", args->group, "a protocol with groups: check only this group (default: every group)");
   CLI::Option* plan = cmd->add_flag("--plan", args->plan, "also predict, per distinct stimulus pair, whether an observer can tell its "
                                       "two sides apart on this display (flags the invisible ones), and per "
                                       "depth-matching distance which levels it cannot tell from the real picture");
@@ -65,48 +70,57 @@ void AddValidateCommand(CLI::App& app) {
       observer = session::ParseObserver(args->observer);
     }
     protocol::Protocol p;
-    uint64_t seed = 0;
-    std::vector<protocol::Trial> trials;
-    std::string shown;  // how a frame reaches the screen and the eye
+    // One participant's session per group checked: its seed, trials and what the pre-flight found.
+    struct Checked {
+      std::string group;
+      uint64_t seed = 0;
+      std::vector<protocol::Trial> trials;
+      std::string shown;  // how a frame reaches the screen and the eye
+    };
+    std::vector<Checked> checked;
     if (args->no_files) {
       p = protocol::LoadProtocol(args->file, protocol::ValidateOptions{false});
-      seed = args->seed ? *args->seed : protocol::DefaultSeed(p.name, args->participant);
-      trials = protocol::BuildTrials(p, args->participant, seed);
+      for (const std::string& group : GroupsToCheck(p, args->group)) {
+        const uint64_t seed = args->seed ? *args->seed : protocol::DefaultSeed(p.name, args->participant);
+        checked.push_back({group, seed, protocol::BuildTrials(p, args->participant, seed, group), ""});
+      }
     } else {
-      // What `blurcue run` does before its first trial, through the same function: files decoded, the
-      // calibration read, every trial's scene and radii worked out.
+      // What `blurcue run` does before its first trial, through the same functions: files decoded, the
+      // calibration read, every trial's scene and radii worked out - for each group's blocks.
       try {
-        session::PreparedSession prepared =
-            session::PrepareSession(args->file, args->participant, args->seed, args->display);
-        const session::Presentation& at = prepared.presentation;
-        char line[400];
-        std::snprintf(line, sizeof line,
-                      "  shown: a %d x %d %s in a %d x %d window (%s) at %.4f screen px per photo px; %s: %.2f px per "
-                      "degree, 1 photo px = %.3f arcmin\n",
-                      at.frame_width_px, at.frame_height_px, prepared.scene ? "photo" : "frame", at.window_width_px,
-                      at.window_height_px, at.scaling.c_str(), at.scale, at.profile.name.c_str(),
-                      display::PxPerDeg(at.profile), at.Arcmin(1));
-        shown = line;
-        if (prepared.protocol.groups)
-          shown += "  group: " + prepared.group +
-                   (prepared.protocol.groups->assign == "balanced"
-                        ? " (balanced: a run takes the group with the fewest sessions in its record)\n"
-                        : " (by participant number)\n");
-        if (prepared.scene) {
-          size_t per_pixel = 0;
-          for (const auto& scene : prepared.scenes) per_pixel += scene.per_pixel;
+        session::PreparedSession prepared = session::PrepareStudy(args->file, args->display);
+        for (const std::string& group : GroupsToCheck(prepared.protocol, args->group)) {
+          session::PrepareParticipant(&prepared, args->participant, args->seed, group);
+          const session::Presentation& at = prepared.presentation;
+          char line[400];
           std::snprintf(line, sizeof line,
-                        "  blur plan: %zu of %zu trials per pixel by depth (depth span >= %g %s), the rest one radius\n",
-                        per_pixel, prepared.scenes.size(), prepared.protocol.content.depth_blur_threshold,
-                        prepared.protocol.content.depth_blur_threshold_unit == "arcmin" ? "arcmin" : "screen px");
-          shown += line;
+                        "  shown: a %d x %d %s in a %d x %d window (%s) at %.4f screen px per photo px; %s: %.2f px "
+                        "per degree, 1 photo px = %.3f arcmin\n",
+                        at.frame_width_px, at.frame_height_px, prepared.scene ? "photo" : "frame", at.window_width_px,
+                        at.window_height_px, at.scaling.c_str(), at.scale, at.profile.name.c_str(),
+                        display::PxPerDeg(at.profile), at.Arcmin(1));
+          std::string shown = line;
+          if (prepared.protocol.groups)
+            shown += "  group: " + prepared.group +
+                     (prepared.protocol.groups->assign == "balanced"
+                          ? " (balanced: a run takes the group with the fewest sessions in its record)\n"
+                          : " (by participant number)\n");
+          if (prepared.scene) {
+            size_t per_pixel = 0;
+            for (const auto& scene : prepared.scenes) per_pixel += scene.per_pixel;
+            std::snprintf(line, sizeof line,
+                          "  blur plan: %zu of %zu trials per pixel by depth (depth span >= %g %s), the rest one "
+                          "radius\n",
+                          per_pixel, prepared.scenes.size(), prepared.protocol.content.depth_blur_threshold,
+                          prepared.protocol.content.depth_blur_threshold_unit == "arcmin" ? "arcmin" : "screen px");
+            shown += line;
+          }
+          if (observer)
+            for (const std::string& text : session::VisibilityLines(prepared, *observer, args->visible, false))
+              shown += "  " + text + "\n";
+          checked.push_back({group, prepared.seed, prepared.trials, shown});
         }
-        if (observer)
-          for (const std::string& text : session::VisibilityLines(prepared, *observer, args->visible, false))
-            shown += "  " + text + "\n";
         p = std::move(prepared.protocol);
-        seed = prepared.seed;
-        trials = std::move(prepared.trials);
       } catch (const Error& e) {
         const std::string message = e.what();
         if (message.find(": no such file: ") == std::string::npos) throw;
@@ -114,21 +128,29 @@ void AddValidateCommand(CLI::App& app) {
                                       "skips the file checks)");
       }
     }
-    if (args->list)
-      for (const auto& t : trials) std::cout << protocol::ToJson(t).dump() << "\n";
-    std::cout << "ok: " << trials.size() << " trials for participant " << args->participant << " with seed "
-              << seed << " (hash " << HashHex(protocol::TrialsHash(trials)) << ")\n";
-    std::string counts;
-    int practice = 0;
-    for (const auto& t : trials) practice += t.practice ? 1 : 0;
-    if (practice > 0) counts = "practice " + std::to_string(practice);
-    for (const auto& b : p.blocks) {
-      int n = 0;
-      for (const auto& t : trials) n += (!t.practice && t.block == b.name) ? 1 : 0;
-      counts += (counts.empty() ? "" : ", ") + b.name + " " + std::to_string(n) + " (" + protocol::ToString(b.task) +
-                ", " + protocol::ToString(b.counterbalance) + ")";
+    for (const Checked& one : checked) {
+      const auto& trials = one.trials;
+      if (args->list)
+        for (const auto& t : trials) std::cout << protocol::ToJson(t).dump() << "\n";
+      std::cout << "ok: " << trials.size() << " trials for participant " << args->participant << " with seed "
+                << one.seed << " (hash " << HashHex(protocol::TrialsHash(trials)) << ")"
+                << (one.group.empty() ? "" : ", group " + one.group) << "\n";
+      std::string counts;
+      int practice = 0;
+      for (const auto& t : trials) practice += t.practice ? 1 : 0;
+      if (practice > 0) counts = "practice " + std::to_string(practice);
+      for (const auto& b : p.blocks) {
+        // A group's own blocks (and those every group runs); another group's are its to report.
+        if (!one.group.empty() && !b.groups.empty() &&
+            std::find(b.groups.begin(), b.groups.end(), one.group) == b.groups.end())
+          continue;
+        int n = 0;
+        for (const auto& t : trials) n += (!t.practice && t.block == b.name) ? 1 : 0;
+        counts += (counts.empty() ? "" : ", ") + b.name + " " + std::to_string(n) + " (" + protocol::ToString(b.task) +
+                  ", " + protocol::ToString(b.counterbalance) + ")";
+      }
+      std::cout << "  " << counts << "\n" << one.shown;
     }
-    std::cout << "  " << counts << "\n" << shown;
   });
 }
 

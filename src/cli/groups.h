@@ -1,0 +1,50 @@
+#pragma once
+// Which between-subject groups `validate` and `preview` check: every group, so that no group's trials go unchecked,
+// or the one --group names.
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "protocol/protocol.h"
+
+namespace blurcue::cli {
+
+// The groups to check: every group of a protocol with groups (in the file's order), or only `group` when it is given;
+// {""} for a protocol without groups. Throws Error(kUsage) naming --group for a name the protocol does not have (with
+// the nearest name as did-you-mean) or for --group on a protocol without groups.
+inline std::vector<std::string> GroupsToCheck(const protocol::Protocol& p, const std::string& group) {
+  if (!p.groups) {
+    if (!group.empty())
+      throw Error(ErrorKind::kUsage, "--group " + group + ": " + p.file.string() + " has no groups");
+    return {""};
+  }
+  const std::vector<std::string>& names = p.groups->names;
+  if (group.empty()) return names;
+  if (std::find(names.begin(), names.end(), group) != names.end()) return {group};
+  // Did you mean: the name fewest single-character edits away.
+  auto distance = [](const std::string& a, const std::string& b) {
+    std::vector<size_t> row(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (size_t i = 1; i <= a.size(); ++i) {
+      size_t diagonal = row[0];
+      row[0] = i;
+      for (size_t j = 1; j <= b.size(); ++j) {
+        const size_t up = row[j];
+        row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+        diagonal = up;
+      }
+    }
+    return row[b.size()];
+  };
+  std::string nearest;
+  size_t best = std::string::npos;
+  for (const std::string& name : names)
+    if (const size_t d = distance(group, name); d < best) best = d, nearest = name;
+  std::string listed;
+  for (const std::string& name : names) listed += (listed.empty() ? "" : ", ") + name;
+  throw Error(ErrorKind::kUsage, "--group " + group + ": " + p.file.string() + " has no such group (did you mean " +
+                                     nearest + "? its groups: " + listed + ")");
+}
+
+}  // namespace blurcue::cli
