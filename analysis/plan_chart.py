@@ -3,9 +3,13 @@
 
   /usr/bin/python3 analysis/plan_chart.py --plan DIR/plan.csv --out DIR [--title STUDY] [--target 0.8]
 
-Writes DIR/power.png and DIR/power.svg: one line per condition's exact binomial test (thin) and the t-test across
-participants (the GLMM stand-in, thick), the target power as a dashed line, and each test's smallest N reaching it
-marked. Exit 3 when plan.csv is missing or not a plan.
+Writes DIR/power.png and DIR/power.svg: one line per condition's exact binomial test (thin), the t-tests across
+participants (the GLMM stand-in, per group where the protocol has groups, thick), the comparisons between groups
+(Welch) and between procedure cells (paired t on per-participant thresholds: the model's own difference solid, a
+declared one dashed), the target power as a dashed line, and each test's smallest N reaching it marked. A plan with
+procedure cells gets a second panel: the width of the 95 % interval of the mean threshold against N, per cell, with
+its truth and bias in the legend - or, where the true threshold is not determined, that said in words. Exit 3 when
+plan.csv is missing or not a plan.
 """
 import argparse
 import os
@@ -19,6 +23,9 @@ import pandas as pd  # noqa: E402
 import common  # noqa: E402
 
 COLUMNS = ["test", "condition", "measure", "participants", "power"]
+# Columns a plan with procedure cells adds (older plans lack them: no threshold panel then).
+THRESHOLD_COLUMNS = ["true_threshold", "mean_estimate", "bias", "sd_estimate", "interval_width"]
+COMPARISONS = {"paired_t": "paired t", "second_cell_t": "paired t, a second cell", "groups_t": "Welch t"}
 
 
 def smallest_n(g, target):
@@ -27,11 +34,16 @@ def smallest_n(g, target):
     return int(reached["participants"].iloc[0]) if len(reached) else None
 
 
-def chart(plan, out_dir, title, target):
-    tested = plan[plan["test"] != "none"].copy()
-    tested["power"] = pd.to_numeric(tested["power"], errors="coerce")
-    tested["participants"] = pd.to_numeric(tested["participants"], errors="coerce")
-    fig, ax = plt.subplots(figsize=(7.5, 4.2))
+def _numeric(frame, columns):
+    for c in columns:
+        if c in frame.columns:
+            frame[c] = pd.to_numeric(frame[c], errors="coerce")
+    return frame
+
+
+def power_panel(ax, plan, target):
+    tested = _numeric(plan[plan["test"] != "none"].copy(), ["power", "participants"])
+    tested = tested[tested["power"].notna()]
     binomial = tested[tested["test"] == "binomial"]
     conditions = list(dict.fromkeys(binomial["condition"]))
     cmap = plt.get_cmap("viridis")
@@ -40,24 +52,72 @@ def chart(plan, out_dir, title, target):
         n = smallest_n(g, target)
         ax.plot(g["participants"], g["power"], lw=1, color=cmap(i / max(1, len(conditions) - 1)),
                 label=f"binomial, {condition}" + (f" (N = {n})" if n else ""))
-    for measure, g in tested[tested["test"] == "participants_t"].groupby("measure"):
+    for (condition, measure), g in tested[tested["test"] == "participants_t"].groupby(["condition", "measure"],
+                                                                                      sort=False):
         g = g.sort_values("participants")
         n = smallest_n(g, target)
-        ax.plot(g["participants"], g["power"], lw=2.6, color="#D55E00",
-                label=f"t-test across participants ({measure}; GLMM stand-in)" + (f" (N = {n})" if n else ""))
+        who = "" if condition == "all" else f"{condition}, "
+        ax.plot(g["participants"], g["power"], lw=2.6, color="#D55E00", ls="-" if condition == "all" else ":",
+                label=f"t-test across participants ({who}{measure}; GLMM stand-in)" + (f" (N = {n})" if n else ""))
         if n:
             ax.plot([n], [g[g["participants"] == n]["power"].iloc[0]], "o", color="#D55E00", ms=6)
-    for condition, g in tested[tested["test"] == "slope_t"].groupby("condition"):
+    for condition, g in tested[tested["test"] == "slope_t"].groupby("condition", sort=False):
         g = g.sort_values("participants")
         n = smallest_n(g, target)
         ax.plot(g["participants"], g["power"], lw=2.6, color="#0072B2",
                 label=f"slope t-test, {condition} (depth matching)" + (f" (N = {n})" if n else ""))
+    colors = ["#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#0072B2"]
+    compared = tested[tested["test"].isin(list(COMPARISONS))]
+    for i, ((test, condition), g) in enumerate(compared.groupby(["test", "condition"], sort=False)):
+        g = g.sort_values("participants")
+        n = smallest_n(g, target)
+        ax.plot(g["participants"], g["power"], lw=2.2, color=colors[i % len(colors)],
+                ls="--" if "declared" in condition or test == "second_cell_t" else "-",
+                label=f"{COMPARISONS[test]}: {condition}" + (f" (N = {n})" if n else ""))
+        if n:
+            ax.plot([n], [g[g["participants"] == n]["power"].iloc[0]], "o", color=colors[i % len(colors)], ms=5)
     ax.axhline(target, color="#555555", ls="--", lw=1)
     ax.set_xlabel("participants (N)")
-    ax.set_ylabel("power (share of simulated studies with p < alpha)")
+    ax.set_ylabel("power\n(share of simulated studies with p < alpha)")
     ax.set_ylim(-0.02, 1.02)
-    ax.set_title(f"{title}: power against participants (dashed: {target:.0%})", loc="left")
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7.5, handlelength=1.5)
+    else:
+        ax.text(0.5, 0.5, "no test to plan here\n(for a procedure: give --difference)", ha="center", va="center",
+                transform=ax.transAxes, fontsize=9, color="#555555")
+
+
+def threshold_label(g):
+    """A cell's legend: its truth, mean estimate and bias - or, with no true threshold, that said in words."""
+    first = g.iloc[0]
+    cell = first["condition"]
+    if pd.isna(first["true_threshold"]):
+        return f"{cell}: mean estimate {first['mean_estimate']:.3g}, sd {first['sd_estimate']:.3g}; " \
+               "true threshold not determined (see the plan's summary)"
+    return f"{cell}: truth {first['true_threshold']:.3g}, mean {first['mean_estimate']:.3g} " \
+           f"(bias {first['bias']:+.3g}), sd {first['sd_estimate']:.3g}"
+
+
+def threshold_panel(ax, cells):
+    cells = _numeric(cells.copy(), ["participants"] + THRESHOLD_COLUMNS)
+    for condition, g in cells.groupby("condition", sort=False):
+        g = g.sort_values("participants")
+        ax.plot(g["participants"], g["interval_width"], lw=2, label=threshold_label(g))
+    ax.set_xlabel("participants (N)")
+    ax.set_ylabel("95 % interval width of the mean threshold\n(the procedure's units)")
+    ax.set_ylim(bottom=0)
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7.5, handlelength=1.5)
+
+
+def chart(plan, out_dir, title, target):
+    cells = plan[plan["test"] == "threshold"] if all(c in plan.columns for c in THRESHOLD_COLUMNS) else plan.iloc[0:0]
+    if len(cells):
+        fig, (ax, ax2) = plt.subplots(2, 1, figsize=(7.5, 7.6))
+        threshold_panel(ax2, cells)
+    else:
+        fig, ax = plt.subplots(figsize=(7.5, 4.2))
+    power_panel(ax, plan, target)
+    ax.set_title(f"{title}: power against participants (dashed: {target:.0%})", loc="left")
     return common.save(fig, out_dir, "power")
 
 

@@ -98,3 +98,12 @@ set_tests_properties(preview_one_group PROPERTIES FIXTURES_REQUIRED "scene;calib
   PASS_REGULAR_EXPRESSION "12 distinct stimuli of 12 trials \\(groups no_blur\\)" FAIL_REGULAR_EXPRESSION "group estimated")
 add_plan_failure_test(preview_unknown_group 2 "--group estimatd: ${G} has no such group (did you mean estimated?"
                       preview ${G} --group estimatd --out ${T}/preview-bad.png)
+
+# The chart's own tests (analysis/tests/test_plan_chart.py), with the analysis's Python (tests/analysis_tests.cmake,
+# included after this file, declares the same cache entry).
+set(BLURCUE_ANALYSIS_PYTHON /usr/bin/python3 CACHE FILEPATH "Python with pandas, scipy, matplotlib, statsmodels")
+add_test(NAME analysis.plan_chart
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_plan_chart.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(analysis.plan_chart PROPERTIES LABELS "analysis;plan" TIMEOUT 180
+                     ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
