@@ -15,6 +15,11 @@
 //                  slope b of log(accepted cut-off) on log(distance) - the report's power law c = e^a d^b - and a
 //                  one-sample t-test of the slopes against 0 across participants (the report's mixed model's slope
 //                  with a random intercept, in the same stand-in spirit).
+//   (a procedure cell - a crossing of a staircase's or QUEST+'s block - sets its own share correct, so it is not
+//   tested against chance; plan/comparisons.h plans what it measures instead: the threshold's bias, sd and interval
+//   width against the observer's true threshold (plan/threshold.h), and paired / Welch t-tests between cells and
+//   groups, for the model's own difference and a declared one.)
+// With between-subject groups, shares are tested per group and between groups (Welch), never pooled over them.
 // Deterministic: participant i of study s is "P<i+1>" with seed DeriveSeed(DeriveSeed(seed, s), i), whatever the
 // thread count, so the first n participants of a study of N are the study of n, and every simulated participant can
 // be rerun with `blurcue run --participant P<i+1> --seed <its seed> --observer <the same>`.
