@@ -282,6 +282,24 @@ assert float(welch[-1]["power"]) > float(welch[2]["power"]), [r["power"] for r i
 print(f"  groups' difference {diff:.3f}; Welch power at N = 3..6 {[r['power'][:5] for r in welch[2:]]}")
 PYEOF
   grep -q "groups are compared, not pooled" "$W/g.out" || fail "summary: $(cat "$W/g.out")"
-  echo "ok: groups are compared (per group and Welch between them), not pooled" ;;
+  # A procedure in two groups (each group its own copy of QUEST+'s block): the groups' thresholds compared by Welch,
+  # the same true threshold in both (the same cell), and a declared difference compared instead of a second cell.
+  variant "$P/quest-blur-difference.json" "$W/quest-groups.json" '
+p["groups"] = {"names": ["a", "b"], "assign": "balanced"}
+p["blocks"] = [dict(p["blocks"][0], name="quest-" + g, groups=[g]) for g in ("a", "b")]'
+  $BC plan "$W/quest-groups.json" --participants 8 --studies 100 --seed 9 --difference 0.5 --no-chart \
+    --out "$W/qg" > "$W/qg.out" 2>&1 || fail "plan quest groups: $(tail -2 "$W/qg.out")"
+  $PY - "$W/qg/plan.csv" <<'PYEOF' || fail "threshold group rows"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+truths = {r["condition"]: float(r["true_threshold"]) for r in rows if r["test"] == "threshold"}
+assert set(truths) == {"quest-a: edge=9", "quest-b: edge=9"} and abs(truths["quest-a: edge=9"] - truths["quest-b: edge=9"]) < 1e-9, truths
+own = [r for r in rows if r["test"] == "groups_t" and "model's own" in r["condition"]]
+declared = [r for r in rows if r["test"] == "groups_t" and "declared +0.5" in r["condition"]]
+assert len(own) == len(declared) == 8 and abs(float(own[0]["difference"])) < 1e-9, own[0]
+assert float(declared[0]["difference"]) == 0.5 and not [r for r in rows if r["test"] == "second_cell_t"], declared[0]
+assert float(declared[-1]["power"]) > float(own[-1]["power"]), (declared[-1]["power"], own[-1]["power"])
+PYEOF
+  echo "ok: groups are compared (per group and Welch between them), not pooled; a procedure's thresholds too" ;;
 *) fail "unknown case $CASE" ;;
 esac
