@@ -66,6 +66,10 @@ set_tests_properties(plan_leading_zero_is_decimal PROPERTIES FIXTURES_REQUIRED "
                      LABELS plan PASS_REGULAR_EXPRESSION "1 simulated studies of 10 participants \\(seed 5\\)")
 add_plan_failure_test(plan_bad_difference 2 "--difference: must be a non-zero number in the procedure's units (0.5) or a percentage of the true threshold (20%), got 'abc'"
                       plan ${T}/protocols/quest-blur-difference.json --difference abc --no-chart --out ${T}/plan-bad)
+add_test(NAME plan_difference_without_procedure
+         COMMAND ${BC} plan ${P1} --participants 2 --studies 1 --difference 0.5 --no-chart --out ${T}/plan-no-procedure)
+set_tests_properties(plan_difference_without_procedure PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
+                     LABELS plan PASS_REGULAR_EXPRESSION "note: --difference is not planned: it is a difference between thresholds")
 add_plan_failure_test(plan_zero_difference 2 "--difference: must be a non-zero number"
                       plan ${T}/protocols/quest-blur-difference.json --difference 0% --no-chart --out ${T}/plan-bad)
 

@@ -95,7 +95,12 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
   std::vector<const Condition*> cells;
   for (const Condition& c : r.conditions)
     if (c.measure == "threshold") cells.push_back(&c);
-  if (cells.empty()) return;
+  if (cells.empty()) {
+    if (o.difference)
+      r.notes.push_back("--difference is not planned: it is a difference between thresholds, and no block of this "
+                        "protocol has a procedure (staircase or QUEST+)");
+    return;
+  }
   std::map<std::string, Grid> est;
   std::map<std::string, Moments> overall;
   for (const Condition* c : cells) {
