@@ -78,7 +78,7 @@ void AddValidateCommand(CLI::App& app) {
       try {
         session::PreparedSession prepared =
             session::PrepareSession(args->file, args->participant, args->seed, args->display);
-        const session::Presentation& at = prepared.presentation;
+        const stimulus::Presentation& at = prepared.presentation;
         char line[400];
         std::snprintf(line, sizeof line,
                       "  shown: a %d x %d %s in a %d x %d window (%s) at %.4f screen px per photo px; %s: %.2f px per "

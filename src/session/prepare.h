@@ -13,7 +13,7 @@
 #include "display/profile.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
-#include "session/stimulus.h"
+#include "stimulus/stimulus.h"
 
 namespace blurcue::session {
 
@@ -24,11 +24,11 @@ struct PreparedSession {
   std::string group;                      // the between-subject group whose blocks the trials hold ("": none)
   std::vector<protocol::Trial> trials;
   std::optional<calib::SceneCalib> scene;
-  StimulusImages images;
-  std::vector<TrialScene> scenes;         // one per trial
+  stimulus::StimulusImages images;
+  std::vector<stimulus::TrialScene> scenes;         // one per trial
   display::Profile display;               // --display, else the protocol's display.profile, else the default
-  Presentation presentation;              // how a frame maps to the screen and the eye
-  std::set<double> real_photos_checked;   // the distances whose real photo has been decoded (CheckRealPhotos)
+  stimulus::Presentation presentation;              // how a frame maps to the screen and the eye
+  std::set<double> real_photos_checked;   // the distances whose real photo has been decoded (stimulus::CheckRealPhotos)
 };
 
 // Reads and validates the protocol, builds the participant's trial list, loads the calibration and every image

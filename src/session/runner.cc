@@ -28,12 +28,20 @@
 #include "session/answer.h"
 #include "session/observer.h"
 #include "session/prepare.h"
+#include "session/recording.h"
 #include "session/screens.h"
-#include "session/stimulus.h"
+#include "session/stimulus_renderer.h"
 #include "session/trial_logic.h"
+#include "stimulus/stimulus.h"
 #include "store/record.h"
 
 namespace blurcue::session {
+
+using stimulus::DescribeFrame;
+using stimulus::IntervalScene;
+using stimulus::IntervalShowsRight;
+using stimulus::TrialScene;
+
 namespace {
 
 using protocol::Task;

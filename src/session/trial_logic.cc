@@ -9,6 +9,11 @@
 
 namespace blurcue::session {
 
+using stimulus::ApplyLevel;
+using stimulus::PlanOnScreen;
+using stimulus::Presentation;
+using stimulus::TrialScene;
+
 using protocol::Task;
 
 double StimulusEndS(const protocol::Protocol& protocol, const TrialScene& scene) {
