@@ -2,14 +2,121 @@
 
 #include <cmath>
 #include <string>
+#include <string_view>
 #include <utility>
 
+#include "session/prepare.h"
 #include "store/export.h"
+#include "store/record.h"
 
 namespace blurcue::session {
 
 using stimulus::Presentation;
 using stimulus::TrialScene;
+
+namespace {
+
+static_assert(std::string_view(kChoiceNone) == store::kChoiceNone);
+static_assert(std::string_view(kChoiceSkipped) == store::kChoiceSkipped);
+
+// The trial list as saved: one record per trial, with its planned radii.
+std::vector<store::TrialRecord> TrialRecords(const PreparedSession& s) {
+  const protocol::Protocol& protocol = s.protocol;
+  std::vector<store::TrialRecord> records;
+  for (const protocol::Trial& trial : s.trials) {
+    store::TrialRecord r;
+    r.index = trial.index;
+    r.block = protocol::BlockIndex(protocol, trial);
+    const TrialScene& planned = s.scenes[size_t(trial.index)];
+    r.factors_json = TrialVariables(trial, planned, s.presentation).dump();
+    r.left_json = trial.left.dump();
+    r.right_json = trial.right.dump();
+    r.block_name = trial.block;
+    r.task = protocol::ToString(trial.task);
+    r.practice = trial.practice;
+    r.swapped = trial.swapped;
+    if (planned.content != "picture" && trial.task != protocol::Task::kAdjustment) {
+      r.r_left_px = planned.r_left_px;
+      if (!planned.left_only) r.r_right_px = planned.r_right_px;
+      r.r_scene_px = planned.r_scene_px;
+    }
+    records.push_back(std::move(r));
+  }
+  return records;
+}
+
+}  // namespace
+
+GroupsSoFar PeekGroups(const std::filesystem::path& db, const std::string& study, const std::string& participant) {
+  const store::GroupsSoFar g = store::PeekGroups(db, study, participant);
+  return {g.sessions, g.unfinished, g.unfinished_group, g.unfinished_info};
+}
+
+Recording::Recording(std::unique_ptr<store::Record> record) : record_(std::move(record)) {}
+Recording::~Recording() = default;
+Recording::Recording(Recording&&) noexcept = default;
+
+Recording Recording::Open(const std::filesystem::path& db) {
+  return Recording(std::make_unique<store::Record>(store::Record::Open(db)));
+}
+
+std::vector<int64_t> Recording::CompletedSessions(const std::string& study, const std::string& participant) {
+  return record_->CompletedSessions(study, participant);
+}
+
+SessionStart Recording::StartOrResumeSession(const std::string& study, const std::string& participant,
+                                             const std::string& protocol_text, uint64_t seed,
+                                             const SessionInfo& info, bool resume) {
+  store::SessionMeta meta;
+  meta.display = info.display;
+  meta.display_profile = info.display_profile;
+  meta.group = info.group;
+  meta.assign_group = info.assign_group;
+  meta.participant_info = info.participant_info;
+  meta.simulated = info.simulated;
+  meta.observer_params = info.observer_params;
+  meta.window = info.window;
+  const store::SessionStart s = record_->StartOrResumeSession(study, participant, protocol_text, seed, meta, resume);
+  return {s.session_id, s.first_unanswered_trial, s.trial_count, s.resumed, s.group};
+}
+
+void Recording::SaveTrialList(int64_t session, const PreparedSession& prepared) {
+  record_->SaveTrialList(session, TrialRecords(prepared));
+}
+
+void Recording::CheckTrialList(int64_t session, const PreparedSession& prepared) {
+  record_->CheckTrialList(session, TrialRecords(prepared));
+}
+
+void Recording::RecordResponse(int64_t session, int64_t trial_index, const Response& response,
+                               const std::vector<FrameRecord>& frames) {
+  store::Response r;
+  r.choice = response.choice;
+  r.rt_ms = response.rt_ms;
+  r.adjustment_json = response.adjustment_json;
+  r.shown_json = response.shown_json;
+  r.level = response.level;
+  r.r_left_px = response.r_left_px;
+  r.r_right_px = response.r_right_px;
+  r.correct = response.correct;
+  std::vector<store::FrameRecord> rows;
+  rows.reserve(frames.size());
+  for (const FrameRecord& f : frames)
+    rows.push_back({f.frame_index, f.flip_time_s, f.dropped, f.r_left_px, f.r_right_px, f.y_mm});
+  record_->RecordResponse(session, trial_index, r, rows);
+}
+
+void Recording::Heartbeat(int64_t session) { record_->Heartbeat(session); }
+
+void Recording::CompleteSession(int64_t session) { record_->FinishSession(session, store::SessionStatus::kCompleted); }
+
+int64_t Recording::FirstUnansweredTrial(int64_t session) { return record_->FirstUnansweredTrial(session); }
+
+std::map<int64_t, RecordedAnswer> Recording::AnsweredTrials(int64_t session) {
+  std::map<int64_t, RecordedAnswer> answers;
+  for (const auto& [index, a] : record_->AnsweredTrials(session)) answers[index] = {a.choice, a.shown_json};
+  return answers;
+}
 
 Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation) {
   // Every level under store::DesignColumn's name: one named like a column of trials.csv or a variable recorded
