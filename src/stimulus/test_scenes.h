@@ -1,6 +1,9 @@
 #pragma once
-// Test fixtures (tests only): the thesis's view built by hand, a ball protocol, a pair trial.
+// Test fixtures (tests only): the thesis's view built by hand, stand-ins for the files a protocol names, a ball
+// protocol, a pair trial.
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <utility>
 
 #include <opencv2/calib3d.hpp>
@@ -38,6 +41,17 @@ inline calib::SceneCalib ThesisScene() {
   section.ok = true;
   s.sections.push_back(section);
   return s;
+}
+
+// Files a protocol names must exist: stand-ins, never read (the calibration and the photo are given by hand).
+inline Json StandInScene() {
+  static const std::filesystem::path dir = [] {
+    const std::filesystem::path d = std::filesystem::temp_directory_path() / "blurcue-stand-in-scene";
+    std::filesystem::create_directories(d);
+    for (const char* name : {"scene.png", "calib.json"}) std::ofstream(d / name) << "";
+    return d;
+  }();
+  return {{"background", (dir / "scene.png").string()}, {"calib", (dir / "calib.json").string()}};
 }
 
 inline protocol::Protocol BallProtocol() {
