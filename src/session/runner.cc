@@ -230,7 +230,7 @@ RunResult RunSession(const RunOptions& options) {
                       KeyMap{chosen.protocol.responses, chosen.protocol.layout == "odd_one_out"},
                       window ? &keys : nullptr);
   Responder& responder = simulated ? static_cast<Responder&>(*simulated) : keys;
-  return RunTrials(options, chosen, presenter, responder, record, start);
+  return RunTrials({options.db, options.stop_after}, chosen, presenter, responder, record, start);
 }
 
 }  // namespace blurcue::session

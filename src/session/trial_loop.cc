@@ -34,7 +34,7 @@ enum class Outcome { kAnswered, kQuit };
 
 class Runner {
  public:
-  Runner(const RunOptions& options, const PreparedSession& prepared, Presenter& presenter, Responder& responder)
+  Runner(const LoopOptions& options, const PreparedSession& prepared, Presenter& presenter, Responder& responder)
       : options_(options), prepared_(prepared), protocol_(prepared.protocol), presenter_(presenter),
         responder_(responder), trials_(prepared.trials), scenes_(prepared.scenes),
         keys_{protocol_.responses, protocol_.layout == "odd_one_out"} {}
@@ -345,7 +345,7 @@ class Runner {
 
 
  private:
-  const RunOptions& options_;
+  const LoopOptions& options_;
   const PreparedSession& prepared_;
   const protocol::Protocol& protocol_;
   Presenter& presenter_;
@@ -358,7 +358,7 @@ class Runner {
 
 }  // namespace
 
-RunResult RunTrials(const RunOptions& options, const PreparedSession& prepared, Presenter& presenter,
+RunResult RunTrials(const LoopOptions& options, const PreparedSession& prepared, Presenter& presenter,
                     Responder& responder, Recording& recording, const SessionStart& start) {
   Runner runner(options, prepared, presenter, responder);
   return runner.Run(recording, start);
