@@ -23,7 +23,8 @@
 #include "session/answer.h"
 #include "session/observer.h"
 #include "session/prepare.h"
-#include "session/stimulus.h"
+#include "session/stimulus_renderer.h"
+#include "stimulus/stimulus.h"
 #include "session/visibility.h"
 
 namespace blurcue::cli {
@@ -77,7 +78,7 @@ void AddPreviewCommand(CLI::App& app) {
     const protocol::Protocol& p = prepared.protocol;
     const auto& scene = prepared.scene;
     struct Tile {
-      session::TrialScene scene;
+      stimulus::TrialScene scene;
       double level;
       std::string label, label2;  // levels; the sides and their radii
       Json key;                    // sorts the sheet by level
@@ -95,9 +96,9 @@ void AddPreviewCommand(CLI::App& app) {
       std::set<std::string> seen;  // labels or level keys already on the sheet
       session::AdaptiveState adaptive(p);  // no answers yet: each procedure's first level
       for (const auto& t : trials) {
-        const session::TrialScene& s_planned = prepared.scenes[size_t(t.index)];
+        const stimulus::TrialScene& s_planned = prepared.scenes[size_t(t.index)];
         if (t.task == protocol::Task::kAdjustment) {
-          const session::TrialScene& s = s_planned;
+          const stimulus::TrialScene& s = s_planned;
           // Every level once (at the first distance shown), and every distance once (at the middle level): the
           // two halves of the frame vary apart, so together these show every distinct half.
           const std::string parameter = p.blocks.front().adjust ? p.blocks.front().adjust->parameter : "level";
@@ -125,21 +126,21 @@ void AddPreviewCommand(CLI::App& app) {
         key["right"] = t.right;
         if (!seen.insert(key.dump()).second) continue;
         // A procedure's crossing is shown at its first trial's level, on that trial's test side.
-        session::TrialScene s = s_planned;
+        stimulus::TrialScene s = s_planned;
         std::string first;
         if (t.cell >= 0) {
           const double level = adaptive.Level(t);
           const protocol::Procedure& procedure = *protocol::BlockOf(p, t)->procedure;  // t.cell >= 0: it has one
-          session::ApplyLevel(procedure, t, level, prepared.presentation, &s);
+          stimulus::ApplyLevel(procedure, t, level, prepared.presentation, &s);
           first = " (" + protocol::ToString(procedure.kind) + ": " + procedure.variable + " " + Json(level).dump() +
                   " on the " + t.test_side + " at first)";
-          session::PlanOnScreen(p, *scene, prepared.presentation, &s);
+          stimulus::PlanOnScreen(p, *scene, prepared.presentation, &s);
         }
         const std::string levels = session::LevelsLabel(t);
         auto source = [](const Json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); };
         // Each side's radius as the camera made it (photo px) and as the screen shows it (screen px, arcmin): the
         // numbers the record keeps for these trials.
-        const session::Presentation& at = prepared.presentation;
+        const stimulus::Presentation& at = prepared.presentation;
         auto side = [&](const char* name, const Json& v, double r) {
           char text[160];
           std::snprintf(text, sizeof text, "%s %s %.2f px = %.2f scr px %.2f'", name, source(v).c_str(), r,
@@ -162,11 +163,11 @@ void AddPreviewCommand(CLI::App& app) {
           const bool odd = s.intervals > 2;
           Json first_key = key;
           first_key["interval"] = 1;
-          tiles.push_back({session::IntervalScene(s, false), 0, levels + first,
+          tiles.push_back({stimulus::IntervalScene(s, false), 0, levels + first,
                            side(odd ? "the others: L" : "1st interval: L", t.left, s.r_left_px), first_key});
           Json second = key;
           second["interval"] = 2;
-          tiles.push_back({session::IntervalScene(s, true), 0, levels + first,
+          tiles.push_back({stimulus::IntervalScene(s, true), 0, levels + first,
                            side(odd ? "the odd one: R" : "2nd interval: R", t.right, s.r_right_px), second});
         } else {
           tiles.push_back({s, 0, levels + first, side("L", t.left, s.r_left_px) + " | " + side("R", t.right, s.r_right_px),

@@ -91,7 +91,7 @@ void AddValidateCommand(CLI::App& app) {
         session::PreparedSession prepared = session::PrepareStudy(args->file, args->display);
         for (const std::string& group : GroupsToCheck(prepared.protocol, args->group)) {
           session::PrepareParticipant(&prepared, args->participant, args->seed, group);
-          const session::Presentation& at = prepared.presentation;
+          const stimulus::Presentation& at = prepared.presentation;
           char line[400];
           std::snprintf(line, sizeof line,
                         "  shown: a %d x %d %s in a %d x %d window (%s) at %.4f screen px per photo px; %s: %.2f px "

@@ -43,7 +43,7 @@ std::string LevelText(const Json& level) {
 
 // The condition of a main (not practice) trial and the measure its tests use; nullopt for what is not planned.
 std::optional<Condition> ConditionOf(const protocol::Protocol& protocol, const protocol::Trial& trial,
-                                     const session::TrialScene& scene, bool several_blocks) {
+                                     const stimulus::TrialScene& scene, bool several_blocks) {
   Condition c;
   c.block = protocol::BlockIndex(protocol, trial);
   c.levels = trial.levels.dump();
@@ -96,7 +96,7 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
       continue;
     }
     double level = 0;
-    const session::TrialScene scene = logic.SceneOf(trial, &level);
+    const stimulus::TrialScene scene = logic.SceneOf(trial, &level);
     const auto presses = session::ObserverPresses(observer, study.seed, protocol, trial, scene, study.presentation);
     const std::string choice = session::HeadlessAnswer(protocol, trial, scene, presses).first;
     const session::Scored scored = logic.Answer(trial, scene, level, choice);

@@ -34,8 +34,8 @@ std::string Text(double v) { return protocol::LevelText(v); }
 }  // namespace
 
 TrueThreshold ObserverThreshold(const session::ObserverParams& observer, const protocol::Procedure& procedure,
-                                const protocol::Trial& trial, const session::TrialScene& planned,
-                                const session::Presentation& presentation) {
+                                const protocol::Trial& trial, const stimulus::TrialScene& planned,
+                                const stimulus::Presentation& presentation) {
   TrueThreshold t;
   if (planned.intervals > 2) {
     t.why = "not worked out for an odd one out (the observer's closed form is for two sides)";
@@ -52,8 +52,8 @@ TrueThreshold ObserverThreshold(const session::ObserverParams& observer, const p
   const double target = TargetShare(procedure, lapse / 2);
   // The probability of a correct answer at a level, from the model's closed form on the pair the trial would show.
   auto share = [&](double level) {
-    session::TrialScene scene = planned;
-    session::ApplyLevel(procedure, trial, level, presentation, &scene);
+    stimulus::TrialScene scene = planned;
+    stimulus::ApplyLevel(procedure, trial, level, presentation, &scene);
     return (1 - lapse) * session::ProbabilityCorrect2afc(observer, session::ViewOf(scene, presentation)) + lapse / 2;
   };
   if (!(target < 1 - lapse / 2)) {

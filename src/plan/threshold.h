@@ -9,7 +9,7 @@
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
 #include "session/observer.h"
-#include "session/stimulus.h"
+#include "stimulus/stimulus.h"
 
 namespace blurcue::plan {
 
@@ -35,8 +35,8 @@ struct TrueThreshold {
 // the closed form does not cover (odd one out), an observer whose lapses keep it below the target share, or a level
 // outside what the procedure can show (a staircase's [min, max], QUEST+'s threshold grid).
 TrueThreshold ObserverThreshold(const session::ObserverParams& observer, const protocol::Procedure& procedure,
-                                const protocol::Trial& trial, const session::TrialScene& planned,
-                                const session::Presentation& presentation);
+                                const protocol::Trial& trial, const stimulus::TrialScene& planned,
+                                const stimulus::Presentation& presentation);
 
 // One participant's threshold estimate for one track, as the report takes it: QUEST+'s posterior mean after the last
 // answer; a staircase's mean of its last 6 reversal levels, or of its last 10 levels with fewer than 4 reversals

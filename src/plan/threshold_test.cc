@@ -46,8 +46,8 @@ TEST(TrackEstimate, TheReportsReversalRule) {
 struct PixelPair {
   session::ObserverParams observer = session::ParseObserver("sim:model=pixel,jnd=0.6,lapse=0");
   protocol::Trial trial;
-  session::TrialScene scene;
-  session::Presentation presentation;
+  stimulus::TrialScene scene;
+  stimulus::Presentation presentation;
   PixelPair() {
     trial.cell = 0, trial.test_side = "right";
     scene.r_left_px = scene.r_right_px = 2;

@@ -7,6 +7,9 @@
 
 namespace blurcue::session {
 
+using stimulus::Presentation;
+using stimulus::TrialScene;
+
 uint64_t TrialSeed(uint64_t seed, int index) { return DeriveSeed(seed, static_cast<uint64_t>(index)); }
 
 PairView ViewOf(const TrialScene& scene, const Presentation& presentation) {

@@ -8,7 +8,7 @@
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
 #include "session/observer.h"
-#include "session/stimulus.h"
+#include "stimulus/stimulus.h"
 
 namespace blurcue::session {
 
@@ -22,18 +22,18 @@ uint64_t TrialSeed(uint64_t session_seed, int trial_index);
 // criterion asks "which side is more blurred?"; other pairs "which fits the scene?" (with can't tell when the
 // protocol has its key). The presentation gives the arcmin per photo px the arcmin model sees.
 std::vector<KeyPress> AnswerTrial(SimulatedObserver& observer, const protocol::Protocol& protocol,
-                                  const protocol::Trial& trial, const TrialScene& scene,
-                                  const Presentation& presentation);
+                                  const protocol::Trial& trial, const stimulus::TrialScene& scene,
+                                  const stimulus::Presentation& presentation);
 
 // What the observer sees of an adjustment trial: the distance, and for a picture the real picture's blur (when the
 // protocol names its camera) and each level's blur in arcmin as this presentation shows them.
-AdjustView AdjustViewOf(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation);
+AdjustView AdjustViewOf(const protocol::Trial& trial, const stimulus::TrialScene& scene, const stimulus::Presentation& presentation);
 
 // Throws Error(kInput) naming /content/real_camera when `observer` cannot answer the protocol's trials: the arcmin
 // model in a depth-matching (adjustment) block without the real photos' camera. Run and plan check before any trial.
 void CheckObserverCanAnswer(const ObserverParams& observer, const protocol::Protocol& protocol);
 
 // What the observer sees of a trial's pair: its radii (photo px) and arcmin per photo px on this presentation.
-PairView ViewOf(const TrialScene& scene, const Presentation& presentation);
+PairView ViewOf(const stimulus::TrialScene& scene, const stimulus::Presentation& presentation);
 
 }  // namespace blurcue::session

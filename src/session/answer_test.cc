@@ -5,6 +5,9 @@
 #include <cmath>
 
 namespace blurcue::session {
+
+using stimulus::Presentation;
+using stimulus::TrialScene;
 namespace {
 
 double Phi(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }

@@ -7,6 +7,14 @@
 
 namespace blurcue::session {
 
+using stimulus::CheckRealPhotos;
+using stimulus::DescribeTrial;
+using stimulus::LoadProtocolScene;
+using stimulus::LoadStimulusImages;
+using stimulus::PlanOnScreen;
+using stimulus::Presentation;
+using stimulus::TrialScene;
+
 PreparedSession PrepareStudy(const std::filesystem::path& protocol_file, const std::filesystem::path& display_profile) {
   PreparedSession s;
   // Read once: the text recorded with the session is the text that was validated.

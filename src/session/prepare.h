@@ -14,7 +14,7 @@
 #include "display/profile.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
-#include "session/stimulus.h"
+#include "stimulus/stimulus.h"
 
 namespace blurcue::session {
 
@@ -25,11 +25,11 @@ struct PreparedSession {
   std::string group;                      // the between-subject group whose blocks the trials hold ("": none)
   std::vector<protocol::Trial> trials;
   std::optional<calib::SceneCalib> scene;
-  StimulusImages images;
-  std::vector<TrialScene> scenes;         // one per trial
+  stimulus::StimulusImages images;
+  std::vector<stimulus::TrialScene> scenes;         // one per trial
   display::Profile display;               // --display, else the protocol's display.profile, else the default
-  Presentation presentation;              // how a frame maps to the screen and the eye
-  std::set<double> real_photos_checked;   // the distances whose real photo has been decoded (CheckRealPhotos)
+  stimulus::Presentation presentation;              // how a frame maps to the screen and the eye
+  std::set<double> real_photos_checked;   // the distances whose real photo has been decoded (stimulus::CheckRealPhotos)
 };
 
 // Reads and validates the protocol, builds the participant's trial list, loads the calibration and every image
@@ -45,8 +45,8 @@ PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const
 // Scenes already worked out, by what a trial shows (SceneKey) and a procedure's level: the participants of one study
 // repeat the same trials in other orders, so `blurcue plan` describes and plans each once. One per thread.
 struct SceneCache {
-  std::map<std::string, TrialScene> planned;                    // DescribeTrial + PlanOnScreen, by SceneKey
-  std::map<std::pair<std::string, double>, TrialScene> leveled;  // a procedure trial at a level (SessionLogic::SceneOf)
+  std::map<std::string, stimulus::TrialScene> planned;                    // DescribeTrial + PlanOnScreen, by SceneKey
+  std::map<std::pair<std::string, double>, stimulus::TrialScene> leveled;  // a procedure trial at a level (SessionLogic::SceneOf)
 };
 
 // Every field of a trial that its scene depends on (all but its index and repetition, which DescribeTrial reads only

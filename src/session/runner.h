@@ -11,6 +11,8 @@
 #include <utility>
 #include <vector>
 
+#include "session/run_result.h"
+
 namespace blurcue::session {
 
 struct RunOptions {
@@ -29,18 +31,6 @@ struct RunOptions {
   // fields are asked for in the terminal when stdin is one, else refused; a resumed session keeps what it recorded.
   std::vector<std::pair<std::string, std::string>> info;
   int stop_after = -1;           // >= 0: leave the session (running, resumable) after this many new answers
-};
-
-struct RunResult {
-  int64_t session_id = 0;
-  uint64_t seed = 0;
-  int64_t trial_count = 0;
-  int64_t answered_before = 0;   // answers the session already had (resume)
-  int64_t answered_now = 0;
-  int64_t skipped_now = 0;       // trials recorded as skipped, not shown: by a procedure's stop rule ...
-  int64_t skipped_by_criterion_now = 0;  // ... or, these of them, as practice runs after the one that met its criterion
-  bool completed = false;        // false: quit, window closed or stop_after reached; resume with --resume
-  int64_t dropped_frames = 0;
 };
 
 // Throws Error: kInput for a bad protocol, a locked or mismatched session; kUsage for bad options.

@@ -5,9 +5,14 @@
 #include <limits>
 
 #include "core/error.h"
-#include "store/record.h"
+#include "session/recording.h"
 
 namespace blurcue::session {
+
+using stimulus::ApplyLevel;
+using stimulus::PlanOnScreen;
+using stimulus::Presentation;
+using stimulus::TrialScene;
 
 using protocol::Task;
 
@@ -124,9 +129,9 @@ std::pair<std::string, double> HeadlessAnswer(const protocol::Protocol& protocol
                                               const TrialScene& scene, const std::vector<KeyPress>& presses) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   if (trial.task != Task::kAdjustment) {
-    if (presses.empty()) return {store::kChoiceNone, nan};
+    if (presses.empty()) return {kChoiceNone, nan};
     const double t_ms = (StimulusEndS(protocol, scene) + presses.front().after_ms / 1000) * 1000;
-    if (protocol.timing.deadline_ms > 0 && t_ms >= protocol.timing.deadline_ms) return {store::kChoiceNone, nan};
+    if (protocol.timing.deadline_ms > 0 && t_ms >= protocol.timing.deadline_ms) return {kChoiceNone, nan};
     return {presses.front().action, t_ms};
   }
   // The adjustment's steps through the levels (cyclic), as the runner applies them, to the one accepted.
@@ -142,7 +147,7 @@ std::pair<std::string, double> HeadlessAnswer(const protocol::Protocol& protocol
       return {protocol::LevelText(trial.adjust_levels[size_t(level)]), t_ms};
     }
   }
-  return {store::kChoiceNone, nan};
+  return {kChoiceNone, nan};
 }
 
 }  // namespace blurcue::session

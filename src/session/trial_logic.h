@@ -18,17 +18,17 @@
 #include "session/answer.h"
 #include "session/observer.h"
 #include "session/prepare.h"
-#include "session/stimulus.h"
+#include "stimulus/stimulus.h"
 
 namespace blurcue::session {
 
 // When a trial's stimulus has run its course, in seconds after onset: the end of its motion, or of its last interval.
-double StimulusEndS(const protocol::Protocol& protocol, const TrialScene& scene);
+double StimulusEndS(const protocol::Protocol& protocol, const stimulus::TrialScene& scene);
 
 // Whether `choice` answered `trial` correctly, where a trial has a correct answer: a procedure's test side or an odd
 // one out's interval; for a practice pair, the side showing the larger radius (equal radii: can't tell). Empty
 // where nothing is correct (yes/no, rating, adjustment).
-std::optional<bool> CorrectOf(const protocol::Trial& trial, const TrialScene& scene, const std::string& choice);
+std::optional<bool> CorrectOf(const protocol::Trial& trial, const stimulus::TrialScene& scene, const std::string& choice);
 
 // Practice blocks run until a criterion: per block, per run of its design, the answers and the correct ones; a run
 // is over when all its trials are answered. A pure function of the answers, so a resumed session decides the same.
@@ -64,10 +64,10 @@ class SessionLogic {
   Json SkipReason(const protocol::Trial& trial);
   // The scene `trial` shows now: its planned scene, with a procedure's level from the answers so far applied and
   // planned on the screen (`*level`: that level, 0 for a trial without one).
-  TrialScene SceneOf(const protocol::Trial& trial, double* level);
+  stimulus::TrialScene SceneOf(const protocol::Trial& trial, double* level);
   // Scores `choice` (what the record stores: "left", "3", kChoiceNone, ...) to `trial` shown as `shown` at `level`,
   // and feeds it to the trial's procedure and practice run.
-  Scored Answer(const protocol::Trial& trial, const TrialScene& shown, double level, const std::string& choice);
+  Scored Answer(const protocol::Trial& trial, const stimulus::TrialScene& shown, double level, const std::string& choice);
 
  private:
   const PreparedSession& prepared_;
@@ -82,8 +82,8 @@ class SessionLogic {
 // answer's press counts from the end of the stimulus (StimulusEndS: a moving stimulus is watched to its end, intervals
 // too), an adjustment's first step from onset.
 std::vector<KeyPress> ObserverPresses(const ObserverParams& params, uint64_t seed, const protocol::Protocol& protocol,
-                                      const protocol::Trial& trial, const TrialScene& scene,
-                                      const Presentation& presentation);
+                                      const protocol::Trial& trial, const stimulus::TrialScene& scene,
+                                      const stimulus::Presentation& presentation);
 
 // An adjustment's level after a "next" or "previous" key (any other action leaves it): cyclic over `levels`.
 int StepLevel(int level, const std::string& action, int levels);
@@ -92,6 +92,6 @@ int StepLevel(int level, const std::string& action, int levels);
 // and its response time in ms from onset; kChoiceNone (response time NaN) when the answer comes at or after the
 // protocol's deadline.
 std::pair<std::string, double> HeadlessAnswer(const protocol::Protocol& protocol, const protocol::Trial& trial,
-                                              const TrialScene& scene, const std::vector<KeyPress>& presses);
+                                              const stimulus::TrialScene& scene, const std::vector<KeyPress>& presses);
 
 }  // namespace blurcue::session

@@ -11,6 +11,11 @@
 
 namespace blurcue::session {
 
+using stimulus::ApplyLevel;
+using stimulus::PlanOnScreen;
+using stimulus::Presentation;
+using stimulus::TrialScene;
+
 std::string LevelsLabel(const protocol::Trial& t) {
   std::string levels;
   for (const auto& [name, value] : t.levels.items())

@@ -1,6 +1,7 @@
 #pragma once
-// What a trial shows, worked out from the protocol, the trial and the calibrated scene before anything is drawn
-// (TrialScene: pure, no GL), and the frames that show it (StimulusRenderer: GL).
+// What a trial shows, worked out from the protocol, the trial and the calibrated scene before anything is drawn:
+// TrialScene, its objects per frame, the blur plan, and how a frame maps to the screen and the eye (Presentation).
+// Pure, no GL: session's StimulusRenderer draws exactly these, and the runner records them.
 //   grid    - two 5x5 grid cards lying on the table beside the board, left and right of it, aligned with an edge
 //             (test 1), each blurred by its side's source at its own depth;
 //   ball    - two balls rolling side by side along sections 3 and 5 of the board (tests 2 and 3): edge 1 -> 11 at
@@ -26,7 +27,7 @@
 #include "render/blur.h"
 #include "render/frame_compositor.h"
 
-namespace blurcue::session {
+namespace blurcue::stimulus {
 
 struct TrialScene {
   std::string content;                // "grid" | "ball" | "picture"
@@ -108,15 +109,6 @@ bool IntervalShowsRight(const protocol::Trial& trial, const TrialScene& scene, i
 void PlanOnScreen(const protocol::Protocol& protocol, const calib::SceneCalib& scene, const Presentation& presentation,
               TrialScene* trial);
 
-// The variables recorded with a trial beside its factor levels: practice, block_name, swapped, and for pairs each
-// radius in photo px, screen px and arcmin (r_left_px, r_left_screen_px, r_left_arcmin; the same for right and
-// scene) with the presentation's screen_px_per_photo_px and the blur plan (blur_plan: one_radius | per_pixel,
-// r_span_screen_px) and each object's size_left_deg / size_right_deg, or start_level and adjust_levels (adjustment;
-// a picture: picture_width_arcmin, and the real picture's r_scene_* when content.real_camera names its camera).
-// Each level is recorded under store::DesignColumn(name): factor_NAME for one named like any of those or like a
-// column of trials.csv (store::IsRecordedName), so nothing recorded takes a level's place.
-Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation);
-
 // The protocol's calibration (none for a picture without one). Throws Error(kInput) naming the protocol file and
 // /scene/calib when the file is not a calibration written by `blurcue calibrate`.
 std::optional<calib::SceneCalib> LoadProtocolScene(const protocol::Protocol& protocol);
@@ -188,55 +180,4 @@ StimulusImages LoadStimulusImages(const protocol::Protocol& protocol, const std:
 void CheckRealPhotos(const protocol::Protocol& protocol, const std::vector<TrialScene>& scenes,
                      std::set<double>* checked);
 
-class StimulusRenderer {
- public:
-  // Needs a current GL context. `scene` is the protocol's calibration (LoadProtocolScene), `images` its images
-  // (LoadStimulusImages), both copied; frames are composed as `presentation` says (the window's size).
-  StimulusRenderer(const protocol::Protocol& protocol, const std::optional<calib::SceneCalib>& scene,
-                   const StimulusImages& images, const Presentation& presentation);
-  ~StimulusRenderer();
-  StimulusRenderer(const StimulusRenderer&) = delete;
-  StimulusRenderer& operator=(const StimulusRenderer&) = delete;
-
-  // Size of the frames it makes (the photo's, or the depth-matching frame's).
-  cv::Size FrameSize() const;
-  // What a trial's frames need besides their own drawing, done before its first frame so that the frame loop reads
-  // no file and resamples no photo: the photo placed where the trial shows it (pairs), the real photo at the trial's
-  // distance read and scaled (picture). Cheap when nothing changed; Compose at t_s = 0 calls it too.
-  void Prepare(const TrialScene& trial);
-  // Composes the frame t_s after onset; `level` is the adjustment level shown (picture only).
-  void Compose(const TrialScene& trial, double t_s, double level);
-  // What the last composed frame showed of a pair (ObjectsAt, as drawn; radii in photo px): empty sides for
-  // pictures and wiped balls.
-  const std::array<std::optional<render::BlurredObject>, 2>& Shown() const { return shown_; }
-  // Where the last composed frame showed the photo (pairs; the identity of the frame for a picture).
-  render::FrameView View() const;
-  // Shows the last composed frame in the current window, fitted to width x height.
-  void Present(int width_px, int height_px);
-  // Waits until the last composed frame is drawn (for timing).
-  void Finish();
-  // The last composed frame, 8-bit sRGB BGR.
-  cv::Mat Read();
-
- private:
-  const protocol::Protocol& protocol_;
-  std::optional<calib::SceneCalib> scene_;
-  Presentation presentation_;
-  cv::Mat photo_;
-  render::SurfaceTexture texture_;
-  std::vector<render::BlurredObject> objects_;  // the frame's objects for the compositor, kept between frames  // the objects' texture: one GL texture for the session
-  std::unique_ptr<render::FrameCompositor> compositor_;
-  // Picture: the upper half at a cut-off, made once (the Butterworth runs on the CPU) and kept; every level of
-  // the protocol is made up front.
-  const cv::Mat& UpperHalf(double level);
-  cv::Mat picture_;
-  std::vector<std::pair<double, cv::Mat>> upper_cache_;  // cut-off -> upper half
-  cv::Mat picture_frame_;
-  std::unique_ptr<render::WindowImage> picture_shown_;  // picture_frame_ on the GPU, updated in place
-  bool picture_stale_ = true;                          // picture_frame_ changed since it was last uploaded
-  double lower_distance_m_ = -1;  // the distance whose real photo lower_ shows (one at a time: 27 would hold ~50 MB)
-  cv::Mat lower_;                 // the frame's lower half, scaled once per trial
-  std::array<std::optional<render::BlurredObject>, 2> shown_;
-};
-
-}  // namespace blurcue::session
+}  // namespace blurcue::stimulus

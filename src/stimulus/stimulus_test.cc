@@ -1,5 +1,5 @@
 // What a trial shows, worked out without GL: placement, motion and radii per side.
-#include "session/stimulus.h"
+#include "stimulus/stimulus.h"
 
 #include "render/frame_compositor.h"
 
@@ -10,54 +10,14 @@
 #include <opencv2/calib3d.hpp>
 
 #include "core/error.h"
-#include "store/export.h"
+#include "stimulus/test_scenes.h"
 
-namespace blurcue::session {
+namespace blurcue::stimulus {
 namespace {
 
-// The thesis's view built by hand (camera pitched down 38 deg, 440 mm from the board's centre), a lens focused
-// at 342.3 mm with the nominal aperture, and one measured section at edge 1 reading 0.3 px.
-calib::SceneCalib ThesisScene() {
-  calib::SceneCalib s;
-  s.camera = ThesisCamera().Resized(1148, 764);
-  const double a = 38 * M_PI / 180, sn = std::sin(a), c = std::cos(a);
-  const cv::Matx33d r(1, 0, 0, 0, -sn, -c, 0, c, -sn);
-  const cv::Vec3d forward(0, c, -sn), target(87.5, 125, 0);
-  const cv::Vec3d centre = target - 440.0 * forward;
-  cv::Rodrigues(r, s.rvec);
-  s.tvec = -(r * centre);
-  s.reference_edge = 1;
-  s.reference_u_mm = s.ToCamera({87.5, 0, 0})[2];
-  s.reference_r_px = 0.0;
-  s.model.focus_mm = s.reference_u_mm;
-  s.model.aperture_mm = 21 / 5.6;
-  s.model.kind = "thin_lens";
-  calib::SceneCalib::Section section;
-  section.edge = 1;
-  section.section = 4;
-  section.midpoint_camera_mm = s.ToCamera({87.5, 0, 0});
-  section.r_px = 0.3;
-  section.ok = true;
-  s.sections.push_back(section);
-  return s;
-}
-
-protocol::Protocol BallProtocol() {
-  protocol::Protocol p;
-  p.file = "balls.json";
-  p.content.type = "ball";
-  p.content.radius_mm = 10;
-  return p;
-}
-
-protocol::Trial PairTrial(Json levels, Json left, Json right) {
-  protocol::Trial t;
-  t.block = "task2";
-  t.levels = std::move(levels);
-  t.left = std::move(left);
-  t.right = std::move(right);
-  return t;
-}
+using fixtures::BallProtocol;
+using fixtures::PairTrial;
+using fixtures::ThesisScene;
 
 TEST(DescribeTrial, SectionRunGoesEdgeToEdgeAtThePatternSpeedAndIsWiped) {
   const calib::SceneCalib scene = ThesisScene();
@@ -212,58 +172,8 @@ TEST(DescribeTrial, GridCardsSitBesideTheBoardAtTheirEdge) {
   shown.frame_width_px = 4592, shown.frame_height_px = 3056, shown.window_width_px = 1920, shown.window_height_px = 1080;
   shown.scale = render::FitScale(4592, 3056, 1920, 1080);
   EXPECT_DOUBLE_EQ(shown.scale, 1622.0 / 4592.0);
-  const Json v = TrialVariables(PairTrial({{"edge", 2}}, "measured", "fitted"), far, shown);
-  for (const char* key : {"edge", "practice", "block_name", "swapped", "r_left_px", "r_right_px", "r_scene_px",
-                          "r_left_screen_px", "r_right_arcmin", "r_scene_arcmin", "screen_px_per_photo_px"})
-    EXPECT_TRUE(v.contains(key)) << key;
-  const double r = far.r_right_px;
-  EXPECT_NEAR(v["r_right_screen_px"].get<double>(), r * 1622.0 / 4592.0, 1e-4);
-  const double pitch_mm = 531.4 / 1920, deg = 180 / 3.14159265358979323846;
-  EXPECT_NEAR(v["r_right_arcmin"].get<double>(), 2 * std::atan(0.5 * r * 1622.0 / 4592.0 * pitch_mm / 600) * deg * 60,
-              1e-4);
-}
-
-// A level named like something the record or trials.csv holds of its own (a conditions table's r_left_px, status or
-// participant; a staircase block's level, test_side or correct) is recorded as factor_NAME with its own value, and
-// the variable recorded under that name is the one the trial showed: neither overwrites the other. Every name
-// recorded beside the levels is one store::IsRecordedName reserves, so no future variable can take a level's place.
-TEST(TrialVariables, LevelsNamedLikeRecordedVariablesKeepTheirValuesUnderFactorNames) {
-  const calib::SceneCalib scene = ThesisScene();
-  protocol::Protocol p = BallProtocol();
-  p.content.type = "grid";
-  const Json row = {{"edge", 2}, {"status", "x"}, {"participant", "P8"}, {"r_left_px", 7.5}, {"info_age", 40},
-                    {"level", 99}, {"test_side", "left"}, {"correct", 1}, {"label", "near"}};
-  protocol::Trial trial = PairTrial({{"row", row}, {"group", "g"}}, "fitted", "fitted");
-  trial.cell = 0;  // a procedure's trial: level, test_side and the procedure cell are recorded
-  trial.test_side = "right";
-  TrialScene t = DescribeTrial(p, trial, &scene);
-  t.level = 0.4;
-  Presentation shown;
-  shown.scale = 0.5;
-  const Json v = TrialVariables(trial, t, shown);
-  EXPECT_EQ(v["factor_status"], "x");
-  EXPECT_EQ(v["factor_participant"], "P8");
-  EXPECT_EQ(v["factor_r_left_px"], 7.5);
-  EXPECT_EQ(v["factor_info_age"], 40);
-  EXPECT_EQ(v["factor_level"], 99);
-  EXPECT_EQ(v["factor_test_side"], "left");
-  EXPECT_EQ(v["factor_correct"], 1);
-  EXPECT_EQ(v["factor_group"], "g");
-  EXPECT_EQ(v["edge"], 2);
-  EXPECT_EQ(v["label"], "near");
-  EXPECT_NEAR(v["r_left_px"].get<double>(), t.r_left_px, 1e-4);  // the radius shown, not the table's 7.5
-  EXPECT_NE(v["r_left_px"], 7.5);
-  EXPECT_EQ(v["level"], 0.4);
-  EXPECT_EQ(v["test_side"], "right");
-  for (const auto& [key, value] : v.items())
-    if (!row.contains(key) && key != "group" && key.rfind("factor_", 0) != 0) {
-      EXPECT_TRUE(store::IsRecordedName(key)) << key << " is recorded but not reserved for it";
-    }
-  for (const char* name : {"status", "participant", "r_left_px", "level", "test_side", "correct", "practice",
-                           "swapped", "block_name", "info_age", "group", "round", "odd_interval"})
-    EXPECT_TRUE(store::IsRecordedName(name)) << name;
-  for (const char* name : {"edge", "label", "speed_cm_s", "right_x_mm", "factor_status"})
-    EXPECT_FALSE(store::IsRecordedName(name)) << name;
+  // What is recorded of it in photo px, screen px and arcmin: session's TrialVariables
+  // (TrialVariables.GridTrialRecordsEachRadiusInPhotoPxScreenPxAndArcmin).
 }
 
 TEST(PlanOnScreen, PerPixelExactlyWhenTheObjectsDepthSpanReachesTheThresholdOnScreen) {
@@ -303,7 +213,7 @@ TEST(PlanOnScreen, PerPixelExactlyWhenTheObjectsDepthSpanReachesTheThresholdOnSc
   p.content.depth_blur_threshold = display::ArcminOfScreenPx(shown.profile, span) * 0.99;
   PlanOnScreen(p, scene, shown, &t);
   EXPECT_TRUE(t.per_pixel);
-  EXPECT_EQ(TrialVariables(PairTrial({{"edge", 2}}, "fitted", "fitted"), t, shown)["blur_plan"], "per_pixel");
+  // Recorded as blur_plan per_pixel: TrialVariables.RecordsThePerPixelBlurPlan (session).
   // A procedure's gain on a side scales its radius at every depth, and so its span.
   t.left_gain = 3;
   PlanOnScreen(p, scene, shown, &t);
@@ -388,4 +298,4 @@ TEST(DescribeTrial, MissingLevelOrCalibrationIsAnInputErrorNamingTheField) {
 }
 
 }  // namespace
-}  // namespace blurcue::session
+}  // namespace blurcue::stimulus

@@ -1,0 +1,194 @@
+#include "session/recording.h"
+
+#include <cmath>
+#include <string>
+#include <string_view>
+#include <utility>
+
+#include "session/prepare.h"
+#include "store/export.h"
+#include "store/record.h"
+
+namespace blurcue::session {
+
+using stimulus::Presentation;
+using stimulus::TrialScene;
+
+namespace {
+
+static_assert(std::string_view(kChoiceNone) == store::kChoiceNone);
+static_assert(std::string_view(kChoiceSkipped) == store::kChoiceSkipped);
+
+// The trial list as saved: one record per trial, with its planned radii.
+std::vector<store::TrialRecord> TrialRecords(const PreparedSession& s) {
+  const protocol::Protocol& protocol = s.protocol;
+  std::vector<store::TrialRecord> records;
+  for (const protocol::Trial& trial : s.trials) {
+    store::TrialRecord r;
+    r.index = trial.index;
+    r.block = protocol::BlockIndex(protocol, trial);
+    const TrialScene& planned = s.scenes[size_t(trial.index)];
+    r.factors_json = TrialVariables(trial, planned, s.presentation).dump();
+    r.left_json = trial.left.dump();
+    r.right_json = trial.right.dump();
+    r.block_name = trial.block;
+    r.task = protocol::ToString(trial.task);
+    r.practice = trial.practice;
+    r.swapped = trial.swapped;
+    if (planned.content != "picture" && trial.task != protocol::Task::kAdjustment) {
+      r.r_left_px = planned.r_left_px;
+      if (!planned.left_only) r.r_right_px = planned.r_right_px;
+      r.r_scene_px = planned.r_scene_px;
+    }
+    records.push_back(std::move(r));
+  }
+  return records;
+}
+
+}  // namespace
+
+GroupsSoFar PeekGroups(const std::filesystem::path& db, const std::string& study, const std::string& participant) {
+  const store::GroupsSoFar g = store::PeekGroups(db, study, participant);
+  return {g.sessions, g.unfinished, g.unfinished_group, g.unfinished_info};
+}
+
+Recording::Recording(std::unique_ptr<store::Record> record) : record_(std::move(record)) {}
+Recording::~Recording() = default;
+Recording::Recording(Recording&&) noexcept = default;
+
+Recording Recording::Open(const std::filesystem::path& db) {
+  return Recording(std::make_unique<store::Record>(store::Record::Open(db)));
+}
+
+std::vector<int64_t> Recording::CompletedSessions(const std::string& study, const std::string& participant) {
+  return record_->CompletedSessions(study, participant);
+}
+
+SessionStart Recording::StartOrResumeSession(const std::string& study, const std::string& participant,
+                                             const std::string& protocol_text, uint64_t seed,
+                                             const SessionInfo& info, bool resume) {
+  store::SessionMeta meta;
+  meta.display = info.display;
+  meta.display_profile = info.display_profile;
+  meta.group = info.group;
+  meta.assign_group = info.assign_group;
+  meta.participant_info = info.participant_info;
+  meta.simulated = info.simulated;
+  meta.observer_params = info.observer_params;
+  meta.window = info.window;
+  const store::SessionStart s = record_->StartOrResumeSession(study, participant, protocol_text, seed, meta, resume);
+  return {s.session_id, s.first_unanswered_trial, s.trial_count, s.resumed, s.group};
+}
+
+void Recording::SaveTrialList(int64_t session, const PreparedSession& prepared) {
+  record_->SaveTrialList(session, TrialRecords(prepared));
+}
+
+void Recording::CheckTrialList(int64_t session, const PreparedSession& prepared) {
+  record_->CheckTrialList(session, TrialRecords(prepared));
+}
+
+void Recording::RecordResponse(int64_t session, int64_t trial_index, const Response& response,
+                               const std::vector<FrameRecord>& frames) {
+  store::Response r;
+  r.choice = response.choice;
+  r.rt_ms = response.rt_ms;
+  r.adjustment_json = response.adjustment_json;
+  r.shown_json = response.shown_json;
+  r.level = response.level;
+  r.r_left_px = response.r_left_px;
+  r.r_right_px = response.r_right_px;
+  r.correct = response.correct;
+  std::vector<store::FrameRecord> rows;
+  rows.reserve(frames.size());
+  for (const FrameRecord& f : frames)
+    rows.push_back({f.frame_index, f.flip_time_s, f.dropped, f.r_left_px, f.r_right_px, f.y_mm});
+  record_->RecordResponse(session, trial_index, r, rows);
+}
+
+void Recording::Heartbeat(int64_t session) { record_->Heartbeat(session); }
+
+void Recording::CompleteSession(int64_t session) { record_->FinishSession(session, store::SessionStatus::kCompleted); }
+
+int64_t Recording::FirstUnansweredTrial(int64_t session) { return record_->FirstUnansweredTrial(session); }
+
+std::map<int64_t, RecordedAnswer> Recording::AnsweredTrials(int64_t session) {
+  std::map<int64_t, RecordedAnswer> answers;
+  for (const auto& [index, a] : record_->AnsweredTrials(session)) answers[index] = {a.choice, a.shown_json};
+  return answers;
+}
+
+Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation) {
+  // Every level under store::DesignColumn's name: one named like a column of trials.csv or a variable recorded
+  // below (status, r_left_px, level, correct, ...) as factor_NAME, so what is recorded never overwrites a level.
+  Json v = Json::object();
+  if (trial.levels.is_object())
+    for (const auto& [name, level] : trial.levels.items()) v[store::DesignColumn(name)] = level;
+  // A level object's values get columns of their own (a pattern's speed_cm_s, a conditions table's edge); the sides
+  // are recorded as such. A conditions table's row object itself is no factor of the design: only its columns stay.
+  for (const auto& [name, level] : trial.levels.items())
+    if (level.is_object())
+      for (const auto& [key, value] : level.items())
+        if (key != "left" && key != "right" && key != "object" && !v.contains(store::DesignColumn(key)))
+          v[store::DesignColumn(key)] = value;
+  if (v.contains("row") && v["row"].is_object()) v.erase("row");
+  v["practice"] = trial.practice ? 1 : 0;
+  v["block_name"] = trial.block;
+  v["swapped"] = trial.swapped ? 1 : 0;
+  if (trial.round >= 0) v["round"] = trial.round + 1;  // a practice block run until a criterion: which run
+  if (trial.cell >= 0) {  // a procedure's trial: which of its block's procedures, the test side, the level shown
+    v["procedure_cell"] = trial.cell;
+    v["test_side"] = trial.test_side;
+    if (!std::isnan(scene.level)) v["level"] = scene.level;
+  }
+  // Odd one out: the interval that showed the right side's object (the correct answer), and how many there were.
+  if (scene.intervals > 2 && trial.task == protocol::Task::kForcedChoice) {
+    v["odd_interval"] = std::stoi(trial.test_side);
+    v["intervals"] = scene.intervals;
+  }
+  // Rounded to 1e-4 px: the record is read by people and charts, not fed back.
+  auto round4 = [](double x) { return std::round(x * 1e4) / 1e4; };
+  if (trial.task == protocol::Task::kAdjustment) {
+    if (trial.start_index >= 0 && size_t(trial.start_index) < trial.adjust_levels.size())
+      v["start_level"] = trial.adjust_levels[size_t(trial.start_index)];
+    // The levels in the order "next" steps through them (cyclic): what the participant could reach, as shown.
+    std::string levels;
+    for (double level : trial.adjust_levels) levels += (levels.empty() ? "" : ";") + protocol::LevelText(level);
+    v["adjust_levels"] = levels;
+  }
+  if (scene.content == "picture") {
+    // The virtual picture's width as shown (a level c's blur is r = 2 x 0.1874 x this / c arcmin), and the real
+    // picture's blur when its camera is known: in its camera's px, on the screen and on the eye.
+    v["picture_width_arcmin"] = round4(presentation.Arcmin(presentation.layout.picture.width));
+    if (presentation.real_frame_px_per_px > 0) {
+      v["r_scene_px"] = round4(scene.r_scene_px);
+      v["r_scene_screen_px"] = round4(presentation.ScreenPx(scene.r_scene_px * presentation.real_frame_px_per_px));
+      v["r_scene_arcmin"] = round4(presentation.RealArcmin(scene.r_scene_px));
+    }
+  } else if (trial.task != protocol::Task::kAdjustment) {
+    // Each radius as the camera made it (photo px), as the window shows it (screen px) and as the eye gets it.
+    // The single layout shows only its object, recorded as the left side.
+    for (const auto& [name, r] : {std::pair<const char*, double>{"left", scene.r_left_px},
+                                  {"right", scene.r_right_px}, {"scene", scene.r_scene_px}}) {
+      if (scene.left_only && name == std::string("right")) continue;
+      v[std::string("r_") + name + "_px"] = round4(r);
+      v[std::string("r_") + name + "_screen_px"] = round4(presentation.ScreenPx(r));
+      v[std::string("r_") + name + "_arcmin"] = round4(presentation.Arcmin(r));
+    }
+    v["screen_px_per_photo_px"] = std::round(presentation.scale * 1e6) / 1e6;
+    v["kernel"] = scene.kernel;
+    v["blur_plan"] = scene.per_pixel ? "per_pixel" : "one_radius";
+    v["r_span_screen_px"] = round4(scene.r_span_screen_px);
+    v["size_left_deg"] = round4(scene.size_left_deg);
+    if (!scene.left_only) v["size_right_deg"] = round4(scene.size_right_deg);
+    v["brightness"] = scene.brightness;
+    v["contrast"] = scene.contrast;
+    v["white_balance_r"] = scene.white_balance[0];
+    v["white_balance_g"] = scene.white_balance[1];
+    v["white_balance_b"] = scene.white_balance[2];
+  }
+  return v;
+}
+
+
+}  // namespace blurcue::session

@@ -1,0 +1,131 @@
+#pragma once
+// The session's one door to the record (store): what a session records, in session terms. Nothing else in session/
+// includes a store header; recording.cc turns these into the record's rows.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/json_io.h"
+#include "protocol/trials.h"
+#include "stimulus/stimulus.h"
+
+namespace blurcue::store {
+class Record;
+}
+
+namespace blurcue::session {
+
+struct PreparedSession;
+
+// The choices recorded besides the answers themselves: no answer before the deadline, and a trial not shown (a
+// procedure ended by its stop rule, a practice run after the one that met its criterion). The record's own words
+// (store::kChoiceNone, store::kChoiceSkipped; recording.cc checks they agree).
+inline constexpr const char* kChoiceNone = "none";
+inline constexpr const char* kChoiceSkipped = "skipped";
+
+// One trial's answer as recorded (store::Response): the choice ("left" | "right" | "cant_tell" | an interval or
+// rating "1".."n" | yes | no | an adjustment level | kChoiceNone | kChoiceSkipped), its response time (NaN: none),
+// the adjustment's steps, and what a procedure's trial showed as decided then (shown_json, level, radii, correct).
+struct Response {
+  std::string choice;
+  double rt_ms = 0;
+  std::string adjustment_json = "[]";
+  std::string shown_json = "{}";
+  std::optional<double> level, r_left_px, r_right_px;
+  std::optional<bool> correct;
+};
+
+// One flip of a trial (store::FrameRecord): its time from onset, whether a frame was dropped before it, and what it
+// showed of a pair (each side's radius in photo px, the objects' y on the board in mm; empty: not shown).
+struct FrameRecord {
+  int64_t frame_index = 0;
+  double flip_time_s = 0;
+  bool dropped = false;
+  std::optional<double> r_left_px, r_right_px, y_mm;
+};
+
+// The station a session runs on, as the record states it (store::SessionMeta).
+struct SessionInfo {
+  std::string display;                  // "window 1280x720@60; llvmpipe ..." - what shows the frames
+  std::string display_profile = "{}";   // the display profile as JSON
+  std::string group;                    // the between-subject group ("" without groups)
+  // Set: a new session's group is decided by this in the transaction that starts it (balanced assignment).
+  std::function<std::string(const std::map<std::string, int64_t>&)> assign_group;
+  std::string participant_info = "{}";
+  bool simulated = false;               // answered by the simulated observer (observer_params), else a person
+  std::string observer_params;
+  bool window = true;                   // in a window on the real clock, else headless on a simulated one
+};
+
+// A started or resumed session (store::SessionStart).
+struct SessionStart {
+  int64_t session_id = 0;
+  int64_t first_unanswered_trial = 0;  // = trial_count when all are answered
+  int64_t trial_count = 0;             // 0: a new session without its trial list yet
+  bool resumed = false;
+  std::string group;                   // the group the record gave
+};
+
+// A recorded answer, as a resumed session replays it.
+struct RecordedAnswer {
+  std::string choice;
+  std::string shown_json;
+};
+
+// What a record already says of a study's groups and a participant's unfinished session (store::GroupsSoFar), read
+// without writing; a missing file says nothing.
+struct GroupsSoFar {
+  std::map<std::string, int64_t> sessions;
+  bool unfinished = false;
+  std::string unfinished_group, unfinished_info = "{}";
+};
+GroupsSoFar PeekGroups(const std::filesystem::path& db, const std::string& study, const std::string& participant);
+
+// A session's record: one transaction per answer, resume at the first unanswered trial, one writer per session.
+// Each call is the store::Record call of the same name (its errors too).
+class Recording {
+ public:
+  // Opens (creating) the record at `db`; ":memory:" for one that lives as long as this object.
+  static Recording Open(const std::filesystem::path& db);
+  ~Recording();
+  Recording(Recording&&) noexcept;
+  Recording& operator=(Recording&&) = delete;
+
+  std::vector<int64_t> CompletedSessions(const std::string& study, const std::string& participant);
+  SessionStart StartOrResumeSession(const std::string& study, const std::string& participant,
+                                    const std::string& protocol_text, uint64_t seed, const SessionInfo& info,
+                                    bool resume);
+  // A new session saves the prepared trial list (one row per trial with its planned radii and variables); a resumed
+  // one checks that the list it saved is this one.
+  void SaveTrialList(int64_t session, const PreparedSession& prepared);
+  void CheckTrialList(int64_t session, const PreparedSession& prepared);
+  // Commits one answer with its trial's frames, before anything else happens.
+  void RecordResponse(int64_t session, int64_t trial_index, const Response& response,
+                      const std::vector<FrameRecord>& frames = {});
+  void Heartbeat(int64_t session);
+  // Marks the session completed and releases its lock.
+  void CompleteSession(int64_t session);
+  int64_t FirstUnansweredTrial(int64_t session);
+  std::map<int64_t, RecordedAnswer> AnsweredTrials(int64_t session);
+
+ private:
+  explicit Recording(std::unique_ptr<store::Record> record);
+  std::unique_ptr<store::Record> record_;
+};
+
+// The variables recorded with a trial beside its factor levels: practice, block_name, swapped, and for pairs each
+// radius in photo px, screen px and arcmin (r_left_px, r_left_screen_px, r_left_arcmin; the same for right and
+// scene) with the presentation's screen_px_per_photo_px and the blur plan (blur_plan: one_radius | per_pixel,
+// r_span_screen_px) and each object's size_left_deg / size_right_deg, or start_level and adjust_levels (adjustment;
+// a picture: picture_width_arcmin, and the real picture's r_scene_* when content.real_camera names its camera).
+// Each level is recorded under store::DesignColumn(name): factor_NAME for one named like any of those or like a
+// column of trials.csv (store::IsRecordedName), so nothing recorded takes a level's place.
+Json TrialVariables(const protocol::Trial& trial, const stimulus::TrialScene& scene,
+                    const stimulus::Presentation& presentation);
+
+}  // namespace blurcue::session

@@ -1,0 +1,105 @@
+#include "session/recording.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "render/frame_compositor.h"
+#include "stimulus/test_scenes.h"
+#include "store/export.h"
+
+namespace blurcue::session {
+namespace {
+
+using stimulus::DescribeTrial;
+using stimulus::Presentation;
+using stimulus::TrialScene;
+using stimulus::fixtures::BallProtocol;
+using stimulus::fixtures::PairTrial;
+using stimulus::fixtures::ThesisScene;
+
+// Edge 11's grid cards (stimulus's DescribeTrial.GridCardsSitBesideTheBoardAtTheirEdge) fitted into a 1920 x 1080
+// window: each radius recorded as the camera made it, as the window shows it and as the eye gets it.
+TEST(TrialVariables, GridTrialRecordsEachRadiusInPhotoPxScreenPxAndArcmin) {
+  const calib::SceneCalib scene = ThesisScene();
+  protocol::Protocol p = BallProtocol();
+  p.content.type = "grid";
+  const TrialScene far = DescribeTrial(p, PairTrial({{"edge", 11}}, "estimated", "fitted"), &scene);
+  // A 4592 x 3056 photo fitted into a 1920 x 1080 window: 1080 / 3056 of a photo px per screen px, floored to
+  // whole shown pixels (1622 of 1622.8); on the default monitor (37.84 px per degree) that is the arcmin.
+  Presentation shown;
+  shown.frame_width_px = 4592, shown.frame_height_px = 3056, shown.window_width_px = 1920, shown.window_height_px = 1080;
+  shown.scale = render::FitScale(4592, 3056, 1920, 1080);
+  const Json v = TrialVariables(PairTrial({{"edge", 2}}, "measured", "fitted"), far, shown);
+  for (const char* key : {"edge", "practice", "block_name", "swapped", "r_left_px", "r_right_px", "r_scene_px",
+                          "r_left_screen_px", "r_right_arcmin", "r_scene_arcmin", "screen_px_per_photo_px"})
+    EXPECT_TRUE(v.contains(key)) << key;
+  const double r = far.r_right_px;
+  EXPECT_NEAR(v["r_right_screen_px"].get<double>(), r * 1622.0 / 4592.0, 1e-4);
+  const double pitch_mm = 531.4 / 1920, deg = 180 / 3.14159265358979323846;
+  EXPECT_NEAR(v["r_right_arcmin"].get<double>(), 2 * std::atan(0.5 * r * 1622.0 / 4592.0 * pitch_mm / 600) * deg * 60,
+              1e-4);
+}
+
+// The per-pixel plan (stimulus's PlanOnScreen.PerPixelExactlyWhenTheObjectsDepthSpanReachesTheThresholdOnScreen) is
+// recorded as such.
+TEST(TrialVariables, RecordsThePerPixelBlurPlan) {
+  const calib::SceneCalib scene = ThesisScene();
+  protocol::Protocol p = BallProtocol();
+  p.content.type = "grid";
+  TrialScene t = DescribeTrial(p, PairTrial({{"edge", 2}}, "fitted", "fitted"), &scene);
+  Presentation shown;
+  shown.scale = 0.5;
+  p.content.depth_blur_threshold = 1e-6;
+  stimulus::PlanOnScreen(p, scene, shown, &t);
+  ASSERT_TRUE(t.per_pixel);
+  EXPECT_EQ(TrialVariables(PairTrial({{"edge", 2}}, "fitted", "fitted"), t, shown)["blur_plan"], "per_pixel");
+  t.per_pixel = false;
+  EXPECT_EQ(TrialVariables(PairTrial({{"edge", 2}}, "fitted", "fitted"), t, shown)["blur_plan"], "one_radius");
+}
+
+// A level named like something the record or trials.csv holds of its own (a conditions table's r_left_px, status or
+// participant; a staircase block's level, test_side or correct) is recorded as factor_NAME with its own value, and
+// the variable recorded under that name is the one the trial showed: neither overwrites the other. Every name
+// recorded beside the levels is one store::IsRecordedName reserves, so no future variable can take a level's place.
+TEST(TrialVariables, LevelsNamedLikeRecordedVariablesKeepTheirValuesUnderFactorNames) {
+  const calib::SceneCalib scene = ThesisScene();
+  protocol::Protocol p = BallProtocol();
+  p.content.type = "grid";
+  const Json row = {{"edge", 2}, {"status", "x"}, {"participant", "P8"}, {"r_left_px", 7.5}, {"info_age", 40},
+                    {"level", 99}, {"test_side", "left"}, {"correct", 1}, {"label", "near"}};
+  protocol::Trial trial = PairTrial({{"row", row}, {"group", "g"}}, "fitted", "fitted");
+  trial.cell = 0;  // a procedure's trial: level, test_side and the procedure cell are recorded
+  trial.test_side = "right";
+  TrialScene t = DescribeTrial(p, trial, &scene);
+  t.level = 0.4;
+  Presentation shown;
+  shown.scale = 0.5;
+  const Json v = TrialVariables(trial, t, shown);
+  EXPECT_EQ(v["factor_status"], "x");
+  EXPECT_EQ(v["factor_participant"], "P8");
+  EXPECT_EQ(v["factor_r_left_px"], 7.5);
+  EXPECT_EQ(v["factor_info_age"], 40);
+  EXPECT_EQ(v["factor_level"], 99);
+  EXPECT_EQ(v["factor_test_side"], "left");
+  EXPECT_EQ(v["factor_correct"], 1);
+  EXPECT_EQ(v["factor_group"], "g");
+  EXPECT_EQ(v["edge"], 2);
+  EXPECT_EQ(v["label"], "near");
+  EXPECT_NEAR(v["r_left_px"].get<double>(), t.r_left_px, 1e-4);  // the radius shown, not the table's 7.5
+  EXPECT_NE(v["r_left_px"], 7.5);
+  EXPECT_EQ(v["level"], 0.4);
+  EXPECT_EQ(v["test_side"], "right");
+  for (const auto& [key, value] : v.items())
+    if (!row.contains(key) && key != "group" && key.rfind("factor_", 0) != 0) {
+      EXPECT_TRUE(store::IsRecordedName(key)) << key << " is recorded but not reserved for it";
+    }
+  for (const char* name : {"status", "participant", "r_left_px", "level", "test_side", "correct", "practice",
+                           "swapped", "block_name", "info_age", "group", "round", "odd_interval"})
+    EXPECT_TRUE(store::IsRecordedName(name)) << name;
+  for (const char* name : {"edge", "label", "speed_cm_s", "right_x_mm", "factor_status"})
+    EXPECT_FALSE(store::IsRecordedName(name)) << name;
+}
+
+}  // namespace
+}  // namespace blurcue::session

@@ -1,0 +1,19 @@
+#pragma once
+// What running a session did (RunSession, RunTrials).
+#include <cstdint>
+
+namespace blurcue::session {
+
+struct RunResult {
+  int64_t session_id = 0;
+  uint64_t seed = 0;
+  int64_t trial_count = 0;
+  int64_t answered_before = 0;   // answers the session already had (resume)
+  int64_t answered_now = 0;
+  int64_t skipped_now = 0;       // trials recorded as skipped, not shown: by a procedure's stop rule ...
+  int64_t skipped_by_criterion_now = 0;  // ... or, these of them, as practice runs after the one that met its criterion
+  bool completed = false;        // false: quit, window closed or stop_after reached; resume with --resume
+  int64_t dropped_frames = 0;
+};
+
+}  // namespace blurcue::session

@@ -1,0 +1,117 @@
+#include "session/stimulus_renderer.h"
+
+#include <algorithm>
+
+#include <opencv2/imgproc.hpp>
+
+#include "core/image.h"
+
+#include "render/scene_render.h"
+
+namespace blurcue::session {
+
+using stimulus::LoadProtocolScene;
+using stimulus::Presentation;
+using stimulus::StimulusImages;
+using stimulus::TrialScene;
+
+StimulusRenderer::StimulusRenderer(const protocol::Protocol& protocol, const std::optional<calib::SceneCalib>& scene,
+                                   const StimulusImages& images, const Presentation& presentation)
+    : protocol_(protocol), scene_(scene), presentation_(presentation) {
+  photo_ = images.photo;
+  if (protocol.content.type == "picture") {
+    picture_ = images.picture;
+    // Every adjustment level's low-passed picture up front (~0.1 s each on the CPU): stepping through the levels
+    // in a trial then never stalls a frame on a Butterworth filter.
+    for (const auto& block : protocol.blocks)
+      if (block.adjust)
+        for (double level : block.adjust->levels) UpperHalf(level);
+    return;
+  }
+  if (!scene_) scene_ = LoadProtocolScene(protocol);
+  texture_ = render::SurfaceTexture(images.texture);
+  compositor_ = std::make_unique<render::FrameCompositor>(scene_->camera, scene_->rvec, scene_->tvec, photo_,
+                                                          presentation.view);
+}
+
+StimulusRenderer::~StimulusRenderer() = default;
+
+const cv::Mat& StimulusRenderer::UpperHalf(double level) {
+  auto cached = std::find_if(upper_cache_.begin(), upper_cache_.end(),
+                             [&](const auto& entry) { return entry.first == level; });
+  if (cached != upper_cache_.end()) return cached->second;
+  const render::DepthMatchingLayout& l = presentation_.layout;
+  upper_cache_.emplace_back(level, render::PictureOnGrey(picture_, l.upper.size(), l.picture.height, level));
+  return upper_cache_.back().second;
+}
+
+cv::Size StimulusRenderer::FrameSize() const {
+  if (compositor_) return {presentation_.window_width_px, presentation_.window_height_px};
+  return presentation_.layout.frame;
+}
+
+render::FrameView StimulusRenderer::View() const {
+  return compositor_ ? compositor_->view() : presentation_.view;
+}
+
+void StimulusRenderer::Prepare(const TrialScene& trial) {
+  if (!compositor_) {
+    const double distance_m = protocol_.content.real_photos.empty() ? 0 : trial.distance_m;
+    if (lower_.empty() || distance_m != lower_distance_m_) {
+      const cv::Mat photo = protocol_.content.real_photos.empty()
+                                ? photo_
+                                : ReadImage(protocol::RealPhotoFor(protocol_.content, trial.distance_m), 1);
+      lower_ = presentation_.layout.LowerHalf(photo);
+      lower_distance_m_ = distance_m;
+    }
+    return;
+  }
+  const render::FrameView v = presentation_.ViewFor(protocol_, *scene_, trial);
+  compositor_->Place(v.x_px, v.y_px);  // redraws the base only when the place changed
+}
+
+void StimulusRenderer::Compose(const TrialScene& trial, double t_s, double level) {
+  if (t_s <= 0) Prepare(trial);  // a trial's first frame: nothing to do when the runner prepared it
+  if (!compositor_) {
+    render::StackDepthMatchingFrame(UpperHalf(level), lower_, &picture_frame_);
+    picture_stale_ = true;
+    return;
+  }
+  shown_ = ObjectsAt(protocol_, *scene_, trial, t_s);
+  objects_.clear();  // kept between frames: its storage is reused
+  for (auto& shown : shown_) {
+    if (!shown) continue;
+    shown->object.texture = texture_;
+    objects_.push_back(*shown);
+  }
+  compositor_->Compose(objects_);
+}
+
+void StimulusRenderer::Present(int width_px, int height_px) {
+  if (compositor_) {
+    compositor_->Present(width_px, height_px);
+    return;
+  }
+  if (!picture_shown_) picture_shown_ = std::make_unique<render::WindowImage>(picture_frame_);
+  else if (picture_stale_) picture_shown_->Update(picture_frame_);
+  picture_stale_ = false;
+  picture_shown_->Present(width_px, height_px);
+}
+
+void StimulusRenderer::Finish() {
+  if (compositor_) compositor_->Finish();
+}
+
+cv::Mat StimulusRenderer::Read() {
+  if (compositor_) return compositor_->Read();
+  // The picture's frame where the window shows it, on the grey field.
+  const render::FrameView& v = presentation_.view;
+  cv::Mat window(v.height_px, v.width_px, CV_8UC3, cv::Scalar::all(128));
+  cv::Mat bgr = picture_frame_;
+  if (bgr.channels() == 4) cv::cvtColor(bgr, bgr, cv::COLOR_BGRA2BGR);
+  else if (bgr.channels() == 1) cv::cvtColor(bgr, bgr, cv::COLOR_GRAY2BGR);
+  bgr.copyTo(window(cv::Rect(v.x_px, v.y_px, bgr.cols, bgr.rows)));
+  return window;
+}
+
+}  // namespace blurcue::session

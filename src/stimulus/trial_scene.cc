@@ -1,0 +1,368 @@
+#include "stimulus/stimulus.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <limits>
+
+#include "core/error.h"
+#include "render/scene_render.h"
+#include "stimulus/internal.h"
+
+namespace blurcue::stimulus {
+namespace {
+
+constexpr int kLeftSection = 3, kRightSection = 5;  // the balls roll side by side, one section apart
+
+using protocol::FindLevel;
+
+// `where` names the field that chose the source ("FILE: /pointer"), made only when there is a problem to name. A
+// fixed radius on the screen is converted to photo px by `presentation`.
+calib::BlurSource Source(const Json& v, double* fixed, const std::function<std::string()>& where,
+                         const Presentation* presentation) {
+  if (v.is_number()) {
+    *fixed = v.get<double>();
+    return calib::BlurSource::kFixed;
+  }
+  if (v.is_object() && v.size() == 1 && (v.contains("screen_px") || v.contains("arcmin")) && v.front().is_number()) {
+    if (!presentation || presentation->scale <= 0)
+      throw InputError(where(), "a radius on the screen needs the display it is shown on, got " + v.dump());
+    const double r = v.front().get<double>();
+    const double screen_px = v.contains("arcmin") ? display::ScreenPxOfArcmin(presentation->profile, r) : r;
+    *fixed = screen_px / presentation->scale;
+    return calib::BlurSource::kFixed;
+  }
+  if (!v.is_string()) throw InputError(where(), "the trial shows no blur source on this side, got " + v.dump());
+  try {
+    return calib::ParseBlurSource(v.get<std::string>(), fixed);
+  } catch (const Error& e) {
+    throw InputError(where(), e.what());
+  }
+}
+
+// Board-frame placement of the two objects of a pair (render's poses on the board; x and y in mm where the trial
+// says so).
+render::VirtualObject Card(const calib::SceneCalib& s, const TrialScene& t, bool left) {
+  render::VirtualObject o = render::CardBesideBoard(s.board, 1, left, t.card_width_mm);
+  o.card_height_mm = t.card_height_mm;
+  o.standing = t.standing;
+  o.rotation_deg = t.rotation_deg;
+  const double x = left ? t.left_x_mm : t.right_x_mm;
+  // Its centre at the placement; a standing card's lowest edge rests at height_mm above the table.
+  const double h = o.card_height_mm > 0 ? o.card_height_mm : o.size_mm;
+  o.center_board_mm = {std::isnan(x) ? o.center_board_mm[0] : x, t.from_y_mm, t.height_mm + (t.standing ? h / 2 : 0)};
+  return o;
+}
+render::VirtualObject Ball(const calib::SceneCalib& s, const TrialScene& t, double y_mm, double radius_mm, bool left) {
+  render::VirtualObject o =
+      render::BallOnBoard(s.board, left ? kLeftSection : kRightSection, y_mm, radius_mm, t.from_y_mm);
+  const double x = left ? t.left_x_mm : t.right_x_mm;
+  if (!std::isnan(x)) o.center_board_mm[0] = x;
+  o.center_board_mm[2] += t.height_mm;
+  return o;
+}
+
+
+}  // namespace
+
+double TrialScene::MotionS() const {
+  return speed_mm_s > 0 ? std::abs(to_y_mm - from_y_mm) / speed_mm_s : 0;
+}
+
+double TrialScene::BallYMm(double t_s) const {
+  const double run = std::abs(to_y_mm - from_y_mm);
+  const double travelled = speed_mm_s * std::max(0.0, t_s);
+  if (travelled >= run && wipe_at_end && speed_mm_s > 0) return -std::numeric_limits<double>::infinity();
+  return from_y_mm + (to_y_mm >= from_y_mm ? 1 : -1) * std::min(run, travelled);
+}
+
+namespace {
+
+// A placement must show: each object, at the start and at the end of its run, must land in the photo.
+void CheckInPhoto(const protocol::Protocol& protocol, const protocol::Trial& trial, const calib::SceneCalib& scene,
+                  const TrialScene& t) {
+  const cv::Rect photo(0, 0, scene.camera.image_width_px, scene.camera.image_height_px);
+  for (const auto& objects : RunEnds(protocol, scene, t)) {
+    for (size_t side = 0; side < 2; ++side) {
+      // An intervals trial shows the right side's object at the left's place (IntervalScene): side 0's check is its.
+      if (!objects[side] || (side == 1 && t.intervals > 0)) continue;
+      if ((render::FootprintOf(scene.camera, scene.rvec, scene.tvec, objects[side]->object).bounds & photo).empty()) {
+        const char* level = t.content == "grid" ? (std::isnan(side == 0 ? t.left_x_mm : t.right_x_mm) ? "edge"
+                                                   : side == 0 ? "left_x_mm" : "right_x_mm")
+                                                : "speed_cm_s";
+        throw InputError(protocol.file.string() + ": " + protocol::LevelPointer(protocol, trial, level),
+                         std::string("the ") + (side == 0 ? "left" : "right") + " " + t.content + " at (" +
+                             std::to_string(int(std::lround(objects[side]->object.center_board_mm[0]))) + ", " +
+                             std::to_string(int(std::lround(objects[side]->object.center_board_mm[1]))) +
+                             ") mm on the board lies outside the " + std::to_string(photo.width) + " x " +
+                             std::to_string(photo.height) + " photo (trial " + std::to_string(trial.index) + ")");
+      }
+    }
+  }
+}
+
+}  // namespace
+
+TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Trial& trial,
+                         const calib::SceneCalib* scene, const Presentation* presentation) {
+  TrialScene t;
+  t.content = protocol.content.type;
+  t.left_only = protocol.layout == "single";
+  t.intervals = protocol::IntervalCount(protocol);
+  t.kernel = protocol.content.kernel;
+  t.brightness = protocol.content.brightness;
+  t.contrast = protocol.content.contrast;
+  t.white_balance = protocol.content.white_balance;
+  // Problems name the protocol field that asked for what cannot be shown, and the trial as a detail.
+  const std::string trial_text = " (trial " + std::to_string(trial.index) + ", block " + trial.block + ")";
+  if (t.content == "picture") {
+    const Json* d = FindLevel(trial.levels, "distance_m");
+    t.distance_m = d && d->is_number() ? d->get<double>() : 1.0;
+    // The real picture's blur: the thin lens of the camera that took its photo (content.real_camera).
+    if (const auto& camera = protocol.content.real_camera) {
+      try {
+        t.r_scene_px = optics::BlurRadiusPx(optics::Lens::FromCamera(*camera), protocol.content.real_focus_m * 1000,
+                                            t.distance_m * 1000);
+        // As synth-pictures refuses to make such a photo: a blur past any kernel is a wrong focus or camera.
+        if (!(t.r_scene_px <= optics::kMaxBlurRadiusPx))
+          throw Error(ErrorKind::kDomain, "the real picture at " + protocol::LevelText(t.distance_m) +
+                                              " m would be blurred by " + std::to_string(std::lround(t.r_scene_px)) +
+                                              " px, more than the largest blur (" +
+                                              std::to_string(int(optics::kMaxBlurRadiusPx)) + " px)");
+      } catch (const Error& e) {
+        throw InputError(At(protocol, "/content/real_camera"), std::string(e.what()) + trial_text);
+      }
+    }
+    return t;
+  }
+  if (!scene) throw InputError(protocol.file.string(), "/scene/calib: a " + t.content + " needs a calibration");
+  // Where a side's source was chosen ("" for the scene's own blur, the calibration's): looked up only for a message.
+  auto field = [&](const char* side) {
+    return At(protocol, side ? protocol::SidePointer(protocol, trial, side) : "/scene/calib");
+  };
+  t.left = Source(trial.left, &t.left_fixed_px, [&] { return field("left"); }, presentation);
+  t.right = Source(trial.right, &t.right_fixed_px, [&] { return field("right"); }, presentation);
+  const double s = scene->board.square_mm;
+  // Where the right side's object is shown, so where its radius is evaluated: its own place, or in an intervals
+  // trial the left object's (IntervalScene shows each side alone there). Evaluated at its own place, a place-dependent
+  // source (measured_section, estimated, fitted) gave the right interval a radius of somewhere not shown.
+  const bool right_place = t.intervals > 0;  // Card / Ball: true = the left object's place
+  // A radius that cannot be evaluated (eq. 3.7 nearer than focus, no usable measured section) is a problem of the
+  // source the protocol chose with this calibration: an input error naming that field.
+  auto r_at = [&](const cv::Vec3d& board_mm, calib::BlurSource source, double fixed, const char* side) {
+    try {
+      const double r = calib::BlurAtPx(*scene, source, scene->ToCamera(board_mm), fixed);
+      if (!std::isfinite(r) || r < 0) throw Error(ErrorKind::kDomain, "radius " + std::to_string(r) + " px");
+      return r;
+    } catch (const Error& e) {
+      throw InputError(field(side), calib::ToString(source) + " blur cannot be evaluated with " +
+                                        protocol.scene.calib.string() + trial_text + ": " + e.what());
+    }
+  };
+  // Edges and sections are the calibrated board's: its own count, whatever its size.
+  const int edges = scene->board.EdgeCount();
+  auto board_level = [&](const char* name, int most) -> std::optional<int> {
+    const Json* v = FindLevel(trial.levels, name);
+    if (!v || !v->is_number_integer()) return std::nullopt;
+    const int n = v->get<int>();
+    if (n < 1 || n > most)
+      throw InputError(At(protocol, protocol::LevelPointer(protocol, trial, name)),
+                       std::string(name) + " " + std::to_string(n) + " is not on the calibrated board (" +
+                           std::to_string(scene->board.cols) + " x " + std::to_string(scene->board.rows) +
+                           " squares: edges 1-" + std::to_string(edges) + ", sections 1-" + std::to_string(edges - 1) +
+                           ")" + trial_text);
+    return n;
+  };
+  auto mm_level = [&](const char* name) {
+    const Json* v = FindLevel(trial.levels, name);
+    return v && v->is_number() ? std::optional<double>(v->get<double>()) : std::nullopt;
+  };
+  if (auto x = mm_level("left_x_mm")) t.left_x_mm = *x;
+  if (auto x = mm_level("right_x_mm")) t.right_x_mm = *x;
+  t.height_mm = mm_level("height_mm").value_or(protocol.content.height_mm);
+  if (t.content == "grid") {
+    t.card_width_mm = protocol.content.size_mm;
+    t.card_height_mm = protocol.content.card_height_mm;
+    t.standing = protocol.content.standing;
+    t.rotation_deg = mm_level("rotation_deg").value_or(protocol.content.rotation_deg);
+  }
+  if (t.content == "grid") {
+    const auto edge = board_level("edge", edges);
+    const auto y = mm_level("y_mm");
+    if (!edge && !y)
+      throw InputError(At(protocol, protocol::LevelPointer(protocol, trial, "edge")),
+                       "a grid needs an integer level edge or a y_mm" + trial_text);
+    t.edge = edge ? *edge : 0;
+    t.from_y_mm = t.to_y_mm = y ? *y : (*edge - 1) * s;
+    const cv::Vec3d l = Card(*scene, t, true).center_board_mm, r = Card(*scene, t, right_place).center_board_mm;
+    t.r_left_px = r_at(l, t.left, t.left_fixed_px, "left");
+    t.r_right_px = r_at(r, t.right, t.right_fixed_px, "right");
+    t.r_scene_px = 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, nullptr) +
+                          r_at(r, calib::BlurSource::kFitted, 0, nullptr));
+    CheckInPhoto(protocol, trial, *scene, t);
+    return t;
+  }
+  // Balls: a section run (edge s to s + 1, wiped on arrival), explicit edges, the whole board, or at rest at an
+  // edge. A ball without a speed rests where it starts, and its radii are those of that place, not of a run.
+  int from = 1, to = scene->board.EdgeCount();
+  const Json* speed = FindLevel(trial.levels, "speed_cm_s");
+  t.speed_mm_s = speed && speed->is_number() ? 10 * speed->get<double>() : 0;
+  const auto edge = board_level("edge", edges);
+  const auto rest_y = mm_level("y_mm");
+  if (edge || rest_y) {
+    if (t.speed_mm_s > 0 || FindLevel(trial.levels, "section") || FindLevel(trial.levels, "from_edge") ||
+        FindLevel(trial.levels, "to_edge") || FindLevel(trial.levels, "from_y_mm") ||
+        FindLevel(trial.levels, "to_y_mm") || (edge && rest_y))
+      throw InputError(At(protocol, protocol::LevelPointer(protocol, trial, edge ? "edge" : "y_mm")),
+                       "a ball at an edge (or y_mm) rests there: it takes no speed_cm_s, section, from/to edge or "
+                       "y_mm, and not both edge and y_mm" + trial_text);
+    if (edge) from = to = *edge;
+  } else if (const auto section = board_level("section", edges - 1)) {
+    from = *section;
+    to = from + 1;
+    t.wipe_at_end = true;
+  } else {
+    if (const auto f = board_level("from_edge", edges)) from = *f;
+    if (const auto e = board_level("to_edge", edges)) to = *e;
+  }
+  // Without a speed the ball rests where it starts: an end or a section it would run to is never shown (it would be
+  // recorded all the same).
+  if (t.speed_mm_s <= 0)
+    for (const char* run_level : {"section", "to_edge", "to_y_mm"})
+      if (FindLevel(trial.levels, run_level))
+        throw InputError(At(protocol, protocol::LevelPointer(protocol, trial, run_level)),
+                         std::string("a ball without a speed_cm_s rests where it starts: ") + run_level +
+                             " describes a run it never makes (give a speed, or place it with edge, y_mm or "
+                             "from_edge)" + trial_text);
+  t.from_y_mm = rest_y ? *rest_y : mm_level("from_y_mm").value_or((from - 1) * s);
+  t.to_y_mm = rest_y ? *rest_y : mm_level("to_y_mm").value_or((to - 1) * s);
+  if (t.speed_mm_s <= 0) t.to_y_mm = t.from_y_mm;
+  // Radii averaged over the run (what the observer sees on the whole), sampled evenly along it.
+  const int samples = 21;
+  const double radius = protocol.content.radius_mm;
+  for (int i = 0; i < samples; ++i) {
+    const double y = t.from_y_mm + (t.to_y_mm - t.from_y_mm) * i / (samples - 1);
+    const cv::Vec3d l = Ball(*scene, t, y, radius, true).center_board_mm;
+    const cv::Vec3d r = Ball(*scene, t, y, radius, right_place).center_board_mm;
+    t.r_left_px += r_at(l, t.left, t.left_fixed_px, "left") / samples;
+    t.r_right_px += r_at(r, t.right, t.right_fixed_px, "right") / samples;
+    t.r_scene_px += 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, nullptr) +
+                           r_at(r, calib::BlurSource::kFitted, 0, nullptr)) / samples;
+  }
+  // Every edge the run passes, too: the samples step over edges on a long board, and a frame there must have a
+  // radius (a measured source is its nearest edge's value, refused for an edge with no usable section).
+  for (int k = 1; k <= edges; ++k) {
+    const double y = (k - 1) * s;
+    if (y < std::min(t.from_y_mm, t.to_y_mm) || y > std::max(t.from_y_mm, t.to_y_mm)) continue;
+    r_at(Ball(*scene, t, y, radius, true).center_board_mm, t.left, t.left_fixed_px, "left");
+    r_at(Ball(*scene, t, y, radius, right_place).center_board_mm, t.right, t.right_fixed_px, "right");
+  }
+  CheckInPhoto(protocol, trial, *scene, t);
+  return t;
+}
+
+std::array<std::optional<render::BlurredObject>, 2> ObjectsAt(const protocol::Protocol& protocol,
+                                                              const calib::SceneCalib& s, const TrialScene& trial,
+                                                              double t_s) {
+  std::array<std::optional<render::BlurredObject>, 2> shown;
+  for (const bool left : {true, false}) {
+    if (!left && trial.left_only) continue;
+    render::BlurredObject b;
+    render::VirtualObject& o = b.object;
+    const calib::BlurSource source = left ? trial.left : trial.right;
+    const double fixed = left ? trial.left_fixed_px : trial.right_fixed_px;
+    const double gain = left ? trial.left_gain : trial.right_gain, add = left ? trial.left_add_px : trial.right_add_px;
+    if (trial.content == "grid") {
+      o = Card(s, trial, left);
+    } else {
+      const double y = trial.BallYMm(t_s);
+      if (!std::isfinite(y)) continue;  // wiped at the end of a section
+      o = Ball(s, trial, y, protocol.content.radius_mm, left);
+    }
+    if (trial.per_pixel) {
+      // The radius along the object's line of sight at each depth: the source evaluated where the pixel's surface is.
+      const cv::Vec3d centre = s.ToCamera(o.center_board_mm);
+      b.r_of_depth_px = [&s, source, fixed, centre, gain, add](double z) {
+        return gain * calib::BlurAlongSightPx(s, source, centre, z, fixed) + add;
+      };
+    }
+    o.brightness = trial.brightness;
+    o.contrast = trial.contrast;
+    o.white_balance = {trial.white_balance[0], trial.white_balance[1], trial.white_balance[2]};
+    b.method = trial.kernel;
+    b.r_px = gain * calib::BlurAtPx(s, source, s.ToCamera(o.center_board_mm), fixed) + add;
+    shown[left ? 0 : 1] = std::move(b);
+  }
+  return shown;
+}
+bool IntervalShowsRight(const protocol::Trial& trial, const TrialScene& scene, int i) {
+  if (scene.intervals == 2) return i == 1;
+  return trial.task == protocol::Task::kForcedChoice && !trial.test_side.empty() &&
+         std::isdigit(static_cast<unsigned char>(trial.test_side[0])) && std::stoi(trial.test_side) == i + 1;
+}
+
+TrialScene IntervalScene(const TrialScene& scene, bool right) {
+  TrialScene s = scene;
+  s.left_only = true;
+  if (right) {
+    s.left = s.right;
+    s.left_fixed_px = s.right_fixed_px;
+    s.left_gain = s.right_gain;
+    s.left_add_px = s.right_add_px;
+    s.r_left_px = s.r_right_px;
+  }
+  return s;
+}
+
+void ApplyLevel(const protocol::Procedure& procedure, const protocol::Trial& trial, double level,
+                const Presentation& presentation, TrialScene* scene) {
+  const bool left = trial.test_side == "left";
+  double& gain = left ? scene->left_gain : scene->right_gain;
+  double& add = left ? scene->left_add_px : scene->right_add_px;
+  double& r = left ? scene->r_left_px : scene->r_right_px;
+  const double reference = (r - add) / gain;  // as DescribeTrial made it
+  if (procedure.variable == "relative_difference") {
+    gain = 1 + level, add = 0;
+  } else {
+    gain = 1;
+    add = presentation.scale > 0 ? display::ScreenPxOfArcmin(presentation.profile, level) / presentation.scale : 0;
+  }
+  r = gain * reference + add;
+  scene->level = level;
+}
+
+void PlanOnScreen(const protocol::Protocol& protocol, const calib::SceneCalib& s, const Presentation& presentation,
+              TrialScene* trial) {
+  if (trial->content == "picture") return;
+  const protocol::Content& c = protocol.content;
+  const double threshold = c.depth_blur_threshold_unit == "arcmin"
+                               ? display::ScreenPxOfArcmin(presentation.profile, c.depth_blur_threshold)
+                               : c.depth_blur_threshold;
+  // The objects as the per-pixel plan would draw them: each one's radius at its nearest and farthest depth is what
+  // that plan would give those pixels (a procedure's gain included).
+  TrialScene as_per_pixel = *trial;
+  as_per_pixel.per_pixel = true;
+  const auto ends = RunEnds(protocol, s, as_per_pixel);
+  double span = 0;
+  for (const auto& shown : ends)
+    for (const auto& object : shown) {
+      if (!object) continue;
+      const render::Footprint f = render::FootprintOf(s.camera, s.rvec, s.tvec, object->object);
+      span = std::max(span, presentation.ScreenPx(std::abs(object->r_of_depth_px(f.z_max_mm) -
+                                                           object->r_of_depth_px(f.z_min_mm))));
+    }
+  trial->r_span_screen_px = span;
+  trial->per_pixel = span >= threshold;
+  const auto& onset = ends[0];
+  for (size_t side = 0; side < 2; ++side)
+    (side == 0 ? trial->size_left_deg : trial->size_right_deg) =
+        onset[side] ? display::ArcminOfScreenPx(presentation.profile,
+                                                presentation.ScreenPx(ExtentPx(render::OutlineOf(
+                                                    s.camera, s.rvec, s.tvec, onset[side]->object)))) /
+                          60
+                    : 0;
+}
+
+}  // namespace blurcue::stimulus
