@@ -198,6 +198,15 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
               Json(ToString(b->counterbalance)));
   }
   if (auto s = Text(obj, "instructions", ptr, false, kMaxTextChars, false)) b->instructions = *s;
+  // What the participant sees: a title of one line, a prompt of its own (the timing is read once the layout is known).
+  if (auto s = Text(obj, "title", ptr, false, 100, true)) {
+    if (s->empty()) Problem(ptr + "/title", "must not be empty (leave it out for \"Part n of N\")", Json(*s));
+    b->title = *s;
+  }
+  if (auto s = Text(obj, "prompt", ptr, false, 200, true)) {
+    if (s->empty()) Problem(ptr + "/prompt", "must not be empty (leave it out for /responses/prompt)", Json(*s));
+    b->prompt = *s;
+  }
   if (auto s = Bool(obj, "shuffle", ptr)) b->shuffle = *s;
   if (auto s = Bool(obj, "practice", ptr)) b->practice = *s;
   // Practice until a criterion: the share correct in one run of the design, and how many runs at most.

@@ -9,6 +9,14 @@
 
 namespace blurcue::protocol::detail {
 
+void Parser::CheckReadName(const std::string& name, const std::string& what, const std::string& ptr,
+                           const std::string& where) {
+  if (IsValueName(name) || IsLabelName(name)) return;
+  // A misspelt name used to be taken as a label: recorded with every trial while the level it meant was never set.
+  Problem(ptr, where + "no part of blurcue reads a " + what + " " + name + DidYouMean(name, ReadNames()) +
+                   "; to record it as a label nobody reads, name it label_" + name);
+}
+
 // Checks a value by the name it goes by (a factor's name, or a key of an object level).
 void Parser::CheckLevelValue(const std::string& name, const Json& v, const std::string& ptr) {
   auto integer_in = [&](int lo, int hi, const std::string& what) {
@@ -33,7 +41,11 @@ void Parser::CheckLevelValue(const std::string& name, const Json& v, const std::
     if (!IsBlurSource(v))
       Problem(ptr, "a blur source must be none, measured, measured_section, estimated, fitted, a radius in " +
                        Range(0, kMaxFixedRadiusPx, "photo px") + ", {\"screen_px\": r} with r in " +
-                       Range(0, kMaxFixedRadiusPx, "") + " or {\"arcmin\": r} with r in " + Range(0, 600, ""), v);
+                       Range(0, kMaxFixedRadiusPx, "") + " or {\"arcmin\": r} with r in " + Range(0, 600, "") +
+                       (v.is_string() ? DidYouMean(v.get<std::string>(), {"none", "measured", "measured_section",
+                                                                          "estimated", "fitted"})
+                                      : std::string()),
+              v);
   } else if (v.is_number() && !std::isfinite(v.get<double>())) {
     Problem(ptr, "must be a finite number", v);
   }
@@ -70,8 +82,12 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
       Problem(fp, "may list at most " + std::to_string(kMaxLevels) + " levels, got " + std::to_string(levels.size()));
       continue;
     }
+    // A factor's name is what reads its levels (edge, speed_cm_s, ...), unless its levels are objects whose keys are.
+    if (!std::all_of(levels.begin(), levels.end(), [](const Json& level) { return level.is_object(); }))
+      CheckReadName(name, "factor", fp);
     Factor f{name, {}};
     bool sides = false;
+    std::set<std::string> keys_checked;  // an object level's key is named once, at the first level that has it
     std::map<std::string, size_t> seen;  // a level's text -> its first index
     for (size_t i = 0; i < levels.size(); ++i) {
       const Json& level = levels[i];
@@ -88,6 +104,7 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
       // levels carry named values.
       if (level.is_object() && !IsValueName(name)) {
         for (const auto& [key, value] : level.items()) {
+          if (keys_checked.insert(key).second) CheckReadName(key, "level key", lp + "/" + Escape(key));
           if (value.is_object() || value.is_array()) Problem(lp + "/" + Escape(key), "must be a number or a string", value);
           else CheckLevelValue(key, value, lp + "/" + Escape(key));
         }
@@ -182,6 +199,10 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
               Json(*text));
       return {};
     }
+  // Each column is a level's name: read (edge, left, ...) or a label (id, label, label_*).
+  for (size_t c = 0; c < header.size(); ++c)
+    CheckReadName(header[c], "column", ptr,
+                  where + " line " + std::to_string(rows.front().line) + ", column " + std::to_string(c + 1) + ": ");
   Factor factor;
   factor.name = "row";
   for (size_t r = 1; r < rows.size(); ++r) {

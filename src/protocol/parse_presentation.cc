@@ -57,8 +57,19 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
     const bool grid = *type == "grid";
     p->content.texture = grid ? "grid" : "soccer";
     if (auto t = Text(v, "texture", ptr, false, kMaxPathChars, true)) {
-      if (grid ? *t == "grid" : (*t == "soccer" || *t == "wood")) p->content.texture = *t;
-      else p->content.texture = Path(v, "texture", ptr, true).string();
+      const std::vector<std::string> shipped = grid ? std::vector<std::string>{"grid"}
+                                                    : std::vector<std::string>{"soccer", "wood"};
+      const std::string nearest = NearestName(*t, shipped);
+      std::error_code ec;
+      if (std::count(shipped.begin(), shipped.end(), *t)) {
+        p->content.texture = *t;
+      } else if (!nearest.empty() && !fs::exists(base_ / *t, ec)) {
+        // "Soccer" is a slip of the shipped texture's name, not an image file that happens to be missing.
+        Problem(ptr + "/texture", "must be " + (grid ? std::string("grid") : "soccer or wood") +
+                                      " or an image file (did you mean " + nearest + "?)", Json(*t));
+      } else {
+        p->content.texture = Path(v, "texture", ptr, true).string();
+      }
     }
   }
   if (*type == "grid" || *type == "ball") {
@@ -215,7 +226,7 @@ void Parser::ParseResponses(const Json& v, const std::string& ptr, const std::se
     if (s == "Escape") return Problem(at, "Escape is reserved for pausing a session", value), std::nullopt;
     if (!IsKeyName(s))
       return Problem(at, "must be a key name: A-Z, 0-9, Left, Right, Up, Down, Space, Return, Tab, Backspace, F1-F12 "
-                         "or KP_0-KP_9", value), std::nullopt;
+                         "or KP_0-KP_9" + DidYouMean(s, KeyNames()), value), std::nullopt;
     return s;
   };
   std::map<std::string, std::string*> slots = {{"left", &r->left},         {"right", &r->right},
@@ -289,4 +300,44 @@ void Parser::ParseResponses(const Json& v, const std::string& ptr, const std::se
   if (tasks.count(Task::kRating)) distinct_list("rating", r->rating);
   if (p.layout == "odd_one_out") distinct_list("alternatives", r->alternatives);
 }
+// The protocol's timing (at /timing) or a block's (at /blocks/N/timing): each field given is checked and set in `t`,
+// so a block's fields override the protocol's and the others stay as inherited.
+void Parser::ParseTiming(const Json& v, const std::string& ptr, const Protocol& p,
+                         const std::vector<const Block*>& blocks, Timing* t) {
+  if (!Object(v, ptr, {"stimulus_ms", "inter_trial_ms", "interval_ms", "isi_ms", "deadline_ms", "feedback_ms",
+                       "fixation_ms"}))
+    return;
+  if (const Json* s = Field(v, "stimulus_ms", ptr, false)) {
+    // From about a frame to a minute.
+    if (s->is_string() && *s == "until_response") t->stimulus_ms = 0;
+    else if (NumberIn(*s, 10, 60000)) t->stimulus_ms = s->get<double>();
+    else Problem(ptr + "/stimulus_ms", "must be a duration in " + Range(10, 60000, "ms") + " or \"until_response\"" +
+                                           (s->is_string() ? DidYouMean(s->get<std::string>(), {"until_response"}) : ""),
+                 *s);
+  }
+  if (auto x = Number(v, "inter_trial_ms", ptr, false, 0, 60000, "ms")) t->inter_trial_ms = *x;
+  if (auto x = Number(v, "interval_ms", ptr, false, 100, 10000, "ms")) t->interval_ms = *x;
+  if (auto x = Number(v, "isi_ms", ptr, false, 0, 10000, "ms")) t->isi_ms = *x;
+  if (auto x = Number(v, "deadline_ms", ptr, false, 100, 60000, "ms")) t->deadline_ms = *x;
+  if (auto x = Number(v, "feedback_ms", ptr, false, 100, 5000, "ms")) t->feedback_ms = *x;
+  if (auto x = Number(v, "fixation_ms", ptr, false, 100, 5000, "ms")) t->fixation_ms = *x;
+  // Feedback needs a correct answer: a procedure's, an odd one out's, or a practice run to a criterion's.
+  const bool correct = p.layout == "odd_one_out" || std::any_of(blocks.begin(), blocks.end(), [](const Block* b) {
+                         return b->procedure || b->criterion;
+                       });
+  if (v.contains("feedback_ms") && !correct)
+    Problem(ptr + "/feedback_ms", "needs a correct answer: a block with a procedure or a criterion, or the "
+                                  "layout odd_one_out, defines one", v["feedback_ms"]);
+  const bool adjustment =
+      std::any_of(blocks.begin(), blocks.end(), [](const Block* b) { return b->task == Task::kAdjustment; });
+  if (v.contains("deadline_ms") && adjustment)
+    Problem(ptr + "/deadline_ms", "is for a forced choice, yes/no or rating; adjustment runs until a level is "
+                                  "accepted", v["deadline_ms"]);
+  for (const char* key : {"interval_ms", "isi_ms"})
+    if (v.contains(key) && IntervalCount(p) == 0)
+      Problem(ptr + "/" + key, "is for the layouts two_intervals and odd_one_out", v[key]);
+  if (v.contains("stimulus_ms") && IntervalCount(p) > 0)
+    Problem(ptr + "/stimulus_ms", "intervals are timed by interval_ms and isi_ms", v["stimulus_ms"]);
+}
+
 }  // namespace blurcue::protocol::detail

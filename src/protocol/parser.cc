@@ -84,12 +84,40 @@ bool IsBlurSource(const Json& v) {
 }
 
 // Names whose values CheckLevelValue knows: a level of a factor so named is that value, never an object.
+const std::vector<std::string>& ValueNames() {
+  static const std::vector<std::string> kNames = {"edge",       "from_edge",  "to_edge", "section",   "speed_cm_s",
+                                                  "distance_m", "cutoff",     "left",    "right",     "y_mm",   "object",
+                                                  "from_y_mm",  "to_y_mm",    "left_x_mm", "right_x_mm",
+                                                  "height_mm",  "rotation_deg"};
+  return kNames;
+}
+
 bool IsValueName(const std::string& name) {
-  static const std::set<std::string> kNames = {"edge",       "from_edge",  "to_edge", "section",   "speed_cm_s",
-                                               "distance_m", "cutoff",     "left",    "right",     "y_mm",   "object",
-                                               "from_y_mm",  "to_y_mm",    "left_x_mm", "right_x_mm",
-                                               "height_mm",  "rotation_deg"};
-  return kNames.count(name) > 0;
+  const auto& names = ValueNames();
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+bool IsLabelName(const std::string& name) { return name == "id" || name == "label" || name.rfind("label_", 0) == 0; }
+
+const std::vector<std::string>& ReadNames() {
+  static const std::vector<std::string> kNames = [] {
+    std::vector<std::string> names = ValueNames();
+    names.insert(names.end(), {"id", "label"});
+    return names;
+  }();
+  return kNames;
+}
+
+const std::vector<std::string>& KeyNames() {
+  static const std::vector<std::string> kNames = [] {
+    std::vector<std::string> names = {"Left", "Right", "Up", "Down", "Space", "Return", "Tab", "Backspace"};
+    for (char c = 'A'; c <= 'Z'; ++c) names.emplace_back(1, c);
+    for (char c = '0'; c <= '9'; ++c) names.emplace_back(1, c);
+    for (int f = 1; f <= 12; ++f) names.push_back("F" + std::to_string(f));
+    for (char c = '0'; c <= '9'; ++c) names.push_back(std::string("KP_") + c);
+    return names;
+  }();
+  return kNames;
 }
 
 bool IsKeyName(const std::string& key) {
@@ -161,7 +189,7 @@ std::optional<std::string> Parser::String(const Json& obj, const std::string& ke
   if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), s) == allowed.end()) {
     std::string list;
     for (const auto& a : allowed) list += (list.empty() ? "" : " | ") + a;
-    Problem(p, "must be one of " + list, *v);
+    Problem(p, "must be one of " + list + DidYouMean(s, allowed), *v);
     return std::nullopt;
   }
   return s;

@@ -40,6 +40,14 @@ const double kMaxFixedRadiusPx = 100;
 bool IsBlurSource(const Json& v);
 // Names whose values CheckLevelValue knows: a level of a factor so named is that value, never an object.
 bool IsValueName(const std::string& name);
+const std::vector<std::string>& ValueNames();  // the names IsValueName knows, in one list
+// A label: recorded with each trial but read by nothing else (id, label, label_*), so any value goes.
+bool IsLabelName(const std::string& name);
+// The names a factor, an object level's key or a conditions column may have that are read (ValueNames, id, label):
+// the candidates of a misspelt one's did-you-mean.
+const std::vector<std::string>& ReadNames();
+// Every name IsKeyName takes, as a list (the candidates of a misspelt key's did-you-mean).
+const std::vector<std::string>& KeyNames();
 // A key name a station knows: A-Z, 0-9, Left, Right, Up, Down, Space, Return, Tab, Backspace, F1-F12, KP_0-KP_9.
 bool IsKeyName(const std::string& key);
 
@@ -101,6 +109,14 @@ class Parser {
   void ParseRealCamera(const Json& v, const std::string& ptr, const Json& content, Protocol* p);
   std::optional<Procedure> ParseProcedure(const Json& v, const std::string& ptr);
   std::vector<Factor> ParseConditions(const Json& v, const std::string& ptr);
+  // Reports `name` (a factor, an object level's key, a conditions column: `what`) at `ptr` when nothing reads it and
+  // it is no label, with the nearest read name; `where` goes before the message (a CSV file's line and column).
+  void CheckReadName(const std::string& name, const std::string& what, const std::string& ptr,
+                     const std::string& where = "");
+  // Timing fields given in `v` (the protocol's, or a block's that overrides them) into `t`; `blocks` are those the
+  // timing applies to, for the fields that only some blocks or layouts read.
+  void ParseTiming(const Json& v, const std::string& ptr, const Protocol& p, const std::vector<const Block*>& blocks,
+                   Timing* t);
   void ParseInfo(const Json& v, const std::string& ptr, Protocol* p);
   void ParseGroups(const Json& v, const Json& top, const std::string& ptr, Protocol* p);
   void ParseSides(const Json& v, const std::string& ptr);

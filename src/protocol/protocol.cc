@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "core/limits.h"
+#include "core/names.h"
 #include "core/typed.h"
 
 namespace blurcue::protocol {
@@ -96,7 +97,8 @@ Protocol Parser::Parse(const Json& json) {
       const Json& obj = (*blocks)[i];
       const std::string bp = "/blocks/" + std::to_string(i);
       if (!Object(obj, bp, {"name", "task", "factors", "conditions", "repetitions", "counterbalance", "sides",
-                            "adjust", "procedure", "instructions", "shuffle", "groups", "practice", "criterion"}))
+                            "adjust", "procedure", "instructions", "shuffle", "groups", "practice", "criterion",
+                            "title", "prompt", "timing"}))
         continue;
       Block b;
       if (auto s = Text(obj, "name", bp, true, kMaxNameChars, true)) {
@@ -118,7 +120,9 @@ Protocol Parser::Parse(const Json& json) {
       if (auto s = String(*v, "block", "/practice", false)) {
         bool found = false;
         for (const auto& b : p.blocks) found = found || b.name == *s;
-        if (!found) Problem("/practice/block", "names no block of this protocol", Json(*s));
+        std::vector<std::string> names;
+        for (const auto& b : p.blocks) names.push_back(b.name);
+        if (!found) Problem("/practice/block", "names no block of this protocol" + DidYouMean(*s, names), Json(*s));
         p.practice.block = *s;
       }
     }
@@ -170,39 +174,17 @@ Protocol Parser::Parse(const Json& json) {
   for (const auto& b : p.blocks) tasks.insert(b.task);
   const Json* responses = Field(json, "responses", "", false);
   ParseResponses(responses ? *responses : Json(), "/responses", tasks, p, &p.responses);
-  if (const Json* v = Field(json, "timing", "", false)) {
-    if (Object(*v, "/timing", {"stimulus_ms", "inter_trial_ms", "interval_ms", "isi_ms", "deadline_ms", "feedback_ms",
-                               "fixation_ms"})) {
-      if (const Json* s = Field(*v, "stimulus_ms", "/timing", false)) {
-        // From about a frame to a minute.
-        if (s->is_string() && *s == "until_response") p.timing.stimulus_ms = 0;
-        else if (NumberIn(*s, 10, 60000)) p.timing.stimulus_ms = s->get<double>();
-        else Problem("/timing/stimulus_ms", "must be a duration in " + Range(10, 60000, "ms") + " or \"until_response\"", *s);
-      }
-      if (auto x = Number(*v, "inter_trial_ms", "/timing", false, 0, 60000, "ms")) p.timing.inter_trial_ms = *x;
-      if (auto x = Number(*v, "interval_ms", "/timing", false, 100, 10000, "ms")) p.timing.interval_ms = *x;
-      if (auto x = Number(*v, "isi_ms", "/timing", false, 0, 10000, "ms")) p.timing.isi_ms = *x;
-      if (auto x = Number(*v, "deadline_ms", "/timing", false, 100, 60000, "ms")) p.timing.deadline_ms = *x;
-      if (auto x = Number(*v, "feedback_ms", "/timing", false, 100, 5000, "ms")) p.timing.feedback_ms = *x;
-      if (auto x = Number(*v, "fixation_ms", "/timing", false, 100, 5000, "ms")) p.timing.fixation_ms = *x;
-      // Feedback needs a correct answer: a procedure's, an odd one out's, or a practice run to a criterion's.
-      const bool correct = p.layout == "odd_one_out" ||
-                           std::any_of(p.blocks.begin(), p.blocks.end(),
-                                       [](const Block& b) { return b.procedure || b.criterion; });
-      if (v->contains("feedback_ms") && !correct)
-        Problem("/timing/feedback_ms", "needs a correct answer: a block with a procedure or a criterion, or the "
-                                       "layout odd_one_out, defines one", (*v)["feedback_ms"]);
-      const bool adjustment = std::any_of(p.blocks.begin(), p.blocks.end(),
-                                          [](const Block& b) { return b.task == Task::kAdjustment; });
-      if (v->contains("deadline_ms") && adjustment)
-        Problem("/timing/deadline_ms", "is for a forced choice, yes/no or rating; adjustment runs until a level is "
-                                       "accepted", (*v)["deadline_ms"]);
-      for (const char* key : {"interval_ms", "isi_ms"})
-        if (v->contains(key) && IntervalCount(p) == 0)
-          Problem(std::string("/timing/") + key, "is for the layouts two_intervals and odd_one_out", (*v)[key]);
-      if (v->contains("stimulus_ms") && IntervalCount(p) > 0)
-        Problem("/timing/stimulus_ms", "intervals are timed by interval_ms and isi_ms", (*v)["stimulus_ms"]);
-    }
+  std::vector<const Block*> every_block;
+  for (const auto& b : p.blocks) every_block.push_back(&b);
+  if (const Json* v = Field(json, "timing", "", false)) ParseTiming(*v, "/timing", p, every_block, &p.timing);
+  // What a block's trials read is resolved here, once: its timing is the protocol's with each field the block gives
+  // overriding it, its prompt the protocol's unless it gives its own.
+  for (auto& b : p.blocks) {
+    b.timing = p.timing;
+    if (b.prompt.empty()) b.prompt = p.responses.prompt;
+    if (b.pointer.empty()) continue;  // the one block of a file without blocks: the top level is its own
+    const Json& obj = json.at(Json::json_pointer(b.pointer));
+    if (const Json* v = Field(obj, "timing", b.pointer, false)) ParseTiming(*v, b.pointer + "/timing", p, {&b}, &b.timing);
   }
   if (const Json* v = Field(json, "display", "", false)) {
     if (Object(*v, "/display", {"width_px", "height_px", "fullscreen", "monitor", "profile", "scale", "width_deg"})) {
@@ -217,7 +199,9 @@ Protocol Parser::Parse(const Json& json) {
         if (s->is_string() && *s == "fit") p.display.scaling = Scaling::kFit;
         else if (s->is_string() && *s == "native") p.display.scaling = Scaling::kNative;
         else if (NumberIn(*s, 0.05, 8)) p.display.scaling = Scaling::kScale, p.display.scale = s->get<double>();
-        else Problem("/display/scale", "must be \"fit\", \"native\" or screen px per photo px in " + Range(0.05, 8, ""), *s);
+        else Problem("/display/scale", "must be \"fit\", \"native\" or screen px per photo px in " + Range(0.05, 8, "") +
+                                           (s->is_string() ? DidYouMean(s->get<std::string>(), {"fit", "native"}) : ""),
+                     *s);
       }
       if (auto x = Number(*v, "width_deg", "/display", false, 0.5, 180, "deg")) {
         if (v->contains("scale")) Problem("/display/width_deg", "give either scale or width_deg, not both", *x);
@@ -243,7 +227,8 @@ void Parser::CheckDesign(const Protocol& p) {
     for (size_t i = 0; i < b.groups.size(); ++i)
       if (!p.groups || std::find(p.groups->names.begin(), p.groups->names.end(), b.groups[i]) == p.groups->names.end())
         Problem((b.pointer.empty() ? std::string() : b.pointer) + "/groups/" + std::to_string(i),
-                p.groups ? "names no group of /groups/names" : "names a group but the protocol declares no /groups",
+                p.groups ? "names no group of /groups/names" + DidYouMean(b.groups[i], p.groups->names)
+                         : "names a group but the protocol declares no /groups",
                 Json(b.groups[i]));
   if (p.groups)
     for (const auto& g : p.groups->names)
@@ -467,7 +452,7 @@ std::string CheckInfoValue(const InfoField& f, const std::string& value) {
     if (std::find(f.choices.begin(), f.choices.end(), value) != f.choices.end()) return "";
     std::string list;
     for (const auto& c : f.choices) list += (list.empty() ? "" : ", ") + c;
-    return "must be one of " + list;
+    return "must be one of " + list + DidYouMean(value, f.choices);
   }
   if (value.size() > 200 || !IsPrintableUtf8(value)) return "must be one line of printable text, at most 200 bytes";
   return "";

@@ -246,7 +246,7 @@ TEST(ProtocolValidate, RealPhotoDistancesComeFromFactorsObjectLevelsAndCondition
   EXPECT_EQ(distances(Json::parse(R"({"factors": {"distance_m": [0.4, 1.092]}})")), want);
   EXPECT_EQ(distances(Json::parse(R"({"factors": {"place": [{"distance_m": 0.4}, {"distance_m": 1.092}]}})")), want);
   EXPECT_EQ(distances(Json::parse(R"({"blocks": [{"name": "b", "conditions": "dm.csv"}]})")), want);
-  EXPECT_TRUE(distances(Json::parse(R"({"factors": {"other": [1, 2]}})")).empty());
+  EXPECT_TRUE(distances(Json::parse(R"({"factors": {"label_other": [1, 2]}})")).empty());
 }
 
 // Participant information and between-subject groups: every field checked with its pointer; a block names only

@@ -249,12 +249,12 @@ TEST(ProtocolValidate, TrialCountOverTheCapRejectedNamingTheCap) {
   for (int f = 0; f < 8; ++f) {
     Json levels = Json::array();
     for (int l = 0; l < 30; ++l) levels.push_back(l);
-    factors["f" + std::to_string(f)] = levels;
+    factors["label_f" + std::to_string(f)] = levels;
   }
   factors["pattern"] = j["blocks"][0]["factors"]["pattern"];
   j["blocks"][0]["factors"] = factors;
   const std::string p = OnlyProblem(j);
-  EXPECT_TRUE(Contains(p, "/blocks/0/factors: the session would have 2624400000006 trials (30 f0 x ")) << p;
+  EXPECT_TRUE(Contains(p, "/blocks/0/factors: the session would have 2624400000006 trials (30 label_f0 x ")) << p;
   EXPECT_TRUE(Contains(p, "a session may have at most 10000 trials, practice included")) << p;
 }
 
@@ -264,7 +264,7 @@ TEST(ProtocolValidate, TrialCountBeyondSixtyFourBitsIsStillRefused) {
   for (int f = 0; f < 15; ++f) {
     Json levels = Json::array();
     for (int l = 0; l < 1000; ++l) levels.push_back(l);
-    factors["f" + std::to_string(f)] = levels;  // 1000^15 = 1e45 trials
+    factors["label_f" + std::to_string(f)] = levels;  // 1000^15 = 1e45 trials
   }
   factors["pattern"] = j["blocks"][0]["factors"]["pattern"];
   j["blocks"][0]["factors"] = factors;
@@ -285,12 +285,13 @@ TEST(ProtocolValidate, TrialCountOverTheCapCountsCriterionRunsAndNamesTheBlocksT
   const Json pattern = {Valid()["blocks"][0]["factors"]["pattern"][0]};
   j["blocks"] = Json::array({
       {{"name", "warm-up"}, {"practice", true}, {"criterion", {{"correct", 0.8}, {"max_repeats", 11}}},
-       {"factors", {{"pattern", pattern}, {"f", levels}}}, {"repetitions", 11}},  // 495 a run
-      {{"name", "main"}, {"factors", {{"pattern", pattern}, {"f", levels}}}, {"repetitions", 110}}});  // 4950
+       {"factors", {{"pattern", pattern}, {"label_f", levels}}}, {"repetitions", 11}},  // 495 a run
+      {{"name", "main"}, {"factors", {{"pattern", pattern}, {"label_f", levels}}}, {"repetitions", 110}}});  // 4950
   std::string p = OnlyProblem(j);
   EXPECT_TRUE(Contains(p, "/blocks/0/factors: the session would have up to 10395 trials (11 runs (criterion "
-                          "max_repeats) x 45 f x 1 pattern x 11 repetitions = 5445 in block warm-up + 45 f x 1 pattern "
-                          "x 110 repetitions = 4950 in block main); a session may have at most 10000 trials")) << p;
+                          "max_repeats) x 45 label_f x 1 pattern x 11 repetitions = 5445 in block warm-up + 45 "
+                          "label_f x 1 pattern x 110 repetitions = 4950 in block main); a session may have at most "
+                          "10000 trials")) << p;
   // The block with the most trials per run is not the one that makes most of the total: the criterion's is named
   // first, and its pointer given.
   j["blocks"][1]["repetitions"] = 200;  // 9000 a run, once
@@ -298,9 +299,9 @@ TEST(ProtocolValidate, TrialCountOverTheCapCountsCriterionRunsAndNamesTheBlocksT
   EXPECT_TRUE(Problems(j).empty()) << Problems(j).front();  // 9990
   j["blocks"][0]["criterion"]["max_repeats"] = 20;  // 1800 + 9000
   p = OnlyProblem(j);
-  EXPECT_TRUE(Contains(p, "/blocks/1/factors: the session would have up to 10800 trials (45 f x 1 pattern x 200 "
-                          "repetitions = 9000 in block main + 20 runs (criterion max_repeats) x 45 f x 1 pattern x 2 "
-                          "repetitions = 1800 in block warm-up)")) << p;
+  EXPECT_TRUE(Contains(p, "/blocks/1/factors: the session would have up to 10800 trials (45 label_f x 1 pattern x "
+                          "200 repetitions = 9000 in block main + 20 runs (criterion max_repeats) x 45 label_f x 1 "
+                          "pattern x 2 repetitions = 1800 in block warm-up)")) << p;
   // The practice drawn from a block is added to it.
   j = Valid();
   levels.erase(levels.begin());
@@ -398,11 +399,11 @@ TEST(ProtocolValidate, KeyWithALineBreakIsNamedOnOneLine) {
 
 TEST(ProtocolValidate, RepeatedLevelNamesItsFirstOccurrence) {
   Json j = Valid();
-  j["blocks"][1]["factors"]["size"] = {1, 2, 1.0, 3, 2};
+  j["blocks"][1]["factors"]["label_size"] = {1, 2, 1.0, 3, 2};
   const auto problems = Problems(j);
   ASSERT_EQ(problems.size(), 2u);
-  EXPECT_TRUE(Contains(problems[0], "/blocks/1/factors/size/2: repeats level 0, got 1.0")) << problems[0];
-  EXPECT_TRUE(Contains(problems[1], "/blocks/1/factors/size/4: repeats level 1, got 2")) << problems[1];
+  EXPECT_TRUE(Contains(problems[0], "/blocks/1/factors/label_size/2: repeats level 0, got 1.0")) << problems[0];
+  EXPECT_TRUE(Contains(problems[1], "/blocks/1/factors/label_size/4: repeats level 1, got 2")) << problems[1];
 }
 
 TEST(ProtocolValidate, ObjectLevelOfAValueFactorRejected) {

@@ -19,6 +19,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/image.h"
+#include "core/names.h"
 #include "core/typed.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
@@ -220,7 +221,7 @@ class Runner {
     // Headless the prompt is not drawn into a window: put its band where the window shows it.
     const int band = prepared_.presentation.prompt_band_px;
     if (prompt && !station_.window() && band > 0 && band <= image.rows)
-      PromptBand(image.cols, band, protocol_.responses.prompt).copyTo(image.rowRange(image.rows - band, image.rows));
+      PromptBand(image.cols, band, protocol::PromptOf(protocol_, trial)).copyTo(image.rowRange(image.rows - band, image.rows));
     char name[32];
     std::snprintf(name, sizeof name, "trial-%04d", trial.index + 1);
     Json frame = DescribeFrame(prepared_.scene ? &*prepared_.scene : nullptr, scene, prepared_.presentation,
@@ -230,7 +231,7 @@ class Runner {
     frame["trial_index"] = trial.index;
     frame["block"] = trial.block;
     frame["practice"] = trial.practice;
-    frame["prompt"] = prompt ? Json(protocol_.responses.prompt) : Json();
+    frame["prompt"] = prompt ? Json(protocol::PromptOf(protocol_, trial)) : Json();
     if (scene.content == "picture")
       frame["real_picture"]["photo"] = protocol_.content.real_photos.empty()
                                            ? protocol_.scene.ShownPhoto().string()
@@ -306,7 +307,8 @@ class Runner {
     if (trial.task != Task::kAdjustment) {
       // A moving stimulus is watched to its end before the answer (task 1 is one answer per run); intervals too.
       for (const KeyPress& press : presses)
-        station_.Script(keys_.Key(press.action, trial.task), onset + StimulusEndS(protocol_, scene) + press.after_ms / 1000);
+        station_.Script(keys_.Key(press.action, trial.task),
+                        onset + StimulusEndS(protocol::TimingOf(protocol_, trial), scene) + press.after_ms / 1000);
       return;
     }
     double t = onset;
@@ -320,18 +322,20 @@ class Runner {
   Outcome RunTrial(const protocol::Trial& trial, const TrialScene& scene, store::Response* response,
                    std::vector<store::FrameRecord>* frames) {
     station_.StartTrial();
+    const protocol::Timing& timing = protocol::TimingOf(protocol_, trial);  // its block's
+    const std::string& prompt_text = protocol::PromptOf(protocol_, trial);
     // Whatever the trial's frames need from disk or a resampling, now, not in its first frame.
     renderer_.Prepare(scene.intervals > 0 ? IntervalScene(scene, IntervalShowsRight(trial, scene, 0)) : scene);
     // Inter-trial interval: the grey field.
-    if (protocol_.timing.inter_trial_ms > 0) {
+    if (timing.inter_trial_ms > 0) {
       if (station_.window()) {
         Blank().Present(context_.width_px(), context_.height_px());
         station_.Flip();
       }
-      station_.Wait(protocol_.timing.inter_trial_ms / 1000);
+      station_.Wait(timing.inter_trial_ms / 1000);
     }
     // A fixation mark before the stimulus, where the participant should look.
-    if (protocol_.timing.fixation_ms > 0) ShowFor(FixationScreen(screen_size_), protocol_.timing.fixation_ms / 1000);
+    if (timing.fixation_ms > 0) ShowFor(FixationScreen(screen_size_), timing.fixation_ms / 1000);
     station_.ClearScript();
     // Keys pressed before the stimulus (during the interval) answer nothing: drop them. Escape still pauses.
     for (const InputEvent& e : station_.Poll())
@@ -341,17 +345,17 @@ class Runner {
     int level = trial.start_index;
     const int levels = static_cast<int>(trial.adjust_levels.size());
     Json steps = Json::array();
-    const double stimulus_s = protocol_.timing.stimulus_ms / 1000;
+    const double stimulus_s = timing.stimulus_ms / 1000;
     double last_flip = -1;
     int composed_level = -2;  // none yet (-1 is the level of a trial without levels)
     // Intervals (2IFC, odd one out): each interval's object for interval_ms, grey for isi_ms between them, then grey
     // until the answer.
     const int n = scene.intervals;
-    const double interval_s = protocol_.timing.interval_ms / 1000, isi_s = protocol_.timing.isi_ms / 1000;
+    const double interval_s = timing.interval_ms / 1000, isi_s = timing.isi_ms / 1000;
     std::vector<TrialScene> intervals;
     for (int k = 0; k < n; ++k) intervals.push_back(IntervalScene(scene, IntervalShowsRight(trial, scene, k)));
     // With responses.after_motion keys count (and the prompt shows) only once the motion or the intervals are over.
-    const double answer_from_s = protocol_.responses.after_motion ? StimulusEndS(protocol_, scene) : 0;
+    const double answer_from_s = protocol_.responses.after_motion ? StimulusEndS(timing, scene) : 0;
     int composed_interval = -1;
     for (int frame = 0;; ++frame) {
       const double t = onset < 0 ? 0 : station_.Now() - onset - paused_s;
@@ -368,13 +372,13 @@ class Runner {
         composed_level = level;
       }
       // The prompt shows while an answer is taken.
-      const bool prompt = prepared_.presentation.prompt_band_px > 0 && t >= answer_from_s;
+      const bool prompt = prepared_.presentation.prompt_band_px > 0 && !prompt_text.empty() && t >= answer_from_s;
       if (station_.window()) {
         if (shown)
           renderer_.Present(context_.width_px(), context_.height_px());
         else
           Blank().Present(context_.width_px(), context_.height_px());
-        if (prompt) Prompt().PresentAt(0, context_.height_px() - prepared_.presentation.prompt_band_px, context_.height_px());
+        if (prompt) Prompt(prompt_text).PresentAt(0, context_.height_px() - prepared_.presentation.prompt_band_px, context_.height_px());
       }
       if (frame == 0 && !options_.capture_dir.empty())
         Capture(trial, n > 0 ? intervals[0] : scene, prompt, levels > 0 ? trial.adjust_levels[size_t(level)] : 0);
@@ -401,8 +405,8 @@ class Runner {
       last_flip = flip;
       if (station_.Closed()) return Outcome::kQuit;
       // A deadline: no answer this long after onset is recorded as "none", without a response time.
-      if (protocol_.timing.deadline_ms > 0 && trial.task != Task::kAdjustment &&
-          (station_.Now() - onset - paused_s) * 1000 >= protocol_.timing.deadline_ms) {
+      if (timing.deadline_ms > 0 && trial.task != Task::kAdjustment &&
+          (station_.Now() - onset - paused_s) * 1000 >= timing.deadline_ms) {
         response->choice = store::kChoiceNone;
         response->rt_ms = std::numeric_limits<double>::quiet_NaN();
         return Outcome::kAnswered;
@@ -522,7 +526,8 @@ class Runner {
           if (block) text = block->instructions;
           if (text.empty() && shown_practice && !trial.practice) text = "The practice is over; the study starts now.";
         }
-        if (!text.empty() && !ShowScreen(trial.practice ? "Practice" : "Part: " + trial.block, text,
+        // The block's title or "Part n of N", never its name (which may give the condition away).
+        if (!text.empty() && !ShowScreen(protocol::BlockTitle(protocol_, trials_, size_t(i)), text,
                                          "Press Return to go on"))
           return result;
         shown_block = part;
@@ -568,10 +573,10 @@ class Runner {
       }
       record.RecordResponse(start.session_id, i, response, frames);  // committed before anything else happens
       // Feedback where an answer is right or wrong: procedure trials, odd one out, practice run to a criterion.
-      if (right && protocol_.timing.feedback_ms > 0)
+      if (right && protocol::TimingOf(protocol_, trial).feedback_ms > 0)
         ShowFor(TextScreen(screen_size_, response.choice == store::kChoiceNone ? "Too slow" : correct ? "Correct" : "Wrong", "",
                            ""),
-                protocol_.timing.feedback_ms / 1000);
+                protocol::TimingOf(protocol_, trial).feedback_ms / 1000);
       ++result.answered_now;
       progress(i + 1);
       if (!trial.practice) ++main_answered;
@@ -604,11 +609,13 @@ class Runner {
     return *blank_;
   }
 
-  // The response prompt's band (window only), made once.
-  const render::WindowImage& Prompt() {
-    if (!prompt_)
+  // The response prompt's band (window only), made again only when a block's prompt differs from the last one.
+  const render::WindowImage& Prompt(const std::string& text) {
+    if (!prompt_ || prompt_text_ != text) {
       prompt_ = std::make_unique<render::WindowImage>(
-          PromptBand(context_.width_px(), prepared_.presentation.prompt_band_px, protocol_.responses.prompt));
+          PromptBand(context_.width_px(), prepared_.presentation.prompt_band_px, text));
+      prompt_text_ = text;
+    }
     return *prompt_;
   }
 
@@ -625,6 +632,7 @@ class Runner {
   Station station_;
   cv::Size screen_size_;
   std::unique_ptr<render::WindowImage> blank_, prompt_;
+  std::string prompt_text_;  // what prompt_ says
   int64_t dropped_frames_ = 0;
 };
 
@@ -656,7 +664,8 @@ Json CollectInfo(const protocol::Protocol& p, const RunOptions& options, const s
     return f.type == "text" ? std::string("text") : std::string(range);
   };
   std::string asked;
-  for (const auto& f : p.participant_info) asked += (asked.empty() ? "" : ", ") + f.key;
+  std::vector<std::string> keys;
+  for (const auto& f : p.participant_info) asked += (asked.empty() ? "" : ", ") + f.key, keys.push_back(f.key);
   Json info = Json::object();
   for (const auto& [key, text] : options.info) {
     const protocol::InfoField* f = field_of(key);
@@ -664,7 +673,7 @@ Json CollectInfo(const protocol::Protocol& p, const RunOptions& options, const s
       throw Error(ErrorKind::kUsage, "--info " + Echo(key, false) + ": " + options.protocol_file.string() +
                                          (asked.empty() ? " asks for no participant information"
                                                         : " asks for " + asked + " (participant_info), not " +
-                                                              Echo(key, false)));
+                                                              Echo(key, false) + DidYouMean(key, keys)));
     if (const std::string why = protocol::CheckInfoValue(*f, text); !why.empty())
       throw Error(ErrorKind::kUsage, "--info " + key + "=" + Echo(text, false) + ": " + why);
     info[key] = value_of(*f, text);
