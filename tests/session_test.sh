@@ -420,6 +420,13 @@ img = np.asarray(Image.open(sys.argv[3] + "/trial-0001.png").convert("L")).astyp
 band = img[y0:y0 + h]
 assert band.max() - band.min() > 80, "no text in the prompt band"
 assert (band > 200).mean() < 0.2, "the band is not mostly grey"
+# Each block's own prompt (yes-no-ball.json gives one per block, none at the top): the trial's block's is shown.
+import glob
+prompts = {}
+for f in glob.glob(sys.argv[3] + "/trial-*.json"):
+    c = json.load(open(f))
+    prompts.setdefault(c["block"], set()).add(c["prompt"])
+assert prompts == {"yes_no": {"Does it stand out?  Y (yes) or N (no)"}, "rating": {"1 (fits) to 5 (stands out)"}}, prompts
 print(len(odd), "odd-one-out and", len(one), "one-object trials")
 PYEOF
   # Stopped after 5 answers and resumed: the same record as one run through.
@@ -636,6 +643,18 @@ PYEOF
     || fail "deadline: $(sql "$W/d.sqlite" "SELECT choice, rt_ms FROM responses LIMIT 3")"
   [ "$(sql "$W/d.sqlite" "SELECT count(*) FROM responses WHERE json_extract(shown, '$.correct') = 0")" = 40 ] \
     || fail "deadline: a timeout must count wrong"
+  # The same deadline given by the block's own timing (overriding the protocol's, which has none): its trials read it.
+  $PY - "$P/quest-blur-difference.json" "$W/fast-block.json" <<'PYEOF'
+import json, sys
+p = json.load(open(sys.argv[1]))
+p["timing"].pop("deadline_ms", None)
+p["blocks"][0]["timing"] = {"deadline_ms": 300}
+json.dump(p, open(sys.argv[2], "w"))
+PYEOF
+  sed -i "s|\"\.\./|\"$P/../|g" "$W/fast-block.json"
+  $BC run "$W/fast-block.json" --participant D1 --db "$W/db.sqlite" --observer sim > /dev/null 2>&1 || fail "block deadline run"
+  [ "$(sql "$W/db.sqlite" "SELECT count(*) FROM responses WHERE choice = 'none' AND rt_ms IS NULL")" = 40 ] \
+    || fail "block deadline: $(sql "$W/db.sqlite" "SELECT choice, rt_ms FROM responses LIMIT 3")"
   $PY - "$P/test1-static-grids.json" "$W/feedback.json" <<'PYEOF'
 import json, sys
 p = json.load(open(sys.argv[1]))
@@ -648,7 +667,7 @@ PYEOF
   code=$?
   set -e
   [ $code = 3 ] && grep -q "/timing/feedback_ms: needs a correct answer" "$W/err" || fail "feedback without a procedure: $(cat "$W/err")"
-  echo "ok: a missed deadline records none without a time and counts wrong; feedback needs a procedure" ;;
+  echo "ok: a missed deadline (the protocol's or the block's) records none without a time and counts wrong; feedback needs a procedure" ;;
 second_writer)
   # While one process runs a session, a second one resuming it is refused with a clear message (exit 3).
   $BC run "$P/test2-moving-balls.json" --participant L1 --db "$W/s.sqlite" --observer sim --sim-fps 8 > /dev/null 2>&1 &
