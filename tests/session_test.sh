@@ -693,7 +693,7 @@ window_adjust)
   run=$!
   at Instructions Return; at Practice Return
   at "trial 1 of 28" Right; at "trial 1 of 28" Right; at "trial 1 of 28" Return   # two steps on
-  at "Part: main" Return
+  at "Part 1 of 1" Return   # the main block's screen: its place, never its name
   at "trial 2 of 28" "" 4; at "trial 2 of 28" "" 1                               # wheel up (next), click accepts
   at "trial 3 of 28" Left; at "trial 3 of 28" "" 5; at "trial 3 of 28" "" 5       # three steps back
   last=1 at "trial 3 of 28" Return                                              # the third answer ends the run
@@ -728,7 +728,7 @@ window)
   at Instructions Return; at Practice Return
   keys=(Left Right Left Right Down Left Right Down Left Right Down Left Left)
   for i in "${!keys[@]}"; do
-    [ "$i" = 2 ] && at "Part: main" Return
+    [ "$i" = 2 ] && at "Part 1 of 1" Return  # the main block's screen: its place, never its name
     at "trial $((i + 1)) of 13" "${keys[$i]}"
   done
   wait $run || fail "run failed: $(cat "$W/err")"

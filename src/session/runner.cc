@@ -221,7 +221,8 @@ class Runner {
     // Headless the prompt is not drawn into a window: put its band where the window shows it.
     const int band = prepared_.presentation.prompt_band_px;
     if (prompt && !station_.window() && band > 0 && band <= image.rows)
-      PromptBand(image.cols, band, protocol::PromptOf(protocol_, trial)).copyTo(image.rowRange(image.rows - band, image.rows));
+      PromptBand(image.cols, band, protocol::PromptOf(protocol_, trial))
+          .copyTo(image.rowRange(image.rows - band, image.rows));
     char name[32];
     std::snprintf(name, sizeof name, "trial-%04d", trial.index + 1);
     Json frame = DescribeFrame(prepared_.scene ? &*prepared_.scene : nullptr, scene, prepared_.presentation,
