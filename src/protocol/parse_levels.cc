@@ -18,12 +18,14 @@ void Parser::CheckReadName(const std::string& name, const std::string& what, con
 }
 
 // Checks a value by the name it goes by (a factor's name, or a key of an object level).
-void Parser::CheckLevelValue(const std::string& name, const Json& v, const std::string& ptr) {
+void Parser::CheckLevelValue(const std::string& name, const Json& v, const std::string& ptr,
+                             const std::string& where) {
+  auto report = [&](const std::string& what) { Problem(ptr, what + ", got " + Got(v) + where); };
   auto integer_in = [&](int lo, int hi, const std::string& what) {
-    if (!IntegerIn(v, lo, hi)) Problem(ptr, what + " must be an integer in " + Range(lo, hi, ""), v);
+    if (!IntegerIn(v, lo, hi)) report(what + " must be an integer in " + Range(lo, hi, ""));
   };
   auto number_in = [&](double lo, double hi, const std::string& unit, const std::string& what) {
-    if (!NumberIn(v, lo, hi)) Problem(ptr, what + " must be a number in " + Range(lo, hi, unit), v);
+    if (!NumberIn(v, lo, hi)) report(what + " must be a number in " + Range(lo, hi, unit));
   };
   if (name == "edge" || name == "from_edge" || name == "to_edge") integer_in(1, kEdges, "an edge");
   else if (name == "section") integer_in(1, kEdges - 1, "a section (edge s to s + 1)");
@@ -39,15 +41,14 @@ void Parser::CheckLevelValue(const std::string& name, const Json& v, const std::
   else if (name == "cutoff") number_in(0, 1000, "cycles per picture width", "a cut-off");
   else if (name == "left" || name == "right" || name == "object") {
     if (!IsBlurSource(v))
-      Problem(ptr, "a blur source must be none, measured, measured_section, estimated, fitted, a radius in " +
-                       Range(0, kMaxFixedRadiusPx, "photo px") + ", {\"screen_px\": r} with r in " +
-                       Range(0, kMaxFixedRadiusPx, "") + " or {\"arcmin\": r} with r in " + Range(0, 600, "") +
-                       (v.is_string() ? DidYouMean(v.get<std::string>(), {"none", "measured", "measured_section",
-                                                                          "estimated", "fitted"})
-                                      : std::string()),
-              v);
+      report("a blur source must be none, measured, measured_section, estimated, fitted, a radius in " +
+             Range(0, kMaxFixedRadiusPx, "photo px") + ", {\"screen_px\": r} with r in " +
+             Range(0, kMaxFixedRadiusPx, "") + " or {\"arcmin\": r} with r in " + Range(0, 600, "") +
+             (v.is_string() ? DidYouMean(v.get<std::string>(), {"none", "measured", "measured_section", "estimated",
+                                                                "fitted"})
+                            : std::string()));
   } else if (v.is_number() && !std::isfinite(v.get<double>())) {
-    Problem(ptr, "must be a finite number", v);
+    report("must be a finite number");
   }
 }
 
@@ -235,8 +236,10 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
       level[header[c]] = IsWholeDecimal(cell) && std::abs(*number) < 9e15 ? Json(int64_t(*number))
                          : number                                       ? Json(*number)
                                                                         : Json(cell);
-      if (cell.empty()) Problem(cp, "is empty", Json(cell));
-      else CheckLevelValue(header[c], level[header[c]], cp);
+      // Where the cell is, for the one who opens the table to fix it.
+      const std::string in = " (" + line + ", column " + std::to_string(c + 1) + ")";
+      if (cell.empty()) Problem(cp, "is empty, got \"\"" + in);
+      else CheckLevelValue(header[c], level[header[c]], cp, in);
     }
     if (!printable) continue;
     factor.levels.push_back(std::move(level));

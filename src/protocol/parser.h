@@ -104,7 +104,8 @@ class Parser {
   void ParseScene(const Json& v, const std::string& ptr, Protocol* p);
   void ParseContent(const Json& v, const std::string& ptr, Protocol* p);
   std::vector<Factor> ParseFactors(const Json& v, const std::string& ptr);
-  void CheckLevelValue(const std::string& name, const Json& v, const std::string& ptr);
+  // `where`, if given, follows the value in a problem (a conditions table's " (FILE line N, column C)").
+  void CheckLevelValue(const std::string& name, const Json& v, const std::string& ptr, const std::string& where = "");
   std::optional<Adjustment> ParseAdjust(const Json& v, const std::string& ptr);
   void ParseRealCamera(const Json& v, const std::string& ptr, const Json& content, Protocol* p);
   std::optional<Procedure> ParseProcedure(const Json& v, const std::string& ptr);

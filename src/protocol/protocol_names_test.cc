@@ -81,6 +81,24 @@ TEST(ProtocolValidate, MisspeltConditionsColumnIsRefusedNamingFileLineAndColumn)
   EXPECT_TRUE(Problems(j).empty()) << Problems(j).front();
 }
 
+// A cell's problem says where the cell is in the table (its line and column), after its pointer and value.
+TEST(ProtocolValidate, ConditionsCellProblemNamesTheTablesLineAndColumn) {
+  const fs::path dir = SceneFolder();
+  std::ofstream(dir / "rows-cells.csv") << "id,speed_cm_s,left,right\n1,3,measured,none\n2,300,Measured,\n";
+  Json j = Valid();
+  j["blocks"][0].erase("factors");
+  j["blocks"][0]["conditions"] = "rows-cells.csv";
+  const std::string table = (dir / "rows-cells.csv").string();
+  const auto problems = Problems(j);
+  ASSERT_EQ(problems.size(), 3u);
+  EXPECT_EQ(problems[0], Line("/blocks/0/conditions/row/1/speed_cm_s: a speed must be a number in [0.1, 100] cm/s, "
+                              "got 300 (" + table + " line 3, column 2)"));
+  EXPECT_TRUE(Contains(problems[1], "/blocks/0/conditions/row/1/left: a blur source must be ")) << problems[1];
+  EXPECT_TRUE(Contains(problems[1], "(did you mean measured?), got \"Measured\" (" + table + " line 3, column 3)"))
+      << problems[1];
+  EXPECT_EQ(problems[2], Line("/blocks/0/conditions/row/1/right: is empty, got \"\" (" + table + " line 3, column 4)"));
+}
+
 TEST(ProtocolValidate, EnumValueMisspeltGetsDidYouMean) {
   Json j = Valid();
   j["counterbalance"] = "swap-copies";
