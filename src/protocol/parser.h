@@ -13,7 +13,6 @@
 namespace blurcue::protocol::detail {
 namespace fs = std::filesystem;
 
-
 // Edges a board can have: 101 for a board 100 squares long (the thesis's 7 x 10 board has 11, figure 4.10). A
 // session checks its levels against the calibrated board's own count (session/stimulus.cc DescribeTrial).
 const int kEdges = 101;
@@ -27,6 +26,7 @@ const size_t kMaxAdjustLevels = 50;     // each is low-passed up front: ~0.1 s a
 const size_t kMaxTextChars = 2000;      // instructions: about what a screen holds
 const size_t kMaxPathChars = 4096;
 
+// `key` as a JSON pointer token (RFC 6901: ~ as ~0, / as ~1).
 std::string Escape(const std::string& key);
 // `value` as compact JSON of at most about 80 characters (cut at a character, "..." when cut): what a problem got.
 std::string Got(const Json& value);
@@ -98,6 +98,7 @@ class Parser {
   // What is in it (an image that decodes, a calibration that parses) is checked before a session: PrepareSession.
   bool CheckFile(const fs::path& resolved, const std::string& ptr, const Json& got);
 
+  // The protocol `json` describes; its problems are in `problems` (and counted in more_problems) afterwards.
   Protocol Parse(const Json& json);
 
  private:
