@@ -60,3 +60,26 @@ print('schema ok')")
     set_tests_properties(protocol_schema PROPERTIES PASS_REGULAR_EXPRESSION "schema ok")
   endif()
 endif()
+
+# A factor nothing reads is refused with the nearest name that is read (exit 3, the one problem on one line).
+add_test(NAME cli_validate_misspelt_factor
+         COMMAND ${CMAKE_COMMAND} -DCMD=$<TARGET_FILE:blurcue>
+                 "-DARGS=validate;${PROJECT_SOURCE_DIR}/tests/data/misspelt-factor.json;--no-files" -DEXPECT_CODE=3
+                 "-DEXPECT_TEXT=misspelt-factor.json: /factors/secton: no part of blurcue reads a factor secton (did you mean section?); to record it as a label nobody reads, name it label_secton"
+                 -DONE_LINE=1 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+# Participant information: a choice in the wrong case, and a key the protocol does not ask for, are refused (exit 2)
+# with the one meant, before anything is recorded (over the session tests' copy of the protocols and their scene).
+set(CLI_T ${PROJECT_BINARY_DIR}/cli-test)
+foreach(case "handedness=Left|--info handedness=Left: must be one of left, right, both (did you mean left?)"
+             "handednes=left|(participant_info), not handednes (did you mean handedness?)")
+  string(REPLACE "|" ";" parts "${case}")
+  list(GET parts 0 info)
+  list(GET parts 1 expect)
+  string(MAKE_C_IDENTIFIER "${info}" id)
+  add_test(NAME cli_run_info_did_you_mean_${id}
+           COMMAND ${CMAKE_COMMAND} -DCMD=$<TARGET_FILE:blurcue>
+                   "-DARGS=run;${CLI_T}/protocols/groups-and-info.json;--participant;P1;--db;${CLI_T}/info-did-you-mean.sqlite;--observer;sim;--info;age=34;--info;${info};--info;vision=normal"
+                   -DEXPECT_CODE=2 "-DEXPECT_TEXT=${expect}" -DONE_LINE=1
+                   -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+  set_tests_properties(cli_run_info_did_you_mean_${id} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols")
+endforeach()

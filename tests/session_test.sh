@@ -420,6 +420,13 @@ img = np.asarray(Image.open(sys.argv[3] + "/trial-0001.png").convert("L")).astyp
 band = img[y0:y0 + h]
 assert band.max() - band.min() > 80, "no text in the prompt band"
 assert (band > 200).mean() < 0.2, "the band is not mostly grey"
+# Each block's own prompt (yes-no-ball.json gives one per block, none at the top): the trial's block's is shown.
+import glob
+prompts = {}
+for f in glob.glob(sys.argv[3] + "/trial-*.json"):
+    c = json.load(open(f))
+    prompts.setdefault(c["block"], set()).add(c["prompt"])
+assert prompts == {"yes_no": {"Does it stand out?  Y (yes) or N (no)"}, "rating": {"1 (fits) to 5 (stands out)"}}, prompts
 print(len(odd), "odd-one-out and", len(one), "one-object trials")
 PYEOF
   # Stopped after 5 answers and resumed: the same record as one run through.
@@ -636,6 +643,18 @@ PYEOF
     || fail "deadline: $(sql "$W/d.sqlite" "SELECT choice, rt_ms FROM responses LIMIT 3")"
   [ "$(sql "$W/d.sqlite" "SELECT count(*) FROM responses WHERE json_extract(shown, '$.correct') = 0")" = 40 ] \
     || fail "deadline: a timeout must count wrong"
+  # The same deadline given by the block's own timing (overriding the protocol's, which has none): its trials read it.
+  $PY - "$P/quest-blur-difference.json" "$W/fast-block.json" <<'PYEOF'
+import json, sys
+p = json.load(open(sys.argv[1]))
+p["timing"].pop("deadline_ms", None)
+p["blocks"][0]["timing"] = {"deadline_ms": 300}
+json.dump(p, open(sys.argv[2], "w"))
+PYEOF
+  sed -i "s|\"\.\./|\"$P/../|g" "$W/fast-block.json"
+  $BC run "$W/fast-block.json" --participant D1 --db "$W/db.sqlite" --observer sim > /dev/null 2>&1 || fail "block deadline run"
+  [ "$(sql "$W/db.sqlite" "SELECT count(*) FROM responses WHERE choice = 'none' AND rt_ms IS NULL")" = 40 ] \
+    || fail "block deadline: $(sql "$W/db.sqlite" "SELECT choice, rt_ms FROM responses LIMIT 3")"
   $PY - "$P/test1-static-grids.json" "$W/feedback.json" <<'PYEOF'
 import json, sys
 p = json.load(open(sys.argv[1]))
@@ -648,7 +667,7 @@ PYEOF
   code=$?
   set -e
   [ $code = 3 ] && grep -q "/timing/feedback_ms: needs a correct answer" "$W/err" || fail "feedback without a procedure: $(cat "$W/err")"
-  echo "ok: a missed deadline records none without a time and counts wrong; feedback needs a procedure" ;;
+  echo "ok: a missed deadline (the protocol's or the block's) records none without a time and counts wrong; feedback needs a procedure" ;;
 second_writer)
   # While one process runs a session, a second one resuming it is refused with a clear message (exit 3).
   $BC run "$P/test2-moving-balls.json" --participant L1 --db "$W/s.sqlite" --observer sim --sim-fps 8 > /dev/null 2>&1 &
@@ -674,7 +693,7 @@ window_adjust)
   run=$!
   at Instructions Return; at Practice Return
   at "trial 1 of 28" Right; at "trial 1 of 28" Right; at "trial 1 of 28" Return   # two steps on
-  at "Part: main" Return
+  at "Part 1 of 1" Return   # the main block's screen: its place, never its name
   at "trial 2 of 28" "" 4; at "trial 2 of 28" "" 1                               # wheel up (next), click accepts
   at "trial 3 of 28" Left; at "trial 3 of 28" "" 5; at "trial 3 of 28" "" 5       # three steps back
   last=1 at "trial 3 of 28" Return                                              # the third answer ends the run
@@ -709,7 +728,7 @@ window)
   at Instructions Return; at Practice Return
   keys=(Left Right Left Right Down Left Right Down Left Right Down Left Left)
   for i in "${!keys[@]}"; do
-    [ "$i" = 2 ] && at "Part: main" Return
+    [ "$i" = 2 ] && at "Part 1 of 1" Return  # the main block's screen: its place, never its name
     at "trial $((i + 1)) of 13" "${keys[$i]}"
   done
   wait $run || fail "run failed: $(cat "$W/err")"
@@ -1291,17 +1310,22 @@ resume_exact)
   done
   echo "ok: stopped after 5 and resumed = uninterrupted to the last digit of every response and flip time (test 2, depth matching)" ;;
 level_names)
-  # A design's levels named like what trials.csv records of its own - a conditions table's status, participant,
-  # r_left_px and info_age; a staircase table's level, test_side and correct - validate, run and come out of export as
-  # factor_NAME with the table's values, beside the columns the record fills (the radius shown, the staircase's level,
-  # the participant's age). r_left_px, level, test_side and correct used to lose the table's values, and info_age
-  # made two columns of one name.
+  # A design's columns are names blurcue reads or labels: a conditions table's status (a name trials.csv records of
+  # its own, which nothing reads as a level) is refused at validate with the label it could be. Labels named like
+  # what trials.csv records - label_status, label_participant, label_r_left_px, label_info_age; a staircase table's
+  # label_level, label_test_side, label_correct - validate, run and come out of export with the table's values,
+  # beside the columns the record fills (the radius shown, the staircase's level, the participant's age).
   $PY - "$P/test1-static-grids.json" "$W" <<'PYEOF'
 import json, sys
 t, w = json.load(open(sys.argv[1])), sys.argv[2]
-open(w + "/rows.csv", "w").write("edge,status,participant,r_left_px,info_age\n3,answered,P9,7.5,41\n6,x,P8,1,42\n")
-open(w + "/stairs.csv", "w").write("edge,level,test_side,correct\n6,99,left,1\n3,98,right,0\n")
+open(w + "/unread.csv", "w").write("edge,status\n3,answered\n")
+open(w + "/rows.csv", "w").write("edge,label_status,label_participant,label_r_left_px,label_info_age\n"
+                                 "3,answered,P9,7.5,41\n6,x,P8,1,42\n")
+open(w + "/stairs.csv", "w").write("edge,label_level,label_test_side,label_correct\n6,99,left,1\n3,98,right,0\n")
 common = {"version": 1, "scene": t["scene"], "content": {"type": "grid"}, "task": "forced_choice"}
+json.dump(dict(common, name="unread-table",
+               blocks=[{"name": "tab", "conditions": "unread.csv", "sides": {"left": "measured", "right": "none"}}]),
+          open(w + "/unread.json", "w"))
 json.dump(dict(common, name="clash-table", participant_info=[{"key": "age", "type": "integer", "min": 16, "max": 99}],
                blocks=[{"name": "tab", "conditions": "rows.csv", "sides": {"left": "measured", "right": "none"}}]),
           open(w + "/table.json", "w"))
@@ -1312,7 +1336,12 @@ json.dump(dict(common, name="clash-stairs", responses={"cant_tell": None},
                                       "steps": [0.5]}}]),
           open(w + "/stairs.json", "w"))
 PYEOF
-  sed -i "s|\"\.\./|\"$P/../|g" "$W/table.json" "$W/stairs.json"
+  sed -i "s|\"\.\./|\"$P/../|g" "$W/unread.json" "$W/table.json" "$W/stairs.json"
+  code=0
+  $BC validate "$W/unread.json" > "$W/out" 2>&1 || code=$?
+  [ "$code" = 3 ] || fail "validate of a table with a column nobody reads: exit $code, expected 3"
+  grep -q "unread.csv line 1, column 2: no part of blurcue reads a column status; to record it as a label nobody reads, name it label_status" "$W/out" ||
+    fail "validate of an unread column: $(tail -1 "$W/out")"
   for p in table stairs; do
     $BC validate "$W/$p.json" > "$W/out" 2>&1 || fail "validate $p: $(tail -1 "$W/out")"
   done
@@ -1321,7 +1350,7 @@ PYEOF
   $BC run "$W/stairs.json" --participant P2 --db "$W/s.sqlite" --observer sim > "$W/out" 2>&1 ||
     fail "run stairs: $(tail -1 "$W/out")"
   $BC export --db "$W/s.sqlite" --out "$W/tables" > /dev/null
-  $PY - "$W/tables" <<'PYEOF' || fail "levels named like recorded columns"
+  $PY - "$W/tables" <<'PYEOF' || fail "labels named like recorded columns"
 import csv, sys
 d = sys.argv[1]
 header = next(csv.reader(open(d + "/trials.csv")))
@@ -1331,20 +1360,20 @@ table = [r for r in rows if r["study"] == "clash-table"]
 assert len(table) == 2, len(table)
 for r in table:
     designed = {"3": ("answered", "P9", "7.5", "41"), "6": ("x", "P8", "1", "42")}[r["edge"]]
-    got = (r["factor_status"], r["factor_participant"], r["factor_r_left_px"], r["factor_info_age"])
+    got = (r["label_status"], r["label_participant"], r["label_r_left_px"], r["label_info_age"])
     assert got == designed, (r["edge"], got)
     assert (r["participant"], r["status"], r["info_age"]) == ("P1", "answered", "30"), r
-    assert r["r_left_px"] and r["r_left_px"] != r["factor_r_left_px"], r["r_left_px"]  # the radius shown
+    assert r["r_left_px"] and r["r_left_px"] != r["label_r_left_px"], r["r_left_px"]  # the radius shown
 stairs = [r for r in rows if r["study"] == "clash-stairs"]
 assert len(stairs) == 6, len(stairs)
 for r in stairs:
     designed = {"6": ("99", "left", "1"), "3": ("98", "right", "0")}[r["edge"]]
-    assert (r["factor_level"], r["factor_test_side"], r["factor_correct"]) == designed, r
+    assert (r["label_level"], r["label_test_side"], r["label_correct"]) == designed, r
     assert 0.1 <= float(r["level"]) <= 2 and r["test_side"] in ("left", "right") and r["correct"] in ("0", "1"), r
 codebook = {row["column"]: row["meaning"] for row in csv.DictReader(open(d + "/codebook.csv")) if row["table"] == "trials.csv"}
-assert "factor r_left_px" in codebook["factor_r_left_px"], codebook["factor_r_left_px"]
+assert "factor label_r_left_px" in codebook["label_r_left_px"], codebook["label_r_left_px"]
 print("ok")
 PYEOF
-  echo "ok: a table's status, participant, r_left_px, info_age and a staircase table's level, test_side, correct come out as factor_NAME with their values, beside the recorded columns" ;;
+  echo "ok: a column nobody reads is refused at validate; a table's label_status, label_participant, label_r_left_px, label_info_age and a staircase table's label_level, label_test_side, label_correct come out with their values, beside the recorded columns" ;;
 *) fail "unknown case $CASE" ;;
 esac

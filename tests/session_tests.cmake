@@ -115,8 +115,8 @@ string(REPEAT "]" 100000 close)
 add_preflight_test(nested-100000-deep "not valid JSON: nested deeper than 64 levels at line 1, column "
                    "${ball_head} ${ball_scene}, \"factors\": {\"pattern\": [${pattern}]}, \"instructions\": ${open}${close}}")
 set(levels "[1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16,17,18,19,20,21,22,23,24,25,26,27,28,29,30]")
-add_preflight_test(eight-factors-of-30 "/factors: the session would have 656100000000 trials (30 a x 30 b x "
-                   "${ball_head} ${ball_scene}, \"factors\": {\"pattern\": [${pattern}], \"a\": ${levels}, \"b\": ${levels}, \"c\": ${levels}, \"d\": ${levels}, \"e\": ${levels}, \"f\": ${levels}, \"g\": ${levels}, \"h\": ${levels}}}")
+add_preflight_test(eight-factors-of-30 "/factors: the session would have 656100000000 trials (30 label_a x 30 label_b x "
+                   "${ball_head} ${ball_scene}, \"factors\": {\"pattern\": [${pattern}], \"label_a\": ${levels}, \"label_b\": ${levels}, \"label_c\": ${levels}, \"label_d\": ${levels}, \"label_e\": ${levels}, \"label_f\": ${levels}, \"label_g\": ${levels}, \"label_h\": ${levels}}}")
 
 # A conditions table's cell of Latin-1 bytes or with an escape byte: exit 3 naming the CSV file, its line and column
 # (it used to be exit 10, "invalid UTF-8 byte", or an escape written raw into the record).

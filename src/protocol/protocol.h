@@ -68,6 +68,16 @@ std::string ToString(Procedure::Kind kind);
 // overflow-safe arithmetic) before a trial list is made, so no design can exhaust memory or wrap a count.
 inline constexpr int kMaxTrials = 10000;
 
+// When things happen in a trial (the protocol's "timing", or a block's overriding it field by field).
+struct Timing {
+  double stimulus_ms = 0;             // 0: until the participant answers
+  double inter_trial_ms = 500;
+  double interval_ms = 1000, isi_ms = 500;  // layout two_intervals: each interval, and the grey between them
+  double deadline_ms = 0;             // forced choice: no answer this long after onset records "none"; 0: no deadline
+  double feedback_ms = 0;             // procedure trials: "Correct" / "Wrong" / "Too slow" shown this long; 0: none
+  double fixation_ms = 0;             // a fixation mark (+) on grey before each stimulus; 0: none
+};
+
 // A block of trials with its own design; blocks run in file order, trials are randomised within a block.
 struct Block {
   std::string name;
@@ -93,6 +103,14 @@ struct Block {
     int max_repeats = 3;
   };
   std::optional<Criterion> criterion;
+  // What the participant sees of the block - never its name, which is the experimenter's (it may give a condition
+  // away): the title of the screen that opens it (1-100 printable characters; empty: "Part n of N", or "Practice",
+  // as BlockTitle says), the prompt while an answer is taken (responses.prompt unless the block gives its own;
+  // empty: none), and its timing (the protocol's, each field the block gives overriding it). Resolved by the parser:
+  // a trial reads its block's, never the protocol's.
+  std::string title;
+  std::string prompt;
+  Timing timing;
 };
 
 struct Scene {
@@ -165,15 +183,6 @@ struct Responses {
   bool after_motion = false;
 };
 
-struct Timing {
-  double stimulus_ms = 0;             // 0: until the participant answers
-  double inter_trial_ms = 500;
-  double interval_ms = 1000, isi_ms = 500;  // layout two_intervals: each interval, and the grey between them
-  double deadline_ms = 0;             // forced choice: no answer this long after onset records "none"; 0: no deadline
-  double feedback_ms = 0;             // procedure trials: "Correct" / "Wrong" / "Too slow" shown this long; 0: none
-  double fixation_ms = 0;             // a fixation mark (+) on grey before each stimulus; 0: none
-};
-
 // How a grid or ball trial's photo maps to the screen (a picture's frame is always fitted, 4:3, at 1 screen px per
 // frame px).
 enum class Scaling { kFit, kNative, kScale, kDegrees };  // "fit" | "native" | a number | width_deg
@@ -237,8 +246,8 @@ struct Protocol {
   std::string instructions;
   int break_every_trials = 0;         // 0: no breaks
   std::string break_text;
-  Responses responses;
-  Timing timing;
+  Responses responses;                // responses.prompt is the blocks' default: a trial reads Block::prompt
+  Timing timing;                      // the blocks' default: a trial reads Block::timing
   Display display;
 };
 
@@ -249,7 +258,6 @@ int IntervalCount(const Protocol& protocol);
 int64_t DesignTrials(const Block& block);
 // Trials of a session (practice included), or kMaxTrials + 1 when it would have more.
 int64_t SessionTrials(const Protocol& protocol);
-
 
 // A trial's level by name: a factor of its own, or a key of an object level (a pattern carries speed and sides, a
 // conditions table's row every column); null when neither.

@@ -232,6 +232,32 @@ const Block* BlockOf(const Protocol& protocol, const Trial& trial) {
   return nullptr;
 }
 
+const Timing& TimingOf(const Protocol& protocol, const Trial& trial) {
+  const Block* block = BlockOf(protocol, trial);
+  return block ? block->timing : protocol.timing;
+}
+
+const std::string& PromptOf(const Protocol& protocol, const Trial& trial) {
+  const Block* block = BlockOf(protocol, trial);
+  return block ? block->prompt : protocol.responses.prompt;
+}
+
+std::string BlockTitle(const Protocol& protocol, const std::vector<Trial>& trials, size_t index) {
+  const Trial& trial = trials.at(index);
+  const Block* block = BlockOf(protocol, trial);
+  const bool practice_block = block && block->practice;
+  if (trial.practice && !practice_block) return "Practice";
+  if (block && !block->title.empty()) return block->title;
+  if (trial.practice) return "Practice";
+  // The participant's own count: the scored blocks this session runs (its group's), in the order it runs them. A
+  // block's name is the experimenter's and may give the condition away ("rate-sharp"), so it is never shown.
+  std::vector<std::string> scored;
+  for (const Trial& t : trials)
+    if (!t.practice && std::find(scored.begin(), scored.end(), t.block) == scored.end()) scored.push_back(t.block);
+  const size_t n = size_t(std::find(scored.begin(), scored.end(), trial.block) - scored.begin()) + 1;
+  return "Part " + std::to_string(n) + " of " + std::to_string(scored.size());
+}
+
 int BlockIndex(const Protocol& protocol, const Trial& trial) {
   const Block* block = BlockOf(protocol, trial);
   return block ? static_cast<int>(block - protocol.blocks.data()) : 0;

@@ -89,6 +89,14 @@ std::string AssignGroup(const Protocol& protocol, const std::string& participant
 const Block* BlockOf(const Protocol& protocol, const Trial& trial);
 // Its place in protocol.blocks (0 when no block has the trial's name, as for a trial made by hand).
 int BlockIndex(const Protocol& protocol, const Trial& trial);
+// What `trial` reads of its block (Block::timing, Block::prompt); the protocol's own for a trial of no block.
+const Timing& TimingOf(const Protocol& protocol, const Trial& trial);
+const std::string& PromptOf(const Protocol& protocol, const Trial& trial);
+// The title of the screen that opens the part trials[index] belongs to, never a block's name: "Practice" for
+// practice drawn from a main block (protocol.practice); else the block's title; else "Practice" for a practice
+// block, or "Part n of N" - n the place of the trial's block among the scored blocks of `trials` in the order the
+// participant runs them, N their count.
+std::string BlockTitle(const Protocol& protocol, const std::vector<Trial>& trials, size_t index);
 
 // The JSON pointer of the field that chose what `trial` shows on `side` ("left" | "right" as shown, swaps
 // applied): the side of a level object (/blocks/1/factors/pattern/2/left) or of the block's sides (/sides/left).

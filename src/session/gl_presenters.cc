@@ -13,8 +13,8 @@
 namespace blurcue::session {
 
 WindowPresenter::WindowPresenter(render::GlContext& context, StimulusRenderer& renderer, cv::Size screen,
-                                 int prompt_band_px, std::string prompt)
-    : GlPresenter(context, renderer), screen_(screen), prompt_band_px_(prompt_band_px), prompt_(std::move(prompt)),
+                                 int prompt_band_px)
+    : GlPresenter(context, renderer), screen_(screen), prompt_band_px_(prompt_band_px),
       frame_s_(1.0 / (context.RefreshHz() > 0 ? context.RefreshHz() : 60.0)) {}
 
 void WindowPresenter::Wait(double seconds) { std::this_thread::sleep_for(std::chrono::duration<double>(seconds)); }
@@ -36,7 +36,7 @@ void WindowPresenter::ShowStimulus(const StimulusFrame& frame) {
     renderer_.Present(w, h);
   else
     Blank().Present(w, h);
-  if (frame.prompt) Prompt().PresentAt(0, h - prompt_band_px_, h);
+  if (!frame.prompt.empty()) Prompt(frame.prompt).PresentAt(0, h - prompt_band_px_, h);
 }
 
 void WindowPresenter::ShowText(const std::string& title, const std::string& body, const std::string& footer) {
@@ -74,7 +74,7 @@ void WindowPresenter::ShowLast(const std::string& title, const std::string& body
   Wait(0.5);
 }
 
-cv::Mat WindowPresenter::ReadFrame(bool /*prompt*/) {
+cv::Mat WindowPresenter::ReadFrame(std::string_view /*prompt*/) {
   return render::ReadWindow(context_.width_px(), context_.height_px());
 }
 
@@ -83,16 +83,18 @@ const render::WindowImage& WindowPresenter::Blank() {
   return *blank_;
 }
 
-const render::WindowImage& WindowPresenter::Prompt() {
-  if (!prompt_image_)
+// Made again only when a block's prompt differs from the last one shown.
+const render::WindowImage& WindowPresenter::Prompt(std::string_view text) {
+  if (!prompt_image_ || prompt_ != text) {
+    prompt_ = std::string(text);
     prompt_image_ = std::make_unique<render::WindowImage>(PromptBand(context_.width_px(), prompt_band_px_, prompt_));
+  }
   return *prompt_image_;
 }
 
 HeadlessPresenter::HeadlessPresenter(render::GlContext& context, StimulusRenderer& renderer, double fps,
-                                     int prompt_band_px, std::string prompt)
-    : GlPresenter(context, renderer), frame_s_(1.0 / fps), prompt_band_px_(prompt_band_px),
-      prompt_(std::move(prompt)) {}
+                                     int prompt_band_px)
+    : GlPresenter(context, renderer), frame_s_(1.0 / fps), prompt_band_px_(prompt_band_px) {}
 
 bool HeadlessPresenter::StartTrial() {
   // Carried over from the session's start, the same durations added to a larger clock and taken off its onset again
@@ -110,12 +112,12 @@ double HeadlessPresenter::DoFlip(double wake_s) {
   return flip;
 }
 
-cv::Mat HeadlessPresenter::ReadFrame(bool prompt) {
+cv::Mat HeadlessPresenter::ReadFrame(std::string_view prompt) {
   cv::Mat image = renderer_.Read();
   // Headless the prompt is not drawn into a window: put its band where the window shows it.
   const int band = prompt_band_px_;
-  if (prompt && band > 0 && band <= image.rows)
-    PromptBand(image.cols, band, prompt_).copyTo(image.rowRange(image.rows - band, image.rows));
+  if (!prompt.empty() && band > 0 && band <= image.rows)
+    PromptBand(image.cols, band, std::string(prompt)).copyTo(image.rowRange(image.rows - band, image.rows));
   return image;
 }
 
@@ -129,8 +131,8 @@ double CapturingPresenter::DoFlip(double wake_s) { return inner_.Flip(wake_s); }
 
 // The trial's first frame as the swap shows it (read back from the window, or the frame composed headless: the same
 // pixels) and what it shows in screen terms.
-void CapturingPresenter::Capture(const protocol::Trial& trial, const stimulus::TrialScene& scene, bool prompt,
-                                 double cutoff) {
+void CapturingPresenter::Capture(const protocol::Trial& trial, const stimulus::TrialScene& scene,
+                                 std::string_view prompt, double cutoff) {
   const cv::Mat image = inner_.ReadFrame(prompt);
   const int band = prepared_.presentation.prompt_band_px;
   char name[32];
@@ -142,7 +144,7 @@ void CapturingPresenter::Capture(const protocol::Trial& trial, const stimulus::T
   frame["trial_index"] = trial.index;
   frame["block"] = trial.block;
   frame["practice"] = trial.practice;
-  frame["prompt"] = prompt ? Json(protocol_.responses.prompt) : Json();
+  frame["prompt"] = !prompt.empty() ? Json(std::string(prompt)) : Json();
   if (scene.content == "picture")
     frame["real_picture"]["photo"] = protocol_.content.real_photos.empty()
                                          ? protocol_.scene.ShownPhoto().string()
@@ -151,7 +153,7 @@ void CapturingPresenter::Capture(const protocol::Trial& trial, const stimulus::T
   // (its "side" below is the slot it is drawn in).
   if (scene.intervals > 0)
     frame["first_interval_shows"] = stimulus::IntervalShowsRight(trial, scene, 0) ? "right" : "left";
-  if (prompt) frame["prompt_rect_px"] = {0, image.rows - band, image.cols, band};
+  if (!prompt.empty()) frame["prompt_rect_px"] = {0, image.rows - band, image.cols, band};
   WriteImage(dir_ / (std::string(name) + ".png"), image);
   WriteFileAtomically(dir_ / (std::string(name) + ".json"), frame.dump(1) + "\n");
 }

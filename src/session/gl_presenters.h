@@ -31,8 +31,8 @@ class GlPresenter : public Presenter {
   const std::array<std::optional<render::BlurredObject>, 2>& Shown() const override { return renderer_.Shown(); }
   // Where the last composed frame showed the photo.
   render::FrameView View() const { return renderer_.View(); }
-  // The frame as the screen shows it now (8-bit BGR), the prompt's band included when `prompt`.
-  virtual cv::Mat ReadFrame(bool prompt) = 0;
+  // The frame as the screen shows it now (8-bit BGR), with `prompt` in its band when not empty.
+  virtual cv::Mat ReadFrame(std::string_view prompt) = 0;
 
  protected:
   render::GlContext& context_;
@@ -43,9 +43,8 @@ class GlPresenter : public Presenter {
 // for it (no vsync, e.g. under Xvfb).
 class WindowPresenter : public GlPresenter {
  public:
-  // `prompt_band_px` high at the bottom: the response prompt `prompt` (Presentation::prompt_band_px).
-  WindowPresenter(render::GlContext& context, StimulusRenderer& renderer, cv::Size screen, int prompt_band_px,
-                  std::string prompt);
+  // `prompt_band_px` high at the bottom: the band each frame's prompt is shown in (Presentation::prompt_band_px).
+  WindowPresenter(render::GlContext& context, StimulusRenderer& renderer, cv::Size screen, int prompt_band_px);
   bool RealTime() const override { return true; }
   double FrameS() const override { return frame_s_; }
   double Now() const override { return context_.Now(); }
@@ -58,20 +57,20 @@ class WindowPresenter : public GlPresenter {
   void ShowFixationFor(double seconds) override;
   void ShowBlankFor(double seconds) override;
   void ShowLast(const std::string& title, const std::string& body) override;
-  cv::Mat ReadFrame(bool prompt) override;
+  cv::Mat ReadFrame(std::string_view prompt) override;
 
  protected:
   double DoFlip(double wake_s) override;
 
  private:
   void ShowFor(const cv::Mat& image, double seconds);
-  // The grey field between trials and after a timed stimulus, and the prompt's band: made once.
+  // The grey field between trials and after a timed stimulus (made once), and the prompt's band.
   const render::WindowImage& Blank();
-  const render::WindowImage& Prompt();
+  const render::WindowImage& Prompt(std::string_view text);
 
   cv::Size screen_;
   int prompt_band_px_;
-  std::string prompt_;
+  std::string prompt_;  // what prompt_image_ says
   double frame_s_;
   double last_flip_s_ = 0;
   std::optional<render::WindowImage> screen_image_;  // the text screen up now: uploaded once, drawn every frame
@@ -84,8 +83,7 @@ class WindowPresenter : public GlPresenter {
 // session's are bit-identical to an uninterrupted one's.
 class HeadlessPresenter : public GlPresenter {
  public:
-  HeadlessPresenter(render::GlContext& context, StimulusRenderer& renderer, double fps, int prompt_band_px,
-                    std::string prompt);
+  HeadlessPresenter(render::GlContext& context, StimulusRenderer& renderer, double fps, int prompt_band_px);
   bool RealTime() const override { return false; }
   double FrameS() const override { return frame_s_; }
   double Now() const override { return clock_s_; }
@@ -98,7 +96,7 @@ class HeadlessPresenter : public GlPresenter {
   void ShowFixationFor(double seconds) override { Wait(seconds); }
   void ShowBlankFor(double seconds) override { Wait(seconds); }
   void ShowLast(const std::string&, const std::string&) override {}
-  cv::Mat ReadFrame(bool prompt) override;
+  cv::Mat ReadFrame(std::string_view prompt) override;
 
  protected:
   double DoFlip(double wake_s) override;
@@ -106,7 +104,6 @@ class HeadlessPresenter : public GlPresenter {
  private:
   double frame_s_;
   int prompt_band_px_;
-  std::string prompt_;
   double clock_s_ = 0;
 };
 
@@ -147,7 +144,8 @@ class CapturingPresenter : public Presenter {
   double DoFlip(double wake_s) override;
 
  private:
-  void Capture(const protocol::Trial& trial, const stimulus::TrialScene& scene, bool prompt, double cutoff);
+  void Capture(const protocol::Trial& trial, const stimulus::TrialScene& scene, std::string_view prompt,
+               double cutoff);
 
   GlPresenter& inner_;
   const PreparedSession& prepared_;

@@ -8,6 +8,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 
 #include "protocol/trials.h"
@@ -22,7 +23,7 @@ struct StimulusFrame {
   const stimulus::TrialScene* scene = nullptr;  // what the trial's first frame shows (an intervals trial's first)
   int index = 0;       // the frame's number in the trial, from 0
   bool shown = false;  // the stimulus, else the grey field (between intervals, after a timed stimulus)
-  bool prompt = false; // the response prompt's band under it
+  std::string_view prompt;  // the response prompt shown in its band under it (the block's); empty: no band
   double cutoff = 0;   // the adjustment level shown (picture)
 };
 

@@ -39,7 +39,8 @@ void ObserverResponder::StimulusShown(const protocol::Trial& trial, const stimul
   if (trial.task != Task::kAdjustment) {
     // A moving stimulus is watched to its end before the answer (task 1 is one answer per run); intervals too.
     for (const KeyPress& press : presses)
-      Script(keys_.Key(press.action, trial.task), onset_s + StimulusEndS(protocol_, scene) + press.after_ms / 1000);
+      Script(keys_.Key(press.action, trial.task),
+             onset_s + StimulusEndS(protocol::TimingOf(protocol_, trial), scene) + press.after_ms / 1000);
     return;
   }
   double t = onset_s;

@@ -11,6 +11,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/error.h"
+#include "core/names.h"
 #include "core/typed.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
@@ -53,7 +54,8 @@ Json CollectInfo(const protocol::Protocol& p, const RunOptions& options, const G
     return f.type == "text" ? std::string("text") : std::string(range);
   };
   std::string asked;
-  for (const auto& f : p.participant_info) asked += (asked.empty() ? "" : ", ") + f.key;
+  std::vector<std::string> keys;
+  for (const auto& f : p.participant_info) asked += (asked.empty() ? "" : ", ") + f.key, keys.push_back(f.key);
   Json info = Json::object();
   for (const auto& [key, text] : options.info) {
     const protocol::InfoField* f = field_of(key);
@@ -61,7 +63,7 @@ Json CollectInfo(const protocol::Protocol& p, const RunOptions& options, const G
       throw Error(ErrorKind::kUsage, "--info " + Echo(key, false) + ": " + options.protocol_file.string() +
                                          (asked.empty() ? " asks for no participant information"
                                                         : " asks for " + asked + " (participant_info), not " +
-                                                              Echo(key, false)));
+                                                              Echo(key, false) + DidYouMean(key, keys)));
     if (const std::string why = protocol::CheckInfoValue(*f, text); !why.empty())
       throw Error(ErrorKind::kUsage, "--info " + key + "=" + Echo(text, false) + ": " + why);
     info[key] = value_of(*f, text);
@@ -217,9 +219,9 @@ RunResult RunSession(const RunOptions& options) {
   const int band = chosen.presentation.prompt_band_px;
   std::unique_ptr<GlPresenter> shows;
   if (window)
-    shows = std::make_unique<WindowPresenter>(*context, renderer, screen, band, protocol.responses.prompt);
+    shows = std::make_unique<WindowPresenter>(*context, renderer, screen, band);
   else
-    shows = std::make_unique<HeadlessPresenter>(*context, renderer, options.sim_fps, band, protocol.responses.prompt);
+    shows = std::make_unique<HeadlessPresenter>(*context, renderer, options.sim_fps, band);
   std::optional<CapturingPresenter> capture;
   if (!options.capture_dir.empty()) capture.emplace(*shows, chosen, options.capture_dir, options.participant);
   Presenter& presenter = capture ? static_cast<Presenter&>(*capture) : *shows;

@@ -299,7 +299,7 @@ TEST(Runner, ShowsTheInstructionsThenEachPartsScreenAsItsBlockBegins) {
   AnsweringResponder responder;
   ASSERT_TRUE(RunSessionOf(recording, prepared, presenter, responder).completed);
   EXPECT_EQ(presenter.screens, (std::vector<std::string>{"Instructions: Which one is more blurred?",
-                                                         "Part: near: The near cards.", "Part: far: The far cards.",
+                                                         "Part 1 of 2: The near cards.", "Part 2 of 2: The far cards.",
                                                          "Thank you"}));
 }
 

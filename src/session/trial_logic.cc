@@ -16,9 +16,9 @@ using stimulus::TrialScene;
 
 using protocol::Task;
 
-double StimulusEndS(const protocol::Protocol& protocol, const TrialScene& scene) {
+double StimulusEndS(const protocol::Timing& timing, const TrialScene& scene) {
   const int n = scene.intervals;
-  return n > 0 ? (n * protocol.timing.interval_ms + (n - 1) * protocol.timing.isi_ms) / 1000 : scene.MotionS();
+  return n > 0 ? (n * timing.interval_ms + (n - 1) * timing.isi_ms) / 1000 : scene.MotionS();
 }
 
 std::optional<bool> CorrectOf(const protocol::Trial& trial, const TrialScene& scene, const std::string& choice) {
@@ -130,8 +130,9 @@ std::pair<std::string, double> HeadlessAnswer(const protocol::Protocol& protocol
   const double nan = std::numeric_limits<double>::quiet_NaN();
   if (trial.task != Task::kAdjustment) {
     if (presses.empty()) return {kChoiceNone, nan};
-    const double t_ms = (StimulusEndS(protocol, scene) + presses.front().after_ms / 1000) * 1000;
-    if (protocol.timing.deadline_ms > 0 && t_ms >= protocol.timing.deadline_ms) return {kChoiceNone, nan};
+    const protocol::Timing& timing = protocol::TimingOf(protocol, trial);
+    const double t_ms = (StimulusEndS(timing, scene) + presses.front().after_ms / 1000) * 1000;
+    if (timing.deadline_ms > 0 && t_ms >= timing.deadline_ms) return {kChoiceNone, nan};
     return {presses.front().action, t_ms};
   }
   // The adjustment's steps through the levels (cyclic), as the runner applies them, to the one accepted.

@@ -22,8 +22,9 @@
 
 namespace blurcue::session {
 
-// When a trial's stimulus has run its course, in seconds after onset: the end of its motion, or of its last interval.
-double StimulusEndS(const protocol::Protocol& protocol, const stimulus::TrialScene& scene);
+// When a trial's stimulus has run its course, in seconds after onset: the end of its motion, or of its last interval
+// (timed by the trial's block's `timing`: protocol::TimingOf).
+double StimulusEndS(const protocol::Timing& timing, const stimulus::TrialScene& scene);
 
 // Whether `choice` answered `trial` correctly, where a trial has a correct answer: a procedure's test side or an odd
 // one out's interval; for a practice pair, the side showing the larger radius (equal radii: can't tell). Empty

@@ -28,13 +28,13 @@ TEST(StimulusEndS, IsTheEndOfTheMotionOrOfTheLastInterval) {
   protocol::Protocol p;
   TrialScene ball;
   ball.from_y_mm = 25, ball.to_y_mm = 85, ball.speed_mm_s = 30;  // 60 mm at 30 mm/s
-  EXPECT_DOUBLE_EQ(StimulusEndS(p, ball), 2.0);
+  EXPECT_DOUBLE_EQ(StimulusEndS(p.timing, ball), 2.0);
   ball.speed_mm_s = 0;  // at rest: nothing to wait for
-  EXPECT_DOUBLE_EQ(StimulusEndS(p, ball), 0.0);
+  EXPECT_DOUBLE_EQ(StimulusEndS(p.timing, ball), 0.0);
   p.timing.interval_ms = 500, p.timing.isi_ms = 250;
   TrialScene three;
   three.intervals = 3;  // 3 x 500 ms with 2 gaps of 250 ms
-  EXPECT_DOUBLE_EQ(StimulusEndS(p, three), 2.0);
+  EXPECT_DOUBLE_EQ(StimulusEndS(p.timing, three), 2.0);
 }
 
 TEST(CorrectOf, APairIsAnsweredRightByTheSideWithTheLargerRadiusOrCantTellWhenEqual) {

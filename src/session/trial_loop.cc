@@ -85,12 +85,14 @@ class Runner {
                    std::vector<FrameRecord>* frames) {
     // Times planned on a clock that started again are void.
     if (presenter_.StartTrial()) responder_.Forget();
+    const protocol::Timing& timing = protocol::TimingOf(protocol_, trial);  // its block's
+    const std::string& prompt_text = protocol::PromptOf(protocol_, trial);
     // Whatever the trial's frames need from disk or a resampling, now, not in its first frame.
     presenter_.Prepare(scene.intervals > 0 ? IntervalScene(scene, IntervalShowsRight(trial, scene, 0)) : scene);
     // Inter-trial interval: the grey field.
-    if (protocol_.timing.inter_trial_ms > 0) presenter_.ShowBlankFor(protocol_.timing.inter_trial_ms / 1000);
+    if (timing.inter_trial_ms > 0) presenter_.ShowBlankFor(timing.inter_trial_ms / 1000);
     // A fixation mark before the stimulus, where the participant should look.
-    if (protocol_.timing.fixation_ms > 0) presenter_.ShowFixationFor(protocol_.timing.fixation_ms / 1000);
+    if (timing.fixation_ms > 0) presenter_.ShowFixationFor(timing.fixation_ms / 1000);
     responder_.Forget();
     // Keys pressed before the stimulus (during the interval) answer nothing: drop them. Escape still pauses.
     for (const InputEvent& e : responder_.Poll(presenter_.Now()))
@@ -100,17 +102,17 @@ class Runner {
     int level = trial.start_index;
     const int levels = static_cast<int>(trial.adjust_levels.size());
     Json steps = Json::array();
-    const double stimulus_s = protocol_.timing.stimulus_ms / 1000;
+    const double stimulus_s = timing.stimulus_ms / 1000;
     double last_flip = -1;
     int composed_level = -2;  // none yet (-1 is the level of a trial without levels)
     // Intervals (2IFC, odd one out): each interval's object for interval_ms, grey for isi_ms between them, then grey
     // until the answer.
     const int n = scene.intervals;
-    const double interval_s = protocol_.timing.interval_ms / 1000, isi_s = protocol_.timing.isi_ms / 1000;
+    const double interval_s = timing.interval_ms / 1000, isi_s = timing.isi_ms / 1000;
     std::vector<TrialScene> intervals;
     for (int k = 0; k < n; ++k) intervals.push_back(IntervalScene(scene, IntervalShowsRight(trial, scene, k)));
     // With responses.after_motion keys count (and the prompt shows) only once the motion or the intervals are over.
-    const double answer_from_s = protocol_.responses.after_motion ? StimulusEndS(protocol_, scene) : 0;
+    const double answer_from_s = protocol_.responses.after_motion ? StimulusEndS(timing, scene) : 0;
     int composed_interval = -1;
     for (int frame = 0;; ++frame) {
       const double t = onset < 0 ? 0 : presenter_.Now() - onset - paused_s;
@@ -127,8 +129,9 @@ class Runner {
         composed_level = level;
       }
       // The prompt shows while an answer is taken.
-      const bool prompt = prepared_.presentation.prompt_band_px > 0 && t >= answer_from_s;
-      presenter_.ShowStimulus({&trial, n > 0 ? &intervals[0] : &scene, frame, shown, prompt,
+      const bool prompt = prepared_.presentation.prompt_band_px > 0 && !prompt_text.empty() && t >= answer_from_s;
+      presenter_.ShowStimulus({&trial, n > 0 ? &intervals[0] : &scene, frame, shown,
+                               prompt ? std::string_view(prompt_text) : std::string_view(),
                                levels > 0 ? trial.adjust_levels[size_t(level)] : 0});
       const double flip = presenter_.Flip(responder_.NextPressS());
       if (onset < 0) {
@@ -153,8 +156,8 @@ class Runner {
       last_flip = flip;
       if (presenter_.Closed()) return Outcome::kQuit;
       // A deadline: no answer this long after onset is recorded as "none", without a response time.
-      if (protocol_.timing.deadline_ms > 0 && trial.task != Task::kAdjustment &&
-          (presenter_.Now() - onset - paused_s) * 1000 >= protocol_.timing.deadline_ms) {
+      if (timing.deadline_ms > 0 && trial.task != Task::kAdjustment &&
+          (presenter_.Now() - onset - paused_s) * 1000 >= timing.deadline_ms) {
         response->choice = kChoiceNone;
         response->rt_ms = std::numeric_limits<double>::quiet_NaN();
         return Outcome::kAnswered;
@@ -274,7 +277,8 @@ class Runner {
           if (block) text = block->instructions;
           if (text.empty() && shown_practice && !trial.practice) text = "The practice is over; the study starts now.";
         }
-        if (!text.empty() && !ShowScreen(trial.practice ? "Practice" : "Part: " + trial.block, text,
+        // The block's title or "Part n of N", never its name (which may give the condition away).
+        if (!text.empty() && !ShowScreen(protocol::BlockTitle(protocol_, trials_, size_t(i)), text,
                                          "Press Return to go on"))
           return result;
         shown_block = part;
@@ -320,9 +324,9 @@ class Runner {
       }
       record.RecordResponse(start.session_id, i, response, frames);  // committed before anything else happens
       // Feedback where an answer is right or wrong: procedure trials, odd one out, practice run to a criterion.
-      if (right && protocol_.timing.feedback_ms > 0)
+      if (const double feedback_ms = protocol::TimingOf(protocol_, trial).feedback_ms; right && feedback_ms > 0)
         presenter_.ShowTextFor(response.choice == kChoiceNone ? "Too slow" : correct ? "Correct" : "Wrong",
-                               protocol_.timing.feedback_ms / 1000);
+                               feedback_ms / 1000);
       ++result.answered_now;
       progress(i + 1);
       if (!trial.practice) ++main_answered;

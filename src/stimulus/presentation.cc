@@ -20,7 +20,8 @@ Presentation Presentation::Of(const protocol::Protocol& protocol, const Stimulus
   p.window_height_px = protocol.display.height_px;
   p.profile = profile;
   // The prompt's band: a line of text at the display's scale (TextScreen's unit).
-  if (!protocol.responses.prompt.empty()) p.prompt_band_px = std::max(32, protocol.display.height_px / 12);
+  if (std::any_of(protocol.blocks.begin(), protocol.blocks.end(), [](const auto& b) { return !b.prompt.empty(); }))
+    p.prompt_band_px = std::max(32, protocol.display.height_px / 12);
   // The stimulus has the window above the prompt's band.
   const int W = p.window_width_px, H = p.window_height_px - p.prompt_band_px;
   if (protocol.content.type == "picture") {

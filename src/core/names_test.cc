@@ -1,0 +1,45 @@
+#include "core/names.h"
+
+#include <gtest/gtest.h>
+
+namespace blurcue {
+namespace {
+
+TEST(EditDistance, CountsInsertionsDeletionsAndSubstitutions) {
+  EXPECT_EQ(EditDistance("secton", "section"), 1u);    // one insertion
+  EXPECT_EQ(EditDistance("section", "secton"), 1u);    // one deletion
+  EXPECT_EQ(EditDistance("edge", "edgy"), 1u);         // one substitution
+  EXPECT_EQ(EditDistance("kitten", "sitting"), 3u);
+  EXPECT_EQ(EditDistance("", "abc"), 3u);
+  EXPECT_EQ(EditDistance("same", "same"), 0u);
+}
+
+TEST(NearestName, CaseSlipWinsOverAnEditDistanceTie) {
+  // "left" is one substitution from "lefT" and from "Left" alike; the case slip is the one meant.
+  EXPECT_EQ(NearestName("left", {"lefx", "Left"}), "Left");
+  EXPECT_EQ(NearestName("Measured", {"none", "measured", "estimated"}), "measured");
+  EXPECT_EQ(NearestName("Edge", {"edge", "section"}), "edge");
+}
+
+TEST(NearestName, NearestWithinTwoEditsIgnoringCase) {
+  EXPECT_EQ(NearestName("secton", {"edge", "section", "speed_cm_s"}), "section");
+  EXPECT_EQ(NearestName("difference_arcmins", {"relative_difference", "difference_arcmin"}), "difference_arcmin");
+  EXPECT_EQ(NearestName("Sectoin", {"section"}), "section");  // a transposition is two edits; case ignored
+}
+
+TEST(NearestName, NothingNearGivesEmpty) {
+  EXPECT_EQ(NearestName("colour", {"edge", "section"}), "");
+  EXPECT_EQ(NearestName("", {"edge"}), "");
+  // Two edits turn any two letters into "id": a short name is not corrected into an unrelated one.
+  EXPECT_EQ(NearestName("xy", {"id"}), "");
+  EXPECT_EQ(NearestName(std::string(1000, 'e'), {"edge"}), "");
+}
+
+TEST(DidYouMean, SaysTheNearestOrNothing) {
+  EXPECT_EQ(DidYouMean("secton", {"edge", "section"}), " (did you mean section?)");
+  EXPECT_EQ(DidYouMean("section", {"edge", "section"}), "");
+  EXPECT_EQ(DidYouMean("colour", {"edge", "section"}), "");
+}
+
+}  // namespace
+}  // namespace blurcue

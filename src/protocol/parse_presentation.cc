@@ -1,0 +1,343 @@
+#include "protocol/parser.h"
+
+#include <algorithm>
+#include <map>
+
+#include "core/error.h"
+#include "core/names.h"
+#include "core/typed.h"
+
+namespace blurcue::protocol::detail {
+
+void Parser::ParseScene(const Json& v, const std::string& ptr, Protocol* p) {
+  if (!Object(v, ptr, {"background", "board_free", "calib", "show"})) return;
+  p->scene.background = Path(v, "background", ptr, true);
+  p->scene.board_free = Path(v, "board_free", ptr, false);
+  p->scene.calib = Path(v, "calib", ptr, false);
+  if (auto show = String(v, "show", ptr, false, {"background", "board_free"})) p->scene.show = *show;
+  if (p->scene.show == "board_free" && !v.contains("board_free"))
+    Problem(ptr + "/show", "names the board-free photo but /scene/board_free is missing", v["show"]);
+}
+
+void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
+  if (!v.is_object()) {
+    Problem(ptr, "must be an object", v);
+    return;
+  }
+  const auto type = String(v, "type", ptr, true, {"grid", "ball", "picture"});
+  if (!type) return;
+  p->content.type = *type;
+  if (*type == "grid" || *type == "ball") {
+    if (auto k = String(v, "kernel", ptr, false, {"gaussian", "disc"})) p->content.kernel = *k;
+    // The thesis matched the virtual object to the scene by eye; a factor of 4 either way is far beyond that.
+    if (auto x = Number(v, "brightness", ptr, false, 0.25, 4, "(a factor)")) p->content.brightness = *x;
+    if (auto x = Number(v, "contrast", ptr, false, 0.25, 4, "(a factor)")) p->content.contrast = *x;
+    if (const Json* t = Field(v, "depth_blur_threshold", ptr, false)) {
+      const std::string at = ptr + "/depth_blur_threshold";
+      if (t->is_object() && t->size() == 1 && (t->contains("screen_px") || t->contains("arcmin"))) {
+        const bool px = t->contains("screen_px");
+        if (auto x = Number(*t, px ? "screen_px" : "arcmin", at, true, 0, px ? 100 : 600, px ? "screen px" : "arcmin"))
+          p->content.depth_blur_threshold = *x, p->content.depth_blur_threshold_unit = px ? "screen_px" : "arcmin";
+      } else {
+        Problem(at, "must be {\"screen_px\": N} or {\"arcmin\": N}", *t);
+      }
+    }
+    if (const Json* wb = Field(v, "white_balance", ptr, false)) {
+      if (wb->is_array() && wb->size() == 3 && std::all_of(wb->begin(), wb->end(), [](const Json& g) {
+            return NumberIn(g, 0.25, 4);
+          }))
+        for (size_t c = 0; c < 3; ++c) p->content.white_balance[c] = (*wb)[c].get<double>();
+      else
+        Problem(ptr + "/white_balance", "must be [red, green, blue] gains, each in " + Range(0.25, 4, "(a factor)"),
+                *wb);
+    }
+  }
+  if (*type == "grid" || *type == "ball") {
+    // The card's face or the ball's surface: a shipped texture by name, or an image file.
+    const bool grid = *type == "grid";
+    p->content.texture = grid ? "grid" : "soccer";
+    if (auto t = Text(v, "texture", ptr, false, kMaxPathChars, true)) {
+      const std::vector<std::string> shipped = grid ? std::vector<std::string>{"grid"}
+                                                    : std::vector<std::string>{"soccer", "wood"};
+      const std::string nearest = NearestName(*t, shipped);
+      std::error_code ec;
+      if (std::count(shipped.begin(), shipped.end(), *t)) {
+        p->content.texture = *t;
+      } else if (!nearest.empty() && !fs::exists(base_ / *t, ec)) {
+        // "Soccer" is a slip of the shipped texture's name, not an image file that happens to be missing.
+        Problem(ptr + "/texture", "must be " + (grid ? std::string("grid") : "soccer or wood") +
+                                      " or an image file (did you mean " + nearest + "?)", Json(*t));
+      } else {
+        p->content.texture = Path(v, "texture", ptr, true).string();
+      }
+    }
+  }
+  if (*type == "grid" || *type == "ball") {
+    // Raised above the table: up to a metre.
+    if (auto h = Number(v, "height_mm", ptr, false, 0, 1000, "mm")) p->content.height_mm = *h;
+  }
+  if (*type == "grid") {
+    Object(v, ptr, {"type", "cells", "texture", "kernel", "brightness", "contrast", "white_balance",
+                    "depth_blur_threshold", "size_mm", "pose", "rotation_deg", "height_mm"});
+    if (auto n = Int(v, "cells", ptr, false, 1, 20, "cells per side")) p->content.cells = *n;
+    if (v.contains("cells") && p->content.texture != "grid")
+      Problem(ptr + "/cells", "draws the grid card; an image texture has no cells", v["cells"]);
+    // A card from 5 mm to half a metre: one side (a square), or [width, height].
+    if (const Json* size = Field(v, "size_mm", ptr, false)) {
+      if (NumberIn(*size, 5, 500))
+        p->content.size_mm = size->get<double>();
+      else if (size->is_array() && size->size() == 2 && NumberIn((*size)[0], 5, 500) && NumberIn((*size)[1], 5, 500))
+        p->content.size_mm = (*size)[0].get<double>(), p->content.card_height_mm = (*size)[1].get<double>();
+      else
+        Problem(ptr + "/size_mm", "must be the card's side in " + Range(5, 500, "mm") + " or [width, height]", *size);
+    }
+    if (auto pose = String(v, "pose", ptr, false, {"lying", "standing"})) p->content.standing = *pose == "standing";
+    if (auto r = Number(v, "rotation_deg", ptr, false, -180, 180, "deg")) p->content.rotation_deg = *r;
+  } else if (*type == "ball") {
+    Object(v, ptr, {"type", "texture", "radius_mm", "kernel", "brightness", "contrast", "white_balance",
+                    "depth_blur_threshold", "height_mm"});
+    // A ball rolls on the board's 25 mm squares: from a marble to a football.
+    if (auto r = Number(v, "radius_mm", ptr, false, 1, 150, "mm")) p->content.radius_mm = *r;
+  } else {
+    Object(v, ptr, {"type", "image", "real_photos", "real_camera"});
+    p->content.image = Path(v, "image", ptr, true);
+    if (auto pattern = Text(v, "real_photos", ptr, false, kMaxPathChars, true)) {
+      if (pattern->find("{distance_m}") == std::string::npos)
+        Problem(ptr + "/real_photos", "must contain {distance_m} (one photo per distance)", Json(*pattern));
+      else
+        p->content.real_photos = (base_ / *pattern).lexically_normal().string();
+    }
+    if (const Json* real = Field(v, "real_camera", ptr, false)) ParseRealCamera(*real, ptr + "/real_camera", v, p);
+  }
+}
+
+// content.real_camera: the camera (camera.json) that took the real photos and its focus distance.
+void Parser::ParseRealCamera(const Json& v, const std::string& ptr, const Json& content, Protocol* p) {
+  if (!content.contains("real_photos")) {
+    Problem(ptr, "describes the camera of content.real_photos, which this protocol does not name", v);
+    return;
+  }
+  if (!Object(v, ptr, {"camera", "focus_m"})) return;
+  const size_t problems_before = calls_;
+  p->content.real_camera_file = Path(v, "camera", ptr, true);
+  const bool camera_file_ok = calls_ == problems_before;
+  // From a hand's breadth to a kilometre (the thin lens needs it beyond the focal length: checked per distance).
+  if (auto focus = Number(v, "focus_m", ptr, true, 0.01, 1000, "m")) p->content.real_focus_m = *focus;
+  if (!options_.check_files || p->content.real_camera_file.empty() || !camera_file_ok) return;
+  try {
+    p->content.real_camera = LoadCamera(p->content.real_camera_file);
+  } catch (const Error& e) {
+    Problem(ptr + "/camera", e.what(), v["camera"]);
+  }
+}
+
+void Parser::ParseInfo(const Json& v, const std::string& ptr, Protocol* p) {
+  if (!v.is_array() || v.size() > 20) {
+    Problem(ptr, "must be a list of at most 20 fields ({\"key\": ..., \"type\": ...})", v);
+    return;
+  }
+  std::set<std::string> keys;
+  for (size_t i = 0; i < v.size(); ++i) {
+    const std::string fp = ptr + "/" + std::to_string(i);
+    const Json& f = v[i];
+    if (!Object(f, fp, {"key", "type", "min", "max", "choices", "required", "prompt"})) continue;
+    InfoField field;
+    if (auto k = Text(f, "key", fp, true, 40, true)) {
+      const bool ok = !k->empty() && std::all_of(k->begin(), k->end(), [](char c) {
+        return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+      });
+      if (!ok) Problem(fp + "/key", "must be 1-40 characters of a-z, 0-9 and _", Json(*k));
+      else if (!keys.insert(*k).second) Problem(fp + "/key", "repeats an earlier key", Json(*k));
+      field.key = *k;
+    }
+    if (auto t = String(f, "type", fp, false, {"integer", "number", "choice", "text"})) field.type = *t;
+    const bool numeric = field.type == "integer" || field.type == "number";
+    if (numeric) {
+      auto lo = Number(f, "min", fp, true, -1e9, 1e9, ""), hi = Number(f, "max", fp, true, -1e9, 1e9, "");
+      if (lo && hi && *lo >= *hi) Problem(fp + "/max", "must be larger than min", f["max"]);
+      field.min = lo.value_or(0), field.max = hi.value_or(0);
+    } else {
+      for (const char* k : {"min", "max"})
+        if (f.contains(k)) Problem(fp + "/" + k, "is for an integer or number field, not " + field.type, f[k]);
+    }
+    if (field.type == "choice") {
+      const Json* c = Field(f, "choices", fp, true);
+      if (c && (!c->is_array() || c->empty() || c->size() > 20))
+        Problem(fp + "/choices", "must be a list of 1 to 20 answers", *c);
+      else if (c)
+        for (size_t k = 0; k < c->size(); ++k) {
+          const Json& choice = (*c)[k];
+          if (!choice.is_string() || choice.get<std::string>().empty() || choice.get<std::string>().size() > 100 ||
+              !IsPrintableUtf8(choice.get<std::string>()) ||
+              std::count(field.choices.begin(), field.choices.end(), choice.get<std::string>()))
+            Problem(fp + "/choices/" + std::to_string(k), "must be a new answer of 1-100 characters", choice);
+          else
+            field.choices.push_back(choice.get<std::string>());
+        }
+    } else if (f.contains("choices")) {
+      Problem(fp + "/choices", "is for a choice field, not " + field.type, f["choices"]);
+    }
+    if (auto r = Bool(f, "required", fp)) field.required = *r;
+    if (auto s = Text(f, "prompt", fp, false, 200, true)) field.prompt = *s;
+    p->participant_info.push_back(std::move(field));
+  }
+}
+
+void Parser::ParseGroups(const Json& v, const Json& top, const std::string& ptr, Protocol* p) {
+  if (!Object(v, ptr, {"names", "assign"})) return;
+  Groups g;
+  if (auto a = String(v, "assign", ptr, false, {"by_number", "balanced"})) g.assign = *a;
+  const Json* names = Field(v, "names", ptr, true);
+  if (names && (!names->is_array() || names->size() < 2 || names->size() > 20)) {
+    Problem(ptr + "/names", "must be a list of 2 to 20 group names", *names);
+    return;
+  }
+  if (names)
+    for (size_t i = 0; i < names->size(); ++i) {
+      const Json& n = (*names)[i];
+      if (!n.is_string() || n.get<std::string>().empty() || n.get<std::string>().size() > kMaxNameChars ||
+          !IsPrintableUtf8(n.get<std::string>()) ||
+          std::count(g.names.begin(), g.names.end(), n.get<std::string>()))
+        Problem(ptr + "/names/" + std::to_string(i), "must be a new name of 1-100 characters", n);
+      else
+        g.names.push_back(n.get<std::string>());
+    }
+  p->groups = g;
+  (void)top;
+}
+
+void Parser::ParseResponses(const Json& v, const std::string& ptr, const std::set<Task>& tasks, const Protocol& p,
+                            Responses* r) {
+  // Defaults that suit a keyboard: arrows to choose or step, Return to accept, Y / N, digits for scales and intervals.
+  *r = Responses{};
+  r->left = "Left", r->right = "Right", r->cant_tell = "Down", r->previous = "Left", r->next = "Right",
+  r->accept = "Return";
+  r->rating = {"1", "2", "3", "4", "5"};
+  for (int i = 1; i <= p.alternatives; ++i) r->alternatives.push_back(std::to_string(i));
+  // Odd one out names one of its intervals: there is no "can't tell" unless a key is given for it.
+  if (p.layout == "odd_one_out") r->cant_tell = "";
+  if (v.is_null()) return;
+  if (!Object(v, ptr, {"left", "right", "cant_tell", "previous", "next", "accept", "yes", "no", "rating",
+                       "alternatives", "prompt", "after_motion"}))
+    return;
+  auto key_name = [&](const Json& value, const std::string& at) -> std::optional<std::string> {
+    if (!value.is_string()) return Problem(at, "must be a key name", value), std::nullopt;
+    const std::string s = value.get<std::string>();
+    if (s == "Escape") return Problem(at, "Escape is reserved for pausing a session", value), std::nullopt;
+    if (!IsKeyName(s))
+      return Problem(at, "must be a key name: A-Z, 0-9, Left, Right, Up, Down, Space, Return, Tab, Backspace, F1-F12 "
+                         "or KP_0-KP_9" + DidYouMean(s, KeyNames()), value), std::nullopt;
+    return s;
+  };
+  std::map<std::string, std::string*> slots = {{"left", &r->left},         {"right", &r->right},
+                                               {"cant_tell", &r->cant_tell}, {"previous", &r->previous},
+                                               {"next", &r->next},         {"accept", &r->accept},
+                                               {"yes", &r->yes},           {"no", &r->no}};
+  for (auto& [key, slot] : slots) {
+    if (!v.contains(key)) continue;
+    // "cant_tell": null makes a strict 2AFC: no key answers can't tell.
+    if (key == "cant_tell" && v[key].is_null()) {
+      *slot = "";
+      continue;
+    }
+    if (auto s = key_name(v[key], ptr + "/" + key)) *slot = *s;
+  }
+  // Key lists: one key per point of a rating scale (2 to 9), one per interval of an odd-one-out trial.
+  auto key_list = [&](const char* key, size_t min, size_t max, std::vector<std::string>* out) {
+    if (!v.contains(key)) return;
+    const Json& list = v[key];
+    const std::string at = ptr + "/" + key;
+    if (!list.is_array() || list.size() < min || list.size() > max)
+      return Problem(at, "must be a list of " + std::to_string(min) + (min == max ? "" : " to " + std::to_string(max)) +
+                             " key names", list);
+    out->clear();
+    for (size_t i = 0; i < list.size(); ++i)
+      if (auto s = key_name(list[i], at + "/" + std::to_string(i))) out->push_back(*s);
+  };
+  key_list("rating", 2, 9, &r->rating);
+  key_list("alternatives", size_t(std::max(p.alternatives, 1)), size_t(std::max(p.alternatives, 1)), &r->alternatives);
+  if (auto s = Text(v, "prompt", ptr, false, 200, true)) {
+    if (s->empty()) Problem(ptr + "/prompt", "must not be empty (leave it out for no prompt)", Json(*s));
+    r->prompt = *s;
+  }
+  if (auto b = Bool(v, "after_motion", ptr)) r->after_motion = *b;
+  // Keys for a task no block has would be read by nothing.
+  auto unused = [&](const char* key, bool used, const std::string& why) {
+    if (v.contains(key) && !used) Problem(ptr + "/" + key, why, v[key]);
+  };
+  unused("yes", tasks.count(Task::kYesNo), "is for the task yes_no, which no block has");
+  unused("no", tasks.count(Task::kYesNo), "is for the task yes_no, which no block has");
+  unused("rating", tasks.count(Task::kRating), "is for the task rating, which no block has");
+  unused("alternatives", p.layout == "odd_one_out", "is for the layout odd_one_out");
+  const bool choice = tasks.count(Task::kForcedChoice) > 0, sides = choice && p.layout != "odd_one_out";
+  unused("left", sides, choice ? "is not read by the layout odd_one_out (its intervals have /responses/alternatives)"
+                               : "is for the task forced_choice, which no block has");
+  unused("right", sides, choice ? "is not read by the layout odd_one_out (its intervals have /responses/alternatives)"
+                                : "is for the task forced_choice, which no block has");
+  unused("cant_tell", choice, "is for the task forced_choice, which no block has");
+  for (const char* key : {"previous", "next", "accept"})
+    unused(key, tasks.count(Task::kAdjustment) > 0, "is for the task adjustment, which no block has");
+  auto distinct = [&](const std::vector<std::pair<std::string, std::string>>& set) {
+    for (size_t i = 0; i < set.size(); ++i)
+      for (size_t j = 0; j < i; ++j)
+        if (set[i].second == set[j].second)
+          Problem(ptr + "/" + set[i].first, "is the same key as /responses/" + set[j].first, Json(set[i].second));
+  };
+  if (tasks.count(Task::kForcedChoice))
+    distinct(r->cant_tell.empty() ? std::vector<std::pair<std::string, std::string>>{{"left", r->left}, {"right", r->right}}
+                                  : std::vector<std::pair<std::string, std::string>>{
+                                        {"left", r->left}, {"right", r->right}, {"cant_tell", r->cant_tell}});
+  if (tasks.count(Task::kAdjustment))
+    distinct({{"previous", r->previous}, {"next", r->next}, {"accept", r->accept}});
+  if (tasks.count(Task::kYesNo)) distinct({{"yes", r->yes}, {"no", r->no}});
+  auto distinct_list = [&](const char* key, const std::vector<std::string>& keys) {
+    for (size_t i = 0; i < keys.size(); ++i)
+      for (size_t j = 0; j < i; ++j)
+        if (keys[i] == keys[j])
+          Problem(ptr + "/" + key + "/" + std::to_string(i), "is the same key as /responses/" + std::string(key) + "/" + std::to_string(j),
+                  Json(keys[i]));
+  };
+  if (tasks.count(Task::kRating)) distinct_list("rating", r->rating);
+  if (p.layout == "odd_one_out") distinct_list("alternatives", r->alternatives);
+}
+// The protocol's timing (at /timing) or a block's (at /blocks/N/timing): each field given is checked and set in `t`,
+// so a block's fields override the protocol's and the others stay as inherited.
+void Parser::ParseTiming(const Json& v, const std::string& ptr, const Protocol& p,
+                         const std::vector<const Block*>& blocks, Timing* t) {
+  if (!Object(v, ptr, {"stimulus_ms", "inter_trial_ms", "interval_ms", "isi_ms", "deadline_ms", "feedback_ms",
+                       "fixation_ms"}))
+    return;
+  if (const Json* s = Field(v, "stimulus_ms", ptr, false)) {
+    // From about a frame to a minute.
+    if (s->is_string() && *s == "until_response") t->stimulus_ms = 0;
+    else if (NumberIn(*s, 10, 60000)) t->stimulus_ms = s->get<double>();
+    else Problem(ptr + "/stimulus_ms", "must be a duration in " + Range(10, 60000, "ms") + " or \"until_response\"" +
+                                           (s->is_string() ? DidYouMean(s->get<std::string>(), {"until_response"}) : ""),
+                 *s);
+  }
+  if (auto x = Number(v, "inter_trial_ms", ptr, false, 0, 60000, "ms")) t->inter_trial_ms = *x;
+  if (auto x = Number(v, "interval_ms", ptr, false, 100, 10000, "ms")) t->interval_ms = *x;
+  if (auto x = Number(v, "isi_ms", ptr, false, 0, 10000, "ms")) t->isi_ms = *x;
+  if (auto x = Number(v, "deadline_ms", ptr, false, 100, 60000, "ms")) t->deadline_ms = *x;
+  if (auto x = Number(v, "feedback_ms", ptr, false, 100, 5000, "ms")) t->feedback_ms = *x;
+  if (auto x = Number(v, "fixation_ms", ptr, false, 100, 5000, "ms")) t->fixation_ms = *x;
+  // Feedback needs a correct answer: a procedure's, an odd one out's, or a practice run to a criterion's.
+  const bool correct = p.layout == "odd_one_out" || std::any_of(blocks.begin(), blocks.end(), [](const Block* b) {
+                         return b->procedure || b->criterion;
+                       });
+  if (v.contains("feedback_ms") && !correct)
+    Problem(ptr + "/feedback_ms", "needs a correct answer: a block with a procedure or a criterion, or the "
+                                  "layout odd_one_out, defines one", v["feedback_ms"]);
+  const bool adjustment =
+      std::any_of(blocks.begin(), blocks.end(), [](const Block* b) { return b->task == Task::kAdjustment; });
+  if (v.contains("deadline_ms") && adjustment)
+    Problem(ptr + "/deadline_ms", "is for a forced choice, yes/no or rating; adjustment runs until a level is "
+                                  "accepted", v["deadline_ms"]);
+  for (const char* key : {"interval_ms", "isi_ms"})
+    if (v.contains(key) && IntervalCount(p) == 0)
+      Problem(ptr + "/" + key, "is for the layouts two_intervals and odd_one_out", v[key]);
+  if (v.contains("stimulus_ms") && IntervalCount(p) > 0)
+    Problem(ptr + "/stimulus_ms", "intervals are timed by interval_ms and isi_ms", v["stimulus_ms"]);
+}
+
+}  // namespace blurcue::protocol::detail
