@@ -248,7 +248,7 @@ TEST(Export, EveryRowCarriesItsSessionsStatusAbortedIncluded) {
   testing::TempDir dir;
   {
     Record record = Record::Open(dir / "r.sqlite");
-    const int64_t first = record.StartOrResumeSession("test1", "P01", "{}", 1, {}, false).session_id;
+    const int64_t first = record.StartOrResumeSession("test1", "P01", R"({"study":"test1"})", 1, {}, false).session_id;
     TrialRecord trial;
     record.SaveTrialList(first, {trial});
     Response r;
@@ -257,7 +257,7 @@ TEST(Export, EveryRowCarriesItsSessionsStatusAbortedIncluded) {
     record.AbortSession(first);
     RunSession(record, "P01", "{}", 2, 2);  // the same participant again, completed
     RunSession(record, "P02", "{}", 2, 1);
-    const int64_t running = record.StartOrResumeSession("test1", "P03", "{}", 1, {}, false).session_id;
+    const int64_t running = record.StartOrResumeSession("test1", "P03", R"({"study":"test1"})", 1, {}, false).session_id;
     record.SaveTrialList(running, {trial});
   }
   ExportCsv(dir / "r.sqlite", dir / "out");

@@ -94,7 +94,13 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
   }
   const std::filesystem::path temp = TemporaryBeside(out, "partial");
   RemoveDatabaseFiles(temp);
-  std::vector<std::string> unfinished;
+  std::vector<std::string> unfinished, renumbered;
+  // The session numbers the inputs gave (version 8 on), by the merged session's id.
+  struct Numbered {
+    std::string input;
+    int64_t session = 0, number = 0;
+  };
+  std::map<int64_t, Numbered> numbered;
   try {
     {
       Database dst(temp);
@@ -113,7 +119,10 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
         while (studies.Step())
           study_ids[studies.GetInt64(0)] = EnsureStudy(dst, studies.GetText(1), studies.GetText(2));
 
-        Statement protocols(src, "SELECT id, study_id, json, hash, created FROM protocol_versions");
+        const bool v8 = SchemaVersion(src) >= 8;
+        Statement protocols(src, std::string("SELECT id, study_id, json, hash, created, ") +
+                                     (v8 ? "version" : "NULL") + " FROM protocol_versions");
+        Statement set_version(dst, "UPDATE protocol_versions SET version = ? WHERE id = ? AND version IS NULL");
         while (protocols.Step()) {
           // An input of schema 1 holds raw texts: the merged record keys them by their canonical text, as run does.
           std::string json = protocols.GetText(2), hash = protocols.GetText(3);
@@ -127,6 +136,32 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
               dst, study_ids.at(protocols.GetInt64(1)), json, hash, protocols.GetText(4), &stored_json);
           if (stored_json != json)
             throw InputError(input.string(), "protocol hash " + hash + " names a different protocol text in another input");
+          if (!protocols.IsNull(5)) {
+            set_version.Bind(1, protocols.GetInt64(5));
+            set_version.Bind(2, protocol_ids[protocols.GetInt64(0)]);
+            set_version.Run();
+            set_version.Reset();
+          }
+        }
+        if (v8) {
+          // One design per protocol version: the first input that recorded it gives it.
+          Statement design(src, "SELECT protocol_version_id, position, name, role, type, unit, allowed FROM "
+                                "design_columns ORDER BY protocol_version_id, position");
+          Statement insert_design(dst, "INSERT INTO design_columns (protocol_version_id, position, name, role, type, "
+                                       "unit, allowed) VALUES (?, ?, ?, ?, ?, ?, ?)");
+          std::map<int64_t, bool> had_design;
+          while (design.Step()) {
+            const int64_t id = protocol_ids.at(design.GetInt64(0));
+            if (!had_design.count(id))
+              had_design[id] = dst.QueryInt64("SELECT count(*) FROM design_columns WHERE protocol_version_id = " +
+                                              std::to_string(id)) > 0;
+            if (had_design[id]) continue;
+            insert_design.Bind(1, id);
+            insert_design.Bind(2, design.GetInt64(1));
+            for (int column = 2; column <= 6; ++column) insert_design.Bind(column + 1, design.GetText(column));
+            insert_design.Run();
+            insert_design.Reset();
+          }
         }
 
         Statement participants(src, "SELECT id, study_id, code, created FROM participants");
@@ -138,7 +173,8 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
                                 "display, started, ended, status, " +
                                 std::string(SchemaVersion(src) >= 3 ? "display_profile" : "'{}'") + ", " +
                                 std::string(SchemaVersion(src) >= 6 ? "group_name, participant_info" : "'', '{}'") +
-                                TypedList("sessions", typed) + " FROM sessions");
+                                TypedList("sessions", typed) + (v8 ? ", session_number" : ", NULL") +
+                                " FROM sessions");
         Statement duplicate(dst, "SELECT id FROM sessions WHERE participant_id = ? AND protocol_version_id = ? "
                                  "AND seed = ? AND host = ? AND started = ?");
         Statement insert_session(dst, "INSERT INTO sessions (participant_id, protocol_version_id, seed, "
@@ -172,6 +208,9 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
           insert_session.Run();
           insert_session.Reset();
           session_ids[sessions.GetInt64(0)] = dst.LastInsertRowId();
+          if (!sessions.IsNull(13 + int(TypedColumnsOf("sessions").size()) * typed))
+            numbered[dst.LastInsertRowId()] = {input.string(), sessions.GetInt64(0),
+                                               sessions.GetInt64(13 + int(TypedColumnsOf("sessions").size()) * typed)};
         }
         if (typed) {
           Statement info(src, "SELECT session_id, key, value FROM session_info");
@@ -186,16 +225,19 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
         }
 
         Statement trials(src, "SELECT id, session_id, trial_index, block, factors, left_shown, right_shown" +
-                                  TypedList("trials", typed) + " FROM trials");
+                                  TypedList("trials", typed) + (v8 ? ", cell" : ", NULL") + " FROM trials");
         Statement insert_trial(dst, "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, "
-                                    "right_shown" + TypedList("trials", typed) + ") VALUES (?, ?, ?, ?, ?, ?" +
-                                    TypedPlaceholders("trials", typed) + ")");
+                                    "right_shown" + TypedList("trials", typed) + ", cell) VALUES (?, ?, ?, ?, ?, ?" +
+                                    TypedPlaceholders("trials", typed) + ", ?)");
+        const int cell = 7 + int(TypedColumnsOf("trials").size()) * typed;
         while (trials.Step()) {
           insert_trial.Bind(1, session_ids.at(trials.GetInt64(1)));
           insert_trial.Bind(2, trials.GetInt64(2));
           insert_trial.Bind(3, trials.GetInt64(3));
           for (int column = 4; column <= 6; ++column) insert_trial.Bind(column, trials.GetText(column));
           CopyTyped("trials", typed, trials, 7, insert_trial, 7);
+          if (trials.IsNull(cell)) insert_trial.BindNull(cell);
+          else insert_trial.Bind(cell, trials.GetText(cell));
           insert_trial.Run();
           insert_trial.Reset();
           trial_ids[trials.GetInt64(0)] = dst.LastInsertRowId();
@@ -241,11 +283,29 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
       }
       // Inputs from before the typed record: their typed columns from their texts, as a migration would.
       DeriveTypedColumns(dst);
+      // A participant's sessions from several stations are numbered again by start, all together: two inputs' first
+      // sessions cannot both be number 1. Each number that differs from its input's is told.
+      DeriveVersionsAndNumbers(dst);
+      NumberSessions(dst, true);
+      Statement number(dst, "SELECT s.session_number, st.name, p.code FROM sessions s JOIN participants p ON "
+                            "p.id = s.participant_id JOIN studies st ON st.id = p.study_id WHERE s.id = ?");
+      for (const auto& [id, was] : numbered) {
+        number.Bind(1, id);
+        number.Step();
+        if (number.GetInt64(0) != was.number)
+          renumbered.push_back(was.input + ": session " + std::to_string(was.session) + " (study " + number.GetText(1) +
+                               ", participant " + number.GetText(2) + ") is session number " +
+                               std::to_string(was.number) + " there and " + std::to_string(number.GetInt64(0)) +
+                               " in the merged record (numbered by start)");
+        number.Reset();
+      }
       transaction.Commit();
     }  // the last connection closes: the WAL is checkpointed into the file and removed
     MoveIntoPlace(temp, out);
-    if (note)
+    if (note) {
       for (const auto& line : unfinished) note(line);
+      for (const auto& line : renumbered) note(line);
+    }
   } catch (...) {
     RemoveDatabaseFiles(temp);
     throw;

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <chrono>
 #include <algorithm>
@@ -280,7 +281,126 @@ std::string DisplayChanges(const std::string& recorded, const std::string& given
   return name_a.dump() + ", got " + name_b.dump() + " (" + (a == b ? "the same values" : JsonChanges(a, b)) + ")";
 }
 
+// The first place two protocol texts differ, as "POINTER: OLD in the record, NEW now" ("absent" for a member one
+// of them lacks); "the recorded text is not JSON" for a damaged record.
+std::string FirstChange(const std::string& recorded, const std::string& now, bool ignore_version) {
+  Json a, b;
+  if (!ParseBoth(recorded, now, &a, &b)) return "the recorded text is not JSON";
+  if (ignore_version && a.is_object() && b.is_object()) a.erase("version"), b.erase("version");
+  const Json patch = Json::diff(a, b);
+  if (patch.empty()) return "the same text but for /version";
+  const Json& op = patch.front();
+  const std::string path = op.at("path").get<std::string>();
+  auto value = [](const Json& v) {
+    const std::string t = v.dump();
+    return t.size() > 60 ? t.substr(0, 57) + "..." : t;
+  };
+  const std::string kind = op.at("op").get<std::string>();
+  const std::string before = kind == "add" ? "absent" : value(a.at(Json::json_pointer(path)));
+  const std::string after = kind == "remove" ? "absent" : value(op.at("value"));
+  return (path.empty() ? "/" : path) + ": " + before + " in the record, " + after + " now";
+}
+
+// Shortest text that reads back as the same double.
+std::string Shortest(double value) {
+  char text[64];
+  const auto result = std::to_chars(text, text + sizeof(text), value);
+  return std::string(text, result.ptr);
+}
+
 }  // namespace
+
+std::string AllowedText(const DesignColumnRecord& column) {
+  std::string text;
+  if (!column.numbers.empty()) {
+    for (double v : column.numbers) text += (text.empty() ? "" : "|") + Shortest(v);
+  } else if (!column.names.empty()) {
+    for (const std::string& v : column.names) text += (text.empty() ? "" : "|") + v;
+  } else if (column.min && column.max) {
+    text = Shortest(*column.min) + ".." + Shortest(*column.max);
+  } else if (column.min) {
+    text = ">= " + Shortest(*column.min);
+  }
+  return text;
+}
+
+void Record::CheckProtocolVersion(int64_t study_id, const std::string& study, const std::string& canonical,
+                                  const std::string& hash, int64_t version) {
+  Statement same(db_, "SELECT count(*) FROM protocol_versions WHERE study_id = ? AND hash = ?");
+  same.Bind(1, study_id);
+  same.Bind(2, hash);
+  same.Step();
+  if (same.GetInt64(0) > 0) return;  // a text the study already records: as it was
+  // The highest recorded version first: a text under it or under an equal version would make one version name two
+  // designs in the tables.
+  Statement others(db_, "SELECT coalesce(version, 1), json FROM protocol_versions WHERE study_id = ? "
+                        "AND coalesce(version, 1) >= ? ORDER BY coalesce(version, 1) DESC, id DESC LIMIT 1");
+  others.Bind(1, study_id);
+  others.Bind(2, version);
+  if (!others.Step()) return;
+  const int64_t recorded = others.GetInt64(0);
+  const std::string way_out = "; raise \"version\" to " + std::to_string(recorded + 1) +
+                              " to record it as a new version, or use another record (--db)";
+  if (recorded == version)
+    throw InputError(db_.path(), "study " + study + " records protocol version " + std::to_string(version) +
+                                     " with another text (" + FirstChange(others.GetText(1), canonical, false) + ")" +
+                                     way_out);
+  throw InputError(db_.path(), "study " + study + " records protocol version " + std::to_string(recorded) +
+                                   ", this protocol says version " + std::to_string(version) +
+                                   " with another text (" + FirstChange(others.GetText(1), canonical, true) + ")" +
+                                   way_out);
+}
+
+void Record::SaveDesign(int64_t protocol_id, int64_t version, const std::vector<DesignColumnRecord>& design) {
+  Statement set(db_, "UPDATE protocol_versions SET version = ? WHERE id = ? AND version IS NULL");
+  set.Bind(1, version);
+  set.Bind(2, protocol_id);
+  set.Run();
+  // Once per protocol version: its sessions share one text, so one design.
+  if (design.empty() ||
+      db_.QueryInt64("SELECT count(*) FROM design_columns WHERE protocol_version_id = " + std::to_string(protocol_id)) > 0)
+    return;
+  Statement insert(db_, "INSERT INTO design_columns (protocol_version_id, position, name, role, type, unit, allowed) "
+                        "VALUES (?, ?, ?, ?, ?, ?, ?)");
+  int64_t position = 0;
+  for (const DesignColumnRecord& c : design) {
+    insert.Bind(1, protocol_id);
+    insert.Bind(2, position++);
+    insert.Bind(3, c.name);
+    insert.Bind(4, c.role);
+    insert.Bind(5, c.type);
+    insert.Bind(6, c.unit);
+    insert.Bind(7, AllowedText(c));
+    insert.Run();
+    insert.Reset();
+  }
+}
+
+int64_t Record::NextSessionNumber(int64_t participant_id, const std::string& study, const std::string& participant,
+                                  uint64_t seed, const SessionMeta& meta) {
+  const int64_t number = db_.QueryInt64("SELECT coalesce(max(session_number), 0) + 1 FROM sessions WHERE "
+                                        "participant_id = " + std::to_string(participant_id));
+  const std::string who = "participant " + participant + " of study " + study;
+  if (meta.seed_for_number > 0 && meta.seed_for_number != number)
+    throw InputError(db_.path(), "the session of " + who + " was prepared as session number " +
+                                     std::to_string(meta.seed_for_number) + " with its seed, but the record now "
+                                     "gives it number " + std::to_string(number) + " (another station started a "
+                                     "session of this participant meanwhile?); run it again");
+  // The same seed makes the same trial order (and a simulated observer's same answers): a copy, not a session.
+  Statement used(db_, "SELECT id, coalesce(session_number, 0) FROM sessions WHERE participant_id = ? AND seed = ? "
+                      "ORDER BY id LIMIT 1");
+  used.Bind(1, participant_id);
+  used.Bind(2, static_cast<int64_t>(seed));
+  if (used.Step())
+    throw InputError(db_.path(), std::string(meta.seed_given ? "--seed " : "seed ") + std::to_string(seed) +
+                                     " is the seed of " + who + "'s session number " + std::to_string(used.GetInt64(1)) +
+                                     " (" + SessionName(used.GetInt64(0)) + "): a session with it repeats that "
+                                     "session's trial order; " +
+                                     (meta.seed_given ? "leave out --seed (each session number gets a seed of its own) "
+                                                        "or give another"
+                                                      : "give another with --seed"));
+  return number;
+}
 
 SessionStart Record::StartOrResumeSession(const std::string& study, const std::string& participant,
                                           const std::string& protocol_json, uint64_t seed, const SessionMeta& meta,
@@ -294,7 +414,7 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
   const int64_t participant_id = EnsureParticipant(db_, study_id, participant, now);
 
   Statement running(db_, "SELECT s.id, s.seed, p.hash, p.json, s.observer, s.observer_params, s.display_profile, s.group_name, "
-                         "s.window "
+                         "s.window, s.session_number "
                          "FROM sessions s "
                          "JOIN protocol_versions p "
                          "ON p.id = s.protocol_version_id WHERE s.participant_id = ? AND s.status = 'running' "
@@ -352,6 +472,7 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     start.session_id = session;
     start.resumed = true;
     start.group = running.IsNull(7) ? "" : running.GetText(7);
+    start.session_number = running.IsNull(9) ? 1 : running.GetInt64(9);
   } else if (resume) {
     // Nothing to continue: say what there is instead of starting a whole new session unasked.
     Statement past(db_, "SELECT status, count(*), max(id) FROM sessions WHERE participant_id = ? GROUP BY status");
@@ -366,10 +487,15 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
                                      "); leave out --resume to start a new session" +
                                      (found.find("completed") != std::string::npos ? ", with --again" : ""));
   } else {
+    CheckProtocolVersion(study_id, study, canonical, hash, meta.protocol_version);
     std::string stored_json;
     const int64_t protocol_id = EnsureProtocolVersion(db_, study_id, canonical, hash, now, &stored_json);
     if (stored_json != canonical)  // a 64-bit hash collision: refuse rather than mix texts
       throw Error(ErrorKind::kInternal, "protocol hash " + hash + " collides with another protocol text");
+    SaveDesign(protocol_id, meta.protocol_version, meta.design);
+    // Numbered in the transaction that inserts the session, as the balanced group is: two stations never give one
+    // number twice.
+    start.session_number = NextSessionNumber(participant_id, study, participant, seed, meta);
     // Counted and inserted in one transaction (BEGIN IMMEDIATE): a station starting at the same moment waits for
     // this one's session and counts it.
     start.group = meta.assign_group ? meta.assign_group(SessionsPerGroup(db_, study)) : meta.group;
@@ -377,8 +503,8 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     Statement insert(db_, "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, "
                           "host, display, started, status, lock_host, lock_pid, lock_token, lock_heartbeat_ms, "
                           "display_profile, group_name, participant_info, observer, observer_params, window, "
-                          "profile_name, screen_width_mm, screen_height_mm, viewing_distance_mm, px_per_deg) "
-                          "VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+                          "profile_name, screen_width_mm, screen_height_mm, viewing_distance_mm, px_per_deg, session_number) "
+                          "VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
     insert.Bind(1, participant_id);
     insert.Bind(2, protocol_id);
     insert.Bind(3, static_cast<int64_t>(seed));
@@ -412,6 +538,7 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     number(20, "height_mm");
     number(21, "distance_mm");
     number(22, "px_per_deg");
+    insert.Bind(23, start.session_number);
     insert.Run();
     start.session_id = db_.LastInsertRowId();
     // The participant information, one row per key (text as given; numbers as JSON text).
@@ -464,8 +591,8 @@ void Record::SaveTrialList(int64_t session, const std::vector<TrialRecord>& tria
     throw InputError(db_.path(), SessionName(session) + " already has its trial list");
   Statement insert(db_, "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, right_shown, "
                         "block_name, practice, swapped, left_source, left_fixed, right_source, right_fixed, "
-                        "r_left_px, r_right_px, r_scene_px, task) "
-                        "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+                        "r_left_px, r_right_px, r_scene_px, task, cell) "
+                        "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
   auto optional = [&](int column, const std::optional<double>& value) {
     if (value) insert.Bind(column, *value);
     else insert.BindNull(column);
@@ -490,6 +617,8 @@ void Record::SaveTrialList(int64_t session, const std::vector<TrialRecord>& tria
     optional(15, trial.r_right_px);
     optional(16, trial.r_scene_px);
     insert.Bind(17, trial.task);
+    if (trial.cell.empty()) insert.BindNull(18);
+    else insert.Bind(18, trial.cell);
     insert.Run();
     insert.Reset();
   }
@@ -622,6 +751,24 @@ int64_t Record::FirstUnansweredTrial(int64_t session) {
   query.Step();
   if (!query.IsNull(0)) return query.GetInt64(0);
   return db_.QueryInt64("SELECT COUNT(*) FROM trials WHERE session_id = " + std::to_string(session));
+}
+
+int64_t PeekNextSessionNumber(const std::filesystem::path& db_path, const std::string& study,
+                              const std::string& participant) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(db_path, ec) || std::filesystem::file_size(db_path, ec) == 0) return 1;
+  Database db(db_path, OpenMode::kReadOnly);
+  if (db.QueryInt64("SELECT count(*) FROM sqlite_schema") == 0) return 1;
+  RequireReadableRecord(db);
+  // Before version 8 the migration numbers a participant's sessions 1..n by start: the next is n + 1.
+  Statement next(db, std::string("SELECT ") + (SchemaVersion(db) >= 8 ? "coalesce(max(s.session_number), count(*))"
+                                                                        : "count(*)") +
+                         " + 1 FROM sessions s JOIN participants p ON p.id = s.participant_id JOIN studies st ON "
+                         "st.id = p.study_id WHERE st.name = ? AND p.code = ?");
+  next.Bind(1, study);
+  next.Bind(2, participant);
+  next.Step();
+  return next.GetInt64(0);
 }
 
 GroupsSoFar PeekGroups(const std::filesystem::path& db_path, const std::string& study, const std::string& participant) {
