@@ -565,7 +565,8 @@ PYEOF
     || fail "good observer: $(tail -1 "$W/out")"
   grep -q "12 practice trials skipped now: the criterion was met" "$W/out" || fail "good observer: $(tail -1 "$W/out")"
   grep -q "procedure had stopped" "$W/out" && fail "good observer: a stop rule named where none ran: $(tail -1 "$W/out")"
-  sed 's/"correct": 0.8/"correct": 1/' "$W/p.json" > "$W/strict.json"
+  # Another protocol text under the study's name in the same record: a new version.
+  sed 's/"correct": 0.8/"correct": 1/; s/"version": 1/"version": 2/' "$W/p.json" > "$W/strict.json"
   $BC run "$W/strict.json" --participant B1 --db "$W/s.sqlite" --observer sim:jnd=50,lapse=0 > "$W/out" 2>&1 \
     || fail "guessing observer: $(tail -1 "$W/out")"
   grep -q "22 of 22 trials answered" "$W/out" || fail "guessing observer: $(tail -1 "$W/out")"

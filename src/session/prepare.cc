@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "core/error.h"
+#include "core/hash.h"
 #include "core/json_io.h"
 
 namespace blurcue::session {
@@ -27,10 +28,16 @@ PreparedSession PrepareStudy(const std::filesystem::path& protocol_file, const s
   return s;
 }
 
+uint64_t DefaultSessionSeed(const std::string& study, const std::string& participant, int64_t session_number) {
+  if (session_number <= 1) return protocol::DefaultSeed(study, participant);
+  return Fnv1a64(study + "/" + participant + "#" + std::to_string(session_number));
+}
+
 void PrepareParticipant(PreparedSession* s, const std::string& participant, std::optional<uint64_t> seed,
-                        const std::string& group) {
+                        const std::string& group, int64_t session_number) {
   const std::string file = s->protocol.file.string();
-  s->seed = seed ? *seed : protocol::DefaultSeed(s->protocol.name, participant);
+  s->session_number = session_number;
+  s->seed = seed ? *seed : DefaultSessionSeed(s->protocol.name, participant, session_number);
   s->group = !group.empty() ? group : protocol::AssignGroup(s->protocol, participant, {});
   if (s->protocol.groups && std::find(s->protocol.groups->names.begin(), s->protocol.groups->names.end(), s->group) ==
                                 s->protocol.groups->names.end())
@@ -50,9 +57,9 @@ void PrepareParticipant(PreparedSession* s, const std::string& participant, std:
 
 PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const std::string& participant,
                                std::optional<uint64_t> seed, const std::filesystem::path& display_profile,
-                               const std::string& group) {
+                               const std::string& group, int64_t session_number) {
   PreparedSession s = PrepareStudy(protocol_file, display_profile);
-  PrepareParticipant(&s, participant, seed, group);
+  PrepareParticipant(&s, participant, seed, group, session_number);
   return s;
 }
 

@@ -20,6 +20,7 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "core/typed.h"
+#include "protocol/design.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
 #include "render/frame_compositor.h"
@@ -28,6 +29,7 @@
 #include "session/answer.h"
 #include "session/observer.h"
 #include "session/prepare.h"
+#include "session/record_design.h"
 #include "session/screens.h"
 #include "session/stimulus.h"
 #include "session/trial_logic.h"
@@ -721,9 +723,15 @@ RunResult RunSession(const RunOptions& options) {
                             : so_far.unfinished ? so_far.unfinished_group
                                                 : protocol::AssignGroup(head, options.participant, so_far.sessions);
   const Json info = CollectInfo(head, options, so_far);
+  // A new session's number decides its default seed (the record decides the number again when it starts the
+  // session); a resumed one runs with the seed it recorded.
+  const store::SessionsSoFar sessions = store::PeekSessions(options.db, head.name, options.participant);
+  const int64_t session_number = options.resume && sessions.unfinished ? sessions.unfinished_number : sessions.next_number;
+  std::optional<uint64_t> seed_given = options.seed;
+  if (!seed_given && options.resume && sessions.unfinished) seed_given = sessions.unfinished_seed;
   // Everything checked before the first trial is what `blurcue validate` checks: the same function.
-  const PreparedSession prepared =
-      PrepareSession(options.protocol_file, options.participant, options.seed, options.display_profile, group);
+  const PreparedSession prepared = PrepareSession(options.protocol_file, options.participant, seed_given,
+                                                  options.display_profile, group, session_number);
   const protocol::Protocol& protocol = prepared.protocol;
   if (observer) CheckObserverCanAnswer(*observer, protocol);
   // A new session's balanced group is decided again in the transaction that starts it: a station starting at the
@@ -734,7 +742,7 @@ RunResult RunSession(const RunOptions& options) {
     for (const std::string& name : protocol.groups->names)
       if (name != prepared.group) {
         PreparedSession other = prepared;
-        PrepareParticipant(&other, options.participant, options.seed, name);
+        PrepareParticipant(&other, options.participant, seed_given, name, session_number);
         other_groups.emplace(name, std::move(other));
       }
   const std::string& protocol_text = prepared.protocol_text;
@@ -755,6 +763,7 @@ RunResult RunSession(const RunOptions& options) {
       r.task = protocol::ToString(trial.task);
       r.practice = trial.practice;
       r.swapped = trial.swapped;
+      r.cell = protocol::CellLevels(protocol, trial);
       if (planned.content != "picture" && trial.task != protocol::Task::kAdjustment) {
         r.r_left_px = planned.r_left_px;
         if (!planned.left_only) r.r_right_px = planned.r_right_px;
@@ -822,6 +831,10 @@ RunResult RunSession(const RunOptions& options) {
   meta.simulated = observer.has_value();
   meta.observer_params = observer ? ToString(*observer) : "";
   meta.window = window;
+  meta.protocol_version = protocol.version;
+  meta.design = DesignRecord(protocol);
+  meta.seed_given = options.seed.has_value();
+  if (!options.seed && !options.resume) meta.seed_for_number = session_number;
   if (!options.again && !options.resume) {
     // Running a participant through a study they finished is usually a typo in the id: say so.
     const std::vector<int64_t> done = record.CompletedSessions(protocol.name, options.participant);
@@ -841,7 +854,9 @@ RunResult RunSession(const RunOptions& options) {
   else
     record.CheckTrialList(start.session_id, trial_records(chosen));
   Runner runner(options, chosen, *context, renderer, observer);
-  return runner.Run(record, start);
+  RunResult result = runner.Run(record, start);
+  result.session_number = start.session_number;
+  return result;
 }
 
 }  // namespace blurcue::session

@@ -18,7 +18,7 @@ struct RunOptions {
   std::filesystem::path db;
   std::filesystem::path display_profile;  // --display: overrides the protocol's display.profile
   std::string participant;
-  std::optional<uint64_t> seed;  // unset: protocol::DefaultSeed(study, participant), recorded like any seed
+  std::optional<uint64_t> seed;  // unset: DefaultSessionSeed(study, participant, session number), recorded
   std::string observer;          // empty: a person at the window; "sim[:params]": the simulated observer
   bool resume = false;
   bool again = false;            // allow another session for a participant who completed the study
@@ -33,6 +33,7 @@ struct RunOptions {
 
 struct RunResult {
   int64_t session_id = 0;
+  int64_t session_number = 0;    // the participant's n-th session of the study
   uint64_t seed = 0;
   int64_t trial_count = 0;
   int64_t answered_before = 0;   // answers the session already had (resume)

@@ -31,6 +31,8 @@ const std::vector<ColumnDef>& TrialColumnsBefore() {
   static const std::vector<ColumnDef> columns = {
       {"study", "string", "", "", "the protocol's name"},
       {"protocol_hash", "string", "", "16 hex digits", "FNV-1a-64 of the protocol's canonical text: its version"},
+      {"protocol_version", "integer", "", ">= 1",
+       "the protocol's declared \"version\" the session ran (one text per version of a study)"},
       {"participant", "string", "", "", "the participant's id"},
       {"observer", "string", "", "person|simulated", "who answered: a person, or blurcue's simulated observer"},
       {"observer_params", "string", "", "", "the simulated observer's parameters (sim:model=arcmin,... or sim:model=pixel,...; before model= existed sim:jnd=..., the pixel model); empty for a person"},
@@ -56,6 +58,9 @@ const std::vector<ColumnDef>& TrialColumnsDesign() {
       {"task", "string", "", "forced_choice|adjustment|yes_no|rating", "the trial's task"},
       {"practice", "boolean", "", "0|1", "1: a practice trial (not scored)"},
       {"swapped", "boolean", "", "0|1", "1: left and right exchanged against the design (counterbalancing)"},
+      {"cell", "string", "", "",
+       "a procedure trial's cell by its levels (NAME=LEVEL;... of its block's factors): its own track and threshold; "
+       "empty outside a procedure and in records made before cells were recorded"},
   };
   return columns;
 }
@@ -173,6 +178,65 @@ struct TypeOf {
   }
 };
 
+// What the record's design table says of one column of trials.csv, over every protocol version that has it.
+struct DesignOf {
+  std::set<std::string> roles;
+  std::vector<std::string> allowed;  // each version's allowed text, once
+};
+
+// The allowed values of several protocol versions as one: a list of numbers in numeric order, else of names in the
+// order met; one text when they agree; "" (any) when ranges and lists mix.
+std::string UnionAllowed(const std::vector<std::string>& texts) {
+  if (texts.size() == 1) return texts[0];
+  std::vector<std::string> names;
+  bool numbers = true;
+  for (const std::string& text : texts) {
+    if (text.empty() || text.find("..") != std::string::npos || text.rfind(">=", 0) == 0) return "";
+    for (size_t at = 0; at <= text.size();) {
+      const size_t bar = std::min(text.find('|', at), text.size());
+      const std::string name = text.substr(at, bar - at);
+      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+      if (!ParseDecimal(name)) numbers = false;
+      at = bar + 1;
+    }
+  }
+  if (numbers)
+    std::sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) {
+      return *ParseDecimal(a) < *ParseDecimal(b);
+    });
+  std::string text;
+  for (const std::string& name : names) text += (text.empty() ? "" : "|") + name;
+  return text;
+}
+
+// Gives each design column of trials.csv its role and the values the protocol allows, from the design table (schema
+// 8: recorded once per protocol version). A record with a protocol version that ran sessions but recorded no design
+// (made before designs were recorded) keeps the values seen, and the codebook says so.
+void ApplyDesign(Database& db, std::vector<ColumnDef>* columns) {
+  const bool complete = db.QueryInt64("SELECT count(*) FROM protocol_versions pv WHERE EXISTS (SELECT 1 FROM sessions "
+                                      "s WHERE s.protocol_version_id = pv.id) AND NOT EXISTS (SELECT 1 FROM "
+                                      "design_columns d WHERE d.protocol_version_id = pv.id)") == 0;
+  std::map<std::string, DesignOf> design;
+  Statement rows(db, "SELECT name, role, allowed FROM design_columns ORDER BY protocol_version_id, position");
+  while (rows.Step()) {
+    DesignOf& d = design[rows.GetText(0)];
+    d.roles.insert(rows.GetText(1));
+    if (std::find(d.allowed.begin(), d.allowed.end(), rows.GetText(2)) == d.allowed.end())
+      d.allowed.push_back(rows.GetText(2));
+  }
+  for (ColumnDef& c : *columns) {
+    const auto it = design.find(c.name);
+    if (it == design.end()) {
+      if (!complete && c.meaning.rfind("a level of the protocol's design", 0) == 0)
+        c.meaning += "; allowed: the values seen (the record holds sessions from before designs were recorded)";
+      continue;
+    }
+    for (const std::string& role : it->second.roles) c.role += (c.role.empty() ? "" : "|") + role;
+    if (complete) c.allowed = UnionAllowed(it->second.allowed);
+    else c.meaning += "; allowed: the values seen (the record holds sessions from before designs were recorded)";
+  }
+}
+
 bool AllDigits(const std::string& text) {
   return !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
 }
@@ -278,6 +342,7 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
                          " because trials.csv has a column " + level + " of its own")});
   }
   columns.insert(columns.end(), TrialColumnsAfter().begin(), TrialColumnsAfter().end());
+  ApplyDesign(db, &columns);
   std::vector<std::string> header;
   for (const auto& c : columns) header.push_back(c.name);
   std::string text = CsvLine(header);
@@ -288,18 +353,13 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
                  "t.block_name, t.task, t.practice, t.swapped, t.left_source, t.left_fixed, t.right_source, "
                  "t.right_fixed, coalesce(r.r_left_px, t.r_left_px), coalesce(r.r_right_px, t.r_right_px), "
                  "r.id IS NULL, r.choice, r.rt_ms, r.answered_at, r.adjustment, coalesce(r.shown, '{}'), r.correct, "
-                 "s.group_name, s.observer, s.observer_params, s.window, s.status "
+                 "s.group_name, s.observer, s.observer_params, s.window, s.status, pv.version, s.session_number, "
+                 "t.cell "
                  "FROM trials t JOIN sessions s ON s.id = t.session_id "
                  "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
                  "JOIN protocol_versions pv ON pv.id = s.protocol_version_id "
                  "LEFT JOIN responses r ON r.trial_id = t.id "
                  "ORDER BY st.name, p.code, s.id, t.trial_index");
-  // The participant's n-th session (of the study: a participant belongs to one study).
-  std::map<int64_t, int64_t> session_number;
-  {
-    Statement numbers(db, "SELECT s.id, row_number() OVER (PARTITION BY s.participant_id ORDER BY s.id) FROM sessions s");
-    while (numbers.Step()) session_number[numbers.GetInt64(0)] = numbers.GetInt64(1);
-  }
   int64_t count = 0;
   auto optional_number = [&](int column) { return rows.IsNull(column) ? std::string() : Number(rows.GetDouble(column)); };
   while (rows.Step()) {
@@ -308,12 +368,13 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
     const std::string where = Where(db_path, session, trial);
     std::vector<std::string> cells = {rows.GetText(0),
                                       rows.GetText(1),
+                                      std::to_string(rows.GetInt64(30)),
                                       rows.GetText(2),
                                       rows.IsNull(26) ? "person" : rows.GetText(26),
                                       rows.IsNull(27) ? "" : rows.GetText(27),
                                       rows.IsNull(28) ? "" : std::to_string(rows.GetInt64(28)),
                                       std::to_string(session),
-                                      std::to_string(session_number[session]),
+                                      std::to_string(rows.GetInt64(31)),
                                       rows.GetText(29),
                                       "s" + std::to_string(static_cast<uint64_t>(rows.GetInt64(4)))};
     if (groups) cells.push_back(rows.GetText(25));
@@ -329,6 +390,7 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
     cells.push_back(task);
     cells.push_back(rows.IsNull(10) ? "0" : std::to_string(rows.GetInt64(10)));
     cells.push_back(rows.IsNull(11) ? "0" : std::to_string(rows.GetInt64(11)));
+    cells.push_back(rows.IsNull(32) ? "" : rows.GetText(32));
     // The plan's variables, with what the trial showed when it was shown laid over them (adaptive levels).
     Json factors = ParseColumn(rows.GetText(7), where + " factors");
     const Json shown = ParseColumn(rows.GetText(23), where + " shown");
@@ -378,11 +440,13 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
     }
     ++count;
   }
-  // The codebook: every column of every table this export writes.
-  std::string codebook = CsvLine({"table", "column", "type", "unit", "allowed", "meaning"});
-  for (const auto& c : columns) codebook += CsvLine({"trials.csv", c.name, c.type, c.unit, c.allowed, c.meaning});
-  for (const auto& c : AdjustmentColumns()) codebook += CsvLine({"adjustments.csv", c.name, c.type, c.unit, c.allowed, c.meaning});
-  for (const auto& c : FrameColumns()) codebook += CsvLine({"frames.csv", c.name, c.type, c.unit, c.allowed, c.meaning});
+  // The codebook: every column of every table this export writes; a design's column with its role.
+  std::string codebook = CsvLine({"table", "column", "type", "unit", "allowed", "meaning", "role"});
+  for (const auto& c : columns)
+    codebook += CsvLine({"trials.csv", c.name, c.type, c.unit, c.allowed, c.meaning, c.role});
+  for (const auto& c : AdjustmentColumns())
+    codebook += CsvLine({"adjustments.csv", c.name, c.type, c.unit, c.allowed, c.meaning, ""});
+  for (const auto& c : FrameColumns()) codebook += CsvLine({"frames.csv", c.name, c.type, c.unit, c.allowed, c.meaning, ""});
   // Every table of one export appears together: a kill leaves the previous export whole, never its frames.csv
   // beside a new trials.csv.
   WriteFolderAtomically(

@@ -146,11 +146,11 @@ std::string WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
         {"planned", "integer", "", ">= 0", "trials planned, practice apart"},
         {"answered", "integer", "", ">= 0", "trials answered, practice apart"},
         {"median_rt_ms", "number", "ms", ">= 0", "the median response time of the answered trials"}};
-    for (const auto& c : columns) codebook += CsvLine({file, c.name, c.type, c.unit, c.allowed, c.meaning});
+    for (const auto& c : columns) codebook += CsvLine({file, c.name, c.type, c.unit, c.allowed, c.meaning, ""});
     for (const auto& name : answer_names[study])
       codebook += CsvLine({file, "n_" + name, "integer", "", ">= 0",
                            "how often the answer " + name + " was given (forced choice: the source chosen, or "
-                           "cant_tell; adjustment: the level accepted)"});
+                           "cant_tell; adjustment: the level accepted)", ""});
     std::string text = CsvLine(header);
     for (auto& [session, row] : sessions) {
       std::sort(row.rts.begin(), row.rts.end());

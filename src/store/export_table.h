@@ -17,6 +17,7 @@ namespace blurcue::store {
 // from the same ones, so the two cannot drift.
 struct ColumnDef {
   std::string name, type, unit, allowed, meaning;
+  std::string role = "";  // a design's column: within, group, procedure_cell, label or practice (the design table's)
 };
 
 

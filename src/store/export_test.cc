@@ -95,9 +95,9 @@ TEST(Export, ColumnsAreTheSameForParticipantsWithDifferentFactors) {
   const Rows rows = ReadCsv(dir / "out" / "trials.csv");
   ASSERT_EQ(rows.size(), 8u);
   const std::vector<std::string> expected = {
-      "study",       "protocol_hash", "participant", "observer",    "observer_params",    "window",
+      "study",       "protocol_hash", "protocol_version", "participant", "observer",    "observer_params", "window",
       "session_id",  "session_number", "session_status", "seed", "trial_index", "block",            "block_name",
-      "task",        "practice",      "swapped",     "blur",        "edge",               "speed_cm_s",
+      "task",        "practice",      "swapped",     "cell",        "blur",        "edge",               "speed_cm_s",
       "left_source", "left_fixed",    "right_source", "right_fixed", "status",            "chosen_side",
       "chose_more_blurred", "chosen_interval", "yes_no", "rating",   "adjusted_level",    "correct",
       "rt_ms",       "answered_at"};

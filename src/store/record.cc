@@ -753,22 +753,38 @@ int64_t Record::FirstUnansweredTrial(int64_t session) {
   return db_.QueryInt64("SELECT COUNT(*) FROM trials WHERE session_id = " + std::to_string(session));
 }
 
-int64_t PeekNextSessionNumber(const std::filesystem::path& db_path, const std::string& study,
-                              const std::string& participant) {
+SessionsSoFar PeekSessions(const std::filesystem::path& db_path, const std::string& study,
+                           const std::string& participant) {
+  SessionsSoFar so_far;
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(db_path, ec) || std::filesystem::file_size(db_path, ec) == 0) return 1;
-  Database db(db_path, OpenMode::kReadOnly);
-  if (db.QueryInt64("SELECT count(*) FROM sqlite_schema") == 0) return 1;
-  RequireReadableRecord(db);
-  // Before version 8 the migration numbers a participant's sessions 1..n by start: the next is n + 1.
-  Statement next(db, std::string("SELECT ") + (SchemaVersion(db) >= 8 ? "coalesce(max(s.session_number), count(*))"
-                                                                        : "count(*)") +
-                         " + 1 FROM sessions s JOIN participants p ON p.id = s.participant_id JOIN studies st ON "
-                         "st.id = p.study_id WHERE st.name = ? AND p.code = ?");
-  next.Bind(1, study);
-  next.Bind(2, participant);
-  next.Step();
-  return next.GetInt64(0);
+  if (!std::filesystem::is_regular_file(db_path, ec) || std::filesystem::file_size(db_path, ec) == 0) return so_far;
+  try {
+    Database db(db_path, OpenMode::kReadOnly);
+    if (db.QueryInt64("SELECT count(*) FROM sqlite_schema") == 0) return so_far;
+    RequireReadableRecord(db);
+    // Before version 8 the migration numbers a participant's sessions by start: a session's number is its place.
+    const std::string place = "(SELECT count(*) FROM sessions o WHERE o.participant_id = s.participant_id AND "
+                              "(o.started < s.started OR (o.started = s.started AND o.id <= s.id)))";
+    const std::string number = SchemaVersion(db) >= 8 ? "coalesce(s.session_number, " + place + ")" : place;
+    const std::string of = " FROM sessions s JOIN participants p ON p.id = s.participant_id JOIN studies st ON "
+                           "st.id = p.study_id WHERE st.name = ? AND p.code = ?";
+    Statement next(db, "SELECT coalesce(max(" + number + "), 0) + 1" + of);
+    next.Bind(1, study);
+    next.Bind(2, participant);
+    next.Step();
+    so_far.next_number = next.GetInt64(0);
+    Statement running(db, "SELECT s.seed, " + number + of + " AND s.status = 'running' ORDER BY s.id DESC LIMIT 1");
+    running.Bind(1, study);
+    running.Bind(2, participant);
+    if (running.Step()) {
+      so_far.unfinished = true;
+      so_far.unfinished_seed = static_cast<uint64_t>(running.GetInt64(0));
+      so_far.unfinished_number = running.GetInt64(1);
+    }
+  } catch (const Error&) {
+    return {};  // not a record this build reads: opening it for the session says why
+  }
+  return so_far;
 }
 
 GroupsSoFar PeekGroups(const std::filesystem::path& db_path, const std::string& study, const std::string& participant) {

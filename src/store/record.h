@@ -64,10 +64,16 @@ struct GroupsSoFar {
 };
 GroupsSoFar PeekGroups(const std::filesystem::path& db, const std::string& study, const std::string& participant);
 
-// The number a new session of the participant would get (1 when the record or the participant is missing), read
-// without writing; StartOrResumeSession decides it again in its transaction.
-int64_t PeekNextSessionNumber(const std::filesystem::path& db, const std::string& study,
-                              const std::string& participant);
+// What a record says of a participant's sessions, read without writing: the number a new session would get
+// (StartOrResumeSession decides it again in its transaction), and the participant's running session's seed and
+// number. A missing file, or one that is not a readable record (Record::Open refuses it, saying why), says nothing.
+struct SessionsSoFar {
+  int64_t next_number = 1;
+  bool unfinished = false;
+  uint64_t unfinished_seed = 0;
+  int64_t unfinished_number = 0;
+};
+SessionsSoFar PeekSessions(const std::filesystem::path& db, const std::string& study, const std::string& participant);
 
 // One planned trial, saved up front. JSON members are compact JSON text.
 struct TrialRecord {

@@ -91,17 +91,21 @@ TEST(Record, SeedDerivedForAnotherSessionNumberIsRefused) {
   EXPECT_EQ(record.StartOrResumeSession("s", "P1", kV1, 99, meta, false).session_number, 2);
 }
 
-TEST(Record, PeekSaysTheNextSessionNumberWithoutWriting) {
+TEST(Record, PeekSaysTheNextSessionNumberAndTheRunningSessionsSeedWithoutWriting) {
   testing::TempDir dir;
-  EXPECT_EQ(PeekNextSessionNumber(dir / "none.sqlite", "s", "P1"), 1);
+  EXPECT_EQ(PeekSessions(dir / "none.sqlite", "s", "P1").next_number, 1);
   {
     Record record = Record::Open(dir / "r.sqlite");
     Complete(record, "P1", kV1, 11);
-    Complete(record, "P1", kV1, 12);
+    record.StartOrResumeSession("s", "P1", kV1, 12, {}, false);
   }
-  EXPECT_EQ(PeekNextSessionNumber(dir / "r.sqlite", "s", "P1"), 3);
-  EXPECT_EQ(PeekNextSessionNumber(dir / "r.sqlite", "s", "P2"), 1);
-  EXPECT_EQ(PeekNextSessionNumber(dir / "r.sqlite", "other", "P1"), 1);
+  const SessionsSoFar p1 = PeekSessions(dir / "r.sqlite", "s", "P1");
+  EXPECT_EQ(p1.next_number, 3);
+  EXPECT_TRUE(p1.unfinished);
+  EXPECT_EQ(p1.unfinished_seed, 12u);
+  EXPECT_EQ(p1.unfinished_number, 2);
+  EXPECT_EQ(PeekSessions(dir / "r.sqlite", "s", "P2").next_number, 1);
+  EXPECT_FALSE(PeekSessions(dir / "r.sqlite", "other", "P1").unfinished);
 }
 
 TEST(Record, ChangedProtocolUnderTheSameVersionIsRefusedNamingTheFirstDifference) {
