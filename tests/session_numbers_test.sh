@@ -73,7 +73,7 @@ protocol_version)
   code=$?
   set -e
   [ $code = 3 ] || fail "changed protocol, same version: exit $code"
-  [ "$(cat "$W/err")" = "run: $W/s.sqlite: study test1-static-grids records protocol version 1 with another text (/timing/inter_trial_ms: 500 in the record, 300 now); raise \"version\" to 2 to record it as a new version, or use another record (--db)" ] \
+  [ "$(cat "$W/err")" = "blurcue: $W/s.sqlite: study test1-static-grids records protocol version 1 with another text (/timing/inter_trial_ms: 500 in the record, 300 now); raise \"version\" to 2 to record it as a new version, or use another record (--db)" ] \
     || fail "message: $(cat "$W/err")"
   [ "$(sql "$W/s.sqlite" "SELECT count(*) FROM sessions")" = 1 ] || fail "a refused session was recorded"
   $BC run "$W/v2.json" --participant V2 --db "$W/s.sqlite" --observer sim > /dev/null
