@@ -299,6 +299,15 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
                                " in the merged record (numbered by start)");
         number.Reset();
       }
+      // Stations that each ran another text under one version (or records made before versions were kept apart)
+      // are merged as they are; the tables cannot tell those sessions' designs apart by version, so say so.
+      Statement shared(dst, "SELECT st.name, pv.version, count(*) FROM protocol_versions pv JOIN studies st ON "
+                            "st.id = pv.study_id GROUP BY pv.study_id, pv.version HAVING count(*) > 1 "
+                            "ORDER BY st.name, pv.version");
+      while (shared.Step())
+        renumbered.push_back("study " + shared.GetText(0) + ": protocol version " + std::to_string(shared.GetInt64(1)) +
+                             " has " + std::to_string(shared.GetInt64(2)) + " different texts in the merged record "
+                             "(protocol_hash tells their sessions apart)");
       transaction.Commit();
     }  // the last connection closes: the WAL is checkpointed into the file and removed
     MoveIntoPlace(temp, out);

@@ -232,3 +232,24 @@ TEST(Merge, SessionNumbersFollowTheStartAcrossInputsAndChangesAreTold) {
 
 }  // namespace
 }  // namespace blurcue::store
+
+namespace blurcue::store {
+namespace {
+
+TEST(Merge, AVersionRunWithTwoTextsAtTwoStationsIsMergedAndTold) {
+  testing::TempDir dir;
+  {
+    Record a = Record::Open(dir / "a.sqlite");
+    Complete(a, "P1", kV1, 11, Version(1));
+    Record b = Record::Open(dir / "b.sqlite");
+    Complete(b, "P2", R"({"name":"s","timing":{"stimulus_ms":300},"version":1})", 21, Version(1));
+  }
+  std::vector<std::string> notes;
+  MergeDatabases({dir / "a.sqlite", dir / "b.sqlite"}, dir / "m.sqlite",
+                 [&](const std::string& line) { notes.push_back(line); });
+  EXPECT_EQ(notes, (std::vector<std::string>{"study s: protocol version 1 has 2 different texts in the merged record "
+                                             "(protocol_hash tells their sessions apart)"}));
+}
+
+}  // namespace
+}  // namespace blurcue::store
