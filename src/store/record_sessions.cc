@@ -152,8 +152,13 @@ SessionsSoFar PeekSessions(const std::filesystem::path& db_path, const std::stri
   if (!std::filesystem::is_regular_file(db_path, ec) || std::filesystem::file_size(db_path, ec) == 0) return so_far;
   try {
     Database db(db_path, OpenMode::kReadOnly);
-    if (db.QueryInt64("SELECT count(*) FROM sqlite_schema") == 0) return so_far;
-    RequireReadableRecord(db);
+    // No page check here (Record::Open makes it, and refuses a damaged file before anything runs): a peek that
+    // read every page would double a large record's start-up.
+    // A record from before the application id was stamped has 0 (another program's file fails the queries below).
+    const int64_t id = db.QueryInt64("PRAGMA application_id");
+    if (db.QueryInt64("SELECT count(*) FROM sqlite_schema") == 0 || (id != kApplicationId && id != 0) ||
+        SchemaVersion(db) > CurrentSchemaVersion())
+      return so_far;
     // Before version 8 the migration numbers a participant's sessions by start: a session's number is its place.
     const std::string place = "(SELECT count(*) FROM sessions o WHERE o.participant_id = s.participant_id AND "
                               "(o.started < s.started OR (o.started = s.started AND o.id <= s.id)))";
