@@ -27,7 +27,7 @@ again)
   $BC run "$P/test1-static-grids.json" --participant A1 --db "$W/s.sqlite" --observer sim --again > "$W/out2"
   $BC run "$P/test1-static-grids.json" --participant A1 --db "$W/s.sqlite" --observer sim --again > "$W/out3"
   for n in 1 2 3; do
-    grep -q "participant A1, session $n (the participant's session number $n), seed" "$W/out$n" \
+    grep -q "participant A1, session $n, the participant's session $n, seed" "$W/out$n" \
       || fail "summary $n: $(cat "$W/out$n")"
   done
   [ "$(sql "$W/s.sqlite" "SELECT count(DISTINCT seed) FROM sessions")" = 3 ] || fail "seeds: $(sql "$W/s.sqlite" "SELECT seed FROM sessions")"

@@ -1080,7 +1080,9 @@ PYEOF
   $BC sessions --db "$W/s.sqlite" | grep -Eq "test1-static-grids +S1 +aborted +6/13" || fail "sessions: $($BC sessions --db "$W/s.sqlite")"
   set +e; $BC sessions --db "$W/s.sqlite" --abort 1 2> "$W/err"; code=$?; set -e
   [ $code = 3 ] && grep -q "session 1 is aborted; only a running session can be aborted" "$W/err" || fail "abort twice: $(cat "$W/err")"
-  $BC run "$P/test1-changed.json" --participant S1 --db "$W/s.sqlite" --observer sim | grep -q "session 2, .* 13 of 13" \
+  # Run anew, the changed text is another version of the study's protocol: its "version" is raised.
+  sed 's/"version": 1,/"version": 2,/' "$P/test1-changed.json" > "$P/test1-changed-v2.json"
+  $BC run "$P/test1-changed-v2.json" --participant S1 --db "$W/s.sqlite" --observer sim | grep -q "session 2, .* 13 of 13" \
     || fail "no new session after the abort"
   integrity "$W/s.sqlite"
   echo "ok: CRLF-reformatted protocol resumes; a changed one names the change; --abort closes it, answers kept" ;;

@@ -128,8 +128,8 @@ void AddRunCommand(CLI::App& app) {
     if (by_stop_rule > 0) skipped += ", " + std::to_string(by_stop_rule) + " skipped now: their procedure had stopped";
     if (r.skipped_by_criterion_now > 0)
       skipped += ", " + std::to_string(r.skipped_by_criterion_now) + " practice trials skipped now: the criterion was met";
-    std::printf("%s: participant %s, session %lld (the participant's session number %lld), seed %llu: %lld of %lld "
-                "trials %s (%lld answered now%s%s)%s\n",
+    std::printf("%s: participant %s, session %lld, the participant's session %lld, seed %llu: %lld of %lld trials %s "
+                "(%lld answered now%s%s)%s\n",
                 args->db.c_str(), options.participant.c_str(), static_cast<long long>(r.session_id),
                 static_cast<long long>(r.session_number),
                 static_cast<unsigned long long>(r.seed),
