@@ -421,9 +421,8 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
       const double l = rows.GetDouble(16), r = rows.GetDouble(17);
       if (std::abs(l - r) > 1e-9) more_blurred = ((side == "left") == (l > r)) ? "1" : "0";
     }
-    std::string correct = rows.IsNull(24) ? "" : std::to_string(rows.GetInt64(24));
-    if (correct.empty() && !interval.empty() && factors.contains("odd_interval"))
-      correct = TidyCell(factors["odd_interval"]) == interval ? "1" : "0";
+    // Scored once, when the answer was given (records from before: by the migration to schema 8), never here.
+    const std::string correct = rows.IsNull(24) ? "" : std::to_string(rows.GetInt64(24));
     for (const std::string& cell : {status, side, more_blurred, interval, yes_no, rating, level, correct})
       cells.push_back(cell);
     cells.push_back(answered && !rows.IsNull(20) ? Number(rows.GetDouble(20)) : "");

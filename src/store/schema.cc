@@ -257,6 +257,12 @@ void DeriveVersionsAndNumbers(Database& db) {
           "'integer' AND json_extract(json, '$.version') >= 1 THEN json_extract(json, '$.version') ELSE 1 END "
           "WHERE version IS NULL");
   NumberSessions(db, false);
+  // An answer is scored once, when it is given (Response::correct); an odd one out answered before the runner
+  // recorded it is scored here from its trial's odd interval, so that export reads every correct and scores none.
+  db.Exec("UPDATE responses SET correct = (choice = (SELECT CAST(json_extract(t.factors, '$.odd_interval') AS TEXT) "
+          "FROM trials t WHERE t.id = responses.trial_id)) "
+          "WHERE correct IS NULL AND choice <> '' AND choice NOT GLOB '*[^0-9]*' AND (SELECT json_extract(t.factors, "
+          "'$.odd_interval') FROM trials t WHERE t.id = responses.trial_id AND json_valid(t.factors)) IS NOT NULL");
 }
 
 void NumberSessions(Database& db, bool all) {

@@ -52,7 +52,8 @@ const std::vector<TypedColumn>& TypedColumns();
 void DeriveTypedColumns(Database& db);
 
 // Fills what version 8 added where it is NULL: a protocol version's declared "version" from its JSON (1 when it
-// declares none), and the session numbers of every participant with an unnumbered session (NumberSessions).
+// declares none), the session numbers of every participant with an unnumbered session (NumberSessions), and the
+// correctness of an odd one out answered before it was recorded with the answer (choice = the trial's odd_interval).
 void DeriveVersionsAndNumbers(Database& db);
 
 // Numbers sessions 1, 2, ... per participant by order of start (then id): every session (`all`, as merge does), or

@@ -195,7 +195,12 @@ TEST(Schema, VersionSevenRecordGetsSessionNumbersByStartAndVersionsFromItsTexts)
             "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, host, display, "
             "  started, status) VALUES (1, 1, 1, 'v', 'h', 'd', '2024-01-02T00:00:00.000Z', 'completed'),"
             "  (2, 1, 2, 'v', 'h', 'd', '2024-01-01T00:00:00.000Z', 'completed'),"
-            "  (1, 2, 3, 'v', 'h', 'd', '2024-01-01T00:00:00.000Z', 'aborted');");
+            "  (1, 2, 3, 'v', 'h', 'd', '2024-01-01T00:00:00.000Z', 'aborted');"
+            "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, right_shown) VALUES "
+            "  (1, 0, 0, '{\"odd_interval\": 2}', 'null', 'null'), (1, 1, 0, '{\"odd_interval\": 3}', 'null', 'null'),"
+            "  (1, 2, 0, '{\"odd_interval\": 3}', 'null', 'null'), (1, 3, 0, '{}', 'null', 'null');"
+            "INSERT INTO responses (trial_id, choice, adjustment, answered_at) VALUES (1, '2', '[]', 'now'), "
+            "  (2, '1', '[]', 'now'), (3, 'none', '[]', 'now'), (4, '2', '[]', 'now');");
   }
   Record record = Record::Open(dir / "old.sqlite");
   EXPECT_EQ(record.database().QueryText("SELECT group_concat(session_number, ',') FROM (SELECT * FROM sessions "
@@ -205,6 +210,11 @@ TEST(Schema, VersionSevenRecordGetsSessionNumbersByStartAndVersionsFromItsTexts)
                                         "ORDER BY id)"),
             "3,1");
   EXPECT_EQ(record.StartOrResumeSession("s", "P1", R"({"version":4})", 4, Version(4), false).session_number, 3);
+  // An odd one out answered before the answer's correctness was recorded is scored once, here: 2 of 2 right, 1 of 3
+  // wrong; a timeout and a trial without an odd interval have no correct answer.
+  EXPECT_EQ(record.database().QueryText("SELECT group_concat(coalesce(correct, 'NULL'), ',') FROM (SELECT * FROM "
+                                        "responses ORDER BY id)"),
+            "1,0,NULL,NULL");
 }
 
 // Two stations each ran a participant's first session: merged, the participant's sessions are numbered by start.
