@@ -3,7 +3,6 @@
 #include <algorithm>
 
 #include "core/error.h"
-#include "core/hash.h"
 #include "core/json_io.h"
 
 namespace blurcue::session {
@@ -28,16 +27,10 @@ PreparedSession PrepareStudy(const std::filesystem::path& protocol_file, const s
   return s;
 }
 
-uint64_t DefaultSessionSeed(const std::string& study, const std::string& participant, int64_t session_number) {
-  if (session_number <= 1) return protocol::DefaultSeed(study, participant);
-  return Fnv1a64(study + "/" + participant + "#" + std::to_string(session_number));
-}
-
 void PrepareParticipant(PreparedSession* s, const std::string& participant, std::optional<uint64_t> seed,
-                        const std::string& group, int64_t session_number) {
+                        const std::string& group) {
   const std::string file = s->protocol.file.string();
-  s->session_number = session_number;
-  s->seed = seed ? *seed : DefaultSessionSeed(s->protocol.name, participant, session_number);
+  s->seed = seed ? *seed : protocol::DefaultSeed(s->protocol.name, participant);
   s->group = !group.empty() ? group : protocol::AssignGroup(s->protocol, participant, {});
   if (s->protocol.groups && std::find(s->protocol.groups->names.begin(), s->protocol.groups->names.end(), s->group) ==
                                 s->protocol.groups->names.end())
@@ -57,9 +50,9 @@ void PrepareParticipant(PreparedSession* s, const std::string& participant, std:
 
 PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const std::string& participant,
                                std::optional<uint64_t> seed, const std::filesystem::path& display_profile,
-                               const std::string& group, int64_t session_number) {
+                               const std::string& group) {
   PreparedSession s = PrepareStudy(protocol_file, display_profile);
-  PrepareParticipant(&s, participant, seed, group, session_number);
+  PrepareParticipant(&s, participant, seed, group);
   return s;
 }
 

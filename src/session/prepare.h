@@ -20,8 +20,7 @@ namespace blurcue::session {
 struct PreparedSession {
   protocol::Protocol protocol;
   std::string protocol_text;              // the file as read and parsed (recorded with the session)
-  uint64_t seed = 0;                      // as given, else DefaultSessionSeed(study, participant, session_number)
-  int64_t session_number = 1;             // the participant's n-th session of the study the seed was made for
+  uint64_t seed = 0;                      // as given, else protocol::DefaultSeed(study, participant)
   std::string group;                      // the between-subject group whose blocks the trials hold ("": none)
   std::vector<protocol::Trial> trials;
   std::optional<calib::SceneCalib> scene;
@@ -32,20 +31,15 @@ struct PreparedSession {
   std::set<double> real_photos_checked;   // the distances whose real photo has been decoded (CheckRealPhotos)
 };
 
-// The seed of a participant's session `session_number` when none is given: protocol::DefaultSeed(study,
-// participant) for the first (records made before sessions were numbered keep their seeds), FNV-1a 64 of
-// "STUDY/PARTICIPANT#K" for session K > 1, so a session run again is not a copy of the first.
-uint64_t DefaultSessionSeed(const std::string& study, const std::string& participant, int64_t session_number);
-
 // Reads and validates the protocol, builds the participant's trial list, loads the calibration and every image
 // the trials show (each must decode, at a size its use can show), and works out every trial's scene and radii.
 // Throws Error(kInput) whose lines each name the protocol file and the JSON pointer of the field at fault.
 // `display_profile` (--display) overrides the protocol's display.profile. `group`: the group to run (a resumed
 // session's, or one assigned from the record); empty: assigned as if the record were empty (by_number, or the
-// first group when balanced). `session_number`: which of the participant's sessions this is (its default seed).
+// first group when balanced).
 PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const std::string& participant,
                                std::optional<uint64_t> seed, const std::filesystem::path& display_profile = {},
-                               const std::string& group = "", int64_t session_number = 1);
+                               const std::string& group = "");
 
 // PrepareSession in two parts, for many participants of one study (blurcue plan): what every participant shares
 // (the protocol, the calibration, the images, the display and the presentation; no trials yet), then one
@@ -53,6 +47,6 @@ PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const
 PreparedSession PrepareStudy(const std::filesystem::path& protocol_file,
                              const std::filesystem::path& display_profile = {});
 void PrepareParticipant(PreparedSession* study, const std::string& participant, std::optional<uint64_t> seed,
-                        const std::string& group = "", int64_t session_number = 1);
+                        const std::string& group = "");
 
 }  // namespace blurcue::session

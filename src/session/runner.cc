@@ -29,7 +29,7 @@
 #include "session/answer.h"
 #include "session/observer.h"
 #include "session/prepare.h"
-#include "session/record_design.h"
+#include "session/record_meta.h"
 #include "session/screens.h"
 #include "session/stimulus.h"
 #include "session/trial_logic.h"
@@ -727,11 +727,12 @@ RunResult RunSession(const RunOptions& options) {
   // session); a resumed one runs with the seed it recorded.
   const store::SessionsSoFar sessions = store::PeekSessions(options.db, head.name, options.participant);
   const int64_t session_number = options.resume && sessions.unfinished ? sessions.unfinished_number : sessions.next_number;
-  std::optional<uint64_t> seed_given = options.seed;
-  if (!seed_given && options.resume && sessions.unfinished) seed_given = sessions.unfinished_seed;
+  const uint64_t session_seed = options.seed                                  ? *options.seed
+                                : options.resume && sessions.unfinished ? sessions.unfinished_seed
+                                : DefaultSessionSeed(head.name, options.participant, session_number);
   // Everything checked before the first trial is what `blurcue validate` checks: the same function.
-  const PreparedSession prepared = PrepareSession(options.protocol_file, options.participant, seed_given,
-                                                  options.display_profile, group, session_number);
+  const PreparedSession prepared =
+      PrepareSession(options.protocol_file, options.participant, session_seed, options.display_profile, group);
   const protocol::Protocol& protocol = prepared.protocol;
   if (observer) CheckObserverCanAnswer(*observer, protocol);
   // A new session's balanced group is decided again in the transaction that starts it: a station starting at the
@@ -742,7 +743,7 @@ RunResult RunSession(const RunOptions& options) {
     for (const std::string& name : protocol.groups->names)
       if (name != prepared.group) {
         PreparedSession other = prepared;
-        PrepareParticipant(&other, options.participant, seed_given, name, session_number);
+        PrepareParticipant(&other, options.participant, session_seed, name);
         other_groups.emplace(name, std::move(other));
       }
   const std::string& protocol_text = prepared.protocol_text;

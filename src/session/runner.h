@@ -18,7 +18,7 @@ struct RunOptions {
   std::filesystem::path db;
   std::filesystem::path display_profile;  // --display: overrides the protocol's display.profile
   std::string participant;
-  std::optional<uint64_t> seed;  // unset: DefaultSessionSeed(study, participant, session number), recorded
+  std::optional<uint64_t> seed;  // unset: DefaultSessionSeed (record_meta.h) of the session's number
   std::string observer;          // empty: a person at the window; "sim[:params]": the simulated observer
   bool resume = false;
   bool again = false;            // allow another session for a participant who completed the study

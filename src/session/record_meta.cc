@@ -1,6 +1,8 @@
-#include "session/record_design.h"
+#include "session/record_meta.h"
 
+#include "core/hash.h"
 #include "protocol/design.h"
+#include "protocol/trials.h"
 #include "store/export.h"
 
 namespace blurcue::session {
@@ -21,6 +23,11 @@ std::vector<store::DesignColumnRecord> DesignRecord(const protocol::Protocol& pr
     out.push_back(std::move(r));
   }
   return out;
+}
+
+uint64_t DefaultSessionSeed(const std::string& study, const std::string& participant, int64_t session_number) {
+  if (session_number <= 1) return protocol::DefaultSeed(study, participant);
+  return Fnv1a64(study + "/" + participant + "#" + std::to_string(session_number));
 }
 
 }  // namespace blurcue::session
