@@ -61,7 +61,9 @@ def main(export_dir, db_path):
                     fail(f"{table}.{column}: {text!r} read as {value!r}")
                 if kind == "datetime" and not pd.notna(pd.to_datetime(text, utc=True)):
                     fail(f"{table}.{column}: {text!r} is no date")
-                if allowed and "|" in allowed and text not in allowed.split("|"):
+                # A numeric column's allowed values are numbers (the design's levels: 4 allows a cell 4.0).
+                if allowed and "|" in allowed and text not in allowed.split("|") and not (
+                        kind in ("integer", "number") and Decimal(text) in {Decimal(a) for a in allowed.split("|")}):
                     fail(f"{table}.{column}: {text!r} is not one of {allowed}")
                 checked += 1
         # Seeds: exact, as the record holds them (SQLite keeps the uint64's bits as an int64).

@@ -59,7 +59,7 @@ complete)
   [ "$(sql "$W/s.sqlite" "SELECT min(n) > 0 FROM (SELECT count(f.id) n FROM trials t LEFT JOIN frames f ON f.trial_id = t.id GROUP BY t.id)")" = 1 ] \
     || fail "every trial records its frames"
   $BC export --db "$W/s.sqlite" --out "$W/export"
-  head -1 "$W/export/trials.csv" | grep -q "block_name,task,practice,swapped,blur_plan,brightness,contrast,edge,kernel,r_left_arcmin,r_left_px,r_left_screen_px,r_right_arcmin,r_right_px,r_right_screen_px,r_scene_arcmin,r_scene_px,r_scene_screen_px,r_span_screen_px,screen_px_per_photo_px,size_left_deg,size_right_deg,white_balance_b,white_balance_g,white_balance_r,left_source,left_fixed,right_source,right_fixed,status,chosen_side" \
+  head -1 "$W/export/trials.csv" | grep -q "block_name,task,practice,swapped,cell,blur_plan,brightness,contrast,edge,kernel,r_left_arcmin,r_left_px,r_left_screen_px,r_right_arcmin,r_right_px,r_right_screen_px,r_scene_arcmin,r_scene_px,r_scene_screen_px,r_span_screen_px,screen_px_per_photo_px,size_left_deg,size_right_deg,white_balance_b,white_balance_g,white_balance_r,left_source,left_fixed,right_source,right_fixed,status,chosen_side" \
     || fail "export header: $(head -1 "$W/export/trials.csv")"
   # Every radius in three units: the screen px follow the fit of the photo into the protocol's display (its size read
   # from the PNG header here), the arcmin follow the display profile the session recorded.
@@ -572,7 +572,8 @@ PYEOF
     || fail "good observer: $(tail -1 "$W/out")"
   grep -q "12 practice trials skipped now: the criterion was met" "$W/out" || fail "good observer: $(tail -1 "$W/out")"
   grep -q "procedure had stopped" "$W/out" && fail "good observer: a stop rule named where none ran: $(tail -1 "$W/out")"
-  sed 's/"correct": 0.8/"correct": 1/' "$W/p.json" > "$W/strict.json"
+  # Another protocol text under the study's name in the same record: a new version.
+  sed 's/"correct": 0.8/"correct": 1/; s/"version": 1/"version": 2/' "$W/p.json" > "$W/strict.json"
   $BC run "$W/strict.json" --participant B1 --db "$W/s.sqlite" --observer sim:jnd=50,lapse=0 > "$W/out" 2>&1 \
     || fail "guessing observer: $(tail -1 "$W/out")"
   grep -q "22 of 22 trials answered" "$W/out" || fail "guessing observer: $(tail -1 "$W/out")"
@@ -1098,7 +1099,9 @@ PYEOF
   $BC sessions --db "$W/s.sqlite" | grep -Eq "test1-static-grids +S1 +aborted +6/13" || fail "sessions: $($BC sessions --db "$W/s.sqlite")"
   set +e; $BC sessions --db "$W/s.sqlite" --abort 1 2> "$W/err"; code=$?; set -e
   [ $code = 3 ] && grep -q "session 1 is aborted; only a running session can be aborted" "$W/err" || fail "abort twice: $(cat "$W/err")"
-  $BC run "$P/test1-changed.json" --participant S1 --db "$W/s.sqlite" --observer sim | grep -q "session 2, .* 13 of 13" \
+  # Run anew, the changed text is another version of the study's protocol: its "version" is raised.
+  sed 's/"version": 1,/"version": 2,/' "$P/test1-changed.json" > "$P/test1-changed-v2.json"
+  $BC run "$P/test1-changed-v2.json" --participant S1 --db "$W/s.sqlite" --observer sim | grep -q "session 2, .* 13 of 13" \
     || fail "no new session after the abort"
   integrity "$W/s.sqlite"
   echo "ok: CRLF-reformatted protocol resumes; a changed one names the change; --abort closes it, answers kept" ;;

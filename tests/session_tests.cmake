@@ -20,6 +20,12 @@ foreach(case complete same_seed resume kill9 second_writer window window_adjust 
                        PASS_REGULAR_EXPRESSION "^ok:|\nok:")
 endforeach()
 set_tests_properties(session_window session_window_adjust session_window_after_motion PROPERTIES LABELS "gl;session;window")
+# Sessions numbered per participant, protocol versions kept apart (tests/session_numbers_test.sh).
+foreach(case again protocol_version)
+  add_test(NAME session_numbers_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/session_numbers_test.sh ${case} ${BC} ${T})
+  set_tests_properties(session_numbers_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
+                       LABELS "gl;session" PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+endforeach()
 
 add_test(NAME session_preview
          COMMAND ${BC} preview ${T}/protocols/test1-static-grids.json --out ${T}/preview-test1.png)

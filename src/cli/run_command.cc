@@ -72,8 +72,9 @@ void AddRunCommand(CLI::App& app) {
   cmd->add_option("--participant", args->options.participant, "participant id, e.g. P7 (its trailing number "
                                                               "decides by_participant sides)")->required();
   cmd->add_option("--db", args->db, "the SQLite record (created if missing)")->required();
-  cmd->add_option("--seed", args->seed, "seed of the trial order (default: derived from the study name and the "
-                                        "participant id; always recorded)")
+  cmd->add_option("--seed", args->seed, "seed of the trial order (default: derived from the study name, the "
+                                        "participant id and the session number; always recorded; a seed an "
+                                        "earlier session of the participant used is refused)")
       ->transform(SeedValidator());
   CLI::Option* observer =
       cmd->add_option("--observer", args->observer, "sim or sim:NAME=VALUE,... - a simulated observer answers");
@@ -83,7 +84,8 @@ void AddRunCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_flag("--resume", args->options.resume, "continue the participant's unfinished session");
   cmd->add_flag("--again", args->options.again, "another session for a participant who completed the study (a "
-                                                "participant id seen before is refused otherwise)");
+                                                "participant id seen before is refused otherwise); it is numbered "
+                                                "next and gets a seed of its own");
   // Options nothing would read are refused: --window and --sim-fps are the simulated observer's, --sim-fps headless.
   CLI::Option* window =
       cmd->add_flag("--window", args->options.window, "with --observer: show the session in a window, in real time")
@@ -126,8 +128,10 @@ void AddRunCommand(CLI::App& app) {
     if (by_stop_rule > 0) skipped += ", " + std::to_string(by_stop_rule) + " skipped now: their procedure had stopped";
     if (r.skipped_by_criterion_now > 0)
       skipped += ", " + std::to_string(r.skipped_by_criterion_now) + " practice trials skipped now: the criterion was met";
-    std::printf("%s: participant %s, session %lld, seed %llu: %lld of %lld trials %s (%lld answered now%s%s)%s\n",
+    std::printf("%s: participant %s, session %lld, the participant's session %lld, seed %llu: %lld of %lld trials %s "
+                "(%lld answered now%s%s)%s\n",
                 args->db.c_str(), options.participant.c_str(), static_cast<long long>(r.session_id),
+                static_cast<long long>(r.session_number),
                 static_cast<unsigned long long>(r.seed),
                 static_cast<long long>(r.answered_before + r.answered_now + r.skipped_now),
                 static_cast<long long>(r.trial_count), r.skipped_now > 0 ? "done" : "answered",

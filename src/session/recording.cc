@@ -5,6 +5,8 @@
 #include <string_view>
 #include <utility>
 
+#include "core/hash.h"
+#include "protocol/design.h"
 #include "session/prepare.h"
 #include "store/export.h"
 #include "store/record.h"
@@ -35,6 +37,7 @@ std::vector<store::TrialRecord> TrialRecords(const PreparedSession& s) {
     r.task = protocol::ToString(trial.task);
     r.practice = trial.practice;
     r.swapped = trial.swapped;
+    r.cell = protocol::CellLevels(protocol, trial);
     if (planned.content != "picture" && trial.task != protocol::Task::kAdjustment) {
       r.r_left_px = planned.r_left_px;
       if (!planned.left_only) r.r_right_px = planned.r_right_px;
@@ -45,7 +48,36 @@ std::vector<store::TrialRecord> TrialRecords(const PreparedSession& s) {
   return records;
 }
 
+// protocol::DescribeDesign as the record keeps it: a level named store::DesignColumn(name) (factor_NAME for one named
+// like a column of trials.csv, as TrialVariables records it).
+std::vector<store::DesignColumnRecord> DesignRecord(const std::vector<protocol::DesignColumn>& design) {
+  std::vector<store::DesignColumnRecord> out;
+  for (const protocol::DesignColumn& c : design) {
+    store::DesignColumnRecord r;
+    r.name = c.level ? store::DesignColumn(c.name) : c.name;
+    r.role = protocol::ToString(c.role);
+    r.type = protocol::ToString(c.type);
+    r.unit = c.unit;
+    r.numbers = c.numbers;
+    r.names = c.names;
+    r.min = c.min;
+    r.max = c.max;
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
 }  // namespace
+
+SessionsSoFar PeekSessions(const std::filesystem::path& db, const std::string& study, const std::string& participant) {
+  const store::SessionsSoFar s = store::PeekSessions(db, study, participant);
+  return {s.next_number, s.unfinished, s.unfinished_seed, s.unfinished_number};
+}
+
+uint64_t DefaultSessionSeed(const std::string& study, const std::string& participant, int64_t session_number) {
+  if (session_number <= 1) return protocol::DefaultSeed(study, participant);
+  return Fnv1a64(study + "/" + participant + "#" + std::to_string(session_number));
+}
 
 GroupsSoFar PeekGroups(const std::filesystem::path& db, const std::string& study, const std::string& participant) {
   const store::GroupsSoFar g = store::PeekGroups(db, study, participant);
@@ -76,8 +108,12 @@ SessionStart Recording::StartOrResumeSession(const std::string& study, const std
   meta.simulated = info.simulated;
   meta.observer_params = info.observer_params;
   meta.window = info.window;
+  meta.protocol_version = info.protocol_version;
+  meta.design = DesignRecord(info.design);
+  meta.seed_given = info.seed_given;
+  meta.seed_for_number = info.seed_for_number;
   const store::SessionStart s = record_->StartOrResumeSession(study, participant, protocol_text, seed, meta, resume);
-  return {s.session_id, s.first_unanswered_trial, s.trial_count, s.resumed, s.group};
+  return {s.session_id, s.first_unanswered_trial, s.trial_count, s.resumed, s.group, s.session_number};
 }
 
 void Recording::SaveTrialList(int64_t session, const PreparedSession& prepared) {

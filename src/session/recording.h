@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/json_io.h"
+#include "protocol/design.h"
 #include "protocol/trials.h"
 #include "stimulus/stimulus.h"
 
@@ -60,6 +61,14 @@ struct SessionInfo {
   bool simulated = false;               // answered by the simulated observer (observer_params), else a person
   std::string observer_params;
   bool window = true;                   // in a window on the real clock, else headless on a simulated one
+  // The protocol's declared "version" and its design (protocol::DescribeDesign), recorded once per protocol version.
+  int64_t protocol_version = 1;
+  std::vector<protocol::DesignColumn> design;
+  // The seed was given (--seed): refused when an earlier session of the participant used it. Else, for a new
+  // session, the number its default seed was made for (DefaultSessionSeed): refused if the record numbers it
+  // otherwise (another station started one meanwhile); 0: not checked.
+  bool seed_given = false;
+  int64_t seed_for_number = 0;
 };
 
 // A started or resumed session (store::SessionStart).
@@ -69,6 +78,7 @@ struct SessionStart {
   int64_t trial_count = 0;             // 0: a new session without its trial list yet
   bool resumed = false;
   std::string group;                   // the group the record gave
+  int64_t session_number = 0;          // the participant's n-th session of the study (1, 2, ...)
 };
 
 // A recorded answer, as a resumed session replays it.
@@ -85,6 +95,21 @@ struct GroupsSoFar {
   std::string unfinished_group, unfinished_info = "{}";
 };
 GroupsSoFar PeekGroups(const std::filesystem::path& db, const std::string& study, const std::string& participant);
+
+// What a record says of a participant's sessions of a study (store::SessionsSoFar), read without writing: the
+// number a new session would get, and an unfinished session's number and seed.
+struct SessionsSoFar {
+  int64_t next_number = 1;
+  bool unfinished = false;
+  uint64_t unfinished_seed = 0;
+  int64_t unfinished_number = 0;
+};
+SessionsSoFar PeekSessions(const std::filesystem::path& db, const std::string& study, const std::string& participant);
+
+// The seed of a participant's session `session_number` when none is given: protocol::DefaultSeed(study,
+// participant) for the first (records made before sessions were numbered keep their seeds), FNV-1a 64 of
+// "STUDY/PARTICIPANT#K" for session K > 1, so a session run again is not a copy of the first.
+uint64_t DefaultSessionSeed(const std::string& study, const std::string& participant, int64_t session_number);
 
 // A session's record: one transaction per answer, resume at the first unanswered trial, one writer per session.
 // Each call is the store::Record call of the same name (its errors too).

@@ -6,6 +6,7 @@ namespace blurcue::session {
 
 struct RunResult {
   int64_t session_id = 0;
+  int64_t session_number = 0;    // the participant's n-th session of the study
   uint64_t seed = 0;
   int64_t trial_count = 0;
   int64_t answered_before = 0;   // answers the session already had (resume)

@@ -120,9 +120,16 @@ RunResult RunSession(const RunOptions& options) {
                             : so_far.unfinished ? so_far.unfinished_group
                                                 : protocol::AssignGroup(head, options.participant, so_far.sessions);
   const Json info = CollectInfo(head, options, so_far);
+  // A new session's number decides its default seed (the record decides the number again when it starts the
+  // session); a resumed one runs with the seed it recorded.
+  const SessionsSoFar sessions = PeekSessions(options.db, head.name, options.participant);
+  const int64_t session_number = options.resume && sessions.unfinished ? sessions.unfinished_number : sessions.next_number;
+  const uint64_t session_seed = options.seed                            ? *options.seed
+                                : options.resume && sessions.unfinished ? sessions.unfinished_seed
+                                : DefaultSessionSeed(head.name, options.participant, session_number);
   // Everything checked before the first trial is what `blurcue validate` checks: the same function.
   const PreparedSession prepared =
-      PrepareSession(options.protocol_file, options.participant, options.seed, options.display_profile, group);
+      PrepareSession(options.protocol_file, options.participant, session_seed, options.display_profile, group);
   const protocol::Protocol& protocol = prepared.protocol;
   if (observer) CheckObserverCanAnswer(*observer, protocol);
   // A new session's balanced group is decided again in the transaction that starts it: a station starting at the
@@ -133,7 +140,7 @@ RunResult RunSession(const RunOptions& options) {
     for (const std::string& name : protocol.groups->names)
       if (name != prepared.group) {
         PreparedSession other = prepared;
-        PrepareParticipant(&other, options.participant, options.seed, name);
+        PrepareParticipant(&other, options.participant, session_seed, name);
         other_groups.emplace(name, std::move(other));
       }
   const std::string& protocol_text = prepared.protocol_text;
@@ -196,6 +203,10 @@ RunResult RunSession(const RunOptions& options) {
   meta.simulated = observer.has_value();
   meta.observer_params = observer ? ToString(*observer) : "";
   meta.window = window;
+  meta.protocol_version = protocol.version;
+  meta.design = protocol::DescribeDesign(protocol);
+  meta.seed_given = options.seed.has_value();
+  if (!options.seed && !options.resume) meta.seed_for_number = session_number;
   if (!options.again && !options.resume) {
     // Running a participant through a study they finished is usually a typo in the id: say so.
     const std::vector<int64_t> done = record.CompletedSessions(protocol.name, options.participant);
@@ -232,7 +243,9 @@ RunResult RunSession(const RunOptions& options) {
                       KeyMap{chosen.protocol.responses, chosen.protocol.layout == "odd_one_out"},
                       window ? &keys : nullptr);
   Responder& responder = simulated ? static_cast<Responder&>(*simulated) : keys;
-  return RunTrials({options.db, options.stop_after}, chosen, presenter, responder, record, start);
+  RunResult result = RunTrials({options.db, options.stop_after}, chosen, presenter, responder, record, start);
+  result.session_number = start.session_number;
+  return result;
 }
 
 }  // namespace blurcue::session

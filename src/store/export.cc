@@ -16,6 +16,7 @@
 #include "core/hash.h"
 #include "core/json_io.h"
 #include "core/typed.h"
+#include "store/export_table.h"
 #include "store/record.h"
 #include "store/schema.h"
 #include "store/sqlite.h"
@@ -25,259 +26,13 @@
 namespace blurcue::store {
 namespace {
 
-// What the codebook says of a column: its type (string, integer, number, boolean - 0 or 1 -, datetime - ISO 8601
-// UTC), unit, allowed values and meaning. The tables are written from these definitions and the codebook is written
-// from the same ones, so the two cannot drift.
-struct ColumnDef {
-  std::string name, type, unit, allowed, meaning;
-};
-
-// A JSON value as a cell: strings bare, null empty, anything else as compact JSON.
-std::string Cell(const Json& value) {
-  if (value.is_string()) return value.get<std::string>();
-  if (value.is_null()) return {};
-  return value.dump();
-}
-
-Json ParseColumn(const std::string& text, const std::string& where) {
-  try {
-    return Json::parse(text);
-  } catch (const Json::exception& e) {
-    throw InputError(where, std::string("not valid JSON: ") + e.what());
-  }
-}
-
-// Shortest text that reads back as the same double.
-std::string Number(double value) {
-  char text[64];
-  const auto result = std::to_chars(text, text + sizeof(text), value);
-  return std::string(text, result.ptr);
-}
-
-std::string Where(const std::filesystem::path& db, int64_t session, int64_t trial) {
-  return db.string() + ": session " + std::to_string(session) + " trial " + std::to_string(trial);
-}
-
-// What an export folder may hold and still be replaced as a whole: the files an export writes, and the
-// temporaries an earlier version left beside them when killed (FILE.csv.tmpPID).
-bool IsExportFile(const std::string& name) {
-  const bool table = name == "trials.csv" || name == "frames.csv" || name == "adjustments.csv" ||
-                     name == "codebook.csv" || name.rfind("summary-", 0) == 0;
-  if (table && name.size() > 4 && name.compare(name.size() - 4, 4, ".csv") == 0) return true;
-  const size_t tmp = name.rfind(".csv.tmp");
-  return tmp != std::string::npos && tmp + 8 < name.size() &&
-         name.find_first_not_of("0123456789", tmp + 8) == std::string::npos;
-}
-
-void Note(const ProgressNote& note, const std::vector<std::filesystem::path>& removed) {
-  for (const auto& path : removed)
-    if (note) note("removed " + path.string() + ", left by an interrupted run");
-}
-
-std::string CsvLine(const std::vector<std::string>& cells) {
-  std::string line;
-  for (size_t i = 0; i < cells.size(); ++i) {
-    if (i) line += ',';
-    line += CsvField(cells[i]);
-  }
-  return line + "\r\n";
-}
-
-// Per study, one row per session: trials planned and answered (practice apart), the median response time, and
-// how often each answer was given - for forced choice the source chosen (the one shown on the side picked) or
-// cant_tell, for adjustment the level accepted. Writes OUT/SummaryFileName(STUDY) for every study and returns the
-// codebook's rows for them.
-std::string WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
-  struct Row {
-    std::string participant, status;
-    int64_t planned = 0, answered = 0;
-    std::vector<double> rts;
-    std::map<std::string, int64_t> answers;
-  };
-  std::map<std::string, std::map<int64_t, Row>> studies;
-  // Answers in a natural order: numbers (adjustment levels) by value, then names.
-  struct Natural {
-    bool operator()(const std::string& a, const std::string& b) const {
-      const std::optional<double> x = ParseDecimal(a), y = ParseDecimal(b);
-      if (x.has_value() != y.has_value()) return x.has_value();
-      return x && *x != *y ? *x < *y : a < b;
-    }
-  };
-  std::map<std::string, std::set<std::string, Natural>> answer_names;
-  Statement rows(db,
-                 "SELECT st.name, p.code, s.id, s.status, r.id IS NOT NULL, r.choice, r.rt_ms, "
-                 "CASE r.choice WHEN 'left' THEN t.left_shown WHEN 'right' THEN t.right_shown END "
-                 "FROM trials t JOIN sessions s ON s.id = t.session_id "
-                 "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
-                 "LEFT JOIN responses r ON r.trial_id = t.id "
-                 "WHERE coalesce(t.practice, 0) = 0 AND coalesce(r.choice, '') <> '" + std::string(kChoiceSkipped) +
-                 "' ORDER BY st.name, p.code, s.id");
-  while (rows.Step()) {
-    Row& row = studies[rows.GetText(0)][rows.GetInt64(2)];
-    row.participant = rows.GetText(1);
-    row.status = rows.GetText(3);
-    ++row.planned;
-    if (rows.GetInt64(4) == 0) continue;
-    ++row.answered;
-    if (!rows.IsNull(6)) row.rts.push_back(rows.GetDouble(6));
-    const std::string answer = rows.IsNull(7) ? rows.GetText(5) : Cell(Json::parse(rows.GetText(7)));
-    ++row.answers[answer];
-    answer_names[rows.GetText(0)].insert(answer);
-  }
-  std::string codebook;
-  // File names folded to lower case: two studies' summaries must not share a name on a case-insensitive file system
-  // either.
-  std::map<std::string, std::string> files;
-  for (auto& [study, sessions] : studies) {
-    const std::string file = SummaryFileName(study);
-    std::string folded = file;
-    for (char& c : folded) c = char(std::tolower(static_cast<unsigned char>(c)));
-    if (const auto [it, fresh] = files.emplace(folded, study); !fresh)
-      throw InputError(db.path(), "the studies " + Echo(it->second) + " and " + Echo(study) +
-                                               " would both be summarised as " + file);
-    std::vector<std::string> header = {"participant", "session", "status", "planned", "answered", "median_rt_ms"};
-    for (const auto& name : answer_names[study]) header.push_back("n_" + name);
-    const std::string of = " (study " + study + ")";
-    const std::vector<ColumnDef> columns = {
-        {"participant", "string", "", "", "the participant's id" + of},
-        {"session", "integer", "", ">= 1", "the session's id in this record (session_id in trials.csv)"},
-        {"status", "string", "", "", "the session's status"},
-        {"planned", "integer", "", ">= 0", "trials planned, practice apart"},
-        {"answered", "integer", "", ">= 0", "trials answered, practice apart"},
-        {"median_rt_ms", "number", "ms", ">= 0", "the median response time of the answered trials"}};
-    for (const auto& c : columns) codebook += CsvLine({file, c.name, c.type, c.unit, c.allowed, c.meaning});
-    for (const auto& name : answer_names[study])
-      codebook += CsvLine({file, "n_" + name, "integer", "", ">= 0",
-                           "how often the answer " + name + " was given (forced choice: the source chosen, or "
-                           "cant_tell; adjustment: the level accepted)"});
-    std::string text = CsvLine(header);
-    for (auto& [session, row] : sessions) {
-      std::sort(row.rts.begin(), row.rts.end());
-      const size_t n = row.rts.size();
-      const std::string median =
-          n == 0 ? "" : Number(n % 2 ? row.rts[n / 2] : 0.5 * (row.rts[n / 2 - 1] + row.rts[n / 2]));
-      std::vector<std::string> cells = {row.participant, std::to_string(session), row.status,
-                                        std::to_string(row.planned), std::to_string(row.answered), median};
-      for (const auto& name : answer_names[study]) cells.push_back(std::to_string(row.answers[name]));
-      text += CsvLine(cells);
-    }
-    WriteFileAtomically(out_dir / file, text);
-  }
-  return codebook;
-}
-
-// The columns of adjustments.csv and frames.csv, for their writers and the codebook.
-const std::vector<ColumnDef>& AdjustmentColumns() {
-  static const std::vector<ColumnDef> columns = {
-      {"study", "string", "", "", "the protocol's name"},
-      {"participant", "string", "", "", "the participant's id"},
-      {"session_id", "integer", "", ">= 1", "the session's id in this record (as in trials.csv)"},
-      {"trial_index", "integer", "", ">= 0", "the trial (as in trials.csv)"},
-      {"step", "integer", "", ">= 1", "the step's place in the trial's adjustment, from 1"},
-      {"level", "number", "the adjusted parameter's unit", "", "the level stepped to"},
-      {"t_ms", "number", "ms", ">= 0", "when, from the stimulus's first frame"},
-  };
-  return columns;
-}
-const std::vector<ColumnDef>& FrameColumns() {
-  static const std::vector<ColumnDef> columns = {
-      {"study", "string", "", "", "the protocol's name"},
-      {"participant", "string", "", "", "the participant's id"},
-      {"session_id", "integer", "", ">= 1", "the session's id in this record (as in trials.csv)"},
-      {"window", "boolean", "", "0|1", "1: a real window on the real clock; 0: headless on a simulated clock"},
-      {"trial_index", "integer", "", ">= 0", "the trial (as in trials.csv)"},
-      {"frame_index", "integer", "", ">= 0", "the frame's place in the trial"},
-      {"flip_time_s", "number", "s", ">= 0", "when the frame reached the screen, from the trial's first flip"},
-      {"dropped", "boolean", "", "0|1", "1: more than 1.5 refresh periods after the frame before (window only)"},
-      {"r_left_px", "number", "photo px", ">= 0", "the left object's blur radius in this frame; empty: not shown"},
-      {"r_right_px", "number", "photo px", ">= 0", "the right object's blur radius in this frame; empty: not shown"},
-      {"y_mm", "number", "mm", "", "the objects' place along the board's y in this frame (0 at edge 1)"},
-  };
-  return columns;
-}
-
-// OUT/frames.csv: every recorded display flip, one row each (FrameColumns): what each frame showed of a pair, empty
-// where nothing was shown and for pictures.
-void WriteFrames(Database& db, const std::filesystem::path& out_dir) {
-  std::vector<std::string> header;
-  for (const auto& c : FrameColumns()) header.push_back(c.name);
-  std::string text = CsvLine(header);
-  Statement rows(db,
-                 "SELECT st.name, p.code, s.id, t.trial_index, f.frame_index, f.flip_time_s, f.dropped, "
-                 "coalesce(s.window, s.display LIKE 'window%'), f.r_left_px, f.r_right_px, f.y_mm "
-                 "FROM frames f JOIN trials t ON t.id = f.trial_id JOIN sessions s ON s.id = t.session_id "
-                 "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
-                 "ORDER BY st.name, p.code, s.id, t.trial_index, f.frame_index");
-  auto optional = [&](int column) { return rows.IsNull(column) ? std::string() : Number(rows.GetDouble(column)); };
-  while (rows.Step())
-    text += CsvLine({rows.GetText(0), rows.GetText(1), std::to_string(rows.GetInt64(2)),
-                     std::to_string(rows.GetInt64(7)), std::to_string(rows.GetInt64(3)),
-                     std::to_string(rows.GetInt64(4)), Number(rows.GetDouble(5)), std::to_string(rows.GetInt64(6)),
-                     optional(8), optional(9), optional(10)});
-  WriteFileAtomically(out_dir / "frames.csv", text);
-}
-
-// Schema 7's typed columns of one table (schema.h TypedColumns): copied as they are from an input of version 7 or
-// later; derived from the texts (DeriveTypedColumns) for an older one.
-std::vector<TypedColumn> TypedColumnsOf(const std::string& table) {
-  std::vector<TypedColumn> out;
-  for (const TypedColumn& c : TypedColumns())
-    if (table == c.table) out.push_back(c);
-  return out;
-}
-// ", a, b, c" for a SELECT or INSERT column list; empty for an input before version 7.
-std::string TypedList(const std::string& table, bool typed) {
-  std::string list;
-  if (typed)
-    for (const auto& c : TypedColumnsOf(table)) list += std::string(", ") + c.name;
-  return list;
-}
-std::string TypedPlaceholders(const std::string& table, bool typed) {
-  std::string list;
-  if (typed)
-    for (size_t i = 0; i < TypedColumnsOf(table).size(); ++i) list += ", ?";
-  return list;
-}
-// Binds the typed columns read from `from` (starting at column `first`) to `to` (starting at parameter `at`).
-void CopyTyped(const std::string& table, bool typed, Statement& from, int first, Statement& to, int at) {
-  if (!typed) return;
-  for (const auto& c : TypedColumnsOf(table)) {
-    const std::string type = c.type;
-    if (from.IsNull(first)) to.BindNull(at);
-    else if (type == "TEXT") to.Bind(at, from.GetText(first));
-    else if (type == "REAL") to.Bind(at, from.GetDouble(first));
-    else to.Bind(at, from.GetInt64(first));
-    ++first, ++at;
-  }
-}
-
-void RemoveDatabaseFiles(const std::filesystem::path& path) {
-  std::error_code ignored;
-  for (const char* suffix : {"", "-wal", "-shm", "-journal"})
-    std::filesystem::remove(path.string() + suffix, ignored);
-}
-
-}  // namespace
-
-std::string CsvField(const std::string& text) {
-  const bool quote = text.find_first_of(",\"\r\n") != std::string::npos ||
-                     (!text.empty() && (text.front() == ' ' || text.back() == ' '));
-  if (!quote) return text;
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"') out += '"';
-    out += c;
-  }
-  return out + "\"";
-}
-
-namespace {
-
 // The fixed columns of trials.csv before the design's variables, and after them.
 const std::vector<ColumnDef>& TrialColumnsBefore() {
   static const std::vector<ColumnDef> columns = {
       {"study", "string", "", "", "the protocol's name"},
       {"protocol_hash", "string", "", "16 hex digits", "FNV-1a-64 of the protocol's canonical text: its version"},
+      {"protocol_version", "integer", "", ">= 1",
+       "the protocol's declared \"version\" the session ran (one text per version of a study)"},
       {"participant", "string", "", "", "the participant's id"},
       {"observer", "string", "", "person|simulated", "who answered: a person, or blurcue's simulated observer"},
       {"observer_params", "string", "", "", "the simulated observer's parameters (sim:model=arcmin,... or sim:model=pixel,...; before model= existed sim:jnd=..., the pixel model); empty for a person"},
@@ -303,6 +58,9 @@ const std::vector<ColumnDef>& TrialColumnsDesign() {
       {"task", "string", "", "forced_choice|adjustment|yes_no|rating", "the trial's task"},
       {"practice", "boolean", "", "0|1", "1: a practice trial (not scored)"},
       {"swapped", "boolean", "", "0|1", "1: left and right exchanged against the design (counterbalancing)"},
+      {"cell", "string", "", "",
+       "a procedure trial's cell by its levels (NAME=LEVEL;... of its block's factors): its own track and threshold; "
+       "empty outside a procedure and in records made before cells were recorded"},
   };
   return columns;
 }
@@ -420,6 +178,65 @@ struct TypeOf {
   }
 };
 
+// What the record's design table says of one column of trials.csv, over every protocol version that has it.
+struct DesignOf {
+  std::set<std::string> roles;
+  std::vector<std::string> allowed;  // each version's allowed text, once
+};
+
+// The allowed values of several protocol versions as one: a list of numbers in numeric order, else of names in the
+// order met; one text when they agree; "" (any) when ranges and lists mix.
+std::string UnionAllowed(const std::vector<std::string>& texts) {
+  if (texts.size() == 1) return texts[0];
+  std::vector<std::string> names;
+  bool numbers = true;
+  for (const std::string& text : texts) {
+    if (text.empty() || text.find("..") != std::string::npos || text.rfind(">=", 0) == 0) return "";
+    for (size_t at = 0; at <= text.size();) {
+      const size_t bar = std::min(text.find('|', at), text.size());
+      const std::string name = text.substr(at, bar - at);
+      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+      if (!ParseDecimal(name)) numbers = false;
+      at = bar + 1;
+    }
+  }
+  if (numbers)
+    std::sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) {
+      return *ParseDecimal(a) < *ParseDecimal(b);
+    });
+  std::string text;
+  for (const std::string& name : names) text += (text.empty() ? "" : "|") + name;
+  return text;
+}
+
+// Gives each design column of trials.csv its role and the values the protocol allows, from the design table (schema
+// 8: recorded once per protocol version). A record with a protocol version that ran sessions but recorded no design
+// (made before designs were recorded) keeps the values seen, and the codebook says so.
+void ApplyDesign(Database& db, std::vector<ColumnDef>* columns) {
+  const bool complete = db.QueryInt64("SELECT count(*) FROM protocol_versions pv WHERE EXISTS (SELECT 1 FROM sessions "
+                                      "s WHERE s.protocol_version_id = pv.id) AND NOT EXISTS (SELECT 1 FROM "
+                                      "design_columns d WHERE d.protocol_version_id = pv.id)") == 0;
+  std::map<std::string, DesignOf> design;
+  Statement rows(db, "SELECT name, role, allowed FROM design_columns ORDER BY protocol_version_id, position");
+  while (rows.Step()) {
+    DesignOf& d = design[rows.GetText(0)];
+    d.roles.insert(rows.GetText(1));
+    if (std::find(d.allowed.begin(), d.allowed.end(), rows.GetText(2)) == d.allowed.end())
+      d.allowed.push_back(rows.GetText(2));
+  }
+  for (ColumnDef& c : *columns) {
+    const auto it = design.find(c.name);
+    if (it == design.end()) {
+      if (!complete && c.meaning.rfind("a level of the protocol's design", 0) == 0)
+        c.meaning += "; allowed: the values seen (the record holds sessions from before designs were recorded)";
+      continue;
+    }
+    for (const std::string& role : it->second.roles) c.role += (c.role.empty() ? "" : "|") + role;
+    if (complete) c.allowed = UnionAllowed(it->second.allowed);
+    else c.meaning += "; allowed: the values seen (the record holds sessions from before designs were recorded)";
+  }
+}
+
 bool AllDigits(const std::string& text) {
   return !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
 }
@@ -525,6 +342,7 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
                          " because trials.csv has a column " + level + " of its own")});
   }
   columns.insert(columns.end(), TrialColumnsAfter().begin(), TrialColumnsAfter().end());
+  ApplyDesign(db, &columns);
   std::vector<std::string> header;
   for (const auto& c : columns) header.push_back(c.name);
   std::string text = CsvLine(header);
@@ -535,18 +353,13 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
                  "t.block_name, t.task, t.practice, t.swapped, t.left_source, t.left_fixed, t.right_source, "
                  "t.right_fixed, coalesce(r.r_left_px, t.r_left_px), coalesce(r.r_right_px, t.r_right_px), "
                  "r.id IS NULL, r.choice, r.rt_ms, r.answered_at, r.adjustment, coalesce(r.shown, '{}'), r.correct, "
-                 "s.group_name, s.observer, s.observer_params, s.window, s.status "
+                 "s.group_name, s.observer, s.observer_params, s.window, s.status, pv.version, s.session_number, "
+                 "t.cell "
                  "FROM trials t JOIN sessions s ON s.id = t.session_id "
                  "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
                  "JOIN protocol_versions pv ON pv.id = s.protocol_version_id "
                  "LEFT JOIN responses r ON r.trial_id = t.id "
                  "ORDER BY st.name, p.code, s.id, t.trial_index");
-  // The participant's n-th session (of the study: a participant belongs to one study).
-  std::map<int64_t, int64_t> session_number;
-  {
-    Statement numbers(db, "SELECT s.id, row_number() OVER (PARTITION BY s.participant_id ORDER BY s.id) FROM sessions s");
-    while (numbers.Step()) session_number[numbers.GetInt64(0)] = numbers.GetInt64(1);
-  }
   int64_t count = 0;
   auto optional_number = [&](int column) { return rows.IsNull(column) ? std::string() : Number(rows.GetDouble(column)); };
   while (rows.Step()) {
@@ -555,12 +368,13 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
     const std::string where = Where(db_path, session, trial);
     std::vector<std::string> cells = {rows.GetText(0),
                                       rows.GetText(1),
+                                      std::to_string(rows.GetInt64(30)),
                                       rows.GetText(2),
                                       rows.IsNull(26) ? "person" : rows.GetText(26),
                                       rows.IsNull(27) ? "" : rows.GetText(27),
                                       rows.IsNull(28) ? "" : std::to_string(rows.GetInt64(28)),
                                       std::to_string(session),
-                                      std::to_string(session_number[session]),
+                                      std::to_string(rows.GetInt64(31)),
                                       rows.GetText(29),
                                       "s" + std::to_string(static_cast<uint64_t>(rows.GetInt64(4)))};
     if (groups) cells.push_back(rows.GetText(25));
@@ -576,6 +390,7 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
     cells.push_back(task);
     cells.push_back(rows.IsNull(10) ? "0" : std::to_string(rows.GetInt64(10)));
     cells.push_back(rows.IsNull(11) ? "0" : std::to_string(rows.GetInt64(11)));
+    cells.push_back(rows.IsNull(32) ? "" : rows.GetText(32));
     // The plan's variables, with what the trial showed when it was shown laid over them (adaptive levels).
     Json factors = ParseColumn(rows.GetText(7), where + " factors");
     const Json shown = ParseColumn(rows.GetText(23), where + " shown");
@@ -606,9 +421,8 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
       const double l = rows.GetDouble(16), r = rows.GetDouble(17);
       if (std::abs(l - r) > 1e-9) more_blurred = ((side == "left") == (l > r)) ? "1" : "0";
     }
-    std::string correct = rows.IsNull(24) ? "" : std::to_string(rows.GetInt64(24));
-    if (correct.empty() && !interval.empty() && factors.contains("odd_interval"))
-      correct = TidyCell(factors["odd_interval"]) == interval ? "1" : "0";
+    // Scored once, when the answer was given (records from before: by the migration to schema 8), never here.
+    const std::string correct = rows.IsNull(24) ? "" : std::to_string(rows.GetInt64(24));
     for (const std::string& cell : {status, side, more_blurred, interval, yes_no, rating, level, correct})
       cells.push_back(cell);
     cells.push_back(answered && !rows.IsNull(20) ? Number(rows.GetDouble(20)) : "");
@@ -625,11 +439,13 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
     }
     ++count;
   }
-  // The codebook: every column of every table this export writes.
-  std::string codebook = CsvLine({"table", "column", "type", "unit", "allowed", "meaning"});
-  for (const auto& c : columns) codebook += CsvLine({"trials.csv", c.name, c.type, c.unit, c.allowed, c.meaning});
-  for (const auto& c : AdjustmentColumns()) codebook += CsvLine({"adjustments.csv", c.name, c.type, c.unit, c.allowed, c.meaning});
-  for (const auto& c : FrameColumns()) codebook += CsvLine({"frames.csv", c.name, c.type, c.unit, c.allowed, c.meaning});
+  // The codebook: every column of every table this export writes; a design's column with its role.
+  std::string codebook = CsvLine({"table", "column", "type", "unit", "allowed", "meaning", "role"});
+  for (const auto& c : columns)
+    codebook += CsvLine({"trials.csv", c.name, c.type, c.unit, c.allowed, c.meaning, c.role});
+  for (const auto& c : AdjustmentColumns())
+    codebook += CsvLine({"adjustments.csv", c.name, c.type, c.unit, c.allowed, c.meaning, ""});
+  for (const auto& c : FrameColumns()) codebook += CsvLine({"frames.csv", c.name, c.type, c.unit, c.allowed, c.meaning, ""});
   // Every table of one export appears together: a kill leaves the previous export whole, never its frames.csv
   // beside a new trials.csv.
   WriteFolderAtomically(
@@ -643,259 +459,6 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
       },
       IsExportFile);
   return count;
-}
-
-std::string SummaryFileName(const std::string& study) {
-  // Plain: what needs no change on any file system and cannot be mistaken for a name with a suffix.
-  const bool plain =
-      !study.empty() && std::all_of(study.begin(), study.end(), [](char c) {
-        return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' || c == '_';
-      });
-  const bool looks_suffixed = study.size() > 17 && study[study.size() - 17] == '-' &&
-                              study.find_first_not_of("0123456789abcdef", study.size() - 16) == std::string::npos;
-  if (plain && !looks_suffixed) return "summary-" + study + ".csv";
-  std::string safe = study;
-  for (char& c : safe)
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
-  char hash[17];
-  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(Fnv1a64(study)));
-  return "summary-" + safe + "-" + hash + ".csv";
-}
-
-std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path) {
-  Database db(db_path, OpenMode::kReadOnly);
-  RequireReadableRecord(db);
-  Statement rows(db,
-                 "SELECT s.id, st.name, p.code, s.status, s.started, coalesce(s.ended, ''), s.host, s.seed, "
-                 "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), "
-                 "(SELECT count(*) FROM trials t JOIN responses r ON r.trial_id = t.id WHERE t.session_id = s.id), "
-                 "s.lock_token IS NOT NULL, coalesce(s.lock_pid, 0), coalesce(s.lock_host, ''), "
-                 "coalesce(s.lock_heartbeat_ms, 0) "
-                 "FROM sessions s JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
-                 "ORDER BY st.name, p.code, s.id");
-  std::vector<SessionSummary> sessions;
-  while (rows.Step()) {
-    SessionSummary s;
-    s.id = rows.GetInt64(0);
-    s.study = rows.GetText(1);
-    s.participant = rows.GetText(2);
-    s.status = rows.GetText(3);
-    s.started = rows.GetText(4);
-    s.ended = rows.GetText(5);
-    s.host = rows.GetText(6);
-    s.seed = static_cast<uint64_t>(rows.GetInt64(7));
-    s.planned = rows.GetInt64(8);
-    s.answered = rows.GetInt64(9);
-    if (rows.GetInt64(10) != 0) s.writer = JudgeLock(rows.GetText(12), rows.GetInt64(11), rows.GetInt64(13)).text;
-    sessions.push_back(std::move(s));
-  }
-  return sessions;
-}
-
-namespace {
-
-// Refuses an input whose session a live writer holds (the record's own rule, JudgeLock: a copy taken now would miss
-// the answers still coming, and the two copies could each be resumed and never merged again). Adds one line to
-// `unfinished` per running session with no live writer (a killed or stopped one): copied as it is, and it must be
-// resumed in one record only.
-void CheckSessionsToMerge(Database& src, const std::filesystem::path& input, std::vector<std::string>* unfinished) {
-  Statement sessions(src,
-                     "SELECT s.id, st.name, p.code, s.status, "
-                     "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), "
-                     "(SELECT count(*) FROM trials t JOIN responses r ON r.trial_id = t.id WHERE t.session_id = s.id), "
-                     "s.lock_token IS NOT NULL, coalesce(s.lock_host, ''), coalesce(s.lock_pid, 0), "
-                     "coalesce(s.lock_heartbeat_ms, 0) "
-                     "FROM sessions s JOIN participants p ON p.id = s.participant_id "
-                     "JOIN studies st ON st.id = p.study_id ORDER BY s.id");
-  while (sessions.Step()) {
-    const std::string id = std::to_string(sessions.GetInt64(0));
-    const std::string who = "session " + id + " (study " + sessions.GetText(1) + ", participant " +
-                            sessions.GetText(2) + ", " + std::to_string(sessions.GetInt64(5)) + " of " +
-                            std::to_string(sessions.GetInt64(4)) + " trials answered)";
-    if (sessions.GetInt64(6) != 0) {
-      const LockState lock = JudgeLock(sessions.GetText(7), sessions.GetInt64(8), sessions.GetInt64(9));
-      if (!lock.stale)
-        throw InputError(input.string(),
-                         who + " is being written by " + lock.text + "; merge it once that session has ended (to "
-                         "give it up instead: stop that run, then blurcue sessions --db " + input.string() +
-                         " --abort " + id + ")");
-    }
-    if (sessions.GetText(3) == "running")
-      unfinished->push_back(input.string() + ": " + who + " is unfinished, with no live writer: copied as running; "
-                            "resume it in one record only (this one, then merge again into a new file, or the "
-                            "merged one), never both: the two copies could not be merged again");
-  }
-}
-
-}  // namespace
-
-void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out,
-                    const ProgressNote& note) {
-  Note(note, RemoveStaleLeftovers(out));
-  if (std::filesystem::exists(out)) throw InputError(out.string(), "exists; merge refuses to overwrite it");
-  std::set<std::filesystem::path> seen;
-  for (const auto& input : inputs) {
-    if (!seen.insert(std::filesystem::weakly_canonical(input)).second)
-      throw InputError(input.string(), "listed twice among the merge inputs");
-  }
-  const std::filesystem::path temp = TemporaryBeside(out, "partial");
-  RemoveDatabaseFiles(temp);
-  std::vector<std::string> unfinished;
-  try {
-    {
-      Database dst(temp);
-      Migrate(dst);
-      Transaction transaction(dst);
-      for (const auto& input : inputs) {
-        Database src(input, OpenMode::kReadOnly);
-        RequireReadableRecord(src);
-        // One snapshot of the input: the sessions judged below are the ones copied, with the answers they had then.
-        src.Exec("BEGIN");
-        CheckSessionsToMerge(src, input, &unfinished);
-        std::map<int64_t, int64_t> study_ids, protocol_ids, participant_ids, session_ids, trial_ids;
-        const bool typed = SchemaVersion(src) >= 7;
-
-        Statement studies(src, "SELECT id, name, created FROM studies");
-        while (studies.Step())
-          study_ids[studies.GetInt64(0)] = EnsureStudy(dst, studies.GetText(1), studies.GetText(2));
-
-        Statement protocols(src, "SELECT id, study_id, json, hash, created FROM protocol_versions");
-        while (protocols.Step()) {
-          // An input of schema 1 holds raw texts: the merged record keys them by their canonical text, as run does.
-          std::string json = protocols.GetText(2), hash = protocols.GetText(3);
-          try {
-            json = CanonicalProtocolText(json);
-            hash = ProtocolHash(json);
-          } catch (const Error&) {
-          }
-          std::string stored_json;
-          protocol_ids[protocols.GetInt64(0)] = EnsureProtocolVersion(
-              dst, study_ids.at(protocols.GetInt64(1)), json, hash, protocols.GetText(4), &stored_json);
-          if (stored_json != json)
-            throw InputError(input.string(), "protocol hash " + hash + " names a different protocol text in another input");
-        }
-
-        Statement participants(src, "SELECT id, study_id, code, created FROM participants");
-        while (participants.Step())
-          participant_ids[participants.GetInt64(0)] = EnsureParticipant(
-              dst, study_ids.at(participants.GetInt64(1)), participants.GetText(2), participants.GetText(3));
-
-        Statement sessions(src, "SELECT id, participant_id, protocol_version_id, seed, software_version, host, "
-                                "display, started, ended, status, " +
-                                std::string(SchemaVersion(src) >= 3 ? "display_profile" : "'{}'") + ", " +
-                                std::string(SchemaVersion(src) >= 6 ? "group_name, participant_info" : "'', '{}'") +
-                                TypedList("sessions", typed) + " FROM sessions");
-        Statement duplicate(dst, "SELECT id FROM sessions WHERE participant_id = ? AND protocol_version_id = ? "
-                                 "AND seed = ? AND host = ? AND started = ?");
-        Statement insert_session(dst, "INSERT INTO sessions (participant_id, protocol_version_id, seed, "
-                                      "software_version, host, display, started, ended, status, display_profile, "
-                                      "group_name, participant_info" + TypedList("sessions", typed) +
-                                      ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?" +
-                                      TypedPlaceholders("sessions", typed) + ")");
-        while (sessions.Step()) {
-          const int64_t participant = participant_ids.at(sessions.GetInt64(1));
-          const int64_t protocol = protocol_ids.at(sessions.GetInt64(2));
-          duplicate.Bind(1, participant);
-          duplicate.Bind(2, protocol);
-          duplicate.Bind(3, sessions.GetInt64(3));
-          duplicate.Bind(4, sessions.GetText(5));
-          duplicate.Bind(5, sessions.GetText(7));
-          if (duplicate.Step())
-            throw InputError(input.string(), "session " + std::to_string(sessions.GetInt64(0)) +
-                                                 " is already in the merge (an input merged twice?)");
-          duplicate.Reset();
-          insert_session.Bind(1, participant);
-          insert_session.Bind(2, protocol);
-          insert_session.Bind(3, sessions.GetInt64(3));
-          for (int column = 4; column <= 7; ++column) insert_session.Bind(column, sessions.GetText(column));
-          if (sessions.IsNull(8)) insert_session.BindNull(8);
-          else insert_session.Bind(8, sessions.GetText(8));
-          insert_session.Bind(9, sessions.GetText(9));
-          insert_session.Bind(10, sessions.GetText(10));
-          insert_session.Bind(11, sessions.GetText(11));
-          insert_session.Bind(12, sessions.GetText(12));
-          CopyTyped("sessions", typed, sessions, 13, insert_session, 13);
-          insert_session.Run();
-          insert_session.Reset();
-          session_ids[sessions.GetInt64(0)] = dst.LastInsertRowId();
-        }
-        if (typed) {
-          Statement info(src, "SELECT session_id, key, value FROM session_info");
-          Statement insert_info(dst, "INSERT INTO session_info (session_id, key, value) VALUES (?, ?, ?)");
-          while (info.Step()) {
-            insert_info.Bind(1, session_ids.at(info.GetInt64(0)));
-            insert_info.Bind(2, info.GetText(1));
-            insert_info.Bind(3, info.GetText(2));
-            insert_info.Run();
-            insert_info.Reset();
-          }
-        }
-
-        Statement trials(src, "SELECT id, session_id, trial_index, block, factors, left_shown, right_shown" +
-                                  TypedList("trials", typed) + " FROM trials");
-        Statement insert_trial(dst, "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, "
-                                    "right_shown" + TypedList("trials", typed) + ") VALUES (?, ?, ?, ?, ?, ?" +
-                                    TypedPlaceholders("trials", typed) + ")");
-        while (trials.Step()) {
-          insert_trial.Bind(1, session_ids.at(trials.GetInt64(1)));
-          insert_trial.Bind(2, trials.GetInt64(2));
-          insert_trial.Bind(3, trials.GetInt64(3));
-          for (int column = 4; column <= 6; ++column) insert_trial.Bind(column, trials.GetText(column));
-          CopyTyped("trials", typed, trials, 7, insert_trial, 7);
-          insert_trial.Run();
-          insert_trial.Reset();
-          trial_ids[trials.GetInt64(0)] = dst.LastInsertRowId();
-        }
-
-        Statement responses(src, "SELECT trial_id, choice, rt_ms, adjustment, answered_at, " +
-                                     std::string(SchemaVersion(src) >= 5 ? "shown" : "'{}'") +
-                                     TypedList("responses", typed) + " FROM responses");
-        Statement insert_response(dst, "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at, "
-                                       "shown" + TypedList("responses", typed) + ") VALUES (?, ?, ?, ?, ?, ?" +
-                                       TypedPlaceholders("responses", typed) + ")");
-        while (responses.Step()) {
-          insert_response.Bind(1, trial_ids.at(responses.GetInt64(0)));
-          insert_response.Bind(2, responses.GetText(1));
-          if (responses.IsNull(2)) insert_response.BindNull(3);
-          else insert_response.Bind(3, responses.GetDouble(2));
-          insert_response.Bind(4, responses.GetText(3));
-          insert_response.Bind(5, responses.GetText(4));
-          insert_response.Bind(6, responses.GetText(5));
-          CopyTyped("responses", typed, responses, 6, insert_response, 7);
-          insert_response.Run();
-          insert_response.Reset();
-        }
-
-        Statement frames(src, "SELECT trial_id, frame_index, flip_time_s, dropped, " +
-                                  std::string(SchemaVersion(src) >= 4 ? "r_left_px, r_right_px, y_mm"
-                                                                      : "NULL, NULL, NULL") + " FROM frames");
-        Statement insert_frame(dst, "INSERT INTO frames (trial_id, frame_index, flip_time_s, dropped, r_left_px, "
-                                    "r_right_px, y_mm) VALUES (?, ?, ?, ?, ?, ?, ?)");
-        while (frames.Step()) {
-          insert_frame.Bind(1, trial_ids.at(frames.GetInt64(0)));
-          insert_frame.Bind(2, frames.GetInt64(1));
-          insert_frame.Bind(3, frames.GetDouble(2));
-          insert_frame.Bind(4, frames.GetInt64(3));
-          for (int column = 4; column <= 6; ++column) {
-            if (frames.IsNull(column)) insert_frame.BindNull(column + 1);
-            else insert_frame.Bind(column + 1, frames.GetDouble(column));
-          }
-          insert_frame.Run();
-          insert_frame.Reset();
-        }
-        src.Exec("COMMIT");
-      }
-      // Inputs from before the typed record: their typed columns from their texts, as a migration would.
-      DeriveTypedColumns(dst);
-      transaction.Commit();
-    }  // the last connection closes: the WAL is checkpointed into the file and removed
-    MoveIntoPlace(temp, out);
-    if (note)
-      for (const auto& line : unfinished) note(line);
-  } catch (...) {
-    RemoveDatabaseFiles(temp);
-    throw;
-  }
 }
 
 }  // namespace blurcue::store

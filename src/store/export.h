@@ -13,8 +13,10 @@ using ProgressNote = std::function<void(const std::string&)>;
 
 // Writes `out_dir`/trials.csv: one row per planned trial, answered or not, ordered by study,
 // participant, session, trial index. Columns, the same for every participant:
-//   study, protocol_hash, participant, session, seed, trial_index, block, <every factor key found in the record,
-//   sorted>, left, right, choice, rt_ms, adjustment (the JSON path of steps; empty when none), answered_at
+//   study, protocol_hash, protocol_version, participant, ..., session_id, session_number, ..., seed, trial_index,
+//   block, ..., practice, swapped, cell, <every factor key found in the record, sorted>, ..., answered_at
+// (codebook.csv names each, with a design column's role and the values its protocol allows where the record keeps
+// the design).
 // A factor a trial lacks is an empty cell; a factor named like a column of trials.csv or a recorded variable
 // (IsRecordedName) is written as "factor_<name>".
 // Beside it, per study, `out_dir`/SummaryFileName(STUDY): one row per session with the trials planned and answered
@@ -48,7 +50,8 @@ std::string DesignColumn(const std::string& name);
 // (killed, stopped or stale) is copied as running, and one line per such session, told to `note` once `out` is in
 // place, says so and that it must be resumed in one record only. The record is built beside `out` as
 // DIR/.NAME.partial-PID and renamed to `out` when complete; leftovers of a killed merge to the same `out` are removed
-// first, each one told to `note`.
+// first, each one told to `note`. A participant's sessions are numbered again by start across the inputs (one line
+// to `note` per session whose number changes), and one line per study version holding several texts.
 void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out,
                     const ProgressNote& note = {});
 

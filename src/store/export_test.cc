@@ -95,9 +95,9 @@ TEST(Export, ColumnsAreTheSameForParticipantsWithDifferentFactors) {
   const Rows rows = ReadCsv(dir / "out" / "trials.csv");
   ASSERT_EQ(rows.size(), 8u);
   const std::vector<std::string> expected = {
-      "study",       "protocol_hash", "participant", "observer",    "observer_params",    "window",
+      "study",       "protocol_hash", "protocol_version", "participant", "observer",    "observer_params", "window",
       "session_id",  "session_number", "session_status", "seed", "trial_index", "block",            "block_name",
-      "task",        "practice",      "swapped",     "blur",        "edge",               "speed_cm_s",
+      "task",        "practice",      "swapped",     "cell",        "blur",        "edge",               "speed_cm_s",
       "left_source", "left_fixed",    "right_source", "right_fixed", "status",            "chosen_side",
       "chose_more_blurred", "chosen_interval", "yes_no", "rating",   "adjusted_level",    "correct",
       "rt_ms",       "answered_at"};
@@ -248,7 +248,7 @@ TEST(Export, EveryRowCarriesItsSessionsStatusAbortedIncluded) {
   testing::TempDir dir;
   {
     Record record = Record::Open(dir / "r.sqlite");
-    const int64_t first = record.StartOrResumeSession("test1", "P01", "{}", 1, {}, false).session_id;
+    const int64_t first = record.StartOrResumeSession("test1", "P01", R"({"study":"test1"})", 1, {}, false).session_id;
     TrialRecord trial;
     record.SaveTrialList(first, {trial});
     Response r;
@@ -257,7 +257,7 @@ TEST(Export, EveryRowCarriesItsSessionsStatusAbortedIncluded) {
     record.AbortSession(first);
     RunSession(record, "P01", "{}", 2, 2);  // the same participant again, completed
     RunSession(record, "P02", "{}", 2, 1);
-    const int64_t running = record.StartOrResumeSession("test1", "P03", "{}", 1, {}, false).session_id;
+    const int64_t running = record.StartOrResumeSession("test1", "P03", R"({"study":"test1"})", 1, {}, false).session_id;
     record.SaveTrialList(running, {trial});
   }
   ExportCsv(dir / "r.sqlite", dir / "out");

@@ -294,7 +294,7 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
   const int64_t participant_id = EnsureParticipant(db_, study_id, participant, now);
 
   Statement running(db_, "SELECT s.id, s.seed, p.hash, p.json, s.observer, s.observer_params, s.display_profile, s.group_name, "
-                         "s.window "
+                         "s.window, s.session_number "
                          "FROM sessions s "
                          "JOIN protocol_versions p "
                          "ON p.id = s.protocol_version_id WHERE s.participant_id = ? AND s.status = 'running' "
@@ -352,6 +352,7 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     start.session_id = session;
     start.resumed = true;
     start.group = running.IsNull(7) ? "" : running.GetText(7);
+    start.session_number = running.IsNull(9) ? 1 : running.GetInt64(9);
   } else if (resume) {
     // Nothing to continue: say what there is instead of starting a whole new session unasked.
     Statement past(db_, "SELECT status, count(*), max(id) FROM sessions WHERE participant_id = ? GROUP BY status");
@@ -366,10 +367,15 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
                                      "); leave out --resume to start a new session" +
                                      (found.find("completed") != std::string::npos ? ", with --again" : ""));
   } else {
+    CheckProtocolVersion(study_id, study, canonical, hash, meta.protocol_version);
     std::string stored_json;
     const int64_t protocol_id = EnsureProtocolVersion(db_, study_id, canonical, hash, now, &stored_json);
     if (stored_json != canonical)  // a 64-bit hash collision: refuse rather than mix texts
       throw Error(ErrorKind::kInternal, "protocol hash " + hash + " collides with another protocol text");
+    SaveDesign(protocol_id, meta.protocol_version, meta.design);
+    // Numbered in the transaction that inserts the session, as the balanced group is: two stations never give one
+    // number twice.
+    start.session_number = NextSessionNumber(participant_id, study, participant, seed, meta);
     // Counted and inserted in one transaction (BEGIN IMMEDIATE): a station starting at the same moment waits for
     // this one's session and counts it.
     start.group = meta.assign_group ? meta.assign_group(SessionsPerGroup(db_, study)) : meta.group;
@@ -377,8 +383,8 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     Statement insert(db_, "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, "
                           "host, display, started, status, lock_host, lock_pid, lock_token, lock_heartbeat_ms, "
                           "display_profile, group_name, participant_info, observer, observer_params, window, "
-                          "profile_name, screen_width_mm, screen_height_mm, viewing_distance_mm, px_per_deg) "
-                          "VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+                          "profile_name, screen_width_mm, screen_height_mm, viewing_distance_mm, px_per_deg, session_number) "
+                          "VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
     insert.Bind(1, participant_id);
     insert.Bind(2, protocol_id);
     insert.Bind(3, static_cast<int64_t>(seed));
@@ -412,6 +418,7 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     number(20, "height_mm");
     number(21, "distance_mm");
     number(22, "px_per_deg");
+    insert.Bind(23, start.session_number);
     insert.Run();
     start.session_id = db_.LastInsertRowId();
     // The participant information, one row per key (text as given; numbers as JSON text).
@@ -464,8 +471,8 @@ void Record::SaveTrialList(int64_t session, const std::vector<TrialRecord>& tria
     throw InputError(db_.path(), SessionName(session) + " already has its trial list");
   Statement insert(db_, "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, right_shown, "
                         "block_name, practice, swapped, left_source, left_fixed, right_source, right_fixed, "
-                        "r_left_px, r_right_px, r_scene_px, task) "
-                        "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+                        "r_left_px, r_right_px, r_scene_px, task, cell) "
+                        "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
   auto optional = [&](int column, const std::optional<double>& value) {
     if (value) insert.Bind(column, *value);
     else insert.BindNull(column);
@@ -490,6 +497,8 @@ void Record::SaveTrialList(int64_t session, const std::vector<TrialRecord>& tria
     optional(15, trial.r_right_px);
     optional(16, trial.r_scene_px);
     insert.Bind(17, trial.task);
+    if (trial.cell.empty()) insert.BindNull(18);
+    else insert.Bind(18, trial.cell);
     insert.Run();
     insert.Reset();
   }

@@ -13,6 +13,21 @@
 
 namespace blurcue::store {
 
+// A column the design puts in trials.csv, as the record keeps it (design_columns, once per protocol version): the
+// session fills it from protocol::DescribeDesign, so the store needs no protocol types.
+struct DesignColumnRecord {
+  std::string name;                 // as trials.csv names it (store::DesignColumn for a level)
+  std::string role;                 // within | group | procedure_cell | label | practice
+  std::string type;                 // integer | number | string | boolean
+  std::string unit;
+  std::vector<double> numbers;      // numeric levels, ascending
+  std::vector<std::string> names;   // text levels or choices, in the protocol's order
+  std::optional<double> min, max;   // a range: both set, or a lower bound alone
+};
+// The codebook's allowed values of `column`: the numbers ("2|6|10", shortest round-trip text), else the names
+// ("a|b"), else the range ("1..7", ">= 0"); "" when none is known.
+std::string AllowedText(const DesignColumnRecord& column);
+
 // Describes the station; host empty = this machine's host name.
 struct SessionMeta {
   std::string software_version;  // empty = this build's BLURCUE_VERSION
@@ -30,6 +45,14 @@ struct SessionMeta {
   bool simulated = false;
   std::string observer_params;
   bool window = true;
+  // The protocol's declared "version" and its design (recorded once per protocol version; empty: none recorded).
+  int64_t protocol_version = 1;
+  std::vector<DesignColumnRecord> design;
+  // The seed was given (--seed), not derived: one an earlier session of the participant used is refused as such.
+  bool seed_given = false;
+  // > 0: the seed was derived for this session number, and a new session given another number (a station started
+  // one for the participant meanwhile) is refused; 0: not checked.
+  int64_t seed_for_number = 0;
 };
 
 // What a record already says about a study's groups and a participant's unfinished session, read without writing
@@ -40,6 +63,17 @@ struct GroupsSoFar {
   std::string unfinished_group, unfinished_info = "{}";
 };
 GroupsSoFar PeekGroups(const std::filesystem::path& db, const std::string& study, const std::string& participant);
+
+// What a record says of a participant's sessions, read without writing: the number a new session would get
+// (StartOrResumeSession decides it again in its transaction), and the participant's running session's seed and
+// number. A missing file, or one that is not a readable record (Record::Open refuses it, saying why), says nothing.
+struct SessionsSoFar {
+  int64_t next_number = 1;
+  bool unfinished = false;
+  uint64_t unfinished_seed = 0;
+  int64_t unfinished_number = 0;
+};
+SessionsSoFar PeekSessions(const std::filesystem::path& db, const std::string& study, const std::string& participant);
 
 // One planned trial, saved up front. JSON members are compact JSON text.
 struct TrialRecord {
@@ -54,6 +88,7 @@ struct TrialRecord {
   std::string block_name, task;  // task: forced_choice | adjustment | yes_no | rating
   bool practice = false, swapped = false;
   std::optional<double> r_left_px, r_right_px, r_scene_px;
+  std::string cell;  // a procedure trial's cell by its levels ("edge=9", "edge=9;speed_cm_s=3"); "" otherwise
 };
 
 // A side's source as typed columns: its name (none, measured, measured_section, estimated, fitted, fixed_px,
@@ -103,6 +138,7 @@ struct SessionStart {
   bool resumed = false;
   uint64_t seed = 0;
   std::string group;  // the session's group: as recorded (resumed), or as given or assigned (new)
+  int64_t session_number = 0;  // the participant's n-th session of the study (1, 2, ...)
 };
 
 struct RecordOptions {
@@ -146,7 +182,12 @@ class Record {
   //  - the resumed session was started with another protocol (naming what changed) or seed, or with another
   //    observer (meta.simulated and meta.observer_params, compared as recorded: both named), or with another
   //    display profile (meta.display_profile but for the file it was read from: both named, and what differs),
-  //  - another live process or Record holds the session.
+  //  - another live process or Record holds the session,
+  //  - a new session's protocol text differs from one the study recorded under the same or a higher declared version
+  //    (meta.protocol_version; naming the first JSON pointer that differs),
+  //  - a new session's seed is one an earlier session of the participant used, or it was derived for another session
+  //    number than the one the record gives (meta.seed_for_number).
+  // A new session gets the participant's next session number in the transaction that inserts it.
   SessionStart StartOrResumeSession(const std::string& study, const std::string& participant,
                                     const std::string& protocol_json, uint64_t seed, const SessionMeta& meta,
                                     bool resume);
@@ -204,6 +245,13 @@ class Record {
   // Stamps the final status and end and releases the lock, inside the caller's transaction.
   void Close(int64_t session, SessionStatus status);
   int64_t TrialId(int64_t session, int64_t trial_index);
+  // Inside StartOrResumeSession's transaction: refuses a new text under a recorded version (see there); records a
+  // protocol version's declared version and design once; decides a new session's number and refuses a used seed.
+  void CheckProtocolVersion(int64_t study_id, const std::string& study, const std::string& canonical,
+                            const std::string& hash, int64_t version);
+  void SaveDesign(int64_t protocol_id, int64_t version, const std::vector<DesignColumnRecord>& design);
+  int64_t NextSessionNumber(int64_t participant_id, const std::string& study, const std::string& participant,
+                            uint64_t seed, const SessionMeta& meta);
 
   Database db_;
   RecordOptions options_;

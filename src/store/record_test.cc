@@ -239,7 +239,7 @@ TEST(Record, FinishedSessionTakesNoMoreAnswersAndANewOneStarts) {
   EXPECT_THROW(record.RecordResponse(session, 0, Answer("left")), Error);
   EXPECT_EQ(record.database().QueryText("SELECT status FROM sessions"), "aborted");
   EXPECT_THROW(record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, true), Error);  // nothing to resume
-  const SessionStart next = record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, false);
+  const SessionStart next = record.StartOrResumeSession("test1", "P01", kProtocol, 8, {}, false);
   EXPECT_FALSE(next.resumed);
   EXPECT_NE(next.session_id, session);
   // The same protocol text is one protocol version.
@@ -524,7 +524,12 @@ TEST(Record, ChangedProtocolNamesTheChangeAndAbortKeepsTheAnswers) {
   EXPECT_EQ(record.database().QueryText("SELECT status FROM sessions WHERE id = 1"), "aborted");
   EXPECT_EQ(record.database().QueryInt64("SELECT count(*) FROM responses"), 2);
   EXPECT_TRUE(Contains(ErrorOf([&] { record.AbortSession(session); }), "session 1 is aborted; only a running"));
-  const SessionStart fresh = record.StartOrResumeSession("test1", "P01", changed, 7, {}, false);
+  // Started anew, the changed text is a new version of the study's protocol, with a seed of its own.
+  SessionMeta v2;
+  v2.protocol_version = 2;
+  const SessionStart fresh = record.StartOrResumeSession(
+      "test1", "P01", R"({"name":"test1","timing":{"inter_trial_ms":800,"stimulus_ms":0},"trials":4,"version":2})", 8,
+      v2, false);
   EXPECT_NE(fresh.session_id, session);
 }
 

@@ -152,6 +152,24 @@ std::vector<Migration> MakeMigrations() {
                "  PRIMARY KEY (session_id, key))" + strict + ";";
   }
   steps.push_back({typed, &DeriveTypedColumns});
+  // 8: the design reaches the record. protocol_versions: the protocol's declared "version" (a study's texts differ
+  // only under distinct versions from here on); sessions: the participant's n-th session of the study (decided with
+  // the insert, in its transaction); trials: a procedure trial's cell by its levels ("edge=9"); design_columns: per
+  // protocol version, every column the design puts in trials.csv with its role and the values the protocol allows.
+  steps.push_back({"ALTER TABLE protocol_versions ADD COLUMN version INTEGER CHECK (version >= 1);"
+                   "ALTER TABLE sessions ADD COLUMN session_number INTEGER CHECK (session_number >= 1);"
+                   "CREATE UNIQUE INDEX sessions_number ON sessions (participant_id, session_number);"
+                   "ALTER TABLE trials ADD COLUMN cell TEXT;"
+                   "CREATE TABLE design_columns ("
+                   "  protocol_version_id INTEGER NOT NULL REFERENCES protocol_versions(id),"
+                   "  position INTEGER NOT NULL,"
+                   "  name TEXT NOT NULL,"
+                   "  role TEXT NOT NULL CHECK (role IN ('within', 'group', 'procedure_cell', 'label', 'practice')),"
+                   "  type TEXT NOT NULL CHECK (type IN ('integer', 'number', 'string', 'boolean')),"
+                   "  unit TEXT NOT NULL,"
+                   "  allowed TEXT NOT NULL,"
+                   "  PRIMARY KEY (protocol_version_id, name))" + strict + ";",
+                   &DeriveVersionsAndNumbers});
   return steps;
 }
 
@@ -231,6 +249,30 @@ void DeriveTypedColumns(Database& db) {
           "correct = json_extract(shown, '$.correct'), "
           "r_left_px = json_extract(shown, '$.r_left_px'), r_right_px = json_extract(shown, '$.r_right_px') "
           "WHERE json_valid(shown) AND shown <> '{}' AND level IS NULL AND correct IS NULL");
+}
+
+void DeriveVersionsAndNumbers(Database& db) {
+  // A protocol without "version" is version 1 (the parser's default); a text that is not JSON cannot be run again.
+  db.Exec("UPDATE protocol_versions SET version = CASE WHEN json_valid(json) AND json_type(json, '$.version') = "
+          "'integer' AND json_extract(json, '$.version') >= 1 THEN json_extract(json, '$.version') ELSE 1 END "
+          "WHERE version IS NULL");
+  NumberSessions(db, false);
+  // An answer is scored once, when it is given (Response::correct); an odd one out answered before the runner
+  // recorded it is scored here from its trial's odd interval, so that export reads every correct and scores none.
+  db.Exec("UPDATE responses SET correct = (choice = (SELECT CAST(json_extract(t.factors, '$.odd_interval') AS TEXT) "
+          "FROM trials t WHERE t.id = responses.trial_id)) "
+          "WHERE correct IS NULL AND choice <> '' AND choice NOT GLOB '*[^0-9]*' AND (SELECT json_extract(t.factors, "
+          "'$.odd_interval') FROM trials t WHERE t.id = responses.trial_id AND json_valid(t.factors)) IS NOT NULL");
+}
+
+void NumberSessions(Database& db, bool all) {
+  // Cleared first: the unique (participant, number) index is checked row by row while the numbers move.
+  const std::string which = all ? std::string("1") : "participant_id IN (SELECT participant_id FROM sessions WHERE "
+                                                     "session_number IS NULL)";
+  db.Exec("UPDATE sessions SET session_number = NULL WHERE " + which);
+  db.Exec("UPDATE sessions SET session_number = (SELECT n FROM (SELECT id, row_number() OVER (PARTITION BY "
+          "participant_id ORDER BY started, id) AS n FROM sessions) x WHERE x.id = sessions.id) "
+          "WHERE session_number IS NULL");
 }
 
 const std::vector<Migration>& Migrations() {

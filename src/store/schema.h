@@ -51,6 +51,15 @@ const std::vector<TypedColumn>& TypedColumns();
 // trial's factors and shown sides, a response's shown object. Rows written at version 7 have them already.
 void DeriveTypedColumns(Database& db);
 
+// Fills what version 8 added where it is NULL: a protocol version's declared "version" from its JSON (1 when it
+// declares none), the session numbers of every participant with an unnumbered session (NumberSessions), and the
+// correctness of an odd one out answered before it was recorded with the answer (choice = the trial's odd_interval).
+void DeriveVersionsAndNumbers(Database& db);
+
+// Numbers sessions 1, 2, ... per participant by order of start (then id): every session (`all`, as merge does), or
+// only those of participants with an unnumbered session.
+void NumberSessions(Database& db, bool all);
+
 // PRAGMA user_version of `db`.
 int SchemaVersion(Database& db);
 

@@ -1,0 +1,207 @@
+#include "protocol/design.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+namespace blurcue::protocol {
+namespace {
+
+// The unit a level's name states by its suffix, as the house names values (speed_cm_s, distance_m, stimulus_ms).
+std::string UnitOf(const std::string& name) {
+  static const std::vector<std::pair<std::string, std::string>> suffixes = {
+      {"_cm_s", "cm/s"}, {"_mm", "mm"}, {"_cm", "cm"}, {"_ms", "ms"}, {"_px", "px"}, {"_arcmin", "arcmin"},
+      {"_deg", "deg"},   {"_m", "m"},   {"_s", "s"}};
+  for (const auto& [suffix, unit] : suffixes)
+    if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0)
+      return unit;
+  return "";
+}
+
+// A level as trials.csv shows it: a string bare, a number as JSON, an object by its id (else its scalar members as
+// key=value;...), as the export's TidyCell does.
+std::string LevelName(const Json& level) {
+  auto scalar = [](const Json& v) { return v.is_string() ? v.get<std::string>() : v.is_null() ? "" : v.dump(); };
+  if (level.is_object()) {
+    if (level.contains("id") && !level["id"].is_structured()) return scalar(level["id"]);
+    std::string text;
+    for (const auto& [key, member] : level.items())
+      if (!member.is_structured()) text += (text.empty() ? "" : ";") + key + "=" + scalar(member);
+    return text;
+  }
+  return scalar(level);
+}
+
+// The values one column takes, collected over blocks: numbers apart, so they are given in numeric order.
+struct Values {
+  std::set<double> numbers;
+  std::vector<std::string> names;
+  bool integers = true, others = false;
+  void Add(const Json& v) {
+    if (v.is_number()) {
+      const double x = v.get<double>();
+      numbers.insert(x);
+      if (!(std::isfinite(x) && x == std::floor(x))) integers = false;
+      return;
+    }
+    others = true;
+    const std::string name = LevelName(v);
+    if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+  }
+  void Into(DesignColumn* c) const {
+    if (others) {  // mixed or text: every value as text, in the protocol's order
+      c->type = ValueType::kString;
+      c->names = names;
+      for (double x : numbers) {
+        const std::string text = Json(x).dump();
+        if (std::find(c->names.begin(), c->names.end(), text) == c->names.end()) c->names.push_back(text);
+      }
+    } else {
+      c->type = integers ? ValueType::kInteger : ValueType::kNumber;
+      c->numbers.assign(numbers.begin(), numbers.end());
+    }
+  }
+};
+
+}  // namespace
+
+std::string ToString(Role role) {
+  switch (role) {
+    case Role::kWithin: return "within";
+    case Role::kGroup: return "group";
+    case Role::kProcedureCell: return "procedure_cell";
+    case Role::kLabel: return "label";
+    case Role::kPractice: return "practice";
+  }
+  return "within";
+}
+
+std::string ToString(ValueType type) {
+  switch (type) {
+    case ValueType::kInteger: return "integer";
+    case ValueType::kNumber: return "number";
+    case ValueType::kString: return "string";
+    case ValueType::kBoolean: return "boolean";
+  }
+  return "string";
+}
+
+std::vector<DesignColumn> DescribeDesign(const Protocol& protocol) {
+  // The levels first, in the order the blocks and their factors name them; a name is one column however many blocks
+  // vary it (as in trials.csv).
+  std::vector<std::string> order;
+  std::map<std::string, Values> values;
+  std::set<std::string> cells;
+  auto add = [&](const std::string& name, const Json& value, bool cell) {
+    if (!values.count(name)) order.push_back(name);
+    values[name].Add(value);
+    if (cell) cells.insert(name);
+  };
+  for (const Block& block : protocol.blocks)
+    for (const Factor& factor : block.factors) {
+      const bool cell = block.procedure.has_value();
+      for (const Json& level : factor.levels) {
+        // A conditions table's row is no column of its own: its columns are (session/stimulus.cc TrialVariables).
+        if (!(factor.name == "row" && level.is_object())) add(factor.name, level, cell);
+        if (level.is_object())
+          for (const auto& [key, value] : level.items())
+            if (key != "left" && key != "right" && key != "object" && key != factor.name) add(key, value, cell);
+      }
+    }
+  std::vector<DesignColumn> columns;
+  for (const std::string& name : order) {
+    DesignColumn c;
+    c.name = name;
+    c.level = true;
+    // An object level's id names the level (a pattern's) rather than varying the stimulus: a label beside it.
+    c.role = name == "id" ? Role::kLabel : cells.count(name) ? Role::kProcedureCell : Role::kWithin;
+    c.unit = UnitOf(name);
+    values[name].Into(&c);
+    columns.push_back(std::move(c));
+  }
+  // The procedure's level: a staircase's bounds, QUEST+'s stimuli (over every procedure block).
+  std::optional<DesignColumn> level;
+  for (const Block& block : protocol.blocks) {
+    if (!block.procedure) continue;
+    const Procedure& p = *block.procedure;
+    if (!level) {
+      level.emplace();
+      level->name = "level";
+      level->role = Role::kWithin;
+      level->type = ValueType::kNumber;
+      level->unit = p.variable == "difference_arcmin" ? "arcmin" : "";
+    }
+    if (p.kind == Procedure::Kind::kQuestPlus) {
+      std::set<double> all(level->numbers.begin(), level->numbers.end());
+      all.insert(p.stimuli.begin(), p.stimuli.end());
+      level->numbers.assign(all.begin(), all.end());
+    } else {
+      level->min = level->min ? std::min(*level->min, p.min) : p.min;
+      level->max = level->max ? std::max(*level->max, p.max) : p.max;
+    }
+  }
+  if (level) {
+    // Staircase and QUEST+ blocks together: one range over both.
+    if (level->min && !level->numbers.empty()) {
+      level->min = std::min(*level->min, level->numbers.front());
+      level->max = std::max(*level->max, level->numbers.back());
+      level->numbers.clear();
+    }
+    columns.push_back(*level);
+  }
+  if (std::any_of(protocol.blocks.begin(), protocol.blocks.end(),
+                  [](const Block& b) { return b.task == Task::kRating; }) &&
+      !protocol.responses.rating.empty()) {
+    DesignColumn rating;
+    rating.name = "rating";
+    rating.role = Role::kLabel;
+    rating.type = ValueType::kInteger;
+    rating.min = 1;
+    rating.max = static_cast<double>(protocol.responses.rating.size());
+    columns.push_back(rating);
+  }
+  if (protocol.groups) {
+    DesignColumn group;
+    group.name = "group";
+    group.role = Role::kGroup;
+    group.names = protocol.groups->names;
+    columns.push_back(group);
+  }
+  for (const InfoField& field : protocol.participant_info) {
+    DesignColumn info;
+    info.name = "info_" + field.key;
+    info.role = Role::kLabel;
+    info.unit = UnitOf(field.key);
+    if (field.type == "integer" || field.type == "number") {
+      info.type = field.type == "integer" ? ValueType::kInteger : ValueType::kNumber;
+      if (field.max > field.min) info.min = field.min, info.max = field.max;
+    } else {
+      info.names = field.choices;
+    }
+    columns.push_back(info);
+  }
+  DesignColumn practice;
+  practice.name = "practice";
+  practice.role = Role::kPractice;
+  practice.type = ValueType::kBoolean;
+  practice.numbers = {0, 1};
+  columns.push_back(practice);
+  return columns;
+}
+
+std::string CellLevels(const Protocol& protocol, const Trial& trial) {
+  const Block* block = BlockOf(protocol, trial);
+  if (trial.cell < 0 || !block || !block->procedure) return "";
+  std::string text;
+  for (const Factor& factor : block->factors) {
+    const Json* level = trial.levels.is_object() && trial.levels.contains(factor.name) ? &trial.levels[factor.name]
+                                                                                       : nullptr;
+    if (!level) continue;
+    const std::string value = level->is_number() ? LevelText(level->get<double>()) : LevelName(*level);
+    text += (text.empty() ? "" : ";") + factor.name + "=" + value;
+  }
+  return text;
+}
+
+}  // namespace blurcue::protocol

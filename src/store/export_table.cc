@@ -1,0 +1,238 @@
+// The tables an export writes beside trials.csv (summaries, frames) and the helpers every writer shares.
+#include "store/export_table.h"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cstdio>
+#include <map>
+#include <optional>
+#include <set>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/hash.h"
+#include "core/typed.h"
+#include "store/record.h"
+
+namespace blurcue::store {
+
+// A JSON value as a cell: strings bare, null empty, anything else as compact JSON.
+std::string Cell(const Json& value) {
+  if (value.is_string()) return value.get<std::string>();
+  if (value.is_null()) return {};
+  return value.dump();
+}
+
+Json ParseColumn(const std::string& text, const std::string& where) {
+  try {
+    return Json::parse(text);
+  } catch (const Json::exception& e) {
+    throw InputError(where, std::string("not valid JSON: ") + e.what());
+  }
+}
+
+// Shortest text that reads back as the same double.
+std::string Number(double value) {
+  char text[64];
+  const auto result = std::to_chars(text, text + sizeof(text), value);
+  return std::string(text, result.ptr);
+}
+
+std::string Where(const std::filesystem::path& db, int64_t session, int64_t trial) {
+  return db.string() + ": session " + std::to_string(session) + " trial " + std::to_string(trial);
+}
+
+// What an export folder may hold and still be replaced as a whole: the files an export writes, and the
+// temporaries an earlier version left beside them when killed (FILE.csv.tmpPID).
+bool IsExportFile(const std::string& name) {
+  const bool table = name == "trials.csv" || name == "frames.csv" || name == "adjustments.csv" ||
+                     name == "codebook.csv" || name.rfind("summary-", 0) == 0;
+  if (table && name.size() > 4 && name.compare(name.size() - 4, 4, ".csv") == 0) return true;
+  const size_t tmp = name.rfind(".csv.tmp");
+  return tmp != std::string::npos && tmp + 8 < name.size() &&
+         name.find_first_not_of("0123456789", tmp + 8) == std::string::npos;
+}
+
+void Note(const ProgressNote& note, const std::vector<std::filesystem::path>& removed) {
+  for (const auto& path : removed)
+    if (note) note("removed " + path.string() + ", left by an interrupted run");
+}
+
+std::string CsvLine(const std::vector<std::string>& cells) {
+  std::string line;
+  for (size_t i = 0; i < cells.size(); ++i) {
+    if (i) line += ',';
+    line += CsvField(cells[i]);
+  }
+  return line + "\r\n";
+}
+
+void RemoveDatabaseFiles(const std::filesystem::path& path) {
+  std::error_code ignored;
+  for (const char* suffix : {"", "-wal", "-shm", "-journal"})
+    std::filesystem::remove(path.string() + suffix, ignored);
+}
+std::string CsvField(const std::string& text) {
+  const bool quote = text.find_first_of(",\"\r\n") != std::string::npos ||
+                     (!text.empty() && (text.front() == ' ' || text.back() == ' '));
+  if (!quote) return text;
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+// Per study, one row per session: trials planned and answered (practice apart), the median response time, and
+// how often each answer was given - for forced choice the source chosen (the one shown on the side picked) or
+// cant_tell, for adjustment the level accepted. Writes OUT/SummaryFileName(STUDY) for every study and returns the
+// codebook's rows for them.
+std::string WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
+  struct Row {
+    std::string participant, status;
+    int64_t planned = 0, answered = 0;
+    std::vector<double> rts;
+    std::map<std::string, int64_t> answers;
+  };
+  std::map<std::string, std::map<int64_t, Row>> studies;
+  // Answers in a natural order: numbers (adjustment levels) by value, then names.
+  struct Natural {
+    bool operator()(const std::string& a, const std::string& b) const {
+      const std::optional<double> x = ParseDecimal(a), y = ParseDecimal(b);
+      if (x.has_value() != y.has_value()) return x.has_value();
+      return x && *x != *y ? *x < *y : a < b;
+    }
+  };
+  std::map<std::string, std::set<std::string, Natural>> answer_names;
+  Statement rows(db,
+                 "SELECT st.name, p.code, s.id, s.status, r.id IS NOT NULL, r.choice, r.rt_ms, "
+                 "CASE r.choice WHEN 'left' THEN t.left_shown WHEN 'right' THEN t.right_shown END "
+                 "FROM trials t JOIN sessions s ON s.id = t.session_id "
+                 "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
+                 "LEFT JOIN responses r ON r.trial_id = t.id "
+                 "WHERE coalesce(t.practice, 0) = 0 AND coalesce(r.choice, '') <> '" + std::string(kChoiceSkipped) +
+                 "' ORDER BY st.name, p.code, s.id");
+  while (rows.Step()) {
+    Row& row = studies[rows.GetText(0)][rows.GetInt64(2)];
+    row.participant = rows.GetText(1);
+    row.status = rows.GetText(3);
+    ++row.planned;
+    if (rows.GetInt64(4) == 0) continue;
+    ++row.answered;
+    if (!rows.IsNull(6)) row.rts.push_back(rows.GetDouble(6));
+    const std::string answer = rows.IsNull(7) ? rows.GetText(5) : Cell(Json::parse(rows.GetText(7)));
+    ++row.answers[answer];
+    answer_names[rows.GetText(0)].insert(answer);
+  }
+  std::string codebook;
+  // File names folded to lower case: two studies' summaries must not share a name on a case-insensitive file system
+  // either.
+  std::map<std::string, std::string> files;
+  for (auto& [study, sessions] : studies) {
+    const std::string file = SummaryFileName(study);
+    std::string folded = file;
+    for (char& c : folded) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (const auto [it, fresh] = files.emplace(folded, study); !fresh)
+      throw InputError(db.path(), "the studies " + Echo(it->second) + " and " + Echo(study) +
+                                               " would both be summarised as " + file);
+    std::vector<std::string> header = {"participant", "session", "status", "planned", "answered", "median_rt_ms"};
+    for (const auto& name : answer_names[study]) header.push_back("n_" + name);
+    const std::string of = " (study " + study + ")";
+    const std::vector<ColumnDef> columns = {
+        {"participant", "string", "", "", "the participant's id" + of},
+        {"session", "integer", "", ">= 1", "the session's id in this record (session_id in trials.csv)"},
+        {"status", "string", "", "", "the session's status"},
+        {"planned", "integer", "", ">= 0", "trials planned, practice apart"},
+        {"answered", "integer", "", ">= 0", "trials answered, practice apart"},
+        {"median_rt_ms", "number", "ms", ">= 0", "the median response time of the answered trials"}};
+    for (const auto& c : columns) codebook += CsvLine({file, c.name, c.type, c.unit, c.allowed, c.meaning, ""});
+    for (const auto& name : answer_names[study])
+      codebook += CsvLine({file, "n_" + name, "integer", "", ">= 0",
+                           "how often the answer " + name + " was given (forced choice: the source chosen, or "
+                           "cant_tell; adjustment: the level accepted)", ""});
+    std::string text = CsvLine(header);
+    for (auto& [session, row] : sessions) {
+      std::sort(row.rts.begin(), row.rts.end());
+      const size_t n = row.rts.size();
+      const std::string median =
+          n == 0 ? "" : Number(n % 2 ? row.rts[n / 2] : 0.5 * (row.rts[n / 2 - 1] + row.rts[n / 2]));
+      std::vector<std::string> cells = {row.participant, std::to_string(session), row.status,
+                                        std::to_string(row.planned), std::to_string(row.answered), median};
+      for (const auto& name : answer_names[study]) cells.push_back(std::to_string(row.answers[name]));
+      text += CsvLine(cells);
+    }
+    WriteFileAtomically(out_dir / file, text);
+  }
+  return codebook;
+}
+
+// The columns of adjustments.csv and frames.csv, for their writers and the codebook.
+const std::vector<ColumnDef>& AdjustmentColumns() {
+  static const std::vector<ColumnDef> columns = {
+      {"study", "string", "", "", "the protocol's name"},
+      {"participant", "string", "", "", "the participant's id"},
+      {"session_id", "integer", "", ">= 1", "the session's id in this record (as in trials.csv)"},
+      {"trial_index", "integer", "", ">= 0", "the trial (as in trials.csv)"},
+      {"step", "integer", "", ">= 1", "the step's place in the trial's adjustment, from 1"},
+      {"level", "number", "the adjusted parameter's unit", "", "the level stepped to"},
+      {"t_ms", "number", "ms", ">= 0", "when, from the stimulus's first frame"},
+  };
+  return columns;
+}
+const std::vector<ColumnDef>& FrameColumns() {
+  static const std::vector<ColumnDef> columns = {
+      {"study", "string", "", "", "the protocol's name"},
+      {"participant", "string", "", "", "the participant's id"},
+      {"session_id", "integer", "", ">= 1", "the session's id in this record (as in trials.csv)"},
+      {"window", "boolean", "", "0|1", "1: a real window on the real clock; 0: headless on a simulated clock"},
+      {"trial_index", "integer", "", ">= 0", "the trial (as in trials.csv)"},
+      {"frame_index", "integer", "", ">= 0", "the frame's place in the trial"},
+      {"flip_time_s", "number", "s", ">= 0", "when the frame reached the screen, from the trial's first flip"},
+      {"dropped", "boolean", "", "0|1", "1: more than 1.5 refresh periods after the frame before (window only)"},
+      {"r_left_px", "number", "photo px", ">= 0", "the left object's blur radius in this frame; empty: not shown"},
+      {"r_right_px", "number", "photo px", ">= 0", "the right object's blur radius in this frame; empty: not shown"},
+      {"y_mm", "number", "mm", "", "the objects' place along the board's y in this frame (0 at edge 1)"},
+  };
+  return columns;
+}
+
+// OUT/frames.csv: every recorded display flip, one row each (FrameColumns): what each frame showed of a pair, empty
+// where nothing was shown and for pictures.
+void WriteFrames(Database& db, const std::filesystem::path& out_dir) {
+  std::vector<std::string> header;
+  for (const auto& c : FrameColumns()) header.push_back(c.name);
+  std::string text = CsvLine(header);
+  Statement rows(db,
+                 "SELECT st.name, p.code, s.id, t.trial_index, f.frame_index, f.flip_time_s, f.dropped, "
+                 "coalesce(s.window, s.display LIKE 'window%'), f.r_left_px, f.r_right_px, f.y_mm "
+                 "FROM frames f JOIN trials t ON t.id = f.trial_id JOIN sessions s ON s.id = t.session_id "
+                 "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
+                 "ORDER BY st.name, p.code, s.id, t.trial_index, f.frame_index");
+  auto optional = [&](int column) { return rows.IsNull(column) ? std::string() : Number(rows.GetDouble(column)); };
+  while (rows.Step())
+    text += CsvLine({rows.GetText(0), rows.GetText(1), std::to_string(rows.GetInt64(2)),
+                     std::to_string(rows.GetInt64(7)), std::to_string(rows.GetInt64(3)),
+                     std::to_string(rows.GetInt64(4)), Number(rows.GetDouble(5)), std::to_string(rows.GetInt64(6)),
+                     optional(8), optional(9), optional(10)});
+  WriteFileAtomically(out_dir / "frames.csv", text);
+}
+
+std::string SummaryFileName(const std::string& study) {
+  // Plain: what needs no change on any file system and cannot be mistaken for a name with a suffix.
+  const bool plain =
+      !study.empty() && std::all_of(study.begin(), study.end(), [](char c) {
+        return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' || c == '_';
+      });
+  const bool looks_suffixed = study.size() > 17 && study[study.size() - 17] == '-' &&
+                              study.find_first_not_of("0123456789abcdef", study.size() - 16) == std::string::npos;
+  if (plain && !looks_suffixed) return "summary-" + study + ".csv";
+  std::string safe = study;
+  for (char& c : safe)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+  char hash[17];
+  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(Fnv1a64(study)));
+  return "summary-" + safe + "-" + hash + ".csv";
+}
+
+}  // namespace blurcue::store

@@ -1,0 +1,39 @@
+// blurcue sessions: every session of a record, as the experimenter sees it.
+#include "core/error.h"
+#include "store/export.h"
+#include "store/record.h"
+#include "store/schema.h"
+#include "store/sqlite.h"
+
+namespace blurcue::store {
+
+std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path) {
+  Database db(db_path, OpenMode::kReadOnly);
+  RequireReadableRecord(db);
+  Statement rows(db,
+                 "SELECT s.id, st.name, p.code, s.status, s.started, coalesce(s.ended, ''), s.host, s.seed, "
+                 "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), "
+                 "(SELECT count(*) FROM trials t JOIN responses r ON r.trial_id = t.id WHERE t.session_id = s.id), "
+                 "s.lock_token IS NOT NULL, coalesce(s.lock_pid, 0), coalesce(s.lock_host, ''), "
+                 "coalesce(s.lock_heartbeat_ms, 0) "
+                 "FROM sessions s JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
+                 "ORDER BY st.name, p.code, s.id");
+  std::vector<SessionSummary> sessions;
+  while (rows.Step()) {
+    SessionSummary s;
+    s.id = rows.GetInt64(0);
+    s.study = rows.GetText(1);
+    s.participant = rows.GetText(2);
+    s.status = rows.GetText(3);
+    s.started = rows.GetText(4);
+    s.ended = rows.GetText(5);
+    s.host = rows.GetText(6);
+    s.seed = static_cast<uint64_t>(rows.GetInt64(7));
+    s.planned = rows.GetInt64(8);
+    s.answered = rows.GetInt64(9);
+    if (rows.GetInt64(10) != 0) s.writer = JudgeLock(rows.GetText(12), rows.GetInt64(11), rows.GetInt64(13)).text;
+    sessions.push_back(std::move(s));
+  }
+  return sessions;
+}
+}  // namespace blurcue::store

@@ -1,0 +1,324 @@
+// blurcue merge: the records of several stations copied into one new record, with fresh ids.
+#include <map>
+#include <set>
+#include <string>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "store/export.h"
+#include "store/export_table.h"
+#include "store/record.h"
+#include "store/schema.h"
+#include "store/sqlite.h"
+
+namespace blurcue::store {
+namespace {
+
+// Schema 7's typed columns of one table (schema.h TypedColumns): copied as they are from an input of version 7 or
+// later; derived from the texts (DeriveTypedColumns) for an older one.
+std::vector<TypedColumn> TypedColumnsOf(const std::string& table) {
+  std::vector<TypedColumn> out;
+  for (const TypedColumn& c : TypedColumns())
+    if (table == c.table) out.push_back(c);
+  return out;
+}
+// ", a, b, c" for a SELECT or INSERT column list; empty for an input before version 7.
+std::string TypedList(const std::string& table, bool typed) {
+  std::string list;
+  if (typed)
+    for (const auto& c : TypedColumnsOf(table)) list += std::string(", ") + c.name;
+  return list;
+}
+std::string TypedPlaceholders(const std::string& table, bool typed) {
+  std::string list;
+  if (typed)
+    for (size_t i = 0; i < TypedColumnsOf(table).size(); ++i) list += ", ?";
+  return list;
+}
+// Binds the typed columns read from `from` (starting at column `first`) to `to` (starting at parameter `at`).
+void CopyTyped(const std::string& table, bool typed, Statement& from, int first, Statement& to, int at) {
+  if (!typed) return;
+  for (const auto& c : TypedColumnsOf(table)) {
+    const std::string type = c.type;
+    if (from.IsNull(first)) to.BindNull(at);
+    else if (type == "TEXT") to.Bind(at, from.GetText(first));
+    else if (type == "REAL") to.Bind(at, from.GetDouble(first));
+    else to.Bind(at, from.GetInt64(first));
+    ++first, ++at;
+  }
+}
+
+// Refuses an input whose session a live writer holds (the record's own rule, JudgeLock: a copy taken now would miss
+// the answers still coming, and the two copies could each be resumed and never merged again). Adds one line to
+// `unfinished` per running session with no live writer (a killed or stopped one): copied as it is, and it must be
+// resumed in one record only.
+void CheckSessionsToMerge(Database& src, const std::filesystem::path& input, std::vector<std::string>* unfinished) {
+  Statement sessions(src,
+                     "SELECT s.id, st.name, p.code, s.status, "
+                     "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), "
+                     "(SELECT count(*) FROM trials t JOIN responses r ON r.trial_id = t.id WHERE t.session_id = s.id), "
+                     "s.lock_token IS NOT NULL, coalesce(s.lock_host, ''), coalesce(s.lock_pid, 0), "
+                     "coalesce(s.lock_heartbeat_ms, 0) "
+                     "FROM sessions s JOIN participants p ON p.id = s.participant_id "
+                     "JOIN studies st ON st.id = p.study_id ORDER BY s.id");
+  while (sessions.Step()) {
+    const std::string id = std::to_string(sessions.GetInt64(0));
+    const std::string who = "session " + id + " (study " + sessions.GetText(1) + ", participant " +
+                            sessions.GetText(2) + ", " + std::to_string(sessions.GetInt64(5)) + " of " +
+                            std::to_string(sessions.GetInt64(4)) + " trials answered)";
+    if (sessions.GetInt64(6) != 0) {
+      const LockState lock = JudgeLock(sessions.GetText(7), sessions.GetInt64(8), sessions.GetInt64(9));
+      if (!lock.stale)
+        throw InputError(input.string(),
+                         who + " is being written by " + lock.text + "; merge it once that session has ended (to "
+                         "give it up instead: stop that run, then blurcue sessions --db " + input.string() +
+                         " --abort " + id + ")");
+    }
+    if (sessions.GetText(3) == "running")
+      unfinished->push_back(input.string() + ": " + who + " is unfinished, with no live writer: copied as running; "
+                            "resume it in one record only (this one, then merge again into a new file, or the "
+                            "merged one), never both: the two copies could not be merged again");
+  }
+}
+
+}  // namespace
+
+void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out,
+                    const ProgressNote& note) {
+  Note(note, RemoveStaleLeftovers(out));
+  if (std::filesystem::exists(out)) throw InputError(out.string(), "exists; merge refuses to overwrite it");
+  std::set<std::filesystem::path> seen;
+  for (const auto& input : inputs) {
+    if (!seen.insert(std::filesystem::weakly_canonical(input)).second)
+      throw InputError(input.string(), "listed twice among the merge inputs");
+  }
+  const std::filesystem::path temp = TemporaryBeside(out, "partial");
+  RemoveDatabaseFiles(temp);
+  std::vector<std::string> unfinished, renumbered;
+  // The session numbers the inputs gave (version 8 on), by the merged session's id.
+  struct Numbered {
+    std::string input;
+    int64_t session = 0, number = 0;
+  };
+  std::map<int64_t, Numbered> numbered;
+  try {
+    {
+      Database dst(temp);
+      Migrate(dst);
+      Transaction transaction(dst);
+      for (const auto& input : inputs) {
+        Database src(input, OpenMode::kReadOnly);
+        RequireReadableRecord(src);
+        // One snapshot of the input: the sessions judged below are the ones copied, with the answers they had then.
+        src.Exec("BEGIN");
+        CheckSessionsToMerge(src, input, &unfinished);
+        std::map<int64_t, int64_t> study_ids, protocol_ids, participant_ids, session_ids, trial_ids;
+        const bool typed = SchemaVersion(src) >= 7;
+
+        Statement studies(src, "SELECT id, name, created FROM studies");
+        while (studies.Step())
+          study_ids[studies.GetInt64(0)] = EnsureStudy(dst, studies.GetText(1), studies.GetText(2));
+
+        const bool v8 = SchemaVersion(src) >= 8;
+        Statement protocols(src, std::string("SELECT id, study_id, json, hash, created, ") +
+                                     (v8 ? "version" : "NULL") + " FROM protocol_versions");
+        Statement set_version(dst, "UPDATE protocol_versions SET version = ? WHERE id = ? AND version IS NULL");
+        while (protocols.Step()) {
+          // An input of schema 1 holds raw texts: the merged record keys them by their canonical text, as run does.
+          std::string json = protocols.GetText(2), hash = protocols.GetText(3);
+          try {
+            json = CanonicalProtocolText(json);
+            hash = ProtocolHash(json);
+          } catch (const Error&) {
+          }
+          std::string stored_json;
+          protocol_ids[protocols.GetInt64(0)] = EnsureProtocolVersion(
+              dst, study_ids.at(protocols.GetInt64(1)), json, hash, protocols.GetText(4), &stored_json);
+          if (stored_json != json)
+            throw InputError(input.string(), "protocol hash " + hash + " names a different protocol text in another input");
+          if (!protocols.IsNull(5)) {
+            set_version.Bind(1, protocols.GetInt64(5));
+            set_version.Bind(2, protocol_ids[protocols.GetInt64(0)]);
+            set_version.Run();
+            set_version.Reset();
+          }
+        }
+        if (v8) {
+          // One design per protocol version: the first input that recorded it gives it.
+          Statement design(src, "SELECT protocol_version_id, position, name, role, type, unit, allowed FROM "
+                                "design_columns ORDER BY protocol_version_id, position");
+          Statement insert_design(dst, "INSERT INTO design_columns (protocol_version_id, position, name, role, type, "
+                                       "unit, allowed) VALUES (?, ?, ?, ?, ?, ?, ?)");
+          std::map<int64_t, bool> had_design;
+          while (design.Step()) {
+            const int64_t id = protocol_ids.at(design.GetInt64(0));
+            if (!had_design.count(id))
+              had_design[id] = dst.QueryInt64("SELECT count(*) FROM design_columns WHERE protocol_version_id = " +
+                                              std::to_string(id)) > 0;
+            if (had_design[id]) continue;
+            insert_design.Bind(1, id);
+            insert_design.Bind(2, design.GetInt64(1));
+            for (int column = 2; column <= 6; ++column) insert_design.Bind(column + 1, design.GetText(column));
+            insert_design.Run();
+            insert_design.Reset();
+          }
+        }
+
+        Statement participants(src, "SELECT id, study_id, code, created FROM participants");
+        while (participants.Step())
+          participant_ids[participants.GetInt64(0)] = EnsureParticipant(
+              dst, study_ids.at(participants.GetInt64(1)), participants.GetText(2), participants.GetText(3));
+
+        Statement sessions(src, "SELECT id, participant_id, protocol_version_id, seed, software_version, host, "
+                                "display, started, ended, status, " +
+                                std::string(SchemaVersion(src) >= 3 ? "display_profile" : "'{}'") + ", " +
+                                std::string(SchemaVersion(src) >= 6 ? "group_name, participant_info" : "'', '{}'") +
+                                TypedList("sessions", typed) + (v8 ? ", session_number" : ", NULL") +
+                                " FROM sessions");
+        Statement duplicate(dst, "SELECT id FROM sessions WHERE participant_id = ? AND protocol_version_id = ? "
+                                 "AND seed = ? AND host = ? AND started = ?");
+        Statement insert_session(dst, "INSERT INTO sessions (participant_id, protocol_version_id, seed, "
+                                      "software_version, host, display, started, ended, status, display_profile, "
+                                      "group_name, participant_info" + TypedList("sessions", typed) +
+                                      ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?" +
+                                      TypedPlaceholders("sessions", typed) + ")");
+        while (sessions.Step()) {
+          const int64_t participant = participant_ids.at(sessions.GetInt64(1));
+          const int64_t protocol = protocol_ids.at(sessions.GetInt64(2));
+          duplicate.Bind(1, participant);
+          duplicate.Bind(2, protocol);
+          duplicate.Bind(3, sessions.GetInt64(3));
+          duplicate.Bind(4, sessions.GetText(5));
+          duplicate.Bind(5, sessions.GetText(7));
+          if (duplicate.Step())
+            throw InputError(input.string(), "session " + std::to_string(sessions.GetInt64(0)) +
+                                                 " is already in the merge (an input merged twice?)");
+          duplicate.Reset();
+          insert_session.Bind(1, participant);
+          insert_session.Bind(2, protocol);
+          insert_session.Bind(3, sessions.GetInt64(3));
+          for (int column = 4; column <= 7; ++column) insert_session.Bind(column, sessions.GetText(column));
+          if (sessions.IsNull(8)) insert_session.BindNull(8);
+          else insert_session.Bind(8, sessions.GetText(8));
+          insert_session.Bind(9, sessions.GetText(9));
+          insert_session.Bind(10, sessions.GetText(10));
+          insert_session.Bind(11, sessions.GetText(11));
+          insert_session.Bind(12, sessions.GetText(12));
+          CopyTyped("sessions", typed, sessions, 13, insert_session, 13);
+          insert_session.Run();
+          insert_session.Reset();
+          session_ids[sessions.GetInt64(0)] = dst.LastInsertRowId();
+          if (!sessions.IsNull(13 + int(TypedColumnsOf("sessions").size()) * typed))
+            numbered[dst.LastInsertRowId()] = {input.string(), sessions.GetInt64(0),
+                                               sessions.GetInt64(13 + int(TypedColumnsOf("sessions").size()) * typed)};
+        }
+        if (typed) {
+          Statement info(src, "SELECT session_id, key, value FROM session_info");
+          Statement insert_info(dst, "INSERT INTO session_info (session_id, key, value) VALUES (?, ?, ?)");
+          while (info.Step()) {
+            insert_info.Bind(1, session_ids.at(info.GetInt64(0)));
+            insert_info.Bind(2, info.GetText(1));
+            insert_info.Bind(3, info.GetText(2));
+            insert_info.Run();
+            insert_info.Reset();
+          }
+        }
+
+        Statement trials(src, "SELECT id, session_id, trial_index, block, factors, left_shown, right_shown" +
+                                  TypedList("trials", typed) + (v8 ? ", cell" : ", NULL") + " FROM trials");
+        Statement insert_trial(dst, "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, "
+                                    "right_shown" + TypedList("trials", typed) + ", cell) VALUES (?, ?, ?, ?, ?, ?" +
+                                    TypedPlaceholders("trials", typed) + ", ?)");
+        const int cell = 7 + int(TypedColumnsOf("trials").size()) * typed;
+        while (trials.Step()) {
+          insert_trial.Bind(1, session_ids.at(trials.GetInt64(1)));
+          insert_trial.Bind(2, trials.GetInt64(2));
+          insert_trial.Bind(3, trials.GetInt64(3));
+          for (int column = 4; column <= 6; ++column) insert_trial.Bind(column, trials.GetText(column));
+          CopyTyped("trials", typed, trials, 7, insert_trial, 7);
+          if (trials.IsNull(cell)) insert_trial.BindNull(cell);
+          else insert_trial.Bind(cell, trials.GetText(cell));
+          insert_trial.Run();
+          insert_trial.Reset();
+          trial_ids[trials.GetInt64(0)] = dst.LastInsertRowId();
+        }
+
+        Statement responses(src, "SELECT trial_id, choice, rt_ms, adjustment, answered_at, " +
+                                     std::string(SchemaVersion(src) >= 5 ? "shown" : "'{}'") +
+                                     TypedList("responses", typed) + " FROM responses");
+        Statement insert_response(dst, "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at, "
+                                       "shown" + TypedList("responses", typed) + ") VALUES (?, ?, ?, ?, ?, ?" +
+                                       TypedPlaceholders("responses", typed) + ")");
+        while (responses.Step()) {
+          insert_response.Bind(1, trial_ids.at(responses.GetInt64(0)));
+          insert_response.Bind(2, responses.GetText(1));
+          if (responses.IsNull(2)) insert_response.BindNull(3);
+          else insert_response.Bind(3, responses.GetDouble(2));
+          insert_response.Bind(4, responses.GetText(3));
+          insert_response.Bind(5, responses.GetText(4));
+          insert_response.Bind(6, responses.GetText(5));
+          CopyTyped("responses", typed, responses, 6, insert_response, 7);
+          insert_response.Run();
+          insert_response.Reset();
+        }
+
+        Statement frames(src, "SELECT trial_id, frame_index, flip_time_s, dropped, " +
+                                  std::string(SchemaVersion(src) >= 4 ? "r_left_px, r_right_px, y_mm"
+                                                                      : "NULL, NULL, NULL") + " FROM frames");
+        Statement insert_frame(dst, "INSERT INTO frames (trial_id, frame_index, flip_time_s, dropped, r_left_px, "
+                                    "r_right_px, y_mm) VALUES (?, ?, ?, ?, ?, ?, ?)");
+        while (frames.Step()) {
+          insert_frame.Bind(1, trial_ids.at(frames.GetInt64(0)));
+          insert_frame.Bind(2, frames.GetInt64(1));
+          insert_frame.Bind(3, frames.GetDouble(2));
+          insert_frame.Bind(4, frames.GetInt64(3));
+          for (int column = 4; column <= 6; ++column) {
+            if (frames.IsNull(column)) insert_frame.BindNull(column + 1);
+            else insert_frame.Bind(column + 1, frames.GetDouble(column));
+          }
+          insert_frame.Run();
+          insert_frame.Reset();
+        }
+        src.Exec("COMMIT");
+      }
+      // Inputs from before the typed record: their typed columns from their texts, as a migration would.
+      DeriveTypedColumns(dst);
+      // A participant's sessions from several stations are numbered again by start, all together: two inputs' first
+      // sessions cannot both be number 1. Each number that differs from its input's is told.
+      DeriveVersionsAndNumbers(dst);
+      NumberSessions(dst, true);
+      Statement number(dst, "SELECT s.session_number, st.name, p.code FROM sessions s JOIN participants p ON "
+                            "p.id = s.participant_id JOIN studies st ON st.id = p.study_id WHERE s.id = ?");
+      for (const auto& [id, was] : numbered) {
+        number.Bind(1, id);
+        number.Step();
+        if (number.GetInt64(0) != was.number)
+          renumbered.push_back(was.input + ": session " + std::to_string(was.session) + " (study " + number.GetText(1) +
+                               ", participant " + number.GetText(2) + ") is session number " +
+                               std::to_string(was.number) + " there and " + std::to_string(number.GetInt64(0)) +
+                               " in the merged record (numbered by start)");
+        number.Reset();
+      }
+      // Stations that each ran another text under one version (or records made before versions were kept apart)
+      // are merged as they are; the tables cannot tell those sessions' designs apart by version, so say so.
+      Statement shared(dst, "SELECT st.name, pv.version, count(*) FROM protocol_versions pv JOIN studies st ON "
+                            "st.id = pv.study_id GROUP BY pv.study_id, pv.version HAVING count(*) > 1 "
+                            "ORDER BY st.name, pv.version");
+      while (shared.Step())
+        renumbered.push_back("study " + shared.GetText(0) + ": protocol version " + std::to_string(shared.GetInt64(1)) +
+                             " has " + std::to_string(shared.GetInt64(2)) + " different texts in the merged record "
+                             "(protocol_hash tells their sessions apart)");
+      transaction.Commit();
+    }  // the last connection closes: the WAL is checkpointed into the file and removed
+    MoveIntoPlace(temp, out);
+    if (note) {
+      for (const auto& line : unfinished) note(line);
+      for (const auto& line : renumbered) note(line);
+    }
+  } catch (...) {
+    RemoveDatabaseFiles(temp);
+    throw;
+  }
+}
+
+}  // namespace blurcue::store

@@ -1,0 +1,265 @@
+// Sessions numbered per participant, seeds of their own, protocol versions kept apart and the design recorded
+// (schema 8): the record's side, on :memory: and on real files.
+#include <chrono>
+#include <functional>
+#include <thread>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "store/export.h"
+#include "store/record.h"
+#include "store/schema.h"
+#include "store/test_util.h"
+
+namespace blurcue::store {
+namespace {
+
+std::string ErrorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+const char* kV1 = R"({"name":"s","timing":{"stimulus_ms":1500},"version":1})";
+
+SessionMeta Version(int64_t version) {
+  SessionMeta meta;
+  meta.protocol_version = version;
+  return meta;
+}
+
+// Starts, saves one trial and completes a session; returns its start.
+SessionStart Complete(Record& record, const std::string& participant, const std::string& protocol, uint64_t seed,
+                      const SessionMeta& meta = {}) {
+  const SessionStart start = record.StartOrResumeSession("s", participant, protocol, seed, meta, false);
+  TrialRecord trial;
+  record.SaveTrialList(start.session_id, {trial});
+  record.FinishSession(start.session_id, SessionStatus::kCompleted);
+  return start;
+}
+
+TEST(Record, AgainSessionGetsNextNumberAndANewSeed) {
+  Record record = Record::Open(":memory:");
+  EXPECT_EQ(Complete(record, "P1", kV1, 11).session_number, 1);
+  EXPECT_EQ(Complete(record, "P2", kV1, 21).session_number, 1);  // numbered per participant
+  const SessionStart second = Complete(record, "P1", kV1, 12);
+  EXPECT_EQ(second.session_number, 2);
+  EXPECT_EQ(record.database().QueryText("SELECT group_concat(session_number || ':' || seed, ',') FROM "
+                                        "(SELECT * FROM sessions ORDER BY id)"),
+            "1:11,1:21,2:12");
+}
+
+TEST(Record, ResumedSessionKeepsItsNumber) {
+  Record record = Record::Open(":memory:");
+  Complete(record, "P1", kV1, 11);
+  const SessionStart running = record.StartOrResumeSession("s", "P1", kV1, 12, {}, false);
+  const SessionStart resumed = record.StartOrResumeSession("s", "P1", kV1, 12, {}, true);
+  EXPECT_TRUE(resumed.resumed);
+  EXPECT_EQ(running.session_number, 2);
+  EXPECT_EQ(resumed.session_number, 2);
+}
+
+TEST(Record, GivenSeedOfAnEarlierSessionIsRefusedSayingWhyAndWhatToDo) {
+  Record record = Record::Open(":memory:");
+  Complete(record, "P1", kV1, 11);
+  SessionMeta given;
+  given.seed_given = true;
+  EXPECT_EQ(ErrorOf([&] { record.StartOrResumeSession("s", "P1", kV1, 11, given, false); }),
+            ":memory:: --seed 11 is the seed of participant P1 of study s's session number 1 (session 1): a session "
+            "with it repeats that session's trial order; leave out --seed (each session number gets a seed of its "
+            "own) or give another");
+  EXPECT_EQ(record.database().QueryInt64("SELECT count(*) FROM sessions"), 1);
+  // Another participant may have that seed: only a participant's own sessions are copies of each other.
+  EXPECT_EQ(record.StartOrResumeSession("s", "P2", kV1, 11, given, false).session_number, 1);
+}
+
+TEST(Record, SeedDerivedForAnotherSessionNumberIsRefused) {
+  Record record = Record::Open(":memory:");
+  Complete(record, "P1", kV1, 11);
+  SessionMeta meta;
+  meta.seed_for_number = 1;  // prepared before the first session was recorded
+  EXPECT_NE(ErrorOf([&] { record.StartOrResumeSession("s", "P1", kV1, 99, meta, false); })
+                .find("was prepared as session number 1 with its seed, but the record now gives it number 2"),
+            std::string::npos);
+  meta.seed_for_number = 2;
+  EXPECT_EQ(record.StartOrResumeSession("s", "P1", kV1, 99, meta, false).session_number, 2);
+}
+
+TEST(Record, PeekSaysTheNextSessionNumberAndTheRunningSessionsSeedWithoutWriting) {
+  testing::TempDir dir;
+  EXPECT_EQ(PeekSessions(dir / "none.sqlite", "s", "P1").next_number, 1);
+  {
+    Record record = Record::Open(dir / "r.sqlite");
+    Complete(record, "P1", kV1, 11);
+    record.StartOrResumeSession("s", "P1", kV1, 12, {}, false);
+  }
+  const SessionsSoFar p1 = PeekSessions(dir / "r.sqlite", "s", "P1");
+  EXPECT_EQ(p1.next_number, 3);
+  EXPECT_TRUE(p1.unfinished);
+  EXPECT_EQ(p1.unfinished_seed, 12u);
+  EXPECT_EQ(p1.unfinished_number, 2);
+  EXPECT_EQ(PeekSessions(dir / "r.sqlite", "s", "P2").next_number, 1);
+  EXPECT_FALSE(PeekSessions(dir / "r.sqlite", "other", "P1").unfinished);
+}
+
+TEST(Record, ChangedProtocolUnderTheSameVersionIsRefusedNamingTheFirstDifference) {
+  testing::TempDir dir;
+  Record record = Record::Open(dir / "r.sqlite");
+  Complete(record, "P1", kV1, 11, Version(1));
+  const std::string changed = R"({"name":"s","timing":{"stimulus_ms":300},"version":1})";
+  EXPECT_EQ(ErrorOf([&] { record.StartOrResumeSession("s", "P2", changed, 21, Version(1), false); }),
+            (dir / "r.sqlite").string() + ": study s records protocol version 1 with another text "
+            "(/timing/stimulus_ms: 1500 in the record, 300 now); raise \"version\" to 2 to record it as a new "
+            "version, or use another record (--db)");
+  EXPECT_EQ(record.database().QueryInt64("SELECT count(*) FROM protocol_versions"), 1);
+  EXPECT_EQ(record.database().QueryInt64("SELECT count(*) FROM participants"), 1);  // rolled back: P2 not added
+  // The same text reformatted is the same protocol: fine, as before.
+  EXPECT_EQ(record.StartOrResumeSession("s", "P2", R"({ "version": 1, "timing": {"stimulus_ms": 1500}, "name": "s" })",
+                                        21, Version(1), false).session_number, 1);
+}
+
+TEST(Record, RaisedVersionIsRecordedBesideTheFirstAndEachSessionSaysWhichItRan) {
+  Record record = Record::Open(":memory:");
+  Complete(record, "P1", kV1, 11, Version(1));
+  const std::string v2 = R"({"name":"s","timing":{"stimulus_ms":300},"version":2})";
+  Complete(record, "P2", v2, 21, Version(2));
+  Complete(record, "P1", kV1, 12, Version(1));  // version 1's own text still runs
+  EXPECT_EQ(record.database().QueryText("SELECT group_concat(version, ',') FROM (SELECT version FROM "
+                                        "protocol_versions ORDER BY id)"),
+            "1,2");
+  EXPECT_EQ(record.database().QueryText("SELECT group_concat(p.code || ':' || v.version, ',') FROM (SELECT * FROM "
+                                        "sessions ORDER BY id) s JOIN participants p ON p.id = s.participant_id "
+                                        "JOIN protocol_versions v ON v.id = s.protocol_version_id"),
+            "P1:1,P2:2,P1:1");
+}
+
+TEST(Record, LowerVersionWithAnotherTextIsRefused) {
+  Record record = Record::Open(":memory:");
+  Complete(record, "P1", R"({"name":"s","timing":{"stimulus_ms":300},"version":3})", 11, Version(3));
+  EXPECT_EQ(ErrorOf([&] { record.StartOrResumeSession("s", "P2", kV1, 21, Version(1), false); }),
+            ":memory:: study s records protocol version 3, this protocol says version 1 with another text "
+            "(/timing/stimulus_ms: 300 in the record, 1500 now); raise \"version\" to 4 to record it as a new "
+            "version, or use another record (--db)");
+}
+
+TEST(Record, DesignIsRecordedOncePerProtocolVersionWithNumericLevelsInOrder) {
+  Record record = Record::Open(":memory:");
+  SessionMeta meta = Version(1);
+  DesignColumnRecord edge{"edge", "within", "integer", "", {2, 6, 10}, {}, {}, {}};
+  DesignColumnRecord group{"group", "group", "string", "", {}, {"a", "b"}, {}, {}};
+  DesignColumnRecord level{"level", "within", "number", "", {}, {}, 0.0, 1.5};
+  DesignColumnRecord age{"info_age", "label", "integer", "years", {}, {}, 18.0, {}};
+  meta.design = {edge, group, level, age};
+  Complete(record, "P1", kV1, 11, meta);
+  Complete(record, "P2", kV1, 21, meta);
+  EXPECT_EQ(record.database().QueryText("SELECT group_concat(name || ':' || role || ':' || type || ':' || unit || ':' "
+                                        "|| allowed, ',') FROM (SELECT * FROM design_columns ORDER BY position)"),
+            "edge:within:integer::2|6|10,group:group:string::a|b,level:within:number::0..1.5,"
+            "info_age:label:integer:years:>= 18");
+}
+
+TEST(Record, ProcedureTrialKeepsItsCellByLevels) {
+  Record record = Record::Open(":memory:");
+  const int64_t session = record.StartOrResumeSession("s", "P1", kV1, 11, {}, false).session_id;
+  TrialRecord cell, plain;
+  cell.cell = "edge=9";
+  plain.index = 1;
+  record.SaveTrialList(session, {cell, plain});
+  EXPECT_EQ(record.database().QueryText("SELECT group_concat(coalesce(cell, 'NULL'), ',') FROM (SELECT cell FROM "
+                                        "trials ORDER BY trial_index)"),
+            "edge=9,NULL");
+}
+
+// A record of version 7 knew no session numbers nor declared versions: the migration numbers each participant's
+// sessions by start and reads the version off each protocol text.
+TEST(Schema, VersionSevenRecordGetsSessionNumbersByStartAndVersionsFromItsTexts) {
+  testing::TempDir dir;
+  {
+    Database db(dir / "old.sqlite");
+    for (int i = 0; i < 7; ++i) {
+      const Migration& step = Migrations()[size_t(i)];
+      if (!step.sql.empty()) db.Exec(step.sql);
+      if (step.data) step.data(db);
+    }
+    db.Exec("PRAGMA user_version = 7");
+    db.Exec("INSERT INTO studies (name, created) VALUES ('s', 'now');"
+            "INSERT INTO protocol_versions (study_id, json, hash, created) VALUES (1, '{\"version\":3}', 'a', 'now'),"
+            "  (1, '{}', 'b', 'now');"
+            "INSERT INTO participants (study_id, code, created) VALUES (1, 'P1', 'now'), (1, 'P2', 'now');"
+            "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, host, display, "
+            "  started, status) VALUES (1, 1, 1, 'v', 'h', 'd', '2024-01-02T00:00:00.000Z', 'completed'),"
+            "  (2, 1, 2, 'v', 'h', 'd', '2024-01-01T00:00:00.000Z', 'completed'),"
+            "  (1, 2, 3, 'v', 'h', 'd', '2024-01-01T00:00:00.000Z', 'aborted');"
+            "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, right_shown) VALUES "
+            "  (1, 0, 0, '{\"odd_interval\": 2}', 'null', 'null'), (1, 1, 0, '{\"odd_interval\": 3}', 'null', 'null'),"
+            "  (1, 2, 0, '{\"odd_interval\": 3}', 'null', 'null'), (1, 3, 0, '{}', 'null', 'null');"
+            "INSERT INTO responses (trial_id, choice, adjustment, answered_at) VALUES (1, '2', '[]', 'now'), "
+            "  (2, '1', '[]', 'now'), (3, 'none', '[]', 'now'), (4, '2', '[]', 'now');");
+  }
+  Record record = Record::Open(dir / "old.sqlite");
+  EXPECT_EQ(record.database().QueryText("SELECT group_concat(session_number, ',') FROM (SELECT * FROM sessions "
+                                        "ORDER BY id)"),
+            "2,1,1");  // P1's session 3 started first
+  EXPECT_EQ(record.database().QueryText("SELECT group_concat(version, ',') FROM (SELECT * FROM protocol_versions "
+                                        "ORDER BY id)"),
+            "3,1");
+  EXPECT_EQ(record.StartOrResumeSession("s", "P1", R"({"version":4})", 4, Version(4), false).session_number, 3);
+  // An odd one out answered before the answer's correctness was recorded is scored once, here: 2 of 2 right, 1 of 3
+  // wrong; a timeout and a trial without an odd interval have no correct answer.
+  EXPECT_EQ(record.database().QueryText("SELECT group_concat(coalesce(correct, 'NULL'), ',') FROM (SELECT * FROM "
+                                        "responses ORDER BY id)"),
+            "1,0,NULL,NULL");
+}
+
+// Two stations each ran a participant's first session: merged, the participant's sessions are numbered by start.
+TEST(Merge, SessionNumbersFollowTheStartAcrossInputsAndChangesAreTold) {
+  testing::TempDir dir;
+  for (const char* name : {"a.sqlite", "b.sqlite"}) {
+    Record record = Record::Open(dir / name);
+    Complete(record, "P1", kV1, name[0] == 'a' ? 11 : 12);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));  // b starts later, by the clock's milliseconds
+  }
+  std::vector<std::string> notes;
+  MergeDatabases({dir / "b.sqlite", dir / "a.sqlite"}, dir / "m.sqlite",
+                 [&](const std::string& line) { notes.push_back(line); });
+  Record merged = Record::Open(dir / "m.sqlite");
+  // a's session started first (made first above), so it is session 1 although b was merged first.
+  EXPECT_EQ(merged.database().QueryText("SELECT group_concat(seed || ':' || session_number, ',') FROM (SELECT * FROM "
+                                        "sessions ORDER BY session_number)"),
+            "11:1,12:2");
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("b.sqlite: session 1 (study s, participant P1) is session number 1 there and 2 in the "
+                          "merged record"),
+            std::string::npos)
+      << notes[0];
+}
+
+}  // namespace
+}  // namespace blurcue::store
+
+namespace blurcue::store {
+namespace {
+
+TEST(Merge, AVersionRunWithTwoTextsAtTwoStationsIsMergedAndTold) {
+  testing::TempDir dir;
+  {
+    Record a = Record::Open(dir / "a.sqlite");
+    Complete(a, "P1", kV1, 11, Version(1));
+    Record b = Record::Open(dir / "b.sqlite");
+    Complete(b, "P2", R"({"name":"s","timing":{"stimulus_ms":300},"version":1})", 21, Version(1));
+  }
+  std::vector<std::string> notes;
+  MergeDatabases({dir / "a.sqlite", dir / "b.sqlite"}, dir / "m.sqlite",
+                 [&](const std::string& line) { notes.push_back(line); });
+  EXPECT_EQ(notes, (std::vector<std::string>{"study s: protocol version 1 has 2 different texts in the merged record "
+                                             "(protocol_hash tells their sessions apart)"}));
+}
+
+}  // namespace
+}  // namespace blurcue::store

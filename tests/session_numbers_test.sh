@@ -1,0 +1,100 @@
+#!/usr/bin/env bash
+# End-to-end tests of sessions numbered per participant and protocol versions kept apart (blurcue run, export):
+# usage: session_numbers_test.sh CASE BLURCUE DIR (DIR as for session_test.sh: protocols/ and the scene they show).
+set -euo pipefail
+CASE=$1 BC=$2 DIR=$3
+P=$DIR/protocols
+W=$DIR/session-numbers-$CASE
+rm -rf "$W" && mkdir -p "$W"
+source "$(dirname "$0")/lib.sh"
+# test1-static-grids as $2 with `python` assignments $3 applied (p: the protocol), its paths made absolute.
+variant() {
+  $PY - "$P/$1.json" "$2" "$3" <<'PYEOF'
+import json, sys
+p = json.load(open(sys.argv[1]))
+exec(sys.argv[3])
+json.dump(p, open(sys.argv[2], "w"), indent=2)
+PYEOF
+  sed -i "s|\"\.\./|\"$P/../|g" "$2"
+}
+
+case $CASE in
+again)
+  # --again twice: the participant's sessions 1, 2 and 3, each with a seed of its own (session 1 the default seed of
+  # before), so the second is no copy of the first; the numbers in run's summary and in trials.csv. A --seed an
+  # earlier session used is refused (exit 3), saying why and what to do.
+  $BC run "$P/test1-static-grids.json" --participant A1 --db "$W/s.sqlite" --observer sim > "$W/out1"
+  $BC run "$P/test1-static-grids.json" --participant A1 --db "$W/s.sqlite" --observer sim --again > "$W/out2"
+  $BC run "$P/test1-static-grids.json" --participant A1 --db "$W/s.sqlite" --observer sim --again > "$W/out3"
+  for n in 1 2 3; do
+    grep -q "participant A1, session $n, the participant's session $n, seed" "$W/out$n" \
+      || fail "summary $n: $(cat "$W/out$n")"
+  done
+  [ "$(sql "$W/s.sqlite" "SELECT count(DISTINCT seed) FROM sessions")" = 3 ] || fail "seeds: $(sql "$W/s.sqlite" "SELECT seed FROM sessions")"
+  orders=$(sql "$W/s.sqlite" "SELECT count(DISTINCT o) FROM (SELECT group_concat(json_extract(factors, '$.edge')) o
+           FROM (SELECT * FROM trials ORDER BY trial_index) GROUP BY session_id)")
+  [ "$orders" = 3 ] || fail "the sessions' trial orders: $orders distinct of 3"
+  $BC export --db "$W/s.sqlite" --out "$W/tables" > /dev/null
+  $PY - "$W/tables/trials.csv" "$W/s.sqlite" <<'PYEOF' || fail "session numbers in trials.csv"
+import csv, sqlite3, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+numbers = sorted({(r["session_id"], r["session_number"], r["protocol_version"], r["seed"]) for r in rows})
+assert [n[:3] for n in numbers] == [("1", "1", "1"), ("2", "2", "1"), ("3", "3", "1")], numbers
+assert len({n[3] for n in numbers}) == 3, numbers
+# Session 1 keeps the seed of before: FNV-1a 64 of "STUDY/PARTICIPANT".
+h = 0xcbf29ce484222325
+for b in b"test1-static-grids/A1":
+    h = ((h ^ b) * 0x100000001b3) % 2**64
+assert numbers[0][3] == "s%d" % h, (numbers[0], h)
+assert all(r["cell"] == "" for r in rows), "no procedure, no cell"
+PYEOF
+  seed=$($PY -c "print($(sql "$W/s.sqlite" "SELECT seed FROM sessions WHERE session_number = 2") % 2**64)")
+  set +e
+  $BC run "$P/test1-static-grids.json" --participant A1 --db "$W/s.sqlite" --observer sim --again --seed "$seed" \
+    > /dev/null 2> "$W/err"
+  code=$?
+  set -e
+  [ $code = 3 ] || fail "a used seed: exit $code"
+  [ "$(wc -l < "$W/err")" = 1 ] || fail "one line: $(cat "$W/err")"
+  grep -q -- "--seed $seed is the seed of participant A1 of study test1-static-grids's session number 2 (session 2): a session with it repeats that session's trial order; leave out --seed" "$W/err" \
+    || fail "message: $(cat "$W/err")"
+  [ "$(sql "$W/s.sqlite" "SELECT count(*) FROM sessions")" = 3 ] || fail "a refused session was recorded"
+  echo "ok: --again twice gave sessions 1, 2, 3 with three seeds and three orders, in run's summary and trials.csv; a used --seed refused" ;;
+protocol_version)
+  # A protocol changed under the same study name and version is refused (exit 3, one line naming the study, the
+  # version, the first pointer that differs with both values, and the way out); raised, it is recorded beside the
+  # first and every row of trials.csv says which version its session ran; a lower version with another text is refused.
+  variant test1-static-grids "$W/v1.json" 'pass'
+  variant test1-static-grids "$W/changed.json" 'p["timing"]["inter_trial_ms"] = 300'
+  variant test1-static-grids "$W/v2.json" 'p["timing"]["inter_trial_ms"] = 300; p["version"] = 2'
+  $BC run "$W/v1.json" --participant V1 --db "$W/s.sqlite" --observer sim > /dev/null
+  set +e
+  $BC run "$W/changed.json" --participant V2 --db "$W/s.sqlite" --observer sim > /dev/null 2> "$W/err"
+  code=$?
+  set -e
+  [ $code = 3 ] || fail "changed protocol, same version: exit $code"
+  [ "$(cat "$W/err")" = "blurcue: $W/s.sqlite: study test1-static-grids records protocol version 1 with another text (/timing/inter_trial_ms: 500 in the record, 300 now); raise \"version\" to 2 to record it as a new version, or use another record (--db)" ] \
+    || fail "message: $(cat "$W/err")"
+  [ "$(sql "$W/s.sqlite" "SELECT count(*) FROM sessions")" = 1 ] || fail "a refused session was recorded"
+  $BC run "$W/v2.json" --participant V2 --db "$W/s.sqlite" --observer sim > /dev/null
+  $BC run "$W/v1.json" --participant V3 --db "$W/s.sqlite" --observer sim > /dev/null  # version 1's own text
+  variant test1-static-grids "$W/v1b.json" 'p["timing"]["inter_trial_ms"] = 700'
+  set +e
+  $BC run "$W/v1b.json" --participant V4 --db "$W/s.sqlite" --observer sim > /dev/null 2> "$W/err"
+  code=$?
+  set -e
+  [ $code = 3 ] && grep -q "records protocol version 2, this protocol says version 1 with another text (/timing/inter_trial_ms: 300 in the record, 700 now); raise \"version\" to 3" "$W/err" \
+    || fail "lower version: exit $code, $(cat "$W/err")"
+  $BC export --db "$W/s.sqlite" --out "$W/tables" > /dev/null
+  $PY - "$W/tables/trials.csv" "$W/tables/codebook.csv" <<'PYEOF' || fail "versions in trials.csv"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+got = sorted({(r["participant"], r["protocol_version"]) for r in rows})
+assert got == [("V1", "1"), ("V2", "2"), ("V3", "1")], got
+book = {r["column"]: r for r in csv.DictReader(open(sys.argv[2])) if r["table"] == "trials.csv"}
+assert book["edge"]["role"] == "within" and book["edge"]["allowed"] == "1|2|3|4|5|6|7|8|9|10|11", book["edge"]
+assert book["practice"]["role"] == "practice", book["practice"]
+PYEOF
+  echo "ok: a changed protocol under version 1 refused naming /timing/inter_trial_ms; version 2 recorded beside it; a lower version refused; trials.csv says each session's version" ;;
+*) fail "unknown case $CASE" ;;
+esac
