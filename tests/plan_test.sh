@@ -301,5 +301,33 @@ assert float(declared[0]["difference"]) == 0.5 and not [r for r in rows if r["te
 assert float(declared[-1]["power"]) > float(own[-1]["power"]), (declared[-1]["power"], own[-1]["power"])
 PYEOF
   echo "ok: groups are compared (per group and Welch between them), not pooled; a procedure's thresholds too" ;;
+difference_meaningless)
+  # A declared difference is planned only where it means something: from a known true threshold to a second one the
+  # procedure can measure. --difference 1e308 (a 300-digit difference was printed), -200 % (a negative threshold), an
+  # absolute difference on a staircase pinned at its bound and on a QUEST+ whose stimuli lie outside its threshold
+  # grid (their estimates barely scatter: "power 1.000 at N = 2") are each said in a note, with no power row.
+  variant "$P/quest-blur-difference.json" "$W/stimuli-low.json" 'p["blocks"][0]["procedure"]["stimuli"] = [0.01, 0.02, 0.03]'
+  variant "$P/staircase-ball-gain.json" "$W/pinned.json" 'p["blocks"][0]["procedure"].update(start=3, min=2.9)'
+  run_case() {  # name protocol difference expected-note
+    $BC plan "$2" --participants 3 --studies 4 --seed 1 --difference "$3" --no-chart --out "$W/$1" > "$W/$1.out" 2>&1 \
+      || fail "plan $1: $(tail -2 "$W/$1.out")"
+    grep -qF "$4" "$W/$1.out" || fail "$1: no note '$4': $(cat "$W/$1.out")"
+    ! grep -q "(declared\|second_cell_t  " "$W/$1.out" || fail "$1: a declared difference was planned: $(cat "$W/$1.out")"
+    ! cut -d, -f1,2 "$W/$1/plan.csv" | grep -q "second_cell_t\|declared" || fail "$1: plan.csv has a declared row"
+    ! grep -qi "nan\|inf\|e+" "$W/$1/plan.csv" || fail "$1: plan.csv: $(grep -i 'nan\|inf\|e+' "$W/$1/plan.csv" | head -2)"
+  }
+  run_case huge "$P/quest-blur-difference.json" 1e308 \
+    "+ 1e+308) would be above the tested range (0.25 to 6)"
+  grep -q "is not planned for edge=9: the second threshold (its true 1\.6[0-9]* + 1e+308)" "$W/huge.out" || fail "huge"
+  run_case negative "$P/quest-blur-difference.json" -200% "would be below the tested range (0.25 to 6)"
+  run_case stimuli "$W/stimuli-low.json" 0.1 \
+    "edge=9: its true threshold is not measured: QUEST+'s stimuli (0.01 to 0.03) lie outside its threshold grid (0.25 to 6)"
+  grep -q "edge=9 *difference_arcmin *- .* - " "$W/stimuli.out" || fail "stimuli: a truth or bias printed: $(cat "$W/stimuli.out")"
+  run_case pinned "$W/pinned.json" 0.1 "its true threshold is below the tested range (2.9 to 3)"
+  # Still planned where it means something: 0.5 arcmin from a truth of 1.6 is within 0.25 to 6.
+  $BC plan "$P/quest-blur-difference.json" --participants 3 --studies 4 --seed 1 --difference 0.5 --no-chart \
+    --out "$W/fine" > "$W/fine.out" 2>&1 || fail "plan fine"
+  grep -q "second_cell_t  edge=9 vs a second cell +0.5 difference_arcmin" "$W/fine.out" || fail "fine: $(cat "$W/fine.out")"
+  echo "ok: a declared difference that means nothing (beyond the range, from an unknown truth) is said in a note, not powered" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -1,7 +1,8 @@
 # blurcue plan end to end over the CLI tests' scene (fixtures scene, calib, session_protocols): tests/plan_test.sh.
 set(BC $<TARGET_FILE:blurcue>)
 set(T ${PROJECT_BINARY_DIR}/cli-test)
-foreach(case same_as_run power_exact same_seed chart prediction depth_slope threshold_truth difference_power groups)
+foreach(case same_as_run power_exact same_seed chart prediction depth_slope threshold_truth difference_power groups
+       difference_meaningless)
   add_test(NAME plan_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/plan_test.sh ${case} ${BC} ${T})
   set_tests_properties(plan_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures" LABELS "gl;plan"
                        PASS_REGULAR_EXPRESSION "^ok:|\nok:" TIMEOUT 600)

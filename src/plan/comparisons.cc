@@ -1,5 +1,6 @@
 #include "plan/comparisons.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -140,15 +141,31 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
       r.rows.push_back(row);
     }
   }
-  // The declared difference in the procedure's units for a cell (NaN when relative to a truth that is not known).
-  auto declared = [&](const Condition& c) {
-    if (!o.difference) return kNan;
-    if (!o.difference->relative) return o.difference->value;
-    return c.truth_determined ? o.difference->value * c.truth : kNan;
+  // The declared difference in the procedure's units for a cell; NaN, with a note saying why, where it means nothing:
+  // the cell's true threshold is not known (the procedure sits at a bound of its range, or shows nothing near it:
+  // its estimates barely scatter, so any shift had "power 1.000 at N = 2"), or the second threshold, truth + the
+  // difference, lies outside what the procedure measures (--difference 1e308, -200%: a negative threshold).
+  // `c` is the cell the difference is declared from, `second` the one shifted by it (the same cell for a second cell).
+  auto note = [&](const std::string& text) {
+    if (std::find(r.notes.begin(), r.notes.end(), text) == r.notes.end()) r.notes.push_back(text);
   };
-  auto no_truth_note = [&](const Condition& c) {
-    r.notes.push_back("--difference " + DifferenceText(*o.difference, c.units) + " is not planned for " + c.label +
-                      ": its true threshold is " + c.truth_why);
+  auto declared = [&](const Condition& c, const Condition& other) {
+    if (!o.difference) return kNan;
+    const std::string what = "--difference " + DifferenceText(*o.difference, c.units) + " is not planned for " + c.label;
+    if (!c.truth_determined) {
+      note(what + ": its true threshold is " + c.truth_why);
+      return kNan;
+    }
+    const double delta = o.difference->relative ? o.difference->value * c.truth : o.difference->value;
+    const double second = c.truth + delta;
+    if (!(second >= other.range_lo && second <= other.range_hi)) {
+      note(what + ": the second threshold (its true " + protocol::LevelText(c.truth) + " " + (delta >= 0 ? "+ " : "- ") +
+           protocol::LevelText(std::abs(delta)) + ") would be " + (second < other.range_lo ? "below" : "above") +
+           " the tested range (" + protocol::LevelText(other.range_lo) + " to " + protocol::LevelText(other.range_hi) +
+           ")");
+      return kNan;
+    }
+    return delta;
   };
   // Between two cells of the same participants: the paired t-test of per-participant thresholds the report would run.
   std::set<std::string> paired;
@@ -175,11 +192,8 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
       own.mean_estimate = overall[B.key].mean - overall[A.key].mean;
       AddPowerRows(r, o, own, [&](int s, int m) { return OneSampleTTestP(differences(s, m, 0, 0), 0); });
       if (!o.difference) continue;
-      const double delta = declared(A);
-      if (!std::isfinite(delta)) {
-        no_truth_note(A);
-        continue;
-      }
+      const double delta = declared(A, B);
+      if (!std::isfinite(delta)) continue;
       // The estimates' scatter as simulated, each cell centred on its own mean estimate, the second shifted by delta.
       PowerRow shifted = Row("paired_t", name + " (declared " + DifferenceText(*o.difference, A.units) + ")",
                              "threshold", 0);
@@ -222,11 +236,8 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
           return WelchTTestP(values(gb, r.groups[g2], s, m, 0), values(ga, r.groups[g1], s, m, 0));
         });
         if (!o.difference) continue;
-        const double delta = declared(*A);
-        if (!std::isfinite(delta)) {
-          no_truth_note(*A);
-          continue;
-        }
+        const double delta = declared(*A, *B);
+        if (!std::isfinite(delta)) continue;
         PowerRow shifted = Row("groups_t", name + " (declared " + DifferenceText(*o.difference, A->units) + ")",
                                "threshold", 0);
         shifted.difference = delta;
@@ -247,11 +258,8 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
   // simulated participant is the same observer with its own seed, so the two are independent draws).
   for (const Condition* c : cells) {
     if (paired.count(c->key)) continue;
-    const double delta = declared(*c);
-    if (!std::isfinite(delta)) {
-      no_truth_note(*c);
-      continue;
-    }
+    const double delta = declared(*c, *c);
+    if (!std::isfinite(delta)) continue;
     if (S < 2) {
       r.notes.push_back("--difference for " + c->label + " needs --studies 2 or more (a second cell's track comes "
                         "from the next study)");

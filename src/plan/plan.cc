@@ -138,6 +138,7 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
         with_truth.truth_determined = truth.determined;
         with_truth.truth = truth.level;
         with_truth.truth_why = truth.why;
+        with_truth.range_lo = truth.range_lo, with_truth.range_hi = truth.range_hi;
         conditions->emplace(c->key, with_truth);
       }
       Track& track = tracks.try_emplace(c->key, Track{protocol::BlockOf(protocol, trial)->procedure->kind, {}, {}})
