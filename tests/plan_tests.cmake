@@ -74,6 +74,15 @@ set_tests_properties(plan_difference_without_procedure PROPERTIES FIXTURES_REQUI
 add_plan_failure_test(plan_zero_difference 2 "--difference: must be a non-zero number"
                       plan ${T}/protocols/quest-blur-difference.json --difference 0% --no-chart --out ${T}/plan-bad)
 
+# bench plan times the adaptive protocol by its name beside --protocol's: the same study twice had its runs merged
+# into one median, a protocol without a procedure passed as the adaptive one; both are usage errors now.
+add_plan_failure_test(bench_plan_adaptive_is_protocol 2
+                      "--adaptive-protocol ${P1}: the same study as --protocol (test1-static-grids); 'none' times --protocol alone"
+                      bench plan --quick --participants 2 --protocol ${P1} --adaptive-protocol ${P1} --out ${T}/bench-plan-bad.csv)
+add_plan_failure_test(bench_plan_adaptive_without_procedure 2
+                      "--adaptive-protocol ${T}/protocols/groups-and-info.json: no block has a procedure (staircase or QUEST+), got study groups-and-info"
+                      bench plan --quick --participants 2 --protocol ${P1} --adaptive-protocol ${T}/protocols/groups-and-info.json --out ${T}/bench-plan-bad.csv)
+
 # Every group checked: validate, validate --plan and preview cover each group of a protocol with groups (groups-and-info:
 # 6 edges x 2 swapped copies = 12 trials in each group's own block), or only --group's; an unknown group is a usage
 # error with the nearest name.
