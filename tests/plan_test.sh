@@ -329,5 +329,33 @@ difference_meaningless)
     --out "$W/fine" > "$W/fine.out" 2>&1 || fail "plan fine"
   grep -q "second_cell_t  edge=9 vs a second cell +0.5 difference_arcmin" "$W/fine.out" || fail "fine: $(cat "$W/fine.out")"
   echo "ok: a declared difference that means nothing (beyond the range, from an unknown truth) is said in a note, not powered" ;;
+units_and_groups)
+  # Only what can be compared is: two QUEST+ cells with thresholds in different units (arcmin, a relative
+  # difference) had a paired t-test of arcmin minus fraction ("-1.035, power 1.000 at N = 4"), and a group running no
+  # pair block had a t-test and a Welch test with no values ("power 0.000"). Now a note says each, and no such row.
+  variant "$P/quest-blur-difference.json" "$W/units.json" '
+import copy
+c = copy.deepcopy(p["blocks"][0])
+c["name"] = "quest-rel"
+c["procedure"].update(variable="relative_difference", stimuli=[0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1, 1.5, 2],
+                      threshold=[0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1, 1.5])
+p["blocks"].append(c)'
+  variant "$P/quest-blur-difference.json" "$W/half.json" '
+p["groups"] = {"names": ["a", "b"], "assign": "balanced"}
+p["blocks"][0]["groups"] = ["a"]
+p["blocks"].append({"name": "pairs", "groups": ["b"], "factors": {"edge": [1, 9]},
+                    "sides": {"left": "measured", "right": "estimated"}})'
+  for v in units half; do
+    $BC plan "$W/$v.json" --participants 6 --studies 10 --seed 1 --no-chart --out "$W/$v" > "$W/$v.out" 2>&1 \
+      || fail "plan $v: $(tail -2 "$W/$v.out")"
+  done
+  grep -q "note: quest-rel: edge=9 and quest: edge=9 are not compared: their thresholds are in different units (relative_difference, difference_arcmin)" \
+    "$W/units.out" || fail "units: $(cat "$W/units.out")"
+  ! cut -d, -f1 "$W/units/plan.csv" | grep -q paired_t || fail "units: a paired_t row across units"
+  grep -q "note: first_source is not compared between groups: group a runs no block that gives it" "$W/half.out" \
+    || fail "half: $(cat "$W/half.out")"
+  ! grep -q "group=a\|group b - a" "$W/half/plan.csv" || fail "half: a row for group a's missing pairs"
+  grep -q "^participants_t,group=b," "$W/half/plan.csv" || fail "half: no row for group b"
+  echo "ok: thresholds in different units and a group without the measure are not compared (a note says so)" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -172,6 +172,13 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
   for (size_t a = 0; a < cells.size(); ++a)
     for (size_t b = a + 1; b < cells.size(); ++b) {
       const Condition &A = *cells[a], &B = *cells[b];
+      // Thresholds in different units (a difference in arcmin, a relative one) have no difference to test: their
+      // paired t-test subtracted a fraction from arcmin ("-1.035, power 1.000 at N = 4").
+      if (A.units != B.units) {
+        r.notes.push_back(B.label + " and " + A.label + " are not compared: their thresholds are in different units (" +
+                          B.units + ", " + A.units + ")");
+        continue;
+      }
       const Grid &ga = est[A.key], &gb = est[B.key];
       bool both = false;
       for (int s = 0; s < S && !both; ++s)
@@ -217,7 +224,7 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
                 if (p.group == r.groups[g1] && !A) A = c;
                 if (p.group == r.groups[g2] && !B) B = c;
               }
-        if (!A || !B) continue;
+        if (!A || !B || A->units != B->units) continue;
         compared_groups = true;
         const Grid &ga = est[A->key], &gb = est[B->key];
         auto values = [&](const Grid& g, const std::string& group, int s, int m, double shift) {
@@ -312,7 +319,23 @@ void AddGroupShareRows(PlanResult& r, const PlanOptions& o) {
       }
       return MomentsOf(all).mean;
     };
+    // Only the groups whose blocks give this measure: a group that runs none of it had a t-test and a Welch test with
+    // no values, printed as "power 0.000".
+    std::vector<std::string> groups;
     for (const std::string& group : r.groups) {
+      bool any = false;
+      for (int s = 0; s < S && !any; ++s) any = !values(group, s, o.participants).empty();
+      if (any) groups.push_back(group);
+    }
+    if (groups.size() < r.groups.size() && !groups.empty()) {
+      std::string without;
+      for (const std::string& group : r.groups)
+        if (std::find(groups.begin(), groups.end(), group) == groups.end()) without += (without.empty() ? "" : ", ") + group;
+      r.notes.push_back(measure + " is not compared between groups: group" +
+                        (r.groups.size() - groups.size() > 1 ? "s " : " ") + without + " run" +
+                        (r.groups.size() - groups.size() > 1 ? "" : "s") + " no block that gives it");
+    }
+    for (const std::string& group : groups) {
       PowerRow row = Row("participants_t", "group=" + group, measure, 0);
       row.chance = chance;
       row.expected_share = mean_of(group);
@@ -321,13 +344,13 @@ void AddGroupShareRows(PlanResult& r, const PlanOptions& o) {
         return v.size() >= 2 ? OneSampleTTestP(v, chance) : kNan;
       });
     }
-    for (size_t g1 = 0; g1 < r.groups.size(); ++g1)
-      for (size_t g2 = g1 + 1; g2 < r.groups.size(); ++g2) {
-        PowerRow row = Row("groups_t", "group " + r.groups[g2] + " - " + r.groups[g1], measure, 0);
+    for (size_t g1 = 0; g1 < groups.size(); ++g1)
+      for (size_t g2 = g1 + 1; g2 < groups.size(); ++g2) {
+        PowerRow row = Row("groups_t", "group " + groups[g2] + " - " + groups[g1], measure, 0);
         row.chance = chance;
-        row.expected_share = mean_of(r.groups[g2]) - mean_of(r.groups[g1]);
+        row.expected_share = mean_of(groups[g2]) - mean_of(groups[g1]);
         AddPowerRows(r, o, row, [&](int s, int m) {
-          return WelchTTestP(values(r.groups[g2], s, m), values(r.groups[g1], s, m));
+          return WelchTTestP(values(groups[g2], s, m), values(groups[g1], s, m));
         });
       }
   }
