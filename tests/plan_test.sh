@@ -357,5 +357,35 @@ p["blocks"].append({"name": "pairs", "groups": ["b"], "factors": {"edge": [1, 9]
   ! grep -q "group=a\|group b - a" "$W/half/plan.csv" || fail "half: a row for group a's missing pairs"
   grep -q "^participants_t,group=b," "$W/half/plan.csv" || fail "half: no row for group b"
   echo "ok: thresholds in different units and a group without the measure are not compared (a note says so)" ;;
+groups_shared_block)
+  # A block that both groups run is planned per group, not pooled: its conditions (a pair's binomial per edge, a
+  # QUEST+ cell's threshold) were one row mixing both groups' participants. Now each is "group=NAME: ...", the
+  # groups' thresholds compared by Welch under the cell's own name, and the rows the same with 1 and 2 threads.
+  variant "$P/groups-and-info.json" "$W/shared.json" 'p["blocks"] = [{"name": "shared", "sides": {"left": "measured", "right": "estimated"}}]'
+  variant "$P/quest-blur-difference.json" "$W/quest-shared.json" 'p["groups"] = {"names": ["a", "b"], "assign": "balanced"}'
+  for v in shared quest-shared; do
+    for t in 1 2; do
+      $BC plan "$W/$v.json" --participants 6 --studies 10 --seed 2 --threads $t --difference 0.5 --no-chart \
+        --out "$W/$v-$t" > "$W/$v-$t.out" 2>&1 || fail "plan $v: $(tail -2 "$W/$v-$t.out")"
+    done
+    cmp -s "$W/$v-1/plan.csv" "$W/$v-2/plan.csv" || fail "$v: plan.csv differs between 1 and 2 threads"
+  done
+  $PY - "$W/shared-1/plan.csv" "$W/quest-shared-1/plan.csv" <<'PYEOF' || fail "shared block rows"
+import csv, sys
+pairs = list(csv.DictReader(open(sys.argv[1])))
+binomial = sorted({r["condition"] for r in pairs if r["test"] == "binomial"})
+assert binomial and all(c.startswith(("group=estimated: edge=", "group=no_blur: edge=")) for c in binomial), binomial
+assert len(binomial) == 12, binomial
+quest = list(csv.DictReader(open(sys.argv[2])))
+cells = {r["condition"] for r in quest if r["test"] == "threshold"}
+assert cells == {"group=a: edge=9", "group=b: edge=9"}, cells
+welch = {r["condition"] for r in quest if r["test"] == "groups_t"}
+assert welch == {"group b - a: edge=9 (the model's own)", "group b - a: edge=9 (declared +0.5 difference_arcmin)"}, welch
+# Each group's interval width at N = 6 comes from its own 3 participants, never from all 6.
+for r in quest:
+    if r["test"] == "threshold" and r["participants"] == "6":
+        assert float(r["mean_trials"]) == 3, r
+PYEOF
+  echo "ok: a block both groups run is planned per group (shares and thresholds), compared by Welch, not pooled" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -234,8 +234,13 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
               v.push_back(g[size_t(s)][size_t(i)] - shift);
           return v;
         };
-        const std::string name = "group " + r.groups[g2] + " - " + r.groups[g1] + ": " +
-                                 (A->label == B->label ? A->label : B->label + " - " + A->label);
+        // A block both groups run is planned per group ("group=a: edge=9"): the comparison names its cell once.
+        auto cell = [](const Condition& c, const std::string& group) {
+          const std::string prefix = "group=" + group + ": ";
+          return c.label.rfind(prefix, 0) == 0 ? c.label.substr(prefix.size()) : c.label;
+        };
+        const std::string la = cell(*A, r.groups[g1]), lb = cell(*B, r.groups[g2]);
+        const std::string name = "group " + r.groups[g2] + " - " + r.groups[g1] + ": " + (la == lb ? la : lb + " - " + la);
         PowerRow own = Row("groups_t", name + " (the model's own)", "threshold", 0);
         own.difference = A->truth_determined && B->truth_determined ? B->truth - A->truth : kNan;
         own.mean_estimate = overall[B->key].mean - overall[A->key].mean;
