@@ -65,6 +65,13 @@ add_test(NAME plan_leading_zero_is_decimal
          COMMAND ${BC} plan ${P1} --participants 010 --studies 1 --seed s5 --no-chart --out ${T}/plan-leading-zero)
 set_tests_properties(plan_leading_zero_is_decimal PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
                      LABELS plan PASS_REGULAR_EXPRESSION "1 simulated studies of 10 participants \\(seed 5\\)")
+# The exact binomial test's p of every k of every n up to the trials of 10000 participants: one O(n) sum per k made it
+# O(n^3) (3 minutes after a 4 s simulation at 3000 x 20; past 60 s, unfinished, at --participants 10000). Now
+# O(n log n) per n: seconds.
+add_test(NAME plan_many_participants_in_seconds
+         COMMAND ${BC} plan ${P1} --participants 10000 --studies 1 --no-chart --out ${T}/plan-many)
+set_tests_properties(plan_many_participants_in_seconds PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
+                     LABELS plan TIMEOUT 90 PASS_REGULAR_EXPRESSION "1 simulated studies of 10000 participants")
 add_plan_failure_test(plan_bad_difference 2 "--difference: must be a non-zero number in the procedure's units (0.5) or a percentage of the true threshold (20%), got 'abc'"
                       plan ${T}/protocols/quest-blur-difference.json --difference abc --no-chart --out ${T}/plan-bad)
 add_test(NAME plan_difference_without_procedure

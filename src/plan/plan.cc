@@ -361,10 +361,7 @@ PlanResult RunPlan(const PlanOptions& options) {
   std::map<std::pair<int, double>, std::vector<double>> p_cache;
   auto p_of = [&](int k, int n, double chance) {
     auto& v = p_cache[{n, chance}];
-    if (v.empty()) {
-      v.resize(size_t(n) + 1);
-      for (int j = 0; j <= n; ++j) v[size_t(j)] = BinomialTestP(j, n, chance);
-    }
+    if (v.empty()) v = BinomialTestPAll(n, chance);
     return v[size_t(k)];
   };
   for (const Condition& c : r.conditions) {
