@@ -111,6 +111,11 @@ add_plan_failure_test(validate_unknown_group 2
                       validate ${G} --group no_blr)
 add_plan_failure_test(validate_group_without_groups 2 "--group estimated: ${P1} has no groups"
                       validate ${P1} --group estimated)
+# --group as typed is echoed as every value is: a long one cut at 60 characters with its length, one with a space at either end quoted.
+string(REPEAT x 5000 LONG_GROUP)
+add_plan_failure_test(validate_group_long 2 "--group xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx... (5000 characters): ${G} has no such group"
+                      validate ${G} --group ${LONG_GROUP})
+add_plan_failure_test(validate_group_blank 2 "--group ' no_blur': ${G} has no such group (did you mean no_blur?" validate ${G} --group " no_blur")
 add_test(NAME preview_every_group COMMAND ${BC} preview ${G} --list --out ${T}/preview-groups.png)
 set_tests_properties(preview_every_group PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS "gl;plan"
   PASS_REGULAR_EXPRESSION "#1 group estimated: edge 1: .*#13 group no_blur: edge 1: .*24 distinct stimuli of 24 trials \\(groups estimated, no_blur\\)")
