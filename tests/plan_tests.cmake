@@ -74,6 +74,10 @@ set_tests_properties(plan_many_participants_in_seconds PROPERTIES FIXTURES_REQUI
                      LABELS plan TIMEOUT 90 PASS_REGULAR_EXPRESSION "1 simulated studies of 10000 participants")
 add_plan_failure_test(plan_bad_difference 2 "--difference: must be a non-zero number in the procedure's units (0.5) or a percentage of the true threshold (20%), got 'abc'"
                       plan ${T}/protocols/quest-blur-difference.json --difference abc --no-chart --out ${T}/plan-bad)
+# A long --difference is quoted as every typed value is: its first 60 characters and its length (it was echoed whole).
+string(REPEAT x 200 LONG_DIFFERENCE)
+add_plan_failure_test(plan_bad_difference_long 2 "got 'xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx...' (200 characters)"
+                      plan ${T}/protocols/quest-blur-difference.json --difference ${LONG_DIFFERENCE} --no-chart --out ${T}/plan-bad)
 add_test(NAME plan_difference_without_procedure
          COMMAND ${BC} plan ${P1} --participants 2 --studies 1 --difference 0.5 --no-chart --out ${T}/plan-no-procedure)
 set_tests_properties(plan_difference_without_procedure PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"

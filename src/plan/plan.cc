@@ -489,7 +489,7 @@ Difference ParseDifference(const std::string& text) {
   const std::optional<double> value = ParseDecimal(number);
   if (!value || !std::isfinite(*value) || *value == 0)
     throw Error(ErrorKind::kUsage, "--difference: must be a non-zero number in the procedure's units (0.5) or a "
-                                   "percentage of the true threshold (20%), got '" + text + "'");
+                                   "percentage of the true threshold (20%), got " + Echo(text));
   d.value = d.relative ? *value / 100 : *value;
   return d;
 }
