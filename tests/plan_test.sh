@@ -324,6 +324,13 @@ difference_meaningless)
     "edge=9: its true threshold is not measured: QUEST+'s stimuli (0.01 to 0.03) lie outside its threshold grid (0.25 to 6)"
   grep -q "edge=9 *difference_arcmin *- .* - " "$W/stimuli.out" || fail "stimuli: a truth or bias printed: $(cat "$W/stimuli.out")"
   run_case pinned "$W/pinned.json" 0.1 "its true threshold is below the tested range (2.9 to 3)"
+  # An observer with 90 % lapses drives QUEST+ to the top of its grid (about 5.95 of 6): +0.5 shifts its estimates
+  # past what QUEST+ can report (it had "power 1.000 at N = 3").
+  variant "$P/quest-blur-difference.json" "$W/lapses.json" 'p["name"] = "quest-lapses"'
+  printf '#!/bin/sh\nexec %s "$@" --observer sim:lapse=0.9\n' "$BC" > "$W/bc-lapses" && chmod +x "$W/bc-lapses"
+  BC_SAVED=$BC BC=$W/bc-lapses
+  run_case lapses "$W/lapses.json" 0.5 "shifted by it would be above the tested range (0.25 to 6), which the procedure cannot report"
+  BC=$BC_SAVED
   # Still planned where it means something: 0.5 arcmin from a truth of 1.6 is within 0.25 to 6.
   $BC plan "$P/quest-blur-difference.json" --participants 3 --studies 4 --seed 1 --difference 0.5 --no-chart \
     --out "$W/fine" > "$W/fine.out" 2>&1 || fail "plan fine"

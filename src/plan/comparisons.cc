@@ -165,6 +165,16 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
            ")");
       return kNan;
     }
+    // The declared difference is planned by shifting the estimates as simulated: shifted past the range, they are
+    // estimates the procedure can never report (an observer with 90 % lapses drives QUEST+ to its grid's top, 5.95
+    // of 6, sd 0.05: "+0.5 arcmin, power 1.000 at N = 3").
+    const double shifted = overall[c.key].mean + delta;
+    if (!(shifted >= other.range_lo && shifted <= other.range_hi)) {
+      note(what + ": its estimates (mean " + protocol::LevelText(overall[c.key].mean) + ") shifted by it would be " +
+           (shifted < other.range_lo ? "below" : "above") + " the tested range (" + protocol::LevelText(other.range_lo) +
+           " to " + protocol::LevelText(other.range_hi) + "), which the procedure cannot report");
+      return kNan;
+    }
     return delta;
   };
   // Between two cells of the same participants: the paired t-test of per-participant thresholds the report would run.
