@@ -18,6 +18,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
 import pandas as pd  # noqa: E402
 
 import common  # noqa: E402
@@ -78,12 +79,13 @@ def power_panel(ax, plan, target):
             ax.plot([n], [g[g["participants"] == n]["power"].iloc[0]], "o", color=colors[i % len(colors)], ms=5)
     ax.axhline(target, color="#555555", ls="--", lw=1)
     ax.set_xlabel("participants (N)")
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_ylabel("power\n(share of simulated studies with p < alpha)")
     ax.set_ylim(-0.02, 1.02)
     if ax.get_legend_handles_labels()[0]:
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7.5, handlelength=1.5)
     else:
-        ax.text(0.5, 0.5, "no test to plan here\n(for a procedure: give --difference)", ha="center", va="center",
+        ax.text(0.5, 0.5, "no test to plan here\n(for a procedure: give --difference;\nthe plan's notes say why one is not planned)", ha="center", va="center",
                 transform=ax.transAxes, fontsize=9, color="#555555")
 
 
@@ -104,6 +106,7 @@ def threshold_panel(ax, cells):
         g = g.sort_values("participants")
         ax.plot(g["participants"], g["interval_width"], lw=2, label=threshold_label(g))
     ax.set_xlabel("participants (N)")
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_ylabel("95 % interval width of the mean threshold\n(the procedure's units)")
     ax.set_ylim(bottom=0)
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7.5, handlelength=1.5)

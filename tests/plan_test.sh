@@ -301,5 +301,98 @@ assert float(declared[0]["difference"]) == 0.5 and not [r for r in rows if r["te
 assert float(declared[-1]["power"]) > float(own[-1]["power"]), (declared[-1]["power"], own[-1]["power"])
 PYEOF
   echo "ok: groups are compared (per group and Welch between them), not pooled; a procedure's thresholds too" ;;
+difference_meaningless)
+  # A declared difference is planned only where it means something: from a known true threshold to a second one the
+  # procedure can measure. --difference 1e308 (a 300-digit difference was printed), -200 % (a negative threshold), an
+  # absolute difference on a staircase pinned at its bound and on a QUEST+ whose stimuli lie outside its threshold
+  # grid (their estimates barely scatter: "power 1.000 at N = 2") are each said in a note, with no power row.
+  variant "$P/quest-blur-difference.json" "$W/stimuli-low.json" 'p["blocks"][0]["procedure"]["stimuli"] = [0.01, 0.02, 0.03]'
+  variant "$P/staircase-ball-gain.json" "$W/pinned.json" 'p["blocks"][0]["procedure"].update(start=3, min=2.9)'
+  run_case() {  # name protocol difference expected-note
+    $BC plan "$2" --participants 3 --studies 4 --seed 1 --difference "$3" --no-chart --out "$W/$1" > "$W/$1.out" 2>&1 \
+      || fail "plan $1: $(tail -2 "$W/$1.out")"
+    grep -qF "$4" "$W/$1.out" || fail "$1: no note '$4': $(cat "$W/$1.out")"
+    ! grep -q "(declared\|second_cell_t  " "$W/$1.out" || fail "$1: a declared difference was planned: $(cat "$W/$1.out")"
+    ! cut -d, -f1,2 "$W/$1/plan.csv" | grep -q "second_cell_t\|declared" || fail "$1: plan.csv has a declared row"
+    ! grep -qi "nan\|inf\|e+" "$W/$1/plan.csv" || fail "$1: plan.csv: $(grep -i 'nan\|inf\|e+' "$W/$1/plan.csv" | head -2)"
+  }
+  run_case huge "$P/quest-blur-difference.json" 1e308 \
+    "+ 1e+308) would be above the tested range (0.25 to 6)"
+  grep -q "is not planned for edge=9: the second threshold (its true 1\.6[0-9]* + 1e+308)" "$W/huge.out" || fail "huge"
+  run_case negative "$P/quest-blur-difference.json" -200% "would be below the tested range (0.25 to 6)"
+  run_case stimuli "$W/stimuli-low.json" 0.1 \
+    "edge=9: its true threshold is not measured: QUEST+'s stimuli (0.01 to 0.03) lie outside its threshold grid (0.25 to 6)"
+  grep -q "edge=9 *difference_arcmin *- .* - " "$W/stimuli.out" || fail "stimuli: a truth or bias printed: $(cat "$W/stimuli.out")"
+  run_case pinned "$W/pinned.json" 0.1 "its true threshold is below the tested range (2.9 to 3)"
+  # An observer with 90 % lapses drives QUEST+ to the top of its grid (about 5.95 of 6): +0.5 shifts its estimates
+  # past what QUEST+ can report (it had "power 1.000 at N = 3").
+  variant "$P/quest-blur-difference.json" "$W/lapses.json" 'p["name"] = "quest-lapses"'
+  printf '#!/bin/sh\nexec %s "$@" --observer sim:lapse=0.9\n' "$BC" > "$W/bc-lapses" && chmod +x "$W/bc-lapses"
+  BC_SAVED=$BC BC=$W/bc-lapses
+  run_case lapses "$W/lapses.json" 0.5 "shifted by it would be above the tested range (0.25 to 6), which the procedure cannot report"
+  BC=$BC_SAVED
+  # Still planned where it means something: 0.5 arcmin from a truth of 1.6 is within 0.25 to 6.
+  $BC plan "$P/quest-blur-difference.json" --participants 3 --studies 4 --seed 1 --difference 0.5 --no-chart \
+    --out "$W/fine" > "$W/fine.out" 2>&1 || fail "plan fine"
+  grep -q "second_cell_t  edge=9 vs a second cell +0.5 difference_arcmin" "$W/fine.out" || fail "fine: $(cat "$W/fine.out")"
+  echo "ok: a declared difference that means nothing (beyond the range, from an unknown truth) is said in a note, not powered" ;;
+units_and_groups)
+  # Only what can be compared is: two QUEST+ cells with thresholds in different units (arcmin, a relative
+  # difference) had a paired t-test of arcmin minus fraction ("-1.035, power 1.000 at N = 4"), and a group running no
+  # pair block had a t-test and a Welch test with no values ("power 0.000"). Now a note says each, and no such row.
+  variant "$P/quest-blur-difference.json" "$W/units.json" '
+import copy
+c = copy.deepcopy(p["blocks"][0])
+c["name"] = "quest-rel"
+c["procedure"].update(variable="relative_difference", stimuli=[0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1, 1.5, 2],
+                      threshold=[0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1, 1.5])
+p["blocks"].append(c)'
+  variant "$P/quest-blur-difference.json" "$W/half.json" '
+p["groups"] = {"names": ["a", "b"], "assign": "balanced"}
+p["blocks"][0]["groups"] = ["a"]
+p["blocks"].append({"name": "pairs", "groups": ["b"], "factors": {"edge": [1, 9]},
+                    "sides": {"left": "measured", "right": "estimated"}})'
+  for v in units half; do
+    $BC plan "$W/$v.json" --participants 6 --studies 10 --seed 1 --no-chart --out "$W/$v" > "$W/$v.out" 2>&1 \
+      || fail "plan $v: $(tail -2 "$W/$v.out")"
+  done
+  grep -q "note: quest-rel: edge=9 and quest: edge=9 are not compared: their thresholds are in different units (relative_difference, difference_arcmin)" \
+    "$W/units.out" || fail "units: $(cat "$W/units.out")"
+  ! cut -d, -f1 "$W/units/plan.csv" | grep -q paired_t || fail "units: a paired_t row across units"
+  grep -q "note: first_source is not compared between groups: group a runs no block that gives it" "$W/half.out" \
+    || fail "half: $(cat "$W/half.out")"
+  ! grep -q "group=a\|group b - a" "$W/half/plan.csv" || fail "half: a row for group a's missing pairs"
+  grep -q "^participants_t,group=b," "$W/half/plan.csv" || fail "half: no row for group b"
+  echo "ok: thresholds in different units and a group without the measure are not compared (a note says so)" ;;
+groups_shared_block)
+  # A block that both groups run is planned per group, not pooled: its conditions (a pair's binomial per edge, a
+  # QUEST+ cell's threshold) were one row mixing both groups' participants. Now each is "group=NAME: ...", the
+  # groups' thresholds compared by Welch under the cell's own name, and the rows the same with 1 and 2 threads.
+  variant "$P/groups-and-info.json" "$W/shared.json" 'p["blocks"] = [{"name": "shared", "sides": {"left": "measured", "right": "estimated"}}]'
+  variant "$P/quest-blur-difference.json" "$W/quest-shared.json" 'p["groups"] = {"names": ["a", "b"], "assign": "balanced"}'
+  for v in shared quest-shared; do
+    for t in 1 2; do
+      $BC plan "$W/$v.json" --participants 6 --studies 10 --seed 2 --threads $t --difference 0.5 --no-chart \
+        --out "$W/$v-$t" > "$W/$v-$t.out" 2>&1 || fail "plan $v: $(tail -2 "$W/$v-$t.out")"
+    done
+    cmp -s "$W/$v-1/plan.csv" "$W/$v-2/plan.csv" || fail "$v: plan.csv differs between 1 and 2 threads"
+  done
+  $PY - "$W/shared-1/plan.csv" "$W/quest-shared-1/plan.csv" <<'PYEOF' || fail "shared block rows"
+import csv, sys
+pairs = list(csv.DictReader(open(sys.argv[1])))
+binomial = sorted({r["condition"] for r in pairs if r["test"] == "binomial"})
+assert binomial and all(c.startswith(("group=estimated: edge=", "group=no_blur: edge=")) for c in binomial), binomial
+assert len(binomial) == 12, binomial
+quest = list(csv.DictReader(open(sys.argv[2])))
+cells = {r["condition"] for r in quest if r["test"] == "threshold"}
+assert cells == {"group=a: edge=9", "group=b: edge=9"}, cells
+welch = {r["condition"] for r in quest if r["test"] == "groups_t"}
+assert welch == {"group b - a: edge=9 (the model's own)", "group b - a: edge=9 (declared +0.5 difference_arcmin)"}, welch
+# Each group's interval width at N = 6 comes from its own 3 participants, never from all 6.
+for r in quest:
+    if r["test"] == "threshold" and r["participants"] == "6":
+        assert float(r["mean_trials"]) == 3, r
+PYEOF
+  echo "ok: a block both groups run is planned per group (shares and thresholds), compared by Welch, not pooled" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -1,7 +1,8 @@
 # blurcue plan end to end over the CLI tests' scene (fixtures scene, calib, session_protocols): tests/plan_test.sh.
 set(BC $<TARGET_FILE:blurcue>)
 set(T ${PROJECT_BINARY_DIR}/cli-test)
-foreach(case same_as_run power_exact same_seed chart prediction depth_slope threshold_truth difference_power groups)
+foreach(case same_as_run power_exact same_seed chart prediction depth_slope threshold_truth difference_power groups
+       difference_meaningless units_and_groups groups_shared_block)
   add_test(NAME plan_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/plan_test.sh ${case} ${BC} ${T})
   set_tests_properties(plan_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures" LABELS "gl;plan"
                        PASS_REGULAR_EXPRESSION "^ok:|\nok:" TIMEOUT 600)
@@ -64,14 +65,34 @@ add_test(NAME plan_leading_zero_is_decimal
          COMMAND ${BC} plan ${P1} --participants 010 --studies 1 --seed s5 --no-chart --out ${T}/plan-leading-zero)
 set_tests_properties(plan_leading_zero_is_decimal PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
                      LABELS plan PASS_REGULAR_EXPRESSION "1 simulated studies of 10 participants \\(seed 5\\)")
+# The exact binomial test's p of every k of every n up to the trials of 10000 participants: one O(n) sum per k made it
+# O(n^3) (3 minutes after a 4 s simulation at 3000 x 20; past 60 s, unfinished, at --participants 10000). Now
+# O(n log n) per n: seconds.
+add_test(NAME plan_many_participants_in_seconds
+         COMMAND ${BC} plan ${P1} --participants 10000 --studies 1 --no-chart --out ${T}/plan-many)
+set_tests_properties(plan_many_participants_in_seconds PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
+                     LABELS plan TIMEOUT 90 PASS_REGULAR_EXPRESSION "1 simulated studies of 10000 participants")
 add_plan_failure_test(plan_bad_difference 2 "--difference: must be a non-zero number in the procedure's units (0.5) or a percentage of the true threshold (20%), got 'abc'"
                       plan ${T}/protocols/quest-blur-difference.json --difference abc --no-chart --out ${T}/plan-bad)
+# A long --difference is quoted as every typed value is: its first 60 characters and its length (it was echoed whole).
+string(REPEAT x 200 LONG_DIFFERENCE)
+add_plan_failure_test(plan_bad_difference_long 2 "got 'xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx...' (200 characters)"
+                      plan ${T}/protocols/quest-blur-difference.json --difference ${LONG_DIFFERENCE} --no-chart --out ${T}/plan-bad)
 add_test(NAME plan_difference_without_procedure
          COMMAND ${BC} plan ${P1} --participants 2 --studies 1 --difference 0.5 --no-chart --out ${T}/plan-no-procedure)
 set_tests_properties(plan_difference_without_procedure PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
                      LABELS plan PASS_REGULAR_EXPRESSION "note: --difference is not planned: it is a difference between thresholds")
 add_plan_failure_test(plan_zero_difference 2 "--difference: must be a non-zero number"
                       plan ${T}/protocols/quest-blur-difference.json --difference 0% --no-chart --out ${T}/plan-bad)
+
+# bench plan times the adaptive protocol by its name beside --protocol's: the same study twice had its runs merged
+# into one median, a protocol without a procedure passed as the adaptive one; both are usage errors now.
+add_plan_failure_test(bench_plan_adaptive_is_protocol 2
+                      "--adaptive-protocol ${P1}: the same study as --protocol (test1-static-grids); 'none' times --protocol alone"
+                      bench plan --quick --participants 2 --protocol ${P1} --adaptive-protocol ${P1} --out ${T}/bench-plan-bad.csv)
+add_plan_failure_test(bench_plan_adaptive_without_procedure 2
+                      "--adaptive-protocol ${T}/protocols/groups-and-info.json: no block has a procedure (staircase or QUEST+), got study groups-and-info"
+                      bench plan --quick --participants 2 --protocol ${P1} --adaptive-protocol ${T}/protocols/groups-and-info.json --out ${T}/bench-plan-bad.csv)
 
 # Every group checked: validate, validate --plan and preview cover each group of a protocol with groups (groups-and-info:
 # 6 edges x 2 swapped copies = 12 trials in each group's own block), or only --group's; an unknown group is a usage
@@ -94,6 +115,11 @@ add_plan_failure_test(validate_unknown_group 2
                       validate ${G} --group no_blr)
 add_plan_failure_test(validate_group_without_groups 2 "--group estimated: ${P1} has no groups"
                       validate ${P1} --group estimated)
+# --group as typed is echoed as every value is: a long one cut at 60 characters with its length, one with a space at either end quoted.
+string(REPEAT x 5000 LONG_GROUP)
+add_plan_failure_test(validate_group_long 2 "--group xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx... (5000 characters): ${G} has no such group"
+                      validate ${G} --group ${LONG_GROUP})
+add_plan_failure_test(validate_group_blank 2 "--group ' no_blur': ${G} has no such group (did you mean no_blur?" validate ${G} --group " no_blur")
 add_test(NAME preview_every_group COMMAND ${BC} preview ${G} --list --out ${T}/preview-groups.png)
 set_tests_properties(preview_every_group PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS "gl;plan"
   PASS_REGULAR_EXPRESSION "#1 group estimated: edge 1: .*#13 group no_blur: edge 1: .*24 distinct stimuli of 24 trials \\(groups estimated, no_blur\\)")

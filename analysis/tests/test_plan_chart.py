@@ -83,6 +83,17 @@ class PlanChartTest(unittest.TestCase):
         fig = self.draw(plan[plan["test"] != "threshold"])
         self.assertEqual(len(fig.axes), 1)
 
+    def test_only_cells_with_nothing_tested_say_why_in_words(self):
+        # --difference given but not planned (a truth out of range): the empty power panel points at the notes, and
+        # neither panel counts participants in quarters.
+        plan = plan_rows()
+        fig = self.draw(plan[plan["test"] == "threshold"])
+        power, cells = fig.axes[0], fig.axes[1]
+        self.assertIn("the plan's notes say why", " ".join(t.get_text() for t in power.texts))
+        for ax in (power, cells):
+            ticks = [t for t in ax.get_xticks() if ax.get_xlim()[0] <= t <= ax.get_xlim()[1]]
+            self.assertTrue(all(float(t).is_integer() for t in ticks), ticks)
+
     def test_not_a_plan_is_exit_3(self):
         with tempfile.TemporaryDirectory() as d:
             path = os.path.join(d, "plan.csv")

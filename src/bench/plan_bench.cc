@@ -52,6 +52,19 @@ std::vector<PlanBenchRow> RunPlanBench(const PlanBenchOptions& options) {
     p.studies = 1;
     plan::SimulateStudies(p, studies.back(), &conditions, &notes, &used);
   }
+  // The adaptive protocol is timed and summarised by its name beside the first: the same study twice had its runs
+  // merged into one median ("median of 2 runs" with --rounds 1), and a protocol without a procedure is no adaptive one.
+  if (studies.size() == 2) {
+    const std::string what = "--adaptive-protocol " + options.adaptive_file.string() + ": ";
+    if (studies[1].protocol.name == studies[0].protocol.name)
+      throw Error(ErrorKind::kUsage, what + "the same study as --protocol (" + studies[0].protocol.name +
+                                         "); 'none' times --protocol alone");
+    bool adaptive = false;
+    for (const auto& block : studies[1].protocol.blocks) adaptive = adaptive || block.procedure.has_value();
+    if (!adaptive)
+      throw Error(ErrorKind::kUsage, what + "no block has a procedure (staircase or QUEST+), got study " +
+                                         studies[1].protocol.name);
+  }
   p.studies = options.studies;
   std::vector<std::vector<std::vector<std::pair<int, std::string>>>> reference(files.size());
   for (int round = 0; round < options.rounds; ++round) {

@@ -2,10 +2,12 @@
 // Which between-subject groups `validate` and `preview` check: every group, so that no group's trials go unchecked,
 // or the one --group names.
 #include <algorithm>
+#include <cctype>
 #include <string>
 #include <vector>
 
 #include "core/error.h"
+#include "core/typed.h"
 #include "protocol/protocol.h"
 
 namespace blurcue::cli {
@@ -14,9 +16,14 @@ namespace blurcue::cli {
 // {""} for a protocol without groups. Throws Error(kUsage) naming --group for a name the protocol does not have (with
 // the nearest name as did-you-mean) or for --group on a protocol without groups.
 inline std::vector<std::string> GroupsToCheck(const protocol::Protocol& p, const std::string& group) {
+  // The name as typed, cut as every echoed value is (a 5000-character --group was a 5067-character message), and
+  // quoted when a space at either end would otherwise not show ("--group  : ...").
+  const bool padded = !group.empty() && (std::isspace(static_cast<unsigned char>(group.front())) ||
+                                          std::isspace(static_cast<unsigned char>(group.back())));
+  const std::string shown = Echo(group, padded);
   if (!p.groups) {
     if (!group.empty())
-      throw Error(ErrorKind::kUsage, "--group " + group + ": " + p.file.string() + " has no groups");
+      throw Error(ErrorKind::kUsage, "--group " + shown + ": " + p.file.string() + " has no groups");
     return {""};
   }
   const std::vector<std::string>& names = p.groups->names;
@@ -43,7 +50,7 @@ inline std::vector<std::string> GroupsToCheck(const protocol::Protocol& p, const
     if (const size_t d = distance(group, name); d < best) best = d, nearest = name;
   std::string listed;
   for (const std::string& name : names) listed += (listed.empty() ? "" : ", ") + name;
-  throw Error(ErrorKind::kUsage, "--group " + group + ": " + p.file.string() + " has no such group (did you mean " +
+  throw Error(ErrorKind::kUsage, "--group " + shown + ": " + p.file.string() + " has no such group (did you mean " +
                                      nearest + "? its groups: " + listed + ")");
 }
 

@@ -1,5 +1,6 @@
 #include "plan/comparisons.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -140,21 +141,54 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
       r.rows.push_back(row);
     }
   }
-  // The declared difference in the procedure's units for a cell (NaN when relative to a truth that is not known).
-  auto declared = [&](const Condition& c) {
-    if (!o.difference) return kNan;
-    if (!o.difference->relative) return o.difference->value;
-    return c.truth_determined ? o.difference->value * c.truth : kNan;
+  // The declared difference in the procedure's units for a cell; NaN, with a note saying why, where it means nothing:
+  // the cell's true threshold is not known (the procedure sits at a bound of its range, or shows nothing near it:
+  // its estimates barely scatter, so any shift had "power 1.000 at N = 2"), or the second threshold, truth + the
+  // difference, lies outside what the procedure measures (--difference 1e308, -200%: a negative threshold).
+  // `c` is the cell the difference is declared from, `second` the one shifted by it (the same cell for a second cell).
+  auto note = [&](const std::string& text) {
+    if (std::find(r.notes.begin(), r.notes.end(), text) == r.notes.end()) r.notes.push_back(text);
   };
-  auto no_truth_note = [&](const Condition& c) {
-    r.notes.push_back("--difference " + DifferenceText(*o.difference, c.units) + " is not planned for " + c.label +
-                      ": its true threshold is " + c.truth_why);
+  auto declared = [&](const Condition& c, const Condition& other) {
+    if (!o.difference) return kNan;
+    const std::string what = "--difference " + DifferenceText(*o.difference, c.units) + " is not planned for " + c.label;
+    if (!c.truth_determined) {
+      note(what + ": its true threshold is " + c.truth_why);
+      return kNan;
+    }
+    const double delta = o.difference->relative ? o.difference->value * c.truth : o.difference->value;
+    const double second = c.truth + delta;
+    if (!(second >= other.range_lo && second <= other.range_hi)) {
+      note(what + ": the second threshold (its true " + protocol::LevelText(c.truth) + " " + (delta >= 0 ? "+ " : "- ") +
+           protocol::LevelText(std::abs(delta)) + ") would be " + (second < other.range_lo ? "below" : "above") +
+           " the tested range (" + protocol::LevelText(other.range_lo) + " to " + protocol::LevelText(other.range_hi) +
+           ")");
+      return kNan;
+    }
+    // The declared difference is planned by shifting the estimates as simulated: shifted past the range, they are
+    // estimates the procedure can never report (an observer with 90 % lapses drives QUEST+ to its grid's top, 5.95
+    // of 6, sd 0.05: "+0.5 arcmin, power 1.000 at N = 3").
+    const double shifted = overall[c.key].mean + delta;
+    if (!(shifted >= other.range_lo && shifted <= other.range_hi)) {
+      note(what + ": its estimates (mean " + protocol::LevelText(overall[c.key].mean) + ") shifted by it would be " +
+           (shifted < other.range_lo ? "below" : "above") + " the tested range (" + protocol::LevelText(other.range_lo) +
+           " to " + protocol::LevelText(other.range_hi) + "), which the procedure cannot report");
+      return kNan;
+    }
+    return delta;
   };
   // Between two cells of the same participants: the paired t-test of per-participant thresholds the report would run.
   std::set<std::string> paired;
   for (size_t a = 0; a < cells.size(); ++a)
     for (size_t b = a + 1; b < cells.size(); ++b) {
       const Condition &A = *cells[a], &B = *cells[b];
+      // Thresholds in different units (a difference in arcmin, a relative one) have no difference to test: their
+      // paired t-test subtracted a fraction from arcmin ("-1.035, power 1.000 at N = 4").
+      if (A.units != B.units) {
+        r.notes.push_back(B.label + " and " + A.label + " are not compared: their thresholds are in different units (" +
+                          B.units + ", " + A.units + ")");
+        continue;
+      }
       const Grid &ga = est[A.key], &gb = est[B.key];
       bool both = false;
       for (int s = 0; s < S && !both; ++s)
@@ -175,11 +209,8 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
       own.mean_estimate = overall[B.key].mean - overall[A.key].mean;
       AddPowerRows(r, o, own, [&](int s, int m) { return OneSampleTTestP(differences(s, m, 0, 0), 0); });
       if (!o.difference) continue;
-      const double delta = declared(A);
-      if (!std::isfinite(delta)) {
-        no_truth_note(A);
-        continue;
-      }
+      const double delta = declared(A, B);
+      if (!std::isfinite(delta)) continue;
       // The estimates' scatter as simulated, each cell centred on its own mean estimate, the second shifted by delta.
       PowerRow shifted = Row("paired_t", name + " (declared " + DifferenceText(*o.difference, A.units) + ")",
                              "threshold", 0);
@@ -203,7 +234,7 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
                 if (p.group == r.groups[g1] && !A) A = c;
                 if (p.group == r.groups[g2] && !B) B = c;
               }
-        if (!A || !B) continue;
+        if (!A || !B || A->units != B->units) continue;
         compared_groups = true;
         const Grid &ga = est[A->key], &gb = est[B->key];
         auto values = [&](const Grid& g, const std::string& group, int s, int m, double shift) {
@@ -213,8 +244,13 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
               v.push_back(g[size_t(s)][size_t(i)] - shift);
           return v;
         };
-        const std::string name = "group " + r.groups[g2] + " - " + r.groups[g1] + ": " +
-                                 (A->label == B->label ? A->label : B->label + " - " + A->label);
+        // A block both groups run is planned per group ("group=a: edge=9"): the comparison names its cell once.
+        auto cell = [](const Condition& c, const std::string& group) {
+          const std::string prefix = "group=" + group + ": ";
+          return c.label.rfind(prefix, 0) == 0 ? c.label.substr(prefix.size()) : c.label;
+        };
+        const std::string la = cell(*A, r.groups[g1]), lb = cell(*B, r.groups[g2]);
+        const std::string name = "group " + r.groups[g2] + " - " + r.groups[g1] + ": " + (la == lb ? la : lb + " - " + la);
         PowerRow own = Row("groups_t", name + " (the model's own)", "threshold", 0);
         own.difference = A->truth_determined && B->truth_determined ? B->truth - A->truth : kNan;
         own.mean_estimate = overall[B->key].mean - overall[A->key].mean;
@@ -222,11 +258,8 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
           return WelchTTestP(values(gb, r.groups[g2], s, m, 0), values(ga, r.groups[g1], s, m, 0));
         });
         if (!o.difference) continue;
-        const double delta = declared(*A);
-        if (!std::isfinite(delta)) {
-          no_truth_note(*A);
-          continue;
-        }
+        const double delta = declared(*A, *B);
+        if (!std::isfinite(delta)) continue;
         PowerRow shifted = Row("groups_t", name + " (declared " + DifferenceText(*o.difference, A->units) + ")",
                                "threshold", 0);
         shifted.difference = delta;
@@ -247,11 +280,8 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
   // simulated participant is the same observer with its own seed, so the two are independent draws).
   for (const Condition* c : cells) {
     if (paired.count(c->key)) continue;
-    const double delta = declared(*c);
-    if (!std::isfinite(delta)) {
-      no_truth_note(*c);
-      continue;
-    }
+    const double delta = declared(*c, *c);
+    if (!std::isfinite(delta)) continue;
     if (S < 2) {
       r.notes.push_back("--difference for " + c->label + " needs --studies 2 or more (a second cell's track comes "
                         "from the next study)");
@@ -304,7 +334,23 @@ void AddGroupShareRows(PlanResult& r, const PlanOptions& o) {
       }
       return MomentsOf(all).mean;
     };
+    // Only the groups whose blocks give this measure: a group that runs none of it had a t-test and a Welch test with
+    // no values, printed as "power 0.000".
+    std::vector<std::string> groups;
     for (const std::string& group : r.groups) {
+      bool any = false;
+      for (int s = 0; s < S && !any; ++s) any = !values(group, s, o.participants).empty();
+      if (any) groups.push_back(group);
+    }
+    if (groups.size() < r.groups.size() && !groups.empty()) {
+      std::string without;
+      for (const std::string& group : r.groups)
+        if (std::find(groups.begin(), groups.end(), group) == groups.end()) without += (without.empty() ? "" : ", ") + group;
+      r.notes.push_back(measure + " is not compared between groups: group" +
+                        (r.groups.size() - groups.size() > 1 ? "s " : " ") + without + " run" +
+                        (r.groups.size() - groups.size() > 1 ? "" : "s") + " no block that gives it");
+    }
+    for (const std::string& group : groups) {
       PowerRow row = Row("participants_t", "group=" + group, measure, 0);
       row.chance = chance;
       row.expected_share = mean_of(group);
@@ -313,13 +359,13 @@ void AddGroupShareRows(PlanResult& r, const PlanOptions& o) {
         return v.size() >= 2 ? OneSampleTTestP(v, chance) : kNan;
       });
     }
-    for (size_t g1 = 0; g1 < r.groups.size(); ++g1)
-      for (size_t g2 = g1 + 1; g2 < r.groups.size(); ++g2) {
-        PowerRow row = Row("groups_t", "group " + r.groups[g2] + " - " + r.groups[g1], measure, 0);
+    for (size_t g1 = 0; g1 < groups.size(); ++g1)
+      for (size_t g2 = g1 + 1; g2 < groups.size(); ++g2) {
+        PowerRow row = Row("groups_t", "group " + groups[g2] + " - " + groups[g1], measure, 0);
         row.chance = chance;
-        row.expected_share = mean_of(r.groups[g2]) - mean_of(r.groups[g1]);
+        row.expected_share = mean_of(groups[g2]) - mean_of(groups[g1]);
         AddPowerRows(r, o, row, [&](int s, int m) {
-          return WelchTTestP(values(r.groups[g2], s, m), values(r.groups[g1], s, m));
+          return WelchTTestP(values(groups[g2], s, m), values(groups[g1], s, m));
         });
       }
   }

@@ -71,6 +71,17 @@ std::optional<Condition> ConditionOf(const protocol::Protocol& protocol, const p
   return c;
 }
 
+// With groups, a block that several groups run is planned per group (key and label name the group): its conditions -
+// shares and procedure cells alike - are compared between the groups, never pooled over them (a shared block's
+// "edge=1" binomial and a shared QUEST+ cell's threshold and interval width mixed both groups' participants).
+void SplitByGroup(const protocol::Protocol& protocol, const protocol::Trial& trial, const std::string& group,
+                  Condition* c) {
+  if (!protocol.groups || protocol.groups->names.size() < 2 || group.empty()) return;
+  if (protocol::BlockOf(protocol, trial)->groups.size() == 1) return;
+  c->key += "\ngroup=" + group;
+  c->label = "group=" + group + ": " + c->label;
+}
+
 // One simulated participant through the session's own decisions (what `blurcue run --observer sim` does headless).
 SimParticipant Simulate(session::PreparedSession& study, const session::ObserverParams& observer, const std::string& id,
                         uint64_t seed, const std::string& group, bool keep_answers, bool several_blocks,
@@ -111,6 +122,7 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
       c.label = (several_blocks ? trial.block + ": " : std::string()) + "cut-off ~ distance";
       c.measure = "log_cutoff_slope";
       c.chance = 0;
+      SplitByGroup(protocol, trial, p.group, &c);
       conditions->emplace(c.key, c);
       Tally& t = p.tallies[c.key];
       ++t.shown;
@@ -123,7 +135,8 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
       p.matches[c.key].emplace_back(std::log(scene.distance_m), std::log(cutoff));
       continue;
     }
-    const std::optional<Condition> c = ConditionOf(protocol, trial, scene, several_blocks);
+    std::optional<Condition> c = ConditionOf(protocol, trial, scene, several_blocks);
+    if (c) SplitByGroup(protocol, trial, p.group, &*c);
     if (!c) {
       unplanned->insert(protocol::ToString(trial.task));
       continue;
@@ -138,6 +151,7 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
         with_truth.truth_determined = truth.determined;
         with_truth.truth = truth.level;
         with_truth.truth_why = truth.why;
+        with_truth.range_lo = truth.range_lo, with_truth.range_hi = truth.range_hi;
         conditions->emplace(c->key, with_truth);
       }
       Track& track = tracks.try_emplace(c->key, Track{protocol::BlockOf(protocol, trial)->procedure->kind, {}, {}})
@@ -258,7 +272,8 @@ std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& opti
   }
   conditions->clear();
   for (const auto& [key, c] : all) conditions->push_back(c);
-  std::sort(conditions->begin(), conditions->end(), [](const Condition& a, const Condition& b) {
+  // Stable: the same block and levels in several groups keep the keys' order (the map's), whatever the threads.
+  std::stable_sort(conditions->begin(), conditions->end(), [](const Condition& a, const Condition& b) {
     if (a.block != b.block) return a.block < b.block;
     return Json::parse(a.levels) < Json::parse(b.levels);
   });
@@ -346,10 +361,7 @@ PlanResult RunPlan(const PlanOptions& options) {
   std::map<std::pair<int, double>, std::vector<double>> p_cache;
   auto p_of = [&](int k, int n, double chance) {
     auto& v = p_cache[{n, chance}];
-    if (v.empty()) {
-      v.resize(size_t(n) + 1);
-      for (int j = 0; j <= n; ++j) v[size_t(j)] = BinomialTestP(j, n, chance);
-    }
+    if (v.empty()) v = BinomialTestPAll(n, chance);
     return v[size_t(k)];
   };
   for (const Condition& c : r.conditions) {
@@ -477,7 +489,7 @@ Difference ParseDifference(const std::string& text) {
   const std::optional<double> value = ParseDecimal(number);
   if (!value || !std::isfinite(*value) || *value == 0)
     throw Error(ErrorKind::kUsage, "--difference: must be a non-zero number in the procedure's units (0.5) or a "
-                                   "percentage of the true threshold (20%), got '" + text + "'");
+                                   "percentage of the true threshold (20%), got " + Echo(text));
   d.value = d.relative ? *value / 100 : *value;
   return d;
 }

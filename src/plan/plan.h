@@ -73,6 +73,7 @@ struct Condition {
   bool truth_determined = false;
   double truth = 0;
   std::string truth_why;  // why there is no truth, in words
+  double range_lo = 0, range_hi = 0;  // where the procedure measures a threshold (TrueThreshold's range)
 };
 
 // What one simulated participant answered: per condition (by Condition::key) the counts.

@@ -1,5 +1,6 @@
 #include "plan/power.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -24,6 +25,23 @@ double BinomialTestP(int k, int n, double p) {
     if (q <= bound) total += q;
   }
   return std::min(1.0, total);
+}
+
+std::vector<double> BinomialTestPAll(int n, double p) {
+  if (n <= 0) return {1.0};
+  std::vector<double> pmf(size_t(n) + 1);
+  for (int j = 0; j <= n; ++j) pmf[size_t(j)] = BinomialPmf(j, n, p);
+  std::vector<double> sorted = pmf;
+  std::sort(sorted.begin(), sorted.end());
+  std::vector<double> below(sorted.size() + 1, 0);  // below[i]: the sum of the i least likely outcomes
+  for (size_t i = 0; i < sorted.size(); ++i) below[i + 1] = below[i] + sorted[i];
+  std::vector<double> out(pmf.size());
+  for (size_t k = 0; k < pmf.size(); ++k) {
+    const double bound = pmf[k] * (1 + 1e-7);
+    const size_t count = size_t(std::upper_bound(sorted.begin(), sorted.end(), bound) - sorted.begin());
+    out[k] = std::min(1.0, below[count]);
+  }
+  return out;
 }
 
 std::pair<double, double> Wilson95(int k, int n) {

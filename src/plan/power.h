@@ -14,6 +14,11 @@ double BinomialPmf(int k, int n, double p);
 // (relative tolerance 1e-7, as scipy.stats.binomtest). 1 when n == 0.
 double BinomialTestP(int k, int n, double p);
 
+// BinomialTestP(k, n, p) for every k in 0 .. n at once, in O(n log n) (the outcomes' probabilities sorted once, the
+// sum of those no more likely than k's read from their running sum): the plan needs every k of every n up to
+// --participants x trials, which one BinomialTestP (O(n)) per k made O(n^3) - minutes to hours past 3000 participants.
+std::vector<double> BinomialTestPAll(int n, double p);
+
 // Wilson score interval (95 %) of k of n: (low, high); (0, 1) when n == 0.
 std::pair<double, double> Wilson95(int k, int n);
 

@@ -22,6 +22,17 @@ TEST(BinomialTest, AsymmetricNullSumsTheOutcomesNoMoreLikely) {
   EXPECT_EQ(BinomialTestP(0, 0, 0.5), 1);
 }
 
+TEST(BinomialTest, AllOutcomesAtOnceAsOneByOne) {
+  // The sorted running sum gives each k's p as BinomialTestP does (summed in another order: to 1e-12).
+  for (int n : {0, 1, 2, 7, 10, 31, 200, 1001})
+    for (double p : {0.5, 0.2, 1.0 / 3, 0.9}) {
+      const std::vector<double> all = BinomialTestPAll(n, p);
+      ASSERT_EQ(all.size(), size_t(n) + 1);
+      for (int k = 0; k <= n; ++k) EXPECT_NEAR(all[size_t(k)], BinomialTestP(k, n, p), 1e-12) << k << " of " << n;
+    }
+  EXPECT_NEAR(BinomialTestPAll(10, 0.5)[7], 352.0 / 1024, 1e-12);
+}
+
 TEST(Wilson, FourteenOfTwentyByTheClosedForm) {
   // p = 0.7, z = 1.959964: centre (p + z^2 / 2n) / (1 + z^2 / n) = 0.667775, half-width 0.186748.
   const auto [lo, hi] = Wilson95(14, 20);

@@ -45,7 +45,21 @@ TrueThreshold ObserverThreshold(const session::ObserverParams& observer, const p
   if (procedure.kind == protocol::Procedure::Kind::kQuestPlus && !procedure.thresholds.empty()) {
     const auto [lo, hi] = std::minmax_element(procedure.thresholds.begin(), procedure.thresholds.end());
     range_lo = *lo, range_hi = *hi;
+    // QUEST+ shows only its stimuli: a threshold below the smallest or above the largest is never near what it shows,
+    // so its answers say little about it and the estimate is its prior's (the plan found sds of 0.02 arcmin and
+    // "power 1.000 at N = 2" for stimuli 0.01 to 0.03 over a threshold grid 0.25 to 6).
+    if (!procedure.stimuli.empty()) {
+      const auto [slo, shi] = std::minmax_element(procedure.stimuli.begin(), procedure.stimuli.end());
+      if (*slo > range_hi || *shi < range_lo) {
+        t.range_lo = *slo, t.range_hi = range_hi;  // empty
+        t.why = "not measured: QUEST+'s stimuli (" + Text(*slo) + " to " + Text(*shi) +
+                ") lie outside its threshold grid (" + Text(range_lo) + " to " + Text(range_hi) + ")";
+        return t;
+      }
+      range_lo = std::max(range_lo, *slo), range_hi = std::min(range_hi, *shi);
+    }
   }
+  t.range_lo = range_lo, t.range_hi = range_hi;
   // A lapse is a coin flip between the two sides: the observer misses lapse / 2 of even the easiest trials, which
   // is the Weibull's lapse parameter for this observer.
   const double lapse = observer.lapse;

@@ -27,13 +27,17 @@ struct TrueThreshold {
   bool determined = false;
   double level = 0;     // when determined
   std::string why;      // when not: said in words ("beyond the tested range 0.25 to 6", ...)
+  // The levels within which the procedure measures a threshold: a staircase's [min, max]; QUEST+'s threshold grid
+  // where its stimuli span it too (a threshold no stimulus comes near is left to the prior). Empty (lo > hi) when
+  // QUEST+'s stimuli lie wholly outside its threshold grid.
+  double range_lo = 0, range_hi = 0;
 };
 
 // The level at which the observer's probability of a correct answer (ProbabilityCorrect2afc on the pair as the trial
 // shows it at that level, with its lapses: (1 - lapse) P + lapse / 2) reaches TargetShare, found by bisection on the
 // level; `planned` is the trial's scene as planned (before any level). Not determined - with the reason - for a task
 // the closed form does not cover (odd one out), an observer whose lapses keep it below the target share, or a level
-// outside what the procedure can show (a staircase's [min, max], QUEST+'s threshold grid).
+// outside what the procedure can show (a staircase's [min, max], QUEST+'s threshold grid within its stimuli's span).
 TrueThreshold ObserverThreshold(const session::ObserverParams& observer, const protocol::Procedure& procedure,
                                 const protocol::Trial& trial, const stimulus::TrialScene& planned,
                                 const stimulus::Presentation& presentation);

@@ -91,5 +91,30 @@ TEST(ObserverThreshold, OutsideTheRangeIsSaidInWords) {
   EXPECT_NE(t.why.find("never reached"), std::string::npos) << t.why;
 }
 
+// QUEST+ shows only its stimuli: a truth (0.27) inside its threshold grid but below every stimulus is not measured
+// (the estimate is its prior's; the plan printed sd 0.016 and "power 1.000 at N = 2" for a declared difference), and
+// stimuli wholly outside the grid measure nothing. Stimuli spanning the truth keep it, the range their overlap.
+TEST(ObserverThreshold, QuestPlusStimuliBoundWhatItMeasures) {
+  PixelPair pair;
+  protocol::Procedure quest;
+  quest.kind = protocol::Procedure::Kind::kQuestPlus;
+  quest.thresholds = {0.05, 0.1, 0.5, 1};
+  quest.stimuli = {0.4, 0.6, 0.8};
+  TrueThreshold t = ObserverThreshold(pair.observer, quest, pair.trial, pair.scene, pair.presentation);
+  EXPECT_FALSE(t.determined);
+  EXPECT_EQ(t.why, "below the tested range (0.4 to 0.8)");
+  quest.stimuli = {2, 3};
+  t = ObserverThreshold(pair.observer, quest, pair.trial, pair.scene, pair.presentation);
+  EXPECT_FALSE(t.determined);
+  EXPECT_EQ(t.why, "not measured: QUEST+'s stimuli (2 to 3) lie outside its threshold grid (0.05 to 1)");
+  EXPECT_GT(t.range_lo, t.range_hi);
+  quest.stimuli = {0.1, 0.2, 0.4, 2};
+  t = ObserverThreshold(pair.observer, quest, pair.trial, pair.scene, pair.presentation);
+  ASSERT_TRUE(t.determined) << t.why;
+  EXPECT_NEAR(t.level, 0.3 * 0.9004525966377902, 1e-9);
+  EXPECT_EQ(t.range_lo, 0.1);
+  EXPECT_EQ(t.range_hi, 1);
+}
+
 }  // namespace
 }  // namespace blurcue::plan
