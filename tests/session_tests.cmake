@@ -10,14 +10,22 @@ add_test(NAME session_pictures
 set_tests_properties(session_pictures PROPERTIES FIXTURES_REQUIRED scene FIXTURES_SETUP session_pictures
                      PASS_REGULAR_EXPRESSION "wrote 27 photos")
 set_tests_properties(session_protocols PROPERTIES FIXTURES_SETUP session_protocols)
-foreach(case complete same_seed resume kill9 second_writer window window_adjust recover depth_arcmin merge merge_live_writer
-             merge_killed_session resume_guards stranded
-             stale_lock readonly frames_shown adaptive groups_info two_intervals deadline layouts window_after_motion codebook report_any_study report_aborted practice_criterion visibility depth_capture
-             resume_observer resume_display groups_concurrent resume_exact level_names)
-  add_test(NAME session_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/session_test.sh ${case} ${BC} ${T})
-  set_tests_properties(session_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures"
-                       LABELS "gl;session"
-                       PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+# Each script holds the cases of one concern: the record (session_test.sh), what the design records and reports
+# (session_design_test.sh), what the screen shows (session_display_test.sh); session_lib.sh is their shared part.
+set(SESSION_CASES_session_test complete same_seed resume kill9 second_writer recover merge merge_live_writer
+    merge_killed_session resume_guards stranded stale_lock readonly resume_observer resume_display groups_concurrent
+    resume_exact)
+set(SESSION_CASES_session_design_test adaptive groups_info codebook report_any_study report_aborted practice_criterion
+    level_names)
+set(SESSION_CASES_session_display_test window window_adjust depth_arcmin frames_shown two_intervals deadline layouts
+    window_after_motion visibility depth_capture)
+foreach(script session_test session_design_test session_display_test)
+  foreach(case ${SESSION_CASES_${script}})
+    add_test(NAME session_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/${script}.sh ${case} ${BC} ${T})
+    set_tests_properties(session_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures"
+                         LABELS "gl;session"
+                         PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+  endforeach()
 endforeach()
 set_tests_properties(session_window session_window_adjust session_window_after_motion PROPERTIES LABELS "gl;session;window")
 # Sessions numbered per participant, protocol versions kept apart (tests/session_numbers_test.sh).
