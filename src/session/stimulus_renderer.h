@@ -53,8 +53,8 @@ class StimulusRenderer {
   std::optional<calib::SceneCalib> scene_;
   stimulus::Presentation presentation_;
   cv::Mat photo_;
-  scene::SurfaceTexture texture_;
-  std::vector<scene::BlurredObject> objects_;  // the frame's objects for the compositor, kept between frames  // the objects' texture: one GL texture for the session
+  scene::SurfaceTexture texture_;  // the objects' texture: one GL texture for the session
+  std::vector<scene::BlurredObject> objects_;  // the frame's objects for the compositor, kept between frames
   std::unique_ptr<render::FrameCompositor> compositor_;
   // Picture: the upper half at a cut-off, made once (the Butterworth runs on the CPU) and kept; every level of
   // the protocol is made up front.
