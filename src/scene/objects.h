@@ -54,6 +54,7 @@ struct VirtualObject {
 // Texture, brightness and contrast are left to the caller.
 // `size_mm` > 0: a card of that width (its centre as far beside the board); 0: two squares wide.
 VirtualObject CardBesideBoard(const Board& board, int edge, bool left, double size_mm = 0);
+VirtualObject BallOnBoard(const Board& board, int section, double y_mm, double radius_mm, double from_y_mm);
 
 // A card's axes in the board frame, each scaled to its extent: along its width (u), towards its texture's top (v),
 // and its unit normal (n).
@@ -66,7 +67,6 @@ CardAxes AxesOf(const VirtualObject& o);
 // A card's four corners in the board frame (mm): top-left, top-right, bottom-right, bottom-left of its texture - the
 // one definition of its pose that drawing, footprints and outlines use.
 std::vector<cv::Point3d> CardCorners(const VirtualObject& card);
-VirtualObject BallOnBoard(const Board& board, int section, double y_mm, double radius_mm, double from_y_mm);
 
 // Where the object lands in the photo, and how far it spans in depth.
 struct Footprint {
