@@ -161,7 +161,7 @@ def _model_median(v):
 
 
 # A Butterworth level c's blur as the equivalent Gaussian's (the one that halves contrast at the cut-off, s =
-# sqrt(ln 2 / 2) / (pi c) picture widths; blurcue's r = 2 s), as render::ButterworthEquivalentSigma states it.
+# sqrt(ln 2 / 2) / (pi c) picture widths; blurcue's r = 2 s), as scene::ButterworthEquivalentSigma states it.
 EQUIVALENT_S = math.sqrt(math.log(2) / 2) / math.pi
 
 

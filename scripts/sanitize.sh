@@ -7,8 +7,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 JOBS="${1:--j2}"
 BUILD=build-asan
-FAST_TESTS=(core_test optics_test protocol_test store_test display_test synth_test calib_test calibrate_test stimuli_test
-            session_test)
+FAST_TESTS=(core_test optics_test protocol_test store_test display_test synth_test calib_test calibrate_test scene_test
+            real_picture_test session_test)
 GL_TESTS=(render_test scene_render_test)
 cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g -O1" -DBLURCUE_SANITIZE=ON > /dev/null
 cmake --build "$BUILD" "$JOBS" --target "${FAST_TESTS[@]}" "${GL_TESTS[@]}" blurcue

@@ -19,7 +19,9 @@
 #include "render/frame_compositor.h"
 #include "render/gl_context.h"
 #include "render/gl_objects.h"
-#include "render/stimuli.h"
+#include "scene/frame.h"
+#include "scene/objects.h"
+#include "scene/stimuli.h"
 #include "synth/scene.h"
 
 namespace blurcue::bench {
@@ -183,7 +185,7 @@ std::vector<RenderRow> RunRenderBench(const RenderBenchOptions& options) {
   const synth::Scene scene = synth::RenderScene(scene_options);
   const optics::Lens lens = optics::Lens::FromCamera(scene.camera);
   render::FrameCompositor compositor(scene.camera, scene.rvec, scene.tvec, scene.image);
-  const render::SurfaceTexture soccer(render::SoccerTexture(1024));
+  const scene::SurfaceTexture soccer(scene::SoccerTexture(1024));
   const int frames = options.quick ? 10 : 120;
   for (const std::string approach : {"region", "whole_frame"}) {
     std::vector<double> times;
@@ -191,10 +193,10 @@ std::vector<RenderRow> RunRenderBench(const RenderBenchOptions& options) {
     double mean_err = 0, max_err = 0;
     for (int i = 0; i < frames; ++i) {
       const double y = 250.0 * i / std::max(1, frames - 1);  // edge 1 -> edge 11
-      std::vector<render::BlurredObject> balls(2);
+      std::vector<scene::BlurredObject> balls(2);
       for (int b = 0; b < 2; ++b) {
         auto& o = balls[b].object;
-        o = render::BallOnBoard(scene.board, b == 0 ? 3 : 5, y, 10, 0);  // test 2's balls on sections 3 and 5
+        o = scene::BallOnBoard(scene.board, b == 0 ? 3 : 5, y, 10, 0);  // test 2's balls on sections 3 and 5
         o.texture = soccer;
         cv::Matx33d rot;
         cv::Rodrigues(scene.rvec, rot);
@@ -248,12 +250,12 @@ std::vector<RenderRow> RunRenderBench(const RenderBenchOptions& options) {
     std::vector<double> times;
     double r_sum = 0;
     for (int i = 0; i <= growth_frames; ++i) {  // frame 0 uploads the texture: not timed
-      std::vector<render::BlurredObject> balls(static_cast<size_t>(objects));
+      std::vector<scene::BlurredObject> balls(static_cast<size_t>(objects));
       for (int b = 0; b < objects; ++b) {
         // Spread over the board's 7 sections and along it, rolling.
         const double y = std::fmod(250.0 * i / growth_frames + 37.0 * b, 250.0);
         auto& o = balls[size_t(b)].object;
-        o = render::BallOnBoard(s.board, 1 + b % 7, y, 10, 0);
+        o = scene::BallOnBoard(s.board, 1 + b % 7, y, 10, 0);
         o.texture = soccer;
         const double z = (rot * o.center_board_mm + s.tvec)[2];
         balls[size_t(b)].r_px = fixed_r_px > 0 ? fixed_r_px : 3 * optics::BlurRadiusPx(l, s.focus_mm, z);

@@ -21,7 +21,9 @@
 #include "render/frame_compositor.h"
 #include "render/gl_context.h"
 #include "render/scene_render.h"
-#include "render/stimuli.h"
+#include "scene/frame.h"
+#include "scene/objects.h"
+#include "scene/stimuli.h"
 
 namespace blurcue::cli {
 
@@ -96,7 +98,7 @@ void AddAnimateCommand(CLI::App& app) {
     double fixed_left = 0, fixed_right = 0;
     const calib::BlurSource left = calib::ParseBlurSource(args->left, &fixed_left);
     const calib::BlurSource right = calib::ParseBlurSource(args->right, &fixed_right);
-    const render::SurfaceTexture texture(ReadImage(render::ResolveStimulus(args->texture)));
+    const scene::SurfaceTexture texture(ReadImage(scene::ResolveStimulus(args->texture)));
 
     std::unique_ptr<render::GlContext> context;
     if (args->window) {
@@ -132,8 +134,8 @@ void AddAnimateCommand(CLI::App& app) {
     log << "frame,t_s,y_mm,r_left_px,r_right_px,render_ms,flip_s\n";
     using Clock = std::chrono::steady_clock;
     {  // a warm-up frame uploads and mipmaps the texture, so frame 0 is not slower than the rest
-      render::BlurredObject b;
-      b.object = render::BallOnBoard(scene.board, args->left_section, y0, radius, y0);
+      scene::BlurredObject b;
+      b.object = scene::BallOnBoard(scene.board, args->left_section, y0, radius, y0);
       b.object.texture = texture;
       compositor.Compose({b});
       compositor.Finish();
@@ -144,14 +146,14 @@ void AddAnimateCommand(CLI::App& app) {
     for (int i = 0; i < frames && !(context->ShouldClose()); ++i) {
       const double t = i / args->fps;
       const double y = y0 + (y1 > y0 ? 1 : -1) * std::min(std::abs(y1 - y0), speed_mm_s * t);
-      std::vector<render::BlurredObject> balls(2);
+      std::vector<scene::BlurredObject> balls(2);
       const int section[2] = {args->left_section, args->right_section};
       const calib::BlurSource source[2] = {left, right};
       const double fixed[2] = {fixed_left, fixed_right};
       double r[2];
       for (int b = 0; b < 2; ++b) {
-        render::VirtualObject& o = balls[b].object;
-        o = render::BallOnBoard(scene.board, section[b], y, radius, y0);
+        scene::VirtualObject& o = balls[b].object;
+        o = scene::BallOnBoard(scene.board, section[b], y, radius, y0);
         o.texture = texture;
         r[b] = args->gain * calib::BlurAtPx(scene, source[b], scene.ToCamera(o.center_board_mm), fixed[b]);
         if (!(r[b] >= 0 && r[b] <= render::kMaxBlurRadiusPx))

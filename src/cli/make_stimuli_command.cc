@@ -11,7 +11,8 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "protocol/protocol.h"
-#include "render/stimuli.h"
+#include "render/real_picture.h"
+#include "scene/stimuli.h"
 
 namespace blurcue::cli {
 
@@ -27,7 +28,7 @@ void AddMakeStimuliCommand(CLI::App& app) {
       "Example: blurcue make-stimuli --out stimuli");
   cmd->add_option("--out", *out, "folder to write into (created if needed)")->capture_default_str();
   cmd->callback([out] {
-    for (const auto& file : render::WriteStandardStimuli(*out)) std::printf("wrote %s\n", file.string().c_str());
+    for (const auto& file : scene::WriteStandardStimuli(*out)) std::printf("wrote %s\n", file.string().c_str());
   });
 }
 
@@ -82,7 +83,7 @@ void AddSynthPicturesCommand(CLI::App& app) {
     const Camera scaled = camera.Resized(args->width_px, int(std::lround(double(args->width_px) *
                                                                           camera.image_height_px /
                                                                           camera.image_width_px)));
-    const cv::Mat picture = ReadImage(render::ResolveStimulus(args->picture), -1);
+    const cv::Mat picture = ReadImage(scene::ResolveStimulus(args->picture), -1);
     std::filesystem::create_directories(args->out);
     const std::string stem = std::filesystem::path(args->picture).stem().string();
     for (double d : distances) {

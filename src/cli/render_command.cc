@@ -15,7 +15,9 @@
 #include "render/gl_context.h"
 #include "render/gl_objects.h"
 #include "render/scene_render.h"
-#include "render/stimuli.h"
+#include "scene/frame.h"
+#include "scene/objects.h"
+#include "scene/stimuli.h"
 
 namespace blurcue::cli {
 void AddRenderCommand(CLI::App& app) {
@@ -73,10 +75,10 @@ void AddRenderCommand(CLI::App& app) {
     const auto t0 = std::chrono::steady_clock::now();
     if (args->object.rfind("picture", 0) == 0) {
       const std::string name = args->object.size() > 8 && args->object[7] == ':' ? args->object.substr(8) : "face";
-      const cv::Mat picture = ReadImage(render::ResolveStimulus(name));
+      const cv::Mat picture = ReadImage(scene::ResolveStimulus(name));
       const cv::Mat photo = ReadImage(args->background, 1);
       const int w = args->display_width > 0 ? args->display_width : 960;
-      const render::DepthMatchingLayout l = render::DepthMatchingLayout::Of(w, picture.size());
+      const scene::DepthMatchingLayout l = scene::DepthMatchingLayout::Of(w, picture.size());
       const int h = l.frame.height, half = l.upper.height;
       const int picture_h = args->picture_height > 0 ? args->picture_height : l.picture.height;
       if (picture_h > half)
@@ -104,25 +106,25 @@ void AddRenderCommand(CLI::App& app) {
     double fixed_r = 0;
     const calib::BlurSource source = calib::ParseBlurSource(args->blur, &fixed_r);
 
-    render::VirtualObject object;
+    scene::VirtualObject object;
     const double y = (args->edge - 1) * scene.board.square_mm;
     std::string texture_name;
     if (args->object == "grid") {
-      object = render::CardBesideBoard(scene.board, args->edge, /*left=*/false);
+      object = scene::CardBesideBoard(scene.board, args->edge, /*left=*/false);
       texture_name = "grid";
     } else if (args->object.rfind("ball", 0) == 0) {
-      object = render::BallOnBoard(scene.board, args->section, y, 10, y);
+      object = scene::BallOnBoard(scene.board, args->section, y, 10, y);
       texture_name = args->object.size() > 5 && args->object[4] == ':' ? args->object.substr(5) : "soccer";
     } else {
       throw Error(ErrorKind::kUsage, "--object must be grid or ball[:TEXTURE], got " + Echo(args->object));
     }
-    object.texture = render::SurfaceTexture(ReadImage(render::ResolveStimulus(texture_name)));
+    object.texture = scene::SurfaceTexture(ReadImage(scene::ResolveStimulus(texture_name)));
     object.brightness = args->brightness;
     object.contrast = args->contrast;
 
     auto context = render::GlContext::CreateOffscreen();
     render::SceneRenderer renderer(scene.camera, scene.rvec, scene.tvec);
-    const render::Footprint f = renderer.Measure(object);
+    const scene::Footprint f = renderer.Measure(object);
     // An object outside the photo would leave the photo as it was, written as if it were the stimulus.
     if ((f.bounds & cv::Rect(0, 0, photo.cols, photo.rows)).empty())
       throw Error(ErrorKind::kUsage, "the " + args->object + " at --at-edge " + std::to_string(args->edge) +

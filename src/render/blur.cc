@@ -12,8 +12,13 @@
 #include "core/image.h"
 #include "render/gl_objects.h"
 #include "render/shaders.h"
+#include "scene/frame.h"
 
 namespace blurcue::render {
+
+using scene::GreyMarginPx;
+using scene::LayerOnField;
+using scene::ScaledWidthPx;
 
 static std::string Num(double v) {
   std::ostringstream s;
@@ -207,34 +212,6 @@ cv::Mat ButterworthBlurCpu(const cv::Mat& rgba, double cutoff, int order) {
   return FilterInFrequency(rgba, [&](double f) { return 1.0 / (1.0 + std::pow(f * w / cutoff, 2 * order)); });
 }
 
-double ButterworthEquivalentSigma(double cutoff) { return std::sqrt(std::log(2.0) / 2) / (M_PI * cutoff); }
-
-namespace {
-
-// A picture's width when scaled to height_px (its aspect kept, rounded, at least 1 px).
-int ScaledWidthPx(cv::Size picture, int height_px) {
-  return std::max(1, int(std::lround(double(picture.width) * height_px / picture.height)));
-}
-
-// Where PictureOnField puts a layer of `layer` size: centred on the field (it may overhang).
-cv::Rect LayerOnField(cv::Size field, cv::Size layer) {
-  return {(field.width - layer.width) / 2, (field.height - layer.height) / 2, layer.width, layer.height};
-}
-
-// PictureOnGrey's transparent margin around a picture of `scaled` size: room for its blur to spread.
-int GreyMarginPx(cv::Size scaled) { return std::max(scaled.width, scaled.height) / 4; }
-
-// Where PictureOnGrey puts a picture of `picture` size scaled to height_px on a `field`: its outline before the blur
-// spreads it, with the drawing's own rounding.
-cv::Rect PictureRectOnGrey(cv::Size picture, cv::Size field, int height_px) {
-  const cv::Size scaled(ScaledWidthPx(picture, height_px), height_px);
-  const int m = GreyMarginPx(scaled);
-  const cv::Rect layer = LayerOnField(field, {scaled.width + 2 * m, scaled.height + 2 * m});
-  return {layer.x + m, layer.y + m, scaled.width, scaled.height};
-}
-
-}  // namespace
-
 cv::Mat PictureOnField(const cv::Mat& picture, cv::Size field, int height_px, int margin_px,
                        const std::function<cv::Mat(const cv::Mat&, int)>& filter, double grey) {
   CV_Assert(height_px > 0 && field.width > 0 && field.height > 0);
@@ -271,28 +248,6 @@ cv::Mat PictureOnGrey(const cv::Mat& picture, cv::Size field, int height_px, dou
     return cutoff > 0 ? ButterworthBlurCpu(layer, cutoff * layer.cols / picture_width_px) : layer;
   };
   return PictureOnField(picture, field, height_px, GreyMarginPx({width_px, height_px}), butterworth, grey);
-}
-
-DepthMatchingLayout DepthMatchingLayout::Of(int width_px, cv::Size picture) {
-  DepthMatchingLayout l;
-  const int h = width_px * 3 / 4, half = h / 2;
-  l.frame = {width_px, h};
-  l.upper = {0, 0, width_px, half};
-  if (!picture.empty()) l.picture = PictureRectOnGrey(picture, l.upper.size(), half * 6 / 10);
-  l.lower = {0, half, width_px, h - half};
-  return l;
-}
-
-double DepthMatchingLayout::LowerScale(cv::Size photo) const {
-  return std::max(double(lower.width) / photo.width, double(lower.height) / photo.height);
-}
-
-cv::Mat DepthMatchingLayout::LowerHalf(const cv::Mat& photo) const {
-  const double scale = LowerScale(photo.size());
-  cv::Mat scaled;
-  cv::resize(photo, scaled, cv::Size(), scale, scale, cv::INTER_AREA);
-  return scaled(cv::Rect((scaled.cols - lower.width) / 2, (scaled.rows - lower.height) / 2, lower.width,
-                         lower.height)).clone();
 }
 
 void StackDepthMatchingFrame(const cv::Mat& upper, const cv::Mat& lower, cv::Mat* frame) {

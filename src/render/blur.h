@@ -51,14 +51,7 @@ cv::Mat FilterInFrequency(const cv::Mat& rgba, const std::function<double(double
 // The image is mirror-padded first so its borders do not wrap around. Throws Error(kDomain) unless the cut-off is
 // in (0, kMaxCutoffCyclesPerWidth] and the order in 1..16.
 cv::Mat ButterworthBlurCpu(const cv::Mat& rgba, double cutoff_cycles_per_width, int order = 2);
-// The std of the Gaussian equivalent to a Butterworth low-pass at `cutoff` cycles per width, in widths: the Gaussian
-// that also halves contrast at the cut-off (H(cutoff) = 1/2 for every order; exp(-2 pi^2 s^2 f^2) = 1/2 there), so
-// s = sqrt(ln 2 / 2) / (pi cutoff) ~ 0.187 / cutoff; its blurcue radius is r = 2 s. The Butterworth's line-spread
-// function has no usable second moment (a 2nd-order one's is zero: H = 1 - (f/fc)^4 + ...), so r = 2 std cannot
-// define it; other equivalences land within 7 % of this one (equal area under the transfer: 0.180 / cutoff; the
-// same 10-90 % edge rise: 0.175 / cutoff, checked against ButterworthBlurCpu in render_test).
-double ButterworthEquivalentSigma(double cutoff_cycles_per_width);
-
+// (Its equivalent Gaussian, which the record states, is scene::ButterworthEquivalentSigma.)
 // The depth-matching study's stimulus (thesis 3.2): `picture` (8-bit sRGB, alpha = its shape) scaled to
 // `height_px`, low-passed by the 2nd-order Butterworth at `cutoff` cycles per picture width (0 = sharp), centred on
 // a uniform grey field of `field` size with linear grey level `grey`. Returns 8-bit BGR sRGB.
@@ -69,21 +62,9 @@ cv::Mat PictureOnGrey(const cv::Mat& picture, cv::Size field, int height_px, dou
 cv::Mat PictureOnField(const cv::Mat& picture, cv::Size field, int height_px, int margin_px,
                        const std::function<cv::Mat(const cv::Mat&, int)>& filter, double grey);
 
-// The depth-matching study's frame (thesis 3.2) of width_px showing a picture of `picture` size, in frame px: the
-// frame (width x 3/4 width); its upper half, grey, with the virtual picture's outline (before the blur spreads it)
-// centred in it at 0.6 of its height (PictureOnGrey's place, with its rounding); its lower half, the real photo
-// scaled to cover it and cropped at its centre.
-struct DepthMatchingLayout {
-  cv::Size frame;
-  cv::Rect upper, picture, lower;  // `picture` empty for an empty picture size
-  static DepthMatchingLayout Of(int width_px, cv::Size picture);
-  // The scale (frame px per photo px) at which the lower half shows a photo of `photo` size, and that photo there
-  // (8-bit BGR of lower's size).
-  double LowerScale(cv::Size photo) const;
-  cv::Mat LowerHalf(const cv::Mat& photo) const;
-};
-// The frame: `upper` (a PictureOnGrey of the upper half's size) over `lower` (a LowerHalf), stacked into `frame`
-// (allocated only when its size changes: a trial stepping through levels reuses it). 8-bit BGR.
+// A scene::DepthMatchingLayout's frame: `upper` (a PictureOnGrey of the upper half's size) over `lower` (a
+// LowerHalf), stacked into `frame` (allocated only when its size changes: a trial stepping through levels reuses
+// it). 8-bit BGR.
 void StackDepthMatchingFrame(const cv::Mat& upper, const cv::Mat& lower, cv::Mat* frame);
 
 // 8-bit sRGB BGR/BGRA/grey -> CV_32FC4 linear premultiplied BGRA, and back (alpha kept when `keep_alpha`).

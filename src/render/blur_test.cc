@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "render/gl_context.h"
 #include "render/gl_objects.h"
+#include "scene/frame.h"
 
 namespace blurcue::render {
 namespace {
@@ -189,7 +190,7 @@ TEST(CpuBlur, ButterworthEquivalentGaussianHasItsEdgeRise) {
     return cross(0.9) - cross(0.1);
   };
   for (double cutoff : {16.0, 32.0}) {
-    const double s_px = ButterworthEquivalentSigma(cutoff) * step.cols;
+    const double s_px = scene::ButterworthEquivalentSigma(cutoff) * step.cols;
     const double butterworth = rise(ButterworthBlurCpu(step, cutoff)), gaussian = rise(GaussianBlurCpu(step, 2 * s_px));
     EXPECT_NEAR(butterworth / gaussian, 1.0, 0.10) << cutoff << ": " << butterworth << " vs " << gaussian << " px";
     EXPECT_NEAR(gaussian, 2 * 1.2815515655 * s_px, 0.03 * gaussian) << cutoff;  // the sampled Gaussian is one

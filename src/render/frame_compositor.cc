@@ -12,6 +12,10 @@
 
 namespace blurcue::render {
 
+using scene::BlurredObject;
+using scene::Footprint;
+using scene::FrameView;
+
 struct FrameCompositor::Impl {
   Camera camera;
   FrameView view;
@@ -153,15 +157,6 @@ struct FrameCompositor::Impl {
   }
 };
 
-FrameView FrameView::Identity(int photo_width_px, int photo_height_px) {
-  return {photo_width_px, photo_height_px, photo_width_px, photo_height_px, 0, 0};
-}
-
-Camera FrameView::CameraOf(const Camera& c) const {
-  return c.Viewed(double(photo_width_px) / c.image_width_px, double(photo_height_px) / c.image_height_px, x_px, y_px,
-                  width_px, height_px);
-}
-
 FrameCompositor::FrameCompositor(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec,
                                  const cv::Mat& background, std::optional<FrameView> view)
     : impl_(std::make_unique<Impl>(camera, rvec, tvec, background,
@@ -201,7 +196,7 @@ namespace {
 // rows count from the bottom, so the blit flips.
 void BlitToWindow(GLuint read_fb, int src_w, int src_h, int width_px, int height_px) {
   const double scale = std::min(double(width_px) / src_w, double(height_px) / src_h);
-  const int w = int(src_w * scale), h = int(src_h * scale);  // FitScale: w / src_w
+  const int w = int(src_w * scale), h = int(src_h * scale);  // scene::FitScale: w / src_w
   const int x0 = (width_px - w) / 2, y0 = (height_px - h) / 2;
   glBindFramebuffer(GL_READ_FRAMEBUFFER, read_fb);
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
@@ -211,11 +206,6 @@ void BlitToWindow(GLuint read_fb, int src_w, int src_h, int width_px, int height
   glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
 }
 }  // namespace
-
-double FitScale(int src_w, int src_h, int width_px, int height_px) {
-  const double scale = std::min(double(width_px) / src_w, double(height_px) / src_h);
-  return double(int(src_w * scale)) / src_w;
-}
 
 cv::Mat ReadWindow(int width_px, int height_px) {
   cv::Mat rgba(height_px, width_px, CV_8UC4);

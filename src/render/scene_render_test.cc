@@ -14,6 +14,11 @@
 #include "render/gl_objects.h"
 
 namespace blurcue::render {
+
+using scene::Footprint;
+using scene::SurfaceTexture;
+using scene::VirtualObject;
+
 namespace {
 
 // The thesis's view, built by hand: camera pitched down 38 deg, looking at the board's centre from 440 mm.
@@ -123,25 +128,6 @@ TEST_F(SceneRenderTest, BallLandsWhereThePoseProjectsIt) {
     EXPECT_NEAR(c.x, px[0].x, 1.0) << "y = " << y;
     EXPECT_NEAR(c.y, px[0].y, 1.0) << "y = " << y;
   }
-}
-
-// A card's corners from its pose, worked out by hand: an 80 x 60 mm card standing at (100, 50) with its lowest edge
-// 10 mm above the table, turned 90 deg (its width along +y, facing +x), and one lying flat, unturned.
-TEST(CardCorners, FollowItsPoseByHand) {
-  VirtualObject card;
-  card.kind = VirtualObject::Kind::kCard;
-  card.size_mm = 80, card.card_height_mm = 60;
-  card.standing = true, card.rotation_deg = 90;
-  card.center_board_mm = {100, 50, 40};
-  const std::vector<cv::Point3d> expected = {{100, 10, 70}, {100, 90, 70}, {100, 90, 10}, {100, 10, 10}};
-  const auto corners = CardCorners(card);
-  ASSERT_EQ(corners.size(), 4u);
-  for (size_t i = 0; i < 4; ++i) EXPECT_LT(cv::norm(corners[i] - expected[i]), 1e-9) << i;
-  card.standing = false, card.rotation_deg = 0;
-  card.center_board_mm = {0, 0, 0};
-  const std::vector<cv::Point3d> lying = {{-40, 30, 0}, {40, 30, 0}, {40, -30, 0}, {-40, -30, 0}};
-  const auto flat = CardCorners(card);
-  for (size_t i = 0; i < 4; ++i) EXPECT_LT(cv::norm(flat[i] - lying[i]), 1e-9) << i;
 }
 
 // Drawn by GL, a standing, turned, raised card covers the polygon its hand-made corners project to: the same area
@@ -260,8 +246,12 @@ TEST_F(SceneRenderTest, WhiteBalanceScalesEachChannelInLinearLight) {
 
 #include "core/image.h"
 #include "render/frame_compositor.h"
+#include "scene/frame.h"
 
 namespace blurcue::render {
+
+using scene::BlurredObject;
+
 namespace {
 
 cv::Mat Photo(const Camera& c) {

@@ -28,9 +28,9 @@ class GlPresenter : public Presenter {
   void Compose(const stimulus::TrialScene& scene, double t_s, double level) override {
     renderer_.Compose(scene, t_s, level);
   }
-  const std::array<std::optional<render::BlurredObject>, 2>& Shown() const override { return renderer_.Shown(); }
+  const std::array<std::optional<scene::BlurredObject>, 2>& Shown() const override { return renderer_.Shown(); }
   // Where the last composed frame showed the photo.
-  render::FrameView View() const { return renderer_.View(); }
+  scene::FrameView View() const { return renderer_.View(); }
   // The frame as the screen shows it now (8-bit BGR), with `prompt` in its band when not empty.
   virtual cv::Mat ReadFrame(std::string_view prompt) = 0;
 
@@ -126,7 +126,7 @@ class CapturingPresenter : public Presenter {
   void Compose(const stimulus::TrialScene& scene, double t_s, double level) override {
     inner_.Compose(scene, t_s, level);
   }
-  const std::array<std::optional<render::BlurredObject>, 2>& Shown() const override { return inner_.Shown(); }
+  const std::array<std::optional<scene::BlurredObject>, 2>& Shown() const override { return inner_.Shown(); }
   void ShowStimulus(const StimulusFrame& frame) override;
   void ShowText(const std::string& title, const std::string& body, const std::string& footer) override {
     inner_.ShowText(title, body, footer);

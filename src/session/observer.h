@@ -34,7 +34,7 @@
 //
 // Adjustment (depth matching: the real picture below, the virtual one above at the level shown). model=arcmin: the
 // observer sets the virtual picture to the blur it cannot tell from the real picture's, both in visual angle - each
-// level's blur as its equivalent Gaussian (render::ButterworthEquivalentSigma) and the real one as its camera made it
+// level's blur as its equivalent Gaussian (scene::ButterworthEquivalentSigma) and the real one as its camera made it
 // (content.real_camera). It steps "next" through every level, comparing each once with the real picture,
 // D = ln E(level) - ln E(real) + N(0, compare sd), then steps back the shorter way to the level with the smallest |D|
 // and accepts it. Through the dipper, levels all sharper than the eye's intrinsic blur look alike, so for a sharp

@@ -12,7 +12,7 @@
 #include <utility>
 
 #include "protocol/trials.h"
-#include "render/frame_compositor.h"
+#include "scene/frame.h"
 #include "stimulus/stimulus.h"
 
 namespace blurcue::session {
@@ -50,7 +50,7 @@ class Presenter {
   // Composes the stimulus t_s after onset at the adjustment `level` (StimulusRenderer::Compose).
   virtual void Compose(const stimulus::TrialScene& scene, double t_s, double level) = 0;
   // What the last composed frame showed of a pair (radii in photo px); empty sides for pictures and wiped balls.
-  virtual const std::array<std::optional<render::BlurredObject>, 2>& Shown() const = 0;
+  virtual const std::array<std::optional<scene::BlurredObject>, 2>& Shown() const = 0;
   // Puts a trial's frame on the screen for the next flip.
   virtual void ShowStimulus(const StimulusFrame& frame) = 0;
 

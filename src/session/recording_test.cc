@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "render/frame_compositor.h"
+#include "scene/frame.h"
 #include "stimulus/test_scenes.h"
 #include "store/export.h"
 
@@ -29,7 +29,7 @@ TEST(TrialVariables, GridTrialRecordsEachRadiusInPhotoPxScreenPxAndArcmin) {
   // whole shown pixels (1622 of 1622.8); on the default monitor (37.84 px per degree) that is the arcmin.
   Presentation shown;
   shown.frame_width_px = 4592, shown.frame_height_px = 3056, shown.window_width_px = 1920, shown.window_height_px = 1080;
-  shown.scale = render::FitScale(4592, 3056, 1920, 1080);
+  shown.scale = scene::FitScale(4592, 3056, 1920, 1080);
   const Json v = TrialVariables(PairTrial({{"edge", 2}}, "measured", "fitted"), far, shown);
   for (const char* key : {"edge", "practice", "block_name", "swapped", "r_left_px", "r_right_px", "r_scene_px",
                           "r_left_screen_px", "r_right_arcmin", "r_scene_arcmin", "screen_px_per_photo_px"})

@@ -70,7 +70,7 @@ class FakePresenter : public Presenter {
     shown_ = stimulus::ObjectsAt(prepared_.protocol, *prepared_.scene, scene, t_s);
     composed_levels.push_back(scene.level);
   }
-  const std::array<std::optional<render::BlurredObject>, 2>& Shown() const override { return shown_; }
+  const std::array<std::optional<scene::BlurredObject>, 2>& Shown() const override { return shown_; }
   void ShowStimulus(const StimulusFrame& frame) override {
     if (frame.index == 0) trials_shown.push_back(frame.trial->index);
   }
@@ -99,7 +99,7 @@ class FakePresenter : public Presenter {
 
  private:
   const PreparedSession& prepared_;
-  std::array<std::optional<render::BlurredObject>, 2> shown_;
+  std::array<std::optional<scene::BlurredObject>, 2> shown_;
   double clock_s_ = 0;
 };
 

@@ -29,7 +29,7 @@ StimulusRenderer::StimulusRenderer(const protocol::Protocol& protocol, const std
     return;
   }
   if (!scene_) scene_ = LoadProtocolScene(protocol);
-  texture_ = render::SurfaceTexture(images.texture);
+  texture_ = scene::SurfaceTexture(images.texture);
   compositor_ = std::make_unique<render::FrameCompositor>(scene_->camera, scene_->rvec, scene_->tvec, photo_,
                                                           presentation.view);
 }
@@ -40,7 +40,7 @@ const cv::Mat& StimulusRenderer::UpperHalf(double level) {
   auto cached = std::find_if(upper_cache_.begin(), upper_cache_.end(),
                              [&](const auto& entry) { return entry.first == level; });
   if (cached != upper_cache_.end()) return cached->second;
-  const render::DepthMatchingLayout& l = presentation_.layout;
+  const scene::DepthMatchingLayout& l = presentation_.layout;
   upper_cache_.emplace_back(level, render::PictureOnGrey(picture_, l.upper.size(), l.picture.height, level));
   return upper_cache_.back().second;
 }
@@ -50,7 +50,7 @@ cv::Size StimulusRenderer::FrameSize() const {
   return presentation_.layout.frame;
 }
 
-render::FrameView StimulusRenderer::View() const {
+scene::FrameView StimulusRenderer::View() const {
   return compositor_ ? compositor_->view() : presentation_.view;
 }
 
@@ -66,7 +66,7 @@ void StimulusRenderer::Prepare(const TrialScene& trial) {
     }
     return;
   }
-  const render::FrameView v = presentation_.ViewFor(protocol_, *scene_, trial);
+  const scene::FrameView v = presentation_.ViewFor(protocol_, *scene_, trial);
   compositor_->Place(v.x_px, v.y_px);  // redraws the base only when the place changed
 }
 
@@ -105,7 +105,7 @@ void StimulusRenderer::Finish() {
 cv::Mat StimulusRenderer::Read() {
   if (compositor_) return compositor_->Read();
   // The picture's frame where the window shows it, on the grey field.
-  const render::FrameView& v = presentation_.view;
+  const scene::FrameView& v = presentation_.view;
   cv::Mat window(v.height_px, v.width_px, CV_8UC3, cv::Scalar::all(128));
   cv::Mat bgr = picture_frame_;
   if (bgr.channels() == 4) cv::cvtColor(bgr, bgr, cv::COLOR_BGRA2BGR);

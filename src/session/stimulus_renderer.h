@@ -13,6 +13,7 @@
 #include "protocol/protocol.h"
 #include "render/blur.h"
 #include "render/frame_compositor.h"
+#include "scene/frame.h"
 #include "stimulus/stimulus.h"
 
 namespace blurcue::session {
@@ -37,9 +38,9 @@ class StimulusRenderer {
   void Compose(const stimulus::TrialScene& trial, double t_s, double level);
   // What the last composed frame showed of a pair (ObjectsAt, as drawn; radii in photo px): empty sides for
   // pictures and wiped balls.
-  const std::array<std::optional<render::BlurredObject>, 2>& Shown() const { return shown_; }
+  const std::array<std::optional<scene::BlurredObject>, 2>& Shown() const { return shown_; }
   // Where the last composed frame showed the photo (pairs; the identity of the frame for a picture).
-  render::FrameView View() const;
+  scene::FrameView View() const;
   // Shows the last composed frame in the current window, fitted to width x height.
   void Present(int width_px, int height_px);
   // Waits until the last composed frame is drawn (for timing).
@@ -52,8 +53,8 @@ class StimulusRenderer {
   std::optional<calib::SceneCalib> scene_;
   stimulus::Presentation presentation_;
   cv::Mat photo_;
-  render::SurfaceTexture texture_;
-  std::vector<render::BlurredObject> objects_;  // the frame's objects for the compositor, kept between frames  // the objects' texture: one GL texture for the session
+  scene::SurfaceTexture texture_;  // the objects' texture: one GL texture for the session
+  std::vector<scene::BlurredObject> objects_;  // the frame's objects for the compositor, kept between frames
   std::unique_ptr<render::FrameCompositor> compositor_;
   // Picture: the upper half at a cut-off, made once (the Butterworth runs on the CPU) and kept; every level of
   // the protocol is made up front.
@@ -65,7 +66,7 @@ class StimulusRenderer {
   bool picture_stale_ = true;                          // picture_frame_ changed since it was last uploaded
   double lower_distance_m_ = -1;  // the distance whose real photo lower_ shows (one at a time: 27 would hold ~50 MB)
   cv::Mat lower_;                 // the frame's lower half, scaled once per trial
-  std::array<std::optional<render::BlurredObject>, 2> shown_;
+  std::array<std::optional<scene::BlurredObject>, 2> shown_;
 };
 
 }  // namespace blurcue::session

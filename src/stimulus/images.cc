@@ -7,7 +7,7 @@
 
 #include "core/error.h"
 #include "core/image.h"
-#include "render/stimuli.h"
+#include "scene/stimuli.h"
 #include "stimulus/internal.h"
 
 namespace blurcue::stimulus {
@@ -71,7 +71,7 @@ StimulusImages LoadStimulusImages(const protocol::Protocol& protocol, const std:
   }
   if (protocol.content.type == "picture") {
     images.picture = ReadFieldImage(protocol, "/content/image",
-                                    protocol.content.image.empty() ? render::ResolveStimulus("face")
+                                    protocol.content.image.empty() ? scene::ResolveStimulus("face")
                                                                    : protocol.content.image,
                                     -1, 10, kMaxPhotoSidePx);
     return images;
@@ -88,7 +88,7 @@ StimulusImages LoadStimulusImages(const protocol::Protocol& protocol, const std:
   const bool shipped = name == "grid" || name == "soccer" || name == "wood";
   std::filesystem::path texture;
   try {
-    texture = render::ResolveStimulus(name);
+    texture = scene::ResolveStimulus(name);
   } catch (const std::exception& e) {
     throw InputError(At(protocol, shipped ? "/content/type" : "/content/texture"), e.what());
   }
@@ -96,7 +96,7 @@ StimulusImages LoadStimulusImages(const protocol::Protocol& protocol, const std:
                                   kMaxTextureSidePx);
   // A grid card of another count of cells than the shipped 5 x 5 is drawn here, at the shipped card's resolution.
   if (name == "grid" && protocol.content.cells != 5)
-    images.texture = render::GridBoard(images.texture.cols, protocol.content.cells);
+    images.texture = scene::GridBoard(images.texture.cols, protocol.content.cells);
   // An image on a card of a given size: its pixels keep their shape, or the card says another.
   if (protocol.content.type == "grid" && !shipped) {
     const protocol::Content& c = protocol.content;

@@ -29,7 +29,7 @@ inline double ExtentPx(const std::vector<cv::Point2d>& outline) {
 
 // What a pair trial shows at the start and at the end of its run (the same twice for a still one; the end taken just
 // before a section run's wipe): where a check of its whole extent looks.
-inline std::array<std::array<std::optional<render::BlurredObject>, 2>, 2> RunEnds(const protocol::Protocol& protocol,
+inline std::array<std::array<std::optional<scene::BlurredObject>, 2>, 2> RunEnds(const protocol::Protocol& protocol,
                                                                          const calib::SceneCalib& scene,
                                                                          const TrialScene& trial) {
   return {ObjectsAt(protocol, scene, trial, 0),

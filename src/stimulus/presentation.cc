@@ -6,9 +6,8 @@
 #include <opencv2/calib3d.hpp>
 
 #include "core/error.h"
-#include "render/blur.h"
-#include "render/frame_compositor.h"
-#include "render/scene_render.h"
+#include "scene/frame.h"
+#include "scene/objects.h"
 #include "stimulus/internal.h"
 
 namespace blurcue::stimulus {
@@ -26,7 +25,7 @@ Presentation Presentation::Of(const protocol::Protocol& protocol, const Stimulus
   const int W = p.window_width_px, H = p.window_height_px - p.prompt_band_px;
   if (protocol.content.type == "picture") {
     // The depth-matching frame, 4:3, as large as the window holds (the thesis's 960 x 720 in a 1280 x 720 one).
-    p.layout = render::DepthMatchingLayout::Of(std::min(W, H * 4 / 3), images.picture.size());
+    p.layout = scene::DepthMatchingLayout::Of(std::min(W, H * 4 / 3), images.picture.size());
     p.frame_width_px = p.layout.frame.width;
     p.frame_height_px = p.layout.frame.height;
     p.scaling = "fit";
@@ -44,7 +43,7 @@ Presentation Presentation::Of(const protocol::Protocol& protocol, const Stimulus
   const Scaling scaling = protocol.display.scaling;
   double scale = 1;
   switch (scaling) {
-    case Scaling::kFit: scale = render::FitScale(w, h, W, H), p.scaling = "fit"; break;
+    case Scaling::kFit: scale = scene::FitScale(w, h, W, H), p.scaling = "fit"; break;
     case Scaling::kNative: scale = 1, p.scaling = "native"; break;
     case Scaling::kScale: scale = protocol.display.scale, p.scaling = "scale"; break;
     case Scaling::kDegrees:
@@ -68,19 +67,19 @@ Presentation Presentation::Of(const protocol::Protocol& protocol, const Stimulus
 }
 
 double Presentation::LevelScreenPx(double cutoff) const {
-  return cutoff > 0 ? ScreenPx(2 * render::ButterworthEquivalentSigma(cutoff) * layout.picture.width) : 0;
+  return cutoff > 0 ? ScreenPx(2 * scene::ButterworthEquivalentSigma(cutoff) * layout.picture.width) : 0;
 }
 
-render::FrameView Presentation::ViewFor(const protocol::Protocol& protocol, const calib::SceneCalib& scene,
+scene::FrameView Presentation::ViewFor(const protocol::Protocol& protocol, const calib::SceneCalib& scene,
                                         const TrialScene& trial) const {
-  render::FrameView v = view;
+  scene::FrameView v = view;
   if (v.photo_width_px <= v.width_px && v.photo_height_px <= v.height_px - prompt_band_px) return v;
   // What the trial shows, in photo px: both objects at the start and at the end of their run.
   cv::Rect shows;
   for (const auto& objects : RunEnds(protocol, scene, trial))
     for (const auto& object : objects)
       if (object) {
-        const cv::Rect b = render::FootprintOf(scene.camera, scene.rvec, scene.tvec, object->object).bounds;
+        const cv::Rect b = scene::FootprintOf(scene.camera, scene.rvec, scene.tvec, object->object).bounds;
         shows = shows.empty() ? b : (shows | b);
       }
   if (shows.empty()) return v;
@@ -97,7 +96,7 @@ render::FrameView Presentation::ViewFor(const protocol::Protocol& protocol, cons
 }
 
 Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, const Presentation& presentation,
-                   const render::FrameView& view, const std::array<std::optional<render::BlurredObject>, 2>& shown,
+                   const scene::FrameView& view, const std::array<std::optional<scene::BlurredObject>, 2>& shown,
                    double cutoff) {
   const display::Profile& profile = presentation.profile;
   auto round = [](double x, double unit) {  // to a decimal unit, printed as such
@@ -119,7 +118,7 @@ Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, cons
       {"objects", Json::array()}};
   if (trial.content == "picture") {
     // The frame is shown at one screen px per frame px where `view` places it.
-    const render::DepthMatchingLayout& l = presentation.layout;
+    const scene::DepthMatchingLayout& l = presentation.layout;
     auto on_screen = [&](const cv::Rect& r) { return Json{view.x_px + r.x, view.y_px + r.y, r.width, r.height}; };
     frame["picture"] = {{"rect_px", on_screen(l.picture)},
                         {"cutoff", cutoff},
@@ -139,8 +138,8 @@ Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, cons
   const Camera camera = view.CameraOf(scene->camera);
   for (int side = 0; side < 2; ++side) {
     if (!shown[size_t(side)]) continue;
-    const render::BlurredObject& b = *shown[size_t(side)];
-    const std::vector<cv::Point2d> outline = render::OutlineOf(camera, scene->rvec, scene->tvec, b.object);
+    const scene::BlurredObject& b = *shown[size_t(side)];
+    const std::vector<cv::Point2d> outline = scene::OutlineOf(camera, scene->rvec, scene->tvec, b.object);
     std::vector<cv::Point2d> centre;
     cv::projectPoints(std::vector<cv::Point3d>{cv::Point3d(b.object.center_board_mm)}, scene->rvec, scene->tvec,
                       cv::Matx33d(camera.Intrinsics().data()), camera.dist_coeffs, centre);
@@ -148,7 +147,7 @@ Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, cons
     for (const cv::Point2d& p : outline) polygon.push_back({round(p.x, 1e-3), round(p.y, 1e-3)});
     frame["objects"].push_back(
         {{"side", side == 0 ? "left" : "right"},
-         {"kind", b.object.kind == render::VirtualObject::Kind::kBall ? "ball" : "card"},
+         {"kind", b.object.kind == scene::VirtualObject::Kind::kBall ? "ball" : "card"},
          {"source", calib::ToString(side == 0 ? trial.left : trial.right)},
          {"kernel", b.method},
          {"center_px", {round(centre[0].x, 1e-3), round(centre[0].y, 1e-3)}},

@@ -23,9 +23,7 @@
 #include "display/profile.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
-
-#include "render/blur.h"
-#include "render/frame_compositor.h"
+#include "scene/frame.h"
 
 namespace blurcue::stimulus {
 
@@ -81,7 +79,7 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
 // What a pair trial (grid or ball) shows t_s after onset: each side's object where it is at that moment and the blur
 // radius (photo px) it gets there; [0] left, [1] right, empty for a ball wiped at the end of its section. No GL:
 // StimulusRenderer::Compose draws exactly these, and the runner records each frame's radii from them.
-std::array<std::optional<render::BlurredObject>, 2> ObjectsAt(const protocol::Protocol& protocol,
+std::array<std::optional<scene::BlurredObject>, 2> ObjectsAt(const protocol::Protocol& protocol,
                                                               const calib::SceneCalib& scene, const TrialScene& trial,
                                                               double t_s);
 
@@ -133,25 +131,25 @@ struct Presentation {
   // A band this high at the bottom of the window holds the response prompt (responses.prompt; 0: none): the
   // stimulus is fitted, centred and cropped in the window above it.
   int prompt_band_px = 0;
-  render::FrameView view;   // the photo's place before a trial moves it (centred, or letterboxed when it fits)
+  scene::FrameView view;   // the photo's place before a trial moves it (centred, or letterboxed when it fits)
   display::Profile profile;
 
   // picture: the frame's parts (frame px; the virtual picture's outline among them), and the frame px per px of the
   // real photos' camera (content.real_camera, the lower half's scale; 0 without one).
-  render::DepthMatchingLayout layout;
+  scene::DepthMatchingLayout layout;
   double real_frame_px_per_px = 0;
 
   double ScreenPx(double frame_px) const { return frame_px * scale; }
   double Arcmin(double frame_px) const { return display::ArcminOfScreenPx(profile, ScreenPx(frame_px)); }
   // picture: the blur as shown (blurcue's r, arcmin) of the virtual picture low-passed at `cutoff` cycles per picture
-  // width (its equivalent Gaussian, render::ButterworthEquivalentSigma; 0 = sharp), and of the real picture blurred
+  // width (its equivalent Gaussian, scene::ButterworthEquivalentSigma; 0 = sharp), and of the real picture blurred
   // by r_camera_px (px of the real camera's full image).
   double LevelArcmin(double cutoff) const { return display::ArcminOfScreenPx(profile, LevelScreenPx(cutoff)); }
   double LevelScreenPx(double cutoff) const;
   double RealArcmin(double r_camera_px) const { return Arcmin(r_camera_px * real_frame_px_per_px); }
   // Where a pair trial shows the photo: `view` when the scaled photo fits the window; else cropped so that what the
   // trial shows (both objects over their whole run) is centred, as far as the photo reaches.
-  render::FrameView ViewFor(const protocol::Protocol& protocol, const calib::SceneCalib& scene,
+  scene::FrameView ViewFor(const protocol::Protocol& protocol, const calib::SceneCalib& scene,
                             const TrialScene& trial) const;
   // Throws Error(kInput) naming /display/width_deg or /display/scale when the photo would be smaller than 8 px or
   // larger than 16384 px on screen.
@@ -167,7 +165,7 @@ struct Presentation {
 // blur; cutoff, the level shown; its blur as r_screen_px and r_arcmin; width_arcmin) and the real one (rect_px, the
 // lower half; distance_m; with content.real_camera its blur as r_camera_px, r_screen_px and r_arcmin).
 Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, const Presentation& presentation,
-                   const render::FrameView& view, const std::array<std::optional<render::BlurredObject>, 2>& shown,
+                   const scene::FrameView& view, const std::array<std::optional<scene::BlurredObject>, 2>& shown,
                    double cutoff = 0);
 
 // Reads every image the protocol names: each must decode as an image of a size its use can show. Throws

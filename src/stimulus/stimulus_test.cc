@@ -1,7 +1,7 @@
 // What a trial shows, worked out without GL: placement, motion and radii per side.
 #include "stimulus/stimulus.h"
 
-#include "render/frame_compositor.h"
+#include "scene/frame.h"
 
 #include <gtest/gtest.h>
 
@@ -170,7 +170,7 @@ TEST(DescribeTrial, GridCardsSitBesideTheBoardAtTheirEdge) {
   // whole shown pixels (1622 of 1622.8); on the default monitor (37.84 px per degree) that is the arcmin.
   Presentation shown;
   shown.frame_width_px = 4592, shown.frame_height_px = 3056, shown.window_width_px = 1920, shown.window_height_px = 1080;
-  shown.scale = render::FitScale(4592, 3056, 1920, 1080);
+  shown.scale = scene::FitScale(4592, 3056, 1920, 1080);
   EXPECT_DOUBLE_EQ(shown.scale, 1622.0 / 4592.0);
   // What is recorded of it in photo px, screen px and arcmin: session's TrialVariables
   // (TrialVariables.GridTrialRecordsEachRadiusInPhotoPxScreenPxAndArcmin).
@@ -185,7 +185,7 @@ TEST(PlanOnScreen, PerPixelExactlyWhenTheObjectsDepthSpanReachesTheThresholdOnSc
   TrialScene t = DescribeTrial(p, PairTrial({{"edge", 2}}, "fitted", "fitted"), &scene);
   Presentation shown;
   shown.scale = 0.5;
-  const render::VirtualObject card = render::CardBesideBoard(scene.board, 2, true);
+  const scene::VirtualObject card = scene::CardBesideBoard(scene.board, 2, true);
   auto r_at = [&](double y) {
     return calib::BlurAtPx(scene, calib::BlurSource::kFitted, scene.ToCamera({card.center_board_mm[0], y, 0}));
   };

@@ -8,7 +8,7 @@
 #include <limits>
 
 #include "core/error.h"
-#include "render/scene_render.h"
+#include "scene/objects.h"
 #include "stimulus/internal.h"
 
 namespace blurcue::stimulus {
@@ -42,10 +42,10 @@ calib::BlurSource Source(const Json& v, double* fixed, const std::function<std::
   }
 }
 
-// Board-frame placement of the two objects of a pair (render's poses on the board; x and y in mm where the trial
+// Board-frame placement of the two objects of a pair (scene's poses on the board; x and y in mm where the trial
 // says so).
-render::VirtualObject Card(const calib::SceneCalib& s, const TrialScene& t, bool left) {
-  render::VirtualObject o = render::CardBesideBoard(s.board, 1, left, t.card_width_mm);
+scene::VirtualObject Card(const calib::SceneCalib& s, const TrialScene& t, bool left) {
+  scene::VirtualObject o = scene::CardBesideBoard(s.board, 1, left, t.card_width_mm);
   o.card_height_mm = t.card_height_mm;
   o.standing = t.standing;
   o.rotation_deg = t.rotation_deg;
@@ -55,9 +55,9 @@ render::VirtualObject Card(const calib::SceneCalib& s, const TrialScene& t, bool
   o.center_board_mm = {std::isnan(x) ? o.center_board_mm[0] : x, t.from_y_mm, t.height_mm + (t.standing ? h / 2 : 0)};
   return o;
 }
-render::VirtualObject Ball(const calib::SceneCalib& s, const TrialScene& t, double y_mm, double radius_mm, bool left) {
-  render::VirtualObject o =
-      render::BallOnBoard(s.board, left ? kLeftSection : kRightSection, y_mm, radius_mm, t.from_y_mm);
+scene::VirtualObject Ball(const calib::SceneCalib& s, const TrialScene& t, double y_mm, double radius_mm, bool left) {
+  scene::VirtualObject o =
+      scene::BallOnBoard(s.board, left ? kLeftSection : kRightSection, y_mm, radius_mm, t.from_y_mm);
   const double x = left ? t.left_x_mm : t.right_x_mm;
   if (!std::isnan(x)) o.center_board_mm[0] = x;
   o.center_board_mm[2] += t.height_mm;
@@ -88,7 +88,7 @@ void CheckInPhoto(const protocol::Protocol& protocol, const protocol::Trial& tri
     for (size_t side = 0; side < 2; ++side) {
       // An intervals trial shows the right side's object at the left's place (IntervalScene): side 0's check is its.
       if (!objects[side] || (side == 1 && t.intervals > 0)) continue;
-      if ((render::FootprintOf(scene.camera, scene.rvec, scene.tvec, objects[side]->object).bounds & photo).empty()) {
+      if ((scene::FootprintOf(scene.camera, scene.rvec, scene.tvec, objects[side]->object).bounds & photo).empty()) {
         const char* level = t.content == "grid" ? (std::isnan(side == 0 ? t.left_x_mm : t.right_x_mm) ? "edge"
                                                    : side == 0 ? "left_x_mm" : "right_x_mm")
                                                 : "speed_cm_s";
@@ -263,14 +263,14 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   return t;
 }
 
-std::array<std::optional<render::BlurredObject>, 2> ObjectsAt(const protocol::Protocol& protocol,
+std::array<std::optional<scene::BlurredObject>, 2> ObjectsAt(const protocol::Protocol& protocol,
                                                               const calib::SceneCalib& s, const TrialScene& trial,
                                                               double t_s) {
-  std::array<std::optional<render::BlurredObject>, 2> shown;
+  std::array<std::optional<scene::BlurredObject>, 2> shown;
   for (const bool left : {true, false}) {
     if (!left && trial.left_only) continue;
-    render::BlurredObject b;
-    render::VirtualObject& o = b.object;
+    scene::BlurredObject b;
+    scene::VirtualObject& o = b.object;
     const calib::BlurSource source = left ? trial.left : trial.right;
     const double fixed = left ? trial.left_fixed_px : trial.right_fixed_px;
     const double gain = left ? trial.left_gain : trial.right_gain, add = left ? trial.left_add_px : trial.right_add_px;
@@ -349,7 +349,7 @@ void PlanOnScreen(const protocol::Protocol& protocol, const calib::SceneCalib& s
   for (const auto& shown : ends)
     for (const auto& object : shown) {
       if (!object) continue;
-      const render::Footprint f = render::FootprintOf(s.camera, s.rvec, s.tvec, object->object);
+      const scene::Footprint f = scene::FootprintOf(s.camera, s.rvec, s.tvec, object->object);
       span = std::max(span, presentation.ScreenPx(std::abs(object->r_of_depth_px(f.z_max_mm) -
                                                            object->r_of_depth_px(f.z_min_mm))));
     }
@@ -359,7 +359,7 @@ void PlanOnScreen(const protocol::Protocol& protocol, const calib::SceneCalib& s
   for (size_t side = 0; side < 2; ++side)
     (side == 0 ? trial->size_left_deg : trial->size_right_deg) =
         onset[side] ? display::ArcminOfScreenPx(presentation.profile,
-                                                presentation.ScreenPx(ExtentPx(render::OutlineOf(
+                                                presentation.ScreenPx(ExtentPx(scene::OutlineOf(
                                                     s.camera, s.rvec, s.tvec, onset[side]->object)))) /
                           60
                     : 0;

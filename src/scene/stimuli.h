@@ -1,6 +1,6 @@
 #pragma once
 // The study's stimulus textures, drawn procedurally (no downloaded images) and deterministically, as 8-bit sRGB.
-// Spherical textures are equirectangular in the convention of the ball in scene_render.cc: texel (x, y) of a
+// Spherical textures are equirectangular in the convention of the ball in render/scene_render.cc: texel (x, y) of a
 // W x H image (W = 2H) looks along theta = pi (y + 0.5) / H from +z, phi = 2 pi (x + 0.5) / W from +x towards +y.
 #include <cstdint>
 #include <filesystem>
@@ -9,9 +9,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "core/camera.h"
-
-namespace blurcue::render {
+namespace blurcue::scene {
 
 // A stimulus by name or path: an existing file as given, else the shipped stimuli/NAME.png (soccer, wood, grid,
 // face). Throws Error(kInput) naming both places when neither exists.
@@ -44,16 +42,8 @@ double GridLineWidthPx(int size_px, int cells = 5);
 // transparent outside the head. 8-bit sRGB BGRA, width_px x 1.5 width_px; width_px must be even and >= 16.
 cv::Mat FacePicture(int width_px);
 
-// A photo of the real picture in the depth-matching study, made with the thin lens (no photos needed to try the
-// study): `picture` (8-bit sRGB, alpha = its shape) picture_height_mm high, facing `camera` at distance_mm on the
-// optical axis, imaged at magnification f / (u - f) and blurred by the disc of the thin-lens radius for a lens
-// focused at focus_mm, over a uniform wall of linear grey `grey`, in linear light. 8-bit BGR sRGB at the camera's
-// resolution. Throws Error(kDomain) for a distance or focus not beyond the focal length.
-cv::Mat RealPicturePhoto(const cv::Mat& picture, const Camera& camera, double focus_mm, double distance_mm,
-                         double picture_height_mm = 120, double grey = 0.18);
-
 // Writes soccer.png (2048 x 1024), wood.png (2048 x 1024, seed 1), grid.png (1024 x 1024) and face.png
 // (800 x 1200) into dir (created if needed); returns the files written. Throws Error naming a file on failure.
 std::vector<std::filesystem::path> WriteStandardStimuli(const std::filesystem::path& dir);
 
-}  // namespace blurcue::render
+}  // namespace blurcue::scene
