@@ -1,5 +1,7 @@
 // What a new session checks and records of its study and participant, inside StartOrResumeSession's transaction:
 // protocol versions kept apart, the design recorded once per version, the session's number and a seed of its own.
+#include <algorithm>
+#include <array>
 #include <charconv>
 #include <string>
 
@@ -94,15 +96,40 @@ void Record::CheckProtocolVersion(int64_t study_id, const std::string& study, co
                                    way_out);
 }
 
-void Record::SaveDesign(int64_t protocol_id, int64_t version, const std::vector<DesignColumnRecord>& design) {
+void Record::SaveDesign(int64_t protocol_id, const std::string& study, int64_t version,
+                        const std::vector<DesignColumnRecord>& design) {
   Statement set(db_, "UPDATE protocol_versions SET version = ? WHERE id = ? AND version IS NULL");
   set.Bind(1, version);
   set.Bind(2, protocol_id);
   set.Run();
-  // Once per protocol version: its sessions share one text, so one design.
-  if (design.empty() ||
-      db_.QueryInt64("SELECT count(*) FROM design_columns WHERE protocol_version_id = " + std::to_string(protocol_id)) > 0)
-    return;
+  if (design.empty()) return;
+  // Once per protocol version: its sessions share one text, so one design - unless a file the text names changed
+  // (a conditions table's rows are not in the text). Such a session used to be recorded under the same version,
+  // the codebook giving the first session's values for both.
+  Statement recorded(db_, "SELECT name, role, allowed FROM design_columns WHERE protocol_version_id = ? "
+                          "ORDER BY position");
+  recorded.Bind(1, protocol_id);
+  std::vector<std::array<std::string, 3>> before;
+  while (recorded.Step()) before.push_back({recorded.GetText(0), recorded.GetText(1), recorded.GetText(2)});
+  if (!before.empty()) {
+    std::string change;
+    for (size_t i = 0; i < std::max(before.size(), design.size()) && change.empty(); ++i) {
+      if (i >= design.size()) change = "column " + before[i][0] + " in the record, absent now";
+      else if (i >= before.size()) change = "column " + design[i].name + " absent in the record, present now";
+      else if (before[i][0] != design[i].name || before[i][1] != design[i].role)
+        change = "column " + before[i][0] + " (" + before[i][1] + ") in the record, " + design[i].name + " (" +
+                 design[i].role + ") now";
+      else if (before[i][2] != AllowedText(design[i]))
+        change = "column " + design[i].name + ": " + before[i][2] + " in the record, " + AllowedText(design[i]) +
+                 " now";
+    }
+    if (change.empty()) return;
+    throw InputError(db_.path(), "study " + study + " records protocol version " + std::to_string(version) +
+                                     " with another design (" + change + "): the text is the same, so a file it "
+                                     "names (a conditions table) has changed; raise \"version\" to " +
+                                     std::to_string(version + 1) +
+                                     " to record it as a new version, or use another record (--db)");
+  }
   Statement insert(db_, "INSERT INTO design_columns (protocol_version_id, position, name, role, type, unit, allowed) "
                         "VALUES (?, ?, ?, ?, ?, ?, ?)");
   int64_t position = 0;

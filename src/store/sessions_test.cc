@@ -164,6 +164,28 @@ TEST(Record, DesignIsRecordedOncePerProtocolVersionWithNumericLevelsInOrder) {
             "info_age:label:integer:years:>= 18");
 }
 
+// A conditions table is a file the protocol names, not part of its text: edited (edge 2 -> 3) under an unchanged
+// text, a new session used to be recorded under the same version, its codebook giving the first table's values.
+// Now the design recorded with the version is compared, and a different one refused as a changed protocol.
+TEST(Record, SameTextWithAnotherDesignIsRefusedAsAChangedProtocol) {
+  Record record = Record::Open(":memory:");
+  SessionMeta meta = Version(1);
+  meta.design = {DesignColumnRecord{"edge", "within", "integer", "", {2, 9}, {}, {}, {}}};
+  Complete(record, "P1", kV1, 11, meta);
+  Complete(record, "P2", kV1, 21, meta);  // the same design: fine
+  meta.design[0].numbers = {3, 9};
+  EXPECT_EQ(ErrorOf([&] { record.StartOrResumeSession("s", "P3", kV1, 31, meta, false); }),
+            ":memory:: study s records protocol version 1 with another design (column edge: 2|9 in the record, 3|9 "
+            "now): the text is the same, so a file it names (a conditions table) has changed; raise \"version\" to "
+            "2 to record it as a new version, or use another record (--db)");
+  EXPECT_EQ(record.database().QueryInt64("SELECT count(*) FROM sessions"), 2);
+  meta.design.push_back(DesignColumnRecord{"label", "label", "string", "", {}, {"near"}, {}, {}});
+  meta.design[0].numbers = {2, 9};
+  EXPECT_NE(ErrorOf([&] { record.StartOrResumeSession("s", "P3", kV1, 31, meta, false); }).find(
+                "(column label absent in the record, present now)"),
+            std::string::npos);
+}
+
 TEST(Record, ProcedureTrialKeepsItsCellByLevels) {
   Record record = Record::Open(":memory:");
   const int64_t session = record.StartOrResumeSession("s", "P1", kV1, 11, {}, false).session_id;
