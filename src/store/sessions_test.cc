@@ -268,6 +268,26 @@ TEST(Merge, SessionNumbersFollowTheStartAcrossInputsAndChangesAreTold) {
 namespace blurcue::store {
 namespace {
 
+// Two stations each ran P1's first session with the default seed (so one trial order): merged, P1 has sessions 1
+// and 2 with one seed, which run refuses to make - likely two people given one id. It used to pass untold.
+TEST(Merge, OneParticipantsSessionsWithOneSeedAtTwoStationsAreTold) {
+  testing::TempDir dir;
+  for (const char* name : {"a.sqlite", "b.sqlite"}) {
+    Record record = Record::Open(dir / name);
+    Complete(record, "P1", kV1, 11);
+    Complete(record, "P2", kV1, name[0] == 'a' ? 21 : 22);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  std::vector<std::string> notes;
+  MergeDatabases({dir / "a.sqlite", dir / "b.sqlite"}, dir / "m.sqlite",
+                 [&](const std::string& line) { notes.push_back(line); });
+  ASSERT_FALSE(notes.empty());
+  EXPECT_EQ(notes.back(), "study s, participant P1: sessions 1, 2 in the merged record ran with one seed, so in one "
+                          "trial order - two people given one id at two stations, or one person shown the same order "
+                          "twice; check before analysing them as one participant");
+  for (const std::string& line : notes) EXPECT_EQ(line.find("participant P2: sessions"), std::string::npos) << line;
+}
+
 TEST(Merge, AVersionRunWithTwoTextsAtTwoStationsIsMergedAndTold) {
   testing::TempDir dir;
   {
