@@ -1,8 +1,8 @@
 // What a new session checks and records of its study and participant, inside StartOrResumeSession's transaction:
 // protocol versions kept apart, the design recorded once per version, the session's number and a seed of its own.
 #include <algorithm>
-#include <array>
 #include <charconv>
+#include <map>
 #include <string>
 
 #include "core/error.h"
@@ -106,23 +106,30 @@ void Record::SaveDesign(int64_t protocol_id, const std::string& study, int64_t v
   // Once per protocol version: its sessions share one text, so one design - unless a file the text names changed
   // (a conditions table's rows are not in the text). Such a session used to be recorded under the same version,
   // the codebook giving the first session's values for both.
+  // Only the columns the levels set (roles within and procedure_cell) are compared: a label varies nothing, and a
+  // later build may describe the other columns otherwise.
+  auto varies = [](const std::string& role) { return role == "within" || role == "procedure_cell"; };
   Statement recorded(db_, "SELECT name, role, allowed FROM design_columns WHERE protocol_version_id = ? "
                           "ORDER BY position");
   recorded.Bind(1, protocol_id);
-  std::vector<std::array<std::string, 3>> before;
-  while (recorded.Step()) before.push_back({recorded.GetText(0), recorded.GetText(1), recorded.GetText(2)});
-  if (!before.empty()) {
+  std::map<std::string, std::string> before, now;
+  bool any = false;
+  while (recorded.Step()) {
+    any = true;
+    if (varies(recorded.GetText(1))) before[recorded.GetText(0)] = recorded.GetText(2);
+  }
+  if (any) {
+    for (const DesignColumnRecord& c : design)
+      if (varies(c.role)) now[c.name] = AllowedText(c);
     std::string change;
-    for (size_t i = 0; i < std::max(before.size(), design.size()) && change.empty(); ++i) {
-      if (i >= design.size()) change = "column " + before[i][0] + " in the record, absent now";
-      else if (i >= before.size()) change = "column " + design[i].name + " absent in the record, present now";
-      else if (before[i][0] != design[i].name || before[i][1] != design[i].role)
-        change = "column " + before[i][0] + " (" + before[i][1] + ") in the record, " + design[i].name + " (" +
-                 design[i].role + ") now";
-      else if (before[i][2] != AllowedText(design[i]))
-        change = "column " + design[i].name + ": " + before[i][2] + " in the record, " + AllowedText(design[i]) +
-                 " now";
+    for (const auto& [name, allowed] : before) {
+      const auto it = now.find(name);
+      if (it == now.end()) change = "column " + name + " in the record, absent now";
+      else if (it->second != allowed) change = "column " + name + ": " + allowed + " in the record, " + it->second + " now";
+      if (!change.empty()) break;
     }
+    for (const auto& [name, allowed] : now)
+      if (change.empty() && !before.count(name)) change = "column " + name + " absent in the record, present now";
     if (change.empty()) return;
     throw InputError(db_.path(), "study " + study + " records protocol version " + std::to_string(version) +
                                      " with another design (" + change + "): the text is the same, so a file it "

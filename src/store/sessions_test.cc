@@ -179,11 +179,14 @@ TEST(Record, SameTextWithAnotherDesignIsRefusedAsAChangedProtocol) {
             "now): the text is the same, so a file it names (a conditions table) has changed; raise \"version\" to "
             "2 to record it as a new version, or use another record (--db)");
   EXPECT_EQ(record.database().QueryInt64("SELECT count(*) FROM sessions"), 2);
-  meta.design.push_back(DesignColumnRecord{"label", "label", "string", "", {}, {"near"}, {}, {}});
+  // A column the levels set, new: refused; a label or a column a later build describes otherwise: not compared.
   meta.design[0].numbers = {2, 9};
+  meta.design.push_back(DesignColumnRecord{"speed_cm_s", "within", "number", "cm/s", {1.8}, {}, {}, {}});
   EXPECT_NE(ErrorOf([&] { record.StartOrResumeSession("s", "P3", kV1, 31, meta, false); }).find(
-                "(column label absent in the record, present now)"),
+                "(column speed_cm_s absent in the record, present now)"),
             std::string::npos);
+  meta.design.back() = DesignColumnRecord{"label", "label", "string", "", {}, {"near"}, {}, {}};
+  EXPECT_EQ(record.StartOrResumeSession("s", "P3", kV1, 31, meta, false).session_number, 1);
 }
 
 TEST(Record, ProcedureTrialKeepsItsCellByLevels) {
