@@ -212,9 +212,13 @@ TEST(ProtocolValidate, BlockTitlePromptAndTimingAreChecked) {
   EXPECT_TRUE(Contains(OnlyProblem(j), "/blocks/0/title: must not contain control characters")) << OnlyProblem(j);
   j["blocks"][0]["title"] = "";
   EXPECT_EQ(OnlyProblem(j), Line("/blocks/0/title: must not be empty (leave it out for \"Part n of N\"), got \"\""));
+  j["blocks"][0]["title"] = "   ";  // blank: no title on screen, accepted before
+  EXPECT_EQ(OnlyProblem(j), Line("/blocks/0/title: must not be empty (leave it out for \"Part n of N\"), got \"   \""));
   j = Valid();
   j["blocks"][0]["prompt"] = "";
   EXPECT_EQ(OnlyProblem(j), Line("/blocks/0/prompt: must not be empty (leave it out for /responses/prompt), got \"\""));
+  j["blocks"][0]["prompt"] = " ";
+  EXPECT_EQ(OnlyProblem(j), Line("/blocks/0/prompt: must not be empty (leave it out for /responses/prompt), got \" \""));
   j = Valid();
   j["blocks"][0]["timing"] = {{"fixaton_ms", 200}};
   EXPECT_EQ(OnlyProblem(j), Line("/blocks/0/timing/fixaton_ms: unknown key (did you mean \"fixation_ms\"?), got 200"));
