@@ -1,5 +1,7 @@
 #include "protocol/design.h"
 
+#include "protocol/parser.h"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -36,12 +38,14 @@ std::string LevelName(const Json& level) {
 // The values one column takes, collected over blocks: numbers apart, so they are given in numeric order.
 struct Values {
   std::set<double> numbers;
+  std::map<double, std::string> number_texts;  // each number as trials.csv writes it (1, not 1.0), first seen
   std::vector<std::string> names;
   bool integers = true, others = false;
   void Add(const Json& v) {
     if (v.is_number()) {
       const double x = v.get<double>();
       numbers.insert(x);
+      number_texts.emplace(x, LevelName(v));
       if (!(std::isfinite(x) && x == std::floor(x))) integers = false;
       return;
     }
@@ -54,7 +58,8 @@ struct Values {
       c->type = ValueType::kString;
       c->names = names;
       for (double x : numbers) {
-        const std::string text = Json(x).dump();
+        // As the level's own text: a label [1, "a"] used to be allowed "a|1.0" while trials.csv holds 1.
+        const std::string& text = number_texts.at(x);
         if (std::find(c->names.begin(), c->names.end(), text) == c->names.end()) c->names.push_back(text);
       }
     } else {
@@ -115,7 +120,9 @@ std::vector<DesignColumn> DescribeDesign(const Protocol& protocol) {
     c.name = name;
     c.level = true;
     // An object level's id names the level (a pattern's) rather than varying the stimulus: a label beside it.
-    c.role = name == "id" ? Role::kLabel : cells.count(name) ? Role::kProcedureCell : Role::kWithin;
+    // A label (id, label, label_*: IsLabelName) is read by nothing; it used to be given the role within when a
+    // factor or a conditions column, varying nothing.
+    c.role = detail::IsLabelName(name) ? Role::kLabel : cells.count(name) ? Role::kProcedureCell : Role::kWithin;
     c.unit = UnitOf(name);
     values[name].Into(&c);
     columns.push_back(std::move(c));

@@ -75,12 +75,25 @@ TEST(DescribeDesign, LevelsOfTheDesignAreMarkedForTheRecordsNaming) {
 TEST(DescribeDesign, ConditionsRowIsNoColumnButItsColumnsAre) {
   Protocol p;
   Block b;
-  b.factors = {Levels("row", {Json{{"edge", 3}, {"note", "a"}}, Json{{"edge", 1}, {"note", "b"}}})};
+  b.factors = {Levels("row", {Json{{"edge", 3}, {"label", "a"}}, Json{{"edge", 1}, {"label", "b"}}})};
   p.blocks = {b};
   std::vector<std::string> got;
   for (const DesignColumn& c : DescribeDesign(p)) got.push_back(Describe(c));
-  EXPECT_EQ(got, (std::vector<std::string>{"edge within integer [] 1 3", "note within string [] 'a' 'b'",
+  EXPECT_EQ(got, (std::vector<std::string>{"edge within integer [] 1 3", "label label string [] 'a' 'b'",
                                            "practice practice boolean [] 0 1"}));
+}
+
+// A label factor or column (label, label_*) has the role label, not within (it varies nothing); one mixing numbers
+// and text allows each number as trials.csv writes it: 1, not 1.0.
+TEST(DescribeDesign, LabelsAreLabelsAndMixedLevelsAreWrittenAsTrialsCsvHoldsThem) {
+  Protocol p;
+  Block b;
+  b.factors = {Levels("edge", {2}), Levels("label_x", {1, "a", 2.5}), Levels("label_", {"x"})};
+  p.blocks = {b};
+  std::vector<std::string> got;
+  for (const DesignColumn& c : DescribeDesign(p)) got.push_back(Describe(c));
+  EXPECT_EQ(got, (std::vector<std::string>{"edge within integer [] 2", "label_x label string [] 'a' '1' '2.5'",
+                                           "label_ label string [] 'x'", "practice practice boolean [] 0 1"}));
 }
 
 TEST(CellLevels, AProcedureTrialNamesItsCellByItsLevels) {

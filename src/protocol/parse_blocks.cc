@@ -199,12 +199,14 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
   }
   if (auto s = Text(obj, "instructions", ptr, false, kMaxTextChars, false)) b->instructions = *s;
   // What the participant sees: a title of one line, a prompt of its own (the timing is read once the layout is known).
+  // Blank (spaces only) is empty: it used to pass and open the block with no title on screen.
+  auto blank = [](const std::string& t) { return t.find_first_not_of(' ') == std::string::npos; };
   if (auto s = Text(obj, "title", ptr, false, 100, true)) {
-    if (s->empty()) Problem(ptr + "/title", "must not be empty (leave it out for \"Part n of N\")", Json(*s));
+    if (blank(*s)) Problem(ptr + "/title", "must not be empty (leave it out for \"Part n of N\")", Json(*s));
     b->title = *s;
   }
   if (auto s = Text(obj, "prompt", ptr, false, 200, true)) {
-    if (s->empty()) Problem(ptr + "/prompt", "must not be empty (leave it out for /responses/prompt)", Json(*s));
+    if (blank(*s)) Problem(ptr + "/prompt", "must not be empty (leave it out for /responses/prompt)", Json(*s));
     b->prompt = *s;
   }
   if (auto s = Bool(obj, "shuffle", ptr)) b->shuffle = *s;

@@ -1,6 +1,7 @@
 #include "protocol/parser.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <map>
 
@@ -12,8 +13,12 @@ namespace blurcue::protocol::detail {
 void Parser::CheckReadName(const std::string& name, const std::string& what, const std::string& ptr,
                            const std::string& where) {
   if (IsValueName(name) || IsLabelName(name)) return;
+  // A name with a space at either end ("edge " from a CSV header) is quoted and said to be so: it used to read
+  // "a column edge  (did you mean edge?)", the difference invisible.
+  const bool padded = !name.empty() && (std::isspace((unsigned char)name.front()) || std::isspace((unsigned char)name.back()));
+  const std::string shown = padded ? "\"" + name + "\" (a space at its start or end)" : name;
   // A misspelt name used to be taken as a label: recorded with every trial while the level it meant was never set.
-  Problem(ptr, where + "no part of blurcue reads a " + what + " " + name + DidYouMean(name, ReadNames()) +
+  Problem(ptr, where + "no part of blurcue reads a " + what + " " + shown + DidYouMean(name, ReadNames()) +
                    "; to record it as a label nobody reads, name it label_" + name);
 }
 
@@ -145,6 +150,9 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
     Problem(ptr, e.what(), Json(*text));
     return {};
   }
+  // Excel's "CSV UTF-8" and Notepad begin the file with a byte order mark; it is not part of the first column's
+  // name (it used to be, and the column - edge - was refused as an unknown name that looked like edge).
+  if (csv.rfind("\xEF\xBB\xBF", 0) == 0) csv.erase(0, 3);
   // Comma-separated, double quotes around a field that holds commas or quotes ("" for one quote); a field does not
   // span lines, so a quote still open at the line's end is an error (it used to swallow the rest of the line).
   struct Row {

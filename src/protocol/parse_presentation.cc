@@ -1,6 +1,7 @@
 #include "protocol/parser.h"
 
 #include <algorithm>
+#include <cctype>
 #include <map>
 
 #include "core/error.h"
@@ -8,6 +9,19 @@
 #include "core/typed.h"
 
 namespace blurcue::protocol::detail {
+
+namespace {
+// Two names that differ only in ASCII letter case: one name, since a case slip is answered with the nearest
+// (--info handedness=Left: did you mean left?) - groups "a" and "A", or choices "left" and "Left", used to pass.
+bool SameButCase(const std::string& a, const std::string& b) {
+  return a != b && a.size() == b.size() &&
+         std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) { return std::tolower((unsigned char)x) ==
+                                                                              std::tolower((unsigned char)y); });
+}
+bool CaseTwin(const std::vector<std::string>& names, const std::string& name) {
+  return std::any_of(names.begin(), names.end(), [&](const std::string& n) { return SameButCase(n, name); });
+}
+}  // namespace
 
 void Parser::ParseScene(const Json& v, const std::string& ptr, Protocol* p) {
   if (!Object(v, ptr, {"background", "board_free", "calib", "show"})) return;
@@ -171,6 +185,9 @@ void Parser::ParseInfo(const Json& v, const std::string& ptr, Protocol* p) {
               !IsPrintableUtf8(choice.get<std::string>()) ||
               std::count(field.choices.begin(), field.choices.end(), choice.get<std::string>()))
             Problem(fp + "/choices/" + std::to_string(k), "must be a new answer of 1-100 characters", choice);
+          else if (CaseTwin(field.choices, choice.get<std::string>()))
+            Problem(fp + "/choices/" + std::to_string(k), "must differ from an earlier answer by more than letter case",
+                    choice);
           else
             field.choices.push_back(choice.get<std::string>());
         }
@@ -199,6 +216,8 @@ void Parser::ParseGroups(const Json& v, const Json& top, const std::string& ptr,
           !IsPrintableUtf8(n.get<std::string>()) ||
           std::count(g.names.begin(), g.names.end(), n.get<std::string>()))
         Problem(ptr + "/names/" + std::to_string(i), "must be a new name of 1-100 characters", n);
+      else if (CaseTwin(g.names, n.get<std::string>()))
+        Problem(ptr + "/names/" + std::to_string(i), "must differ from an earlier name by more than letter case", n);
       else
         g.names.push_back(n.get<std::string>());
     }

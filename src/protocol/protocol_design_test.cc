@@ -172,6 +172,24 @@ TEST(ProtocolValidate, ConditionsTableGivesTheDesignRowByRow) {
   EXPECT_TRUE(Contains(OnlyProblem(j), "/blocks/0/conditions: no such file")) << OnlyProblem(j);
 }
 
+// A table saved by Excel ("CSV UTF-8") or Notepad begins with a byte order mark: it used to become part of the
+// first column's name, so "edge" was refused as an unknown column that looked like edge. A header name with a space
+// at its end ("edge ") is refused with the name quoted, the space said; it used to read "a column edge  (did you
+// mean edge?)".
+TEST(ProtocolValidate, ConditionsTableWithAByteOrderMarkReadsItsFirstColumn) {
+  const fs::path dir = SceneFolder();
+  std::ofstream(dir / "bom.csv") << "\xEF\xBB\xBF" "edge,left,right\r\n1,measured,none\r\n";
+  Json j = Valid();
+  j["blocks"] = {{{"name", "rows"}, {"conditions", "bom.csv"}}};
+  EXPECT_TRUE(Problems(j).empty()) << Problems(j).front();
+  const Protocol p = ParseProtocol(j, dir / "p.json");
+  EXPECT_EQ(p.blocks[0].factors[0].levels[0]["edge"], 1);
+  std::ofstream(dir / "padded.csv") << "edge ,left,right\n1,measured,none\n";
+  j["blocks"][0]["conditions"] = "padded.csv";
+  const std::string problem = OnlyProblem(j);
+  EXPECT_TRUE(Contains(problem, "column \"edge \" (a space at its start or end) (did you mean edge?)")) << problem;
+}
+
 // A conditions table's cell that is not UTF-8 (a Latin-1 file's "é" or stray bytes) is a problem naming the CSV
 // file, its line and column, and the cell's pointer; it used to pass and stop validate, run, preview and plan with
 // the JSON library's "invalid UTF-8 byte" (exit 10) when the trial list was hashed.

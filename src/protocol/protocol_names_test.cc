@@ -153,6 +153,22 @@ TEST(ProtocolValidate, BlockGroupAndPracticeBlockMisspeltGetDidYouMean) {
                                  "\"tsk1\""));
 }
 
+// Groups or choices that differ only in letter case: a slip of one is answered with the other (did you mean), so
+// they cannot be told apart; "a" and "A", "left" and "Left" used to pass.
+TEST(ProtocolValidate, GroupsOrChoicesDifferingOnlyInCaseAreRefused) {
+  Json j = Valid();
+  j["groups"] = {{"names", {"near", "Near"}}};
+  bool named = false;
+  for (const std::string& p : Problems(j))
+    named = named || Contains(p, "/groups/names/1: must differ from an earlier name by more than letter case, got "
+                                 "\"Near\"");
+  EXPECT_TRUE(named) << Problems(j).front();
+  j = Valid();
+  j["participant_info"] = {{{"key", "hand"}, {"type", "choice"}, {"choices", {"left", "right", "Left"}}}};
+  EXPECT_EQ(OnlyProblem(j), Line("/participant_info/0/choices/2: must differ from an earlier answer by more than "
+                                 "letter case, got \"Left\""));
+}
+
 TEST(ProtocolValidate, ResponseKeyInTheWrongCaseGetsDidYouMean) {
   Json j = Valid();
   j["responses"] = {{"left", "left"}, {"right", "q"}};
@@ -212,9 +228,13 @@ TEST(ProtocolValidate, BlockTitlePromptAndTimingAreChecked) {
   EXPECT_TRUE(Contains(OnlyProblem(j), "/blocks/0/title: must not contain control characters")) << OnlyProblem(j);
   j["blocks"][0]["title"] = "";
   EXPECT_EQ(OnlyProblem(j), Line("/blocks/0/title: must not be empty (leave it out for \"Part n of N\"), got \"\""));
+  j["blocks"][0]["title"] = "   ";  // blank: no title on screen, accepted before
+  EXPECT_EQ(OnlyProblem(j), Line("/blocks/0/title: must not be empty (leave it out for \"Part n of N\"), got \"   \""));
   j = Valid();
   j["blocks"][0]["prompt"] = "";
   EXPECT_EQ(OnlyProblem(j), Line("/blocks/0/prompt: must not be empty (leave it out for /responses/prompt), got \"\""));
+  j["blocks"][0]["prompt"] = " ";
+  EXPECT_EQ(OnlyProblem(j), Line("/blocks/0/prompt: must not be empty (leave it out for /responses/prompt), got \" \""));
   j = Valid();
   j["blocks"][0]["timing"] = {{"fixaton_ms", 200}};
   EXPECT_EQ(OnlyProblem(j), Line("/blocks/0/timing/fixaton_ms: unknown key (did you mean \"fixation_ms\"?), got 200"));

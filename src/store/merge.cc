@@ -308,6 +308,18 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
         renumbered.push_back("study " + shared.GetText(0) + ": protocol version " + std::to_string(shared.GetInt64(1)) +
                              " has " + std::to_string(shared.GetInt64(2)) + " different texts in the merged record "
                              "(protocol_hash tells their sessions apart)");
+      // Two stations that each ran a participant's first session gave both the default seed: merged they read as
+      // one person seeing one trial order twice, which run refuses. It used to pass untold; it is likely two people
+      // given one id, so say so (the record cannot tell).
+      Statement twins(dst, "SELECT st.name, p.code, group_concat(s.session_number, ', ') FROM (SELECT * FROM sessions "
+                           "ORDER BY session_number) s JOIN participants p ON p.id = s.participant_id JOIN studies st "
+                           "ON st.id = p.study_id GROUP BY s.participant_id, s.seed HAVING count(*) > 1 "
+                           "ORDER BY st.name, p.code");
+      while (twins.Step())
+        renumbered.push_back("study " + twins.GetText(0) + ", participant " + twins.GetText(1) + ": sessions " +
+                             twins.GetText(2) + " in the merged record ran with one seed, so in one trial order - "
+                             "two people given one id at two stations, or one person shown the same order twice; "
+                             "check before analysing them as one participant");
       transaction.Commit();
     }  // the last connection closes: the WAL is checkpointed into the file and removed
     MoveIntoPlace(temp, out);

@@ -372,7 +372,7 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     const int64_t protocol_id = EnsureProtocolVersion(db_, study_id, canonical, hash, now, &stored_json);
     if (stored_json != canonical)  // a 64-bit hash collision: refuse rather than mix texts
       throw Error(ErrorKind::kInternal, "protocol hash " + hash + " collides with another protocol text");
-    SaveDesign(protocol_id, meta.protocol_version, meta.design);
+    SaveDesign(protocol_id, study, meta.protocol_version, meta.design);
     // Numbered in the transaction that inserts the session, as the balanced group is: two stations never give one
     // number twice.
     start.session_number = NextSessionNumber(participant_id, study, participant, seed, meta);

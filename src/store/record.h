@@ -246,10 +246,13 @@ class Record {
   void Close(int64_t session, SessionStatus status);
   int64_t TrialId(int64_t session, int64_t trial_index);
   // Inside StartOrResumeSession's transaction: refuses a new text under a recorded version (see there); records a
-  // protocol version's declared version and design once; decides a new session's number and refuses a used seed.
+  // protocol version's declared version and design once (a later session of the version whose design differs - a
+  // conditions table edited under an unchanged text - is refused); decides a new session's number and refuses a
+  // used seed.
   void CheckProtocolVersion(int64_t study_id, const std::string& study, const std::string& canonical,
                             const std::string& hash, int64_t version);
-  void SaveDesign(int64_t protocol_id, int64_t version, const std::vector<DesignColumnRecord>& design);
+  void SaveDesign(int64_t protocol_id, const std::string& study, int64_t version,
+                  const std::vector<DesignColumnRecord>& design);
   int64_t NextSessionNumber(int64_t participant_id, const std::string& study, const std::string& participant,
                             uint64_t seed, const SessionMeta& meta);
 

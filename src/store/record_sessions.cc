@@ -1,6 +1,8 @@
 // What a new session checks and records of its study and participant, inside StartOrResumeSession's transaction:
 // protocol versions kept apart, the design recorded once per version, the session's number and a seed of its own.
+#include <algorithm>
 #include <charconv>
+#include <map>
 #include <string>
 
 #include "core/error.h"
@@ -94,15 +96,47 @@ void Record::CheckProtocolVersion(int64_t study_id, const std::string& study, co
                                    way_out);
 }
 
-void Record::SaveDesign(int64_t protocol_id, int64_t version, const std::vector<DesignColumnRecord>& design) {
+void Record::SaveDesign(int64_t protocol_id, const std::string& study, int64_t version,
+                        const std::vector<DesignColumnRecord>& design) {
   Statement set(db_, "UPDATE protocol_versions SET version = ? WHERE id = ? AND version IS NULL");
   set.Bind(1, version);
   set.Bind(2, protocol_id);
   set.Run();
-  // Once per protocol version: its sessions share one text, so one design.
-  if (design.empty() ||
-      db_.QueryInt64("SELECT count(*) FROM design_columns WHERE protocol_version_id = " + std::to_string(protocol_id)) > 0)
-    return;
+  if (design.empty()) return;
+  // Once per protocol version: its sessions share one text, so one design - unless a file the text names changed
+  // (a conditions table's rows are not in the text). Such a session used to be recorded under the same version,
+  // the codebook giving the first session's values for both.
+  // Only the columns the levels set (roles within and procedure_cell) are compared: a label varies nothing, and a
+  // later build may describe the other columns otherwise.
+  auto varies = [](const std::string& role) { return role == "within" || role == "procedure_cell"; };
+  Statement recorded(db_, "SELECT name, role, allowed FROM design_columns WHERE protocol_version_id = ? "
+                          "ORDER BY position");
+  recorded.Bind(1, protocol_id);
+  std::map<std::string, std::string> before, now;
+  bool any = false;
+  while (recorded.Step()) {
+    any = true;
+    if (varies(recorded.GetText(1))) before[recorded.GetText(0)] = recorded.GetText(2);
+  }
+  if (any) {
+    for (const DesignColumnRecord& c : design)
+      if (varies(c.role)) now[c.name] = AllowedText(c);
+    std::string change;
+    for (const auto& [name, allowed] : before) {
+      const auto it = now.find(name);
+      if (it == now.end()) change = "column " + name + " in the record, absent now";
+      else if (it->second != allowed) change = "column " + name + ": " + allowed + " in the record, " + it->second + " now";
+      if (!change.empty()) break;
+    }
+    for (const auto& [name, allowed] : now)
+      if (change.empty() && !before.count(name)) change = "column " + name + " absent in the record, present now";
+    if (change.empty()) return;
+    throw InputError(db_.path(), "study " + study + " records protocol version " + std::to_string(version) +
+                                     " with another design (" + change + "): the text is the same, so a file it "
+                                     "names (a conditions table) has changed; raise \"version\" to " +
+                                     std::to_string(version + 1) +
+                                     " to record it as a new version, or use another record (--db)");
+  }
   Statement insert(db_, "INSERT INTO design_columns (protocol_version_id, position, name, role, type, unit, allowed) "
                         "VALUES (?, ?, ?, ?, ?, ?, ?)");
   int64_t position = 0;

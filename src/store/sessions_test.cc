@@ -164,6 +164,31 @@ TEST(Record, DesignIsRecordedOncePerProtocolVersionWithNumericLevelsInOrder) {
             "info_age:label:integer:years:>= 18");
 }
 
+// A conditions table is a file the protocol names, not part of its text: edited (edge 2 -> 3) under an unchanged
+// text, a new session used to be recorded under the same version, its codebook giving the first table's values.
+// Now the design recorded with the version is compared, and a different one refused as a changed protocol.
+TEST(Record, SameTextWithAnotherDesignIsRefusedAsAChangedProtocol) {
+  Record record = Record::Open(":memory:");
+  SessionMeta meta = Version(1);
+  meta.design = {DesignColumnRecord{"edge", "within", "integer", "", {2, 9}, {}, {}, {}}};
+  Complete(record, "P1", kV1, 11, meta);
+  Complete(record, "P2", kV1, 21, meta);  // the same design: fine
+  meta.design[0].numbers = {3, 9};
+  EXPECT_EQ(ErrorOf([&] { record.StartOrResumeSession("s", "P3", kV1, 31, meta, false); }),
+            ":memory:: study s records protocol version 1 with another design (column edge: 2|9 in the record, 3|9 "
+            "now): the text is the same, so a file it names (a conditions table) has changed; raise \"version\" to "
+            "2 to record it as a new version, or use another record (--db)");
+  EXPECT_EQ(record.database().QueryInt64("SELECT count(*) FROM sessions"), 2);
+  // A column the levels set, new: refused; a label or a column a later build describes otherwise: not compared.
+  meta.design[0].numbers = {2, 9};
+  meta.design.push_back(DesignColumnRecord{"speed_cm_s", "within", "number", "cm/s", {1.8}, {}, {}, {}});
+  EXPECT_NE(ErrorOf([&] { record.StartOrResumeSession("s", "P3", kV1, 31, meta, false); }).find(
+                "(column speed_cm_s absent in the record, present now)"),
+            std::string::npos);
+  meta.design.back() = DesignColumnRecord{"label", "label", "string", "", {}, {"near"}, {}, {}};
+  EXPECT_EQ(record.StartOrResumeSession("s", "P3", kV1, 31, meta, false).session_number, 1);
+}
+
 TEST(Record, ProcedureTrialKeepsItsCellByLevels) {
   Record record = Record::Open(":memory:");
   const int64_t session = record.StartOrResumeSession("s", "P1", kV1, 11, {}, false).session_id;
@@ -245,6 +270,26 @@ TEST(Merge, SessionNumbersFollowTheStartAcrossInputsAndChangesAreTold) {
 
 namespace blurcue::store {
 namespace {
+
+// Two stations each ran P1's first session with the default seed (so one trial order): merged, P1 has sessions 1
+// and 2 with one seed, which run refuses to make - likely two people given one id. It used to pass untold.
+TEST(Merge, OneParticipantsSessionsWithOneSeedAtTwoStationsAreTold) {
+  testing::TempDir dir;
+  for (const char* name : {"a.sqlite", "b.sqlite"}) {
+    Record record = Record::Open(dir / name);
+    Complete(record, "P1", kV1, 11);
+    Complete(record, "P2", kV1, name[0] == 'a' ? 21 : 22);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  std::vector<std::string> notes;
+  MergeDatabases({dir / "a.sqlite", dir / "b.sqlite"}, dir / "m.sqlite",
+                 [&](const std::string& line) { notes.push_back(line); });
+  ASSERT_FALSE(notes.empty());
+  EXPECT_EQ(notes.back(), "study s, participant P1: sessions 1, 2 in the merged record ran with one seed, so in one "
+                          "trial order - two people given one id at two stations, or one person shown the same order "
+                          "twice; check before analysing them as one participant");
+  for (const std::string& line : notes) EXPECT_EQ(line.find("participant P2: sessions"), std::string::npos) << line;
+}
 
 TEST(Merge, AVersionRunWithTwoTextsAtTwoStationsIsMergedAndTold) {
   testing::TempDir dir;
