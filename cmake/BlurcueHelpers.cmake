@@ -6,8 +6,10 @@ function(add_module_library name)
   target_include_directories(blurcue_${name} PUBLIC ${PROJECT_SOURCE_DIR}/src)
   target_link_libraries(blurcue_${name} PUBLIC ${ARG_DEPS})
   # -Wno-array-bounds: a GCC 12 false positive in nlohmann/json; -Wno-restrict: GCC 12 flags std::string assignments
-  # and "literal" + std::to_string(...) inside libstdc++ (GCC bug 105651), not code of ours
-  target_compile_options(blurcue_${name} PRIVATE -Wall -Wextra -Wno-array-bounds -Wno-restrict)
+  # and "literal" + std::to_string(...) inside libstdc++ (GCC bug 105651), not code of ours. -Wswitch-enum: a switch
+  # over an enum lists every value even with a default:, so a new value (a protocol's layout, task...) shows every
+  # place to touch
+  target_compile_options(blurcue_${name} PRIVATE -Wall -Wextra -Wswitch-enum -Wno-array-bounds -Wno-restrict)
 endfunction()
 
 # add_module_test(NAME SRCS a_test.cc DEPS libs [LABELS gl slow])
@@ -16,7 +18,7 @@ function(add_module_test name)
   cmake_parse_arguments(ARG "" "" "SRCS;DEPS;LABELS" ${ARGN})
   add_executable(${name} ${ARG_SRCS})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest_main)
-  target_compile_options(${name} PRIVATE -Wall -Wextra -Wno-array-bounds -Wno-restrict)
+  target_compile_options(${name} PRIVATE -Wall -Wextra -Wswitch-enum -Wno-array-bounds -Wno-restrict)
   include(GoogleTest)
   gtest_discover_tests(${name} WORKING_DIRECTORY ${PROJECT_BINARY_DIR} NO_PRETTY_VALUES
                        PROPERTIES LABELS "${ARG_LABELS}" DISCOVERY_TIMEOUT 60)

@@ -132,7 +132,7 @@ void AddPreviewCommand(CLI::App& app) {
           const double level = adaptive.Level(t);
           const protocol::Procedure& procedure = *protocol::BlockOf(p, t)->procedure;  // t.cell >= 0: it has one
           stimulus::ApplyLevel(procedure, t, level, prepared.presentation, &s);
-          first = " (" + protocol::ToString(procedure.kind) + ": " + procedure.variable + " " + Json(level).dump() +
+          first = " (" + protocol::ToString(procedure.kind) + ": " + protocol::ToString(procedure.variable) + " " + Json(level).dump() +
                   " on the " + t.test_side + " at first)";
           stimulus::PlanOnScreen(p, *scene, prepared.presentation, &s);
         }
@@ -201,7 +201,7 @@ void AddPreviewCommand(CLI::App& app) {
       renderer.Finish();
       const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       std::string plan;
-      if (tiles[i].scene.content != "picture") {
+      if (tiles[i].scene.content != protocol::ContentType::kPicture) {
         char text[128];
         std::snprintf(text, sizeof text, "plan: %s, span %.2f scr px, %.1f ms/frame",
                       tiles[i].scene.per_pixel ? "per pixel" : "one radius", tiles[i].scene.r_span_screen_px, ms);

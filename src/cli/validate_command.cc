@@ -102,7 +102,7 @@ void AddValidateCommand(CLI::App& app) {
           std::string shown = line;
           if (prepared.protocol.groups)
             shown += "  group: " + prepared.group +
-                     (prepared.protocol.groups->assign == "balanced"
+                     (prepared.protocol.groups->assign == protocol::GroupAssign::kBalanced
                           ? " (balanced: a run takes the group with the fewest sessions in its record)\n"
                           : " (by participant number)\n");
           if (prepared.scene) {
@@ -112,7 +112,7 @@ void AddValidateCommand(CLI::App& app) {
                           "  blur plan: %zu of %zu trials per pixel by depth (depth span >= %g %s), the rest one "
                           "radius\n",
                           per_pixel, prepared.scenes.size(), prepared.protocol.content.depth_blur_threshold,
-                          prepared.protocol.content.depth_blur_threshold_unit == "arcmin" ? "arcmin" : "screen px");
+                          prepared.protocol.content.depth_blur_threshold_unit == protocol::ThresholdUnit::kArcmin ? "arcmin" : "screen px");
             shown += line;
           }
           if (observer)

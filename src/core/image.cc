@@ -31,8 +31,13 @@ std::string KindOfNonRegular(std::filesystem::file_type type) {
     case std::filesystem::file_type::block: return "a block device";
     case std::filesystem::file_type::fifo: return "a pipe";
     case std::filesystem::file_type::socket: return "a socket";
-    default: return "not a regular file";
+    case std::filesystem::file_type::none:
+    case std::filesystem::file_type::not_found:
+    case std::filesystem::file_type::regular:
+    case std::filesystem::file_type::symlink:
+    case std::filesystem::file_type::unknown: break;
   }
+  return "not a regular file";
 }
 
 uint32_t BigEndian(const std::vector<uint8_t>& b, size_t at, int bytes) {

@@ -58,11 +58,11 @@ std::optional<Condition> ConditionOf(const protocol::Protocol& protocol, const p
     // A procedure sets how often its trials are right (it moves the level to its target share): what it measures is
     // the threshold, so that is what is planned, not its share correct against chance.
     c.measure = "threshold";
-    c.units = protocol::BlockOf(protocol, trial)->procedure->variable;
+    c.units = protocol::ToString(protocol::BlockOf(protocol, trial)->procedure->variable);
   } else if (!trial.test_side.empty()) {
     c.measure = "correct";
     c.chance = scene.intervals > 2 ? 1.0 / scene.intervals : 0.5;
-  } else if (trial.task == Task::kForcedChoice && scene.content != "picture") {
+  } else if (trial.task == Task::kForcedChoice && scene.content != protocol::ContentType::kPicture) {
     c.measure = "first_source";
     c.chance = 0.5;
   } else {
@@ -113,7 +113,7 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
     const session::Scored scored = logic.Answer(trial, scene, level, choice);
     if (keep_answers) p.answers.emplace_back(trial.index, choice);
     if (trial.practice) continue;
-    if (trial.task == Task::kAdjustment && scene.content == "picture") {
+    if (trial.task == Task::kAdjustment && scene.content == protocol::ContentType::kPicture) {
       // Depth matching: one condition per block, the slope of the accepted cut-off on distance across its trials.
       Condition c;
       c.block = protocol::BlockIndex(protocol, trial);

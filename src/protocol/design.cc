@@ -137,7 +137,7 @@ std::vector<DesignColumn> DescribeDesign(const Protocol& protocol) {
       level->name = "level";
       level->role = Role::kWithin;
       level->type = ValueType::kNumber;
-      level->unit = p.variable == "difference_arcmin" ? "arcmin" : "";
+      level->unit = p.variable == ProcedureVariable::kDifferenceArcmin ? "arcmin" : "";
     }
     if (p.kind == Procedure::Kind::kQuestPlus) {
       std::set<double> all(level->numbers.begin(), level->numbers.end());
@@ -180,11 +180,14 @@ std::vector<DesignColumn> DescribeDesign(const Protocol& protocol) {
     info.name = "info_" + field.key;
     info.role = Role::kLabel;
     info.unit = UnitOf(field.key);
-    if (field.type == "integer" || field.type == "number") {
-      info.type = field.type == "integer" ? ValueType::kInteger : ValueType::kNumber;
-      if (field.max > field.min) info.min = field.min, info.max = field.max;
-    } else {
-      info.names = field.choices;
+    switch (field.type) {
+      case InfoType::kInteger:
+      case InfoType::kNumber:
+        info.type = field.type == InfoType::kInteger ? ValueType::kInteger : ValueType::kNumber;
+        if (field.max > field.min) info.min = field.min, info.max = field.max;
+        break;
+      case InfoType::kChoice:
+      case InfoType::kText: info.names = field.choices; break;
     }
     columns.push_back(info);
   }

@@ -27,14 +27,14 @@ Protocol Sample() {
   rate.task = Task::kRating;
   p.blocks = {main, stair, rate};
   p.responses.rating = {"1", "2", "3", "4", "5"};
-  p.groups = Groups{{"near", "far"}, "balanced"};
+  p.groups = Groups{{"near", "far"}, GroupAssign::kBalanced};
   InfoField age;
   age.key = "age";
-  age.type = "integer";
+  age.type = InfoType::kInteger;
   age.min = 18, age.max = 99;
   InfoField hand;
   hand.key = "hand";
-  hand.type = "choice";
+  hand.type = InfoType::kChoice;
   hand.choices = {"left", "right"};
   p.participant_info = {age, hand};
   return p;

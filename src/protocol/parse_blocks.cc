@@ -11,7 +11,7 @@ std::optional<Adjustment> Parser::ParseAdjust(const Json& v, const std::string& 
   Adjustment a;
   // The renderer steps through Butterworth cut-offs of a picture; no other parameter is drawn.
   if (auto s = String(v, "parameter", ptr, false, {"cutoff"})) a.parameter = *s;
-  if (auto s = String(v, "order", ptr, false, {"shuffled", "ascending", "descending"})) a.order = *s;
+  if (auto order = Word<AdjustOrder>(v, "order", ptr, false)) a.order = *order;
   const Json* levels = Field(v, "levels", ptr, true);
   if (!levels) return a;
   if (!levels->is_array() || levels->size() < 2 || levels->size() > kMaxAdjustLevels) {
@@ -38,18 +38,18 @@ std::optional<Procedure> Parser::ParseProcedure(const Json& v, const std::string
     Problem(ptr, "must be an object (type staircase or quest_plus)", v);
     return std::nullopt;
   }
-  const auto type = String(v, "type", ptr, true, {"staircase", "quest_plus"});
-  if (!type) return std::nullopt;
+  const auto kind = Word<ProcedureKind>(v, "type", ptr, true);
+  if (!kind) return std::nullopt;
   Procedure pr;
-  pr.kind = *type == "quest_plus" ? Procedure::Kind::kQuestPlus : Procedure::Kind::kStaircase;
+  pr.kind = *kind;
   const bool quest = pr.kind == Procedure::Kind::kQuestPlus;
   if (quest)
     Object(v, ptr, {"type", "variable", "reference", "trials", "stimuli", "threshold", "slope", "lapse", "guess"});
   else
     Object(v, ptr, {"type", "variable", "reference", "trials", "start", "min", "max", "up", "down", "steps", "stop"});
-  if (auto s = String(v, "variable", ptr, true, {"relative_difference", "difference_arcmin"})) pr.variable = *s;
+  if (auto variable = Word<ProcedureVariable>(v, "variable", ptr, true)) pr.variable = *variable;
   // What the level can be: up to 20 times more blur, or up to 10 degrees more.
-  const bool relative = pr.variable == "relative_difference";
+  const bool relative = pr.variable == ProcedureVariable::kRelativeDifference;
   const double hi = relative ? 20 : 600;
   const std::string unit = relative ? "(times the reference)" : "arcmin";
   if (const Json* r = Field(v, "reference", ptr, true)) {
@@ -143,11 +143,8 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
   if (const Source s = pick("task"); !s.holder) {
     Problem(ptr + "/task", "is required (here or at /task) but missing");
   } else if (b->task_pointer = s.ptr + "/task";
-             auto t = String(*s.holder, "task", s.ptr, true, {"forced_choice", "adjustment", "yes_no", "rating"})) {
-    b->task = *t == "adjustment" ? Task::kAdjustment
-              : *t == "yes_no"   ? Task::kYesNo
-              : *t == "rating"   ? Task::kRating
-                                 : Task::kForcedChoice;
+             auto t = Word<Task>(*s.holder, "task", s.ptr, true)) {
+    b->task = *t;
   }
   b->pointer = ptr;
   const size_t calls_before_factors = calls_;
@@ -169,10 +166,7 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
   }
   if (const Source s = pick("counterbalance"); s.holder) {
     b->counterbalance_pointer = s.ptr + "/counterbalance";
-    if (auto c = String(*s.holder, "counterbalance", s.ptr, true, {"swap_copies", "by_participant", "none"}))
-      b->counterbalance = *c == "swap_copies"      ? Counterbalance::kSwapCopies
-                          : *c == "by_participant" ? Counterbalance::kByParticipant
-                                                   : Counterbalance::kNone;
+    if (auto c = Word<Counterbalance>(*s.holder, "counterbalance", s.ptr, true)) b->counterbalance = *c;
   }
   const Source sides = pick("sides");
   if (sides.holder) {

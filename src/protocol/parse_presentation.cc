@@ -28,8 +28,8 @@ void Parser::ParseScene(const Json& v, const std::string& ptr, Protocol* p) {
   p->scene.background = Path(v, "background", ptr, true);
   p->scene.board_free = Path(v, "board_free", ptr, false);
   p->scene.calib = Path(v, "calib", ptr, false);
-  if (auto show = String(v, "show", ptr, false, {"background", "board_free"})) p->scene.show = *show;
-  if (p->scene.show == "board_free" && !v.contains("board_free"))
+  if (auto show = Word<ScenePhoto>(v, "show", ptr, false)) p->scene.show = *show;
+  if (p->scene.show == ScenePhoto::kBoardFree && !v.contains("board_free"))
     Problem(ptr + "/show", "names the board-free photo but /scene/board_free is missing", v["show"]);
 }
 
@@ -38,11 +38,12 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
     Problem(ptr, "must be an object", v);
     return;
   }
-  const auto type = String(v, "type", ptr, true, {"grid", "ball", "picture"});
+  const auto type = Word<ContentType>(v, "type", ptr, true);
   if (!type) return;
   p->content.type = *type;
-  if (*type == "grid" || *type == "ball") {
-    if (auto k = String(v, "kernel", ptr, false, {"gaussian", "disc"})) p->content.kernel = *k;
+  const bool object = *type == ContentType::kGrid || *type == ContentType::kBall;
+  if (object) {
+    if (auto k = Word<Kernel>(v, "kernel", ptr, false)) p->content.kernel = *k;
     // The thesis matched the virtual object to the scene by eye; a factor of 4 either way is far beyond that.
     if (auto x = Number(v, "brightness", ptr, false, 0.25, 4, "(a factor)")) p->content.brightness = *x;
     if (auto x = Number(v, "contrast", ptr, false, 0.25, 4, "(a factor)")) p->content.contrast = *x;
@@ -51,7 +52,7 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
       if (t->is_object() && t->size() == 1 && (t->contains("screen_px") || t->contains("arcmin"))) {
         const bool px = t->contains("screen_px");
         if (auto x = Number(*t, px ? "screen_px" : "arcmin", at, true, 0, px ? 100 : 600, px ? "screen px" : "arcmin"))
-          p->content.depth_blur_threshold = *x, p->content.depth_blur_threshold_unit = px ? "screen_px" : "arcmin";
+          p->content.depth_blur_threshold = *x, p->content.depth_blur_threshold_unit = px ? ThresholdUnit::kScreenPx : ThresholdUnit::kArcmin;
       } else {
         Problem(at, "must be {\"screen_px\": N} or {\"arcmin\": N}", *t);
       }
@@ -66,9 +67,9 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
                 *wb);
     }
   }
-  if (*type == "grid" || *type == "ball") {
+  if (object) {
     // The card's face or the ball's surface: a shipped texture by name, or an image file.
-    const bool grid = *type == "grid";
+    const bool grid = *type == ContentType::kGrid;
     p->content.texture = grid ? "grid" : "soccer";
     if (auto t = Text(v, "texture", ptr, false, kMaxPathChars, true)) {
       const std::vector<std::string> shipped = grid ? std::vector<std::string>{"grid"}
@@ -86,11 +87,11 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
       }
     }
   }
-  if (*type == "grid" || *type == "ball") {
+  if (object) {
     // Raised above the table: up to a metre.
     if (auto h = Number(v, "height_mm", ptr, false, 0, 1000, "mm")) p->content.height_mm = *h;
   }
-  if (*type == "grid") {
+  if (*type == ContentType::kGrid) {
     Object(v, ptr, {"type", "cells", "texture", "kernel", "brightness", "contrast", "white_balance",
                     "depth_blur_threshold", "size_mm", "pose", "rotation_deg", "height_mm"});
     if (auto n = Int(v, "cells", ptr, false, 1, 20, "cells per side")) p->content.cells = *n;
@@ -107,7 +108,7 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
     }
     if (auto pose = String(v, "pose", ptr, false, {"lying", "standing"})) p->content.standing = *pose == "standing";
     if (auto r = Number(v, "rotation_deg", ptr, false, -180, 180, "deg")) p->content.rotation_deg = *r;
-  } else if (*type == "ball") {
+  } else if (*type == ContentType::kBall) {
     Object(v, ptr, {"type", "texture", "radius_mm", "kernel", "brightness", "contrast", "white_balance",
                     "depth_blur_threshold", "height_mm"});
     // A ball rolls on the board's 25 mm squares: from a marble to a football.
@@ -164,17 +165,17 @@ void Parser::ParseInfo(const Json& v, const std::string& ptr, Protocol* p) {
       else if (!keys.insert(*k).second) Problem(fp + "/key", "repeats an earlier key", Json(*k));
       field.key = *k;
     }
-    if (auto t = String(f, "type", fp, false, {"integer", "number", "choice", "text"})) field.type = *t;
-    const bool numeric = field.type == "integer" || field.type == "number";
+    if (auto t = Word<InfoType>(f, "type", fp, false)) field.type = *t;
+    const bool numeric = field.type == InfoType::kInteger || field.type == InfoType::kNumber;
     if (numeric) {
       auto lo = Number(f, "min", fp, true, -1e9, 1e9, ""), hi = Number(f, "max", fp, true, -1e9, 1e9, "");
       if (lo && hi && *lo >= *hi) Problem(fp + "/max", "must be larger than min", f["max"]);
       field.min = lo.value_or(0), field.max = hi.value_or(0);
     } else {
       for (const char* k : {"min", "max"})
-        if (f.contains(k)) Problem(fp + "/" + k, "is for an integer or number field, not " + field.type, f[k]);
+        if (f.contains(k)) Problem(fp + "/" + k, "is for an integer or number field, not " + ToString(field.type), f[k]);
     }
-    if (field.type == "choice") {
+    if (field.type == InfoType::kChoice) {
       const Json* c = Field(f, "choices", fp, true);
       if (c && (!c->is_array() || c->empty() || c->size() > 20))
         Problem(fp + "/choices", "must be a list of 1 to 20 answers", *c);
@@ -192,7 +193,7 @@ void Parser::ParseInfo(const Json& v, const std::string& ptr, Protocol* p) {
             field.choices.push_back(choice.get<std::string>());
         }
     } else if (f.contains("choices")) {
-      Problem(fp + "/choices", "is for a choice field, not " + field.type, f["choices"]);
+      Problem(fp + "/choices", "is for a choice field, not " + ToString(field.type), f["choices"]);
     }
     if (auto r = Bool(f, "required", fp)) field.required = *r;
     if (auto s = Text(f, "prompt", fp, false, 200, true)) field.prompt = *s;
@@ -203,7 +204,7 @@ void Parser::ParseInfo(const Json& v, const std::string& ptr, Protocol* p) {
 void Parser::ParseGroups(const Json& v, const Json& top, const std::string& ptr, Protocol* p) {
   if (!Object(v, ptr, {"names", "assign"})) return;
   Groups g;
-  if (auto a = String(v, "assign", ptr, false, {"by_number", "balanced"})) g.assign = *a;
+  if (auto a = Word<GroupAssign>(v, "assign", ptr, false)) g.assign = *a;
   const Json* names = Field(v, "names", ptr, true);
   if (names && (!names->is_array() || names->size() < 2 || names->size() > 20)) {
     Problem(ptr + "/names", "must be a list of 2 to 20 group names", *names);
@@ -234,7 +235,7 @@ void Parser::ParseResponses(const Json& v, const std::string& ptr, const std::se
   r->rating = {"1", "2", "3", "4", "5"};
   for (int i = 1; i <= p.alternatives; ++i) r->alternatives.push_back(std::to_string(i));
   // Odd one out names one of its intervals: there is no "can't tell" unless a key is given for it.
-  if (p.layout == "odd_one_out") r->cant_tell = "";
+  if (p.layout == Layout::kOddOneOut) r->cant_tell = "";
   if (v.is_null()) return;
   if (!Object(v, ptr, {"left", "right", "cant_tell", "previous", "next", "accept", "yes", "no", "rating",
                        "alternatives", "prompt", "after_motion"}))
@@ -287,8 +288,8 @@ void Parser::ParseResponses(const Json& v, const std::string& ptr, const std::se
   unused("yes", tasks.count(Task::kYesNo), "is for the task yes_no, which no block has");
   unused("no", tasks.count(Task::kYesNo), "is for the task yes_no, which no block has");
   unused("rating", tasks.count(Task::kRating), "is for the task rating, which no block has");
-  unused("alternatives", p.layout == "odd_one_out", "is for the layout odd_one_out");
-  const bool choice = tasks.count(Task::kForcedChoice) > 0, sides = choice && p.layout != "odd_one_out";
+  unused("alternatives", p.layout == Layout::kOddOneOut, "is for the layout odd_one_out");
+  const bool choice = tasks.count(Task::kForcedChoice) > 0, sides = choice && p.layout != Layout::kOddOneOut;
   unused("left", sides, choice ? "is not read by the layout odd_one_out (its intervals have /responses/alternatives)"
                                : "is for the task forced_choice, which no block has");
   unused("right", sides, choice ? "is not read by the layout odd_one_out (its intervals have /responses/alternatives)"
@@ -317,7 +318,7 @@ void Parser::ParseResponses(const Json& v, const std::string& ptr, const std::se
                   Json(keys[i]));
   };
   if (tasks.count(Task::kRating)) distinct_list("rating", r->rating);
-  if (p.layout == "odd_one_out") distinct_list("alternatives", r->alternatives);
+  if (p.layout == Layout::kOddOneOut) distinct_list("alternatives", r->alternatives);
 }
 // The protocol's timing (at /timing) or a block's (at /blocks/N/timing): each field given is checked and set in `t`,
 // so a block's fields override the protocol's and the others stay as inherited.
@@ -341,7 +342,7 @@ void Parser::ParseTiming(const Json& v, const std::string& ptr, const Protocol& 
   if (auto x = Number(v, "feedback_ms", ptr, false, 100, 5000, "ms")) t->feedback_ms = *x;
   if (auto x = Number(v, "fixation_ms", ptr, false, 100, 5000, "ms")) t->fixation_ms = *x;
   // Feedback needs a correct answer: a procedure's, an odd one out's, or a practice run to a criterion's.
-  const bool correct = p.layout == "odd_one_out" || std::any_of(blocks.begin(), blocks.end(), [](const Block* b) {
+  const bool correct = p.layout == Layout::kOddOneOut || std::any_of(blocks.begin(), blocks.end(), [](const Block* b) {
                          return b->procedure || b->criterion;
                        });
   if (v.contains("feedback_ms") && !correct)

@@ -73,6 +73,13 @@ class Parser {
   std::optional<std::string> String(const Json& obj, const std::string& key, const std::string& ptr, bool required,
                                     const std::vector<std::string>& allowed = {});
 
+  // A word of the vocabulary E (vocabulary.h): a string among Words<E>(), reported as String reports it.
+  template <typename E>
+  std::optional<E> Word(const Json& obj, const std::string& key, const std::string& ptr, bool required) {
+    const std::optional<std::string> word = String(obj, key, ptr, required, Words<E>());
+    return word ? ParseWord<E>(*word) : std::nullopt;
+  }
+
   // An integer in [min, max]; `unit` (e.g. "px", "trials") goes into the message.
   std::optional<int> Int(const Json& obj, const std::string& key, const std::string& ptr, bool required, int min,
                          int max, const std::string& unit = "");

@@ -18,28 +18,6 @@
 namespace blurcue::protocol {
 namespace fs = std::filesystem;
 
-std::string ToString(Task task) {
-  switch (task) {
-    case Task::kAdjustment: return "adjustment";
-    case Task::kYesNo: return "yes_no";
-    case Task::kRating: return "rating";
-    default: return "forced_choice";
-  }
-}
-
-std::string ToString(Procedure::Kind kind) {
-  return kind == Procedure::Kind::kQuestPlus ? "quest_plus" : "staircase";
-}
-
-std::string ToString(Counterbalance counterbalance) {
-  switch (counterbalance) {
-    case Counterbalance::kSwapCopies: return "swap_copies";
-    case Counterbalance::kByParticipant: return "by_participant";
-    case Counterbalance::kNone: break;
-  }
-  return "none";
-}
-
 namespace detail {
 
 Protocol Parser::Parse(const Json& json) {
@@ -58,22 +36,27 @@ Protocol Parser::Parse(const Json& json) {
   if (auto s = Text(json, "description", "", false, 5 * kMaxTextChars, false)) p.description = *s;
   if (auto s = Text(json, "instructions", "", false, kMaxTextChars, false)) p.instructions = *s;
   if (const Json* v = Field(json, "content", "", true)) ParseContent(*v, "/content", &p);
+  // Whether the file gives a valid content type (ParseContent then set it): the checks that depend on it stay
+  // silent when it is missing or invalid (already reported).
+  const bool typed = json.contains("content") && json["content"].is_object() && json["content"].contains("type") &&
+                     json["content"]["type"].is_string() &&
+                     ParseWord<ContentType>(json["content"]["type"].get<std::string>()).has_value();
+  const ContentType type = p.content.type;
   // A depth matching with real photos shows no scene photo: its lower half is the real photo of each distance.
-  const bool real_photos = p.content.type == "picture" && json.contains("content") && json["content"].is_object() &&
-                           json["content"].contains("real_photos");
+  const bool real_photos = typed && type == ContentType::kPicture && json["content"].contains("real_photos");
   if (const Json* v = Field(json, "scene", "", !real_photos)) {
     if (real_photos)
       Problem("/scene", "is not shown: with content.real_photos the lower half shows the real photo of each distance", *v);
     else
       ParseScene(*v, "/scene", &p);
   }
-  if (p.content.type == "picture" && json.contains("scene") && json["scene"].is_object() &&
+  if (typed && type == ContentType::kPicture && json.contains("scene") && json["scene"].is_object() &&
       json["scene"].contains("calib"))
     Problem("/scene/calib", "is not read by a picture (the real picture's blur comes from /content/real_camera)",
             json["scene"]["calib"]);
   if (json.contains("scene") && json["scene"].is_object() && !json["scene"].contains("calib") &&
-      (p.content.type == "grid" || p.content.type == "ball"))
-    Problem("/scene/calib", "is required for a " + p.content.type + " (its blur comes from the calibration) but missing");
+      (typed && (type == ContentType::kGrid || type == ContentType::kBall)))
+    Problem("/scene/calib", "is required for a " + ToString(type) + " (its blur comes from the calibration) but missing");
 
   // Protocol-level design fields are checked where they are written even when no block inherits them.
   if (json.contains("factors")) ParseFactors(json["factors"], "/factors");
@@ -81,8 +64,8 @@ Protocol Parser::Parse(const Json& json) {
   if (json.contains("adjust")) ParseAdjust(json["adjust"], "/adjust");
   if (json.contains("repetitions")) Int(json, "repetitions", "", true, 1, kMaxTrials, "repetitions");
   if (json.contains("counterbalance"))
-    String(json, "counterbalance", "", true, {"swap_copies", "by_participant", "none"});
-  if (json.contains("task")) String(json, "task", "", true, {"forced_choice", "adjustment", "yes_no", "rating"});
+    Word<Counterbalance>(json, "counterbalance", "", true);
+  if (json.contains("task")) Word<Task>(json, "task", "", true);
 
   const Json* blocks = Field(json, "blocks", "", false);
   if (!blocks) {
@@ -127,21 +110,21 @@ Protocol Parser::Parse(const Json& json) {
       }
     }
   }
-  if (auto order = String(json, "block_order", "", false, {"fixed", "random", "latin_square"}))
-    p.block_order = *order;
-  if (auto layout = String(json, "layout", "", false, {"side_by_side", "two_intervals", "single", "odd_one_out"})) {
+  if (auto order = Word<BlockSequence>(json, "block_order", "", false)) p.block_order = *order;
+  if (auto layout = Word<Layout>(json, "layout", "", false)) {
     p.layout = *layout;
-    if (p.layout != "side_by_side" && p.content.type == "picture")
-      Problem("/layout", "is for grids and balls; a picture is shown in its depth-matching frame", Json(*layout));
+    if (p.layout != Layout::kSideBySide && typed && type == ContentType::kPicture)
+      Problem("/layout", "is for grids and balls; a picture is shown in its depth-matching frame",
+              Json(ToString(*layout)));
   }
-  if (p.layout == "odd_one_out") p.alternatives = 3;
+  if (p.layout == Layout::kOddOneOut) p.alternatives = 3;
   if (json.contains("alternatives")) {
     if (auto n = Int(json, "alternatives", "", true, 3, 6, "intervals")) p.alternatives = *n;
-    if (p.layout != "odd_one_out")
+    if (p.layout != Layout::kOddOneOut)
       Problem("/alternatives", "is for the layout odd_one_out (the intervals of an odd-one-out trial)", json["alternatives"]);
   }
   // QUEST+'s guess rate is the chance of a right answer by guessing: 1/n of an odd-one-out trial's n intervals.
-  if (p.layout == "odd_one_out")
+  if (p.layout == Layout::kOddOneOut)
     for (auto& b : p.blocks)
       if (b.procedure && b.procedure->kind == Procedure::Kind::kQuestPlus) {
         if (!b.procedure->guess_given) b.procedure->guess = 1.0 / p.alternatives;
@@ -207,7 +190,7 @@ Protocol Parser::Parse(const Json& json) {
         if (v->contains("scale")) Problem("/display/width_deg", "give either scale or width_deg, not both", *x);
         else p.display.scaling = Scaling::kDegrees, p.display.width_deg = *x;
       }
-      if ((v->contains("scale") || v->contains("width_deg")) && p.content.type == "picture")
+      if ((v->contains("scale") || v->contains("width_deg")) && typed && type == ContentType::kPicture)
         Problem(v->contains("scale") ? "/display/scale" : "/display/width_deg",
                 "a picture's frame is always fitted to the window at one screen px per frame px; leave it out",
                 v->contains("scale") ? (*v)["scale"] : (*v)["width_deg"]);
@@ -221,7 +204,8 @@ Protocol Parser::Parse(const Json& json) {
 // the levels its content needs, and the session's size is within the cap.
 void Parser::CheckDesign(const Protocol& p) {
   if (calls_ > 0) return;  // a design built from fields with problems would only repeat them
-  const std::string& type = p.content.type;
+  const ContentType type = p.content.type;
+  const std::string type_name = ToString(type), layout_name = ToString(p.layout);
   // Groups: a block names only the protocol's groups, and every group runs at least one block.
   for (const auto& b : p.blocks)
     for (size_t i = 0; i < b.groups.size(); ++i)
@@ -238,19 +222,19 @@ void Parser::CheckDesign(const Protocol& p) {
         Problem("/groups/names", "group " + g + " runs no block", Json(g));
   for (const auto& b : p.blocks) {
     // The renderer draws a picture for adjustment (cut-offs) and a pair of grids or balls for forced choice.
-    if (type == "picture" && b.task != Task::kAdjustment)
+    if (type == ContentType::kPicture && b.task != Task::kAdjustment)
       Problem(b.task_pointer, "must be adjustment for a picture (forced_choice compares a pair of grids or balls)",
               Json(ToString(b.task)));
-    if (type != "picture" && b.task == Task::kAdjustment)
-      Problem(b.task_pointer, "must be forced_choice for a " + type + " (adjustment steps through the cut-offs of a "
+    if (type != ContentType::kPicture && b.task == Task::kAdjustment)
+      Problem(b.task_pointer, "must be forced_choice for a " + type_name + " (adjustment steps through the cut-offs of a "
                               "picture)", Json(ToString(b.task)));
     // A level that places or moves a stimulus is read only by the content it is for: anywhere else it would be
     // recorded but not shown.
-    static const std::map<std::string, std::set<std::string>> kUses = {
-        {"grid", {"edge", "y_mm", "left_x_mm", "right_x_mm", "height_mm", "rotation_deg"}},
-        {"ball", {"edge", "from_edge", "to_edge", "section", "speed_cm_s", "y_mm", "from_y_mm", "to_y_mm",
+    static const std::map<ContentType, std::set<std::string>> kUses = {
+        {ContentType::kGrid, {"edge", "y_mm", "left_x_mm", "right_x_mm", "height_mm", "rotation_deg"}},
+        {ContentType::kBall, {"edge", "from_edge", "to_edge", "section", "speed_cm_s", "y_mm", "from_y_mm", "to_y_mm",
                   "left_x_mm", "right_x_mm", "height_mm"}},
-        {"picture", {"distance_m"}}};
+        {ContentType::kPicture, {"distance_m"}}};
     static const std::set<std::string> kStimulusLevels = {"edge",      "from_edge",  "to_edge",   "section",
                                                           "speed_cm_s", "distance_m", "y_mm",      "from_y_mm",
                                                           "to_y_mm",   "left_x_mm",  "right_x_mm", "height_mm",
@@ -264,7 +248,7 @@ void Parser::CheckDesign(const Protocol& p) {
       for (const auto& name : names)
         if (kStimulusLevels.count(name) && uses != kUses.end() && !uses->second.count(name))
           Problem(b.factors_pointer + "/" + f.name,
-                  "a " + type + " does not use " + name + " (it would be recorded but not shown); a " + type +
+                  "a " + type_name + " does not use " + name + " (it would be recorded but not shown); a " + type_name +
                       " uses " + [&] {
                         std::string list;
                         for (const auto& u : uses->second) list += (list.empty() ? "" : ", ") + u;
@@ -274,9 +258,9 @@ void Parser::CheckDesign(const Protocol& p) {
     // Every layout but side_by_side draws its objects - the single one, each interval's - at the left one's place,
     // and intervals hold them still: a level that places the right object, or ends a run in intervals, would be
     // recorded but not shown. Named at the factor, or at the first level (a conditions table's row) that gives it.
-    if (uses != kUses.end() && type != "picture" && p.layout != "side_by_side") {
+    if (uses != kUses.end() && type != ContentType::kPicture && p.layout != Layout::kSideBySide) {
       std::vector<std::pair<std::string, std::string>> unshown = {
-          {"right_x_mm", "the layout " + p.layout + " shows every object at the left one's place (move it with "
+          {"right_x_mm", "the layout " + layout_name + " shows every object at the left one's place (move it with "
                          "left_x_mm): a right_x_mm level would be recorded but not shown"}};
       if (IntervalCount(p) > 0)
         for (const char* end : {"to_edge", "to_y_mm"})
@@ -300,16 +284,16 @@ void Parser::CheckDesign(const Protocol& p) {
       Problem(b.factors_pointer, "intervals show still objects: a speed_cm_s level would move them");
     // The layout decides the question: one object is answered yes/no or rated, a pair or N intervals chosen from.
     const bool one = b.task == Task::kYesNo || b.task == Task::kRating;
-    if (p.layout == "single" && type != "picture" && !one)
+    if (p.layout == Layout::kSingle && type != ContentType::kPicture && !one)
       Problem(b.task_pointer, "must be yes_no or rating for the layout single (one object: nothing to choose between)",
               Json(ToString(b.task)));
-    if (p.layout != "single" && one)
-      Problem(b.task_pointer, "is for the layout single (one object); a " + p.layout + " trial is a forced choice",
+    if (p.layout != Layout::kSingle && one)
+      Problem(b.task_pointer, "is for the layout single (one object); a " + layout_name + " trial is a forced choice",
               Json(ToString(b.task)));
-    if (p.layout == "single" && b.counterbalance != Counterbalance::kNone)
+    if (p.layout == Layout::kSingle && b.counterbalance != Counterbalance::kNone)
       Problem(b.counterbalance_pointer, "must be none for the layout single (one object: no sides to swap)",
               Json(ToString(b.counterbalance)));
-    if (p.layout == "single" && b.procedure)
+    if (p.layout == Layout::kSingle && b.procedure)
       Problem(b.pointer + "/procedure", "needs a forced choice (layouts side_by_side, two_intervals, odd_one_out)");
     // "object" is the single layout's one source; a pair layout reads left and right.
     bool object = b.sides.is_object() && b.sides.contains("object");
@@ -319,16 +303,16 @@ void Parser::CheckDesign(const Protocol& p) {
         object = object || (level.is_object() && level.contains("object"));
         pair = pair || (level.is_object() && level.contains("left"));
       }
-    if (p.layout == "single" && pair)
+    if (p.layout == Layout::kSingle && pair)
       Problem(b.sides.is_object() ? b.sides_pointer : b.factors_pointer,
               "the layout single shows one object: give \"object\", not left and right");
-    if (p.layout != "single" && object)
+    if (p.layout != Layout::kSingle && object)
       Problem(b.sides.is_object() ? b.sides_pointer : b.factors_pointer,
-              "\"object\" is for the layout single; a " + p.layout + " trial shows left and right");
-    if (type == "grid" && !Provides(b, "edge") && !Provides(b, "y_mm"))
+              "\"object\" is for the layout single; a " + layout_name + " trial shows left and right");
+    if (type == ContentType::kGrid && !Provides(b, "edge") && !Provides(b, "y_mm"))
       Problem(b.factors_pointer, "a grid stands at an edge: needs a factor edge (or y_mm), or a factor whose every "
                                  "level has an edge (1..11 on the thesis's board)");
-    if (type == "picture" && !p.content.real_photos.empty() && !Provides(b, "distance_m"))
+    if (type == ContentType::kPicture && !p.content.real_photos.empty() && !Provides(b, "distance_m"))
       Problem(b.factors_pointer, "content.real_photos chooses the photo by distance: needs a factor distance_m, or "
                                  "a factor whose every level has a distance_m");
   }
@@ -438,26 +422,29 @@ bool Parser::Provides(const Block& b, const std::string& name) {
 using detail::Parser;
 
 std::string CheckInfoValue(const InfoField& f, const std::string& value) {
-  if (f.type == "integer" || f.type == "number") {
-    const std::optional<double> x = ParseDecimal(value);
-    if (!x || (f.type == "integer" && !IsWholeDecimal(value)) || *x < f.min || *x > f.max) {
-      char range[96];
-      std::snprintf(range, sizeof range, "%s in [%g, %g]", f.type == "integer" ? "a whole number" : "a number", f.min,
-                    f.max);
-      return std::string("must be ") + range;
+  switch (f.type) {
+    case InfoType::kInteger:
+    case InfoType::kNumber: {
+      const bool integer = f.type == InfoType::kInteger;
+      const std::optional<double> x = ParseDecimal(value);
+      if (!x || (integer && !IsWholeDecimal(value)) || *x < f.min || *x > f.max) {
+        char range[96];
+        std::snprintf(range, sizeof range, "%s in [%g, %g]", integer ? "a whole number" : "a number", f.min, f.max);
+        return std::string("must be ") + range;
+      }
+      return "";
     }
-    return "";
-  }
-  if (f.type == "choice") {
-    if (std::find(f.choices.begin(), f.choices.end(), value) != f.choices.end()) return "";
-    std::string list;
-    for (const auto& c : f.choices) list += (list.empty() ? "" : ", ") + c;
-    return "must be one of " + list + DidYouMean(value, f.choices);
+    case InfoType::kChoice: {
+      if (std::find(f.choices.begin(), f.choices.end(), value) != f.choices.end()) return "";
+      std::string list;
+      for (const auto& c : f.choices) list += (list.empty() ? "" : ", ") + c;
+      return "must be one of " + list + DidYouMean(value, f.choices);
+    }
+    case InfoType::kText: break;
   }
   if (value.size() > 200 || !IsPrintableUtf8(value)) return "must be one line of printable text, at most 200 bytes";
   return "";
 }
-
 
 std::vector<std::string> Validate(const Json& json, const fs::path& file, const ValidateOptions& options) {
   Parser parser(file, options);
@@ -483,7 +470,13 @@ Protocol ParseProtocol(const Json& json, const fs::path& file, const ValidateOpt
 }
 
 int IntervalCount(const Protocol& protocol) {
-  return protocol.layout == "two_intervals" ? 2 : protocol.layout == "odd_one_out" ? protocol.alternatives : 0;
+  switch (protocol.layout) {
+    case Layout::kTwoIntervals: return 2;
+    case Layout::kOddOneOut: return protocol.alternatives;
+    case Layout::kSideBySide:
+    case Layout::kSingle: return 0;
+  }
+  return 0;
 }
 
 int64_t DesignTrials(const Block& block) {

@@ -12,17 +12,9 @@
 
 #include "core/camera.h"
 #include "core/json_io.h"
+#include "protocol/vocabulary.h"
 
 namespace blurcue::protocol {
-
-// "forced_choice": which of two sides or intervals (or, odd one out, which of N intervals); "adjustment": step through
-// levels and accept one; "yes_no" and "rating" (layout single): one object, answered yes or no, or on a scale of
-// responses.rating's keys.
-enum class Task { kForcedChoice, kAdjustment, kYesNo, kRating };
-enum class Counterbalance { kNone, kSwapCopies, kByParticipant };  // "none" | "swap_copies" | "by_participant"
-
-std::string ToString(Task task);
-std::string ToString(Counterbalance counterbalance);
 
 // One factor: its name and its levels (numbers, strings or objects) in the order the file lists them.
 struct Factor {
@@ -34,7 +26,7 @@ struct Factor {
 struct Adjustment {
   std::string parameter = "cutoff";   // what the levels set, e.g. the Butterworth cut-off (cycles per picture width)
   std::vector<double> levels;
-  std::string order = "shuffled";     // "shuffled" (a fresh random order per trial) | "ascending" | "descending"
+  AdjustOrder order = AdjustOrder::kShuffled;  // shuffled: a fresh random order per trial
 };
 
 // An adaptive procedure (a block's "procedure"): the stimulus of each trial is decided from the answers so far.
@@ -44,9 +36,9 @@ struct Adjustment {
 // correct (can't tell is not). Each crossing of the block's factors runs its own procedure for `trials` trials, all
 // interleaved in the block's shuffled order (like PsychoPy's MultiStairHandler).
 struct Procedure {
-  enum class Kind { kStaircase, kQuestPlus };
+  using Kind = ProcedureKind;
   Kind kind = Kind::kStaircase;
-  std::string variable = "relative_difference";  // "relative_difference" | "difference_arcmin"
+  ProcedureVariable variable = ProcedureVariable::kRelativeDifference;
   Json reference;                    // the blur source both sides start from
   int trials = 30;                   // per crossing of the block's factors
   // Staircase: n-up/m-down (down correct answers in a row step the level down, up wrong ones step it up); the step
@@ -61,8 +53,6 @@ struct Procedure {
   double guess = 0.5;
   bool guess_given = false;          // the file gave guess (else it is chance: 0.5, or 1/n for an odd one out)
 };
-
-std::string ToString(Procedure::Kind kind);
 
 // The most trials a session may have, practice included: at ~2 s a trial, more than five hours. Checked (with
 // overflow-safe arithmetic) before a trial list is made, so no design can exhaust memory or wrap a count.
@@ -117,14 +107,14 @@ struct Scene {
   std::filesystem::path background;   // absolute, resolved against the protocol file's folder
   std::filesystem::path board_free;   // empty when not given
   std::filesystem::path calib;        // empty when not given (a picture needs none)
-  std::string show = "background";    // which photo the trials show: "background" | "board_free"
+  ScenePhoto show = ScenePhoto::kBackground;  // which photo the trials show
   // The photo the trials show, as `show` says (the background when there is no board_free).
-  bool ShowsBoardFree() const { return show == "board_free" && !board_free.empty(); }
+  bool ShowsBoardFree() const { return show == ScenePhoto::kBoardFree && !board_free.empty(); }
   const std::filesystem::path& ShownPhoto() const { return ShowsBoardFree() ? board_free : background; }
 };
 
 struct Content {
-  std::string type;                   // "grid" | "ball" | "picture"
+  ContentType type = ContentType::kGrid;
   int cells = 5;                      // grid: cells per side of the drawn grid card (1-20)
   // grid: the card's width and height in mm (0: two board squares; a height of 0: square), upright on the table
   // facing the camera ("standing") or flat on it ("lying"), turned about the vertical axis by rotation_deg.
@@ -134,7 +124,7 @@ struct Content {
                                       // ball's lowest point); a level height_mm (rotation_deg) sets it per trial
   // grid and ball: the blur kernel and the thesis's brightness/contrast matching of the virtual object (5.3.1.3),
   // applied in linear light (factors of the texture's values; 1 = as the texture is).
-  std::string kernel = "gaussian";    // "gaussian" | "disc"
+  Kernel kernel = Kernel::kGaussian;
   double brightness = 1, contrast = 1;
   // grid and ball: the thesis's "white balance" (5.3.1.3): gains of the object's red, green and blue in linear light.
   std::array<double, 3> white_balance{1, 1, 1};
@@ -142,7 +132,7 @@ struct Content {
   // instead of with one radius at its centre (model no more than the scene needs): {"screen_px": 0.5} (the default)
   // or {"arcmin": 1}; 0 blurs every object per pixel.
   double depth_blur_threshold = 0.5;
-  std::string depth_blur_threshold_unit = "screen_px";  // "screen_px" | "arcmin"
+  ThresholdUnit depth_blur_threshold_unit = ThresholdUnit::kScreenPx;
   double radius_mm = 10;              // ball
   std::string texture = "soccer";     // grid: grid (the 5 x 5 card) | an image path; ball: soccer | wood | a path
   std::filesystem::path image;        // picture: the image (resolved)
@@ -203,7 +193,7 @@ struct Display {
 // A piece of participant information the protocol asks for (PsychoPy's expInfo): recorded with the session.
 struct InfoField {
   std::string key;                   // [a-z0-9_], 1-40 characters
-  std::string type = "text";         // "integer" | "number" | "choice" | "text"
+  InfoType type = InfoType::kText;
   double min = 0, max = 0;           // integer, number
   std::vector<std::string> choices;  // choice
   bool required = true;
@@ -213,8 +203,9 @@ struct InfoField {
 // Between-subject groups: each participant runs the blocks of one group (a block's "groups"; none: every group).
 struct Groups {
   std::vector<std::string> names;
-  std::string assign = "by_number";  // "by_number": names[(number - 1) mod n]; "balanced": the group with the fewest
-                                     // sessions in the record so far (the first of equals)
+  // by_number: names[(number - 1) mod n]; balanced: the group with the fewest sessions in the record so far (the
+  // first of equals).
+  GroupAssign assign = GroupAssign::kByNumber;
 };
 
 // Why `value` is not an answer to `field` ("" when it is one): a whole number in [min, max], a number, one of the
@@ -230,7 +221,7 @@ struct Protocol {
   std::vector<Block> blocks;          // at least one; a file without "blocks" has one block named "main"
   // The order blocks run in: "fixed" (file order), "random" (drawn with the seed) or "latin_square" (a balanced
   // Latin square over participants by their number: each block equally often in each place, and after each other).
-  std::string block_order = "fixed";
+  BlockSequence block_order = BlockSequence::kFixed;
   // How a pair is shown: "side_by_side" (both at once, left and right) or "two_intervals" (2IFC: the left side's
   // object for timing.interval_ms, grey for timing.isi_ms, then the right side's, both at the left object's place;
   // the left / right keys answer first / second interval). Still pairs only.
@@ -238,7 +229,7 @@ struct Protocol {
   // (timing.interval_ms each, isi_ms between) at the left object's place, one of them - drawn with the seed, the
   // trial's test_side "1".."n" - showing the right side's object, the others the left side's; the participant names the
   // odd interval with responses.alternatives.
-  std::string layout = "side_by_side";
+  Layout layout = Layout::kSideBySide;
   int alternatives = 0;               // odd_one_out: intervals per trial (3-6)
   std::vector<InfoField> participant_info;
   std::optional<Groups> groups;

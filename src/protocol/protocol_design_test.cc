@@ -29,7 +29,7 @@ TEST(ProtocolValidate, KernelBrightnessContrastWhiteBalanceScaleAndCellsAreCheck
   j["content"]["contrast"] = 0.9;
   EXPECT_TRUE(Problems(j).empty());
   const Protocol p = ParseProtocol(j, SceneFolder() / "p.json");
-  EXPECT_EQ(p.content.kernel, "disc");
+  EXPECT_EQ(p.content.kernel, Kernel::kDisc);
   EXPECT_DOUBLE_EQ(p.content.brightness, 1.2);
   j["content"]["kernel"] = "box";
   EXPECT_TRUE(Contains(OnlyProblem(j), "/content/kernel")) << OnlyProblem(j);

@@ -183,7 +183,7 @@ TEST(ProtocolValidate, ResponseKeyInTheWrongCaseGetsDidYouMean) {
 TEST(ParticipantInfo, ChoiceInTheWrongCaseGetsDidYouMean) {
   InfoField handedness;
   handedness.key = "handedness";
-  handedness.type = "choice";
+  handedness.type = InfoType::kChoice;
   handedness.choices = {"left", "right", "both"};
   EXPECT_EQ(CheckInfoValue(handedness, "Left"), "must be one of left, right, both (did you mean left?)");
   EXPECT_EQ(CheckInfoValue(handedness, "rigth"), "must be one of left, right, both (did you mean right?)");

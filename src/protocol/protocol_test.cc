@@ -461,8 +461,8 @@ INSTANTIATE_TEST_SUITE_P(Thesis, ShippedProtocol,
 
 TEST(ShippedProtocols, TestThreeShowsTheBoardFreePhoto) {
   const fs::path dir = fs::path(BLURCUE_SOURCE_DIR) / "protocols";
-  EXPECT_EQ(LoadProtocol(dir / "test3-no-board.json", {false}).scene.show, "board_free");
-  EXPECT_EQ(LoadProtocol(dir / "test2-moving-balls.json", {false}).scene.show, "background");
+  EXPECT_EQ(LoadProtocol(dir / "test3-no-board.json", {false}).scene.show, ScenePhoto::kBoardFree);
+  EXPECT_EQ(LoadProtocol(dir / "test2-moving-balls.json", {false}).scene.show, ScenePhoto::kBackground);
 }
 
 TEST(ShippedProtocols, SceneFilesResolveToTheDemoOutput) {

@@ -108,9 +108,11 @@ void DrawAdjustment(const Block& block, int alternatives, std::mt19937_64& rng, 
   }
   if (block.task != Task::kAdjustment || !block.adjust) return;
   t->adjust_levels = block.adjust->levels;
-  if (block.adjust->order == "shuffled") Shuffle(t->adjust_levels, rng);
-  else if (block.adjust->order == "ascending") std::sort(t->adjust_levels.begin(), t->adjust_levels.end());
-  else std::sort(t->adjust_levels.rbegin(), t->adjust_levels.rend());
+  switch (block.adjust->order) {
+    case AdjustOrder::kShuffled: Shuffle(t->adjust_levels, rng); break;
+    case AdjustOrder::kAscending: std::sort(t->adjust_levels.begin(), t->adjust_levels.end()); break;
+    case AdjustOrder::kDescending: std::sort(t->adjust_levels.rbegin(), t->adjust_levels.rend()); break;
+  }
   t->start_index = static_cast<int>(UniformBelow(rng, t->adjust_levels.size()));
 }
 
@@ -120,7 +122,7 @@ std::string AssignGroup(const Protocol& protocol, const std::string& participant
                         const std::map<std::string, int64_t>& sessions) {
   if (!protocol.groups || protocol.groups->names.empty()) return "";
   const auto& names = protocol.groups->names;
-  if (protocol.groups->assign == "balanced") {
+  if (protocol.groups->assign == GroupAssign::kBalanced) {
     std::string best = names.front();
     int64_t fewest = INT64_MAX;
     for (const auto& name : names) {
@@ -199,14 +201,14 @@ std::vector<size_t> BlockOrder(const Protocol& protocol, const std::string& part
   // Practice comes first whatever the order, in the file's order; only the scored blocks are ordered. The random
   // order still shuffles every block (the same draws as before practice blocks were lifted out, so the generator
   // is where it was for everything drawn after) and keeps the scored blocks in the order that shuffle gives them.
-  if (protocol.block_order == "random") Shuffle(all, rng);
+  if (protocol.block_order == BlockSequence::kRandom) Shuffle(all, rng);
   std::vector<size_t> order, scored;
   for (size_t i = 0; i < n; ++i)
     if (protocol.blocks[i].practice) order.push_back(i);
   for (const size_t k : all)
     if (!protocol.blocks[k].practice) scored.push_back(k);
   const size_t m = scored.size();
-  if (protocol.block_order == "latin_square" && m > 1) {
+  if (protocol.block_order == BlockSequence::kLatinSquare && m > 1) {
     const int number = ParticipantNumber(participant);
     if (number < 0)
       throw InputError(protocol.file.string() + ": /block_order",

@@ -281,7 +281,7 @@ TEST(TrialBuilder, GroupsAreAssignedAndSelectTheirBlocks) {
   EXPECT_EQ(AssignGroup(p, "P0", {}), "c");
   EXPECT_THROW(AssignGroup(p, "anonymous", {}), Error);
   Protocol balanced = p;
-  balanced.groups->assign = "balanced";
+  balanced.groups->assign = GroupAssign::kBalanced;
   EXPECT_EQ(AssignGroup(balanced, "anonymous", {}), "a");
   EXPECT_EQ(AssignGroup(balanced, "x", {{"a", 3}, {"b", 2}, {"c", 2}}), "b");
   EXPECT_EQ(AssignGroup(balanced, "x", {{"a", 1}, {"b", 2}, {"c", 2}}), "a");

@@ -21,14 +21,14 @@ PairView ViewOf(const TrialScene& scene, const Presentation& presentation) {
 AdjustView AdjustViewOf(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation) {
   AdjustView view;
   view.distance_m = scene.distance_m;
-  if (scene.content != "picture") return view;
+  if (scene.content != protocol::ContentType::kPicture) return view;
   if (presentation.real_frame_px_per_px > 0) view.r_real_arcmin = presentation.RealArcmin(scene.r_scene_px);
   for (double level : trial.adjust_levels) view.level_r_arcmin.push_back(presentation.LevelArcmin(level));
   return view;
 }
 
 void CheckObserverCanAnswer(const ObserverParams& observer, const protocol::Protocol& protocol) {
-  if (observer.model != ObserverModel::kArcmin || protocol.content.type != "picture" || protocol.content.real_camera)
+  if (observer.model != ObserverModel::kArcmin || protocol.content.type != protocol::ContentType::kPicture || protocol.content.real_camera)
     return;
   for (const auto& block : protocol.blocks)
     if (block.task == protocol::Task::kAdjustment)

@@ -145,7 +145,7 @@ void CapturingPresenter::Capture(const protocol::Trial& trial, const stimulus::T
   frame["block"] = trial.block;
   frame["practice"] = trial.practice;
   frame["prompt"] = !prompt.empty() ? Json(std::string(prompt)) : Json();
-  if (scene.content == "picture")
+  if (scene.content == protocol::ContentType::kPicture)
     frame["real_picture"]["photo"] = protocol_.content.real_photos.empty()
                                          ? protocol_.scene.ShownPhoto().string()
                                          : protocol::RealPhotoFor(protocol_.content, scene.distance_m).string();

@@ -38,7 +38,7 @@ std::vector<store::TrialRecord> TrialRecords(const PreparedSession& s) {
     r.practice = trial.practice;
     r.swapped = trial.swapped;
     r.cell = protocol::CellLevels(protocol, trial);
-    if (planned.content != "picture" && trial.task != protocol::Task::kAdjustment) {
+    if (planned.content != protocol::ContentType::kPicture && trial.task != protocol::Task::kAdjustment) {
       r.r_left_px = planned.r_left_px;
       if (!planned.left_only) r.r_right_px = planned.r_right_px;
       r.r_scene_px = planned.r_scene_px;
@@ -192,7 +192,7 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
     for (double level : trial.adjust_levels) levels += (levels.empty() ? "" : ";") + protocol::LevelText(level);
     v["adjust_levels"] = levels;
   }
-  if (scene.content == "picture") {
+  if (scene.content == protocol::ContentType::kPicture) {
     // The virtual picture's width as shown (a level c's blur is r = 2 x 0.1874 x this / c arcmin), and the real
     // picture's blur when its camera is known: in its camera's px, on the screen and on the eye.
     v["picture_width_arcmin"] = round4(presentation.Arcmin(presentation.layout.picture.width));
@@ -212,7 +212,7 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
       v[std::string("r_") + name + "_arcmin"] = round4(presentation.Arcmin(r));
     }
     v["screen_px_per_photo_px"] = std::round(presentation.scale * 1e6) / 1e6;
-    v["kernel"] = scene.kernel;
+    v["kernel"] = protocol::ToString(scene.kernel);
     v["blur_plan"] = scene.per_pixel ? "per_pixel" : "one_radius";
     v["r_span_screen_px"] = round4(scene.r_span_screen_px);
     v["size_left_deg"] = round4(scene.size_left_deg);

@@ -23,7 +23,7 @@ using stimulus::fixtures::ThesisScene;
 TEST(TrialVariables, GridTrialRecordsEachRadiusInPhotoPxScreenPxAndArcmin) {
   const calib::SceneCalib scene = ThesisScene();
   protocol::Protocol p = BallProtocol();
-  p.content.type = "grid";
+  p.content.type = protocol::ContentType::kGrid;
   const TrialScene far = DescribeTrial(p, PairTrial({{"edge", 11}}, "estimated", "fitted"), &scene);
   // A 4592 x 3056 photo fitted into a 1920 x 1080 window: 1080 / 3056 of a photo px per screen px, floored to
   // whole shown pixels (1622 of 1622.8); on the default monitor (37.84 px per degree) that is the arcmin.
@@ -46,7 +46,7 @@ TEST(TrialVariables, GridTrialRecordsEachRadiusInPhotoPxScreenPxAndArcmin) {
 TEST(TrialVariables, RecordsThePerPixelBlurPlan) {
   const calib::SceneCalib scene = ThesisScene();
   protocol::Protocol p = BallProtocol();
-  p.content.type = "grid";
+  p.content.type = protocol::ContentType::kGrid;
   TrialScene t = DescribeTrial(p, PairTrial({{"edge", 2}}, "fitted", "fitted"), &scene);
   Presentation shown;
   shown.scale = 0.5;
@@ -65,7 +65,7 @@ TEST(TrialVariables, RecordsThePerPixelBlurPlan) {
 TEST(TrialVariables, LevelsNamedLikeRecordedVariablesKeepTheirValuesUnderFactorNames) {
   const calib::SceneCalib scene = ThesisScene();
   protocol::Protocol p = BallProtocol();
-  p.content.type = "grid";
+  p.content.type = protocol::ContentType::kGrid;
   const Json row = {{"edge", 2}, {"status", "x"}, {"participant", "P8"}, {"r_left_px", 7.5}, {"info_age", 40},
                     {"level", 99}, {"test_side", "left"}, {"correct", 1}, {"label", "near"}};
   protocol::Trial trial = PairTrial({{"row", row}, {"group", "g"}}, "fitted", "fitted");

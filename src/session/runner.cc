@@ -39,19 +39,28 @@ Json CollectInfo(const protocol::Protocol& p, const RunOptions& options, const G
   };
   auto value_of = [](const protocol::InfoField& f, const std::string& text) {
     // Checked by CheckInfoValue before: a decimal number in the field's range.
-    return f.type == "integer" ? Json(int64_t(*ParseDecimal(text)))
-           : f.type == "number" ? Json(*ParseDecimal(text))
-                                : Json(text);
+    switch (f.type) {
+      case protocol::InfoType::kInteger: return Json(int64_t(*ParseDecimal(text)));
+      case protocol::InfoType::kNumber: return Json(*ParseDecimal(text));
+      case protocol::InfoType::kChoice:
+      case protocol::InfoType::kText: break;
+    }
+    return Json(text);
   };
   auto describe = [](const protocol::InfoField& f) {
-    if (f.type == "choice") {
-      std::string list;
-      for (const auto& c : f.choices) list += (list.empty() ? "" : " / ") + c;
-      return list;
+    switch (f.type) {
+      case protocol::InfoType::kChoice: {
+        std::string list;
+        for (const auto& c : f.choices) list += (list.empty() ? "" : " / ") + c;
+        return list;
+      }
+      case protocol::InfoType::kText: return std::string("text");
+      case protocol::InfoType::kInteger:
+      case protocol::InfoType::kNumber: break;
     }
     char range[64];
     std::snprintf(range, sizeof range, "%g-%g", f.min, f.max);
-    return f.type == "text" ? std::string("text") : std::string(range);
+    return std::string(range);
   };
   std::string asked;
   std::vector<std::string> keys;
@@ -134,7 +143,7 @@ RunResult RunSession(const RunOptions& options) {
   if (observer) CheckObserverCanAnswer(*observer, protocol);
   // A new session's balanced group is decided again in the transaction that starts it: a station starting at the
   // same moment may take the group peeked above. So each group it may get is prepared (and checked) now.
-  const bool balanced = protocol.groups && protocol.groups->assign == "balanced" && !options.resume;
+  const bool balanced = protocol.groups && protocol.groups->assign == protocol::GroupAssign::kBalanced && !options.resume;
   std::map<std::string, PreparedSession> other_groups;
   if (balanced)
     for (const std::string& name : protocol.groups->names)
@@ -240,7 +249,7 @@ RunResult RunSession(const RunOptions& options) {
   std::optional<ObserverResponder> simulated;
   if (observer)
     simulated.emplace(*observer, chosen.seed, chosen.protocol, chosen.presentation,
-                      KeyMap{chosen.protocol.responses, chosen.protocol.layout == "odd_one_out"},
+                      KeyMap{chosen.protocol.responses, chosen.protocol.layout == protocol::Layout::kOddOneOut},
                       window ? &keys : nullptr);
   Responder& responder = simulated ? static_cast<Responder&>(*simulated) : keys;
   RunResult result = RunTrials({options.db, options.stop_after}, chosen, presenter, responder, record, start);

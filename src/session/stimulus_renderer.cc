@@ -19,7 +19,7 @@ StimulusRenderer::StimulusRenderer(const protocol::Protocol& protocol, const std
                                    const StimulusImages& images, const Presentation& presentation)
     : protocol_(protocol), scene_(scene), presentation_(presentation) {
   photo_ = images.photo;
-  if (protocol.content.type == "picture") {
+  if (protocol.content.type == protocol::ContentType::kPicture) {
     picture_ = images.picture;
     // Every adjustment level's low-passed picture up front (~0.1 s each on the CPU): stepping through the levels
     // in a trial then never stalls a frame on a Butterworth filter.

@@ -23,7 +23,7 @@ double StimulusEndS(const protocol::Timing& timing, const TrialScene& scene) {
 
 std::optional<bool> CorrectOf(const protocol::Trial& trial, const TrialScene& scene, const std::string& choice) {
   if (!trial.test_side.empty()) return choice == trial.test_side;
-  if (trial.task != Task::kForcedChoice || scene.content == "picture") return std::nullopt;
+  if (trial.task != Task::kForcedChoice || scene.content == protocol::ContentType::kPicture) return std::nullopt;
   if (std::abs(scene.r_left_px - scene.r_right_px) <= 1e-9) return choice == "cant_tell";
   return choice == (scene.r_left_px > scene.r_right_px ? "left" : "right");
 }

@@ -41,7 +41,7 @@ TEST(CorrectOf, APairIsAnsweredRightByTheSideWithTheLargerRadiusOrCantTellWhenEq
   protocol::Trial trial;
   trial.task = protocol::Task::kForcedChoice;
   TrialScene scene;
-  scene.content = "grid";
+  scene.content = protocol::ContentType::kGrid;
   scene.r_left_px = 2, scene.r_right_px = 1;
   EXPECT_EQ(CorrectOf(trial, scene, "left"), std::optional<bool>(true));
   EXPECT_EQ(CorrectOf(trial, scene, "right"), std::optional<bool>(false));
@@ -58,7 +58,7 @@ TEST(CorrectOf, APairIsAnsweredRightByTheSideWithTheLargerRadiusOrCantTellWhenEq
   trial.task = protocol::Task::kYesNo;
   EXPECT_FALSE(CorrectOf(trial, scene, "yes").has_value());
   trial.task = protocol::Task::kForcedChoice;
-  scene.content = "picture";
+  scene.content = protocol::ContentType::kPicture;
   EXPECT_FALSE(CorrectOf(trial, scene, "left").has_value());
 }
 

@@ -37,7 +37,7 @@ class Runner {
   Runner(const LoopOptions& options, const PreparedSession& prepared, Presenter& presenter, Responder& responder)
       : options_(options), prepared_(prepared), protocol_(prepared.protocol), presenter_(presenter),
         responder_(responder), trials_(prepared.trials), scenes_(prepared.scenes),
-        keys_{protocol_.responses, protocol_.layout == "odd_one_out"} {}
+        keys_{protocol_.responses, protocol_.layout == protocol::Layout::kOddOneOut} {}
 
   // Shows a text screen until one of `keys` is pressed and returns it ("" when the window is closed).
   std::string ShowUntil(const std::string& title, const std::string& body, const std::string& footer,

@@ -34,7 +34,7 @@ std::vector<PairVisibility> PairVisibilities(const PreparedSession& prepared, co
   AdaptiveState adaptive(p);             // no answers yet: each procedure's first level
   for (const protocol::Trial& t : prepared.trials) {
     TrialScene s = prepared.scenes[size_t(t.index)];
-    if (t.task == protocol::Task::kAdjustment || s.content == "picture") continue;
+    if (t.task == protocol::Task::kAdjustment || s.content == protocol::ContentType::kPicture) continue;
     // Either side order is one pair: a swapped copy shows the same two blurs.
     const std::string a = source(t.left), b = source(t.right);
     Json key = t.levels;
@@ -49,7 +49,7 @@ std::vector<PairVisibility> PairVisibilities(const PreparedSession& prepared, co
       const double first = adaptive.Level(t);
       ApplyLevel(procedure, t, first, prepared.presentation, &s);
       PlanOnScreen(p, *prepared.scene, prepared.presentation, &s);
-      at += (at.empty() ? "" : ", ") + std::string("the first ") + procedure.variable + " " + Json(first).dump();
+      at += (at.empty() ? "" : ", ") + std::string("the first ") + protocol::ToString(procedure.variable) + " " + Json(first).dump();
     }
     PairVisibility pair;
     PairView view = ViewOf(s, prepared.presentation);
@@ -86,7 +86,7 @@ std::vector<MatchVisibility> MatchVisibilities(const PreparedSession& prepared, 
   if (!(shown.real_frame_px_per_px > 0)) return {};
   for (const protocol::Trial& t : prepared.trials) {
     const TrialScene& s = prepared.scenes[size_t(t.index)];
-    if (t.task != protocol::Task::kAdjustment || s.content != "picture") continue;
+    if (t.task != protocol::Task::kAdjustment || s.content != protocol::ContentType::kPicture) continue;
     MatchVisibility& m = by_distance[s.distance_m];
     if (m.trials++ > 0) continue;
     m.distance_m = s.distance_m;

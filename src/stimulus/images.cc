@@ -14,8 +14,8 @@ namespace blurcue::stimulus {
 
 std::optional<calib::SceneCalib> LoadProtocolScene(const protocol::Protocol& protocol) {
   if (protocol.scene.calib.empty()) {
-    if (protocol.content.type == "picture") return std::nullopt;
-    throw InputError(At(protocol, "/scene/calib"), "a " + protocol.content.type + " needs a calibration");
+    if (protocol.content.type == protocol::ContentType::kPicture) return std::nullopt;
+    throw InputError(At(protocol, "/scene/calib"), "a " + protocol::ToString(protocol.content.type) + " needs a calibration");
   }
   try {
     return calib::LoadSceneCalib(protocol.scene.calib);
@@ -62,21 +62,22 @@ StimulusImages LoadStimulusImages(const protocol::Protocol& protocol, const std:
   const bool board_free = protocol.scene.ShowsBoardFree();
   const std::string photo_field = board_free ? "/scene/board_free" : "/scene/background";
   const auto& photo_path = protocol.scene.ShownPhoto();
-  if (protocol.content.type != "picture" || protocol.content.real_photos.empty()) {
+  if (protocol.content.type != protocol::ContentType::kPicture || protocol.content.real_photos.empty()) {
     images.photo = ReadFieldImage(protocol, photo_field, photo_path, 1, 10, kMaxPhotoSidePx);
     // The photo not shown is still a photo of the scene: check it decodes too.
     if (!protocol.scene.board_free.empty() && !board_free)
       ReadFieldImage(protocol, "/scene/board_free", protocol.scene.board_free, 1, 10, kMaxPhotoSidePx);
     if (board_free) ReadFieldImage(protocol, "/scene/background", protocol.scene.background, 1, 10, kMaxPhotoSidePx);
   }
-  if (protocol.content.type == "picture") {
+  if (protocol.content.type == protocol::ContentType::kPicture) {
     images.picture = ReadFieldImage(protocol, "/content/image",
                                     protocol.content.image.empty() ? scene::ResolveStimulus("face")
                                                                    : protocol.content.image,
                                     -1, 10, kMaxPhotoSidePx);
     return images;
   }
-  if (!scene) throw InputError(At(protocol, "/scene/calib"), "a " + protocol.content.type + " needs a calibration");
+  if (!scene)
+    throw InputError(At(protocol, "/scene/calib"), "a " + protocol::ToString(protocol.content.type) + " needs a calibration");
   // The objects are drawn in the calibrated camera's view of this photo.
   try {
     scene->RequireSameSize(images.photo, photo_path.string());
@@ -98,7 +99,7 @@ StimulusImages LoadStimulusImages(const protocol::Protocol& protocol, const std:
   if (name == "grid" && protocol.content.cells != 5)
     images.texture = scene::GridBoard(images.texture.cols, protocol.content.cells);
   // An image on a card of a given size: its pixels keep their shape, or the card says another.
-  if (protocol.content.type == "grid" && !shipped) {
+  if (protocol.content.type == protocol::ContentType::kGrid && !shipped) {
     const protocol::Content& c = protocol.content;
     const double w = c.size_mm > 0 ? c.size_mm : 2 * scene->board.square_mm, h = c.card_height_mm > 0 ? c.card_height_mm : w;
     const double image = double(images.texture.rows) / images.texture.cols;
@@ -123,7 +124,7 @@ void CheckRealPhotos(const protocol::Protocol& protocol, const std::vector<Trial
                      std::set<double>* checked) {
   if (protocol.content.real_photos.empty()) return;
   for (const TrialScene& scene : scenes)
-    if (scene.content == "picture" && checked->insert(scene.distance_m).second) {
+    if (scene.content == protocol::ContentType::kPicture && checked->insert(scene.distance_m).second) {
       const cv::Mat photo = ReadFieldImage(protocol, "/content/real_photos",
                                            protocol::RealPhotoFor(protocol.content, scene.distance_m), 1, 10,
                                            kMaxPhotoSidePx);

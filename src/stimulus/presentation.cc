@@ -23,7 +23,7 @@ Presentation Presentation::Of(const protocol::Protocol& protocol, const Stimulus
     p.prompt_band_px = std::max(32, protocol.display.height_px / 12);
   // The stimulus has the window above the prompt's band.
   const int W = p.window_width_px, H = p.window_height_px - p.prompt_band_px;
-  if (protocol.content.type == "picture") {
+  if (protocol.content.type == protocol::ContentType::kPicture) {
     // The depth-matching frame, 4:3, as large as the window holds (the thesis's 960 x 720 in a 1280 x 720 one).
     p.layout = scene::DepthMatchingLayout::Of(std::min(W, H * 4 / 3), images.picture.size());
     p.frame_width_px = p.layout.frame.width;
@@ -113,10 +113,10 @@ Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, cons
       {"scaling", presentation.scaling},
       {"screen_px_per_photo_px", round(presentation.scale, 1e-6)},
       {"photo_rect_px", {view.x_px, view.y_px, view.photo_width_px, view.photo_height_px}},
-      {"blur_plan", trial.content == "picture" ? "none" : trial.per_pixel ? "per_pixel" : "one_radius"},
+      {"blur_plan", trial.content == protocol::ContentType::kPicture ? "none" : trial.per_pixel ? "per_pixel" : "one_radius"},
       {"r_span_screen_px", std::round(trial.r_span_screen_px * 1e4) / 1e4},
       {"objects", Json::array()}};
-  if (trial.content == "picture") {
+  if (trial.content == protocol::ContentType::kPicture) {
     // The frame is shown at one screen px per frame px where `view` places it.
     const scene::DepthMatchingLayout& l = presentation.layout;
     auto on_screen = [&](const cv::Rect& r) { return Json{view.x_px + r.x, view.y_px + r.y, r.width, r.height}; };

@@ -28,7 +28,7 @@
 namespace blurcue::stimulus {
 
 struct TrialScene {
-  std::string content;                // "grid" | "ball" | "picture"
+  protocol::ContentType content = protocol::ContentType::kGrid;
   // Pairs (grid, ball): the source on each side as shown (swaps applied).
   calib::BlurSource left = calib::BlurSource::kNone, right = calib::BlurSource::kNone;
   double left_fixed_px = 0, right_fixed_px = 0;
@@ -44,7 +44,7 @@ struct TrialScene {
   double speed_mm_s = 0;              // ball: 0 = at rest at from_y_mm
   bool wipe_at_end = false;           // ball: disappear on arrival (a section run)
   double distance_m = 0;              // picture: the real picture's distance
-  std::string kernel = "gaussian";    // pairs: the blur kernel, and the object's brightness/contrast matching
+  protocol::Kernel kernel = protocol::Kernel::kGaussian;  // pairs: the blur kernel, and the object's matching
   double brightness = 1, contrast = 1;
   std::array<double, 3> white_balance{1, 1, 1};  // red, green, blue gains
   // A procedure's level on the test side (ApplyLevel): each side's radius is gain x its source's + add_px.

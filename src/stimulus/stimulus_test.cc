@@ -55,7 +55,7 @@ TEST(DescribeTrial, WholeRunRestsAtTheFarEdgeAndAveragesTheGrowingBlur) {
 TEST(ObjectsAt, CarryTheProtocolsKernelAndMatchingAndEachSidesRadius) {
   const calib::SceneCalib scene = ThesisScene();
   protocol::Protocol p = BallProtocol();
-  p.content.kernel = "disc";
+  p.content.kernel = protocol::Kernel::kDisc;
   p.content.brightness = 1.3;
   p.content.contrast = 0.8;
   const Json pattern = {{"id", 2}, {"speed_cm_s", 1.8}, {"left", "measured"}, {"right", "none"}};
@@ -122,9 +122,9 @@ TEST(DescribeTrial, IntervalsRecordTheRightSidesRadiusWhereItsIntervalShowsIt) {
     scene.sections.push_back(measured);
   }
   protocol::Protocol pair = BallProtocol();
-  pair.layout = "pair";
+  pair.layout = protocol::Layout::kSideBySide;
   protocol::Protocol intervals = BallProtocol();
-  intervals.layout = "two_intervals";
+  intervals.layout = protocol::Layout::kTwoIntervals;
   const protocol::Trial trial = PairTrial({{"edge", 6}, {"left_x_mm", -30}}, "measured_section", "measured_section");
   const TrialScene side_by_side = DescribeTrial(pair, trial, &scene);
   EXPECT_DOUBLE_EQ(side_by_side.r_left_px, 0.5);   // nearest the left ball: section 1
@@ -151,7 +151,7 @@ TEST(DescribeTrial, GridCardsSitBesideTheBoardAtTheirEdge) {
   edge2.r_px = 0.45;
   scene.sections.push_back(edge2);
   protocol::Protocol p = BallProtocol();
-  p.content.type = "grid";
+  p.content.type = protocol::ContentType::kGrid;
   const TrialScene near = DescribeTrial(p, PairTrial({{"edge", 2}}, "measured", "fitted"), &scene);
   const TrialScene far = DescribeTrial(p, PairTrial({{"edge", 11}}, "estimated", "fitted"), &scene);
   EXPECT_EQ(near.edge, 2);
@@ -181,7 +181,7 @@ TEST(PlanOnScreen, PerPixelExactlyWhenTheObjectsDepthSpanReachesTheThresholdOnSc
   // corners minus that at its near ones (z of the corners, the model evaluated there), times the screen scale.
   const calib::SceneCalib scene = ThesisScene();
   protocol::Protocol p = BallProtocol();
-  p.content.type = "grid";
+  p.content.type = protocol::ContentType::kGrid;
   TrialScene t = DescribeTrial(p, PairTrial({{"edge", 2}}, "fitted", "fitted"), &scene);
   Presentation shown;
   shown.scale = 0.5;
@@ -206,7 +206,7 @@ TEST(PlanOnScreen, PerPixelExactlyWhenTheObjectsDepthSpanReachesTheThresholdOnSc
   EXPECT_NEAR(objects[0]->r_of_depth_px(z_centre), objects[0]->r_px, 1e-9);
   EXPECT_NEAR(objects[0]->r_of_depth_px(scene.ToCamera({card.center_board_mm[0], 50, 0})[2]), r_at(50), 1e-2);
   // In arcmin, converted by the profile: the same span is 0.5 x span screen px x arcmin per px.
-  p.content.depth_blur_threshold_unit = "arcmin";
+  p.content.depth_blur_threshold_unit = protocol::ThresholdUnit::kArcmin;
   p.content.depth_blur_threshold = display::ArcminOfScreenPx(shown.profile, span) * 1.01;
   PlanOnScreen(p, scene, shown, &t);
   EXPECT_FALSE(t.per_pixel);
@@ -225,7 +225,7 @@ TEST(DescribeTrial, ARadiusGivenOnTheScreenIsTurnedIntoPhotoPxByThePresentation)
   // px; at 0.5 screen px per photo px, 2.5228 photo px. 1.5 screen px is 3 photo px.
   const calib::SceneCalib scene = ThesisScene();
   protocol::Protocol p = BallProtocol();
-  p.content.type = "grid";
+  p.content.type = protocol::ContentType::kGrid;
   Presentation shown;
   shown.scale = 0.5;
   const TrialScene t = DescribeTrial(p, PairTrial({{"edge", 3}}, Json{{"arcmin", 2}}, Json{{"screen_px", 1.5}}),
@@ -248,14 +248,14 @@ TEST(DescribeTrial, ARadiusGivenOnTheScreenIsTurnedIntoPhotoPxByThePresentation)
 TEST(DescribeTrial, PlacesInMillimetresAndChecksTheBoardAndThePhoto) {
   const calib::SceneCalib scene = ThesisScene();
   protocol::Protocol p = BallProtocol();
-  p.content.type = "grid";
+  p.content.type = protocol::ContentType::kGrid;
   const TrialScene card = DescribeTrial(p, PairTrial({{"y_mm", 60}, {"left_x_mm", -40}, {"right_x_mm", 230}},
                                                      "fitted", "fitted"), &scene);
   const auto cards = ObjectsAt(p, scene, card, 0);
   EXPECT_EQ(cards[0]->object.center_board_mm, cv::Vec3d(-40, 60, 0));
   EXPECT_EQ(cards[1]->object.center_board_mm, cv::Vec3d(230, 60, 0));
   EXPECT_NEAR(card.r_left_px, calib::BlurAtPx(scene, calib::BlurSource::kFitted, scene.ToCamera({-40, 60, 0})), 1e-9);
-  p.content.type = "ball";
+  p.content.type = protocol::ContentType::kBall;
   const TrialScene ball = DescribeTrial(p, PairTrial({{"from_y_mm", 10}, {"to_y_mm", 110}, {"speed_cm_s", 2},
                                                       {"left_x_mm", 50}}, "fitted", "none"), &scene);
   EXPECT_DOUBLE_EQ(ball.MotionS(), 5.0);  // 100 mm at 20 mm/s
@@ -268,7 +268,7 @@ TEST(DescribeTrial, PlacesInMillimetresAndChecksTheBoardAndThePhoto) {
     EXPECT_NE(std::string(e.what()).find("edge 12 is not on the calibrated board (7 x 10 squares: edges 1-11"),
               std::string::npos) << e.what();
   }
-  p.content.type = "grid";
+  p.content.type = protocol::ContentType::kGrid;
   try {
     DescribeTrial(p, PairTrial({{"y_mm", 60}, {"right_x_mm", 5000}}, "fitted", "fitted"), &scene);
     ADD_FAILURE() << "a card 5 m off the board was accepted";
@@ -281,7 +281,7 @@ TEST(DescribeTrial, PlacesInMillimetresAndChecksTheBoardAndThePhoto) {
 TEST(DescribeTrial, MissingLevelOrCalibrationIsAnInputErrorNamingTheField) {
   const calib::SceneCalib scene = ThesisScene();
   protocol::Protocol p = BallProtocol();
-  p.content.type = "grid";
+  p.content.type = protocol::ContentType::kGrid;
   protocol::Block block;
   block.name = "task2";
   block.factors_pointer = "/blocks/1/factors";

@@ -57,7 +57,7 @@ inline Json StandInScene() {
 inline protocol::Protocol BallProtocol() {
   protocol::Protocol p;
   p.file = "balls.json";
-  p.content.type = "ball";
+  p.content.type = protocol::ContentType::kBall;
   p.content.radius_mm = 10;
   return p;
 }

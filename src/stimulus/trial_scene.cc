@@ -65,6 +65,16 @@ scene::VirtualObject Ball(const calib::SceneCalib& s, const TrialScene& t, doubl
 }
 
 
+// The protocol's kernel as the renderer names its blur method: the one place the two vocabularies meet (render knows
+// nothing of protocols).
+std::string RenderMethod(protocol::Kernel kernel) {
+  switch (kernel) {
+    case protocol::Kernel::kGaussian: return "gaussian";
+    case protocol::Kernel::kDisc: return "disc";
+  }
+  return "gaussian";
+}
+
 }  // namespace
 
 double TrialScene::MotionS() const {
@@ -89,11 +99,13 @@ void CheckInPhoto(const protocol::Protocol& protocol, const protocol::Trial& tri
       // An intervals trial shows the right side's object at the left's place (IntervalScene): side 0's check is its.
       if (!objects[side] || (side == 1 && t.intervals > 0)) continue;
       if ((scene::FootprintOf(scene.camera, scene.rvec, scene.tvec, objects[side]->object).bounds & photo).empty()) {
-        const char* level = t.content == "grid" ? (std::isnan(side == 0 ? t.left_x_mm : t.right_x_mm) ? "edge"
-                                                   : side == 0 ? "left_x_mm" : "right_x_mm")
-                                                : "speed_cm_s";
+        const char* level = t.content == protocol::ContentType::kGrid
+                                ? (std::isnan(side == 0 ? t.left_x_mm : t.right_x_mm) ? "edge"
+                                   : side == 0                                          ? "left_x_mm"
+                                                                                        : "right_x_mm")
+                                : "speed_cm_s";
         throw InputError(protocol.file.string() + ": " + protocol::LevelPointer(protocol, trial, level),
-                         std::string("the ") + (side == 0 ? "left" : "right") + " " + t.content + " at (" +
+                         std::string("the ") + (side == 0 ? "left" : "right") + " " + protocol::ToString(t.content) + " at (" +
                              std::to_string(int(std::lround(objects[side]->object.center_board_mm[0]))) + ", " +
                              std::to_string(int(std::lround(objects[side]->object.center_board_mm[1]))) +
                              ") mm on the board lies outside the " + std::to_string(photo.width) + " x " +
@@ -109,7 +121,7 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
                          const calib::SceneCalib* scene, const Presentation* presentation) {
   TrialScene t;
   t.content = protocol.content.type;
-  t.left_only = protocol.layout == "single";
+  t.left_only = protocol.layout == protocol::Layout::kSingle;
   t.intervals = protocol::IntervalCount(protocol);
   t.kernel = protocol.content.kernel;
   t.brightness = protocol.content.brightness;
@@ -117,7 +129,7 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   t.white_balance = protocol.content.white_balance;
   // Problems name the protocol field that asked for what cannot be shown, and the trial as a detail.
   const std::string trial_text = " (trial " + std::to_string(trial.index) + ", block " + trial.block + ")";
-  if (t.content == "picture") {
+  if (t.content == protocol::ContentType::kPicture) {
     const Json* d = FindLevel(trial.levels, "distance_m");
     t.distance_m = d && d->is_number() ? d->get<double>() : 1.0;
     // The real picture's blur: the thin lens of the camera that took its photo (content.real_camera).
@@ -137,7 +149,7 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
     }
     return t;
   }
-  if (!scene) throw InputError(protocol.file.string(), "/scene/calib: a " + t.content + " needs a calibration");
+  if (!scene) throw InputError(protocol.file.string(), "/scene/calib: a " + protocol::ToString(t.content) + " needs a calibration");
   // Where a side's source was chosen ("" for the scene's own blur, the calibration's): looked up only for a message.
   auto field = [&](const char* side) {
     return At(protocol, side ? protocol::SidePointer(protocol, trial, side) : "/scene/calib");
@@ -182,13 +194,13 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   if (auto x = mm_level("left_x_mm")) t.left_x_mm = *x;
   if (auto x = mm_level("right_x_mm")) t.right_x_mm = *x;
   t.height_mm = mm_level("height_mm").value_or(protocol.content.height_mm);
-  if (t.content == "grid") {
+  if (t.content == protocol::ContentType::kGrid) {
     t.card_width_mm = protocol.content.size_mm;
     t.card_height_mm = protocol.content.card_height_mm;
     t.standing = protocol.content.standing;
     t.rotation_deg = mm_level("rotation_deg").value_or(protocol.content.rotation_deg);
   }
-  if (t.content == "grid") {
+  if (t.content == protocol::ContentType::kGrid) {
     const auto edge = board_level("edge", edges);
     const auto y = mm_level("y_mm");
     if (!edge && !y)
@@ -274,7 +286,7 @@ std::array<std::optional<scene::BlurredObject>, 2> ObjectsAt(const protocol::Pro
     const calib::BlurSource source = left ? trial.left : trial.right;
     const double fixed = left ? trial.left_fixed_px : trial.right_fixed_px;
     const double gain = left ? trial.left_gain : trial.right_gain, add = left ? trial.left_add_px : trial.right_add_px;
-    if (trial.content == "grid") {
+    if (trial.content == protocol::ContentType::kGrid) {
       o = Card(s, trial, left);
     } else {
       const double y = trial.BallYMm(t_s);
@@ -291,7 +303,7 @@ std::array<std::optional<scene::BlurredObject>, 2> ObjectsAt(const protocol::Pro
     o.brightness = trial.brightness;
     o.contrast = trial.contrast;
     o.white_balance = {trial.white_balance[0], trial.white_balance[1], trial.white_balance[2]};
-    b.method = trial.kernel;
+    b.method = RenderMethod(trial.kernel);
     b.r_px = gain * calib::BlurAtPx(s, source, s.ToCamera(o.center_board_mm), fixed) + add;
     shown[left ? 0 : 1] = std::move(b);
   }
@@ -323,7 +335,7 @@ void ApplyLevel(const protocol::Procedure& procedure, const protocol::Trial& tri
   double& add = left ? scene->left_add_px : scene->right_add_px;
   double& r = left ? scene->r_left_px : scene->r_right_px;
   const double reference = (r - add) / gain;  // as DescribeTrial made it
-  if (procedure.variable == "relative_difference") {
+  if (procedure.variable == protocol::ProcedureVariable::kRelativeDifference) {
     gain = 1 + level, add = 0;
   } else {
     gain = 1;
@@ -335,9 +347,9 @@ void ApplyLevel(const protocol::Procedure& procedure, const protocol::Trial& tri
 
 void PlanOnScreen(const protocol::Protocol& protocol, const calib::SceneCalib& s, const Presentation& presentation,
               TrialScene* trial) {
-  if (trial->content == "picture") return;
+  if (trial->content == protocol::ContentType::kPicture) return;
   const protocol::Content& c = protocol.content;
-  const double threshold = c.depth_blur_threshold_unit == "arcmin"
+  const double threshold = c.depth_blur_threshold_unit == protocol::ThresholdUnit::kArcmin
                                ? display::ScreenPxOfArcmin(presentation.profile, c.depth_blur_threshold)
                                : c.depth_blur_threshold;
   // The objects as the per-pixel plan would draw them: each one's radius at its nearest and farthest depth is what

@@ -1,0 +1,144 @@
+#pragma once
+// The protocol's vocabularies: each word a protocol file may use for a mode is an enum value here, with one
+// ToString (the word, as the file, the record and every message spell it) and one ParseWord beside it. The parser
+// reads the words once; after protocol/, code switches over these enums (exhaustively, no default:), so a new value
+// makes the compiler show every place to touch. To add a value: the enum, its case in ToString, its place in
+// Vocabulary<E>::values (the order the parser lists the allowed words in).
+#include <array>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace blurcue::protocol {
+
+// Every value of a vocabulary, in the order the parser's "must be one of" lists them; specialised per enum below.
+template <typename E>
+struct Vocabulary;
+
+// "forced_choice": which of two sides or intervals (or, odd one out, which of N intervals); "adjustment": step through
+// levels and accept one; "yes_no" and "rating" (layout single): one object, answered yes or no, or on a scale of
+// responses.rating's keys.
+enum class Task { kForcedChoice, kAdjustment, kYesNo, kRating };
+template <>
+struct Vocabulary<Task> {
+  static constexpr std::array values{Task::kForcedChoice, Task::kAdjustment, Task::kYesNo, Task::kRating};
+};
+
+// "none" | "swap_copies" | "by_participant".
+enum class Counterbalance { kNone, kSwapCopies, kByParticipant };
+template <>
+struct Vocabulary<Counterbalance> {
+  static constexpr std::array values{Counterbalance::kSwapCopies, Counterbalance::kByParticipant,
+                                     Counterbalance::kNone};
+};
+
+// An adaptive procedure's type: "staircase" | "quest_plus".
+enum class ProcedureKind { kStaircase, kQuestPlus };
+template <>
+struct Vocabulary<ProcedureKind> {
+  static constexpr std::array values{ProcedureKind::kStaircase, ProcedureKind::kQuestPlus};
+};
+
+// A procedure's level: "relative_difference" (a blur gain of 1 + level) | "difference_arcmin" (plus level arcmin).
+enum class ProcedureVariable { kRelativeDifference, kDifferenceArcmin };
+template <>
+struct Vocabulary<ProcedureVariable> {
+  static constexpr std::array values{ProcedureVariable::kRelativeDifference, ProcedureVariable::kDifferenceArcmin};
+};
+
+// The order an adjustment's levels are stepped through: "shuffled" | "ascending" | "descending".
+enum class AdjustOrder { kShuffled, kAscending, kDescending };
+template <>
+struct Vocabulary<AdjustOrder> {
+  static constexpr std::array values{AdjustOrder::kShuffled, AdjustOrder::kAscending, AdjustOrder::kDescending};
+};
+
+// What the trials show: "grid" (a drawn card) | "ball" | "picture" (a whole low-passed image).
+enum class ContentType { kGrid, kBall, kPicture };
+template <>
+struct Vocabulary<ContentType> {
+  static constexpr std::array values{ContentType::kGrid, ContentType::kBall, ContentType::kPicture};
+};
+
+// The blur kernel of a grid or ball: "gaussian" | "disc".
+enum class Kernel { kGaussian, kDisc };
+template <>
+struct Vocabulary<Kernel> {
+  static constexpr std::array values{Kernel::kGaussian, Kernel::kDisc};
+};
+
+// The unit of content.depth_blur_threshold: "screen_px" | "arcmin".
+enum class ThresholdUnit { kScreenPx, kArcmin };
+template <>
+struct Vocabulary<ThresholdUnit> {
+  static constexpr std::array values{ThresholdUnit::kScreenPx, ThresholdUnit::kArcmin};
+};
+
+// Which scene photo the trials show: "background" | "board_free".
+enum class ScenePhoto { kBackground, kBoardFree };
+template <>
+struct Vocabulary<ScenePhoto> {
+  static constexpr std::array values{ScenePhoto::kBackground, ScenePhoto::kBoardFree};
+};
+
+// How a trial is laid out: "side_by_side" | "two_intervals" | "single" | "odd_one_out" (see Protocol::layout).
+enum class Layout { kSideBySide, kTwoIntervals, kSingle, kOddOneOut };
+template <>
+struct Vocabulary<Layout> {
+  static constexpr std::array values{Layout::kSideBySide, Layout::kTwoIntervals, Layout::kSingle, Layout::kOddOneOut};
+};
+
+// The order blocks run in: "fixed" | "random" | "latin_square" (see Protocol::block_order).
+enum class BlockSequence { kFixed, kRandom, kLatinSquare };
+template <>
+struct Vocabulary<BlockSequence> {
+  static constexpr std::array values{BlockSequence::kFixed, BlockSequence::kRandom, BlockSequence::kLatinSquare};
+};
+
+// How a participant is put in a group: "by_number" | "balanced" (see Groups::assign).
+enum class GroupAssign { kByNumber, kBalanced };
+template <>
+struct Vocabulary<GroupAssign> {
+  static constexpr std::array values{GroupAssign::kByNumber, GroupAssign::kBalanced};
+};
+
+// A participant information field's type: "integer" | "number" | "choice" | "text".
+enum class InfoType { kInteger, kNumber, kChoice, kText };
+template <>
+struct Vocabulary<InfoType> {
+  static constexpr std::array values{InfoType::kInteger, InfoType::kNumber, InfoType::kChoice, InfoType::kText};
+};
+
+// The word for a value, as protocol files, the record and messages spell it ("" for a value outside the enum).
+std::string ToString(Task value);
+std::string ToString(Counterbalance value);
+std::string ToString(ProcedureKind value);
+std::string ToString(ProcedureVariable value);
+std::string ToString(AdjustOrder value);
+std::string ToString(ContentType value);
+std::string ToString(Kernel value);
+std::string ToString(ThresholdUnit value);
+std::string ToString(ScenePhoto value);
+std::string ToString(Layout value);
+std::string ToString(BlockSequence value);
+std::string ToString(GroupAssign value);
+std::string ToString(InfoType value);
+
+// The value a word names, or nullopt when the vocabulary has no such word.
+template <typename E>
+std::optional<E> ParseWord(std::string_view word) {
+  for (const E value : Vocabulary<E>::values)
+    if (ToString(value) == word) return value;
+  return std::nullopt;
+}
+
+// Every word of a vocabulary, in Vocabulary<E>::values order: the parser's allowed values.
+template <typename E>
+std::vector<std::string> Words() {
+  std::vector<std::string> words;
+  for (const E value : Vocabulary<E>::values) words.push_back(ToString(value));
+  return words;
+}
+
+}  // namespace blurcue::protocol
