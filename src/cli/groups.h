@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/names.h"
 #include "core/typed.h"
 #include "protocol/protocol.h"
 
@@ -29,25 +30,12 @@ inline std::vector<std::string> GroupsToCheck(const protocol::Protocol& p, const
   const std::vector<std::string>& names = p.groups->names;
   if (group.empty()) return names;
   if (std::find(names.begin(), names.end(), group) != names.end()) return {group};
-  // Did you mean: the name fewest single-character edits away.
-  auto distance = [](const std::string& a, const std::string& b) {
-    std::vector<size_t> row(b.size() + 1);
-    for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-    for (size_t i = 1; i <= a.size(); ++i) {
-      size_t diagonal = row[0];
-      row[0] = i;
-      for (size_t j = 1; j <= b.size(); ++j) {
-        const size_t up = row[j];
-        row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-        diagonal = up;
-      }
-    }
-    return row[b.size()];
-  };
-  std::string nearest;
+  // Did you mean: a case slip first (NearestName), else the name fewest single-character edits away.
+  std::string nearest = NearestName(group, names);
   size_t best = std::string::npos;
-  for (const std::string& name : names)
-    if (const size_t d = distance(group, name); d < best) best = d, nearest = name;
+  if (nearest.empty())
+    for (const std::string& name : names)
+      if (const size_t d = EditDistance(group, name); d < best) best = d, nearest = name;
   std::string listed;
   for (const std::string& name : names) listed += (listed.empty() ? "" : ", ") + name;
   throw Error(ErrorKind::kUsage, "--group " + shown + ": " + p.file.string() + " has no such group (did you mean " +
