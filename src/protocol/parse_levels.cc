@@ -12,6 +12,11 @@ namespace blurcue::protocol::detail {
 
 void Parser::CheckReadName(const std::string& name, const std::string& what, const std::string& ptr,
                            const std::string& where) {
+  // "label_" alone names no label: its column would be one more "label_" beside any other such.
+  if (name == "label_") {
+    Problem(ptr, where + "a label needs a name after label_ (e.g. label_stim_id)");
+    return;
+  }
   if (IsValueName(name) || IsLabelName(name)) return;
   // A name with a space at either end ("edge " from a CSV header) is quoted and said to be so: it used to read
   // "a column edge  (did you mean edge?)", the difference invisible.

@@ -56,6 +56,12 @@ TEST(ProtocolValidate, LabelsAreRecordedThoughNothingReadsThem) {
   EXPECT_TRUE(Problems(j).empty()) << Problems(j).front();
 }
 
+TEST(ProtocolValidate, LabelWithoutANameIsRefused) {
+  Json j = Valid();
+  j["blocks"][1]["factors"]["label_"] = {"am", "pm"};
+  EXPECT_EQ(OnlyProblem(j), Line("/blocks/1/factors/label_: a label needs a name after label_ (e.g. label_stim_id)"));
+}
+
 TEST(ProtocolValidate, MisspeltObjectLevelKeyIsRefusedOnceWithDidYouMean) {
   Json j = Valid();
   for (auto& level : j["blocks"][0]["factors"]["pattern"]) {
