@@ -52,6 +52,6 @@ WINDOW=()
 $BC bench measure --quick --out results/bench/measure.csv
 $BC bench render --quick --out results/bench/render.csv
 $BC bench record --trials 100 --folder results/bench   # what a power-loss-safe commit costs per answer
-$BC bench procedures --quick --out results/bench/procedures.csv   # which adaptive procedure to choose
+$BC bench procedures --out results/bench/procedures.csv   # which adaptive procedure to choose (200 runs each, ~15 s)
 $BC report --db "$OUT/study.sqlite" --out "$OUT/report" --bench results/bench
 echo "demo: results in $OUT/ (calib.json, ball-edge9-estimated.png, pattern3.avi, study.sqlite, report/index.html)"

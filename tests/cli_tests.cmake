@@ -100,11 +100,15 @@ set_tests_properties(cli_bench_record PROPERTIES
 
 # Which procedure: 40 seeded runs each; the CSV must show what the procedures are known to do - every one gets
 # better with trials for a nominal observer, QUEST+ is the least biased and the first within 10 % RMSE there, and a
-# side bias or a threshold beyond the stimulus range defeats the adaptive ones (tests/procedure_bench_check.py).
+# side bias or a threshold beyond the stimulus range defeats the adaptive ones (tests/procedure_bench_check.py). A
+# second run with another seed checks the rows' Monte Carlo standard errors against the spread between the two runs.
 add_test(NAME cli_bench_procedures
          COMMAND ${BC} bench procedures --quick --out ${T}/bench/procedures.csv)
 set_tests_properties(cli_bench_procedures PROPERTIES PASS_REGULAR_EXPRESSION "wrote .*procedures.csv \\(80 rows")
+add_test(NAME cli_bench_procedures_seed2
+         COMMAND ${BC} bench procedures --quick --seed 2 --out ${T}/bench/procedures-seed2.csv)
 add_test(NAME cli_bench_procedures_check
-         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/procedure_bench_check.py ${T}/bench/procedures.csv)
-set_tests_properties(cli_bench_procedures_check PROPERTIES DEPENDS cli_bench_procedures
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/procedure_bench_check.py ${T}/bench/procedures.csv
+                 ${T}/bench/procedures-seed2.csv)
+set_tests_properties(cli_bench_procedures_check PROPERTIES DEPENDS "cli_bench_procedures;cli_bench_procedures_seed2"
                      PASS_REGULAR_EXPRESSION "ok: ")

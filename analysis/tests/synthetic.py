@@ -245,7 +245,8 @@ def write_bench_fixtures(folder):
         f.write("\n".join(lines) + "\n")
 
     # procedures.csv (`blurcue bench procedures`): errors that shrink as 1 / sqrt(trials), the failures it finds.
-    lines = ["procedure,condition,trials,runs,failed,truth,bias,sd,rmse,us_per_trial"]
+    lines = ["procedure,condition,trials,runs,failed,truth,bias,bias_se,sd,rmse,rmse_se,within_target,fails,"
+             "us_per_trial"]
     truths = {"constant_stimuli": 1.0, "staircase_1u2d": 0.84, "staircase_1u3d": 0.9, "quest_plus": 1.0}
     spread = {"constant_stimuli": 1.6, "staircase_1u2d": 1.6, "staircase_1u3d": 1.15, "quest_plus": 1.0}
     biases = {"side_bias": 0.45, "beyond_range": -0.25}
@@ -255,7 +256,13 @@ def write_bench_fixtures(folder):
                 sd = 0.85 * spread[procedure] * truth / n ** 0.5
                 bias = biases.get(condition, 0.01) * truth
                 rmse = (sd * sd + bias * bias) ** 0.5
-                lines.append(f"{procedure},{condition},{n},200,0,{truth},{bias:.5f},{sd:.5f},{rmse:.5f},35")
+                bias_se, rmse_se = sd / 200 ** 0.5, rmse / 400 ** 0.5  # Monte Carlo errors of 200 runs, roughly
+                within = "yes" if rmse + 2 * rmse_se <= 0.1 * truth else \
+                    "no" if rmse - 2 * rmse_se > 0.1 * truth else "undecided"
+                fails = "yes" if abs(bias) - 2 * bias_se > 0.15 * truth else \
+                    "no" if abs(bias) + 2 * bias_se <= 0.15 * truth else "undecided"
+                lines.append(f"{procedure},{condition},{n},200,0,{truth},{bias:.5f},{bias_se:.5f},{sd:.5f},"
+                             f"{rmse:.5f},{rmse_se:.5f},{within},{fails},35")
     with open(os.path.join(folder, "procedures.csv"), "w") as f:
         f.write("\n".join(lines) + "\n")
     return folder

@@ -132,5 +132,44 @@ class BenchChartsTest(unittest.TestCase):
         self.assertIn("--quick", ax.get_title(loc="left"))
 
 
+
+def procedure_rows(rows):
+    """procedures.csv rows from (procedure, trials, rmse, rmse_se, within, bias, bias_se, fails), truth 1, 200 runs."""
+    return pd.DataFrame([{"procedure": p, "condition": "nominal", "trials": n, "runs": 200, "failed": 0, "truth": 1.0,
+                          "bias": b, "bias_se": bse, "sd": 0.05, "rmse": r, "rmse_se": rse, "within_target": w,
+                          "fails": f, "us_per_trial": 1.0} for p, n, r, rse, w, b, bse, f in rows])
+
+
+class ProcedureClaimsTest(unittest.TestCase):
+    """The bench page's sentences about procedures follow the CSV's verdicts: ties are ties, undecided is said."""
+
+    def test_two_procedures_first_at_the_same_trials_are_a_tie_not_an_alphabetical_winner(self):
+        d = procedure_rows([("quest_plus", 40, 0.084, 0.006, "yes", 0.0, 0.005, "no"),
+                            ("staircase_1u3d", 40, 0.080, 0.007, "yes", 0.0, 0.005, "no"),
+                            ("constant_stimuli", 40, 0.2, 0.01, "no", 0.0, 0.005, "no")])
+        notes = bench_charts.procedure_claims(d, "5 % lapses")
+        self.assertIn("a tie", notes[0])
+        self.assertIn("1-up/3-down", notes[0])
+        self.assertIn("QUEST+", notes[0])
+        self.assertNotIn("first by", notes[0])
+
+    def test_one_first_names_it_with_its_monte_carlo_error_and_an_earlier_undecided_row(self):
+        d = procedure_rows([("quest_plus", 20, 0.105, 0.01, "undecided", 0.0, 0.005, "no"),
+                            ("quest_plus", 40, 0.06, 0.004, "yes", 0.0, 0.005, "no"),
+                            ("staircase_1u2d", 80, 0.07, 0.004, "yes", 0.0, 0.005, "no")])
+        notes = bench_charts.procedure_claims(d, "nominal observer")
+        self.assertIn("first by QUEST+ (40 trials; RMSE QUEST+ 6.0 ± 0.4 %", notes[0])
+        self.assertTrue(any("at 20 trials" in n and "undecided with 200 runs" in n for n in notes), notes)
+
+    def test_failure_only_where_the_verdict_says_so(self):
+        d = procedure_rows([("quest_plus", 160, 0.3, 0.01, "no", -0.26, 0.001, "yes"),
+                            ("staircase_1u2d", 160, 0.16, 0.01, "no", 0.148, 0.01, "undecided"),
+                            ("staircase_1u3d", 160, 0.05, 0.01, "yes", 0.01, 0.01, "no")])
+        notes = bench_charts.procedure_claims(d, "beyond")
+        self.assertTrue(any("QUEST+ fails - bias -26.0 %" in n for n in notes), notes)
+        self.assertTrue(any("1-up/2-down" in n and "undecided" in n and "fails" not in n for n in notes), notes)
+        self.assertFalse(any("1-up/3-down fails" in n for n in notes), notes)
+
+
 if __name__ == "__main__":
     unittest.main()

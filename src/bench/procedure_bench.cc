@@ -97,7 +97,53 @@ struct Tally {
   int failed = 0;
 };
 
+constexpr double kPrecision = 0.10;  // the stated precision: RMSE within 10 % of the target
+constexpr double kFailBias = 0.15;   // a procedure fails where its bias exceeds 15 % of the target
+constexpr double kZ95 = 1.959964;
+
+ProcedureRow::Verdict Compare(double value, double se, double limit) {
+  if (value + kZ95 * se <= limit) return ProcedureRow::Verdict::kYes;
+  if (value - kZ95 * se > limit) return ProcedureRow::Verdict::kNo;
+  return ProcedureRow::Verdict::kUndecided;
+}
+
+// Bias, SD and RMSE of the estimates against the truth, with their Monte Carlo standard errors, and the verdicts.
+void Summarize(const std::vector<double>& estimates, double truth, ProcedureRow* row) {
+  const double n = double(estimates.size());
+  double mean = 0, mse = 0;
+  for (double e : estimates) mean += e, mse += (e - truth) * (e - truth);
+  mean /= n, mse /= n;
+  double var = 0, var_sq = 0;
+  for (double e : estimates) {
+    var += (e - mean) * (e - mean);
+    const double sq = (e - truth) * (e - truth);
+    var_sq += (sq - mse) * (sq - mse);
+  }
+  const double denominator = std::max(1.0, n - 1);
+  row->bias = mean - truth;
+  row->sd = std::sqrt(var / denominator);
+  row->rmse = std::sqrt(mse);
+  row->bias_se = row->sd / std::sqrt(n);
+  row->rmse_se = row->rmse > 0 ? std::sqrt(var_sq / denominator / n) / (2 * row->rmse) : 0;
+  row->within = row->failed > 0 ? ProcedureRow::Verdict::kNo : Compare(row->rmse, row->rmse_se, kPrecision * truth);
+  // Compare says whether |bias| stays within the line; failing is the other way round.
+  switch (Compare(std::abs(row->bias), row->bias_se, kFailBias * truth)) {
+    case ProcedureRow::Verdict::kYes: row->fails = ProcedureRow::Verdict::kNo; break;
+    case ProcedureRow::Verdict::kNo: row->fails = ProcedureRow::Verdict::kYes; break;
+    case ProcedureRow::Verdict::kUndecided: row->fails = ProcedureRow::Verdict::kUndecided; break;
+  }
+}
+
 }  // namespace
+
+const char* ToString(ProcedureRow::Verdict verdict) {
+  switch (verdict) {
+    case ProcedureRow::Verdict::kYes: return "yes";
+    case ProcedureRow::Verdict::kNo: return "no";
+    case ProcedureRow::Verdict::kUndecided: return "undecided";
+  }
+  return "undecided";
+}
 
 std::vector<ProcedureRow> RunProcedureBench(const ProcedureBenchOptions& options) {
   const char* kProcedures[] = {"constant_stimuli", "staircase_1u2d", "staircase_1u3d", "quest_plus"};
@@ -163,16 +209,10 @@ std::vector<ProcedureRow> RunProcedureBench(const ProcedureBenchOptions& options
         row.failed = tally.failed;
         row.truth = truth;
         row.us_per_trial = us;
-        if (!tally.estimates.empty()) {
-          double mean = 0, sq = 0;
-          for (double e : tally.estimates) mean += e, sq += (e - truth) * (e - truth);
-          mean /= double(tally.estimates.size());
-          double var = 0;
-          for (double e : tally.estimates) var += (e - mean) * (e - mean);
-          row.bias = mean - truth;
-          row.sd = std::sqrt(var / std::max<size_t>(1, tally.estimates.size() - 1));
-          row.rmse = std::sqrt(sq / double(tally.estimates.size()));
-        }
+        if (!tally.estimates.empty())
+          Summarize(tally.estimates, truth, &row);
+        else
+          row.within = ProcedureRow::Verdict::kNo;  // no estimate at all
         rows.push_back(row);
       }
       if (options.progress) {
@@ -188,12 +228,13 @@ std::vector<ProcedureRow> RunProcedureBench(const ProcedureBenchOptions& options
 
 void WriteProcedureCsv(const std::vector<ProcedureRow>& rows, const std::filesystem::path& path, bool quick) {
   std::ostringstream out;
-  out << "procedure,condition,trials,runs,failed,truth,bias,sd,rmse,us_per_trial,quick\n";
+  out << "procedure,condition,trials,runs,failed,truth,bias,bias_se,sd,rmse,rmse_se,within_target,fails,us_per_trial,"
+         "quick\n";
   for (const auto& r : rows) {
-    char line[256];
-    std::snprintf(line, sizeof line, "%s,%s,%d,%d,%d,%.6g,%.6g,%.6g,%.6g,%.4g,%d\n", r.procedure.c_str(),
-                  r.condition.c_str(), r.trials, r.runs, r.failed, r.truth, r.bias, r.sd, r.rmse, r.us_per_trial,
-                  int(quick));
+    char line[320];
+    std::snprintf(line, sizeof line, "%s,%s,%d,%d,%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%s,%s,%.4g,%d\n",
+                  r.procedure.c_str(), r.condition.c_str(), r.trials, r.runs, r.failed, r.truth, r.bias, r.bias_se,
+                  r.sd, r.rmse, r.rmse_se, ToString(r.within), ToString(r.fails), r.us_per_trial, int(quick));
     out << line;
   }
   WriteFileAtomically(path, out.str());
@@ -208,16 +249,19 @@ std::string SummarizeProcedures(const std::vector<ProcedureRow>& rows) {
       const ProcedureRow* last = nullptr;
       for (const auto& r : rows)
         if (r.condition == c.name && r.procedure == name) {
-          if (needed < 0 && r.failed == 0 && r.rmse <= 0.1 * r.truth) needed = r.trials;
+          if (needed < 0 && r.within == ProcedureRow::Verdict::kYes) needed = r.trials;
           last = &r;
         }
       if (!last) continue;
-      char line[200];
-      std::snprintf(line, sizeof line, "  %-17s RMSE within 10 %% of its target by %s trials; at 160: bias %+5.1f %%, "
-                                       "sd %4.1f %%%s\n",
+      const char* verdict = last->fails == ProcedureRow::Verdict::kYes         ? "  <- fails here (bias > 15 %)"
+                            : last->fails == ProcedureRow::Verdict::kUndecided ? "  (bias near 15 %: undecided)"
+                                                                                : "";
+      char line[240];
+      std::snprintf(line, sizeof line,
+                    "  %-17s RMSE clearly within 10 %% of its target by %s trials; at 160: bias %+5.1f %% "
+                    "(MC se %.1f %%), sd %4.1f %%%s\n",
                     name, needed < 0 ? "> 160" : std::to_string(needed).c_str(), 100 * last->bias / last->truth,
-                    100 * last->sd / last->truth,
-                    std::abs(last->bias) > 0.15 * last->truth ? "  <- fails here (bias > 15 %)" : "");
+                    100 * last->bias_se / last->truth, 100 * last->sd / last->truth, verdict);
       out << line;
     }
   }
