@@ -77,6 +77,37 @@ bool IsPrintableUtf8(std::string_view text) {
   return true;
 }
 
+size_t Utf8Length(std::string_view text) {
+  size_t n = 0;
+  for (char c : text) n += (static_cast<unsigned char>(c) & 0xC0) != 0x80;
+  return n;
+}
+
+std::string UnsafeIdReason(std::string_view text) {
+  if (!text.empty() && std::string_view("=+-@").find(text.front()) != std::string_view::npos)
+    return std::string("begins with ") + text.front() + ", which a spreadsheet opening the exported tables runs as a "
+           "formula";
+  // The bidirectional controls in UTF-8: U+061C (D8 9C), U+200E/F (E2 80 8E/8F), U+202A-E (E2 80 AA-AE),
+  // U+2066-9 (E2 81 A6-A9).
+  for (size_t i = 0; i + 1 < text.size(); ++i) {
+    const auto b = [&](size_t k) { return static_cast<unsigned char>(text[i + k]); };
+    unsigned code = 0;
+    if (b(0) == 0xD8 && b(1) == 0x9C) code = 0x061C;
+    else if (i + 2 < text.size() && b(0) == 0xE2 && b(1) == 0x80 &&
+             (b(2) == 0x8E || b(2) == 0x8F || (b(2) >= 0xAA && b(2) <= 0xAE)))
+      code = 0x2000 + (b(2) - 0x80);
+    else if (i + 2 < text.size() && b(0) == 0xE2 && b(1) == 0x81 && b(2) >= 0xA6 && b(2) <= 0xA9)
+      code = 0x2040 + (b(2) - 0x80);
+    if (code) {
+      char hex[16];
+      std::snprintf(hex, sizeof hex, "U+%04X", code);
+      return std::string("holds the bidirectional control character ") + hex +
+             ", which shows the text to a reader in another order than it is recorded";
+    }
+  }
+  return "";
+}
+
 std::string OneLine(std::string_view text) {
   std::string out;
   out.reserve(text.size());

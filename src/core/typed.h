@@ -21,6 +21,15 @@ bool IsWholeDecimal(std::string_view text);
 // U+001F, U+007F to U+009F): text a record, a CSV cell, a terminal line and the report can all hold as it is.
 bool IsPrintableUtf8(std::string_view text);
 
+// The characters (UTF-8 code points) of valid UTF-8 text: what a limit "1-100 characters" counts.
+size_t Utf8Length(std::string_view text);
+
+// Why `text` cannot be an id or a name (a participant id, a study, group or block name, an id cell), or "" when it
+// can: it begins with = + - or @, which a spreadsheet opening the exported tables runs as a formula
+// (=HYPERLINK(...), =cmd|...), or it holds a bidirectional control character (U+061C, U+200E, U+200F, U+202A to
+// U+202E, U+2066 to U+2069), which shows the text to a reader in another order than it is recorded.
+std::string UnsafeIdReason(std::string_view text);
+
 // `text` as one printable line: what IsPrintableUtf8 takes kept as it is, a newline, return or tab written \n, \r,
 // \t, any other control or broken byte \xNN. For messages that echo what someone typed.
 std::string OneLine(std::string_view text);

@@ -68,5 +68,25 @@ TEST(Echo, CutsLongValuesAndSaysTheirLength) {
   EXPECT_EQ(Echo("a\nb\x1b"), "'a\\nb\\x1b'");
 }
 
+TEST(UnsafeIdReason, FormulaStartsAndBidiControlsAreNamed) {
+  EXPECT_EQ(UnsafeIdReason("P1"), "");
+  EXPECT_EQ(UnsafeIdReason("P-1"), "");  // a minus inside is harmless
+  EXPECT_EQ(UnsafeIdReason(""), "");
+  for (const char* id : {"=1+1", "+1", "-2", "@SUM(A1)"})
+    EXPECT_NE(UnsafeIdReason(id).find("formula"), std::string::npos) << id;
+  EXPECT_NE(UnsafeIdReason("a\u202Eb").find("U+202E"), std::string::npos);
+  EXPECT_NE(UnsafeIdReason("a\u2066b").find("U+2066"), std::string::npos);
+  EXPECT_NE(UnsafeIdReason("a\u200Fb").find("U+200F"), std::string::npos);
+  EXPECT_NE(UnsafeIdReason("a\u061Cb").find("U+061C"), std::string::npos);
+  EXPECT_EQ(UnsafeIdReason("a\u2022b"), "");  // a bullet (E2 80 A2) is not a control
+}
+
+TEST(Utf8Length, CountsCodePoints) {
+  EXPECT_EQ(Utf8Length(""), 0u);
+  EXPECT_EQ(Utf8Length("abc"), 3u);
+  EXPECT_EQ(Utf8Length("\u00e9\u00e9"), 2u);      // 4 bytes
+  EXPECT_EQ(Utf8Length("\u6f22\U0001F600"), 2u);  // 3 + 4 bytes
+}
+
 }  // namespace
 }  // namespace blurcue

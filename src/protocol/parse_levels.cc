@@ -3,8 +3,13 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <map>
+#include <string_view>
 
+#include "core/csv.h"
+#include "core/json_io.h"
 #include "core/names.h"
 #include "core/typed.h"
 
@@ -57,6 +62,15 @@ void Parser::CheckLevelValue(const std::string& name, const Json& v, const std::
              (v.is_string() ? DidYouMean(v.get<std::string>(), {"none", "measured", "measured_section", "estimated",
                                                                 "fitted"})
                             : std::string()));
+  } else if (name == "id") {
+    // An id names a row or a pattern in the tables, the report's file names and its charts: text a spreadsheet
+    // shows as written, or a whole number every reader holds exactly (1e308 and 2^64 - 1 are neither).
+    constexpr double kExact = 9007199254740992.0;  // 2^53
+    if (v.is_string()) {
+      if (const std::string why = UnsafeIdReason(v.get<std::string>()); !why.empty()) report("an id " + why);
+    } else if (!v.is_number_integer() || std::abs(v.get<double>()) >= kExact) {
+      report("an id must be text or a whole number below 2^53 (9007199254740992)");
+    }
   } else if (v.is_number() && !std::isfinite(v.get<double>())) {
     report("must be a finite number");
   }
@@ -76,7 +90,7 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
   int carrying_sides = 0;
   for (const auto& [name, levels] : v.items()) {
     const std::string fp = ptr + "/" + Escape(name);
-    if (name.empty() || name.size() > kMaxNameChars || !IsPrintableUtf8(name)) {
+    if (name.empty() || Utf8Length(name) > kMaxNameChars || !IsPrintableUtf8(name)) {
       Problem(fp, "a factor name must be 1 to " + std::to_string(kMaxNameChars) +
                       " characters without control characters", Json(name));
       continue;
@@ -139,15 +153,60 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
   return factors;
 }
 
-// A conditions table instead of factors: a CSV file whose header names the levels (edge, speed_cm_s, left, right,
-// any label) and whose every row is one design row - for designs that are not full crossings. It becomes one factor
-// "row" whose levels are the rows as objects (numbers read as numbers), checked like any level: a problem names
-// /.../conditions/row/K/COLUMN, K counting the table's data rows from 0.
+namespace {
+
+// A decimal's digits without leading or trailing zeros and the power of ten of its first: "0.0250" and "2.5e-2"
+// are ("25", -2). For comparing what a cell says with what a double holds.
+std::pair<std::string, int> Digits(std::string_view text) {
+  std::string digits;
+  int exponent = 0, point = -1;
+  size_t i = (!text.empty() && (text[0] == '+' || text[0] == '-')) ? 1 : 0;
+  for (; i < text.size() && text[i] != 'e' && text[i] != 'E'; ++i) {
+    if (text[i] == '.') point = int(digits.size());
+    else digits += text[i];
+  }
+  if (i < text.size()) exponent = std::atoi(std::string(text.substr(i + 1)).c_str());
+  if (point < 0) point = int(digits.size());
+  const size_t first = digits.find_first_not_of('0');
+  if (first == std::string::npos) return {"0", 0};
+  exponent += point - int(first) - 1;
+  digits = digits.substr(first);
+  digits.erase(digits.find_last_not_of('0') + 1);
+  return {digits, exponent};
+}
+
+// Whether the double nearest to the decimal `cell` is the decimal itself as a reader sees it: its shortest
+// round-trip form has the same digits ("0.1" yes; "9007199254740993" and "0.12345678901234567" no).
+bool HoldsExactly(std::string_view cell, double value) {
+  char text[40];
+  for (int precision = 1; precision <= 17; ++precision) {
+    std::snprintf(text, sizeof text, "%.*g", precision, value);
+    if (std::strtod(text, nullptr) == value) break;
+  }
+  return Digits(cell) == Digits(text);
+}
+
+}  // namespace
+
+// A conditions table instead of factors: a CSV file (RFC 4180, as spreadsheets save it: core/csv.h) whose header
+// names the levels (edge, speed_cm_s, left, right, any label) and whose every row is one design row - for designs
+// that are not full crossings. It becomes one factor "row" whose levels are the rows as objects, checked like any
+// level: a problem names /.../conditions/row/K/COLUMN, K counting the table's data rows from 0, and the file's line
+// and column. A label's cell (id, label, label_*) stays the text it is ("007" and "7" are two ids); any other
+// cell that is a number is that number exactly, or refused.
 std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& ptr) {
   const auto text = Text(v, "conditions", ptr.substr(0, ptr.rfind('/')), true, kMaxPathChars, true);
   if (!text) return {};
   const fs::path file = (base_ / *text).lexically_normal();
   if (!CheckFile(file, ptr, Json(*text))) return {};
+  const std::string where = file.string();
+  std::error_code size_error;
+  const uintmax_t bytes = fs::file_size(file, size_error);
+  if (!size_error && bytes > kMaxJsonBytes) {
+    Problem(ptr, where + ": a conditions table may have at most 16 MiB (" + std::to_string(kMaxTrials) +
+                     " rows); this file has " + std::to_string(bytes) + " bytes", Json(*text));
+    return {};
+  }
   std::string csv;
   try {
     csv = ReadTextFile(file);
@@ -155,79 +214,43 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
     Problem(ptr, e.what(), Json(*text));
     return {};
   }
-  // Excel's "CSV UTF-8" and Notepad begin the file with a byte order mark; it is not part of the first column's
-  // name (it used to be, and the column - edge - was refused as an unknown name that looked like edge).
-  if (csv.rfind("\xEF\xBB\xBF", 0) == 0) csv.erase(0, 3);
-  // Comma-separated, double quotes around a field that holds commas or quotes ("" for one quote); a field does not
-  // span lines, so a quote still open at the line's end is an error (it used to swallow the rest of the line).
-  struct Row {
-    std::vector<std::string> fields{1};
-    size_t line = 0;      // in the file, from 1
-    bool closed = true;   // every quote closed
+  const CsvText table = ParseCsv(csv, size_t(kMaxTrials) + 1);
+  auto at = [&](size_t line, size_t column) {
+    return where + " line " + std::to_string(line) + (column ? ", column " + std::to_string(column) : "");
   };
-  auto split = [](const std::string& line, size_t number) {
-    Row row;
-    row.line = number;
-    bool quoted = false;
-    for (size_t i = 0; i < line.size(); ++i) {
-      const char c = line[i];
-      if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"') row.fields.back() += '"', ++i;
-      else if (c == '"') quoted = !quoted;
-      else if (c == ',' && !quoted) row.fields.emplace_back();
-      else row.fields.back() += c;
-    }
-    row.closed = !quoted;
-    return row;
-  };
-  std::vector<Row> rows;
-  size_t start = 0, number = 0;
-  while (start <= csv.size()) {
-    size_t end = csv.find('\n', start);
-    if (end == std::string::npos) end = csv.size();
-    std::string line = csv.substr(start, end - start);
-    ++number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (!line.empty()) rows.push_back(split(line, number));
-    start = end + 1;
-    if (rows.size() > size_t(kMaxTrials) + 1) break;
+  if (!table.problems.empty()) {
+    const CsvProblem& p = table.problems.front();
+    Problem(ptr, at(p.line, p.column) + ": " + p.message, Json(*text));
+    return {};
   }
-  const std::string where = file.string();
+  const std::vector<CsvRecord>& rows = table.records;
   if (rows.size() < 2) {
-    Problem(ptr, where + ": needs a header and at least one row", Json(*text));
+    Problem(ptr, where + (rows.empty() ? ": is empty" : ": has a header but no rows") +
+                     "; a conditions table needs a header naming its columns and at least one row", Json(*text));
     return {};
   }
   if (rows.size() > size_t(kMaxTrials) + 1) {
     Problem(ptr, where + ": more than " + std::to_string(kMaxTrials) + " rows", Json(*text));
     return {};
   }
-  const std::string unclosed = ": a quoted field is not closed (a field cannot span lines; write \"\" for a quote)";
-  if (!rows.front().closed) {
-    Problem(ptr, where + " line " + std::to_string(rows.front().line) + unclosed, Json(*text));
-    return {};
-  }
   const std::vector<std::string>& header = rows.front().fields;
   std::set<std::string> names;
-  for (const auto& name : header)
-    if (name.empty() || name.size() > kMaxNameChars || !IsPrintableUtf8(name) || !names.insert(name).second) {
-      Problem(ptr, where + ": the header must name each column once, 1-100 characters, got \"" + name + "\"",
-              Json(*text));
+  for (size_t c = 0; c < header.size(); ++c) {
+    const std::string& name = header[c];
+    if (name.empty() || Utf8Length(name) > kMaxNameChars || !IsPrintableUtf8(name) || !names.insert(name).second) {
+      Problem(ptr, at(rows.front().line, c + 1) + ": the header must name each column once, 1-100 characters, got " +
+                       Json(name).dump(-1, ' ', false, Json::error_handler_t::replace), Json(*text));
       return {};
     }
+  }
   // Each column is a level's name: read (edge, left, ...) or a label (id, label, label_*).
-  for (size_t c = 0; c < header.size(); ++c)
-    CheckReadName(header[c], "column", ptr,
-                  where + " line " + std::to_string(rows.front().line) + ", column " + std::to_string(c + 1) + ": ");
+  for (size_t c = 0; c < header.size(); ++c) CheckReadName(header[c], "column", ptr, at(rows.front().line, c + 1) + ": ");
   Factor factor;
   factor.name = "row";
   for (size_t r = 1; r < rows.size(); ++r) {
     const std::string rp = ptr + "/row/" + std::to_string(r - 1);
-    const std::string line = where + " line " + std::to_string(rows[r].line);
-    if (!rows[r].closed) {
-      Problem(rp, line + unclosed, Json(*text));
-      continue;
-    }
     if (rows[r].fields.size() != header.size()) {
-      Problem(rp, line + ": has " + std::to_string(rows[r].fields.size()) + " fields, the header " +
+      Problem(rp, at(rows[r].line, 0) + ": has " + std::to_string(rows[r].fields.size()) + " fields, the header " +
                       std::to_string(header.size()), Json(*text));
       continue;
     }
@@ -236,23 +259,31 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
     for (size_t c = 0; c < header.size(); ++c) {
       const std::string& cell = rows[r].fields[c];
       const std::string cp = rp + "/" + Escape(header[c]);
+      const std::string in = " (" + at(rows[r].line, c + 1) + ")";
       // A cell becomes a level, a label in the record, the tables and the report: text they can all hold as it
       // is. A Latin-1 byte or a NUL used to reach the record raw, or to stop validate with a JSON library error.
       if (!IsPrintableUtf8(cell)) {
-        Problem(cp, line + ", column " + std::to_string(c + 1) + " (" + header[c] +
-                        "): must be printable UTF-8 text (no control characters; save the file as UTF-8), got " +
-                        Echo(cell));
+        Problem(cp, at(rows[r].line, c + 1) + " (" + header[c] +
+                        "): must be printable UTF-8 text on one line (no control characters or line breaks; save the "
+                        "file as UTF-8), got " + Echo(cell));
         printable = false;
         continue;
       }
-      const std::optional<double> number = ParseDecimal(cell);
-      level[header[c]] = IsWholeDecimal(cell) && std::abs(*number) < 9e15 ? Json(int64_t(*number))
-                         : number                                       ? Json(*number)
-                                                                        : Json(cell);
-      // Where the cell is, for the one who opens the table to fix it.
-      const std::string in = " (" + line + ", column " + std::to_string(c + 1) + ")";
-      if (cell.empty()) Problem(cp, "is empty, got \"\"" + in);
-      else CheckLevelValue(header[c], level[header[c]], cp, in);
+      if (cell.empty()) {
+        Problem(cp, "is empty, got \"\"" + in);
+        continue;
+      }
+      const std::optional<double> number = IsLabelName(header[c]) ? std::nullopt : ParseDecimal(cell);
+      if (number && !HoldsExactly(cell, *number)) {
+        Problem(cp, "has more digits than a number holds exactly (it would be recorded as " +
+                        Json(*number).dump() + "), got " + Echo(cell) + in +
+                        "; a value that names something belongs in a label column (label_NAME), kept as text");
+        continue;
+      }
+      level[header[c]] = !number                                             ? Json(cell)
+                         : IsWholeDecimal(cell) && std::abs(*number) < 9e15 ? Json(int64_t(*number))
+                                                                             : Json(*number);
+      CheckLevelValue(header[c], level[header[c]], cp, in);
     }
     if (!printable) continue;
     factor.levels.push_back(std::move(level));

@@ -182,7 +182,7 @@ void Parser::ParseInfo(const Json& v, const std::string& ptr, Protocol* p) {
       else if (c)
         for (size_t k = 0; k < c->size(); ++k) {
           const Json& choice = (*c)[k];
-          if (!choice.is_string() || choice.get<std::string>().empty() || choice.get<std::string>().size() > 100 ||
+          if (!choice.is_string() || choice.get<std::string>().empty() || Utf8Length(choice.get<std::string>()) > 100 ||
               !IsPrintableUtf8(choice.get<std::string>()) ||
               std::count(field.choices.begin(), field.choices.end(), choice.get<std::string>()))
             Problem(fp + "/choices/" + std::to_string(k), "must be a new answer of 1-100 characters", choice);
@@ -213,10 +213,12 @@ void Parser::ParseGroups(const Json& v, const Json& top, const std::string& ptr,
   if (names)
     for (size_t i = 0; i < names->size(); ++i) {
       const Json& n = (*names)[i];
-      if (!n.is_string() || n.get<std::string>().empty() || n.get<std::string>().size() > kMaxNameChars ||
+      if (!n.is_string() || n.get<std::string>().empty() || Utf8Length(n.get<std::string>()) > kMaxNameChars ||
           !IsPrintableUtf8(n.get<std::string>()) ||
           std::count(g.names.begin(), g.names.end(), n.get<std::string>()))
         Problem(ptr + "/names/" + std::to_string(i), "must be a new name of 1-100 characters", n);
+      else if (const std::string why = UnsafeIdReason(n.get<std::string>()); !why.empty())
+        Problem(ptr + "/names/" + std::to_string(i), why, n);
       else if (CaseTwin(g.names, n.get<std::string>()))
         Problem(ptr + "/names/" + std::to_string(i), "must differ from an earlier name by more than letter case", n);
       else

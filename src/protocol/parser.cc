@@ -245,12 +245,29 @@ std::optional<std::string> Parser::Text(const Json& obj, const std::string& key,
   const auto s = String(obj, key, ptr, required);
   if (!s) return std::nullopt;
   const std::string p = ptr + "/" + Escape(key);
-  if (s->size() > max_chars) {
-    Problem(p, "must be at most " + std::to_string(max_chars) + " characters, got " + std::to_string(s->size()));
+  // Characters, as the message says: 100 x "é" is 100 characters (200 bytes), and fits.
+  if (Utf8Length(*s) > max_chars) {
+    Problem(p, "must be at most " + std::to_string(max_chars) + " characters, got " + std::to_string(Utf8Length(*s)));
     return std::nullopt;
   }
   if (one_line && !IsPrintableUtf8(*s)) {
     Problem(p, "must not contain control characters (line breaks, tabs, NUL)", Json(*s));
+    return std::nullopt;
+  }
+  return s;
+}
+
+std::optional<std::string> Parser::Name(const Json& obj, const std::string& key, const std::string& ptr,
+                                        bool required) {
+  auto s = Text(obj, key, ptr, required, kMaxNameChars, true);
+  if (!s) return std::nullopt;
+  const std::string p = ptr + "/" + Escape(key);
+  if (s->empty()) {
+    Problem(p, "must not be empty", Json(*s));
+    return std::nullopt;
+  }
+  if (const std::string why = UnsafeIdReason(*s); !why.empty()) {
+    Problem(p, why, Json(*s));
     return std::nullopt;
   }
   return s;

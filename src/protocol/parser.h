@@ -93,6 +93,8 @@ class Parser {
   static bool NumberIn(const Json& v, double min, double max);
 
   // A string of at most `max_chars` bytes; `one_line`: without control characters (names, keys, paths).
+  // A name (the study's, a block's): Text of 1 to kMaxNameChars characters on one line that UnsafeIdReason takes.
+  std::optional<std::string> Name(const Json& obj, const std::string& key, const std::string& ptr, bool required);
   std::optional<std::string> Text(const Json& obj, const std::string& key, const std::string& ptr, bool required,
                                   size_t max_chars, bool one_line);
 

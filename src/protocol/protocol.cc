@@ -28,10 +28,7 @@ Protocol Parser::Parse(const Json& json) {
                "repetitions", "counterbalance", "sides", "adjust", "blocks", "block_order", "practice", "instructions",
                "breaks", "responses", "timing", "display", "participant_info", "groups", "layout", "alternatives"}))
     return p;
-  if (auto s = Text(json, "name", "", true, kMaxNameChars, true)) {
-    if (s->empty()) Problem("/name", "must not be empty", Json(*s));
-    p.name = *s;
-  }
+  if (auto s = Name(json, "name", "", true)) p.name = *s;
   if (auto n = Int(json, "version", "", true, 1, 1000000)) p.version = *n;
   if (auto s = Text(json, "description", "", false, 5 * kMaxTextChars, false)) p.description = *s;
   if (auto s = Text(json, "instructions", "", false, kMaxTextChars, false)) p.instructions = *s;
@@ -84,8 +81,7 @@ Protocol Parser::Parse(const Json& json) {
                             "title", "prompt", "timing"}))
         continue;
       Block b;
-      if (auto s = Text(obj, "name", bp, true, kMaxNameChars, true)) {
-        if (s->empty()) Problem(bp + "/name", "must not be empty", Json(*s));
+      if (auto s = Name(obj, "name", bp, true)) {
         for (const auto& other : p.blocks)
           if (other.name == *s) Problem(bp + "/name", "repeats the name of an earlier block", Json(*s));
         b.name = *s;

@@ -228,20 +228,21 @@ TEST(ProtocolValidate, ConditionsTableCellWithAControlByteIsRefused) {
   EXPECT_TRUE(Contains(problems[2], "/row/2/label: ")) << problems[2];
 }
 
-// A quote left open at a line's end is a problem naming the file and the line (a field cannot span lines): the
-// table `2,measured,none,"ab` used to validate and record the label `ab`. The line counts the file's lines, blank
-// ones included.
+// A quote left open to the end of the file is a problem naming the file, the line and the column where it opened:
+// the table `2,measured,none,"ab` used to validate and record the label `ab`. The line counts the file's lines,
+// blank ones included.
 TEST(ProtocolValidate, ConditionsTableUnclosedQuoteIsRefusedNamingTheLine) {
   const fs::path dir = SceneFolder();
   std::ofstream(dir / "open.csv") << "edge,left,right,label\n1,measured,none,\"a \"\"b\"\"\"\n\n2,measured,none,\"ab\n";
   Json j = Valid();
   j["blocks"] = {{{"name", "rows"}, {"conditions", "open.csv"}}};
   const std::string problem = OnlyProblem(j);
-  EXPECT_TRUE(Contains(problem, "/blocks/0/conditions/row/1: " + (dir / "open.csv").string() +
-                                    " line 4: a quoted field is not closed")) << problem;
+  EXPECT_TRUE(Contains(problem, "/blocks/0/conditions: " + (dir / "open.csv").string() +
+                                    " line 4, column 17: a quoted field is not closed")) << problem;
   std::ofstream(dir / "open-header.csv") << "edge,left,right,\"label\n1,measured,none,x\n";
   j["blocks"][0]["conditions"] = "open-header.csv";
-  EXPECT_TRUE(Contains(OnlyProblem(j), "open-header.csv line 1: a quoted field is not closed")) << OnlyProblem(j);
+  EXPECT_TRUE(Contains(OnlyProblem(j), "open-header.csv line 1, column 17: a quoted field is not closed"))
+      << OnlyProblem(j);
   // Closed quotes still read as before: "" is one quote.
   std::ofstream(dir / "open.csv") << "edge,left,right,label\n1,measured,none,\"a \"\"b\"\"\"\n";
   j["blocks"][0]["conditions"] = "open.csv";
@@ -599,6 +600,81 @@ TEST(ProtocolValidate, CardsAndBallsInAnyPose) {
   ball = Valid();
   ball["blocks"][1]["factors"]["rotation_deg"] = {0, 30};
   ExpectProblem(ball, "a ball does not use rotation_deg");
+}
+
+
+// Tables as spreadsheets save them (issue 24): CRLF and a lone CR end lines alike, a quoted field may hold a comma,
+// and text after a closing quote ("ne"ar) is refused where it is instead of read as near.
+TEST(ProtocolValidate, ConditionsTableReadAsSpreadsheetsWriteIt) {
+  const fs::path dir = SceneFolder();
+  Json j = Valid();
+  j["blocks"] = {{{"name", "rows"}, {"conditions", "t.csv"}}};
+  for (const char* text : {"edge,left,right,label\r\n1,measured,none,\"a, b\"\r\n2,none,measured,c\r\n",
+                           "edge,left,right,label\r1,measured,none,\"a, b\"\r2,none,measured,c\r"}) {
+    std::ofstream(dir / "t.csv", std::ios::binary) << text;
+    const Protocol p = ParseProtocol(j, dir / "p.json");
+    ASSERT_EQ(p.blocks[0].factors[0].levels.size(), 2u) << text;
+    EXPECT_EQ(p.blocks[0].factors[0].levels[0]["label"], "a, b");
+    EXPECT_EQ(p.blocks[0].factors[0].levels[1]["edge"], 2);
+  }
+  std::ofstream(dir / "t.csv", std::ios::binary) << "edge,left,right\n1,\"mea\"sured,none\n";
+  EXPECT_TRUE(Contains(OnlyProblem(j), "t.csv line 2, column 8: text after a field's closing quote")) << OnlyProblem(j);
+  // A line break inside quotes is part of the field: the problem names the row's own line, not a row that is not.
+  std::ofstream(dir / "t.csv", std::ios::binary) << "edge,left,right,label\n1,measured,none,\"two\nlines\"\n";
+  EXPECT_TRUE(Contains(OnlyProblem(j), "/row/0/label: " + (dir / "t.csv").string() + " line 2, column 4 (label): "
+                                       "must be printable UTF-8 text on one line")) << OnlyProblem(j);
+}
+
+// A label's cell stays the text it is: 007 and 7 are two ids, and a 16-digit id keeps its last digit. A number in a
+// column that reads one must be held exactly, or it is refused naming what it would have become.
+TEST(ProtocolValidate, ConditionsCellsKeepTheirTextAndNumbersTheirDigits) {
+  const fs::path dir = SceneFolder();
+  Json j = Valid();
+  j["blocks"] = {{{"name", "rows"}, {"conditions", "t.csv"}}};
+  std::ofstream(dir / "t.csv") << "edge,left,right,label_stim\n1,measured,none,007\n2,measured,none,7\n"
+                                  "3,measured,none,9007199254740993\n";
+  const Protocol p = ParseProtocol(j, dir / "p.json");
+  const auto& levels = p.blocks[0].factors[0].levels;
+  ASSERT_EQ(levels.size(), 3u);
+  EXPECT_EQ(levels[0]["label_stim"], "007");
+  EXPECT_EQ(levels[1]["label_stim"], "7");
+  EXPECT_EQ(levels[2]["label_stim"], "9007199254740993");
+  std::ofstream(dir / "t.csv") << "edge,left,right,y_mm\n1,measured,none,0.12345678901234567\n";
+  EXPECT_TRUE(Contains(OnlyProblem(j), "/row/0/y_mm: has more digits than a number holds exactly (it would be "
+                                       "recorded as 0.12345678901234566)")) << OnlyProblem(j);
+  std::ofstream(dir / "t.csv") << "edge,left,right,y_mm\n1,measured,none,0.1\n2,measured,none,-2.50e1\n";
+  EXPECT_EQ(ParseProtocol(j, dir / "p.json").blocks[0].factors[0].levels[1]["y_mm"], -25.0);
+}
+
+// An id a spreadsheet would run as a formula, or that a bidirectional control shows reversed, is refused; a name of
+// 100 characters fits however many bytes they take.
+TEST(ProtocolValidate, IdsAndNamesAreSafeToOpenAndCountCharacters) {
+  const fs::path dir = SceneFolder();
+  Json j = Valid();
+  j["blocks"] = {{{"name", "rows"}, {"conditions", "t.csv"}}};
+  std::ofstream(dir / "t.csv") << "edge,left,right,id\n1,measured,none,=cmd|' /C calc'!A0\n";
+  EXPECT_TRUE(Contains(OnlyProblem(j), "/row/0/id: an id begins with =, which a spreadsheet opening the exported "
+                                       "tables runs as a formula")) << OnlyProblem(j);
+  j = Valid();
+  j["name"] = "study\u202Eevil";
+  EXPECT_TRUE(Contains(OnlyProblem(j), "/name: holds the bidirectional control character U+202E")) << OnlyProblem(j);
+  std::string e100;
+  for (int i = 0; i < 100; ++i) e100 += "\u00e9";
+  j["name"] = e100;
+  EXPECT_EQ(ParseProtocol(j, dir / "p.json").name, e100);
+  EXPECT_THROW(CheckParticipantId("@P1"), Error);
+  EXPECT_THROW(CheckParticipantId("P\u200F1"), Error);
+  EXPECT_NO_THROW(CheckParticipantId("P-1"));
+}
+
+// A table too large is said in a table's words, not a JSON file's.
+TEST(ProtocolValidate, ConditionsTableTooLargeSaysSo) {
+  const fs::path dir = SceneFolder();
+  { std::ofstream(dir / "big.csv") << "edge\n1\n"; }
+  fs::resize_file(dir / "big.csv", 17u << 20);
+  Json j = Valid();
+  j["blocks"] = {{{"name", "rows"}, {"conditions", "big.csv"}}};
+  EXPECT_TRUE(Contains(OnlyProblem(j), "a conditions table may have at most 16 MiB")) << OnlyProblem(j);
 }
 
 }  // namespace

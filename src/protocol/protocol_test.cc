@@ -419,7 +419,7 @@ TEST(ProtocolValidate, LongUnicodeValueIsQuotedCutAtACharacter) {
   for (int i = 0; i < 1000; ++i) name += "\u6f22";  // three bytes each: a cut at 80 bytes falls inside one
   j["name"] = name;
   const std::string p = OnlyProblem(j);
-  EXPECT_TRUE(Contains(p, "/name: must be at most 100 characters, got 3000")) << p;
+  EXPECT_TRUE(Contains(p, "/name: must be at most 100 characters, got 1000")) << p;
   j["name"] = 1;
   j["unknown"] = name;
   const auto problems = Problems(j);

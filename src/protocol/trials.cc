@@ -30,6 +30,8 @@ void CheckParticipantId(const std::string& participant) {
     why = "must be printable UTF-8 text (no newline, tab, escape or broken bytes)";
   else if (participant.front() == ' ' || participant.back() == ' ')
     why = "must not begin or end with a space";
+  else if (const std::string unsafe = UnsafeIdReason(participant); !unsafe.empty())
+    why = unsafe;
   if (why.empty()) return;
   // The id as JSON text: control characters escaped, broken bytes replaced, cut short - one line whatever it held.
   std::string shown = Json(participant.substr(0, 40)).dump(-1, ' ', false, Json::error_handler_t::replace);
