@@ -96,5 +96,26 @@ assert book["edge"]["role"] == "within" and book["edge"]["allowed"] == "1|2|3|4|
 assert book["practice"]["role"] == "practice", book["practice"]
 PYEOF
   echo "ok: a changed protocol under version 1 refused naming /timing/inter_trial_ms; version 2 recorded beside it; a lower version refused; trials.csv says each session's version" ;;
+conditions_version)
+  # A conditions table is part of the protocol's version (issue 24): a table edited between two sessions under the
+  # same version is refused naming the table, and a label cell stays the text it is (007 and 7: two ids in trials.csv).
+  printf 'edge,left,right,label_stim\n1,measured,estimated,007\n2,estimated,measured,7\n' > "$W/t.csv"
+  variant test1-static-grids "$W/c.json" 'del p["factors"], p["sides"], p["counterbalance"]; p["conditions"] = "t.csv"; p["practice"]["count"] = 0'
+  $BC run "$W/c.json" --participant C1 --db "$W/s.sqlite" --observer sim > /dev/null
+  printf 'edge,left,right,label_stim\n1,measured,estimated,007\n3,estimated,measured,7\n' > "$W/t.csv"
+  set +e
+  $BC run "$W/c.json" --participant C2 --db "$W/s.sqlite" --observer sim > /dev/null 2> "$W/err"
+  code=$?
+  set -e
+  [ $code = 3 ] && grep -q 'records protocol version 1 with another text (/recorded_conditions/t.csv: ' "$W/err" \
+    || fail "an edited table under the same version: exit $code, $(cat "$W/err")"
+  $BC export --db "$W/s.sqlite" --out "$W/tables" > /dev/null
+  $PY - "$W/tables/trials.csv" <<'PYEOF' || fail "label cells in trials.csv"
+import csv, sys
+rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["practice"] == "0"]
+got = sorted((r["edge"], r["label_stim"]) for r in rows)
+assert got == [("1", "007"), ("2", "7")], got
+PYEOF
+  echo "ok: an edited conditions table under version 1 refused naming /recorded_conditions/t.csv; 007 and 7 kept apart in trials.csv" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -214,6 +214,7 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
     Problem(ptr, e.what(), Json(*text));
     return {};
   }
+  tables_[*text] = csv;
   const CsvText table = ParseCsv(csv, size_t(kMaxTrials) + 1);
   auto at = [&](size_t line, size_t column) {
     return where + " line " + std::to_string(line) + (column ? ", column " + std::to_string(column) : "");

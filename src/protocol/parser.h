@@ -2,6 +2,7 @@
 // The protocol parser's internals, shared by the files it is split into (protocol.cc, parser.cc, parse_levels.cc,
 // parse_blocks.cc, parse_presentation.cc); not part of the module's interface.
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -140,6 +141,7 @@ class Parser {
 
   fs::path file_, base_;
   ValidateOptions options_;
+  std::map<std::string, std::string> tables_;  // each conditions table read: its path as written -> its text
   std::set<std::string> reported_;
   size_t calls_ = 0;  // problems found, repeats included
 };

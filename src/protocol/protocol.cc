@@ -193,6 +193,7 @@ Protocol Parser::Parse(const Json& json) {
     }
   }
   CheckDesign(p);
+  p.conditions_tables = tables_;
   return p;
 }
 
@@ -535,6 +536,14 @@ fs::path RealPhotoFor(const Content& content, double distance_m) {
   for (size_t at = path.find(key); at != std::string::npos; at = path.find(key, at + text.size()))
     path.replace(at, key.size(), text);
   return path;
+}
+
+std::string RecordedText(const std::string& text, const Protocol& protocol) {
+  if (protocol.conditions_tables.empty()) return text;
+  Json json = ParseJson(text, protocol.file.string());
+  Json& tables = json["recorded_conditions"] = Json::object();
+  for (const auto& [path, table] : protocol.conditions_tables) tables[path] = table;
+  return json.dump(2, ' ', false, Json::error_handler_t::replace);
 }
 
 }  // namespace blurcue::protocol

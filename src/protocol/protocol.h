@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -219,6 +220,9 @@ struct Protocol {
   Scene scene;
   Content content;
   std::vector<Block> blocks;          // at least one; a file without "blocks" has one block named "main"
+  // Each conditions table the blocks read: its path as the protocol writes it -> its text as read. Part of the
+  // protocol's version (RecordedText): a table edited between sessions is another design.
+  std::map<std::string, std::string> conditions_tables;
   // The order blocks run in: "fixed" (file order), "random" (drawn with the seed) or "latin_square" (a balanced
   // Latin square over participants by their number: each block equally often in each place, and after each other).
   BlockSequence block_order = BlockSequence::kFixed;
@@ -272,5 +276,11 @@ Protocol ParseProtocol(const Json& json, const std::filesystem::path& file, cons
 
 // Reads `file` and parses it as above (Error(kInput) naming the file when it cannot be read or is not JSON).
 Protocol LoadProtocol(const std::filesystem::path& file, const ValidateOptions& options = {});
+
+// The text a record keeps as the protocol's version: `text` (the file as read, which parsed into `protocol`) as it
+// is when no block reads a conditions table; otherwise the same JSON with one more member, "recorded_conditions":
+// {path as written: the table's text as read}, so that a table edited between sessions gives another version and
+// the record names the change. A protocol file cannot itself hold that member (no such field is read).
+std::string RecordedText(const std::string& text, const Protocol& protocol);
 
 }  // namespace blurcue::protocol

@@ -18,8 +18,9 @@ using stimulus::TrialScene;
 PreparedSession PrepareStudy(const std::filesystem::path& protocol_file, const std::filesystem::path& display_profile) {
   PreparedSession s;
   // Read once: the text recorded with the session is the text that was validated.
-  s.protocol_text = ReadTextFile(protocol_file);
-  s.protocol = protocol::ParseProtocol(ParseJson(s.protocol_text, protocol_file.string()), protocol_file);
+  const std::string text = ReadTextFile(protocol_file);
+  s.protocol = protocol::ParseProtocol(ParseJson(text, protocol_file.string()), protocol_file);
+  s.protocol_text = protocol::RecordedText(text, s.protocol);
   s.scene = LoadProtocolScene(s.protocol);
   s.images = LoadStimulusImages(s.protocol, s.scene);
   if (!display_profile.empty()) {

@@ -20,7 +20,7 @@ namespace blurcue::session {
 
 struct PreparedSession {
   protocol::Protocol protocol;
-  std::string protocol_text;              // the file as read and parsed (recorded with the session)
+  std::string protocol_text;              // the file as read and parsed, with its conditions tables: RecordedText
   uint64_t seed = 0;                      // as given, else protocol::DefaultSeed(study, participant)
   std::string group;                      // the between-subject group whose blocks the trials hold ("": none)
   std::vector<protocol::Trial> trials;

@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "core/typed.h"
 #include "core/json_io.h"
 #include "store/schema.h"
 
@@ -305,10 +306,18 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
   const std::string abort_hint = "blurcue sessions --db " + db_.path() + " --abort ";
   if (running.Step()) {
     const int64_t session = running.GetInt64(0);
-    if (!resume)
+    if (!resume) {
+      // Another station starting the same participant a moment earlier holds it alive: --resume would only be
+      // refused again, and --abort would close a session someone is answering.
+      const LockState lock = Lock(session);
+      if (lock.held && !lock.stale && !lock.mine)
+        throw InputError(db_.path(), "participant " + participant + " of study " + study + " is being run right now "
+                                         "in " + SessionName(session) + " by " + lock.text + "; check the participant "
+                                         "id, or wait for that session to end");
       throw InputError(db_.path(), "participant " + participant + " of study " + study + " has an unfinished " +
                                        SessionName(session) + "; continue it with --resume, or close it with " +
                                        abort_hint + std::to_string(session) + " (its answers are kept)");
+    }
     if (running.GetText(2) != hash)
       throw InputError(db_.path(), SessionName(session) + " was started with another version of the protocol (" +
                                        ProtocolChanges(running.GetText(3), canonical) +
@@ -506,6 +515,7 @@ void Record::SaveTrialList(int64_t session, const std::vector<TrialRecord>& tria
 }
 
 void Record::CheckTrialList(int64_t session, const std::vector<TrialRecord>& trials) {
+  const std::string abort_hint = "blurcue sessions --db " + db_.path() + " --abort " + std::to_string(session);
   Statement saved(db_, "SELECT trial_index, block, factors, left_shown, right_shown FROM trials "
                        "WHERE session_id = ? ORDER BY trial_index");
   saved.Bind(1, session);
@@ -513,15 +523,28 @@ void Record::CheckTrialList(int64_t session, const std::vector<TrialRecord>& tri
   for (; saved.Step(); ++n) {
     const size_t i = static_cast<size_t>(saved.GetInt64(0));
     // The same values dumped the same way are the same text (JSON object keys are sorted).
-    if (i >= trials.size() || saved.GetInt64(1) != trials[i].block || saved.GetText(2) != trials[i].factors_json ||
-        saved.GetText(3) != trials[i].left_json || saved.GetText(4) != trials[i].right_json)
-      throw InputError(db_.path(), SessionName(session) + " trial " + std::to_string(i) +
-                                       ": the saved trial differs from the one made now (another calibration or "
-                                       "blurcue version?); it cannot be resumed with them");
+    if (i >= trials.size()) break;
+    // What differs, saved against made now: the first of the trial's parts that does.
+    std::string change;
+    if (saved.GetInt64(1) != trials[i].block)
+      change = "block " + std::to_string(saved.GetInt64(1)) + " saved, " + std::to_string(trials[i].block) + " now";
+    else if (saved.GetText(2) != trials[i].factors_json)
+      change = "levels " + saved.GetText(2) + " saved, " + trials[i].factors_json + " now";
+    else if (saved.GetText(3) != trials[i].left_json)
+      change = "left side " + saved.GetText(3) + " saved, " + trials[i].left_json + " now";
+    else if (saved.GetText(4) != trials[i].right_json)
+      change = "right side " + saved.GetText(4) + " saved, " + trials[i].right_json + " now";
+    if (!change.empty())
+      throw InputError(db_.path(), SessionName(session) + " trial " + std::to_string(i) + " differs from the one made "
+                                       "now (" + OneLine(change) + "): a file it reads (the calibration, a picture, a "
+                                       "conditions table) or blurcue changed since it started; resume it with those it "
+                                       "started with, or close it with " + abort_hint + " (its answers are kept)");
   }
   if (n != trials.size())
     throw InputError(db_.path(), SessionName(session) + " has " + std::to_string(n) + " trials saved, " +
-                                     std::to_string(trials.size()) + " were made now");
+                                     std::to_string(trials.size()) + " were made now: a file it reads or blurcue "
+                                     "changed since it started; resume it with those it started with, or close it "
+                                     "with " + abort_hint + " (its answers are kept)");
 }
 
 std::vector<int64_t> Record::CompletedSessions(const std::string& study, const std::string& participant) {

@@ -131,7 +131,11 @@ TEST(Record, ResumedTrialListIsCheckedAgainstTheSavedOne) {
     record.CheckTrialList(session, changed);
     ADD_FAILURE() << "a changed trial was accepted";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("session 1 trial 2: the saved trial differs"), std::string::npos) << e.what();
+    // What differs, both ways, and the way out.
+    EXPECT_NE(std::string(e.what()).find("session 1 trial 2 differs from the one made now (levels "
+                                         "{\"edge\":3,\"blur\":\"measured\"} saved, {\"edge\":3,\"blur\":"
+                                         "\"measured\",\"r_left_px\":1.5} now)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--abort 1 (its answers are kept)"), std::string::npos) << e.what();
   }
   EXPECT_THROW(record.CheckTrialList(session, Trials(5)), Error);
 }
@@ -573,6 +577,26 @@ TEST(Record, LockOfAReusedPidIsStaleByItsHeartbeatAge) {
   PlantLock(record.database(), session, HostName(), 1, 61);
   EXPECT_TRUE(Contains(record.Lock(session).text, "(silent for over 60 s: a stale lock"));
   EXPECT_TRUE(record.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, true).resumed);
+}
+
+// Eight stations starting one participant at once: those refused are told another process is running that session
+// right now, not to --resume or --abort it; once its lock is stale the usual way out is offered.
+TEST(Record, StartingAParticipantAnotherStationIsRunningSaysSo) {
+  testing::TempDir dir;
+  int64_t session = 0;
+  {
+    Record first = Record::Open(dir / "r.sqlite");
+    session = first.StartOrResumeSession("test1", "P01", kProtocol, 7, {}, false).session_id;
+  }
+  Record record = Record::Open(dir / "r.sqlite");
+  PlantLock(record.database(), session, HostName(), 1, 2);
+  const std::string live = ErrorOf([&] { record.StartOrResumeSession("test1", "P01", kProtocol, 8, {}, false); });
+  EXPECT_TRUE(Contains(live, "participant P01 of study test1 is being run right now in session 1 by pid 1 on host " +
+                                 HostName() + ", heartbeat 2 s ago (alive); check the participant id")) << live;
+  EXPECT_FALSE(Contains(live, "--resume")) << live;
+  PlantLock(record.database(), session, HostName(), 1, 61);
+  EXPECT_TRUE(Contains(ErrorOf([&] { record.StartOrResumeSession("test1", "P01", kProtocol, 8, {}, false); }),
+                       "has an unfinished session 1; continue it with --resume"));
 }
 
 // A lock from another host is kept for 10 minutes; the experimenter can break it explicitly.
