@@ -145,7 +145,7 @@ add_preflight_test(escape-cell "/conditions/row/1/label: ${D}/escape-cell.csv li
                    "${grid_head} \"conditions\": \"escape-cell.csv\"}")
 # A quote left open at a line's end: the label "ab" used to be recorded.
 file(WRITE ${D}/open-quote.csv "edge,left,right,label\n1,measured,none,ok\n2,measured,none,\"ab\n")
-add_preflight_test(open-quote "/conditions/row/1: ${D}/open-quote.csv line 3: a quoted field is not closed"
+add_preflight_test(open-quote "/conditions: ${D}/open-quote.csv line 3, column 17: a quoted field is not closed"
                    "${grid_head} \"conditions\": \"open-quote.csv\"}")
 # A place no layout draws: the single object (and every interval's) stands at the left one's place, so a right_x_mm
 # level was recorded on every row though nothing was drawn there.
