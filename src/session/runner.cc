@@ -1,8 +1,11 @@
 #include "session/runner.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <map>
 #include <memory>
 #include <optional>
@@ -11,6 +14,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/error.h"
+#include "core/json_io.h"
 #include "core/names.h"
 #include "core/typed.h"
 #include "protocol/protocol.h"
@@ -27,6 +31,63 @@
 #include "session/trial_loop.h"
 
 namespace blurcue::session {
+
+namespace {
+
+// trial-NNNN.png or trial-NNNN.json (four digits or more): what a capture writes.
+bool IsCaptureFile(const std::string& name) {
+  if (name.rfind("trial-", 0) != 0) return false;
+  size_t i = 6;
+  while (i < name.size() && name[i] >= '0' && name[i] <= '9') ++i;
+  const std::string ext = name.substr(i);
+  return i >= 10 && (ext == ".png" || ext == ".json");
+}
+
+}  // namespace
+
+void CheckCaptureFolder(const std::filesystem::path& dir, const std::string& study, const std::string& participant) {
+  namespace fs = std::filesystem;
+  const std::string where = dir.string();
+  std::error_code ec;
+  // A link is not followed: as root, --capture on a link to /etc used to write trial-0001.png into /etc.
+  if (fs::is_symlink(fs::symlink_status(dir, ec)))
+    throw InputError(where, "--capture: is a symbolic link; captures go only into a real folder (name the folder it "
+                            "points to if that is meant)");
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir))
+    throw InputError(where, "--capture: cannot make a folder here (" + (ec ? ec.message() : std::string("not a folder")) +
+                                ")");
+  // Empty, or an earlier capture of this participant in this study (a resumed session goes on where it left off):
+  // anything else would be overwritten or mixed with this session's frames.
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.is_symlink())
+      throw InputError(where, "--capture: holds a symbolic link, " + Echo(name) + "; capture into an empty folder");
+    if (!IsCaptureFile(name) || !entry.is_regular_file())
+      throw InputError(where, "--capture: holds " + Echo(name) + ", which is not a capture; capture into an empty "
+                              "folder (or one holding only this participant's earlier capture)");
+    if (entry.path().extension() != ".json") continue;
+    std::string owner;
+    try {
+      const Json frame = ReadJsonFile(entry.path());
+      if (frame.value("protocol", "") != study || frame.value("participant", "") != participant)
+        owner = "participant " + frame.value("participant", std::string("?")) + " of study " +
+                frame.value("protocol", std::string("?"));
+    } catch (const std::exception&) {
+      owner = "something else";
+    }
+    if (!owner.empty())
+      throw InputError(where, "--capture: holds the capture of " + OneLine(owner) + " (" + name + "), which this "
+                              "session would overwrite; capture into another folder");
+  }
+  if (ec) throw InputError(where, "--capture: cannot list the folder (" + ec.message() + ")");
+  // Writable now, not at the first trial: a read-only folder used to stop the session there, left running at 0.
+  const fs::path probe = dir / (".blurcue-capture-probe-" + std::to_string(getpid()));
+  const int fd = ::open(probe.c_str(), O_CREAT | O_EXCL | O_WRONLY | O_NOFOLLOW | O_CLOEXEC, 0600);
+  if (fd < 0) throw InputError(where, std::string("--capture: cannot write here (") + std::strerror(errno) + ")");
+  ::close(fd);
+  fs::remove(probe, ec);
+}
 
 // The participant information a session records: --info values checked against the protocol's fields, the
 // required ones that are missing asked for in the terminal (stdin a terminal) or refused; a resumed session's
@@ -184,14 +245,8 @@ RunResult RunSession(const RunOptions& options) {
                          std::to_string(protocol.display.width_px) + " x " + std::to_string(protocol.display.height_px) +
                          " px; set width_px/height_px to the screen's (full screen: the monitor's mode)");
   StimulusRenderer renderer(protocol, scene, prepared.images, prepared.presentation);
-  // The capture folder is made before the session starts: a path that cannot hold captures stops here.
-  if (!options.capture_dir.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(options.capture_dir, ec);
-    if (ec || !std::filesystem::is_directory(options.capture_dir))
-      throw InputError(options.capture_dir.string(), "--capture: cannot make a folder here (" +
-                                                         (ec ? ec.message() : std::string("not a folder")) + ")");
-  }
+  // The capture folder is checked before the session starts: a path that cannot hold captures stops here.
+  if (!options.capture_dir.empty()) CheckCaptureFolder(options.capture_dir, protocol.name, options.participant);
 
   Recording record = Recording::Open(options.db);
   SessionInfo meta;

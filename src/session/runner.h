@@ -36,4 +36,8 @@ struct RunOptions {
 // Throws Error: kInput for a bad protocol, a locked or mismatched session; kUsage for bad options.
 RunResult RunSession(const RunOptions& options);
 
+// --capture's folder, before a session starts (InputError naming it otherwise): not a symbolic link, made if missing,
+// holding nothing but an earlier capture of `participant` in `study` (trial-NNNN.png/.json, no links), and writable.
+void CheckCaptureFolder(const std::filesystem::path& dir, const std::string& study, const std::string& participant);
+
 }  // namespace blurcue::session
