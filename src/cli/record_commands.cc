@@ -6,6 +6,8 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "core/error.h"
+#include "core/typed.h"
 #include "store/export.h"
 #include "store/record.h"
 
@@ -52,7 +54,7 @@ void AddExportCommand(CLI::App& app) {
 
 void AddMergeCommand(CLI::App& app) {
   struct Args {
-    std::vector<std::string> inputs;
+    std::vector<std::string> inputs, renames, same_person;
     std::string out;
   };
   auto args = std::make_shared<Args>();
@@ -67,14 +69,43 @@ void AddMergeCommand(CLI::App& app) {
       "with blurcue sessions --db FILE --abort ID). An unfinished session nobody is writing (a run killed or stopped)\n"
       "is copied as running, and one line on stderr per such session says so: resume it in one record only - its\n"
       "own (then merge again into a new OUT) or the merged one - never both, or the two copies cannot be merged again.\n"
-      "Example: blurcue merge station-a.sqlite station-b.sqlite --out all.sqlite");
+      "People are kept apart: a participant id that two inputs both hold (in one study) is refused, exit 3, until you\n"
+      "say who they are - two people who got one id: --rename INPUT:ID=NEWID gives one of them another id in that\n"
+      "input; one person who ran sessions at two stations: --same-person ID.\n"
+      "Example: blurcue merge station-a.sqlite station-b.sqlite --out all.sqlite\n"
+      "         blurcue merge a.sqlite b.sqlite --rename b.sqlite:P1=P1b --out all.sqlite");
   cmd->add_option("inputs", args->inputs, "records to combine")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "the new record")->required();
+  cmd->add_option("--rename", args->renames,
+                  "INPUT:ID=NEWID: in that input, participant ID is recorded as NEWID (two people who got one id); "
+                  "repeatable");
+  cmd->add_option("--same-person", args->same_person,
+                  "ID: the inputs' participant ID is one person who ran at several stations; repeatable");
   cmd->callback([args] {
     std::vector<std::filesystem::path> inputs(args->inputs.begin(), args->inputs.end());
+    store::MergeOptions options;
+    options.same_person = args->same_person;
+    for (const std::string& spec : args->renames) {
+      // INPUT:ID=NEWID, INPUT as listed (a path may hold ':'): the input this spec begins with, then ':'.
+      std::optional<store::MergeOptions::Rename> rename;
+      for (const std::string& input : args->inputs)
+        if (spec.size() > input.size() + 1 && spec.compare(0, input.size(), input) == 0 && spec[input.size()] == ':') {
+          const std::string ids = spec.substr(input.size() + 1);
+          const size_t eq = ids.find('=');
+          if (eq == std::string::npos || eq == 0 || eq + 1 == ids.size()) break;
+          rename = store::MergeOptions::Rename{input, ids.substr(0, eq), ids.substr(eq + 1)};
+        }
+      if (!rename) {
+        std::string listed;
+        for (const std::string& input : args->inputs) listed += (listed.empty() ? "" : ", ") + input;
+        throw Error(ErrorKind::kUsage, "--rename " + Echo(spec) + ": write INPUT:ID=NEWID, INPUT one of the records "
+                                       "listed (" + listed + ")");
+      }
+      options.renames.push_back(*rename);
+    }
     store::MergeDatabases(inputs, args->out, [](const std::string& line) {
       std::fprintf(stderr, "merge: %s\n", line.c_str());
-    });
+    }, options);
     std::printf("merged %zu records into %s\n", inputs.size(), args->out.c_str());
   });
 }

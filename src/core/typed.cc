@@ -108,6 +108,16 @@ std::string UnsafeIdReason(std::string_view text) {
   return "";
 }
 
+std::string ParticipantIdProblem(std::string_view id) {
+  if (id.empty()) return "must not be empty";
+  if (id.size() > kMaxParticipantIdBytes)
+    return "must be at most " + std::to_string(kMaxParticipantIdBytes) + " bytes (it has " + std::to_string(id.size()) +
+           ")";
+  if (!IsPrintableUtf8(id)) return "must be printable UTF-8 text (no newline, tab, escape or broken bytes)";
+  if (id.front() == ' ' || id.back() == ' ') return "must not begin or end with a space";
+  return UnsafeIdReason(id);
+}
+
 std::string OneLine(std::string_view text) {
   std::string out;
   out.reserve(text.size());

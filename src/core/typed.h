@@ -30,6 +30,14 @@ size_t Utf8Length(std::string_view text);
 // U+202E, U+2066 to U+2069), which shows the text to a reader in another order than it is recorded.
 std::string UnsafeIdReason(std::string_view text);
 
+// The most bytes a participant id may have.
+inline constexpr size_t kMaxParticipantIdBytes = 64;
+
+// Why `id` cannot be a participant id, or "" when it can: the record, the exported tables and the report hold
+// 1 to kMaxParticipantIdBytes bytes of printable UTF-8 (IsPrintableUtf8), no space at either end, that
+// UnsafeIdReason takes. "must not be empty", "must be at most 64 bytes (it has 70)", ...
+std::string ParticipantIdProblem(std::string_view id);
+
 // `text` as one printable line: what IsPrintableUtf8 takes kept as it is, a newline, return or tab written \n, \r,
 // \t, any other control or broken byte \xNN. For messages that echo what someone typed.
 std::string OneLine(std::string_view text);

@@ -21,17 +21,7 @@ uint64_t UniformBelow(std::mt19937_64& rng, uint64_t n) {
 }
 
 void CheckParticipantId(const std::string& participant) {
-  std::string why;
-  if (participant.empty()) why = "must not be empty";
-  else if (participant.size() > kMaxParticipantIdBytes)
-    why = "must be at most " + std::to_string(kMaxParticipantIdBytes) + " bytes (it has " +
-          std::to_string(participant.size()) + ")";
-  else if (!IsPrintableUtf8(participant))
-    why = "must be printable UTF-8 text (no newline, tab, escape or broken bytes)";
-  else if (participant.front() == ' ' || participant.back() == ' ')
-    why = "must not begin or end with a space";
-  else if (const std::string unsafe = UnsafeIdReason(participant); !unsafe.empty())
-    why = unsafe;
+  const std::string why = ParticipantIdProblem(participant);
   if (why.empty()) return;
   // The id as JSON text: control characters escaped, broken bytes replaced, cut short - one line whatever it held.
   std::string shown = Json(participant.substr(0, 40)).dump(-1, ' ', false, Json::error_handler_t::replace);

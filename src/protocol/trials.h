@@ -47,12 +47,9 @@ void Shuffle(std::vector<T>& items, std::mt19937_64& rng) {
   }
 }
 
-// The most bytes a participant id may have.
-constexpr size_t kMaxParticipantIdBytes = 64;
-
-// A participant id as the record, the exported tables and the report hold it: 1 to 64 bytes of printable UTF-8
-// (IsPrintableUtf8: no newline, tab or escape), no space at either end. Throws Error(kUsage) naming the id
-// otherwise. BuildTrials checks it; RunSession checks it before it opens the record.
+// A participant id as the record, the exported tables and the report hold it (core/typed.h ParticipantIdProblem).
+// Throws Error(kUsage) naming the id otherwise. BuildTrials checks it; RunSession checks it before it opens the
+// record.
 void CheckParticipantId(const std::string& participant);
 
 // The participant's number: the trailing digits of the id ("P7" -> 7); -1 when it has none.

@@ -1,4 +1,5 @@
 #include "protocol/trials.h"
+#include "core/typed.h"
 #include "blurcue/source_dir.h"
 
 #include <map>

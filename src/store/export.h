@@ -52,8 +52,20 @@ std::string DesignColumn(const std::string& name);
 // DIR/.NAME.partial-PID and renamed to `out` when complete; leftovers of a killed merge to the same `out` are removed
 // first, each one told to `note`. A participant's sessions are numbered again by start across the inputs (one line
 // to `note` per session whose number changes), and one line per study version holding several texts.
+//
+// People are kept apart: a participant code (in one study) that an earlier input already holds is refused, naming
+// both inputs and the two ways out, unless the experimenter says which it is - two people: `renames` gives one of
+// them another code in its input; one person who ran at two stations: `same_person` lists the code.
+struct MergeOptions {
+  struct Rename {
+    std::filesystem::path input;  // as listed among the inputs
+    std::string from, to;         // participant codes
+  };
+  std::vector<Rename> renames;
+  std::vector<std::string> same_person;
+};
 void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out,
-                    const ProgressNote& note = {});
+                    const ProgressNote& note = {}, const MergeOptions& options = {});
 
 // One session as the experimenter sees it: who, what, how far.
 struct SessionSummary {

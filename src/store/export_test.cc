@@ -309,7 +309,9 @@ TEST(Merge, KeepsAllRowsAndIdsStayConsistent) {
     RunSession(b, "P01", R"({"edge":4})", 2, 1);  // the same participant at a second station
     RunSession(b, "Q01", R"({"edge":5})", 2, 2, "test2");
   }
-  MergeDatabases({dir / "a.sqlite", dir / "b.sqlite"}, dir / "merged.sqlite");
+  MergeOptions one_person;
+  one_person.same_person = {"P01"};  // one person ran at both stations
+  MergeDatabases({dir / "a.sqlite", dir / "b.sqlite"}, dir / "merged.sqlite", {}, one_person);
 
   Database db(dir / "merged.sqlite", OpenMode::kReadOnly);
   EXPECT_EQ(db.QueryText("PRAGMA integrity_check"), "ok");

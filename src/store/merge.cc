@@ -1,10 +1,13 @@
 // blurcue merge: the records of several stations copied into one new record, with fresh ids.
+#include <algorithm>
 #include <map>
 #include <set>
 #include <string>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/names.h"
+#include "core/typed.h"
 #include "store/export.h"
 #include "store/export_table.h"
 #include "store/record.h"
@@ -84,7 +87,7 @@ void CheckSessionsToMerge(Database& src, const std::filesystem::path& input, std
 }  // namespace
 
 void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out,
-                    const ProgressNote& note) {
+                    const ProgressNote& note, const MergeOptions& options) {
   Note(note, RemoveStaleLeftovers(out));
   if (std::filesystem::exists(out)) throw InputError(out.string(), "exists; merge refuses to overwrite it");
   std::set<std::filesystem::path> seen;
@@ -92,6 +95,37 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
     if (!seen.insert(std::filesystem::weakly_canonical(input)).second)
       throw InputError(input.string(), "listed twice among the merge inputs");
   }
+  // Each rename names an input of this merge and a participant that input holds (checked as it is read); each
+  // same-person code some input holds.
+  std::vector<std::string> input_names;
+  for (const auto& input : inputs) input_names.push_back(input.string());
+  std::map<std::filesystem::path, std::map<std::string, std::string>> renames;
+  for (const auto& r : options.renames) {
+    const auto canonical = std::filesystem::weakly_canonical(r.input);
+    if (!seen.count(canonical))
+      throw InputError("--rename", "names " + Echo(r.input.string()) + ", which is not an input of this merge" +
+                                       DidYouMean(r.input.string(), input_names));
+    if (!renames[canonical].emplace(r.from, r.to).second)
+      throw InputError("--rename", "renames participant " + Echo(r.from) + " of " + r.input.string() + " twice");
+  }
+  // The codes each input holds, read before anything is merged: a rename or a same-person code that names nobody
+  // is refused first, with the nearest code.
+  std::set<std::string> same_person(options.same_person.begin(), options.same_person.end()), held;
+  for (const auto& input : inputs) {
+    Database src(input, OpenMode::kReadOnly);
+    RequireReadableRecord(src);
+    std::vector<std::string> codes;
+    Statement all(src, "SELECT code FROM participants");
+    while (all.Step()) codes.push_back(all.GetText(0));
+    held.insert(codes.begin(), codes.end());
+    for (const auto& [from, to] : renames[std::filesystem::weakly_canonical(input)])
+      if (std::find(codes.begin(), codes.end(), from) == codes.end())
+        throw InputError("--rename", input.string() + " holds no participant " + Echo(from) + DidYouMean(from, codes));
+  }
+  for (const std::string& code : same_person)
+    if (!held.count(code))
+      throw InputError("--same-person", "no input holds a participant " + Echo(code) +
+                                            DidYouMean(code, std::vector<std::string>(held.begin(), held.end())));
   const std::filesystem::path temp = TemporaryBeside(out, "partial");
   RemoveDatabaseFiles(temp);
   std::vector<std::string> unfinished, renumbered;
@@ -164,10 +198,33 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
           }
         }
 
-        Statement participants(src, "SELECT id, study_id, code, created FROM participants");
-        while (participants.Step())
-          participant_ids[participants.GetInt64(0)] = EnsureParticipant(
-              dst, study_ids.at(participants.GetInt64(1)), participants.GetText(2), participants.GetText(3));
+        // People kept apart: a code an earlier input holds in the same study is two people or one person at two
+        // stations; merge does not guess which.
+        const auto& rename = renames[std::filesystem::weakly_canonical(input)];
+        Statement participants(src, "SELECT p.id, p.study_id, p.code, p.created, s.name FROM participants p JOIN "
+                                    "studies s ON s.id = p.study_id");
+        Statement holds(dst, "SELECT count(*) FROM participants WHERE study_id = ? AND code = ?");
+        while (participants.Step()) {
+          const int64_t study = study_ids.at(participants.GetInt64(1));
+          std::string code = participants.GetText(2);
+          if (const auto r = rename.find(code); r != rename.end()) {
+            if (const std::string why = ParticipantIdProblem(r->second); !why.empty())
+              throw InputError("--rename " + input.string() + ":" + code + "=" + OneLine(r->second), "the new id " + why);
+            code = r->second;
+          }
+          holds.Bind(1, study);
+          holds.Bind(2, code);
+          holds.Step();
+          const bool taken = holds.GetInt64(0) > 0;
+          holds.Reset();
+          if (taken && !same_person.count(code))
+            throw InputError(input.string(), "participant " + code + " of study " + participants.GetText(4) +
+                                                 " is also in an earlier input of this merge: two people with one id, "
+                                                 "or one person who ran at two stations? Two people: give one another "
+                                                 "id with --rename " + input.string() + ":" + code + "=NEW; one "
+                                                 "person: say so with --same-person " + code);
+          participant_ids[participants.GetInt64(0)] = EnsureParticipant(dst, study, code, participants.GetText(3));
+        }
 
         Statement sessions(src, "SELECT id, participant_id, protocol_version_id, seed, software_version, host, "
                                 "display, started, ended, status, " +

@@ -44,6 +44,12 @@ SessionStart Complete(Record& record, const std::string& participant, const std:
   return start;
 }
 
+MergeOptions SamePerson(std::vector<std::string> codes) {
+  MergeOptions options;
+  options.same_person = std::move(codes);
+  return options;
+}
+
 TEST(Record, AgainSessionGetsNextNumberAndANewSeed) {
   Record record = Record::Open(":memory:");
   EXPECT_EQ(Complete(record, "P1", kV1, 11).session_number, 1);
@@ -252,7 +258,7 @@ TEST(Merge, SessionNumbersFollowTheStartAcrossInputsAndChangesAreTold) {
   }
   std::vector<std::string> notes;
   MergeDatabases({dir / "b.sqlite", dir / "a.sqlite"}, dir / "m.sqlite",
-                 [&](const std::string& line) { notes.push_back(line); });
+                 [&](const std::string& line) { notes.push_back(line); }, SamePerson({"P1"}));
   Record merged = Record::Open(dir / "m.sqlite");
   // a's session started first (made first above), so it is session 1 although b was merged first.
   EXPECT_EQ(merged.database().QueryText("SELECT group_concat(seed || ':' || session_number, ',') FROM (SELECT * FROM "
@@ -271,8 +277,8 @@ TEST(Merge, SessionNumbersFollowTheStartAcrossInputsAndChangesAreTold) {
 namespace blurcue::store {
 namespace {
 
-// Two stations each ran P1's first session with the default seed (so one trial order): merged, P1 has sessions 1
-// and 2 with one seed, which run refuses to make - likely two people given one id. It used to pass untold.
+// Two stations each ran P1's first session with the default seed (so one trial order): merged as one person (the
+// experimenter says so), P1 has sessions 1 and 2 with one seed, which run refuses to make - a likely mistake.
 TEST(Merge, OneParticipantsSessionsWithOneSeedAtTwoStationsAreTold) {
   testing::TempDir dir;
   for (const char* name : {"a.sqlite", "b.sqlite"}) {
@@ -283,7 +289,7 @@ TEST(Merge, OneParticipantsSessionsWithOneSeedAtTwoStationsAreTold) {
   }
   std::vector<std::string> notes;
   MergeDatabases({dir / "a.sqlite", dir / "b.sqlite"}, dir / "m.sqlite",
-                 [&](const std::string& line) { notes.push_back(line); });
+                 [&](const std::string& line) { notes.push_back(line); }, SamePerson({"P1", "P2"}));
   ASSERT_FALSE(notes.empty());
   EXPECT_EQ(notes.back(), "study s, participant P1: sessions 1, 2 in the merged record ran with one seed, so in one "
                           "trial order - two people given one id at two stations, or one person shown the same order "
@@ -304,6 +310,52 @@ TEST(Merge, AVersionRunWithTwoTextsAtTwoStationsIsMergedAndTold) {
                  [&](const std::string& line) { notes.push_back(line); });
   EXPECT_EQ(notes, (std::vector<std::string>{"study s: protocol version 1 has 2 different texts in the merged record "
                                              "(protocol_hash tells their sessions apart)"}));
+}
+
+MergeOptions::Rename Rename(const std::filesystem::path& input, std::string from, std::string to) {
+  return {input, std::move(from), std::move(to)};
+}
+
+// Two stations gave one id to two people (issue 24): merge refuses to join them, naming both ways out; renamed, they
+// stay two participants; declared one person, they are one. A rename or a same-person code that names nothing is
+// refused with the nearest name.
+TEST(Merge, OneIdAtTwoStationsIsRefusedUntilTheExperimenterSaysWhoItIs) {
+  testing::TempDir dir;
+  for (const char* name : {"a.sqlite", "b.sqlite"}) {
+    Record record = Record::Open(dir / name);
+    Complete(record, "P1", kV1, name[0] == 'a' ? 11 : 12);
+  }
+  const std::string refused = ErrorOf([&] { MergeDatabases({dir / "a.sqlite", dir / "b.sqlite"}, dir / "m.sqlite"); });
+  EXPECT_NE(refused.find("b.sqlite: participant P1 of study s is also in an earlier input of this merge: two people "
+                         "with one id, or one person who ran at two stations? Two people: give one another id with "
+                         "--rename " + (dir / "b.sqlite").string() + ":P1=NEW; one person: say so with --same-person P1"),
+            std::string::npos) << refused;
+  EXPECT_FALSE(std::filesystem::exists(dir / "m.sqlite"));
+
+  MergeOptions two;
+  two.renames = {Rename(dir / "b.sqlite", "P1", "P1b")};
+  MergeDatabases({dir / "a.sqlite", dir / "b.sqlite"}, dir / "two.sqlite", {}, two);
+  Record merged = Record::Open(dir / "two.sqlite");
+  EXPECT_EQ(merged.database().QueryText("SELECT group_concat(p.code || ':' || s.seed, ',') FROM (SELECT * FROM "
+                                        "sessions ORDER BY seed) s JOIN participants p ON p.id = s.participant_id"),
+            "P1:11,P1b:12");
+
+  MergeDatabases({dir / "a.sqlite", dir / "b.sqlite"}, dir / "one.sqlite", {}, SamePerson({"P1"}));
+  EXPECT_EQ(Record::Open(dir / "one.sqlite").database().QueryInt64("SELECT count(*) FROM participants"), 1);
+
+  MergeOptions typo;
+  typo.renames = {Rename(dir / "b.sqlite", "p1", "P1b")};
+  EXPECT_NE(ErrorOf([&] { MergeDatabases({dir / "a.sqlite", dir / "b.sqlite"}, dir / "t.sqlite", {}, typo); })
+                .find("holds no participant 'p1' (did you mean P1?)"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { MergeDatabases({dir / "a.sqlite", dir / "b.sqlite"}, dir / "t.sqlite", {}, SamePerson({"P2"})); })
+                .find("--same-person: no input holds a participant 'P2'"),
+            std::string::npos);
+  MergeOptions unsafe;
+  unsafe.renames = {Rename(dir / "b.sqlite", "P1", "=P1")};
+  EXPECT_NE(ErrorOf([&] { MergeDatabases({dir / "a.sqlite", dir / "b.sqlite"}, dir / "t.sqlite", {}, unsafe); })
+                .find("the new id begins with ="),
+            std::string::npos);
 }
 
 }  // namespace
