@@ -217,7 +217,25 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
           holds.Step();
           const bool taken = holds.GetInt64(0) > 0;
           holds.Reset();
-          if (taken && !same_person.count(code))
+          // A session of this participant already in the merge is an input merged twice: said below, per session.
+          bool merged_before = false;
+          if (taken) {
+            Statement own(src, "SELECT seed, host, started FROM sessions WHERE participant_id = ?");
+            own.Bind(1, participants.GetInt64(0));
+            Statement twin(dst, "SELECT count(*) FROM sessions s JOIN participants p ON p.id = s.participant_id "
+                                "WHERE p.study_id = ? AND p.code = ? AND s.seed = ? AND s.host = ? AND s.started = ?");
+            while (own.Step() && !merged_before) {
+              twin.Bind(1, study);
+              twin.Bind(2, code);
+              twin.Bind(3, own.GetInt64(0));
+              twin.Bind(4, own.GetText(1));
+              twin.Bind(5, own.GetText(2));
+              twin.Step();
+              merged_before = twin.GetInt64(0) > 0;
+              twin.Reset();
+            }
+          }
+          if (taken && !merged_before && !same_person.count(code))
             throw InputError(input.string(), "participant " + code + " of study " + participants.GetText(4) +
                                                  " is also in an earlier input of this merge: two people with one id, "
                                                  "or one person who ran at two stations? Two people: give one another "
