@@ -141,7 +141,11 @@ def main(argv=None):
         print(f"plan_chart: {args.plan}: not a blurcue plan (missing {', '.join(missing)})", file=sys.stderr)
         return 3
     common.setup_style()
-    png, _ = chart(plan, args.out, args.title, args.target)
+    try:
+        png, _ = chart(plan, args.out, args.title, args.target)
+    except OSError as e:  # a full disk, a read-only or vanished folder: one line naming the file, exit 3
+        print(f"plan_chart: {e.filename or args.out}: cannot write the chart ({e.strerror or e})", file=sys.stderr)
+        return 3
     print(f"plan_chart: drew {os.path.basename(png)} and power.svg", file=sys.stderr)
     return 0
 

@@ -1,6 +1,8 @@
 """The plan's chart says what the plan holds: each test's line and its smallest N reaching the target (worked out
 here from the rows by hand), groups compared and not pooled, a procedure cell's interval width with its truth and
 bias, and a truth that is not determined said in words, never as a number. Figures are caught before saving."""
+import contextlib
+import io
 import os
 import sys
 import tempfile
@@ -99,6 +101,20 @@ class PlanChartTest(unittest.TestCase):
             path = os.path.join(d, "plan.csv")
             pd.DataFrame([{"x": 1}]).to_csv(path, index=False)
             self.assertEqual(plan_chart.main(["--plan", path, "--out", d]), 3)
+
+    def test_a_chart_that_cannot_be_written_is_exit_3_naming_the_file(self):
+        # A full disk (ENOSPC) as the save raises it: one line naming the file, exit 3, no traceback.
+        def full(fig, out_dir, name):
+            raise OSError(28, "No space left on device", os.path.join(out_dir, name + ".png"))
+        plan_chart.common.save = full
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "plan.csv")
+            plan_rows().to_csv(path, index=False)
+            err = io.StringIO()
+            with contextlib.redirect_stderr(err):
+                self.assertEqual(plan_chart.main(["--plan", path, "--out", d]), 3)
+            self.assertEqual(err.getvalue().strip(),
+                             f"plan_chart: {d}/power.png: cannot write the chart (No space left on device)")
 
 
 if __name__ == "__main__":
