@@ -6,7 +6,9 @@
 #include <utility>
 
 #include "core/hash.h"
+#include "core/error.h"
 #include "protocol/design.h"
+#include "session/observer.h"
 #include "session/prepare.h"
 #include "store/export.h"
 #include "store/record.h"
@@ -107,6 +109,13 @@ SessionStart Recording::StartOrResumeSession(const std::string& study, const std
   meta.participant_info = info.participant_info;
   meta.simulated = info.simulated;
   meta.observer_params = info.observer_params;
+  meta.canonical_observer = [](const std::string& stored) {
+    try {
+      return ToString(ParseObserver(stored));
+    } catch (const Error&) {
+      return stored;  // not a spec this build reads: compared as stored, and the message shows it
+    }
+  };
   meta.window = info.window;
   meta.protocol_version = info.protocol_version;
   meta.design = DesignRecord(info.design);

@@ -5,8 +5,11 @@
 #include <cmath>
 
 #include "scene/frame.h"
+#include "session/observer.h"
 #include "stimulus/test_scenes.h"
 #include "store/export.h"
+#include "store/record.h"
+#include "store/test_util.h"
 
 namespace blurcue::session {
 namespace {
@@ -99,6 +102,27 @@ TEST(TrialVariables, LevelsNamedLikeRecordedVariablesKeepTheirValuesUnderFactorN
     EXPECT_TRUE(store::IsRecordedName(name)) << name;
   for (const char* name : {"edge", "label", "speed_cm_s", "right_x_mm", "factor_status"})
     EXPECT_FALSE(store::IsRecordedName(name)) << name;
+}
+
+// A session an older build started with a simulated observer recorded as sim:jnd=... (before model= existed)
+// resumes with today's spelling of that observer (issue 24): every spelling used to be refused, the suggested one too.
+TEST(Recording, AnOldObserverSpellingResumesWithTodaysCanonicalForm) {
+  store::testing::TempDir dir;
+  const std::string protocol = R"({"name":"s","version":1})";
+  {
+    store::Record old = store::Record::Open(dir / "r.sqlite");
+    store::SessionMeta meta;
+    meta.simulated = true;
+    meta.observer_params = "sim:jnd=0.3";  // as the record of an older build holds it
+    old.StartOrResumeSession("s", "P1", protocol, 7, meta, false);
+  }
+  Recording record = Recording::Open(dir / "r.sqlite");
+  SessionInfo info;
+  info.simulated = true;
+  info.observer_params = ToString(ParseObserver("sim:model=pixel,jnd=0.3"));
+  EXPECT_TRUE(record.StartOrResumeSession("s", "P1", protocol, 7, info, true).resumed);
+  info.observer_params = ToString(ParseObserver("sim:model=pixel,jnd=0.4"));  // another observer is still refused
+  EXPECT_THROW(record.StartOrResumeSession("s", "P1", protocol, 7, info, true), Error);
 }
 
 }  // namespace

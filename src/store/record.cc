@@ -334,7 +334,10 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
         return simulated ? "--observer " + params : std::string("a person (no --observer)");
       };
       const bool stored_simulated = running.GetText(4) == "simulated";
-      const std::string stored_params = running.IsNull(5) ? "" : running.GetText(5);
+      // A record from before model= holds sim:jnd=...: read in today's canonical form, so the spelling the message
+      // suggests resumes it.
+      std::string stored_params = running.IsNull(5) ? "" : running.GetText(5);
+      if (stored_simulated && meta.canonical_observer) stored_params = meta.canonical_observer(stored_params);
       if (stored_simulated != meta.simulated || (meta.simulated && stored_params != meta.observer_params))
         throw InputError(db_.path(), SessionName(session) + " was started with " +
                                          observer(stored_simulated, stored_params) + ", got " +

@@ -44,6 +44,8 @@ struct SessionMeta {
   // session::ToString(ObserverParams)), in a real window on the real clock or headless on a simulated clock.
   bool simulated = false;
   std::string observer_params;
+  // The canonical form of observer parameters as an older build recorded them (unset: compared as stored).
+  std::function<std::string(const std::string&)> canonical_observer;
   bool window = true;
   // The protocol's declared "version" and its design (recorded once per protocol version; empty: none recorded).
   int64_t protocol_version = 1;
