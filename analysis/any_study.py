@@ -231,22 +231,37 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
                  loc="left")
     png, svg = save(fig, out_dir, name)
     inside = not math.isnan(th) and x.min() <= th <= x.max()
-    # A threshold beyond the tested range is an extrapolation: written in words, not as a number.
+    # A threshold beyond the tested range is an extrapolation, and an interval that reaches beyond it (or that the
+    # bootstrap could not bound) is not determined by these answers: both are written in words, not as numbers.
+    bounded = inside and not math.isnan(th_lo) and x.min() <= th_lo and th_hi <= x.max()
+    beta_lo, beta_hi = fit.ci.get("beta", (math.nan, math.nan))
+    b_bounds = fit.options.get("beta_bounds") or (0.0, math.inf)
+    beta_free = "beta" not in fit.on_bound
+    beta_ci = beta_free and not math.isnan(beta_lo) and beta_lo > b_bounds[0] * 1.001 + 1e-9 and \
+        beta_hi < b_bounds[1] * 0.999
+    interval_words = ("" if bounded else "the threshold's 95 % interval reaches beyond the tested range: not "
+                      "determined by these answers" if inside else
+                      f"beyond the tested range {x.min():.3g} to {x.max():.3g}")
     t = pd.DataFrame([{**({"cell": cell} if cell else {}), "threshold": th if inside else math.nan,
-                       "threshold_low": th_lo if inside else math.nan, "threshold_high": th_hi if inside else math.nan,
-                       "threshold_note": "" if inside else f"beyond the tested range {x.min():.3g} to {x.max():.3g}",
+                       "threshold_low": th_lo if bounded else math.nan,
+                       "threshold_high": th_hi if bounded else math.nan, "threshold_note": interval_words,
                        "on_bound": ", ".join(fit.on_bound) if fit.on_bound else "", "criterion": p_mid,
-                       "alpha": fit.alpha, "beta_slope": fit.beta if "beta" not in fit.on_bound else math.nan, "beta_low": fit.ci.get("beta", (math.nan,))[0],
-                       "beta_high": fit.ci.get("beta", (math.nan, math.nan))[1], "guess": fit.gamma,
-                       "lapse": fit.lam, "answers": len(x), "participants": d["participant"].nunique()}])
+                       "alpha": fit.alpha, "beta_slope": fit.beta if beta_free else math.nan,
+                       "beta_low": beta_lo if beta_ci else math.nan, "beta_high": beta_hi if beta_ci else math.nan,
+                       "guess": fit.gamma, "lapse": fit.lam, "answers": len(x),
+                       "participants": d["participant"].nunique()}])
     notes = [f"Weibull with the guess rate fixed at chance ({chance:.3g}) and a lapse rate fitted in [0, 0.1]; "
              f"threshold = the stimulus at {p_mid:.0%}: " +
-             (f"{th:.3g} [{th_lo:.3g}, {th_hi:.3g}] (parametric bootstrap, {n_boot} samples)" if inside else
+             (f"{th:.3g} [{th_lo:.3g}, {th_hi:.3g}] (parametric bootstrap, {n_boot} samples)" if bounded else
+              f"{th:.3g}, its interval not determined (the bootstrap's reaches beyond the tested range "
+              f"{x.min():.3g} to {x.max():.3g})" if inside else
               f"beyond the tested range {x.min():.3g} to {x.max():.3g} (an extrapolation, not an estimate)") +
-             f"; slope {fit.beta:.3g}"]
+             (f"; slope {fit.beta:.3g}" if beta_free else "; slope on a bound of its range: not determined") +
+             ("" if beta_ci or not beta_free else "; the slope's interval reaches a bound: not determined")]
     if fit.on_bound:
         notes.append("on a bound of its range: " + ", ".join(f"{k} ({v[1]})" for k, v in fit.on_bound.items()))
-    return Chart(name, png, svg, t, notes), ((th, th_lo, th_hi, fit.beta) if inside else
+    return Chart(name, png, svg, t, notes), ((th, th_lo, th_hi, fit.beta) if bounded else
+                                             (th, math.nan, math.nan, fit.beta) if inside else
                                              (math.nan, x.min(), x.max(), fit.beta))
 
 
@@ -435,7 +450,9 @@ def psychometric_cells(m, kind, guess, what, design, study, out_dir, slug, note,
                                                              n_boot, seed, what, cell=cell)
             charts.append(chart)
             where = f"{cell}: " if cell else ""
-            words.append(f"{where}threshold {th:.3g} [{th_lo:.3g}, {th_hi:.3g}]" if not math.isnan(th) else
+            words.append(f"{where}threshold {th:.3g} [{th_lo:.3g}, {th_hi:.3g}]" if not math.isnan(th_lo) and
+                         not math.isnan(th) else
+                         f"{where}threshold {th:.3g} (its interval not determined)" if not math.isnan(th) else
                          f"{where}threshold beyond the tested range {th_lo:.3g} to {th_hi:.3g}")
         except Skip as e:
             charts.append(Chart(name, None, None, None, [str(e)]))
