@@ -145,10 +145,20 @@ def without_unfinished(df):
 
 
 def session_numbers(df):
-    """Each row's session number (the participant's n-th session of its study; 1 in an export from before it)."""
+    """Each row's session as the analysis counts it: 1 + how many sessions of the study its participant completed
+    before it (in the order started). A participant's --again session after a completed one is 2; a session after an
+    aborted (given up) one is still a first session. From session_number and session_status (1 for every row of an
+    export from before them; session_number alone without session_status)."""
     if "session_number" not in df.columns:
         return pd.Series(1, index=df.index)
-    return pd.to_numeric(df["session_number"], errors="coerce").fillna(1).astype(int)
+    number = pd.to_numeric(df["session_number"], errors="coerce").fillna(1).astype(int)
+    if "session_status" not in df.columns:
+        return number
+    s = pd.DataFrame({"study": df["study"], "participant": df["participant"], "session_id": df["session_id"],
+                      "n": number, "done": (df["session_status"] == "completed").astype(int)})
+    s = s.drop_duplicates("session_id").sort_values("n")
+    s["rank"] = s.groupby(["study", "participant"])["done"].transform(lambda x: x.shift(fill_value=0).cumsum()) + 1
+    return df["session_id"].map(dict(zip(s["session_id"], s["rank"]))).astype(int)
 
 
 def protocol_versions(df):

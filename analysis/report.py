@@ -200,9 +200,10 @@ def kept_apart(trials):
         if len(again):
             who = ", ".join(f"{p} (session number {n})" for p, n in
                             zip(again["participant"], common.session_numbers(again)))
-            out.append((study, f"{len(again)} repeated session{'s' if len(again) != 1 else ''} ({who}) analysed apart "
-                               f"from first sessions: a section per session number ('session N'); the thesis's views "
-                               f"and the observed-vs-model step use first sessions only"))
+            out.append((study, f"{len(again)} repeated session{'s' if len(again) != 1 else ''} ({who}: after one the "
+                               f"participant completed) analysed apart from first sessions: a section per session "
+                               f"number ('session N'); the thesis's views and the observed-vs-model step use first "
+                               f"sessions only"))
         versions = common.protocol_versions(d)
         if versions.nunique() > 1:
             listed = sorted(versions.unique(), key=lambda v: (len(v), v))
