@@ -156,9 +156,12 @@ def session_numbers(df):
         return number
     s = pd.DataFrame({"study": df["study"], "participant": df["participant"], "session_id": df["session_id"],
                       "n": number, "done": (df["session_status"] == "completed").astype(int)})
-    s = s.drop_duplicates("session_id").sort_values("n")
-    s["rank"] = s.groupby(["study", "participant"])["done"].transform(lambda x: x.shift(fill_value=0).cumsum()) + 1
-    return df["session_id"].map(dict(zip(s["session_id"], s["rank"]))).astype(int)
+    s = s.drop_duplicates("session_id")
+    rank = {}
+    for _, g in s.groupby(["study", "participant"]):
+        for sid, n in zip(g["session_id"], g["n"]):
+            rank[sid] = 1 + int(g.loc[g["n"] < n, "done"].sum())  # completed sessions started before this one
+    return df["session_id"].map(rank).astype(int)
 
 
 def protocol_versions(df):

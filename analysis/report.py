@@ -198,8 +198,7 @@ def kept_apart(trials):
         numbers = common.session_numbers(d)
         again = d[numbers > 1].drop_duplicates("session_id")
         if len(again):
-            who = ", ".join(f"{p} (session number {n})" for p, n in
-                            zip(again["participant"], common.session_numbers(again)))
+            who = ", ".join(f"{p} (session number {n})" for p, n in zip(again["participant"], numbers[again.index]))
             out.append((study, f"{len(again)} repeated session{'s' if len(again) != 1 else ''} ({who}: after one the "
                                f"participant completed) analysed apart from first sessions: a section per session "
                                f"number ('session N'); the thesis's views and the observed-vs-model step use first "
