@@ -324,6 +324,9 @@ def _analyse(d, study, codebook, out_dir, n_boot, seed, group, task, part):
         n_running = m.loc[m["session_status"] == "running", "session_id"].nunique()
         note += f", incl. {n_running} unfinished session{'s' if n_running != 1 else ''} (partial data)"
     if not design.group:
+        declared = _text_values(m, "group")
+        if len(declared) == 1:  # a group study of which these rows hold one group: say which
+            note += f", group {declared[0]}"
         return _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, note, n_boot, seed)
     # A between-subject group is a factor: each group analysed on its own, then the groups compared with
     # participants as the unit.
@@ -338,6 +341,13 @@ def _analyse(d, study, codebook, out_dir, n_boot, seed, group, task, part):
         findings.append(f"group {level}: {f}")
     c, f = group_section(m, kind, what, design, codebook, study, out_dir, slug, note)
     return charts + c, "; ".join(findings + [f])
+
+
+def _text_values(m, column):
+    """The distinct non-empty values of a column, as text ([] without the column)."""
+    if column not in m:
+        return []
+    return sorted({str(v) for v in m[column] if str(v).strip() not in ("", "nan")})
 
 
 def group_section(m, kind, what, design, codebook, study, out_dir, slug, note):
