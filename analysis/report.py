@@ -119,8 +119,10 @@ def write_index(out_dir, sections, header, name="index.html", title="blurcue ana
 def thesis_findings(trials, sections):
     """One line per thesis study for the summary: the depth matching's pooled slope of log cut-off on log distance
     (from its chart's table), and for the forced-choice tests how often measured was chosen over estimated where the
-    two were shown side by side (Wilson 95 % interval, exact binomial test against 0.5)."""
+    two were shown side by side (Wilson 95 % interval of the answers; the test against 0.5 with participants as the
+    unit, study_tests.against_chance)."""
     import stats
+    import study_tests
     out = {}
     charts = {c.name: c for _, cs, _ in sections for c in cs}
     dm = charts.get("depth-matching")
@@ -144,9 +146,13 @@ def thesis_findings(trials, sections):
         if len(pair):
             k, n = int((pair["chosen_source"] == "measured").sum()), len(pair)
             p, lo, hi = stats.wilson(k, n)
-            out[study] = (f"measured chosen over estimated {p:.2f} [{lo:.2f}, {hi:.2f}] of {n} decisive answers "
-                          f"({common.p_text(stats.binom_p(k, n, 0.5))} against 0.5); can't tell {share_cant:.0%} "
-                          f"of all answers")
+            # Answers of one participant are not independent: the test against 0.5 takes participants as the unit.
+            test = study_tests.against_chance(pair.assign(y=(pair["chosen_source"] == "measured").astype(float)), 0.5)
+            people = pair["participant"].nunique()
+            out[study] = (f"measured chosen over estimated {p:.2f} [{lo:.2f}, {hi:.2f}] of {n} decisive answers from "
+                          f"{people} participant{'s' if people != 1 else ''}; against 0.5: {test['test']}"
+                          + (f", {common.p_text(test['p'])}" if not math.isnan(test["p"]) else "") +
+                          f"; can't tell {share_cant:.0%} of all answers")
         else:
             out[study] = f"no measured-vs-estimated pairs answered; can't tell {share_cant:.0%} of all answers"
     return out
