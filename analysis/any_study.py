@@ -245,10 +245,11 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
     t = pd.DataFrame([{**({"cell": cell} if cell else {}), "threshold": th if inside else math.nan,
                        "threshold_low": th_lo if bounded else math.nan,
                        "threshold_high": th_hi if bounded else math.nan, "threshold_note": interval_words,
-                       "on_bound": ", ".join(fit.on_bound) if fit.on_bound else "", "criterion": p_mid,
+                       "on_bound": ", ".join(f"{k} at its {v[1]} bound {v[0]:.3g}" for k, v in fit.on_bound.items()),
+                       "criterion": p_mid,
                        "alpha": fit.alpha, "beta_slope": fit.beta if beta_free else math.nan,
                        "beta_low": beta_lo if beta_ci else math.nan, "beta_high": beta_hi if beta_ci else math.nan,
-                       "guess": fit.gamma, "lapse": fit.lam, "answers": len(x),
+                       "guess": fit.gamma, "lapse": fit.lam if "lam" not in fit.on_bound else math.nan, "answers": len(x),
                        "participants": d["participant"].nunique()}])
     notes = [f"Weibull with the guess rate fixed at chance ({chance:.3g}) and a lapse rate fitted in [0, 0.1]; "
              f"threshold = the stimulus at {p_mid:.0%}: " +

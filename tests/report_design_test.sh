@@ -134,7 +134,7 @@ first = decisive(lambda r: r["session_number"] == "1" and r["session_status"] ==
 assert analysed(out, "2ifc-grids-simulated-conditions.csv") == (first, 3), (analysed(out, "2ifc-grids-simulated-conditions.csv"), first)
 again = decisive(lambda r: r["session_number"] == "2")
 assert analysed(out, "2ifc-grids-session2-simulated-conditions.csv") == (again, 1), again
-assert "study 2ifc-grids (session 2, simulated observers)" in index and "1 repeated session (P1 (session number 2))" in index
+assert "study 2ifc-grids (session 2, simulated observers)" in index and "1 repeated session (P1 (session number 2): after one the participant completed)" in index
 # --include-unfinished: P4's answers in, said to be partial data.
 index_all = open(os.path.join(out_all, "index.html"), encoding="utf-8").read()
 assert "included 1 unfinished session (P4 (session 5)) with 3 answers as partial data" in index_all
