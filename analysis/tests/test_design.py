@@ -197,5 +197,36 @@ class ParticipantsAsTheUnit(unittest.TestCase):
         self.assertIn("no test of the group effect: group a has 1 participant", words)
 
 
+class VersionsInTheReport(unittest.TestCase):
+    """report.py on a study run under two protocol versions: a section per version, each with its own answers."""
+
+    def test_each_version_has_its_own_section(self):
+        sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+        import synthetic
+        tmp = tempfile.mkdtemp(prefix="blurcue-design-")
+        self.addCleanup(shutil.rmtree, tmp, True)
+        rows = synthetic.trials_rows(studies=["test1-static-grids"], unanswered=0)
+        for r in rows:
+            r["study"] = "my-grids"
+            r["protocol_version"] = 1 if r["participant"] in ("P1", "P2", "P3") else 2
+        trials = synthetic.write_trials_csv(os.path.join(tmp, "trials.csv"), rows)
+        out = os.path.join(tmp, "out")
+        report = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "report.py")
+        proc = subprocess.run([sys.executable, report, "--trials", trials, "--bench", os.path.join(tmp, "none"),
+                               "--out", out, "--boot", "20"], capture_output=True, text=True, timeout=170)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        self.assertIn("report: protocol versions 1, 2 analysed apart", proc.stderr)
+        with open(os.path.join(out, "index.html"), encoding="utf-8") as f:
+            index = f.read()
+        for version, people in ((1, {"P1", "P2", "P3"}), (2, {"P4", "P5", "P6"})):
+            self.assertIn(f"study my-grids (version {version}, simulated observers)", index)
+            table = pd.read_csv(os.path.join(out, f"my-grids-version{version}-simulated-conditions.csv"))
+            decisive = sum(1 for r in rows if r["participant"] in people and not r.get("practice")
+                           and r.get("choice") in ("left", "right") and r["r_left_px"] != r["r_right_px"])
+            self.assertEqual(int(table["n"].sum()), decisive)
+            self.assertEqual(int(table["participants"].max()), 3)
+        self.assertFalse(os.path.exists(os.path.join(out, "my-grids-simulated-conditions.csv")), "versions pooled")
+
+
 if __name__ == "__main__":
     unittest.main()
