@@ -8,13 +8,16 @@ What a study measures follows from its rows of trials.csv (their task and the co
   yes_no      one object: the share of "yes"
   rating      one object: the rating (1..n)
   adjustment  the level accepted
-The design's factors are the columns the export's codebook.csv calls "a level of the protocol's design" (constant
-ones left out). Per study: a table per condition (the crossing of the factors) with Wilson 95 % intervals and exact
-binomial tests against chance (Holm-adjusted), a chart per factor, a psychometric function over the stimulus variable
-(the level of a procedure, else the blur difference on screen in arcmin) with guess and lapse rates and a bootstrap
-band, logistic models across participants (a GLMM where there are three or more), the level tracks of adaptive
-procedures, and the side bias. People and simulated observers are analysed apart (report.py --pool-simulated pools
-them). A study that cannot be analysed raises Skip saying why.
+The design comes from the record (design.py: the codebook's roles, the rows' procedure cells). Per study: a table per
+condition (the crossing of the within factors and cells) with Wilson 95 % intervals and tests against chance with
+participants as the unit (study_tests.py, Holm-adjusted; none for an adaptive procedure, whose share correct the
+procedure sets), a chart per factor, a psychometric function where the design defines a correct answer - per
+procedure cell over its level, an odd one out's over the blur difference on screen in arcmin - with guess and lapse
+rates and a bootstrap band (none for a preference question), logistic models across participants (a GLMM where there
+are three or more), the level tracks of adaptive procedures (tracks.py), and the side bias. A between-subject group
+is a factor: everything per group, then the groups compared with participants as the unit. People and simulated
+observers are analysed apart (report.py --pool-simulated pools them), and so are protocol versions and repeated
+sessions (report.py, common.study_parts). A study that cannot be analysed raises Skip saying why.
 """
 import math
 import re

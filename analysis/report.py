@@ -6,7 +6,9 @@
 Writes DIR/<chart>.png, DIR/<chart>.svg, DIR/<table>.csv and DIR/index.html (self-contained, relative links).
 Display timing reads frames.csv from trials.csv's folder (written there by `blurcue export`; missing = skipped).
 One progress line per step on stderr. A section that the data cannot support (a study nobody ran, no answers, no
-bench files) is skipped with a one-line message and a note in index.html.
+bench files) is skipped with a one-line message and a note in index.html. Aborted and unfinished sessions are left out
+(--include-aborted, --include-unfinished take them in); repeated sessions and protocol versions get sections of their
+own; the summary says what was left out or kept apart.
 Exit codes: 0 report written; 2 usage; 3 trials.csv missing or unreadable, or the output folder cannot be written;
 10 a section failed unexpectedly (the rest of the report is still written, and the failure is named).
 """

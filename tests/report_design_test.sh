@@ -103,7 +103,8 @@ models = list(csv.DictReader(open(os.path.join(out, f"{slug}-groups-models.csv")
 assert any("group" in r["term"] for r in models), [r["term"] for r in models]
 print(f"group a {share['a']:.2f}, group b {share['b']:.2f}, Welch p = {float(effect['a']['p_welch']):.3g}")
 PYEOF
-  echo "ok: per-group tables and charts, the planted group difference found with participants as the unit: $(cat "$W/found")" ;;
+  $PY "$(dirname "$0")/browser_check.py" "$W/report" index.html > "$W/browser" || fail "$(cat "$W/browser")"
+  echo "ok: per-group tables and charts, the planted group difference found with participants as the unit: $(cat "$W/found"); $(sed 's/^ok: //' "$W/browser")" ;;
 sessions)
   # Three participants complete the 2IFC study, P1 comes back (--again: session number 2), P4 stops after 3 answers
   # (left running). The report analyses the three first sessions, says it left P4 out, and gives P1's second session
