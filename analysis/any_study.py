@@ -8,16 +8,18 @@ What a study measures follows from its rows of trials.csv (their task and the co
   yes_no      one object: the share of "yes"
   rating      one object: the rating (1..n)
   adjustment  the level accepted
-The design's factors are the columns the export's codebook.csv calls "a level of the protocol's design" (constant
-ones left out). Per study: a table per condition (the crossing of the factors) with Wilson 95 % intervals and exact
-binomial tests against chance (Holm-adjusted), a chart per factor, a psychometric function over the stimulus variable
-(the level of a procedure, else the blur difference on screen in arcmin) with guess and lapse rates and a bootstrap
-band, logistic models across participants (a GLMM where there are three or more), the level tracks of adaptive
-procedures, and the side bias. People and simulated observers are analysed apart (report.py --pool-simulated pools
-them). A study that cannot be analysed raises Skip saying why.
+The design comes from the record (design.py: the codebook's roles, the rows' procedure cells). Per study: a table per
+condition (the crossing of the within factors and cells) with Wilson 95 % intervals and tests against chance with
+participants as the unit (study_tests.py, Holm-adjusted; none for an adaptive procedure, whose share correct the
+procedure sets), a chart per factor, a psychometric function where the design defines a correct answer - per
+procedure cell over its level, an odd one out's over the blur difference on screen in arcmin - with guess and lapse
+rates and a bootstrap band (none for a preference question), logistic models across participants (a GLMM where there
+are three or more), the level tracks of adaptive procedures (tracks.py), and the side bias. A between-subject group
+is a factor: everything per group, then the groups compared with participants as the unit. People and simulated
+observers are analysed apart (report.py --pool-simulated pools them), and so are protocol versions and repeated
+sessions (report.py, common.study_parts). A study that cannot be analysed raises Skip saying why.
 """
 import math
-import os
 import re
 
 import matplotlib.pyplot as plt
@@ -25,36 +27,20 @@ import numpy as np
 import pandas as pd
 
 import stats
-from common import Chart, Skip, error_bars, p_text, participants_note, save, stars
+import study_tests
+import tracks
+from common import Chart, Skip, error_bars, participants_note, save, stars
+from design import design_of, load_codebook  # noqa: F401  (load_codebook: report.py reads the codebook through here)
 
-DESIGN_MEANING = "a level of the protocol's design"
-# Columns that identify a level rather than vary the stimulus (a pattern's id beside the pattern itself).
-NOT_FACTORS = {"id"}
 KIND_TITLES = {"pair": "forced choice between two", "odd": "odd one out",
                "procedure": "adaptive procedure", "yes_no": "yes / no", "rating": "rating",
                "adjustment": "method of adjustment"}
 
 
-def load_codebook(trials_path):
-    """codebook.csv beside trials.csv as {column: meaning}; {} when there is none."""
-    path = os.path.join(os.path.dirname(os.path.abspath(trials_path)), "codebook.csv")
-    if not os.path.isfile(path):
-        return {}
-    book = pd.read_csv(path, dtype=str, keep_default_na=False)
-    book = book[book["table"] == "trials.csv"]
-    return dict(zip(book["column"], book["meaning"]))
-
-
 def design_factors(d, codebook):
-    """The design's factors that vary within these rows, in column order."""
-    out = []
-    for column in d.columns:
-        if column in NOT_FACTORS or not codebook.get(column, "").startswith(DESIGN_MEANING):
-            continue
-        values = d[column].astype(str).replace("nan", "")
-        if values.replace("", np.nan).dropna().nunique() > 1:
-            out.append(column)
-    return out
+    """The design's factors that vary within these rows (within-subject factors and procedure cells), in column
+    order; the between-subject group is not one of them (see design.Design)."""
+    return list(design_of(d, codebook).factors)
 
 
 def kind_of(d):
@@ -104,8 +90,9 @@ def _label(value):
 
 
 def condition_table(m, factors, chance):
-    """One row per condition: n, k, share with its Wilson interval, and (with a chance level) the exact binomial test
-    against it, Holm-adjusted over the conditions."""
+    """One row per condition: n, k, share with its Wilson interval (descriptive: answers pooled), the participants,
+    and with a chance level the test against it with participants as the unit (study_tests.against_chance),
+    Holm-adjusted over the conditions that have one."""
     keys = None if not factors else factors[0] if len(factors) == 1 else factors
     groups = m.groupby(keys, dropna=False) if keys is not None else [((), m)]
     rows = []
@@ -117,11 +104,11 @@ def condition_table(m, factors, chance):
         row.update(n=n, k=k, share=p, share_low=lo, share_high=hi, participants=g["participant"].nunique())
         if chance is not None:
             row["chance"] = chance
-            row["p_binomial"] = stats.binom_p(k, n, chance)
+            row.update(study_tests.against_chance(g, chance, people=m["participant"].nunique()))
         rows.append(row)
     t = pd.DataFrame(rows)
     if chance is not None and not t.empty:
-        t["p_holm"] = stats.holm(list(t["p_binomial"]))
+        t["p_holm"] = stats.holm(list(t["p"]))
     return t
 
 
@@ -154,9 +141,10 @@ def factor_chart(m, factor, chance, what, study, out_dir, name, group_note):
     ax.grid(axis="x", visible=False)
     ax.set_title(f"{study}: {what} per {factor}\n{group_note}, {int(t['n'].sum())} answers", loc="left")
     png, svg = save(fig, out_dir, name)
-    notes = ["bars: share of answers with Wilson 95 % intervals" +
-             ("; * p < 0.05, ** < 0.01, *** < 0.001: exact binomial test against chance, Holm-adjusted over the "
-              "chart's bars" if chance is not None else "")]
+    tests = sorted(set(t["test"])) if "test" in t else []
+    notes = ["bars: share of answers with Wilson 95 % intervals (answers pooled: a description, not a test)" +
+             (f"; * p < 0.05, ** < 0.01, *** < 0.001 against chance, Holm-adjusted over the chart's bars, with "
+              f"participants as the unit: {'; '.join(tests)}" if chance is not None else "")]
     return Chart(name, png, svg, t, notes)
 
 
@@ -202,11 +190,15 @@ def models(m, factors, study, group_note, what):
     return Chart(f"{study}-models", None, None, table, notes)
 
 
-def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note, n_boot, seed, what):
+def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note, n_boot, seed, what, cell=""):
+    """A Weibull with the guess rate at chance over one procedure cell's (or one odd one out's) answers; raises Skip
+    with too few levels or answers. Returns (Chart, (threshold, low, high, slope) or (nan, min, max, slope) when the
+    threshold lies beyond the tested range)."""
+    where = f" ({cell})" if cell else ""
     d = m.dropna(subset=[xcol])
     x, k = d[xcol].to_numpy(float), d["y"].to_numpy(float)
     if len(np.unique(x)) < 3 or len(x) < 20:
-        raise Skip(f"{study}: psychometric function needs >= 3 stimulus levels and >= 20 answers "
+        raise Skip(f"{study}{where}: psychometric function needs >= 3 stimulus levels and >= 20 answers "
                    f"(has {len(np.unique(x))} levels, {len(x)} answers)")
     fit = stats.fit_psychometric(x, k, None, kind="weibull", gamma=chance, lam=(0.0, 0.1))
     grid, lo, hi = stats.bootstrap(x, k, np.ones_like(k), fit, n_boot=n_boot, seed=seed)
@@ -238,76 +230,67 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
     ax.set_ylabel(f"share: {what}")
     ax.set_ylim(min(chance, 0.4) - 0.05, 1.05)
     ax.legend(loc="lower right", fontsize=8)
-    ax.set_title(f"{study}: psychometric function\n{group_note}, {len(x)} answers", loc="left")
+    ax.set_title(f"{study}: psychometric function{' - cell ' + cell if cell else ''}\n{group_note}, {len(x)} answers",
+                 loc="left")
     png, svg = save(fig, out_dir, name)
-    t = pd.DataFrame([{"threshold": th, "threshold_low": th_lo, "threshold_high": th_hi, "criterion": p_mid,
-                       "alpha": fit.alpha, "beta_slope": fit.beta, "beta_low": fit.ci.get("beta", (math.nan,))[0],
-                       "beta_high": fit.ci.get("beta", (math.nan, math.nan))[1], "guess": fit.gamma,
-                       "lapse": fit.lam, "answers": len(x)}])
     inside = not math.isnan(th) and x.min() <= th <= x.max()
+    # A threshold beyond the tested range is an extrapolation, and an interval that reaches beyond it (or that the
+    # bootstrap could not bound) is not determined by these answers: both are written in words, not as numbers.
+    bounded = inside and not math.isnan(th_lo) and x.min() <= th_lo and th_hi <= x.max()
+    beta_lo, beta_hi = fit.ci.get("beta", (math.nan, math.nan))
+    b_bounds = fit.options.get("beta_bounds") or (0.0, math.inf)
+    beta_free = "beta" not in fit.on_bound
+    beta_ci = beta_free and not math.isnan(beta_lo) and beta_lo > b_bounds[0] * 1.001 + 1e-9 and \
+        beta_hi < b_bounds[1] * 0.999
+    interval_words = ("" if bounded else "the threshold's 95 % interval reaches beyond the tested range: not "
+                      "determined by these answers" if inside else
+                      f"beyond the tested range {x.min():.3g} to {x.max():.3g}")
+    t = pd.DataFrame([{**({"cell": cell} if cell else {}), "threshold": th if inside else math.nan,
+                       "threshold_low": th_lo if bounded else math.nan,
+                       "threshold_high": th_hi if bounded else math.nan, "threshold_note": interval_words,
+                       "on_bound": ", ".join(f"{k} at its {v[1]} bound {v[0]:.3g}" for k, v in fit.on_bound.items()),
+                       "criterion": p_mid,
+                       "alpha": fit.alpha, "beta_slope": fit.beta if beta_free else math.nan,
+                       "beta_low": beta_lo if beta_ci else math.nan, "beta_high": beta_hi if beta_ci else math.nan,
+                       "guess": fit.gamma, "lapse": fit.lam if "lam" not in fit.on_bound else math.nan, "answers": len(x),
+                       "participants": d["participant"].nunique()}])
     notes = [f"Weibull with the guess rate fixed at chance ({chance:.3g}) and a lapse rate fitted in [0, 0.1]; "
              f"threshold = the stimulus at {p_mid:.0%}: " +
-             (f"{th:.3g} [{th_lo:.3g}, {th_hi:.3g}] (parametric bootstrap, {n_boot} samples)" if inside else
+             (f"{th:.3g} [{th_lo:.3g}, {th_hi:.3g}] (parametric bootstrap, {n_boot} samples)" if bounded else
+              f"{th:.3g}, its interval not determined (the bootstrap's reaches beyond the tested range "
+              f"{x.min():.3g} to {x.max():.3g})" if inside else
               f"beyond the tested range {x.min():.3g} to {x.max():.3g} (an extrapolation, not an estimate)") +
-             f"; slope {fit.beta:.3g}"]
+             (f"; slope {fit.beta:.3g}" if beta_free else "; slope on a bound of its range: not determined") +
+             ("" if beta_ci or not beta_free else "; the slope's interval reaches a bound: not determined")]
     if fit.on_bound:
         notes.append("on a bound of its range: " + ", ".join(f"{k} ({v[1]})" for k, v in fit.on_bound.items()))
-    return Chart(name, png, svg, t, notes), ((th, th_lo, th_hi, fit.beta) if inside else
+    return Chart(name, png, svg, t, notes), ((th, th_lo, th_hi, fit.beta) if bounded else
+                                             (th, math.nan, math.nan, fit.beta) if inside else
                                              (math.nan, x.min(), x.max(), fit.beta))
 
 
-def tracks_chart(m, study, out_dir, name, group_note):
-    """The level each adaptive procedure showed, trial after trial, with the answers, and its threshold estimate:
-    QUEST+'s posterior mean after the last answer (its running posterior mean drawn dashed), a staircase's mean of
-    its last 6 reversal levels (or of its last 10 levels with fewer than 4 reversals)."""
-    d = m.dropna(subset=["level"]).copy()
-    d["level"] = d["level"].astype(float)
-    fig, ax = plt.subplots(figsize=(6.5, 3.8))
-    rows = []
-    colors = ["#0072B2", "#E69F00", "#009E73", "#CC79A7", "#D55E00", "#56B4E9"]
-    for i, ((participant, cell), g) in enumerate(d.sort_values("trial_index").groupby(["participant", "procedure_cell"])):
-        levels = g["level"].to_numpy()
-        step = np.arange(1, len(levels) + 1)
-        c = colors[i % len(colors)]
-        ax.plot(step, levels, "-", color=c, lw=1, alpha=0.8)
-        ok = g["y"].to_numpy() == 1
-        ax.plot(step[ok], levels[ok], "o", color=c, ms=3.5)
-        ax.plot(step[~ok], levels[~ok], "x", color=c, ms=4)
-        posterior = _num(g["posterior_threshold"]) if "posterior_threshold" in g else pd.Series(dtype=float)
-        moves = np.sign(np.diff(levels))
-        moves = moves[moves != 0]
-        reversals = [levels[1:][np.diff(levels) != 0][j] for j in range(1, len(moves)) if moves[j] != moves[j - 1]]
-        if posterior.notna().any():
-            ax.plot(step, posterior.to_numpy(), "--", color=c, lw=1)
-            estimate, by = float(posterior.dropna().iloc[-1]), "QUEST+ posterior mean after the last answer"
-        elif len(reversals) >= 4:
-            estimate, by = float(np.mean(reversals[-6:])), "mean of the last 6 reversal levels"
-        else:
-            estimate, by = float(np.mean(levels[-10:])), "mean of the last 10 levels"
-        rows.append({"participant": participant, "procedure_cell": _label(cell), "trials": len(levels),
-                     "reversals": len(reversals), "estimate": estimate, "by": by,
-                     "share_correct": float(ok.mean())})
-    ax.set_xlabel("trial of the procedure")
-    ax.set_ylabel("level shown")
-    ax.set_title(f"{study}: procedure tracks (o correct, x wrong; dashed: QUEST+'s posterior mean threshold)\n"
-                 f"{group_note}", loc="left")
-    png, svg = save(fig, out_dir, name)
-    return Chart(name, png, svg, pd.DataFrame(rows), ["one line per participant and crossing of the block's factors; "
-                                                       "estimate: each track's threshold as its procedure gives it"])
-
-
 def side_bias_table(m, study, group_note):
-    d = m[m["chosen_side"].isin(["left", "right"])]
+    """The share of decisive answers choosing the left side: pooled (Wilson, descriptive) and its test against 0.5
+    with participants as the unit."""
+    d = m[m["chosen_side"].isin(["left", "right"])].copy()
     n, k = len(d), int((d["chosen_side"] == "left").sum())
     p, lo, hi = stats.wilson(k, n)
-    t = pd.DataFrame([{"answers": n, "chose_left": k, "share_left": p, "share_left_low": lo, "share_left_high": hi,
-                       "p_binomial": stats.binom_p(k, n, 0.5)}])
-    return Chart(f"{study}-side-bias", None, None, t,
-                 [f"{group_note}: share of decisive answers choosing the left side, against 0.5 (no side bias)"])
+    row = {"answers": n, "chose_left": k, "share_left": p, "share_left_low": lo, "share_left_high": hi,
+           "participants": d["participant"].nunique()}
+    d["y"] = (d["chosen_side"] == "left").astype(float)
+    row.update(study_tests.against_chance(d, 0.5))
+    return Chart(f"{study}-side-bias", None, None, pd.DataFrame([row]),
+                 [f"{group_note}: share of decisive answers choosing the left side, against 0.5 (no side bias), "
+                  f"tested with participants as the unit"])
 
 
-def analyse(df, study, codebook, out_dir, n_boot=200, seed=1, group=""):
-    """Charts for one study (the rows of one observer group); returns ([Chart], finding) - finding: one line for the
+def _safe(text):
+    return re.sub(r"[^A-Za-z0-9_-]", "_", str(text))
+
+
+def analyse(df, study, codebook, out_dir, n_boot=200, seed=1, group="", part=""):
+    """Charts for one study (the rows of one observer group; part: which protocol version or session number they
+    are, "" for a study's first sessions of its only version); returns ([Chart], finding) - finding: one line for the
     report's summary. Blocks of different tasks (yes/no and rating, say) are analysed apart. Raises Skip when nothing
     can be analysed."""
     d = df[(df["study"] == study) & (df["practice"] != 1)].copy()
@@ -315,11 +298,11 @@ def analyse(df, study, codebook, out_dir, n_boot=200, seed=1, group=""):
         raise Skip(f"{study}: no trials outside practice")
     tasks = sorted(set(d["task"]))
     if len(tasks) == 1:
-        return _analyse(d, study, codebook, out_dir, n_boot, seed, group, "")
+        return _analyse(d, study, codebook, out_dir, n_boot, seed, group, "", part)
     charts, findings, skips = [], [], []
     for task in tasks:
         try:
-            c, f = _analyse(d[d["task"] == task], study, codebook, out_dir, n_boot, seed, group, task)
+            c, f = _analyse(d[d["task"] == task], study, codebook, out_dir, n_boot, seed, group, task, part)
             charts += c
             findings.append(f)
         except Skip as e:
@@ -330,65 +313,163 @@ def analyse(df, study, codebook, out_dir, n_boot=200, seed=1, group=""):
     return charts, "; ".join(findings)
 
 
-def _analyse(d, study, codebook, out_dir, n_boot, seed, group, part):
+def _analyse(d, study, codebook, out_dir, n_boot, seed, group, task, part):
     kind = kind_of(d)
-    m, chance, what = measured(d, kind)
+    m, guess, what = measured(d, kind)
     if m.empty:
         answered = int((d["status"] == "answered").sum())
         raise Skip(f"{study} ({KIND_TITLES[kind]}): no answers to analyse ({answered} answered of {len(d)}"
                    + ("; none chose a side between unequal radii" if kind == "pair" and answered else "") + ")")
-    factors = design_factors(m, codebook)
-    slug = re.sub(r"[^A-Za-z0-9_-]", "_", study + (f"-{part}" if part else "") +
-                  (f"-{group.split()[0]}" if group else ""))
-    group_note = participants_note(m) + (f" ({group})" if group else "")
+    design = design_of(m, codebook)
+    slug = _safe(study + (f"-{task}" if task else "") + (f"-{part.replace(', ', '-').replace(' ', '')}" if part else "")
+                 + (f"-{group.split()[0]}" if group else ""))
+    note = participants_note(m) + (f" ({group})" if group else "") + (f", {part}" if part else "")
+    if "session_status" in m and (m["session_status"] == "running").any():
+        n_running = m.loc[m["session_status"] == "running", "session_id"].nunique()
+        note += f", incl. {n_running} unfinished session{'s' if n_running != 1 else ''} (partial data)"
+    if not design.group:
+        declared = _text_values(m, "group")
+        if len(declared) == 1:  # a group study of which these rows hold one group: say which
+            note += f", group {declared[0]}"
+        return _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, note, n_boot, seed)
+    # A between-subject group is a factor: each group analysed on its own, then the groups compared with
+    # participants as the unit.
+    charts, findings = [], []
+    levels = _sorted_levels(list(m[design.group].astype(str).unique()))
+    for level in levels:
+        rows = m[m[design.group].astype(str) == level]
+        c, f = _analyse_rows(rows, kind, guess, what, design_of(rows, codebook), codebook, study, out_dir,
+                             f"{slug}-group-{_safe(level)}", f"group {level}: {participants_note(rows)}"
+                             f"{note[len(participants_note(m)):]}", n_boot, seed)
+        charts += c
+        findings.append(f"group {level}: {f}")
+    c, f = group_section(m, kind, what, design, codebook, study, out_dir, slug, note)
+    return charts + c, "; ".join(findings + [f])
+
+
+def _text_values(m, column):
+    """The distinct non-empty values of a column, as text ([] without the column)."""
+    if column not in m:
+        return []
+    return sorted({str(v) for v in m[column] if str(v).strip() not in ("", "nan")})
+
+
+def group_section(m, kind, what, design, codebook, study, out_dir, slug, note):
+    """The group effect with participants as the unit: a chart of every participant's share (or mean) per group
+    with the groups' means, Welch's t and Mann-Whitney's U (study_tests.group_effect), and for a 0/1 measure the
+    logistic models across participants with the group as a fixed effect. Returns ([Chart], finding)."""
+    group = design.group
+    if kind == "procedure":
+        words = ("groups not compared on the share correct: an adaptive procedure sets it; compare the groups' "
+                 "thresholds in the tracks tables")
+        return [Chart(f"{slug}-per-group", None, None, None, [words])], words
+    column = "value" if kind in ("rating", "adjustment") else "y"
+    table, notes, words = study_tests.group_effect(m, group, column)
+    pp = study_tests.per_participant(m, column, by=[group])
+    fig, ax = plt.subplots(figsize=(max(4.5, 1.2 * len(table) + 2.5), 3.6))
+    x = np.arange(len(table))
+    rng = np.random.default_rng(1)
+    for xi, level in zip(x, table["group"]):
+        v = pp.loc[pp[group].astype(str) == level, "mean"]
+        ax.plot(xi + rng.uniform(-0.1, 0.1, len(v)), v, "o", ms=4, color="#999999", alpha=0.8)
+    ax.errorbar(x, table["participant_mean"], yerr=error_bars(table["participant_mean"], table["ci_low"],
+                                                               table["ci_high"]),
+                fmt="s", color="#0072B2", ecolor="#0072B2", ms=7)
+    ax.set_xticks(x)
+    ax.set_xticklabels([f"group {g}" for g in table["group"]])
+    ax.set_xlim(-0.6, len(table) - 0.4)
+    ax.set_ylabel(f"{'mean ' + what if column == 'value' else 'share: ' + what}\nper participant")
+    if column == "y":
+        ax.set_ylim(-0.03, 1.03)
+    ax.set_title(f"{study}: {what} per group (grey: each participant)\n{note}", loc="left")
+    png, svg = save(fig, out_dir, f"{slug}-per-group")
+    notes = notes + ["blue: the mean of the participants' values with its t 95 % interval (none with one participant)"]
+    charts = [Chart(f"{slug}-per-group", png, svg, table, notes)]
+    if column == "y":
+        shared = [f for f in design.factors if f != group]
+        charts.append(models(m, shared + [group], f"{slug}-groups", note, what))
+    return charts, f"group effect: {words}"
+
+
+def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, note, n_boot, seed):
+    """The charts of one set of rows that the design lets be pooled (one group, one version, one session number)."""
+    factors = list(design.factors)
     charts = []
-    finding = ""
     if kind in ("rating", "adjustment"):
-        for f in factors or []:
-            charts.append(value_chart(m, f, what, study, out_dir, f"{slug}-{what.replace(' ', '-')}-per-{f}", group_note))
-        summary = m["value"].describe()
-        finding = f"{KIND_TITLES[kind]}: mean {what} {summary['mean']:.3g} (median {m['value'].median():.3g}) over " \
-                  f"{len(m)} answers" + (f"; per {', '.join(factors)} in the charts" if factors else "")
+        for f in factors:
+            charts.append(value_chart(m, f, what, study, out_dir, f"{slug}-{what.replace(' ', '-')}-per-{f}", note))
+        people = study_tests.per_participant(m, "value")["mean"]
+        finding = (f"{KIND_TITLES[kind]}: mean {what} {m['value'].mean():.3g} (median {m['value'].median():.3g}) over "
+                   f"{len(m)} answers" + (f", {len(people)} participants' means from {people.min():.3g} to "
+                                          f"{people.max():.3g}" if len(people) > 1 else "") +
+                   (f"; per {', '.join(factors)} in the charts" if factors else ""))
         if not factors:
             charts.append(Chart(f"{slug}-{what.replace(' ', '-')}", None, None,
-                                m["value"].describe().to_frame().T.reset_index(drop=True), [group_note]))
+                                m["value"].describe().to_frame().T.reset_index(drop=True), [note]))
         return charts, finding
+    # An adaptive procedure chooses each level from the answers so far: its share correct is what the procedure
+    # aims at, so testing it against chance says nothing. Its thresholds are its result.
+    chance = None if kind == "procedure" else guess
     table = condition_table(m, factors, chance)
     charts.append(Chart(f"{slug}-conditions", None, None, table,
-                        [f"{group_note}: {what} per condition (the crossing of {', '.join(factors) or 'no factors'}); "
-                         "Wilson 95 % intervals" + ("; exact binomial test against chance, Holm-adjusted over the "
-                                                    "conditions" if chance is not None else "")]))
-    for f in factors:
-        charts.append(factor_chart(m, f, chance, what, study, out_dir, f"{slug}-per-{f}", group_note))
-    k, n = int(m["y"].sum()), len(m)
-    p, lo, hi = stats.wilson(k, n)
-    finding = f"{KIND_TITLES[kind]}: {what} {p:.2f} [{lo:.2f}, {hi:.2f}] of {n} answers"
-    if chance is not None:
-        finding += f" (chance {chance:.2g}, {p_text(stats.binom_p(k, n, chance))})"
-    # The psychometric function over the stimulus variable: a procedure's level, else the blur difference on screen.
-    if chance is not None:
-        if kind == "procedure":
-            xcol, xlabel = "level", "level shown (the procedure's variable)"
-            m["level"] = _num(m["level"])
-        else:
-            m["difference"] = (_num(m["r_right_arcmin"]) - _num(m["r_left_arcmin"])).abs()
-            xcol, xlabel = "difference", "blur difference between the two, |r_right - r_left| (arcmin)"
-        try:
-            chart, (th, th_lo, th_hi, slope) = psychometric_chart(m, xcol, xlabel, chance, study, out_dir,
-                                                                   f"{slug}-psychometric", group_note, n_boot, seed,
-                                                                   what)
-            charts.append(chart)
-            finding += f"; threshold {th:.3g} [{th_lo:.3g}, {th_hi:.3g}]" if not math.isnan(th) else \
-                f"; threshold beyond the tested range {th_lo:.3g} to {th_hi:.3g}"
-        except Skip as e:
-            charts.append(Chart(f"{slug}-psychometric", None, None, None, [str(e)]))
-        except ValueError as e:
-            charts.append(Chart(f"{slug}-psychometric", None, None, None, [f"no psychometric fit: {e}"]))
+                        [f"{note}: {what} per condition (the crossing of {', '.join(factors) or 'no factors'}); "
+                         "Wilson 95 % intervals of the answers pooled (a description)" +
+                         ("; against chance with participants as the unit (test column), Holm-adjusted over the "
+                          "conditions" if chance is not None else
+                          "; no test against chance: an adaptive procedure sets the share correct")]))
+    if kind != "procedure":
+        for f in factors:
+            charts.append(factor_chart(m, f, chance, what, study, out_dir, f"{slug}-per-{f}", note))
+        finding = f"{KIND_TITLES[kind]}: " + study_tests.summary_words(m, chance, what)
+    else:
+        finding = (f"{KIND_TITLES[kind]}: {participants_note(m)}, {len(m)} answers (share correct set by the "
+                   f"procedure, not tested)")
+    if kind in ("procedure", "odd"):
+        c, words = psychometric_cells(m, kind, guess, what, design, study, out_dir, slug, note, n_boot, seed)
+        charts += c
+        finding += "; " + words if words else ""
+    else:
+        charts.append(Chart(f"{slug}-psychometric", None, None, None,
+                            ["no psychometric function: the question has no correct answer (a preference: which "
+                             "fits the scene), so a guess rate of 0.5 would be a claim the design does not make; the "
+                             "shares of choosing the more blurred side per condition are in the tables"]))
     if kind == "procedure":
-        m["level"] = _num(m["level"])
-        charts.append(tracks_chart(m, study, out_dir, f"{slug}-tracks", group_note))
-    if kind in ("pair", "procedure", "odd"):
-        charts.append(models(m, factors, slug, group_note, what))
+        charts += tracks.charts(m, study, out_dir, slug, note)
+    else:
+        charts.append(models(m, factors, slug, note, what))
     if "chosen_side" in m and m["chosen_side"].isin(["left", "right"]).any():
-        charts.append(side_bias_table(m, slug, group_note))
+        charts.append(side_bias_table(m, slug, note))
     return charts, finding
+
+
+def psychometric_cells(m, kind, guess, what, design, study, out_dir, slug, note, n_boot, seed):
+    """A psychometric function per procedure cell (never pooled across cells; labelled by the cell's levels), over
+    the procedure's level; an odd one out's over the blur difference on screen. Returns ([Chart], words)."""
+    m = m.copy()
+    if kind == "procedure":
+        xcol, xlabel = "level", "level shown (the procedure's variable)"
+        m["level"] = _num(m["level"])
+        cells = design.cell_of(m)
+    else:
+        m["difference"] = (_num(m["r_right_arcmin"]) - _num(m["r_left_arcmin"])).abs()
+        xcol, xlabel = "difference", "blur difference between the two, |r_right - r_left| (arcmin)"
+        cells = pd.Series([""] * len(m), index=m.index)
+    names = list(dict.fromkeys(cells))
+    charts, words = [], []
+    for cell in _sorted_levels(names) if all(names) else names:
+        rows = m[cells == cell]
+        name = f"{slug}-psychometric" + (f"-{_safe(cell)}" if len(names) > 1 else "")
+        try:
+            chart, (th, th_lo, th_hi, _) = psychometric_chart(rows, xcol, xlabel, guess, study, out_dir, name, note,
+                                                             n_boot, seed, what, cell=cell)
+            charts.append(chart)
+            where = f"{cell}: " if cell else ""
+            words.append(f"{where}threshold {th:.3g} [{th_lo:.3g}, {th_hi:.3g}]" if not math.isnan(th_lo) and
+                         not math.isnan(th) else
+                         f"{where}threshold {th:.3g} (its interval not determined)" if not math.isnan(th) else
+                         f"{where}threshold beyond the tested range {th_lo:.3g} to {th_hi:.3g}")
+        except Skip as e:
+            charts.append(Chart(name, None, None, None, [str(e)]))
+        except ValueError as e:
+            charts.append(Chart(name, None, None, None, [f"no psychometric fit{' in ' + cell if cell else ''}: {e}"]))
+    return charts, "; ".join(words)

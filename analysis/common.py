@@ -130,6 +130,79 @@ def without_aborted(df):
     return df[df["session_status"] != "aborted"].copy()
 
 
+def unfinished_rows(df):
+    """The rows of unfinished sessions (session_status running: stopped, killed, or still being written)."""
+    if "session_status" not in df.columns:
+        return df.iloc[0:0]
+    return df[df["session_status"] == "running"]
+
+
+def without_unfinished(df):
+    """trials without the rows of unfinished sessions (their answers are a part of a session, not a session)."""
+    if "session_status" not in df.columns:
+        return df
+    return df[df["session_status"] != "running"].copy()
+
+
+def session_numbers(df):
+    """Each row's session as the analysis counts it: 1 + how many sessions of the study its participant completed
+    before it (in the order started). A participant's --again session after a completed one is 2; a session after an
+    aborted (given up) one is still a first session. From session_number and session_status (1 for every row of an
+    export from before them; session_number alone without session_status)."""
+    if "session_number" not in df.columns:
+        return pd.Series(1, index=df.index)
+    number = pd.to_numeric(df["session_number"], errors="coerce").fillna(1).astype(int)
+    if "session_status" not in df.columns:
+        return number
+    s = pd.DataFrame({"study": df["study"], "participant": df["participant"], "session_id": df["session_id"],
+                      "n": number, "done": (df["session_status"] == "completed").astype(int)})
+    s = s.drop_duplicates("session_id")
+    rank = {}
+    for _, g in s.groupby(["study", "participant"]):
+        for sid, n in zip(g["session_id"], g["n"]):
+            rank[sid] = 1 + int(g.loc[g["n"] < n, "done"].sum())  # completed sessions started before this one
+    return df["session_id"].map(rank).astype(int)
+
+
+def protocol_versions(df):
+    """Each row's protocol version as text ("" in an export from before versions were recorded)."""
+    if "protocol_version" not in df.columns:
+        return pd.Series("", index=df.index)
+    return df["protocol_version"].astype(str).str.strip().replace("nan", "")
+
+
+def study_parts(rows):
+    """A study's rows split where they must not be pooled: by protocol version (where the study has more than one)
+    and by session number (a participant's first sessions apart from their second, third, ...). Returns
+    [(label, rows)] in order, label "" for the only part of a study with one version and first sessions only, else
+    e.g. "version 2", "session 2", "version 2, session 3"."""
+    versions, numbers = protocol_versions(rows), session_numbers(rows)
+    several = versions.nunique() > 1
+    out = []
+    for version in sorted(versions.unique(), key=lambda v: (len(v), v)):
+        for number in sorted(numbers[versions == version].unique()):
+            part = rows[(versions == version) & (numbers == number)]
+            label = ", ".join(([f"version {version}"] if several else []) +
+                              ([f"session {number}"] if number > 1 else []))
+            out.append((label, part))
+    return out
+
+
+def main_rows(df):
+    """The rows the thesis's views and the observed-vs-model step read: every study's first sessions of its latest
+    protocol version (the rest is analysed apart, part by part, study_parts)."""
+    if df.empty:
+        return df
+    keep = session_numbers(df) == 1
+    versions = protocol_versions(df)
+    for study, d in df.groupby("study"):
+        v = versions[d.index]
+        if v.nunique() > 1:
+            latest = max(v.unique(), key=lambda x: (len(x), x))
+            keep[d.index] &= v == latest
+    return df[keep].copy()
+
+
 def study_rows(df, study):
     """The study's non-practice rows (practice == 1 is excluded from every analysis)."""
     d = df[(df["study"] == study) & (df["practice"] != 1)]

@@ -6,7 +6,9 @@
 Writes DIR/<chart>.png, DIR/<chart>.svg, DIR/<table>.csv and DIR/index.html (self-contained, relative links).
 Display timing reads frames.csv from trials.csv's folder (written there by `blurcue export`; missing = skipped).
 One progress line per step on stderr. A section that the data cannot support (a study nobody ran, no answers, no
-bench files) is skipped with a one-line message and a note in index.html.
+bench files) is skipped with a one-line message and a note in index.html. Aborted and unfinished sessions are left out
+(--include-aborted, --include-unfinished take them in); repeated sessions and protocol versions get sections of their
+own; the summary says what was left out or kept apart.
 Exit codes: 0 report written; 2 usage; 3 trials.csv missing or unreadable, or the output folder cannot be written;
 10 a section failed unexpectedly (the rest of the report is still written, and the failure is named).
 """
@@ -119,8 +121,10 @@ def write_index(out_dir, sections, header, name="index.html", title="blurcue ana
 def thesis_findings(trials, sections):
     """One line per thesis study for the summary: the depth matching's pooled slope of log cut-off on log distance
     (from its chart's table), and for the forced-choice tests how often measured was chosen over estimated where the
-    two were shown side by side (Wilson 95 % interval, exact binomial test against 0.5)."""
+    two were shown side by side (Wilson 95 % interval of the answers; the test against 0.5 with participants as the
+    unit, study_tests.against_chance)."""
     import stats
+    import study_tests
     out = {}
     charts = {c.name: c for _, cs, _ in sections for c in cs}
     dm = charts.get("depth-matching")
@@ -144,9 +148,13 @@ def thesis_findings(trials, sections):
         if len(pair):
             k, n = int((pair["chosen_source"] == "measured").sum()), len(pair)
             p, lo, hi = stats.wilson(k, n)
-            out[study] = (f"measured chosen over estimated {p:.2f} [{lo:.2f}, {hi:.2f}] of {n} decisive answers "
-                          f"({common.p_text(stats.binom_p(k, n, 0.5))} against 0.5); can't tell {share_cant:.0%} "
-                          f"of all answers")
+            # Answers of one participant are not independent: the test against 0.5 takes participants as the unit.
+            test = study_tests.against_chance(pair.assign(y=(pair["chosen_source"] == "measured").astype(float)), 0.5)
+            people = pair["participant"].nunique()
+            out[study] = (f"measured chosen over estimated {p:.2f} [{lo:.2f}, {hi:.2f}] of {n} decisive answers from "
+                          f"{people} participant{'s' if people != 1 else ''}; against 0.5: {test['test']}"
+                          + (f", {common.p_text(test['p'])}" if not math.isnan(test["p"]) else "") +
+                          f"; can't tell {share_cant:.0%} of all answers")
         else:
             out[study] = f"no measured-vs-estimated pairs answered; can't tell {share_cant:.0%} of all answers"
     return out
@@ -171,6 +179,47 @@ def aborted_sessions(trials, included):
     return out
 
 
+def unfinished_sessions(trials, included):
+    """(study, line) per study holding unfinished sessions (session_status running: stopped, killed, or still being
+    written): how many sessions and answers the report leaves out, or with `included` analyses as partial data."""
+    out = []
+    for study, d in common.unfinished_rows(trials).groupby("study", sort=True):
+        sessions = d.drop_duplicates("session_id")
+        who = ", ".join(f"{p} (session {s})" for p, s in zip(sessions["participant"], sessions["session_id"]))
+        n, answers = len(sessions), int((d["answered"] & (d["practice"] != 1)).sum())
+        what = (f"{n} unfinished session{'s' if n != 1 else ''} ({who}) with {answers} "
+                f"answer{'s' if answers != 1 else ''}")
+        if included:
+            out.append((study, f"included {what} as partial data (--include-unfinished): stopped, killed or still "
+                               f"running, each is a part of a session"))
+        else:
+            out.append((study, f"left out {what}: stopped, killed or still running, a part of a session is not a "
+                               f"participant's data; blurcue report --include-unfinished analyses them as partial data"))
+    return out
+
+
+def kept_apart(trials):
+    """(study, line) per study whose record holds repeated sessions or several protocol versions: what is analysed
+    apart, and where."""
+    out = []
+    for study, d in trials.groupby("study", sort=True):
+        numbers = common.session_numbers(d)
+        again = d[numbers > 1].drop_duplicates("session_id")
+        if len(again):
+            who = ", ".join(f"{p} (session number {n})" for p, n in zip(again["participant"], numbers[again.index]))
+            out.append((study, f"{len(again)} repeated session{'s' if len(again) != 1 else ''} ({who}: after one the "
+                               f"participant completed) analysed apart from first sessions: a section per session "
+                               f"number ('session N'); the thesis's views and the observed-vs-model step use first "
+                               f"sessions only"))
+        versions = common.protocol_versions(d)
+        if versions.nunique() > 1:
+            listed = sorted(versions.unique(), key=lambda v: (len(v), v))
+            out.append((study, f"protocol versions {', '.join(listed)} analysed apart: a section per version "
+                               f"('version N'); the thesis's views and the observed-vs-model step use version "
+                               f"{listed[-1]}, the latest"))
+    return out
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description="Charts, tables and index.html from trials.csv and bench CSVs.")
     parser.add_argument("--trials", required=True, help="trials.csv written by `blurcue export`")
@@ -187,6 +236,9 @@ def main(argv=None):
     parser.add_argument("--include-aborted", action="store_true",
                         help="analyse the answers of aborted sessions too (by default they are left out, and the "
                              "summary says how many)")
+    parser.add_argument("--include-unfinished", action="store_true",
+                        help="analyse the answers of unfinished sessions (stopped, killed or still running) as partial "
+                             "data (by default they are left out, and the summary says how many)")
     args = parser.parse_args(argv)
     warnings.showwarning = _warning_line
 
@@ -268,9 +320,19 @@ def main(argv=None):
         say(str(e))  # the only line: the file and what is wrong with it
         return EXIT_INPUT
     # An aborted session was given up (sessions --abort): its answers are not the study's unless asked for.
-    aborted_lines = aborted_sessions(holder["trials"], args.include_aborted)
+    session_lines = aborted_sessions(holder["trials"], args.include_aborted)
     if not args.include_aborted:
         holder["trials"] = common.without_aborted(holder["trials"])
+    # An unfinished session (running: stopped, killed, still being written) is a part of a session: not analysed
+    # unless asked for, and then named as partial data.
+    session_lines += unfinished_sessions(holder["trials"], args.include_unfinished)
+    if not args.include_unfinished:
+        holder["trials"] = common.without_unfinished(holder["trials"])
+    # Repeated sessions and protocol versions are analysed apart: the thesis's views and the observed-vs-model step
+    # read every study's first sessions of its latest version; every other part gets its own section below.
+    all_trials = holder["trials"]
+    session_lines += kept_apart(all_trials)
+    holder["trials"] = common.main_rows(all_trials)
     trials = holder["trials"]
     codebook = any_study.load_codebook(args.trials)
 
@@ -279,24 +341,26 @@ def main(argv=None):
     known = set(common.STUDY_TITLES)
     findings = {}  # step title -> one line for the summary
 
-    def study_step(study, rows, group):
+    def study_step(study, rows, group, label):
         def run():
             charts, finding = any_study.analyse(rows, study, codebook, args.out, n_boot=args.boot, seed=args.seed,
-                                                group=group)
+                                                group=group, part=label)
             findings[title] = finding
             return charts
-        title = f"study {study}" + (f" ({group})" if group else "")
+        title = f"study {study}" + (f" ({', '.join(filter(None, [label, group]))})" if label or group else "")
         return title, run
 
     study_steps = []
-    for study in sorted(set(trials["study"]) - known):
-        rows = trials[trials["study"] == study]
-        kinds = sorted(set(rows["observer"])) if not args.pool_simulated else ["all"]
-        for kind in kinds:
-            part = rows if kind == "all" else rows[rows["observer"] == kind]
-            group = "" if kind == "all" or kinds == ["person"] else \
-                ("simulated observers" if kind == "simulated" else "people")
-            study_steps.append(study_step(study, part, group))
+    for study in sorted(set(all_trials["study"])):
+        for label, rows in common.study_parts(all_trials[all_trials["study"] == study]):
+            if study in known and rows.index.isin(trials.index).all():
+                continue  # a thesis study's first sessions of its latest version: the thesis's own views
+            kinds = sorted(set(rows["observer"])) if not args.pool_simulated else ["all"]
+            for kind in kinds:
+                part = rows if kind == "all" else rows[rows["observer"] == kind]
+                group = "" if kind == "all" or kinds == ["person"] else \
+                    ("simulated observers" if kind == "simulated" else "people")
+                study_steps.append(study_step(study, part, group, label))
     # The thesis's views of the thesis's studies that are in the record (none is a box saying it is missing).
     present = set(trials["study"])
     uses = [{common.STUDY_DEPTH}, {common.STUDY_TEST1}, {common.STUDY_TEST2}, {common.STUDY_TEST3},
@@ -309,23 +373,23 @@ def main(argv=None):
     steps = thesis_steps + study_steps + [predict_step] + steps[8:] + bench_steps
     n_data_steps = len(steps) - len(bench_steps)
     total = len(steps) + 2  # + reading trials.csv + writing the index
-    say(f"[1/{total}] read {shown(args.trials)}: {len(trials)} rows")
-    studies = trials["study"].value_counts().sort_index()
+    say(f"[1/{total}] read {shown(args.trials)}: {len(all_trials)} rows")
+    studies = all_trials["study"].value_counts().sort_index()
     known = set(common.STUDY_TITLES)
-    header = [f"trials: {os.path.abspath(shown(args.trials))} - {len(trials)} rows, "
-              f"{int(trials['answered'].sum())} answered, {trials['participant'].nunique()} participants",
+    header = [f"trials: {os.path.abspath(shown(args.trials))} - {len(all_trials)} rows, "
+              f"{int(all_trials['answered'].sum())} answered, {all_trials['participant'].nunique()} participants",
               "studies: " + (", ".join(f"{s} ({n} rows)" for s, n in studies.items()) or "none"),
               f"frames: {os.path.abspath(shown(frames_path))}",
               f"bench: {os.path.abspath(args.bench)}",
               f"written {datetime.datetime.now().strftime('%Y-%m-%d %H:%M')}; practice trials excluded everywhere"]
-    header[1:1] = [line for _, line in aborted_lines]
-    for _, line in aborted_lines:
+    header[1:1] = [line for _, line in session_lines]
+    for _, line in session_lines:
         say(line)
-    observers = trials.groupby("observer")["participant"].nunique()
+    observers = all_trials.groupby("observer")["participant"].nunique()
     header.insert(1, "participants: " + ", ".join(f"{n} {'people' if k == 'person' else 'simulated'}"
                                                     for k, n in observers.items()) +
                   ("; analysed apart" if len(observers) > 1 and not args.pool_simulated else ""))
-    if trials.empty:
+    if all_trials.empty:
         say(f"{args.trials}: no trials - every trial section is skipped")
 
     sections = []
@@ -357,7 +421,7 @@ def main(argv=None):
 
     say(f"[{total}/{total}] index.html ...")
     # The summary: what each study found (the thesis's studies point at their figures).
-    summary = list(aborted_lines)
+    summary = list(session_lines)
     thesis = thesis_findings(trials, sections)
     for study in sorted(set(trials["study"]) & known):
         d = trials[(trials["study"] == study) & (trials["practice"] != 1)]

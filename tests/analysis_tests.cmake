@@ -15,7 +15,10 @@ add_test(NAME analysis.bench_charts
 add_test(NAME analysis.prediction
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_prediction.py
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
-set_tests_properties(analysis.stats analysis.report analysis.bench_charts analysis.prediction PROPERTIES
+add_test(NAME analysis.design
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_design.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(analysis.stats analysis.report analysis.bench_charts analysis.prediction analysis.design PROPERTIES
                      LABELS analysis TIMEOUT 180
                      # Matplotlib writes its font cache under HOME; keep it out of a read-only or shared home.
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")

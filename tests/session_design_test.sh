@@ -195,6 +195,8 @@ report_any_study)
       $BC run "$P/$p.json" --participant $id --db "$W/s.sqlite" --observer sim > /dev/null 2>&1 || fail "$p $id"
     done
   done
+  # A third odd-one-out observer: a test against chance takes participants as the unit, and needs three.
+  $BC run "$P/odd-one-out-grids.json" --participant S3 --db "$W/s.sqlite" --observer sim > /dev/null 2>&1 || fail "odd S3"
   MPLCONFIGDIR=$W/mpl $BC report --db "$W/s.sqlite" --out "$W/report" --bench "$W/no-bench" --boot 60 2> "$W/err" \
     || fail "report: $(tail -3 "$W/err")"
   grep -q "ignored" "$W/err" && fail "a study was ignored: $(grep ignored "$W/err")"
@@ -226,10 +228,11 @@ assert lo <= truth <= hi, (lo, th, hi, truth)
 tracks = list(csv.DictReader(open(os.path.join(out, "quest-blur-difference-simulated-tracks.csv"))))
 assert len(tracks) == 5 and all(t["by"].startswith("QUEST+ posterior mean") for t in tracks), tracks
 assert all(0.25 <= float(t["estimate"]) <= 4 for t in tracks), tracks
-# The odd one out is found above chance (1/3) where the odd card differs most (edge 9), with its test.
+# The odd one out is found above chance (1/3) where the odd card differs most (edge 9), with its test across the
+# three participants.
 odd = list(csv.DictReader(open(os.path.join(out, "odd-one-out-grids-simulated-per-edge.csv"))))
 nine = next(r for r in odd if r["edge"] == "9")
-assert float(nine["share"]) > 1 / 3 and float(nine["p_binomial"]) < 0.05, nine
+assert float(nine["share"]) > 1 / 3 and nine["test"].startswith("one-sample t across 3") and float(nine["p"]) < 0.05, nine
 # The summary says what each study found.
 assert "Summary" in index and "threshold" in index and "chance 0.33" in index, "summary"
 PYEOF

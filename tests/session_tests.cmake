@@ -34,6 +34,13 @@ foreach(case again protocol_version conditions_version)
   set_tests_properties(session_numbers_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
                        LABELS "gl;session" PASS_REGULAR_EXPRESSION "^ok:|\nok:")
 endforeach()
+# The report analyses the design the record declares (tests/report_design_test.sh): a QUEST+ per depth per depth,
+# between-subject groups compared across participants, unfinished and repeated sessions apart.
+foreach(case quest_per_depth groups sessions)
+  add_test(NAME report_design_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/report_design_test.sh ${case} ${BC} ${T})
+  set_tests_properties(report_design_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
+                       LABELS "gl;session" PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+endforeach()
 
 add_test(NAME session_preview
          COMMAND ${BC} preview ${T}/protocols/test1-static-grids.json --out ${T}/preview-test1.png)

@@ -19,7 +19,7 @@ void AddReportCommand(CLI::App& app) {
   struct Args {
     std::string db, out, bench = "results/bench", python = "/usr/bin/python3";
     int boot = 200;
-    bool pool_simulated = false, include_aborted = false;
+    bool pool_simulated = false, include_aborted = false, include_unfinished = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -27,9 +27,10 @@ void AddReportCommand(CLI::App& app) {
       "Write the report of a record: the tables (DIR/tables/, as blurcue export, with their codebook), then every\n"
       "chart as PNG and SVG with its numbers beside it, DIR/index.html (a summary of what each study found, then a\n"
       "section per study) and DIR/bench.html (the software benchmarks):\n"
-      "  any study, from what its trials declare: per condition the share with Wilson intervals and exact binomial\n"
-      "          tests against chance (Holm), a chart per factor, a psychometric function over a procedure's level or\n"
-      "          the blur difference on screen (Weibull, guess and lapse, bootstrap band and threshold interval),\n"
+      "  any study, from what its trials declare: per condition the share with Wilson intervals and a test against\n"
+      "          chance with participants as the unit (Holm), a chart per factor, a psychometric function per\n"
+      "          procedure cell over its level, or an odd one out's over the blur difference on screen (Weibull, guess\n"
+      "          and lapse, bootstrap band and threshold interval; none for a preference question),\n"
       "          procedure tracks, models across participants (GLMM from three), side bias, ratings, adjusted levels;\n"
       "          people and simulated observers apart (--pool-simulated pools them)\n"
       "  the thesis's studies, besides:\n"
@@ -40,7 +41,11 @@ void AddReportCommand(CLI::App& app) {
       "  speed vs accuracy of every blur and measurement method with the Pareto front, and where each breaks\n"
       "          (from --bench: measure.csv and render.csv of blurcue bench)\n"
       "Aborted sessions (closed with blurcue sessions --abort) are left out of every analysis, and the summary says\n"
-      "how many sessions and answers per study (--include-aborted analyses them too).\n"
+      "how many sessions and answers per study (--include-aborted analyses them too); so are unfinished sessions\n"
+      "(running: stopped, killed or still being written; --include-unfinished analyses them as partial data).\n"
+      "A between-subject group is analysed per group and compared with participants as the unit; an adaptive\n"
+      "procedure per cell, without a test against chance; a participant's repeated sessions (--again) and each\n"
+      "protocol version get sections of their own.\n"
       "Sections without data are skipped with a note. Needs Debian's python3-pandas, -scipy, -matplotlib and\n"
       "-statsmodels (scripts/setup.sh installs them).\n"
       "The folder is built beside DIR as .DIR.partial-PID and swapped in only when the analysis succeeded: an\n"
@@ -57,6 +62,9 @@ void AddReportCommand(CLI::App& app) {
                 "analyse people and simulated observers together (by default each study reports them apart)");
   cmd->add_flag("--include-aborted", args->include_aborted,
                 "analyse the answers of aborted sessions too (by default they are left out, and the summary says so)");
+  cmd->add_flag("--include-unfinished", args->include_unfinished,
+                "analyse the answers of unfinished sessions too, as partial data (by default they are left out, and "
+                "the summary says so)");
   cmd->callback([args] {
     const std::filesystem::path out = args->out;
     const std::filesystem::path script = DataDir().path / "analysis" / "report.py";
@@ -82,6 +90,7 @@ void AddReportCommand(CLI::App& app) {
                                            std::to_string(args->boot)};
           if (args->pool_simulated) argv.push_back("--pool-simulated");
           if (args->include_aborted) argv.push_back("--include-aborted");
+          if (args->include_unfinished) argv.push_back("--include-unfinished");
           RunAnalysis(argv, "the analysis", out.string(), {(partial / "index.html").string()});
         },
         [earlier_report](const std::string&) { return earlier_report; });

@@ -40,7 +40,8 @@ const std::vector<ColumnDef>& TrialColumnsBefore() {
       {"session_id", "integer", "", ">= 1", "the session's id in this record (merged records renumber it)"},
       {"session_number", "integer", "", ">= 1", "the participant's n-th session of this study, in the order started"},
       {"session_status", "string", "", "running|completed|aborted",
-       "the session's status when exported: running (unfinished: stopped, killed or still being written), "
+       "the session's status when exported: running (unfinished: stopped, killed or still being written; blurcue "
+       "report leaves its answers out unless --include-unfinished), "
        "completed, or aborted (closed with blurcue sessions --abort; blurcue report leaves its answers out unless "
        "--include-aborted)"},
       {"seed", "string", "", "s followed by 1-20 digits",
