@@ -14,6 +14,7 @@ Exit codes: 0 report written; 2 usage; 3 trials.csv missing or unreadable, or th
 """
 import argparse
 import datetime
+import errno
 import html
 import math
 import os
@@ -220,7 +221,22 @@ def kept_apart(trials):
     return out
 
 
+# What a full disk, a quota, a read-only file system or a folder taken away mid-report raise: exit 3 naming the file.
+WRITE_ERRNOS = {errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.EIO}
+
+
 def main(argv=None):
+    try:
+        return _main(argv)
+    except OSError as e:
+        if e.errno not in WRITE_ERRNOS:
+            raise
+        where = f"{e.filename}: " if e.filename else ""
+        print(f"report: {where}cannot write ({e.strerror or e}); nothing was written in its place", file=sys.stderr)
+        return EXIT_INPUT
+
+
+def _main(argv=None):
     parser = argparse.ArgumentParser(description="Charts, tables and index.html from trials.csv and bench CSVs.")
     parser.add_argument("--trials", required=True, help="trials.csv written by `blurcue export`")
     parser.add_argument("--bench", default=os.path.join("results", "bench"),
@@ -404,6 +420,15 @@ def main(argv=None):
             skips.append(shown_text(str(e)))
             if title.startswith("study "):
                 findings[title] = "not analysed: " + shown_text(str(e))
+        except OSError as e:
+            if e.errno in WRITE_ERRNOS:
+                raise  # the disk is full or read-only: no section can be written, said once by main
+            if args.debug:
+                raise
+            message = str(e).strip().splitlines()[0] if str(e).strip() else ""
+            say(f"  {title} failed: {type(e).__name__}: {message}")
+            skips.append(f"failed unexpectedly: {type(e).__name__}: {message}")
+            failed.append(title)
         except Exception as e:  # a bug or data this code did not foresee: name it, keep the rest of the report
             if args.debug:
                 raise

@@ -132,6 +132,37 @@ class EdgeCaseTest(ReportTestCase):
         self.assertIn("trials.csv", err)
         self.assertCleanStderr(err)
 
+    def test_a_full_disk_is_exit_3_naming_the_file_and_never_says_wrote(self):
+        # The disk fills while the charts are saved: one line naming the file, exit 3 (it used to be exit 10 after
+        # "wrote .../index.html").
+        import contextlib
+        import errno
+        import io
+        import report
+        rows = synthetic.trials_rows(participants=("P1", "P2"), studies=["test1-static-grids"], unanswered=0)
+        trials = synthetic.write_trials_csv(os.path.join(self.tmp, "trials.csv"), rows)
+        out = os.path.join(self.tmp, "out")
+
+        def full(fig, out_dir, name):
+            raise OSError(errno.ENOSPC, "No space left on device", os.path.join(out_dir, name + ".png"))
+        saved = report.common.save
+        modules = [m for m in sys.modules.values() if getattr(m, "save", None) is saved]
+        for m in modules:
+            m.save = full
+        try:
+            err = io.StringIO()
+            with contextlib.redirect_stderr(err):
+                code = report.main(["--trials", trials, "--bench", os.path.join(self.tmp, "bench"), "--out", out,
+                                    "--boot", "10"])
+        finally:
+            for m in modules:
+                m.save = saved
+        self.assertEqual(code, 3)
+        last = err.getvalue().strip().splitlines()[-1]
+        self.assertRegex(last, r"^report: .*/out/[^/]+\.png: cannot write \(No space left on device\)")
+        self.assertNotIn("wrote", err.getvalue())
+        self.assertNotIn("Traceback", err.getvalue())
+
     def test_zero_responses(self):
         rows = synthetic.trials_rows(participants=("P1", "P2", "P3"), unanswered=1.0)
         trials = synthetic.write_trials_csv(os.path.join(self.tmp, "trials.csv"), rows)
