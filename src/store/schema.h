@@ -35,17 +35,6 @@ void RequireIntactPages(Database& db);
 // The schema version a fully migrated database reports (= Migrations().size()).
 int CurrentSchemaVersion();
 
-// A column schema 7 (the typed record) added to sessions, trials or responses: its SQL type and CHECK ("" none).
-struct TypedColumn {
-  const char* table;
-  const char* name;
-  const char* type;  // "TEXT" | "REAL" | "INTEGER"
-  const char* check;
-};
-// Schema 7's typed columns in the order its migration adds them (session_info is a table of its own): the one list
-// the migration and `merge` use. Never changed once shipped - a new column is a new migration.
-const std::vector<TypedColumn>& TypedColumns();
-
 // Fills the typed columns of version 7 that are NULL (rows written before it, or merged from a record before it) from
 // the texts earlier versions kept: the session's display text and profile JSON, the participant information JSON, a
 // trial's factors and shown sides, a response's shown object. Rows written at version 7 have them already.
