@@ -28,24 +28,24 @@ namespace blurcue::store {
 namespace {
 
 // trials.csv's columns of one place, in the column table's order (columns.h), as the codebook defines them.
-std::vector<ColumnDef> Defs(Place place) {
+std::vector<ColumnDef> Defs(const std::vector<Column>& table, Place place) {
   std::vector<ColumnDef> defs;
-  for (const Column& c : RecordColumns())
+  for (const Column& c : table)
     if (c.place == place) defs.push_back({c.name, c.type, c.unit, c.allowed, c.meaning});
   return defs;
 }
 
 // The runner's variable named `key` (session/recording.h TrialVariables), or null: any other key of a trial's
 // variables is a level of the protocol's design (or a column of its conditions table, or a level's value).
-const Column* RecordedVariable(const std::string& key) {
-  for (const Column& c : RecordColumns())
+const Column* RecordedVariable(const std::vector<Column>& table, const std::string& key) {
+  for (const Column& c : table)
     if (c.place == Place::kVariable && c.name == key) return &c;
   return nullptr;
 }
 
 // A variable the runner writes both in the trial's variables and in a typed column: exported from the typed column.
-bool TypedVariable(const std::string& key) {
-  for (const Column& c : RecordColumns())
+bool TypedVariable(const std::vector<Column>& table, const std::string& key) {
+  for (const Column& c : table)
     if (c.in_variables && c.name == key) return true;
   return false;
 }
@@ -165,6 +165,11 @@ std::string DesignColumn(const std::string& name) { return IsRecordedName(name) 
 
 int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::path& out_dir,
                   const ProgressNote& note) {
+  return ExportCsvWith(RecordColumns(), db_path, out_dir, note);
+}
+
+int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::path& db_path,
+                      const std::filesystem::path& out_dir, const ProgressNote& note) {
   Note(note, RemoveStaleLeftovers(out_dir));
   Database source(db_path, OpenMode::kReadOnly);
   RequireReadableRecord(source);
@@ -197,7 +202,7 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
         if (!object.is_object())
           throw InputError(where, std::string(column == 2 ? "factors" : "shown") + " must be a JSON object");
         for (const auto& item : object.items())
-          if (!TypedVariable(item.key())) keys[item.key()].Add(item.value());
+          if (!TypedVariable(table, item.key())) keys[item.key()].Add(item.value());
       }
     }
   }
@@ -223,17 +228,17 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
   }
 
   // The header and the codebook, from the same definitions.
-  std::vector<ColumnDef> columns = Defs(Place::kSession);
+  std::vector<ColumnDef> columns = Defs(table, Place::kSession);
   if (groups) columns.push_back({"group", "string", "", "", "the between-subject group the session ran"});
   for (const auto& [key, type] : info_keys)
     columns.push_back({"info_" + key, type.Type(), "", type.Allowed(), "participant information: " + key});
-  const std::vector<ColumnDef> trial_columns = Defs(Place::kTrial);
+  const std::vector<ColumnDef> trial_columns = Defs(table, Place::kTrial);
   columns.insert(columns.end(), trial_columns.begin(), trial_columns.end());
   std::vector<std::string> variable_names;
   for (const auto& [key, type] : keys) {
     // A recorded variable keeps its name; a level named like one (the runner records it as factor_NAME; a record of
     // before that holds it under its own name where no recorded variable took it) gets the same prefix.
-    const Column* known = RecordedVariable(key);
+    const Column* known = RecordedVariable(table, key);
     const std::string name = known ? key : DesignColumn(key);
     variable_names.push_back(key);
     const std::string level = key.rfind("factor_", 0) == 0 && IsRecordedName(key.substr(7)) ? key.substr(7) : key;
@@ -248,7 +253,7 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
                          "conditions table)" + (name == key && level == key ? "" : "; named " + name +
                          " because trials.csv has a column " + level + " of its own")});
   }
-  const std::vector<ColumnDef> answer_columns = Defs(Place::kAnswer);
+  const std::vector<ColumnDef> answer_columns = Defs(table, Place::kAnswer);
   columns.insert(columns.end(), answer_columns.begin(), answer_columns.end());
   ApplyDesign(db, &columns);
   std::vector<std::string> header;
@@ -263,7 +268,7 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
                        "coalesce(r.r_right_px, t.r_right_px), r.adjustment, s.group_name";
   std::map<const Column*, int> at;
   int next = 13;
-  for (const Column& c : RecordColumns())
+  for (const Column& c : table)
     if (c.place != Place::kVariable && c.place != Place::kNone && c.cell != Cell::kAnswer) {
       select += ", " + SelectOf(c);
       at[&c] = next++;
@@ -323,7 +328,7 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
       return rows.GetText(i);
     };
     auto cells_of = [&](Place place, std::vector<std::string>* cells) {
-      for (const Column& c : RecordColumns())
+      for (const Column& c : table)
         if (c.place == place) cells->push_back(cell(c));
     };
     std::vector<std::string> cells;

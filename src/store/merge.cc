@@ -17,7 +17,7 @@ namespace {
 
 // The typed columns (schema 7 on) the column table keeps in `table` (columns.h), as a SELECT list for an input of
 // schema `version`: NULL for a column it predates (DeriveTypedColumns and DeriveVersionsAndNumbers fill those from
-// its texts, as a migration would); InsertNames and InsertPlaceholders give the INSERT's.
+// its texts, as a migration would); CopiedNames and CopiedPlaceholders give the INSERT's.
 std::string TypedSelect(const std::string& table, int version) {
   std::string list;
   for (const Kept& kept : KeptIn(RecordColumns(), table, 7))
@@ -31,9 +31,29 @@ int TypedIndex(const std::string& table, const std::string& name) {
     if (kept[i].name == name) return int(i);
   throw Error(ErrorKind::kInternal, "merge: no typed column " + table + "." + name);
 }
-// Binds the typed columns read from `from` (starting at column `first`) to `to` (starting at parameter `at`).
+// A session's number is read but not copied: a participant's sessions from several inputs are numbered again.
+bool Renumbered(const Kept& kept) { return kept.stored->table == "sessions" && kept.name == "session_number"; }
+// ", a, b" and ", ?, ?" for the typed columns an INSERT of `table` copies.
+std::string CopiedNames(const std::string& table) {
+  std::string names;
+  for (const Kept& kept : KeptIn(RecordColumns(), table, 7))
+    if (!Renumbered(kept)) names += ", " + kept.name;
+  return names;
+}
+std::string CopiedPlaceholders(const std::string& table) {
+  std::string marks;
+  for (const Kept& kept : KeptIn(RecordColumns(), table, 7))
+    if (!Renumbered(kept)) marks += ", ?";
+  return marks;
+}
+// Binds the typed columns read from `from` (TypedSelect's, starting at column `first`) that are copied to `to`
+// (starting at parameter `at`).
 void CopyTyped(const std::string& table, Statement& from, int first, Statement& to, int at) {
   for (const Kept& kept : KeptIn(RecordColumns(), table, 7)) {
+    if (Renumbered(kept)) {
+      ++first;
+      continue;
+    }
     if (from.IsNull(first)) to.BindNull(at);
     else if (kept.stored->sql == "TEXT") to.Bind(at, from.GetText(first));
     else if (kept.stored->sql == "REAL") to.Bind(at, from.GetDouble(first));
@@ -175,9 +195,9 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
                                  "AND seed = ? AND host = ? AND started = ?");
         Statement insert_session(dst, "INSERT INTO sessions (participant_id, protocol_version_id, seed, "
                                       "software_version, host, display, started, ended, status, display_profile, "
-                                      "group_name, participant_info" + InsertNames(RecordColumns(), "sessions") +
+                                      "group_name, participant_info" + CopiedNames("sessions") +
                                       ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?" +
-                                      InsertPlaceholders(RecordColumns(), "sessions") + ")");
+                                      CopiedPlaceholders("sessions") + ")");
         const int number_at = 13 + TypedIndex("sessions", "session_number");
         while (sessions.Step()) {
           const int64_t participant = participant_ids.at(sessions.GetInt64(1));
@@ -223,8 +243,8 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
         Statement trials(src, "SELECT id, session_id, trial_index, block, factors, left_shown, right_shown" +
                                   TypedSelect("trials", version) + " FROM trials");
         Statement insert_trial(dst, "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, "
-                                    "right_shown" + InsertNames(RecordColumns(), "trials") + ") VALUES (?, ?, ?, ?, ?, ?" +
-                                    InsertPlaceholders(RecordColumns(), "trials") + ")");
+                                    "right_shown" + CopiedNames("trials") + ") VALUES (?, ?, ?, ?, ?, ?" +
+                                    CopiedPlaceholders("trials") + ")");
         while (trials.Step()) {
           insert_trial.Bind(1, session_ids.at(trials.GetInt64(1)));
           insert_trial.Bind(2, trials.GetInt64(2));
@@ -240,8 +260,8 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
                                      std::string(version >= 5 ? "shown" : "'{}'") +
                                      TypedSelect("responses", version) + " FROM responses");
         Statement insert_response(dst, "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at, "
-                                       "shown" + InsertNames(RecordColumns(), "responses") + ") VALUES (?, ?, ?, ?, ?, ?" +
-                                       InsertPlaceholders(RecordColumns(), "responses") + ")");
+                                       "shown" + CopiedNames("responses") + ") VALUES (?, ?, ?, ?, ?, ?" +
+                                       CopiedPlaceholders("responses") + ")");
         while (responses.Step()) {
           insert_response.Bind(1, trial_ids.at(responses.GetInt64(0)));
           insert_response.Bind(2, responses.GetText(1));
