@@ -27,10 +27,26 @@ Stored Plain(const std::string& table, const std::string& column, const std::str
   s.since = since;
   return s;
 }
-Stored Typed(const std::string& table, const std::string& sql, const std::string& check, int since) {
+Stored Typed(const std::string& table, const std::string& sql, const std::string& check, int since,
+             const std::string& derive = "") {
   Stored s = Plain(table, "", sql, since);
   s.check = check;
+  s.derive = derive;
   return s;
+}
+// A side's source and fixed radius as a record of before version 7 kept them: the side's JSON (a source's name, a
+// number of photo px, or an object of screen_px or arcmin).
+std::string SourceOf(const std::string& column) {
+  return "CASE json_type(" + column + ") WHEN 'text' THEN json_extract(" + column + ", '$') "
+         "WHEN 'integer' THEN 'fixed_px' WHEN 'real' THEN 'fixed_px' "
+         "WHEN 'object' THEN CASE WHEN json_extract(" + column + ", '$.screen_px') IS NOT NULL "
+         "THEN 'fixed_screen_px' ELSE 'fixed_arcmin' END END";
+}
+std::string FixedOf(const std::string& column) {
+  return "CASE json_type(" + column + ") WHEN 'integer' THEN json_extract(" + column + ", '$') "
+         "WHEN 'real' THEN json_extract(" + column + ", '$') "
+         "WHEN 'object' THEN coalesce(json_extract(" + column + ", '$.screen_px'), json_extract(" + column +
+         ", '$.arcmin')) END";
 }
 Stored OfSession(Stored s, Value (*of)(const SessionValues&)) { return s.of_session = of, s; }
 Stored OfTrial(Stored s, Value (*of)(const TrialRecord&)) { return s.of_trial = of, s; }
@@ -62,33 +78,37 @@ std::vector<Column> MakeColumns() {
   Column& observer = add("observer", "string", "", "person|simulated",
                          "who answered: a person, or blurcue's simulated observer", S, Cell::kText);
   observer.if_null = "person";  // a record of before the typed columns that no migration filled
-  observer.at = OfSession(Typed("sessions", "TEXT", "observer IN ('person', 'simulated')", 7),
+  observer.at = OfSession(Typed("sessions", "TEXT", "observer IN ('person', 'simulated')", 7,
+                                "CASE WHEN instr(display, '; observer ') > 0 THEN 'simulated' ELSE 'person' END"),
                           [](const SessionValues& s) { return Value(s.meta.simulated ? "simulated" : "person"); });
   add("observer_params", "string", "", "", "the simulated observer's parameters (sim:model=arcmin,... or sim:model=pixel,...; before model= existed sim:jnd=..., the pixel model); empty for a person", S, Cell::kText)
-      .at = OfSession(Typed("sessions", "TEXT", "", 7), [](const SessionValues& s) { return Value(s.meta.observer_params); });
+      .at = OfSession(Typed("sessions", "TEXT", "", 7,
+                            "CASE WHEN instr(display, '; observer ') > 0 "
+                            "THEN substr(display, instr(display, '; observer ') + 11) ELSE '' END"),
+                      [](const SessionValues& s) { return Value(s.meta.observer_params); });
   add("window", "boolean", "", "0|1", "1: shown in a real window on the real clock; 0: headless on a simulated clock",
       S, Cell::kInteger)
-      .at = OfSession(Typed("sessions", "INTEGER", "window IN (0, 1)", 7),
+      .at = OfSession(Typed("sessions", "INTEGER", "window IN (0, 1)", 7, "(display LIKE 'window%')"),
                       [](const SessionValues& s) { return Value(int64_t(s.meta.window ? 1 : 0)); });
   // The display profile's geometry, typed from the profile the session records whole; trials.csv leaves it out.
   add("profile_name", "string", "", "", "the display profile's name", N, Cell::kText)
-      .at = OfSession(Typed("sessions", "TEXT", "", 7), [](const SessionValues& s) {
+      .at = OfSession(Typed("sessions", "TEXT", "", 7, "json_extract(display_profile, '$.name')"), [](const SessionValues& s) {
         const Json& p = s.profile;
         return p.is_object() && p.contains("name") && p["name"].is_string() ? Value(p["name"].get<std::string>())
                                                                               : Value();
       });
   add("screen_width_mm", "number", "mm", "", "the screen's width (display profile)", N, Cell::kNumber)
-      .at = OfSession(Typed("sessions", "REAL", "", 7),
+      .at = OfSession(Typed("sessions", "REAL", "", 7, "json_extract(display_profile, '$.width_mm')"),
                       [](const SessionValues& s) { return ProfileNumber(s.profile, "width_mm"); });
   add("screen_height_mm", "number", "mm", "", "the screen's height (display profile)", N, Cell::kNumber)
-      .at = OfSession(Typed("sessions", "REAL", "", 7),
+      .at = OfSession(Typed("sessions", "REAL", "", 7, "json_extract(display_profile, '$.height_mm')"),
                       [](const SessionValues& s) { return ProfileNumber(s.profile, "height_mm"); });
   add("viewing_distance_mm", "number", "mm", "", "the eye's distance to the screen (display profile)", N, Cell::kNumber)
-      .at = OfSession(Typed("sessions", "REAL", "", 7),
+      .at = OfSession(Typed("sessions", "REAL", "", 7, "json_extract(display_profile, '$.distance_mm')"),
                       [](const SessionValues& s) { return ProfileNumber(s.profile, "distance_mm"); });
   add("px_per_deg", "number", "screen px / deg", "", "screen pixels per degree of visual angle (display profile)", N,
       Cell::kNumber)
-      .at = OfSession(Typed("sessions", "REAL", "", 7),
+      .at = OfSession(Typed("sessions", "REAL", "", 7, "json_extract(display_profile, '$.px_per_deg')"),
                       [](const SessionValues& s) { return ProfileNumber(s.profile, "px_per_deg"); });
   add("session_id", "integer", "", ">= 1", "the session's id in this record (merged records renumber it)", S,
       Cell::kInteger).at = Plain("sessions", "id", "INTEGER", 1);
@@ -112,17 +132,22 @@ std::vector<Column> MakeColumns() {
       .at = Plain("trials", "block", "INTEGER", 1);
   Column& block_name = add("block_name", "string", "", "", "the block's name", T, Cell::kText);
   block_name.in_variables = true;
-  block_name.at = OfTrial(Typed("trials", "TEXT", "", 7), [](const TrialRecord& t) { return Value(t.block_name); });
+  block_name.at = OfTrial(Typed("trials", "TEXT", "", 7, "coalesce(json_extract(factors, '$.block_name'), '')"), [](const TrialRecord& t) { return Value(t.block_name); });
   add("task", "string", "", "forced_choice|adjustment|yes_no|rating", "the trial's task", T, Cell::kText)
-      .at = OfTrial(Typed("trials", "TEXT", "", 7), [](const TrialRecord& t) { return Value(t.task); });
+      .at = OfTrial(Typed("trials", "TEXT", "", 7,
+                          "CASE WHEN json_extract(factors, '$.start_level') IS NOT NULL THEN 'adjustment' "
+                          "ELSE 'forced_choice' END"),
+                    [](const TrialRecord& t) { return Value(t.task); });
   Column& practice = add("practice", "boolean", "", "0|1", "1: a practice trial (not scored)", T, Cell::kInteger);
   practice.if_null = "0", practice.in_variables = true;
-  practice.at = OfTrial(Typed("trials", "INTEGER", "practice IN (0, 1)", 7),
+  practice.at = OfTrial(Typed("trials", "INTEGER", "practice IN (0, 1)", 7,
+                              "coalesce(json_extract(factors, '$.practice'), 0) <> 0"),
                         [](const TrialRecord& t) { return Value(int64_t(t.practice ? 1 : 0)); });
   Column& swapped = add("swapped", "boolean", "", "0|1",
                         "1: left and right exchanged against the design (counterbalancing)", T, Cell::kInteger);
   swapped.if_null = "0", swapped.in_variables = true;
-  swapped.at = OfTrial(Typed("trials", "INTEGER", "swapped IN (0, 1)", 7),
+  swapped.at = OfTrial(Typed("trials", "INTEGER", "swapped IN (0, 1)", 7,
+                             "coalesce(json_extract(factors, '$.swapped'), 0) <> 0"),
                        [](const TrialRecord& t) { return Value(int64_t(t.swapped ? 1 : 0)); });
   add("cell", "string", "", "",
       "a procedure trial's cell by its levels (NAME=LEVEL;... of its block's factors): its own track and threshold; "
@@ -133,24 +158,25 @@ std::vector<Column> MakeColumns() {
   const std::string sources = "none|measured|measured_section|estimated|fitted|fixed_px|fixed_screen_px|fixed_arcmin";
   add("left_source", "string", "", sources, "the left side's blur source (the single layout's object); empty: none shown",
       A, Cell::kText)
-      .at = OfTrial(Typed("trials", "TEXT", "", 7),
+      .at = OfTrial(Typed("trials", "TEXT", "", 7, SourceOf("left_shown")),
                     [](const TrialRecord& t) { return NonEmpty(SourceColumns::Of(t.left_json).source); });
   add("left_fixed", "number", "the source's unit", ">= 0", "a fixed_* left source's radius, in the unit its name says",
       A, Cell::kNumber)
-      .at = OfTrial(Typed("trials", "REAL", "", 7),
+      .at = OfTrial(Typed("trials", "REAL", "", 7, FixedOf("left_shown")),
                     [](const TrialRecord& t) { return Optional(SourceColumns::Of(t.left_json).fixed); });
   add("right_source", "string", "", sources, "the right side's blur source; empty: none shown", A, Cell::kText)
-      .at = OfTrial(Typed("trials", "TEXT", "", 7),
+      .at = OfTrial(Typed("trials", "TEXT", "", 7, SourceOf("right_shown")),
                     [](const TrialRecord& t) { return NonEmpty(SourceColumns::Of(t.right_json).source); });
   add("right_fixed", "number", "the source's unit", ">= 0", "a fixed_* right source's radius, in the unit its name says",
       A, Cell::kNumber)
-      .at = OfTrial(Typed("trials", "REAL", "", 7),
+      .at = OfTrial(Typed("trials", "REAL", "", 7, FixedOf("right_shown")),
                     [](const TrialRecord& t) { return Optional(SourceColumns::Of(t.right_json).fixed); });
 
   // The runner's variables of a trial (session/recording.h TrialVariables), kept in its variables' JSON (factors; a
   // response's shown for what a procedure decided at the trial). Those also kept typed come first, in schema 7's order.
   add("level", "number", "the procedure's variable", "", "a procedure trial: the level shown", V, Cell::kText)
-      .shown = OfResponse(Typed("responses", "REAL", "", 7), [](const Response& r) { return Optional(r.level); });
+      .shown = OfResponse(Typed("responses", "REAL", "", 7, "json_extract(shown, '$.level')"),
+                          [](const Response& r) { return Optional(r.level); });
 
   // The answer.
   add("status", "string", "", "answered|timed_out|skipped|unanswered",
@@ -174,7 +200,7 @@ std::vector<Column> MakeColumns() {
                         "1: the answer was correct (procedure trials, odd one out); empty where no answer is correct",
                         A, Cell::kInteger);
   correct.in_variables = true;
-  correct.at = OfResponse(Typed("responses", "INTEGER", "correct IN (0, 1)", 7), [](const Response& r) {
+  correct.at = OfResponse(Typed("responses", "INTEGER", "correct IN (0, 1)", 7, "json_extract(shown, '$.correct')"), [](const Response& r) {
     return r.correct ? Value(int64_t(*r.correct ? 1 : 0)) : Value();
   });
 
@@ -186,14 +212,17 @@ std::vector<Column> MakeColumns() {
                                              : "the " + side + " object's blur radius";
     Column& px = add("r_" + side + "_px", "number", "photo px",
                      "", what + ", as the camera makes it (moving: averaged over the run)", V, Cell::kText);
+    // Before version 7 only the variables' JSON had it, planned (factors) and as shown (shown).
+    const Stored planned = Typed("trials", "REAL", "", 7, "json_extract(factors, '$.r_" + side + "_px')");
+    const Stored shown = Typed("responses", "REAL", "", 7, "json_extract(shown, '$.r_" + side + "_px')");
     if (side == "left") {
-      px.at = OfTrial(Typed("trials", "REAL", "", 7), [](const TrialRecord& t) { return Optional(t.r_left_px); });
-      px.shown = OfResponse(Typed("responses", "REAL", "", 7), [](const Response& r) { return Optional(r.r_left_px); });
+      px.at = OfTrial(planned, [](const TrialRecord& t) { return Optional(t.r_left_px); });
+      px.shown = OfResponse(shown, [](const Response& r) { return Optional(r.r_left_px); });
     } else if (side == "right") {
-      px.at = OfTrial(Typed("trials", "REAL", "", 7), [](const TrialRecord& t) { return Optional(t.r_right_px); });
-      px.shown = OfResponse(Typed("responses", "REAL", "", 7), [](const Response& r) { return Optional(r.r_right_px); });
+      px.at = OfTrial(planned, [](const TrialRecord& t) { return Optional(t.r_right_px); });
+      px.shown = OfResponse(shown, [](const Response& r) { return Optional(r.r_right_px); });
     } else {
-      px.at = OfTrial(Typed("trials", "REAL", "", 7), [](const TrialRecord& t) { return Optional(t.r_scene_px); });
+      px.at = OfTrial(planned, [](const TrialRecord& t) { return Optional(t.r_scene_px); });
     }
     add("r_" + side + "_screen_px", "number", "screen px", "", what + ", on the screen", V, Cell::kText);
     add("r_" + side + "_arcmin", "number", "arcmin", "", what + ", at the eye", V, Cell::kText);
@@ -291,6 +320,13 @@ std::string AddColumnsSql(const std::vector<Column>& columns, int version) {
         sql += std::string("ALTER TABLE ") + table + " ADD COLUMN " + kept.name + " " + kept.stored->sql +
                (kept.stored->check.empty() ? std::string() : " CHECK (" + kept.stored->check + ")") + ";";
   return sql;
+}
+
+std::string DerivedColumnsSql(const std::vector<Column>& columns, const std::string& table) {
+  std::string set;
+  for (const Kept& kept : KeptIn(columns, table, 7))
+    if (kept.stored->since == 7) set += (set.empty() ? "" : ", ") + kept.name + " = " + kept.stored->derive;
+  return set;
 }
 
 // The INSERTs of sessions, trials and responses write the typed columns their rows give (protocol_versions.version

@@ -53,6 +53,9 @@ struct Stored {
   std::string sql;     // TEXT | REAL | INTEGER
   std::string check;   // the CHECK expression, "" for none
   int since = 0;
+  // Version 7: how a row written before it had the value (SQL over the row's older texts: the display, the display
+  // profile, the variables' JSON), for DeriveTypedColumns; "" for none.
+  std::string derive;
   Value (*of_session)(const SessionValues&) = nullptr;
   Value (*of_trial)(const TrialRecord&) = nullptr;
   Value (*of_response)(const Response&) = nullptr;
@@ -96,6 +99,9 @@ std::vector<Kept> KeptIn(const std::vector<Column>& columns, const std::string& 
 // The SQL that adds the columns version `version` brought to sessions, trials, responses and protocol_versions
 // ("ALTER TABLE T ADD COLUMN C TYPE CHECK (...);" each).
 std::string AddColumnsSql(const std::vector<Column>& columns, int version);
+
+// "a = DERIVE, b = DERIVE" for the columns of `table` version 7 added: DeriveTypedColumns' UPDATE.
+std::string DerivedColumnsSql(const std::vector<Column>& columns, const std::string& table);
 
 // ", a, b" and ", ?, ?" for the typed columns (version 7 on) of `table`: the INSERT's part this table generates.
 std::string InsertNames(const std::vector<Column>& columns, const std::string& table);

@@ -80,6 +80,12 @@ TEST(Columns, EachNameIsDefinedOnce) {
     if (c.place != Place::kVariable && c.place != Place::kNone && c.cell != Cell::kAnswer) {
       EXPECT_FALSE(c.select.empty() && c.at.table.empty()) << c.name << " is read from nowhere";
     }
+    // A column of the typed record says how a row of an older record gets it (DeriveTypedColumns).
+    for (const Stored* stored : {&c.at, &c.shown}) {
+      if (stored->since == 7) {
+        EXPECT_FALSE(stored->derive.empty()) << c.name << " in " << stored->table;
+      }
+    }
   }
 }
 

@@ -181,47 +181,16 @@ std::vector<Migration> MakeMigrations() {
 void DeriveTypedColumns(Database& db) {
   // Sessions: the free-text display said "window ..." or "headless ..." and, for a simulated observer, "; observer
   // sim:..." at its end.
-  db.Exec("UPDATE sessions SET window = (display LIKE 'window%'), "
-          "observer = CASE WHEN instr(display, '; observer ') > 0 THEN 'simulated' ELSE 'person' END, "
-          "observer_params = CASE WHEN instr(display, '; observer ') > 0 "
-          "  THEN substr(display, instr(display, '; observer ') + 11) ELSE '' END, "
-          "profile_name = json_extract(display_profile, '$.name'), "
-          "screen_width_mm = json_extract(display_profile, '$.width_mm'), "
-          "screen_height_mm = json_extract(display_profile, '$.height_mm'), "
-          "viewing_distance_mm = json_extract(display_profile, '$.distance_mm'), "
-          "px_per_deg = json_extract(display_profile, '$.px_per_deg') "
-          "WHERE observer IS NULL");
+  // Each column as the table derives it (columns.h Stored::derive).
+  db.Exec("UPDATE sessions SET " + DerivedColumnsSql(RecordColumns(), "sessions") + " WHERE observer IS NULL");
   db.Exec("INSERT OR IGNORE INTO session_info (session_id, key, value) "
           "SELECT s.id, j.key, CASE j.type WHEN 'text' THEN j.value ELSE json_quote(j.value) END "
           "FROM sessions s, json_each(s.participant_info) j "
           "WHERE json_valid(s.participant_info) AND json_type(s.participant_info) = 'object'");
   // Trials: the variables the runner wrote into the factors text, and each side's source from what was shown.
-  auto source = [](const std::string& column) {
-    return "CASE json_type(" + column + ") WHEN 'text' THEN json_extract(" + column + ", '$') "
-           "WHEN 'integer' THEN 'fixed_px' WHEN 'real' THEN 'fixed_px' "
-           "WHEN 'object' THEN CASE WHEN json_extract(" + column + ", '$.screen_px') IS NOT NULL "
-           "THEN 'fixed_screen_px' ELSE 'fixed_arcmin' END END";
-  };
-  auto fixed = [](const std::string& column) {
-    return "CASE json_type(" + column + ") WHEN 'integer' THEN json_extract(" + column + ", '$') "
-           "WHEN 'real' THEN json_extract(" + column + ", '$') "
-           "WHEN 'object' THEN coalesce(json_extract(" + column + ", '$.screen_px'), json_extract(" + column +
-           ", '$.arcmin')) END";
-  };
-  db.Exec("UPDATE trials SET "
-          "block_name = coalesce(json_extract(factors, '$.block_name'), ''), "
-          "task = CASE WHEN json_extract(factors, '$.start_level') IS NOT NULL THEN 'adjustment' "
-          "  ELSE 'forced_choice' END, "
-          "practice = coalesce(json_extract(factors, '$.practice'), 0) <> 0, "
-          "swapped = coalesce(json_extract(factors, '$.swapped'), 0) <> 0, "
-          "left_source = " + source("left_shown") + ", left_fixed = " + fixed("left_shown") + ", "
-          "right_source = " + source("right_shown") + ", right_fixed = " + fixed("right_shown") + ", "
-          "r_left_px = json_extract(factors, '$.r_left_px'), r_right_px = json_extract(factors, '$.r_right_px'), "
-          "r_scene_px = json_extract(factors, '$.r_scene_px') "
+  db.Exec("UPDATE trials SET " + DerivedColumnsSql(RecordColumns(), "trials") + " "
           "WHERE block_name IS NULL AND json_valid(factors) AND json_valid(left_shown) AND json_valid(right_shown)");
-  db.Exec("UPDATE responses SET level = json_extract(shown, '$.level'), "
-          "correct = json_extract(shown, '$.correct'), "
-          "r_left_px = json_extract(shown, '$.r_left_px'), r_right_px = json_extract(shown, '$.r_right_px') "
+  db.Exec("UPDATE responses SET " + DerivedColumnsSql(RecordColumns(), "responses") + " "
           "WHERE json_valid(shown) AND shown <> '{}' AND level IS NULL AND correct IS NULL");
 }
 

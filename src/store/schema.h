@@ -14,7 +14,9 @@ struct Migration {
   void (*data)(Database& db) = nullptr;
 };
 
-// The migrations, oldest first. A migration once shipped never changes: a new column is a new migration.
+// The migrations, oldest first. A migration once shipped never changes: a new column is a new migration. The typed
+// record's columns (version 7 on) are generated from the column table (columns.h: a row's `since`), and a version
+// whose rows need nothing more is generated whole.
 const std::vector<Migration>& Migrations();
 
 // PRAGMA application_id of every blurcue record ("BLcu"): SQLite's header field for telling file kinds apart.
