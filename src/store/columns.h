@@ -2,8 +2,8 @@
 // The record's columns as one table: every variable of a trial's row of trials.csv, defined once - its name, type,
 // unit, allowed values, meaning, where trials.csv puts it and how it is read (a column of the record, a variable the
 // runner records with the trial, or the answer) - with the typed columns the record keeps it in. Generated from it:
-// the schema's typed columns (the migrations to versions 7 and 8), the record's INSERT of a session's, a trial's and
-// a response's typed columns, the export's SELECT and cells, the codebook's rows, the names a design's level may not
+// the schema's typed columns (the migrations to versions 7 and 8, and how version 7 fills them in older rows), the
+// record's INSERT of a session's, a trial's and a response's typed columns, the export's SELECT and cells, the codebook's rows, the names a design's level may not
 // take (IsRecordedName) and the merge's column lists. Values the protocol allows (levels, ranges, choices) are not
 // here: the design table (design_columns) gives them per protocol version.
 #include <cstdint>
