@@ -1,7 +1,7 @@
 // The record's column table (columns.h) and what is generated from it for the schema, the INSERTs and the merge.
 #include "store/columns.h"
 
-#include <cmath>
+#include <optional>
 
 #include "core/error.h"
 #include "store/record.h"
