@@ -3,9 +3,10 @@
 // unit, allowed values, meaning, where trials.csv puts it and how it is read (a column of the record, a variable the
 // runner records with the trial, or the answer) - with the typed columns the record keeps it in. Generated from it:
 // the schema's typed columns (the migrations to versions 7 and 8, and how version 7 fills them in older rows), the
-// record's INSERT of a session's, a trial's and a response's typed columns, the export's SELECT and cells, the codebook's rows, the names a design's level may not
-// take (IsRecordedName) and the merge's column lists. Values the protocol allows (levels, ranges, choices) are not
-// here: the design table (design_columns) gives them per protocol version.
+// record's INSERT of a session's, a trial's and a response's typed columns, the export's SELECT and cells, the
+// codebook's rows, the names a design's level may not take (IsRecordedName) and the merge's column lists. Values the
+// protocol allows (levels, ranges, choices) are not here: the design table (design_columns) gives them per protocol
+// version. The columns of the tables beside trials.csv (frames.csv, adjustments.csv, summaries) are export_table.cc's.
 #include <cstdint>
 #include <string>
 #include <variant>
@@ -45,8 +46,8 @@ struct SessionValues {
 
 // A column of the record that keeps a variable: its table, SQL type and CHECK, and the schema version that added it.
 // Columns of version 7 on (the typed record) are added by migrations generated from this table, written by the
-// record's INSERTs through `of` (the one of its table) and copied by merge; older ones (`since` < 7) are the shipped
-// migrations' and the record writes them itself.
+// record's INSERTs through `of_*` (the one of its table) and copied by merge (but for the session number, which merge
+// gives again); older ones (`since` < 7) are the shipped migrations' and the record writes them itself.
 struct Stored {
   std::string table;   // "" (not kept), studies, protocol_versions, participants, sessions, trials or responses
   std::string column;  // "" = the variable's name
