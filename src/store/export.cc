@@ -16,6 +16,7 @@
 #include "core/hash.h"
 #include "core/json_io.h"
 #include "core/typed.h"
+#include "store/columns.h"
 #include "store/export_table.h"
 #include "store/record.h"
 #include "store/schema.h"
@@ -26,123 +27,27 @@
 namespace blurcue::store {
 namespace {
 
-// The fixed columns of trials.csv before the design's variables, and after them.
-const std::vector<ColumnDef>& TrialColumnsBefore() {
-  static const std::vector<ColumnDef> columns = {
-      {"study", "string", "", "", "the protocol's name"},
-      {"protocol_hash", "string", "", "16 hex digits", "FNV-1a-64 of the protocol's canonical text: its version"},
-      {"protocol_version", "integer", "", ">= 1",
-       "the protocol's declared \"version\" the session ran (one text per version of a study)"},
-      {"participant", "string", "", "", "the participant's id"},
-      {"observer", "string", "", "person|simulated", "who answered: a person, or blurcue's simulated observer"},
-      {"observer_params", "string", "", "", "the simulated observer's parameters (sim:model=arcmin,... or sim:model=pixel,...; before model= existed sim:jnd=..., the pixel model); empty for a person"},
-      {"window", "boolean", "", "0|1", "1: shown in a real window on the real clock; 0: headless on a simulated clock"},
-      {"session_id", "integer", "", ">= 1", "the session's id in this record (merged records renumber it)"},
-      {"session_number", "integer", "", ">= 1", "the participant's n-th session of this study, in the order started"},
-      {"session_status", "string", "", "running|completed|aborted",
-       "the session's status when exported: running (unfinished: stopped, killed or still being written; blurcue "
-       "report leaves its answers out unless --include-unfinished), "
-       "completed, or aborted (closed with blurcue sessions --abort; blurcue report leaves its answers out unless "
-       "--include-aborted)"},
-      {"seed", "string", "", "s followed by 1-20 digits",
-       "the seed of the session's trial order, a 64-bit unsigned integer written with a leading s so that spreadsheets, "
-       "R and JavaScript keep every digit; blurcue run --seed takes it as written"},
-  };
-  return columns;
+// trials.csv's columns of one place, in the column table's order (columns.h), as the codebook defines them.
+std::vector<ColumnDef> Defs(const std::vector<Column>& table, Place place) {
+  std::vector<ColumnDef> defs;
+  for (const Column& c : table)
+    if (c.place == place) defs.push_back({c.name, c.type, c.unit, c.allowed, c.meaning});
+  return defs;
 }
 
-const std::vector<ColumnDef>& TrialColumnsDesign() {
-  static const std::vector<ColumnDef> columns = {
-      {"trial_index", "integer", "", ">= 0", "the trial's place in the session, practice included, from 0"},
-      {"block", "integer", "", ">= 0", "the block's place in the protocol's list of blocks, from 0"},
-      {"block_name", "string", "", "", "the block's name"},
-      {"task", "string", "", "forced_choice|adjustment|yes_no|rating", "the trial's task"},
-      {"practice", "boolean", "", "0|1", "1: a practice trial (not scored)"},
-      {"swapped", "boolean", "", "0|1", "1: left and right exchanged against the design (counterbalancing)"},
-      {"cell", "string", "", "",
-       "a procedure trial's cell by its levels (NAME=LEVEL;... of its block's factors): its own track and threshold; "
-       "empty outside a procedure and in records made before cells were recorded"},
-  };
-  return columns;
+// The runner's variable named `key` (session/recording.h TrialVariables), or null: any other key of a trial's
+// variables is a level of the protocol's design (or a column of its conditions table, or a level's value).
+const Column* RecordedVariable(const std::vector<Column>& table, const std::string& key) {
+  for (const Column& c : table)
+    if (c.place == Place::kVariable && c.name == key) return &c;
+  return nullptr;
 }
 
-const std::vector<ColumnDef>& TrialColumnsAfter() {
-  static const std::string sources = "none|measured|measured_section|estimated|fitted|fixed_px|fixed_screen_px|fixed_arcmin";
-  static const std::vector<ColumnDef> columns = {
-      {"left_source", "string", "", sources, "the left side's blur source (the single layout's object); empty: none shown"},
-      {"left_fixed", "number", "the source's unit", ">= 0", "a fixed_* left source's radius, in the unit its name says"},
-      {"right_source", "string", "", sources, "the right side's blur source; empty: none shown"},
-      {"right_fixed", "number", "the source's unit", ">= 0", "a fixed_* right source's radius, in the unit its name says"},
-      {"status", "string", "", "answered|timed_out|skipped|unanswered",
-       "answered; timed_out: no answer before the deadline; skipped: not shown (a stopped procedure, a practice "
-       "criterion met); unanswered: not reached"},
-      {"chosen_side", "string", "", "left|right|cant_tell",
-       "forced choice of a pair: the side chosen (two intervals: left = the first, right = the second)"},
-      {"chose_more_blurred", "boolean", "", "0|1",
-       "forced choice of a pair: 1 when the side chosen showed the larger blur radius; empty when the radii were "
-       "equal or no side was chosen"},
-      {"chosen_interval", "integer", "", "1..alternatives", "odd one out: the interval named"},
-      {"yes_no", "string", "", "yes|no", "yes_no task: the answer"},
-      {"rating", "integer", "", "1..points", "rating task: the point of the scale chosen (1 the lowest)"},
-      {"adjusted_level", "number", "the adjusted parameter's unit", "", "adjustment: the level accepted"},
-      {"correct", "boolean", "", "0|1", "1: the answer was correct (procedure trials, odd one out); empty where no answer is correct"},
-      {"rt_ms", "number", "ms", ">= 0", "response time from the stimulus's first frame; empty without an answer"},
-      {"answered_at", "datetime", "", "", "when the answer was recorded (UTC)"},
-  };
-  return columns;
-}
-
-// What the runner records beside the factor levels (session/stimulus.h TrialVariables): the codebook's words for
-// them. Any other column is a factor of the protocol (or a column of its conditions table, or a level's value).
-const std::map<std::string, ColumnDef>& KnownVariables() {
-  static const std::map<std::string, ColumnDef> known = [] {
-    std::map<std::string, ColumnDef> m;
-    auto add = [&](const std::string& name, const std::string& type, const std::string& unit, const std::string& meaning) {
-      m[name] = {name, type, unit, "", meaning};
-    };
-    for (const std::string side : {"left", "right", "scene"}) {
-      const std::string what = side == "scene" ? "the scene's own blur at the object's place (the fitted model; depth "
-                                                 "matching: the real picture's, the thin lens of content.real_camera)"
-                                               : "the " + side + " object's blur radius";
-      add("r_" + side + "_px", "number", "photo px", what + ", as the camera makes it (moving: averaged over the run)");
-      add("r_" + side + "_screen_px", "number", "screen px", what + ", on the screen");
-      add("r_" + side + "_arcmin", "number", "arcmin", what + ", at the eye");
-    }
-    add("screen_px_per_photo_px", "number", "screen px / photo px", "how the photo was scaled onto the screen");
-    add("kernel", "string", "", "the blur kernel (gaussian | disc)");
-    add("blur_plan", "string", "", "one_radius: each object blurred with one radius; per_pixel: by depth");
-    add("r_span_screen_px", "number", "screen px", "the largest change of a radius across an object's depth");
-    add("size_left_deg", "number", "deg", "the left object's largest extent on screen at onset");
-    add("size_right_deg", "number", "deg", "the right object's largest extent on screen at onset");
-    add("brightness", "number", "", "the object's brightness matching (factor of its texture's values)");
-    add("contrast", "number", "", "the object's contrast matching");
-    add("white_balance_r", "number", "", "the object's red gain in linear light");
-    add("white_balance_g", "number", "", "the object's green gain in linear light");
-    add("white_balance_b", "number", "", "the object's blue gain in linear light");
-    add("start_level", "number", "the adjusted parameter's unit", "adjustment: the level shown first");
-    add("adjust_levels", "string", "the adjusted parameter's unit",
-        "adjustment: the levels in the order the next key steps through them (cyclic), separated by ;");
-    add("picture_width_arcmin", "number", "arcmin",
-        "depth matching: the virtual picture's width at the eye (a cut-off c's blur is r = 2 x 0.1874 x this / c)");
-    add("procedure_cell", "integer", "", "a procedure trial: which crossing of its block's factors (its own procedure)");
-    add("test_side", "string", "", "a procedure trial: the side (or odd-one-out interval) showing the procedure's level");
-    add("level", "number", "the procedure's variable", "a procedure trial: the level shown");
-    add("reversals", "integer", "", "a staircase trial: the staircase's reversals before this answer (or when it stopped)");
-    add("skipped", "string", "", "why a trial was not shown (stop rule: its staircase had ended)");
-    add("posterior_threshold", "number", "the procedure's variable",
-        "a QUEST+ trial: the posterior mean of the threshold after this answer (its running estimate)");
-    add("posterior_slope", "number", "", "a QUEST+ trial: the posterior mean of the slope after this answer");
-    add("round", "integer", "", "a practice block run until a criterion: which run of its design (from 1)");
-    add("odd_interval", "integer", "", "odd one out: the interval that showed the right side's object (the correct answer)");
-    add("intervals", "integer", "", "odd one out: intervals per trial");
-    return m;
-  }();
-  return known;
-}
-
-// Columns of the design written from the record's typed columns, not from the factors' text.
-bool TypedVariable(const std::string& key) {
-  return key == "practice" || key == "swapped" || key == "block_name" || key == "correct";
+// A variable the runner writes both in the trial's variables and in a typed column: exported from the typed column.
+bool TypedVariable(const std::vector<Column>& table, const std::string& key) {
+  for (const Column& c : table)
+    if (c.in_variables && c.name == key) return true;
+  return false;
 }
 
 // A variable's cell: strings bare, null empty, numbers as JSON; an object level (a pattern) by its id, else its
@@ -249,9 +154,8 @@ bool IsRecordedName(const std::string& name) {
   // the table and its codebook are written from, so a column added there is reserved here without another list.
   static const std::set<std::string> names = [] {
     std::set<std::string> n = {"group"};
-    for (const auto* list : {&TrialColumnsBefore(), &TrialColumnsDesign(), &TrialColumnsAfter()})
-      for (const auto& c : *list) n.insert(c.name);
-    for (const auto& [name, definition] : KnownVariables()) n.insert(name);
+    for (const Column& c : RecordColumns())
+      if (c.place != Place::kNone) n.insert(c.name);
     return n;
   }();
   return names.count(name) > 0 || name.rfind("info_", 0) == 0;
@@ -261,6 +165,11 @@ std::string DesignColumn(const std::string& name) { return IsRecordedName(name) 
 
 int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::path& out_dir,
                   const ProgressNote& note) {
+  return ExportCsvWith(RecordColumns(), db_path, out_dir, note);
+}
+
+int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::path& db_path,
+                      const std::filesystem::path& out_dir, const ProgressNote& note) {
   Note(note, RemoveStaleLeftovers(out_dir));
   Database source(db_path, OpenMode::kReadOnly);
   RequireReadableRecord(source);
@@ -293,7 +202,7 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
         if (!object.is_object())
           throw InputError(where, std::string(column == 2 ? "factors" : "shown") + " must be a JSON object");
         for (const auto& item : object.items())
-          if (!TypedVariable(item.key())) keys[item.key()].Add(item.value());
+          if (!TypedVariable(table, item.key())) keys[item.key()].Add(item.value());
       }
     }
   }
@@ -319,93 +228,66 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
   }
 
   // The header and the codebook, from the same definitions.
-  std::vector<ColumnDef> columns = TrialColumnsBefore();
+  std::vector<ColumnDef> columns = Defs(table, Place::kSession);
   if (groups) columns.push_back({"group", "string", "", "", "the between-subject group the session ran"});
   for (const auto& [key, type] : info_keys)
     columns.push_back({"info_" + key, type.Type(), "", type.Allowed(), "participant information: " + key});
-  columns.insert(columns.end(), TrialColumnsDesign().begin(), TrialColumnsDesign().end());
+  const std::vector<ColumnDef> trial_columns = Defs(table, Place::kTrial);
+  columns.insert(columns.end(), trial_columns.begin(), trial_columns.end());
   std::vector<std::string> variable_names;
   for (const auto& [key, type] : keys) {
     // A recorded variable keeps its name; a level named like one (the runner records it as factor_NAME; a record of
     // before that holds it under its own name where no recorded variable took it) gets the same prefix.
-    const auto known = KnownVariables().find(key);
-    const std::string name = known != KnownVariables().end() ? key : DesignColumn(key);
+    const Column* known = RecordedVariable(table, key);
+    const std::string name = known ? key : DesignColumn(key);
     variable_names.push_back(key);
     const std::string level = key.rfind("factor_", 0) == 0 && IsRecordedName(key.substr(7)) ? key.substr(7) : key;
     // A recorded measurement takes any value; a name (kernel, plan) or a level of the design one of those seen.
-    if (known != KnownVariables().end())
-      columns.push_back({name, known->second.type, known->second.unit,
-                         known->second.type == "string" ? type.Allowed() : "", known->second.meaning});
+    if (known)
+      columns.push_back({name, known->type, known->unit,
+                         !known->allowed.empty() ? known->allowed : known->type == "string" ? type.Allowed() : "",
+                         known->meaning});
     else
       columns.push_back({name, type.Type(), "", type.Allowed(),
                          "a level of the protocol's design: factor " + level + " (or a column of a level or of the "
                          "conditions table)" + (name == key && level == key ? "" : "; named " + name +
                          " because trials.csv has a column " + level + " of its own")});
   }
-  columns.insert(columns.end(), TrialColumnsAfter().begin(), TrialColumnsAfter().end());
+  const std::vector<ColumnDef> answer_columns = Defs(table, Place::kAnswer);
+  columns.insert(columns.end(), answer_columns.begin(), answer_columns.end());
   ApplyDesign(db, &columns);
   std::vector<std::string> header;
   for (const auto& c : columns) header.push_back(c.name);
   std::string text = CsvLine(header);
   std::string adjustments = CsvLine({"study", "participant", "session_id", "trial_index", "step", "level", "t_ms"});
 
-  Statement rows(db,
-                 "SELECT st.name, pv.hash, p.code, s.id, s.seed, t.trial_index, t.block, t.factors, "
-                 "t.block_name, t.task, t.practice, t.swapped, t.left_source, t.left_fixed, t.right_source, "
-                 "t.right_fixed, coalesce(r.r_left_px, t.r_left_px), coalesce(r.r_right_px, t.r_right_px), "
-                 "r.id IS NULL, r.choice, r.rt_ms, r.answered_at, r.adjustment, coalesce(r.shown, '{}'), r.correct, "
-                 "s.group_name, s.observer, s.observer_params, s.window, s.status, pv.version, s.session_number, "
-                 "t.cell "
-                 "FROM trials t JOIN sessions s ON s.id = t.session_id "
+  // What every row needs (who, which trial, its variables, the answer and the radii it is judged by), then each
+  // column of the table that is read from the record, as it says (SelectOf), at `at[column]`.
+  std::string select = "SELECT st.name, p.code, s.id, t.trial_index, t.factors, coalesce(r.shown, '{}'), r.id IS NULL, "
+                       "r.choice, coalesce(t.task, ''), coalesce(r.r_left_px, t.r_left_px), "
+                       "coalesce(r.r_right_px, t.r_right_px), r.adjustment, s.group_name";
+  std::map<const Column*, int> at;
+  int next = 13;
+  for (const Column& c : table)
+    if (c.place != Place::kVariable && c.place != Place::kNone && c.cell != Cell::kAnswer) {
+      select += ", " + SelectOf(c);
+      at[&c] = next++;
+    }
+  Statement rows(db, select +
+                 " FROM trials t JOIN sessions s ON s.id = t.session_id "
                  "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
                  "JOIN protocol_versions pv ON pv.id = s.protocol_version_id "
                  "LEFT JOIN responses r ON r.trial_id = t.id "
                  "ORDER BY st.name, p.code, s.id, t.trial_index");
   int64_t count = 0;
-  auto optional_number = [&](int column) { return rows.IsNull(column) ? std::string() : Number(rows.GetDouble(column)); };
   while (rows.Step()) {
-    const int64_t session = rows.GetInt64(3);
-    const int64_t trial = rows.GetInt64(5);
+    const int64_t session = rows.GetInt64(2);
+    const int64_t trial = rows.GetInt64(3);
     const std::string where = Where(db_path, session, trial);
-    std::vector<std::string> cells = {rows.GetText(0),
-                                      rows.GetText(1),
-                                      std::to_string(rows.GetInt64(30)),
-                                      rows.GetText(2),
-                                      rows.IsNull(26) ? "person" : rows.GetText(26),
-                                      rows.IsNull(27) ? "" : rows.GetText(27),
-                                      rows.IsNull(28) ? "" : std::to_string(rows.GetInt64(28)),
-                                      std::to_string(session),
-                                      std::to_string(rows.GetInt64(31)),
-                                      rows.GetText(29),
-                                      "s" + std::to_string(static_cast<uint64_t>(rows.GetInt64(4)))};
-    if (groups) cells.push_back(rows.GetText(25));
-    for (const auto& [key, type] : info_keys) {
-      const auto& info = info_of[session];
-      const auto it = info.find(key);
-      cells.push_back(it == info.end() ? std::string() : it->second);
-    }
-    cells.push_back(std::to_string(trial));
-    cells.push_back(std::to_string(rows.GetInt64(6)));
-    cells.push_back(rows.IsNull(8) ? "" : rows.GetText(8));
-    const std::string task = rows.IsNull(9) ? "" : rows.GetText(9);
-    cells.push_back(task);
-    cells.push_back(rows.IsNull(10) ? "0" : std::to_string(rows.GetInt64(10)));
-    cells.push_back(rows.IsNull(11) ? "0" : std::to_string(rows.GetInt64(11)));
-    cells.push_back(rows.IsNull(32) ? "" : rows.GetText(32));
-    // The plan's variables, with what the trial showed when it was shown laid over them (adaptive levels).
-    Json factors = ParseColumn(rows.GetText(7), where + " factors");
-    const Json shown = ParseColumn(rows.GetText(23), where + " shown");
-    if (factors.is_object() && shown.is_object())
-      for (const auto& [key, value] : shown.items()) factors[key] = value;
-    for (const auto& key : variable_names)
-      cells.push_back(factors.contains(key) ? TidyCell(factors.at(key)) : std::string());
-    cells.push_back(rows.IsNull(12) ? "" : rows.GetText(12));
-    cells.push_back(optional_number(13));
-    cells.push_back(rows.IsNull(14) ? "" : rows.GetText(14));
-    cells.push_back(optional_number(15));
     // The answer, split by what it is: one column per kind of answer, each of one type.
-    const bool answered = rows.GetInt64(18) == 0;
-    const std::string choice = answered ? rows.GetText(19) : "";
+    const bool answered = rows.GetInt64(6) == 0;
+    const std::string choice = answered ? rows.GetText(7) : "";
+    const std::string task = rows.GetText(8);
     const std::string status = !answered                  ? "unanswered"
                                : choice == kChoiceNone    ? "timed_out"
                                : choice == kChoiceSkipped ? "skipped"
@@ -418,23 +300,61 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
       else if (AllDigits(choice)) interval = choice;
       else side = choice;
     }
-    if ((side == "left" || side == "right") && !rows.IsNull(16) && !rows.IsNull(17)) {
-      const double l = rows.GetDouble(16), r = rows.GetDouble(17);
+    if ((side == "left" || side == "right") && !rows.IsNull(9) && !rows.IsNull(10)) {
+      const double l = rows.GetDouble(9), r = rows.GetDouble(10);
       if (std::abs(l - r) > 1e-9) more_blurred = ((side == "left") == (l > r)) ? "1" : "0";
     }
-    // Scored once, when the answer was given (records from before: by the migration to schema 8), never here.
-    const std::string correct = rows.IsNull(24) ? "" : std::to_string(rows.GetInt64(24));
-    for (const std::string& cell : {status, side, more_blurred, interval, yes_no, rating, level, correct})
-      cells.push_back(cell);
-    cells.push_back(answered && !rows.IsNull(20) ? Number(rows.GetDouble(20)) : "");
-    cells.push_back(answered ? rows.GetText(21) : "");
+    // A column's cell as the table says it is read.
+    auto cell = [&](const Column& c) -> std::string {
+      switch (c.answer) {
+        case Answer::kStatus: return status;
+        case Answer::kChosenSide: return side;
+        case Answer::kChoseMoreBlurred: return more_blurred;
+        case Answer::kChosenInterval: return interval;
+        case Answer::kYesNo: return yes_no;
+        case Answer::kRating: return rating;
+        case Answer::kAdjustedLevel: return level;
+        case Answer::kNone: break;
+      }
+      const int i = at.at(&c);
+      if (rows.IsNull(i)) return c.if_null;
+      switch (c.cell) {
+        case Cell::kInteger: return std::to_string(rows.GetInt64(i));
+        case Cell::kNumber: return Number(rows.GetDouble(i));
+        case Cell::kSeed: return "s" + std::to_string(static_cast<uint64_t>(rows.GetInt64(i)));
+        case Cell::kText:
+        case Cell::kAnswer: break;
+      }
+      return rows.GetText(i);
+    };
+    auto cells_of = [&](Place place, std::vector<std::string>* cells) {
+      for (const Column& c : table)
+        if (c.place == place) cells->push_back(cell(c));
+    };
+    std::vector<std::string> cells;
+    cells_of(Place::kSession, &cells);
+    if (groups) cells.push_back(rows.GetText(12));
+    for (const auto& [key, type] : info_keys) {
+      const auto& info = info_of[session];
+      const auto it = info.find(key);
+      cells.push_back(it == info.end() ? std::string() : it->second);
+    }
+    cells_of(Place::kTrial, &cells);
+    // The plan's variables, with what the trial showed when it was shown laid over them (adaptive levels).
+    Json factors = ParseColumn(rows.GetText(4), where + " factors");
+    const Json shown = ParseColumn(rows.GetText(5), where + " shown");
+    if (factors.is_object() && shown.is_object())
+      for (const auto& [key, value] : shown.items()) factors[key] = value;
+    for (const auto& key : variable_names)
+      cells.push_back(factors.contains(key) ? TidyCell(factors.at(key)) : std::string());
+    cells_of(Place::kAnswer, &cells);
     text += CsvLine(cells);
     // The adjustment path, long: one row per step.
-    if (answered && !rows.IsNull(22)) {
-      const Json steps = ParseColumn(rows.GetText(22), where + " adjustment");
+    if (answered && !rows.IsNull(11)) {
+      const Json steps = ParseColumn(rows.GetText(11), where + " adjustment");
       if (steps.is_array())
         for (size_t i = 0; i < steps.size(); ++i)
-          adjustments += CsvLine({rows.GetText(0), rows.GetText(2), std::to_string(session), std::to_string(trial),
+          adjustments += CsvLine({rows.GetText(0), rows.GetText(1), std::to_string(session), std::to_string(trial),
                                   std::to_string(i + 1), steps[i].is_object() ? TidyCell(steps[i].value("level", Json())) : "",
                                   steps[i].is_object() ? TidyCell(steps[i].value("t_ms", Json())) : ""});
     }

@@ -39,6 +39,11 @@ std::string CsvLine(const std::vector<std::string>& cells);
 // Removes a database file and its -wal, -shm and -journal (never throws).
 void RemoveDatabaseFiles(const std::filesystem::path& path);
 
+struct Column;
+// ExportCsv with the record's columns given (RecordColumns(), or a test's table with a column more).
+int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::path& db_path,
+                      const std::filesystem::path& out_dir, const ProgressNote& note);
+
 // Per study, one row per session: trials planned and answered (practice apart), the median response time, and
 // how often each answer was given - for forced choice the source chosen (the one shown on the side picked) or
 // cant_tell, for adjustment the level accepted. Writes OUT/SummaryFileName(STUDY) for every study and returns the

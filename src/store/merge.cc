@@ -9,6 +9,7 @@
 #include "core/names.h"
 #include "core/typed.h"
 #include "store/export.h"
+#include "store/columns.h"
 #include "store/export_table.h"
 #include "store/record.h"
 #include "store/schema.h"
@@ -17,35 +18,48 @@
 namespace blurcue::store {
 namespace {
 
-// Schema 7's typed columns of one table (schema.h TypedColumns): copied as they are from an input of version 7 or
-// later; derived from the texts (DeriveTypedColumns) for an older one.
-std::vector<TypedColumn> TypedColumnsOf(const std::string& table) {
-  std::vector<TypedColumn> out;
-  for (const TypedColumn& c : TypedColumns())
-    if (table == c.table) out.push_back(c);
-  return out;
-}
-// ", a, b, c" for a SELECT or INSERT column list; empty for an input before version 7.
-std::string TypedList(const std::string& table, bool typed) {
+// The typed columns (schema 7 on) the column table keeps in `table` (columns.h), as a SELECT list for an input of
+// schema `version`: NULL for a column it predates (DeriveTypedColumns and DeriveVersionsAndNumbers fill those from
+// its texts, as a migration would); CopiedNames and CopiedPlaceholders give the INSERT's.
+std::string TypedSelect(const std::string& table, int version) {
   std::string list;
-  if (typed)
-    for (const auto& c : TypedColumnsOf(table)) list += std::string(", ") + c.name;
+  for (const Kept& kept : KeptIn(RecordColumns(), table, 7))
+    list += ", " + (version >= kept.stored->since ? kept.name : std::string("NULL"));
   return list;
 }
-std::string TypedPlaceholders(const std::string& table, bool typed) {
-  std::string list;
-  if (typed)
-    for (size_t i = 0; i < TypedColumnsOf(table).size(); ++i) list += ", ?";
-  return list;
+// Where `name` is among TypedSelect's columns of `table`, from 0.
+int TypedIndex(const std::string& table, const std::string& name) {
+  const std::vector<Kept> kept = KeptIn(RecordColumns(), table, 7);
+  for (size_t i = 0; i < kept.size(); ++i)
+    if (kept[i].name == name) return int(i);
+  throw Error(ErrorKind::kInternal, "merge: no typed column " + table + "." + name);
 }
-// Binds the typed columns read from `from` (starting at column `first`) to `to` (starting at parameter `at`).
-void CopyTyped(const std::string& table, bool typed, Statement& from, int first, Statement& to, int at) {
-  if (!typed) return;
-  for (const auto& c : TypedColumnsOf(table)) {
-    const std::string type = c.type;
+// A session's number is read but not copied: a participant's sessions from several inputs are numbered again.
+bool Renumbered(const Kept& kept) { return kept.stored->table == "sessions" && kept.name == "session_number"; }
+// ", a, b" and ", ?, ?" for the typed columns an INSERT of `table` copies.
+std::string CopiedNames(const std::string& table) {
+  std::string names;
+  for (const Kept& kept : KeptIn(RecordColumns(), table, 7))
+    if (!Renumbered(kept)) names += ", " + kept.name;
+  return names;
+}
+std::string CopiedPlaceholders(const std::string& table) {
+  std::string marks;
+  for (const Kept& kept : KeptIn(RecordColumns(), table, 7))
+    if (!Renumbered(kept)) marks += ", ?";
+  return marks;
+}
+// Binds the typed columns read from `from` (TypedSelect's, starting at column `first`) that are copied to `to`
+// (starting at parameter `at`).
+void CopyTyped(const std::string& table, Statement& from, int first, Statement& to, int at) {
+  for (const Kept& kept : KeptIn(RecordColumns(), table, 7)) {
+    if (Renumbered(kept)) {
+      ++first;
+      continue;
+    }
     if (from.IsNull(first)) to.BindNull(at);
-    else if (type == "TEXT") to.Bind(at, from.GetText(first));
-    else if (type == "REAL") to.Bind(at, from.GetDouble(first));
+    else if (kept.stored->sql == "TEXT") to.Bind(at, from.GetText(first));
+    else if (kept.stored->sql == "REAL") to.Bind(at, from.GetDouble(first));
     else to.Bind(at, from.GetInt64(first));
     ++first, ++at;
   }
@@ -147,16 +161,21 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
         src.Exec("BEGIN");
         CheckSessionsToMerge(src, input, &unfinished);
         std::map<int64_t, int64_t> study_ids, protocol_ids, participant_ids, session_ids, trial_ids;
-        const bool typed = SchemaVersion(src) >= 7;
+        const int version = SchemaVersion(src);
 
         Statement studies(src, "SELECT id, name, created FROM studies");
         while (studies.Step())
           study_ids[studies.GetInt64(0)] = EnsureStudy(dst, studies.GetText(1), studies.GetText(2));
 
-        const bool v8 = SchemaVersion(src) >= 8;
-        Statement protocols(src, std::string("SELECT id, study_id, json, hash, created, ") +
-                                     (v8 ? "version" : "NULL") + " FROM protocol_versions");
-        Statement set_version(dst, "UPDATE protocol_versions SET version = ? WHERE id = ? AND version IS NULL");
+        const bool v8 = version >= 8;
+        // A protocol version's typed columns: given by the first input that has them.
+        std::string set_typed;
+        for (const Kept& kept : KeptIn(RecordColumns(), "protocol_versions", 7))
+          set_typed += (set_typed.empty() ? "" : ", ") + kept.name + " = coalesce(" + kept.name + ", ?)";
+        Statement protocols(src, "SELECT id, study_id, json, hash, created" + TypedSelect("protocol_versions", version) +
+                                     " FROM protocol_versions");
+        const int pv_typed = int(KeptIn(RecordColumns(), "protocol_versions", 7).size());
+        Statement set_version(dst, "UPDATE protocol_versions SET " + set_typed + " WHERE id = ?");
         while (protocols.Step()) {
           // An input of schema 1 holds raw texts: the merged record keys them by their canonical text, as run does.
           std::string json = protocols.GetText(2), hash = protocols.GetText(3);
@@ -170,12 +189,10 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
               dst, study_ids.at(protocols.GetInt64(1)), json, hash, protocols.GetText(4), &stored_json);
           if (stored_json != json)
             throw InputError(input.string(), "protocol hash " + hash + " names a different protocol text in another input");
-          if (!protocols.IsNull(5)) {
-            set_version.Bind(1, protocols.GetInt64(5));
-            set_version.Bind(2, protocol_ids[protocols.GetInt64(0)]);
-            set_version.Run();
-            set_version.Reset();
-          }
+          CopyTyped("protocol_versions", protocols, 5, set_version, 1);
+          set_version.Bind(pv_typed + 1, protocol_ids[protocols.GetInt64(0)]);
+          set_version.Run();
+          set_version.Reset();
         }
         if (v8) {
           // One design per protocol version: the first input that recorded it gives it.
@@ -246,17 +263,17 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
 
         Statement sessions(src, "SELECT id, participant_id, protocol_version_id, seed, software_version, host, "
                                 "display, started, ended, status, " +
-                                std::string(SchemaVersion(src) >= 3 ? "display_profile" : "'{}'") + ", " +
-                                std::string(SchemaVersion(src) >= 6 ? "group_name, participant_info" : "'', '{}'") +
-                                TypedList("sessions", typed) + (v8 ? ", session_number" : ", NULL") +
-                                " FROM sessions");
+                                std::string(version >= 3 ? "display_profile" : "'{}'") + ", " +
+                                std::string(version >= 6 ? "group_name, participant_info" : "'', '{}'") +
+                                TypedSelect("sessions", version) + " FROM sessions");
         Statement duplicate(dst, "SELECT id FROM sessions WHERE participant_id = ? AND protocol_version_id = ? "
                                  "AND seed = ? AND host = ? AND started = ?");
         Statement insert_session(dst, "INSERT INTO sessions (participant_id, protocol_version_id, seed, "
                                       "software_version, host, display, started, ended, status, display_profile, "
-                                      "group_name, participant_info" + TypedList("sessions", typed) +
+                                      "group_name, participant_info" + CopiedNames("sessions") +
                                       ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?" +
-                                      TypedPlaceholders("sessions", typed) + ")");
+                                      CopiedPlaceholders("sessions") + ")");
+        const int number_at = 13 + TypedIndex("sessions", "session_number");
         while (sessions.Step()) {
           const int64_t participant = participant_ids.at(sessions.GetInt64(1));
           const int64_t protocol = protocol_ids.at(sessions.GetInt64(2));
@@ -279,15 +296,14 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
           insert_session.Bind(10, sessions.GetText(10));
           insert_session.Bind(11, sessions.GetText(11));
           insert_session.Bind(12, sessions.GetText(12));
-          CopyTyped("sessions", typed, sessions, 13, insert_session, 13);
+          CopyTyped("sessions", sessions, 13, insert_session, 13);
           insert_session.Run();
           insert_session.Reset();
           session_ids[sessions.GetInt64(0)] = dst.LastInsertRowId();
-          if (!sessions.IsNull(13 + int(TypedColumnsOf("sessions").size()) * typed))
-            numbered[dst.LastInsertRowId()] = {input.string(), sessions.GetInt64(0),
-                                               sessions.GetInt64(13 + int(TypedColumnsOf("sessions").size()) * typed)};
+          if (!sessions.IsNull(number_at))
+            numbered[dst.LastInsertRowId()] = {input.string(), sessions.GetInt64(0), sessions.GetInt64(number_at)};
         }
-        if (typed) {
+        if (version >= 7) {
           Statement info(src, "SELECT session_id, key, value FROM session_info");
           Statement insert_info(dst, "INSERT INTO session_info (session_id, key, value) VALUES (?, ?, ?)");
           while (info.Step()) {
@@ -300,30 +316,27 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
         }
 
         Statement trials(src, "SELECT id, session_id, trial_index, block, factors, left_shown, right_shown" +
-                                  TypedList("trials", typed) + (v8 ? ", cell" : ", NULL") + " FROM trials");
+                                  TypedSelect("trials", version) + " FROM trials");
         Statement insert_trial(dst, "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, "
-                                    "right_shown" + TypedList("trials", typed) + ", cell) VALUES (?, ?, ?, ?, ?, ?" +
-                                    TypedPlaceholders("trials", typed) + ", ?)");
-        const int cell = 7 + int(TypedColumnsOf("trials").size()) * typed;
+                                    "right_shown" + CopiedNames("trials") + ") VALUES (?, ?, ?, ?, ?, ?" +
+                                    CopiedPlaceholders("trials") + ")");
         while (trials.Step()) {
           insert_trial.Bind(1, session_ids.at(trials.GetInt64(1)));
           insert_trial.Bind(2, trials.GetInt64(2));
           insert_trial.Bind(3, trials.GetInt64(3));
           for (int column = 4; column <= 6; ++column) insert_trial.Bind(column, trials.GetText(column));
-          CopyTyped("trials", typed, trials, 7, insert_trial, 7);
-          if (trials.IsNull(cell)) insert_trial.BindNull(cell);
-          else insert_trial.Bind(cell, trials.GetText(cell));
+          CopyTyped("trials", trials, 7, insert_trial, 7);
           insert_trial.Run();
           insert_trial.Reset();
           trial_ids[trials.GetInt64(0)] = dst.LastInsertRowId();
         }
 
         Statement responses(src, "SELECT trial_id, choice, rt_ms, adjustment, answered_at, " +
-                                     std::string(SchemaVersion(src) >= 5 ? "shown" : "'{}'") +
-                                     TypedList("responses", typed) + " FROM responses");
+                                     std::string(version >= 5 ? "shown" : "'{}'") +
+                                     TypedSelect("responses", version) + " FROM responses");
         Statement insert_response(dst, "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at, "
-                                       "shown" + TypedList("responses", typed) + ") VALUES (?, ?, ?, ?, ?, ?" +
-                                       TypedPlaceholders("responses", typed) + ")");
+                                       "shown" + CopiedNames("responses") + ") VALUES (?, ?, ?, ?, ?, ?" +
+                                       CopiedPlaceholders("responses") + ")");
         while (responses.Step()) {
           insert_response.Bind(1, trial_ids.at(responses.GetInt64(0)));
           insert_response.Bind(2, responses.GetText(1));
@@ -332,13 +345,13 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
           insert_response.Bind(4, responses.GetText(3));
           insert_response.Bind(5, responses.GetText(4));
           insert_response.Bind(6, responses.GetText(5));
-          CopyTyped("responses", typed, responses, 6, insert_response, 7);
+          CopyTyped("responses", responses, 6, insert_response, 7);
           insert_response.Run();
           insert_response.Reset();
         }
 
         Statement frames(src, "SELECT trial_id, frame_index, flip_time_s, dropped, " +
-                                  std::string(SchemaVersion(src) >= 4 ? "r_left_px, r_right_px, y_mm"
+                                  std::string(version >= 4 ? "r_left_px, r_right_px, y_mm"
                                                                       : "NULL, NULL, NULL") + " FROM frames");
         Statement insert_frame(dst, "INSERT INTO frames (trial_id, frame_index, flip_time_s, dropped, r_left_px, "
                                     "r_right_px, y_mm) VALUES (?, ?, ?, ?, ?, ?, ?)");

@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "core/typed.h"
 #include "core/json_io.h"
+#include "store/columns.h"
 #include "store/schema.h"
 
 #ifndef BLURCUE_VERSION
@@ -392,11 +393,13 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     // this one's session and counts it.
     start.group = meta.assign_group ? meta.assign_group(SessionsPerGroup(db_, study)) : meta.group;
 
+    // The typed columns (who answered, where, the display's geometry, the session's number) as the column table
+    // reads them (columns.h) from the session's description and the display profile it records whole.
     Statement insert(db_, "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, "
                           "host, display, started, status, lock_host, lock_pid, lock_token, lock_heartbeat_ms, "
-                          "display_profile, group_name, participant_info, observer, observer_params, window, "
-                          "profile_name, screen_width_mm, screen_height_mm, viewing_distance_mm, px_per_deg, session_number) "
-                          "VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+                          "display_profile, group_name, participant_info" + InsertNames(RecordColumns(), "sessions") +
+                          ") VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?" +
+                          InsertPlaceholders(RecordColumns(), "sessions") + ")");
     insert.Bind(1, participant_id);
     insert.Bind(2, protocol_id);
     insert.Bind(3, static_cast<int64_t>(seed));
@@ -411,26 +414,8 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     insert.Bind(12, meta.display_profile);
     insert.Bind(13, start.group);
     insert.Bind(14, meta.participant_info);
-    insert.Bind(15, meta.simulated ? "simulated" : "person");
-    insert.Bind(16, meta.observer_params);
-    insert.Bind(17, meta.window ? 1 : 0);
-    // The display profile's geometry, typed, from the profile the session records whole.
     const Json profile = ParseJson(meta.display_profile, "display profile");
-    auto number = [&](int column, const char* key) {
-      if (profile.is_object() && profile.contains(key) && profile[key].is_number())
-        insert.Bind(column, profile[key].get<double>());
-      else
-        insert.BindNull(column);
-    };
-    if (profile.is_object() && profile.contains("name") && profile["name"].is_string())
-      insert.Bind(18, profile["name"].get<std::string>());
-    else
-      insert.BindNull(18);
-    number(19, "width_mm");
-    number(20, "height_mm");
-    number(21, "distance_mm");
-    number(22, "px_per_deg");
-    insert.Bind(23, start.session_number);
+    BindTyped(RecordColumns(), insert, 15, SessionValues{meta, profile, start.session_number});
     insert.Run();
     start.session_id = db_.LastInsertRowId();
     // The participant information, one row per key (text as given; numbers as JSON text).
@@ -481,14 +466,11 @@ void Record::SaveTrialList(int64_t session, const std::vector<TrialRecord>& tria
   RequireLock(session);
   if (db_.QueryInt64("SELECT COUNT(*) FROM trials WHERE session_id = " + std::to_string(session)) > 0)
     throw InputError(db_.path(), SessionName(session) + " already has its trial list");
-  Statement insert(db_, "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, right_shown, "
-                        "block_name, practice, swapped, left_source, left_fixed, right_source, right_fixed, "
-                        "r_left_px, r_right_px, r_scene_px, task, cell) "
-                        "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
-  auto optional = [&](int column, const std::optional<double>& value) {
-    if (value) insert.Bind(column, *value);
-    else insert.BindNull(column);
-  };
+  // The typed columns (block name, task, flags, each side's source, the planned radii, the cell) as the column table
+  // reads them (columns.h).
+  Statement insert(db_, "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, right_shown" +
+                        InsertNames(RecordColumns(), "trials") + ") VALUES (?, ?, ?, ?, ?, ?" +
+                        InsertPlaceholders(RecordColumns(), "trials") + ")");
   for (const TrialRecord& trial : trials) {
     insert.Bind(1, session);
     insert.Bind(2, trial.index);
@@ -496,21 +478,7 @@ void Record::SaveTrialList(int64_t session, const std::vector<TrialRecord>& tria
     insert.Bind(4, trial.factors_json);
     insert.Bind(5, trial.left_json);
     insert.Bind(6, trial.right_json);
-    insert.Bind(7, trial.block_name);
-    insert.Bind(8, trial.practice ? 1 : 0);
-    insert.Bind(9, trial.swapped ? 1 : 0);
-    for (const auto& [column, json] : {std::pair<int, const std::string*>{10, &trial.left_json}, {12, &trial.right_json}}) {
-      const SourceColumns side = SourceColumns::Of(*json);
-      if (side.source.empty()) insert.BindNull(column);
-      else insert.Bind(column, side.source);
-      optional(column + 1, side.fixed);
-    }
-    optional(14, trial.r_left_px);
-    optional(15, trial.r_right_px);
-    optional(16, trial.r_scene_px);
-    insert.Bind(17, trial.task);
-    if (trial.cell.empty()) insert.BindNull(18);
-    else insert.Bind(18, trial.cell);
+    BindTyped(RecordColumns(), insert, 7, trial);
     insert.Run();
     insert.Reset();
   }
@@ -580,8 +548,9 @@ void Record::RecordResponse(int64_t session, int64_t trial_index, const Response
   if (existing.Step())
     throw InputError(db_.path(), SessionName(session) + " trial " + std::to_string(trial_index) +
                                      " already has a response (answered at " + existing.GetText(0) + ")");
-  Statement insert(db_, "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at, shown, level, "
-                        "correct, r_left_px, r_right_px) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  Statement insert(db_, "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at, shown" +
+                        InsertNames(RecordColumns(), "responses") + ") VALUES (?, ?, ?, ?, ?, ?" +
+                        InsertPlaceholders(RecordColumns(), "responses") + ")");
   insert.Bind(1, trial_id);
   insert.Bind(2, response.choice);
   if (std::isnan(response.rt_ms)) insert.BindNull(3);  // no answer before the deadline: no response time
@@ -589,15 +558,7 @@ void Record::RecordResponse(int64_t session, int64_t trial_index, const Response
   insert.Bind(4, response.adjustment_json);
   insert.Bind(5, response.answered_at.empty() ? NowIso8601() : response.answered_at);
   insert.Bind(6, response.shown_json);
-  auto optional = [&](int column, const std::optional<double>& value) {
-    if (value) insert.Bind(column, *value);
-    else insert.BindNull(column);
-  };
-  optional(7, response.level);
-  if (response.correct) insert.Bind(8, *response.correct ? 1 : 0);
-  else insert.BindNull(8);
-  optional(9, response.r_left_px);
-  optional(10, response.r_right_px);
+  BindTyped(RecordColumns(), insert, 7, response);  // the level, correctness and radii decided at the trial
   insert.Run();
   Statement frame(db_, "INSERT INTO frames (trial_id, frame_index, flip_time_s, dropped, r_left_px, r_right_px, "
                       "y_mm) VALUES (?, ?, ?, ?, ?, ?, ?)");

@@ -1,10 +1,12 @@
 #include "store/schema.h"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "core/error.h"
 #include "core/hash.h"
 #include "core/json_io.h"
+#include "store/columns.h"
 
 namespace blurcue::store {
 namespace {
@@ -140,26 +142,21 @@ std::vector<Migration> MakeMigrations() {
   //  trials: the block's name and task (forced_choice, adjustment, yes_no, rating), practice and swapped flags, each side's source (none, measured, measured_section,
   //  estimated, fitted, fixed_px, fixed_screen_px, fixed_arcmin) and fixed radius, the radii planned (photo px);
   //  responses: what an adaptive procedure showed and scored (level, correct) and the radii shown (photo px).
-  std::string typed;
-  for (const TypedColumn& c : TypedColumns()) {
-    typed += std::string("ALTER TABLE ") + c.table + " ADD COLUMN " + c.name + " " + c.type +
-             (*c.check ? std::string(" CHECK (") + c.check + ")" : std::string()) + ";";
-    if (std::string(c.name) == "px_per_deg")  // after the sessions' columns: the participant information
-      typed += "CREATE TABLE session_info ("
-               "  session_id INTEGER NOT NULL REFERENCES sessions(id),"
-               "  key TEXT NOT NULL,"
-               "  value TEXT NOT NULL,"
-               "  PRIMARY KEY (session_id, key))" + strict + ";";
-  }
-  steps.push_back({typed, &DeriveTypedColumns});
+  // Its columns are the column table's (columns.h) that say since 7; then the participant information's table.
+  steps.push_back({AddColumnsSql(RecordColumns(), 7) +
+                       "CREATE TABLE session_info ("
+                       "  session_id INTEGER NOT NULL REFERENCES sessions(id),"
+                       "  key TEXT NOT NULL,"
+                       "  value TEXT NOT NULL,"
+                       "  PRIMARY KEY (session_id, key))" + strict + ";",
+                   &DeriveTypedColumns});
   // 8: the design reaches the record. protocol_versions: the protocol's declared "version" (a study's texts differ
   // only under distinct versions from here on); sessions: the participant's n-th session of the study (decided with
   // the insert, in its transaction); trials: a procedure trial's cell by its levels ("edge=9"); design_columns: per
   // protocol version, every column the design puts in trials.csv with its role and the values the protocol allows.
-  steps.push_back({"ALTER TABLE protocol_versions ADD COLUMN version INTEGER CHECK (version >= 1);"
-                   "ALTER TABLE sessions ADD COLUMN session_number INTEGER CHECK (session_number >= 1);"
+  // The columns (protocol_versions.version, sessions.session_number, trials.cell) are the column table's since 8.
+  steps.push_back({AddColumnsSql(RecordColumns(), 8) +
                    "CREATE UNIQUE INDEX sessions_number ON sessions (participant_id, session_number);"
-                   "ALTER TABLE trials ADD COLUMN cell TEXT;"
                    "CREATE TABLE design_columns ("
                    "  protocol_version_id INTEGER NOT NULL REFERENCES protocol_versions(id),"
                    "  position INTEGER NOT NULL,"
@@ -170,84 +167,30 @@ std::vector<Migration> MakeMigrations() {
                    "  allowed TEXT NOT NULL,"
                    "  PRIMARY KEY (protocol_version_id, name))" + strict + ";",
                    &DeriveVersionsAndNumbers});
+  // 9 on: a typed column the column table adds with `since` N is migration N (NULL in the rows already there). A
+  // version that needs more (a table, a derivation from older texts) is written above as its own step.
+  int last = 0;
+  for (const Column& c : RecordColumns()) last = std::max({last, c.at.since, c.shown.since});
+  for (int version = int(steps.size()) + 1; version <= last; ++version)
+    steps.push_back({AddColumnsSql(RecordColumns(), version)});
   return steps;
 }
 
 }  // namespace
 
-const std::vector<TypedColumn>& TypedColumns() {
-  static const std::vector<TypedColumn> columns = {
-      {"sessions", "observer", "TEXT", "observer IN ('person', 'simulated')"},
-      {"sessions", "observer_params", "TEXT", ""},
-      {"sessions", "window", "INTEGER", "window IN (0, 1)"},
-      {"sessions", "profile_name", "TEXT", ""},
-      {"sessions", "screen_width_mm", "REAL", ""},
-      {"sessions", "screen_height_mm", "REAL", ""},
-      {"sessions", "viewing_distance_mm", "REAL", ""},
-      {"sessions", "px_per_deg", "REAL", ""},
-      {"trials", "block_name", "TEXT", ""},
-      {"trials", "task", "TEXT", ""},
-      {"trials", "practice", "INTEGER", "practice IN (0, 1)"},
-      {"trials", "swapped", "INTEGER", "swapped IN (0, 1)"},
-      {"trials", "left_source", "TEXT", ""},
-      {"trials", "left_fixed", "REAL", ""},
-      {"trials", "right_source", "TEXT", ""},
-      {"trials", "right_fixed", "REAL", ""},
-      {"trials", "r_left_px", "REAL", ""},
-      {"trials", "r_right_px", "REAL", ""},
-      {"trials", "r_scene_px", "REAL", ""},
-      {"responses", "level", "REAL", ""},
-      {"responses", "correct", "INTEGER", "correct IN (0, 1)"},
-      {"responses", "r_left_px", "REAL", ""},
-      {"responses", "r_right_px", "REAL", ""},
-  };
-  return columns;
-}
-
 void DeriveTypedColumns(Database& db) {
   // Sessions: the free-text display said "window ..." or "headless ..." and, for a simulated observer, "; observer
   // sim:..." at its end.
-  db.Exec("UPDATE sessions SET window = (display LIKE 'window%'), "
-          "observer = CASE WHEN instr(display, '; observer ') > 0 THEN 'simulated' ELSE 'person' END, "
-          "observer_params = CASE WHEN instr(display, '; observer ') > 0 "
-          "  THEN substr(display, instr(display, '; observer ') + 11) ELSE '' END, "
-          "profile_name = json_extract(display_profile, '$.name'), "
-          "screen_width_mm = json_extract(display_profile, '$.width_mm'), "
-          "screen_height_mm = json_extract(display_profile, '$.height_mm'), "
-          "viewing_distance_mm = json_extract(display_profile, '$.distance_mm'), "
-          "px_per_deg = json_extract(display_profile, '$.px_per_deg') "
-          "WHERE observer IS NULL");
+  // Each column as the table derives it (columns.h Stored::derive).
+  db.Exec("UPDATE sessions SET " + DerivedColumnsSql(RecordColumns(), "sessions") + " WHERE observer IS NULL");
   db.Exec("INSERT OR IGNORE INTO session_info (session_id, key, value) "
           "SELECT s.id, j.key, CASE j.type WHEN 'text' THEN j.value ELSE json_quote(j.value) END "
           "FROM sessions s, json_each(s.participant_info) j "
           "WHERE json_valid(s.participant_info) AND json_type(s.participant_info) = 'object'");
   // Trials: the variables the runner wrote into the factors text, and each side's source from what was shown.
-  auto source = [](const std::string& column) {
-    return "CASE json_type(" + column + ") WHEN 'text' THEN json_extract(" + column + ", '$') "
-           "WHEN 'integer' THEN 'fixed_px' WHEN 'real' THEN 'fixed_px' "
-           "WHEN 'object' THEN CASE WHEN json_extract(" + column + ", '$.screen_px') IS NOT NULL "
-           "THEN 'fixed_screen_px' ELSE 'fixed_arcmin' END END";
-  };
-  auto fixed = [](const std::string& column) {
-    return "CASE json_type(" + column + ") WHEN 'integer' THEN json_extract(" + column + ", '$') "
-           "WHEN 'real' THEN json_extract(" + column + ", '$') "
-           "WHEN 'object' THEN coalesce(json_extract(" + column + ", '$.screen_px'), json_extract(" + column +
-           ", '$.arcmin')) END";
-  };
-  db.Exec("UPDATE trials SET "
-          "block_name = coalesce(json_extract(factors, '$.block_name'), ''), "
-          "task = CASE WHEN json_extract(factors, '$.start_level') IS NOT NULL THEN 'adjustment' "
-          "  ELSE 'forced_choice' END, "
-          "practice = coalesce(json_extract(factors, '$.practice'), 0) <> 0, "
-          "swapped = coalesce(json_extract(factors, '$.swapped'), 0) <> 0, "
-          "left_source = " + source("left_shown") + ", left_fixed = " + fixed("left_shown") + ", "
-          "right_source = " + source("right_shown") + ", right_fixed = " + fixed("right_shown") + ", "
-          "r_left_px = json_extract(factors, '$.r_left_px'), r_right_px = json_extract(factors, '$.r_right_px'), "
-          "r_scene_px = json_extract(factors, '$.r_scene_px') "
+  db.Exec("UPDATE trials SET " + DerivedColumnsSql(RecordColumns(), "trials") + " "
           "WHERE block_name IS NULL AND json_valid(factors) AND json_valid(left_shown) AND json_valid(right_shown)");
-  db.Exec("UPDATE responses SET level = json_extract(shown, '$.level'), "
-          "correct = json_extract(shown, '$.correct'), "
-          "r_left_px = json_extract(shown, '$.r_left_px'), r_right_px = json_extract(shown, '$.r_right_px') "
+  db.Exec("UPDATE responses SET " + DerivedColumnsSql(RecordColumns(), "responses") + " "
           "WHERE json_valid(shown) AND shown <> '{}' AND level IS NULL AND correct IS NULL");
 }
 

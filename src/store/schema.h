@@ -14,7 +14,9 @@ struct Migration {
   void (*data)(Database& db) = nullptr;
 };
 
-// The migrations, oldest first. A migration once shipped never changes: a new column is a new migration.
+// The migrations, oldest first. A migration once shipped never changes: a new column is a new migration. The typed
+// record's columns (version 7 on) are generated from the column table (columns.h: a row's `since`), and a version
+// whose rows need nothing more is generated whole.
 const std::vector<Migration>& Migrations();
 
 // PRAGMA application_id of every blurcue record ("BLcu"): SQLite's header field for telling file kinds apart.
@@ -34,17 +36,6 @@ void RequireIntactPages(Database& db);
 
 // The schema version a fully migrated database reports (= Migrations().size()).
 int CurrentSchemaVersion();
-
-// A column schema 7 (the typed record) added to sessions, trials or responses: its SQL type and CHECK ("" none).
-struct TypedColumn {
-  const char* table;
-  const char* name;
-  const char* type;  // "TEXT" | "REAL" | "INTEGER"
-  const char* check;
-};
-// Schema 7's typed columns in the order its migration adds them (session_info is a table of its own): the one list
-// the migration and `merge` use. Never changed once shipped - a new column is a new migration.
-const std::vector<TypedColumn>& TypedColumns();
 
 // Fills the typed columns of version 7 that are NULL (rows written before it, or merged from a record before it) from
 // the texts earlier versions kept: the session's display text and profile JSON, the participant information JSON, a

@@ -68,6 +68,9 @@ TEST(Schema, AVersionSixRecordGetsItsTypedColumns) {
   EXPECT_EQ(db.QueryText("SELECT observer || '|' || observer_params || '|' || window || '|' || profile_name || '|' || "
                          "viewing_distance_mm FROM sessions WHERE id = 1"),
             "simulated|sim:jnd=0.6,bias=0.2|0|lab|600.0");
+  EXPECT_EQ(db.QueryText("SELECT screen_width_mm || '|' || screen_height_mm || '|' || px_per_deg FROM sessions "
+                         "WHERE id = 1"),
+            "531.4|298.9|37.8");
   EXPECT_EQ(db.QueryText("SELECT observer || '|' || observer_params || '|' || window FROM sessions WHERE id = 2"),
             "person||1");
   EXPECT_EQ(db.QueryText("SELECT group_concat(key || '=' || value, ',') FROM (SELECT * FROM session_info ORDER BY key)"),
@@ -76,6 +79,8 @@ TEST(Schema, AVersionSixRecordGetsItsTypedColumns) {
                          "coalesce(left_fixed, '') || '|' || right_source || '|' || right_fixed || '|' || r_left_px "
                          "FROM trials WHERE trial_index = 0"),
             "b|1|0|measured||fixed_screen_px|4.0|1.25");
+  EXPECT_EQ(db.QueryText("SELECT task || '|' || r_right_px || '|' || r_scene_px FROM trials WHERE trial_index = 0"),
+            "forced_choice|0.0|1.1");
   EXPECT_EQ(db.QueryText("SELECT left_source || '|' || left_fixed || '|' || right_source || '|' || right_fixed || '|' || "
                          "swapped || '|' || coalesce(r_left_px, 'null') FROM trials WHERE trial_index = 1"),
             "fixed_px|2.5|fixed_arcmin|3.0|1|null");

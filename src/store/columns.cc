@@ -1,0 +1,360 @@
+// The record's column table (columns.h) and what is generated from it for the schema, the INSERTs and the merge.
+#include "store/columns.h"
+
+#include <optional>
+
+#include "core/error.h"
+#include "store/record.h"
+#include "store/sqlite.h"
+
+namespace blurcue::store {
+namespace {
+
+Value Optional(const std::optional<double>& value) { return value ? Value(*value) : Value(); }
+Value NonEmpty(const std::string& text) { return text.empty() ? Value() : Value(text); }
+// A number of the display profile the session records whole, typed.
+Value ProfileNumber(const Json& profile, const char* key) {
+  if (profile.is_object() && profile.contains(key) && profile[key].is_number()) return profile[key].get<double>();
+  return {};
+}
+
+// A kept place with no accessor (a column the shipped migrations made and the record writes itself).
+Stored Plain(const std::string& table, const std::string& column, const std::string& sql, int since) {
+  Stored s;
+  s.table = table;
+  s.column = column;
+  s.sql = sql;
+  s.since = since;
+  return s;
+}
+Stored Typed(const std::string& table, const std::string& sql, const std::string& check, int since,
+             const std::string& derive = "") {
+  Stored s = Plain(table, "", sql, since);
+  s.check = check;
+  s.derive = derive;
+  return s;
+}
+// A side's source and fixed radius as a record of before version 7 kept them: the side's JSON (a source's name, a
+// number of photo px, or an object of screen_px or arcmin).
+std::string SourceOf(const std::string& column) {
+  return "CASE json_type(" + column + ") WHEN 'text' THEN json_extract(" + column + ", '$') "
+         "WHEN 'integer' THEN 'fixed_px' WHEN 'real' THEN 'fixed_px' "
+         "WHEN 'object' THEN CASE WHEN json_extract(" + column + ", '$.screen_px') IS NOT NULL "
+         "THEN 'fixed_screen_px' ELSE 'fixed_arcmin' END END";
+}
+std::string FixedOf(const std::string& column) {
+  return "CASE json_type(" + column + ") WHEN 'integer' THEN json_extract(" + column + ", '$') "
+         "WHEN 'real' THEN json_extract(" + column + ", '$') "
+         "WHEN 'object' THEN coalesce(json_extract(" + column + ", '$.screen_px'), json_extract(" + column +
+         ", '$.arcmin')) END";
+}
+Stored OfSession(Stored s, Value (*of)(const SessionValues&)) { return s.of_session = of, s; }
+Stored OfTrial(Stored s, Value (*of)(const TrialRecord&)) { return s.of_trial = of, s; }
+Stored OfResponse(Stored s, Value (*of)(const Response&)) { return s.of_response = of, s; }
+
+std::vector<Column> MakeColumns() {
+  std::vector<Column> c;
+  c.reserve(128);  // rows are filled in through references to them
+  // One row: name, codebook type, unit, allowed, meaning, place, cell; the rest set on the returned row.
+  auto add = [&](const std::string& name, const std::string& type, const std::string& unit,
+                 const std::string& allowed, const std::string& meaning, Place place, Cell cell) -> Column& {
+    Column column;
+    column.name = name, column.type = type, column.unit = unit, column.allowed = allowed;
+    column.meaning = meaning, column.place = place, column.cell = cell;
+    c.push_back(std::move(column));
+    return c.back();
+  };
+  const Place S = Place::kSession, T = Place::kTrial, V = Place::kVariable, A = Place::kAnswer, N = Place::kNone;
+
+  // The session's.
+  add("study", "string", "", "", "the protocol's name", S, Cell::kText).at = Plain("studies", "name", "TEXT", 1);
+  add("protocol_hash", "string", "", "16 hex digits", "FNV-1a-64 of the protocol's canonical text: its version", S,
+      Cell::kText).at = Plain("protocol_versions", "hash", "TEXT", 1);
+  add("protocol_version", "integer", "", ">= 1",
+      "the protocol's declared \"version\" the session ran (one text per version of a study)", S, Cell::kInteger)
+      .at = Typed("protocol_versions", "INTEGER", "version >= 1", 8);
+  c.back().at.column = "version";  // written by the record with the protocol version (EnsureProtocolVersion)
+  add("participant", "string", "", "", "the participant's id", S, Cell::kText).at = Plain("participants", "code", "TEXT", 1);
+  Column& observer = add("observer", "string", "", "person|simulated",
+                         "who answered: a person, or blurcue's simulated observer", S, Cell::kText);
+  observer.if_null = "person";  // a record of before the typed columns that no migration filled
+  observer.at = OfSession(Typed("sessions", "TEXT", "observer IN ('person', 'simulated')", 7,
+                                "CASE WHEN instr(display, '; observer ') > 0 THEN 'simulated' ELSE 'person' END"),
+                          [](const SessionValues& s) { return Value(s.meta.simulated ? "simulated" : "person"); });
+  add("observer_params", "string", "", "", "the simulated observer's parameters (sim:model=arcmin,... or sim:model=pixel,...; before model= existed sim:jnd=..., the pixel model); empty for a person", S, Cell::kText)
+      .at = OfSession(Typed("sessions", "TEXT", "", 7,
+                            "CASE WHEN instr(display, '; observer ') > 0 "
+                            "THEN substr(display, instr(display, '; observer ') + 11) ELSE '' END"),
+                      [](const SessionValues& s) { return Value(s.meta.observer_params); });
+  add("window", "boolean", "", "0|1", "1: shown in a real window on the real clock; 0: headless on a simulated clock",
+      S, Cell::kInteger)
+      .at = OfSession(Typed("sessions", "INTEGER", "window IN (0, 1)", 7, "(display LIKE 'window%')"),
+                      [](const SessionValues& s) { return Value(int64_t(s.meta.window ? 1 : 0)); });
+  // The display profile's geometry, typed from the profile the session records whole; trials.csv leaves it out.
+  add("profile_name", "string", "", "", "the display profile's name", N, Cell::kText)
+      .at = OfSession(Typed("sessions", "TEXT", "", 7, "json_extract(display_profile, '$.name')"), [](const SessionValues& s) {
+        const Json& p = s.profile;
+        return p.is_object() && p.contains("name") && p["name"].is_string() ? Value(p["name"].get<std::string>())
+                                                                              : Value();
+      });
+  add("screen_width_mm", "number", "mm", "", "the screen's width (display profile)", N, Cell::kNumber)
+      .at = OfSession(Typed("sessions", "REAL", "", 7, "json_extract(display_profile, '$.width_mm')"),
+                      [](const SessionValues& s) { return ProfileNumber(s.profile, "width_mm"); });
+  add("screen_height_mm", "number", "mm", "", "the screen's height (display profile)", N, Cell::kNumber)
+      .at = OfSession(Typed("sessions", "REAL", "", 7, "json_extract(display_profile, '$.height_mm')"),
+                      [](const SessionValues& s) { return ProfileNumber(s.profile, "height_mm"); });
+  add("viewing_distance_mm", "number", "mm", "", "the eye's distance to the screen (display profile)", N, Cell::kNumber)
+      .at = OfSession(Typed("sessions", "REAL", "", 7, "json_extract(display_profile, '$.distance_mm')"),
+                      [](const SessionValues& s) { return ProfileNumber(s.profile, "distance_mm"); });
+  add("px_per_deg", "number", "screen px / deg", "", "screen pixels per degree of visual angle (display profile)", N,
+      Cell::kNumber)
+      .at = OfSession(Typed("sessions", "REAL", "", 7, "json_extract(display_profile, '$.px_per_deg')"),
+                      [](const SessionValues& s) { return ProfileNumber(s.profile, "px_per_deg"); });
+  add("session_id", "integer", "", ">= 1", "the session's id in this record (merged records renumber it)", S,
+      Cell::kInteger).at = Plain("sessions", "id", "INTEGER", 1);
+  add("session_number", "integer", "", ">= 1", "the participant's n-th session of this study, in the order started",
+      S, Cell::kInteger)
+      .at = OfSession(Typed("sessions", "INTEGER", "session_number >= 1", 8),
+                      [](const SessionValues& s) { return Value(s.number); });
+  add("session_status", "string", "", "running|completed|aborted",
+      "the session's status when exported: running (unfinished: stopped, killed or still being written; blurcue "
+      "report leaves its answers out unless --include-unfinished), completed, or aborted (closed with blurcue sessions --abort; blurcue report leaves its answers out unless "
+      "--include-aborted)", S, Cell::kText).at = Plain("sessions", "status", "TEXT", 1);
+  add("seed", "string", "", "s followed by 1-20 digits",
+      "the seed of the session's trial order, a 64-bit unsigned integer written with a leading s so that spreadsheets, "
+      "R and JavaScript keep every digit; blurcue run --seed takes it as written", S, Cell::kSeed)
+      .at = Plain("sessions", "seed", "INTEGER", 1);
+
+  // The trial's.
+  add("trial_index", "integer", "", ">= 0", "the trial's place in the session, practice included, from 0", T,
+      Cell::kInteger).at = Plain("trials", "trial_index", "INTEGER", 1);
+  add("block", "integer", "", ">= 0", "the block's place in the protocol's list of blocks, from 0", T, Cell::kInteger)
+      .at = Plain("trials", "block", "INTEGER", 1);
+  Column& block_name = add("block_name", "string", "", "", "the block's name", T, Cell::kText);
+  block_name.in_variables = true;
+  block_name.at = OfTrial(Typed("trials", "TEXT", "", 7, "coalesce(json_extract(factors, '$.block_name'), '')"), [](const TrialRecord& t) { return Value(t.block_name); });
+  add("task", "string", "", "forced_choice|adjustment|yes_no|rating", "the trial's task", T, Cell::kText)
+      .at = OfTrial(Typed("trials", "TEXT", "", 7,
+                          "CASE WHEN json_extract(factors, '$.start_level') IS NOT NULL THEN 'adjustment' "
+                          "ELSE 'forced_choice' END"),
+                    [](const TrialRecord& t) { return Value(t.task); });
+  Column& practice = add("practice", "boolean", "", "0|1", "1: a practice trial (not scored)", T, Cell::kInteger);
+  practice.if_null = "0", practice.in_variables = true;
+  practice.at = OfTrial(Typed("trials", "INTEGER", "practice IN (0, 1)", 7,
+                              "coalesce(json_extract(factors, '$.practice'), 0) <> 0"),
+                        [](const TrialRecord& t) { return Value(int64_t(t.practice ? 1 : 0)); });
+  Column& swapped = add("swapped", "boolean", "", "0|1",
+                        "1: left and right exchanged against the design (counterbalancing)", T, Cell::kInteger);
+  swapped.if_null = "0", swapped.in_variables = true;
+  swapped.at = OfTrial(Typed("trials", "INTEGER", "swapped IN (0, 1)", 7,
+                             "coalesce(json_extract(factors, '$.swapped'), 0) <> 0"),
+                       [](const TrialRecord& t) { return Value(int64_t(t.swapped ? 1 : 0)); });
+  add("cell", "string", "", "",
+      "a procedure trial's cell by its levels (NAME=LEVEL;... of its block's factors): its own track and threshold; "
+      "empty outside a procedure and in records made before cells were recorded", T, Cell::kText)
+      .at = OfTrial(Typed("trials", "TEXT", "", 8), [](const TrialRecord& t) { return NonEmpty(t.cell); });
+
+  // Each side's source, with the answer in trials.csv; in schema 7's order before the planned radii.
+  const std::string sources = "none|measured|measured_section|estimated|fitted|fixed_px|fixed_screen_px|fixed_arcmin";
+  add("left_source", "string", "", sources, "the left side's blur source (the single layout's object); empty: none shown",
+      A, Cell::kText)
+      .at = OfTrial(Typed("trials", "TEXT", "", 7, SourceOf("left_shown")),
+                    [](const TrialRecord& t) { return NonEmpty(SourceColumns::Of(t.left_json).source); });
+  add("left_fixed", "number", "the source's unit", ">= 0", "a fixed_* left source's radius, in the unit its name says",
+      A, Cell::kNumber)
+      .at = OfTrial(Typed("trials", "REAL", "", 7, FixedOf("left_shown")),
+                    [](const TrialRecord& t) { return Optional(SourceColumns::Of(t.left_json).fixed); });
+  add("right_source", "string", "", sources, "the right side's blur source; empty: none shown", A, Cell::kText)
+      .at = OfTrial(Typed("trials", "TEXT", "", 7, SourceOf("right_shown")),
+                    [](const TrialRecord& t) { return NonEmpty(SourceColumns::Of(t.right_json).source); });
+  add("right_fixed", "number", "the source's unit", ">= 0", "a fixed_* right source's radius, in the unit its name says",
+      A, Cell::kNumber)
+      .at = OfTrial(Typed("trials", "REAL", "", 7, FixedOf("right_shown")),
+                    [](const TrialRecord& t) { return Optional(SourceColumns::Of(t.right_json).fixed); });
+
+  // The runner's variables of a trial (session/recording.h TrialVariables), kept in its variables' JSON (factors; a
+  // response's shown for what a procedure decided at the trial). Those also kept typed come first, in schema 7's order.
+  add("level", "number", "the procedure's variable", "", "a procedure trial: the level shown", V, Cell::kText)
+      .shown = OfResponse(Typed("responses", "REAL", "", 7, "json_extract(shown, '$.level')"),
+                          [](const Response& r) { return Optional(r.level); });
+
+  // The answer.
+  add("status", "string", "", "answered|timed_out|skipped|unanswered",
+      "answered; timed_out: no answer before the deadline; skipped: not shown (a stopped procedure, a practice "
+      "criterion met); unanswered: not reached", A, Cell::kAnswer).answer = Answer::kStatus;
+  add("chosen_side", "string", "", "left|right|cant_tell",
+      "forced choice of a pair: the side chosen (two intervals: left = the first, right = the second)", A, Cell::kAnswer)
+      .answer = Answer::kChosenSide;
+  add("chose_more_blurred", "boolean", "", "0|1",
+      "forced choice of a pair: 1 when the side chosen showed the larger blur radius; empty when the radii were "
+      "equal or no side was chosen", A, Cell::kAnswer).answer = Answer::kChoseMoreBlurred;
+  add("chosen_interval", "integer", "", "1..alternatives", "odd one out: the interval named", A, Cell::kAnswer)
+      .answer = Answer::kChosenInterval;
+  add("yes_no", "string", "", "yes|no", "yes_no task: the answer", A, Cell::kAnswer).answer = Answer::kYesNo;
+  add("rating", "integer", "", "1..points", "rating task: the point of the scale chosen (1 the lowest)", A,
+      Cell::kAnswer).answer = Answer::kRating;
+  add("adjusted_level", "number", "the adjusted parameter's unit", "", "adjustment: the level accepted", A,
+      Cell::kAnswer).answer = Answer::kAdjustedLevel;
+  // Scored once, when the answer is given (records from before: by the migration to schema 8), never by the export.
+  Column& correct = add("correct", "boolean", "", "0|1",
+                        "1: the answer was correct (procedure trials, odd one out); empty where no answer is correct",
+                        A, Cell::kInteger);
+  correct.in_variables = true;
+  correct.at = OfResponse(Typed("responses", "INTEGER", "correct IN (0, 1)", 7, "json_extract(shown, '$.correct')"), [](const Response& r) {
+    return r.correct ? Value(int64_t(*r.correct ? 1 : 0)) : Value();
+  });
+
+  // Each radius as the camera made it, on the screen and at the eye; the photo px ones also typed, planned (trials)
+  // and as shown (responses), for a procedure decides them at the trial.
+  for (const std::string side : {"left", "right", "scene"}) {
+    const std::string what = side == "scene" ? "the scene's own blur at the object's place (the fitted model; depth "
+                                               "matching: the real picture's, the thin lens of content.real_camera)"
+                                             : "the " + side + " object's blur radius";
+    Column& px = add("r_" + side + "_px", "number", "photo px",
+                     "", what + ", as the camera makes it (moving: averaged over the run)", V, Cell::kText);
+    // Before version 7 only the variables' JSON had it, planned (factors) and as shown (shown).
+    const Stored planned = Typed("trials", "REAL", "", 7, "json_extract(factors, '$.r_" + side + "_px')");
+    const Stored shown = Typed("responses", "REAL", "", 7, "json_extract(shown, '$.r_" + side + "_px')");
+    if (side == "left") {
+      px.at = OfTrial(planned, [](const TrialRecord& t) { return Optional(t.r_left_px); });
+      px.shown = OfResponse(shown, [](const Response& r) { return Optional(r.r_left_px); });
+    } else if (side == "right") {
+      px.at = OfTrial(planned, [](const TrialRecord& t) { return Optional(t.r_right_px); });
+      px.shown = OfResponse(shown, [](const Response& r) { return Optional(r.r_right_px); });
+    } else {
+      px.at = OfTrial(planned, [](const TrialRecord& t) { return Optional(t.r_scene_px); });
+    }
+    add("r_" + side + "_screen_px", "number", "screen px", "", what + ", on the screen", V, Cell::kText);
+    add("r_" + side + "_arcmin", "number", "arcmin", "", what + ", at the eye", V, Cell::kText);
+  }
+  Column& rt = add("rt_ms", "number", "ms", ">= 0", "response time from the stimulus's first frame; empty without an answer",
+                   A, Cell::kNumber);
+  rt.at = Plain("responses", "rt_ms", "REAL", 1);
+  add("answered_at", "datetime", "", "", "when the answer was recorded (UTC)", A, Cell::kText)
+      .at = Plain("responses", "answered_at", "TEXT", 1);
+
+  auto variable = [&](const std::string& name, const std::string& type, const std::string& unit,
+                      const std::string& meaning) { add(name, type, unit, "", meaning, V, Cell::kText); };
+  variable("screen_px_per_photo_px", "number", "screen px / photo px", "how the photo was scaled onto the screen");
+  variable("kernel", "string", "", "the blur kernel (gaussian | disc)");
+  variable("blur_plan", "string", "", "one_radius: each object blurred with one radius; per_pixel: by depth");
+  variable("r_span_screen_px", "number", "screen px", "the largest change of a radius across an object's depth");
+  variable("size_left_deg", "number", "deg", "the left object's largest extent on screen at onset");
+  variable("size_right_deg", "number", "deg", "the right object's largest extent on screen at onset");
+  variable("brightness", "number", "", "the object's brightness matching (factor of its texture's values)");
+  variable("contrast", "number", "", "the object's contrast matching");
+  variable("white_balance_r", "number", "", "the object's red gain in linear light");
+  variable("white_balance_g", "number", "", "the object's green gain in linear light");
+  variable("white_balance_b", "number", "", "the object's blue gain in linear light");
+  variable("start_level", "number", "the adjusted parameter's unit", "adjustment: the level shown first");
+  variable("adjust_levels", "string", "the adjusted parameter's unit",
+           "adjustment: the levels in the order the next key steps through them (cyclic), separated by ;");
+  variable("picture_width_arcmin", "number", "arcmin",
+           "depth matching: the virtual picture's width at the eye (a cut-off c's blur is r = 2 x 0.1874 x this / c)");
+  variable("procedure_cell", "integer", "", "a procedure trial: which crossing of its block's factors (its own procedure)");
+  variable("test_side", "string", "", "a procedure trial: the side (or odd-one-out interval) showing the procedure's level");
+  variable("reversals", "integer", "", "a staircase trial: the staircase's reversals before this answer (or when it stopped)");
+  variable("skipped", "string", "", "why a trial was not shown (stop rule: its staircase had ended)");
+  variable("posterior_threshold", "number", "the procedure's variable",
+           "a QUEST+ trial: the posterior mean of the threshold after this answer (its running estimate)");
+  variable("posterior_slope", "number", "", "a QUEST+ trial: the posterior mean of the slope after this answer");
+  variable("round", "integer", "", "a practice block run until a criterion: which run of its design (from 1)");
+  variable("odd_interval", "integer", "", "odd one out: the interval that showed the right side's object (the correct answer)");
+  variable("intervals", "integer", "", "odd one out: intervals per trial");
+  return c;
+}
+
+// The export's alias of each table the record keeps a variable in.
+std::string Alias(const std::string& table) {
+  if (table == "studies") return "st";
+  if (table == "protocol_versions") return "pv";
+  if (table == "participants") return "p";
+  if (table == "sessions") return "s";
+  if (table == "trials") return "t";
+  if (table == "responses") return "r";
+  throw Error(ErrorKind::kInternal, "columns: no alias for table " + table);
+}
+
+void BindValue(Statement& insert, int index, const Value& value) {
+  if (const auto* i = std::get_if<int64_t>(&value)) insert.Bind(index, *i);
+  else if (const auto* d = std::get_if<double>(&value)) insert.Bind(index, *d);
+  else if (const auto* t = std::get_if<std::string>(&value)) insert.Bind(index, *t);
+  else insert.BindNull(index);
+}
+
+// Binds the typed columns of `table` each read by `read` (its accessor, or null for one the record writes elsewhere).
+template <typename Read>
+void BindEach(const std::vector<Column>& columns, const std::string& table, Statement& insert, int first, Read read) {
+  for (const Kept& kept : KeptIn(columns, table, 7)) BindValue(insert, first++, read(*kept.stored));
+}
+
+}  // namespace
+
+const std::vector<Column>& RecordColumns() {
+  static const std::vector<Column> columns = MakeColumns();
+  return columns;
+}
+
+std::string ColumnName(const Column& column, const Stored& stored) {
+  return stored.column.empty() ? column.name : stored.column;
+}
+
+std::string SelectOf(const Column& column) {
+  if (!column.select.empty()) return column.select;
+  return Alias(column.at.table) + "." + ColumnName(column, column.at);
+}
+
+std::vector<Kept> KeptIn(const std::vector<Column>& columns, const std::string& table, int since) {
+  std::vector<Kept> kept;
+  for (const Column& column : columns)
+    for (const Stored* stored : {&column.at, &column.shown})
+      if (stored->table == table && stored->since >= since) kept.push_back({&column, stored, ColumnName(column, *stored)});
+  return kept;
+}
+
+std::string AddColumnsSql(const std::vector<Column>& columns, int version) {
+  std::string sql;
+  for (const char* table : {"protocol_versions", "sessions", "trials", "responses"})
+    for (const Kept& kept : KeptIn(columns, table, version))
+      if (kept.stored->since == version)
+        sql += std::string("ALTER TABLE ") + table + " ADD COLUMN " + kept.name + " " + kept.stored->sql +
+               (kept.stored->check.empty() ? std::string() : " CHECK (" + kept.stored->check + ")") + ";";
+  return sql;
+}
+
+std::string DerivedColumnsSql(const std::vector<Column>& columns, const std::string& table) {
+  std::string set;
+  for (const Kept& kept : KeptIn(columns, table, 7))
+    if (kept.stored->since == 7) set += (set.empty() ? "" : ", ") + kept.name + " = " + kept.stored->derive;
+  return set;
+}
+
+// The INSERTs of sessions, trials and responses write the typed columns their rows give (protocol_versions.version
+// is written with the protocol version, not by an INSERT of these).
+std::string InsertNames(const std::vector<Column>& columns, const std::string& table) {
+  std::string names;
+  for (const Kept& kept : KeptIn(columns, table, 7)) names += ", " + kept.name;
+  return names;
+}
+
+std::string InsertPlaceholders(const std::vector<Column>& columns, const std::string& table) {
+  std::string marks;
+  for (size_t i = 0; i < KeptIn(columns, table, 7).size(); ++i) marks += ", ?";
+  return marks;
+}
+
+void BindTyped(const std::vector<Column>& columns, Statement& insert, int first, const SessionValues& session) {
+  BindEach(columns, "sessions", insert, first,
+           [&](const Stored& s) { return s.of_session ? s.of_session(session) : Value(); });
+}
+
+void BindTyped(const std::vector<Column>& columns, Statement& insert, int first, const TrialRecord& trial) {
+  BindEach(columns, "trials", insert, first, [&](const Stored& s) { return s.of_trial ? s.of_trial(trial) : Value(); });
+}
+
+void BindTyped(const std::vector<Column>& columns, Statement& insert, int first, const Response& response) {
+  BindEach(columns, "responses", insert, first,
+           [&](const Stored& s) { return s.of_response ? s.of_response(response) : Value(); });
+}
+
+}  // namespace blurcue::store

@@ -1,0 +1,115 @@
+#pragma once
+// The record's columns as one table: every variable of a trial's row of trials.csv, defined once - its name, type,
+// unit, allowed values, meaning, where trials.csv puts it and how it is read (a column of the record, a variable the
+// runner records with the trial, or the answer) - with the typed columns the record keeps it in. Generated from it:
+// the schema's typed columns (the migrations to versions 7 and 8, and how version 7 fills them in older rows), the
+// record's INSERT of a session's, a trial's and a response's typed columns, the export's SELECT and cells, the
+// codebook's rows, the names a design's level may not take (IsRecordedName) and the merge's column lists. Values the
+// protocol allows (levels, ranges, choices) are not here: the design table (design_columns) gives them per protocol
+// version. The columns of the tables beside trials.csv (frames.csv, adjustments.csv, summaries) are export_table.cc's.
+#include <cstdint>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "core/json_io.h"
+
+namespace blurcue::store {
+
+struct TrialRecord;
+struct Response;
+struct SessionMeta;
+class Statement;
+
+// Where trials.csv writes a column: with the session (before the group and info_KEY columns), with the trial (before
+// the design's variables), among the design's variables (sorted with the levels; a cell only where the trial recorded
+// it), with the answer (after them), or nowhere (a typed column the record keeps for readers of the file).
+enum class Place { kSession, kTrial, kVariable, kAnswer, kNone };
+
+// How a cell is written from the value the export's SELECT reads: as text, an integer, a number (the shortest text
+// that reads back the same), the seed ("s" and its unsigned digits); NULL writes Column::if_null. kAnswer: decided
+// from the answer (Column::answer). A variable's cell is its JSON value (export.cc TidyCell).
+enum class Cell { kText, kInteger, kNumber, kSeed, kAnswer };
+
+// The cells decided from the answer when it is exported: one column per kind of answer, each of one type.
+enum class Answer { kNone, kStatus, kChosenSide, kChoseMoreBlurred, kChosenInterval, kYesNo, kRating, kAdjustedLevel };
+
+// A value for a typed column: NULL, an integer, a number or a text.
+using Value = std::variant<std::monostate, int64_t, double, std::string>;
+
+// What a new session's typed columns are read from: its description, its display profile parsed, its number.
+struct SessionValues {
+  const SessionMeta& meta;
+  const Json& profile;
+  int64_t number;
+};
+
+// A column of the record that keeps a variable: its table, SQL type and CHECK, and the schema version that added it.
+// Columns of version 7 on (the typed record) are added by migrations generated from this table, written by the
+// record's INSERTs through `of_*` (the one of its table) and copied by merge (but for the session number, which merge
+// gives again); older ones (`since` < 7) are the shipped migrations' and the record writes them itself.
+struct Stored {
+  std::string table;   // "" (not kept), studies, protocol_versions, participants, sessions, trials or responses
+  std::string column;  // "" = the variable's name
+  std::string sql;     // TEXT | REAL | INTEGER
+  std::string check;   // the CHECK expression, "" for none
+  int since = 0;
+  // Version 7: how a row written before it had the value (SQL over the row's older texts: the display, the display
+  // profile, the variables' JSON), for DeriveTypedColumns; "" for none.
+  std::string derive;
+  Value (*of_session)(const SessionValues&) = nullptr;
+  Value (*of_trial)(const TrialRecord&) = nullptr;
+  Value (*of_response)(const Response&) = nullptr;
+};
+
+struct Column {
+  std::string name;     // trials.csv's and the codebook's
+  std::string type;     // the codebook's: string | integer | number | boolean (0|1) | datetime (ISO 8601 UTC)
+  std::string unit;
+  std::string allowed;  // what the record allows; a variable of type string without it: the values seen
+  std::string meaning;
+  Place place = Place::kNone;
+  Cell cell = Cell::kText;
+  std::string select;   // the export's SQL over st, pv, p, s, t, r; "" = the kept column (at), e.g. t.block_name
+  std::string if_null;  // the cell of a NULL
+  Answer answer = Answer::kNone;
+  // Where the record keeps it, and for a trial's variable decided when the trial is shown, the response's copy.
+  Stored at, shown;
+  // Also in the trial's variables (factors or shown JSON), written there by the runner: exported from the typed
+  // column, not from there.
+  bool in_variables = false;
+};
+
+// The record's columns, in the order schema 7 added the typed ones within each table (trials.csv orders by place).
+const std::vector<Column>& RecordColumns();
+
+// The column's SQL name in its table (Stored::column, else its name), and the alias the export reads it under.
+std::string ColumnName(const Column& column, const Stored& stored);
+// What the export selects for `column`: Column::select, else ALIAS.COLUMN of where it is kept.
+std::string SelectOf(const Column& column);
+
+// One column of the record kept in `table` by `columns` (at or shown), with its definition.
+struct Kept {
+  const Column* column;
+  const Stored* stored;
+  std::string name;  // its SQL name
+};
+// The columns `columns` keep in `table` that version `since` or later added (>= 7: the typed record), in order.
+std::vector<Kept> KeptIn(const std::vector<Column>& columns, const std::string& table, int since);
+
+// The SQL that adds the columns version `version` brought to sessions, trials, responses and protocol_versions
+// ("ALTER TABLE T ADD COLUMN C TYPE CHECK (...);" each).
+std::string AddColumnsSql(const std::vector<Column>& columns, int version);
+
+// "a = DERIVE, b = DERIVE" for the columns of `table` version 7 added: DeriveTypedColumns' UPDATE.
+std::string DerivedColumnsSql(const std::vector<Column>& columns, const std::string& table);
+
+// ", a, b" and ", ?, ?" for the typed columns (version 7 on) of `table`: the INSERT's part this table generates.
+std::string InsertNames(const std::vector<Column>& columns, const std::string& table);
+std::string InsertPlaceholders(const std::vector<Column>& columns, const std::string& table);
+// Binds a new row's typed columns of sessions, trials or responses from its values, from parameter `first` on.
+void BindTyped(const std::vector<Column>& columns, Statement& insert, int first, const SessionValues& session);
+void BindTyped(const std::vector<Column>& columns, Statement& insert, int first, const TrialRecord& trial);
+void BindTyped(const std::vector<Column>& columns, Statement& insert, int first, const Response& response);
+
+}  // namespace blurcue::store
