@@ -124,13 +124,22 @@ def thesis_findings(trials, sections):
     out = {}
     charts = {c.name: c for _, cs, _ in sections for c in cs}
     dm = charts.get("depth-matching")
-    if dm is not None and dm.table is not None and not dm.table.empty and "b_low" in dm.table:
-        pooled = dm.table[dm.table["fit"].astype(str).str.startswith("pooled")]
-        if len(pooled):
-            r = pooled.iloc[0]
-            out[common.STUDY_DEPTH] = (f"accepted cut-off against distance: c ~ d^b with b = {r['b']:.2f} "
-                                       f"[{r['b_low']:.2f}, {r['b_high']:.2f}] ({common.p_text(r['p_b'])}); b < 0: "
-                                       f"more blur accepted farther away")
+    if dm is not None and dm.table is not None and not dm.table.empty and "term" in dm.table:
+        t = dm.table
+        # The match in arcmin where the record has it (the lmer, else the clustered OLS), else the power law's.
+        for label, term, text in (("set on real", "per arcmin of real blur (1 = set as real)",
+                                   "set blur against the real picture's blur (arcmin): slope"),
+                                  ("power law", "b (per unit of log distance)", "accepted cut-off against "
+                                   "distance: c ~ d^b with b")):
+            rows = t[t["model"].astype(str).str.startswith(label + ":") & (t["term"] == term) &
+                     ~t["model"].astype(str).str.contains("observer ") & t["estimate"].notna()]
+            rows = rows.sort_values("engine", key=lambda e: ~e.astype(str).str.startswith("lme4"))
+            if len(rows):
+                r = rows.iloc[0]
+                half = stats.sps.t.ppf(0.975, r["df"]) * r["se"] if r["df"] > 0 else math.nan
+                out[common.STUDY_DEPTH] = (f"{text} = {r['estimate']:.2f} [{r['estimate'] - half:.2f}, "
+                                           f"{r['estimate'] + half:.2f}] ({common.p_text(r['p'])}; {r['model']})")
+                break
     for study in common.FORCED_CHOICE_STUDIES:
         d = common.study_rows(trials, study)
         if d.empty:

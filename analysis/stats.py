@@ -535,18 +535,7 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
             else:
                 fixed = f.fixed.copy()
                 add_fit(model, f.engine, fixed, lambda c: status)
-                for term, value, singular in f.sds:
-                    label = "observer SD: " + (words.get(term, term) if term != "Intercept" else
-                                               ("baseline (intercept)" if "Intercept" in words else "intercept"))
-                    rows.append(model_row(study, model, label, math.nan if singular else value, engine=f.engine,
-                                          note="singular: estimated at 0, on its bound - no spread between "
-                                               "participants detectable" if singular else
-                                          "SD of the participants' effects (log-odds)"))
-                for (a, b), value, singular in f.corrs:
-                    name = lambda t: words.get(t, t) if t != "Intercept" else "intercept"
-                    rows.append(model_row(study, model, f"observer correlation: {name(a)} with {name(b)}",
-                                          math.nan if singular else value, engine=f.engine,
-                                          note="singular: at +-1" if singular else ""))
+                rows += variance_rows(study, model, f, words, "log-odds")
     elif n_groups == 2:
         notes.append("two participants: too few for a GLMM (a spread between participants from two is not an "
                      "estimate); cluster-robust GLM only")
@@ -554,6 +543,30 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
     if not table.empty:
         notes += disagreements(table)
     return table, notes
+
+
+def variance_rows(study, model, f, words, unit):
+    """The rows of a mixed.Fit's SDs and correlations of the participants' effects: one estimated at its bound (a
+    singular fit) in words, never as a number."""
+    rows = []
+
+    def name(t):
+        if t == "Intercept":
+            return "baseline (intercept)" if "Intercept" in words else "intercept"
+        return words.get(t, t)
+    for term, value, singular in f.sds:
+        if term == "Residual":
+            rows.append(model_row(study, model, "residual SD", value, engine=f.engine, note=f"SD within a "
+                                  f"participant ({unit})"))
+            continue
+        rows.append(model_row(study, model, f"observer SD: {name(term)}", math.nan if singular else value,
+                              engine=f.engine, note="singular: estimated at 0, on its bound - no spread between "
+                              "participants detectable" if singular else f"SD of the participants' effects ({unit})"))
+    for (a, b), value, singular in f.corrs:
+        rows.append(model_row(study, model, f"observer correlation: {name(a)} with {name(b)}",
+                              math.nan if singular else value, engine=f.engine,
+                              note="singular: at +-1" if singular else ""))
+    return rows
 
 
 def disagreements(table):
