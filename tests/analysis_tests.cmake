@@ -9,13 +9,18 @@ add_test(NAME analysis.stats
 add_test(NAME analysis.report
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_report.py
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# The models across observers by lme4 (analysis/models.R) against a direct glmer call, simulated observers and
+# hand-worked cells; the R-absent path. Rscript from Debian (r-base-core, r-cran-lme4, r-cran-lmertest).
+add_test(NAME analysis.mixed
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_mixed.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 add_test(NAME analysis.bench_charts
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_bench_charts.py
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 add_test(NAME analysis.prediction
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_prediction.py
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
-set_tests_properties(analysis.stats analysis.report analysis.bench_charts analysis.prediction PROPERTIES
+set_tests_properties(analysis.stats analysis.report analysis.mixed analysis.bench_charts analysis.prediction PROPERTIES
                      LABELS analysis TIMEOUT 180
                      # Matplotlib writes its font cache under HOME; keep it out of a read-only or shared home.
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
