@@ -117,8 +117,7 @@ def fit(kind, y, design, groups, slopes=()):
     fixed["term"] = fixed["term"].map(lambda t: back.get(t, t))
     result = Fit(engine=info.get("engine", "lme4"), structure=info.get("structure", ""), fixed=fixed.reset_index(
         drop=True), singular="singular" in info, failed=info.get("failed", ""))
-    result.slopes = tuple(s for s in slopes if code[s] in result.structure) if "slopes by participant" in \
-        result.structure else ()
+    result.slopes = tuple(slopes) if result.structure.startswith("random intercept and slopes") else ()
     for _, r in out[out["row"] == "sd"].iterrows():
         term = r["term"] if r["term"] in ("Intercept", "Residual") else back.get(r["term"], r["term"])
         result.sds.append((term, float(r["estimate"]), r["note"] == "singular"))

@@ -219,6 +219,22 @@ class WithoutRTest(unittest.TestCase):
         self.assertFalse(table["engine"].str.contains("lme4|Bayes|VB").any())
         self.assertTrue(any("GLMM not fitted: R is not installed" in n for n in notes), notes)
 
+    @unittest.skipUnless(RSCRIPT, "R is not installed")
+    def test_lme4_missing_is_said_in_words(self):
+        # An Rscript whose library path leaves out Debian's site library, where r-cran-lme4 lives.
+        tmp = tempfile.mkdtemp()
+        wrapper = os.path.join(tmp, "Rscript")
+        with open(wrapper, "w") as f:
+            f.write(f"#!/bin/sh\nR_LIBS_SITE=/nonexistent R_LIBS_USER=/nonexistent exec {RSCRIPT} \"$@\"\n")
+        os.chmod(wrapper, 0o755)
+        probe = subprocess.run([wrapper, "-e", "quit(status = requireNamespace('lme4', quietly = TRUE))"])
+        if probe.returncode != 0:
+            self.skipTest("lme4 is installed outside the site library")
+        with mock_env(BLURCUE_RSCRIPT=wrapper):
+            table, notes = stats.observer_models(simulated(6, 44, 0.5, 0.0), "y", "edge_c", study="s")
+        self.assertFalse(table["engine"].str.contains("lme4").any())
+        self.assertTrue(any("GLMM not fitted: the R package lme4 is not installed" in n for n in notes), notes)
+
     def test_report_without_r(self):
         tmp = tempfile.mkdtemp()
         rows = synthetic.trials_rows(participants=("P1", "P2", "P3", "P4"), studies=["test1-static-grids"])
