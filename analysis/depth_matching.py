@@ -157,9 +157,9 @@ def _across(a, x, y, label, words, notes, study):
             notes.append(f"{label}: mixed model {f.failed}")
             return rows, pooled
         status = f.structure + ("; singular fit" if f.singular else "")
-        for _, r in f.fixed.iterrows():
+        for _, r in stats.without_unheld_tests(f, [x]).iterrows():
             rows.append(stats.model_row(study, model, words[r["term"]], r["estimate"], r["se"], r["df"], r["p"],
-                                        f.engine, status))
+                                        f.engine, status + r["why"]))
         rows += stats.variance_rows(study, model, f, words, "arcmin" if y == "set_arcmin" else "log cut-off")
     elif n_groups == 2:
         notes.append(f"{label}: two participants, too few for a mixed model")
