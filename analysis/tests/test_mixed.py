@@ -95,6 +95,25 @@ class GlmmAgainstDirectGlmer(unittest.TestCase):
         sd_row = glmm[glmm["term"] == "observer SD: per edge (edge centred at 6)"].iloc[0]
         self.assertAlmostEqual(sd_row["estimate"], sds["edge_c"], delta=0.1 * sds["edge_c"])
 
+    def test_a_term_that_lost_its_random_slope_has_no_p(self):
+        # Participants differ in their baseline only (slope SD 0): the maximal model is singular here (checked with
+        # the direct call), so the report fits the random intercept alone and gives the slope no SE and no p.
+        d = simulated(6, 88, sd_intercept=1.2, sd_slope=0.0, seed=21)
+        _, _, maximal_singular = direct_glmer(d, "y ~ edge_c + (1 + edge_c | participant)")
+        self.assertTrue(maximal_singular)
+        fixed, _, singular = direct_glmer(d, "y ~ edge_c + (1 | participant)")
+        self.assertFalse(singular)
+        table, _ = stats.observer_models(d, "y", "edge_c", study="s")
+        glmm = rows_of(table, "lme4")
+        self.assertIn("(1 | participant)", glmm["model"].iloc[0])
+        slope = glmm[glmm["term"] == "per edge (edge centred at 6)"].iloc[0]
+        self.assertTrue(math.isnan(slope["p"]) and math.isnan(slope["se"]), slope)
+        self.assertAlmostEqual(slope["estimate"], fixed["edge_c"][0], delta=0.25 * fixed["edge_c"][1])
+        self.assertIn("no SE or p", slope["note"])
+        base = glmm[glmm["term"] == "baseline (intercept)"].iloc[0]  # its random intercept is there: p from t(5)
+        est, se = fixed["(Intercept)"]
+        self.assertAlmostEqual(base["p"], 2 * sps.t.sf(abs(est / se), 5), delta=0.02)
+
     def test_identical_observers_have_sd_zero_in_words(self):
         # Every participant gives the very same answers: the between-participant SD's maximum likelihood is exactly 0
         # (at SD 0 each participant's score is 0, so the likelihood falls as the SD grows), so the fit is singular.
