@@ -102,6 +102,15 @@ def charts(df, out_dir):
 
 
 WORDS_POWER = {"Intercept": "a (log cut-off at 1 m)", "log_d": "b (per unit of log distance)"}
+# a = 0 would be a cut-off of 1 cycle per picture width at 1 m: no one's hypothesis, so no p for it.
+NO_P_POWER_A = "no p: a = 0 (a cut-off of 1 cycle per picture width at 1 m) is no hypothesis"
+
+
+def _meaningful(term, words, p, note):
+    """The p and note of a row: the power law's intercept gets no p (see NO_P_POWER_A)."""
+    if words is WORDS_POWER and term == "Intercept":
+        return math.nan, (note + "; " if note else "") + NO_P_POWER_A
+    return p, note
 WORDS_MATCH = {"Intercept": "set blur at real blur 0 (arcmin)",
                "real_arcmin": "per arcmin of real blur (1 = set as real)"}
 
@@ -114,8 +123,8 @@ def _ols_rows(g, x, y, model, words, study):
     df = len(g) - 2
     out = []
     for term, est, se in (("Intercept", res.intercept, res.intercept_stderr), (x, res.slope, res.stderr)):
-        p = 2 * sps.t.sf(abs(est / se), df) if se > 0 else math.nan
-        out.append(stats.model_row(study, model, words[term], est, se, df, p, "scipy linregress (OLS)"))
+        p, note = _meaningful(term, words, 2 * sps.t.sf(abs(est / se), df) if se > 0 else math.nan, "")
+        out.append(stats.model_row(study, model, words[term], est, se, df, p, "scipy linregress (OLS)", note))
     return out
 
 
@@ -142,8 +151,9 @@ def _across(a, x, y, label, words, notes, study):
             engine = f"statsmodels {version} OLS (one observer)"
             model = f"lm({y} ~ {x}) (one observer)"
     for _, r in t.iterrows():
+        p, note = _meaningful(r["term"], words, r["p"], "")
         rows.append(stats.model_row(study, f"{label}: {model}", words[r["term"]], r["estimate"], r["se"], r["df"],
-                                    r["p"], engine))
+                                    p, engine, note))
     pooled = (float(t["estimate"].iloc[0]), float(t["estimate"].iloc[1]))
     if n_groups >= 3:
         try:
@@ -158,8 +168,9 @@ def _across(a, x, y, label, words, notes, study):
             return rows, pooled
         status = f.structure + ("; singular fit" if f.singular else "")
         for _, r in stats.without_unheld_tests(f, [x]).iterrows():
-            rows.append(stats.model_row(study, model, words[r["term"]], r["estimate"], r["se"], r["df"], r["p"],
-                                        f.engine, status + r["why"]))
+            p, note = _meaningful(r["term"], words, r["p"], status + r["why"])
+            rows.append(stats.model_row(study, model, words[r["term"]], r["estimate"], r["se"], r["df"], p,
+                                        f.engine, note))
         rows += stats.variance_rows(study, model, f, words, "arcmin" if y == "set_arcmin" else "log cut-off")
     elif n_groups == 2:
         notes.append(f"{label}: two participants, too few for a mixed model")

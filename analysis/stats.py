@@ -524,8 +524,10 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
         if f is not None:
             random = "(1" + "".join(f" + {v}" for v in dict.fromkeys(sources[c] for c in f.slopes)) + f" | {group})"
             model = f"glmer({_formula_text(response, formula_rhs, random)})"
-            status = f.structure + ("; singular fit: the participants' spread estimated at 0 - the fixed effects "
-                                    "are then those of a plain GLM" if f.singular else "")
+            status = f.structure + ("; singular fit (the participants' spread estimated at 0)" if f.singular
+                                    else "")
+            for c in sorted(slopes, key=len, reverse=True):  # the slopes by their words, not patsy's names
+                status = status.replace(c, words[c])
             if f.failed:
                 notes.append(f"GLMM: {f.failed}")
                 add_fit(model, f.engine, None, lambda c: "")
