@@ -20,9 +20,14 @@ add_test(NAME analysis.bench_charts
 add_test(NAME analysis.prediction
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_prediction.py
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
-set_tests_properties(analysis.stats analysis.report analysis.mixed analysis.bench_charts analysis.prediction PROPERTIES
+set_tests_properties(analysis.stats analysis.report analysis.bench_charts analysis.prediction PROPERTIES
                      LABELS analysis TIMEOUT 180
                      # Matplotlib writes its font cache under HOME; keep it out of a read-only or shared home.
+                     ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
+# Wall-time limits for cores shared with other work. analysis.mixed: about 25 s of CPU, most of it R starting and
+# fitting (one Rscript per model, and the tests' own glmer calls), 148 s of wall time with both cores busy.
+# analysis.report: 64 s of CPU (50 s before the lme4 models), 171-222 s of wall time on a loaded machine.
+set_tests_properties(analysis.mixed analysis.report PROPERTIES LABELS analysis TIMEOUT 600
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
 
 # The psychometric fit against psignifit 4, where it is installed (from PyPI; a SKIP line where it is not).
