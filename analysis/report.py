@@ -137,8 +137,9 @@ def thesis_findings(trials, sections):
             if len(rows):
                 r = rows.iloc[0]
                 half = stats.sps.t.ppf(0.975, r["df"]) * r["se"] if r["df"] > 0 else math.nan
-                out[common.STUDY_DEPTH] = (f"{text} = {r['estimate']:.2f} [{r['estimate'] - half:.2f}, "
-                                           f"{r['estimate'] + half:.2f}] ({common.p_text(r['p'])}; {r['model']})")
+                interval = f" [{r['estimate'] - half:.2f}, {r['estimate'] + half:.2f}]" if math.isfinite(half) else ""
+                test = common.p_text(r["p"]) + "; " if math.isfinite(r["p"]) else ""
+                out[common.STUDY_DEPTH] = f"{text} = {r['estimate']:.2f}{interval} ({test}{r['model']})"
                 break
     for study in common.FORCED_CHOICE_STUDIES:
         d = common.study_rows(trials, study)
