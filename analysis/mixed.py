@@ -1,6 +1,7 @@
 """Mixed models across participants fitted by lme4 in R (analysis/models.R), called with data in and a table out.
 
-One Rscript process per model: the data go to a CSV in a temporary folder, models.R fits the maximal
+One Rscript process per report (models.R --serve, started at the first model and kept; R and lme4 take a second to
+start, a model a fraction of that): the data go to a CSV in a temporary folder, models.R fits the maximal
 by-participant model (random intercept and the slopes given), falls back to the random intercept alone when that is
 singular or does not converge, and writes its table back. This module owns the call, its time limit and every
 failure, which come back as a sentence (R missing, a package missing, a fit that failed), never as a traceback.
@@ -8,7 +9,9 @@ failure, which come back as a sentence (R missing, a package missing, a fit that
 BLURCUE_RSCRIPT names the Rscript to run (default: Rscript on PATH, else /usr/bin/Rscript); set it to a path that
 does not exist to see the report without R.
 """
+import atexit
 import os
+import select
 import shutil
 import subprocess
 import tempfile
@@ -38,6 +41,94 @@ class Fit:
     singular: bool = False              # the chosen model's fit is singular
     failed: str = ""                    # not empty: no fixed effects (the reason in words)
     slopes: tuple = ()                  # the columns with a random slope in the fitted model
+
+
+class _Server:
+    """One `Rscript models.R --serve` process: a job per line on its stdin, "done" on its stdout when the table is
+    written. stderr goes to a file (a pipe nobody reads could fill and stall R)."""
+
+    def __init__(self, exe):
+        self.exe = exe
+        self.err = tempfile.TemporaryFile(mode="w+")
+        try:
+            self.proc = subprocess.Popen([exe, "--vanilla", SCRIPT, "--serve"], stdin=subprocess.PIPE,
+                                         stdout=subprocess.PIPE, stderr=self.err, text=True, bufsize=1)
+        except OSError as e:
+            raise Unavailable(f"Rscript could not be started ({e.strerror}): no mixed model")
+
+    def _died(self):
+        code = self.proc.wait()
+        self.err.seek(0)
+        lines = self.err.read().strip().splitlines()
+        if code == 4 and lines and lines[-1].startswith("missing R package:"):
+            package = lines[-1].split(":")[-1].strip()
+            return Unavailable(f"the R package {package} is not installed: no mixed model; install "
+                               f"r-cran-{package.lower()}")
+        return Unavailable(f"Rscript models.R stopped (exit {code}: {lines[-1] if lines else 'no message'}): "
+                           f"no mixed model")
+
+    def run(self, kind, data_path, out_path, slopes):
+        try:
+            self.proc.stdin.write(f"{kind}\t{data_path}\t{out_path}\t{slopes}\n")
+            self.proc.stdin.flush()
+        except (BrokenPipeError, OSError):
+            raise self._died()
+        ready, _, _ = select.select([self.proc.stdout], [], [], TIMEOUT_S)
+        if not ready:
+            self.proc.kill()
+            self.proc.wait()
+            raise Unavailable(f"lme4 did not finish within {TIMEOUT_S} s: no mixed model")
+        line = self.proc.stdout.readline()
+        if line.strip() != "done":
+            raise self._died()
+
+    def close(self):
+        if self.proc.poll() is None:
+            try:
+                self.proc.stdin.close()
+                self.proc.wait(timeout=30)
+            except (OSError, subprocess.TimeoutExpired):
+                self.proc.kill()
+                self.proc.wait()
+        self.err.close()
+
+
+_SERVERS = {}  # Rscript path -> its _Server, or the Unavailable it ended with
+
+
+def _server(exe):
+    """The running server for this Rscript, started on first use; a server that failed keeps its reason."""
+    s = _SERVERS.get(exe)
+    if isinstance(s, Unavailable):
+        raise s
+    if s is None or s.proc.poll() is not None:
+        s = _SERVERS[exe] = _Server(exe)
+    return _Proxy(exe, s)
+
+
+class _Proxy:
+    """Runs a job on a server and remembers a server that died (R or lme4 missing) so the next model says the same
+    without starting R again."""
+
+    def __init__(self, exe, server):
+        self.exe, self.server = exe, server
+
+    def run(self, *job):
+        try:
+            self.server.run(*job)
+        except Unavailable as e:
+            if self.server.proc.poll() is not None:
+                self.server.close()
+                _SERVERS[self.exe] = e if "not installed" in str(e) else None
+            raise
+
+
+@atexit.register
+def _close_servers():
+    for s in list(_SERVERS.values()):
+        if isinstance(s, _Server):
+            s.close()
+    _SERVERS.clear()
 
 
 def rscript():
@@ -96,21 +187,13 @@ def fit(kind, y, design, groups, slopes=()):
     with tempfile.TemporaryDirectory(prefix="blurcue-lme4-") as tmp:
         data_path, out_path = os.path.join(tmp, "data.csv"), os.path.join(tmp, "out.csv")
         frame.to_csv(data_path, index=False, float_format="%.17g")
-        cmd = [exe, "--vanilla", SCRIPT, kind, data_path, out_path, ",".join(code[s] for s in slopes)]
-        try:
-            run = subprocess.run(cmd, capture_output=True, text=True, timeout=TIMEOUT_S)
-        except subprocess.TimeoutExpired:
-            raise Unavailable(f"lme4 did not finish within {TIMEOUT_S} s: no mixed model")
-        except OSError as e:
-            raise Unavailable(f"Rscript could not be started ({e.strerror}): no mixed model")
-        if run.returncode == 4:
-            package = run.stderr.strip().splitlines()[-1].split(":")[-1].strip()
-            raise Unavailable(f"the R package {package} is not installed: no mixed model; install "
-                              f"r-cran-{package.lower()}")
-        if run.returncode != 0 or not os.path.isfile(out_path):
-            last = (run.stderr.strip().splitlines() or ["no message"])[-1]
-            raise Unavailable(f"Rscript models.R failed (exit {run.returncode}: {last}): no mixed model")
+        _server(exe).run(kind, data_path, out_path, ",".join(code[s] for s in slopes))
         out = pd.read_csv(out_path, keep_default_na=True)
+    missing = out[(out["row"] == "info") & (out["term"] == "missing")]
+    if len(missing):
+        package = str(missing["note"].iloc[0])
+        raise Unavailable(f"the R package {package} is not installed: no mixed model; install "
+                          f"r-cran-{package.lower()}")
     out["note"] = out["note"].fillna("").astype(str)
     info = {r["term"]: r["note"] for _, r in out[out["row"] == "info"].iterrows()}
     fixed = out[out["row"] == "fixed"][["term", "estimate", "se", "df", "p"]].copy()
