@@ -513,7 +513,6 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
 
     if n_groups >= 3:
         slopes = mixed.slope_columns(Xr[fit_cols], gr) if estimable else []
-        random = "(1" + "".join(f" + {v}" for v in dict.fromkeys(sources[c] for c in slopes)) + f" | {group})"
         try:
             if not estimable:
                 raise mixed.Unavailable("no term left to fit after the separated ones")
