@@ -24,9 +24,9 @@ set_tests_properties(analysis.stats analysis.report analysis.bench_charts analys
                      LABELS analysis TIMEOUT 180
                      # Matplotlib writes its font cache under HOME; keep it out of a read-only or shared home.
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
-# Wall-time limits for cores shared with other work. analysis.mixed: about 25 s of CPU, most of it R starting and
-# fitting (one Rscript per model, and the tests' own glmer calls), 148 s of wall time with both cores busy.
-# analysis.report: 64 s of CPU (50 s before the lme4 models), 171-222 s of wall time on a loaded machine.
+# Wall-time limits for cores shared with other work. analysis.mixed: 21 s of CPU, most of it R starting and fitting
+# (the tests' own glmer calls start R each), 100-160 s of wall time with both cores busy. analysis.report: 59 s of
+# CPU (50 s before the lme4 models; R starts once per report), 195-246 s of wall time on a loaded machine.
 set_tests_properties(analysis.mixed analysis.report PROPERTIES LABELS analysis TIMEOUT 600
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
 
