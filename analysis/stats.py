@@ -546,13 +546,14 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
     return table, notes
 
 
-# Measured (300 and 200 simulated null data sets: 4 participants, 66 answers each, a true slope 0 whose SD between
-# participants is 0.3 log-odds per edge): the Wald t(G-1) of the maximal glmer rejected at 0.05 in 5.8 % of the
-# data sets where it was kept; the intercept-only fallback's in 39 % (it assumes one slope for everyone); CR1 with
-# t(G-1) 6.5 %. So a GLMM term without the random slope it was offered gets no SE and no p.
+# Measured (analysis/tests/measure_glmm_type1.R, 300 simulated null data sets each: 4 or 8 participants, 66 answers
+# each, a true slope 0 whose SD between participants is 0.3 log-odds per edge): the maximal glmer's Wald t(G-1)
+# rejected at 0.05 in 3.8 % (4 participants) and 5.6 % (8) of the data sets where it was kept; the intercept-only
+# fallback's in 33 % (it assumes one slope for everyone); CR1 with t(G-1) 4.3 % and 5.0 %. So a GLMM term without the
+# random slope it was offered gets no SE and no p.
 UNHELD_LOST_SLOPE = ("; no SE or p: this term's random slope could not be fitted, and without it the GLMM assumes "
                      "every participant has the same effect, which makes its p far too small (in simulation with 4 "
-                     "participants it rejected a true null 39 % of the time) - use the cluster-robust test")
+                     "participants it rejected a true null 33 % of the time) - use the cluster-robust test")
 UNHELD_SINGULAR = ("; no SE or p: a singular fit counts one participant's answers as independent - use the "
                    "cluster-robust test")
 
@@ -598,7 +599,7 @@ def variance_rows(study, model, f, words, unit):
 def disagreements(table):
     """Where the cluster-robust GLM and the lme4 GLMM both give a p for a term and fall on opposite sides of 0.05, a
     note saying what that means. Both tests held their level in simulation with 4 participants (the GLMM with its
-    random slope 5.8 %, CR1 with t(G-1) 6.5 %), and the GLMM gives no p where its test does not hold (a lost random
+    random slope 3.8 %, CR1 with t(G-1) 4.3 %), and the GLMM gives no p where its test does not hold (a lost random
     slope, a singular fit: its note says to use the cluster-robust test), so neither overrules the other: a split is
     borderline evidence."""
     out = []
