@@ -133,7 +133,9 @@ def thesis_findings(trials, sections):
                                    "distance: c ~ d^b with b")):
             rows = t[t["model"].astype(str).str.startswith(label + ":") & (t["term"] == term) &
                      ~t["model"].astype(str).str.contains("observer ") & t["estimate"].notna()]
-            rows = rows.sort_values("engine", key=lambda e: ~e.astype(str).str.startswith("lme4"))
+            # A row with a test first (a mixed model's slope without its random slope has none), lme4 before OLS.
+            rows = rows.assign(_order=rows["p"].isna() * 2 + ~rows["engine"].astype(str).str.startswith("lme4"))
+            rows = rows.sort_values("_order", kind="stable")
             if len(rows):
                 r = rows.iloc[0]
                 half = stats.sps.t.ppf(0.975, r["df"]) * r["se"] if r["df"] > 0 else math.nan

@@ -551,9 +551,10 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
 # rejected at 0.05 in 3.8 % (4 participants) and 5.6 % (8) of the data sets where it was kept; the intercept-only
 # fallback's in 33 % (it assumes one slope for everyone); CR1 with t(G-1) 4.3 % and 5.0 %. So a GLMM term without the
 # random slope it was offered gets no SE and no p.
-UNHELD_LOST_SLOPE = ("; no SE or p: this term's random slope could not be fitted, and without it the GLMM assumes "
-                     "every participant has the same effect, which makes its p far too small (in simulation with 4 "
-                     "participants it rejected a true null 33 % of the time) - use the cluster-robust test")
+UNHELD_LOST_SLOPE = ("; no SE or p: this term's random slope could not be fitted, and without it the model assumes "
+                     "every participant has the same effect, which makes its p far too small (the GLMM's, in "
+                     "simulation with 4 participants, rejected a true null 33 % of the time) - use the "
+                     "cluster-robust test")
 UNHELD_SINGULAR = ("; no SE or p: a singular fit counts one participant's answers as independent - use the "
                    "cluster-robust test")
 

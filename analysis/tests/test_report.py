@@ -100,6 +100,9 @@ class EndToEndTest(ReportTestCase):
         self.assertTrue(model.startswith("study,model,term,estimate,se,df,p,engine,note\n"), model[:80])
         self.assertIn("glmer(chose_first ~ edge_c", model)
         self.assertIn("lme4 ", model)
+        depth = read(out, "depth-matching.csv")  # the match in arcmin by lmer, beside the power law
+        self.assertIn("set on real: lmer(set_arcmin ~ real_arcmin", depth)
+        self.assertIn("power law: lm(log_c ~ log_d), cluster-robust", depth)
         for name in os.listdir(out):  # every model table has the same columns
             if name.endswith("model.csv") or name.endswith("models.csv") or name == "depth-matching.csv":
                 self.assertTrue(read(out, name).startswith("study,model,term,estimate,se,df,p,engine,note"), name)
