@@ -126,7 +126,8 @@ def thesis_findings(trials, sections):
     dm = charts.get("depth-matching")
     if dm is not None and dm.table is not None and not dm.table.empty and "term" in dm.table:
         t = dm.table
-        # The match in arcmin where the record has it (the lmer, else the clustered OLS), else the power law's.
+        # The match in arcmin where the record has it, and the thesis's power law (each: the lmer, else the OLS).
+        found = []
         for label, term, text in (("set on real", "per arcmin of real blur (1 = set as real)",
                                    "set blur against the real picture's blur (arcmin): slope"),
                                   ("power law", "b (per unit of log distance)", "accepted cut-off against "
@@ -141,8 +142,9 @@ def thesis_findings(trials, sections):
                 half = stats.sps.t.ppf(0.975, r["df"]) * r["se"] if r["df"] > 0 else math.nan
                 interval = f" [{r['estimate'] - half:.2f}, {r['estimate'] + half:.2f}]" if math.isfinite(half) else ""
                 test = common.p_text(r["p"]) + "; " if math.isfinite(r["p"]) else ""
-                out[common.STUDY_DEPTH] = f"{text} = {r['estimate']:.2f}{interval} ({test}{r['model']})"
-                break
+                found.append(f"{text} = {r['estimate']:.2f}{interval} ({test}{r['model']})")
+        if found:
+            out[common.STUDY_DEPTH] = "; ".join(found)
     for study in common.FORCED_CHOICE_STUDIES:
         d = common.study_rows(trials, study)
         if d.empty:
