@@ -59,7 +59,7 @@ class EndToEndTest(ReportTestCase):
         self.assertIn("measured chosen over estimated", index)
         self.assertRegex(index, r"c ~ d\^b with b = -?[0-9.]+ \[")
         pngs = sorted(f for f in os.listdir(out) if f.endswith(".png"))
-        expected = {"depth-matching", "test1-per-edge", "test2-per-pattern", "test3-per-pattern",
+        expected = {"depth-matching", "depth-matching-arcmin", "test1-per-edge", "test2-per-pattern", "test3-per-pattern",
                     "test2-pattern2-per-section", "test2-pattern4-per-section", "test2-pattern6-per-section",
                     "test3-pattern2-per-section", "test3-pattern4-per-section", "test3-pattern6-per-section",
                     "psychometric", "side-bias", "frame-intervals", "bench-measure-speed-accuracy", "bench-stability-within-target",
