@@ -182,7 +182,7 @@ def models(m, factors, study, group_note, what):
     for f in factors:
         d[f] = d[f].map(_label)
     rhs = " + ".join(f"C({f}, levels={_sorted_levels(list(d[f].unique()))!r})" for f in factors) if factors else "1"
-    table, notes = stats.observer_models(d, "y", rhs)
+    table, notes = stats.observer_models(d, "y", rhs, study=study)
     if table.empty:
         return Chart(f"{study}-models", None, None, table, notes)
     notes.insert(0, f"{group_note}: logistic models of '{what}' across participants; estimates in log-odds, each "

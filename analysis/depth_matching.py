@@ -1,13 +1,16 @@
-"""Pre-research depth matching (thesis 3.2, Fig. 3.3): the accepted Butterworth cut-off against distance.
+"""Pre-research depth matching (thesis 3.2, Fig. 3.3): the accepted blur against the real picture's.
 
-Each observer accepted one of 22 cut-offs (cycles per picture width) at each of 27 distances (0.4-4 m). The chart
-shows every observer's answers, the pooled geometric mean per distance with its 95 % interval across observers, and
-a power law fitted to all answers: log c = a + b log d, i.e. c = e^a d^b (b < 0: more blur accepted farther away).
+Each observer accepted one of 22 Butterworth cut-offs (cycles per picture width) at each of 27 distances (0.4-4 m)
+of a real picture photographed with the camera focused at 1 m. What the task measures is the match: the blur set
+against the real picture's blur, both in arcmin at the eye (trials.csv's r_scene_arcmin; a level's blur as the
+equivalent Gaussian's). The thesis's power law of cut-off over distance is kept as the replication of its Fig. 3.3,
+with its limit said: the real blur is V-shaped around the focus, so one power law over distance flattens it.
 
-Fits in the table:
-  per observer      ordinary least squares on that observer's answers
-  pooled OLS        all answers, standard errors clustered by observer (repeated answers are not independent)
-  mixed model       statsmodels MixedLM, random intercept per observer (>= 3 observers), REML
+Model table (stats.MODEL_COLUMNS), where the record allows:
+  set on real       set_arcmin ~ real_arcmin: lmer with a random intercept and slope by participant (Satterthwaite
+                    df; intercept-only when that is singular), and pooled OLS with SEs clustered by participant (CR1,
+                    t(G-1)); needs r_scene_arcmin and picture_width_arcmin
+  power law         log c ~ log d: per observer (OLS), pooled OLS clustered as above, and lmer as above
 """
 import math
 import warnings
@@ -18,21 +21,13 @@ import matplotlib.pyplot as plt
 from matplotlib.ticker import FixedLocator, NullLocator
 from scipy import stats as sps
 
+import mixed
 import prediction
+import stats
 from common import Chart, Skip, STUDY_DEPTH, participants_note, save, study_rows
 
 
-def _ols(x, y):
-    """Slope, intercept, R² of y on x; NaNs when x does not vary."""
-    if len(x) < 2 or np.ptp(x) == 0:
-        return math.nan, math.nan, math.nan
-    res = sps.linregress(x, y)
-    return res.intercept, res.slope, res.rvalue ** 2
-
-
 def charts(df, out_dir):
-    import statsmodels.formula.api as smf
-
     d = study_rows(df, STUDY_DEPTH)
     if d.empty:
         raise Skip("depth matching: no trials in trials.csv")
@@ -49,44 +44,11 @@ def charts(df, out_dir):
     if bad:
         notes.append(f"{bad} answers without a positive numeric cut-off ignored")
 
-    rows = []
-    for p in observers:
-        g = a[a["participant"] == p]
-        icpt, slope, r2 = _ols(g["log_d"], g["log_c"])
-        rows.append({"fit": "per observer", "observer": p, "answers": len(g), "a": icpt, "b": slope, "r2": r2})
-
-    pooled = None
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        if a["log_d"].nunique() >= 2:
-            if len(observers) >= 2:
-                pooled = smf.ols("log_c ~ log_d", a).fit(cov_type="cluster",
-                                                         cov_kwds={"groups": pd.factorize(a["participant"])[0]})
-                label = "pooled OLS, cluster-robust SE"
-            else:
-                pooled = smf.ols("log_c ~ log_d", a).fit()
-                label = "pooled OLS (one observer)"
-                notes.append("one participant: no fit across observers; the pooled line is that observer's")
-            ci = pooled.conf_int()
-            rows.append({"fit": label, "observer": "all", "answers": len(a),
-                         "a": pooled.params["Intercept"], "a_low": ci.loc["Intercept", 0], "a_high": ci.loc["Intercept", 1],
-                         "b": pooled.params["log_d"], "b_low": ci.loc["log_d", 0], "b_high": ci.loc["log_d", 1],
-                         "p_b": pooled.pvalues["log_d"], "r2": pooled.rsquared})
-        if len(observers) >= 3:
-            try:
-                mixed = smf.mixedlm("log_c ~ log_d", a, groups=a["participant"]).fit(reml=True)
-                ci = mixed.conf_int()
-                rows.append({"fit": "mixed model (random intercept)", "observer": "all", "answers": len(a),
-                             "a": mixed.fe_params["Intercept"], "a_low": ci.loc["Intercept", 0],
-                             "a_high": ci.loc["Intercept", 1], "b": mixed.fe_params["log_d"],
-                             "b_low": ci.loc["log_d", 0], "b_high": ci.loc["log_d", 1],
-                             "p_b": mixed.pvalues["log_d"], "observer_sd": float(np.sqrt(mixed.cov_re.iloc[0, 0]))})
-            except Exception as e:  # a singular fit on odd data: the pooled fit still stands
-                notes.append(f"mixed model not fitted: {type(e).__name__}")
-        elif len(observers) == 2:
-            notes.append("two participants: too few for a mixed model")
-    table = pd.DataFrame(rows)
-
+    a["set_arcmin"] = (2 * EQUIVALENT_S * pd.to_numeric(a["picture_width_arcmin"], errors="coerce") / a["cutoff"]
+                       if "picture_width_arcmin" in a else np.nan)
+    a["real_arcmin"] = pd.to_numeric(a["r_scene_arcmin"], errors="coerce") if "r_scene_arcmin" in a else np.nan
+    rows, pooled = fits(a, notes)
+    table = stats.model_table(rows)
     # Per distance across observers: geometric mean (mean of log cut-off per observer, then across observers).
     per_obs = a.groupby(["distance_m", "participant"])["log_c"].mean().reset_index()
     summary = per_obs.groupby("distance_m")["log_c"].agg(["mean", "std", "count"]).reset_index()
@@ -109,7 +71,7 @@ def charts(df, out_dir):
                 label="geometric mean" + (" (95 % CI across observers)" if len(observers) >= 2 else ""))
     if pooled is not None:
         grid = np.linspace(a["distance_m"].min(), a["distance_m"].max(), 200)
-        aa, bb = pooled.params["Intercept"], pooled.params["log_d"]
+        aa, bb = pooled
         ax.plot(grid, np.exp(aa) * grid ** bb, color="#D55E00", lw=2, zorder=6,
                 label=f"fit: $c = {math.exp(aa):.1f}\\, d^{{{bb:.2f}}}$ (d in m)")
     ax.set_yscale("log")
@@ -123,8 +85,11 @@ def charts(df, out_dir):
                  "lower cut-off = more blur", loc="left")
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     png, svg = save(fig, out_dir, "depth-matching")
-    notes.append("fit: log c = a + b log d (natural logs, d in m, c in cycles per picture width); b < 0 means more "
-                 "blur is accepted farther away; CIs 95 %")
+    notes.append("power law (the thesis's Fig. 3.3): log c = a + b log d (natural logs, d in m, c in cycles per "
+                 "picture width); b < 0 means more blur is accepted farther away. Its limit: the real picture's blur "
+                 "is V-shaped around the camera's 1 m focus (none at the focus, more nearer and farther), so one power "
+                 "law over distance has a slope near 0 by construction; the match itself is the set blur against the "
+                 "real blur, both in arcmin (the 'set on real' rows)")
     summary = summary.rename(columns={"mean": "mean_log_cutoff", "std": "sd_log_cutoff", "count": "observers"})
     out = [Chart("depth-matching", png, svg, table, notes),
            Chart("depth-matching-per-distance", None, None, summary,
@@ -134,6 +99,104 @@ def charts(df, out_dir):
     if arcmin is not None:
         out.append(arcmin)
     return out
+
+
+WORDS_POWER = {"Intercept": "a (log cut-off at 1 m)", "log_d": "b (per unit of log distance)"}
+# a = 0 would be a cut-off of 1 cycle per picture width at 1 m: no one's hypothesis, so no p for it.
+NO_P_POWER_A = "no p: a = 0 (a cut-off of 1 cycle per picture width at 1 m) is no hypothesis"
+
+
+def _meaningful(term, words, p, note):
+    """The p and note of a row: the power law's intercept gets no p (see NO_P_POWER_A)."""
+    if words is WORDS_POWER and term == "Intercept":
+        return math.nan, (note + "; " if note else "") + NO_P_POWER_A
+    return p, note
+WORDS_MATCH = {"Intercept": "set blur at real blur 0 (arcmin)",
+               "real_arcmin": "per arcmin of real blur (1 = set as real)"}
+
+
+def _ols_rows(g, x, y, model, words, study):
+    """OLS of one observer's y on x: intercept and slope with their t (n-2 df)."""
+    if len(g) < 3 or g[x].nunique() < 2:
+        return []
+    res = sps.linregress(g[x], g[y])
+    df = len(g) - 2
+    out = []
+    for term, est, se in (("Intercept", res.intercept, res.intercept_stderr), (x, res.slope, res.stderr)):
+        p, note = _meaningful(term, words, 2 * sps.t.sf(abs(est / se), df) if se > 0 else math.nan, "")
+        out.append(stats.model_row(study, model, words[term], est, se, df, p, "scipy linregress (OLS)", note))
+    return out
+
+
+def _across(a, x, y, label, words, notes, study):
+    """Pooled OLS clustered by participant and the lmer of y on x with a random intercept and slope by participant;
+    rows and the pooled (intercept, slope)."""
+    import statsmodels
+    import statsmodels.api as sm
+    rows, pooled = [], None
+    X = pd.DataFrame({"Intercept": 1.0, x: a[x].to_numpy(float)}, index=a.index)
+    groups = a["participant"].astype(str).to_numpy()
+    n_groups = len(set(groups))
+    version = statsmodels.__version__.split("+")[0]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        if n_groups >= 2:
+            t = stats.cluster_robust(a[y].to_numpy(float), X, groups, family=sm.families.Gaussian())
+            engine = f"statsmodels {version} OLS cluster-robust CR1, t(G-1)"
+            model = f"lm({y} ~ {x}), cluster-robust"
+        else:
+            res = sm.OLS(a[y].to_numpy(float), X).fit()
+            t = pd.DataFrame({"term": list(X.columns), "estimate": res.params.to_numpy(), "se": res.bse.to_numpy(),
+                              "df": res.df_resid, "p": res.pvalues.to_numpy()})
+            engine = f"statsmodels {version} OLS (one observer)"
+            model = f"lm({y} ~ {x}) (one observer)"
+    for _, r in t.iterrows():
+        p, note = _meaningful(r["term"], words, r["p"], "")
+        rows.append(stats.model_row(study, f"{label}: {model}", words[r["term"]], r["estimate"], r["se"], r["df"],
+                                    p, engine, note))
+    pooled = (float(t["estimate"].iloc[0]), float(t["estimate"].iloc[1]))
+    if n_groups >= 3:
+        try:
+            f = mixed.fit("lmm", a[y].to_numpy(float), X, groups, slopes=[x])
+        except mixed.Unavailable as e:
+            notes.append(f"{label}: mixed model not fitted: {e}")
+            return rows, pooled
+        random = f"(1 + {x} | participant)" if f.slopes else "(1 | participant)"
+        model = f"{label}: lmer({y} ~ {x} + {random})"
+        if f.failed:
+            notes.append(f"{label}: mixed model {f.failed}")
+            return rows, pooled
+        status = f.structure + ("; singular fit" if f.singular else "")
+        for _, r in stats.without_unheld_tests(f, [x]).iterrows():
+            p, note = _meaningful(r["term"], words, r["p"], status + r["why"])
+            rows.append(stats.model_row(study, model, words[r["term"]], r["estimate"], r["se"], r["df"], p,
+                                        f.engine, note))
+        rows += stats.variance_rows(study, model, f, words, "arcmin" if y == "set_arcmin" else "log cut-off")
+    elif n_groups == 2:
+        notes.append(f"{label}: two participants, too few for a mixed model")
+    return rows, pooled
+
+
+def fits(a, notes):
+    """The depth-matching model table's rows and the pooled power law (a, b) for the chart (None without one)."""
+    rows, pooled = [], None
+    study = STUDY_DEPTH
+    m = a[a["set_arcmin"].notna() & a["real_arcmin"].notna()]
+    if len(m) >= 3 and m["real_arcmin"].nunique() >= 2:
+        r, _ = _across(m, "real_arcmin", "set_arcmin", "set on real", WORDS_MATCH, notes, study)
+        rows += r
+    elif len(a):
+        notes.append("no set-on-real model: trials.csv has no r_scene_arcmin / picture_width_arcmin (the real "
+                     "picture's blur in visual angle); only the power law over distance")
+    if a["log_d"].nunique() >= 2:
+        if a["participant"].nunique() == 1:
+            notes.append("one participant: no fit across observers; the pooled line is that observer's")
+        r, pooled = _across(a, "log_d", "log_c", "power law", WORDS_POWER, notes, study)
+        rows += r
+        for p in sorted(a["participant"].unique()):
+            rows += _ols_rows(a[a["participant"] == p], "log_d", "log_c", f"power law: observer {p}",
+                              WORDS_POWER, study)
+    return rows, pooled
 
 
 def _model_median(v):

@@ -115,10 +115,10 @@ def _model(d, formula_rhs, title, extra=None):
     """Logistic models across observers of 'chose the first source' among decisive answers (see stats.observer_models)."""
     dec = d[d["answered"] & d["decisive"]].copy()
     dec["chose_first"] = (dec["chosen_source"] == dec["first"]).astype(float)
-    table, notes = stats.observer_models(dec, "chose_first", formula_rhs)
-    if extra is not None and not table.empty:
-        for k, v in extra.items():
-            table.insert(0, k, v)
+    study = str(dec["study"].iloc[0]) if "study" in dec and len(dec) else ""
+    table, notes = stats.observer_models(dec, "chose_first", formula_rhs, study=study)
+    if extra is not None and not table.empty:  # e.g. the pattern, named in the model column (the columns are fixed)
+        table["model"] = ", ".join(f"{k} {v}" for k, v in extra.items()) + ": " + table["model"]
     return table, [f"{title}: {n}" for n in notes]
 
 

@@ -129,13 +129,27 @@ def thesis_findings(trials, sections):
     out = {}
     charts = {c.name: c for _, cs, _ in sections for c in cs}
     dm = charts.get("depth-matching")
-    if dm is not None and dm.table is not None and not dm.table.empty and "b_low" in dm.table:
-        pooled = dm.table[dm.table["fit"].astype(str).str.startswith("pooled")]
-        if len(pooled):
-            r = pooled.iloc[0]
-            out[common.STUDY_DEPTH] = (f"accepted cut-off against distance: c ~ d^b with b = {r['b']:.2f} "
-                                       f"[{r['b_low']:.2f}, {r['b_high']:.2f}] ({common.p_text(r['p_b'])}); b < 0: "
-                                       f"more blur accepted farther away")
+    if dm is not None and dm.table is not None and not dm.table.empty and "term" in dm.table:
+        t = dm.table
+        # The match in arcmin where the record has it, and the thesis's power law (each: the lmer, else the OLS).
+        found = []
+        for label, term, text in (("set on real", "per arcmin of real blur (1 = set as real)",
+                                   "set blur against the real picture's blur (arcmin): slope"),
+                                  ("power law", "b (per unit of log distance)", "accepted cut-off against "
+                                   "distance: c ~ d^b with b")):
+            rows = t[t["model"].astype(str).str.startswith(label + ":") & (t["term"] == term) &
+                     ~t["model"].astype(str).str.contains("observer ") & t["estimate"].notna()]
+            # A row with a test first (a mixed model's slope without its random slope has none), lme4 before OLS.
+            rows = rows.assign(_order=rows["p"].isna() * 2 + ~rows["engine"].astype(str).str.startswith("lme4"))
+            rows = rows.sort_values("_order", kind="stable")
+            if len(rows):
+                r = rows.iloc[0]
+                half = stats.sps.t.ppf(0.975, r["df"]) * r["se"] if r["df"] > 0 else math.nan
+                interval = f" [{r['estimate'] - half:.2f}, {r['estimate'] + half:.2f}]" if math.isfinite(half) else ""
+                test = common.p_text(r["p"]) + "; " if math.isfinite(r["p"]) else ""
+                found.append(f"{text} = {r['estimate']:.2f}{interval} ({test}{r['model']})")
+        if found:
+            out[common.STUDY_DEPTH] = "; ".join(found)
     for study in common.FORCED_CHOICE_STUDIES:
         d = common.study_rows(trials, study)
         if d.empty:

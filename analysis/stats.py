@@ -301,7 +301,6 @@ def threshold(fit, p=0.75):
 
 MIN_ANSWERS = 10        # fewer decisive answers than this: no model, a note instead
 MIN_EACH_OUTCOME = 2    # and at least this many of each outcome (else the log-odds run off to infinity)
-SEPARATION_LOGODDS = 10  # |log-odds| beyond this (odds 22000:1) from a GLM means separation, not an estimate
 
 
 # What the model terms mean, in words, for the page (patsy's names are for programs): centred covariates by their
@@ -334,103 +333,286 @@ def term_in_words(term, data):
     return f"{name} {level} (against {name} {base})"
 
 
-def observer_models(data, response, formula_rhs, group="participant"):
-    """Logistic models of a 0/1 response across observers; returns (table, notes).
+# Every model table has these columns and no others: one row per (model, term), terms in words, the engine that
+# fitted it, and a note where a value is missing or needs words (separation, a singular fit, a fallback).
+MODEL_COLUMNS = ["study", "model", "term", "estimate", "se", "df", "p", "engine", "note"]
+SEPARATION_NOTE = ("separation: every answer behind this term went one way, so it has no finite estimate and no p "
+                   "(found by the linear program of Konis 2007, not by the size of a fit); see the binomial test of "
+                   "its cell")
 
-    Two models where the data allow, one row per (model, term):
-      - 'GLM, cluster-robust SE': a logistic GLM whose standard errors are clustered by observer, so repeated answers
-        of one observer do not count as independent evidence (sandwich estimator; optimistic with < 5 observers).
-      - 'GLMM (random intercept, VB)': statsmodels' BinomialBayesMixedGLM with a random intercept per observer, fitted
-        by variational Bayes; estimate = posterior mean, se = posterior SD, p from the normal approximation. Its
-        'observer SD' row is the posterior mean SD of the observers' intercepts (log-odds).
-    With one observer only a plain logistic GLM is fitted (its SEs treat the answers as independent), and said so.
-    """
+
+def model_row(study, model, term, estimate=math.nan, se=math.nan, df=math.nan, p=math.nan, engine="", note=""):
+    return {"study": study, "model": model, "term": term, "estimate": estimate, "se": se, "df": df, "p": p,
+            "engine": engine, "note": note}
+
+
+def model_table(rows):
+    return pd.DataFrame(rows, columns=MODEL_COLUMNS)
+
+
+def separation(X, y, tol=1e-6):
+    """Which coefficients of a logistic model of y (0/1) on the design X have no finite maximum-likelihood estimate,
+    and which answers they predict perfectly: (infinite column indices, boolean mask of separated rows).
+
+    A direction b with s_i x_i.b >= 0 for every answer (s_i = +1 for y = 1, -1 for y = 0) and > 0 for some raises the
+    likelihood without end along b (Albert & Anderson 1984); Konis (2007) finds such directions by linear programming
+    with b in [-1, 1]. Coefficient j is infinite when some such direction has b_j != 0: two programs per column (max
+    and min b_j), plus Konis's own (max sum_i s_i x_i.b) for the rows. A large finite effect (49 answers one way, 3 the
+    other) has no such direction and is not flagged, however large its log-odds."""
+    from scipy.optimize import linprog
+    X = np.asarray(X, float)
+    s = 2 * np.asarray(y, float) - 1
+    A = s[:, None] * X
+    n, k = A.shape
+    scale = max(1.0, float(np.abs(X).max(initial=0.0)))
+    bounds = [(-1.0, 1.0)] * k
+    infinite, total = set(), np.zeros(k)
+    objectives = [-A.sum(axis=0)]
+    for j in range(k):
+        for sign in (1.0, -1.0):
+            c = np.zeros(k)
+            c[j] = -sign
+            objectives.append(c)
+    for c in objectives:
+        res = linprog(c, A_ub=-A, b_ub=np.zeros(n), bounds=bounds, method="highs")
+        if res.status != 0 or -res.fun <= tol * scale:
+            continue
+        margin = A @ res.x
+        if margin.max() <= tol * scale:  # a direction along a collinear design, not a separating one
+            continue
+        total += res.x
+        infinite |= {j for j in range(k) if abs(res.x[j]) > tol}
+    rows = (A @ total) > tol * scale if infinite else np.zeros(n, bool)
+    return sorted(infinite), rows
+
+
+def cluster_robust(y, X, groups, family=None):
+    """A GLM (logistic by default) with standard errors clustered by group: sandwich with the CR1 small-sample factor
+    G/(G-1) (N-1)/(N-K) (statsmodels' correction), and t with G-1 df for the p-values - with 3-4 participants a normal
+    reference would call t = 5 'p < 1e-6' where t(3) gives 0.015. Returns a DataFrame term, estimate, se, df, p."""
     import statsmodels.api as sm
-    import statsmodels.formula.api as smf
-    from statsmodels.genmod.bayes_mixed_glm import BinomialBayesMixedGLM
+    family = family or sm.families.Binomial()
+    codes = pd.factorize(np.asarray(groups))[0]
+    G = int(codes.max()) + 1
+    res = sm.GLM(np.asarray(y, float), X, family=family).fit(
+        cov_type="cluster", cov_kwds={"groups": codes, "use_correction": True})
+    est, se = np.asarray(res.params, float), np.asarray(res.bse, float)
+    t = est / se
+    return pd.DataFrame({"term": list(X.columns), "estimate": est, "se": se, "df": float(G - 1),
+                         "p": 2 * sps.t.sf(np.abs(t), G - 1)})
 
-    notes = []
-    rows = []
+
+def _formula_text(response, rhs, random=None):
+    """The model as R users write it: patsy's C(f, levels=[...]) as f, the random part beside it."""
+    import re
+    text = re.sub(r"C\((\w+)(?:, levels=\[[^\]]*\])?\)", r"\1", rhs)
+    return f"{response} ~ {text}" + (f" + {random}" if random else "")
+
+
+def _term_sources(X):
+    """Design column -> the variable it comes from, in R's words ('C(edge)[T.6]' -> 'edge')."""
+    import re
+    out = {}
+    for term, sl in X.design_info.term_slices.items():
+        name = term.name()
+        name = re.sub(r"C\((\w+)(?:, levels=\[[^\]]*\])?\)", r"\1", name)
+        for col in X.columns[sl]:
+            out[col] = name
+    return out
+
+
+def observer_models(data, response, formula_rhs, group="participant", study=""):
+    """Logistic models of a 0/1 response across observers; returns (table, notes), the table in MODEL_COLUMNS.
+
+    - GLM, cluster-robust: a logistic GLM (statsmodels) with SEs clustered by participant (CR1) and p from t(G-1).
+      Population-averaged; needs no R.
+    - GLMM by lme4 (>= 3 participants): glmer, Laplace, with the maximal by-participant random part (intercept and
+      slopes of the within-participant terms), the random intercept alone when that is singular or does not converge
+      (the note says which and why); p from the Wald statistic against t(G-1), since with a handful of participants
+      the normal reference is far too liberal. Its 'observer SD' rows are the SDs of the participants' effects; one
+      estimated at 0 (a singular fit) is said in words.
+    - one participant: a plain logistic GLM (answers treated as independent), said so.
+    Separation (a term whose answers all went one way) is found before any fit (separation()); such a term gets no
+    estimate and no p in either model, and the other terms are fitted on the answers it does not predict perfectly
+    (the limit of the maximum-likelihood fit). Without R the table has the GLM and a note saying the GLMM is missing.
+    """
+    import patsy
+    import statsmodels
+    import statsmodels.api as sm
+    import mixed
+
+    notes, rows = [], []
     d = data.dropna(subset=[response]).copy()
     d[response] = d[response].astype(float)
     n = len(d)
     ones = int(d[response].sum())
-    groups = d[group].astype(str)
-    n_groups = groups.nunique()
     if n < MIN_ANSWERS or min(ones, n - ones) < MIN_EACH_OUTCOME:
         notes.append(f"no model across observers: {n} decisive answers ({ones} of one kind, {n - ones} of the other); "
                      f"needs >= {MIN_ANSWERS} with >= {MIN_EACH_OUTCOME} of each")
-        return pd.DataFrame(rows), notes
-    formula = f"{response} ~ {formula_rhs}"
+        return model_table(rows), notes
+    y, X = patsy.dmatrices(f"{response} ~ {formula_rhs}", d, return_type="dataframe")
+    d = d.loc[X.index]
+    y = y.iloc[:, 0].to_numpy(float)
+    groups = d[group].astype(str).to_numpy()
+    n_groups = len(set(groups))
+    sources = _term_sources(X)
+    words = {c: term_in_words(c, d) for c in X.columns}
 
-    def add(model, term, est, se, note=""):
-        z = est / se if se and se > 0 else math.nan
-        p = 2 * sps.norm.sf(abs(z)) if not math.isnan(z) else math.nan
-        rows.append({"model": model, "term": term, "estimate_logodds": est, "se": se, "z": z, "p": p,
-                     "ci_low": est - Z95 * se, "ci_high": est + Z95 * se, "odds_ratio": math.exp(est)
-                     if abs(est) < 700 else math.inf, "answers": n, "observers": n_groups, "note": note})
+    # Separation first: its terms are missing from every model, the rest fitted on the answers it leaves.
+    infinite, separated = separation(X.to_numpy(float), y)
+    infinite_cols = [X.columns[j] for j in infinite]
+    keep = ~separated
+    Xr = X.loc[keep, [c for c in X.columns if np.any(X.loc[keep, c] != 0)]]
+    yr, gr = y[keep], groups[keep]
+    fit_cols = [c for c in Xr.columns if c not in infinite_cols]
+    estimable = len(fit_cols) > 0 and np.linalg.matrix_rank(Xr.to_numpy(float)) == Xr.shape[1] and \
+        min(yr.sum(), len(yr) - yr.sum()) >= 1
+    if infinite_cols:
+        notes.append(f"separation in {', '.join(words[c] for c in infinite_cols)}: "
+                     f"{int(separated.sum())} answers that those terms predict perfectly left out of the other "
+                     f"terms' fits" + ("" if estimable else "; no other term can be estimated apart from them"))
+    sm_version = statsmodels.__version__.split("+")[0]
 
+    def add_fit(model, engine, table, note_of):
+        by_term = {r["term"]: r for _, r in table.iterrows()} if table is not None else {}
+        for c in X.columns:
+            if c in infinite_cols:
+                rows.append(model_row(study, model, words[c], engine=engine, note=SEPARATION_NOTE))
+            elif c in by_term:
+                r = by_term[c]
+                rows.append(model_row(study, model, words[c], r["estimate"], r["se"], r["df"], r["p"], engine,
+                                      note_of(c)))
+            else:
+                rows.append(model_row(study, model, words[c], engine=engine,
+                                      note="not estimable apart from the separated terms"))
+
+    # GLM across observers (or the one observer's).
+    formula = _formula_text(response, formula_rhs)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
+        table = None
         try:
-            if n_groups >= 2:
-                res = smf.glm(formula, d, family=sm.families.Binomial()).fit(
-                    cov_type="cluster", cov_kwds={"groups": pd.factorize(groups)[0]})
-                label = "GLM, cluster-robust SE"
-                note = "few observers: robust SE optimistic" if n_groups < 5 else ""
+            if not estimable:
+                pass
+            elif n_groups >= 2:
+                table = cluster_robust(yr, Xr, gr)
             else:
-                res = smf.glm(formula, d, family=sm.families.Binomial()).fit()
-                label = "GLM (one observer)"
-                note = "one observer: answers treated as independent"
-                notes.append("one participant: no model across observers; plain logistic GLM instead")
-            for term in res.params.index:
-                est, se = float(res.params[term]), float(res.bse[term])
-                if abs(est) > SEPARATION_LOGODDS:
-                    # Every answer behind this term went one way: the ML estimate runs off to infinity and its SE
-                    # means nothing. Say so rather than print a log-odds of 23.
-                    rows.append({"model": label, "term": term, "answers": n, "observers": n_groups,
-                                 "note": "separation: all answers one way, no finite estimate (see the binomial test)"})
-                    continue
-                add(label, term, est, se, note)
-        except Exception as e:  # perfect separation, singular design: say so instead of a traceback
+                res = sm.GLM(yr, Xr, family=sm.families.Binomial()).fit()
+                z = np.asarray(res.params) / np.asarray(res.bse)
+                table = pd.DataFrame({"term": list(Xr.columns), "estimate": res.params.to_numpy(),
+                                      "se": res.bse.to_numpy(), "df": math.nan, "p": 2 * sps.norm.sf(np.abs(z))})
+        except Exception as e:  # a singular design: say so instead of a traceback
             notes.append(f"logistic GLM not fitted: {type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''}")
+        if n_groups >= 2:
+            add_fit(f"glm({formula}), cluster-robust", f"statsmodels {sm_version} GLM cluster-robust CR1, t(G-1)",
+                    table, lambda c: "")
+        else:
+            notes.append("one participant: no model across observers; plain logistic GLM instead")
+            add_fit(f"glm({formula})", f"statsmodels {sm_version} GLM (one observer), Wald z", table,
+                    lambda c: "one observer: answers treated as independent")
 
-        if n_groups >= 3:
-            try:
-                model = BinomialBayesMixedGLM.from_formula(formula, {"observer": f"0 + C({group})"}, d)
-                vb = model.fit_vb()
-                for i, term in enumerate(model.exog_names):
-                    add("GLMM (random intercept, VB)", term, float(vb.fe_mean[i]), float(vb.fe_sd[i]))
-                rows.append({"model": "GLMM (random intercept, VB)", "term": "observer SD",
-                             "estimate_logodds": float(np.exp(vb.vcp_mean[0])), "answers": n, "observers": n_groups,
-                             "note": "SD of observers' intercepts"})
-            except Exception as e:
-                notes.append(f"GLMM not fitted: {type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''}")
-        elif n_groups == 2:
-            notes.append("two participants: too few for a random-intercept GLMM; cluster-robust GLM only")
-    table = pd.DataFrame(rows)
+    if n_groups >= 3:
+        slopes = mixed.slope_columns(Xr[fit_cols], gr) if estimable else []
+        try:
+            if not estimable:
+                raise mixed.Unavailable("no term left to fit after the separated ones")
+            f = mixed.fit("glmm", yr, Xr, gr, slopes)
+        except mixed.Unavailable as e:
+            notes.append(f"GLMM not fitted: {e}")
+            f = None
+        if f is not None:
+            random = "(1" + "".join(f" + {v}" for v in dict.fromkeys(sources[c] for c in f.slopes)) + f" | {group})"
+            model = f"glmer({_formula_text(response, formula_rhs, random)})"
+            status = f.structure + ("; singular fit (the participants' spread estimated at 0)" if f.singular
+                                    else "")
+            for c in sorted(slopes, key=len, reverse=True):  # the slopes by their words, not patsy's names
+                status = status.replace(c, words[c])
+            if f.failed:
+                notes.append(f"GLMM: {f.failed}")
+                add_fit(model, f.engine, None, lambda c: "")
+                for r in rows:
+                    if r["model"] == model and not r["note"]:
+                        r["note"] = f"no estimate: {f.failed}"
+            else:
+                fixed = without_unheld_tests(f, slopes)
+                add_fit(model, f.engine, fixed, lambda c: status + fixed.set_index("term")["why"].get(c, ""))
+                rows += variance_rows(study, model, f, words, "log-odds")
+    elif n_groups == 2:
+        notes.append("two participants: too few for a GLMM (a spread between participants from two is not an "
+                     "estimate); cluster-robust GLM only")
+    table = model_table(rows)
     if not table.empty:
-        table["term"] = [term_in_words(t, d) for t in table["term"]]
         notes += disagreements(table)
     return table, notes
 
 
+# Measured (analysis/tests/measure_glmm_type1.R, 300 simulated null data sets each: 4 or 8 participants, 66 answers
+# each, a true slope 0 whose SD between participants is 0.3 log-odds per edge): the maximal glmer's Wald t(G-1)
+# rejected at 0.05 in 3.8 % (4 participants) and 5.6 % (8) of the data sets where it was kept; the intercept-only
+# fallback's in 33 % (it assumes one slope for everyone); CR1 with t(G-1) 4.3 % and 5.0 %. So a GLMM term without the
+# random slope it was offered gets no SE and no p.
+UNHELD_LOST_SLOPE = ("; no SE or p: this term's random slope could not be fitted, and without it the model assumes "
+                     "every participant has the same effect, which makes its p far too small (the GLMM's, in "
+                     "simulation with 4 participants, rejected a true null 33 % of the time) - use the "
+                     "cluster-robust test")
+UNHELD_SINGULAR = ("; no SE or p: a singular fit counts one participant's answers as independent - use the "
+                   "cluster-robust test")
+
+
+def without_unheld_tests(f, offered):
+    """A mixed.Fit's fixed effects with se, df and p blanked (and a 'why' column) where the test does not hold: the
+    fit is singular, or the term was offered a random slope that the fitted model does not have."""
+    fixed = f.fixed.copy()
+    fixed["why"] = ""
+    lost = set(offered) - set(f.slopes)
+    for i, term in fixed["term"].items():
+        why = UNHELD_SINGULAR if f.singular else (UNHELD_LOST_SLOPE if term in lost else "")
+        if why:
+            fixed.loc[i, ["se", "df", "p"]] = math.nan
+            fixed.loc[i, "why"] = why
+    return fixed
+
+
+def variance_rows(study, model, f, words, unit):
+    """The rows of a mixed.Fit's SDs and correlations of the participants' effects: one estimated at its bound (a
+    singular fit) in words, never as a number."""
+    rows = []
+
+    def name(t):
+        if t == "Intercept":
+            return "baseline (intercept)" if "Intercept" in words else "intercept"
+        return words.get(t, t)
+    for term, value, singular in f.sds:
+        if term == "Residual":
+            rows.append(model_row(study, model, "residual SD", value, engine=f.engine, note=f"SD within a "
+                                  f"participant ({unit})"))
+            continue
+        rows.append(model_row(study, model, f"observer SD: {name(term)}", math.nan if singular else value,
+                              engine=f.engine, note="singular: estimated at 0, on its bound - no spread between "
+                              "participants detectable" if singular else f"SD of the participants' effects ({unit})"))
+    for (a, b), value, singular in f.corrs:
+        rows.append(model_row(study, model, f"observer correlation: {name(a)} with {name(b)}",
+                              math.nan if singular else value, engine=f.engine,
+                              note="singular: at +-1" if singular else ""))
+    return rows
+
+
 def disagreements(table):
-    """Where the GLM and the GLMM disagree on a term (one has no finite estimate, or one is significant at 0.05 and the
-    other not), a note saying which to trust and why."""
+    """Where the cluster-robust GLM and the lme4 GLMM both give a p for a term and fall on opposite sides of 0.05, a
+    note saying what that means. Both tests held their level in simulation with 4 participants (the GLMM with its
+    random slope 3.8 %, CR1 with t(G-1) 4.3 %), and the GLMM gives no p where its test does not hold (a lost random
+    slope, a singular fit: its note says to use the cluster-robust test), so neither overrules the other: a split is
+    borderline evidence."""
     out = []
-    glm = table[table["model"].str.startswith("GLM,") | table["model"].str.startswith("GLM (")]
-    glmm = table[table["model"].str.startswith("GLMM")]
-    for term in [t for t in glm["term"] if t in set(glmm["term"])]:
+    glm = table[table["engine"].astype(str).str.contains("cluster-robust")]
+    glmm = table[table["engine"].astype(str).str.startswith("lme4")]
+    for term in [t for t in glm["term"] if t in set(glmm["term"]) and not str(t).startswith("observer ")]:
         a, b = glm[glm["term"] == term].iloc[0], glmm[glmm["term"] == term].iloc[0]
-        separation = "separation" in str(a.get("note", ""))
-        pa, pb = a.get("p", math.nan), b.get("p", math.nan)
-        split = not separation and not (pd.isna(pa) or pd.isna(pb)) and (pa < 0.05) != (pb < 0.05)
-        if separation or split:
-            glm_text = "no finite estimate (every answer behind it went one way)" if separation else \
-                ("p < 0.001" if pa < 0.001 else f"p = {pa:.3f}")
-            glmm_text = "p < 0.001" if pb < 0.001 else f"p = {pb:.3f}"
-            out.append(f"{term}: the GLM says {glm_text}, the GLMM {glmm_text} - trust the GLMM: it shrinks each "
-                       f"participant's estimate toward the group, so it has an estimate where every answer of a cell "
-                       f"went one way, and it does not count one participant's repeated answers as independent")
+        pa, pb = a["p"], b["p"]
+        if pd.isna(pa) or pd.isna(pb) or (pa < 0.05) == (pb < 0.05):
+            continue
+        text = lambda p: "p < 0.001" if p < 0.001 else f"p = {p:.3f}"
+        out.append(f"{term}: the cluster-robust GLM says {text(pa)}, the GLMM {text(pb)} - borderline: both tests "
+                   f"hold their level with few participants, so neither overrules the other; the GLMM's estimate is "
+                   f"a typical participant's effect, the GLM's the population average (smaller in log-odds)")
     return out

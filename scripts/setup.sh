@@ -11,6 +11,7 @@ PACKAGES=(
   libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libglfw3-dev libglm-dev xvfb xauth xdotool
   python3-pandas python3-matplotlib python3-scipy python3-statsmodels python3-jsonschema python3-numpy python3-pil
   python3-questplus
+  r-base-core r-cran-lme4 r-cran-lmertest r-cran-pbkrtest r-cran-emmeans
 )
 # --tests: what only the tests need besides - a real browser to open the report as a reader would.
 [ "${1:-}" = "--tests" ] && PACKAGES+=(chromium)

@@ -9,6 +9,11 @@ add_test(NAME analysis.stats
 add_test(NAME analysis.report
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_report.py
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# The models across observers by lme4 (analysis/models.R) against a direct glmer call, simulated observers and
+# hand-worked cells; the R-absent path. Rscript from Debian (r-base-core, r-cran-lme4, r-cran-lmertest).
+add_test(NAME analysis.mixed
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_mixed.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 add_test(NAME analysis.bench_charts
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_bench_charts.py
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
@@ -21,6 +26,11 @@ add_test(NAME analysis.design
 set_tests_properties(analysis.stats analysis.report analysis.bench_charts analysis.prediction analysis.design PROPERTIES
                      LABELS analysis TIMEOUT 180
                      # Matplotlib writes its font cache under HOME; keep it out of a read-only or shared home.
+                     ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
+# Wall-time limits for cores shared with other work. analysis.mixed: 21 s of CPU, most of it R starting and fitting
+# (the tests' own glmer calls start R each), 100-160 s of wall time with both cores busy. analysis.report: 59 s of
+# CPU (50 s before the lme4 models; R starts once per report), 195-246 s of wall time on a loaded machine.
+set_tests_properties(analysis.mixed analysis.report PROPERTIES LABELS analysis TIMEOUT 600
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
 
 # The psychometric fit against psignifit 4, where it is installed (from PyPI; a SKIP line where it is not).

@@ -87,8 +87,11 @@ def trials_rows(participants=("P1", "P2", "P3", "P4", "P5", "P6"), studies=None,
                 for practice, d in design:
                     wanted = 35 * d ** -0.8 * math.exp(offset + rng.normal(0, 0.25))
                     cut = min(DEPTH_LEVELS, key=lambda c: abs(math.log(c / wanted)))
+                    # The real picture's blur in arcmin, V-shaped around the camera's 1 m focus, and the picture's
+                    # width at the eye (content.real_camera): what the depth-matching LMM regresses the set blur on.
                     trials.append(({"block_name": "matching", "distance_m": float(d), "practice": practice,
-                                    "start_level": int(rng.integers(0, 22))}, 0, None, None, str(cut)))
+                                    "start_level": int(rng.integers(0, 22)), "r_scene_arcmin": 6.0 * abs(1 / d - 1),
+                                    "picture_width_arcmin": 600.0}, 0, None, None, str(cut)))
             elif study == "test1-static-grids":
                 swapped = number % 2 == 0  # by_participant counterbalancing
                 edges = list(rng.permutation(range(1, 12)))

@@ -59,7 +59,7 @@ class EndToEndTest(ReportTestCase):
         self.assertIn("measured chosen over estimated", index)
         self.assertRegex(index, r"c ~ d\^b with b = -?[0-9.]+ \[")
         pngs = sorted(f for f in os.listdir(out) if f.endswith(".png"))
-        expected = {"depth-matching", "test1-per-edge", "test2-per-pattern", "test3-per-pattern",
+        expected = {"depth-matching", "depth-matching-arcmin", "test1-per-edge", "test2-per-pattern", "test3-per-pattern",
                     "test2-pattern2-per-section", "test2-pattern4-per-section", "test2-pattern6-per-section",
                     "test3-pattern2-per-section", "test3-pattern4-per-section", "test3-pattern6-per-section",
                     "psychometric", "side-bias", "frame-intervals", "bench-measure-speed-accuracy", "bench-stability-within-target",
@@ -96,7 +96,16 @@ class EndToEndTest(ReportTestCase):
         t1 = read(out, "test1-per-edge.csv").splitlines()
         self.assertEqual(len(t1), 12)  # header + 11 edges
         self.assertIn("p_binom", t1[0])
-        self.assertIn("GLMM (random intercept, VB)", read(out, "test1-model.csv"))
+        model = read(out, "test1-model.csv")
+        self.assertTrue(model.startswith("study,model,term,estimate,se,df,p,engine,note\n"), model[:80])
+        self.assertIn("glmer(chose_first ~ edge_c", model)
+        self.assertIn("lme4 ", model)
+        depth = read(out, "depth-matching.csv")  # the match in arcmin by lmer, beside the power law
+        self.assertIn("set on real: lmer(set_arcmin ~ real_arcmin", depth)
+        self.assertIn("power law: lm(log_c ~ log_d), cluster-robust", depth)
+        for name in os.listdir(out):  # every model table has the same columns
+            if name.endswith("model.csv") or name.endswith("models.csv") or name == "depth-matching.csv":
+                self.assertTrue(read(out, name).startswith("study,model,term,estimate,se,df,p,engine,note"), name)
 
         # The two checks: side bias per study and pooled (+ per participant), display timing per window session.
         self.assertRegex(err, r"report: \[\d+/\d+\] side bias \(counterbalancing check\) \.\.\.")
@@ -197,8 +206,8 @@ class EdgeCaseTest(ReportTestCase):
         for chart in ("depth-matching", "test1-per-edge", "test2-per-pattern"):
             self.assertTrue(os.path.isfile(os.path.join(out, chart + ".png")), chart)
         model = read(out, "depth-matching.csv")
-        self.assertIn("pooled OLS (one observer)", model)
-        self.assertNotIn("mixed model", model)
+        self.assertIn("lm(log_c ~ log_d) (one observer)", model)
+        self.assertNotIn("lmer(", model)
 
     def test_missing_bench_folder(self):
         rows = synthetic.trials_rows(participants=("P1", "P2"), studies=["pre-research-depth-matching"])

@@ -172,13 +172,16 @@ class ObserverModelTest(unittest.TestCase):
 
     def test_several_observers(self):
         table, notes = stats.observer_models(self.frame(list("ABCDEF"), 44), "y", "edge")
-        self.assertEqual(set(table["model"]), {"GLM, cluster-robust SE", "GLMM (random intercept, VB)"})
-        slope = table[(table["model"] == "GLM, cluster-robust SE") & (table["term"] == "edge")].iloc[0]
-        self.assertAlmostEqual(slope["estimate_logodds"], 0.5, delta=0.2)
+        self.assertEqual(list(table.columns), stats.MODEL_COLUMNS)
+        glm = table[table["engine"].str.contains("cluster-robust")]
+        self.assertEqual(set(glm["df"]), {5.0})  # t with G - 1 = 5 df
+        slope = glm[glm["term"] == "edge"].iloc[0]
+        self.assertAlmostEqual(slope["estimate"], 0.5, delta=0.2)
 
     def test_one_observer_falls_back_with_a_note(self):
         table, notes = stats.observer_models(self.frame(["A"], 66), "y", "edge")
-        self.assertEqual(set(table["model"]), {"GLM (one observer)"})
+        self.assertEqual(set(table["model"]), {"glm(y ~ edge)"})
+        self.assertTrue(table["note"].str.contains("one observer").all())
         self.assertTrue(any("one participant" in n for n in notes))
 
     def test_too_few_answers(self):
@@ -186,25 +189,19 @@ class ObserverModelTest(unittest.TestCase):
         self.assertTrue(table.empty)
         self.assertTrue(any("no model across observers" in n for n in notes))
 
-    def test_separation_is_not_an_estimate(self):
-        d = pd.DataFrame({"participant": np.repeat(list("ABCD"), 10), "cell": np.tile(["a", "b"], 20)})
-        d["y"] = np.where(d["cell"] == "a", 1.0, np.tile([0.0, 0.0, 1.0, 1.0], 10))  # a: every answer 1; b: mixed
-        table, _ = stats.observer_models(d, "y", "0 + C(cell)")
-        glm = table[table["model"] == "GLM, cluster-robust SE"]
-        a = glm[glm["term"] == "cell a"].iloc[0]  # patsy's C(cell)[a], in words
-        self.assertTrue(math.isnan(a["estimate_logodds"]))
-        self.assertIn("separation", a["note"])
-
-    def test_disagreeing_models_say_which_to_trust(self):
-        table = pd.DataFrame([
-            {"model": "GLM, cluster-robust SE", "term": "pattern_id 3", "note": "separation: all answers one way"},
-            {"model": "GLMM (random intercept, VB)", "term": "pattern_id 3", "p": 0.035, "note": ""},
-            {"model": "GLM, cluster-robust SE", "term": "pattern_id 4", "p": 0.2, "note": ""},
-            {"model": "GLMM (random intercept, VB)", "term": "pattern_id 4", "p": 0.3, "note": ""}])
+    def test_disagreeing_models_are_called_borderline(self):
+        glm = "statsmodels 0.13.5 GLM cluster-robust CR1, t(G-1)"
+        lme4 = "lme4 1.1-31 glmer (Laplace), Wald t(G-1)"
+        table = stats.model_table([
+            stats.model_row("s", "glm", "per edge", p=0.01, engine=glm),
+            stats.model_row("s", "glmer", "per edge", p=0.2, engine=lme4),
+            stats.model_row("s", "glm", "pattern_id 3", p=0.01, engine=glm),
+            stats.model_row("s", "glmer", "pattern_id 3", engine=lme4, note=stats.UNHELD_LOST_SLOPE),
+            stats.model_row("s", "glm", "pattern_id 4", p=0.2, engine=glm),
+            stats.model_row("s", "glmer", "pattern_id 4", p=0.3, engine=lme4)])
         notes = stats.disagreements(table)
         self.assertEqual(len(notes), 1, notes)
-        self.assertIn("pattern_id 3: the GLM says no finite estimate", notes[0])
-        self.assertIn("the GLMM p = 0.035 - trust the GLMM", notes[0])
+        self.assertIn("per edge: the cluster-robust GLM says p = 0.010, the GLMM p = 0.200 - borderline", notes[0])
 
     def test_terms_in_words(self):
         d = pd.DataFrame({"edge": [3, 6, 9]})

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "core/error.h"
 #include "scene/frame.h"
 #include "session/observer.h"
 #include "stimulus/test_scenes.h"

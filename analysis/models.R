@@ -1,0 +1,164 @@
+# Mixed models across participants by lme4, for analysis/mixed.py (which writes the data and reads the table back).
+#
+#   Rscript models.R KIND DATA.csv OUT.csv SLOPES   one model
+#   Rscript models.R --serve                        many: one job per line on stdin, KIND DATA OUT SLOPES separated
+#                                                   by tabs, each answered by a line "done" once OUT is written (R and
+#                                                   lme4 start once per report, not once per model)
+#
+# KIND    glmm (binomial glmer, Laplace) or lmm (lmer, REML, lmerTest's Satterthwaite df)
+# DATA    columns y (0/1 for glmm), g (the participant), X0 .. Xk (the fixed-effects design, intercept included as a
+#         column of ones where the model has one: the fixed part is y ~ 0 + X0 + ... + Xk)
+# SLOPES  comma-separated design columns given a random slope by participant in the maximal model ("" = none)
+#
+# The maximal model is (1 + SLOPES | g); when it is singular, does not converge or fails, the intercept-only model
+# (1 | g) is fitted instead and the table says which and why. OUT has the columns
+#   row (fixed / sd / corr / info), term, estimate, se, df, p, note
+# lme4 missing: exit 4 with one line on stderr. lmerTest missing: an info row 'missing'. Any other failure: an info
+# row 'failed' with R's message, never a traceback.
+if (!requireNamespace("lme4", quietly = TRUE)) {
+  cat("missing R package: lme4\n", file = stderr())
+  quit(status = 4)
+}
+suppressPackageStartupMessages(library(lme4))
+
+# One fit with its warnings and messages kept (lme4 says "boundary (singular) fit" as a message, convergence
+# trouble as warnings).
+fit_one <- function(kind, d, xs, random) {
+  said <- character()
+  f <- as.formula(paste("y ~ 0 +", paste(xs, collapse = " + "), "+", random))
+  m <- withCallingHandlers(
+    tryCatch(
+      if (kind == "glmm") {
+        glmer(f, data = d, family = binomial,
+              control = glmerControl(optimizer = "bobyqa", optCtrl = list(maxfun = 2e5)))
+      } else {
+        lmerTest::lmer(f, data = d, REML = TRUE, control = lmerControl(optimizer = "bobyqa"))
+      },
+      error = function(e) e),
+    warning = function(w) { said <<- c(said, conditionMessage(w)); invokeRestart("muffleWarning") },
+    message = function(m) { said <<- c(said, trimws(conditionMessage(m))); invokeRestart("muffleMessage") })
+  if (inherits(m, "error")) {
+    return(list(ok = FALSE, why = sprintf("failed (%s)", conditionMessage(m)), m = NULL))
+  }
+  conv <- c(m@optinfo$conv$lme4$messages, if (m@optinfo$conv$opt != 0) "the optimizer did not finish",
+            said[grepl("converge|unidentifiable|Hessian", said)])
+  conv <- unique(conv[!grepl("singular", conv)])
+  if (length(conv)) {
+    return(list(ok = FALSE, why = sprintf("did not converge (%s)", paste(conv, collapse = "; ")), m = NULL))
+  }
+  if (isSingular(m)) {
+    return(list(ok = FALSE, why = "was singular (a variance estimated at 0 or a correlation at +-1)", m = m,
+                singular = TRUE))
+  }
+  list(ok = TRUE, m = m, singular = FALSE)
+}
+
+# The maximal model, else the intercept-only one; its fixed effects, SDs and correlations through emit().
+fit_job <- function(kind, data_path, slopes, emit) {
+  d <- read.csv(data_path, stringsAsFactors = FALSE)
+  d$g <- factor(d$g)
+  xs <- grep("^X[0-9]+$", names(d), value = TRUE)
+  n_groups <- nlevels(d$g)
+  version <- packageDescription("lme4")$Version
+  engine <- if (kind == "glmm") {
+    sprintf("lme4 %s glmer (Laplace), Wald t(G-1)", version)
+  } else {
+    sprintf("lme4 %s lmer (REML), lmerTest %s Satterthwaite df", version, packageDescription("lmerTest")$Version)
+  }
+  emit("info", "engine", note = engine)
+
+  if (length(slopes)) {
+    first <- fit_one(kind, d, xs, sprintf("(1 + %s | g)", paste(slopes, collapse = " + ")))
+    if (first$ok) {
+      chosen <- first
+      structure <- sprintf("random intercept and slopes by participant (%s)", paste(slopes, collapse = ", "))
+    } else {
+      chosen <- fit_one(kind, d, xs, "(1 | g)")
+      structure <- sprintf("random intercept only: the model with random slopes (%s) %s",
+                           paste(slopes, collapse = ", "), first$why)
+    }
+  } else {
+    chosen <- fit_one(kind, d, xs, "(1 | g)")
+    structure <- "random intercept only (no within-participant term to give a slope)"
+  }
+  emit("info", "structure", note = structure)
+  if (is.null(chosen$m)) {
+    emit("info", "failed", note = chosen$why)
+    return(invisible())
+  }
+  m <- chosen$m
+  if (isTRUE(chosen$singular)) emit("info", "singular", note = chosen$why)
+
+  if (kind == "glmm") {
+    # Wald z against t with G-1 df: with a handful of participants the normal reference is far too liberal.
+    co <- coef(summary(m))
+    df <- n_groups - 1
+    for (term in rownames(co)) {
+      z <- co[term, "Estimate"] / co[term, "Std. Error"]
+      emit("fixed", term, co[term, "Estimate"], co[term, "Std. Error"], df, 2 * pt(-abs(z), df))
+    }
+  } else {
+    co <- coef(summary(m, ddf = "Satterthwaite"))
+    for (term in rownames(co)) {
+      emit("fixed", term, co[term, "Estimate"], co[term, "Std. Error"], co[term, "df"], co[term, "Pr(>|t|)"])
+    }
+  }
+
+  # Variance components: an SD on its bound (below isSingular's tolerance) is flagged, and the caller says it in
+  # words, never as a number.
+  vc <- as.data.frame(VarCorr(m))
+  for (i in seq_len(nrow(vc))) {
+    r <- vc[i, ]
+    if (r$grp == "Residual") {
+      emit("sd", "Residual", r$sdcor)
+    } else if (is.na(r$var2)) {
+      name <- if (r$var1 == "(Intercept)") "Intercept" else r$var1
+      tiny <- r$sdcor < 1e-4 * (if (kind == "lmm") sigma(m) else 1)
+      emit("sd", name, if (tiny) 0 else r$sdcor, note = if (tiny) "singular" else "")
+    } else {
+      a <- if (r$var1 == "(Intercept)") "Intercept" else r$var1
+      b <- if (r$var2 == "(Intercept)") "Intercept" else r$var2
+      emit("corr", paste(a, b, sep = ":"), r$sdcor, note = if (abs(r$sdcor) > 0.999) "singular" else "")
+    }
+  }
+  invisible()
+}
+
+# One job: the table written to out_path whatever happens inside.
+run_job <- function(kind, data_path, out_path, slopes) {
+  rows <- list()
+  emit <- function(row, term, estimate = NA, se = NA, df = NA, p = NA, note = "") {
+    rows[[length(rows) + 1]] <<- data.frame(row = row, term = term, estimate = estimate, se = se, df = df, p = p,
+                                            note = note, stringsAsFactors = FALSE)
+  }
+  if (kind == "lmm" && !requireNamespace("lmerTest", quietly = TRUE)) {
+    emit("info", "missing", note = "lmerTest")
+  } else {
+    result <- tryCatch(fit_job(kind, data_path, slopes, emit), error = function(e) e)
+    if (inherits(result, "error")) emit("info", "failed", note = sprintf("failed (%s)", conditionMessage(result)))
+  }
+  out <- if (length(rows)) do.call(rbind, rows) else
+    data.frame(row = character(), term = character(), estimate = numeric(), se = numeric(), df = numeric(),
+               p = numeric(), note = character())
+  write.csv(out, out_path, row.names = FALSE, na = "")
+}
+
+slopes_of <- function(text) if (!is.na(text) && nzchar(text)) strsplit(text, ",", fixed = TRUE)[[1]] else character()
+
+args <- commandArgs(trailingOnly = TRUE)
+if (length(args) == 1 && args[1] == "--serve") {
+  input <- file("stdin", open = "r")
+  repeat {
+    line <- readLines(input, n = 1)
+    if (length(line) == 0) break
+    job <- strsplit(line, "\t", fixed = TRUE)[[1]]
+    run_job(job[1], job[2], job[3], slopes_of(job[4]))
+    cat("done\n")
+    flush(stdout())
+  }
+} else if (length(args) >= 3) {
+  run_job(args[1], args[2], args[3], slopes_of(args[4]))
+} else {
+  cat("usage: Rscript models.R glmm|lmm DATA.csv OUT.csv [SLOPES] | Rscript models.R --serve\n", file = stderr())
+  quit(status = 2)
+}
