@@ -13,8 +13,8 @@ ones left out). Per study: a table per condition (the crossing of the factors) w
 binomial tests against chance (Holm-adjusted), a chart per factor, a psychometric function over the stimulus variable
 (the level of a procedure, else the blur difference on screen in arcmin) with guess and lapse rates and a bootstrap
 band, logistic models across participants (a GLMM where there are three or more), the level tracks of adaptive
-procedures, and the side bias. People and simulated observers are analysed apart (report.py --pool-simulated pools
-them). A study that cannot be analysed raises Skip saying why.
+procedures with a threshold and interval per track (tracks.py), and the side bias. People and simulated observers are
+analysed apart (report.py --pool-simulated pools them). A study that cannot be analysed raises Skip saying why.
 """
 import math
 import os
@@ -25,6 +25,7 @@ import numpy as np
 import pandas as pd
 
 import stats
+import tracks
 from common import Chart, Skip, error_bars, p_text, participants_note, save, stars
 
 DESIGN_MEANING = "a level of the protocol's design"
@@ -256,46 +257,6 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
                                              (math.nan, x.min(), x.max(), fit.beta))
 
 
-def tracks_chart(m, study, out_dir, name, group_note):
-    """The level each adaptive procedure showed, trial after trial, with the answers, and its threshold estimate:
-    QUEST+'s posterior mean after the last answer (its running posterior mean drawn dashed), a staircase's mean of
-    its last 6 reversal levels (or of its last 10 levels with fewer than 4 reversals)."""
-    d = m.dropna(subset=["level"]).copy()
-    d["level"] = d["level"].astype(float)
-    fig, ax = plt.subplots(figsize=(6.5, 3.8))
-    rows = []
-    colors = ["#0072B2", "#E69F00", "#009E73", "#CC79A7", "#D55E00", "#56B4E9"]
-    for i, ((participant, cell), g) in enumerate(d.sort_values("trial_index").groupby(["participant", "procedure_cell"])):
-        levels = g["level"].to_numpy()
-        step = np.arange(1, len(levels) + 1)
-        c = colors[i % len(colors)]
-        ax.plot(step, levels, "-", color=c, lw=1, alpha=0.8)
-        ok = g["y"].to_numpy() == 1
-        ax.plot(step[ok], levels[ok], "o", color=c, ms=3.5)
-        ax.plot(step[~ok], levels[~ok], "x", color=c, ms=4)
-        posterior = _num(g["posterior_threshold"]) if "posterior_threshold" in g else pd.Series(dtype=float)
-        moves = np.sign(np.diff(levels))
-        moves = moves[moves != 0]
-        reversals = [levels[1:][np.diff(levels) != 0][j] for j in range(1, len(moves)) if moves[j] != moves[j - 1]]
-        if posterior.notna().any():
-            ax.plot(step, posterior.to_numpy(), "--", color=c, lw=1)
-            estimate, by = float(posterior.dropna().iloc[-1]), "QUEST+ posterior mean after the last answer"
-        elif len(reversals) >= 4:
-            estimate, by = float(np.mean(reversals[-6:])), "mean of the last 6 reversal levels"
-        else:
-            estimate, by = float(np.mean(levels[-10:])), "mean of the last 10 levels"
-        rows.append({"participant": participant, "procedure_cell": _label(cell), "trials": len(levels),
-                     "reversals": len(reversals), "estimate": estimate, "by": by,
-                     "share_correct": float(ok.mean())})
-    ax.set_xlabel("trial of the procedure")
-    ax.set_ylabel("level shown")
-    ax.set_title(f"{study}: procedure tracks (o correct, x wrong; dashed: QUEST+'s posterior mean threshold)\n"
-                 f"{group_note}", loc="left")
-    png, svg = save(fig, out_dir, name)
-    return Chart(name, png, svg, pd.DataFrame(rows), ["one line per participant and crossing of the block's factors; "
-                                                       "estimate: each track's threshold as its procedure gives it"])
-
-
 def side_bias_table(m, study, group_note):
     d = m[m["chosen_side"].isin(["left", "right"])]
     n, k = len(d), int((d["chosen_side"] == "left").sum())
@@ -386,7 +347,7 @@ def _analyse(d, study, codebook, out_dir, n_boot, seed, group, part):
             charts.append(Chart(f"{slug}-psychometric", None, None, None, [f"no psychometric fit: {e}"]))
     if kind == "procedure":
         m["level"] = _num(m["level"])
-        charts.append(tracks_chart(m, study, out_dir, f"{slug}-tracks", group_note))
+        charts += tracks.charts(m, study, out_dir, slug, group_note)
     if kind in ("pair", "procedure", "odd"):
         charts.append(models(m, factors, slug, group_note, what))
     if "chosen_side" in m and m["chosen_side"].isin(["left", "right"]).any():

@@ -5,15 +5,18 @@ e.g. "distance_m 0.5") in one session. Its threshold and interval, from the proc
 beside trials.csv, joined to each row as `procedure_parameters` by common.load_trials):
 
   QUEST+     the posterior over the protocol's grid (threshold x slope x lapse, uniform prior, the Weibull with the
-             protocol's guess rate) given the track's answers, computed here from the answers: the threshold is its
-             posterior mean (the procedure's own estimate; checked against the posterior_threshold it recorded), the
-             interval the equal-tailed 95 % credible interval of the threshold's marginal posterior on the grid (its
-             2.5 % and 97.5 % quantiles, each the grid point where the cumulative mass first reaches it).
+             protocol's guess rate) given the track's answers, computed here from the answers (its mean checked
+             against the posterior_threshold the procedure recorded): the threshold is the median of the threshold's
+             marginal posterior (the cumulative mass interpolated linearly between grid points; the mean runs high,
+             pulled by the grid's long upper tail), the interval its equal-tailed 95 % credible interval on the grid
+             (the 2.5 % and 97.5 % quantiles, each the grid point where the cumulative mass first reaches it).
   staircase  the turning points the procedure records (src/session/adaptive.cc Staircase::ReversalLevels: the level
              shown on the answer that made the direction change), found by replaying its up/down rule on the answers;
              the threshold is the mean of the last 6 turning points (4 when there are 4 or 5), the interval a t
              interval over the midpoints of the consecutive turning-point pairs used (3 pairs: 2 degrees of freedom).
 
+plan::TrackEstimate (src/plan/threshold.cc) takes the same estimates, so `blurcue plan` and the report agree. A missed
+deadline counts as a wrong answer, as the procedure counted it (rows with status timed_out, where given).
 A value that means "not determined" is said in words, never written as a number: a QUEST+ posterior whose median is
 the grid's lowest or highest threshold, a staircase that turned at its bound, too few turning points, a posterior
 that the answers here do not reproduce. An interval end on the grid's bound says so (`interval_at_bound`).
@@ -178,6 +181,16 @@ def credible(grid, mass, level=CREDIBLE):
     return grid[int(np.searchsorted(cum, tail - 1e-12))], grid[int(np.searchsorted(cum, 1 - tail - 1e-12))]
 
 
+def median(grid, mass):
+    """The grid's median: the cumulative mass interpolated linearly between the grid points around 1/2 (as
+    plan::TrackEstimate)."""
+    cum = np.cumsum(mass) / np.sum(mass)
+    k = int(np.argmax(cum >= 0.5))
+    if k == 0:
+        return float(grid[0])
+    return float(grid[k - 1] + (0.5 - cum[k - 1]) / (cum[k] - cum[k - 1]) * (grid[k] - grid[k - 1]))
+
+
 def quest_threshold(p, stimuli, correct, recorded=None):
     """A QUEST+ track's threshold (dict) from its posterior over the protocol's grid."""
     if p is None:
@@ -190,15 +203,16 @@ def quest_threshold(p, stimuli, correct, recorded=None):
     grid = np.asarray(p["thresholds"], float)
     slopes = np.asarray(p["slopes"], float)
     marginal, slope_marginal = post.sum(axis=(1, 2)), post.sum(axis=(0, 2))
-    estimate = float((marginal * grid).sum())
+    mean = float((marginal * grid).sum())
+    estimate = median(grid, marginal)
     out = {"method": f"QUEST+ posterior over the protocol's grid ({len(grid)} thresholds x {len(slopes)} slopes x "
-                     f"{len(p['lapses'])} lapses, uniform prior): mean, equal-tailed {CREDIBLE:.0%} credible interval",
-           "slope": float((slope_marginal * slopes).sum())}
+                     f"{len(p['lapses'])} lapses, uniform prior): median, equal-tailed {CREDIBLE:.0%} credible "
+                     "interval", "slope": float((slope_marginal * slopes).sum()), "posterior_mean": mean}
     stim = np.asarray(p["stimuli"], float)
     lo, hi = max(grid.min(), stim.min()), min(grid.max(), stim.max())
     out["range"] = (lo, hi)
-    if recorded is not None and math.isfinite(recorded) and abs(recorded - estimate) > 1e-6 * max(1.0, abs(estimate)):
-        out["why"] = (f"not determined: the answers in these rows give a posterior mean of {_text(estimate)}, the "
+    if recorded is not None and math.isfinite(recorded) and abs(recorded - mean) > 1e-6 * max(1.0, abs(mean)):
+        out["why"] = (f"not determined: the answers in these rows give a posterior mean of {_text(mean)}, the "
                       f"procedure recorded {_text(recorded)} (answers missing from these rows, such as missed "
                       "deadlines?)")
         return out
@@ -234,6 +248,8 @@ def track_rows(m):
     sessions = d.groupby("participant")["session_id"].nunique() if "session_id" in d else None
     out = []
     for key, g in d.sort_values("trial_index").groupby(keys, sort=True):
+        if "status" in g:
+            g = g.assign(y=g["y"].where(g["status"] != "timed_out", 0))
         g = g.dropna(subset=["level", "y"])
         if g.empty:
             continue
@@ -242,6 +258,8 @@ def track_rows(m):
         kind = (p or {}).get("procedure") or ("quest_plus" if "posterior_threshold" in g and
                                                _num(g["posterior_threshold"]).notna().any() else "staircase")
         levels, correct = g["level"].to_numpy(float), g["y"].to_numpy() == 1
+        if "status" in g:  # a missed deadline, where the rows hold one, counts as wrong (as the procedure counted it)
+            correct &= (g["status"] != "timed_out").to_numpy()
         recorded = _num(g["posterior_threshold"]).iloc[-1] if "posterior_threshold" in g else math.nan
         result = quest_threshold(p, levels, correct, recorded) if kind == "quest_plus" else \
             staircase_threshold(p, levels, correct)
@@ -270,7 +288,7 @@ def _track_table(tracks):
             "threshold_low": r["low"] if determined else None, "threshold_high": r["high"] if determined else None,
             "interval_at_bound": r.get("interval_at_bound", ""),
             "turning_points": r.get("turning_points") if t["kind"] != "quest_plus" else None,
-            "slope": r.get("slope"),
+            "slope": r.get("slope"), "posterior_mean": r.get("posterior_mean"),
             "threshold_says": "determined" if determined else r.get("why", "not determined"),
             "note": r.get("note", ""), "method": r["method"]})
     return pd.DataFrame(rows)
@@ -326,7 +344,8 @@ def _tracks_figure(tracks, cells, study, group_note, out_dir, name):
     n = len(cells)
     cols = min(n, 3)
     rows = math.ceil(n / cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols + 0.6, 3.2 * rows + 0.8), squeeze=False, sharey=True)
+    width = 6.8 if cols == 1 else 4.2 * cols + 0.6
+    fig, axes = plt.subplots(rows, cols, figsize=(width, 3.2 * rows + 0.8), squeeze=False, sharey=True)
     for ax, cell in zip(axes.flat, cells):
         these = [t for t in tracks if t["cell"] == cell]
         for i, t in enumerate(these):

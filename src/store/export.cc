@@ -16,6 +16,7 @@
 #include "core/hash.h"
 #include "core/json_io.h"
 #include "core/typed.h"
+#include "store/export_procedures.h"
 #include "store/export_table.h"
 #include "store/record.h"
 #include "store/schema.h"
@@ -454,6 +455,7 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
         WriteFileAtomically(partial / "trials.csv", text);
         WriteFileAtomically(partial / "adjustments.csv", adjustments);
         codebook += WriteSummaries(db, partial);
+        codebook += WriteProcedures(db, partial);
         WriteFileAtomically(partial / "codebook.csv", codebook);
         WriteFrames(db, partial);
       },
