@@ -139,6 +139,10 @@ def staircase_threshold(p, levels, correct):
         return out
     estimate = float(used.mean())
     mids = (used[0::2] + used[1::2]) / 2
+    if not mids.std(ddof=1) > 0:
+        # Pairs that agree exactly leave no spread to estimate from: a zero-width interval would claim certainty.
+        return out | {"estimate": estimate, "used": len(used),
+                      "note": f"interval not determined: the {len(mids)} turning-point pairs share one midpoint"}
     half = sps.t.ppf(0.975, len(mids) - 1) * mids.std(ddof=1) / math.sqrt(len(mids))
     low, high = estimate - half, estimate + half
     bound = []
@@ -149,7 +153,8 @@ def staircase_threshold(p, levels, correct):
     out.update(estimate=estimate, low=low, high=high, interval_at_bound=" and ".join(bound),
                used=len(used))
     if at_bound.any():
-        out["note"] = f"{int(at_bound.sum())} of the turning points used sit at the level's bound"
+        k = int(at_bound.sum())
+        out["note"] = f"{k} of the {len(used)} turning points used {'sits' if k == 1 else 'sit'} at the level's bound"
     return out
 
 
@@ -285,7 +290,8 @@ def _track_table(tracks):
             "procedure": "QUEST+" if t["kind"] == "quest_plus" else "staircase", "trials": len(t["levels"]),
             "share_correct": float(t["correct"].mean()),
             "threshold": r["estimate"] if determined else None,
-            "threshold_low": r["low"] if determined else None, "threshold_high": r["high"] if determined else None,
+            "threshold_low": r.get("low") if determined else None,
+            "threshold_high": r.get("high") if determined else None,
             "interval_at_bound": r.get("interval_at_bound", ""),
             "turning_points": r.get("turning_points") if t["kind"] != "quest_plus" else None,
             "slope": r.get("slope"), "posterior_mean": r.get("posterior_mean"),
@@ -340,6 +346,13 @@ def comparisons_table(tracks):
     return pd.DataFrame(rows)
 
 
+def _bar(r):
+    """An estimate's error bar for matplotlib; none where its interval is not determined."""
+    if "low" not in r:
+        return None
+    return [[r["estimate"] - r["low"]], [r["high"] - r["estimate"]]]
+
+
 def _tracks_figure(tracks, cells, study, group_note, out_dir, name):
     n = len(cells)
     cols = min(n, 3)
@@ -358,8 +371,7 @@ def _tracks_figure(tracks, cells, study, group_note, out_dir, name):
                 ax.plot(step[~t["correct"]], t["levels"][~t["correct"]], "x", color=c, ms=3.5)
             r = t["result"]
             if "estimate" in r:
-                ax.errorbar(len(step) + 1.5 + 0.4 * (i % 5), r["estimate"],
-                            yerr=[[r["estimate"] - r["low"]], [r["high"] - r["estimate"]]], fmt="s", color=c, ms=3.5,
+                ax.errorbar(len(step) + 1.5 + 0.4 * (i % 5), r["estimate"], yerr=_bar(r), fmt="s", color=c, ms=3.5,
                             lw=0.9, alpha=alpha)
         ax.set_title(cell, loc="left", fontsize=10)
         ax.set_xlabel("trial of the procedure")
@@ -376,14 +388,13 @@ def _tracks_figure(tracks, cells, study, group_note, out_dir, name):
 
 
 def _thresholds_figure(tracks, summary, cells, study, group_note, out_dir, name):
-    fig, ax = plt.subplots(figsize=(max(4.8, 1.3 * len(cells) + 2.5), 3.8))
+    fig, ax = plt.subplots(figsize=(max(6.8, 1.3 * len(cells) + 2.5), 3.8))
     for xi, cell in enumerate(cells):
         these = [t for t in tracks if t["cell"] == cell and "estimate" in t["result"]]
         offsets = np.linspace(-0.25, 0.25, len(these)) if len(these) > 1 else [0.0]
         for off, t in zip(offsets, these):
             r = t["result"]
-            ax.errorbar(xi + off, r["estimate"], yerr=[[r["estimate"] - r["low"]], [r["high"] - r["estimate"]]],
-                        fmt="o", color="#999999", ms=3, lw=0.8)
+            ax.errorbar(xi + off, r["estimate"], yerr=_bar(r), fmt="o", color="#999999", ms=3, lw=0.8)
         s = summary[summary["cell"] == cell].iloc[0]
         if "mean_low" in s and pd.notna(s.get("mean_low")):
             ax.errorbar(xi + 0.38, s["mean"], yerr=[[s["mean"] - s["mean_low"]], [s["mean_high"] - s["mean"]]],
