@@ -236,6 +236,11 @@ def quest_threshold(p, stimuli, correct, recorded=None):
     tail = (1 - CREDIBLE) / 2
     bound = (["lower"] if low == grid[0] and marginal[0] >= tail else []) + \
             (["upper"] if high == grid[-1] and marginal[-1] >= tail else [])
+    # No interval end beyond the stimuli shown: there the answers say nothing, the grid's prior everything.
+    if low < lo:
+        low, bound = lo, sorted(set(bound) | {"lower"})
+    if high > hi:
+        high, bound = hi, sorted(set(bound) | {"upper"})
     out.update(estimate=estimate, low=float(low), high=float(high), interval_at_bound=" and ".join(bound))
     return out
 
