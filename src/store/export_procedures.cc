@@ -51,11 +51,15 @@ std::string WriteProcedures(Database& db, const std::filesystem::path& out_dir) 
   while (versions.Step()) {
     protocol::Protocol parsed;
     try {
-      // The files it names were checked when it ran; their absence here says nothing about the procedure.
-      parsed = protocol::ParseProtocol(Json::parse(versions.GetText(2)), "protocol.json",
-                                       protocol::ValidateOptions{false});
+      // The files it names were checked when it ran; their absence here says nothing about the procedure. The
+      // conditions tables a version recorded beside its text (protocol::RecordedText) are no field of a protocol.
+      Json text = Json::parse(versions.GetText(2));
+      if (text.is_object()) text.erase("recorded_conditions");
+      parsed = protocol::ParseProtocol(text, "protocol.json", protocol::ValidateOptions{false});
     } catch (const std::exception&) {
-      continue;  // a text of an older blurcue the parser refuses: no parameters to give (documented)
+      // A text the parser refuses (an older blurcue's; a block reading a conditions table, whose file is not here):
+      // no parameters to give; the analysis says its intervals are not determined.
+      continue;
     }
     for (size_t b = 0; b < parsed.blocks.size(); ++b) {
       const protocol::Block& block = parsed.blocks[b];
