@@ -1,5 +1,11 @@
 #include "store/export_procedures.h"
 
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <fstream>
+
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "protocol/protocol.h"
@@ -40,6 +46,49 @@ Json ParametersOf(const protocol::Procedure& p) {
   return out;
 }
 
+// A recorded text as it parsed when it ran. Its conditions tables (protocol::RecordedText keeps them beside the text
+// as "recorded_conditions", no field of a protocol) are written where the text's paths find them from a protocol file
+// in a fresh folder, deep enough for every leading "../", and the folder is removed afterwards. The files a protocol
+// names otherwise were checked when it ran and are not read here.
+protocol::Protocol ParseRecorded(Json text) {
+  Json tables = Json::object();
+  if (text.is_object() && text.contains("recorded_conditions")) {
+    tables = text["recorded_conditions"];
+    text.erase("recorded_conditions");
+  }
+  const protocol::ValidateOptions no_files{false};
+  if (!tables.is_object() || tables.empty()) return protocol::ParseProtocol(text, "protocol.json", no_files);
+  size_t depth = 0;
+  for (const auto& item : tables.items()) {
+    const std::filesystem::path path = std::filesystem::path(item.key()).lexically_normal();
+    if (path.is_absolute()) throw Error(ErrorKind::kInput, "an absolute conditions path: " + item.key());
+    size_t up = 0;
+    for (const auto& part : path) up += part == "..";
+    depth = std::max(depth, up);
+  }
+  static std::atomic<int> counter{0};
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("blurcue-procedures-" + std::to_string(::getpid()) + "-" + std::to_string(++counter));
+  struct Remove {
+    std::filesystem::path path;
+    ~Remove() {
+      std::error_code ignored;
+      std::filesystem::remove_all(path, ignored);
+    }
+  } remove{dir};
+  std::filesystem::path base = dir;
+  for (size_t i = 0; i < depth; ++i) base /= "d";
+  std::filesystem::create_directories(base);
+  for (const auto& item : tables.items()) {
+    const std::filesystem::path target = (base / item.key()).lexically_normal();
+    std::filesystem::create_directories(target.parent_path());
+    std::ofstream out(target, std::ios::binary);
+    out << (item.value().is_string() ? item.value().get<std::string>() : std::string());
+    if (!out) throw Error(ErrorKind::kInput, "cannot write " + target.string());
+  }
+  return protocol::ParseProtocol(text, base / "protocol.json", no_files);
+}
+
 }  // namespace
 
 std::string WriteProcedures(Database& db, const std::filesystem::path& out_dir) {
@@ -51,14 +100,10 @@ std::string WriteProcedures(Database& db, const std::filesystem::path& out_dir) 
   while (versions.Step()) {
     protocol::Protocol parsed;
     try {
-      // The files it names were checked when it ran; their absence here says nothing about the procedure. The
-      // conditions tables a version recorded beside its text (protocol::RecordedText) are no field of a protocol.
-      Json text = Json::parse(versions.GetText(2));
-      if (text.is_object()) text.erase("recorded_conditions");
-      parsed = protocol::ParseProtocol(text, "protocol.json", protocol::ValidateOptions{false});
+      parsed = ParseRecorded(Json::parse(versions.GetText(2)));
     } catch (const std::exception&) {
-      // A text the parser refuses (an older blurcue's; a block reading a conditions table, whose file is not here):
-      // no parameters to give; the analysis says its intervals are not determined.
+      // A text the parser refuses (an older blurcue's): no parameters to give; the analysis says its intervals are
+      // not determined.
       continue;
     }
     for (size_t b = 0; b < parsed.blocks.size(); ++b) {

@@ -15,8 +15,8 @@ const std::vector<ColumnDef>& ProcedureColumns();
 
 // OUT/procedures.csv: one row per study x protocol version (hash) x block with a procedure, its parameters as the
 // protocol parser reads them from the protocol text the record keeps (defaults filled in: a QUEST+ guess rate left
-// out is chance). A version whose text the current parser refuses gets no rows (an older blurcue's text; a protocol
-// whose blocks read a conditions table, which the export does not have as a file). Returns the codebook's rows.
+// out is chance; conditions tables as the version recorded them). A version whose text the current parser refuses
+// (an older blurcue's) gets no rows. Returns the codebook's rows.
 std::string WriteProcedures(Database& db, const std::filesystem::path& out_dir);
 
 }  // namespace blurcue::store
