@@ -16,7 +16,8 @@ beside trials.csv, joined to each row as `procedure_parameters` by common.load_t
              interval over the midpoints of the consecutive turning-point pairs used (3 pairs: 2 degrees of freedom).
 
 plan::TrackEstimate (src/plan/threshold.cc) takes the same estimates, so `blurcue plan` and the report agree. A missed
-deadline counts as a wrong answer, as the procedure counted it (rows with status timed_out, where given).
+deadline counts as a wrong answer, as the procedure counted it (rows with status timed_out, where given; a QUEST+
+track whose rows lack them gets them back from the procedure's own stimulus choice, quest_fill_missed).
 A value that means "not determined" is said in words, never written as a number: a QUEST+ posterior whose median is
 the grid's lowest or highest threshold, a staircase that turned at its bound, too few turning points, a posterior
 that the answers here do not reproduce. An interval end on the grid's bound says so (`interval_at_bound`).
@@ -178,6 +179,57 @@ def quest_posterior(p, stimuli, correct):
     return post / post.sum()
 
 
+def _likelihoods(p):
+    """P(correct) per stimulus over the grid: [stimulus, threshold, slope, lapse]."""
+    x = np.asarray(p["stimuli"], float)[:, None, None, None]
+    t = np.asarray(p["thresholds"], float)[None, :, None, None]
+    b = np.asarray(p["slopes"], float)[None, None, :, None]
+    lam = np.asarray(p["lapses"], float)[None, None, None, :]
+    g = float(p["guess"])
+    return 1 - lam - (1 - g - lam) * np.exp(-((x / t) ** b))
+
+
+def quest_next(post, psi, stimuli):
+    """QUEST+'s next stimulus (src/session/adaptive.cc QuestPlus::Next): least expected posterior entropy, the first
+    of equals."""
+    expected = np.zeros(len(stimuli))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for outcome in (psi, 1 - psi):
+            joint = post[None] * outcome
+            pk = joint.sum(axis=(1, 2, 3))
+            q = joint / np.where(pk > 0, pk, 1)[:, None, None, None]
+            h = -np.where(q > 0, q * np.log(np.where(q > 0, q, 1)), 0).sum(axis=(1, 2, 3))
+            expected += np.where(pk > 0, pk * h, 0)
+    return float(np.asarray(stimuli, float)[int(np.argmin(expected))])
+
+
+def quest_fill_missed(p, stimuli, correct, most=5):
+    """The track with the answers these rows lack put back: where a row's stimulus is not the one QUEST+ would show
+    next, a missed deadline came before it (the procedure counted it wrong, at the stimulus it chose). Returns
+    (stimuli, correct, missed); missed None when the rows cannot be explained by at most `most` missed answers each."""
+    psi = _likelihoods(p)
+    index = {float(x): i for i, x in enumerate(p["stimuli"])}
+    post = np.full(psi.shape[1:], 1.0 / psi[0].size)
+    xs, oks, missed = [], [], 0
+    for x, ok in zip(stimuli, correct):
+        for _ in range(most + 1):
+            shown = quest_next(post, psi, p["stimuli"])
+            if abs(shown - x) <= 1e-9 * max(1.0, abs(x)):
+                break
+            post = post * (1 - psi[index[shown]])
+            post /= post.sum()
+            xs.append(shown), oks.append(False)
+            missed += 1
+        else:
+            return stimuli, correct, None
+        if float(x) not in index:
+            return stimuli, correct, None
+        post = post * (psi[index[float(x)]] if ok else 1 - psi[index[float(x)]])
+        post /= post.sum()
+        xs.append(float(x)), oks.append(bool(ok))
+    return np.array(xs), np.array(oks), missed
+
+
 def credible(grid, mass, level=CREDIBLE):
     """Equal-tailed interval on a grid: the first grid point where the cumulative mass reaches (1 - level) / 2, and the
     first where it reaches 1 - (1 - level) / 2."""
@@ -204,6 +256,11 @@ def quest_threshold(p, stimuli, correct, recorded=None):
         if recorded is not None and math.isfinite(recorded):
             out["estimate_recorded"] = recorded
         return out
+    missed = 0
+    if recorded is not None and math.isfinite(recorded):
+        filled, answers, missed = quest_fill_missed(p, stimuli, correct)
+        if missed:  # only where the rows lack answers: the procedure's record then decides (the mean check below)
+            stimuli, correct = filled, answers
     post = quest_posterior(p, stimuli, correct)
     grid = np.asarray(p["thresholds"], float)
     slopes = np.asarray(p["slopes"], float)
@@ -213,6 +270,9 @@ def quest_threshold(p, stimuli, correct, recorded=None):
     out = {"method": f"QUEST+ posterior over the protocol's grid ({len(grid)} thresholds x {len(slopes)} slopes x "
                      f"{len(p['lapses'])} lapses, uniform prior): median, equal-tailed {CREDIBLE:.0%} credible "
                      "interval", "slope": float((slope_marginal * slopes).sum()), "posterior_mean": mean}
+    if missed:
+        out["note"] = (f"{missed} missed answer{'s' if missed > 1 else ''} (not in these rows) put back where QUEST+ "
+                       "chose its stimulus, counted wrong as the procedure counted them")
     stim = np.asarray(p["stimuli"], float)
     lo, hi = max(grid.min(), stim.min()), min(grid.max(), stim.max())
     out["range"] = (lo, hi)
@@ -222,7 +282,7 @@ def quest_threshold(p, stimuli, correct, recorded=None):
                       "deadlines?)")
         return out
     if slope_marginal.argmax() in (0, len(slopes) - 1) and len(slopes) > 1:
-        out["note"] = (f"the slope's posterior peaks at its grid's {'lowest' if slope_marginal.argmax() == 0 else 'highest'} "
+        out["note"] = (out.get("note", "") + "; " if out.get("note") else "") + (f"the slope's posterior peaks at its grid's {'lowest' if slope_marginal.argmax() == 0 else 'highest'} "
                        f"value {_text(slopes[slope_marginal.argmax()])}: the grid may not hold the observer's slope")
     if marginal[0] >= 0.5 or estimate < lo:
         out["why"] = (f"not determined: below the tested range {_text(lo)} to {_text(hi)} (posterior mass "

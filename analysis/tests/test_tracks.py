@@ -90,6 +90,39 @@ class QuestPlusIntervals(unittest.TestCase):
         self.assertTrue((numbers_in(table) <= 1e6).all())
 
 
+class MissedDeadlines(unittest.TestCase):
+    def test_rows_without_the_missed_answers_give_the_whole_tracks_threshold(self):
+        # A QUEST+ track chosen by python3-questplus in which trials 10 and 25 missed their deadline (the procedure
+        # counts them wrong); the analysis is given only the answered rows (as any_study measures them): it puts the
+        # two back where QUEST+ chose its stimulus and gets the threshold of the whole track.
+        warnings.simplefilter("ignore")
+        p = shipped_quest()
+        q = qp.QuestPlusWeibull(intensities=p["stimuli"], thresholds=p["thresholds"], slopes=p["slopes"],
+                                lower_asymptotes=[p["guess"]], lapse_rates=p["lapses"],
+                                responses=["Correct", "Incorrect"], stim_scale="linear",
+                                stim_selection_method="min_entropy", param_estimation_method="mean")
+        rng = np.random.default_rng(4)
+        levels, answers, posterior, status = [], [], [], []
+        for i in range(p["trials"]):
+            x = q.next_intensity
+            missed = i in (10, 25)
+            ok = not missed and rng.random() < p_correct(2.8321, 2.8321 + x, 0.35)
+            q.update(intensity=x, response="Correct" if ok else "Incorrect")
+            levels.append(x), answers.append(ok), posterior.append(q.param_estimate["threshold"])
+            status.append("timed_out" if missed else "answered")
+        whole = rows_of("P1", levels, answers, p, posterior=posterior)
+        whole["status"] = status
+        answered = whole[whole["status"] == "answered"]
+        with tempfile.TemporaryDirectory() as out:
+            a = tracks.charts(whole, "q", out, "a", "1 participant")[0].table.iloc[0]
+            b = tracks.charts(answered, "q", out, "b", "1 participant")[0].table.iloc[0]
+        self.assertEqual((a["threshold_says"], b["threshold_says"]), ("determined", "determined"), b["threshold_says"])
+        self.assertEqual((a["trials"], b["trials"]), (40, 38))
+        self.assertAlmostEqual(a["threshold"], b["threshold"], places=9)
+        self.assertAlmostEqual(b["posterior_mean"], q.param_estimate["threshold"], places=9)
+        self.assertTrue(b["note"].startswith("2 missed answers (not in these rows) put back"), b["note"])
+
+
 class StaircaseEstimate(unittest.TestCase):
     def test_hand_worked_turning_points(self):
         # As src/plan/threshold_test.cc: 1-up/2-down from 1.0, steps 0.4 then 0.2; turning points .2 .4 .2 .6 .4 .6.
