@@ -17,7 +17,8 @@ beside trials.csv, joined to each row as `procedure_parameters` by common.load_t
 
 plan::TrackEstimate (src/plan/threshold.cc) takes the same estimates, so `blurcue plan` and the report agree. A missed
 deadline counts as a wrong answer, as the procedure counted it (rows with status timed_out, where given; a QUEST+
-track whose rows lack them gets them back from the procedure's own stimulus choice, quest_fill_missed).
+track whose rows lack them gets them back from the procedure's own stimulus choice, quest_fill_missed; a staircase
+from its levels, staircase_fill_missed).
 A value that means "not determined" is said in words, never written as a number: a QUEST+ posterior whose median is
 the grid's lowest or highest threshold, a staircase that turned at its bound, too few turning points, a posterior
 that the answers here do not reproduce. An interval end on the grid's bound says so (`interval_at_bound`).
@@ -67,34 +68,60 @@ def cell_label(g):
 # Staircase
 
 
-def staircase_turns(p, levels, correct):
-    """Replays the n-up/m-down rule of src/session/adaptive.cc on the answers: (turning points, the levels the rule
-    would have shown). A turning point is the level shown on the answer whose step goes the other way than the last
-    step (Staircase::ReversalLevels)."""
-    level, run_ok, run_bad, direction, turns = float(p["start"]), 0, 0, 0, []
-    shown = []
-    steps = p.get("steps") or [0.0]
-    for ok in correct:
-        shown.append(level)
+class _Staircase:
+    """The n-up/m-down rule of src/session/adaptive.cc Staircase: `level` is what it shows next; update() takes an
+    answer; `turns` are the levels shown on the answers whose step went the other way than the last (ReversalLevels)."""
+
+    def __init__(self, p):
+        self.p, self.level, self.turns = p, float(p["start"]), []
+        self.run_ok = self.run_bad = self.direction = 0
+        self.steps = p.get("steps") or [0.0]
+
+    def update(self, ok):
         move = 0
         if ok:
-            run_bad = 0
-            run_ok += 1
-            if run_ok >= p["down"]:
-                move, run_ok = -1, 0
+            self.run_bad, self.run_ok = 0, self.run_ok + 1
+            if self.run_ok >= self.p["down"]:
+                move, self.run_ok = -1, 0
         else:
-            run_ok = 0
-            run_bad += 1
-            if run_bad >= p["up"]:
-                move, run_bad = 1, 0
+            self.run_ok, self.run_bad = 0, self.run_bad + 1
+            if self.run_bad >= self.p["up"]:
+                move, self.run_bad = 1, 0
         if move == 0:
-            continue
-        if direction != 0 and move != direction:
-            turns.append(level)
-        direction = move
-        step = steps[min(len(turns), len(steps) - 1)]
-        level = min(max(level + move * step, p["min"]), p["max"])
-    return turns, np.array(shown)
+            return
+        if self.direction != 0 and move != self.direction:
+            self.turns.append(self.level)
+        self.direction = move
+        step = self.steps[min(len(self.turns), len(self.steps) - 1)]
+        self.level = min(max(self.level + move * step, self.p["min"]), self.p["max"])
+
+
+def staircase_turns(p, levels, correct):
+    """Replays the rule on the answers: (turning points, the levels the rule would have shown)."""
+    s, shown = _Staircase(p), []
+    for ok in correct:
+        shown.append(s.level)
+        s.update(ok)
+    return s.turns, np.array(shown)
+
+
+def staircase_fill_missed(p, levels, correct, most=5):
+    """The track with the answers these rows lack put back: where a row's level is not the one the rule shows next, a
+    missed deadline came before it (counted wrong, at the level shown). Returns (levels, correct, missed); missed None
+    when the rows cannot be explained by at most `most` missed answers each."""
+    s, xs, oks, missed = _Staircase(p), [], [], 0
+    for x, ok in zip(levels, correct):
+        for _ in range(most + 1):
+            if abs(s.level - x) <= 1e-6 * max(1.0, abs(x)):
+                break
+            xs.append(s.level), oks.append(False)
+            s.update(False)
+            missed += 1
+        else:
+            return levels, correct, None
+        xs.append(float(x)), oks.append(bool(ok))
+        s.update(ok)
+    return np.array(xs), np.array(oks), missed
 
 
 def turns_from_levels(levels):
@@ -113,6 +140,11 @@ def staircase_threshold(p, levels, correct):
     out = {"method": f"mean of the last {LAST_TURNS} turning points; interval: t over the midpoints of turning-point "
                      "pairs"}
     if p is not None:
+        filled, answers, missed = staircase_fill_missed(p, levels, correct)
+        if missed:
+            levels, correct = filled, answers
+            out["note"] = (f"{missed} missed answer{'s' if missed > 1 else ''} (not in these rows) put back where the "
+                           "levels show them, counted wrong as the procedure counted them")
         turns, replayed = staircase_turns(p, levels, correct)
         if len(replayed) != len(levels) or np.abs(replayed - levels).max() > 1e-6 * max(1.0, np.abs(levels).max()):
             first = int(np.argmax(np.abs(replayed - levels) > 1e-6))
@@ -143,7 +175,8 @@ def staircase_threshold(p, levels, correct):
     if not mids.std(ddof=1) > 0:
         # Pairs that agree exactly leave no spread to estimate from: a zero-width interval would claim certainty.
         return out | {"estimate": estimate, "used": len(used),
-                      "note": f"interval not determined: the {len(mids)} turning-point pairs share one midpoint"}
+                      "note": (out.get("note", "") + "; " if out.get("note") else "") +
+                      f"interval not determined: the {len(mids)} turning-point pairs share one midpoint"}
     half = sps.t.ppf(0.975, len(mids) - 1) * mids.std(ddof=1) / math.sqrt(len(mids))
     low, high = estimate - half, estimate + half
     bound = []
@@ -155,7 +188,8 @@ def staircase_threshold(p, levels, correct):
                used=len(used))
     if at_bound.any():
         k = int(at_bound.sum())
-        out["note"] = f"{k} of the {len(used)} turning points used {'sits' if k == 1 else 'sit'} at the level's bound"
+        out["note"] = (out.get("note", "") + "; " if out.get("note") else "") + \
+            f"{k} of the {len(used)} turning points used {'sits' if k == 1 else 'sit'} at the level's bound"
     return out
 
 

@@ -134,9 +134,14 @@ class StaircaseEstimate(unittest.TestCase):
         np.testing.assert_allclose(shown, levels, atol=1e-12)
         r = tracks.staircase_threshold(p, np.array(levels, float), np.array(correct) == 1)
         self.assertAlmostEqual(r["estimate"], 0.4, places=12)
-        # Levels the rule would not have shown (an answer missing from the rows): said, not estimated.
+        # The wrong answer at trial 5 missing from the rows (a missed deadline): the level after it (0.4 where the
+        # rule shows 0.2) puts it back, and the whole track's estimate follows.
         r = tracks.staircase_threshold(p, np.array(levels[:4] + levels[5:], float),
                                        np.array(correct[:4] + correct[5:]) == 1)
+        self.assertAlmostEqual(r["estimate"], 0.4, places=12)
+        self.assertTrue(r["note"].startswith("1 missed answer (not in these rows) put back"), r["note"])
+        # Levels no missed answers explain (a step down after a single correct answer): said, not estimated.
+        r = tracks.staircase_threshold(p, np.array([1.0, 0.6, 0.6], float), np.array([1, 1, 1]) == 1)
         self.assertNotIn("estimate", r)
         self.assertTrue(r["why"].startswith("not determined: replaying the answers"), r["why"])
 
