@@ -14,7 +14,8 @@ participants as the unit (study_tests.py, Holm-adjusted; none for an adaptive pr
 procedure sets), a chart per factor, a psychometric function where the design defines a correct answer - per
 procedure cell over its level, an odd one out's over the blur difference on screen in arcmin - with guess and lapse
 rates and a bootstrap band (none for a preference question), logistic models across participants (a GLMM where there
-are three or more), the level tracks of adaptive procedures (tracks.py), and the side bias. A between-subject group
+are three or more), the level tracks of adaptive procedures with a threshold
+and interval per track and cell (tracks.py), and the side bias. A between-subject group
 is a factor: everything per group, then the groups compared with participants as the unit. People and simulated
 observers are analysed apart (report.py --pool-simulated pools them), and so are protocol versions and repeated
 sessions (report.py, common.study_parts). A study that cannot be analysed raises Skip saying why.
@@ -434,6 +435,7 @@ def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, 
                              "fits the scene), so a guess rate of 0.5 would be a claim the design does not make; the "
                              "shares of choosing the more blurred side per condition are in the tables"]))
     if kind == "procedure":
+        m["level"] = _num(m["level"])
         charts += tracks.charts(m, study, out_dir, slug, note)
     else:
         charts.append(models(m, factors, slug, note, what))

@@ -95,6 +95,7 @@ def load_trials(path):
         raise TrialsError(f"{path}: not a blurcue trials.csv (missing column{'s' if len(missing) > 1 else ''} "
                           f"{', '.join(missing)})")
     df["session"] = df["session_id"]
+    df = _with_procedures(df, os.path.join(os.path.dirname(os.path.abspath(path)), "procedures.csv"))
     for c in NUMERIC:
         if c in df.columns:
             df[c] = pd.to_numeric(df[c].replace("", np.nan), errors="coerce")
@@ -113,6 +114,42 @@ def load_trials(path):
     df["answered"] = df["status"].isin(["answered", "timed_out"])
     if "pattern" in df.columns:
         df["pattern_id"] = pd.to_numeric(df["pattern"].replace("", np.nan), errors="coerce")
+    return df
+
+
+# What analysis/tracks.py reads of each procedure's parameters (procedures.csv, `blurcue export`).
+PROCEDURE_KEYS = {"staircase": ("start", "min", "max", "up", "down", "steps"),
+                  "quest_plus": ("stimuli", "thresholds", "slopes", "lapses", "guess")}
+
+
+def _with_procedures(df, path):
+    """trials with procedure_parameters (JSON text, empty outside a procedure) joined from procedures.csv by study,
+    protocol version and block; unchanged without the file (an export of before it). TrialsError naming the file, the
+    row and the field for a file that cannot be used."""
+    if not os.path.isfile(path):
+        return df
+    try:
+        table = read_text_csv(path)
+    except ValueError as e:
+        raise TrialsError(f"{path}: {e}")
+    missing = [c for c in ("study", "protocol_hash", "block", "parameters") if c not in table.columns]
+    if missing:
+        raise TrialsError(f"{path}: not a blurcue procedures.csv (missing column {', '.join(missing)})")
+    by = {}
+    for i, row in table.iterrows():
+        where = f"{path}: row {i + 2} parameters"
+        try:
+            parameters = json.loads(row["parameters"])
+        except ValueError:
+            raise TrialsError(f"{where}: not JSON ({row['parameters'][:40]!r})")
+        kind = parameters.get("procedure") if isinstance(parameters, dict) else None
+        if kind not in PROCEDURE_KEYS:
+            raise TrialsError(f"{where}: procedure must be one of {', '.join(PROCEDURE_KEYS)}, got {kind!r}")
+        lacking = [k for k in PROCEDURE_KEYS[kind] if k not in parameters]
+        if lacking:
+            raise TrialsError(f"{where}: a {kind} needs {', '.join(lacking)}")
+        by[(row["study"], row["protocol_hash"], row["block"])] = row["parameters"]
+    df["procedure_parameters"] = [by.get(key, "") for key in zip(df["study"], df["protocol_hash"], df["block"])]
     return df
 
 

@@ -1,58 +1,539 @@
-"""The level tracks of adaptive procedures (a minimal stand-in with the interface the tracks module exposes:
-charts(m, study, out_dir, slug, group_note) -> [Chart]; it wraps any_study's former tracks chart, per participant and
-procedure cell)."""
+"""Adaptive procedures: each track, its threshold with an interval, a summary per procedure cell, comparisons.
+
+One track is one participant's procedure in one cell (the crossing of its block's factors, labelled by its levels,
+e.g. "distance_m 0.5") in one session. Its threshold and interval, from the procedure's own parameters (procedures.csv
+beside trials.csv, joined to each row as `procedure_parameters` by common.load_trials):
+
+  QUEST+     the posterior over the protocol's grid (threshold x slope x lapse, uniform prior, the Weibull with the
+             protocol's guess rate) given the track's answers, computed here from the answers (its mean checked
+             against the posterior_threshold the procedure recorded): the threshold is the median of the threshold's
+             marginal posterior (the cumulative mass interpolated linearly between grid points; the mean runs high,
+             pulled by the grid's long upper tail), the interval its equal-tailed 95 % credible interval on the grid
+             (the 2.5 % and 97.5 % quantiles, each the grid point where the cumulative mass first reaches it).
+  staircase  the turning points the procedure records (src/session/adaptive.cc Staircase::ReversalLevels: the level
+             shown on the answer that made the direction change), found by replaying its up/down rule on the answers;
+             the threshold is the mean of the last 6 turning points (4 when there are 4 or 5), the interval a t
+             interval over the midpoints of the consecutive turning-point pairs used (3 pairs: 2 degrees of freedom).
+
+plan::TrackEstimate (src/plan/threshold.cc) takes the same estimates, so `blurcue plan` and the report agree. A missed
+deadline counts as a wrong answer, as the procedure counted it (rows with status timed_out, where given; a QUEST+
+track whose rows lack them gets them back from the procedure's own stimulus choice, quest_fill_missed; a staircase
+from its levels, staircase_fill_missed).
+A value that means "not determined" is said in words, never written as a number: a QUEST+ posterior whose median is
+the grid's lowest or highest threshold, a staircase that turned at its bound, too few turning points, a posterior
+that the answers here do not reproduce. An interval end on the grid's bound says so (`interval_at_bound`).
+"""
+import json
+import math
+
+import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
-import matplotlib.pyplot as plt
+from scipy import stats as sps
 
 from common import Chart, save
+
+CREDIBLE = 0.95
+# A staircase's threshold: the mean of this many last turning points (an even number: as many peaks as troughs).
+LAST_TURNS = 6
+MIN_TURNS = 4
+COLORS = ["#0072B2", "#E69F00", "#009E73", "#CC79A7", "#D55E00", "#56B4E9", "#F0E442", "#000000"]
 
 
 def _num(series):
     return pd.to_numeric(series.astype(str).replace({"": np.nan, "nan": np.nan}), errors="coerce")
 
 
-def _label(value):
-    text = str(value)
-    return text[:-2] if text.endswith(".0") else text
+def _text(v):
+    return f"{v:.4g}"
+
+
+def parameters(g):
+    """The procedure's parameters for a track's rows (the JSON procedures.csv gives), or None without them."""
+    if "procedure_parameters" not in g:
+        return None
+    texts = [t for t in g["procedure_parameters"].astype(str) if t.strip() not in ("", "nan")]
+    return json.loads(texts[0]) if texts else None
+
+
+def cell_label(g):
+    """The cell by its levels: 'edge=9;speed_cm_s=3' -> 'edge 9, speed_cm_s 3'."""
+    text = str(g["cell"].iloc[0]) if "cell" in g and str(g["cell"].iloc[0]) not in ("", "nan") else ""
+    if not text:
+        return f"cell {g['procedure_cell'].iloc[0]}"
+    return ", ".join(part.replace("=", " ", 1) for part in text.split(";") if part)
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# Staircase
+
+
+class _Staircase:
+    """The n-up/m-down rule of src/session/adaptive.cc Staircase: `level` is what it shows next; update() takes an
+    answer; `turns` are the levels shown on the answers whose step went the other way than the last (ReversalLevels)."""
+
+    def __init__(self, p):
+        self.p, self.level, self.turns = p, float(p["start"]), []
+        self.run_ok = self.run_bad = self.direction = 0
+        self.steps = p.get("steps") or [0.0]
+
+    def update(self, ok):
+        move = 0
+        if ok:
+            self.run_bad, self.run_ok = 0, self.run_ok + 1
+            if self.run_ok >= self.p["down"]:
+                move, self.run_ok = -1, 0
+        else:
+            self.run_ok, self.run_bad = 0, self.run_bad + 1
+            if self.run_bad >= self.p["up"]:
+                move, self.run_bad = 1, 0
+        if move == 0:
+            return
+        if self.direction != 0 and move != self.direction:
+            self.turns.append(self.level)
+        self.direction = move
+        step = self.steps[min(len(self.turns), len(self.steps) - 1)]
+        self.level = min(max(self.level + move * step, self.p["min"]), self.p["max"])
+
+
+def staircase_turns(p, levels, correct):
+    """Replays the rule on the answers: (turning points, the levels the rule would have shown)."""
+    s, shown = _Staircase(p), []
+    for ok in correct:
+        shown.append(s.level)
+        s.update(ok)
+    return s.turns, np.array(shown)
+
+
+def staircase_fill_missed(p, levels, correct, most=5):
+    """The track with the answers these rows lack put back: where a row's level is not the one the rule shows next, a
+    missed deadline came before it (counted wrong, at the level shown). Returns (levels, correct, missed); missed None
+    when the rows cannot be explained by at most `most` missed answers each."""
+    s, xs, oks, missed = _Staircase(p), [], [], 0
+    for x, ok in zip(levels, correct):
+        for _ in range(most + 1):
+            if abs(s.level - x) <= 1e-6 * max(1.0, abs(x)):
+                break
+            xs.append(s.level), oks.append(False)
+            s.update(False)
+            missed += 1
+        else:
+            return levels, correct, None
+        xs.append(float(x)), oks.append(bool(ok))
+        s.update(ok)
+    return np.array(xs), np.array(oks), missed
+
+
+def turns_from_levels(levels):
+    """Without the procedure's parameters: the levels at which the direction of the levels shown changed."""
+    turns, last = [], 0
+    for i in range(1, len(levels)):
+        move = np.sign(levels[i] - levels[i - 1])
+        if move != 0 and last != 0 and move != last:
+            turns.append(levels[i - 1])
+        last = move if move != 0 else last
+    return turns
+
+
+def staircase_threshold(p, levels, correct):
+    """A staircase track's threshold (dict): estimate, interval and what they mean."""
+    out = {"method": f"mean of the last {LAST_TURNS} turning points; interval: t over the midpoints of turning-point "
+                     "pairs"}
+    if p is not None:
+        filled, answers, missed = staircase_fill_missed(p, levels, correct)
+        if missed:
+            levels, correct = filled, answers
+            out["note"] = (f"{missed} missed answer{'s' if missed > 1 else ''} (not in these rows) put back where the "
+                           "levels show them, counted wrong as the procedure counted them")
+        turns, replayed = staircase_turns(p, levels, correct)
+        if len(replayed) != len(levels) or np.abs(replayed - levels).max() > 1e-6 * max(1.0, np.abs(levels).max()):
+            first = int(np.argmax(np.abs(replayed - levels) > 1e-6))
+            out["why"] = (f"not determined: replaying the answers here gives level {_text(replayed[first])} at the "
+                          f"track's trial {first + 1}, the record shows {_text(levels[first])} (answers missing from "
+                          "these rows, such as missed deadlines?)")
+            return out | {"turning_points": len(turns)}
+        lo, hi = float(p["min"]), float(p["max"])
+    else:
+        turns = turns_from_levels(levels)
+        lo, hi = float(np.min(levels)), float(np.max(levels))
+        out["method"] += " (procedures.csv missing: turning points from the levels, bounds unknown)"
+    out["turning_points"] = len(turns)
+    out["range"] = (lo, hi)
+    if len(turns) < MIN_TURNS:
+        out["why"] = f"not determined: {len(turns)} turning point{'s' if len(turns) != 1 else ''} (needs {MIN_TURNS})"
+        return out
+    take = min(LAST_TURNS, len(turns) - len(turns) % 2)
+    used = np.array(turns[-take:], float)
+    at_bound = np.isclose(used, lo) | np.isclose(used, hi)
+    if p is not None and at_bound.sum() * 2 >= len(used):
+        side = "above" if np.isclose(used, hi).sum() >= np.isclose(used, lo).sum() else "below"
+        out["why"] = (f"not determined: {side} the tested range {_text(lo)} to {_text(hi)} (the track turned at its "
+                      f"bound {int(at_bound.sum())} of {len(used)} times)")
+        return out
+    estimate = float(used.mean())
+    mids = (used[0::2] + used[1::2]) / 2
+    if not mids.std(ddof=1) > 0:
+        # Pairs that agree exactly leave no spread to estimate from: a zero-width interval would claim certainty.
+        return out | {"estimate": estimate, "used": len(used),
+                      "note": (out.get("note", "") + "; " if out.get("note") else "") +
+                      f"interval not determined: the {len(mids)} turning-point pairs share one midpoint"}
+    half = sps.t.ppf(0.975, len(mids) - 1) * mids.std(ddof=1) / math.sqrt(len(mids))
+    low, high = estimate - half, estimate + half
+    bound = []
+    if low < lo:
+        low, bound = lo, bound + ["lower"]
+    if high > hi:
+        high, bound = hi, bound + ["upper"]
+    out.update(estimate=estimate, low=low, high=high, interval_at_bound=" and ".join(bound),
+               used=len(used))
+    if at_bound.any():
+        k = int(at_bound.sum())
+        out["note"] = (out.get("note", "") + "; " if out.get("note") else "") + \
+            f"{k} of the {len(used)} turning points used {'sits' if k == 1 else 'sit'} at the level's bound"
+    return out
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# QUEST+
+
+
+def quest_posterior(p, stimuli, correct):
+    """The posterior over the grid [threshold, slope, lapse] (uniform prior) after the answers, as QUEST+ keeps it."""
+    t = np.asarray(p["thresholds"], float)[:, None, None]
+    b = np.asarray(p["slopes"], float)[None, :, None]
+    lam = np.asarray(p["lapses"], float)[None, None, :]
+    g = float(p["guess"])
+    log_post = np.zeros((t.shape[0], b.shape[1], lam.shape[2]))
+    with np.errstate(divide="ignore"):
+        for x, ok in zip(stimuli, correct):
+            psi = 1 - lam - (1 - g - lam) * np.exp(-((x / t) ** b))
+            log_post = log_post + np.log(psi if ok else 1 - psi)
+    log_post -= log_post.max()
+    post = np.exp(log_post)
+    return post / post.sum()
+
+
+def _likelihoods(p):
+    """P(correct) per stimulus over the grid: [stimulus, threshold, slope, lapse]."""
+    x = np.asarray(p["stimuli"], float)[:, None, None, None]
+    t = np.asarray(p["thresholds"], float)[None, :, None, None]
+    b = np.asarray(p["slopes"], float)[None, None, :, None]
+    lam = np.asarray(p["lapses"], float)[None, None, None, :]
+    g = float(p["guess"])
+    return 1 - lam - (1 - g - lam) * np.exp(-((x / t) ** b))
+
+
+def quest_next(post, psi, stimuli):
+    """QUEST+'s next stimulus (src/session/adaptive.cc QuestPlus::Next): least expected posterior entropy, the first
+    of equals."""
+    expected = np.zeros(len(stimuli))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for outcome in (psi, 1 - psi):
+            joint = post[None] * outcome
+            pk = joint.sum(axis=(1, 2, 3))
+            q = joint / np.where(pk > 0, pk, 1)[:, None, None, None]
+            h = -np.where(q > 0, q * np.log(np.where(q > 0, q, 1)), 0).sum(axis=(1, 2, 3))
+            expected += np.where(pk > 0, pk * h, 0)
+    return float(np.asarray(stimuli, float)[int(np.argmin(expected))])
+
+
+def quest_fill_missed(p, stimuli, correct, most=5):
+    """The track with the answers these rows lack put back: where a row's stimulus is not the one QUEST+ would show
+    next, a missed deadline came before it (the procedure counted it wrong, at the stimulus it chose). Returns
+    (stimuli, correct, missed); missed None when the rows cannot be explained by at most `most` missed answers each."""
+    psi = _likelihoods(p)
+    index = {float(x): i for i, x in enumerate(p["stimuli"])}
+    post = np.full(psi.shape[1:], 1.0 / psi[0].size)
+    xs, oks, missed = [], [], 0
+    for x, ok in zip(stimuli, correct):
+        for _ in range(most + 1):
+            shown = quest_next(post, psi, p["stimuli"])
+            if abs(shown - x) <= 1e-9 * max(1.0, abs(x)):
+                break
+            post = post * (1 - psi[index[shown]])
+            post /= post.sum()
+            xs.append(shown), oks.append(False)
+            missed += 1
+        else:
+            return stimuli, correct, None
+        if float(x) not in index:
+            return stimuli, correct, None
+        post = post * (psi[index[float(x)]] if ok else 1 - psi[index[float(x)]])
+        post /= post.sum()
+        xs.append(float(x)), oks.append(bool(ok))
+    return np.array(xs), np.array(oks), missed
+
+
+def credible(grid, mass, level=CREDIBLE):
+    """Equal-tailed interval on a grid: the first grid point where the cumulative mass reaches (1 - level) / 2, and the
+    first where it reaches 1 - (1 - level) / 2."""
+    cum = np.cumsum(mass)
+    tail = (1 - level) / 2
+    return grid[int(np.searchsorted(cum, tail - 1e-12))], grid[int(np.searchsorted(cum, 1 - tail - 1e-12))]
+
+
+def median(grid, mass):
+    """The grid's median: the cumulative mass interpolated linearly between the grid points around 1/2 (as
+    plan::TrackEstimate)."""
+    cum = np.cumsum(mass) / np.sum(mass)
+    k = int(np.argmax(cum >= 0.5))
+    if k == 0:
+        return float(grid[0])
+    return float(grid[k - 1] + (0.5 - cum[k - 1]) / (cum[k] - cum[k - 1]) * (grid[k] - grid[k - 1]))
+
+
+def quest_threshold(p, stimuli, correct, recorded=None):
+    """A QUEST+ track's threshold (dict) from its posterior over the protocol's grid."""
+    if p is None:
+        out = {"method": "QUEST+'s posterior mean as recorded (procedures.csv missing: no grid, no interval)",
+               "why": "interval not determined: the export has no procedures.csv (export again with this blurcue)"}
+        if recorded is not None and math.isfinite(recorded):
+            out["estimate_recorded"] = recorded
+        return out
+    missed = 0
+    if recorded is not None and math.isfinite(recorded):
+        filled, answers, missed = quest_fill_missed(p, stimuli, correct)
+        if missed:  # only where the rows lack answers: the procedure's record then decides (the mean check below)
+            stimuli, correct = filled, answers
+    post = quest_posterior(p, stimuli, correct)
+    grid = np.asarray(p["thresholds"], float)
+    slopes = np.asarray(p["slopes"], float)
+    marginal, slope_marginal = post.sum(axis=(1, 2)), post.sum(axis=(0, 2))
+    mean = float((marginal * grid).sum())
+    estimate = median(grid, marginal)
+    out = {"method": f"QUEST+ posterior over the protocol's grid ({len(grid)} thresholds x {len(slopes)} slopes x "
+                     f"{len(p['lapses'])} lapses, uniform prior): median, equal-tailed {CREDIBLE:.0%} credible "
+                     "interval", "slope": float((slope_marginal * slopes).sum()), "posterior_mean": mean}
+    if missed:
+        out["note"] = (f"{missed} missed answer{'s' if missed > 1 else ''} (not in these rows) put back where QUEST+ "
+                       "chose its stimulus, counted wrong as the procedure counted them")
+    stim = np.asarray(p["stimuli"], float)
+    lo, hi = max(grid.min(), stim.min()), min(grid.max(), stim.max())
+    out["range"] = (lo, hi)
+    if recorded is not None and math.isfinite(recorded) and abs(recorded - mean) > 1e-6 * max(1.0, abs(mean)):
+        out["why"] = (f"not determined: the answers in these rows give a posterior mean of {_text(mean)}, the "
+                      f"procedure recorded {_text(recorded)} (answers missing from these rows, such as missed "
+                      "deadlines?)")
+        return out
+    if slope_marginal.argmax() in (0, len(slopes) - 1) and len(slopes) > 1:
+        out["note"] = (out.get("note", "") + "; " if out.get("note") else "") + (f"the slope's posterior peaks at its grid's {'lowest' if slope_marginal.argmax() == 0 else 'highest'} "
+                       f"value {_text(slopes[slope_marginal.argmax()])}: the grid may not hold the observer's slope")
+    if marginal[0] >= 0.5 or estimate < lo:
+        out["why"] = (f"not determined: below the tested range {_text(lo)} to {_text(hi)} (posterior mass "
+                      f"{marginal[0]:.2f} on the grid's lowest threshold)")
+        return out
+    if marginal[-1] >= 0.5 or estimate > hi:
+        out["why"] = (f"not determined: above the tested range {_text(lo)} to {_text(hi)} (posterior mass "
+                      f"{marginal[-1]:.2f} on the grid's highest threshold)")
+        return out
+    low, high = credible(grid, marginal)
+    tail = (1 - CREDIBLE) / 2
+    bound = (["lower"] if low == grid[0] and marginal[0] >= tail else []) + \
+            (["upper"] if high == grid[-1] and marginal[-1] >= tail else [])
+    # No interval end beyond the stimuli shown: there the answers say nothing, the grid's prior everything.
+    if low < lo:
+        low, bound = lo, sorted(set(bound) | {"lower"})
+    if high > hi:
+        high, bound = hi, sorted(set(bound) | {"upper"})
+    out.update(estimate=estimate, low=float(low), high=float(high), interval_at_bound=" and ".join(bound))
+    return out
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# Tables and charts
+
+
+def track_rows(m):
+    """One dict per track: who, which cell, the levels and answers, and its threshold."""
+    d = m.dropna(subset=["level"]).copy()
+    d["level"] = _num(d["level"])
+    keys = [k for k in ("participant", "session_id", "block_name", "procedure_cell") if k in d]
+    several_blocks = "block_name" in d and d["block_name"].nunique() > 1
+    sessions = d.groupby("participant")["session_id"].nunique() if "session_id" in d else None
+    out = []
+    for key, g in d.sort_values("trial_index").groupby(keys, sort=True):
+        if "status" in g:
+            g = g.assign(y=g["y"].where(g["status"] != "timed_out", 0))
+        g = g.dropna(subset=["level", "y"])
+        if g.empty:
+            continue
+        key = dict(zip(keys, key if isinstance(key, tuple) else (key,)))
+        p = parameters(g)
+        kind = (p or {}).get("procedure") or ("quest_plus" if "posterior_threshold" in g and
+                                               _num(g["posterior_threshold"]).notna().any() else "staircase")
+        levels, correct = g["level"].to_numpy(float), g["y"].to_numpy() == 1
+        if "status" in g:  # a missed deadline, where the rows hold one, counts as wrong (as the procedure counted it)
+            correct &= (g["status"] != "timed_out").to_numpy()
+        recorded = _num(g["posterior_threshold"]).iloc[-1] if "posterior_threshold" in g else math.nan
+        result = quest_threshold(p, levels, correct, recorded) if kind == "quest_plus" else \
+            staircase_threshold(p, levels, correct)
+        label = cell_label(g)
+        if several_blocks:
+            label = f"{key['block_name']}: {label}"
+        participant = str(key["participant"])
+        if sessions is not None and sessions.get(key["participant"], 1) > 1:
+            participant += f" (session {key['session_id']})"
+        out.append({"participant": participant, "cell": label, "kind": kind, "levels": levels, "correct": correct,
+                    "posterior": _num(g["posterior_threshold"]).to_numpy() if kind == "quest_plus" and
+                    "posterior_threshold" in g else None, "result": result})
+    return out
+
+
+def _track_table(tracks):
+    rows = []
+    for t in tracks:
+        r = t["result"]
+        determined = "estimate" in r
+        rows.append({
+            "participant": t["participant"], "cell": t["cell"],
+            "procedure": "QUEST+" if t["kind"] == "quest_plus" else "staircase", "trials": len(t["levels"]),
+            "share_correct": float(t["correct"].mean()),
+            "threshold": r["estimate"] if determined else None,
+            "threshold_low": r.get("low") if determined else None,
+            "threshold_high": r.get("high") if determined else None,
+            "interval_at_bound": r.get("interval_at_bound", ""),
+            "turning_points": r.get("turning_points") if t["kind"] != "quest_plus" else None,
+            "slope": r.get("slope"), "posterior_mean": r.get("posterior_mean"),
+            "threshold_says": "determined" if determined else r.get("why", "not determined"),
+            "note": r.get("note", ""), "method": r["method"]})
+    return pd.DataFrame(rows)
+
+
+def summary_table(tracks):
+    """Per cell across participants: the determined thresholds' mean with a t 95 % interval (n >= 2) and median."""
+    rows = []
+    for cell in dict.fromkeys(t["cell"] for t in tracks):
+        these = [t for t in tracks if t["cell"] == cell]
+        v = np.array([t["result"]["estimate"] for t in these if "estimate" in t["result"]], float)
+        row = {"cell": cell, "tracks": len(these), "determined": len(v), "not_determined": len(these) - len(v)}
+        if len(v):
+            row.update(mean=float(v.mean()), median=float(np.median(v)))
+        if len(v) >= 2:
+            half = sps.t.ppf(0.975, len(v) - 1) * v.std(ddof=1) / math.sqrt(len(v))
+            row.update(mean_low=float(v.mean() - half), mean_high=float(v.mean() + half),
+                       sd_across_participants=float(v.std(ddof=1)))
+        row["interval"] = "t 95 % across participants" if len(v) >= 2 else \
+            ("not determined: fewer than 2 determined thresholds" if len(these) else "")
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def comparisons_table(tracks):
+    """Every pair of cells, paired across the participants with a determined threshold in both: the mean
+    difference (second minus first) with its t 95 % interval and the paired t-test."""
+    by = {}
+    for t in tracks:
+        if "estimate" in t["result"]:
+            by.setdefault(t["cell"], {})[t["participant"]] = t["result"]["estimate"]
+    cells = list(dict.fromkeys(t["cell"] for t in tracks))
+    rows = []
+    for i, a in enumerate(cells):
+        for b in cells[i + 1:]:
+            both = sorted(set(by.get(a, {})) & set(by.get(b, {})))
+            row = {"first": a, "second": b, "pairs": len(both)}
+            if len(both) >= 2:
+                diff = np.array([by[b][p] - by[a][p] for p in both])
+                half = sps.t.ppf(0.975, len(diff) - 1) * diff.std(ddof=1) / math.sqrt(len(diff))
+                row.update(mean_difference=float(diff.mean()), difference_low=float(diff.mean() - half),
+                           difference_high=float(diff.mean() + half))
+                if diff.std(ddof=1) > 0:
+                    row["p_paired_t"] = float(sps.ttest_rel([by[b][p] for p in both], [by[a][p] for p in both]).pvalue)
+                row["test"] = "paired t across participants"
+            else:
+                row["test"] = "not determined: fewer than 2 participants with a threshold in both cells"
+            rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def _bar(r):
+    """An estimate's error bar for matplotlib; none where its interval is not determined."""
+    if "low" not in r:
+        return None
+    return [[r["estimate"] - r["low"]], [r["high"] - r["estimate"]]]
+
+
+def _tracks_figure(tracks, cells, study, group_note, out_dir, name):
+    n = len(cells)
+    cols = min(n, 3)
+    rows = math.ceil(n / cols)
+    width = 6.8 if cols == 1 else 4.2 * cols + 0.6
+    fig, axes = plt.subplots(rows, cols, figsize=(width, 3.2 * rows + 0.8), squeeze=False, sharey=True)
+    for ax, cell in zip(axes.flat, cells):
+        these = [t for t in tracks if t["cell"] == cell]
+        for i, t in enumerate(these):
+            c = COLORS[i % len(COLORS)] if len(these) <= len(COLORS) else "#0072B2"
+            alpha = 0.9 if len(these) <= len(COLORS) else 0.35
+            step = np.arange(1, len(t["levels"]) + 1)
+            ax.plot(step, t["levels"], "-", color=c, lw=1, alpha=alpha)
+            if len(these) <= len(COLORS):
+                ax.plot(step[t["correct"]], t["levels"][t["correct"]], "o", color=c, ms=3)
+                ax.plot(step[~t["correct"]], t["levels"][~t["correct"]], "x", color=c, ms=3.5)
+            r = t["result"]
+            if "estimate" in r:
+                ax.errorbar(len(step) + 1.5 + 0.4 * (i % 5), r["estimate"], yerr=_bar(r), fmt="s", color=c, ms=3.5,
+                            lw=0.9, alpha=alpha)
+        ax.set_title(cell, loc="left", fontsize=10)
+        ax.set_xlabel("trial of the procedure")
+    for ax in axes.flat[n:]:
+        ax.set_visible(False)
+    for ax in axes[:, 0]:
+        ax.set_ylabel("level shown")
+    kinds = {t["kind"] for t in tracks}
+    fig.suptitle(f"{study}: procedure tracks ({', '.join('QUEST+' if k == 'quest_plus' else 'staircase' for k in sorted(kinds))})"
+                 f"\n{group_note}; o correct, x wrong; squares at the right: each track's threshold and interval",
+                 x=0.01, ha="left", fontsize=11)
+    fig.tight_layout()
+    return save(fig, out_dir, name)
+
+
+def _thresholds_figure(tracks, summary, cells, study, group_note, out_dir, name):
+    fig, ax = plt.subplots(figsize=(max(6.8, 1.3 * len(cells) + 2.5), 3.8))
+    for xi, cell in enumerate(cells):
+        these = [t for t in tracks if t["cell"] == cell and "estimate" in t["result"]]
+        offsets = np.linspace(-0.25, 0.25, len(these)) if len(these) > 1 else [0.0]
+        for off, t in zip(offsets, these):
+            r = t["result"]
+            ax.errorbar(xi + off, r["estimate"], yerr=_bar(r), fmt="o", color="#999999", ms=3, lw=0.8)
+        s = summary[summary["cell"] == cell].iloc[0]
+        if "mean_low" in s and pd.notna(s.get("mean_low")):
+            ax.errorbar(xi + 0.38, s["mean"], yerr=[[s["mean"] - s["mean_low"]], [s["mean_high"] - s["mean"]]],
+                        fmt="D", color="#D55E00", ms=6, lw=1.6)
+        missing = int(s["not_determined"])
+        if missing:
+            ax.annotate(f"{missing} not determined", (xi, 0), xycoords=("data", "axes fraction"), ha="center",
+                        va="bottom", fontsize=8, color="#D55E00")
+    ax.set_xticks(range(len(cells)))
+    ax.set_xticklabels(cells, rotation=20 if len(cells) > 3 else 0, ha="right" if len(cells) > 3 else "center")
+    ax.set_xlim(-0.6, len(cells) - 0.4)
+    ax.set_ylabel("threshold (the procedure's level)")
+    ax.set_title(f"{study}: thresholds per cell\n{group_note}; grey: each participant with its 95 % interval; "
+                 "orange: the mean with its t 95 % interval", loc="left", fontsize=10)
+    return save(fig, out_dir, name)
 
 
 def charts(m, study, out_dir, slug, group_note):
-    """The level each adaptive procedure showed, trial after trial, with the answers, and its threshold estimate:
-    QUEST+'s posterior mean after the last answer (its running posterior mean drawn dashed), a staircase's mean of
-    its last 6 reversal levels (or of its last 10 levels with fewer than 4 reversals)."""
-    name = f"{slug}-tracks"
-    d = m.dropna(subset=["level"]).copy()
-    d["level"] = d["level"].astype(float)
-    fig, ax = plt.subplots(figsize=(6.5, 3.8))
-    rows = []
-    colors = ["#0072B2", "#E69F00", "#009E73", "#CC79A7", "#D55E00", "#56B4E9"]
-    for i, ((participant, cell), g) in enumerate(d.sort_values("trial_index").groupby(["participant", "procedure_cell"])):
-        levels = g["level"].to_numpy()
-        step = np.arange(1, len(levels) + 1)
-        c = colors[i % len(colors)]
-        ax.plot(step, levels, "-", color=c, lw=1, alpha=0.8)
-        ok = g["y"].to_numpy() == 1
-        ax.plot(step[ok], levels[ok], "o", color=c, ms=3.5)
-        ax.plot(step[~ok], levels[~ok], "x", color=c, ms=4)
-        posterior = _num(g["posterior_threshold"]) if "posterior_threshold" in g else pd.Series(dtype=float)
-        moves = np.sign(np.diff(levels))
-        moves = moves[moves != 0]
-        reversals = [levels[1:][np.diff(levels) != 0][j] for j in range(1, len(moves)) if moves[j] != moves[j - 1]]
-        if posterior.notna().any():
-            ax.plot(step, posterior.to_numpy(), "--", color=c, lw=1)
-            estimate, by = float(posterior.dropna().iloc[-1]), "QUEST+ posterior mean after the last answer"
-        elif len(reversals) >= 4:
-            estimate, by = float(np.mean(reversals[-6:])), "mean of the last 6 reversal levels"
-        else:
-            estimate, by = float(np.mean(levels[-10:])), "mean of the last 10 levels"
-        rows.append({"participant": participant, "procedure_cell": _label(cell), "trials": len(levels),
-                     "reversals": len(reversals), "estimate": estimate, "by": by,
-                     "share_correct": float(ok.mean())})
-    ax.set_xlabel("trial of the procedure")
-    ax.set_ylabel("level shown")
-    ax.set_title(f"{study}: procedure tracks (o correct, x wrong; dashed: QUEST+'s posterior mean threshold)\n"
-                 f"{group_note}", loc="left")
-    png, svg = save(fig, out_dir, name)
-    return [Chart(name, png, svg, pd.DataFrame(rows), ["one line per participant and crossing of the block's factors; "
-                                                        "estimate: each track's threshold as its procedure gives it"])]
+    """The tracks, the thresholds per cell and the comparisons between cells, for one study's procedure rows."""
+    tracks = track_rows(m)
+    if not tracks:
+        return [Chart(f"{slug}-tracks", None, None, None, ["no procedure track with levels and answers"])]
+    cells = list(dict.fromkeys(t["cell"] for t in tracks))
+    table = _track_table(tracks)
+    summary = summary_table(tracks)
+    png, svg = _tracks_figure(tracks, cells, study, group_note, out_dir, f"{slug}-tracks")
+    methods = sorted(set(table["method"]))
+    out = [Chart(f"{slug}-tracks", png, svg, table,
+                 [f"{group_note}: one track per participant and procedure cell (the crossing of its block's factors, "
+                  "by its levels); threshold and interval: " + "; ".join(methods),
+                  "a threshold that the track does not determine is said in words (threshold_says), never written "
+                  "as a number; interval_at_bound: an interval end on the grid's or the level's bound"])]
+    png, svg = _thresholds_figure(tracks, summary, cells, study, group_note, out_dir, f"{slug}-thresholds")
+    out.append(Chart(f"{slug}-thresholds", png, svg, summary,
+                     [f"{group_note}: per cell, the determined thresholds' mean with a t 95 % interval across "
+                      "participants (n >= 2) and their median; tracks whose threshold is not determined are counted, "
+                      "not averaged"]))
+    if len(cells) > 1:
+        out.append(Chart(f"{slug}-threshold-comparisons", None, None, comparisons_table(tracks),
+                         [f"{group_note}: each pair of cells, paired across the participants with a determined "
+                          "threshold in both: mean of (second - first) with its t 95 % interval, paired t-test "
+                          "(not adjusted for the number of pairs)"]))
+    return out

@@ -23,7 +23,13 @@ add_test(NAME analysis.prediction
 add_test(NAME analysis.design
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_design.py
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
-set_tests_properties(analysis.stats analysis.report analysis.bench_charts analysis.prediction analysis.design PROPERTIES
+# Tracks, thresholds and intervals against simulated observers of known threshold (python3-questplus picks QUEST+'s
+# stimuli) and a hand-worked staircase.
+add_test(NAME analysis.tracks
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_tracks.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(analysis.stats analysis.report analysis.bench_charts analysis.prediction analysis.design
+                     analysis.tracks PROPERTIES
                      LABELS analysis TIMEOUT 180
                      # Matplotlib writes its font cache under HOME; keep it out of a read-only or shared home.
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")

@@ -222,7 +222,35 @@ import csv, sys
 th = [r for r in csv.DictReader(open(sys.argv[1])) if r["test"] == "threshold"]
 assert th and all(r["true_threshold"] == "" and r["bias"] == "" and r["mean_estimate"] != "" for r in th), th[0]
 PYEOF
-  echo "ok: QUEST+ plans its threshold: the observer's truth by the closed form, bias, sd and interval width; a truth beyond the range in words" ;;
+  # validate --plan: the shipped grid holds the observer; a slope grid of 1.5-5 does not, and the observer's slope there
+  # is the closed form's: x dP/dx at the threshold x, over a Weibull's (1 - 0.5 - lapse / 2) / e, with
+  # P = lapse / 2 + (1 - lapse) Phi(z75 ln(E(r + x) / E(r)) / ln 1.35) and d ln E / dx = (r + x) / 4 / E(r + x)^2.
+  $BC validate "$P/quest-blur-difference.json" --plan > "$W/v.out" 2>&1 || fail "validate --plan shipped: $(tail -2 "$W/v.out")"
+  variant "$P/quest-blur-difference.json" "$W/steep.json" 'p["blocks"][0]["procedure"]["slope"] = [1.5, 2.5, 3.5, 5]'
+  set +e
+  $BC validate "$W/steep.json" --plan > "$W/steep.out" 2>&1
+  code=$?
+  set -e
+  [ "$code" = 3 ] || fail "validate --plan steep grid: exit $code, $(cat "$W/steep.out")"
+  $PY - "$W/steep.out" "$W/tables/trials.csv" <<'PYEOF' || fail "validate --plan slope: $(cat "$W/steep.out")"
+import csv, math, re, sys
+from scipy.optimize import brentq
+from scipy.stats import norm
+text = open(sys.argv[1]).read().strip()
+assert len(text.splitlines()) == 1 and "steep.json: /blocks/0/procedure/slope: the observer's Weibull slope" in text, text
+said = float(re.search(r"threshold \(([0-9.]+)\) is ([0-9.]+), outside the slope grid 1.5 to 5", text).group(2))
+row = next(r for r in csv.DictReader(open(sys.argv[2])) if r["practice"] == "0")
+r = float(row["r_right_arcmin"] if row["test_side"] == "left" else row["r_left_arcmin"])
+E = lambda v: math.hypot(v / 2, 0.6)
+z75, lapse = norm.ppf(0.75), 0.04
+P = lambda x: lapse / 2 + (1 - lapse) * norm.cdf(z75 * math.log(E(r + x) / E(r)) / math.log(1.35))
+x = brentq(lambda v: P(v) - (0.5 + (0.5 - lapse / 2) * (1 - 1 / math.e)), 1e-6, 50)
+z = z75 * math.log(E(r + x) / E(r)) / math.log(1.35)
+slope = x * (1 - lapse) * norm.pdf(z) * z75 / math.log(1.35) * (r + x) / 4 / E(r + x) ** 2 * math.e / (0.5 - lapse / 2)
+assert abs(said - slope) < 0.006, (said, slope)
+print(f"  validate --plan: the observer's slope {said} (closed form {slope:.4f}) outside 1.5-5, exit 3")
+PYEOF
+  echo "ok: QUEST+ plans its threshold: the observer's truth by the closed form, bias, sd and interval width; a truth beyond the range in words; validate --plan checks the grid holds the observer's slope" ;;
 difference_power)
   # The power of a declared difference: a second cell like edge=9 in the same participants, 0.5 arcmin more. Its
   # paired differences have sd sqrt(2) x the estimates' sd, so the t-test's power is the noncentral t's (df N - 1,

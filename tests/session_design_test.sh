@@ -224,10 +224,15 @@ fit = next(csv.DictReader(open(os.path.join(out, "quest-blur-difference-simulate
 lo, th, hi = float(fit["threshold_low"]), float(fit["threshold"]), float(fit["threshold_high"])
 print(f"QUEST+ threshold {th:.3f} [{lo:.3f}, {hi:.3f}] arcmin; the observers' {truth:.3f}")
 assert lo <= truth <= hi, (lo, th, hi, truth)
-# Each QUEST+ track's estimate is its posterior mean after its last answer, inside the stimulus range.
+# Each QUEST+ track's threshold is its posterior median over the grid, with a credible interval inside the grid, or
+# "not determined" in words (no number).
 tracks = list(csv.DictReader(open(os.path.join(out, "quest-blur-difference-simulated-tracks.csv"))))
-assert len(tracks) == 5 and all(t["by"].startswith("QUEST+ posterior mean") for t in tracks), tracks
-assert all(0.25 <= float(t["estimate"]) <= 4 for t in tracks), tracks
+assert len(tracks) == 5 and all(t["method"].startswith("QUEST+ posterior over the protocol's grid") for t in tracks), tracks
+for t in tracks:
+    if t["threshold_says"] == "determined":
+        assert 0.25 <= float(t["threshold_low"]) <= float(t["threshold"]) <= float(t["threshold_high"]) <= 6, t
+    else:
+        assert t["threshold_says"].startswith("not determined") and t["threshold"] == "", t
 # The odd one out is found above chance (1/3) where the odd card differs most (edge 9), with its test across the
 # three participants.
 odd = list(csv.DictReader(open(os.path.join(out, "odd-one-out-grids-simulated-per-edge.csv"))))

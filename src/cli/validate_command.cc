@@ -10,6 +10,7 @@
 #include "cli/groups.h"
 #include "core/error.h"
 #include "core/hash.h"
+#include "plan/threshold.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
 #include "session/observer.h"
@@ -78,6 +79,7 @@ void AddValidateCommand(CLI::App& app) {
       std::string shown;  // how a frame reaches the screen and the eye
     };
     std::vector<Checked> checked;
+    std::vector<std::string> grid_problems;  // --plan: a QUEST+ grid that does not hold the observer
     if (args->no_files) {
       p = protocol::LoadProtocol(args->file, protocol::ValidateOptions{false});
       for (const std::string& group : GroupsToCheck(p, args->group)) {
@@ -115,9 +117,13 @@ void AddValidateCommand(CLI::App& app) {
                           prepared.protocol.content.depth_blur_threshold_unit == protocol::ThresholdUnit::kArcmin ? "arcmin" : "screen px");
             shown += line;
           }
-          if (observer)
+          if (observer) {
             for (const std::string& text : session::VisibilityLines(prepared, *observer, args->visible, false))
               shown += "  " + text + "\n";
+            for (const std::string& problem : plan::QuestGridProblems(prepared, *observer, args->file))
+              if (std::find(grid_problems.begin(), grid_problems.end(), problem) == grid_problems.end())
+                grid_problems.push_back(problem);
+          }
           checked.push_back({group, prepared.seed, prepared.trials, shown});
         }
         p = std::move(prepared.protocol);
@@ -127,6 +133,11 @@ void AddValidateCommand(CLI::App& app) {
         throw e.Wrapped(e.kind(), "", "(scripts/demo.sh writes the demo scene the shipped protocols use; --no-files "
                                       "skips the file checks)");
       }
+    }
+    if (!grid_problems.empty()) {
+      std::string text;
+      for (const std::string& problem : grid_problems) text += (text.empty() ? "" : "\n") + problem;
+      throw Error(ErrorKind::kInput, text);
     }
     for (const Checked& one : checked) {
       const auto& trials = one.trials;

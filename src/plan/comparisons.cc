@@ -385,8 +385,8 @@ std::string ThresholdSummary(const PlanResult& r, const PlanOptions& o) {
   std::string out;
   char line[1024];
   std::snprintf(line, sizeof line,
-                "procedure cells: the threshold each estimates (QUEST+: its posterior mean after the last answer; a "
-                "staircase: the mean of its last 6 reversal levels, as the report takes them), over every simulated "
+                "procedure cells: the threshold each estimates (QUEST+: its posterior median over its grid; a staircase: "
+                "the mean of its last 6 turning points, as the report takes them), over every simulated "
                 "participant, against the simulated observer's true threshold (its psychometric function's point the "
                 "procedure aims at: QUEST+'s Weibull threshold, a staircase's convergence point), and the mean width "
                 "of the 95 %% t interval of the mean of N = %d participants' estimates\n",

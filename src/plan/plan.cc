@@ -94,11 +94,11 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
   p.group = study.group;
   const protocol::Protocol& protocol = study.protocol;
   session::SessionLogic logic(study, cache);
-  // A procedure cell's track: the levels shown, and QUEST+'s posterior mean threshold after the last answer.
+  // A procedure cell's track: the levels shown and the answers as the procedure scored them (a missed deadline wrong).
   struct Track {
-    protocol::Procedure::Kind kind;
+    const protocol::Procedure* procedure;
     std::vector<double> levels;
-    std::optional<double> posterior;
+    std::vector<bool> correct;
   };
   std::map<std::string, Track> tracks;
   for (const protocol::Trial& trial : study.trials) {
@@ -154,10 +154,10 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
         with_truth.range_lo = truth.range_lo, with_truth.range_hi = truth.range_hi;
         conditions->emplace(c->key, with_truth);
       }
-      Track& track = tracks.try_emplace(c->key, Track{protocol::BlockOf(protocol, trial)->procedure->kind, {}, {}})
-                         .first->second;
+      Track& track =
+          tracks.try_emplace(c->key, Track{&*protocol::BlockOf(protocol, trial)->procedure, {}, {}}).first->second;
       track.levels.push_back(level);
-      if (scored.posterior) track.posterior = scored.posterior->first;
+      track.correct.push_back(scored.correct.value_or(false));
       continue;
     }
     conditions->emplace(c->key, *c);
@@ -178,7 +178,7 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
     }
   }
   for (const auto& [key, track] : tracks)
-    if (const auto estimate = TrackEstimate(track.kind, track.levels, track.posterior)) p.thresholds[key] = *estimate;
+    if (const auto estimate = TrackEstimate(*track.procedure, track.levels, track.correct)) p.thresholds[key] = *estimate;
   return p;
 }
 

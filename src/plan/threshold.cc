@@ -2,8 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <set>
 
+#include "protocol/design.h"
 #include "protocol/trials.h"
+#include "session/adaptive.h"
 #include "session/answer.h"
 
 namespace blurcue::plan {
@@ -30,6 +34,13 @@ double TargetShare(const protocol::Procedure& procedure, double miss) {
 namespace {
 
 std::string Text(double v) { return protocol::LevelText(v); }
+
+// Three significant digits: a derived quantity, not a level the protocol names.
+std::string Short(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", v);
+  return text;
+}
 
 }  // namespace
 
@@ -91,26 +102,93 @@ TrueThreshold ObserverThreshold(const session::ObserverParams& observer, const p
   }
   t.determined = true;
   t.level = (lo + hi) / 2;
+  if (procedure.kind == protocol::Procedure::Kind::kQuestPlus) {
+    // The observer's slope on a log axis at its threshold, by a central difference of +-0.1 % in the level; a
+    // Weibull's there is (1 - guess - miss) slope / e.
+    const double h = 1e-3;
+    const double dp = (share(t.level * (1 + h)) - share(t.level * (1 - h))) / (std::log1p(h) - std::log1p(-h));
+    t.weibull_slope = dp * std::exp(1.0) / (1 - procedure.guess - lapse / 2);
+  }
   return t;
 }
 
-std::optional<double> TrackEstimate(protocol::Procedure::Kind kind, const std::vector<double>& levels,
-                                    std::optional<double> last_posterior) {
-  if (levels.empty()) return std::nullopt;
-  if (kind == protocol::Procedure::Kind::kQuestPlus && last_posterior) return *last_posterior;
-  // The report's rule, step by step: the level after each change of level, and a reversal where a change goes the
-  // other way than the one before it.
-  std::vector<double> after;
-  std::vector<int> moves;
-  for (size_t i = 1; i < levels.size(); ++i)
-    if (levels[i] != levels[i - 1]) after.push_back(levels[i]), moves.push_back(levels[i] > levels[i - 1] ? 1 : -1);
-  std::vector<double> reversals;
-  for (size_t j = 1; j < moves.size(); ++j)
-    if (moves[j] != moves[j - 1]) reversals.push_back(after[j]);
-  const std::vector<double>& from = reversals.size() >= 4 ? reversals : levels;
-  const size_t take = std::min(from.size(), reversals.size() >= 4 ? size_t(6) : size_t(10));
+std::vector<std::string> QuestGridProblems(const session::PreparedSession& prepared,
+                                           const session::ObserverParams& observer, const std::string& file) {
+  std::vector<std::string> problems;
+  std::set<std::pair<std::string, int>> seen;
+  for (const protocol::Trial& trial : prepared.trials) {
+    const protocol::Block* block = protocol::BlockOf(prepared.protocol, trial);
+    if (trial.cell < 0 || !block || !block->procedure || !seen.insert({trial.block, trial.cell}).second) continue;
+    const protocol::Procedure& procedure = *block->procedure;
+    if (procedure.kind != protocol::Procedure::Kind::kQuestPlus) continue;
+    const TrueThreshold truth =
+        ObserverThreshold(observer, procedure, trial, prepared.scenes[size_t(trial.index)], prepared.presentation);
+    const std::string cell = protocol::CellLevels(prepared.protocol, trial);
+    const std::string at = file + ": " + block->pointer + "/procedure/";
+    const std::string who = " (cell " + cell + ", observer " + session::ToString(observer) + ")";
+    if (!truth.determined) {
+      if (truth.why.rfind("never reached", 0) != 0 && truth.why.rfind("not worked out", 0) != 0)
+        problems.push_back(at + "threshold: the observer's threshold is " + truth.why + who +
+                           ": widen the threshold grid and the stimuli to hold it");
+      continue;
+    }
+    const auto [lo, hi] = std::minmax_element(procedure.slopes.begin(), procedure.slopes.end());
+    if (lo != procedure.slopes.end() && (truth.weibull_slope < *lo || truth.weibull_slope > *hi))
+      problems.push_back(at + "slope: the observer's Weibull slope at its threshold (" + Short(truth.level) + ") is " +
+                         Short(truth.weibull_slope) + ", outside the slope grid " + Text(*lo) + " to " + Text(*hi) +
+                         who + ": QUEST+ would fit the wrong shape and misplace the threshold");
+  }
+  return problems;
+}
+
+std::vector<double> TurningPoints(const protocol::Procedure& procedure, const std::vector<bool>& correct) {
+  session::Staircase staircase(procedure);
+  for (const bool answer : correct) staircase.Update(answer);
+  return staircase.ReversalLevels();
+}
+
+std::optional<double> TrackEstimate(const protocol::Procedure& procedure, const std::vector<double>& levels,
+                                    const std::vector<bool>& correct) {
+  if (levels.empty() || levels.size() != correct.size()) return std::nullopt;
+  if (procedure.kind == protocol::Procedure::Kind::kQuestPlus) {
+    session::QuestPlus quest(procedure);
+    for (size_t i = 0; i < levels.size(); ++i) quest.Update(levels[i], correct[i]);
+    // The threshold's marginal: the posterior runs threshold x slope x lapse, lapse fastest.
+    const size_t per_threshold = procedure.slopes.size() * procedure.lapses.size();
+    const std::vector<double>& posterior = quest.Posterior();
+    std::vector<double> cumulative(procedure.thresholds.size(), 0);
+    double sum = 0;
+    for (size_t t = 0; t < procedure.thresholds.size(); ++t) {
+      for (size_t k = 0; k < per_threshold; ++k) sum += posterior[t * per_threshold + k];
+      cumulative[t] = sum;
+    }
+    if (!(sum > 0) || cumulative.size() < 2) return std::nullopt;
+    for (double& c : cumulative) c /= sum;
+    // Half the mass on an end of the grid: the threshold lies at or beyond what the grid tested.
+    if (cumulative.front() >= 0.5 || 1 - cumulative[cumulative.size() - 2] >= 0.5) return std::nullopt;
+    size_t k = 0;
+    while (cumulative[k] < 0.5) ++k;
+    const std::vector<double>& grid = procedure.thresholds;
+    const double median =
+        grid[k - 1] + (0.5 - cumulative[k - 1]) / (cumulative[k] - cumulative[k - 1]) * (grid[k] - grid[k - 1]);
+    // Beyond every stimulus shown: the answers never came near it (ObserverThreshold's range).
+    if (!procedure.stimuli.empty()) {
+      const auto [lo, hi] = std::minmax_element(procedure.stimuli.begin(), procedure.stimuli.end());
+      if (median < *lo || median > *hi) return std::nullopt;
+    }
+    return median;
+  }
+  const std::vector<double> turns = TurningPoints(procedure, correct);
+  if (turns.size() < 4) return std::nullopt;
+  const size_t take = std::min<size_t>(6, turns.size() - turns.size() % 2);
   double sum = 0;
-  for (size_t i = from.size() - take; i < from.size(); ++i) sum += from[i];
+  size_t at_bound = 0;
+  for (size_t i = turns.size() - take; i < turns.size(); ++i) {
+    sum += turns[i];
+    at_bound += std::abs(turns[i] - procedure.min) <= 1e-9 * std::max(1.0, std::abs(procedure.min)) ||
+                std::abs(turns[i] - procedure.max) <= 1e-9 * std::max(1.0, std::abs(procedure.max));
+  }
+  if (2 * at_bound >= take) return std::nullopt;
   return sum / double(take);
 }
 

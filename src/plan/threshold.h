@@ -9,6 +9,7 @@
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
 #include "session/observer.h"
+#include "session/prepare.h"
 #include "stimulus/stimulus.h"
 
 namespace blurcue::plan {
@@ -31,6 +32,9 @@ struct TrueThreshold {
   // where its stimuli span it too (a threshold no stimulus comes near is left to the prior). Empty (lo > hi) when
   // QUEST+'s stimuli lie wholly outside its threshold grid.
   double range_lo = 0, range_hi = 0;
+  // QUEST+ (when determined): the slope of the Weibull that has the observer's threshold and the observer's slope
+  // there on a log axis, dP / d ln x = (1 - guess - miss) slope / e - what QUEST+'s slope grid must hold.
+  double weibull_slope = 0;
 };
 
 // The level at which the observer's probability of a correct answer (ProbabilityCorrect2afc on the pair as the trial
@@ -42,10 +46,27 @@ TrueThreshold ObserverThreshold(const session::ObserverParams& observer, const p
                                 const protocol::Trial& trial, const stimulus::TrialScene& planned,
                                 const stimulus::Presentation& presentation);
 
-// One participant's threshold estimate for one track, as the report takes it: QUEST+'s posterior mean after the last
-// answer; a staircase's mean of its last 6 reversal levels, or of its last 10 levels with fewer than 4 reversals
-// (a reversal: a change of direction of the levels shown). Empty for an empty track.
-std::optional<double> TrackEstimate(protocol::Procedure::Kind kind, const std::vector<double>& levels,
-                                    std::optional<double> last_posterior);
+// Whether each QUEST+ cell's grid holds the observer it is planned with: the observer's threshold (ObserverThreshold)
+// inside the threshold grid and within its stimuli, and its Weibull slope there (weibull_slope) inside the slope grid.
+// One line per problem, naming the protocol file, the field's JSON pointer, the value and the grid; empty when every
+// cell's grid holds the observer. A grid that misses the observer's slope misplaces the threshold (a Weibull of
+// slope 1.5 fitted to an observer of slope 1.1 put QUEST+'s estimate 20 % high at 40 trials).
+std::vector<std::string> QuestGridProblems(const session::PreparedSession& prepared,
+                                           const session::ObserverParams& observer, const std::string& file);
+
+// The procedure's turning points (session::Staircase::ReversalLevels: the level shown on the answer whose step goes
+// the other way than the last) replayed from a staircase's answers, in order.
+std::vector<double> TurningPoints(const protocol::Procedure& procedure, const std::vector<bool>& correct);
+
+// One participant's threshold estimate for one track (the levels shown and the answers, a missed deadline counted
+// wrong as the procedure counts it), as the report takes it (analysis/tracks.py):
+//   QUEST+: the median of the threshold's marginal posterior over the protocol's grid (the cumulative mass
+//   interpolated linearly between grid points); empty when half the mass or more is on the grid's lowest or highest
+//   threshold (below or above what it tested);
+//   staircase: the mean of the last 6 turning points (4 when there are 4 or 5); empty with fewer than 4, or when half
+//   of those used or more sit at the level's bound (min or max).
+// Empty for an empty track.
+std::optional<double> TrackEstimate(const protocol::Procedure& procedure, const std::vector<double>& levels,
+                                    const std::vector<bool>& correct);
 
 }  // namespace blurcue::plan

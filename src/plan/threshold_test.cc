@@ -1,5 +1,5 @@
 // The plan's truth about thresholds against hand-worked cases: Levitt's convergence points, the Weibull's threshold
-// point, the report's reversal rule and the pixel observer's closed form Phi(dr / jnd) solved by hand.
+// point, the report's turning-point rule and QUEST+'s posterior median and the pixel observer's closed form Phi(dr / jnd) solved by hand.
 #include "plan/threshold.h"
 
 #include <cmath>
@@ -28,17 +28,45 @@ TEST(TargetShare, LevittPointsAndTheWeibullThreshold) {
   EXPECT_NEAR(TargetShare(quest, 0.02), 0.5 + 0.48 * (1 - 1 / M_E), 1e-12);
 }
 
-TEST(TrackEstimate, TheReportsReversalRule) {
-  // Moves D D U D U D U D; the levels after them .6 .4 .6 .4 .6 .5 .6 .5; reversals at moves 3..8: .6 .4 .6 .5 .6 .5,
-  // whose mean is 3.2 / 6 (analysis/any_study.py gives 0.5333 for the same list).
-  const std::vector<double> levels = {1.0, 0.6, 0.6, 0.4, 0.6, 0.4, 0.6, 0.5, 0.6, 0.5};
-  EXPECT_NEAR(*TrackEstimate(protocol::Procedure::Kind::kStaircase, levels, std::nullopt), 3.2 / 6, 1e-12);
-  // Fewer than 4 reversals (one): the mean of the last 10 levels, .6 + .4 + .2 + 7 x .4 = 4.0.
-  const std::vector<double> few = {1, 0.8, 0.6, 0.4, 0.2, 0.4, 0.4, 0.4, 0.4, 0.4, 0.4, 0.4};
-  EXPECT_NEAR(*TrackEstimate(protocol::Procedure::Kind::kStaircase, few, std::nullopt), 4.0 / 10, 1e-12);
-  // QUEST+: its posterior mean, whatever the levels.
-  EXPECT_EQ(*TrackEstimate(protocol::Procedure::Kind::kQuestPlus, levels, 1.25), 1.25);
-  EXPECT_FALSE(TrackEstimate(protocol::Procedure::Kind::kStaircase, {}, std::nullopt));
+// A 1-up/2-down staircase from 1.0, steps 0.4 then 0.2, answered C C C C W C C W W C C W C C, worked by hand: it
+// shows 1, 1, .6, .6, .2, .4, .4, .2, .4, .6, .6, .4, .6, .6 and turns (the level shown on the answer whose step goes
+// the other way) at trials 5, 7, 8, 11, 12, 14: .2 .4 .2 .6 .4 .6, mean 2.4 / 6 = 0.4. The levels after each turn
+// (the rule of before) would give .4 .2 .4 .4 .6 and a sixth level never shown.
+TEST(TrackEstimate, StaircaseMeanOfItsTurningPoints) {
+  protocol::Procedure staircase;
+  staircase.start = 1, staircase.min = 0, staircase.max = 3, staircase.up = 1, staircase.down = 2;
+  staircase.steps = {0.4, 0.2};
+  const std::vector<double> levels = {1, 1, 0.6, 0.6, 0.2, 0.4, 0.4, 0.2, 0.4, 0.6, 0.6, 0.4, 0.6, 0.6};
+  const std::vector<bool> correct = {true, true, true, true, false, true, true,
+                                     false, false, true, true, false, true, true};
+  const std::vector<double> turns = TurningPoints(staircase, correct);
+  const std::vector<double> by_hand = {0.2, 0.4, 0.2, 0.6, 0.4, 0.6};
+  ASSERT_EQ(turns.size(), by_hand.size());
+  for (size_t i = 0; i < turns.size(); ++i) EXPECT_NEAR(turns[i], by_hand[i], 1e-12) << i;
+  EXPECT_NEAR(*TrackEstimate(staircase, levels, correct), 0.4, 1e-12);
+  // After 10 answers it has turned 3 times (.2 .4 .2): too few for a threshold.
+  EXPECT_FALSE(TrackEstimate(staircase, std::vector<double>(levels.begin(), levels.begin() + 10),
+                             std::vector<bool>(correct.begin(), correct.begin() + 10)));
+  // Turning at its bounds 4 times of 6 (.2 and .6 the bounds): not determined (the threshold may lie beyond them).
+  staircase.min = 0.2, staircase.max = 0.6;
+  EXPECT_FALSE(TrackEstimate(staircase, levels, correct));
+  EXPECT_FALSE(TrackEstimate(staircase, {}, {}));
+}
+
+// QUEST+ over thresholds {1, 2, 3}, slope 2, no lapse, guess 0.5, after one correct answer at 1: each threshold's
+// likelihood 1 - 0.5 exp(-(1 / t)^2), the marginal their share, the median interpolated in the cumulative mass.
+TEST(TrackEstimate, QuestPlusPosteriorMedianByHand) {
+  protocol::Procedure quest;
+  quest.kind = protocol::Procedure::Kind::kQuestPlus;
+  quest.thresholds = {1, 2, 3}, quest.slopes = {2}, quest.lapses = {0}, quest.stimuli = {0.5, 1, 2, 4};
+  quest.guess = 0.5;
+  double w[3], sum = 0;
+  for (int t = 0; t < 3; ++t) sum += w[t] = 1 - 0.5 * std::exp(-std::pow(1.0 / (t + 1), 2));
+  const double p1 = w[0] / sum, p2 = w[1] / sum;
+  ASSERT_LT(p1, 0.5);
+  EXPECT_NEAR(*TrackEstimate(quest, {1}, {true}), 1 + (0.5 - p1) / p2, 1e-12);
+  // Wrong at 4 twice: half the mass or more on the largest threshold - above what the grid tested, no number.
+  EXPECT_FALSE(TrackEstimate(quest, {4, 4, 4}, {false, false, false}));
 }
 
 // A pair at 2 px both sides, the right one the test side, seen by the pixel observer (jnd 0.6 px): a relative level
@@ -63,6 +91,9 @@ TEST(ObserverThreshold, PixelObserverByTheClosedForm) {
   TrueThreshold t = ObserverThreshold(pair.observer, quest, pair.trial, pair.scene, pair.presentation);
   ASSERT_TRUE(t.determined) << t.why;
   EXPECT_NEAR(t.level, 0.3 * 0.9004525966377902, 1e-9);
+  // Its slope on a log axis there, x phi(x / 0.3) / 0.3 = z phi(z), is a Weibull's (1 - 0.5) slope / e.
+  const double z = 0.9004525966377902, phi = std::exp(-z * z / 2) / std::sqrt(2 * M_PI);
+  EXPECT_NEAR(t.weibull_slope, z * phi * std::exp(1.0) / 0.5, 1e-5);
   // A 1-up/2-down staircase with 4 % lapses: (1 - 0.04) Phi(x / 0.3) + 0.02 = sqrt(1/2), x = 0.3 x 0.5702214.
   protocol::Procedure staircase;
   staircase.min = 0.01, staircase.max = 3;

@@ -17,6 +17,7 @@
 #include "core/json_io.h"
 #include "core/typed.h"
 #include "store/columns.h"
+#include "store/export_procedures.h"
 #include "store/export_table.h"
 #include "store/record.h"
 #include "store/schema.h"
@@ -375,6 +376,7 @@ int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::p
         WriteFileAtomically(partial / "trials.csv", text);
         WriteFileAtomically(partial / "adjustments.csv", adjustments);
         codebook += WriteSummaries(db, partial);
+        codebook += WriteProcedures(db, partial);
         WriteFileAtomically(partial / "codebook.csv", codebook);
         WriteFrames(db, partial);
       },

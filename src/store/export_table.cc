@@ -47,7 +47,7 @@ std::string Where(const std::filesystem::path& db, int64_t session, int64_t tria
 // temporaries an earlier version left beside them when killed (FILE.csv.tmpPID).
 bool IsExportFile(const std::string& name) {
   const bool table = name == "trials.csv" || name == "frames.csv" || name == "adjustments.csv" ||
-                     name == "codebook.csv" || name.rfind("summary-", 0) == 0;
+                     name == "procedures.csv" || name == "codebook.csv" || name.rfind("summary-", 0) == 0;
   if (table && name.size() > 4 && name.compare(name.size() - 4, 4, ".csv") == 0) return true;
   const size_t tmp = name.rfind(".csv.tmp");
   return tmp != std::string::npos && tmp + 8 < name.size() &&
