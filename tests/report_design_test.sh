@@ -63,7 +63,8 @@ line = line[:line.index("</tr>")]
 assert "chance" not in line and "edge=3: threshold" in line and "edge=9: threshold" in line, line
 print("thresholds per depth " + ", ".join(f"edge {e}: {fitted[e]:.2f} (observer {truth[e]:.2f})" for e in fitted))
 PYEOF
-  echo "ok: one QUEST+ per depth analysed per depth, labelled by edge, no chance test; $(cat "$W/found")" ;;
+  $PY "$(dirname "$0")/report_numbers_check.py" "$W/report" > "$W/numbers" || fail "$(cat "$W/numbers")"
+  echo "ok: one QUEST+ per depth analysed per depth, labelled by edge, no chance test; $(cat "$W/found"); $(sed 's/^ok: //' "$W/numbers")" ;;
 groups)
   # Two between-subject groups that see the same trials, answered by simulated observers with a planted difference:
   # group a's observers have no bias toward the more blurred side (blurrier=0), group b's a strong one
@@ -104,6 +105,7 @@ assert any("group" in r["term"] for r in models), [r["term"] for r in models]
 print(f"group a {share['a']:.2f}, group b {share['b']:.2f}, Welch p = {float(effect['a']['p_welch']):.3g}")
 PYEOF
   $PY "$(dirname "$0")/browser_check.py" "$W/report" index.html > "$W/browser" || fail "$(cat "$W/browser")"
+  $PY "$(dirname "$0")/report_numbers_check.py" "$W/report" > "$W/numbers" || fail "$(cat "$W/numbers")"
   echo "ok: per-group tables and charts, the planted group difference found with participants as the unit: $(cat "$W/found"); $(sed 's/^ok: //' "$W/browser")" ;;
 sessions)
   # Three participants complete the 2IFC study, P1 comes back (--again: session number 2), P4 stops after 3 answers
@@ -145,6 +147,7 @@ assert "incl. 1 unfinished session (partial data)" in index_all
 print(f"{first} first-session answers of 3 participants, {again} of P1's second session apart, {with_p4 - first} of P4 only with --include-unfinished")
 PYEOF
   $PY "$(dirname "$0")/browser_check.py" "$W/report" index.html > "$W/browser" || fail "$(cat "$W/browser")"
+  $PY "$(dirname "$0")/report_numbers_check.py" "$W/report" > "$W/numbers" || fail "$(cat "$W/numbers")"
   echo "ok: unfinished session left out and counted, repeated session apart: $(cat "$W/found"); $(sed 's/^ok: //' "$W/browser")" ;;
 *) fail "unknown case $CASE" ;;
 esac

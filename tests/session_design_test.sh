@@ -242,7 +242,8 @@ assert float(nine["share"]) > 1 / 3 and nine["test"].startswith("one-sample t ac
 assert "Summary" in index and "threshold" in index and "chance 0.33" in index, "summary"
 PYEOF
   $PY "$(dirname "$0")/browser_check.py" "$W/report" index.html bench.html > "$W/browser" || fail "$(cat "$W/browser")"
-  echo "ok: every study has its section; $(cat "$W/fit"); $(cat "$W/browser" | sed 's/^ok: //')" ;;
+  $PY "$(dirname "$0")/report_numbers_check.py" "$W/report" > "$W/numbers" || fail "$(cat "$W/numbers")"
+  echo "ok: every study has its section; $(cat "$W/fit"); $(cat "$W/browser" | sed 's/^ok: //'); $(sed 's/^ok: //' "$W/numbers")" ;;
 practice_criterion)
   # A practice block run until a criterion (80 % correct in one run of its design, at most 3 runs): an observer who
   # sees every difference meets it in the first run and the two runs after it are recorded as skipped; one who
