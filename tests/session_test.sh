@@ -192,11 +192,12 @@ recover)
   done
   MPLCONFIGDIR=$W/mpl $BC report --db "$W/s.sqlite" --out "$W/report" --bench "$W/no-bench" --boot 20 2> "$W/err" \
     || fail "report: $(cat "$W/err")"
-  fit=$(grep '^"pooled' "$W/report/depth-matching.csv") || fail "no pooled fit in depth-matching.csv"
-  $PY - "$fit" <<'PYEOF' || fail "fit: $fit"
+  # The thesis's power law, pooled over the observers (OLS with SEs clustered by participant): log c = a + b log d.
+  $PY - "$W/report/depth-matching.csv" <<'PYEOF' > "$W/fit" || fail "fit: $(cat "$W/fit")"
 import csv, math, sys
-row = next(csv.reader([sys.argv[1]]))
-a, b = float(row[3]), float(row[4])   # log c = a + b log d
+rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["model"] == "power law: lm(log_c ~ log_d), cluster-robust"]
+a = float(next(r["estimate"] for r in rows if r["term"].startswith("a ")))
+b = float(next(r["estimate"] for r in rows if r["term"].startswith("b ")))
 print(f"recovered c = {math.exp(a):.2f} d^{b:.3f}")
 sys.exit(0 if abs(b + 0.5) < 0.08 and abs(math.exp(a) / 20 - 1) < 0.12 else 1)
 PYEOF
