@@ -245,17 +245,21 @@ def per_section(df, out_dir, study):
 def psychometric(df, out_dir, n_boot=200, seed=1):
     """Share choosing the more-blurred stimulus against the blur difference, pooled over the forced-choice studies.
 
-    Only decisive answers (left/right) with a non-zero difference count: can't tell is not a choice of either
-    stimulus, and with equal blur neither is the more blurred. Weibull and logistic are fitted with the guess rate
-    fixed at 0.5 (two alternatives) and a lapse rate in [0, 0.1]; the one with the lower AIC is drawn with its
-    parametric bootstrap 95 % band.
+    The question of tests 1-3 ("which fits the scene better?") is a preference: it has no correct answer, so no
+    psychometric function with a 2AFC guess rate is fitted (it would assume the choice tends to the more blurred one
+    as the difference grows, a direction the data must show instead). Drawn: the share in equal-count bins of the
+    difference with Wilson 95 % intervals; tested: a logistic model of choosing the more blurred one on the difference
+    across participants (stats.observer_models: GLM clustered by participant, GLMM by lme4), whose slope says whether
+    and which way the choice moves with the difference. Only decisive answers (left/right) with a non-zero difference
+    count: can't tell is not a choice of either stimulus, and with equal blur neither is the more blurred.
+    n_boot and seed are kept for the caller; nothing here resamples.
     """
     parts = [forced_choice(study_rows(df, s)) for s in FORCED_CHOICE_STUDIES if (df["study"] == s).any()]
     if not parts:
-        raise Skip("psychometric function: no forced-choice trials")
+        raise Skip("blur difference: no forced-choice trials")
     d = pd.concat(parts, ignore_index=True)
     if "r_left_px" not in d or "r_right_px" not in d:
-        raise Skip("psychometric function: trials.csv has no r_left_px / r_right_px columns")
+        raise Skip("blur difference: trials.csv has no r_left_px / r_right_px columns")
     a = d[d["answered"]]
     dec = a[a["decisive"] & a["r_left_px"].notna() & a["r_right_px"].notna()].copy()
     dec["diff"] = (dec["r_left_px"] - dec["r_right_px"]).abs()
@@ -265,87 +269,44 @@ def psychometric(df, out_dir, n_boot=200, seed=1):
     dec["y"] = (dec["choice"].str.strip() == dec["more_blurred"]).astype(float)
     n = len(dec)
     if n < 20 or dec["diff"].nunique() < 3:
-        raise Skip(f"psychometric function: {n} decisive answers at {dec['diff'].nunique()} blur differences "
+        raise Skip(f"blur difference: {n} decisive answers at {dec['diff'].nunique()} blur differences "
                    f"(needs >= 20 at >= 3)")
-    x, y = dec["diff"].to_numpy(), dec["y"].to_numpy()
-    ones = np.ones_like(y)
-    fits = {kind: stats.fit_psychometric(x, y, ones, kind=kind, gamma=0.5, lam=(0.0, 0.1)) for kind in stats.KINDS}
-    best = min(fits.values(), key=lambda f: f.aic)
-    grid = np.linspace(0, x.max() * 1.02, 200)
-    _, band_lo, band_hi = stats.bootstrap(x, y, ones, best, method="parametric", n_boot=n_boot, seed=seed, grid=grid)
-    for f in fits.values():
-        if f is not best:
-            stats.bootstrap(x, y, ones, f, method="parametric", n_boot=max(50, n_boot // 2), seed=seed, grid=grid)
 
-    # Display bins: equal-count bins of the difference (the fit itself uses every trial).
+    # Equal-count bins of the difference, for the chart; the model uses every answer.
     n_bins = int(min(10, max(4, n // 40)))
     dec["bin"] = pd.qcut(dec["diff"], n_bins, duplicates="drop")
     b = dec.groupby("bin", observed=True).agg(diff_mean=("diff", "mean"), n=("y", "size"), k=("y", "sum")).reset_index()
     b["k"] = b["k"].astype(int)
     wilson_columns(b, "k", "n", "share")
     b["bin"] = b["bin"].astype(str)
+    model, model_notes = stats.observer_models(dec, "y", "diff", study="tests 1-3 pooled")
 
     fig, ax = plt.subplots(figsize=(7.2, 4.6))
-    ax.axhline(0.5, color="#888888", lw=0.8, ls=":", label="chance (0.5)")
-    ax.fill_between(grid, band_lo, band_hi, color="#0072B2", alpha=0.18, lw=0,
-                    label=f"{best.kind} 95 % bootstrap band ({n_boot} samples)")
-    for kind, f in fits.items():
-        at_bound = " (bound)" if "beta" in f.on_bound else ""
-        ax.plot(grid, f(grid), "-" if f is best else "--", color="#0072B2" if f is best else "#D55E00",
-                lw=1.8 if f is best else 1.2,
-                label=f"{kind} fit: α = {f.alpha:.2f} px, β = {f.beta:.3g}{at_bound}, λ = {f.lam:.3f} "
-                      f"(AIC {f.aic:.1f})")
+    ax.axhline(0.5, color="#888888", lw=0.8, ls=":", label="no preference (0.5)")
     sizes = 15 + 60 * b["n"] / b["n"].max()
     ax.errorbar(b["diff_mean"], b["share"], yerr=error_bars(b["share"], b["share_low"], b["share_high"]), fmt="none",
                 ecolor="#222222", lw=0.9, zorder=3)
+    ax.plot(b["diff_mean"], b["share"], "-", color="#0072B2", lw=1, zorder=2)
     ax.scatter(b["diff_mean"], b["share"], s=sizes, color="#222222", zorder=4,
                label="answers, equal-count bins (Wilson 95 %; size ∝ n)")
-    ax.set_xlim(0, grid[-1])
-    ax.set_ylim(0.3, 1.02)
+    ax.set_xlim(0, float(dec["diff"].max()) * 1.02)
+    ax.set_ylim(0, 1)
     ax.set_xlabel("blur difference |r_left − r_right| (px)")
     ax.set_ylabel("share choosing the more-blurred stimulus")
     studies = ", ".join(sorted(dec["study"].unique()))
-    ax.set_title(f"Psychometric function, pooled over forced-choice studies\n{participants_note(dec)}, {n} decisive "
-                 f"answers", loc="left")
+    ax.set_title(f"Choosing the more blurred one against the blur difference, pooled over forced-choice studies\n"
+                 f"{participants_note(dec)}, {n} decisive answers (a preference: no psychometric function fitted)",
+                 loc="left")
     ax.legend(loc="lower right", fontsize=8)
     png, svg = save(fig, out_dir, "psychometric")
-
-    rows = []
-    for kind, f in fits.items():
-        row = {"function": kind, "drawn": f is best, "trials": f.n_trials, "nll": f.nll, "aic": f.aic,
-               "converged": f.converged, "threshold_75_px": stats.threshold(f, 0.75)}
-        for p in ("alpha", "beta", "gamma", "lam"):
-            row[p] = getattr(f, p)
-            lo, hi = f.ci.get(p, (math.nan, math.nan))
-            row[p + "_low"], row[p + "_high"] = lo, hi
-        row["beta_min"], row["beta_max"] = f.options["beta_bounds"]
-        row["on_bound"] = "; ".join(f"{p} at {side} bound {v:.3g}" for p, (v, side) in f.on_bound.items())
-        rows.append(row)
-    table = pd.DataFrame(rows)
     notes = [f"studies pooled: {studies}",
              f"{n} decisive answers used; {int((a['chosen_source'] == 'cant_tell').sum())} can't-tell answers and "
              f"{ties} decisive answers with equal blur on both sides left out",
-             "ψ(x) = γ + (1 − γ − λ) F(x); γ = 0.5 fixed, λ in [0, 0.1]; Weibull F = 1 − exp(−(x/α)^β), logistic "
-             "F = 1/(1 + exp(−(x − α)/β)); maximum likelihood on single trials; CIs: parametric bootstrap "
-             f"percentiles (seed {seed})",
-             "threshold_75_px: difference at which 75 % choose the more-blurred stimulus",
-             f"β bounded so that a fit cannot collapse into a step between clustered differences: logistic spread "
-             f"β >= {stats.LOGISTIC_MIN_SPREAD:g} × (largest − smallest difference), Weibull shape β <= "
-             f"{stats.WEIBULL_MAX_SHAPE:g}; the bootstrap refits keep the same bounds"]
-    for kind, f in fits.items():
-        if f.on_bound:
-            notes.append(f"{kind}: " + ", ".join(f"{'β' if p == 'beta' else 'λ'} = {getattr(f, p):.3g} at its {side} "
-                                                 f"bound {v:.3g}" for p, (v, side) in f.on_bound.items())
-                         + (" - the data do not pin β down; its value is the bound's, not an estimate"
-                            if "beta" in f.on_bound else ""))
-        b_lo, b_hi = f.options["beta_bounds"]
-        ci_lo, ci_hi = f.ci.get("beta", (math.nan, math.nan))
-        reach = [f"{v:.3g}" for v, end in ((b_lo, ci_lo), (b_hi, ci_hi)) if math.isclose(v, end, rel_tol=1e-3)]
-        if reach and "beta" not in f.on_bound:
-            notes.append(f"{kind}: the bootstrap interval of β reaches its bound {' and '.join(reach)} "
-                         f"(that end of the interval is the bound's, not the data's)")
-    return [Chart("psychometric", png, svg, table, notes),
-            Chart("psychometric-bins", None, None, b, ["the binned points drawn in the psychometric chart"])]
+             "the question (which fits the scene better?) has no correct answer, so no psychometric function with a "
+             "guess rate is fitted and no threshold is given; the model's slope on the difference says whether the "
+             "choice of the more blurred one moves with it, and which way"] + model_notes
+    return [Chart("psychometric", png, svg, model, notes),
+            Chart("psychometric-bins", None, None, b, ["the binned points drawn in the chart above"])]
 
 
 SIDE_BIAS_POOLED = "pooled"

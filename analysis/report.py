@@ -330,7 +330,8 @@ def _main(argv=None):
         ("test 2 per section, patterns 2, 4, 6 (Fig. 5.10-5.12)",
          lambda: forced_choice.per_section(df(), args.out, common.STUDY_TEST2)),
         ("test 3 per section, patterns 2, 4, 6", lambda: forced_choice.per_section(df(), args.out, common.STUDY_TEST3)),
-        ("psychometric function", lambda: forced_choice.psychometric(df(), args.out, n_boot=args.boot, seed=args.seed)),
+        ("the more blurred one against the blur difference (tests 1-3 pooled)",
+         lambda: forced_choice.psychometric(df(), args.out, n_boot=args.boot, seed=args.seed)),
         ("side bias (counterbalancing check)", lambda: forced_choice.side_bias(df(), args.out)),
         ("display timing", lambda: frame_timing.charts(frames_path, args.out)),
     ]
@@ -434,18 +435,9 @@ def _main(argv=None):
             skips.append(shown_text(str(e)))
             if title.startswith("study "):
                 findings[title] = "not analysed: " + shown_text(str(e))
-        except OSError as e:
-            if e.errno in WRITE_ERRNOS:
-                raise  # the disk is full or read-only: no section can be written, said once by main
-            if args.debug:
-                raise
-            message = str(e).strip().splitlines()[0] if str(e).strip() else ""
-            say(f"  {title} failed: {type(e).__name__}: {message}")
-            skips.append(f"failed unexpectedly: {type(e).__name__}: {message}")
-            failed.append(title)
         except Exception as e:  # a bug or data this code did not foresee: name it, keep the rest of the report
-            if args.debug:
-                raise
+            if args.debug or (isinstance(e, OSError) and e.errno in WRITE_ERRNOS):
+                raise  # a full or read-only disk: no section can be written, said once by main
             message = str(e).strip().splitlines()[0] if str(e).strip() else ""
             say(f"  {title} failed: {type(e).__name__}: {message}")
             skips.append(f"failed unexpectedly: {type(e).__name__}: {message}")
