@@ -225,7 +225,7 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
     ax.scatter(levels["x"], levels["sum"] / levels["count"], s=sizes, color="#333333", zorder=3,
                label="share per level (size: answers)")
     ax.axhline(chance, color="#999999", ls="--", lw=1)
-    if not math.isnan(th):
+    if not math.isnan(th) and x.min() <= th <= x.max():
         ax.axvline(th, color="#D55E00", lw=1, ls=":", label=f"threshold ({p_mid:.0%}): {th:.3g}")
     ax.set_xlabel(xlabel)
     ax.set_ylabel(f"share: {what}")
@@ -251,7 +251,8 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
                        "threshold_high": th_hi if bounded else math.nan, "threshold_note": interval_words,
                        "on_bound": ", ".join(f"{k} at its {v[1]} bound {v[0]:.3g}" for k, v in fit.on_bound.items()),
                        "criterion": p_mid,
-                       "alpha": fit.alpha, "beta_slope": fit.beta if beta_free else math.nan,
+                       # The Weibull's scale is the threshold's other name: not a number where that is not one.
+                       "alpha": fit.alpha if inside else math.nan, "beta_slope": fit.beta if beta_free else math.nan,
                        "beta_low": beta_lo if beta_ci else math.nan, "beta_high": beta_hi if beta_ci else math.nan,
                        "guess": fit.gamma, "lapse": fit.lam if "lam" not in fit.on_bound else math.nan, "answers": len(x),
                        "participants": d["participant"].nunique()}])
@@ -297,13 +298,20 @@ def analyse(df, study, codebook, out_dir, n_boot=200, seed=1, group="", part="")
     d = df[(df["study"] == study) & (df["practice"] != 1)].copy()
     if d.empty:
         raise Skip(f"{study}: no trials outside practice")
-    tasks = sorted(set(d["task"]))
+    # Blocks of one task but of two kinds - an adaptive procedure beside fixed levels - are two analyses too: the
+    # fixed block's answers used to be dropped unsaid (a procedure's measure is `correct`, which they lack).
+    adaptive = d["procedure_cell"].astype(str).str.strip().replace("nan", "").ne("") if "procedure_cell" in d \
+        else pd.Series(False, index=d.index)
+    keys = d["task"].astype(str).where(~adaptive, d["task"].astype(str) + " adaptive")
+    if adaptive.any() and not adaptive.all():
+        keys = keys.where(adaptive, d["task"].astype(str) + " fixed levels")
+    tasks = sorted(set(keys))
     if len(tasks) == 1:
         return _analyse(d, study, codebook, out_dir, n_boot, seed, group, "", part)
     charts, findings, skips = [], [], []
     for task in tasks:
         try:
-            c, f = _analyse(d[d["task"] == task], study, codebook, out_dir, n_boot, seed, group, task, part)
+            c, f = _analyse(d[keys == task], study, codebook, out_dir, n_boot, seed, group, task, part)
             charts += c
             findings.append(f)
         except Skip as e:

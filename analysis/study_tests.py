@@ -56,8 +56,8 @@ def against_chance(m, chance, people=None):
         t = (mean - chance) / (sd / math.sqrt(n_people))
         p = float(2 * sps.t.sf(abs(t), n_people - 1))
         test = f"one-sample t across {n_people} participants' shares"
-    return {"test": test, "p": p, "participant_mean": mean, "participant_low": mean - half,
-            "participant_high": mean + half, "t": t, "df": n_people - 1, "p_sign": p_sign,
+    return {"test": test, "p": p, "participant_mean": mean, "participant_low": max(0.0, mean - half),
+            "participant_high": min(1.0, mean + half), "t": t, "df": n_people - 1, "p_sign": p_sign,
             "participants_above": above, "participants_below": below}
 
 
@@ -78,7 +78,9 @@ def summary_words(m, chance, what):
         return (f"{what}: mean of {people} participants' shares {mean:.2f} ({n} answers)" +
                 (f"; chance {chance:.2g}: too few participants for a test across them" if chance is not None else ""))
     half = sps.t.ppf(0.975, people - 1) * shares.std(ddof=1) / math.sqrt(people)
-    text = f"{what}: mean of {people} participants' shares {mean:.2f} [{mean - half:.2f}, {mean + half:.2f}] ({n} answers)"
+    # A t interval of shares is cut at 0 and 1: a share beyond them is not a value the interval could hold.
+    text = (f"{what}: mean of {people} participants' shares {mean:.2f} [{max(0.0, mean - half):.2f}, "
+            f"{min(1.0, mean + half):.2f}] ({n} answers)")
     if chance is not None:
         r = against_chance(m, chance)
         text += (f"; against chance {chance:.2g}: {r['test']}, {p_text(r['p'])}; {r['participants_above']} of "
@@ -105,7 +107,10 @@ def group_effect(m, group, column="y"):
         samples[str(level)] = v
         half = sps.t.ppf(0.975, len(v) - 1) * v.std(ddof=1) / math.sqrt(len(v)) if len(v) > 1 else math.nan
         rows.append({"group": str(level), "participants": len(v), "answers": int(g["n"].sum()),
-                     "participant_mean": v.mean(), "ci_low": v.mean() - half, "ci_high": v.mean() + half,
+                     "participant_mean": v.mean(),
+                     # Shares (column y) cannot leave [0, 1]: their t interval is cut there.
+                     "ci_low": max(0.0, v.mean() - half) if column == "y" else v.mean() - half,
+                     "ci_high": min(1.0, v.mean() + half) if column == "y" else v.mean() + half,
                      "participant_sd": v.std(ddof=1) if len(v) > 1 else math.nan})
     table = pd.DataFrame(rows)
     names = list(samples)
@@ -113,10 +118,11 @@ def group_effect(m, group, column="y"):
     sizes = [len(samples[n]) for n in names]
     if len(names) < 2:
         return table, notes, "one group only"
-    if min(sizes) < 2:
+    # Welch's t on 2 against 2 has about 1.6 degrees of freedom: as few as the test against chance takes (3).
+    if min(sizes) < MIN_PARTICIPANTS_T:
         words = ("no test of the group effect: " + ", ".join(f"group {n} has {len(samples[n])} participant"
                                                               f"{'s' if len(samples[n]) != 1 else ''}" for n in names)
-                 + " (needs >= 2 in each)")
+                 + f" (needs >= {MIN_PARTICIPANTS_T} in each)")
         notes.append(words)
         return table, notes, words
     means = {n: samples[n].mean() for n in names}

@@ -162,6 +162,14 @@ def staircase_threshold(p, levels, correct):
     if len(turns) < MIN_TURNS:
         out["why"] = f"not determined: {len(turns)} turning point{'s' if len(turns) != 1 else ''} (needs {MIN_TURNS})"
         return out
+    # A staircase that stops after N reversals and ran out of trials before them has not converged: its last turning
+    # points may still be the approach.
+    stop = int(float(p["stop_reversals"])) if p is not None and str(p.get("stop_reversals", "")).strip() not in \
+        ("", "0", "None", "nan") else 0
+    if stop and len(turns) < stop:
+        out["why"] = (f"not determined: the track ended after {len(levels)} trials with {len(turns)} of the "
+                      f"{stop} turning points its stop rule asks for (it had not settled)")
+        return out
     take = min(LAST_TURNS, len(turns) - len(turns) % 2)
     used = np.array(turns[-take:], float)
     at_bound = np.isclose(used, lo) | np.isclose(used, hi)
@@ -184,6 +192,10 @@ def staircase_threshold(p, levels, correct):
         low, bound = lo, bound + ["lower"]
     if high > hi:
         high, bound = hi, bound + ["upper"]
+    if len(bound) == 2:
+        # An interval as wide as every level the staircase can show says nothing about where the threshold is.
+        return out | {"why": f"not determined: its interval spans the whole tested range {_text(lo)} to {_text(hi)}",
+                      "used": len(used)}
     out.update(estimate=estimate, low=low, high=high, interval_at_bound=" and ".join(bound),
                used=len(used))
     if at_bound.any():
@@ -393,7 +405,8 @@ def _track_table(tracks):
             "threshold_high": r.get("high") if determined else None,
             "interval_at_bound": r.get("interval_at_bound", ""),
             "turning_points": r.get("turning_points") if t["kind"] != "quest_plus" else None,
-            "slope": r.get("slope"), "posterior_mean": r.get("posterior_mean"),
+            "slope": r.get("slope") if determined else None,
+            "posterior_mean": r.get("posterior_mean") if determined else None,
             "threshold_says": "determined" if determined else r.get("why", "not determined"),
             "note": r.get("note", ""), "method": r["method"]})
     return pd.DataFrame(rows)
@@ -406,6 +419,16 @@ def summary_table(tracks):
         these = [t for t in tracks if t["cell"] == cell]
         v = np.array([t["result"]["estimate"] for t in these if "estimate" in t["result"]], float)
         row = {"cell": cell, "tracks": len(these), "determined": len(v), "not_determined": len(these) - len(v)}
+        # A track beyond the tested range has a threshold known only to lie past it: the mean or median of the
+        # others would move the cell's threshold toward the range (censored values left out). Said in words.
+        censored = [t for t in these if "estimate" not in t["result"] and "the tested range" in
+                    t["result"].get("why", "")]
+        if censored:
+            row["interval"] = (f"not determined: {len(censored)} of {len(these)} tracks lie beyond the tested range "
+                               "(their thresholds are censored there; a mean or median of the others would be "
+                               "biased toward the range)")
+            rows.append(row)
+            continue
         if len(v):
             row.update(mean=float(v.mean()), median=float(np.median(v)))
         if len(v) >= 2:

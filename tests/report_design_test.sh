@@ -149,5 +149,38 @@ PYEOF
   $PY "$(dirname "$0")/browser_check.py" "$W/report" index.html > "$W/browser" || fail "$(cat "$W/browser")"
   $PY "$(dirname "$0")/report_numbers_check.py" "$W/report" > "$W/numbers" || fail "$(cat "$W/numbers")"
   echo "ok: unfinished session left out and counted, repeated session apart: $(cat "$W/found"); $(sed 's/^ok: //' "$W/browser")" ;;
+mixed_blocks)
+  # One study, one task, two kinds of block: one QUEST+ per depth and a block of fixed levels (edges 3 and 9,
+  # measured against none, 3 repetitions). Each kind is analysed as what it is; the fixed block's answers used to be
+  # dropped unsaid because the study counted as adaptive (a procedure's measure is `correct`, which they lack).
+  protocol quest-per-depth
+  $PY - "$W/quest-per-depth.json" "$W/mixed.json" <<'PYEOF'
+import json, sys
+p = json.load(open(sys.argv[1]))
+p["name"] = "mixed-blocks"
+p["blocks"].append({"name": "constant", "factors": {"edge": [3, 9]}, "sides": {"left": "measured", "right": "none"},
+                    "repetitions": 3})
+json.dump(p, open(sys.argv[2], "w"), indent=1)
+PYEOF
+  for id in M1 M2 M3; do
+    $BC run "$W/mixed.json" --participant $id --db "$W/m.sqlite" --observer sim > /dev/null 2>&1 || fail "run $id"
+  done
+  report "$W/m.sqlite" "$W/report" > /dev/null 2> "$W/err" || fail "report: $(tail -3 "$W/err")"
+  $PY - "$W/report" <<'PYEOF' > "$W/found" || fail "mixed blocks: $(cat "$W/found")"
+import csv, glob, os, sys
+out = sys.argv[1]
+rows = list(csv.DictReader(open(os.path.join(out, "tables", "trials.csv"))))
+fixed = [r for r in rows if r["block_name"] == "constant" and r["status"] == "answered" and r["practice"] == "0"]
+assert len(fixed) == 3 * 2 * 3, len(fixed)
+tables = glob.glob(os.path.join(out, "mixed-blocks-forced_choice_fixed_levels*-conditions.csv"))
+assert len(tables) == 1, sorted(os.listdir(out))
+n = sum(int(r["n"]) for r in csv.DictReader(open(tables[0])))
+assert n == len(fixed), (n, len(fixed))
+index = open(os.path.join(out, "index.html"), encoding="utf-8").read()
+assert "adaptive procedure" in index and "forced choice between two" in index, "both kinds in the summary"
+print(f"the fixed block's {n} answers analysed beside the procedure's cells")
+PYEOF
+  $PY "$(dirname "$0")/report_numbers_check.py" "$W/report" > "$W/numbers" || fail "$(cat "$W/numbers")"
+  echo "ok: an adaptive and a fixed-levels block of one study each analysed as what it is: $(cat "$W/found")" ;;
 *) fail "unknown case $CASE" ;;
 esac

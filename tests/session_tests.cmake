@@ -36,7 +36,7 @@ foreach(case again protocol_version conditions_version)
 endforeach()
 # The report analyses the design the record declares (tests/report_design_test.sh): a QUEST+ per depth per depth,
 # between-subject groups compared across participants, unfinished and repeated sessions apart.
-foreach(case quest_per_depth groups sessions)
+foreach(case quest_per_depth groups sessions mixed_blocks)
   add_test(NAME report_design_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/report_design_test.sh ${case} ${BC} ${T})
   set_tests_properties(report_design_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
                        LABELS "gl;session" PASS_REGULAR_EXPRESSION "^ok:|\nok:")

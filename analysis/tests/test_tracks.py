@@ -145,6 +145,35 @@ class StaircaseEstimate(unittest.TestCase):
         self.assertNotIn("estimate", r)
         self.assertTrue(r["why"].startswith("not determined: replaying the answers"), r["why"])
 
+    def test_a_track_that_never_met_its_stop_rule_is_not_determined(self):
+        # The hand-worked track has 6 turning points; a protocol that stops at 8 reversals ran out of trials before
+        # it settled (the adversary's P4: 4 of 6 turning points in 30 trials, a drifting track called determined).
+        p = {"procedure": "staircase", "start": 1.0, "min": 0.0, "max": 3.0, "up": 1, "down": 2, "steps": [0.4, 0.2],
+             "stop_reversals": 8}
+        levels = [1, 1, 0.6, 0.6, 0.2, 0.4, 0.4, 0.2, 0.4, 0.6, 0.6, 0.4, 0.6, 0.6]
+        correct = [1, 1, 1, 1, 0, 1, 1, 0, 0, 1, 1, 0, 1, 1]
+        r = tracks.staircase_threshold(p, np.array(levels, float), np.array(correct) == 1)
+        self.assertNotIn("estimate", r)
+        self.assertEqual(r["why"], "not determined: the track ended after 14 trials with 6 of the 8 turning points "
+                                   "its stop rule asks for (it had not settled)")
+        r = tracks.staircase_threshold(p | {"stop_reversals": 6}, np.array(levels, float), np.array(correct) == 1)
+        self.assertAlmostEqual(r["estimate"], 0.4, places=12)
+
+    def test_a_cell_with_tracks_beyond_the_range_gives_no_mean_of_the_rest(self):
+        # Three tracks determined near 1, three above the grid: their thresholds lie past 6, so the mean of the three
+        # others (1.0) would sit far below the cell's; the summary says so in words (the adversary's case).
+        tracks_ = [{"cell": "edge 9", "result": {"estimate": 1.0 + 0.1 * i}} for i in range(3)] + \
+                  [{"cell": "edge 9", "result": {"why": "not determined: above the tested range 0.25 to 6 (...)"}}
+                   for _ in range(3)] + \
+                  [{"cell": "edge 3", "result": {"estimate": 0.5}}, {"cell": "edge 3", "result": {"estimate": 0.7}},
+                   {"cell": "edge 3", "result": {"why": "not determined: 1 turning point (needs 4)"}}]
+        table = tracks.summary_table(tracks_).set_index("cell")
+        self.assertTrue(pd.isna(table.loc["edge 9"].get("mean", math.nan)))
+        self.assertTrue(table.loc["edge 9", "interval"].startswith("not determined: 3 of 6 tracks lie beyond the "
+                                                                   "tested range"), table.loc["edge 9", "interval"])
+        # A track lost for too few turning points is missing, not censored: the others are summarised.
+        self.assertAlmostEqual(table.loc["edge 3", "mean"], 0.6)
+
     def test_bias_against_the_70_7_point_within_monte_carlo_error(self):
         # 400 tracks of a 1-up/2-down staircase on a relative difference (test radius (1 + L) x 3 arcmin), run by the
         # loop below (independent of tracks.py), started at the truth with steps of 0.03 (a tenth of the threshold:
