@@ -202,10 +202,18 @@ def session_numbers(df):
 
 
 def protocol_versions(df):
-    """Each row's protocol version as text ("" in an export from before versions were recorded)."""
+    """Each row's protocol version as text ("" in an export from before versions were recorded). A version that a
+    merge brought with two texts (two stations ran one version number with different protocols; run refuses that in
+    one record, merge warns) is two versions here, each named by its text's hash: "1 (text 5c3e4c56)"."""
     if "protocol_version" not in df.columns:
         return pd.Series("", index=df.index)
-    return df["protocol_version"].astype(str).str.strip().replace("nan", "")
+    versions = df["protocol_version"].astype(str).str.strip().replace("nan", "")
+    if "protocol_hash" in df.columns and len(df):
+        hashes = df["protocol_hash"].astype(str).str.strip()
+        key = (df["study"].astype(str) + "\x00" if "study" in df.columns else "") + versions
+        texts = hashes.groupby(key).transform("nunique")
+        versions = versions.where(texts <= 1, versions + " (text " + hashes.str[:8] + ")")
+    return versions
 
 
 def study_parts(rows):

@@ -124,6 +124,17 @@ class SessionsKeptApart(unittest.TestCase):
         # The thesis's views read the latest version's first sessions: version 10 (numerically, not as text).
         self.assertEqual(sorted(set(common.main_rows(d)["session_id"])), [3])
 
+    def test_one_version_with_two_texts_after_a_merge_is_two_parts(self):
+        # Two stations ran version 1 with different protocols (merge warns, run refuses it in one record): the
+        # report keeps them apart by their texts' hashes instead of pooling them as one version.
+        d = rows_of([("P1", 1, 1, "completed", 1), ("P2", 2, 1, "completed", 1), ("P3", 3, 1, "completed", 1)])
+        d["protocol_hash"] = d["session_id"].map({1: "aaaaaaaa11111111", 2: "aaaaaaaa11111111", 3: "bbbbbbbb22222222"})
+        parts = common.study_parts(d)
+        self.assertEqual([label for label, _ in parts], ["version 1 (text aaaaaaaa)", "version 1 (text bbbbbbbb)"])
+        self.assertEqual([sorted(set(p["session_id"])) for _, p in parts], [[1, 2], [3]])
+        d["protocol_hash"] = "aaaaaaaa11111111"  # one text: one version, as before
+        self.assertEqual([label for label, _ in common.study_parts(d)], [""])
+
     def test_unfinished_sessions_are_the_running_ones(self):
         d = rows_of([("P1", 1, 1, "completed", 1), ("P3", 5, 1, "running", 1)])
         self.assertEqual(set(common.unfinished_rows(d)["session_id"]), {5})
