@@ -117,5 +117,18 @@ got = sorted((r["edge"], r["label_stim"]) for r in rows)
 assert got == [("1", "007"), ("2", "7")], got
 PYEOF
   echo "ok: an edited conditions table under version 1 refused naming /recorded_conditions/t.csv; 007 and 7 kept apart in trials.csv" ;;
+again_group)
+  # A between-subject participant's --again session stays in their group (issue 23's review): balanced assignment
+  # used to give it the group with the fewest sessions, so one person saw both groups' conditions.
+  G="$P/groups-and-info.json"
+  info=(--info age=30 --info handedness=right --info vision=normal)
+  for id in A1 A2 A3; do $BC run "$G" --participant $id --db "$W/s.sqlite" --observer sim "${info[@]}" > /dev/null; done
+  group() { sql "$W/s.sqlite" "SELECT s.group_name FROM sessions s JOIN participants p ON p.id = s.participant_id
+                               WHERE p.code = '$1' ORDER BY s.id"; }
+  first=$(group A3)
+  counts=$(sql "$W/s.sqlite" "SELECT group_name, count(*) FROM sessions GROUP BY group_name ORDER BY group_name")
+  $BC run "$G" --participant A3 --db "$W/s.sqlite" --observer sim "${info[@]}" --again > /dev/null
+  [ "$(group A3)" = "$first"$'\n'"$first" ] || fail "A3's sessions ran in groups $(group A3 | tr '\n' ' ') (counts before: $counts)"
+  echo "ok: A3's --again session stayed in group $first (sessions per group before it: $(echo "$counts" | tr '\n' ' '))" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -83,7 +83,7 @@ uint64_t DefaultSessionSeed(const std::string& study, const std::string& partici
 
 GroupsSoFar PeekGroups(const std::filesystem::path& db, const std::string& study, const std::string& participant) {
   const store::GroupsSoFar g = store::PeekGroups(db, study, participant);
-  return {g.sessions, g.unfinished, g.unfinished_group, g.unfinished_info};
+  return {g.sessions, g.unfinished, g.unfinished_group, g.unfinished_info, g.earlier_group};
 }
 
 Recording::Recording(std::unique_ptr<store::Record> record) : record_(std::move(record)) {}

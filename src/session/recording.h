@@ -93,6 +93,7 @@ struct GroupsSoFar {
   std::map<std::string, int64_t> sessions;
   bool unfinished = false;
   std::string unfinished_group, unfinished_info = "{}";
+  std::string earlier_group;  // the participant's latest session's group that was not aborted (store::GroupsSoFar)
 };
 GroupsSoFar PeekGroups(const std::filesystem::path& db, const std::string& study, const std::string& participant);
 

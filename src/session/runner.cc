@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -186,8 +187,13 @@ RunResult RunSession(const RunOptions& options) {
   GroupsSoFar so_far;
   if (head.groups || !head.participant_info.empty())
     so_far = PeekGroups(options.db, head.name, options.participant);
+  // A participant's session run again (--again) stays in the group of their earlier one: a between-subject
+  // participant shown both groups' conditions would belong to neither (it used to be assigned afresh).
+  const bool stays = head.groups && !so_far.earlier_group.empty() &&
+                     std::count(head.groups->names.begin(), head.groups->names.end(), so_far.earlier_group) > 0;
   const std::string group = !head.groups       ? ""
                             : so_far.unfinished ? so_far.unfinished_group
+                            : stays             ? so_far.earlier_group
                                                 : protocol::AssignGroup(head, options.participant, so_far.sessions);
   const Json info = CollectInfo(head, options, so_far);
   // A new session's number decides its default seed (the record decides the number again when it starts the
@@ -204,7 +210,8 @@ RunResult RunSession(const RunOptions& options) {
   if (observer) CheckObserverCanAnswer(*observer, protocol);
   // A new session's balanced group is decided again in the transaction that starts it: a station starting at the
   // same moment may take the group peeked above. So each group it may get is prepared (and checked) now.
-  const bool balanced = protocol.groups && protocol.groups->assign == protocol::GroupAssign::kBalanced && !options.resume;
+  const bool balanced = protocol.groups && protocol.groups->assign == protocol::GroupAssign::kBalanced &&
+                        !options.resume && !stays;
   std::map<std::string, PreparedSession> other_groups;
   if (balanced)
     for (const std::string& name : protocol.groups->names)

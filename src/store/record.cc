@@ -640,6 +640,12 @@ GroupsSoFar PeekGroups(const std::filesystem::path& db_path, const std::string& 
     so_far.unfinished_group = running.GetText(0);
     so_far.unfinished_info = running.GetText(1);
   }
+  Statement earlier(db, "SELECT s.group_name FROM sessions s JOIN participants p ON p.id = s.participant_id JOIN "
+                        "studies st ON st.id = p.study_id WHERE st.name = ? AND p.code = ? AND s.status <> 'aborted' "
+                        "AND coalesce(s.group_name, '') <> '' ORDER BY s.id DESC LIMIT 1");
+  earlier.Bind(1, study);
+  earlier.Bind(2, participant);
+  if (earlier.Step()) so_far.earlier_group = earlier.GetText(0);
   return so_far;
 }
 

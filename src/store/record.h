@@ -63,6 +63,9 @@ struct GroupsSoFar {
   std::map<std::string, int64_t> sessions;  // group -> sessions of the study that were not aborted
   bool unfinished = false;                  // the participant has a running session
   std::string unfinished_group, unfinished_info = "{}";
+  // The group of the participant's latest session that was not aborted ("" for none): a session run again (--again)
+  // stays in it - a between-subject participant who saw two groups' conditions would be in neither.
+  std::string earlier_group;
 };
 GroupsSoFar PeekGroups(const std::filesystem::path& db, const std::string& study, const std::string& participant);
 
