@@ -526,11 +526,13 @@ def _thresholds_figure(tracks, summary, cells, study, group_note, out_dir, name)
             ax.annotate(f"{missing} not determined", (xi, 0), xycoords=("data", "axes fraction"), ha="center",
                         va="bottom", fontsize=8, color="#D55E00")
     ax.set_xticks(range(len(cells)))
-    ax.set_xticklabels(cells, rotation=20 if len(cells) > 3 else 0, ha="right" if len(cells) > 3 else "center")
+    # A cell's levels one per line: "from_edge 3, speed_cm_s 1.8, to_edge 8" side by side ran into its neighbour.
+    ax.set_xticklabels([c.replace(", ", "\n") for c in cells], fontsize=8)
     ax.set_xlim(-0.6, len(cells) - 0.4)
     ax.set_ylabel("threshold (the procedure's level)")
-    ax.set_title(f"{study}: thresholds per cell\n{group_note}; grey: each participant with its 95 % interval; "
+    ax.set_title(f"{study}: thresholds per cell\n{group_note}\ngrey: each participant with its 95 % interval; "
                  "orange: the mean with its t 95 % interval", loc="left", fontsize=10)
+    fig.tight_layout()
     return save(fig, out_dir, name)
 
 
