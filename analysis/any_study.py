@@ -438,10 +438,13 @@ def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, 
         charts += c
         finding += "; " + words if words else ""
     else:
-        charts.append(Chart(f"{slug}-psychometric", None, None, None,
-                            ["no psychometric function: the question has no correct answer (a preference: which "
-                             "fits the scene), so a guess rate of 0.5 would be a claim the design does not make; the "
-                             "shares of choosing the more blurred side per condition are in the tables"]))
+        # Why there is none, in the words of what was asked (a pair's preference, a yes/no question, ...).
+        asked = ("the question has no correct answer (a preference: which fits the scene), so a guess rate of 0.5 "
+                 "would be a claim the design does not make; the shares of choosing the more blurred side per "
+                 "condition are in the tables") if kind == "pair" else \
+            (f"a {KIND_TITLES[kind]} answer has no correct one and no guess rate; the {what} per condition is in "
+             "the tables")
+        charts.append(Chart(f"{slug}-psychometric", None, None, None, ["no psychometric function: " + asked]))
     if kind == "procedure":
         m["level"] = _num(m["level"])
         charts += tracks.charts(m, study, out_dir, slug, note)

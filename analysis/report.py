@@ -24,6 +24,8 @@ import warnings
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # the sibling modules, from any working directory
 
 
+import numpy as np  # noqa: E402
+
 import any_study  # noqa: E402
 import bench_charts  # noqa: E402
 import prediction  # noqa: E402
@@ -48,7 +50,9 @@ def _warning_line(message, category, filename, lineno, file=None, line=None):
 
 
 def _fmt(value):
-    """Table cells in HTML: 4 significant digits for floats, blanks for NaN."""
+    """Table cells in HTML: 4 significant digits for floats, blanks for NaN and for no value (None)."""
+    if value is None:
+        return ""
     if isinstance(value, float):
         if math.isnan(value):
             return ""
@@ -59,6 +63,8 @@ def _fmt(value):
 def _table_html(table):
     if table is None or table.empty:
         return ""
+    # No value in an object column is None, which pandas writes as "None" whatever na_rep says: NaN, written blank.
+    table = table.where(table.notna(), np.nan)
     return table.to_html(index=False, na_rep="", formatters={c: _fmt for c in table.columns}, border=0,
                          classes="data")
 
