@@ -130,5 +130,20 @@ again_group)
   $BC run "$G" --participant A3 --db "$W/s.sqlite" --observer sim "${info[@]}" --again > /dev/null
   [ "$(group A3)" = "$first"$'\n'"$first" ] || fail "A3's sessions ran in groups $(group A3 | tr '\n' ' ') (counts before: $counts)"
   echo "ok: A3's --again session stayed in group $first (sessions per group before it: $(echo "$counts" | tr '\n' ' '))" ;;
+merge_people)
+  # Two stations each gave the id P1 to someone: merge refuses to join them (exit 3, both ways out named) until told
+  # who they are; --rename works written before the inputs too (it used to take the inputs as renames).
+  $BC run "$P/test1-static-grids.json" --participant P1 --db "$W/a.sqlite" --observer sim > /dev/null
+  $BC run "$P/test1-static-grids.json" --participant P1 --db "$W/b.sqlite" --observer sim:lapse=0.2 > /dev/null
+  set +e
+  $BC merge "$W/a.sqlite" "$W/b.sqlite" --out "$W/all.sqlite" > /dev/null 2> "$W/err"
+  code=$?
+  set -e
+  [ $code = 3 ] && grep -q "participant P1 of study test1-static-grids is also in an earlier input" "$W/err" \
+    && grep -q -- "--same-person P1" "$W/err" && [ ! -e "$W/all.sqlite" ] || fail "joined: exit $code $(cat "$W/err")"
+  $BC merge --rename "$W/b.sqlite:P1=P1b" "$W/a.sqlite" "$W/b.sqlite" --out "$W/all.sqlite" > /dev/null
+  [ "$(sql "$W/all.sqlite" "SELECT group_concat(code, ' ') FROM (SELECT code FROM participants ORDER BY code)")" = "P1 P1b" ] \
+    || fail "renamed: $(sql "$W/all.sqlite" "SELECT code FROM participants")"
+  echo "ok: one id at two stations refused until renamed; renamed, two participants P1 and P1b" ;;
 *) fail "unknown case $CASE" ;;
 esac

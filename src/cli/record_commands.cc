@@ -78,9 +78,11 @@ void AddMergeCommand(CLI::App& app) {
   cmd->add_option("--out", args->out, "the new record")->required();
   cmd->add_option("--rename", args->renames,
                   "INPUT:ID=NEWID: in that input, participant ID is recorded as NEWID (two people who got one id); "
-                  "repeatable");
+                  "repeatable")
+      ->allow_extra_args(false);  // one value each time: before the inputs it must not take them as renames
   cmd->add_option("--same-person", args->same_person,
-                  "ID: the inputs' participant ID is one person who ran at several stations; repeatable");
+                  "ID: the inputs' participant ID is one person who ran at several stations; repeatable")
+      ->allow_extra_args(false);
   cmd->callback([args] {
     std::vector<std::filesystem::path> inputs(args->inputs.begin(), args->inputs.end());
     store::MergeOptions options;
