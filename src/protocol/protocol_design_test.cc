@@ -608,20 +608,20 @@ TEST(ProtocolValidate, CardsAndBallsInAnyPose) {
 TEST(ProtocolValidate, ConditionsTableReadAsSpreadsheetsWriteIt) {
   const fs::path dir = SceneFolder();
   Json j = Valid();
-  j["blocks"] = {{{"name", "rows"}, {"conditions", "t.csv"}}};
+  j["blocks"] = {{{"name", "rows"}, {"conditions", "sheet.csv"}}};
   for (const char* text : {"edge,left,right,label\r\n1,measured,none,\"a, b\"\r\n2,none,measured,c\r\n",
                            "edge,left,right,label\r1,measured,none,\"a, b\"\r2,none,measured,c\r"}) {
-    std::ofstream(dir / "t.csv", std::ios::binary) << text;
+    std::ofstream(dir / "sheet.csv", std::ios::binary) << text;
     const Protocol p = ParseProtocol(j, dir / "p.json");
     ASSERT_EQ(p.blocks[0].factors[0].levels.size(), 2u) << text;
     EXPECT_EQ(p.blocks[0].factors[0].levels[0]["label"], "a, b");
     EXPECT_EQ(p.blocks[0].factors[0].levels[1]["edge"], 2);
   }
-  std::ofstream(dir / "t.csv", std::ios::binary) << "edge,left,right\n1,\"mea\"sured,none\n";
-  EXPECT_TRUE(Contains(OnlyProblem(j), "t.csv line 2, column 8: text after a field's closing quote")) << OnlyProblem(j);
+  std::ofstream(dir / "sheet.csv", std::ios::binary) << "edge,left,right\n1,\"mea\"sured,none\n";
+  EXPECT_TRUE(Contains(OnlyProblem(j), "sheet.csv line 2, column 8: text after a field's closing quote")) << OnlyProblem(j);
   // A line break inside quotes is part of the field: the problem names the row's own line, not a row that is not.
-  std::ofstream(dir / "t.csv", std::ios::binary) << "edge,left,right,label\n1,measured,none,\"two\nlines\"\n";
-  EXPECT_TRUE(Contains(OnlyProblem(j), "/row/0/label: " + (dir / "t.csv").string() + " line 2, column 4 (label): "
+  std::ofstream(dir / "sheet.csv", std::ios::binary) << "edge,left,right,label\n1,measured,none,\"two\nlines\"\n";
+  EXPECT_TRUE(Contains(OnlyProblem(j), "/row/0/label: " + (dir / "sheet.csv").string() + " line 2, column 4 (label): "
                                        "must be printable UTF-8 text on one line")) << OnlyProblem(j);
 }
 
@@ -630,8 +630,8 @@ TEST(ProtocolValidate, ConditionsTableReadAsSpreadsheetsWriteIt) {
 TEST(ProtocolValidate, ConditionsCellsKeepTheirTextAndNumbersTheirDigits) {
   const fs::path dir = SceneFolder();
   Json j = Valid();
-  j["blocks"] = {{{"name", "rows"}, {"conditions", "t.csv"}}};
-  std::ofstream(dir / "t.csv") << "edge,left,right,label_stim\n1,measured,none,007\n2,measured,none,7\n"
+  j["blocks"] = {{{"name", "rows"}, {"conditions", "cells.csv"}}};
+  std::ofstream(dir / "cells.csv") << "edge,left,right,label_stim\n1,measured,none,007\n2,measured,none,7\n"
                                   "3,measured,none,9007199254740993\n";
   const Protocol p = ParseProtocol(j, dir / "p.json");
   const auto& levels = p.blocks[0].factors[0].levels;
@@ -639,10 +639,10 @@ TEST(ProtocolValidate, ConditionsCellsKeepTheirTextAndNumbersTheirDigits) {
   EXPECT_EQ(levels[0]["label_stim"], "007");
   EXPECT_EQ(levels[1]["label_stim"], "7");
   EXPECT_EQ(levels[2]["label_stim"], "9007199254740993");
-  std::ofstream(dir / "t.csv") << "edge,left,right,y_mm\n1,measured,none,0.12345678901234567\n";
+  std::ofstream(dir / "cells.csv") << "edge,left,right,y_mm\n1,measured,none,0.12345678901234567\n";
   EXPECT_TRUE(Contains(OnlyProblem(j), "/row/0/y_mm: has more digits than a number holds exactly (it would be "
                                        "recorded as 0.12345678901234566)")) << OnlyProblem(j);
-  std::ofstream(dir / "t.csv") << "edge,left,right,y_mm\n1,measured,none,0.1\n2,measured,none,-2.50e1\n";
+  std::ofstream(dir / "cells.csv") << "edge,left,right,y_mm\n1,measured,none,0.1\n2,measured,none,-2.50e1\n";
   EXPECT_EQ(ParseProtocol(j, dir / "p.json").blocks[0].factors[0].levels[1]["y_mm"], -25.0);
 }
 
@@ -651,8 +651,8 @@ TEST(ProtocolValidate, ConditionsCellsKeepTheirTextAndNumbersTheirDigits) {
 TEST(ProtocolValidate, IdsAndNamesAreSafeToOpenAndCountCharacters) {
   const fs::path dir = SceneFolder();
   Json j = Valid();
-  j["blocks"] = {{{"name", "rows"}, {"conditions", "t.csv"}}};
-  std::ofstream(dir / "t.csv") << "edge,left,right,id\n1,measured,none,=cmd|' /C calc'!A0\n";
+  j["blocks"] = {{{"name", "rows"}, {"conditions", "ids.csv"}}};
+  std::ofstream(dir / "ids.csv") << "edge,left,right,id\n1,measured,none,=cmd|' /C calc'!A0\n";
   EXPECT_TRUE(Contains(OnlyProblem(j), "/row/0/id: an id begins with =, which a spreadsheet opening the exported "
                                        "tables runs as a formula")) << OnlyProblem(j);
   j = Valid();
