@@ -112,3 +112,9 @@ add_test(NAME cli_bench_procedures_check
                  ${T}/bench/procedures-seed2.csv)
 set_tests_properties(cli_bench_procedures_check PROPERTIES DEPENDS "cli_bench_procedures;cli_bench_procedures_seed2"
                      PASS_REGULAR_EXPRESSION "ok: ")
+
+# blurcue camera: camera.json from EXIF that Pillow wrote (focal-plane resolution, the sensor table, the 35 mm
+# equivalent, a photo stored turned), and missing tags refused naming the tag and the option.
+add_test(NAME cli_camera_exif
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/camera_exif_test.py ${BC} ${T}/camera-exif)
+set_tests_properties(cli_camera_exif PROPERTIES PASS_REGULAR_EXPRESSION "ok: camera.json from EXIF")

@@ -1,0 +1,184 @@
+#include "core/camera_exif.h"
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include <libexif/exif-data.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "core/error.h"
+#include "core/image.h"
+#include "core/typed.h"
+
+namespace blurcue {
+
+const std::vector<KnownSensor>& KnownSensors() {
+  // Makers' published sensor sizes (active area), by the Model string the camera writes.
+  static const std::vector<KnownSensor> kSensors = {
+      {"NEX-5N", 23.4, 15.6},          // the thesis's camera (Table 4.1: 23.4 x 15.6 mm, 4592 x 3056 px)
+      {"NEX-C3", 23.4, 15.6},
+      {"ILCE-6000", 23.5, 15.6},
+      {"ILCE-7M3", 35.6, 23.8},
+      {"Canon EOS 5D Mark IV", 36.0, 24.0},
+      {"Canon EOS 90D", 22.3, 14.8},
+      {"Canon EOS 80D", 22.3, 14.9},
+      {"NIKON D850", 35.9, 23.9},
+      {"NIKON D7500", 23.5, 15.6},
+      {"X-T3", 23.5, 15.6},
+      {"E-M10MarkIII", 17.3, 13.0},
+  };
+  return kSensors;
+}
+
+namespace {
+
+std::string Num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+std::string Hex(ExifTag tag) {
+  char b[16];
+  std::snprintf(b, sizeof b, "0x%04x", unsigned(tag));
+  return b;
+}
+
+struct Exif {
+  ExifData* data;
+  ExifByteOrder order;
+  std::string file;
+
+  ExifEntry* Find(ExifTag tag) const {
+    for (int ifd = 0; ifd < EXIF_IFD_COUNT; ++ifd)
+      if (ExifEntry* e = exif_content_get_entry(data->ifd[ifd], tag)) return e;
+    return nullptr;
+  }
+  std::string Name(ExifTag tag) const {
+    const char* n = exif_tag_get_name(tag);
+    return std::string("EXIF ") + (n ? n : "tag") + " (" + Hex(tag) + ")";
+  }
+  // A number as the tag holds it: rational, short or long; nullopt when absent. Throws when present but unusable.
+  std::optional<double> Number(ExifTag tag) const {
+    ExifEntry* e = Find(tag);
+    if (!e || e->components < 1) return std::nullopt;
+    const size_t need = exif_format_get_size(e->format);
+    if (need == 0 || e->size < need) throw InputError(file, Name(tag) + " is damaged");
+    switch (e->format) {
+      case EXIF_FORMAT_RATIONAL: {
+        const ExifRational r = exif_get_rational(e->data, order);
+        if (r.denominator == 0) return std::nullopt;  // 0/0 is how cameras write "unknown"
+        return double(r.numerator) / r.denominator;
+      }
+      case EXIF_FORMAT_SRATIONAL: {
+        const ExifSRational r = exif_get_srational(e->data, order);
+        if (r.denominator == 0) return std::nullopt;
+        return double(r.numerator) / r.denominator;
+      }
+      case EXIF_FORMAT_SHORT:
+        return double(exif_get_short(e->data, order));
+      case EXIF_FORMAT_LONG:
+        return double(exif_get_long(e->data, order));
+      case EXIF_FORMAT_BYTE:
+      case EXIF_FORMAT_ASCII:
+      case EXIF_FORMAT_SBYTE:
+      case EXIF_FORMAT_UNDEFINED:
+      case EXIF_FORMAT_SSHORT:
+      case EXIF_FORMAT_SLONG:
+      case EXIF_FORMAT_FLOAT:
+      case EXIF_FORMAT_DOUBLE:
+        break;
+    }
+    throw InputError(file, Name(tag) + " has an unexpected format (" + exif_format_get_name(e->format) + ")");
+  }
+  std::string Text(ExifTag tag) const {
+    ExifEntry* e = Find(tag);
+    if (!e || e->format != EXIF_FORMAT_ASCII || !e->data) return "";
+    std::string s(reinterpret_cast<const char*>(e->data), e->size);
+    s = s.substr(0, s.find('\0'));
+    const size_t a = s.find_first_not_of(' '), b = s.find_last_not_of(' ');
+    return a == std::string::npos ? "" : OneLine(s.substr(a, b - a + 1));
+  }
+};
+
+}  // namespace
+
+ExifCamera CameraFromExif(const std::filesystem::path& photo, std::optional<std::pair<double, double>> sensor_mm,
+                          std::optional<double> focal_length_mm, std::optional<double> f_number) {
+  const std::string file = photo.string();
+  // The image as calibrate decodes it (EXIF orientation applied): its size is the calibration's.
+  const cv::Mat image = ReadImage(photo, cv::IMREAD_COLOR);
+  std::unique_ptr<ExifData, void (*)(ExifData*)> data(exif_data_new_from_file(file.c_str()), exif_data_unref);
+  const bool have_exif = data != nullptr;
+  const Exif exif{data.get(), have_exif ? exif_data_get_byte_order(data.get()) : EXIF_BYTE_ORDER_INTEL, file};
+  auto number = [&](ExifTag tag) { return have_exif ? exif.Number(tag) : std::nullopt; };
+
+  ExifCamera out;
+  Camera& c = out.camera;
+  c.image_width_px = image.cols;
+  c.image_height_px = image.rows;
+  if (have_exif) out.make = exif.Text(EXIF_TAG_MAKE), out.model = exif.Text(EXIF_TAG_MODEL);
+  auto missing = [&](ExifTag tag, const char* option) {
+    return InputError(file, (have_exif ? exif.Name(tag) + " is missing" : std::string("holds no EXIF")) +
+                                "; give " + option);
+  };
+
+  const std::optional<double> fl = focal_length_mm ? focal_length_mm : number(EXIF_TAG_FOCAL_LENGTH);
+  if (!fl) throw missing(EXIF_TAG_FOCAL_LENGTH, "--focal-length-mm");
+  c.focal_length_mm = *fl;
+  const std::optional<double> n = f_number ? f_number : number(EXIF_TAG_FNUMBER);
+  if (!n) throw missing(EXIF_TAG_FNUMBER, "--f-number");
+  c.f_number = *n;
+
+  // EXIF's pixel dimensions are the stored image's, before orientation: a portrait photo's are swapped against ours.
+  const std::optional<double> px = number(EXIF_TAG_PIXEL_X_DIMENSION), py = number(EXIF_TAG_PIXEL_Y_DIMENSION);
+  const std::optional<double> orientation = number(EXIF_TAG_ORIENTATION);
+  const bool turned = orientation && *orientation >= 5 && *orientation <= 8;
+  const double stored_w = px ? *px : turned ? image.rows : image.cols;
+  const double stored_h = py ? *py : turned ? image.cols : image.rows;
+  double sw = 0, sh = 0;  // in the stored image's orientation
+  const std::optional<double> xres = number(EXIF_TAG_FOCAL_PLANE_X_RESOLUTION);
+  const std::optional<double> yres = number(EXIF_TAG_FOCAL_PLANE_Y_RESOLUTION);
+  const std::optional<double> unit = number(EXIF_TAG_FOCAL_PLANE_RESOLUTION_UNIT);
+  const KnownSensor* known = nullptr;
+  for (const KnownSensor& k : KnownSensors())
+    if (out.model == k.model) known = &k;
+  if (sensor_mm) {
+    sw = turned ? sensor_mm->second : sensor_mm->first, sh = turned ? sensor_mm->first : sensor_mm->second;
+    out.sensor_source = "given (--sensor-mm)";
+  } else if (xres && yres && *xres > 0 && *yres > 0 && unit && (*unit == 2 || *unit == 3 || *unit == 4)) {
+    const double mm_per_unit = *unit == 2 ? 25.4 : *unit == 3 ? 10.0 : 1.0;  // inch, cm, mm (4: some makers)
+    sw = stored_w / *xres * mm_per_unit, sh = stored_h / *yres * mm_per_unit;
+    out.sensor_source = "focal-plane resolution";
+  } else if (known) {
+    const bool portrait = stored_h > stored_w;
+    sw = portrait ? known->height_mm : known->width_mm, sh = portrait ? known->width_mm : known->height_mm;
+    out.sensor_source = std::string("sensor table (") + known->model + ")";
+  } else if (const std::optional<double> fl35 = number(EXIF_TAG_FOCAL_LENGTH_IN_35MM_FILM); fl35 && *fl35 > 0) {
+    // The 35 mm equivalent keeps the diagonal: 43.27 mm x f / f35; the image's sides give the aspect.
+    const double diagonal = std::hypot(36.0, 24.0) * c.focal_length_mm / *fl35;
+    const double aspect = stored_w / stored_h;
+    sh = diagonal / std::sqrt(1 + aspect * aspect), sw = sh * aspect;
+    out.sensor_source = "35 mm equivalent focal length (" + Num(*fl35) + " mm)";
+    out.notes.push_back("the sensor size is approximate: EXIF rounds the 35 mm equivalent to whole mm (up to " +
+                        Num(50 / *fl35) + " % here); give --sensor-mm W H from the maker's data for a better one");
+  } else {
+    throw InputError(file, have_exif ? "EXIF gives no sensor size (no FocalPlaneXResolution (0xa20e), no "
+                                       "FocalLengthIn35mmFilm (0xa405), and model '" + out.model +
+                                           "' is not in the sensor table); give --sensor-mm W H"
+                                     : std::string("holds no EXIF; give --focal-length-mm, --f-number and --sensor-mm"));
+  }
+  auto micron = [](double mm) { return std::round(mm * 1e4) / 1e4; };  // finer than any maker states
+  c.sensor_width_mm = micron(turned ? sh : sw);
+  c.sensor_height_mm = micron(turned ? sw : sh);
+  if (turned) out.notes.push_back("the photo is stored turned (EXIF Orientation " + Num(*orientation) +
+                                  "): the sensor's sides are swapped to match the image calibrate reads");
+
+  if (const std::optional<double> d = number(EXIF_TAG_SUBJECT_DISTANCE); d && *d > 0 && *d < 4e6)
+    out.focus_distance_mm = *d * 1000;  // metres; 0 is "unknown", 0xFFFFFFFF/1 "infinity"
+  c.Validate(file);
+  return out;
+}
+
+}  // namespace blurcue
