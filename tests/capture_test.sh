@@ -274,5 +274,40 @@ assert residual <= 0.25 and residual <= residual_nearest / 3, (residual, residua
 PYEOF
   echo "ok: a downscaled checkerboard keeps its mean light and little of its pattern"
   ;;
+subpixel)
+  # Sub-pixel blur as recorded (blur-discrimination thresholds lie at 0.3-0.6 screen px): grid cards over a flat grey
+  # photo, each pair of radii given in screen px, captured with the Gaussian and the pillbox kernel, through the GL
+  # path (one radius per object) and the CPU path (the per-pixel plan, forced by a depth threshold of 0 screen px). Each
+  # frame's blur is the kernel that maps its unblurred twin onto it, solved tap by tap by tests/capture_kernel.py
+  # (numpy only, no code of blurcue's): within max(0.03 px, 3 %) of the record from 0.25 screen px up.
+  $PY - "$DIR/scene/scene.png" "$W/grey.png" <<'PYEOF'
+import sys
+from PIL import Image
+Image.new("RGB", Image.open(sys.argv[1]).size, (118, 118, 118)).save(sys.argv[2])
+PYEOF
+  base=(content.cells=5 'practice={"count": 0}' 'factors={"edge": [3, 9]}' 'counterbalance="none"'
+        "scene={\"background\": \"$W/grey.png\", \"calib\": \"$DIR/calib.json\"}")
+  for path in gl cpu; do
+    extra=()
+    [ $path = cpu ] && extra=('content.depth_blur_threshold={"screen_px": 0}')
+    variant "$P/test1-static-grids.json" "$W/twin-$path.json" "${base[@]}" "${extra[@]}" 'sides={"left": 0, "right": 0}'
+    capture "$W/twin-$path.json" "twin-$path"
+    for kernel in gaussian disc; do
+      for pair in "0.25 0.35" "0.5 0.7" "0.9 1.4" "2 3"; do
+        set -- $pair
+        name="$path-$kernel-$1"
+        variant "$P/test1-static-grids.json" "$W/$name.json" "${base[@]}" "${extra[@]}" "content.kernel=\"$kernel\"" \
+            "sides={\"left\": {\"screen_px\": $1}, \"right\": {\"screen_px\": $2}}"
+        capture "$W/$name.json" "$name"
+        grep -q "\"blur_plan\": \"$([ $path = cpu ] && echo per_pixel || echo one_radius)\"" "$W/$name/trial-0001.json" \
+            || fail "$name: not drawn through the $path path"
+        $PY "$(dirname "$0")/capture_kernel.py" "$W/$name" "$W/twin-$path" > "$W/$name.txt" \
+            || fail "$name: $(grep BAD "$W/$name.txt" | head -2) $(tail -1 "$W/$name.txt")"
+        sed "s/^/$path $kernel /" "$W/$name.txt" | grep -v judged
+      done
+    done
+  done
+  echo "ok: sub-pixel blur is shown as recorded, Gaussian and pillbox, GL and CPU paths"
+  ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -35,8 +35,8 @@ double GaussianKernelSigma(double sigma_px);
 cv::Mat GaussianBlurCpu(const cv::Mat& rgba, double r_px);
 
 // The pillbox kernel for radius r (px): weight clamp(R + 0.5 - distance, 0, 1), normalised, (2 t + 1)^2 taps with
-// t = ceil(R + 0.5), where R = DiscCoverageRadiusPx(r) = sqrt(r^2 - 1/3) takes out the variance the coverage ramp
-// adds. The same formula as shaders/blur_disc.frag.
+// t = ceil(R + 0.5), where R = DiscCoverageRadiusPx(r) is the coverage radius whose discrete kernel has exactly the
+// line-spread variance r^2 / 4 of the DESIGN.md unit. The same formula as shaders/blur_disc.frag.
 double DiscCoverageRadiusPx(double r_px);
 cv::Mat DiscKernel(double r_px);
 cv::Mat DiscBlurCpu(const cv::Mat& rgba, double r_px);
