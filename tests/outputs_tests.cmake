@@ -21,3 +21,8 @@ set_tests_properties(outputs_json_onto_a_folder PROPERTIES FIXTURES_REQUIRED sce
 add_test(NAME install_relocatable
          COMMAND bash ${PROJECT_SOURCE_DIR}/tests/install_test.sh ${PROJECT_BINARY_DIR} ${PROJECT_BINARY_DIR}/install-test)
 set_tests_properties(install_relocatable PROPERTIES LABELS gl PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+
+# blurcue init from an installed, moved prefix: shipped examples as study folders that validate and run.
+add_test(NAME init_from_prefix
+         COMMAND bash ${PROJECT_SOURCE_DIR}/tests/init_test.sh ${PROJECT_BINARY_DIR} ${PROJECT_BINARY_DIR}/init-test)
+set_tests_properties(init_from_prefix PROPERTIES LABELS gl PASS_REGULAR_EXPRESSION "^ok:|\nok:")

@@ -85,6 +85,7 @@ inline CLI::Validator SeedValidator() {
 void AddEstimateCommand(CLI::App& app);     // estimate_command.cc
 void AddSynthSceneCommand(CLI::App& app);   // synth_scene_command.cc
 void AddCameraCommand(CLI::App& app);       // camera_command.cc
+void AddInitCommand(CLI::App& app);         // init_command.cc
 void AddCalibrateCommand(CLI::App& app);    // calibrate_command.cc
 void AddBenchCommand(CLI::App& app);        // bench_command.cc
 void AddBlurCommand(CLI::App& app);         // blur_command.cc

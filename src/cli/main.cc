@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
 
   // The command table: one entry per subcommand, each in its own file under src/cli/.
   const std::vector<std::pair<const char*, void (*)(CLI::App&)>> commands = {
+      {"init", &cli::AddInitCommand},
       {"synth-scene", &cli::AddSynthSceneCommand},
       {"camera", &cli::AddCameraCommand},
       {"calibrate", &cli::AddCalibrateCommand},

@@ -130,8 +130,8 @@ void AddValidateCommand(CLI::App& app) {
       } catch (const Error& e) {
         const std::string message = e.what();
         if (message.find(": no such file: ") == std::string::npos) throw;
-        throw e.Wrapped(e.kind(), "", "(scripts/demo.sh writes the demo scene the shipped protocols use; --no-files "
-                                      "skips the file checks)");
+        throw e.Wrapped(e.kind(), "", "('blurcue init DIR --from EXAMPLE' makes a shipped example a study folder with "
+                                      "its own scene and calibration; --no-files skips the file checks)");
       }
     }
     if (!grid_problems.empty()) {

@@ -1,0 +1,175 @@
+// blurcue init: a study folder that validates and runs at once - protocol, scene, calibration and next steps.
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli/child.h"
+#include "cli/commands.h"
+#include "core/atomic_file.h"
+#include "core/data_dir.h"
+#include "core/error.h"
+#include "core/names.h"
+#include "core/typed.h"
+
+namespace blurcue::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct InitArgs {
+  std::string dir;
+  std::string from = "test1-static-grids";
+  std::string photo, camera;
+  int seed = 7;
+};
+
+// The shipped examples: protocols/*.json beside the binary (installed) or in the source tree.
+std::vector<std::string> Examples() {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(DataDir().path / "protocols", ec))
+    if (entry.path().extension() == ".json" && entry.path().stem() != "protocol.schema")
+      names.push_back(entry.path().stem().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+std::string ReadText(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string(), "cannot open file");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Runs this blurcue with `args`; a failure stops init naming the step, and says the folder is left as far as it got.
+void Step(const std::string& what, std::vector<std::string> args, const fs::path& dir) {
+  std::cout << "init: " << what << "\n";
+  args.insert(args.begin(), (ExecutableDir() / "blurcue").string());
+  const int status = RunChild(args);
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return;
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 10;
+  throw Error(code == 2 || code == 3 ? ErrorKind::kInput : ErrorKind::kInternal,
+              "init: " + what + " failed (exit " + std::to_string(code) + "); " + dir.string() +
+                  " holds what was made before it");
+}
+
+std::string NextSteps(const std::string& example, const std::string& study, bool synthetic) {
+  std::ostringstream s;
+  s << "# " << study << "\n\n"
+    << "A study folder made by `blurcue init` from the shipped example `" << example << "`.\n\n"
+    << "| file | what it is |\n|---|---|\n"
+    << "| `protocol.json` | the study: what each trial shows and asks (see `blurcue validate --help` and the protocol "
+       "reference, `protocols/README.md` in blurcue's share folder) |\n"
+    << "| `scene/` | the scene photo and `camera.json`" << (synthetic ? " (a ground-truth scene made by `blurcue "
+       "synth-scene`: replace it with your own photo of the printed board and `blurcue camera PHOTO` for its "
+       "camera.json)" : "") << " |\n"
+    << "| `calib.json` | the scene's blur, measured and modelled by `blurcue calibrate` |\n\n"
+    << "## Next steps\n\n```sh\n"
+    << "blurcue validate protocol.json                  # every problem at once, or the trial count\n"
+    << "blurcue preview protocol.json --out sheet.png   # every distinct stimulus, to look at\n"
+    << "blurcue run protocol.json --participant S1 --observer sim --db record.sqlite   # a simulated observer, headless\n"
+    << "blurcue run protocol.json --participant P1 --db record.sqlite                  # a person, in a window\n"
+    << "blurcue export --db record.sqlite --out tables  # trials.csv, codebook.csv, ...\n"
+    << "blurcue report --db record.sqlite --out report  # report/index.html\n"
+    << "```\n\n"
+    << "With your own photo: `blurcue camera photo.jpg --out scene/camera.json`, then `blurcue calibrate photo.jpg "
+       "--camera scene/camera.json --out calib.json`, and point `scene.background` in protocol.json at the photo.\n";
+  return s.str();
+}
+
+}  // namespace
+
+void AddInitCommand(CLI::App& app) {
+  auto args = std::make_shared<InitArgs>();
+  std::string examples;
+  for (const std::string& name : Examples()) examples += "\n  " + name;
+  CLI::App* cmd = app.add_subcommand(
+      "init",
+      "Make a study folder that validates and runs at once: a protocol from a shipped example, a scene, its\n"
+      "calibration, and a README of next steps.\n"
+      "Without --photo the scene is a ground-truth one made by synth-scene (the thesis's set-up; --seed), so a lab\n"
+      "with no photo yet can preview and run the study; with --photo (and --camera, or the photo's EXIF) it is\n"
+      "yours. DIR must not exist or be empty: init never overwrites. Example:\n"
+      "  blurcue init my-study --from yes-no-ball && cd my-study && blurcue validate protocol.json\n"
+      "Examples shipped (--from):" + examples);
+  cmd->add_option("dir", args->dir, "the study folder to make")->required();
+  cmd->add_option("--from", args->from, "the shipped example to start from")->capture_default_str();
+  cmd->add_option("--photo", args->photo, "your scene photo with the printed board (default: a synthetic scene)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--camera", args->camera, "the photo's camera.json (default: from its EXIF, blurcue camera)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--seed", args->seed, "the synthetic scene's seed (recorded in scene/truth.json)")
+      ->capture_default_str()->check(IntRange(0, 2147483647));
+  cmd->callback([args] {
+    const std::vector<std::string> examples = Examples();
+    if (std::find(examples.begin(), examples.end(), args->from) == examples.end())
+      throw Error(ErrorKind::kUsage, "--from: no shipped example " + Echo(args->from) +
+                                         DidYouMean(args->from, examples) + "; 'blurcue init --help' lists them");
+    if (!args->camera.empty() && args->photo.empty())
+      throw Error(ErrorKind::kUsage, "--camera: goes with --photo (a synthetic scene has its own camera)");
+    const fs::path dir = args->dir;
+    std::error_code ec;
+    if (fs::exists(dir, ec) && !(fs::is_directory(dir, ec) && fs::is_empty(dir, ec)))
+      throw InputError(dir.string(), "exists and is not an empty folder; init never overwrites: name a new folder");
+    fs::create_directories(dir / "scene", ec);
+    if (ec) throw InputError(dir.string(), "cannot make the folder: " + ec.message());
+
+    // The protocol: the example's text with its demo paths pointing into this folder (relative to the protocol).
+    const fs::path example = DataDir().path / "protocols" / (args->from + ".json");
+    std::string text = ReadText(example);
+    const std::string demo = "../results/demo/";
+    for (size_t at = text.find(demo); at != std::string::npos; at = text.find(demo, at)) text.erase(at, demo.size());
+    const bool pictures = text.find("\"pictures/") != std::string::npos;
+    // The shipped stimuli it names ("../stimuli/face.png") are copied in, so the folder stands on its own.
+    const std::string shipped = "\"../stimuli/";
+    for (size_t at = text.find(shipped); at != std::string::npos; at = text.find(shipped, at)) {
+      const size_t end = text.find('"', at + shipped.size());
+      const std::string name = text.substr(at + shipped.size(), end - at - shipped.size());
+      fs::create_directories(dir / "stimuli", ec);
+      fs::copy_file(DataDir().path / "stimuli" / name, dir / "stimuli" / name, fs::copy_options::skip_existing, ec);
+      if (ec)
+        throw InputError((DataDir().path / "stimuli" / name).string(),
+                         "cannot copy into " + dir.string() + ": " + ec.message());
+      text.replace(at, shipped.size(), "\"stimuli/");
+    }
+
+    const fs::path scene = dir / "scene";
+    fs::path photo = scene / "scene.png";
+    if (args->photo.empty()) {
+      Step("a ground-truth scene (synth-scene, seed " + std::to_string(args->seed) + ")",
+           {"synth-scene", "--out", scene.string(), "--seed", std::to_string(args->seed), "--noise", "0.004"}, dir);
+    } else {
+      // Your photo under its own name; a board-free photo (scene.board_free) stays for you to add.
+      photo = scene / fs::path(args->photo).filename();
+      fs::copy_file(args->photo, photo, ec);
+      if (!ec && !args->camera.empty()) fs::copy_file(args->camera, scene / "camera.json", ec);
+      if (ec) throw InputError(args->photo, "cannot copy into " + scene.string() + ": " + ec.message());
+      if (args->camera.empty())
+        Step("camera.json from the photo's EXIF", {"camera", photo.string(), "--out", (scene / "camera.json").string()},
+             dir);
+      const std::string from = "\"scene/scene.png\"", to = "\"scene/" + photo.filename().string() + "\"";
+      for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
+        text.replace(at, from.size(), to);
+    }
+    Step("calibration (calibrate)", {"calibrate", photo.string(), "--camera", (scene / "camera.json").string(),
+                                     "--out", (dir / "calib.json").string()}, dir);
+    WriteFileAtomically(dir / "protocol.json", text);
+    if (pictures)
+      Step("the real pictures at each distance (synth-pictures)",
+           {"synth-pictures", "--protocol", (dir / "protocol.json").string(), "--out", (dir / "pictures").string()},
+           dir);
+    WriteFileAtomically(dir / "README.md", NextSteps(args->from, dir.filename().string(), args->photo.empty()));
+    Step("validate", {"validate", (dir / "protocol.json").string()}, dir);
+    std::cout << "init: " << dir.string() << " is ready; its README.md lists the next steps\n";
+  });
+}
+
+}  // namespace blurcue::cli
