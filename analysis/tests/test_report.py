@@ -95,7 +95,7 @@ class EndToEndTest(ReportTestCase):
         # Tables: one CSV per chart with a table; the numbers are there.
         t1 = read(out, "test1-per-edge.csv").splitlines()
         self.assertEqual(len(t1), 12)  # header + 11 edges
-        self.assertIn("p_binom", t1[0])
+        self.assertIn(",p,", t1[0])  # the test across participants (study_tests), not pooled answers
         model = read(out, "test1-model.csv")
         self.assertTrue(model.startswith("study,model,term,estimate,se,df,p,engine,note\n"), model[:80])
         self.assertIn("glmer(chose_first ~ edge_c", model)
