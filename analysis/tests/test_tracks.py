@@ -15,6 +15,7 @@ from scipy.optimize import brentq
 from scipy.stats import norm
 
 import common
+import criteria
 import tracks
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -255,6 +256,50 @@ class NotDeterminedInWords(unittest.TestCase):
         self.assertEqual((comparison["first"], comparison["second"], comparison["pairs"]),
                          ("speed_cm_s 1.8", "speed_cm_s 3", 3))
         self.assertAlmostEqual(comparison["mean_difference"], 0.1, places=9)
+
+
+class OneCriterion(unittest.TestCase):
+    """The pooled psychometric fit of a procedure cell reads its threshold at the procedure's own criterion (issue 23:
+    the summary gave the 75 % point beside QUEST+'s 81.6 % one), said in words, over the procedure's tested range."""
+
+    def test_quest_cell_fit_at_quests_threshold_parameter(self):
+        import any_study
+        from design import Design
+        # A Weibull observer, guess 0.5, no lapses, alpha 1, beta 3: QUEST+'s threshold is alpha (81.6 % correct);
+        # the 75 % point would be (ln 2)^(1/3) = 0.885. 400 answers at each of 9 levels.
+        rng = np.random.default_rng(4)
+        levels = np.repeat(np.linspace(0.4, 2.0, 9), 400)
+        psi = 0.5 + 0.5 * (1 - np.exp(-(levels / 1.0) ** 3))
+        params = {"procedure": "quest_plus", "guess": 0.5, "stimuli": list(np.linspace(0.2, 2.4, 12)),
+                  "thresholds": list(np.linspace(0.1, 3.0, 30)), "slopes": [1, 3, 5], "lapses": [0, 0.02]}
+        m = pd.DataFrame({"level": levels, "y": (rng.random(levels.size) < psi).astype(float),
+                          "participant": "P1", "cell": "edge=9", "procedure_cell": "1",
+                          "procedure_parameters": json.dumps(params)})
+        with tempfile.TemporaryDirectory() as out:
+            charts, words = any_study.psychometric_cells(m, "procedure", 0.5, "correct", Design(cells=("edge",)),
+                                                         "s", out, "s", "1 participant", 60, 1)
+        row = charts[0].table.iloc[0]
+        self.assertLess(abs(row["threshold"] - 1.0), 0.05, row)       # alpha, not 0.885
+        self.assertGreater(row["threshold"], 0.93, row)
+        self.assertAlmostEqual(row["criterion_share_correct"], 0.5 + (0.5 - row["lapse"] if not math.isnan(
+            row["lapse"]) else 0.5) * (1 - math.exp(-1)), places=9)
+        self.assertTrue(row["criterion"].startswith("81.6 % correct"), row["criterion"])
+        self.assertIn("edge 9: threshold at 81.6 % correct", words)
+        # The same words as the tracks' table states for a QUEST+ track.
+        self.assertEqual(criteria_short("quest_plus", params), row["criterion"])
+
+    def test_staircase_criterion_is_levitts_point(self):
+        p = {"procedure": "staircase", "up": 1, "down": 2, "min": 0.0, "max": 3.0}
+        c = criteria.criterion("staircase", p, 0.5)
+        self.assertAlmostEqual(c.psi(0.5, 0.03), math.sqrt(0.5), places=12)  # 0.707: p^2 = 1/2
+        self.assertTrue(c.short().startswith("70.7 % correct"), c.short())
+        c3 = criteria.criterion("staircase", dict(p, down=3), 0.5)
+        self.assertAlmostEqual(c3.psi(0.5, 0.0), 0.5 ** (1 / 3), places=12)  # 0.794
+        self.assertEqual(criteria.tested_range(p, [0.5, 1.0]), (0.0, 3.0))  # what it could show, not what it showed
+
+
+def criteria_short(kind, params):
+    return criteria.criterion(kind, params, 0.5).short()
 
 
 class ProceduresFile(unittest.TestCase):
