@@ -201,6 +201,18 @@ def session_numbers(df):
     return df["session_id"].map(rank).astype(int)
 
 
+def session_words(df):
+    """Each row's session said as what it is, for a label beside a participant: "aborted session", "unfinished
+    session", "first session" or "repeated session N" (session_numbers: a session after an aborted one is still a
+    first session), with the record's session id ("first session, id 2": what blurcue sessions lists)."""
+    numbers = session_numbers(df)
+    status = df["session_status"].astype(str) if "session_status" in df.columns else pd.Series("", index=df.index)
+    kind = np.where(status == "aborted", "aborted session", np.where(
+        status == "running", "unfinished session", np.where(numbers > 1, "repeated session " + numbers.astype(str),
+                                                            "first session")))
+    return pd.Series(kind, index=df.index) + ", id " + df["session_id"].astype(str)
+
+
 def protocol_versions(df):
     """Each row's protocol version as text ("" in an export from before versions were recorded). A version that a
     merge brought with two texts (two stations ran one version number with different protocols; run refuses that in

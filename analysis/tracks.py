@@ -32,7 +32,7 @@ import pandas as pd
 from scipy import stats as sps
 
 import criteria
-from common import Chart, save
+from common import Chart, save, session_words
 
 CREDIBLE = 0.95
 # A staircase's threshold: the mean of this many last turning points (an even number: as many peaks as troughs).
@@ -363,6 +363,7 @@ def track_rows(m):
     keys = [k for k in ("participant", "session_id", "block_name", "procedure_cell") if k in d]
     several_blocks = "block_name" in d and d["block_name"].nunique() > 1
     sessions = d.groupby("participant")["session_id"].nunique() if "session_id" in d else None
+    said = session_words(d) if "session_id" in d else None
     out = []
     for key, g in d.sort_values("trial_index").groupby(keys, sort=True):
         if "status" in g:
@@ -385,7 +386,8 @@ def track_rows(m):
             label = f"{key['block_name']}: {label}"
         participant = str(key["participant"])
         if sessions is not None and sessions.get(key["participant"], 1) > 1:
-            participant += f" (session {key['session_id']})"
+            # Said as what it is: the record's id alone ("session 2") read as a second session after an abort.
+            participant += f" ({said[g.index[0]]})"
         crit = criteria.criterion(kind, p, float((p or {}).get("guess", 0.5)))
         out.append({"participant": participant, "cell": label, "kind": kind, "levels": levels, "correct": correct,
                     "criterion": crit.short(),

@@ -258,6 +258,22 @@ class NotDeterminedInWords(unittest.TestCase):
         self.assertAlmostEqual(comparison["mean_difference"], 0.1, places=9)
 
 
+class SessionsSaidAsWhatTheyAre(unittest.TestCase):
+    def test_a_session_after_an_abort_is_a_first_session_not_session_2(self):
+        # P1 gave up session id 1 (aborted, analysed with --include-aborted) and ran the study again (id 2, the
+        # record's number 2), then once more after completing it (id 3): the tracks say aborted, first, repeated 2.
+        p = {"procedure": "staircase", "start": 1.0, "min": 0.0, "max": 3.0, "up": 1, "down": 2, "steps": [0.4, 0.2]}
+        levels = np.array([1, 1, 0.6, 0.6, 0.2, 0.4, 0.4, 0.2, 0.4, 0.6, 0.6, 0.4, 0.6, 0.6])
+        correct = [1, 1, 1, 1, 0, 1, 1, 0, 0, 1, 1, 0, 1, 1]
+        frames = []
+        for sid, number, status in (("1", 1, "aborted"), ("2", 2, "completed"), ("3", 3, "completed")):
+            frames.append(rows_of("P1", levels, correct, p).assign(session_id=sid, session_number=str(number),
+                                                                   session_status=status, study="s"))
+        labels = sorted(t["participant"] for t in tracks.track_rows(pd.concat(frames, ignore_index=True)))
+        self.assertEqual(labels, ["P1 (aborted session, id 1)", "P1 (first session, id 2)",
+                                  "P1 (repeated session 2, id 3)"])
+
+
 class OneCriterion(unittest.TestCase):
     """The pooled psychometric fit of a procedure cell reads its threshold at the procedure's own criterion (issue 23:
     the summary gave the 75 % point beside QUEST+'s 81.6 % one), said in words, over the procedure's tested range."""
