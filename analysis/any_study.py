@@ -31,7 +31,7 @@ import criteria
 import stats
 import study_tests
 import tracks
-from common import Chart, Skip, error_bars, participants_note, save, stars
+from common import Chart, Skip, error_bars, participants_note, save, stars, text
 from design import design_of, load_codebook  # noqa: F401  (load_codebook: report.py reads the codebook through here)
 
 KIND_TITLES = {"pair": "forced choice between two", "odd": "odd one out",
@@ -50,13 +50,13 @@ def kind_of(d):
     for task in ("adjustment", "rating", "yes_no"):
         if task in tasks:
             return task
-    if "odd_interval" in d and d["odd_interval"].astype(str).str.strip().replace("nan", "").ne("").any():
+    if "odd_interval" in d and text(d["odd_interval"]).ne("").any():
         return "procedure" if _has(d, "procedure_cell") else "odd"
     return "procedure" if _has(d, "procedure_cell") else "pair"
 
 
 def _has(d, column):
-    return column in d and d[column].astype(str).str.strip().replace("nan", "").ne("").any()
+    return column in d and text(d[column]).ne("").any()
 
 
 def _num(series):
@@ -307,7 +307,7 @@ def analyse(df, study, codebook, out_dir, n_boot=200, seed=1, group="", part="")
         raise Skip(f"{study}: no trials outside practice")
     # Blocks of one task but of two kinds - an adaptive procedure beside fixed levels - are two analyses too: the
     # fixed block's answers used to be dropped unsaid (a procedure's measure is `correct`, which they lack).
-    adaptive = d["procedure_cell"].astype(str).str.strip().replace("nan", "").ne("") if "procedure_cell" in d \
+    adaptive = text(d["procedure_cell"]).ne("") if "procedure_cell" in d \
         else pd.Series(False, index=d.index)
     keys = d["task"].astype(str).where(~adaptive, d["task"].astype(str) + " adaptive")
     if adaptive.any() and not adaptive.all():
@@ -367,7 +367,7 @@ def _text_values(m, column):
     """The distinct non-empty values of a column, as text ([] without the column)."""
     if column not in m:
         return []
-    return sorted({str(v) for v in m[column] if str(v).strip() not in ("", "nan")})
+    return sorted({v for v in text(m[column]) if v})
 
 
 def group_section(m, kind, what, design, codebook, study, out_dir, slug, note):

@@ -24,7 +24,7 @@ import pandas as pd
 from scipy.stats import norm
 
 import stats
-from common import Chart, Skip, error_bars, participants_note, save
+from common import Chart, Skip, error_bars, participants_note, save, text
 
 Z75 = 0.6744897501960817  # Phi^-1(0.75)
 # The C++ model's defaults (session/observer.h ObserverParams, model=arcmin).
@@ -97,7 +97,7 @@ def predicted(d):
     rl, rr = _num(a["r_left_arcmin"]), _num(a["r_right_arcmin"])
     rs = _num(a["r_scene_arcmin"]) if "r_scene_arcmin" in a else pd.Series(np.nan, index=a.index)
     procedure = _num(a["level"]).notna() if "level" in a else pd.Series(False, index=a.index)
-    odd = a["chosen_interval"].astype(str).str.strip().replace("nan", "").ne("")
+    odd = text(a["chosen_interval"]).ne("")
     # Whether a study offers can't tell is in its protocol, not its table: taken as offered when anyone used it.
     offers = a.groupby("study")["chosen_side"].transform(lambda c: (c == "cant_tell").any())
     out = []
