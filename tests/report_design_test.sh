@@ -22,8 +22,9 @@ quest_per_depth)
   # chance (QUEST+ sets the share correct). The truth: the observer's own threshold per depth, from its formula
   # (session/observer.h, model=arcmin defaults): a blur of std s = r / 2 arcmin is seen as E = sqrt(s^2 + 0.6^2);
   # P(correct) = lapse / 2 + (1 - lapse) Phi(ln(E_test / E_ref) / sd), sd = ln(1.35) / Phi^-1(0.75), lapse 0.04 - so
-  # the extra blur needed for 75 % grows with the depth's own blur (Weber): the fits must rank the near and the far
-  # depth the same way.
+  # the extra blur needed for QUEST+'s criterion (its Weibull's scale: 0.5 + 0.5 (1 - 1/e) = 81.6 % correct) grows
+  # with the depth's own blur (Weber): the fits must rank the near and the far depth the same way, and the summary
+  # must state that criterion for the tracks and the pooled fit alike (criteria.py).
   protocol quest-per-depth
   for id in Q1 Q2 Q3; do
     $BC run "$W/quest-per-depth.json" --participant $id --db "$W/q.sqlite" --observer sim:blurrier=0 > /dev/null 2>&1 \
@@ -39,7 +40,7 @@ index = open(os.path.join(out, "index.html"), encoding="utf-8").read()
 assert not os.path.exists(os.path.join(out, "quest-per-depth-simulated-psychometric.png")), "a fit pooled over depths"
 z = NormalDist().inv_cdf
 sd, lapse = math.log(1.35) / z(0.75), 0.04
-d = sd * z((0.75 - lapse / 2) / (1 - lapse))
+d = sd * z((0.5 + 0.5 * (1 - math.exp(-1)) - lapse / 2) / (1 - lapse))
 fitted, truth = {}, {}
 for edge in ("3", "6", "9"):
     name = f"quest-per-depth-simulated-psychometric-edge_{edge}"
@@ -60,7 +61,9 @@ assert {r["edge"] for r in table} == {"3", "6", "9"} and not {"p", "p_holm", "ch
 summary = index.split("<h3>Contents</h3>")[0]
 line = summary[summary.index("quest-per-depth (simulated observers)"):]
 line = line[:line.index("</tr>")]
-assert "chance" not in line and "edge=3: threshold" in line and "edge=9: threshold" in line, line
+assert "chance" not in line and "tracks: edge 3: threshold at 81.6 % correct" in line, line
+assert "psychometric fit of the answers pooled: edge 3: threshold at 81.6 % correct" in line, line
+assert "edge 9: threshold at 81.6 % correct" in line and "75 %" not in line, line
 print("thresholds per depth " + ", ".join(f"edge {e}: {fitted[e]:.2f} (observer {truth[e]:.2f})" for e in fitted))
 PYEOF
   $PY "$(dirname "$0")/report_numbers_check.py" "$W/report" > "$W/numbers" || fail "$(cat "$W/numbers")"
