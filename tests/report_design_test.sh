@@ -47,7 +47,7 @@ for edge in ("3", "6", "9"):
     assert f"<img src='{name}.png'" in index, name
     fit = next(csv.DictReader(open(os.path.join(out, name + ".csv"))))
     mine = [r for r in rows if r["cell"] == f"edge={edge}"]
-    assert fit["cell"] == f"edge={edge}" and int(fit["answers"]) == len(mine) == 72, (fit["cell"], fit["answers"])
+    assert fit["cell"] == f"edge={edge}" and int(fit["answers"]) == len(mine) == 96, (fit["cell"], fit["answers"])
     assert fit["threshold"], f"edge {edge}: no threshold"
     fitted[edge] = float(fit["threshold"])
     ref = {float(r["r_right_arcmin"] if r["test_side"] == "left" else r["r_left_arcmin"]) for r in mine}
