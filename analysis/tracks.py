@@ -438,12 +438,19 @@ def summary_table(tracks):
             continue
         if len(v):
             row.update(mean=float(v.mean()), median=float(np.median(v)))
-        if len(v) >= 2:
-            half = sps.t.ppf(0.975, len(v) - 1) * v.std(ddof=1) / math.sqrt(len(v))
-            row.update(mean_low=float(v.mean() - half), mean_high=float(v.mean() + half),
-                       sd_across_participants=float(v.std(ddof=1)))
         row["interval"] = "t 95 % across participants" if len(v) >= 2 else \
             ("not determined: fewer than 2 determined thresholds" if len(these) else "")
+        if len(v) >= 2:
+            half = sps.t.ppf(0.975, len(v) - 1) * v.std(ddof=1) / math.sqrt(len(v))
+            row["sd_across_participants"] = float(v.std(ddof=1))
+            ranges = [t["result"]["range"] for t in these if "range" in t["result"]]
+            lo, hi = (min(r[0] for r in ranges), max(r[1] for r in ranges)) if ranges else (-math.inf, math.inf)
+            if v.mean() - half < lo or v.mean() + half > hi:
+                # A t interval past what the procedure could show (a negative threshold, say) is no interval.
+                row["interval"] = (f"not determined: the t 95 % interval across participants reaches beyond "
+                                   f"{criteria.range_words(lo, hi)}")
+            else:
+                row.update(mean_low=float(v.mean() - half), mean_high=float(v.mean() + half))
         rows.append(row)
     return pd.DataFrame(rows)
 
@@ -456,6 +463,9 @@ def summary_words(summary):
         text = f"{r['cell']}: threshold at {r['criterion']}"
         if str(r.get("interval", "")).startswith("not determined") and pd.isna(r.get("mean")):
             text += f" {r['interval']}"
+        elif str(r.get("interval", "")).startswith("not determined"):
+            text += (f" {r['mean']:.3g} (mean of {int(r['determined'])} participants' thresholds; its interval "
+                     f"{r['interval']})")
         elif pd.notna(r.get("mean_low")):
             text += (f" {r['mean']:.3g} [{r['mean_low']:.3g}, {r['mean_high']:.3g}] (mean of {int(r['determined'])} "
                      "participants' thresholds, t 95 %)")

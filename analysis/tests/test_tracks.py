@@ -258,6 +258,27 @@ class NotDeterminedInWords(unittest.TestCase):
         self.assertAlmostEqual(comparison["mean_difference"], 0.1, places=9)
 
 
+class IntervalsWithinTheTestedRange(unittest.TestCase):
+    def test_a_cells_t_interval_past_the_range_is_not_determined(self):
+        # Three thresholds 0.1, 0.2 and 2.9 in a range 0.05 to 3: mean 1.067, t interval 1.067 +- 4.303 x 1.589 /
+        # sqrt 3 = [-2.88, 5.01] (by hand), past both ends: not determined, in words, no bound written; the mean stays.
+        def track(who, th, cell):
+            return {"participant": who, "cell": cell, "criterion": "81.6 % correct",
+                    "result": {"estimate": th, "range": (0.05, 3.0)}}
+        these = [track("P1", 0.1, "a"), track("P2", 0.2, "a"), track("P3", 2.9, "a"),
+                 track("P1", 1.0, "b"), track("P2", 1.1, "b"), track("P3", 1.2, "b")]
+        t = tracks.summary_table(these).set_index("cell")
+        self.assertTrue(pd.isna(t.loc["a"].get("mean_low")) and pd.isna(t.loc["a"].get("mean_high")))
+        self.assertEqual(t.loc["a", "interval"], "not determined: the t 95 % interval across participants reaches "
+                                                 "beyond the tested range 0.05 to 3")
+        self.assertAlmostEqual(t.loc["a", "mean"], 3.2 / 3, places=12)
+        # Cell b: 1.1 +- 4.303 x 0.1 / sqrt 3 = [0.852, 1.348], inside.
+        self.assertAlmostEqual(t.loc["b", "mean_low"], 1.1 - 4.302652729911275 * 0.1 / math.sqrt(3), places=9)
+        words = tracks.summary_words(t.reset_index())
+        self.assertIn("a: threshold at 81.6 % correct 1.07 (mean of 3 participants' thresholds; its interval not "
+                      "determined", words)
+
+
 class SessionsSaidAsWhatTheyAre(unittest.TestCase):
     def test_a_session_after_an_abort_is_a_first_session_not_session_2(self):
         # P1 gave up session id 1 (aborted, analysed with --include-aborted) and ran the study again (id 2, the
