@@ -195,7 +195,7 @@ def aborted_sessions(trials, included):
     out = []
     for study, d in aborted.groupby("study", sort=True):
         sessions = d.drop_duplicates("session_id")
-        who = ", ".join(f"{p} (session {s})" for p, s in zip(sessions["participant"], sessions["session_id"]))
+        who = ", ".join(f"{p} (session id {s})" for p, s in zip(sessions["participant"], sessions["session_id"]))
         n, answers = len(sessions), int((d["answered"] & (d["practice"] != 1)).sum())
         what = f"{n} aborted session{'s' if n != 1 else ''} ({who}) with {answers} answer{'s' if answers != 1 else ''}"
         if included:
@@ -212,7 +212,7 @@ def unfinished_sessions(trials, included):
     out = []
     for study, d in common.unfinished_rows(trials).groupby("study", sort=True):
         sessions = d.drop_duplicates("session_id")
-        who = ", ".join(f"{p} (session {s})" for p, s in zip(sessions["participant"], sessions["session_id"]))
+        who = ", ".join(f"{p} (session id {s})" for p, s in zip(sessions["participant"], sessions["session_id"]))
         n, answers = len(sessions), int((d["answered"] & (d["practice"] != 1)).sum())
         what = (f"{n} unfinished session{'s' if n != 1 else ''} ({who}) with {answers} "
                 f"answer{'s' if answers != 1 else ''}")

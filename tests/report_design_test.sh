@@ -121,7 +121,7 @@ sessions)
   $BC run "$P/2ifc-grids.json" --participant P4 --db "$W/s.sqlite" --observer sim --stop-after 3 > /dev/null 2>&1 || fail "P4"
   report "$W/s.sqlite" "$W/report" > /dev/null 2> "$W/err" || fail "report: $(tail -3 "$W/err")"
   report "$W/s.sqlite" "$W/report-all" --include-unfinished > /dev/null 2> "$W/err-all" || fail "report: $(tail -3 "$W/err-all")"
-  grep -q "^report: left out 1 unfinished session (P4 (session 5)) with 3 answers" "$W/err" || fail "stderr: $(cat "$W/err")"
+  grep -q "^report: left out 1 unfinished session (P4 (session id 5)) with 3 answers" "$W/err" || fail "stderr: $(cat "$W/err")"
   $PY - "$W/report" "$W/report-all" <<'PYEOF' > "$W/found" || fail "sessions: $(cat "$W/found")"
 import csv, os, sys
 out, out_all = sys.argv[1], sys.argv[2]
@@ -135,7 +135,7 @@ def analysed(folder, name):
     table = list(csv.DictReader(open(os.path.join(folder, name))))
     return sum(int(r["n"]) for r in table), max(int(r["participants"]) for r in table)
 index = open(os.path.join(out, "index.html"), encoding="utf-8").read()
-assert "left out 1 unfinished session (P4 (session 5)) with 3 answers" in index
+assert "left out 1 unfinished session (P4 (session id 5)) with 3 answers" in index
 first = decisive(lambda r: r["session_number"] == "1" and r["session_status"] == "completed")
 assert analysed(out, "2ifc-grids-simulated-conditions.csv") == (first, 3), (analysed(out, "2ifc-grids-simulated-conditions.csv"), first)
 again = decisive(lambda r: r["session_number"] == "2")
@@ -143,7 +143,7 @@ assert analysed(out, "2ifc-grids-session2-simulated-conditions.csv") == (again, 
 assert "study 2ifc-grids (session 2, simulated observers)" in index and "1 repeated session (P1 (session number 2): after one the participant completed)" in index
 # --include-unfinished: P4's answers in, said to be partial data.
 index_all = open(os.path.join(out_all, "index.html"), encoding="utf-8").read()
-assert "included 1 unfinished session (P4 (session 5)) with 3 answers as partial data" in index_all
+assert "included 1 unfinished session (P4 (session id 5)) with 3 answers as partial data" in index_all
 with_p4 = decisive(lambda r: r["session_number"] == "1")
 assert analysed(out_all, "2ifc-grids-simulated-conditions.csv") == (with_p4, 4), with_p4
 assert "incl. 1 unfinished session (partial data)" in index_all

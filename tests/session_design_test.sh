@@ -165,20 +165,20 @@ PYEOF
     || fail "report: $(tail -3 "$W/err")"
   read -r answers kept all <<< "$(counts "$W/report/tables/trials.csv")"
   [ "$answers" -gt 0 ] && [ "$all" -gt "$kept" ] || fail "the aborted session has no decisive answers: $answers $kept $all"
-  grep -q "left out 1 aborted session (P1 (session 1)) with $answers answers: closed with blurcue sessions --abort" \
+  grep -q "left out 1 aborted session (P1 (session id 1)) with $answers answers: closed with blurcue sessions --abort" \
     "$W/report/index.html" || fail "the summary does not say what it left out: $(grep -o 'aborted[^<]*' "$W/report/index.html")"
   grep -q "report: left out 1 aborted session" "$W/err" || fail "stderr: $(cat "$W/err")"
   grep -q "of $kept decisive answers" "$W/report/index.html" || fail "not $kept decisive answers: $(grep -o 'of [0-9]* decisive answers' "$W/report/index.html")"
   MPLCONFIGDIR=$W/mpl $BC report --db "$W/s.sqlite" --out "$W/report-all" --bench "$W/no-bench" --boot 20 --include-aborted \
     > /dev/null 2> "$W/err" || fail "report --include-aborted: $(tail -3 "$W/err")"
-  grep -q "included 1 aborted session (P1 (session 1)) with $answers answers" "$W/report-all/index.html" || fail "--include-aborted not said"
+  grep -q "included 1 aborted session (P1 (session id 1)) with $answers answers" "$W/report-all/index.html" || fail "--include-aborted not said"
   grep -q "of $all decisive answers" "$W/report-all/index.html" || fail "--include-aborted: not $all decisive answers"
   # Only an aborted session.
   $BC run "$P/test1-static-grids.json" --participant P9 --db "$W/o.sqlite" --observer sim --stop-after 8 > /dev/null 2>&1
   $BC sessions --db "$W/o.sqlite" --abort 1 > /dev/null
   MPLCONFIGDIR=$W/mpl $BC report --db "$W/o.sqlite" --out "$W/report-only" --bench "$W/no-bench" --boot 20 > /dev/null 2> "$W/err" \
     || fail "report of an aborted session only: $(tail -3 "$W/err")"
-  grep -q "left out 1 aborted session (P9 (session 1))" "$W/report-only/index.html" || fail "the report does not say aborted"
+  grep -q "left out 1 aborted session (P9 (session id 1))" "$W/report-only/index.html" || fail "the report does not say aborted"
   grep -q "decisive answers" "$W/report-only/index.html" && fail "an aborted session only was analysed"
   echo "ok: an aborted session's $answers answers left out and said ($kept decisive answers, $all with --include-aborted)" ;;
 report_any_study)
