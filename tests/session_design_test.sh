@@ -213,14 +213,18 @@ for png in ("quest-blur-difference-simulated-psychometric.png", "quest-blur-diff
     assert os.path.isfile(os.path.join(out, png)), png
     assert f"<img src='{png}'" in index, png
 # The truth: the observer picks the more blurred side with P = Phi(d / jnd) (1 - lapse) + lapse / 2, d the radius
-# difference in photo px; 75 % correct at d = jnd * Phi^-1((0.75 - lapse / 2) / (1 - lapse)), in arcmin via the
-# display's arcmin per photo px (the export's r_left_arcmin / r_left_px).
+# difference in photo px. The report reads a QUEST+ cell's threshold at QUEST+'s own criterion (analysis/criteria.py):
+# 1 - 1/e of the way from guessing (0.5) to the top (1 - lapse / 2), so P* = 0.5 + (0.5 - lapse / 2)(1 - 1/e), at
+# d = jnd * Phi^-1((P* - lapse / 2) / (1 - lapse)), in arcmin via the display's arcmin per photo px (the export's
+# r_left_arcmin / r_left_px).
 rows = [r for r in csv.DictReader(open(trials)) if r["study"] == "quest-blur-difference" and r["r_left_px"]
         and float(r["r_left_px"]) > 0]
 arcmin_per_px = float(rows[0]["r_left_arcmin"]) / float(rows[0]["r_left_px"])
 jnd, lapse = 1.4, 0.02
-truth = jnd * NormalDist().inv_cdf((0.75 - lapse / 2) / (1 - lapse)) * arcmin_per_px
+target = 0.5 + (0.5 - lapse / 2) * (1 - math.exp(-1))
+truth = jnd * NormalDist().inv_cdf((target - lapse / 2) / (1 - lapse)) * arcmin_per_px
 fit = next(csv.DictReader(open(os.path.join(out, "quest-blur-difference-simulated-psychometric.csv"))))
+assert fit["criterion"] == "81.6 % correct", fit["criterion"]
 lo, th, hi = float(fit["threshold_low"]), float(fit["threshold"]), float(fit["threshold_high"])
 print(f"QUEST+ threshold {th:.3f} [{lo:.3f}, {hi:.3f}] arcmin; the observers' {truth:.3f}")
 assert lo <= truth <= hi, (lo, th, hi, truth)
