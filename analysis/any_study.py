@@ -87,8 +87,9 @@ def measured(d, kind):
 
 
 def _label(value):
-    text = str(value)
-    return text[:-2] if text.endswith(".0") else text
+    """A level as the tables write it: 3.0 as 3, a level the row does not have (NaN: not applicable) blank."""
+    words = text(pd.Series([value])).iloc[0]
+    return words[:-2] if words.endswith(".0") else words
 
 
 def condition_table(m, factors, chance):

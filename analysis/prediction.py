@@ -128,12 +128,13 @@ def predicted(d):
 
 
 def condition_table(m, factors):
+    import any_study
     keys = None if not factors else factors[0] if len(factors) == 1 else factors
     groups = m.groupby(keys, dropna=False) if keys else [((), m)]
     rows = []
     for key, g in groups:
         key = key if isinstance(key, tuple) else (key,)
-        row = {f: (str(v)[:-2] if str(v).endswith(".0") else str(v)) for f, v in zip(factors, key)}
+        row = {f: any_study._label(v) for f, v in zip(factors, key)}
         n, k = len(g), int(g["y"].sum())
         share, lo, hi = stats.wilson(k, n)
         pred = float(g["predicted"].mean())

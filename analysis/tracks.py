@@ -463,6 +463,8 @@ def summary_words(summary):
         text = f"{r['cell']}: threshold at {r['criterion']}"
         if str(r.get("interval", "")).startswith("not determined") and pd.isna(r.get("mean")):
             text += f" {r['interval']}"
+        elif int(r["determined"]) == 1:
+            text += f" {r['mean']:.3g} (one participant's threshold)"
         elif str(r.get("interval", "")).startswith("not determined"):
             text += (f" {r['mean']:.3g} (mean of {int(r['determined'])} participants' thresholds; its interval "
                      f"{r['interval']})")

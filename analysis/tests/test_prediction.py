@@ -54,6 +54,16 @@ class ClosedFormTest(unittest.TestCase):
         self.assertTrue(bool(t["departs"].iloc[0]))  # 0 of 40 correct against ~0.79
 
 
+class LevelsInTheTable(unittest.TestCase):
+    def test_a_level_a_row_does_not_have_is_blank_not_nan(self):
+        # Task 1 rows of test 2 have no section: their cell is blank (not applicable), never the text "nan" that
+        # report_numbers_check.py flags as a number meaning "not determined".
+        m = pd.DataFrame({"section": [1.0, 1.0, np.nan], "y": [1, 0, 1], "predicted": [0.5, 0.5, 0.5],
+                          "participant": ["P1"] * 3})
+        t = prediction.condition_table(m, ["section"])
+        self.assertEqual(sorted(t["section"]), ["", "1"])
+
+
 class PerGroupTest(unittest.TestCase):
     def test_between_subject_groups_are_never_pooled(self):
         # Group a (P1, P2) always right, group b (P3, P4) always wrong, on the same trials: each group's table holds

@@ -277,6 +277,8 @@ class IntervalsWithinTheTestedRange(unittest.TestCase):
         words = tracks.summary_words(t.reset_index())
         self.assertIn("a: threshold at 81.6 % correct 1.07 (mean of 3 participants' thresholds; its interval not "
                       "determined", words)
+        one = tracks.summary_words(tracks.summary_table([track("P1", 0.8, "c")]))
+        self.assertEqual(one, "c: threshold at 81.6 % correct 0.8 (one participant's threshold)")
 
 
 class SessionsSaidAsWhatTheyAre(unittest.TestCase):
