@@ -27,10 +27,11 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+import criteria
 import stats
 import study_tests
 import tracks
-from common import Chart, Skip, error_bars, participants_note, save, stars
+from common import Chart, Skip, error_bars, participants_note, save, stars, text
 from design import design_of, load_codebook  # noqa: F401  (load_codebook: report.py reads the codebook through here)
 
 KIND_TITLES = {"pair": "forced choice between two", "odd": "odd one out",
@@ -49,13 +50,13 @@ def kind_of(d):
     for task in ("adjustment", "rating", "yes_no"):
         if task in tasks:
             return task
-    if "odd_interval" in d and d["odd_interval"].astype(str).str.strip().replace("nan", "").ne("").any():
+    if "odd_interval" in d and text(d["odd_interval"]).ne("").any():
         return "procedure" if _has(d, "procedure_cell") else "odd"
     return "procedure" if _has(d, "procedure_cell") else "pair"
 
 
 def _has(d, column):
-    return column in d and d[column].astype(str).str.strip().replace("nan", "").ne("").any()
+    return column in d and text(d[column]).ne("").any()
 
 
 def _num(series):
@@ -86,8 +87,9 @@ def measured(d, kind):
 
 
 def _label(value):
-    text = str(value)
-    return text[:-2] if text.endswith(".0") else text
+    """A level as the tables write it: 3.0 as 3, a level the row does not have (NaN: not applicable) blank."""
+    words = text(pd.Series([value])).iloc[0]
+    return words[:-2] if words.endswith(".0") else words
 
 
 def condition_table(m, factors, chance):
@@ -191,10 +193,13 @@ def models(m, factors, study, group_note, what):
     return Chart(f"{study}-models", None, None, table, notes)
 
 
-def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note, n_boot, seed, what, cell=""):
+def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note, n_boot, seed, what, cell="",
+                       crit=None, tested=None):
     """A Weibull with the guess rate at chance over one procedure cell's (or one odd one out's) answers; raises Skip
-    with too few levels or answers. Returns (Chart, (threshold, low, high, slope) or (nan, min, max, slope) when the
-    threshold lies beyond the tested range)."""
+    with too few levels or answers. crit: the threshold's criteria.Criterion (the cell's procedure's own; fixed
+    levels' by default), tested: the tested range (criteria.tested_range; the levels shown by default). Returns
+    (Chart, (threshold, low, high, slope) or (nan, low, high of the tested range, slope) when the threshold lies
+    beyond it)."""
     where = f" ({cell})" if cell else ""
     d = m.dropna(subset=[xcol])
     x, k = d[xcol].to_numpy(float), d["y"].to_numpy(float)
@@ -203,16 +208,18 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
                    f"(has {len(np.unique(x))} levels, {len(x)} answers)")
     fit = stats.fit_psychometric(x, k, None, kind="weibull", gamma=chance, lam=(0.0, 0.1))
     grid, lo, hi = stats.bootstrap(x, k, np.ones_like(k), fit, n_boot=n_boot, seed=seed)
-    p_mid = chance + (1 - chance) / 2
+    crit = crit or criteria.criterion("", None, chance)
+    x_lo, x_hi = tested or criteria.tested_range(None, x)
+    p_mid = crit.psi(fit.gamma, fit.lam)
     th = stats.threshold(fit, p_mid)
     boot_th = []
     rng = np.random.default_rng(seed)
     for _ in range(max(50, n_boot // 2)):
         kb = rng.binomial(1, np.clip(fit(x), 0, 1)).astype(float)
         try:
-            boot_th.append(stats.threshold(stats.fit_psychometric(x, kb, None, kind="weibull", gamma=chance,
-                                                                  lam=(0.0, 0.1), starts=[(fit.alpha, fit.beta)]),
-                                           p_mid))
+            refit = stats.fit_psychometric(x, kb, None, kind="weibull", gamma=chance, lam=(0.0, 0.1),
+                                           starts=[(fit.alpha, fit.beta)])
+            boot_th.append(stats.threshold(refit, crit.psi(refit.gamma, refit.lam)))
         except ValueError:
             pass
     boot_th = np.array([b for b in boot_th if not math.isnan(b)])
@@ -225,8 +232,8 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
     ax.scatter(levels["x"], levels["sum"] / levels["count"], s=sizes, color="#333333", zorder=3,
                label="share per level (size: answers)")
     ax.axhline(chance, color="#999999", ls="--", lw=1)
-    if not math.isnan(th) and x.min() <= th <= x.max():
-        ax.axvline(th, color="#D55E00", lw=1, ls=":", label=f"threshold ({p_mid:.0%}): {th:.3g}")
+    if criteria.inside(th, x_lo, x_hi):
+        ax.axvline(th, color="#D55E00", lw=1, ls=":", label=f"threshold ({crit.short()}): {th:.3g}")
     ax.set_xlabel(xlabel)
     ax.set_ylabel(f"share: {what}")
     ax.set_ylim(min(chance, 0.4) - 0.05, 1.05)
@@ -234,41 +241,42 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
     ax.set_title(f"{study}: psychometric function{' - cell ' + cell if cell else ''}\n{group_note}, {len(x)} answers",
                  loc="left")
     png, svg = save(fig, out_dir, name)
-    inside = not math.isnan(th) and x.min() <= th <= x.max()
+    inside = criteria.inside(th, x_lo, x_hi)
     # A threshold beyond the tested range is an extrapolation, and an interval that reaches beyond it (or that the
     # bootstrap could not bound) is not determined by these answers: both are written in words, not as numbers.
-    bounded = inside and not math.isnan(th_lo) and x.min() <= th_lo and th_hi <= x.max()
+    bounded = inside and not math.isnan(th_lo) and x_lo <= th_lo and th_hi <= x_hi
+    side = "below" if not math.isnan(th) and th < x_lo else "above" if not math.isnan(th) else "beyond"
     beta_lo, beta_hi = fit.ci.get("beta", (math.nan, math.nan))
     b_bounds = fit.options.get("beta_bounds") or (0.0, math.inf)
     beta_free = "beta" not in fit.on_bound
     beta_ci = beta_free and not math.isnan(beta_lo) and beta_lo > b_bounds[0] * 1.001 + 1e-9 and \
         beta_hi < b_bounds[1] * 0.999
-    interval_words = ("" if bounded else "the threshold's 95 % interval reaches beyond the tested range: not "
-                      "determined by these answers" if inside else
-                      f"beyond the tested range {x.min():.3g} to {x.max():.3g}")
+    interval_words = ("" if bounded else f"the threshold's 95 % interval reaches beyond "
+                      f"{criteria.range_words(x_lo, x_hi)}: not determined by these answers" if inside else
+                      criteria.beyond_words(side, x_lo, x_hi))
     t = pd.DataFrame([{**({"cell": cell} if cell else {}), "threshold": th if inside else math.nan,
                        "threshold_low": th_lo if bounded else math.nan,
                        "threshold_high": th_hi if bounded else math.nan, "threshold_note": interval_words,
                        "on_bound": ", ".join(f"{k} at its {v[1]} bound {v[0]:.3g}" for k, v in fit.on_bound.items()),
-                       "criterion": p_mid,
+                       "criterion": crit.short(), "criterion_share_correct": p_mid,
                        # The Weibull's scale is the threshold's other name: not a number where that is not one.
                        "alpha": fit.alpha if inside else math.nan, "beta_slope": fit.beta if beta_free else math.nan,
                        "beta_low": beta_lo if beta_ci else math.nan, "beta_high": beta_hi if beta_ci else math.nan,
                        "guess": fit.gamma, "lapse": fit.lam if "lam" not in fit.on_bound else math.nan, "answers": len(x),
                        "participants": d["participant"].nunique()}])
     notes = [f"Weibull with the guess rate fixed at chance ({chance:.3g}) and a lapse rate fitted in [0, 0.1]; "
-             f"threshold = the stimulus at {p_mid:.0%}: " +
-             (f"{th:.3g} [{th_lo:.3g}, {th_hi:.3g}] (parametric bootstrap, {n_boot} samples)" if bounded else
-              f"{th:.3g}, its interval not determined (the bootstrap's reaches beyond the tested range "
-              f"{x.min():.3g} to {x.max():.3g})" if inside else
-              f"beyond the tested range {x.min():.3g} to {x.max():.3g} (an extrapolation, not an estimate)") +
+             f"threshold at {crit.words}: " +
+             (f"{th:.3g} [{th_lo:.3g}, {th_hi:.3g}] (parametric bootstrap, {len(boot_th)} refits)" if bounded else
+              f"{th:.3g}, its interval not determined (the bootstrap's reaches beyond "
+              f"{criteria.range_words(x_lo, x_hi)})" if inside else
+              criteria.beyond_words(side, x_lo, x_hi, "an extrapolation, not an estimate")) +
              (f"; slope {fit.beta:.3g}" if beta_free else "; slope on a bound of its range: not determined") +
              ("" if beta_ci or not beta_free else "; the slope's interval reaches a bound: not determined")]
     if fit.on_bound:
         notes.append("on a bound of its range: " + ", ".join(f"{k} ({v[1]})" for k, v in fit.on_bound.items()))
     return Chart(name, png, svg, t, notes), ((th, th_lo, th_hi, fit.beta) if bounded else
                                              (th, math.nan, math.nan, fit.beta) if inside else
-                                             (math.nan, x.min(), x.max(), fit.beta))
+                                             (math.nan, x_lo, x_hi, fit.beta))
 
 
 def side_bias_table(m, study, group_note):
@@ -300,7 +308,7 @@ def analyse(df, study, codebook, out_dir, n_boot=200, seed=1, group="", part="")
         raise Skip(f"{study}: no trials outside practice")
     # Blocks of one task but of two kinds - an adaptive procedure beside fixed levels - are two analyses too: the
     # fixed block's answers used to be dropped unsaid (a procedure's measure is `correct`, which they lack).
-    adaptive = d["procedure_cell"].astype(str).str.strip().replace("nan", "").ne("") if "procedure_cell" in d \
+    adaptive = text(d["procedure_cell"]).ne("") if "procedure_cell" in d \
         else pd.Series(False, index=d.index)
     keys = d["task"].astype(str).where(~adaptive, d["task"].astype(str) + " adaptive")
     if adaptive.any() and not adaptive.all():
@@ -360,7 +368,7 @@ def _text_values(m, column):
     """The distinct non-empty values of a column, as text ([] without the column)."""
     if column not in m:
         return []
-    return sorted({str(v) for v in m[column] if str(v).strip() not in ("", "nan")})
+    return sorted({v for v in text(m[column]) if v})
 
 
 def group_section(m, kind, what, design, codebook, study, out_dir, slug, note):
@@ -436,6 +444,14 @@ def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, 
     if kind in ("procedure", "odd"):
         c, words = psychometric_cells(m, kind, guess, what, design, study, out_dir, slug, note, n_boot, seed)
         charts += c
+        if kind == "procedure":
+            # The procedure's own result first (each participant's track), then the pooled fit at the same criterion.
+            m["level"] = _num(m["level"])
+            track_charts = tracks.charts(m, study, out_dir, slug, note)
+            summary = [t.table for t in track_charts if t.name == f"{slug}-thresholds"]
+            if summary:
+                finding += "; tracks: " + tracks.summary_words(summary[0])
+            words = "psychometric fit of the answers pooled: " + words if words else ""
         finding += "; " + words if words else ""
     else:
         # Why there is none, in the words of what was asked (a pair's preference, a yes/no question, ...).
@@ -446,8 +462,7 @@ def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, 
              "the tables")
         charts.append(Chart(f"{slug}-psychometric", None, None, None, ["no psychometric function: " + asked]))
     if kind == "procedure":
-        m["level"] = _num(m["level"])
-        charts += tracks.charts(m, study, out_dir, slug, note)
+        charts += track_charts
     else:
         charts.append(models(m, factors, slug, note, what))
     if "chosen_side" in m and m["chosen_side"].isin(["left", "right"]).any():
@@ -472,15 +487,22 @@ def psychometric_cells(m, kind, guess, what, design, study, out_dir, slug, note,
     for cell in _sorted_levels(names) if all(names) else names:
         rows = m[cells == cell]
         name = f"{slug}-psychometric" + (f"-{_safe(cell)}" if len(names) > 1 else "")
+        # A procedure cell's threshold is read at its procedure's own criterion over what it could show, so the
+        # fit and the tracks give one quantity (criteria.py).
+        params = tracks.parameters(rows) if kind == "procedure" else None
+        crit = criteria.criterion((params or {}).get("procedure", ""), params, guess)
         try:
-            chart, (th, th_lo, th_hi, _) = psychometric_chart(rows, xcol, xlabel, guess, study, out_dir, name, note,
-                                                             n_boot, seed, what, cell=cell)
+            dx = rows[xcol].dropna().to_numpy(float)
+            chart, (th, th_lo, th_hi, _) = psychometric_chart(
+                rows, xcol, xlabel, guess, study, out_dir, name, note, n_boot, seed, what, cell=cell, crit=crit,
+                tested=criteria.tested_range(params, dx) if len(dx) else None)
             charts.append(chart)
-            where = f"{cell}: " if cell else ""
-            words.append(f"{where}threshold {th:.3g} [{th_lo:.3g}, {th_hi:.3g}]" if not math.isnan(th_lo) and
-                         not math.isnan(th) else
-                         f"{where}threshold {th:.3g} (its interval not determined)" if not math.isnan(th) else
-                         f"{where}threshold beyond the tested range {th_lo:.3g} to {th_hi:.3g}")
+            where = f"{tracks.cell_label(rows) if kind == 'procedure' else cell}: " if cell else ""
+            words.append(f"{where}threshold at {crit.short()} {th:.3g} [{th_lo:.3g}, {th_hi:.3g}]"
+                         if not math.isnan(th_lo) and not math.isnan(th) else
+                         f"{where}threshold at {crit.short()} {th:.3g} (its interval not determined)"
+                         if not math.isnan(th) else
+                         f"{where}threshold at {crit.short()} " + criteria.beyond_words("beyond", th_lo, th_hi))
         except Skip as e:
             charts.append(Chart(name, None, None, None, [str(e)]))
         except ValueError as e:

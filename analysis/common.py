@@ -65,6 +65,12 @@ def _flag(value):
     return np.nan
 
 
+def text(series):
+    """A column's cells as text, stripped: a value the analysis made missing (NaN, None) is "", a level written
+    "NA", "nan", "None" or "null" stays what it says (read_text_csv keeps them; no NaN stands for a level)."""
+    return series.map(lambda v: "" if v is None or (isinstance(v, float) and math.isnan(v)) else str(v).strip())
+
+
 def read_text_csv(path):
     """A CSV with every cell as text (an empty cell stays empty, never NaN or 0); ValueError with a one-line reason
     when the file cannot be read as CSV."""
@@ -107,9 +113,7 @@ def load_trials(path):
     # The answer, whatever its kind (each has its own column in the export).
     choice = df["status"].map({"timed_out": "none"}).fillna("")
     for column in ("chosen_side", "chosen_interval", "yes_no", "rating", "adjusted_level"):
-        text = df[column].astype(str).str.strip() if df[column].dtype == object else df[column].astype(str)
-        text = text.replace("nan", "")
-        choice = choice.where(choice != "", text)
+        choice = choice.where(choice != "", text(df[column]))
     df["choice"] = choice
     df["answered"] = df["status"].isin(["answered", "timed_out"])
     if "pattern" in df.columns:
@@ -201,13 +205,25 @@ def session_numbers(df):
     return df["session_id"].map(rank).astype(int)
 
 
+def session_words(df):
+    """Each row's session said as what it is, for a label beside a participant: "aborted session", "unfinished
+    session", "first session" or "repeated session N" (session_numbers: a session after an aborted one is still a
+    first session), with the record's session id ("first session, id 2": what blurcue sessions lists)."""
+    numbers = session_numbers(df)
+    status = df["session_status"].astype(str) if "session_status" in df.columns else pd.Series("", index=df.index)
+    kind = np.where(status == "aborted", "aborted session", np.where(
+        status == "running", "unfinished session", np.where(numbers > 1, "repeated session " + numbers.astype(str),
+                                                            "first session")))
+    return pd.Series(kind, index=df.index) + ", id " + df["session_id"].astype(str)
+
+
 def protocol_versions(df):
     """Each row's protocol version as text ("" in an export from before versions were recorded). A version that a
     merge brought with two texts (two stations ran one version number with different protocols; run refuses that in
     one record, merge warns) is two versions here, each named by its text's hash: "1 (text 5c3e4c56)"."""
     if "protocol_version" not in df.columns:
         return pd.Series("", index=df.index)
-    versions = df["protocol_version"].astype(str).str.strip().replace("nan", "")
+    versions = text(df["protocol_version"])
     if "protocol_hash" in df.columns and len(df):
         hashes = df["protocol_hash"].astype(str).str.strip()
         key = (df["study"].astype(str) + "\x00" if "study" in df.columns else "") + versions

@@ -9,7 +9,8 @@ with its limit said: the real blur is V-shaped around the focus, so one power la
 Model table (stats.MODEL_COLUMNS), where the record allows:
   set on real       set_arcmin ~ real_arcmin: lmer with a random intercept and slope by participant (Satterthwaite
                     df; intercept-only when that is singular), and pooled OLS with SEs clustered by participant (CR1,
-                    t(G-1)); needs r_scene_arcmin and picture_width_arcmin
+                    t(G-1)); needs r_scene_arcmin and picture_width_arcmin. The slope is tested against 1 (set as
+                    real: t = (b - 1) / SE on the fit's df) and, on a row beside it, against 0
   power law         log c ~ log d: per observer (OLS), pooled OLS clustered as above, and lmer as above
 """
 import math
@@ -112,7 +113,22 @@ def _meaningful(term, words, p, note):
         return math.nan, (note + "; " if note else "") + NO_P_POWER_A
     return p, note
 WORDS_MATCH = {"Intercept": "set blur at real blur 0 (arcmin)",
-               "real_arcmin": "per arcmin of real blur (1 = set as real)"}
+               "real_arcmin": "per arcmin of real blur, against 1 (set as real)"}
+# The match's slope is tested against 1 - "set as real", the hypothesis the task is about - and, on a row of its own
+# beside it, against 0 (any relation at all): the same estimate, SE and df, two tests, each labelled.
+MATCH_SLOPE_AGAINST_0 = "per arcmin of real blur, against 0 (any relation)"
+
+
+def _rows_of(study, model, words, term, est, se, df, p, engine, note):
+    """The model rows of one term: the match's slope twice (its p against 1 from the fit's own SE and df - t = (b -
+    1) / SE on df - then the fit's p against 0), any other term once."""
+    if words is not WORDS_MATCH or term != "real_arcmin":
+        p, note = _meaningful(term, words, p, note)
+        return [stats.model_row(study, model, words[term], est, se, df, p, engine, note)]
+    ok = math.isfinite(p) and se > 0 and df > 0
+    p1 = float(2 * sps.t.sf(abs(est - 1) / se, df)) if ok else math.nan
+    return [stats.model_row(study, model, words[term], est, se, df, p1, engine, note),
+            stats.model_row(study, model, MATCH_SLOPE_AGAINST_0, est, se, df, p, engine, note)]
 
 
 def _ols_rows(g, x, y, model, words, study):
@@ -123,8 +139,8 @@ def _ols_rows(g, x, y, model, words, study):
     df = len(g) - 2
     out = []
     for term, est, se in (("Intercept", res.intercept, res.intercept_stderr), (x, res.slope, res.stderr)):
-        p, note = _meaningful(term, words, 2 * sps.t.sf(abs(est / se), df) if se > 0 else math.nan, "")
-        out.append(stats.model_row(study, model, words[term], est, se, df, p, "scipy linregress (OLS)", note))
+        out += _rows_of(study, model, words, term, est, se, df, 2 * sps.t.sf(abs(est / se), df) if se > 0
+                        else math.nan, "scipy linregress (OLS)", "")
     return out
 
 
@@ -151,9 +167,8 @@ def _across(a, x, y, label, words, notes, study):
             engine = f"statsmodels {version} OLS (one observer)"
             model = f"lm({y} ~ {x}) (one observer)"
     for _, r in t.iterrows():
-        p, note = _meaningful(r["term"], words, r["p"], "")
-        rows.append(stats.model_row(study, f"{label}: {model}", words[r["term"]], r["estimate"], r["se"], r["df"],
-                                    p, engine, note))
+        rows += _rows_of(study, f"{label}: {model}", words, r["term"], r["estimate"], r["se"], r["df"], r["p"],
+                         engine, "")
     pooled = (float(t["estimate"].iloc[0]), float(t["estimate"].iloc[1]))
     if n_groups >= 3:
         try:
@@ -168,10 +183,11 @@ def _across(a, x, y, label, words, notes, study):
             return rows, pooled
         status = f.structure + ("; singular fit" if f.singular else "")
         for _, r in stats.without_unheld_tests(f, [x]).iterrows():
-            p, note = _meaningful(r["term"], words, r["p"], status + r["why"])
-            rows.append(stats.model_row(study, model, words[r["term"]], r["estimate"], r["se"], r["df"], p,
-                                        f.engine, note))
-        rows += stats.variance_rows(study, model, f, words, "arcmin" if y == "set_arcmin" else "log cut-off")
+            rows += _rows_of(study, model, words, r["term"], r["estimate"], r["se"], r["df"], r["p"], f.engine,
+                             status + r["why"])
+        # The SD of the participants' slopes is a spread, tested against nothing: named without a test's words.
+        sd_words = {**words, x: "per arcmin of real blur"} if words is WORDS_MATCH else words
+        rows += stats.variance_rows(study, model, f, sd_words, "arcmin" if y == "set_arcmin" else "log cut-off")
     elif n_groups == 2:
         notes.append(f"{label}: two participants, too few for a mixed model")
     return rows, pooled

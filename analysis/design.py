@@ -15,6 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from common import read_text_csv, text
+
 DESIGN_MEANING = "a level of the protocol's design"
 # A codebook row of trials.csv: what it means, its roles (a set; empty for a column of no design role), its allowed
 # values as the codebook writes them.
@@ -29,7 +31,7 @@ def load_codebook(trials_path):
     path = os.path.join(os.path.dirname(os.path.abspath(trials_path)), "codebook.csv")
     if not os.path.isfile(path):
         return {}
-    book = pd.read_csv(path, dtype=str, keep_default_na=False)
+    book = read_text_csv(path)
     book = book[book["table"] == "trials.csv"]
     roles = book["role"] if "role" in book else pd.Series([""] * len(book), index=book.index)
     allowed = book["allowed"] if "allowed" in book else pd.Series([""] * len(book), index=book.index)
@@ -44,7 +46,7 @@ def load_codebook(trials_path):
 
 
 def _text(series):
-    return series.astype(str).str.strip().replace("nan", "")
+    return text(series)
 
 
 def varies(d, column):

@@ -8,9 +8,11 @@ Figures (thesis chapter 5):
   side bias                   share of decisive answers choosing the LEFT side per study, pooled and per participant
                               (the counterbalancing check: a side preference cancels out of the source comparisons)
 
-Every bar is a share of the answered trials with its Wilson 95 % interval. The binomial test asks whether, among the
-answers that picked a side (not can't tell), the first source of the pair was chosen more or less often than half
-the time; p-values are exact, two-sided, and Holm-adjusted over the cells of one chart.
+Every bar is a share of the answered trials with its Wilson 95 % interval. The test asks whether, among the answers
+that picked a side (not can't tell), the first source of the pair was chosen more or less often than half the time,
+with participants as the unit (study_tests.against_chance: t across the participants' shares, a sign test beside
+it; an exact binomial only where there is one participant); p-values are two-sided and Holm-adjusted over the cells
+of one chart.
 """
 import math
 
@@ -20,6 +22,7 @@ import pandas as pd
 import matplotlib.pyplot as plt
 
 import stats
+import study_tests
 from common import (Chart, Skip, SOURCE_COLORS, SOURCE_LABELS, STUDY_TEST1, STUDY_TEST2, STUDY_TEST3, STUDY_TITLES,
                     FORCED_CHOICE_STUDIES, error_bars, forced_choice, p_text, participants_note, save, stars,
                     study_rows, wilson_columns)
@@ -53,24 +56,34 @@ def _notes(d):
 
 def count_table(d, key):
     """Per value of `key`: planned, answered, answers for the pair's first and second source and can't tell, their
-    shares of the answered trials with Wilson 95 % intervals, and the binomial test of first vs second."""
+    shares of the answered trials with Wilson 95 % intervals (descriptive: answers pooled), and the test of first vs
+    second with participants as the unit (study_tests.against_chance on each participant's share of the first source
+    among their decisive answers: t across participants with a sign test beside it; the exact binomial of the answers
+    only where the chart has one participant), Holm-adjusted over the chart's cells."""
     rows = []
+    people = d["participant"].nunique()
     for value, g in d.groupby(key, sort=True):
         a = g[g["answered"]]
         first = g["first"].dropna().iloc[0] if g["first"].notna().any() else ""
         second = g["second"].dropna().iloc[0] if g["second"].notna().any() else ""
         n_first = int((a["chosen_source"] == first).sum())
         n_second = int((a["chosen_source"] == second).sum())
-        rows.append({key: value, "first": first, "second": second, "planned": len(g), "answered": len(a),
-                     "n_first": n_first, "n_second": n_second, "n_cant_tell": int((a["chosen_source"] == "cant_tell").sum()),
-                     "observers": g["participant"].nunique()})
+        row = {key: value, "first": first, "second": second, "planned": len(g), "answered": len(a),
+               "n_first": n_first, "n_second": n_second, "n_cant_tell": int((a["chosen_source"] == "cant_tell").sum()),
+               "observers": g["participant"].nunique()}
+        dec = a[a["chosen_source"].isin([first, second])]
+        if dec.empty:
+            row.update(test="none: no decisive answer", p=math.nan)
+        else:
+            row.update(study_tests.against_chance(dec.assign(y=(dec["chosen_source"] == first).astype(float)), 0.5,
+                                                  people=people))
+        rows.append(row)
     t = pd.DataFrame(rows)
     for what in ("first", "second", "cant_tell"):
         wilson_columns(t, f"n_{what}", "answered", f"share_{what}")
     t["decisive"] = t["n_first"] + t["n_second"]
     t["share_first_of_decisive"] = [k / n if n else math.nan for k, n in zip(t["n_first"], t["decisive"])]
-    t["p_binom"] = [stats.binom_p(k, n) for k, n in zip(t["n_first"], t["decisive"])]
-    t["p_holm"] = stats.holm(t["p_binom"])
+    t["p_holm"] = stats.holm(t["p"])
     return t
 
 
@@ -106,9 +119,12 @@ def _bars(ax, t, key, xlabels):
 
 
 def _caption_note():
-    return ("bars: share of answered trials with Wilson 95 % intervals; * p < 0.05, ** p < 0.01, *** p < 0.001: "
-            "exact binomial test of the first vs the second source among decisive answers (not can't tell) against "
-            "0.5, Holm-adjusted over the chart's cells")
+    return ("bars: share of answered trials with Wilson 95 % intervals (answers pooled, descriptive); * p < 0.05, "
+            "** p < 0.01, *** p < 0.001: first vs second source with participants as the unit - each participant's "
+            "share of the first source among their decisive answers (not can't tell), a one-sample t test of those "
+            "shares against 0.5 (3 or more participants; an exact sign test beside it in the table), or with one "
+            "participant the exact binomial test of their answers (said in the column test); Holm-adjusted over the "
+            "chart's cells")
 
 
 def _model(d, formula_rhs, title, extra=None):

@@ -55,7 +55,8 @@ fit_one <- function(kind, d, xs, random) {
 
 # The maximal model, else the intercept-only one; its fixed effects, SDs and correlations through emit().
 fit_job <- function(kind, data_path, slopes, emit) {
-  d <- read.csv(data_path, stringsAsFactors = FALSE)
+  # A participant named "NA" is a participant: no text is read as missing (numbers' empty cells still are).
+  d <- read.csv(data_path, stringsAsFactors = FALSE, na.strings = character(0), colClasses = c(g = "character"))
   d$g <- factor(d$g)
   xs <- grep("^X[0-9]+$", names(d), value = TRUE)
   n_groups <- nlevels(d$g)

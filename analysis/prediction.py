@@ -24,7 +24,7 @@ import pandas as pd
 from scipy.stats import norm
 
 import stats
-from common import Chart, Skip, error_bars, participants_note, save
+from common import Chart, Skip, error_bars, participants_note, save, text
 
 Z75 = 0.6744897501960817  # Phi^-1(0.75)
 # The C++ model's defaults (session/observer.h ObserverParams, model=arcmin).
@@ -97,7 +97,7 @@ def predicted(d):
     rl, rr = _num(a["r_left_arcmin"]), _num(a["r_right_arcmin"])
     rs = _num(a["r_scene_arcmin"]) if "r_scene_arcmin" in a else pd.Series(np.nan, index=a.index)
     procedure = _num(a["level"]).notna() if "level" in a else pd.Series(False, index=a.index)
-    odd = a["chosen_interval"].astype(str).str.strip().replace("nan", "").ne("")
+    odd = text(a["chosen_interval"]).ne("")
     # Whether a study offers can't tell is in its protocol, not its table: taken as offered when anyone used it.
     offers = a.groupby("study")["chosen_side"].transform(lambda c: (c == "cant_tell").any())
     out = []
@@ -128,12 +128,13 @@ def predicted(d):
 
 
 def condition_table(m, factors):
+    import any_study
     keys = None if not factors else factors[0] if len(factors) == 1 else factors
     groups = m.groupby(keys, dropna=False) if keys else [((), m)]
     rows = []
     for key, g in groups:
         key = key if isinstance(key, tuple) else (key,)
-        row = {f: (str(v)[:-2] if str(v).endswith(".0") else str(v)) for f, v in zip(factors, key)}
+        row = {f: any_study._label(v) for f, v in zip(factors, key)}
         n, k = len(g), int(g["y"].sum())
         share, lo, hi = stats.wilson(k, n)
         pred = float(g["predicted"].mean())
@@ -144,8 +145,10 @@ def condition_table(m, factors):
 
 
 def charts(df, out_dir, codebook, pool_simulated=False):
-    """One chart and table per study and measure (people and simulated observers apart unless pooled)."""
+    """One chart and table per study and measure (people and simulated observers apart unless pooled), and per
+    between-subject group: each group saw other conditions, so its rows are never pooled with another's."""
     import any_study
+    from design import design_of
     d = df[df["practice"] != 1]
     m_all = predicted(d)
     if m_all.empty:
@@ -156,32 +159,44 @@ def charts(df, out_dir, codebook, pool_simulated=False):
         kinds = ["all"] if pool_simulated else sorted(set(m["observer"]))
         for who in kinds:
             part = m if who == "all" else m[m["observer"] == who]
-            factors = [f for f in any_study.design_factors(part, codebook)]
-            t = condition_table(part, factors)
             label = "all" if who == "all" else ("people" if who == "person" else "simulated observers")
             slug = re.sub(r"[^A-Za-z0-9_-]", "_", f"{study}-predicted-{kind.split(':')[0]}-{label.split()[0]}")
-            fig, ax = plt.subplots(figsize=(max(5.0, 0.6 * len(t) + 3), 3.8))
-            x = np.arange(len(t))
-            ax.bar(x, t["observed"], 0.6, color="#0072B2", edgecolor="white", label="observed (95 % Wilson)")
-            ax.errorbar(x, t["observed"], yerr=error_bars(t["observed"], t["observed_low"], t["observed_high"]),
-                        fmt="none", ecolor="#333333", lw=0.9)
-            ax.plot(x, t["predicted"], "D", color="#D55E00", ms=6, label="the observer model predicts")
-            for xi, dep in zip(x, t["departs"]):
-                if dep:
-                    ax.text(xi, 1.04, "!", ha="center", va="bottom", color="#D55E00", fontsize=11, fontweight="bold")
-            labels = [" ".join(str(r[f]) for f in factors) or "all" for _, r in t.iterrows()]
-            ax.set_xticks(x)
-            ax.set_xticklabels(labels, rotation=45 if len(labels) > 8 else 0, ha="right" if len(labels) > 8 else "center")
-            ax.set_xlabel(", ".join(factors) or "all trials")
-            ax.set_ylim(0, 1.12)
-            ax.set_ylabel(f"share: {kind.split(': ')[1]}")
-            ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0))
-            ax.set_title(f"{study}: observed vs predicted ({label}, {participants_note(part)})", loc="left")
-            png, svg = save(fig, out_dir, slug)
-            departs = int(t["departs"].sum())
-            notes = [f"{label}: {kind} per condition; bars observed with 95 % Wilson intervals, diamonds the "
-                     f"simulated observer's prediction for the same trials (model=arcmin, default parameters: "
-                     + ", ".join(f"{k} {v:g}" for k, v in DEFAULTS.items()) + "); ! where the interval excludes it",
-                     f"{departs} of {len(t)} conditions depart from the model"]
-            out.append(Chart(slug, png, svg, t, notes))
+            group = design_of(part, codebook).group
+            if not group:
+                out.append(_chart(part, any_study.design_factors(part, codebook), study, kind, label, slug,
+                                  out_dir))
+                continue
+            for level in any_study._sorted_levels(list(part[group].astype(str).unique())):
+                rows = part[part[group].astype(str) == level]
+                out.append(_chart(rows, any_study.design_factors(rows, codebook), study, kind,
+                                  f"{label}, group {level}", f"{slug}-group-{any_study._safe(level)}", out_dir))
     return out
+
+
+def _chart(part, factors, study, kind, label, slug, out_dir):
+    """The observed-vs-predicted chart and table of one set of rows (one study, measure, observer kind, group)."""
+    t = condition_table(part, factors)
+    fig, ax = plt.subplots(figsize=(max(5.0, 0.6 * len(t) + 3), 3.8))
+    x = np.arange(len(t))
+    ax.bar(x, t["observed"], 0.6, color="#0072B2", edgecolor="white", label="observed (95 % Wilson)")
+    ax.errorbar(x, t["observed"], yerr=error_bars(t["observed"], t["observed_low"], t["observed_high"]),
+                fmt="none", ecolor="#333333", lw=0.9)
+    ax.plot(x, t["predicted"], "D", color="#D55E00", ms=6, label="the observer model predicts")
+    for xi, dep in zip(x, t["departs"]):
+        if dep:
+            ax.text(xi, 1.04, "!", ha="center", va="bottom", color="#D55E00", fontsize=11, fontweight="bold")
+    labels = [" ".join(str(r[f]) for f in factors) or "all" for _, r in t.iterrows()]
+    ax.set_xticks(x)
+    ax.set_xticklabels(labels, rotation=45 if len(labels) > 8 else 0, ha="right" if len(labels) > 8 else "center")
+    ax.set_xlabel(", ".join(factors) or "all trials")
+    ax.set_ylim(0, 1.12)
+    ax.set_ylabel(f"share: {kind.split(': ')[1]}")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    ax.set_title(f"{study}: observed vs predicted ({label}, {participants_note(part)})", loc="left")
+    png, svg = save(fig, out_dir, slug)
+    departs = int(t["departs"].sum())
+    notes = [f"{label}: {kind} per condition; bars observed with 95 % Wilson intervals, diamonds the "
+             f"simulated observer's prediction for the same trials (model=arcmin, default parameters: "
+             + ", ".join(f"{k} {v:g}" for k, v in DEFAULTS.items()) + "); ! where the interval excludes it",
+             f"{departs} of {len(t)} conditions depart from the model"]
+    return Chart(slug, png, svg, t, notes)

@@ -139,7 +139,7 @@ def thesis_findings(trials, sections):
         t = dm.table
         # The match in arcmin where the record has it, and the thesis's power law (each: the lmer, else the OLS).
         found = []
-        for label, term, text in (("set on real", "per arcmin of real blur (1 = set as real)",
+        for label, term, text in (("set on real", depth_matching.WORDS_MATCH["real_arcmin"],
                                    "set blur against the real picture's blur (arcmin): slope"),
                                   ("power law", "b (per unit of log distance)", "accepted cut-off against "
                                    "distance: c ~ d^b with b")):
@@ -153,6 +153,12 @@ def thesis_findings(trials, sections):
                 half = stats.sps.t.ppf(0.975, r["df"]) * r["se"] if r["df"] > 0 else math.nan
                 interval = f" [{r['estimate'] - half:.2f}, {r['estimate'] + half:.2f}]" if math.isfinite(half) else ""
                 test = common.p_text(r["p"]) + "; " if math.isfinite(r["p"]) else ""
+                if label == "set on real" and test:
+                    # The match's slope: against 1 (set as real) first, against 0 beside it (the same fit's row).
+                    zero = t[(t["model"] == r["model"]) & (t["term"] == depth_matching.MATCH_SLOPE_AGAINST_0)]
+                    test = f"against 1 (set as real): {common.p_text(r['p'])}" + (
+                        f"; against 0: {common.p_text(zero['p'].iloc[0])}" if len(zero) and
+                        math.isfinite(zero["p"].iloc[0]) else "") + "; "
                 found.append(f"{text} = {r['estimate']:.2f}{interval} ({test}{r['model']})")
         if found:
             out[common.STUDY_DEPTH] = "; ".join(found)
@@ -189,7 +195,7 @@ def aborted_sessions(trials, included):
     out = []
     for study, d in aborted.groupby("study", sort=True):
         sessions = d.drop_duplicates("session_id")
-        who = ", ".join(f"{p} (session {s})" for p, s in zip(sessions["participant"], sessions["session_id"]))
+        who = ", ".join(f"{p} (session id {s})" for p, s in zip(sessions["participant"], sessions["session_id"]))
         n, answers = len(sessions), int((d["answered"] & (d["practice"] != 1)).sum())
         what = f"{n} aborted session{'s' if n != 1 else ''} ({who}) with {answers} answer{'s' if answers != 1 else ''}"
         if included:
@@ -206,7 +212,7 @@ def unfinished_sessions(trials, included):
     out = []
     for study, d in common.unfinished_rows(trials).groupby("study", sort=True):
         sessions = d.drop_duplicates("session_id")
-        who = ", ".join(f"{p} (session {s})" for p, s in zip(sessions["participant"], sessions["session_id"]))
+        who = ", ".join(f"{p} (session id {s})" for p, s in zip(sessions["participant"], sessions["session_id"]))
         n, answers = len(sessions), int((d["answered"] & (d["practice"] != 1)).sum())
         what = (f"{n} unfinished session{'s' if n != 1 else ''} ({who}) with {answers} "
                 f"answer{'s' if answers != 1 else ''}")

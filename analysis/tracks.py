@@ -31,7 +31,8 @@ import numpy as np
 import pandas as pd
 from scipy import stats as sps
 
-from common import Chart, save
+import criteria
+from common import Chart, save, session_words
 
 CREDIBLE = 0.95
 # A staircase's threshold: the mean of this many last turning points (an even number: as many peaks as troughs).
@@ -152,10 +153,10 @@ def staircase_threshold(p, levels, correct):
                           f"track's trial {first + 1}, the record shows {_text(levels[first])} (answers missing from "
                           "these rows, such as missed deadlines?)")
             return out | {"turning_points": len(turns)}
-        lo, hi = float(p["min"]), float(p["max"])
+        lo, hi = criteria.tested_range(p, levels)
     else:
         turns = turns_from_levels(levels)
-        lo, hi = float(np.min(levels)), float(np.max(levels))
+        lo, hi = criteria.tested_range(None, levels)
         out["method"] += " (procedures.csv missing: turning points from the levels, bounds unknown)"
     out["turning_points"] = len(turns)
     out["range"] = (lo, hi)
@@ -175,8 +176,8 @@ def staircase_threshold(p, levels, correct):
     at_bound = np.isclose(used, lo) | np.isclose(used, hi)
     if p is not None and at_bound.sum() * 2 >= len(used):
         side = "above" if np.isclose(used, hi).sum() >= np.isclose(used, lo).sum() else "below"
-        out["why"] = (f"not determined: {side} the tested range {_text(lo)} to {_text(hi)} (the track turned at its "
-                      f"bound {int(at_bound.sum())} of {len(used)} times)")
+        out["why"] = criteria.beyond_words(side, lo, hi, f"the track turned at its bound {int(at_bound.sum())} of "
+                                                         f"{len(used)} times")
         return out
     estimate = float(used.mean())
     mids = (used[0::2] + used[1::2]) / 2
@@ -194,7 +195,7 @@ def staircase_threshold(p, levels, correct):
         high, bound = hi, bound + ["upper"]
     if len(bound) == 2:
         # An interval as wide as every level the staircase can show says nothing about where the threshold is.
-        return out | {"why": f"not determined: its interval spans the whole tested range {_text(lo)} to {_text(hi)}",
+        return out | {"why": f"not determined: its interval spans the whole of {criteria.range_words(lo, hi)}",
                       "used": len(used)}
     out.update(estimate=estimate, low=low, high=high, interval_at_bound=" and ".join(bound),
                used=len(used))
@@ -320,7 +321,7 @@ def quest_threshold(p, stimuli, correct, recorded=None):
         out["note"] = (f"{missed} missed answer{'s' if missed > 1 else ''} (not in these rows) put back where QUEST+ "
                        "chose its stimulus, counted wrong as the procedure counted them")
     stim = np.asarray(p["stimuli"], float)
-    lo, hi = max(grid.min(), stim.min()), min(grid.max(), stim.max())
+    lo, hi = criteria.tested_range(p, stim)
     out["range"] = (lo, hi)
     if recorded is not None and math.isfinite(recorded) and abs(recorded - mean) > 1e-6 * max(1.0, abs(mean)):
         out["why"] = (f"not determined: the answers in these rows give a posterior mean of {_text(mean)}, the "
@@ -331,12 +332,12 @@ def quest_threshold(p, stimuli, correct, recorded=None):
         out["note"] = (out.get("note", "") + "; " if out.get("note") else "") + (f"the slope's posterior peaks at its grid's {'lowest' if slope_marginal.argmax() == 0 else 'highest'} "
                        f"value {_text(slopes[slope_marginal.argmax()])}: the grid may not hold the observer's slope")
     if marginal[0] >= 0.5 or estimate < lo:
-        out["why"] = (f"not determined: below the tested range {_text(lo)} to {_text(hi)} (posterior mass "
-                      f"{marginal[0]:.2f} on the grid's lowest threshold)")
+        out["why"] = criteria.beyond_words("below", lo, hi, f"posterior mass {marginal[0]:.2f} on the grid's lowest "
+                                                            "threshold")
         return out
     if marginal[-1] >= 0.5 or estimate > hi:
-        out["why"] = (f"not determined: above the tested range {_text(lo)} to {_text(hi)} (posterior mass "
-                      f"{marginal[-1]:.2f} on the grid's highest threshold)")
+        out["why"] = criteria.beyond_words("above", lo, hi, f"posterior mass {marginal[-1]:.2f} on the grid's "
+                                                            "highest threshold")
         return out
     low, high = credible(grid, marginal)
     tail = (1 - CREDIBLE) / 2
@@ -362,6 +363,7 @@ def track_rows(m):
     keys = [k for k in ("participant", "session_id", "block_name", "procedure_cell") if k in d]
     several_blocks = "block_name" in d and d["block_name"].nunique() > 1
     sessions = d.groupby("participant")["session_id"].nunique() if "session_id" in d else None
+    said = session_words(d) if "session_id" in d else None
     out = []
     for key, g in d.sort_values("trial_index").groupby(keys, sort=True):
         if "status" in g:
@@ -384,8 +386,11 @@ def track_rows(m):
             label = f"{key['block_name']}: {label}"
         participant = str(key["participant"])
         if sessions is not None and sessions.get(key["participant"], 1) > 1:
-            participant += f" (session {key['session_id']})"
+            # Said as what it is: the record's id alone ("session 2") read as a second session after an abort.
+            participant += f" ({said[g.index[0]]})"
+        crit = criteria.criterion(kind, p, float((p or {}).get("guess", 0.5)))
         out.append({"participant": participant, "cell": label, "kind": kind, "levels": levels, "correct": correct,
+                    "criterion": crit.short(),
                     "posterior": _num(g["posterior_threshold"]).to_numpy() if kind == "quest_plus" and
                     "posterior_threshold" in g else None, "result": result})
     return out
@@ -399,6 +404,7 @@ def _track_table(tracks):
         rows.append({
             "participant": t["participant"], "cell": t["cell"],
             "procedure": "QUEST+" if t["kind"] == "quest_plus" else "staircase", "trials": len(t["levels"]),
+            "criterion": t.get("criterion", ""),
             "share_correct": float(t["correct"].mean()),
             "threshold": r["estimate"] if determined else None,
             "threshold_low": r.get("low") if determined else None,
@@ -418,7 +424,8 @@ def summary_table(tracks):
     for cell in dict.fromkeys(t["cell"] for t in tracks):
         these = [t for t in tracks if t["cell"] == cell]
         v = np.array([t["result"]["estimate"] for t in these if "estimate" in t["result"]], float)
-        row = {"cell": cell, "tracks": len(these), "determined": len(v), "not_determined": len(these) - len(v)}
+        row = {"cell": cell, "criterion": "; ".join(dict.fromkeys(t.get("criterion", "") for t in these)),
+               "tracks": len(these), "determined": len(v), "not_determined": len(these) - len(v)}
         # A track beyond the tested range has a threshold known only to lie past it: the mean or median of the
         # others would move the cell's threshold toward the range (censored values left out). Said in words.
         censored = [t for t in these if "estimate" not in t["result"] and "the tested range" in
@@ -431,14 +438,47 @@ def summary_table(tracks):
             continue
         if len(v):
             row.update(mean=float(v.mean()), median=float(np.median(v)))
-        if len(v) >= 2:
-            half = sps.t.ppf(0.975, len(v) - 1) * v.std(ddof=1) / math.sqrt(len(v))
-            row.update(mean_low=float(v.mean() - half), mean_high=float(v.mean() + half),
-                       sd_across_participants=float(v.std(ddof=1)))
         row["interval"] = "t 95 % across participants" if len(v) >= 2 else \
             ("not determined: fewer than 2 determined thresholds" if len(these) else "")
+        if len(v) >= 2:
+            half = sps.t.ppf(0.975, len(v) - 1) * v.std(ddof=1) / math.sqrt(len(v))
+            row["sd_across_participants"] = float(v.std(ddof=1))
+            ranges = [t["result"]["range"] for t in these if "range" in t["result"]]
+            lo, hi = (min(r[0] for r in ranges), max(r[1] for r in ranges)) if ranges else (-math.inf, math.inf)
+            if v.mean() - half < lo or v.mean() + half > hi:
+                # A t interval past what the procedure could show (a negative threshold, say) is no interval.
+                row["interval"] = (f"not determined: the t 95 % interval across participants reaches beyond "
+                                   f"{criteria.range_words(lo, hi)}")
+            else:
+                row.update(mean_low=float(v.mean() - half), mean_high=float(v.mean() + half))
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+def summary_words(summary):
+    """The thresholds per cell for the report's summary, in the words of the thresholds table (criterion, tested
+    range, not determined): one clause per cell."""
+    out = []
+    for _, r in summary.iterrows():
+        text = f"{r['cell']}: threshold at {r['criterion']}"
+        if str(r.get("interval", "")).startswith("not determined") and pd.isna(r.get("mean")):
+            text += f" {r['interval']}"
+        elif int(r["determined"]) == 1:
+            text += f" {r['mean']:.3g} (one participant's threshold)"
+        elif str(r.get("interval", "")).startswith("not determined"):
+            text += (f" {r['mean']:.3g} (mean of {int(r['determined'])} participants' thresholds; its interval "
+                     f"{r['interval']})")
+        elif pd.notna(r.get("mean_low")):
+            text += (f" {r['mean']:.3g} [{r['mean_low']:.3g}, {r['mean_high']:.3g}] (mean of {int(r['determined'])} "
+                     "participants' thresholds, t 95 %)")
+        elif pd.notna(r.get("mean")):
+            text += f" {r['mean']:.3g} (one participant's threshold)"
+        else:
+            text += " not determined"
+        if int(r["not_determined"]) and not str(r.get("interval", "")).startswith("not determined"):
+            text += f"; {int(r['not_determined'])} of {int(r['tracks'])} tracks not determined"
+        out.append(text)
+    return "; ".join(out)
 
 
 def comparisons_table(tracks):

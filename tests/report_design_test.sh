@@ -22,8 +22,9 @@ quest_per_depth)
   # chance (QUEST+ sets the share correct). The truth: the observer's own threshold per depth, from its formula
   # (session/observer.h, model=arcmin defaults): a blur of std s = r / 2 arcmin is seen as E = sqrt(s^2 + 0.6^2);
   # P(correct) = lapse / 2 + (1 - lapse) Phi(ln(E_test / E_ref) / sd), sd = ln(1.35) / Phi^-1(0.75), lapse 0.04 - so
-  # the extra blur needed for 75 % grows with the depth's own blur (Weber): the fits must rank the near and the far
-  # depth the same way.
+  # the extra blur needed for QUEST+'s criterion (its Weibull's scale: 0.5 + 0.5 (1 - 1/e) = 81.6 % correct) grows
+  # with the depth's own blur (Weber): the fits must rank the near and the far depth the same way, and the summary
+  # must state that criterion for the tracks and the pooled fit alike (criteria.py).
   protocol quest-per-depth
   for id in Q1 Q2 Q3; do
     $BC run "$W/quest-per-depth.json" --participant $id --db "$W/q.sqlite" --observer sim:blurrier=0 > /dev/null 2>&1 \
@@ -39,14 +40,14 @@ index = open(os.path.join(out, "index.html"), encoding="utf-8").read()
 assert not os.path.exists(os.path.join(out, "quest-per-depth-simulated-psychometric.png")), "a fit pooled over depths"
 z = NormalDist().inv_cdf
 sd, lapse = math.log(1.35) / z(0.75), 0.04
-d = sd * z((0.75 - lapse / 2) / (1 - lapse))
+d = sd * z((0.5 + 0.5 * (1 - math.exp(-1)) - lapse / 2) / (1 - lapse))
 fitted, truth = {}, {}
 for edge in ("3", "6", "9"):
     name = f"quest-per-depth-simulated-psychometric-edge_{edge}"
     assert f"<img src='{name}.png'" in index, name
     fit = next(csv.DictReader(open(os.path.join(out, name + ".csv"))))
     mine = [r for r in rows if r["cell"] == f"edge={edge}"]
-    assert fit["cell"] == f"edge={edge}" and int(fit["answers"]) == len(mine) == 72, (fit["cell"], fit["answers"])
+    assert fit["cell"] == f"edge={edge}" and int(fit["answers"]) == len(mine) == 96, (fit["cell"], fit["answers"])
     assert fit["threshold"], f"edge {edge}: no threshold"
     fitted[edge] = float(fit["threshold"])
     ref = {float(r["r_right_arcmin"] if r["test_side"] == "left" else r["r_left_arcmin"]) for r in mine}
@@ -60,7 +61,9 @@ assert {r["edge"] for r in table} == {"3", "6", "9"} and not {"p", "p_holm", "ch
 summary = index.split("<h3>Contents</h3>")[0]
 line = summary[summary.index("quest-per-depth (simulated observers)"):]
 line = line[:line.index("</tr>")]
-assert "chance" not in line and "edge=3: threshold" in line and "edge=9: threshold" in line, line
+assert "chance" not in line and "tracks: edge 3: threshold at 81.6 % correct" in line, line
+assert "psychometric fit of the answers pooled: edge 3: threshold at 81.6 % correct" in line, line
+assert "edge 9: threshold at 81.6 % correct" in line and "75 %" not in line, line
 print("thresholds per depth " + ", ".join(f"edge {e}: {fitted[e]:.2f} (observer {truth[e]:.2f})" for e in fitted))
 PYEOF
   $PY "$(dirname "$0")/report_numbers_check.py" "$W/report" > "$W/numbers" || fail "$(cat "$W/numbers")"
@@ -118,7 +121,7 @@ sessions)
   $BC run "$P/2ifc-grids.json" --participant P4 --db "$W/s.sqlite" --observer sim --stop-after 3 > /dev/null 2>&1 || fail "P4"
   report "$W/s.sqlite" "$W/report" > /dev/null 2> "$W/err" || fail "report: $(tail -3 "$W/err")"
   report "$W/s.sqlite" "$W/report-all" --include-unfinished > /dev/null 2> "$W/err-all" || fail "report: $(tail -3 "$W/err-all")"
-  grep -q "^report: left out 1 unfinished session (P4 (session 5)) with 3 answers" "$W/err" || fail "stderr: $(cat "$W/err")"
+  grep -q "^report: left out 1 unfinished session (P4 (session id 5)) with 3 answers" "$W/err" || fail "stderr: $(cat "$W/err")"
   $PY - "$W/report" "$W/report-all" <<'PYEOF' > "$W/found" || fail "sessions: $(cat "$W/found")"
 import csv, os, sys
 out, out_all = sys.argv[1], sys.argv[2]
@@ -132,7 +135,7 @@ def analysed(folder, name):
     table = list(csv.DictReader(open(os.path.join(folder, name))))
     return sum(int(r["n"]) for r in table), max(int(r["participants"]) for r in table)
 index = open(os.path.join(out, "index.html"), encoding="utf-8").read()
-assert "left out 1 unfinished session (P4 (session 5)) with 3 answers" in index
+assert "left out 1 unfinished session (P4 (session id 5)) with 3 answers" in index
 first = decisive(lambda r: r["session_number"] == "1" and r["session_status"] == "completed")
 assert analysed(out, "2ifc-grids-simulated-conditions.csv") == (first, 3), (analysed(out, "2ifc-grids-simulated-conditions.csv"), first)
 again = decisive(lambda r: r["session_number"] == "2")
@@ -140,7 +143,7 @@ assert analysed(out, "2ifc-grids-session2-simulated-conditions.csv") == (again, 
 assert "study 2ifc-grids (session 2, simulated observers)" in index and "1 repeated session (P1 (session number 2): after one the participant completed)" in index
 # --include-unfinished: P4's answers in, said to be partial data.
 index_all = open(os.path.join(out_all, "index.html"), encoding="utf-8").read()
-assert "included 1 unfinished session (P4 (session 5)) with 3 answers as partial data" in index_all
+assert "included 1 unfinished session (P4 (session id 5)) with 3 answers as partial data" in index_all
 with_p4 = decisive(lambda r: r["session_number"] == "1")
 assert analysed(out_all, "2ifc-grids-simulated-conditions.csv") == (with_p4, 4), with_p4
 assert "incl. 1 unfinished session (partial data)" in index_all

@@ -165,20 +165,20 @@ PYEOF
     || fail "report: $(tail -3 "$W/err")"
   read -r answers kept all <<< "$(counts "$W/report/tables/trials.csv")"
   [ "$answers" -gt 0 ] && [ "$all" -gt "$kept" ] || fail "the aborted session has no decisive answers: $answers $kept $all"
-  grep -q "left out 1 aborted session (P1 (session 1)) with $answers answers: closed with blurcue sessions --abort" \
+  grep -q "left out 1 aborted session (P1 (session id 1)) with $answers answers: closed with blurcue sessions --abort" \
     "$W/report/index.html" || fail "the summary does not say what it left out: $(grep -o 'aborted[^<]*' "$W/report/index.html")"
   grep -q "report: left out 1 aborted session" "$W/err" || fail "stderr: $(cat "$W/err")"
   grep -q "of $kept decisive answers" "$W/report/index.html" || fail "not $kept decisive answers: $(grep -o 'of [0-9]* decisive answers' "$W/report/index.html")"
   MPLCONFIGDIR=$W/mpl $BC report --db "$W/s.sqlite" --out "$W/report-all" --bench "$W/no-bench" --boot 20 --include-aborted \
     > /dev/null 2> "$W/err" || fail "report --include-aborted: $(tail -3 "$W/err")"
-  grep -q "included 1 aborted session (P1 (session 1)) with $answers answers" "$W/report-all/index.html" || fail "--include-aborted not said"
+  grep -q "included 1 aborted session (P1 (session id 1)) with $answers answers" "$W/report-all/index.html" || fail "--include-aborted not said"
   grep -q "of $all decisive answers" "$W/report-all/index.html" || fail "--include-aborted: not $all decisive answers"
   # Only an aborted session.
   $BC run "$P/test1-static-grids.json" --participant P9 --db "$W/o.sqlite" --observer sim --stop-after 8 > /dev/null 2>&1
   $BC sessions --db "$W/o.sqlite" --abort 1 > /dev/null
   MPLCONFIGDIR=$W/mpl $BC report --db "$W/o.sqlite" --out "$W/report-only" --bench "$W/no-bench" --boot 20 > /dev/null 2> "$W/err" \
     || fail "report of an aborted session only: $(tail -3 "$W/err")"
-  grep -q "left out 1 aborted session (P9 (session 1))" "$W/report-only/index.html" || fail "the report does not say aborted"
+  grep -q "left out 1 aborted session (P9 (session id 1))" "$W/report-only/index.html" || fail "the report does not say aborted"
   grep -q "decisive answers" "$W/report-only/index.html" && fail "an aborted session only was analysed"
   echo "ok: an aborted session's $answers answers left out and said ($kept decisive answers, $all with --include-aborted)" ;;
 report_any_study)
@@ -213,14 +213,18 @@ for png in ("quest-blur-difference-simulated-psychometric.png", "quest-blur-diff
     assert os.path.isfile(os.path.join(out, png)), png
     assert f"<img src='{png}'" in index, png
 # The truth: the observer picks the more blurred side with P = Phi(d / jnd) (1 - lapse) + lapse / 2, d the radius
-# difference in photo px; 75 % correct at d = jnd * Phi^-1((0.75 - lapse / 2) / (1 - lapse)), in arcmin via the
-# display's arcmin per photo px (the export's r_left_arcmin / r_left_px).
+# difference in photo px. The report reads a QUEST+ cell's threshold at QUEST+'s own criterion (analysis/criteria.py):
+# 1 - 1/e of the way from guessing (0.5) to the top (1 - lapse / 2), so P* = 0.5 + (0.5 - lapse / 2)(1 - 1/e), at
+# d = jnd * Phi^-1((P* - lapse / 2) / (1 - lapse)), in arcmin via the display's arcmin per photo px (the export's
+# r_left_arcmin / r_left_px).
 rows = [r for r in csv.DictReader(open(trials)) if r["study"] == "quest-blur-difference" and r["r_left_px"]
         and float(r["r_left_px"]) > 0]
 arcmin_per_px = float(rows[0]["r_left_arcmin"]) / float(rows[0]["r_left_px"])
 jnd, lapse = 1.4, 0.02
-truth = jnd * NormalDist().inv_cdf((0.75 - lapse / 2) / (1 - lapse)) * arcmin_per_px
+target = 0.5 + (0.5 - lapse / 2) * (1 - math.exp(-1))
+truth = jnd * NormalDist().inv_cdf((target - lapse / 2) / (1 - lapse)) * arcmin_per_px
 fit = next(csv.DictReader(open(os.path.join(out, "quest-blur-difference-simulated-psychometric.csv"))))
+assert fit["criterion"] == "81.6 % correct", fit["criterion"]
 lo, th, hi = float(fit["threshold_low"]), float(fit["threshold"]), float(fit["threshold_high"])
 print(f"QUEST+ threshold {th:.3f} [{lo:.3f}, {hi:.3f}] arcmin; the observers' {truth:.3f}")
 assert lo <= truth <= hi, (lo, th, hi, truth)

@@ -130,6 +130,32 @@ again_group)
   $BC run "$G" --participant A3 --db "$W/s.sqlite" --observer sim "${info[@]}" --again > /dev/null
   [ "$(group A3)" = "$first"$'\n'"$first" ] || fail "A3's sessions ran in groups $(group A3 | tr '\n' ' ') (counts before: $counts)"
   echo "ok: A3's --again session stayed in group $first (sessions per group before it: $(echo "$counts" | tr '\n' ' '))" ;;
+balanced_counts)
+  # Balanced assignment counts participants with a completed session or one being run now (issue 23's review: it
+  # counted unfinished sessions, so a participant stopped before the end, or killed, tilted the groups). Hand-worked
+  # with groups-and-info's order (estimated, then no_blur; the first of equals): A1 stopped after 2 trials and A2
+  # aborted count for nothing, so A1, A2 and A3 all get estimated; A4 then no_blur (1 vs 0); A1 resumed and
+  # completed keeps estimated (2 vs 1), A5 gets no_blur (2 vs 2 after it). A3 run again stays in estimated and is
+  # still one participant, so A6 gets estimated (2 vs 2, the first of equals); counted as sessions it would be 3 vs 2
+  # and A6 would get no_blur.
+  G="$P/groups-and-info.json"
+  info=(--info age=30 --info handedness=right --info vision=normal)
+  r() { $BC run "$G" --db "$W/s.sqlite" --observer sim "${info[@]}" --participant "$@" > /dev/null; }
+  group() { sql "$W/s.sqlite" "SELECT group_concat(g, ' ') FROM (SELECT s.group_name g FROM sessions s JOIN
+                               participants p ON p.id = s.participant_id WHERE p.code = '$1' ORDER BY s.id)"; }
+  r A1 --stop-after 2
+  r A2 --stop-after 2
+  $BC sessions --db "$W/s.sqlite" --abort 2 > /dev/null
+  r A3
+  r A4
+  r A1 --resume
+  r A5
+  r A3 --again
+  r A6
+  got="A1=$(group A1) A2=$(group A2) A3=$(group A3) A4=$(group A4) A5=$(group A5) A6=$(group A6)"
+  want="A1=estimated A2=estimated A3=estimated estimated A4=no_blur A5=no_blur A6=estimated"
+  [ "$got" = "$want" ] || fail "groups: $got, expected $want"
+  echo "ok: balanced groups count completed and live participants only: $got" ;;
 merge_people)
   # Two stations each gave the id P1 to someone: merge refuses to join them (exit 3, both ways out named) until told
   # who they are; --rename works written before the inputs too (it used to take the inputs as renames).

@@ -29,7 +29,7 @@ foreach(script session_test session_design_test session_display_test)
 endforeach()
 set_tests_properties(session_window session_window_adjust session_window_after_motion PROPERTIES LABELS "gl;session;window")
 # Sessions numbered per participant, protocol versions kept apart (tests/session_numbers_test.sh).
-foreach(case again protocol_version conditions_version again_group merge_people)
+foreach(case again protocol_version conditions_version again_group balanced_counts merge_people)
   add_test(NAME session_numbers_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/session_numbers_test.sh ${case} ${BC} ${T})
   set_tests_properties(session_numbers_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
                        LABELS "gl;session" PASS_REGULAR_EXPRESSION "^ok:|\nok:")

@@ -54,6 +54,38 @@ class DesignFromTheRecord(unittest.TestCase):
             ("practice", "1: a practice trial", "practice"), ("participant", "the participant's id", "")],
             with_role))
 
+    def test_levels_named_na_nan_none_are_levels_not_missing(self):
+        # Issue 23: a level "NA", "nan" or "None" read back as missing. Read through the CSV helper, a group of "NA"
+        # and "None" and a within factor of "nan" and "x" are two levels each; only an empty cell is missing.
+        path = os.path.join(self.tmp, "t.csv")
+        with open(path, "w") as f:
+            f.write("participant,group,speed_cm_s,edge\nNA,NA,nan,\nNA,NA,x,\nP2,None,nan,\nP2,None,x,\n")
+        d = common.read_text_csv(path)
+        self.assertEqual(list(d["participant"]), ["NA", "NA", "P2", "P2"])
+        got = design.design_of(d, self.book())
+        self.assertEqual(got.group, "group")
+        self.assertEqual(got.within, ("speed_cm_s",))  # edge is empty in every row: not applicable, not a factor
+        self.assertEqual(list(common.text(pd.Series(["nan", float("nan"), None, " NA "]))), ["nan", "", "", "NA"])
+
+    @unittest.skipUnless(RSCRIPT, "R not installed")
+    def test_a_participant_named_na_is_fitted_by_lme4(self):
+        # R's read.csv takes "NA" for missing: the participant's answers were dropped from every mixed model. The
+        # fit with that participant named "NA" must be the fit with them named "Pna" (renaming changes nothing).
+        import mixed
+        import numpy as np
+        rng = np.random.default_rng(3)
+        people = np.repeat(["NA", "P2", "P3", "P4"], 30)
+        offset = {"NA": 5.0, "P2": 0.0, "P3": 0.5, "P4": -0.5}
+        x = np.tile(np.linspace(-1, 1, 30), 4)
+        y = np.array([offset[p] for p in people]) + 0.8 * x + rng.normal(0, 0.3, x.size)
+        X = pd.DataFrame({"Intercept": 1.0, "x": x})
+        with_na = mixed.fit("lmm", y, X, people)
+        renamed = mixed.fit("lmm", y, X, np.where(people == "NA", "Pna", people))
+        a, b = with_na.fixed.set_index("term"), renamed.fixed.set_index("term")
+        self.assertAlmostEqual(a.loc["Intercept", "estimate"], b.loc["Intercept", "estimate"], places=6)
+        # NA's offset of 5 lifts the mean of the 4 participants' intercepts to about 1.25 (3 of them: about 0).
+        self.assertGreater(a.loc["Intercept", "estimate"], 0.8)
+
     def test_a_procedure_study_has_cells_from_its_rows_not_within_factors(self):
         # edge is a procedure cell in this study (the codebook's union says procedure_cell|within, the rows' cell text
         # decides); the procedure's level is its variable, not a factor; participant information is a label.

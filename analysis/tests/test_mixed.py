@@ -291,7 +291,7 @@ class DepthMatchingLmmTest(unittest.TestCase):
         rows, _ = depth_matching.fits(a, notes)
         t = stats.model_table(rows)
         slope = t[t["model"].str.startswith("set on real: lmer(set_arcmin ~ real_arcmin + (1 + real_arcmin")
-                  & (t["term"] == "per arcmin of real blur (1 = set as real)")]
+                  & (t["term"] == "per arcmin of real blur, against 1 (set as real)")]
         self.assertEqual(len(slope), 1, (t, notes))
         row = slope.iloc[0]
         self.assertLess(abs(row["estimate"] - 0.8), 3 * row["se"], row)
@@ -299,6 +299,53 @@ class DepthMatchingLmmTest(unittest.TestCase):
         # A random slope: the slope's Satterthwaite df are about the participants' (G - 1 = 7), not the answers'.
         self.assertTrue(4 < row["df"] < 12, row)
         self.assertTrue(row["engine"].startswith("lme4") and "Satterthwaite" in row["engine"])
+
+    @unittest.skipUnless(HAVE_LME4, "R with lme4/lmerTest not installed")
+    def test_slope_tested_against_1_as_lmertest_does(self):
+        # "Set as real" is slope 1: the report's p against 1 must be lmerTest's own for the slope of (set - real) on
+        # real (that model's slope is b - 1 with the same likelihood), written here in R, not through models.R; the
+        # row against 0 beside it is lmerTest's summary of the model itself. Observers set 0.8 x real: far from 1.
+        rng = np.random.default_rng(11)
+        real = 6.0 * np.abs(1 / np.geomspace(0.4, 4, 27) - 1.0)
+        rows = []
+        for i in range(6):
+            a_p, b_p = 2.0 + rng.normal(0, 0.4), 0.8 + rng.normal(0, 0.1)
+            rows += [{"participant": f"P{i}", "real_arcmin": r, "set_arcmin": a_p + b_p * r + rng.normal(0, 0.4)}
+                     for r in real]
+        a = pd.DataFrame(rows)
+        notes = []
+        rows, _ = depth_matching._across(a, "real_arcmin", "set_arcmin", "set on real", depth_matching.WORDS_MATCH,
+                                         notes, "s")
+        t = stats.model_table(rows)
+        lmer = t[t["engine"].str.startswith("lme4")]
+        one = lmer[lmer["term"] == depth_matching.WORDS_MATCH["real_arcmin"]].iloc[0]
+        zero = lmer[lmer["term"] == depth_matching.MATCH_SLOPE_AGAINST_0].iloc[0]
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "d.csv")
+            a.to_csv(path, index=False)
+            code = f"""
+suppressPackageStartupMessages(library(lmerTest))
+d <- read.csv("{path}")
+d$diff <- d$set_arcmin - d$real_arcmin
+m0 <- lmer(set_arcmin ~ real_arcmin + (1 + real_arcmin | participant), data = d)
+m1 <- lmer(diff ~ real_arcmin + (1 + real_arcmin | participant), data = d)
+c0 <- coef(summary(m0)); c1 <- coef(summary(m1))
+cat(c0[2, 1], c0[2, 2], c0[2, 3], c0[2, 5], c1[2, 1], c1[2, 3], c1[2, 5], "\n")
+"""
+            run = subprocess.run([RSCRIPT, "--vanilla", "-e", code], capture_output=True, text=True, timeout=300)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        b, se, df, p0, b1, df1, p1 = map(float, run.stdout.split())
+        self.assertAlmostEqual(b1, b - 1, places=4)
+        self.assertAlmostEqual(one["estimate"], b, delta=1e-4 * max(1, abs(b)))
+        self.assertAlmostEqual(one["se"], se, delta=1e-3 * se)
+        self.assertAlmostEqual(one["df"], df1, delta=0.02 * df1)
+        self.assertLess(abs(one["p"] - p1), 0.02 * p1 + 1e-12, (one["p"], p1))
+        self.assertLess(abs(zero["p"] - p0), 0.02 * p0 + 1e-12, (zero["p"], p0))
+        self.assertLess(one["p"], 0.05)  # 0.8 is not "set as real"
+        self.assertEqual(zero["estimate"], one["estimate"])
+        # The SD of the participants' slopes is named without a test's words.
+        self.assertTrue(any(str(r).startswith("observer SD: per arcmin of real blur") and "against" not in str(r)
+                            for r in lmer["term"]), list(lmer["term"]))
 
 
 if __name__ == "__main__":

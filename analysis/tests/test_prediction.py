@@ -54,5 +54,41 @@ class ClosedFormTest(unittest.TestCase):
         self.assertTrue(bool(t["departs"].iloc[0]))  # 0 of 40 correct against ~0.79
 
 
+class LevelsInTheTable(unittest.TestCase):
+    def test_a_level_a_row_does_not_have_is_blank_not_nan(self):
+        # Task 1 rows of test 2 have no section: their cell is blank (not applicable), never the text "nan" that
+        # report_numbers_check.py flags as a number meaning "not determined".
+        m = pd.DataFrame({"section": [1.0, 1.0, np.nan], "y": [1, 0, 1], "predicted": [0.5, 0.5, 0.5],
+                          "participant": ["P1"] * 3})
+        t = prediction.condition_table(m, ["section"])
+        self.assertEqual(sorted(t["section"]), ["", "1"])
+
+
+class PerGroupTest(unittest.TestCase):
+    def test_between_subject_groups_are_never_pooled(self):
+        # Group a (P1, P2) always right, group b (P3, P4) always wrong, on the same trials: each group's table holds
+        # its own share (hand count: 20 of 20 and 0 of 20), never the pooled 20 of 40 (issue 23: prediction.py
+        # pooled between-subject groups).
+        import tempfile
+        from design import Column
+        n = 10
+        d = pd.DataFrame({
+            "study": ["s"] * 4 * n, "participant": sum([[p] * n for p in ("P1", "P2", "P3", "P4")], []),
+            "group": ["a"] * 2 * n + ["b"] * 2 * n, "observer": ["person"] * 4 * n,
+            "practice": [0] * 4 * n, "status": ["answered"] * 4 * n, "task": ["forced_choice"] * 4 * n,
+            "chosen_side": ["left"] * 4 * n, "chosen_interval": [""] * 4 * n, "level": [0.5] * 4 * n,
+            "correct": ["1"] * 2 * n + ["0"] * 2 * n, "chose_more_blurred": [""] * 4 * n,
+            "r_left_arcmin": [6.0] * 4 * n, "r_right_arcmin": [4.0] * 4 * n, "r_scene_arcmin": [4.0] * 4 * n})
+        book = {"group": Column("the participant's between-subject group", frozenset({"group"}), "")}
+        with tempfile.TemporaryDirectory() as out:
+            charts = prediction.charts(d, out, book)
+        by_slug = {c.name: c for c in charts}
+        self.assertEqual(sorted(by_slug), ["s-predicted-procedure-people-group-a", "s-predicted-procedure-people-group-b"])
+        a, b = by_slug["s-predicted-procedure-people-group-a"].table, by_slug["s-predicted-procedure-people-group-b"].table
+        self.assertEqual((int(a["k"].iloc[0]), int(a["n"].iloc[0])), (20, 20))
+        self.assertEqual((int(b["k"].iloc[0]), int(b["n"].iloc[0])), (0, 20))
+        self.assertIn("group a", by_slug["s-predicted-procedure-people-group-a"].notes[0])
+
+
 if __name__ == "__main__":
     unittest.main()

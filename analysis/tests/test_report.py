@@ -95,7 +95,7 @@ class EndToEndTest(ReportTestCase):
         # Tables: one CSV per chart with a table; the numbers are there.
         t1 = read(out, "test1-per-edge.csv").splitlines()
         self.assertEqual(len(t1), 12)  # header + 11 edges
-        self.assertIn("p_binom", t1[0])
+        self.assertIn(",p,", t1[0])  # the test across participants (study_tests), not pooled answers
         model = read(out, "test1-model.csv")
         self.assertTrue(model.startswith("study,model,term,estimate,se,df,p,engine,note\n"), model[:80])
         self.assertIn("glmer(chose_first ~ edge_c", model)
@@ -267,7 +267,7 @@ class AbortedSessionsTest(ReportTestCase):
         rows, first = self.rows()
         index, err = self.report(rows + first)
         answers = sum(1 for r in first if not r.get("practice"))
-        said = (f"left out 1 aborted session (P1 (session 99)) with {answers} answers: closed with blurcue sessions "
+        said = (f"left out 1 aborted session (P1 (session id 99)) with {answers} answers: closed with blurcue sessions "
                 f"--abort, they are not part of the study; blurcue report --include-aborted analyses them")
         self.assertIn(html.escape(said), index)
         self.assertIn(said, err)
@@ -277,13 +277,13 @@ class AbortedSessionsTest(ReportTestCase):
     def test_include_aborted_counts_them_and_says_so(self):
         rows, first = self.rows()
         index, _ = self.report(rows + first, "--include-aborted")
-        self.assertIn("included 1 aborted session (P1 (session 99))", index)
+        self.assertIn("included 1 aborted session (P1 (session id 99))", index)
         self.assertIn(f"of {self.decisive(rows + first)} decisive answers", index)
 
     def test_a_record_of_an_aborted_session_only_says_aborted(self):
         _, first = self.rows()
         index, _ = self.report(first)
-        self.assertIn("left out 1 aborted session (P1 (session 99))", index)
+        self.assertIn("left out 1 aborted session (P1 (session id 99))", index)
         self.assertNotIn("decisive answers", index)
 
 

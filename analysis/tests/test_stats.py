@@ -355,6 +355,48 @@ class SideBiasTest(TempDirCase):
         self.assertIn("no forced-choice trials", str(e.exception))
 
 
+class PerPatternUnitTest(TempDirCase):
+    """Tests 2 and 3 per pattern and per section test participants, not pooled answers (issue 23): each
+    participant's share of the first source among decisive answers, t across them against 0.5 with a sign test beside
+    it; scipy's ttest_1samp and binomtest on shares counted by hand are the truth."""
+
+    @staticmethod
+    def rows(participant, n_first, n_second, pattern=2, section=None, cant=0):
+        out = fc_rows("test2-moving-balls", participant, ["left"] * n_first + ["right"] * n_second
+                      + ["cant_tell"] * cant, swapped=0)
+        for r in out:
+            r.update(pattern_left="measured", pattern_right="estimated", pattern_id=pattern, speed_cm_s=3.0,
+                     section=section if section is not None else math.nan)
+        return out
+
+    def test_per_pattern_t_across_participants_with_a_sign_test(self):
+        from scipy import stats as sps
+        counts = {"P1": (8, 2), "P2": (6, 4), "P3": (9, 1), "P4": (3, 7)}
+        df = pd.DataFrame(sum((self.rows(p, *c, cant=2) for p, c in counts.items()), []))
+        t = forced_choice.per_pattern(df, self.tmp, "test2-moving-balls")[0].table.iloc[0]
+        shares = [0.8, 0.6, 0.9, 0.3]
+        expect = sps.ttest_1samp(shares, 0.5)
+        self.assertAlmostEqual(float(t["t"]), float(expect.statistic), places=10)
+        self.assertAlmostEqual(float(t["p"]), float(expect.pvalue), places=10)
+        self.assertEqual(int(t["df"]), 3)
+        self.assertAlmostEqual(float(t["participant_mean"]), 0.65, places=12)
+        # Sign test: 3 participants above 0.5, 1 below.
+        self.assertEqual((int(t["participants_above"]), int(t["participants_below"])), (3, 1))
+        self.assertAlmostEqual(float(t["p_sign"]), sps.binomtest(3, 4, 0.5).pvalue, places=12)
+        self.assertIn("participants", t["test"])
+        self.assertNotIn("p_binom", t.index)
+        # Pooled answers (26 of 40) would say p = 0.08; the participants' test says 0.45.
+        self.assertGreater(float(t["p"]), 0.3)
+
+    def test_per_section_with_one_participant_is_the_exact_binomial_said_so(self):
+        from scipy import stats as sps
+        df = pd.DataFrame(self.rows("P1", 9, 1, pattern=2, section=1) + self.rows("P1", 4, 6, pattern=2, section=2))
+        t = forced_choice.per_section(df, self.tmp, "test2-moving-balls")[0].table.set_index("section")
+        self.assertAlmostEqual(float(t.loc[1, "p"]), sps.binomtest(9, 10, 0.5).pvalue, places=12)
+        self.assertAlmostEqual(float(t.loc[2, "p"]), sps.binomtest(4, 10, 0.5).pvalue, places=12)
+        self.assertIn("one participant", t.loc[1, "test"])
+
+
 class FrameTimingTest(TempDirCase):
     # Window session 7: two trials of 30 intervals each, 29 x 16.7 ms and one 50 ms in each -> 62 flips, 60
     # intervals (the step from trial 0's last flip to trial 1's first is not one). Sorted: 58 x 16.7, 2 x 50.

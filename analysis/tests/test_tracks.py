@@ -15,6 +15,7 @@ from scipy.optimize import brentq
 from scipy.stats import norm
 
 import common
+import criteria
 import tracks
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -255,6 +256,89 @@ class NotDeterminedInWords(unittest.TestCase):
         self.assertEqual((comparison["first"], comparison["second"], comparison["pairs"]),
                          ("speed_cm_s 1.8", "speed_cm_s 3", 3))
         self.assertAlmostEqual(comparison["mean_difference"], 0.1, places=9)
+
+
+class IntervalsWithinTheTestedRange(unittest.TestCase):
+    def test_a_cells_t_interval_past_the_range_is_not_determined(self):
+        # Three thresholds 0.1, 0.2 and 2.9 in a range 0.05 to 3: mean 1.067, t interval 1.067 +- 4.303 x 1.589 /
+        # sqrt 3 = [-2.88, 5.01] (by hand), past both ends: not determined, in words, no bound written; the mean stays.
+        def track(who, th, cell):
+            return {"participant": who, "cell": cell, "criterion": "81.6 % correct",
+                    "result": {"estimate": th, "range": (0.05, 3.0)}}
+        these = [track("P1", 0.1, "a"), track("P2", 0.2, "a"), track("P3", 2.9, "a"),
+                 track("P1", 1.0, "b"), track("P2", 1.1, "b"), track("P3", 1.2, "b")]
+        t = tracks.summary_table(these).set_index("cell")
+        self.assertTrue(pd.isna(t.loc["a"].get("mean_low")) and pd.isna(t.loc["a"].get("mean_high")))
+        self.assertEqual(t.loc["a", "interval"], "not determined: the t 95 % interval across participants reaches "
+                                                 "beyond the tested range 0.05 to 3")
+        self.assertAlmostEqual(t.loc["a", "mean"], 3.2 / 3, places=12)
+        # Cell b: 1.1 +- 4.303 x 0.1 / sqrt 3 = [0.852, 1.348], inside.
+        self.assertAlmostEqual(t.loc["b", "mean_low"], 1.1 - 4.302652729911275 * 0.1 / math.sqrt(3), places=9)
+        words = tracks.summary_words(t.reset_index())
+        self.assertIn("a: threshold at 81.6 % correct 1.07 (mean of 3 participants' thresholds; its interval not "
+                      "determined", words)
+        one = tracks.summary_words(tracks.summary_table([track("P1", 0.8, "c")]))
+        self.assertEqual(one, "c: threshold at 81.6 % correct 0.8 (one participant's threshold)")
+
+
+class SessionsSaidAsWhatTheyAre(unittest.TestCase):
+    def test_a_session_after_an_abort_is_a_first_session_not_session_2(self):
+        # P1 gave up session id 1 (aborted, analysed with --include-aborted) and ran the study again (id 2, the
+        # record's number 2), then once more after completing it (id 3): the tracks say aborted, first, repeated 2.
+        p = {"procedure": "staircase", "start": 1.0, "min": 0.0, "max": 3.0, "up": 1, "down": 2, "steps": [0.4, 0.2]}
+        levels = np.array([1, 1, 0.6, 0.6, 0.2, 0.4, 0.4, 0.2, 0.4, 0.6, 0.6, 0.4, 0.6, 0.6])
+        correct = [1, 1, 1, 1, 0, 1, 1, 0, 0, 1, 1, 0, 1, 1]
+        frames = []
+        for sid, number, status in (("1", 1, "aborted"), ("2", 2, "completed"), ("3", 3, "completed")):
+            frames.append(rows_of("P1", levels, correct, p).assign(session_id=sid, session_number=str(number),
+                                                                   session_status=status, study="s"))
+        labels = sorted(t["participant"] for t in tracks.track_rows(pd.concat(frames, ignore_index=True)))
+        self.assertEqual(labels, ["P1 (aborted session, id 1)", "P1 (first session, id 2)",
+                                  "P1 (repeated session 2, id 3)"])
+
+
+class OneCriterion(unittest.TestCase):
+    """The pooled psychometric fit of a procedure cell reads its threshold at the procedure's own criterion (issue 23:
+    the summary gave the 75 % point beside QUEST+'s 81.6 % one), said in words, over the procedure's tested range."""
+
+    def test_quest_cell_fit_at_quests_threshold_parameter(self):
+        import any_study
+        from design import Design
+        # A Weibull observer, guess 0.5, no lapses, alpha 1, beta 3: QUEST+'s threshold is alpha (81.6 % correct);
+        # the 75 % point would be (ln 2)^(1/3) = 0.885. 400 answers at each of 9 levels.
+        rng = np.random.default_rng(4)
+        levels = np.repeat(np.linspace(0.4, 2.0, 9), 400)
+        psi = 0.5 + 0.5 * (1 - np.exp(-(levels / 1.0) ** 3))
+        params = {"procedure": "quest_plus", "guess": 0.5, "stimuli": list(np.linspace(0.2, 2.4, 12)),
+                  "thresholds": list(np.linspace(0.1, 3.0, 30)), "slopes": [1, 3, 5], "lapses": [0, 0.02]}
+        m = pd.DataFrame({"level": levels, "y": (rng.random(levels.size) < psi).astype(float),
+                          "participant": "P1", "cell": "edge=9", "procedure_cell": "1",
+                          "procedure_parameters": json.dumps(params)})
+        with tempfile.TemporaryDirectory() as out:
+            charts, words = any_study.psychometric_cells(m, "procedure", 0.5, "correct", Design(cells=("edge",)),
+                                                         "s", out, "s", "1 participant", 60, 1)
+        row = charts[0].table.iloc[0]
+        self.assertLess(abs(row["threshold"] - 1.0), 0.05, row)       # alpha, not 0.885
+        self.assertGreater(row["threshold"], 0.93, row)
+        self.assertAlmostEqual(row["criterion_share_correct"], 0.5 + (0.5 - row["lapse"] if not math.isnan(
+            row["lapse"]) else 0.5) * (1 - math.exp(-1)), places=9)
+        self.assertTrue(row["criterion"].startswith("81.6 % correct"), row["criterion"])
+        self.assertIn("edge 9: threshold at 81.6 % correct", words)
+        # The same words as the tracks' table states for a QUEST+ track.
+        self.assertEqual(criteria_short("quest_plus", params), row["criterion"])
+
+    def test_staircase_criterion_is_levitts_point(self):
+        p = {"procedure": "staircase", "up": 1, "down": 2, "min": 0.0, "max": 3.0}
+        c = criteria.criterion("staircase", p, 0.5)
+        self.assertAlmostEqual(c.psi(0.5, 0.03), math.sqrt(0.5), places=12)  # 0.707: p^2 = 1/2
+        self.assertTrue(c.short().startswith("70.7 % correct"), c.short())
+        c3 = criteria.criterion("staircase", dict(p, down=3), 0.5)
+        self.assertAlmostEqual(c3.psi(0.5, 0.0), 0.5 ** (1 / 3), places=12)  # 0.794
+        self.assertEqual(criteria.tested_range(p, [0.5, 1.0]), (0.0, 3.0))  # what it could show, not what it showed
+
+
+def criteria_short(kind, params):
+    return criteria.criterion(kind, params, 0.5).short()
 
 
 class ProceduresFile(unittest.TestCase):

@@ -204,8 +204,8 @@ struct InfoField {
 // Between-subject groups: each participant runs the blocks of one group (a block's "groups"; none: every group).
 struct Groups {
   std::vector<std::string> names;
-  // by_number: names[(number - 1) mod n]; balanced: the group with the fewest sessions in the record so far (the
-  // first of equals).
+  // by_number: names[(number - 1) mod n]; balanced: the group with the fewest participants in the record so far
+  // (store::SessionsPerGroup says who counts; the first of equals).
   GroupAssign assign = GroupAssign::kByNumber;
 };
 

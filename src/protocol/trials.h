@@ -77,8 +77,8 @@ std::vector<Trial> BuildTrials(const Protocol& protocol, const std::string& part
                                const std::string& group = "");
 
 // The group a new session of `participant` runs: by_number - names[(number - 1) mod n] (Error(kInput) for an id
-// without number); balanced - the group with the fewest sessions so far (`sessions`: group -> count; the first of
-// equals). "" when the protocol has no groups.
+// without number); balanced - the group with the fewest participants so far (`sessions`: group -> count; the first
+// of equals). "" when the protocol has no groups.
 std::string AssignGroup(const Protocol& protocol, const std::string& participant,
                         const std::map<std::string, int64_t>& sessions);
 

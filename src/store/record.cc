@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <ctime>
 #include <random>
+#include <set>
 #include <utility>
 
 #include "core/error.h"
@@ -40,15 +41,26 @@ std::string NewToken() {
 
 std::string SessionName(int64_t session) { return "session " + std::to_string(session); }
 
-// The study's sessions per group, aborted ones left out: what a balanced assignment counts.
-std::map<std::string, int64_t> SessionsPerGroup(Database& db, const std::string& study) {
-  Statement counts(db, "SELECT s.group_name, count(*) FROM sessions s JOIN participants p ON p.id = s.participant_id "
-                       "JOIN studies st ON st.id = p.study_id WHERE st.name = ? AND s.status != 'aborted' "
-                       "GROUP BY s.group_name");
-  counts.Bind(1, study);
-  std::map<std::string, int64_t> sessions;
-  while (counts.Step()) sessions[counts.GetText(0)] = counts.GetInt64(1);
-  return sessions;
+// What a balanced assignment counts, per group: the participants of the study with a completed session in it, and
+// those whose session is being run right now (a live lock: a station starting at the same moment must see it). An
+// aborted session, and one stopped or killed before its end (running with no lock or a stale one), count for
+// nothing: they would tilt the groups by people whose data the analysis leaves out. A participant counts once
+// however many sessions they ran (an --again session stays in its group and is no new person).
+std::map<std::string, int64_t> SessionsPerGroup(Database& db, const std::string& study, const RecordOptions& options) {
+  Statement rows(db, "SELECT s.group_name, s.participant_id, s.status, s.lock_host, s.lock_pid, s.lock_heartbeat_ms "
+                     "FROM sessions s JOIN participants p ON p.id = s.participant_id "
+                     "JOIN studies st ON st.id = p.study_id WHERE st.name = ? AND s.status != 'aborted'");
+  rows.Bind(1, study);
+  std::map<std::string, std::set<int64_t>> people;
+  while (rows.Step()) {
+    const bool completed = rows.GetText(2) == "completed";
+    const bool live = !completed && !rows.IsNull(3) && !rows.IsNull(5) &&
+                      !JudgeLock(rows.GetText(3), rows.GetInt64(4), rows.GetInt64(5), options).stale;
+    if (completed || live) people[rows.GetText(0)].insert(rows.GetInt64(1));
+  }
+  std::map<std::string, int64_t> counts;
+  for (const auto& [group, ids] : people) counts[group] = static_cast<int64_t>(ids.size());
+  return counts;
 }
 
 }  // namespace
@@ -391,7 +403,7 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     start.session_number = NextSessionNumber(participant_id, study, participant, seed, meta);
     // Counted and inserted in one transaction (BEGIN IMMEDIATE): a station starting at the same moment waits for
     // this one's session and counts it.
-    start.group = meta.assign_group ? meta.assign_group(SessionsPerGroup(db_, study)) : meta.group;
+    start.group = meta.assign_group ? meta.assign_group(SessionsPerGroup(db_, study, options_)) : meta.group;
 
     // The typed columns (who answered, where, the display's geometry, the session's number) as the column table
     // reads them (columns.h) from the session's description and the display profile it records whole.
@@ -629,7 +641,7 @@ GroupsSoFar PeekGroups(const std::filesystem::path& db_path, const std::string& 
   if (db.QueryInt64("SELECT count(*) FROM sqlite_schema") == 0) return so_far;
   RequireReadableRecord(db);
   if (SchemaVersion(db) < 6) return so_far;  // no groups recorded before version 6
-  so_far.sessions = SessionsPerGroup(db, study);
+  so_far.sessions = SessionsPerGroup(db, study, RecordOptions{});
   Statement running(db, "SELECT s.group_name, s.participant_info FROM sessions s JOIN participants p "
                         "ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
                         "WHERE st.name = ? AND p.code = ? AND s.status = 'running' ORDER BY s.id DESC LIMIT 1");

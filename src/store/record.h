@@ -60,7 +60,7 @@ struct SessionMeta {
 // What a record already says about a study's groups and a participant's unfinished session, read without writing
 // (a missing file says nothing): how to assign the next group, and what a resumed session must keep.
 struct GroupsSoFar {
-  std::map<std::string, int64_t> sessions;  // group -> sessions of the study that were not aborted
+  std::map<std::string, int64_t> sessions;  // group -> participants with a completed or live session
   bool unfinished = false;                  // the participant has a running session
   std::string unfinished_group, unfinished_info = "{}";
   // The group of the participant's latest session that was not aborted ("" for none): a session run again (--again)

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -761,6 +762,10 @@ TEST(Record, ConcurrentStartsCountEachOtherForABalancedGroup) {
       if (start.group != record.database().QueryText("SELECT group_name FROM sessions WHERE id = " +
                                                       std::to_string(start.session_id)))
         _exit(6);
+      // A station runs its session while the others start: it stays alive (its lock live) until all four have
+      // started. A session whose process ended unfinished counts for nothing (SessionsPerGroup), as a killed one.
+      for (int wait = 0; wait < 400 && record.database().QueryInt64("SELECT count(*) FROM sessions") < 4; ++wait)
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
     });
     Record record = Record::Open(path);
     EXPECT_EQ(record.database().QueryText("SELECT group_concat(g) FROM (SELECT group_name || '=' || count(*) g "

@@ -1,0 +1,96 @@
+"""What a threshold means, where the stimuli were tested, and what lies beyond them: one definition each, read by the
+tracks (tracks.py), the psychometric functions (any_study.py) and the report's summary alike, so that a threshold in
+the summary and the one in its section are the same quantity, stated with the same criterion and the same range.
+
+  criterion     the share correct a threshold stands for, said with it:
+                  QUEST+          its threshold parameter, the Weibull's scale: F = 1 - 1/e of the way from guessing
+                                  to the top (at guess g and no lapses, g + (1 - g)(1 - 1/e): 81.6 % at g = 0.5)
+                  staircase       the point its rule converges to (Levitt 1971): 1-up/n-down 0.5^(1/n) of the answers
+                                  correct (70.7 % for 2-down), n-up/1-down 1 - 0.5^(1/n)
+                  fixed levels    half way from guessing to the top (75 % correct at guess 0.5)
+  tested range  what the procedure could show (QUEST+: its stimuli within its grid; a staircase: its min to max), or,
+                without a procedure, the levels shown
+  beyond        a threshold below or above the tested range: "not determined", in words, never a number
+"""
+import math
+from dataclasses import dataclass
+
+CORE_AT_ALPHA = 1 - math.exp(-1)  # the Weibull's F at its scale: QUEST+'s threshold parameter
+
+
+@dataclass(frozen=True)
+class Criterion:
+    """A threshold's criterion: either a point of the core F (0-1, guess and lapse apart) or a share of the answers
+    correct (guess and lapse included), with its words."""
+    words: str
+    core: float = math.nan      # F at the threshold (QUEST+, fixed levels)
+    answers: float = math.nan   # share correct at the threshold (a staircase's target)
+
+    def psi(self, guess, lapse):
+        """The psychometric function's value (share correct) at the threshold, for a fit with this guess and lapse."""
+        if math.isfinite(self.core):
+            return guess + (1 - guess - lapse) * self.core
+        return self.answers
+
+    def short(self):
+        """'81.6 % correct' (no lapses) - the criterion in a few words for a summary."""
+        return self.words.split(":")[0]
+
+
+def _pct(v):
+    return f"{100 * v:.1f} %".replace(".0 %", " %")
+
+
+def criterion(kind, params, guess):
+    """The Criterion of a procedure cell (kind: quest_plus, staircase or "" for fixed levels; params: its
+    procedures.csv JSON, None where the export has none) at this guess rate."""
+    if kind == "quest_plus":
+        params = params or {}
+        g = float(params.get("guess", guess))
+        return Criterion(f"{_pct(g + (1 - g) * CORE_AT_ALPHA)} correct: QUEST+'s threshold parameter, the Weibull's "
+                         f"scale, where the function has risen 1 - 1/e = 63.2 % of the way from guessing ({g:.3g}) "
+                         "to the top (no lapses)", core=CORE_AT_ALPHA)
+    if kind == "staircase":
+        if not params:
+            return Criterion("the staircase's target (procedures.csv missing: its rule, so its target, unknown)")
+        up, down = int(params.get("up", 1)), int(params.get("down", 1))
+        if up == 1:
+            target = 0.5 ** (1 / down)
+        elif down == 1:
+            target = 1 - 0.5 ** (1 / up)
+        else:
+            return Criterion(f"the {up}-up/{down}-down staircase's own target: the point its rule converges to "
+                             "(no closed form for this rule)", answers=math.nan)
+        return Criterion(f"{_pct(target)} correct: the point the {up}-up/{down}-down staircase converges to (Levitt "
+                         "1971)", answers=target)
+    return Criterion(f"{_pct(guess + (1 - guess) / 2)} correct: half way from guessing ({guess:.3g}) to the top (no "
+                     "lapses)", answers=guess + (1 - guess) / 2)
+
+
+def tested_range(params, levels):
+    """(low, high): what the procedure could show, or the levels shown (levels: the stimuli of these answers)."""
+    params = params or {}
+    if params.get("thresholds") and params.get("stimuli"):  # QUEST+
+        return (max(min(params["thresholds"]), min(params["stimuli"])),
+                min(max(params["thresholds"]), max(params["stimuli"])))
+    if "min" in params and "max" in params:  # a staircase
+        return float(params["min"]), float(params["max"])
+    return float(min(levels)), float(max(levels))
+
+
+def _text(v):
+    return f"{v:.4g}"
+
+
+def range_words(low, high):
+    return f"the tested range {_text(low)} to {_text(high)}"
+
+
+def beyond_words(side, low, high, why=""):
+    """'not determined: above the tested range 0.1 to 2 (why)': a threshold outside the range (side: below, above,
+    beyond)."""
+    return f"not determined: {side} {range_words(low, high)}" + (f" ({why})" if why else "")
+
+
+def inside(value, low, high):
+    return value is not None and math.isfinite(value) and low <= value <= high
