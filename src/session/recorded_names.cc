@@ -1,5 +1,6 @@
 #include "session/recorded_names.h"
 
+#include <cctype>
 #include <map>
 #include <set>
 
@@ -22,6 +23,17 @@ std::string TablePath(const Json& json, const std::string& pointer) {
   } catch (const Json::exception&) {
     return "";
   }
+}
+
+// A name a model formula reads as one variable: letters (any script: bytes of UTF-8 beyond ASCII), digits and _,
+// not starting with a digit.
+bool IsFormulaName(const std::string& name) {
+  if (name.empty() || std::isdigit(static_cast<unsigned char>(name.front()))) return false;
+  for (const char c : name) {
+    const auto u = static_cast<unsigned char>(c);
+    if (!(u >= 0x80 || std::isalnum(u) || c == '_')) return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -75,6 +87,14 @@ std::vector<std::string> RecordedNameProblems(const protocol::Protocol& protocol
       // A conditions table's rows (factor "row") and any factor of object levels named row: only their keys are
       // recorded (TrialVariables).
       if (!(f.name == "row" && objects)) add({f.name, "the factor " + f.name, at}, "");
+      // A factor of object levels is named freely, and the report analyses it: its name is a term of the models'
+      // formulas (Python's patsy, R's lme4), so it is a name they read as one. A factor side/pair validated, ran
+      // and stopped the report (exit 10: patsy read side divided by pair). Any other factor or key is a name
+      // blurcue reads or a label, which no model reads.
+      if (objects && !IsFormulaName(f.name))
+        problems.push_back(file + ": " + at + ": the factor " + f.name + " names a term of the report's models (R "
+                           "and Python formulas): letters, digits and _ only, not starting with a digit; got " +
+                           Json(f.name).dump());
       std::set<std::string> keys;  // each key once per factor (every row of a table has every column)
       for (size_t i = 0; i < f.levels.size(); ++i) {
         if (!f.levels[i].is_object()) continue;

@@ -16,7 +16,8 @@ namespace blurcue::session {
 // status or correct), so a factor, an object level's key or a conditions table's column must not land in the column
 // of another design variable (status and factor_status would both be factor_status: one of them stored nowhere),
 // nor in a column of the record, nor be given twice in one block (a factor and an object level's key of the same
-// name: the key's value was dropped). `json` is the protocol's JSON (it names a conditions table's file). Empty
+// name: the key's value was dropped); and a factor of object levels (named freely, analysed by the report) must have
+// a name a model formula reads as one: letters, digits and _, not starting with a digit. `json` is the protocol's JSON (it names a conditions table's file). Empty
 // when every variable has its own column.
 std::vector<std::string> RecordedNameProblems(const protocol::Protocol& protocol, const Json& json);
 

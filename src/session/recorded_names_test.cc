@@ -101,5 +101,29 @@ TEST(RecordedNames, AFactorAndALevelsKeyOfOneNameInOneBlockAreRefused) {
       << problems[0];
 }
 
+// A factor of object levels is named freely and analysed: side/pair stopped the report (patsy read side / pair).
+// Refused naming it; a label's name (recorded, never a term of a model) may hold a '/'.
+TEST(RecordedNames, AnAnalysedFactorsNameIsOneAModelFormulaReads) {
+  Json j = Valid();
+  j["blocks"][0]["factors"]["side/pair"] = Ids("m/e", "e/n");
+  auto problems = ProblemsOf(j);
+  ASSERT_EQ(problems.size(), 1u) << All(problems);
+  EXPECT_TRUE(Contains(problems[0], "/blocks/0/factors/side~1pair: the factor side/pair names a term of the report's "
+                                    "models")) << problems[0];
+  for (const char* bad : {"2nd", "a b", "a-b"}) {
+    Json k = Valid();
+    k["blocks"][0]["factors"][bad] = Ids("x", "y");
+    EXPECT_EQ(ProblemsOf(k).size(), 1u) << bad;
+  }
+  for (const char* good : {"side_pair", "Gr\u00f6\u00dfe", "_p2"}) {
+    Json k = Valid();
+    k["blocks"][0]["factors"][good] = Ids("x", "y");
+    EXPECT_TRUE(ProblemsOf(k).empty()) << good << ": " << All(ProblemsOf(k));
+  }
+  Json k = Valid();
+  k["blocks"][0]["factors"]["label_a/b"] = {"p/q", "r/s"};
+  EXPECT_TRUE(ProblemsOf(k).empty()) << All(ProblemsOf(k));
+}
+
 }  // namespace
 }  // namespace blurcue::session
