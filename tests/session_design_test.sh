@@ -410,6 +410,11 @@ t["factors"]["side/pair"] = t["factors"].pop("pair")
 json.dump(t, open(w + "/analysed.json", "w"))
 json.dump(dict(common, name="slash-table", blocks=[{"name": "tab", "conditions": "rows.csv"}]),
           open(w + "/table.json", "w"))
+# Numeric ids no reader holds exactly (1e308, 2^64 - 1): refused too (the adversary's ids that validated).
+for name, pid in (("huge", 1e308), ("wide", 18446744073709551615)):
+    json.dump(dict(common, name="id-" + name, factors={"pattern": [{"id": pid, "left": "measured", "right": "none"}],
+                                                       "edge": [3]}),
+              open(w + "/" + name + ".json", "w"))
 for name, pid in (("infinity", "Infinity"), ("nan", "nan")):
     json.dump(dict(common, name="id-" + name, factors={"pattern": [{"id": pid, "left": "measured", "right": "none"},
                                                                    {"id": 2, "left": "estimated", "right": "none"}],
@@ -431,6 +436,12 @@ PYEOF
     [ "$code" = 3 ] || fail "$cmd: exit $code, expected 3: $(tail -1 "$W/out")"
     grep -qF "/factors/side~1pair: the factor side/pair names a term of the report's models" "$W/out" ||
       fail "$cmd: $(tail -1 "$W/out")"
+  done
+  for p in huge wide; do
+    code=0
+    $BC validate --no-files "$W/$p.json" > "$W/out" 2>&1 || code=$?
+    [ "$code" = 3 ] && grep -q "/factors/pattern/0/id: an id must be text or a whole number below 2^53" "$W/out" ||
+      fail "validate of a pattern id $p: exit $code: $(tail -1 "$W/out")"
   done
   code=0
   $BC run "$W/factor.json" --participant NA --db "$W/na.sqlite" --observer sim > "$W/out" 2>&1 || code=$?
@@ -462,7 +473,7 @@ missing = [l for l in links if not os.path.isfile(os.path.join(d, l))]
 assert not missing, missing
 assert not any(os.path.isdir(os.path.join(d, e)) and e not in ("tables",) for e in os.listdir(d)), os.listdir(d)
 PYEOF
-  echo "ok: labels and ids with '/' report (exit 0), kept verbatim; a factor side/pair, ids Infinity and nan and a participant NA refused" ;;
+  echo "ok: labels and ids with '/' report (exit 0), kept verbatim; a factor side/pair, ids Infinity, nan, 1e308 and 2^64 - 1 and a participant NA refused" ;;
 collided_names)
   # Two design variables recorded in one column are refused by validate (with and without --no-files) and by run,
   # naming both, before anything is recorded (issue 24: a factor status and a factor factor_status validated, and
