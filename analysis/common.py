@@ -1,7 +1,9 @@
 """Shared helpers of the analysis scripts: reading trials.csv, the chart record, the paper style, saving figures."""
+import hashlib
 import json
 import math
 import os
+import re
 from collections import namedtuple
 
 import matplotlib
@@ -305,11 +307,23 @@ def setup_style():
     })
 
 
+def file_stem(name):
+    """A chart's or table's NAME as a file name in the report's folder: letters, digits, '_', '-' and '.' kept, any
+    other character (the '/' of a factor named a/b, a space, a non-ASCII letter) written '_', then 8 hex digits of
+    NAME's SHA-1 so that two names differing only there stay two files; at most 200 characters. A factor named a/b
+    used to be a folder in the file name, and the report stopped (exit 10). The page shows NAME itself."""
+    name = str(name)
+    stem = re.sub(r"[^A-Za-z0-9_.-]", "_", name)
+    if stem == name and not stem.startswith(".") and len(stem) <= 200:
+        return stem
+    return stem.lstrip(".")[:191] + "-" + hashlib.sha1(name.encode("utf-8")).hexdigest()[:8]
+
+
 def save(fig, out_dir, name):
-    """Writes NAME.png and NAME.svg into out_dir; returns their paths and closes the figure."""
+    """Writes file_stem(NAME).png and .svg into out_dir; returns their paths and closes the figure."""
     os.makedirs(out_dir, exist_ok=True)
-    png = os.path.join(out_dir, name + ".png")
-    svg = os.path.join(out_dir, name + ".svg")
+    png = os.path.join(out_dir, file_stem(name) + ".png")
+    svg = os.path.join(out_dir, file_stem(name) + ".svg")
     fig.savefig(png, bbox_inches="tight")
     fig.savefig(svg, bbox_inches="tight")
     plt.close(fig)

@@ -392,5 +392,127 @@ assert "factor label_r_left_px" in codebook["label_r_left_px"], codebook["label_
 print("ok")
 PYEOF
   echo "ok: a column nobody reads is refused at validate; a table's label_status, label_participant, label_r_left_px, label_info_age and a staircase table's label_level, label_test_side, label_correct come out with their values, beside the recorded columns" ;;
+odd_names)
+  # Names that validate and run must report (issue 24: report exited 10, and one such session in a merged record
+  # withheld the whole report). A factor and a conditions table's column named with a '/' (label_a/b) are kept
+  # verbatim in the page and in trials.csv, their files named without the '/'. A pattern id Infinity, and ids or a
+  # participant spelled NA or nan (text pandas and R read as no value or an infinite number), are refused by validate
+  # and run, naming the field and the value.
+  $PY - "$P/test1-static-grids.json" "$W" <<'PYEOF'
+import json, sys
+t, w = json.load(open(sys.argv[1])), sys.argv[2]
+open(w + "/rows.csv", "w").write("edge,left,right,label_c/d\n3,measured,estimated,x/1\n9,measured,estimated,y/2\n"
+                                 "6,estimated,measured,x/1\n")
+common = {"version": 1, "scene": t["scene"], "content": {"type": "grid"}, "task": "forced_choice"}
+json.dump(dict(common, name="slash-factor", counterbalance="swap_copies",
+               factors={"edge": [3, 9], "label_a/b": ["p/q", "r/s"],
+                        "pair": [{"id": "m/e", "left": "measured", "right": "estimated"},
+                                 {"id": "e/n", "left": "estimated", "right": "none"}]}),
+          open(w + "/factor.json", "w"))
+t = json.load(open(w + "/factor.json"))
+t["factors"]["side/pair"] = t["factors"].pop("pair")
+json.dump(t, open(w + "/analysed.json", "w"))
+json.dump(dict(common, name="slash-table", blocks=[{"name": "tab", "conditions": "rows.csv"}]),
+          open(w + "/table.json", "w"))
+# Numeric ids no reader holds exactly (1e308, 2^64 - 1): refused too (the adversary's ids that validated).
+for name, pid in (("huge", 1e308), ("wide", 18446744073709551615)):
+    json.dump(dict(common, name="id-" + name, factors={"pattern": [{"id": pid, "left": "measured", "right": "none"}],
+                                                       "edge": [3]}),
+              open(w + "/" + name + ".json", "w"))
+for name, pid in (("infinity", "Infinity"), ("nan", "nan")):
+    json.dump(dict(common, name="id-" + name, factors={"pattern": [{"id": pid, "left": "measured", "right": "none"},
+                                                                   {"id": 2, "left": "estimated", "right": "none"}],
+                                                       "edge": [3]}),
+              open(w + "/" + name + ".json", "w"))
+PYEOF
+  sed -i "s|\"\.\./|\"$P/../|g" "$W"/*.json
+  for p in infinity nan; do
+    code=0
+    $BC validate "$W/$p.json" > "$W/out" 2>&1 || code=$?
+    [ "$code" = 3 ] || fail "validate of a pattern id $p: exit $code, expected 3: $(tail -1 "$W/out")"
+    grep -q "/factors/pattern/0/id: an id is text the readers of the exported tables (pandas, R) take as a missing value or an infinite number, not as a name" "$W/out" ||
+      fail "validate of a pattern id $p: $(tail -1 "$W/out")"
+  done
+  # A factor of object levels (analysed: a term of the report's models) named side/pair: refused by validate and run.
+  for cmd in "validate $W/analysed.json" "run $W/analysed.json --participant P1 --db $W/refused.sqlite --observer sim"; do
+    code=0
+    $BC $cmd > "$W/out" 2>&1 || code=$?
+    [ "$code" = 3 ] || fail "$cmd: exit $code, expected 3: $(tail -1 "$W/out")"
+    grep -qF "/factors/side~1pair: the factor side/pair names a term of the report's models" "$W/out" ||
+      fail "$cmd: $(tail -1 "$W/out")"
+  done
+  for p in huge wide; do
+    code=0
+    $BC validate --no-files "$W/$p.json" > "$W/out" 2>&1 || code=$?
+    [ "$code" = 3 ] && grep -q "/factors/pattern/0/id: an id must be text or a whole number below 2^53" "$W/out" ||
+      fail "validate of a pattern id $p: exit $code: $(tail -1 "$W/out")"
+  done
+  code=0
+  $BC run "$W/factor.json" --participant NA --db "$W/na.sqlite" --observer sim > "$W/out" 2>&1 || code=$?
+  [ "$code" = 2 ] || fail "run of participant NA: exit $code, expected 2: $(tail -1 "$W/out")"
+  grep -q "missing value" "$W/out" || fail "run of participant NA: $(tail -1 "$W/out")"
+  for p in factor table; do
+    $BC validate "$W/$p.json" > "$W/out" 2>&1 || fail "validate $p: $(tail -1 "$W/out")"
+    $BC run "$W/$p.json" --participant P1 --db "$W/s.sqlite" --observer sim > "$W/out" 2>&1 || fail "run $p: $(tail -1 "$W/out")"
+  done
+  code=0
+  MPLCONFIGDIR=$W/mpl $BC report --db "$W/s.sqlite" --out "$W/report" --bench "$W/no-bench" --boot 20 > "$W/out" 2>&1 ||
+    code=$?
+  [ "$code" = 0 ] || fail "report of names with '/': exit $code: $(tail -3 "$W/out")"
+  # The pattern's ids with a '/' are shown verbatim; the labels are recorded as they are.
+  for name in "m/e" "e/n"; do
+    grep -qF "$name" "$W/report/index.html" || fail "the page does not show $name verbatim"
+  done
+  for name in "label_a/b" "label_c/d"; do
+    head -1 "$W/report/tables/trials.csv" | grep -qF "$name" || fail "trials.csv has no column $name"
+  done
+  # Every file the page links to is in the report's folder, and no file name has a folder in it.
+  $PY - "$W/report" <<'PYEOF' || fail "the report's links"
+import html, os, re, sys
+d = sys.argv[1]
+page = open(os.path.join(d, "index.html"), encoding="utf-8").read()
+links = [html.unescape(l) for l in re.findall(r"(?:src|href)='([^'#:]+)'", page)]
+assert links, "no links"
+missing = [l for l in links if not os.path.isfile(os.path.join(d, l))]
+assert not missing, missing
+assert not any(os.path.isdir(os.path.join(d, e)) and e not in ("tables",) for e in os.listdir(d)), os.listdir(d)
+PYEOF
+  echo "ok: labels and ids with '/' report (exit 0), kept verbatim; a factor side/pair, ids Infinity, nan, 1e308 and 2^64 - 1 and a participant NA refused" ;;
+collided_names)
+  # Two design variables recorded in one column are refused by validate (with and without --no-files) and by run,
+  # naming both, before anything is recorded (issue 24: a factor status and a factor factor_status validated, and
+  # factor_status was recorded with status's levels, b1/b2 stored nowhere). A factor of object levels may take any
+  # name, so status (a column trials.csv writes itself, its levels recorded as factor_status) meets factor_status.
+  $PY - "$P/test1-static-grids.json" "$W" <<'PYEOF'
+import json, sys
+t, w = json.load(open(sys.argv[1])), sys.argv[2]
+common = {"version": 1, "scene": t["scene"], "content": {"type": "grid"}, "task": "forced_choice",
+          "sides": {"left": "measured", "right": "estimated"}}
+ids = lambda *names: [{"id": n} for n in names]
+json.dump(dict(common, name="collided", factors={"edge": [2, 5], "status": ids("a1", "a2"),
+                                                 "factor_status": ids("b1", "b2")}),
+          open(w + "/status.json", "w"))
+json.dump(dict(common, name="collided", factors={"edge": [2, 5], "correct": ids("a1", "a2"),
+                                                 "factor_correct": ids("b1", "b2")}),
+          open(w + "/correct.json", "w"))
+PYEOF
+  sed -i "s|\"\.\./|\"$P/../|g" "$W"/*.json
+  for name in status correct; do
+    # The factors in name order: correct before factor_correct, factor_status before status.
+    if [ $name = correct ]; then
+      want="/factors/factor_$name: the factor factor_$name is recorded in the column factor_$name, as is the factor $name (/factors/$name)"
+    else
+      want="/factors/$name: the factor $name is recorded in the column factor_$name, as is the factor factor_$name (/factors/factor_$name)"
+    fi
+    for cmd in "validate $W/$name.json" "validate --no-files $W/$name.json" \
+               "run $W/$name.json --participant P1 --db $W/s.sqlite --observer sim"; do
+      code=0
+      $BC $cmd > "$W/out" 2>&1 || code=$?
+      [ "$code" = 3 ] || fail "$cmd: exit $code, expected 3: $(tail -1 "$W/out")"
+      grep -qF "$want" "$W/out" || fail "$cmd: $(cat "$W/out")"
+    done
+  done
+  [ ! -e "$W/s.sqlite" ] || [ "$(sql "$W/s.sqlite" "SELECT count(*) FROM sessions")" = 0 ] || fail "run recorded a session"
+  echo "ok: status/factor_status and correct/factor_correct refused by validate, validate --no-files and run, naming both" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -423,5 +423,95 @@ resume_exact)
       fail "$proto: resumed differs from uninterrupted in $(grep -c '^<' "$W/$proto.diff") rows, e.g. $(grep -m2 '^[<>]' "$W/$proto.diff" | tr '\n' ' ')"
   done
   echo "ok: stopped after 5 and resumed = uninterrupted to the last digit of every response and flip time (test 2, depth matching)" ;;
+schema1)
+  # A record an early build wrote (schema 1: no display profile, no typed columns, a trial's variables as that build's
+  # TrialVariables kept them - the levels as given, a pattern's speed_cm_s only inside the pattern object, then
+  # practice, block_name, swapped and the three radii) exports every variable it holds and reports (issue 24: export
+  # left speed_cm_s out and report exited 10 for every study). It is made from a record of today's run (test 2's
+  # task 1, the balls rolled at 2 frames a second) by writing its rows into schema 1's tables, as that build did.
+  $PY - "$P/test2-moving-balls.json" "$W/t2.json" <<'PYEOF'
+import json, sys
+t = json.load(open(sys.argv[1]))
+t["blocks"] = t["blocks"][:1]
+t.pop("practice", None)
+json.dump(t, open(sys.argv[2], "w"))
+PYEOF
+  sed -i "s|\"\.\./|\"$P/../|g" "$W/t2.json"
+  $BC run "$W/t2.json" --participant P1 --db "$W/new.sqlite" --observer sim --sim-fps 2 > "$W/out" 2>&1 ||
+    fail "run: $(tail -1 "$W/out")"
+  $PY - "$W/new.sqlite" "$W/old.sqlite" <<'PYEOF'
+import json, sqlite3, sys
+new, old = sqlite3.connect(sys.argv[1]), sqlite3.connect(sys.argv[2])
+# Schema 1 as the early build created it (src/store/schema.cc at 0fc9814^, STRICT as SQLite >= 3.37 made it).
+S = " STRICT"
+old.executescript(f"""
+CREATE TABLE studies (id INTEGER PRIMARY KEY, name TEXT NOT NULL UNIQUE, created TEXT NOT NULL){S};
+CREATE TABLE protocol_versions (id INTEGER PRIMARY KEY, study_id INTEGER NOT NULL REFERENCES studies(id),
+  json TEXT NOT NULL, hash TEXT NOT NULL, created TEXT NOT NULL, UNIQUE (study_id, hash)){S};
+CREATE TABLE participants (id INTEGER PRIMARY KEY, study_id INTEGER NOT NULL REFERENCES studies(id),
+  code TEXT NOT NULL, created TEXT NOT NULL, UNIQUE (study_id, code)){S};
+CREATE TABLE sessions (id INTEGER PRIMARY KEY, participant_id INTEGER NOT NULL REFERENCES participants(id),
+  protocol_version_id INTEGER NOT NULL REFERENCES protocol_versions(id), seed INTEGER NOT NULL,
+  software_version TEXT NOT NULL, host TEXT NOT NULL, display TEXT NOT NULL, started TEXT NOT NULL, ended TEXT,
+  status TEXT NOT NULL CHECK (status IN ('running', 'completed', 'aborted')), lock_host TEXT, lock_pid INTEGER,
+  lock_token TEXT, lock_heartbeat_ms INTEGER){S};
+CREATE INDEX sessions_participant ON sessions (participant_id);
+CREATE TABLE trials (id INTEGER PRIMARY KEY, session_id INTEGER NOT NULL REFERENCES sessions(id),
+  trial_index INTEGER NOT NULL, block INTEGER NOT NULL, factors TEXT NOT NULL, left_shown TEXT NOT NULL,
+  right_shown TEXT NOT NULL, UNIQUE (session_id, trial_index)){S};
+CREATE TABLE responses (id INTEGER PRIMARY KEY, trial_id INTEGER NOT NULL UNIQUE REFERENCES trials(id),
+  choice TEXT NOT NULL, rt_ms REAL, adjustment TEXT NOT NULL, answered_at TEXT NOT NULL){S};
+CREATE TABLE frames (id INTEGER PRIMARY KEY, trial_id INTEGER NOT NULL REFERENCES trials(id),
+  frame_index INTEGER NOT NULL, flip_time_s REAL NOT NULL, dropped INTEGER NOT NULL CHECK (dropped IN (0, 1)),
+  UNIQUE (trial_id, frame_index)){S};
+PRAGMA user_version = 1;
+""")
+def copy(table, columns, transform=None):
+    for row in new.execute(f"SELECT {', '.join(columns)} FROM {table} ORDER BY id"):
+        row = list(row)
+        if transform: row = transform(row)
+        old.execute(f"INSERT INTO {table} ({', '.join(columns)}) VALUES ({', '.join('?' * len(columns))})", row)
+copy("studies", ["id", "name", "created"])
+# The protocol's text as run; the early build hashed the file's bytes (migration 2 makes the hash canonical).
+copy("protocol_versions", ["id", "study_id", "json", "hash", "created"], lambda r: r[:3] + ["0123456789abcdef", r[4]])
+copy("participants", ["id", "study_id", "code", "created"])
+# The early build wrote the simulated observer into the display text ("...; observer sim:..."), in its spelling.
+copy("sessions", ["id", "participant_id", "protocol_version_id", "seed", "software_version", "host", "display",
+                  "started", "ended", "status"],
+     lambda r: r[:6] + [r[6].split("; observer ")[0] + "; observer sim:jnd=0.6,bias=0"] + r[7:])
+kept = ("practice", "block_name", "swapped", "r_left_px", "r_right_px", "r_scene_px")
+protocol = json.loads(new.execute("SELECT json FROM protocol_versions").fetchone()[0])
+levels = set(protocol["blocks"][0]["factors"])
+def old_factors(r):
+    f = json.loads(r[4])
+    r[4] = json.dumps({k: v for k, v in f.items() if k in levels or k in kept}, separators=(",", ":"))
+    return r
+copy("trials", ["id", "session_id", "trial_index", "block", "factors", "left_shown", "right_shown"], old_factors)
+copy("responses", ["id", "trial_id", "choice", "rt_ms", "adjustment", "answered_at"])
+copy("frames", ["id", "trial_id", "frame_index", "flip_time_s", "dropped"])
+old.commit()
+first = json.loads(old.execute("SELECT factors FROM trials").fetchone()[0])
+assert "speed_cm_s" not in first and "speed_cm_s" in first["pattern"], first
+PYEOF
+  $BC export --db "$W/old.sqlite" --out "$W/old-tables" > "$W/out" 2>&1 || fail "export of the old record: $(tail -1 "$W/out")"
+  $BC export --db "$W/new.sqlite" --out "$W/new-tables" > "$W/out" 2>&1 || fail "export of the new record: $(tail -1 "$W/out")"
+  # Every variable the old record holds is a column, with the value today's run recorded for it.
+  $PY - "$W/old-tables/trials.csv" "$W/new-tables/trials.csv" <<'PYEOF' || fail "the old record's export"
+import csv, sys
+old, new = (list(csv.DictReader(open(p))) for p in sys.argv[1:])
+assert len(old) == len(new) == 12, (len(old), len(new))
+for column in ("pattern", "speed_cm_s", "practice", "block_name", "swapped", "r_left_px", "r_right_px", "chosen_side"):
+    assert column in old[0], f"no column {column} in the old record's export: {sorted(old[0])}"
+for o, n in zip(old, new):
+    for column in ("trial_index", "pattern", "speed_cm_s", "r_left_px", "r_right_px", "chosen_side"):
+        assert o.get(column) == n.get(column), (column, o.get(column), n.get(column))
+assert sorted({o["speed_cm_s"] for o in old}) == ["1.8", "3"], {o["speed_cm_s"] for o in old}
+PYEOF
+  code=0
+  MPLCONFIGDIR=$W/mpl $BC report --db "$W/old.sqlite" --out "$W/report" --bench "$W/no-bench" --boot 20 > "$W/out" 2>&1 ||
+    code=$?
+  [ "$code" = 0 ] || fail "report on the old record: exit $code: $(tail -3 "$W/out")"
+  grep -q "speed" "$W/report/index.html" || fail "the old record's report says nothing of speed"
+  echo "ok: a schema-1 record exports speed_cm_s (12 rows equal to today's record's) and reports (exit 0)" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -14,9 +14,9 @@ set_tests_properties(session_protocols PROPERTIES FIXTURES_SETUP session_protoco
 # (session_design_test.sh), what the screen shows (session_display_test.sh); session_lib.sh is their shared part.
 set(SESSION_CASES_session_test complete same_seed resume kill9 second_writer recover merge merge_live_writer
     merge_killed_session resume_guards stranded stale_lock readonly resume_observer resume_display groups_concurrent
-    resume_exact)
+    resume_exact schema1)
 set(SESSION_CASES_session_design_test adaptive groups_info codebook report_any_study report_aborted practice_criterion
-    level_names)
+    level_names odd_names collided_names)
 set(SESSION_CASES_session_display_test window window_adjust depth_arcmin frames_shown two_intervals deadline layouts
     window_after_motion visibility depth_capture)
 foreach(script session_test session_design_test session_display_test)

@@ -289,3 +289,19 @@ class AbortedSessionsTest(ReportTestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class FileStemTest(unittest.TestCase):
+    """A chart's name as a file name (issue 24: a factor named a/b made report write into a folder a/ that did not
+    exist, exit 10): safe names as they are, others with '_' for each unsafe character and a hash of the name."""
+
+    def test_names_as_file_names(self):
+        sys.path.insert(0, os.path.dirname(HERE))
+        from common import file_stem
+        self.assertEqual(file_stem("test1-static-grids-per-edge"), "test1-static-grids-per-edge")
+        slash, underscore = file_stem("s-share-per-label_a/b"), file_stem("s-share-per-label_a_b")
+        self.assertTrue(slash.startswith("s-share-per-label_a_b-"), slash)
+        self.assertNotEqual(slash, underscore)  # two names stay two files
+        self.assertRegex(slash, r"^[A-Za-z0-9_.-]+$")
+        self.assertFalse(file_stem("../x").startswith("."))
+        self.assertLessEqual(len(file_stem("é" * 300)), 200)

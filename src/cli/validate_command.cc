@@ -15,6 +15,7 @@
 #include "protocol/trials.h"
 #include "session/observer.h"
 #include "session/prepare.h"
+#include "session/recorded_names.h"
 #include "session/visibility.h"
 
 namespace blurcue::cli {
@@ -82,6 +83,8 @@ void AddValidateCommand(CLI::App& app) {
     std::vector<std::string> grid_problems;  // --plan: a QUEST+ grid that does not hold the observer
     if (args->no_files) {
       p = protocol::LoadProtocol(args->file, protocol::ValidateOptions{false});
+      // As PrepareStudy does for run: each design variable recorded in a column of its own.
+      session::CheckRecordedNames(p, ParseJson(ReadTextFile(args->file), args->file));
       for (const std::string& group : GroupsToCheck(p, args->group)) {
         const uint64_t seed = args->seed ? *args->seed : protocol::DefaultSeed(p.name, args->participant);
         checked.push_back({group, seed, protocol::BuildTrials(p, args->participant, seed, group), ""});

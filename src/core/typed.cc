@@ -87,6 +87,17 @@ std::string UnsafeIdReason(std::string_view text) {
   if (!text.empty() && std::string_view("=+-@").find(text.front()) != std::string_view::npos)
     return std::string("begins with ") + text.front() + ", which a spreadsheet opening the exported tables runs as a "
            "formula";
+  // What the readers of the exported tables take for no value or for an infinite number instead of a name: pandas
+  // reads NA, NaN, nan, null, N/A, #N/A, <NA>, 1.#IND, inf and Infinity (in any case) so, R reads NA; another
+  // spelling of one of them in other letter cases is refused too, so the rule does not depend on a reader's version.
+  // An id Infinity stopped the report (exit 10); a participant NA was dropped as missing.
+  std::string lower(text);
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  for (const char* missing : {"na", "nan", "n/a", "null", "none", "#n/a", "#na", "#n/a n/a", "<na>", "1.#ind",
+                              "1.#qnan", "inf", "infinity"})
+    if (lower == missing)
+      return "is text the readers of the exported tables (pandas, R) take as a missing value or an infinite number, "
+             "not as a name";
   // The bidirectional controls in UTF-8: U+061C (D8 9C), U+200E/F (E2 80 8E/8F), U+202A-E (E2 80 AA-AE),
   // U+2066-9 (E2 81 A6-A9).
   for (size_t i = 0; i + 1 < text.size(); ++i) {

@@ -81,6 +81,16 @@ TEST(UnsafeIdReason, FormulaStartsAndBidiControlsAreNamed) {
   EXPECT_EQ(UnsafeIdReason("a\u2022b"), "");  // a bullet (E2 80 A2) is not a control
 }
 
+// Text that pandas or R reads as a missing value or an infinite number (checked against pandas.read_csv by hand: an
+// id column holding Infinity becomes float inf, NA and nan become NaN) is no name: a pattern id Infinity stopped the
+// report with exit 10, a participant NA would be dropped as missing (issue 24).
+TEST(UnsafeIdReason, WhatTheTablesReadersTakeAsMissingOrInfiniteIsRefused) {
+  for (const char* id : {"Infinity", "infinity", "INF", "inf", "NaN", "nan", "NAN", "NA", "na", "null", "NULL", "None",
+                         "N/A", "#N/A", "<NA>", "1.#IND"})
+    EXPECT_NE(UnsafeIdReason(id).find("missing value or an infinite number"), std::string::npos) << id;
+  for (const char* id : {"NA1", "Nancy", "info", "Infinite", "P_nan", "n.a."}) EXPECT_EQ(UnsafeIdReason(id), "") << id;
+}
+
 TEST(Utf8Length, CountsCodePoints) {
   EXPECT_EQ(Utf8Length(""), 0u);
   EXPECT_EQ(Utf8Length("abc"), 3u);

@@ -4,6 +4,7 @@
 
 #include "core/error.h"
 #include "core/json_io.h"
+#include "session/recorded_names.h"
 
 namespace blurcue::session {
 
@@ -19,7 +20,10 @@ PreparedSession PrepareStudy(const std::filesystem::path& protocol_file, const s
   PreparedSession s;
   // Read once: the text recorded with the session is the text that was validated.
   const std::string text = ReadTextFile(protocol_file);
-  s.protocol = protocol::ParseProtocol(ParseJson(text, protocol_file.string()), protocol_file);
+  const Json json = ParseJson(text, protocol_file.string());
+  s.protocol = protocol::ParseProtocol(json, protocol_file);
+  // Each design variable in a column of its own (the record's rule: recorded_names.h), before anything else is read.
+  CheckRecordedNames(s.protocol, json);
   s.protocol_text = protocol::RecordedText(text, s.protocol);
   s.scene = LoadProtocolScene(s.protocol);
   s.images = LoadStimulusImages(s.protocol, s.scene);

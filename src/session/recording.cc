@@ -166,17 +166,9 @@ std::map<int64_t, RecordedAnswer> Recording::AnsweredTrials(int64_t session) {
 Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation) {
   // Every level under store::DesignColumn's name: one named like a column of trials.csv or a variable recorded
   // below (status, r_left_px, level, correct, ...) as factor_NAME, so what is recorded never overwrites a level.
-  Json v = Json::object();
-  if (trial.levels.is_object())
-    for (const auto& [name, level] : trial.levels.items()) v[store::DesignColumn(name)] = level;
   // A level object's values get columns of their own (a pattern's speed_cm_s, a conditions table's edge); the sides
   // are recorded as such. A conditions table's row object itself is no factor of the design: only its columns stay.
-  for (const auto& [name, level] : trial.levels.items())
-    if (level.is_object())
-      for (const auto& [key, value] : level.items())
-        if (key != "left" && key != "right" && key != "object" && !v.contains(store::DesignColumn(key)))
-          v[store::DesignColumn(key)] = value;
-  if (v.contains("row") && v["row"].is_object()) v.erase("row");
+  Json v = store::LevelVariables(trial.levels);
   v["practice"] = trial.practice ? 1 : 0;
   v["block_name"] = trial.block;
   v["swapped"] = trial.swapped ? 1 : 0;

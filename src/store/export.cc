@@ -164,6 +164,27 @@ bool IsRecordedName(const std::string& name) {
 
 std::string DesignColumn(const std::string& name) { return IsRecordedName(name) ? "factor_" + name : name; }
 
+void SpreadObjectLevels(Json* variables) {
+  if (!variables->is_object()) return;
+  Json spread = Json::object();
+  for (const auto& [name, level] : variables->items())
+    if (level.is_object())
+      for (const auto& [key, value] : level.items())
+        if (key != "left" && key != "right" && key != "object" && !variables->contains(DesignColumn(key)) &&
+            !spread.contains(DesignColumn(key)))
+          spread[DesignColumn(key)] = value;
+  for (auto& [key, value] : spread.items()) (*variables)[key] = std::move(value);
+}
+
+Json LevelVariables(const Json& levels) {
+  Json v = Json::object();
+  if (!levels.is_object()) return v;
+  for (const auto& [name, level] : levels.items()) v[DesignColumn(name)] = level;
+  SpreadObjectLevels(&v);
+  if (v.contains("row") && v["row"].is_object()) v.erase("row");
+  return v;
+}
+
 int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::path& out_dir,
                   const ProgressNote& note) {
   return ExportCsvWith(RecordColumns(), db_path, out_dir, note);
@@ -199,7 +220,8 @@ int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::p
     while (factors.Step()) {
       const std::string where = Where(db_path, factors.GetInt64(0), factors.GetInt64(1));
       for (int column : {2, 3}) {
-        const Json object = ParseColumn(factors.GetText(column), where + (column == 2 ? " factors" : " shown"));
+        Json object = ParseColumn(factors.GetText(column), where + (column == 2 ? " factors" : " shown"));
+        if (column == 2) SpreadObjectLevels(&object);
         if (!object.is_object())
           throw InputError(where, std::string(column == 2 ? "factors" : "shown") + " must be a JSON object");
         for (const auto& item : object.items())
@@ -343,6 +365,7 @@ int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::p
     cells_of(Place::kTrial, &cells);
     // The plan's variables, with what the trial showed when it was shown laid over them (adaptive levels).
     Json factors = ParseColumn(rows.GetText(4), where + " factors");
+    SpreadObjectLevels(&factors);
     const Json shown = ParseColumn(rows.GetText(5), where + " shown");
     if (factors.is_object() && shown.is_object())
       for (const auto& [key, value] : shown.items()) factors[key] = value;

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "core/json_io.h"
+
 namespace blurcue::store {
 
 // Receives one line for the user (what was cleaned up, what needs care); the caller decides where to print it.
@@ -40,6 +42,15 @@ bool IsRecordedName(const std::string& name);
 // The name a design's level `name` is recorded and exported under: "factor_<name>" when IsRecordedName(name) (so it
 // can never be overwritten by, or mistaken for, what the runner records), else `name`.
 std::string DesignColumn(const std::string& name);
+
+// The variables a trial's levels are recorded as (the runner's, session TrialVariables): each level under
+// DesignColumn(name); each value of an object level (a pattern's speed_cm_s, a conditions table's columns; not its
+// sides left, right and object) under DesignColumn(key) where no level took that column; a conditions table's row
+// object itself is not kept, only its columns.
+Json LevelVariables(const Json& levels);
+// Adds to a trial's recorded variables each value of an object level they hold (as LevelVariables records it) where
+// they lack it: a record of an early build kept a pattern's speed_cm_s only inside the pattern.
+void SpreadObjectLevels(Json* variables);
 
 // Copies every study, protocol version, participant, session, trial, response and frame of `inputs` into a new
 // record at `out`, with fresh ids. Protocol versions are shared by (study, hash) and participants by (study,

@@ -195,6 +195,45 @@ TEST(Merge, AnOlderAndANewRecordMergeWithTheirTypedColumns) {
             "measured:2.00000000,estimated:1.23456789");
 }
 
+// A record of schema 1 as an early build wrote it (issue 24): the trial's variables were its levels as given - a
+// pattern's speed_cm_s only inside the pattern object - and practice, block_name, swapped and the radii. Its export
+// has a speed_cm_s column with each trial's pattern's speed, as today's runner records it (it used to be left out,
+// and the report stopped with exit 10); the pattern's column names it by its id; its sides are no columns.
+TEST(Export, ASchemaOneRecordsPatternGivesItsSpeedAColumn) {
+  testing::TempDir dir;
+  {
+    Database db(dir / "old.sqlite");
+    db.Exec(Migrations()[0].sql);
+    db.Exec("PRAGMA user_version = 1;"
+            "INSERT INTO studies (name, created) VALUES ('test2-moving-balls', 'now');"
+            "INSERT INTO protocol_versions (study_id, json, hash, created) VALUES (1, '{}', 'h', 'now');"
+            "INSERT INTO participants (study_id, code, created) VALUES (1, 'P1', 'now');"
+            "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, host, display, "
+            "  started, status) VALUES (1, 1, 5, 'v', 'h', 'headless 1280x720; llvmpipe; observer sim:jnd=0.6', "
+            "  'now', 'completed');"
+            "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, right_shown) VALUES "
+            "  (1, 0, 0, '{\"pattern\":{\"id\":1,\"left\":\"measured\",\"right\":\"none\",\"speed_cm_s\":3},"
+            "\"practice\":0,\"block_name\":\"task1\",\"swapped\":0,\"r_left_px\":2.5,\"r_right_px\":0,"
+            "\"r_scene_px\":2.4}', '\"measured\"', '\"none\"'),"
+            "  (1, 1, 0, '{\"pattern\":{\"id\":4,\"left\":\"estimated\",\"right\":\"none\",\"speed_cm_s\":1.8},"
+            "\"practice\":0,\"block_name\":\"task1\",\"swapped\":1,\"r_left_px\":0,\"r_right_px\":3.1,"
+            "\"r_scene_px\":2.4}', '\"none\"', '\"estimated\"');"
+            "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at) VALUES "
+            "  (1, 'left', 700, '[]', 'now'), (2, 'cant_tell', 900, '[]', 'now');");
+  }
+  EXPECT_EQ(ExportCsv(dir / "old.sqlite", dir / "out"), 2);
+  const Rows rows = ReadCsv(dir / "out" / "trials.csv");
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[1][Column(rows, "speed_cm_s")], "3");
+  EXPECT_EQ(rows[2][Column(rows, "speed_cm_s")], "1.8");
+  EXPECT_EQ(rows[1][Column(rows, "pattern")], "1");
+  EXPECT_EQ(rows[2][Column(rows, "pattern")], "4");
+  EXPECT_EQ(rows[2][Column(rows, "r_right_px")], "3.1");
+  EXPECT_EQ(rows[2][Column(rows, "right_source")], "estimated");
+  for (const char* side : {"left", "right"})
+    for (const auto& name : rows[0]) EXPECT_NE(name, side);
+}
+
 // A record of schema 6 (its typed columns still in JSON texts and free text) exports the same tidy table from a
 // migrated copy, and is itself left as it was.
 TEST(Export, AnOlderRecordExportsFromAMigratedCopy) {
