@@ -169,6 +169,9 @@ Json CalibToJson(const CalibResult& r) {
                  {"ok", s.fit.ok},
                  {"flags", s.fit.flags},
                  {"psf", s.fit.psf},
+                 {"disc_r_px", s.fit.disc_r_px},
+                 {"floor_sigma_px", s.fit.floor_sigma_px},
+                 {"shape_ambiguous", s.fit.shape_ambiguous},
                  {"fit_rms_rel", s.fit.rms_rel},
                  {"step_linear", s.fit.step},
                  {"thesis_ok", s.thesis.ok}};

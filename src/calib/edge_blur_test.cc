@@ -132,7 +132,9 @@ TEST(EdgeModel, PicksTheBetterFittingFamilyForLargeBlur) {
     spec.r_px = 10;
     spec.noise = 0.005;
     const EdgeImage img = Render(spec);
-    EXPECT_EQ(MeasureEdgeModel(img.linear, img.segment).psf, psf);
+    const ModelFit fit = MeasureEdgeModel(img.linear, img.segment);
+    EXPECT_EQ(fit.psf, psf) << "disc " << fit.disc_r_px << " floor " << fit.floor_sigma_px << " se "
+                            << fit.shape_se_rad;
   }
 }
 
