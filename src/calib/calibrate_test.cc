@@ -185,6 +185,22 @@ TEST(Calibrate, RealOpticsMeasuredAndFittedWithinTwoPercentMedianFivePercentP90)
   }
 }
 
+// Model no more than the scene needs: a floor where the optics have one, none where they do not, chosen by
+// leave-one-out error and written to calib.json with both candidates' errors and eq. 3.7's beside them.
+TEST(Calibrate, ModelChoiceByHeldOutErrorIsWrittenWithBothFits) {
+  const Calibration& with_floor = Calibrated(RealOpticsScenes()[2].options);  // floor 0.35 px, focus on edge 1
+  const Json a = CalibToJson(with_floor.result)["model"]["choice"];
+  std::printf("floor scene: %s\n", a.dump().c_str());
+  EXPECT_EQ(a["chosen"], "thin_lens+floor");
+  EXPECT_LT(a["thin_lens+floor"]["loo_rms_px"].get<double>(), 0.9 * a["thin_lens"]["loo_rms_px"].get<double>());
+  EXPECT_NEAR(a["thin_lens+floor"]["floor_px"].get<double>(), 0.7, 0.07);  // 2 x 0.35 px
+  EXPECT_GT(a["eq37"]["sections"].get<int>(), 0);
+  const Json b = CalibToJson(Calibrated(Blurry()).result)["model"]["choice"];
+  std::printf("no-floor scene: %s\n", b.dump().c_str());
+  EXPECT_EQ(b["chosen"], "thin_lens");
+  EXPECT_TRUE(b["thin_lens+floor"]["loo_rms_px"].is_number());
+}
+
 TEST(Calibrate, JsonHasEveryFieldTheIssueNames) {
   const Calibration& r = Calibrated(Thesis());
   const Json j = CalibToJson(r.result);
