@@ -524,7 +524,7 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
   std::array<std::array<double, 3>, 3> jtj{};
   {
     FitState mixed;
-    for (double phi : {best.phi == 0 ? 0.15 : kPi / 2 - 0.15, kPi / 4}) {
+    for (double phi : {best.phi == 0 ? 0.15 : kPi / 2 - 0.15}) {
       FitState start_state = best;
       start_state.phi = phi;
       std::array<std::array<double, 3>, 3> a{};
