@@ -7,8 +7,11 @@
                                    convolution, per frame size; Pareto front per size and radius
   two-ball frame                   region-by-region vs the thesis's whole-frame blur, median and p99 per frame
   stability                        share of sections within target, and mean |error|, against each swept factor
-                                   (noise, contrast, JPEG, flaws, blur size, tilt); the README's target line and the
-                                   level where each method first fails
+                                   (noise, contrast, JPEG, flaws, blur size, tilt, vignetting); the README's target
+                                   line and the level where each method first fails
+  error against r, per PSF         median (and p90) |error| / true r against the true r for each PSF family (disc,
+                                   Gaussian, disc x floor at floor/defocus ratios, near focus with a 0.35 px floor),
+                                   one panel per method; the issue's 2 % / 5 % lines and where each family breaks
 Target (README, `bench measure`): |error| <= max(0.25 px, 5 %) on >= 90 % of sections (and >= 50 % answered).
 """
 import os
@@ -37,7 +40,7 @@ METHOD_LABELS = {"model_fit": "model fit (r_px)", "thesis": "thesis threshold co
 METHOD_COLORS = {"model_fit": "#0072B2", "thesis": "#D55E00", "eq37": "#E69F00", "fitted_model": "#009E73"}
 FACTOR_LABELS = {"noise": "sensor noise std (fraction of full scale)", "contrast": "Michelson contrast",
                  "jpeg": "JPEG quality", "flaws": "printing flaws (dark spots)", "blur": "true blur radius r (px)",
-                 "tilt": "camera tilt (deg)"}
+                 "tilt": "camera tilt (deg)", "vignetting": "vignetting (fall-off at the corner)"}
 RENDER_COLORS = {("gaussian", "gl"): "#0072B2", ("gaussian", "cpu"): "#56B4E9", ("disc", "gl"): "#D55E00",
                  ("disc", "cpu"): "#E69F00"}
 RADIUS_MARKERS = {1: "o", 4: "s", 8: "^", 16: "D"}
@@ -208,11 +211,88 @@ def breakpoints(measure):
     return pd.DataFrame(rows)
 
 
+PSF_FAMILY_LABELS = {"psf_disc": "disc", "psf_gaussian": "Gaussian", "psf_disc_floor_0.25": "disc x floor 0.25 R",
+                     "psf_disc_floor_0.5": "disc x floor 0.5 R", "psf_disc_floor_1": "disc x floor 1 R",
+                     "near_focus": "disc x floor 0.35 px (near focus)"}
+PSF_FAMILY_COLORS = {"psf_disc": "#0072B2", "psf_gaussian": "#D55E00", "psf_disc_floor_0.25": "#009E73",
+                     "psf_disc_floor_0.5": "#CC79A7", "psf_disc_floor_1": "#E69F00", "near_focus": "#000000"}
+MEDIAN_REL, P90_REL = 0.02, 0.05  # issue 25, "Must hold"
+
+
+def _is_psf_family(factor):
+    return factor.startswith("psf_") or factor == "near_focus"
+
+
+def error_vs_r(measure, out_dir):
+    """Each method's relative error against the true r, one line per PSF family (bench measure's PSF sweeps)."""
+    if "median_rel_error" not in measure.columns:
+        raise Skip("bench measure: measure.csv has no median_rel_error column (written by an older blurcue)")
+    fams = [f for f in dict.fromkeys(measure["factor"]) if _is_psf_family(f)]
+    if not fams:
+        raise Skip("bench measure: no PSF-family sweeps in measure.csv")
+    methods = [m for m in ("model_fit", "thesis", "fitted_model") if m in set(measure["method"])]
+    fig, axes = plt.subplots(1, len(methods), figsize=(4.6 * len(methods), 4.4), squeeze=False, sharey=True)
+    rows = []
+    for ax, method in zip(axes.flat, methods):
+        for fam in fams:
+            g = measure[(measure["factor"] == fam) & (measure["method"] == method)].sort_values("level")
+            answered = g[g["answered"] > 0]
+            color = PSF_FAMILY_COLORS.get(fam, "#555555")
+            ax.plot(answered["level"], 100 * answered["median_rel_error"].clip(lower=5e-4), "-o", ms=3.5, lw=1.3,
+                    color=color, label=PSF_FAMILY_LABELS.get(fam, fam))
+            ax.plot(answered["level"], 100 * answered["p90_rel_error"].clip(lower=5e-4), ":", lw=1, color=color)
+            holds = (g["answered"] * 2 >= g["sections"]) & (g["median_rel_error"] <= MEDIAN_REL) & \
+                (g["p90_rel_error"] <= P90_REL)
+            fails = g[~holds]
+            if len(fails) and fails.iloc[0]["answered"] > 0:
+                first = fails.iloc[0]
+                ax.scatter([first["level"]], [100 * max(first["median_rel_error"], 5e-4)], marker="X", s=90,
+                           color=color, edgecolor="black", lw=0.6, zorder=5)
+            rows.append({"method": method, "psf": PSF_FAMILY_LABELS.get(fam, fam),
+                         "holds_at_r_px": ", ".join(f"{lv:.3g}" for lv in g.loc[holds, "level"]),
+                         "breaks_at_r_px": f"{fails.iloc[0]['level']:.3g}" if len(fails) else "holds everywhere",
+                         "median_rel_error_at_break": fails.iloc[0]["median_rel_error"] if len(fails) else np.nan,
+                         "p90_rel_error_at_break": fails.iloc[0]["p90_rel_error"] if len(fails) else np.nan})
+        ax.axhline(100 * MEDIAN_REL, color="black", ls="--", lw=0.9)
+        ax.axhline(100 * P90_REL, color="black", ls="-.", lw=0.9)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        plain_log_ticks(ax.xaxis)
+        plain_log_ticks(ax.yaxis)
+        ax.set_xlabel("true r (px, 2 x std of the optical LSF)")
+        ax.set_title(METHOD_LABELS.get(method, method), loc="left", fontsize=9)
+    axes[0][0].set_ylabel("|error| / true r (%, log)\nsolid: median, dotted: p90")
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    handles += [plt.Line2D([], [], color="black", ls="--", lw=0.9), plt.Line2D([], [], color="black", ls="-.", lw=0.9),
+                plt.Line2D([], [], marker="X", ls="none", color="#777777", markeredgecolor="black", ms=9)]
+    labels += ["2 % (median target)", "5 % (p90 target)", "first r where median > 2 % or p90 > 5 %"]
+    fig.legend(handles, labels, loc="lower center", ncol=4, bbox_to_anchor=(0.5, -0.12), fontsize=8.5)
+    fig.suptitle("Blur measurement against the true r, per PSF shape (one radius over the whole scene; noise 0.003)" +
+                 quick_note(measure, "\n"), x=0.01, ha="left", fontsize=11)
+    fig.tight_layout(rect=(0, 0.02, 1, 1))
+    name = "bench-measure-error-vs-r"
+    png, svg = save(fig, out_dir, name)
+    notes = ["truth: 2 x the std of the line-spread function of the kernels the synthetic scene applied (defocus and "
+             "floor, from their arrays), pixel aperture excluded",
+             "floor R: a Gaussian floor of std ratio x the disc radius R; near focus: a 0.35 px floor under a disc of "
+             "0 .. 1.5 px, so r starts at 0.7 px",
+             "a method that answers fewer than half the sections at some r counts as broken there"]
+    return [Chart(name, png, svg, pd.DataFrame(rows), notes)]
+
+
 def stability(measure, out_dir):
+    charts, against_r = [], []
+    try:
+        against_r = error_vs_r(measure, out_dir)
+    except Skip:
+        pass
+    # The PSF families have their own chart against r (above); the panels here sweep the other factors.
+    measure = measure[~measure["factor"].map(_is_psf_family)]
     sweeps = _sweeps(measure)
     if not sweeps:
+        if against_r:
+            return against_r
         raise Skip("bench measure: no swept factors in measure.csv (only the base scene)")
-    charts = []
     table = breakpoints(measure)
     for what, column, ylabel in (("within-target", "within_target", "share of sections within target"),
                                  ("error", "mean_abs_error_px", "mean |error| (px, log)")):
@@ -270,7 +350,7 @@ def stability(measure, out_dir):
                  "table: levels where each method meets the README's target and the first where it does not "
                  "(answered >= 50 % of sections and >= 90 % of them within max(0.25 px, 5 %))"]
         charts.append(Chart(name, png, svg, table if what == "within-target" else pd.DataFrame(), notes))
-    return charts
+    return charts + against_r
 
 
 # --------------------------------------------------------------------------------------------------------------------

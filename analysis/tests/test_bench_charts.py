@@ -108,6 +108,27 @@ class BenchChartsTest(unittest.TestCase):
         xs = sorted(p[0][0] for p in marks)
         self.assertEqual(xs, [0.0, 2.0])
 
+    def test_error_against_r_per_psf_says_where_each_family_breaks(self):
+        rows = []
+        for fam, rel in (("psf_disc", (0.01, 0.01, 0.01)), ("near_focus", (0.30, 0.015, 0.01))):
+            for level, e in zip((0.7, 1.0, 1.5), rel):
+                for method in ("model_fit", "thesis"):
+                    err = e if method == "model_fit" else 2.0
+                    rows.append(dict(method=method, factor=fam, level=level, sections=77, answered=77,
+                                     mean_abs_error_px=err * level, median_abs_error_px=err * level,
+                                     p90_abs_error_px=2 * err * level, max_abs_error_px=3 * err * level, bias_px=0,
+                                     within_target=1.0, time_us_per_section=100, meets_target=1, board_found=1,
+                                     median_rel_error=err, p90_rel_error=2 * err, quick=0))
+        charts = bench_charts.stability(pd.DataFrame(rows), self.out)
+        self.assertEqual([c.name for c in charts], ["bench-measure-error-vs-r"])
+        t = charts[0].table.set_index(["method", "psf"])
+        self.assertEqual(t.loc[("model_fit", "disc"), "breaks_at_r_px"], "holds everywhere")
+        # near focus: median 30 % at r = 0.7 breaks there; 1.5 % median with a 3 % p90 holds
+        self.assertEqual(t.loc[("model_fit", "disc x floor 0.35 px (near focus)"), "breaks_at_r_px"], "0.7")
+        self.assertEqual(t.loc[("model_fit", "disc x floor 0.35 px (near focus)"), "holds_at_r_px"], "1, 1.5")
+        self.assertEqual(t.loc[("thesis", "disc"), "breaks_at_r_px"], "0.7")
+        self.assertIn("bench-measure-error-vs-r", self.caught.figures)
+
     def test_frame_growth_charts_each_sweep_and_says_what_fits_a_refresh(self):
         rows = [dict(kind="growth", method="objects", backend="gl", radius_px=3, width=1920, height=1080, samples=40,
                      median_ms=1 + 2 * n, p99_ms=1.5 + 2 * n, objects=n, quick=0) for n in (1, 2, 8, 32)]

@@ -73,6 +73,46 @@ std::vector<Condition> Conditions(bool quick, uint64_t seed) {
     o.supersample = r >= 2 ? 2 : 4;
     c.push_back({"blur", r, o});
   }
+  // The PSF family (issue 25): one radius everywhere, from a sharp edge through the near-focus range to 8 px, as a
+  // pure disc, a pure Gaussian, and a disc convolved with a floor of std ratio x its radius. The level is the true r
+  // (2 x the LSF's std): sqrt(R^2 + 4 (ratio R)^2).
+  struct Family {
+    const char* name;
+    synth::Psf psf;
+    double floor_ratio;
+  };
+  for (const Family& fam : {Family{"psf_disc", synth::Psf::kDisc, 0}, Family{"psf_gaussian", synth::Psf::kGaussian, 0},
+                            Family{"psf_disc_floor_0.25", synth::Psf::kDisc, 0.25},
+                            Family{"psf_disc_floor_0.5", synth::Psf::kDisc, 0.5},
+                            Family{"psf_disc_floor_1", synth::Psf::kDisc, 1.0}})
+    for (double R : pick({0.25, 0.5, 0.75, 1, 1.5, 3, 8})) {
+      auto o = Base(seed);
+      if (R >= 2) {  // as the blur sweep: big radii need more room between the edges
+        o.camera = ThesisCamera().Resized(2296, 1528);
+        o.tilt_deg = 65;
+        o.supersample = 2;
+      }
+      o.noise_std = 0.003;
+      o.psf = fam.psf;
+      o.fixed_r_px = R;
+      o.floor_sigma_px = fam.floor_ratio * R;
+      c.push_back({fam.name, R * std::sqrt(1 + 4 * fam.floor_ratio * fam.floor_ratio), o});
+    }
+  // Near focus with a lens floor: a 0.35 px floor under a defocus disc of 0 .. 1.5 px (true r 0.7 .. 1.66 px).
+  for (double R : pick({0, 0.25, 0.5, 0.75, 1, 1.25, 1.5})) {
+    auto o = Base(seed);
+    o.noise_std = 0.003;
+    o.fixed_r_px = R;
+    o.floor_sigma_px = 0.35;
+    c.push_back({"near_focus", std::hypot(R, 0.7), o});
+  }
+  // Vignetting (slowly varying levels) on the thesis scene with a 0.35 px floor.
+  for (double v : pick({0, 0.15, 0.35, 0.5, 0.7})) {
+    auto o = Base(seed);
+    o.floor_sigma_px = 0.35;
+    o.vignetting = v;
+    c.push_back({"vignetting", v, o});
+  }
   for (double t : pick({20, 30, 45, 55, 65, 75})) {
     auto o = Base(seed);
     o.tilt_deg = t;
@@ -96,6 +136,8 @@ MeasureRow Summarize(const std::string& method, const Condition& cond, const cal
   row.p90_abs_error_px = m.p90_abs_error_px;
   row.max_abs_error_px = m.max_abs_error_px;
   row.bias_px = m.bias_px;
+  row.median_rel_error = m.median_rel_error;
+  row.p90_rel_error = m.p90_rel_error;
   row.within_target = m.answered ? double(m.within_target) / m.answered : 0;
   row.meets_target = row.answered * 2 >= row.sections && row.within_target >= 0.9;
   return row;
@@ -188,13 +230,15 @@ std::vector<MeasureRow> RunMeasureBench(const MeasureBenchOptions& options) {
 void WriteMeasureCsv(const std::vector<MeasureRow>& rows, const std::filesystem::path& path, bool quick) {
   std::string text =
       "method,factor,level,sections,answered,mean_abs_error_px,median_abs_error_px,p90_abs_error_px,"
-      "max_abs_error_px,bias_px,within_target,time_us_per_section,meets_target,board_found,quick\n";
+      "max_abs_error_px,bias_px,within_target,time_us_per_section,meets_target,board_found,median_rel_error,"
+      "p90_rel_error,quick\n";
   for (const auto& r : rows) {
     char line[512];
-    std::snprintf(line, sizeof line, "%s,%s,%g,%d,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.2f,%d,%d,%d\n", r.method.c_str(),
+    std::snprintf(line, sizeof line, "%s,%s,%g,%d,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.2f,%d,%d,%.5f,%.5f,%d\n",
+                  r.method.c_str(),
                   r.factor.c_str(), r.level, r.sections, r.answered, r.mean_abs_error_px, r.median_abs_error_px,
                   r.p90_abs_error_px, r.max_abs_error_px, r.bias_px, r.within_target, r.time_us_per_section,
-                  int(r.meets_target), int(r.board_found), int(quick));
+                  int(r.meets_target), int(r.board_found), r.median_rel_error, r.p90_rel_error, int(quick));
     text += line;
   }
   WriteFileAtomically(path, text);

@@ -10,12 +10,16 @@ namespace blurcue::bench {
 
 struct MeasureRow {
   std::string method;      // "model_fit", "thesis", "eq37", "fitted_model"
-  std::string factor;      // "base", "noise", "contrast", "jpeg", "flaws", "blur", "tilt"
-  double level = 0;        // the factor's value (noise std, Michelson contrast, JPEG quality, spots, r px, deg)
+  std::string factor;      // "base", "noise", "contrast", "jpeg", "flaws", "blur", "tilt", the PSF family
+                           // ("psf_disc", "psf_gaussian", "psf_disc_floor_0.25" ... : floor sigma / disc radius),
+                           // "near_focus" (disc + 0.35 px floor), "vignetting"
+  double level = 0;        // the factor's value (noise std, Michelson contrast, JPEG quality, spots, r px, deg;
+                           // PSF family and near focus: the true r px; vignetting: fall-off at the corner)
   int sections = 0;        // sections in the scene
   int answered = 0;        // sections the method gave a value for (model fit: flagged ok)
   double mean_abs_error_px = 0, median_abs_error_px = 0, p90_abs_error_px = 0, max_abs_error_px = 0;
   double bias_px = 0;          // mean signed error
+  double median_rel_error = 0, p90_rel_error = 0;  // |error| / true r
   double within_target = 0;    // fraction of answered sections within max(0.25 px, 5 %)
   double time_us_per_section = 0;  // measurement methods: per section; estimators: per section from measured input
   bool meets_target = false;   // answered >= 50 % of sections and >= 90 % of them within target

@@ -169,6 +169,9 @@ Json CalibToJson(const CalibResult& r) {
                  {"ok", s.fit.ok},
                  {"flags", s.fit.flags},
                  {"psf", s.fit.psf},
+                 {"disc_r_px", s.fit.disc_r_px},
+                 {"floor_sigma_px", s.fit.floor_sigma_px},
+                 {"shape_ambiguous", s.fit.shape_ambiguous},
                  {"fit_rms_rel", s.fit.rms_rel},
                  {"step_linear", s.fit.step},
                  {"thesis_ok", s.thesis.ok}};
@@ -178,6 +181,25 @@ Json CalibToJson(const CalibResult& r) {
     edges.push_back({{"index", e.index}, {"u_mm", e.u_mm}, {"usable_sections", e.usable}, {"sections", sections}});
   }
   const auto& m = r.model;
+  // The model choice (DESIGN.md: the simplest model whose held-out error is within target): both candidates'
+  // errors against the measured sections, and eq. 3.7 (as published, from the reference edge) beside them.
+  auto number_or_note = [](double v) { return std::isfinite(v) ? Json(v) : Json("not determined (not fitted)"); };
+  double eq37_sum = 0;
+  int eq37_n = 0;
+  for (const auto& e : r.edges)
+    for (const auto& s : e.sections)
+      if (s.fit.ok && s.r_estimated_px) eq37_sum += std::pow(*s.r_estimated_px - s.fit.r_px, 2), ++eq37_n;
+  const Json choice = {
+      {"chosen", m.kind},
+      {"rule", "leave-one-out rms: the floor is kept only when it predicts held-out sections >= 10 % and >= 0.01 px "
+               "better, with at least 10 sections"},
+      {"thin_lens", {{"rms_px", m.thin_rms_px}, {"loo_rms_px", m.thin_loo_rms_px}}},
+      {"thin_lens+floor", {{"rms_px", number_or_note(m.floor_rms_px)}, {"loo_rms_px", number_or_note(m.floor_loo_rms_px)},
+                           {"floor_px", number_or_note(m.floor_candidate_px)}}},
+      {"eq37", {{"rms_px", eq37_n > 0 ? Json(std::sqrt(eq37_sum / eq37_n)) : Json("not determined (no section)")},
+                {"sections", eq37_n},
+                {"note", "eq. 3.7 as published, from the reference edge; no parameters fitted, error against the "
+                         "measured sections"}}}};
   return {
       {"format", "blurcue-calib"},
       {"version", 1},
@@ -190,7 +212,8 @@ Json CalibToJson(const CalibResult& r) {
       {"reference", {{"u_mm", r.reference_u_mm}, {"r_px", r.reference_r_px}}},
       {"model", {{"kind", m.kind}, {"focus_mm", std::isinf(m.focus_mm) ? Json("infinity") : Json(m.focus_mm)},
                  {"aperture_mm", m.aperture_mm}, {"floor_px", m.floor_px}, {"rms_px", m.rms_px},
-                 {"loo_rms_px", m.loo_rms_px}, {"samples_used", m.samples_used}, {"outliers", m.outliers}}},
+                 {"loo_rms_px", m.loo_rms_px}, {"samples_used", m.samples_used}, {"outliers", m.outliers},
+                 {"choice", choice}}},
       {"timing_ms", {{"detect", r.detect_ms}, {"measure", r.measure_ms}, {"estimate", r.estimate_ms}}},
       {"edges", edges},
   };

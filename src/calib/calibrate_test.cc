@@ -2,6 +2,7 @@
 // known pose and known blur (src/synth), calibrated as a photo would be.
 #include "calib/calibrate.h"
 
+#include <algorithm>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -41,7 +42,9 @@ struct Calibration {
 // Rendering a scene takes seconds: each distinct scene is rendered and calibrated once per test binary.
 const Calibration& Calibrated(const synth::SceneOptions& o) {
   static std::map<std::string, Calibration> cache;
-  const std::string key = std::to_string(o.focus_mm) + "/" + std::to_string(o.noise_std);
+  const std::string key = std::to_string(o.focus_mm) + "/" + std::to_string(o.noise_std) + "/" +
+                          std::to_string(o.floor_sigma_px) + "/" + std::to_string(o.vignetting) + "/" +
+                          std::to_string(o.jpeg_quality) + "/" + std::to_string(int(o.psf));
   auto it = cache.find(key);
   if (it != cache.end()) return it->second;
   Calibration r;
@@ -120,6 +123,82 @@ TEST(Calibrate, Eq37FromTheReferenceEdgeFollowsTheThinLens) {
   for (int e = 2; e <= 11; ++e)
     EXPECT_NEAR(r.result.edges[e - 1].r_estimated_px, c.true_r_per_edge[e - 1], 0.1 * c.true_r_per_edge[e - 1] + 0.1)
         << "edge " << e;
+}
+
+// Optics as real lenses make them (issue 25, "Must hold"): a defocus disc or Gaussian convolved with a lens floor,
+// vignetting, JPEG, sensor noise; focus off the board, on edge 1, and mid-board (both sides of focus, in-focus
+// sections included). Truth is the applied kernels' second moment (synth). Measured and fitted r_px: median
+// relative error <= 2 %, p90 <= 5 % over every section the measurement answers, and it answers >= 90 % of them.
+struct RealOptics {
+  const char* name;
+  synth::SceneOptions options;
+};
+
+std::vector<RealOptics> RealOpticsScenes() {
+  std::vector<RealOptics> out;
+  synth::SceneOptions a = Thesis(0.003);
+  a.focus_mm = 260, a.floor_sigma_px = 0.6, a.vignetting = 0.35, a.jpeg_quality = 92;
+  out.push_back({"disc x floor 0.6 px, focus off the board, vignetting 35 %, JPEG 92", a});
+  synth::SceneOptions b = Thesis(0.002);
+  b.psf = synth::Psf::kGaussian, b.focus_mm = 430, b.floor_sigma_px = 0.45;
+  out.push_back({"Gaussian x floor 0.45 px, focus mid-board", b});
+  synth::SceneOptions c = Thesis(0.003);
+  c.floor_sigma_px = 0.35, c.vignetting = 0.2, c.jpeg_quality = 95;
+  out.push_back({"disc x floor 0.35 px, focus on edge 1, vignetting 20 %, JPEG 95", c});
+  return out;
+}
+
+struct RelErrors {
+  double median = 0, p90 = 0;
+  int n = 0;
+};
+RelErrors Relative(const TruthComparison& cmp, MethodError SectionComparison::*m) {
+  std::vector<double> e;
+  for (const auto& s : cmp.sections)
+    if ((s.*m).answered) e.push_back(std::abs((s.*m).error_px) / s.true_r_px);
+  RelErrors out;
+  out.n = int(e.size());
+  if (e.empty()) return out;
+  std::sort(e.begin(), e.end());
+  out.median = e[e.size() / 2];
+  out.p90 = e[std::min(e.size() - 1, size_t(0.9 * e.size()))];
+  return out;
+}
+
+TEST(Calibrate, RealOpticsMeasuredAndFittedWithinTwoPercentMedianFivePercentP90) {
+  for (const RealOptics& scene : RealOpticsScenes()) {
+    const Calibration& r = Calibrated(scene.options);
+    const RelErrors measured = Relative(r.cmp, &SectionComparison::model);
+    const RelErrors fitted = Relative(r.cmp, &SectionComparison::fitted);
+    double r_min = 1e9;
+    for (const auto& s : r.cmp.sections) r_min = std::min(r_min, s.true_r_px);
+    std::printf("%s (true r from %.2f px; model %s, floor %.2f px): measured %d/%zu, median %.2f %%, p90 %.2f %%; "
+                "fitted median %.2f %%, p90 %.2f %%\n",
+                scene.name, r_min, r.result.model.kind.c_str(), r.result.model.floor_px, measured.n,
+                r.cmp.sections.size(), 100 * measured.median, 100 * measured.p90, 100 * fitted.median,
+                100 * fitted.p90);
+    EXPECT_GE(measured.n, 0.9 * r.cmp.sections.size()) << scene.name;
+    EXPECT_LE(measured.median, 0.02) << scene.name;
+    EXPECT_LE(measured.p90, 0.05) << scene.name;
+    EXPECT_LE(fitted.median, 0.02) << scene.name;
+    EXPECT_LE(fitted.p90, 0.05) << scene.name;
+  }
+}
+
+// Model no more than the scene needs: a floor where the optics have one, none where they do not, chosen by
+// leave-one-out error and written to calib.json with both candidates' errors and eq. 3.7's beside them.
+TEST(Calibrate, ModelChoiceByHeldOutErrorIsWrittenWithBothFits) {
+  const Calibration& with_floor = Calibrated(RealOpticsScenes()[2].options);  // floor 0.35 px, focus on edge 1
+  const Json a = CalibToJson(with_floor.result)["model"]["choice"];
+  std::printf("floor scene: %s\n", a.dump().c_str());
+  EXPECT_EQ(a["chosen"], "thin_lens+floor");
+  EXPECT_LT(a["thin_lens+floor"]["loo_rms_px"].get<double>(), 0.9 * a["thin_lens"]["loo_rms_px"].get<double>());
+  EXPECT_NEAR(a["thin_lens+floor"]["floor_px"].get<double>(), 0.7, 0.07);  // 2 x 0.35 px
+  EXPECT_GT(a["eq37"]["sections"].get<int>(), 0);
+  const Json b = CalibToJson(Calibrated(Blurry()).result)["model"]["choice"];
+  std::printf("no-floor scene: %s\n", b.dump().c_str());
+  EXPECT_EQ(b["chosen"], "thin_lens");
+  EXPECT_TRUE(b["thin_lens+floor"]["loo_rms_px"].is_number());
 }
 
 TEST(Calibrate, JsonHasEveryFieldTheIssueNames) {

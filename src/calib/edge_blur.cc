@@ -1,6 +1,7 @@
 #include "calib/edge_blur.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -17,8 +18,8 @@ constexpr double kMaxRadiusPx = 200.0;   // ... nor above this
 constexpr double kBlackClip = 1e-4;      // linear value at or below which a sample counts as clipped black
 constexpr double kFineBinPx = 0.25;      // finest bin across the edge (ISO 12233 uses 1/4 pixel)
 constexpr int kMinSamples = 100;
-
-enum class Psf { kDisc, kGaussian };
+// Standard error of the shape angle (radians) above which the disc/floor split is "shape_ambiguous".
+constexpr double kShapeSeLimitRad = 0.15;
 
 // Geometry shared by both methods. The normal is the segment direction turned +90 degrees in image
 // coordinates (x right, y down): n = (-t.y, t.x). Pixel centres sit at integer coordinates (OpenCV).
@@ -69,30 +70,85 @@ double F2Disc(double x, double R) {
   return R * R * (0.25 * u * u + bracket / kPi + 1.0 / 16);
 }
 
+// The optical PSF family the fit spans: a defocus disc of radius R convolved with a Gaussian of std s (the lens
+// floor: aberrations, diffraction, demosaicing). Parametrised by the DESIGN.md radius r = sqrt(R^2 + 4 s^2), which
+// is what the measurement reports, and the shape angle phi: R = r cos(phi), 2 s = r sin(phi) (phi = 0: a pure
+// disc, pi/2: a pure Gaussian). The LSF's variance is R^2/4 + s^2 = r^2/4 at every phi, so r is the second moment
+// whatever share of it the shape puts in the disc or the floor, and a poorly determined phi leaves r well
+// determined.
 struct EsfModel {
-  Psf psf = Psf::kDisc;
-  double r = 1;            // DESIGN.md unit
+  double r = 1, phi = 0;   // DESIGN.md radius and shape angle
+  double R = 1, s = 0;     // disc radius, Gaussian std
   double w1 = 1, w2 = 0;   // pixel aperture boxes across the edge, w1 >= w2
   double reach = 0;        // beyond |x| > reach the model is exactly 0 or 1
+  enum class Mode { kDisc, kGaussian, kOverDisc, kOverGaussian } mode = Mode::kDisc;
+  // Quadrature of the mixed shape: nodes (shifts, px) and weights (sum 1).
+  static constexpr int kMaxNodes = 49;
+  int n = 0;
+  std::array<double, kMaxNodes> node{}, weight{};
 
-  EsfModel(Psf p, double radius, double box1, double box2) : psf(p), r(radius), w1(box1), w2(box2) {
-    const double optical = psf == Psf::kDisc ? r : 3.5 * r;  // Gaussian: 7 s (tail 1e-12)
-    reach = optical + 0.5 * (w1 + w2) + 1e-9;
+  EsfModel(double radius, double shape, double box1, double box2)
+      : r(radius), phi(shape), R(radius * std::cos(shape)), s(0.5 * radius * std::sin(shape)), w1(box1), w2(box2) {
+    // An exactly pure shape (or a share too small to matter) is the closed form itself.
+    if (s <= 1e-4 * r) {
+      mode = Mode::kDisc, R = r, s = 0;
+    } else if (R <= 1e-4 * r) {
+      mode = Mode::kGaussian, R = 0, s = 0.5 * r;
+    } else {
+      // Disc x Gaussian has no closed form; it is a weighted sum of shifted closed forms of one factor (pixel
+      // aperture included), integrated over the other. Which factor to integrate over: the one that is narrow
+      // against the other's smoothness, so a few nodes resolve it.
+      const double smooth = std::sqrt(s * s + (w1 * w1 + w2 * w2) / 12);
+      if (R <= 2 * smooth) {
+        // Over the disc's semicircular LSF: Gauss-Chebyshev (second kind) nodes, exact for polynomials of degree
+        // 2n - 1 against the semicircle; spaced at most half the Gaussian-and-box smoothness apart.
+        mode = Mode::kOverDisc;
+        n = std::clamp(static_cast<int>(std::ceil(2 * kPi * R / smooth)) + 2, 4, kMaxNodes);
+        for (int k = 1; k <= n; ++k) {
+          const double th = k * kPi / (n + 1);
+          node[k - 1] = R * std::cos(th);
+          weight[k - 1] = 2.0 / (n + 1) * std::sin(th) * std::sin(th);
+        }
+      } else {
+        // Over the Gaussian: trapezoid nodes s/2 apart over +-6 s. The disc-and-box ESF it shifts has a continuous
+        // derivative here (R > 0.5 px), so the rule's error is far below the noise.
+        mode = Mode::kOverGaussian;
+        n = 25;
+        double sum = 0;
+        for (int k = 0; k < n; ++k) {
+          const double z = 0.5 * (k - 12);
+          node[k] = z * s;
+          sum += weight[k] = std::exp(-0.5 * z * z);
+        }
+        for (int k = 0; k < n; ++k) weight[k] /= sum;
+      }
+    }
+    reach = R + 7 * s + 0.5 * (w1 + w2) + 1e-9;  // Gaussian: 7 s (tail 1e-12)
   }
 
-  double F1(double x) const { return psf == Psf::kDisc ? F1Disc(x, r) : F1Gauss(x, 0.5 * r); }
-  double F2(double x) const { return psf == Psf::kDisc ? F2Disc(x, r) : F2Gauss(x, 0.5 * r); }
+  // ESF of a disc (Gaussian when gauss) pixel-averaged: a second divided difference of F2 (first of F1).
+  double Boxed(bool gauss, double width, double x) const {
+    auto F1 = [&](double t) { return gauss ? F1Gauss(t, width) : F1Disc(t, width); };
+    auto F2 = [&](double t) { return gauss ? F2Gauss(t, width) : F2Disc(t, width); };
+    const double h1 = 0.5 * w1, h2 = 0.5 * w2;
+    if (w2 < 1e-3) return (F1(x + h1) - F1(x - h1)) / w1;
+    return (F2(x + h1 + h2) - F2(x + h1 - h2) - F2(x - h1 + h2) + F2(x - h1 - h2)) / (w1 * w2);
+  }
 
   // ESF in [0, 1] at signed distance x from the edge, pixel aperture included.
   double operator()(double x) const {
     if (x <= -reach) return 0;
     if (x >= reach) return 1;
-    const double h1 = 0.5 * w1, h2 = 0.5 * w2;
-    double v;
-    if (w2 < 1e-3) {
-      v = (F1(x + h1) - F1(x - h1)) / w1;
-    } else {
-      v = (F2(x + h1 + h2) - F2(x + h1 - h2) - F2(x - h1 + h2) + F2(x - h1 - h2)) / (w1 * w2);
+    double v = 0;
+    switch (mode) {
+      case Mode::kDisc: v = Boxed(false, R, x); break;
+      case Mode::kGaussian: v = Boxed(true, s, x); break;
+      case Mode::kOverDisc:
+        for (int k = 0; k < n; ++k) v += weight[k] * Boxed(true, s, x - node[k]);
+        break;
+      case Mode::kOverGaussian:
+        for (int k = 0; k < n; ++k) v += weight[k] * Boxed(false, R, x - node[k]);
+        break;
     }
     return std::clamp(v, 0.0, 1.0);
   }
@@ -188,38 +244,73 @@ BinStats RefineBins(std::vector<Bin>& bins, const std::vector<int>& start, std::
 
 // ---- Fit ---------------------------------------------------------------------------------------------
 
+// Solves the K x K system a x = b; false when singular.
+template <int K>
+bool Solve(const std::array<std::array<double, K>, K>& a, const std::array<double, K>& b, std::array<double, K>* x) {
+  cv::Matx<double, K, K> m;
+  cv::Vec<double, K> v, out;
+  for (int i = 0; i < K; ++i) {
+    v[i] = b[i];
+    for (int j = 0; j < K; ++j) m(i, j) = a[i][j];
+  }
+  if (!cv::solve(m, v, out, cv::DECOMP_LU)) return false;
+  for (int i = 0; i < K; ++i) (*x)[i] = out[i];
+  return std::all_of(x->begin(), x->end(), [](double d) { return std::isfinite(d); });
+}
+
 struct FitState {
-  double d0 = 0, r = 1, a = 0, b = 0, sse = std::numeric_limits<double>::infinity();
+  double d0 = 0, r = 1, phi = 0;
+  // Levels: v = a + b E + (a' + b' E) x / L across the window (x: bin position, L: half window). The slope terms
+  // take up slowly varying illumination (vignetting, shading) that would otherwise tilt the plateaus into the edge.
+  std::array<double, 4> lin{};
+  double sse = std::numeric_limits<double>::infinity();
+  double Step() const { return lin[1]; }  // at x = 0, the segment line
 };
 
-// For fixed (d0, r) the levels a, b follow by weighted linear least squares (variable projection).
+struct FitSetup {
+  const std::vector<Bin>* bins = nullptr;
+  double w1 = 1, w2 = 0, half_window = 1;
+  bool slopes = false;
+};
+
+// For fixed (d0, r, phi) the levels follow by weighted linear least squares (variable projection).
 // Fills `residuals` (weighted) when given.
-FitState Evaluate(const std::vector<Bin>& bins, Psf psf, double d0, double r, double w1, double w2,
-                  std::vector<double>* residuals = nullptr) {
+FitState Evaluate(const FitSetup& fs, double d0, double r, double phi, std::vector<double>* residuals = nullptr) {
+  const std::vector<Bin>& bins = *fs.bins;
   FitState st;
-  st.d0 = d0;
-  st.r = r;
-  const EsfModel model(psf, r, w1, w2);
-  thread_local std::vector<double> e;
-  e.resize(bins.size());
-  double sw = 0, se = 0, see = 0, sv = 0, sev = 0;
+  st.d0 = d0, st.r = r, st.phi = phi;
+  const EsfModel model(r, phi, fs.w1, fs.w2);
+  const int k = fs.slopes ? 4 : 2;
+  thread_local std::vector<std::array<double, 4>> basis;
+  basis.resize(bins.size());
+  std::array<std::array<double, 4>, 4> a{};
+  std::array<double, 4> rhs{};
   for (size_t i = 0; i < bins.size(); ++i) {
-    const Bin& bin = bins[i];
-    e[i] = model(bin.x - d0);
-    sw += bin.w, se += bin.w * e[i], see += bin.w * e[i] * e[i], sv += bin.w * bin.v, sev += bin.w * e[i] * bin.v;
+    const double e = model(bins[i].x - d0), t = bins[i].x / fs.half_window;
+    basis[i] = {1, e, t, t * e};
+    for (int p = 0; p < k; ++p) {
+      rhs[p] += bins[i].w * basis[i][p] * bins[i].v;
+      for (int q = 0; q < k; ++q) a[p][q] += bins[i].w * basis[i][p] * basis[i][q];
+    }
   }
-  const double det = sw * see - se * se;
-  if (!(det > 1e-12 * sw * sw)) {  // the model is flat over the bins: no step to fit
-    st.a = sv / std::max(sw, 1e-12);
-    st.b = 0;
+  bool solved;
+  std::array<double, 4> x{};
+  if (fs.slopes) {
+    solved = Solve<4>(a, rhs, &x) && std::abs(a[1][1] * a[0][0] - a[0][1] * a[0][1]) > 1e-12 * a[0][0] * a[0][0];
   } else {
-    st.b = (sw * sev - se * sv) / det;
-    st.a = (sv - st.b * se) / sw;
+    std::array<std::array<double, 2>, 2> a2{{{a[0][0], a[0][1]}, {a[1][0], a[1][1]}}};
+    std::array<double, 2> r2{rhs[0], rhs[1]}, x2{};
+    solved = std::abs(a2[0][0] * a2[1][1] - a2[0][1] * a2[0][1]) > 1e-12 * a2[0][0] * a2[0][0] && Solve<2>(a2, r2, &x2);
+    x = {x2[0], x2[1], 0, 0};
   }
+  if (!solved) x = {rhs[0] / std::max(a[0][0], 1e-12), 0, 0, 0};  // the model is flat over the bins: no step
+  st.lin = x;
   double sse = 0;
   if (residuals) residuals->resize(bins.size());
   for (size_t i = 0; i < bins.size(); ++i) {
-    const double res = bins[i].v - st.a - st.b * e[i];
+    double m = 0;
+    for (int p = 0; p < 4; ++p) m += x[p] * basis[i][p];
+    const double res = bins[i].v - m;
     sse += bins[i].w * res * res;
     if (residuals) (*residuals)[i] = std::sqrt(bins[i].w) * res;
   }
@@ -227,47 +318,67 @@ FitState Evaluate(const std::vector<Bin>& bins, Psf psf, double d0, double r, do
   return st;
 }
 
-// Levenberg-Marquardt on (d0, r) of the reduced (a, b eliminated) problem, numeric Jacobian.
-FitState FitFamily(const std::vector<Bin>& bins, Psf psf, double d0, double r, double w1, double w2,
-                   double d0_limit) {
-  r = std::clamp(r, kMinRadiusPx, kMaxRadiusPx);
-  std::vector<double> res0, jd, jr, trial_res;
-  FitState best = Evaluate(bins, psf, d0, r, w1, w2, &res0);
+// Levenberg-Marquardt on (d0, r[, phi]) of the reduced (levels eliminated) problem, numeric Jacobian. With
+// `jtj_out` the Gauss-Newton matrix at the optimum is returned (for the shape's uncertainty).
+FitState FitShape(const FitSetup& fs, FitState start, bool free_phi, double d0_limit,
+                  std::array<std::array<double, 3>, 3>* jtj_out = nullptr) {
+  const double phi_max = kPi / 2;
+  start.r = std::clamp(start.r, kMinRadiusPx, kMaxRadiusPx);
+  start.phi = std::clamp(start.phi, 0.0, phi_max);
+  std::vector<double> res0, trial_res;
+  std::array<std::vector<double>, 3> jac;
+  FitState best = Evaluate(fs, start.d0, start.r, start.phi, &res0);
+  const size_t n = res0.size();
   double lambda = 1e-3;
+  std::array<std::array<double, 3>, 3> A{};
   for (int iter = 0; iter < 40; ++iter) {
     const double h = 1e-3 * (1 + best.r);
-    Evaluate(bins, psf, best.d0 + h, best.r, w1, w2, &jd);
-    Evaluate(bins, psf, best.d0, best.r + h, w1, w2, &jr);
-    // J = d(residual)/d(param); normal equations with Marquardt scaling.
-    double A00 = 0, A01 = 0, A11 = 0, g0 = 0, g1 = 0;
-    for (size_t i = 0; i < bins.size(); ++i) {
-      const double j0 = (jd[i] - res0[i]) / h, j1 = (jr[i] - res0[i]) / h;
-      A00 += j0 * j0, A01 += j0 * j1, A11 += j1 * j1;
-      g0 += j0 * res0[i], g1 += j1 * res0[i];
+    // Forward differences, backwards at the upper bound of phi.
+    const double hp = best.phi + 1e-3 > phi_max ? -1e-3 : 1e-3;
+    Evaluate(fs, best.d0 + h, best.r, best.phi, &jac[0]);
+    Evaluate(fs, best.d0, best.r + h, best.phi, &jac[1]);
+    if (free_phi) Evaluate(fs, best.d0, best.r, best.phi + hp, &jac[2]);
+    const std::array<double, 3> step_h = {h, h, hp};
+    A = {};
+    std::array<double, 3> g{};
+    const int np = free_phi ? 3 : 2;
+    for (size_t i = 0; i < n; ++i) {
+      double j[3] = {0, 0, 0};
+      for (int p = 0; p < np; ++p) j[p] = (jac[p][i] - res0[i]) / step_h[p];
+      for (int p = 0; p < np; ++p) {
+        g[p] += j[p] * res0[i];
+        for (int q = 0; q < np; ++q) A[p][q] += j[p] * j[q];
+      }
     }
+    if (!free_phi) A[2][2] = 1;
     bool improved = false;
     for (int tries = 0; tries < 10 && !improved; ++tries) {
-      const double B00 = A00 * (1 + lambda) + 1e-15, B11 = A11 * (1 + lambda) + 1e-15;
-      const double det = B00 * B11 - A01 * A01;
-      if (!(std::abs(det) > 0)) break;
-      const double s0 = -(B11 * g0 - A01 * g1) / det, s1 = -(B00 * g1 - A01 * g0) / det;
-      const double nd0 = std::clamp(best.d0 + s0, -d0_limit, d0_limit);
-      const double nr = std::clamp(best.r + s1, kMinRadiusPx, kMaxRadiusPx);
-      const FitState trial = Evaluate(bins, psf, nd0, nr, w1, w2, &trial_res);
+      auto B = A;
+      for (int p = 0; p < 3; ++p) B[p][p] = A[p][p] * (1 + lambda) + 1e-15;
+      std::array<double, 3> neg_g = {-g[0], -g[1], -g[2]}, step{};
+      if (!Solve<3>(B, neg_g, &step)) break;
+      const double nd0 = std::clamp(best.d0 + step[0], -d0_limit, d0_limit);
+      const double nr = std::clamp(best.r + step[1], kMinRadiusPx, kMaxRadiusPx);
+      const double nphi = free_phi ? std::clamp(best.phi + step[2], 0.0, phi_max) : best.phi;
+      const FitState trial = Evaluate(fs, nd0, nr, nphi, &trial_res);
       if (trial.sse < best.sse) {
         res0.swap(trial_res);
         const double gain = best.sse - trial.sse;
-        const bool tiny_step = std::abs(nd0 - best.d0) < 1e-5 && std::abs(nr - best.r) < 1e-5 * (1 + best.r);
+        const bool tiny_step = std::abs(nd0 - best.d0) < 1e-5 && std::abs(nr - best.r) < 1e-5 * (1 + best.r) &&
+                               std::abs(nphi - best.phi) < 1e-5;
         best = trial;
         lambda = std::max(lambda * 0.3, 1e-9);
         improved = true;
-        if (tiny_step || gain < 1e-12 * (1 + best.sse)) return best;
+        if (tiny_step || gain < 1e-12 * (1 + best.sse)) {
+          iter = 1000;  // converged
+        }
       } else {
         lambda *= 10;
       }
     }
     if (!improved) break;
   }
+  if (jtj_out) *jtj_out = A;
   return best;
 }
 
@@ -374,10 +485,12 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
   StartEstimate(bins, hw, low, step0, &d0, &r0);
 
   const double w1 = std::max(std::abs(f.n.x), std::abs(f.n.y)), w2 = std::min(std::abs(f.n.x), std::abs(f.n.y));
+  FitSetup setup;
+  setup.w1 = w1, setup.w2 = w2, setup.half_window = hw;
   FitState best;
-  Psf best_psf = Psf::kDisc;
   double bin_width = 0;  // the start bins hold a subsample: always rebin
-  // Bins wider than r/6 would smear the edge they sample; refit on finer bins when the fit says so.
+  // Bins wider than r/6 would smear the edge they sample; refit on finer bins when the fit says so. These passes
+  // fit the two pure shapes (a disc, a Gaussian) for the size; the mixed shape is fitted once on the final bins.
   for (int pass = 0; pass < 3; ++pass) {
     const double want = std::max(kFineBinPx, r0 / 8);
     if (std::abs(want - bin_width) > 1e-9) {
@@ -389,12 +502,17 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
       fit.flags = {"too_few_pixels"};
       return fit;
     }
+    setup.bins = &bins;
+    // Slope terms need bins enough to tell them from the edge.
+    setup.slopes = bins.size() >= 16;
     best = FitState{};
-    for (Psf psf : {Psf::kDisc, Psf::kGaussian}) {
+    for (double phi : {0.0, kPi / 2}) {
       // Two starts guard against a start far on the wrong side of the minimum.
       for (double scale : {1.0, 0.5}) {
-        const FitState st = FitFamily(bins, psf, d0, r0 * scale, w1, w2, hw);
-        if (st.sse < best.sse) best = st, best_psf = psf;
+        FitState start_state;
+        start_state.d0 = d0, start_state.r = r0 * scale, start_state.phi = phi;
+        const FitState st = FitShape(setup, start_state, /*free_phi=*/false, hw);
+        if (st.sse < best.sse) best = st;
         if (r0 < 1) break;
       }
     }
@@ -402,15 +520,49 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
     d0 = best.d0;
     r0 = best.r;
   }
+  // The mixed shape (disc x Gaussian), from the better pure shape moved a little inwards and from the middle.
+  std::array<std::array<double, 3>, 3> jtj{};
+  {
+    FitState mixed;
+    for (double phi : {best.phi == 0 ? 0.15 : kPi / 2 - 0.15}) {
+      FitState start_state = best;
+      start_state.phi = phi;
+      std::array<std::array<double, 3>, 3> a{};
+      const FitState st = FitShape(setup, start_state, /*free_phi=*/true, hw, &a);
+      if (st.sse < mixed.sse) mixed = st, jtj = a;
+    }
+    // A pure shape that stays better keeps the curvature of the mixed fit that came back towards it.
+    if (mixed.sse < best.sse) best = mixed;
+  }
 
   double sw = 0;
   for (const Bin& b : bins) sw += b.w;
   fit.r_px = std::isfinite(best.r) ? best.r : 0;
-  fit.psf = best_psf == Psf::kDisc ? "disc" : "gaussian";
+  fit.disc_r_px = fit.r_px * std::cos(best.phi);
+  fit.floor_sigma_px = 0.5 * fit.r_px * std::sin(best.phi);
   fit.offset_px = std::isfinite(best.d0) ? best.d0 : 0;
-  fit.step = std::isfinite(best.b) ? best.b : 0;
+  fit.step = std::isfinite(best.Step()) ? best.Step() : 0;
   const double rms = std::sqrt(std::max(0.0, best.sse) / std::max(sw, 1.0));
   fit.rms_rel = std::abs(fit.step) > 1e-12 && std::isfinite(rms) ? rms / std::abs(fit.step) : 1e9;
+  // The shape's standard error from the Gauss-Newton curvature, with the residual variance per bin (model error
+  // included, so it errs on the side of "ambiguous"). Near r = 0 every shape looks alike: ambiguous by nature.
+  {
+    const int params = 3 + (setup.slopes ? 4 : 2);
+    const double dof = std::max(1.0, double(bins.size()) - params);
+    std::array<std::array<double, 3>, 3> cov_in = jtj;
+    std::array<double, 3> e2 = {0, 0, 1}, col{};
+    double var_phi = std::numeric_limits<double>::infinity();
+    if (Solve<3>(cov_in, e2, &col) && col[2] > 0) var_phi = best.sse / dof * col[2];
+    fit.shape_se_rad = std::sqrt(var_phi);
+    fit.shape_ambiguous = !(fit.shape_se_rad <= kShapeSeLimitRad) || fit.r_px < 0.5;
+  }
+  // The name says which factor holds the variance: a pure shape when the other holds under 15 % of r^2 (the
+  // split's tails are what 8-bit quantisation and JPEG distort first), or when the fit is within two standard
+  // errors of it.
+  const double near = std::max(std::asin(std::sqrt(0.15)), 2 * std::min(fit.shape_se_rad, 1.0));
+  fit.psf = best.phi <= near && best.phi <= kPi / 2 - best.phi ? "disc"
+            : best.phi >= kPi / 2 - near                       ? "gaussian"
+                                                               : "disc x gaussian";
 
   // Printing flaws: samples far from their bin's median (rejected above, reported here).
   if (std::abs(step0) > 0 && stats.outliers > std::max<long>(10, static_cast<long>(samples.size()) / 1000))

@@ -29,8 +29,13 @@ struct ModelFit {
   bool ok = false;                 // usable: none of the disqualifying flags below
   std::vector<std::string> flags;  // "low_contrast", "saturated", "crowded", "poor_fit", "too_few_pixels"
                                    // disqualify; "flaw" (robustly rejected outliers) is informational
-  double r_px = 0;                 // optical blur radius, pixel aperture removed
-  std::string psf;                 // "disc" or "gaussian": the family that fit better
+  double r_px = 0;                 // optical blur radius: 2 x the std of the optical LSF, pixel aperture removed
+                                   // (the fitted disc x Gaussian's second moment, whatever its shape)
+  // The shape within r_px^2 = disc_r_px^2 + 4 floor_sigma_px^2 (DESIGN.md): a defocus disc and a Gaussian floor.
+  double disc_r_px = 0, floor_sigma_px = 0;
+  double shape_se_rad = 0;         // standard error of the shape angle atan(2 floor_sigma / disc_r)
+  bool shape_ambiguous = true;     // the profile does not pin the split (r_px stays well determined)
+  std::string psf;                 // "disc", "gaussian" or "disc x gaussian": the fitted shape
   double offset_px = 0;            // fitted edge position along the normal, relative to the segment line
   double step = 0;                 // signed step in linear light (dark->bright along the normal is > 0)
   double rms_rel = 0;              // residual rms / |step|

@@ -63,12 +63,13 @@ TruthComparison CompareToTruth(const CalibResult& result, const Json& truth, con
 MethodSummary SummarizeMethod(const TruthComparison& comparison, MethodError SectionComparison::*method) {
   MethodSummary m;
   m.sections = int(comparison.sections.size());
-  std::vector<double> abs_err;
+  std::vector<double> abs_err, rel_err;
   double sum_signed = 0;
   for (const auto& s : comparison.sections) {
     const MethodError& e = s.*method;
     if (!e.answered) continue;
     abs_err.push_back(std::abs(e.error_px));
+    rel_err.push_back(s.true_r_px > 0 ? std::abs(e.error_px) / s.true_r_px : 0.0);
     sum_signed += e.error_px;
     m.within_target += std::abs(e.error_px) <= MeasureTolerancePx(s.true_r_px);
   }
@@ -83,6 +84,9 @@ MethodSummary SummarizeMethod(const TruthComparison& comparison, MethodError Sec
   m.p90_abs_error_px = abs_err[std::min(n - 1, size_t(0.9 * n))];
   m.max_abs_error_px = abs_err.back();
   m.bias_px = sum_signed / n;
+  std::sort(rel_err.begin(), rel_err.end());
+  m.median_rel_error = rel_err[n / 2];
+  m.p90_rel_error = rel_err[std::min(n - 1, size_t(0.9 * n))];
   return m;
 }
 

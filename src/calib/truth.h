@@ -40,6 +40,8 @@ struct MethodSummary {
   int sections = 0, answered = 0, within_target = 0;  // within MeasureTolerancePx
   double mean_abs_error_px = 0, median_abs_error_px = 0, p90_abs_error_px = 0, max_abs_error_px = 0;
   double bias_px = 0;  // mean signed error
+  // |error| / true r: median and 90th percentile (the "Must hold" measure)
+  double median_rel_error = 0, p90_rel_error = 0;
 };
 MethodSummary SummarizeMethod(const TruthComparison& comparison, MethodError SectionComparison::*method);
 

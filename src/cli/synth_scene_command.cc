@@ -38,6 +38,7 @@ Error AsOptionError(const Error& e) {
       {"blur_gain", "--blur-gain"},     {"white", "--white"},           {"black", "--black"},
       {"table", "--table"},             {"noise_std", "--noise"},       {"jpeg_quality", "--jpeg-quality"},
       {"flaws", "--flaws"},             {"supersample", "--supersample"}, {"board", "--board"},
+      {"floor_sigma_px", "--floor-sigma-px"}, {"vignetting", "--vignetting"},
   };
   const std::string message = e.what();
   const size_t colon = message.find(':');
@@ -117,6 +118,11 @@ void AddSynthSceneCommand(CLI::App& app) {
       ->check(FiniteRange(0, optics::kMaxBlurRadiusPx, "px"));
   cmd->add_option("--blur-gain", o.blur_gain, "multiplies every thin-lens radius (a lens blurrier than ideal)")
       ->capture_default_str()->check(FiniteRange(0, 100, ""));
+  cmd->add_option("--floor-sigma-px", o.floor_sigma_px,
+                  "lens floor: every PSF convolved with a Gaussian of this std, px (truth adds its second moment)")
+      ->capture_default_str()->check(FiniteRange(0, 20, "px"));
+  cmd->add_option("--vignetting", o.vignetting, "light fall-off at the image corner, 0..0.9 (0.35: corners at 65 %)")
+      ->capture_default_str()->check(FiniteRange(0, 0.9, ""));
   cmd->add_option("--noise", o.noise_std,
                   "sensor noise std in linear units (plus shot noise of the same size at white), e.g. 0.004")
       ->capture_default_str()->check(FiniteRange(0, 1, "linear units"));

@@ -403,12 +403,12 @@ FittedModel FitThinLens(const Lens& lens, const std::vector<BlurSample>& samples
     };
     // Held-out error exceeds the in-sample error, and more so for the model with more parameters, so a floor
     // that does not even fit the data 5 % better cannot predict it 10 % better: skip its n refits (most scenes).
+    // (Both errors are still written to calib.json, so the floor's leave-one-out error is computed either way.)
     const bool worth_judging = with_floor.t > 0 && clearly_better(WeightedRms(s, floor_fit, judged),
                                                                    WeightedRms(s, thin_res.fit, judged), 0.95);
-    if (worth_judging) {
-      floor_res = Evaluate(s, with_floor, true, c);
+    floor_res = Evaluate(s, with_floor, true, c);
+    if (worth_judging)
       use_floor = clearly_better(WeightedRms(s, floor_res.loo, judged), WeightedRms(s, thin_res.loo, judged), 0.9);
-    }
   } else {
     for (size_t i = 0; i < s.n(); ++i) judged[i] = inlier(thin_res.fit[i]);
     if (std::none_of(judged.begin(), judged.end(), [](bool b) { return b; })) judged.assign(s.n(), true);
@@ -430,6 +430,13 @@ FittedModel FitThinLens(const Lens& lens, const std::vector<BlurSample>& samples
   if (out.outliers == out.samples_used) inliers.assign(s.n(), true);
   out.rms_px = WeightedRms(s, res.fit, inliers);
   out.loo_rms_px = WeightedRms(s, res.loo, judged);
+  out.thin_rms_px = WeightedRms(s, thin_res.fit, judged);
+  out.thin_loo_rms_px = WeightedRms(s, thin_res.loo, judged);
+  const bool floor_fitted = !floor_res.loo.empty();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  out.floor_rms_px = floor_fitted ? WeightedRms(s, floor_res.fit, judged) : nan;
+  out.floor_loo_rms_px = floor_fitted ? WeightedRms(s, floor_res.loo, judged) : nan;
+  out.floor_candidate_px = floor_fitted ? std::sqrt(with_floor.t) : nan;
   return out;
 }
 

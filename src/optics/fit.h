@@ -30,6 +30,11 @@ struct FittedModel {
   int samples_used = 0;    // with weight > 0
   int outliers = 0;        // samples whose residual exceeds 3 huber_px at the optimum
   std::string kind;        // "thin_lens" or "thin_lens+floor"
+  // Both candidates' errors on the same (inlier) samples, whichever was kept: in-sample and leave-one-out rms, px.
+  // The floor model's are NaN where it was not fitted (fewer than 10 samples, or allow_floor off).
+  double thin_rms_px = 0, thin_loo_rms_px = 0;
+  double floor_rms_px = 0, floor_loo_rms_px = 0;
+  double floor_candidate_px = 0;  // the floor the floor model found (kept or not)
 
   // Predicted unsigned radius at depth u (px), with the lens's f and pitch.
   double PredictPx(const Lens& lens, double u_mm) const;

@@ -235,6 +235,10 @@ void ValidateOptions(const SceneOptions& o) {
     throw InputError("blur_gain", "must be >= 0, got " + Num(o.blur_gain));
   for (auto [name, v] : {std::pair{"white", o.white}, {"black", o.black}, {"table", o.table}})
     if (!(v >= 0 && v <= 1)) throw InputError(name, "must be a linear reflectance in [0, 1], got " + Num(v));
+  if (!(o.floor_sigma_px >= 0 && o.floor_sigma_px <= 20))
+    throw InputError("floor_sigma_px", "must be in [0, 20] px, got " + Num(o.floor_sigma_px));
+  if (!(o.vignetting >= 0 && o.vignetting <= 0.9))
+    throw InputError("vignetting", "must be in [0, 0.9] (fall-off at the image corner), got " + Num(o.vignetting));
   if (!(o.noise_std >= 0 && o.noise_std <= 1))
     throw InputError("noise_std", "must be in [0, 1] (linear units), got " + Num(o.noise_std));
   if (o.jpeg_quality < 0 || o.jpeg_quality > 100)
@@ -274,6 +278,8 @@ Json OptionsToJson(const SceneOptions& o) {
   j["flaws"] = o.flaws;
   j["seed"] = o.seed;
   j["supersample"] = o.supersample;
+  j["floor_sigma_px"] = o.floor_sigma_px;
+  j["vignetting"] = o.vignetting;
   return j;
 }
 
@@ -353,7 +359,13 @@ Scene RenderScene(const SceneOptions& o) {
   const std::vector<Level> levels = ChooseLevels(r_min, r_max, o.fixed_r_px, ss, o.psf);
   int reach = 0;
   for (const Level& l : levels) reach = std::max(reach, l.reach);
-  const int m = reach + 2;  // the sharp scene is rendered this far beyond the image: blur brings light in from there
+  // The floor is spatially invariant, so it is applied to the sharp scene first (convolution commutes); its
+  // truth is its taps' variance, not the sigma asked for.
+  const std::vector<double> floor_taps = detail::FloorTaps(o.floor_sigma_px, ss);
+  const int floor_reach = static_cast<int>(floor_taps.size()) / 2;
+  const double floor_var_px2 = detail::TapsVariance(floor_taps) / (double(ss) * ss);
+  // The sharp scene is rendered this far beyond the image: blur brings light in from there.
+  const int m = reach + floor_reach + 2;
 
   // Flaws: dark spots on white squares, near an edge, in the middle half of a section.
   Rng flaw_rng(o.seed, kFlawStream);
@@ -498,10 +510,30 @@ Scene RenderScene(const SceneOptions& o) {
     }
   });
 
-  // Pass 3: depth-varying blur, downsample; then noise, sRGB, JPEG.
+  // Pass 3: the floor, depth-varying blur, downsample, vignetting; then noise, sRGB, JPEG.
+  if (floor_reach > 0) {
+    const cv::Mat k(floor_taps, true);
+    cv::Mat k32;
+    k.convertTo(k32, CV_32F);
+    for (cv::Mat* img : {&sharp, &sharp_no_board})
+      cv::sepFilter2D(*img, *img, CV_32F, k32, k32, cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
+  }
   cv::Mat linear = BlurAndDownsample(sharp, v, H, W, levels, ss, m);
   cv::Mat linear_no_board = BlurAndDownsample(sharp_no_board, v, H, W, levels, ss, m);
   sharp.release(), sharp_no_board.release();
+  if (o.vignetting > 0) {
+    const double rho2_corner = std::max({v.cx * v.cx + v.cy * v.cy, (W - 1 - v.cx) * (W - 1 - v.cx) + v.cy * v.cy,
+                                         v.cx * v.cx + (H - 1 - v.cy) * (H - 1 - v.cy),
+                                         (W - 1 - v.cx) * (W - 1 - v.cx) + (H - 1 - v.cy) * (H - 1 - v.cy)});
+    for (cv::Mat* img : {&linear, &linear_no_board})
+      for (int y = 0; y < H; ++y) {
+        float* p = img->ptr<float>(y);
+        for (int x = 0; x < W; ++x) {
+          const double rho2 = (x - v.cx) * (x - v.cx) + (y - v.cy) * (y - v.cy);
+          p[x] = static_cast<float>(p[x] * (1 - o.vignetting * rho2 / rho2_corner));
+        }
+      }
+  }
 
   Scene scene;
   scene.image = Finish(linear, o, Rng(o.seed, kNoiseStream));
@@ -523,10 +555,14 @@ Scene RenderScene(const SceneOptions& o) {
       t.edge = e;
       t.section = s;
       t.u_mm = u;
-      t.r_px = o.fixed_r_px ? *o.fixed_r_px : optics::BlurRadiusPx(lens, focus, u) * o.blur_gain;
+      t.defocus_r_px = o.fixed_r_px ? *o.fixed_r_px : optics::BlurRadiusPx(lens, focus, u) * o.blur_gain;
+      // Truth is what was applied: the mixed defocus levels' and the floor taps' variances from their arrays.
+      const double var_px2 = detail::AppliedVarianceSs(levels, t.defocus_r_px, ss) / (double(ss) * ss) + floor_var_px2;
+      t.r_px = 2 * std::sqrt(var_px2);
       t.flawed = flawed[e - 1][s - 1];
       scene.sections.push_back(t);
-      sections.push_back({{"edge", e}, {"section", s}, {"u_mm", u}, {"r_px", t.r_px}, {"flawed", t.flawed}});
+      sections.push_back({{"edge", e}, {"section", s}, {"u_mm", u}, {"r_px", t.r_px},
+                          {"defocus_r_px", t.defocus_r_px}, {"flawed", t.flawed}});
     }
 
   Json rotation = Json::array();
@@ -548,7 +584,9 @@ Scene RenderScene(const SceneOptions& o) {
   j["aperture_mm"] = lens.aperture_mm;
   j["pixel_pitch_mm"] = lens.pixel_pitch_mm;
   j["psf"] = o.psf == Psf::kDisc ? "disc" : "gaussian";
-  j["r_unit"] = "px, 2 x std of the line-spread function, optical only (pixel area excluded)";
+  j["r_unit"] = "px, 2 x std of the line-spread function of the kernels applied (defocus and floor), optical only "
+                "(pixel area excluded)";
+  j["floor_sigma_applied_px"] = std::sqrt(floor_var_px2);
   j["r_range_px"] = {r_min, r_max};
   j["blur_levels_px"] = levels_json;
   j["sections"] = sections;

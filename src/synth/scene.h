@@ -32,6 +32,12 @@ struct SceneOptions {
   std::optional<double> fixed_r_px;
   double blur_gain = 1.0;      // multiplies every thin-lens radius (a lens blurrier than ideal)
   Psf psf = Psf::kDisc;
+  // The lens floor: every point's defocus PSF convolved with a Gaussian of this std (px), as aberrations,
+  // diffraction and demosaicing do in a real camera; 0 = an ideal thin lens.
+  double floor_sigma_px = 0;
+  // Vignetting: linear light falls off as 1 - vignetting (rho / rho_corner)^2 from the principal point (0.35: the
+  // corners get 65 % of the centre's light).
+  double vignetting = 0;
   double white = 0.80;         // linear reflectance x exposure of the white squares
   double black = 0.04;         // ... of the black squares
   double table = 0.30;         // mean of the (textured) table
@@ -46,7 +52,9 @@ struct SectionTruth {
   int edge = 0;      // 1-based
   int section = 0;   // 1-based
   double u_mm = 0;   // camera z of the midpoint
-  double r_px = 0;   // true optical blur radius at the midpoint (DESIGN.md unit; excludes pixel area)
+  double r_px = 0;   // true optical blur radius at the midpoint (DESIGN.md unit; excludes pixel area): 2 x the std
+                     // of the LSF of the kernels actually applied (defocus levels mixed there, floor), from their arrays
+  double defocus_r_px = 0;  // the defocus part alone (the thin lens's radius at the midpoint)
   bool flawed = false;  // a printing flaw touches this section
 };
 

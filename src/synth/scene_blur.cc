@@ -160,6 +160,39 @@ std::vector<Level> ChooseLevels(double r_min, double r_max, std::optional<double
   return levels;
 }
 
+double AppliedVarianceSs(const std::vector<Level>& levels, double r_px, int ss) {
+  std::vector<double> var(levels.size());
+  for (size_t k = 0; k < levels.size(); ++k) var[k] = levels[k].var_ss;
+  // The same choice of levels and weights as BlurAndDownsample.
+  const double v = 0.25 * r_px * ss * r_px * ss;
+  int k = static_cast<int>(std::upper_bound(var.begin(), var.end(), v) - var.begin()) - 1;
+  k = std::clamp(k, 0, static_cast<int>(var.size()) - 1);
+  double w = 1;
+  if (k + 1 < static_cast<int>(var.size())) w = std::clamp((var[k + 1] - v) / (var[k + 1] - var[k]), 0.0, 1.0);
+  // Each level's own spread from its arrays: across rows and columns (equal by construction; averaged).
+  auto actual = [](const Level& l) {
+    if (l.identity()) return 0.0;
+    if (l.psf == Psf::kGaussian) return RowVariance(l.taps);
+    return 0.5 * (RowVariance(l.row_weight) + ColumnVariance(l));
+  };
+  double out = w * actual(levels[k]);
+  if (k + 1 < static_cast<int>(levels.size())) out += (1 - w) * actual(levels[k + 1]);
+  return out;
+}
+
+std::vector<double> FloorTaps(double sigma_px, int ss) {
+  const double s = sigma_px * ss;
+  if (!(s > 0)) return {1.0};
+  const int n = std::max(1, static_cast<int>(std::ceil(4 * s)));
+  std::vector<double> taps(2 * n + 1);
+  double total = 0;
+  for (int i = -n; i <= n; ++i) total += taps[i + n] = std::exp(-0.5 * i * i / (s * s));
+  for (double& t : taps) t /= total;
+  return taps;
+}
+
+double TapsVariance(const std::vector<double>& taps) { return RowVariance(taps); }
+
 cv::Mat BlurAndDownsample(const cv::Mat& sharp, const View& view, int H, int W, const std::vector<Level>& levels,
                           int ss, int m) {
   const int wss = W * ss, wp = sharp.cols;

@@ -32,6 +32,15 @@ struct Level {
 // The levels spanning radii r_min .. r_max (px) on a ladder (one level when `fixed`), for ss sub-pixels per pixel.
 std::vector<Level> ChooseLevels(double r_min, double r_max, std::optional<double> fixed, int ss, Psf psf);
 
+// Variance (sub-pixels^2) across an edge of the kernel BlurAndDownsample applies for radius r_px: the two levels
+// around it mixed with its weights, each level's variance computed from its kernel arrays.
+double AppliedVarianceSs(const std::vector<Level>& levels, double r_px, int ss);
+
+// The lens floor at sub-pixel resolution: separable taps of a Gaussian of std sigma_px * ss, 4 sigma wide.
+std::vector<double> FloorTaps(double sigma_px, int ss);
+// Variance (sub-pixels^2) of those taps, from the array.
+double TapsVariance(const std::vector<double>& taps);
+
 // Blurs the padded sharp image `sharp` (margin m on every side) with the radius each image sub-pixel's ray calls
 // for (RadiusRow, r in output pixels), mixing levels, and area-downsamples by ss. Output: CV_32F, H x W.
 cv::Mat BlurAndDownsample(const cv::Mat& sharp, const View& view, int H, int W, const std::vector<Level>& levels,

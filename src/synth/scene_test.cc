@@ -219,6 +219,43 @@ TEST(SynthScene, TurnedAndShiftedBoardIsWhereThePoseSays) {
   EXPECT_NEAR(s.sections[6].u_mm - s.sections[0].u_mm, 6 * 25 * std::sin(12 * kPi / 180) * std::cos(38 * kPi / 180), 1e-9);
 }
 
+// A lens floor: the truth is the defocus and floor kernels' second moments added (r^2 = R^2 + 4 f^2 for the floor
+// asked, within the taps' discretisation), and the rendered edge's own second moment (the differenced profile,
+// less the pixel's area and the difference's unit box) finds it, for a disc and a Gaussian under the floor.
+TEST(SynthScene, FloorAddsItsSecondMomentToTheTruthAndTheImage) {
+  for (Psf psf : {Psf::kDisc, Psf::kGaussian}) {
+    SceneOptions o = FixedBlur(3, psf);
+    o.floor_sigma_px = 0.8;
+    const Scene s = RenderScene(o);
+    const SectionTruth& t = s.sections[2 * 5 + 2];  // edge 3, section 3
+    EXPECT_NEAR(t.defocus_r_px, 3, 1e-12);
+    EXPECT_NEAR(t.r_px, std::hypot(3, 1.6), 0.01 * std::hypot(3, 1.6));
+    const Profile p = EdgeProfile(s, 3, 3);
+    double m0 = 0, m1 = 0, m2 = 0;
+    for (size_t i = 0; i + 1 < p.values.size(); ++i) {
+      const double g = p.values[i + 1] - p.values[i], x = i + 0.5;
+      m0 += g, m1 += g * x, m2 += g * x * x;
+    }
+    const double var = m2 / m0 - (m1 / m0) * (m1 / m0);
+    EXPECT_NEAR(2 * std::sqrt(var - 1.0 / 6), t.r_px, 0.03 * t.r_px) << "variance " << var;
+  }
+}
+
+// Vignetting darkens the corners by the fraction asked and leaves the centre as it was.
+TEST(SynthScene, VignettingDarkensTheCornersByTheFractionAsked) {
+  SceneOptions o = FixedBlur(1, Psf::kDisc);
+  const cv::Mat plain = Linear(RenderScene(o).image_no_board);
+  o.vignetting = 0.35;
+  const cv::Mat vign = Linear(RenderScene(o).image_no_board);
+  const auto ratio = [&](int x, int y) {
+    const cv::Rect box(x - 2, y - 2, 5, 5);
+    return cv::mean(vign(box))[0] / cv::mean(plain(box))[0];
+  };
+  EXPECT_NEAR(ratio(300, 200), 1.0, 0.01);
+  EXPECT_NEAR(ratio(2, 2), 0.65, 0.02);
+  EXPECT_NEAR(ratio(597, 397), 0.65, 0.02);
+}
+
 struct BlurCase {
   double r;
   Psf psf;
