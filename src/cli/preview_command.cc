@@ -97,7 +97,7 @@ void AddPreviewCommand(CLI::App& app) {
       session::AdaptiveState adaptive(p);  // no answers yet: each procedure's first level
       for (const auto& t : trials) {
         const stimulus::TrialScene& s_planned = prepared.scenes[size_t(t.index)];
-        if (t.task == protocol::Task::kAdjustment) {
+        if (protocol::TraitsOf(t.task).answer == protocol::TaskAnswer::kLevel) {
           const stimulus::TrialScene& s = s_planned;
           // Every level once (at the first distance shown), and every distance once (at the middle level): the
           // two halves of the frame vary apart, so together these show every distinct half.
@@ -121,9 +121,9 @@ void AddPreviewCommand(CLI::App& app) {
           }
           continue;
         }
-        Json key = t.levels;
-        key["left"] = t.left;
-        key["right"] = t.right;
+        Json key = protocol::ToJson(t.levels);
+        key["left"] = protocol::ToJson(t.left);
+        key["right"] = protocol::ToJson(t.right);
         if (!seen.insert(key.dump()).second) continue;
         // A procedure's crossing is shown at its first trial's level, on that trial's test side.
         stimulus::TrialScene s = s_planned;
