@@ -137,13 +137,12 @@ void AddPreviewCommand(CLI::App& app) {
           stimulus::PlanOnScreen(p, *scene, prepared.presentation, &s);
         }
         const std::string levels = session::LevelsLabel(t);
-        auto source = [](const Json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); };
         // Each side's radius as the camera made it (photo px) and as the screen shows it (screen px, arcmin): the
         // numbers the record keeps for these trials.
         const stimulus::Presentation& at = prepared.presentation;
-        auto side = [&](const char* name, const Json& v, double r) {
+        auto side = [&](const char* name, const std::optional<protocol::BlurSpec>& v, double r) {
           char text[160];
-          std::snprintf(text, sizeof text, "%s %s %.2f px = %.2f scr px %.2f'", name, source(v).c_str(), r,
+          std::snprintf(text, sizeof text, "%s %s %.2f px = %.2f scr px %.2f'", name, protocol::SideText(v).c_str(), r,
                         at.ScreenPx(r), at.Arcmin(r));
           return std::string(text);
         };

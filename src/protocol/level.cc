@@ -109,6 +109,10 @@ Json ToJson(const std::optional<BlurSpec>& side) {
   return Json();
 }
 
+std::string SideText(const std::optional<BlurSpec>& side) {
+  return side && side->source != BlurSource::kFixed ? ToString(side->source) : ToJson(side).dump();
+}
+
 const LevelValue* FindLevel(const std::vector<Level>& levels, const std::string& name) {
   for (const Level& level : levels)
     if (level.factor == name) return level.object ? nullptr : &level.value;

@@ -70,6 +70,10 @@ Json ToJson(const Level& level);
 Json ToJson(const std::vector<Level>& levels);  // {factor: level, ...}
 Json ToJson(const std::optional<BlurSpec>& side);  // null for no side
 
+// A side as the protocol wrote it, for people to read: a source's word ("measured"), a radius's JSON ("2.5",
+// {"screen_px":1}), "null" for no side.
+std::string SideText(const std::optional<BlurSpec>& side);
+
 // A trial's level by name: a factor of its own that holds a value, or a key of an object level (a pattern carries
 // speed and sides, a conditions table's row every column); null when neither.
 const LevelValue* FindLevel(const std::vector<Level>& levels, const std::string& name);

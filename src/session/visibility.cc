@@ -29,11 +29,6 @@ std::string LevelsLabel(const protocol::Trial& t) {
 std::vector<PairVisibility> PairVisibilities(const PreparedSession& prepared, const ObserverParams& observer,
                                              double level) {
   const protocol::Protocol& p = prepared.protocol;
-  // A side as the protocol wrote it: a source's word, a radius's JSON ("2.5", {"screen_px":1}).
-  auto source = [](const std::optional<protocol::BlurSpec>& side) {
-    return side && side->source != protocol::BlurSource::kFixed ? protocol::ToString(side->source)
-                                                                : protocol::ToJson(side).dump();
-  };
   std::vector<PairVisibility> pairs;
   std::map<std::string, size_t> index;  // the pair's key -> its place in `pairs`
   std::vector<Json> keys;                // per pair: its levels and sources, the order they are listed in
@@ -43,7 +38,7 @@ std::vector<PairVisibility> PairVisibilities(const PreparedSession& prepared, co
     if (protocol::TraitsOf(t.task).answer == protocol::TaskAnswer::kLevel || s.content == protocol::ContentType::kPicture)
       continue;
     // Either side order is one pair: a swapped copy shows the same two blurs.
-    const std::string a = source(t.left), b = source(t.right);
+    const std::string a = protocol::SideText(t.left), b = protocol::SideText(t.right);
     Json key = protocol::ToJson(t.levels);  // sorted as the levels' JSON sorts: numbers as numbers
     key["sources"] = s.left_only ? Json::array({a}) : Json::array({std::min(a, b), std::max(a, b)});
     if (const auto it = index.find(key.dump()); it != index.end()) {
