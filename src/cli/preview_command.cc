@@ -97,7 +97,7 @@ void AddPreviewCommand(CLI::App& app) {
       session::AdaptiveState adaptive(p);  // no answers yet: each procedure's first level
       for (const auto& t : trials) {
         const stimulus::TrialScene& s_planned = prepared.scenes[size_t(t.index)];
-        if (t.task == protocol::Task::kAdjustment) {
+        if (protocol::TraitsOf(t.task).answer == protocol::TaskAnswer::kLevel) {
           const stimulus::TrialScene& s = s_planned;
           // Every level once (at the first distance shown), and every distance once (at the middle level): the
           // two halves of the frame vary apart, so together these show every distinct half.
@@ -121,9 +121,9 @@ void AddPreviewCommand(CLI::App& app) {
           }
           continue;
         }
-        Json key = t.levels;
-        key["left"] = t.left;
-        key["right"] = t.right;
+        Json key = protocol::ToJson(t.levels);
+        key["left"] = protocol::ToJson(t.left);
+        key["right"] = protocol::ToJson(t.right);
         if (!seen.insert(key.dump()).second) continue;
         // A procedure's crossing is shown at its first trial's level, on that trial's test side.
         stimulus::TrialScene s = s_planned;
@@ -137,13 +137,12 @@ void AddPreviewCommand(CLI::App& app) {
           stimulus::PlanOnScreen(p, *scene, prepared.presentation, &s);
         }
         const std::string levels = session::LevelsLabel(t);
-        auto source = [](const Json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); };
         // Each side's radius as the camera made it (photo px) and as the screen shows it (screen px, arcmin): the
         // numbers the record keeps for these trials.
         const stimulus::Presentation& at = prepared.presentation;
-        auto side = [&](const char* name, const Json& v, double r) {
+        auto side = [&](const char* name, const std::optional<protocol::BlurSpec>& v, double r) {
           char text[160];
-          std::snprintf(text, sizeof text, "%s %s %.2f px = %.2f scr px %.2f'", name, source(v).c_str(), r,
+          std::snprintf(text, sizeof text, "%s %s %.2f px = %.2f scr px %.2f'", name, protocol::SideText(v).c_str(), r,
                         at.ScreenPx(r), at.Arcmin(r));
           return std::string(text);
         };

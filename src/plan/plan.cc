@@ -33,12 +33,14 @@ using protocol::Task;
 
 
 // A level as a label shows it: a number as %g, a string as itself, an object by its id or name.
-std::string LevelText(const Json& level) {
-  if (level.is_number()) return protocol::LevelText(level.get<double>());
-  if (level.is_string()) return level.get<std::string>();
+std::string LevelText(const protocol::LevelValue& value) {
+  return value.IsNumber() ? protocol::LevelText(value.number) : value.text;
+}
+std::string LevelText(const protocol::Level& level) {
+  if (!level.object) return LevelText(level.value);
   for (const char* name : {"id", "name"})
-    if (level.is_object() && level.contains(name)) return LevelText(level[name]);
-  return level.dump();
+    if (const protocol::LevelValue* v = level.Field(name)) return LevelText(*v);
+  return protocol::ToJson(level).dump();
 }
 
 // The condition of a main (not practice) trial and the measure its tests use; nullopt for what is not planned.
@@ -46,13 +48,14 @@ std::optional<Condition> ConditionOf(const protocol::Protocol& protocol, const p
                                      const stimulus::TrialScene& scene, bool several_blocks) {
   Condition c;
   c.block = protocol::BlockIndex(protocol, trial);
-  c.levels = trial.levels.dump();
+  c.levels = protocol::ToJson(trial.levels).dump();
   c.key = trial.block + "\n" + c.levels;
   std::string label;
-  if (trial.levels.is_object())
-    for (const auto& [name, value] : trial.levels.items()) label += (label.empty() ? "" : " ") + name + "=" + LevelText(value);
+  for (const protocol::Level& level : trial.levels)
+    label += (label.empty() ? "" : " ") + level.factor + "=" + LevelText(level);
   c.label = (several_blocks ? trial.block + (label.empty() ? "" : ": ") : "") + (label.empty() && !several_blocks ? "all" : label);
-  if (trial.task == Task::kYesNo) {
+  const protocol::TaskTraits& task = protocol::TraitsOf(trial.task);
+  if (task.answer == protocol::TaskAnswer::kYesNo) {
     c.measure = "yes";
   } else if (trial.cell >= 0) {
     // A procedure sets how often its trials are right (it moves the level to its target share): what it measures is
@@ -62,7 +65,7 @@ std::optional<Condition> ConditionOf(const protocol::Protocol& protocol, const p
   } else if (!trial.test_side.empty()) {
     c.measure = "correct";
     c.chance = scene.intervals > 2 ? 1.0 / scene.intervals : 0.5;
-  } else if (trial.task == Task::kForcedChoice && scene.content != protocol::ContentType::kPicture) {
+  } else if (task.answer == protocol::TaskAnswer::kSide && scene.content != protocol::ContentType::kPicture) {
     c.measure = "first_source";
     c.chance = 0.5;
   } else {
@@ -113,7 +116,8 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
     const session::Scored scored = logic.Answer(trial, scene, level, choice);
     if (keep_answers) p.answers.emplace_back(trial.index, choice);
     if (trial.practice) continue;
-    if (trial.task == Task::kAdjustment && scene.content == protocol::ContentType::kPicture) {
+    if (protocol::TraitsOf(trial.task).answer == protocol::TaskAnswer::kLevel &&
+        scene.content == protocol::ContentType::kPicture) {
       // Depth matching: one condition per block, the slope of the accepted cut-off on distance across its trials.
       Condition c;
       c.block = protocol::BlockIndex(protocol, trial);

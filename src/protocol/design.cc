@@ -10,17 +10,6 @@
 namespace blurcue::protocol {
 namespace {
 
-// The unit a level's name states by its suffix, as the house names values (speed_cm_s, distance_m, stimulus_ms).
-std::string UnitOf(const std::string& name) {
-  static const std::vector<std::pair<std::string, std::string>> suffixes = {
-      {"_cm_s", "cm/s"}, {"_mm", "mm"}, {"_cm", "cm"}, {"_ms", "ms"}, {"_px", "px"}, {"_arcmin", "arcmin"},
-      {"_deg", "deg"},   {"_m", "m"},   {"_s", "s"}};
-  for (const auto& [suffix, unit] : suffixes)
-    if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0)
-      return unit;
-  return "";
-}
-
 // A level as trials.csv shows it: a string bare, a number as JSON, an object by its id (else its scalar members as
 // key=value;...), as the export's TidyCell does.
 std::string LevelName(const Json& level) {
@@ -158,7 +147,7 @@ std::vector<DesignColumn> DescribeDesign(const Protocol& protocol) {
     columns.push_back(*level);
   }
   if (std::any_of(protocol.blocks.begin(), protocol.blocks.end(),
-                  [](const Block& b) { return b.task == Task::kRating; }) &&
+                  [](const Block& b) { return TraitsOf(b.task).answer == TaskAnswer::kRatingPoint; }) &&
       !protocol.responses.rating.empty()) {
     DesignColumn rating;
     rating.name = "rating";
@@ -205,10 +194,11 @@ std::string CellLevels(const Protocol& protocol, const Trial& trial) {
   if (trial.cell < 0 || !block || !block->procedure) return "";
   std::string text;
   for (const Factor& factor : block->factors) {
-    const Json* level = trial.levels.is_object() && trial.levels.contains(factor.name) ? &trial.levels[factor.name]
-                                                                                       : nullptr;
-    if (!level) continue;
-    const std::string value = level->is_number() ? LevelText(level->get<double>()) : LevelName(*level);
+    const auto level = std::find_if(trial.levels.begin(), trial.levels.end(),
+                                    [&](const Level& l) { return l.factor == factor.name; });
+    if (level == trial.levels.end()) continue;
+    const std::string value =
+        !level->object && level->value.IsNumber() ? LevelText(level->value.number) : LevelName(ToJson(*level));
     text += (text.empty() ? "" : ";") + factor.name + "=" + value;
   }
   return text;

@@ -101,11 +101,11 @@ TEST(CellLevels, AProcedureTrialNamesItsCellByItsLevels) {
   Trial trial;
   trial.block = "stair";
   trial.cell = 1;
-  trial.levels = Json{{"speed_cm_s", 1.8}};
+  trial.levels = LevelsOf(Json{{"speed_cm_s", 1.8}});
   EXPECT_EQ(CellLevels(p, trial), "speed_cm_s=1.8");
   Trial plain;
   plain.block = "main";
-  plain.levels = Json{{"edge", 9}};
+  plain.levels = LevelsOf(Json{{"edge", 9}});
   EXPECT_EQ(CellLevels(p, plain), "");
 }
 

@@ -175,13 +175,16 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
     b->sides_pointer = sides.ptr + "/sides";
   }
   const Source adjust = pick("adjust");
-  if (adjust.holder && b->task == Task::kAdjustment)
+  const TaskTraits& task = TraitsOf(b->task);
+  if (adjust.holder && task.answer == TaskAnswer::kLevel)
     b->adjust = ParseAdjust((*adjust.holder)["adjust"], adjust.ptr + "/adjust");
   if (obj.is_object() && obj.contains("procedure")) {
     b->procedure = ParseProcedure(obj["procedure"], ptr + "/procedure");
     // The procedure says what each side shows and how often: the design fields that would say it too are refused.
-    if (b->task != Task::kForcedChoice)
-      Problem(b->task_pointer, "must be forced_choice for a procedure (which side is more blurred?)",
+    if (!task.scored || task.answer != TaskAnswer::kSide)
+      Problem(b->task_pointer, "must be " + TaskWords([](const TaskTraits& t) {
+                                 return t.scored && t.answer == TaskAnswer::kSide;
+                               }) + " for a procedure (which side is more blurred?)",
               Json(ToString(b->task)));
     if (sides.holder) Problem(sides.ptr + "/sides", "is given but the procedure shows its reference on both sides",
                               (*sides.holder)["sides"]);
@@ -215,7 +218,7 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
       b->criterion = criterion;
     }
     if (!b->practice) Problem(at, "is for a practice block (\"practice\": true): a scored block runs once", *c);
-    if (b->task != Task::kForcedChoice || b->procedure)
+    if (!task.scored || b->procedure)
       Problem(at, "needs answers that are right or wrong: a forced choice without a procedure", *c);
   }
   if (const Json* g = Field(obj, "groups", ptr, false)) {
@@ -238,14 +241,14 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
     Problem(sides.ptr + "/sides", "is given but a factor's levels already carry the sides (left and right, or object)",
             (*sides.holder)["sides"]);
   const bool needs_sides =
-      !b->procedure && (b->task == Task::kForcedChoice || b->counterbalance != Counterbalance::kNone);
+      !b->procedure && (task.shows == TaskShows::kPair || b->counterbalance != Counterbalance::kNone);
   if (needs_sides && factors_ok && !factor_sides && !sides.holder)
     Problem(where, "needs what is shown left and right: a \"sides\" object or a factor whose levels have left and "
                    "right (a forced choice or left/right counterbalancing compares two sides)");
-  if ((b->task == Task::kYesNo || b->task == Task::kRating) && factors_ok && !factor_sides && !sides.holder)
+  if (task.shows == TaskShows::kOneObject && factors_ok && !factor_sides && !sides.holder)
     Problem(where, "needs the object shown: \"sides\": {\"object\": SOURCE} or a factor whose levels have an object "
                    "(a " + ToString(b->task) + " trial shows one object)");
-  if (b->task == Task::kAdjustment && !adjust.holder)
-    Problem(ptr + "/adjust", "is required for the adjustment task (here or at /adjust) but missing");
+  if (task.answer == TaskAnswer::kLevel && !adjust.holder)
+    Problem(ptr + "/adjust", "is required for the " + ToString(b->task) + " task (here or at /adjust) but missing");
 }
 }  // namespace blurcue::protocol::detail

@@ -287,31 +287,31 @@ void Parser::ParseResponses(const Json& v, const std::string& ptr, const std::se
   auto unused = [&](const char* key, bool used, const std::string& why) {
     if (v.contains(key) && !used) Problem(ptr + "/" + key, why, v[key]);
   };
-  unused("yes", tasks.count(Task::kYesNo), "is for the task yes_no, which no block has");
-  unused("no", tasks.count(Task::kYesNo), "is for the task yes_no, which no block has");
-  unused("rating", tasks.count(Task::kRating), "is for the task rating, which no block has");
+  // Each task's keys (TaskTraits::keys) are read when a block has the task; an odd one out answers with its
+  // intervals' keys, not left and right.
+  for (const Task task : Vocabulary<Task>::values)
+    for (const std::string& key : TraitsOf(task).keys) {
+      const bool read = tasks.count(task) > 0;
+      const bool intervals = p.layout == Layout::kOddOneOut && TraitsOf(task).answer == TaskAnswer::kSide &&
+                             key != "cant_tell";
+      unused(key.c_str(), read && !intervals,
+             read ? "is not read by the layout odd_one_out (its intervals have /responses/alternatives)"
+                  : "is for the task " + ToString(task) + ", which no block has");
+    }
   unused("alternatives", p.layout == Layout::kOddOneOut, "is for the layout odd_one_out");
-  const bool choice = tasks.count(Task::kForcedChoice) > 0, sides = choice && p.layout != Layout::kOddOneOut;
-  unused("left", sides, choice ? "is not read by the layout odd_one_out (its intervals have /responses/alternatives)"
-                               : "is for the task forced_choice, which no block has");
-  unused("right", sides, choice ? "is not read by the layout odd_one_out (its intervals have /responses/alternatives)"
-                                : "is for the task forced_choice, which no block has");
-  unused("cant_tell", choice, "is for the task forced_choice, which no block has");
-  for (const char* key : {"previous", "next", "accept"})
-    unused(key, tasks.count(Task::kAdjustment) > 0, "is for the task adjustment, which no block has");
   auto distinct = [&](const std::vector<std::pair<std::string, std::string>>& set) {
     for (size_t i = 0; i < set.size(); ++i)
       for (size_t j = 0; j < i; ++j)
         if (set[i].second == set[j].second)
           Problem(ptr + "/" + set[i].first, "is the same key as /responses/" + set[j].first, Json(set[i].second));
   };
-  if (tasks.count(Task::kForcedChoice))
-    distinct(r->cant_tell.empty() ? std::vector<std::pair<std::string, std::string>>{{"left", r->left}, {"right", r->right}}
-                                  : std::vector<std::pair<std::string, std::string>>{
-                                        {"left", r->left}, {"right", r->right}, {"cant_tell", r->cant_tell}});
-  if (tasks.count(Task::kAdjustment))
-    distinct({{"previous", r->previous}, {"next", r->next}, {"accept", r->accept}});
-  if (tasks.count(Task::kYesNo)) distinct({{"yes", r->yes}, {"no", r->no}});
+  // A task's single keys (a rating's list is checked below) must differ; a strict 2AFC has no can't-tell key.
+  for (const Task task : tasks) {
+    std::vector<std::pair<std::string, std::string>> keys;
+    for (const std::string& key : TraitsOf(task).keys)
+      if (const auto it = slots.find(key); it != slots.end() && !it->second->empty()) keys.emplace_back(key, *it->second);
+    distinct(keys);
+  }
   auto distinct_list = [&](const char* key, const std::vector<std::string>& keys) {
     for (size_t i = 0; i < keys.size(); ++i)
       for (size_t j = 0; j < i; ++j)
@@ -319,7 +319,8 @@ void Parser::ParseResponses(const Json& v, const std::string& ptr, const std::se
           Problem(ptr + "/" + key + "/" + std::to_string(i), "is the same key as /responses/" + std::string(key) + "/" + std::to_string(j),
                   Json(keys[i]));
   };
-  if (tasks.count(Task::kRating)) distinct_list("rating", r->rating);
+  for (const Task task : tasks)
+    if (TraitsOf(task).answer == TaskAnswer::kRatingPoint) distinct_list("rating", r->rating);
   if (p.layout == Layout::kOddOneOut) distinct_list("alternatives", r->alternatives);
 }
 // The protocol's timing (at /timing) or a block's (at /blocks/N/timing): each field given is checked and set in `t`,
@@ -350,9 +351,9 @@ void Parser::ParseTiming(const Json& v, const std::string& ptr, const Protocol& 
   if (v.contains("feedback_ms") && !correct)
     Problem(ptr + "/feedback_ms", "needs a correct answer: a block with a procedure or a criterion, or the "
                                   "layout odd_one_out, defines one", v["feedback_ms"]);
-  const bool adjustment =
-      std::any_of(blocks.begin(), blocks.end(), [](const Block* b) { return b->task == Task::kAdjustment; });
-  if (v.contains("deadline_ms") && adjustment)
+  const bool untimed =
+      std::any_of(blocks.begin(), blocks.end(), [](const Block* b) { return !TraitsOf(b->task).deadline; });
+  if (v.contains("deadline_ms") && untimed)
     Problem(ptr + "/deadline_ms", "is for a forced choice, yes/no or rating; adjustment runs until a level is "
                                   "accepted", v["deadline_ms"]);
   for (const char* key : {"interval_ms", "isi_ms"})

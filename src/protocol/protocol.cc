@@ -219,10 +219,13 @@ void Parser::CheckDesign(const Protocol& p) {
         Problem("/groups/names", "group " + g + " runs no block", Json(g));
   for (const auto& b : p.blocks) {
     // The renderer draws a picture for adjustment (cut-offs) and a pair of grids or balls for forced choice.
-    if (type == ContentType::kPicture && b.task != Task::kAdjustment)
-      Problem(b.task_pointer, "must be adjustment for a picture (forced_choice compares a pair of grids or balls)",
+    const TaskTraits& task = TraitsOf(b.task);
+    const bool picture_task = task.shows == TaskShows::kPicture;
+    if (type == ContentType::kPicture && !picture_task)
+      Problem(b.task_pointer, "must be " + TaskWords([](const TaskTraits& t) { return t.shows == TaskShows::kPicture; }) +
+                                  " for a picture (forced_choice compares a pair of grids or balls)",
               Json(ToString(b.task)));
-    if (type != ContentType::kPicture && b.task == Task::kAdjustment)
+    if (type != ContentType::kPicture && picture_task)
       Problem(b.task_pointer, "must be forced_choice for a " + type_name + " (adjustment steps through the cut-offs of a "
                               "picture)", Json(ToString(b.task)));
     // A level that places or moves a stimulus is read only by the content it is for: anywhere else it would be
@@ -280,9 +283,10 @@ void Parser::CheckDesign(const Protocol& p) {
     if (IntervalCount(p) > 0 && Provides(b, "speed_cm_s"))
       Problem(b.factors_pointer, "intervals show still objects: a speed_cm_s level would move them");
     // The layout decides the question: one object is answered yes/no or rated, a pair or N intervals chosen from.
-    const bool one = b.task == Task::kYesNo || b.task == Task::kRating;
+    const bool one = task.shows == TaskShows::kOneObject;
     if (p.layout == Layout::kSingle && type != ContentType::kPicture && !one)
-      Problem(b.task_pointer, "must be yes_no or rating for the layout single (one object: nothing to choose between)",
+      Problem(b.task_pointer, "must be " + TaskWords([](const TaskTraits& t) { return t.shows == TaskShows::kOneObject; }) +
+                                  " for the layout single (one object: nothing to choose between)",
               Json(ToString(b.task)));
     if (p.layout != Layout::kSingle && one)
       Problem(b.task_pointer, "is for the layout single (one object); a " + layout_name + " trial is a forced choice",
@@ -502,23 +506,15 @@ Protocol LoadProtocol(const fs::path& file, const ValidateOptions& options) {
   return ParseProtocol(ReadJsonFile(file), file, options);
 }
 
-const Json* FindLevel(const Json& levels, const std::string& name) {
-  if (!levels.is_object()) return nullptr;
-  if (auto it = levels.find(name); it != levels.end()) return &*it;
-  for (const auto& [key, value] : levels.items())
-    if (value.is_object())
-      if (auto it = value.find(name); it != value.end()) return &*it;
-  return nullptr;
-}
-
 std::set<double> NumericLevels(const Protocol& protocol, const std::string& factor) {
   std::set<double> values;
   for (const auto& b : protocol.blocks)
     for (const auto& f : b.factors)
       for (const auto& level : f.levels) {
-        Json levels = Json::object();
-        levels[f.name] = level;
-        if (const Json* v = FindLevel(levels, factor); v && v->is_number()) values.insert(v->get<double>());
+        // As FindLevel finds it in a trial (the factor itself, or a key of its object levels); read while the
+        // levels are still being checked, so from the JSON.
+        const Json* v = f.name == factor ? &level : level.is_object() && level.contains(factor) ? &level[factor] : nullptr;
+        if (v && v->is_number()) values.insert(v->get<double>());
       }
   return values;
 }

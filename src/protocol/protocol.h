@@ -254,10 +254,6 @@ int64_t DesignTrials(const Block& block);
 // Trials of a session (practice included), or kMaxTrials + 1 when it would have more.
 int64_t SessionTrials(const Protocol& protocol);
 
-// A trial's level by name: a factor of its own, or a key of an object level (a pattern carries speed and sides, a
-// conditions table's row every column); null when neither.
-const Json* FindLevel(const Json& levels, const std::string& name);
-
 // Every distinct number a trial can find by FindLevel(levels, `factor`), over all blocks, ascending: the factor's own
 // levels, or the key of object levels and conditions rows.
 std::set<double> NumericLevels(const Protocol& protocol, const std::string& factor);

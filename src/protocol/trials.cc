@@ -40,12 +40,17 @@ namespace {
 
 // The sides a design row shows: from the level object that carries left/right, else the block's "sides". The
 // single layout's one "object" is shown as the left side (and recorded on both).
-void SetSides(const Block& block, Trial* t) {
-  auto set = [&](const Json& from) {
-    t->left = from.contains("object") ? from["object"] : from.value("left", Json());
-    t->right = from.contains("object") ? from["object"] : from.value("right", Json());
+void SetSides(const Block& block, const Json& levels, Trial* t) {
+  auto side = [](const Json& from, const char* key) -> std::optional<BlurSpec> {
+    const Json& v = from.contains("object") ? from["object"] : from.value(key, Json());
+    if (v.is_null()) return std::nullopt;
+    return BlurSpecOf(v);
   };
-  for (const auto& [name, level] : t->levels.items())
+  auto set = [&](const Json& from) {
+    t->left = side(from, "left");
+    t->right = side(from, "right");
+  };
+  for (const auto& [name, level] : levels.items())
     if (level.is_object() && (level.contains("left") || level.contains("object"))) return set(level);
   if (block.sides.is_object()) set(block.sides);
 }
@@ -64,16 +69,17 @@ std::vector<Trial> Design(const Block& block, bool participant_even) {
       t.task = block.task;
       t.repetition = rep;
       if (block.procedure) t.cell = static_cast<int>(c);
-      t.levels = Json::object();
+      Json levels = Json::object();
       // Mixed radix with the last factor fastest.
       size_t rest = c;
       for (size_t k = block.factors.size(); k-- > 0;) {
         const auto& f = block.factors[k];
-        t.levels[f.name] = f.levels[rest % f.levels.size()];
+        levels[f.name] = f.levels[rest % f.levels.size()];
         rest /= f.levels.size();
       }
-      SetSides(block, &t);
-      if (block.procedure) t.left = t.right = block.procedure->reference;
+      t.levels = LevelsOf(levels);
+      SetSides(block, levels, &t);
+      if (block.procedure) t.left = t.right = BlurSpecOf(block.procedure->reference);
       if (block.counterbalance == Counterbalance::kByParticipant && participant_even) {
         std::swap(t.left, t.right);
         t.swapped = true;
@@ -90,7 +96,7 @@ std::vector<Trial> Design(const Block& block, bool participant_even) {
 }
 
 void DrawAdjustment(const Block& block, int alternatives, std::mt19937_64& rng, Trial* t) {
-  if (alternatives > 0 && block.task == Task::kForcedChoice) {
+  if (alternatives > 0 && TraitsOf(block.task).answer == TaskAnswer::kSide) {
     t->test_side = std::to_string(1 + UniformBelow(rng, uint64_t(alternatives)));
     return;
   }
@@ -98,7 +104,7 @@ void DrawAdjustment(const Block& block, int alternatives, std::mt19937_64& rng, 
     t->test_side = UniformBelow(rng, 2) == 0 ? "left" : "right";
     return;
   }
-  if (block.task != Task::kAdjustment || !block.adjust) return;
+  if (TraitsOf(block.task).answer != TaskAnswer::kLevel || !block.adjust) return;
   t->adjust_levels = block.adjust->levels;
   switch (block.adjust->order) {
     case AdjustOrder::kShuffled: Shuffle(t->adjust_levels, rng); break;
@@ -262,8 +268,9 @@ std::string SidePointer(const Protocol& protocol, const Trial& trial, const std:
   const std::string designed = trial.swapped ? (side == "left" ? "right" : "left") : side;
   for (const auto& b : protocol.blocks) {
     if (b.name != trial.block) continue;
+    const Json levels = ToJson(trial.levels);
     for (const auto& f : b.factors) {
-      const Json* level = trial.levels.is_object() && trial.levels.contains(f.name) ? &trial.levels.at(f.name) : nullptr;
+      const Json* level = levels.contains(f.name) ? &levels.at(f.name) : nullptr;
       if (!level || !level->is_object() || !level->contains(designed)) continue;
       const auto at = std::find(f.levels.begin(), f.levels.end(), *level);
       return b.factors_pointer + "/" + JsonPointerToken(f.name) + "/" + std::to_string(at - f.levels.begin()) + "/" +
@@ -278,8 +285,9 @@ std::string SidePointer(const Protocol& protocol, const Trial& trial, const std:
 std::string LevelPointer(const Protocol& protocol, const Trial& trial, const std::string& name) {
   for (const auto& b : protocol.blocks) {
     if (b.name != trial.block) continue;
+    const Json levels = ToJson(trial.levels);
     for (const auto& f : b.factors) {
-      const Json* level = trial.levels.is_object() && trial.levels.contains(f.name) ? &trial.levels.at(f.name) : nullptr;
+      const Json* level = levels.contains(f.name) ? &levels.at(f.name) : nullptr;
       if (!level || (f.name != name && !(level->is_object() && level->contains(name)))) continue;
       const auto at = std::find(f.levels.begin(), f.levels.end(), *level);
       std::string pointer = b.factors_pointer + "/" + JsonPointerToken(f.name) + "/" +
@@ -295,8 +303,8 @@ std::string LevelPointer(const Protocol& protocol, const Trial& trial, const std
 Json ToJson(const Trial& t) {
   Json j = {{"index", t.index},         {"block", t.block},     {"practice", t.practice},
             {"task", ToString(t.task)}, {"repetition", t.repetition}, {"swapped", t.swapped},
-            {"levels", t.levels},       {"left", t.left},       {"right", t.right}};
-  if (t.task == Task::kAdjustment) {
+            {"levels", ToJson(t.levels)}, {"left", ToJson(t.left)}, {"right", ToJson(t.right)}};
+  if (TraitsOf(t.task).answer == TaskAnswer::kLevel) {
     j["adjust_levels"] = t.adjust_levels;
     j["start_index"] = t.start_index;
   }

@@ -5,11 +5,13 @@
 // std::shuffle or std::uniform_int_distribution, whose results differ between libraries.
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "core/hash.h"
+#include "protocol/level.h"
 #include "protocol/protocol.h"
 
 namespace blurcue::protocol {
@@ -22,8 +24,9 @@ struct Trial {
   int repetition = 0;        // 0-based copy of the design within the block
   int round = -1;            // a practice block with a criterion: which run of its design (0-based); -1 otherwise
   bool swapped = false;      // left and right exchanged against the design (counterbalancing)
-  Json levels;               // factor name -> level, as designed (not swapped)
-  Json left, right;          // blur source shown on each side; null when the block shows no pair
+  std::vector<Level> levels;  // one per factor of its block, in name order, as designed (not swapped)
+  // The blur shown on each side (the single layout's object on both); none when the block shows no pair.
+  std::optional<BlurSpec> left, right;
   // Adjustment only: the levels in the order the participant steps through them, and where stepping starts.
   std::vector<double> adjust_levels;
   int start_index = -1;

@@ -32,7 +32,7 @@ const char* kFour = R"({
 
 std::vector<int> Edges(const std::vector<Trial>& trials) {
   std::vector<int> edges;
-  for (const auto& t : trials) edges.push_back(t.levels["edge"].get<int>());
+  for (const auto& t : trials) edges.push_back(ToJson(t.levels)["edge"].get<int>());
   return edges;
 }
 
@@ -85,9 +85,9 @@ TEST(TrialBuilder, ProcedureBlocksInterleaveTheirCrossingsWithSeededTestSides) {
     const Trial& t = a[i];
     ASSERT_TRUE(t.cell == 0 || t.cell == 1);
     ++per_cell[t.cell];
-    EXPECT_EQ(t.levels["edge"], t.cell == 0 ? 4 : 8);
-    EXPECT_EQ(t.left, "measured");
-    EXPECT_EQ(t.right, "measured");
+    EXPECT_EQ(ToJson(t.levels)["edge"], t.cell == 0 ? 4 : 8);
+    EXPECT_EQ(ToJson(t.left), "measured");
+    EXPECT_EQ(ToJson(t.right), "measured");
     ASSERT_TRUE(t.test_side == "left" || t.test_side == "right");
     left += t.test_side == "left";
     if (i > 0 && a[i - 1].cell != t.cell) ++switches;
@@ -115,8 +115,8 @@ TEST(TrialBuilder, OddOneOutDrawsEachTrialsOddInterval) {
   for (const Trial& t : a) {
     ASSERT_TRUE(t.test_side == "1" || t.test_side == "2" || t.test_side == "3" || t.test_side == "4") << t.test_side;
     ++count[std::stoi(t.test_side)];
-    EXPECT_EQ(t.left, "measured");
-    EXPECT_EQ(t.right, "none");
+    EXPECT_EQ(ToJson(t.left), "measured");
+    EXPECT_EQ(ToJson(t.right), "none");
   }
   for (int k = 1; k <= 4; ++k) {
     EXPECT_GT(count[k], 15) << k;  // 30 expected
@@ -134,7 +134,7 @@ TEST(TrialBuilder, SingleLayoutShowsItsObject) {
   const auto trials = BuildTrials(p, "P1", 1);
   ASSERT_EQ(trials.size(), 4u);
   for (const Trial& t : trials) {
-    EXPECT_EQ(t.left, t.levels["blur"]["object"]);
+    EXPECT_EQ(ToJson(t.left), ToJson(t.levels)["blur"]["object"]);
     EXPECT_EQ(t.right, t.left);
     EXPECT_EQ(t.task, Task::kYesNo);
     EXPECT_TRUE(t.test_side.empty());
@@ -157,7 +157,7 @@ TEST(TrialBuilder, PracticeToACriterionRunsItsDesignInRounds) {
     EXPECT_EQ(trials[i].block, "warmup");
     EXPECT_TRUE(trials[i].practice);
     EXPECT_EQ(trials[i].round, int(i / 5));
-    runs[size_t(trials[i].round)].push_back(trials[i].levels["edge"].get<int>());
+    runs[size_t(trials[i].round)].push_back(ToJson(trials[i].levels)["edge"].get<int>());
   }
   for (auto& run : runs) {
     std::vector<int> sorted = run;
@@ -356,7 +356,7 @@ TEST(TrialBuilder, EveryLevelAppearsAsDesigned) {
   for (const auto& t : trials) {
     if (t.practice || t.block != "task2") continue;
     auto& counts = t.swapped ? swapped : plain;
-    ++counts[{t.levels["pattern"]["id"].get<int>(), t.levels["section"].get<int>()}];
+    ++counts[{ToJson(t.levels)["pattern"]["id"].get<int>(), ToJson(t.levels)["section"].get<int>()}];
   }
   ASSERT_EQ(plain.size(), 30u);
   ASSERT_EQ(swapped.size(), 30u);
@@ -372,10 +372,10 @@ TEST(TrialBuilder, SwapCopiesPutEachSourceOnEachSideEquallyOften) {
   std::map<std::pair<int, std::string>, int> on_left;  // (pattern, source) -> times shown left
   for (const auto& t : trials) {
     if (t.practice || t.block != "task1") continue;
-    const Json& design = t.levels["pattern"];
-    EXPECT_EQ(t.left, t.swapped ? design["right"] : design["left"]);
-    EXPECT_EQ(t.right, t.swapped ? design["left"] : design["right"]);
-    ++on_left[{design["id"].get<int>(), t.left.get<std::string>()}];
+    const Json design = ToJson(t.levels)["pattern"];
+    EXPECT_EQ(ToJson(t.left), t.swapped ? design["right"] : design["left"]);
+    EXPECT_EQ(ToJson(t.right), t.swapped ? design["left"] : design["right"]);
+    ++on_left[{design["id"].get<int>(), ToJson(t.left).get<std::string>()}];
   }
   const Protocol p = Shipped("test2-moving-balls.json");
   ASSERT_EQ(p.blocks[0].factors[0].levels.size(), 6u);
@@ -390,12 +390,12 @@ TEST(TrialBuilder, ByParticipantSwapsForEvenNumbers) {
   const Protocol p = Shipped("test1-static-grids.json");
   for (const auto& t : BuildTrials(p, "P7", 1)) {
     EXPECT_FALSE(t.swapped);
-    EXPECT_EQ(t.left, "measured");
+    EXPECT_EQ(ToJson(t.left), "measured");
   }
   for (const auto& t : BuildTrials(p, "P8", 1)) {
     EXPECT_TRUE(t.swapped);
-    EXPECT_EQ(t.left, "estimated");
-    EXPECT_EQ(t.right, "measured");
+    EXPECT_EQ(ToJson(t.left), "estimated");
+    EXPECT_EQ(ToJson(t.right), "measured");
   }
 }
 
@@ -433,7 +433,7 @@ TEST(TrialBuilder, RepetitionsMultiplyTheDesign) {
   const auto trials = BuildTrials(ParseProtocol(j, "inline.json", {false}), "P1", 1);
   ASSERT_EQ(trials.size(), 12u);
   std::map<int, int> counts;
-  for (const auto& t : trials) ++counts[t.levels["edge"].get<int>()];
+  for (const auto& t : trials) ++counts[ToJson(t.levels)["edge"].get<int>()];
   for (int e = 1; e <= 4; ++e) EXPECT_EQ(counts[e], 3);
 }
 
@@ -453,7 +453,7 @@ TEST(TrialBuilder, AdjustmentLevelsAndStartAreDrawnPerTrial) {
     ASSERT_LT(t.start_index, 22);
     orders.insert(t.adjust_levels);
     starts.insert(t.start_index);
-    if (!t.practice) distances.insert(t.levels["distance_m"].get<double>());
+    if (!t.practice) distances.insert(ToJson(t.levels)["distance_m"].get<double>());
     EXPECT_EQ(ToJson(t)["start_index"], t.start_index);
   }
   EXPECT_EQ(distances.size(), 27u);
@@ -485,13 +485,13 @@ TEST(TrialPointers, SideNamesTheLevelThatChoseIt) {
   bool saw_swapped = false, saw_plain = false;
   for (const auto& t : BuildTrials(p, "P1", 3)) {
     if (t.practice || t.block != "task2") continue;
-    const int at = t.levels["pattern"]["id"].get<int>() / 2 - 1;  // task 2 lists patterns 2, 4, 6
+    const int at = ToJson(t.levels)["pattern"]["id"].get<int>() / 2 - 1;  // task 2 lists patterns 2, 4, 6
     const std::string level = "/blocks/1/factors/pattern/" + std::to_string(at);
     // A swapped copy shows the design's right source on the left.
     EXPECT_EQ(SidePointer(p, t, "left"), level + (t.swapped ? "/right" : "/left"));
     EXPECT_EQ(SidePointer(p, t, "right"), level + (t.swapped ? "/left" : "/right"));
     EXPECT_EQ(LevelPointer(p, t, "section"),
-              "/blocks/1/factors/section/" + std::to_string(t.levels["section"].get<int>() - 1));
+              "/blocks/1/factors/section/" + std::to_string(ToJson(t.levels)["section"].get<int>() - 1));
     EXPECT_EQ(LevelPointer(p, t, "speed_cm_s"), level + "/speed_cm_s");
     (t.swapped ? saw_swapped : saw_plain) = true;
   }
@@ -503,7 +503,7 @@ TEST(TrialPointers, SidesObjectOfTheProtocolWhenNoLevelCarriesThem) {
   const auto trials = BuildTrials(p, "P2", 1);  // even: every trial swapped
   EXPECT_EQ(SidePointer(p, trials.back(), "left"), "/sides/right");
   EXPECT_EQ(LevelPointer(p, trials.back(), "edge"),
-            "/factors/edge/" + std::to_string(trials.back().levels["edge"].get<int>() - 1));
+            "/factors/edge/" + std::to_string(ToJson(trials.back().levels)["edge"].get<int>() - 1));
 }
 
 TEST(TrialBuilder, ProtocolOverTheTrialCapIsRefusedBeforeBuilding) {

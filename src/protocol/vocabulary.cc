@@ -15,6 +15,23 @@ std::string ToString(Task value) {
   return "";
 }
 
+const TaskTraits& TraitsOf(Task task) {
+  // shows, answer, scored, deadline, keys (the /responses fields read; an odd one out's intervals read
+  // responses.alternatives, which the layout decides).
+  static const TaskTraits kForcedChoice{TaskShows::kPair, TaskAnswer::kSide, true, true, {"left", "right", "cant_tell"}};
+  static const TaskTraits kAdjustment{TaskShows::kPicture, TaskAnswer::kLevel, false, false,
+                                      {"previous", "next", "accept"}};
+  static const TaskTraits kYesNo{TaskShows::kOneObject, TaskAnswer::kYesNo, false, true, {"yes", "no"}};
+  static const TaskTraits kRating{TaskShows::kOneObject, TaskAnswer::kRatingPoint, false, true, {"rating"}};
+  switch (task) {
+    case Task::kForcedChoice: return kForcedChoice;
+    case Task::kAdjustment: return kAdjustment;
+    case Task::kYesNo: return kYesNo;
+    case Task::kRating: return kRating;
+  }
+  return kForcedChoice;
+}
+
 std::string ToString(Counterbalance value) {
   switch (value) {
     case Counterbalance::kNone: return "none";
@@ -115,6 +132,27 @@ std::string ToString(InfoType value) {
     case InfoType::kNumber: return "number";
     case InfoType::kChoice: return "choice";
     case InfoType::kText: return "text";
+  }
+  return "";
+}
+
+std::string ToString(BlurSource value) {
+  switch (value) {
+    case BlurSource::kNone: return "none";
+    case BlurSource::kMeasured: return "measured";
+    case BlurSource::kMeasuredSection: return "measured_section";
+    case BlurSource::kEstimated: return "estimated";
+    case BlurSource::kFitted: return "fitted";
+    case BlurSource::kFixed: return "fixed";
+  }
+  return "";
+}
+
+std::string ToString(RadiusUnit value) {
+  switch (value) {
+    case RadiusUnit::kPhotoPx: return "photo_px";
+    case RadiusUnit::kScreenPx: return "screen_px";
+    case RadiusUnit::kArcmin: return "arcmin";
   }
   return "";
 }

@@ -110,6 +110,53 @@ struct Vocabulary<InfoType> {
   static constexpr std::array values{InfoType::kInteger, InfoType::kNumber, InfoType::kChoice, InfoType::kText};
 };
 
+// Where a side's blur comes from: "none" | "measured" (the thesis's edge value) | "measured_section" | "estimated"
+// (eq. 3.7) | "fitted" (the thin-lens model) | "fixed" (a radius the protocol gives as a number, never as this word).
+enum class BlurSource { kNone, kMeasured, kMeasuredSection, kEstimated, kFitted, kFixed };
+template <>
+struct Vocabulary<BlurSource> {
+  static constexpr std::array values{BlurSource::kNone,     BlurSource::kMeasured, BlurSource::kMeasuredSection,
+                                     BlurSource::kEstimated, BlurSource::kFitted,   BlurSource::kFixed};
+};
+
+// The unit of a fixed radius: "photo_px" (a bare number: the camera's pixels) | "screen_px" | "arcmin" (the keys of
+// {"screen_px": r} and {"arcmin": r}).
+enum class RadiusUnit { kPhotoPx, kScreenPx, kArcmin };
+template <>
+struct Vocabulary<RadiusUnit> {
+  static constexpr std::array values{RadiusUnit::kPhotoPx, RadiusUnit::kScreenPx, RadiusUnit::kArcmin};
+};
+
+// What a trial of a task shows: a picture (content "picture": the real one and the virtual one to match), one object
+// (the layout single), or a pair of objects (side by side, in two intervals, or as an odd one out of n).
+enum class TaskShows { kPicture, kOneObject, kPair };
+// What the participant answers: a side or interval (left / right / can't tell, or an odd-one-out interval "1".."n"),
+// yes or no, a point of a rating scale ("1".."n"), or a level stepped to and accepted.
+enum class TaskAnswer { kSide, kYesNo, kRatingPoint, kLevel };
+
+// Everything the code knows of a task, in one place (TraitsOf): after protocol/ a caller asks these instead of
+// comparing Task values, so a new task with the shows/answer of an existing one is a row here (see the README's
+// section for contributors).
+struct TaskTraits {
+  TaskShows shows = TaskShows::kPair;
+  TaskAnswer answer = TaskAnswer::kSide;
+  // An answer is right or wrong (the side showing more blur, a procedure's test side, the odd interval): what a
+  // procedure, a practice criterion and feedback need.
+  bool scored = false;
+  // A deadline (timing.deadline_ms) can end a trial with no answer; false: it runs until a level is accepted.
+  bool deadline = true;
+  // The /responses fields the task reads (its keys), as the protocol file spells them.
+  std::vector<std::string> keys;
+};
+
+// The traits of `task` (a switch: a new Task value makes the compiler ask for its row).
+const TaskTraits& TraitsOf(Task task);
+
+// The words of the tasks whose traits satisfy `pred`, in Vocabulary<Task>::values order, joined by " or "
+// ("yes_no or rating"): how a message names the tasks a rule allows.
+template <typename Pred>
+std::string TaskWords(Pred pred);
+
 // The word for a value, as protocol files, the record and messages spell it ("" for a value outside the enum).
 std::string ToString(Task value);
 std::string ToString(Counterbalance value);
@@ -124,6 +171,8 @@ std::string ToString(Layout value);
 std::string ToString(BlockSequence value);
 std::string ToString(GroupAssign value);
 std::string ToString(InfoType value);
+std::string ToString(BlurSource value);
+std::string ToString(RadiusUnit value);
 
 // The value a word names, or nullopt when the vocabulary has no such word.
 template <typename E>
@@ -131,6 +180,14 @@ std::optional<E> ParseWord(std::string_view word) {
   for (const E value : Vocabulary<E>::values)
     if (ToString(value) == word) return value;
   return std::nullopt;
+}
+
+template <typename Pred>
+std::string TaskWords(Pred pred) {
+  std::string words;
+  for (const Task task : Vocabulary<Task>::values)
+    if (pred(TraitsOf(task))) words += (words.empty() ? "" : " or ") + ToString(task);
+  return words;
 }
 
 // Every word of a vocabulary, in Vocabulary<E>::values order: the parser's allowed values.

@@ -31,7 +31,7 @@ void CheckObserverCanAnswer(const ObserverParams& observer, const protocol::Prot
   if (observer.model != ObserverModel::kArcmin || protocol.content.type != protocol::ContentType::kPicture || protocol.content.real_camera)
     return;
   for (const auto& block : protocol.blocks)
-    if (block.task == protocol::Task::kAdjustment)
+    if (protocol::TraitsOf(block.task).answer == protocol::TaskAnswer::kLevel)
       throw InputError(protocol.file.string() + ": /content/real_camera",
                        "is needed by the simulated observer (model=arcmin), which sets the picture to the real "
                        "picture's blur in visual angle: name the camera and focus of the real photos, or use "
@@ -41,14 +41,18 @@ void CheckObserverCanAnswer(const ObserverParams& observer, const protocol::Prot
 std::vector<KeyPress> AnswerTrial(SimulatedObserver& observer, const protocol::Protocol& protocol,
                                   const protocol::Trial& trial, const TrialScene& scene,
                                   const Presentation& presentation) {
-  using protocol::Task;
-  if (trial.task == Task::kAdjustment)
-    return observer.Adjust(trial.adjust_levels, trial.start_index, AdjustViewOf(trial, scene, presentation));
+  using protocol::TaskAnswer;
+  switch (protocol::TraitsOf(trial.task).answer) {
+    case TaskAnswer::kLevel:
+      return observer.Adjust(trial.adjust_levels, trial.start_index, AdjustViewOf(trial, scene, presentation));
+    case TaskAnswer::kYesNo: return {observer.SayYesNo(ViewOf(scene, presentation))};
+    case TaskAnswer::kRatingPoint:
+      return {observer.Rate(ViewOf(scene, presentation), int(protocol.responses.rating.size()))};
+    case TaskAnswer::kSide: break;
+  }
   const PairView view = ViewOf(scene, presentation);
   const KeyPress press =
-      trial.task == Task::kYesNo    ? observer.SayYesNo(view)
-      : trial.task == Task::kRating ? observer.Rate(view, int(protocol.responses.rating.size()))
-      : scene.intervals > 2         ? observer.ChooseOdd(view, scene.intervals, std::stoi(trial.test_side))
+      scene.intervals > 2 ? observer.ChooseOdd(view, scene.intervals, std::stoi(trial.test_side))
       // A procedure, or practice scored by a criterion: "which side is more blurred?"
       : trial.cell >= 0 || trial.round >= 0 ? observer.ChooseBlurrier(view)
                                             : observer.ChooseSide(view, !protocol.responses.cant_tell.empty());

@@ -19,29 +19,36 @@ struct KeyMap {
   bool odd_one_out;
   // The keys whose position names the answer ("1".."n"): a rating's points, an odd-one-out trial's intervals.
   const std::vector<std::string>* Numbered(protocol::Task task) const {
-    return task == protocol::Task::kRating                       ? &r.rating
-           : task == protocol::Task::kForcedChoice && odd_one_out ? &r.alternatives
+    const protocol::TaskAnswer answer = protocol::TraitsOf(task).answer;
+    return answer == protocol::TaskAnswer::kRatingPoint             ? &r.rating
+           : answer == protocol::TaskAnswer::kSide && odd_one_out ? &r.alternatives
                                                                   : nullptr;
   }
   std::string Action(const std::string& key, protocol::Task task) const {
     if (key == "Escape") return "pause";
+    const protocol::TaskAnswer answer = protocol::TraitsOf(task).answer;
     if (const auto* keys = Numbered(task)) {
       const auto it = std::find(keys->begin(), keys->end(), key);
       if (it != keys->end()) return std::to_string(it - keys->begin() + 1);
-      if (task == protocol::Task::kForcedChoice && !r.cant_tell.empty() && key == r.cant_tell) return "cant_tell";
+      if (answer == protocol::TaskAnswer::kSide && !r.cant_tell.empty() && key == r.cant_tell) return "cant_tell";
       return "";
     }
-    if (task == protocol::Task::kForcedChoice) {
-      if (key == r.left) return "left";
-      if (key == r.right) return "right";
-      if (key == r.cant_tell) return "cant_tell";
-    } else if (task == protocol::Task::kYesNo) {
-      if (key == r.yes) return "yes";
-      if (key == r.no) return "no";
-    } else if (task == protocol::Task::kAdjustment) {
-      if (key == r.previous || key == "WheelDown") return "previous";
-      if (key == r.next || key == "WheelUp") return "next";
-      if (key == r.accept || key == "MouseLeft") return "accept";
+    switch (answer) {
+      case protocol::TaskAnswer::kSide:
+        if (key == r.left) return "left";
+        if (key == r.right) return "right";
+        if (key == r.cant_tell) return "cant_tell";
+        break;
+      case protocol::TaskAnswer::kYesNo:
+        if (key == r.yes) return "yes";
+        if (key == r.no) return "no";
+        break;
+      case protocol::TaskAnswer::kLevel:
+        if (key == r.previous || key == "WheelDown") return "previous";
+        if (key == r.next || key == "WheelUp") return "next";
+        if (key == r.accept || key == "MouseLeft") return "accept";
+        break;
+      case protocol::TaskAnswer::kRatingPoint: break;  // numbered above
     }
     return "";
   }
@@ -61,17 +68,18 @@ struct KeyMap {
   // them, an adjustment's level (as the record writes it), or no answer (a deadline passed).
   bool CanRecord(const std::string& choice, const protocol::Trial& trial) const {
     if (choice == kChoiceNone) return true;
-    if (trial.task == protocol::Task::kAdjustment)
+    const protocol::TaskAnswer answer = protocol::TraitsOf(trial.task).answer;
+    if (answer == protocol::TaskAnswer::kLevel)
       return std::any_of(trial.adjust_levels.begin(), trial.adjust_levels.end(),
                          [&](double level) { return protocol::LevelText(level) == choice; });
-    const bool cant_tell = trial.task == protocol::Task::kForcedChoice && !r.cant_tell.empty() && choice == "cant_tell";
+    const bool cant_tell = answer == protocol::TaskAnswer::kSide && !r.cant_tell.empty() && choice == "cant_tell";
     if (const auto* keys = Numbered(trial.task)) {
       for (size_t i = 0; i < keys->size(); ++i)
         if (choice == std::to_string(i + 1)) return true;
       return cant_tell;
     }
-    if (trial.task == protocol::Task::kForcedChoice) return choice == "left" || choice == "right" || cant_tell;
-    if (trial.task == protocol::Task::kYesNo) return choice == "yes" || choice == "no";
+    if (answer == protocol::TaskAnswer::kSide) return choice == "left" || choice == "right" || cant_tell;
+    if (answer == protocol::TaskAnswer::kYesNo) return choice == "yes" || choice == "no";
     return false;
   }
   // An action that answers a trial (not a step of an adjustment, not the pause).

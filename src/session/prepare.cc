@@ -43,8 +43,9 @@ PreparedSession PrepareStudy(const std::filesystem::path& protocol_file, const s
 std::string SceneKey(const protocol::Trial& t) {
   std::string key = t.block + '\n' + std::to_string(int(t.task)) + ' ' + std::to_string(t.practice) + ' ' +
                     std::to_string(t.round) + ' ' + std::to_string(t.swapped) + ' ' + std::to_string(t.cell) + ' ' +
-                    t.test_side + ' ' + std::to_string(t.start_index) + '\n' + t.levels.dump() + '\n' +
-                    t.left.dump() + '\n' + t.right.dump() + '\n';
+                    t.test_side + ' ' + std::to_string(t.start_index) + '\n' +
+                    protocol::ToJson(t.levels).dump() + '\n' + protocol::ToJson(t.left).dump() + '\n' +
+                    protocol::ToJson(t.right).dump() + '\n';
   for (double level : t.adjust_levels) key += std::to_string(level) + ' ';
   return key;
 }

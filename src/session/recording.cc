@@ -33,14 +33,15 @@ std::vector<store::TrialRecord> TrialRecords(const PreparedSession& s) {
     r.block = protocol::BlockIndex(protocol, trial);
     const TrialScene& planned = s.scenes[size_t(trial.index)];
     r.factors_json = TrialVariables(trial, planned, s.presentation).dump();
-    r.left_json = trial.left.dump();
-    r.right_json = trial.right.dump();
+    r.left_json = protocol::ToJson(trial.left).dump();
+    r.right_json = protocol::ToJson(trial.right).dump();
     r.block_name = trial.block;
     r.task = protocol::ToString(trial.task);
     r.practice = trial.practice;
     r.swapped = trial.swapped;
     r.cell = protocol::CellLevels(protocol, trial);
-    if (planned.content != protocol::ContentType::kPicture && trial.task != protocol::Task::kAdjustment) {
+    if (planned.content != protocol::ContentType::kPicture &&
+        protocol::TraitsOf(trial.task).shows != protocol::TaskShows::kPicture) {
       r.r_left_px = planned.r_left_px;
       if (!planned.left_only) r.r_right_px = planned.r_right_px;
       r.r_scene_px = planned.r_scene_px;
@@ -168,7 +169,7 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
   // below (status, r_left_px, level, correct, ...) as factor_NAME, so what is recorded never overwrites a level.
   // A level object's values get columns of their own (a pattern's speed_cm_s, a conditions table's edge); the sides
   // are recorded as such. A conditions table's row object itself is no factor of the design: only its columns stay.
-  Json v = store::LevelVariables(trial.levels);
+  Json v = store::LevelVariables(protocol::ToJson(trial.levels));
   v["practice"] = trial.practice ? 1 : 0;
   v["block_name"] = trial.block;
   v["swapped"] = trial.swapped ? 1 : 0;
@@ -179,13 +180,14 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
     if (!std::isnan(scene.level)) v["level"] = scene.level;
   }
   // Odd one out: the interval that showed the right side's object (the correct answer), and how many there were.
-  if (scene.intervals > 2 && trial.task == protocol::Task::kForcedChoice) {
+  const protocol::TaskTraits& task = protocol::TraitsOf(trial.task);
+  if (scene.intervals > 2 && task.answer == protocol::TaskAnswer::kSide) {
     v["odd_interval"] = std::stoi(trial.test_side);
     v["intervals"] = scene.intervals;
   }
   // Rounded to 1e-4 px: the record is read by people and charts, not fed back.
   auto round4 = [](double x) { return std::round(x * 1e4) / 1e4; };
-  if (trial.task == protocol::Task::kAdjustment) {
+  if (task.answer == protocol::TaskAnswer::kLevel) {
     if (trial.start_index >= 0 && size_t(trial.start_index) < trial.adjust_levels.size())
       v["start_level"] = trial.adjust_levels[size_t(trial.start_index)];
     // The levels in the order "next" steps through them (cyclic): what the participant could reach, as shown.
@@ -202,7 +204,7 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
       v["r_scene_screen_px"] = round4(presentation.ScreenPx(scene.r_scene_px * presentation.real_frame_px_per_px));
       v["r_scene_arcmin"] = round4(presentation.RealArcmin(scene.r_scene_px));
     }
-  } else if (trial.task != protocol::Task::kAdjustment) {
+  } else if (task.shows != protocol::TaskShows::kPicture) {
     // Each radius as the camera made it (photo px), as the window shows it (screen px) and as the eye gets it.
     // The single layout shows only its object, recorded as the left side.
     for (const auto& [name, r] : {std::pair<const char*, double>{"left", scene.r_left_px},

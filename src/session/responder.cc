@@ -36,7 +36,7 @@ void ObserverResponder::ScreenShown(double now_s) { Script("Return", now_s + 0.6
 void ObserverResponder::StimulusShown(const protocol::Trial& trial, const stimulus::TrialScene& scene,
                                       double onset_s) {
   const std::vector<KeyPress> presses = ObserverPresses(params_, seed_, protocol_, trial, scene, presentation_);
-  if (trial.task != Task::kAdjustment) {
+  if (protocol::TraitsOf(trial.task).answer != protocol::TaskAnswer::kLevel) {
     // A moving stimulus is watched to its end before the answer (task 1 is one answer per run); intervals too.
     for (const KeyPress& press : presses)
       Script(keys_.Key(press.action, trial.task),

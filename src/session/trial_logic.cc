@@ -23,7 +23,7 @@ double StimulusEndS(const protocol::Timing& timing, const TrialScene& scene) {
 
 std::optional<bool> CorrectOf(const protocol::Trial& trial, const TrialScene& scene, const std::string& choice) {
   if (!trial.test_side.empty()) return choice == trial.test_side;
-  if (trial.task != Task::kForcedChoice || scene.content == protocol::ContentType::kPicture) return std::nullopt;
+  if (!protocol::TraitsOf(trial.task).scored || scene.content == protocol::ContentType::kPicture) return std::nullopt;
   if (std::abs(scene.r_left_px - scene.r_right_px) <= 1e-9) return choice == "cant_tell";
   return choice == (scene.r_left_px > scene.r_right_px ? "left" : "right");
 }
@@ -128,7 +128,7 @@ int StepLevel(int level, const std::string& action, int levels) {
 std::pair<std::string, double> HeadlessAnswer(const protocol::Protocol& protocol, const protocol::Trial& trial,
                                               const TrialScene& scene, const std::vector<KeyPress>& presses) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  if (trial.task != Task::kAdjustment) {
+  if (protocol::TraitsOf(trial.task).answer != protocol::TaskAnswer::kLevel) {
     if (presses.empty()) return {kChoiceNone, nan};
     const protocol::Timing& timing = protocol::TimingOf(protocol, trial);
     const double t_ms = (StimulusEndS(timing, scene) + presses.front().after_ms / 1000) * 1000;

@@ -156,7 +156,7 @@ class Runner {
       last_flip = flip;
       if (presenter_.Closed()) return Outcome::kQuit;
       // A deadline: no answer this long after onset is recorded as "none", without a response time.
-      if (timing.deadline_ms > 0 && trial.task != Task::kAdjustment &&
+      if (timing.deadline_ms > 0 && protocol::TraitsOf(trial.task).deadline &&
           (presenter_.Now() - onset - paused_s) * 1000 >= timing.deadline_ms) {
         response->choice = kChoiceNone;
         response->rt_ms = std::numeric_limits<double>::quiet_NaN();

@@ -18,26 +18,28 @@ using stimulus::TrialScene;
 
 std::string LevelsLabel(const protocol::Trial& t) {
   std::string levels;
-  for (const auto& [name, value] : t.levels.items())
-    levels += (levels.empty() ? "" : " ") + name + " " +
-              (value.is_object() && value.contains("id") ? value["id"].dump() : value.dump());
+  for (const protocol::Level& level : t.levels) {
+    const protocol::LevelValue* id = level.object ? level.Field("id") : nullptr;
+    levels += (levels.empty() ? "" : " ") + level.factor + " " +
+              (id ? protocol::ToJson(*id).dump() : protocol::ToJson(level).dump());
+  }
   return levels;
 }
 
 std::vector<PairVisibility> PairVisibilities(const PreparedSession& prepared, const ObserverParams& observer,
                                              double level) {
   const protocol::Protocol& p = prepared.protocol;
-  auto source = [](const Json& v) { return v.is_string() ? v.get<std::string>() : v.dump(); };
   std::vector<PairVisibility> pairs;
   std::map<std::string, size_t> index;  // the pair's key -> its place in `pairs`
   std::vector<Json> keys;                // per pair: its levels and sources, the order they are listed in
   AdaptiveState adaptive(p);             // no answers yet: each procedure's first level
   for (const protocol::Trial& t : prepared.trials) {
     TrialScene s = prepared.scenes[size_t(t.index)];
-    if (t.task == protocol::Task::kAdjustment || s.content == protocol::ContentType::kPicture) continue;
+    if (protocol::TraitsOf(t.task).answer == protocol::TaskAnswer::kLevel || s.content == protocol::ContentType::kPicture)
+      continue;
     // Either side order is one pair: a swapped copy shows the same two blurs.
-    const std::string a = source(t.left), b = source(t.right);
-    Json key = t.levels;
+    const std::string a = protocol::SideText(t.left), b = protocol::SideText(t.right);
+    Json key = protocol::ToJson(t.levels);  // sorted as the levels' JSON sorts: numbers as numbers
     key["sources"] = s.left_only ? Json::array({a}) : Json::array({std::min(a, b), std::max(a, b)});
     if (const auto it = index.find(key.dump()); it != index.end()) {
       ++pairs[it->second].trials;
@@ -86,7 +88,8 @@ std::vector<MatchVisibility> MatchVisibilities(const PreparedSession& prepared, 
   if (!(shown.real_frame_px_per_px > 0)) return {};
   for (const protocol::Trial& t : prepared.trials) {
     const TrialScene& s = prepared.scenes[size_t(t.index)];
-    if (t.task != protocol::Task::kAdjustment || s.content != protocol::ContentType::kPicture) continue;
+    if (protocol::TraitsOf(t.task).answer != protocol::TaskAnswer::kLevel || s.content != protocol::ContentType::kPicture)
+      continue;
     MatchVisibility& m = by_distance[s.distance_m];
     if (m.trials++ > 0) continue;
     m.distance_m = s.distance_m;

@@ -65,9 +65,9 @@ inline protocol::Protocol BallProtocol() {
 inline protocol::Trial PairTrial(Json levels, Json left, Json right) {
   protocol::Trial t;
   t.block = "task2";
-  t.levels = std::move(levels);
-  t.left = std::move(left);
-  t.right = std::move(right);
+  t.levels = protocol::LevelsOf(levels);
+  if (!left.is_null()) t.left = protocol::BlurSpecOf(left);
+  if (!right.is_null()) t.right = protocol::BlurSpecOf(right);
   return t;
 }
 

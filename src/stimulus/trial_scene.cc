@@ -20,26 +20,32 @@ using protocol::FindLevel;
 
 // `where` names the field that chose the source ("FILE: /pointer"), made only when there is a problem to name. A
 // fixed radius on the screen is converted to photo px by `presentation`.
-calib::BlurSource Source(const Json& v, double* fixed, const std::function<std::string()>& where,
-                         const Presentation* presentation) {
-  if (v.is_number()) {
-    *fixed = v.get<double>();
-    return calib::BlurSource::kFixed;
+// The protocol's blur source as the calibration evaluates it: the one place the two vocabularies meet (calib knows
+// nothing of protocols).
+calib::BlurSource Source(const std::optional<protocol::BlurSpec>& spec, double* fixed,
+                         const std::function<std::string()>& where, const Presentation* presentation) {
+  if (!spec) throw InputError(where(), "the trial shows no blur source on this side, got null");
+  switch (spec->source) {
+    case protocol::BlurSource::kNone: return calib::BlurSource::kNone;
+    case protocol::BlurSource::kMeasured: return calib::BlurSource::kMeasured;
+    case protocol::BlurSource::kMeasuredSection: return calib::BlurSource::kMeasuredSection;
+    case protocol::BlurSource::kEstimated: return calib::BlurSource::kEstimated;
+    case protocol::BlurSource::kFitted: return calib::BlurSource::kFitted;
+    case protocol::BlurSource::kFixed: break;
   }
-  if (v.is_object() && v.size() == 1 && (v.contains("screen_px") || v.contains("arcmin")) && v.front().is_number()) {
-    if (!presentation || presentation->scale <= 0)
-      throw InputError(where(), "a radius on the screen needs the display it is shown on, got " + v.dump());
-    const double r = v.front().get<double>();
-    const double screen_px = v.contains("arcmin") ? display::ScreenPxOfArcmin(presentation->profile, r) : r;
-    *fixed = screen_px / presentation->scale;
-    return calib::BlurSource::kFixed;
+  const double r = spec->radius.number;
+  switch (spec->unit) {
+    case protocol::RadiusUnit::kPhotoPx: *fixed = r; break;
+    case protocol::RadiusUnit::kScreenPx:
+    case protocol::RadiusUnit::kArcmin:
+      if (!presentation || presentation->scale <= 0)
+        throw InputError(where(), "a radius on the screen needs the display it is shown on, got " +
+                                      protocol::ToJson(spec).dump());
+      *fixed = (spec->unit == protocol::RadiusUnit::kArcmin ? display::ScreenPxOfArcmin(presentation->profile, r) : r) /
+               presentation->scale;
+      break;
   }
-  if (!v.is_string()) throw InputError(where(), "the trial shows no blur source on this side, got " + v.dump());
-  try {
-    return calib::ParseBlurSource(v.get<std::string>(), fixed);
-  } catch (const Error& e) {
-    throw InputError(where(), e.what());
-  }
+  return calib::BlurSource::kFixed;
 }
 
 // Board-frame placement of the two objects of a pair (scene's poses on the board; x and y in mm where the trial
@@ -130,8 +136,8 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   // Problems name the protocol field that asked for what cannot be shown, and the trial as a detail.
   const std::string trial_text = " (trial " + std::to_string(trial.index) + ", block " + trial.block + ")";
   if (t.content == protocol::ContentType::kPicture) {
-    const Json* d = FindLevel(trial.levels, "distance_m");
-    t.distance_m = d && d->is_number() ? d->get<double>() : 1.0;
+    const protocol::LevelValue* d = FindLevel(trial.levels, "distance_m");
+    t.distance_m = d && d->IsNumber() ? d->number : 1.0;
     // The real picture's blur: the thin lens of the camera that took its photo (content.real_camera).
     if (const auto& camera = protocol.content.real_camera) {
       try {
@@ -176,20 +182,19 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   // Edges and sections are the calibrated board's: its own count, whatever its size.
   const int edges = scene->board.EdgeCount();
   auto board_level = [&](const char* name, int most) -> std::optional<int> {
-    const Json* v = FindLevel(trial.levels, name);
-    if (!v || !v->is_number_integer()) return std::nullopt;
-    const int n = v->get<int>();
-    if (n < 1 || n > most)
+    const protocol::LevelValue* v = FindLevel(trial.levels, name);
+    if (!v || v->kind != protocol::LevelValue::Kind::kInteger) return std::nullopt;
+    if (!(v->number >= 1 && v->number <= most))
       throw InputError(At(protocol, protocol::LevelPointer(protocol, trial, name)),
-                       std::string(name) + " " + std::to_string(n) + " is not on the calibrated board (" +
+                       std::string(name) + " " + v->text + " is not on the calibrated board (" +
                            std::to_string(scene->board.cols) + " x " + std::to_string(scene->board.rows) +
                            " squares: edges 1-" + std::to_string(edges) + ", sections 1-" + std::to_string(edges - 1) +
                            ")" + trial_text);
-    return n;
+    return int(v->number);
   };
   auto mm_level = [&](const char* name) {
-    const Json* v = FindLevel(trial.levels, name);
-    return v && v->is_number() ? std::optional<double>(v->get<double>()) : std::nullopt;
+    const protocol::LevelValue* v = FindLevel(trial.levels, name);
+    return v && v->IsNumber() ? std::optional<double>(v->number) : std::nullopt;
   };
   if (auto x = mm_level("left_x_mm")) t.left_x_mm = *x;
   if (auto x = mm_level("right_x_mm")) t.right_x_mm = *x;
@@ -219,8 +224,8 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   // Balls: a section run (edge s to s + 1, wiped on arrival), explicit edges, the whole board, or at rest at an
   // edge. A ball without a speed rests where it starts, and its radii are those of that place, not of a run.
   int from = 1, to = scene->board.EdgeCount();
-  const Json* speed = FindLevel(trial.levels, "speed_cm_s");
-  t.speed_mm_s = speed && speed->is_number() ? 10 * speed->get<double>() : 0;
+  const protocol::LevelValue* speed = FindLevel(trial.levels, "speed_cm_s");
+  t.speed_mm_s = speed && speed->IsNumber() ? 10 * speed->number : 0;
   const auto edge = board_level("edge", edges);
   const auto rest_y = mm_level("y_mm");
   if (edge || rest_y) {
@@ -311,7 +316,7 @@ std::array<std::optional<scene::BlurredObject>, 2> ObjectsAt(const protocol::Pro
 }
 bool IntervalShowsRight(const protocol::Trial& trial, const TrialScene& scene, int i) {
   if (scene.intervals == 2) return i == 1;
-  return trial.task == protocol::Task::kForcedChoice && !trial.test_side.empty() &&
+  return protocol::TraitsOf(trial.task).answer == protocol::TaskAnswer::kSide && !trial.test_side.empty() &&
          std::isdigit(static_cast<unsigned char>(trial.test_side[0])) && std::stoi(trial.test_side) == i + 1;
 }
 

@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "core/error.h"
+#include "protocol/vocabulary.h"
 #include "store/record.h"
 #include "store/sqlite.h"
 
@@ -133,7 +134,9 @@ std::vector<Column> MakeColumns() {
   Column& block_name = add("block_name", "string", "", "", "the block's name", T, Cell::kText);
   block_name.in_variables = true;
   block_name.at = OfTrial(Typed("trials", "TEXT", "", 7, "coalesce(json_extract(factors, '$.block_name'), '')"), [](const TrialRecord& t) { return Value(t.block_name); });
-  add("task", "string", "", "forced_choice|adjustment|yes_no|rating", "the trial's task", T, Cell::kText)
+  std::string tasks;  // the task vocabulary's words, as the protocol spells them
+  for (const std::string& word : protocol::Words<protocol::Task>()) tasks += (tasks.empty() ? "" : "|") + word;
+  add("task", "string", "", tasks, "the trial's task", T, Cell::kText)
       .at = OfTrial(Typed("trials", "TEXT", "", 7,
                           "CASE WHEN json_extract(factors, '$.start_level') IS NOT NULL THEN 'adjustment' "
                           "ELSE 'forced_choice' END"),
