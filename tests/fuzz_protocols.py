@@ -342,7 +342,7 @@ def main():
             # Every line names the protocol file: "blurcue: FILE: ..." first, then "FILE: ...", then "(N problems)".
             ok = bool(lines) and lines[0].startswith("blurcue: " + path + ": ") and all(
                 line.startswith(path + ": ") or (line.startswith("(") and "problems" in line) or
-                line.startswith("(scripts/demo.sh")
+                line.startswith("('blurcue init DIR --from EXAMPLE'")
                 for line in lines[1:])
             # Several problems come one per line: "(N problems)" closes N lines (an escaped "\n" would join them).
             m = re.fullmatch(r"\((\d+) problems\)", lines[-1]) if lines else None
