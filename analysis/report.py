@@ -265,8 +265,9 @@ def main(argv=None):
 def _main(argv=None):
     parser = argparse.ArgumentParser(description="Charts, tables and index.html from trials.csv and bench CSVs.")
     parser.add_argument("--trials", required=True, help="trials.csv written by `blurcue export`")
-    parser.add_argument("--bench", default=os.path.join("results", "bench"),
-                        help="folder with measure.csv, render.csv and procedures.csv (default results/bench)")
+    parser.add_argument("--bench",
+                        help="folder with measure.csv, render.csv and procedures.csv (default results/bench, when "
+                        "it exists: a study's report has no benchmark page unless there are benchmarks)")
     parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--final-out", help="where --out is renamed to once complete (blurcue report builds the "
                         "folder beside its target): index.html and messages name paths there")
@@ -413,6 +414,10 @@ def _main(argv=None):
     # Every study's answers beside the simulated observer's prediction for the same trials (prediction.py).
     predict_step = ("observed vs the observer model",
                     lambda: prediction.charts(df(), args.out, codebook, pool_simulated=args.pool_simulated))
+    if args.bench is None:  # not asked for: the benchmark page only where `blurcue bench` wrote its folder
+        args.bench = os.path.join("results", "bench")
+        if not os.path.isdir(args.bench):
+            bench_steps = []
     steps = thesis_steps + study_steps + [predict_step] + steps[8:] + bench_steps
     n_data_steps = len(steps) - len(bench_steps)
     total = len(steps) + 2  # + reading trials.csv + writing the index
@@ -423,7 +428,7 @@ def _main(argv=None):
               f"{int(all_trials['answered'].sum())} answered, {all_trials['participant'].nunique()} participants",
               "studies: " + (", ".join(f"{s} ({n} rows)" for s, n in studies.items()) or "none"),
               f"frames: {os.path.abspath(shown(frames_path))}",
-              f"bench: {os.path.abspath(args.bench)}",
+              f"bench: {os.path.abspath(args.bench)}" if bench_steps else "bench: none (blurcue bench writes them)",
               f"written {datetime.datetime.now().strftime('%Y-%m-%d %H:%M')}; practice trials excluded everywhere"]
     header[1:1] = [line for _, line in session_lines]
     for _, line in session_lines:
@@ -472,10 +477,11 @@ def _main(argv=None):
                                f"answered; " + thesis.get(study, "see its figures below")))
     summary += [(title[len("study "):], finding) for title, finding in findings.items()]
     data_sections, bench_sections = sections[:n_data_steps], sections[n_data_steps:]
-    write_index(args.out, bench_sections, [f"bench: {os.path.abspath(args.bench)}"], name="bench.html",
-                title="blurcue software benchmarks", links=[("index.html", "the studies")])
+    if bench_steps:
+        write_index(args.out, bench_sections, [f"bench: {os.path.abspath(args.bench)}"], name="bench.html",
+                    title="blurcue software benchmarks", links=[("index.html", "the studies")])
     path = write_index(args.out, data_sections, header, summary=summary,
-                       links=[("bench.html", "software benchmarks (speed against accuracy)")])
+                       links=[("bench.html", "software benchmarks (speed against accuracy)")] if bench_steps else [])
     n_charts = sum(1 for _, charts, _ in sections for c in charts if c.png)
     n_skipped = sum(1 for _, _, skips in sections if skips)
     say(f"wrote {shown(path)}: {n_charts} charts, {n_skipped} section{'s' if n_skipped != 1 else ''} with notes")

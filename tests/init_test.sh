@@ -22,6 +22,11 @@ done
   || fail "run: $(tail -2 yes-no-ball/run.log)"
 $BC export --db yes-no-ball/record.sqlite --out yes-no-ball/tables > /dev/null || fail "export"
 [ "$(wc -l < yes-no-ball/tables/trials.csv)" -gt 10 ] || fail "too few trials exported"
+# A study's report without benchmarks: no benchmark page and no lines about skipped benchmarks.
+(cd yes-no-ball && MPLCONFIGDIR=$W/mpl $BC report --db record.sqlite --out report --boot 20 > report.out 2> report.err) \
+  || fail "report: $(tail -2 yes-no-ball/report.err)"
+[ -s yes-no-ball/report/index.html ] && [ ! -e yes-no-ball/report/bench.html ] || fail "report: bench.html without benchmarks"
+if grep -qi "bench" yes-no-ball/report.err; then fail "report speaks of benchmarks: $(grep -i bench yes-no-ball/report.err | head -2)"; fi
 set +e
 $BC init yes-no-ball --from yes-no-ball > /dev/null 2> used.err; used=$?
 $BC init fresh --from yes-no-bal > /dev/null 2> unknown.err; unknown=$?

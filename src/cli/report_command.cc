@@ -54,7 +54,8 @@ void AddReportCommand(CLI::App& app) {
       "Example: blurcue report --db results/demo/study.sqlite --out results/demo/report");
   cmd->add_option("--db", args->db, "the SQLite record")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "folder for the report (created)")->required();
-  cmd->add_option("--bench", args->bench, "folder of the benchmark CSVs")->capture_default_str();
+  CLI::Option* bench = cmd->add_option("--bench", args->bench, "folder of the benchmark CSVs (by default results/bench, "
+                                      "where it exists: without benchmarks the report has no benchmark page)");
   cmd->add_option("--boot", args->boot, "bootstrap samples of the psychometric fit")->capture_default_str()
       ->transform(IntRange(10, 100000));
   cmd->add_option("--python", args->python, "the Python that sees the analysis packages")->capture_default_str();
@@ -65,7 +66,7 @@ void AddReportCommand(CLI::App& app) {
   cmd->add_flag("--include-unfinished", args->include_unfinished,
                 "analyse the answers of unfinished sessions too, as partial data (by default they are left out, and "
                 "the summary says so)");
-  cmd->callback([args] {
+  cmd->callback([args, bench] {
     const std::filesystem::path out = args->out;
     const std::filesystem::path script = DataDir().path / "analysis" / "report.py";
     if (!std::filesystem::exists(script)) throw InputError(script.string(), "the analysis script is missing");
@@ -85,9 +86,9 @@ void AddReportCommand(CLI::App& app) {
           std::fprintf(stderr, "report: exported %lld trials to %s\n", static_cast<long long>(rows),
                        (out / "tables").c_str());
           std::vector<std::string> argv = {args->python, script.string(), "--trials",
-                                           (partial / "tables" / "trials.csv").string(), "--bench", args->bench,
-                                           "--out", partial.string(), "--final-out", out.string(), "--boot",
+                                           (partial / "tables" / "trials.csv").string(), "--out", partial.string(), "--final-out", out.string(), "--boot",
                                            std::to_string(args->boot)};
+          if (bench->count() > 0) argv.insert(argv.end(), {"--bench", args->bench});
           if (args->pool_simulated) argv.push_back("--pool-simulated");
           if (args->include_aborted) argv.push_back("--include-aborted");
           if (args->include_unfinished) argv.push_back("--include-unfinished");
