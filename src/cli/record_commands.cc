@@ -120,9 +120,11 @@ void AddSessionsCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "sessions",
-      "List the sessions of a record: study, participant, status, trials answered of planned, seed, start and end,\n"
-      "host, and who holds its lock (a writer alive, or a stale lock left by a crash). An unfinished session\n"
-      "continues with blurcue run ... --resume. A read-only record (an archive, a read-only mount) lists too.\n"
+      "List the sessions of a record: study, participant, the participant's session number (n), group, observer\n"
+      "(person or simulated), status, trials answered of planned (skipped and timed-out trials counted apart, never\n"
+      "as answered), seed, start and end, host, and who holds its lock (a writer alive, or a stale lock left by a\n"
+      "crash). An unfinished session continues with blurcue run ... --resume. A read-only record (an archive, a\n"
+      "read-only mount) lists too.\n"
       "\n"
       "Two repairs, each the experimenter's explicit call:\n"
       "  --abort ID       close an unfinished session as aborted, keeping every answer (e.g. its protocol was\n"
@@ -159,15 +161,22 @@ void AddSessionsCommand(CLI::App& app) {
       std::printf("%s: no sessions yet\n", db.c_str());
       return;
     }
-    std::printf("%4s  %-28s %-12s %-9s %9s  %-20s  %-24s %-24s %s\n", "id", "study", "participant", "status",
-                "answered", "seed", "started", "ended", "host");
+    // answered: answers given of the trials planned; skipped and timed-out trials are counted apart, never as
+    // answered. n: the participant's n-th session of the study.
+    std::printf("%4s  %-28s %-12s %3s %-12s %-9s %-9s %9s %7s %9s  %-20s  %-24s %-24s %s\n", "id", "study",
+                "participant", "n", "group", "observer", "status", "answered", "skipped", "timed_out", "seed",
+                "started", "ended", "host");
     int unfinished = 0;
     for (const auto& s : sessions) {
       const std::string answered = std::to_string(s.answered) + "/" + std::to_string(s.planned);
-      std::printf("%4lld  %-28s %-12s %-9s %9s  %-20llu  %-24s %-24s %s%s\n", static_cast<long long>(s.id),
-                  s.study.c_str(), s.participant.c_str(), s.status.c_str(), answered.c_str(),
-                  static_cast<unsigned long long>(s.seed), s.started.c_str(), s.ended.empty() ? "-" : s.ended.c_str(),
-                  s.host.c_str(), s.writer.empty() ? "" : ("  lock: " + s.writer).c_str());
+      const std::string number = s.number > 0 ? std::to_string(s.number) : "-";
+      std::printf("%4lld  %-28s %-12s %3s %-12s %-9s %-9s %9s %7lld %9lld  %-20llu  %-24s %-24s %s%s\n",
+                  static_cast<long long>(s.id), s.study.c_str(), s.participant.c_str(), number.c_str(),
+                  s.group.empty() ? "-" : s.group.c_str(), s.observer.empty() ? "-" : s.observer.c_str(),
+                  s.status.c_str(), answered.c_str(), static_cast<long long>(s.skipped),
+                  static_cast<long long>(s.timed_out), static_cast<unsigned long long>(s.seed), s.started.c_str(),
+                  s.ended.empty() ? "-" : s.ended.c_str(), s.host.c_str(),
+                  s.writer.empty() ? "" : ("  lock: " + s.writer).c_str());
       unfinished += s.status == "running";
     }
     std::printf("%zu sessions, %d unfinished\n", sessions.size(), unfinished);

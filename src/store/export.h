@@ -82,8 +82,13 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
 struct SessionSummary {
   int64_t id = 0;
   std::string study, participant, status, started, ended, host;
+  std::string group;     // the between-subject group, "" without groups
+  std::string observer;  // "person" or "simulated" ("" in a record too old to say)
+  int64_t number = 0;    // the participant's n-th session of the study (0 in a record too old to say)
   uint64_t seed = 0;
-  int64_t planned = 0, answered = 0;  // practice included
+  // Planned trials (practice included) and what became of them: answered (an answer given), skipped (not shown: a
+  // stopped procedure, practice after its criterion was met), timed out (shown, no answer before the deadline).
+  int64_t planned = 0, answered = 0, skipped = 0, timed_out = 0;
   // Who holds its lock: empty for nobody, else JudgeLock's text ("pid P on host H, heartbeat N s ago (alive)",
   // or why it is stale).
   std::string writer;

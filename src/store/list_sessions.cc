@@ -13,11 +13,18 @@ std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path) {
   Statement rows(db,
                  "SELECT s.id, st.name, p.code, s.status, s.started, coalesce(s.ended, ''), s.host, s.seed, "
                  "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), "
-                 "(SELECT count(*) FROM trials t JOIN responses r ON r.trial_id = t.id WHERE t.session_id = s.id), "
+                 "(SELECT count(*) FROM trials t JOIN responses r ON r.trial_id = t.id WHERE t.session_id = s.id "
+                 " AND r.choice NOT IN (?1, ?2)), "
+                 "(SELECT count(*) FROM trials t JOIN responses r ON r.trial_id = t.id WHERE t.session_id = s.id "
+                 " AND r.choice = ?2), "
+                 "(SELECT count(*) FROM trials t JOIN responses r ON r.trial_id = t.id WHERE t.session_id = s.id "
+                 " AND r.choice = ?1), "
                  "s.lock_token IS NOT NULL, coalesce(s.lock_pid, 0), coalesce(s.lock_host, ''), "
-                 "coalesce(s.lock_heartbeat_ms, 0) "
+                 "coalesce(s.lock_heartbeat_ms, 0), s.group_name, coalesce(s.observer, ''), coalesce(s.session_number, 0) "
                  "FROM sessions s JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
                  "ORDER BY st.name, p.code, s.id");
+  rows.Bind(1, std::string_view(kChoiceNone));
+  rows.Bind(2, std::string_view(kChoiceSkipped));
   std::vector<SessionSummary> sessions;
   while (rows.Step()) {
     SessionSummary s;
@@ -31,7 +38,12 @@ std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path) {
     s.seed = static_cast<uint64_t>(rows.GetInt64(7));
     s.planned = rows.GetInt64(8);
     s.answered = rows.GetInt64(9);
-    if (rows.GetInt64(10) != 0) s.writer = JudgeLock(rows.GetText(12), rows.GetInt64(11), rows.GetInt64(13)).text;
+    s.skipped = rows.GetInt64(10);
+    s.timed_out = rows.GetInt64(11);
+    if (rows.GetInt64(12) != 0) s.writer = JudgeLock(rows.GetText(14), rows.GetInt64(13), rows.GetInt64(15)).text;
+    s.group = rows.GetText(16);
+    s.observer = rows.GetText(17);
+    s.number = rows.GetInt64(18);
     sessions.push_back(std::move(s));
   }
   return sessions;
