@@ -123,6 +123,11 @@ add_plan_failure_test(validate_group_blank 2 "--group ' no_blur': ${G} has no su
 add_test(NAME preview_every_group COMMAND ${BC} preview ${G} --list --out ${T}/preview-groups.png)
 set_tests_properties(preview_every_group PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS "gl;plan"
   PASS_REGULAR_EXPRESSION "#1 group estimated: edge 1: .*#13 group no_blur: edge 1: .*24 distinct stimuli of 24 trials \\(groups estimated, no_blur\\)")
+# The preview shows every object at 1:1 screen scale: each inset equals the frame run --capture wrote for the same
+# trial, pixel for pixel, around the object's outline; labels stay inside their tile.
+add_test(NAME preview_insets_1to1
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/preview_inset_check.py ${BC} ${P1} ${T}/preview-insets)
+set_tests_properties(preview_insets_1to1 PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS "gl;plan")
 add_test(NAME preview_one_group COMMAND ${BC} preview ${G} --group no_blur --list --out ${T}/preview-group.png)
 set_tests_properties(preview_one_group PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS "gl;plan"
   PASS_REGULAR_EXPRESSION "12 distinct stimuli of 12 trials \\(groups no_blur\\)" FAIL_REGULAR_EXPRESSION "group estimated")

@@ -28,12 +28,80 @@
 #include "session/visibility.h"
 
 namespace blurcue::cli {
+namespace {
+
+const double kFontScale = 0.36;  // labels: about 6 px a character
+const int kLineHeight = 14;
+
+// `lines` broken at spaces so that none is wider than `width_px` in the labels' font (a word wider than that
+// alone on its line).
+std::vector<std::string> WrapToWidth(const std::vector<std::string>& lines, int width_px) {
+  std::vector<std::string> out;
+  auto width = [](const std::string& text) {
+    int baseline = 0;
+    return cv::getTextSize(text, cv::FONT_HERSHEY_SIMPLEX, kFontScale, 1, &baseline).width;
+  };
+  for (const std::string& line : lines) {
+    std::string current;
+    size_t at = 0;
+    while (at < line.size()) {
+      const size_t space = line.find(' ', at);
+      const std::string word = line.substr(at, space == std::string::npos ? space : space - at);
+      at = space == std::string::npos ? line.size() : space + 1;
+      const std::string joined = current.empty() ? word : current + " " + word;
+      if (!current.empty() && width(joined) > width_px) {
+        out.push_back(current);
+        current = "  " + word;  // a continued line is indented
+      } else {
+        current = joined;
+      }
+    }
+    out.push_back(current);
+  }
+  return out;
+}
+
+// Each object of a composed frame (`described`: stimulus::DescribeFrame) at 1:1 screen scale: a `box_px` square of
+// the sheet centred on it, holding box_px / zoom screen px each way, every screen px a zoom x zoom square (nearest
+// neighbour: nothing resampled). A depth-matching frame's two pictures likewise, centred on each.
+std::vector<std::pair<std::string, cv::Mat>> ObjectInsets(const cv::Mat& frame, const Json& described, int box_px,
+                                                          int zoom) {
+  std::vector<std::pair<std::string, cv::Point2d>> centres;
+  for (const Json& o : described["objects"]) {
+    cv::Point2d lo(1e18, 1e18), hi(-1e18, -1e18);
+    for (const Json& p : o["outline_px"]) {
+      lo = {std::min(lo.x, p[0].get<double>()), std::min(lo.y, p[1].get<double>())};
+      hi = {std::max(hi.x, p[0].get<double>()), std::max(hi.y, p[1].get<double>())};
+    }
+    if (hi.x >= lo.x) centres.push_back({o["side"].get<std::string>(), (lo + hi) * 0.5});
+  }
+  for (const char* part : {"picture", "real_picture"}) {
+    if (!described.contains(part)) continue;
+    const Json& r = described[part]["rect_px"];
+    centres.push_back({part == std::string("picture") ? "virtual" : "real",
+                       {r[0].get<double>() + r[2].get<double>() / 2, r[1].get<double>() + r[3].get<double>() / 2}});
+  }
+  std::vector<std::pair<std::string, cv::Mat>> insets;
+  const int side = std::max(1, box_px / zoom);
+  for (const auto& [name, centre] : centres) {
+    // The crop, moved inside the frame where the object is near its border.
+    const int w = std::min(side, frame.cols), h = std::min(side, frame.rows);
+    const int x = std::clamp(int(std::lround(centre.x)) - w / 2, 0, frame.cols - w);
+    const int y = std::clamp(int(std::lround(centre.y)) - h / 2, 0, frame.rows - h);
+    cv::Mat zoomed;
+    cv::resize(frame(cv::Rect(x, y, w, h)), zoomed, cv::Size(), zoom, zoom, cv::INTER_NEAREST);
+    insets.push_back({name + (zoom == 1 ? " 1:1" : " 1:1 x" + std::to_string(zoom)), zoomed});
+  }
+  return insets;
+}
+
+}  // namespace
 
 void AddPreviewCommand(CLI::App& app) {
   struct Args {
     std::string protocol, out, participant = "P1", display, observer = "sim", group;
     std::optional<uint64_t> seed;
-    int columns = 6, tile_width = 320;
+    int columns = 6, tile_width = 320, zoom = 1;
     double visible = 0.75;
     bool list = false;
   };
@@ -51,6 +119,9 @@ void AddPreviewCommand(CLI::App& app) {
       "sides apart on the display (--display) in a 2AFC; below --visible it is flagged invisible, and every distinct\n"
       "pair is listed so (as blurcue validate --plan).\n"
       "A protocol with between-subject groups gets each group's tiles (labelled with the group), or only --group's.\n"
+      "Each tile shows the whole frame (scaled to --tile-width) and, beside it, every object at 1:1 screen scale\n"
+      "(each screen px one sheet px, or --zoom sheet px, never resampled), so a blur of 1-2 screen px is seen as a\n"
+      "participant sees it; a frame no wider than --tile-width is shown whole at 1:1. Labels are wrapped to the tile.\n"
       "Example: blurcue preview protocols/test1-static-grids.json --out results/preview-test1.png");
   cmd->add_option("protocol", args->protocol, "the protocol JSON file")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "the contact sheet PNG")->required();
@@ -68,8 +139,12 @@ void AddPreviewCommand(CLI::App& app) {
                                               "invisible")
       ->capture_default_str()->check(FiniteRange(0.5, 1, "share correct"));
   cmd->add_option("--columns", args->columns, "tiles per row")->capture_default_str()->transform(IntRange(1, 20));
-  cmd->add_option("--tile-width", args->tile_width, "tile width in px")->capture_default_str()
+  cmd->add_option("--tile-width", args->tile_width, "width of each tile's whole frame in px (a frame this wide or "
+                                                    "narrower is shown at 1:1)")->capture_default_str()
       ->transform(IntRange(80, 2000, "px"));
+  cmd->add_option("--zoom", args->zoom, "sheet px per screen px in the 1:1 insets (nearest neighbour: each screen px "
+                                        "becomes a square of this many)")->capture_default_str()
+      ->transform(IntRange(1, 8));
   cmd->callback([args] {
     // The pre-flight of blurcue run: the same checks, and every trial's scene already worked out.
     const session::ObserverParams observer = session::ParseObserver(args->observer);
@@ -186,11 +261,20 @@ void AddPreviewCommand(CLI::App& app) {
     auto context = render::GlContext::CreateOffscreen();
     session::StimulusRenderer renderer(p, scene, prepared.images, prepared.presentation);
     const cv::Size frame = renderer.FrameSize();
-    const int tw = args->tile_width, th = tw * frame.height / frame.width, strip = 76;
+    // Each tile: the whole frame (1:1 when it fits --tile-width), then an inset per object at 1:1 (x --zoom).
+    const bool whole_at_1to1 = frame.width <= args->tile_width;
+    const int tw = whole_at_1to1 ? frame.width : args->tile_width, th = tw * frame.height / frame.width;
+    const int inset = whole_at_1to1 ? 0 : std::max(th, 160), insets = whole_at_1to1 ? 0 : 2;
+    const int tile_w = tw + insets * (inset + 4);
     const int cols = std::min<int>(args->columns, int(tiles.size()));
     const int rows = (int(tiles.size()) + cols - 1) / cols;
-    cv::Mat sheet(rows * (th + strip), cols * tw, CV_8UC3, cv::Scalar(40, 40, 40));
     const bool tty = isatty(2);  // a terminal gets a progress line; a log only the summary
+    struct Drawn {
+      cv::Mat whole;
+      std::vector<std::pair<std::string, cv::Mat>> insets;  // label, 1:1 crop (zoomed)
+      std::vector<std::string> lines;
+    };
+    std::vector<Drawn> drawn(tiles.size());
     for (size_t i = 0; i < tiles.size(); ++i) {
       // Composed twice: the second time is what a frame of it costs in a session (textures already uploaded).
       renderer.Compose(tiles[i].scene, 0, tiles[i].level);
@@ -206,22 +290,35 @@ void AddPreviewCommand(CLI::App& app) {
                       tiles[i].scene.per_pixel ? "per pixel" : "one radius", tiles[i].scene.r_span_screen_px, ms);
         plan = text;
       }
-      const cv::Mat small = ResampleSrgb8(renderer.Read(), cv::Size(tw, th));
-      const int x = int(i % size_t(cols)) * tw, y = int(i / size_t(cols)) * (th + strip);
-      small.copyTo(sheet(cv::Rect(x, y, tw, th)));
-      // One line each: the levels, each side, the plan (a tile is ~45 characters wide).
-      std::vector<std::string> lines{"#" + std::to_string(i + 1) + " " + tiles[i].label};
+      const cv::Mat full = renderer.Read();
+      Drawn& d = drawn[i];
+      d.whole = whole_at_1to1 ? full.clone() : ResampleSrgb8(full, cv::Size(tw, th));
+      const Json described = stimulus::DescribeFrame(scene ? &*scene : nullptr, tiles[i].scene,
+                                                     prepared.presentation, renderer.View(), renderer.Shown(),
+                                                     tiles[i].level);
+      if (insets > 0) d.insets = ObjectInsets(full, described, inset, args->zoom);
+      d.lines = {"#" + std::to_string(i + 1) + " " + tiles[i].label};
       for (size_t at = 0, bar; at != std::string::npos; at = bar == std::string::npos ? bar : bar + 3) {
         bar = tiles[i].label2.find(" | ", at);
-        lines.push_back(tiles[i].label2.substr(at, bar == std::string::npos ? bar : bar - at));
+        d.lines.push_back(tiles[i].label2.substr(at, bar == std::string::npos ? bar : bar - at));
       }
-      if (!plan.empty()) lines.push_back(plan.substr(6));  // without "plan: "
-      if (!tiles[i].seen.empty()) lines.push_back(tiles[i].seen);
-      for (size_t k = 0; k < lines.size(); ++k) {
-        const bool flagged = k + 1 == lines.size() && tiles[i].seen.find("INVISIBLE") != std::string::npos;
-        cv::putText(sheet, lines[k], {x + 4, y + th + 14 * int(k + 1)}, cv::FONT_HERSHEY_SIMPLEX, 0.36,
-                    flagged ? cv::Scalar(90, 90, 255) : cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
+      if (described.contains("picture")) {  // depth matching: each picture's blur on this screen
+        char text[160];
+        const Json& virt = described["picture"];
+        const Json& real = described["real_picture"];
+        std::snprintf(text, sizeof text, "virtual r %.2f scr px %.2f'", virt["r_screen_px"].get<double>(),
+                      virt["r_arcmin"].get<double>());
+        std::string radii = text;
+        if (real.contains("r_screen_px")) {
+          std::snprintf(text, sizeof text, ", real r %.2f scr px %.2f'", real["r_screen_px"].get<double>(),
+                        real["r_arcmin"].get<double>());
+          radii += text;
+        }
+        d.lines.push_back(radii);
       }
+      if (!plan.empty()) d.lines.push_back(plan.substr(6));  // without "plan: "
+      if (!tiles[i].seen.empty()) d.lines.push_back(tiles[i].seen);
+      d.lines = WrapToWidth(d.lines, tile_w - 8);
       if (args->list)
         std::printf("#%zu %s: %s%s%s%s%s\n", i + 1, tiles[i].label.c_str(), tiles[i].label2.c_str(),
                     plan.empty() ? "" : " | ", plan.c_str(), tiles[i].seen.empty() ? "" : " | ",
@@ -229,6 +326,30 @@ void AddPreviewCommand(CLI::App& app) {
       if (tty) std::fprintf(stderr, "\rpreview: %zu of %zu", i + 1, tiles.size());
     }
     if (tty) std::fprintf(stderr, "\n");
+    // The label strip is as tall as the longest label needs, so no label runs into the next row's tiles.
+    size_t most_lines = 0;
+    for (const Drawn& d : drawn) most_lines = std::max(most_lines, d.lines.size());
+    const int tile_h = std::max(th, inset), strip = kLineHeight * int(most_lines) + 8;
+    cv::Mat sheet(rows * (tile_h + strip), cols * (tile_w + 8), CV_8UC3, cv::Scalar(40, 40, 40));
+    for (size_t i = 0; i < drawn.size(); ++i) {
+      const Drawn& d = drawn[i];
+      const int x = int(i % size_t(cols)) * (tile_w + 8), y = int(i / size_t(cols)) * (tile_h + strip);
+      d.whole.copyTo(sheet(cv::Rect(x, y, d.whole.cols, d.whole.rows)));
+      for (size_t k = 0; k < d.insets.size(); ++k) {
+        const cv::Mat& crop = d.insets[k].second;
+        const int ix = x + tw + 4 + int(k) * (inset + 4);
+        crop.copyTo(sheet(cv::Rect(ix, y, crop.cols, crop.rows)));
+        cv::putText(sheet, d.insets[k].first, {ix + 3, y + 12}, cv::FONT_HERSHEY_SIMPLEX, kFontScale,
+                    cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
+        cv::putText(sheet, d.insets[k].first, {ix + 3, y + 12}, cv::FONT_HERSHEY_SIMPLEX, kFontScale,
+                    cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+      }
+      for (size_t k = 0; k < d.lines.size(); ++k) {
+        const bool flagged = d.lines[k].find("INVISIBLE") != std::string::npos;
+        cv::putText(sheet, d.lines[k], {x + 4, y + tile_h + kLineHeight * int(k + 1)}, cv::FONT_HERSHEY_SIMPLEX,
+                    kFontScale, flagged ? cv::Scalar(90, 90, 255) : cv::Scalar(235, 235, 235), 1, cv::LINE_AA);
+      }
+    }
     WriteImage(args->out, sheet);
     std::string in_groups;
     for (const std::string& group : groups)

@@ -45,6 +45,13 @@ std::string NearestName(const std::string& name, const std::vector<std::string>&
     const size_t d = EditDistance(lower, Lower(c));
     if (d < best_distance && 2 * d < name.size()) best_distance = d, best = c;
   }
+  if (!best.empty() || name.size() < 3) return best;
+  // An abbreviation of exactly one candidate: "int" for integer, "sim" for simulated.
+  for (const auto& c : candidates) {
+    if (c.size() <= name.size() || Lower(c).compare(0, lower.size(), lower) != 0) continue;
+    if (!best.empty()) return "";  // it abbreviates two: neither is the likelier
+    best = c;
+  }
   return best;
 }
 

@@ -27,6 +27,14 @@ TEST(NearestName, NearestWithinTwoEditsIgnoringCase) {
   EXPECT_EQ(NearestName("Sectoin", {"section"}), "section");  // a transposition is two edits; case ignored
 }
 
+// An abbreviation of one candidate (3 characters or more) names it; one of two names neither.
+TEST(NearestName, AbbreviationOfExactlyOneCandidate) {
+  EXPECT_EQ(NearestName("int", {"integer", "number", "choice", "text"}), "integer");
+  EXPECT_EQ(NearestName("Num", {"integer", "number", "choice", "text"}), "number");
+  EXPECT_EQ(NearestName("mea", {"measured", "measured_section", "none"}), "");
+  EXPECT_EQ(NearestName("me", {"measured"}), "");
+}
+
 TEST(NearestName, NothingNearGivesEmpty) {
   EXPECT_EQ(NearestName("colour", {"edge", "section"}), "");
   EXPECT_EQ(NearestName("", {"edge"}), "");

@@ -191,8 +191,8 @@ bool HoldsExactly(std::string_view cell, double value) {
 // A conditions table instead of factors: a CSV file (RFC 4180, as spreadsheets save it: core/csv.h) whose header
 // names the levels (edge, speed_cm_s, left, right, any label) and whose every row is one design row - for designs
 // that are not full crossings. It becomes one factor "row" whose levels are the rows as objects, checked like any
-// level: a problem names /.../conditions/row/K/COLUMN, K counting the table's data rows from 0, and the file's line
-// and column. A label's cell (id, label, label_*) stays the text it is ("007" and "7" are two ids); any other
+// level, at /.../conditions/row/K/COLUMN (K counting the table's data rows from 0); a problem there names the
+// file's line and column instead (table_places_), once however many blocks use the table. A label's cell (id, label, label_*) stays the text it is ("007" and "7" are two ids); any other
 // cell that is a number is that number exactly, or refused.
 std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& ptr) {
   const auto text = Text(v, "conditions", ptr.substr(0, ptr.rfind('/')), true, kMaxPathChars, true);
@@ -250,9 +250,10 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
   factor.name = "row";
   for (size_t r = 1; r < rows.size(); ++r) {
     const std::string rp = ptr + "/row/" + std::to_string(r - 1);
+    table_places_[rp] = at(rows[r].line, 0);
     if (rows[r].fields.size() != header.size()) {
-      Problem(rp, at(rows[r].line, 0) + ": has " + std::to_string(rows[r].fields.size()) + " fields, the header " +
-                      std::to_string(header.size()), Json(*text));
+      Problem(rp, "has " + std::to_string(rows[r].fields.size()) + " fields, the header " +
+                      std::to_string(header.size()));
       continue;
     }
     Json level = Json::object();
@@ -260,31 +261,30 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
     for (size_t c = 0; c < header.size(); ++c) {
       const std::string& cell = rows[r].fields[c];
       const std::string cp = rp + "/" + Escape(header[c]);
-      const std::string in = " (" + at(rows[r].line, c + 1) + ")";
+      table_places_[cp] = at(rows[r].line, c + 1) + " (" + header[c] + ")";
       // A cell becomes a level, a label in the record, the tables and the report: text they can all hold as it
       // is. A Latin-1 byte or a NUL used to reach the record raw, or to stop validate with a JSON library error.
       if (!IsPrintableUtf8(cell)) {
-        Problem(cp, at(rows[r].line, c + 1) + " (" + header[c] +
-                        "): must be printable UTF-8 text on one line (no control characters or line breaks; save the "
-                        "file as UTF-8), got " + Echo(cell));
+        Problem(cp, "must be printable UTF-8 text on one line (no control characters or line breaks; save the "
+                    "file as UTF-8), got " + Echo(cell));
         printable = false;
         continue;
       }
       if (cell.empty()) {
-        Problem(cp, "is empty, got \"\"" + in);
+        Problem(cp, "is empty, got \"\"");
         continue;
       }
       const std::optional<double> number = IsLabelName(header[c]) ? std::nullopt : ParseDecimal(cell);
       if (number && !HoldsExactly(cell, *number)) {
         Problem(cp, "has more digits than a number holds exactly (it would be recorded as " +
-                        Json(*number).dump() + "), got " + Echo(cell) + in +
+                        Json(*number).dump() + "), got " + Echo(cell) +
                         "; a value that names something belongs in a label column (label_NAME), kept as text");
         continue;
       }
       level[header[c]] = !number                                             ? Json(cell)
                          : IsWholeDecimal(cell) && std::abs(*number) < 9e15 ? Json(int64_t(*number))
                                                                              : Json(*number);
-      CheckLevelValue(header[c], level[header[c]], cp, in);
+      CheckLevelValue(header[c], level[header[c]], cp);
     }
     if (!printable) continue;
     factor.levels.push_back(std::move(level));

@@ -134,7 +134,9 @@ bool IsKeyName(const std::string& key) {
 // Fields inherited by several blocks are checked once per block: each message is kept once.
 void Parser::Problem(const std::string& ptr, const std::string& what) {
   ++calls_;
-  std::string line = file_.string() + ": " + (ptr.empty() ? "/" : ptr) + ": " + what;
+  const auto place = table_places_.find(ptr);
+  const std::string& at = place != table_places_.end() ? place->second : ptr;
+  std::string line = file_.string() + ": " + (at.empty() ? "/" : at) + ": " + what;
   if (!reported_.insert(line).second) return;
   if (problems.size() < kMaxProblems) problems.push_back(std::move(line));
   else ++more_problems;

@@ -143,6 +143,10 @@ class Parser {
   ValidateOptions options_;
   std::map<std::string, std::string> tables_;  // each conditions table read: its path as written -> its text
   std::set<std::string> reported_;
+  // A conditions table's rows and cells are levels at pointers that exist in no file the experimenter wrote
+  // (/blocks/0/conditions/row/K/COLUMN): each is named by where it is written instead ("rows.csv line 7, column
+  // height_mm"), so a table that several blocks use reports a bad cell once.
+  std::map<std::string, std::string> table_places_;
   size_t calls_ = 0;  // problems found, repeats included
 };
 

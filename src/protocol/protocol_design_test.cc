@@ -155,14 +155,14 @@ TEST(ProtocolValidate, ConditionsTableGivesTheDesignRowByRow) {
   j["blocks"][0]["conditions"] = "bad.csv";
   const auto problems = Problems(j);
   ASSERT_EQ(problems.size(), 2u);
-  EXPECT_TRUE(Contains(problems[0], "/blocks/0/conditions/row/0/edge: an edge must be an integer in [1, 101], got 102"))
+  EXPECT_TRUE(Contains(problems[0], "bad.csv line 2, column 1 (edge): an edge must be an integer in [1, 101], got 102"))
       << problems[0];
   EXPECT_TRUE(Contains(problems[1], "bad.csv line 3: has 2 fields, the header 3")) << problems[1];
   // A cell is a number only as a decimal: "0x9" (which strtod reads as edge 9) and " 9" are text, refused as edges.
   for (const char* edge : {"0x9", " 9", "9 ", "nan"}) {
     std::ofstream(dir / "odd.csv") << "edge,left,right\n" << edge << ",measured,none\n";
     j["blocks"][0]["conditions"] = "odd.csv";
-    EXPECT_TRUE(Contains(OnlyProblem(j), "/blocks/0/conditions/row/0/edge: an edge must be an integer")) << edge;
+    EXPECT_TRUE(Contains(OnlyProblem(j), "odd.csv line 2, column 1 (edge): an edge must be an integer")) << edge;
   }
   j["blocks"][0]["conditions"] = "bad.csv";
   j["blocks"][0]["factors"] = {{"edge", {1}}};
@@ -199,8 +199,8 @@ TEST(ProtocolValidate, ConditionsTableCellThatIsNotUtf8IsRefusedNamingFileLineAn
   Json j = Valid();
   j["blocks"] = {{{"name", "rows"}, {"conditions", "latin1.csv"}}};
   const std::string problem = OnlyProblem(j);
-  EXPECT_TRUE(Contains(problem, "p.json: /blocks/0/conditions/row/1/label: ")) << problem;
-  EXPECT_TRUE(Contains(problem, "latin1.csv line 3, column 4 (label): must be printable UTF-8 text")) << problem;
+  EXPECT_TRUE(Contains(problem, "p.json: " + (dir / "latin1.csv").string() + " line 3, column 4 (label): must be "
+                                "printable UTF-8 text")) << problem;
   EXPECT_TRUE(Contains(problem, "got 'caf\\xe9\\xff\\xfe'")) << problem;
   try {
     ParseProtocol(j, dir / "p.json");
@@ -220,12 +220,12 @@ TEST(ProtocolValidate, ConditionsTableCellWithAControlByteIsRefused) {
   j["blocks"] = {{{"name", "rows"}, {"conditions", "controls.csv"}}};
   const auto problems = Problems(j);
   ASSERT_EQ(problems.size(), 3u);
-  EXPECT_TRUE(Contains(problems[0], "/row/0/label: " + (dir / "controls.csv").string() + " line 2, column 4 (label): "
+  EXPECT_TRUE(Contains(problems[0], (dir / "controls.csv").string() + " line 2, column 4 (label): "
                                     "must be printable UTF-8 text")) << problems[0];
   EXPECT_TRUE(Contains(problems[0], "got 'o\\x00k'")) << problems[0];
-  EXPECT_TRUE(Contains(problems[1], "/row/1/label: ")) << problems[1];
+  EXPECT_TRUE(Contains(problems[1], "controls.csv line 3, column 4 (label): ")) << problems[1];
   EXPECT_TRUE(Contains(problems[1], "got 'a\\x1b[2Jb'")) << problems[1];
-  EXPECT_TRUE(Contains(problems[2], "/row/2/label: ")) << problems[2];
+  EXPECT_TRUE(Contains(problems[2], "controls.csv line 4, column 4 (label): ")) << problems[2];
 }
 
 // A quote left open to the end of the file is a problem naming the file, the line and the column where it opened:
@@ -497,7 +497,7 @@ TEST(ProtocolValidate, PlaceALayoutDoesNotDrawIsRefused) {
   table["content"] = {{"type", "grid"}};
   table["blocks"][0].erase("factors");
   table["blocks"][0]["conditions"] = "places.csv";
-  EXPECT_TRUE(Contains(OnlyProblem(table), "/blocks/0/conditions/row/0/right_x_mm: the layout odd_one_out shows "
+  EXPECT_TRUE(Contains(OnlyProblem(table), "places.csv line 2, column 3 (right_x_mm): the layout odd_one_out shows "
                                            "every object at the left one's place"))
       << OnlyProblem(table);
   // Side by side, the right object stands where right_x_mm puts it, and a rolling ball ends its run at to_edge.
@@ -621,7 +621,7 @@ TEST(ProtocolValidate, ConditionsTableReadAsSpreadsheetsWriteIt) {
   EXPECT_TRUE(Contains(OnlyProblem(j), "sheet.csv line 2, column 8: text after a field's closing quote")) << OnlyProblem(j);
   // A line break inside quotes is part of the field: the problem names the row's own line, not a row that is not.
   std::ofstream(dir / "sheet.csv", std::ios::binary) << "edge,left,right,label\n1,measured,none,\"two\nlines\"\n";
-  EXPECT_TRUE(Contains(OnlyProblem(j), "/row/0/label: " + (dir / "sheet.csv").string() + " line 2, column 4 (label): "
+  EXPECT_TRUE(Contains(OnlyProblem(j), (dir / "sheet.csv").string() + " line 2, column 4 (label): "
                                        "must be printable UTF-8 text on one line")) << OnlyProblem(j);
 }
 
@@ -640,7 +640,7 @@ TEST(ProtocolValidate, ConditionsCellsKeepTheirTextAndNumbersTheirDigits) {
   EXPECT_EQ(levels[1]["label_stim"], "7");
   EXPECT_EQ(levels[2]["label_stim"], "9007199254740993");
   std::ofstream(dir / "cells.csv") << "edge,left,right,y_mm\n1,measured,none,0.12345678901234567\n";
-  EXPECT_TRUE(Contains(OnlyProblem(j), "/row/0/y_mm: has more digits than a number holds exactly (it would be "
+  EXPECT_TRUE(Contains(OnlyProblem(j), "cells.csv line 2, column 4 (y_mm): has more digits than a number holds exactly (it would be "
                                        "recorded as 0.12345678901234566)")) << OnlyProblem(j);
   std::ofstream(dir / "cells.csv") << "edge,left,right,y_mm\n1,measured,none,0.1\n2,measured,none,-2.50e1\n";
   EXPECT_EQ(ParseProtocol(j, dir / "p.json").blocks[0].factors[0].levels[1]["y_mm"], -25.0);
@@ -653,7 +653,7 @@ TEST(ProtocolValidate, IdsAndNamesAreSafeToOpenAndCountCharacters) {
   Json j = Valid();
   j["blocks"] = {{{"name", "rows"}, {"conditions", "ids.csv"}}};
   std::ofstream(dir / "ids.csv") << "edge,left,right,id\n1,measured,none,=cmd|' /C calc'!A0\n";
-  EXPECT_TRUE(Contains(OnlyProblem(j), "/row/0/id: an id begins with =, which a spreadsheet opening the exported "
+  EXPECT_TRUE(Contains(OnlyProblem(j), "ids.csv line 2, column 4 (id): an id begins with =, which a spreadsheet opening the exported "
                                        "tables runs as a formula")) << OnlyProblem(j);
   j = Valid();
   j["name"] = "study\u202Eevil";

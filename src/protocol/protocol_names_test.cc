@@ -87,22 +87,24 @@ TEST(ProtocolValidate, MisspeltConditionsColumnIsRefusedNamingFileLineAndColumn)
   EXPECT_TRUE(Problems(j).empty()) << Problems(j).front();
 }
 
-// A cell's problem says where the cell is in the table (its line and column), after its pointer and value.
+// A cell's problem is named where the cell is written: the table's file, line and column (by number and name), not
+// a pointer into a JSON document the experimenter never wrote; and once, however many blocks use the table.
 TEST(ProtocolValidate, ConditionsCellProblemNamesTheTablesLineAndColumn) {
   const fs::path dir = SceneFolder();
   std::ofstream(dir / "rows-cells.csv") << "id,speed_cm_s,left,right\n1,3,measured,none\n2,300,Measured,\n";
   Json j = Valid();
   j["blocks"][0].erase("factors");
   j["blocks"][0]["conditions"] = "rows-cells.csv";
+  j["blocks"][1].erase("factors");
+  j["blocks"][1]["conditions"] = "rows-cells.csv";
   const std::string table = (dir / "rows-cells.csv").string();
   const auto problems = Problems(j);
   ASSERT_EQ(problems.size(), 3u);
-  EXPECT_EQ(problems[0], Line("/blocks/0/conditions/row/1/speed_cm_s: a speed must be a number in [0.1, 100] cm/s, "
-                              "got 300 (" + table + " line 3, column 2)"));
-  EXPECT_TRUE(Contains(problems[1], "/blocks/0/conditions/row/1/left: a blur source must be ")) << problems[1];
-  EXPECT_TRUE(Contains(problems[1], "(did you mean measured?), got \"Measured\" (" + table + " line 3, column 3)"))
-      << problems[1];
-  EXPECT_EQ(problems[2], Line("/blocks/0/conditions/row/1/right: is empty, got \"\" (" + table + " line 3, column 4)"));
+  EXPECT_EQ(problems[0], Line(table + " line 3, column 2 (speed_cm_s): a speed must be a number in [0.1, 100] cm/s, "
+                              "got 300"));
+  EXPECT_TRUE(Contains(problems[1], table + " line 3, column 3 (left): a blur source must be ")) << problems[1];
+  EXPECT_TRUE(Contains(problems[1], "(did you mean measured?), got \"Measured\"")) << problems[1];
+  EXPECT_EQ(problems[2], Line(table + " line 3, column 4 (right): is empty, got \"\""));
 }
 
 TEST(ProtocolValidate, EnumValueMisspeltGetsDidYouMean) {
