@@ -38,6 +38,16 @@ std::string NearestName(const std::string& name, const std::vector<std::string>&
   // A case slip is the likeliest meaning whatever else is near: "Left" is what someone who wrote "left" meant.
   for (const auto& c : candidates)
     if (c != name && Lower(c) == lower) return c;
+  // Two neighbouring letters swapped ("egde" for edge) is one slip, however short the name.
+  for (const auto& c : candidates) {
+    const std::string other = Lower(c);
+    if (other.size() != lower.size() || other == lower) continue;
+    size_t first = 0;
+    while (other[first] == lower[first]) ++first;
+    if (first + 1 < lower.size() && other[first] == lower[first + 1] && other[first + 1] == lower[first] &&
+        other.compare(first + 2, std::string::npos, lower, first + 2, std::string::npos) == 0)
+      return c;
+  }
   std::string best;
   size_t best_distance = 3;
   for (const auto& c : candidates) {

@@ -10,9 +10,10 @@ namespace blurcue {
 size_t EditDistance(const std::string& a, const std::string& b);
 
 // The candidate `name` was probably meant to be, "" when none is near: first one that differs only in case
-// (Measured -> measured, left -> Left), else the nearest by edit distance ignoring case, if at most 2 and less than
-// half of `name`'s length (so a short name is not "corrected" into an unrelated one), else the one candidate that
-// `name` (3 characters or more) abbreviates (int -> integer). Ties: the earlier candidate.
+// (Measured -> measured, left -> Left), else one with two neighbouring letters swapped (egde -> edge), else the
+// nearest by edit distance ignoring case, if at most 2 and less than half of `name`'s length (so a short name is not
+// "corrected" into an unrelated one), else the one candidate that `name` (3 characters or more) abbreviates
+// (int -> integer). Ties: the earlier candidate.
 std::string NearestName(const std::string& name, const std::vector<std::string>& candidates);
 
 // " (did you mean X?)" for the nearest candidate, "" when none is near or `name` is itself a candidate.

@@ -27,6 +27,13 @@ TEST(NearestName, NearestWithinTwoEditsIgnoringCase) {
   EXPECT_EQ(NearestName("Sectoin", {"section"}), "section");  // a transposition is two edits; case ignored
 }
 
+// Two neighbouring letters swapped is one slip even in a short name: 2 edits would be too many for 4 letters.
+TEST(NearestName, SwappedNeighboursInAShortName) {
+  EXPECT_EQ(NearestName("egde", {"edge", "section", "speed_cm_s"}), "edge");
+  EXPECT_EQ(NearestName("ei", {"id"}), "");  // 2 letters: not a slip of anything
+  EXPECT_EQ(NearestName("dei", {"id", "die"}), "die");
+}
+
 // An abbreviation of one candidate (3 characters or more) names it; one of two names neither.
 TEST(NearestName, AbbreviationOfExactlyOneCandidate) {
   EXPECT_EQ(NearestName("int", {"integer", "number", "choice", "text"}), "integer");
