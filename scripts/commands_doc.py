@@ -22,7 +22,8 @@ text by `scripts/commands_doc.py`; do not edit it by hand: after changing a comm
 `docs_commands_current` fails until you do).
 
 Errors are one line naming the file, the field and the value; exit codes: 2 usage, 3 bad input file, 4 nothing
-found (no board), 5 outside a model's domain, 10 internal ([running a study](running.md#errors-exit-codes-and-typed-values)).
+found (no board), 5 outside a model's domain, 10 internal
+([running a study](running.md#errors-exit-codes-and-typed-values)).
 """
 
 

@@ -36,7 +36,8 @@ def without_code(text):
 
 def links(text):
     """Every markdown link and image target: [text](target) and ![alt](target), without a "title"."""
-    return [m.group(1).split()[0] for m in re.finditer(r"!?\[[^\]]*\]\(([^)\s]+(?:\s+\"[^\"]*\")?)\)", without_code(text))]
+    pattern = r"!?\[[^\]]*\]\(([^)\s]+(?:\s+\"[^\"]*\")?)\)"
+    return [m.group(1).split()[0] for m in re.finditer(pattern, without_code(text))]
 
 
 def slug(heading):
