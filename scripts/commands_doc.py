@@ -21,9 +21,7 @@ text by `scripts/commands_doc.py`; do not edit it by hand: after changing a comm
 `python3 scripts/commands_doc.py build/src/cli/blurcue --out docs/commands.md`, and the test
 `docs_commands_current` fails until you do).
 
-Errors are one line naming the file, the field and the value; exit codes: 2 usage, 3 bad input file, 4 nothing
-found (no board), 5 outside a model's domain, 10 internal
-([running a study](running.md#errors-exit-codes-and-typed-values)).
+Errors, exit codes and how typed values are read: [running a study](running.md#errors-exit-codes-and-typed-values).
 """
 
 
