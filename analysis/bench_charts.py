@@ -7,12 +7,13 @@
                                    convolution, per frame size; Pareto front per size and radius
   two-ball frame                   region-by-region vs the thesis's whole-frame blur, median and p99 per frame
   stability                        share of sections within target, and mean |error|, against each swept factor
-                                   (noise, contrast, JPEG, flaws, blur size, tilt, vignetting); the README's target
-                                   line and the level where each method first fails
+                                   (noise, contrast, JPEG, flaws, blur size, tilt, vignetting); the target line of
+                                   docs/benchmarks.md and the level where each method first fails
   error against r, per PSF         median (and p90) |error| / true r against the true r for each PSF family (disc,
                                    Gaussian, disc x floor at floor/defocus ratios, near focus with a 0.35 px floor),
                                    one panel per method; the issue's 2 % / 5 % lines and where each family breaks
-Target (README, `bench measure`): |error| <= max(0.25 px, 5 %) on >= 90 % of sections (and >= 50 % answered).
+Target (docs/benchmarks.md, `bench measure`): |error| <= max(0.25 px, 5 %) on >= 90 % of sections (and >= 50 %
+answered).
 """
 import os
 
@@ -29,11 +30,11 @@ MEASURE_COLUMNS = ["method", "factor", "level", "sections", "answered", "mean_ab
 RENDER_COLUMNS = ["kind", "method", "backend", "radius_px", "width", "height", "samples", "median_ms", "p99_ms",
                   "mean_abs_error_levels", "max_abs_error_levels"]  # and objects (frame and growth rows), quick
 
-WITHIN_TARGET = 0.9      # README: within max(0.25 px, 5 %) on >= 90 % of sections
+WITHIN_TARGET = 0.9      # docs/benchmarks.md: within max(0.25 px, 5 %) on >= 90 % of sections
 ERROR_FLOOR_PX = 0.25    # the target's absolute part
 REFRESH_MS = 1000 / 60   # one 60 Hz refresh
 REFRESH_120_MS = 1000 / 120  # one 120 Hz refresh: the frame budget of a 120 Hz display
-ONE_LEVEL = 1.0          # README: GL and CPU within 1 level of the exact convolution for r >= 4
+ONE_LEVEL = 1.0          # docs/benchmarks.md: GL and CPU within 1 level of the exact convolution for r >= 4
 
 METHOD_LABELS = {"model_fit": "model fit (r_px)", "thesis": "thesis threshold count (r_thesis_px)",
                  "eq37": "eq. 3.7 from edge 1", "fitted_model": "fitted thin-lens model"}
@@ -347,7 +348,7 @@ def stability(measure, out_dir):
         notes = ["x: the factor's levels in sweep order, from the base scene's value to the hardest"] + \
                 [f"{METHOD_LABELS.get(method, method)} misses the target from the first level of "
                  f"{', '.join(g['factor'])} (marked there)" for method, g in never.groupby("method", sort=False)] + [
-                 "table: levels where each method meets the README's target and the first where it does not "
+                 "table: levels where each method meets docs/benchmarks.md's target and the first where it does not "
                  "(answered >= 50 % of sections and >= 90 % of them within max(0.25 px, 5 %))"]
         charts.append(Chart(name, png, svg, table if what == "within-target" else pd.DataFrame(), notes))
     return charts + against_r
@@ -404,7 +405,7 @@ def render_speed_accuracy(render, out_dir):
                 for r, mk in RADIUS_MARKERS.items() if r in radii]
     handles += [plt.Line2D([], [], marker="o", ls="--", color="black", markerfacecolor="none", ms=11, lw=0.8,
                            label="Pareto front at one radius"),
-                plt.Line2D([], [], ls=":", color="#888888", label="1 level (README: reached for r >= 4)")]
+                plt.Line2D([], [], ls=":", color="#888888", label="1 level (docs/benchmarks.md: reached for r >= 4)")]
     axes.flat[-1].legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8)
     where = "per frame size" if len(sizes) > 1 else f"at {sizes[0][0]} x {sizes[0][1]}"
     fig.suptitle(f"Blur rendering: speed against accuracy {where}" + quick_note(render, "\n"), x=0.01, ha="left",
@@ -459,9 +460,9 @@ def render_frame(render, out_dir):
                      f"{verdict(REFRESH_MS)}; one 120 Hz refresh (8.3 ms): {verdict(REFRESH_120_MS)}")
     if len(region) and len(whole):
         speedup = whole["median_ms"].iloc[0] / region["median_ms"].iloc[0]
-        notes.append(f"speed-up: the region approach is {speedup:.0f} x faster than the whole-frame blur (README "
-                     f"target >= 10 x: {'met' if speedup >= 10 else 'NOT met'}); outputs differ by at most "
-                     f"{whole['max_abs_error_levels'].iloc[0]:.0f} levels")
+        notes.append(f"speed-up: the region approach is {speedup:.0f} x faster than the whole-frame blur "
+                     f"(docs/benchmarks.md target >= 10 x: {'met' if speedup >= 10 else 'NOT met'}); "
+                     f"outputs differ by at most {whole['max_abs_error_levels'].iloc[0]:.0f} levels")
     notes.append("error columns of the whole_frame row: difference to the region approach's output, not to an exact "
                  "reference")
     return [Chart("bench-frame", png, svg, table, notes)]

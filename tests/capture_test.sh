@@ -80,7 +80,7 @@ PYEOF
   variant "$P/test1-static-grids.json" "$W/quarter.json" "content.texture=\"$W/white.ppm\"" content.cells=DELETE 'display.scale=0.25' \
       "scene={\"background\": \"$W/full/scene.png\", \"calib\": \"$W/full/calib.json\"}"
   capture "$W/quarter.json" quarter
-  # Place only: below a screen px of blur the edge fit on drawn edges scatters by up to 0.3 px (README).
+  # Place only: below a screen px of blur the edge fit on drawn edges scatters by up to 0.3 px (docs/benchmarks.md).
   "$MEASURE" "$W/quarter" --tolerance-px 1e9 > "$W/quarter.txt" || fail "0.25 scale: $(grep BAD "$W/quarter.txt" | head -3)"
   tail -1 "$W/quarter.txt"
   echo "ok: objects land on their outlines at native and 0.25 scale"

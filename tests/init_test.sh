@@ -5,13 +5,8 @@
 # usage: init_test.sh BUILD_DIR WORK_DIR
 set -euo pipefail
 BUILD=$1 W=$2
-rm -rf "$W" && mkdir -p "$W/elsewhere"
-fail() { echo "FAIL: $*"; exit 1; }
-cmake --install "$BUILD" --prefix "$W/prefix" > "$W/install.log" || fail "install: $(tail -3 "$W/install.log")"
-mv "$W/prefix" "$W/moved"
-BC=$W/moved/bin/blurcue
-cd "$W/elsewhere"
-unset BLURCUE_DATA_DIR BLURCUE_SHADER_DIR
+source "$(dirname "$0")/lib.sh"
+install_moved "$BUILD"
 for example in yes-no-ball pre-research-depth-matching test3-no-board quest-blur-difference; do
   $BC init "$example" --from "$example" > "$example.log" 2>&1 || fail "init $example: $(tail -2 "$example.log")"
   grep -q "^ok: " "$example.log" || fail "init $example did not validate: $(tail -2 "$example.log")"

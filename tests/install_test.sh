@@ -5,13 +5,8 @@
 # usage: install_test.sh BUILD_DIR WORK_DIR
 set -euo pipefail
 BUILD=$1 W=$2
-rm -rf "$W" && mkdir -p "$W/elsewhere"
-fail() { echo "FAIL: $*"; exit 1; }
-cmake --install "$BUILD" --prefix "$W/prefix" > "$W/install.log" || fail "install: $(tail -3 "$W/install.log")"
-mv "$W/prefix" "$W/moved"
-BC=$W/moved/bin/blurcue
-cd "$W/elsewhere"
-unset BLURCUE_DATA_DIR BLURCUE_SHADER_DIR
+source "$(dirname "$0")/lib.sh"
+install_moved "$BUILD"
 $BC info > info.txt || fail "info: $(cat info.txt)"
 grep -q "^data: *$W/moved/share/blurcue (installed)" info.txt || fail "not found beside the binary: $(cat info.txt)"
 $BC synth-scene --out scene --seed 5 > /dev/null

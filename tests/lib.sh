@@ -19,3 +19,14 @@ start_xvfb() {
   [ -s "$W/display" ] || fail "Xvfb did not start in 20 s: $(cat "$W/xvfb.log")"
   export DISPLAY=":$(head -1 "$W/display")"
 }
+# blurcue installed into a temporary prefix that is then moved (relocatable), run from an empty folder of its own:
+# install_moved BUILD_DIR  (with W set) - W is made afresh, blurcue is installed to W/prefix and moved to W/moved,
+# BC is the moved binary, the shell is in the empty W/elsewhere, and no variable points blurcue at a source tree.
+install_moved() {
+  rm -rf "$W" && mkdir -p "$W/elsewhere"
+  cmake --install "$1" --prefix "$W/prefix" > "$W/install.log" || fail "install: $(tail -3 "$W/install.log")"
+  mv "$W/prefix" "$W/moved"
+  BC=$W/moved/bin/blurcue
+  cd "$W/elsewhere"
+  unset BLURCUE_DATA_DIR BLURCUE_SHADER_DIR
+}

@@ -2,8 +2,8 @@
 observers) and bench CSVs with the columns src/bench/measure_bench.cc and render_bench.cc write.
 
 The observers follow known curves so the charts have something to show; the numbers in the bench fixtures follow
-the README's "What the benchmarks measured" (model fit holds to noise 0.02, contrast 0.1, JPEG 80; the thesis count
-meets the target nowhere; detection fails from contrast 0.2).
+docs/benchmarks.md's "What the benchmarks measured" (model fit holds to noise 0.02, contrast 0.1, JPEG 80; the thesis
+count meets the target nowhere; detection fails from contrast 0.2).
 """
 import csv
 import json

@@ -83,7 +83,7 @@ void AddDisplayCommand(CLI::App& app) {
       "Examples:\n"
       "  blurcue display check --profile monitors/lab1.json --fullscreen\n"
       "  blurcue display check --frames 600 --screenshot check.png");
-  cmd->add_option("--profile", args->profile, "the display profile JSON (see README: describing a monitor)")
+  cmd->add_option("--profile", args->profile, "the display profile JSON (see docs/display.md: describing a monitor)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--frames", args->frames, "flips to time")->capture_default_str()->transform(IntRange(10, 100000));
   cmd->add_flag("--fullscreen", args->fullscreen, "fill the monitor (and check its resolution against the profile)");

@@ -39,7 +39,7 @@ TEST(Profile, ArcminAndScreenPixelsAreInverses) {
   EXPECT_NEAR(ArcminOfScreenPx(p, 1000), 2 * std::atan(0.5 * 1000 * 531.4 / 1920 / 450) * 180 / kPi * 60, 1e-9);
 }
 
-// The README's worked example: the thesis's 4 px on a 4592 x 3056 photo fitted into a 1920 x 1080 window (shown
+// docs/display.md's worked example: the thesis's 4 px on a 4592 x 3056 photo fitted into a 1920 x 1080 window (shown
 // 1622 px wide) on the default monitor: 1.413 screen px, 2.241 arcmin.
 TEST(Profile, WorkedExampleOfTheReadme) {
   const Profile p = DefaultProfile();

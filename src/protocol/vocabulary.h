@@ -135,8 +135,8 @@ enum class TaskShows { kPicture, kOneObject, kPair };
 enum class TaskAnswer { kSide, kYesNo, kRatingPoint, kLevel };
 
 // Everything the code knows of a task, in one place (TraitsOf): after protocol/ a caller asks these instead of
-// comparing Task values, so a new task with the shows/answer of an existing one is a row here (see the README's
-// section for contributors).
+// comparing Task values, so a new task with the shows/answer of an existing one is a row here (see
+// docs/contributing.md).
 struct TaskTraits {
   TaskShows shows = TaskShows::kPair;
   TaskAnswer answer = TaskAnswer::kSide;

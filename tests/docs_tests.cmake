@@ -1,0 +1,18 @@
+# The documentation as a reader meets it (tests/docs_check.py): the README under 2,500 words and naming no path
+# outside the repository, every relative link and anchor of README.md and docs/*.md resolving.
+add_test(NAME docs_links_and_length
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} ${PROJECT_SOURCE_DIR}/tests/docs_check.py ${PROJECT_SOURCE_DIR})
+set_tests_properties(docs_links_and_length PROPERTIES LABELS docs)
+
+# docs/commands.md is what `blurcue COMMAND --help` prints today (scripts/commands_doc.py --check).
+add_test(NAME docs_commands_current
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} ${PROJECT_SOURCE_DIR}/scripts/commands_doc.py $<TARGET_FILE:blurcue>
+                 --check ${PROJECT_SOURCE_DIR}/docs/commands.md)
+set_tests_properties(docs_commands_current PROPERTIES LABELS docs PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+
+# The README's first study, command by command, from an installed and moved prefix in an empty folder
+# (tests/readme_walk_test.sh).
+add_test(NAME readme_first_study
+         COMMAND bash ${PROJECT_SOURCE_DIR}/tests/readme_walk_test.sh ${PROJECT_BINARY_DIR}
+                 ${PROJECT_BINARY_DIR}/readme-walk)
+set_tests_properties(readme_first_study PROPERTIES LABELS "gl;docs" TIMEOUT 600 PASS_REGULAR_EXPRESSION "^ok:|\nok:")
