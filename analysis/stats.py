@@ -421,6 +421,24 @@ def _term_sources(X):
     return out
 
 
+def _kept_basis(Xk, infinite_cols):
+    """The columns to fit on the answers separation leaves (Xk): the finite terms first, each kept where it adds to
+    the rank (a finite term in the span of the others is not estimable), then the infinite terms that the rest still
+    needs to span Xk. On those answers the separating direction changes nothing, so an infinite column may be
+    collinear with the others there (a separated baseline cell: the intercept is the sum of the other cells'
+    indicators) - dropping it loses nothing, while keeping every column left the design rank-deficient and no term
+    was fitted. The finite terms' estimates are the limit of the maximum-likelihood fit whichever basis is taken."""
+    chosen = []
+    finite = [c for c in Xk.columns if c not in infinite_cols]
+    for c in finite + [c for c in Xk.columns if c in infinite_cols]:
+        if not np.any(Xk[c] != 0):
+            continue
+        trial = chosen + [c]
+        if np.linalg.matrix_rank(Xk[trial].to_numpy(float)) == len(trial):
+            chosen = trial
+    return [c for c in Xk.columns if c in chosen]
+
+
 def observer_models(data, response, formula_rhs, group="participant", study=""):
     """Logistic models of a 0/1 response across observers; returns (table, notes), the table in MODEL_COLUMNS.
 
@@ -462,11 +480,10 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
     infinite, separated = separation(X.to_numpy(float), y)
     infinite_cols = [X.columns[j] for j in infinite]
     keep = ~separated
-    Xr = X.loc[keep, [c for c in X.columns if np.any(X.loc[keep, c] != 0)]]
+    Xr = X.loc[keep, _kept_basis(X.loc[keep], infinite_cols)]
     yr, gr = y[keep], groups[keep]
     fit_cols = [c for c in Xr.columns if c not in infinite_cols]
-    estimable = len(fit_cols) > 0 and np.linalg.matrix_rank(Xr.to_numpy(float)) == Xr.shape[1] and \
-        min(yr.sum(), len(yr) - yr.sum()) >= 1
+    estimable = len(fit_cols) > 0 and min(yr.sum(), len(yr) - yr.sum()) >= 1
     if infinite_cols:
         notes.append(f"separation in {', '.join(words[c] for c in infinite_cols)}: "
                      f"{int(separated.sum())} answers that those terms predict perfectly left out of the other "

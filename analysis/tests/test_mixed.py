@@ -163,6 +163,31 @@ class SeparationTest(unittest.TestCase):
         self.assertAlmostEqual(b["estimate"], math.log(12 / 8), places=6)
         self.assertTrue(any("separation in cell a" in n for n in notes), notes)
 
+    def test_separated_baseline_leaves_the_other_factor_estimated(self):
+        # The baseline cell a went all one way, so the intercept and every cell's contrast against a are infinite;
+        # the side factor is not: on cells b and c the odds are 1 and 2 (b), 3 and 6 (c) for sides l and r, which an
+        # additive model fits exactly, so its maximum-likelihood side effect is log(2), hand-worked. (Found on a
+        # one-participant yes/no session whose 6 px blur was all 'yes': every term was 'not estimable'.)
+        counts = {("a", "l"): (5, 0), ("a", "r"): (5, 0), ("b", "l"): (5, 5), ("b", "r"): (8, 4),
+                  ("c", "l"): (9, 3), ("c", "r"): (12, 2)}
+        rows = [(cell, side, y) for (cell, side), (ones, zeros) in counts.items()
+                for y in [1.0] * ones + [0.0] * zeros]
+        d = pd.DataFrame(rows, columns=["cell", "side", "y"])
+        d["participant"] = [f"P{i % 4}" for i in range(len(d))]
+        table, notes = stats.observer_models(d, "y", "C(cell) + C(side)", study="s")
+        glm = table[table["engine"].str.contains("cluster-robust")]
+        side = glm[glm["term"] == "side r (against side l)"].iloc[0]
+        self.assertAlmostEqual(side["estimate"], math.log(2), places=5)
+        self.assertFalse(math.isnan(side["p"]), side)
+        for term in ("baseline (intercept)", "cell b (against cell a)", "cell c (against cell a)"):
+            row = glm[glm["term"] == term].iloc[0]
+            self.assertTrue(math.isnan(row["estimate"]) and math.isnan(row["p"]), row)
+            self.assertIn("separation", row["note"])
+        if HAVE_LME4:
+            glmm = rows_of(table, "lme4")
+            side = glmm[glmm["term"] == "side r (against side l)"].iloc[0]
+            self.assertAlmostEqual(side["estimate"], math.log(2), delta=0.05, msg=(side, notes))
+
     def test_large_finite_effect_is_not_separation(self):
         d = self.cells(49, 3, 26, 26)
         table, _ = stats.observer_models(d, "y", "0 + C(cell)", study="s")
