@@ -41,6 +41,17 @@ class Fit:
     singular: bool = False              # the chosen model's fit is singular
     failed: str = ""                    # not empty: no fixed effects (the reason in words)
     slopes: tuple = ()                  # the columns with a random slope in the fitted model
+    intercept: bool = True              # the fitted model has a random intercept (left out when estimated at 0)
+    correlated: bool = True             # its random effects are correlated (the maximal model) or not
+
+    def random_text(self, source=lambda c: c, group="participant"):
+        """The fitted random part as R users write it: (1 + x | participant), (1 + x || participant) uncorrelated,
+        (0 + x | participant) without the intercept."""
+        names = list(dict.fromkeys(source(c) for c in self.slopes))
+        if not names:
+            return f"(1 | {group})"
+        return "(" + ("1" if self.intercept else "0") + "".join(f" + {v}" for v in names) + \
+            (" | " if self.correlated or not self.intercept and len(names) == 1 else " || ") + f"{group})"
 
 
 class _Server:
@@ -200,7 +211,11 @@ def fit(kind, y, design, groups, slopes=()):
     fixed["term"] = fixed["term"].map(lambda t: back.get(t, t))
     result = Fit(engine=info.get("engine", "lme4"), structure=info.get("structure", ""), fixed=fixed.reset_index(
         drop=True), singular="singular" in info, failed=info.get("failed", ""))
-    result.slopes = tuple(slopes) if result.structure.startswith("random intercept and slopes") else ()
+    kept = str(info.get("slopes", "")).split(",") if info.get("slopes", "") else []
+    result.slopes = tuple(back.get(c, c) for c in kept)
+    result.intercept = info.get("intercept", "yes") != "no"
+    result.correlated = result.structure.startswith("random intercept and slopes") and "uncorrelated" not in \
+        result.structure.split(":")[0]
     for _, r in out[out["row"] == "sd"].iterrows():
         term = r["term"] if r["term"] in ("Intercept", "Residual") else back.get(r["term"], r["term"])
         result.sds.append((term, float(r["estimate"]), r["note"] == "singular"))

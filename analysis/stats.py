@@ -538,7 +538,7 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
             notes.append(f"GLMM not fitted: {e}")
             f = None
         if f is not None:
-            random = "(1" + "".join(f" + {v}" for v in dict.fromkeys(sources[c] for c in f.slopes)) + f" | {group})"
+            random = f.random_text(lambda c: sources[c], group)
             model = f"glmer({_formula_text(response, formula_rhs, random)})"
             status = f.structure + ("; singular fit (the participants' spread estimated at 0)" if f.singular
                                     else "")
@@ -572,6 +572,9 @@ UNHELD_LOST_SLOPE = ("; no SE or p: this term's random slope could not be fitted
                      "every participant has the same effect, which makes its p far too small (the GLMM's, in "
                      "simulation with 4 participants, rejected a true null 33 % of the time) - use the "
                      "cluster-robust test")
+UNHELD_NO_INTERCEPT = ("; no SE or p: the participants' spread in it was estimated at 0 and left out of the random "
+                       "part, so its SE counts one participant's answers as independent - use the cluster-robust "
+                       "test")
 UNHELD_SINGULAR = ("; no SE or p: a singular fit counts one participant's answers as independent - use the "
                    "cluster-robust test")
 
@@ -584,6 +587,8 @@ def without_unheld_tests(f, offered):
     lost = set(offered) - set(f.slopes)
     for i, term in fixed["term"].items():
         why = UNHELD_SINGULAR if f.singular else (UNHELD_LOST_SLOPE if term in lost else "")
+        if term == "Intercept" and not f.intercept and not f.singular:
+            why = UNHELD_NO_INTERCEPT
         if why:
             fixed.loc[i, ["se", "df", "p"]] = math.nan
             fixed.loc[i, "why"] = why

@@ -114,6 +114,32 @@ class GlmmAgainstDirectGlmer(unittest.TestCase):
         est, se = fixed["(Intercept)"]
         self.assertAlmostEqual(base["p"], 2 * sps.t.sf(abs(est / se), 5), delta=0.02)
 
+    def test_a_slope_spread_without_an_intercept_spread_keeps_its_slope_and_test(self):
+        # Participants differ in their slope only (intercept SD 0, slope SD 0.35): the maximal model and the
+        # uncorrelated one are singular here (their intercept SD at 0, checked with the direct calls), but the
+        # slope's spread is real. Dropping every slope (the old fallback) took the slope's test away; the random
+        # part reduced only by the component at 0 keeps it: the direct (0 + edge_c | participant) fit, written here.
+        d = simulated(8, 66, sd_intercept=0.0, sd_slope=0.35, seed=3)
+        _, _, maximal_singular = direct_glmer(d, "y ~ edge_c + (1 + edge_c | participant)")
+        _, sds, uncorrelated_singular = direct_glmer(d, "y ~ edge_c + (1 | participant) + (0 + edge_c | participant)")
+        self.assertTrue(maximal_singular and uncorrelated_singular)
+        self.assertLess(sds["(Intercept)"], 1e-4)
+        fixed, sds, singular = direct_glmer(d, "y ~ edge_c + (0 + edge_c | participant)")
+        self.assertFalse(singular)
+        table, notes = stats.observer_models(d, "y", "edge_c", study="s")
+        glmm = rows_of(table, "lme4")
+        self.assertIn("(0 + edge_c | participant)", glmm["model"].iloc[0], notes)
+        slope = glmm[glmm["term"] == "per edge (edge centred at 6)"].iloc[0]
+        est, se = fixed["edge_c"]
+        self.assertLessEqual(abs(slope["estimate"] - est), max(0.10 * abs(est), 0.25 * se), slope)
+        self.assertLessEqual(abs(slope["se"] - se), 0.20 * se, slope)
+        self.assertAlmostEqual(slope["p"], 2 * sps.t.sf(abs(est / se), 7), delta=0.02)
+        self.assertIn("estimated the spread of the intercept at 0", slope["note"])
+        base = glmm[glmm["term"] == "baseline (intercept)"].iloc[0]  # no random intercept left: no SE or p
+        self.assertTrue(math.isnan(base["p"]) and math.isnan(base["se"]), base)
+        sd = glmm[glmm["term"] == "observer SD: per edge (edge centred at 6)"].iloc[0]
+        self.assertAlmostEqual(sd["estimate"], sds["edge_c"], delta=0.1 * sds["edge_c"])
+
     def test_identical_observers_have_sd_zero_in_words(self):
         # Every participant gives the very same answers: the between-participant SD's maximum likelihood is exactly 0
         # (at SD 0 each participant's score is 0, so the likelihood falls as the SD grows), so the fit is singular.
