@@ -11,6 +11,7 @@ does not exist to see the report without R.
 """
 import atexit
 import os
+import re
 import select
 import shutil
 import subprocess
@@ -45,13 +46,20 @@ class Fit:
     correlated: bool = True             # its random effects are correlated (the maximal model) or not
 
     def random_text(self, source=lambda c: c, group="participant"):
-        """The fitted random part as R users write it: (1 + x | participant), (1 + x || participant) uncorrelated,
-        (0 + x | participant) without the intercept."""
-        names = list(dict.fromkeys(source(c) for c in self.slopes))
-        if not names:
+        """The fitted random part as R users write it: (1 + x | participant) for the maximal model; uncorrelated or
+        reduced, one term per column, (1 | participant) + (0 + x | participant), a factor's level as lme4 writes one
+        column of it, dummy(f, "level") (a factor in (1 + f || participant) would give every level a slope)."""
+        if not self.slopes:
             return f"(1 | {group})"
-        return "(" + ("1" if self.intercept else "0") + "".join(f" + {v}" for v in names) + \
-            (" | " if self.correlated or not self.intercept and len(names) == 1 else " || ") + f"{group})"
+        if self.correlated:
+            names = list(dict.fromkeys(source(c) for c in self.slopes))
+            return "(1" + "".join(f" + {v}" for v in names) + f" | {group})"
+        parts = [f"(1 | {group})"] if self.intercept else []
+        for c in self.slopes:
+            level = re.search(r"\[T\.(.*)\]$", str(c))
+            term = f'dummy({source(c)}, "{level.group(1)}")' if level else source(c)
+            parts.append(f"(0 + {term} | {group})")
+        return " + ".join(parts)
 
 
 class _Server:

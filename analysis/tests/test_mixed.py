@@ -128,7 +128,7 @@ class GlmmAgainstDirectGlmer(unittest.TestCase):
         self.assertFalse(singular)
         table, notes = stats.observer_models(d, "y", "edge_c", study="s")
         glmm = rows_of(table, "lme4")
-        self.assertIn("(0 + edge_c | participant)", glmm["model"].iloc[0], notes)
+        self.assertIn("y ~ edge_c + (0 + edge_c | participant))", glmm["model"].iloc[0], notes)
         slope = glmm[glmm["term"] == "per edge (edge centred at 6)"].iloc[0]
         est, se = fixed["edge_c"]
         self.assertLessEqual(abs(slope["estimate"] - est), max(0.10 * abs(est), 0.25 * se), slope)
@@ -166,6 +166,22 @@ class GlmmAgainstDirectGlmer(unittest.TestCase):
             self.assertIn("singular", row["note"])
         else:
             self.assertAlmostEqual(row["estimate"], sds["(Intercept)"], delta=0.05)
+
+
+class RandomPartAsRWritesIt(unittest.TestCase):
+    def test_a_reduced_factor_slope_is_written_as_lme4s_dummy(self):
+        # One level's slope kept of a factor: (1 + blur || participant) would give R every level a slope; lme4's
+        # dummy() names the one column (checked by hand in R on an experimenter's yes/no group: glmer with this
+        # formula gave the report's estimates, -3.18117 (0.72481)).
+        f = mixed.Fit(engine="", structure="", fixed=pd.DataFrame(), slopes=("C(blur)[T.object=measured]",),
+                      intercept=True, correlated=False)
+        self.assertEqual(f.random_text(lambda c: "blur"),
+                         '(1 | participant) + (0 + dummy(blur, "object=measured") | participant)')
+        f = mixed.Fit(engine="", structure="", fixed=pd.DataFrame(), slopes=("real_arcmin",), intercept=False,
+                      correlated=False)
+        self.assertEqual(f.random_text(), "(0 + real_arcmin | participant)")
+        f = mixed.Fit(engine="", structure="", fixed=pd.DataFrame(), slopes=("x", "z"))
+        self.assertEqual(f.random_text(), "(1 + x + z | participant)")
 
 
 class SeparationTest(unittest.TestCase):
