@@ -39,6 +39,13 @@ KIND_TITLES = {"pair": "forced choice between two", "odd": "odd one out",
                "adjustment": "method of adjustment"}
 
 
+# Why a share gets no test against chance, by the kind of answer (a yes/no study was told an adaptive procedure
+# set its share).
+NO_CHANCE_WHY = {"procedure": "; no test against chance: an adaptive procedure sets the share correct",
+                 "yes_no": "; no test against chance: a share of 'yes' has no chance level (it is the answer itself, "
+                           "compared between conditions and groups)"}
+
+
 def design_factors(d, codebook):
     """The design's factors that vary within these rows (within-subject factors and procedure cells), in column
     order; the between-subject group is not one of them (see design.Design)."""
@@ -119,7 +126,13 @@ def _sorted_levels(values):
     numeric = pd.to_numeric(pd.Series(values), errors="coerce")
     if numeric.notna().all():
         return [values[i] for i in np.argsort(numeric.to_numpy(), kind="stable")]
-    return sorted(values)
+    # Cells such as edge=10 and edge=2 in the order of their numbers (text order put a depth 10 before 2).
+    import re
+
+    def key(v):
+        return [(0, float(part), "") if re.fullmatch(r"[-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?", part) else (1, 0.0, part)
+                for part in re.split(r"([-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?)", str(v)) if part]
+    return sorted(values, key=key)
 
 
 def factor_chart(m, factor, chance, what, study, out_dir, name, group_note):
@@ -433,7 +446,8 @@ def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, 
                          "Wilson 95 % intervals of the answers pooled (a description)" +
                          ("; against chance with participants as the unit (test column), Holm-adjusted over the "
                           "conditions" if chance is not None else
-                          "; no test against chance: an adaptive procedure sets the share correct")]))
+                          NO_CHANCE_WHY.get(kind, "; no test against chance: the design defines no chance "
+                                                  "level for it"))]))
     if kind != "procedure":
         for f in factors:
             charts.append(factor_chart(m, f, chance, what, study, out_dir, f"{slug}-per-{f}", note))

@@ -176,7 +176,7 @@ def _across(a, x, y, label, words, notes, study):
         except mixed.Unavailable as e:
             notes.append(f"{label}: mixed model not fitted: {e}")
             return rows, pooled
-        random = f"(1 + {x} | participant)" if f.slopes else "(1 | participant)"
+        random = f.random_text()
         model = f"{label}: lmer({y} ~ {x} + {random})"
         if f.failed:
             notes.append(f"{label}: mixed model {f.failed}")

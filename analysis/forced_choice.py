@@ -366,7 +366,8 @@ def side_table(dec, by):
 
 def side_bias(df, out_dir):
     """Side bias: among decisive answers, the share choosing the LEFT side per forced-choice study and pooled (Wilson
-    95 %, exact binomial test against 0.5), and per participant.
+    95 % of the answers pooled; tested against 0.5 with participants as the unit), and per participant (exact
+    binomial test of their answers).
 
     The studies counterbalance the sides (test 1 by participant, tests 2 and 3 with swapped copies of every pair), so
     a preference for one side cancels out of the source comparisons and shows up only here; `first_on_left` checks
@@ -379,8 +380,20 @@ def side_bias(df, out_dir):
                                     "no decisive (left / right) answers in the forced-choice studies"))
     order = [s for s in FORCED_CHOICE_STUDIES if (dec["study"] == s).any()]
     pooled = dec.assign(study=SIDE_BIAS_POOLED)
-    t = side_table(pd.concat([dec, pooled], ignore_index=True), ["study"])
-    t["p_holm"] = stats.holm(t["p_binom"])
+    both = pd.concat([dec, pooled], ignore_index=True)
+    t = side_table(both, ["study"]).drop(columns="p_binom")
+    # A study's (and the pooled) row is tested with participants as the unit, as every other share of the report:
+    # the binomial test of the answers pooled took 45 answers of 7 observers as independent. One participant: the
+    # exact binomial test of that participant's answers (study_tests.against_chance says which).
+    tests = []
+    for study in t["study"]:
+        g = both[both["study"] == study].assign(y=lambda x: x["chose_left"].astype(float))
+        r = study_tests.against_chance(g, 0.5)
+        tests.append({"test": r["test"], "p": r["p"], "participant_mean": r.get("participant_mean", math.nan),
+                      "participant_low": r.get("participant_low", math.nan),
+                      "participant_high": r.get("participant_high", math.nan), "p_sign": r.get("p_sign", math.nan)})
+    t = pd.concat([t.reset_index(drop=True), pd.DataFrame(tests)], axis=1)
+    t["p_holm"] = stats.holm(t["p"])
     per_p = side_table(pd.concat([dec, pooled], ignore_index=True).sort_values(["participant"], kind="stable"),
                        ["study", "participant"])
     per_p["p_holm"] = np.nan
@@ -423,9 +436,11 @@ def side_bias(df, out_dir):
     png, svg = save(fig, out_dir, "side-bias")
 
     notes = [f"{participants_note(dec)}; {len(dec)} decisive answers (left / right; can't tell and practice left out)",
-             "share_left: share of the decisive answers choosing the left side, Wilson 95 % interval; p_binom: exact "
-             "two-sided binomial test against 0.5; p_holm: Holm-adjusted over the chart's rows (the pooled row "
-             "included); the chart prints the adjusted p",
+             "share_left: share of the decisive answers choosing the left side, Wilson 95 % interval (a "
+             "description of the answers pooled); test, p: against 0.5 with participants as the unit (a one-sample "
+             "t of the participants' shares, from 3 participants; p_sign the sign test beside it; one participant: "
+             "the exact binomial test of that participant's answers); p_holm: Holm-adjusted over the chart's rows "
+             "(the pooled row included); the chart prints the adjusted p",
              "the studies counterbalance the sides (test 1 by participant, tests 2 and 3 with a swapped copy of every "
              "pair), so a side preference cancels out of the source comparisons and shows up only here; "
              "first_on_left: share of these answers whose left side showed the pair's first source (0.5 = balanced)"]
@@ -434,7 +449,7 @@ def side_bias(df, out_dir):
             notes.append(f"{row.study}: the first source was on the left in {row.first_on_left:.0%} of the decisive "
                          f"answers - the sides are not balanced there, so a side preference would bias its source "
                          f"comparison")
-        if row.p_holm < 0.05:
+        if not math.isnan(row.p_holm) and row.p_holm < 0.05:
             notes.append(f"{row.study}: {row.share_left:.0%} chose the left side ({p_text(row.p_holm)}, Holm) - "
                          f"a side preference")
     fixed = per_p[(per_p["study"] != SIDE_BIAS_POOLED) & per_p["first_on_left"].isin([0.0, 1.0])

@@ -11,6 +11,7 @@ does not exist to see the report without R.
 """
 import atexit
 import os
+import re
 import select
 import shutil
 import subprocess
@@ -41,6 +42,24 @@ class Fit:
     singular: bool = False              # the chosen model's fit is singular
     failed: str = ""                    # not empty: no fixed effects (the reason in words)
     slopes: tuple = ()                  # the columns with a random slope in the fitted model
+    intercept: bool = True              # the fitted model has a random intercept (left out when estimated at 0)
+    correlated: bool = True             # its random effects are correlated (the maximal model) or not
+
+    def random_text(self, source=lambda c: c, group="participant"):
+        """The fitted random part as R users write it: (1 + x | participant) for the maximal model; uncorrelated or
+        reduced, one term per column, (1 | participant) + (0 + x | participant), a factor's level as lme4 writes one
+        column of it, dummy(f, "level") (a factor in (1 + f || participant) would give every level a slope)."""
+        if not self.slopes:
+            return f"(1 | {group})"
+        if self.correlated:
+            names = list(dict.fromkeys(source(c) for c in self.slopes))
+            return "(1" + "".join(f" + {v}" for v in names) + f" | {group})"
+        parts = [f"(1 | {group})"] if self.intercept else []
+        for c in self.slopes:
+            level = re.search(r"\[T\.(.*)\]$", str(c))
+            term = f'dummy({source(c)}, "{level.group(1)}")' if level else source(c)
+            parts.append(f"(0 + {term} | {group})")
+        return " + ".join(parts)
 
 
 class _Server:
@@ -200,7 +219,11 @@ def fit(kind, y, design, groups, slopes=()):
     fixed["term"] = fixed["term"].map(lambda t: back.get(t, t))
     result = Fit(engine=info.get("engine", "lme4"), structure=info.get("structure", ""), fixed=fixed.reset_index(
         drop=True), singular="singular" in info, failed=info.get("failed", ""))
-    result.slopes = tuple(slopes) if result.structure.startswith("random intercept and slopes") else ()
+    kept = str(info.get("slopes", "")).split(",") if info.get("slopes", "") else []
+    result.slopes = tuple(back.get(c, c) for c in kept)
+    result.intercept = info.get("intercept", "yes") != "no"
+    result.correlated = result.structure.startswith("random intercept and slopes") and "uncorrelated" not in \
+        result.structure.split(":")[0]
     for _, r in out[out["row"] == "sd"].iterrows():
         term = r["term"] if r["term"] in ("Intercept", "Residual") else back.get(r["term"], r["term"])
         result.sds.append((term, float(r["estimate"]), r["note"] == "singular"))

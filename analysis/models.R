@@ -10,8 +10,9 @@
 #         column of ones where the model has one: the fixed part is y ~ 0 + X0 + ... + Xk)
 # SLOPES  comma-separated design columns given a random slope by participant in the maximal model ("" = none)
 #
-# The maximal model is (1 + SLOPES | g); when it is singular, does not converge or fails, the intercept-only model
-# (1 | g) is fitted instead and the table says which and why. OUT has the columns
+# The maximal model is (1 + SLOPES | g); when it is singular, does not converge or fails, the slopes uncorrelated,
+# then without the components estimated at 0 (reduce_random), and only then the intercept-only model (1 | g); the
+# table says which and why (info rows structure, slopes: the slopes kept, intercept: yes / no). OUT has the columns
 #   row (fixed / sd / corr / info), term, estimate, se, df, p, note
 # lme4 missing: exit 4 with one line on stderr. lmerTest missing: an info row 'missing'. Any other failure: an info
 # row 'failed' with R's message, never a traceback.
@@ -53,7 +54,42 @@ fit_one <- function(kind, d, xs, random) {
   list(ok = TRUE, m = m, singular = FALSE)
 }
 
-# The maximal model, else the intercept-only one; its fixed effects, SDs and correlations through emit().
+# When the maximal model fails: the slopes uncorrelated with each other and with the intercept, (1 | g) + (0 + x | g)
+# + ...; where that is singular, the components it estimates at 0 are left out (each a variance on its bound, so the
+# fit is the same) and the rest refitted, uncorrelated (Bates et al. 2015, Matuschek et al. 2017: the random part
+# reduced as far as the data need, not at once to the intercept). NULL when no slope survives in a non-singular fit.
+# A participant effect that is real but uncorrelated, or a slope spread with no intercept spread (a depth matching's
+# set-on-real slope), keeps its slope and so its test.
+reduce_random <- function(kind, d, xs, slopes) {
+  uncorrelated <- function(intercept, s) {
+    paste(c(if (intercept) "(1 | g)", sprintf("(0 + %s | g)", s)), collapse = " + ")
+  }
+  second <- fit_one(kind, d, xs, uncorrelated(TRUE, slopes))
+  if (second$ok) {
+    return(list(fit = second, slopes = slopes, intercept = TRUE,
+                words = sprintf("random intercept and slopes by participant (%s), uncorrelated",
+                                paste(slopes, collapse = ", ")),
+                why = "the uncorrelated one was not"))
+  }
+  if (is.null(second$m)) return(NULL)
+  vc <- as.data.frame(VarCorr(second$m))
+  scale <- if (kind == "lmm") sigma(second$m) else 1
+  alive <- vc$var1[vc$grp != "Residual" & is.na(vc$var2) & vc$sdcor >= 1e-4 * scale]
+  keep <- intersect(slopes, alive)
+  intercept <- "(Intercept)" %in% alive
+  if (!length(keep)) return(NULL)
+  third <- fit_one(kind, d, xs, uncorrelated(intercept, keep))
+  if (!third$ok) return(NULL)
+  dropped <- c(if (!intercept) "the intercept", setdiff(slopes, keep))
+  list(fit = third, slopes = keep, intercept = intercept,
+       words = sprintf("%sslopes by participant (%s), uncorrelated", if (intercept) "random intercept and " else
+                       "random ", paste(keep, collapse = ", ")),
+       why = sprintf("the uncorrelated one estimated the spread of %s at 0, so %s left out",
+                     paste(dropped, collapse = ", "), if (length(dropped) > 1) "they were" else "it was"))
+}
+
+# The maximal model, else a reduced one (reduce_random), else the intercept-only one; its fixed effects, SDs and
+# correlations through emit().
 fit_job <- function(kind, data_path, slopes, emit) {
   # A participant named "NA" is a participant: no text is read as missing (numbers' empty cells still are).
   d <- read.csv(data_path, stringsAsFactors = FALSE, na.strings = character(0), colClasses = c(g = "character"))
@@ -68,20 +104,34 @@ fit_job <- function(kind, data_path, slopes, emit) {
   }
   emit("info", "engine", note = engine)
 
+  kept <- character()
+  intercept <- TRUE
   if (length(slopes)) {
     first <- fit_one(kind, d, xs, sprintf("(1 + %s | g)", paste(slopes, collapse = " + ")))
     if (first$ok) {
       chosen <- first
+      kept <- slopes
       structure <- sprintf("random intercept and slopes by participant (%s)", paste(slopes, collapse = ", "))
     } else {
-      chosen <- fit_one(kind, d, xs, "(1 | g)")
-      structure <- sprintf("random intercept only: the model with random slopes (%s) %s",
-                           paste(slopes, collapse = ", "), first$why)
+      reduced <- reduce_random(kind, d, xs, slopes)
+      if (!is.null(reduced)) {
+        chosen <- reduced$fit
+        kept <- reduced$slopes
+        intercept <- reduced$intercept
+        structure <- sprintf("%s: the model with correlated random slopes (%s) %s; %s",
+                             reduced$words, paste(slopes, collapse = ", "), first$why, reduced$why)
+      } else {
+        chosen <- fit_one(kind, d, xs, "(1 | g)")
+        structure <- sprintf(paste("random intercept only: the model with random slopes (%s) %s, and no model",
+                                   "with uncorrelated slopes kept a slope"), paste(slopes, collapse = ", "), first$why)
+      }
     }
   } else {
     chosen <- fit_one(kind, d, xs, "(1 | g)")
     structure <- "random intercept only (no within-participant term to give a slope)"
   }
+  emit("info", "slopes", note = paste(kept, collapse = ","))
+  emit("info", "intercept", note = if (intercept) "yes" else "no")
   emit("info", "structure", note = structure)
   if (is.null(chosen$m)) {
     emit("info", "failed", note = chosen$why)

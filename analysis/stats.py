@@ -421,6 +421,24 @@ def _term_sources(X):
     return out
 
 
+def _kept_basis(Xk, infinite_cols):
+    """The columns to fit on the answers separation leaves (Xk): the finite terms first, each kept where it adds to
+    the rank (a finite term in the span of the others is not estimable), then the infinite terms that the rest still
+    needs to span Xk. On those answers the separating direction changes nothing, so an infinite column may be
+    collinear with the others there (a separated baseline cell: the intercept is the sum of the other cells'
+    indicators) - dropping it loses nothing, while keeping every column left the design rank-deficient and no term
+    was fitted. The finite terms' estimates are the limit of the maximum-likelihood fit whichever basis is taken."""
+    chosen = []
+    finite = [c for c in Xk.columns if c not in infinite_cols]
+    for c in finite + [c for c in Xk.columns if c in infinite_cols]:
+        if not np.any(Xk[c] != 0):
+            continue
+        trial = chosen + [c]
+        if np.linalg.matrix_rank(Xk[trial].to_numpy(float)) == len(trial):
+            chosen = trial
+    return [c for c in Xk.columns if c in chosen]
+
+
 def observer_models(data, response, formula_rhs, group="participant", study=""):
     """Logistic models of a 0/1 response across observers; returns (table, notes), the table in MODEL_COLUMNS.
 
@@ -462,11 +480,10 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
     infinite, separated = separation(X.to_numpy(float), y)
     infinite_cols = [X.columns[j] for j in infinite]
     keep = ~separated
-    Xr = X.loc[keep, [c for c in X.columns if np.any(X.loc[keep, c] != 0)]]
+    Xr = X.loc[keep, _kept_basis(X.loc[keep], infinite_cols)]
     yr, gr = y[keep], groups[keep]
     fit_cols = [c for c in Xr.columns if c not in infinite_cols]
-    estimable = len(fit_cols) > 0 and np.linalg.matrix_rank(Xr.to_numpy(float)) == Xr.shape[1] and \
-        min(yr.sum(), len(yr) - yr.sum()) >= 1
+    estimable = len(fit_cols) > 0 and min(yr.sum(), len(yr) - yr.sum()) >= 1
     if infinite_cols:
         notes.append(f"separation in {', '.join(words[c] for c in infinite_cols)}: "
                      f"{int(separated.sum())} answers that those terms predict perfectly left out of the other "
@@ -521,7 +538,7 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
             notes.append(f"GLMM not fitted: {e}")
             f = None
         if f is not None:
-            random = "(1" + "".join(f" + {v}" for v in dict.fromkeys(sources[c] for c in f.slopes)) + f" | {group})"
+            random = f.random_text(lambda c: sources[c], group)
             model = f"glmer({_formula_text(response, formula_rhs, random)})"
             status = f.structure + ("; singular fit (the participants' spread estimated at 0)" if f.singular
                                     else "")
@@ -555,6 +572,9 @@ UNHELD_LOST_SLOPE = ("; no SE or p: this term's random slope could not be fitted
                      "every participant has the same effect, which makes its p far too small (the GLMM's, in "
                      "simulation with 4 participants, rejected a true null 33 % of the time) - use the "
                      "cluster-robust test")
+UNHELD_NO_INTERCEPT = ("; no SE or p: the participants' spread in it was estimated at 0 and left out of the random "
+                       "part, so its SE counts one participant's answers as independent - use the cluster-robust "
+                       "test")
 UNHELD_SINGULAR = ("; no SE or p: a singular fit counts one participant's answers as independent - use the "
                    "cluster-robust test")
 
@@ -567,6 +587,8 @@ def without_unheld_tests(f, offered):
     lost = set(offered) - set(f.slopes)
     for i, term in fixed["term"].items():
         why = UNHELD_SINGULAR if f.singular else (UNHELD_LOST_SLOPE if term in lost else "")
+        if term == "Intercept" and not f.intercept and not f.singular:
+            why = UNHELD_NO_INTERCEPT
         if why:
             fixed.loc[i, ["se", "df", "p"]] = math.nan
             fixed.loc[i, "why"] = why

@@ -136,15 +136,20 @@ def group_effect(m, group, column="y"):
             t, p_t = sps.ttest_ind(a, b, equal_var=False)
             t_words = f"Welch's t = {t:.2f}, {p_text(float(p_t))}"
         u, p_u = sps.mannwhitneyu(a, b, alternative="two-sided")
-        words = f"{t_words}; Mann-Whitney U = {u:.1f}, {p_text(float(p_u))}; {direction}"
+        # The direction is said as a finding only where a test finds it; otherwise as what the sample shows.
+        found = (not math.isnan(float(p_t)) and float(p_t) < 0.05) or float(p_u) < 0.05
+        words = (f"{t_words}; Mann-Whitney U = {u:.1f}, {p_text(float(p_u))}; " +
+                 (direction if found else f"{direction} in this sample, not significant at 0.05 by either test"))
         table["test"] = ["Welch t / Mann-Whitney U"] + [""] * (len(table) - 1)
         table["p_welch"] = [float(p_t)] + [math.nan] * (len(table) - 1)
         table["p_mann_whitney"] = [float(p_u)] + [math.nan] * (len(table) - 1)
     else:
         p_w = welch_anova_p([samples[n] for n in names])
         h, p_k = sps.kruskal(*[samples[n] for n in names])
+        found = (not math.isnan(p_w) and p_w < 0.05) or float(p_k) < 0.05
         words = (f"Welch's ANOVA {p_text(p_w)}; Kruskal-Wallis H = {h:.2f}, {p_text(float(p_k))}; highest group "
-                 f"{order[-1]}, lowest {order[0]}")
+                 f"{order[-1]}, lowest {order[0]}" + ("" if found else " in this sample, not significant at 0.05 by "
+                                                      "either test"))
         table["test"] = ["Welch ANOVA / Kruskal-Wallis"] + [""] * (len(table) - 1)
         table["p_welch"] = [p_w] + [math.nan] * (len(table) - 1)
         table["p_kruskal"] = [float(p_k)] + [math.nan] * (len(table) - 1)

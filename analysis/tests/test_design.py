@@ -14,6 +14,7 @@ import pandas as pd
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import common  # noqa: E402
 import design  # noqa: E402
+import any_study  # noqa: E402
 import study_tests  # noqa: E402
 
 RSCRIPT = shutil.which("Rscript") or ("/usr/bin/Rscript" if os.path.exists("/usr/bin/Rscript") else None)
@@ -234,6 +235,27 @@ class ParticipantsAsTheUnit(unittest.TestCase):
         self.assertAlmostEqual(table["p_welch"][0], r_value(f"oneway.test({y} ~ {g})$p.value"), places=9)
         self.assertAlmostEqual(table["p_kruskal"][0], r_value(f"kruskal.test({y}, {g})$p.value"), places=9)
         self.assertIn("highest group b, lowest a", words)
+
+    @unittest.skipUnless(RSCRIPT, "R is not installed")
+    def test_a_direction_no_test_finds_is_said_as_the_samples_not_as_a_finding(self):
+        # Overlapping groups (R: Welch p = 0.30, Wilcoxon p = 0.41): the means differ, no test finds it. The summary
+        # said 'group b higher than group a' at p = 0.08 in an experimenter's yes/no study.
+        a, b = [0.3, 0.5, 0.45, 0.6], [0.5, 0.65, 0.4, 0.7]
+        table, _, words = study_tests.group_effect(self.group_data({"a": a, "b": b}), "group")
+        ra, rb = "c(" + ",".join(map(str, a)) + ")", "c(" + ",".join(map(str, b)) + ")"
+        self.assertGreater(r_value(f"t.test({ra}, {rb})$p.value"), 0.05)
+        self.assertGreater(r_value(f"wilcox.test({ra}, {rb}, exact = FALSE)$p.value"), 0.05)
+        self.assertIn("group b higher than group a in this sample, not significant at 0.05 by either test", words)
+
+    def test_cells_in_the_order_of_their_numbers(self):
+        # A QUEST+ per depth's psychometric cells came as edge 10, 2, 6 (text order).
+        self.assertEqual(any_study._sorted_levels(["edge=10", "edge=2", "edge=6"]), ["edge=2", "edge=6", "edge=10"])
+        self.assertEqual(any_study._sorted_levels(["edge=9;speed_cm_s=3", "edge=9;speed_cm_s=1.8", "edge=10;speed_cm_s=1"]),
+                         ["edge=9;speed_cm_s=1.8", "edge=9;speed_cm_s=3", "edge=10;speed_cm_s=1"])
+
+    def test_a_yes_no_table_is_not_said_to_be_an_adaptive_procedures(self):
+        self.assertNotIn("adaptive", any_study.NO_CHANCE_WHY["yes_no"])
+        self.assertIn("adaptive procedure", any_study.NO_CHANCE_WHY["procedure"])
 
     def test_a_group_of_one_participant_gets_no_test_in_words(self):
         _, _, words = study_tests.group_effect(self.group_data({"a": [0.2], "b": [0.6, 0.7]}), "group")

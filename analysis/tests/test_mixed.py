@@ -114,6 +114,32 @@ class GlmmAgainstDirectGlmer(unittest.TestCase):
         est, se = fixed["(Intercept)"]
         self.assertAlmostEqual(base["p"], 2 * sps.t.sf(abs(est / se), 5), delta=0.02)
 
+    def test_a_slope_spread_without_an_intercept_spread_keeps_its_slope_and_test(self):
+        # Participants differ in their slope only (intercept SD 0, slope SD 0.35): the maximal model and the
+        # uncorrelated one are singular here (their intercept SD at 0, checked with the direct calls), but the
+        # slope's spread is real. Dropping every slope (the old fallback) took the slope's test away; the random
+        # part reduced only by the component at 0 keeps it: the direct (0 + edge_c | participant) fit, written here.
+        d = simulated(8, 66, sd_intercept=0.0, sd_slope=0.35, seed=3)
+        _, _, maximal_singular = direct_glmer(d, "y ~ edge_c + (1 + edge_c | participant)")
+        _, sds, uncorrelated_singular = direct_glmer(d, "y ~ edge_c + (1 | participant) + (0 + edge_c | participant)")
+        self.assertTrue(maximal_singular and uncorrelated_singular)
+        self.assertLess(sds["(Intercept)"], 1e-4)
+        fixed, sds, singular = direct_glmer(d, "y ~ edge_c + (0 + edge_c | participant)")
+        self.assertFalse(singular)
+        table, notes = stats.observer_models(d, "y", "edge_c", study="s")
+        glmm = rows_of(table, "lme4")
+        self.assertIn("y ~ edge_c + (0 + edge_c | participant))", glmm["model"].iloc[0], notes)
+        slope = glmm[glmm["term"] == "per edge (edge centred at 6)"].iloc[0]
+        est, se = fixed["edge_c"]
+        self.assertLessEqual(abs(slope["estimate"] - est), max(0.10 * abs(est), 0.25 * se), slope)
+        self.assertLessEqual(abs(slope["se"] - se), 0.20 * se, slope)
+        self.assertAlmostEqual(slope["p"], 2 * sps.t.sf(abs(est / se), 7), delta=0.02)
+        self.assertIn("estimated the spread of the intercept at 0", slope["note"])
+        base = glmm[glmm["term"] == "baseline (intercept)"].iloc[0]  # no random intercept left: no SE or p
+        self.assertTrue(math.isnan(base["p"]) and math.isnan(base["se"]), base)
+        sd = glmm[glmm["term"] == "observer SD: per edge (edge centred at 6)"].iloc[0]
+        self.assertAlmostEqual(sd["estimate"], sds["edge_c"], delta=0.1 * sds["edge_c"])
+
     def test_identical_observers_have_sd_zero_in_words(self):
         # Every participant gives the very same answers: the between-participant SD's maximum likelihood is exactly 0
         # (at SD 0 each participant's score is 0, so the likelihood falls as the SD grows), so the fit is singular.
@@ -142,6 +168,22 @@ class GlmmAgainstDirectGlmer(unittest.TestCase):
             self.assertAlmostEqual(row["estimate"], sds["(Intercept)"], delta=0.05)
 
 
+class RandomPartAsRWritesIt(unittest.TestCase):
+    def test_a_reduced_factor_slope_is_written_as_lme4s_dummy(self):
+        # One level's slope kept of a factor: (1 + blur || participant) would give R every level a slope; lme4's
+        # dummy() names the one column (checked by hand in R on an experimenter's yes/no group: glmer with this
+        # formula gave the report's estimates, -3.18117 (0.72481)).
+        f = mixed.Fit(engine="", structure="", fixed=pd.DataFrame(), slopes=("C(blur)[T.object=measured]",),
+                      intercept=True, correlated=False)
+        self.assertEqual(f.random_text(lambda c: "blur"),
+                         '(1 | participant) + (0 + dummy(blur, "object=measured") | participant)')
+        f = mixed.Fit(engine="", structure="", fixed=pd.DataFrame(), slopes=("real_arcmin",), intercept=False,
+                      correlated=False)
+        self.assertEqual(f.random_text(), "(0 + real_arcmin | participant)")
+        f = mixed.Fit(engine="", structure="", fixed=pd.DataFrame(), slopes=("x", "z"))
+        self.assertEqual(f.random_text(), "(1 + x + z | participant)")
+
+
 class SeparationTest(unittest.TestCase):
     def cells(self, a_ones, a_zeros, b_ones, b_zeros, participants=4):
         """Cells a and b with the given answer counts, spread over the participants in turn."""
@@ -162,6 +204,31 @@ class SeparationTest(unittest.TestCase):
         b = table[(table["term"] == "cell b") & table["engine"].str.contains("cluster-robust")].iloc[0]
         self.assertAlmostEqual(b["estimate"], math.log(12 / 8), places=6)
         self.assertTrue(any("separation in cell a" in n for n in notes), notes)
+
+    def test_separated_baseline_leaves_the_other_factor_estimated(self):
+        # The baseline cell a went all one way, so the intercept and every cell's contrast against a are infinite;
+        # the side factor is not: on cells b and c the odds are 1 and 2 (b), 3 and 6 (c) for sides l and r, which an
+        # additive model fits exactly, so its maximum-likelihood side effect is log(2), hand-worked. (Found on a
+        # one-participant yes/no session whose 6 px blur was all 'yes': every term was 'not estimable'.)
+        counts = {("a", "l"): (5, 0), ("a", "r"): (5, 0), ("b", "l"): (5, 5), ("b", "r"): (8, 4),
+                  ("c", "l"): (9, 3), ("c", "r"): (12, 2)}
+        rows = [(cell, side, y) for (cell, side), (ones, zeros) in counts.items()
+                for y in [1.0] * ones + [0.0] * zeros]
+        d = pd.DataFrame(rows, columns=["cell", "side", "y"])
+        d["participant"] = [f"P{i % 4}" for i in range(len(d))]
+        table, notes = stats.observer_models(d, "y", "C(cell) + C(side)", study="s")
+        glm = table[table["engine"].str.contains("cluster-robust")]
+        side = glm[glm["term"] == "side r (against side l)"].iloc[0]
+        self.assertAlmostEqual(side["estimate"], math.log(2), places=5)
+        self.assertFalse(math.isnan(side["p"]), side)
+        for term in ("baseline (intercept)", "cell b (against cell a)", "cell c (against cell a)"):
+            row = glm[glm["term"] == term].iloc[0]
+            self.assertTrue(math.isnan(row["estimate"]) and math.isnan(row["p"]), row)
+            self.assertIn("separation", row["note"])
+        if HAVE_LME4:
+            glmm = rows_of(table, "lme4")
+            side = glmm[glmm["term"] == "side r (against side l)"].iloc[0]
+            self.assertAlmostEqual(side["estimate"], math.log(2), delta=0.05, msg=(side, notes))
 
     def test_large_finite_effect_is_not_separation(self):
         d = self.cells(49, 3, 26, 26)

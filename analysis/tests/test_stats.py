@@ -322,19 +322,20 @@ class SideBiasTest(TempDirCase):
         low, high = wilson_closed_form(14, 20)
         self.assertAlmostEqual(t1["share_left_low"], low, places=10)
         self.assertAlmostEqual(t1["share_left_high"], high, places=10)
-        self.assertAlmostEqual(t1["p_binom"], 2 * 60460 / 2 ** 20, places=12)
-        self.assertAlmostEqual(t1["p_binom"], binom_two_sided_half(14, 20), places=12)
+        # Two participants: too few for a test across participants, said so, no p (their 20 answers pooled gave
+        # the binomial p 0.115 as if independent).
+        self.assertTrue(t1["test"].startswith("none: 2 participants"), t1["test"])
+        self.assertTrue(math.isnan(t1["p"]))
+        self.assertNotIn("p_binom", t.columns)
         # P1 (swapped = 0) had measured on the left for 10 answers, P2 (swapped = 1) for none of 10.
         self.assertAlmostEqual(t1["first_on_left"], 0.5)
 
-        t2 = t.loc["test2-moving-balls"]
+        t2 = t.loc["test2-moving-balls"]  # one participant: the exact binomial test of that participant's answers
         self.assertEqual((t2["decisive"], t2["n_left"]), (10, 5))
-        self.assertAlmostEqual(t2["p_binom"], 1.0)
+        self.assertAlmostEqual(t2["p"], 1.0)
         pooled = t.loc["pooled"]
         self.assertEqual((pooled["decisive"], pooled["n_left"]), (30, 19))
-        self.assertAlmostEqual(pooled["p_binom"], binom_two_sided_half(19, 30), places=12)
-        # Holm over the chart's three rows: the smallest p times 3.
-        self.assertAlmostEqual(t1["p_holm"], min(1.0, 3 * t.loc[:, "p_binom"].min()), places=12)
+        self.assertTrue(math.isnan(pooled["p"]))  # P1 and P2 across the studies: two participants
 
         per_p = charts[1].table
         p1 = per_p[(per_p["study"] == "test1-static-grids") & (per_p["participant"] == "P1")].iloc[0]
@@ -343,6 +344,22 @@ class SideBiasTest(TempDirCase):
         self.assertEqual(set(per_p["study"]), {"test1-static-grids", "test2-moving-balls", "pooled"})
         # Test 1 is counterbalanced by participant: each one saw measured on one side only, and a note says so.
         self.assertTrue(any("always on the same side" in n for n in charts[1].notes), charts[1].notes)
+
+    def test_a_studys_side_bias_is_tested_with_participants_as_the_unit(self):
+        # Four participants choosing left in 8, 7, 9 and 6 of 10 decisive answers: shares 0.8, 0.7, 0.9, 0.6, mean
+        # 0.75, deviations +-0.05, +-0.15: sd = sqrt(0.05 / 3) = 0.1290994; t = 0.25 / (0.1290994 / 2) = 3.872983 on
+        # 3 df. The answers pooled (30 of 40) would give the binomial p 0.0022 as if 40 answers were independent.
+        rows = []
+        for i, left in enumerate([8, 7, 9, 6]):
+            rows += fc_rows("test1-static-grids", f"P{i}", ["left"] * left + ["right"] * (10 - left), swapped=i % 2)
+        t = forced_choice.side_bias(pd.DataFrame(rows), self.tmp)[0].table.set_index("study")
+        t1 = t.loc["test1-static-grids"]
+        self.assertEqual((t1["decisive"], t1["n_left"]), (40, 30))
+        self.assertAlmostEqual(t1["participant_mean"], 0.75, places=12)
+        self.assertAlmostEqual(t1["p"], 2 * __import__("scipy.stats").stats.t.sf(0.25 / (math.sqrt(0.05 / 3) / 2), 3), places=10)
+        self.assertGreater(t1["p"], 0.02)
+        self.assertAlmostEqual(t1["p_sign"], 2 * 0.5 ** 4, places=12)  # all four above 0.5
+        self.assertTrue(t1["test"].startswith("one-sample t across 4 participants"), t1["test"])
 
     def test_no_forced_choice_answers_is_a_skip(self):
         df = pd.DataFrame(fc_rows("test1-static-grids", "P1", ["cant_tell", ""]))
