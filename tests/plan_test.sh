@@ -250,6 +250,20 @@ slope = x * (1 - lapse) * norm.pdf(z) * z75 / math.log(1.35) * (r + x) / 4 / E(r
 assert abs(said - slope) < 0.006, (said, slope)
 print(f"  validate --plan: the observer's slope {said} (closed form {slope:.4f}) outside 1.5-5, exit 3")
 PYEOF
+  # Several cells outside the slope grid: each its own line (they were joined into one with a literal "\n").
+  $PY - "$(dirname "$0")/data/quest-per-depth.json" "$P/quest-blur-difference.json" "$W/per-depth.json" <<'PYEOF'
+import json, sys
+p, shipped = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+p["scene"] = shipped["scene"]  # the CLI tests' scene
+json.dump(p, open(sys.argv[3], "w"))
+PYEOF
+  sed -i "s|\"\.\./|\"$P/../|g" "$W/per-depth.json"
+  set +e
+  $BC validate "$W/per-depth.json" --plan > "$W/per-depth.out" 2>&1
+  code=$?
+  set -e
+  [ "$code" = 3 ] && [ "$(grep -c "per-depth.json: /blocks/0/procedure/slope: the observer's Weibull slope" "$W/per-depth.out")" = 3 ] \
+    && ! grep -qF '\n' "$W/per-depth.out" || fail "validate --plan, three cells: exit $code, $(cat "$W/per-depth.out")"
   echo "ok: QUEST+ plans its threshold: the observer's truth by the closed form, bias, sd and interval width; a truth beyond the range in words; validate --plan checks the grid holds the observer's slope" ;;
 difference_power)
   # The power of a declared difference: a second cell like edge=9 in the same participants, 0.5 arcmin more. Its

@@ -137,11 +137,8 @@ void AddValidateCommand(CLI::App& app) {
                                       "its own scene and calibration; --no-files skips the file checks)");
       }
     }
-    if (!grid_problems.empty()) {
-      std::string text;
-      for (const std::string& problem : grid_problems) text += (text.empty() ? "" : "\n") + problem;
-      throw Error(ErrorKind::kInput, text);
-    }
+    // Each on its own line, as a protocol's problems are (one joined text came out as one line with "\n" in it).
+    if (!grid_problems.empty()) throw Error(ErrorKind::kInput, grid_problems);
     for (const Checked& one : checked) {
       const auto& trials = one.trials;
       if (args->list)
