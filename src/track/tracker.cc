@@ -4,6 +4,8 @@
 #include <cmath>
 #include <utility>
 
+#include <opencv2/imgproc.hpp>
+
 #include "calib/board_pose.h"
 #include "core/error.h"
 #include "core/image.h"
@@ -11,6 +13,8 @@
 
 namespace blurcue::track {
 namespace {
+
+constexpr int kSmallFactor = 4;  // the copy the frame-to-frame shift is found on: a quarter of each side
 
 double MsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -36,13 +40,18 @@ const char* Name(FrameStatus status) {
 Tracker::Tracker(Camera camera, Board board, TrackOptions options)
     : camera_(std::move(camera)), board_(std::move(board)), options_(std::move(options)) {}
 
-std::optional<calib::BoardPose> Tracker::Track(const cv::Mat& grey8, std::string* note) const {
+std::optional<calib::BoardPose> Tracker::Track(const cv::Mat& grey8, const cv::Mat& small, std::string* note) const {
   if (last_.empty()) return std::nullopt;
   // Constant velocity in the image: smooth camera motion moves each corner nearly as it did a frame ago, far more
-  // exactly than the refinement window (a quarter of a square) needs.
+  // exactly than the refinement window (a quarter of a square) needs. With one frame of history there is no
+  // velocity yet: the whole image's shift from that frame (phase correlation at a quarter size) stands in.
   std::vector<cv::Point2f> corners = last_;
-  if (!before_last_.empty())
+  if (!before_last_.empty()) {
     for (size_t i = 0; i < corners.size(); ++i) corners[i] += last_[i] - before_last_[i];
+  } else if (!last_small_.empty() && last_small_.size() == small.size()) {
+    const cv::Point2d shift = cv::phaseCorrelate(last_small_, small) * double(kSmallFactor);
+    for (cv::Point2f& p : corners) p += cv::Point2f(float(shift.x), float(shift.y));
+  }
   const cv::Rect2f inside(2, 2, grey8.cols - 5, grey8.rows - 5);
   for (const cv::Point2f& p : corners)
     if (!inside.contains(p)) {
@@ -70,8 +79,13 @@ FrameResult Tracker::Process(const cv::Mat& photo, int index, double time_s) {
                      "is " + std::to_string(photo.cols) + "x" + std::to_string(photo.rows) + " but the camera says " +
                          std::to_string(camera_.image_width_px) + "x" + std::to_string(camera_.image_height_px));
   const cv::Mat grey8 = ToGrey8(photo);
+  cv::Mat small;
+  if (!options_.always_detect) {
+    cv::resize(grey8, small, cv::Size(), 1.0 / kSmallFactor, 1.0 / kSmallFactor, cv::INTER_AREA);
+    small.convertTo(small, CV_32F);
+  }
   std::optional<calib::BoardPose> pose;
-  if (!options_.always_detect) pose = Track(grey8, &r.note);
+  if (!options_.always_detect) pose = Track(grey8, small, &r.note);
   r.status = FrameStatus::kTracked;
   if (!pose) {
     r.status = FrameStatus::kFound;
@@ -87,10 +101,12 @@ FrameResult Tracker::Process(const cv::Mat& photo, int index, double time_s) {
   if (!pose) {
     before_last_.clear();
     last_.clear();
+    last_small_.release();
     r.frame_ms = MsSince(t0);
     return r;
   }
   before_last_ = std::exchange(last_, pose->corners);
+  last_small_ = small;
 
   const auto t1 = std::chrono::steady_clock::now();
   calib::CalibrateOptions options = options_.calibrate;

@@ -45,12 +45,13 @@ class Tracker {
   FrameResult Process(const cv::Mat& photo, int index, double time_s);
 
  private:
-  std::optional<calib::BoardPose> Track(const cv::Mat& grey8, std::string* note) const;
+  std::optional<calib::BoardPose> Track(const cv::Mat& grey8, const cv::Mat& small, std::string* note) const;
 
   Camera camera_;
   Board board_;
   TrackOptions options_;
   std::vector<cv::Point2f> last_, before_last_;  // corners of the last two frames with a pose (empty: none)
+  cv::Mat last_small_;  // the last frame with a pose, a quarter size, float: its shift to the next one
 };
 
 // The take's one lens model (fixed focus and aperture): the thin-lens fit to every usable section of every frame
