@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <regex>
 
 #include "core/error.h"
@@ -40,6 +41,9 @@ FrameSource::FrameSource(const std::string& input, double fps) : input_(input), 
     return;
   }
   if (!std::filesystem::exists(input)) throw InputError(input, "no such video file");
+  // FFmpeg logs every damaged packet on stderr ("[ffv1 @ 0x...] Slice pointer chain broken"); the error this class
+  // throws says it in one line instead. OpenCV reads the level once, at its first FFmpeg use; a user's own setting wins.
+  setenv("OPENCV_FFMPEG_LOGLEVEL", "-8" /* AV_LOG_QUIET */, 0);
   if (!video_.open(input, cv::CAP_ANY) || !video_.isOpened())
     throw InputError(input, "OpenCV's videoio cannot open it as a video");
   const double rate = video_.get(cv::CAP_PROP_FPS);
