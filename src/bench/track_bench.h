@@ -14,6 +14,8 @@ struct TrackRow {
   std::string status;      // found | tracked | lost (calibrate: found | lost)
   double frame_ms = 0;     // the frame's work, decoding excluded (the PNG decode is timed apart: decode_ms)
   double pose_ms = 0, measure_ms = 0;
+  double cpu_ms = 0;       // the process's CPU time over the frame's work (all threads): what the frame costs when
+                           // the machine is shared and wall time is not the frame's own
   double decode_ms = 0;    // PNG decode of the frame (the same for every mode)
   double max_depth_error_rel = 0;     // max over sections of |u - u_true| / u_true
   double translation_error_mm = 0;    // |t - t_true|
