@@ -1,38 +1,15 @@
 // blurcue synth-take: a ground-truth moving-camera take (src/synth/take.h) rendered and written to a folder.
 #include <chrono>
 #include <cstdio>
-#include <map>
 #include <memory>
 #include <string>
 
 #include "cli/commands.h"
+#include "cli/scene_option_error.h"
 #include "core/error.h"
 #include "synth/take.h"
 
 namespace blurcue::cli {
-namespace {
-
-// RenderScene and ValidateTake name option fields; say them as the options a user typed.
-Error AsTakeOptionError(const Error& e) {
-  static const std::map<std::string, std::string> kOptions = {
-      {"frames", "--frames"},           {"fps", "--fps"},
-      {"focus_mm", "--focus-mm"},       {"floor_sigma_px", "--floor-sigma-px"},
-      {"edge1_u_mm", "--from-u-mm/--to-u-mm"}, {"lateral_mm", "--from-lateral-mm/--to-lateral-mm"},
-      {"edge1_u_start_mm", "--from-u-mm"}, {"edge1_u_end_mm", "--to-u-mm"},
-      {"lateral_start_mm", "--from-lateral-mm"}, {"lateral_end_mm", "--to-lateral-mm"},
-      {"tilt_deg", "--tilt-deg"},       {"noise_std", "--noise"}, {"supersample", "--supersample"},
-  };
-  const std::string message = e.what();
-  const size_t colon = message.find(':');
-  if (e.kind() == ErrorKind::kInput && colon != std::string::npos) {
-    auto it = kOptions.find(message.substr(0, colon));
-    if (it != kOptions.end()) return Error(ErrorKind::kUsage, it->second + message.substr(colon));
-  }
-  return e;
-}
-
-}  // namespace
-
 void AddSynthTakeCommand(CLI::App& app) {
   struct Args {
     std::string out;
@@ -96,7 +73,12 @@ void AddSynthTakeCommand(CLI::App& app) {
     try {
       files = synth::WriteTake(o, args->out, progress);
     } catch (const Error& e) {
-      throw AsTakeOptionError(e);
+      // The take's own fields, and the still's path fields as the take's path options.
+      throw AsSceneOptionError(e, {{"frames", "--frames"}, {"fps", "--fps"},
+                                   {"edge1_u_mm", "--from-u-mm/--to-u-mm"},
+                                   {"lateral_mm", "--from-lateral-mm/--to-lateral-mm"},
+                                   {"edge1_u_start_mm", "--from-u-mm"}, {"edge1_u_end_mm", "--to-u-mm"},
+                                   {"lateral_start_mm", "--from-lateral-mm"}, {"lateral_end_mm", "--to-lateral-mm"}});
     }
     if (args->quiet) return;
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
