@@ -59,6 +59,13 @@ if [ -f "$W/take/take.avi" ]; then
   echo "truncated video: exit 3, $rows frames kept: $(cat "$W/trunc.err")"
 fi
 
+# A file that is not a video: one line, exit 3 (no backend's warnings before it).
+echo "not a video" > "$W/garbage.avi"
+"$BC" track "$W/garbage.avi" --camera "$W/take/camera.json" --out "$W/x" 2> "$W/garbage.err"
+code=$?
+[ $code -eq 3 ] && [ "$(wc -l < "$W/garbage.err")" -eq 1 ] && grep -q "garbage.avi: OpenCV's videoio (FFmpeg) cannot open it" "$W/garbage.err" ||
+  fail "not a video: exit $code: $(cat "$W/garbage.err")"
+
 # A missing frame inside a sequence.
 mkdir -p "$W/gap" && cp "$W/take/frame-000"[0-5].png "$W/gap/" && rm "$W/gap/frame-0003.png"
 "$BC" track "$W/gap/frame-%04d.png" --camera "$W/take/camera.json" --out "$W/track-gap" --quiet > /dev/null 2> "$W/gap.err"

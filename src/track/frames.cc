@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <regex>
 
+#include <opencv2/core/utils/logger.hpp>
+
 #include "core/error.h"
 #include "core/image.h"
 
@@ -44,8 +46,17 @@ FrameSource::FrameSource(const std::string& input, double fps) : input_(input), 
   // FFmpeg logs every damaged packet on stderr ("[ffv1 @ 0x...] Slice pointer chain broken"); the error this class
   // throws says it in one line instead. OpenCV reads the level once, at its first FFmpeg use; a user's own setting wins.
   setenv("OPENCV_FFMPEG_LOGLEVEL", "-8" /* AV_LOG_QUIET */, 0);
-  if (!video_.open(input, cv::CAP_ANY) || !video_.isOpened())
-    throw InputError(input, "OpenCV's videoio cannot open it as a video");
+  // FFmpeg reads every video Debian's videoio does; trying every backend (CAP_ANY) on a file that is not a video makes
+  // GStreamer and the image-sequence reader print pages of warnings first. OpenCV's own log is quiet while opening.
+  const cv::utils::logging::LogLevel level = cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+  bool opened = false;
+  try {
+    opened = video_.open(input, cv::CAP_FFMPEG) && video_.isOpened();
+  } catch (const cv::Exception&) {
+    opened = false;
+  }
+  cv::utils::logging::setLogLevel(level);
+  if (!opened) throw InputError(input, "OpenCV's videoio (FFmpeg) cannot open it as a video");
   const double rate = video_.get(cv::CAP_PROP_FPS);
   if (rate > 0 && rate <= 1000) fps_ = rate;
   const double count = video_.get(cv::CAP_PROP_FRAME_COUNT);
