@@ -26,7 +26,7 @@ struct TrackRow {
 
 struct TrackBenchOptions {
   int frames = 12;
-  bool quick = false;      // 4 frames (a smoke run)
+  bool quick = false;      // the first 4 frames of the take (a smoke run, the same motion per frame)
   uint64_t seed = 1;
   std::function<void(const std::string&)> progress;
 };

@@ -231,12 +231,12 @@ void AddTrack(CLI::App& bench) {
       "(track), full detection on every frame (detect) and calib::Calibrate as `calibrate` does (calibrate). Each\n"
       "row: the frame's time (decoding timed apart), its pose and measurement parts, depth and blur errors against\n"
       "the truth. Targets: track's median <= 33 ms a frame and >= 6x faster than calibrate a frame.\n"
-      "analysis/track_chart.py charts time per frame against accuracy. --quick: 4 frames.");
+      "analysis/track_chart.py charts time per frame against accuracy. --quick: the first 4 frames of the take.");
   cmd->add_option("--out", args->out, "CSV, one row per (mode, frame)")->capture_default_str();
   cmd->add_option("--frames", args->frames, "frames in the take")->capture_default_str()->transform(IntRange(2, 1000));
   cmd->add_option("--seed", args->seed, "seed of the take's texture and noise")->capture_default_str()
       ->transform(SeedValidator());
-  cmd->add_flag("--quick", args->quick, "4 frames (smoke run)");
+  cmd->add_flag("--quick", args->quick, "the first 4 frames of the take (smoke run)");
   cmd->callback([args] {
     bench::TrackBenchOptions options;
     options.frames = args->frames;

@@ -1,5 +1,6 @@
 #include "track/tracker.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <utility>
@@ -58,7 +59,24 @@ std::optional<calib::BoardPose> Tracker::Track(const cv::Mat& grey8, const cv::M
       *note = "tracking lost: a predicted corner leaves the image";
       return std::nullopt;
     }
+  // A corner refined farther than a third of the closest spacing from where it was predicted may have slid to its
+  // neighbour's place; if all of them did, the pose fits as well as the true one, one square off. So a prediction
+  // is trusted only where the refinement confirms it.
+  const std::vector<cv::Point2f> predicted = corners;
+  const int nx = board_.InnerCornersX();
+  double spacing = 1e9;
+  for (size_t i = 0; i + 1 < predicted.size(); ++i)
+    if (int(i % nx) != nx - 1) spacing = std::min(spacing, double(cv::norm(predicted[i + 1] - predicted[i])));
+  for (size_t i = 0; i + nx < predicted.size(); ++i)
+    spacing = std::min(spacing, double(cv::norm(predicted[i + nx] - predicted[i])));
   calib::RefineCorners(grey8, board_, corners);
+  double moved = 0;
+  for (size_t i = 0; i < corners.size(); ++i) moved = std::max(moved, double(cv::norm(corners[i] - predicted[i])));
+  if (!(moved <= spacing / 3)) {
+    *note = "tracking lost: a corner refined " + Fixed(moved, 1) + " px from its prediction (> a third of the " +
+            Fixed(spacing, 1) + " px spacing)";
+    return std::nullopt;
+  }
   calib::BoardPose pose = calib::PoseFromCorners(std::move(corners), camera_, board_);
   // A corner that slid to a neighbour's place, or onto texture, leaves the pose's fit: the rms error shows it.
   if (!(pose.reprojection_error_px <= options_.max_track_error_px)) {
