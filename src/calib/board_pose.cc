@@ -57,6 +57,26 @@ double SolvePose(const std::vector<cv::Point2f>& corners, const Board& board, co
 
 }  // namespace
 
+void RefineCorners(const cv::Mat& grey8, const Board& board, std::vector<cv::Point2f>& corners) {
+  const int nx = board.InnerCornersX(), ny = board.InnerCornersY();
+  CV_Assert(int(corners.size()) == nx * ny);
+  // Wide enough for blurred corners, narrow enough not to reach the next corner.
+  double spacing = 1e9;
+  for (int iy = 0; iy < ny; ++iy)
+    for (int ix = 0; ix + 1 < nx; ++ix)
+      spacing = std::min(spacing, double(cv::norm(corners[iy * nx + ix + 1] - corners[iy * nx + ix])));
+  const int half = std::clamp(int(spacing / 4), 2, 40);
+  cv::cornerSubPix(grey8, corners, cv::Size(half, half), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 40, 0.01));
+}
+
+BoardPose PoseFromCorners(std::vector<cv::Point2f> corners, const Camera& camera, const Board& board) {
+  BoardPose pose;
+  pose.corners = std::move(corners);
+  pose.reprojection_error_px = SolvePose(pose.corners, board, camera, pose.rvec, pose.tvec);
+  return pose;
+}
+
 BoardPose FindBoardPose(const cv::Mat& grey8, const Camera& camera, const Board& board,
                         const DetectOptions& options) {
   CV_Assert(grey8.type() == CV_8UC1);
@@ -85,15 +105,7 @@ BoardPose FindBoardPose(const cv::Mat& grey8, const Camera& camera, const Board&
                                           std::to_string(nx) + "x" + std::to_string(ny) + " inner corners)");
   for (auto& p : found) p *= 1.0 / scale;
 
-  // Refine at full resolution with a window a quarter of the corner spacing: wide enough for blurred corners,
-  // narrow enough not to reach the next corner.
-  double spacing = 1e9;
-  for (int iy = 0; iy < ny; ++iy)
-    for (int ix = 0; ix + 1 < nx; ++ix)
-      spacing = std::min(spacing, double(cv::norm(found[iy * nx + ix + 1] - found[iy * nx + ix])));
-  const int half = std::clamp(int(spacing / 4), 2, 40);
-  cv::cornerSubPix(grey8, found, cv::Size(half, half), cv::Size(-1, -1),
-                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 40, 0.01));
+  RefineCorners(grey8, board, found);
 
   // OpenCV returns ny rows of nx corners in one of four orders; put them in the board frame: y (rows) away from
   // the camera so edge 1 is the nearest, x left to right in the image.

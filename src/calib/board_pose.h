@@ -26,6 +26,13 @@ struct DetectOptions {
 BoardPose FindBoardPose(const cv::Mat& grey8, const Camera& camera, const Board& board,
                         const DetectOptions& options = {});
 
+// Refines inner corners (board order, in place) at full resolution with a window a quarter of their closest spacing:
+// from a detector's rough places or a tracker's prediction.
+void RefineCorners(const cv::Mat& grey8, const Board& board, std::vector<cv::Point2f>& corners);
+
+// The pose from inner corners already in board order (a tracker's), with its RMS reprojection error.
+BoardPose PoseFromCorners(std::vector<cv::Point2f> corners, const Camera& camera, const Board& board);
+
 cv::Matx33d CameraMatrix(const Camera& camera);
 // Board-frame point (mm) -> camera frame (mm).
 cv::Vec3d ToCamera(const BoardPose& pose, const std::array<double, 3>& board_mm);

@@ -43,6 +43,19 @@ cv::Mat LinearGrey(const cv::Mat& photo) {
   return grey;
 }
 
+void ApplyModel(CalibResult& result, const optics::FittedModel& model) {
+  const optics::Lens lens = optics::Lens::FromCamera(result.camera);
+  result.model = model;
+  for (auto& edge : result.edges) {
+    edge.r_fitted_px = 0;
+    for (auto& s : edge.sections) {
+      s.r_fitted_px = model.PredictPx(lens, s.u_mm);
+      if (s.fit.ok) edge.r_fitted_px += s.r_fitted_px;
+    }
+    if (edge.usable > 0) edge.r_fitted_px /= edge.usable;
+  }
+}
+
 CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& board,
                       const CalibrateOptions& options) {
   if (photo.cols != camera.image_width_px || photo.rows != camera.image_height_px)
@@ -130,13 +143,11 @@ CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& b
         if (e.kind() != ErrorKind::kDomain) throw;
         s.estimated_note = e.what();
       }
-      s.r_fitted_px = result.model.PredictPx(lens, s.u_mm);
       if (s.fit.ok) {
         ++edge.usable;
         edge.r_px += s.fit.r_px;
         edge.r_thesis_px += s.thesis.r_px;
         if (s.r_estimated_px) ++edge.estimated, edge.r_estimated_px += *s.r_estimated_px;
-        edge.r_fitted_px += s.r_fitted_px;
       }
     }
     edge.u_mm = su / edge.sections.size();
@@ -144,9 +155,9 @@ CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& b
       edge.r_px /= edge.usable;
       edge.r_thesis_px /= edge.usable;
       if (edge.estimated > 0) edge.r_estimated_px /= edge.estimated;
-      edge.r_fitted_px /= edge.usable;
     }
   }
+  ApplyModel(result, result.model);
   result.estimate_ms = MsSince(t0);
   return result;
 }

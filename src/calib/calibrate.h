@@ -70,6 +70,10 @@ cv::Mat LinearGrey(const cv::Mat& photo);
 CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& board,
                       const CalibrateOptions& options = {});
 
+// Makes `model` the result's thin-lens model: every section's r_fitted_px and every edge's mean follow it (a tracked
+// take's one lens model replacing each frame's own).
+void ApplyModel(CalibResult& result, const optics::FittedModel& model);
+
 // calib.json: camera, board, pose, reference edge, fitted model, and 11 edges x 7 sections with u_mm, r_px,
 // r_thesis_px, r_estimated_px, r_fitted_px, ok (and flags, psf, fit quality).
 Json CalibToJson(const CalibResult& result);

@@ -25,8 +25,10 @@ int main(int argc, char** argv) {
   const std::vector<std::pair<const char*, void (*)(CLI::App&)>> commands = {
       {"init", &cli::AddInitCommand},
       {"synth-scene", &cli::AddSynthSceneCommand},
+      {"synth-take", &cli::AddSynthTakeCommand},
       {"camera", &cli::AddCameraCommand},
       {"calibrate", &cli::AddCalibrateCommand},
+      {"track", &cli::AddTrackCommand},
       {"estimate", &cli::AddEstimateCommand},
       {"make-stimuli", &cli::AddMakeStimuliCommand},
       {"synth-pictures", &cli::AddSynthPicturesCommand},

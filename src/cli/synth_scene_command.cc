@@ -10,6 +10,7 @@
 #include <string>
 
 #include "cli/commands.h"
+#include "cli/scene_option_error.h"
 #include "core/camera.h"
 #include "core/error.h"
 #include "core/typed.h"
@@ -30,9 +31,12 @@ double ParseFocus(const std::string& text) {
   throw UsageError("--focus-mm", "must be a distance in (0, 1000000] mm or 'inf', got " + Echo(text));
 }
 
-// RenderScene names SceneOptions fields; say them as the options a user typed.
-Error AsOptionError(const Error& e) {
-  static const std::map<std::string, std::string> kOptions = {
+}  // namespace
+
+// RenderScene names SceneOptions fields; say them as the options a user typed (`renamed` adds or overrides names:
+// synth-take's).
+Error AsSceneOptionError(const Error& e, const std::map<std::string, std::string>& renamed) {
+  std::map<std::string, std::string> options = {
       {"tilt_deg", "--tilt-deg"},       {"edge1_u_mm", "--edge1-u-mm"}, {"lateral_mm", "--lateral-mm"},
       {"yaw_deg", "--yaw-deg"},         {"focus_mm", "--focus-mm"},     {"fixed_r_px", "--fixed-r-px"},
       {"blur_gain", "--blur-gain"},     {"white", "--white"},           {"black", "--black"},
@@ -40,16 +44,16 @@ Error AsOptionError(const Error& e) {
       {"flaws", "--flaws"},             {"supersample", "--supersample"}, {"board", "--board"},
       {"floor_sigma_px", "--floor-sigma-px"}, {"vignetting", "--vignetting"},
   };
+  for (const auto& [field, option] : renamed) options[field] = option;
   const std::string message = e.what();
   const size_t colon = message.find(':');
   if (e.kind() == ErrorKind::kInput && colon != std::string::npos) {
-    auto it = kOptions.find(message.substr(0, colon));
-    if (it != kOptions.end()) return Error(ErrorKind::kUsage, it->second + message.substr(colon));
+    auto it = options.find(message.substr(0, colon));
+    if (it != options.end()) return Error(ErrorKind::kUsage, it->second + message.substr(colon));
   }
   return e;
 }
 
-}  // namespace
 
 void AddSynthSceneCommand(CLI::App& app) {
   struct Args {
@@ -177,7 +181,7 @@ void AddSynthSceneCommand(CLI::App& app) {
     try {
       scene = synth::RenderScene(o);
     } catch (const Error& e) {
-      throw AsOptionError(e);
+      throw AsSceneOptionError(e);
     }
     const double render_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     synth::WriteScene(scene, args->out);

@@ -277,6 +277,7 @@ Json OptionsToJson(const SceneOptions& o) {
   j["jpeg_quality"] = o.jpeg_quality;
   j["flaws"] = o.flaws;
   j["seed"] = o.seed;
+  if (o.noise_seed) j["noise_seed"] = *o.noise_seed;
   j["supersample"] = o.supersample;
   j["floor_sigma_px"] = o.floor_sigma_px;
   j["vignetting"] = o.vignetting;
@@ -536,8 +537,8 @@ Scene RenderScene(const SceneOptions& o) {
   }
 
   Scene scene;
-  scene.image = Finish(linear, o, Rng(o.seed, kNoiseStream));
-  scene.image_no_board = Finish(linear_no_board, o, Rng(o.seed, kNoiseNoBoardStream));
+  scene.image = Finish(linear, o, Rng(o.noise_seed.value_or(o.seed), kNoiseStream));
+  scene.image_no_board = Finish(linear_no_board, o, Rng(o.noise_seed.value_or(o.seed), kNoiseNoBoardStream));
   scene.camera = cam;
   scene.board = board;
   cv::Vec3d rvec;

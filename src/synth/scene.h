@@ -45,6 +45,8 @@ struct SceneOptions {
   int jpeg_quality = 0;        // 0: none; 1..100: JPEG round trip before writing PNG
   int flaws = 0;               // dark printing spots on white squares near edges (thesis Fig. 4.15)
   uint64_t seed = 1;
+  // Seed of the sensor noise alone (empty: `seed`): a take's frames share the table and flaws but not the noise.
+  std::optional<uint64_t> noise_seed;
   int supersample = 4;         // sub-pixels per pixel side for anti-aliasing and the PSF
 };
 

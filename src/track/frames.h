@@ -1,0 +1,45 @@
+#pragma once
+// The frames of a take: a video file (whatever OpenCV's videoio reads) or an image sequence named by a printf
+// pattern (frames/frame-%04d.png, numbered from 0).
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
+
+namespace blurcue::track {
+
+class FrameSource {
+ public:
+  // `fps` gives the frames' times for an image sequence (a video's own rate is used when it states one).
+  // Throws Error(kUsage) for a pattern with other than one integer conversion, Error(kInput) for a video that
+  // cannot be opened or a sequence whose first frame is missing.
+  FrameSource(const std::string& input, double fps);
+
+  // The next frame (8-bit BGR) with its index and time; false at the clean end of the take. Throws Error(kInput)
+  // naming the input and the frame for a damaged or truncated video, a missing frame inside a sequence, or an
+  // unreadable image.
+  bool Next(cv::Mat* frame, int* index, double* time_s);
+
+  bool is_video() const { return !pattern_; }
+  double fps() const { return fps_; }
+  // Frames the video's header promises (0 when it does not say, or for a sequence).
+  int expected_frames() const { return expected_; }
+
+ private:
+  std::string input_;
+  std::optional<std::string> pattern_;
+  cv::VideoCapture video_;
+  double fps_ = 30;
+  int expected_ = 0;
+  int next_ = 0;
+};
+
+// True when `input` is a printf pattern (holds a '%'), i.e. an image sequence.
+bool IsFramePattern(const std::string& input);
+// The pattern's file for frame `index`; Error(kUsage) unless the pattern has exactly one %d-style conversion.
+std::filesystem::path PatternFile(const std::string& pattern, int index);
+
+}  // namespace blurcue::track

@@ -1,0 +1,119 @@
+#include "track/take.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/json_io.h"
+
+namespace blurcue::track {
+namespace {
+
+std::string Number(double v, int digits) {
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*f", digits, v);
+  return text;
+}
+
+}  // namespace
+
+const std::vector<TrackColumn> kTrackColumns = {
+    {"frame", "frame index from 0"},
+    {"time_s", "frame time: index / frame rate (the video's own rate, or --fps for a sequence)"},
+    {"status", "found (full detection), tracked (carried from the previous frames) or lost (no pose)"},
+    {"reprojection_error_px", "RMS distance of the inner corners from the solved pose's projection, px"},
+    {"rvec_x", "pose rotation (Rodrigues vector, board frame -> camera), rad"},
+    {"rvec_y", ""},
+    {"rvec_z", ""},
+    {"tvec_x_mm", "board origin in the camera frame, mm"},
+    {"tvec_y_mm", ""},
+    {"tvec_z_mm", ""},
+    {"focus_mm", "the take's lens model: focus distance, mm (inf: at infinity)"},
+    {"aperture_mm", "the take's lens model: effective aperture diameter, mm"},
+    {"floor_px", "the take's lens model: blur floor added in quadrature, px (0: the thin lens alone was kept)"},
+    {"usable_sections", "edge sections whose blur measurement is usable"},
+    {"pose_ms", "time spent tracking (or detecting) and solving the pose, ms"},
+    {"measure_ms", "time spent measuring every section's blur and the frame's estimates, ms"},
+    {"frame_ms", "all of the frame's work (decoding excluded), ms"},
+    {"note", "why tracking fell back to detection, or why the frame is lost"},
+};
+
+std::string CalibFileName(int index) {
+  char name[32];
+  std::snprintf(name, sizeof name, "calib-%04d.json", index);
+  return name;
+}
+
+TakeResult TrackTake(FrameSource& source, Tracker& tracker, const std::function<void(const FrameResult&)>& progress) {
+  TakeResult take;
+  cv::Mat frame;
+  int index = 0;
+  double time_s = 0;
+  for (;;) {
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      if (!source.Next(&frame, &index, &time_s)) break;
+      take.decode_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      take.frames.push_back(tracker.Process(frame, index, time_s));
+    } catch (const Error& e) {
+      if (e.kind() != ErrorKind::kInput) throw;
+      take.error = e;
+      break;
+    }
+    const FrameResult& r = take.frames.back();
+    switch (r.status) {
+      case FrameStatus::kFound: ++take.found; break;
+      case FrameStatus::kTracked: ++take.tracked; break;
+      case FrameStatus::kLost: ++take.lost; break;
+    }
+    if (progress) progress(r);
+  }
+  try {
+    take.model = FitTakeModel(take.frames);
+  } catch (const Error& e) {
+    if (e.kind() != ErrorKind::kNotFound) throw;
+    if (!take.error) take.error = e;
+  }
+  return take;
+}
+
+void WriteTake(const TakeResult& take, const std::filesystem::path& dir, const std::string& input) {
+  std::filesystem::create_directories(dir);
+  std::ostringstream csv;
+  for (size_t i = 0; i < kTrackColumns.size(); ++i) csv << (i ? "," : "") << kTrackColumns[i].name;
+  csv << "\n";
+  for (const FrameResult& f : take.frames) {
+    csv << f.index << "," << Number(f.time_s, 6) << "," << Name(f.status) << ",";
+    if (f.calib) {
+      const calib::CalibResult& c = *f.calib;
+      csv << Number(c.pose.reprojection_error_px, 4);
+      for (int k = 0; k < 3; ++k) csv << "," << Number(c.pose.rvec[k], 8);
+      for (int k = 0; k < 3; ++k) csv << "," << Number(c.pose.tvec[k], 4);
+      int usable = 0;
+      for (const auto& e : c.edges) usable += e.usable;
+      csv << "," << Number(c.model.focus_mm, 3) << "," << Number(c.model.aperture_mm, 5) << ","
+          << Number(c.model.floor_px, 4) << "," << usable;
+      Json json = calib::CalibToJson(c);
+      json["photo"] = input;
+      json["frame"] = f.index;
+      json["time_s"] = f.time_s;
+      json["track_status"] = Name(f.status);
+      json["lens_model"] = "one model for the whole take (fixed focus and aperture): fitted to every usable section "
+                           "of every frame";
+      WriteJsonFile(dir / CalibFileName(f.index), json);
+    } else {
+      csv << ",,,,,,,,,,0";  // no pose, no model for this frame
+    }
+    std::string note = f.note;
+    for (char& ch : note)
+      if (ch == '"') ch = '\'';
+    csv << "," << Number(f.pose_ms, 2) << "," << Number(f.measure_ms, 2) << "," << Number(f.frame_ms, 2) << ",\""
+        << note << "\"\n";
+  }
+  WriteFileAtomically(dir / "track.csv", csv.str());
+}
+
+}  // namespace blurcue::track

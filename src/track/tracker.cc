@@ -1,0 +1,164 @@
+#include "track/tracker.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <utility>
+
+#include <opencv2/imgproc.hpp>
+
+#include "calib/board_pose.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "optics/thin_lens.h"
+
+namespace blurcue::track {
+namespace {
+
+constexpr int kSmallFactor = 4;  // the copy the frame-to-frame shift is found on: a quarter of each side
+
+double MsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::string Fixed(double v, int digits) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*f", digits, v);
+  return text;
+}
+
+}  // namespace
+
+const char* Name(FrameStatus status) {
+  switch (status) {
+    case FrameStatus::kFound: return "found";
+    case FrameStatus::kTracked: return "tracked";
+    case FrameStatus::kLost: return "lost";
+  }
+  return "lost";
+}
+
+Tracker::Tracker(Camera camera, Board board, TrackOptions options)
+    : camera_(std::move(camera)), board_(std::move(board)), options_(std::move(options)) {}
+
+std::optional<calib::BoardPose> Tracker::Track(const cv::Mat& grey8, const cv::Mat& small, std::string* note) const {
+  if (last_.empty()) return std::nullopt;
+  // Constant velocity in the image: smooth camera motion moves each corner nearly as it did a frame ago, far more
+  // exactly than the refinement window (a quarter of a square) needs. With one frame of history there is no
+  // velocity yet: the whole image's shift from that frame (phase correlation at a quarter size) stands in.
+  std::vector<cv::Point2f> corners = last_;
+  if (!before_last_.empty()) {
+    for (size_t i = 0; i < corners.size(); ++i) corners[i] += last_[i] - before_last_[i];
+  } else if (!last_small_.empty() && last_small_.size() == small.size()) {
+    const cv::Point2d shift = cv::phaseCorrelate(last_small_, small) * double(kSmallFactor);
+    for (cv::Point2f& p : corners) p += cv::Point2f(float(shift.x), float(shift.y));
+  }
+  const cv::Rect2f inside(2, 2, grey8.cols - 5, grey8.rows - 5);
+  for (const cv::Point2f& p : corners)
+    if (!inside.contains(p)) {
+      *note = "tracking lost: a predicted corner leaves the image";
+      return std::nullopt;
+    }
+  // A corner refined farther than a third of the closest spacing from where it was predicted may have slid to its
+  // neighbour's place; if all of them did, the pose fits as well as the true one, one square off. So a prediction
+  // is trusted only where the refinement confirms it.
+  const std::vector<cv::Point2f> predicted = corners;
+  const int nx = board_.InnerCornersX();
+  double spacing = 1e9;
+  for (size_t i = 0; i + 1 < predicted.size(); ++i)
+    if (int(i % nx) != nx - 1) spacing = std::min(spacing, double(cv::norm(predicted[i + 1] - predicted[i])));
+  for (size_t i = 0; i + nx < predicted.size(); ++i)
+    spacing = std::min(spacing, double(cv::norm(predicted[i + nx] - predicted[i])));
+  calib::RefineCorners(grey8, board_, corners);
+  double moved = 0;
+  for (size_t i = 0; i < corners.size(); ++i) moved = std::max(moved, double(cv::norm(corners[i] - predicted[i])));
+  if (!(moved <= spacing / 3)) {
+    *note = "tracking lost: a corner refined " + Fixed(moved, 1) + " px from its prediction (> a third of the " +
+            Fixed(spacing, 1) + " px spacing)";
+    return std::nullopt;
+  }
+  calib::BoardPose pose = calib::PoseFromCorners(std::move(corners), camera_, board_);
+  // A corner that slid to a neighbour's place, or onto texture, leaves the pose's fit: the rms error shows it.
+  if (!(pose.reprojection_error_px <= options_.max_track_error_px)) {
+    *note = "tracking lost: reprojection error " + Fixed(pose.reprojection_error_px, 2) + " px > " +
+            Fixed(options_.max_track_error_px, 2) + " px";
+    return std::nullopt;
+  }
+  return pose;
+}
+
+FrameResult Tracker::Process(const cv::Mat& photo, int index, double time_s) {
+  const auto t0 = std::chrono::steady_clock::now();
+  FrameResult r;
+  r.index = index;
+  r.time_s = time_s;
+  if (photo.cols != camera_.image_width_px || photo.rows != camera_.image_height_px)
+    throw InputError("frame " + std::to_string(index),
+                     "is " + std::to_string(photo.cols) + "x" + std::to_string(photo.rows) + " but the camera says " +
+                         std::to_string(camera_.image_width_px) + "x" + std::to_string(camera_.image_height_px));
+  const cv::Mat grey8 = ToGrey8(photo);
+  cv::Mat small;
+  if (!options_.always_detect) {
+    cv::resize(grey8, small, cv::Size(), 1.0 / kSmallFactor, 1.0 / kSmallFactor, cv::INTER_AREA);
+    small.convertTo(small, CV_32F);
+  }
+  std::optional<calib::BoardPose> pose;
+  if (!options_.always_detect) pose = Track(grey8, small, &r.note);
+  r.status = FrameStatus::kTracked;
+  if (!pose) {
+    r.status = FrameStatus::kFound;
+    try {
+      pose = calib::FindBoardPose(grey8, camera_, board_, options_.calibrate.detect);
+    } catch (const Error& e) {
+      if (e.kind() != ErrorKind::kNotFound) throw;
+      r.status = FrameStatus::kLost;
+      r.note = r.note.empty() ? e.what() : r.note + "; " + e.what();
+    }
+  }
+  r.pose_ms = MsSince(t0);
+  if (!pose) {
+    before_last_.clear();
+    last_.clear();
+    last_small_.release();
+    r.frame_ms = MsSince(t0);
+    return r;
+  }
+  before_last_ = std::exchange(last_, pose->corners);
+  last_small_ = small;
+
+  const auto t1 = std::chrono::steady_clock::now();
+  calib::CalibrateOptions options = options_.calibrate;
+  options.known_pose = *pose;
+  try {
+    r.calib = calib::Calibrate(photo, camera_, board_, options);
+    r.calib->detect_ms = r.pose_ms;
+  } catch (const Error& e) {
+    // The board is there but its blur is not measurable (the reference edge or the whole board flagged).
+    if (e.kind() != ErrorKind::kNotFound) throw;
+    r.status = FrameStatus::kLost;
+    r.note = e.what();
+  }
+  r.measure_ms = MsSince(t1);
+  r.frame_ms = MsSince(t0);
+  return r;
+}
+
+optics::FittedModel FitTakeModel(std::vector<FrameResult>& frames, const optics::FitOptions& options) {
+  std::vector<optics::BlurSample> samples;
+  const calib::CalibResult* any = nullptr;
+  for (const FrameResult& f : frames) {
+    if (!f.calib) continue;
+    any = &*f.calib;
+    for (const auto& edge : f.calib->edges)
+      for (const auto& s : edge.sections)
+        if (s.fit.ok) samples.push_back({s.u_mm, s.fit.r_px, 1.0});
+  }
+  if (!any) throw Error(ErrorKind::kNotFound, "no frame of the take has a calibration (the board was never found)");
+  const optics::FittedModel model =
+      optics::FitThinLens(optics::Lens::FromCamera(any->camera), samples, options);
+  for (FrameResult& f : frames)
+    if (f.calib) calib::ApplyModel(*f.calib, model);
+  return model;
+}
+
+}  // namespace blurcue::track

@@ -1,0 +1,149 @@
+// Tracking against a ground-truth moving-camera take (src/synth/take.h): a fixed-focus lens with a floor, focused
+// inside the board, on a camera moving closer and sideways; every frame's pose and per-section blur are known from
+// the kernels the renderer applied.
+#include "track/tracker.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "calib/truth.h"
+#include "core/error.h"
+#include "synth/take.h"
+
+namespace blurcue::track {
+namespace {
+
+synth::TakeOptions TestTake() {
+  // 12 frames, edge 1 from 440 to 360 mm, 50 mm sideways, focus 450 mm (inside the board), floor 0.35 px: true r
+  // 0.7-1.5 px. No sensor noise: at these radii the measurement itself (calibrate's, identical here) misses the
+  // issue's 3 % / 8 % with noise 0.004 (medians 2.5-4.2 %, p90 up to 14 % on a 2 x 2 supersampled take), so this
+  // test holds the tracking to the numbers where the measurement can meet them.
+  synth::TakeOptions o;
+  o.scene.seed = 5;
+  return o;
+}
+
+struct Tracked {
+  std::vector<synth::TakeFrame> frames;
+  std::vector<FrameResult> results;
+  optics::FittedModel model;
+};
+
+// Rendering the take takes tens of seconds: once per test binary.
+const Tracked& TrackedTake() {
+  static const Tracked tracked = [] {
+    Tracked t;
+    const synth::TakeOptions o = TestTake();
+    for (int i = 0; i < o.frames; ++i) t.frames.push_back(synth::RenderTakeFrame(o, i));
+    Tracker tracker(t.frames[0].scene.camera, t.frames[0].scene.board, TrackOptions{});
+    for (const auto& f : t.frames) t.results.push_back(tracker.Process(f.scene.image, f.index, f.time_s));
+    t.model = FitTakeModel(t.results);
+    return t;
+  }();
+  return tracked;
+}
+
+TEST(Tracker, FirstFrameFoundEveryOtherTracked) {
+  const Tracked& t = TrackedTake();
+  ASSERT_EQ(t.results.size(), 12u);
+  EXPECT_EQ(t.results[0].status, FrameStatus::kFound);
+  for (size_t i = 1; i < t.results.size(); ++i)
+    EXPECT_EQ(t.results[i].status, FrameStatus::kTracked) << "frame " << i << ": " << t.results[i].note;
+  for (const auto& r : t.results) EXPECT_TRUE(r.calib.has_value()) << "frame " << r.index;
+}
+
+TEST(Tracker, SectionDepthsWithinATenthOfAPercent) {
+  const Tracked& t = TrackedTake();
+  for (size_t i = 0; i < t.results.size(); ++i) {
+    ASSERT_TRUE(t.results[i].calib) << "frame " << i;
+    const calib::CalibResult& c = *t.results[i].calib;
+    const auto& truth = t.frames[i].scene.sections;
+    size_t k = 0;
+    for (const auto& edge : c.edges)
+      for (const auto& s : edge.sections) {
+        ASSERT_LT(k, truth.size());
+        EXPECT_LE(std::abs(s.u_mm - truth[k].u_mm) / truth[k].u_mm, 0.001)
+            << "frame " << i << " edge " << s.edge << " section " << s.section;
+        ++k;
+      }
+  }
+}
+
+TEST(Tracker, EveryFramesBlurWithinThreePercentMedianEightP90) {
+  const Tracked& t = TrackedTake();
+  for (size_t i = 0; i < t.results.size(); ++i) {
+    ASSERT_TRUE(t.results[i].calib) << "frame " << i;
+    const calib::TruthComparison cmp = calib::CompareToTruth(*t.results[i].calib, t.frames[i].scene.truth, "truth");
+    const calib::MethodSummary m = calib::SummarizeMethod(cmp, &calib::SectionComparison::model);
+    std::printf("frame %2zu: %d/%d sections, r_px |error|/r median %.4f p90 %.4f; pose %.3f mm %.4f deg\n", i,
+                m.answered, m.sections, m.median_rel_error, m.p90_rel_error, cmp.translation_error_mm,
+                cmp.rotation_error_deg);
+    EXPECT_GE(m.answered, m.sections * 9 / 10) << "frame " << i;
+    EXPECT_LE(m.median_rel_error, 0.03) << "frame " << i;
+    EXPECT_LE(m.p90_rel_error, 0.08) << "frame " << i;
+  }
+}
+
+TEST(Tracker, TakeModelIsEveryFramesModel) {
+  const Tracked& t = TrackedTake();
+  const optics::Lens lens = optics::Lens::FromCamera(t.frames[0].scene.camera);
+  for (const auto& r : t.results) {
+    ASSERT_TRUE(r.calib);
+    EXPECT_EQ(r.calib->model.focus_mm, t.model.focus_mm);
+    EXPECT_EQ(r.calib->model.aperture_mm, t.model.aperture_mm);
+    for (const auto& e : r.calib->edges)
+      for (const auto& s : e.sections) EXPECT_DOUBLE_EQ(s.r_fitted_px, t.model.PredictPx(lens, s.u_mm));
+  }
+  std::printf("take model %s: focus %.1f mm (true 450), aperture %.3f mm (nominal %.3f), floor %.3f px, rms %.3f px\n",
+              t.model.kind.c_str(), t.model.focus_mm, t.model.aperture_mm, lens.aperture_mm, t.model.floor_px,
+              t.model.rms_px);
+}
+
+// A frame without the board (the same view, board removed) is lost, and the next frame is found again by a full
+// detection: tracking does not carry a stale pose over a gap.
+TEST(Tracker, FrameWithoutBoardIsLostAndTheNextIsFoundAgain) {
+  const Tracked& t = TrackedTake();
+  Tracker tracker(t.frames[0].scene.camera, t.frames[0].scene.board, TrackOptions{});
+  EXPECT_EQ(tracker.Process(t.frames[0].scene.image, 0, 0).status, FrameStatus::kFound);
+  EXPECT_EQ(tracker.Process(t.frames[1].scene.image, 1, 0).status, FrameStatus::kTracked);
+  const FrameResult lost = tracker.Process(t.frames[2].scene.image_no_board, 2, 0);
+  EXPECT_EQ(lost.status, FrameStatus::kLost);
+  EXPECT_FALSE(lost.calib.has_value());
+  EXPECT_NE(lost.note.find("no 7x10 checkerboard found"), std::string::npos) << lost.note;
+  EXPECT_EQ(tracker.Process(t.frames[3].scene.image, 3, 0).status, FrameStatus::kFound);
+}
+
+// Every third frame of the take: three times the motion the velocity was learnt from. A corner that would slide to
+// its neighbour (the pose one square off, with as small a reprojection error) makes the frame fall back to a full
+// detection; whatever the status, every pose is the true one.
+TEST(Tracker, LargeMotionNeverGivesAPoseOneSquareOff) {
+  const Tracked& t = TrackedTake();
+  Tracker tracker(t.frames[0].scene.camera, t.frames[0].scene.board, TrackOptions{});
+  for (size_t i = 0; i < t.frames.size(); i += 3) {
+    const FrameResult r = tracker.Process(t.frames[i].scene.image, int(i), 0);
+    ASSERT_TRUE(r.calib) << "frame " << i << ": " << r.note;
+    const calib::TruthComparison cmp = calib::CompareToTruth(*r.calib, t.frames[i].scene.truth, "truth");
+    EXPECT_LT(cmp.translation_error_mm, 0.5) << "frame " << i << " (" << Name(r.status) << ")";
+  }
+}
+
+TEST(Tracker, FrameOfAnotherSizeIsAnInputError) {
+  const Tracked& t = TrackedTake();
+  Tracker tracker(t.frames[0].scene.camera, t.frames[0].scene.board, TrackOptions{});
+  cv::Mat small(100, 100, CV_8UC3, cv::Scalar(0, 0, 0));
+  try {
+    tracker.Process(small, 4, 0);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    EXPECT_NE(std::string(e.what()).find("frame 4: is 100x100 but the camera says 1148x764"), std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace blurcue::track
