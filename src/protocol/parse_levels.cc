@@ -22,6 +22,12 @@ void Parser::CheckReadName(const std::string& name, const std::string& what, con
     Problem(ptr, where + "a label needs a name after label_ (e.g. label_stim_id)");
     return;
   }
+  // A label's name becomes a column of the tables and a heading of the report: refused as any other name would be
+  // when it holds a bidirectional control (label_\u202Ex read backwards) or could run as a spreadsheet formula.
+  if (const std::string why = UnsafeIdReason(name); !why.empty()) {
+    Problem(ptr, where + "the " + what + " name " + Echo(name) + " " + why);
+    return;
+  }
   if (IsValueName(name) || IsLabelName(name)) return;
   // A name with a space at either end ("edge " from a CSV header) is quoted and said to be so: it used to read
   // "a column edge  (did you mean edge?)", the difference invisible.
@@ -110,6 +116,8 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
     // A factor's name is what reads its levels (edge, speed_cm_s, ...), unless its levels are objects whose keys are.
     if (!std::all_of(levels.begin(), levels.end(), [](const Json& level) { return level.is_object(); }))
       CheckReadName(name, "factor", fp);
+    else if (const std::string why = UnsafeIdReason(name); !why.empty())
+      Problem(fp, "the factor name " + Echo(name) + " " + why);
     Factor f{name, {}};
     bool sides = false;
     std::set<std::string> keys_checked;  // an object level's key is named once, at the first level that has it
