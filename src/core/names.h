@@ -6,7 +6,8 @@
 
 namespace blurcue {
 
-// Levenshtein distance between `a` and `b` (insertions, deletions, substitutions of one byte each).
+// Edit distance between `a` and `b`: insertions, deletions, substitutions of one byte and swaps of two
+// neighbouring bytes each count one (optimal string alignment), so "gird" is one slip from "grid".
 size_t EditDistance(const std::string& a, const std::string& b);
 
 // The candidate `name` was probably meant to be, "" when none is near: first one that differs only in case
