@@ -243,12 +243,22 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
     return {};
   }
   const std::vector<std::string>& header = rows.front().fields;
+  // A spreadsheet set to another list separator (a German or French Excel's "CSV") writes ';' or a tab: the header
+  // is then one column "edge;left;right", which was refused as a misspelt name to be recorded as label_edge;left;right.
+  if (header.size() == 1)
+    for (const char separator : {';', '\t'})
+      if (header.front().find(separator) != std::string::npos) {
+        Problem(ptr, at(rows.front().line, 0) + ": has one column, " + Echo(header.front()) + "; the columns of a "
+                         "conditions table are separated by commas, and this one uses " +
+                         (separator == ';' ? "';'" : "tabs") + " (save it as CSV with commas)", Json(*text));
+        return {};
+      }
   std::set<std::string> names;
   for (size_t c = 0; c < header.size(); ++c) {
     const std::string& name = header[c];
     if (name.empty() || Utf8Length(name) > kMaxNameChars || !IsPrintableUtf8(name) || !names.insert(name).second) {
-      Problem(ptr, at(rows.front().line, c + 1) + ": the header must name each column once, 1-100 characters, got " +
-                       Json(name).dump(-1, ' ', false, Json::error_handler_t::replace), Json(*text));
+      Problem(ptr, at(rows.front().line, c + 1) + " (" + Echo(name) + "): the header must name each column once, "
+                       "1-100 characters", Json(*text));
       return {};
     }
   }
