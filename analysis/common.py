@@ -1,4 +1,5 @@
 """Shared helpers of the analysis scripts: reading trials.csv, the chart record, the paper style, saving figures."""
+import contextlib
 import hashlib
 import json
 import math
@@ -319,14 +320,29 @@ def file_stem(name):
     return stem.lstrip(".")[:191] + "-" + hashlib.sha1(name.encode("utf-8")).hexdigest()[:8]
 
 
+@contextlib.contextmanager
+def writing(path):
+    """Names PATH in an OSError raised while it is written: a full disk fails a file's write or close with no file
+    name (a real 2 MiB tmpfs gave "report: cannot write (No space left on device)", naming nothing)."""
+    try:
+        yield
+    except OSError as e:
+        if e.filename:
+            raise
+        raise OSError(e.errno, e.strerror or str(e), path) from e
+
+
 def save(fig, out_dir, name):
     """Writes file_stem(NAME).png and .svg into out_dir; returns their paths and closes the figure."""
     os.makedirs(out_dir, exist_ok=True)
     png = os.path.join(out_dir, file_stem(name) + ".png")
     svg = os.path.join(out_dir, file_stem(name) + ".svg")
-    fig.savefig(png, bbox_inches="tight")
-    fig.savefig(svg, bbox_inches="tight")
-    plt.close(fig)
+    try:
+        for path in (png, svg):
+            with writing(path):
+                fig.savefig(path, bbox_inches="tight")
+    finally:
+        plt.close(fig)
     return png, svg
 
 

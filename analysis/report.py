@@ -120,7 +120,7 @@ def write_index(out_dir, sections, header, name="index.html", title="blurcue ana
                 parts.append(f"<div class='scroll'>{table}</div>")
     parts.append("</body></html>")
     path = os.path.join(out_dir, name)
-    with open(path, "w", encoding="utf-8") as f:
+    with common.writing(path), open(path, "w", encoding="utf-8") as f:
         f.write("\n".join(parts) + "\n")
     return path
 
@@ -464,7 +464,9 @@ def _main(argv=None):
         charts = [c._replace(notes=[shown_text(n) for n in c.notes]) if c.notes else c for c in charts]
         for c in charts:
             if c.table is not None and not c.table.empty:
-                c.table.to_csv(os.path.join(args.out, file_stem(c.name) + ".csv"), index=False)
+                table = os.path.join(args.out, file_stem(c.name) + ".csv")
+                with common.writing(table):
+                    c.table.to_csv(table, index=False)
         sections.append((title, charts, skips))
 
     say(f"[{total}/{total}] index.html ...")

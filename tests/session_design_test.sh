@@ -485,7 +485,26 @@ missing = [l for l in links if not os.path.isfile(os.path.join(d, l))]
 assert not missing, missing
 assert not any(os.path.isdir(os.path.join(d, e)) and e not in ("tables",) for e in os.listdir(d)), os.listdir(d)
 PYEOF
-  echo "ok: labels and ids with '/' report (exit 0), kept verbatim; a factor side/pair, ids Infinity, nan, 1e308 and 2^64 - 1 and a participant NA refused" ;;
+  # One such session inside a merged record: merged with another station's record (test 1, one session completed and
+  # one killed), the whole record still reports (exit 0), the '/' names verbatim beside test 1's rows.
+  $BC run "$P/test1-static-grids.json" --participant P1 --db "$W/other.sqlite" --observer sim > /dev/null 2>&1 ||
+    fail "run test 1"
+  $BC run "$P/test1-static-grids.json" --participant P2 --db "$W/other.sqlite" --observer sim --stop-after 4 \
+    > /dev/null 2>&1 || fail "run test 1, stopped"
+  $BC merge "$W/s.sqlite" "$W/other.sqlite" --out "$W/merged.sqlite" > "$W/out" 2>&1 || fail "merge: $(tail -1 "$W/out")"
+  code=0
+  MPLCONFIGDIR=$W/mpl $BC report --db "$W/merged.sqlite" --out "$W/merged-report" --bench "$W/no-bench" --boot 20 \
+    > "$W/out" 2>&1 || code=$?
+  [ "$code" = 0 ] || fail "report of a merged record holding names with '/': exit $code: $(tail -3 "$W/out")"
+  grep -qF "m/e" "$W/merged-report/index.html" || fail "the merged record's page does not show m/e verbatim"
+  $PY - "$W/merged-report/tables/trials.csv" <<'PYEOF' || fail "the merged record's trials.csv"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+studies = {r["study"] for r in rows}
+assert studies == {"slash-factor", "slash-table", "test1-static-grids"}, studies
+assert {r["label_a/b"] for r in rows if r["study"] == "slash-factor"} == {"p/q", "r/s"}
+PYEOF
+  echo "ok: labels and ids with '/' report (exit 0), kept verbatim, alone and merged with another station's record; a factor side/pair, ids Infinity, nan, 1e308 and 2^64 - 1 and a participant NA refused" ;;
 collided_names)
   # Two design variables recorded in one column are refused by validate (with and without --no-files) and by run,
   # naming both, before anything is recorded (issue 24: a factor status and a factor factor_status validated, and

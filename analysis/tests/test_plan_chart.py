@@ -116,6 +116,20 @@ class PlanChartTest(unittest.TestCase):
             self.assertEqual(err.getvalue().strip(),
                              f"plan_chart: {d}/power.png: cannot write the chart (No space left on device)")
 
+    def test_a_full_disk_is_exit_3_naming_the_file_it_could_not_write(self):
+        # A real ENOSPC: power.png is a link to /dev/full, which fails every write at flush, with no file name in the
+        # error (as a full 2 MiB tmpfs did: the message named only the folder). The line names power.png.
+        plan_chart.common.save = self.saved  # the real save, not the test's stand-in
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "plan.csv")
+            plan_rows().to_csv(path, index=False)
+            os.symlink("/dev/full", os.path.join(d, "power.png"))
+            err = io.StringIO()
+            with contextlib.redirect_stderr(err):
+                self.assertEqual(plan_chart.main(["--plan", path, "--out", d]), 3)
+            self.assertEqual(err.getvalue().strip(),
+                             f"plan_chart: {d}/power.png: cannot write the chart (No space left on device)")
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -172,6 +172,15 @@ class EdgeCaseTest(ReportTestCase):
         self.assertNotIn("wrote", err.getvalue())
         self.assertNotIn("Traceback", err.getvalue())
 
+    def test_a_page_the_disk_cannot_hold_is_named(self):
+        # A real ENOSPC at the page's write: /dev/full fails it with no file name, as a full tmpfs did ("report:
+        # cannot write (No space left on device)", naming nothing); the error names the page.
+        import errno
+        import report
+        with self.assertRaises(OSError) as caught:
+            report.write_index("/dev", [], ["a line"], name="full")
+        self.assertEqual((caught.exception.errno, caught.exception.filename), (errno.ENOSPC, "/dev/full"))
+
     def test_zero_responses(self):
         rows = synthetic.trials_rows(participants=("P1", "P2", "P3"), unanswered=1.0)
         trials = synthetic.write_trials_csv(os.path.join(self.tmp, "trials.csv"), rows)

@@ -5,15 +5,16 @@
 namespace blurcue {
 
 size_t EditDistance(const std::string& a, const std::string& b) {
-  std::vector<size_t> row(b.size() + 1);
+  // Three rows: a swap of two neighbouring bytes looks two rows back (optimal string alignment).
+  std::vector<size_t> before(b.size() + 1), previous(b.size() + 1), row(b.size() + 1);
   for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
   for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
+    before.swap(previous);
+    previous.swap(row);
     row[0] = i;
     for (size_t j = 1; j <= b.size(); ++j) {
-      const size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = up;
+      row[j] = std::min({previous[j] + 1, row[j - 1] + 1, previous[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) row[j] = std::min(row[j], before[j - 2] + 1);
     }
   }
   return row[b.size()];
@@ -38,16 +39,6 @@ std::string NearestName(const std::string& name, const std::vector<std::string>&
   // A case slip is the likeliest meaning whatever else is near: "Left" is what someone who wrote "left" meant.
   for (const auto& c : candidates)
     if (c != name && Lower(c) == lower) return c;
-  // Two neighbouring letters swapped ("egde" for edge) is one slip, however short the name.
-  for (const auto& c : candidates) {
-    const std::string other = Lower(c);
-    if (other.size() != lower.size() || other == lower) continue;
-    size_t first = 0;
-    while (other[first] == lower[first]) ++first;
-    if (first + 1 < lower.size() && other[first] == lower[first + 1] && other[first + 1] == lower[first] &&
-        other.compare(first + 2, std::string::npos, lower, first + 2, std::string::npos) == 0)
-      return c;
-  }
   std::string best;
   size_t best_distance = 3;
   for (const auto& c : candidates) {

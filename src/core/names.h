@@ -6,12 +6,13 @@
 
 namespace blurcue {
 
-// Levenshtein distance between `a` and `b` (insertions, deletions, substitutions of one byte each).
+// Edit distance between `a` and `b`: insertions, deletions, substitutions of one byte and swaps of two
+// neighbouring bytes each count one (optimal string alignment), so "gird" is one slip from "grid".
 size_t EditDistance(const std::string& a, const std::string& b);
 
 // The candidate `name` was probably meant to be, "" when none is near: first one that differs only in case
-// (Measured -> measured, left -> Left), else one with two neighbouring letters swapped (egde -> edge), else the
-// nearest by edit distance ignoring case, if at most 2 and less than half of `name`'s length (so a short name is not
+// (Measured -> measured, left -> Left), else the nearest by edit distance ignoring case (a swap of neighbours is one
+// edit: egde -> edge), if at most 2 and less than half of `name`'s length (so a short name is not
 // "corrected" into an unrelated one), else the one candidate that `name` (3 characters or more) abbreviates
 // (int -> integer). Ties: the earlier candidate.
 std::string NearestName(const std::string& name, const std::vector<std::string>& candidates);

@@ -14,6 +14,17 @@ TEST(EditDistance, CountsInsertionsDeletionsAndSubstitutions) {
   EXPECT_EQ(EditDistance("same", "same"), 0u);
 }
 
+// Two neighbouring letters swapped are one slip: "gird" for grid got no did-you-mean (two edits of a four-letter
+// name), as content.type "gird" showed the adversary.
+TEST(EditDistance, ASwapOfNeighboursIsOneEdit) {
+  EXPECT_EQ(EditDistance("gird", "grid"), 1u);
+  EXPECT_EQ(EditDistance("sectoin", "section"), 1u);
+  EXPECT_EQ(EditDistance("ab", "ba"), 1u);
+  EXPECT_EQ(EditDistance("abc", "ca"), 3u);  // no substring is edited twice (optimal string alignment)
+  EXPECT_EQ(NearestName("gird", {"grid", "ball", "picture"}), "grid");
+  EXPECT_EQ(NearestName("xy", {"yx"}), "");  // still less than half of a two-letter name
+}
+
 TEST(NearestName, CaseSlipWinsOverAnEditDistanceTie) {
   // "left" is one substitution from "lefT" and from "Left" alike; the case slip is the one meant.
   EXPECT_EQ(NearestName("left", {"lefx", "Left"}), "Left");
@@ -24,10 +35,10 @@ TEST(NearestName, CaseSlipWinsOverAnEditDistanceTie) {
 TEST(NearestName, NearestWithinTwoEditsIgnoringCase) {
   EXPECT_EQ(NearestName("secton", {"edge", "section", "speed_cm_s"}), "section");
   EXPECT_EQ(NearestName("difference_arcmins", {"relative_difference", "difference_arcmin"}), "difference_arcmin");
-  EXPECT_EQ(NearestName("Sectoin", {"section"}), "section");  // a transposition is two edits; case ignored
+  EXPECT_EQ(NearestName("Sectoin", {"section"}), "section");  // a swap of neighbours; case ignored
 }
 
-// Two neighbouring letters swapped is one slip even in a short name: 2 edits would be too many for 4 letters.
+// Two neighbouring letters swapped is one edit, so a short name gets its did-you-mean too.
 TEST(NearestName, SwappedNeighboursInAShortName) {
   EXPECT_EQ(NearestName("egde", {"edge", "section", "speed_cm_s"}), "edge");
   EXPECT_EQ(NearestName("ei", {"id"}), "");  // 2 letters: not a slip of anything

@@ -22,6 +22,12 @@ void Parser::CheckReadName(const std::string& name, const std::string& what, con
     Problem(ptr, where + "a label needs a name after label_ (e.g. label_stim_id)");
     return;
   }
+  // A label's name becomes a column of the tables and a heading of the report: refused as any other name would be
+  // when it holds a bidirectional control (label_\u202Ex read backwards) or could run as a spreadsheet formula.
+  if (const std::string why = UnsafeIdReason(name); !why.empty()) {
+    Problem(ptr, where + "the " + what + " name " + Echo(name) + " " + why);
+    return;
+  }
   if (IsValueName(name) || IsLabelName(name)) return;
   // A name with a space at either end ("edge " from a CSV header) is quoted and said to be so: it used to read
   // "a column edge  (did you mean edge?)", the difference invisible.
@@ -110,6 +116,8 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
     // A factor's name is what reads its levels (edge, speed_cm_s, ...), unless its levels are objects whose keys are.
     if (!std::all_of(levels.begin(), levels.end(), [](const Json& level) { return level.is_object(); }))
       CheckReadName(name, "factor", fp);
+    else if (const std::string why = UnsafeIdReason(name); !why.empty())
+      Problem(fp, "the factor name " + Echo(name) + " " + why);
     Factor f{name, {}};
     bool sides = false;
     std::set<std::string> keys_checked;  // an object level's key is named once, at the first level that has it
@@ -235,12 +243,22 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
     return {};
   }
   const std::vector<std::string>& header = rows.front().fields;
+  // A spreadsheet set to another list separator (a German or French Excel's "CSV") writes ';' or a tab: the header
+  // is then one column "edge;left;right", which was refused as a misspelt name to be recorded as label_edge;left;right.
+  if (header.size() == 1)
+    for (const char separator : {';', '\t'})
+      if (header.front().find(separator) != std::string::npos) {
+        Problem(ptr, at(rows.front().line, 0) + ": has one column, " + Echo(header.front()) + "; the columns of a "
+                         "conditions table are separated by commas, and this one uses " +
+                         (separator == ';' ? "';'" : "tabs") + " (save it as CSV with commas)", Json(*text));
+        return {};
+      }
   std::set<std::string> names;
   for (size_t c = 0; c < header.size(); ++c) {
     const std::string& name = header[c];
     if (name.empty() || Utf8Length(name) > kMaxNameChars || !IsPrintableUtf8(name) || !names.insert(name).second) {
-      Problem(ptr, at(rows.front().line, c + 1) + ": the header must name each column once, 1-100 characters, got " +
-                       Json(name).dump(-1, ' ', false, Json::error_handler_t::replace), Json(*text));
+      Problem(ptr, at(rows.front().line, c + 1) + " (" + Echo(name) + "): the header must name each column once, "
+                       "1-100 characters", Json(*text));
       return {};
     }
   }

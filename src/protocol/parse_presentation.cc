@@ -186,6 +186,8 @@ void Parser::ParseInfo(const Json& v, const std::string& ptr, Protocol* p) {
               !IsPrintableUtf8(choice.get<std::string>()) ||
               std::count(field.choices.begin(), field.choices.end(), choice.get<std::string>()))
             Problem(fp + "/choices/" + std::to_string(k), "must be a new answer of 1-100 characters", choice);
+          else if (const std::string why = UnsafeIdReason(choice.get<std::string>()); !why.empty())
+            Problem(fp + "/choices/" + std::to_string(k), why, choice);  // recorded as info_KEY, a name in the tables
           else if (CaseTwin(field.choices, choice.get<std::string>()))
             Problem(fp + "/choices/" + std::to_string(k), "must differ from an earlier answer by more than letter case",
                     choice);

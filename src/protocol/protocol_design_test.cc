@@ -625,6 +625,27 @@ TEST(ProtocolValidate, ConditionsTableReadAsSpreadsheetsWriteIt) {
                                        "must be printable UTF-8 text on one line")) << OnlyProblem(j);
 }
 
+// A table a spreadsheet wrote with another list separator (';' from a German Excel, or tabs) says so; it was
+// refused as one misspelt column, "to record it as a label nobody reads, name it label_edge;left;right". A column
+// named twice is named once in the message (it read 'got "label", got "sheet.csv"').
+TEST(ProtocolValidate, ConditionsTableWithAnotherSeparatorSaysSo) {
+  const fs::path dir = SceneFolder();
+  const std::string table = (dir / "sheet.csv").string();
+  Json j = Valid();
+  j["blocks"] = {{{"name", "rows"}, {"conditions", "sheet.csv"}}};
+  std::ofstream(dir / "sheet.csv", std::ios::binary) << "edge;left;right\r\n1;measured;none\r\n";
+  EXPECT_EQ(OnlyProblem(j), (dir / "p.json").string() + ": /blocks/0/conditions: " + table + " line 1: has one "
+            "column, 'edge;left;right'; the columns of a conditions table are separated by commas, and this one uses "
+            "';' (save it as CSV with commas), got \"sheet.csv\"");
+  std::ofstream(dir / "sheet.csv", std::ios::binary) << "edge\tleft\tright\n1\tmeasured\tnone\n";
+  EXPECT_TRUE(Contains(OnlyProblem(j), table + " line 1: has one column, 'edge\\tleft\\tright'; the columns of a "
+                                       "conditions table are separated by commas, and this one uses tabs"))
+      << OnlyProblem(j);
+  std::ofstream(dir / "sheet.csv", std::ios::binary) << "edge,left,right,label,label\n1,measured,none,a,b\n";
+  EXPECT_EQ(OnlyProblem(j), (dir / "p.json").string() + ": /blocks/0/conditions: " + table + " line 1, column 5 "
+            "('label'): the header must name each column once, 1-100 characters, got \"sheet.csv\"");
+}
+
 // A label's cell stays the text it is: 007 and 7 are two ids, and a 16-digit id keeps its last digit. A number in a
 // column that reads one must be held exactly, or it is refused naming what it would have become.
 TEST(ProtocolValidate, ConditionsCellsKeepTheirTextAndNumbersTheirDigits) {

@@ -87,6 +87,34 @@ TEST(ProtocolValidate, MisspeltConditionsColumnIsRefusedNamingFileLineAndColumn)
   EXPECT_TRUE(Problems(j).empty()) << Problems(j).front();
 }
 
+// A name that becomes a column of the tables - a label factor's, an object-level factor's, a conditions table's
+// column - or a value recorded as a name (a choice, recorded as info_KEY) is refused when it holds a bidirectional
+// control, which shows it in another order than it is recorded, or begins as a spreadsheet formula (the adversary's
+// label_U+202Ex and "=left" validated and reached trials.csv as they were).
+TEST(ProtocolValidate, NamesThatReadBackwardsOrRunAsFormulasAreRefused) {
+  const std::string rlo = "\xE2\x80\xAE";  // U+202E RIGHT-TO-LEFT OVERRIDE
+  const std::string why = "holds the bidirectional control character U+202E, which shows the text to a reader in "
+                          "another order than it is recorded";
+  Json j = Valid();
+  j["blocks"][1]["factors"]["label_" + rlo + "ab"] = {"x", "y"};
+  EXPECT_EQ(OnlyProblem(j), Line("/blocks/1/factors/label_" + rlo + "ab: the factor name 'label_" + rlo + "ab' " + why));
+  j = Valid();
+  j["blocks"][0]["factors"]["pat" + rlo + "tern"] = j["blocks"][0]["factors"]["pattern"];
+  j["blocks"][0]["factors"].erase("pattern");
+  EXPECT_EQ(OnlyProblem(j), Line("/blocks/0/factors/pat" + rlo + "tern: the factor name 'pat" + rlo + "tern' " + why));
+  const fs::path dir = SceneFolder();
+  std::ofstream(dir / "rows-bidi.csv") << "id,speed_cm_s,left,right,label_" << rlo << "x\n1,3,measured,none,a\n";
+  j = Valid();
+  j["blocks"][0].erase("factors");
+  j["blocks"][0]["conditions"] = "rows-bidi.csv";
+  EXPECT_EQ(OnlyProblem(j), Line("/blocks/0/conditions: " + (dir / "rows-bidi.csv").string() + " line 1, column 5: "
+                                 "the column name 'label_" + rlo + "x' " + why));
+  j = Valid();
+  j["participant_info"] = {{{"key", "hand"}, {"type", "choice"}, {"choices", {"=left", "right"}}}};
+  EXPECT_EQ(OnlyProblem(j), Line("/participant_info/0/choices/0: begins with =, which a spreadsheet opening the "
+                                 "exported tables runs as a formula, got \"=left\""));
+}
+
 // A cell's problem is named where the cell is written: the table's file, line and column (by number and name), not
 // a pointer into a JSON document the experimenter never wrote; and once, however many blocks use the table.
 TEST(ProtocolValidate, ConditionsCellProblemNamesTheTablesLineAndColumn) {

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/names.h"
 #include "core/typed.h"
 #include "core/stats.h"
 
@@ -88,11 +89,17 @@ ObserverParams ParseObserver(const std::string& spec) {
       return v;
     };
     static const std::set<std::string> kBoth = {"lapse", "rt", "step"};
-    if (!kArcminOnly.count(name) && !kPixelOnly.count(name) && !kBoth.count(name))
-      throw Error(ErrorKind::kUsage, "--observer: unknown parameter " + Echo(name) + " (known: model, " +
-                                         (pixel ? "jnd, bias, cutoff1m, slope, sdlog, tol"
-                                                : "intrinsic, weber, exponent, side, blurrier, rthard") +
-                                         ", lapse, rt, step)");
+    if (!kArcminOnly.count(name) && !kPixelOnly.count(name) && !kBoth.count(name)) {
+      // A slip of a known name is answered with it (bais: did you mean bias?), as a protocol's names are.
+      std::vector<std::string> known = {"model"};
+      for (const auto* names : {pixel ? &kPixelOnly : &kArcminOnly, &kBoth})
+        known.insert(known.end(), names->begin(), names->end());
+      std::string list;
+      for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+      const std::string hint = DidYouMean(name, known);
+      throw Error(ErrorKind::kUsage, "--observer: unknown parameter " + Echo(name) +
+                                         (hint.empty() ? " (known: " + list + ")" : hint));
+    }
     if (!parsed) bad("must be a number");
     // Ranges: what a human observer could be, so a typo (1e308, a missing decimal point) is refused, not simulated.
     if (name == "intrinsic") p.intrinsic_arcmin = in(0, 60, true, "must be in (0, 60] arcmin (a Gaussian std)");

@@ -423,7 +423,11 @@ TEST(ObserverParams, RejectsEveryBadValueWithOneLineNamingIt) {
       {"sim:", "--observer: an empty parameter"},
       {"sim:lapse=0,", "--observer: an empty parameter"},
       {"sim:weber", "--observer weber must be a number, got ''"},
-      {"sim:sharpness=2", "--observer: unknown parameter 'sharpness'"},
+      {"sim:sharpness=2", "--observer: unknown parameter 'sharpness' (known: model, blurrier, exponent, intrinsic, "
+                          "rthard, side, weber, lapse, rt, step)"},
+      // A slip of a known name gets a did-you-mean (the model's own names: bias is model=pixel's).
+      {"sim:jnd=0.6,bais=0", "--observer: unknown parameter 'bais' (did you mean bias?)"},
+      {"sim:webr=0.3", "--observer: unknown parameter 'webr' (did you mean weber?)"},
       {"sim:weber=0x10", "--observer weber must be a number, got '0x10'"},  // not 16: decimal only
       {"sim:weber= 0.3", "--observer weber must be a number, got ' 0.3'"},
       {"sim:lapse=0.1 ", "--observer lapse must be a number, got '0.1 '"},

@@ -132,9 +132,30 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
     Statement all(src, "SELECT code FROM participants");
     while (all.Step()) codes.push_back(all.GetText(0));
     held.insert(codes.begin(), codes.end());
-    for (const auto& [from, to] : renames[std::filesystem::weakly_canonical(input)])
+    const auto& own = renames[std::filesystem::weakly_canonical(input)];
+    for (const auto& [from, to] : own)
       if (std::find(codes.begin(), codes.end(), from) == codes.end())
         throw InputError("--rename", input.string() + " holds no participant " + Echo(from) + DidYouMean(from, codes));
+    // A new id this input already gives another person of the same study (not renamed away itself) would join two
+    // people the station kept apart: the collision used to be blamed on "an earlier input", and the --same-person
+    // it offered made them one participant.
+    std::map<std::string, std::string> renamed_to;  // new id -> the id it replaces
+    Statement holder(src, "SELECT st.name FROM participants a JOIN participants b ON b.study_id = a.study_id JOIN "
+                          "studies st ON st.id = a.study_id WHERE a.code = ? AND b.code = ?");
+    for (const auto& [from, to] : own) {
+      if (const auto [first, fresh] = renamed_to.emplace(to, from); !fresh)
+        throw InputError("--rename", "gives participants " + first->second + " and " + from + " of " +
+                                         input.string() + " one new id " + Echo(to) + "; they are two people there");
+      if (own.count(to)) continue;
+      holder.Bind(1, from);
+      holder.Bind(2, to);
+      if (holder.Step())
+        throw InputError("--rename", input.string() + ":" + from + "=" + OneLine(to) + ": " + input.string() +
+                                         " already holds a participant " + OneLine(to) + " of study " +
+                                         holder.GetText(0) + ", another person than " + from + "; give " + from +
+                                         " an id that record does not hold");
+      holder.Reset();
+    }
   }
   for (const std::string& code : same_person)
     if (!held.count(code))

@@ -358,5 +358,38 @@ TEST(Merge, OneIdAtTwoStationsIsRefusedUntilTheExperimenterSaysWhoItIs) {
             std::string::npos);
 }
 
+// A rename onto an id the same record gives another person of the study would join two people the station kept
+// apart: refused naming both (it was blamed on "an earlier input", and the --same-person it offered made b's P1 and
+// P2 one participant). Two ids renamed to one are refused; a rename onto an id that is itself renamed away is not.
+TEST(Merge, ARenameOntoAnIdTheSameRecordGivesAnotherPersonIsRefused) {
+  testing::TempDir dir;
+  {
+    Record a = Record::Open(dir / "a.sqlite");
+    Complete(a, "P1", kV1, 11);
+    Record b = Record::Open(dir / "b.sqlite");
+    Complete(b, "P1", kV1, 12);
+    Complete(b, "P2", kV1, 13);
+  }
+  const std::string b = (dir / "b.sqlite").string();
+  MergeOptions onto;
+  onto.renames = {Rename(dir / "b.sqlite", "P1", "P2")};
+  onto.same_person = {"P2"};
+  EXPECT_EQ(ErrorOf([&] { MergeDatabases({dir / "a.sqlite", dir / "b.sqlite"}, dir / "m.sqlite", {}, onto); }),
+            "--rename: " + b + ":P1=P2: " + b + " already holds a participant P2 of study s, another person than P1; "
+            "give P1 an id that record does not hold");
+  EXPECT_FALSE(std::filesystem::exists(dir / "m.sqlite"));
+  MergeOptions both;
+  both.renames = {Rename(dir / "b.sqlite", "P1", "S2"), Rename(dir / "b.sqlite", "P2", "S2")};
+  EXPECT_EQ(ErrorOf([&] { MergeDatabases({dir / "a.sqlite", dir / "b.sqlite"}, dir / "m.sqlite", {}, both); }),
+            "--rename: gives participants P1 and P2 of " + b + " one new id 'S2'; they are two people there");
+  MergeOptions chain;
+  chain.renames = {Rename(dir / "b.sqlite", "P1", "P2"), Rename(dir / "b.sqlite", "P2", "P3")};
+  MergeDatabases({dir / "a.sqlite", dir / "b.sqlite"}, dir / "chain.sqlite", {}, chain);
+  EXPECT_EQ(Record::Open(dir / "chain.sqlite").database().QueryText(
+                "SELECT group_concat(p.code || ':' || s.seed, ',') FROM (SELECT * FROM sessions ORDER BY seed) s "
+                "JOIN participants p ON p.id = s.participant_id"),
+            "P1:11,P2:12,P3:13");
+}
+
 }  // namespace
 }  // namespace blurcue::store
