@@ -424,8 +424,9 @@ def _main(argv=None):
     say(f"[1/{total}] read {shown(args.trials)}: {len(all_trials)} rows")
     studies = all_trials["study"].value_counts().sort_index()
     known = set(common.STUDY_TITLES)
+    n_people = all_trials["participant"].nunique()
     header = [f"trials: {os.path.abspath(shown(args.trials))} - {len(all_trials)} rows, "
-              f"{int(all_trials['answered'].sum())} answered, {all_trials['participant'].nunique()} participants",
+              f"{int(all_trials['answered'].sum())} answered, {n_people} participant{'' if n_people == 1 else 's'}",
               "studies: " + (", ".join(f"{s} ({n} rows)" for s, n in studies.items()) or "none"),
               f"frames: {os.path.abspath(shown(frames_path))}",
               f"bench: {os.path.abspath(args.bench)}" if bench_steps else "bench: none (blurcue bench writes them)",
