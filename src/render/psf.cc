@@ -49,11 +49,10 @@ cv::Mat GaussianKernel2d(double s) {
   return k;
 }
 
-// The segment from -L/2 to L/2 along unit d, n points spread bilinearly; its variance along d.
-cv::Mat Splat(const cv::Vec2d& d, double length, double* variance_along) {
+// The segment from -L/2 to L/2 along unit d, n points spread bilinearly; its variances along d and across it.
+cv::Mat Splat(const cv::Vec2d& d, double length, int n, double* along, double* across) {
   const int h = int(std::ceil(length / 2)) + 1;
   cv::Mat k = cv::Mat::zeros(2 * h + 1, 2 * h + 1, CV_32F);
-  const int n = std::max(2, int(std::ceil(8 * length)) + 1);
   for (int i = 0; i < n; ++i) {
     const double s = (-0.5 + (i + 0.5) / n) * length;
     const double x = h + s * d[0], y = h + s * d[1];
@@ -64,16 +63,40 @@ cv::Mat Splat(const cv::Vec2d& d, double length, double* variance_along) {
     k.at<float>(y0 + 1, x0) += float((1 - ax) * ay / n);
     k.at<float>(y0 + 1, x0 + 1) += float(ax * ay / n);
   }
-  double sum = 0, second = 0;
+  double sum = 0, second_along = 0, second_across = 0;
   for (int y = 0; y < k.rows; ++y)
     for (int x = 0; x < k.cols; ++x) {
-      const double w = k.at<float>(y, x), u = (x - h) * d[0] + (y - h) * d[1];
-      sum += w, second += w * u * u;
+      const double w = k.at<float>(y, x), u = (x - h) * d[0] + (y - h) * d[1], v = -(x - h) * d[1] + (y - h) * d[0];
+      sum += w, second_along += w * u * u, second_across += w * v * v;
     }
-  *variance_along = second / sum;
+  *along = second_along / sum, *across = second_across / sum;
   return k / sum;
 }
 
+}  // namespace
+
+cv::Mat StreakKernel(const cv::Vec2d& m, double* across_px2) {
+  const double length = cv::norm(m);
+  if (across_px2) *across_px2 = 0;
+  if (!(length > 0)) return cv::Mat::ones(1, 1, CV_32F);
+  const cv::Vec2d d = m / length;
+  // The drawn length whose kernel's variance along d exceeds its variance across by the continuous segment's,
+  // L^2 / 12: the samples' bilinear spreading adds some both ways (PsfKernel takes the across part out of the
+  // isotropic part), their spacing takes some away. The excess grows with the drawn length: bisect.
+  const double target = length * length / 12;
+  double lo = 0, hi = length + 2, along = 0, across = 0;
+  const int n = int(std::ceil(8 * hi)) + 1;  // 8 samples a px or more, one count for the whole search (continuous in L)
+  for (int i = 0; i < 40; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    Splat(d, mid, n, &along, &across);
+    (along - across < target ? lo : hi) = mid;
+  }
+  cv::Mat k = Splat(d, 0.5 * (lo + hi), n, &along, &across);
+  if (across_px2) *across_px2 = across;
+  return k;
+}
+
+namespace {
 }  // namespace
 
 double Psf::FloorSigmaPx() const { return std::clamp(floor_sigma_px, 0.0, std::max(0.0, r_px) / 2); }
@@ -99,33 +122,24 @@ void CheckPsf(const Psf& psf) {
                                         Num(psf.motion_px[0]) + ", " + Num(psf.motion_px[1]) + ")");
 }
 
-cv::Mat StreakKernel(const cv::Vec2d& m) {
-  const double length = cv::norm(m);
-  if (!(length > 0)) return cv::Mat::ones(1, 1, CV_32F);
-  const cv::Vec2d d = m / length;
-  // The drawn length whose kernel has the variance along d of the continuous segment, L^2 / 12: the samples'
-  // spreading adds some, their spacing takes some away. The variance grows with the drawn length: bisect.
-  const double target = length * length / 12;
-  double lo = 0, hi = length + 2, v = 0;
-  for (int i = 0; i < 40; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    Splat(d, mid, &v);
-    (v < target ? lo : hi) = mid;
-  }
-  return Splat(d, 0.5 * (lo + hi), &v);
-}
-
 cv::Mat PsfKernel(const Psf& psf) {
   CheckPsf(psf);
+  // The streak first: the variance its spreading adds across it (e) is taken out of the isotropic part (the floor
+  // first, then the defocus), so that across the motion the kernel's variance is r^2 / 4 and along it r^2 / 4 +
+  // L^2 / 12. Where r^2 / 4 < e (a sub-pixel defocus under a diagonal streak) what is left over stays.
+  double e = 0;
+  const cv::Mat streak = psf.MotionLengthPx() > 0 ? StreakKernel(psf.motion_px, &e) : cv::Mat();
   cv::Mat iso;
   if (psf.method == "disc") {
-    const double R = psf.DefocusRadiusPx();
-    cv::Mat disc = R > 0 ? DiscKernel(R) : cv::Mat::ones(1, 1, CV_32F);
-    iso = Convolve(disc, GaussianKernel2d(psf.FloorSigmaPx()));
+    const double f = psf.FloorSigmaPx(), R = psf.DefocusRadiusPx();
+    const double f2 = f * f - e;
+    const double R_drawn = f2 >= 0 ? R : std::sqrt(std::max(0.0, R * R + 4 * f2));
+    cv::Mat disc = R_drawn > 0 ? DiscKernel(R_drawn) : cv::Mat::ones(1, 1, CV_32F);
+    iso = Convolve(disc, GaussianKernel2d(std::sqrt(std::max(0.0, f2))));
   } else {
-    iso = GaussianKernel2d(psf.r_px / 2);
+    iso = GaussianKernel2d(std::sqrt(std::max(0.0, psf.r_px * psf.r_px / 4 - e)));
   }
-  cv::Mat k = psf.MotionLengthPx() > 0 ? Convolve(iso, StreakKernel(psf.motion_px)) : iso;
+  cv::Mat k = streak.empty() ? iso : Convolve(iso, streak);
   return k / cv::sum(k)[0];
 }
 

@@ -40,7 +40,8 @@ cv::Mat PsfKernel(const Psf& psf);
 // Its half-width h, without building it.
 int PsfHalfWidth(const Psf& psf);
 
-// The streak alone (normalised, centred, odd square), as PsfKernel makes it.
-cv::Mat StreakKernel(const cv::Vec2d& motion_px);
+// The streak alone (normalised, centred, odd square), as PsfKernel makes it: its variance along the motion exceeds
+// its variance across it (returned in across_px2 when given) by exactly |m|^2 / 12.
+cv::Mat StreakKernel(const cv::Vec2d& motion_px, double* across_px2 = nullptr);
 
 }  // namespace blurcue::render

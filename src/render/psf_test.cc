@@ -73,13 +73,17 @@ TEST(Psf, StreakAddsItsLengthSquaredOverTwelveAlongTheMotion) {
   EXPECT_NEAR(m.xx, 0.25 + 3, 1e-3);
   EXPECT_NEAR(m.yy, 0.25, 1e-3);
   EXPECT_NEAR(m.cx, m.cy, 1e-6);  // centred
-  // A diagonal one (3, 4) of length 5 on a pillbox with a floor: along the motion exactly 25/12 more than across
-  // plus the bilinear spreading's own (at most 1/4 px^2 across).
-  m = Of(PsfKernel(Make("disc", 2, 0.3, {3, 4})));
-  const double along = (9 * m.xx + 16 * m.yy + 24 * m.xy) / 25, across = (16 * m.xx + 9 * m.yy - 24 * m.xy) / 25;
-  EXPECT_NEAR(along, 1 + 25.0 / 12, 1e-3);
-  EXPECT_GE(across, 1 - 1e-6);
-  EXPECT_LE(across, 1 + 0.25);
+  // Diagonal and nearly vertical ones on a pillbox with a floor and on a Gaussian: across the motion exactly r^2 / 4,
+  // along it r^2 / 4 + L^2 / 12 (the spreading's own variance taken out of the floor or the defocus).
+  for (const Psf& p : {Make("disc", 2, 0.3, {3, 4}), Make("disc", 2, 0, {3, 4}), Make("gaussian", 1.1, 0, {0.11, 1.43}),
+                       Make("disc", 1.2, 0.6, {-0.4, 6.5})}) {
+    m = Of(PsfKernel(p));
+    const double l = p.MotionLengthPx(), c = p.motion_px[0] / l, s = p.motion_px[1] / l;
+    const double along = c * c * m.xx + s * s * m.yy + 2 * c * s * m.xy;
+    const double across = s * s * m.xx + c * c * m.yy - 2 * c * s * m.xy;
+    EXPECT_NEAR(across, p.r_px * p.r_px / 4, 2e-3) << p.method << " " << p.motion_px;
+    EXPECT_NEAR(along, p.r_px * p.r_px / 4 + l * l / 12, 2e-3) << p.method << " " << p.motion_px;
+  }
   // Sub-pixel streaks too.
   for (double length : {0.3, 0.8, 1.7}) {
     m = Of(StreakKernel({0, length}));
