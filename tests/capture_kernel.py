@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""capture_kernel.py BLURRED SHARP [--tolerance-px 0.03 --tolerance-rel 0.03 --min-r 0.25]
+"""capture_kernel.py BLURRED SHARP [--tolerance-px 0.03 --tolerance-rel 0.03 --min-r 0.25
+                                   --streak-tolerance-px 0.3 --streak-tolerance-rel 0.05]
 
 The blur a captured frame shows, found without any of blurcue's code: for every object of every trial-NNNN.json
 in BLURRED, the kernel that maps the same trial's frame in SHARP (its unblurred twin, captured with blur 0 over a
@@ -10,8 +11,15 @@ variances. Nothing is assumed of the kernel's shape, so a Gaussian and a pillbox
 fitted at whole-pixel samples of a formula (a Gaussian sampled at whole pixels keeps too little variance below
 1 px: r 0.81 sampled has the variance of r 0.58).
 
+A moving object (a record with a non-zero motion_screen_px) leaves a streak: the kernel's covariance is then taken
+apart along its principal axes (numpy's eigen decomposition, nothing of the record's direction), the across variance
+giving r (2 x its std) and the along variance's excess over it the streak, L = sqrt(12 (var_along - var_across)) (a
+segment of length L has variance L^2 / 12); its direction is the principal axis.
+
 Prints one line per object and exits 1 when an object whose recorded r_screen_px is at least --min-r is off by more
-than max(tolerance-px, tolerance-rel x r), or when an object of the record is not in the frame.
+than max(tolerance-px, tolerance-rel x r), a streak's length is off by more than max(streak-tolerance-px,
+streak-tolerance-rel x L) or its direction by more than the angle that tolerance subtends at its end, or when an
+object of the record is not in the frame.
 """
 import argparse
 import glob
@@ -55,6 +63,21 @@ def kernel_radius(k):
     return 2 * math.sqrt(max(0.0, sum(variances) / 2)), total
 
 
+def kernel_streak(k):
+    """r (2 x the std across), the streak's length and its direction (radians, image x right, y down, mod pi)."""
+    h = k.shape[0] // 2
+    t = np.arange(-h, h + 1, dtype=np.float64)
+    total = k.sum()
+    xs, ys = np.meshgrid(t, t)
+    mx, my = (k * xs).sum() / total, (k * ys).sum() / total
+    dx, dy = xs - mx, ys - my
+    cov = np.array([[(k * dx * dx).sum(), (k * dx * dy).sum()], [(k * dx * dy).sum(), (k * dy * dy).sum()]]) / total
+    values, vectors = np.linalg.eigh(cov)  # ascending
+    across, along = values
+    direction = math.atan2(vectors[1, 1], vectors[0, 1]) % math.pi
+    return 2 * math.sqrt(max(0.0, across)), math.sqrt(12 * max(0.0, along - across)), direction, total
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[1], formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("blurred")
@@ -62,6 +85,8 @@ def main():
     ap.add_argument("--tolerance-px", type=float, default=0.03)
     ap.add_argument("--tolerance-rel", type=float, default=0.03)
     ap.add_argument("--min-r", type=float, default=0.25)
+    ap.add_argument("--streak-tolerance-px", type=float, default=0.3)
+    ap.add_argument("--streak-tolerance-rel", type=float, default=0.05)
     args = ap.parse_args()
     trials = sorted(glob.glob(os.path.join(args.blurred, "trial-*.json")))
     if not trials:
@@ -80,7 +105,9 @@ def main():
         height, width = blurred.shape[:2]
         for o in frame["objects"]:
             r_rec = o["r_screen_px"]
-            h = max(3, math.ceil(1.6 * r_rec) + 2)
+            m_rec = o.get("motion_screen_px", [0, 0])
+            l_rec = math.hypot(*m_rec)
+            h = max(3, math.ceil(1.6 * r_rec + l_rec / 2) + 2)
             xs = [p[0] for p in o["outline_px"]]
             ys = [p[1] for p in o["outline_px"]]
             margin = h + 2
@@ -91,7 +118,10 @@ def main():
                 bad += 1
                 continue
             k = solve_kernel(sharp, blurred, box, h)
-            r, total = kernel_radius(k)
+            if l_rec > 0:
+                r, length, direction, total = kernel_streak(k)
+            else:
+                r, total = kernel_radius(k)
             err = r - r_rec
             limit = max(args.tolerance_px, args.tolerance_rel * r_rec)
             judged = r_rec >= args.min_r
@@ -99,10 +129,24 @@ def main():
             if judged:
                 checked += 1
                 worst = max(worst, abs(err) / limit)
+            streak = ""
+            if l_rec > 0:
+                l_err = length - l_rec
+                l_limit = max(args.streak_tolerance_px, args.streak_tolerance_rel * l_rec)
+                rec_direction = math.atan2(m_rec[1], m_rec[0]) % math.pi
+                d_err = (direction - rec_direction + math.pi / 2) % math.pi - math.pi / 2
+                d_limit = math.atan2(l_limit, l_rec / 2)
+                l_off = abs(l_err) > l_limit or abs(d_err) > d_limit
+                off = off or l_off
+                checked += 1
+                worst = max(worst, abs(l_err) / l_limit, abs(d_err) / d_limit)
+                streak = (f"; streak recorded {l_rec:.4f} px at {math.degrees(rec_direction):.2f} deg, shown {length:.4f} "
+                          f"at {math.degrees(direction):.2f} deg (error {l_err:+.4f} px, limit {l_limit:.3f}; "
+                          f"{math.degrees(d_err):+.2f} deg, limit {math.degrees(d_limit):.2f})")
             bad += off
             print(f"{'BAD ' if off else ''}{name} {o['side']} {o['kernel']}: recorded r {r_rec:.4f} screen px, "
                   f"shown {r:.4f} (error {err:+.4f}, limit {limit:.3f}{'' if judged else ', below --min-r: not judged'}), "
-                  f"kernel sum {total:.4f}")
+                  f"kernel sum {total:.4f}{streak}")
     print(f"{checked} objects judged, {bad} off; the largest error is {worst:.2f} of its limit")
     sys.exit(1 if bad or not checked else 0)
 

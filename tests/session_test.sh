@@ -24,7 +24,7 @@ complete)
   [ "$(sql "$W/s.sqlite" "SELECT min(n) > 0 FROM (SELECT count(f.id) n FROM trials t LEFT JOIN frames f ON f.trial_id = t.id GROUP BY t.id)")" = 1 ] \
     || fail "every trial records its frames"
   $BC export --db "$W/s.sqlite" --out "$W/export"
-  head -1 "$W/export/trials.csv" | grep -q "block_name,task,practice,swapped,cell,blur_plan,brightness,contrast,edge,kernel,r_left_arcmin,r_left_px,r_left_screen_px,r_right_arcmin,r_right_px,r_right_screen_px,r_scene_arcmin,r_scene_px,r_scene_screen_px,r_span_screen_px,screen_px_per_photo_px,size_left_deg,size_right_deg,white_balance_b,white_balance_g,white_balance_r,left_source,left_fixed,right_source,right_fixed,status,chosen_side" \
+  head -1 "$W/export/trials.csv" | grep -q "block_name,task,practice,swapped,cell,blur_plan,brightness,contrast,edge,exposure_ms,floor_sigma_left_px,floor_sigma_left_screen_px,floor_sigma_right_px,floor_sigma_right_screen_px,kernel,motion_left_x_screen_px,motion_left_y_screen_px,motion_right_x_screen_px,motion_right_y_screen_px,r_left_arcmin,r_left_px,r_left_screen_px,r_right_arcmin,r_right_px,r_right_screen_px,r_scene_arcmin,r_scene_px,r_scene_screen_px,r_span_screen_px,screen_px_per_photo_px,size_left_deg,size_right_deg,white_balance_b,white_balance_g,white_balance_r,left_source,left_fixed,right_source,right_fixed,status,chosen_side" \
     || fail "export header: $(head -1 "$W/export/trials.csv")"
   # Every radius in three units: the screen px follow the fit of the photo into the protocol's display (its size read
   # from the PNG header here), the arcmin follow the display profile the session recorded.

@@ -189,7 +189,7 @@ add_preflight_test(criterion-10395
 # blur against its recorded r_screen_px and its edges against its recorded outline (tests/capture_measure.cc).
 add_executable(capture_measure ${PROJECT_SOURCE_DIR}/tests/capture_measure.cc)
 target_link_libraries(capture_measure PRIVATE blurcue_calib blurcue_core)
-foreach(case blur place pose window agree thesis aliasing subpixel)
+foreach(case blur place pose window agree thesis aliasing subpixel kernel)
   add_test(NAME capture_${case}
            COMMAND bash ${PROJECT_SOURCE_DIR}/tests/capture_test.sh ${case} ${BC} $<TARGET_FILE:capture_measure> ${T})
   set_tests_properties(capture_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"

@@ -213,6 +213,18 @@ double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& p, 
   return 0;
 }
 
+double FloorSigmaPx(const SceneCalib& scene, BlurSource source) {
+  switch (source) {
+    case BlurSource::kMeasured:
+    case BlurSource::kMeasuredSection:
+    case BlurSource::kFitted: return scene.model.floor_px / 2;
+    case BlurSource::kEstimated:
+    case BlurSource::kFixed:
+    case BlurSource::kNone: return 0;
+  }
+  return 0;
+}
+
 double BlurAlongSightPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& centre, double z_mm,
                         double fixed_r_px) {
   try {

@@ -57,6 +57,11 @@ std::string ToString(BlurSource source);
 //   fixed     - fixed_r_px; none - 0.
 double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& point_camera_mm, double fixed_r_px = 0);
 
+// The lens floor (std, px) inside the blur `source` gives: for the scene's own blur (measured, measured_section,
+// fitted) the fitted model's floor r0 as a std (r0 / 2, DESIGN.md's r = 2 std; 0 when the model kept none), which a
+// virtual object's defocus is drawn convolved with so that its PSF is the photo's; 0 for estimated, fixed and none.
+double FloorSigmaPx(const SceneCalib& scene, BlurSource source);
+
 // The source's radius on the line of sight through an object's centre (camera frame, mm) at camera depth z_mm: what
 // a pixel of the object at that depth gets when it is blurred per pixel by depth. Where the source cannot be
 // evaluated there (eq. 3.7 as published, in front of the focus plane) the centre's radius stands in.

@@ -9,6 +9,7 @@
 
 #include <unistd.h>
 
+#include <opencv2/calib3d.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "calib/scene_blur.h"
@@ -31,7 +32,7 @@ void AddAnimateCommand(CLI::App& app) {
   struct Args {
     std::string calib, background, left = "estimated", right = "none", texture = "soccer", method = "gaussian";
     std::string video, frames_dir, log;
-    double speed_cm_s = 3, fps = 60, gain = 1;
+    double speed_cm_s = 3, fps = 60, gain = 1, exposure_ms = 0;
     int from_edge = 1, to_edge = 11, left_section = 3, right_section = 5;
     bool window = false, fullscreen = false;
   };
@@ -57,6 +58,10 @@ void AddAnimateCommand(CLI::App& app) {
       ->check(FiniteRange(0.1, 1000, "cm/s"));
   cmd->add_option("--fps", args->fps, "frames per second of the video (a window runs at its refresh)")
       ->capture_default_str()->check(FiniteRange(1, 1000, "frames per second"));
+  cmd->add_option("--exposure-ms", args->exposure_ms,
+                  "the camera's exposure: each rolling ball gets the motion blur of its image velocity over it, drawn\n"
+                  "with its defocus in one kernel (0: none)")
+      ->capture_default_str()->check(FiniteRange(0, 1000, "ms"));
   cmd->add_option("--from-edge", args->from_edge, "start edge")->capture_default_str()->transform(IntRange(1, 1000));
   cmd->add_option("--to-edge", args->to_edge, "end edge")->capture_default_str()->transform(IntRange(1, 1000));
   cmd->add_option("--left-section", args->left_section, "section the left ball rolls along")->capture_default_str()
@@ -65,7 +70,9 @@ void AddAnimateCommand(CLI::App& app) {
       ->capture_default_str()->transform(IntRange(1, 1000));
   cmd->add_option("--video", args->video, "write an MJPG .avi");
   cmd->add_option("--frames", args->frames_dir, "write frame PNGs into this folder");
-  cmd->add_option("--log", args->log, "per-frame CSV: index, t_s, y_mm, r_left_px, r_right_px, render_ms, flip_s");
+  cmd->add_option("--log", args->log,
+                  "per-frame CSV: index, t_s, y_mm, r_left_px, r_right_px, each ball's lens floor (std) and motion\n"
+                  "streak (x, y) in photo px, render_ms, flip_s");
   cmd->add_flag("--window", args->window, "show in a GLFW window (vsync)");
   cmd->add_flag("--fullscreen", args->fullscreen, "with --window: fullscreen on the first monitor");
   cmd->callback([args] {
@@ -131,7 +138,20 @@ void AddAnimateCommand(CLI::App& app) {
     }
     // The log is written whole at the end (WriteFileAtomically): a run cut short leaves no half log.
     std::ostringstream log;
-    log << "frame,t_s,y_mm,r_left_px,r_right_px,render_ms,flip_s\n";
+    log << "frame,t_s,y_mm,r_left_px,r_right_px,floor_sigma_left_px,floor_sigma_right_px,motion_left_x_px,"
+           "motion_left_y_px,motion_right_x_px,motion_right_y_px,render_ms,flip_s\n";
+    // A ball's streak over the exposure: where its centre's image goes from half an exposure before to half after.
+    const double half_mm = 0.5 * speed_mm_s * args->exposure_ms / 1000 * (y1 >= y0 ? 1 : -1);
+    auto streak = [&](int section, double y) -> cv::Vec2d {
+      if (!(half_mm != 0)) return {0, 0};
+      std::vector<cv::Point3d> ends = {
+          cv::Point3d(scene::BallOnBoard(scene.board, section, y - half_mm, radius, y0).center_board_mm),
+          cv::Point3d(scene::BallOnBoard(scene.board, section, y + half_mm, radius, y0).center_board_mm)};
+      std::vector<cv::Point2d> image;
+      cv::projectPoints(ends, scene.rvec, scene.tvec, cv::Matx33d(scene.camera.Intrinsics().data()),
+                        scene.camera.dist_coeffs, image);
+      return {image[1].x - image[0].x, image[1].y - image[0].y};
+    };
     using Clock = std::chrono::steady_clock;
     {  // a warm-up frame uploads and mipmaps the texture, so frame 0 is not slower than the rest
       scene::BlurredObject b;
@@ -146,6 +166,7 @@ void AddAnimateCommand(CLI::App& app) {
     for (int i = 0; i < frames && !(context->ShouldClose()); ++i) {
       const double t = i / args->fps;
       const double y = y0 + (y1 > y0 ? 1 : -1) * std::min(std::abs(y1 - y0), speed_mm_s * t);
+      const bool rolling = speed_mm_s * t < std::abs(y1 - y0);
       std::vector<scene::BlurredObject> balls(2);
       const int section[2] = {args->left_section, args->right_section};
       const calib::BlurSource source[2] = {left, right};
@@ -163,6 +184,8 @@ void AddAnimateCommand(CLI::App& app) {
                                              BoundText(render::kMaxBlurRadiusPx) + "] px");
         balls[b].r_px = r[b];
         balls[b].method = args->method;
+        balls[b].floor_sigma_px = calib::FloorSigmaPx(scene, source[b]);
+        balls[b].motion_px = rolling ? streak(section[b], y) : cv::Vec2d(0, 0);
       }
       const auto t0 = Clock::now();
       compositor.Compose(balls);
@@ -184,7 +207,9 @@ void AddAnimateCommand(CLI::App& app) {
           WriteImage(std::filesystem::path(args->frames_dir) / name, frame);
         }
       }
-      log << i << "," << t << "," << y << "," << r[0] << "," << r[1] << "," << render_ms << "," << flip_s << "\n";
+      log << i << "," << t << "," << y << "," << r[0] << "," << r[1] << "," << balls[0].floor_sigma_px << ","
+          << balls[1].floor_sigma_px << "," << balls[0].motion_px[0] << "," << balls[0].motion_px[1] << ","
+          << balls[1].motion_px[0] << "," << balls[1].motion_px[1] << "," << render_ms << "," << flip_s << "\n";
       if (tty || (i + 1) % std::max(1, frames / 4) == 0 || i + 1 == frames)
         std::fprintf(stderr, "%sframe %d/%d  y %.1f mm  r %.2f | %.2f px  %.1f ms%s", tty ? "\r" : "", i + 1, frames,
                      y, r[0], r[1], render_ms, tty ? "" : "\n");

@@ -135,6 +135,9 @@ struct Content {
   double depth_blur_threshold = 0.5;
   ThresholdUnit depth_blur_threshold_unit = ThresholdUnit::kScreenPx;
   double radius_mm = 10;              // ball
+  // ball: the camera's exposure time (ms) that a moving ball's motion blur lasts (its image-space velocity x this,
+  // drawn with its defocus in one kernel); 0 (the default): no motion blur.
+  double exposure_ms = 0;
   std::string texture = "soccer";     // grid: grid (the 5 x 5 card) | an image path; ball: soccer | wood | a path
   std::filesystem::path image;        // picture: the image (resolved)
   // picture: photos of the real picture, one per distance: a resolved path with "{distance_m}" standing for the

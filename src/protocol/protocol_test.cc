@@ -243,6 +243,22 @@ TEST(ProtocolValidate, FixedRadiusAndBallSizeHaveRanges) {
   EXPECT_TRUE(Contains(problems[1], "/blocks/0/factors/pattern/0/left: a blur source must be")) << problems[1];
 }
 
+TEST(ProtocolValidate, ExposureIsCheckedAndNamedWithDidYouMean) {
+  Json j = Valid();
+  j["content"]["exposure_ms"] = 40;
+  EXPECT_TRUE(Problems(j).empty());
+  EXPECT_EQ(ParseProtocol(j, SceneFolder() / "p.json").content.exposure_ms, 40);
+  j["content"]["exposure_ms"] = -1;
+  auto problems = Problems(j);
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_TRUE(Contains(problems[0], "/content/exposure_ms: must be a number in [0, 1000] ms, got -1")) << problems[0];
+  j["content"].erase("exposure_ms");
+  j["content"]["exposure"] = 40;
+  problems = Problems(j);
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_TRUE(Contains(problems[0], "exposure_ms")) << problems[0];
+}
+
 TEST(ProtocolValidate, TrialCountOverTheCapRejectedNamingTheCap) {
   Json j = Valid();
   Json factors = Json::object();

@@ -325,14 +325,22 @@ cv::Mat FromLinearPremultiplied(const cv::Mat& rgba, bool keep_alpha) {
 GlBlur::GlBlur()
     : gaussian_(std::make_unique<GaussianBlurShader>()),
       disc_(std::make_unique<DiscBlurShader>()),
+      kernel_(std::make_unique<KernelBlurShader>()),
+      kernel_atlas_(std::make_unique<GrowingTarget>()),
       scratch_(std::make_unique<GrowingTarget>()),
       pass_(std::make_unique<FullscreenPass>()) {}
 
 GlBlur::~GlBlur() = default;
 
 void GlBlur::BlurTexture(Texture& texture, const std::string& method, double r_px) {
+  Psf psf;
+  psf.method = method, psf.r_px = r_px;
+  BlurTexture(texture, psf);
+}
+
+void GlBlur::BlurTexture(Texture& texture, const Psf& psf) {
   const Framebuffer framebuffer(texture);
-  Blur(texture, framebuffer.id(), {{cv::Rect(0, 0, texture.width_px(), texture.height_px()), method, r_px}});
+  Blur(texture, framebuffer.id(), {{cv::Rect(0, 0, texture.width_px(), texture.height_px()), psf}});
 }
 
 void GlBlur::BlurRegions(GrowingTarget& target, const std::vector<Region>& regions) {
@@ -343,37 +351,66 @@ void GlBlur::BlurRegions(GrowingTarget& target, const std::vector<Region>& regio
 
 void GlBlur::Blur(const Texture& texture, GLuint framebuffer, const std::vector<Region>& regions) {
   // Before anything: a NaN radius would otherwise skip the blur and return the image as is.
-  for (const Region& region : regions) CheckBlurRadius(region.r_px);
+  for (const Region& region : regions) CheckPsf(region.psf);
   GrowingTarget& scratch = *scratch_;
   scratch.Reserve(texture.width_px(), texture.height_px());
-  // The first pass of every region into the scratch target: the Gaussian's horizontal pass, or the whole disc.
-  // Both kernels read their texels as an image (imageLoad): on llvmpipe a third cheaper than texelFetch through the
-  // sampler, where a blur spends most of its time.
+  // The general kernels (a streak, a pillbox with a floor) side by side in one atlas, uploaded in one go.
+  kernel_origin_.assign(regions.size(), cv::Point(-1, -1));
+  kernel_taps_.assign(regions.size(), 0);
+  int atlas_w = 0, atlas_h = 0;
+  std::vector<cv::Mat> kernels(regions.size());
+  for (size_t k = 0; k < regions.size(); ++k) {
+    if (!regions[k].psf.General()) continue;
+    kernels[k] = PsfKernel(regions[k].psf);
+    kernel_origin_[k] = cv::Point(atlas_w, 0);
+    kernel_taps_[k] = kernels[k].rows / 2;
+    atlas_w += kernels[k].cols, atlas_h = std::max(atlas_h, kernels[k].rows);
+  }
+  if (atlas_w > 0) {
+    kernel_atlas_cpu_.create(atlas_h, atlas_w, CV_32FC4);
+    kernel_atlas_cpu_.setTo(cv::Scalar::all(0));
+    for (size_t k = 0; k < regions.size(); ++k) {
+      if (kernel_origin_[k].x < 0) continue;
+      cv::Mat channels[4] = {kernels[k], kernels[k], kernels[k], kernels[k]};
+      cv::merge(channels, 4, kernel_atlas_cpu_(cv::Rect(kernel_origin_[k], kernels[k].size())));
+    }
+    kernel_atlas_->Upload(kernel_atlas_cpu_);
+    kernel_atlas_->texture().BindImageForReading(1);
+  }
+  // The first pass of every region into the scratch target: the Gaussian's horizontal pass, or the whole disc or
+  // general kernel. The kernels read their texels as an image (imageLoad): on llvmpipe a third cheaper than
+  // texelFetch through the sampler, where a blur spends most of its time.
   glBindFramebuffer(GL_FRAMEBUFFER, scratch.framebuffer());
   texture.BindImageForReading(0);
   auto viewport = [](const cv::Rect& r) { glViewport(r.x, r.y, r.width, r.height); };
-  auto taps = [](const Region& region) { return GaussianTaps(region.r_px / 2); };
-  auto blurs = [&](const Region& region) { return region.method == "disc" ? region.r_px > 0 : taps(region) > 0; };
-  kernel_sigma_.assign(regions.size(), 1.0);  // a disc's second pass is a copy: any width
+  auto taps = [](const Region& region) { return GaussianTaps(region.psf.r_px / 2); };
+  auto one_pass = [](const Region& region) { return region.psf.General() || region.psf.method == "disc"; };
+  auto blurs = [&](const Region& region) {
+    return region.psf.General() ? true : region.psf.method == "disc" ? region.psf.r_px > 0 : taps(region) > 0;
+  };
+  kernel_sigma_.assign(regions.size(), 1.0);  // a one-pass kernel's second pass is a copy: any width
   for (size_t k = 0; k < regions.size(); ++k) {
     const Region& region = regions[k];
     if (!blurs(region)) continue;
     const cv::Rect& r = region.rect;
     viewport(r);
-    if (region.method == "disc") {
-      const double coverage_r = DiscCoverageRadiusPx(region.r_px);
+    if (region.psf.General()) {
+      kernel_->Use().SetRegion(r.x, r.y, r.br().x, r.br().y)
+          .SetKernel(kernel_origin_[k].x, kernel_origin_[k].y, kernel_taps_[k]);
+    } else if (region.psf.method == "disc") {
+      const double coverage_r = DiscCoverageRadiusPx(region.psf.r_px);
       disc_->Use().SetRegion(r.x, r.y, r.br().x, r.br().y).SetKernel(float(coverage_r), int(std::ceil(coverage_r + 0.5)));
     } else {
       // GaussianKernelSigma (a root search): the discrete kernel's variance is exactly s^2; worked out once for both
       // passes.
-      kernel_sigma_[k] = GaussianKernelSigma(region.r_px / 2);
+      kernel_sigma_[k] = GaussianKernelSigma(region.psf.r_px / 2);
       gaussian_->Use().SetRegion(r.x, r.y, r.br().x, r.br().y).SetKernel(kernel_sigma_[k], taps(region))
           .SetDirection(1, 0);
     }
     pass_->Draw();
   }
-  // The second pass of every region back into the texture: the Gaussian's vertical pass, or the disc's result
-  // copied (a pass of no taps is an exact copy).
+  // The second pass of every region back into the texture: the Gaussian's vertical pass, or a one-pass kernel's
+  // result copied (a pass of no taps is an exact copy).
   glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
   scratch.texture().BindImageForReading(0);
   gaussian_->Use();
@@ -382,9 +419,8 @@ void GlBlur::Blur(const Texture& texture, GLuint framebuffer, const std::vector<
     if (!blurs(region)) continue;
     const cv::Rect& r = region.rect;
     viewport(r);
-    const bool disc = region.method == "disc";
     gaussian_->SetRegion(r.x, r.y, r.br().x, r.br().y)
-        .SetKernel(kernel_sigma_[k], disc ? 0 : taps(region))
+        .SetKernel(kernel_sigma_[k], one_pass(region) ? 0 : taps(region))
         .SetDirection(0, 1);
     pass_->Draw();
   }
@@ -392,10 +428,16 @@ void GlBlur::Blur(const Texture& texture, GLuint framebuffer, const std::vector<
 }
 
 cv::Mat GlBlur::BlurImage(const cv::Mat& rgba, const std::string& method, double r_px) {
+  Psf psf;
+  psf.method = method, psf.r_px = r_px;
+  return BlurImage(rgba, psf);
+}
+
+cv::Mat GlBlur::BlurImage(const cv::Mat& rgba, const Psf& psf) {
   CV_Assert(rgba.type() == CV_32FC4);
   Texture texture(rgba.cols, rgba.rows);
   texture.Upload(rgba);
-  BlurTexture(texture, method, r_px);
+  BlurTexture(texture, psf);
   return texture.Download();
 }
 

@@ -11,6 +11,7 @@
 #include <epoxy/gl.h>
 
 #include "optics/thin_lens.h"
+#include "render/psf.h"
 
 namespace blurcue::render {
 
@@ -76,6 +77,7 @@ class GrowingTarget;
 class FullscreenPass;
 class GaussianBlurShader;
 class DiscBlurShader;
+class KernelBlurShader;
 
 // The GPU path. Needs a current GL context; loads its shaders from ShaderDir(). Its scratch texture is made once and
 // grown, so blurring layer after layer in a frame loop allocates nothing.
@@ -87,17 +89,20 @@ class GlBlur {
   GlBlur& operator=(const GlBlur&) = delete;
   // CV_32FC4 in and out through a texture: BlurTexture on a copy.
   cv::Mat BlurImage(const cv::Mat& rgba, const std::string& method, double r_px);
+  cv::Mat BlurImage(const cv::Mat& rgba, const Psf& psf);
   // Two passes (horizontal, vertical) of the Gaussian of r = 2 s.
   cv::Mat Gaussian(const cv::Mat& rgba, double r_px) { return BlurImage(rgba, "gaussian", r_px); }
   // One pass of the pillbox of radius r.
   cv::Mat Disc(const cv::Mat& rgba, double r_px) { return BlurImage(rgba, "disc", r_px); }
   // On the GPU, texture in and out (RGBA32F, same size): "gaussian" or "disc"; r <= 0 leaves it unchanged.
   void BlurTexture(Texture& texture, const std::string& method, double r_px);
-  // One layer's blur: a rectangle of a texture (its own image: the kernel clamps at its border) and its kernel.
+  void BlurTexture(Texture& texture, const Psf& psf);
+  // One layer's blur: a rectangle of a texture (its own image: the kernel clamps at its border) and its PSF: the
+  // separable Gaussian's two passes, the pillbox's one, or a general kernel's one (Psf::General: a streak, a pillbox
+  // with a floor; PsfKernel's weights, worked out on the CPU and uploaded into a kernel atlas made once and grown).
   struct Region {
     cv::Rect rect;
-    std::string method = "gaussian";
-    double r_px = 0;
+    Psf psf;
   };
   // Blurs each region of `target` in place; regions must not overlap, and outside them nothing is read or written.
   // Every region's first pass runs, then every region's second, so llvmpipe renders each stage of a frame's layers
@@ -108,6 +113,11 @@ class GlBlur {
   void Blur(const Texture& texture, GLuint framebuffer, const std::vector<Region>& regions);
   std::unique_ptr<GaussianBlurShader> gaussian_;
   std::unique_ptr<DiscBlurShader> disc_;
+  std::unique_ptr<KernelBlurShader> kernel_;
+  std::unique_ptr<GrowingTarget> kernel_atlas_;  // the general kernels of a Blur call side by side (red channel)
+  cv::Mat kernel_atlas_cpu_;                     // and their weights before the upload (kept between frames)
+  std::vector<cv::Point> kernel_origin_;         // per region, its kernel's place in the atlas (x < 0: none)
+  std::vector<int> kernel_taps_;
   std::unique_ptr<GrowingTarget> scratch_;
   std::unique_ptr<FullscreenPass> pass_;
   std::vector<double> kernel_sigma_;  // per region of a Blur call, the Gaussian's kernel width (kept: no frame allocates)

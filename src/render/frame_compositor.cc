@@ -99,13 +99,13 @@ struct FrameCompositor::Impl {
         placed.push_back({&o, {}, {}});
         continue;
       }
-      const double r = o.r_px * scale;  // at screen resolution
-      const int margin = whole_frame ? std::max(width, height) : KernelMarginPx(o.method, r) + 1;
+      const Psf psf = PsfOf(o, scale);  // at screen resolution
+      const int margin = whole_frame ? std::max(width, height) : KernelMarginPx(psf) + 1;
       const cv::Rect roi = renderer.LayerRoi(o.object, margin);
       if (roi.empty()) continue;
       if (x > 0 && x + roi.width > width) x = 0, y += row, row = 0;  // rows as wide as the frame
       placed.push_back({&o, roi, {x, y}});
-      regions.push_back({cv::Rect(x, y, roi.width, roi.height), o.method, r});
+      regions.push_back({cv::Rect(x, y, roi.width, roi.height), psf});
       x += roi.width, row = std::max(row, roi.height);
     }
     if (regions.empty() && placed.empty()) return;
@@ -128,10 +128,11 @@ struct FrameCompositor::Impl {
   void ComposeVarying(const BlurredObject& o, double scale) {
     const Footprint f = renderer.Measure(o.object);
     auto r_screen = [&](double z) { return std::max(0.0, o.r_of_depth_px(z) * scale); };
-    const double r_max = std::max({o.r_px * scale, r_screen(f.z_min_mm), r_screen(f.z_max_mm)});
-    Layer layer = renderer.Draw(o.object, KernelMarginPx(o.method, r_max) + 1);
+    Psf widest = PsfOf(o, scale);
+    widest.r_px = std::max({widest.r_px, r_screen(f.z_min_mm), r_screen(f.z_max_mm)});
+    Layer layer = renderer.Draw(o.object, KernelMarginPx(widest) + 1);
     if (layer.bgra.empty()) return;
-    BlurLayerVarying(layer, o.method, r_screen, nullptr);
+    BlurLayerVarying(layer, widest, r_screen, nullptr);
     cv::Mat rgba;
     cv::cvtColor(layer.bgra, rgba, cv::COLOR_BGRA2RGBA);
     uploaded.Upload(rgba);

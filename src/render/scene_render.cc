@@ -290,21 +290,45 @@ int KernelMarginPx(const std::string& method, double r_px) {
   return method == "disc" ? int(std::ceil(r_px + 0.5)) : GaussianTaps(r_px / 2);
 }
 
+int KernelMarginPx(const Psf& psf) { return PsfHalfWidth(psf); }
+
+Psf PsfOf(const scene::BlurredObject& object, double scale) {
+  Psf psf;
+  psf.method = object.method;
+  psf.r_px = object.r_px * scale;
+  psf.floor_sigma_px = object.floor_sigma_px * scale;
+  psf.motion_px = object.motion_px * scale;
+  return psf;
+}
+
 void BlurLayer(Layer& layer, const std::string& method, double r_px, GlBlur* gl) {
-  CheckBlurRadius(r_px);
-  if (r_px <= 0 || layer.bgra.empty()) return;
-  if (method != "gaussian" && method != "disc")
-    throw Error(ErrorKind::kUsage, "blur method for objects must be gaussian or disc, got " + Echo(method));
-  const bool disc = method == "disc";
+  Psf psf;
+  psf.method = method, psf.r_px = r_px;
+  BlurLayer(layer, psf, gl);
+}
+
+void BlurLayer(Layer& layer, const Psf& psf, GlBlur* gl) {
+  CheckPsf(psf);
+  if ((psf.r_px <= 0 && psf.MotionLengthPx() <= 0) || layer.bgra.empty()) return;
   if (gl) {
-    layer.bgra = disc ? gl->Disc(layer.bgra, r_px) : gl->Gaussian(layer.bgra, r_px);
+    layer.bgra = gl->BlurImage(layer.bgra, psf);
+  } else if (psf.General()) {
+    cv::Mat out;
+    cv::filter2D(layer.bgra, out, CV_32F, PsfKernel(psf), cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
+    layer.bgra = out;
   } else {
-    layer.bgra = disc ? DiscBlurCpu(layer.bgra, r_px) : GaussianBlurCpu(layer.bgra, r_px);
+    layer.bgra = psf.method == "disc" ? DiscBlurCpu(layer.bgra, psf.r_px) : GaussianBlurCpu(layer.bgra, psf.r_px);
   }
 }
 
 void BlurLayerVarying(Layer& layer, const std::string& method, const std::function<double(double)>& r_of_depth,
                       GlBlur* gl) {
+  Psf psf;
+  psf.method = method;
+  BlurLayerVarying(layer, psf, r_of_depth, gl);
+}
+
+void BlurLayerVarying(Layer& layer, const Psf& psf, const std::function<double(double)>& r_of_depth, GlBlur* gl) {
   if (layer.bgra.empty()) return;
   CV_Assert(layer.depth_mm.size() == layer.bgra.size());
   // Radius per covered pixel; uncovered pixels take their nearest covered pixel's radius.
@@ -332,7 +356,9 @@ void BlurLayerVarying(Layer& layer, const std::string& method, const std::functi
   std::vector<cv::Mat> blurred;
   for (double r : levels) {
     Layer copy{layer.roi, layer.bgra.clone(), {}};
-    BlurLayer(copy, method, r, gl);
+    Psf level = psf;
+    level.r_px = r;
+    BlurLayer(copy, level, gl);
     blurred.push_back(copy.bgra);
   }
   for (int y = 0; y < r_map.rows; ++y)

@@ -10,6 +10,8 @@
 #include <opencv2/core.hpp>
 
 #include "core/camera.h"
+#include "render/psf.h"
+#include "scene/frame.h"
 #include "scene/objects.h"
 
 namespace blurcue::render {
@@ -65,15 +67,26 @@ class SceneRenderer {
 // (CPU reference otherwise). The layer's margin must cover the kernel.
 class GlBlur;
 void BlurLayer(Layer& layer, const std::string& method, double r_px, GlBlur* gl);
+// The same with a whole PSF (defocus x floor x streak, render/psf.h): the general kernel through filter2D on the CPU,
+// one pass of blur_kernel.frag on the GL path.
+void BlurLayer(Layer& layer, const Psf& psf, GlBlur* gl);
 
 // Depth-varying blur: each pixel of the object gets r_of_depth(its camera z); pixels the blur spreads into take
 // the r of the nearest covered pixel. The layer is blurred at radius levels 0.5 px apart and each pixel mixes its
 // two nearest levels so the variance (r^2 / 4) is exact. Margin must cover r at the largest depth.
 void BlurLayerVarying(Layer& layer, const std::string& method, const std::function<double(double)>& r_of_depth,
                       GlBlur* gl);
+// The same with `psf`'s shape, floor and streak at every level (its r_px unused): the floor and the streak do not
+// change with depth, so the levels' variances still mix exactly.
+void BlurLayerVarying(Layer& layer, const Psf& psf, const std::function<double(double)>& r_of_depth, GlBlur* gl);
 
 // The margin (px) a blur of radius r needs around an object: the kernel's half-width.
 int KernelMarginPx(const std::string& method, double r_px);
+// The margin a whole PSF needs (PsfHalfWidth).
+int KernelMarginPx(const Psf& psf);
+
+// The PSF `object` is drawn with at `scale` screen px per photo px.
+Psf PsfOf(const scene::BlurredObject& object, double scale);
 
 // `background` linear BGR (CV_32FC3); the layer composited over it ("over", premultiplied), in place.
 void CompositeOver(cv::Mat& background_linear, const Layer& layer);

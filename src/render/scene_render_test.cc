@@ -311,7 +311,7 @@ TEST_F(SceneRenderTest, GpuFrameMatchesCpuReferenceAndWholeFrameApproach) {
   const View v;
   const cv::Mat photo = Photo(v.camera);
   FrameCompositor gpu(v.camera, v.rvec, v.tvec, photo);
-  std::vector<BlurredObject> balls = {{Ball(150), "gaussian", 3.0, {}}, {Ball(200), "disc", 5.0, {}}};
+  std::vector<BlurredObject> balls = {{Ball(150), "gaussian", 3.0, 0, {0, 0}, {}}, {Ball(200), "disc", 5.0, 0, {0, 0}, {}}};
   balls[1].object.center_board_mm[0] = 137.5;
   gpu.Compose(balls);
   const cv::Mat region = gpu.Read();
@@ -341,7 +341,7 @@ TEST_F(SceneRenderTest, AFrameWithoutObjectsIsThePhotoExactlyAfterFramesWithThem
   const View v;
   const cv::Mat photo = Photo(v.camera);
   FrameCompositor gpu(v.camera, v.rvec, v.tvec, photo);
-  std::vector<BlurredObject> balls = {{Ball(150), "gaussian", 3.0, {}}, {Ball(200), "disc", 5.0, {}}};
+  std::vector<BlurredObject> balls = {{Ball(150), "gaussian", 3.0, 0, {0, 0}, {}}, {Ball(200), "disc", 5.0, 0, {0, 0}, {}}};
   balls[1].object.center_board_mm[0] = 137.5;
   gpu.Compose({});
   const cv::Mat empty = gpu.Read();

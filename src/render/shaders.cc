@@ -144,6 +144,25 @@ DiscBlurShader& DiscBlurShader::SetKernel(float coverage_radius_px, int taps) {
   return *this;
 }
 
+KernelBlurShader::KernelBlurShader()
+    : program_(FullscreenProgram("blur_kernel.frag")),
+      region_(program_.Uniform("u_region")),
+      origin_(program_.Uniform("u_kernel_origin")),
+      taps_(program_.Uniform("u_taps")) {}
+KernelBlurShader& KernelBlurShader::Use() {
+  program_.Use();
+  return *this;
+}
+KernelBlurShader& KernelBlurShader::SetRegion(int x0, int y0, int x1, int y1) {
+  glUniform4i(region_, x0, y0, x1, y1);
+  return *this;
+}
+KernelBlurShader& KernelBlurShader::SetKernel(int origin_x, int origin_y, int taps) {
+  glUniform2i(origin_, origin_x, origin_y);
+  glUniform1i(taps_, taps);
+  return *this;
+}
+
 CompositeShader::CompositeShader()
     : program_(FullscreenProgram("composite.frag")), origin_(program_.Uniform("u_origin")) {
   ImageOnUnitZero(program_, "u_layer");

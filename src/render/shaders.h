@@ -87,6 +87,21 @@ class DiscBlurShader {
   GLint region_, radius_, taps_;
 };
 
+// shaders/blur_kernel.frag: a general 2-D kernel (render/psf.h) read from a kernel atlas on image unit 1, over a
+// rectangle of a texture.
+class KernelBlurShader {
+ public:
+  KernelBlurShader();
+  KernelBlurShader& Use();
+  KernelBlurShader& SetRegion(int x0, int y0, int x1, int y1);
+  // The kernel's top-left texel in the atlas and its half-width.
+  KernelBlurShader& SetKernel(int origin_x, int origin_y, int taps);
+
+ private:
+  Program program_;
+  GLint region_, origin_, taps_;
+};
+
 // shaders/composite.frag: a layer blended over the frame, texel (0, 0) of its texture landing on frame pixel `origin`.
 class CompositeShader {
  public:
@@ -101,5 +116,6 @@ class CompositeShader {
 
 static_assert(!std::is_copy_constructible_v<ObjectShader>);
 static_assert(!std::is_copy_constructible_v<GaussianBlurShader>);
+static_assert(!std::is_copy_constructible_v<KernelBlurShader>);
 
 }  // namespace blurcue::render

@@ -15,7 +15,13 @@ namespace blurcue::scene {
 struct BlurredObject {
   VirtualObject object;
   std::string method = "gaussian";  // "gaussian" or "disc"
-  double r_px = 0;                  // in the camera's (photo) px; drawn at r_px x the view's scale in screen px
+  // The radius of its PSF without the motion, in the camera's (photo) px, as the measurement states it (2 x the std
+  // of the line-spread function of defocus x lens floor); drawn at r_px x the view's scale in screen px.
+  double r_px = 0;
+  // The scene's lens floor inside r_px (std, photo px; 0: none): a pillbox defocus is drawn convolved with it.
+  double floor_sigma_px = 0;
+  // The motion blur: where the object moves in the image during the exposure (photo px, x right, y down; 0: none).
+  cv::Vec2d motion_px{0, 0};
   // The per-pixel plan: the radius (photo px) at a camera depth (mm), each pixel blurred by its own depth
   // (BlurLayerVarying); empty: r_px everywhere.
   std::function<double(double)> r_of_depth_px;

@@ -218,6 +218,19 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
     v["kernel"] = protocol::ToString(scene.kernel);
     v["blur_plan"] = scene.per_pixel ? "per_pixel" : "one_radius";
     v["r_span_screen_px"] = round4(scene.r_span_screen_px);
+    v["exposure_ms"] = scene.exposure_ms;
+    for (const bool left : {true, false}) {
+      if (scene.left_only && !left) continue;
+      const std::string side = left ? "left" : "right";
+      // As drawn (render::Psf): a floor beyond half the radius is the whole of it.
+      const double floor = std::min(left ? scene.floor_left_sigma_px : scene.floor_right_sigma_px,
+                                    std::max(0.0, left ? scene.r_left_px : scene.r_right_px) / 2);
+      const cv::Vec2d motion = left ? scene.motion_left_px : scene.motion_right_px;
+      v["floor_sigma_" + side + "_px"] = round4(floor);
+      v["floor_sigma_" + side + "_screen_px"] = round4(presentation.ScreenPx(floor));
+      v["motion_" + side + "_x_screen_px"] = round4(presentation.ScreenPx(motion[0]));
+      v["motion_" + side + "_y_screen_px"] = round4(presentation.ScreenPx(motion[1]));
+    }
     v["size_left_deg"] = round4(scene.size_left_deg);
     if (!scene.left_only) v["size_right_deg"] = round4(scene.size_right_deg);
     v["brightness"] = scene.brightness;

@@ -139,6 +139,7 @@ Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, cons
   for (int side = 0; side < 2; ++side) {
     if (!shown[size_t(side)]) continue;
     const scene::BlurredObject& b = *shown[size_t(side)];
+    const double floor = std::min(b.floor_sigma_px, std::max(0.0, b.r_px) / 2);  // as drawn (render::Psf)
     const std::vector<cv::Point2d> outline = scene::OutlineOf(camera, scene->rvec, scene->tvec, b.object);
     std::vector<cv::Point2d> centre;
     cv::projectPoints(std::vector<cv::Point3d>{cv::Point3d(b.object.center_board_mm)}, scene->rvec, scene->tvec,
@@ -155,6 +156,12 @@ Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, cons
          {"r_camera_px", round(b.r_px, 1e-4)},
          {"r_screen_px", round(presentation.ScreenPx(b.r_px), 1e-4)},
          {"r_arcmin", round(presentation.Arcmin(b.r_px), 1e-4)},
+         // The PSF's parts (render/psf.h): r^2 = defocus_r^2 + 4 floor_sigma^2, and the motion streak beside it.
+         {"floor_sigma_screen_px", round(presentation.ScreenPx(floor), 1e-4)},
+         {"defocus_r_screen_px", round(presentation.ScreenPx(std::sqrt(std::max(0.0, b.r_px * b.r_px - 4 * floor * floor))), 1e-4)},
+         {"motion_screen_px", {round(presentation.ScreenPx(b.motion_px[0]), 1e-4),
+                               round(presentation.ScreenPx(b.motion_px[1]), 1e-4)}},
+         {"exposure_ms", trial.exposure_ms},
          {"size_deg", round(display::ArcminOfScreenPx(profile, ExtentPx(outline)) / 60, 1e-4)}});
   }
   return frame;

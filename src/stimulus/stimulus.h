@@ -55,6 +55,13 @@ struct TrialScene {
   int intervals = 0;       // the intervals a pair trial shows one after the other (protocol::IntervalCount), else 0
   // The radii rendered, averaged over the run for balls, and the scene's own blur (the fitted model) there.
   double r_left_px = 0, r_right_px = 0, r_scene_px = 0;
+  // Each side's lens floor inside its radius (std, photo px; calib::FloorSigmaPx of its source): a scene source's
+  // defocus is drawn convolved with the scene's floor.
+  double floor_left_sigma_px = 0, floor_right_sigma_px = 0;
+  // Motion blur: the exposure (content.exposure_ms; 0: none) and each ball's streak over it (photo px, image x right,
+  // y down), averaged over the run like the radii.
+  double exposure_ms = 0;
+  cv::Vec2d motion_left_px{0, 0}, motion_right_px{0, 0};
 
   // The blur plan (PlanOnScreen): per pixel by depth when an object's depth span changes its radius on screen by at least
   // the protocol's depth_blur_threshold, else one radius at its centre.
@@ -77,7 +84,8 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
                          const calib::SceneCalib* scene, const Presentation* presentation = nullptr);
 
 // What a pair trial (grid or ball) shows t_s after onset: each side's object where it is at that moment and the blur
-// radius (photo px) it gets there; [0] left, [1] right, empty for a ball wiped at the end of its section. No GL:
+// radius (photo px) it gets there, the lens floor inside it (a scene source's) and, for a rolling ball with an exposure,
+// its motion streak; [0] left, [1] right, empty for a ball wiped at the end of its section. No GL:
 // StimulusRenderer::Compose draws exactly these, and the runner records each frame's radii from them.
 std::array<std::optional<scene::BlurredObject>, 2> ObjectsAt(const protocol::Protocol& protocol,
                                                               const calib::SceneCalib& scene, const TrialScene& trial,
@@ -160,7 +168,10 @@ struct Presentation {
 // What a frame shows, in screen terms (run --capture's trial-NNNN.json): the display (the monitor's width_px,
 // height_px, width_mm, height_mm, distance_mm, px_per_deg, and window_px, the window's size), where the photo sits (scaling, screen_px_per_photo_px,
 // photo_rect_px), the blur plan (blur_plan, r_span_screen_px) and every object on it: side, kind, source, kernel, center_px (its pose's centre), outline_px (the
-// screen polygon of its silhouette), r_camera_px, r_screen_px, r_arcmin and size_deg (the outline's largest extent).
+// screen polygon of its silhouette), r_camera_px, r_screen_px, r_arcmin (its PSF without the motion, 2 x the std of
+// its line-spread function, as the measurement states it), floor_sigma_screen_px and defocus_r_screen_px (its parts:
+// r^2 = defocus_r^2 + 4 floor_sigma^2), motion_screen_px ([x, y], the streak over exposure_ms) and size_deg (the
+// outline's largest extent).
 // A picture's frame (`scene` may be null; no objects) instead: the virtual picture (rect_px, its outline before the
 // blur; cutoff, the level shown; its blur as r_screen_px and r_arcmin; width_arcmin) and the real one (rect_px, the
 // lower half; distance_m; with content.real_camera its blur as r_camera_px, r_screen_px and r_arcmin).

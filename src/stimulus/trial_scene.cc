@@ -6,6 +6,9 @@
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <vector>
+
+#include <opencv2/calib3d.hpp>
 
 #include "core/error.h"
 #include "scene/objects.h"
@@ -70,6 +73,17 @@ scene::VirtualObject Ball(const calib::SceneCalib& s, const TrialScene& t, doubl
   return o;
 }
 
+// The streak a ball centred at y_mm leaves over the trial's exposure while it rolls (photo px): where its centre's
+// image goes from half an exposure before to half after, through the calibrated camera (its distortion included).
+cv::Vec2d StreakAtPx(const calib::SceneCalib& s, const TrialScene& t, double y_mm, double radius_mm, bool left) {
+  if (!(t.exposure_ms > 0 && t.speed_mm_s > 0)) return {0, 0};
+  const double half = 0.5 * t.speed_mm_s * t.exposure_ms / 1000 * (t.to_y_mm >= t.from_y_mm ? 1 : -1);
+  std::vector<cv::Point3d> ends = {cv::Point3d(Ball(s, t, y_mm - half, radius_mm, left).center_board_mm),
+                                   cv::Point3d(Ball(s, t, y_mm + half, radius_mm, left).center_board_mm)};
+  std::vector<cv::Point2d> image;
+  cv::projectPoints(ends, s.rvec, s.tvec, cv::Matx33d(s.camera.Intrinsics().data()), s.camera.dist_coeffs, image);
+  return {image[1].x - image[0].x, image[1].y - image[0].y};
+}
 
 // The protocol's kernel as the renderer names its blur method: the one place the two vocabularies meet (render knows
 // nothing of protocols).
@@ -131,6 +145,7 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   t.intervals = protocol::IntervalCount(protocol);
   t.kernel = protocol.content.kernel;
   t.brightness = protocol.content.brightness;
+  t.exposure_ms = protocol.content.exposure_ms;
   t.contrast = protocol.content.contrast;
   t.white_balance = protocol.content.white_balance;
   // Problems name the protocol field that asked for what cannot be shown, and the trial as a detail.
@@ -162,6 +177,8 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   };
   t.left = Source(trial.left, &t.left_fixed_px, [&] { return field("left"); }, presentation);
   t.right = Source(trial.right, &t.right_fixed_px, [&] { return field("right"); }, presentation);
+  t.floor_left_sigma_px = calib::FloorSigmaPx(*scene, t.left);
+  t.floor_right_sigma_px = calib::FloorSigmaPx(*scene, t.right);
   const double s = scene->board.square_mm;
   // Where the right side's object is shown, so where its radius is evaluated: its own place, or in an intervals
   // trial the left object's (IntervalScene shows each side alone there). Evaluated at its own place, a place-dependent
@@ -267,6 +284,8 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
     t.r_right_px += r_at(r, t.right, t.right_fixed_px, "right") / samples;
     t.r_scene_px += 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, nullptr) +
                            r_at(r, calib::BlurSource::kFitted, 0, nullptr)) / samples;
+    t.motion_left_px += StreakAtPx(*scene, t, y, radius, true) / samples;
+    t.motion_right_px += StreakAtPx(*scene, t, y, radius, right_place) / samples;
   }
   // Every edge the run passes, too: the samples step over edges on a long board, and a frame there must have a
   // radius (a measured source is its nearest edge's value, refused for an edge with no usable section).
@@ -297,7 +316,10 @@ std::array<std::optional<scene::BlurredObject>, 2> ObjectsAt(const protocol::Pro
       const double y = trial.BallYMm(t_s);
       if (!std::isfinite(y)) continue;  // wiped at the end of a section
       o = Ball(s, trial, y, protocol.content.radius_mm, left);
+      // Rolling (onset to arrival): the streak of its velocity there over the exposure; at rest, none.
+      if (t_s >= 0 && t_s < trial.MotionS()) b.motion_px = StreakAtPx(s, trial, y, protocol.content.radius_mm, left);
     }
+    b.floor_sigma_px = calib::FloorSigmaPx(s, source);
     if (trial.per_pixel) {
       // The radius along the object's line of sight at each depth: the source evaluated where the pixel's surface is.
       const cv::Vec3d centre = s.ToCamera(o.center_board_mm);
@@ -329,6 +351,8 @@ TrialScene IntervalScene(const TrialScene& scene, bool right) {
     s.left_gain = s.right_gain;
     s.left_add_px = s.right_add_px;
     s.r_left_px = s.r_right_px;
+    s.floor_left_sigma_px = s.floor_right_sigma_px;
+    s.motion_left_px = s.motion_right_px;
   }
   return s;
 }

@@ -242,6 +242,18 @@ std::vector<Column> MakeColumns() {
   variable("kernel", "string", "", "the blur kernel (gaussian | disc)");
   variable("blur_plan", "string", "", "one_radius: each object blurred with one radius; per_pixel: by depth");
   variable("r_span_screen_px", "number", "screen px", "the largest change of a radius across an object's depth");
+  // The PSF beside each radius (render/psf.h): the lens floor inside it and the motion streak over the exposure.
+  variable("exposure_ms", "number", "ms", "the exposure a moving object's motion blur lasts (content.exposure_ms; 0: none)");
+  for (const std::string side : {"left", "right"}) {
+    variable("floor_sigma_" + side + "_px", "number", "photo px",
+             "the lens floor (std) inside the " + side + " object's radius: the scene's, for a measured, measured_section "
+             "or fitted source (its defocus drawn convolved with it); 0 for the others");
+    variable("floor_sigma_" + side + "_screen_px", "number", "screen px", "the same on the screen");
+    variable("motion_" + side + "_x_screen_px", "number", "screen px",
+             "the " + side + " object's motion streak over the exposure, across (x right), averaged over the run");
+    variable("motion_" + side + "_y_screen_px", "number", "screen px",
+             "the " + side + " object's motion streak over the exposure, down (y down), averaged over the run");
+  }
   variable("size_left_deg", "number", "deg", "the left object's largest extent on screen at onset");
   variable("size_right_deg", "number", "deg", "the right object's largest extent on screen at onset");
   variable("brightness", "number", "", "the object's brightness matching (factor of its texture's values)");

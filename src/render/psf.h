@@ -1,0 +1,47 @@
+#pragma once
+// The point-spread function a virtual object is drawn with (DESIGN.md "Definitions", "Motion"): its depth's defocus
+// (a Gaussian or a pillbox) convolved with the scene's lens floor (a Gaussian) and with the streak its motion
+// leaves during the exposure, as one discrete 2-D kernel whose second moments are exactly the stated ones.
+#include <string>
+
+#include <opencv2/core.hpp>
+
+namespace blurcue::render {
+
+struct Psf {
+  std::string method = "gaussian";  // the defocus's shape: "gaussian" or "disc"
+  // The radius of defocus x floor (2 x the std of its line-spread function; r^2 = R^2 + 4 f^2 for a disc of radius R
+  // and a floor of std f), the whole PSF's radius without the motion. A floor larger than r / 2 is r / 2 (no defocus).
+  double r_px = 0;
+  double floor_sigma_px = 0;  // the lens floor's std inside r_px (only shapes the kernel of a pillbox)
+  cv::Vec2d motion_px{0, 0};  // the streak: where the object moves during the exposure (px, image x right, y down)
+
+  // The pillbox's radius R inside r_px: sqrt(r^2 - 4 f^2), 0 when the floor is the whole of r.
+  double DefocusRadiusPx() const;
+  // The floor's std as drawn: min(floor_sigma_px, r_px / 2).
+  double FloorSigmaPx() const;
+  double MotionLengthPx() const { return cv::norm(motion_px); }
+  // Whether it needs the general kernel (one 2-D pass): a streak, or a pillbox with a floor. Otherwise the separable
+  // Gaussian or the pillbox pass draws it (a Gaussian defocus x a Gaussian floor is the Gaussian of r).
+  bool General() const;
+};
+
+// Throws Error(kDomain) naming the value unless r, the floor and the streak are finite and within the largest blur
+// (optics::kMaxBlurRadiusPx), and the method is gaussian or disc.
+void CheckPsf(const Psf& psf);
+
+// The discrete kernel (CV_32F, (2 h + 1)^2, normalised, centred): the defocus kernel of blur.h (GaussianBlurCpu's
+// sampled Gaussian of r / 2, or DiscKernel of R) convolved with the sampled Gaussian of the floor (GaussianKernelSigma:
+// its variance is exactly f^2) and with the streak. Its line-spread variance is r^2 / 4 across and along any axis,
+// plus |m|^2 / 12 along the motion m: the streak is the segment from -m/2 to m/2 sampled densely and each sample
+// spread bilinearly over its four nearest pixels, the segment's drawn length chosen so that its variance along m is
+// exactly |m|^2 / 12 (bilinear spreading adds a little of its own, up to 1/4 px^2 across a diagonal streak).
+cv::Mat PsfKernel(const Psf& psf);
+// Its half-width h, without building it.
+int PsfHalfWidth(const Psf& psf);
+
+// The streak alone (normalised, centred, odd square), as PsfKernel makes it: its variance along the motion exceeds
+// its variance across it (returned in across_px2 when given) by exactly |m|^2 / 12.
+cv::Mat StreakKernel(const cv::Vec2d& motion_px, double* across_px2 = nullptr);
+
+}  // namespace blurcue::render

@@ -1,0 +1,122 @@
+// The PSF's kernel against its analytic second moments, and the GL pass against the CPU reference (label "gl": runs
+// on Mesa's llvmpipe through EGL with no display).
+#include "render/psf.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/error.h"
+#include "render/blur.h"
+#include "render/gl_context.h"
+
+#include <opencv2/imgproc.hpp>
+
+namespace blurcue::render {
+namespace {
+
+// The kernel's covariance (px^2) about its centroid: xx, yy, xy; and its centroid.
+struct Moments {
+  double xx = 0, yy = 0, xy = 0, cx = 0, cy = 0, sum = 0;
+};
+Moments Of(const cv::Mat& k) {
+  Moments m;
+  for (int y = 0; y < k.rows; ++y)
+    for (int x = 0; x < k.cols; ++x) {
+      const double w = k.at<float>(y, x);
+      m.sum += w, m.cx += w * x, m.cy += w * y;
+    }
+  m.cx /= m.sum, m.cy /= m.sum;
+  for (int y = 0; y < k.rows; ++y)
+    for (int x = 0; x < k.cols; ++x) {
+      const double w = k.at<float>(y, x) / m.sum, dx = x - m.cx, dy = y - m.cy;
+      m.xx += w * dx * dx, m.yy += w * dy * dy, m.xy += w * dx * dy;
+    }
+  return m;
+}
+
+Psf Make(const char* method, double r, double floor, cv::Vec2d motion = {0, 0}) {
+  Psf p;
+  p.method = method, p.r_px = r, p.floor_sigma_px = floor, p.motion_px = motion;
+  return p;
+}
+
+TEST(Psf, PillboxWithFloorHasTheStatedRadius) {
+  // r^2 = R^2 + 4 f^2: the whole kernel's line-spread variance is r^2 / 4 across x and y, from sub-pixel up.
+  for (double r : {0.3, 0.7, 1.2, 3.0, 9.5})
+    for (double f : {0.1, 0.35, 0.6}) {
+      const Moments m = Of(PsfKernel(Make("disc", r, f)));
+      EXPECT_NEAR(m.sum, 1, 1e-5);
+      EXPECT_NEAR(2 * std::sqrt(m.xx), r, 1e-3 * r) << "r " << r << " floor " << f;
+      EXPECT_NEAR(2 * std::sqrt(m.yy), r, 1e-3 * r) << "r " << r << " floor " << f;
+      EXPECT_NEAR(m.xy, 0, 1e-6);
+    }
+}
+
+TEST(Psf, FloorBeyondTheRadiusIsTheWholeRadius) {
+  const Psf p = Make("disc", 0.5, 0.4);  // 2 f = 0.8 > r: no defocus left, the floor drawn as r / 2
+  EXPECT_DOUBLE_EQ(p.DefocusRadiusPx(), 0);
+  EXPECT_DOUBLE_EQ(p.FloorSigmaPx(), 0.25);
+  EXPECT_NEAR(2 * std::sqrt(Of(PsfKernel(p)).xx), 0.5, 1e-3);
+}
+
+TEST(Psf, PillboxWithFloorIsWiderTailedThanThePillbox) {
+  // Same second moment, other shape: the floor rounds the pillbox's rim (its corner tap is no longer 0).
+  const cv::Mat plain = PsfKernel(Make("disc", 3, 0)), floored = PsfKernel(Make("disc", 3, 0.8));
+  EXPECT_GT(floored.rows, plain.rows);
+  EXPECT_NEAR(Of(plain).xx, Of(floored).xx, 1e-3);
+}
+
+TEST(Psf, StreakAddsItsLengthSquaredOverTwelveAlongTheMotion) {
+  // A horizontal streak of 6 px on a Gaussian of r 1: var_x = 1/4 + 36/12, var_y = 1/4.
+  Moments m = Of(PsfKernel(Make("gaussian", 1, 0, {6, 0})));
+  EXPECT_NEAR(m.xx, 0.25 + 3, 1e-3);
+  EXPECT_NEAR(m.yy, 0.25, 1e-3);
+  EXPECT_NEAR(m.cx, m.cy, 1e-6);  // centred
+  // Diagonal and nearly vertical ones on a pillbox with a floor and on a Gaussian: across the motion exactly r^2 / 4,
+  // along it r^2 / 4 + L^2 / 12 (the spreading's own variance taken out of the floor or the defocus).
+  for (const Psf& p : {Make("disc", 2, 0.3, {3, 4}), Make("disc", 2, 0, {3, 4}), Make("gaussian", 1.1, 0, {0.11, 1.43}),
+                       Make("disc", 1.2, 0.6, {-0.4, 6.5})}) {
+    m = Of(PsfKernel(p));
+    const double l = p.MotionLengthPx(), c = p.motion_px[0] / l, s = p.motion_px[1] / l;
+    const double along = c * c * m.xx + s * s * m.yy + 2 * c * s * m.xy;
+    const double across = s * s * m.xx + c * c * m.yy - 2 * c * s * m.xy;
+    EXPECT_NEAR(across, p.r_px * p.r_px / 4, 2e-3) << p.method << " " << p.motion_px;
+    EXPECT_NEAR(along, p.r_px * p.r_px / 4 + l * l / 12, 2e-3) << p.method << " " << p.motion_px;
+  }
+  // Sub-pixel streaks too.
+  for (double length : {0.3, 0.8, 1.7}) {
+    m = Of(StreakKernel({0, length}));
+    EXPECT_NEAR(m.yy, length * length / 12, 1e-4) << length;
+    EXPECT_NEAR(m.xx, 0, 1e-9);
+  }
+}
+
+TEST(Psf, RefusesNanAndUnknownShapes) {
+  EXPECT_THROW(PsfKernel(Make("disc", 1, std::nan(""))), Error);
+  EXPECT_THROW(PsfKernel(Make("disc", 1, 0, {std::nan(""), 0})), Error);
+  EXPECT_THROW(PsfKernel(Make("box", 1, 0)), Error);
+  EXPECT_THROW(PsfKernel(Make("gaussian", 1, 0, {600, 0})), Error);
+}
+
+TEST(Psf, HalfWidthHoldsTheKernel) {
+  for (const Psf& p : {Make("disc", 0.4, 0.2), Make("disc", 5, 0.5, {7, -2}), Make("gaussian", 3, 0, {0.4, 9})})
+    EXPECT_GE(PsfHalfWidth(p), PsfKernel(p).rows / 2);
+}
+
+TEST(PsfGl, GlPassEqualsCpuReference) {
+  const auto context = GlContext::CreateOffscreen();
+  cv::Mat img(48, 64, CV_32FC4, cv::Scalar(0, 0, 0, 0));
+  img(cv::Rect(16, 12, 30, 20)).setTo(cv::Scalar(0.8, 0.5, 0.2, 1.0));
+  img(cv::Rect(20, 14, 4, 10)).setTo(cv::Scalar(0.05, 0.05, 0.05, 1.0));
+  GlBlur gl;
+  for (const Psf& p : {Make("disc", 2.5, 0.4), Make("gaussian", 1.5, 0, {5, 2}), Make("disc", 0.6, 0.2, {-0.5, 3})}) {
+    cv::Mat cpu;
+    cv::filter2D(img, cpu, CV_32F, PsfKernel(p), cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
+    const cv::Mat shown = gl.BlurImage(img, p);
+    EXPECT_LT(cv::norm(shown, cpu, cv::NORM_INF), 1e-5) << p.method << " r " << p.r_px;
+  }
+}
+
+}  // namespace
+}  // namespace blurcue::render
