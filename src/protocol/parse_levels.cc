@@ -76,6 +76,19 @@ void Parser::CheckLevelValue(const std::string& name, const Json& v, const std::
   }
 }
 
+namespace {
+
+// A level as typed once it has been checked. A value the parser refused inside an object level (an object or a list)
+// is kept as its JSON text, so the design's counts stay as written: the protocol is refused anyway.
+Level Typed(const std::string& factor, const Json& level) {
+  if (!level.is_object()) return LevelOf(factor, level);
+  Json scalars = Json::object();
+  for (const auto& [key, value] : level.items()) scalars[key] = value.is_structured() ? Json(value.dump()) : value;
+  return LevelOf(factor, scalars);
+}
+
+}  // namespace
+
 std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) {
   std::vector<Factor> factors;
   if (!v.is_object()) {
@@ -144,7 +157,7 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
       } else {
         CheckLevelValue(name, level, lp);
       }
-      f.levels.push_back(level);
+      f.levels.push_back(Typed(name, level));
     }
     if (sides) ++carrying_sides;
     factors.push_back(std::move(f));
@@ -287,7 +300,7 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
       CheckLevelValue(header[c], level[header[c]], cp, in);
     }
     if (!printable) continue;
-    factor.levels.push_back(std::move(level));
+    factor.levels.push_back(LevelOf(factor.name, level));
   }
   return {factor};
 }

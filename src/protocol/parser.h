@@ -131,7 +131,8 @@ class Parser {
                    Timing* t);
   void ParseInfo(const Json& v, const std::string& ptr, Protocol* p);
   void ParseGroups(const Json& v, const Json& top, const std::string& ptr, Protocol* p);
-  void ParseSides(const Json& v, const std::string& ptr);
+  // A block's "sides", checked, and typed as far as it is valid.
+  std::optional<Block::Sides> ParseSides(const Json& v, const std::string& ptr);
   // Fills `b` from `obj` at `ptr`, falling back to the protocol-level defaults in `top`.
   void ParseBlock(const Json& obj, const std::string& ptr, const Json& top, Block* b);
   void ParseResponses(const Json& v, const std::string& ptr, const std::set<Task>& tasks, const Protocol& p,

@@ -83,7 +83,7 @@ std::vector<std::string> RecordedNameProblems(const protocol::Protocol& protocol
     for (const protocol::Factor& f : block.factors) {
       const std::string at = block.factors_pointer + (table ? "" : "/" + JsonPointerToken(f.name));
       bool objects = false;
-      for (const Json& level : f.levels) objects = objects || level.is_object();
+      for (const protocol::Level& level : f.levels) objects = objects || level.object;
       // A conditions table's rows (factor "row") and any factor of object levels named row: only their keys are
       // recorded (TrialVariables).
       if (!(f.name == "row" && objects)) add({f.name, "the factor " + f.name, at}, "");
@@ -97,8 +97,7 @@ std::vector<std::string> RecordedNameProblems(const protocol::Protocol& protocol
                            Json(f.name).dump());
       std::set<std::string> keys;  // each key once per factor (every row of a table has every column)
       for (size_t i = 0; i < f.levels.size(); ++i) {
-        if (!f.levels[i].is_object()) continue;
-        for (const auto& [key, value] : f.levels[i].items()) {
+        for (const auto& [key, value] : f.levels[i].fields) {
           // The sides are recorded as such.
           if (key == "left" || key == "right" || key == "object" || !keys.insert(key).second) continue;
           if (table)
