@@ -167,7 +167,8 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
             (*conditions.holder)["conditions"]);
   else if (conditions.holder)
     b->factors = ParseConditions(*conditions.holder, conditions.ptr + "/conditions"),
-    b->factors_pointer = conditions.ptr + "/conditions";
+    b->factors_pointer = conditions.ptr + "/conditions",
+    b->conditions = (*conditions.holder)["conditions"].is_string() ? (*conditions.holder)["conditions"].get<std::string>() : "";
   else if (!factors.holder)
     Problem(ptr + "/factors", "is required (here or at /factors; or a conditions table) but missing");
   else

@@ -55,13 +55,13 @@ void Parser::CheckLevelValue(const std::string& name, const Json& v, const std::
   // Cycles per picture width; 0 shows the picture unfiltered.
   else if (name == "cutoff") number_in(0, 1000, "cycles per picture width", "a cut-off");
   else if (name == "left" || name == "right" || name == "object") {
-    if (!IsBlurSource(v))
-      report("a blur source must be none, measured, measured_section, estimated, fitted, a radius in " +
-             Range(0, kMaxFixedRadiusPx, "photo px") + ", {\"screen_px\": r} with r in " +
-             Range(0, kMaxFixedRadiusPx, "") + " or {\"arcmin\": r} with r in " + Range(0, 600, "") +
-             (v.is_string() ? DidYouMean(v.get<std::string>(), {"none", "measured", "measured_section", "estimated",
-                                                                "fitted"})
-                            : std::string()));
+    if (!IsBlurSource(v)) {
+      std::string words;
+      for (const std::string& word : BlurSourceWords()) words += word + ", ";
+      report("a blur source must be " + words + "a radius in " + Range(0, kMaxFixedRadiusPx, "photo px") +
+             ", {\"screen_px\": r} with r in " + Range(0, kMaxFixedRadiusPx, "") + " or {\"arcmin\": r} with r in " +
+             Range(0, 600, "") + (v.is_string() ? DidYouMean(v.get<std::string>(), BlurSourceWords()) : std::string()));
+    }
   } else if (name == "id") {
     // An id names a row or a pattern in the tables, the report's file names and its charts: text a spreadsheet
     // shows as written, or a whole number every reader holds exactly (1e308 and 2^64 - 1 are neither).

@@ -36,7 +36,7 @@ std::string Range(double lo, double hi, const std::string& unit);
 
 // A fixed blur radius: the thesis's measured radii reach ~17 px; 100 px blurs a whole object away.
 const double kMaxFixedRadiusPx = 100;
-// A blur source: none, measured, measured_section, estimated, fitted, a radius in photo px, {"screen_px": r} or
+// A blur source: a word of BlurSourceWords() (none, measured, ...), a radius in photo px, {"screen_px": r} or
 // {"arcmin": r}.
 bool IsBlurSource(const Json& v);
 // Names whose values CheckLevelValue knows: a level of a factor so named is that value, never an object.

@@ -78,6 +78,7 @@ struct Block {
   std::string pointer, task_pointer, factors_pointer, sides_pointer, counterbalance_pointer;
   Task task = Task::kForcedChoice;
   std::vector<Factor> factors;        // crossed in full; sorted by name (JSON object order)
+  std::string conditions;             // a conditions table's path as the protocol writes it (its factor "row"); "" for none
   int repetitions = 1;
   Counterbalance counterbalance = Counterbalance::kNone;
   // "sides": what each side shows when no factor's levels carry the sides: {"left": SOURCE, "right": SOURCE}, or the
