@@ -341,5 +341,22 @@ TEST(SceneCalib, BadFieldIsNamed) {
   EXPECT_THROW(ParseBlurSource("blurry", nullptr), Error);
 }
 
+// A command's blur source and a protocol's are one vocabulary (core/blur_source.h): each word a protocol may write
+// names the same source here, "fixed" is no word (a number is), and a misspelt word is refused with a did-you-mean.
+TEST(SceneBlur, CommandsReadTheProtocolsBlurSourceWords) {
+  EXPECT_EQ(BlurSourceWords(), (std::vector<std::string>{"none", "measured", "measured_section", "estimated", "fitted"}));
+  for (const BlurSource source : kBlurSources) {
+    if (source == BlurSource::kFixed) continue;
+    EXPECT_EQ(ParseBlurSource(ToString(source), nullptr), source) << ToString(source);
+  }
+  EXPECT_THROW(ParseBlurSource("fixed", nullptr), Error);
+  try {
+    ParseBlurSource("mesured", nullptr);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("got 'mesured' (did you mean measured?)"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace blurcue::calib

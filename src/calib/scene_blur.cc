@@ -9,6 +9,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "core/error.h"
+#include "core/names.h"
 #include "core/typed.h"
 #include "optics/thin_lens.h"
 
@@ -141,31 +142,18 @@ SceneCalib LoadSceneCalib(const std::filesystem::path& path) {
 }
 
 BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px) {
-  if (text == "none") return BlurSource::kNone;
-  if (text == "measured") return BlurSource::kMeasured;
-  if (text == "measured_section") return BlurSource::kMeasuredSection;
-  if (text == "estimated") return BlurSource::kEstimated;
-  if (text == "fitted") return BlurSource::kFitted;
+  for (const BlurSource source : kBlurSources)
+    if (source != BlurSource::kFixed && ToString(source) == text) return source;
   const std::optional<double> r = ParseDecimal(text);
   if (r && *r >= 0 && *r <= optics::kMaxBlurRadiusPx) {
     if (fixed_r_px) *fixed_r_px = *r;
     return BlurSource::kFixed;
   }
-  throw Error(ErrorKind::kUsage,
-              "blur source must be none, measured, measured_section, estimated, fitted or a radius in [0, " +
-                  std::to_string(int(optics::kMaxBlurRadiusPx)) + "] px, got " + Echo(text));
-}
-
-std::string ToString(BlurSource source) {
-  switch (source) {
-    case BlurSource::kNone: return "none";
-    case BlurSource::kMeasured: return "measured";
-    case BlurSource::kMeasuredSection: return "measured_section";
-    case BlurSource::kEstimated: return "estimated";
-    case BlurSource::kFitted: return "fitted";
-    case BlurSource::kFixed: return "fixed";
-  }
-  return "?";
+  std::string words;
+  for (const std::string& word : BlurSourceWords()) words += (words.empty() ? "" : ", ") + word;
+  throw Error(ErrorKind::kUsage, "blur source must be " + words + " or a radius in [0, " +
+                                     std::to_string(int(optics::kMaxBlurRadiusPx)) + "] px, got " + Echo(text) +
+                                     DidYouMean(text, BlurSourceWords()));
 }
 
 double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& p, double fixed_r_px) {

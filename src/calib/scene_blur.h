@@ -8,6 +8,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "core/blur_source.h"
 #include "core/board.h"
 #include "core/camera.h"
 #include "core/json_io.h"
@@ -40,11 +41,12 @@ struct SceneCalib {
 SceneCalib LoadSceneCalib(const std::filesystem::path& path);
 SceneCalib SceneCalibFromJson(const Json& json, const std::string& where);
 
-enum class BlurSource { kNone, kMeasured, kMeasuredSection, kEstimated, kFitted, kFixed };
-// "none", "measured", "measured_section", "estimated", "fitted", or a number (a fixed radius in px). Throws
-// Error(kUsage) otherwise.
+// The sources of blur: core's one vocabulary (core/blur_source.h), which protocols name too.
+using ::blurcue::BlurSource;
+using ::blurcue::ToString;
+// A word of BlurSourceWords() ("none", "measured", ...) or a number (a fixed radius in px), as a command takes it.
+// Throws Error(kUsage) otherwise, with a did-you-mean.
 BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px);
-std::string ToString(BlurSource source);
 
 // Blur radius (px) the scene calls for at a camera-frame point:
 //   measured  - the thesis's edge value (its Fig. 4.11): the mean r_px of the usable sections of the board edge

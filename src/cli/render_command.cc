@@ -166,7 +166,7 @@ void AddRenderCommand(CLI::App& app) {
     WriteImage(args->out, out);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     std::printf("%s at edge %d: depth %.1f mm, blur %s x %.2f = %.2f px (%s, %s); layer %dx%d of %dx%d -> %s in %.0f ms\n",
-                args->object.c_str(), args->edge, f.z_center_mm, calib::ToString(source).c_str(), args->gain, r,
+                args->object.c_str(), args->edge, f.z_center_mm, ToString(source).c_str(), args->gain, r,
                 args->method.c_str(), args->backend.c_str(), layer.roi.width, layer.roi.height, photo.cols,
                 photo.rows, args->out.c_str(), ms);
     if (varying)

@@ -84,7 +84,7 @@ void AddValidateCommand(CLI::App& app) {
     if (args->no_files) {
       p = protocol::LoadProtocol(args->file, protocol::ValidateOptions{false});
       // As PrepareStudy does for run: each design variable recorded in a column of its own.
-      session::CheckRecordedNames(p, ParseJson(ReadTextFile(args->file), args->file));
+      session::CheckRecordedNames(p);
       for (const std::string& group : GroupsToCheck(p, args->group)) {
         const uint64_t seed = args->seed ? *args->seed : protocol::DefaultSeed(p.name, args->participant);
         checked.push_back({group, seed, protocol::BuildTrials(p, args->participant, seed, group), ""});

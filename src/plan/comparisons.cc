@@ -50,7 +50,7 @@ Moments MomentsOf(const std::vector<double>& v) {
 // [study][participant] -> the participant's estimate for `key` (NaN: none).
 using Grid = std::vector<std::vector<double>>;
 
-Grid EstimatesOf(const PlanResult& r, const std::string& key) {
+Grid EstimatesOf(const PlanResult& r, const ConditionKey& key) {
   Grid g(r.studies.size());
   for (size_t s = 0; s < r.studies.size(); ++s)
     for (const SimParticipant& p : r.studies[s]) {
@@ -102,8 +102,8 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
                         "protocol has a procedure (staircase or QUEST+)");
     return;
   }
-  std::map<std::string, Grid> est;
-  std::map<std::string, Moments> overall;
+  std::map<ConditionKey, Grid> est;
+  std::map<ConditionKey, Moments> overall;
   for (const Condition* c : cells) {
     est[c->key] = EstimatesOf(r, c->key);
     overall[c->key] = MomentsOf(Flat(est[c->key]));
@@ -178,7 +178,7 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
     return delta;
   };
   // Between two cells of the same participants: the paired t-test of per-participant thresholds the report would run.
-  std::set<std::string> paired;
+  std::set<ConditionKey> paired;
   for (size_t a = 0; a < cells.size(); ++a)
     for (size_t b = a + 1; b < cells.size(); ++b) {
       const Condition &A = *cells[a], &B = *cells[b];
@@ -222,15 +222,15 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
   bool compared_groups = false;
   for (size_t g1 = 0; g1 < r.groups.size(); ++g1)
     for (size_t g2 = g1 + 1; g2 < r.groups.size(); ++g2) {
-      std::set<std::string> levels;
-      for (const Condition* c : cells) levels.insert(c->levels);
-      for (const std::string& level : levels) {
+      std::set<std::vector<protocol::Level>, protocol::LevelsLess> levels;
+      for (const Condition* c : cells) levels.insert(c->key.levels);
+      for (const std::vector<protocol::Level>& level : levels) {
         // Per group, the cell of those levels its participants run (its block may be the group's own).
         const Condition *A = nullptr, *B = nullptr;
         for (const auto& study : r.studies)
           for (const SimParticipant& p : study)
             for (const Condition* c : cells)
-              if (c->levels == level && p.thresholds.count(c->key)) {
+              if (c->key.levels == level && p.thresholds.count(c->key)) {
                 if (p.group == r.groups[g1] && !A) A = c;
                 if (p.group == r.groups[g2] && !B) B = c;
               }

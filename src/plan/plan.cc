@@ -27,6 +27,14 @@
 #include "store/schema.h"
 
 namespace blurcue::plan {
+
+bool ConditionKey::operator<(const ConditionKey& o) const {
+  if (block != o.block) return block < o.block;
+  if (slope != o.slope) return slope < o.slope;
+  if (const int c = protocol::Compare(levels, o.levels)) return c < 0;
+  return group < o.group;
+}
+
 namespace {
 
 using protocol::Task;
@@ -48,8 +56,8 @@ std::optional<Condition> ConditionOf(const protocol::Protocol& protocol, const p
                                      const stimulus::TrialScene& scene, bool several_blocks) {
   Condition c;
   c.block = protocol::BlockIndex(protocol, trial);
-  c.levels = protocol::ToJson(trial.levels).dump();
-  c.key = trial.block + "\n" + c.levels;
+  c.key.block = trial.block;
+  c.key.levels = trial.levels;
   std::string label;
   for (const protocol::Level& level : trial.levels)
     label += (label.empty() ? "" : " ") + level.factor + "=" + LevelText(level);
@@ -81,14 +89,14 @@ void SplitByGroup(const protocol::Protocol& protocol, const protocol::Trial& tri
                   Condition* c) {
   if (!protocol.groups || protocol.groups->names.size() < 2 || group.empty()) return;
   if (protocol::BlockOf(protocol, trial)->groups.size() == 1) return;
-  c->key += "\ngroup=" + group;
+  c->key.group = group;
   c->label = "group=" + group + ": " + c->label;
 }
 
 // One simulated participant through the session's own decisions (what `blurcue run --observer sim` does headless).
 SimParticipant Simulate(session::PreparedSession& study, const session::ObserverParams& observer, const std::string& id,
                         uint64_t seed, const std::string& group, bool keep_answers, bool several_blocks,
-                        session::SceneCache* cache, std::map<std::string, Condition>* conditions,
+                        session::SceneCache* cache, std::map<ConditionKey, Condition>* conditions,
                         std::set<std::string>* unplanned) {
   session::PrepareParticipant(&study, id, seed, group, cache);
   SimParticipant p;
@@ -103,9 +111,9 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
     std::vector<double> levels;
     std::vector<bool> correct;
   };
-  std::map<std::string, Track> tracks;
+  std::map<ConditionKey, Track> tracks;
   for (const protocol::Trial& trial : study.trials) {
-    if (const Json why = logic.SkipReason(trial); !why.is_null()) {
+    if (logic.SkipReason(trial)) {
       if (keep_answers) p.answers.emplace_back(trial.index, store::kChoiceSkipped);
       continue;
     }
@@ -121,8 +129,8 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
       // Depth matching: one condition per block, the slope of the accepted cut-off on distance across its trials.
       Condition c;
       c.block = protocol::BlockIndex(protocol, trial);
-      c.key = trial.block + "\nslope";
-      c.levels = "{}";
+      c.key.block = trial.block;
+      c.key.slope = true;
       c.label = (several_blocks ? trial.block + ": " : std::string()) + "cut-off ~ distance";
       c.measure = "log_cutoff_slope";
       c.chance = 0;
@@ -234,7 +242,7 @@ std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& opti
   *threads_used = threads;
   std::vector<std::vector<SimParticipant>> out(static_cast<size_t>(options.studies),
                                                 std::vector<SimParticipant>(static_cast<size_t>(n)));
-  std::vector<std::map<std::string, Condition>> found(static_cast<size_t>(threads));
+  std::vector<std::map<ConditionKey, Condition>> found(static_cast<size_t>(threads));
   std::vector<std::set<std::string>> unplanned(static_cast<size_t>(threads));
   std::atomic<int64_t> next{0}, done{0};
   std::atomic<bool> failed{false};
@@ -268,7 +276,7 @@ std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& opti
   work(0);
   for (auto& t : pool) t.join();
   if (error) std::rethrow_exception(error);
-  std::map<std::string, Condition> all;
+  std::map<ConditionKey, Condition> all;
   std::set<std::string> skipped_tasks;
   for (int t = 0; t < threads; ++t) {
     all.insert(found[size_t(t)].begin(), found[size_t(t)].end());
@@ -279,7 +287,7 @@ std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& opti
   // Stable: the same block and levels in several groups keep the keys' order (the map's), whatever the threads.
   std::stable_sort(conditions->begin(), conditions->end(), [](const Condition& a, const Condition& b) {
     if (a.block != b.block) return a.block < b.block;
-    return Json::parse(a.levels) < Json::parse(b.levels);
+    return protocol::Compare(a.key.levels, b.key.levels) < 0;
   });
   for (const std::string& task : skipped_tasks)
     notes->push_back(task + " trials are not planned: they have no share to test against a chance level");

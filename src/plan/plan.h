@@ -31,6 +31,8 @@
 #include <string>
 #include <vector>
 
+#include "protocol/level.h"
+
 namespace blurcue::session {
 struct PreparedSession;
 }
@@ -59,11 +61,21 @@ struct PlanOptions {
   std::function<void(const std::string&)> progress;  // about every 10 % of the participants
 };
 
+// What tells a condition from the others: its block, its levels (typed, as designed), a depth matching's slope
+// (one per block, no levels), and the group it is planned for ("" when not planned per group).
+struct ConditionKey {
+  std::string block;
+  std::vector<protocol::Level> levels;
+  bool slope = false;
+  std::string group;
+  bool operator<(const ConditionKey& o) const;
+  bool operator==(const ConditionKey& o) const { return !(*this < o) && !(o < *this); }
+};
+
 // One condition: a crossing of a block's factors (as designed, swaps undone), with the measure its tests use.
 struct Condition {
-  std::string key;        // block + levels (JSON), unique
+  ConditionKey key;       // unique
   int block = 0;          // index in protocol.blocks (conditions are ordered by block, then levels)
-  std::string levels;     // the levels as JSON
   std::string label;      // "edge=3" (and the block's name when the protocol has several)
   std::string measure;    // "first_source" (a pair) | "correct" | "yes" | "log_cutoff_slope" (depth matching)
                           // | "threshold" (a procedure cell: what it estimates, not its share correct)
@@ -86,11 +98,11 @@ struct SimParticipant {
   std::string id, group;
   uint64_t seed = 0;
   std::vector<std::pair<int, std::string>> answers;  // (trial index, choice as the record stores it), every trial
-  std::map<std::string, Tally> tallies;               // by condition key
+  std::map<ConditionKey, Tally> tallies;
   // Depth matching, by condition key: (log distance, log accepted cut-off) of each answered trial.
-  std::map<std::string, std::vector<std::pair<double, double>>> matches;
+  std::map<ConditionKey, std::vector<std::pair<double, double>>> matches;
   // A procedure cell's threshold estimate, as the report takes it from the track (threshold.h TrackEstimate).
-  std::map<std::string, double> thresholds;
+  std::map<ConditionKey, double> thresholds;
 };
 
 inline constexpr double kNoValue = __builtin_nan("");

@@ -10,18 +10,14 @@
 namespace blurcue::protocol {
 namespace {
 
-// A level as trials.csv shows it: a string bare, a number as JSON, an object by its id (else its scalar members as
-// key=value;...), as the export's TidyCell does.
-std::string LevelName(const Json& level) {
-  auto scalar = [](const Json& v) { return v.is_string() ? v.get<std::string>() : v.is_null() ? "" : v.dump(); };
-  if (level.is_object()) {
-    if (level.contains("id") && !level["id"].is_structured()) return scalar(level["id"]);
-    std::string text;
-    for (const auto& [key, member] : level.items())
-      if (!member.is_structured()) text += (text.empty() ? "" : ";") + key + "=" + scalar(member);
-    return text;
-  }
-  return scalar(level);
+// A level as trials.csv shows it: a string bare, a number as JSON (LevelValue::text, both), an object by its id (else
+// its members as key=value;...), as the export's TidyCell does.
+std::string LevelName(const Level& level) {
+  if (!level.object) return level.value.text;
+  if (const LevelValue* id = level.Field("id")) return id->text;
+  std::string text;
+  for (const auto& [key, member] : level.fields) text += (text.empty() ? "" : ";") + key + "=" + member.text;
+  return text;
 }
 
 // The values one column takes, collected over blocks: numbers apart, so they are given in numeric order.
@@ -30,16 +26,18 @@ struct Values {
   std::map<double, std::string> number_texts;  // each number as trials.csv writes it (1, not 1.0), first seen
   std::vector<std::string> names;
   bool integers = true, others = false;
-  void Add(const Json& v) {
-    if (v.is_number()) {
-      const double x = v.get<double>();
+  void Add(const LevelValue& v) {
+    if (v.IsNumber()) {
+      const double x = v.number;
       numbers.insert(x);
-      number_texts.emplace(x, LevelName(v));
+      number_texts.emplace(x, v.text);
       if (!(std::isfinite(x) && x == std::floor(x))) integers = false;
       return;
     }
+    AddName(v.text);
+  }
+  void AddName(const std::string& name) {
     others = true;
-    const std::string name = LevelName(v);
     if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
   }
   void Into(DesignColumn* c) const {
@@ -87,20 +85,20 @@ std::vector<DesignColumn> DescribeDesign(const Protocol& protocol) {
   std::vector<std::string> order;
   std::map<std::string, Values> values;
   std::set<std::string> cells;
-  auto add = [&](const std::string& name, const Json& value, bool cell) {
+  auto add = [&](const std::string& name, bool cell) -> Values& {
     if (!values.count(name)) order.push_back(name);
-    values[name].Add(value);
     if (cell) cells.insert(name);
+    return values[name];
   };
   for (const Block& block : protocol.blocks)
     for (const Factor& factor : block.factors) {
       const bool cell = block.procedure.has_value();
-      for (const Json& level : factor.levels) {
-        // A conditions table's row is no column of its own: its columns are (session/stimulus.cc TrialVariables).
-        if (!(factor.name == "row" && level.is_object())) add(factor.name, level, cell);
-        if (level.is_object())
-          for (const auto& [key, value] : level.items())
-            if (key != "left" && key != "right" && key != "object" && key != factor.name) add(key, value, cell);
+      for (const Level& level : factor.levels) {
+        // A conditions table's row is no column of its own: its columns are (session/recording.cc TrialVariables).
+        if (!level.object) add(factor.name, cell).Add(level.value);
+        else if (factor.name != "row") add(factor.name, cell).AddName(LevelName(level));
+        for (const auto& [key, value] : level.fields)
+          if (key != "left" && key != "right" && key != "object" && key != factor.name) add(key, cell).Add(value);
       }
     }
   std::vector<DesignColumn> columns;
@@ -198,7 +196,7 @@ std::string CellLevels(const Protocol& protocol, const Trial& trial) {
                                     [&](const Level& l) { return l.factor == factor.name; });
     if (level == trial.levels.end()) continue;
     const std::string value =
-        !level->object && level->value.IsNumber() ? LevelText(level->value.number) : LevelName(ToJson(*level));
+        !level->object && level->value.IsNumber() ? LevelText(level->value.number) : LevelName(*level);
     text += (text.empty() ? "" : ";") + factor.name + "=" + value;
   }
   return text;

@@ -5,7 +5,11 @@
 namespace blurcue::protocol {
 namespace {
 
-Factor Levels(const std::string& name, std::vector<Json> levels) { return {name, std::move(levels)}; }
+Factor Levels(const std::string& name, const std::vector<Json>& levels) {
+  Factor f{name, {}};
+  for (const Json& level : levels) f.levels.push_back(LevelOf(name, level));
+  return f;
+}
 
 // A protocol with a crossed block (edge 10, 2, 6 in file order; a pattern of objects), a staircase block split by
 // speed, groups, participant information and a rating block.

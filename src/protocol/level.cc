@@ -113,6 +113,39 @@ std::string SideText(const std::optional<BlurSpec>& side) {
   return side && side->source != BlurSource::kFixed ? ToString(side->source) : ToJson(side).dump();
 }
 
+namespace {
+
+template <typename T>
+int Sign(const T& a, const T& b) {
+  return a < b ? -1 : b < a ? 1 : 0;
+}
+
+}  // namespace
+
+int Compare(const LevelValue& a, const LevelValue& b) {
+  if (a.IsNumber() != b.IsNumber()) return a.IsNumber() ? -1 : 1;
+  return a.IsNumber() ? Sign(a.number, b.number) : Sign(a.text, b.text);
+}
+
+int Compare(const Level& a, const Level& b) {
+  if (int c = Sign(a.factor, b.factor)) return c;
+  // As JSON types sort: a number, then an object, then text.
+  auto rank = [](const Level& l) { return l.object ? 1 : l.value.IsNumber() ? 0 : 2; };
+  if (int c = Sign(rank(a), rank(b))) return c;
+  if (!a.object) return Compare(a.value, b.value);
+  for (size_t i = 0; i < a.fields.size() && i < b.fields.size(); ++i) {
+    if (int c = Sign(a.fields[i].first, b.fields[i].first)) return c;
+    if (int c = Compare(a.fields[i].second, b.fields[i].second)) return c;
+  }
+  return Sign(a.fields.size(), b.fields.size());
+}
+
+int Compare(const std::vector<Level>& a, const std::vector<Level>& b) {
+  for (size_t i = 0; i < a.size() && i < b.size(); ++i)
+    if (int c = Compare(a[i], b[i])) return c;
+  return Sign(a.size(), b.size());
+}
+
 const LevelValue* FindLevel(const std::vector<Level>& levels, const std::string& name) {
   for (const Level& level : levels)
     if (level.factor == name) return level.object ? nullptr : &level.value;

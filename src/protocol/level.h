@@ -74,6 +74,17 @@ Json ToJson(const std::optional<BlurSpec>& side);  // null for no side
 // {"screen_px":1}), "null" for no side.
 std::string SideText(const std::optional<BlurSpec>& side);
 
+// An order of levels for listings and keys, the one their JSON has (a trial's levels used to be listed by it): by
+// factor name, then value - numbers by value (2 before 10; 2 and 2.0 are one) before objects (key by key) before text.
+// Negative, zero or positive as `a` comes before, with or after `b`.
+int Compare(const LevelValue& a, const LevelValue& b);
+int Compare(const Level& a, const Level& b);
+int Compare(const std::vector<Level>& a, const std::vector<Level>& b);  // factor by factor; a prefix first
+// The order above, for maps and sorts keyed by a trial's levels.
+struct LevelsLess {
+  bool operator()(const std::vector<Level>& a, const std::vector<Level>& b) const { return Compare(a, b) < 0; }
+};
+
 // A trial's level by name: a factor of its own that holds a value, or a key of an object level (a pattern carries
 // speed and sides, a conditions table's row every column); null when neither.
 const LevelValue* FindLevel(const std::vector<Level>& levels, const std::string& name);

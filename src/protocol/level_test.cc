@@ -92,5 +92,28 @@ TEST(BlurSpec, EachWayASideIsWrittenRoundTrips) {
     EXPECT_THROW(BlurSpecOf(Json::parse(text)), Error) << text;
 }
 
+// Levels are listed and keyed in the order their JSON sorts (nlohmann's operator<, an implementation that shares no
+// code with Compare): by factor, numbers by value before objects before text, objects key by key.
+TEST(Level, CompareOrdersAsTheLevelsJsonSorts) {
+  const std::vector<Json> written = {
+      Json::parse(R"({"edge": 2})"),           Json::parse(R"({"edge": 10})"),
+      Json::parse(R"({"edge": 2.5})"),         Json::parse(R"({"edge": "007"})"),
+      Json::parse(R"({"edge": "7"})"),         Json::parse(R"({"edge": {"id": 1, "left": "measured"}})"),
+      Json::parse(R"({"edge": {"id": 1, "left": "fitted"}})"),
+      Json::parse(R"({"edge": {"id": 2}})"),   Json::parse(R"({"edge": {"left": "none"}})"),
+      Json::parse(R"({"edge": 2, "speed_cm_s": 1.8})"),
+      Json::parse(R"({"edge": 2, "speed_cm_s": 3})"),
+      Json::parse(R"({"section": 1})"),        Json::parse(R"({})")};
+  for (const Json& a : written)
+    for (const Json& b : written) {
+      const int sign = a < b ? -1 : b < a ? 1 : 0;
+      const int c = Compare(LevelsOf(a), LevelsOf(b));
+      EXPECT_EQ((c > 0) - (c < 0), sign) << a.dump() << " vs " << b.dump();
+      EXPECT_EQ(LevelsLess()(LevelsOf(a), LevelsOf(b)), a < b) << a.dump() << " vs " << b.dump();
+    }
+  // 2 and 2.0 are one value in the order (as in JSON), though they are written differently.
+  EXPECT_EQ(Compare(LevelsOf(Json::parse(R"({"edge": 2})")), LevelsOf(Json::parse(R"({"edge": 2.0})"))), 0);
+}
+
 }  // namespace
 }  // namespace blurcue::protocol

@@ -54,7 +54,7 @@ std::optional<Procedure> Parser::ParseProcedure(const Json& v, const std::string
   const std::string unit = relative ? "(times the reference)" : "arcmin";
   if (const Json* r = Field(v, "reference", ptr, true)) {
     CheckLevelValue("left", *r, ptr + "/reference");
-    pr.reference = *r;
+    if (IsBlurSource(*r)) pr.reference = BlurSpecOf(*r);
   }
   if (auto n = Int(v, "trials", ptr, true, 1, 1000, "trials per crossing")) pr.trials = *n;
   // A list of 1 to `most` numbers in [lo, hi], ascending when `ascending`.
@@ -116,16 +116,29 @@ std::optional<Procedure> Parser::ParseProcedure(const Json& v, const std::string
   return pr;
 }
 
-void Parser::ParseSides(const Json& v, const std::string& ptr) {
+std::optional<Block::Sides> Parser::ParseSides(const Json& v, const std::string& ptr) {
+  // A source as typed, when it is one (a problem is reported for any other).
+  auto typed = [](const Json& source) -> std::optional<BlurSpec> {
+    return IsBlurSource(source) ? std::optional<BlurSpec>(BlurSpecOf(source)) : std::nullopt;
+  };
+  if (!v.is_object()) {
+    Object(v, ptr, {"left", "right", "object"});
+    return std::nullopt;
+  }
+  Block::Sides sides;
   // The single layout shows one "object"; the others a pair, left and right.
-  if (v.is_object() && v.contains("object")) {
-    if (Object(v, ptr, {"object"})) CheckLevelValue("object", v["object"], ptr + "/object");
-    return;
+  if (v.contains("object")) {
+    sides.object = true;
+    if (Object(v, ptr, {"object"})) {
+      CheckLevelValue("object", v["object"], ptr + "/object");
+      sides.left = sides.right = typed(v["object"]);
+    }
+    return sides;
   }
-  if (!Object(v, ptr, {"left", "right", "object"})) return;
-  for (const char* side : {"left", "right"}) {
-    if (const Json* s = Field(v, side, ptr, true)) CheckLevelValue(side, *s, ptr + "/" + side);
-  }
+  if (!Object(v, ptr, {"left", "right", "object"})) return sides;
+  if (const Json* s = Field(v, "left", ptr, true)) CheckLevelValue("left", *s, ptr + "/left"), sides.left = typed(*s);
+  if (const Json* s = Field(v, "right", ptr, true)) CheckLevelValue("right", *s, ptr + "/right"), sides.right = typed(*s);
+  return sides;
 }
 
 void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top, Block* b) {
@@ -154,7 +167,8 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
             (*conditions.holder)["conditions"]);
   else if (conditions.holder)
     b->factors = ParseConditions(*conditions.holder, conditions.ptr + "/conditions"),
-    b->factors_pointer = conditions.ptr + "/conditions";
+    b->factors_pointer = conditions.ptr + "/conditions",
+    b->conditions = (*conditions.holder)["conditions"].is_string() ? (*conditions.holder)["conditions"].get<std::string>() : "";
   else if (!factors.holder)
     Problem(ptr + "/factors", "is required (here or at /factors; or a conditions table) but missing");
   else
@@ -170,8 +184,7 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
   }
   const Source sides = pick("sides");
   if (sides.holder) {
-    ParseSides((*sides.holder)["sides"], sides.ptr + "/sides");
-    b->sides = (*sides.holder)["sides"];
+    b->sides = ParseSides((*sides.holder)["sides"], sides.ptr + "/sides");
     b->sides_pointer = sides.ptr + "/sides";
   }
   const Source adjust = pick("adjust");
@@ -234,8 +247,7 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
   // What is shown left and right must be known for a comparison, and for any left/right counterbalancing.
   bool factor_sides = false;
   for (const auto& f : b->factors)
-    for (const auto& level : f.levels)
-      factor_sides = factor_sides || (level.is_object() && (level.contains("left") || level.contains("object")));
+    for (const auto& level : f.levels) factor_sides = factor_sides || level.Field("left") || level.Field("object");
   const std::string where = ptr.empty() ? "/" : ptr;
   if (factor_sides && sides.holder)
     Problem(sides.ptr + "/sides", "is given but a factor's levels already carry the sides (left and right, or object)",

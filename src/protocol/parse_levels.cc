@@ -61,13 +61,13 @@ void Parser::CheckLevelValue(const std::string& name, const Json& v, const std::
   // Cycles per picture width; 0 shows the picture unfiltered.
   else if (name == "cutoff") number_in(0, 1000, "cycles per picture width", "a cut-off");
   else if (name == "left" || name == "right" || name == "object") {
-    if (!IsBlurSource(v))
-      report("a blur source must be none, measured, measured_section, estimated, fitted, a radius in " +
-             Range(0, kMaxFixedRadiusPx, "photo px") + ", {\"screen_px\": r} with r in " +
-             Range(0, kMaxFixedRadiusPx, "") + " or {\"arcmin\": r} with r in " + Range(0, 600, "") +
-             (v.is_string() ? DidYouMean(v.get<std::string>(), {"none", "measured", "measured_section", "estimated",
-                                                                "fitted"})
-                            : std::string()));
+    if (!IsBlurSource(v)) {
+      std::string words;
+      for (const std::string& word : BlurSourceWords()) words += word + ", ";
+      report("a blur source must be " + words + "a radius in " + Range(0, kMaxFixedRadiusPx, "photo px") +
+             ", {\"screen_px\": r} with r in " + Range(0, kMaxFixedRadiusPx, "") + " or {\"arcmin\": r} with r in " +
+             Range(0, 600, "") + (v.is_string() ? DidYouMean(v.get<std::string>(), BlurSourceWords()) : std::string()));
+    }
   } else if (name == "id") {
     // An id names a row or a pattern in the tables, the report's file names and its charts: text a spreadsheet
     // shows as written, or a whole number every reader holds exactly (1e308 and 2^64 - 1 are neither).
@@ -81,6 +81,19 @@ void Parser::CheckLevelValue(const std::string& name, const Json& v, const std::
     report("must be a finite number");
   }
 }
+
+namespace {
+
+// A level as typed once it has been checked. A value the parser refused inside an object level (an object or a list)
+// is kept as its JSON text, so the design's counts stay as written: the protocol is refused anyway.
+Level Typed(const std::string& factor, const Json& level) {
+  if (!level.is_object()) return LevelOf(factor, level);
+  Json scalars = Json::object();
+  for (const auto& [key, value] : level.items()) scalars[key] = value.is_structured() ? Json(value.dump()) : value;
+  return LevelOf(factor, scalars);
+}
+
+}  // namespace
 
 std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) {
   std::vector<Factor> factors;
@@ -152,7 +165,7 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
       } else {
         CheckLevelValue(name, level, lp);
       }
-      f.levels.push_back(level);
+      f.levels.push_back(Typed(name, level));
     }
     if (sides) ++carrying_sides;
     factors.push_back(std::move(f));
@@ -305,7 +318,7 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
       CheckLevelValue(header[c], level[header[c]], cp);
     }
     if (!printable) continue;
-    factor.levels.push_back(std::move(level));
+    factor.levels.push_back(LevelOf(factor.name, level));
   }
   return {factor};
 }

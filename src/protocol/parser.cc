@@ -79,8 +79,8 @@ bool IsBlurSource(const Json& v) {
            r.get<double>() >= 0 && r.get<double>() <= (arcmin ? 600 : kMaxFixedRadiusPx);
   }
   if (!v.is_string()) return false;
-  static const std::set<std::string> kNames = {"none", "measured", "measured_section", "estimated", "fitted"};
-  return kNames.count(v.get<std::string>()) > 0;
+  const std::optional<BlurSource> source = ParseWord<BlurSource>(v.get<std::string>());
+  return source && *source != BlurSource::kFixed;  // a fixed radius is a number, never the word
 }
 
 // Names whose values CheckLevelValue knows: a level of a factor so named is that value, never an object.

@@ -36,7 +36,7 @@ std::string Range(double lo, double hi, const std::string& unit);
 
 // A fixed blur radius: the thesis's measured radii reach ~17 px; 100 px blurs a whole object away.
 const double kMaxFixedRadiusPx = 100;
-// A blur source: none, measured, measured_section, estimated, fitted, a radius in photo px, {"screen_px": r} or
+// A blur source: a word of BlurSourceWords() (none, measured, ...), a radius in photo px, {"screen_px": r} or
 // {"arcmin": r}.
 bool IsBlurSource(const Json& v);
 // Names whose values CheckLevelValue knows: a level of a factor so named is that value, never an object.
@@ -131,7 +131,8 @@ class Parser {
                    Timing* t);
   void ParseInfo(const Json& v, const std::string& ptr, Protocol* p);
   void ParseGroups(const Json& v, const Json& top, const std::string& ptr, Protocol* p);
-  void ParseSides(const Json& v, const std::string& ptr);
+  // A block's "sides", checked, and typed as far as it is valid.
+  std::optional<Block::Sides> ParseSides(const Json& v, const std::string& ptr);
   // Fills `b` from `obj` at `ptr`, falling back to the protocol-level defaults in `top`.
   void ParseBlock(const Json& obj, const std::string& ptr, const Json& top, Block* b);
   void ParseResponses(const Json& v, const std::string& ptr, const std::set<Task>& tasks, const Protocol& p,

@@ -242,9 +242,8 @@ void Parser::CheckDesign(const Protocol& p) {
     const auto uses = kUses.find(type);
     for (const auto& f : b.factors) {
       std::set<std::string> names{f.name};
-      for (const auto& level : f.levels)
-        if (level.is_object())
-          for (const auto& [key, value] : level.items()) names.insert(key);
+      for (const Level& level : f.levels)
+        for (const auto& [key, value] : level.fields) names.insert(key);
       for (const auto& name : names)
         if (kStimulusLevels.count(name) && uses != kUses.end() && !uses->second.count(name))
           Problem(b.factors_pointer + "/" + f.name,
@@ -269,13 +268,15 @@ void Parser::CheckDesign(const Protocol& p) {
       for (const auto& [name, why] : unshown)
         for (const auto& f : b.factors) {
           if (f.name == name) {
-            Problem(b.factors_pointer + "/" + JsonPointerToken(f.name), why, Json(f.levels));
+            Json levels = Json::array();
+            for (const Level& level : f.levels) levels.push_back(ToJson(level));
+            Problem(b.factors_pointer + "/" + JsonPointerToken(f.name), why, levels);
             continue;
           }
           for (size_t i = 0; i < f.levels.size(); ++i)
-            if (f.levels[i].is_object() && f.levels[i].contains(name)) {
+            if (const LevelValue* value = f.levels[i].Field(name)) {
               Problem(b.factors_pointer + "/" + JsonPointerToken(f.name) + "/" + std::to_string(i) + "/" + name, why,
-                      f.levels[i][name]);
+                      ToJson(*value));
               break;
             }
         }
@@ -297,18 +298,18 @@ void Parser::CheckDesign(const Protocol& p) {
     if (p.layout == Layout::kSingle && b.procedure)
       Problem(b.pointer + "/procedure", "needs a forced choice (layouts side_by_side, two_intervals, odd_one_out)");
     // "object" is the single layout's one source; a pair layout reads left and right.
-    bool object = b.sides.is_object() && b.sides.contains("object");
-    bool pair = b.sides.is_object() && (b.sides.contains("left") || b.sides.contains("right"));
+    bool object = b.sides && b.sides->object;
+    bool pair = b.sides && !b.sides->object;
     for (const auto& f : b.factors)
-      for (const auto& level : f.levels) {
-        object = object || (level.is_object() && level.contains("object"));
-        pair = pair || (level.is_object() && level.contains("left"));
+      for (const Level& level : f.levels) {
+        object = object || level.Field("object");
+        pair = pair || level.Field("left");
       }
     if (p.layout == Layout::kSingle && pair)
-      Problem(b.sides.is_object() ? b.sides_pointer : b.factors_pointer,
+      Problem(b.sides ? b.sides_pointer : b.factors_pointer,
               "the layout single shows one object: give \"object\", not left and right");
     if (p.layout != Layout::kSingle && object)
-      Problem(b.sides.is_object() ? b.sides_pointer : b.factors_pointer,
+      Problem(b.sides ? b.sides_pointer : b.factors_pointer,
               "\"object\" is for the layout single; a " + layout_name + " trial shows left and right");
     if (type == ContentType::kGrid && !Provides(b, "edge") && !Provides(b, "y_mm"))
       Problem(b.factors_pointer, "a grid stands at an edge: needs a factor edge (or y_mm), or a factor whose every "
@@ -410,9 +411,8 @@ void Parser::CheckDesign(const Protocol& p) {
 bool Parser::Provides(const Block& b, const std::string& name) {
   for (const auto& f : b.factors) {
     if (f.name == name) return true;
-    if (!f.levels.empty() && std::all_of(f.levels.begin(), f.levels.end(), [&](const Json& level) {
-          return level.is_object() && level.contains(name);
-        }))
+    if (!f.levels.empty() &&
+        std::all_of(f.levels.begin(), f.levels.end(), [&](const Level& level) { return level.Field(name); }))
       return true;
   }
   return false;
@@ -510,11 +510,10 @@ std::set<double> NumericLevels(const Protocol& protocol, const std::string& fact
   std::set<double> values;
   for (const auto& b : protocol.blocks)
     for (const auto& f : b.factors)
-      for (const auto& level : f.levels) {
-        // As FindLevel finds it in a trial (the factor itself, or a key of its object levels); read while the
-        // levels are still being checked, so from the JSON.
-        const Json* v = f.name == factor ? &level : level.is_object() && level.contains(factor) ? &level[factor] : nullptr;
-        if (v && v->is_number()) values.insert(v->get<double>());
+      for (const Level& level : f.levels) {
+        // As FindLevel finds it in a trial: the factor itself, or a key of its object levels.
+        const LevelValue* v = f.name == factor ? (level.object ? nullptr : &level.value) : level.Field(factor);
+        if (v && v->IsNumber()) values.insert(v->number);
       }
   return values;
 }

@@ -13,14 +13,15 @@
 
 #include "core/camera.h"
 #include "core/json_io.h"
+#include "protocol/level.h"
 #include "protocol/vocabulary.h"
 
 namespace blurcue::protocol {
 
-// One factor: its name and its levels (numbers, strings or objects) in the order the file lists them.
+// One factor: its name and its levels (numbers, strings or objects of them, typed) in the order the file lists them.
 struct Factor {
   std::string name;
-  std::vector<Json> levels;
+  std::vector<Level> levels;  // each Level::factor is `name`
 };
 
 // Method of adjustment: the participant steps through `levels` of `parameter` and accepts one.
@@ -40,7 +41,7 @@ struct Procedure {
   using Kind = ProcedureKind;
   Kind kind = Kind::kStaircase;
   ProcedureVariable variable = ProcedureVariable::kRelativeDifference;
-  Json reference;                    // the blur source both sides start from
+  BlurSpec reference;                // the blur source both sides start from
   int trials = 30;                   // per crossing of the block's factors
   // Staircase: n-up/m-down (down correct answers in a row step the level down, up wrong ones step it up); the step
   // is steps[k] after k reversals (the last one kept); the level stays in [min, max].
@@ -77,9 +78,17 @@ struct Block {
   std::string pointer, task_pointer, factors_pointer, sides_pointer, counterbalance_pointer;
   Task task = Task::kForcedChoice;
   std::vector<Factor> factors;        // crossed in full; sorted by name (JSON object order)
+  std::string conditions;             // a conditions table's path as the protocol writes it (its factor "row"); "" for none
   int repetitions = 1;
   Counterbalance counterbalance = Counterbalance::kNone;
-  Json sides;                         // {"left": SOURCE, "right": SOURCE} when no factor's levels carry the sides
+  // "sides": what each side shows when no factor's levels carry the sides: {"left": SOURCE, "right": SOURCE}, or the
+  // single layout's {"object": SOURCE} (shown as the left side and recorded on both). A source the parser refused is
+  // left unset.
+  struct Sides {
+    bool object = false;
+    std::optional<BlurSpec> left, right;
+  };
+  std::optional<Sides> sides;         // set when the block (or the protocol) gives a "sides" object
   std::optional<Adjustment> adjust;   // set for the adjustment task
   std::optional<Procedure> procedure; // set for an adaptive block
   bool shuffle = true;

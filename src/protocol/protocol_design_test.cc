@@ -148,8 +148,8 @@ TEST(ProtocolValidate, ConditionsTableGivesTheDesignRowByRow) {
   const Protocol p = ParseProtocol(j, dir / "p.json");
   ASSERT_EQ(p.blocks[0].factors.size(), 1u);
   EXPECT_EQ(p.blocks[0].factors[0].levels.size(), 2u);
-  EXPECT_EQ(p.blocks[0].factors[0].levels[0]["label"], "near, fast");
-  EXPECT_EQ(p.blocks[0].factors[0].levels[1]["speed_cm_s"], 1.8);
+  EXPECT_EQ(ToJson(p.blocks[0].factors[0].levels[0])["label"], "near, fast");
+  EXPECT_EQ(ToJson(p.blocks[0].factors[0].levels[1])["speed_cm_s"], 1.8);
   EXPECT_EQ(DesignTrials(p.blocks[0]), 2 * 2);  // two rows x the protocol's swap_copies
   std::ofstream(dir / "bad.csv") << "edge,left,right\n102,measured,none\n3,measured\n";
   j["blocks"][0]["conditions"] = "bad.csv";
@@ -183,7 +183,7 @@ TEST(ProtocolValidate, ConditionsTableWithAByteOrderMarkReadsItsFirstColumn) {
   j["blocks"] = {{{"name", "rows"}, {"conditions", "bom.csv"}}};
   EXPECT_TRUE(Problems(j).empty()) << Problems(j).front();
   const Protocol p = ParseProtocol(j, dir / "p.json");
-  EXPECT_EQ(p.blocks[0].factors[0].levels[0]["edge"], 1);
+  EXPECT_EQ(ToJson(p.blocks[0].factors[0].levels[0])["edge"], 1);
   std::ofstream(dir / "padded.csv") << "edge ,left,right\n1,measured,none\n";
   j["blocks"][0]["conditions"] = "padded.csv";
   const std::string problem = OnlyProblem(j);
@@ -246,7 +246,7 @@ TEST(ProtocolValidate, ConditionsTableUnclosedQuoteIsRefusedNamingTheLine) {
   // Closed quotes still read as before: "" is one quote.
   std::ofstream(dir / "open.csv") << "edge,left,right,label\n1,measured,none,\"a \"\"b\"\"\"\n";
   j["blocks"][0]["conditions"] = "open.csv";
-  EXPECT_EQ(ParseProtocol(j, dir / "p.json").blocks[0].factors[0].levels[0]["label"], "a \"b\"");
+  EXPECT_EQ(ToJson(ParseProtocol(j, dir / "p.json").blocks[0].factors[0].levels[0])["label"], "a \"b\"");
 }
 
 // The real photos of a depth matching are chosen by distance_m wherever a trial finds it: its own factor, a key of
@@ -614,8 +614,8 @@ TEST(ProtocolValidate, ConditionsTableReadAsSpreadsheetsWriteIt) {
     std::ofstream(dir / "sheet.csv", std::ios::binary) << text;
     const Protocol p = ParseProtocol(j, dir / "p.json");
     ASSERT_EQ(p.blocks[0].factors[0].levels.size(), 2u) << text;
-    EXPECT_EQ(p.blocks[0].factors[0].levels[0]["label"], "a, b");
-    EXPECT_EQ(p.blocks[0].factors[0].levels[1]["edge"], 2);
+    EXPECT_EQ(ToJson(p.blocks[0].factors[0].levels[0])["label"], "a, b");
+    EXPECT_EQ(ToJson(p.blocks[0].factors[0].levels[1])["edge"], 2);
   }
   std::ofstream(dir / "sheet.csv", std::ios::binary) << "edge,left,right\n1,\"mea\"sured,none\n";
   EXPECT_TRUE(Contains(OnlyProblem(j), "sheet.csv line 2, column 8: text after a field's closing quote")) << OnlyProblem(j);
@@ -657,14 +657,14 @@ TEST(ProtocolValidate, ConditionsCellsKeepTheirTextAndNumbersTheirDigits) {
   const Protocol p = ParseProtocol(j, dir / "p.json");
   const auto& levels = p.blocks[0].factors[0].levels;
   ASSERT_EQ(levels.size(), 3u);
-  EXPECT_EQ(levels[0]["label_stim"], "007");
-  EXPECT_EQ(levels[1]["label_stim"], "7");
-  EXPECT_EQ(levels[2]["label_stim"], "9007199254740993");
+  EXPECT_EQ(ToJson(levels[0])["label_stim"], "007");
+  EXPECT_EQ(ToJson(levels[1])["label_stim"], "7");
+  EXPECT_EQ(ToJson(levels[2])["label_stim"], "9007199254740993");
   std::ofstream(dir / "cells.csv") << "edge,left,right,y_mm\n1,measured,none,0.12345678901234567\n";
   EXPECT_TRUE(Contains(OnlyProblem(j), "cells.csv line 2, column 4 (y_mm): has more digits than a number holds exactly (it would be "
                                        "recorded as 0.12345678901234566)")) << OnlyProblem(j);
   std::ofstream(dir / "cells.csv") << "edge,left,right,y_mm\n1,measured,none,0.1\n2,measured,none,-2.50e1\n";
-  EXPECT_EQ(ParseProtocol(j, dir / "p.json").blocks[0].factors[0].levels[1]["y_mm"], -25.0);
+  EXPECT_EQ(ToJson(ParseProtocol(j, dir / "p.json").blocks[0].factors[0].levels[1])["y_mm"], -25.0);
 }
 
 // An id a spreadsheet would run as a formula, or that a bidirectional control shows reversed, is refused; a name of

@@ -488,5 +488,73 @@ TEST(ShippedProtocols, SceneFilesResolveToTheDemoOutput) {
   EXPECT_EQ(p.scene.calib, (dir / "../results/demo/calib.json").lexically_normal());
 }
 
+// After the parser a factor's levels, a block's sides and a procedure's reference are typed values, each as the file
+// wrote it: nothing after protocol/ reads the protocol's JSON for them.
+TEST(ProtocolTyped, FactorLevelsSidesAndReferenceAreTypedAsWritten) {
+  Json j = test::Valid();
+  j["blocks"][1]["factors"]["section"] = Json::parse("[1, 3]");
+  j["blocks"].push_back(Json::parse(R"({"name": "fixed", "factors": {"edge": [4]}, "counterbalance": "none",
+                                        "sides": {"left": {"screen_px": 0.5}, "right": 2.0}})"));
+  j["blocks"].push_back(Json::parse(R"({"name": "quest", "factors": {"speed_cm_s": [1.8]}, "counterbalance": "none",
+      "procedure": {"type": "quest_plus", "variable": "difference_arcmin", "reference": {"arcmin": 1.5},
+                    "trials": 4, "stimuli": [0, 1], "threshold": [0.5, 1], "slope": [2], "lapse": [0.02]}})"));
+  const Protocol p = ParseProtocol(j, test::SceneFolder() / "p.json");
+  ASSERT_EQ(p.blocks.size(), 4u);
+  // An object level keeps its keys in name order, each value of its kind.
+  const Level& pattern = p.blocks[0].factors[0].levels[1];
+  EXPECT_EQ(pattern.factor, "pattern");
+  ASSERT_TRUE(pattern.object);
+  EXPECT_EQ(pattern.Field("id")->kind, LevelValue::Kind::kInteger);
+  EXPECT_EQ(pattern.Field("speed_cm_s")->kind, LevelValue::Kind::kReal);
+  EXPECT_EQ(pattern.Field("speed_cm_s")->number, 1.8);
+  EXPECT_EQ(pattern.Field("left")->text, "estimated");
+  ASSERT_EQ(p.blocks[1].factors.size(), 2u);  // pattern, section: in name order
+  EXPECT_EQ(p.blocks[1].factors[1].name, "section");
+  EXPECT_EQ(p.blocks[1].factors[1].levels[1].unit, "");
+  EXPECT_EQ(p.blocks[1].factors[1].levels[1].value.text, "3");
+  EXPECT_FALSE(p.blocks[0].sides);  // the pattern's levels carry the sides
+  // A block's sides: the radius on the screen and the one in photo px written 2.0 (a real, not the integer 2).
+  ASSERT_TRUE(p.blocks[2].sides);
+  EXPECT_FALSE(p.blocks[2].sides->object);
+  ASSERT_TRUE(p.blocks[2].sides->left && p.blocks[2].sides->right);
+  EXPECT_EQ(p.blocks[2].sides->left->source, BlurSource::kFixed);
+  EXPECT_EQ(p.blocks[2].sides->left->unit, RadiusUnit::kScreenPx);
+  EXPECT_EQ(p.blocks[2].sides->left->radius.number, 0.5);
+  EXPECT_EQ(p.blocks[2].sides->right->unit, RadiusUnit::kPhotoPx);
+  EXPECT_EQ(p.blocks[2].sides->right->radius.kind, LevelValue::Kind::kReal);
+  EXPECT_EQ(p.blocks[2].sides->right->radius.text, "2.0");
+  // The procedure's reference, and both sides of its trials show it.
+  ASSERT_TRUE(p.blocks[3].procedure);
+  const BlurSpec& reference = p.blocks[3].procedure->reference;
+  EXPECT_EQ(reference.source, BlurSource::kFixed);
+  EXPECT_EQ(reference.unit, RadiusUnit::kArcmin);
+  EXPECT_EQ(reference.radius.number, 1.5);
+  for (const Trial& t : BuildTrials(p, "P1", 1)) {
+    if (t.block == "fixed") {
+      EXPECT_EQ(SideText(t.left), R"({"screen_px":0.5})");
+      EXPECT_EQ(SideText(t.right), "2.0");
+    }
+    if (t.block == "quest") {
+      EXPECT_TRUE(t.left == reference && t.right == reference);
+    }
+  }
+}
+
+// The single layout's {"object": SOURCE}: one object, shown as the left side and recorded on both.
+TEST(ProtocolTyped, AnObjectSideIsBothSides) {
+  Json j = test::Valid();
+  j["layout"] = "single";
+  j["task"] = "yes_no";
+  j["counterbalance"] = "none";
+  j["responses"] = Json::parse(R"({"yes": "Y", "no": "N"})");
+  j["blocks"] = Json::parse(R"([{"name": "one", "factors": {"edge": [2]}, "sides": {"object": "fitted"}}])");
+  const Protocol p = ParseProtocol(j, test::SceneFolder() / "p.json");
+  ASSERT_TRUE(p.blocks[0].sides);
+  EXPECT_TRUE(p.blocks[0].sides->object);
+  ASSERT_TRUE(p.blocks[0].sides->left && p.blocks[0].sides->right);
+  EXPECT_EQ(p.blocks[0].sides->left->source, BlurSource::kFitted);
+  EXPECT_EQ(p.blocks[0].sides->right->source, BlurSource::kFitted);
+}
+
 }  // namespace
 }  // namespace blurcue::protocol

@@ -40,19 +40,29 @@ namespace {
 
 // The sides a design row shows: from the level object that carries left/right, else the block's "sides". The
 // single layout's one "object" is shown as the left side (and recorded on both).
-void SetSides(const Block& block, const Json& levels, Trial* t) {
-  auto side = [](const Json& from, const char* key) -> std::optional<BlurSpec> {
-    const Json& v = from.contains("object") ? from["object"] : from.value(key, Json());
-    if (v.is_null()) return std::nullopt;
-    return BlurSpecOf(v);
+void SetSides(const Block& block, Trial* t) {
+  auto side = [](const Level& from, const char* key) -> std::optional<BlurSpec> {
+    const LevelValue* v = from.Field("object") ? from.Field("object") : from.Field(key);
+    if (!v) return std::nullopt;
+    return BlurSpecOf(ToJson(*v));
   };
-  auto set = [&](const Json& from) {
-    t->left = side(from, "left");
-    t->right = side(from, "right");
-  };
-  for (const auto& [name, level] : levels.items())
-    if (level.is_object() && (level.contains("left") || level.contains("object"))) return set(level);
-  if (block.sides.is_object()) set(block.sides);
+  for (const Level& level : t->levels)
+    if (level.Field("left") || level.Field("object")) {
+      t->left = side(level, "left");
+      t->right = side(level, "right");
+      return;
+    }
+  if (block.sides) {
+    t->left = block.sides->left;
+    t->right = block.sides->right;
+  }
+}
+
+// The trial's level of factor `name`, or null.
+const Level* LevelOf(const Trial& trial, const std::string& name) {
+  for (const Level& level : trial.levels)
+    if (level.factor == name) return &level;
+  return nullptr;
 }
 
 // Full factorial x repetitions x counterbalancing, unshuffled.
@@ -69,17 +79,16 @@ std::vector<Trial> Design(const Block& block, bool participant_even) {
       t.task = block.task;
       t.repetition = rep;
       if (block.procedure) t.cell = static_cast<int>(c);
-      Json levels = Json::object();
-      // Mixed radix with the last factor fastest.
+      // Mixed radix with the last factor fastest; the levels in name order (the factors are).
+      t.levels.resize(block.factors.size());
       size_t rest = c;
       for (size_t k = block.factors.size(); k-- > 0;) {
         const auto& f = block.factors[k];
-        levels[f.name] = f.levels[rest % f.levels.size()];
+        t.levels[k] = f.levels[rest % f.levels.size()];
         rest /= f.levels.size();
       }
-      t.levels = LevelsOf(levels);
-      SetSides(block, levels, &t);
-      if (block.procedure) t.left = t.right = BlurSpecOf(block.procedure->reference);
+      SetSides(block, &t);
+      if (block.procedure) t.left = t.right = block.procedure->reference;
       if (block.counterbalance == Counterbalance::kByParticipant && participant_even) {
         std::swap(t.left, t.right);
         t.swapped = true;
@@ -268,10 +277,9 @@ std::string SidePointer(const Protocol& protocol, const Trial& trial, const std:
   const std::string designed = trial.swapped ? (side == "left" ? "right" : "left") : side;
   for (const auto& b : protocol.blocks) {
     if (b.name != trial.block) continue;
-    const Json levels = ToJson(trial.levels);
     for (const auto& f : b.factors) {
-      const Json* level = levels.contains(f.name) ? &levels.at(f.name) : nullptr;
-      if (!level || !level->is_object() || !level->contains(designed)) continue;
+      const Level* level = LevelOf(trial, f.name);
+      if (!level || !level->Field(designed)) continue;
       const auto at = std::find(f.levels.begin(), f.levels.end(), *level);
       return b.factors_pointer + "/" + JsonPointerToken(f.name) + "/" + std::to_string(at - f.levels.begin()) + "/" +
              designed;
@@ -285,10 +293,9 @@ std::string SidePointer(const Protocol& protocol, const Trial& trial, const std:
 std::string LevelPointer(const Protocol& protocol, const Trial& trial, const std::string& name) {
   for (const auto& b : protocol.blocks) {
     if (b.name != trial.block) continue;
-    const Json levels = ToJson(trial.levels);
     for (const auto& f : b.factors) {
-      const Json* level = levels.contains(f.name) ? &levels.at(f.name) : nullptr;
-      if (!level || (f.name != name && !(level->is_object() && level->contains(name)))) continue;
+      const Level* level = LevelOf(trial, f.name);
+      if (!level || (f.name != name && !level->Field(name))) continue;
       const auto at = std::find(f.levels.begin(), f.levels.end(), *level);
       std::string pointer = b.factors_pointer + "/" + JsonPointerToken(f.name) + "/" +
                             std::to_string(at - f.levels.begin());

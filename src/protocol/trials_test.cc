@@ -379,7 +379,8 @@ TEST(TrialBuilder, SwapCopiesPutEachSourceOnEachSideEquallyOften) {
   }
   const Protocol p = Shipped("test2-moving-balls.json");
   ASSERT_EQ(p.blocks[0].factors[0].levels.size(), 6u);
-  for (const auto& level : p.blocks[0].factors[0].levels) {
+  for (const Level& typed : p.blocks[0].factors[0].levels) {
+    const Json level = ToJson(typed);
     const int id = level["id"].get<int>();
     EXPECT_EQ((on_left[{id, level["left"].get<std::string>()}]), 1) << id;
     EXPECT_EQ((on_left[{id, level["right"].get<std::string>()}]), 1) << id;
@@ -509,7 +510,7 @@ TEST(TrialPointers, SidesObjectOfTheProtocolWhenNoLevelCarriesThem) {
 TEST(TrialBuilder, ProtocolOverTheTrialCapIsRefusedBeforeBuilding) {
   Protocol p = FromJson(kFour);
   Factor big{"big", {}};
-  for (int i = 0; i < 1000; ++i) big.levels.push_back(i);
+  for (int i = 0; i < 1000; ++i) big.levels.push_back(LevelOf("big", i));
   for (int k = 0; k < 8; ++k) p.blocks[0].factors.push_back(big);  // 4 x 1000^8: would never fit in memory
   try {
     BuildTrials(p, "P1", 1);

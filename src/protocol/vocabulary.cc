@@ -136,18 +136,6 @@ std::string ToString(InfoType value) {
   return "";
 }
 
-std::string ToString(BlurSource value) {
-  switch (value) {
-    case BlurSource::kNone: return "none";
-    case BlurSource::kMeasured: return "measured";
-    case BlurSource::kMeasuredSection: return "measured_section";
-    case BlurSource::kEstimated: return "estimated";
-    case BlurSource::kFitted: return "fitted";
-    case BlurSource::kFixed: return "fixed";
-  }
-  return "";
-}
-
 std::string ToString(RadiusUnit value) {
   switch (value) {
     case RadiusUnit::kPhotoPx: return "photo_px";

@@ -10,6 +10,8 @@
 #include <string_view>
 #include <vector>
 
+#include "core/blur_source.h"
+
 namespace blurcue::protocol {
 
 // Every value of a vocabulary, in the order the parser's "must be one of" lists them; specialised per enum below.
@@ -110,13 +112,12 @@ struct Vocabulary<InfoType> {
   static constexpr std::array values{InfoType::kInteger, InfoType::kNumber, InfoType::kChoice, InfoType::kText};
 };
 
-// Where a side's blur comes from: "none" | "measured" (the thesis's edge value) | "measured_section" | "estimated"
-// (eq. 3.7) | "fitted" (the thin-lens model) | "fixed" (a radius the protocol gives as a number, never as this word).
-enum class BlurSource { kNone, kMeasured, kMeasuredSection, kEstimated, kFitted, kFixed };
+// Where a side's blur comes from: core's one vocabulary (core/blur_source.h), which calib evaluates too.
+using ::blurcue::BlurSource;
+using ::blurcue::ToString;
 template <>
 struct Vocabulary<BlurSource> {
-  static constexpr std::array values{BlurSource::kNone,     BlurSource::kMeasured, BlurSource::kMeasuredSection,
-                                     BlurSource::kEstimated, BlurSource::kFitted,   BlurSource::kFixed};
+  static constexpr auto values = kBlurSources;
 };
 
 // The unit of a fixed radius: "photo_px" (a bare number: the camera's pixels) | "screen_px" | "arcmin" (the keys of
@@ -171,7 +172,6 @@ std::string ToString(Layout value);
 std::string ToString(BlockSequence value);
 std::string ToString(GroupAssign value);
 std::string ToString(InfoType value);
-std::string ToString(BlurSource value);
 std::string ToString(RadiusUnit value);
 
 // The value a word names, or nullopt when the vocabulary has no such word.

@@ -23,7 +23,7 @@ PreparedSession PrepareStudy(const std::filesystem::path& protocol_file, const s
   const Json json = ParseJson(text, protocol_file.string());
   s.protocol = protocol::ParseProtocol(json, protocol_file);
   // Each design variable in a column of its own (the record's rule: recorded_names.h), before anything else is read.
-  CheckRecordedNames(s.protocol, json);
+  CheckRecordedNames(s.protocol);
   s.protocol_text = protocol::RecordedText(text, s.protocol);
   s.scene = LoadProtocolScene(s.protocol);
   s.images = LoadStimulusImages(s.protocol, s.scene);

@@ -5,7 +5,7 @@
 #include <set>
 
 #include "core/error.h"
-#include "store/export.h"
+#include "session/recording.h"
 
 namespace blurcue::session {
 namespace {
@@ -14,16 +14,6 @@ namespace {
 struct Origin {
   std::string name, what, pointer;
 };
-
-// The conditions table's path as the protocol writes it at `pointer` (".../conditions"), else "".
-std::string TablePath(const Json& json, const std::string& pointer) {
-  try {
-    const Json& path = json.at(Json::json_pointer(pointer));
-    return path.is_string() ? path.get<std::string>() : "";
-  } catch (const Json::exception&) {
-    return "";
-  }
-}
 
 // A name a model formula reads as one variable: letters (any script: bytes of UTF-8 beyond ASCII), digits and _,
 // not starting with a digit.
@@ -38,11 +28,11 @@ bool IsFormulaName(const std::string& name) {
 
 }  // namespace
 
-std::vector<std::string> RecordedNameProblems(const protocol::Protocol& protocol, const Json& json) {
+std::vector<std::string> RecordedNameProblems(const protocol::Protocol& protocol) {
   std::vector<std::string> problems;
   const std::string file = protocol.file.string();
   auto why = [](const std::string& name) {
-    const std::string column = store::DesignColumn(name);
+    const std::string column = RecordedColumn(name);
     return column == name ? std::string()
                           : " (" + name + " is a column trials.csv writes itself, so a design's " + name +
                                 " is recorded as " + column + ")";
@@ -55,7 +45,7 @@ std::vector<std::string> RecordedNameProblems(const protocol::Protocol& protocol
     std::map<std::string, std::string> given;
     const bool table = block.factors_pointer.size() >= 11 &&
                        block.factors_pointer.compare(block.factors_pointer.size() - 11, 11, "/conditions") == 0;
-    const std::string path = table ? TablePath(json, block.factors_pointer) : "";
+    const std::string path = table ? block.conditions : "";
     auto add = [&](const Origin& o, const std::string& factor) {
       const auto [in_block, first] = given.emplace(o.name, factor);
       // Two factors of object levels each with ids: the id column keeps the first's, and each factor's own column
@@ -67,8 +57,8 @@ std::vector<std::string> RecordedNameProblems(const protocol::Protocol& protocol
                            Json(o.name).dump());
         return;
       }
-      const std::string column = store::DesignColumn(o.name);
-      if (store::IsRecordedName(column)) {
+      const std::string column = RecordedColumn(o.name);
+      if (IsRecordColumn(column)) {
         problems.push_back(file + ": " + o.pointer + ": " + o.what + " would be recorded in " + column +
                            ", a column trials.csv writes itself; rename it, got " + Json(o.name).dump());
         return;
@@ -83,7 +73,7 @@ std::vector<std::string> RecordedNameProblems(const protocol::Protocol& protocol
     for (const protocol::Factor& f : block.factors) {
       const std::string at = block.factors_pointer + (table ? "" : "/" + JsonPointerToken(f.name));
       bool objects = false;
-      for (const Json& level : f.levels) objects = objects || level.is_object();
+      for (const protocol::Level& level : f.levels) objects = objects || level.object;
       // A conditions table's rows (factor "row") and any factor of object levels named row: only their keys are
       // recorded (TrialVariables).
       if (!(f.name == "row" && objects)) add({f.name, "the factor " + f.name, at}, "");
@@ -97,8 +87,7 @@ std::vector<std::string> RecordedNameProblems(const protocol::Protocol& protocol
                            Json(f.name).dump());
       std::set<std::string> keys;  // each key once per factor (every row of a table has every column)
       for (size_t i = 0; i < f.levels.size(); ++i) {
-        if (!f.levels[i].is_object()) continue;
-        for (const auto& [key, value] : f.levels[i].items()) {
+        for (const auto& [key, value] : f.levels[i].fields) {
           // The sides are recorded as such.
           if (key == "left" || key == "right" || key == "object" || !keys.insert(key).second) continue;
           if (table)
@@ -119,8 +108,8 @@ std::vector<std::string> RecordedNameProblems(const protocol::Protocol& protocol
   return once;
 }
 
-void CheckRecordedNames(const protocol::Protocol& protocol, const Json& json) {
-  const std::vector<std::string> problems = RecordedNameProblems(protocol, json);
+void CheckRecordedNames(const protocol::Protocol& protocol) {
+  const std::vector<std::string> problems = RecordedNameProblems(protocol);
   if (!problems.empty()) throw Error(ErrorKind::kInput, problems);
 }
 

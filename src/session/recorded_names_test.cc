@@ -16,7 +16,7 @@ using protocol::test::Valid;
 
 std::vector<std::string> ProblemsOf(const Json& json) {
   const auto file = SceneFolder() / "p.json";
-  return RecordedNameProblems(protocol::ParseProtocol(json, file), json);
+  return RecordedNameProblems(protocol::ParseProtocol(json, file));
 }
 std::string All(const std::vector<std::string>& problems) {
   std::string all;
@@ -46,7 +46,7 @@ TEST(RecordedNames, AFactorRecordedInAnotherFactorsColumnIsRefusedNamingBoth) {
       << problems[0];
   EXPECT_TRUE(Contains(problems[0], "status is a column trials.csv writes itself")) << problems[0];
   EXPECT_TRUE(Contains(problems[0], "got \"status\"")) << problems[0];
-  EXPECT_THROW(CheckRecordedNames(protocol::ParseProtocol(j, SceneFolder() / "p.json"), j), Error);
+  EXPECT_THROW(CheckRecordedNames(protocol::ParseProtocol(j, SceneFolder() / "p.json")), Error);
   // correct and factor_correct: the same.
   j["blocks"][0]["factors"].erase("status");
   j["blocks"][0]["factors"].erase("factor_status");

@@ -10,6 +10,7 @@
 #include "protocol/design.h"
 #include "session/observer.h"
 #include "session/prepare.h"
+#include "store/columns.h"
 #include "store/export.h"
 #include "store/record.h"
 
@@ -71,6 +72,9 @@ std::vector<store::DesignColumnRecord> DesignRecord(const std::vector<protocol::
 }
 
 }  // namespace
+
+std::string RecordedColumn(const std::string& name) { return store::DesignColumn(name); }
+bool IsRecordColumn(const std::string& column) { return store::IsRecordedName(column); }
 
 SessionsSoFar PeekSessions(const std::filesystem::path& db, const std::string& study, const std::string& participant) {
   const store::SessionsSoFar s = store::PeekSessions(db, study, participant);
@@ -164,83 +168,115 @@ std::map<int64_t, RecordedAnswer> Recording::AnsweredTrials(int64_t session) {
   return answers;
 }
 
+namespace {
+
+// The variables of TrialVariables, typed (store::RecordedVariables names them).
+store::RecordedVariables Variables(const protocol::Trial& trial, const TrialScene& scene,
+                                   const Presentation& presentation) {
+  store::RecordedVariables v;
+  v.practice = trial.practice;
+  v.block_name = trial.block;
+  v.swapped = trial.swapped;
+  if (trial.round >= 0) v.round = trial.round + 1;  // a practice block run until a criterion: which run
+  if (trial.cell >= 0) {  // a procedure's trial: which of its block's procedures, the test side, the level shown
+    v.procedure_cell = trial.cell;
+    v.test_side = trial.test_side;
+    if (!std::isnan(scene.level)) v.level = scene.level;
+  }
+  // Odd one out: the interval that showed the right side's object (the correct answer), and how many there were.
+  const protocol::TaskTraits& task = protocol::TraitsOf(trial.task);
+  if (scene.intervals > 2 && task.answer == protocol::TaskAnswer::kSide) {
+    v.odd_interval = std::stoi(trial.test_side);
+    v.intervals = scene.intervals;
+  }
+  // Rounded to 1e-4 px: the record is read by people and charts, not fed back.
+  auto round4 = [](double x) { return std::round(x * 1e4) / 1e4; };
+  if (task.answer == protocol::TaskAnswer::kLevel) {
+    if (trial.start_index >= 0 && size_t(trial.start_index) < trial.adjust_levels.size())
+      v.start_level = trial.adjust_levels[size_t(trial.start_index)];
+    // The levels in the order "next" steps through them (cyclic): what the participant could reach, as shown.
+    std::string levels;
+    for (double level : trial.adjust_levels) levels += (levels.empty() ? "" : ";") + protocol::LevelText(level);
+    v.adjust_levels = levels;
+  }
+  constexpr size_t kLeft = 0, kRight = 1, kScene = 2;  // RecordedVariables::kSides
+  if (scene.content == protocol::ContentType::kPicture) {
+    // The virtual picture's width as shown (a level c's blur is r = 2 x 0.1874 x this / c arcmin), and the real
+    // picture's blur when its camera is known: in its camera's px, on the screen and on the eye.
+    v.picture_width_arcmin = round4(presentation.Arcmin(presentation.layout.picture.width));
+    if (presentation.real_frame_px_per_px > 0) {
+      v.r_px[kScene] = round4(scene.r_scene_px);
+      v.r_screen_px[kScene] = round4(presentation.ScreenPx(scene.r_scene_px * presentation.real_frame_px_per_px));
+      v.r_arcmin[kScene] = round4(presentation.RealArcmin(scene.r_scene_px));
+    }
+  } else if (task.shows != protocol::TaskShows::kPicture) {
+    // Each radius as the camera made it (photo px), as the window shows it (screen px) and as the eye gets it.
+    // The single layout shows only its object, recorded as the left side.
+    for (const auto& [side, r] : {std::pair<size_t, double>{kLeft, scene.r_left_px}, {kRight, scene.r_right_px},
+                                  {kScene, scene.r_scene_px}}) {
+      if (scene.left_only && side == kRight) continue;
+      v.r_px[side] = round4(r);
+      v.r_screen_px[side] = round4(presentation.ScreenPx(r));
+      v.r_arcmin[side] = round4(presentation.Arcmin(r));
+    }
+    v.screen_px_per_photo_px = std::round(presentation.scale * 1e6) / 1e6;
+    v.kernel = protocol::ToString(scene.kernel);
+    v.blur_plan = scene.per_pixel ? "per_pixel" : "one_radius";
+    v.r_span_screen_px = round4(scene.r_span_screen_px);
+    v.exposure_ms = scene.exposure_ms;
+    for (const size_t side : {kLeft, kRight}) {
+      if (scene.left_only && side == kRight) continue;
+      // As drawn (render::Psf): a floor beyond half the radius is the whole of it.
+      const double floor = std::min(side == kLeft ? scene.floor_left_sigma_px : scene.floor_right_sigma_px,
+                                    std::max(0.0, side == kLeft ? scene.r_left_px : scene.r_right_px) / 2);
+      const cv::Vec2d motion = side == kLeft ? scene.motion_left_px : scene.motion_right_px;
+      v.floor_sigma_px[side] = round4(floor);
+      v.floor_sigma_screen_px[side] = round4(presentation.ScreenPx(floor));
+      v.motion_x_screen_px[side] = round4(presentation.ScreenPx(motion[0]));
+      v.motion_y_screen_px[side] = round4(presentation.ScreenPx(motion[1]));
+    }
+    v.size_left_deg = round4(scene.size_left_deg);
+    if (!scene.left_only) v.size_right_deg = round4(scene.size_right_deg);
+    v.brightness = scene.brightness;
+    v.contrast = scene.contrast;
+    v.white_balance_r = scene.white_balance[0];
+    v.white_balance_g = scene.white_balance[1];
+    v.white_balance_b = scene.white_balance[2];
+  }
+  return v;
+}
+
+}  // namespace
+
 Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation) {
   // Every level under store::DesignColumn's name: one named like a column of trials.csv or a variable recorded
   // below (status, r_left_px, level, correct, ...) as factor_NAME, so what is recorded never overwrites a level.
   // A level object's values get columns of their own (a pattern's speed_cm_s, a conditions table's edge); the sides
   // are recorded as such. A conditions table's row object itself is no factor of the design: only its columns stay.
   Json v = store::LevelVariables(protocol::ToJson(trial.levels));
-  v["practice"] = trial.practice ? 1 : 0;
-  v["block_name"] = trial.block;
-  v["swapped"] = trial.swapped ? 1 : 0;
-  if (trial.round >= 0) v["round"] = trial.round + 1;  // a practice block run until a criterion: which run
-  if (trial.cell >= 0) {  // a procedure's trial: which of its block's procedures, the test side, the level shown
-    v["procedure_cell"] = trial.cell;
-    v["test_side"] = trial.test_side;
-    if (!std::isnan(scene.level)) v["level"] = scene.level;
-  }
-  // Odd one out: the interval that showed the right side's object (the correct answer), and how many there were.
-  const protocol::TaskTraits& task = protocol::TraitsOf(trial.task);
-  if (scene.intervals > 2 && task.answer == protocol::TaskAnswer::kSide) {
-    v["odd_interval"] = std::stoi(trial.test_side);
-    v["intervals"] = scene.intervals;
-  }
-  // Rounded to 1e-4 px: the record is read by people and charts, not fed back.
-  auto round4 = [](double x) { return std::round(x * 1e4) / 1e4; };
-  if (task.answer == protocol::TaskAnswer::kLevel) {
-    if (trial.start_index >= 0 && size_t(trial.start_index) < trial.adjust_levels.size())
-      v["start_level"] = trial.adjust_levels[size_t(trial.start_index)];
-    // The levels in the order "next" steps through them (cyclic): what the participant could reach, as shown.
-    std::string levels;
-    for (double level : trial.adjust_levels) levels += (levels.empty() ? "" : ";") + protocol::LevelText(level);
-    v["adjust_levels"] = levels;
-  }
-  if (scene.content == protocol::ContentType::kPicture) {
-    // The virtual picture's width as shown (a level c's blur is r = 2 x 0.1874 x this / c arcmin), and the real
-    // picture's blur when its camera is known: in its camera's px, on the screen and on the eye.
-    v["picture_width_arcmin"] = round4(presentation.Arcmin(presentation.layout.picture.width));
-    if (presentation.real_frame_px_per_px > 0) {
-      v["r_scene_px"] = round4(scene.r_scene_px);
-      v["r_scene_screen_px"] = round4(presentation.ScreenPx(scene.r_scene_px * presentation.real_frame_px_per_px));
-      v["r_scene_arcmin"] = round4(presentation.RealArcmin(scene.r_scene_px));
-    }
-  } else if (task.shows != protocol::TaskShows::kPicture) {
-    // Each radius as the camera made it (photo px), as the window shows it (screen px) and as the eye gets it.
-    // The single layout shows only its object, recorded as the left side.
-    for (const auto& [name, r] : {std::pair<const char*, double>{"left", scene.r_left_px},
-                                  {"right", scene.r_right_px}, {"scene", scene.r_scene_px}}) {
-      if (scene.left_only && name == std::string("right")) continue;
-      v[std::string("r_") + name + "_px"] = round4(r);
-      v[std::string("r_") + name + "_screen_px"] = round4(presentation.ScreenPx(r));
-      v[std::string("r_") + name + "_arcmin"] = round4(presentation.Arcmin(r));
-    }
-    v["screen_px_per_photo_px"] = std::round(presentation.scale * 1e6) / 1e6;
-    v["kernel"] = protocol::ToString(scene.kernel);
-    v["blur_plan"] = scene.per_pixel ? "per_pixel" : "one_radius";
-    v["r_span_screen_px"] = round4(scene.r_span_screen_px);
-    v["exposure_ms"] = scene.exposure_ms;
-    for (const bool left : {true, false}) {
-      if (scene.left_only && !left) continue;
-      const std::string side = left ? "left" : "right";
-      // As drawn (render::Psf): a floor beyond half the radius is the whole of it.
-      const double floor = std::min(left ? scene.floor_left_sigma_px : scene.floor_right_sigma_px,
-                                    std::max(0.0, left ? scene.r_left_px : scene.r_right_px) / 2);
-      const cv::Vec2d motion = left ? scene.motion_left_px : scene.motion_right_px;
-      v["floor_sigma_" + side + "_px"] = round4(floor);
-      v["floor_sigma_" + side + "_screen_px"] = round4(presentation.ScreenPx(floor));
-      v["motion_" + side + "_x_screen_px"] = round4(presentation.ScreenPx(motion[0]));
-      v["motion_" + side + "_y_screen_px"] = round4(presentation.ScreenPx(motion[1]));
-    }
-    v["size_left_deg"] = round4(scene.size_left_deg);
-    if (!scene.left_only) v["size_right_deg"] = round4(scene.size_right_deg);
-    v["brightness"] = scene.brightness;
-    v["contrast"] = scene.contrast;
-    v["white_balance_r"] = scene.white_balance[0];
-    v["white_balance_g"] = scene.white_balance[1];
-    v["white_balance_b"] = scene.white_balance[2];
-  }
+  v.update(store::VariablesJson(Variables(trial, scene, presentation)));
   return v;
 }
 
+std::string ShownVariables(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation,
+                           const Scored& scored) {
+  store::RecordedVariables v = Variables(trial, scene, presentation);
+  v.correct = scored.correct.value_or(false);
+  if (scored.reversals_before) v.reversals = *scored.reversals_before;
+  if (scored.posterior) {
+    v.posterior_threshold = scored.posterior->first;
+    v.posterior_slope = scored.posterior->second;
+  }
+  Json shown = store::LevelVariables(protocol::ToJson(trial.levels));
+  shown.update(store::VariablesJson(v));
+  return shown.dump();
+}
+
+std::string SkippedVariables(const Skip& skip) {
+  store::RecordedVariables v;
+  v.skipped = skip.why;
+  if (skip.reversals) v.reversals = *skip.reversals;
+  return store::VariablesJson(v).dump();
+}
 
 }  // namespace blurcue::session

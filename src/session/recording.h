@@ -13,6 +13,7 @@
 #include "core/json_io.h"
 #include "protocol/design.h"
 #include "protocol/trials.h"
+#include "session/trial_logic.h"
 #include "stimulus/stimulus.h"
 
 namespace blurcue::store {
@@ -144,6 +145,12 @@ class Recording {
   std::unique_ptr<store::Record> record_;
 };
 
+// The column of trials.csv a design variable `name` is recorded in (store::DesignColumn: factor_NAME for a name the
+// record writes itself), and whether `column` is one the record writes itself (store::IsRecordedName): the record's
+// rule, for checking a design before it runs (recorded_names.h).
+std::string RecordedColumn(const std::string& name);
+bool IsRecordColumn(const std::string& column);
+
 // The variables recorded with a trial beside its factor levels: practice, block_name, swapped, and for pairs each
 // radius in photo px, screen px and arcmin (r_left_px, r_left_screen_px, r_left_arcmin; the same for right and
 // scene) with the presentation's screen_px_per_photo_px and the blur plan (blur_plan: one_radius | per_pixel,
@@ -153,5 +160,11 @@ class Recording {
 // column of trials.csv (store::IsRecordedName), so nothing recorded takes a level's place.
 Json TrialVariables(const protocol::Trial& trial, const stimulus::TrialScene& scene,
                     const stimulus::Presentation& presentation);
+// A procedure trial's variables as shown (the response's copy, as JSON text): TrialVariables at the level shown, with
+// the answer as scored (correct: 1 | 0), a staircase's reversals before it and QUEST+'s posterior means after it.
+std::string ShownVariables(const protocol::Trial& trial, const stimulus::TrialScene& scene,
+                           const stimulus::Presentation& presentation, const Scored& scored);
+// What a skipped trial's response records (JSON text): why (skipped) and a stop rule's reversals.
+std::string SkippedVariables(const Skip& skip);
 
 }  // namespace blurcue::session

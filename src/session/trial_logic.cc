@@ -68,12 +68,11 @@ const protocol::Procedure& ProcedureOf(const protocol::Protocol& protocol, const
 SessionLogic::SessionLogic(const PreparedSession& prepared, SceneCache* cache)
     : prepared_(prepared), cache_(cache), adaptive_(prepared.protocol), rounds_(prepared.protocol, prepared.trials) {}
 
-Json SessionLogic::SkipReason(const protocol::Trial& trial) {
-  if (trial.cell >= 0 && adaptive_.Stopped(trial))
-    return {{"skipped", "stop rule"}, {"reversals", adaptive_.Reversals(trial)}};
+std::optional<Skip> SessionLogic::SkipReason(const protocol::Trial& trial) {
+  if (trial.cell >= 0 && adaptive_.Stopped(trial)) return Skip{"stop rule", false, adaptive_.Reversals(trial)};
   if (const int met = rounds_.MetBefore(trial); met >= 0)
-    return {{"skipped", "criterion met in run " + std::to_string(met + 1)}};
-  return Json();
+    return Skip{"criterion met in run " + std::to_string(met + 1), true, std::nullopt};
+  return std::nullopt;
 }
 
 TrialScene SessionLogic::SceneOf(const protocol::Trial& trial, double* level) {

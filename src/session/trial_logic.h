@@ -56,13 +56,21 @@ struct Scored {
   std::optional<std::pair<double, double>> posterior;
 };
 
+// Why a trial is not shown but recorded as skipped: its procedure's stop rule (with the reversals it stopped at), or
+// its practice block's criterion, met in an earlier run.
+struct Skip {
+  std::string why;                // "stop rule" | "criterion met in run K"
+  bool criterion = false;         // the practice criterion's
+  std::optional<int> reversals;   // a stop rule's
+};
+
 // The decisions of one session, trial by trial in order. Holds references into `prepared`, which must outlive it.
 class SessionLogic {
  public:
   // `cache`: procedure trials' scenes at their levels from earlier participants of the same study (blurcue plan).
   explicit SessionLogic(const PreparedSession& prepared, SceneCache* cache = nullptr);
-  // Why `trial` is not shown but recorded as skipped ({"skipped": why, ...}); null when it is shown.
-  Json SkipReason(const protocol::Trial& trial);
+  // Why `trial` is not shown but recorded as skipped; nullopt when it is shown.
+  std::optional<Skip> SkipReason(const protocol::Trial& trial);
   // The scene `trial` shows now: its planned scene, with a procedure's level from the answers so far applied and
   // planned on the screen (`*level`: that level, 0 for a trial without one).
   stimulus::TrialScene SceneOf(const protocol::Trial& trial, double* level);

@@ -232,13 +232,12 @@ class Runner {
         const auto it = answered.find(i);
         if (it == answered.end()) throw cannot(i, "the record has no answer for it but has answers after it");
         const bool recorded_skip = it->second.choice == kChoiceSkipped;
-        const Json why = logic.SkipReason(t);
-        if (recorded_skip && why.is_null())
+        const std::optional<Skip> why = logic.SkipReason(t);
+        if (recorded_skip && !why)
           throw cannot(i, "the record skips it, but the answers before it show it (its procedure had not stopped, "
                           "its practice criterion was not met)");
-        if (!recorded_skip && !why.is_null())
-          throw cannot(i, "the record shows it, but the answers before it skip it (" +
-                              why["skipped"].get<std::string>() + ")");
+        if (!recorded_skip && why)
+          throw cannot(i, "the record shows it, but the answers before it skip it (" + why->why + ")");
         if (recorded_skip) continue;
         if (!keys_.CanRecord(it->second.choice, t))
           throw cannot(i, "the record's answer '" + it->second.choice + "' is none this trial can have");
@@ -286,14 +285,14 @@ class Runner {
       shown_practice = trial.practice;
       // Not shown, recorded as skipped: a procedure ended by its stop rule, a practice run after the run that met
       // its block's criterion.
-      if (const Json why = logic.SkipReason(trial); !why.is_null()) {
+      if (const std::optional<Skip> why = logic.SkipReason(trial)) {
         Response skipped;
         skipped.choice = kChoiceSkipped;
         skipped.rt_ms = std::numeric_limits<double>::quiet_NaN();
-        skipped.shown_json = why.dump();
+        skipped.shown_json = SkippedVariables(*why);
         record.RecordResponse(start.session_id, i, skipped);
         ++result.skipped_now;
-        result.skipped_by_criterion_now += trial.practice && why.value("skipped", "").rfind("criterion", 0) == 0;
+        result.skipped_by_criterion_now += trial.practice && why->criterion;
         progress(i + 1);
         continue;
       }
@@ -310,14 +309,7 @@ class Runner {
       const bool correct = right.value_or(false);
       response.correct = right;
       if (trial.cell >= 0) {
-        Json shown = TrialVariables(trial, scene, prepared_.presentation);
-        shown["correct"] = correct ? 1 : 0;
-        if (scored.reversals_before) shown["reversals"] = *scored.reversals_before;
-        if (scored.posterior) {
-          shown["posterior_threshold"] = scored.posterior->first;
-          shown["posterior_slope"] = scored.posterior->second;
-        }
-        response.shown_json = shown.dump();
+        response.shown_json = ShownVariables(trial, scene, prepared_.presentation, scored);
         response.level = level;
         response.r_left_px = scene.r_left_px;
         response.r_right_px = scene.r_right_px;

@@ -26,12 +26,27 @@ std::string LevelsLabel(const protocol::Trial& t) {
   return levels;
 }
 
+namespace {
+
+// A pair as listed: its levels and the sources it compares (either side order is one pair). Ordered by the levels
+// (numbers as numbers: edge 2 before edge 10), then the sources.
+struct PairKey {
+  std::vector<protocol::Level> levels;
+  std::vector<std::string> sources;
+  bool operator<(const PairKey& o) const {
+    if (const int c = protocol::Compare(levels, o.levels)) return c < 0;
+    return sources < o.sources;
+  }
+};
+
+}  // namespace
+
 std::vector<PairVisibility> PairVisibilities(const PreparedSession& prepared, const ObserverParams& observer,
                                              double level) {
   const protocol::Protocol& p = prepared.protocol;
   std::vector<PairVisibility> pairs;
-  std::map<std::string, size_t> index;  // the pair's key -> its place in `pairs`
-  std::vector<Json> keys;                // per pair: its levels and sources, the order they are listed in
+  std::map<PairKey, size_t> index;  // the pair's key -> its place in `pairs`
+  std::vector<PairKey> keys;        // per pair: its key, the order they are listed in
   AdaptiveState adaptive(p);             // no answers yet: each procedure's first level
   for (const protocol::Trial& t : prepared.trials) {
     TrialScene s = prepared.scenes[size_t(t.index)];
@@ -39,9 +54,9 @@ std::vector<PairVisibility> PairVisibilities(const PreparedSession& prepared, co
       continue;
     // Either side order is one pair: a swapped copy shows the same two blurs.
     const std::string a = protocol::SideText(t.left), b = protocol::SideText(t.right);
-    Json key = protocol::ToJson(t.levels);  // sorted as the levels' JSON sorts: numbers as numbers
-    key["sources"] = s.left_only ? Json::array({a}) : Json::array({std::min(a, b), std::max(a, b)});
-    if (const auto it = index.find(key.dump()); it != index.end()) {
+    const PairKey key{t.levels, s.left_only ? std::vector<std::string>{a}
+                                            : std::vector<std::string>{std::min(a, b), std::max(a, b)}};
+    if (const auto it = index.find(key); it != index.end()) {
       ++pairs[it->second].trials;
       continue;
     }
@@ -68,7 +83,7 @@ std::vector<PairVisibility> PairVisibilities(const PreparedSession& prepared, co
     pair.p_correct = ProbabilityCorrect2afc(observer, view);
     pair.visible = pair.p_correct >= level;
     pair.trials = 1;
-    index[key.dump()] = pairs.size();
+    index[key] = pairs.size();
     pairs.push_back(pair);
     keys.push_back(key);
   }

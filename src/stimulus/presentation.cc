@@ -149,7 +149,7 @@ Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, cons
     frame["objects"].push_back(
         {{"side", side == 0 ? "left" : "right"},
          {"kind", b.object.kind == scene::VirtualObject::Kind::kBall ? "ball" : "card"},
-         {"source", calib::ToString(side == 0 ? trial.left : trial.right)},
+         {"source", ToString(side == 0 ? trial.left : trial.right)},
          {"kernel", b.method},
          {"center_px", {round(centre[0].x, 1e-3), round(centre[0].y, 1e-3)}},
          {"outline_px", polygon},

@@ -23,19 +23,12 @@ using protocol::FindLevel;
 
 // `where` names the field that chose the source ("FILE: /pointer"), made only when there is a problem to name. A
 // fixed radius on the screen is converted to photo px by `presentation`.
-// The protocol's blur source as the calibration evaluates it: the one place the two vocabularies meet (calib knows
-// nothing of protocols).
-calib::BlurSource Source(const std::optional<protocol::BlurSpec>& spec, double* fixed,
-                         const std::function<std::string()>& where, const Presentation* presentation) {
+// The side's blur source as the calibration evaluates it (one vocabulary, core/blur_source.h), with a fixed radius in
+// photo px.
+BlurSource Source(const std::optional<protocol::BlurSpec>& spec, double* fixed,
+                  const std::function<std::string()>& where, const Presentation* presentation) {
   if (!spec) throw InputError(where(), "the trial shows no blur source on this side, got null");
-  switch (spec->source) {
-    case protocol::BlurSource::kNone: return calib::BlurSource::kNone;
-    case protocol::BlurSource::kMeasured: return calib::BlurSource::kMeasured;
-    case protocol::BlurSource::kMeasuredSection: return calib::BlurSource::kMeasuredSection;
-    case protocol::BlurSource::kEstimated: return calib::BlurSource::kEstimated;
-    case protocol::BlurSource::kFitted: return calib::BlurSource::kFitted;
-    case protocol::BlurSource::kFixed: break;
-  }
+  if (spec->source != BlurSource::kFixed) return spec->source;
   const double r = spec->radius.number;
   switch (spec->unit) {
     case protocol::RadiusUnit::kPhotoPx: *fixed = r; break;
@@ -48,7 +41,7 @@ calib::BlurSource Source(const std::optional<protocol::BlurSpec>& spec, double* 
                presentation->scale;
       break;
   }
-  return calib::BlurSource::kFixed;
+  return BlurSource::kFixed;
 }
 
 // Board-frame placement of the two objects of a pair (scene's poses on the board; x and y in mm where the trial
@@ -192,7 +185,7 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
       if (!std::isfinite(r) || r < 0) throw Error(ErrorKind::kDomain, "radius " + std::to_string(r) + " px");
       return r;
     } catch (const Error& e) {
-      throw InputError(field(side), calib::ToString(source) + " blur cannot be evaluated with " +
+      throw InputError(field(side), ToString(source) + " blur cannot be evaluated with " +
                                         protocol.scene.calib.string() + trial_text + ": " + e.what());
     }
   };

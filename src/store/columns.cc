@@ -2,6 +2,7 @@
 #include "store/columns.h"
 
 #include <optional>
+#include <type_traits>
 
 #include "core/error.h"
 #include "protocol/vocabulary.h"
@@ -49,6 +50,22 @@ std::string FixedOf(const std::string& column) {
          "WHEN 'object' THEN coalesce(json_extract(" + column + ", '$.screen_px'), json_extract(" + column +
          ", '$.arcmin')) END";
 }
+// A member of RecordedVariables as the variables' JSON holds it: a flag as 1 | 0, a number or text as it is.
+template <typename T>
+std::function<Json(const RecordedVariables&)> Member(std::optional<T> RecordedVariables::*member) {
+  return [member](const RecordedVariables& v) -> Json {
+    const std::optional<T>& x = v.*member;
+    if (!x) return Json();
+    if constexpr (std::is_same_v<T, bool>) return Json(int64_t(*x ? 1 : 0));
+    else return Json(*x);
+  };
+}
+// One side's radius of RecordedVariables::r_px, r_screen_px or r_arcmin.
+std::function<Json(const RecordedVariables&)> Radius(std::array<std::optional<double>, 3> RecordedVariables::*radii,
+                                                    size_t side) {
+  return [radii, side](const RecordedVariables& v) { return (v.*radii)[side] ? Json(*(v.*radii)[side]) : Json(); };
+}
+
 Stored OfSession(Stored s, Value (*of)(const SessionValues&)) { return s.of_session = of, s; }
 Stored OfTrial(Stored s, Value (*of)(const TrialRecord&)) { return s.of_trial = of, s; }
 Stored OfResponse(Stored s, Value (*of)(const Response&)) { return s.of_response = of, s; }
@@ -132,7 +149,7 @@ std::vector<Column> MakeColumns() {
   add("block", "integer", "", ">= 0", "the block's place in the protocol's list of blocks, from 0", T, Cell::kInteger)
       .at = Plain("trials", "block", "INTEGER", 1);
   Column& block_name = add("block_name", "string", "", "", "the block's name", T, Cell::kText);
-  block_name.in_variables = true;
+  block_name.in_variables = true, block_name.variable = Member(&RecordedVariables::block_name);
   block_name.at = OfTrial(Typed("trials", "TEXT", "", 7, "coalesce(json_extract(factors, '$.block_name'), '')"), [](const TrialRecord& t) { return Value(t.block_name); });
   std::string tasks;  // the task vocabulary's words, as the protocol spells them
   for (const std::string& word : protocol::Words<protocol::Task>()) tasks += (tasks.empty() ? "" : "|") + word;
@@ -142,13 +159,13 @@ std::vector<Column> MakeColumns() {
                           "ELSE 'forced_choice' END"),
                     [](const TrialRecord& t) { return Value(t.task); });
   Column& practice = add("practice", "boolean", "", "0|1", "1: a practice trial (not scored)", T, Cell::kInteger);
-  practice.if_null = "0", practice.in_variables = true;
+  practice.if_null = "0", practice.in_variables = true, practice.variable = Member(&RecordedVariables::practice);
   practice.at = OfTrial(Typed("trials", "INTEGER", "practice IN (0, 1)", 7,
                               "coalesce(json_extract(factors, '$.practice'), 0) <> 0"),
                         [](const TrialRecord& t) { return Value(int64_t(t.practice ? 1 : 0)); });
   Column& swapped = add("swapped", "boolean", "", "0|1",
                         "1: left and right exchanged against the design (counterbalancing)", T, Cell::kInteger);
-  swapped.if_null = "0", swapped.in_variables = true;
+  swapped.if_null = "0", swapped.in_variables = true, swapped.variable = Member(&RecordedVariables::swapped);
   swapped.at = OfTrial(Typed("trials", "INTEGER", "swapped IN (0, 1)", 7,
                              "coalesce(json_extract(factors, '$.swapped'), 0) <> 0"),
                        [](const TrialRecord& t) { return Value(int64_t(t.swapped ? 1 : 0)); });
@@ -158,7 +175,7 @@ std::vector<Column> MakeColumns() {
       .at = OfTrial(Typed("trials", "TEXT", "", 8), [](const TrialRecord& t) { return NonEmpty(t.cell); });
 
   // Each side's source, with the answer in trials.csv; in schema 7's order before the planned radii.
-  const std::string sources = "none|measured|measured_section|estimated|fitted|fixed_px|fixed_screen_px|fixed_arcmin";
+  const std::string sources = SourceColumns::Names();
   add("left_source", "string", "", sources, "the left side's blur source (the single layout's object); empty: none shown",
       A, Cell::kText)
       .at = OfTrial(Typed("trials", "TEXT", "", 7, SourceOf("left_shown")),
@@ -177,9 +194,11 @@ std::vector<Column> MakeColumns() {
 
   // The runner's variables of a trial (session/recording.h TrialVariables), kept in its variables' JSON (factors; a
   // response's shown for what a procedure decided at the trial). Those also kept typed come first, in schema 7's order.
-  add("level", "number", "the procedure's variable", "", "a procedure trial: the level shown", V, Cell::kText)
-      .shown = OfResponse(Typed("responses", "REAL", "", 7, "json_extract(shown, '$.level')"),
-                          [](const Response& r) { return Optional(r.level); });
+  Column& level = add("level", "number", "the procedure's variable", "", "a procedure trial: the level shown", V,
+                      Cell::kText);
+  level.variable = Member(&RecordedVariables::level);
+  level.shown = OfResponse(Typed("responses", "REAL", "", 7, "json_extract(shown, '$.level')"),
+                           [](const Response& r) { return Optional(r.level); });
 
   // The answer.
   add("status", "string", "", "answered|timed_out|skipped|unanswered",
@@ -202,19 +221,21 @@ std::vector<Column> MakeColumns() {
   Column& correct = add("correct", "boolean", "", "0|1",
                         "1: the answer was correct (procedure trials, odd one out); empty where no answer is correct",
                         A, Cell::kInteger);
-  correct.in_variables = true;
+  correct.in_variables = true, correct.variable = Member(&RecordedVariables::correct);
   correct.at = OfResponse(Typed("responses", "INTEGER", "correct IN (0, 1)", 7, "json_extract(shown, '$.correct')"), [](const Response& r) {
     return r.correct ? Value(int64_t(*r.correct ? 1 : 0)) : Value();
   });
 
   // Each radius as the camera made it, on the screen and at the eye; the photo px ones also typed, planned (trials)
   // and as shown (responses), for a procedure decides them at the trial.
-  for (const std::string side : {"left", "right", "scene"}) {
+  for (size_t k = 0; k < RecordedVariables::kSides.size(); ++k) {
+    const std::string side = RecordedVariables::kSides[k];
     const std::string what = side == "scene" ? "the scene's own blur at the object's place (the fitted model; depth "
                                                "matching: the real picture's, the thin lens of content.real_camera)"
                                              : "the " + side + " object's blur radius";
     Column& px = add("r_" + side + "_px", "number", "photo px",
                      "", what + ", as the camera makes it (moving: averaged over the run)", V, Cell::kText);
+    px.variable = Radius(&RecordedVariables::r_px, k);
     // Before version 7 only the variables' JSON had it, planned (factors) and as shown (shown).
     const Stored planned = Typed("trials", "REAL", "", 7, "json_extract(factors, '$.r_" + side + "_px')");
     const Stored shown = Typed("responses", "REAL", "", 7, "json_extract(shown, '$.r_" + side + "_px')");
@@ -227,8 +248,10 @@ std::vector<Column> MakeColumns() {
     } else {
       px.at = OfTrial(planned, [](const TrialRecord& t) { return Optional(t.r_scene_px); });
     }
-    add("r_" + side + "_screen_px", "number", "screen px", "", what + ", on the screen", V, Cell::kText);
-    add("r_" + side + "_arcmin", "number", "arcmin", "", what + ", at the eye", V, Cell::kText);
+    add("r_" + side + "_screen_px", "number", "screen px", "", what + ", on the screen", V, Cell::kText).variable =
+        Radius(&RecordedVariables::r_screen_px, k);
+    add("r_" + side + "_arcmin", "number", "arcmin", "", what + ", at the eye", V, Cell::kText).variable =
+        Radius(&RecordedVariables::r_arcmin, k);
   }
   Column& rt = add("rt_ms", "number", "ms", ">= 0", "response time from the stimulus's first frame; empty without an answer",
                    A, Cell::kNumber);
@@ -237,45 +260,55 @@ std::vector<Column> MakeColumns() {
       .at = Plain("responses", "answered_at", "TEXT", 1);
 
   auto variable = [&](const std::string& name, const std::string& type, const std::string& unit,
-                      const std::string& meaning) { add(name, type, unit, "", meaning, V, Cell::kText); };
-  variable("screen_px_per_photo_px", "number", "screen px / photo px", "how the photo was scaled onto the screen");
-  variable("kernel", "string", "", "the blur kernel (gaussian | disc)");
-  variable("blur_plan", "string", "", "one_radius: each object blurred with one radius; per_pixel: by depth");
-  variable("r_span_screen_px", "number", "screen px", "the largest change of a radius across an object's depth");
+                      const std::string& meaning, std::function<Json(const RecordedVariables&)> read) {
+    add(name, type, unit, "", meaning, V, Cell::kText).variable = std::move(read);
+  };
+  using R = RecordedVariables;
+  variable("screen_px_per_photo_px", "number", "screen px / photo px", "how the photo was scaled onto the screen", Member(&R::screen_px_per_photo_px));
+  variable("kernel", "string", "", "the blur kernel (gaussian | disc)", Member(&R::kernel));
+  variable("blur_plan", "string", "", "one_radius: each object blurred with one radius; per_pixel: by depth",
+           Member(&R::blur_plan));
+  variable("r_span_screen_px", "number", "screen px", "the largest change of a radius across an object's depth", Member(&R::r_span_screen_px));
   // The PSF beside each radius (render/psf.h): the lens floor inside it and the motion streak over the exposure.
-  variable("exposure_ms", "number", "ms", "the exposure a moving object's motion blur lasts (content.exposure_ms; 0: none)");
-  for (const std::string side : {"left", "right"}) {
+  variable("exposure_ms", "number", "ms", "the exposure a moving object's motion blur lasts (content.exposure_ms; 0: none)",
+           Member(&R::exposure_ms));
+  for (size_t k = 0; k < 2; ++k) {
+    const std::string side = RecordedVariables::kSides[k];
     variable("floor_sigma_" + side + "_px", "number", "photo px",
              "the lens floor (std) inside the " + side + " object's radius: the scene's, for a measured, measured_section "
-             "or fitted source (its defocus drawn convolved with it); 0 for the others");
-    variable("floor_sigma_" + side + "_screen_px", "number", "screen px", "the same on the screen");
+             "or fitted source (its defocus drawn convolved with it); 0 for the others", Radius(&R::floor_sigma_px, k));
+    variable("floor_sigma_" + side + "_screen_px", "number", "screen px", "the same on the screen",
+             Radius(&R::floor_sigma_screen_px, k));
     variable("motion_" + side + "_x_screen_px", "number", "screen px",
-             "the " + side + " object's motion streak over the exposure, across (x right), averaged over the run");
+             "the " + side + " object's motion streak over the exposure, across (x right), averaged over the run",
+             Radius(&R::motion_x_screen_px, k));
     variable("motion_" + side + "_y_screen_px", "number", "screen px",
-             "the " + side + " object's motion streak over the exposure, down (y down), averaged over the run");
+             "the " + side + " object's motion streak over the exposure, down (y down), averaged over the run",
+             Radius(&R::motion_y_screen_px, k));
   }
-  variable("size_left_deg", "number", "deg", "the left object's largest extent on screen at onset");
-  variable("size_right_deg", "number", "deg", "the right object's largest extent on screen at onset");
-  variable("brightness", "number", "", "the object's brightness matching (factor of its texture's values)");
-  variable("contrast", "number", "", "the object's contrast matching");
-  variable("white_balance_r", "number", "", "the object's red gain in linear light");
-  variable("white_balance_g", "number", "", "the object's green gain in linear light");
-  variable("white_balance_b", "number", "", "the object's blue gain in linear light");
-  variable("start_level", "number", "the adjusted parameter's unit", "adjustment: the level shown first");
+  variable("size_left_deg", "number", "deg", "the left object's largest extent on screen at onset", Member(&R::size_left_deg));
+  variable("size_right_deg", "number", "deg", "the right object's largest extent on screen at onset", Member(&R::size_right_deg));
+  variable("brightness", "number", "", "the object's brightness matching (factor of its texture's values)", Member(&R::brightness));
+  variable("contrast", "number", "", "the object's contrast matching", Member(&R::contrast));
+  variable("white_balance_r", "number", "", "the object's red gain in linear light", Member(&R::white_balance_r));
+  variable("white_balance_g", "number", "", "the object's green gain in linear light", Member(&R::white_balance_g));
+  variable("white_balance_b", "number", "", "the object's blue gain in linear light", Member(&R::white_balance_b));
+  variable("start_level", "number", "the adjusted parameter's unit", "adjustment: the level shown first", Member(&R::start_level));
   variable("adjust_levels", "string", "the adjusted parameter's unit",
-           "adjustment: the levels in the order the next key steps through them (cyclic), separated by ;");
+           "adjustment: the levels in the order the next key steps through them (cyclic), separated by ;",
+           Member(&R::adjust_levels));
   variable("picture_width_arcmin", "number", "arcmin",
-           "depth matching: the virtual picture's width at the eye (a cut-off c's blur is r = 2 x 0.1874 x this / c)");
-  variable("procedure_cell", "integer", "", "a procedure trial: which crossing of its block's factors (its own procedure)");
-  variable("test_side", "string", "", "a procedure trial: the side (or odd-one-out interval) showing the procedure's level");
-  variable("reversals", "integer", "", "a staircase trial: the staircase's reversals before this answer (or when it stopped)");
-  variable("skipped", "string", "", "why a trial was not shown (stop rule: its staircase had ended)");
+           "depth matching: the virtual picture's width at the eye (a cut-off c's blur is r = 2 x 0.1874 x this / c)", Member(&R::picture_width_arcmin));
+  variable("procedure_cell", "integer", "", "a procedure trial: which crossing of its block's factors (its own procedure)", Member(&R::procedure_cell));
+  variable("test_side", "string", "", "a procedure trial: the side (or odd-one-out interval) showing the procedure's level", Member(&R::test_side));
+  variable("reversals", "integer", "", "a staircase trial: the staircase's reversals before this answer (or when it stopped)", Member(&R::reversals));
+  variable("skipped", "string", "", "why a trial was not shown (stop rule: its staircase had ended)", Member(&R::skipped));
   variable("posterior_threshold", "number", "the procedure's variable",
-           "a QUEST+ trial: the posterior mean of the threshold after this answer (its running estimate)");
-  variable("posterior_slope", "number", "", "a QUEST+ trial: the posterior mean of the slope after this answer");
-  variable("round", "integer", "", "a practice block run until a criterion: which run of its design (from 1)");
-  variable("odd_interval", "integer", "", "odd one out: the interval that showed the right side's object (the correct answer)");
-  variable("intervals", "integer", "", "odd one out: intervals per trial");
+           "a QUEST+ trial: the posterior mean of the threshold after this answer (its running estimate)", Member(&R::posterior_threshold));
+  variable("posterior_slope", "number", "", "a QUEST+ trial: the posterior mean of the slope after this answer", Member(&R::posterior_slope));
+  variable("round", "integer", "", "a practice block run until a criterion: which run of its design (from 1)", Member(&R::round));
+  variable("odd_interval", "integer", "", "odd one out: the interval that showed the right side's object (the correct answer)", Member(&R::odd_interval));
+  variable("intervals", "integer", "", "odd one out: intervals per trial", Member(&R::intervals));
   return c;
 }
 
@@ -308,6 +341,14 @@ void BindEach(const std::vector<Column>& columns, const std::string& table, Stat
 const std::vector<Column>& RecordColumns() {
   static const std::vector<Column> columns = MakeColumns();
   return columns;
+}
+
+Json VariablesJson(const RecordedVariables& variables) {
+  Json json = Json::object();
+  for (const Column& column : RecordColumns())
+    if (column.variable)
+      if (Json value = column.variable(variables); !value.is_null()) json[column.name] = std::move(value);
+  return json;
 }
 
 std::string ColumnName(const Column& column, const Stored& stored) {

@@ -7,7 +7,10 @@
 // codebook's rows, the names a design's level may not take (IsRecordedName) and the merge's column lists. Values the
 // protocol allows (levels, ranges, choices) are not here: the design table (design_columns) gives them per protocol
 // version. The columns of the tables beside trials.csv (frames.csv, adjustments.csv, summaries) are export_table.cc's.
+#include <array>
 #include <cstdint>
+#include <functional>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -44,6 +47,29 @@ struct SessionValues {
   int64_t number;
 };
 
+// What the runner records of a trial beside its levels, typed: the variables' JSON of a trial (planned), and of a
+// response (as a procedure decided it at the trial, or why a trial was skipped). Each member is read by one column of
+// RecordColumns() (Column::variable), whose name is its key in the JSON: the keys, trials.csv's columns and the
+// codebook's rows are that one table. Unset: not recorded for this trial.
+struct RecordedVariables {
+  std::optional<bool> practice, swapped, correct;  // recorded 1 | 0
+  std::optional<std::string> block_name, test_side, adjust_levels, kernel, blur_plan, skipped;
+  std::optional<int64_t> round, procedure_cell, odd_interval, intervals, reversals;
+  std::optional<double> level, start_level, picture_width_arcmin, screen_px_per_photo_px, r_span_screen_px,
+      size_left_deg, size_right_deg, brightness, contrast, white_balance_r, white_balance_g, white_balance_b,
+      posterior_threshold, posterior_slope;
+  // Each radius of kSides as the camera made it (photo px), on the screen (screen px) and at the eye (arcmin).
+  static constexpr std::array<const char*, 3> kSides{"left", "right", "scene"};
+  std::array<std::optional<double>, 3> r_px, r_screen_px, r_arcmin;
+  // The PSF beside them (render/psf.h): the exposure a moving object's streak lasts, and for the left and right
+  // sides (kSides' first two) the lens floor inside the radius (std) and the streak's x and y on the screen.
+  std::optional<double> exposure_ms;
+  std::array<std::optional<double>, 3> floor_sigma_px, floor_sigma_screen_px, motion_x_screen_px, motion_y_screen_px;
+};
+
+// The JSON the record keeps `variables` in: {NAME: value} for each member set, NAME its column's.
+Json VariablesJson(const RecordedVariables& variables);
+
 // A column of the record that keeps a variable: its table, SQL type and CHECK, and the schema version that added it.
 // Columns of version 7 on (the typed record) are added by migrations generated from this table, written by the
 // record's INSERTs through `of_*` (the one of its table) and copied by merge (but for the session number, which merge
@@ -78,6 +104,9 @@ struct Column {
   // Also in the trial's variables (factors or shown JSON), written there by the runner: exported from the typed
   // column, not from there.
   bool in_variables = false;
+  // A variable the runner records (a Place::kVariable column, or in_variables): its member of RecordedVariables, as
+  // JSON (null when unset).
+  std::function<Json(const RecordedVariables&)> variable;
 };
 
 // The record's columns, in the order schema 7 added the typed ones within each table (trials.csv orders by place).

@@ -261,5 +261,39 @@ TEST(Columns, MergeCopiesEveryTypedColumn) {
     }
 }
 
+// The runner's variables are the table's: every variable column (and every column also kept in the variables) reads
+// one member of RecordedVariables, each member is read by one column, and the JSON's keys are the columns' names.
+// The record of a trial that recorded a practice round, a procedure's level and one radius, hand-written.
+TEST(Columns, TheRunnersVariablesAreTheTablesColumns) {
+  for (const Column& c : RecordColumns())
+    EXPECT_EQ(bool(c.variable), c.place == Place::kVariable || c.in_variables) << c.name;
+  EXPECT_EQ(VariablesJson(RecordedVariables{}), Json::object());
+  RecordedVariables v;
+  v.practice = true;
+  v.round = 2;
+  v.level = 0.25;
+  v.test_side = "left";
+  v.r_px[2] = 1.5;             // the scene's
+  v.r_arcmin[0] = 0.75;        // the left one's
+  EXPECT_EQ(VariablesJson(v).dump(),
+            R"({"level":0.25,"practice":1,"r_left_arcmin":0.75,"r_scene_px":1.5,"round":2,"test_side":"left"})");
+  // Every member set: one key per member (28 single ones, 3 sides x 3 units of radius), none twice.
+  RecordedVariables all;
+  all.practice = all.swapped = all.correct = false;
+  all.block_name = all.test_side = all.adjust_levels = all.kernel = all.blur_plan = all.skipped = std::string("x");
+  all.round = all.procedure_cell = all.odd_interval = all.intervals = all.reversals = int64_t{1};
+  for (std::optional<double>* x : {&all.level, &all.start_level, &all.picture_width_arcmin,
+                                   &all.screen_px_per_photo_px, &all.r_span_screen_px, &all.size_left_deg,
+                                   &all.size_right_deg, &all.brightness, &all.contrast, &all.white_balance_r,
+                                   &all.white_balance_g, &all.white_balance_b, &all.posterior_threshold,
+                                   &all.posterior_slope})
+    *x = 2.5;
+  for (size_t k = 0; k < 3; ++k) all.r_px[k] = all.r_screen_px[k] = all.r_arcmin[k] = 3.5;
+  const Json json = VariablesJson(all);
+  EXPECT_EQ(json.size(), 28u + 9u) << json.dump();
+  EXPECT_EQ(json["practice"], 0);
+  EXPECT_EQ(json["r_right_screen_px"], 3.5);
+}
+
 }  // namespace
 }  // namespace blurcue::store

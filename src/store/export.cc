@@ -16,6 +16,7 @@
 #include "core/hash.h"
 #include "core/json_io.h"
 #include "core/typed.h"
+#include "protocol/vocabulary.h"
 #include "store/columns.h"
 #include "store/export_procedures.h"
 #include "store/export_table.h"
@@ -310,18 +311,22 @@ int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::p
     // The answer, split by what it is: one column per kind of answer, each of one type.
     const bool answered = rows.GetInt64(6) == 0;
     const std::string choice = answered ? rows.GetText(7) : "";
-    const std::string task = rows.GetText(8);
+    // The task's kind of answer (a record's task column holds a word of the task vocabulary; an unknown word is
+    // read as a side or interval, as forced choice).
+    const std::optional<protocol::Task> task = protocol::ParseWord<protocol::Task>(rows.GetText(8));
+    const protocol::TaskAnswer kind = task ? protocol::TraitsOf(*task).answer : protocol::TaskAnswer::kSide;
     const std::string status = !answered                  ? "unanswered"
                                : choice == kChoiceNone    ? "timed_out"
                                : choice == kChoiceSkipped ? "skipped"
                                                           : "answered";
     std::string side, more_blurred, interval, yes_no, rating, level;
     if (status == "answered") {
-      if (task == "adjustment") level = choice;
-      else if (task == "yes_no") yes_no = choice;
-      else if (task == "rating") rating = choice;
-      else if (AllDigits(choice)) interval = choice;
-      else side = choice;
+      switch (kind) {
+        case protocol::TaskAnswer::kLevel: level = choice; break;
+        case protocol::TaskAnswer::kYesNo: yes_no = choice; break;
+        case protocol::TaskAnswer::kRatingPoint: rating = choice; break;
+        case protocol::TaskAnswer::kSide: (AllDigits(choice) ? interval : side) = choice; break;
+      }
     }
     if ((side == "left" || side == "right") && !rows.IsNull(9) && !rows.IsNull(10)) {
       const double l = rows.GetDouble(9), r = rows.GetDouble(10);
@@ -390,7 +395,8 @@ int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::p
     codebook += CsvLine({"trials.csv", c.name, c.type, c.unit, c.allowed, c.meaning, c.role});
   for (const auto& c : AdjustmentColumns())
     codebook += CsvLine({"adjustments.csv", c.name, c.type, c.unit, c.allowed, c.meaning, ""});
-  for (const auto& c : FrameColumns()) codebook += CsvLine({"frames.csv", c.name, c.type, c.unit, c.allowed, c.meaning, ""});
+  for (const auto& [c, select, cell] : FrameColumns())
+    codebook += CsvLine({"frames.csv", c.name, c.type, c.unit, c.allowed, c.meaning, ""});
   // Every table of one export appears together: a kill leaves the previous export whole, never its frames.csv
   // beside a new trials.csv.
   WriteFolderAtomically(

@@ -32,7 +32,7 @@ namespace {
 
 Json ParametersOf(const protocol::Procedure& p) {
   Json out = {{"procedure", protocol::ToString(p.kind)}, {"variable", protocol::ToString(p.variable)},
-              {"reference", p.reference}, {"trials", p.trials}};
+              {"reference", protocol::ToJson(std::optional<protocol::BlurSpec>(p.reference))}, {"trials", p.trials}};
   switch (p.kind) {
     case protocol::ProcedureKind::kStaircase:
       out.update({{"start", p.start}, {"min", p.min}, {"max", p.max}, {"up", p.up}, {"down", p.down},

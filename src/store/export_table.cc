@@ -180,19 +180,26 @@ const std::vector<ColumnDef>& AdjustmentColumns() {
   };
   return columns;
 }
-const std::vector<ColumnDef>& FrameColumns() {
-  static const std::vector<ColumnDef> columns = {
-      {"study", "string", "", "", "the protocol's name"},
-      {"participant", "string", "", "", "the participant's id"},
-      {"session_id", "integer", "", ">= 1", "the session's id in this record (as in trials.csv)"},
-      {"window", "boolean", "", "0|1", "1: a real window on the real clock; 0: headless on a simulated clock"},
-      {"trial_index", "integer", "", ">= 0", "the trial (as in trials.csv)"},
-      {"frame_index", "integer", "", ">= 0", "the frame's place in the trial"},
-      {"flip_time_s", "number", "s", ">= 0", "when the frame reached the screen, from the trial's first flip"},
-      {"dropped", "boolean", "", "0|1", "1: more than 1.5 refresh periods after the frame before (window only)"},
-      {"r_left_px", "number", "photo px", ">= 0", "the left object's blur radius in this frame; empty: not shown"},
-      {"r_right_px", "number", "photo px", ">= 0", "the right object's blur radius in this frame; empty: not shown"},
-      {"y_mm", "number", "mm", "", "the objects' place along the board's y in this frame (0 at edge 1)"},
+const std::vector<FrameColumn>& FrameColumns() {
+  static const std::vector<FrameColumn> columns = {
+      {{"study", "string", "", "", "the protocol's name"}, "st.name", Cell::kText},
+      {{"participant", "string", "", "", "the participant's id"}, "p.code", Cell::kText},
+      {{"session_id", "integer", "", ">= 1", "the session's id in this record (as in trials.csv)"}, "s.id",
+       Cell::kInteger},
+      {{"window", "boolean", "", "0|1", "1: a real window on the real clock; 0: headless on a simulated clock"},
+       "coalesce(s.window, s.display LIKE 'window%')", Cell::kInteger},
+      {{"trial_index", "integer", "", ">= 0", "the trial (as in trials.csv)"}, "t.trial_index", Cell::kInteger},
+      {{"frame_index", "integer", "", ">= 0", "the frame's place in the trial"}, "f.frame_index", Cell::kInteger},
+      {{"flip_time_s", "number", "s", ">= 0", "when the frame reached the screen, from the trial's first flip"},
+       "f.flip_time_s", Cell::kNumber},
+      {{"dropped", "boolean", "", "0|1", "1: more than 1.5 refresh periods after the frame before (window only)"},
+       "f.dropped", Cell::kInteger},
+      {{"r_left_px", "number", "photo px", ">= 0", "the left object's blur radius in this frame; empty: not shown"},
+       "f.r_left_px", Cell::kNumber},
+      {{"r_right_px", "number", "photo px", ">= 0", "the right object's blur radius in this frame; empty: not shown"},
+       "f.r_right_px", Cell::kNumber},
+      {{"y_mm", "number", "mm", "", "the objects' place along the board's y in this frame (0 at edge 1)"}, "f.y_mm",
+       Cell::kNumber},
   };
   return columns;
 }
@@ -200,21 +207,34 @@ const std::vector<ColumnDef>& FrameColumns() {
 // OUT/frames.csv: every recorded display flip, one row each (FrameColumns): what each frame showed of a pair, empty
 // where nothing was shown and for pictures.
 void WriteFrames(Database& db, const std::filesystem::path& out_dir) {
+  const std::vector<FrameColumn>& columns = FrameColumns();
   std::vector<std::string> header;
-  for (const auto& c : FrameColumns()) header.push_back(c.name);
+  std::string select;
+  for (const FrameColumn& c : columns) {
+    header.push_back(c.def.name);
+    select += (select.empty() ? "" : ", ") + c.select;
+  }
   std::string text = CsvLine(header);
-  Statement rows(db,
-                 "SELECT st.name, p.code, s.id, t.trial_index, f.frame_index, f.flip_time_s, f.dropped, "
-                 "coalesce(s.window, s.display LIKE 'window%'), f.r_left_px, f.r_right_px, f.y_mm "
-                 "FROM frames f JOIN trials t ON t.id = f.trial_id JOIN sessions s ON s.id = t.session_id "
-                 "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
-                 "ORDER BY st.name, p.code, s.id, t.trial_index, f.frame_index");
-  auto optional = [&](int column) { return rows.IsNull(column) ? std::string() : Number(rows.GetDouble(column)); };
-  while (rows.Step())
-    text += CsvLine({rows.GetText(0), rows.GetText(1), std::to_string(rows.GetInt64(2)),
-                     std::to_string(rows.GetInt64(7)), std::to_string(rows.GetInt64(3)),
-                     std::to_string(rows.GetInt64(4)), Number(rows.GetDouble(5)), std::to_string(rows.GetInt64(6)),
-                     optional(8), optional(9), optional(10)});
+  Statement rows(db, "SELECT " + select +
+                         " FROM frames f JOIN trials t ON t.id = f.trial_id JOIN sessions s ON s.id = t.session_id "
+                         "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
+                         "ORDER BY st.name, p.code, s.id, t.trial_index, f.frame_index");
+  auto cell = [&](int at, enum Cell kind) -> std::string {
+    if (rows.IsNull(at)) return "";
+    switch (kind) {
+      case Cell::kInteger: return std::to_string(rows.GetInt64(at));
+      case Cell::kNumber: return Number(rows.GetDouble(at));
+      case Cell::kText:
+      case Cell::kSeed:
+      case Cell::kAnswer: break;
+    }
+    return rows.GetText(at);
+  };
+  while (rows.Step()) {
+    std::vector<std::string> cells;
+    for (size_t i = 0; i < columns.size(); ++i) cells.push_back(cell(int(i), columns[i].cell));
+    text += CsvLine(cells);
+  }
   WriteFileAtomically(out_dir / "frames.csv", text);
 }
 

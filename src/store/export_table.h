@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/json_io.h"
+#include "store/columns.h"
 #include "store/export.h"
 #include "store/sqlite.h"
 
@@ -49,9 +50,17 @@ int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::p
 // cant_tell, for adjustment the level accepted. Writes OUT/SummaryFileName(STUDY) for every study and returns the
 // codebook's rows for them.
 std::string WriteSummaries(Database& db, const std::filesystem::path& out_dir);
+// A column of frames.csv, defined once: its codebook row, what the export selects for it (SQL over f = frames, t, s,
+// p, st) and how its cell is written (kText, kInteger, kNumber; NULL: empty). Its header, SELECT, cells and codebook
+// rows are generated from this table.
+struct FrameColumn {
+  ColumnDef def;
+  std::string select;
+  enum Cell cell = Cell::kText;  // the enum (columns.h), which the function Cell below hides
+};
 // The columns of adjustments.csv and frames.csv, for their writers and the codebook.
 const std::vector<ColumnDef>& AdjustmentColumns();
-const std::vector<ColumnDef>& FrameColumns();
+const std::vector<FrameColumn>& FrameColumns();
 // OUT/frames.csv: every recorded display flip, one row each (FrameColumns): what each frame showed of a pair, empty
 // where nothing was shown and for pictures.
 void WriteFrames(Database& db, const std::filesystem::path& out_dir);

@@ -16,6 +16,7 @@
 #include "core/error.h"
 #include "core/typed.h"
 #include "core/json_io.h"
+#include "protocol/level.h"
 #include "store/columns.h"
 #include "store/schema.h"
 
@@ -463,14 +464,47 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
   return start;
 }
 
+namespace {
+
+// The record's name of a source: its word, or for a fixed radius fixed_ and its unit (photo px as records have always
+// written it, fixed_px).
+std::string SourceName(protocol::BlurSource source, protocol::RadiusUnit unit) {
+  if (source != protocol::BlurSource::kFixed) return protocol::ToString(source);
+  switch (unit) {
+    case protocol::RadiusUnit::kPhotoPx: return "fixed_px";
+    case protocol::RadiusUnit::kScreenPx:
+    case protocol::RadiusUnit::kArcmin: return "fixed_" + protocol::ToString(unit);
+  }
+  return "";
+}
+
+}  // namespace
+
 SourceColumns SourceColumns::Of(const std::string& source_json) {
   const Json v = ParseJson(source_json, "a side's source");
-  if (v.is_string()) return {v.get<std::string>(), std::nullopt};
-  if (v.is_number()) return {"fixed_px", v.get<double>()};
-  if (v.is_object() && v.contains("screen_px") && v["screen_px"].is_number())
-    return {"fixed_screen_px", v["screen_px"].get<double>()};
-  if (v.is_object() && v.contains("arcmin") && v["arcmin"].is_number()) return {"fixed_arcmin", v["arcmin"].get<double>()};
-  return {};
+  if (v.is_null()) return {};
+  try {
+    const protocol::BlurSpec spec = protocol::BlurSpecOf(v);
+    if (spec.source != protocol::BlurSource::kFixed) return {SourceName(spec.source, spec.unit), std::nullopt};
+    return {SourceName(spec.source, spec.unit), spec.radius.number};
+  } catch (const Error&) {
+    // Not a side this build reads: a text kept as written (the typed column says what the record says).
+    if (v.is_string()) return {v.get<std::string>(), std::nullopt};
+    return {};
+  }
+}
+
+std::string SourceColumns::Names() {
+  std::string names;
+  for (const protocol::BlurSource source : protocol::Vocabulary<protocol::BlurSource>::values) {
+    if (source != protocol::BlurSource::kFixed) {
+      names += (names.empty() ? "" : "|") + SourceName(source, protocol::RadiusUnit::kPhotoPx);
+      continue;
+    }
+    for (const protocol::RadiusUnit unit : protocol::Vocabulary<protocol::RadiusUnit>::values)
+      names += (names.empty() ? "" : "|") + SourceName(source, unit);
+  }
+  return names;
 }
 
 void Record::SaveTrialList(int64_t session, const std::vector<TrialRecord>& trials) {

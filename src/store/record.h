@@ -96,12 +96,14 @@ struct TrialRecord {
   std::string cell;  // a procedure trial's cell by its levels ("edge=9", "edge=9;speed_cm_s=3"); "" otherwise
 };
 
-// A side's source as typed columns: its name (none, measured, measured_section, estimated, fitted, fixed_px,
-// fixed_screen_px, fixed_arcmin; empty for null) and the fixed radius in that unit.
+// A side's source as typed columns: its name (a word of the blur-source vocabulary, or fixed_px, fixed_screen_px,
+// fixed_arcmin for a fixed radius in photo px, screen px, arcmin; empty for null) and the fixed radius in that unit.
 struct SourceColumns {
   std::string source;
   std::optional<double> fixed;
   static SourceColumns Of(const std::string& source_json);
+  // Every name `source` may hold, "|"-separated (the codebook's allowed values), in the vocabulary's order.
+  static std::string Names();
 };
 
 // The choices a record holds besides the answers themselves: no answer before the deadline, and a trial not shown
