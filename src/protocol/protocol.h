@@ -238,13 +238,8 @@ struct Protocol {
   // The order blocks run in: "fixed" (file order), "random" (drawn with the seed) or "latin_square" (a balanced
   // Latin square over participants by their number: each block equally often in each place, and after each other).
   BlockSequence block_order = BlockSequence::kFixed;
-  // How a pair is shown: "side_by_side" (both at once, left and right) or "two_intervals" (2IFC: the left side's
-  // object for timing.interval_ms, grey for timing.isi_ms, then the right side's, both at the left object's place;
-  // the left / right keys answer first / second interval). Still pairs only.
-  // "single": one object (the sides' or levels' "object"), for yes_no or rating. "odd_one_out": `alternatives` intervals
-  // (timing.interval_ms each, isi_ms between) at the left object's place, one of them - drawn with the seed, the
-  // trial's test_side "1".."n" - showing the right side's object, the others the left side's; the participant names the
-  // odd interval with responses.alternatives.
+  // How a trial is shown: each layout's word and meaning are in protocols/protocol.schema.json's layout field
+  // (vocabulary.h lists them; stimulus/trial_scene.cc turns each into what a trial shows).
   Layout layout = Layout::kSideBySide;
   int alternatives = 0;               // odd_one_out: intervals per trial (3-6)
   std::vector<InfoField> participant_info;
