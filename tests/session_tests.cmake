@@ -146,9 +146,9 @@ string(ASCII 27 escape)
 file(WRITE ${D}/latin1-cell.csv "edge,left,right,label\n1,measured,none,caf${latin1}\n")
 file(WRITE ${D}/escape-cell.csv "edge,left,right,label\n1,measured,none,ok\n2,measured,none,a${escape}[2Jb\n")
 set(grid_head "{\"name\": \"t\", \"version\": 1, \"content\": {\"type\": \"grid\"}, \"task\": \"forced_choice\", ${ball_scene},")
-add_preflight_test(latin1-cell ": ${D}/latin1-cell.csv line 2, column 4 (label): must be printable UTF-8 text"
+add_preflight_test(latin1-cell "${D}/latin1-cell.csv line 2, column 4 (label): must be printable UTF-8 text"
                    "${grid_head} \"conditions\": \"latin1-cell.csv\"}")
-add_preflight_test(escape-cell ": ${D}/escape-cell.csv line 3, column 4 (label): must be printable UTF-8 text"
+add_preflight_test(escape-cell "${D}/escape-cell.csv line 3, column 4 (label): must be printable UTF-8 text"
                    "${grid_head} \"conditions\": \"escape-cell.csv\"}")
 # A quote left open at a line's end: the label "ab" used to be recorded.
 file(WRITE ${D}/open-quote.csv "edge,left,right,label\n1,measured,none,ok\n2,measured,none,\"ab\n")

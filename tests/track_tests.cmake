@@ -5,11 +5,11 @@ add_test(NAME track_cli COMMAND bash ${PROJECT_SOURCE_DIR}/tests/track_test.sh $
 set_tests_properties(track_cli PROPERTIES PASS_REGULAR_EXPRESSION "^ok:|\nok:")
 # The track bench on 4 frames writes one row per (mode, frame) and says the targets in words; its chart is drawn.
 add_test(NAME cli_bench_track_quick
-         COMMAND $<TARGET_FILE:blurcue> bench track --quick --out ${PROJECT_BINARY_DIR}/track-test/bench/track.csv)
-set_tests_properties(cli_bench_track_quick PROPERTIES LABELS slow
+         COMMAND $<TARGET_FILE:blurcue> bench track --quick --out ${PROJECT_BINARY_DIR}/track-bench/track.csv)
+set_tests_properties(cli_bench_track_quick PROPERTIES LABELS slow FIXTURES_SETUP track_bench
                      PASS_REGULAR_EXPRESSION "wrote .*track.csv \\(12 rows\\).*track +4 .*\\(3 tracked\\).*track: median [0-9.]+ ms a frame wall")
 add_test(NAME cli_bench_track_chart
          COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/analysis/track_chart.py
-                 ${PROJECT_BINARY_DIR}/track-test/bench/track.csv ${PROJECT_BINARY_DIR}/track-test/bench)
-set_tests_properties(cli_bench_track_chart PROPERTIES DEPENDS cli_bench_track_quick LABELS slow
+                 ${PROJECT_BINARY_DIR}/track-bench/track.csv ${PROJECT_BINARY_DIR}/track-bench)
+set_tests_properties(cli_bench_track_chart PROPERTIES FIXTURES_REQUIRED track_bench LABELS slow
                      WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}/analysis PASS_REGULAR_EXPRESSION "wrote .*bench-track.png")

@@ -16,12 +16,6 @@
 namespace blurcue::calib {
 namespace {
 
-std::string Num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 // A number of calib.json in [lo, hi] (unit for the message); NaN and infinity fail too.
 double Ranged(const Json& obj, const std::string& key, const std::string& where, double lo, double hi,
               const std::string& unit) {

@@ -36,12 +36,6 @@ struct Row {
   std::string signed_reason;
 };
 
-std::string Num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 std::string Px(double v) {
   char buf[32];
   // Two decimals, and no "-0.00" for a point on the focus plane.

@@ -7,12 +7,6 @@
 
 namespace blurcue {
 
-static std::string Num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 std::array<double, 9> Camera::Intrinsics() const {
   if (camera_matrix) return *camera_matrix;
   const double fpx = focal_length_mm / PixelPitchMm();

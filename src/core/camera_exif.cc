@@ -33,12 +33,6 @@ const std::vector<KnownSensor>& KnownSensors() {
 
 namespace {
 
-std::string Num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
-}
-
 std::string Hex(ExifTag tag) {
   char b[16];
   std::snprintf(b, sizeof b, "0x%04x", unsigned(tag));

@@ -1,6 +1,7 @@
 #pragma once
 // Errors that cross a module boundary. Each kind maps to one exit code of the `blurcue` executable,
 // so scripts can tell a typo in a command line from a bad file from a failed computation.
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -48,6 +49,13 @@ class Error : public std::runtime_error {
 // A bad file or value: message is "where: what, got what".
 inline Error InputError(const std::string& where, const std::string& what) {
   return Error(ErrorKind::kInput, where + ": " + what);
+}
+
+// A number as a message shows it: at most 6 significant digits, as printf's %g (2, 0.35, 1.5e+06, inf, nan).
+inline std::string Num(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
 }
 
 }  // namespace blurcue

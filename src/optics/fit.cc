@@ -324,12 +324,6 @@ double WeightedRms(const Data& s, const std::vector<double>& e, const std::vecto
   return sw > 0 ? std::sqrt(sum / sw) : 0.0;
 }
 
-std::string Num(double v) {
-  std::ostringstream o;
-  o << v;
-  return o.str();
-}
-
 }  // namespace
 
 double FittedModel::PredictPx(const Lens& lens, double u_mm) const {

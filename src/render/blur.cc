@@ -20,12 +20,6 @@ using scene::GreyMarginPx;
 using scene::LayerOnField;
 using scene::ScaledWidthPx;
 
-static std::string Num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 void CheckBlurRadius(double r_px) {
   // Written so that NaN fails too: every comparison with NaN is false.
   if (!(r_px >= 0 && r_px <= kMaxBlurRadiusPx))

@@ -12,12 +12,6 @@
 namespace blurcue::render {
 namespace {
 
-std::string Num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 // The full 2-D convolution of two odd square kernels (the result's centre is both centres').
 cv::Mat Convolve(const cv::Mat& a, const cv::Mat& b) {
   const int ha = a.rows / 2, hb = b.rows / 2, h = ha + hb;

@@ -34,12 +34,6 @@ using detail::View;
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::string Num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 // ---------------------------------------------------------------------------------------------------------------
 // Random numbers: std::mt19937_64's output is fixed by the standard, but the std:: distributions are not, so the
 // uniform and normal draws are written out here; that keeps "same options + seed -> identical bytes" across

@@ -13,12 +13,6 @@
 namespace blurcue::synth {
 namespace {
 
-std::string Num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 std::string Indexed(const char* pattern, int index) {
   char name[64];
   std::snprintf(name, sizeof name, pattern, index);
