@@ -12,13 +12,19 @@ function(add_module_library name)
   target_compile_options(blurcue_${name} PRIVATE -Wall -Wextra -Wswitch-enum -Wno-array-bounds -Wno-restrict)
 endfunction()
 
-# add_module_test(NAME SRCS a_test.cc DEPS libs [LABELS gl slow])
-#   One GoogleTest executable, registered with CTest test by test.
+# add_module_test(NAME SRCS a_test.cc DEPS libs [LABELS gl slow] [ONE_PROCESS])
+#   One GoogleTest executable, registered with CTest test by test; with ONE_PROCESS as one CTest test (for tests that
+#   share an expensive set-up made once per process, such as a rendered take: CTest runs each test in a process).
 function(add_module_test name)
-  cmake_parse_arguments(ARG "" "" "SRCS;DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "ONE_PROCESS" "" "SRCS;DEPS;LABELS" ${ARGN})
   add_executable(${name} ${ARG_SRCS})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest_main)
   target_compile_options(${name} PRIVATE -Wall -Wextra -Wswitch-enum -Wno-array-bounds -Wno-restrict)
+  if(ARG_ONE_PROCESS)
+    add_test(NAME ${name} COMMAND ${name} WORKING_DIRECTORY ${PROJECT_BINARY_DIR})
+    set_tests_properties(${name} PROPERTIES LABELS "${ARG_LABELS}")
+    return()
+  endif()
   include(GoogleTest)
   gtest_discover_tests(${name} WORKING_DIRECTORY ${PROJECT_BINARY_DIR} NO_PRETTY_VALUES
                        PROPERTIES LABELS "${ARG_LABELS}" DISCOVERY_TIMEOUT 60)
