@@ -332,6 +332,11 @@ double WeightedRms(const Data& s, const std::vector<double>& e, const std::vecto
 
 }  // namespace
 
+// In step with FitThinLens's kMinSamplesForFloor and clearly_better below.
+const char* const kModelChoiceRule =
+    "leave-one-out rms: the floor is kept only when it predicts held-out sections >= 10 % and >= 0.001 px better, "
+    "with at least 10 sections";
+
 double FittedModel::PredictPx(const Lens& lens, double u_mm) const {
   const Lens fitted{lens.focal_length_mm, aperture_mm, lens.pixel_pitch_mm};
   const double thin = SignedBlurRadiusPx(fitted, focus_mm, u_mm);
