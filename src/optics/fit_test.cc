@@ -278,6 +278,14 @@ TEST(FitThinLens, FittedRadiusWithinTwoPercentOnEitherSideOfFocus) {
             << "focus " << focus_mm << " floor " << floor_px << " u " << u << ": " << m.kind << " focus "
             << m.focus_mm << " aperture " << m.aperture_mm << " floor " << m.floor_px;
       }
+      // Off the board, at the true focus, the blur is the floor alone: a thin lens kept where the floor buys only
+      // a few thousandths of a px on the board (the choice's absolute margin was 0.01 px) put its focus elsewhere
+      // and drew 0.24 px there for focus 1000 mm, 0.7 px floor. Within 10 %: where every sample is blurred well
+      // beyond the floor, the floor is the fit's least determined part (0.66 px for focus 300 mm).
+      if (floor_px > 0) {
+        EXPECT_NEAR(m.PredictPx(take, focus_mm), floor_px, 0.1 * floor_px)
+            << "focus " << focus_mm << ": " << m.kind << " focus " << m.focus_mm << " floor " << m.floor_px;
+      }
     }
 }
 
