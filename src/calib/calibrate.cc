@@ -202,8 +202,7 @@ Json CalibToJson(const CalibResult& r) {
       if (s.fit.ok && s.r_estimated_px) eq37_sum += std::pow(*s.r_estimated_px - s.fit.r_px, 2), ++eq37_n;
   const Json choice = {
       {"chosen", m.kind},
-      {"rule", "leave-one-out rms: the floor is kept only when it predicts held-out sections >= 10 % and >= 0.01 px "
-               "better, with at least 10 sections"},
+      {"rule", optics::kModelChoiceRule},
       {"thin_lens", {{"rms_px", m.thin_rms_px}, {"loo_rms_px", m.thin_loo_rms_px}}},
       {"thin_lens+floor", {{"rms_px", number_or_note(m.floor_rms_px)}, {"loo_rms_px", number_or_note(m.floor_loo_rms_px)},
                            {"floor_px", number_or_note(m.floor_candidate_px)}}},

@@ -40,6 +40,9 @@ struct FittedModel {
   double PredictPx(const Lens& lens, double u_mm) const;
 };
 
+// How FitThinLens chooses between its two candidates, in words (calib.json's model.choice.rule).
+extern const char* const kModelChoiceRule;
+
 // Robust least squares over (focus, aperture[, floor]). Throws Error(kNotFound) with fewer than 3 usable samples
 // or samples all at one depth.
 FittedModel FitThinLens(const Lens& lens, const std::vector<BlurSample>& samples, const FitOptions& options = {});

@@ -1,5 +1,6 @@
 #include "optics/fit.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -18,10 +19,11 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 const double kEdgeMm[] = {342.3, 359.6, 377.0, 394.3, 411.7, 429.0, 446.3, 463.7, 481.0, 498.3, 527.3};
 
 // Textbook blur-circle radius in px, r = D f |u - u0| / (2 u (u0 - f) pitch), independent of the code under test.
-double TruthPx(double u0, double u, double aperture_mm = kThesis.aperture_mm, double floor_px = 0) {
+double TruthPx(double u0, double u, double aperture_mm = kThesis.aperture_mm, double floor_px = 0,
+               double pitch_mm = kThesis.pixel_pitch_mm) {
   const double f = kThesis.focal_length_mm;
   const double c = std::isinf(u0) ? aperture_mm * f / u : aperture_mm * f * std::abs(u - u0) / (u * (u0 - f));
-  const double r = c / 2 / kThesis.pixel_pitch_mm;
+  const double r = c / 2 / pitch_mm;
   return std::sqrt(r * r + floor_px * floor_px);
 }
 
@@ -227,6 +229,64 @@ TEST(FitThinLens, SampleAtInfinityIsUsable) {
   EXPECT_EQ(m.samples_used, 78);
   EXPECT_EQ(m.outliers, 0);
   EXPECT_NEAR(m.focus_mm, 258.18, 0.01 * 258.18);
+}
+
+// The synth take's optics (synth-take: 23.4 mm sensor over 1148 px, f = 21 mm at f/5.6, floor std 0.35 px, so
+// r = 0.7 px at focus) over its depths (edge 1 at 360 mm to edge 11 at 640 mm across the take's frames), 7
+// sections a depth, each radius from the textbook formula with a little measurement noise.
+std::vector<BlurSample> TakeSamples(double focus_mm, double floor_px, uint64_t seed = 3) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  std::vector<BlurSample> out;
+  for (int k = 0; k <= 14; ++k)
+    for (int s = 0; s < 7; ++s) {
+      const double u = 360.0 + 20.0 * k;
+      const double r = TruthPx(focus_mm, u, kThesis.aperture_mm, floor_px, 23.4 / 1148);
+      out.push_back({u, std::max(0.0, r + noise(rng)), 1.0});
+    }
+  return out;
+}
+
+// Focus inside the sampled depths with a floor: the blur falls to the floor at focus and grows both ways. The
+// search over focus warm-starts each candidate from its neighbour; an aperture driven to 0 far from focus (a flat
+// floor fits there best) once stayed 0 all along the search, because the floor model's slope in D vanishes at D = 0,
+// so the floor model never reached focus and the thin lens alone was kept (focus 178 mm, aperture 0.50 mm for a
+// 0.7 px floor).
+TEST(FitThinLens, FloorModelFindsFocusInsideTheSampledDepths) {
+  const Lens take{21.0, 21.0 / 5.6, 23.4 / 1148};
+  for (double floor_px : {0.35, 0.7, 1.0}) {
+    const FittedModel m = FitThinLens(take, TakeSamples(450.0, floor_px));
+    EXPECT_EQ(m.kind, "thin_lens+floor") << "floor " << floor_px;
+    EXPECT_NEAR(m.focus_mm, 450.0, 0.01 * 450.0) << "floor " << floor_px;
+    EXPECT_NEAR(m.aperture_mm, 3.75, 0.02 * 3.75) << "floor " << floor_px;
+    EXPECT_NEAR(m.floor_px, floor_px, 0.03) << "floor " << floor_px;
+    EXPECT_LT(m.rms_px, 0.015) << "floor " << floor_px;
+  }
+}
+
+// Focus in front of, inside and behind the sampled depths, with and without a floor: the fitted radius at every
+// sampled depth within 2 % of the textbook one (issue 25's median target, held here at every depth), or within
+// 0.01 px (the samples' noise) where the textbook radius is near 0 (focus without a floor).
+TEST(FitThinLens, FittedRadiusWithinTwoPercentOnEitherSideOfFocus) {
+  const Lens take{21.0, 21.0 / 5.6, 23.4 / 1148};
+  for (double focus_mm : {300.0, 450.0, 520.0, 700.0, 1000.0})
+    for (double floor_px : {0.0, 0.7}) {
+      const FittedModel m = FitThinLens(take, TakeSamples(focus_mm, floor_px));
+      for (double u = 360.0; u <= 640.0; u += 20.0) {
+        const double truth = TruthPx(focus_mm, u, take.aperture_mm, floor_px, take.pixel_pitch_mm);
+        EXPECT_NEAR(m.PredictPx(take, u), truth, std::max(0.02 * truth, 0.01))
+            << "focus " << focus_mm << " floor " << floor_px << " u " << u << ": " << m.kind << " focus "
+            << m.focus_mm << " aperture " << m.aperture_mm << " floor " << m.floor_px;
+      }
+      // Off the board, at the true focus, the blur is the floor alone: a thin lens kept where the floor buys only
+      // a few thousandths of a px on the board (the choice's absolute margin was 0.01 px) put its focus elsewhere
+      // and drew 0.24 px there for focus 1000 mm, 0.7 px floor. Within 10 %: where every sample is blurred well
+      // beyond the floor, the floor is the fit's least determined part (0.66 px for focus 300 mm).
+      if (floor_px > 0) {
+        EXPECT_NEAR(m.PredictPx(take, focus_mm), floor_px, 0.1 * floor_px)
+            << "focus " << focus_mm << ": " << m.kind << " focus " << m.focus_mm << " floor " << m.floor_px;
+      }
+    }
 }
 
 TEST(FittedModel, PredictPxAddsFloorInQuadrature) {

@@ -103,6 +103,33 @@ TEST(Tracker, TakeModelIsEveryFramesModel) {
               t.model.rms_px);
 }
 
+// The take's one lens model against the truth: the fixed-focus lens (focus 450 mm inside the board, aperture
+// 3.75 mm, floor std 0.35 px) found from every frame's sections, and its radius r_fitted_px on every section of
+// every frame within issue 25's 2 % median and 5 % p90 (issue 27 asks 3 % and 8 % a frame). Until the floor model's
+// search was fixed (src/optics/fit.cc) the fit settled on focus 249 mm, aperture 0.85 mm: a median 14 % off.
+TEST(Tracker, TakeModelPredictsEveryFramesSectionsWithinTwoPercentMedianFiveP90) {
+  const Tracked& t = TrackedTake();
+  const synth::TakeOptions o = TestTake();
+  const double aperture_mm = t.frames[0].scene.camera.ApertureMm();
+  EXPECT_EQ(t.model.kind, "thin_lens+floor");
+  EXPECT_NEAR(t.model.focus_mm, o.scene.focus_mm, 0.01 * o.scene.focus_mm);
+  EXPECT_NEAR(t.model.aperture_mm, aperture_mm, 0.02 * aperture_mm);
+  EXPECT_NEAR(t.model.floor_px, 2 * o.scene.floor_sigma_px, 0.05);
+  for (size_t i = 0; i < t.results.size(); ++i) {
+    ASSERT_TRUE(t.results[i].calib) << "frame " << i;
+    const calib::TruthComparison cmp = calib::CompareToTruth(*t.results[i].calib, t.frames[i].scene.truth, "truth");
+    std::vector<double> rel;
+    for (const auto& s : cmp.sections)
+      if (s.fitted.answered) rel.push_back(std::abs(s.fitted.error_px) / s.true_r_px);
+    ASSERT_EQ(rel.size(), cmp.sections.size()) << "frame " << i;
+    std::sort(rel.begin(), rel.end());
+    const double median = rel[rel.size() / 2], p90 = rel[std::min(rel.size() - 1, rel.size() * 9 / 10)];
+    std::printf("frame %2zu: r_fitted_px |error|/r median %.4f p90 %.4f\n", i, median, p90);
+    EXPECT_LE(median, 0.02) << "frame " << i;
+    EXPECT_LE(p90, 0.05) << "frame " << i;
+  }
+}
+
 // A frame without the board (the same view, board removed) is lost, and the next frame is found again by a full
 // detection: tracking does not carry a stale pose over a gap.
 TEST(Tracker, FrameWithoutBoardIsLostAndTheNextIsFoundAgain) {
