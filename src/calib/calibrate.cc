@@ -185,6 +185,7 @@ CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& b
 Json CalibToJson(const CalibResult& r) {
   auto vec = [](const cv::Vec3d& v) { return Json::array({v[0], v[1], v[2]}); };
   auto opt = [](const std::optional<double>& v) { return v ? Json(*v) : Json(nullptr); };
+  const bool distorted = !LensDistortion(r.camera).Identity();
   Json edges = Json::array();
   for (const auto& e : r.edges) {
     Json sections = Json::array();
@@ -207,7 +208,7 @@ Json CalibToJson(const CalibResult& r) {
                  {"step_linear", s.fit.step},
                  {"thesis_ok", s.thesis.ok}};
       if (!s.estimated_note.empty()) js["r_estimated_note"] = s.estimated_note;
-      if (!LensDistortion(r.camera).Identity()) js["stretch"] = s.stretch;
+      if (distorted) js["stretch"] = s.stretch;
       sections.push_back(js);
     }
     edges.push_back({{"index", e.index}, {"u_mm", e.u_mm}, {"usable_sections", e.usable}, {"sections", sections}});
@@ -246,13 +247,11 @@ Json CalibToJson(const CalibResult& r) {
                  {"aperture_mm", m.aperture_mm}, {"floor_px", m.floor_px}, {"rms_px", m.rms_px},
                  {"loo_rms_px", m.loo_rms_px}, {"samples_used", m.samples_used}, {"outliers", m.outliers},
                  {"choice", choice}}},
-      {"r_units", LensDistortion(r.camera).Identity()
-                      ? Json("px of the photo (no dist_coeffs: the photo is the pinhole image)")
-                      : Json({{"sections", "r_px, r_thesis_px, r_estimated_px, r_fitted_px: photo px (distorted), across "
-                                           "the edge"},
-                              {"model", "floor_px and the thin lens's radius: ideal (undistorted, pinhole) px; a point's "
-                                        "photo-px radius is the model's times the stretch there (sections: stretch "
-                                        "across the edge; a round blur anywhere: sqrt(det J) of the distortion map)"}})},
+      {"r_units", !distorted ? Json("px of the photo (no dist_coeffs: the photo is the pinhole image)") : Json({
+           {"sections", "r_px, r_thesis_px, r_estimated_px, r_fitted_px: photo px (distorted), across the edge"},
+           {"model", "floor_px and the thin lens's radius: ideal (undistorted, pinhole) px; a point's photo-px radius "
+                     "is the model's times the stretch there (sections: stretch across the edge; a round blur "
+                     "anywhere: sqrt(det J) of the distortion map)"}})},
       {"timing_ms", {{"detect", r.detect_ms}, {"measure", r.measure_ms}, {"estimate", r.estimate_ms}}},
       {"edges", edges},
   };
