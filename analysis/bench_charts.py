@@ -41,7 +41,8 @@ METHOD_LABELS = {"model_fit": "model fit (r_px)", "thesis": "thesis threshold co
 METHOD_COLORS = {"model_fit": "#0072B2", "thesis": "#D55E00", "eq37": "#E69F00", "fitted_model": "#009E73"}
 FACTOR_LABELS = {"noise": "sensor noise std (fraction of full scale)", "contrast": "Michelson contrast",
                  "jpeg": "JPEG quality", "flaws": "printing flaws (dark spots)", "blur": "true blur radius r (px)",
-                 "tilt": "camera tilt (deg)", "vignetting": "vignetting (fall-off at the corner)"}
+                 "tilt": "camera tilt (deg)", "vignetting": "vignetting (fall-off at the corner)",
+                 "distortion": "lens distortion k1 in camera.json (barrel < 0)"}
 RENDER_COLORS = {("gaussian", "gl"): "#0072B2", ("gaussian", "cpu"): "#56B4E9", ("disc", "gl"): "#D55E00",
                  ("disc", "cpu"): "#E69F00"}
 RADIUS_MARKERS = {1: "o", 4: "s", 8: "^", 16: "D"}

@@ -113,6 +113,15 @@ std::vector<Condition> Conditions(bool quick, uint64_t seed) {
     o.vignetting = v;
     c.push_back({"vignetting", v, o});
   }
+  // Barrel distortion in camera.json (issue 25): k1 from none to strong, the board turned and shifted towards a
+  // corner (centred, it sees stretches of 2 % at most), 0.35 px floor; truth is the blur times the stretch across.
+  for (double k1 : pick({0, -0.05, -0.12, -0.2, -0.3})) {
+    auto o = Base(seed);
+    o.floor_sigma_px = 0.35;
+    o.edge1_u_mm = 300, o.yaw_deg = 30, o.lateral_mm = 30;
+    o.camera.dist_coeffs = {k1, 0, 0, 0};
+    c.push_back({"distortion", k1, o});
+  }
   for (double t : pick({20, 30, 45, 55, 65, 75})) {
     auto o = Base(seed);
     o.tilt_deg = t;

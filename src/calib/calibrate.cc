@@ -8,6 +8,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/distortion.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "optics/thin_lens.h"
@@ -43,13 +44,21 @@ cv::Mat LinearGrey(const cv::Mat& photo) {
   return grey;
 }
 
+std::vector<optics::BlurSample> ModelSamples(const CalibResult& result) {
+  std::vector<optics::BlurSample> samples;
+  for (const auto& edge : result.edges)
+    for (const auto& s : edge.sections)
+      if (s.fit.ok) samples.push_back({s.u_mm, s.fit.r_px / s.stretch, 1.0});
+  return samples;
+}
+
 void ApplyModel(CalibResult& result, const optics::FittedModel& model) {
   const optics::Lens lens = optics::Lens::FromCamera(result.camera);
   result.model = model;
   for (auto& edge : result.edges) {
     edge.r_fitted_px = 0;
     for (auto& s : edge.sections) {
-      s.r_fitted_px = model.PredictPx(lens, s.u_mm);
+      s.r_fitted_px = model.PredictPx(lens, s.u_mm) * s.stretch;
       if (s.fit.ok) edge.r_fitted_px += s.r_fitted_px;
     }
     if (edge.usable > 0) edge.r_fitted_px /= edge.usable;
@@ -88,6 +97,12 @@ CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& b
     }
   const std::vector<cv::Point2d> px = Project(result.pose, camera, points);
   auto mid_px = [&](int e, int s) { return px[((e - 1) * S + (s - 1)) * 3 + 2]; };
+  // The same points through the pinhole alone (ideal px): there the edge is straight, and the distortion's Jacobian
+  // at its midpoint says how the photo stretches a blur across it.
+  const LensDistortion distortion(camera);
+  Camera pinhole = camera;
+  pinhole.dist_coeffs.clear();
+  const std::vector<cv::Point2d> ideal = distortion.Identity() ? px : Project(result.pose, pinhole, points);
 
   for (int e = 1; e <= E; ++e) {
     EdgeResult edge;
@@ -105,6 +120,15 @@ CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& b
       if (e > 1) gap = std::min(gap, cv::norm(m - mid_px(e - 1, s)));
       if (e < E) gap = std::min(gap, cv::norm(m - mid_px(e + 1, s)));
       sec.segment = EdgeSegment{px[i], px[i + 1], 0.5 * gap};
+      if (!distortion.Identity()) {
+        const cv::Point2d a = ideal[i], b = ideal[i + 1], mid = ideal[i + 2];
+        sec.stretch = distortion.StretchAcross({mid.x, mid.y}, {a.y - b.y, b.x - a.x});
+        // The photo's edge bows away from the chord between its ends: by this much at the midpoint, along the
+        // chord's normal (edge_blur.h).
+        const cv::Point2d chord = px[i + 1] - px[i];
+        const double len = cv::norm(chord);
+        if (len > 0) sec.segment.bow_px = (m - 0.5 * (px[i] + px[i + 1])).dot(cv::Point2d(-chord.y, chord.x) / len);
+      }
       sec.fit = MeasureEdgeModel(linear, sec.segment, options.model_fit);
       sec.thesis = MeasureEdgeThesis(grey8, sec.segment, options.thesis);
       edge.sections.push_back(sec);
@@ -127,11 +151,7 @@ CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& b
   result.reference_r_px = Median(ref_r);
   result.reference_u_mm = Median(ref_u);
 
-  std::vector<optics::BlurSample> samples;
-  for (const auto& edge : result.edges)
-    for (const auto& s : edge.sections)
-      if (s.fit.ok) samples.push_back({s.u_mm, s.fit.r_px, 1.0});
-  result.model = optics::FitThinLens(lens, samples, options.optics_fit);
+  result.model = optics::FitThinLens(lens, ModelSamples(result), options.optics_fit);
 
   for (auto& edge : result.edges) {
     double su = 0;
@@ -165,6 +185,7 @@ CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& b
 Json CalibToJson(const CalibResult& r) {
   auto vec = [](const cv::Vec3d& v) { return Json::array({v[0], v[1], v[2]}); };
   auto opt = [](const std::optional<double>& v) { return v ? Json(*v) : Json(nullptr); };
+  const bool distorted = !LensDistortion(r.camera).Identity();
   Json edges = Json::array();
   for (const auto& e : r.edges) {
     Json sections = Json::array();
@@ -187,6 +208,7 @@ Json CalibToJson(const CalibResult& r) {
                  {"step_linear", s.fit.step},
                  {"thesis_ok", s.thesis.ok}};
       if (!s.estimated_note.empty()) js["r_estimated_note"] = s.estimated_note;
+      if (distorted) js["stretch"] = s.stretch;
       sections.push_back(js);
     }
     edges.push_back({{"index", e.index}, {"u_mm", e.u_mm}, {"usable_sections", e.usable}, {"sections", sections}});
@@ -224,6 +246,11 @@ Json CalibToJson(const CalibResult& r) {
                  {"aperture_mm", m.aperture_mm}, {"floor_px", m.floor_px}, {"rms_px", m.rms_px},
                  {"loo_rms_px", m.loo_rms_px}, {"samples_used", m.samples_used}, {"outliers", m.outliers},
                  {"choice", choice}}},
+      {"r_units", !distorted ? Json("px of the photo (no dist_coeffs: the photo is the pinhole image)") : Json({
+           {"sections", "r_px, r_thesis_px, r_estimated_px, r_fitted_px: photo px (distorted), across the edge"},
+           {"model", "floor_px and the thin lens's radius: ideal (undistorted, pinhole) px; a point's photo-px radius "
+                     "is the model's times the stretch there (sections: stretch across the edge; a round blur "
+                     "anywhere: sqrt(det J) of the distortion map)"}})},
       {"timing_ms", {{"detect", r.detect_ms}, {"measure", r.measure_ms}, {"estimate", r.estimate_ms}}},
       {"edges", edges},
   };

@@ -35,9 +35,13 @@ struct SectionResult {
   EdgeSegment segment;                // the section in the photo (end points, window across it)
   ModelFit fit;                       // r_px = fit.r_px, usable when fit.ok
   ThesisMeasure thesis;               // r_thesis_px
+  // How much the lens distortion (camera.json's dist_coeffs) stretches a blur across this edge at its midpoint
+  // (core/distortion.h; 1 without distortion): photo px per ideal (pinhole) px. The thin-lens model lives in ideal
+  // px, so it is fitted to r_px / stretch and predicts r_fitted_px = model x stretch.
+  double stretch = 1;
   std::optional<double> r_estimated_px;  // eq. 3.7 from the reference edge; empty where it does not hold
   std::string estimated_note;            // why it is empty
-  double r_fitted_px = 0;                // fitted thin-lens model
+  double r_fitted_px = 0;                // fitted thin-lens model, in photo px (the model's ideal px x stretch)
 };
 
 struct EdgeResult {
@@ -69,6 +73,10 @@ cv::Mat LinearGrey(const cv::Mat& photo);
 // the camera's, Error(kNotFound) when no board is found or the reference edge has no usable section.
 CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& board,
                       const CalibrateOptions& options = {});
+
+// The usable sections as the thin-lens model's samples: depth and r_px / stretch (ideal px), so a distorted photo's
+// blur is fitted in the undistorted lens's terms. A tracked take pools these over its frames.
+std::vector<optics::BlurSample> ModelSamples(const CalibResult& result);
 
 // Makes `model` the result's thin-lens model: every section's r_fitted_px and every edge's mean follow it (a tracked
 // take's one lens model replacing each frame's own).

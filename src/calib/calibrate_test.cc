@@ -44,7 +44,9 @@ const Calibration& Calibrated(const synth::SceneOptions& o) {
   static std::map<std::string, Calibration> cache;
   const std::string key = std::to_string(o.focus_mm) + "/" + std::to_string(o.noise_std) + "/" +
                           std::to_string(o.floor_sigma_px) + "/" + std::to_string(o.vignetting) + "/" +
-                          std::to_string(o.jpeg_quality) + "/" + std::to_string(int(o.psf));
+                          std::to_string(o.jpeg_quality) + "/" + std::to_string(int(o.psf)) + "/" +
+                          Json(o.camera.dist_coeffs).dump() + "/" + std::to_string(o.yaw_deg) + "/" +
+                          std::to_string(o.lateral_mm) + "/" + std::to_string(o.edge1_u_mm);
   auto it = cache.find(key);
   if (it != cache.end()) return it->second;
   Calibration r;
@@ -208,6 +210,83 @@ TEST(Calibrate, FocusInsideTheBoardFitsFocusApertureAndRadius) {
     EXPECT_EQ(fitted.n, int(r.cmp.sections.size())) << name;
     EXPECT_LE(fitted.median, 0.02) << name;
     EXPECT_LE(fitted.p90, 0.05) << name;
+  }
+}
+
+// Lens distortion in camera.json (issue 25 item 1): the photo's blur is the lens's times the map's stretch across
+// each edge, so the measurement (in photo px) and the model (fitted in ideal px, predicted back with each section's
+// stretch) must hold the same targets as without: median <= 2 %, p90 <= 5 %, focus off the board. Barrel k1 = -0.12
+// with the issue's optics (floor 0.6 px, vignetting 35 %, JPEG 92) and pincushion k1 = +0.05 with a plain disc.
+// The board is turned and shifted towards a corner: centred, as in the thesis, it sees stretches of 2 % at most;
+// here up to 5 % (barrel) and 2 % (pincushion).
+TEST(Calibrate, DistortedPhotoMeasuredAndFittedWithinTwoPercentMedianFivePercentP90) {
+  synth::SceneOptions cornered = Thesis(0.003);
+  cornered.focus_mm = 260, cornered.edge1_u_mm = 300, cornered.yaw_deg = 30, cornered.lateral_mm = 30;
+  synth::SceneOptions barrel = cornered;
+  barrel.floor_sigma_px = 0.6, barrel.vignetting = 0.35, barrel.jpeg_quality = 92;
+  barrel.camera.dist_coeffs = {-0.12, 0, 0, 0, 0};
+  synth::SceneOptions pincushion = cornered;
+  pincushion.camera.dist_coeffs = {0.05, 0, 0, 0};
+  for (const synth::SceneOptions& o : {barrel, pincushion}) {
+    const Calibration& r = Calibrated(o);
+    const RelErrors measured = Relative(r.cmp, &SectionComparison::model);
+    const RelErrors fitted = Relative(r.cmp, &SectionComparison::fitted);
+    // How far the stretch moves the truth: the check has teeth only if ignoring it would miss the targets.
+    double stretch_lo = 1e9, stretch_hi = 0;
+    for (const synth::SectionTruth& t : r.scene.sections)
+      stretch_lo = std::min(stretch_lo, t.stretch), stretch_hi = std::max(stretch_hi, t.stretch);
+    std::printf("k1 = %+.2f (stretch %.3f..%.3f; model %s): measured %d/%zu, median %.2f %%, p90 %.2f %%; fitted "
+                "median %.2f %%, p90 %.2f %%\n",
+                o.camera.dist_coeffs[0], stretch_lo, stretch_hi, r.result.model.kind.c_str(), measured.n,
+                r.cmp.sections.size(), 100 * measured.median, 100 * measured.p90, 100 * fitted.median,
+                100 * fitted.p90);
+    EXPECT_GE(measured.n, 0.9 * r.cmp.sections.size());
+    EXPECT_LE(measured.median, 0.02);
+    EXPECT_LE(measured.p90, 0.05);
+    EXPECT_LE(fitted.median, 0.02);
+    EXPECT_LE(fitted.p90, 0.05);
+    EXPECT_GT(std::max(1 - stretch_lo, stretch_hi - 1), o.camera.dist_coeffs[0] < 0 ? 0.04 : 0.015);
+    // Where the stretch exceeds 3 %, ignoring it would use up most of the p90 target there; with it each answered
+    // section is within the target.
+    for (const SectionComparison& c : r.cmp.sections) {
+      const synth::SectionTruth& t = r.scene.sections[(c.edge - 1) * 7 + (c.section - 1)];
+      if (std::abs(1 - t.stretch) > 0.03 && c.model.answered) {
+        EXPECT_LE(std::abs(c.model.error_px), 0.05 * c.true_r_px) << "edge " << c.edge << " section " << c.section
+                                                                  << ", stretch " << t.stretch;
+      }
+    }
+    // Each section's stretch is the truth's (the same map, the same edge), and calib.json carries it.
+    const Json j = CalibToJson(r.result);
+    for (size_t e = 0; e < r.result.edges.size(); ++e)
+      for (size_t k = 0; k < r.result.edges[e].sections.size(); ++k) {
+        EXPECT_NEAR(r.result.edges[e].sections[k].stretch, r.scene.sections[e * 7 + k].stretch, 2e-3);
+        EXPECT_EQ(j["edges"][e]["sections"][k]["stretch"], r.result.edges[e].sections[k].stretch);
+      }
+    // A virtual object at a section's midpoint gets the model's radius times the round stretch there, within a few
+    // % of the photo's blur across the edge (a round kernel cannot be stretched across and along at once).
+    const SceneCalib scene = SceneCalibFromJson(j, "calib.json: ");
+    size_t most = 0;  // the section with the largest stretch
+    for (size_t i = 0; i < r.scene.sections.size(); ++i)
+      if (std::abs(1 - r.scene.sections[i].stretch) > std::abs(1 - r.scene.sections[most].stretch)) most = i;
+    const SectionResult& far = r.result.edges[most / 7].sections[most % 7];
+    const double truth = r.cmp.sections[most].true_r_px;
+    const double fitted_at = BlurAtPx(scene, BlurSource::kFitted, far.midpoint_camera_mm);
+    EXPECT_NEAR(fitted_at / StretchAt(scene, far.midpoint_camera_mm),
+                r.result.model.PredictPx(optics::Lens::FromCamera(scene.camera), far.u_mm), 1e-9);
+    EXPECT_NEAR(fitted_at, truth, 0.05 * truth);
+    // The same model fitted to the photo's radii as they are (no stretch) misses that section by more than twice.
+    std::vector<optics::BlurSample> raw;
+    for (const auto& edge : r.result.edges)
+      for (const auto& sec : edge.sections)
+        if (sec.fit.ok) raw.push_back({sec.u_mm, sec.fit.r_px, 1.0});
+    const optics::Lens lens = optics::Lens::FromCamera(r.result.camera);
+    const double unstretched = optics::FitThinLens(lens, raw).PredictPx(lens, far.u_mm);
+    std::printf("  most stretched section (stretch %.3f): true %.3f px, fitted %.3f px, fitted ignoring the stretch "
+                "%.3f px\n", r.scene.sections[most].stretch, truth, far.r_fitted_px, unstretched);
+    // (Barrel's 5 % only: pincushion's 2 % here is within the fit's own error.)
+    if (r.scene.sections[most].stretch < 0.96) {
+      EXPECT_LT(2 * std::abs(far.r_fitted_px - truth), std::abs(unstretched - truth));
+    }
   }
 }
 

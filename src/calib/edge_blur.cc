@@ -442,6 +442,7 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
     }
   const int x0 = std::max(0, static_cast<int>(std::ceil(xmin))), x1 = std::min(linear.cols - 1, int(std::floor(xmax)));
   const int y0 = std::max(0, static_cast<int>(std::ceil(ymin))), y1 = std::min(linear.rows - 1, int(std::floor(ymax)));
+  const double bow = std::isfinite(segment.bow_px) ? segment.bow_px : 0;
   std::vector<Sample> samples;
   if (x0 <= x1 && y0 <= y1) samples.reserve(static_cast<size_t>((x1 - x0 + 1)) * (y1 - y0 + 1) / 2 + 16);
   double s_min = 1e18, s_max = -1e18;
@@ -454,7 +455,9 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
       if (s < s_lo || s > s_hi || d < -hw || d > hw) continue;
       const float v = row[x];
       if (!std::isfinite(v)) continue;
-      samples.push_back({static_cast<float>(d), v});
+      // Across the bowed edge: the parabola's offset at s taken off (exact to first order in the bow).
+      const double u = 2 * s / f.length - 1;
+      samples.push_back({static_cast<float>(d - bow * (1 - u * u)), v});
       s_min = std::min(s_min, s), s_max = std::max(s_max, s);
     }
   }

@@ -15,6 +15,9 @@ struct EdgeSegment {
   cv::Point2d a, b;          // end points (the square corners bounding the section)
   double half_window_px = 0; // how far across the edge samples may reach on each side
                              // (about half the image distance to the neighbouring parallel edge)
+  // How far the edge's midpoint lies off the chord a-b along its normal (px; a lens distortion bows straight edges):
+  // distances across the edge are taken from the parabola through a, b and that point. 0: a straight edge.
+  double bow_px = 0;
 };
 
 struct ModelFitOptions {

@@ -34,6 +34,7 @@ struct EdgeSpec {
   double half_window_px = 50;
   double length_px = 120;
   int spots = 0;             // dark printing spots on the bright side near the edge
+  double bow_px = 0;         // the edge is the parabola bowing this far off the chord at its middle (0: straight)
   unsigned seed = 1;
 };
 
@@ -96,7 +97,8 @@ EdgeImage Render(const EdgeSpec& spec) {
     const double y = (j + 0.5) / S - 0.5;
     for (int i = 0; i < N * S; ++i) {
       const double x = (i + 0.5) / S - 0.5;
-      const double d = (x - c.x) * n.x + (y - c.y) * n.y - spec.offset_px;
+      const double along = 2 * ((x - c.x) * t.x + (y - c.y) * t.y) / spec.length_px;
+      const double d = (x - c.x) * n.x + (y - c.y) * n.y - spec.offset_px - spec.bow_px * (1 - along * along);
       const double e = d < -reach ? 0.0 : d > reach ? 1.0 : mixed ? (*mixed)(d) : OpticalEsf(spec.psf, spec.r_px, d);
       row[i] = static_cast<float>(spec.black + (spec.white - spec.black) * e);
     }
@@ -275,6 +277,21 @@ TEST(EdgeModel, RealDiscConvolutionMeasuresItsRadius) {
 }
 
 // Without modelling the pixel's own area a sharp edge would read about 0.58 px.
+// A lens distortion bows a board's straight edge (calibrate.cc gives the bow from the projected midpoint): sampled
+// across the parabola the bowed edge measures its own blur; taken as straight, the bow's spread adds to it.
+TEST(EdgeModel, BowedEdgeMeasuredAcrossItsCurve) {
+  EdgeSpec spec;
+  spec.r_px = 1.2;
+  spec.bow_px = 4;
+  spec.angle_deg = 7;
+  EdgeImage img = Render(spec);
+  const ModelFit curved = MeasureEdgeModel(img.linear, [&] { EdgeSegment s = img.segment; s.bow_px = 4; return s; }());
+  EXPECT_TRUE(curved.ok) << Describe(curved);
+  EXPECT_NEAR(curved.r_px, 1.2, 0.02 * 1.2) << Describe(curved);
+  const ModelFit straight = MeasureEdgeModel(img.linear, img.segment);
+  EXPECT_GT(std::abs(straight.r_px - 1.2), 0.1 * 1.2) << Describe(straight);
+}
+
 TEST(EdgeModel, SharpEdgeMeasuresNearZero) {
   for (double angle : {0.0, 7.0, 30.0, 45.0}) {
     EdgeSpec spec;

@@ -8,6 +8,7 @@
 
 #include <opencv2/calib3d.hpp>
 
+#include "core/distortion.h"
 #include "core/error.h"
 #include "core/names.h"
 #include "core/typed.h"
@@ -150,13 +151,21 @@ BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px) {
                                      DidYouMean(text, BlurSourceWords()));
 }
 
+double StretchAt(const SceneCalib& scene, const cv::Vec3d& p) {
+  const LensDistortion distortion(scene.camera);
+  if (distortion.Identity() || !(p[2] > 0)) return 1;
+  const std::array<double, 9> k = scene.camera.Intrinsics();
+  return distortion.StretchIsotropic({k[0] * p[0] / p[2] + k[2], k[4] * p[1] / p[2] + k[5]});
+}
+
 double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& p, double fixed_r_px) {
   const optics::Lens lens = optics::Lens::FromCamera(scene.camera);
   switch (source) {
     case BlurSource::kNone: return 0;
     case BlurSource::kFixed: return fixed_r_px;
     case BlurSource::kEstimated: return optics::Eq37Px(lens, scene.reference_u_mm, scene.reference_r_px, p[2]);
-    case BlurSource::kFitted: return scene.model.PredictPx(lens, p[2]);
+    // The model is in ideal px; the photo's blur at the point is that times the distortion's stretch there.
+    case BlurSource::kFitted: return scene.model.PredictPx(lens, p[2]) * StretchAt(scene, p);
     case BlurSource::kMeasuredSection: {
       const SceneCalib::Section* best = nullptr;
       double best_d = 1e300;

@@ -55,9 +55,13 @@ BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px);
 //               has no usable section (never another edge's value);
 //   measured_section - r_px of the nearest usable measured section alone (3-D distance between midpoints);
 //   estimated - eq. 3.7 from the reference edge at the point's depth (Error(kDomain) nearer than focus);
-//   fitted    - the fitted thin-lens model at the point's depth;
+//   fitted    - the fitted thin-lens model at the point's depth (ideal px), times StretchAt the point (photo px);
 //   fixed     - fixed_r_px; none - 0.
 double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& point_camera_mm, double fixed_r_px = 0);
+
+// How much camera.json's dist_coeffs stretch a round blur at a camera-frame point's place in the photo: sqrt(det J)
+// of the distortion map there (core/distortion.h), 1 without distortion. Photo px per ideal (pinhole) px.
+double StretchAt(const SceneCalib& scene, const cv::Vec3d& point_camera_mm);
 
 // The lens floor (std, px) inside the blur `source` gives: for the scene's own blur (measured, measured_section,
 // fitted) the fitted model's floor r0 as a std (r0 / 2, DESIGN.md's r = 2 std; 0 when the model kept none), which a

@@ -16,7 +16,9 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "optics/thin_lens.h"
+#include "core/distortion.h"
 #include "synth/scene_blur.h"
+#include "synth/scene_distort.h"
 #include "synth/scene_view.h"
 
 namespace blurcue::synth {
@@ -206,10 +208,6 @@ cv::Mat Finish(cv::Mat linear, const SceneOptions& o, Rng rng) {
 
 void ValidateOptions(const SceneOptions& o) {
   o.camera.Validate("camera");
-  if (!o.camera.dist_coeffs.empty() &&
-      std::any_of(o.camera.dist_coeffs.begin(), o.camera.dist_coeffs.end(), [](double d) { return d != 0; }))
-    throw InputError("camera/dist_coeffs", "synthetic scenes are rendered through an ideal (undistorted) lens; "
-                                           "remove the distortion coefficients");
   o.board.Validate("board");
   auto finite = [](double v) { return std::isfinite(v); };
   if (!(o.tilt_deg > 0 && o.tilt_deg <= 90))
@@ -288,6 +286,23 @@ Scene RenderScene(const SceneOptions& o) {
   const std::array<double, 9> K = cam.Intrinsics();
   const Pose pose = PlaceBoard(o);
   const optics::Lens lens = optics::Lens::FromCamera(cam);
+  // With dist_coeffs the ideal (pinhole) view is rendered and blurred on a canvas covering every ray the photo sees,
+  // then warped onto the photo's pixels (scene_distort.h); without, the canvas is the photo.
+  const LensDistortion distortion(cam);
+  detail::IdealCanvas canvas{0, 0, W, H};
+  if (!distortion.Identity()) {
+    try {
+      canvas = detail::CanvasFor(distortion, W, H);
+    } catch (const Error& e) {
+      throw InputError("camera/dist_coeffs", e.what());
+    }
+  }
+  const int Wi = canvas.width, Hi = canvas.height;
+  if (double(Wi) * Hi * ss * ss > 64e6)
+    throw InputError("camera/dist_coeffs", "the undistorted view behind the photo is " + std::to_string(Wi) + " x " +
+                                               std::to_string(Hi) + " px, more than a scene renders at " +
+                                               std::to_string(ss) + " x " + std::to_string(ss) +
+                                               " sub-pixels (lower --supersample or the size)");
 
   // The whole board must be in front of the lens and inside the image.
   {
@@ -295,7 +310,8 @@ Scene RenderScene(const SceneOptions& o) {
                                   {board.WidthMm(), board.LengthMm()}};
     for (const auto& c : corners) {
       const cv::Vec3d P = pose.R * cv::Vec3d(c[0], c[1], 0) + pose.t;
-      const double px = K[0] * P[0] / P[2] + K[2], py = K[4] * P[1] / P[2] + K[5];
+      const Point2 image = distortion.Distort({K[0] * P[0] / P[2] + K[2], K[4] * P[1] / P[2] + K[5]});
+      const double px = image[0], py = image[1];
       if (!(P[2] > cam.focal_length_mm) || px < 0 || py < 0 || px > W - 1 || py > H - 1) {
         std::ostringstream s;
         s << "board not fully in view: its corner (" << c[0] << ", " << c[1] << ") mm lands at pixel (" << px
@@ -310,7 +326,7 @@ Scene RenderScene(const SceneOptions& o) {
   const double focus = std::isnan(o.focus_mm) ? edge1_u : o.focus_mm;
 
   View v;
-  v.fx = K[0], v.fy = K[4], v.cx = K[2], v.cy = K[5];
+  v.fx = K[0], v.fy = K[4], v.cx = K[2] + canvas.ox, v.cy = K[5] + canvas.oy;
   v.ss = ss;
   v.Rt = pose.R.t();
   v.t = pose.t;
@@ -332,7 +348,7 @@ Scene RenderScene(const SceneOptions& o) {
   v.fixed_r = o.fixed_r_px;
 
   // Pass 1: the range of blur radii, row by row, to choose the levels and the margin.
-  const int hss = H * ss, wss = W * ss;
+  const int hss = Hi * ss, wss = Wi * ss;
   std::vector<float> row_min(hss), row_max(hss);
   std::atomic<bool> too_near{false};
   cv::parallel_for_(cv::Range(0, hss), [&](const cv::Range& range) {
@@ -404,8 +420,8 @@ Scene RenderScene(const SceneOptions& o) {
     for (int c = 0; c < 16; ++c) {
       const double a = 2 * kPi * c / 16, rr = fl.radius * 1.1 + 0.2;
       const cv::Vec3d P = pose.R * cv::Vec3d(fl.x + rr * std::cos(a), fl.y + rr * std::sin(a), 0) + pose.t;
-      const double px = (K[0] * P[0] / P[2] + K[2] + 0.5) * ss - 0.5 + m;
-      const double py = (K[4] * P[1] / P[2] + K[5] + 0.5) * ss - 0.5 + m;
+      const double px = (K[0] * P[0] / P[2] + v.cx + 0.5) * ss - 0.5 + m;
+      const double py = (K[4] * P[1] / P[2] + v.cy + 0.5) * ss - 0.5 + m;
       x0 = std::min(x0, px), x1 = std::max(x1, px), y0 = std::min(y0, py), y1 = std::max(y1, py);
     }
     fl.col0 = static_cast<int>(std::floor(x0)) - 2, fl.col1 = static_cast<int>(std::ceil(x1)) + 2;
@@ -424,7 +440,7 @@ Scene RenderScene(const SceneOptions& o) {
   // The table and wall are smooth, so they are shaded once per output pixel (footprint: the pixel) over the image
   // plus the margin; the board's edges, which carry the measurement, are shaded per sub-pixel.
   const int mb = (m + ss - 1) / ss;  // margin in whole pixels
-  cv::Mat background(H + 2 * mb, W + 2 * mb, CV_32F);
+  cv::Mat background(Hi + 2 * mb, Wi + 2 * mb, CV_32F);
   cv::parallel_for_(cv::Range(0, background.rows), [&](const cv::Range& range) {
     for (int by = range.start; by < range.end; ++by) {
       float* bg = background.ptr<float>(by);
@@ -513,10 +529,22 @@ Scene RenderScene(const SceneOptions& o) {
     for (cv::Mat* img : {&sharp, &sharp_no_board})
       cv::sepFilter2D(*img, *img, CV_32F, k32, k32, cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
   }
-  cv::Mat linear = BlurAndDownsample(sharp, v, H, W, levels, ss, m);
-  cv::Mat linear_no_board = BlurAndDownsample(sharp_no_board, v, H, W, levels, ss, m);
-  sharp.release(), sharp_no_board.release();
+  cv::Mat linear, linear_no_board;
+  if (distortion.Identity()) {
+    linear = BlurAndDownsample(sharp, v, H, W, levels, ss, m);
+    linear_no_board = BlurAndDownsample(sharp_no_board, v, H, W, levels, ss, m);
+    sharp.release(), sharp_no_board.release();
+  } else {
+    std::vector<cv::Mat> ideal = {BlurAndDownsample(sharp, v, Hi, Wi, levels, ss, m, true)};
+    sharp.release();
+    ideal.push_back(BlurAndDownsample(sharp_no_board, v, Hi, Wi, levels, ss, m, true));
+    sharp_no_board.release();
+    std::vector<cv::Mat> photo = detail::DistortAndDownsample(ideal, distortion, canvas, ss, H, W);
+    linear = photo[0], linear_no_board = photo[1];
+  }
   if (o.vignetting > 0) {
+    // On the sensor: from the photo's principal point.
+    v.cx = K[2], v.cy = K[5];
     const double rho2_corner = std::max({v.cx * v.cx + v.cy * v.cy, (W - 1 - v.cx) * (W - 1 - v.cx) + v.cy * v.cy,
                                          v.cx * v.cx + (H - 1 - v.cy) * (H - 1 - v.cy),
                                          (W - 1 - v.cx) * (W - 1 - v.cx) + (H - 1 - v.cy) * (H - 1 - v.cy)});
@@ -551,13 +579,23 @@ Scene RenderScene(const SceneOptions& o) {
       t.section = s;
       t.u_mm = u;
       t.defocus_r_px = o.fixed_r_px ? *o.fixed_r_px : optics::BlurRadiusPx(lens, focus, u) * o.blur_gain;
-      // Truth is what was applied: the mixed defocus levels' and the floor taps' variances from their arrays.
+      // Truth is what was applied: the mixed defocus levels' and the floor taps' variances from their arrays (in
+      // ideal px), times the distortion's stretch across the edge at the midpoint (1 without distortion).
       const double var_px2 = detail::AppliedVarianceSs(levels, t.defocus_r_px, ss) / (double(ss) * ss) + floor_var_px2;
-      t.r_px = 2 * std::sqrt(var_px2);
+      auto ideal_px = [&](const std::array<double, 3>& b) {
+        const cv::Vec3d P = pose.R * cv::Vec3d(b[0], b[1], b[2]) + pose.t;
+        return Point2{K[0] * P[0] / P[2] + K[2], K[4] * P[1] / P[2] + K[5]};
+      };
+      const Point2 a = ideal_px(board.SectionStart(e, s)), b = ideal_px(board.SectionEnd(e, s));
+      t.stretch = distortion.StretchAcross(ideal_px(mid), {a[1] - b[1], b[0] - a[0]});
+      t.r_ideal_px = 2 * std::sqrt(var_px2);
+      t.r_px = t.r_ideal_px * t.stretch;
       t.flawed = flawed[e - 1][s - 1];
       scene.sections.push_back(t);
-      sections.push_back({{"edge", e}, {"section", s}, {"u_mm", u}, {"r_px", t.r_px},
-                          {"defocus_r_px", t.defocus_r_px}, {"flawed", t.flawed}});
+      Json row = {{"edge", e}, {"section", s}, {"u_mm", u}, {"r_px", t.r_px}, {"defocus_r_px", t.defocus_r_px},
+                  {"flawed", t.flawed}};
+      if (!distortion.Identity()) row["r_ideal_px"] = t.r_ideal_px, row["stretch"] = t.stretch;
+      sections.push_back(row);
     }
 
   Json rotation = Json::array();
@@ -579,8 +617,12 @@ Scene RenderScene(const SceneOptions& o) {
   j["aperture_mm"] = lens.aperture_mm;
   j["pixel_pitch_mm"] = lens.pixel_pitch_mm;
   j["psf"] = o.psf == Psf::kDisc ? "disc" : "gaussian";
-  j["r_unit"] = "px, 2 x std of the line-spread function of the kernels applied (defocus and floor), optical only "
-                "(pixel area excluded)";
+  j["r_unit"] = distortion.Identity()
+                   ? "px, 2 x std of the line-spread function of the kernels applied (defocus and floor), optical only "
+                     "(pixel area excluded)"
+                   : "photo px, 2 x std of the line-spread function across the edge of the kernels applied (defocus "
+                     "and floor, in ideal px: r_ideal_px) times the distortion's stretch across the edge at the "
+                     "section's midpoint (stretch = 1 / |J^-T n|), optical only (pixel area excluded)";
   j["floor_sigma_applied_px"] = std::sqrt(floor_var_px2);
   j["r_range_px"] = {r_min, r_max};
   j["blur_levels_px"] = levels_json;

@@ -56,7 +56,10 @@ struct SectionTruth {
   double u_mm = 0;   // camera z of the midpoint
   double r_px = 0;   // true optical blur radius at the midpoint (DESIGN.md unit; excludes pixel area): 2 x the std
                      // of the LSF of the kernels actually applied (defocus levels mixed there, floor), from their arrays
-  double defocus_r_px = 0;  // the defocus part alone (the thin lens's radius at the midpoint)
+  double defocus_r_px = 0;  // the defocus part alone (the thin lens's radius at the midpoint, ideal px)
+  // With dist_coeffs: r_px = r_ideal_px x stretch, the blur applied in the ideal (pinhole) image times the map's
+  // stretch across the edge at the midpoint (core/distortion.h); both 1:1 without distortion.
+  double r_ideal_px = 0, stretch = 1;
   bool flawed = false;  // a printing flaw touches this section
 };
 

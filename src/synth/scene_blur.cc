@@ -194,9 +194,9 @@ std::vector<double> FloorTaps(double sigma_px, int ss) {
 double TapsVariance(const std::vector<double>& taps) { return RowVariance(taps); }
 
 cv::Mat BlurAndDownsample(const cv::Mat& sharp, const View& view, int H, int W, const std::vector<Level>& levels,
-                          int ss, int m) {
+                          int ss, int m, bool keep_subpixels) {
   const int wss = W * ss, wp = sharp.cols;
-  cv::Mat out(H, W, CV_32F, cv::Scalar(0));
+  cv::Mat out = keep_subpixels ? cv::Mat(H * ss, W * ss, CV_32F, cv::Scalar(0)) : cv::Mat(H, W, CV_32F, cv::Scalar(0));
   std::vector<double> var(levels.size());
   int max_reach = 0;
   for (size_t k = 0; k < levels.size(); ++k) var[k] = levels[k].var_ss, max_reach = std::max(max_reach, levels[k].reach);
@@ -221,7 +221,7 @@ cv::Mat BlurAndDownsample(const cv::Mat& sharp, const View& view, int H, int W, 
     };
 
     for (int Y = range.start; Y < range.end; ++Y) {
-      float* o = out.ptr<float>(Y);
+      float* o = keep_subpixels ? nullptr : out.ptr<float>(Y);
       for (int y = Y * ss; y < (Y + 1) * ss; ++y) {
         const int py = y + m;  // padded row
         // Per sub-pixel: the level just below the wanted variance and its weight.
@@ -296,7 +296,12 @@ cv::Mat BlurAndDownsample(const cv::Mat& sharp, const View& view, int H, int W, 
             row_out[x] += w * blurred[x];
           }
         }
-        for (int x = 0; x < wss; ++x) o[x / ss] += static_cast<float>(row_out[x] / ss2);
+        if (keep_subpixels) {
+          float* sub = out.ptr<float>(y);
+          for (int x = 0; x < wss; ++x) sub[x] = static_cast<float>(row_out[x]);
+        } else {
+          for (int x = 0; x < wss; ++x) o[x / ss] += static_cast<float>(row_out[x] / ss2);
+        }
       }
     }
   };

@@ -42,8 +42,9 @@ std::vector<double> FloorTaps(double sigma_px, int ss);
 double TapsVariance(const std::vector<double>& taps);
 
 // Blurs the padded sharp image `sharp` (margin m on every side) with the radius each image sub-pixel's ray calls
-// for (RadiusRow, r in output pixels), mixing levels, and area-downsamples by ss. Output: CV_32F, H x W.
+// for (RadiusRow, r in output pixels), mixing levels, and area-downsamples by ss. Output: CV_32F, H x W; with
+// `keep_subpixels` the blurred sub-pixels themselves, (H ss) x (W ss), for a lens distortion to warp first.
 cv::Mat BlurAndDownsample(const cv::Mat& sharp, const View& view, int H, int W, const std::vector<Level>& levels,
-                          int ss, int m);
+                          int ss, int m, bool keep_subpixels = false);
 
 }  // namespace blurcue::synth::detail

@@ -432,6 +432,63 @@ TEST(SynthScene, ImpossibleOptionsNameTheOption) {
   expect(o, "fixed_r_px");
 }
 
+// Through a barrel lens (k1 = -0.3) the photo's blur across an edge is the applied blur times the stretch there.
+// Checked on the image by a plain numeric method that shares nothing with the renderer or core/distortion: the
+// edge's place and normal in the photo from cv::projectPoints (normal by finite differences), the pixels binned
+// by signed distance along that normal, the binned profile differenced, its variance less the pixel's 1/12.
+TEST(SynthScene, DistortedBlurIsTheAppliedBlurTimesTheStretchAcrossTheEdge) {
+  SceneOptions o = FixedBlur(2.5, Psf::kDisc);
+  o.board = Board{5, 8, 25};
+  o.tilt_deg = 80;
+  o.yaw_deg = 10;  // no edge along a pixel row: the bins across it fill at every 0.1 px
+  o.edge1_u_mm = 275;
+  o.camera.dist_coeffs = {-0.3, 0, 0, 0};
+  const Scene s = RenderScene(o);
+  const cv::Mat lin = Linear(s.image);
+  const auto k = s.camera.Intrinsics();
+  auto project = [&](double x, double y) {
+    std::vector<cv::Point2d> q;
+    cv::projectPoints(std::vector<cv::Point3d>{{x, y, 0}}, s.rvec, s.tvec, cv::Matx33d(k.data()), s.camera.dist_coeffs,
+                      q);
+    return q[0];
+  };
+  double stretch_min = 1;
+  for (int edge : {2, 5, 8}) {
+    for (int section : {1, 3, 5}) {
+      const SectionTruth& t = s.sections[(edge - 1) * 5 + (section - 1)];
+      const double sq = s.board.square_mm, y = (edge - 1) * sq, x = (section - 0.5) * sq;
+      const cv::Point2d m = project(x, y), along = project(x + 0.01, y) - project(x - 0.01, y);
+      cv::Point2d tan = along / cv::norm(along), n(-tan.y, tan.x);
+      // Pixels within 8 px of the midpoint along the edge and 9 px across, binned at 0.1 px by distance.
+      const int nb = 180;
+      std::vector<double> sum(nb, 0), count(nb, 0);
+      for (int py = int(m.y) - 14; py <= int(m.y) + 14; ++py)
+        for (int px = int(m.x) - 14; px <= int(m.x) + 14; ++px) {
+          const cv::Point2d d(px - m.x, py - m.y);
+          const double a = d.dot(tan), c = d.dot(n);
+          if (std::abs(a) > 8 || std::abs(c) >= 9) continue;
+          const int b = int((c + 9) / 0.1);
+          sum[b] += lin.at<float>(py, px), count[b] += 1;
+        }
+      std::vector<double> xs, vs;
+      for (int b = 0; b < nb; ++b)
+        if (count[b] > 0) xs.push_back(-9 + (b + 0.5) * 0.1), vs.push_back(sum[b] / count[b]);
+      double m0 = 0, m1 = 0, m2 = 0;
+      for (size_t i = 0; i + 1 < vs.size(); ++i) {
+        const double g = vs[i + 1] - vs[i], xm = 0.5 * (xs[i] + xs[i + 1]);
+        m0 += g, m1 += g * xm, m2 += g * xm * xm;
+      }
+      const double var = m2 / m0 - (m1 / m0) * (m1 / m0) - 1.0 / 12;
+      const double measured = 2 * std::sqrt(var);
+      EXPECT_NEAR(measured, t.r_px, 0.01 * t.r_px) << "edge " << edge << " section " << section << ", stretch "
+                                                    << t.stretch << ", ideal " << t.r_ideal_px;
+      stretch_min = std::min(stretch_min, t.stretch);
+    }
+  }
+  // The check has teeth: the stretch moves r by several times the 1 % tolerance somewhere.
+  EXPECT_LT(stretch_min, 0.95);
+}
+
 TEST(SynthScene, LowTiltShowsTheBackWall) {
   SceneOptions o = Small();
   o.tilt_deg = 15;  // the view reaches above the horizon

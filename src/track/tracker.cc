@@ -149,9 +149,8 @@ optics::FittedModel FitTakeModel(std::vector<FrameResult>& frames, const optics:
   for (const FrameResult& f : frames) {
     if (!f.calib) continue;
     any = &*f.calib;
-    for (const auto& edge : f.calib->edges)
-      for (const auto& s : edge.sections)
-        if (s.fit.ok) samples.push_back({s.u_mm, s.fit.r_px, 1.0});
+    const std::vector<optics::BlurSample> own = calib::ModelSamples(*f.calib);
+    samples.insert(samples.end(), own.begin(), own.end());
   }
   if (!any) throw Error(ErrorKind::kNotFound, "no frame of the take has a calibration (the board was never found)");
   const optics::FittedModel model =
