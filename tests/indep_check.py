@@ -10,7 +10,9 @@ Prints every figure (pose, depth error, measured r_px and fitted r_fitted_px: me
 every section with an edge, per frame for a take) and exits 1 when a target is missed:
   --what pose: board found (every frame tracked or found), section depths within 0.1 % of the truth;
   --what blur: issue 25 (still): median <= 2 %, p90 <= 5 % for measured and fitted r;
-               issue 27 (take): every frame's measured r median <= 3 %, p90 <= 8 %.
+               issue 27 (take): every frame's measured r median <= 3 %, p90 <= 8 %;
+  --what fitted (take): the take's lens model's r per frame, median <= 3 %, p90 <= 8 % (as for measured r);
+  --what all: pose and blur.
 Exit 2 when blurcue itself fails (its message is printed), so an expected-to-fail blur test (WILL_FAIL) is told
 apart only by the sibling pose test, which must pass.
 """
@@ -107,6 +109,8 @@ def check_track(args):
         worst_depth = max(worst_depth, depth)
         if args.what in ("pose", "all") and depth > 0.001:
             missed.append("frame %d: depth error %.3f %%" % (i, 100 * depth))
+        if args.what == "fitted" and (fm is None or fm > 0.03 or fp > 0.08):
+            missed.append("frame %d: fitted r median %s, p90 %s (target <= 3 %%, <= 8 %%)" % (i, pct(fm), pct(fp)))
         if args.what in ("blur", "all"):
             if mm is None or mm > 0.03 or mp > 0.08:
                 missed.append("frame %d: measured r median %s, p90 %s (target <= 3 %%, <= 8 %%)" % (i, pct(mm),
@@ -116,7 +120,7 @@ def check_track(args):
     if len(rows) != expected:
         missed.append("%d of %d frames in track.csv" % (len(rows), expected))
     print("%d frames; worst depth error %.4f %%" % (len(rows), 100 * worst_depth) +
-          ("" if args.what == "pose" else "; worst per-frame measured r median %s, p90 %s" % (pct(worst_med),
+          ("" if args.what in ("pose", "fitted") else "; worst per-frame measured r median %s, p90 %s" % (pct(worst_med),
                                                                                              pct(worst_p90))))
     return missed
 
@@ -126,7 +130,7 @@ def main():
     p.add_argument("mode", choices=("calibrate", "track"))
     p.add_argument("blurcue")
     p.add_argument("dir")
-    p.add_argument("--what", choices=("pose", "blur", "all"), default="all")
+    p.add_argument("--what", choices=("pose", "blur", "fitted", "all"), default="all")
     args = p.parse_args()
     missed = check_calibrate(args) if args.mode == "calibrate" else check_track(args)
     for m in missed:

@@ -23,8 +23,10 @@ indep_scene(disc indep_disc still --psf disc --f-number 2.8 --floor-sigma-px 0.6
             --noise 0.0025 --jpeg-quality 92 --seed 11)
 indep_scene(gauss indep_gauss still --psf gaussian --f-number 4 --floor-sigma-px 0.45 --focus-mm 440 --noise 0.002
             --jpeg-quality 95 --seed 12)
-indep_scene(dist indep_dist still --psf disc --f-number 2.8 --floor-sigma-px 0.6 --focus-mm 430 --vignetting 0.35
-            --noise 0.0025 --jpeg-quality 92 --k1 -0.12 --seed 13)
+# Barrel distortion k1 = -0.12 in camera.json, the board near and to the right so that its far sections are squeezed
+# across their edges by up to 5 % (the truth is in px of the distorted image).
+indep_scene(dist indep_dist still --psf disc --f-number 2.8 --floor-sigma-px 0.6 --focus-mm 400 --vignetting 0.35
+            --noise 0.0025 --jpeg-quality 92 --k1 -0.12 --edge1-u-mm 300 --lateral-mm 55 --seed 14)
 # (c) 12 frames at 1148 x 764, the camera moving closer (edge 1 from 440 to 360 mm) and sideways (-25 to 25 mm),
 # fixed focus 450 mm (inside the board in every frame), thesis lens f/5.6, floor 0.35 px, noise 0.002, PNG.
 indep_scene(take indep_take take --frames 12 --floor-sigma-px 0.35 --focus-mm 450 --noise 0.002 --seed 27)
@@ -44,3 +46,9 @@ indep_check(indep_calibrate_distortion calibrate dist indep_dist all)
 indep_check(indep_track_pose track take indep_take pose)
 # ... and every frame's measured r median <= 3 %, p90 <= 8 % (issue 27).
 indep_check(indep_track_blur track take indep_take blur)
+# Expected to fail today: the take's one lens model (r_fitted_px in calib-NNNN.json) with the focus inside the board
+# fits focus 249 mm, aperture 0.85 mm (truth 450 mm, 3.75 mm), so its r is 12-17 % off (median) per frame, p90 21-39 %
+# (issues 25 and 27: the fit with focus inside the board, being fixed on another branch). Flip WILL_FAIL when it
+# passes: tests/indep_check.py then prints "ok: track fitted targets met".
+indep_check(indep_track_fitted track take indep_take fitted)
+set_tests_properties(indep_track_fitted PROPERTIES WILL_FAIL TRUE LABELS "slow;indep;expected_fail")
