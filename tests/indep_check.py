@@ -120,13 +120,14 @@ def check_track(args):
             if mm is None or mm > 0.03 or mp > 0.08:
                 missed.append("frame %d: measured r median %s, p90 %s (target <= 3 %%, <= 8 %%)" % (i, pct(mm),
                                                                                                    pct(mp)))
-            worst_med, worst_p90 = max(worst_med, mm or 1), max(worst_p90, mp or 1)
+            worst_med = max(worst_med, 1.0 if mm is None else mm)
+            worst_p90 = max(worst_p90, 1.0 if mp is None else mp)
     expected = len([n for n in os.listdir(d) if n.startswith("frame-") and n.endswith(".png")])
     if len(rows) != expected:
         missed.append("%d of %d frames in track.csv" % (len(rows), expected))
+    blur = "; worst per-frame measured r median %s, p90 %s" % (pct(worst_med), pct(worst_p90))
     print("%d frames; worst depth error %.4f %%" % (len(rows), 100 * worst_depth) +
-          ("" if args.what in ("pose", "fitted") else "; worst per-frame measured r median %s, p90 %s" % (pct(worst_med),
-                                                                                             pct(worst_p90))))
+          ("" if args.what in ("pose", "fitted") else blur))
     return missed
 
 
