@@ -65,8 +65,9 @@ def run(cmd):
 
 def check_calibrate(args):
     d = args.dir
+    # --truth as well: calibrate reads the generator's truth.json itself (a format it did not write).
     run([args.blurcue, "calibrate", os.path.join(d, "scene.png"), "--camera", os.path.join(d, "camera.json"),
-         "--out", os.path.join(d, "calib-%s.json" % args.what), "--quiet"])
+         "--out", os.path.join(d, "calib-%s.json" % args.what), "--truth", os.path.join(d, "truth.json"), "--quiet"])
     calib = json.load(open(os.path.join(d, "calib-%s.json" % args.what)))
     truth = json.load(open(os.path.join(d, "truth.json")))
     m, f, depth, n = rel_errors(calib, truth)
