@@ -87,6 +87,10 @@ def slanted_edge_r(image, cam, board, R, t, edge, section, bin_px=0.1, half_widt
     return 2 * math.sqrt(max(var, 0.0))
 
 
+def setUpModule():
+    gen.keep_freed_memory()
+
+
 class IndependentTruth(unittest.TestCase):
     board = gen.Board()
     u_mm = 420.0
