@@ -571,10 +571,42 @@ def keep_freed_memory():
         pass
 
 
+def validate(args):
+    """The first option outside what the generator can render, as 'name: must be ..., got value'; None when fine."""
+    checks = [("--supersample", args.supersample, 1 <= args.supersample <= 16, "in [1, 16]"),
+              ("--tilt-deg", args.tilt_deg, 0 < args.tilt_deg <= 90, "in (0, 90]"),
+              ("--focus-mm", args.focus_mm, args.focus_mm > args.focal_mm, "beyond the focal length (or inf)"),
+              ("--f-number", args.f_number, args.f_number > 0, "> 0"),
+              ("--floor-sigma-px", args.floor_sigma_px, 0 <= args.floor_sigma_px <= 20, "in [0, 20] px"),
+              ("--vignetting", args.vignetting, 0 <= args.vignetting <= 0.9, "in [0, 0.9]"),
+              ("--noise", args.noise, 0 <= args.noise <= 1, "in [0, 1] (linear units)"),
+              ("--jpeg-quality", args.jpeg_quality, 0 <= args.jpeg_quality <= 100, "0 (none) or 1..100"),
+              ("--width", args.width, 32 <= args.width <= 20000, "in [32, 20000] px"),
+              ("--height", args.height, 32 <= args.height <= 20000, "in [32, 20000] px")]
+    if args.what == "take":
+        checks.append(("--frames", args.frames, 1 <= args.frames <= 10000, "in [1, 10000]"))
+    for name, value, ok, rule in checks:
+        if not ok or (isinstance(value, float) and math.isnan(value)):
+            return "%s: must be %s, got %s" % (name, rule, value)
+    return None
+
+
 def main(argv):
     keep_freed_memory()
     args = parse(argv)
+    problem = validate(args)
+    if problem:
+        print("indep_scene.py: " + problem, file=sys.stderr)
+        return 2
     t0 = time.time()
+    try:
+        return run(args, t0)
+    except ValueError as e:  # a view that cannot be rendered (the horizon in view): one line, exit 3
+        print("indep_scene.py: %s" % e, file=sys.stderr)
+        return 3
+
+
+def run(args, t0):
     if args.what == "still":
         sections = render_still(args)
         if not args.quiet:
