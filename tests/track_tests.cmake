@@ -13,3 +13,8 @@ add_test(NAME cli_bench_track_chart
                  ${PROJECT_BINARY_DIR}/track-bench/track.csv ${PROJECT_BINARY_DIR}/track-bench)
 set_tests_properties(cli_bench_track_chart PROPERTIES FIXTURES_REQUIRED track_bench LABELS slow
                      WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}/analysis PASS_REGULAR_EXPRESSION "wrote .*bench-track.png")
+# blurcue ar on a ground-truth take: the ball's place and defocus against the truth, the card's blur and streak measured
+# on the written frames by numpy (tests/ar_check.py), a truncated input, bad names and values (tests/ar_test.sh).
+add_test(NAME ar_cli COMMAND bash ${PROJECT_SOURCE_DIR}/tests/ar_test.sh $<TARGET_FILE:blurcue>
+                             ${PROJECT_BINARY_DIR}/ar-test)
+set_tests_properties(ar_cli PROPERTIES PASS_REGULAR_EXPRESSION "(^|\n)ok: ar_test" LABELS gl)
