@@ -77,6 +77,24 @@ assert frames == int(sys.argv[2]), (frames, sys.argv[2])
 PYEOF
 echo "truncated input: exit 3, $kept frames kept: $(cat "$W/trunc.err")"
 
+# A lost frame (frame 2 marked lost, its calibration gone): written as it is, without objects, and flagged.
+mkdir -p "$W/losttrack" && cp "$W/track/"* "$W/losttrack/" && rm "$W/losttrack/calib-0002.json"
+sed -i '4s/^\([^,]*,[^,]*\),[a-z]*,/\1,lost,/' "$W/losttrack/track.csv"
+"$BC" ar "$W/take/take.avi" --track "$W/losttrack" --ball 50,125 --out "$W/lost.avi" --frames "$W/lost" > "$W/lost.out" \
+  2>&1 || fail "ar with a lost frame: $(cat "$W/lost.out")"
+grep -q "^4 frames: 3 with objects, 1 without" "$W/lost.out" || fail "lost frame: $(cat "$W/lost.out")"
+grep -q "^2,0.066667,lost,,,,,,,,$" "$W/lost.csv" || fail "lost frame's CSV row: $(cat "$W/lost.csv")"
+$PY - "$W" <<'PYEOF' || fail "the lost frame is not the input frame"
+import sys
+import numpy as np
+from PIL import Image
+w = sys.argv[1]
+a = np.asarray(Image.open(f"{w}/lost/frame-0002.png").convert("RGB"))
+b = np.asarray(Image.open(f"{w}/take/frame-0002.png").convert("RGB"))
+assert (a == b).all(), int((a != b).sum())
+print("lost frame 2: written as it is")
+PYEOF
+
 # Names and values: one line, exit 2 (usage) or 3 (a file).
 expect() {  # expect CODE PATTERN ARGS...
   local want=$1 pattern=$2
@@ -97,7 +115,7 @@ expect 3 "typo.json: /objects/0/radus_mm: unknown key for a ball (did you mean r
 echo '{"objects": [{"kind": "bal", "x_mm": 1, "y_mm": 2}]}' > "$W/kind.json"
 expect 3 "/objects/0/kind: must be \"ball\" or \"card\", got \"bal\" (did you mean ball?)" "${A[@]}" --objects "$W/kind.json"
 expect 3 "no-such/track.csv\|no-such: no such folder" "$W/take/take.avi" --track "$W/no-such" --out "$W/e.avi" --ball 1,2
-mkdir -p "$W/badtrack" && cp "$W/track/"* "$W/badtrack/" && sed -i '3s/,tracked,/,trackd,/' "$W/badtrack/track.csv"
+mkdir -p "$W/badtrack" && cp "$W/track/"* "$W/badtrack/" && sed -i '3s/^\([^,]*,[^,]*\),[a-z]*,/\1,trackd,/' "$W/badtrack/track.csv"
 expect 3 "track.csv: line 3, status: must be found, tracked or lost, got 'trackd' (did you mean tracked?)" \
   "$W/take/take.avi" --track "$W/badtrack" --out "$W/e.avi" --ball 1,2
 echo "ok: ar_test"
