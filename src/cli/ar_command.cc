@@ -1,5 +1,6 @@
 // blurcue ar: the offline AR view of a tracked take - virtual objects drawn in every frame with that frame's pose,
 // defocus and motion blur (the thesis's prototype, on video; src/stimulus/tracked_take.h places them).
+#include <algorithm>
 #include <chrono>
 #include <cctype>
 #include <cstdio>
@@ -165,6 +166,7 @@ void AddArCommand(CLI::App& app) {
     const bool tty = isatty(2) && !args->quiet;
     int written = 0, drawn_frames = 0, unposed = 0;
     std::optional<Error> ended;
+    std::vector<double> draw_ms;  // per frame with objects: photo upload, pose, compose, read back
     cv::Mat frame;
     int index = 0;
     double time_s = 0;
@@ -197,9 +199,12 @@ void AddArCommand(CLI::App& app) {
       if (in_take && take.frames[size_t(index)].calib) {
         const calib::SceneCalib& c = *take.frames[size_t(index)].calib;
         if (!compositor) compositor = std::make_unique<render::FrameCompositor>(camera, c.rvec, c.tvec, frame);
+        const auto draw_start = std::chrono::steady_clock::now();
         compositor->SetFrame(c.rvec, c.tvec, frame);
         compositor->Compose(plan.objects);
         out = compositor->Read();
+        draw_ms.push_back(
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - draw_start).count());
         ++drawn_frames;
       } else {
         ++unposed;
@@ -225,6 +230,12 @@ void AddArCommand(CLI::App& app) {
       std::printf("%d frames: %d with objects, %d without (lost or beyond track.csv); wrote %s (%s) and %s in %.1f s\n",
                   written, drawn_frames, unposed, args->out.c_str(), codec_used.c_str(), csv_path.c_str(),
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      if (!draw_ms.empty()) {
+        std::sort(draw_ms.begin(), draw_ms.end());
+        std::printf("drawing: median %.1f ms a frame, slowest %.1f ms (photo upload, objects composed, frame read "
+                    "back; decoding and encoding not included)\n",
+                    draw_ms[draw_ms.size() / 2], draw_ms.back());
+      }
       if (!ended && written < int(take.frames.size()))
         std::printf("note: %s ended after %d frames; track.csv has %zu\n", args->input.c_str(), written,
                     take.frames.size());
