@@ -95,6 +95,33 @@ assert (a == b).all(), int((a != b).sum())
 print("lost frame 2: written as it is")
 PYEOF
 
+# A study on the video (issue 27 item 4, first step): a protocol whose scene is the take and its track folder is
+# validated and previewed through the same loading code as run (a trial shows the take's first frame with a pose).
+cat > "$W/video-study.json" <<'JSONEOF'
+{"name": "video-ball", "version": 1, "scene": {"video": "take/take.avi", "track": "track"},
+ "content": {"type": "ball"}, "layout": "single", "task": "yes_no",
+ "factors": {"edge": [3, 6], "blur": [{"object": "fitted"}, {"object": "none"}]},
+ "responses": {"yes": "Y", "no": "N"}}
+JSONEOF
+"$BC" validate "$W/video-study.json" > "$W/validate.out" 2>&1 || fail "validate of a video study: $(cat "$W/validate.out")"
+"$BC" preview "$W/video-study.json" --out "$W/video-preview.png" > "$W/preview.out" 2>&1 ||
+  fail "preview of a video study: $(cat "$W/preview.out")"
+[ -s "$W/video-preview.png" ] || fail "preview wrote no sheet"
+$PY - "$W/video-study.json" "$W/bad-study.json" <<'PYEOF'
+import json, sys
+p = json.load(open(sys.argv[1]))
+p["scene"]["background"] = "take/frame-0000.png"
+json.dump(p, open(sys.argv[2], "w"))
+PYEOF
+"$BC" validate "$W/bad-study.json" > "$W/bad.out" 2>&1
+[ $? -eq 3 ] || fail "a video scene with a background: not exit 3: $(cat "$W/bad.out")"
+grep -q "/scene/background.*is not read with a video scene" "$W/bad.out" || fail "video + background: $(cat "$W/bad.out")"
+sed 's|"track": "track"|"track": "no-such"|' "$W/video-study.json" > "$W/notrack.json"
+"$BC" validate "$W/notrack.json" > "$W/notrack.out" 2>&1
+[ $? -eq 3 ] && grep -q "/scene/track.*no such file.*no-such/track.csv" "$W/notrack.out" ||
+  fail "a missing track folder: $(cat "$W/notrack.out")"
+echo "video study: validate and preview accept it; a background beside it and a missing track folder are named"
+
 # Names and values: one line, exit 2 (usage) or 3 (a file).
 expect() {  # expect CODE PATTERN ARGS...
   local want=$1 pattern=$2
