@@ -107,6 +107,9 @@ JSONEOF
 "$BC" preview "$W/video-study.json" --out "$W/video-preview.png" > "$W/preview.out" 2>&1 ||
   fail "preview of a video study: $(cat "$W/preview.out")"
 [ -s "$W/video-preview.png" ] || fail "preview wrote no sheet"
+"$BC" run "$W/video-study.json" --participant P1 --db "$W/video.sqlite" --observer sim > "$W/run.out" 2>&1 ||
+  fail "run of a video study: $(cat "$W/run.out")"
+grep -q "4 of 4 trials answered" "$W/run.out" || fail "run of a video study: $(cat "$W/run.out")"
 $PY - "$W/video-study.json" "$W/bad-study.json" <<'PYEOF'
 import json, sys
 p = json.load(open(sys.argv[1]))
@@ -120,7 +123,7 @@ sed 's|"track": "track"|"track": "no-such"|' "$W/video-study.json" > "$W/notrack
 "$BC" validate "$W/notrack.json" > "$W/notrack.out" 2>&1
 [ $? -eq 3 ] && grep -q "/scene/track.*no such file.*no-such/track.csv" "$W/notrack.out" ||
   fail "a missing track folder: $(cat "$W/notrack.out")"
-echo "video study: validate and preview accept it; a background beside it and a missing track folder are named"
+echo "video study: validate, preview and a simulated run accept it; a background beside it and a missing track folder are named"
 
 # Names and values: one line, exit 2 (usage) or 3 (a file).
 expect() {  # expect CODE PATTERN ARGS...
