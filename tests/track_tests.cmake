@@ -13,3 +13,16 @@ add_test(NAME cli_bench_track_chart
                  ${PROJECT_BINARY_DIR}/track-bench/track.csv ${PROJECT_BINARY_DIR}/track-bench)
 set_tests_properties(cli_bench_track_chart PROPERTIES FIXTURES_REQUIRED track_bench LABELS slow
                      WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}/analysis PASS_REGULAR_EXPRESSION "wrote .*bench-track.png")
+# blurcue ar on a ground-truth take: the ball's place and defocus against the truth, the card's blur and streak measured
+# on the written frames by numpy (tests/ar_check.py), a truncated input, bad names and values (tests/ar_test.sh).
+add_test(NAME ar_cli COMMAND bash ${PROJECT_SOURCE_DIR}/tests/ar_test.sh $<TARGET_FILE:blurcue>
+                             ${PROJECT_BINARY_DIR}/ar-test)
+set_tests_properties(ar_cli PROPERTIES PASS_REGULAR_EXPRESSION "(^|\n)ok: ar_test" LABELS gl)
+set_tests_properties(ar_cli PROPERTIES FIXTURES_SETUP ar_take)
+# The ball's r against the take's TRUE lens within 3 % (issue 27's target). It fails today, and is marked so: the
+# take's fitted lens model, which `ar --blur fitted` draws with, is not the true one (docs/track.md "Known limit";
+# scipy's least squares on the same 924 sections finds the true focus, optics::FitThinLens does not). When the fit is
+# fixed this test "fails" by passing: remove WILL_FAIL then.
+add_test(NAME ar_defocus_truth_lens
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/ar_check.py ${PROJECT_BINARY_DIR}/ar-test --truth-lens)
+set_tests_properties(ar_defocus_truth_lens PROPERTIES FIXTURES_REQUIRED ar_take WILL_FAIL TRUE)

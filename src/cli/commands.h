@@ -86,6 +86,7 @@ void AddEstimateCommand(CLI::App& app);     // estimate_command.cc
 void AddSynthSceneCommand(CLI::App& app);   // synth_scene_command.cc
 void AddSynthTakeCommand(CLI::App& app);    // synth_take_command.cc
 void AddTrackCommand(CLI::App& app);        // track_command.cc
+void AddArCommand(CLI::App& app);           // ar_command.cc
 void AddCameraCommand(CLI::App& app);       // camera_command.cc
 void AddInitCommand(CLI::App& app);         // init_command.cc
 void AddCalibrateCommand(CLI::App& app);    // calibrate_command.cc

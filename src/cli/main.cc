@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
       {"camera", &cli::AddCameraCommand},
       {"calibrate", &cli::AddCalibrateCommand},
       {"track", &cli::AddTrackCommand},
+      {"ar", &cli::AddArCommand},
       {"estimate", &cli::AddEstimateCommand},
       {"make-stimuli", &cli::AddMakeStimuliCommand},
       {"synth-pictures", &cli::AddSynthPicturesCommand},

@@ -24,7 +24,24 @@ bool CaseTwin(const std::vector<std::string>& names, const std::string& name) {
 }  // namespace
 
 void Parser::ParseScene(const Json& v, const std::string& ptr, Protocol* p) {
-  if (!Object(v, ptr, {"background", "board_free", "calib", "show"})) return;
+  if (!Object(v, ptr, {"background", "board_free", "calib", "show", "video", "track"})) return;
+  if (v.contains("video") || v.contains("track")) {
+    // A tracked take: each frame's photo and calibration come from the take and its track folder.
+    for (const char* key : {"background", "board_free", "calib", "show"})
+      if (v.contains(key))
+        Problem(ptr + "/" + key, "is not read with a video scene (each frame's photo and calibration come from " +
+                                     ptr + "/video and " + ptr + "/track)", v[key]);
+    if (auto s = Text(v, "video", ptr, true, kMaxPathChars, true)) {
+      p->scene.video = (base_ / *s).lexically_normal();
+      // A printf pattern (frames/frame-%04d.png) names no one file; its first frame is checked when it is read.
+      if (options_.check_files && s->find('%') == std::string::npos) CheckFile(p->scene.video, ptr + "/video", Json(*s));
+    }
+    if (auto s = Text(v, "track", ptr, true, kMaxPathChars, true)) {
+      p->scene.track = (base_ / *s).lexically_normal();
+      if (options_.check_files) CheckFile(p->scene.track / "track.csv", ptr + "/track", Json(*s));
+    }
+    return;
+  }
   p->scene.background = Path(v, "background", ptr, true);
   p->scene.board_free = Path(v, "board_free", ptr, false);
   p->scene.calib = Path(v, "calib", ptr, false);

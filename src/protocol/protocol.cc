@@ -51,7 +51,11 @@ Protocol Parser::Parse(const Json& json) {
       json["scene"].contains("calib"))
     Problem("/scene/calib", "is not read by a picture (the real picture's blur comes from /content/real_camera)",
             json["scene"]["calib"]);
+  if (typed && type == ContentType::kPicture && json.contains("scene") && json["scene"].is_object() &&
+      json["scene"].contains("video"))
+    Problem("/scene/video", "is for a grid or a ball (a picture's depth matching shows photos)", json["scene"]["video"]);
   if (json.contains("scene") && json["scene"].is_object() && !json["scene"].contains("calib") &&
+      !json["scene"].contains("video") && !json["scene"].contains("track") &&
       (typed && (type == ContentType::kGrid || type == ContentType::kBall)))
     Problem("/scene/calib", "is required for a " + ToString(type) + " (its blur comes from the calibration) but missing");
 

@@ -118,6 +118,11 @@ struct Scene {
   std::filesystem::path board_free;   // empty when not given
   std::filesystem::path calib;        // empty when not given (a picture needs none)
   ScenePhoto show = ScenePhoto::kBackground;  // which photo the trials show
+  // A tracked video instead of a photo (issue 27 item 4): the take (a video file or a printf pattern of an image
+  // sequence) and the folder `blurcue track` wrote for it; background, board_free and calib are then empty. So far a
+  // trial shows the take's first frame with a pose, with that frame's calibration (stimulus::LoadProtocolScene).
+  std::filesystem::path video, track;
+  bool IsVideo() const { return !video.empty(); }
   // The photo the trials show, as `show` says (the background when there is no board_free).
   bool ShowsBoardFree() const { return show == ScenePhoto::kBoardFree && !board_free.empty(); }
   const std::filesystem::path& ShownPhoto() const { return ShowsBoardFree() ? board_free : background; }

@@ -165,6 +165,14 @@ FrameCompositor::FrameCompositor(const Camera& camera, const cv::Vec3d& rvec, co
   CV_Assert(background.cols == camera.image_width_px && background.rows == camera.image_height_px);
 }
 
+void FrameCompositor::SetFrame(const cv::Vec3d& rvec, const cv::Vec3d& tvec, const cv::Mat& background) {
+  Impl& m = *impl_;
+  CV_Assert(background.cols == m.camera.image_width_px && background.rows == m.camera.image_height_px);
+  m.photo.UploadSrgb(ResampleSrgb8(background, {m.view.photo_width_px, m.view.photo_height_px}));
+  m.renderer.SetPose(rvec, tvec);
+  m.Place(m.view.x_px, m.view.y_px);  // the base frame from the new photo; the whole frame dirty
+}
+
 void FrameCompositor::Place(int x_px, int y_px) {
   if (x_px != impl_->view.x_px || y_px != impl_->view.y_px) impl_->Place(x_px, y_px);
 }

@@ -157,6 +157,12 @@ SceneRenderer::SceneRenderer(const Camera& camera, const cv::Vec3d& rvec, const 
 
 SceneRenderer::~SceneRenderer() = default;
 
+void SceneRenderer::SetPose(const cv::Vec3d& rvec, const cv::Vec3d& tvec) {
+  impl_->rvec = rvec;
+  impl_->tvec = tvec;
+  cv::Rodrigues(rvec, impl_->rotation);
+}
+
 Footprint SceneRenderer::Measure(const VirtualObject& o) const {
   return FootprintOf(impl_->camera, impl_->rvec, impl_->tvec, o);
 }

@@ -44,6 +44,8 @@ class SceneRenderer {
   scene::Footprint Measure(const scene::VirtualObject& object) const;
   // Draws from now on as `camera` sees (the same pose): a view of the photo scaled and placed (Camera::Viewed).
   void SetCamera(const Camera& camera);
+  // Draws from now on with the board at another pose (a tracked take's next frame): nothing is allocated.
+  void SetPose(const cv::Vec3d& rvec, const cv::Vec3d& tvec);
   // Draws the object into a layer covering its bounds grown by margin_px, clipped to the image.
   Layer Draw(const scene::VirtualObject& object, int margin_px);
   // The same, left on the GPU for frame composition, in targets the renderer made once and grows (a frame loop

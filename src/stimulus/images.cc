@@ -9,10 +9,54 @@
 #include "core/image.h"
 #include "scene/stimuli.h"
 #include "stimulus/internal.h"
+#include "stimulus/tracked_take.h"
+#include "track/frames.h"
 
 namespace blurcue::stimulus {
 
+namespace {
+
+// A video scene's still: the first frame of the take with a pose (issue 27 item 4, first step: a trial shows it as a
+// photo; per-frame drawing is not done yet). Its index, its calibration and, when `photo` is given, its image.
+int VideoSceneFrame(const protocol::Protocol& protocol, calib::SceneCalib* calib, cv::Mat* photo) {
+  TrackedTake take;
+  try {
+    take = LoadTrackedTake(protocol.scene.track);
+  } catch (const std::exception& e) {
+    throw InputError(At(protocol, "/scene/track"), e.what());
+  }
+  int index = 0;
+  while (!take.frames[size_t(index)].calib) ++index;  // LoadTrackedTake: at least one frame has a pose
+  *calib = *take.frames[size_t(index)].calib;
+  if (!photo) return index;
+  try {
+    track::FrameSource source(protocol.scene.video.string(), 30);
+    int at = -1;
+    double time_s = 0;
+    while (at < index)
+      if (!source.Next(photo, &at, &time_s))
+        throw Error(ErrorKind::kInput, "ends before frame " + std::to_string(index) + ", the first with a pose in " +
+                                           protocol.scene.track.string());
+  } catch (const std::exception& e) {
+    throw InputError(At(protocol, "/scene/video"), e.what());
+  }
+  try {
+    calib->RequireSameSize(*photo, protocol.scene.video.string());
+  } catch (const std::exception& e) {
+    throw InputError(At(protocol, "/scene/video"), std::string(e.what()) + " (" + protocol.scene.track.string() +
+                                                       " is the track of another take)");
+  }
+  return index;
+}
+
+}  // namespace
+
 std::optional<calib::SceneCalib> LoadProtocolScene(const protocol::Protocol& protocol) {
+  if (protocol.scene.IsVideo()) {
+    calib::SceneCalib c;
+    VideoSceneFrame(protocol, &c, nullptr);
+    return c;
+  }
   if (protocol.scene.calib.empty()) {
     if (protocol.content.type == protocol::ContentType::kPicture) return std::nullopt;
     throw InputError(At(protocol, "/scene/calib"), "a " + protocol::ToString(protocol.content.type) + " needs a calibration");
@@ -62,7 +106,10 @@ StimulusImages LoadStimulusImages(const protocol::Protocol& protocol, const std:
   const bool board_free = protocol.scene.ShowsBoardFree();
   const std::string photo_field = board_free ? "/scene/board_free" : "/scene/background";
   const auto& photo_path = protocol.scene.ShownPhoto();
-  if (protocol.content.type != protocol::ContentType::kPicture || protocol.content.real_photos.empty()) {
+  if (protocol.scene.IsVideo()) {
+    calib::SceneCalib c;
+    VideoSceneFrame(protocol, &c, &images.photo);
+  } else if (protocol.content.type != protocol::ContentType::kPicture || protocol.content.real_photos.empty()) {
     images.photo = ReadFieldImage(protocol, photo_field, photo_path, 1, 10, kMaxPhotoSidePx);
     // The photo not shown is still a photo of the scene: check it decodes too.
     if (!protocol.scene.board_free.empty() && !board_free)

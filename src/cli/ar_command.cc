@@ -1,0 +1,249 @@
+// blurcue ar: the offline AR view of a tracked take - virtual objects drawn in every frame with that frame's pose,
+// defocus and motion blur (the thesis's prototype, on video; src/stimulus/tracked_take.h places them).
+#include <algorithm>
+#include <chrono>
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <opencv2/videoio.hpp>
+
+#include "calib/scene_blur.h"
+#include "cli/commands.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "core/typed.h"
+#include "render/frame_compositor.h"
+#include "render/gl_context.h"
+#include "scene/stimuli.h"
+#include "stimulus/tracked_take.h"
+#include "track/frames.h"
+
+namespace blurcue::cli {
+namespace {
+
+// "X,Y[,A[,B]]" in mm: 2 to `most` numbers. Error(kUsage) naming the option and the text.
+std::vector<double> MmList(const std::string& option, const std::string& text, size_t most, const char* form) {
+  std::vector<double> v;
+  bool ok = true;
+  for (size_t start = 0; ok;) {
+    const size_t comma = text.find(',', start);
+    const std::optional<double> n = ParseDecimal(text.substr(start, comma == std::string::npos ? comma : comma - start));
+    ok = n && std::abs(*n) <= 1e5;
+    if (ok) v.push_back(*n);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  if (!ok) v.clear();
+  if (v.size() < 2 || v.size() > most)
+    throw Error(ErrorKind::kUsage, option + " " + Echo(text) + ": expected " + form + " (mm, numbers within 1e5)");
+  return v;
+}
+
+}  // namespace
+
+void AddArCommand(CLI::App& app) {
+  struct Args {
+    std::string input, track, out, csv, objects, frames_dir, blur = "fitted", method = "disc";
+    std::string ball_texture = "soccer", card_texture = "wood";
+    std::vector<std::string> balls, cards;
+    double exposure_ms = -1;
+    bool quiet = false;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "ar",
+      "Draw virtual objects into a tracked take: the offline AR view, every frame at its own pose, each object blurred\n"
+      "for its depth (the frame's blur model: defocus x the lens floor) and for its image motion between frames over\n"
+      "the exposure, in one pass in linear light, through the GL renderer (headless).\n"
+      "INPUT is the take `blurcue track` read (a video, or an image sequence as a printf pattern); --track is the\n"
+      "folder it wrote. Objects: --ball X,Y[,RADIUS] and --card X,Y[,WIDTH[,HEIGHT]] in board mm (repeatable; a ball\n"
+      "resting on the board over X,Y; a card standing on the board facing the camera, its bottom edge's middle at\n"
+      "X,Y), or --objects objects.json (docs/ar.md). Lost frames are written without objects and flagged.\n"
+      "\n"
+      "Writes OUT.avi (FFV1, lossless; MJPEG where videoio has no FFV1) and a CSV (--csv, default OUT.csv) with one row\n"
+      "per object per frame: screen position, depth, r, floor, motion streak, the frame's tracking status.\n"
+      "A damaged or truncated INPUT ends the take: the frames drawn before it are written, exit 3.\n"
+      "Example: blurcue ar take/take.avi --track take/track --ball 87.5,125 --card 120,150,40,30 --out ar.avi");
+  cmd->add_option("input", args->input, "the take: a video file, or a printf pattern of an image sequence")
+      ->required();
+  cmd->add_option("--track", args->track, "the folder blurcue track wrote for INPUT (track.csv, calib-NNNN.json)")
+      ->required();
+  cmd->add_option("--out", args->out, "the AR video to write (.avi)")->required();
+  cmd->add_option("--csv", args->csv, "what was drawn, per frame and object (default: OUT with .csv)");
+  cmd->add_option("--ball", args->balls, "a ball resting on the board: X,Y[,RADIUS] in board mm (radius 10)");
+  cmd->add_option("--card", args->cards,
+                  "a card standing on the board facing the camera: X,Y[,WIDTH[,HEIGHT]] in board mm (50 x 50)");
+  cmd->add_option("--objects", args->objects, "objects from a JSON file (docs/ar.md)")->check(CLI::ExistingFile);
+  cmd->add_option("--ball-texture", args->ball_texture, "texture of --ball balls: soccer, wood or an image")
+      ->capture_default_str();
+  cmd->add_option("--card-texture", args->card_texture, "texture of --card cards: a stimulus name or an image")
+      ->capture_default_str();
+  cmd->add_option("--blur", args->blur,
+                  "blur source at each object's centre: fitted (the take's lens model), measured, measured_section,\n"
+                  "estimated, none, or a radius in px")
+      ->capture_default_str();
+  cmd->add_option("--method", args->method, "the defocus's shape: disc (a thin lens's pillbox) or gaussian")
+      ->capture_default_str()->check(CLI::IsMember({"disc", "gaussian"}));
+  cmd->add_option("--exposure-ms", args->exposure_ms,
+                  "the camera's exposure; objects are streaked by their image velocity over it (0: no motion blur).\n"
+                  "Default: half the frame interval of a video that states its frame rate (a 180-degree shutter); 0\n"
+                  "for an image sequence, whose rate is not known")
+      ->check(FiniteRange(0, 1000, "ms"));
+  cmd->add_option("--frames", args->frames_dir, "also write each frame as frame-NNNN.png into this folder");
+  cmd->add_flag("--quiet", args->quiet, "print only errors");
+  cmd->callback([args] {
+    const auto t0 = std::chrono::steady_clock::now();
+    {
+      std::string extension = std::filesystem::path(args->out).extension().string();
+      for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+      if (extension != ".avi") throw Error(ErrorKind::kUsage, "--out " + Echo(args->out) + ": must end in .avi");
+    }
+    const std::string csv_path =
+        args->csv.empty() ? std::filesystem::path(args->out).replace_extension(".csv").string() : args->csv;
+    RequireReplaceableFile(args->out);
+    RequireReplaceableFile(csv_path);
+    stimulus::TakeBlur blur;
+    blur.source = calib::ParseBlurSource(args->blur, &blur.fixed_r_px);
+    blur.method = args->method;
+
+    std::vector<stimulus::PlacedObject> objects;
+    if (!args->objects.empty()) objects = stimulus::LoadPlacedObjects(args->objects);
+    auto add = [&](const char* kind, const scene::VirtualObject& o, const std::string& texture) {
+      stimulus::PlacedObject p;
+      int n = 1;
+      for (const auto& q : objects) n += q.object.kind == o.kind;
+      p.name = kind + std::to_string(n);
+      p.object = o;
+      p.object.texture = scene::SurfaceTexture(ReadImage(scene::ResolveStimulus(texture)));
+      objects.push_back(std::move(p));
+    };
+    for (const std::string& b : args->balls) {
+      const std::vector<double> v = MmList("--ball", b, 3, "X,Y[,RADIUS]");
+      if (v.size() == 3 && !(v[2] > 0)) throw Error(ErrorKind::kUsage, "--ball " + Echo(b) + ": RADIUS must be > 0");
+      add("ball", stimulus::BallAt(v[0], v[1], v.size() == 3 ? v[2] : 10), args->ball_texture);
+    }
+    for (const std::string& c : args->cards) {
+      const std::vector<double> v = MmList("--card", c, 4, "X,Y[,WIDTH[,HEIGHT]]");
+      const double w = v.size() >= 3 ? v[2] : 50, h = v.size() == 4 ? v[3] : w;
+      if (!(w > 0 && h > 0)) throw Error(ErrorKind::kUsage, "--card " + Echo(c) + ": WIDTH and HEIGHT must be > 0");
+      add("card", stimulus::StandingCardAt(v[0], v[1], w, h, 0), args->card_texture);
+    }
+    if (objects.empty()) throw Error(ErrorKind::kUsage, "no objects: give --ball, --card or --objects");
+
+    const stimulus::TrackedTake take = stimulus::LoadTrackedTake(args->track);
+    const Camera& camera = take.camera();
+    const double take_fps = take.FramesPerSecond();
+    track::FrameSource source(args->input, take_fps > 0 ? take_fps : 30);
+    std::string exposure_note = "given";
+    if (args->exposure_ms < 0) {
+      const bool rate_known = source.is_video() && source.fps() > 0;
+      blur.exposure_ms = rate_known ? 1000 / source.fps() / 2 : 0;
+      exposure_note = rate_known ? "half the frame interval of the video's " + Num(source.fps()) + " fps"
+                                 : "no motion blur: an image sequence states no frame rate (give --exposure-ms)";
+    } else {
+      blur.exposure_ms = args->exposure_ms;
+    }
+    if (!args->quiet)
+      std::fprintf(stderr, "%zu objects, blur %s, exposure %s ms (%s), %zu frames in %s\n", objects.size(),
+                   args->blur.c_str(), Num(blur.exposure_ms).c_str(), exposure_note.c_str(), take.frames.size(),
+                   args->track.c_str());
+
+    std::unique_ptr<render::GlContext> context = render::GlContext::CreateOffscreen();
+    std::unique_ptr<render::FrameCompositor> compositor;
+    cv::VideoWriter video;
+    std::string codec_used;
+    if (std::filesystem::path(args->out).has_parent_path())
+      std::filesystem::create_directories(std::filesystem::path(args->out).parent_path());
+    if (!args->frames_dir.empty()) std::filesystem::create_directories(args->frames_dir);
+    std::string csv = stimulus::DrawnCsvHeader();
+    const bool tty = isatty(2) && !args->quiet;
+    int written = 0, drawn_frames = 0, unposed = 0;
+    std::optional<Error> ended;
+    std::vector<double> draw_ms;  // per frame with objects: photo upload, pose, compose, read back
+    cv::Mat frame;
+    int index = 0;
+    double time_s = 0;
+    while (true) {
+      try {
+        if (!source.Next(&frame, &index, &time_s)) break;
+      } catch (const Error& e) {
+        ended = e;
+        break;
+      }
+      if (frame.cols != camera.image_width_px || frame.rows != camera.image_height_px)
+        throw InputError(args->input, "frame " + std::to_string(index) + " is " + std::to_string(frame.cols) + " x " +
+                                          std::to_string(frame.rows) + " px; the take's calibration is " +
+                                          std::to_string(camera.image_width_px) + " x " +
+                                          std::to_string(camera.image_height_px) + " (another take?)");
+      if (!video.isOpened()) {
+        for (const char* codec : {"FFV1", "MJPG"}) {
+          video.open(args->out, cv::VideoWriter::fourcc(codec[0], codec[1], codec[2], codec[3]),
+                     source.fps() > 0 ? source.fps() : 30, frame.size());
+          if (video.isOpened()) {
+            codec_used = codec;
+            break;
+          }
+        }
+        if (!video.isOpened()) throw InputError(args->out, "cannot open a video writer (FFV1 or MJPEG .avi)");
+      }
+      const bool in_take = index < int(take.frames.size());
+      const stimulus::TrackedFramePlan plan = stimulus::PlanTrackedFrame(take, index, objects, blur);
+      cv::Mat out = frame;
+      if (in_take && take.frames[size_t(index)].calib) {
+        const calib::SceneCalib& c = *take.frames[size_t(index)].calib;
+        if (!compositor) compositor = std::make_unique<render::FrameCompositor>(camera, c.rvec, c.tvec, frame);
+        const auto draw_start = std::chrono::steady_clock::now();
+        compositor->SetFrame(c.rvec, c.tvec, frame);
+        compositor->Compose(plan.objects);
+        out = compositor->Read();
+        draw_ms.push_back(
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - draw_start).count());
+        ++drawn_frames;
+      } else {
+        ++unposed;
+      }
+      video.write(out);
+      if (!args->frames_dir.empty()) {
+        char name[32];
+        std::snprintf(name, sizeof name, "frame-%04d.png", index);
+        WriteImage(std::filesystem::path(args->frames_dir) / name, out);
+      }
+      const std::string status = in_take ? track::Name(take.frames[size_t(index)].status) : "untracked";
+      csv += stimulus::DrawnCsvRows(index, in_take ? take.frames[size_t(index)].time_s : time_s, status, plan.drawn);
+      ++written;
+      if (!args->quiet && (tty || (written % 10 == 0)))
+        std::fprintf(stderr, "%sframe %d%s: %s%s", tty ? "\r" : "", index,
+                     source.expected_frames() > 0 ? ("/" + std::to_string(source.expected_frames())).c_str() : "",
+                     status.c_str(), tty ? "   " : "\n");
+    }
+    if (tty) std::fprintf(stderr, "\n");
+    video.release();  // the frames written so far make a whole file, also when the input ended early
+    WriteFileAtomically(csv_path, csv);
+    if (!args->quiet) {
+      std::printf("%d frames: %d with objects, %d without (lost or beyond track.csv); wrote %s (%s) and %s in %.1f s\n",
+                  written, drawn_frames, unposed, args->out.c_str(), codec_used.c_str(), csv_path.c_str(),
+                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      if (!draw_ms.empty()) {
+        std::sort(draw_ms.begin(), draw_ms.end());
+        std::printf("drawing: median %.1f ms a frame, slowest %.1f ms (photo upload, objects composed, frame read "
+                    "back; decoding and encoding not included)\n",
+                    draw_ms[draw_ms.size() / 2], draw_ms.back());
+      }
+      if (!ended && written < int(take.frames.size()))
+        std::printf("note: %s ended after %d frames; track.csv has %zu\n", args->input.c_str(), written,
+                    take.frames.size());
+    }
+    if (ended)
+      throw Error(ended->kind(), std::string(ended->what()) + "; the " + std::to_string(written) +
+                                     " frames before it are in " + args->out);
+  });
+}
+
+}  // namespace blurcue::cli

@@ -1,0 +1,292 @@
+#include "stimulus/tracked_take.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include <opencv2/calib3d.hpp>
+
+#include "core/csv.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "core/names.h"
+#include "core/typed.h"
+#include "optics/thin_lens.h"
+#include "scene/stimuli.h"
+#include "track/take.h"
+
+namespace blurcue::stimulus {
+namespace {
+
+constexpr size_t kMaxFrames = 1000000;
+
+// A field of a track.csv row as a number; the error names the file, the line and the column.
+double NumberField(const std::string& file, const CsvRecord& row, size_t column, const std::string& name) {
+  const std::optional<double> v = column < row.fields.size() ? ParseDecimal(row.fields[column]) : std::nullopt;
+  if (!v || !std::isfinite(*v))
+    throw InputError(file + ": line " + std::to_string(row.line) + ", " + name,
+                     "must be a number, got " + Echo(column < row.fields.size() ? row.fields[column] : ""));
+  return *v;
+}
+
+track::FrameStatus ParseStatus(const std::string& where, const std::string& text) {
+  std::vector<std::string> words;
+  for (track::FrameStatus s : {track::FrameStatus::kFound, track::FrameStatus::kTracked, track::FrameStatus::kLost}) {
+    if (text == track::Name(s)) return s;
+    words.push_back(track::Name(s));
+  }
+  throw InputError(where, "must be found, tracked or lost, got " + Echo(text) + DidYouMean(text, words));
+}
+
+// The image position of a board point at a frame's pose (the calibration's camera and distortion).
+cv::Point2d Project(const calib::SceneCalib& c, const cv::Vec3d& board_mm) {
+  std::vector<cv::Point3d> points = {cv::Point3d(board_mm)};
+  std::vector<cv::Point2d> image;
+  cv::projectPoints(points, c.rvec, c.tvec, cv::Matx33d(c.camera.Intrinsics().data()), c.camera.dist_coeffs, image);
+  return image[0];
+}
+
+// The nearest frame with a pose before (step -1) or after (step +1) `index`; -1 when there is none.
+int NeighbourWithPose(const TrackedTake& take, int index, int step) {
+  for (int i = index + step; i >= 0 && i < int(take.frames.size()); i += step)
+    if (take.frames[size_t(i)].calib) return i;
+  return -1;
+}
+
+const std::vector<std::string> kBallKeys = {"kind", "name", "x_mm", "y_mm", "radius_mm", "texture"};
+const std::vector<std::string> kCardKeys = {"kind", "name", "x_mm", "y_mm", "width_mm", "height_mm", "rotation_deg",
+                                            "texture"};
+
+double NumberIn(const Json& o, const std::string& key, const std::string& where, double fallback, double lo,
+                double hi, bool required) {
+  if (!o.contains(key)) {
+    if (required) throw InputError(where + "/" + key, "missing (a number in mm)");
+    return fallback;
+  }
+  const Json& v = o.at(key);
+  if (!v.is_number() || !std::isfinite(v.get<double>()) || v.get<double>() < lo || v.get<double>() > hi)
+    throw InputError(where + "/" + key, "must be a number in [" + Num(lo) + ", " + Num(hi) + "], got " +
+                                            Echo(v.dump(), false));
+  return v.get<double>();
+}
+
+}  // namespace
+
+const Camera& TrackedTake::camera() const {
+  for (const TrackedFrame& f : frames)
+    if (f.calib) return f.calib->camera;
+  throw Error(ErrorKind::kInput, "the take has no frame with a pose (every frame is lost)");
+}
+
+const Board& TrackedTake::board() const {
+  for (const TrackedFrame& f : frames)
+    if (f.calib) return f.calib->board;
+  throw Error(ErrorKind::kInput, "the take has no frame with a pose (every frame is lost)");
+}
+
+double TrackedTake::FramesPerSecond() const {
+  if (frames.size() < 2 || !(frames[1].time_s > frames[0].time_s)) return 0;
+  return 1 / (frames[1].time_s - frames[0].time_s);
+}
+
+TrackedTake LoadTrackedTake(const std::filesystem::path& dir) {
+  const std::filesystem::path csv_path = dir / "track.csv";
+  const std::string file = csv_path.string();
+  if (!std::filesystem::is_directory(dir)) throw InputError(dir.string(), "no such folder (the --out of blurcue track)");
+  if (!std::filesystem::exists(csv_path)) throw InputError(file, "does not exist: is this a folder blurcue track wrote?");
+  const CsvText csv = ParseCsv(ReadTextFile(csv_path), kMaxFrames + 1);
+  if (!csv.problems.empty())
+    throw InputError(file + ": line " + std::to_string(csv.problems.front().line), csv.problems.front().message);
+  if (csv.records.empty()) throw InputError(file, "is empty (no header)");
+  const std::vector<std::string>& header = csv.records.front().fields;
+  auto column = [&](const char* name) {
+    const auto it = std::find(header.begin(), header.end(), name);
+    if (it == header.end()) throw InputError(file, std::string("no column '") + name + "' in its header");
+    return size_t(it - header.begin());
+  };
+  const size_t c_frame = column(track::kTrackColumns[0].name), c_time = column("time_s"), c_status = column("status");
+  TrackedTake take;
+  for (size_t k = 1; k < csv.records.size(); ++k) {
+    const CsvRecord& row = csv.records[k];
+    TrackedFrame f;
+    const double index = NumberField(file, row, c_frame, "frame");
+    if (index != double(take.frames.size()))
+      throw InputError(file + ": line " + std::to_string(row.line) + ", frame",
+                       "must be " + std::to_string(take.frames.size()) + " (frames in order from 0), got " +
+                           Echo(row.fields[c_frame], false));
+    f.index = int(index);
+    f.time_s = NumberField(file, row, c_time, "time_s");
+    f.status = ParseStatus(file + ": line " + std::to_string(row.line) + ", status",
+                           c_status < row.fields.size() ? row.fields[c_status] : "");
+    if (f.status != track::FrameStatus::kLost) f.calib = calib::LoadSceneCalib(dir / track::CalibFileName(f.index));
+    take.frames.push_back(std::move(f));
+  }
+  if (take.frames.empty()) throw InputError(file, "has no frames (only a header)");
+  (void)take.camera();  // at least one pose
+  return take;
+}
+
+scene::VirtualObject BallAt(double x_mm, double y_mm, double radius_mm) {
+  scene::VirtualObject o;
+  o.kind = scene::VirtualObject::Kind::kBall;
+  o.size_mm = radius_mm;
+  o.center_board_mm = {x_mm, y_mm, radius_mm};  // resting on the board (+z towards the camera's side)
+  return o;
+}
+
+scene::VirtualObject StandingCardAt(double x_mm, double y_mm, double width_mm, double height_mm, double rotation_deg) {
+  scene::VirtualObject o;
+  o.kind = scene::VirtualObject::Kind::kCard;
+  o.size_mm = width_mm;
+  o.card_height_mm = height_mm;
+  o.standing = true;
+  o.rotation_deg = rotation_deg;
+  o.center_board_mm = {x_mm, y_mm, height_mm / 2};
+  return o;
+}
+
+std::vector<PlacedObject> PlacedObjectsFromJson(const Json& json, const std::string& where) {
+  if (!json.is_object() || !json.contains("objects"))
+    throw InputError(where, "must be an object with \"objects\": [...] (docs/ar.md)");
+  for (const auto& [key, value] : json.items())
+    if (key != "objects") throw InputError(where + "/" + key, "unknown key" + DidYouMean(key, {"objects"}));
+  const Json& list = json.at("objects");
+  if (!list.is_array() || list.empty()) throw InputError(where + "/objects", "must be a non-empty array of objects");
+  std::vector<PlacedObject> out;
+  int balls = 0, cards = 0;
+  for (size_t i = 0; i < list.size(); ++i) {
+    const std::string at = where + "/objects/" + std::to_string(i);
+    const Json& o = list[i];
+    if (!o.is_object()) throw InputError(at, "must be an object, got " + Echo(o.dump(), false));
+    const std::string kind = o.contains("kind") && o.at("kind").is_string() ? o.at("kind").get<std::string>() : "";
+    if (kind != "ball" && kind != "card")
+      throw InputError(at + "/kind", "must be \"ball\" or \"card\", got " +
+                                         Echo(o.contains("kind") ? o.at("kind").dump() : "nothing", false) +
+                                         DidYouMean(kind, {"ball", "card"}));
+    const std::vector<std::string>& keys = kind == "ball" ? kBallKeys : kCardKeys;
+    for (const auto& [key, value] : o.items())
+      if (std::find(keys.begin(), keys.end(), key) == keys.end())
+        throw InputError(at + "/" + JsonPointerToken(key), "unknown key for a " + kind + DidYouMean(key, keys));
+    const double x = NumberIn(o, "x_mm", at, 0, -1e5, 1e5, true), y = NumberIn(o, "y_mm", at, 0, -1e5, 1e5, true);
+    PlacedObject p;
+    std::string texture;
+    if (kind == "ball") {
+      p.object = BallAt(x, y, NumberIn(o, "radius_mm", at, 10, 0.1, 1e4, false));
+      p.name = "ball" + std::to_string(++balls);
+      texture = "soccer";
+    } else {
+      const double w = NumberIn(o, "width_mm", at, 50, 0.1, 1e4, false);
+      p.object = StandingCardAt(x, y, w, NumberIn(o, "height_mm", at, w, 0.1, 1e4, false),
+                                NumberIn(o, "rotation_deg", at, 0, -360, 360, false));
+      p.name = "card" + std::to_string(++cards);
+      texture = "wood";
+    }
+    if (o.contains("name")) {
+      // A name goes into the CSV as it is: letters, digits, '-' and '_' need no quoting anywhere.
+      const bool ok = o.at("name").is_string() && !o.at("name").get<std::string>().empty() &&
+                      o.at("name").get<std::string>().size() <= 40 &&
+                      o.at("name").get<std::string>().find_first_not_of(
+                          "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_") == std::string::npos;
+      if (!ok)
+        throw InputError(at + "/name", "must be 1-40 letters, digits, '-' or '_', got " + Echo(o.at("name").dump(), false));
+      p.name = o.at("name").get<std::string>();
+    }
+    if (o.contains("texture")) {
+      if (!o.at("texture").is_string()) throw InputError(at + "/texture", "must be a string");
+      texture = o.at("texture").get<std::string>();
+    }
+    for (const PlacedObject& q : out)
+      if (q.name == p.name) throw InputError(at + "/name", "\"" + p.name + "\" names two objects");
+    p.object.texture = scene::SurfaceTexture(ReadImage(scene::ResolveStimulus(texture)));
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+std::vector<PlacedObject> LoadPlacedObjects(const std::filesystem::path& path) {
+  return PlacedObjectsFromJson(ReadJsonFile(path), path.string() + ": ");
+}
+
+TrackedFramePlan PlanTrackedFrame(const TrackedTake& take, int index, const std::vector<PlacedObject>& objects,
+                                  const TakeBlur& blur) {
+  TrackedFramePlan plan;
+  if (index < 0 || index >= int(take.frames.size()) || !take.frames[size_t(index)].calib) return plan;
+  const TrackedFrame& frame = take.frames[size_t(index)];
+  const calib::SceneCalib& c = *frame.calib;
+  const int before = NeighbourWithPose(take, index, -1), after = NeighbourWithPose(take, index, +1);
+  // Central difference where both neighbours have a pose: exact for motion linear in time, and centred on this
+  // frame, as the streak is (from -m/2 to +m/2 about the object's place).
+  const int a = before >= 0 ? before : index, b = after >= 0 ? after : index;
+  const double dt = take.frames[size_t(b)].time_s - take.frames[size_t(a)].time_s;
+  for (const PlacedObject& p : objects) {
+    const std::string who = p.name + " in frame " + std::to_string(index);
+    DrawnObject d;
+    d.name = p.name;
+    d.screen_px = Project(c, p.object.center_board_mm);
+    const cv::Vec3d centre = c.ToCamera(p.object.center_board_mm);
+    d.depth_mm = centre[2];
+    try {
+      d.r_px = calib::BlurAtPx(c, blur.source, centre, blur.fixed_r_px);
+    } catch (const Error& e) {
+      throw Error(e.kind(), who + ": " + e.what());
+    }
+    d.floor_sigma_px = calib::FloorSigmaPx(c, blur.source);
+    if (a != b && dt > 0 && blur.exposure_ms > 0) {
+      const cv::Point2d pa = Project(*take.frames[size_t(a)].calib, p.object.center_board_mm);
+      const cv::Point2d pb = Project(*take.frames[size_t(b)].calib, p.object.center_board_mm);
+      const double s = blur.exposure_ms / 1000 / dt;
+      d.motion_px = {(pb.x - pa.x) * s, (pb.y - pa.y) * s};
+    }
+    const double streak = cv::norm(d.motion_px);
+    if (!(d.r_px >= 0 && d.r_px <= optics::kMaxBlurRadiusPx && streak <= optics::kMaxBlurRadiusPx))
+      throw Error(ErrorKind::kDomain, who + ": blur r " + Num(d.r_px) + " px, streak " + Num(streak) +
+                                          " px; each must be in [0, " + Num(optics::kMaxBlurRadiusPx) + "] px");
+    scene::BlurredObject o;
+    o.object = p.object;
+    o.method = blur.method;
+    o.r_px = d.r_px;
+    o.floor_sigma_px = d.floor_sigma_px;
+    o.motion_px = d.motion_px;
+    plan.objects.push_back(std::move(o));
+    plan.drawn.push_back(std::move(d));
+  }
+  return plan;
+}
+
+const std::vector<DrawnColumn> kDrawnColumns = {
+    {"frame", "frame index from 0 (the take's, as in track.csv)"},
+    {"time_s", "the frame's time, s (track.csv's)"},
+    {"status", "track.csv's status: found, tracked or lost (lost: drawn without objects); untracked: a frame of INPUT "
+               "beyond track.csv, drawn without objects"},
+    {"object", "the object's name (empty on a frame drawn without objects)"},
+    {"screen_x_px", "its centre's projection at the frame's pose, image px from the left (pixel centres at integers)"},
+    {"screen_y_px", "... from the top"},
+    {"depth_mm", "its centre's camera z (depth), mm"},
+    {"r_px", "its blur without the motion: defocus x lens floor, 2 x the std of the PSF's line-spread function, px"},
+    {"floor_sigma_px", "the lens floor (std, px) inside r_px"},
+    {"motion_x_px", "the motion streak: the centre's image velocity x the exposure, px (x right)"},
+    {"motion_y_px", "... (y down)"},
+};
+
+std::string DrawnCsvHeader() {
+  std::string line;
+  for (const DrawnColumn& c : kDrawnColumns) line += (line.empty() ? "" : ",") + std::string(c.name);
+  return line + "\n";
+}
+
+std::string DrawnCsvRows(int frame, double time_s, const std::string& status, const std::vector<DrawnObject>& drawn) {
+  std::ostringstream out;
+  char head[96];
+  std::snprintf(head, sizeof head, "%d,%.6f,%s,", frame, time_s, status.c_str());
+  if (drawn.empty()) out << head << ",,,,,,,\n";
+  for (const DrawnObject& d : drawn) {
+    char row[256];
+    std::snprintf(row, sizeof row, "%.4f,%.4f,%.3f,%.4f,%.4f,%.4f,%.4f", d.screen_px.x, d.screen_px.y, d.depth_mm,
+                  d.r_px, d.floor_sigma_px, d.motion_px[0], d.motion_px[1]);
+    out << head << d.name << "," << row << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace blurcue::stimulus
