@@ -22,7 +22,7 @@ function(add_module_test name)
   target_compile_options(${name} PRIVATE -Wall -Wextra -Wswitch-enum -Wno-array-bounds -Wno-restrict)
   if(ARG_ONE_PROCESS)
     add_test(NAME ${name} COMMAND ${name} WORKING_DIRECTORY ${PROJECT_BINARY_DIR})
-    set_tests_properties(${name} PROPERTIES LABELS "${ARG_LABELS}")
+    set_tests_properties(${name} PROPERTIES LABELS "${ARG_LABELS}" COST 100)  # long: started first
     return()
   endif()
   include(GoogleTest)

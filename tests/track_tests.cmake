@@ -19,10 +19,8 @@ add_test(NAME ar_cli COMMAND bash ${PROJECT_SOURCE_DIR}/tests/ar_test.sh $<TARGE
                              ${PROJECT_BINARY_DIR}/ar-test)
 set_tests_properties(ar_cli PROPERTIES PASS_REGULAR_EXPRESSION "(^|\n)ok: ar_test" LABELS gl)
 set_tests_properties(ar_cli PROPERTIES FIXTURES_SETUP ar_take)
-# The ball's r against the take's TRUE lens within 3 % (issue 27's target). It fails today, and is marked so: the
-# take's fitted lens model, which `ar --blur fitted` draws with, is not the true one (docs/track.md "Known limit";
-# scipy's least squares on the same 924 sections finds the true focus, optics::FitThinLens does not). When the fit is
-# fixed this test "fails" by passing: remove WILL_FAIL then.
+# The ball's r against the take's TRUE lens within 3 % (issue 27's target): the take's fitted lens model, which
+# `ar --blur fitted` draws with, must be the true one.
 add_test(NAME ar_defocus_truth_lens
          COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/ar_check.py ${PROJECT_BINARY_DIR}/ar-test --truth-lens)
-set_tests_properties(ar_defocus_truth_lens PROPERTIES FIXTURES_REQUIRED ar_take WILL_FAIL TRUE)
+set_tests_properties(ar_defocus_truth_lens PROPERTIES FIXTURES_REQUIRED ar_take)
