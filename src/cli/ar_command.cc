@@ -183,15 +183,9 @@ void AddArCommand(CLI::App& app) {
                                           std::to_string(camera.image_width_px) + " x " +
                                           std::to_string(camera.image_height_px) + " (another take?)");
       if (!video.isOpened()) {
-        for (const char* codec : {"FFV1", "MJPG"}) {
-          video.open(args->out, cv::VideoWriter::fourcc(codec[0], codec[1], codec[2], codec[3]),
-                     source.fps() > 0 ? source.fps() : 30, frame.size());
-          if (video.isOpened()) {
-            codec_used = codec;
-            break;
-          }
-        }
-        if (!video.isOpened()) throw InputError(args->out, "cannot open a video writer (FFV1 or MJPEG .avi)");
+        const char* codec = OpenLosslessVideo(video, args->out, source.fps() > 0 ? source.fps() : 30, frame.size());
+        if (!codec) throw InputError(args->out, "cannot open a video writer (FFV1 or MJPEG .avi)");
+        codec_used = codec;
       }
       const bool in_take = index < int(take.frames.size());
       const stimulus::TrackedFramePlan plan = stimulus::PlanTrackedFrame(take, index, objects, blur);

@@ -257,4 +257,12 @@ cv::Mat ToGrey8(const cv::Mat& image) {
   return grey;
 }
 
+const char* OpenLosslessVideo(cv::VideoWriter& video, const std::filesystem::path& path, double fps, cv::Size size) {
+  for (const char* codec : {"FFV1", "MJPG"}) {
+    video.open(path.string(), cv::VideoWriter::fourcc(codec[0], codec[1], codec[2], codec[3]), fps, size);
+    if (video.isOpened()) return codec;
+  }
+  return nullptr;
+}
+
 }  // namespace blurcue

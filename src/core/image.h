@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
 
 namespace blurcue {
 
@@ -11,6 +12,10 @@ namespace blurcue {
 cv::Mat ReadImage(const std::filesystem::path& path, int flags = -1 /* cv::IMREAD_UNCHANGED */);
 // Writes atomically (core/atomic_file.h); creates the folder; throws naming the file on failure.
 void WriteImage(const std::filesystem::path& path, const cv::Mat& image);
+
+// Opens `video` on an .avi at `path`: lossless FFV1 first (measurements are of edges a JPEG would soften), MJPEG,
+// which every videoio writes, else. Returns the codec opened ("FFV1" or "MJPG"), or nullptr when neither opens.
+const char* OpenLosslessVideo(cv::VideoWriter& video, const std::filesystem::path& path, double fps, cv::Size size);
 
 // sRGB transfer function, one channel value in [0, 1].
 double SrgbToLinear(double v);

@@ -75,16 +75,9 @@ TakeFiles WriteTake(const TakeOptions& o, const std::filesystem::path& dir,
     WriteJsonFile(dir / TakeTruthName(i), f.scene.truth);
     if (i == 0) {
       WriteJsonFile(dir / "camera.json", CameraToJson(f.scene.camera));
-      // Lossless first (the measurement is of edges a JPEG would soften); MJPEG, which every videoio writes, else.
-      const cv::Size size = f.scene.image.size();
-      for (const char* codec : {"FFV1", "MJPG"}) {
-        video.open((dir / "take.avi").string(), cv::VideoWriter::fourcc(codec[0], codec[1], codec[2], codec[3]),
-                   o.fps, size);
-        if (video.isOpened()) {
-          files.video = "take.avi";
-          files.video_codec = codec;
-          break;
-        }
+      if (const char* codec = OpenLosslessVideo(video, dir / "take.avi", o.fps, f.scene.image.size())) {
+        files.video = "take.avi";
+        files.video_codec = codec;
       }
     }
     if (video.isOpened()) video.write(f.scene.image);
