@@ -352,23 +352,38 @@ void GlBlur::Blur(const Texture& texture, GLuint framebuffer, const std::vector<
   kernel_origin_.assign(regions.size(), cv::Point(-1, -1));
   kernel_taps_.assign(regions.size(), 0);
   int atlas_w = 0, atlas_h = 0;
-  std::vector<cv::Mat> kernels(regions.size());
+  // A region whose PSF is the one it had in the last call keeps its kernel: a static object's general kernel (an
+  // elliptical one under distortion, a pillbox with a floor) is worked out and uploaded once, not every frame.
+  bool changed = kernels_.size() != regions.size();
+  kernels_.resize(regions.size());
+  kernel_psf_.resize(regions.size());
   for (size_t k = 0; k < regions.size(); ++k) {
-    if (!regions[k].psf.General()) continue;
-    kernels[k] = PsfKernel(regions[k].psf);
+    if (!regions[k].psf.General()) {
+      // Emptied, so that the atlas is laid out again (its places shift) and a later call cannot reuse a stale kernel.
+      if (!kernels_[k].empty()) kernels_[k].release(), changed = true;
+      continue;
+    }
+    if (kernels_[k].empty() || kernel_psf_[k] != regions[k].psf) {
+      kernels_[k] = PsfKernel(regions[k].psf);
+      kernel_psf_[k] = regions[k].psf;
+      changed = true;
+    }
     kernel_origin_[k] = cv::Point(atlas_w, 0);
-    kernel_taps_[k] = kernels[k].rows / 2;
-    atlas_w += kernels[k].cols, atlas_h = std::max(atlas_h, kernels[k].rows);
+    kernel_taps_[k] = kernels_[k].rows / 2;
+    atlas_w += kernels_[k].cols, atlas_h = std::max(atlas_h, kernels_[k].rows);
   }
   if (atlas_w > 0) {
-    kernel_atlas_cpu_.create(atlas_h, atlas_w, CV_32FC4);
-    kernel_atlas_cpu_.setTo(cv::Scalar::all(0));
-    for (size_t k = 0; k < regions.size(); ++k) {
-      if (kernel_origin_[k].x < 0) continue;
-      cv::Mat channels[4] = {kernels[k], kernels[k], kernels[k], kernels[k]};
-      cv::merge(channels, 4, kernel_atlas_cpu_(cv::Rect(kernel_origin_[k], kernels[k].size())));
+    if (changed || kernel_atlas_cpu_.rows != atlas_h || kernel_atlas_cpu_.cols != atlas_w) {
+      kernel_atlas_cpu_.create(atlas_h, atlas_w, CV_32FC4);
+      kernel_atlas_cpu_.setTo(cv::Scalar::all(0));
+      for (size_t k = 0; k < regions.size(); ++k) {
+        if (kernel_origin_[k].x < 0) continue;
+        const cv::Mat& w = kernels_[k];
+        cv::Mat channels[4] = {w, w, w, w};
+        cv::merge(channels, 4, kernel_atlas_cpu_(cv::Rect(kernel_origin_[k], w.size())));
+      }
+      kernel_atlas_->Upload(kernel_atlas_cpu_);
     }
-    kernel_atlas_->Upload(kernel_atlas_cpu_);
     kernel_atlas_->texture().BindImageForReading(1);
   }
   // The first pass of every region into the scratch target: the Gaussian's horizontal pass, or the whole disc or

@@ -116,6 +116,8 @@ class GlBlur {
   std::unique_ptr<KernelBlurShader> kernel_;
   std::unique_ptr<GrowingTarget> kernel_atlas_;  // the general kernels of a Blur call side by side (red channel)
   cv::Mat kernel_atlas_cpu_;                     // and their weights before the upload (kept between frames)
+  std::vector<cv::Mat> kernels_;                 // per region of the last call, its general kernel and its PSF:
+  std::vector<Psf> kernel_psf_;                  // reused while a region's PSF stays the same
   std::vector<cv::Point> kernel_origin_;         // per region, its kernel's place in the atlas (x < 0: none)
   std::vector<int> kernel_taps_;
   std::unique_ptr<GrowingTarget> scratch_;

@@ -67,6 +67,36 @@ cv::Mat Splat(const cv::Vec2d& d, double length, int n, double* along, double* a
   return k / sum;
 }
 
+// The anisotropic part of an elliptical PSF: a kernel whose covariance is exactly mu I + D, with D = [[d, c], [c, -d]]
+// the ellipse's deviator and mu = |d| + |c| the least isotropic variance that lets it be drawn with non-negative
+// weights: the n-fold convolution of one point-symmetric 3 x 3 kernel of covariance (mu I + D) / n (covariances add),
+// weights alpha at (+-1, 0), beta at (0, +-1), gamma+ at +-(1, 1), gamma- at +-(1, -1), the rest at the centre:
+// xx = 2 (alpha + gamma+ + gamma-), yy = 2 (beta + gamma+ + gamma-), xy = 2 (gamma+ - gamma-). n is the fewest copies
+// whose centre weight stays >= 0. No search: the moments are exact by construction, from sub-pixel up.
+int AnisotropicCopies(double d, double c) { return std::max(1, int(std::ceil(2 * (std::abs(d) + std::abs(c)) - std::abs(c)))); }
+cv::Mat AnisotropicKernel(double d, double c, double* mu_px2) {
+  const double mu = std::abs(d) + std::abs(c);
+  *mu_px2 = mu;
+  const int n = AnisotropicCopies(d, c);
+  const double xx = (mu + d) / n, yy = (mu - d) / n, xy = c / n;
+  const double gp = std::max(xy, 0.0) / 2, gm = std::max(-xy, 0.0) / 2;
+  const double alpha = xx / 2 - gp - gm, beta = yy / 2 - gp - gm;
+  // Row y = -1, 0, +1; column x = -1, 0, +1.
+  cv::Mat k3 = (cv::Mat_<float>(3, 3) << float(gp), float(beta), float(gm),  //
+                float(alpha), float(1 - 2 * (alpha + beta + gp + gm)), float(alpha),  //
+                float(gm), float(beta), float(gp));
+  cv::Mat k = k3;
+  for (int i = 1; i < n; ++i) k = Convolve(k, k3);
+  return k;
+}
+
+// The ellipse's deviator ((xx - yy) / 2, xy of r^2 / 4 x shape shape^T), px^2, and its mean variance (trace / 2).
+cv::Vec2d DeviatorOf(const Psf& psf, double* mean_px2) {
+  const cv::Matx22d m = psf.shape * psf.shape.t() * (psf.r_px * psf.r_px / 4);
+  *mean_px2 = 0.5 * (m(0, 0) + m(1, 1));
+  return {0.5 * (m(0, 0) - m(1, 1)), m(0, 1)};
+}
+
 }  // namespace
 
 cv::Mat StreakKernel(const cv::Vec2d& m, double* across_px2) {
@@ -100,8 +130,21 @@ double Psf::DefocusRadiusPx() const {
   return std::sqrt(std::max(0.0, r_px * r_px - 4 * f * f));
 }
 
+bool Psf::Stretched() const { return shape != cv::Matx22d(1, 0, 0, 1); }
+
+double Psf::RadiusAcrossPx(const cv::Vec2d& normal) const {
+  const double len = cv::norm(normal);
+  if (!(len > 0)) return r_px;
+  return r_px * cv::norm(shape.t() * (normal / len));
+}
+
 bool Psf::General() const {
-  return MotionLengthPx() > 0 || (method == "disc" && FloorSigmaPx() > 0);
+  return MotionLengthPx() > 0 || Stretched() || (method == "disc" && FloorSigmaPx() > 0);
+}
+
+bool Psf::operator==(const Psf& o) const {
+  return method == o.method && r_px == o.r_px && floor_sigma_px == o.floor_sigma_px && motion_px == o.motion_px &&
+         shape == o.shape;
 }
 
 void CheckPsf(const Psf& psf) {
@@ -114,37 +157,65 @@ void CheckPsf(const Psf& psf) {
   if (!(psf.MotionLengthPx() <= kMaxBlurRadiusPx))  // NaN fails too
     throw Error(ErrorKind::kDomain, "motion streak must be at most " + Num(kMaxBlurRadiusPx) + " px long, got (" +
                                         Num(psf.motion_px[0]) + ", " + Num(psf.motion_px[1]) + ")");
+  const cv::Matx22d& m = psf.shape;
+  const double det = m(0, 0) * m(1, 1) - m(0, 1) * m(1, 0);
+  const cv::Matx22d mm = m * m.t();
+  const double largest = 0.5 * (mm(0, 0) + mm(1, 1)) + std::hypot(0.5 * (mm(0, 0) - mm(1, 1)), mm(0, 1));
+  if (!(std::abs(det - 1) <= 1e-6 && largest <= 4))  // NaN fails too; a stretch of 2 is far past any real lens's
+    throw Error(ErrorKind::kDomain, "PSF shape must have determinant 1 and stretch by at most 2, got [" +
+                                        Num(m(0, 0)) + ", " + Num(m(0, 1)) + "; " + Num(m(1, 0)) + ", " +
+                                        Num(m(1, 1)) + "]");
 }
 
 cv::Mat PsfKernel(const Psf& psf) {
   CheckPsf(psf);
-  // The streak first: the variance its spreading adds across it (e) is taken out of the isotropic part (the floor
-  // first, then the defocus), so that across the motion the kernel's variance is r^2 / 4 and along it r^2 / 4 +
-  // L^2 / 12. Where r^2 / 4 < e (a sub-pixel defocus under a diagonal streak) what is left over stays.
-  double e = 0;
-  const cv::Mat streak = psf.MotionLengthPx() > 0 ? StreakKernel(psf.motion_px, &e) : cv::Mat();
+  // A shape first: its anisotropic part is one small kernel (AnisotropicKernel) that also adds an isotropic mu, taken
+  // out of the round part like the streak's spreading; the round part is drawn at the ellipse's mean variance (its
+  // defocus and floor scaled alike by sqrt(trace / 2) / (r / 2)).
+  double mean = psf.r_px * psf.r_px / 4, e = 0;
+  cv::Mat stretch;
+  if (psf.Stretched() && psf.r_px > 0) {
+    const cv::Vec2d dev = DeviatorOf(psf, &mean);
+    stretch = AnisotropicKernel(dev[0], dev[1], &e);
+  }
+  const double scale = psf.r_px > 0 ? std::sqrt(mean) / (psf.r_px / 2) : 1.0;
+  // The streak: the variance its spreading adds across it (and the shape's mu: e) is taken out of the isotropic part
+  // (the floor first, then the defocus), so that across the motion the kernel's variance is r^2 / 4 and along it
+  // r^2 / 4 + L^2 / 12. Where r^2 / 4 < e (a sub-pixel defocus under a diagonal streak) what is left over stays.
+  double e_streak = 0;
+  const cv::Mat streak = psf.MotionLengthPx() > 0 ? StreakKernel(psf.motion_px, &e_streak) : cv::Mat();
+  e += e_streak;
   cv::Mat iso;
   if (psf.method == "disc") {
-    const double f = psf.FloorSigmaPx(), R = psf.DefocusRadiusPx();
+    const double f = psf.FloorSigmaPx() * scale, R = psf.DefocusRadiusPx() * scale;
     const double f2 = f * f - e;
     const double R_drawn = f2 >= 0 ? R : std::sqrt(std::max(0.0, R * R + 4 * f2));
     cv::Mat disc = R_drawn > 0 ? DiscKernel(R_drawn) : cv::Mat::ones(1, 1, CV_32F);
     iso = Convolve(disc, GaussianKernel2d(std::sqrt(std::max(0.0, f2))));
   } else {
-    iso = GaussianKernel2d(std::sqrt(std::max(0.0, psf.r_px * psf.r_px / 4 - e)));
+    iso = GaussianKernel2d(std::sqrt(std::max(0.0, mean - e)));
   }
   cv::Mat k = streak.empty() ? iso : Convolve(iso, streak);
+  if (!stretch.empty()) k = Convolve(k, stretch);
   return k / cv::sum(k)[0];
 }
 
 int PsfHalfWidth(const Psf& psf) {
   CheckPsf(psf);
-  int h = 0;
+  // The round part at the ellipse's mean variance (at most its largest, <= 2 r / 2 by CheckPsf) and the shape's copies.
+  double mean = psf.r_px * psf.r_px / 4;
+  int copies = 0;
+  if (psf.Stretched() && psf.r_px > 0) {
+    const cv::Vec2d dev = DeviatorOf(psf, &mean);
+    copies = AnisotropicCopies(dev[0], dev[1]);
+  }
+  const double scale = psf.r_px > 0 ? std::sqrt(mean) / (psf.r_px / 2) : 1.0;
+  int h = copies;
   if (psf.method == "disc") {
-    const double R = psf.DefocusRadiusPx();
-    h = (R > 0 ? int(std::ceil(DiscCoverageRadiusPx(R) + 0.5)) : 0) + GaussianTaps(psf.FloorSigmaPx());
+    const double R = psf.DefocusRadiusPx() * scale;
+    h += (R > 0 ? int(std::ceil(DiscCoverageRadiusPx(R) + 0.5)) : 0) + GaussianTaps(psf.FloorSigmaPx() * scale);
   } else {
-    h = GaussianTaps(psf.r_px / 2);
+    h += GaussianTaps(std::sqrt(mean));
   }
   // The streak's drawn length is at most L + 2 (StreakKernel's search).
   if (psf.MotionLengthPx() > 0) h += int(std::ceil((psf.MotionLengthPx() + 2) / 2)) + 1;

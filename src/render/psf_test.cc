@@ -92,6 +92,49 @@ TEST(Psf, StreakAddsItsLengthSquaredOverTwelveAlongTheMotion) {
   }
 }
 
+// The unit-determinant map stretching by s along the direction at angle t (rad) and by 1 / s across it.
+cv::Matx22d Shape(double s, double t) {
+  const double c = std::cos(t), n = std::sin(t);
+  const cv::Matx22d rot(c, -n, n, c);
+  return rot * cv::Matx22d(s, 0, 0, 1 / s) * rot.t();
+}
+
+TEST(Psf, ShapedKernelHasTheEllipsesSecondMoments) {
+  // Covariance r^2 / 4 x S S^T, worked by hand for S stretching by s along angle t and 1 / s across:
+  // xx = r^2 / 4 (s^2 cos^2 t + sin^2 t / s^2), yy = r^2 / 4 (s^2 sin^2 t + cos^2 t / s^2),
+  // xy = r^2 / 4 (s^2 - 1 / s^2) cos t sin t. Gaussian and pillbox with a floor, sub-pixel up, with a streak too.
+  for (const char* method : {"gaussian", "disc"})
+    for (double r : {0.3, 0.8, 2.0, 6.0})
+      for (const auto& [st, t] : {std::pair{1.08, 0.6}, std::pair{0.93, 0.0}, std::pair{1.2, M_PI / 2}}) {
+        Psf p = Make(method, r, 0.3 * r);
+        p.shape = Shape(st, t);
+        const Moments m = Of(PsfKernel(p));
+        const double q = r * r / 4, c = std::cos(t), n = std::sin(t);
+        const double tol = std::max(1.5e-3, 5e-3 * q);
+        EXPECT_NEAR(m.sum, 1, 1e-5);
+        EXPECT_NEAR(m.xx, q * (st * st * c * c + n * n / (st * st)), tol) << method << " r " << r << " s " << st;
+        EXPECT_NEAR(m.yy, q * (st * st * n * n + c * c / (st * st)), tol) << method << " r " << r << " s " << st;
+        EXPECT_NEAR(m.xy, q * (st * st - 1 / (st * st)) * c * n, tol) << method << " r " << r << " s " << st;
+        EXPECT_NEAR(p.RadiusAcrossPx({1, 0}), r * std::sqrt(st * st * c * c + n * n / (st * st)), 1e-12);
+      }
+  // With a horizontal streak of 4 px: the streak's L^2 / 12 on top along x.
+  Psf p = Make("gaussian", 2, 0, {4, 0});
+  p.shape = Shape(1.1, 0.3);
+  const Moments m = Of(PsfKernel(p));
+  const double c = std::cos(0.3), n = std::sin(0.3);
+  EXPECT_NEAR(m.xx, 1.0 * (1.21 * c * c + n * n / 1.21) + 16.0 / 12, 3e-3);
+  EXPECT_NEAR(m.yy, 1.0 * (1.21 * n * n + c * c / 1.21), 3e-3);
+  EXPECT_GE(PsfHalfWidth(p), PsfKernel(p).rows / 2);
+}
+
+TEST(Psf, RefusesAShapeThatChangesTheArea) {
+  Psf p = Make("gaussian", 1, 0);
+  p.shape = cv::Matx22d(1.1, 0, 0, 1);
+  EXPECT_THROW(PsfKernel(p), Error);
+  p.shape = cv::Matx22d(std::nan(""), 0, 0, 1);
+  EXPECT_THROW(PsfKernel(p), Error);
+}
+
 TEST(Psf, RefusesNanAndUnknownShapes) {
   EXPECT_THROW(PsfKernel(Make("disc", 1, std::nan(""))), Error);
   EXPECT_THROW(PsfKernel(Make("disc", 1, 0, {std::nan(""), 0})), Error);
@@ -102,6 +145,11 @@ TEST(Psf, RefusesNanAndUnknownShapes) {
 TEST(Psf, HalfWidthHoldsTheKernel) {
   for (const Psf& p : {Make("disc", 0.4, 0.2), Make("disc", 5, 0.5, {7, -2}), Make("gaussian", 3, 0, {0.4, 9})})
     EXPECT_GE(PsfHalfWidth(p), PsfKernel(p).rows / 2);
+  for (double st : {0.8, 1.05, 1.3})
+    for (Psf p : {Make("disc", 0.4, 0.2), Make("disc", 5, 0.5, {7, -2}), Make("gaussian", 3, 0, {0.4, 9})}) {
+      p.shape = Shape(st, 0.7);
+      EXPECT_GE(PsfHalfWidth(p), PsfKernel(p).rows / 2) << st;
+    }
 }
 
 TEST(PsfGl, GlPassEqualsCpuReference) {
@@ -110,11 +158,23 @@ TEST(PsfGl, GlPassEqualsCpuReference) {
   img(cv::Rect(16, 12, 30, 20)).setTo(cv::Scalar(0.8, 0.5, 0.2, 1.0));
   img(cv::Rect(20, 14, 4, 10)).setTo(cv::Scalar(0.05, 0.05, 0.05, 1.0));
   GlBlur gl;
-  for (const Psf& p : {Make("disc", 2.5, 0.4), Make("gaussian", 1.5, 0, {5, 2}), Make("disc", 0.6, 0.2, {-0.5, 3})}) {
+  Psf ellipse = Make("gaussian", 1.8, 0.4), ellipse_disc = Make("disc", 2.2, 0.5);
+  ellipse.shape = Shape(1.15, 0.5), ellipse_disc.shape = Shape(0.87, -0.6);
+  for (const Psf& p : {Make("disc", 2.5, 0.4), Make("gaussian", 1.5, 0, {5, 2}), Make("disc", 0.6, 0.2, {-0.5, 3}),
+                       ellipse, ellipse_disc}) {
     cv::Mat cpu;
     cv::filter2D(img, cpu, CV_32F, PsfKernel(p), cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
     const cv::Mat shown = gl.BlurImage(img, p);
     EXPECT_LT(cv::norm(shown, cpu, cv::NORM_INF), 1e-5) << p.method << " r " << p.r_px;
+  }
+  // A kernel kept from the last call (the same PSF again) and one laid out anew after a round PSF in between.
+  for (const Psf& p : {ellipse, ellipse, Make("gaussian", 1.0, 0), ellipse_disc, ellipse_disc}) {
+    cv::Mat cpu;
+    if (p.General())
+      cv::filter2D(img, cpu, CV_32F, PsfKernel(p), cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
+    else
+      cpu = GaussianBlurCpu(img, p.r_px);
+    EXPECT_LT(cv::norm(gl.BlurImage(img, p), cpu, cv::NORM_INF), 1e-5) << p.method << " r " << p.r_px;
   }
 }
 
