@@ -9,6 +9,8 @@
 uniform sampler2D u_texture;     // sRGB equirectangular texture: sampling returns linear values
 uniform vec4 u_intrinsics;       // fx, fy, cx, cy (px)
 uniform vec2 u_origin;           // the layer's top-left pixel in the image (framebuffer row = image row)
+uniform mat3 u_image_to_ideal;   // image px -> ideal (pinhole) px: the inverse of the lens distortion's local affine
+                                 // map at the ball (scene::LocalImageMap); the identity without distortion
 uniform vec3 u_center;           // the sphere's centre, camera frame (mm)
 uniform float u_radius;          // mm
 uniform mat3 u_camera_to_object; // camera-frame offsets from the centre -> the unit sphere's frame (spin undone)
@@ -23,7 +25,7 @@ layout(location = 0) out vec4 o_layer;  // premultiplied colour x coverage; or c
 // Where the ray through image point `px` (pixel centres at integers) meets the sphere: x = distance along the ray
 // direction (z = 1 units), y = the discriminant (< 0: a miss; also when the sphere is not in front of the eye).
 vec2 Hit(vec2 px) {
-  vec3 d = vec3((px - u_intrinsics.zw) / u_intrinsics.xy, 1.0);
+  vec3 d = vec3(((u_image_to_ideal * vec3(px, 1.0)).xy - u_intrinsics.zw) / u_intrinsics.xy, 1.0);
   float b = dot(d, u_center), a = dot(d, d);
   float disc = b * b - a * (dot(u_center, u_center) - u_radius * u_radius);
   float t = (b - sqrt(max(disc, 0.0))) / a;
@@ -34,7 +36,7 @@ vec2 Hit(vec2 px) {
 // longitude along u (its seam at u = 0 = 1), latitude along v (0 at the +z pole), as the texture is laid out; and in
 // .zw the camera-frame point's z and the discriminant.
 vec4 SurfaceAt(vec2 px, out vec3 p) {
-  vec3 d = vec3((px - u_intrinsics.zw) / u_intrinsics.xy, 1.0);
+  vec3 d = vec3(((u_image_to_ideal * vec3(px, 1.0)).xy - u_intrinsics.zw) / u_intrinsics.xy, 1.0);
   vec2 hit = Hit(px);
   p = hit.x * d;
   vec3 o = normalize(u_camera_to_object * (p - u_center));

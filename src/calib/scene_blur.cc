@@ -204,16 +204,37 @@ double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& p, 
   return 0;
 }
 
-double FloorSigmaPx(const SceneCalib& scene, BlurSource source) {
+namespace {
+
+// Whether a source is the scene's own blur (drawn with the photo's floor and stretch).
+bool SceneOwn(BlurSource source) {
   switch (source) {
     case BlurSource::kMeasured:
     case BlurSource::kMeasuredSection:
-    case BlurSource::kFitted: return scene.model.floor_px / 2;
+    case BlurSource::kFitted: return true;
     case BlurSource::kEstimated:
     case BlurSource::kFixed:
-    case BlurSource::kNone: return 0;
+    case BlurSource::kNone: return false;
   }
-  return 0;
+  return false;
+}
+
+}  // namespace
+
+double FloorSigmaPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& p) {
+  return SceneOwn(source) ? scene.model.floor_px / 2 * StretchAt(scene, p) : 0.0;
+}
+
+cv::Matx22d ShapeAt(const SceneCalib& scene, BlurSource source, const cv::Vec3d& p) {
+  const cv::Matx22d round(1, 0, 0, 1);
+  const LensDistortion distortion(scene.camera);
+  if (!SceneOwn(source) || distortion.Identity() || !(p[2] > 0)) return round;
+  const std::array<double, 9> k = scene.camera.Intrinsics();
+  const Jacobian2 j = distortion.JacobianAt({k[0] * p[0] / p[2] + k[2], k[4] * p[1] / p[2] + k[5]});
+  const double det = j[0] * j[3] - j[1] * j[2];
+  if (!(det > 0)) return round;  // a map folded over there (synth and calibrate refuse such a lens)
+  const double s = 1 / std::sqrt(det);
+  return cv::Matx22d(j[0] * s, j[1] * s, j[2] * s, j[3] * s);
 }
 
 double BlurAlongSightPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& centre, double z_mm,

@@ -63,10 +63,17 @@ double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& poi
 // of the distortion map there (core/distortion.h), 1 without distortion. Photo px per ideal (pinhole) px.
 double StretchAt(const SceneCalib& scene, const cv::Vec3d& point_camera_mm);
 
-// The lens floor (std, px) inside the blur `source` gives: for the scene's own blur (measured, measured_section,
-// fitted) the fitted model's floor r0 as a std (r0 / 2, DESIGN.md's r = 2 std; 0 when the model kept none), which a
-// virtual object's defocus is drawn convolved with so that its PSF is the photo's; 0 for estimated, fixed and none.
-double FloorSigmaPx(const SceneCalib& scene, BlurSource source);
+// The lens floor (std, photo px) inside the blur `source` gives at a camera-frame point: for the scene's own blur
+// (measured, measured_section, fitted) the fitted model's floor r0 as a std (r0 / 2, DESIGN.md's r = 2 std; 0 when
+// the model kept none) times StretchAt the point (the model's floor is in ideal px), which a virtual object's defocus
+// is drawn convolved with so that its PSF is the photo's; 0 for estimated, fixed and none.
+double FloorSigmaPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& point_camera_mm);
+
+// The shape (render::Psf::shape) the blur `source` gives a virtual object at a camera-frame point: for the scene's
+// own blur the distortion's Jacobian J at the point's ideal image position over sqrt(det J), so that the object's
+// PSF (defocus x floor) is stretched along and across as the photo's blur is there; the identity for estimated
+// (eq. 3.7 as published), fixed and none, and without distortion.
+cv::Matx22d ShapeAt(const SceneCalib& scene, BlurSource source, const cv::Vec3d& point_camera_mm);
 
 // The source's radius on the line of sight through an object's centre (camera frame, mm) at camera depth z_mm: what
 // a pixel of the object at that depth gets when it is blurred per pixel by depth. Where the source cannot be

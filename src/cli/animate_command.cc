@@ -184,7 +184,8 @@ void AddAnimateCommand(CLI::App& app) {
                                              BoundText(render::kMaxBlurRadiusPx) + "] px");
         balls[b].r_px = r[b];
         balls[b].method = args->method;
-        balls[b].floor_sigma_px = calib::FloorSigmaPx(scene, source[b]);
+        balls[b].floor_sigma_px = calib::FloorSigmaPx(scene, source[b], scene.ToCamera(o.center_board_mm));
+        balls[b].shape = calib::ShapeAt(scene, source[b], scene.ToCamera(o.center_board_mm));
         balls[b].motion_px = rolling ? streak(section[b], y) : cv::Vec2d(0, 0);
       }
       const auto t0 = Clock::now();

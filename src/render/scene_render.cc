@@ -69,6 +69,16 @@ glm::mat4 ModelMatrix(const VirtualObject& o) {
   return m;
 }
 
+// The inverse of an affine image map (ideal px -> image px) as a GLSL mat3 (column-major): image px -> ideal px.
+glm::mat3 ImageToIdeal(const cv::Matx23d& a) {
+  const double det = a(0, 0) * a(1, 1) - a(0, 1) * a(1, 0);
+  const double i00 = a(1, 1) / det, i01 = -a(0, 1) / det, i10 = -a(1, 0) / det, i11 = a(0, 0) / det;
+  glm::mat3 m(1.0f);
+  m[0][0] = float(i00), m[1][0] = float(i01), m[2][0] = float(-(i00 * a(0, 2) + i01 * a(1, 2)));
+  m[0][1] = float(i10), m[1][1] = float(i11), m[2][1] = float(-(i10 * a(0, 2) + i11 * a(1, 2)));
+  return m;
+}
+
 }  // namespace
 
 struct SceneRenderer::Impl {
@@ -216,13 +226,22 @@ void SceneRenderer::DrawLayerAt(const VirtualObject& o, const cv::Rect& roi, Gro
   if (!color.Holds(at.x + w, at.y + h) || (depth && !depth->Holds(at.x + w, at.y + h)))
     throw Error(ErrorKind::kInternal, "a layer was drawn past its target's reserved room (reserve before drawing)");
   const auto k = cam.Intrinsics();
+  // Under lens distortion the object is drawn through the distortion's local affine map at its centre
+  // (scene::LocalImageMap: image px = A ideal px + t), as its blur is stretched (Psf::shape); the identity without.
+  const cv::Matx23d a = scene::LocalImageMap(cam, impl_->rvec, impl_->tvec, o);
+  // Camera (x, y, z) -> image px x z: rows m (x, y, z) with m = A [fx 0 cx; 0 fy cy] + t e_z (skew ignored, as
+  // cv::projectPoints does).
+  const cv::Matx23d m(a(0, 0) * k[0], a(0, 1) * k[4], a(0, 0) * k[2] + a(0, 1) * k[5] + a(0, 2),
+                      a(1, 0) * k[0], a(1, 1) * k[4], a(1, 0) * k[2] + a(1, 1) * k[5] + a(1, 2));
   // Camera frame -> clip for this sub-window; framebuffer row r is image row roi.y + r (nothing is flipped).
   const double n = 1.0, far = 1e5;
   glm::mat4 projection(0.0f);  // column-major: projection[col][row]
-  projection[0][0] = float(2 * k[0] / w);
-  projection[1][1] = float(2 * k[4] / h);
-  projection[2][0] = float(2 * (k[2] + 0.5 - roi.x) / w - 1);
-  projection[2][1] = float(2 * (k[5] + 0.5 - roi.y) / h - 1);
+  projection[0][0] = float(2 * m(0, 0) / w);
+  projection[1][0] = float(2 * m(0, 1) / w);
+  projection[0][1] = float(2 * m(1, 0) / h);
+  projection[1][1] = float(2 * m(1, 1) / h);
+  projection[2][0] = float(2 * (m(0, 2) + 0.5 - roi.x) / w - 1);
+  projection[2][1] = float(2 * (m(1, 2) + 0.5 - roi.y) / h - 1);
   projection[2][2] = float((far + n) / (far - n));
   projection[3][2] = float(-2 * far * n / (far - n));
   projection[2][3] = 1.0f;
@@ -243,7 +262,8 @@ void SceneRenderer::DrawLayerAt(const VirtualObject& o, const cv::Rect& roi, Gro
     BallShader& shader = impl_->ball_shader;
     shader.Use()
         .SetCamera(glm::vec4(float(k[0]), float(k[4]), float(k[2]), float(k[5])),
-                   glm::vec2(float(roi.x - at.x), float(roi.y - at.y)))  // framebuffer pixel -> image pixel
+                   glm::vec2(float(roi.x - at.x), float(roi.y - at.y)),  // framebuffer pixel -> image pixel
+                   ImageToIdeal(a))
         .SetSphere(glm::vec3(model_to_camera[3]), float(o.size_mm), glm::inverse(glm::mat3(model_to_camera)))
         .SetLight(light, ambient)
         .SetColour(float(o.brightness), float(o.contrast), white_balance);
@@ -304,6 +324,7 @@ Psf PsfOf(const scene::BlurredObject& object, double scale) {
   psf.r_px = object.r_px * scale;
   psf.floor_sigma_px = object.floor_sigma_px * scale;
   psf.motion_px = object.motion_px * scale;
+  psf.shape = object.shape;  // the view's scale is the same along x and y: the shape is the photo's
   return psf;
 }
 

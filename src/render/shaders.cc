@@ -56,6 +56,7 @@ BallShader::BallShader()
       colour_(program_),
       intrinsics_(program_.Uniform("u_intrinsics")),
       origin_(program_.Uniform("u_origin")),
+      image_to_ideal_(program_.Uniform("u_image_to_ideal")),
       center_(program_.Uniform("u_center")),
       radius_(program_.Uniform("u_radius")),
       camera_to_object_(program_.Uniform("u_camera_to_object")),
@@ -68,9 +69,10 @@ BallShader& BallShader::Use() {
   program_.Use();
   return *this;
 }
-BallShader& BallShader::SetCamera(const glm::vec4& k, const glm::vec2& origin) {
+BallShader& BallShader::SetCamera(const glm::vec4& k, const glm::vec2& origin, const glm::mat3& image_to_ideal) {
   glUniform4f(intrinsics_, k.x, k.y, k.z, k.w);
   glUniform2f(origin_, origin.x, origin.y);
+  glUniformMatrix3fv(image_to_ideal_, 1, GL_FALSE, glm::value_ptr(image_to_ideal));
   return *this;
 }
 BallShader& BallShader::SetSphere(const glm::vec3& center, float radius_mm, const glm::mat3& camera_to_object) {

@@ -42,8 +42,9 @@ class BallShader {
  public:
   BallShader();
   BallShader& Use();
-  // The pinhole camera (px) and the layer's top-left pixel in its image.
-  BallShader& SetCamera(const glm::vec4& fx_fy_cx_cy, const glm::vec2& layer_origin_px);
+  // The pinhole camera (px), the layer's top-left pixel in its image, and the affine map from image px to the
+  // pinhole's (the inverse of scene::LocalImageMap; the identity without distortion).
+  BallShader& SetCamera(const glm::vec4& fx_fy_cx_cy, const glm::vec2& layer_origin_px, const glm::mat3& image_to_ideal);
   // The sphere in the camera frame (mm), and the rotation from the camera frame to its texture's frame.
   BallShader& SetSphere(const glm::vec3& center_camera_mm, float radius_mm, const glm::mat3& camera_to_object);
   BallShader& SetWriteDepth(bool depth);
@@ -54,7 +55,7 @@ class BallShader {
  private:
   Program program_;
   ColourUniforms colour_;
-  GLint intrinsics_, origin_, center_, radius_, camera_to_object_, write_depth_, light_dir_, ambient_;
+  GLint intrinsics_, origin_, image_to_ideal_, center_, radius_, camera_to_object_, write_depth_, light_dir_, ambient_;
 };
 
 // shaders/blur_gaussian.frag: one pass of the separable Gaussian over a rectangle of a texture (no taps: a copy).

@@ -8,6 +8,8 @@
 
 #include <opencv2/calib3d.hpp>
 
+#include "core/distortion.h"
+
 namespace blurcue::scene {
 
 SurfaceTexture::SurfaceTexture(cv::Mat image) : image_(std::move(image)) {
@@ -51,6 +53,20 @@ VirtualObject BallOnBoard(const Board& board, int section, double y_mm, double r
   return o;
 }
 
+cv::Matx23d LocalImageMap(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec, const VirtualObject& o) {
+  const LensDistortion distortion(camera);
+  cv::Matx33d rotation;
+  cv::Rodrigues(rvec, rotation);
+  const cv::Vec3d c = rotation * o.center_board_mm + tvec;
+  if (distortion.Identity() || !(c[2] > 0)) return cv::Matx23d(1, 0, 0, 0, 1, 0);
+  const std::array<double, 9> k = camera.Intrinsics();
+  const Point2 ideal{k[0] * c[0] / c[2] + k[2], k[4] * c[1] / c[2] + k[5]};
+  const Point2 photo = distortion.Distort(ideal);
+  const Jacobian2 j = distortion.JacobianAt(ideal);
+  return cv::Matx23d(j[0], j[1], photo[0] - j[0] * ideal[0] - j[1] * ideal[1],  //
+                     j[2], j[3], photo[1] - j[2] * ideal[0] - j[3] * ideal[1]);
+}
+
 Footprint FootprintOf(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec, const VirtualObject& o) {
   cv::Matx33d rotation;
   cv::Rodrigues(rvec, rotation);
@@ -71,6 +87,19 @@ Footprint FootprintOf(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec
       const double z = (rotation * cv::Vec3d(c) + tvec)[2];
       f.z_min_mm = std::min(f.z_min_mm, z), f.z_max_mm = std::max(f.z_max_mm, z);
     }
+  }
+  if (!camera.dist_coeffs.empty() && !LensDistortion(camera).Identity()) {
+    // What the renderer draws: the pinhole outline through the local affine map.
+    Camera pinhole = camera;
+    pinhole.dist_coeffs.clear();
+    const cv::Matx23d a = LocalImageMap(camera, rvec, tvec, o);
+    std::vector<cv::Point2d> drawn;
+    if (o.kind == VirtualObject::Kind::kBall) {
+      drawn = OutlineOf(pinhole, rvec, tvec, o, 64);
+    } else {
+      cv::projectPoints(CardCorners(o), rvec, tvec, cv::Matx33d(camera.Intrinsics().data()), cv::noArray(), drawn);
+    }
+    for (const cv::Point2d& p : drawn) px.push_back(cv::Point2d(a * cv::Vec3d(p.x, p.y, 1)));
   }
   double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
   for (const cv::Point2d& p : px)

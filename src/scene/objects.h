@@ -70,12 +70,21 @@ std::vector<cv::Point3d> CardCorners(const VirtualObject& card);
 
 // Where the object lands in the photo, and how far it spans in depth.
 struct Footprint {
-  cv::Rect bounds;  // the image pixels it may cover (not clipped): its corners' box (card), its outline's box (ball)
+  // The image pixels it may cover (not clipped): its corners' box (card), its outline's box (ball); under distortion
+  // the box of both its exact outline and the one LocalImageMap draws.
+  cv::Rect bounds;
   double z_min_mm = 0, z_max_mm = 0, z_center_mm = 0;
 };
 
 // Where `object` lands in `camera`'s image (board frame -> camera by rvec/tvec), without GL.
 Footprint FootprintOf(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec, const VirtualObject& object);
+// How an object is drawn through the camera's lens distortion (camera.json's dist_coeffs): by the distortion's local
+// affine map at its centre, photo px = A ideal px + t (A the Jacobian there, t putting the centre where the lens puts
+// it), applied to its whole pinhole image, so that its shape and its blur (render::Psf::shape) are stretched by the
+// same map. Exact at the centre; a card of 100 px at a k1 = -0.3 corner bends by ~1.5 px at its corners, which the
+// affine map leaves straight. The identity (A = I, t = 0) without distortion.
+cv::Matx23d LocalImageMap(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec, const VirtualObject& object);
+
 // The object's silhouette in `camera`'s image as a polygon (image px, centres at integers): a card's four corners,
 // a ball's outline circle (the sphere's rim as seen from the camera's centre) at `points` points. No GL.
 std::vector<cv::Point2d> OutlineOf(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec3d& tvec,

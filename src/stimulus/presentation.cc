@@ -156,6 +156,12 @@ Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, cons
          {"r_camera_px", round(b.r_px, 1e-4)},
          {"r_screen_px", round(presentation.ScreenPx(b.r_px), 1e-4)},
          {"r_arcmin", round(presentation.Arcmin(b.r_px), 1e-4)},
+         // Under lens distortion the PSF is elliptical (its shape): the radius across a vertical edge (the profile
+         // along x) and across a horizontal one (along y), as a section's r_px is measured across its edge.
+         {"r_x_screen_px", round(presentation.ScreenPx(b.r_px * cv::norm(cv::Vec2d(b.shape(0, 0), b.shape(0, 1)))), 1e-4)},
+         {"r_y_screen_px", round(presentation.ScreenPx(b.r_px * cv::norm(cv::Vec2d(b.shape(1, 0), b.shape(1, 1)))), 1e-4)},
+         {"shape", {{round(b.shape(0, 0), 1e-6), round(b.shape(0, 1), 1e-6)},
+                    {round(b.shape(1, 0), 1e-6), round(b.shape(1, 1), 1e-6)}}},
          // The PSF's parts (render/psf.h): r^2 = defocus_r^2 + 4 floor_sigma^2, and the motion streak beside it.
          {"floor_sigma_screen_px", round(presentation.ScreenPx(floor), 1e-4)},
          {"defocus_r_screen_px", round(presentation.ScreenPx(std::sqrt(std::max(0.0, b.r_px * b.r_px - 4 * floor * floor))), 1e-4)},

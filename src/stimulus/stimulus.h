@@ -55,8 +55,8 @@ struct TrialScene {
   int intervals = 0;       // the intervals a pair trial shows one after the other (protocol::IntervalCount), else 0
   // The radii rendered, averaged over the run for balls, and the scene's own blur (the fitted model) there.
   double r_left_px = 0, r_right_px = 0, r_scene_px = 0;
-  // Each side's lens floor inside its radius (std, photo px; calib::FloorSigmaPx of its source): a scene source's
-  // defocus is drawn convolved with the scene's floor.
+  // Each side's lens floor inside its radius (std, photo px; calib::FloorSigmaPx of its source at the object's place,
+  // averaged over the run for balls): a scene source's defocus is drawn convolved with the scene's floor.
   double floor_left_sigma_px = 0, floor_right_sigma_px = 0;
   // Motion blur: the exposure (content.exposure_ms; 0: none) and each ball's streak over it (photo px, image x right,
   // y down), averaged over the run like the radii.
@@ -169,7 +169,9 @@ struct Presentation {
 // height_px, width_mm, height_mm, distance_mm, px_per_deg, and window_px, the window's size), where the photo sits (scaling, screen_px_per_photo_px,
 // photo_rect_px), the blur plan (blur_plan, r_span_screen_px) and every object on it: side, kind, source, kernel, center_px (its pose's centre), outline_px (the
 // screen polygon of its silhouette), r_camera_px, r_screen_px, r_arcmin (its PSF without the motion, 2 x the std of
-// its line-spread function, as the measurement states it), floor_sigma_screen_px and defocus_r_screen_px (its parts:
+// its line-spread function, as the measurement states it; under distortion the geometric mean of the elliptical PSF's
+// principal radii), r_x_screen_px and r_y_screen_px (the radius across a vertical and a horizontal edge: the profile
+// along x and along y), shape (the PSF's map of determinant 1, identity when round), floor_sigma_screen_px and defocus_r_screen_px (its parts:
 // r^2 = defocus_r^2 + 4 floor_sigma^2), motion_screen_px ([x, y], the streak over exposure_ms) and size_deg (the
 // outline's largest extent).
 // A picture's frame (`scene` may be null; no objects) instead: the virtual picture (rect_px, its outline before the

@@ -231,7 +231,7 @@ TrackedFramePlan PlanTrackedFrame(const TrackedTake& take, int index, const std:
     } catch (const Error& e) {
       throw Error(e.kind(), who + ": " + e.what());
     }
-    d.floor_sigma_px = calib::FloorSigmaPx(c, blur.source);
+    d.floor_sigma_px = calib::FloorSigmaPx(c, blur.source, centre);
     if (a != b && dt > 0 && blur.exposure_ms > 0) {
       const cv::Point2d pa = Project(*take.frames[size_t(a)].calib, p.object.center_board_mm);
       const cv::Point2d pb = Project(*take.frames[size_t(b)].calib, p.object.center_board_mm);
@@ -247,6 +247,7 @@ TrackedFramePlan PlanTrackedFrame(const TrackedTake& take, int index, const std:
     o.method = blur.method;
     o.r_px = d.r_px;
     o.floor_sigma_px = d.floor_sigma_px;
+    o.shape = calib::ShapeAt(c, blur.source, centre);
     o.motion_px = d.motion_px;
     plan.objects.push_back(std::move(o));
     plan.drawn.push_back(std::move(d));

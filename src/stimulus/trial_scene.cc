@@ -170,8 +170,6 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   };
   t.left = Source(trial.left, &t.left_fixed_px, [&] { return field("left"); }, presentation);
   t.right = Source(trial.right, &t.right_fixed_px, [&] { return field("right"); }, presentation);
-  t.floor_left_sigma_px = calib::FloorSigmaPx(*scene, t.left);
-  t.floor_right_sigma_px = calib::FloorSigmaPx(*scene, t.right);
   const double s = scene->board.square_mm;
   // Where the right side's object is shown, so where its radius is evaluated: its own place, or in an intervals
   // trial the left object's (IntervalScene shows each side alone there). Evaluated at its own place, a place-dependent
@@ -226,6 +224,9 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
     const cv::Vec3d l = Card(*scene, t, true).center_board_mm, r = Card(*scene, t, right_place).center_board_mm;
     t.r_left_px = r_at(l, t.left, t.left_fixed_px, "left");
     t.r_right_px = r_at(r, t.right, t.right_fixed_px, "right");
+    // The floor at each card's place (the distortion's stretch there; ObjectsAt draws the same).
+    t.floor_left_sigma_px = calib::FloorSigmaPx(*scene, t.left, scene->ToCamera(l));
+    t.floor_right_sigma_px = calib::FloorSigmaPx(*scene, t.right, scene->ToCamera(r));
     t.r_scene_px = 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, nullptr) +
                           r_at(r, calib::BlurSource::kFitted, 0, nullptr));
     CheckInPhoto(protocol, trial, *scene, t);
@@ -275,6 +276,8 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
     const cv::Vec3d r = Ball(*scene, t, y, radius, right_place).center_board_mm;
     t.r_left_px += r_at(l, t.left, t.left_fixed_px, "left") / samples;
     t.r_right_px += r_at(r, t.right, t.right_fixed_px, "right") / samples;
+    t.floor_left_sigma_px += calib::FloorSigmaPx(*scene, t.left, scene->ToCamera(l)) / samples;
+    t.floor_right_sigma_px += calib::FloorSigmaPx(*scene, t.right, scene->ToCamera(r)) / samples;
     t.r_scene_px += 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, nullptr) +
                            r_at(r, calib::BlurSource::kFitted, 0, nullptr)) / samples;
     t.motion_left_px += StreakAtPx(*scene, t, y, radius, true) / samples;
@@ -312,7 +315,9 @@ std::array<std::optional<scene::BlurredObject>, 2> ObjectsAt(const protocol::Pro
       // Rolling (onset to arrival): the streak of its velocity there over the exposure; at rest, none.
       if (t_s >= 0 && t_s < trial.MotionS()) b.motion_px = StreakAtPx(s, trial, y, protocol.content.radius_mm, left);
     }
-    b.floor_sigma_px = calib::FloorSigmaPx(s, source);
+    // The scene's floor and stretch at the object's place: its PSF is the photo's there (docs/distortion.md).
+    b.floor_sigma_px = calib::FloorSigmaPx(s, source, s.ToCamera(o.center_board_mm));
+    b.shape = calib::ShapeAt(s, source, s.ToCamera(o.center_board_mm));
     if (trial.per_pixel) {
       // The radius along the object's line of sight at each depth: the source evaluated where the pixel's surface is.
       const cv::Vec3d centre = s.ToCamera(o.center_board_mm);
