@@ -20,15 +20,16 @@ struct BlurredObject {
   double r_px = 0;
   // The scene's lens floor inside r_px (std, photo px; 0: none): a pillbox defocus is drawn convolved with it.
   double floor_sigma_px = 0;
-  // Where the photo's lens distortion stretches its blur unequally (docs/distortion.md): the map, of determinant 1, the
-  // round PSF is drawn through (calib::ShapeAt; render::Psf::shape); identity: round. r_px is then the geometric
-  // mean of the principal radii, and the radius across an edge of normal n is r_px |shape^T n|.
-  cv::Matx22d shape{1, 0, 0, 1};
   // The motion blur: where the object moves in the image during the exposure (photo px, x right, y down; 0: none).
   cv::Vec2d motion_px{0, 0};
   // The per-pixel plan: the radius (photo px) at a camera depth (mm), each pixel blurred by its own depth
   // (BlurLayerVarying); empty: r_px everywhere.
   std::function<double(double)> r_of_depth_px;
+  // Where the photo's lens distortion stretches its blur unequally (docs/distortion.md; last, so that
+  // aggregate initialisers of the fields above keep their order): the map, of determinant 1, the
+  // round PSF is drawn through (calib::ShapeAt; render::Psf::shape); identity: round. r_px is then the geometric
+  // mean of the principal radii, and the radius across an edge of normal n is r_px |shape^T n|.
+  cv::Matx22d shape{1, 0, 0, 1};
 };
 
 // Where a composed frame (the window, in screen px) shows the camera's photo: resampled in linear light with an area
