@@ -30,17 +30,24 @@ validate)
   [ -s "$W/sheet.png" ] || fail "preview wrote no sheet"
   echo "ok: video-ball-depth validates ($((MAIN + PRACTICE)) trials) and previews" ;;
 kill9)
-  # A headless simulated session killed -9 mid-way, then resumed: every planned trial answered exactly once.
-  $BC run "$PROTOCOL" --participant K1 --db "$W/s.sqlite" --observer sim --sim-fps 30 > "$W/out" 2>&1 &
+  # A headless simulated session killed -9 mid-way, then resumed: every planned trial answered exactly once. A
+  # simulated session answers a trial in milliseconds, so it runs in slices of ~2 ms between SIGSTOPs and the record
+  # is read while it is stopped: it is killed after its first answers, far from its last.
+  $BC run "$PROTOCOL" --participant K1 --db "$W/s.sqlite" --observer sim > "$W/out" 2>&1 &
   pid=$!
-  wait_for_answers "$W/s.sqlite" 1
+  kill -STOP $pid
+  for _ in $(seq 1 3000); do
+    n=$(sql "$W/s.sqlite" "SELECT count(*) FROM responses" 2>/dev/null || echo 0)
+    [ "${n:-0}" -ge 1 ] && break
+    kill -CONT $pid; sleep 0.002; kill -STOP $pid 2>/dev/null || break
+  done
   kill -9 $pid; wait $pid 2>/dev/null
   answered=$(sql "$W/s.sqlite" "SELECT count(*) FROM responses")
   [ "$answered" -ge 1 ] && [ "$answered" -lt $((MAIN + PRACTICE)) ] ||
     fail "killed after $answered answers, expected mid-session: $(tail -2 "$W/out")"
   [ "$(sql "$W/s.sqlite" "SELECT status FROM sessions")" = running ] || fail "killed: the session is not resumable"
   integrity "$W/s.sqlite"
-  $BC run "$PROTOCOL" --participant K1 --db "$W/s.sqlite" --observer sim --sim-fps 30 --resume > "$W/resume" 2>&1 ||
+  $BC run "$PROTOCOL" --participant K1 --db "$W/s.sqlite" --observer sim --resume > "$W/resume" 2>&1 ||
     fail "resume: $(tail -2 "$W/resume")"
   grep -q "$((MAIN + PRACTICE)) of $((MAIN + PRACTICE)) trials answered" "$W/resume" || fail "resume: $(tail -2 "$W/resume")"
   [ "$(sql "$W/s.sqlite" "SELECT count(*), status FROM sessions")" = "1|completed" ] || fail "not one completed session"
