@@ -2,6 +2,7 @@
 """Every chart and table of a blurcue run, and an index.html that shows them.
 
   /usr/bin/python3 analysis/report.py --trials DIR/trials.csv [--bench results/bench] --out DIR [--boot 200]
+                                      [--db RECORD.sqlite]   (the record: a video study's scene is described)
 
 Writes DIR/<chart>.png, DIR/<chart>.svg, DIR/<table>.csv and DIR/index.html (self-contained, relative links).
 Display timing reads frames.csv from trials.csv's folder (written there by `blurcue export`; missing = skipped).
