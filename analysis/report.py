@@ -2,6 +2,7 @@
 """Every chart and table of a blurcue run, and an index.html that shows them.
 
   /usr/bin/python3 analysis/report.py --trials DIR/trials.csv [--bench results/bench] --out DIR [--boot 200]
+                                      [--db RECORD.sqlite]   (the record: a video study's scene is described)
 
 Writes DIR/<chart>.png, DIR/<chart>.svg, DIR/<table>.csv and DIR/index.html (self-contained, relative links).
 Display timing reads frames.csv from trials.csv's folder (written there by `blurcue export`; missing = skipped).
@@ -29,6 +30,7 @@ import numpy as np  # noqa: E402
 import any_study  # noqa: E402
 import bench_charts  # noqa: E402
 import prediction  # noqa: E402
+import scenes  # noqa: E402
 import common  # noqa: E402
 import depth_matching  # noqa: E402
 import forced_choice  # noqa: E402
@@ -251,6 +253,21 @@ def kept_apart(trials):
 WRITE_ERRNOS = {errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.EIO}
 
 
+def video_scenes(db, trials, frames_path):
+    """(study, "scene: ...") for each study whose scene is a tracked video (scenes.py), from the record at db."""
+    if not db:
+        return []
+    bases = [os.getcwd(), os.path.join(os.getcwd(), "protocols"), os.path.dirname(os.path.abspath(db))]
+    try:
+        lines = scenes.video_scene_lines(db, trials, frames_path, bases)
+    except Exception as e:  # noqa: BLE001 - a record this code cannot read: say so, keep the report
+        say(f"{db}: the studies' scenes are not described ({type(e).__name__}: {e})")
+        return []
+    for study, line in lines:
+        say(f"scene of {study}: {line}")
+    return [(study, "scene: " + line) for study, line in lines]
+
+
 def main(argv=None):
     try:
         return _main(argv)
@@ -271,6 +288,8 @@ def _main(argv=None):
     parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--final-out", help="where --out is renamed to once complete (blurcue report builds the "
                         "folder beside its target): index.html and messages name paths there")
+    parser.add_argument("--db", help="the SQLite record trials.csv was exported from (blurcue report gives it): its "
+                        "protocols say what each study's scene was (a video's take, frames and exposure)")
     parser.add_argument("--boot", type=int, default=200, help="bootstrap samples for the psychometric band")
     parser.add_argument("--seed", type=int, default=1, help="bootstrap seed")
     parser.add_argument("--debug", action="store_true", help="let an unexpected error raise (with its traceback)")
@@ -479,6 +498,7 @@ def _main(argv=None):
         summary.append((study, f"{common.STUDY_TITLES[study]}: {int(d['answered'].sum())} of {len(d)} trials "
                                f"answered; " + thesis.get(study, "see its figures below")))
     summary += [(title[len("study "):], finding) for title, finding in findings.items()]
+    summary += video_scenes(args.db, all_trials, frames_path)
     data_sections, bench_sections = sections[:n_data_steps], sections[n_data_steps:]
     if bench_steps:
         write_index(args.out, bench_sections, [f"bench: {os.path.abspath(args.bench)}"], name="bench.html",

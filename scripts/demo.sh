@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# The main job: set up, make a ground-truth scene (the thesis's set-up), calibrate it, render stimuli from it, run
-# the thesis's test 1 and test 2 with simulated observers into an SQLite record, export the tables and write the
-# report. Everything lands in results/demo/.
+# The main job: set up, make a ground-truth scene (the thesis's set-up), calibrate it, synthesise and track a short
+# moving-camera take of it, render stimuli from it, run the thesis's test 1 and test 2 (and the studies beyond it, one
+# on the take) with simulated observers into an SQLite record, export the tables and write the report. Everything
+# lands in results/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
@@ -11,6 +12,13 @@ mkdir -p "$OUT"
 $BC synth-scene --out "$OUT/scene" --seed 7 --noise 0.004
 $BC calibrate "$OUT/scene/scene.png" --camera "$OUT/scene/camera.json" --truth "$OUT/scene/truth.json" \
     --out "$OUT/calib.json"
+# A moving camera (the thesis's future work, 6.2): a short take of the same set-up with known per-frame truth - the lens
+# focused at 340 mm, inside the board, the camera moving 40 mm closer and 30 mm sideways over 5 frames at 30 fps -
+# tracked frame by frame: the scene of the example video study (protocols/video-ball-depth.json).
+rm -rf "$OUT/take" "$OUT/track"  # a fresh take each time: no frame of an earlier, longer one left behind
+$BC synth-take --out "$OUT/take" --frames 5 --supersample 2 --noise 0.004 --seed 7 --from-u-mm 320 --to-u-mm 280 \
+    --focus-mm 340 --from-lateral-mm -15 --to-lateral-mm 15 --quiet
+$BC track "$OUT/take/take.avi" --camera "$OUT/take/camera.json" --out "$OUT/track" --quiet
 # Stimuli from that calibration: one ball at edge 9 with the estimated blur, and the moving-ball pattern 3 of the
 # thesis's Table 5.1 (estimated | none at 3 cm/s) as a video with its per-frame log.
 $BC render --calib "$OUT/calib.json" --background "$OUT/scene/scene.png" --object ball --at-edge 9 \
@@ -43,6 +51,8 @@ run staircase-ball-gain P1
 run odd-one-out-grids P1 P2
 run yes-no-ball P1 P2
 run 2ifc-grids P1 P2
+# A study on the take: two balls drawn in its frames, each frame at its own pose and blur (docs/video-studies.md).
+run video-ball-depth P1 P2 P3
 # One more test-1 session in a real window on the real clock (under Xvfb when there is no screen), answered by the
 # simulated observer: its frame timing is the report's display-timing chart.
 WINDOW=()
@@ -54,4 +64,4 @@ $BC bench render --quick --out results/bench/render.csv
 $BC bench record --trials 100 --folder results/bench   # what a power-loss-safe commit costs per answer
 $BC bench procedures --out results/bench/procedures.csv   # which adaptive procedure to choose (200 runs each, ~15 s)
 $BC report --db "$OUT/study.sqlite" --out "$OUT/report" --bench results/bench
-echo "demo: results in $OUT/ (calib.json, ball-edge9-estimated.png, pattern3.avi, study.sqlite, report/index.html)"
+echo "demo: results in $OUT/ (calib.json, ball-edge9-estimated.png, pattern3.avi, take/, track/, study.sqlite, report/index.html)"

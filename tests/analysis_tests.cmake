@@ -28,8 +28,12 @@ add_test(NAME analysis.design
 add_test(NAME analysis.tracks
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_tracks.py
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# A study on a tracked video: its scene described from a hand-made record, track.csv, trials and frames (scenes.py).
+add_test(NAME analysis.scenes
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_scenes.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(analysis.stats analysis.report analysis.bench_charts analysis.prediction analysis.design
-                     analysis.tracks PROPERTIES
+                     analysis.tracks analysis.scenes PROPERTIES
                      LABELS analysis TIMEOUT 180
                      # Matplotlib writes its font cache under HOME; keep it out of a read-only or shared home.
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")

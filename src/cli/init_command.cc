@@ -61,17 +61,30 @@ void Step(const std::string& what, std::vector<std::string> args, const fs::path
                   " holds what was made before it");
 }
 
-std::string NextSteps(const std::string& example, const std::string& study, bool synthetic) {
+// The ground-truth take a video example's study folder gets (scripts/demo.sh makes the same one for the shipped
+// protocol): the lens focused inside the board at 340 mm, the camera moving 40 mm closer and 30 mm sideways.
+const std::vector<std::string> kExampleTake = {"--frames", "5", "--supersample", "2", "--noise", "0.004",
+                                               "--from-u-mm", "320", "--to-u-mm", "280", "--focus-mm", "340",
+                                               "--from-lateral-mm", "-15", "--to-lateral-mm", "15"};
+
+std::string NextSteps(const std::string& example, const std::string& study, bool synthetic, bool video) {
   std::ostringstream s;
   s << "# " << study << "\n\n"
     << "A study folder made by `blurcue init` from the shipped example `" << example << "`.\n\n"
     << "| file | what it is |\n|---|---|\n"
     << "| `protocol.json` | the study: what each trial shows and asks (see `blurcue validate --help` and the protocol "
-       "reference, `protocols/README.md` in blurcue's share folder) |\n"
-    << "| `scene/` | the scene photo and `camera.json`" << (synthetic ? " (a ground-truth scene made by `blurcue "
-       "synth-scene`: replace it with your own photo of the printed board and `blurcue camera PHOTO` for its "
-       "camera.json)" : "") << " |\n"
-    << "| `calib.json` | the scene's blur, measured and modelled by `blurcue calibrate` |\n\n"
+       "reference, `protocols/README.md` in blurcue's share folder) |\n";
+  if (video)
+    s << "| `take/` | the video the trials are drawn on (`take.avi`, its frames and `camera.json`; a ground-truth take "
+         "made by `blurcue synth-take`: replace it with your own video of the printed board) |\n"
+      << "| `track/` | the take tracked by `blurcue track`: each frame's pose and blur (`calib-NNNN.json`, `track.csv`) "
+         "|\n\n";
+  else
+    s << "| `scene/` | the scene photo and `camera.json`" << (synthetic ? " (a ground-truth scene made by `blurcue "
+         "synth-scene`: replace it with your own photo of the printed board and `blurcue camera PHOTO` for its "
+         "camera.json)" : "") << " |\n"
+      << "| `calib.json` | the scene's blur, measured and modelled by `blurcue calibrate` |\n\n";
+  s
     << "## Next steps\n\n```sh\n"
     << "blurcue validate protocol.json                  # every problem at once, or the trial count\n"
     << "blurcue preview protocol.json --out sheet.png   # every distinct stimulus, to look at\n"
@@ -80,8 +93,11 @@ std::string NextSteps(const std::string& example, const std::string& study, bool
     << "blurcue export --db record.sqlite --out tables  # trials.csv, codebook.csv, ...\n"
     << "blurcue report --db record.sqlite --out report  # report/index.html\n"
     << "```\n\n"
-    << "With your own photo: `blurcue camera photo.jpg --out scene/camera.json`, then `blurcue calibrate photo.jpg "
-       "--camera scene/camera.json --out calib.json`, and point `scene.background` in protocol.json at the photo.\n";
+    << (video ? "With your own video: `blurcue track my.avi --camera camera.json --out track`, and point `scene.video` "
+                "and `scene.track` in protocol.json at them.\n"
+              : "With your own photo: `blurcue camera photo.jpg --out scene/camera.json`, then `blurcue calibrate "
+                "photo.jpg --camera scene/camera.json --out calib.json`, and point `scene.background` in protocol.json "
+                "at the photo.\n");
   return s.str();
 }
 
@@ -97,7 +113,8 @@ void AddInitCommand(CLI::App& app) {
       "calibration, and a README of next steps.\n"
       "Without --photo the scene is a ground-truth one made by synth-scene (the thesis's set-up; --seed), so a lab\n"
       "with no photo yet can preview and run the study; with --photo (and --camera, or the photo's EXIF) it is\n"
-      "yours. DIR must not exist or be empty: init never overwrites. Example:\n"
+      "yours. A study on a video (video-ball-depth) gets a ground-truth take instead (synth-take, tracked by\n"
+      "track: take/ and track/). DIR must not exist or be empty: init never overwrites. Example:\n"
       "  blurcue init my-study --from yes-no-ball && cd my-study && blurcue validate protocol.json\n"
       "Examples shipped (--from):" + examples);
   cmd->add_option("dir", args->dir, "the study folder to make")->required();
@@ -116,15 +133,20 @@ void AddInitCommand(CLI::App& app) {
     if (!args->camera.empty() && args->photo.empty())
       throw Error(ErrorKind::kUsage, "--camera: goes with --photo (a synthetic scene has its own camera)");
     const fs::path dir = args->dir;
+    const fs::path example = DataDir().path / "protocols" / (args->from + ".json");
+    std::string text = ReadText(example);
+    // A study on a video: its scene is a take and the track folder, made here by synth-take and track.
+    const bool video = text.find("\"video\":") != std::string::npos;
+    if (video && !args->photo.empty())
+      throw Error(ErrorKind::kUsage, "--photo: " + args->from + " is a study on a video; init makes a ground-truth "
+                                     "take for it (for your own, track it and point scene.video and scene.track at it)");
     std::error_code ec;
     if (fs::exists(dir, ec) && !(fs::is_directory(dir, ec) && fs::is_empty(dir, ec)))
       throw InputError(dir.string(), "exists and is not an empty folder; init never overwrites: name a new folder");
-    fs::create_directories(dir / "scene", ec);
+    fs::create_directories(dir / (video ? "take" : "scene"), ec);
     if (ec) throw InputError(dir.string(), "cannot make the folder: " + ec.message());
 
     // The protocol: the example's text with its demo paths pointing into this folder (relative to the protocol).
-    const fs::path example = DataDir().path / "protocols" / (args->from + ".json");
-    std::string text = ReadText(example);
     const std::string demo = "../results/demo/";
     for (size_t at = text.find(demo); at != std::string::npos; at = text.find(demo, at)) text.erase(at, demo.size());
     const bool pictures = text.find("\"pictures/") != std::string::npos;
@@ -143,7 +165,15 @@ void AddInitCommand(CLI::App& app) {
 
     const fs::path scene = dir / "scene";
     fs::path photo = scene / "scene.png";
-    if (args->photo.empty()) {
+    if (video) {
+      std::vector<std::string> synth = {"synth-take", "--out", (dir / "take").string(), "--seed",
+                                        std::to_string(args->seed), "--quiet"};
+      synth.insert(synth.end(), kExampleTake.begin(), kExampleTake.end());
+      Step("a ground-truth take (synth-take, seed " + std::to_string(args->seed) + ")", synth, dir);
+      Step("the take tracked (track)", {"track", (dir / "take" / "take.avi").string(), "--camera",
+                                        (dir / "take" / "camera.json").string(), "--out", (dir / "track").string(),
+                                        "--quiet"}, dir);
+    } else if (args->photo.empty()) {
       Step("a ground-truth scene (synth-scene, seed " + std::to_string(args->seed) + ")",
            {"synth-scene", "--out", scene.string(), "--seed", std::to_string(args->seed), "--noise", "0.004"}, dir);
     } else {
@@ -159,14 +189,15 @@ void AddInitCommand(CLI::App& app) {
       for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
         text.replace(at, from.size(), to);
     }
-    Step("calibration (calibrate)", {"calibrate", photo.string(), "--camera", (scene / "camera.json").string(),
-                                     "--out", (dir / "calib.json").string()}, dir);
+    if (!video)
+      Step("calibration (calibrate)", {"calibrate", photo.string(), "--camera", (scene / "camera.json").string(),
+                                       "--out", (dir / "calib.json").string()}, dir);
     WriteFileAtomically(dir / "protocol.json", text);
     if (pictures)
       Step("the real pictures at each distance (synth-pictures)",
            {"synth-pictures", "--protocol", (dir / "protocol.json").string(), "--out", (dir / "pictures").string()},
            dir);
-    WriteFileAtomically(dir / "README.md", NextSteps(args->from, dir.filename().string(), args->photo.empty()));
+    WriteFileAtomically(dir / "README.md", NextSteps(args->from, dir.filename().string(), args->photo.empty(), video));
     Step("validate", {"validate", (dir / "protocol.json").string()}, dir);
     std::cout << "init: " << dir.string() << " is ready; its README.md lists the next steps\n";
   });

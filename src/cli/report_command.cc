@@ -32,7 +32,9 @@ void AddReportCommand(CLI::App& app) {
       "          procedure cell over its level, or an odd one out's over the blur difference on screen (Weibull, guess\n"
       "          and lapse, bootstrap band and threshold interval; none for a preference question),\n"
       "          procedure tracks, models across participants (GLMM from three), side bias, ratings, adjusted levels;\n"
-      "          people and simulated observers apart (--pool-simulated pools them)\n"
+      "          people and simulated observers apart (--pool-simulated pools them); a study on a tracked video\n"
+      "          has its scene described in the summary: the take, its frames (its track.csv, looked for from the\n"
+      "          working folder, its protocols/ and the record's folder), the exposure and the motion streaks\n"
       "  the thesis's studies, besides:\n"
       "  depth matching: chosen cut-off vs distance per observer and pooled, with a fitted curve (thesis Fig. 3.3)\n"
       "  test 1: answers per edge (Fig. 5.2); tests 2 and 3: per pattern (Fig. 5.9, 5.13) and per section\n"
@@ -87,7 +89,7 @@ void AddReportCommand(CLI::App& app) {
                        (out / "tables").c_str());
           std::vector<std::string> argv = {args->python, script.string(), "--trials",
                                            (partial / "tables" / "trials.csv").string(), "--out", partial.string(), "--final-out", out.string(), "--boot",
-                                           std::to_string(args->boot)};
+                                           std::to_string(args->boot), "--db", args->db};
           if (bench->count() > 0) argv.insert(argv.end(), {"--bench", args->bench});
           if (args->pool_simulated) argv.push_back("--pool-simulated");
           if (args->include_aborted) argv.push_back("--include-aborted");

@@ -1,0 +1,142 @@
+"""What each study showed its objects over, as the record's protocol says: a photo, or a tracked video (a take and the
+folder `blurcue track` wrote for it). One line per study whose scene is a video, for the report's summary:
+
+  video-ball-depth: a tracked video: take ../results/demo/take/take.avi, track folder ../results/demo/track (as the
+  protocol names them); 5 frames at 30 fps (2 found, 3 tracked, 0 lost), one lens model: focus 339.6 mm, ...;
+  exposure 16.7 ms; motion streak on screen ...; frames presented per trial (frames.csv): median 2
+
+Reads the record (SQLite: the protocol text of each study's latest version), trials.csv (exposure_ms and the motion
+columns, as recorded per trial) and frames.csv (frames per trial). The record keeps a protocol's text, not where the
+protocol file was, so the take's paths (relative to the protocol) are looked for from the folders the caller gives
+(the working directory, its protocols/ folder and the record's folder); where none holds the track folder the take's
+frames are "not determined" in words.
+"""
+import csv
+import json
+import math
+import os
+import sqlite3
+
+import pandas as pd
+
+
+def latest_protocols(db_path):
+    """{study: protocol JSON (dict)} of each study's latest protocol version in the record at db_path."""
+    con = sqlite3.connect(f"file:{db_path}?mode=ro", uri=True)
+    try:
+        rows = con.execute("SELECT s.name, pv.json FROM protocol_versions pv JOIN studies s ON s.id = pv.study_id "
+                           "ORDER BY pv.id").fetchall()
+    finally:
+        con.close()
+    out = {}
+    for study, text in rows:
+        try:
+            out[study] = json.loads(text)
+        except ValueError:
+            continue  # not a protocol blurcue wrote: nothing to describe
+    return out
+
+
+def read_track(folder):
+    """track.csv of a track folder: (rows as dicts), or None when it is not there or not readable."""
+    path = os.path.join(folder, "track.csv")
+    try:
+        with open(path, newline="", encoding="utf-8") as f:
+            return list(csv.DictReader(f))
+    except (OSError, UnicodeDecodeError, csv.Error):
+        return None
+
+
+def _number(text):
+    try:
+        value = float(text)
+    except (TypeError, ValueError):
+        return math.nan
+    return value if math.isfinite(value) else math.nan
+
+
+def describe_take(track_rows):
+    """The take as track.csv gives it: frames, rate, how each was found, and the take's one lens model."""
+    n = len(track_rows)
+    statuses = [r.get("status", "") for r in track_rows]
+    counts = ", ".join(f"{statuses.count(s)} {s}" for s in ("found", "tracked", "lost"))
+    times = [_number(r.get("time_s")) for r in track_rows]
+    steps = [b - a for a, b in zip(times, times[1:]) if math.isfinite(a) and math.isfinite(b) and b > a]
+    rate = f" at {1 / (sum(steps) / len(steps)):.3g} fps" if steps else ""
+    text = f"{n} frame{'' if n == 1 else 's'}{rate} ({counts})"
+    posed = [r for r in track_rows if r.get("status") != "lost"]
+    focus = {round(_number(r.get("focus_mm")), 3) for r in posed}
+    aperture = {round(_number(r.get("aperture_mm")), 4) for r in posed}
+    if len(focus) == 1 and len(aperture) == 1 and all(math.isfinite(v) for v in focus | aperture):
+        text += f", one lens model: focus {next(iter(focus)):.1f} mm, aperture {next(iter(aperture)):.2f} mm"
+    elif focus:
+        finite = [v for v in focus if math.isfinite(v)]
+        if finite:
+            text += f", focus per frame {min(finite):.1f}-{max(finite):.1f} mm"
+    return text
+
+
+def _shown(trials, frames, study):
+    """Exposure, motion and frames per trial as the study's trials recorded them (practice left out)."""
+    d = trials[(trials["study"] == study)]
+    if "practice" in d:
+        d = d[pd.to_numeric(d["practice"], errors="coerce") != 1]
+    parts = []
+    if "exposure_ms" in d:
+        exposure = pd.to_numeric(d["exposure_ms"], errors="coerce").dropna().unique()
+        if len(exposure) == 1:
+            parts.append(f"exposure {exposure[0]:g} ms" + (" (no motion blur)" if exposure[0] == 0 else ""))
+        elif len(exposure) > 1:
+            parts.append(f"exposure {min(exposure):g}-{max(exposure):g} ms")
+    streaks = []
+    for side in ("left", "right"):
+        x, y = f"motion_{side}_x_screen_px", f"motion_{side}_y_screen_px"
+        if x in d and y in d:
+            length = (pd.to_numeric(d[x], errors="coerce") ** 2 + pd.to_numeric(d[y], errors="coerce") ** 2) ** 0.5
+            length = length.dropna()
+            if len(length):
+                streaks.append(f"{side} {length.mean():.2f} (max {length.max():.2f})")
+    if streaks:
+        parts.append("motion streak on screen, mean over trials: " + ", ".join(streaks) + " screen px")
+    if frames is not None and not frames.empty and "study" in frames:
+        f = frames[frames["study"] == study]
+        if not f.empty:
+            per_trial = f.groupby(["session_id", "trial_index"]).size()
+            parts.append(f"frames presented per trial (frames.csv): median {per_trial.median():g} "
+                         f"({per_trial.min()}-{per_trial.max()})")
+    return parts
+
+
+def read_frames(path):
+    """frames.csv (written by `blurcue export` beside trials.csv), or None."""
+    try:
+        return pd.read_csv(path) if path and os.path.exists(path) else None
+    except (OSError, ValueError):
+        return None
+
+
+def video_scene_lines(db_path, trials, frames_path=None, search_dirs=()):
+    """[(study, line)] for each study of the record whose (latest) protocol's scene is a tracked video."""
+    frames = read_frames(frames_path)
+    lines = []
+    for study, protocol in sorted(latest_protocols(db_path).items()):
+        scene = protocol.get("scene") if isinstance(protocol, dict) else None
+        if not isinstance(scene, dict) or "video" not in scene:
+            continue
+        video, track = str(scene.get("video", "")), str(scene.get("track", ""))
+        text = f"a tracked video: take {video}, track folder {track} (as the protocol names them, relative to it)"
+        found = None
+        for base in search_dirs:
+            folder = os.path.normpath(os.path.join(base, track))
+            rows = read_track(folder)
+            if rows is not None:
+                found = (folder, rows)
+                break
+        if found:
+            text += f"; the take ({found[0]}): " + describe_take(found[1])
+        else:
+            text += ("; the take's frames: not determined (the record keeps the protocol's text, not its folder, and "
+                     "no track.csv was found from " + ", ".join(search_dirs or ["here"]) + ")")
+        parts = _shown(trials, frames, study) if "study" in trials else []
+        lines.append((study, text + ("; " + "; ".join(parts) if parts else "")))
+    return lines

@@ -1,0 +1,89 @@
+"""scenes.py: a study on a tracked video described from a hand-made record, track.csv, trials and frames."""
+import json
+import os
+import shutil
+import sqlite3
+import sys
+import tempfile
+import unittest
+
+import pandas as pd
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+import scenes  # noqa: E402
+
+# Three frames 0.04 s apart (25 fps): one found, one tracked, one lost; one lens model (the lost frame has none).
+TRACK_CSV = """frame,time_s,status,reprojection_error_px,focus_mm,aperture_mm,floor_px,note
+0,0.000000,found,0.02,339.643,3.73897,0.69,""
+1,0.040000,tracked,0.03,339.643,3.73897,0.69,""
+2,0.080000,lost,,,,,"board not found"
+"""
+
+
+def make_record(path, protocols):
+    """A record with the tables scenes.py reads: studies and protocol_versions (latest version last)."""
+    con = sqlite3.connect(path)
+    con.executescript("CREATE TABLE studies (id INTEGER PRIMARY KEY, name TEXT NOT NULL UNIQUE, created TEXT);"
+                      "CREATE TABLE protocol_versions (id INTEGER PRIMARY KEY, study_id INTEGER, json TEXT, hash TEXT,"
+                      " created TEXT);")
+    for i, (study, protocol) in enumerate(protocols, start=1):
+        sid = con.execute("SELECT id FROM studies WHERE name = ?", (study,)).fetchone()
+        if sid is None:
+            sid = (con.execute("INSERT INTO studies (name, created) VALUES (?, '')", (study,)).lastrowid,)
+        con.execute("INSERT INTO protocol_versions (study_id, json, hash, created) VALUES (?, ?, ?, '')",
+                    (sid[0], json.dumps(protocol), str(i)))
+    con.commit()
+    con.close()
+
+
+class VideoSceneLines(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix="blurcue-scenes-")
+        self.addCleanup(shutil.rmtree, self.tmp, True)
+        os.makedirs(os.path.join(self.tmp, "study", "track"))
+        with open(os.path.join(self.tmp, "study", "track", "track.csv"), "w") as f:
+            f.write(TRACK_CSV)
+        self.db = os.path.join(self.tmp, "record.sqlite")
+        video = {"scene": {"video": "take/take.avi", "track": "track"}}
+        make_record(self.db, [("photo-study", {"scene": {"background": "scene.png"}}),
+                              ("video-study", {"scene": {"background": "old.png"}}),  # an earlier version
+                              ("video-study", video)])
+        # Main trials: exposure 20 ms, streaks (3, 4) -> 5 px and (0, 0) on the left, (6, 8) -> 10 px on the right;
+        # a practice trial's 100 px streak is left out.
+        self.trials = pd.DataFrame({
+            "study": ["video-study"] * 3 + ["photo-study"],
+            "practice": [0, 0, 1, 0],
+            "exposure_ms": [20, 20, 20, 0],
+            "motion_left_x_screen_px": [3, 0, 100, 0], "motion_left_y_screen_px": [4, 0, 0, 0],
+            "motion_right_x_screen_px": [6, 6, 0, 0], "motion_right_y_screen_px": [8, 8, 0, 0]})
+        self.frames = os.path.join(self.tmp, "frames.csv")
+        # Frames per trial: 3 and 5 (median 4).
+        pd.DataFrame({"study": ["video-study"] * 8, "session_id": [1] * 8,
+                      "trial_index": [0, 0, 0, 1, 1, 1, 1, 1]}).to_csv(self.frames, index=False)
+
+    def test_a_video_study_is_described_from_its_track_folder(self):
+        lines = scenes.video_scene_lines(self.db, self.trials, self.frames, [os.path.join(self.tmp, "study")])
+        self.assertEqual([study for study, _ in lines], ["video-study"])  # the photo study has no line
+        line = lines[0][1]
+        self.assertIn("a tracked video: take take/take.avi, track folder track", line)
+        self.assertIn("3 frames at 25 fps (1 found, 1 tracked, 1 lost)", line)
+        self.assertIn("one lens model: focus 339.6 mm, aperture 3.74 mm", line)
+        self.assertIn("exposure 20 ms", line)
+        self.assertIn("left 2.50 (max 5.00), right 10.00 (max 10.00) screen px", line)
+        self.assertIn("frames presented per trial (frames.csv): median 4 (3-5)", line)
+
+    def test_a_track_folder_found_nowhere_is_not_determined(self):
+        lines = scenes.video_scene_lines(self.db, self.trials, None, [os.path.join(self.tmp, "elsewhere")])
+        self.assertIn("the take's frames: not determined", lines[0][1])
+        self.assertNotIn("frames at", lines[0][1])
+
+    def test_a_focus_pull_is_a_range(self):
+        rows = [{"frame": "0", "time_s": "0", "status": "found", "focus_mm": "300"},
+                {"frame": "1", "time_s": "0.5", "status": "tracked", "focus_mm": "420.04"}]
+        self.assertEqual(scenes.describe_take(rows),
+                         "2 frames at 2 fps (1 found, 1 tracked, 0 lost), focus per frame 300.0-420.0 mm")
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)

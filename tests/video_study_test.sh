@@ -1,0 +1,131 @@
+#!/usr/bin/env bash
+# The shipped video study (protocols/video-ball-depth.json) on a small take of its own: the take (case take, the
+# fixture: synth-take + track into DIR/take and DIR/track, where the session tests' copy of the protocol points),
+# validate, a headless simulated session killed -9 and resumed, its report, and bad video scenes.
+# usage: video_study_test.sh CASE BLURCUE DIR   (DIR: the CLI tests' folder, holding protocols/ from session_protocols)
+set -uo pipefail
+BC=$2 DIR=$3
+CASE=video_$1  # session_lib.sh makes DIR/session-$CASE afresh: a folder of this script's own
+source "$(dirname "$0")/session_lib.sh"
+PROTOCOL=$P/video-ball-depth.json
+# The design worked by hand: 3 edges x 3 patterns x 2 (swap_copies) = 18 main trials, and 2 practice trials drawn
+# from them.
+MAIN=18 PRACTICE=2
+
+case $1 in
+take)
+  # 4 frames of the demo's set-up (focus inside the board, the camera moving closer and sideways), 2x supersampled.
+  rm -rf "$DIR/take" "$DIR/track"
+  $BC synth-take --out "$DIR/take" --frames 4 --supersample 2 --noise 0.004 --seed 7 --from-u-mm 320 --to-u-mm 280 \
+    --focus-mm 340 --from-lateral-mm -15 --to-lateral-mm 15 --quiet || fail "synth-take"
+  $BC track "$DIR/take/take.avi" --camera "$DIR/take/camera.json" --out "$DIR/track" --quiet || fail "track"
+  [ "$(($(wc -l < "$DIR/track/track.csv") - 1))" = 4 ] || fail "track.csv: $(cat "$DIR/track/track.csv")"
+  echo "ok: a 4-frame take in $DIR/take, tracked into $DIR/track" ;;
+validate)
+  $BC validate "$PROTOCOL" > "$W/out" 2>&1 || fail "validate: $(cat "$W/out")"
+  grep -q "^ok: $((MAIN + PRACTICE)) trials for participant P1" "$W/out" || fail "validate: $(cat "$W/out")"
+  grep -q "practice $PRACTICE, main $MAIN (forced_choice, swap_copies)" "$W/out" || fail "validate: $(cat "$W/out")"
+  $BC preview "$PROTOCOL" --out "$W/sheet.png" > "$W/preview" 2>&1 || fail "preview: $(cat "$W/preview")"
+  grep -q "$MAIN distinct stimuli of $((MAIN + PRACTICE)) trials" "$W/preview" || fail "preview: $(cat "$W/preview")"
+  [ -s "$W/sheet.png" ] || fail "preview wrote no sheet"
+  echo "ok: video-ball-depth validates ($((MAIN + PRACTICE)) trials) and previews" ;;
+kill9)
+  # A headless simulated session killed -9 mid-way, then resumed: every planned trial answered exactly once. A
+  # simulated session answers a trial in milliseconds, so it runs in slices of ~2 ms between SIGSTOPs and the record
+  # is read while it is stopped: it is killed after its first answers, far from its last.
+  $BC run "$PROTOCOL" --participant K1 --db "$W/s.sqlite" --observer sim > "$W/out" 2>&1 &
+  pid=$!
+  kill -STOP $pid
+  for _ in $(seq 1 3000); do
+    n=$(sql "$W/s.sqlite" "SELECT count(*) FROM responses" 2>/dev/null || echo 0)
+    [ "${n:-0}" -ge 1 ] && break
+    kill -CONT $pid; sleep 0.002; kill -STOP $pid 2>/dev/null || break
+  done
+  kill -9 $pid; wait $pid 2>/dev/null
+  answered=$(sql "$W/s.sqlite" "SELECT count(*) FROM responses")
+  [ "$answered" -ge 1 ] && [ "$answered" -lt $((MAIN + PRACTICE)) ] ||
+    fail "killed after $answered answers, expected mid-session: $(tail -2 "$W/out")"
+  [ "$(sql "$W/s.sqlite" "SELECT status FROM sessions")" = running ] || fail "killed: the session is not resumable"
+  integrity "$W/s.sqlite"
+  $BC run "$PROTOCOL" --participant K1 --db "$W/s.sqlite" --observer sim --resume > "$W/resume" 2>&1 ||
+    fail "resume: $(tail -2 "$W/resume")"
+  grep -q "$((MAIN + PRACTICE)) of $((MAIN + PRACTICE)) trials answered" "$W/resume" || fail "resume: $(tail -2 "$W/resume")"
+  [ "$(sql "$W/s.sqlite" "SELECT count(*), status FROM sessions")" = "1|completed" ] || fail "not one completed session"
+  # One trial row per planned trial, indices 0..19, each answered once.
+  [ "$(sql "$W/s.sqlite" "SELECT count(*), count(DISTINCT trial_index), min(trial_index), max(trial_index) FROM trials")" \
+    = "$((MAIN + PRACTICE))|$((MAIN + PRACTICE))|0|$((MAIN + PRACTICE - 1))" ] || fail "trials: $(sql "$W/s.sqlite" \
+    "SELECT count(*), count(DISTINCT trial_index) FROM trials")"
+  [ "$(sql "$W/s.sqlite" "SELECT count(*), count(DISTINCT trial_id) FROM responses")" = \
+    "$((MAIN + PRACTICE))|$((MAIN + PRACTICE))" ] || fail "responses: not one per trial"
+  # The main trials are the design's crossing, each once: 3 edges x 3 patterns x swapped 0/1.
+  sql "$W/s.sqlite" "SELECT json_extract(factors, '$.edge'), json_extract(factors, '$.pattern.id'),
+                      json_extract(factors, '$.swapped') FROM trials WHERE json_extract(factors, '$.practice') = 0" |
+    sort > "$W/main"
+  for e in 3 6 9; do for p in 1 2 3; do for s in 0 1; do echo "$e|$p|$s"; done; done; done | sort > "$W/planned"
+  diff "$W/planned" "$W/main" > "$W/diff" || fail "main trials are not the design's crossing once each: $(cat "$W/diff")"
+  integrity "$W/s.sqlite"
+  echo "ok: killed -9 after $answered answers, resumed: $((MAIN + PRACTICE)) planned trials, each answered once" ;;
+report)
+  # Three simulated observers, then the report (from DIR, so the take's track folder is found as the protocols see it).
+  for id in R1 R2 R3; do
+    $BC run "$PROTOCOL" --participant $id --db "$W/s.sqlite" --observer sim > /dev/null 2>&1 || fail "run $id"
+  done
+  (cd "$DIR" && MPLCONFIGDIR=$W/mpl $BC report --db "$W/s.sqlite" --out "$W/report" --bench "$W/no-bench" --boot 20) \
+    > "$W/out" 2> "$W/err" || fail "report exit $?: $(tail -3 "$W/err")"
+  if grep -q "Traceback" "$W/err"; then fail "report: $(cat "$W/err")"; fi
+  index=$W/report/index.html
+  grep -q "study video-ball-depth" "$index" || fail "the report has no section for video-ball-depth"
+  # Analysed as any forced choice: its conditions (edge x pattern), 3 participants.
+  grep -q "video-ball-depth-simulated-conditions" "$index" || fail "no conditions table for video-ball-depth"
+  grep -q "3 participants" "$index" || fail "the report does not count 3 participants"
+  # Its scene is described as a video: the take as the protocol names it, its 4 frames at 30 fps (the fixture's, by
+  # construction) and the protocol's 16.7 ms exposure.
+  grep -q "scene: a tracked video: take ../take/take.avi, track folder ../track" "$index" ||
+    fail "the report does not describe the scene as a video: $(grep -o 'scene: [^<]*' "$index")"
+  grep -q "4 frames at 30 fps" "$index" || fail "the take's frames: $(grep -o 'scene: [^<]*' "$index")"
+  grep -q "exposure 16.7 ms" "$index" || fail "the exposure: $(grep -o 'scene: [^<]*' "$index")"
+  echo "ok: the report analyses video-ball-depth and describes its scene: $(grep -o 'scene: [^<;]*' "$index")" ;;
+bad_scene)
+  # One problem, exit 3, naming the field: a missing take, a take of another frame size than its track folder's,
+  # an unknown key.
+  expect() {  # expect NAME FIELD TEXT: validate and run W/NAME.json
+    for cmd in validate run; do
+      local args=()
+      [ $cmd = run ] && args=(--participant B1 --db "$W/$1.sqlite" --observer sim)
+      $BC $cmd "$W/$1.json" "${args[@]}" > "$W/$1.out" 2> "$W/$1.err"
+      local code=$?
+      [ $code = 3 ] || fail "$cmd $1: exit $code, expected 3: $(cat "$W/$1.err")"
+      [ "$(grep -c "$1.json: " "$W/$1.err")" = 1 ] || fail "$cmd $1: not one problem: $(cat "$W/$1.err")"
+      grep -q "$1.json: $2: .*$3" "$W/$1.err" || fail "$cmd $1: expected '$2: ...$3': $(cat "$W/$1.err")"
+      if grep -q "Traceback\|terminate\|Aborted" "$W/$1.err"; then fail "$cmd $1: $(cat "$W/$1.err")"; fi
+    done
+  }
+  edit() {  # edit NAME PYTHON: W/NAME.json from the shipped protocol's copy, with p (the JSON) changed by PYTHON
+    $PY - "$PROTOCOL" "$W/$1.json" "$DIR" "$2" <<'PYEOF'
+import json, os, sys
+p = json.load(open(sys.argv[1]))
+d = sys.argv[3]
+p["scene"] = {"video": os.path.join(d, "take", "take.avi"), "track": os.path.join(d, "track")}
+exec(sys.argv[4])
+json.dump(p, open(sys.argv[2], "w"), indent=1)
+PYEOF
+  }
+  edit missing 'p["scene"]["video"] = os.path.join(d, "take", "tkae.avi")'
+  expect missing /scene/video "no such file"
+  # The take's frames at half size with the 1148 x 764 take's track folder.
+  $PY - "$DIR/take" "$W/half" <<'PYEOF' || fail "could not write the half-size frames"
+import glob, os, sys
+from PIL import Image
+os.makedirs(sys.argv[2], exist_ok=True)
+for f in sorted(glob.glob(os.path.join(sys.argv[1], "frame-*.png"))):
+    im = Image.open(f)
+    im.resize((im.width // 2, im.height // 2)).save(os.path.join(sys.argv[2], os.path.basename(f)))
+PYEOF
+  edit other_size "p['scene']['video'] = '$W/half/frame-%04d.png'"
+  expect other_size /scene/video "is 574x382 but the scene was calibrated on 1148x764 (.*track is the track of another take)"
+  edit unknown_key 'p["scene"]["tracks"] = p["scene"]["track"]'
+  expect unknown_key /scene/tracks 'unknown key (did you mean "track"?)'
+  echo "ok: a missing take, a take of another size than its track, an unknown key: one problem each, exit 3" ;;
+*)
+  fail "unknown case $1" ;;
+esac
