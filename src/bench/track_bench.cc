@@ -144,9 +144,10 @@ std::vector<TrackRow> RunTrackBench(const TrackBenchOptions& options) {
 
   std::vector<TrackRow> rows;
   std::vector<std::optional<calib::CalibResult>> calibrated(frames);  // the in-process calibrate's, per frame
-  for (const std::string mode : {"track", "detect", "calibrate"}) {
+  for (const std::string mode : {"track", "track-serial", "detect", "calibrate"}) {
     track::TrackOptions to;
     to.always_detect = mode == "detect";
+    to.calibrate.parallel_sections = mode != "track-serial";
     track::Tracker tracker(camera, board, to);
     std::vector<track::FrameResult> results;
     std::vector<TrackRow> mode_rows;
@@ -273,7 +274,7 @@ std::string SummarizeTrackBench(const std::vector<TrackRow>& rows) {
   std::snprintf(line, sizeof line, "%-17s %6s %9s %9s %9s %9s %9s %12s %11s %11s\n", "mode", "frames", "median_ms", "cpu_ms",
                 "p90_ms", "pose_ms", "meas_ms", "depth_err_%", "r_med_err_%", "r_p90_err_%");
   out << line;
-  for (const std::string mode : {"track", "detect", "calibrate", "calibrate-process"}) {
+  for (const std::string mode : {"track", "track-serial", "detect", "calibrate", "calibrate-process"}) {
     const auto& g = by_mode[mode];
     if (g.empty()) continue;
     std::vector<double> ms, pose, meas, depth, rmed, rp90;
