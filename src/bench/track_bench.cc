@@ -1,5 +1,8 @@
 #include "bench/track_bench.h"
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -7,17 +10,8 @@
 #include <ctime>
 #include <map>
 #include <optional>
-#include <sstream>
-
-#include <sys/prctl.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <csignal>
-#include <cstring>
 #include <fstream>
+#include <sstream>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -27,6 +21,7 @@
 #include "core/data_dir.h"
 #include "core/error.h"
 #include "core/json_io.h"
+#include "core/process.h"
 #include "synth/take.h"
 #include "track/tracker.h"
 
@@ -69,34 +64,6 @@ void Score(TrackRow& row, const calib::CalibResult& c, const synth::Scene& truth
       const double u = truth.sections[k++].u_mm;
       row.max_depth_error_rel = std::max(row.max_depth_error_rel, std::abs(s.u_mm - u) / u);
     }
-}
-
-// A whole command as an experimenter runs it: started, waited for; its wall time and its own CPU time (user +
-// system, from the kernel's accounting of the finished child). Returns the exit status (-1: killed by a signal).
-int RunTimed(const std::vector<std::string>& argv, double* wall_ms, double* cpu_ms) {
-  std::vector<char*> args;
-  for (const auto& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
-  args.push_back(nullptr);
-  const pid_t parent = getpid();
-  std::fflush(stdout);
-  std::fflush(stderr);
-  const auto t0 = Clock::now();
-  const pid_t child = fork();
-  if (child < 0) throw Error(ErrorKind::kInternal, "cannot start " + argv[0] + ": " + std::strerror(errno));
-  if (child == 0) {
-    // The child dies with the bench (as cli::RunChild's do).
-    if (prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || getppid() != parent) _exit(126);
-    execv(args[0], args.data());
-    _exit(127);
-  }
-  int status = 0;
-  rusage usage{};
-  while (wait4(child, &status, 0, &usage) < 0)
-    if (errno != EINTR) throw Error(ErrorKind::kInternal, "cannot wait for " + argv[0] + ": " + std::strerror(errno));
-  *wall_ms = Ms(t0);
-  auto ms = [](const timeval& t) { return t.tv_sec * 1e3 + t.tv_usec * 1e-3; };
-  *cpu_ms = ms(usage.ru_utime) + ms(usage.ru_stime);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 // Whether the command's calib.json holds the in-process calibration's sections (depth and r_px, exactly: JSON keeps
@@ -221,10 +188,13 @@ std::vector<TrackRow> RunTrackBench(const TrackBenchOptions& options) {
     TrackRow row = *in_process.at(i);  // accuracy: the in-process calibration's, when the command wrote the same
     row.mode = "calibrate-process";
     row.pose_ms = row.measure_ms = row.decode_ms = 0;  // not seen from outside the process
-    const int code = RunTimed({exe.string(), "calibrate", png_path.string(), "--camera", (dir / "camera.json").string(),
+    ProcessTimes times;
+    const int status = RunProcess({exe.string(), "calibrate", png_path.string(), "--camera", (dir / "camera.json").string(),
                                "--board", std::to_string(board.cols) + "x" + std::to_string(board.rows), "--square-mm",
                                std::to_string(board.square_mm), "--out", out.string(), "--quiet"},
-                              &row.frame_ms, &row.cpu_ms);
+                              &times);
+    row.frame_ms = times.wall_ms, row.cpu_ms = times.cpu_ms;
+    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     row.status = code == 0 ? "found" : "lost";
     // A command that failed, or wrote other numbers than the library gave in this process, has no accuracy here.
     const bool same = code == 0 && calibrated[i] && SameSections(out, *calibrated[i]);
