@@ -1,5 +1,6 @@
 """Chart of `blurcue bench track` (results/bench/track.csv): time per frame against accuracy for tracking, full
-detection on every frame and calibrate on every frame.
+detection on every frame, calibrate on every frame in the same process, and `blurcue calibrate` run as a command
+on every frame (calibrate-process; its accuracy is the in-process calibrate's, NaN where its numbers differed).
 
   left    wall time per frame (ms, log) against the frame's median |error| / r of the measured r_px, one point per
           frame, one colour per mode; the 33 ms line (a 30 fps camera)
@@ -18,7 +19,7 @@ import pandas as pd
 from common import save
 
 COLUMNS = ["mode", "frame", "status", "frame_ms", "cpu_ms", "max_depth_error_rel", "r_median_rel_error"]
-COLORS = {"track": "#0072B2", "detect": "#E69F00", "calibrate": "#D55E00"}
+COLORS = {"track": "#0072B2", "track-serial": "#56B4E9", "detect": "#E69F00", "calibrate": "#D55E00", "calibrate-process": "#CC79A7"}
 FRAME_BUDGET_MS = 1000 / 30
 DEPTH_TARGET = 0.001
 

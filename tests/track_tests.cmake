@@ -3,11 +3,12 @@
 add_test(NAME track_cli COMMAND bash ${PROJECT_SOURCE_DIR}/tests/track_test.sh $<TARGET_FILE:blurcue>
                                 ${PROJECT_BINARY_DIR}/track-test)
 set_tests_properties(track_cli PROPERTIES PASS_REGULAR_EXPRESSION "^ok:|\nok:")
-# The track bench on 4 frames writes one row per (mode, frame) and says the targets in words; its chart is drawn.
+# The track bench on 4 frames writes one row per (mode, frame) - track, track-serial, detect, calibrate in process and
+# calibrate run as a command - and says the targets and the measured ratio in words; its chart is drawn.
 add_test(NAME cli_bench_track_quick
          COMMAND $<TARGET_FILE:blurcue> bench track --quick --out ${PROJECT_BINARY_DIR}/track-bench/track.csv)
 set_tests_properties(cli_bench_track_quick PROPERTIES LABELS slow FIXTURES_SETUP track_bench
-                     PASS_REGULAR_EXPRESSION "wrote .*track.csv \\(12 rows\\).*track +4 .*\\(3 tracked\\).*track: median [0-9.]+ ms a frame wall")
+                     PASS_REGULAR_EXPRESSION "wrote .*track.csv \\(20 rows\\).*track +4 .*\\(3 tracked\\).*calibrate-process +4 .*track: median [0-9.]+ ms a frame wall.*track vs calibrate run as a command on each frame: [0-9.]+x faster")
 add_test(NAME cli_bench_track_chart
          COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/analysis/track_chart.py
                  ${PROJECT_BINARY_DIR}/track-bench/track.csv ${PROJECT_BINARY_DIR}/track-bench)

@@ -9,7 +9,12 @@
 namespace blurcue::bench {
 
 struct TrackRow {
-  std::string mode;        // "track" (carried pose), "detect" (full detection every frame), "calibrate" (calib::Calibrate)
+  // "track" (carried pose), "track-serial" (the same, its sections measured one after another on one core),
+  // "detect" (full detection every frame), "calibrate" (calib::Calibrate in this process),
+  // "calibrate-process" (`blurcue calibrate` run as a command on the frame's PNG: start-up, decode, calib.json
+  // written; wall and the child's CPU time; its accuracy is the in-process calibrate's when it wrote the same
+  // sections, NaN otherwise)
+  std::string mode;
   int frame = 0;
   std::string status;      // found | tracked | lost (calibrate: found | lost)
   double frame_ms = 0;     // the frame's work, decoding excluded (the PNG decode is timed apart: decode_ms)

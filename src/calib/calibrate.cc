@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/distortion.h"
@@ -29,19 +30,36 @@ double Median(std::vector<double> v) {
 }  // namespace
 
 cv::Mat LinearGrey(const cv::Mat& photo) {
+  cv::Mat linear;
+  LinearGrey(photo, linear);
+  return linear;
+}
+
+void LinearGrey(const cv::Mat& photo, cv::Mat& linear) {
   CV_Assert(photo.depth() == CV_8U);
-  if (photo.channels() == 1) return DecodeSrgb8(photo);
   // One fused pass (decode each channel by table, then mix with Rec. 601 weights as cv::cvtColor does): a 14 MP
   // photo never becomes a 3-channel float image, which alone took most of a second.
   const std::array<float, 256>& lut = SrgbDecodeTable();
   const int step = photo.channels();
-  cv::Mat grey(photo.size(), CV_32F);
-  for (int y = 0; y < photo.rows; ++y) {
-    const uint8_t* p = photo.ptr<uint8_t>(y);
-    float* g = grey.ptr<float>(y);
-    for (int x = 0; x < photo.cols; ++x, p += step) g[x] = 0.114f * lut[p[0]] + 0.587f * lut[p[1]] + 0.299f * lut[p[2]];
-  }
-  return grey;
+  linear.create(photo.size(), CV_32F);
+  // Rows are independent: split among the cores (a video frame's few milliseconds matter in `track`).
+  cv::parallel_for_(cv::Range(0, photo.rows), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      const uint8_t* p = photo.ptr<uint8_t>(y);
+      float* g = linear.ptr<float>(y);
+      if (step == 1) {
+        for (int x = 0; x < photo.cols; ++x) g[x] = lut[p[x]];
+      } else {
+        for (int x = 0; x < photo.cols; ++x, p += step)
+          g[x] = 0.114f * lut[p[0]] + 0.587f * lut[p[1]] + 0.299f * lut[p[2]];
+      }
+    }
+  }, 8);
+}
+
+void PhotoPlanes::Fill(const cv::Mat& photo) {
+  ToGrey8(photo, grey8);
+  LinearGrey(photo, linear);
 }
 
 std::vector<optics::BlurSample> ModelSamples(const CalibResult& result) {
@@ -67,6 +85,14 @@ void ApplyModel(CalibResult& result, const optics::FittedModel& model) {
 
 CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& board,
                       const CalibrateOptions& options) {
+  PhotoPlanes planes;
+  planes.Fill(photo);
+  return Calibrate(planes, camera, board, options);
+}
+
+CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Board& board,
+                      const CalibrateOptions& options) {
+  const cv::Mat& photo = planes.grey8;
   if (photo.cols != camera.image_width_px || photo.rows != camera.image_height_px)
     throw InputError("camera /image_width_px, /image_height_px",
                      "say " + std::to_string(camera.image_width_px) + "x" + std::to_string(camera.image_height_px) +
@@ -80,13 +106,13 @@ CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& b
   result.reference_edge = options.reference_edge;
 
   auto t0 = std::chrono::steady_clock::now();
-  const cv::Mat grey8 = ToGrey8(photo);
+  const cv::Mat& grey8 = planes.grey8;
   result.pose = options.known_pose ? *options.known_pose : FindBoardPose(grey8, camera, board, options.detect);
   result.detect_ms = MsSince(t0);
 
   // Geometry of every section: end points in the photo and 3-D midpoint.
   t0 = std::chrono::steady_clock::now();
-  const cv::Mat linear = LinearGrey(photo);
+  const cv::Mat& linear = planes.linear;
   const int E = board.EdgeCount(), S = board.SectionCount();
   std::vector<std::array<double, 3>> points;  // per section: start, end, midpoint
   for (int e = 1; e <= E; ++e)
@@ -129,12 +155,22 @@ CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& b
         const double len = cv::norm(chord);
         if (len > 0) sec.segment.bow_px = (m - 0.5 * (px[i] + px[i + 1])).dot(cv::Point2d(-chord.y, chord.x) / len);
       }
-      sec.fit = MeasureEdgeModel(linear, sec.segment, options.model_fit);
-      sec.thesis = MeasureEdgeThesis(grey8, sec.segment, options.thesis);
       edge.sections.push_back(sec);
     }
     result.edges.push_back(std::move(edge));
   }
+  // Each section's measurement reads the photo and writes only its own result, so measured on every core (OpenCV's
+  // thread pool, made once per process) the numbers are the serial ones; one stripe a section balances their
+  // unequal costs.
+  auto measure = [&](const cv::Range& range) {
+    for (int k = range.start; k < range.end; ++k) {
+      SectionResult& sec = result.edges[k / S].sections[k % S];
+      sec.fit = MeasureEdgeModel(linear, sec.segment, options.model_fit);
+      sec.thesis = MeasureEdgeThesis(grey8, sec.segment, options.thesis);
+    }
+  };
+  if (options.parallel_sections) cv::parallel_for_(cv::Range(0, E * S), measure, E * S);
+  else measure(cv::Range(0, E * S));
   result.measure_ms = MsSince(t0);
 
   // Estimation: eq. 3.7 from the reference edge, and a thin-lens model fitted to every usable section.

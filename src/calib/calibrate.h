@@ -26,6 +26,8 @@ struct CalibrateOptions {
   optics::FitOptions optics_fit;
   // Skip detection and use this pose (benchmarks: to measure blur where detection breaks first).
   std::optional<BoardPose> known_pose;
+  // The sections measured on every core (false: one after another; the numbers are the same either way).
+  bool parallel_sections = true;
 };
 
 struct SectionResult {
@@ -68,10 +70,22 @@ struct CalibResult {
 // Linear-light grey of an 8-bit sRGB photo: each channel decoded first, then mixed (mixing encoded values would
 // bend edges). CV_32F, one channel.
 cv::Mat LinearGrey(const cv::Mat& photo);
+// The same into `linear`, whose buffer is reused when it has the size already (a video's frames).
+void LinearGrey(const cv::Mat& photo, cv::Mat& linear);
+
+// A photo's two working images: the 8-bit grey as stored (detection, corners, the thesis's method) and the
+// linear-light grey (the model fit). A tracker keeps one and refills it every frame, so a take allocates them once.
+struct PhotoPlanes {
+  cv::Mat grey8, linear;
+  void Fill(const cv::Mat& photo);  // 8-bit BGR, BGRA or grey sRGB
+};
 
 // `photo` is 8-bit BGR or grey sRGB as read from disk. Throws Error(kInput) when the photo's size differs from
 // the camera's, Error(kNotFound) when no board is found or the reference edge has no usable section.
 CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& board,
+                      const CalibrateOptions& options = {});
+// The same on a photo's planes made already (PhotoPlanes::Fill).
+CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Board& board,
                       const CalibrateOptions& options = {});
 
 // The usable sections as the thin-lens model's samples: depth and r_px / stretch (ideal px), so a distorted photo's

@@ -10,6 +10,8 @@
 #include <string>
 #include <cstdio>
 
+#include <opencv2/core/utility.hpp>
+
 #include "calib/scene_blur.h"
 #include "calib/truth.h"
 #include "core/error.h"
@@ -73,6 +75,45 @@ TEST(Calibrate, PoseWithinOneMillimetreAndHalfDegree) {
   EXPECT_LT(r.cmp.rotation_error_deg, 0.5);
   EXPECT_LT(r.cmp.max_depth_error_mm, 1.0);
   EXPECT_LT(r.result.pose.reprojection_error_px, 0.5);
+}
+
+// The sections measured on every core must give the numbers measured one after another, bit for bit: two orders of
+// the same computation, on rendered photos with noise (sharp and blurred edges, a distorted lens: bowed sections).
+TEST(Calibrate, ParallelSectionsGiveTheSerialNumbers) {
+  std::printf("OpenCV threads: %d\n", cv::getNumThreads());
+  synth::SceneOptions distorted = Thesis();
+  distorted.camera.dist_coeffs = {-0.12, 0, 0, 0, 0};
+  for (const synth::SceneOptions& o : {Thesis(), Blurry(), distorted}) {
+    const synth::Scene& scene = Rendered(o);
+    CalibrateOptions serial, parallel;
+    serial.parallel_sections = false;
+    parallel.parallel_sections = true;
+    const CalibResult a = Calibrate(scene.image, scene.camera, scene.board, serial);
+    const CalibResult b = Calibrate(scene.image, scene.camera, scene.board, parallel);
+    ASSERT_EQ(a.edges.size(), b.edges.size());
+    int usable = 0;
+    for (size_t e = 0; e < a.edges.size(); ++e)
+      for (size_t k = 0; k < a.edges[e].sections.size(); ++k) {
+        const SectionResult &x = a.edges[e].sections[k], &y = b.edges[e].sections[k];
+        SCOPED_TRACE("edge " + std::to_string(x.edge) + " section " + std::to_string(x.section));
+        EXPECT_EQ(x.fit.ok, y.fit.ok);
+        EXPECT_EQ(x.fit.flags, y.fit.flags);
+        EXPECT_EQ(x.fit.r_px, y.fit.r_px);
+        EXPECT_EQ(x.fit.disc_r_px, y.fit.disc_r_px);
+        EXPECT_EQ(x.fit.floor_sigma_px, y.fit.floor_sigma_px);
+        EXPECT_EQ(x.fit.offset_px, y.fit.offset_px);
+        EXPECT_EQ(x.fit.step, y.fit.step);
+        EXPECT_EQ(x.fit.rms_rel, y.fit.rms_rel);
+        EXPECT_EQ(x.fit.samples, y.fit.samples);
+        EXPECT_EQ(x.thesis.r_px, y.thesis.r_px);
+        EXPECT_EQ(x.r_fitted_px, y.r_fitted_px);
+        usable += x.fit.ok;
+      }
+    EXPECT_GT(usable, 60);  // the comparison covers real fits, not 77 flagged sections
+    EXPECT_EQ(a.model.focus_mm, b.model.focus_mm);
+    EXPECT_EQ(a.model.aperture_mm, b.model.aperture_mm);
+    EXPECT_EQ(a.reference_r_px, b.reference_r_px);
+  }
 }
 
 TEST(Calibrate, ElevenEdgesOfSevenSectionsNearestFirst) {

@@ -1,6 +1,5 @@
 #include "cli/child.h"
 
-#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -10,32 +9,12 @@
 #include <cstring>
 
 #include "core/error.h"
+#include "core/process.h"
 #include "core/typed.h"
 
 namespace blurcue::cli {
 
-int RunChild(const std::vector<std::string>& argv) {
-  std::vector<char*> args;
-  for (const auto& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
-  args.push_back(nullptr);
-  const pid_t parent = getpid();
-  std::fflush(stdout);
-  std::fflush(stderr);
-  const pid_t child = fork();
-  if (child < 0) throw Error(ErrorKind::kInternal, "cannot start " + argv[0] + ": " + std::strerror(errno));
-  if (child == 0) {
-    // Only async-signal-safe calls here. PR_SET_PDEATHSIG sends SIGKILL when the parent dies; a parent that died
-    // before the prctl took effect is caught by getppid() no longer being it.
-    if (prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || getppid() != parent) _exit(126);
-    execvp(args[0], args.data());
-    _exit(127);
-  }
-  int status = 0;
-  while (waitpid(child, &status, 0) < 0) {
-    if (errno != EINTR) throw Error(ErrorKind::kInternal, "cannot wait for " + argv[0] + ": " + std::strerror(errno));
-  }
-  return status;
-}
+int RunChild(const std::vector<std::string>& argv) { return RunProcess(argv); }
 
 void RunAnalysis(const std::vector<std::string>& argv, const std::string& what, const std::string& unchanged,
                  const std::vector<std::string>& promised) {

@@ -251,10 +251,17 @@ cv::Mat ResampleSrgb8(const cv::Mat& srgb8, cv::Size size) {
 }
 
 cv::Mat ToGrey8(const cv::Mat& image) {
-  if (image.channels() == 1) return image;
   cv::Mat grey;
-  cv::cvtColor(image, grey, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+  ToGrey8(image, grey);
   return grey;
+}
+
+void ToGrey8(const cv::Mat& image, cv::Mat& grey) {
+  if (image.channels() == 1) {
+    grey = image;
+    return;
+  }
+  cv::cvtColor(image, grey, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
 }
 
 const char* OpenLosslessVideo(cv::VideoWriter& video, const std::filesystem::path& path, double fps, cv::Size size) {

@@ -32,5 +32,7 @@ cv::Mat EncodeSrgb8(const cv::Mat& linear);
 cv::Mat ResampleSrgb8(const cv::Mat& srgb8, cv::Size size);
 // 8-bit BGR/BGRA/grey -> one-channel 8-bit grey (as stored: gamma-encoded).
 cv::Mat ToGrey8(const cv::Mat& image);
+// The same into `grey`, whose buffer is reused when it has the size already (a video's frames).
+void ToGrey8(const cv::Mat& image, cv::Mat& grey);
 
 }  // namespace blurcue

@@ -96,7 +96,10 @@ FrameResult Tracker::Process(const cv::Mat& photo, int index, double time_s) {
     throw InputError("frame " + std::to_string(index),
                      "is " + std::to_string(photo.cols) + "x" + std::to_string(photo.rows) + " but the camera says " +
                          std::to_string(camera_.image_width_px) + "x" + std::to_string(camera_.image_height_px));
-  const cv::Mat grey8 = ToGrey8(photo);
+  // The frame's grey and linear-light planes, once, into the buffers of the previous frame: tracking, detection and
+  // the measurement all read them.
+  planes_.Fill(photo);
+  const cv::Mat& grey8 = planes_.grey8;
   cv::Mat small;
   if (!options_.always_detect) {
     cv::resize(grey8, small, cv::Size(), 1.0 / kSmallFactor, 1.0 / kSmallFactor, cv::INTER_AREA);
@@ -130,7 +133,7 @@ FrameResult Tracker::Process(const cv::Mat& photo, int index, double time_s) {
   calib::CalibrateOptions options = options_.calibrate;
   options.known_pose = *pose;
   try {
-    r.calib = calib::Calibrate(photo, camera_, board_, options);
+    r.calib = calib::Calibrate(planes_, camera_, board_, options);
     r.calib->detect_ms = r.pose_ms;
   } catch (const Error& e) {
     // The board is there but its blur is not measurable (the reference edge or the whole board flagged).

@@ -52,6 +52,7 @@ class Tracker {
   TrackOptions options_;
   std::vector<cv::Point2f> last_, before_last_;  // corners of the last two frames with a pose (empty: none)
   cv::Mat last_small_;  // the last frame with a pose, a quarter size, float: its shift to the next one
+  calib::PhotoPlanes planes_;  // the frame's grey and linear planes; their buffers serve the whole take
 };
 
 // The take's one lens model (fixed focus and aperture): the thin-lens fit to every usable section of every frame
