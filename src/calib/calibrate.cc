@@ -236,7 +236,9 @@ Json CalibToJson(const CalibResult& r) {
       {"rule", optics::kModelChoiceRule},
       {"thin_lens", {{"rms_px", m.thin_rms_px}, {"loo_rms_px", m.thin_loo_rms_px}}},
       {"thin_lens+floor", {{"rms_px", number_or_note(m.floor_rms_px)}, {"loo_rms_px", number_or_note(m.floor_loo_rms_px)},
-                           {"floor_px", number_or_note(m.floor_candidate_px)}}},
+                           {"floor_px", number_or_note(m.floor_candidate_px)},
+                           {"floor_range_px", std::isfinite(m.floor_lo_px) ? Json::array({m.floor_lo_px, m.floor_hi_px})
+                                                                            : Json("not determined (not fitted)")}}},
       {"eq37", {{"rms_px", eq37_n > 0 ? Json(std::sqrt(eq37_sum / eq37_n)) : Json("not determined (no section)")},
                 {"sections", eq37_n},
                 {"note", "eq. 3.7 as published, from the reference edge; no parameters fitted, error against the "
@@ -252,7 +254,9 @@ Json CalibToJson(const CalibResult& r) {
       {"reference_edge", r.reference_edge},
       {"reference", {{"u_mm", r.reference_u_mm}, {"r_px", r.reference_r_px}}},
       {"model", {{"kind", m.kind}, {"focus_mm", std::isinf(m.focus_mm) ? Json("infinity") : Json(m.focus_mm)},
-                 {"aperture_mm", m.aperture_mm}, {"floor_px", m.floor_px}, {"rms_px", m.rms_px},
+                 {"aperture_mm", m.aperture_mm}, {"floor_px", m.floor_px},
+                 // floor_px stays a number (the model predicts with it); whether the sections pin it is said here.
+                 {"floor_determined", m.floor_determined}, {"rms_px", m.rms_px},
                  {"loo_rms_px", m.loo_rms_px}, {"samples_used", m.samples_used}, {"outliers", m.outliers},
                  {"choice", choice}}},
       {"r_units", !distorted ? Json("px of the photo (no dist_coeffs: the photo is the pinhole image)") : Json({

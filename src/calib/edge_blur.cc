@@ -442,7 +442,7 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
   // Pixels in the central `along_fraction` of the section, +-hw across it: a parallelogram whose ends run parallel
   // to the lines crossing the edge at a and b (a rectangle where they are perpendicular to it). A rectangle's
   // corners would reach across an oblique crossing line into the next square, whose opposite colour and blurred
-  // edge pull the plateaus near the window's ends towards the step and widen the fitted edge (docs/blur-kernels.md).
+  // edge pull the plateaus near the window's ends towards the step and widen the fitted edge (docs/independent-truth.md).
   const double frac = std::clamp(options.along_fraction, 0.0, 1.0);
   const double s_lo = 0.5 * (1 - frac) * f.length, s_hi = 0.5 * (1 + frac) * f.length;
   const double shear_a = CrossShear(segment.cross_a, f), shear_b = CrossShear(segment.cross_b, f);
