@@ -174,9 +174,9 @@ TEST(Calibrate, RealOpticsMeasuredAndFittedWithinTwoPercentMedianFivePercentP90)
     const RelErrors fitted = Relative(r.cmp, &SectionComparison::fitted);
     double r_min = 1e9;
     for (const auto& s : r.cmp.sections) r_min = std::min(r_min, s.true_r_px);
-    std::printf("%s (true r from %.2f px; model %s, floor %.2f px): measured %d/%zu, median %.2f %%, p90 %.2f %%; "
+    std::printf("%s (true r from %.2f px; model %s, %s): measured %d/%zu, median %.2f %%, p90 %.2f %%; "
                 "fitted median %.2f %%, p90 %.2f %%\n",
-                scene.name, r_min, r.result.model.kind.c_str(), r.result.model.floor_px, measured.n,
+                scene.name, r_min, r.result.model.kind.c_str(), optics::FloorText(r.result.model).c_str(), measured.n,
                 r.cmp.sections.size(), 100 * measured.median, 100 * measured.p90, 100 * fitted.median,
                 100 * fitted.p90);
     EXPECT_GE(measured.n, 0.9 * r.cmp.sections.size()) << scene.name;
