@@ -114,15 +114,22 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
   t0 = std::chrono::steady_clock::now();
   const cv::Mat& linear = planes.linear;
   const int E = board.EdgeCount(), S = board.SectionCount();
-  std::vector<std::array<double, 3>> points;  // per section: start, end, midpoint
+  // Per section: start, end, midpoint, and a point a tenth of a square along the board line crossing the edge at
+  // the start and at the end (their directions in the photo shape the sampling window, edge_blur.h).
+  constexpr int kPoints = 5;
+  std::vector<std::array<double, 3>> points;
+  const double step_mm = 0.1 * board.square_mm;
   for (int e = 1; e <= E; ++e)
     for (int s = 1; s <= S; ++s) {
-      points.push_back(board.SectionStart(e, s));
-      points.push_back(board.SectionEnd(e, s));
+      const std::array<double, 3> a = board.SectionStart(e, s), b = board.SectionEnd(e, s);
+      points.push_back(a);
+      points.push_back(b);
       points.push_back(board.SectionMidpoint(e, s));
+      points.push_back({a[0], a[1] + step_mm, a[2]});
+      points.push_back({b[0], b[1] + step_mm, b[2]});
     }
   const std::vector<cv::Point2d> px = Project(result.pose, camera, points);
-  auto mid_px = [&](int e, int s) { return px[((e - 1) * S + (s - 1)) * 3 + 2]; };
+  auto mid_px = [&](int e, int s) { return px[((e - 1) * S + (s - 1)) * kPoints + 2]; };
   // The same points through the pinhole alone (ideal px): there the edge is straight, and the distortion's Jacobian
   // at its midpoint says how the photo stretches a blur across it.
   const LensDistortion distortion(camera);
@@ -134,7 +141,7 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
     EdgeResult edge;
     edge.index = e;
     for (int s = 1; s <= S; ++s) {
-      const size_t i = ((e - 1) * S + (s - 1)) * 3;
+      const size_t i = ((e - 1) * S + (s - 1)) * kPoints;
       SectionResult sec;
       sec.edge = e;
       sec.section = s;
@@ -146,6 +153,8 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
       if (e > 1) gap = std::min(gap, cv::norm(m - mid_px(e - 1, s)));
       if (e < E) gap = std::min(gap, cv::norm(m - mid_px(e + 1, s)));
       sec.segment = EdgeSegment{px[i], px[i + 1], 0.5 * gap};
+      sec.segment.cross_a = px[i + 3] - px[i];
+      sec.segment.cross_b = px[i + 4] - px[i + 1];
       if (!distortion.Identity()) {
         const cv::Point2d a = ideal[i], b = ideal[i + 1], mid = ideal[i + 2];
         sec.stretch = distortion.StretchAcross({mid.x, mid.y}, {a.y - b.y, b.x - a.x});
@@ -263,7 +272,9 @@ Json CalibToJson(const CalibResult& r) {
       {"rule", optics::kModelChoiceRule},
       {"thin_lens", {{"rms_px", m.thin_rms_px}, {"loo_rms_px", m.thin_loo_rms_px}}},
       {"thin_lens+floor", {{"rms_px", number_or_note(m.floor_rms_px)}, {"loo_rms_px", number_or_note(m.floor_loo_rms_px)},
-                           {"floor_px", number_or_note(m.floor_candidate_px)}}},
+                           {"floor_px", number_or_note(m.floor_candidate_px)},
+                           {"floor_range_px", std::isfinite(m.floor_lo_px) ? Json::array({m.floor_lo_px, m.floor_hi_px})
+                                                                            : Json("not determined (not fitted)")}}},
       {"eq37", {{"rms_px", eq37_n > 0 ? Json(std::sqrt(eq37_sum / eq37_n)) : Json("not determined (no section)")},
                 {"sections", eq37_n},
                 {"note", "eq. 3.7 as published, from the reference edge; no parameters fitted, error against the "
@@ -279,7 +290,9 @@ Json CalibToJson(const CalibResult& r) {
       {"reference_edge", r.reference_edge},
       {"reference", {{"u_mm", r.reference_u_mm}, {"r_px", r.reference_r_px}}},
       {"model", {{"kind", m.kind}, {"focus_mm", std::isinf(m.focus_mm) ? Json("infinity") : Json(m.focus_mm)},
-                 {"aperture_mm", m.aperture_mm}, {"floor_px", m.floor_px}, {"rms_px", m.rms_px},
+                 {"aperture_mm", m.aperture_mm}, {"floor_px", m.floor_px},
+                 // floor_px stays a number (the model predicts with it); whether the sections pin it is said here.
+                 {"floor_determined", m.floor_determined}, {"rms_px", m.rms_px},
                  {"loo_rms_px", m.loo_rms_px}, {"samples_used", m.samples_used}, {"outliers", m.outliers},
                  {"choice", choice}}},
       {"r_units", !distorted ? Json("px of the photo (no dist_coeffs: the photo is the pinhole image)") : Json({

@@ -215,9 +215,9 @@ TEST(Calibrate, RealOpticsMeasuredAndFittedWithinTwoPercentMedianFivePercentP90)
     const RelErrors fitted = Relative(r.cmp, &SectionComparison::fitted);
     double r_min = 1e9;
     for (const auto& s : r.cmp.sections) r_min = std::min(r_min, s.true_r_px);
-    std::printf("%s (true r from %.2f px; model %s, floor %.2f px): measured %d/%zu, median %.2f %%, p90 %.2f %%; "
+    std::printf("%s (true r from %.2f px; model %s, %s): measured %d/%zu, median %.2f %%, p90 %.2f %%; "
                 "fitted median %.2f %%, p90 %.2f %%\n",
-                scene.name, r_min, r.result.model.kind.c_str(), r.result.model.floor_px, measured.n,
+                scene.name, r_min, r.result.model.kind.c_str(), optics::FloorText(r.result.model).c_str(), measured.n,
                 r.cmp.sections.size(), 100 * measured.median, 100 * measured.p90, 100 * fitted.median,
                 100 * fitted.p90);
     EXPECT_GE(measured.n, 0.9 * r.cmp.sections.size()) << scene.name;
@@ -248,9 +248,53 @@ TEST(Calibrate, FocusInsideTheBoardFitsFocusApertureAndRadius) {
     EXPECT_NEAR(m.focus_mm, r.scene.focus_mm, 0.02 * r.scene.focus_mm) << name;
     EXPECT_NEAR(m.aperture_mm, r.scene.camera.ApertureMm(), 0.03 * r.scene.camera.ApertureMm()) << name;
     EXPECT_NEAR(m.floor_px, 2 * 0.35, 0.07) << name;
+    // The sections nearest focus read the floor itself: it is pinned, and its range holds the truth.
+    EXPECT_TRUE(m.floor_determined) << name << ": " << optics::FloorText(m);
+    EXPECT_LE(m.floor_lo_px, 0.7 * 1.01) << name;
+    EXPECT_GE(m.floor_hi_px, 0.7 * 0.99) << name;
     EXPECT_EQ(fitted.n, int(r.cmp.sections.size())) << name;
     EXPECT_LE(fitted.median, 0.02) << name;
     EXPECT_LE(fitted.p90, 0.05) << name;
+  }
+}
+
+// Issue 25 (b): with focus off the board (260 mm; every section 2-4.4 px, the disc dominating) the floor (0.6 px
+// std: 2 x 0.6 = 1.2 px) changes the sections' radii almost as a slightly other focus and aperture would; the fit
+// read 1.59 px. The floor is then said to be not determined, with the range of floors that fit alike, and the truth
+// lies in it; the fitted radius stays right (the Must-hold test above).
+TEST(Calibrate, FloorOffFocusIsNotDeterminedAndItsRangeHoldsTheTruth) {
+  const Calibration& r = Calibrated(RealOpticsScenes()[0].options);
+  const optics::FittedModel& m = r.result.model;
+  std::printf("focus off the board: model %s, %s (truth 1.20 px)\n", m.kind.c_str(), optics::FloorText(m).c_str());
+  EXPECT_FALSE(m.floor_determined);
+  EXPECT_LE(m.floor_lo_px, 1.2);
+  EXPECT_GE(m.floor_hi_px, 1.2);
+  EXPECT_NE(optics::FloorText(m).find("not determined"), std::string::npos);
+  const Json model = CalibToJson(r.result)["model"];
+  EXPECT_FALSE(model["floor_determined"].get<bool>());
+  EXPECT_EQ(model["choice"]["thin_lens+floor"]["floor_range_px"].size(), 2u);
+}
+
+// Issue 25 (a): a board turned about the table normal by 20, 30 and 45 degrees both ways puts its edges diagonal in
+// the photo and its squares become parallelograms. The sampling window's ends follow the crossing board lines
+// (edge_blur.h, EdgeSegment::cross_a/b); a rectangle's corners reached into the next square and read r 1-2 % high at
+// 45 degrees (p90 3 %). Disc x floor 0.6 px, focus off the board (r 2.2-4.4 px), noise 0.003: measured and fitted
+// r median <= 2 %, p90 <= 5 % over every section.
+TEST(Calibrate, TurnedBoardMeasuredAndFittedWithinTwoPercentMedianFivePercentP90) {
+  for (double yaw : {20.0, -20.0, 30.0, -30.0, 45.0, -45.0}) {
+    synth::SceneOptions o = Thesis(0.003);
+    o.focus_mm = 260, o.floor_sigma_px = 0.6, o.yaw_deg = yaw;
+    const Calibration& r = Calibrated(o);
+    const RelErrors measured = Relative(r.cmp, &SectionComparison::model);
+    const RelErrors fitted = Relative(r.cmp, &SectionComparison::fitted);
+    std::printf("yaw %+.0f deg: measured %d/%zu, median %.2f %%, p90 %.2f %%; fitted median %.2f %%, p90 %.2f %%\n",
+                yaw, measured.n, r.cmp.sections.size(), 100 * measured.median, 100 * measured.p90,
+                100 * fitted.median, 100 * fitted.p90);
+    EXPECT_GE(measured.n, int(0.95 * r.cmp.sections.size())) << yaw;
+    EXPECT_LE(measured.median, 0.02) << yaw;
+    EXPECT_LE(measured.p90, 0.05) << yaw;
+    EXPECT_LE(fitted.median, 0.02) << yaw;
+    EXPECT_LE(fitted.p90, 0.05) << yaw;
   }
 }
 

@@ -418,6 +418,14 @@ void StartEstimate(const std::vector<Bin>& bins, double half_window, double low,
   *r = std::max(0.3, std::sqrt(std::max(0.0, width * width - 0.64)) / 1.25);
 }
 
+// How far along the edge a crossing line of direction `cross` moves per px across it (0: perpendicular). Lines
+// within 6 degrees of the edge itself are not a square's side: treated as perpendicular.
+double CrossShear(const cv::Point2d& cross, const Frame& f) {
+  const double along = cross.dot(f.t), across = cross.dot(f.n);
+  if (!std::isfinite(along) || !std::isfinite(across) || !(std::abs(across) > 0.1 * std::hypot(along, across))) return 0;
+  return along / across;
+}
+
 }  // namespace
 
 ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, const ModelFitOptions& options) {
@@ -431,12 +439,16 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
     return fit;
   }
 
-  // Pixels in the oriented rectangle: the central `along_fraction` of the section, +-hw across it.
+  // Pixels in the central `along_fraction` of the section, +-hw across it: a parallelogram whose ends run parallel
+  // to the lines crossing the edge at a and b (a rectangle where they are perpendicular to it). A rectangle's
+  // corners would reach across an oblique crossing line into the next square, whose opposite colour and blurred
+  // edge pull the plateaus near the window's ends towards the step and widen the fitted edge (docs/independent-truth.md).
   const double frac = std::clamp(options.along_fraction, 0.0, 1.0);
   const double s_lo = 0.5 * (1 - frac) * f.length, s_hi = 0.5 * (1 + frac) * f.length;
+  const double shear_a = CrossShear(segment.cross_a, f), shear_b = CrossShear(segment.cross_b, f);
   double xmin = 1e18, xmax = -1e18, ymin = 1e18, ymax = -1e18;
-  for (double s : {s_lo, s_hi})
-    for (double d : {-hw, hw}) {
+  for (double d : {-hw, hw})
+    for (double s : {s_lo + shear_a * d, s_hi + shear_b * d}) {
       const cv::Point2d p = f.a + s * f.t + d * f.n;
       xmin = std::min(xmin, p.x), xmax = std::max(xmax, p.x), ymin = std::min(ymin, p.y), ymax = std::max(ymax, p.y);
     }
@@ -452,7 +464,7 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
     double s = (x0 - f.a.x) * f.t.x + ry * f.t.y;
     double d = (x0 - f.a.x) * f.n.x + ry * f.n.y;
     for (int x = x0; x <= x1; ++x, s += f.t.x, d += f.n.x) {
-      if (s < s_lo || s > s_hi || d < -hw || d > hw) continue;
+      if (d < -hw || d > hw || s < s_lo + shear_a * d || s > s_hi + shear_b * d) continue;
       const float v = row[x];
       if (!std::isfinite(v)) continue;
       // Across the bowed edge: the parabola's offset at s taken off (exact to first order in the bow).
@@ -579,7 +591,9 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
   // The blur must fit in the window on both sides of the edge, the X-junctions at the section ends must not
   // reach into the central part used (a disc reaches r), and the image border must leave enough of that part.
   const double reach = 1.5 * fit.r_px + 2;
-  if (reach > hw - std::abs(fit.offset_px) || 0.5 * (1 - frac) * f.length < fit.r_px + 1 ||
+  // The X-junctions' distance from the samples is taken across the crossing lines (shorter where they lean).
+  const double lean = std::sqrt(1 + std::max(shear_a * shear_a, shear_b * shear_b));
+  if (reach > hw - std::abs(fit.offset_px) || 0.5 * (1 - frac) * f.length / lean < fit.r_px + 1 ||
       s_max - s_min < std::min(2 * reach, 0.5 * frac * f.length))
     flag("crowded");
   if (fit.rms_rel > options.max_rms_rel) flag("poor_fit");

@@ -18,6 +18,11 @@ struct EdgeSegment {
   // How far the edge's midpoint lies off the chord a-b along its normal (px; a lens distortion bows straight edges):
   // distances across the edge are taken from the parabola through a, b and that point. 0: a straight edge.
   double bow_px = 0;
+  // Directions in the image of the board's other lines, the ones that cross this edge at a and at b (any length,
+  // either sense; zero: perpendicular to the edge). Where the squares are parallelograms in the image (a board
+  // turned about the table normal, seen obliquely) those lines lean across the window; the samples keep their
+  // distance from them along the edge at every offset across it, so the crossing edges never enter.
+  cv::Point2d cross_a{0, 0}, cross_b{0, 0};
 };
 
 struct ModelFitOptions {

@@ -524,3 +524,110 @@ TEST(EdgeBlurReport, TrueVsModelVsThesis) {
 
 }  // namespace
 }  // namespace blurcue::calib
+
+namespace blurcue::calib {
+namespace {
+
+// Gauss-Legendre nodes and weights on [-1, 1] (Newton on P_n): a pixel's exact average of a smooth ESF.
+void GaussLegendre(int n, std::vector<double>* x, std::vector<double>* w) {
+  x->resize(n), w->resize(n);
+  for (int i = 0; i < n; ++i) {
+    double z = std::cos(kPi * (i + 0.75) / (n + 0.5)), dp = 0;
+    for (int it = 0; it < 100; ++it) {
+      double p0 = 1, p1 = z;
+      for (int k = 2; k <= n; ++k) {
+        const double p2 = ((2 * k - 1) * z * p1 - (k - 1) * p0) / k;
+        p0 = p1, p1 = p2;
+      }
+      dp = n * (z * p1 - p0) / (z * z - 1);
+      const double dz = p1 / dp;
+      z -= dz;
+      if (std::abs(dz) < 1e-15) break;
+    }
+    (*x)[i] = z, (*w)[i] = 2 / ((1 - z * z) * dp * dp);
+  }
+}
+
+// Issue 25 (a): a Gaussian edge (std r / 2) at angle theta, each pixel the exact mean of erf over its unit square
+// (16 x 16 Gauss-Legendre nodes; no supersampled grid, no closed form shared with the code), 8-bit sRGB, noise
+// 0.002. The pixel's aperture across a diagonal edge is a trapezoid, not a box (the fit models it so); r is within
+// 1 % at 0, 4, +-20, 30, 45 and 60 degrees for r 1.5-6 px, and within 2.5 % at the floor (0.7 px).
+TEST(EdgeModel, SlantedGaussianEdgeWithExactPixelIntegrationWithinOnePercent) {
+  std::vector<double> gx, gw;
+  GaussLegendre(16, &gx, &gw);
+  const int N = 160;
+  const cv::Point2d c(0.5 * (N - 1), 0.5 * (N - 1));
+  unsigned seed = 5;
+  for (double r : {0.7, 1.5, 3.0, 6.0})
+    for (double angle : {0.0, 4.0, 20.0, -20.0, 30.0, -30.0, 45.0, -45.0, 60.0}) {
+      const double th = angle * kPi / 180, s = r / 2;
+      const cv::Point2d t(std::cos(th), std::sin(th)), n(-t.y, t.x);
+      cv::Mat linear(N, N, CV_32F);
+      for (int y = 0; y < N; ++y)
+        for (int x = 0; x < N; ++x) {
+          const double d0 = (x - c.x) * n.x + (y - c.y) * n.y;
+          double v = 0;
+          if (d0 < -(6 * s + 1)) v = 0;
+          else if (d0 > 6 * s + 1) v = 1;
+          else
+            for (int i = 0; i < 16; ++i)
+              for (int j = 0; j < 16; ++j) {
+                const double d = d0 + 0.5 * gx[i] * n.x + 0.5 * gx[j] * n.y;
+                v += 0.25 * gw[i] * gw[j] * 0.5 * std::erfc(-d / (s * std::sqrt(2.0)));
+              }
+          linear.at<float>(y, x) = static_cast<float>(0.04 + 0.76 * v);
+        }
+      cv::Mat noise(linear.size(), CV_32F);
+      cv::RNG rng(seed++);
+      rng.fill(noise, cv::RNG::NORMAL, 0, 0.002);
+      linear += noise;
+      cv::min(cv::max(linear, 0.0), 1.0, linear);
+      const EdgeSegment seg{c - 60.0 * t, c + 60.0 * t, 50};
+      const ModelFit fit = MeasureEdgeModel(DecodeSrgb8(EncodeSrgb8(linear)), seg);
+      EXPECT_TRUE(fit.ok) << "r " << r << " angle " << angle << ": " << Describe(fit);
+      // At the floor (0.7 px) the fit reads 1-2 % high at every angle, a slight one included (4 degrees): not a
+      // slant effect; the issue's 2 % median holds there, the 1 % this test asks elsewhere does not.
+      EXPECT_NEAR(fit.r_px, r, (r < 1 ? 0.025 : 0.01) * r) << "angle " << angle << ": " << Describe(fit);
+    }
+}
+
+// Issue 25 (a), the cause: squares seen as parallelograms (a board turned about the table normal). Cells 48 px a
+// side, the crossing lines 50 degrees off the edge, Gaussian blur r = 4 px (cv::GaussianBlur of a sharp pattern on
+// an 8x grid, area-averaged to pixels). The window is half the cell (24 px) across the edge; the section's central
+// half starts 12 px from the corner, and a crossing line at 50 degrees leans 24 x cot 50 = 20 px along the edge at
+// the window's reach: a rectangle's corners take in the next square. With the crossing lines given (as calibrate
+// gives them) the window's ends follow them and r is within 1 %; without them it reads more than 1 % high.
+TEST(EdgeModel, ParallelogramSquaresMeasuredAlongTheirCrossingLines) {
+  const int S = 8, N = 200;
+  const double L = 48, beta = 50 * kPi / 180, r = 4;
+  for (double angle : {35.0, -40.0}) {
+    const double th = angle * kPi / 180;
+    const cv::Point2d t(std::cos(th), std::sin(th)), cr(std::cos(th + beta), std::sin(th + beta));
+    const cv::Point2d o(0.5 * (N - 1) - 0.5 * L * (t.x + cr.x), 0.5 * (N - 1) - 0.5 * L * (t.y + cr.y));
+    // p = o + L (u t + v cr): the square's colour is the parity of floor(u) + floor(v).
+    const double det = t.x * cr.y - t.y * cr.x;
+    cv::Mat fine(N * S, N * S, CV_32F);
+    for (int j = 0; j < N * S; ++j)
+      for (int i = 0; i < N * S; ++i) {
+        const double px = (i + 0.5) / S - 0.5 - o.x, py = (j + 0.5) / S - 0.5 - o.y;
+        const double u = (px * cr.y - py * cr.x) / det / L, v = (t.x * py - t.y * px) / det / L;
+        const bool white = (static_cast<long>(std::floor(u)) + static_cast<long>(std::floor(v))) % 2 != 0;
+        fine.at<float>(j, i) = white ? 0.8f : 0.04f;
+      }
+    cv::GaussianBlur(fine, fine, cv::Size(0, 0), 0.5 * r * S);
+    cv::Mat linear;
+    cv::resize(fine, linear, cv::Size(N, N), 0, 0, cv::INTER_AREA);
+    EdgeSegment seg{o, o + L * t, 0.5 * L};
+    const ModelFit rect = MeasureEdgeModel(linear, seg);
+    seg.cross_a = seg.cross_b = cr;
+    const ModelFit fit = MeasureEdgeModel(linear, seg);
+    std::printf("parallelogram squares, edge at %+.0f deg: r %.4f with the crossing lines, %.4f in a rectangle "
+                "(true %.1f)\n", angle, fit.r_px, rect.r_px, r);
+    EXPECT_TRUE(fit.ok) << Describe(fit);
+    EXPECT_NEAR(fit.r_px, r, 0.01 * r) << angle << ": " << Describe(fit);
+    EXPECT_GT(rect.r_px, 1.01 * r) << angle << ": the rectangle no longer reads high; " << Describe(rect);
+  }
+}
+
+}  // namespace
+}  // namespace blurcue::calib

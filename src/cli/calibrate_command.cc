@@ -11,6 +11,7 @@
 #include "cli/commands.h"
 #include "core/error.h"
 #include "core/image.h"
+#include "optics/fit.h"
 
 namespace blurcue::cli {
 
@@ -72,10 +73,10 @@ void AddCalibrateCommand(CLI::App& app) {
                 board.Name().c_str(), result.pose.reprojection_error_px, cv::norm(result.pose.tvec));
     std::printf("reference edge %d: u = %.1f mm, r = %.2f px (median of its usable sections)\n",
                 result.reference_edge, result.reference_u_mm, result.reference_r_px);
-    std::printf("fitted %s model: focus %.1f mm, aperture %.3f mm (nominal %.3f), floor %.2f px, rms %.3f px,"
+    std::printf("fitted %s model: focus %.1f mm, aperture %.3f mm (nominal %.3f), %s, rms %.3f px,"
                 " leave-one-out %.3f px, %d outliers of %d\n",
-                m.kind.c_str(), m.focus_mm, m.aperture_mm, camera.ApertureMm(), m.floor_px, m.rms_px, m.loo_rms_px,
-                m.outliers, m.samples_used);
+                m.kind.c_str(), m.focus_mm, m.aperture_mm, camera.ApertureMm(), optics::FloorText(m).c_str(),
+                m.rms_px, m.loo_rms_px, m.outliers, m.samples_used);
     std::vector<double> true_r;
     if (!args->truth.empty()) {
       const calib::TruthComparison cmp =

@@ -8,6 +8,7 @@
 #include "cli/commands.h"
 #include "core/camera.h"
 #include "core/error.h"
+#include "optics/fit.h"
 #include "track/take.h"
 
 namespace blurcue::cli {
@@ -87,11 +88,11 @@ void AddTrackCommand(CLI::App& app) {
                   n, take.tracked, take.found, take.lost, median, n > 0 ? take.decode_ms / n : 0.0);
       if (take.model) {
         const auto& m = *take.model;
-        std::printf("the take's lens model (%s, %d sections): focus %s mm, aperture %.3f mm (nominal %.3f), floor "
-                    "%.2f px, rms %.3f px\n",
+        std::printf("the take's lens model (%s, %d sections): focus %s mm, aperture %.3f mm (nominal %.3f), %s, "
+                    "rms %.3f px\n",
                     m.kind.c_str(), m.samples_used,
                     std::isinf(m.focus_mm) ? "infinity" : std::to_string(m.focus_mm).substr(0, 7).c_str(),
-                    m.aperture_mm, camera.ApertureMm(), m.floor_px, m.rms_px);
+                    m.aperture_mm, camera.ApertureMm(), optics::FloorText(m).c_str(), m.rms_px);
       }
       std::printf("wrote %s/track.csv and %d calib-NNNN.json in %.1f s\n", args->out.c_str(), n - take.lost,
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <sstream>
 
@@ -127,9 +128,9 @@ bool Solve(std::array<std::array<double, K>, K> a, std::array<double, K> b, std:
 // whole grid, through the true focus: on a take focused inside the board (floor std 0.35 px) the floor model never
 // saw its basin and the thin lens alone settled on focus 249 mm, aperture 0.85 mm for a true 450 mm, 3.75 mm.
 Params Refine(const Data& s, const std::vector<double>& w, Params m, bool floor, bool free_q, double c,
-              int max_iter) {
+              int max_iter, bool hold_t = false) {
   // Unknowns in a fixed order: q, D (D^2 for the floor model), t; the mask says which take part.
-  const std::array<bool, 3> use = {free_q, true, floor};
+  const std::array<bool, 3> use = {free_q, true, floor && !hold_t};
   double loss = Loss(s, w, m, floor, c);
   double lambda = 1e-3;
   for (int it = 0; it < max_iter; ++it) {
@@ -323,6 +324,38 @@ Residuals Evaluate(const Data& s, const Params& m, bool floor, double c) {
   return res;
 }
 
+// The floors the board's radii cannot tell apart: every r0 whose best focus and aperture predict the sections within
+// kFloorTolerance (relative rms) of the floor model's own predictions. A measurement accurate to about half a
+// percent (docs/independent-truth.md) cannot choose among them. With focus off the board every section sits far
+// from focus, where sqrt(D^2 a^2 + r0^2) changes with r0 almost as it does with a slightly other focus and aperture,
+// and the range is wide; with focus on or inside the board the sections nearest it read the floor itself.
+constexpr double kFloorTolerance = 0.005;
+std::pair<double, double> FloorRange(const Data& s, const Params& best, double c) {
+  const double r0 = std::sqrt(best.t);
+  double r_min = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < s.n(); ++i)
+    if (s.w[i] > 0) r_min = std::min(r_min, Model(s, best, true, i));
+  auto off = [&](double floor_px) {
+    Params m = best;
+    m.t = floor_px * floor_px;
+    m = Refine(s, s.w, m, /*floor=*/true, /*free_q=*/true, c, 50, /*hold_t=*/true);
+    double sum = 0, sw = 0;
+    for (size_t i = 0; i < s.n(); ++i) {
+      if (!(s.w[i] > 0)) continue;
+      const double ref = Model(s, best, true, i);
+      const double e = (Model(s, m, true, i) - ref) / std::max(ref, 1e-6);
+      sum += s.w[i] * e * e, sw += s.w[i];
+    }
+    return sw > 0 ? std::sqrt(sum / sw) : 0.0;
+  };
+  // Walk out from r0 in steps of 2 % of the smallest radius (no floor exceeds it) until the predictions part.
+  const double step = 0.02 * r_min;
+  double lo = r0, hi = r0;
+  while (lo > 0 && off(std::max(0.0, lo - step)) <= kFloorTolerance) lo = std::max(0.0, lo - step);
+  while (hi < r_min && off(std::min(r_min, hi + step)) <= kFloorTolerance) hi = std::min(r_min, hi + step);
+  return {lo, hi};
+}
+
 double WeightedRms(const Data& s, const std::vector<double>& e, const std::vector<bool>& take) {
   double sum = 0, sw = 0;
   for (size_t i = 0; i < s.n(); ++i)
@@ -341,6 +374,17 @@ double FittedModel::PredictPx(const Lens& lens, double u_mm) const {
   const Lens fitted{lens.focal_length_mm, aperture_mm, lens.pixel_pitch_mm};
   const double thin = SignedBlurRadiusPx(fitted, focus_mm, u_mm);
   return std::sqrt(thin * thin + floor_px * floor_px);
+}
+
+std::string FloorText(const FittedModel& m) {
+  char text[96];
+  if (m.kind != "thin_lens+floor")
+    std::snprintf(text, sizeof text, "floor 0 px (thin lens alone)");
+  else if (m.floor_determined)
+    std::snprintf(text, sizeof text, "floor %.2f px", m.floor_px);
+  else
+    std::snprintf(text, sizeof text, "floor not determined (%.2f-%.2f px fit alike)", m.floor_lo_px, m.floor_hi_px);
+  return text;
 }
 
 FittedModel FitThinLens(const Lens& lens, const std::vector<BlurSample>& samples, const FitOptions& options) {
@@ -446,6 +490,13 @@ FittedModel FitThinLens(const Lens& lens, const std::vector<BlurSample>& samples
   out.floor_rms_px = floor_fitted ? WeightedRms(s, floor_res.fit, judged) : nan;
   out.floor_loo_rms_px = floor_fitted ? WeightedRms(s, floor_res.loo, judged) : nan;
   out.floor_candidate_px = floor_fitted ? std::sqrt(with_floor.t) : nan;
+  if (floor_fitted) {
+    const auto [lo, hi] = FloorRange(s, with_floor, c);
+    out.floor_lo_px = lo, out.floor_hi_px = hi;
+  } else {
+    out.floor_lo_px = out.floor_hi_px = nan;
+  }
+  out.floor_determined = use_floor && out.floor_hi_px - out.floor_lo_px <= std::max(0.1, 0.2 * out.floor_px);
   return out;
 }
 

@@ -35,10 +35,20 @@ struct FittedModel {
   double thin_rms_px = 0, thin_loo_rms_px = 0;
   double floor_rms_px = 0, floor_loo_rms_px = 0;
   double floor_candidate_px = 0;  // the floor the floor model found (kept or not)
+  // The floors the sections cannot tell apart from the floor model's (its predictions within 0.5 % rms after
+  // refitting focus and aperture), px; NaN where the floor model was not fitted.
+  double floor_lo_px = 0, floor_hi_px = 0;
+  // The kept floor is pinned by the sections: that range spans at most max(0.1 px, 20 % of it). False for the thin
+  // lens alone (no floor kept) and where focus off the board leaves the floor free (a wide range).
+  bool floor_determined = false;
 
   // Predicted unsigned radius at depth u (px), with the lens's f and pitch.
   double PredictPx(const Lens& lens, double u_mm) const;
 };
+
+// The floor in words for a summary line: "floor 0.70 px", "floor 0 px (thin lens alone)" or, where the sections do
+// not pin it, "floor not determined (0.99-1.86 px fit alike)".
+std::string FloorText(const FittedModel& m);
 
 // How FitThinLens chooses between its two candidates, in words (calib.json's model.choice.rule).
 extern const char* const kModelChoiceRule;
