@@ -120,6 +120,16 @@ CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& b
       if (e > 1) gap = std::min(gap, cv::norm(m - mid_px(e - 1, s)));
       if (e < E) gap = std::min(gap, cv::norm(m - mid_px(e + 1, s)));
       sec.segment = EdgeSegment{px[i], px[i + 1], 0.5 * gap};
+      // The same section of the parallel edges either side: where the blur reaches them, their steps are modelled.
+      // Past the board's outer edge the image is taken to be free of edges for half a gap, as the plain window does.
+      for (const int k : {e - 1, e + 1}) {
+        if (k < 1 || k > E) continue;
+        const size_t j = ((k - 1) * S + (s - 1)) * 3;
+        const int next = k + (k - e);
+        const double beyond = next >= 1 && next <= E ? cv::norm(mid_px(k, s) - mid_px(next, s))
+                                                     : cv::norm(mid_px(k, s) - m);
+        sec.segment.neighbours.push_back({px[j], px[j + 1], 0.5 * beyond});
+      }
       if (!distortion.Identity()) {
         const cv::Point2d a = ideal[i], b = ideal[i + 1], mid = ideal[i + 2];
         sec.stretch = distortion.StretchAcross({mid.x, mid.y}, {a.y - b.y, b.x - a.x});
@@ -208,6 +218,7 @@ Json CalibToJson(const CalibResult& r) {
                  {"step_linear", s.fit.step},
                  {"thesis_ok", s.thesis.ok}};
       if (!s.estimated_note.empty()) js["r_estimated_note"] = s.estimated_note;
+      if (!s.fit.crowded_why.empty()) js["crowded_why"] = s.fit.crowded_why;
       if (distorted) js["stretch"] = s.stretch;
       sections.push_back(js);
     }
