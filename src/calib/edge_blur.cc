@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 
 #include "calib/edge_window.h"
 #include "core/image.h"
@@ -275,9 +276,9 @@ struct FitSetup {
   double w1 = 1, w2 = 0, half_window = 1;
   bool slopes = false;
   // Neighbouring parallel edges in the window (edge_window.h): their distances from this edge (px). Each step has
-  // its own free size (the board's neighbour beyond its outer edges is the table, not the opposite square) and the
-  // same blur as this edge (their depths differ by a square's: a few % of r, on both sides, in the tails only).
-  std::vector<double> steps;
+  // its own free size (the board's neighbour beyond its outer edges is the table, not the opposite square) and its
+  // own blur where known (its depth differs by a square's: a few % of r), else this edge's, with this edge's shape.
+  std::vector<EdgeWindow::Step> steps;
 };
 
 FitState EvaluateWithNeighbours(const FitSetup& fs, double d0, double r, double phi, std::vector<double>* residuals);
@@ -340,7 +341,11 @@ FitState EvaluateWithNeighbours(const FitSetup& fs, double d0, double r, double 
   std::array<bool, K> used{};
   used[0] = used[1] = true;
   used[2] = used[3] = fs.slopes;
-  for (int k = 0; k < m; ++k) used[4 + k] = true;
+  std::array<std::optional<EsfModel>, kMaxNeighbours> other;
+  for (int k = 0; k < m; ++k) {
+    used[4 + k] = true;
+    if (fs.steps[k].r_px > 0) other[k].emplace(fs.steps[k].r_px, phi, fs.w1, fs.w2);
+  }
   thread_local std::vector<std::array<double, K>> basis;
   basis.resize(bins.size());
   std::array<std::array<double, K>, K> a{};
@@ -351,7 +356,7 @@ FitState EvaluateWithNeighbours(const FitSetup& fs, double d0, double r, double 
     b = {};
     b[0] = 1, b[1] = e;
     if (fs.slopes) b[2] = t, b[3] = t * e;
-    for (int k = 0; k < m; ++k) b[4 + k] = model(x - fs.steps[k]);
+    for (int k = 0; k < m; ++k) b[4 + k] = other[k] ? (*other[k])(x - fs.steps[k].at_px) : model(x - fs.steps[k].at_px);
     for (int p = 0; p < K; ++p) {
       rhs[p] += bins[i].w * b[p] * bins[i].v;
       for (int q = 0; q < K; ++q) a[p][q] += bins[i].w * b[p] * b[q];

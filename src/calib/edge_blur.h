@@ -15,6 +15,7 @@ namespace blurcue::calib {
 struct NeighbourEdge {
   cv::Point2d a, b;
   double beyond_px = 0;  // how far past it the image holds no other edge (half the gap to the edge after it)
+  double r_px = 0;       // its blur where measured (its depth differs from the section's); 0: taken as the section's
 };
 
 // One edge section in image pixels.

@@ -49,10 +49,10 @@ std::string Format(const char* fmt, double a, double b, double c = 0) {
 
 }  // namespace
 
-std::vector<double> EdgeWindow::Steps() const {
-  std::vector<double> out;
-  if (minus.neighbour_px > 0) out.push_back(-minus.neighbour_px);
-  if (plus.neighbour_px > 0) out.push_back(plus.neighbour_px);
+std::vector<EdgeWindow::Step> EdgeWindow::Steps() const {
+  std::vector<Step> out;
+  if (minus.neighbour_px > 0) out.push_back({-minus.neighbour_px, minus.neighbour_r_px});
+  if (plus.neighbour_px > 0) out.push_back({plus.neighbour_px, plus.neighbour_r_px});
   return out;
 }
 
@@ -73,6 +73,7 @@ EdgeWindow NeighbourWindow(const EdgeSegment& segment, double reach_px) {
     EdgeWindow::Side& side = g > 0 ? w.plus : w.minus;
     if (side.neighbour_px > 0 && side.neighbour_px <= std::abs(g)) continue;  // the nearer one on a side
     side.neighbour_px = std::abs(g);
+    side.neighbour_r_px = std::isfinite(k.r_px) && k.r_px > 0 ? k.r_px : 0;
     // Past the neighbour until the edge after it (2 x beyond_px further) comes within reach.
     side.end_px = side.neighbour_px + std::max(0.0, std::min(k.beyond_px, 2 * k.beyond_px - reach_px));
     ka += ColumnSlope(x, segment.a, k.a), kb += ColumnSlope(x, segment.b, k.b), ++slopes;

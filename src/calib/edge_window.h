@@ -2,6 +2,7 @@
 // Where an edge section's blur is measured (the samples and the profile model of edge_blur.cc): how far across the
 // edge, how far along it from the X-junctions, which neighbouring parallel edges' steps the profile includes; and,
 // in words, why a window cannot hold a blur ("crowded").
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@ struct EdgeWindow {
   // neighbouring parallel edge is modelled there, it lies `neighbour_px` away (0: none, the side is free of edges).
   struct Side {
     double end_px = 0, neighbour_px = 0;
+    double neighbour_r_px = 0;  // the neighbour's blur (NeighbourEdge::r_px; 0: this edge's)
   };
   Side minus, plus;
   // Along the edge: the section's ends lie on the board's column lines, which slant by ka (at end a) and kb (at end
@@ -23,8 +25,11 @@ struct EdgeWindow {
   double lo() const { return -minus.end_px; }
   double hi() const { return plus.end_px; }
   double HalfWidth() const { return std::max(minus.end_px, plus.end_px); }
-  // The modelled neighbours' signed distances from this edge along the normal (px), at the section's middle.
-  std::vector<double> Steps() const;
+  // The modelled neighbours: signed distance from this edge along the normal (px, at the section's middle), blur.
+  struct Step {
+    double at_px = 0, r_px = 0;
+  };
+  std::vector<Step> Steps() const;
 };
 
 // +-half_window_px across, the central part along between perpendicular ends: the window of the plain fit.
