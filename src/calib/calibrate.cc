@@ -146,16 +146,19 @@ CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& b
     result.edges.push_back(std::move(edge));
   }
   // A section measured across its neighbouring edges took their blur for its own; measured again with each
-  // neighbour's own (first-pass) blur, since their depths differ by a square's.
+  // neighbour's own measured blur (where usable; edge by edge, so a neighbour measured again already counts), since
+  // their depths differ by a square's.
   for (int e = 1; e <= E; ++e)
     for (int s = 1; s <= S; ++s) {
       SectionResult& sec = result.edges[e - 1].sections[s - 1];
       const auto& flags = sec.fit.flags;
       if (std::find(flags.begin(), flags.end(), "neighbours") == flags.end()) continue;
       size_t n = 0;
-      for (const int k : {e - 1, e + 1})  // the order they were listed in above
-        if (k >= 1 && k <= E && n < sec.segment.neighbours.size())
-          sec.segment.neighbours[n++].r_px = result.edges[k - 1].sections[s - 1].fit.r_px;
+      for (const int k : {e - 1, e + 1}) {  // the order they were listed in above
+        if (k < 1 || k > E || n >= sec.segment.neighbours.size()) continue;
+        const ModelFit& other = result.edges[k - 1].sections[s - 1].fit;
+        sec.segment.neighbours[n++].r_px = other.ok ? other.r_px : 0;
+      }
       sec.fit = MeasureEdgeModel(linear, sec.segment, options.model_fit);
     }
   result.measure_ms = MsSince(t0);

@@ -24,22 +24,9 @@ constexpr int kMinSamples = 100;
 constexpr double kShapeSeLimitRad = 0.15;
 constexpr int kMaxNeighbours = 2;  // one each side of the edge
 
-// Geometry shared by both methods. The normal is the segment direction turned +90 degrees in image
-// coordinates (x right, y down): n = (-t.y, t.x). Pixel centres sit at integer coordinates (OpenCV).
-struct Frame {
-  cv::Point2d a, t, n;
-  double length = 0;
-};
-
-Frame MakeFrame(const EdgeSegment& s) {
-  Frame f;
-  f.a = s.a;
-  const cv::Point2d d = s.b - s.a;
-  f.length = std::hypot(d.x, d.y);
-  if (f.length > 0) f.t = d / f.length;
-  f.n = cv::Point2d(-f.t.y, f.t.x);
-  return f;
-}
+// Geometry shared by both methods and the window: EdgeFrame (edge_window.h). Pixel centres sit at integer
+// coordinates (OpenCV).
+using Frame = EdgeFrame;
 
 // ---- Edge spread functions ---------------------------------------------------------------------------
 // F2 is the second antiderivative of the optical ESF (zero far on the dark side): F2(x) = E[(x - X)_+^2] / 2
@@ -480,10 +467,6 @@ void StartEstimate(const std::vector<Bin>& bins, double half_window, double low,
   *r = std::max(0.3, std::sqrt(std::max(0.0, width * width - 0.64)) / 1.25);
 }
 
-}  // namespace
-
-namespace {
-
 // The fit in one window (edge_window.h). `prior`: a fit of the same edge in a narrower window, whose position, size
 // and step start this one (the wide window's outer parts hold other edges, so the plateau-based start would be
 // wrong there). Disqualifying flags but "crowded" are set; `along_span` is the extent of the samples along the edge.
@@ -491,7 +474,7 @@ ModelFit FitInWindow(const cv::Mat& linear, const EdgeSegment& segment, const Mo
                      const EdgeWindow& window, const ModelFit* prior, double* along_span) {
   ModelFit fit;
   fit.psf = "disc";
-  const Frame f = MakeFrame(segment);
+  const Frame f = MakeEdgeFrame(segment);
   const double hw = window.HalfWidth();
   *along_span = 0;
 
@@ -665,7 +648,7 @@ ModelFit FitInWindow(const cv::Mat& linear, const EdgeSegment& segment, const Mo
 
 ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, const ModelFitOptions& options) {
   CV_Assert(linear.type() == CV_32FC1);
-  const Frame f = MakeFrame(segment);
+  const Frame f = MakeEdgeFrame(segment);
   const double hw = segment.half_window_px;
   if (!(f.length > 1) || !(hw > 1) || linear.empty() || !std::isfinite(hw)) {
     ModelFit fit;
@@ -707,7 +690,7 @@ ThesisMeasure MeasureEdgeThesis(const cv::Mat& grey8, const EdgeSegment& segment
   ThesisMeasure out;
   if (grey8.empty()) return out;
   const cv::Mat grey = grey8.type() == CV_8UC1 ? grey8 : ToGrey8(grey8);
-  const Frame f = MakeFrame(segment);
+  const Frame f = MakeEdgeFrame(segment);
   if (!(f.length > 0) || !(segment.half_window_px >= 1)) return out;
   const cv::Point2d m = 0.5 * (segment.a + segment.b);
 

@@ -395,6 +395,15 @@ TEST(EdgeModel, SectionTooShortForItsBlurIsCrowded) {
   EXPECT_TRUE(HasFlag(fit, "crowded")) << Describe(fit);
 }
 
+// The segment with its parallel neighbours `gap_px` either side (a stripe pattern's, as calibrate gives a board's),
+// the image free of other edges half a gap past them.
+EdgeSegment WithNeighbours(EdgeSegment segment, double gap_px) {
+  const cv::Point2d dir = (segment.b - segment.a) / cv::norm(segment.b - segment.a), n(-dir.y, dir.x);
+  for (double side : {-1.0, 1.0})
+    segment.neighbours.push_back({segment.a + side * gap_px * n, segment.b + side * gap_px * n, 0.5 * gap_px});
+  return segment;
+}
+
 // Parallel edges closer than 3 r (a board's squares at strong blur: each edge's spread reaches the next). Without
 // their places the section is refused as crowded, saying why; with them (as calibrate gives them from the pose) the
 // window reaches across the neighbours, their steps join the profile model, and r is within 2 % of the truth: a
@@ -424,11 +433,7 @@ TEST(EdgeModel, ParallelEdgesCloserThanThreeRadiiMeasuredAcrossEachOther) {
     EXPECT_TRUE(HasFlag(alone, "crowded")) << c.psf << ": " << Describe(alone);
     EXPECT_NE(alone.crowded_why.find("next edge"), std::string::npos) << alone.crowded_why;
 
-    EdgeSegment with = img.segment;
-    const cv::Point2d dir = (with.b - with.a) / cv::norm(with.b - with.a), n(-dir.y, dir.x);
-    for (double side : {-1.0, 1.0})
-      with.neighbours.push_back({with.a + side * c.gap_px * n, with.b + side * c.gap_px * n, 0.5 * c.gap_px});
-    const ModelFit fit = MeasureEdgeModel(img.linear, with);
+    const ModelFit fit = MeasureEdgeModel(img.linear, WithNeighbours(img.segment, c.gap_px));
     EXPECT_TRUE(fit.ok) << c.psf << ": " << Describe(fit) << " " << fit.crowded_why;
     EXPECT_TRUE(HasFlag(fit, "neighbours")) << c.psf << ": " << Describe(fit);
     EXPECT_NEAR(fit.r_px, c.truth_px, 0.02 * c.truth_px) << c.psf << ": " << Describe(fit);
@@ -445,10 +450,7 @@ TEST(EdgeModel, NeighboursWithinTheBlurAreCrowdedSayingWhy) {
   spec.half_window_px = 3.5;
   spec.srgb8 = false;
   const EdgeImage img = Render(spec);
-  EdgeSegment with = img.segment;
-  const cv::Point2d dir = (with.b - with.a) / cv::norm(with.b - with.a), n(-dir.y, dir.x);
-  for (double side : {-1.0, 1.0}) with.neighbours.push_back({with.a + side * 7.0 * n, with.b + side * 7.0 * n, 3.5});
-  const ModelFit fit = MeasureEdgeModel(img.linear, with);
+  const ModelFit fit = MeasureEdgeModel(img.linear, WithNeighbours(img.segment, 7));
   EXPECT_FALSE(fit.ok) << Describe(fit);
   EXPECT_TRUE(HasFlag(fit, "crowded")) << Describe(fit);
   EXPECT_NE(fit.crowded_why.find("within reach of its blur"), std::string::npos) << fit.crowded_why;

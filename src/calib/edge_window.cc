@@ -7,26 +7,9 @@
 namespace blurcue::calib {
 namespace {
 
-// The section's frame: unit direction t (a -> b), normal n = t turned +90 degrees in image coordinates (as in
-// edge_blur.cc), length.
-struct Axes {
-  cv::Point2d a, t, n;
-  double length = 0;
-};
-
-Axes MakeAxes(const EdgeSegment& s) {
-  Axes x;
-  x.a = s.a;
-  const cv::Point2d d = s.b - s.a;
-  x.length = std::hypot(d.x, d.y);
-  if (x.length > 0) x.t = d / x.length;
-  x.n = cv::Point2d(-x.t.y, x.t.x);
-  return x;
-}
-
 // Signed distance along the normal from the section's middle to the neighbour's line (px); 0 when the neighbour is
 // degenerate or runs along the normal.
-double NeighbourDistance(const Axes& x, const NeighbourEdge& k) {
+double NeighbourDistance(const EdgeFrame& x, const NeighbourEdge& k) {
   const cv::Point2d m = x.a + 0.5 * x.length * x.t, dir = k.b - k.a;
   const double along = x.t.dot(dir);
   if (!(std::abs(along) > 1e-9)) return 0;
@@ -36,7 +19,7 @@ double NeighbourDistance(const Axes& x, const NeighbourEdge& k) {
 }
 
 // Along-per-across slope of the line from a section end `p` to the neighbour's matching end `q`.
-double ColumnSlope(const Axes& x, const cv::Point2d& p, const cv::Point2d& q) {
+double ColumnSlope(const EdgeFrame& x, const cv::Point2d& p, const cv::Point2d& q) {
   const double across = x.n.dot(q - p);
   return std::abs(across) > 1e-9 ? x.t.dot(q - p) / across : 0;
 }
@@ -48,6 +31,16 @@ std::string Format(const char* fmt, double a, double b, double c = 0) {
 }
 
 }  // namespace
+
+EdgeFrame MakeEdgeFrame(const EdgeSegment& s) {
+  EdgeFrame f;
+  f.a = s.a;
+  const cv::Point2d d = s.b - s.a;
+  f.length = std::hypot(d.x, d.y);
+  if (f.length > 0) f.t = d / f.length;
+  f.n = cv::Point2d(-f.t.y, f.t.x);
+  return f;
+}
 
 std::vector<EdgeWindow::Step> EdgeWindow::Steps() const {
   std::vector<Step> out;
@@ -64,7 +57,7 @@ EdgeWindow PlainWindow(const EdgeSegment& segment) {
 
 EdgeWindow NeighbourWindow(const EdgeSegment& segment, double reach_px) {
   EdgeWindow w = PlainWindow(segment);
-  const Axes x = MakeAxes(segment);
+  const EdgeFrame x = MakeEdgeFrame(segment);
   double ka = 0, kb = 0;
   int slopes = 0;
   for (const NeighbourEdge& k : segment.neighbours) {

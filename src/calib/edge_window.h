@@ -10,6 +10,14 @@
 
 namespace blurcue::calib {
 
+// A section's frame: a, the unit direction t (a -> b), the normal n = t turned +90 degrees in image coordinates (x
+// right, y down): n = (-t.y, t.x), and the length. Distances across the edge are along n, along it along t from a.
+struct EdgeFrame {
+  cv::Point2d a, t, n;
+  double length = 0;
+};
+EdgeFrame MakeEdgeFrame(const EdgeSegment& segment);
+
 struct EdgeWindow {
   // One side of the edge (the normal's minus or plus side): samples reach `end_px` from the segment line; when a
   // neighbouring parallel edge is modelled there, it lies `neighbour_px` away (0: none, the side is free of edges).
