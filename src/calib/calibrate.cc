@@ -155,6 +155,16 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
       sec.segment = EdgeSegment{px[i], px[i + 1], 0.5 * gap};
       sec.segment.cross_a = px[i + 3] - px[i];
       sec.segment.cross_b = px[i + 4] - px[i + 1];
+      // The same section of the parallel edges either side: where the blur reaches them, their steps are modelled.
+      // Past the board's outer edge the image is taken to be free of edges for half a gap, as the plain window does.
+      for (const int k : {e - 1, e + 1}) {
+        if (k < 1 || k > E) continue;
+        const size_t j = ((k - 1) * S + (s - 1)) * kPoints;
+        const int next = k + (k - e);
+        const double beyond = next >= 1 && next <= E ? cv::norm(mid_px(k, s) - mid_px(next, s))
+                                                     : cv::norm(mid_px(k, s) - m);
+        sec.segment.neighbours.push_back({px[j], px[j + 1], 0.5 * beyond});
+      }
       if (!distortion.Identity()) {
         const cv::Point2d a = ideal[i], b = ideal[i + 1], mid = ideal[i + 2];
         sec.stretch = distortion.StretchAcross({mid.x, mid.y}, {a.y - b.y, b.x - a.x});
@@ -180,6 +190,28 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
   };
   if (options.parallel_sections) cv::parallel_for_(cv::Range(0, E * S), measure, E * S);
   else measure(cv::Range(0, E * S));
+  // A section measured across its neighbouring edges took their blur for its own; measured again with each
+  // neighbour's own measured blur (where usable; edge by edge, so a neighbour measured again already counts), since
+  // their depths differ by a square's.
+  // The sections of one edge are independent of each other: measured again on every core, edge after edge.
+  for (int e = 1; e <= E; ++e) {
+    auto again = [&](const cv::Range& range) {
+      for (int s = range.start + 1; s <= range.end; ++s) {
+        SectionResult& sec = result.edges[e - 1].sections[s - 1];
+        const auto& flags = sec.fit.flags;
+        if (std::find(flags.begin(), flags.end(), "neighbours") == flags.end()) continue;
+        size_t n = 0;
+        for (const int k : {e - 1, e + 1}) {  // the order they were listed in above
+          if (k < 1 || k > E || n >= sec.segment.neighbours.size()) continue;
+          const ModelFit& other = result.edges[k - 1].sections[s - 1].fit;
+          sec.segment.neighbours[n++].r_px = other.ok ? other.r_px : 0;
+        }
+        sec.fit = MeasureEdgeModel(linear, sec.segment, options.model_fit);
+      }
+    };
+    if (options.parallel_sections) cv::parallel_for_(cv::Range(0, S), again, S);
+    else again(cv::Range(0, S));
+  }
   result.measure_ms = MsSince(t0);
 
   // Estimation: eq. 3.7 from the reference edge, and a thin-lens model fitted to every usable section.
@@ -253,6 +285,7 @@ Json CalibToJson(const CalibResult& r) {
                  {"step_linear", s.fit.step},
                  {"thesis_ok", s.thesis.ok}};
       if (!s.estimated_note.empty()) js["r_estimated_note"] = s.estimated_note;
+      if (!s.fit.crowded_why.empty()) js["crowded_why"] = s.fit.crowded_why;
       if (distorted) js["stretch"] = s.stretch;
       sections.push_back(js);
     }

@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 
+#include "calib/edge_window.h"
 #include "core/image.h"
 #include "core/stats.h"
 
@@ -20,23 +22,11 @@ constexpr double kFineBinPx = 0.25;      // finest bin across the edge (ISO 1223
 constexpr int kMinSamples = 100;
 // Standard error of the shape angle (radians) above which the disc/floor split is "shape_ambiguous".
 constexpr double kShapeSeLimitRad = 0.15;
+constexpr int kMaxNeighbours = 2;  // one each side of the edge
 
-// Geometry shared by both methods. The normal is the segment direction turned +90 degrees in image
-// coordinates (x right, y down): n = (-t.y, t.x). Pixel centres sit at integer coordinates (OpenCV).
-struct Frame {
-  cv::Point2d a, t, n;
-  double length = 0;
-};
-
-Frame MakeFrame(const EdgeSegment& s) {
-  Frame f;
-  f.a = s.a;
-  const cv::Point2d d = s.b - s.a;
-  f.length = std::hypot(d.x, d.y);
-  if (f.length > 0) f.t = d / f.length;
-  f.n = cv::Point2d(-f.t.y, f.t.x);
-  return f;
-}
+// Geometry shared by both methods and the window: EdgeFrame (edge_window.h). Pixel centres sit at integer
+// coordinates (OpenCV).
+using Frame = EdgeFrame;
 
 // ---- Edge spread functions ---------------------------------------------------------------------------
 // F2 is the second antiderivative of the optical ESF (zero far on the dark side): F2(x) = E[(x - X)_+^2] / 2
@@ -262,7 +252,8 @@ struct FitState {
   double d0 = 0, r = 1, phi = 0;
   // Levels: v = a + b E + (a' + b' E) x / L across the window (x: bin position, L: half window). The slope terms
   // take up slowly varying illumination (vignetting, shading) that would otherwise tilt the plateaus into the edge.
-  std::array<double, 4> lin{};
+  // With neighbouring edges (FitSetup::steps) their steps follow: v += c_k E(x - d0 - g_k), after the four above.
+  std::array<double, 4 + kMaxNeighbours> lin{};
   double sse = std::numeric_limits<double>::infinity();
   double Step() const { return lin[1]; }  // at x = 0, the segment line
 };
@@ -271,11 +262,18 @@ struct FitSetup {
   const std::vector<Bin>* bins = nullptr;
   double w1 = 1, w2 = 0, half_window = 1;
   bool slopes = false;
+  // Neighbouring parallel edges in the window (edge_window.h): their distances from this edge (px). Each step has
+  // its own free size (the board's neighbour beyond its outer edges is the table, not the opposite square) and its
+  // own blur where known (its depth differs by a square's: a few % of r), else this edge's, with this edge's shape.
+  std::vector<EdgeWindow::Step> steps;
 };
+
+FitState EvaluateWithNeighbours(const FitSetup& fs, double d0, double r, double phi, std::vector<double>* residuals);
 
 // For fixed (d0, r, phi) the levels follow by weighted linear least squares (variable projection).
 // Fills `residuals` (weighted) when given.
 FitState Evaluate(const FitSetup& fs, double d0, double r, double phi, std::vector<double>* residuals = nullptr) {
+  if (!fs.steps.empty()) return EvaluateWithNeighbours(fs, d0, r, phi, residuals);
   const std::vector<Bin>& bins = *fs.bins;
   FitState st;
   st.d0 = d0, st.r = r, st.phi = phi;
@@ -304,13 +302,64 @@ FitState Evaluate(const FitSetup& fs, double d0, double r, double phi, std::vect
     x = {x2[0], x2[1], 0, 0};
   }
   if (!solved) x = {rhs[0] / std::max(a[0][0], 1e-12), 0, 0, 0};  // the model is flat over the bins: no step
-  st.lin = x;
+  std::copy(x.begin(), x.end(), st.lin.begin());
   double sse = 0;
   if (residuals) residuals->resize(bins.size());
   for (size_t i = 0; i < bins.size(); ++i) {
     double m = 0;
     for (int p = 0; p < 4; ++p) m += x[p] * basis[i][p];
     const double res = bins[i].v - m;
+    sse += bins[i].w * res * res;
+    if (residuals) (*residuals)[i] = std::sqrt(bins[i].w) * res;
+  }
+  st.sse = sse;
+  return st;
+}
+
+// Evaluate with the steps of neighbouring edges in the profile: columns 1, E, t, t E (as above; the slopes only
+// with FitSetup::slopes) and E(x - d0 - g_k) per neighbour; unused columns are padded out of the system.
+FitState EvaluateWithNeighbours(const FitSetup& fs, double d0, double r, double phi, std::vector<double>* residuals) {
+  constexpr int K = 4 + kMaxNeighbours;
+  const std::vector<Bin>& bins = *fs.bins;
+  FitState st;
+  st.d0 = d0, st.r = r, st.phi = phi;
+  const EsfModel model(r, phi, fs.w1, fs.w2);
+  const int m = std::min<int>(fs.steps.size(), kMaxNeighbours);
+  std::array<bool, K> used{};
+  used[0] = used[1] = true;
+  used[2] = used[3] = fs.slopes;
+  std::array<std::optional<EsfModel>, kMaxNeighbours> other;
+  for (int k = 0; k < m; ++k) {
+    used[4 + k] = true;
+    if (fs.steps[k].r_px > 0) other[k].emplace(fs.steps[k].r_px, phi, fs.w1, fs.w2);
+  }
+  thread_local std::vector<std::array<double, K>> basis;
+  basis.resize(bins.size());
+  std::array<std::array<double, K>, K> a{};
+  std::array<double, K> rhs{};
+  for (size_t i = 0; i < bins.size(); ++i) {
+    const double x = bins[i].x - d0, e = model(x), t = bins[i].x / fs.half_window;
+    std::array<double, K>& b = basis[i];
+    b = {};
+    b[0] = 1, b[1] = e;
+    if (fs.slopes) b[2] = t, b[3] = t * e;
+    for (int k = 0; k < m; ++k) b[4 + k] = other[k] ? (*other[k])(x - fs.steps[k].at_px) : model(x - fs.steps[k].at_px);
+    for (int p = 0; p < K; ++p) {
+      rhs[p] += bins[i].w * b[p] * bins[i].v;
+      for (int q = 0; q < K; ++q) a[p][q] += bins[i].w * b[p] * b[q];
+    }
+  }
+  for (int p = 0; p < K; ++p)
+    if (!used[p]) a[p][p] = 1;
+  std::array<double, K> x{};
+  if (!Solve<K>(a, rhs, &x)) x = {};
+  st.lin = x;
+  double sse = 0;
+  if (residuals) residuals->resize(bins.size());
+  for (size_t i = 0; i < bins.size(); ++i) {
+    double v = 0;
+    for (int p = 0; p < K; ++p) v += x[p] * basis[i][p];
+    const double res = bins[i].v - v;
     sse += bins[i].w * res * res;
     if (residuals) (*residuals)[i] = std::sqrt(bins[i].w) * res;
   }
@@ -418,40 +467,33 @@ void StartEstimate(const std::vector<Bin>& bins, double half_window, double low,
   *r = std::max(0.3, std::sqrt(std::max(0.0, width * width - 0.64)) / 1.25);
 }
 
-// How far along the edge a crossing line of direction `cross` moves per px across it (0: perpendicular). Lines
-// within 6 degrees of the edge itself are not a square's side: treated as perpendicular.
-double CrossShear(const cv::Point2d& cross, const Frame& f) {
-  const double along = cross.dot(f.t), across = cross.dot(f.n);
-  if (!std::isfinite(along) || !std::isfinite(across) || !(std::abs(across) > 0.1 * std::hypot(along, across))) return 0;
-  return along / across;
-}
-
-}  // namespace
-
-ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, const ModelFitOptions& options) {
+// The fit in one window (edge_window.h). `prior`: a fit of the same edge in a narrower window, whose position, size
+// and step start this one (the wide window's outer parts hold other edges, so the plateau-based start would be
+// wrong there). Disqualifying flags but "crowded" are set; `along_span` is the extent of the samples along the edge.
+ModelFit FitInWindow(const cv::Mat& linear, const EdgeSegment& segment, const ModelFitOptions& options,
+                     const EdgeWindow& window, const ModelFit* prior, double* along_span) {
   ModelFit fit;
   fit.psf = "disc";
-  CV_Assert(linear.type() == CV_32FC1);
-  const Frame f = MakeFrame(segment);
-  const double hw = segment.half_window_px;
-  if (!(f.length > 1) || !(hw > 1) || linear.empty() || !std::isfinite(hw)) {
-    fit.flags = {"too_few_pixels"};
-    return fit;
-  }
+  const Frame f = MakeEdgeFrame(segment);
+  const double hw = window.HalfWidth();
+  *along_span = 0;
 
-  // Pixels in the central `along_fraction` of the section, +-hw across it: a parallelogram whose ends run parallel
-  // to the lines crossing the edge at a and b (a rectangle where they are perpendicular to it). A rectangle's
-  // corners would reach across an oblique crossing line into the next square, whose opposite colour and blurred
-  // edge pull the plateaus near the window's ends towards the step and widen the fitted edge (docs/independent-truth.md).
+  // Pixels in the window: across it from lo to hi, along it the central `along_fraction` of the strip between the
+  // column lines through the section's ends (perpendicular to the edge in the plain window: an oriented rectangle).
   const double frac = std::clamp(options.along_fraction, 0.0, 1.0);
-  const double s_lo = 0.5 * (1 - frac) * f.length, s_hi = 0.5 * (1 + frac) * f.length;
-  const double shear_a = CrossShear(segment.cross_a, f), shear_b = CrossShear(segment.cross_b, f);
+  auto along_range = [&](double d, double* lo, double* hi) {
+    const double sa = window.ka * d, sb = f.length + window.kb * d, margin = 0.5 * (1 - frac) * (sb - sa);
+    *lo = sa + margin, *hi = sb - margin;
+  };
   double xmin = 1e18, xmax = -1e18, ymin = 1e18, ymax = -1e18;
-  for (double d : {-hw, hw})
-    for (double s : {s_lo + shear_a * d, s_hi + shear_b * d}) {
+  for (double d : {window.lo(), window.hi()}) {
+    double s_lo, s_hi;
+    along_range(d, &s_lo, &s_hi);
+    for (double s : {s_lo, s_hi}) {
       const cv::Point2d p = f.a + s * f.t + d * f.n;
       xmin = std::min(xmin, p.x), xmax = std::max(xmax, p.x), ymin = std::min(ymin, p.y), ymax = std::max(ymax, p.y);
     }
+  }
   const int x0 = std::max(0, static_cast<int>(std::ceil(xmin))), x1 = std::min(linear.cols - 1, int(std::floor(xmax)));
   const int y0 = std::max(0, static_cast<int>(std::ceil(ymin))), y1 = std::min(linear.rows - 1, int(std::floor(ymax)));
   const double bow = std::isfinite(segment.bow_px) ? segment.bow_px : 0;
@@ -464,7 +506,10 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
     double s = (x0 - f.a.x) * f.t.x + ry * f.t.y;
     double d = (x0 - f.a.x) * f.n.x + ry * f.n.y;
     for (int x = x0; x <= x1; ++x, s += f.t.x, d += f.n.x) {
-      if (d < -hw || d > hw || s < s_lo + shear_a * d || s > s_hi + shear_b * d) continue;
+      if (d < window.lo() || d > window.hi()) continue;
+      double s_lo, s_hi;
+      along_range(d, &s_lo, &s_hi);
+      if (s < s_lo || s > s_hi) continue;
       const float v = row[x];
       if (!std::isfinite(v)) continue;
       // Across the bowed edge: the parabola's offset at s taken off (exact to first order in the bow).
@@ -474,6 +519,7 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
     }
   }
   fit.samples = static_cast<int>(samples.size());
+  *along_span = std::max(0.0, s_max - s_min);
   if (fit.samples < kMinSamples || s_max - s_min < 4) {
     fit.flags = {"too_few_pixels"};
     return fit;
@@ -492,16 +538,21 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
     bins = MakeBins(sub, hw, kFineBinPx, start, values);
   }
   double low = 0;
-  const double step0 = PlateauStep(bins, hw, &low);
+  const double step0 = prior ? prior->step : PlateauStep(bins, hw, &low);
   // Samples more than a quarter step (and 6 sigma) from their bin's median are printing flaws (or worse); bins
   // of r/8 hold at most ~1/16 step of slope either side of the median, so the edge itself is never cut.
   BinStats stats = RefineBins(bins, start, values, 0.25, step0, options.saturation_level, kBlackClip);
   double d0 = 0, r0 = 1;
-  StartEstimate(bins, hw, low, step0, &d0, &r0);
+  if (prior)
+    d0 = prior->offset_px, r0 = prior->r_px;
+  else
+    StartEstimate(bins, hw, low, step0, &d0, &r0);
 
   const double w1 = std::max(std::abs(f.n.x), std::abs(f.n.y)), w2 = std::min(std::abs(f.n.x), std::abs(f.n.y));
   FitSetup setup;
   setup.w1 = w1, setup.w2 = w2, setup.half_window = hw;
+  setup.steps = window.Steps();
+  const double d0_limit = segment.half_window_px;
   FitState best;
   double bin_width = 0;  // the start bins hold a subsample: always rebin
   // Bins wider than r/6 would smear the edge they sample; refit on finer bins when the fit says so. These passes
@@ -526,7 +577,7 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
       for (double scale : {1.0, 0.5}) {
         FitState start_state;
         start_state.d0 = d0, start_state.r = r0 * scale, start_state.phi = phi;
-        const FitState st = FitShape(setup, start_state, /*free_phi=*/false, hw);
+        const FitState st = FitShape(setup, start_state, /*free_phi=*/false, d0_limit);
         if (st.sse < best.sse) best = st;
         if (r0 < 1) break;
       }
@@ -543,7 +594,7 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
       FitState start_state = best;
       start_state.phi = phi;
       std::array<std::array<double, 3>, 3> a{};
-      const FitState st = FitShape(setup, start_state, /*free_phi=*/true, hw, &a);
+      const FitState st = FitShape(setup, start_state, /*free_phi=*/true, d0_limit, &a);
       if (st.sse < mixed.sse) mixed = st, jtj = a;
     }
     // A pure shape that stays better keeps the curvature of the mixed fit that came back towards it.
@@ -562,7 +613,7 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
   // The shape's standard error from the Gauss-Newton curvature, with the residual variance per bin (model error
   // included, so it errs on the side of "ambiguous"). Near r = 0 every shape looks alike: ambiguous by nature.
   {
-    const int params = 3 + (setup.slopes ? 4 : 2);
+    const int params = 3 + (setup.slopes ? 4 : 2) + static_cast<int>(setup.steps.size());
     const double dof = std::max(1.0, double(bins.size()) - params);
     std::array<std::array<double, 3>, 3> cov_in = jtj;
     std::array<double, 3> e2 = {0, 0, 1}, col{};
@@ -588,16 +639,50 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
   if (std::abs(fit.step) < options.min_contrast) flag("low_contrast");
   // Clipped noise tails do not bias the bin medians; clipped signal (a bin whose median is clipped) does.
   if (stats.clipped > options.max_saturated_fraction * fit.samples) flag("saturated");
-  // The blur must fit in the window on both sides of the edge, the X-junctions at the section ends must not
-  // reach into the central part used (a disc reaches r), and the image border must leave enough of that part.
-  const double reach = 1.5 * fit.r_px + 2;
-  // The X-junctions' distance from the samples is taken across the crossing lines (shorter where they lean).
-  const double lean = std::sqrt(1 + std::max(shear_a * shear_a, shear_b * shear_b));
-  if (reach > hw - std::abs(fit.offset_px) || 0.5 * (1 - frac) * f.length / lean < fit.r_px + 1 ||
-      s_max - s_min < std::min(2 * reach, 0.5 * frac * f.length))
-    flag("crowded");
   if (fit.rms_rel > options.max_rms_rel) flag("poor_fit");
   fit.ok = !bad;
+  return fit;
+}
+
+}  // namespace
+
+ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, const ModelFitOptions& options) {
+  CV_Assert(linear.type() == CV_32FC1);
+  const Frame f = MakeEdgeFrame(segment);
+  const double hw = segment.half_window_px;
+  if (!(f.length > 1) || !(hw > 1) || linear.empty() || !std::isfinite(hw)) {
+    ModelFit fit;
+    fit.psf = "disc";
+    fit.flags = {"too_few_pixels"};
+    return fit;
+  }
+  // The plain window first: half way to the next edge each side. The blur must fit in it with plateau to spare on
+  // both sides of the edge, the X-junctions at the section ends must not reach into the central part used (a disc
+  // reaches r), and the image border must leave enough of that part.
+  const EdgeWindow plain = PlainWindow(segment);
+  double span = 0;
+  ModelFit fit = FitInWindow(linear, segment, options, plain, nullptr, &span);
+  if (fit.samples < kMinSamples || fit.flags == std::vector<std::string>{"too_few_pixels"}) return fit;
+  std::string why = CrowdedReason(segment, plain, fit, options.along_fraction, span, /*plain=*/true);
+  // Blur reaching the neighbouring edges: the window reaches across them and their steps join the profile model,
+  // started from the plain fit (whose size is already close: the plain window holds most of the edge's spread).
+  if (!why.empty() && !segment.neighbours.empty() && fit.r_px > 0) {
+    const EdgeWindow wide = NeighbourWindow(segment, BlurReachPx(fit));
+    if (!wide.Steps().empty()) {
+      double wide_span = 0;
+      ModelFit across = FitInWindow(linear, segment, options, wide, &fit, &wide_span);
+      if (across.samples >= kMinSamples && across.r_px > 0) {
+        fit = std::move(across);
+        fit.flags.push_back("neighbours");
+        why = CrowdedReason(segment, wide, fit, options.along_fraction, wide_span, /*plain=*/false);
+      }
+    }
+  }
+  if (!why.empty()) {
+    fit.flags.push_back("crowded");
+    fit.crowded_why = why;
+    fit.ok = false;
+  }
   return fit;
 }
 
@@ -605,7 +690,7 @@ ThesisMeasure MeasureEdgeThesis(const cv::Mat& grey8, const EdgeSegment& segment
   ThesisMeasure out;
   if (grey8.empty()) return out;
   const cv::Mat grey = grey8.type() == CV_8UC1 ? grey8 : ToGrey8(grey8);
-  const Frame f = MakeFrame(segment);
+  const Frame f = MakeEdgeFrame(segment);
   if (!(f.length > 0) || !(segment.half_window_px >= 1)) return out;
   const cv::Point2d m = 0.5 * (segment.a + segment.b);
 

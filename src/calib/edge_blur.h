@@ -10,6 +10,14 @@
 
 namespace blurcue::calib {
 
+// A board edge parallel to a section and next to it: the same section of the edge before or after it, in image px,
+// its ends listed in the same order as the section's (a at the same column line as the section's a).
+struct NeighbourEdge {
+  cv::Point2d a, b;
+  double beyond_px = 0;  // how far past it the image holds no other edge (half the gap to the edge after it)
+  double r_px = 0;       // its blur where measured (its depth differs from the section's); 0: taken as the section's
+};
+
 // One edge section in image pixels.
 struct EdgeSegment {
   cv::Point2d a, b;          // end points (the square corners bounding the section)
@@ -23,6 +31,10 @@ struct EdgeSegment {
   // turned about the table normal, seen obliquely) those lines lean across the window; the samples keep their
   // distance from them along the edge at every offset across it, so the crossing edges never enter.
   cv::Point2d cross_a{0, 0}, cross_b{0, 0};
+  // The parallel board edges on either side, where the board has them (calibrate.cc gives them from the pose). When
+  // the blur reaches past half_window_px, the window reaches across them and the profile model includes their steps
+  // (edge_window.h) instead of refusing the section as "crowded".
+  std::vector<NeighbourEdge> neighbours = {};
 };
 
 struct ModelFitOptions {
@@ -36,7 +48,9 @@ struct ModelFitOptions {
 struct ModelFit {
   bool ok = false;                 // usable: none of the disqualifying flags below
   std::vector<std::string> flags;  // "low_contrast", "saturated", "crowded", "poor_fit", "too_few_pixels"
-                                   // disqualify; "flaw" (robustly rejected outliers) is informational
+                                   // disqualify; "flaw" (robustly rejected outliers) and "neighbours" (measured
+                                   // across the neighbouring edges, their steps in the model) are informational
+  std::string crowded_why;         // with "crowded": why the blur cannot be measured here, in words
   double r_px = 0;                 // optical blur radius: 2 x the std of the optical LSF, pixel aperture removed
                                    // (the fitted disc x Gaussian's second moment, whatever its shape)
   // The shape within r_px^2 = disc_r_px^2 + 4 floor_sigma_px^2 (DESIGN.md): a defocus disc and a Gaussian floor.

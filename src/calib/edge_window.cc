@@ -1,0 +1,130 @@
+#include "calib/edge_window.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace blurcue::calib {
+namespace {
+
+// Signed distance along the normal from the section's middle to the neighbour's line (px); 0 when the neighbour is
+// degenerate or runs along the normal.
+double NeighbourDistance(const EdgeFrame& x, const NeighbourEdge& k) {
+  const cv::Point2d m = x.a + 0.5 * x.length * x.t, dir = k.b - k.a;
+  const double along = x.t.dot(dir);
+  if (!(std::abs(along) > 1e-9)) return 0;
+  const double lambda = x.t.dot(m - k.a) / along;  // where the normal through m meets the neighbour's line
+  const double g = x.n.dot(k.a + lambda * dir - m);
+  return std::isfinite(g) ? g : 0;
+}
+
+// Along-per-across slope of the line from a section end `p` to the neighbour's matching end `q`.
+double ColumnSlope(const EdgeFrame& x, const cv::Point2d& p, const cv::Point2d& q) {
+  const double across = x.n.dot(q - p);
+  return std::abs(across) > 1e-9 ? x.t.dot(q - p) / across : 0;
+}
+
+// How far along the edge a crossing line of direction `cross` moves per px across it (0: perpendicular, or not
+// given). Lines within 6 degrees of the edge itself are not a square's side: treated as perpendicular.
+double CrossShear(const cv::Point2d& cross, const EdgeFrame& f) {
+  const double along = cross.dot(f.t), across = cross.dot(f.n);
+  if (!std::isfinite(along) || !std::isfinite(across) || !(std::abs(across) > 0.1 * std::hypot(along, across))) return 0;
+  return along / across;
+}
+
+std::string Format(const char* fmt, double a, double b, double c = 0) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, fmt, a, b, c);
+  return buf;
+}
+
+}  // namespace
+
+EdgeFrame MakeEdgeFrame(const EdgeSegment& s) {
+  EdgeFrame f;
+  f.a = s.a;
+  const cv::Point2d d = s.b - s.a;
+  f.length = std::hypot(d.x, d.y);
+  if (f.length > 0) f.t = d / f.length;
+  f.n = cv::Point2d(-f.t.y, f.t.x);
+  return f;
+}
+
+std::vector<EdgeWindow::Step> EdgeWindow::Steps() const {
+  std::vector<Step> out;
+  if (minus.neighbour_px > 0) out.push_back({-minus.neighbour_px, minus.neighbour_r_px});
+  if (plus.neighbour_px > 0) out.push_back({plus.neighbour_px, plus.neighbour_r_px});
+  return out;
+}
+
+EdgeWindow PlainWindow(const EdgeSegment& segment) {
+  EdgeWindow w;
+  w.minus.end_px = w.plus.end_px = segment.half_window_px;
+  const EdgeFrame x = MakeEdgeFrame(segment);
+  w.ka = CrossShear(segment.cross_a, x), w.kb = CrossShear(segment.cross_b, x);
+  return w;
+}
+
+EdgeWindow NeighbourWindow(const EdgeSegment& segment, double reach_px) {
+  EdgeWindow w = PlainWindow(segment);
+  const EdgeFrame x = MakeEdgeFrame(segment);
+  double ka = 0, kb = 0;
+  int slopes = 0;
+  for (const NeighbourEdge& k : segment.neighbours) {
+    const double g = NeighbourDistance(x, k);
+    if (g == 0 || !(k.beyond_px >= 0)) continue;
+    EdgeWindow::Side& side = g > 0 ? w.plus : w.minus;
+    if (side.neighbour_px > 0 && side.neighbour_px <= std::abs(g)) continue;  // the nearer one on a side
+    side.neighbour_px = std::abs(g);
+    side.neighbour_r_px = std::isfinite(k.r_px) && k.r_px > 0 ? k.r_px : 0;
+    // Past the neighbour until the edge after it (2 x beyond_px further) comes within reach.
+    side.end_px = side.neighbour_px + std::max(0.0, std::min(k.beyond_px, 2 * k.beyond_px - reach_px));
+    ka += ColumnSlope(x, segment.a, k.a), kb += ColumnSlope(x, segment.b, k.b), ++slopes;
+  }
+  // The crossing lines' own directions where calibrate gave them; otherwise the lines to the neighbours' ends.
+  const bool crossing = segment.cross_a != cv::Point2d(0, 0) || segment.cross_b != cv::Point2d(0, 0);
+  if (slopes > 0 && !crossing) w.ka = ka / slopes, w.kb = kb / slopes;
+  return w;
+}
+
+double BlurReachPx(const ModelFit& fit) {
+  if (fit.shape_ambiguous) return 1.5 * fit.r_px + 1.5;
+  return fit.disc_r_px + 3 * fit.floor_sigma_px + 1.5;
+}
+
+std::string CrowdedReason(const EdgeSegment& segment, const EdgeWindow& window, const ModelFit& fit,
+                          double along_fraction, double along_span_px, bool plain) {
+  const double r = fit.r_px, offset = std::abs(fit.offset_px);
+  const double reach = plain ? 1.5 * r + 2 : BlurReachPx(fit);
+  for (const EdgeWindow::Side* side : {&window.minus, &window.plus}) {
+    if (side->neighbour_px == 0) {
+      if (reach > side->end_px - offset)
+        return Format(plain ? "its blur (r = %.2f px) needs %.1f px each side of the edge, but the next edge is %.1f "
+                              "px away"
+                            : "its blur (r = %.2f px) reaches %.1f px from the edge, past the %.1f px free of other "
+                              "edges on the side without a neighbouring edge",
+                      r, reach, plain ? 2 * side->end_px : side->end_px);
+    } else {
+      if (side->neighbour_px < r)
+        return Format("the neighbouring edge (%.1f px away) lies inside its blur (r = %.2f px)", side->neighbour_px,
+                      r);
+      if (side->end_px - side->neighbour_px < 1)
+        return Format("the edge after the neighbouring one (%.1f px away) lies within reach of its blur (r = %.2f "
+                      "px)", side->neighbour_px, r);
+    }
+  }
+  const double length = cv::norm(segment.b - segment.a), frac = std::clamp(along_fraction, 0.0, 1.0);
+  double margin = 1e300;
+  for (double d : {window.lo(), window.hi()})
+    margin = std::min(margin, 0.5 * (1 - frac) * (length + (window.kb - window.ka) * d));
+  // The X-junctions' distance from the samples is taken across the crossing lines (shorter where they lean).
+  margin /= std::sqrt(1 + std::max(window.ka * window.ka, window.kb * window.kb));
+  if (margin < r + 1)
+    return Format("the X-junctions at the section's ends lie %.1f px from the part measured, within its blur (r = "
+                  "%.2f px): the section is too short", margin, r);
+  if (along_span_px < std::min(2 * reach, 0.5 * frac * length))
+    return Format("the image border leaves %.1f px of the section's %.1f px", along_span_px, length);
+  return "";
+}
+
+}  // namespace blurcue::calib
