@@ -7,7 +7,8 @@
 #include <map>
 #include <sstream>
 
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // its flags (the functions: core/media.h)
+#include "core/media.h"
 
 #include "calib/calibrate.h"
 #include "calib/truth.h"
@@ -314,12 +315,12 @@ PipelineTiming TimeFullResolution(int repeats, const std::function<void(const st
   const synth::Scene scene = synth::RenderScene(o);
   t.render_s = Ms(t0) / 1000;
   std::vector<uint8_t> png;
-  cv::imencode(".png", scene.image, png);
+  media::Imencode(".png", scene.image, &png);
   t.total_ms = t.decode_ms = t.detect_ms = t.measure_ms = t.estimate_ms = 1e30;
   calib::CalibResult result;
   for (int rep = 0; rep < repeats; ++rep) {
     t0 = Clock::now();
-    const cv::Mat photo = cv::imdecode(png, cv::IMREAD_COLOR);
+    const cv::Mat photo = media::Imdecode(png, cv::IMREAD_COLOR);
     t.decode_ms = std::min(t.decode_ms, Ms(t0));
     t0 = Clock::now();
     result = calib::Calibrate(photo, scene.camera, scene.board);

@@ -13,7 +13,8 @@
 #include <fstream>
 #include <sstream>
 
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // its flags (the functions: core/media.h)
+#include "core/media.h"
 
 #include "calib/calibrate.h"
 #include "calib/truth.h"
@@ -100,7 +101,7 @@ std::vector<TrackRow> RunTrackBench(const TrackBenchOptions& options) {
     const auto t0 = Clock::now();
     synth::TakeFrame f = synth::RenderTakeFrame(take, i);
     png.emplace_back();
-    cv::imencode(".png", f.scene.image, png.back());
+    media::Imencode(".png", f.scene.image, &png.back());
     truth.push_back(std::move(f.scene));
     if (options.progress)
       options.progress("rendered frame " + std::to_string(i + 1) + "/" + std::to_string(frames) + " in " +
@@ -123,7 +124,7 @@ std::vector<TrackRow> RunTrackBench(const TrackBenchOptions& options) {
       row.mode = mode;
       row.frame = i;
       auto t0 = Clock::now();
-      const cv::Mat photo = cv::imdecode(png[i], cv::IMREAD_COLOR);
+      const cv::Mat photo = media::Imdecode(png[i], cv::IMREAD_COLOR);
       row.decode_ms = Ms(t0);
       if (mode == "calibrate") {
         t0 = Clock::now();

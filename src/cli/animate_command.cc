@@ -10,7 +10,7 @@
 #include <unistd.h>
 
 #include <opencv2/calib3d.hpp>
-#include <opencv2/videoio.hpp>
+#include "core/media.h"
 
 #include "calib/scene_blur.h"
 #include "cli/commands.h"
@@ -129,12 +129,11 @@ void AddAnimateCommand(CLI::App& app) {
                                          BoundText(args->fps) + " make " + BoundText(frame_count) +
                                          " frames; at most " + BoundText(kMaxFrames) + " (go faster or lower --fps)");
     const int frames = std::max(1, int(frame_count));
-    cv::VideoWriter video;
+    media::VideoWriter video;
     if (!args->video.empty()) {
       if (std::filesystem::path(args->video).has_parent_path())
         std::filesystem::create_directories(std::filesystem::path(args->video).parent_path());
-      video.open(args->video, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), args->fps, photo.size());
-      if (!video.isOpened()) throw InputError(args->video, "cannot open a video writer (MJPG .avi)");
+      if (!video.Open(args->video, media::Fourcc('M', 'J', 'P', 'G'), args->fps, photo.size())) throw InputError(args->video, "cannot open a video writer (MJPG .avi)");
     }
     // The log is written whole at the end (WriteFileAtomically): a run cut short leaves no half log.
     std::ostringstream log;
@@ -199,9 +198,9 @@ void AddAnimateCommand(CLI::App& app) {
         context->SwapBuffers();
         flip_s = std::chrono::duration<double>(Clock::now() - start).count();
       }
-      if (video.isOpened() || !args->frames_dir.empty()) {
+      if (video.IsOpened() || !args->frames_dir.empty()) {
         const cv::Mat frame = compositor.Read();
-        if (video.isOpened()) video.write(frame);
+        if (video.IsOpened()) video.Write(frame);
         if (!args->frames_dir.empty()) {
           char name[32];
           std::snprintf(name, sizeof name, "frame-%05d.png", i);

@@ -11,7 +11,7 @@
 
 #include <unistd.h>
 
-#include <opencv2/videoio.hpp>
+#include "core/media.h"
 
 #include "calib/scene_blur.h"
 #include "cli/commands.h"
@@ -157,7 +157,7 @@ void AddArCommand(CLI::App& app) {
 
     std::unique_ptr<render::GlContext> context = render::GlContext::CreateOffscreen();
     std::unique_ptr<render::FrameCompositor> compositor;
-    cv::VideoWriter video;
+    media::VideoWriter video;
     std::string codec_used;
     if (std::filesystem::path(args->out).has_parent_path())
       std::filesystem::create_directories(std::filesystem::path(args->out).parent_path());
@@ -182,7 +182,7 @@ void AddArCommand(CLI::App& app) {
                                           std::to_string(frame.rows) + " px; the take's calibration is " +
                                           std::to_string(camera.image_width_px) + " x " +
                                           std::to_string(camera.image_height_px) + " (another take?)");
-      if (!video.isOpened()) {
+      if (!video.IsOpened()) {
         const char* codec = OpenLosslessVideo(video, args->out, source.fps() > 0 ? source.fps() : 30, frame.size());
         if (!codec) throw InputError(args->out, "cannot open a video writer (FFV1 or MJPEG .avi)");
         codec_used = codec;
@@ -203,7 +203,7 @@ void AddArCommand(CLI::App& app) {
       } else {
         ++unposed;
       }
-      video.write(out);
+      video.Write(out);
       if (!args->frames_dir.empty()) {
         char name[32];
         std::snprintf(name, sizeof name, "frame-%04d.png", index);
@@ -218,7 +218,7 @@ void AddArCommand(CLI::App& app) {
                      status.c_str(), tty ? "   " : "\n");
     }
     if (tty) std::fprintf(stderr, "\n");
-    video.release();  // the frames written so far make a whole file, also when the input ended early
+    video.Release();  // the frames written so far make a whole file, also when the input ended early
     WriteFileAtomically(csv_path, csv);
     if (!args->quiet) {
       std::printf("%d frames: %d with objects, %d without (lost or beyond track.csv); wrote %s (%s) and %s in %.1f s\n",

@@ -12,7 +12,6 @@
 
 #include <unistd.h>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/atomic_file.h"
@@ -163,7 +162,7 @@ cv::Mat ReadImage(const std::filesystem::path& path, int flags) {
   {
     CapturedStderr captured;
     try {
-      image = cv::imread(path.string(), flags);
+      image = media::Imread(path.string(), flags);
     } catch (const cv::Exception& e) {
       decoder_said = e.err;
     }
@@ -181,7 +180,7 @@ void WriteImage(const std::filesystem::path& path, const cv::Mat& image) {
   std::vector<uchar> bytes;
   bool ok = false;
   try {
-    ok = cv::imencode(path.extension().string(), image, bytes);
+    ok = media::Imencode(path.extension().string(), image, &bytes);
   } catch (const cv::Exception&) {
     // OpenCV's own text runs over several lines and names its source file: say what the user can change instead.
     throw InputError(path.string(), "cannot encode an image as '" + path.extension().string() +
@@ -264,10 +263,9 @@ void ToGrey8(const cv::Mat& image, cv::Mat& grey) {
   cv::cvtColor(image, grey, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
 }
 
-const char* OpenLosslessVideo(cv::VideoWriter& video, const std::filesystem::path& path, double fps, cv::Size size) {
+const char* OpenLosslessVideo(media::VideoWriter& video, const std::filesystem::path& path, double fps, cv::Size size) {
   for (const char* codec : {"FFV1", "MJPG"}) {
-    video.open(path.string(), cv::VideoWriter::fourcc(codec[0], codec[1], codec[2], codec[3]), fps, size);
-    if (video.isOpened()) return codec;
+    if (video.Open(path.string(), media::Fourcc(codec[0], codec[1], codec[2], codec[3]), fps, size)) return codec;
   }
   return nullptr;
 }

@@ -4,7 +4,8 @@
 #include <filesystem>
 
 #include <opencv2/core.hpp>
-#include <opencv2/videoio.hpp>
+
+#include "core/media.h"
 
 namespace blurcue {
 
@@ -15,7 +16,7 @@ void WriteImage(const std::filesystem::path& path, const cv::Mat& image);
 
 // Opens `video` on an .avi at `path`: lossless FFV1 first (measurements are of edges a JPEG would soften), MJPEG,
 // which every videoio writes, else. Returns the codec opened ("FFV1" or "MJPG"), or nullptr when neither opens.
-const char* OpenLosslessVideo(cv::VideoWriter& video, const std::filesystem::path& path, double fps, cv::Size size);
+const char* OpenLosslessVideo(media::VideoWriter& video, const std::filesystem::path& path, double fps, cv::Size size);
 
 // sRGB transfer function, one channel value in [0, 1].
 double SrgbToLinear(double v);

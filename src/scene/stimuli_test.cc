@@ -257,7 +257,7 @@ TEST(Stimuli, WriteStandardStimuliWritesFourReadablePngs) {
   ASSERT_EQ(files.size(), 4u);
   const std::vector<cv::Size> sizes{{2048, 1024}, {2048, 1024}, {1024, 1024}, {800, 1200}};
   for (size_t i = 0; i < files.size(); ++i) {
-    const cv::Mat image = cv::imread(files[i].string(), cv::IMREAD_UNCHANGED);
+    const cv::Mat image = ReadImage(files[i], cv::IMREAD_UNCHANGED);
     ASSERT_FALSE(image.empty()) << files[i];
     EXPECT_EQ(image.size(), sizes[i]) << files[i];
   }

@@ -10,7 +10,8 @@
 #include <thread>
 
 #include <opencv2/calib3d.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // its flags (the functions: core/media.h)
+#include "core/media.h"
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
@@ -200,8 +201,8 @@ cv::Mat Finish(cv::Mat linear, const SceneOptions& o, Rng rng) {
   cv::cvtColor(grey8, bgr, cv::COLOR_GRAY2BGR);
   if (o.jpeg_quality > 0) {
     std::vector<uint8_t> bytes;
-    cv::imencode(".jpg", bgr, bytes, {cv::IMWRITE_JPEG_QUALITY, o.jpeg_quality});
-    bgr = cv::imdecode(bytes, cv::IMREAD_COLOR);
+    media::Imencode(".jpg", bgr, &bytes, {cv::IMWRITE_JPEG_QUALITY, o.jpeg_quality});
+    bgr = media::Imdecode(bytes, cv::IMREAD_COLOR);
   }
   return bgr;
 }

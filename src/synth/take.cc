@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <sstream>
 
-#include <opencv2/videoio.hpp>
+#include "core/media.h"
 
 #include "core/error.h"
 #include "core/image.h"
@@ -67,7 +67,7 @@ TakeFiles WriteTake(const TakeOptions& o, const std::filesystem::path& dir,
   ValidateTake(o);
   std::filesystem::create_directories(dir);
   TakeFiles files;
-  cv::VideoWriter video;
+  media::VideoWriter video;
   Json frames = Json::array();
   for (int i = 0; i < o.frames; ++i) {
     const TakeFrame f = RenderTakeFrame(o, i);
@@ -80,7 +80,7 @@ TakeFiles WriteTake(const TakeOptions& o, const std::filesystem::path& dir,
         files.video_codec = codec;
       }
     }
-    if (video.isOpened()) video.write(f.scene.image);
+    if (video.IsOpened()) video.Write(f.scene.image);
     frames.push_back({{"frame", i},
                       {"file", TakeFrameName(i)},
                       {"truth", TakeTruthName(i)},
@@ -90,7 +90,7 @@ TakeFiles WriteTake(const TakeOptions& o, const std::filesystem::path& dir,
       progress("frame " + std::to_string(i + 1) + "/" + std::to_string(o.frames) + ": edge 1 at " +
                Num(std::round(f.scene.sections.front().u_mm * 10) / 10) + " mm");
   }
-  video.release();
+  video.Release();
   files.frames = o.frames;
   Json take = {{"generator", "blurcue synth-take"},
                {"frames", o.frames},

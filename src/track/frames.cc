@@ -6,6 +6,7 @@
 #include <regex>
 
 #include <opencv2/core/utils/logger.hpp>
+#include <opencv2/videoio.hpp>  // its constants (the reader: core/media.h)
 
 #include "core/error.h"
 #include "core/image.h"
@@ -51,15 +52,15 @@ FrameSource::FrameSource(const std::string& input, double fps) : input_(input), 
   const cv::utils::logging::LogLevel level = cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
   bool opened = false;
   try {
-    opened = video_.open(input, cv::CAP_FFMPEG) && video_.isOpened();
+    opened = video_.Open(input, cv::CAP_FFMPEG);
   } catch (const cv::Exception&) {
     opened = false;
   }
   cv::utils::logging::setLogLevel(level);
   if (!opened) throw InputError(input, "OpenCV's videoio (FFmpeg) cannot open it as a video");
-  const double rate = video_.get(cv::CAP_PROP_FPS);
+  const double rate = video_.Get(cv::CAP_PROP_FPS);
   if (rate > 0 && rate <= 1000) fps_ = rate;
-  const double count = video_.get(cv::CAP_PROP_FRAME_COUNT);
+  const double count = video_.Get(cv::CAP_PROP_FRAME_COUNT);
   expected_ = count > 0 && count < 1e7 ? static_cast<int>(std::lround(count)) : 0;
 }
 
@@ -83,7 +84,7 @@ bool FrameSource::Next(cv::Mat* frame, int* index, double* time_s) {
   }
   bool ok = false;
   try {
-    ok = video_.read(*frame);
+    ok = video_.Read(frame);
   } catch (const cv::Exception& e) {
     throw InputError(input_, "frame " + std::to_string(next_) + " cannot be decoded (" + e.err + ")");
   }

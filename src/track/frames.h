@@ -7,7 +7,8 @@
 #include <string>
 
 #include <opencv2/core.hpp>
-#include <opencv2/videoio.hpp>
+
+#include "core/media.h"
 
 namespace blurcue::track {
 
@@ -31,7 +32,7 @@ class FrameSource {
  private:
   std::string input_;
   std::optional<std::string> pattern_;
-  cv::VideoCapture video_;
+  media::VideoReader video_;
   double fps_ = 30;
   int expected_ = 0;
   int next_ = 0;
