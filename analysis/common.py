@@ -338,9 +338,12 @@ def save(fig, out_dir, name):
     png = os.path.join(out_dir, file_stem(name) + ".png")
     svg = os.path.join(out_dir, file_stem(name) + ".svg")
     try:
+        # The tight box once for both files (bbox_inches="tight" draws the figure again for each file to find it).
+        fig.draw_without_rendering()
+        bbox = fig.get_tightbbox(fig.canvas.get_renderer()).padded(plt.rcParams["savefig.pad_inches"])
         for path in (png, svg):
             with writing(path):
-                fig.savefig(path, bbox_inches="tight")
+                fig.savefig(path, bbox_inches=bbox)
     finally:
         plt.close(fig)
     return png, svg
