@@ -19,13 +19,16 @@ here, and r the object's round radius without distortion (FLAT's record, where t
 elliptical PSF of covariance r^2 / 4 J J^T has r_x = r |J row 0| and r_y = r |J row 1|. Exits 1 when a measured
 radius is off the prediction by more than max(tolerance-px, tolerance-rel x r), when the distorted record's
 r_x_screen_px / r_y_screen_px are, or when the object at the principal point (J = I there) is not round or not the
-size it was without distortion, within the same tolerance.
+size it was without distortion, within the same tolerance. The round radius the trial JSON's r_screen_px and the
+record (--db: the trials' r_left_px / r_right_px in photo px and their factors' r_*_screen_px) give must be r
+sqrt(det J), the geometric mean of the principal radii (docs/distortion.md), within the same tolerance.
 """
 import argparse
 import glob
 import json
 import math
 import os
+import sqlite3
 import sys
 
 import numpy as np
@@ -170,6 +173,7 @@ def check(args):
     bad = checked = 0
     worst = 0.0
     centre_seen = False
+    db = sqlite3.connect(args.db) if args.db else None
     for path in trials:
         name = os.path.basename(path)[:-5]
         frame = json.load(open(path))
@@ -196,10 +200,20 @@ def check(args):
                 worst = max(worst, abs(value - want) / limit)
                 return f"{'BAD ' if off else ''}{label} {value:.4f} vs {want:.4f} (limit {limit:.3f})"
 
+            # The round radius the record gives: the geometric mean of the principal radii, r sqrt(det J).
+            stretch = math.sqrt(abs(np.linalg.det(j)))
             parts = [judge("shown r_x", rx, pred_x, pred_x), judge("shown r_y", ry, pred_y, pred_y),
                      judge("recorded r_x", o["r_x_screen_px"], pred_x, pred_x),
                      judge("recorded r_y", o["r_y_screen_px"], pred_y, pred_y),
-                     judge("flat r_x", fx, r0, r0), judge("flat r_y", fy, r0, r0)]
+                     judge("recorded round r", o["r_screen_px"], r0 * stretch, r0 * stretch)]
+            if args.db:
+                row = db.execute(f"SELECT r_{o['side']}_px, factors FROM trials WHERE trial_index = ?",
+                                 (frame["trial_index"],)).fetchone()
+                want = o0["r_camera_px"] * stretch
+                parts += [judge("record's photo px", row[0], want, want),
+                          judge("record's screen px", json.loads(row[1])[f"r_{o['side']}_screen_px"], r0 * stretch,
+                                r0 * stretch)]
+            parts += [judge("flat r_x", fx, r0, r0), judge("flat r_y", fy, r0, r0)]
             if at_centre:
                 parts += [judge("centre r_x - r_y", rx - ry, 0, r0), judge("centre r_x vs flat", rx, fx, fx),
                           judge("centre r_y vs flat", ry, fy, fy)]
@@ -225,6 +239,7 @@ def main():
     ap.add_argument("dist_twin")
     ap.add_argument("flat")
     ap.add_argument("flat_twin")
+    ap.add_argument("--db", help="the distorted run's SQLite record: its trials' round radii are checked too")
     ap.add_argument("--tolerance-px", type=float, default=0.03)
     ap.add_argument("--tolerance-rel", type=float, default=0.03)
     return check(ap.parse_args())

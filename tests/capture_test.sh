@@ -418,7 +418,7 @@ PYEOF
       grep -q "\"blur_plan\": \"$([ $pose = standing ] && echo per_pixel || echo one_radius)\"" "$W/$name/trial-0001.json" \
           || fail "$name: not drawn through the $([ $pose = standing ] && echo CPU || echo GL) path"
       $PY "$(dirname "$0")/capture_distortion.py" check "$W/k1.json" "$W/$name" "$W/twin-$pose-k1" \
-          "$W/$pose-flat-$kernel" "$W/twin-$pose-flat" > "$W/$name.txt" \
+          "$W/$pose-flat-$kernel" "$W/twin-$pose-flat" --db "$W/$name.sqlite" > "$W/$name.txt" \
           || fail "$name: $(grep BAD "$W/$name.txt" | head -2) $(tail -1 "$W/$name.txt")"
       sed "s/^/$pose $kernel /" "$W/$name.txt"
     done
