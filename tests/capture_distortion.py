@@ -34,7 +34,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from capture_kernel import linear, solve_kernel  # noqa: E402  (test code: numpy least squares, nothing of blurcue's)
+from capture_kernel import linear, object_box, solve_kernel  # noqa: E402  (test code: numpy least squares, nothing of blurcue's)
 
 
 def intrinsics(camera):
@@ -145,11 +145,7 @@ def measure(blurred_dir, sharp_dir, name, o, r_hint):
     sharp = linear(os.path.join(sharp_dir, name + ".png"))
     height, width = blurred.shape[:2]
     h = max(3, math.ceil(1.6 * r_hint) + 2)
-    xs = [p[0] for p in o["outline_px"]]
-    ys = [p[1] for p in o["outline_px"]]
-    margin = h + 2
-    box = (max(h, int(min(xs)) - margin), max(h, int(min(ys)) - margin),
-           min(width - h, int(math.ceil(max(xs))) + margin), min(height - h, int(math.ceil(max(ys))) + margin))
+    box = object_box(o, h, width, height)
     if box[2] - box[0] < 4 * h or box[3] - box[1] < 4 * h:
         raise SystemExit(f"BAD {name} {o['side']}: the object is not in the frame (box {box})")
     return marginal_radii(solve_kernel(sharp, blurred, box, h))
