@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""capture_distortion.py place CALIB [Z_MM]  |  capture_distortion.py check CALIB DIST DIST_TWIN FLAT FLAT_TWIN [--tolerance-px 0.03 --tolerance-rel 0.03]
+"""capture_distortion.py place CALIB [Z_MM]  |  capture_distortion.py check CALIB DIST DIST_TWIN FLAT FLAT_TWIN [--db DB --tolerance-px 0.03 --tolerance-rel 0.03]
 
 A virtual object's blur under lens distortion, found on captured frames without any of blurcue's code.
 
@@ -19,7 +19,8 @@ here, and r the object's round radius without distortion (FLAT's record, where t
 elliptical PSF of covariance r^2 / 4 J J^T has r_x = r |J row 0| and r_y = r |J row 1|. Exits 1 when a measured
 radius is off the prediction by more than max(tolerance-px, tolerance-rel x r), when the distorted record's
 r_x_screen_px / r_y_screen_px are, or when the object at the principal point (J = I there) is not round or not the
-size it was without distortion, within the same tolerance. The round radius the trial JSON's r_screen_px and the
+size it was without distortion, or when FLAT's own blur along x or y is not its record, within the same tolerance.
+The round radius the trial JSON's r_screen_px and the
 record (--db: the trials' r_left_px / r_right_px in photo px and their factors' r_*_screen_px) give must be r
 sqrt(det J), the geometric mean of the principal radii (docs/distortion.md), within the same tolerance.
 """
