@@ -13,10 +13,12 @@ check: DIST holds the trial-NNNN.json / .png a `run --capture` wrote with CALIB 
 the same protocol with the same calibration without them; DIST_TWIN and FLAT_TWIN each run's unblurred twin (blur 0,
 the same geometry). For every object, the kernel that maps the twin onto the frame (tests/capture_kernel.py's least
 squares, numpy only) gives the drawn blur's radius along x and y: 2 x the standard deviation of its x and y
-marginals (the profile across a vertical and a horizontal edge). The prediction is the Jacobian's: with J the
+marginals (the profile across a vertical and a horizontal edge), and across the two diagonals (its covariance along
+(1, +-1) / sqrt(2)), which with x and y pin the ellipse's tilt too. The prediction is the Jacobian's: with J the
 distortion map's Jacobian at the object's ideal (undistorted) place, by central finite differences of the formula
 here, and r the object's round radius without distortion (FLAT's record, where the photo is the pinhole image), an
-elliptical PSF of covariance r^2 / 4 J J^T has r_x = r |J row 0| and r_y = r |J row 1|. Exits 1 when a measured
+elliptical PSF of covariance r^2 / 4 J J^T has r_x = r |J row 0|, r_y = r |J row 1| and r_n = r |J^T n| across
+a unit normal n. Exits 1 when a measured
 radius is off the prediction by more than max(tolerance-px, tolerance-rel x r), when the distorted record's
 r_x_screen_px / r_y_screen_px are, or when the object at the principal point (J = I there) is not round or not the
 size it was without distortion, or when FLAT's own blur along x or y is not its record, within the same tolerance.
@@ -181,8 +183,12 @@ def check(args):
             ui, vi = lens.ideal_of_photo(*screen_to_photo(frame, o["center_px"]))
             j = lens.jacobian(ui, vi)
             pred_x, pred_y = r0 * np.linalg.norm(j[0]), r0 * np.linalg.norm(j[1])
-            pred_xy = r0 * r0 / 4 * (j @ j.T)[0, 1]
+            # Across the diagonals (edges at 45 degrees): 2 sqrt(n^T C n), n = (1, +-1) / sqrt(2); the measured ones
+            # from the kernel's covariance. With x and y they pin all three terms of the ellipse, its tilt included.
+            pred_d = [r0 * np.linalg.norm(j.T @ np.array([1.0, sign]) / math.sqrt(2)) for sign in (1, -1)]
             rx, ry, vxy, total = measure(args.dist, args.dist_twin, name, o, max(pred_x, pred_y))
+            mean_var = (rx * rx + ry * ry) / 8
+            rd = [2 * math.sqrt(max(0.0, mean_var + sign * vxy)) for sign in (1, -1)]
             fx, fy, _, _ = measure(args.flat, args.flat_twin, name, o0, r0)
             rho = math.hypot((ui - lens.cx) / lens.fx, (vi - lens.cy) / lens.fy)
             at_centre = math.hypot(ui - lens.cx, vi - lens.cy) < 1
@@ -200,6 +206,8 @@ def check(args):
             # The round radius the record gives: the geometric mean of the principal radii, r sqrt(det J).
             stretch = math.sqrt(abs(np.linalg.det(j)))
             parts = [judge("shown r_x", rx, pred_x, pred_x), judge("shown r_y", ry, pred_y, pred_y),
+                     judge("shown r across (1, 1)", rd[0], pred_d[0], pred_d[0]),
+                     judge("shown r across (1, -1)", rd[1], pred_d[1], pred_d[1]),
                      judge("recorded r_x", o["r_x_screen_px"], pred_x, pred_x),
                      judge("recorded r_y", o["r_y_screen_px"], pred_y, pred_y),
                      judge("recorded round r", o["r_screen_px"], r0 * stretch, r0 * stretch)]
@@ -214,10 +222,9 @@ def check(args):
             if at_centre:
                 parts += [judge("centre r_x - r_y", rx - ry, 0, r0), judge("centre r_x vs flat", rx, fx, fx),
                           judge("centre r_y vs flat", ry, fy, fy)]
-            # The ellipse's tilt: its xy covariance, printed (judged through r_x and r_y's sizes only).
             print(f"{name} {o['side']} {o['kernel']}: ideal ({ui:.1f}, {vi:.1f}) px, rho {rho:.3f}, "
                   f"|J rows| {np.linalg.norm(j[0]):.4f} {np.linalg.norm(j[1]):.4f}, r without distortion {r0:.4f}; "
-                  + "; ".join(parts) + f"; cov xy {vxy:+.4f} vs {pred_xy:+.4f} px^2, kernel sum {total:.4f}")
+                  + "; ".join(parts) + f"; kernel sum {total:.4f}")
     if not centre_seen:
         print("BAD no object at the principal point")
         bad += 1
