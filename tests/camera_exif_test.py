@@ -128,6 +128,40 @@ p = photo("tiny.jpg", (600, 400), {MODEL: "NEX-5N"}, {FOCAL: R(1, 10), FNUMBER: 
 code, _, err = run(p)
 check("an impossible focal length is refused naming the field", code == 3 and "focal_length_mm" in err, (code, err))
 
+# 9. A zero focal length (a lens without electronic contacts writes 0/1): refused naming the tag and the option.
+p = photo("zero-focal.jpg", (600, 400), {MODEL: "NEX-5N"}, {FOCAL: R(0, 1), FNUMBER: R(8, 1)})
+code, _, err = run(p)
+check("a zero focal length is refused naming the EXIF tag and --focal-length-mm",
+      code == 3 and "/focal_length_mm: must be in [0.5, 2000] mm, got 0 (EXIF FocalLength (0x920a); give "
+      "--focal-length-mm)" in err and err.count("\n") == 1, (code, err))
+
+# 10. A sensor size worked out of a tag, impossible: says where it came from. The 35 mm equivalent of 1 mm for a
+# 21 mm lens is a 756 mm wide sensor.
+p = photo("fl35-1.jpg", (600, 400), {MODEL: "Unlisted 6"}, {FOCAL: R(21, 1), FNUMBER: R(8, 1), FOCAL35: 1})
+code, _, err = run(p)
+check("an impossible sensor from the 35 mm equivalent names its source and --sensor-mm",
+      code == 3 and "/sensor_width_mm: must be in [0.5, 500] mm, got 756 (the sensor size from the 35 mm equivalent "
+      "focal length (1 mm); give --sensor-mm W H)" in err, (code, err))
+
+# 11. A PNG (Pillow writes its EXIF in an eXIf chunk, which libexif does not read): the message says the file is
+# not a JPEG rather than that it has no EXIF; with every number given, camera.json is written.
+p = os.path.join(DIR, "tagged.png")
+exif = Image.Exif()
+exif[MODEL] = "NEX-5N"
+exif[EXIF_IFD] = {FOCAL: R(21, 1), FNUMBER: R(8, 1)}
+Image.new("RGB", (600, 400), (90, 120, 150)).save(p, exif=exif.tobytes())
+code, _, err = run(p)
+check("a PNG: not a JPEG, its EXIF not read",
+      code == 3 and "tagged.png: is not a JPEG: its EXIF, if any, is not read (EXIF is read from JPEG files); give "
+      "--focal-length-mm" in err, (code, err))
+c, err = camera(p, "--focal-length-mm", "21", "--f-number", "8", "--sensor-mm", "23.4", "15.6")
+check("a PNG with every number given", c["image_width_px"] == 600 and near(c["sensor_width_mm"], 23.4), (c, err))
+
+# 12. SubjectDistance 0xFFFFFFFF/1 is infinity, said so (not "not in EXIF").
+p = photo("infinity.jpg", (600, 400), {MODEL: "NEX-5N"}, {FOCAL: R(21, 1), FNUMBER: R(8, 1), SUBJECT: R(2 ** 32 - 1, 1)})
+c, err = camera(p)
+check("SubjectDistance infinity is printed as infinity", "SubjectDistance): infinity" in err, err)
+
 if failures:
     sys.exit(f"{len(failures)} failed: {failures}")
 print("ok: camera.json from EXIF as the tags say")

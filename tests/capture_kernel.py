@@ -52,6 +52,16 @@ def solve_kernel(sharp, blurred, box, h):
     return k.reshape(2 * h + 1, 2 * h + 1)
 
 
+def object_box(o, h, width, height):
+    """The box (x0, y0, x1, y1) the kernel of half-width h is solved over: the object's outline and a margin, kept h
+    px inside the frame. Too small (under 4 h a side) when the object is not in the frame."""
+    xs = [p[0] for p in o["outline_px"]]
+    ys = [p[1] for p in o["outline_px"]]
+    margin = h + 2
+    return (max(h, int(min(xs)) - margin), max(h, int(min(ys)) - margin),
+            min(width - h, int(math.ceil(max(xs))) + margin), min(height - h, int(math.ceil(max(ys))) + margin))
+
+
 def kernel_radius(k):
     h = k.shape[0] // 2
     t = np.arange(-h, h + 1, dtype=np.float64)
@@ -108,11 +118,7 @@ def main():
             m_rec = o.get("motion_screen_px", [0, 0])
             l_rec = math.hypot(*m_rec)
             h = max(3, math.ceil(1.6 * r_rec + l_rec / 2) + 2)
-            xs = [p[0] for p in o["outline_px"]]
-            ys = [p[1] for p in o["outline_px"]]
-            margin = h + 2
-            box = (max(h, int(min(xs)) - margin), max(h, int(min(ys)) - margin),
-                   min(width - h, int(math.ceil(max(xs))) + margin), min(height - h, int(math.ceil(max(ys))) + margin))
+            box = object_box(o, h, width, height)
             if box[2] - box[0] < 4 * h or box[3] - box[1] < 4 * h:
                 print(f"BAD {name} {o['side']}: the object is not in the frame (box {box})")
                 bad += 1

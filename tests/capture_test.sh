@@ -375,5 +375,55 @@ PYEOF
   done
   echo "ok: a floored scene's objects and rolling balls' streaks are shown as recorded, Gaussian and pillbox, GL and CPU paths"
   ;;
+distortion)
+  # A virtual object under barrel distortion (docs/distortion.md): the calibration's camera given dist_coeffs k1 =
+  # -0.3 and its model a focus of 250 mm (every card blurred by 1-3 px), over a flat grey photo. Grid cards drawn with
+  # the scene's blur (fitted) at the principal point, near the photo's top right corner and at the two places
+  # between (tests/capture_distortion.py place), flat on the table (GL path) and standing (CPU path, the per-pixel
+  # plan). Each frame's blur along x and y is measured by tests/capture_distortion.py (numpy, against the unblurred
+  # twin) and compared with the Jacobian of the distortion formula at the object's place (finite differences in
+  # Python) times its radius without distortion (the same run without dist_coeffs): within max(0.03 px, 3 %); the
+  # object at the principal point round and as it was without distortion.
+  $PY - "$DIR/scene/scene.png" "$W/grey.png" "$DIR/calib.json" "$W/flat.json" "$W/k1.json" <<'PYEOF'
+import json, sys
+from PIL import Image
+Image.new("RGB", Image.open(sys.argv[1]).size, (118, 118, 118)).save(sys.argv[2])
+c = json.load(open(sys.argv[3]))
+c["model"]["focus_mm"] = 250
+json.dump(c, open(sys.argv[4], "w"), indent=1)
+c["camera"]["dist_coeffs"] = [-0.3, 0, 0, 0]
+json.dump(c, open(sys.argv[5], "w"), indent=1)
+PYEOF
+  # A card is two board squares high: standing, its centre is one square over the table.
+  square=$($PY -c 'import json, sys; print(json.load(open(sys.argv[1]))["board"]["square_mm"])' "$W/k1.json")
+  for pose in flat standing; do
+    extra=()
+    [ $pose = standing ] && extra=('content.depth_blur_threshold={"screen_px": 0}' 'content.pose="standing"')
+    levels=$($PY "$(dirname "$0")/capture_distortion.py" place "$W/k1.json" $([ $pose = standing ] && echo "$square")) \
+        || fail "no places for the cards"
+    for lens in flat k1; do
+      base=(content.cells=5 'practice={"count": 0}' "factors=$levels" 'counterbalance="none"'
+            "scene={\"background\": \"$W/grey.png\", \"calib\": \"$W/$lens.json\"}" "${extra[@]}")
+      variant "$P/test1-static-grids.json" "$W/twin-$pose-$lens.json" "${base[@]}" 'sides={"left": 0, "right": 0}'
+      capture "$W/twin-$pose-$lens.json" "twin-$pose-$lens"
+      for kernel in gaussian disc; do
+        name="$pose-$lens-$kernel"
+        variant "$P/test1-static-grids.json" "$W/$name.json" "${base[@]}" "content.kernel=\"$kernel\"" \
+            'sides={"left": "fitted", "right": "fitted"}'
+        capture "$W/$name.json" "$name"
+      done
+    done
+    for kernel in gaussian disc; do
+      name="$pose-k1-$kernel"
+      grep -q "\"blur_plan\": \"$([ $pose = standing ] && echo per_pixel || echo one_radius)\"" "$W/$name/trial-0001.json" \
+          || fail "$name: not drawn through the $([ $pose = standing ] && echo CPU || echo GL) path"
+      $PY "$(dirname "$0")/capture_distortion.py" check "$W/k1.json" "$W/$name" "$W/twin-$pose-k1" \
+          "$W/$pose-flat-$kernel" "$W/twin-$pose-flat" --db "$W/$name.sqlite" > "$W/$name.txt" \
+          || fail "$name: $(grep BAD "$W/$name.txt" | head -2) $(tail -1 "$W/$name.txt")"
+      sed "s/^/$pose $kernel /" "$W/$name.txt"
+    done
+  done
+  echo "ok: objects under k1 = -0.3 are blurred along x and y as the distortion's Jacobian stretches them, GL and CPU paths"
+  ;;
 *) fail "unknown case $CASE" ;;
 esac

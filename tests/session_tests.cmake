@@ -187,9 +187,11 @@ add_preflight_test(criterion-10395
 
 # What the screen shows, measured on captured frames (run --capture) with the calibration's edge fit: each object's
 # blur against its recorded r_screen_px and its edges against its recorded outline (tests/capture_measure.cc).
+# subpixel, kernel and distortion measure the blur shown with numpy alone against each trial's unblurred twin
+# (tests/capture_kernel.py, tests/capture_distortion.py).
 add_executable(capture_measure ${PROJECT_SOURCE_DIR}/tests/capture_measure.cc)
 target_link_libraries(capture_measure PRIVATE blurcue_calib blurcue_core)
-foreach(case blur place pose window agree thesis aliasing subpixel kernel)
+foreach(case blur place pose window agree thesis aliasing subpixel kernel distortion)
   add_test(NAME capture_${case}
            COMMAND bash ${PROJECT_SOURCE_DIR}/tests/capture_test.sh ${case} ${BC} $<TARGET_FILE:capture_measure> ${T})
   set_tests_properties(capture_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"

@@ -71,6 +71,8 @@ void AddCameraCommand(CLI::App& app) {
     if (e.focus_distance_mm)
       std::cerr << "focus distance (EXIF SubjectDistance): " << *e.focus_distance_mm
                 << " mm; calibrate fits its own from the blur\n";
+    else if (e.focus_at_infinity)
+      std::cerr << "focus distance (EXIF SubjectDistance): infinity; calibrate fits its own from the blur\n";
     else
       std::cerr << "focus distance: not in EXIF; calibrate fits it from the blur\n";
     for (const std::string& note : e.notes) std::cerr << "note: " << note << "\n";

@@ -3,7 +3,9 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/distortion.h"
 #include "core/error.h"
+#include "core/names.h"
 
 namespace blurcue {
 
@@ -66,6 +68,33 @@ int ImageSidePx(const Json& json, const char* key, const std::string& where) {
   return static_cast<int>(v.get<int64_t>());
 }
 
+// Coefficients that fold the photo over (a pixel no ideal point maps onto, or one reached only from beyond the fold,
+// where the map's Jacobian has turned) describe no lens for this image: pose, stretch and undistortion would be
+// wrong there, silently. A 17 x 17 grid over the photo, its border included (half a pixel beyond the centres).
+void CheckNoFold(const Camera& c, const std::string& where) {
+  const LensDistortion distortion(c);
+  if (distortion.Identity()) return;
+  constexpr int kSteps = 16;
+  for (int i = 0; i <= kSteps; ++i) {
+    for (int j = 0; j <= kSteps; ++j) {
+      const Point2 px{-0.5 + double(c.image_width_px) * i / kSteps, -0.5 + double(c.image_height_px) * j / kSteps};
+      bool ok = false;
+      try {
+        const Jacobian2 jac = distortion.JacobianAt(distortion.Undistort(px));
+        ok = jac[0] * jac[3] - jac[1] * jac[2] > 0;
+      } catch (const Error&) {
+      }
+      if (ok) continue;
+      std::string got;
+      for (double d : c.dist_coeffs) got += (got.empty() ? "" : ", ") + Num(d);
+      throw InputError(where + "/dist_coeffs",
+                       "fold the " + std::to_string(c.image_width_px) + " x " + std::to_string(c.image_height_px) +
+                           " px photo over near pixel (" + Num(px[0]) + ", " + Num(px[1]) +
+                           "): no lens maps an image there (OpenCV's order: k1 k2 p1 p2 [k3 ...]), got [" + got + "]");
+    }
+  }
+}
+
 }  // namespace
 
 void Camera::Validate(const std::string& where) const {
@@ -105,6 +134,7 @@ void Camera::Validate(const std::string& where) const {
   const double coeff[2] = {-CameraLimits::kDistCoeff, CameraLimits::kDistCoeff};
   for (size_t i = 0; i < n; ++i)
     RequireIn(where, ("dist_coeffs/" + std::to_string(i)).c_str(), dist_coeffs[i], coeff, "");
+  CheckNoFold(*this, where);
 }
 
 Camera CameraFromJson(const Json& json, const std::string& where) {
@@ -120,7 +150,10 @@ Camera CameraFromJson(const Json& json, const std::string& where) {
   for (auto it = json.begin(); it != json.end(); ++it) {
     bool known = false;
     for (const char* k : kKnown) known = known || it.key() == k;
-    if (!known) throw InputError(where + "/" + it.key(), "is not a camera field");
+    if (!known)
+      throw InputError(where + "/" + it.key(),
+                       "is not a camera field" + DidYouMean(it.key(), std::vector<std::string>(std::begin(kKnown),
+                                                                                              std::end(kKnown))));
   }
   if (json.contains("camera_matrix")) {
     const Json& m = json["camera_matrix"];

@@ -47,7 +47,7 @@ struct Camera {
 
   // Throws Error(kInput) "where/field: must be in [lo, hi] unit, got ..." for the first value outside
   // CameraLimits, an image side outside [1, kMaxImageSidePx] px, or a camera_matrix / dist_coeffs that is not
-  // finite and shaped as OpenCV's.
+  // finite and shaped as OpenCV's, or dist_coeffs that fold the photo over (no lens maps an image onto some pixel).
   void Validate(const std::string& where) const;
 };
 

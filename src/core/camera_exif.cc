@@ -1,7 +1,9 @@
 #include "core/camera_exif.h"
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <fstream>
 #include <memory>
 
 #include <libexif/exif-data.h>
@@ -113,8 +115,17 @@ ExifCamera CameraFromExif(const std::filesystem::path& photo, std::optional<std:
   c.image_width_px = image.cols;
   c.image_height_px = image.rows;
   if (have_exif) out.make = exif.Text(EXIF_TAG_MAKE), out.model = exif.Text(EXIF_TAG_MODEL);
+  // libexif reads a JPEG's EXIF only: a PNG's or a TIFF's, if it has one, is not read, and the message says so.
+  std::string no_exif = "holds no EXIF";
+  {
+    std::ifstream in(photo, std::ios::binary);
+    char magic[2] = {0, 0};
+    in.read(magic, 2);
+    if (!(uint8_t(magic[0]) == 0xFF && uint8_t(magic[1]) == 0xD8))
+      no_exif = "is not a JPEG: its EXIF, if any, is not read (EXIF is read from JPEG files)";
+  }
   auto missing = [&](ExifTag tag, const char* option) {
-    return InputError(file, (have_exif ? exif.Name(tag) + " is missing" : std::string("holds no EXIF")) +
+    return InputError(file, (have_exif ? exif.Name(tag) + " is missing" : no_exif) +
                                 "; give " + option);
   };
 
@@ -161,7 +172,7 @@ ExifCamera CameraFromExif(const std::filesystem::path& photo, std::optional<std:
     throw InputError(file, have_exif ? "EXIF gives no sensor size (no FocalPlaneXResolution (0xa20e), no "
                                        "FocalLengthIn35mmFilm (0xa405), and model '" + out.model +
                                            "' is not in the sensor table); give --sensor-mm W H"
-                                     : std::string("holds no EXIF; give --focal-length-mm, --f-number and --sensor-mm"));
+                                     : no_exif + "; give --focal-length-mm, --f-number and --sensor-mm");
   }
   auto micron = [](double mm) { return std::round(mm * 1e4) / 1e4; };  // finer than any maker states
   c.sensor_width_mm = micron(turned ? sh : sw);
@@ -169,9 +180,26 @@ ExifCamera CameraFromExif(const std::filesystem::path& photo, std::optional<std:
   if (turned) out.notes.push_back("the photo is stored turned (EXIF Orientation " + Num(*orientation) +
                                   "): the sensor's sides are swapped to match the image calibrate reads");
 
-  if (const std::optional<double> d = number(EXIF_TAG_SUBJECT_DISTANCE); d && *d > 0 && *d < 4e6)
-    out.focus_distance_mm = *d * 1000;  // metres; 0 is "unknown", 0xFFFFFFFF/1 "infinity"
-  c.Validate(file);
+  if (const std::optional<double> d = number(EXIF_TAG_SUBJECT_DISTANCE); d && *d > 0) {
+    // Metres; 0 is "unknown", 0xFFFFFFFF/1 "infinity".
+    if (*d < 4e6) out.focus_distance_mm = *d * 1000;
+    else out.focus_at_infinity = true;
+  }
+  try {
+    c.Validate(file);
+  } catch (const Error& e) {
+    // A number refused says where it came from when that was the EXIF, and which option replaces it.
+    const std::string what = e.what();
+    std::string from;
+    if (what.find("/focal_length_mm:") != std::string::npos && !focal_length_mm)
+      from = exif.Name(EXIF_TAG_FOCAL_LENGTH) + "; give --focal-length-mm";
+    else if (what.find("/f_number:") != std::string::npos && !f_number)
+      from = exif.Name(EXIF_TAG_FNUMBER) + "; give --f-number";
+    else if (what.find("/sensor_") != std::string::npos && !sensor_mm)
+      from = "the sensor size from the " + out.sensor_source + "; give --sensor-mm W H";
+    if (from.empty()) throw;
+    throw Error(ErrorKind::kInput, what + " (" + from + ")");
+  }
   return out;
 }
 

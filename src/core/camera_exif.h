@@ -15,6 +15,7 @@ struct ExifCamera {
   std::string make, model;                 // as recorded, trimmed
   std::string sensor_source;               // "focal-plane resolution", "sensor table (MODEL)", "35 mm equivalent (...)"
   std::optional<double> focus_distance_mm; // EXIF SubjectDistance when recorded (not infinity, not 0 = unknown)
+  bool focus_at_infinity = false;          // EXIF SubjectDistance says infinity (0xFFFFFFFF/1)
   std::vector<std::string> notes;          // approximations and what was missing
 };
 

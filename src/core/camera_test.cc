@@ -125,5 +125,29 @@ TEST(Camera, NonFiniteValuesAreRefused) {
   EXPECT_EQ(ErrorOf(j), "cam.json: /dist_coeffs/4: must be in [-10000, 10000], got 1e+308");
 }
 
+TEST(Camera, DistortionThatFoldsThePhotoIsRefused) {
+  // k1 = -1: rho (1 - rho^2) peaks at rho = 1/sqrt(3) (0.385 distorted); the thesis photo's corner lies at a
+  // distorted rho of 0.67 (half its diagonal over f = 4121 px), which no ideal point reaches.
+  Json j = ThesisJson();
+  j["dist_coeffs"] = {-1.0, 0.0, 0.0, 0.0};
+  EXPECT_EQ(ErrorOf(j), "cam.json: /dist_coeffs: fold the 4592 x 3056 px photo over near pixel (-0.5, -0.5): no lens "
+                        "maps an image there (OpenCV's order: k1 k2 p1 p2 [k3 ...]), got [-1, 0, 0, 0]");
+  // k1 = -0.3 stays monotonic out to rho = 1.05 (0.70 distorted), past the corner: a strong barrel, accepted; so
+  // is pincushion of any strength (rho (1 + k1 rho^2) only grows).
+  j["dist_coeffs"] = {-0.3, 0.0, 0.0, 0.0};
+  EXPECT_EQ(ErrorOf(j), "");
+  j["dist_coeffs"] = {5.0, 0.0, 0.0, 0.0};
+  EXPECT_EQ(ErrorOf(j), "");
+  // k1 = -0.5 folds at rho = 0.816 (0.544 distorted), short of the photo's corner (0.67).
+  j["dist_coeffs"] = {-0.5, 0.0, 0.0, 0.0};
+  EXPECT_NE(ErrorOf(j).find("/dist_coeffs: fold the 4592 x 3056 px photo over near pixel"), std::string::npos);
+}
+
+TEST(Camera, UnknownFieldSaysTheNearestName) {
+  Json j = ThesisJson();
+  j["dist_coef"] = {0.0, 0.0, 0.0, 0.0};
+  EXPECT_EQ(ErrorOf(j), "cam.json: /dist_coef: is not a camera field (did you mean dist_coeffs?)");
+}
+
 }  // namespace
 }  // namespace blurcue
