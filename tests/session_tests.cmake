@@ -191,7 +191,7 @@ add_preflight_test(criterion-10395
 # (tests/capture_kernel.py, tests/capture_distortion.py).
 add_executable(capture_measure ${PROJECT_SOURCE_DIR}/tests/capture_measure.cc)
 target_link_libraries(capture_measure PRIVATE blurcue_calib blurcue_core)
-foreach(case blur place pose window agree thesis aliasing subpixel kernel distortion)
+foreach(case blur place pose window agree thesis aliasing subpixel kernel kernel_motion distortion)
   add_test(NAME capture_${case}
            COMMAND bash ${PROJECT_SOURCE_DIR}/tests/capture_test.sh ${case} ${BC} $<TARGET_FILE:capture_measure> ${T})
   set_tests_properties(capture_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
