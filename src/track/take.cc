@@ -33,7 +33,11 @@ const std::vector<TrackColumn> kTrackColumns = {
     {"tvec_z_mm", ""},
     {"focus_mm", "the take's lens model: focus distance, mm (inf: at infinity)"},
     {"aperture_mm", "the take's lens model: effective aperture diameter, mm"},
-    {"floor_px", "the take's lens model: blur floor added in quadrature, px (0: the thin lens alone was kept)"},
+    {"floor_px", "the take's lens model: blur floor added in quadrature, px (0: the thin lens alone was kept; empty where "
+                 "floor_determined is 0)"},
+    {"floor_determined", "1: the sections pin the floor (or the thin lens alone was kept); 0: floors from "
+                         "model.choice[\"thin_lens+floor\"].floor_range_px in calib-NNNN.json fit alike, so floor_px is "
+                         "not a result (the model still predicts with the value in calib-NNNN.json)"},
     {"usable_sections", "edge sections whose blur measurement is usable"},
     {"pose_ms", "time spent tracking (or detecting) and solving the pose, ms"},
     {"measure_ms", "time spent measuring every section's blur and the frame's estimates, ms"},
@@ -94,8 +98,10 @@ void WriteTake(const TakeResult& take, const std::filesystem::path& dir, const s
       for (int k = 0; k < 3; ++k) csv << "," << Number(c.pose.tvec[k], 4);
       int usable = 0;
       for (const auto& e : c.edges) usable += e.usable;
+      // A floor the sections cannot pin is not printed as a result (optics::FloorText says it in words).
+      const bool pinned = c.model.kind != "thin_lens+floor" || c.model.floor_determined;
       csv << "," << Number(c.model.focus_mm, 3) << "," << Number(c.model.aperture_mm, 5) << ","
-          << Number(c.model.floor_px, 4) << "," << usable;
+          << (pinned ? Number(c.model.floor_px, 4) : std::string()) << "," << (pinned ? 1 : 0) << "," << usable;
       Json json = calib::CalibToJson(c);
       json["photo"] = input;
       json["frame"] = f.index;
@@ -105,7 +111,7 @@ void WriteTake(const TakeResult& take, const std::filesystem::path& dir, const s
                            "of every frame";
       WriteJsonFile(dir / CalibFileName(f.index), json);
     } else {
-      csv << ",,,,,,,,,,0";  // no pose, no model for this frame
+      csv << ",,,,,,,,,,,0";  // no pose, no model for this frame
     }
     std::string note = f.note;
     for (char& ch : note)

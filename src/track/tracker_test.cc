@@ -8,11 +8,19 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
 #include <vector>
+
+#include <unistd.h>
 
 #include "calib/truth.h"
 #include "core/error.h"
 #include "synth/take.h"
+#include "track/take.h"
 
 namespace blurcue::track {
 namespace {
@@ -101,6 +109,56 @@ TEST(Tracker, TakeModelIsEveryFramesModel) {
   std::printf("take model %s: focus %.1f mm (true 450), aperture %.3f mm (nominal %.3f), floor %.3f px, rms %.3f px\n",
               t.model.kind.c_str(), t.model.focus_mm, t.model.aperture_mm, lens.aperture_mm, t.model.floor_px,
               t.model.rms_px);
+}
+
+// track.csv's cells of one row, by column name (a hand-made reader: no code of take.cc's).
+std::vector<std::map<std::string, std::string>> ReadTrackCsv(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> names;
+  std::stringstream header(line);
+  for (std::string cell; std::getline(header, cell, ',');) names.push_back(cell);
+  std::vector<std::map<std::string, std::string>> rows;
+  while (std::getline(in, line)) {
+    std::map<std::string, std::string> row;
+    std::stringstream cells(line);
+    size_t i = 0;
+    for (std::string cell; i < names.size() && std::getline(cells, cell, ','); ++i) row[names[i]] = cell;
+    if (line.back() == ',' && i < names.size()) row[names[i++]] = "";
+    EXPECT_EQ(i, names.size()) << line;
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+// A floor the sections pin is a number in track.csv; one they cannot pin (a range of floors fits alike) is an empty
+// cell with floor_determined 0, never a number read as a result; a lost frame's row has every column.
+TEST(Tracker, TrackCsvPrintsAFloorOnlyWhereItIsDetermined) {
+  const Tracked& t = TrackedTake();
+  TakeResult take;
+  take.frames = {t.results[0], t.results[1]};
+  take.frames[1].calib->model.kind = "thin_lens+floor";
+  take.frames[1].calib->model.floor_px = 1.37;
+  take.frames[1].calib->model.floor_determined = false;
+  FrameResult lost;
+  lost.index = 2, lost.status = FrameStatus::kLost;
+  take.frames.push_back(lost);
+  const auto dir = std::filesystem::temp_directory_path() / ("blurcue-trackcsv-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  WriteTake(take, dir, "take.avi");
+  const auto rows = ReadTrackCsv(dir / "track.csv");
+  std::filesystem::remove_all(dir);
+  ASSERT_EQ(rows.size(), 3u);
+  const optics::FittedModel& m0 = t.results[0].calib->model;
+  if (m0.kind != "thin_lens+floor" || m0.floor_determined) {
+    EXPECT_EQ(rows[0].at("floor_determined"), "1");
+    EXPECT_NEAR(std::stod(rows[0].at("floor_px")), m0.floor_px, 1e-3);
+  }
+  EXPECT_EQ(rows[1].at("floor_determined"), "0");
+  EXPECT_EQ(rows[1].at("floor_px"), "");
+  EXPECT_EQ(rows[2].at("status"), "lost");
+  EXPECT_EQ(rows[2].at("floor_px"), "");
 }
 
 // The take's one lens model against the truth: the fixed-focus lens (focus 450 mm inside the board, aperture
