@@ -667,15 +667,19 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
   // Blur reaching the neighbouring edges: the window reaches across them and their steps join the profile model,
   // started from the plain fit (whose size is already close: the plain window holds most of the edge's spread).
   if (!why.empty() && !segment.neighbours.empty() && fit.r_px > 0) {
-    const EdgeWindow wide = NeighbourWindow(segment, BlurReachPx(fit));
-    if (!wide.Steps().empty()) {
+    EdgeWindow wide = NeighbourWindow(segment, BlurReachPx(fit));
+    // Past the board's outer edge the board says nothing: the photo says whether the blur has room there (widened
+    // again once if the fit across the neighbours finds a wider blur than the plain one).
+    WidenFreeSides(linear, segment, BlurReachPx(fit), fit.offset_px, fit.step, &wide);
+    const ModelFit plain_fit = fit;
+    for (int round = 0; round < 2 && !wide.Steps().empty(); ++round) {
       double wide_span = 0;
-      ModelFit across = FitInWindow(linear, segment, options, wide, &fit, &wide_span);
-      if (across.samples >= kMinSamples && across.r_px > 0) {
-        fit = std::move(across);
-        fit.flags.push_back("neighbours");
-        why = CrowdedReason(segment, wide, fit, options.along_fraction, wide_span, /*plain=*/false);
-      }
+      ModelFit across = FitInWindow(linear, segment, options, wide, &plain_fit, &wide_span);
+      if (!(across.samples >= kMinSamples && across.r_px > 0)) break;
+      fit = std::move(across);
+      fit.flags.push_back("neighbours");
+      why = CrowdedReason(segment, wide, fit, options.along_fraction, wide_span, /*plain=*/false);
+      if (why.empty() || !WidenFreeSides(linear, segment, BlurReachPx(fit), fit.offset_px, fit.step, &wide)) break;
     }
   }
   if (!why.empty()) {

@@ -456,6 +456,36 @@ TEST(EdgeModel, NeighboursWithinTheBlurAreCrowdedSayingWhy) {
   EXPECT_NE(fit.crowded_why.find("within reach of its blur"), std::string::npos) << fit.crowded_why;
 }
 
+// The board's outer edge: a neighbouring edge on one side only, and beyond the edge on the other side the table,
+// which the board does not describe. Where the photo there is flat for as far as the blur reaches (a Gaussian of
+// r = 8 px reaches 14 px, past the 12.5 px half gap), the window widens on that side and r is within 2 %; where
+// another edge lies there (18 px away, inside that reach), the section stays refused, saying why.
+EdgeSegment WithNeighbourOnOneSide(EdgeSegment segment, double gap_px) {
+  const cv::Point2d dir = (segment.b - segment.a) / cv::norm(segment.b - segment.a), n(-dir.y, dir.x);
+  segment.neighbours.push_back({segment.a - gap_px * n, segment.b - gap_px * n, 0.5 * gap_px});
+  return segment;
+}
+
+TEST(EdgeModel, OuterEdgeMeasuredWhereThePhotoBeyondIsFlatRefusedWhereAnEdgeLiesThere) {
+  EdgeSpec spec;
+  spec.psf = "gaussian";
+  spec.r_px = 8;
+  spec.half_window_px = 12.5;
+  spec.srgb8 = false;
+  spec.noise = 0.003;
+  const EdgeImage flat = Render(spec);
+  const ModelFit fit = MeasureEdgeModel(flat.linear, WithNeighbourOnOneSide(flat.segment, 25));
+  EXPECT_TRUE(fit.ok) << Describe(fit) << " " << fit.crowded_why;
+  EXPECT_NEAR(fit.r_px, 8, 0.02 * 8) << Describe(fit);
+
+  spec.stripe_px = 18;
+  spec.half_window_px = 9;
+  const EdgeImage striped = Render(spec);
+  const ModelFit refused = MeasureEdgeModel(striped.linear, WithNeighbourOnOneSide(striped.segment, 18));
+  EXPECT_FALSE(refused.ok) << Describe(refused);
+  EXPECT_NE(refused.crowded_why.find("free of other edges"), std::string::npos) << refused.crowded_why;
+}
+
 // Noise clipped at 0 on a near-black square is not clipped signal: the bin medians are unbiased.
 TEST(EdgeModel, ClippedNoiseTailsAreNotSaturation) {
   EdgeSpec spec;

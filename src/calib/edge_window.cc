@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 namespace blurcue::calib {
 namespace {
@@ -85,6 +86,41 @@ EdgeWindow NeighbourWindow(const EdgeSegment& segment, double reach_px) {
   const bool crossing = segment.cross_a != cv::Point2d(0, 0) || segment.cross_b != cv::Point2d(0, 0);
   if (slopes > 0 && !crossing) w.ka = ka / slopes, w.kb = kb / slopes;
   return w;
+}
+
+bool WidenFreeSides(const cv::Mat& linear, const EdgeSegment& segment, double reach_px, double offset_px, double step,
+                    EdgeWindow* window) {
+  const EdgeFrame x = MakeEdgeFrame(segment);
+  if (linear.empty() || !(x.length > 4) || !(std::abs(step) > 0) || !std::isfinite(reach_px)) return false;
+  bool widened = false;
+  for (const double sign : {-1.0, 1.0}) {
+    EdgeWindow::Side& side = sign < 0 ? window->minus : window->plus;
+    const double need = reach_px + std::abs(offset_px);  // to where the blur ends, as CrowdedReason counts it
+    if (side.neighbour_px > 0 || need <= side.end_px || need > 2 * side.end_px) continue;
+    double lo = 1e300, hi = -1e300;
+    bool ok = true;
+    for (double d = side.end_px; ok && d <= need + 1; d += 1) {
+      std::vector<float> band;
+      for (double s = 0.25 * x.length; s <= 0.75 * x.length; s += 1) {
+        const cv::Point2d p = x.a + s * x.t + sign * d * x.n;
+        const int px = int(std::lround(p.x)), py = int(std::lround(p.y));
+        if (px < 0 || py < 0 || px >= linear.cols || py >= linear.rows) continue;
+        const float v = linear.at<float>(py, px);
+        if (std::isfinite(v)) band.push_back(v);
+      }
+      if (band.size() < 3) {
+        ok = false;
+        break;
+      }
+      std::nth_element(band.begin(), band.begin() + band.size() / 2, band.end());
+      const double median = band[band.size() / 2];
+      lo = std::min(lo, median), hi = std::max(hi, median);
+    }
+    if (!ok || hi - lo > 0.05 * std::abs(step)) continue;
+    side.end_px = need + 1;
+    widened = true;
+  }
+  return widened;
 }
 
 double BlurReachPx(const ModelFit& fit) {

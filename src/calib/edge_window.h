@@ -50,6 +50,14 @@ EdgeWindow PlainWindow(const EdgeSegment& segment);
 // the plain window. Along the edge it follows the crossing lines where given, else the lines to the neighbours' ends.
 EdgeWindow NeighbourWindow(const EdgeSegment& segment, double reach_px);
 
+// Widens each side of `window` without a neighbouring edge to where a blur reaching `reach_px` from the edge (at
+// `offset_px` off the segment line) ends, where the photo there holds no other edge: the medians of 1 px bands
+// across the section's central half, from the side's end to the new one, lie within 5 % of |step| of each other.
+// At most to twice the side's end (the board says nothing beyond its outer edge; the photo decides). Returns whether
+// a side was widened.
+bool WidenFreeSides(const cv::Mat& linear, const EdgeSegment& segment, double reach_px, double offset_px, double step,
+                    EdgeWindow* window);
+
 // How far a fitted blur reaches from its edge: the disc's radius, three floor standard deviations (99.9 % of the
 // floor's spread), a pixel and a plateau sample; a Gaussian's 3 std when the shape is ambiguous. px.
 double BlurReachPx(const ModelFit& fit);
