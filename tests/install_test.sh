@@ -9,6 +9,7 @@ source "$(dirname "$0")/lib.sh"
 install_moved "$BUILD"
 $BC info > info.txt || fail "info: $(cat info.txt)"
 grep -q "^data: *$W/moved/share/blurcue (installed)" info.txt || fail "not found beside the binary: $(cat info.txt)"
+grep -q "^media: *$W/moved/lib/blurcue/libblurcue_media.so" info.txt || fail "media plugin not beside the binary: $(cat info.txt)"
 $BC synth-scene --out scene --seed 5 > /dev/null
 $BC calibrate scene/scene.png --camera scene/camera.json --out calib.json > /dev/null
 $BC render --calib calib.json --background scene/scene.png --object ball --at-edge 9 --blur estimated \

@@ -7,6 +7,7 @@
 #include "cli/commands.h"
 #include "core/data_dir.h"
 #include "core/error.h"
+#include "core/media.h"
 #include "render/gl_context.h"
 #include "store/schema.h"
 
@@ -51,6 +52,12 @@ void AddInfoCommand(CLI::App& app) {
       std::printf("  %-9s %s%s\n", part, (data.path / part).string().c_str(), there ? "" : "  MISSING");
     }
     std::printf("record:    schema version %d\n", store::CurrentSchemaVersion());
+    try {  // image files and videos (OpenCV's imgcodecs and videoio, loaded on first use)
+      std::printf("media:     %s\n", media::PluginPath().c_str());
+    } catch (const std::exception& e) {
+      ok = false;
+      std::printf("media:     not available: %s\n", e.what());
+    }
     try {
       const auto context = render::GlContext::CreateOffscreen();
       std::printf("GL:        %s\n", context->Describe().c_str());
