@@ -1,6 +1,11 @@
 #include "calib/edge_blur.h"
+#include "calib/edge_window.h"
 
 #include <gtest/gtest.h>
+
+#include <limits>
+
+#include <array>
 
 #include <algorithm>
 #include <cmath>
@@ -397,9 +402,10 @@ TEST(EdgeModel, SectionTooShortForItsBlurIsCrowded) {
 
 // The segment with its parallel neighbours `gap_px` either side (a stripe pattern's, as calibrate gives a board's),
 // the image free of other edges half a gap past them.
-EdgeSegment WithNeighbours(EdgeSegment segment, double gap_px) {
+// The neighbouring parallel edges gap_px away on the given sides of the normal (-1, +1; both by default).
+EdgeSegment WithNeighbours(EdgeSegment segment, double gap_px, std::initializer_list<double> sides = {-1.0, 1.0}) {
   const cv::Point2d dir = (segment.b - segment.a) / cv::norm(segment.b - segment.a), n(-dir.y, dir.x);
-  for (double side : {-1.0, 1.0})
+  for (double side : sides)
     segment.neighbours.push_back({segment.a + side * gap_px * n, segment.b + side * gap_px * n, 0.5 * gap_px});
   return segment;
 }
@@ -460,12 +466,6 @@ TEST(EdgeModel, NeighboursWithinTheBlurAreCrowdedSayingWhy) {
 // which the board does not describe. Where the photo there is flat for as far as the blur reaches (a Gaussian of
 // r = 8 px reaches 14 px, past the 12.5 px half gap), the window widens on that side and r is within 2 %; where
 // another edge lies there (18 px away, inside that reach), the section stays refused, saying why.
-EdgeSegment WithNeighbourOnOneSide(EdgeSegment segment, double gap_px) {
-  const cv::Point2d dir = (segment.b - segment.a) / cv::norm(segment.b - segment.a), n(-dir.y, dir.x);
-  segment.neighbours.push_back({segment.a - gap_px * n, segment.b - gap_px * n, 0.5 * gap_px});
-  return segment;
-}
-
 TEST(EdgeModel, OuterEdgeMeasuredWhereThePhotoBeyondIsFlatRefusedWhereAnEdgeLiesThere) {
   EdgeSpec spec;
   spec.psf = "gaussian";
@@ -474,16 +474,34 @@ TEST(EdgeModel, OuterEdgeMeasuredWhereThePhotoBeyondIsFlatRefusedWhereAnEdgeLies
   spec.srgb8 = false;
   spec.noise = 0.003;
   const EdgeImage flat = Render(spec);
-  const ModelFit fit = MeasureEdgeModel(flat.linear, WithNeighbourOnOneSide(flat.segment, 25));
+  const ModelFit fit = MeasureEdgeModel(flat.linear, WithNeighbours(flat.segment, 25, {-1.0}));
   EXPECT_TRUE(fit.ok) << Describe(fit) << " " << fit.crowded_why;
   EXPECT_NEAR(fit.r_px, 8, 0.02 * 8) << Describe(fit);
 
   spec.stripe_px = 18;
   spec.half_window_px = 9;
   const EdgeImage striped = Render(spec);
-  const ModelFit refused = MeasureEdgeModel(striped.linear, WithNeighbourOnOneSide(striped.segment, 18));
+  const ModelFit refused = MeasureEdgeModel(striped.linear, WithNeighbours(striped.segment, 18, {-1.0}));
   EXPECT_FALSE(refused.ok) << Describe(refused);
   EXPECT_NE(refused.crowded_why.find("free of other edges"), std::string::npos) << refused.crowded_why;
+}
+
+// A NaN or infinite fit (offset, reach, step) never widens a window: its end would become NaN.
+TEST(EdgeModel, WideningIgnoresNonFiniteFits) {
+  EdgeSpec spec;
+  spec.half_window_px = 12.5;
+  spec.srgb8 = false;
+  const EdgeImage img = Render(spec);
+  const EdgeSegment segment = WithNeighbours(img.segment, 25, {-1.0});
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  for (const auto& [reach, offset, step] : std::vector<std::array<double, 3>>{
+           {14, nan, 0.7}, {nan, 0, 0.7}, {inf, 0, 0.7}, {14, 0, nan}, {14, 1e308, 0.7}, {-1, 0, 0.7}}) {
+    EdgeWindow w = NeighbourWindow(segment, 14);
+    const double before = w.plus.end_px;
+    WidenFreeSides(img.linear, segment, reach, offset, step, &w);
+    EXPECT_TRUE(std::isfinite(w.plus.end_px)) << reach << " " << offset << " " << step;
+    EXPECT_LE(w.plus.end_px, 2 * before + 1) << reach << " " << offset << " " << step;
+  }
 }
 
 // Noise clipped at 0 on a near-black square is not clipped signal: the bin medians are unbiased.

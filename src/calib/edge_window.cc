@@ -91,7 +91,9 @@ EdgeWindow NeighbourWindow(const EdgeSegment& segment, double reach_px) {
 bool WidenFreeSides(const cv::Mat& linear, const EdgeSegment& segment, double reach_px, double offset_px, double step,
                     EdgeWindow* window) {
   const EdgeFrame x = MakeEdgeFrame(segment);
-  if (linear.empty() || !(x.length > 4) || !(std::abs(step) > 0) || !std::isfinite(reach_px)) return false;
+  if (linear.empty() || !(x.length > 4) || !(std::abs(step) > 0) || !std::isfinite(reach_px) ||
+      !std::isfinite(offset_px))
+    return false;
   bool widened = false;
   for (const double sign : {-1.0, 1.0}) {
     EdgeWindow::Side& side = sign < 0 ? window->minus : window->plus;

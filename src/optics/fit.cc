@@ -376,6 +376,8 @@ double FittedModel::PredictPx(const Lens& lens, double u_mm) const {
   return std::sqrt(thin * thin + floor_px * floor_px);
 }
 
+bool FloorPinned(const FittedModel& m) { return m.kind != "thin_lens+floor" || m.floor_determined; }
+
 std::string FloorText(const FittedModel& m) {
   char text[96];
   if (m.kind != "thin_lens+floor")

@@ -46,6 +46,9 @@ struct FittedModel {
   double PredictPx(const Lens& lens, double u_mm) const;
 };
 
+// Whether the model's floor_px is a result: the thin lens alone (floor 0) or a floor the sections pin.
+bool FloorPinned(const FittedModel& m);
+
 // The floor in words for a summary line: "floor 0.70 px", "floor 0 px (thin lens alone)" or, where the sections do
 // not pin it, "floor not determined (0.99-1.86 px fit alike)".
 std::string FloorText(const FittedModel& m);

@@ -99,7 +99,7 @@ void WriteTake(const TakeResult& take, const std::filesystem::path& dir, const s
       int usable = 0;
       for (const auto& e : c.edges) usable += e.usable;
       // A floor the sections cannot pin is not printed as a result (optics::FloorText says it in words).
-      const bool pinned = c.model.kind != "thin_lens+floor" || c.model.floor_determined;
+      const bool pinned = optics::FloorPinned(c.model);
       csv << "," << Number(c.model.focus_mm, 3) << "," << Number(c.model.aperture_mm, 5) << ","
           << (pinned ? Number(c.model.floor_px, 4) : std::string()) << "," << (pinned ? 1 : 0) << "," << usable;
       Json json = calib::CalibToJson(c);
