@@ -149,11 +149,7 @@ void Recording::RecordResponse(int64_t session, int64_t trial_index, const Respo
   r.r_left_px = response.r_left_px;
   r.r_right_px = response.r_right_px;
   r.correct = response.correct;
-  std::vector<store::FrameRecord> rows;
-  rows.reserve(frames.size());
-  for (const FrameRecord& f : frames)
-    rows.push_back({f.frame_index, f.flip_time_s, f.dropped, f.r_left_px, f.r_right_px, f.y_mm});
-  record_->RecordResponse(session, trial_index, r, rows);
+  record_->RecordResponse(session, trial_index, r, frames);
 }
 
 void Recording::Heartbeat(int64_t session) { record_->Heartbeat(session); }

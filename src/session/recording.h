@@ -1,6 +1,6 @@
 #pragma once
 // The session's one door to the record (store): what a session records, in session terms. Nothing else in session/
-// includes a store header; recording.cc turns these into the record's rows.
+// includes a store header (this one includes the frame's values, store/frame_columns.h); recording.cc turns these into the record's rows.
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -15,6 +15,7 @@
 #include "protocol/trials.h"
 #include "session/trial_logic.h"
 #include "stimulus/stimulus.h"
+#include "store/frame_columns.h"
 
 namespace blurcue::store {
 class Record;
@@ -42,14 +43,9 @@ struct Response {
   std::optional<bool> correct;
 };
 
-// One flip of a trial (store::FrameRecord): its time from onset, whether a frame was dropped before it, and what it
-// showed of a pair (each side's radius in photo px, the objects' y on the board in mm; empty: not shown).
-struct FrameRecord {
-  int64_t frame_index = 0;
-  double flip_time_s = 0;
-  bool dropped = false;
-  std::optional<double> r_left_px, r_right_px, y_mm;
-};
+// One flip of a trial as the record keeps it (store/frame_columns.h, the one definition of a frame's values): its
+// time from onset, whether a frame was dropped before it, what it showed of a pair and, on video, of the take.
+using FrameRecord = store::FrameRecord;
 
 // The station a session runs on, as the record states it (store::SessionMeta).
 struct SessionInfo {

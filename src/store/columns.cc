@@ -1,5 +1,6 @@
 // The record's column table (columns.h) and what is generated from it for the schema, the INSERTs and the merge.
 #include "store/columns.h"
+#include "store/frame_columns.h"
 
 #include <optional>
 #include <type_traits>
@@ -323,12 +324,6 @@ std::string Alias(const std::string& table) {
   throw Error(ErrorKind::kInternal, "columns: no alias for table " + table);
 }
 
-void BindValue(Statement& insert, int index, const Value& value) {
-  if (const auto* i = std::get_if<int64_t>(&value)) insert.Bind(index, *i);
-  else if (const auto* d = std::get_if<double>(&value)) insert.Bind(index, *d);
-  else if (const auto* t = std::get_if<std::string>(&value)) insert.Bind(index, *t);
-  else insert.BindNull(index);
-}
 
 // Binds the typed columns of `table` each read by `read` (its accessor, or null for one the record writes elsewhere).
 template <typename Read>

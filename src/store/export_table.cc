@@ -1,5 +1,6 @@
 // The tables an export writes beside trials.csv (summaries, frames) and the helpers every writer shares.
 #include "store/export_table.h"
+#include "store/frame_columns.h"
 
 #include <algorithm>
 #include <cctype>
@@ -181,26 +182,22 @@ const std::vector<ColumnDef>& AdjustmentColumns() {
   return columns;
 }
 const std::vector<FrameColumn>& FrameColumns() {
-  static const std::vector<FrameColumn> columns = {
-      {{"study", "string", "", "", "the protocol's name"}, "st.name", Cell::kText},
-      {{"participant", "string", "", "", "the participant's id"}, "p.code", Cell::kText},
-      {{"session_id", "integer", "", ">= 1", "the session's id in this record (as in trials.csv)"}, "s.id",
-       Cell::kInteger},
-      {{"window", "boolean", "", "0|1", "1: a real window on the real clock; 0: headless on a simulated clock"},
-       "coalesce(s.window, s.display LIKE 'window%')", Cell::kInteger},
-      {{"trial_index", "integer", "", ">= 0", "the trial (as in trials.csv)"}, "t.trial_index", Cell::kInteger},
-      {{"frame_index", "integer", "", ">= 0", "the frame's place in the trial"}, "f.frame_index", Cell::kInteger},
-      {{"flip_time_s", "number", "s", ">= 0", "when the frame reached the screen, from the trial's first flip"},
-       "f.flip_time_s", Cell::kNumber},
-      {{"dropped", "boolean", "", "0|1", "1: more than 1.5 refresh periods after the frame before (window only)"},
-       "f.dropped", Cell::kInteger},
-      {{"r_left_px", "number", "photo px", ">= 0", "the left object's blur radius in this frame; empty: not shown"},
-       "f.r_left_px", Cell::kNumber},
-      {{"r_right_px", "number", "photo px", ">= 0", "the right object's blur radius in this frame; empty: not shown"},
-       "f.r_right_px", Cell::kNumber},
-      {{"y_mm", "number", "mm", "", "the objects' place along the board's y in this frame (0 at edge 1)"}, "f.y_mm",
-       Cell::kNumber},
-  };
+  static const std::vector<FrameColumn> columns = [] {
+    std::vector<FrameColumn> c = {
+        {{"study", "string", "", "", "the protocol's name"}, "st.name", Cell::kText},
+        {{"participant", "string", "", "", "the participant's id"}, "p.code", Cell::kText},
+        {{"session_id", "integer", "", ">= 1", "the session's id in this record (as in trials.csv)"}, "s.id",
+         Cell::kInteger},
+        {{"window", "boolean", "", "0|1", "1: a real window on the real clock; 0: headless on a simulated clock"},
+         "coalesce(s.window, s.display LIKE 'window%')", Cell::kInteger},
+        {{"trial_index", "integer", "", ">= 0", "the trial (as in trials.csv)"}, "t.trial_index", Cell::kInteger},
+    };
+    // The frame's recorded values, as the record keeps them.
+    for (const FrameValue& v : FrameValues())
+      c.push_back({{v.name, v.type, v.unit, v.allowed, v.meaning}, "f." + v.name,
+                   v.sql == "TEXT" ? Cell::kText : v.sql == "REAL" ? Cell::kNumber : Cell::kInteger});
+    return c;
+  }();
   return columns;
 }
 

@@ -10,6 +10,7 @@
 #include "core/typed.h"
 #include "store/export.h"
 #include "store/columns.h"
+#include "store/frame_columns.h"
 #include "store/export_table.h"
 #include "store/record.h"
 #include "store/schema.h"
@@ -371,19 +372,24 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
           insert_response.Reset();
         }
 
-        Statement frames(src, "SELECT trial_id, frame_index, flip_time_s, dropped, " +
-                                  std::string(version >= 4 ? "r_left_px, r_right_px, y_mm"
-                                                                      : "NULL, NULL, NULL") + " FROM frames");
-        Statement insert_frame(dst, "INSERT INTO frames (trial_id, frame_index, flip_time_s, dropped, r_left_px, "
-                                    "r_right_px, y_mm) VALUES (?, ?, ?, ?, ?, ?, ?)");
+        // Every recorded value of a frame (frame_columns.h); NULL for those the input's version did not have.
+        std::string read, names, marks;
+        for (const FrameValue& v : FrameValues()) {
+          read += ", " + (version >= v.since ? v.name : std::string("NULL"));
+          names += ", " + v.name;
+          marks += ", ?";
+        }
+        Statement frames(src, "SELECT trial_id" + read + " FROM frames");
+        Statement insert_frame(dst, "INSERT INTO frames (trial_id" + names + ") VALUES (?" + marks + ")");
         while (frames.Step()) {
           insert_frame.Bind(1, trial_ids.at(frames.GetInt64(0)));
-          insert_frame.Bind(2, frames.GetInt64(1));
-          insert_frame.Bind(3, frames.GetDouble(2));
-          insert_frame.Bind(4, frames.GetInt64(3));
-          for (int column = 4; column <= 6; ++column) {
+          int column = 1;
+          for (const FrameValue& v : FrameValues()) {
             if (frames.IsNull(column)) insert_frame.BindNull(column + 1);
-            else insert_frame.Bind(column + 1, frames.GetDouble(column));
+            else if (v.sql == "TEXT") insert_frame.Bind(column + 1, frames.GetText(column));
+            else if (v.sql == "REAL") insert_frame.Bind(column + 1, frames.GetDouble(column));
+            else insert_frame.Bind(column + 1, frames.GetInt64(column));
+            ++column;
           }
           insert_frame.Run();
           insert_frame.Reset();

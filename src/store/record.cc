@@ -606,19 +606,13 @@ void Record::RecordResponse(int64_t session, int64_t trial_index, const Response
   insert.Bind(6, response.shown_json);
   BindTyped(RecordColumns(), insert, 7, response);  // the level, correctness and radii decided at the trial
   insert.Run();
-  Statement frame(db_, "INSERT INTO frames (trial_id, frame_index, flip_time_s, dropped, r_left_px, r_right_px, "
-                      "y_mm) VALUES (?, ?, ?, ?, ?, ?, ?)");
+  std::string names, marks;
+  for (const FrameValue& v : FrameValues()) names += ", " + v.name, marks += ", ?";
+  Statement frame(db_, "INSERT INTO frames (trial_id" + names + ") VALUES (?" + marks + ")");
   for (const FrameRecord& f : frames) {
     frame.Bind(1, trial_id);
-    frame.Bind(2, f.frame_index);
-    frame.Bind(3, f.flip_time_s);
-    frame.Bind(4, f.dropped ? 1 : 0);
-    int column = 5;
-    for (const std::optional<double>& value : {f.r_left_px, f.r_right_px, f.y_mm}) {
-      if (value) frame.Bind(column, *value);
-      else frame.BindNull(column);
-      ++column;
-    }
+    int column = 2;
+    for (const FrameValue& v : FrameValues()) BindValue(frame, column++, v.of(f));
     frame.Run();
     frame.Reset();
   }

@@ -11,6 +11,8 @@
 
 #include "store/sqlite.h"
 
+#include "store/frame_columns.h"
+
 namespace blurcue::store {
 
 // A column the design puts in trials.csv, as the record keeps it (design_columns, once per protocol version): the
@@ -124,15 +126,6 @@ struct Response {
   // when they were decided at the trial (photo px); empty otherwise.
   std::optional<double> level, r_left_px, r_right_px;
   std::optional<bool> correct;
-};
-
-struct FrameRecord {
-  int64_t frame_index = 0;
-  double flip_time_s = 0;
-  bool dropped = false;
-  // What the frame showed of a pair: each side's blur radius (photo px) and the objects' place along the board's y
-  // (mm); empty for a side not shown (a ball wiped at the end of its section) and for pictures.
-  std::optional<double> r_left_px, r_right_px, y_mm;
 };
 
 enum class SessionStatus { kRunning, kCompleted, kAborted };

@@ -7,6 +7,7 @@
 #include "core/hash.h"
 #include "core/json_io.h"
 #include "store/columns.h"
+#include "store/frame_columns.h"
 
 namespace blurcue::store {
 namespace {
@@ -167,7 +168,10 @@ std::vector<Migration> MakeMigrations() {
                    "  allowed TEXT NOT NULL,"
                    "  PRIMARY KEY (protocol_version_id, name))" + strict + ";",
                    &DeriveVersionsAndNumbers});
-  // 9 on: a typed column the column table adds with `since` N is migration N (NULL in the rows already there). A
+  // 9: a study on video - what each frame showed of the take (frame_columns.h: the take's frame and status, each
+  // side's lens floor and motion streak); NULL for photos and before version 9.
+  steps.push_back({AddColumnsSql(RecordColumns(), 9) + AddFrameColumnsSql(9)});
+  // 10 on: a typed column the column table adds with `since` N is migration N (NULL in the rows already there). A
   // version that needs more (a table, a derivation from older texts) is written above as its own step.
   int last = 0;
   for (const Column& c : RecordColumns()) last = std::max({last, c.at.since, c.shown.since});

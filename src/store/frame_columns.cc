@@ -1,0 +1,82 @@
+#include "store/frame_columns.h"
+
+#include "store/sqlite.h"
+
+namespace blurcue::store {
+namespace {
+
+Value Maybe(const std::optional<double>& v) { return v ? Value(*v) : Value(); }
+
+std::string StatusCheck() {
+  std::string list;
+  for (const char* s : kTakeStatuses) list += (list.empty() ? "'" : ", '") + std::string(s) + "'";
+  return "take_status IN (" + list + ")";
+}
+
+std::string StatusAllowed() {
+  std::string list;
+  for (const char* s : kTakeStatuses) list += (list.empty() ? "" : "|") + std::string(s);
+  return list;
+}
+
+}  // namespace
+
+const std::vector<FrameValue>& FrameValues() {
+  using F = FrameRecord;
+  static const std::vector<FrameValue> values = {
+      {"frame_index", "integer", "", ">= 0", "the frame's place in the trial", "INTEGER", "", 1,
+       [](const F& f) { return Value(f.frame_index); }},
+      {"flip_time_s", "number", "s", ">= 0", "when the frame reached the screen, from the trial's first flip", "REAL",
+       "", 1, [](const F& f) { return Value(f.flip_time_s); }},
+      {"dropped", "boolean", "", "0|1", "1: more than 1.5 refresh periods after the frame before (window only)",
+       "INTEGER", "", 1, [](const F& f) { return Value(int64_t(f.dropped ? 1 : 0)); }},
+      {"r_left_px", "number", "photo px", ">= 0", "the left object's blur radius in this frame; empty: not shown",
+       "REAL", "", 4, [](const F& f) { return Maybe(f.r_left_px); }},
+      {"r_right_px", "number", "photo px", ">= 0", "the right object's blur radius in this frame; empty: not shown",
+       "REAL", "", 4, [](const F& f) { return Maybe(f.r_right_px); }},
+      {"y_mm", "number", "mm", "", "the objects' place along the board's y in this frame (0 at edge 1)", "REAL", "", 4,
+       [](const F& f) { return Maybe(f.y_mm); }},
+      {"take_frame", "integer", "", ">= 0",
+       "a study on video: the take's frame on screen (its index in track.csv); empty for a photo", "INTEGER",
+       "take_frame >= 0", 9,
+       [](const F& f) { return f.take_frame ? Value(*f.take_frame) : Value(); }},
+      {"take_status", "string", "", StatusAllowed(),
+       "a study on video: the take frame's status (found or tracked: shown at its own pose; held: a lost frame or one "
+       "past the take's end, showing the last frame with a pose); empty for a photo",
+       "TEXT", StatusCheck(), 9, [](const F& f) { return f.take_status ? Value(*f.take_status) : Value(); }},
+      {"floor_sigma_left_px", "number", "photo px", ">= 0",
+       "a study on video: the lens floor (std) inside the left object's radius in this frame", "REAL", "", 9,
+       [](const F& f) { return Maybe(f.floor_sigma_left_px); }},
+      {"floor_sigma_right_px", "number", "photo px", ">= 0", "... the right object's", "REAL", "", 9,
+       [](const F& f) { return Maybe(f.floor_sigma_right_px); }},
+      {"motion_left_x_px", "number", "photo px", "",
+       "a study on video: the left object's motion streak in this frame (its image velocity at the frame's pose x "
+       "the exposure), x right",
+       "REAL", "", 9, [](const F& f) { return Maybe(f.motion_left_x_px); }},
+      {"motion_left_y_px", "number", "photo px", "", "... y down", "REAL", "", 9,
+       [](const F& f) { return Maybe(f.motion_left_y_px); }},
+      {"motion_right_x_px", "number", "photo px", "", "the right object's, x right", "REAL", "", 9,
+       [](const F& f) { return Maybe(f.motion_right_x_px); }},
+      {"motion_right_y_px", "number", "photo px", "", "... y down", "REAL", "", 9,
+       [](const F& f) { return Maybe(f.motion_right_y_px); }},
+  };
+  return values;
+}
+
+std::string AddFrameColumnsSql(int version) {
+  std::string sql;
+  for (const FrameValue& v : FrameValues())
+    if (v.since == version)
+      sql += "ALTER TABLE frames ADD COLUMN " + v.name + " " + v.sql +
+             (v.check.empty() ? std::string() : " CHECK (" + v.check + ")") + ";";
+  return sql;
+}
+
+void BindValue(Statement& insert, int index, const Value& value) {
+  if (const auto* i = std::get_if<int64_t>(&value)) insert.Bind(index, *i);
+  else if (const auto* d = std::get_if<double>(&value)) insert.Bind(index, *d);
+  else if (const auto* t = std::get_if<std::string>(&value)) insert.Bind(index, *t);
+  else insert.BindNull(index);
+}
+
+}  // namespace blurcue::store
