@@ -63,8 +63,35 @@ kill9)
     sort > "$W/main"
   for e in 3 6 9; do for p in 1 2 3; do for s in 0 1; do echo "$e|$p|$s"; done; done; done | sort > "$W/planned"
   diff "$W/planned" "$W/main" > "$W/diff" || fail "main trials are not the design's crossing once each: $(cat "$W/diff")"
+  # Each answered trial's frames once, from frame 0 without a gap, each showing a frame of the take: the frames of the
+  # trial the kill interrupted were not recorded (they go with its answer), and the resumed trial's start at 0.
+  [ "$(sql "$W/s.sqlite" "SELECT count(*) FROM (SELECT trial_id, count(*) AS n, max(frame_index) AS m FROM frames
+        GROUP BY trial_id) WHERE n <> m + 1")" = 0 ] || fail "a trial's frames have a gap or a duplicate"
+  [ "$(sql "$W/s.sqlite" "SELECT count(DISTINCT trial_id) FROM frames")" = $((MAIN + PRACTICE)) ] ||
+    fail "frames: not every answered trial has its frames"
+  [ "$(sql "$W/s.sqlite" "SELECT count(*) FROM frames WHERE take_frame IS NULL OR take_status IS NULL")" = 0 ] ||
+    fail "frames without their take frame"
   integrity "$W/s.sqlite"
   echo "ok: killed -9 after $answered answers, resumed: $((MAIN + PRACTICE)) planned trials, each answered once" ;;
+frames)
+  # Frame by frame against the take's truth (tests/video_frames_check.py): the take frame each display frame shows,
+  # each fitted ball's blur at its true depth (3 %), each ball's streak from the true poses (max(0.3 px, 5 %)) with a
+  # 16.7 ms exposure (the protocol's copy with content.exposure_ms set: the shipped one has none, its take being
+  # rendered with an instantaneous shutter), and the captured centres at the true pose.
+  $PY - "$PROTOCOL" "$W/exposed.json" <<'PYEOF' || fail "could not write the protocol's copy"
+import json, os, sys
+p = json.load(open(sys.argv[1]))
+p["content"]["exposure_ms"] = 16.7
+d = os.path.dirname(os.path.abspath(sys.argv[1]))
+p["scene"] = {k: os.path.normpath(os.path.join(d, v)) for k, v in p["scene"].items()}
+json.dump(p, open(sys.argv[2], "w"), indent=1)
+PYEOF
+  $BC run "$W/exposed.json" --participant F1 --db "$W/s.sqlite" --observer sim --capture "$W/capture" > "$W/out" 2>&1 ||
+    fail "run: $(tail -2 "$W/out")"
+  $BC export --db "$W/s.sqlite" --out "$W/export" > "$W/export.out" 2>&1 || fail "export: $(cat "$W/export.out")"
+  $PY "$(dirname "$0")/video_frames_check.py" "$DIR/take" "$W/export" "$W/capture" 16.7 > "$W/check" 2>&1 ||
+    fail "$(cat "$W/check")"
+  echo "ok: every frame of a simulated session on video against the take's truth: $(cat "$W/check")" ;;
 report)
   # Three simulated observers, then the report (from DIR, so the take's track folder is found as the protocols see it).
   for id in R1 R2 R3; do
@@ -79,11 +106,11 @@ report)
   grep -q "video-ball-depth-simulated-conditions" "$index" || fail "no conditions table for video-ball-depth"
   grep -q "3 participants" "$index" || fail "the report does not count 3 participants"
   # Its scene is described as a video: the take as the protocol names it, its 4 frames at 30 fps (the fixture's, by
-  # construction) and the protocol's 16.7 ms exposure.
+  # construction) and the protocol's exposure (none: the take was rendered with an instantaneous shutter).
   grep -q "scene: a tracked video: take ../take/take.avi, track folder ../track" "$index" ||
     fail "the report does not describe the scene as a video: $(grep -o 'scene: [^<]*' "$index")"
   grep -q "4 frames at 30 fps" "$index" || fail "the take's frames: $(grep -o 'scene: [^<]*' "$index")"
-  grep -q "exposure 16.7 ms" "$index" || fail "the exposure: $(grep -o 'scene: [^<]*' "$index")"
+  grep -q "exposure 0 ms (no motion blur)" "$index" || fail "the exposure: $(grep -o 'scene: [^<]*' "$index")"
   echo "ok: the report analyses video-ball-depth and describes its scene: $(grep -o 'scene: [^<;]*' "$index")" ;;
 bad_scene)
   # One problem, exit 3, naming the field: a missing take, a take of another frame size than its track folder's,

@@ -90,8 +90,10 @@ void AddRunCommand(CLI::App& app) {
   CLI::Option* window =
       cmd->add_flag("--window", args->options.window, "with --observer: show the session in a window, in real time")
           ->needs(observer);
-  cmd->add_option("--sim-fps", args->options.sim_fps, "with --observer, headless: frames rendered per simulated second")
-      ->capture_default_str()->check(FiniteRange(0.1, 1000, "frames per second"))->needs(observer)->excludes(window);
+  cmd->add_option("--sim-fps", args->options.sim_fps,
+                  "with --observer, headless: frames rendered per simulated second (default 4; a study on video: the "
+                  "take's frame rate, so that every frame of the take is shown and recorded)")
+      ->check(FiniteRange(0.1, 1000, "frames per second"))->needs(observer)->excludes(window);
   cmd->add_option("--info", args->info,
                   "KEY=VALUE: participant information the protocol asks for (participant_info), repeatable; missing "
                   "required ones are asked for in the terminal");

@@ -167,10 +167,16 @@ FrameCompositor::FrameCompositor(const Camera& camera, const cv::Vec3d& rvec, co
 
 void FrameCompositor::SetFrame(const cv::Vec3d& rvec, const cv::Vec3d& tvec, const cv::Mat& background) {
   Impl& m = *impl_;
-  CV_Assert(background.cols == m.camera.image_width_px && background.rows == m.camera.image_height_px);
-  m.photo.UploadSrgb(ResampleSrgb8(background, {m.view.photo_width_px, m.view.photo_height_px}));
+  const cv::Size scaled(m.view.photo_width_px, m.view.photo_height_px);
+  CV_Assert(background.size() == scaled ||
+            (background.cols == m.camera.image_width_px && background.rows == m.camera.image_height_px));
+  m.photo.UploadSrgb(background.size() == scaled ? background : ResampleSrgb8(background, scaled));
   m.renderer.SetPose(rvec, tvec);
   m.Place(m.view.x_px, m.view.y_px);  // the base frame from the new photo; the whole frame dirty
+}
+
+cv::Mat FrameCompositor::ScaledPhoto(const cv::Mat& background) const {
+  return ResampleSrgb8(background, {impl_->view.photo_width_px, impl_->view.photo_height_px});
 }
 
 void FrameCompositor::Place(int x_px, int y_px) {

@@ -34,9 +34,13 @@ class FrameCompositor {
   // Waits for the GPU (timing) and reads the frame as 8-bit BGR sRGB.
   cv::Mat Read();
   void Finish();
-  // The next frame of a video: `background` (the camera's size, 8-bit sRGB) uploaded into the photo's texture and the
-  // board at rvec/tvec, in the targets made once (a video allocates no GL object per frame).
+  // The next frame of a video: `background` (8-bit sRGB, the camera's size, or already resampled to the view's photo
+  // size: ScaledPhoto) uploaded into the photo's texture and the board at rvec/tvec, in the targets made once (a
+  // video allocates no GL object per frame).
   void SetFrame(const cv::Vec3d& rvec, const cv::Vec3d& tvec, const cv::Mat& background);
+  // A photo of the camera's size resampled as this compositor shows it (linear light, area filter): what SetFrame
+  // takes without resampling again.
+  cv::Mat ScaledPhoto(const cv::Mat& background) const;
   // Moves the photo in the frame (another crop of the same scaled photo): x_px, y_px of the view.
   void Place(int x_px, int y_px);
   const scene::FrameView& view() const;

@@ -137,8 +137,12 @@ void CapturingPresenter::Capture(const protocol::Trial& trial, const stimulus::T
   const int band = prepared_.presentation.prompt_band_px;
   char name[32];
   std::snprintf(name, sizeof name, "trial-%04d", trial.index + 1);
-  Json frame = stimulus::DescribeFrame(prepared_.scene ? &*prepared_.scene : nullptr, scene,
-                                       prepared_.presentation, inner_.View(), inner_.Shown(), cutoff);
+  Json frame = stimulus::DescribeFrame(inner_.ShownScene(), scene, prepared_.presentation, inner_.View(),
+                                       inner_.Shown(), cutoff);
+  if (const auto take = inner_.ShownTake()) {
+    frame["take_frame"] = take->take_frame;
+    frame["take_status"] = take->status;
+  }
   frame["protocol"] = protocol_.name;
   frame["participant"] = participant_;
   frame["trial_index"] = trial.index;

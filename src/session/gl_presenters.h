@@ -29,6 +29,9 @@ class GlPresenter : public Presenter {
     renderer_.Compose(scene, t_s, level);
   }
   const std::array<std::optional<scene::BlurredObject>, 2>& Shown() const override { return renderer_.Shown(); }
+  std::optional<stimulus::TakeFrameShown> ShownTake() const override { return renderer_.ShownTake(); }
+  // The calibration the last composed frame's objects were drawn with (a video's frame's; else the protocol's).
+  const calib::SceneCalib* ShownScene() const { return renderer_.ShownScene(); }
   // Where the last composed frame showed the photo.
   scene::FrameView View() const { return renderer_.View(); }
   // The frame as the screen shows it now (8-bit BGR), with `prompt` in its band when not empty.
@@ -127,6 +130,7 @@ class CapturingPresenter : public Presenter {
     inner_.Compose(scene, t_s, level);
   }
   const std::array<std::optional<scene::BlurredObject>, 2>& Shown() const override { return inner_.Shown(); }
+  std::optional<stimulus::TakeFrameShown> ShownTake() const override { return inner_.ShownTake(); }
   void ShowStimulus(const StimulusFrame& frame) override;
   void ShowText(const std::string& title, const std::string& body, const std::string& footer) override {
     inner_.ShowText(title, body, footer);

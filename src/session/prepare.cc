@@ -1,5 +1,7 @@
 #include "session/prepare.h"
 
+#include "stimulus/video_take.h"
+
 #include <algorithm>
 
 #include "core/error.h"
@@ -15,6 +17,7 @@ using stimulus::LoadStimulusImages;
 using stimulus::PlanOnScreen;
 using stimulus::Presentation;
 using stimulus::TrialScene;
+using stimulus::CheckVideoTrial;
 
 PreparedSession PrepareStudy(const std::filesystem::path& protocol_file, const std::filesystem::path& display_profile) {
   PreparedSession s;
@@ -73,6 +76,7 @@ void PrepareParticipant(PreparedSession* s, const std::string& participant, std:
         TrialScene scene = DescribeTrial(s->protocol, trial, s->scene ? &*s->scene : nullptr, &s->presentation);
         CheckRealPhotos(s->protocol, {scene}, &s->real_photos_checked);
         if (s->scene) PlanOnScreen(s->protocol, *s->scene, s->presentation, &scene);
+        if (s->images.take) CheckVideoTrial(s->protocol, *s->images.take, trial, scene);
         it = cache->planned.emplace(key, std::move(scene)).first;
       }
       s->scenes.push_back(it->second);
@@ -85,6 +89,9 @@ void PrepareParticipant(PreparedSession* s, const std::string& participant, std:
   // Each pair trial's blur plan on that screen: one radius, or per pixel by depth where the object's depth asks.
   if (s->scene)
     for (TrialScene& scene : s->scenes) PlanOnScreen(s->protocol, *s->scene, s->presentation, &scene);
+  // On video, in every frame of the take a trial can show.
+  if (s->images.take)
+    for (size_t i = 0; i < s->trials.size(); ++i) CheckVideoTrial(s->protocol, *s->images.take, s->trials[i], s->scenes[i]);
 }
 
 PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const std::string& participant,

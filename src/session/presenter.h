@@ -14,6 +14,7 @@
 #include "protocol/trials.h"
 #include "scene/frame.h"
 #include "stimulus/stimulus.h"
+#include "stimulus/video_take.h"
 
 namespace blurcue::session {
 
@@ -51,6 +52,8 @@ class Presenter {
   virtual void Compose(const stimulus::TrialScene& scene, double t_s, double level) = 0;
   // What the last composed frame showed of a pair (radii in photo px); empty sides for pictures and wiped balls.
   virtual const std::array<std::optional<scene::BlurredObject>, 2>& Shown() const = 0;
+  // A study on video: the take's frame the last composed frame showed (StimulusRenderer::ShownTake); empty otherwise.
+  virtual std::optional<stimulus::TakeFrameShown> ShownTake() const { return std::nullopt; }
   // Puts a trial's frame on the screen for the next flip.
   virtual void ShowStimulus(const StimulusFrame& frame) = 0;
 

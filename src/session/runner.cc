@@ -1,5 +1,7 @@
 #include "session/runner.h"
 
+#include "stimulus/video_take.h"
+
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -175,7 +177,7 @@ RunResult RunSession(const RunOptions& options) {
   protocol::CheckParticipantId(options.participant);
   std::optional<ObserverParams> observer;
   if (!options.observer.empty()) observer = ParseObserver(options.observer);
-  if (options.sim_fps <= 0) throw Error(ErrorKind::kUsage, "--sim-fps must be > 0");
+  if (options.sim_fps < 0) throw Error(ErrorKind::kUsage, "--sim-fps must be > 0");
 
   // --resume continues what a record holds: a missing record holds nothing (and is not created).
   if (options.resume && !std::filesystem::exists(options.db))
@@ -303,7 +305,9 @@ RunResult RunSession(const RunOptions& options) {
   if (window)
     shows = std::make_unique<WindowPresenter>(*context, renderer, screen, band);
   else
-    shows = std::make_unique<HeadlessPresenter>(*context, renderer, options.sim_fps, band);
+    shows = std::make_unique<HeadlessPresenter>(
+        *context, renderer,
+        options.sim_fps > 0 ? options.sim_fps : chosen.images.take ? chosen.images.take->fps() : 4.0, band);
   std::optional<CapturingPresenter> capture;
   if (!options.capture_dir.empty()) capture.emplace(*shows, chosen, options.capture_dir, options.participant);
   Presenter& presenter = capture ? static_cast<Presenter&>(*capture) : *shows;

@@ -25,7 +25,9 @@ struct RunOptions {
   bool resume = false;
   bool again = false;            // allow another session for a participant who completed the study
   bool window = false;           // a simulated observer in a window, on the real clock (a person always has one)
-  double sim_fps = 4;            // headless: frames rendered per second of simulated time
+  // Headless: frames rendered per second of simulated time; 0: 4, or on video the take's frame rate (every frame of
+  // the take shown and recorded).
+  double sim_fps = 0;
   std::filesystem::path capture_dir;      // --capture: each trial's first frame as shown, and what it shows
   // --info KEY=VALUE: the participant information the protocol asks for (participant_info). Missing required
   // fields are asked for in the terminal when stdin is one, else refused; a resumed session keeps what it recorded.

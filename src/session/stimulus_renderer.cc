@@ -32,6 +32,18 @@ StimulusRenderer::StimulusRenderer(const protocol::Protocol& protocol, const std
   texture_ = scene::SurfaceTexture(images.texture);
   compositor_ = std::make_unique<render::FrameCompositor>(scene_->camera, scene_->rvec, scene_->tvec, photo_,
                                                           presentation.view);
+  if (images.take) {
+    // Every frame a trial can show, resampled for the screen now: a frame of the take then costs an upload.
+    take_ = images.take;
+    take_photos_.resize(take_->take().frames.size());
+    for (const int i : take_->PosedFrames()) take_photos_[size_t(i)] = compositor_->ScaledPhoto(take_->Photo(i));
+    take_posed_ = take_->first_posed();  // the compositor was made with its photo and pose (LoadProtocolScene's)
+  }
+}
+
+const calib::SceneCalib* StimulusRenderer::ShownScene() const {
+  if (take_shown_) return &take_->Calib(take_shown_->posed);
+  return scene_ ? &*scene_ : nullptr;
 }
 
 StimulusRenderer::~StimulusRenderer() = default;
@@ -77,7 +89,25 @@ void StimulusRenderer::Compose(const TrialScene& trial, double t_s, double level
     picture_stale_ = true;
     return;
   }
-  shown_ = ObjectsAt(protocol_, *scene_, trial, t_s);
+  if (take_) {
+    // The take's frame at this moment, at its pose: its photo into the compositor when it changed.
+    const stimulus::TakeFrameShown at = take_->FrameAt(t_s);
+    // Held (a lost frame, past the take's end, or a screen faster than the take) with nothing else moving: the frame
+    // composed last is this one.
+    const bool same = t_s > 0 && take_shown_ && at.posed == take_shown_->posed && &trial == composed_trial_ &&
+                      trial.MotionS() <= 0;
+    take_shown_ = at;
+    composed_trial_ = &trial;
+    if (same) return;
+    if (take_shown_->posed != take_posed_) {
+      take_posed_ = take_shown_->posed;
+      const calib::SceneCalib& c = take_->Calib(take_posed_);
+      compositor_->SetFrame(c.rvec, c.tvec, take_photos_[size_t(take_posed_)]);
+    }
+    shown_ = VideoObjectsAt(protocol_, *take_, *take_shown_, trial, t_s);
+  } else {
+    shown_ = ObjectsAt(protocol_, *scene_, trial, t_s);
+  }
   objects_.clear();  // kept between frames: its storage is reused
   for (auto& shown : shown_) {
     if (!shown) continue;

@@ -15,6 +15,7 @@
 #include "render/frame_compositor.h"
 #include "scene/frame.h"
 #include "stimulus/stimulus.h"
+#include "stimulus/video_take.h"
 
 namespace blurcue::session {
 
@@ -39,6 +40,10 @@ class StimulusRenderer {
   // What the last composed frame showed of a pair (ObjectsAt, as drawn; radii in photo px): empty sides for
   // pictures and wiped balls.
   const std::array<std::optional<scene::BlurredObject>, 2>& Shown() const { return shown_; }
+  // A study on video: the take's frame the last composed frame showed, and its calibration (the pose and blur its
+  // objects were drawn with); empty / null for a photo.
+  const std::optional<stimulus::TakeFrameShown>& ShownTake() const { return take_shown_; }
+  const calib::SceneCalib* ShownScene() const;
   // Where the last composed frame showed the photo (pairs; the identity of the frame for a picture).
   scene::FrameView View() const;
   // Shows the last composed frame in the current window, fitted to width x height.
@@ -67,6 +72,13 @@ class StimulusRenderer {
   double lower_distance_m_ = -1;  // the distance whose real photo lower_ shows (one at a time: 27 would hold ~50 MB)
   cv::Mat lower_;                 // the frame's lower half, scaled once per trial
   std::array<std::optional<scene::BlurredObject>, 2> shown_;
+  // Video: the take, its frames with a pose resampled once for the screen (by take frame; empty for the others), the
+  // frame the compositor holds, and the frame last shown.
+  std::shared_ptr<const stimulus::VideoTake> take_;
+  std::vector<cv::Mat> take_photos_;
+  int take_posed_ = -1;
+  std::optional<stimulus::TakeFrameShown> take_shown_;
+  const stimulus::TrialScene* composed_trial_ = nullptr;  // what the last composed frame showed (a video's hold)
 };
 
 }  // namespace blurcue::session

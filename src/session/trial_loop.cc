@@ -121,9 +121,11 @@ class Runner {
       const int on = k >= 0 && t - k * (interval_s + isi_s) < interval_s ? k : -1;
       const bool shown = n > 0 ? on >= 0 : stimulus_s <= 0 || t < stimulus_s;
       if (n > 0) {
-        if (shown && composed_interval != on) presenter_.Compose(intervals[size_t(on)], 0, 0);
+        // An interval's object is still (composed once), but on video, where the take plays on under it.
+        if (shown && (composed_interval != on || scene.video))
+          presenter_.Compose(intervals[size_t(on)], scene.video ? t : 0, 0);
         composed_interval = on;
-      } else if (shown && (composed_level != level || scene.MotionS() > 0)) {
+      } else if (shown && (composed_level != level || scene.MotionS() > 0 || scene.video)) {
         // A still stimulus is composed once (and again when the adjusted level changes); a moving one every frame.
         presenter_.Compose(scene, t, levels > 0 ? trial.adjust_levels[size_t(level)] : 0);
         composed_level = level;
@@ -140,16 +142,28 @@ class Runner {
         responder_.StimulusShown(trial, scene, onset);
       }
       const bool dropped = presenter_.RealTime() && last_flip >= 0 && flip - last_flip > 1.5 * presenter_.FrameS();
-      FrameRecord shown_frame{frame, flip - onset, dropped, {}, {}, {}};
+      FrameRecord shown_frame;
+      shown_frame.frame_index = frame;
+      shown_frame.flip_time_s = flip - onset;
+      shown_frame.dropped = dropped;
       if (shown) {
         // What this frame showed, as Compose drew it (a still stimulus is composed once and shown unchanged).
         const auto& objects = presenter_.Shown();
-        if (objects[0])
-          (n > 0 && IntervalShowsRight(trial, scene, on) ? shown_frame.r_right_px : shown_frame.r_left_px) =
-              objects[0]->r_px;
-        if (objects[1]) shown_frame.r_right_px = objects[1]->r_px;
-        for (const auto& o : objects)
-          if (o && !shown_frame.y_mm) shown_frame.y_mm = o->object.center_board_mm[1];
+        for (size_t i = 0; i < 2; ++i) {
+          if (!objects[i]) continue;
+          const scene::BlurredObject& o = *objects[i];
+          // An interval shows one side's object in the left slot.
+          const bool right = i == 1 || (n > 0 && IntervalShowsRight(trial, scene, on));
+          (right ? shown_frame.r_right_px : shown_frame.r_left_px) = o.r_px;
+          (right ? shown_frame.floor_sigma_right_px : shown_frame.floor_sigma_left_px) = o.floor_sigma_px;
+          (right ? shown_frame.motion_right_x_px : shown_frame.motion_left_x_px) = o.motion_px[0];
+          (right ? shown_frame.motion_right_y_px : shown_frame.motion_left_y_px) = o.motion_px[1];
+          if (!shown_frame.y_mm) shown_frame.y_mm = o.object.center_board_mm[1];
+        }
+        if (const auto take = presenter_.ShownTake()) {
+          shown_frame.take_frame = take->take_frame;
+          shown_frame.take_status = take->status;
+        }
       }
       frames->push_back(shown_frame);
       dropped_frames_ += dropped;

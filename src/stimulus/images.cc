@@ -10,52 +10,30 @@
 #include "scene/stimuli.h"
 #include "stimulus/internal.h"
 #include "stimulus/tracked_take.h"
-#include "track/frames.h"
+#include "stimulus/video_take.h"
 
 namespace blurcue::stimulus {
 
 namespace {
 
-// A video scene's still: the first frame of the take with a pose (issue 27 item 4, first step: a trial shows it as a
-// photo; per-frame drawing is not done yet). Its index, its calibration and, when `photo` is given, its image.
-int VideoSceneFrame(const protocol::Protocol& protocol, calib::SceneCalib* calib, cv::Mat* photo) {
+// A video scene's calibration as the trials are described with it: its first frame with a pose.
+calib::SceneCalib FirstPosedCalib(const protocol::Protocol& protocol) {
   TrackedTake take;
   try {
     take = LoadTrackedTake(protocol.scene.track);
   } catch (const std::exception& e) {
     throw InputError(At(protocol, "/scene/track"), e.what());
   }
-  int index = 0;
-  while (!take.frames[size_t(index)].calib) ++index;  // LoadTrackedTake: at least one frame has a pose
-  *calib = *take.frames[size_t(index)].calib;
-  if (!photo) return index;
-  try {
-    track::FrameSource source(protocol.scene.video.string(), 30);
-    int at = -1;
-    double time_s = 0;
-    while (at < index)
-      if (!source.Next(photo, &at, &time_s))
-        throw Error(ErrorKind::kInput, "ends before frame " + std::to_string(index) + ", the first with a pose in " +
-                                           protocol.scene.track.string());
-  } catch (const std::exception& e) {
-    throw InputError(At(protocol, "/scene/video"), e.what());
-  }
-  try {
-    calib->RequireSameSize(*photo, protocol.scene.video.string());
-  } catch (const std::exception& e) {
-    throw InputError(At(protocol, "/scene/video"), std::string(e.what()) + " (" + protocol.scene.track.string() +
-                                                       " is the track of another take)");
-  }
-  return index;
+  for (const TrackedFrame& f : take.frames)
+    if (f.calib) return *f.calib;
+  throw InputError(At(protocol, "/scene/track"), "no frame has a pose");  // LoadTrackedTake refuses it already
 }
 
 }  // namespace
 
 std::optional<calib::SceneCalib> LoadProtocolScene(const protocol::Protocol& protocol) {
   if (protocol.scene.IsVideo()) {
-    calib::SceneCalib c;
-    VideoSceneFrame(protocol, &c, nullptr);
-    return c;
+    return FirstPosedCalib(protocol);
   }
   if (protocol.scene.calib.empty()) {
     if (protocol.content.type == protocol::ContentType::kPicture) return std::nullopt;
@@ -107,8 +85,9 @@ StimulusImages LoadStimulusImages(const protocol::Protocol& protocol, const std:
   const std::string photo_field = board_free ? "/scene/board_free" : "/scene/background";
   const auto& photo_path = protocol.scene.ShownPhoto();
   if (protocol.scene.IsVideo()) {
-    calib::SceneCalib c;
-    VideoSceneFrame(protocol, &c, &images.photo);
+    // Every frame a trial can show, decoded once (and checked against the track's camera) for the whole session.
+    images.take = std::make_shared<const VideoTake>(protocol);
+    images.photo = images.take->Photo(images.take->first_posed());
   } else if (protocol.content.type != protocol::ContentType::kPicture || protocol.content.real_photos.empty()) {
     images.photo = ReadFieldImage(protocol, photo_field, photo_path, 1, 10, kMaxPhotoSidePx);
     // The photo not shown is still a photo of the scene: check it decodes too.

@@ -27,6 +27,8 @@
 
 namespace blurcue::stimulus {
 
+class VideoTake;
+
 struct TrialScene {
   protocol::ContentType content = protocol::ContentType::kGrid;
   // Pairs (grid, ball): the source on each side as shown (swaps applied).
@@ -62,6 +64,8 @@ struct TrialScene {
   // y down), averaged over the run like the radii.
   double exposure_ms = 0;
   cv::Vec2d motion_left_px{0, 0}, motion_right_px{0, 0};
+  // A study on video: the take plays while the trial is shown (VideoTake), so every frame is composed again.
+  bool video = false;
 
   // The blur plan (PlanOnScreen): per pixel by depth when an object's depth span changes its radius on screen by at least
   // the protocol's depth_blur_threshold, else one radius at its centre.
@@ -124,6 +128,8 @@ struct StimulusImages {
   cv::Mat photo;    // the scene photo shown (BGR; for a grid or ball the calibrated camera's size)
   cv::Mat picture;  // picture: the picture (alpha kept)
   cv::Mat texture;  // grid or ball: the card's or the ball's texture
+  // A study on video: the tracked take, its frames decoded (photo is its first frame with a pose); null for a photo.
+  std::shared_ptr<const VideoTake> take;
 };
 
 // How a frame reaches the screen and the eye. A grid or ball trial is composed at the window's size: the photo

@@ -208,17 +208,27 @@ std::vector<PlacedObject> LoadPlacedObjects(const std::filesystem::path& path) {
   return PlacedObjectsFromJson(ReadJsonFile(path), path.string() + ": ");
 }
 
+cv::Vec2d StreakPx(const TrackedTake& take, int index, const cv::Vec3d& board_mm, double exposure_ms) {
+  if (exposure_ms <= 0 || index < 0 || index >= int(take.frames.size()) || !take.frames[size_t(index)].calib)
+    return {0, 0};
+  const int before = NeighbourWithPose(take, index, -1), after = NeighbourWithPose(take, index, +1);
+  // Central difference where both neighbours have a pose: exact for motion linear in time, and centred on this
+  // frame, as the streak is (from -m/2 to +m/2 about the object's place).
+  const int a = before >= 0 ? before : index, b = after >= 0 ? after : index;
+  const double dt = take.frames[size_t(b)].time_s - take.frames[size_t(a)].time_s;
+  if (a == b || !(dt > 0)) return {0, 0};
+  const cv::Point2d pa = Project(*take.frames[size_t(a)].calib, board_mm);
+  const cv::Point2d pb = Project(*take.frames[size_t(b)].calib, board_mm);
+  const double s = exposure_ms / 1000 / dt;
+  return {(pb.x - pa.x) * s, (pb.y - pa.y) * s};
+}
+
 TrackedFramePlan PlanTrackedFrame(const TrackedTake& take, int index, const std::vector<PlacedObject>& objects,
                                   const TakeBlur& blur) {
   TrackedFramePlan plan;
   if (index < 0 || index >= int(take.frames.size()) || !take.frames[size_t(index)].calib) return plan;
   const TrackedFrame& frame = take.frames[size_t(index)];
   const calib::SceneCalib& c = *frame.calib;
-  const int before = NeighbourWithPose(take, index, -1), after = NeighbourWithPose(take, index, +1);
-  // Central difference where both neighbours have a pose: exact for motion linear in time, and centred on this
-  // frame, as the streak is (from -m/2 to +m/2 about the object's place).
-  const int a = before >= 0 ? before : index, b = after >= 0 ? after : index;
-  const double dt = take.frames[size_t(b)].time_s - take.frames[size_t(a)].time_s;
   for (const PlacedObject& p : objects) {
     const std::string who = p.name + " in frame " + std::to_string(index);
     DrawnObject d;
@@ -232,12 +242,7 @@ TrackedFramePlan PlanTrackedFrame(const TrackedTake& take, int index, const std:
       throw Error(e.kind(), who + ": " + e.what());
     }
     d.floor_sigma_px = calib::FloorSigmaPx(c, blur.source, centre);
-    if (a != b && dt > 0 && blur.exposure_ms > 0) {
-      const cv::Point2d pa = Project(*take.frames[size_t(a)].calib, p.object.center_board_mm);
-      const cv::Point2d pb = Project(*take.frames[size_t(b)].calib, p.object.center_board_mm);
-      const double s = blur.exposure_ms / 1000 / dt;
-      d.motion_px = {(pb.x - pa.x) * s, (pb.y - pa.y) * s};
-    }
+    d.motion_px = StreakPx(take, index, p.object.center_board_mm, blur.exposure_ms);
     const double streak = cv::norm(d.motion_px);
     if (!(d.r_px >= 0 && d.r_px <= optics::kMaxBlurRadiusPx && streak <= optics::kMaxBlurRadiusPx))
       throw Error(ErrorKind::kDomain, who + ": blur r " + Num(d.r_px) + " px, streak " + Num(streak) +

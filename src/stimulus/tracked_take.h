@@ -82,10 +82,13 @@ struct TrackedFramePlan {
   std::vector<DrawnObject> drawn;
 };
 
-// The objects of frame `index` at its pose. Each one's image velocity is the change of its centre's projection
-// between the nearest frames with a pose on either side (central where both are, one-sided at a gap or an end, none
-// when neither is) over their time apart. Error(kDomain) naming the object and the frame when its blur cannot be
-// evaluated there or exceeds the largest blur.
+// The streak of a board point in frame `index` (image px, x right, y down): its image velocity there - the change of
+// its projection between the nearest frames with a pose on either side (central where both are, one-sided at a gap
+// or an end, none when neither is) over their time apart - times the exposure. 0 for a lost frame or no exposure.
+cv::Vec2d StreakPx(const TrackedTake& take, int index, const cv::Vec3d& board_mm, double exposure_ms);
+
+// The objects of frame `index` at its pose, each streaked by StreakPx of its centre. Error(kDomain) naming the object
+// and the frame when its blur cannot be evaluated there or exceeds the largest blur.
 TrackedFramePlan PlanTrackedFrame(const TrackedTake& take, int index, const std::vector<PlacedObject>& objects,
                                   const TakeBlur& blur);
 

@@ -139,6 +139,7 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   t.kernel = protocol.content.kernel;
   t.brightness = protocol.content.brightness;
   t.exposure_ms = protocol.content.exposure_ms;
+  t.video = protocol.scene.IsVideo();
   t.contrast = protocol.content.contrast;
   t.white_balance = protocol.content.white_balance;
   // Problems name the protocol field that asked for what cannot be shown, and the trial as a detail.

@@ -45,13 +45,13 @@ const std::vector<FrameValue>& FrameValues() {
        "past the take's end, showing the last frame with a pose); empty for a photo",
        "TEXT", StatusCheck(), 9, [](const F& f) { return f.take_status ? Value(*f.take_status) : Value(); }},
       {"floor_sigma_left_px", "number", "photo px", ">= 0",
-       "a study on video: the lens floor (std) inside the left object's radius in this frame", "REAL", "", 9,
+       "the lens floor (std) inside the left object's radius in this frame; empty: not shown", "REAL", "", 9,
        [](const F& f) { return Maybe(f.floor_sigma_left_px); }},
       {"floor_sigma_right_px", "number", "photo px", ">= 0", "... the right object's", "REAL", "", 9,
        [](const F& f) { return Maybe(f.floor_sigma_right_px); }},
       {"motion_left_x_px", "number", "photo px", "",
-       "a study on video: the left object's motion streak in this frame (its image velocity at the frame's pose x "
-       "the exposure), x right",
+       "the left object's motion streak in this frame (its image velocity x the exposure: its own motion's and, on "
+       "video, the camera's), x right; empty: not shown",
        "REAL", "", 9, [](const F& f) { return Maybe(f.motion_left_x_px); }},
       {"motion_left_y_px", "number", "photo px", "", "... y down", "REAL", "", 9,
        [](const F& f) { return Maybe(f.motion_left_y_px); }},

@@ -19,9 +19,9 @@ struct FrameRecord {
   // What the frame showed of a pair: each side's blur radius (photo px) and the objects' place along the board's y
   // (mm); empty for a side not shown (a ball wiped at the end of its section) and for pictures.
   std::optional<double> r_left_px, r_right_px, y_mm;
-  // A study on video (schema 9): the take's frame on screen and its status (found, tracked, or held: a lost frame or
-  // one past the take's end, showing the last frame with a pose); each side's lens floor (std) and motion streak
-  // (photo px, x right, y down) in this frame. Empty for a photo's study.
+  // Schema 9. A study on video: the take's frame on screen and its status (found, tracked, or held: a lost frame or
+  // one past the take's end, showing the last frame with a pose); empty for a photo's study. Each side shown: its
+  // lens floor (std) and motion streak (photo px, x right, y down) in this frame.
   std::optional<int64_t> take_frame;
   std::optional<std::string> take_status;
   std::optional<double> floor_sigma_left_px, floor_sigma_right_px, motion_left_x_px, motion_left_y_px,

@@ -1,0 +1,119 @@
+#include "stimulus/video_take.h"
+
+#include <cmath>
+
+#include "core/error.h"
+#include "core/names.h"
+#include "optics/thin_lens.h"
+#include "stimulus/internal.h"
+#include "track/frames.h"
+
+namespace blurcue::stimulus {
+namespace {
+
+constexpr double kMaxTakeBytes = 4.0 * (1 << 30);
+
+}  // namespace
+
+VideoTake::VideoTake(const protocol::Protocol& protocol) {
+  try {
+    take_ = LoadTrackedTake(protocol.scene.track);
+  } catch (const std::exception& e) {
+    throw InputError(At(protocol, "/scene/track"), e.what());
+  }
+  const int n = int(take_.frames.size());
+  first_posed_ = 0;
+  while (!take_.frames[size_t(first_posed_)].calib) ++first_posed_;  // LoadTrackedTake: at least one has a pose
+  last_posed_ = n - 1;
+  while (!take_.frames[size_t(last_posed_)].calib) --last_posed_;
+  // Over the whole take: track.csv's times are rounded to the microsecond, a step between two frames is not exact.
+  const double span = take_.frames.back().time_s - take_.frames.front().time_s;
+  fps_ = n > 1 && span > 0 ? (n - 1) / span : 30;
+  const std::string track = protocol.scene.track.string(), video = protocol.scene.video.string();
+  // Every frame is held decoded for the session (8-bit BGR): a take that would not fit is refused before decoding.
+  const Camera& camera = take_.camera();
+  const double bytes = 3.0 * camera.image_width_px * camera.image_height_px * (last_posed_ - first_posed_ + 1);
+  if (bytes > kMaxTakeBytes)
+    throw InputError(At(protocol, "/scene/track"),
+                     "the take's " + std::to_string(last_posed_ - first_posed_ + 1) + " frames from the first to the "
+                     "last with a pose would hold " + Num(bytes / (1 << 30)) + " GiB decoded (at most " +
+                     Num(kMaxTakeBytes / (1 << 30)) + " GiB): cut the take, or track a shorter part of it");
+  try {
+    track::FrameSource source(video, fps_);
+    cv::Mat image;
+    int at = -1;
+    double time_s = 0;
+    while (at < last_posed_) {
+      if (!source.Next(&image, &at, &time_s))
+        throw Error(ErrorKind::kInput, "ends after frame " + std::to_string(at) + ", but " + track +
+                                           " has a pose for frame " + std::to_string(last_posed_));
+      if (at < first_posed_) {
+        photos_.emplace_back();  // never shown
+        continue;
+      }
+      if (take_.frames[size_t(at)].calib) {
+        try {
+          take_.frames[size_t(at)].calib->RequireSameSize(image, video + " frame " + std::to_string(at));
+        } catch (const std::exception& e) {
+          throw Error(ErrorKind::kInput, std::string(e.what()) + " (" + track + " is the track of another take)");
+        }
+      }
+      photos_.push_back(image.clone());
+    }
+  } catch (const std::exception& e) {
+    throw InputError(At(protocol, "/scene/video"), e.what());
+  }
+}
+
+TakeFrameShown VideoTake::FrameAt(double t_s) const {
+  const int last = int(take_.frames.size()) - 1;
+  const double k = first_posed_ + std::floor(std::max(0.0, t_s) * fps_ + 1e-6);
+  TakeFrameShown shown;
+  const bool past = k > last;
+  shown.take_frame = past ? last : int(k);
+  shown.posed = std::min(shown.take_frame, last_posed_);
+  while (!take_.frames[size_t(shown.posed)].calib) --shown.posed;  // first_posed_ <= posed: it has one
+  const TrackedFrame& f = take_.frames[size_t(shown.take_frame)];
+  shown.status = past || !f.calib ? "held" : track::Name(f.status);
+  return shown;
+}
+
+std::vector<int> VideoTake::PosedFrames() const {
+  std::vector<int> posed;
+  for (int i = first_posed_; i <= last_posed_; ++i)
+    if (take_.frames[size_t(i)].calib) posed.push_back(i);
+  return posed;
+}
+
+std::array<std::optional<scene::BlurredObject>, 2> VideoObjectsAt(const protocol::Protocol& protocol,
+                                                                   const VideoTake& take, const TakeFrameShown& shown,
+                                                                   const TrialScene& trial, double t_s) {
+  auto objects = ObjectsAt(protocol, take.Calib(shown.posed), trial, t_s);
+  if (trial.exposure_ms > 0)
+    for (auto& o : objects)
+      if (o) o->motion_px += StreakPx(take.take(), shown.posed, o->object.center_board_mm, trial.exposure_ms);
+  return objects;
+}
+
+void CheckVideoTrial(const protocol::Protocol& protocol, const VideoTake& take, const protocol::Trial& trial,
+                     const TrialScene& scene) {
+  for (const int index : take.PosedFrames()) {
+    TakeFrameShown shown;
+    shown.take_frame = shown.posed = index;
+    // The trial's clock at that frame (a moving ball is where it is then).
+    const double t_s = (index - take.first_posed()) / take.fps();
+    try {
+      for (const auto& o : VideoObjectsAt(protocol, take, shown, scene, t_s))
+        if (o && !(o->r_px >= 0 && o->r_px <= optics::kMaxBlurRadiusPx &&
+                   cv::norm(o->motion_px) <= optics::kMaxBlurRadiusPx))
+          throw Error(ErrorKind::kDomain, "blur r " + Num(o->r_px) + " px, streak " + Num(cv::norm(o->motion_px)) +
+                                              " px; each must be in [0, " + Num(optics::kMaxBlurRadiusPx) + "] px");
+    } catch (const std::exception& e) {
+      throw InputError(At(protocol, "/scene/track"), "trial " + std::to_string(trial.index + 1) +
+                                                        " cannot be drawn in the take's frame " +
+                                                        std::to_string(index) + ": " + e.what());
+    }
+  }
+}
+
+}  // namespace blurcue::stimulus

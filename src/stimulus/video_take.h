@@ -1,0 +1,64 @@
+#pragma once
+// A study on video (a protocol's scene {"video": ..., "track": ...}): the tracked take, its frames decoded once per
+// session, and which frame a trial shows when. A trial plays the take from its first frame with a pose at the take's
+// own frame rate; a lost frame, and every moment past the take's end, holds the last frame with a pose (its photo and
+// its objects). GL-free: session's StimulusRenderer draws what this says, the runner records it.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "calib/scene_blur.h"
+#include "protocol/protocol.h"
+#include "stimulus/stimulus.h"
+#include "stimulus/tracked_take.h"
+
+namespace blurcue::stimulus {
+
+// The take's frame on screen at a moment of a trial.
+struct TakeFrameShown {
+  int take_frame = 0;   // the take's frame at this moment (its index in track.csv; the last one past the end)
+  int posed = 0;        // the frame whose photo and pose are shown: take_frame, or for a held one the last with a pose
+  std::string status;   // found | tracked (shown at its own pose) | held (lost, or past the take's end)
+};
+
+class VideoTake {
+ public:
+  // Reads the track folder (LoadTrackedTake) and decodes every frame of the take up to its last with a pose, checking
+  // each against the track's camera. Errors (kInput) name the protocol file and /scene/track or /scene/video.
+  explicit VideoTake(const protocol::Protocol& protocol);
+
+  const TrackedTake& take() const { return take_; }
+  int first_posed() const { return first_posed_; }
+  // Frame `index`'s image (8-bit BGR) and, for a frame with a pose, its calibration.
+  const cv::Mat& Photo(int index) const { return photos_[size_t(index)]; }
+  const calib::SceneCalib& Calib(int index) const { return *take_.frames[size_t(index)].calib; }
+  // The frames per second the take plays at (track.csv's times; 30 for a one-frame take).
+  double fps() const { return fps_; }
+  // The take's frame t_s after a trial's onset: first_posed() + floor(t_s x fps), held as the class says.
+  TakeFrameShown FrameAt(double t_s) const;
+  // Every frame a trial can show (the frames with a pose from first_posed() on).
+  std::vector<int> PosedFrames() const;
+
+ private:
+  TrackedTake take_;
+  std::vector<cv::Mat> photos_;
+  int first_posed_ = 0, last_posed_ = 0;
+  double fps_ = 30;
+};
+
+// What a pair trial shows in the take's frame `shown`, t_s after onset: ObjectsAt at that frame's pose (each side's
+// source evaluated with the frame's calibration: its lens model, its measured edges), each object's streak being its
+// own motion's plus the camera's (StreakPx of its centre over the trial's exposure). Throws as ObjectsAt.
+std::array<std::optional<scene::BlurredObject>, 2> VideoObjectsAt(const protocol::Protocol& protocol,
+                                                                   const VideoTake& take, const TakeFrameShown& shown,
+                                                                   const TrialScene& trial, double t_s);
+
+// Checks that every frame a trial can show can draw its objects (a measured source needs the frame's measurement at
+// the object's edge; every radius and streak within range): Error(kInput) naming the protocol file, the trial and the
+// take's frame.
+void CheckVideoTrial(const protocol::Protocol& protocol, const VideoTake& take, const protocol::Trial& trial,
+                     const TrialScene& scene);
+
+}  // namespace blurcue::stimulus

@@ -1,0 +1,133 @@
+#!/usr/bin/env python3
+"""A study on video, frame by frame, against the take's truth (tests/video_study_test.sh, case frames).
+
+usage: video_frames_check.py TAKE_DIR EXPORT_DIR CAPTURE_DIR EXPOSURE_MS
+
+TAKE_DIR is what `blurcue synth-take` wrote (take.json: per-frame time and true pose; truth-NNNN.json: the lens and
+floor applied); EXPORT_DIR what `blurcue export` wrote for a simulated session of protocols/video-ball-depth.json
+(trials.csv, frames.csv); CAPTURE_DIR its `--capture` folder. Worked here from the truth alone, not from blurcue's code:
+- which take frame each display frame shows: frame floor(t x fps) of the take, the last one held past its end;
+- each ball's centre (the protocol's geometry: over column 3 or 5 of the board, at its edge's y, one radius above the
+  board) projected through the true pose: the capture's centre at the trial's first frame within 0.5 photo px;
+- the blur r of a `fitted` side: the thin lens of the truth (aperture, focal length, focus) at the centre's true depth,
+  with the applied floor, r^2 = r_defocus^2 + (2 floor)^2 (r = 2 x the LSF's std): within 3 %; a `none` side: 0;
+- the motion streak: the centre's projection at the neighbouring true poses (central difference; one-sided at the
+  ends) over their time apart, times the exposure: within max(0.3 px, 5 %).
+"""
+import csv
+import glob
+import json
+import math
+import os
+import sys
+
+import numpy as np
+
+take_dir, export_dir, capture_dir, exposure_ms = sys.argv[1], sys.argv[2], sys.argv[3], float(sys.argv[4])
+take = json.load(open(os.path.join(take_dir, "take.json")))
+truth = json.load(open(os.path.join(take_dir, "truth-0000.json")))
+fps = take["fps"]
+frames = take["per_frame"]
+cam = truth["camera"]
+pitch = truth["pixel_pitch_mm"]
+f_mm, aperture, focus = cam["focal_length_mm"], truth["aperture_mm"], truth["focus_mm"]
+floor = truth["floor_sigma_applied_px"]
+square = truth["board"]["square_mm"]
+radius_mm = 10.0
+fpx = f_mm / pitch
+cx, cy = cam["image_width_px"] / 2, cam["image_height_px"] / 2  # blurcue's and the generator's principal point
+
+
+def camera_point(k, p):
+    pose = frames[k]["pose"]
+    return np.array(pose["rotation"]) @ np.array(p) + np.array(pose["tvec"])
+
+
+def project(k, p):
+    c = camera_point(k, p)
+    return np.array([fpx * c[0] / c[2] + cx, fpx * c[1] / c[2] + cy])
+
+
+def r_true(k, p):
+    z = camera_point(k, p)[2]
+    diameter_mm = aperture * f_mm / (focus - f_mm) * abs(z - focus) / z  # the blur circle on the sensor
+    defocus = diameter_mm / 2 / pitch  # a disc's radius: 2 x its LSF's std
+    return math.hypot(defocus, 2 * floor)
+
+
+def streak_true(k, p):
+    a, b = max(0, k - 1), min(len(frames) - 1, k + 1)
+    dt = frames[b]["time_s"] - frames[a]["time_s"]
+    return (project(b, p) - project(a, p)) / dt * exposure_ms / 1000
+
+
+def rows(name):
+    with open(os.path.join(export_dir, name), newline="") as f:
+        return list(csv.DictReader(f))
+
+
+trials = {int(t["trial_index"]): t for t in rows("trials.csv")}
+failures, checked = [], {"r": 0, "none": 0, "motion": 0, "frames": 0, "centre": 0}
+worst = {"r": 0.0, "motion": 0.0, "centre": 0.0}
+for fr in rows("frames.csv"):
+    t = trials[int(fr["trial_index"])]
+    where = f"trial {fr['trial_index']} frame {fr['frame_index']}"
+    time_s = float(fr["flip_time_s"])
+    expect = min(len(frames) - 1, int(math.floor(time_s * fps + 1e-6)))
+    held = math.floor(time_s * fps + 1e-6) > len(frames) - 1
+    if int(fr["take_frame"]) != expect or (fr["take_status"] == "held") != held:
+        failures.append(f"{where}: at {time_s} s shows take frame {fr['take_frame']} ({fr['take_status']}), "
+                        f"expected {expect}{' held' if held else ''}")
+    checked["frames"] += 1
+    k = expect
+    y = (int(t["edge"]) - 1) * square
+    for side, section in (("left", 3), ("right", 5)):
+        source = t[f"{side}_source"]
+        centre = [(section - 0.5) * square, y, radius_mm]
+        r = float(fr[f"r_{side}_px"])
+        if source == "none":
+            checked["none"] += 1
+            if r != 0:
+                failures.append(f"{where} {side}: r {r}, expected 0 (none)")
+        elif source == "fitted":
+            checked["r"] += 1
+            want = r_true(k, centre)
+            err = abs(r - want) / want
+            worst["r"] = max(worst["r"], err)
+            if err > 0.03:
+                failures.append(f"{where} {side}: r {r:.4f} px, truth {want:.4f} px ({100 * err:.1f} %)")
+        m = np.array([float(fr[f"motion_{side}_x_px"]), float(fr[f"motion_{side}_y_px"])])
+        want_m = streak_true(k, centre)
+        err = np.linalg.norm(m - want_m)
+        tolerance = max(0.3, 0.05 * np.linalg.norm(want_m))
+        worst["motion"] = max(worst["motion"], err / tolerance)
+        checked["motion"] += 1
+        if err > tolerance:
+            failures.append(f"{where} {side}: streak {m.round(3)} px, truth {want_m.round(3)} px")
+
+# The capture of each trial's first frame: where each ball is drawn (screen px back to photo px).
+for path in sorted(glob.glob(os.path.join(capture_dir, "trial-*.json"))):
+    c = json.load(open(path))
+    t = trials[c["trial_index"]]
+    k = c["take_frame"]
+    scale = c["screen_px_per_photo_px"]
+    x0, y0 = c["photo_rect_px"][0], c["photo_rect_px"][1]
+    for o in c["objects"]:
+        section = 3 if o["side"] == "left" else 5
+        centre = [(section - 0.5) * square, (int(t["edge"]) - 1) * square, radius_mm]
+        drawn = np.array([(o["center_px"][0] - x0 + 0.5) / scale - 0.5, (o["center_px"][1] - y0 + 0.5) / scale - 0.5])
+        err = np.linalg.norm(drawn - project(k, centre))
+        worst["centre"] = max(worst["centre"], err)
+        checked["centre"] += 1
+        if err > 0.5:
+            failures.append(f"{os.path.basename(path)} {o['side']}: drawn at {drawn.round(2)} photo px, truth "
+                            f"{project(k, centre).round(2)}")
+
+print(f"checked {checked['frames']} frames: {checked['r']} fitted radii (worst {100 * worst['r']:.2f} %), "
+      f"{checked['none']} unblurred sides, {checked['motion']} streaks (worst {worst['motion']:.2f} of the tolerance), "
+      f"{checked['centre']} captured centres (worst {worst['centre']:.3f} photo px)")
+if not checked["r"] or not checked["motion"] or not checked["centre"]:
+    failures.append("nothing to check")
+for f in failures[:20]:
+    print("FAIL:", f)
+sys.exit(1 if failures else 0)
