@@ -88,22 +88,43 @@ def _shown(trials, frames, study):
             parts.append(f"exposure {exposure[0]:g} ms" + (" (no motion blur)" if exposure[0] == 0 else ""))
         elif len(exposure) > 1:
             parts.append(f"exposure {min(exposure):g}-{max(exposure):g} ms")
-    streaks = []
-    for side in ("left", "right"):
-        x, y = f"motion_{side}_x_screen_px", f"motion_{side}_y_screen_px"
-        if x in d and y in d:
-            length = (pd.to_numeric(d[x], errors="coerce") ** 2 + pd.to_numeric(d[y], errors="coerce") ** 2) ** 0.5
-            length = length.dropna()
-            if len(length):
-                streaks.append(f"{side} {length.mean():.2f} (max {length.max():.2f})")
-    if streaks:
-        parts.append("motion streak on screen, mean over trials: " + ", ".join(streaks) + " screen px")
+    f = None
     if frames is not None and not frames.empty and "study" in frames:
         f = frames[frames["study"] == study]
-        if not f.empty:
-            per_trial = f.groupby(["session_id", "trial_index"]).size()
-            parts.append(f"frames presented per trial (frames.csv): median {per_trial.median():g} "
-                         f"({per_trial.min()}-{per_trial.max()})")
+        if f.empty:
+            f = None
+
+    def streaks(table, unit_suffix):
+        out = []
+        for side in ("left", "right"):
+            x, y = f"motion_{side}_x_{unit_suffix}", f"motion_{side}_y_{unit_suffix}"
+            if x in table and y in table:
+                length = (pd.to_numeric(table[x], errors="coerce") ** 2
+                          + pd.to_numeric(table[y], errors="coerce") ** 2) ** 0.5
+                length = length.dropna()
+                if len(length) and length.max() > 0:  # all 0: no motion blur, which the exposure says
+                    out.append(f"{side} {length.mean():.2f} (max {length.max():.2f})")
+        return out
+
+    # On video the camera streaks the objects frame by frame (frames.csv, photo px); a trial's own streak (trials.csv)
+    # is its objects' motion alone.
+    per_frame = streaks(f, "px") if f is not None else []
+    if per_frame:
+        parts.append("motion streak per frame (frames.csv), mean over frames: " + ", ".join(per_frame) + " photo px")
+    else:
+        per_trial_streaks = streaks(d, "screen_px")
+        if per_trial_streaks:
+            parts.append("motion streak on screen, mean over trials: " + ", ".join(per_trial_streaks) + " screen px")
+    if f is not None:
+        per_trial = f.groupby(["session_id", "trial_index"]).size()
+        parts.append(f"frames presented per trial (frames.csv): median {per_trial.median():g} "
+                     f"({per_trial.min()}-{per_trial.max()})")
+        if "take_status" in f:
+            status = f["take_status"].dropna()
+            if len(status):
+                held = int((status == "held").sum())
+                parts.append(f"{len(status) - held} of {len(status)} frames at the take frame's own pose, {held} "
+                             f"held (a lost frame, or past the take's end)")
     return parts
 
 

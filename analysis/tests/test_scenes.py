@@ -72,6 +72,21 @@ class VideoSceneLines(unittest.TestCase):
         self.assertIn("exposure 20 ms", line)
         self.assertIn("left 2.50 (max 5.00), right 10.00 (max 10.00) screen px", line)
         self.assertIn("frames presented per trial (frames.csv): median 4 (3-5)", line)
+        # Frames without the take's columns (a record from before schema 9): no per-frame streak, no hold count.
+        self.assertNotIn("held", line)
+
+    def test_per_frame_streaks_and_held_frames_come_from_frames_csv(self):
+        # Per frame (photo px): left (3, 4) -> 5 and (0, 0) -> 0, right (6, 8) -> 10 twice; 1 of 4 frames held.
+        pd.DataFrame({"study": ["video-study"] * 4, "session_id": [1] * 4, "trial_index": [0, 0, 1, 1],
+                      "take_status": ["found", "tracked", "held", "tracked"],
+                      "motion_left_x_px": [3, 0, None, None], "motion_left_y_px": [4, 0, None, None],
+                      "motion_right_x_px": [6, 6, None, None], "motion_right_y_px": [8, 8, None, None]}
+                     ).to_csv(self.frames, index=False)
+        line = scenes.video_scene_lines(self.db, self.trials, self.frames, [os.path.join(self.tmp, "study")])[0][1]
+        self.assertIn("motion streak per frame (frames.csv), mean over frames: left 2.50 (max 5.00), right 10.00 "
+                      "(max 10.00) photo px", line)
+        self.assertNotIn("mean over trials", line)
+        self.assertIn("3 of 4 frames at the take frame's own pose, 1 held", line)
 
     def test_a_track_folder_found_nowhere_is_not_determined(self):
         lines = scenes.video_scene_lines(self.db, self.trials, None, [os.path.join(self.tmp, "elsewhere")])

@@ -200,6 +200,13 @@ cv::Mat PsfKernel(const Psf& psf) {
   return k / cv::sum(k)[0];
 }
 
+double DrawnRadiusPx(const Psf& psf) {
+  if (!(psf.MotionLengthPx() > 0)) return psf.r_px;
+  double across = 0;
+  StreakKernel(psf.motion_px, &across);
+  return std::max(psf.r_px, 2 * std::sqrt(across));
+}
+
 int PsfHalfWidth(const Psf& psf) {
   CheckPsf(psf);
   // The round part at the ellipse's mean variance (at most its largest, <= 2 r / 2 by CheckPsf) and the shape's copies.

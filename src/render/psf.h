@@ -58,6 +58,12 @@ cv::Mat PsfKernel(const Psf& psf);
 // Its half-width h, without building it.
 int PsfHalfWidth(const Psf& psf);
 
+// The radius (2 x the std of the line-spread function) PsfKernel's kernel has across the motion: r_px, but for a
+// sub-pixel r under a streak whose drawing spreads it more across (StreakKernel's across variance e > r^2 / 4: a
+// streak between pixel centres cannot be thinner), 2 sqrt(e). What a frame shows, and so what the record states; a
+// PSF with this radius is drawn with the same kernel.
+double DrawnRadiusPx(const Psf& psf);
+
 // The streak alone (normalised, centred, odd square), as PsfKernel makes it: its variance along the motion exceeds
 // its variance across it (returned in across_px2 when given) by exactly |m|^2 / 12.
 cv::Mat StreakKernel(const cv::Vec2d& motion_px, double* across_px2 = nullptr);

@@ -92,6 +92,27 @@ TEST(Psf, StreakAddsItsLengthSquaredOverTwelveAlongTheMotion) {
   }
 }
 
+TEST(Psf, DrawnRadiusIsTheKernelsAcrossTheMotion) {
+  // Under a streak a sub-pixel radius cannot be drawn thinner than the streak's sampling between pixel centres: the
+  // radius the record states (DrawnRadiusPx) is the one the kernel has across the motion, from its own moments.
+  for (const cv::Vec2d motion : {cv::Vec2d(0.452, 5.697), cv::Vec2d(3, 4), cv::Vec2d(-2.2, 0.7), cv::Vec2d(6, 0)})
+    for (double r : {0.0, 0.3, 0.7, 1.5}) {
+      const Psf p = Make("gaussian", r, 0, motion);
+      const Moments m = Of(PsfKernel(p));
+      const double l = p.MotionLengthPx(), c = motion[0] / l, s = motion[1] / l;
+      const double across = s * s * m.xx + c * c * m.yy - 2 * c * s * m.xy;
+      EXPECT_NEAR(DrawnRadiusPx(p), 2 * std::sqrt(across), 2e-3) << motion << " r " << r;
+      EXPECT_GE(DrawnRadiusPx(p), r);
+      // Drawn with its drawn radius, the kernel is the same.
+      Psf drawn = p;
+      drawn.r_px = DrawnRadiusPx(p);
+      EXPECT_LT(cv::norm(PsfKernel(drawn), PsfKernel(p), cv::NORM_INF), 1e-6) << motion << " r " << r;
+    }
+  // Along an axis the streak's samples sit on pixel centres across it: nothing added.
+  EXPECT_DOUBLE_EQ(DrawnRadiusPx(Make("gaussian", 0, 0, {6, 0})), 0);
+  EXPECT_DOUBLE_EQ(DrawnRadiusPx(Make("gaussian", 0.3, 0, {0, 0})), 0.3);
+}
+
 // The unit-determinant map stretching by s along the direction at angle t (rad) and by 1 / s across it.
 cv::Matx22d Shape(double s, double t) {
   const double c = std::cos(t), n = std::sin(t);

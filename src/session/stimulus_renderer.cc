@@ -6,6 +6,7 @@
 
 #include "core/image.h"
 
+#include "render/psf.h"
 #include "render/scene_render.h"
 
 namespace blurcue::session {
@@ -111,6 +112,12 @@ void StimulusRenderer::Compose(const TrialScene& trial, double t_s, double level
   objects_.clear();  // kept between frames: its storage is reused
   for (auto& shown : shown_) {
     if (!shown) continue;
+    // Under a streak a sub-pixel radius is drawn as wide as the streak's drawing is across (render::DrawnRadiusPx):
+    // the record states what the frame shows. Drawn at screen resolution, the compositor's scale.
+    if (shown->motion_px != cv::Vec2d(0, 0)) {
+      const double scale = compositor_->view().Scale(scene_->camera);
+      shown->r_px = render::DrawnRadiusPx(render::PsfOf(*shown, scale)) / scale;
+    }
     shown->object.texture = texture_;
     objects_.push_back(*shown);
   }
