@@ -360,7 +360,9 @@ PYEOF
   echo "ok: a floored scene's objects are shown as recorded, Gaussian and pillbox, GL and CPU paths"
   exit 0
   fi
-  ball=("content={\"type\": \"ball\", \"texture\": \"$W/white.ppm\", \"exposure_ms\": 100}" 'practice={"count": 0}'
+  # A textured ball: on a white one the solve is poorly determined (its shading, rounded to 8 bits in frame and twin
+  # alike, leaves r across a streak reading 2.5-3.5 % high; docs/blur-kernels.md "Across a streak").
+  ball=("content={\"type\": \"ball\", \"texture\": \"soccer\", \"exposure_ms\": 100}" 'practice={"count": 0}'
         'factors={"section": [2, 8], "speed_cm_s": [3]}' 'counterbalance="none"' "$scene")
   for path in gl cpu; do
     extra=()
@@ -373,23 +375,24 @@ PYEOF
       variant "$P/test1-static-grids.json" "$W/$name.json" "${ball[@]}" "${extra[@]}" "content.kernel=\"$kernel\"" \
           'sides={"left": "fitted", "right": {"screen_px": 1.5}}'
       capture "$W/$name.json" "$name"
-      # The radius across a streak is judged within max(0.03 px, 5 %), not 3 %: on these frames it reads 2.5-3.5 %
-      # high in every moving object, GL and CPU, while PsfKernel's own kernel has exactly the recorded r across
-      # and L along (docs/blur-kernels.md, "Across a streak"); the cause is open.
-      $PY "$(dirname "$0")/capture_kernel.py" "$W/$name" "$W/ball-twin-$path" --tolerance-rel 0.05 > "$W/$name.txt" \
+      # The radius across a streak within max(0.03 px, 3 %) on the GL path. The CPU path draws the per-pixel plan:
+      # each pixel blurred for its own depth, so a far ball's visible half (nearer than its centre, whose r is
+      # recorded) shows up to 3.6 % less there; judged within 4 %.
+      rel=0.03
+      [ $path = cpu ] && rel=0.04
+      $PY "$(dirname "$0")/capture_kernel.py" "$W/$name" "$W/ball-twin-$path" --tolerance-rel $rel > "$W/$name.txt" \
           || fail "$name: $(grep BAD "$W/$name.txt" | head -2) $(tail -1 "$W/$name.txt")"
       sed "s/^/$path $kernel /" "$W/$name.txt"
     done
     # No defocus, and 0.3 screen px: a streak drawn between pixel centres is wider across than that (up to 1 px on a
     # diagonal); the record states the radius the kernel has across it (render::DrawnRadiusPx, 0.47-0.62 screen px
     # here; Psf.DrawnRadiusIsTheKernelsAcrossTheMotion checks it against the kernel's moments). On the frames the
-    # solve reads it within 0.12 px (0.07-0.11 off: a white ball's twin leaves a sub-pixel width across a streak
-    # poorly determined), judged so: a record of 0 or 0.3, as before, is off by 0.2-0.6 px.
+    # solve reads it 0.03-0.06 px high, judged within 0.06 px: a record of 0 or 0.3, as before, is off by 0.2-0.6 px.
     name="motion-$path-sharp"
     variant "$P/test1-static-grids.json" "$W/$name.json" "${ball[@]}" "${extra[@]}" \
         'sides={"left": 0, "right": {"screen_px": 0.3}}'
     capture "$W/$name.json" "$name"
-    $PY "$(dirname "$0")/capture_kernel.py" "$W/$name" "$W/ball-twin-$path" --tolerance-px 0.12 --tolerance-rel 0.05 \
+    $PY "$(dirname "$0")/capture_kernel.py" "$W/$name" "$W/ball-twin-$path" --tolerance-px 0.06 --tolerance-rel 0.03 \
         > "$W/$name.txt" \
         || fail "$name: $(grep BAD "$W/$name.txt" | head -2) $(tail -1 "$W/$name.txt")"
     sed "s/^/$path sharp /" "$W/$name.txt"
