@@ -10,7 +10,10 @@ floor applied); EXPORT_DIR what `blurcue export` wrote for a simulated session o
 - each ball's centre (the protocol's geometry: over column 3 or 5 of the board, at its edge's y, one radius above the
   board) projected through the true pose: the capture's centre at the trial's first frame within 0.5 photo px;
 - the blur r of a `fitted` side: the thin lens of the truth (aperture, focal length, focus) at the centre's true depth,
-  with the applied floor, r^2 = r_defocus^2 + (2 floor)^2 (r = 2 x the LSF's std): within 3 %; a `none` side: 0;
+  with the applied floor, r^2 = r_defocus^2 + (2 floor)^2 (r = 2 x the LSF's std): within 3 %; a `none` side: 0.
+  With an exposure, r is the width the frame is drawn with across the streak, which a streak between pixel centres
+  makes up to 1 px (the bilinear spreading of a sample has a variance of at most 1/4 px^2 across): a `fitted` side
+  from 3 % below the truth to the larger of 3 % above it and 1 px, a `none` side at most 1 px;
 - the motion streak: the centre's projection at the neighbouring true poses (central difference; one-sided at the
   ends) over their time apart, times the exposure: within max(0.3 px, 5 %).
 """
@@ -87,15 +90,17 @@ for fr in rows("frames.csv"):
         r = float(fr[f"r_{side}_px"])
         if source == "none":
             checked["none"] += 1
-            if r != 0:
-                failures.append(f"{where} {side}: r {r}, expected 0 (none)")
+            if not (r == 0 if exposure_ms == 0 else 0 <= r <= 1.001):  # the float kernel: 1 + 5e-5 seen
+                failures.append(f"{where} {side}: r {r}, expected {'0' if exposure_ms == 0 else '<= 1 px'} (none)")
         elif source == "fitted":
             checked["r"] += 1
             want = r_true(k, centre)
-            err = abs(r - want) / want
+            high = want * 1.03 if exposure_ms == 0 else max(want * 1.03, 1.0)
+            err = abs(r - want) / want if exposure_ms == 0 else max(0.0, want * 0.97 - r, r - high) / want
             worst["r"] = max(worst["r"], err)
-            if err > 0.03:
-                failures.append(f"{where} {side}: r {r:.4f} px, truth {want:.4f} px ({100 * err:.1f} %)")
+            if not (want * 0.97 <= r <= high):
+                failures.append(f"{where} {side}: r {r:.4f} px, truth {want:.4f} px (allowed {want * 0.97:.4f}-"
+                                f"{high:.4f})")
         m = np.array([float(fr[f"motion_{side}_x_px"]), float(fr[f"motion_{side}_y_px"])])
         want_m = streak_true(k, centre)
         err = np.linalg.norm(m - want_m)

@@ -75,23 +75,27 @@ kill9)
   echo "ok: killed -9 after $answered answers, resumed: $((MAIN + PRACTICE)) planned trials, each answered once" ;;
 frames)
   # Frame by frame against the take's truth (tests/video_frames_check.py): the take frame each display frame shows,
-  # each fitted ball's blur at its true depth (3 %), each ball's streak from the true poses (max(0.3 px, 5 %)) with a
-  # 16.7 ms exposure (the protocol's copy with content.exposure_ms set: the shipped one has none, its take being
-  # rendered with an instantaneous shutter), and the captured centres at the true pose.
-  $PY - "$PROTOCOL" "$W/exposed.json" <<'PYEOF' || fail "could not write the protocol's copy"
+  # each fitted ball's blur at its true depth (3 %), each ball's streak from the true poses (max(0.3 px, 5 %)) and the
+  # captured centres at the true pose. Twice: the shipped protocol (no exposure: its take was rendered with an
+  # instantaneous shutter), and a copy with content.exposure_ms 16.7 for the streaks.
+  for exposure in 0 16.7; do
+    $PY - "$PROTOCOL" "$W/exposed-$exposure.json" "$exposure" <<'PYEOF' || fail "could not write the protocol's copy"
 import json, os, sys
 p = json.load(open(sys.argv[1]))
-p["content"]["exposure_ms"] = 16.7
+p["content"]["exposure_ms"] = float(sys.argv[3])
 d = os.path.dirname(os.path.abspath(sys.argv[1]))
 p["scene"] = {k: os.path.normpath(os.path.join(d, v)) for k, v in p["scene"].items()}
 json.dump(p, open(sys.argv[2], "w"), indent=1)
 PYEOF
-  $BC run "$W/exposed.json" --participant F1 --db "$W/s.sqlite" --observer sim --capture "$W/capture" > "$W/out" 2>&1 ||
-    fail "run: $(tail -2 "$W/out")"
-  $BC export --db "$W/s.sqlite" --out "$W/export" > "$W/export.out" 2>&1 || fail "export: $(cat "$W/export.out")"
-  $PY "$(dirname "$0")/video_frames_check.py" "$DIR/take" "$W/export" "$W/capture" 16.7 > "$W/check" 2>&1 ||
-    fail "$(cat "$W/check")"
-  echo "ok: every frame of a simulated session on video against the take's truth: $(cat "$W/check")" ;;
+    $BC run "$W/exposed-$exposure.json" --participant F1 --db "$W/s-$exposure.sqlite" --observer sim \
+        --capture "$W/capture-$exposure" > "$W/out" 2>&1 || fail "run: $(tail -2 "$W/out")"
+    $BC export --db "$W/s-$exposure.sqlite" --out "$W/export-$exposure" > "$W/export.out" 2>&1 ||
+      fail "export: $(cat "$W/export.out")"
+    $PY "$(dirname "$0")/video_frames_check.py" "$DIR/take" "$W/export-$exposure" "$W/capture-$exposure" $exposure \
+        > "$W/check-$exposure" 2>&1 || fail "exposure $exposure ms: $(cat "$W/check-$exposure")"
+  done
+  echo "ok: every frame of simulated sessions on video against the take's truth: no exposure: $(cat "$W/check-0");" \
+       "16.7 ms: $(cat "$W/check-16.7")" ;;
 report)
   # Three simulated observers, then the report (from DIR, so the take's track folder is found as the protocols see it).
   for id in R1 R2 R3; do

@@ -228,7 +228,7 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
   result.reference_r_px = Median(ref_r);
   result.reference_u_mm = Median(ref_u);
 
-  result.model = optics::FitThinLens(lens, ModelSamples(result), options.optics_fit);
+  if (options.fit_model) result.model = optics::FitThinLens(lens, ModelSamples(result), options.optics_fit);
 
   for (auto& edge : result.edges) {
     double su = 0;
@@ -254,7 +254,7 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
       if (edge.estimated > 0) edge.r_estimated_px /= edge.estimated;
     }
   }
-  ApplyModel(result, result.model);
+  if (options.fit_model) ApplyModel(result, result.model);
   result.estimate_ms = MsSince(t0);
   return result;
 }

@@ -28,6 +28,9 @@ struct CalibrateOptions {
   std::optional<BoardPose> known_pose;
   // The sections measured on every core (false: one after another; the numbers are the same either way).
   bool parallel_sections = true;
+  // Fit the scene's lens model to this photo's sections (false: the result's model is left empty and r_fitted_px 0,
+  // for a caller that fits one model to many photos and applies it with ApplyModel: track, a take's frames).
+  bool fit_model = true;
 };
 
 struct SectionResult {

@@ -132,6 +132,7 @@ FrameResult Tracker::Process(const cv::Mat& photo, int index, double time_s) {
   const auto t1 = std::chrono::steady_clock::now();
   calib::CalibrateOptions options = options_.calibrate;
   options.known_pose = *pose;
+  options.fit_model = false;  // one model for the whole take, fitted to every frame's sections at the end (FitTakeModel)
   try {
     r.calib = calib::Calibrate(planes_, camera_, board_, options);
     r.calib->detect_ms = r.pose_ms;
