@@ -40,6 +40,9 @@ PreparedSession PrepareStudy(const std::filesystem::path& protocol_file, const s
     }
   }
   s.presentation = Presentation::Of(s.protocol, s.images, s.display);
+  // A take's frames are held decoded and, for the screen, resampled: both must fit.
+  if (s.images.take) s.images.take->CheckMemory(s.protocol, {s.presentation.view.photo_width_px,
+                                                             s.presentation.view.photo_height_px});
   return s;
 }
 

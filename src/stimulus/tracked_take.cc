@@ -117,6 +117,15 @@ TrackedTake LoadTrackedTake(const std::filesystem::path& dir) {
                            Echo(row.fields[c_frame], false));
     f.index = int(index);
     f.time_s = NumberField(file, row, c_time, "time_s");
+    // Times increase, by at least a millisecond (at most 1000 frames a second, as a simulated clock may run) and from
+    // 0 to at most a day: the motion between frames is their poses' change over their time apart.
+    const std::string at_time = file + ": line " + std::to_string(row.line) + ", time_s";
+    if (!(f.time_s >= 0 && f.time_s <= 86400))
+      throw InputError(at_time, "must be in [0, 86400] s, got " + Echo(row.fields[c_time], false));
+    if (!take.frames.empty() && !(f.time_s >= take.frames.back().time_s + 0.001 - 1e-9))
+      throw InputError(at_time, "must be at least 1 ms after the frame before's " + Num(take.frames.back().time_s) +
+                                    " s (frames in time order, at most 1000 a second), got " +
+                                    Echo(row.fields[c_time], false));
     f.status = ParseStatus(file + ": line " + std::to_string(row.line) + ", status",
                            c_status < row.fields.size() ? row.fields[c_status] : "");
     if (f.status != track::FrameStatus::kLost) f.calib = calib::LoadSceneCalib(dir / track::CalibFileName(f.index));

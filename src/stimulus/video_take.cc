@@ -45,8 +45,9 @@ VideoTake::VideoTake(const protocol::Protocol& protocol) {
     double time_s = 0;
     while (at < last_posed_) {
       if (!source.Next(&image, &at, &time_s))
-        throw Error(ErrorKind::kInput, "ends after frame " + std::to_string(at) + ", but " + track +
-                                           " has a pose for frame " + std::to_string(last_posed_));
+        throw Error(ErrorKind::kInput, (at < 0 ? std::string("has no frames") :
+                                         "has " + std::to_string(at + 1) + " frames (0-" + std::to_string(at) + ")") +
+                                            ", but " + track + " has a pose for frame " + std::to_string(last_posed_));
       if (at < first_posed_) {
         photos_.emplace_back();  // never shown
         continue;
@@ -78,6 +79,19 @@ TakeFrameShown VideoTake::FrameAt(double t_s) const {
   return shown;
 }
 
+void VideoTake::CheckMemory(const protocol::Protocol& protocol, cv::Size screen_photo) const {
+  const Camera& camera = take_.camera();
+  const double frames = double(PosedFrames().size());
+  const double bytes = frames * (3.0 * camera.image_width_px * camera.image_height_px +
+                                 4.0 * screen_photo.width * screen_photo.height);
+  if (bytes > kMaxTakeBytes)
+    throw InputError(At(protocol, "/scene/track"),
+                     "the take's " + std::to_string(int(frames)) + " frames with a pose, decoded and resampled for a " +
+                         std::to_string(screen_photo.width) + " x " + std::to_string(screen_photo.height) +
+                         " px screen, would hold " + Num(bytes / (1 << 30)) + " GiB (at most " +
+                         Num(kMaxTakeBytes / (1 << 30)) + " GiB): cut the take, or show it smaller");
+}
+
 std::vector<int> VideoTake::PosedFrames() const {
   std::vector<int> posed;
   for (int i = first_posed_; i <= last_posed_; ++i)
@@ -97,11 +111,19 @@ std::array<std::optional<scene::BlurredObject>, 2> VideoObjectsAt(const protocol
 
 void CheckVideoTrial(const protocol::Protocol& protocol, const VideoTake& take, const protocol::Trial& trial,
                      const TrialScene& scene) {
-  for (const int index : take.PosedFrames()) {
-    TakeFrameShown shown;
-    shown.take_frame = shown.posed = index;
-    // The trial's clock at that frame (a moving ball is where it is then).
-    const double t_s = (index - take.first_posed()) / take.fps();
+  // Every moment the trial can show: each frame of the take as it starts and, while a ball rolls (on to its end,
+  // whatever frame is shown or held then), every half frame interval and every half board square of its run.
+  std::vector<double> times;
+  const double frame_s = 1 / take.fps();
+  for (const int index : take.PosedFrames()) times.push_back((index - take.first_posed()) * frame_s);
+  if (scene.MotionS() > 0) {
+    const double step = std::min(frame_s / 2, 0.5 * take.take().board().square_mm / scene.speed_mm_s);
+    const int n = int(std::min(4000.0, std::ceil(scene.MotionS() / step)));
+    for (int i = 0; i <= n; ++i) times.push_back(std::min(scene.MotionS() - 1e-6, i * scene.MotionS() / n));
+  }
+  for (const double t_s : times) {
+    const TakeFrameShown shown = take.FrameAt(t_s);
+    const int index = shown.take_frame;
     try {
       for (const auto& o : VideoObjectsAt(protocol, take, shown, scene, t_s))
         if (o && !(o->r_px >= 0 && o->r_px <= optics::kMaxBlurRadiusPx &&
@@ -111,7 +133,8 @@ void CheckVideoTrial(const protocol::Protocol& protocol, const VideoTake& take, 
     } catch (const std::exception& e) {
       throw InputError(At(protocol, "/scene/track"), "trial " + std::to_string(trial.index + 1) +
                                                         " cannot be drawn in the take's frame " +
-                                                        std::to_string(index) + ": " + e.what());
+                                                        std::to_string(index) + " (" + Num(t_s) + " s after onset): " +
+                                                        e.what());
     }
   }
 }

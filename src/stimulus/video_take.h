@@ -38,6 +38,9 @@ class VideoTake {
   double fps() const { return fps_; }
   // The take's frame t_s after a trial's onset: first_posed() + floor(t_s x fps), held as the class says.
   TakeFrameShown FrameAt(double t_s) const;
+  // Throws Error(kInput) naming /scene/track when the frames a trial can show, decoded and resampled for the screen
+  // (`screen_photo`: the photo's size there, 8-bit RGBA), would hold more than 4 GiB.
+  void CheckMemory(const protocol::Protocol& protocol, cv::Size screen_photo) const;
   // Every frame a trial can show (the frames with a pose from first_posed() on).
   std::vector<int> PosedFrames() const;
 

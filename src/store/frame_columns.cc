@@ -30,14 +30,19 @@ const std::vector<FrameValue>& FrameValues() {
        "", 1, [](const F& f) { return Value(f.flip_time_s); }},
       {"dropped", "boolean", "", "0|1", "1: more than 1.5 refresh periods after the frame before (window only)",
        "INTEGER", "", 1, [](const F& f) { return Value(int64_t(f.dropped ? 1 : 0)); }},
-      {"r_left_px", "number", "photo px", ">= 0", "the left object's blur radius in this frame; empty: not shown",
+      {"r_left_px", "number", "photo px", ">= 0",
+       "the left object's blur radius as drawn in this frame (without the motion; under a streak at least the width "
+       "the streak is drawn with across it, up to 1 screen px); empty: not shown",
        "REAL", "", 4, [](const F& f) { return Maybe(f.r_left_px); }},
       {"r_right_px", "number", "photo px", ">= 0", "the right object's blur radius in this frame; empty: not shown",
        "REAL", "", 4, [](const F& f) { return Maybe(f.r_right_px); }},
       {"y_mm", "number", "mm", "", "the objects' place along the board's y in this frame (0 at edge 1)", "REAL", "", 4,
        [](const F& f) { return Maybe(f.y_mm); }},
       {"take_frame", "integer", "", ">= 0",
-       "a study on video: the take's frame on screen (its index in track.csv); empty for a photo", "INTEGER",
+       "a study on video: the take's frame at this moment (its index in track.csv; past the take's end its last); "
+       "when held, the photo and objects on screen are those of the last frame with a pose before it; empty for a "
+       "photo",
+       "INTEGER",
        "take_frame >= 0", 9,
        [](const F& f) { return f.take_frame ? Value(*f.take_frame) : Value(); }},
       {"take_status", "string", "", StatusAllowed(),
