@@ -198,6 +198,12 @@ foreach(case blur place pose window agree thesis aliasing subpixel kernel kernel
                        LABELS "gl;session;capture" PASS_REGULAR_EXPRESSION "^ok:|\nok:")
 endforeach()
 set_tests_properties(capture_window PROPERTIES LABELS "gl;session;capture;window")
+# The thesis's full-resolution scene and its calibration, made once for capture_place and capture_thesis.
+add_test(NAME capture_thesis_full
+         COMMAND bash ${PROJECT_SOURCE_DIR}/tests/capture_test.sh thesis_full ${BC} $<TARGET_FILE:capture_measure> ${T})
+set_tests_properties(capture_thesis_full PROPERTIES FIXTURES_SETUP thesis_full LABELS "session;capture"
+                     PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+set_tests_properties(capture_place capture_thesis PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols;thesis_full")
 
 # QUEST+ against python3-questplus, an independent implementation (Debian's).
 add_executable(quest_trace ${PROJECT_SOURCE_DIR}/tests/quest_trace.cc)
