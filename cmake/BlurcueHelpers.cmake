@@ -29,10 +29,23 @@ function(add_module_test name)
   endif()
   if(ARG_ONE_PROCESS)
     add_test(NAME ${name} COMMAND ${name} WORKING_DIRECTORY ${PROJECT_BINARY_DIR})
-    set_tests_properties(${name} PROPERTIES LABELS "${ARG_LABELS}" COST 100)  # long: started first
+    set_tests_properties(${name} PROPERTIES LABELS "${ARG_LABELS}" COST 100)  # long: started first (COST: set_test_costs)
     return()
   endif()
   include(GoogleTest)
   gtest_discover_tests(${name} WORKING_DIRECTORY ${PROJECT_BINARY_DIR} NO_PRETTY_VALUES
                        PROPERTIES LABELS "${ARG_LABELS}" DISCOVERY_TIMEOUT 60)
+endfunction()
+
+# set_test_costs(NAME SECONDS [NAME SECONDS ...])
+#   A long test's COST: its seconds in one ctest -j2 run. CTest starts the costliest ready tests first until it has
+#   timed the tests itself (build/Testing/Temporary/CTestCostData.txt, absent on a fresh clone, as in CI): a test of
+#   minutes started last would run alone at the end. Called where the tests are added (set_tests_properties sees only
+#   the tests of its own directory).
+function(set_test_costs)
+  set(args ${ARGN})
+  while(args)
+    list(POP_FRONT args name seconds)
+    set_tests_properties(${name} PROPERTIES COST ${seconds})
+  endwhile()
 endfunction()
