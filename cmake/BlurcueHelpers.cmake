@@ -27,6 +27,10 @@ function(add_module_test name)
   if(CMAKE_BUILD_TYPE STREQUAL "Release")
     target_compile_options(${name} PRIVATE -O1)
   endif()
+  # A module's test files compiled four to a translation unit (a unity build): gtest, nlohmann/json and OpenCV are
+  # parsed once per four files instead of once per file (protocol_test's seven files: 31 s of CPU instead of 86 s).
+  # Helpers in a test file's anonymous namespace therefore have names of their own across the module's tests.
+  set_target_properties(${name} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 4)
   if(ARG_ONE_PROCESS)
     add_test(NAME ${name} COMMAND ${name} WORKING_DIRECTORY ${PROJECT_BINARY_DIR})
     set_tests_properties(${name} PROPERTIES LABELS "${ARG_LABELS}" COST 100)  # long: started first (COST: set_test_costs)
