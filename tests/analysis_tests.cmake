@@ -46,3 +46,5 @@ set_tests_properties(analysis.mixed analysis.report PROPERTIES LABELS analysis T
 # The psychometric fit against psignifit 4, where it is installed (from PyPI; a SKIP line where it is not).
 add_test(NAME analysis.psignifit COMMAND ${BLURCUE_ANALYSIS_PYTHON} ${CMAKE_SOURCE_DIR}/tests/psignifit_agreement.py)
 set_tests_properties(analysis.psignifit PROPERTIES LABELS analysis PASS_REGULAR_EXPRESSION "^ok:|\nok:|^SKIP:")
+# Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
+set_test_costs(analysis.report 134 analysis.mixed 76 analysis.tracks 17)

@@ -41,8 +41,20 @@ capture() {
   $BC run "$protocol" --participant C1 --seed 11 --db "$W/$name.sqlite" --observer sim --capture "$W/$name" "$@" \
       > "$W/$name.out" 2> "$W/$name.err" || fail "$name: $(tail -1 "$W/$name.err")"
 }
+# The thesis's full-resolution set-up (4592 x 3056 px, Table 4.1) and its calibration, made once a ctest run by the
+# case thesis_full (the fixture thesis_full) into $FULL for the cases place and thesis.
+FULL=$DIR/thesis-full
+require_thesis_full() {
+  [ -s "$FULL/scene.png" ] && [ -s "$FULL/calib.json" ] || fail "no thesis scene in $FULL: run the case thesis_full first"
+}
 
 case $CASE in
+thesis_full)
+  rm -rf "$FULL"
+  $BC synth-scene --out "$FULL" --preset thesis --seed 3 > /dev/null
+  $BC calibrate "$FULL/scene.png" --camera "$FULL/camera.json" --out "$FULL/calib.json" > /dev/null
+  echo "ok: the thesis's full-resolution scene and its calibration in $FULL"
+  ;;
 blur)
   # Every object of every trial: the blur measured on the captured frame matches the recorded r_screen_px within
   # max(0.25 px, 5 %), and its edges lie on the recorded outline within 1 px. Test 1's geometry and sides with a
@@ -75,10 +87,9 @@ for f in glob.glob(sys.argv[1] + "/*.json"):
     assert d["scaling"] == "native" and d["screen_px_per_photo_px"] == 1, f
     assert d["photo_rect_px"][2:] == [1148, 764], d["photo_rect_px"]
 PYEOF
-  $BC synth-scene --out "$W/full" --preset thesis --seed 3 > /dev/null
-  $BC calibrate "$W/full/scene.png" --camera "$W/full/camera.json" --out "$W/full/calib.json" > /dev/null
+  require_thesis_full
   variant "$P/test1-static-grids.json" "$W/quarter.json" "content.texture=\"$W/white.ppm\"" content.cells=DELETE 'display.scale=0.25' \
-      "scene={\"background\": \"$W/full/scene.png\", \"calib\": \"$W/full/calib.json\"}"
+      "scene={\"background\": \"$FULL/scene.png\", \"calib\": \"$FULL/calib.json\"}"
   capture "$W/quarter.json" quarter
   # Place only: below a screen px of blur the edge fit on drawn edges scatters by up to 0.3 px (docs/benchmarks.md).
   "$MEASURE" "$W/quarter" --tolerance-px 1e9 > "$W/quarter.txt" || fail "0.25 scale: $(grep BAD "$W/quarter.txt" | head -3)"
@@ -204,11 +215,10 @@ thesis)
   # estimate (eq. 3.7: 16.61 px) exceeded its measurement by about 4 px (a thin-lens ground-truth scene has no such
   # gap, so the two radii are given as fixed sources). On screen that difference must be there, scaled by the
   # recorded screen px per photo px, as measured on the captured frame.
-  $BC synth-scene --out "$W/full" --preset thesis --seed 3 > /dev/null
-  $BC calibrate "$W/full/scene.png" --camera "$W/full/camera.json" --out "$W/full/calib.json" > /dev/null
+  require_thesis_full
   variant "$P/test1-static-grids.json" "$W/t1.json" "content.texture=\"$W/white.ppm\"" content.cells=DELETE 'practice={"count": 0}' \
       'factors={"edge": [11]}' 'sides={"left": 16.61, "right": 12.61}' 'display={"width_px": 1920, "height_px": 1080}' \
-      "scene={\"background\": \"$W/full/scene.png\", \"calib\": \"$W/full/calib.json\"}"
+      "scene={\"background\": \"$FULL/scene.png\", \"calib\": \"$FULL/calib.json\"}"
   capture "$W/t1.json" t1
   "$MEASURE" "$W/t1" > "$W/t1.txt" || fail "1920 x 1080: $(grep BAD "$W/t1.txt" | head -3)"
   $BC export --db "$W/t1.sqlite" --out "$W/tables" > /dev/null

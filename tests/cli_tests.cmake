@@ -118,3 +118,5 @@ set_tests_properties(cli_bench_procedures_check PROPERTIES DEPENDS "cli_bench_pr
 add_test(NAME cli_camera_exif
          COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/camera_exif_test.py ${BC} ${T}/camera-exif)
 set_tests_properties(cli_camera_exif PROPERTIES PASS_REGULAR_EXPRESSION "ok: camera.json from EXIF")
+# Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
+set_test_costs(cli_bench_measure_quick 118 cli_camera_exif 13)

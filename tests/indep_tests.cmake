@@ -62,3 +62,6 @@ indep_check(indep_track_blur track take indep_take blur)
 # aperture stepped in D^2, src/optics/fit.cc).
 indep_check(indep_track_fitted track take indep_take fitted)
 set_tests_properties(indep_track_fitted PROPERTIES LABELS "slow;indep")
+# Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
+set_test_costs(indep_gen_take 158 indep_truth_self 32 indep_gen_dist 31 indep_gen_disc 22 indep_gen_gauss 19
+               indep_gen_far 17 indep_gen_farg 15)

@@ -26,3 +26,5 @@ set_tests_properties(install_relocatable PROPERTIES LABELS gl PASS_REGULAR_EXPRE
 add_test(NAME init_from_prefix
          COMMAND bash ${PROJECT_SOURCE_DIR}/tests/init_test.sh ${PROJECT_BINARY_DIR} ${PROJECT_BINARY_DIR}/init-test)
 set_tests_properties(init_from_prefix PROPERTIES LABELS gl PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+# Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
+set_test_costs(init_from_prefix 124 outputs_kill_export 21 outputs_kill_report 17)

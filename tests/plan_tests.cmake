@@ -142,3 +142,5 @@ add_test(NAME analysis.plan_chart
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(analysis.plan_chart PROPERTIES LABELS "analysis;plan" TIMEOUT 180
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
+# Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
+set_test_costs(plan_same_as_run 34 plan_difference_power 20)

@@ -198,6 +198,12 @@ foreach(case blur place pose window agree thesis aliasing subpixel kernel kernel
                        LABELS "gl;session;capture" PASS_REGULAR_EXPRESSION "^ok:|\nok:")
 endforeach()
 set_tests_properties(capture_window PROPERTIES LABELS "gl;session;capture;window")
+# The thesis's full-resolution scene and its calibration, made once for capture_place and capture_thesis.
+add_test(NAME capture_thesis_full
+         COMMAND bash ${PROJECT_SOURCE_DIR}/tests/capture_test.sh thesis_full ${BC} $<TARGET_FILE:capture_measure> ${T})
+set_tests_properties(capture_thesis_full PROPERTIES FIXTURES_SETUP thesis_full LABELS "session;capture"
+                     PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+set_tests_properties(capture_place capture_thesis PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols;thesis_full")
 
 # QUEST+ against python3-questplus, an independent implementation (Debian's).
 add_executable(quest_trace ${PROJECT_SOURCE_DIR}/tests/quest_trace.cc)
@@ -206,3 +212,11 @@ add_test(NAME quest_agreement
          COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/quest_agreement.py $<TARGET_FILE:quest_trace>
                  ${PROJECT_BINARY_DIR}/quest-agreement)
 set_tests_properties(quest_agreement PROPERTIES PASS_REGULAR_EXPRESSION "ok: blurcue's QUEST\\+ agrees")
+# Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
+set_test_costs(capture_distortion 262 session_depth_arcmin 116 capture_subpixel 114 session_protocol_fuzz 77
+               session_report_any_study 65 report_design_quest_per_depth 61 report_design_mixed_blocks 60
+               capture_kernel_motion 47 capture_thesis_full 30 report_design_groups 38 report_design_sessions 35
+               session_report_aborted 34 session_practice_criterion 34 session_resume 32 capture_kernel 29
+               session_recover 25 session_odd_names 25 session_adaptive 25 session_resume_guards 22
+               session_resume_exact 22 session_numbers_balanced_counts 22 session_resume_display 21
+               session_groups_concurrent 21 session_codebook 21 session_groups_info 19 session_window 18)

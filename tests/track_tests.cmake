@@ -25,3 +25,5 @@ set_tests_properties(ar_cli PROPERTIES FIXTURES_SETUP ar_take)
 add_test(NAME ar_defocus_truth_lens
          COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/ar_check.py ${PROJECT_BINARY_DIR}/ar-test --truth-lens)
 set_tests_properties(ar_defocus_truth_lens PROPERTIES FIXTURES_REQUIRED ar_take)
+# Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
+set_test_costs(ar_cli 56)

@@ -12,3 +12,5 @@ foreach(case validate kill9 frames report bad_scene)
   set_tests_properties(video_study_${case} PROPERTIES FIXTURES_REQUIRED "video_take;session_protocols"
                        LABELS "gl;session" PASS_REGULAR_EXPRESSION "(^|\n)ok:")
 endforeach()
+# Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
+set_test_costs(video_study_report 20 video_study_kill9 12)

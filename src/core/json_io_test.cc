@@ -22,7 +22,7 @@ fs::path TempFile(const std::string& name, const std::string& text) {
 }
 
 // The one-line message of the Error(kInput) that reading `path` throws ("" and a failure when it throws none).
-std::string ReadError(const fs::path& path) {
+std::string JsonReadError(const fs::path& path) {
   try {
     ReadJsonFile(path);
   } catch (const Error& e) {
@@ -44,13 +44,13 @@ TEST(ReadJsonFile, ReadsAValidFile) {
 
 TEST(ReadJsonFile, DeepNestingIsRefusedBeforeParsing) {
   const std::string deep = std::string(100000, '[') + std::string(100000, ']');
-  const std::string message = ReadError(TempFile("deep.json", deep));
+  const std::string message = JsonReadError(TempFile("deep.json", deep));
   EXPECT_TRUE(Contains(message, "nested deeper than 64 levels at line 1, column 65")) << message;
 }
 
 TEST(ReadJsonFile, DeepNestingAfterAByteOrderMarkIsRefusedToo) {
   const std::string deep = "\xEF\xBB\xBF" + std::string(100000, '[') + std::string(100000, ']');
-  EXPECT_TRUE(Contains(ReadError(TempFile("bom-deep.json", deep)), "nested deeper than 64 levels"));
+  EXPECT_TRUE(Contains(JsonReadError(TempFile("bom-deep.json", deep)), "nested deeper than 64 levels"));
 }
 
 TEST(ReadJsonFile, BracketsInsideStringsDoNotCountAsNesting) {
@@ -60,16 +60,16 @@ TEST(ReadJsonFile, BracketsInsideStringsDoNotCountAsNesting) {
 
 TEST(ReadJsonFile, NestingUpToTheLimitIsRead) {
   EXPECT_NO_THROW(ReadJsonFile(TempFile("64.json", std::string(64, '[') + std::string(64, ']'))));
-  EXPECT_TRUE(Contains(ReadError(TempFile("65.json", std::string(65, '[') + std::string(65, ']'))), "deeper"));
+  EXPECT_TRUE(Contains(JsonReadError(TempFile("65.json", std::string(65, '[') + std::string(65, ']'))), "deeper"));
 }
 
 TEST(ReadJsonFile, BinaryFileIsASyntaxErrorNotADepthError) {
-  const std::string message = ReadError(TempFile("image.png", "\x89PNG\r\n" + std::string(200, '[')));
+  const std::string message = JsonReadError(TempFile("image.png", "\x89PNG\r\n" + std::string(200, '[')));
   EXPECT_TRUE(Contains(message, "not valid JSON: parse error at line 1, column 1")) << message;
 }
 
 TEST(ReadJsonFile, KeyGivenTwiceIsRefusedNamingWhere) {
-  const std::string message = ReadError(TempFile(
+  const std::string message = JsonReadError(TempFile(
       "twice.json", R"({"a": [1, {"b": 2}, {"c": {"d": 1, "e/f": 2, "e/f": 3}}], "g": 1})"));
   EXPECT_TRUE(Contains(message, ": /a/2/c/e~1f: is given twice in the same object")) << message;
   // The same key in different objects is not a repeat.
@@ -77,26 +77,26 @@ TEST(ReadJsonFile, KeyGivenTwiceIsRefusedNamingWhere) {
 }
 
 TEST(ReadJsonFile, NumberBeyondDoubleNamesWhereItIs) {
-  const std::string message = ReadError(TempFile("huge.json", "{\n  \"speed_cm_s\": 1e400\n}"));
+  const std::string message = JsonReadError(TempFile("huge.json", "{\n  \"speed_cm_s\": 1e400\n}"));
   EXPECT_TRUE(Contains(message, "at line 2, column 17")) << message;
   EXPECT_TRUE(Contains(message, "1e400")) << message;
 }
 
 TEST(ReadJsonFile, SyntaxErrorNamesLineAndColumn) {
-  const std::string message = ReadError(TempFile("syntax.json", "{\n  \"a\": [1 2]\n}"));
+  const std::string message = JsonReadError(TempFile("syntax.json", "{\n  \"a\": [1 2]\n}"));
   EXPECT_TRUE(Contains(message, "not valid JSON: parse error at line 2, column 11")) << message;
 }
 
 TEST(ReadJsonFile, MissingFileIsAnInputError) {
-  EXPECT_TRUE(Contains(ReadError(fs::temp_directory_path() / "blurcue-no-such.json"), "cannot open file"));
+  EXPECT_TRUE(Contains(JsonReadError(fs::temp_directory_path() / "blurcue-no-such.json"), "cannot open file"));
 }
 
 TEST(ReadJsonFile, FolderIsRefused) {
-  EXPECT_TRUE(Contains(ReadError(fs::temp_directory_path()), "is a folder"));
+  EXPECT_TRUE(Contains(JsonReadError(fs::temp_directory_path()), "is a folder"));
 }
 
 TEST(ReadJsonFile, DeviceIsRefused) {
-  EXPECT_TRUE(Contains(ReadError("/dev/zero"), "not a regular file"));
+  EXPECT_TRUE(Contains(JsonReadError("/dev/zero"), "not a regular file"));
 }
 
 TEST(ReadJsonFile, FifoIsRefusedWithoutWaitingForAWriter) {
@@ -104,16 +104,16 @@ TEST(ReadJsonFile, FifoIsRefusedWithoutWaitingForAWriter) {
   fs::create_directories(fifo.parent_path());
   fs::remove(fifo);
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-  EXPECT_TRUE(Contains(ReadError(fifo), "not a regular file"));
+  EXPECT_TRUE(Contains(JsonReadError(fifo), "not a regular file"));
   fs::remove(fifo);
 }
 
 TEST(ReadJsonFile, ProcFileThatCannotBeReadIsAnInputError) {
-  EXPECT_TRUE(Contains(ReadError("/proc/self/mem"), "cannot read file"));
+  EXPECT_TRUE(Contains(JsonReadError("/proc/self/mem"), "cannot read file"));
 }
 
 TEST(ReadJsonFile, FileOverTheCapIsRefused) {
-  const std::string message = ReadError(TempFile("big.json", "[" + std::string(kMaxJsonBytes, ' ') + "]"));
+  const std::string message = JsonReadError(TempFile("big.json", "[" + std::string(kMaxJsonBytes, ' ') + "]"));
   EXPECT_TRUE(Contains(message, "at most 16 MiB")) << message;
 }
 

@@ -13,15 +13,15 @@
 namespace blurcue::optics {
 namespace {
 
-const Lens kThesis{21.0, 21.0 / 5.6, 5.1e-3};
-constexpr double kInf = std::numeric_limits<double>::infinity();
+const Lens kThesisLens{21.0, 21.0 / 5.6, 5.1e-3};
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 // Table 4.3's edge depths (given there in cm), edge 1 nearest.
 const double kEdgeMm[] = {342.3, 359.6, 377.0, 394.3, 411.7, 429.0, 446.3, 463.7, 481.0, 498.3, 527.3};
 
 // Textbook blur-circle radius in px, r = D f |u - u0| / (2 u (u0 - f) pitch), independent of the code under test.
-double TruthPx(double u0, double u, double aperture_mm = kThesis.aperture_mm, double floor_px = 0,
-               double pitch_mm = kThesis.pixel_pitch_mm) {
-  const double f = kThesis.focal_length_mm;
+double TruthPx(double u0, double u, double aperture_mm = kThesisLens.aperture_mm, double floor_px = 0,
+               double pitch_mm = kThesisLens.pixel_pitch_mm) {
+  const double f = kThesisLens.focal_length_mm;
   const double c = std::isinf(u0) ? aperture_mm * f / u : aperture_mm * f * std::abs(u - u0) / (u * (u0 - f));
   const double r = c / 2 / pitch_mm;
   return std::sqrt(r * r + floor_px * floor_px);
@@ -43,14 +43,14 @@ std::vector<BlurSample> Samples(const SceneSpec& spec) {
   for (int e = spec.first_edge; e <= spec.last_edge; ++e)
     for (int s = 0; s < 7; ++s) {
       const double u = kEdgeMm[e - 1];
-      const double r = TruthPx(spec.focus_mm, u, kThesis.aperture_mm, spec.floor_px);
+      const double r = TruthPx(spec.focus_mm, u, kThesisLens.aperture_mm, spec.floor_px);
       out.push_back({u, std::max(0.0, r + (spec.noise_px > 0 ? noise(rng) : 0.0)), 1.0});
     }
   return out;
 }
 
 TEST(FitThinLens, RecoversFocusAndApertureFromExactSamples) {
-  const FittedModel m = FitThinLens(kThesis, Samples({}));
+  const FittedModel m = FitThinLens(kThesisLens, Samples({}));
   EXPECT_NEAR(m.focus_mm, 258.18, 0.01 * 258.18);
   EXPECT_NEAR(m.aperture_mm, 3.75, 0.01 * 3.75);
   EXPECT_EQ(m.kind, "thin_lens");
@@ -64,7 +64,7 @@ TEST(FitThinLens, RecoversFocusAndApertureFromExactSamples) {
 TEST(FitThinLens, RecoversFocusAndApertureFromNoisySamples) {
   SceneSpec spec;
   spec.noise_px = 0.2;
-  const FittedModel m = FitThinLens(kThesis, Samples(spec));
+  const FittedModel m = FitThinLens(kThesisLens, Samples(spec));
   EXPECT_NEAR(m.focus_mm, 258.18, 0.03 * 258.18);
   EXPECT_NEAR(m.aperture_mm, 3.75, 0.03 * 3.75);
   // The residual is the noise, no more and not much less.
@@ -80,7 +80,7 @@ TEST(FitThinLens, RobustToGrossOutliers) {
   int flawed = 0;
   for (size_t i = 3; i < samples.size(); i += 10) samples[i].r_px *= 2, ++flawed;
   ASSERT_GE(flawed, 7);
-  const FittedModel m = FitThinLens(kThesis, samples);
+  const FittedModel m = FitThinLens(kThesisLens, samples);
   EXPECT_NEAR(m.focus_mm, 258.18, 0.03 * 258.18);
   EXPECT_NEAR(m.aperture_mm, 3.75, 0.03 * 3.75);
   EXPECT_EQ(m.outliers, flawed);
@@ -90,7 +90,7 @@ TEST(FitThinLens, RobustToGrossOutliers) {
 TEST(FitThinLens, FocusInsideTheSampleRange) {
   SceneSpec spec;
   spec.focus_mm = 430.0;
-  const FittedModel m = FitThinLens(kThesis, Samples(spec));
+  const FittedModel m = FitThinLens(kThesisLens, Samples(spec));
   EXPECT_NEAR(m.focus_mm, 430.0, 0.01 * 430.0);
   EXPECT_NEAR(m.aperture_mm, 3.75, 0.01 * 3.75);
 }
@@ -99,19 +99,19 @@ TEST(FitThinLens, FocusBeyondAllSamples) {
   SceneSpec spec;
   spec.focus_mm = 800.0;
   spec.noise_px = 0.1;
-  const FittedModel m = FitThinLens(kThesis, Samples(spec));
+  const FittedModel m = FitThinLens(kThesisLens, Samples(spec));
   EXPECT_NEAR(m.focus_mm, 800.0, 0.03 * 800.0);
   EXPECT_NEAR(m.aperture_mm, 3.75, 0.03 * 3.75);
 }
 
 TEST(FitThinLens, FocusAtInfinity) {
   SceneSpec spec;
-  spec.focus_mm = kInf;
-  const FittedModel m = FitThinLens(kThesis, Samples(spec));
+  spec.focus_mm = kInfinity;
+  const FittedModel m = FitThinLens(kThesisLens, Samples(spec));
   // Beyond 1 km is infinity for a 21 mm lens looking at half a metre.
   EXPECT_GT(m.focus_mm, 1e6);
   EXPECT_NEAR(m.aperture_mm, 3.75, 0.01 * 3.75);
-  EXPECT_NEAR(m.PredictPx(kThesis, 1000.0), TruthPx(kInf, 1000.0), 0.01 * TruthPx(kInf, 1000.0));
+  EXPECT_NEAR(m.PredictPx(kThesisLens, 1000.0), TruthPx(kInfinity, 1000.0), 0.01 * TruthPx(kInfinity, 1000.0));
 }
 
 TEST(FitThinLens, KeepsFloorWhenDataHaveOne) {
@@ -119,7 +119,7 @@ TEST(FitThinLens, KeepsFloorWhenDataHaveOne) {
   spec.focus_mm = 430.0;
   spec.floor_px = 1.5;
   spec.noise_px = 0.05;
-  const FittedModel m = FitThinLens(kThesis, Samples(spec));
+  const FittedModel m = FitThinLens(kThesisLens, Samples(spec));
   EXPECT_EQ(m.kind, "thin_lens+floor");
   EXPECT_NEAR(m.floor_px, 1.5, 0.1 * 1.5);
   EXPECT_NEAR(m.focus_mm, 430.0, 0.02 * 430.0);
@@ -133,7 +133,7 @@ TEST(FitThinLens, DropsFloorWhenDataHaveNone) {
   spec.noise_px = 0.05;
   for (uint64_t seed = 1; seed <= 5; ++seed) {
     spec.seed = seed;
-    const FittedModel m = FitThinLens(kThesis, Samples(spec));
+    const FittedModel m = FitThinLens(kThesisLens, Samples(spec));
     EXPECT_EQ(m.kind, "thin_lens") << "seed " << seed;
     EXPECT_EQ(m.floor_px, 0.0) << "seed " << seed;
   }
@@ -145,7 +145,7 @@ TEST(FitThinLens, NoFloorWhenNotAllowed) {
   spec.floor_px = 1.5;
   FitOptions options;
   options.allow_floor = false;
-  const FittedModel m = FitThinLens(kThesis, Samples(spec), options);
+  const FittedModel m = FitThinLens(kThesisLens, Samples(spec), options);
   EXPECT_EQ(m.kind, "thin_lens");
   EXPECT_EQ(m.floor_px, 0.0);
   // The floor it may not model shows up in the residual.
@@ -156,17 +156,17 @@ TEST(FitThinLens, PredictsHeldOutDepths) {
   SceneSpec spec;
   spec.noise_px = 0.1;
   spec.last_edge = 7;
-  const FittedModel m = FitThinLens(kThesis, Samples(spec));
+  const FittedModel m = FitThinLens(kThesisLens, Samples(spec));
   for (int e = 8; e <= 11; ++e) {
     const double truth = TruthPx(258.18, kEdgeMm[e - 1]);
-    EXPECT_NEAR(m.PredictPx(kThesis, kEdgeMm[e - 1]), truth, 0.05 * truth) << "edge " << e;
+    EXPECT_NEAR(m.PredictPx(kThesisLens, kEdgeMm[e - 1]), truth, 0.05 * truth) << "edge " << e;
   }
 }
 
 TEST(FitThinLens, ZeroWeightDropsSample) {
   std::vector<BlurSample> samples = Samples({});
   samples.push_back({400.0, 1000.0, 0.0});
-  const FittedModel m = FitThinLens(kThesis, samples);
+  const FittedModel m = FitThinLens(kThesisLens, samples);
   EXPECT_EQ(m.samples_used, 77);
   EXPECT_EQ(m.outliers, 0);
   EXPECT_NEAR(m.focus_mm, 258.18, 0.01 * 258.18);
@@ -175,7 +175,7 @@ TEST(FitThinLens, ZeroWeightDropsSample) {
 TEST(FitThinLens, FewerThanThreeSamplesIsNotFound) {
   const std::vector<BlurSample> two = {{342.3, 8.0, 1.0}, {527.3, 16.6, 1.0}, {400.0, 12.0, 0.0}};
   try {
-    FitThinLens(kThesis, two);
+    FitThinLens(kThesisLens, two);
     FAIL() << "expected Error(kNotFound)";
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::kNotFound);
@@ -186,7 +186,7 @@ TEST(FitThinLens, FewerThanThreeSamplesIsNotFound) {
 TEST(FitThinLens, SamplesAtOneDepthIsNotFound) {
   const std::vector<BlurSample> one_depth = {{400.0, 8.0, 1.0}, {400.0, 8.5, 1.0}, {400.0, 7.5, 1.0}};
   try {
-    FitThinLens(kThesis, one_depth);
+    FitThinLens(kThesisLens, one_depth);
     FAIL() << "expected Error(kNotFound)";
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::kNotFound);
@@ -198,7 +198,7 @@ TEST(FitThinLens, SampleInsideFocalLengthIsDomainError) {
   std::vector<BlurSample> samples = Samples({});
   samples[5].u_mm = 20.0;
   try {
-    FitThinLens(kThesis, samples);
+    FitThinLens(kThesisLens, samples);
     FAIL() << "expected Error(kDomain)";
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::kDomain);
@@ -210,7 +210,7 @@ TEST(FitThinLens, NegativeRadiusIsInputError) {
   std::vector<BlurSample> samples = Samples({});
   samples[2].r_px = -1.0;
   try {
-    FitThinLens(kThesis, samples);
+    FitThinLens(kThesisLens, samples);
     FAIL() << "expected Error(kInput)";
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::kInput);
@@ -223,9 +223,9 @@ TEST(FitThinLens, SampleAtInfinityIsUsable) {
   // A far background sample (u = infinity) has the finite radius D f / (2 (u0 - f) pitch).
   std::vector<BlurSample> samples = Samples({});
   const double at_infinity =
-      kThesis.aperture_mm * kThesis.focal_length_mm / (2 * (258.18 - kThesis.focal_length_mm)) / kThesis.pixel_pitch_mm;
-  samples.push_back({kInf, at_infinity, 1.0});
-  const FittedModel m = FitThinLens(kThesis, samples);
+      kThesisLens.aperture_mm * kThesisLens.focal_length_mm / (2 * (258.18 - kThesisLens.focal_length_mm)) / kThesisLens.pixel_pitch_mm;
+  samples.push_back({kInfinity, at_infinity, 1.0});
+  const FittedModel m = FitThinLens(kThesisLens, samples);
   EXPECT_EQ(m.samples_used, 78);
   EXPECT_EQ(m.outliers, 0);
   EXPECT_NEAR(m.focus_mm, 258.18, 0.01 * 258.18);
@@ -241,7 +241,7 @@ std::vector<BlurSample> TakeSamples(double focus_mm, double floor_px, uint64_t s
   for (int k = 0; k <= 14; ++k)
     for (int s = 0; s < 7; ++s) {
       const double u = 360.0 + 20.0 * k;
-      const double r = TruthPx(focus_mm, u, kThesis.aperture_mm, floor_px, 23.4 / 1148);
+      const double r = TruthPx(focus_mm, u, kThesisLens.aperture_mm, floor_px, 23.4 / 1148);
       out.push_back({u, std::max(0.0, r + noise(rng)), 1.0});
     }
   return out;
@@ -295,7 +295,7 @@ TEST(FittedModel, PredictPxAddsFloorInQuadrature) {
   m.aperture_mm = 3.75;
   m.floor_px = 2.0;
   for (double u : {342.3, 430.0, 527.3})
-    EXPECT_NEAR(m.PredictPx(kThesis, u), TruthPx(430.0, u, 3.75, 2.0), 1e-9) << "u = " << u;
+    EXPECT_NEAR(m.PredictPx(kThesisLens, u), TruthPx(430.0, u, 3.75, 2.0), 1e-9) << "u = " << u;
 }
 
 }  // namespace

@@ -13,7 +13,7 @@
 namespace blurcue::session {
 namespace {
 
-double Phi(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
+double NormalCdf(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
 
 // The pixel model's parameters (every record before model= existed names jnd): read as model=pixel.
 TEST(ObserverParams, ParsesNamesAndKeepsDefaults) {
@@ -74,7 +74,7 @@ TEST(SimulatedObserver, ChoiceRatesMatchTheModel) {
     const int draws = 6000;
     for (int i = 0; i < draws; ++i) ++n[o.ChooseSide(v).action];
     const double c = p.jnd_px / 2;
-    const double left = 1 - Phi((c - delta) / p.jnd_px), right = Phi((-c - delta) / p.jnd_px);
+    const double left = 1 - NormalCdf((c - delta) / p.jnd_px), right = NormalCdf((-c - delta) / p.jnd_px);
     const double se = std::sqrt(0.25 / draws);
     EXPECT_NEAR(n["left"] / double(draws), left, 4 * se) << "delta " << delta;
     EXPECT_NEAR(n["right"] / double(draws), right, 4 * se) << "delta " << delta;
@@ -99,9 +99,9 @@ TEST(SimulatedObserver, YesNoAndRatingRatesMatchTheModel) {
       lowest += k.action == "1";
       highest += k.action == "5";
     }
-    EXPECT_NEAR(yes / double(draws), 1 - Phi((p.jnd_px / 2 - m) / p.jnd_px), 4 * se) << "m " << m;
-    EXPECT_NEAR(lowest / double(draws), Phi((p.jnd_px / 2 - m) / p.jnd_px), 4 * se) << "m " << m;
-    EXPECT_NEAR(highest / double(draws), 1 - Phi((4 * p.jnd_px / 2 - m) / p.jnd_px), 4 * se) << "m " << m;
+    EXPECT_NEAR(yes / double(draws), 1 - NormalCdf((p.jnd_px / 2 - m) / p.jnd_px), 4 * se) << "m " << m;
+    EXPECT_NEAR(lowest / double(draws), NormalCdf((p.jnd_px / 2 - m) / p.jnd_px), 4 * se) << "m " << m;
+    EXPECT_NEAR(highest / double(draws), 1 - NormalCdf((4 * p.jnd_px / 2 - m) / p.jnd_px), 4 * se) << "m " << m;
   }
 }
 
@@ -207,7 +207,7 @@ TEST(SimulatedObserver, PixelAdjustmentAcceptsTheLevelNearestItsTarget) {
 // The model's closed form written out here, apart from observer.cc: s the Gaussian std (arcmin), E the seen blur.
 double SeenBlur(double s, double s_i, double p) { return std::pow(std::pow(s, p) + std::pow(s_i, p), 1 / p); }
 double Correct2afc(double s_a, double s_b, double s_i, double w, double p) {
-  return Phi(0.6744897501960817 * std::abs(std::log(SeenBlur(s_a, s_i, p) / SeenBlur(s_b, s_i, p))) / std::log(1 + w));
+  return NormalCdf(0.6744897501960817 * std::abs(std::log(SeenBlur(s_a, s_i, p) / SeenBlur(s_b, s_i, p))) / std::log(1 + w));
 }
 
 TEST(ArcminObserver, ProbabilityIsTheClosedFormOnRadiiTwiceTheStd) {
@@ -338,8 +338,8 @@ TEST(ArcminObserver, MismatchChoiceRatesMatchTheModel) {
     std::map<std::string, int> n;
     for (int i = 0; i < draws; ++i) ++n[o.ChooseSide(v).action];
     const double delta = std::abs(ln_e(2.0 + off) - ln_e(2.0));
-    EXPECT_NEAR(n["left"] / double(draws), 1 - Phi((sd / 2 - delta) / sd), 4 * se) << off;
-    EXPECT_NEAR(n["right"] / double(draws), Phi((-sd / 2 - delta) / sd), 4 * se) << off;
+    EXPECT_NEAR(n["left"] / double(draws), 1 - NormalCdf((sd / 2 - delta) / sd), 4 * se) << off;
+    EXPECT_NEAR(n["right"] / double(draws), NormalCdf((-sd / 2 - delta) / sd), 4 * se) << off;
   }
 }
 
@@ -367,7 +367,7 @@ TEST(ArcminObserver, SideBiasFavoursTheLeftByItsNoiseSds) {
   const int draws = 8000;
   int left = 0;
   for (int i = 0; i < draws; ++i) left += o.ChooseBlurrier({2.0, 2.0, 0, 1.0}).action == "left";
-  EXPECT_NEAR(left / double(draws), Phi(1), 4 * std::sqrt(0.25 / draws));  // equal blurs: bias over unit noise
+  EXPECT_NEAR(left / double(draws), NormalCdf(1), 4 * std::sqrt(0.25 / draws));  // equal blurs: bias over unit noise
 }
 
 // Response times: log-normal around rt for an easy trial, (1 + rthard) rt for one it cannot see (d' = 0).
@@ -472,7 +472,7 @@ TEST(SimulatedObserver, ArcminAdjustmentTakesTheLevelThatLooksClosest) {
       for (size_t i = 0; i < mu.size(); ++i) {
         double others = 1;
         for (size_t j = 0; j < mu.size(); ++j)
-          if (j != i) others *= 1 - (Phi((x - mu[j]) / sd) - Phi((-x - mu[j]) / sd));
+          if (j != i) others *= 1 - (NormalCdf((x - mu[j]) / sd) - NormalCdf((-x - mu[j]) / sd));
         expected[i] += weight * (pdf((x - mu[i]) / sd) + pdf((x + mu[i]) / sd)) / sd * others;
       }
     }

@@ -22,7 +22,7 @@ namespace {
 using testing::Rows;
 using testing::ReadCsv;
 
-size_t Column(const Rows& rows, const std::string& name) {
+size_t ColumnIndex(const Rows& rows, const std::string& name) {
   const auto& header = rows.at(0);
   const auto it = std::find(header.begin(), header.end(), name);
   EXPECT_NE(it, header.end()) << "no column " << name;
@@ -73,27 +73,27 @@ TEST(Export, ColumnsAreTheSameForParticipantsWithDifferentFactors) {
       "rt_ms",       "answered_at"};
   EXPECT_EQ(rows[0], expected);
   for (const auto& row : rows) EXPECT_EQ(row.size(), expected.size());
-  EXPECT_EQ(rows[1][Column(rows, "participant")], "P01");
-  EXPECT_EQ(rows[1][Column(rows, "edge")], "3");
-  EXPECT_EQ(rows[1][Column(rows, "speed_cm_s")], "");
-  EXPECT_EQ(rows[5][Column(rows, "participant")], "P02");
-  EXPECT_EQ(rows[5][Column(rows, "speed_cm_s")], "1.8");
-  EXPECT_EQ(rows[5][Column(rows, "edge")], "");
-  EXPECT_EQ(rows[1][Column(rows, "rt_ms")], "400.25");
-  EXPECT_EQ(rows[1][Column(rows, "seed")], "s42");  // never a number a spreadsheet could round
-  EXPECT_EQ(rows[1][Column(rows, "status")], "answered");
-  EXPECT_EQ(rows[1][Column(rows, "chosen_side")], "right");
-  EXPECT_EQ(rows[5][Column(rows, "session_number")], "1");
-  EXPECT_EQ(rows[5][Column(rows, "session_status")], "completed");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "participant")], "P01");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "edge")], "3");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "speed_cm_s")], "");
+  EXPECT_EQ(rows[5][ColumnIndex(rows, "participant")], "P02");
+  EXPECT_EQ(rows[5][ColumnIndex(rows, "speed_cm_s")], "1.8");
+  EXPECT_EQ(rows[5][ColumnIndex(rows, "edge")], "");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "rt_ms")], "400.25");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "seed")], "s42");  // never a number a spreadsheet could round
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "status")], "answered");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "chosen_side")], "right");
+  EXPECT_EQ(rows[5][ColumnIndex(rows, "session_number")], "1");
+  EXPECT_EQ(rows[5][ColumnIndex(rows, "session_status")], "completed");
   // Unanswered trials are rows with empty answers.
-  EXPECT_EQ(rows[7][Column(rows, "status")], "unanswered");
-  EXPECT_EQ(rows[7][Column(rows, "chosen_side")], "");
-  EXPECT_EQ(rows[7][Column(rows, "answered_at")], "");
+  EXPECT_EQ(rows[7][ColumnIndex(rows, "status")], "unanswered");
+  EXPECT_EQ(rows[7][ColumnIndex(rows, "chosen_side")], "");
+  EXPECT_EQ(rows[7][ColumnIndex(rows, "answered_at")], "");
   // Each side's source and fixed radius in columns of their own, no JSON.
-  EXPECT_EQ(rows[1][Column(rows, "left_source")], "measured");
-  EXPECT_EQ(rows[1][Column(rows, "left_fixed")], "");
-  EXPECT_EQ(rows[1][Column(rows, "right_source")], "fixed_screen_px");
-  EXPECT_EQ(rows[1][Column(rows, "right_fixed")], "2.5");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "left_source")], "measured");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "left_fixed")], "");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "right_source")], "fixed_screen_px");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "right_fixed")], "2.5");
   // The codebook names every column of trials.csv, in order.
   const Rows codebook = ReadCsv(dir / "out" / "codebook.csv");
   std::vector<std::string> named;
@@ -123,7 +123,7 @@ TEST(Export, SummariesOfStudiesWhoseNamesCollideAsFileNamesAreEachKept) {
     EXPECT_TRUE(folded.insert(lower).second) << file;
     const Rows rows = ReadCsv(dir / "out" / file);
     ASSERT_EQ(rows.size(), 2u) << file;
-    EXPECT_EQ(rows[1][Column(rows, "planned")], std::to_string(i + 1)) << file;  // its own study's session
+    EXPECT_EQ(rows[1][ColumnIndex(rows, "planned")], std::to_string(i + 1)) << file;  // its own study's session
   }
   EXPECT_EQ(SummaryFileName("test1-static-grids"), "summary-test1-static-grids.csv");
   EXPECT_EQ(SummaryFileName("a<b"), SummaryFileName("a<b"));  // the same in every export
@@ -224,12 +224,12 @@ TEST(Export, ASchemaOneRecordsPatternGivesItsSpeedAColumn) {
   EXPECT_EQ(ExportCsv(dir / "old.sqlite", dir / "out"), 2);
   const Rows rows = ReadCsv(dir / "out" / "trials.csv");
   ASSERT_EQ(rows.size(), 3u);
-  EXPECT_EQ(rows[1][Column(rows, "speed_cm_s")], "3");
-  EXPECT_EQ(rows[2][Column(rows, "speed_cm_s")], "1.8");
-  EXPECT_EQ(rows[1][Column(rows, "pattern")], "1");
-  EXPECT_EQ(rows[2][Column(rows, "pattern")], "4");
-  EXPECT_EQ(rows[2][Column(rows, "r_right_px")], "3.1");
-  EXPECT_EQ(rows[2][Column(rows, "right_source")], "estimated");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "speed_cm_s")], "3");
+  EXPECT_EQ(rows[2][ColumnIndex(rows, "speed_cm_s")], "1.8");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "pattern")], "1");
+  EXPECT_EQ(rows[2][ColumnIndex(rows, "pattern")], "4");
+  EXPECT_EQ(rows[2][ColumnIndex(rows, "r_right_px")], "3.1");
+  EXPECT_EQ(rows[2][ColumnIndex(rows, "right_source")], "estimated");
   for (const char* side : {"left", "right"})
     for (const auto& name : rows[0]) EXPECT_NE(name, side);
 }
@@ -241,13 +241,13 @@ TEST(Export, AnOlderRecordExportsFromAMigratedCopy) {
   WriteVersionSixRecord(dir / "old.sqlite");
   EXPECT_EQ(ExportCsv(dir / "old.sqlite", dir / "out"), 1);
   const Rows rows = ReadCsv(dir / "out" / "trials.csv");
-  EXPECT_EQ(rows[1][Column(rows, "observer")], "simulated");
-  EXPECT_EQ(rows[1][Column(rows, "observer_params")], "sim:jnd=0.6");
-  EXPECT_EQ(rows[1][Column(rows, "window")], "0");
-  EXPECT_EQ(rows[1][Column(rows, "seed")], "s18446744073709551614");  // 2^64 - 2, stored as -2
-  EXPECT_EQ(rows[1][Column(rows, "left_source")], "measured");
-  EXPECT_EQ(rows[1][Column(rows, "chosen_side")], "left");
-  EXPECT_EQ(rows[1][Column(rows, "chose_more_blurred")], "1");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "observer")], "simulated");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "observer_params")], "sim:jnd=0.6");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "window")], "0");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "seed")], "s18446744073709551614");  // 2^64 - 2, stored as -2
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "left_source")], "measured");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "chosen_side")], "left");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "chose_more_blurred")], "1");
   Database old(dir / "old.sqlite", OpenMode::kReadOnly);
   EXPECT_EQ(SchemaVersion(old), 6);  // the record itself is only read
 }
@@ -273,8 +273,8 @@ TEST(Export, EveryRowCarriesItsSessionsStatusAbortedIncluded) {
   const Rows rows = ReadCsv(dir / "out" / "trials.csv");
   std::vector<std::string> got;
   for (size_t i = 1; i < rows.size(); ++i)
-    got.push_back(rows[i][Column(rows, "participant")] + ":" + rows[i][Column(rows, "session_id")] + ":" +
-                  rows[i][Column(rows, "session_status")]);
+    got.push_back(rows[i][ColumnIndex(rows, "participant")] + ":" + rows[i][ColumnIndex(rows, "session_id")] + ":" +
+                  rows[i][ColumnIndex(rows, "session_status")]);
   EXPECT_EQ(got, (std::vector<std::string>{"P01:1:aborted", "P01:2:completed", "P01:2:completed", "P02:3:completed",
                                            "P02:3:completed", "P03:4:running"}));
 }
@@ -285,7 +285,7 @@ TEST(Export, ReadsARecordAWriterStillHasOpen) {
   RunSession(record, "P01", R"({"block":1})", 2, 1);  // a factor named like a fixed column
   EXPECT_EQ(ExportCsv(dir / "r.sqlite", dir / "out"), 2);
   const Rows rows = ReadCsv(dir / "out" / "trials.csv");
-  EXPECT_EQ(rows[1][Column(rows, "factor_block")], "1");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "factor_block")], "1");
 }
 
 TEST(Export, QuotesFieldsThatNeedIt) {
