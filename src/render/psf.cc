@@ -201,7 +201,8 @@ cv::Mat PsfKernel(const Psf& psf) {
 }
 
 double DrawnRadiusPx(const Psf& psf) {
-  if (!(psf.MotionLengthPx() > 0)) return psf.r_px;
+  // The spreading's variance across is at most 1/4 px^2 (a bilinear splat's): from r = 1 px on it is inside r.
+  if (!(psf.MotionLengthPx() > 0) || psf.r_px >= 1) return psf.r_px;
   double across = 0;
   StreakKernel(psf.motion_px, &across);
   return std::max(psf.r_px, 2 * std::sqrt(across));
