@@ -153,10 +153,32 @@ for f in sorted(glob.glob(os.path.join(sys.argv[1], "frame-*.png"))):
     im.resize((im.width // 2, im.height // 2)).save(os.path.join(sys.argv[2], os.path.basename(f)))
 PYEOF
   edit other_size "p['scene']['video'] = '$W/half/frame-%04d.png'"
-  expect other_size /scene/video "is 574x382 but the scene was calibrated on 1148x764 (.*track is the track of another take)"
+  expect other_size /scene/video "frame 0 is 574 x 382 px; the take .*track tracked is 1148 x 764 px (the track of another take?)"
+  # The same take's frames in reverse order (same size, other pictures): not the frames that were tracked.
+  mkdir -p "$W/reversed" "$W/short"
+  n=$(ls "$DIR/take"/frame-*.png | wc -l)
+  for ((i = 0; i < n; ++i)); do
+    cp "$DIR/take/$(printf 'frame-%04d.png' $((n - 1 - i)))" "$W/reversed/$(printf 'frame-%04d.png' $i)"
+    ((i < n - 1)) && cp "$DIR/take/$(printf 'frame-%04d.png' $i)" "$W/short/"
+  done
+  edit reversed "p['scene']['video'] = '$W/reversed/frame-%04d.png'"
+  expect reversed /scene/video "frame 0 is not the frame .*track tracked (its grey levels differ by up to"
+  # A video with fewer frames than track.csv lists.
+  edit short "p['scene']['video'] = '$W/short/frame-%04d.png'"
+  expect short /scene/video "has $((n - 1)) frames (0-$((n - 2))), but .*track/track.csv lists $n (the track of another take?)"
+  # A track folder edited by hand: a frame marked lost whose calibration is there; one frame's calibration copied
+  # over another's.
+  rm -rf "$W/lostedit" "$W/copied" && cp -r "$DIR/track" "$W/lostedit" && cp -r "$DIR/track" "$W/copied"
+  sed -i '3s/^\([^,]*,[^,]*\),[a-z]*,/\1,lost,/' "$W/lostedit/track.csv"
+  edit lostedit "p['scene']['track'] = '$W/lostedit'"
+  expect lostedit /scene/track "track.csv: line 3, status: says frame 1 is lost, but calib-0001.json holds its calibration"
+  cp "$W/copied/calib-0001.json" "$W/copied/calib-0002.json"
+  edit copied "p['scene']['track'] = '$W/copied'"
+  expect copied /scene/track "calib-0002.json: /frame: must be 2, the frame of its row in track.csv, got 1"
   edit unknown_key 'p["scene"]["tracks"] = p["scene"]["track"]'
   expect unknown_key /scene/tracks 'unknown key (did you mean "track"?)'
-  echo "ok: a missing take, a take of another size than its track, an unknown key: one problem each, exit 3" ;;
+  echo "ok: a missing take, a take of another size than its track, its frames reversed, a video shorter than its" \
+       "track, a frame marked lost by hand, a calibration copied over another, an unknown key: one problem each, exit 3" ;;
 *)
   fail "unknown case $1" ;;
 esac

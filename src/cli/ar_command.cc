@@ -177,11 +177,7 @@ void AddArCommand(CLI::App& app) {
         ended = e;
         break;
       }
-      if (frame.cols != camera.image_width_px || frame.rows != camera.image_height_px)
-        throw InputError(args->input, "frame " + std::to_string(index) + " is " + std::to_string(frame.cols) + " x " +
-                                          std::to_string(frame.rows) + " px; the take's calibration is " +
-                                          std::to_string(camera.image_width_px) + " x " +
-                                          std::to_string(camera.image_height_px) + " (another take?)");
+      stimulus::CheckTakeFrame(take, index, frame, args->input, args->track);
       if (!video.IsOpened()) {
         const char* codec = OpenLosslessVideo(video, args->out, source.fps() > 0 ? source.fps() : 30, frame.size());
         if (!codec) throw InputError(args->out, "cannot open a video writer (FFV1 or MJPEG .avi)");

@@ -46,6 +46,24 @@ PreparedSession PrepareStudy(const std::filesystem::path& protocol_file, const s
   return s;
 }
 
+namespace {
+
+// A trial's scene with its blur plan on the session's screen (one radius, or per pixel by depth where the object's
+// depth asks); on video, as the take plays (its radii averaged over the frames shown) and checked in every frame of
+// the take it can show.
+TrialScene Describe(const PreparedSession& s, const protocol::Trial& trial) {
+  if (s.images.take) {
+    TrialScene scene = stimulus::DescribeVideoTrial(s.protocol, *s.images.take, trial, s.presentation);
+    CheckVideoTrial(s.protocol, *s.images.take, trial, scene);
+    return scene;
+  }
+  TrialScene scene = DescribeTrial(s.protocol, trial, s.scene ? &*s.scene : nullptr, &s.presentation);
+  if (s.scene) PlanOnScreen(s.protocol, *s.scene, s.presentation, &scene);
+  return scene;
+}
+
+}  // namespace
+
 std::string SceneKey(const protocol::Trial& t) {
   std::string key = t.block + '\n' + std::to_string(int(t.task)) + ' ' + std::to_string(t.practice) + ' ' +
                     std::to_string(t.round) + ' ' + std::to_string(t.swapped) + ' ' + std::to_string(t.cell) + ' ' +
@@ -76,25 +94,16 @@ void PrepareParticipant(PreparedSession* s, const std::string& participant, std:
       const std::string key = SceneKey(trial);
       auto it = cache->planned.find(key);
       if (it == cache->planned.end()) {
-        TrialScene scene = DescribeTrial(s->protocol, trial, s->scene ? &*s->scene : nullptr, &s->presentation);
+        TrialScene scene = Describe(*s, trial);
         CheckRealPhotos(s->protocol, {scene}, &s->real_photos_checked);
-        if (s->scene) PlanOnScreen(s->protocol, *s->scene, s->presentation, &scene);
-        if (s->images.take) CheckVideoTrial(s->protocol, *s->images.take, trial, scene);
         it = cache->planned.emplace(key, std::move(scene)).first;
       }
       s->scenes.push_back(it->second);
     }
     return;
   }
-  for (const protocol::Trial& trial : s->trials)
-    s->scenes.push_back(DescribeTrial(s->protocol, trial, s->scene ? &*s->scene : nullptr, &s->presentation));
+  for (const protocol::Trial& trial : s->trials) s->scenes.push_back(Describe(*s, trial));
   CheckRealPhotos(s->protocol, s->scenes, &s->real_photos_checked);
-  // Each pair trial's blur plan on that screen: one radius, or per pixel by depth where the object's depth asks.
-  if (s->scene)
-    for (TrialScene& scene : s->scenes) PlanOnScreen(s->protocol, *s->scene, s->presentation, &scene);
-  // On video, in every frame of the take a trial can show.
-  if (s->images.take)
-    for (size_t i = 0; i < s->trials.size(); ++i) CheckVideoTrial(s->protocol, *s->images.take, s->trials[i], s->scenes[i]);
 }
 
 PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const std::string& participant,

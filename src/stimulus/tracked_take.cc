@@ -14,6 +14,7 @@
 #include "core/typed.h"
 #include "optics/thin_lens.h"
 #include "scene/stimuli.h"
+#include "track/frames.h"
 #include "track/take.h"
 
 namespace blurcue::stimulus {
@@ -52,6 +53,42 @@ int NeighbourWithPose(const TrackedTake& take, int index, int step) {
   for (int i = index + step; i >= 0 && i < int(take.frames.size()); i += step)
     if (take.frames[size_t(i)].calib) return i;
   return -1;
+}
+
+// Two cameras are one when everything that shapes the image is the same.
+bool SameCamera(const Camera& a, const Camera& b) {
+  return a.image_width_px == b.image_width_px && a.image_height_px == b.image_height_px &&
+         a.focal_length_mm == b.focal_length_mm && a.sensor_width_mm == b.sensor_width_mm &&
+         a.sensor_height_mm == b.sensor_height_mm && a.f_number == b.f_number && a.Intrinsics() == b.Intrinsics() &&
+         a.dist_coeffs == b.dist_coeffs;
+}
+
+// A calibration names the frame, time and status track wrote it for, and the frame's signature: each must be the row's.
+void CheckCalibIsTheRows(const Json& json, const std::string& path, const TrackedFrame& f, const std::string& time_text) {
+  const std::string again = " (track the take again)";
+  if (!json.contains("frame") || !json["frame"].is_number_integer() || json["frame"].get<int64_t>() != f.index)
+    throw InputError(path + ": /frame", "must be " + std::to_string(f.index) + ", the frame of its row in track.csv, got " +
+                                            (json.contains("frame") ? Echo(json["frame"].dump(), false) : "nothing") +
+                                            ": a calibration of another frame" + again);
+  if (!json.contains("time_s") || !json["time_s"].is_number() ||
+      !(std::abs(json["time_s"].get<double>() - f.time_s) <= 2e-6))
+    throw InputError(path + ": /time_s", "must be " + time_text + " s, the time of frame " + std::to_string(f.index) +
+                                             " in track.csv, got " +
+                                             (json.contains("time_s") ? Echo(json["time_s"].dump(), false) : "nothing") +
+                                             again);
+  if (!json.contains("track_status") || json["track_status"] != track::Name(f.status))
+    throw InputError(path + ": /track_status", std::string("must be ") + track::Name(f.status) +
+                                                   ", frame " + std::to_string(f.index) + "'s status in track.csv, got " +
+                                                   (json.contains("track_status")
+                                                        ? Echo(json["track_status"].dump(), false)
+                                                        : "nothing") + again);
+  const Json* sig = json.contains("frame_signature") ? &json["frame_signature"] : nullptr;
+  bool ok = sig && sig->is_array() && sig->size() == 64;
+  for (size_t i = 0; ok && i < sig->size(); ++i) ok = (*sig)[i].is_number() && std::isfinite((*sig)[i].get<double>());
+  if (!ok)
+    throw InputError(path + ": /frame_signature",
+                     "must be the frame's 64 grey means that blurcue track writes (this calibration was made by an "
+                     "older blurcue, or edited)" + again);
 }
 
 const std::vector<std::string> kBallKeys = {"kind", "name", "x_mm", "y_mm", "radius_mm", "texture"};
@@ -128,12 +165,46 @@ TrackedTake LoadTrackedTake(const std::filesystem::path& dir) {
                                     Echo(row.fields[c_time], false));
     f.status = ParseStatus(file + ": line " + std::to_string(row.line) + ", status",
                            c_status < row.fields.size() ? row.fields[c_status] : "");
-    if (f.status != track::FrameStatus::kLost) f.calib = calib::LoadSceneCalib(dir / track::CalibFileName(f.index));
+    const std::filesystem::path calib_path = dir / track::CalibFileName(f.index);
+    if (f.status != track::FrameStatus::kLost) {
+      const Json json = ReadJsonFile(calib_path);
+      f.calib = calib::SceneCalibFromJson(json, calib_path.string() + ": ");
+      CheckCalibIsTheRows(json, calib_path.string(), f, row.fields[c_time]);
+      f.signature = json["frame_signature"].get<std::vector<double>>();
+      const TrackedFrame* first = nullptr;
+      for (const TrackedFrame& g : take.frames)
+        if (g.calib && !first) first = &g;
+      if (first && !SameCamera(first->calib->camera, f.calib->camera))
+        throw InputError(calib_path.string() + ": /camera",
+                         "is not the camera of " + track::CalibFileName(first->index) +
+                             " (one camera films a take; this calibration is of another take or another camera)");
+    } else if (std::filesystem::exists(calib_path)) {
+      throw InputError(file + ": line " + std::to_string(row.line) + ", status",
+                       "says frame " + std::to_string(f.index) + " is lost, but " + calib_path.filename().string() +
+                           " holds its calibration: track.csv was edited, or the folder mixes two takes (track "
+                           "the take again)");
+    }
     take.frames.push_back(std::move(f));
   }
   if (take.frames.empty()) throw InputError(file, "has no frames (only a header)");
   (void)take.camera();  // at least one pose
   return take;
+}
+
+void CheckTakeFrame(const TrackedTake& take, int index, const cv::Mat& image, const std::string& video,
+                    const std::string& track_dir) {
+  const Camera& camera = take.camera();
+  const std::string frame = "frame " + std::to_string(index);
+  if (image.cols != camera.image_width_px || image.rows != camera.image_height_px)
+    throw InputError(video, frame + " is " + std::to_string(image.cols) + " x " + std::to_string(image.rows) +
+                                " px; the take " + track_dir + " tracked is " + std::to_string(camera.image_width_px) +
+                                " x " + std::to_string(camera.image_height_px) + " px (the track of another take?)");
+  if (index >= int(take.frames.size()) || !take.frames[size_t(index)].calib) return;
+  const double d = track::SignatureDistance(track::FrameSignature(image), take.frames[size_t(index)].signature);
+  if (d > track::kMaxSignatureDistance)
+    throw InputError(video, frame + " is not the frame " + track_dir + " tracked (its grey levels differ by up to " +
+                                Num(d) + " on an 8 x 8 grid, more than " + Num(track::kMaxSignatureDistance) +
+                                "): the track of another take, or the video changed since blurcue track ran");
 }
 
 scene::VirtualObject BallAt(double x_mm, double y_mm, double radius_mm) {

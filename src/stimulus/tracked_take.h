@@ -24,6 +24,7 @@ struct TrackedFrame {
   double time_s = 0;
   track::FrameStatus status = track::FrameStatus::kLost;
   std::optional<calib::SceneCalib> calib;  // empty when lost
+  std::vector<double> signature;           // the frame's track::FrameSignature as tracked (empty when lost)
 };
 
 struct TrackedTake {
@@ -36,8 +37,15 @@ struct TrackedTake {
 };
 
 // Reads DIR/track.csv and the calib-NNNN.json of every frame it says has a pose. Errors (kInput) name the file and the
-// line or field and the value: a missing file, a column missing, frames out of order, an unknown status.
+// line or field and the value: a missing file, a column missing, frames out of order, an unknown status; a
+// calibration that is not the one track wrote for that row (its frame, time or status differ, its camera is not the
+// take's, or it has no frame signature) and one left for a frame track.csv says is lost.
 TrackedTake LoadTrackedTake(const std::filesystem::path& dir);
+
+// Checks that `image`, frame `index` of `video`, is the frame `track_dir` tracked: the camera's size and, for a frame
+// with a pose, its signature (track::FrameSignature). Error(kInput) naming the video and the frame otherwise.
+void CheckTakeFrame(const TrackedTake& take, int index, const cv::Mat& image, const std::string& video,
+                    const std::string& track_dir);
 
 // An object an experimenter places on the board (board frame, mm; texture set), named for the record.
 struct PlacedObject {

@@ -1,10 +1,12 @@
 #include "stimulus/video_take.h"
 
 #include <cmath>
+#include <map>
 
 #include "core/error.h"
 #include "core/names.h"
 #include "optics/thin_lens.h"
+#include "protocol/trials.h"
 #include "stimulus/internal.h"
 #include "track/frames.h"
 
@@ -41,23 +43,22 @@ VideoTake::VideoTake(const protocol::Protocol& protocol) {
   try {
     track::FrameSource source(video, fps_);
     cv::Mat image;
-    int at = -1;
+    int at = -1, read = 0;
     double time_s = 0;
-    while (at < last_posed_) {
+    // Every frame track.csv lists must be in the video (a longer track.csv is another take's), each one posed the
+    // frame that was tracked; frames after the last with a pose are read, not kept.
+    while (at < n - 1) {
       if (!source.Next(&image, &at, &time_s))
-        throw Error(ErrorKind::kInput, (at < 0 ? std::string("has no frames") :
-                                         "has " + std::to_string(at + 1) + " frames (0-" + std::to_string(at) + ")") +
-                                            ", but " + track + " has a pose for frame " + std::to_string(last_posed_));
+        throw Error(ErrorKind::kInput, (read == 0 ? std::string("has no frames") :
+                                         "has " + std::to_string(read) + " frames (0-" + std::to_string(read - 1) + ")") +
+                                            ", but " + track + "/track.csv lists " + std::to_string(n) +
+                                            " (the track of another take?)");
+      ++read;
+      CheckTakeFrame(take_, at, image, video, track);
+      if (at > last_posed_) continue;
       if (at < first_posed_) {
         photos_.emplace_back();  // never shown
         continue;
-      }
-      if (take_.frames[size_t(at)].calib) {
-        try {
-          take_.frames[size_t(at)].calib->RequireSameSize(image, video + " frame " + std::to_string(at));
-        } catch (const std::exception& e) {
-          throw Error(ErrorKind::kInput, std::string(e.what()) + " (" + track + " is the track of another take)");
-        }
       }
       photos_.push_back(image.clone());
     }
@@ -107,6 +108,65 @@ std::array<std::optional<scene::BlurredObject>, 2> VideoObjectsAt(const protocol
     for (auto& o : objects)
       if (o) o->motion_px += StreakPx(take.take(), shown.posed, o->object.center_board_mm, trial.exposure_ms);
   return objects;
+}
+
+double TakeWindowS(const protocol::Protocol& protocol, const VideoTake& take, const protocol::Trial& trial,
+                   const TrialScene& scene) {
+  const protocol::Timing& timing = protocol::TimingOf(protocol, trial);
+  if (scene.intervals > 0)
+    return (scene.intervals * timing.interval_ms + (scene.intervals - 1) * timing.isi_ms) / 1000;
+  if (timing.stimulus_ms > 0) return timing.stimulus_ms / 1000;
+  double s = std::max((double(take.take().frames.size()) - take.first_posed()) / take.fps(), scene.MotionS());
+  if (timing.deadline_ms > 0) s = std::min(s, timing.deadline_ms / 1000);
+  return s;
+}
+
+TrialScene DescribeVideoTrial(const protocol::Protocol& protocol, const VideoTake& take, const protocol::Trial& trial,
+                              const Presentation& presentation) {
+  auto describe = [&](int posed) {
+    try {
+      const calib::SceneCalib& c = take.Calib(posed);
+      TrialScene t = DescribeTrial(protocol, trial, &c, &presentation);
+      PlanOnScreen(protocol, c, presentation, &t);
+      return t;
+    } catch (const Error& e) {
+      throw Error(e.kind(), std::string(e.what()) + " (in the take's frame " + std::to_string(posed) + ")");
+    }
+  };
+  TrialScene scene = describe(take.first_posed());
+  // Each frame with a pose, weighted by its time on screen in the window: frame k plays from (k - first) / fps, a
+  // lost one and the time past the take's end hold the frame before.
+  const double window = TakeWindowS(protocol, take, trial, scene);
+  std::map<int, double> weight;
+  const int n = int(take.take().frames.size());
+  for (int k = take.first_posed(); k < n; ++k) {
+    const double from = (k - take.first_posed()) / take.fps();
+    if (from >= window) break;
+    const double to = k == n - 1 ? window : std::min(window, (k + 1 - take.first_posed()) / take.fps());
+    weight[take.FrameAt(from + 0.5 / take.fps()).posed] += to - from;
+  }
+  double total = 0;
+  for (const auto& [posed, w] : weight) total += w;
+  if (!(total > 0)) return scene;
+  TrialScene mean = scene;
+  mean.r_left_px = mean.r_right_px = mean.r_scene_px = mean.floor_left_sigma_px = mean.floor_right_sigma_px = 0;
+  mean.motion_left_px = mean.motion_right_px = cv::Vec2d(0, 0);
+  mean.r_span_screen_px = 0;
+  mean.per_pixel = false;
+  for (const auto& [posed, w] : weight) {
+    const TrialScene t = posed == take.first_posed() ? scene : describe(posed);
+    const double a = w / total;
+    mean.r_left_px += a * t.r_left_px;
+    mean.r_right_px += a * t.r_right_px;
+    mean.r_scene_px += a * t.r_scene_px;
+    mean.floor_left_sigma_px += a * t.floor_left_sigma_px;
+    mean.floor_right_sigma_px += a * t.floor_right_sigma_px;
+    mean.motion_left_px += a * t.motion_left_px;
+    mean.motion_right_px += a * t.motion_right_px;
+    mean.r_span_screen_px = std::max(mean.r_span_screen_px, t.r_span_screen_px);
+    mean.per_pixel = mean.per_pixel || t.per_pixel;
+  }
+  return mean;
 }
 
 void CheckVideoTrial(const protocol::Protocol& protocol, const VideoTake& take, const protocol::Trial& trial,

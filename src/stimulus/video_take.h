@@ -58,6 +58,21 @@ std::array<std::optional<scene::BlurredObject>, 2> VideoObjectsAt(const protocol
                                                                    const VideoTake& take, const TakeFrameShown& shown,
                                                                    const TrialScene& trial, double t_s);
 
+// A trial on video as the take plays under it: DescribeTrial and PlanOnScreen at every frame with a pose the trial
+// shows, the record's radii, floors, streaks and scene blur (r_left_px ... motion_right_px, r_scene_px) averaged over
+// the time each frame is on screen while the stimulus is (TakeWindowS), a per-pixel plan where any frame asks for one.
+// What the trial shows first (place, size at onset) is the first frame's. A frame whose objects cannot be drawn or
+// lie outside its photo is an error (kInput) naming the protocol file, the trial and the take's frame. The trial's
+// radii are thus the ones its participant sees on the whole, as a rolling ball's are averaged over its run.
+TrialScene DescribeVideoTrial(const protocol::Protocol& protocol, const VideoTake& take, const protocol::Trial& trial,
+                              const Presentation& presentation);
+
+// The seconds of a trial over which its radii are averaged: the stimulus's time (timing.stimulus_ms, or all the
+// intervals), or for one shown until the answer the take's time as it plays once (from its first frame with a pose
+// to the end of its last frame), or a rolling ball's run if longer, at most the deadline.
+double TakeWindowS(const protocol::Protocol& protocol, const VideoTake& take, const protocol::Trial& trial,
+                   const TrialScene& scene);
+
 // Checks that every frame a trial can show can draw its objects (a measured source needs the frame's measurement at
 // the object's edge; every radius and streak within range): Error(kInput) naming the protocol file, the trial and the
 // take's frame.

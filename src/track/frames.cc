@@ -3,7 +3,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <regex>
+
+#include <opencv2/imgproc.hpp>
 
 #include <opencv2/core/utils/logger.hpp>
 #include <opencv2/videoio.hpp>  // its constants (the reader: core/media.h)
@@ -19,6 +22,28 @@ namespace {
 constexpr int kGapLookahead = 16;
 
 }  // namespace
+
+std::vector<double> FrameSignature(const cv::Mat& bgr) {
+  cv::Mat small;
+  cv::resize(bgr, small, cv::Size(8, 8), 0, 0, cv::INTER_AREA);  // each cell's mean
+  small.convertTo(small, CV_64F);
+  std::vector<double> signature;
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) {
+      const double* p = small.ptr<double>(y) + x * small.channels();
+      double sum = 0;
+      for (int c = 0; c < small.channels(); ++c) sum += p[c];
+      signature.push_back(std::round(100 * sum / small.channels()) / 100);
+    }
+  return signature;
+}
+
+double SignatureDistance(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.size() != b.size()) return std::numeric_limits<double>::infinity();
+  double d = 0;
+  for (size_t i = 0; i < a.size(); ++i) d = std::max(d, std::abs(a[i] - b[i]));
+  return d;
+}
 
 bool IsFramePattern(const std::string& input) { return input.find('%') != std::string::npos; }
 

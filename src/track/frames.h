@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -37,6 +38,16 @@ class FrameSource {
   int expected_ = 0;
   int next_ = 0;
 };
+
+// A frame's signature: the means of its grey level (0-255, channels averaged) over an 8 x 8 grid of cells. `track`
+// writes it in each calib-NNNN.json ("frame_signature") so that whoever plays the take later (a study on video,
+// `ar`) can tell the video is the one that was tracked: another take, or frames in another order, differ by tens of
+// levels in some cell; the same take decoded by another build of a codec, by a level or less.
+std::vector<double> FrameSignature(const cv::Mat& bgr);
+// The largest difference of two signatures' cells (grey levels); infinity when their sizes differ.
+double SignatureDistance(const std::vector<double>& a, const std::vector<double>& b);
+// Signatures further apart than this are of different frames.
+constexpr double kMaxSignatureDistance = 4;
 
 // True when `input` is a printf pattern (holds a '%'), i.e. an image sequence.
 bool IsFramePattern(const std::string& input);

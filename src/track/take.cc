@@ -62,6 +62,7 @@ TakeResult TrackTake(FrameSource& source, Tracker& tracker, const std::function<
       if (!source.Next(&frame, &index, &time_s)) break;
       take.decode_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       take.frames.push_back(tracker.Process(frame, index, time_s));
+      take.frames.back().signature = FrameSignature(frame);
     } catch (const Error& e) {
       if (e.kind() != ErrorKind::kInput) throw;
       take.error = e;
@@ -86,6 +87,15 @@ TakeResult TrackTake(FrameSource& source, Tracker& tracker, const std::function<
 
 void WriteTake(const TakeResult& take, const std::filesystem::path& dir, const std::string& input) {
   std::filesystem::create_directories(dir);
+  // A calibration of an earlier track into the same folder, of a frame this take does not pose, would contradict
+  // track.csv: gone before this take's are written.
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    const bool calib = name.size() > 11 && name.rfind("calib-", 0) == 0 &&
+                       name.compare(name.size() - 5, 5, ".json") == 0 &&
+                       name.find_first_not_of("0123456789", 6) == name.size() - 5;
+    if (calib) std::filesystem::remove(entry.path());
+  }
   std::ostringstream csv;
   for (size_t i = 0; i < kTrackColumns.size(); ++i) csv << (i ? "," : "") << kTrackColumns[i].name;
   csv << "\n";
@@ -107,6 +117,7 @@ void WriteTake(const TakeResult& take, const std::filesystem::path& dir, const s
       json["frame"] = f.index;
       json["time_s"] = f.time_s;
       json["track_status"] = Name(f.status);
+      json["frame_signature"] = f.signature;
       json["lens_model"] = "one model for the whole take (fixed focus and aperture): fitted to every usable section "
                            "of every frame";
       WriteJsonFile(dir / CalibFileName(f.index), json);

@@ -33,6 +33,7 @@ struct FrameResult {
   double pose_ms = 0;                    // tracking or detection, and the pose
   double measure_ms = 0;                 // linear light, every section's blur, the frame's estimate
   double frame_ms = 0;                   // all of the frame's work (decoding excluded)
+  std::vector<double> signature;         // FrameSignature of the frame (TrackTake fills it)
 };
 
 // Carries the board from frame to frame: the corners predicted from the last two frames (constant velocity),
