@@ -110,6 +110,23 @@ for fr in rows("frames.csv"):
         if err > tolerance:
             failures.append(f"{where} {side}: streak {m.round(3)} px, truth {want_m.round(3)} px")
 
+# Each trial's declared radius (trials.csv) of a fitted side: the take's true thin lens averaged over the frames the
+# trial shows as the take plays once (each frame for one frame time; until the answer: the whole take).
+checked["declared"], worst["declared"] = 0, 0.0
+for t in trials.values():
+    y = (int(t["edge"]) - 1) * square
+    for side, section in (("left", 3), ("right", 5)):
+        if t[f"{side}_source"] != "fitted":
+            continue
+        centre = [(section - 0.5) * square, y, radius_mm]
+        want = sum(r_true(k, centre) for k in range(len(frames))) / len(frames)
+        err = abs(float(t[f"r_{side}_px"]) - want) / want
+        worst["declared"] = max(worst["declared"], err)
+        checked["declared"] += 1
+        if err > 0.03:
+            failures.append(f"trial {t['trial_index']} {side}: declared r {t[f'r_{side}_px']} px, the take's true "
+                            f"mean {want:.4f} px")
+
 # The capture of each trial's first frame: where each ball is drawn (screen px back to photo px).
 for path in sorted(glob.glob(os.path.join(capture_dir, "trial-*.json"))):
     c = json.load(open(path))
@@ -130,8 +147,9 @@ for path in sorted(glob.glob(os.path.join(capture_dir, "trial-*.json"))):
 
 print(f"checked {checked['frames']} frames: {checked['r']} fitted radii (worst {100 * worst['r']:.2f} %), "
       f"{checked['none']} unblurred sides, {checked['motion']} streaks (worst {worst['motion']:.2f} of the tolerance), "
-      f"{checked['centre']} captured centres (worst {worst['centre']:.3f} photo px)")
-if not checked["r"] or not checked["motion"] or not checked["centre"]:
+      f"{checked['centre']} captured centres (worst {worst['centre']:.3f} photo px), {checked['declared']} trials' "
+      f"declared radii against the take's mean (worst {100 * worst['declared']:.2f} %)")
+if not checked["r"] or not checked["motion"] or not checked["centre"] or not checked["declared"]:
     failures.append("nothing to check")
 for f in failures[:20]:
     print("FAIL:", f)

@@ -130,6 +130,8 @@ double TrackedTake::FramesPerSecond() const {
 TrackedTake LoadTrackedTake(const std::filesystem::path& dir) {
   const std::filesystem::path csv_path = dir / "track.csv";
   const std::string file = csv_path.string();
+  if (std::filesystem::is_regular_file(dir))
+    throw InputError(dir.string(), "is a file: give the folder that holds track.csv (the --out of blurcue track)");
   if (!std::filesystem::is_directory(dir)) throw InputError(dir.string(), "no such folder (the --out of blurcue track)");
   if (!std::filesystem::exists(csv_path)) throw InputError(file, "does not exist: is this a folder blurcue track wrote?");
   const CsvText csv = ParseCsv(ReadTextFile(csv_path), kMaxFrames + 1);

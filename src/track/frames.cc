@@ -51,12 +51,12 @@ std::filesystem::path PatternFile(const std::string& pattern, int index) {
   // One conversion of an int (%d, %4d, %04d), and "%%" for a literal percent sign: nothing that could read memory.
   static const std::regex kOne("^([^%]|%%)*%0?[0-9]{0,2}d([^%]|%%)*$");
   if (!std::regex_match(pattern, kOne))
-    throw Error(ErrorKind::kUsage, "INPUT: '" + pattern +
+    throw Error(ErrorKind::kUsage, "'" + pattern +
                                        "' must hold exactly one frame-number conversion like %04d (and %% for a "
                                        "literal percent sign)");
   char name[4096];
   const int n = std::snprintf(name, sizeof name, pattern.c_str(), index);
-  if (n < 0 || n >= int(sizeof name)) throw Error(ErrorKind::kUsage, "INPUT: '" + pattern + "' is too long");
+  if (n < 0 || n >= int(sizeof name)) throw Error(ErrorKind::kUsage, "'" + pattern + "' is too long");
   return name;
 }
 
