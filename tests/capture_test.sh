@@ -397,12 +397,13 @@ PYEOF
     # No defocus, and 0.3 screen px: a streak drawn between pixel centres is wider across than that (up to 1 px on a
     # diagonal); the record states the radius the kernel has across it (render::DrawnRadiusPx, 0.47-0.62 screen px
     # here; Psf.DrawnRadiusIsTheKernelsAcrossTheMotion checks it against the kernel's moments). On the frames the
-    # solve reads it 0.03-0.06 px high, judged within 0.06 px: a record of 0 or 0.3, as before, is off by 0.2-0.6 px.
+    # solve reads it 0.02-0.07 px high (the same binary read at most 0.06 px on one machine and 0.067 on another: the
+    # llvmpipe build of the CPU), judged within 0.075 px: a record of 0 or 0.3, as before, is off by 0.2-0.6 px.
     name="motion-$path-sharp"
     variant "$P/test1-static-grids.json" "$W/$name.json" "${ball[@]}" "${extra[@]}" \
         'sides={"left": 0, "right": {"screen_px": 0.3}}'
     capture "$W/$name.json" "$name"
-    $PY "$(dirname "$0")/capture_kernel.py" "$W/$name" "$W/ball-twin-$path" --tolerance-px 0.06 --tolerance-rel 0.03 \
+    $PY "$(dirname "$0")/capture_kernel.py" "$W/$name" "$W/ball-twin-$path" --tolerance-px 0.075 --tolerance-rel 0.03 \
         > "$W/$name.txt" \
         || fail "$name: $(grep BAD "$W/$name.txt" | head -2) $(tail -1 "$W/$name.txt")"
     sed "s/^/$path sharp /" "$W/$name.txt"
