@@ -84,10 +84,10 @@ void CheckCalibIsTheRows(const Json& json, const std::string& path, const Tracke
                                                         : "nothing") + again);
   const Json* sig = json.contains("frame_signature") ? &json["frame_signature"] : nullptr;
   bool ok = sig && sig->is_array() && sig->size() == 64;
-  for (size_t i = 0; ok && i < sig->size(); ++i) ok = (*sig)[i].is_number() && std::isfinite((*sig)[i].get<double>());
+  for (size_t i = 0; ok && i < sig->size(); ++i) ok = (*sig)[i].is_number() && (*sig)[i].get<double>() >= 0 && (*sig)[i].get<double>() <= 255;
   if (!ok)
     throw InputError(path + ": /frame_signature",
-                     "must be the frame's 64 grey means that blurcue track writes (this calibration was made by an "
+                     "must be the frame's 64 grey means (0-255) that blurcue track writes (this calibration was made by an "
                      "older blurcue, or edited)" + again);
 }
 
@@ -146,6 +146,7 @@ TrackedTake LoadTrackedTake(const std::filesystem::path& dir) {
   };
   const size_t c_frame = column(track::kTrackColumns[0].name), c_time = column("time_s"), c_status = column("status");
   TrackedTake take;
+  int first_posed = -1;  // the take's camera is this frame's
   for (size_t k = 1; k < csv.records.size(); ++k) {
     const CsvRecord& row = csv.records[k];
     TrackedFrame f;
@@ -173,13 +174,11 @@ TrackedTake LoadTrackedTake(const std::filesystem::path& dir) {
       f.calib = calib::SceneCalibFromJson(json, calib_path.string() + ": ");
       CheckCalibIsTheRows(json, calib_path.string(), f, row.fields[c_time]);
       f.signature = json["frame_signature"].get<std::vector<double>>();
-      const TrackedFrame* first = nullptr;
-      for (const TrackedFrame& g : take.frames)
-        if (g.calib && !first) first = &g;
-      if (first && !SameCamera(first->calib->camera, f.calib->camera))
+      if (first_posed >= 0 && !SameCamera(take.frames[size_t(first_posed)].calib->camera, f.calib->camera))
         throw InputError(calib_path.string() + ": /camera",
-                         "is not the camera of " + track::CalibFileName(first->index) +
+                         "is not the camera of " + track::CalibFileName(first_posed) +
                              " (one camera films a take; this calibration is of another take or another camera)");
+      if (first_posed < 0) first_posed = f.index;
     } else if (std::filesystem::exists(calib_path)) {
       throw InputError(file + ": line " + std::to_string(row.line) + ", status",
                        "says frame " + std::to_string(f.index) + " is lost, but " + calib_path.filename().string() +
