@@ -92,13 +92,18 @@ def default_beta_bounds(kind, x):
 
 def core(kind, x, alpha, beta):
     x = np.asarray(x, dtype=float)
+    if kind not in KINDS:
+        raise ValueError(f"unknown psychometric function {kind!r}")
+    # (x/alpha)^beta overflows to inf for far-out trial parameters; exp(-inf) = 0 is then the right answer.
+    with np.errstate(over="ignore"):
+        return _core(kind, np.maximum(x, 0.0) if kind == "weibull" else x, alpha, beta)
+
+
+def _core(kind, x, alpha, beta):
+    """core() on levels already checked (Weibull: x >= 0), without its per-call overhead: the fit's inner loop."""
     if kind == "logistic":
         return special.expit((x - alpha) / beta)
-    if kind == "weibull":
-        # (x/alpha)^beta overflows to inf for far-out trial parameters; exp(-inf) = 0 is then the right answer.
-        with np.errstate(over="ignore"):
-            return -np.expm1(-np.power(np.clip(x, 0, None) / alpha, beta))
-    raise ValueError(f"unknown psychometric function {kind!r}")
+    return -np.expm1(-np.power(x / alpha, beta))
 
 
 def psi(kind, x, alpha, beta, gamma, lam):
@@ -153,9 +158,10 @@ def _aggregate(x, k, n):
             np.bincount(inverse, weights=np.asarray(n, float), minlength=len(levels)))
 
 
-def _nll(p, k, n):
-    p = np.clip(p, 1e-9, 1 - 1e-9)
-    return -float(np.sum(k * np.log(p) + (n - k) * np.log1p(-p)))
+def _nll(p, k, misses):
+    """Binomial negative log-likelihood (without the constant) of k hits and `misses` misses at probabilities p."""
+    p = np.minimum(np.maximum(p, 1e-9), 1 - 1e-9)
+    return -float((k * np.log(p) + misses * np.log1p(-p)).sum())
 
 
 def fit_psychometric(x, k, n=None, kind="weibull", gamma=0.5, lam=(0.0, 0.1), starts=None, beta_bounds=None):
@@ -209,11 +215,14 @@ def fit_psychometric(x, k, n=None, kind="weibull", gamma=0.5, lam=(0.0, 0.1), st
             l = lam_lo + (lam_hi - lam_lo) * special.expit(theta[i])
         return a, b, g, l
 
-    def objective(theta):
+    x_core = np.maximum(x, 0.0) if kind == "weibull" else x
+    misses = n - k
+
+    def objective(theta):  # called some 400 times a fit: psi and _nll inlined on prepared arrays
         a, b, g, l = unpack(theta)
         if g + l >= 1:
             return 1e12
-        return _nll(psi(kind, x, a, b, g, l), k, n)
+        return _nll(g + (1 - g - l) * _core(kind, x_core, a, b), k, misses)
 
     span = float(x.max() - x.min()) or 1.0
     if starts is None:
@@ -227,7 +236,7 @@ def fit_psychometric(x, k, n=None, kind="weibull", gamma=0.5, lam=(0.0, 0.1), st
     best = None
     for a0, b0 in starts:
         theta0 = [math.log(a0) if kind == "weibull" else a0, t_of(b0)] + extra
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), np.errstate(over="ignore"):
             warnings.simplefilter("ignore", RuntimeWarning)
             res = optimize.minimize(objective, theta0, method="Nelder-Mead",
                                     options={"xatol": 1e-6, "fatol": 1e-8, "maxiter": 4000, "maxfev": 8000})
