@@ -135,8 +135,21 @@ def _sorted_levels(values):
     return sorted(values, key=key)
 
 
-def factor_chart(m, factor, chance, what, study, out_dir, name, group_note):
+def _pooled(m, factors):
+    """The factors of `factors` that vary in m, each with its levels ("pattern (1, 2, 3)"), and the title's words
+    for them: a chart per level of one factor pools the others' levels (a pattern comparing two blurred balls pooled
+    with ones against a sharp ball is a mixture), and says so."""
+    over = [f"{g} ({', '.join(_label(v) for v in _sorted_levels(list(m[g].dropna().unique())))})"
+            for g in factors if g in m and m[g].nunique() > 1]
+    title = (f", pooled over {over[0].split(' (')[0]}" if len(over) == 1 else
+             ", pooled over the other factors" if over else "")
+    return over, title
+
+
+def factor_chart(m, factor, chance, what, study, out_dir, name, group_note, pooled_over=()):
+    """Bars per level of `factor`; each pools the answers over the levels of the factors in pooled_over (said)."""
     t = condition_table(m, [factor], chance)
+    over, pooled_title = _pooled(m, pooled_over)
     t = t.set_index(factor).loc[_sorted_levels(list(t[factor]))].reset_index()
     fig, ax = plt.subplots(figsize=(max(4.5, 0.7 * len(t) + 2.5), 3.6))
     x = np.arange(len(t))
@@ -155,17 +168,21 @@ def factor_chart(m, factor, chance, what, study, out_dir, name, group_note):
     ax.set_ylim(0, 1.12)
     ax.set_ylabel(f"share: {what}")
     ax.grid(axis="x", visible=False)
-    ax.set_title(f"{study}: {what} per {factor}\n{group_note}, {int(t['n'].sum())} answers", loc="left")
+    ax.set_title(f"{study}: {what} per {factor}{pooled_title}\n{group_note}, {int(t['n'].sum())} answers", loc="left")
     png, svg = save(fig, out_dir, name)
     tests = sorted(set(t["test"])) if "test" in t else []
     notes = ["bars: share of answers with Wilson 95 % intervals (answers pooled: a description, not a test)" +
+             (f"; each bar pools the levels of {' and '.join(over)}: the per-condition table has each crossing"
+              if over else "") +
              (f"; * p < 0.05, ** < 0.01, *** < 0.001 against chance, Holm-adjusted over the chart's bars, with "
               f"participants as the unit: {'; '.join(tests)}" if chance is not None else "")]
     return Chart(name, png, svg, t, notes)
 
 
-def value_chart(m, factor, what, study, out_dir, name, group_note):
-    """Rating or adjusted level per level of a factor: mean with a t 95 % interval, every answer as a dot."""
+def value_chart(m, factor, what, study, out_dir, name, group_note, pooled_over=()):
+    """Rating or adjusted level per level of a factor: mean with a t 95 % interval, every answer as a dot; each level
+    pools the levels of the factors in pooled_over (said)."""
+    over, pooled_title = _pooled(m, pooled_over)
     rows = []
     for level, g in m.groupby(factor, dropna=False):
         v = g["value"].to_numpy(float)
@@ -186,9 +203,10 @@ def value_chart(m, factor, what, study, out_dir, name, group_note):
     ax.set_xticklabels(list(t[factor]))
     ax.set_xlabel(factor)
     ax.set_ylabel(what)
-    ax.set_title(f"{study}: {what} per {factor}\n{group_note}, {int(t['n'].sum())} answers", loc="left")
+    ax.set_title(f"{study}: {what} per {factor}{pooled_title}\n{group_note}, {int(t['n'].sum())} answers", loc="left")
     png, svg = save(fig, out_dir, name)
-    return Chart(name, png, svg, t, ["points: every answer; blue: the mean with its t 95 % interval"])
+    return Chart(name, png, svg, t, ["points: every answer; blue: the mean with its t 95 % interval" +
+                                     (f"; each pools the levels of {' and '.join(over)}" if over else "")])
 
 
 def models(m, factors, study, group_note, what):
@@ -351,6 +369,7 @@ def _analyse(d, study, codebook, out_dir, n_boot, seed, group, task, part):
         raise Skip(f"{study} ({KIND_TITLES[kind]}): no answers to analyse ({answered} answered of {len(d)}"
                    + ("; none chose a side between unequal radii" if kind == "pair" and answered else "") + ")")
     design = design_of(m, codebook)
+    left_out = _left_out_words(d, m, kind)
     slug = _safe(study + (f"-{task}" if task else "") + (f"-{part.replace(', ', '-').replace(' ', '')}" if part else "")
                  + (f"-{group.split()[0]}" if group else ""))
     note = participants_note(m) + (f" ({group})" if group else "") + (f", {part}" if part else "")
@@ -361,7 +380,9 @@ def _analyse(d, study, codebook, out_dir, n_boot, seed, group, task, part):
         declared = _text_values(m, "group")
         if len(declared) == 1:  # a group study of which these rows hold one group: say which
             note += f", group {declared[0]}"
-        return _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, note, n_boot, seed)
+        charts, finding = _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, note, n_boot,
+                                        seed, left_out)
+        return charts, finding + left_out
     # A between-subject group is a factor: each group analysed on its own, then the groups compared with
     # participants as the unit.
     charts, findings = [], []
@@ -370,11 +391,25 @@ def _analyse(d, study, codebook, out_dir, n_boot, seed, group, task, part):
         rows = m[m[design.group].astype(str) == level]
         c, f = _analyse_rows(rows, kind, guess, what, design_of(rows, codebook), codebook, study, out_dir,
                              f"{slug}-group-{_safe(level)}", f"group {level}: {participants_note(rows)}"
-                             f"{note[len(participants_note(m)):]}", n_boot, seed)
+                             f"{note[len(participants_note(m)):]}", n_boot, seed,
+                             _left_out_words(d[d[design.group].astype(str) == level], rows, kind))
         charts += c
         findings.append(f"group {level}: {f}")
     c, f = group_section(m, kind, what, design, codebook, study, out_dir, slug, note)
-    return charts + c, "; ".join(findings + [f])
+    return charts + c, "; ".join(findings + [f]) + left_out
+
+
+def _left_out_words(d, m, kind):
+    """The answered rows a pair's shares leave out, said (", 14 of 60 answers can't tell, left out of the shares"):
+    a "can't tell" chooses no side, and a pair of equal radii has no more blurred side."""
+    if kind != "pair":
+        return ""
+    answered = d[d["status"] == "answered"]
+    cant = int((answered["chosen_side"] == "cant_tell").sum()) if "chosen_side" in answered else 0
+    equal = len(answered) - cant - len(m)
+    parts = ([f"{cant} of {len(answered)} answers can't tell"] if cant else []) + \
+            ([f"{equal} between equal radii (no more blurred side)"] if equal > 0 else [])
+    return (", " + " and ".join(parts) + ", left out of the shares") if parts else ""
 
 
 def _text_values(m, column):
@@ -421,13 +456,14 @@ def group_section(m, kind, what, design, codebook, study, out_dir, slug, note):
     return charts, f"group effect: {words}"
 
 
-def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, note, n_boot, seed):
+def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, note, n_boot, seed, left_out=""):
     """The charts of one set of rows that the design lets be pooled (one group, one version, one session number)."""
     factors = list(design.factors)
     charts = []
     if kind in ("rating", "adjustment"):
         for f in factors:
-            charts.append(value_chart(m, f, what, study, out_dir, f"{slug}-{what.replace(' ', '-')}-per-{f}", note))
+            charts.append(value_chart(m, f, what, study, out_dir, f"{slug}-{what.replace(' ', '-')}-per-{f}", note,
+                                      [g for g in factors if g != f]))
         people = study_tests.per_participant(m, "value")["mean"]
         finding = (f"{KIND_TITLES[kind]}: mean {what} {m['value'].mean():.3g} (median {m['value'].median():.3g}) over "
                    f"{len(m)} answers" + (f", {len(people)} participants' means from {people.min():.3g} to "
@@ -442,7 +478,7 @@ def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, 
     chance = None if kind == "procedure" else guess
     table = condition_table(m, factors, chance)
     charts.append(Chart(f"{slug}-conditions", None, None, table,
-                        [f"{note}: {what} per condition (the crossing of {', '.join(factors) or 'no factors'}); "
+                        [f"{note}{left_out}: {what} per condition (the crossing of {', '.join(factors) or 'no factors'}); "
                          "Wilson 95 % intervals of the answers pooled (a description)" +
                          ("; against chance with participants as the unit (test column), Holm-adjusted over the "
                           "conditions" if chance is not None else
@@ -450,7 +486,8 @@ def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, 
                                                   "level for it"))]))
     if kind != "procedure":
         for f in factors:
-            charts.append(factor_chart(m, f, chance, what, study, out_dir, f"{slug}-per-{f}", note))
+            charts.append(factor_chart(m, f, chance, what, study, out_dir, f"{slug}-per-{f}", note,
+                                       [g for g in factors if g != f]))
         finding = f"{KIND_TITLES[kind]}: " + study_tests.summary_words(m, chance, what)
     else:
         finding = (f"{KIND_TITLES[kind]}: {participants_note(m)}, {len(m)} answers (share correct set by the "

@@ -5,7 +5,7 @@ folder `blurcue track` wrote for it). One line per study whose scene is a video,
   protocol names them); 5 frames at 30 fps (2 found, 3 tracked, 0 lost), one lens model: focus 339.6 mm, ...;
   exposure 16.7 ms; motion streak on screen ...; frames presented per trial (frames.csv): median 2
 
-Reads the record (SQLite: the protocol text of each study's latest version), trials.csv (exposure_ms and the motion
+Reads the record (SQLite: the protocol text of each study's versions), trials.csv (exposure_ms and the motion
 columns, as recorded per trial) and frames.csv (frames per trial). The record keeps a protocol's text, not where the
 protocol file was, so the take's paths (relative to the protocol) are looked for from the folders the caller gives
 (the working directory, its protocols/ folder and the record's folder); where none holds the track folder the take's
@@ -20,18 +20,24 @@ import sqlite3
 import pandas as pd
 
 
-def latest_protocols(db_path):
-    """{study: protocol JSON (dict)} of each study's latest protocol version in the record at db_path."""
+def protocol_versions(db_path):
+    """[(study, hash, version number or None, protocol JSON (dict))] of every protocol version in the record at
+    db_path, in the order the record holds them (a record of merged stations can hold several per study)."""
     con = sqlite3.connect(f"file:{db_path}?mode=ro", uri=True)
     try:
-        rows = con.execute("SELECT s.name, pv.json FROM protocol_versions pv JOIN studies s ON s.id = pv.study_id "
-                           "ORDER BY pv.id").fetchall()
+        try:
+            rows = con.execute("SELECT s.name, pv.hash, pv.version, pv.json FROM protocol_versions pv "
+                               "JOIN studies s ON s.id = pv.study_id ORDER BY pv.id").fetchall()
+        except sqlite3.OperationalError:  # a record from before protocol versions were numbered
+            rows = [(a, b, None, c) for a, b, c in con.execute(
+                "SELECT s.name, pv.hash, pv.json FROM protocol_versions pv JOIN studies s ON s.id = pv.study_id "
+                "ORDER BY pv.id").fetchall()]
     finally:
         con.close()
-    out = {}
-    for study, text in rows:
+    out = []
+    for study, hash_, version, text in rows:
         try:
-            out[study] = json.loads(text)
+            out.append((study, str(hash_), version, json.loads(text)))
         except ValueError:
             continue  # not a protocol blurcue wrote: nothing to describe
     return out
@@ -76,9 +82,12 @@ def describe_take(track_rows):
     return text
 
 
-def _shown(trials, frames, study):
-    """Exposure, motion and frames per trial as the study's trials recorded them (practice left out)."""
+def _shown(trials, frames, study, hashes=None):
+    """Exposure, motion and frames per trial as the study's trials recorded them (practice left out; only the trials
+    of the protocol versions `hashes` where trials.csv names them)."""
     d = trials[(trials["study"] == study)]
+    if hashes is not None and "protocol_hash" in d:
+        d = d[d["protocol_hash"].astype(str).isin(hashes)]
     if "practice" in d:
         d = d[pd.to_numeric(d["practice"], errors="coerce") != 1]
     parts = []
@@ -91,6 +100,12 @@ def _shown(trials, frames, study):
     f = None
     if frames is not None and not frames.empty and "study" in frames:
         f = frames[frames["study"] == study]
+        keys = ["session_id", "trial_index"]
+        if all(k in f and k in d for k in keys):  # the frames of the trials described (practice and others left out)
+            def key(t):  # "session/trial" from numbers, however the CSV typed them (1, 1.0, "1")
+                n = [pd.to_numeric(t[k], errors="coerce") for k in keys]
+                return n[0].map("{:g}".format) + "/" + n[1].map("{:g}".format)
+            f = f[key(f).isin(set(key(d)))]
         if f.empty:
             f = None
 
@@ -137,27 +152,39 @@ def read_frames(path):
 
 
 def video_scene_lines(db_path, trials, frames_path=None, search_dirs=()):
-    """[(study, line)] for each study of the record whose (latest) protocol's scene is a tracked video."""
+    """[(study, line)] for each take a study of the record was shown on: one line per distinct (video, track) of its
+    protocol versions whose scene is a tracked video; where a study's versions name different takes (a record merged
+    from stations with their own takes), each line names its versions and describes only their trials."""
     frames = read_frames(frames_path)
-    lines = []
-    for study, protocol in sorted(latest_protocols(db_path).items()):
+    takes = {}  # study -> {(video, track): [(hash, version)]}, in the record's order
+    for study, hash_, version, protocol in protocol_versions(db_path):
         scene = protocol.get("scene") if isinstance(protocol, dict) else None
         if not isinstance(scene, dict) or "video" not in scene:
             continue
-        video, track = str(scene.get("video", "")), str(scene.get("track", ""))
-        text = f"a tracked video: take {video}, track folder {track} (as the protocol names them, relative to it)"
-        found = None
-        for base in search_dirs:
-            folder = os.path.normpath(os.path.join(base, track))
-            rows = read_track(folder)
-            if rows is not None:
-                found = (folder, rows)
-                break
-        if found:
-            text += f"; the take ({found[0]}): " + describe_take(found[1])
-        else:
-            text += ("; the take's frames: not determined (the record keeps the protocol's text, not its folder, and "
-                     "no track.csv was found from " + ", ".join(search_dirs or ["here"]) + ")")
-        parts = _shown(trials, frames, study) if "study" in trials else []
-        lines.append((study, text + ("; " + "; ".join(parts) if parts else "")))
+        key = (str(scene.get("video", "")), str(scene.get("track", "")))
+        takes.setdefault(study, {}).setdefault(key, []).append((hash_, version))
+    lines = []
+    for study in sorted(takes):
+        several = len(takes[study]) > 1
+        for (video, track), versions in takes[study].items():
+            text = f"a tracked video: take {video}, track folder {track} (as the protocol names them, relative to it)"
+            if several:
+                names = ", ".join((f"{v} " if v is not None else "") + f"({h[:8]})" for h, v in versions)
+                text = (f"{len(takes[study])} takes in this record's protocol versions; version"
+                        f"{'s' if len(versions) > 1 else ''} {names}: " + text)
+            found = None
+            for base in search_dirs:
+                folder = os.path.normpath(os.path.join(base, track))
+                rows = read_track(folder)
+                if rows is not None:
+                    found = (folder, rows)
+                    break
+            if found:
+                text += f"; the take ({found[0]}): " + describe_take(found[1])
+            else:
+                text += ("; the take's frames: not determined (the record keeps the protocol's text, not its folder, "
+                         "and no track.csv was found from " + ", ".join(search_dirs or ["here"]) + ")")
+            hashes = [h for h, _ in versions]
+            parts = _shown(trials, frames, study, hashes) if "study" in trials else []
+            lines.append((study, text + ("; " + "; ".join(parts) if parts else "")))
     return lines

@@ -5,7 +5,7 @@
 # lands in results/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup.sh
+[ -n "${BLURCUE_BUILT:-}" ] || scripts/setup.sh  # set by ctest's `demo` test (scripts/test.sh built it)
 BC=build/src/cli/blurcue
 OUT=results/demo
 mkdir -p "$OUT"

@@ -51,11 +51,24 @@ print("white.avi: RIFF AVI, 4 frames")
 PYEOF
 $PY "$(dirname "$0")/ar_check.py" "$W" || fail "ar_check.py"
 
-# The video's own rate sets the default exposure (30 fps: half the interval, 16.6667 ms), stated.
+# The default exposure is the camera's (synth-take's camera.json says 0: each frame rendered at one instant), stated.
 "$BC" ar "$W/take/take.avi" --track "$W/track" --ball 50,125 --out "$W/default.avi" > /dev/null 2> "$W/default.err" ||
   fail "ar with defaults: $(cat "$W/default.err")"
-grep -q "exposure 16.6667 ms (half the frame interval of the video's 30 fps)" "$W/default.err" ||
+grep -q "exposure 0 ms (the camera's exposure_ms, as tracked)" "$W/default.err" ||
   fail "default exposure: $(cat "$W/default.err")"
+# A camera whose exposure is unknown (no exposure_ms): the video's own rate sets it (30 fps: half the interval), stated.
+rm -rf "$W/track-unknown" && cp -r "$W/track" "$W/track-unknown"
+$PY - "$W/track-unknown" <<'PYEOF'
+import glob, json, sys
+for path in glob.glob(sys.argv[1] + "/calib-*.json"):
+    calib = json.load(open(path))
+    del calib["camera"]["exposure_ms"]
+    json.dump(calib, open(path, "w"))
+PYEOF
+"$BC" ar "$W/take/take.avi" --track "$W/track-unknown" --ball 50,125 --out "$W/default-rate.avi" > /dev/null \
+  2> "$W/default-rate.err" || fail "ar with defaults, exposure unknown: $(cat "$W/default-rate.err")"
+grep -q "exposure 16.6667 ms (the camera's exposure is unknown: half the frame interval of the video's 30 fps" \
+  "$W/default-rate.err" || fail "default exposure from the rate: $(cat "$W/default-rate.err")"
 
 # Truncated input: exit 3, one line naming the file, and the frames before it kept (video and CSV).
 size=$(stat -c %s "$W/take/take.avi")

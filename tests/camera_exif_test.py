@@ -61,18 +61,19 @@ def check(what, ok, detail=""):
 
 
 MAKE, MODEL, ORIENT = 0x010F, 0x0110, 0x0112
-FNUMBER, FOCAL, FOCAL35, SUBJECT = 0x829D, 0x920A, 0xA405, 0x9206
+FNUMBER, FOCAL, FOCAL35, SUBJECT, EXPOSURE = 0x829D, 0x920A, 0xA405, 0x9206, 0x829A
 XDIM, YDIM, FPX, FPY, FPUNIT = 0xA002, 0xA003, 0xA20E, 0xA20F, 0xA210
 
 # 1. Focal-plane resolution in px per cm (unit 3): 600 px over 2.34 cm is a 23.4 mm wide sensor.
 p = photo("fpr.jpg", (600, 400), {MAKE: "Acme", MODEL: "Unlisted 1"},
           {FOCAL: R(21, 1), FNUMBER: R(56, 10), XDIM: 600, YDIM: 400, FPX: R(600 * 100, 234), FPY: R(400 * 100, 156),
-           FPUNIT: 3, SUBJECT: R(12, 10)})
+           FPUNIT: 3, SUBJECT: R(12, 10), EXPOSURE: R(1, 60)})
 c, err = camera(p)
 check("focal-plane resolution: f, N, sensor, size",
       near(c["focal_length_mm"], 21) and near(c["f_number"], 5.6) and near(c["sensor_width_mm"], 23.4)
       and near(c["sensor_height_mm"], 15.6) and c["image_width_px"] == 600 and c["image_height_px"] == 400, c)
 check("the name is make and model", c.get("name") == "Acme Unlisted 1", c)
+check("the exposure is ExposureTime 1/60 s in ms", near(c.get("exposure_ms", -1), 1000 / 60), c)
 check("the focus distance is printed from SubjectDistance", "1200 mm" in err, err)
 
 # The file it writes is a camera.json calibrate's loader takes (blurcue estimate reads it).

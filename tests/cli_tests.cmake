@@ -54,10 +54,7 @@ add_test(NAME cli_unknown_command
          COMMAND ${CMAKE_COMMAND} -DCMD=${BC} "-DARGS=calibrat" -DEXPECT_CODE=2 "-DEXPECT_TEXT=calibrat"
                  -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
 
-# The measurement bench, two levels per factor, writes its CSV.
-add_test(NAME cli_bench_measure_quick
-         COMMAND ${BC} bench measure --quick --no-full-res --out ${T}/bench/measure.csv)
-set_tests_properties(cli_bench_measure_quick PROPERTIES PASS_REGULAR_EXPRESSION "wrote .*measure.csv.*model_fit" LABELS slow)
+# The quick benches (measure, render, record, procedures) run in the demo (ctest `demo`), which charts them.
 
 # Stimuli: one composited ball, a two-ball animation offscreen to video + log, and the same in a window under Xvfb.
 add_test(NAME cli_render_ball
@@ -119,4 +116,4 @@ add_test(NAME cli_camera_exif
          COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/camera_exif_test.py ${BC} ${T}/camera-exif)
 set_tests_properties(cli_camera_exif PROPERTIES PASS_REGULAR_EXPRESSION "ok: camera.json from EXIF")
 # Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
-set_test_costs(cli_bench_measure_quick 118 cli_camera_exif 13)
+set_test_costs(cli_camera_exif 13)

@@ -17,6 +17,9 @@ for example in $examples; do
   grep -q "^ok: " "$example.log" || fail "init $example did not validate: $(tail -2 "$example.log")"
   # The folder stands on its own: no path in its protocol leaves it.
   if grep -q '"\.\./' "$example/protocol.json"; then fail "$example/protocol.json points outside its folder"; fi
+  # The schema its "$schema" names is there.
+  schema=$($PY -c 'import json, sys; print(json.load(open(sys.argv[1]))["$schema"])' "$example/protocol.json")
+  [ -f "$example/$schema" ] || fail "$example/protocol.json names \$schema $schema, not in the folder"
   $BC validate "$example/protocol.json" > /dev/null 2> "$example.err" || fail "validate $example: $(cat "$example.err")"
   info=()
   if [ "$example" = groups-and-info ]; then info=(--info age=30 --info handedness=right --info vision=normal); fi

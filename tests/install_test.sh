@@ -10,6 +10,24 @@ install_moved "$BUILD"
 $BC info > info.txt || fail "info: $(cat info.txt)"
 grep -q "^data: *$W/moved/share/blurcue (installed)" info.txt || fail "not found beside the binary: $(cat info.txt)"
 grep -q "^media: *$W/moved/lib/blurcue/libblurcue_media.so" info.txt || fail "media plugin not beside the binary: $(cat info.txt)"
+# Every relative link of the installed protocols' README (and the installed docs') leads to an installed file.
+$PY - "$W/moved/share/blurcue" <<'PYEOF' || fail "installed documentation links"
+import os, re, sys
+root = sys.argv[1]
+pages = [os.path.join(root, "protocols", "README.md")] + [os.path.join(root, "docs", f)
+                                                          for f in os.listdir(os.path.join(root, "docs")) if f.endswith(".md")]
+broken = []
+for page in pages:
+    for target in re.findall(r"\]\(([^)#]+)(?:#[^)]*)?\)", open(page, encoding="utf-8").read()):
+        if re.match(r"[a-z]+:", target):
+            continue
+        if target.startswith(("../src/", "../tests/", "../scripts/", "../analysis/", "../cmake/", "../.ci/")):
+            continue  # the source tree's files, not installed: these pages are read in a clone as well
+        if not os.path.exists(os.path.normpath(os.path.join(os.path.dirname(page), target))):
+            broken.append(f"{os.path.relpath(page, root)} -> {target}")
+assert os.path.exists(os.path.join(root, "protocols", "README.md")), "no protocols/README.md"
+assert not broken, "; ".join(broken[:5])
+PYEOF
 $BC synth-scene --out scene --seed 5 > /dev/null
 $BC calibrate scene/scene.png --camera scene/camera.json --out calib.json > /dev/null
 $BC render --calib calib.json --background scene/scene.png --object ball --at-edge 9 --blur estimated \

@@ -83,3 +83,18 @@ foreach(case "handedness=Left|--info handedness=Left: must be one of left, right
                    -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
   set_tests_properties(cli_run_info_did_you_mean_${id} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols")
 endforeach()
+# A protocol file that is not there: exit 3 naming it, the same from validate, plan, preview and run (run records
+# nothing: no record file is made).
+foreach(cmd validate preview run)
+  set(extra)
+  if(cmd STREQUAL "preview")
+    set(extra ";--out;${PROJECT_BINARY_DIR}/cli-test/missing-protocol.png")
+  elseif(cmd STREQUAL "run")
+    set(extra ";--participant;P1;--observer;sim;--db;${PROJECT_BINARY_DIR}/cli-test/missing-protocol.sqlite")
+  endif()
+  add_test(NAME cli_${cmd}_missing_protocol
+           COMMAND ${CMAKE_COMMAND} -DCMD=$<TARGET_FILE:blurcue>
+                   "-DARGS=${cmd};${PROJECT_BINARY_DIR}/cli-test/no-such-protocol.json${extra}" -DEXPECT_CODE=3
+                   "-DEXPECT_TEXT=no-such-protocol.json: cannot open file: No such file or directory" -DONE_LINE=1
+                   -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+endforeach()

@@ -88,6 +88,35 @@ class VideoSceneLines(unittest.TestCase):
         self.assertNotIn("mean over trials", line)
         self.assertIn("3 of 4 frames at the take frame's own pose, 1 held", line)
 
+    def test_practice_trials_frames_are_left_out(self):
+        # Trial 0 of session 1 is practice (9 frames); trials 1 and 2 show 3 and 5: the median is 4, not 5.
+        trials = pd.DataFrame({"study": ["video-study"] * 3, "session_id": [1, 1, 1], "trial_index": [0, 1, 2],
+                               "practice": [1, 0, 0], "exposure_ms": [0, 0, 0]})
+        pd.DataFrame({"study": ["video-study"] * 17, "session_id": [1] * 17,
+                      "trial_index": [0] * 9 + [1] * 3 + [2] * 5}).to_csv(self.frames, index=False)
+        line = scenes.video_scene_lines(self.db, trials, self.frames, [os.path.join(self.tmp, "study")])[0][1]
+        self.assertIn("frames presented per trial (frames.csv): median 4 (3-5)", line)
+
+    def test_versions_on_different_takes_are_described_each_with_its_own_trials(self):
+        # A record merged from two stations, each with its own take: version hashes "1" and "2".
+        self.db = os.path.join(self.tmp, "merged.sqlite")
+        make_record(self.db, [("two-takes", {"scene": {"video": "a/take.avi", "track": "track"}}),
+                              ("two-takes", {"scene": {"video": "b/take.avi", "track": "elsewhere"}})])
+        hashes = [h for study, h, _, _ in scenes.protocol_versions(self.db) if study == "two-takes"]
+        self.assertEqual(hashes, ["1", "2"])
+        trials = pd.DataFrame({"study": ["two-takes"] * 2, "protocol_hash": hashes, "exposure_ms": [5, 40]})
+        lines = [line for study, line in scenes.video_scene_lines(self.db, trials, None,
+                                                                  [os.path.join(self.tmp, "study")])
+                 if study == "two-takes"]
+        self.assertEqual(len(lines), 2, lines)
+        self.assertIn(f"2 takes in this record's protocol versions; version ({hashes[0]}): a tracked video: take "
+                      "a/take.avi", lines[0])
+        self.assertIn("exposure 5 ms", lines[0])
+        self.assertNotIn("40 ms", lines[0])
+        self.assertIn("take b/take.avi", lines[1])
+        self.assertIn("exposure 40 ms", lines[1])
+        self.assertIn("the take's frames: not determined", lines[1])
+
     def test_a_track_folder_found_nowhere_is_not_determined(self):
         lines = scenes.video_scene_lines(self.db, self.trials, None, [os.path.join(self.tmp, "elsewhere")])
         self.assertIn("the take's frames: not determined", lines[0][1])

@@ -93,8 +93,9 @@ void AddArCommand(CLI::App& app) {
       ->capture_default_str()->check(CLI::IsMember({"disc", "gaussian"}));
   cmd->add_option("--exposure-ms", args->exposure_ms,
                   "the camera's exposure; objects are streaked by their image velocity over it (0: no motion blur).\n"
-                  "Default: half the frame interval of a video that states its frame rate (a 180-degree shutter); 0\n"
-                  "for an image sequence, whose rate is not known")
+                  "Default: the camera's exposure_ms (camera.json, as tracked: EXIF ExposureTime from `blurcue\n"
+                  "camera`, 0 for a synth-take); when it is unknown, half the frame interval of a video that states\n"
+                  "its frame rate (a 180-degree shutter), and 0 for an image sequence, whose rate is not known")
       ->check(FiniteRange(0, 1000, "ms"));
   cmd->add_option("--frames", args->frames_dir, "also write each frame as frame-NNNN.png into this folder");
   cmd->add_flag("--quiet", args->quiet, "print only errors");
@@ -142,11 +143,16 @@ void AddArCommand(CLI::App& app) {
     const double take_fps = take.FramesPerSecond();
     track::FrameSource source(args->input, take_fps > 0 ? take_fps : 30);
     std::string exposure_note = "given";
-    if (args->exposure_ms < 0) {
+    if (args->exposure_ms < 0 && camera.exposure_ms) {
+      blur.exposure_ms = *camera.exposure_ms;
+      exposure_note = "the camera's exposure_ms, as tracked";
+    } else if (args->exposure_ms < 0) {
       const bool rate_known = source.is_video() && source.fps() > 0;
       blur.exposure_ms = rate_known ? 1000 / source.fps() / 2 : 0;
-      exposure_note = rate_known ? "half the frame interval of the video's " + Num(source.fps()) + " fps"
-                                 : "no motion blur: an image sequence states no frame rate (give --exposure-ms)";
+      exposure_note = rate_known ? "the camera's exposure is unknown: half the frame interval of the video's " +
+                                       Num(source.fps()) + " fps (give --exposure-ms)"
+                                 : "no motion blur: the camera's exposure is unknown and an image sequence states no "
+                                   "frame rate (give --exposure-ms)";
     } else {
       blur.exposure_ms = args->exposure_ms;
     }

@@ -193,6 +193,12 @@ void AddInitCommand(CLI::App& app) {
       Step("calibration (calibrate)", {"calibrate", photo.string(), "--camera", (scene / "camera.json").string(),
                                        "--out", (dir / "calib.json").string()}, dir);
     WriteFileAtomically(dir / "protocol.json", text);
+    // The schema its "$schema" names, beside it: an editor that reads it completes and checks the fields as typed.
+    {
+      std::error_code ec;
+      fs::copy_file(DataDir().path / "protocols" / "protocol.schema.json", dir / "protocol.schema.json", ec);
+      if (ec) throw InputError(dir.string(), "cannot copy protocol.schema.json into it: " + ec.message());
+    }
     if (pictures)
       Step("the real pictures at each distance (synth-pictures)",
            {"synth-pictures", "--protocol", (dir / "protocol.json").string(), "--out", (dir / "pictures").string()},

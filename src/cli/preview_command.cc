@@ -123,7 +123,7 @@ void AddPreviewCommand(CLI::App& app) {
       "(each screen px one sheet px, or --zoom sheet px, never resampled), so a blur of 1-2 screen px is seen as a\n"
       "participant sees it; a frame no wider than --tile-width is shown whole at 1:1. Labels are wrapped to the tile.\n"
       "Example: blurcue preview protocols/test1-static-grids.json --out results/preview-test1.png");
-  cmd->add_option("protocol", args->protocol, "the protocol JSON file")->required()->check(CLI::ExistingFile);
+  cmd->add_option("protocol", args->protocol, "the protocol JSON file")->required();  // missing: exit 3, as validate
   cmd->add_option("--out", args->out, "the contact sheet PNG")->required();
   cmd->add_option("--participant", args->participant, "whose trial list (by_participant sides)")
       ->capture_default_str();
@@ -209,7 +209,7 @@ void AddPreviewCommand(CLI::App& app) {
           stimulus::ApplyLevel(procedure, t, level, prepared.presentation, &s);
           first = " (" + protocol::ToString(procedure.kind) + ": " + protocol::ToString(procedure.variable) + " " + Json(level).dump() +
                   " on the " + t.test_side + " at first)";
-          stimulus::PlanOnScreen(p, *scene, prepared.presentation, &s);
+          session::PlanLeveled(prepared, t, &s);
         }
         const std::string levels = session::LevelsLabel(t);
         // Each side's radius as the camera made it (photo px) and as the screen shows it (screen px, arcmin): the

@@ -57,7 +57,10 @@ void AddSynthTakeCommand(CLI::App& app) {
       ->capture_default_str()->check(FinitePositive(90, "degrees"));
   cmd->add_option("--noise", o.scene.noise_std, "sensor noise std in linear units, e.g. 0.004")->capture_default_str()
       ->check(FiniteRange(0, 1, "linear units"));
-  cmd->add_option("--supersample", o.scene.supersample, "sub-pixels per pixel side for shading and blur")
+  cmd->add_option("--supersample", o.scene.supersample,
+                  "sub-pixels per pixel side for shading and blur. 1 point-samples each pixel: no pixel aperture\n"
+                  "and aliased edges, so blur measured on the frames reads off their truth near focus; 2 or more\n"
+                  "for a ground truth")
       ->capture_default_str()->transform(IntRange(1, 16));
   cmd->add_option("--seed", args->seed, "seed of the texture and noise")->capture_default_str()
       ->transform(SeedValidator());

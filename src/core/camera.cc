@@ -108,9 +108,12 @@ void Camera::Validate(const std::string& where) const {
   // Square pixels: the two pitches may differ by rounding of the resolution, not by more.
   const double pitch_w = sensor_width_mm / image_width_px, pitch_h = sensor_height_mm / image_height_px;
   if (std::abs(pitch_w - pitch_h) > 0.02 * pitch_w)
-    throw InputError(where + "/sensor_height_mm", "gives a pixel pitch of " + Num(pitch_h) +
-                                                     " mm, but the width gives " + Num(pitch_w) +
-                                                     " mm (non-square pixels are not supported)");
+    throw InputError(where + "/sensor_width_mm, /sensor_height_mm, /image_width_px, /image_height_px",
+                     "a " + Num(sensor_width_mm) + " x " + Num(sensor_height_mm) + " mm sensor making " +
+                         std::to_string(image_width_px) + " x " + std::to_string(image_height_px) + " px images has pixels " +
+                         Num(pitch_w) + " mm wide and " + Num(pitch_h) +
+                         " mm tall: one of the four is wrong (non-square pixels are not supported)");
+  if (exposure_ms) RequireIn(where, "exposure_ms", *exposure_ms, CameraLimits::kExposureMs, "ms");
   if (camera_matrix) {
     const auto& k = *camera_matrix;
     for (int i = 0; i < 9; ++i)
@@ -146,7 +149,8 @@ Camera CameraFromJson(const Json& json, const std::string& where) {
   c.image_width_px = ImageSidePx(json, "image_width_px", where);
   c.image_height_px = ImageSidePx(json, "image_height_px", where);
   static const char* kKnown[] = {"focal_length_mm", "f_number", "sensor_width_mm", "sensor_height_mm",
-                                 "image_width_px", "image_height_px", "camera_matrix", "dist_coeffs", "name"};
+                                 "image_width_px", "image_height_px", "camera_matrix", "dist_coeffs", "exposure_ms",
+                                 "name"};
   for (auto it = json.begin(); it != json.end(); ++it) {
     bool known = false;
     for (const char* k : kKnown) known = known || it.key() == k;
@@ -169,6 +173,7 @@ Camera CameraFromJson(const Json& json, const std::string& where) {
     if (!ok) throw InputError(where + "/camera_matrix", "must be a 3x3 array of numbers, got " + m.dump());
     c.camera_matrix = k;
   }
+  if (json.contains("exposure_ms")) c.exposure_ms = RequireNumber(json, "exposure_ms", where);
   if (json.contains("dist_coeffs")) {
     const Json& d = json["dist_coeffs"];
     if (!d.is_array()) throw InputError(where + "/dist_coeffs", "must be an array of numbers, got " + d.dump());
@@ -191,6 +196,7 @@ Json CameraToJson(const Camera& c) {
     j["camera_matrix"] = {{k[0], k[1], k[2]}, {k[3], k[4], k[5]}, {k[6], k[7], k[8]}};
   }
   if (!c.dist_coeffs.empty()) j["dist_coeffs"] = c.dist_coeffs;
+  if (c.exposure_ms) j["exposure_ms"] = *c.exposure_ms;
   return j;
 }
 

@@ -19,6 +19,7 @@ struct CameraLimits {
   static constexpr double kSensorMm[2] = {0.5, 500};           // a phone sensor's side .. large format
   static constexpr double kFocalLengthPx[2] = {1, 1e6};        // camera_matrix fx, fy
   static constexpr double kDistCoeff = 1e4;                    // |each dist_coeffs value|
+  static constexpr double kExposureMs[2] = {0, 60000};         // an instantaneous shutter .. a minute
 };
 
 struct Camera {
@@ -31,6 +32,9 @@ struct Camera {
   // Row-major 3x3 intrinsics in pixels when a lens calibration exists; otherwise derived from the optics.
   std::optional<std::array<double, 9>> camera_matrix;
   std::vector<double> dist_coeffs;  // OpenCV order (k1 k2 p1 p2 [k3 ...]); empty = none
+  // The shutter time each image was exposed over, ms: what streaks a moving object's image (EXIF ExposureTime; 0 for
+  // an image synthesised at one instant). Empty when unknown.
+  std::optional<double> exposure_ms;
 
   // mm per pixel on the sensor (the thesis's sigma): sensor width / image width.
   double PixelPitchMm() const { return sensor_width_mm / image_width_px; }

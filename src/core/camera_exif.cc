@@ -180,6 +180,11 @@ ExifCamera CameraFromExif(const std::filesystem::path& photo, std::optional<std:
   if (turned) out.notes.push_back("the photo is stored turned (EXIF Orientation " + Num(*orientation) +
                                   "): the sensor's sides are swapped to match the image calibrate reads");
 
+  // Seconds; what streaks a moving object in the photo (camera.json's exposure_ms). 0 or absent: unknown.
+  if (const std::optional<double> t = number(EXIF_TAG_EXPOSURE_TIME); t && *t > 0) {
+    if (*t * 1000 <= CameraLimits::kExposureMs[1]) c.exposure_ms = *t * 1000;
+    else out.notes.push_back(exif.Name(EXIF_TAG_EXPOSURE_TIME) + " " + Num(*t) + " s is not kept (longer than a minute)");
+  }
   if (const std::optional<double> d = number(EXIF_TAG_SUBJECT_DISTANCE); d && *d > 0) {
     // Metres; 0 is "unknown", 0xFFFFFFFF/1 "infinity".
     if (*d < 4e6) out.focus_distance_mm = *d * 1000;

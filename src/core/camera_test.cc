@@ -62,6 +62,29 @@ TEST(Camera, RejectsZeroSensorAndNonSquarePixels) {
   j = ThesisJson();
   j["sensor_height_mm"] = 20;
   EXPECT_NE(ErrorOf(j).find("non-square"), std::string::npos);
+  // An image width changed alone: the message names the four numbers that decide the pitch, not one of them.
+  j = ThesisJson();
+  j["image_width_px"] = 4000;
+  const std::string e = ErrorOf(j);
+  EXPECT_NE(e.find("/image_width_px"), std::string::npos) << e;
+  EXPECT_NE(e.find("4000 x 3056 px"), std::string::npos) << e;
+}
+
+TEST(Camera, ExposureIsOptionalCheckedAndKept) {
+  Json j = ThesisJson();
+  EXPECT_FALSE(CameraFromJson(j, "cam.json: ").exposure_ms.has_value());
+  EXPECT_FALSE(CameraToJson(CameraFromJson(j, "cam.json: ")).contains("exposure_ms"));
+  j["exposure_ms"] = 0;  // a synthesised take: an instantaneous shutter
+  EXPECT_EQ(CameraFromJson(j, "cam.json: ").exposure_ms, 0.0);
+  j["exposure_ms"] = 16.6667;
+  EXPECT_DOUBLE_EQ(CameraToJson(CameraFromJson(j, "cam.json: "))["exposure_ms"].get<double>(), 16.6667);
+  j["exposure_ms"] = -1;
+  EXPECT_NE(ErrorOf(j).find("/exposure_ms: must be in [0, 60000] ms, got -1"), std::string::npos) << ErrorOf(j);
+  j["exposure_ms"] = "1/60";
+  EXPECT_NE(ErrorOf(j).find("/exposure_ms"), std::string::npos);
+  j.erase("exposure_ms");
+  j["exposure"] = 10;
+  EXPECT_NE(ErrorOf(j).find("did you mean exposure_ms?"), std::string::npos) << ErrorOf(j);
 }
 
 TEST(Camera, ResizedScalesIntrinsicsNotOptics) {

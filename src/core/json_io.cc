@@ -67,17 +67,17 @@ struct Fd {
 
 }  // namespace
 
-std::string ReadTextFile(const std::filesystem::path& path) {
+std::string ReadTextFile(const std::filesystem::path& path, const std::string& what) {
   const std::string name = path.string();
-  // A JSON file is a regular file: a folder, a device (/dev/zero never ends), a FIFO (blocks until a writer
+  // A text file is a regular file: a folder, a device (/dev/zero never ends), a FIFO (blocks until a writer
   // comes) or a socket is refused before it is opened.
   struct stat st;
   if (::stat(name.c_str(), &st) != 0) throw InputError(name, std::string("cannot open file: ") + std::strerror(errno));
   auto check_kind = [&](const struct stat& s) {
-    if (S_ISDIR(s.st_mode)) throw InputError(name, "is a folder, not a JSON file");
-    if (!S_ISREG(s.st_mode)) throw InputError(name, "is not a regular file (a device, FIFO or socket), not a JSON file");
+    if (S_ISDIR(s.st_mode)) throw InputError(name, "is a folder, not " + what);
+    if (!S_ISREG(s.st_mode)) throw InputError(name, "is not a regular file (a device, FIFO or socket), not " + what);
     if (s.st_size > static_cast<off_t>(kMaxJsonBytes))
-      throw InputError(name, "is " + std::to_string(s.st_size) + " bytes; a JSON file may have at most 16 MiB");
+      throw InputError(name, "is " + std::to_string(s.st_size) + " bytes; " + what + " may have at most 16 MiB");
   };
   check_kind(st);
   const Fd in{::open(name.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC)};
@@ -93,7 +93,7 @@ std::string ReadTextFile(const std::filesystem::path& path) {
     if (n < 0) throw InputError(name, std::string("cannot read file: ") + std::strerror(errno));
     if (n == 0) break;
     text.append(buffer, static_cast<size_t>(n));
-    if (text.size() > kMaxJsonBytes) throw InputError(name, "is larger than 16 MiB, the most a JSON file may have");
+    if (text.size() > kMaxJsonBytes) throw InputError(name, "is larger than 16 MiB, the most " + what + " may have");
   }
   return text;
 }

@@ -20,7 +20,8 @@ inline constexpr int kMaxJsonDepth = 64;
 // object (named by its JSON pointer).
 Json ReadJsonFile(const std::filesystem::path& path);
 // The two halves of ReadJsonFile: the checked read of the text, and its parse (`name` names it in messages).
-std::string ReadTextFile(const std::filesystem::path& path);
+// `what` names the kind of file in the messages ("a folder, not a JSON file", "a track.csv may have at most 16 MiB").
+std::string ReadTextFile(const std::filesystem::path& path, const std::string& what = "a JSON file");
 Json ParseJson(const std::string& text, const std::string& name);
 
 // Writes atomically (core/atomic_file.h) so a crash never leaves half a file; 2-space indent.

@@ -230,7 +230,7 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
   }
   std::string csv;
   try {
-    csv = ReadTextFile(file);
+    csv = ReadTextFile(file, "a conditions table");
   } catch (const std::exception& e) {
     Problem(ptr, e.what(), Json(*text));
     return {};

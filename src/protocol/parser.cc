@@ -154,12 +154,7 @@ bool Parser::Object(const Json& v, const std::string& ptr, const std::vector<std
   }
   for (const auto& [key, value] : v.items()) {
     if (std::find(known.begin(), known.end(), key) != known.end()) continue;
-    std::string hint;
-    size_t best = 3;
-    for (const auto& k : known) {
-      const size_t d = EditDistance(key, k);
-      if (d < best) best = d, hint = k;
-    }
+    const std::string hint = NearestName(key, known);  // a slip or an abbreviation ("exposure" for exposure_ms)
     std::string list;
     for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
     Problem(ptr + "/" + Escape(key),

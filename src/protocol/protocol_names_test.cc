@@ -274,6 +274,8 @@ TEST(ProtocolValidate, BlockTitlePromptAndTimingAreChecked) {
   j = Valid();
   j["blocks"][0]["timing"] = {{"fixaton_ms", 200}};
   EXPECT_EQ(OnlyProblem(j), Line("/blocks/0/timing/fixaton_ms: unknown key (did you mean \"fixation_ms\"?), got 200"));
+  j["blocks"][0]["timing"] = {{"fixation", 200}};  // a key without its unit: the one it abbreviates
+  EXPECT_EQ(OnlyProblem(j), Line("/blocks/0/timing/fixation: unknown key (did you mean \"fixation_ms\"?), got 200"));
   // A field checked against the block it is given for: this block has no correct answer to give feedback on.
   j["blocks"][0]["timing"] = {{"feedback_ms", 500}};
   EXPECT_EQ(OnlyProblem(j), Line("/blocks/0/timing/feedback_ms: needs a correct answer: a block with a procedure or a "

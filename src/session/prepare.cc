@@ -64,6 +64,13 @@ TrialScene Describe(const PreparedSession& s, const protocol::Trial& trial) {
 
 }  // namespace
 
+void PlanLeveled(const PreparedSession& s, const protocol::Trial& trial, TrialScene* scene) {
+  if (s.images.take)
+    stimulus::PlanVideoOnScreen(s.protocol, *s.images.take, trial, s.presentation, scene);
+  else
+    PlanOnScreen(s.protocol, *s.scene, s.presentation, scene);
+}
+
 std::string SceneKey(const protocol::Trial& t) {
   std::string key = t.block + '\n' + std::to_string(int(t.task)) + ' ' + std::to_string(t.practice) + ' ' +
                     std::to_string(t.round) + ' ' + std::to_string(t.swapped) + ' ' + std::to_string(t.cell) + ' ' +

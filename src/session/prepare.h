@@ -42,6 +42,10 @@ PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const
                                std::optional<uint64_t> seed, const std::filesystem::path& display_profile = {},
                                const std::string& group = "");
 
+// PlanOnScreen for a trial of this session whose radii a procedure's level changed (ApplyLevel): on the photo, or on
+// every frame of the take the trial shows (stimulus::PlanVideoOnScreen). Needs a scene (prepared.scene).
+void PlanLeveled(const PreparedSession& prepared, const protocol::Trial& trial, stimulus::TrialScene* scene);
+
 // Scenes already worked out, by what a trial shows (SceneKey) and a procedure's level: the participants of one study
 // repeat the same trials in other orders, so `blurcue plan` describes and plans each once. One per thread.
 struct SceneCache {

@@ -10,7 +10,6 @@
 namespace blurcue::session {
 
 using stimulus::ApplyLevel;
-using stimulus::PlanOnScreen;
 using stimulus::Presentation;
 using stimulus::TrialScene;
 
@@ -86,7 +85,7 @@ TrialScene SessionLogic::SceneOf(const protocol::Trial& trial, double* level) {
     if (cache_)
       if (const auto it = cache_->leveled.find(key); it != cache_->leveled.end()) return it->second;
     ApplyLevel(ProcedureOf(prepared_.protocol, trial), trial, *level, prepared_.presentation, &scene);
-    PlanOnScreen(prepared_.protocol, *prepared_.scene, prepared_.presentation, &scene);
+    PlanLeveled(prepared_, trial, &scene);
     if (cache_) cache_->leveled.emplace(key, scene);
   }
   return scene;

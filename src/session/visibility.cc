@@ -12,7 +12,6 @@
 namespace blurcue::session {
 
 using stimulus::ApplyLevel;
-using stimulus::PlanOnScreen;
 using stimulus::Presentation;
 using stimulus::TrialScene;
 
@@ -65,7 +64,7 @@ std::vector<PairVisibility> PairVisibilities(const PreparedSession& prepared, co
       const protocol::Procedure& procedure = *protocol::BlockOf(p, t)->procedure;  // t.cell >= 0: it has one
       const double first = adaptive.Level(t);
       ApplyLevel(procedure, t, first, prepared.presentation, &s);
-      PlanOnScreen(p, *prepared.scene, prepared.presentation, &s);
+      PlanLeveled(prepared, t, &s);
       at += (at.empty() ? "" : ", ") + std::string("the first ") + protocol::ToString(procedure.variable) + " " + Json(first).dump();
     }
     PairVisibility pair;

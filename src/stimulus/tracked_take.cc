@@ -134,7 +134,7 @@ TrackedTake LoadTrackedTake(const std::filesystem::path& dir) {
     throw InputError(dir.string(), "is a file: give the folder that holds track.csv (the --out of blurcue track)");
   if (!std::filesystem::is_directory(dir)) throw InputError(dir.string(), "no such folder (the --out of blurcue track)");
   if (!std::filesystem::exists(csv_path)) throw InputError(file, "does not exist: is this a folder blurcue track wrote?");
-  const CsvText csv = ParseCsv(ReadTextFile(csv_path), kMaxFrames + 1);
+  const CsvText csv = ParseCsv(ReadTextFile(csv_path, "a track.csv"), kMaxFrames + 1);
   if (!csv.problems.empty())
     throw InputError(file + ": line " + std::to_string(csv.problems.front().line), csv.problems.front().message);
   if (csv.records.empty()) throw InputError(file, "is empty (no header)");

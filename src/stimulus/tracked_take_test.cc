@@ -1,6 +1,9 @@
 // Objects placed in a tracked take, against hand-worked values: a camera translating sideways at a known speed.
 #include "stimulus/tracked_take.h"
 
+#include <filesystem>
+#include <fstream>
+
 #include <gtest/gtest.h>
 
 #include "core/error.h"
@@ -81,6 +84,25 @@ TEST(TrackedTake, ObjectsFileKeysAreCheckedWithADidYouMean) {
               std::string::npos)
         << e.what();
   }
+}
+
+// A track.csv over the 16 MiB any text input may have is refused in a track's words, not a JSON file's.
+TEST(TrackedTake, ATrackCsvTooLargeIsSaidToBeOne) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "tracked-take-too-large";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "track.csv") << "frame,time_s,status\n";
+  std::filesystem::resize_file(dir / "track.csv", (size_t(16) << 20) + 1);  // sparse: no 16 MiB written
+  try {
+    LoadTrackedTake(dir);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    EXPECT_NE(std::string(e.what()).find("track.csv: is 16777217 bytes; a track.csv may have at most 16 MiB"),
+              std::string::npos)
+        << e.what();
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -121,6 +121,39 @@ double TakeWindowS(const protocol::Protocol& protocol, const VideoTake& take, co
   return s;
 }
 
+namespace {
+
+// The frames with a pose a trial shows, each with its time on screen in the window: frame k plays from
+// (k - first) / fps; a lost one and the time past the take's end hold the frame before.
+std::map<int, double> ShownFrames(const protocol::Protocol& protocol, const VideoTake& take,
+                                  const protocol::Trial& trial, const TrialScene& scene) {
+  const double window = TakeWindowS(protocol, take, trial, scene);
+  std::map<int, double> weight;
+  const int n = int(take.take().frames.size());
+  for (int k = take.first_posed(); k < n; ++k) {
+    const double from = (k - take.first_posed()) / take.fps();
+    if (from >= window) break;
+    const double to = k == n - 1 ? window : std::min(window, (k + 1 - take.first_posed()) / take.fps());
+    weight[take.FrameAt(from + 0.5 / take.fps()).posed] += to - from;
+  }
+  return weight;
+}
+
+}  // namespace
+
+void PlanVideoOnScreen(const protocol::Protocol& protocol, const VideoTake& take, const protocol::Trial& trial,
+                       const Presentation& presentation, TrialScene* scene) {
+  const TrialScene given = *scene;
+  PlanOnScreen(protocol, take.Calib(take.first_posed()), presentation, scene);
+  for (const auto& shown : ShownFrames(protocol, take, trial, given)) {
+    if (shown.first == take.first_posed()) continue;
+    TrialScene t = given;
+    PlanOnScreen(protocol, take.Calib(shown.first), presentation, &t);
+    scene->r_span_screen_px = std::max(scene->r_span_screen_px, t.r_span_screen_px);
+    scene->per_pixel = scene->per_pixel || t.per_pixel;
+  }
+}
+
 TrialScene DescribeVideoTrial(const protocol::Protocol& protocol, const VideoTake& take, const protocol::Trial& trial,
                               const Presentation& presentation) {
   auto describe = [&](int posed) {
@@ -134,17 +167,8 @@ TrialScene DescribeVideoTrial(const protocol::Protocol& protocol, const VideoTak
     }
   };
   TrialScene scene = describe(take.first_posed());
-  // Each frame with a pose, weighted by its time on screen in the window: frame k plays from (k - first) / fps, a
-  // lost one and the time past the take's end hold the frame before.
-  const double window = TakeWindowS(protocol, take, trial, scene);
-  std::map<int, double> weight;
-  const int n = int(take.take().frames.size());
-  for (int k = take.first_posed(); k < n; ++k) {
-    const double from = (k - take.first_posed()) / take.fps();
-    if (from >= window) break;
-    const double to = k == n - 1 ? window : std::min(window, (k + 1 - take.first_posed()) / take.fps());
-    weight[take.FrameAt(from + 0.5 / take.fps()).posed] += to - from;
-  }
+  // Each frame with a pose, weighted by its time on screen in the window.
+  const std::map<int, double> weight = ShownFrames(protocol, take, trial, scene);
   double total = 0;
   for (const auto& [posed, w] : weight) total += w;
   if (!(total > 0)) return scene;

@@ -67,6 +67,12 @@ std::array<std::optional<scene::BlurredObject>, 2> VideoObjectsAt(const protocol
 TrialScene DescribeVideoTrial(const protocol::Protocol& protocol, const VideoTake& take, const protocol::Trial& trial,
                               const Presentation& presentation);
 
+// PlanOnScreen for a trial on video whose radii a procedure's level has changed (ApplyLevel): planned on every frame
+// with a pose the trial shows, as DescribeVideoTrial plans it (the per-pixel plan where any frame asks for it, the
+// widest depth span); what it shows first is the first frame's.
+void PlanVideoOnScreen(const protocol::Protocol& protocol, const VideoTake& take, const protocol::Trial& trial,
+                       const Presentation& presentation, TrialScene* scene);
+
 // The seconds of a trial over which its radii are averaged: the stimulus's time (timing.stimulus_ms, or all the
 // intervals), or for one shown until the answer the take's time as it plays once (from its first frame with a pose
 // to the end of its last frame), or a rolling ball's run if longer, at most the deadline.

@@ -279,14 +279,21 @@ Json OptionsToJson(const SceneOptions& o) {
 
 }  // namespace
 
-Scene RenderScene(const SceneOptions& o) {
+namespace {
+
+// What RenderScene checks before it renders: the options, the canvas behind a distorted photo, the whole board in view.
+struct SceneGeometry {
+  Pose pose;
+  detail::IdealCanvas canvas;
+};
+
+SceneGeometry CheckedGeometry(const SceneOptions& o) {
   ValidateOptions(o);
   const Board& board = o.board;
   const Camera& cam = o.camera;
   const int W = cam.image_width_px, H = cam.image_height_px, ss = o.supersample;
   const std::array<double, 9> K = cam.Intrinsics();
   const Pose pose = PlaceBoard(o);
-  const optics::Lens lens = optics::Lens::FromCamera(cam);
   // With dist_coeffs the ideal (pinhole) view is rendered and blurred on a canvas covering every ray the photo sees,
   // then warped onto the photo's pixels (scene_distort.h); without, the canvas is the photo.
   const LensDistortion distortion(cam);
@@ -323,6 +330,24 @@ Scene RenderScene(const SceneOptions& o) {
       }
     }
   }
+  return {pose, canvas};
+}
+
+}  // namespace
+
+void CheckSceneOptions(const SceneOptions& options) { CheckedGeometry(options); }
+
+Scene RenderScene(const SceneOptions& o) {
+  const SceneGeometry geometry = CheckedGeometry(o);
+  const Board& board = o.board;
+  const Camera& cam = o.camera;
+  const int W = cam.image_width_px, H = cam.image_height_px, ss = o.supersample;
+  const std::array<double, 9> K = cam.Intrinsics();
+  const Pose& pose = geometry.pose;
+  const optics::Lens lens = optics::Lens::FromCamera(cam);
+  const LensDistortion distortion(cam);
+  const detail::IdealCanvas& canvas = geometry.canvas;
+  const int Wi = canvas.width, Hi = canvas.height;
   const double edge1_u = (pose.R * cv::Vec3d(board.WidthMm() / 2, 0, 0) + pose.t)[2];
   const double focus = std::isnan(o.focus_mm) ? edge1_u : o.focus_mm;
 

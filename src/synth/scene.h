@@ -76,6 +76,9 @@ struct Scene {
 
 // Throws Error(kInput) for impossible options (board not in view, focus <= f, ...), naming the option.
 Scene RenderScene(const SceneOptions& options);
+// Throws the Error(kInput) RenderScene would throw for these options (an option out of range, a board not wholly in
+// view), without rendering: a take checks every frame's view before it writes its first frame.
+void CheckSceneOptions(const SceneOptions& options);
 
 // Writes DIR/scene.png, DIR/scene-no-board.png, DIR/camera.json, DIR/truth.json.
 void WriteScene(const Scene& scene, const std::filesystem::path& dir);

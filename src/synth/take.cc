@@ -65,6 +65,7 @@ TakeFrame RenderTakeFrame(const TakeOptions& o, int index) {
 TakeFiles WriteTake(const TakeOptions& o, const std::filesystem::path& dir,
                     const std::function<void(const std::string&)>& progress) {
   ValidateTake(o);
+  for (int i = 0; i < o.frames; ++i) CheckSceneOptions(FrameOptions(o, i));  // nothing written for a path out of view
   std::filesystem::create_directories(dir);
   TakeFiles files;
   media::VideoWriter video;
@@ -74,7 +75,9 @@ TakeFiles WriteTake(const TakeOptions& o, const std::filesystem::path& dir,
     WriteImage(dir / TakeFrameName(i), f.scene.image);
     WriteJsonFile(dir / TakeTruthName(i), f.scene.truth);
     if (i == 0) {
-      WriteJsonFile(dir / "camera.json", CameraToJson(f.scene.camera));
+      Camera camera = f.scene.camera;
+      camera.exposure_ms = 0;  // each frame is rendered at one pose: an instantaneous shutter, no streak in the take
+      WriteJsonFile(dir / "camera.json", CameraToJson(camera));
       if (const char* codec = OpenLosslessVideo(video, dir / "take.avi", o.fps, f.scene.image.size())) {
         files.video = "take.avi";
         files.video_codec = codec;

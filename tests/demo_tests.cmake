@@ -1,0 +1,7 @@
+# The main job as a test: scripts/test.sh builds, then ctest runs scripts/demo.sh (already built: BLURCUE_BUILT=1)
+# beside the other tests rather than before them - the demo is one process at a time, so on two cores it shares the
+# machine with the tests instead of leaving a core idle for its 4 minutes. It writes only results/demo and
+# results/bench, which no other test reads or writes.
+add_test(NAME demo COMMAND bash ${PROJECT_SOURCE_DIR}/scripts/demo.sh WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+set_tests_properties(demo PROPERTIES ENVIRONMENT "BLURCUE_BUILT=1" TIMEOUT 1500 LABELS "slow;demo")
+set_test_costs(demo 400)
