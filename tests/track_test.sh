@@ -16,10 +16,11 @@ done
 [ -f "$W/take/camera.json" ] && [ -f "$W/take/take.json" ] || fail "synth-take: camera.json / take.json missing"
 # Its camera says how the frames were exposed: each at one instant (0 ms), what `ar` defaults to.
 grep -q '"exposure_ms": 0' "$W/take/camera.json" || fail "synth-take: camera.json lacks exposure_ms 0"
-# A path whose last frame has the board out of view: refused before any frame is written (exit 3, one line).
+# A path along which the board leaves the view: refused before any frame is written (exit 2 naming the options,
+# one line).
 "$BC" synth-take --out "$W/take-out-of-view" --frames 6 --supersample 2 --to-u-mm 40 --quiet 2> "$W/out-of-view.err"
 code=$?
-[ $code = 3 ] && [ "$(wc -l < "$W/out-of-view.err")" = 1 ] && grep -q "board not fully in view" "$W/out-of-view.err" \
+[ $code = 2 ] && [ "$(wc -l < "$W/out-of-view.err")" = 1 ] && grep -q "^blurcue: --from-u-mm/--to-u-mm: board not fully in view" "$W/out-of-view.err" \
   || fail "a path out of view: exit $code $(cat "$W/out-of-view.err")"
 [ ! -e "$W/take-out-of-view/frame-0000.png" ] || fail "a path out of view: frame 0 written before the refusal"
 
