@@ -69,6 +69,19 @@ PYEOF
   2> "$W/default-rate.err" || fail "ar with defaults, exposure unknown: $(cat "$W/default-rate.err")"
 grep -q "exposure 16.6667 ms (the camera's exposure is unknown: half the frame interval of the video's 30 fps" \
   "$W/default-rate.err" || fail "default exposure from the rate: $(cat "$W/default-rate.err")"
+# A camera whose exposure is longer than a frame of the take (a photo's camera.json, 500 ms): refused, not streaked.
+rm -rf "$W/track-long" && cp -r "$W/track" "$W/track-long"
+$PY - "$W/track-long" <<'PYEOF'
+import glob, json, sys
+for path in glob.glob(sys.argv[1] + "/calib-*.json"):
+    calib = json.load(open(path))
+    calib["camera"]["exposure_ms"] = 500
+    json.dump(calib, open(path, "w"))
+PYEOF
+"$BC" ar "$W/take/take.avi" --track "$W/track-long" --ball 50,125 --out "$W/long.avi" > /dev/null 2> "$W/long.err"
+code=$?
+[ $code = 3 ] && grep -q "track-long: the camera's exposure_ms: is 500 ms, longer than a frame of the take (33.3333 ms" \
+  "$W/long.err" || fail "a camera exposure longer than a frame: exit $code $(cat "$W/long.err")"
 
 # Truncated input: exit 3, one line naming the file, and the frames before it kept (video and CSV).
 size=$(stat -c %s "$W/take/take.avi")

@@ -116,6 +116,42 @@ report)
   grep -q "4 frames at 30 fps" "$index" || fail "the take's frames: $(grep -o 'scene: [^<]*' "$index")"
   grep -q "exposure 0 ms (no motion blur)" "$index" || fail "the exposure: $(grep -o 'scene: [^<]*' "$index")"
   echo "ok: the report analyses video-ball-depth and describes its scene: $(grep -o 'scene: [^<;]*' "$index")" ;;
+procedure)
+  # A staircase on the take (the blur gain one ball needs to look more blurred, at rest at edge 6; both sides fitted):
+  # each trial's test side is (1 + level) x its reference, the trial's radii being the take's average over the frames
+  # it shows (worked here from trials.csv: the level, the test side and the two radii), and the staircase moves.
+  $PY - "$PROTOCOL" "$W/staircase.json" <<'PYEOF' || fail "could not write the staircase protocol"
+import json, sys
+p = json.load(open(sys.argv[1]))
+p["name"] = "video-staircase"
+for key in ("factors", "counterbalance", "practice", "repetitions"):
+    p.pop(key, None)
+p["responses"]["cant_tell"] = None
+p["blocks"] = [{"name": "staircase", "factors": {"edge": [6], "pattern": [{"id": 1, "left": "fitted", "right": "fitted"}]},
+                "procedure": {"type": "staircase", "variable": "relative_difference", "reference": "fitted",
+                              "trials": 12, "start": 1.0, "min": 0.02, "max": 3, "up": 1, "down": 2,
+                              "steps": [0.4, 0.2, 0.1]}}]
+json.dump(p, open(sys.argv[2], "w"), indent=1)
+PYEOF
+  $BC validate "$W/staircase.json" > "$W/validate" 2>&1 || fail "validate: $(cat "$W/validate")"
+  $BC run "$W/staircase.json" --participant S1 --db "$W/s.sqlite" --observer sim > "$W/out" 2>&1 ||
+    fail "run: $(tail -3 "$W/out")"
+  $BC export --db "$W/s.sqlite" --out "$W/tables" > /dev/null || fail "export"
+  $PY - "$W/tables/trials.csv" <<'PYEOF' || fail "staircase on video"
+import csv, sys
+rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["status"] == "answered"]
+assert len(rows) == 12, len(rows)
+levels = set()
+for r in rows:
+    level = float(r["level"])
+    levels.add(level)
+    test, ref = (r["r_left_px"], r["r_right_px"]) if r["test_side"] == "left" else (r["r_right_px"], r["r_left_px"])
+    ratio = float(test) / float(ref)
+    assert abs(ratio - (1 + level)) < 1e-6 * (1 + level), (r["trial_index"], level, ratio)
+assert len(levels) >= 3, levels
+print(f"12 staircase trials on video, levels {sorted(levels)}: each test side (1 + level) x its reference")
+PYEOF
+  echo "ok: a staircase on video: the test side is (1 + level) x the reference, averaged over the take" ;;
 bad_scene)
   # One problem, exit 3, naming the field: a missing take, a take of another frame size than its track folder's,
   # an unknown key.

@@ -144,6 +144,12 @@ void AddArCommand(CLI::App& app) {
     track::FrameSource source(args->input, take_fps > 0 ? take_fps : 30);
     std::string exposure_note = "given";
     if (args->exposure_ms < 0 && camera.exposure_ms) {
+      // A frame is exposed within its own interval: a longer exposure is a camera.json of a photo, not of this take.
+      if (take_fps > 0 && *camera.exposure_ms > 1000 / take_fps * 1.001)
+        throw InputError(args->track + ": the camera's exposure_ms",
+                         "is " + Num(*camera.exposure_ms) + " ms, longer than a frame of the take (" +
+                             Num(1000 / take_fps) + " ms at " + Num(take_fps) +
+                             " fps): not this take's camera? give --exposure-ms");
       blur.exposure_ms = *camera.exposure_ms;
       exposure_note = "the camera's exposure_ms, as tracked";
     } else if (args->exposure_ms < 0) {

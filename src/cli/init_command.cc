@@ -73,7 +73,9 @@ std::string NextSteps(const std::string& example, const std::string& study, bool
     << "A study folder made by `blurcue init` from the shipped example `" << example << "`.\n\n"
     << "| file | what it is |\n|---|---|\n"
     << "| `protocol.json` | the study: what each trial shows and asks (see `blurcue validate --help` and the protocol "
-       "reference, `protocols/README.md` in blurcue's share folder) |\n";
+       "reference, `protocols/README.md` in blurcue's share folder) |\n"
+    << "| `protocol.schema.json` | the protocol's JSON Schema, which its `$schema` names: an editor that reads it "
+       "completes and checks the fields as you type |\n";
   if (video)
     s << "| `take/` | the video the trials are drawn on (`take.avi`, its frames and `camera.json`; a ground-truth take "
          "made by `blurcue synth-take`: replace it with your own video of the printed board) |\n"
