@@ -3,7 +3,7 @@ folder `blurcue track` wrote for it). One line per study whose scene is a video,
 
   video-ball-depth: a tracked video: take ../results/demo/take/take.avi, track folder ../results/demo/track (as the
   protocol names them); 5 frames at 30 fps (2 found, 3 tracked, 0 lost), one lens model: focus 339.6 mm, ...;
-  exposure 16.7 ms; motion streak on screen ...; frames presented per trial (frames.csv): median 2
+  exposure 16.7 ms; motion streak on screen ...; frames of the take presented per trial (frames.csv): median 2
 
 Reads the record (SQLite: the protocol text of each study's versions), trials.csv (exposure_ms and the motion
 columns, as recorded per trial) and frames.csv (frames per trial). The record keeps a protocol's text, not where the
@@ -131,11 +131,14 @@ def _shown(trials, frames, study, hashes=None):
         if per_trial_streaks:
             parts.append("motion streak on screen, mean over trials: " + ", ".join(per_trial_streaks) + " screen px")
     if f is not None:
-        per_trial = f.groupby(["session_id", "trial_index"]).size()
-        parts.append(f"frames presented per trial (frames.csv): median {per_trial.median():g} "
-                     f"({per_trial.min()}-{per_trial.max()})")
+        # The frames that showed the take: after a timed stimulus the answer screen's frames show none.
+        shown = f[f["take_status"].fillna("").astype(str) != ""] if "take_status" in f else f
+        per_trial = shown.groupby(["session_id", "trial_index"]).size()
+        if len(per_trial):
+            parts.append(f"frames of the take presented per trial (frames.csv): median {per_trial.median():g} "
+                         f"({per_trial.min()}-{per_trial.max()})")
         if "take_status" in f:
-            status = f["take_status"].dropna()
+            status = shown["take_status"].dropna()
             if len(status):
                 held = int((status == "held").sum())
                 parts.append(f"{len(status) - held} of {len(status)} frames at the take frame's own pose, {held} "

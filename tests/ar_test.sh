@@ -69,6 +69,21 @@ PYEOF
   2> "$W/default-rate.err" || fail "ar with defaults, exposure unknown: $(cat "$W/default-rate.err")"
 grep -q "exposure 16.6667 ms (the camera's exposure is unknown: half the frame interval of the video's 30 fps" \
   "$W/default-rate.err" || fail "default exposure from the rate: $(cat "$W/default-rate.err")"
+# An object outside the photo in every frame (a slip of millimetres: 5000 for 50; behind the camera): refused before
+# anything is written, naming the option.
+for ball in 5000,125 87.5,-400; do
+  rm -f "$W/off.avi"
+  "$BC" ar "$W/take/take.avi" --track "$W/track" --ball $ball --out "$W/off.avi" > /dev/null 2> "$W/off.err"
+  code=$?
+  [ $code = 3 ] && [ "$(wc -l < "$W/off.err")" = 1 ] && grep -q "^blurcue: --ball '$ball': ball1 at .* lies outside the photo in every frame" \
+    "$W/off.err" && [ ! -e "$W/off.avi" ] || fail "a ball at $ball, outside every frame: exit $code $(cat "$W/off.err")"
+done
+# An exposure longer than a frame of the take: a usage error (exit 2), nothing drawn for minutes.
+"$BC" ar "$W/take/take.avi" --track "$W/track" --ball 50,125 --exposure-ms 300 --out "$W/long-option.avi" > /dev/null \
+  2> "$W/long-option.err"
+code=$?
+[ $code = 2 ] && grep -q "^blurcue: --exposure-ms 300: longer than a frame of the take (33.33 ms at 30 fps)" \
+  "$W/long-option.err" || fail "--exposure-ms 300: exit $code $(cat "$W/long-option.err")"
 # A camera whose exposure is longer than a frame of the take (a photo's camera.json, 500 ms): refused, not streaked.
 rm -rf "$W/track-long" && cp -r "$W/track" "$W/track-long"
 $PY - "$W/track-long" <<'PYEOF'
@@ -80,7 +95,7 @@ for path in glob.glob(sys.argv[1] + "/calib-*.json"):
 PYEOF
 "$BC" ar "$W/take/take.avi" --track "$W/track-long" --ball 50,125 --out "$W/long.avi" > /dev/null 2> "$W/long.err"
 code=$?
-[ $code = 3 ] && grep -q "track-long: the camera's exposure_ms: is 500 ms, longer than a frame of the take (33.3333 ms" \
+[ $code = 3 ] && grep -q "track-long: the camera.s exposure_ms: is 500 ms, longer than a frame of the take (33.33 ms at 30 fps)" \
   "$W/long.err" || fail "a camera exposure longer than a frame: exit $code $(cat "$W/long.err")"
 
 # Truncated input: exit 3, one line naming the file, and the frames before it kept (video and CSV).

@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """A study on video, frame by frame, against the take's truth (tests/video_study_test.sh, case frames).
 
-usage: video_frames_check.py TAKE_DIR EXPORT_DIR CAPTURE_DIR EXPOSURE_MS
+usage: video_frames_check.py TAKE_DIR EXPORT_DIR CAPTURE_DIR EXPOSURE_MS [STIMULUS_S]
+
+STIMULUS_S: the protocol's timing.stimulus_ms in seconds (absent: shown until the answer, the take as it plays once).
 
 TAKE_DIR is what `blurcue synth-take` wrote (take.json: per-frame time and true pose; truth-NNNN.json: the lens and
 floor applied); EXPORT_DIR what `blurcue export` wrote for a simulated session of protocols/video-ball-depth.json
@@ -16,6 +18,10 @@ floor applied); EXPORT_DIR what `blurcue export` wrote for a simulated session o
   from 3 % below the truth to the larger of 3 % above it and 1 px, a `none` side at most 1 px;
 - the motion streak: the centre's projection at the neighbouring true poses (central difference; one-sided at the
   ends) over their time apart, times the exposure: within max(0.3 px, 5 %).
+- each trial's declared radius (trials.csv) of a fitted side, and each side's declared streak: the truth above
+  averaged over the take's frames, each weighted by its time on screen in the stimulus (frame k from k / fps, the
+  last one held to the stimulus's end): the radius within 3 %, the streak within max(0.3 px, 5 %). Display frames
+  after the stimulus (no take frame: the answer screen) show no ball.
 """
 import csv
 import glob
@@ -27,6 +33,7 @@ import sys
 import numpy as np
 
 take_dir, export_dir, capture_dir, exposure_ms = sys.argv[1], sys.argv[2], sys.argv[3], float(sys.argv[4])
+stimulus_s = float(sys.argv[5]) if len(sys.argv) > 5 else None
 take = json.load(open(os.path.join(take_dir, "take.json")))
 truth = json.load(open(os.path.join(take_dir, "truth-0000.json")))
 fps = take["fps"]
@@ -72,10 +79,16 @@ def rows(name):
 trials = {int(t["trial_index"]): t for t in rows("trials.csv")}
 failures, checked = [], {"r": 0, "none": 0, "motion": 0, "frames": 0, "centre": 0}
 worst = {"r": 0.0, "motion": 0.0, "centre": 0.0}
+checked["after"] = 0
 for fr in rows("frames.csv"):
     t = trials[int(fr["trial_index"])]
     where = f"trial {fr['trial_index']} frame {fr['frame_index']}"
     time_s = float(fr["flip_time_s"])
+    if fr["take_status"] == "":  # after the stimulus: the answer screen, no take frame and no ball
+        checked["after"] += 1
+        if stimulus_s is None or time_s < stimulus_s - 1e-6:
+            failures.append(f"{where}: no take frame at {time_s} s, within the stimulus")
+        continue
     expect = min(len(frames) - 1, int(math.floor(time_s * fps + 1e-6)))
     held = math.floor(time_s * fps + 1e-6) > len(frames) - 1
     if int(fr["take_frame"]) != expect or (fr["take_status"] == "held") != held:
@@ -110,16 +123,30 @@ for fr in rows("frames.csv"):
         if err > tolerance:
             failures.append(f"{where} {side}: streak {m.round(3)} px, truth {want_m.round(3)} px")
 
-# Each trial's declared radius (trials.csv) of a fitted side: the take's true thin lens averaged over the frames the
-# trial shows as the take plays once (each frame for one frame time; until the answer: the whole take).
-checked["declared"], worst["declared"] = 0, 0.0
+# Each trial's declared radius (trials.csv) of a fitted side, and its declared streak: the truth averaged over the
+# take's frames, each weighted by its time on screen while the stimulus is (until the answer: the take plays once).
+window = stimulus_s if stimulus_s is not None else len(frames) / fps
+weights = [max(0.0, (window if k == len(frames) - 1 else min(window, (k + 1) / fps)) - k / fps)
+           for k in range(len(frames))]
+weights = [w / sum(weights) for w in weights]
+scales = [json.load(open(p))["screen_px_per_photo_px"] for p in glob.glob(os.path.join(capture_dir, "trial-*.json"))]
+checked["declared"], worst["declared"], checked["declared_motion"], worst["declared_motion"] = 0, 0.0, 0, 0.0
 for t in trials.values():
     y = (int(t["edge"]) - 1) * square
     for side, section in (("left", 3), ("right", 5)):
+        centre = [(section - 0.5) * square, y, radius_mm]
+        if scales and exposure_ms > 0 and t[f"{side}_source"] != "":
+            want_m = sum(w * streak_true(k, centre) for k, w in enumerate(weights))
+            m = np.array([float(t[f"motion_{side}_x_screen_px"]), float(t[f"motion_{side}_y_screen_px"])]) / scales[0]
+            tolerance = max(0.3, 0.05 * np.linalg.norm(want_m))
+            worst["declared_motion"] = max(worst["declared_motion"], np.linalg.norm(m - want_m) / tolerance)
+            checked["declared_motion"] += 1
+            if np.linalg.norm(m - want_m) > tolerance:
+                failures.append(f"trial {t['trial_index']} {side}: declared streak {m.round(3)} photo px, the "
+                                f"take's true mean {want_m.round(3)}")
         if t[f"{side}_source"] != "fitted":
             continue
-        centre = [(section - 0.5) * square, y, radius_mm]
-        want = sum(r_true(k, centre) for k in range(len(frames))) / len(frames)
+        want = sum(w * r_true(k, centre) for k, w in enumerate(weights))
         err = abs(float(t[f"r_{side}_px"]) - want) / want
         worst["declared"] = max(worst["declared"], err)
         checked["declared"] += 1
@@ -148,9 +175,13 @@ for path in sorted(glob.glob(os.path.join(capture_dir, "trial-*.json"))):
 print(f"checked {checked['frames']} frames: {checked['r']} fitted radii (worst {100 * worst['r']:.2f} %), "
       f"{checked['none']} unblurred sides, {checked['motion']} streaks (worst {worst['motion']:.2f} of the tolerance), "
       f"{checked['centre']} captured centres (worst {worst['centre']:.3f} photo px), {checked['declared']} trials' "
-      f"declared radii against the take's mean (worst {100 * worst['declared']:.2f} %)")
+      f"declared radii against the take's mean (worst {100 * worst['declared']:.2f} %), "
+      f"{checked['declared_motion']} declared streaks (worst {worst['declared_motion']:.2f} of the tolerance), "
+      f"{checked['after']} frames after the stimulus")
 if not checked["r"] or not checked["motion"] or not checked["centre"] or not checked["declared"]:
     failures.append("nothing to check")
+if exposure_ms > 0 and not checked["declared_motion"]:
+    failures.append("no declared streak to check")
 for f in failures[:20]:
     print("FAIL:", f)
 sys.exit(1 if failures else 0)

@@ -63,14 +63,18 @@ kill9)
     sort > "$W/main"
   for e in 3 6 9; do for p in 1 2 3; do for s in 0 1; do echo "$e|$p|$s"; done; done; done | sort > "$W/planned"
   diff "$W/planned" "$W/main" > "$W/diff" || fail "main trials are not the design's crossing once each: $(cat "$W/diff")"
-  # Each answered trial's frames once, from frame 0 without a gap, each showing a frame of the take: the frames of the
-  # trial the kill interrupted were not recorded (they go with its answer), and the resumed trial's start at 0.
+  # Each answered trial's frames once, from frame 0 without a gap, each showing a frame of the take while the stimulus
+  # is (timing.stimulus_ms: none after it, on the answer screen): the frames of the trial the kill interrupted were
+  # not recorded (they go with its answer), and the resumed trial's start at 0.
   [ "$(sql "$W/s.sqlite" "SELECT count(*) FROM (SELECT trial_id, count(*) AS n, max(frame_index) AS m FROM frames
         GROUP BY trial_id) WHERE n <> m + 1")" = 0 ] || fail "a trial's frames have a gap or a duplicate"
   [ "$(sql "$W/s.sqlite" "SELECT count(DISTINCT trial_id) FROM frames")" = $((MAIN + PRACTICE)) ] ||
     fail "frames: not every answered trial has its frames"
-  [ "$(sql "$W/s.sqlite" "SELECT count(*) FROM frames WHERE take_frame IS NULL OR take_status IS NULL")" = 0 ] ||
-    fail "frames without their take frame"
+  stimulus_s=$($PY -c 'import json, sys; print(json.load(open(sys.argv[1]))["timing"]["stimulus_ms"] / 1000)' "$PROTOCOL")
+  [ "$(sql "$W/s.sqlite" "SELECT count(*) FROM frames WHERE (take_frame IS NULL OR take_status IS NULL)
+                          AND flip_time_s < $stimulus_s - 1e-6")" = 0 ] || fail "stimulus frames without their take frame"
+  [ "$(sql "$W/s.sqlite" "SELECT count(*) FROM frames WHERE take_frame IS NOT NULL AND flip_time_s >= $stimulus_s")" = 0 ] ||
+    fail "a take frame after the stimulus"
   integrity "$W/s.sqlite"
   echo "ok: killed -9 after $answered answers, resumed: $((MAIN + PRACTICE)) planned trials, each answered once" ;;
 frames)
@@ -91,8 +95,9 @@ PYEOF
         --capture "$W/capture-$exposure" > "$W/out" 2>&1 || fail "run: $(tail -2 "$W/out")"
     $BC export --db "$W/s-$exposure.sqlite" --out "$W/export-$exposure" > "$W/export.out" 2>&1 ||
       fail "export: $(cat "$W/export.out")"
+    stimulus_s=$($PY -c 'import json, sys; v = json.load(open(sys.argv[1]))["timing"]["stimulus_ms"]; print(v / 1000 if isinstance(v, (int, float)) else "")' "$PROTOCOL")
     $PY "$(dirname "$0")/video_frames_check.py" "$DIR/take" "$W/export-$exposure" "$W/capture-$exposure" $exposure \
-        > "$W/check-$exposure" 2>&1 || fail "exposure $exposure ms: $(cat "$W/check-$exposure")"
+        $stimulus_s > "$W/check-$exposure" 2>&1 || fail "exposure $exposure ms: $(cat "$W/check-$exposure")"
   done
   echo "ok: every frame of simulated sessions on video against the take's truth: no exposure: $(cat "$W/check-0");" \
        "16.7 ms: $(cat "$W/check-16.7")" ;;
@@ -118,8 +123,9 @@ report)
   echo "ok: the report analyses video-ball-depth and describes its scene: $(grep -o 'scene: [^<;]*' "$index")" ;;
 procedure)
   # A staircase on the take (the blur gain one ball needs to look more blurred, at rest at edge 6; both sides fitted):
-  # each trial's test side is (1 + level) x its reference, the trial's radii being the take's average over the frames
-  # it shows (worked here from trials.csv: the level, the test side and the two radii), and the staircase moves.
+  # each trial's test side is (1 + level) x the other side (its own reference, at the same depth), the trial's radii
+  # being the take's average over the frames it shows (worked here from trials.csv: the level, the test side and the
+  # two radii), and the staircase moves.
   $PY - "$PROTOCOL" "$W/staircase.json" <<'PYEOF' || fail "could not write the staircase protocol"
 import json, sys
 p = json.load(open(sys.argv[1]))
@@ -147,7 +153,9 @@ for r in rows:
     levels.add(level)
     test, ref = (r["r_left_px"], r["r_right_px"]) if r["test_side"] == "left" else (r["r_right_px"], r["r_left_px"])
     ratio = float(test) / float(ref)
-    assert abs(ratio - (1 + level)) < 1e-6 * (1 + level), (r["trial_index"], level, ratio)
+    # The two balls lie at one depth (edge 6, columns 3 and 5), a fraction of a millimetre apart as the camera moves
+    # sideways: their fitted radii differ by ~1e-4 of themselves.
+    assert abs(ratio - (1 + level)) < 1e-3 * (1 + level), (r["trial_index"], level, ratio)
 assert len(levels) >= 3, levels
 print(f"12 staircase trials on video, levels {sorted(levels)}: each test side (1 + level) x its reference")
 PYEOF
@@ -211,6 +219,9 @@ PYEOF
   cp "$W/copied/calib-0001.json" "$W/copied/calib-0002.json"
   edit copied "p['scene']['track'] = '$W/copied'"
   expect copied /scene/track "calib-0002.json: /frame: must be 2, the frame of its row in track.csv, got 1"
+  # An exposure longer than a frame of the take (30 fps: 33.33 ms).
+  edit long_exposure 'p["content"]["exposure_ms"] = 300'
+  expect long_exposure /content/exposure_ms "is 300 ms, longer than a frame of the take (33.33 ms at 30 fps)"
   edit unknown_key 'p["scene"]["tracks"] = p["scene"]["track"]'
   expect unknown_key /scene/tracks 'unknown key (did you mean "track"?)'
   echo "ok: a missing take, a take of another size than its track, its frames reversed, a video shorter than its" \

@@ -71,22 +71,24 @@ class VideoSceneLines(unittest.TestCase):
         self.assertIn("one lens model: focus 339.6 mm, aperture 3.74 mm", line)
         self.assertIn("exposure 20 ms", line)
         self.assertIn("left 2.50 (max 5.00), right 10.00 (max 10.00) screen px", line)
-        self.assertIn("frames presented per trial (frames.csv): median 4 (3-5)", line)
+        self.assertIn("frames of the take presented per trial (frames.csv): median 4 (3-5)", line)
         # Frames without the take's columns (a record from before schema 9): no per-frame streak, no hold count.
         self.assertNotIn("held", line)
 
     def test_per_frame_streaks_and_held_frames_come_from_frames_csv(self):
         # Per frame (photo px): left (3, 4) -> 5 and (0, 0) -> 0, right (6, 8) -> 10 twice; 1 of 4 frames held.
-        pd.DataFrame({"study": ["video-study"] * 4, "session_id": [1] * 4, "trial_index": [0, 0, 1, 1],
-                      "take_status": ["found", "tracked", "held", "tracked"],
-                      "motion_left_x_px": [3, 0, None, None], "motion_left_y_px": [4, 0, None, None],
-                      "motion_right_x_px": [6, 6, None, None], "motion_right_y_px": [8, 8, None, None]}
+        # A fifth frame, after a timed stimulus (the answer screen: no take frame, no ball), counts nowhere.
+        pd.DataFrame({"study": ["video-study"] * 5, "session_id": [1] * 5, "trial_index": [0, 0, 1, 1, 1],
+                      "take_status": ["found", "tracked", "held", "tracked", None],
+                      "motion_left_x_px": [3, 0, None, None, None], "motion_left_y_px": [4, 0, None, None, None],
+                      "motion_right_x_px": [6, 6, None, None, None], "motion_right_y_px": [8, 8, None, None, None]}
                      ).to_csv(self.frames, index=False)
         line = scenes.video_scene_lines(self.db, self.trials, self.frames, [os.path.join(self.tmp, "study")])[0][1]
         self.assertIn("motion streak per frame (frames.csv), mean over frames: left 2.50 (max 5.00), right 10.00 "
                       "(max 10.00) photo px", line)
         self.assertNotIn("mean over trials", line)
         self.assertIn("3 of 4 frames at the take frame's own pose, 1 held", line)
+        self.assertIn("frames of the take presented per trial (frames.csv): median 2 (2-2)", line)
 
     def test_practice_trials_frames_are_left_out(self):
         # Trial 0 of session 1 is practice (9 frames); trials 1 and 2 show 3 and 5: the median is 4, not 5.
@@ -95,7 +97,7 @@ class VideoSceneLines(unittest.TestCase):
         pd.DataFrame({"study": ["video-study"] * 17, "session_id": [1] * 17,
                       "trial_index": [0] * 9 + [1] * 3 + [2] * 5}).to_csv(self.frames, index=False)
         line = scenes.video_scene_lines(self.db, trials, self.frames, [os.path.join(self.tmp, "study")])[0][1]
-        self.assertIn("frames presented per trial (frames.csv): median 4 (3-5)", line)
+        self.assertIn("frames of the take presented per trial (frames.csv): median 4 (3-5)", line)
 
     def test_versions_on_different_takes_are_described_each_with_its_own_trials(self):
         # A record merged from two stations, each with its own take: version hashes "1" and "2".

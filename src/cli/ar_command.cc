@@ -115,7 +115,11 @@ void AddArCommand(CLI::App& app) {
     blur.method = args->method;
 
     std::vector<stimulus::PlacedObject> objects;
-    if (!args->objects.empty()) objects = stimulus::LoadPlacedObjects(args->objects);
+    std::vector<std::string> given;  // where each object was given, for messages: the option or the file's pointer
+    if (!args->objects.empty()) {
+      objects = stimulus::LoadPlacedObjects(args->objects);
+      for (size_t i = 0; i < objects.size(); ++i) given.push_back(args->objects + ": /objects/" + std::to_string(i));
+    }
     auto add = [&](const char* kind, const scene::VirtualObject& o, const std::string& texture) {
       stimulus::PlacedObject p;
       int n = 1;
@@ -129,12 +133,14 @@ void AddArCommand(CLI::App& app) {
       const std::vector<double> v = MmList("--ball", b, 3, "X,Y[,RADIUS]");
       if (v.size() == 3 && !(v[2] > 0)) throw Error(ErrorKind::kUsage, "--ball " + Echo(b) + ": RADIUS must be > 0");
       add("ball", stimulus::BallAt(v[0], v[1], v.size() == 3 ? v[2] : 10), args->ball_texture);
+      given.push_back("--ball " + Echo(b));
     }
     for (const std::string& c : args->cards) {
       const std::vector<double> v = MmList("--card", c, 4, "X,Y[,WIDTH[,HEIGHT]]");
       const double w = v.size() >= 3 ? v[2] : 50, h = v.size() == 4 ? v[3] : w;
       if (!(w > 0 && h > 0)) throw Error(ErrorKind::kUsage, "--card " + Echo(c) + ": WIDTH and HEIGHT must be > 0");
       add("card", stimulus::StandingCardAt(v[0], v[1], w, h, 0), args->card_texture);
+      given.push_back("--card " + Echo(c));
     }
     if (objects.empty()) throw Error(ErrorKind::kUsage, "no objects: give --ball, --card or --objects");
 
@@ -142,13 +148,33 @@ void AddArCommand(CLI::App& app) {
     const Camera& camera = take.camera();
     const double take_fps = take.FramesPerSecond();
     track::FrameSource source(args->input, take_fps > 0 ? take_fps : 30);
+    // An object in no frame's photo would leave a video without it and a summary that counts it drawn: a slip of
+    // millimetres (400 for 40) is refused before anything is written.
+    const cv::Rect photo(0, 0, camera.image_width_px, camera.image_height_px);
+    for (size_t i = 0; i < objects.size(); ++i) {
+      bool seen = false;
+      for (const stimulus::TrackedFrame& f : take.frames) {
+        if (seen || !f.calib) continue;
+        try {
+          seen = !(scene::FootprintOf(camera, f.calib->rvec, f.calib->tvec, objects[i].object).bounds & photo).empty();
+        } catch (const Error&) {  // behind the camera in this frame: not seen in it
+        }
+      }
+      if (!seen)
+        throw InputError(given[i], objects[i].name + " at (" + Num(objects[i].object.center_board_mm[0]) + ", " +
+                                       Num(objects[i].object.center_board_mm[1]) +
+                                       ") mm on the board lies outside the photo in every frame of the take (the board "
+                                       "is " + Num(take.board().WidthMm()) + " x " + Num(take.board().LengthMm()) +
+                                       " mm): nothing of it would be drawn");
+    }
+
     std::string exposure_note = "given";
     if (args->exposure_ms < 0 && camera.exposure_ms) {
       // A frame is exposed within its own interval: a longer exposure is a camera.json of a photo, not of this take.
       if (take_fps > 0 && *camera.exposure_ms > 1000 / take_fps * 1.001)
         throw InputError(args->track + ": the camera's exposure_ms",
                          "is " + Num(*camera.exposure_ms) + " ms, longer than a frame of the take (" +
-                             Num(1000 / take_fps) + " ms at " + Num(take_fps) +
+                             Num(std::round(1e5 / take_fps) / 100) + " ms at " + Num(std::round(take_fps * 100) / 100) +
                              " fps): not this take's camera? give --exposure-ms");
       blur.exposure_ms = *camera.exposure_ms;
       exposure_note = "the camera's exposure_ms, as tracked";
@@ -160,6 +186,11 @@ void AddArCommand(CLI::App& app) {
                                  : "no motion blur: the camera's exposure is unknown and an image sequence states no "
                                    "frame rate (give --exposure-ms)";
     } else {
+      if (take_fps > 0 && args->exposure_ms > 1000 / take_fps * 1.001)
+        throw Error(ErrorKind::kUsage, "--exposure-ms " + Num(args->exposure_ms) + ": longer than a frame of the take (" +
+                                           Num(std::round(1e5 / take_fps) / 100) + " ms at " +
+                                           Num(std::round(take_fps * 100) / 100) +
+                                           " fps): a camera exposes each frame within its own interval");
       blur.exposure_ms = args->exposure_ms;
     }
     if (!args->quiet)

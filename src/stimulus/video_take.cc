@@ -1,7 +1,10 @@
 #include "stimulus/video_take.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
+#include <optional>
 
 #include "core/error.h"
 #include "core/names.h"
@@ -31,6 +34,13 @@ VideoTake::VideoTake(const protocol::Protocol& protocol) {
   // Over the whole take: track.csv's times are rounded to the microsecond, a step between two frames is not exact.
   const double span = take_.frames.back().time_s - take_.frames.front().time_s;
   fps_ = n > 1 && span > 0 ? (n - 1) / span : 30;
+  // A camera exposes each frame within its own interval: a longer exposure is no camera's, and would streak the
+  // objects over several frames' motion (and cost seconds a frame to draw).
+  if (protocol.content.exposure_ms > 1000 / fps_ * 1.001)
+    throw InputError(At(protocol, "/content/exposure_ms"),
+                     "is " + Num(protocol.content.exposure_ms) + " ms, longer than a frame of the take (" +
+                         Num(std::round(1e5 / fps_) / 100) + " ms at " + Num(std::round(fps_ * 100) / 100) +
+                         " fps): a camera exposes each frame within its own interval");
   const std::string track = protocol.scene.track.string(), video = protocol.scene.video.string();
   // Every frame is held decoded for the session (8-bit BGR): a take that would not fit is refused before decoding.
   const Camera& camera = take_.camera();
@@ -190,6 +200,45 @@ TrialScene DescribeVideoTrial(const protocol::Protocol& protocol, const VideoTak
     mean.r_span_screen_px = std::max(mean.r_span_screen_px, t.r_span_screen_px);
     mean.per_pixel = mean.per_pixel || t.per_pixel;
   }
+  if (scene.intervals > 0) return mean;  // each interval shows one side in the same place: frame by frame above
+  // Each side's radius and streak are what is drawn, averaged over the window: VideoObjectsAt - the side's source at
+  // the object's place at that moment, in the frame shown then, with the camera's streak over the exposure - in
+  // steps within each take frame's time on screen, a quarter of a frame and at most half a board square of a rolling
+  // ball's run apart (a frame's own DescribeTrial above averages a rolling ball over its whole run, and adds no
+  // camera streak).
+  const double window = TakeWindowS(protocol, take, trial, scene);
+  const double rate = std::max(4 * take.fps(), scene.speed_mm_s > 0 ? 2 * scene.speed_mm_s /
+                                                                          take.take().board().square_mm : 0.0);
+  double weight_of[2] = {0, 0}, r[2] = {0, 0};
+  cv::Vec2d motion[2] = {{0, 0}, {0, 0}};
+  const int n = int(take.take().frames.size());
+  for (int k = take.first_posed(); k < n; ++k) {
+    const double from = (k - take.first_posed()) / take.fps();
+    if (from >= window) break;
+    const double to = k == n - 1 ? window : std::min(window, (k + 1 - take.first_posed()) / take.fps());
+    const int steps = std::clamp(int(std::ceil((to - from) * rate)), 1, 4000);
+    for (int i = 0; i < steps; ++i) {
+      const double t_s = from + (i + 0.5) * (to - from) / steps, w = (to - from) / steps;
+      const TakeFrameShown shown = take.FrameAt(t_s);
+      std::array<std::optional<scene::BlurredObject>, 2> objects;
+      try {
+        objects = VideoObjectsAt(protocol, take, shown, scene, t_s);
+      } catch (const std::exception& e) {
+        throw InputError(At(protocol, "/scene/track"), "trial " + std::to_string(trial.index + 1) +
+                                                          " cannot be drawn in the take's frame " +
+                                                          std::to_string(shown.take_frame) + " (" + Num(t_s) +
+                                                          " s after onset): " + e.what());
+      }
+      for (size_t side = 0; side < 2; ++side)
+        if (objects[side]) {
+          weight_of[side] += w;
+          r[side] += w * objects[side]->r_px;
+          motion[side] += w * objects[side]->motion_px;
+        }
+    }
+  }
+  if (weight_of[0] > 0) mean.r_left_px = r[0] / weight_of[0], mean.motion_left_px = motion[0] / weight_of[0];
+  if (weight_of[1] > 0) mean.r_right_px = r[1] / weight_of[1], mean.motion_right_px = motion[1] / weight_of[1];
   return mean;
 }
 
