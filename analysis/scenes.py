@@ -164,12 +164,16 @@ def video_scene_lines(db_path, trials, frames_path=None, search_dirs=()):
         scene = protocol.get("scene") if isinstance(protocol, dict) else None
         if not isinstance(scene, dict) or "video" not in scene:
             continue
-        key = (str(scene.get("video", "")), str(scene.get("track", "")))
+        # The take's identity as run (recorded_take: blurcue adds it to a video study's recorded text), so that one
+        # protocol file run on two stations' own takes is two takes here.
+        recorded = protocol.get("recorded_take")
+        key = (str(scene.get("video", "")), str(scene.get("track", "")),
+               json.dumps(recorded, sort_keys=True) if isinstance(recorded, dict) else "")
         takes.setdefault(study, {}).setdefault(key, []).append((hash_, version))
     lines = []
     for study in sorted(takes):
         several = len(takes[study]) > 1
-        for (video, track), versions in takes[study].items():
+        for (video, track, recorded), versions in takes[study].items():
             text = f"a tracked video: take {video}, track folder {track} (as the protocol names them, relative to it)"
             if several:
                 names = ", ".join((f"{v} " if v is not None else "") + f"({h[:8]})" for h, v in versions)
@@ -185,8 +189,11 @@ def video_scene_lines(db_path, trials, frames_path=None, search_dirs=()):
             if found:
                 text += f"; the take ({found[0]}): " + describe_take(found[1])
             else:
+                as_run = json.loads(recorded) if recorded else {}
                 text += ("; the take's frames: not determined (the record keeps the protocol's text, not its folder, "
-                         "and no track.csv was found from " + ", ".join(search_dirs or ["here"]) + ")")
+                         "and no track.csv was found from " + ", ".join(search_dirs or ["here"]) + ")" +
+                         (f"; as run: {as_run['frames']} frames at {as_run['fps']:g} fps"
+                          if {"frames", "fps"} <= set(as_run) else ""))
             hashes = [h for h, _ in versions]
             parts = _shown(trials, frames, study, hashes) if "study" in trials else []
             lines.append((study, text + ("; " + "; ".join(parts) if parts else "")))

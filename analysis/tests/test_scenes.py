@@ -119,6 +119,19 @@ class VideoSceneLines(unittest.TestCase):
         self.assertIn("exposure 40 ms", lines[1])
         self.assertIn("the take's frames: not determined", lines[1])
 
+    def test_one_protocol_text_on_two_takes_is_two_takes(self):
+        # Two stations ran one protocol file on takes of their own: blurcue recorded each take's identity with the
+        # text (recorded_take), so the record holds two texts; the report describes two takes.
+        self.db = os.path.join(self.tmp, "stations.sqlite")
+        scene = {"video": "take/take.avi", "track": "track"}
+        make_record(self.db, [("s", {"scene": scene, "recorded_take": {"frames": 3, "fps": 25, "frames_fnv1a64": "a"}}),
+                              ("s", {"scene": scene, "recorded_take": {"frames": 8, "fps": 30, "frames_fnv1a64": "b"}})])
+        trials = pd.DataFrame({"study": ["s", "s"], "protocol_hash": ["1", "2"], "exposure_ms": [0, 0]})
+        lines = [line for _, line in scenes.video_scene_lines(self.db, trials, None, [os.path.join(self.tmp, "none")])]
+        self.assertEqual(len(lines), 2, lines)
+        self.assertIn("as run: 3 frames at 25 fps", lines[0])
+        self.assertIn("as run: 8 frames at 30 fps", lines[1])
+
     def test_a_track_folder_found_nowhere_is_not_determined(self):
         lines = scenes.video_scene_lines(self.db, self.trials, None, [os.path.join(self.tmp, "elsewhere")])
         self.assertIn("the take's frames: not determined", lines[0][1])

@@ -1,6 +1,7 @@
 // blurcue validate: check a protocol file and build its trial list, through the pre-flight a session runs.
 #include <cstdio>
 #include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -17,6 +18,7 @@
 #include "session/prepare.h"
 #include "session/recorded_names.h"
 #include "session/visibility.h"
+#include "stimulus/video_take.h"
 
 namespace blurcue::cli {
 
@@ -101,10 +103,24 @@ void AddValidateCommand(CLI::App& app) {
           std::snprintf(line, sizeof line,
                         "  shown: a %d x %d %s in a %d x %d window (%s) at %.4f screen px per photo px; %s: %.2f px "
                         "per degree, 1 photo px = %.3f arcmin\n",
-                        at.frame_width_px, at.frame_height_px, prepared.scene ? "photo" : "frame", at.window_width_px,
+                        at.frame_width_px, at.frame_height_px,
+                        prepared.images.take ? "video" : prepared.scene ? "photo" : "frame", at.window_width_px,
                         at.window_height_px, at.scaling.c_str(), at.scale, at.profile.name.c_str(),
                         display::PxPerDeg(at.profile), at.Arcmin(1));
           std::string shown = line;
+          if (const auto& take = prepared.images.take) {
+            const protocol::Content& c = prepared.protocol.content;
+            shown += "  take: " + std::to_string(take->take().frames.size()) + " frames at " +
+                     Num(std::round(take->fps() * 100) / 100) + " fps";
+            if (c.type == protocol::ContentType::kBall)
+              shown += "; exposure " + Num(std::round(c.exposure_ms * 1000) / 1000) + " ms (" +
+                       (c.exposure_given ? std::string("content.exposure_ms")
+                        : take->take().camera().exposure_ms ? std::string("the take's camera.json exposure_ms")
+                                                            : std::string("half a frame: the take's camera states no "
+                                                                          "exposure_ms; give content.exposure_ms")) +
+                       ")";
+            shown += "\n";
+          }
           if (prepared.protocol.groups)
             shown += "  group: " + prepared.group +
                      (prepared.protocol.groups->assign == protocol::GroupAssign::kBalanced

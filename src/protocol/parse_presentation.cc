@@ -131,7 +131,8 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
     // A ball rolls on the board's 25 mm squares: from a marble to a football.
     if (auto r = Number(v, "radius_mm", ptr, false, 1, 150, "mm")) p->content.radius_mm = *r;
     // A camera's exposure: up to a second (a longer one smears a rolling ball over much of the board).
-    if (auto e = Number(v, "exposure_ms", ptr, false, 0, 1000, "ms")) p->content.exposure_ms = *e;
+    if (auto e = Number(v, "exposure_ms", ptr, false, 0, 1000, "ms"))
+      p->content.exposure_ms = *e, p->content.exposure_given = true;
   } else {
     Object(v, ptr, {"type", "image", "real_photos", "real_camera"});
     p->content.image = Path(v, "image", ptr, true);

@@ -150,8 +150,11 @@ struct Content {
   ThresholdUnit depth_blur_threshold_unit = ThresholdUnit::kScreenPx;
   double radius_mm = 10;              // ball
   // ball: the camera's exposure time (ms) that a moving ball's motion blur lasts (its image-space velocity x this,
-  // drawn with its defocus in one kernel); 0 (the default): no motion blur.
+  // drawn with its defocus in one kernel); 0 (the default on a photo): no motion blur. On a tracked video, when not
+  // given (exposure_given false), the session takes the take's camera's exposure_ms, or half a frame of the take
+  // where the camera does not state it (as `blurcue ar` does; session/prepare.cc).
   double exposure_ms = 0;
+  bool exposure_given = false;
   std::string texture = "soccer";     // grid: grid (the 5 x 5 card) | an image path; ball: soccer | wood | a path
   std::filesystem::path image;        // picture: the image (resolved)
   // picture: photos of the real picture, one per distance: a resolved path with "{distance_m}" standing for the

@@ -3,6 +3,8 @@
 #include "stimulus/video_take.h"
 
 #include <algorithm>
+#include <cmath>
+#include <optional>
 
 #include "core/error.h"
 #include "core/json_io.h"
@@ -30,6 +32,23 @@ PreparedSession PrepareStudy(const std::filesystem::path& protocol_file, const s
   s.protocol_text = protocol::RecordedText(text, s.protocol);
   s.scene = LoadProtocolScene(s.protocol);
   s.images = LoadStimulusImages(s.protocol, s.scene);
+  if (s.images.take) {  // the take the trials are drawn on, in the recorded text (stimulus::TakeIdentity)
+    Json recorded = ParseJson(s.protocol_text, protocol_file.string());
+    recorded["recorded_take"] = stimulus::TakeIdentity(*s.images.take);
+    s.protocol_text = recorded.dump(2, ' ', false, Json::error_handler_t::replace);
+  }
+  // A ball on a tracked video without content.exposure_ms is streaked as the camera streaked the take: its
+  // camera's exposure_ms, or half a frame of the take where the camera does not state it (as `blurcue ar`).
+  if (s.images.take && s.protocol.content.type == protocol::ContentType::kBall && !s.protocol.content.exposure_given) {
+    const std::optional<double> camera = s.images.take->take().camera().exposure_ms;
+    const double frame_ms = 1000 / s.images.take->fps();
+    if (camera && *camera > frame_ms * 1.001)
+      throw InputError(protocol_file.string() + ": /scene/track",
+                       "the take's camera says exposure_ms " + Num(*camera) + ", longer than a frame of the take (" +
+                           Num(std::round(frame_ms * 100) / 100) + " ms): not this take's camera? give "
+                           "content.exposure_ms");
+    s.protocol.content.exposure_ms = camera ? *camera : frame_ms / 2;
+  }
   if (!display_profile.empty()) {
     s.display = display::LoadProfile(display_profile);
   } else if (!s.protocol.display.profile.empty()) {

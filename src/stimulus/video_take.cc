@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "core/error.h"
+#include "core/hash.h"
 #include "core/names.h"
 #include "optics/thin_lens.h"
 #include "protocol/trials.h"
@@ -101,6 +102,18 @@ void VideoTake::CheckMemory(const protocol::Protocol& protocol, cv::Size screen_
                          std::to_string(screen_photo.width) + " x " + std::to_string(screen_photo.height) +
                          " px screen, would hold " + Num(bytes / (1 << 30)) + " GiB (at most " +
                          Num(kMaxTakeBytes / (1 << 30)) + " GiB): cut the take, or show it smaller");
+}
+
+Json TakeIdentity(const VideoTake& take) {
+  std::string frames;
+  for (const TrackedFrame& f : take.take().frames) {
+    frames += std::to_string(f.index) + ' ' + track::Name(f.status);
+    for (const double v : f.signature) frames += ' ' + Num(v);
+    frames += '\n';
+  }
+  return {{"frames", take.take().frames.size()},
+          {"fps", std::round(take.fps() * 1000) / 1000},
+          {"frames_fnv1a64", HashHex(Fnv1a64(frames))}};
 }
 
 std::vector<int> VideoTake::PosedFrames() const {
@@ -203,12 +216,12 @@ TrialScene DescribeVideoTrial(const protocol::Protocol& protocol, const VideoTak
   if (scene.intervals > 0) return mean;  // each interval shows one side in the same place: frame by frame above
   // Each side's radius and streak are what is drawn, averaged over the window: VideoObjectsAt - the side's source at
   // the object's place at that moment, in the frame shown then, with the camera's streak over the exposure - in
-  // steps within each take frame's time on screen, a quarter of a frame and at most half a board square of a rolling
-  // ball's run apart (a frame's own DescribeTrial above averages a rolling ball over its whole run, and adds no
+  // steps within each take frame's time on screen, a sixteenth of a frame and at most a quarter board square of a
+  // rolling ball's run apart (a measured source steps where the ball enters another section) (a frame's own DescribeTrial above averages a rolling ball over its whole run, and adds no
   // camera streak).
   const double window = TakeWindowS(protocol, take, trial, scene);
-  const double rate = std::max(4 * take.fps(), scene.speed_mm_s > 0 ? 2 * scene.speed_mm_s /
-                                                                          take.take().board().square_mm : 0.0);
+  const double rate = std::max(16 * take.fps(), scene.speed_mm_s > 0 ? 4 * scene.speed_mm_s /
+                                                                           take.take().board().square_mm : 0.0);
   double weight_of[2] = {0, 0}, r[2] = {0, 0};
   cv::Vec2d motion[2] = {{0, 0}, {0, 0}};
   const int n = int(take.take().frames.size());

@@ -51,6 +51,13 @@ class VideoTake {
   double fps_ = 30;
 };
 
+// What identifies a take in the record (session/prepare.cc adds it to the recorded protocol text as "recorded_take"):
+// its frame count, frame rate and a hash of every frame's status and signature (track::FrameSignature, as track
+// wrote them). Another take - or the same protocol text at a station that filmed its own - is then another protocol
+// text: refused under the same version, told apart by protocol_hash in a merged record and described apart in the
+// report. Re-tracking the same take gives the same identity (track's timings are not in it).
+Json TakeIdentity(const VideoTake& take);
+
 // What a pair trial shows in the take's frame `shown`, t_s after onset: ObjectsAt at that frame's pose (each side's
 // source evaluated with the frame's calibration: its lens model, its measured edges), each object's streak being its
 // own motion's plus the camera's (StreakPx of its centre over the trial's exposure). Throws as ObjectsAt.

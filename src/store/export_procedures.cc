@@ -47,7 +47,7 @@ Json ParametersOf(const protocol::Procedure& p) {
 }
 
 // A recorded text as it parsed when it ran. Its conditions tables (protocol::RecordedText keeps them beside the text
-// as "recorded_conditions", no field of a protocol) are written where the text's paths find them from a protocol file
+// as "recorded_conditions", no field of a protocol; a video study's take is "recorded_take") are written where the text's paths find them from a protocol file
 // in a fresh folder, deep enough for every leading "../", and the folder is removed afterwards. The files a protocol
 // names otherwise were checked when it ran and are not read here.
 protocol::Protocol ParseRecorded(Json text) {
@@ -56,6 +56,7 @@ protocol::Protocol ParseRecorded(Json text) {
     tables = text["recorded_conditions"];
     text.erase("recorded_conditions");
   }
+  if (text.is_object()) text.erase("recorded_take");  // the take a video study ran on (stimulus::TakeIdentity)
   const protocol::ValidateOptions no_files{false};
   if (!tables.is_object() || tables.empty()) return protocol::ParseProtocol(text, "protocol.json", no_files);
   size_t depth = 0;

@@ -56,7 +56,7 @@ std::optional<calib::BoardPose> Tracker::Track(const cv::Mat& grey8, const cv::M
   const cv::Rect2f inside(2, 2, grey8.cols - 5, grey8.rows - 5);
   for (const cv::Point2f& p : corners)
     if (!inside.contains(p)) {
-      *note = "tracking lost: a predicted corner leaves the image";
+      *note = "not tracked from the frame before (a predicted corner leaves the image): detected anew";
       return std::nullopt;
     }
   // A corner refined farther than a third of the closest spacing from where it was predicted may have slid to its
@@ -73,15 +73,15 @@ std::optional<calib::BoardPose> Tracker::Track(const cv::Mat& grey8, const cv::M
   double moved = 0;
   for (size_t i = 0; i < corners.size(); ++i) moved = std::max(moved, double(cv::norm(corners[i] - predicted[i])));
   if (!(moved <= spacing / 3)) {
-    *note = "tracking lost: a corner refined " + Fixed(moved, 1) + " px from its prediction (> a third of the " +
-            Fixed(spacing, 1) + " px spacing)";
+    *note = "not tracked from the frame before (a corner refined " + Fixed(moved, 1) + " px from its prediction, more "
+            "than a third of the " + Fixed(spacing, 1) + " px spacing): detected anew";
     return std::nullopt;
   }
   calib::BoardPose pose = calib::PoseFromCorners(std::move(corners), camera_, board_);
   // A corner that slid to a neighbour's place, or onto texture, leaves the pose's fit: the rms error shows it.
   if (!(pose.reprojection_error_px <= options_.max_track_error_px)) {
-    *note = "tracking lost: reprojection error " + Fixed(pose.reprojection_error_px, 2) + " px > " +
-            Fixed(options_.max_track_error_px, 2) + " px";
+    *note = "not tracked from the frame before (reprojection error " + Fixed(pose.reprojection_error_px, 2) + " px > " +
+            Fixed(options_.max_track_error_px, 2) + " px): detected anew";
     return std::nullopt;
   }
   return pose;
