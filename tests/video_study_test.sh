@@ -233,6 +233,44 @@ for i, t in trials.items():
 print(f"{len(trials)} trials: declared radius within {100 * worst['r']:.2f} % of what their frames drew")
 PYEOF
   echo "ok: a rolling ball on video: $(cat "$W/check")" ;;
+two_takes)
+  # One protocol text run on another take (a station that filmed its own: here the same set-up with other sensor
+  # noise) is another protocol text: under the same version it is refused naming /recorded_take, under a raised
+  # version it runs, and the record keeps the two texts apart.
+  $BC synth-take --out "$W/take-b" --frames 4 --supersample 2 --noise 0.004 --seed 8 --from-u-mm 320 --to-u-mm 280 \
+    --focus-mm 340 --from-lateral-mm -15 --to-lateral-mm 15 --quiet || fail "synth-take b"
+  $BC track "$W/take-b/take.avi" --camera "$W/take-b/camera.json" --out "$W/track-b" --quiet || fail "track b"
+  $PY - "$PROTOCOL" "$W" "$DIR" <<'PYEOF' || fail "could not write the protocols"
+import json, os, sys
+p = json.load(open(sys.argv[1]))
+w, d = sys.argv[2], sys.argv[3]
+p["scene"] = {"video": os.path.join(d, "take", "take.avi"), "track": os.path.join(d, "track")}
+json.dump(p, open(os.path.join(w, "a.json"), "w"), indent=1)
+p["scene"] = {"video": os.path.join(w, "take-b", "take.avi"), "track": os.path.join(w, "track-b")}
+json.dump(p, open(os.path.join(w, "b.json"), "w"), indent=1)
+PYEOF
+  # The same text but for the scene's paths: make them one text, as two stations with one protocol file would have.
+  mkdir -p "$W/station-a" "$W/station-b"
+  ln -sfn "$DIR/take" "$W/station-a/take"; ln -sfn "$DIR/track" "$W/station-a/track"
+  ln -sfn "$W/take-b" "$W/station-b/take"; ln -sfn "$W/track-b" "$W/station-b/track"
+  $PY - "$W/a.json" "$W/station-a/p.json" "$W/station-b/p.json" <<'PYEOF'
+import json, sys
+p = json.load(open(sys.argv[1]))
+p["scene"] = {"video": "take/take.avi", "track": "track"}
+for out in sys.argv[2:]:
+    json.dump(p, open(out, "w"), indent=1)
+PYEOF
+  (cd "$W/station-a" && $BC run p.json --participant A1 --db "$W/s.sqlite" --observer sim > "$W/a.out" 2>&1) ||
+    fail "station a: $(tail -2 "$W/a.out")"
+  (cd "$W/station-b" && $BC run p.json --participant B1 --db "$W/s.sqlite" --observer sim > "$W/b.out" 2> "$W/b.err")
+  code=$?
+  [ $code = 3 ] && grep -q "records protocol version 1 with another text (/recorded_take/frames_fnv1a64" "$W/b.err" ||
+    fail "another take under version 1: exit $code $(cat "$W/b.err")"
+  sed -i 's/"version": 1,/"version": 2,/' "$W/station-b/p.json"
+  (cd "$W/station-b" && $BC run p.json --participant B1 --db "$W/s.sqlite" --observer sim > "$W/b2.out" 2>&1) ||
+    fail "station b, version 2: $(tail -2 "$W/b2.out")"
+  [ "$(sql "$W/s.sqlite" "SELECT count(DISTINCT hash) FROM protocol_versions")" = 2 ] || fail "not two protocol texts"
+  echo "ok: another take is another protocol text: refused under one version (/recorded_take), kept apart under two" ;;
 bad_scene)
   # One problem, exit 3, naming the field: a missing take, a take of another frame size than its track folder's,
   # an unknown key.

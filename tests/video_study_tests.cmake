@@ -7,7 +7,7 @@ set(T ${PROJECT_BINARY_DIR}/cli-test)
 set(VIDEO_STUDY_TEST bash ${PROJECT_SOURCE_DIR}/tests/video_study_test.sh)
 add_test(NAME video_study_take COMMAND ${VIDEO_STUDY_TEST} take $<TARGET_FILE:blurcue> ${T})
 set_tests_properties(video_study_take PROPERTIES FIXTURES_SETUP video_take PASS_REGULAR_EXPRESSION "(^|\n)ok:")
-foreach(case validate kill9 frames report bad_scene procedure rolling)
+foreach(case validate kill9 frames report bad_scene procedure rolling two_takes)
   add_test(NAME video_study_${case} COMMAND ${VIDEO_STUDY_TEST} ${case} $<TARGET_FILE:blurcue> ${T})
   set_tests_properties(video_study_${case} PROPERTIES FIXTURES_REQUIRED "video_take;session_protocols"
                        LABELS "gl;session" PASS_REGULAR_EXPRESSION "(^|\n)ok:")
