@@ -171,11 +171,10 @@ void AddArCommand(CLI::App& app) {
     std::string exposure_note = "given";
     if (args->exposure_ms < 0 && camera.exposure_ms) {
       // A frame is exposed within its own interval: a longer exposure is a camera.json of a photo, not of this take.
-      if (take_fps > 0 && *camera.exposure_ms > 1000 / take_fps * 1.001)
+      if (const std::string beyond = stimulus::ExposureBeyondFrame(*camera.exposure_ms, take_fps); !beyond.empty())
         throw InputError(args->track + ": the camera's exposure_ms",
-                         "is " + Num(*camera.exposure_ms) + " ms, longer than a frame of the take (" +
-                             Num(std::round(1e5 / take_fps) / 100) + " ms at " + Num(std::round(take_fps * 100) / 100) +
-                             " fps): not this take's camera? give --exposure-ms");
+                         "is " + Num(*camera.exposure_ms) + " ms, " + beyond +
+                             ": not this take's camera? give --exposure-ms");
       blur.exposure_ms = *camera.exposure_ms;
       exposure_note = "the camera's exposure_ms, as tracked";
     } else if (args->exposure_ms < 0) {
@@ -186,11 +185,9 @@ void AddArCommand(CLI::App& app) {
                                  : "no motion blur: the camera's exposure is unknown and an image sequence states no "
                                    "frame rate (give --exposure-ms)";
     } else {
-      if (take_fps > 0 && args->exposure_ms > 1000 / take_fps * 1.001)
-        throw Error(ErrorKind::kUsage, "--exposure-ms " + Num(args->exposure_ms) + ": longer than a frame of the take (" +
-                                           Num(std::round(1e5 / take_fps) / 100) + " ms at " +
-                                           Num(std::round(take_fps * 100) / 100) +
-                                           " fps): a camera exposes each frame within its own interval");
+      if (const std::string beyond = stimulus::ExposureBeyondFrame(args->exposure_ms, take_fps); !beyond.empty())
+        throw Error(ErrorKind::kUsage, "--exposure-ms " + Num(args->exposure_ms) + ": " + beyond +
+                                           ": a camera exposes each frame within its own interval");
       blur.exposure_ms = args->exposure_ms;
     }
     if (!args->quiet)

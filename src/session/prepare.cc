@@ -41,13 +41,12 @@ PreparedSession PrepareStudy(const std::filesystem::path& protocol_file, const s
   // camera's exposure_ms, or half a frame of the take where the camera does not state it (as `blurcue ar`).
   if (s.images.take && s.protocol.content.type == protocol::ContentType::kBall && !s.protocol.content.exposure_given) {
     const std::optional<double> camera = s.images.take->take().camera().exposure_ms;
-    const double frame_ms = 1000 / s.images.take->fps();
-    if (camera && *camera > frame_ms * 1.001)
+    const double fps = s.images.take->fps();
+    if (const std::string beyond = stimulus::ExposureBeyondFrame(camera.value_or(0), fps); !beyond.empty())
       throw InputError(protocol_file.string() + ": /scene/track",
-                       "the take's camera says exposure_ms " + Num(*camera) + ", longer than a frame of the take (" +
-                           Num(std::round(frame_ms * 100) / 100) + " ms): not this take's camera? give "
-                           "content.exposure_ms");
-    s.protocol.content.exposure_ms = camera ? *camera : frame_ms / 2;
+                       "the take's camera says exposure_ms " + Num(*camera) + ", " + beyond +
+                           ": not this take's camera? give content.exposure_ms");
+    s.protocol.content.exposure_ms = camera ? *camera : 1000 / fps / 2;
   }
   if (!display_profile.empty()) {
     s.display = display::LoadProfile(display_profile);

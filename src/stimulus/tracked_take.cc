@@ -289,6 +289,12 @@ std::vector<PlacedObject> LoadPlacedObjects(const std::filesystem::path& path) {
   return PlacedObjectsFromJson(ReadJsonFile(path), path.string() + ": ");
 }
 
+std::string ExposureBeyondFrame(double exposure_ms, double fps) {
+  if (!(fps > 0) || exposure_ms <= 1000 / fps * 1.001) return "";
+  return "longer than a frame of the take (" + Num(std::round(1e5 / fps) / 100) + " ms at " +
+         Num(std::round(fps * 100) / 100) + " fps)";
+}
+
 cv::Vec2d StreakPx(const TrackedTake& take, int index, const cv::Vec3d& board_mm, double exposure_ms) {
   if (exposure_ms <= 0 || index < 0 || index >= int(take.frames.size()) || !take.frames[size_t(index)].calib)
     return {0, 0};

@@ -36,6 +36,11 @@ struct TrackedTake {
   double FramesPerSecond() const;
 };
 
+// A camera exposes each frame of a take within the frame's own interval: "" when exposure_ms fits a take at `fps`
+// frames per second (or the rate is unknown, fps <= 0), else the words for a message ("longer than a frame of the
+// take (33.33 ms at 30 fps)").
+std::string ExposureBeyondFrame(double exposure_ms, double fps);
+
 // Reads DIR/track.csv and the calib-NNNN.json of every frame it says has a pose. Errors (kInput) name the file and the
 // line or field and the value: a missing file, a column missing, frames out of order, an unknown status; a
 // calibration that is not the one track wrote for that row (its frame, time or status differ, its camera is not the

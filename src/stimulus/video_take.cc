@@ -37,11 +37,10 @@ VideoTake::VideoTake(const protocol::Protocol& protocol) {
   fps_ = n > 1 && span > 0 ? (n - 1) / span : 30;
   // A camera exposes each frame within its own interval: a longer exposure is no camera's, and would streak the
   // objects over several frames' motion (and cost seconds a frame to draw).
-  if (protocol.content.exposure_ms > 1000 / fps_ * 1.001)
+  if (const std::string beyond = ExposureBeyondFrame(protocol.content.exposure_ms, fps_); !beyond.empty())
     throw InputError(At(protocol, "/content/exposure_ms"),
-                     "is " + Num(protocol.content.exposure_ms) + " ms, longer than a frame of the take (" +
-                         Num(std::round(1e5 / fps_) / 100) + " ms at " + Num(std::round(fps_ * 100) / 100) +
-                         " fps): a camera exposes each frame within its own interval");
+                     "is " + Num(protocol.content.exposure_ms) + " ms, " + beyond +
+                         ": a camera exposes each frame within its own interval");
   const std::string track = protocol.scene.track.string(), video = protocol.scene.video.string();
   // Every frame is held decoded for the session (8-bit BGR): a take that would not fit is refused before decoding.
   const Camera& camera = take_.camera();
@@ -217,8 +216,8 @@ TrialScene DescribeVideoTrial(const protocol::Protocol& protocol, const VideoTak
   // Each side's radius and streak are what is drawn, averaged over the window: VideoObjectsAt - the side's source at
   // the object's place at that moment, in the frame shown then, with the camera's streak over the exposure - in
   // steps within each take frame's time on screen, a sixteenth of a frame and at most a quarter board square of a
-  // rolling ball's run apart (a measured source steps where the ball enters another section) (a frame's own DescribeTrial above averages a rolling ball over its whole run, and adds no
-  // camera streak).
+  // rolling ball's run apart (a measured source steps where the ball enters another section). A frame's own
+  // DescribeTrial above averages a rolling ball over its whole run, and adds no camera streak.
   const double window = TakeWindowS(protocol, take, trial, scene);
   const double rate = std::max(16 * take.fps(), scene.speed_mm_s > 0 ? 4 * scene.speed_mm_s /
                                                                            take.take().board().square_mm : 0.0);
