@@ -18,6 +18,7 @@
 #include "core/json_io.h"
 #include "protocol/level.h"
 #include "store/columns.h"
+#include "store/record_texts.h"
 #include "store/schema.h"
 
 #ifndef BLURCUE_VERSION
@@ -26,6 +27,9 @@
 
 namespace blurcue::store {
 namespace {
+
+using detail::ParseBoth;
+using detail::SessionName;
 
 int64_t NowMs() {
   return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch())
@@ -40,7 +44,6 @@ std::string NewToken() {
   return text;
 }
 
-std::string SessionName(int64_t session) { return "session " + std::to_string(session); }
 
 // What a balanced assignment counts, per group: the participants of the study with a completed session in it, and
 // those whose session is being run right now (a live lock: a station starting at the same moment must see it). An
@@ -259,16 +262,6 @@ std::string JsonChanges(const Json& a, const Json& b) {
   return text;
 }
 
-// Two recorded-or-given JSON texts, parsed; false when either is not JSON (a damaged record).
-bool ParseBoth(const std::string& first, const std::string& second, Json* a, Json* b) {
-  try {
-    *a = Json::parse(first);
-    *b = Json::parse(second);
-    return true;
-  } catch (const Json::exception&) {
-    return false;
-  }
-}
 
 // What differs between two protocol texts (canonical JSON).
 std::string ProtocolChanges(const std::string& before, const std::string& after) {

@@ -8,23 +8,16 @@
 #include "core/error.h"
 #include "core/json_io.h"
 #include "store/record.h"
+#include "store/record_texts.h"
 #include "store/schema.h"
 
 namespace blurcue::store {
 namespace {
 
-std::string SessionName(int64_t session) { return "session " + std::to_string(session); }
+using detail::ParseBoth;
+using detail::SessionName;
 
-// Two JSON texts parsed; false when either is not JSON (a damaged record).
-bool ParseBoth(const std::string& first, const std::string& second, Json* a, Json* b) {
-  try {
-    *a = Json::parse(first);
-    *b = Json::parse(second);
-    return true;
-  } catch (const Json::exception&) {
-    return false;
-  }
-}
+
 
 // The first place two protocol texts differ, as "POINTER: OLD in the record, NEW now" ("absent" for a member one
 // of them lacks); "the recorded text is not JSON" for a damaged record.
