@@ -10,6 +10,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "bench/clock.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/stats.h"
@@ -27,8 +28,8 @@
 namespace blurcue::bench {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double Ms(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+using detail::Clock;
+using detail::Ms;
 
 // A frame-sized test image: a few bright shapes on a dark field, linear premultiplied, opaque.
 cv::Mat TestFrame(int w, int h) {

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include <opencv2/imgcodecs.hpp>  // its flags (the functions: core/media.h)
+#include "bench/clock.h"
 #include "core/media.h"
 
 #include "calib/calibrate.h"
@@ -29,8 +30,8 @@
 namespace blurcue::bench {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double Ms(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+using detail::Clock;
+using detail::Ms;
 
 // CPU time of the whole process (every thread), ms.
 double CpuMs() {
