@@ -16,8 +16,12 @@ apart along its principal axes (numpy's eigen decomposition, nothing of the reco
 giving r (2 x its std) and the along variance's excess over it the streak, L = sqrt(12 (var_along - var_across)) (a
 segment of length L has variance L^2 / 12); its direction is the principal axis.
 
+An object drawn by the per-pixel plan (each pixel blurred for its own depth) has its visible surface's radii in its
+record, r_range_screen_px [nearest, farthest]: one kernel solved over it mixes them, so its r is judged against that
+range, not its centre's r_screen_px.
+
 Prints one line per object and exits 1 when an object whose recorded r_screen_px is at least --min-r is off by more
-than max(tolerance-px, tolerance-rel x r), a streak's length is off by more than max(streak-tolerance-px,
+than max(tolerance-px, tolerance-rel x r) (outside its range by more than that at the range's nearer end), a streak's length is off by more than max(streak-tolerance-px,
 streak-tolerance-rel x L) or its direction by more than the angle that tolerance subtends at its end, or when an
 object of the record is not in the frame.
 """
@@ -124,9 +128,10 @@ def main():
         height, width = blurred.shape[:2]
         for o in frame["objects"]:
             r_rec = o["r_screen_px"]
+            lo, hi = o.get("r_range_screen_px", [r_rec, r_rec])
             m_rec = o.get("motion_screen_px", [0, 0])
             l_rec = math.hypot(*m_rec)
-            h = max(3, math.ceil(1.6 * r_rec + l_rec / 2) + 2)
+            h = max(3, math.ceil(1.6 * max(r_rec, hi) + l_rec / 2) + 2)
             box = object_box(o, h, width, height)
             if box[2] - box[0] < 4 * h or box[3] - box[1] < 4 * h:
                 print(f"BAD {name} {o['side']}: the object is not in the frame (box {box})")
@@ -137,8 +142,10 @@ def main():
                 r, length, direction, total = kernel_streak(k)
             else:
                 r, total = kernel_radius(k)
-            err = r - r_rec
-            limit = max(args.tolerance_px, args.tolerance_rel * r_rec)
+            # Against the recorded radius, or the nearer end of the recorded range (0 inside it).
+            near = min(max(r, lo), hi) if "r_range_screen_px" in o else r_rec
+            err = r - near
+            limit = max(args.tolerance_px, args.tolerance_rel * near)
             judged = r_rec >= args.min_r
             off = judged and abs(err) > limit
             if judged:
@@ -159,7 +166,8 @@ def main():
                           f"at {math.degrees(direction):.2f} deg (error {l_err:+.4f} px, limit {l_limit:.3f}; "
                           f"{math.degrees(d_err):+.2f} deg, limit {math.degrees(d_limit):.2f})")
             bad += off
-            print(f"{'BAD ' if off else ''}{name} {o['side']} {o['kernel']}: recorded r {r_rec:.4f} screen px, "
+            drawn = f" (per pixel {lo:.4f}-{hi:.4f})" if "r_range_screen_px" in o else ""
+            print(f"{'BAD ' if off else ''}{name} {o['side']} {o['kernel']}: recorded r {r_rec:.4f} screen px{drawn}, "
                   f"shown {r:.4f} (error {err:+.4f}, limit {limit:.3f}{'' if judged else ', below --min-r: not judged'}), "
                   f"kernel sum {total:.4f}{streak}")
     print(f"{checked} objects judged, {bad} off; the largest error is {worst:.2f} of its limit")

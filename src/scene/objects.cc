@@ -74,10 +74,20 @@ Footprint FootprintOf(const Camera& camera, const cv::Vec3d& rvec, const cv::Vec
   f.z_center_mm = (rotation * o.center_board_mm + tvec)[2];
   std::vector<cv::Point2d> px;
   if (o.kind == VirtualObject::Kind::kBall) {
-    // A sphere spans its diameter in depth, and its pixels hug its outline (its bounding box's projection reaches
-    // far wider; a layer is blurred whole, so its area is a frame's cost).
-    f.z_min_mm = f.z_center_mm - o.size_mm;
-    f.z_max_mm = f.z_center_mm + o.size_mm;
+    // A sphere's pixels show its visible cap: from its nearest point (z_c - R) to the farthest point of its rim, the
+    // circle where the lines of sight touch it (centre c (1 - R^2/|c|^2), radius R sqrt(1 - R^2/|c|^2), in the
+    // plane normal to c). Its hidden back is never drawn, so its depth is not the object's. Its pixels hug its
+    // outline (its bounding box's projection reaches far wider; a layer is blurred whole, so its area is a frame's
+    // cost).
+    const cv::Vec3d c = rotation * o.center_board_mm + tvec;
+    const double d2 = c.dot(c), R = o.size_mm;
+    f.z_min_mm = f.z_center_mm - R;
+    if (d2 > R * R) {
+      const double keep = 1 - R * R / d2, uz = c[2] / std::sqrt(d2);
+      f.z_max_mm = c[2] * keep + R * std::sqrt(keep) * std::sqrt(std::max(0.0, 1 - uz * uz));
+    } else {
+      f.z_max_mm = f.z_center_mm + R;  // the camera inside the ball: every part of it may show
+    }
     px = OutlineOf(camera, rvec, tvec, o, 64);
   } else {
     const std::vector<cv::Point3d> corners = CardCorners(o);

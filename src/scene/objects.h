@@ -73,6 +73,8 @@ struct Footprint {
   // The image pixels it may cover (not clipped): its corners' box (card), its outline's box (ball); under distortion
   // the box of both its exact outline and the one LocalImageMap draws.
   cv::Rect bounds;
+  // The camera z (mm) of its visible surface, nearest and farthest (a ball's: its cap facing the camera, whose rim
+  // lies nearer than its centre unless it sits well off the axis), and of its centre.
   double z_min_mm = 0, z_max_mm = 0, z_center_mm = 0;
 };
 

@@ -117,6 +117,12 @@ void StimulusRenderer::Compose(const TrialScene& trial, double t_s, double level
     if (shown->motion_px != cv::Vec2d(0, 0)) {
       const double scale = compositor_->view().Scale(scene_->camera);
       shown->r_px = render::DrawnRadiusPx(render::PsfOf(*shown, scale)) / scale;
+      if (shown->r_of_depth_px) {  // the per-pixel plan: each depth's radius likewise (DrawnRadiusPx is max(r, its floor))
+        scene::BlurredObject sharp = *shown;
+        sharp.r_px = 0;
+        const double least = render::DrawnRadiusPx(render::PsfOf(sharp, scale)) / scale;
+        shown->r_of_depth_px = [r = std::move(shown->r_of_depth_px), least](double z) { return std::max(r(z), least); };
+      }
     }
     shown->object.texture = texture_;
     objects_.push_back(*shown);

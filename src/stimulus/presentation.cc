@@ -169,6 +169,19 @@ Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, cons
                                round(presentation.ScreenPx(b.motion_px[1]), 1e-4)}},
          {"exposure_ms", trial.exposure_ms},
          {"size_deg", round(display::ArcminOfScreenPx(profile, ExtentPx(outline)) / 60, 1e-4)}});
+    if (b.r_of_depth_px) {
+      // The per-pixel plan: each pixel of it is blurred for its own depth, so the frame shows the radii of its
+      // visible surface, nearest to farthest depth (a ball's rim lies a little nearer than the centre r_screen_px
+      // is given for).
+      const scene::Footprint f = scene::FootprintOf(camera, scene->rvec, scene->tvec, b.object);
+      double lo = 1e300, hi = -1e300;
+      for (int i = 0; i <= 32; ++i) {
+        const double r = std::max(0.0, b.r_of_depth_px(f.z_min_mm + (f.z_max_mm - f.z_min_mm) * i / 32));
+        lo = std::min(lo, r), hi = std::max(hi, r);
+      }
+      frame["objects"].back()["r_range_screen_px"] = {round(presentation.ScreenPx(lo), 1e-4),
+                                                      round(presentation.ScreenPx(hi), 1e-4)};
+    }
   }
   return frame;
 }
