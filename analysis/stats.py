@@ -350,6 +350,46 @@ SEPARATION_NOTE = ("separation: every answer behind this term went one way, so i
                    "its cell")
 
 
+# A cluster-robust SE below this (log-odds) is 0 to rounding: a real one this small needs some 10^12 answers.
+SE_ZERO = 1e-6
+
+
+def zero_se_note(words, estimate):
+    """Why a cluster-robust term with an SE of 0 (to rounding) gets no SE and no p, and with an estimate of 0 (to
+    rounding) no estimate either, in words. The sandwich SE is the spread of the participants' pulls on a term; it is 0
+    when no participant's answers pull the term from its estimate - as when, in each participant, its level's answers
+    come out as its baseline's once the other terms are fitted (an estimate of 0 by construction, printed as digits
+    such as -2e-15 that are rounding), or when the participants agree exactly. Its t is then rounding over rounding,
+    and a p from it says nothing."""
+    import re
+    against = re.fullmatch(r"(.+) \(against (.+)\)", words)
+    if abs(estimate) <= SE_ZERO:
+        alike = (f"the answers at {against[1]} come out as those at {against[2]}" if against else
+                 "the answers along this term come out as the other terms predict")
+        return (f"not determined: no participant's answers pull it away from 0 (as when, in each participant, {alike} "
+                f"once the other terms are fitted), so the estimate is 0 by construction and its cluster-robust SE 0 "
+                f"- a fit prints rounding noise there, not an estimate; no estimate, no p (compare the shares of its "
+                f"cells)")
+    return ("SE not determined: no participant's answers pull it away from this estimate (as when every participant's "
+            "answers alone give the same value), so its cluster-robust SE is 0 and a p would be rounding noise; no SE, "
+            "no p")
+
+
+def without_zero_se(table, words):
+    """A cluster_robust() table with se, df and p blanked where the SE is 0 to rounding (or not a number: a variance
+    rounded below 0), the estimate too where it is 0 to rounding; returns (table, {term: note in words})."""
+    table = table.copy()
+    notes = {}
+    for i, r in table.iterrows():
+        if math.isfinite(r["se"]) and r["se"] > SE_ZERO:
+            continue
+        notes[r["term"]] = zero_se_note(words.get(r["term"], r["term"]), r["estimate"])
+        table.loc[i, ["se", "df", "p"]] = math.nan
+        if abs(r["estimate"]) <= SE_ZERO:
+            table.loc[i, "estimate"] = math.nan
+    return table, notes
+
+
 def model_row(study, model, term, estimate=math.nan, se=math.nan, df=math.nan, p=math.nan, engine="", note=""):
     return {"study": study, "model": model, "term": term, "estimate": estimate, "se": se, "df": df, "p": p,
             "engine": engine, "note": note}
@@ -516,12 +556,12 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
     formula = _formula_text(response, formula_rhs)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        table = None
+        table, zero_se = None, {}
         try:
             if not estimable:
                 pass
             elif n_groups >= 2:
-                table = cluster_robust(yr, Xr, gr)
+                table, zero_se = without_zero_se(cluster_robust(yr, Xr, gr), words)
             else:
                 res = sm.GLM(yr, Xr, family=sm.families.Binomial()).fit()
                 z = np.asarray(res.params) / np.asarray(res.bse)
@@ -531,7 +571,7 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
             notes.append(f"logistic GLM not fitted: {type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''}")
         if n_groups >= 2:
             add_fit(f"glm({formula}), cluster-robust", f"statsmodels {sm_version} GLM cluster-robust CR1, t(G-1)",
-                    table, lambda c: "")
+                    table, lambda c: zero_se.get(c, ""))
         else:
             notes.append("one participant: no model across observers; plain logistic GLM instead")
             add_fit(f"glm({formula})", f"statsmodels {sm_version} GLM (one observer), Wald z", table,

@@ -189,6 +189,38 @@ class ObserverModelTest(unittest.TestCase):
         self.assertTrue(table.empty)
         self.assertTrue(any("no model across observers" in n for n in notes))
 
+    @staticmethod
+    def same_at_both_edges():
+        """Two participants whose answers at edge 6 are those at edge 3, answer for answer, in each blur cell: the
+        response is constant across the two edges, so the edge term is 0 by construction."""
+        rows = []
+        for p, (sharp, blurred) in {"P1": ([1, 1, 1, 0], [0, 0, 1, 0]), "P2": ([1, 1, 0, 0], [0, 1, 0, 0])}.items():
+            for edge in (3, 6):
+                rows += [{"participant": p, "edge": edge, "blur": "sharp", "y": float(v)} for v in sharp]
+                rows += [{"participant": p, "edge": edge, "blur": "blurred", "y": float(v)} for v in blurred]
+        return pd.DataFrame(rows)
+
+    def test_term_zero_by_construction_is_said_in_words_not_as_rounding_noise(self):
+        table, _ = stats.observer_models(self.same_at_both_edges(), "y", "C(blur) + C(edge)")
+        edge = table[table["term"] == "edge 6 (against edge 3)"].iloc[0]
+        # The fit gives some 1e-16 with an SE of the same size, and a p from their ratio: none of them is printed.
+        for column in ("estimate", "se", "p"):
+            self.assertTrue(math.isnan(edge[column]), f"{column} = {edge[column]!r}")
+        self.assertIn("not determined", edge["note"])
+        self.assertIn("the answers at edge 6 come out as those at edge 3", edge["note"])
+        blur = table[table["term"] == "blur sharp (against blur blurred)"].iloc[0]  # a real effect keeps its numbers
+        self.assertAlmostEqual(blur["estimate"], math.log(5 / 3) - math.log(1 / 3), places=6)  # 5/8 vs 2/8 yes
+        self.assertGreater(blur["se"], 0.1)
+        self.assertEqual(blur["note"], "")
+
+    def test_se_of_zero_is_said_in_words_and_the_estimate_kept(self):
+        table, _ = stats.observer_models(self.same_at_both_edges(), "y", "C(blur) + C(edge)")
+        # Both participants said yes to 2 of their 8 blurred balls: the baseline is log(2/6) in each, no spread.
+        base = table[table["term"] == "baseline (intercept)"].iloc[0]
+        self.assertAlmostEqual(base["estimate"], math.log(2 / 6), places=6)
+        self.assertTrue(math.isnan(base["se"]) and math.isnan(base["p"]))
+        self.assertIn("SE not determined", base["note"])
+
     def test_disagreeing_models_are_called_borderline(self):
         glm = "statsmodels 0.13.5 GLM cluster-robust CR1, t(G-1)"
         lme4 = "lme4 1.1-31 glmer (Laplace), Wald t(G-1)"
