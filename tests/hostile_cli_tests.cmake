@@ -195,3 +195,15 @@ hostile_test(cli_hostile_observer_weber_100000_digits 2
              --observer sim:weber=${digits})
 hostile_test(cli_hostile_radius_100000_digits 2 "--radius-px: must be in [0, 500] px, got '${shown}...' (100000 characters)"
              blur ${D}/small.png --radius-px ${digits} --out ${H}/x.png)
+
+# An overexposed photo (the scene x 1.3: the board's white squares clip) leaves the first and last edges alone: at two
+# depths a focus between them and one beyond them fit alike (it gave focus 140 mm for 400, exit 0): refused, exit 4,
+# saying which edges were usable and why the others were not.
+add_test(NAME cli_hostile_overexposed_make
+         COMMAND /usr/bin/python3 -c "import sys, numpy as np; from PIL import Image; a = np.asarray(Image.open(sys.argv[1]).convert('RGB')).astype(float); Image.fromarray(np.clip(a * 1.3, 0, 255).astype(np.uint8)).save(sys.argv[2])"
+                 ${T}/scene/scene.png ${H}/overexposed.png)
+set_tests_properties(cli_hostile_overexposed_make PROPERTIES FIXTURES_REQUIRED scene FIXTURES_SETUP overexposed)
+hostile_test(cli_hostile_calibrate_two_depths 4
+             "overexposed.png: only 2 of 11 edges have a usable section (edge 1 and 11); the others are saturated"
+             calibrate ${H}/overexposed.png --camera ${T}/scene/camera.json --out ${H}/calib-two-depths.json)
+set_tests_properties(cli_hostile_calibrate_two_depths PROPERTIES FIXTURES_REQUIRED "scene;overexposed")

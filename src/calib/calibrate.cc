@@ -5,6 +5,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
@@ -69,6 +73,41 @@ std::vector<optics::BlurSample> ModelSamples(const CalibResult& result) {
       if (s.fit.ok) samples.push_back({s.u_mm, s.fit.r_px / s.stretch, 1.0});
   return samples;
 }
+
+// The thin lens's radius is unsigned: sections at two depths fit a focus between them and one beyond them alike
+// (an overexposed photo that leaves the first and last edges only gave focus 140 mm for 400 and an aperture 7 x off).
+// Three edges with a usable section are the least a model is fitted to; fewer is refused, saying why the others
+// were not usable.
+namespace {
+void RequireThreeDepths(const CalibResult& result) {
+  std::vector<int> usable;
+  std::map<std::string, int> why;
+  for (const auto& edge : result.edges) {
+    bool any = false;
+    for (const auto& s : edge.sections) {
+      any = any || s.fit.ok;
+      if (!s.fit.ok)
+        for (const std::string& flag : s.fit.flags) ++why[flag];
+    }
+    if (any) usable.push_back(edge.index);
+  }
+  if (usable.size() >= 3) return;
+  std::string edges, flags;
+  for (const int e : usable) edges += (edges.empty() ? "" : " and ") + std::to_string(e);
+  std::vector<std::pair<int, std::string>> common;
+  for (const auto& [flag, n] : why) common.push_back({-n, flag});
+  std::sort(common.begin(), common.end());
+  for (size_t i = 0; i < common.size() && i < 3; ++i)
+    flags += (i ? ", " : "") + common[i].second + " (" + std::to_string(-common[i].first) + " sections)";
+  throw Error(ErrorKind::kNotFound,
+              "only " + std::to_string(usable.size()) + " of " + std::to_string(result.edges.size()) +
+                  " edges have a usable section" + (edges.empty() ? "" : " (edge " + edges + ")") +
+                  (flags.empty() ? "" : "; the others are " + flags) +
+                  ": a thin lens needs sections at 3 or more depths (at 2 a focus between them and one beyond "
+                  "them fit alike); retake the photo so that more of the board's edges are measured (exposure, "
+                  "framing, focus)");
+}
+}  // namespace
 
 void ApplyModel(CalibResult& result, const optics::FittedModel& model) {
   const optics::Lens lens = optics::Lens::FromCamera(result.camera);
@@ -228,7 +267,10 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
   result.reference_r_px = Median(ref_r);
   result.reference_u_mm = Median(ref_u);
 
-  if (options.fit_model) result.model = optics::FitThinLens(lens, ModelSamples(result), options.optics_fit);
+  if (options.fit_model) {
+    RequireThreeDepths(result);
+    result.model = optics::FitThinLens(lens, ModelSamples(result), options.optics_fit);
+  }
 
   for (auto& edge : result.edges) {
     double su = 0;

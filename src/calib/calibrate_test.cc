@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <map>
 #include <string>
 #include <cstdio>
@@ -529,6 +530,52 @@ TEST(SceneCalib, BadFieldIsNamed) {
         << e.what();
   }
   EXPECT_THROW(ParseBlurSource("blurry", nullptr), Error);
+}
+
+// The model block says which model predicts: its kind is one of the two, the floor model states its floor (a missing
+// one was read as 0: the objects drawn without the scene's floor), the thin lens has none (a floor beside it was
+// drawn), the focus lies beyond the focal length, and a key calibrate does not write is a hand edit the reader would
+// ignore. Each refused, naming the field.
+TEST(SceneCalib, ModelBlockIsReadAsWritten) {
+  const Calibration& r = Calibrated(Thesis());
+  const Json written = CalibToJson(r.result);
+  auto refused = [&](const std::function<void(Json&)>& edit, const std::string& expected) {
+    Json j = written;
+    j["model"]["kind"] = "thin_lens+floor", j["model"]["floor_px"] = 0.7, j["model"]["floor_determined"] = true;
+    EXPECT_NO_THROW(SceneCalibFromJson(j, "calib.json: "));
+    edit(j);
+    try {
+      SceneCalibFromJson(j, "calib.json: ");
+      ADD_FAILURE() << expected;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::kInput);
+      EXPECT_EQ(std::string(e.what()), expected);
+    }
+  };
+  refused([](Json& j) { j["model"]["kind"] = 5; },
+          "calib.json: /model/kind: must be \"thin_lens\" or \"thin_lens+floor\", got 5");
+  refused([](Json& j) { j["model"]["kind"] = "thin_lens+flor"; },
+          "calib.json: /model/kind: must be \"thin_lens\" or \"thin_lens+floor\", got \"thin_lens+flor\" (did you "
+          "mean thin_lens+floor?)");
+  refused([](Json& j) { j["model"].erase("floor_px"); }, "calib.json: /model/floor_px: is required but missing");
+  refused([](Json& j) { j["model"]["kind"] = "thin_lens"; },
+          "calib.json: /model/floor_px: must be 0 for model kind \"thin_lens\" (no floor), got 0.7; a floor needs kind "
+          "\"thin_lens+floor\"");
+  refused([](Json& j) { j["model"]["floor_determined"] = "yes"; },
+          "calib.json: /model/floor_determined: must be true or false, got \"yes\"");
+  refused([](Json& j) { j["model"]["focus_mm"] = 21; },
+          "calib.json: /model/focus_mm: must be beyond the camera's focal length (21 mm): a thin lens forms no real "
+          "image nearer, got 21");
+  refused([](Json& j) { j["model"]["flor_px"] = 1; },
+          "calib.json: /model/flor_px: is not a field of a blurcue calibration (did you mean floor_px?)");
+  refused([](Json& j) { j["edges"][0]["sections"][0]["ok"] = 1; },
+          "calib.json: /edges/0/sections/0/ok: must be true or false, got 1");
+  refused([](Json& j) { j["version"] = 99; },
+          "calib.json: /version: must be 1 (this blurcue reads calibrations of format version 1), got 99");
+  // As written, each kind reads back with its floor.
+  Json thin = written;
+  thin["model"]["kind"] = "thin_lens", thin["model"]["floor_px"] = 0;
+  EXPECT_EQ(SceneCalibFromJson(thin, "calib.json: ").model.floor_px, 0);
 }
 
 // A command's blur source and a protocol's are one vocabulary (core/blur_source.h): each word a protocol may write

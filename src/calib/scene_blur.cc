@@ -58,6 +58,35 @@ const Json& Object(const Json& obj, const std::string& key, const std::string& w
   return obj[key];
 }
 
+// calib.json is written by `blurcue calibrate` (CalibToJson) and `track` (a frame's calib-NNNN.json adds its
+// frame's fields); a key neither writes is a hand edit the reader would ignore: refused, naming the nearest.
+void KnownKeys(const Json& obj, const std::string& where, const std::vector<std::string>& known) {
+  for (auto it = obj.begin(); it != obj.end(); ++it)
+    if (std::find(known.begin(), known.end(), it.key()) == known.end())
+      throw InputError(where + "/" + it.key(), "is not a field of a blurcue calibration" + DidYouMean(it.key(), known));
+}
+
+const std::vector<std::string> kTopKeys = {"format", "version", "software", "camera", "board", "pose",
+                                           "reference_edge", "reference", "model", "r_units", "timing_ms", "edges",
+                                           // a tracked frame's (track/take.cc)
+                                           "photo", "frame", "time_s", "track_status", "frame_signature",
+                                           "lens_model"};
+const std::vector<std::string> kModelKeys = {"kind", "focus_mm", "aperture_mm", "floor_px", "floor_determined",
+                                             "rms_px", "loo_rms_px", "samples_used", "outliers", "choice"};
+const std::vector<std::string> kEdgeKeys = {"index", "u_mm", "usable_sections", "sections"};
+const std::vector<std::string> kSectionKeys = {"index", "u_mm", "midpoint_camera_mm", "image_px", "r_px", "r_thesis_px",
+                                               "r_estimated_px", "r_fitted_px", "ok", "flags", "psf", "disc_r_px",
+                                               "floor_sigma_px", "shape_ambiguous", "fit_rms_rel", "step_linear",
+                                               "thesis_ok", "r_estimated_note", "crowded_why", "stretch"};
+const std::vector<std::string> kModelKinds = {"thin_lens", "thin_lens+floor"};
+
+// A boolean field (absent: `absent`).
+bool Flag(const Json& obj, const std::string& key, const std::string& where, bool absent) {
+  if (!obj.contains(key)) return absent;
+  if (!obj[key].is_boolean()) throw InputError(where + "/" + key, "must be true or false, got " + obj[key].dump());
+  return obj[key].get<bool>();
+}
+
 }  // namespace
 
 cv::Vec3d SceneCalib::ToCamera(const cv::Vec3d& board_mm) const {
@@ -74,8 +103,12 @@ void SceneCalib::RequireSameSize(const cv::Mat& photo, const std::string& photo_
 }
 
 SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
-  if (j.value("format", "") != "blurcue-calib")
+  if (!j.is_object() || !j.contains("format") || j["format"] != "blurcue-calib")
     throw InputError(where + "/format", "must be \"blurcue-calib\" (a file written by blurcue calibrate)");
+  KnownKeys(j, where, kTopKeys);
+  if (j.contains("version") && j["version"] != 1)
+    throw InputError(where + "/version", "must be 1 (this blurcue reads calibrations of format version 1), got " +
+                                             j["version"].dump());
   SceneCalib s;
   s.camera = CameraFromJson(Object(j, "camera", where), where + "/camera");
   const Json& board = Object(j, "board", where);
@@ -91,14 +124,37 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
   s.reference_u_mm = Ranged(ref, "u_mm", where + "/reference", 0, kMaxDistanceMm, "mm");
   s.reference_r_px = Ranged(ref, "r_px", where + "/reference", 0, optics::kMaxBlurRadiusPx, "px");
   const Json& model = Object(j, "model", where);
-  s.model.kind = model.value("kind", "thin_lens");
+  const std::string mw = where + "/model";
+  KnownKeys(model, mw, kModelKeys);
+  if (!model.contains("kind") || !model["kind"].is_string() ||
+      std::find(kModelKinds.begin(), kModelKinds.end(), model["kind"].get<std::string>()) == kModelKinds.end())
+    throw InputError(mw + "/kind", "must be \"thin_lens\" or \"thin_lens+floor\", got " +
+                                       (model.contains("kind") ? model["kind"].dump() : std::string("nothing")) +
+                                       (model.contains("kind") && model["kind"].is_string()
+                                            ? DidYouMean(model["kind"].get<std::string>(), kModelKinds)
+                                            : ""));
+  s.model.kind = model["kind"].get<std::string>();
   s.model.focus_mm = model.contains("focus_mm") && model["focus_mm"] == "infinity"
                          ? std::numeric_limits<double>::infinity()
                          : Ranged(model, "focus_mm", where + "/model", 0, kMaxDistanceMm, "mm");
   s.model.aperture_mm = Ranged(model, "aperture_mm", where + "/model", 0, 1000, "mm");
-  s.model.floor_px = model.contains("floor_px")
-                         ? Ranged(model, "floor_px", where + "/model", 0, optics::kMaxBlurRadiusPx, "px")
-                         : 0.0;
+  // The floor belongs to its model: the floor model states it (a missing one is not taken as 0), the thin lens has
+  // none (a floor beside it would be drawn though the model says there is none).
+  const bool floored = s.model.kind == "thin_lens+floor";
+  if (floored || model.contains("floor_px"))
+    s.model.floor_px = Ranged(model, "floor_px", mw, 0, optics::kMaxBlurRadiusPx, "px");
+  if (!floored && s.model.floor_px != 0)
+    throw InputError(mw + "/floor_px", "must be 0 for model kind \"thin_lens\" (no floor), got " +
+                                           Num(s.model.floor_px) + "; a floor needs kind \"thin_lens+floor\"");
+  s.model.floor_determined = Flag(model, "floor_determined", mw, !floored);
+  // The thin lens forms an image of its focus plane only beyond its focal length.
+  if (const double f_mm = s.camera.focal_length_mm; !(s.model.focus_mm > f_mm))
+    throw InputError(mw + "/focus_mm", "must be beyond the camera's focal length (" + Num(f_mm) +
+                                           " mm): a thin lens forms no real image nearer, got " + Num(s.model.focus_mm));
+  if (!(s.reference_u_mm > s.camera.focal_length_mm))
+    throw InputError(where + "/reference/u_mm", "must be beyond the camera's focal length (" +
+                                                    Num(s.camera.focal_length_mm) + " mm), got " +
+                                                    Num(s.reference_u_mm));
   if (!j.contains("edges") || !j["edges"].is_array()) throw InputError(where + "/edges", "must be an array");
   // An edge or a section listed twice would be averaged with the other copy, or stand in for a missing one: both
   // are refused, so each edge's measured blur is its own sections' and nothing else's.
@@ -106,6 +162,8 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
   for (size_t e = 0; e < j["edges"].size(); ++e) {
     const Json& edge = j["edges"][e];
     const std::string ew = where + "/edges/" + std::to_string(e);
+    if (!edge.is_object()) throw InputError(ew, "must be an object");
+    KnownKeys(edge, ew, kEdgeKeys);
     const int index = RangedInt(edge, "index", ew, 1, s.board.EdgeCount());
     if (const auto [it, fresh] = edge_seen.emplace(index, "/edges/" + std::to_string(e)); !fresh)
       throw InputError(ew + "/index", "edge " + std::to_string(index) + " is listed twice (also at " + it->second +
@@ -116,6 +174,8 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
     for (size_t k = 0; k < edge["sections"].size(); ++k) {
       const Json& sec = edge["sections"][k];
       const std::string sw = ew + "/sections/" + std::to_string(k);
+      if (!sec.is_object()) throw InputError(sw, "must be an object");
+      KnownKeys(sec, sw, kSectionKeys);
       SceneCalib::Section out;
       out.edge = index;
       out.section = RangedInt(sec, "index", sw, 1, s.board.SectionCount());
@@ -123,7 +183,7 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
         throw InputError(sw + "/index", "section " + std::to_string(out.section) + " of edge " +
                                             std::to_string(index) + " is listed twice (also at " + it->second + ")");
       out.midpoint_camera_mm = Vec3(sec, "midpoint_camera_mm", sw, kMaxDistanceMm, "mm");
-      out.ok = sec.value("ok", false);
+      out.ok = Flag(sec, "ok", sw, false);
       // A section the fit gave up on keeps whatever number it had; only usable ones feed a blur.
       out.r_px = out.ok ? Ranged(sec, "r_px", sw, 0, optics::kMaxBlurRadiusPx, "px") : RequireNumber(sec, "r_px", sw);
       s.sections.push_back(out);

@@ -67,6 +67,13 @@ void AddCalibrateCommand(CLI::App& app) {
     Json json = calib::CalibToJson(result);
     json["photo"] = args->photo;
     WriteJsonFile(args->out, json);
+    // A pose that fits its corners badly: the camera is not this photo's (distortion, sensor, focal length).
+    if (result.pose.reprojection_error_px > 1)
+      std::fprintf(stderr,
+                   "blurcue: warning: %s: the board's corners fit the pose only to %.2f px (a photo of this camera "
+                   "fits to well under 1 px): check its dist_coeffs, sensor size and focal length; the depths and "
+                   "blurs measured rest on that pose\n",
+                   args->camera.c_str(), result.pose.reprojection_error_px);
     if (args->quiet) return;
     const auto& m = result.model;
     std::printf("board %s found; pose reprojection error %.3f px; board origin %.1f mm from the lens\n",
@@ -77,6 +84,19 @@ void AddCalibrateCommand(CLI::App& app) {
                 " leave-one-out %.3f px, %d outliers of %d\n",
                 m.kind.c_str(), m.focus_mm, m.aperture_mm, camera.ApertureMm(), optics::FloorText(m).c_str(),
                 m.rms_px, m.loo_rms_px, m.outliers, m.samples_used);
+    // Why this model (calib.json's model.choice): both candidates' held-out errors, and eq. 3.7 as published.
+    const Json& choice = json["model"]["choice"];
+    if (std::isfinite(m.floor_loo_rms_px))
+      std::printf("model choice, held-out error: thin lens %.3f px, thin lens + floor %.3f px (%s)\n",
+                  m.thin_loo_rms_px, m.floor_loo_rms_px, optics::kModelChoiceRule);
+    else
+      std::printf("model: the thin lens alone (the floor model needs at least 10 sections; %d usable)\n",
+                  m.samples_used);
+    if (choice["eq37"]["rms_px"].is_number())
+      std::printf("eq. 3.7 (the thesis's estimate from reference edge %d, no parameters fitted): rms %.3f px against "
+                  "the measured sections%s\n",
+                  result.reference_edge, choice["eq37"]["rms_px"].get<double>(),
+                  m.kind == "thin_lens+floor" ? " (it takes the reference's whole blur for defocus, floor included)" : "");
     std::vector<double> true_r;
     if (!args->truth.empty()) {
       const calib::TruthComparison cmp =

@@ -379,13 +379,21 @@ double FittedModel::PredictPx(const Lens& lens, double u_mm) const {
 bool FloorPinned(const FittedModel& m) { return m.kind != "thin_lens+floor" || m.floor_determined; }
 
 std::string FloorText(const FittedModel& m) {
-  char text[96];
-  if (m.kind != "thin_lens+floor")
-    std::snprintf(text, sizeof text, "floor 0 px (thin lens alone)");
-  else if (m.floor_determined)
-    std::snprintf(text, sizeof text, "floor %.2f px", m.floor_px);
-  else
+  char text[160];
+  const bool range = std::isfinite(m.floor_lo_px) && std::isfinite(m.floor_hi_px);
+  if (m.kind != "thin_lens+floor") {
+    // The thin lens kept: its floor is 0, but where the floor model's floors span a range the sections do not say
+    // there is none (focus off the board): a lens floor would then show only near focus, where nothing was measured.
+    if (range && m.floor_hi_px - m.floor_lo_px > std::max(0.1, 0.2 * m.floor_hi_px))
+      std::snprintf(text, sizeof text, "floor 0 px (thin lens alone; floors %.2f-%.2f px fit alike: not determined)",
+                    m.floor_lo_px, m.floor_hi_px);
+    else
+      std::snprintf(text, sizeof text, "floor 0 px (thin lens alone)");
+  } else if (m.floor_determined) {
+    std::snprintf(text, sizeof text, "floor %.2f px (a std of %.2f px)", m.floor_px, m.floor_px / 2);
+  } else {
     std::snprintf(text, sizeof text, "floor not determined (%.2f-%.2f px fit alike)", m.floor_lo_px, m.floor_hi_px);
+  }
   return text;
 }
 

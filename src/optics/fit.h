@@ -49,8 +49,10 @@ struct FittedModel {
 // Whether the model's floor_px is a result: the thin lens alone (floor 0) or a floor the sections pin.
 bool FloorPinned(const FittedModel& m);
 
-// The floor in words for a summary line: "floor 0.70 px", "floor 0 px (thin lens alone)" or, where the sections do
-// not pin it, "floor not determined (0.99-1.86 px fit alike)".
+// The floor in words for a summary line: "floor 0.70 px (a std of 0.35 px)" (the floor is a radius, 2 x its
+// Gaussian's std, as every r_px), "floor 0 px (thin lens alone)" (with "floors 0.00-3.58 px fit alike: not
+// determined" where the floor model's range is wide) or, where the sections do not pin the floor model's,
+// "floor not determined (0.99-1.86 px fit alike)".
 std::string FloorText(const FittedModel& m);
 
 // How FitThinLens chooses between its two candidates, in words (calib.json's model.choice.rule).
