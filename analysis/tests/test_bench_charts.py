@@ -152,6 +152,50 @@ class BenchChartsTest(unittest.TestCase):
         self.assertTrue(ticks and all("^" not in t and "$" not in t for t in ticks), ticks)
         self.assertIn("--quick", ax.get_title(loc="left"))
 
+    def test_fitted_model_on_the_model_fit_leaves_both_visible(self):
+        rows = measure_rows()
+        fit = rows[(rows["method"] == "model_fit") & (rows["factor"] == "base")].assign(method="fitted_model",
+                                                                                        time_us_per_section=4)
+        bench_charts.measure_speed_accuracy(pd.concat([rows, fit], ignore_index=True), self.out)
+        ax = self.caught.figures["bench-measure-speed-accuracy"].axes[0]
+        marks = {c.get_label(): c for c in ax.collections if not c.get_label().startswith("_")}
+        ring = marks["model fit (r_px)"]
+        diamond = marks["fitted thin-lens model (+ model fit time)"]
+        # Where the numbers put them (104 us: the model fit's 100 plus its own 4; 0.05 px both), not moved apart...
+        self.assertEqual(ring.get_offsets().tolist(), [[100.0, 0.05]])
+        self.assertEqual(diamond.get_offsets().tolist(), [[104.0, 0.05]])
+        # ...so the model fit is an open ring wider than the filled diamond drawn over it.
+        self.assertEqual(ring.get_facecolors().size, 0, "the model fit's ring is open")
+        self.assertGreater(ring.get_sizes()[0], 2 * diamond.get_sizes()[0])
+        self.assertGreater(diamond.get_zorder(), ring.get_zorder())
+
+    def test_stability_labels_stay_in_their_panels_and_levels_have_three_digits(self):
+        rows = measure_rows()
+        rows = pd.concat([rows] + [rows[rows["factor"] == "noise"].assign(factor=f, level=rows["level"] * k + 0.279508)
+                                   for f, k in (("vignetting", 10), ("distortion", -5), ("tilt", 1))],
+                         ignore_index=True)
+        charts = bench_charts.stability(rows, self.out)
+        for name in ("bench-stability-within-target", "bench-stability-error"):
+            fig = self.caught.figures[name]
+            fig.canvas.draw()
+            width = fig.bbox.width
+            for i, ax in enumerate(a for a in fig.axes if a.get_visible()):
+                column = i % 3
+                box = ax.xaxis.label.get_window_extent()
+                # Within its third of the figure: not past the figure's edge, not under the next panel's label.
+                self.assertGreaterEqual(box.x0, column * width / 3 - 1, (name, ax.get_xlabel()))
+                self.assertLessEqual(box.x1, (column + 1) * width / 3 + 1, (name, ax.get_xlabel()))
+                self.assertIn("sweep", ax.get_xlabel())
+        ticks = [t.get_text() for t in self.caught.figures["bench-stability-within-target"].axes[1].get_xticklabels()]
+        self.assertEqual(ticks, ["0.28", "0.48", "0.68"])  # vignetting: 0.279508, 0.479508, 0.679508
+        t = charts[0].table.set_index(["method", "factor"])
+        self.assertEqual(t.loc[("model_fit", "vignetting"), "holds_at"], "0.28, 0.48")
+        self.assertEqual(t.loc[("model_fit", "vignetting"), "breaks_at"], "0.68")
+
+    def test_levels_are_written_with_three_significant_digits(self):
+        self.assertEqual([bench_charts.level_text(v) for v in (0.279508, 17.8885, 1000, 95, 0.04, -0.3, 0)],
+                         ["0.28", "17.9", "1000", "95", "0.04", "-0.3", "0"])
+
 
 
 def procedure_rows(rows):
