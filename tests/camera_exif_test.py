@@ -108,8 +108,11 @@ check("turned photo: 400 x 600 px, sensor 24 x 36 mm",
 # 5. --sensor-mm overrides; --f-number fills a missing FNumber.
 p = photo("nofnumber.jpg", (600, 400), {MODEL: "Unlisted 4"}, {FOCAL: R(35, 1)})
 code, _, err = run(p)
-check("a missing FNumber is refused naming the tag and the option",
-      code == 3 and "EXIF FNumber (0x829d) is missing; give --f-number" in err and err.count("\n") == 1, (code, err))
+# Everything missing is named at once (it took three runs to learn the three options a bare photo needs).
+check("a missing FNumber and sensor are refused at once, naming the tags and the options",
+      code == 3 and "EXIF FNumber (0x829d) is missing, no sensor size (EXIF FocalPlaneXResolution (0xa20e) is "
+      "missing, EXIF FocalLengthIn35mmFilm (0xa405) is missing, model 'Unlisted 4' not in the sensor table); give "
+      "--f-number and --sensor-mm W H" in err and err.count("\n") == 1, (code, err))
 c, err = camera(p, "--f-number", "8", "--sensor-mm", "36", "24")
 check("--f-number and --sensor-mm fill what EXIF lacks",
       near(c["f_number"], 8) and near(c["sensor_width_mm"], 36) and near(c["sensor_height_mm"], 24), (c, err))
@@ -118,6 +121,12 @@ check("--f-number and --sensor-mm fill what EXIF lacks",
 p = photo("nosensor.jpg", (600, 400), {MODEL: "Unlisted 5"}, {FOCAL: R(35, 1), FNUMBER: R(8, 1)})
 code, _, err = run(p)
 check("no sensor size: refused, --sensor-mm named", code == 3 and "give --sensor-mm W H" in err, (code, err))
+# A tag that is there but says "unknown" is not called missing.
+p = photo("fl35-zero.jpg", (600, 400), {}, {FOCAL: R(35, 1), FNUMBER: R(8, 1), FOCAL35: 0})
+code, _, err = run(p)
+check("a 35 mm equivalent of 0 is named as 0 (unknown), not as missing",
+      code == 3 and "EXIF FocalLengthIn35mmFilm (0xa405) is 0 (unknown), no EXIF Model); give --sensor-mm W H" in err,
+      (code, err))
 
 # 7. No EXIF at all.
 p = photo("plain.jpg", (600, 400))
@@ -154,7 +163,10 @@ Image.new("RGB", (600, 400), (90, 120, 150)).save(p, exif=exif.tobytes())
 code, _, err = run(p)
 check("a PNG: not a JPEG, its EXIF not read",
       code == 3 and "tagged.png: is not a JPEG: its EXIF, if any, is not read (EXIF is read from JPEG files); give "
-      "--focal-length-mm" in err, (code, err))
+      "--focal-length-mm, --f-number and --sensor-mm W H" in err, (code, err))
+code, _, err = run(p, "--focal-length-mm", "21")
+check("a PNG with a focal length given: the two others named, not the one given",
+      code == 3 and err.endswith("give --f-number and --sensor-mm W H\n"), (code, err))
 c, err = camera(p, "--focal-length-mm", "21", "--f-number", "8", "--sensor-mm", "23.4", "15.6")
 check("a PNG with every number given", c["image_width_px"] == 600 and near(c["sensor_width_mm"], 23.4), (c, err))
 

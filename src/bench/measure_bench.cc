@@ -256,37 +256,58 @@ void WriteMeasureCsv(const std::vector<MeasureRow>& rows, const std::filesystem:
 }
 
 std::string DescribeBreakpoints(const std::vector<MeasureRow>& rows) {
-  // Rows come in sweep order (increasing difficulty), so the first failing level is where the method breaks.
+  // Rows come in sweep order (increasing difficulty), so the first failing level is where the method breaks - unless
+  // the method fails on the base scene already: then no level of a factor is the cause, and that is said instead.
   std::map<std::pair<std::string, std::string>, std::vector<const MeasureRow*>> groups;
   std::vector<std::pair<std::string, std::string>> order;
+  std::map<std::string, const MeasureRow*> failed_base;
   for (const auto& r : rows) {
-    if (r.factor == "base") continue;
+    if (r.factor == "base") {
+      if (!r.meets_target) failed_base[r.method] = &r;
+      continue;
+    }
     auto key = std::make_pair(r.method, r.factor);
     if (!groups.count(key)) order.push_back(key);
     groups[key].push_back(&r);
   }
+  // A level as the charts print it (3 significant digits), marked where the board was not found (its blur was then
+  // measured at the true pose: the method "held" without the pipeline's detection).
+  auto level = [](const MeasureRow& r) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.3g%s", r.level, r.board_found ? "" : " (board not found)");
+    return std::string(text);
+  };
   std::ostringstream out;
+  for (const auto& [method, r] : failed_base) {
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "  %-12s %-8s fails on the base scene already: %.1f%% within target, mean |error| %.2f px (no "
+                  "factor below is its cause)\n",
+                  method.c_str(), "base", 100 * r->within_target, r->mean_abs_error_px);
+    out << line;
+  }
   for (const auto& key : order) {
     const auto& g = groups[key];
-    std::ostringstream held;
+    std::string held, failed;
     const MeasureRow* broke = nullptr;
     for (const MeasureRow* r : g) {
-      if (r->meets_target) {
-        held << (held.tellp() > 0 ? ", " : "") << r->level;
-      } else if (!broke) {
-        broke = r;
-      }
+      std::string& list = r->meets_target ? held : failed;
+      list += (list.empty() ? "" : ", ") + level(*r);
+      if (!r->meets_target && !broke) broke = r;
     }
     char line[512];
     if (!broke) {
       std::snprintf(line, sizeof line, "  %-12s %-8s holds at every level (%s)\n", key.first.c_str(),
-                    key.second.c_str(), held.str().c_str());
+                    key.second.c_str(), held.c_str());
+    } else if (failed_base.count(key.first)) {
+      std::snprintf(line, sizeof line, "  %-12s %-8s within target at %s; not at %s\n", key.first.c_str(),
+                    key.second.c_str(), held.empty() ? "no level" : held.c_str(), failed.c_str());
     } else {
       std::snprintf(line, sizeof line,
-                    "  %-12s %-8s breaks at %g: answered %d/%d, %.1f%% within target, mean |error| %.2f px%s%s\n",
-                    key.first.c_str(), key.second.c_str(), broke->level, broke->answered, broke->sections,
-                    100 * broke->within_target, broke->mean_abs_error_px, held.tellp() > 0 ? "; holds at " : "",
-                    held.str().c_str());
+                    "  %-12s %-8s breaks at %s: answered %d/%d, %.1f%% within target, mean |error| %.2f px%s%s\n",
+                    key.first.c_str(), key.second.c_str(), level(*broke).c_str(), broke->answered, broke->sections,
+                    100 * broke->within_target, broke->mean_abs_error_px, held.empty() ? "" : "; holds at ",
+                    held.c_str());
     }
     out << line;
   }
@@ -297,7 +318,7 @@ std::string DescribeBreakpoints(const std::vector<MeasureRow>& rows) {
     if (r.method == "model_fit" && !r.board_found && !detection_broke.count(r.factor)) detection_broke[r.factor] = &r;
   for (const auto& [factor, r] : detection_broke) {
     char line[256];
-    std::snprintf(line, sizeof line, "  %-12s %-8s breaks at %g: board not found (blur measured at the true pose)\n",
+    std::snprintf(line, sizeof line, "  %-12s %-8s breaks at %.3g: board not found (blur measured at the true pose)\n",
                   "detection", factor.c_str(), r->level);
     out << line;
   }

@@ -22,7 +22,7 @@
 namespace blurcue::cli {
 void AddRenderCommand(CLI::App& app) {
   struct Args {
-    std::string calib, background, object = "ball", blur = "estimated", method = "gaussian", out, backend = "gl";
+    std::string calib, background, object = "ball", blur = "fitted", method = "gaussian", out, backend = "gl";
     int edge = 1, section = 4, display_width = 0, picture_height = 0;
     double gain = 1, brightness = 1, contrast = 1, cutoff = 0;
   };
@@ -39,10 +39,13 @@ void AddRenderCommand(CLI::App& app) {
       "  --blur none|measured|measured_section|estimated|fitted|R\n"
       "      measured: the edge's value, the mean r of its usable sections (thesis Fig. 4.11), for the edge whose line\n"
       "      passes nearest the object (refused when that edge has no usable section); measured_section: r of the\n"
-      "      nearest usable section alone; estimated: eq. 3.7 from the reference edge;\n"
-      "      fitted: the thin-lens model fitted to all sections; R: a fixed radius in px. --gain scales it.\n"
+      "      nearest usable section alone; fitted (the default): the model calibrate chose from all sections (thin\n"
+      "      lens, or thin lens + the lens's floor of blur), the blur the photo shows at the object's depth;\n"
+      "      estimated: eq. 3.7 from the reference edge, as the thesis published it (it takes the reference's whole\n"
+      "      blur for defocus: with a lens floor there it draws too much blur elsewhere; calibrate prints its error);\n"
+      "      R: a fixed radius in px. --gain scales it.\n"
       "Only the object's pixels plus the kernel's margin are blurred; everything happens in linear light.\n"
-      "Example: blurcue render --calib calib.json --background scene.png --object ball --at-edge 9 --blur estimated\n"
+      "Example: blurcue render --calib calib.json --background scene.png --object ball --at-edge 9 --blur fitted\n"
       "         --out ball-e9.png");
   cmd->add_option("--calib", args->calib, "calib.json from blurcue calibrate (not needed for a picture)")
       ->check(CLI::ExistingFile);

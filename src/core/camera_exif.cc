@@ -124,18 +124,14 @@ ExifCamera CameraFromExif(const std::filesystem::path& photo, std::optional<std:
     if (!(uint8_t(magic[0]) == 0xFF && uint8_t(magic[1]) == 0xD8))
       no_exif = "is not a JPEG: its EXIF, if any, is not read (EXIF is read from JPEG files)";
   }
-  auto missing = [&](ExifTag tag, const char* option) {
-    return InputError(file, (have_exif ? exif.Name(tag) + " is missing" : no_exif) +
-                                "; give " + option);
-  };
-
+  // Every number calibrate needs that neither an option nor the EXIF gives is named at once, with its option.
+  std::vector<std::string> absent, options;
   const std::optional<double> fl = focal_length_mm ? focal_length_mm : number(EXIF_TAG_FOCAL_LENGTH);
-  if (!fl) throw missing(EXIF_TAG_FOCAL_LENGTH, "--focal-length-mm");
-  c.focal_length_mm = *fl;
+  if (!fl) absent.push_back(exif.Name(EXIF_TAG_FOCAL_LENGTH) + " is missing"), options.push_back("--focal-length-mm");
   const std::optional<double> n = f_number ? f_number : number(EXIF_TAG_FNUMBER);
-  if (!n) throw missing(EXIF_TAG_FNUMBER, "--f-number");
-  c.f_number = *n;
-
+  if (!n) absent.push_back(exif.Name(EXIF_TAG_FNUMBER) + " is missing"), options.push_back("--f-number");
+  c.focal_length_mm = fl ? *fl : 0;
+  c.f_number = n ? *n : 0;
   // EXIF's pixel dimensions are the stored image's, before orientation: a portrait photo's are swapped against ours.
   const std::optional<double> px = number(EXIF_TAG_PIXEL_X_DIMENSION), py = number(EXIF_TAG_PIXEL_Y_DIMENSION);
   const std::optional<double> orientation = number(EXIF_TAG_ORIENTATION);
@@ -146,6 +142,7 @@ ExifCamera CameraFromExif(const std::filesystem::path& photo, std::optional<std:
   const std::optional<double> xres = number(EXIF_TAG_FOCAL_PLANE_X_RESOLUTION);
   const std::optional<double> yres = number(EXIF_TAG_FOCAL_PLANE_Y_RESOLUTION);
   const std::optional<double> unit = number(EXIF_TAG_FOCAL_PLANE_RESOLUTION_UNIT);
+  const std::optional<double> fl35 = number(EXIF_TAG_FOCAL_LENGTH_IN_35MM_FILM);
   const KnownSensor* known = nullptr;
   for (const KnownSensor& k : KnownSensors())
     if (out.model == k.model) known = &k;
@@ -160,7 +157,7 @@ ExifCamera CameraFromExif(const std::filesystem::path& photo, std::optional<std:
     const bool portrait = stored_h > stored_w;
     sw = portrait ? known->height_mm : known->width_mm, sh = portrait ? known->width_mm : known->height_mm;
     out.sensor_source = std::string("sensor table (") + known->model + ")";
-  } else if (const std::optional<double> fl35 = number(EXIF_TAG_FOCAL_LENGTH_IN_35MM_FILM); fl35 && *fl35 > 0) {
+  } else if (fl35 && *fl35 > 0 && fl) {
     // The 35 mm equivalent keeps the diagonal: 43.27 mm x f / f35; the image's sides give the aspect.
     const double diagonal = std::hypot(36.0, 24.0) * c.focal_length_mm / *fl35;
     const double aspect = stored_w / stored_h;
@@ -168,11 +165,28 @@ ExifCamera CameraFromExif(const std::filesystem::path& photo, std::optional<std:
     out.sensor_source = "35 mm equivalent focal length (" + Num(*fl35) + " mm)";
     out.notes.push_back("the sensor size is approximate: EXIF rounds the 35 mm equivalent to whole mm (up to " +
                         Num(50 / *fl35) + " % here); give --sensor-mm W H from the maker's data for a better one");
+  } else if (fl35 && *fl35 > 0) {
+    // The 35 mm equivalent gives the sensor once the focal length (named missing above) is given.
   } else {
-    throw InputError(file, have_exif ? "EXIF gives no sensor size (no FocalPlaneXResolution (0xa20e), no "
-                                       "FocalLengthIn35mmFilm (0xa405), and model '" + out.model +
-                                           "' is not in the sensor table); give --sensor-mm W H"
-                                     : no_exif + "; give --focal-length-mm, --f-number and --sensor-mm");
+    // Why each source of a sensor size gave none: a tag absent, or present with a value that says "unknown".
+    auto said = [&](ExifTag tag, const std::optional<double>& v, const char* why) {
+      return exif.Name(tag) + (v ? " is " + Num(*v) + " (" + why + ")" : std::string(" is missing"));
+    };
+    absent.push_back("no sensor size (" +
+                     (!(xres && *xres > 0)   ? said(EXIF_TAG_FOCAL_PLANE_X_RESOLUTION, xres, "no resolution")
+                      : !(yres && *yres > 0) ? said(EXIF_TAG_FOCAL_PLANE_Y_RESOLUTION, yres, "no resolution")
+                                             : said(EXIF_TAG_FOCAL_PLANE_RESOLUTION_UNIT, unit, "not inch, cm or mm")) +
+                     ", " + said(EXIF_TAG_FOCAL_LENGTH_IN_35MM_FILM, fl35, "unknown") +
+                     (out.model.empty() ? ", no EXIF Model" : ", model '" + out.model + "' not in the sensor table") + ")");
+    options.push_back("--sensor-mm W H");
+  }
+  if (!options.empty()) {
+    std::string give;
+    for (size_t i = 0; i < options.size(); ++i)
+      give += (i == 0 ? "" : i + 1 == options.size() ? " and " : ", ") + options[i];
+    std::string why;
+    for (const std::string& a : absent) why += (why.empty() ? "" : ", ") + a;
+    throw InputError(file, (have_exif ? why : no_exif) + "; give " + give);
   }
   auto micron = [](double mm) { return std::round(mm * 1e4) / 1e4; };  // finer than any maker states
   c.sensor_width_mm = micron(turned ? sh : sw);
@@ -191,7 +205,7 @@ ExifCamera CameraFromExif(const std::filesystem::path& photo, std::optional<std:
     else out.focus_at_infinity = true;
   }
   try {
-    c.Validate(file);
+    c.Validate(file + ": ");
   } catch (const Error& e) {
     // A number refused says where it came from when that was the EXIF, and which option replaces it.
     const std::string what = e.what();

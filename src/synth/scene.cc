@@ -650,7 +650,10 @@ Scene RenderScene(const SceneOptions& o) {
                      "and floor, in ideal px: r_ideal_px) times the distortion's stretch across the edge at the "
                      "section's midpoint (stretch = 1 / |J^-T n|), optical only (pixel area excluded)";
   j["floor_sigma_applied_px"] = std::sqrt(floor_var_px2);
-  j["r_range_px"] = {r_min, r_max};
+  // The whole view's blur with the floor (every point has it: nothing in the view is sharper than the floor), and the
+  // defocus alone (the lens formula's range, before discretisation).
+  j["r_range_px"] = {std::sqrt(r_min * r_min + 4 * floor_var_px2), std::sqrt(r_max * r_max + 4 * floor_var_px2)};
+  j["defocus_r_range_px"] = {r_min, r_max};
   j["blur_levels_px"] = levels_json;
   j["sections"] = sections;
   j["flaws"] = flaws_json;

@@ -238,6 +238,11 @@ TEST(SynthScene, FloorAddsItsSecondMomentToTheTruthAndTheImage) {
     }
     const double var = m2 / m0 - (m1 / m0) * (m1 / m0);
     EXPECT_NEAR(2 * std::sqrt(var - 1.0 / 6), t.r_px, 0.03 * t.r_px) << "variance " << var;
+    // The whole view's range has the floor in it: nothing is sharper than it (it printed the defocus alone, 0 px).
+    const double floor_r = 2 * s.truth["floor_sigma_applied_px"].get<double>();
+    EXPECT_NEAR(floor_r, 1.6, 0.05);
+    EXPECT_GE(s.truth["r_range_px"][0].get<double>(), floor_r);
+    for (const SectionTruth& any : s.sections) EXPECT_GE(any.r_px, s.truth["r_range_px"][0].get<double>() - 1e-9);
   }
 }
 
