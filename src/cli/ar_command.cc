@@ -150,17 +150,8 @@ void AddArCommand(CLI::App& app) {
     track::FrameSource source(args->input, take_fps > 0 ? take_fps : 30);
     // An object in no frame's photo would leave a video without it and a summary that counts it drawn: a slip of
     // millimetres (400 for 40) is refused before anything is written.
-    const cv::Rect photo(0, 0, camera.image_width_px, camera.image_height_px);
     for (size_t i = 0; i < objects.size(); ++i) {
-      bool seen = false;
-      for (const stimulus::TrackedFrame& f : take.frames) {
-        if (seen || !f.calib) continue;
-        try {
-          seen = !(scene::FootprintOf(camera, f.calib->rvec, f.calib->tvec, objects[i].object).bounds & photo).empty();
-        } catch (const Error&) {  // behind the camera in this frame: not seen in it
-        }
-      }
-      if (!seen)
+      if (!stimulus::SeenInAnyFrame(take, objects[i].object))
         throw InputError(given[i], objects[i].name + " at (" + Num(objects[i].object.center_board_mm[0]) + ", " +
                                        Num(objects[i].object.center_board_mm[1]) +
                                        ") mm on the board lies outside the photo in every frame of the take (the board "

@@ -310,6 +310,19 @@ cv::Vec2d StreakPx(const TrackedTake& take, int index, const cv::Vec3d& board_mm
   return {(pb.x - pa.x) * s, (pb.y - pa.y) * s};
 }
 
+bool SeenInAnyFrame(const TrackedTake& take, const scene::VirtualObject& object) {
+  const Camera& camera = take.camera();
+  const cv::Rect photo(0, 0, camera.image_width_px, camera.image_height_px);
+  for (const TrackedFrame& f : take.frames) {
+    if (!f.calib) continue;
+    try {
+      if (!(scene::FootprintOf(camera, f.calib->rvec, f.calib->tvec, object).bounds & photo).empty()) return true;
+    } catch (const Error&) {  // behind the camera in this frame: not seen in it
+    }
+  }
+  return false;
+}
+
 TrackedFramePlan PlanTrackedFrame(const TrackedTake& take, int index, const std::vector<PlacedObject>& objects,
                                   const TakeBlur& blur) {
   TrackedFramePlan plan;

@@ -105,6 +105,10 @@ cv::Vec2d StreakPx(const TrackedTake& take, int index, const cv::Vec3d& board_mm
 TrackedFramePlan PlanTrackedFrame(const TrackedTake& take, int index, const std::vector<PlacedObject>& objects,
                                   const TakeBlur& blur);
 
+// Whether any posed frame of the take shows `object` in its photo (its footprint meets the image; a frame with the
+// object behind the camera does not). An object in none would leave a video without it.
+bool SeenInAnyFrame(const TrackedTake& take, const scene::VirtualObject& object);
+
 // The per-frame CSV of what was drawn: its columns (name, meaning), its header line and a frame's lines (one per
 // object; one line with empty object fields for a frame drawn without objects, `status` saying why).
 struct DrawnColumn {

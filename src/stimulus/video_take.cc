@@ -145,19 +145,26 @@ double TakeWindowS(const protocol::Protocol& protocol, const VideoTake& take, co
 
 namespace {
 
-// The frames with a pose a trial shows, each with its time on screen in the window: frame k plays from
-// (k - first) / fps; a lost one and the time past the take's end hold the frame before.
-std::map<int, double> ShownFrames(const protocol::Protocol& protocol, const VideoTake& take,
-                                  const protocol::Trial& trial, const TrialScene& scene) {
-  const double window = TakeWindowS(protocol, take, trial, scene);
-  std::map<int, double> weight;
+// The take as it plays in a window of `window_s` seconds: frame k of the take from (k - first) / fps to the next
+// frame's start (the last frame to the window's end), clipped to the window; `f(from_s, to_s)` for each.
+template <typename F>
+void ForEachFrameSpan(const VideoTake& take, double window_s, F&& f) {
   const int n = int(take.take().frames.size());
   for (int k = take.first_posed(); k < n; ++k) {
     const double from = (k - take.first_posed()) / take.fps();
-    if (from >= window) break;
-    const double to = k == n - 1 ? window : std::min(window, (k + 1 - take.first_posed()) / take.fps());
-    weight[take.FrameAt(from + 0.5 / take.fps()).posed] += to - from;
+    if (from >= window_s) break;
+    f(from, k == n - 1 ? window_s : std::min(window_s, (k + 1 - take.first_posed()) / take.fps()));
   }
+}
+
+// The frames with a pose a trial shows, each with its time on screen in the window (a lost one and the time past the
+// take's end hold the frame before).
+std::map<int, double> ShownFrames(const protocol::Protocol& protocol, const VideoTake& take,
+                                  const protocol::Trial& trial, const TrialScene& scene) {
+  std::map<int, double> weight;
+  ForEachFrameSpan(take, TakeWindowS(protocol, take, trial, scene), [&](double from, double to) {
+    weight[take.FrameAt(from + 0.5 / take.fps()).posed] += to - from;
+  });
   return weight;
 }
 
@@ -223,11 +230,7 @@ TrialScene DescribeVideoTrial(const protocol::Protocol& protocol, const VideoTak
                                                                            take.take().board().square_mm : 0.0);
   double weight_of[2] = {0, 0}, r[2] = {0, 0};
   cv::Vec2d motion[2] = {{0, 0}, {0, 0}};
-  const int n = int(take.take().frames.size());
-  for (int k = take.first_posed(); k < n; ++k) {
-    const double from = (k - take.first_posed()) / take.fps();
-    if (from >= window) break;
-    const double to = k == n - 1 ? window : std::min(window, (k + 1 - take.first_posed()) / take.fps());
+  ForEachFrameSpan(take, window, [&](double from, double to) {
     const int steps = std::clamp(int(std::ceil((to - from) * rate)), 1, 4000);
     for (int i = 0; i < steps; ++i) {
       const double t_s = from + (i + 0.5) * (to - from) / steps, w = (to - from) / steps;
@@ -248,7 +251,7 @@ TrialScene DescribeVideoTrial(const protocol::Protocol& protocol, const VideoTak
           motion[side] += w * objects[side]->motion_px;
         }
     }
-  }
+  });
   if (weight_of[0] > 0) mean.r_left_px = r[0] / weight_of[0], mean.motion_left_px = motion[0] / weight_of[0];
   if (weight_of[1] > 0) mean.r_right_px = r[1] / weight_of[1], mean.motion_right_px = motion[1] / weight_of[1];
   return mean;
