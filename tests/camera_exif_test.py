@@ -142,8 +142,14 @@ check("an impossible focal length is refused naming the field", code == 3 and "f
 p = photo("zero-focal.jpg", (600, 400), {MODEL: "NEX-5N"}, {FOCAL: R(0, 1), FNUMBER: R(8, 1)})
 code, _, err = run(p)
 check("a zero focal length is refused naming the EXIF tag and --focal-length-mm",
-      code == 3 and "/focal_length_mm: must be in [0.5, 2000] mm, got 0 (EXIF FocalLength (0x920a); give "
-      "--focal-length-mm)" in err and err.count("\n") == 1, (code, err))
+      code == 3 and "zero-focal.jpg: EXIF FocalLength (0x920a) is 0 (unknown); give --focal-length-mm" in err
+      and err.count("\n") == 1, (code, err))
+# With a zero FNumber too, both are named at once (it took two runs).
+p = photo("zero-both.jpg", (600, 400), {MODEL: "NEX-5N"}, {FOCAL: R(0, 1), FNUMBER: R(0, 1)})
+code, _, err = run(p)
+check("a zero focal length and f-number are named at once",
+      code == 3 and "EXIF FocalLength (0x920a) is 0 (unknown), EXIF FNumber (0x829d) is 0 (unknown); give "
+      "--focal-length-mm and --f-number" in err, (code, err))
 
 # 10. A sensor size worked out of a tag, impossible: says where it came from. The 35 mm equivalent of 1 mm for a
 # 21 mm lens is a 756 mm wide sensor.

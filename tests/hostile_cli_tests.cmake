@@ -204,6 +204,12 @@ add_test(NAME cli_hostile_overexposed_make
                  ${T}/scene/scene.png ${H}/overexposed.png)
 set_tests_properties(cli_hostile_overexposed_make PROPERTIES FIXTURES_REQUIRED scene FIXTURES_SETUP overexposed)
 hostile_test(cli_hostile_calibrate_two_depths 4
-             "overexposed.png: only 2 of 11 edges have a usable section (edge 1 and 11); the others are saturated"
+             "overexposed.png: only 2 of 11 edges have a usable section (edge 1 and 11); the others' sections are flagged saturated"
              calibrate ${H}/overexposed.png --camera ${T}/scene/camera.json --out ${H}/calib-two-depths.json)
 set_tests_properties(cli_hostile_calibrate_two_depths PROPERTIES FIXTURES_REQUIRED "scene;overexposed")
+# A lens model whose aperture is far from the camera's (here camera.json says f/1.4 of a photo taken at f/5.6; a board
+# with its edges covered gave an aperture of 0 and focus 21 mm): written, with a warning naming both apertures.
+add_test(NAME cli_calibrate_aperture_far_from_nominal
+         COMMAND sh -c "/usr/bin/python3 -c \"import json, sys; c = json.load(open(sys.argv[1])); c['f_number'] = 1.4; json.dump(c, open(sys.argv[2], 'w'))\" ${T}/scene/camera.json ${H}/camera-f1.4.json && $<TARGET_FILE:blurcue> calibrate ${T}/scene/scene.png --camera ${H}/camera-f1.4.json --out ${H}/calib-f1.4.json --quiet")
+set_tests_properties(cli_calibrate_aperture_far_from_nominal PROPERTIES FIXTURES_REQUIRED scene
+                     PASS_REGULAR_EXPRESSION "warning: .*scene.png: the fitted aperture [0-9.]+ mm is 0.2[0-9] x the camera's \\(15.000 mm, f/1.4\\)")

@@ -81,15 +81,16 @@ std::vector<optics::BlurSample> ModelSamples(const CalibResult& result) {
 namespace {
 void RequireThreeDepths(const CalibResult& result) {
   std::vector<int> usable;
-  std::map<std::string, int> why;
+  std::map<std::string, int> why;  // the flags of the unusable edges' sections (a section may carry two)
   for (const auto& edge : result.edges) {
     bool any = false;
-    for (const auto& s : edge.sections) {
-      any = any || s.fit.ok;
-      if (!s.fit.ok)
-        for (const std::string& flag : s.fit.flags) ++why[flag];
+    for (const auto& s : edge.sections) any = any || s.fit.ok;
+    if (any) {
+      usable.push_back(edge.index);
+      continue;
     }
-    if (any) usable.push_back(edge.index);
+    for (const auto& s : edge.sections)
+      for (const std::string& flag : s.fit.flags) ++why[flag];
   }
   if (usable.size() >= 3) return;
   std::string edges, flags;
@@ -100,9 +101,11 @@ void RequireThreeDepths(const CalibResult& result) {
   for (size_t i = 0; i < common.size() && i < 3; ++i)
     flags += (i ? ", " : "") + common[i].second + " (" + std::to_string(-common[i].first) + " sections)";
   throw Error(ErrorKind::kNotFound,
-              "only " + std::to_string(usable.size()) + " of " + std::to_string(result.edges.size()) +
-                  " edges have a usable section" + (edges.empty() ? "" : " (edge " + edges + ")") +
-                  (flags.empty() ? "" : "; the others are " + flags) +
+              (usable.empty() ? "none of the " + std::to_string(result.edges.size()) + " edges has"
+                              : "only " + std::to_string(usable.size()) + " of " + std::to_string(result.edges.size()) +
+                                    (usable.size() == 1 ? " edges has" : " edges have")) +
+                  " a usable section" + (edges.empty() ? "" : " (edge " + edges + ")") +
+                  (flags.empty() ? "" : (usable.empty() ? "; their" : "; the others'") + std::string(" sections are flagged ") + flags) +
                   ": a thin lens needs sections at 3 or more depths (at 2 a focus between them and one beyond "
                   "them fit alike); retake the photo so that more of the board's edges are measured (exposure, "
                   "framing, focus)");
@@ -256,6 +259,7 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
   // Estimation: eq. 3.7 from the reference edge, and a thin-lens model fitted to every usable section.
   t0 = std::chrono::steady_clock::now();
   const optics::Lens lens = optics::Lens::FromCamera(camera);
+  if (options.fit_model) RequireThreeDepths(result);  // before the reference: with no usable edge, say why
   EdgeResult& ref = result.edges[options.reference_edge - 1];
   std::vector<double> ref_r, ref_u;
   for (const auto& s : ref.sections)
@@ -267,10 +271,7 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
   result.reference_r_px = Median(ref_r);
   result.reference_u_mm = Median(ref_u);
 
-  if (options.fit_model) {
-    RequireThreeDepths(result);
-    result.model = optics::FitThinLens(lens, ModelSamples(result), options.optics_fit);
-  }
+  if (options.fit_model) result.model = optics::FitThinLens(lens, ModelSamples(result), options.optics_fit);
 
   for (auto& edge : result.edges) {
     double su = 0;

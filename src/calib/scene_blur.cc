@@ -103,7 +103,9 @@ void SceneCalib::RequireSameSize(const cv::Mat& photo, const std::string& photo_
 }
 
 SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
-  if (!j.is_object() || !j.contains("format") || j["format"] != "blurcue-calib")
+  if (!j.is_object())  // `where` is "path: "
+    throw Error(ErrorKind::kInput, where + "must be a JSON object (a calibration), got " + j.type_name());
+  if (!j.contains("format") || j["format"] != "blurcue-calib")
     throw InputError(where + "/format", "must be \"blurcue-calib\" (a file written by blurcue calibrate)");
   KnownKeys(j, where, kTopKeys);
   if (j.contains("version") && j["version"] != 1)

@@ -74,6 +74,14 @@ void AddCalibrateCommand(CLI::App& app) {
                    "fits to well under 1 px): check its dist_coeffs, sensor size and focal length; the depths and "
                    "blurs measured rest on that pose\n",
                    args->camera.c_str(), result.pose.reprojection_error_px);
+    // A lens model whose aperture is far from the camera's f-number fits sections that may not measure the board's
+    // edges (an edge covered or shaded reads sharp: a covered board gave focus 21 mm and an aperture of 0).
+    if (const double ratio = result.model.aperture_mm / camera.ApertureMm(); !(ratio >= 0.5 && ratio <= 2))
+      std::fprintf(stderr,
+                   "blurcue: warning: %s: the fitted aperture %.3f mm is %.2f x the camera's (%.3f mm, f/%g): the "
+                   "sections may not measure the board's edges (covered, shaded, reflections; see the table's "
+                   "flags) or camera.json's f_number is not the photo's\n",
+                   args->photo.c_str(), result.model.aperture_mm, ratio, camera.ApertureMm(), camera.f_number);
     if (args->quiet) return;
     const auto& m = result.model;
     std::printf("board %s found; pose reprojection error %.3f px; board origin %.1f mm from the lens\n",

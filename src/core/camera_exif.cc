@@ -125,11 +125,18 @@ ExifCamera CameraFromExif(const std::filesystem::path& photo, std::optional<std:
       no_exif = "is not a JPEG: its EXIF, if any, is not read (EXIF is read from JPEG files)";
   }
   // Every number calibrate needs that neither an option nor the EXIF gives is named at once, with its option.
+  // A tag of 0 is the maker's "unknown" (a lens without contacts writes FocalLength 0/1): named like a missing one.
   std::vector<std::string> absent, options;
-  const std::optional<double> fl = focal_length_mm ? focal_length_mm : number(EXIF_TAG_FOCAL_LENGTH);
-  if (!fl) absent.push_back(exif.Name(EXIF_TAG_FOCAL_LENGTH) + " is missing"), options.push_back("--focal-length-mm");
-  const std::optional<double> n = f_number ? f_number : number(EXIF_TAG_FNUMBER);
-  if (!n) absent.push_back(exif.Name(EXIF_TAG_FNUMBER) + " is missing"), options.push_back("--f-number");
+  auto needed = [&](ExifTag tag, const std::optional<double>& given, const char* option) -> std::optional<double> {
+    if (given) return given;
+    const std::optional<double> v = number(tag);
+    if (v && *v > 0) return v;
+    absent.push_back(exif.Name(tag) + (v ? " is " + Num(*v) + " (unknown)" : std::string(" is missing")));
+    options.push_back(option);
+    return std::nullopt;
+  };
+  const std::optional<double> fl = needed(EXIF_TAG_FOCAL_LENGTH, focal_length_mm, "--focal-length-mm");
+  const std::optional<double> n = needed(EXIF_TAG_FNUMBER, f_number, "--f-number");
   c.focal_length_mm = fl ? *fl : 0;
   c.f_number = n ? *n : 0;
   // EXIF's pixel dimensions are the stored image's, before orientation: a portrait photo's are swapped against ours.
