@@ -144,3 +144,10 @@ set_tests_properties(analysis.plan_chart PROPERTIES LABELS "analysis;plan" TIMEO
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
 # Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
 set_test_costs(plan_same_as_run 34 plan_difference_power 20)
+# A single object against the scene's blur (yes-no-ball): below the level it looks as blurred as the scene - what
+# such a study asks - said so, not flagged "invisible" as a pair no one could tell apart (a newcomer read the red
+# INVISIBLE on the measured condition as a defect).
+add_test(NAME validate_plan_single_objects COMMAND ${BC} validate ${T}/protocols/yes-no-ball.json --plan)
+set_tests_properties(validate_plan_single_objects PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS plan
+  PASS_REGULAR_EXPRESSION "0 distinct pairs, 0 invisible; 9 single objects, [1-9] as blurred as the scene to this observer\n.*object measured vs the scene [^\n]* - as blurred as the scene at 60 cm on this monitor"
+  FAIL_REGULAR_EXPRESSION "invisible at")

@@ -228,7 +228,7 @@ void AddPreviewCommand(CLI::App& app) {
         char seen[96];
         std::snprintf(seen, sizeof seen, "%s told apart %.0f %% (2AFC)%s", s.left_only ? "vs scene:" : "L vs R:",
                       100 * p_correct,
-                      p_correct < args->visible ? " - INVISIBLE" : "");
+                      p_correct >= args->visible ? "" : s.left_only ? " - as blurred as the scene" : " - INVISIBLE");
         const size_t first_tile = tiles.size();
         if (s.left_only) {  // layout single: its one object
           tiles.push_back({s, 0, levels + first, side("object", t.left, s.r_left_px), key});

@@ -72,6 +72,7 @@ std::vector<PairVisibility> PairVisibilities(const PreparedSession& prepared, co
     if (s.left_only) {
       // One object: does it look out of place - its blur against the scene's own there.
       pair.what = "object " + a + " vs the scene";
+      pair.against_scene = true;
       view.r_right_px = view.r_scene_px;
     } else {
       pair.what = a + " vs " + b;
@@ -149,12 +150,18 @@ std::vector<std::string> VisibilityLines(const PreparedSession& prepared, const 
   const auto pairs = PairVisibilities(prepared, observer, level);
   const bool arcmin = observer.model == ObserverModel::kArcmin;
   const auto matches = arcmin ? MatchVisibilities(prepared, observer, level) : std::vector<MatchVisibility>{};
-  size_t invisible = 0;
-  for (const auto& pair : pairs) invisible += !pair.visible;
+  size_t invisible = 0, as_scene = 0, objects = 0;
+  for (const auto& pair : pairs) {
+    objects += pair.against_scene;
+    (pair.against_scene ? as_scene : invisible) += !pair.visible;
+  }
   char line[600];
   std::snprintf(line, sizeof line, "visibility (%s; flagged below %g %% correct): %zu distinct pairs, %zu invisible",
-                ToString(observer).c_str(), 100 * level, pairs.size(), invisible);
+                ToString(observer).c_str(), 100 * level, pairs.size() - objects, invisible);
   std::vector<std::string> lines = {line};
+  if (objects > 0)
+    lines.back() += "; " + std::to_string(objects) + " single objects, " + std::to_string(as_scene) +
+                    " as blurred as the scene to this observer";
   if (!matches.empty()) lines.back() += "; " + std::to_string(matches.size()) + " depth-matching distances";
   for (const auto& pair : pairs)
     if (!invisible_only || !pair.visible) lines.push_back("  " + Describe(pair, prepared.display));
@@ -170,7 +177,8 @@ std::string Describe(const PairVisibility& pair, const display::Profile& profile
   char text[512];
   std::snprintf(text, sizeof text, "%s: %.2f arcmin apart (%.2f' vs %.2f'), predicted %.0f %% correct%s",
                 pair.what.c_str(), std::abs(pair.r_a_arcmin - pair.r_b_arcmin), pair.r_a_arcmin, pair.r_b_arcmin,
-                100 * pair.p_correct, pair.visible ? "" : " - invisible at ");
+                100 * pair.p_correct,
+                pair.visible ? "" : pair.against_scene ? " - as blurred as the scene at " : " - invisible at ");
   std::string line = text;
   if (!pair.visible) {
     std::snprintf(text, sizeof text, "%g cm on this monitor", profile.distance_mm / 10);

@@ -18,6 +18,9 @@ struct PairVisibility {
   double p_correct = 0.5;  // ProbabilityCorrect2afc of the two
   bool visible = false;    // p_correct >= the level asked for
   int trials = 0;          // trials of the list showing this pair (either side order)
+  // One object against the scene's blur (a single layout): below the level it looks as blurred as the scene - what a
+  // study of whether objects belong asks, so it is said so, not flagged as a pair no one could tell apart.
+  bool against_scene = false;
 };
 
 // A trial's levels as a label: "edge 2", "edge 2 speed 3" ("" without levels).
