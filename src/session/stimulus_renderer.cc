@@ -114,14 +114,17 @@ void StimulusRenderer::Compose(const TrialScene& trial, double t_s, double level
     if (!shown) continue;
     // Under a streak a sub-pixel radius is drawn as wide as the streak's drawing is across (render::DrawnRadiusPx):
     // the record states what the frame shows. Drawn at screen resolution, the compositor's scale.
+    // DrawnRadiusPx is max(r, the streak's own width across), which is under 1 screen px: only a smaller radius, or
+    // the per-pixel plan's radius at each depth, can fall below it.
     if (shown->motion_px != cv::Vec2d(0, 0)) {
       const double scale = compositor_->view().Scale(scene_->camera);
-      shown->r_px = render::DrawnRadiusPx(render::PsfOf(*shown, scale)) / scale;
-      if (shown->r_of_depth_px) {  // the per-pixel plan: each depth's radius likewise (DrawnRadiusPx is max(r, its floor))
-        scene::BlurredObject sharp = *shown;
-        sharp.r_px = 0;
-        const double least = render::DrawnRadiusPx(render::PsfOf(sharp, scale)) / scale;
-        shown->r_of_depth_px = [r = std::move(shown->r_of_depth_px), least](double z) { return std::max(r(z), least); };
+      render::Psf psf = render::PsfOf(*shown, scale);
+      if (psf.r_px < 1 || shown->r_of_depth_px) {
+        psf.r_px = 0;
+        const double least = render::DrawnRadiusPx(psf) / scale;
+        shown->r_px = std::max(shown->r_px, least);
+        if (shown->r_of_depth_px)
+          shown->r_of_depth_px = [r = std::move(shown->r_of_depth_px), least](double z) { return std::max(r(z), least); };
       }
     }
     shown->object.texture = texture_;
