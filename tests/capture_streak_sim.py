@@ -12,7 +12,7 @@ there; the captured frame's error less that bias is what the renderer adds. A fi
 import sys, os, json, glob, math
 import numpy as np
 from scipy.signal import fftconvolve
-sys.path.insert(0, "/work/main/tests")
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import capture_kernel as ck
 
 def srgb_q(v):
