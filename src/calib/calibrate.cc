@@ -74,11 +74,11 @@ std::vector<optics::BlurSample> ModelSamples(const CalibResult& result) {
   return samples;
 }
 
+namespace {
 // The thin lens's radius is unsigned: sections at two depths fit a focus between them and one beyond them alike
 // (an overexposed photo that leaves the first and last edges only gave focus 140 mm for 400 and an aperture 7 x off).
 // Three edges with a usable section are the least a model is fitted to; fewer is refused, saying why the others
 // were not usable.
-namespace {
 void RequireThreeDepths(const CalibResult& result) {
   std::vector<int> usable;
   std::map<std::string, int> why;  // the flags of the unusable edges' sections (a section may carry two)
@@ -105,7 +105,9 @@ void RequireThreeDepths(const CalibResult& result) {
                               : "only " + std::to_string(usable.size()) + " of " + std::to_string(result.edges.size()) +
                                     (usable.size() == 1 ? " edges has" : " edges have")) +
                   " a usable section" + (edges.empty() ? "" : " (edge " + edges + ")") +
-                  (flags.empty() ? "" : (usable.empty() ? "; their" : "; the others'") + std::string(" sections are flagged ") + flags) +
+                  (flags.empty() ? ""
+                                 : (usable.empty() ? "; their" : "; the others'") + std::string(" sections are flagged ") +
+                                       flags) +
                   ": a thin lens needs sections at 3 or more depths (at 2 a focus between them and one beyond "
                   "them fit alike); retake the photo so that more of the board's edges are measured (exposure, "
                   "framing, focus)");

@@ -152,7 +152,8 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
   // The thin lens forms an image of its focus plane only beyond its focal length.
   if (const double f_mm = s.camera.focal_length_mm; !(s.model.focus_mm > f_mm))
     throw InputError(mw + "/focus_mm", "must be beyond the camera's focal length (" + Num(f_mm) +
-                                           " mm): a thin lens forms no real image nearer, got " + Num(s.model.focus_mm));
+                                           " mm): a thin lens forms no real image nearer, got " +
+                                           Num(s.model.focus_mm));
   if (!(s.reference_u_mm > s.camera.focal_length_mm))
     throw InputError(where + "/reference/u_mm", "must be beyond the camera's focal length (" +
                                                     Num(s.camera.focal_length_mm) + " mm), got " +

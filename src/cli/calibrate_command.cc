@@ -104,7 +104,8 @@ void AddCalibrateCommand(CLI::App& app) {
       std::printf("eq. 3.7 (the thesis's estimate from reference edge %d, no parameters fitted): rms %.3f px against "
                   "the measured sections%s\n",
                   result.reference_edge, choice["eq37"]["rms_px"].get<double>(),
-                  m.kind == "thin_lens+floor" ? " (it takes the reference's whole blur for defocus, floor included)" : "");
+                  m.kind == "thin_lens+floor" ? " (it takes the reference's whole blur for defocus, floor included)"
+                                              : "");
     std::vector<double> true_r;
     if (!args->truth.empty()) {
       const calib::TruthComparison cmp =

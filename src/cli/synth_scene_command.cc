@@ -205,7 +205,8 @@ void AddSynthSceneCommand(CLI::App& app) {
                 camera.image_width_px, camera.image_height_px, o.supersample,
                 o.psf == synth::Psf::kDisc ? "disc PSF," : "gaussian PSF,", scene.board.Name().c_str(), o.tilt_deg,
                 std::isinf(scene.focus_mm) ? "at infinity" : (std::to_string(scene.focus_mm).substr(0, 6) + " mm").c_str());
-    std::printf("mean of edge 1: u = %.1f mm, r = %.2f px;  edge %d: u = %.1f mm, r = %.2f px;  whole view r %.2f - %.2f px (lens floor included)\n",
+    std::printf("mean of edge 1: u = %.1f mm, r = %.2f px;  edge %d: u = %.1f mm, r = %.2f px;  whole view r %.2f - "
+                "%.2f px (lens floor included)\n",
                 edge_u(1), edge_r(1), edges, edge_u(edges), edge_r(edges),
                 scene.truth["r_range_px"][0].get<double>(), scene.truth["r_range_px"][1].get<double>());
     if (o.flaws > 0) std::printf("%d printing flaws touching %d edge sections\n", o.flaws, flawed);

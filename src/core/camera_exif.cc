@@ -184,7 +184,9 @@ ExifCamera CameraFromExif(const std::filesystem::path& photo, std::optional<std:
                       : !(yres && *yres > 0) ? said(EXIF_TAG_FOCAL_PLANE_Y_RESOLUTION, yres, "no resolution")
                                              : said(EXIF_TAG_FOCAL_PLANE_RESOLUTION_UNIT, unit, "not inch, cm or mm")) +
                      ", " + said(EXIF_TAG_FOCAL_LENGTH_IN_35MM_FILM, fl35, "unknown") +
-                     (out.model.empty() ? ", no EXIF Model" : ", model '" + out.model + "' not in the sensor table") + ")");
+                     (out.model.empty() ? ", no EXIF Model"
+                                        : ", model '" + out.model + "' not in the sensor table") +
+                     ")");
     options.push_back("--sensor-mm W H");
   }
   if (!options.empty()) {

@@ -124,7 +124,9 @@ void StimulusRenderer::Compose(const TrialScene& trial, double t_s, double level
         const double least = render::DrawnRadiusPx(psf) / scale;
         shown->r_px = std::max(shown->r_px, least);
         if (shown->r_of_depth_px)
-          shown->r_of_depth_px = [r = std::move(shown->r_of_depth_px), least](double z) { return std::max(r(z), least); };
+          shown->r_of_depth_px = [r = std::move(shown->r_of_depth_px), least](double z) {
+            return std::max(r(z), least);
+          };
       }
     }
     shown->object.texture = texture_;
