@@ -6,8 +6,9 @@ twin): tests/capture_kernel.py's solve on the captured frame, and the same solve
 twin convolved in numpy with an independent streak kernel (401 points along the recorded motion, each splatted
 bilinearly, then a sampled Gaussian whose width is searched so that the kernel's own across r equals the record's
 where it can), quantised to 8-bit sRGB. The synthetic frame's solve minus its kernel's own r is the method's bias
-there; the captured frame's error less that bias is what the renderer adds. A finding (docs/blur-kernels.md
-"Across a streak"), not wired as a test.
+there. NOT a faithful replica: the synthetic frame is made from the rounded twin, so its response carries the
+twin's rounding noise and the captured frame's does not (errors in variables bias only the latter); see
+docs/blur-kernels.md "Across a streak". A finding, not wired as a test.
 """
 import sys, os, json, glob, math
 import numpy as np
