@@ -156,8 +156,11 @@ def _across(a, x, y, label, words, notes, study):
     version = statsmodels.__version__.split("+")[0]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
+        zero_se = {}
         if n_groups >= 2:
             t = stats.cluster_robust(a[y].to_numpy(float), X, groups, family=sm.families.Gaussian())
+            pooled = (float(t["estimate"].iloc[0]), float(t["estimate"].iloc[1]))  # before any is said in words
+            t, zero_se = stats.without_zero_se(t, words)
             engine = f"statsmodels {version} OLS cluster-robust CR1, t(G-1)"
             model = f"lm({y} ~ {x}), cluster-robust"
         else:
@@ -168,8 +171,9 @@ def _across(a, x, y, label, words, notes, study):
             model = f"lm({y} ~ {x}) (one observer)"
     for _, r in t.iterrows():
         rows += _rows_of(study, f"{label}: {model}", words, r["term"], r["estimate"], r["se"], r["df"], r["p"],
-                         engine, "")
-    pooled = (float(t["estimate"].iloc[0]), float(t["estimate"].iloc[1]))
+                         engine, zero_se.get(r["term"], ""))
+    if pooled is None:
+        pooled = (float(t["estimate"].iloc[0]), float(t["estimate"].iloc[1]))
     if n_groups >= 3:
         try:
             f = mixed.fit("lmm", a[y].to_numpy(float), X, groups, slopes=[x])
