@@ -66,6 +66,17 @@ size_t PrintableCharAt(std::string_view text, size_t i) {
   return size_t(more) + 1;
 }
 
+// The bidirectional control character whose UTF-8 begins at text[i], or 0: U+061C (D8 9C), U+200E/F (E2 80 8E/8F),
+// U+202A-E (E2 80 AA-AE), U+2066-9 (E2 81 A6-A9).
+unsigned BidiControlAt(std::string_view text, size_t i) {
+  const auto b = [&](size_t k) { return i + k < text.size() ? static_cast<unsigned char>(text[i + k]) : 0u; };
+  if (b(0) == 0xD8 && b(1) == 0x9C) return 0x061C;
+  if (b(0) == 0xE2 && b(1) == 0x80 && (b(2) == 0x8E || b(2) == 0x8F || (b(2) >= 0xAA && b(2) <= 0xAE)))
+    return 0x2000 + (b(2) - 0x80);
+  if (b(0) == 0xE2 && b(1) == 0x81 && b(2) >= 0xA6 && b(2) <= 0xA9) return 0x2040 + (b(2) - 0x80);
+  return 0;
+}
+
 }  // namespace
 
 bool IsPrintableUtf8(std::string_view text) {
@@ -98,18 +109,8 @@ std::string UnsafeIdReason(std::string_view text) {
     if (lower == missing)
       return "is text the readers of the exported tables (pandas, R) take as a missing value or an infinite number, "
              "not as a name";
-  // The bidirectional controls in UTF-8: U+061C (D8 9C), U+200E/F (E2 80 8E/8F), U+202A-E (E2 80 AA-AE),
-  // U+2066-9 (E2 81 A6-A9).
   for (size_t i = 0; i + 1 < text.size(); ++i) {
-    const auto b = [&](size_t k) { return static_cast<unsigned char>(text[i + k]); };
-    unsigned code = 0;
-    if (b(0) == 0xD8 && b(1) == 0x9C) code = 0x061C;
-    else if (i + 2 < text.size() && b(0) == 0xE2 && b(1) == 0x80 &&
-             (b(2) == 0x8E || b(2) == 0x8F || (b(2) >= 0xAA && b(2) <= 0xAE)))
-      code = 0x2000 + (b(2) - 0x80);
-    else if (i + 2 < text.size() && b(0) == 0xE2 && b(1) == 0x81 && b(2) >= 0xA6 && b(2) <= 0xA9)
-      code = 0x2040 + (b(2) - 0x80);
-    if (code) {
+    if (const unsigned code = BidiControlAt(text, i)) {
       char hex[16];
       std::snprintf(hex, sizeof hex, "U+%04X", code);
       return std::string("holds the bidirectional control character ") + hex +
@@ -134,7 +135,14 @@ std::string OneLine(std::string_view text) {
   out.reserve(text.size());
   for (size_t i = 0; i < text.size();) {
     if (const size_t n = PrintableCharAt(text, i)) {
-      out.append(text.substr(i, n));
+      // A bidirectional control would reorder the rest of the line on a terminal: written as its code point.
+      if (const unsigned code = BidiControlAt(text, i)) {
+        char hex[16];
+        std::snprintf(hex, sizeof hex, "\\u%04X", code);
+        out += hex;
+      } else {
+        out.append(text.substr(i, n));
+      }
       i += n;
       continue;
     }

@@ -39,7 +39,8 @@ inline constexpr size_t kMaxParticipantIdBytes = 64;
 std::string ParticipantIdProblem(std::string_view id);
 
 // `text` as one printable line: what IsPrintableUtf8 takes kept as it is, a newline, return or tab written \n, \r,
-// \t, any other control or broken byte \xNN. For messages that echo what someone typed.
+// \t, any other control or broken byte \xNN, a bidirectional control (UnsafeIdReason's list) \uNNNN. For messages
+// that echo what someone typed.
 std::string OneLine(std::string_view text);
 
 // The most characters of a value a message quotes (Echo).

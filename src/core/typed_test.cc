@@ -51,6 +51,11 @@ TEST(OneLine, EscapesControlsAndBrokenBytesAndKeepsText) {
   EXPECT_EQ(OneLine("Zoë 参加者 \xf0\x9f\x98\x80"), "Zoë 参加者 \xf0\x9f\x98\x80");
   EXPECT_EQ(OneLine(std::string_view("a\0b", 3)), "a\\x00b");
   for (const char* text : {"x\n", "\x1b", "\xc3(", "\xc2\x85"}) EXPECT_TRUE(IsPrintableUtf8(OneLine(text))) << text;
+  // A bidirectional control (U+202E, right-to-left override) would show the rest of a terminal line reversed: its
+  // code point is written instead; Arabic and Hebrew letters stay as they are.
+  EXPECT_EQ(OneLine("/layuot\xe2\x80\xae: unknown key"), "/layuot\\u202E: unknown key");
+  EXPECT_EQ(OneLine("a\xe2\x81\xa6" "b\xd8\x9c"), "a\\u2066b\\u061C");
+  EXPECT_EQ(OneLine("שלום مرحبا"), "שלום مرحبا");
 }
 
 // A typed value a message quotes is cut after 60 characters, with its whole length said; short values stay whole.
