@@ -93,22 +93,23 @@ TEST(ProtocolValidate, MisspeltConditionsColumnIsRefusedNamingFileLineAndColumn)
 // label_U+202Ex and "=left" validated and reached trials.csv as they were).
 TEST(ProtocolValidate, NamesThatReadBackwardsOrRunAsFormulasAreRefused) {
   const std::string rlo = "\xE2\x80\xAE";  // U+202E RIGHT-TO-LEFT OVERRIDE
+  const std::string shown = "\\u202E";     // as a message quotes it (OneLine): a terminal line stays in order
   const std::string why = "holds the bidirectional control character U+202E, which shows the text to a reader in "
                           "another order than it is recorded";
   Json j = Valid();
   j["blocks"][1]["factors"]["label_" + rlo + "ab"] = {"x", "y"};
-  EXPECT_EQ(OnlyProblem(j), Line("/blocks/1/factors/label_" + rlo + "ab: the factor name 'label_" + rlo + "ab' " + why));
+  EXPECT_EQ(OnlyProblem(j), Line("/blocks/1/factors/label_" + rlo + "ab: the factor name 'label_" + shown + "ab' " + why));
   j = Valid();
   j["blocks"][0]["factors"]["pat" + rlo + "tern"] = j["blocks"][0]["factors"]["pattern"];
   j["blocks"][0]["factors"].erase("pattern");
-  EXPECT_EQ(OnlyProblem(j), Line("/blocks/0/factors/pat" + rlo + "tern: the factor name 'pat" + rlo + "tern' " + why));
+  EXPECT_EQ(OnlyProblem(j), Line("/blocks/0/factors/pat" + rlo + "tern: the factor name 'pat" + shown + "tern' " + why));
   const fs::path dir = SceneFolder();
   std::ofstream(dir / "rows-bidi.csv") << "id,speed_cm_s,left,right,label_" << rlo << "x\n1,3,measured,none,a\n";
   j = Valid();
   j["blocks"][0].erase("factors");
   j["blocks"][0]["conditions"] = "rows-bidi.csv";
   EXPECT_EQ(OnlyProblem(j), Line("/blocks/0/conditions: " + (dir / "rows-bidi.csv").string() + " line 1, column 5: "
-                                 "the column name 'label_" + rlo + "x' " + why));
+                                 "the column name 'label_" + shown + "x' " + why));
   j = Valid();
   j["participant_info"] = {{{"key", "hand"}, {"type", "choice"}, {"choices", {"=left", "right"}}}};
   EXPECT_EQ(OnlyProblem(j), Line("/participant_info/0/choices/0: begins with =, which a spreadsheet opening the "
