@@ -499,6 +499,17 @@ TEST(SceneCalib, MeasuredIsTheNearestEdgesOwnValueOrAnError) {
   EXPECT_GT(BlurAtPx(scene, BlurSource::kMeasuredSection, midpoint(9)), 0);
 }
 
+// SceneCalibFromJson refuses `j` with Error(kInput) whose message is exactly `expected`.
+void ExpectCalibRefused(const Json& j, const std::string& expected) {
+  try {
+    SceneCalibFromJson(j, "calib.json: ");
+    ADD_FAILURE() << expected;
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    EXPECT_EQ(std::string(e.what()), expected);
+  }
+}
+
 // An edge or a section listed twice would be averaged with its copy or stand in for a missing one: refused, named.
 TEST(SceneCalib, EdgeOrSectionListedTwiceIsRefused) {
   const Calibration& r = Calibrated(Blurry());
@@ -507,15 +518,8 @@ TEST(SceneCalib, EdgeOrSectionListedTwiceIsRefused) {
   Json twice_section = CalibToJson(r.result);
   twice_section["edges"][2]["sections"][4]["index"] = 2;
   for (const auto& [j, expected] : {std::pair{twice_edge, "calib.json: /edges/1/index: edge 1 is listed twice (also at /edges/0)"},
-                                    {twice_section, "calib.json: /edges/2/sections/4/index: section 2 of edge 3 is listed twice (also at /sections/1)"}}) {
-    try {
-      SceneCalibFromJson(j, "calib.json: ");
-      ADD_FAILURE() << expected;
-    } catch (const Error& e) {
-      EXPECT_EQ(e.kind(), ErrorKind::kInput);
-      EXPECT_EQ(std::string(e.what()), expected);
-    }
-  }
+                                    {twice_section, "calib.json: /edges/2/sections/4/index: section 2 of edge 3 is listed twice (also at /sections/1)"}})
+    ExpectCalibRefused(j, expected);
 }
 
 TEST(SceneCalib, BadFieldIsNamed) {
@@ -544,13 +548,7 @@ TEST(SceneCalib, ModelBlockIsReadAsWritten) {
     j["model"]["kind"] = "thin_lens+floor", j["model"]["floor_px"] = 0.7, j["model"]["floor_determined"] = true;
     EXPECT_NO_THROW(SceneCalibFromJson(j, "calib.json: "));
     edit(j);
-    try {
-      SceneCalibFromJson(j, "calib.json: ");
-      ADD_FAILURE() << expected;
-    } catch (const Error& e) {
-      EXPECT_EQ(e.kind(), ErrorKind::kInput);
-      EXPECT_EQ(std::string(e.what()), expected);
-    }
+    ExpectCalibRefused(j, expected);
   };
   refused([](Json& j) { j["model"]["kind"] = 5; },
           "calib.json: /model/kind: must be \"thin_lens\" or \"thin_lens+floor\", got 5");
