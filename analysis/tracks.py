@@ -35,9 +35,6 @@ import criteria
 from common import Chart, save, session_words
 
 CREDIBLE = 0.95
-# A staircase's threshold: the mean of this many last turning points (an even number: as many peaks as troughs).
-LAST_TURNS = 6
-MIN_TURNS = 4
 COLORS = ["#0072B2", "#E69F00", "#009E73", "#CC79A7", "#D55E00", "#56B4E9", "#F0E442", "#000000"]
 
 
@@ -136,73 +133,96 @@ def turns_from_levels(levels):
     return turns
 
 
+# The staircase posterior (src/procedure/threshold_fit.h StaircasePosterior, its twin, held to it by
+# tests/data/staircase_posterior_golden.csv): a Weibull whose threshold is the level answered correctly `target` of the
+# time, lapses included, over a grid of threshold x slope x lapse with a uniform prior; the median of the threshold's
+# marginal and its equal-tailed 95 % credible interval, each grid point's mass spread over its cell in log threshold.
+THETA_POINTS, SLOPE_POINTS, SLOPE_LOW, SLOPE_HIGH, LAPSES = 161, 17, 0.5, 5.0, (0.0, 0.025, 0.05)
+
+
+def staircase_posterior(guess, target, lo, hi, levels, correct):
+    """dict(determined, estimate, low, high, at_bound, why) as StaircasePosterior gives it."""
+    levels = np.maximum(np.asarray(levels, float), 0.0)
+    correct = np.asarray(correct, bool)
+    if len(levels) == 0:
+        return {"determined": False, "why": "not determined: no answers"}
+    ux, inv = np.unique(levels, return_inverse=True)
+    right = np.bincount(inv, weights=correct.astype(float))
+    wrong = np.bincount(inv).astype(float) - right
+    low_end = max(lo, hi / 1000)
+    log_theta = math.log(low_end) + (math.log(hi) - math.log(low_end)) * np.arange(THETA_POINTS) / (THETA_POINTS - 1)
+    slope = np.exp(math.log(SLOPE_LOW) + (math.log(SLOPE_HIGH) - math.log(SLOPE_LOW)) * np.arange(SLOPE_POINTS) /
+                   (SLOPE_POINTS - 1))
+    lapse = np.asarray(LAPSES)
+    span = 1 - guess - lapse
+    c = -np.log1p(-(target - guess) / span)
+    with np.errstate(divide="ignore", invalid="ignore"):  # log 0 at level 0; 0 x log 0 in np.where's unused branch
+        u = np.exp(slope[None, :, None] * (np.log(ux)[None, None, :] - log_theta[:, None, None]))  # [theta, slope, x]
+        p = guess - span[None, None, :, None] * np.expm1(-c[None, None, :, None] * u[:, :, None, :])
+        ll = (np.where(right > 0, right * np.log(p), 0) + np.where(wrong > 0, wrong * np.log1p(-p), 0)).sum(-1)
+    mass = np.exp(ll - ll.max()).sum(axis=(1, 2))
+    cumulative = np.cumsum(mass) / mass.sum()
+    step = log_theta[1] - log_theta[0]
+
+    def quantile(q):
+        k = min(int(np.searchsorted(cumulative, q, side="left")), THETA_POINTS - 1)
+        before = cumulative[k - 1] if k else 0.0
+        m = cumulative[k] - before
+        start = max(log_theta[k] - step / 2, log_theta[0])
+        end = min(log_theta[k] + step / 2, log_theta[-1])
+        return math.exp(start + ((q - before) / m if m > 0 else 0.5) * (end - start)), k
+
+    tail = (1 - CREDIBLE) / 2
+    (estimate, _), (low, i_low), (high, i_high) = quantile(0.5), quantile(tail), quantile(1 - tail)
+    low_at, high_at = i_low <= 1, i_high + 2 >= THETA_POINTS
+    tenth = (math.log(hi) - math.log(low_end)) / 10
+    out = {"determined": False, "estimate": estimate, "low": low, "high": high, "at_bound": ""}
+    if low_at and high_at:
+        out["why"] = f"not determined: its 95 % interval spans the whole of {criteria.range_words(lo, hi)}"
+    elif low_at and math.log(estimate) < math.log(low_end) + tenth:
+        out["why"] = f"not determined: below {criteria.range_words(lo, hi)} (the answers put it at the lowest levels)"
+    elif high_at and math.log(estimate) > math.log(hi) - tenth:
+        out["why"] = f"not determined: above {criteria.range_words(lo, hi)} (the answers put it at the highest levels)"
+    else:
+        out["determined"] = True
+        if low_at:
+            out.update(low=lo, at_bound="lower")
+        if high_at:
+            out.update(high=hi, at_bound="upper")
+    return out
+
+
 def staircase_threshold(p, levels, correct):
     """A staircase track's threshold (dict): estimate, interval and what they mean."""
-    out = {"method": f"mean of the last {LAST_TURNS} turning points; interval: t over the midpoints of turning-point "
-                     "pairs"}
-    if p is not None:
-        filled, answers, missed = staircase_fill_missed(p, levels, correct)
-        if missed:
-            levels, correct = filled, answers
-            out["note"] = (f"{missed} missed answer{'s' if missed > 1 else ''} (not in these rows) put back where the "
-                           "levels show them, counted wrong as the procedure counted them")
-        turns, replayed = staircase_turns(p, levels, correct)
-        if len(replayed) != len(levels) or np.abs(replayed - levels).max() > 1e-6 * max(1.0, np.abs(levels).max()):
-            first = int(np.argmax(np.abs(replayed - levels) > 1e-6))
-            out["why"] = (f"not determined: replaying the answers here gives level {_text(replayed[first])} at the "
-                          f"track's trial {first + 1}, the record shows {_text(levels[first])} (answers missing from "
-                          "these rows, such as missed deadlines?)")
-            return out | {"turning_points": len(turns)}
-        lo, hi = criteria.tested_range(p, levels)
-    else:
-        turns = turns_from_levels(levels)
-        lo, hi = criteria.tested_range(None, levels)
-        out["method"] += " (procedures.csv missing: turning points from the levels, bounds unknown)"
+    out = {"method": "posterior median at the staircase's target (Weibull, uniform prior over threshold x slope 0.5-5 "
+                     "x lapse 0-5 %); interval: its equal-tailed 95 % credible interval"}
+    if p is None:
+        return out | {"why": "not determined: the export has no procedures.csv (its rule, so its target and range, "
+                             "unknown; export again with this blurcue)",
+                      "turning_points": len(turns_from_levels(levels))}
+    filled, answers, missed = staircase_fill_missed(p, levels, correct)
+    if missed:
+        levels, correct = filled, answers
+        out["note"] = (f"{missed} missed answer{'s' if missed > 1 else ''} (not in these rows) put back where the "
+                       "levels show them, counted wrong as the procedure counted them")
+    turns, replayed = staircase_turns(p, levels, correct)
     out["turning_points"] = len(turns)
+    if len(replayed) != len(levels) or np.abs(replayed - levels).max() > 1e-6 * max(1.0, np.abs(levels).max()):
+        first = int(np.argmax(np.abs(replayed - levels) > 1e-6))
+        out["why"] = (f"not determined: replaying the answers here gives level {_text(replayed[first])} at the "
+                      f"track's trial {first + 1}, the record shows {_text(levels[first])} (answers missing from "
+                      "these rows, such as missed deadlines?)")
+        return out
+    lo, hi = criteria.tested_range(p, levels)
     out["range"] = (lo, hi)
-    if len(turns) < MIN_TURNS:
-        out["why"] = f"not determined: {len(turns)} turning point{'s' if len(turns) != 1 else ''} (needs {MIN_TURNS})"
-        return out
-    # A staircase that stops after N reversals and ran out of trials before them has not converged: its last turning
-    # points may still be the approach.
-    stop = int(float(p["stop_reversals"])) if p is not None and str(p.get("stop_reversals", "")).strip() not in \
-        ("", "0", "None", "nan") else 0
-    if stop and len(turns) < stop:
-        out["why"] = (f"not determined: the track ended after {len(levels)} trials with {len(turns)} of the "
-                      f"{stop} turning points its stop rule asks for (it had not settled)")
-        return out
-    take = min(LAST_TURNS, len(turns) - len(turns) % 2)
-    used = np.array(turns[-take:], float)
-    at_bound = np.isclose(used, lo) | np.isclose(used, hi)
-    if p is not None and at_bound.sum() * 2 >= len(used):
-        side = "above" if np.isclose(used, hi).sum() >= np.isclose(used, lo).sum() else "below"
-        out["why"] = criteria.beyond_words(side, lo, hi, f"the track turned at its bound {int(at_bound.sum())} of "
-                                                         f"{len(used)} times")
-        return out
-    estimate = float(used.mean())
-    mids = (used[0::2] + used[1::2]) / 2
-    if not mids.std(ddof=1) > 0:
-        # Pairs that agree exactly leave no spread to estimate from: a zero-width interval would claim certainty.
-        return out | {"estimate": estimate, "used": len(used),
-                      "note": (out.get("note", "") + "; " if out.get("note") else "") +
-                      f"interval not determined: the {len(mids)} turning-point pairs share one midpoint"}
-    half = sps.t.ppf(0.975, len(mids) - 1) * mids.std(ddof=1) / math.sqrt(len(mids))
-    low, high = estimate - half, estimate + half
-    bound = []
-    if low < lo:
-        low, bound = lo, bound + ["lower"]
-    if high > hi:
-        high, bound = hi, bound + ["upper"]
-    if len(bound) == 2:
-        # An interval as wide as every level the staircase can show says nothing about where the threshold is.
-        return out | {"why": f"not determined: its interval spans the whole of {criteria.range_words(lo, hi)}",
-                      "used": len(used)}
-    out.update(estimate=estimate, low=low, high=high, interval_at_bound=" and ".join(bound),
-               used=len(used))
-    if at_bound.any():
-        k = int(at_bound.sum())
-        out["note"] = (out.get("note", "") + "; " if out.get("note") else "") + \
-            f"{k} of the {len(used)} turning points used {'sits' if k == 1 else 'sit'} at the level's bound"
+    target = criteria.criterion("staircase", p, float(p.get("guess", 0.5))).answers
+    if not math.isfinite(target):
+        return out | {"why": "not determined: this up/down rule has no closed-form target"}
+    fit = staircase_posterior(float(p.get("guess", 0.5)), target, lo, hi, levels, correct)
+    if not fit["determined"]:
+        return out | {"why": fit["why"]}
+    out.update(estimate=fit["estimate"], low=fit["low"], high=fit["high"], interval_at_bound=fit["at_bound"],
+               used=len(levels))
     return out
 
 

@@ -91,6 +91,29 @@ std::string DifferenceText(const Difference& d, const std::string& units) {
   return d.relative ? Signed(100 * d.value) + " % of the true threshold" : Signed(d.value) + " " + units;
 }
 
+std::vector<std::string> DesignWarnings(const Condition& c, const PowerRow& row) {
+  std::vector<std::string> out;
+  char text[320];
+  if (std::isfinite(row.determined_share) && row.determined_share < kDeterminedEnough) {
+    std::snprintf(text, sizeof text,
+                  "%s: only %.0f %% of tracks determine their threshold (the report says 'not determined' for the "
+                  "rest): more trials per track, or levels nearer the threshold",
+                  c.label.c_str(), 100 * row.determined_share);
+    out.push_back(text);
+  }
+  if (std::isfinite(row.coverage) && row.coverage < kCoveredEnough) {
+    std::snprintf(text, sizeof text, "%s: the tracks' 95 %% intervals hold the true threshold in only %.0f %% of them",
+                  c.label.c_str(), 100 * row.coverage);
+    out.push_back(text);
+  }
+  if (c.truth_determined && c.truth > 0 && std::isfinite(row.bias) && std::abs(row.bias) > kBiasEnough * c.truth) {
+    std::snprintf(text, sizeof text, "%s: the estimates sit %+.0f %% from the true threshold on average",
+                  c.label.c_str(), 100 * row.bias / c.truth);
+    out.push_back(text);
+  }
+  return out;
+}
+
 void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
   const int N = o.participants, S = o.studies;
   std::vector<const Condition*> cells;
@@ -138,6 +161,20 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
       }
       row.mean_trials = count / S;  // here: participants with an estimate
       row.interval_width = widths > 0 ? width / widths : kNan;
+      if (m == N) {
+        double tracks = 0, determined = 0, covered = 0;
+        for (const auto& study : r.studies)
+          for (const SimParticipant& p : study) {
+            const auto it = p.tracks.find(c->key);
+            if (it == p.tracks.end()) continue;
+            ++tracks;
+            if (!it->second.determined) continue;
+            ++determined;
+            covered += it->second.low <= c->truth && c->truth <= it->second.high;
+          }
+        row.determined_share = tracks > 0 ? determined / tracks : kNan;
+        row.coverage = determined > 0 && c->truth_determined ? covered / determined : kNan;
+      }
       r.rows.push_back(row);
     }
   }
@@ -386,23 +423,27 @@ std::string ThresholdSummary(const PlanResult& r, const PlanOptions& o) {
   char line[1024];
   std::snprintf(line, sizeof line,
                 "procedure cells: the threshold each estimates (QUEST+: its posterior median over its grid; a staircase: "
-                "the mean of its last 6 turning points, as the report takes them), over every simulated "
+                "the median of its posterior at the staircase's target, as the report takes them), over every simulated "
                 "participant, against the simulated observer's true threshold (its psychometric function's point the "
                 "procedure aims at: QUEST+'s Weibull threshold, a staircase's convergence point), and the mean width "
-                "of the 95 %% t interval of the mean of N = %d participants' estimates\n",
+                "of the 95 %% t interval of the mean of N = %d participants' estimates; determined: the share of tracks whose "
+                "threshold the report would give (the same rule), covered: of those, the share whose own 95 %% "
+                "interval holds the true threshold\n",
                 o.participants);
   out += line;
-  std::snprintf(line, sizeof line, "  %-28s %-18s %8s %8s %8s %8s %9s\n", "cell", "units", "truth", "mean", "bias",
-                "sd", "width");
+  std::snprintf(line, sizeof line, "  %-28s %-18s %8s %8s %8s %8s %9s %10s %8s\n", "cell", "units", "truth", "mean",
+                "bias", "sd", "width", "determined", "covered");
   out += line;
   for (const Condition* c : cells)
     for (const PowerRow& row : r.rows)
       if (row.test == "threshold" && row.condition == c->label && row.participants == o.participants) {
-        std::snprintf(line, sizeof line, "  %-28s %-18s %8s %8s %8s %8s %9s\n", c->label.c_str(), c->units.c_str(),
-                      number(row.true_threshold).c_str(), number(row.mean_estimate).c_str(),
+        std::snprintf(line, sizeof line, "  %-28s %-18s %8s %8s %8s %8s %9s %10s %8s\n", c->label.c_str(),
+                      c->units.c_str(), number(row.true_threshold).c_str(), number(row.mean_estimate).c_str(),
                       number(row.bias, "%+.3f").c_str(), number(row.sd_estimate).c_str(),
-                      number(row.interval_width).c_str());
+                      number(row.interval_width).c_str(), number(100 * row.determined_share, "%.0f %%").c_str(),
+                      number(100 * row.coverage, "%.0f %%").c_str());
         out += line;
+        for (const std::string& warning : DesignWarnings(*c, row)) out += "  WARNING: " + warning + "\n";
         if (!c->truth_determined)
           out += "  " + c->label + ": the true threshold is " + c->truth_why + ", so no bias is given\n";
       }

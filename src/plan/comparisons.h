@@ -20,6 +20,14 @@ void AddGroupShareRows(PlanResult& r, const PlanOptions& options);
 // undetermined true threshold is said in words, never printed as a number.
 std::string ThresholdSummary(const PlanResult& r, const PlanOptions& options);
 
+// What a design should give before it is run, by simulation: at least this share of tracks determined, of those at
+// least this share of 95 % intervals holding the truth, estimates on average within this fraction of the truth.
+inline constexpr double kDeterminedEnough = 0.8, kCoveredEnough = 0.9, kBiasEnough = 0.1;
+
+// The warnings for one procedure cell's threshold row at N = participants: rarely determined, intervals that rarely
+// cover, a biased estimate (each one line, naming the cell and the measured share).
+std::vector<std::string> DesignWarnings(const Condition& c, const PowerRow& row);
+
 // "plus 0.5 difference_arcmin" or "plus 20 % of the true threshold": the declared difference in words.
 std::string DifferenceText(const Difference& d, const std::string& units);
 

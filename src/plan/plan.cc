@@ -189,8 +189,11 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
       t.k += choice == "yes", ++t.n;
     }
   }
-  for (const auto& [key, track] : tracks)
-    if (const auto estimate = TrackEstimate(*track.procedure, track.levels, track.correct)) p.thresholds[key] = *estimate;
+  for (const auto& [key, track] : tracks) {
+    procedure::TrackThreshold t = TrackEstimate(*track.procedure, track.levels, track.correct);
+    if (t.determined) p.thresholds[key] = t.estimate;
+    p.tracks[key] = std::move(t);
+  }
   return p;
 }
 
@@ -483,14 +486,15 @@ PlanResult RunPlan(const PlanOptions& options) {
 std::string PlanCsv(const PlanResult& r) {
   std::string out =
       "test,condition,measure,chance,participants,expected_share,share_first,share_second,share_cant_tell,share_none,"
-      "mean_trials,wilson_width,power,true_threshold,mean_estimate,bias,sd_estimate,interval_width,difference\n";
+      "mean_trials,wilson_width,power,true_threshold,mean_estimate,bias,sd_estimate,interval_width,difference,determined_share,coverage\n";
   for (const PowerRow& row : r.rows)
     out += row.test + "," + store::CsvField(row.condition) + "," + row.measure + "," + Number(row.chance, "%.6g") + "," +
            std::to_string(row.participants) + "," + Number(row.expected_share) + "," + Number(row.share_first) + "," +
            Number(row.share_second) + "," + Number(row.share_cant_tell) + "," + Number(row.share_none) + "," +
            Number(row.mean_trials, "%.3f") + "," + Number(row.wilson_width) + "," + Number(row.power) + "," +
            Number(row.true_threshold) + "," + Number(row.mean_estimate) + "," + Number(row.bias) + "," +
-           Number(row.sd_estimate) + "," + Number(row.interval_width) + "," + Number(row.difference) + "\n";
+           Number(row.sd_estimate) + "," + Number(row.interval_width) + "," + Number(row.difference) + "," +
+           Number(row.determined_share) + "," + Number(row.coverage) + "\n";
   return out;
 }
 

@@ -31,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include "procedure/threshold_fit.h"
 #include "protocol/level.h"
 
 namespace blurcue::session {
@@ -103,6 +104,8 @@ struct SimParticipant {
   std::map<ConditionKey, std::vector<std::pair<double, double>>> matches;
   // A procedure cell's threshold estimate, as the report takes it from the track (threshold.h TrackEstimate).
   std::map<ConditionKey, double> thresholds;
+  // Every procedure cell's track as the report reads it (determined or not, with its interval and why).
+  std::map<ConditionKey, procedure::TrackThreshold> tracks;
 };
 
 inline constexpr double kNoValue = __builtin_nan("");
@@ -125,6 +128,10 @@ struct PowerRow {
   // of the mean of N estimates, and a comparison's true (or declared) difference.
   double true_threshold = kNoValue, mean_estimate = kNoValue, bias = kNoValue, sd_estimate = kNoValue;
   double interval_width = kNoValue, difference = kNoValue;
+  // Procedure cells, over every simulated track (the row at N = participants; NaN elsewhere): the share of tracks
+  // whose threshold is determined (TrackEstimate's rule, the report's), and of those, the share whose own 95 %
+  // interval holds the observer's true threshold (NaN where the truth is not determined).
+  double determined_share = kNoValue, coverage = kNoValue;
 };
 
 struct PlanResult {

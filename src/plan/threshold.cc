@@ -147,49 +147,71 @@ std::vector<double> TurningPoints(const protocol::Procedure& procedure, const st
   return staircase.ReversalLevels();
 }
 
-std::optional<double> TrackEstimate(const protocol::Procedure& procedure, const std::vector<double>& levels,
-                                    const std::vector<bool>& correct) {
-  if (levels.empty() || levels.size() != correct.size()) return std::nullopt;
-  if (procedure.kind == protocol::Procedure::Kind::kQuestPlus) {
-    session::QuestPlus quest(procedure);
-    for (size_t i = 0; i < levels.size(); ++i) quest.Update(levels[i], correct[i]);
-    // The threshold's marginal: the posterior runs threshold x slope x lapse, lapse fastest.
-    const size_t per_threshold = procedure.slopes.size() * procedure.lapses.size();
-    const std::vector<double>& posterior = quest.Posterior();
-    std::vector<double> cumulative(procedure.thresholds.size(), 0);
-    double sum = 0;
-    for (size_t t = 0; t < procedure.thresholds.size(); ++t) {
-      for (size_t k = 0; k < per_threshold; ++k) sum += posterior[t * per_threshold + k];
-      cumulative[t] = sum;
-    }
-    if (!(sum > 0) || cumulative.size() < 2) return std::nullopt;
-    for (double& c : cumulative) c /= sum;
-    // Half the mass on an end of the grid: the threshold lies at or beyond what the grid tested.
-    if (cumulative.front() >= 0.5 || 1 - cumulative[cumulative.size() - 2] >= 0.5) return std::nullopt;
-    size_t k = 0;
-    while (cumulative[k] < 0.5) ++k;
-    const std::vector<double>& grid = procedure.thresholds;
-    const double median =
-        grid[k - 1] + (0.5 - cumulative[k - 1]) / (cumulative[k] - cumulative[k - 1]) * (grid[k] - grid[k - 1]);
-    // Beyond every stimulus shown: the answers never came near it (ObserverThreshold's range).
-    if (!procedure.stimuli.empty()) {
-      const auto [lo, hi] = std::minmax_element(procedure.stimuli.begin(), procedure.stimuli.end());
-      if (median < *lo || median > *hi) return std::nullopt;
-    }
-    return median;
+procedure::TrackThreshold TrackEstimate(const protocol::Procedure& procedure, const std::vector<double>& levels,
+                                        const std::vector<bool>& correct) {
+  procedure::TrackThreshold out;
+  if (levels.empty() || levels.size() != correct.size()) {
+    out.why = "not determined: no answers";
+    return out;
   }
-  const std::vector<double> turns = TurningPoints(procedure, correct);
-  if (turns.size() < 4) return std::nullopt;
-  const size_t take = std::min<size_t>(6, turns.size() - turns.size() % 2);
+  if (procedure.kind != protocol::Procedure::Kind::kQuestPlus)
+    return procedure::StaircasePosterior({procedure.guess, TargetShare(procedure, 0), procedure.min, procedure.max},
+                                         levels, correct);
+  session::QuestPlus quest(procedure);
+  for (size_t i = 0; i < levels.size(); ++i) quest.Update(levels[i], correct[i]);
+  // The threshold's marginal: the posterior runs threshold x slope x lapse, lapse fastest.
+  const size_t per_threshold = procedure.slopes.size() * procedure.lapses.size();
+  const std::vector<double>& posterior = quest.Posterior();
+  std::vector<double> cumulative(procedure.thresholds.size(), 0);
   double sum = 0;
-  size_t at_bound = 0;
-  for (size_t i = turns.size() - take; i < turns.size(); ++i) {
-    sum += turns[i];
-    at_bound += std::abs(turns[i] - procedure.min) <= 1e-9 * std::max(1.0, std::abs(procedure.min)) ||
-                std::abs(turns[i] - procedure.max) <= 1e-9 * std::max(1.0, std::abs(procedure.max));
+  for (size_t t = 0; t < procedure.thresholds.size(); ++t) {
+    for (size_t k = 0; k < per_threshold; ++k) sum += posterior[t * per_threshold + k];
+    cumulative[t] = sum;
   }
-  if (2 * at_bound >= take) return std::nullopt;
-  return sum / double(take);
+  if (!(sum > 0) || cumulative.size() < 2) {
+    out.why = "not determined: the posterior is empty";
+    return out;
+  }
+  for (double& c : cumulative) c /= sum;
+  const std::vector<double>& grid = procedure.thresholds;
+  // Half the mass on an end of the grid: the threshold lies at or beyond what the grid tested.
+  if (cumulative.front() >= 0.5 || 1 - cumulative[cumulative.size() - 2] >= 0.5) {
+    out.why = std::string("not determined: ") + (cumulative.front() >= 0.5 ? "below" : "above") +
+              " the tested range (half the posterior on the grid's end)";
+    return out;
+  }
+  size_t k = 0;
+  while (cumulative[k] < 0.5) ++k;
+  out.estimate =
+      grid[k - 1] + (0.5 - cumulative[k - 1]) / (cumulative[k] - cumulative[k - 1]) * (grid[k] - grid[k - 1]);
+  // The equal-tailed interval on the grid: the first grid point where the cumulative mass reaches each tail
+  // (analysis/tracks.py credible).
+  const double tail = (1 - procedure::kCredible) / 2;
+  auto first_reaching = [&](double p) {
+    size_t j = 0;
+    while (j + 1 < cumulative.size() && cumulative[j] < p - 1e-12) ++j;
+    return j;
+  };
+  const size_t lo_i = first_reaching(tail), hi_i = first_reaching(1 - tail);
+  out.low = grid[lo_i], out.high = grid[hi_i];
+  double range_lo = grid.front(), range_hi = grid.back();
+  if (!procedure.stimuli.empty()) {
+    const auto [slo, shi] = std::minmax_element(procedure.stimuli.begin(), procedure.stimuli.end());
+    // Beyond every stimulus shown: the answers never came near it (ObserverThreshold's range).
+    if (out.estimate < *slo || out.estimate > *shi) {
+      out.why = std::string("not determined: ") + (out.estimate < *slo ? "below" : "above") +
+                " every stimulus shown";
+      return out;
+    }
+    range_lo = std::max(range_lo, *slo), range_hi = std::min(range_hi, *shi);
+  }
+  const size_t last = cumulative.size() - 1;
+  const bool lower = lo_i == 0 || out.low < range_lo;
+  const bool upper = (hi_i == last && 1 - cumulative[last - 1] >= tail) || out.high > range_hi;
+  out.low = std::max(out.low, range_lo), out.high = std::min(out.high, range_hi);
+  out.at_bound = lower && upper ? "lower and upper" : lower ? "lower" : upper ? "upper" : "";
+  out.determined = true;
+  return out;
 }
 
 }  // namespace blurcue::plan

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "procedure/threshold_fit.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
 #include "session/observer.h"
@@ -58,15 +59,14 @@ std::vector<std::string> QuestGridProblems(const session::PreparedSession& prepa
 // the other way than the last) replayed from a staircase's answers, in order.
 std::vector<double> TurningPoints(const protocol::Procedure& procedure, const std::vector<bool>& correct);
 
-// One participant's threshold estimate for one track (the levels shown and the answers, a missed deadline counted
-// wrong as the procedure counts it), as the report takes it (analysis/tracks.py):
+// One participant's threshold for one track (the levels shown and the answers, a missed deadline counted wrong as
+// the procedure counts it), as the report takes it (analysis/tracks.py), with its 95 % interval and whether it is
+// determined (the one rule of plan and report):
 //   QUEST+: the median of the threshold's marginal posterior over the protocol's grid (the cumulative mass
-//   interpolated linearly between grid points); empty when half the mass or more is on the grid's lowest or highest
-//   threshold (below or above what it tested);
-//   staircase: the mean of the last 6 turning points (4 when there are 4 or 5); empty with fewer than 4, or when half
-//   of those used or more sit at the level's bound (min or max).
-// Empty for an empty track.
-std::optional<double> TrackEstimate(const protocol::Procedure& procedure, const std::vector<double>& levels,
-                                    const std::vector<bool>& correct);
+//   interpolated linearly between grid points), its equal-tailed credible interval on the grid; not determined when
+//   half the mass or more is on the grid's lowest or highest threshold, or the median lies beyond every stimulus;
+//   staircase: procedure::StaircasePosterior, at the staircase's target (TargetShare, lapses included).
+procedure::TrackThreshold TrackEstimate(const protocol::Procedure& procedure, const std::vector<double>& levels,
+                                        const std::vector<bool>& correct);
 
 }  // namespace blurcue::plan

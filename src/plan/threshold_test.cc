@@ -32,7 +32,7 @@ TEST(TargetShare, LevittPointsAndTheWeibullThreshold) {
 // shows 1, 1, .6, .6, .2, .4, .4, .2, .4, .6, .6, .4, .6, .6 and turns (the level shown on the answer whose step goes
 // the other way) at trials 5, 7, 8, 11, 12, 14: .2 .4 .2 .6 .4 .6, mean 2.4 / 6 = 0.4. The levels after each turn
 // (the rule of before) would give .4 .2 .4 .4 .6 and a sixth level never shown.
-TEST(TrackEstimate, StaircaseMeanOfItsTurningPoints) {
+TEST(TurningPoints, StaircaseReplayedByHand) {
   protocol::Procedure staircase;
   staircase.start = 1, staircase.min = 0, staircase.max = 3, staircase.up = 1, staircase.down = 2;
   staircase.steps = {0.4, 0.2};
@@ -43,14 +43,13 @@ TEST(TrackEstimate, StaircaseMeanOfItsTurningPoints) {
   const std::vector<double> by_hand = {0.2, 0.4, 0.2, 0.6, 0.4, 0.6};
   ASSERT_EQ(turns.size(), by_hand.size());
   for (size_t i = 0; i < turns.size(); ++i) EXPECT_NEAR(turns[i], by_hand[i], 1e-12) << i;
-  EXPECT_NEAR(*TrackEstimate(staircase, levels, correct), 0.4, 1e-12);
-  // After 10 answers it has turned 3 times (.2 .4 .2): too few for a threshold.
-  EXPECT_FALSE(TrackEstimate(staircase, std::vector<double>(levels.begin(), levels.begin() + 10),
-                             std::vector<bool>(correct.begin(), correct.begin() + 10)));
-  // Turning at its bounds 4 times of 6 (.2 and .6 the bounds): not determined (the threshold may lie beyond them).
-  staircase.min = 0.2, staircase.max = 0.6;
-  EXPECT_FALSE(TrackEstimate(staircase, levels, correct));
-  EXPECT_FALSE(TrackEstimate(staircase, {}, {}));
+  // The plan's track estimate is the staircase posterior at the rule's target (procedure/threshold_fit.h).
+  const procedure::TrackThreshold t = TrackEstimate(staircase, levels, correct);
+  const procedure::TrackThreshold direct =
+      procedure::StaircasePosterior({0.5, std::sqrt(0.5), 0, 3}, levels, correct);
+  EXPECT_EQ(t.determined, direct.determined);
+  EXPECT_NEAR(t.estimate, direct.estimate, 1e-6 * direct.estimate);
+  EXPECT_FALSE(TrackEstimate(staircase, {}, {}).determined);
 }
 
 // QUEST+ over thresholds {1, 2, 3}, slope 2, no lapse, guess 0.5, after one correct answer at 1: each threshold's
@@ -64,9 +63,9 @@ TEST(TrackEstimate, QuestPlusPosteriorMedianByHand) {
   for (int t = 0; t < 3; ++t) sum += w[t] = 1 - 0.5 * std::exp(-std::pow(1.0 / (t + 1), 2));
   const double p1 = w[0] / sum, p2 = w[1] / sum;
   ASSERT_LT(p1, 0.5);
-  EXPECT_NEAR(*TrackEstimate(quest, {1}, {true}), 1 + (0.5 - p1) / p2, 1e-12);
+  EXPECT_NEAR(TrackEstimate(quest, {1}, {true}).estimate, 1 + (0.5 - p1) / p2, 1e-12);
   // Wrong at 4 twice: half the mass or more on the largest threshold - above what the grid tested, no number.
-  EXPECT_FALSE(TrackEstimate(quest, {4, 4, 4}, {false, false, false}));
+  EXPECT_FALSE(TrackEstimate(quest, {4, 4, 4}, {false, false, false}).determined);
 }
 
 // A pair at 2 px both sides, the right one the test side, seen by the pixel observer (jnd 0.6 px): a relative level
