@@ -54,6 +54,15 @@ def parameters(g):
     return json.loads(texts[0]) if texts else None
 
 
+LEVEL_UNITS = {"relative_difference": "(relative blur difference: test radius / reference radius - 1)",
+               "difference_arcmin": "arcmin (blur radius difference on the screen)"}
+
+
+def level_units(p):
+    """The unit of a procedure's level (its variable), in words: '' where the export does not say."""
+    return LEVEL_UNITS.get((p or {}).get("variable", ""), "")
+
+
 def cell_label(g):
     """The cell by its levels: 'edge=9;speed_cm_s=3' -> 'edge 9, speed_cm_s 3'."""
     text = str(g["cell"].iloc[0]) if "cell" in g and str(g["cell"].iloc[0]) not in ("", "nan") else ""
@@ -138,14 +147,15 @@ def turns_from_levels(levels):
 # time, lapses included, over a grid of threshold x slope x lapse with a uniform prior; the median of the threshold's
 # marginal and its equal-tailed 95 % credible interval, each grid point's mass spread over its cell in log threshold.
 THETA_POINTS, SLOPE_POINTS, SLOPE_LOW, SLOPE_HIGH, LAPSES = 161, 17, 0.5, 5.0, (0.0, 0.025, 0.05)
+MIN_ANSWERS = 10  # fewer: not determined, whatever the posterior (kMinAnswers)
 
 
 def staircase_posterior(guess, target, lo, hi, levels, correct):
     """dict(determined, estimate, low, high, at_bound, why) as StaircasePosterior gives it."""
     levels = np.maximum(np.asarray(levels, float), 0.0)
     correct = np.asarray(correct, bool)
-    if len(levels) == 0:
-        return {"determined": False, "why": "not determined: no answers"}
+    if len(levels) < MIN_ANSWERS:
+        return {"determined": False, "why": f"not determined: {len(levels)} answers (needs {MIN_ANSWERS})"}
     ux, inv = np.unique(levels, return_inverse=True)
     right = np.bincount(inv, weights=correct.astype(float))
     wrong = np.bincount(inv).astype(float) - right
@@ -410,7 +420,7 @@ def track_rows(m):
             participant += f" ({said[g.index[0]]})"
         crit = criteria.criterion(kind, p, float((p or {}).get("guess", 0.5)))
         out.append({"participant": participant, "cell": label, "kind": kind, "levels": levels, "correct": correct,
-                    "criterion": crit.short(),
+                    "criterion": crit.short(), "units": level_units(p),
                     "posterior": _num(g["posterior_threshold"]).to_numpy() if kind == "quest_plus" and
                     "posterior_threshold" in g else None, "result": result})
     return out
@@ -424,6 +434,7 @@ def _track_table(tracks):
         rows.append({
             "participant": t["participant"], "cell": t["cell"],
             "procedure": "QUEST+" if t["kind"] == "quest_plus" else "staircase", "trials": len(t["levels"]),
+            "units": t.get("units", ""),
             "criterion": t.get("criterion", ""),
             "share_correct": float(t["correct"].mean()),
             "threshold": r["estimate"] if determined else None,
@@ -438,65 +449,75 @@ def _track_table(tracks):
     return pd.DataFrame(rows)
 
 
+MIN_FOR_INTERVAL = 3  # a t interval across participants needs some spread to estimate (as study_tests.MIN_PARTICIPANTS_T)
+
+
 def summary_table(tracks):
-    """Per cell across participants: the determined thresholds' mean with a t 95 % interval (n >= 2) and median."""
+    """Per cell across participants: the determined thresholds' mean with a t 95 % interval (3 or more) and median,
+    the count of tracks not determined beside them. A cell where half its tracks or more are not determined gets no
+    summary number: the determined ones are a selection (the easier tracks), not the cell."""
     rows = []
     for cell in dict.fromkeys(t["cell"] for t in tracks):
         these = [t for t in tracks if t["cell"] == cell]
         v = np.array([t["result"]["estimate"] for t in these if "estimate" in t["result"]], float)
         row = {"cell": cell, "criterion": "; ".join(dict.fromkeys(t.get("criterion", "") for t in these)),
+               "units": "; ".join(dict.fromkeys(t.get("units", "") for t in these)),
                "tracks": len(these), "determined": len(v), "not_determined": len(these) - len(v)}
         # A track beyond the tested range has a threshold known only to lie past it: the mean or median of the
         # others would move the cell's threshold toward the range (censored values left out). Said in words.
         censored = [t for t in these if "estimate" not in t["result"] and "the tested range" in
-                    t["result"].get("why", "")]
+                    t["result"].get("why", "") and ("below" in t["result"]["why"] or "above" in t["result"]["why"])]
         if censored:
             row["interval"] = (f"not determined: {len(censored)} of {len(these)} tracks lie beyond the tested range "
                                "(their thresholds are censored there; a mean or median of the others would be "
                                "biased toward the range)")
             rows.append(row)
             continue
-        if len(v):
-            row.update(mean=float(v.mean()), median=float(np.median(v)))
-        row["interval"] = "t 95 % across participants" if len(v) >= 2 else \
-            ("not determined: fewer than 2 determined thresholds" if len(these) else "")
-        if len(v) >= 2:
-            half = sps.t.ppf(0.975, len(v) - 1) * v.std(ddof=1) / math.sqrt(len(v))
-            row["sd_across_participants"] = float(v.std(ddof=1))
-            ranges = [t["result"]["range"] for t in these if "range" in t["result"]]
-            lo, hi = (min(r[0] for r in ranges), max(r[1] for r in ranges)) if ranges else (-math.inf, math.inf)
-            if v.mean() - half < lo or v.mean() + half > hi:
-                # A t interval past what the procedure could show (a negative threshold, say) is no interval.
-                row["interval"] = (f"not determined: the t 95 % interval across participants reaches beyond "
-                                   f"{criteria.range_words(lo, hi)}")
-            else:
-                row.update(mean_low=float(v.mean() - half), mean_high=float(v.mean() + half))
+        if 2 * len(v) <= len(these):
+            row["interval"] = (f"not determined: {len(v)} of {len(these)} tracks determined (the determined ones "
+                               "would stand for the cell)")
+            rows.append(row)
+            continue
+        row.update(mean=float(v.mean()), median=float(np.median(v)))
+        if len(v) < MIN_FOR_INTERVAL:
+            row["interval"] = (f"not determined: {len(v)} participants' thresholds are too few for an interval "
+                               f"across participants (needs {MIN_FOR_INTERVAL}); each track's own interval is in the "
+                               "tracks table")
+            rows.append(row)
+            continue
+        row["interval"] = f"t 95 % across {len(v)} participants"
+        half = sps.t.ppf(0.975, len(v) - 1) * v.std(ddof=1) / math.sqrt(len(v))
+        row["sd_across_participants"] = float(v.std(ddof=1))
+        ranges = [t["result"]["range"] for t in these if "range" in t["result"]]
+        lo, hi = (min(r[0] for r in ranges), max(r[1] for r in ranges)) if ranges else (-math.inf, math.inf)
+        if v.mean() - half < lo or v.mean() + half > hi:
+            # A t interval past what the procedure could show (a negative threshold, say) is no interval.
+            row["interval"] = (f"not determined: the t 95 % interval across participants reaches beyond "
+                               f"{criteria.range_words(lo, hi)}")
+        else:
+            row.update(mean_low=float(v.mean() - half), mean_high=float(v.mean() + half))
         rows.append(row)
     return pd.DataFrame(rows)
 
 
 def summary_words(summary):
-    """The thresholds per cell for the report's summary, in the words of the thresholds table (criterion, tested
-    range, not determined): one clause per cell."""
+    """The thresholds per cell for the report's summary, in the words of the thresholds table (criterion, unit, test,
+    N, tracks not determined): one clause per cell."""
     out = []
     for _, r in summary.iterrows():
+        unit = f" {r['units']}" if str(r.get("units", "")) not in ("", "nan") else ""
         text = f"{r['cell']}: threshold at {r['criterion']}"
-        if str(r.get("interval", "")).startswith("not determined") and pd.isna(r.get("mean")):
-            text += f" {r['interval']}"
-        elif int(r["determined"]) == 1:
-            text += f" {r['mean']:.3g} (one participant's threshold)"
-        elif str(r.get("interval", "")).startswith("not determined"):
-            text += (f" {r['mean']:.3g} (mean of {int(r['determined'])} participants' thresholds; its interval "
-                     f"{r['interval']})")
-        elif pd.notna(r.get("mean_low")):
-            text += (f" {r['mean']:.3g} [{r['mean_low']:.3g}, {r['mean_high']:.3g}] (mean of {int(r['determined'])} "
-                     "participants' thresholds, t 95 %)")
+        if pd.notna(r.get("mean_low")):
+            text += (f" {r['mean']:.3g}{unit} [{r['mean_low']:.3g}, {r['mean_high']:.3g}] (mean of "
+                     f"{int(r['determined'])} participants' thresholds, t 95 %)")
+        elif pd.notna(r.get("mean")) and int(r["determined"]) == 1:
+            text += f" {r['mean']:.3g}{unit} (one participant's threshold)"
         elif pd.notna(r.get("mean")):
-            text += f" {r['mean']:.3g} (one participant's threshold)"
+            text += (f" {r['mean']:.3g}{unit} (mean of {int(r['determined'])} participants' thresholds; its interval "
+                     f"{r['interval']})")
         else:
-            text += " not determined"
-        if int(r["not_determined"]) and not str(r.get("interval", "")).startswith("not determined"):
-            text += f"; {int(r['not_determined'])} of {int(r['tracks'])} tracks not determined"
+            text += f" {r.get('interval') or 'not determined'}"
+        text += f"; {int(r['not_determined'])} of {int(r['tracks'])} tracks not determined"
         out.append(text)
     return "; ".join(out)
 
@@ -559,8 +580,9 @@ def _tracks_figure(tracks, cells, study, group_note, out_dir, name):
         ax.set_xlabel("trial of the procedure")
     for ax in axes.flat[n:]:
         ax.set_visible(False)
+    units = "; ".join(dict.fromkeys(t.get("units", "") for t in tracks if t.get("units")))
     for ax in axes[:, 0]:
-        ax.set_ylabel("level shown")
+        ax.set_ylabel(f"level shown {units}" if units else "level shown", fontsize=8)
     kinds = {t["kind"] for t in tracks}
     fig.suptitle(f"{study}: procedure tracks ({', '.join('QUEST+' if k == 'quest_plus' else 'staircase' for k in sorted(kinds))})"
                  f"\n{group_note}; o correct, x wrong; squares at the right: each track's threshold and interval",
@@ -589,7 +611,8 @@ def _thresholds_figure(tracks, summary, cells, study, group_note, out_dir, name)
     # A cell's levels one per line: "from_edge 3, speed_cm_s 1.8, to_edge 8" side by side ran into its neighbour.
     ax.set_xticklabels([c.replace(", ", "\n") for c in cells], fontsize=8)
     ax.set_xlim(-0.6, len(cells) - 0.4)
-    ax.set_ylabel("threshold (the procedure's level)")
+    units = "; ".join(dict.fromkeys(t.get("units", "") for t in tracks if t.get("units")))
+    ax.set_ylabel(f"threshold {units}" if units else "threshold (the procedure's level)", fontsize=8)
     ax.set_title(f"{study}: thresholds per cell\n{group_note}\ngrey: each participant with its 95 % interval; "
                  "orange: the mean with its t 95 % interval", loc="left", fontsize=10)
     fig.tight_layout()
@@ -614,8 +637,9 @@ def charts(m, study, out_dir, slug, group_note):
     png, svg = _thresholds_figure(tracks, summary, cells, study, group_note, out_dir, f"{slug}-thresholds")
     out.append(Chart(f"{slug}-thresholds", png, svg, summary,
                      [f"{group_note}: per cell, the determined thresholds' mean with a t 95 % interval across "
-                      "participants (n >= 2) and their median; tracks whose threshold is not determined are counted, "
-                      "not averaged"]))
+                      f"participants ({MIN_FOR_INTERVAL} or more) and their median; tracks whose threshold is not "
+                      "determined are counted, not averaged, and a cell where half its tracks or more are not "
+                      "determined gets no number"]))
     if len(cells) > 1:
         out.append(Chart(f"{slug}-threshold-comparisons", None, None, comparisons_table(tracks),
                          [f"{group_note}: each pair of cells, paired across the participants with a determined "

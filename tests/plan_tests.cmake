@@ -151,3 +151,19 @@ add_test(NAME validate_plan_single_objects COMMAND ${BC} validate ${T}/protocols
 set_tests_properties(validate_plan_single_objects PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS plan
   PASS_REGULAR_EXPRESSION "0 distinct pairs, 0 invisible; 9 single objects, [1-9] as blurred as the scene to this observer\n.*object measured vs the scene [^\n]* - as blurred as the scene at 60 cm on this monitor"
   FAIL_REGULAR_EXPRESSION "invisible at")
+
+# Issue 38's must-hold: the report's per-track thresholds against 30 simulated observers of drawn Weber fraction,
+# their truth worked out from docs/observer.md in tests/threshold_coverage_check.py - the shipped staircase, a
+# 1-up/3-down variant of it (48 trials, no stop rule) and the shipped QUEST+ protocol.
+add_test(NAME threshold_coverage_staircase
+         COMMAND bash ${PROJECT_SOURCE_DIR}/tests/threshold_coverage_test.sh ${BC} ${T}/protocols/staircase-ball-gain.json
+                 staircase ${T}/coverage-staircase 30)
+add_test(NAME threshold_coverage_1up3down
+         COMMAND bash ${PROJECT_SOURCE_DIR}/tests/threshold_coverage_test.sh ${BC} ${T}/protocols/staircase-ball-gain.json
+                 staircase ${T}/coverage-1up3down 30
+                 "p['name'] += '-1up3down'; pr = p['blocks'][0]['procedure']; pr.update(down=3, trials=48); pr.pop('stop')")
+add_test(NAME threshold_coverage_quest
+         COMMAND bash ${PROJECT_SOURCE_DIR}/tests/threshold_coverage_test.sh ${BC} ${T}/protocols/quest-blur-difference.json
+                 quest_plus ${T}/coverage-quest 30)
+set_tests_properties(threshold_coverage_staircase threshold_coverage_1up3down threshold_coverage_quest PROPERTIES
+                     FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS "gl;plan" TIMEOUT 600)

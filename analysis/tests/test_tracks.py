@@ -134,31 +134,28 @@ class StaircaseEstimate(unittest.TestCase):
         np.testing.assert_allclose(turns, [0.2, 0.4, 0.2, 0.6, 0.4, 0.6], atol=1e-12)
         np.testing.assert_allclose(shown, levels, atol=1e-12)
         r = tracks.staircase_threshold(p, np.array(levels, float), np.array(correct) == 1)
-        self.assertAlmostEqual(r["estimate"], 0.4, places=12)
+        whole = tracks.staircase_posterior(0.5, math.sqrt(0.5), 0.0, 3.0, levels, np.array(correct) == 1)
+        self.assertAlmostEqual(r["estimate"], whole["estimate"], places=12)
         # The wrong answer at trial 5 missing from the rows (a missed deadline): the level after it (0.4 where the
         # rule shows 0.2) puts it back, and the whole track's estimate follows.
         r = tracks.staircase_threshold(p, np.array(levels[:4] + levels[5:], float),
                                        np.array(correct[:4] + correct[5:]) == 1)
-        self.assertAlmostEqual(r["estimate"], 0.4, places=12)
+        self.assertAlmostEqual(r["estimate"], whole["estimate"], places=12)
         self.assertTrue(r["note"].startswith("1 missed answer (not in these rows) put back"), r["note"])
         # Levels no missed answers explain (a step down after a single correct answer): said, not estimated.
         r = tracks.staircase_threshold(p, np.array([1.0, 0.6, 0.6], float), np.array([1, 1, 1]) == 1)
         self.assertNotIn("estimate", r)
         self.assertTrue(r["why"].startswith("not determined: replaying the answers"), r["why"])
 
-    def test_a_track_that_never_met_its_stop_rule_is_not_determined(self):
-        # The hand-worked track has 6 turning points; a protocol that stops at 8 reversals ran out of trials before
-        # it settled (the adversary's P4: 4 of 6 turning points in 30 trials, a drifting track called determined).
-        p = {"procedure": "staircase", "start": 1.0, "min": 0.0, "max": 3.0, "up": 1, "down": 2, "steps": [0.4, 0.2],
+    def test_a_track_too_short_to_bound_its_threshold_is_not_determined(self):
+        # Six answers, one wrong: the posterior reaches both ends of 0.02 to 3 (no number); the stop rule no longer
+        # decides (the posterior says how settled a track is; 4 of 6 turning points could be a settled track).
+        p = {"procedure": "staircase", "start": 1.0, "min": 0.02, "max": 3.0, "up": 1, "down": 2, "steps": [0.4, 0.2],
              "stop_reversals": 8}
-        levels = [1, 1, 0.6, 0.6, 0.2, 0.4, 0.4, 0.2, 0.4, 0.6, 0.6, 0.4, 0.6, 0.6]
-        correct = [1, 1, 1, 1, 0, 1, 1, 0, 0, 1, 1, 0, 1, 1]
-        r = tracks.staircase_threshold(p, np.array(levels, float), np.array(correct) == 1)
+        r = tracks.staircase_threshold(p, np.array([1, 1, 0.6, 0.6, 0.2, 0.4], float),
+                                       np.array([1, 1, 1, 1, 0, 1]) == 1)
         self.assertNotIn("estimate", r)
-        self.assertEqual(r["why"], "not determined: the track ended after 14 trials with 6 of the 8 turning points "
-                                   "its stop rule asks for (it had not settled)")
-        r = tracks.staircase_threshold(p | {"stop_reversals": 6}, np.array(levels, float), np.array(correct) == 1)
-        self.assertAlmostEqual(r["estimate"], 0.4, places=12)
+        self.assertEqual(r["why"], "not determined: 6 answers (needs 10)")
 
     def test_a_cell_with_tracks_beyond_the_range_gives_no_mean_of_the_rest(self):
         # Three tracks determined near 1, three above the grid: their thresholds lie past 6, so the mean of the three
@@ -185,7 +182,7 @@ class StaircaseEstimate(unittest.TestCase):
         p = {"procedure": "staircase", "start": truth, "min": 0.02, "max": 3.0, "up": 1, "down": 2,
              "steps": [0.03]}
         rng = np.random.default_rng(7)
-        estimates = []
+        estimates, covered = [], 0
         for _ in range(400):
             level, run, direction, levels, answers, turns = truth, 0, 0, [], [], []
             while len(turns) < 30 and len(levels) < 400:
@@ -205,13 +202,17 @@ class StaircaseEstimate(unittest.TestCase):
                     level = min(max(level + move * p["steps"][0], p["min"]), p["max"])
             r = tracks.staircase_threshold(p, np.array(levels), np.array(answers))
             self.assertEqual(r["turning_points"], len(turns))
-            self.assertAlmostEqual(r["estimate"], float(np.mean(turns[-6:])), places=12)
             estimates.append(r["estimate"])
+            covered += r["low"] <= truth <= r["high"]
         estimates = np.array(estimates)
         bias, se = estimates.mean() - truth, estimates.std(ddof=1) / math.sqrt(len(estimates))
         print(f"\n  staircase: truth {truth:.4f}, mean estimate {estimates.mean():.4f}, bias {bias:+.4f} "
-              f"(Monte Carlo standard error {se:.4f}, {bias / se:+.1f} se)")
-        self.assertLess(abs(bias), 3 * se)
+              f"(Monte Carlo standard error {se:.4f}, {bias / se:+.1f} se), {covered} of 400 intervals cover")
+        # Measured: +8.4 % (5.9 se), coverage 94.8 %. The Weibull is not this observer's function (a cumulative normal
+        # of the log blur ratio): over the +-50 % a staircase wanders, the fit's target point sits ~8 % high; the
+        # turning-point mean it replaced was unbiased here but 48 % high on the shipped 30-trial design.
+        self.assertLess(abs(bias), 0.12 * truth)
+        self.assertGreaterEqual(covered, 0.9 * 400)
 
 
 class NotDeterminedInWords(unittest.TestCase):
@@ -228,7 +229,7 @@ class NotDeterminedInWords(unittest.TestCase):
         self.assertTrue(table.loc["Q1", "threshold_says"].startswith("not determined: above the tested range 0.25 "
                                                                      "to 6"), table.loc["Q1", "threshold_says"])
         self.assertTrue(pd.isna(table.loc["Q1", "threshold"]) and pd.isna(table.loc["Q1", "threshold_high"]))
-        self.assertEqual(table.loc["S1", "threshold_says"], "not determined: 1 turning point (needs 4)")
+        self.assertEqual(table.loc["S1", "threshold_says"], "not determined: 6 answers (needs 10)")
         self.assertEqual(list(table.loc[:, "cell"]), ["edge 9", "edge 3"])
         for chart in charts:
             if chart.table is not None:
@@ -250,12 +251,15 @@ class NotDeterminedInWords(unittest.TestCase):
         with tempfile.TemporaryDirectory() as out:
             charts = tracks.charts(pd.concat(frames, ignore_index=True), "x", out, "x", "3 participants")
         summary = charts[1].table.set_index("cell")
-        self.assertAlmostEqual(summary.loc["speed_cm_s 1.8", "mean"], 0.4, places=9)
-        self.assertAlmostEqual(summary.loc["speed_cm_s 3", "mean"], 0.5, places=9)
+        a = tracks.staircase_posterior(0.5, math.sqrt(0.5), 0.0, 3.0, levels, np.array(correct) == 1)["estimate"]
+        b = tracks.staircase_posterior(0.5, math.sqrt(0.5), 0.0, 3.0, levels + 0.1, np.array(correct) == 1)["estimate"]
+        self.assertAlmostEqual(summary.loc["speed_cm_s 1.8", "mean"], a, places=9)
+        self.assertAlmostEqual(summary.loc["speed_cm_s 3", "mean"], b, places=9)
+        self.assertGreater(b, a)  # the same answers 0.1 higher: a higher threshold
         comparison = charts[2].table.iloc[0]
         self.assertEqual((comparison["first"], comparison["second"], comparison["pairs"]),
                          ("speed_cm_s 1.8", "speed_cm_s 3", 3))
-        self.assertAlmostEqual(comparison["mean_difference"], 0.1, places=9)
+        self.assertAlmostEqual(comparison["mean_difference"], b - a, places=9)
 
 
 class IntervalsWithinTheTestedRange(unittest.TestCase):
@@ -278,7 +282,8 @@ class IntervalsWithinTheTestedRange(unittest.TestCase):
         self.assertIn("a: threshold at 81.6 % correct 1.07 (mean of 3 participants' thresholds; its interval not "
                       "determined", words)
         one = tracks.summary_words(tracks.summary_table([track("P1", 0.8, "c")]))
-        self.assertEqual(one, "c: threshold at 81.6 % correct 0.8 (one participant's threshold)")
+        self.assertEqual(one, "c: threshold at 81.6 % correct 0.8 (one participant's threshold); 0 of 1 tracks not "
+                              "determined")
 
 
 class SessionsSaidAsWhatTheyAre(unittest.TestCase):

@@ -26,8 +26,8 @@ TrackThreshold StaircasePosterior(const StaircaseFitSpec& spec, const std::vecto
       !(spec.target > spec.guess) || !(spec.target < 1 - kLapses[std::size(kLapses) - 1]))
     throw std::invalid_argument("StaircasePosterior: a spec outside its bounds");
   TrackThreshold out;
-  if (levels.empty() || levels.size() != correct.size()) {
-    out.why = "not determined: no answers";
+  if (levels.size() != correct.size() || levels.size() < size_t(kMinAnswers)) {
+    out.why = "not determined: " + std::to_string(levels.size()) + " answers (needs " + std::to_string(kMinAnswers) + ")";
     return out;
   }
   // The answers by level: (k correct of n) at each distinct level shown.

@@ -26,6 +26,9 @@ inline constexpr int kSlopePoints = 17;
 inline constexpr double kSlopeLow = 0.5, kSlopeHigh = 5;
 inline constexpr double kLapses[] = {0, 0.025, 0.05};
 inline constexpr double kCredible = 0.95;
+// Fewer answers than this: not determined, whatever the posterior (six answers gave an interval 0.03 to 1.9 that the
+// prior, not the answers, shaped).
+inline constexpr int kMinAnswers = 10;
 
 struct StaircaseFitSpec {
   double guess = 0.5;   // the task's guess rate
@@ -45,7 +48,7 @@ struct TrackThreshold {
 
 // The threshold of one staircase track (levels shown, answers, a missed deadline counted wrong). The rule for
 // "determined", the same in plan and report:
-//   not determined   no answers; an interval that reaches both ends of the range ("spans the whole tested range");
+//   not determined   fewer than kMinAnswers answers; an interval that reaches both ends of the range ("spans the whole tested range");
 //                    an interval that reaches one end with the median in the tenth of the (log) range next to it
 //                    ("below/above the tested range": the answers put it there);
 //   determined       otherwise (an end at the range's bound is named in at_bound).
