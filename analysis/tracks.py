@@ -535,7 +535,7 @@ def comparisons_table(tracks):
         for b in cells[i + 1:]:
             both = sorted(set(by.get(a, {})) & set(by.get(b, {})))
             row = {"first": a, "second": b, "pairs": len(both)}
-            if len(both) >= 2:
+            if len(both) >= MIN_FOR_INTERVAL:
                 diff = np.array([by[b][p] - by[a][p] for p in both])
                 half = sps.t.ppf(0.975, len(diff) - 1) * diff.std(ddof=1) / math.sqrt(len(diff))
                 row.update(mean_difference=float(diff.mean()), difference_low=float(diff.mean() - half),
@@ -544,7 +544,8 @@ def comparisons_table(tracks):
                     row["p_paired_t"] = float(sps.ttest_rel([by[b][p] for p in both], [by[a][p] for p in both]).pvalue)
                 row["test"] = "paired t across participants"
             else:
-                row["test"] = "not determined: fewer than 2 participants with a threshold in both cells"
+                row["test"] = (f"not determined: {len(both)} participants with a threshold in both cells (a test needs "
+                               f"{MIN_FOR_INTERVAL})")
             rows.append(row)
     return pd.DataFrame(rows)
 

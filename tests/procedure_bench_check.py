@@ -19,7 +19,10 @@ for p in ("staircase_1u3d", "quest_plus"):  # failures the chart must show
     side = get[(p, "side_bias", 160)]
     assert side["bias"] > 0.15 * side["truth"], (p, side)
     beyond = get[(p, "beyond_range", 160)]
-    assert beyond["bias"] < -0.15 * beyond["truth"], (p, beyond)
+    if p == "quest_plus":  # QUEST+'s posterior mean gives a number pinned inside its grid
+        assert beyond["bias"] < -0.15 * beyond["truth"], (p, beyond)
+    else:  # the staircase posterior says "not determined: above the tested range" (docs/thresholds.md), no number
+        assert beyond["failed"] == beyond["runs"], (p, beyond)
 # Verdicts: one of three words, and consistent with the numbers and the 10 % / 15 % lines they decide.
 for row in rows:
     assert row["within_target"] in ("yes", "no", "undecided") and row["fails"] in ("yes", "no", "undecided"), row

@@ -10,6 +10,8 @@
 
 #include "core/atomic_file.h"
 #include "protocol/protocol.h"
+#include "plan/threshold.h"
+#include "procedure/threshold_fit.h"
 #include "session/adaptive.h"
 
 namespace blurcue::bench {
@@ -176,20 +178,24 @@ std::vector<ProcedureRow> RunProcedureBench(const ProcedureBenchOptions& options
               tallies[trial].estimates.push_back(q.MeanThreshold());
           }
         } else {
-          session::Staircase s(Staircase(procedure == "staircase_1u2d" ? 2 : 3));
+          const protocol::Procedure spec = Staircase(procedure == "staircase_1u2d" ? 2 : 3);
+          session::Staircase s(spec);
+          std::vector<double> levels;
+          std::vector<bool> answers;
           for (int trial = 1; trial <= most; ++trial) {
-            s.Update(o.Answer(s.Level(), rng));
+            const double level = s.Level();
+            const bool ok = o.Answer(level, rng);
+            s.Update(ok);
+            levels.push_back(level), answers.push_back(ok);
             if (std::find(std::begin(kCheckpoints), std::end(kCheckpoints), trial) == std::end(kCheckpoints)) continue;
-            // The mean of the last (up to) six reversals; none with fewer than two.
-            const auto& r = s.ReversalLevels();
-            if (r.size() < 2) {
+            // The report's estimate (procedure/threshold_fit.h): the posterior median at the staircase's target.
+            const procedure::TrackThreshold t = procedure::StaircasePosterior(
+                {spec.guess, plan::TargetShare(spec, 0), spec.min, spec.max}, levels, answers);
+            if (!t.determined) {
               ++tallies[trial].failed;
               continue;
             }
-            const size_t from = r.size() > 6 ? r.size() - 6 : 0;
-            double sum = 0;
-            for (size_t i = from; i < r.size(); ++i) sum += r[i];
-            tallies[trial].estimates.push_back(sum / double(r.size() - from));
+            tallies[trial].estimates.push_back(t.estimate);
           }
         }
       }

@@ -149,8 +149,8 @@ void AddProcedures(CLI::App& bench) {
       "procedures",
       "Which procedure to choose: speed (trials) against accuracy of threshold estimates, and where each fails.\n"
       "Simulated 2AFC observers of known Weibull threshold and slope answer seeded runs of the method of constant\n"
-      "stimuli (8 levels, maximum-likelihood fit), 1-up/2-down and 1-up/3-down staircases (mean of the last six\n"
-      "reversals) and QUEST+ (posterior mean), each given the same stimulus range. After 20, 40, 80 and 160 trials\n"
+      "stimuli (8 levels, maximum-likelihood fit), 1-up/2-down and 1-up/3-down staircases (the report's posterior\n"
+      "median at the target, docs/thresholds.md) and QUEST+ (posterior mean), each given the same stimulus range. After 20, 40, 80 and 160 trials\n"
       "each estimate is compared with what the procedure aims at (the Weibull threshold; a staircase's 70.7 % or\n"
       "79.4 % point of the observer's sensory function): bias, SD and RMSE. Conditions: nominal, lapses (5 %), a\n"
       "side bias (25 % of answers 'left'), a slope unlike QUEST+'s prior (8), a threshold beyond the range (4 > 3).\n"

@@ -55,7 +55,7 @@ void AddPlanCommand(CLI::App& app) {
       "An adaptive block (a staircase or QUEST+) sets how often its trials are right, so its share correct is not\n"
       "tested; per procedure cell (a crossing of the block's factors, e.g. edge=9) the plan reports what it measures:\n"
       "  threshold      the participants' estimates as the report takes them (QUEST+: the median of its posterior\n"
-      "                 over its grid; a staircase: the mean of its last 6 turning points) against the simulated\n"
+      "                 over its grid; a staircase: its posterior median at its target, docs/thresholds.md) against the simulated\n"
       "                 observer's true threshold, worked out from the observer model's own psychometric function (the\n"
       "                 point the procedure aims at: QUEST+'s Weibull threshold, a staircase's convergence point):\n"
       "                 truth, mean, bias, sd and the width of the 95 % t interval of the mean of N estimates. A truth\n"
