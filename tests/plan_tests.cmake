@@ -167,3 +167,4 @@ add_test(NAME threshold_coverage_quest
                  quest_plus ${T}/coverage-quest 30)
 set_tests_properties(threshold_coverage_staircase threshold_coverage_1up3down threshold_coverage_quest PROPERTIES
                      FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS "gl;plan" TIMEOUT 600)
+set_tests_properties(threshold_coverage_staircase threshold_coverage_1up3down PROPERTIES ENVIRONMENT "FPS=0.2")

@@ -3,10 +3,11 @@
 # procedure protocol: tests/threshold_coverage_check.py works out each observer's true threshold from docs/observer.md
 # and checks the share determined, the intervals' coverage and the mean relative error.
 # Usage: threshold_coverage_test.sh BLURCUE PROTOCOL KIND SCRATCH N [CHANGE]
-#   (--sim-fps 2: frames of 0.5 s, short of any response deadline; at 0.2 every QUEST+ answer timed out)
+#   FPS (environment, default 2): --sim-fps; 2 keeps frames of 0.5 s, short of any response deadline (at 0.2 every
+#   QUEST+ answer timed out); the staircase protocol has none and runs at 0.2 (fewer frames rendered)
 #   CHANGE: a Python statement on the parsed protocol p (a variant written beside PROTOCOL, its relative paths kept).
 set -euo pipefail
-BC=$1 PROTOCOL=$2 KIND=$3 DIR=$4 N=$5 CHANGE=${6:-}
+BC=$1 PROTOCOL=$2 KIND=$3 DIR=$4 N=$5 CHANGE=${6:-} FPS=${FPS:-2}
 rm -rf "$DIR" && mkdir -p "$DIR"
 if [ -n "$CHANGE" ]; then
   variant=$(dirname "$PROTOCOL")/_coverage-$(basename "$DIR").json
@@ -22,7 +23,7 @@ weber=$(/usr/bin/python3 -c "import random; r = random.Random(38); print(' '.joi
 i=0
 for w in $weber; do
   i=$((i + 1))
-  "$BC" run "$PROTOCOL" --participant "P$i" --db "$DIR/record.sqlite" --sim-fps 2 \
+  "$BC" run "$PROTOCOL" --participant "P$i" --db "$DIR/record.sqlite" --sim-fps "$FPS" \
     --observer "sim:weber=$w,side=0,blurrier=0" > /dev/null 2> "$DIR/run.log" || { cat "$DIR/run.log"; exit 1; }
 done
 "$BC" export --db "$DIR/record.sqlite" --out "$DIR/export" > /dev/null
