@@ -437,5 +437,22 @@ for r in quest:
         assert float(r["mean_trials"]) == 3, r
 PYEOF
   echo "ok: a block both groups run is planned per group (shares and thresholds), compared by Welch, not pooled" ;;
+design_warnings)
+  # A staircase of 8 trials never gives the report a threshold (fewer than 10 answers is not determined; 12 already
+  # do, with wide intervals): validate --plan and plan say so with a WARNING naming the cell and the share; the
+  # plan's determined share is the share of simulated tracks the report's rule determines.
+  variant "$P/staircase-ball-gain.json" "$W/short.json" 'p["blocks"][0]["procedure"].update(trials=8); p["blocks"][0]["procedure"].pop("stop")'
+  $BC validate "$W/short.json" --plan > "$W/validate.out" 2>&1 || fail "validate --plan: $(tail -2 "$W/validate.out")"
+  grep -q "WARNING: from_edge=3 speed_cm_s=1.8 to_edge=8: only [0-9]* % of tracks determine their threshold" \
+    "$W/validate.out" || fail "no warning from validate --plan: $(grep -i procedure "$W/validate.out")"
+  $BC plan "$W/short.json" --participants 10 --studies 10 --no-chart --out "$W/p" > "$W/plan.out" 2>&1 \
+    || fail "plan: $(tail -2 "$W/plan.out")"
+  grep -q "WARNING: from_edge=3 speed_cm_s=3 to_edge=8: only" "$W/plan.out" || fail "no warning from plan"
+  $PY - "$W/p/plan.csv" <<'PYEOF' || fail "determined share"
+import csv, sys
+rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["test"] == "threshold" and r["participants"] == "10"]
+assert len(rows) == 2 and all(float(r["determined_share"]) < 0.8 for r in rows), rows
+PYEOF
+  echo "ok: a design that rarely determines its threshold is warned of by validate --plan and plan" ;;
 *) fail "unknown case $CASE" ;;
 esac

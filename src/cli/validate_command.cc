@@ -11,6 +11,8 @@
 #include "cli/groups.h"
 #include "core/error.h"
 #include "core/hash.h"
+#include "plan/comparisons.h"
+#include "plan/plan.h"
 #include "plan/threshold.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
@@ -22,13 +24,50 @@
 
 namespace blurcue::cli {
 
+namespace {
+
+struct Args {
+  std::string file, participant = "P1", display, observer = "sim", group;
+  std::optional<uint64_t> seed;
+  bool no_files = false, list = false, plan = false;
+  double visible = 0.75;
+};
+
+// --plan on a protocol with a staircase or QUEST+ block: 200 simulated tracks per procedure cell (`blurcue plan`'s
+// simulation, 10 studies of 20), and how often the report would determine each cell's threshold and its interval
+// hold the truth - a WARNING line where the design rarely does (plan::DesignWarnings, the plan's own rule).
+std::string ProcedureDesignLines(const protocol::Protocol& protocol, const Args& args) {
+  bool any = false;
+  for (const auto& b : protocol.blocks) any = any || (b.procedure && !b.practice);
+  if (!any) return "";
+  plan::PlanOptions options;
+  options.protocol_file = args.file;
+  options.display_profile = args.display;
+  options.observer = args.observer;
+  options.participants = 20, options.studies = 10, options.seed = 1;
+  const plan::PlanResult r = plan::RunPlan(options);
+  std::string out;
+  char line[400];
+  for (const plan::Condition& c : r.conditions) {
+    if (c.measure != "threshold") continue;
+    for (const plan::PowerRow& row : r.rows) {
+      if (row.test != "threshold" || row.condition != c.label || row.participants != options.participants) continue;
+      std::snprintf(line, sizeof line,
+                    "  procedure cell %s: %.0f %% of 200 simulated tracks determine their threshold; %s\n",
+                    c.label.c_str(), 100 * row.determined_share,
+                    std::isfinite(row.coverage) ? (std::to_string(int(std::lround(100 * row.coverage))) +
+                                                   " % of their 95 % intervals hold the observer's true threshold").c_str()
+                                                : ("the observer's true threshold is " + c.truth_why).c_str());
+      out += line;
+      for (const std::string& warning : plan::DesignWarnings(c, row)) out += "  WARNING: " + warning + "\n";
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 void AddValidateCommand(CLI::App& app) {
-  struct Args {
-    std::string file, participant = "P1", display, observer = "sim", group;
-    std::optional<uint64_t> seed;
-    bool no_files = false, list = false, plan = false;
-    double visible = 0.75;
-  };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "validate",
@@ -142,6 +181,7 @@ void AddValidateCommand(CLI::App& app) {
             for (const std::string& problem : plan::QuestGridProblems(prepared, *observer, args->file))
               if (std::find(grid_problems.begin(), grid_problems.end(), problem) == grid_problems.end())
                 grid_problems.push_back(problem);
+            if (checked.empty()) shown += ProcedureDesignLines(prepared.protocol, *args);
           }
           checked.push_back({group, prepared.seed, prepared.trials, shown});
         }
