@@ -502,7 +502,9 @@ def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, 
             summary = [t.table for t in track_charts if t.name == f"{slug}-thresholds"]
             if summary:
                 finding += "; tracks: " + tracks.summary_words(summary[0])
-            words = "psychometric fit of the answers pooled: " + words if words else ""
+            # The pooled fit mixes participants of different thresholds (and a track's levels depend on its own
+            # answers): a description in its chart, not a result beside the per-participant thresholds.
+            words = ""
         finding += "; " + words if words else ""
     else:
         # Why there is none, in the words of what was asked (a pair's preference, a yes/no question, ...).
