@@ -54,8 +54,8 @@ def parameters(g):
     return json.loads(texts[0]) if texts else None
 
 
-LEVEL_UNITS = {"relative_difference": "(relative blur difference: test radius / reference radius - 1)",
-               "difference_arcmin": "arcmin (blur radius difference on the screen)"}
+LEVEL_UNITS = {"relative_difference": "relative difference (r_test / r_ref - 1)",
+               "difference_arcmin": "arcmin (difference of blur radius)"}
 
 
 def level_units(p):
@@ -583,7 +583,7 @@ def _tracks_figure(tracks, cells, study, group_note, out_dir, name):
         ax.set_visible(False)
     units = "; ".join(dict.fromkeys(t.get("units", "") for t in tracks if t.get("units")))
     for ax in axes[:, 0]:
-        ax.set_ylabel(f"level shown {units}" if units else "level shown", fontsize=8)
+        ax.set_ylabel(f"level shown\n{units}" if units else "level shown", fontsize=9)
     kinds = {t["kind"] for t in tracks}
     fig.suptitle(f"{study}: procedure tracks ({', '.join('QUEST+' if k == 'quest_plus' else 'staircase' for k in sorted(kinds))})"
                  f"\n{group_note}; o correct, x wrong; squares at the right: each track's threshold and interval",
@@ -613,7 +613,7 @@ def _thresholds_figure(tracks, summary, cells, study, group_note, out_dir, name)
     ax.set_xticklabels([c.replace(", ", "\n") for c in cells], fontsize=8)
     ax.set_xlim(-0.6, len(cells) - 0.4)
     units = "; ".join(dict.fromkeys(t.get("units", "") for t in tracks if t.get("units")))
-    ax.set_ylabel(f"threshold {units}" if units else "threshold (the procedure's level)", fontsize=8)
+    ax.set_ylabel(f"threshold\n{units}" if units else "threshold (the procedure's level)", fontsize=9)
     ax.set_title(f"{study}: thresholds per cell\n{group_note}\ngrey: each participant with its 95 % interval; "
                  "orange: the mean with its t 95 % interval", loc="left", fontsize=10)
     fig.tight_layout()
