@@ -8,6 +8,8 @@ Per within factor F of a study with a group (design.Design: group, factors):
                   tested by the Kenward-Roger F. The random part is the first of (1 + F | participant),
                   (1 | participant) + (1 | participant:F), (1 | participant) whose fit converges and is not singular
                   (the table says which and why). Other within factors enter as main effects.
+                  With participants as the unit beside it (no R): the split-plot ANOVA of each participant's share
+                  or mean per level, its interaction F with the Greenhouse-Geisser p (split_plot).
   per level       the groups' difference at each level of F: from the model with the interaction by emmeans (log-odds
                   for a 0/1 measure; a GLMM's Wald z against t with G - groups df), and with participants as the unit
                   (each participant's share or mean at that level, Welch's t between the groups), each Holm-adjusted
@@ -147,6 +149,52 @@ def per_level_participants(m, column, factor, group):
     return pd.DataFrame(rows)
 
 
+def split_plot(m, column, factor, group):
+    """The group x factor interaction with participants as the unit, no R: the split-plot (mixed-design) ANOVA of each
+    participant's share (or mean) per level. Each participant's profile over the k levels, less its own mean, as k - 1
+    orthonormal contrasts; the interaction is the groups' difference in those contrasts: F = (SS between the groups'
+    mean contrasts / (g - 1)(k - 1)) / (SS within the groups / (N - g)(k - 1)) - aov(y ~ group * F + Error(participant /
+    F))'s within stratum - and its p with the Greenhouse-Geisser epsilon (tr S)^2 / ((k - 1) tr S^2) of the pooled
+    within-group covariance S of the contrasts, which keeps the level where the levels' variances differ (no
+    sphericity). Participants without an answer at every level are left out (counted). Returns a dict: F, df1, df2, p
+    (Greenhouse-Geisser), p_uncorrected, epsilon, participants, left_out; or why (in words) without a test."""
+    d = m.assign(_level=text(m[factor]).map(_label), _group=text(m[group]))
+    levels = _levels(d["_level"])
+    wide = d.pivot_table(index=["_group", "participant"], columns="_level", values=column, aggfunc="mean")
+    wide = wide.reindex(columns=levels)
+    full = wide.dropna()
+    left_out = len(wide) - len(full)
+    groups_of = full.index.get_level_values("_group")
+    names = _levels(set(groups_of))
+    k, n, g = len(levels), len(full), len(names)
+    sizes = [int((groups_of == name).sum()) for name in names]
+    if g < 2 or k < 2 or min(sizes) < 2:
+        return {"why": f"no split-plot ANOVA: {g} group(s) with participants answering at all {k} levels "
+                       f"({', '.join(f'{name}: {s}' for name, s in zip(names, sizes))}; needs >= 2 in each)",
+                "left_out": left_out}
+    # Orthonormal contrasts of the k levels (the columns of Q orthogonal to the constant).
+    basis = np.linalg.qr(np.column_stack([np.ones(k), np.eye(k)[:, :k - 1]]))[0][:, 1:]
+    z = full.to_numpy(float) @ basis
+    grand = z.mean(axis=0)
+    ss_between, resid = 0.0, []
+    for name in names:
+        zg = z[np.asarray(groups_of == name)]
+        ss_between += len(zg) * float(np.sum((zg.mean(axis=0) - grand) ** 2))
+        resid.append(zg - zg.mean(axis=0))
+    resid = np.vstack(resid)
+    ss_within = float(np.sum(resid ** 2))
+    df1, df2 = (g - 1) * (k - 1), (n - g) * (k - 1)
+    if ss_within <= 0:
+        return {"why": "no split-plot ANOVA: the participants' profiles do not vary within the groups",
+                "left_out": left_out}
+    f_stat = (ss_between / df1) / (ss_within / df2)
+    cov = resid.T @ resid / (n - g)
+    eps = float(np.trace(cov) ** 2 / ((k - 1) * np.trace(cov @ cov))) if k > 2 else 1.0
+    return {"F": f_stat, "df1": df1, "df2": df2, "p_uncorrected": float(sps.f.sf(f_stat, df1, df2)),
+            "epsilon": eps, "p": float(sps.f.sf(f_stat, eps * df1, eps * df2)), "participants": n,
+            "left_out": left_out, "why": ""}
+
+
 def _p_words(p):
     return study_tests.p_text(p)
 
@@ -194,10 +242,28 @@ def charts(m, kind, design, slug, note, what):
                 stat = f"Kenward-Roger F({t['df']:.0f}, {t['df2']:.1f}) = {t['statistic']:.2f}" \
                     if math.isfinite(t["df2"]) else f"likelihood-ratio chi2({t['df']:.0f}) = {t['statistic']:.2f}"
             row["says"] = f"{stat}, {_p_words(t['p'])}"
-            findings.append(f"group x {f}: {row['says']}")
+            findings.append(f"group x {f} by the mixed model: {row['says']}")
         else:
             row["says"] = r["why"]
-            findings.append(f"group x {f}: {r['why']}")
+            findings.append(f"group x {f} by the mixed model: not determined (why: {slug}-groups-interaction)")
+        inter.append(row)
+        sp = split_plot(m, column, f, group)
+        unit = "share" if family == "glmm" else "mean"
+        row = {"factor": f, "model": f"aov({unit} ~ {group} * {f} + Error(participant / {f})), one {unit} per "
+                                     f"participant per level",
+               "term": row["term"], "statistic": sp.get("F", math.nan), "df": sp.get("df1", math.nan),
+               "df2": sp.get("df2", math.nan), "p": sp.get("p", math.nan),
+               "engine": "split-plot ANOVA, Greenhouse-Geisser (participants as the unit; scipy)",
+               "random": "participants as the unit"}
+        if sp["why"]:
+            row["says"] = sp["why"]
+        else:
+            row["says"] = (f"F({sp['df1']}, {sp['df2']}) = {sp['F']:.2f}, Greenhouse-Geisser epsilon "
+                           f"{sp['epsilon']:.2f}: {_p_words(sp['p'])} (uncorrected {_p_words(sp['p_uncorrected'])}), "
+                           f"{sp['participants']} participants")
+            findings.append(f"group x {f} with participants as the unit (split-plot ANOVA): {row['says']}")
+        if sp["left_out"]:
+            row["says"] += f"; {sp['left_out']} participant(s) without an answer at every level left out"
         inter.append(row)
         model_rows = r["contrasts"]
         part = per_level_participants(m, column, f, group)
@@ -232,11 +298,14 @@ def charts(m, kind, design, slug, note, what):
             if len(sel):
                 findings.append(f"groups differ (model, Holm) at {f} " + ", ".join(
                     f"{r['level']} ({_p_words(r['model_p_holm'])})" for _, r in sel.iterrows()))
-    inter_notes = [f"{note}: the group x within-factor interaction - the model with it against the same model "
-                   f"without it, participants as random effects (the random part fitted is in `random`); "
+    inter_notes = [f"{note}: the group x within-factor interaction (does the groups' difference change across the "
+                   f"factor's levels?), two ways: the mixed model with it against the same model without it, "
+                   f"participants as random effects (the random part fitted is in `random`; "
                    + ("a binomial GLMM of '" + what + "', likelihood-ratio chi-square" if family == "glmm" else
                       "a linear mixed model of the " + what + ", Kenward-Roger F (pbkrtest)") +
-                   "; a fit that failed, did not converge or was singular in every random part says 'not determined'"]
+                   "; a fit that failed, did not converge or was singular in every random part says 'not "
+                   "determined'), and with participants as the unit, the split-plot ANOVA of each participant's "
+                   "value per level (Greenhouse-Geisser p)"]
     level_notes = [f"{note}: the groups' difference at each level of the factor, two ways: model_* from the mixed "
                    f"model with the interaction by emmeans ({scale}), welch_* with participants as the unit (each "
                    f"participant's {'share' if family == 'glmm' else 'mean'} at that level, Welch's t between the "

@@ -10,7 +10,10 @@ model gives), never skip.
 """
 import math
 import os
+import shutil
+import subprocess
 import sys
+import tempfile
 import unittest
 
 import numpy as np
@@ -43,6 +46,8 @@ def simulate(seed, delta, per_group=8, trials=24, sd_participant=0.5, sd_by_dept
 
 
 DESIGN = design.Design(within=("edge",), group="group")
+# Rscript for the test that asks R itself; none: that test fails (it needs R as every test here does).
+RSCRIPT = shutil.which("Rscript") or "/usr/bin/Rscript"
 
 
 class GroupByDepth(unittest.TestCase):
@@ -54,6 +59,9 @@ class GroupByDepth(unittest.TestCase):
         self.assertLess(inter["p"], 0.01, inter["says"])
         self.assertEqual(inter["df"], 2)  # (2 groups - 1) x (3 edges - 1) interaction terms
         self.assertIn("likelihood-ratio chi2(2)", inter["says"])
+        split = charts[0].table.iloc[1]  # participants as the unit finds it too
+        self.assertIn("split-plot ANOVA", split["engine"])
+        self.assertLess(split["p"], 0.05, split["says"])
         level = charts[1].table.set_index("level")
         # The truth: group a - group b is -DELTA log-odds at edge 9 (conditional on the participant, as the GLMM's
         # estimate is) and 0 at edges 3 and 6; only edge 9 differs after Holm.
@@ -81,17 +89,42 @@ class GroupByDepth(unittest.TestCase):
         self.assertAlmostEqual(level.loc["9", "p"], want.pvalue, places=10)
         self.assertAlmostEqual(level.loc["9", "difference"], shares["a"].mean() - shares["b"].mean(), places=12)
 
+    def test_the_split_plot_anova_is_rs_own(self):
+        # Participants as the unit: R's multivariate route to the same test, anova.mlm's sphericity table (base R,
+        # not aov and not the formulas of groups.split_plot): its group row is the group x edge interaction, with
+        # the Greenhouse-Geisser p; and aov's within stratum gives the same F.
+        m = simulate(3, 1.0, per_group=5, trials=12)
+        got = groups.split_plot(m, "y", "edge", "group")
+        wide = m.groupby(["group", "participant", "edge"])["y"].mean().unstack().reset_index()
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "wide.csv")
+            wide.to_csv(path, index=False)
+            code = (f'd <- read.csv("{path}", check.names = FALSE); Y <- as.matrix(d[, c("3", "6", "9")]); '
+                    'a <- anova(lm(Y ~ factor(d$group)), X = ~1, test = "Spherical"); '
+                    'cat(sprintf("%.12g", c(a[2, "F"], a[2, "num Df"], a[2, "den Df"], a[2, "Pr(>F)"], '
+                    'a[2, "G-G Pr"])))')
+            out = subprocess.run([RSCRIPT, "-e", code], capture_output=True, text=True, timeout=120, check=True)
+        f, df1, df2, p, p_gg = map(float, out.stdout.split())
+        self.assertAlmostEqual(got["F"], f, places=8)
+        self.assertEqual((got["df1"], got["df2"]), (df1, df2))
+        self.assertAlmostEqual(got["p_uncorrected"], p, places=8)
+        self.assertAlmostEqual(got["p"], p_gg, places=8)
+
     def test_no_interaction_is_not_flagged_above_the_nominal_rate(self):
         # 30 studies with a group effect (0.4 log-odds at every edge) and no interaction. At a true 5 % rate the
         # count of p < 0.05 is Binomial(30, 0.05): P(>= 5) = 0.016; 5 or more (17 %) says the test rejects a true
         # null at more than its nominal rate. Every study must also get a test (no fit 'not determined').
-        ps = []
+        # The split-plot ANOVA (participants as the unit) is held to the same count.
+        ps, split = [], []
         for seed in range(100, 130):
-            r = groups.fit(simulate(seed, 0.0, per_group=6, trials=16), "y", "edge", "group")
+            m = simulate(seed, 0.0, per_group=6, trials=16)
+            r = groups.fit(m, "y", "edge", "group")
             self.assertIsNotNone(r["test"], r["why"])
             ps.append(r["test"]["p"])
+            split.append(groups.split_plot(m, "y", "edge", "group")["p"])
         rejected = sum(p < 0.05 for p in ps)
         self.assertLessEqual(rejected, 4, sorted(ps))
+        self.assertLessEqual(sum(p < 0.05 for p in split), 4, sorted(split))
         # And the p-values are not piled at 0 or 1: a uniform's share below 0.5 is 0.5 (binomial 99.9 % bounds).
         below_half = sum(p < 0.5 for p in ps)
         self.assertTrue(6 <= below_half <= 24, sorted(ps))
