@@ -294,10 +294,11 @@ def charts(m, kind, design, slug, note, what):
             level_t.loc[sel, "model_p_holm"] = _holm(level_t.loc[sel, "model_p"])
             level_t.loc[sel, "welch_p_holm"] = _holm(level_t.loc[sel, "welch_p"])
         for f in factors:
-            sel = level_t[(level_t["factor"] == f) & (level_t["model_p_holm"] < 0.05)]
-            if len(sel):
-                findings.append(f"groups differ (model, Holm) at {f} " + ", ".join(
-                    f"{r['level']} ({_p_words(r['model_p_holm'])})" for _, r in sel.iterrows()))
+            for source, words in (("model", "model"), ("welch", "participants as the unit, Welch")):
+                sel = level_t[(level_t["factor"] == f) & (level_t[f"{source}_p_holm"] < 0.05)]
+                if len(sel):
+                    findings.append(f"groups differ ({words}, Holm) at {f} " + ", ".join(
+                        f"{r['level']} ({_p_words(r[f'{source}_p_holm'])})" for _, r in sel.iterrows()))
     inter_notes = [f"{note}: the group x within-factor interaction (does the groups' difference change across the "
                    f"factor's levels?), two ways: the mixed model with it against the same model without it, "
                    f"participants as random effects (the random part fitted is in `random`; "

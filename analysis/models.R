@@ -249,7 +249,16 @@ group_job <- function(kind, data_path, emit) {
              "a random intercept only, (1 | participant)")
   tried <- character()
   chosen <- NULL
-  for (i in seq_along(randoms)) {
+  # Each participant's own profile has k (k + 1) / 2 variances and correlations: with as many participants or fewer it
+  # cannot be estimated (and a glmer over 11 levels' profiles runs for minutes before it says so).
+  k <- nlevels(d$w)
+  first <- 1
+  if (k * (k + 1) / 2 >= nlevels(d$g)) {
+    tried <- sprintf("%s not tried (%d variances and correlations from %d participants)", words[1], k * (k + 1) / 2,
+                     nlevels(d$g))
+    first <- 2
+  }
+  for (i in first:length(randoms)) {
     full <- group_fit(kind, as.formula(paste0("y ~ grp * w", extra, " + ", randoms[i])), d)
     if (full$ok) { chosen <- i; break }
     tried <- c(tried, sprintf("%s %s", words[i], full$why))
