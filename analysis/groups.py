@@ -46,7 +46,8 @@ def _levels(values):
 
 
 def _label(v):
-    return v[:-2] if v.endswith(".0") else v
+    """A level as the tables write it: 3.0 as 3; an empty cell (the factor does not apply to the row) in words."""
+    return v[:-2] if v.endswith(".0") else v if v else "(not applicable)"
 
 
 def _named(words, factor):
@@ -227,8 +228,9 @@ def charts(m, kind, design, slug, note, what):
         others = [o for o in factors if o != f]
         r = fit(m, column, f, group, others, family)
         rhs = f"{group} * {f}" + "".join(f" + {o}" for o in others)
-        model = (f"{'glmer' if family == 'glmm' else 'lmer'}({column} ~ {rhs} + {r['random'] or '(random)'}) "
-                 f"against {group} + {f}" + "".join(f" + {o}" for o in others))
+        model = (f"{'glmer' if family == 'glmm' else 'lmer'}({column} ~ {rhs} + "
+                 f"{r['random'] or 'a random part by participant'}) against {group} + {f}" +
+                 "".join(f" + {o}" for o in others))
         row = {"factor": f, "model": model, "term": f"{group} x {f} interaction (does the groups' difference change "
                                                     f"across the levels of {f}?)",
                "statistic": math.nan, "df": math.nan, "df2": math.nan, "p": math.nan, "engine": r["engine"],
@@ -271,6 +273,11 @@ def charts(m, kind, design, slug, note, what):
             out = {"factor": f, "level": pr["level"], "contrast": f"group {pr['group_a']} - group {pr['group_b']}"}
             hit = model_rows[(model_rows["level"] == pr["level"]) & (model_rows["group_a"] == pr["group_a"]) &
                              (model_rows["group_b"] == pr["group_b"])] if len(model_rows) else model_rows
+            emm = r["emmeans"]
+            for side in ("a", "b"):  # each group's estimate at the level (a probability for a 0/1 measure)
+                at = emm[(emm["level"] == pr["level"]) & (emm["group"] == pr[f"group_{side}"])] if len(emm) else emm
+                out[f"model_{'prob' if family == 'glmm' else 'mean'}_{side}"] = \
+                    float(at["estimate"].iloc[0]) if len(at) else math.nan
             if len(hit):
                 h = hit.iloc[0]
                 out.update(model_estimate=h["estimate"], model_se=h["se"], model_df=h["df"], model_p=h["p"],
@@ -308,7 +315,9 @@ def charts(m, kind, design, slug, note, what):
                    "determined'), and with participants as the unit, the split-plot ANOVA of each participant's "
                    "value per level (Greenhouse-Geisser p)"]
     level_notes = [f"{note}: the groups' difference at each level of the factor, two ways: model_* from the mixed "
-                   f"model with the interaction by emmeans ({scale}), welch_* with participants as the unit (each "
+                   f"model with the interaction by emmeans ({scale}; model_{'prob' if family == 'glmm' else 'mean'}"
+                   f"_a/_b: each group's estimate at the level, a typical participant's), welch_* with participants "
+                   f"as the unit (each "
                    f"participant's {'share' if family == 'glmm' else 'mean'} at that level, Welch's t between the "
                    f"groups); *_p_holm: Holm-adjusted over the levels (and pairs of groups) of one factor"]
     return [Chart(f"{slug}-groups-interaction", None, None, inter_t, inter_notes),
