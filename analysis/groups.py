@@ -252,7 +252,7 @@ def charts(m, kind, design, slug, note, what):
         sp = split_plot(m, column, f, group)
         unit = "share" if family == "glmm" else "mean"
         row = {"factor": f, "model": f"aov({unit} ~ {group} * {f} + Error(participant / {f})), one {unit} per "
-                                     f"participant per level",
+                                     f"participant per level" + (f", pooled over {', '.join(others)}" if others else ""),
                "term": row["term"], "statistic": sp.get("F", math.nan), "df": sp.get("df1", math.nan),
                "df2": sp.get("df2", math.nan), "p": sp.get("p", math.nan),
                "engine": "split-plot ANOVA, Greenhouse-Geisser (participants as the unit; scipy)",
@@ -304,8 +304,10 @@ def charts(m, kind, design, slug, note, what):
             for source, words in (("model", "model"), ("welch", "participants as the unit, Welch")):
                 sel = level_t[(level_t["factor"] == f) & (level_t[f"{source}_p_holm"] < 0.05)]
                 if len(sel):
+                    pairs = level_t["contrast"].nunique() > 1  # more than two groups: say which pair
                     findings.append(f"groups differ ({words}, Holm) at {f} " + ", ".join(
-                        f"{r['level']} ({_p_words(r[f'{source}_p_holm'])})" for _, r in sel.iterrows()))
+                        f"{r['level']} ({r['contrast'] + ', ' if pairs else ''}{_p_words(r[f'{source}_p_holm'])})"
+                        for _, r in sel.iterrows()))
     inter_notes = [f"{note}: the group x within-factor interaction (does the groups' difference change across the "
                    f"factor's levels?), two ways: the mixed model with it against the same model without it, "
                    f"participants as random effects (the random part fitted is in `random`; "
