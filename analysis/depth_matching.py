@@ -119,6 +119,13 @@ def _meaningful(term, words, p, note, floor_arcmin=None):
     return p, note
 
 
+WORDS_MATCH = {"Intercept": "set blur at real blur 0 (arcmin)",
+               "real_arcmin": "per arcmin of real blur, against 1 (set as real)"}
+# The match's slope is tested against 1 - "set as real", the hypothesis the task is about - and, on a row of its own
+# beside it, against 0 (any relation at all): the same estimate, SE and df, two tests, each labelled.
+MATCH_SLOPE_AGAINST_0 = "per arcmin of real blur, against 0 (any relation)"
+
+
 def no_p_match_intercept(floor_arcmin):
     """Why the match's intercept (the set blur at real blur 0) is not tested: 'set as real' there means a set blur of
     0, which no level can give (a Butterworth level's blur is 0 only at an infinite cut-off); the least the design
@@ -144,11 +151,6 @@ def sharpest_level_arcmin(a):
             return None
         floors.append(2 * EQUIVALENT_S * width / max(cutoffs))
     return min(floors) if floors else None
-WORDS_MATCH = {"Intercept": "set blur at real blur 0 (arcmin)",
-               "real_arcmin": "per arcmin of real blur, against 1 (set as real)"}
-# The match's slope is tested against 1 - "set as real", the hypothesis the task is about - and, on a row of its own
-# beside it, against 0 (any relation at all): the same estimate, SE and df, two tests, each labelled.
-MATCH_SLOPE_AGAINST_0 = "per arcmin of real blur, against 0 (any relation)"
 
 
 def _rows_of(study, model, words, term, est, se, df, p, engine, note, floor_arcmin=None):
