@@ -5,7 +5,9 @@
 #                                                   by tabs, each answered by a line "done" once OUT is written (R and
 #                                                   lme4 start once per report, not once per model)
 #
-# KIND    glmm (binomial glmer, Laplace) or lmm (lmer, REML, lmerTest's Satterthwaite df)
+# KIND    glmm (binomial glmer, Laplace) or lmm (lmer, REML, lmerTest's Satterthwaite df); group_glmm and group_lmm
+#         are a between-subject group crossed with a within factor (group_job below, for analysis/groups.py: its own
+#         DATA columns, SLOPES unused)
 # DATA    columns y (0/1 for glmm), g (the participant), X0 .. Xk (the fixed-effects design, intercept included as a
 #         column of ones where the model has one: the fixed part is y ~ 0 + X0 + ... + Xk)
 # SLOPES  comma-separated design columns given a random slope by participant in the maximal model ("" = none)
