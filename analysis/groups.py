@@ -95,6 +95,8 @@ def fit(m, column, factor, group, others=(), family="glmm"):
         return out
     if "failed_test" in info:
         out["why"] = f"not determined: {info['failed_test']}"
+    if "null_singular" in info:
+        out["structure"] += f"; {info['null_singular']}"
     test = table[table["row"] == "test"]
     if len(test) and math.isfinite(float(test["p"].iloc[0])):
         r = test.iloc[0]

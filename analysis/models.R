@@ -230,7 +230,7 @@ group_fit <- function(kind, f, d) {
   conv <- unique(conv[!grepl("singular", conv)])
   if (length(conv)) return(list(ok = FALSE, why = sprintf("did not converge (%s)", paste(conv, collapse = "; "))))
   if (isSingular(m)) return(list(ok = FALSE, why = "was singular (a variance estimated at 0 or a correlation at +-1)",
-                                 singular = TRUE))
+                                 singular = TRUE, m = m))
   list(ok = TRUE, m = m)
 }
 
@@ -276,6 +276,13 @@ group_job <- function(kind, data_path, emit) {
   m1 <- full$m
   n_groups <- nlevels(d$grp)
   n_people <- nlevels(d$g)
+  # The model without the interaction may put a variance on its bound (a real interaction, left out, is no longer
+  # there for a participant-by-level variance to share): that is its maximum likelihood, and the comparison of the two
+  # likelihoods stands. A fit that failed or did not converge has no maximum to compare.
+  if (isTRUE(null$singular)) {
+    null$ok <- TRUE
+    emit("info", "null_singular", note = "the model without the interaction estimated a variance at 0 (on its bound)")
+  }
   if (!null$ok) {
     emit("info", "failed_test", note = sprintf("the model without the interaction %s", null$why))
   } else if (glmm) {
