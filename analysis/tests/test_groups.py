@@ -79,6 +79,30 @@ class GroupByDepth(unittest.TestCase):
         # The model's df for a between-group contrast: G - groups = 16 - 2.
         self.assertEqual(at9["model_df"], 14)
 
+    def test_observers_less_sensitive_at_one_depth_show_the_interaction_there(self):
+        # Observers as psychometric functions: P(choose the more blurred) = Phi(s x difference), the blur difference
+        # 0.3, 0.6, 0.9 at edges 3, 6, 9 and each observer's sensitivity s = 2 exp(N(0, 0.2)); group b's sensitivity is
+        # 0.3 x theirs at edge 9 only. The truth for a typical observer (s = 2): P = Phi(0.6), Phi(1.2) at edges 3 and 6
+        # in both groups, and at edge 9 Phi(1.8) = 0.964 in group a against Phi(0.54) = 0.705 in group b.
+        rng = np.random.default_rng(21)
+        difference = {3: 0.3, 6: 0.6, 9: 0.9}
+        rows = []
+        for g in ("a", "b"):
+            for i in range(8):
+                s = 2 * math.exp(rng.normal(0, 0.2))
+                for edge, diff in difference.items():
+                    p = sps.norm.cdf(s * diff * (0.3 if g == "b" and edge == 9 else 1.0))
+                    rows += [{"participant": f"{g}{i}", "group": g, "edge": str(edge), "y": float(v)}
+                             for v in rng.random(30) < p]
+        charts, _ = groups.charts(pd.DataFrame(rows), "pair", DESIGN, "sensitivity", "note", "chose it")
+        self.assertLess(charts[0].table.iloc[0]["p"], 0.01, charts[0].table.iloc[0]["says"])
+        level = charts[1].table.set_index("level")
+        self.assertLess(level.loc["9", "model_p_holm"], 0.05)
+        self.assertGreater(level.loc["3", "model_p_holm"], 0.05)
+        self.assertGreater(level.loc["6", "model_p_holm"], 0.05)
+        self.assertAlmostEqual(level.loc["9", "model_prob_a"], sps.norm.cdf(1.8), delta=0.05)
+        self.assertAlmostEqual(level.loc["9", "model_prob_b"], sps.norm.cdf(0.54), delta=0.08)
+
     def test_a_model_without_the_interaction_on_a_bound_still_gives_the_test(self):
         # Left out, a real interaction takes the participant-by-edge variance to 0 in the smaller model (this seed): that
         # is its maximum likelihood, and the likelihood ratio stands. It said 'not determined' in 5 of 40 planted
