@@ -28,6 +28,7 @@ import numpy as np
 import pandas as pd
 
 import criteria
+import groups
 import stats
 import study_tests
 import tracks
@@ -421,8 +422,9 @@ def _text_values(m, column):
 
 def group_section(m, kind, what, design, codebook, study, out_dir, slug, note):
     """The group effect with participants as the unit: a chart of every participant's share (or mean) per group
-    with the groups' means, Welch's t and Mann-Whitney's U (study_tests.group_effect), and for a 0/1 measure the
-    logistic models across participants with the group as a fixed effect. Returns ([Chart], finding)."""
+    with the groups' means, Welch's t and Mann-Whitney's U (study_tests.group_effect), for a 0/1 measure the
+    logistic models across participants with the group as a fixed effect, and the group x within-factor interaction
+    with the groups' difference per level (groups.charts). Returns ([Chart], finding)."""
     group = design.group
     if kind == "procedure":
         words = ("groups not compared on the share correct: an adaptive procedure sets it; compare the groups' "
@@ -453,7 +455,11 @@ def group_section(m, kind, what, design, codebook, study, out_dir, slug, note):
     if column == "y":
         shared = [f for f in design.factors if f != group]
         charts.append(models(m, shared + [group], f"{slug}-groups", note, what))
-    return charts, f"group effect: {words}"
+    # What a design that crosses a group with a within factor asks: does the groups' difference change across the
+    # factor's levels, and at which levels do they differ (groups.py).
+    c, crossed = groups.charts(m, kind, design, slug, note, what)
+    charts += c
+    return charts, f"group effect: {words}" + (f"; {crossed}" if crossed else "")
 
 
 def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, note, n_boot, seed, left_out=""):

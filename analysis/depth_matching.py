@@ -10,7 +10,9 @@ Model table (stats.MODEL_COLUMNS), where the record allows:
   set on real       set_arcmin ~ real_arcmin: lmer with a random intercept and slope by participant (Satterthwaite
                     df; intercept-only when that is singular), and pooled OLS with SEs clustered by participant (CR1,
                     t(G-1)); needs r_scene_arcmin and picture_width_arcmin. The slope is tested against 1 (set as
-                    real: t = (b - 1) / SE on the fit's df) and, on a row beside it, against 0
+                    real: t = (b - 1) / SE on the fit's df) and, on a row beside it, against 0. The intercept (the
+                    set blur at real blur 0) is not tested: 'set as real' there is a set blur of 0, which no level
+                    can give (the sharpest level's blur, from the trials' adjust_levels, is said in its note)
   power law         log c ~ log d: per observer (OLS), pooled OLS clustered as above, and lmer as above
 """
 import math
@@ -107,11 +109,16 @@ WORDS_POWER = {"Intercept": "a (log cut-off at 1 m)", "log_d": "b (per unit of l
 NO_P_POWER_A = "no p: a = 0 (a cut-off of 1 cycle per picture width at 1 m) is no hypothesis"
 
 
-def _meaningful(term, words, p, note):
-    """The p and note of a row: the power law's intercept gets no p (see NO_P_POWER_A)."""
+def _meaningful(term, words, p, note, floor_arcmin=None):
+    """The p and note of a row: the power law's intercept gets no p (see NO_P_POWER_A), nor does the match's (see
+    no_p_match_intercept)."""
     if words is WORDS_POWER and term == "Intercept":
         return math.nan, (note + "; " if note else "") + NO_P_POWER_A
+    if words is WORDS_MATCH and term == "Intercept":
+        return math.nan, (note + "; " if note else "") + no_p_match_intercept(floor_arcmin)
     return p, note
+
+
 WORDS_MATCH = {"Intercept": "set blur at real blur 0 (arcmin)",
                "real_arcmin": "per arcmin of real blur, against 1 (set as real)"}
 # The match's slope is tested against 1 - "set as real", the hypothesis the task is about - and, on a row of its own
@@ -119,11 +126,38 @@ WORDS_MATCH = {"Intercept": "set blur at real blur 0 (arcmin)",
 MATCH_SLOPE_AGAINST_0 = "per arcmin of real blur, against 0 (any relation)"
 
 
-def _rows_of(study, model, words, term, est, se, df, p, engine, note):
+def no_p_match_intercept(floor_arcmin):
+    """Why the match's intercept (the set blur at real blur 0) is not tested: 'set as real' there means a set blur of
+    0, which no level can give (a Butterworth level's blur is 0 only at an infinite cut-off); the least the design
+    can set is its sharpest level's blur (floor_arcmin; None when the record does not give the levels)."""
+    floor = (f"the sharpest level the design offers sets {floor_arcmin:.4g}'" if floor_arcmin is not None and
+             math.isfinite(floor_arcmin) else "every level the design offers sets more than 0'")
+    return (f"no p: 'set as real' at real blur 0 would be a set blur of 0, which the design cannot reach ({floor}); "
+            "the match is tested by the slope against 1")
+
+
+def sharpest_level_arcmin(a):
+    """The least blur any trial of rows a could set (arcmin): the blur of its highest cut-off among the trial's own
+    levels (adjust_levels), the smallest over the trials; None when the record does not give the levels."""
+    if "adjust_levels" not in a or "picture_width_arcmin" not in a:
+        return None
+    floors = []
+    for levels, width in zip(a["adjust_levels"].astype(str), pd.to_numeric(a["picture_width_arcmin"], errors="coerce")):
+        try:
+            cutoffs = [float(c) for c in levels.split(";") if c.strip()]
+        except ValueError:
+            return None
+        if not cutoffs or not math.isfinite(width) or max(cutoffs) <= 0:
+            return None
+        floors.append(2 * EQUIVALENT_S * width / max(cutoffs))
+    return min(floors) if floors else None
+
+
+def _rows_of(study, model, words, term, est, se, df, p, engine, note, floor_arcmin=None):
     """The model rows of one term: the match's slope twice (its p against 1 from the fit's own SE and df - t = (b -
-    1) / SE on df - then the fit's p against 0), any other term once."""
+    1) / SE on df - then the fit's p against 0), any other term once (the intercepts without p: _meaningful)."""
     if words is not WORDS_MATCH or term != "real_arcmin":
-        p, note = _meaningful(term, words, p, note)
+        p, note = _meaningful(term, words, p, note, floor_arcmin)
         return [stats.model_row(study, model, words[term], est, se, df, p, engine, note)]
     ok = math.isfinite(p) and se > 0 and df > 0
     p1 = float(2 * sps.t.sf(abs(est - 1) / se, df)) if ok else math.nan
@@ -144,9 +178,10 @@ def _ols_rows(g, x, y, model, words, study):
     return out
 
 
-def _across(a, x, y, label, words, notes, study):
+def _across(a, x, y, label, words, notes, study, floor_arcmin=None):
     """Pooled OLS clustered by participant and the lmer of y on x with a random intercept and slope by participant;
-    rows and the pooled (intercept, slope)."""
+    rows and the pooled (intercept, slope). floor_arcmin: the least blur the design can set (the match's intercept's
+    note says it)."""
     import statsmodels
     import statsmodels.api as sm
     rows, pooled = [], None
@@ -171,7 +206,7 @@ def _across(a, x, y, label, words, notes, study):
             model = f"lm({y} ~ {x}) (one observer)"
     for _, r in t.iterrows():
         rows += _rows_of(study, f"{label}: {model}", words, r["term"], r["estimate"], r["se"], r["df"], r["p"],
-                         engine, zero_se.get(r["term"], ""))
+                         engine, zero_se.get(r["term"], ""), floor_arcmin)
     if pooled is None:
         pooled = (float(t["estimate"].iloc[0]), float(t["estimate"].iloc[1]))
     if n_groups >= 3:
@@ -188,7 +223,7 @@ def _across(a, x, y, label, words, notes, study):
         status = f.structure + ("; singular fit" if f.singular else "")
         for _, r in stats.without_unheld_tests(f, [x]).iterrows():
             rows += _rows_of(study, model, words, r["term"], r["estimate"], r["se"], r["df"], r["p"], f.engine,
-                             status + r["why"])
+                             status + r["why"], floor_arcmin)
         # The SD of the participants' slopes is a spread, tested against nothing: named without a test's words.
         sd_words = {**words, x: "per arcmin of real blur"} if words is WORDS_MATCH else words
         rows += stats.variance_rows(study, model, f, sd_words, "arcmin" if y == "set_arcmin" else "log cut-off")
@@ -203,7 +238,8 @@ def fits(a, notes):
     study = STUDY_DEPTH
     m = a[a["set_arcmin"].notna() & a["real_arcmin"].notna()]
     if len(m) >= 3 and m["real_arcmin"].nunique() >= 2:
-        r, _ = _across(m, "real_arcmin", "set_arcmin", "set on real", WORDS_MATCH, notes, study)
+        r, _ = _across(m, "real_arcmin", "set_arcmin", "set on real", WORDS_MATCH, notes, study,
+                       sharpest_level_arcmin(m))
         rows += r
     elif len(a):
         notes.append("no set-on-real model: trials.csv has no r_scene_arcmin / picture_width_arcmin (the real "

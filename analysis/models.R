@@ -5,7 +5,9 @@
 #                                                   by tabs, each answered by a line "done" once OUT is written (R and
 #                                                   lme4 start once per report, not once per model)
 #
-# KIND    glmm (binomial glmer, Laplace) or lmm (lmer, REML, lmerTest's Satterthwaite df)
+# KIND    glmm (binomial glmer, Laplace) or lmm (lmer, REML, lmerTest's Satterthwaite df); group_glmm and group_lmm
+#         are a between-subject group crossed with a within factor (group_job below, for analysis/groups.py: its own
+#         DATA columns, SLOPES unused)
 # DATA    columns y (0/1 for glmm), g (the participant), X0 .. Xk (the fixed-effects design, intercept included as a
 #         column of ones where the model has one: the fixed part is y ~ 0 + X0 + ... + Xk)
 # SLOPES  comma-separated design columns given a random slope by participant in the maximal model ("" = none)
@@ -196,6 +198,157 @@ run_job <- function(kind, data_path, out_path, slopes) {
 
 slopes_of <- function(text) if (!is.na(text) && nzchar(text)) strsplit(text, ",", fixed = TRUE)[[1]] else character()
 
+# ---- A between-subject group crossed with a within-participant factor (issue 38; analysis/groups.py) ----------------
+# KIND group_glmm (binomial glmer, Laplace) or group_lmm (lmer, REML). DATA: y, g (the participant), grp (the group,
+# coded G1..), w (the within factor's level, coded W01..), and C0..Ck (other within factors, coded: main effects only).
+# The model with the interaction, y ~ grp * w + C.. + RANDOM, and the same without it, y ~ grp + w + C.. + RANDOM, are
+# fitted with the first random part that converges and is not singular on the full model: (1 + w | g) (each
+# participant's own profile over w), (1 | g) + (1 | g:w) (a participant-by-level deviation of one variance: the
+# profile's spread with one parameter), (1 | g). The interaction is tested by comparing the two: a likelihood-ratio
+# chi-square for the GLMM; for the LMM the Kenward-Roger F (pbkrtest), which holds its level with few participants
+# where the chi-square does not. Each level of w then gets the groups' differences from the full model by emmeans
+# (log-odds or the measure's unit; a GLMM's Wald z against t with G - groups df, as the other GLMM tests take t(G-1)),
+# unadjusted here: analysis/groups.py Holm-adjusts them. OUT rows: info (engine, structure, failed, singular,
+# missing), test (the interaction: estimate = chi-square or F, df, p; note = df2 for F), contrast (term LEVEL|A|B:
+# A - B at LEVEL), emmean (term LEVEL|GROUP: the group's estimate at LEVEL on the response scale).
+group_fit <- function(kind, f, d) {
+  said <- character()
+  m <- withCallingHandlers(
+    tryCatch(
+      if (kind == "group_glmm") {
+        glmer(f, data = d, family = binomial,
+              control = glmerControl(optimizer = "bobyqa", optCtrl = list(maxfun = 2e5)))
+      } else {
+        lmer(f, data = d, REML = TRUE, control = lmerControl(optimizer = "bobyqa"))
+      },
+      error = function(e) e),
+    warning = function(w) { said <<- c(said, conditionMessage(w)); invokeRestart("muffleWarning") },
+    message = function(m) { said <<- c(said, trimws(conditionMessage(m))); invokeRestart("muffleMessage") })
+  if (inherits(m, "error")) return(list(ok = FALSE, why = sprintf("failed (%s)", conditionMessage(m))))
+  conv <- c(m@optinfo$conv$lme4$messages, if (m@optinfo$conv$opt != 0) "the optimizer did not finish",
+            said[grepl("converge|unidentifiable|Hessian|rank deficient", said)])
+  conv <- unique(conv[!grepl("singular", conv)])
+  if (length(conv)) return(list(ok = FALSE, why = sprintf("did not converge (%s)", paste(conv, collapse = "; "))))
+  if (isSingular(m)) return(list(ok = FALSE, why = "was singular (a variance estimated at 0 or a correlation at +-1)",
+                                 singular = TRUE, m = m))
+  list(ok = TRUE, m = m)
+}
+
+group_job <- function(kind, data_path, emit) {
+  d <- read.csv(data_path, stringsAsFactors = FALSE, na.strings = character(0),
+                colClasses = c(g = "character", grp = "character", w = "character"))
+  d$g <- factor(d$g)
+  d$grp <- factor(d$grp, levels = sort(unique(d$grp)))
+  d$w <- factor(d$w, levels = sort(unique(d$w)))
+  others <- grep("^C[0-9]+$", names(d), value = TRUE)
+  for (c in others) d[[c]] <- factor(d[[c]])
+  extra <- if (length(others)) paste0(" + ", paste(others, collapse = " + ")) else ""
+  version <- packageDescription("lme4")$Version
+  glmm <- kind == "group_glmm"
+  randoms <- c("(1 + w | g)", "(1 | g) + (1 | g:w)", "(1 | g)")
+  words <- c("each participant's own profile over the levels, (1 + w | participant)",
+             "a random intercept and a participant-by-level deviation, (1 | participant) + (1 | participant:w)",
+             "a random intercept only, (1 | participant)")
+  tried <- character()
+  chosen <- NULL
+  # Each participant's own profile has k (k + 1) / 2 variances and correlations: with as many participants or fewer it
+  # cannot be estimated (and a glmer over 11 levels' profiles runs for minutes before it says so).
+  k <- nlevels(d$w)
+  first <- 1
+  if (k * (k + 1) / 2 >= nlevels(d$g)) {
+    tried <- sprintf("%s not tried (%d variances and correlations from %d participants)", words[1], k * (k + 1) / 2,
+                     nlevels(d$g))
+    first <- 2
+  }
+  for (i in first:length(randoms)) {
+    full <- group_fit(kind, as.formula(paste0("y ~ grp * w", extra, " + ", randoms[i])), d)
+    if (full$ok) { chosen <- i; break }
+    tried <- c(tried, sprintf("%s %s", words[i], full$why))
+  }
+  if (is.null(chosen)) {
+    emit("info", "failed", note = paste("no random part gave a fit:", paste(tried, collapse = "; ")))
+    return(invisible())
+  }
+  emit("info", "structure", note = paste0(words[chosen], if (length(tried)) paste0(" (", paste(tried, collapse = "; "),
+                                                                                    ")") else ""))
+  emit("info", "random", note = randoms[chosen])
+  null <- group_fit(kind, as.formula(paste0("y ~ grp + w", extra, " + ", randoms[chosen])), d)
+  m1 <- full$m
+  n_groups <- nlevels(d$grp)
+  n_people <- nlevels(d$g)
+  # The model without the interaction may put a variance on its bound (a real interaction, left out, is no longer
+  # there for a participant-by-level variance to share): that is its maximum likelihood, and the comparison of the two
+  # likelihoods stands. A fit that failed or did not converge has no maximum to compare.
+  if (isTRUE(null$singular)) {
+    null$ok <- TRUE
+    emit("info", "null_singular", note = "the model without the interaction estimated a variance at 0 (on its bound)")
+  }
+  if (!null$ok) {
+    emit("info", "failed_test", note = sprintf("the model without the interaction %s", null$why))
+  } else if (glmm) {
+    a <- anova(null$m, m1)
+    emit("info", "engine", note = sprintf("lme4 %s glmer (Laplace), likelihood-ratio chi-square", version))
+    emit("test", "interaction", a$Chisq[2], NA, a$Df[2], a[["Pr(>Chisq)"]][2])
+  } else if (requireNamespace("pbkrtest", quietly = TRUE) && nrow(d) <= 4000) {
+    kr <- pbkrtest::KRmodcomp(m1, null$m)
+    st <- kr$stats
+    emit("info", "engine", note = sprintf("lme4 %s lmer (REML), pbkrtest %s Kenward-Roger F", version,
+                                          packageDescription("pbkrtest")$Version))
+    emit("test", "interaction", st$Fstat, NA, st$ndf, st$p.value, note = sprintf("%.10g", st$ddf))
+  } else {
+    a <- anova(null$m, m1, refit = TRUE)
+    emit("info", "engine", note = sprintf("lme4 %s lmer (ML refit), likelihood-ratio chi-square (%s)", version,
+                                          if (nrow(d) > 4000) "over 4000 answers: Kenward-Roger not computed" else
+                                            "pbkrtest not installed"))
+    emit("test", "interaction", a$Chisq[2], NA, a$Df[2], a[["Pr(>Chisq)"]][2])
+  }
+  if (!requireNamespace("emmeans", quietly = TRUE)) {
+    emit("info", "missing", note = "emmeans")
+    return(invisible())
+  }
+  emmeans::emm_options(lmer.df = "satterthwaite", lmerTest.limit = 1e5, pbkrtest.limit = 1e5)
+  emm <- emmeans::emmeans(m1, ~ grp | w)
+  ct <- as.data.frame(summary(emmeans::contrast(emm, method = "pairwise"), adjust = "none", infer = c(FALSE, TRUE)))
+  for (i in seq_len(nrow(ct))) {
+    r <- ct[i, ]
+    pair <- strsplit(as.character(r$contrast), " - ", fixed = TRUE)[[1]]
+    if (glmm) {
+      df <- n_people - n_groups
+      stat <- r$estimate / r$SE
+      p <- if (df > 0) 2 * pt(-abs(stat), df) else NA
+    } else {
+      df <- r$df
+      p <- r$p.value
+    }
+    emit("contrast", paste(as.character(r$w), pair[1], pair[2], sep = "|"), r$estimate, r$SE, df, p)
+  }
+  em <- as.data.frame(summary(emm, type = "response"))
+  value <- if (glmm) "prob" else "emmean"
+  for (i in seq_len(nrow(em))) {
+    r <- em[i, ]
+    emit("emmean", paste(as.character(r$w), as.character(r$grp), sep = "|"), r[[value]], r$SE)
+  }
+  invisible()
+}
+
+run_group_job <- function(kind, data_path, out_path) {
+  rows <- list()
+  emit <- function(row, term, estimate = NA, se = NA, df = NA, p = NA, note = "") {
+    rows[[length(rows) + 1]] <<- data.frame(row = row, term = term, estimate = estimate, se = se, df = df, p = p,
+                                            note = note, stringsAsFactors = FALSE)
+  }
+  result <- tryCatch(group_job(kind, data_path, emit), error = function(e) e)
+  if (inherits(result, "error")) emit("info", "failed", note = sprintf("failed (%s)", conditionMessage(result)))
+  out <- do.call(rbind, c(rows, list(data.frame(row = "info", term = "done", estimate = NA, se = NA, df = NA, p = NA,
+                                                note = "", stringsAsFactors = FALSE))))
+  write.csv(out, out_path, row.names = FALSE, na = "")
+}
+
+# A job of either family: the group models (group_*) or the models across participants (run_job).
+run_any <- function(kind, data_path, out_path, slopes) {
+  if (startsWith(kind, "group_")) run_group_job(kind, data_path, out_path) else run_job(kind, data_path, out_path, slopes)
+}
+
 args <- commandArgs(trailingOnly = TRUE)
 if (length(args) == 1 && args[1] == "--serve") {
   input <- file("stdin", open = "r")
@@ -203,12 +356,12 @@ if (length(args) == 1 && args[1] == "--serve") {
     line <- readLines(input, n = 1)
     if (length(line) == 0) break
     job <- strsplit(line, "\t", fixed = TRUE)[[1]]
-    run_job(job[1], job[2], job[3], slopes_of(job[4]))
+    run_any(job[1], job[2], job[3], slopes_of(job[4]))
     cat("done\n")
     flush(stdout())
   }
 } else if (length(args) >= 3) {
-  run_job(args[1], args[2], args[3], slopes_of(args[4]))
+  run_any(args[1], args[2], args[3], slopes_of(args[4]))
 } else {
   cat("usage: Rscript models.R glmm|lmm DATA.csv OUT.csv [SLOPES] | Rscript models.R --serve\n", file = stderr())
   quit(status = 2)

@@ -107,6 +107,7 @@ Protocol Parser::Parse(const Json& json) {
         for (const auto& b : p.blocks) names.push_back(b.name);
         if (!found) Problem("/practice/block", "names no block of this protocol" + DidYouMean(*s, names), Json(*s));
         p.practice.block = *s;
+        p.practice.block_given = true;
       }
     }
   }
@@ -404,6 +405,26 @@ void Parser::CheckDesign(const Protocol& p) {
     if (b.name == p.practice.block && p.practice.count > 0 && b.procedure)
       Problem("/practice/block", "names block " + b.name + ", whose trials its procedure decides from the answers; "
                                  "practise on a block without a procedure", Json(b.name));
+  // Each group practises its own condition: the protocol's practice is drawn from one block for every participant,
+  // so a block that only some groups run would show the other groups a condition they never run (issue 38).
+  if (p.groups && p.practice.count > 0)
+    for (const auto& b : p.blocks)
+      if (b.name == p.practice.block && !b.groups.empty()) {
+        std::string runs, others;
+        for (const auto& g : p.groups->names) {
+          std::string& list = std::count(b.groups.begin(), b.groups.end(), g) ? runs : others;
+          list += (list.empty() ? "" : ", ") + g;
+        }
+        if (others.empty()) continue;
+        Problem(p.practice.block_given ? "/practice/block" : "/practice",
+                (p.practice.block_given ? "names block " + b.name
+                                        : "draws from block " + b.name + " (the first; /practice/block names none)") +
+                    ", which only group" + (b.groups.size() > 1 ? "s " : " ") + runs +
+                    " run" + (b.groups.size() > 1 ? "" : "s") + ": group " + others +
+                    " would practise another group's condition; give each group a practice block of its own "
+                    "(\"practice\": true, \"groups\": [...]) or practise on a block every group runs",
+                Json(b.name));
+      }
   for (const auto& b : p.blocks)
     if (b.name == p.practice.block && p.practice.count > DesignTrials(b) && DesignTrials(b) <= kMaxTrials)
       Problem("/practice/count", "asks for " + std::to_string(p.practice.count) + " practice trials but block " +

@@ -174,9 +174,13 @@ std::string LevelText(double level);
 // The real photo of `content` for a distance (content.real_photos with {distance_m} replaced).
 std::filesystem::path RealPhotoFor(const Content& content, double distance_m);
 
+// The protocol's practice: `count` trials drawn from one block's design. With between-subject groups that block must
+// run for every group (validated): a block of one group's would show the others a condition they never run; each
+// group practises its own condition in a practice block of its own ("practice": true, "groups": [...]).
 struct Practice {
   int count = 0;                      // 0: no practice
-  std::string block;                  // drawn from this block's design
+  std::string block;                  // drawn from this block's design (the first block when the file names none)
+  bool block_given = false;           // the file named the block (/practice/block); else it is the first block
   std::string instructions;
 };
 

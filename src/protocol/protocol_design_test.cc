@@ -312,6 +312,52 @@ TEST(ProtocolValidate, ParticipantInfoAndGroupsAreChecked) {
   ExpectProblem(bad, "/groups/names: must be a list of 2 to 20 group names");
 }
 
+// Each group practises its own condition (issue 38): the protocol's practice, drawn from one block for every
+// participant, may not come from a block that only some groups run; practice blocks of each group's own are valid.
+TEST(ProtocolValidate, APracticeFromAnotherGroupsBlockIsRefused) {
+  Json j = Valid();
+  j["groups"] = {{"names", {"a", "b"}}, {"assign", "by_number"}};
+  j["blocks"][0]["groups"] = {"a"};
+  j["blocks"][1]["groups"] = {"b"};
+  Json bad = j;
+  bad["practice"] = {{"count", 2}, {"block", "task1"}};
+  EXPECT_EQ(OnlyProblem(bad), (SceneFolder() / "p.json").string() +
+                                  ": /practice/block: names block task1, which only group a runs: group b would "
+                                  "practise another group's condition; give each group a practice block of its own "
+                                  "(\"practice\": true, \"groups\": [...]) or practise on a block every group runs, "
+                                  "got \"task1\"");
+  bad["practice"] = {{"count", 2}};  // no block named: the first block's, still group a's only
+  EXPECT_TRUE(Contains(OnlyProblem(bad), ": /practice: draws from block task1 (the first; /practice/block names "
+                                         "none), which only group a runs: group b would practise"));
+  // A block every group runs may be practised by all.
+  Json shared = j;
+  shared["blocks"][1].erase("groups");
+  shared["practice"] = {{"count", 2}, {"block", "task2"}};
+  EXPECT_TRUE(Problems(shared).empty()) << Problems(shared).front();
+  // No practice trials (count 0) draw nothing.
+  Json none = j;
+  none["practice"] = {{"count", 0}, {"block", "task1"}};
+  EXPECT_TRUE(Problems(none).empty()) << Problems(none).front();
+  // A practice block per group: each participant runs their own group's (BuildTrials), none of the other group's.
+  Json own = j;
+  own["blocks"].insert(own["blocks"].begin(), Json::parse(R"({"name": "practice-b", "practice": true, "groups": ["b"],
+      "factors": {"pattern": [{"id": 2, "speed_cm_s": 1.8, "left": "measured", "right": "none"}]}})"));
+  own["blocks"].insert(own["blocks"].begin(), Json::parse(R"({"name": "practice-a", "practice": true, "groups": ["a"],
+      "factors": {"pattern": [{"id": 1, "speed_cm_s": 3, "left": "measured", "right": "none"}]}})"));
+  ASSERT_TRUE(Problems(own).empty()) << Problems(own).front();
+  const Protocol p = ParseProtocol(own, SceneFolder() / "p.json");
+  for (const auto& [participant, group] : {std::pair{"P1", "a"}, std::pair{"P2", "b"}}) {
+    ASSERT_EQ(AssignGroup(p, participant, {}), group);
+    int practised = 0;
+    for (const Trial& t : BuildTrials(p, participant, 7, group))
+      if (t.practice) {
+        ++practised;
+        EXPECT_EQ(t.block, std::string("practice-") + group) << participant;
+      }
+    EXPECT_EQ(practised, 2) << participant;  // the practice block's design, swapped copies
+  }
+}
+
 // Two intervals: timed by interval_ms and isi_ms (which a side-by-side protocol refuses), still pairs only.
 TEST(ProtocolValidate, TwoIntervalsAreTimedAndStill) {
   Json j = Valid();
