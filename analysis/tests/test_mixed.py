@@ -206,9 +206,11 @@ class SeparationTest(unittest.TestCase):
         self.assertTrue(any("separation in cell a" in n for n in notes), notes)
 
     def test_separated_baseline_leaves_the_other_factor_estimated(self):
-        # The baseline cell a went all one way, so the intercept and every cell's contrast against a are infinite;
-        # the side factor is not: on cells b and c the odds are 1 and 2 (b), 3 and 6 (c) for sides l and r, which an
-        # additive model fits exactly, so its maximum-likelihood side effect is log(2), hand-worked. (Found on a
+        # The first cell a went all one way, so against it the intercept and every cell's contrast were infinite,
+        # hiding the contrast of c with b that the answers estimate: the reference moves to b, the first cell whose
+        # answers went both ways, and only a's own contrast is separation. On cells b and c the odds are 1 and 2
+        # (b), 3 and 6 (c) for sides l and r, which an additive model fits exactly, so its maximum-likelihood side
+        # effect is log(2), c against b log(3) and the baseline (b, l) log(1) = 0, hand-worked. (Found on a
         # one-participant yes/no session whose 6 px blur was all 'yes': every term was 'not estimable'.)
         counts = {("a", "l"): (5, 0), ("a", "r"): (5, 0), ("b", "l"): (5, 5), ("b", "r"): (8, 4),
                   ("c", "l"): (9, 3), ("c", "r"): (12, 2)}
@@ -221,10 +223,20 @@ class SeparationTest(unittest.TestCase):
         side = glm[glm["term"] == "side r (against side l)"].iloc[0]
         self.assertAlmostEqual(side["estimate"], math.log(2), places=5)
         self.assertFalse(math.isnan(side["p"]), side)
-        for term in ("baseline (intercept)", "cell b (against cell a)", "cell c (against cell a)"):
-            row = glm[glm["term"] == term].iloc[0]
-            self.assertTrue(math.isnan(row["estimate"]) and math.isnan(row["p"]), row)
-            self.assertIn("separation", row["note"])
+        c = glm[glm["term"] == "cell c (against cell b)"].iloc[0]
+        self.assertAlmostEqual(c["estimate"], math.log(3), places=5)
+        self.assertFalse(math.isnan(c["p"]), c)
+        self.assertAlmostEqual(glm[glm["term"] == "baseline (intercept)"].iloc[0]["estimate"], 0.0, places=5)
+        a = glm[glm["term"] == "cell a (against cell b)"].iloc[0]
+        self.assertTrue(math.isnan(a["estimate"]) and math.isnan(a["p"]), a)
+        self.assertIn("separation", a["note"])
+        self.assertTrue(any("reference level is b, not a" in n for n in notes), notes)
+        # The same contrast whatever the level order given.
+        again, _ = stats.observer_models(d, "y", "C(cell, levels=['c', 'a', 'b']) + C(side)", study="s")
+        glm2 = again[again["engine"].str.contains("cluster-robust")]
+        b = glm2[glm2["term"] == "cell b (against cell c)"].iloc[0]
+        self.assertAlmostEqual(b["estimate"], -c["estimate"], places=5)
+        self.assertAlmostEqual(b["p"], c["p"], places=6)
         if HAVE_LME4:
             glmm = rows_of(table, "lme4")
             side = glmm[glmm["term"] == "side r (against side l)"].iloc[0]
