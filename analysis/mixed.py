@@ -253,6 +253,7 @@ def fit(kind, y, design, groups, slopes=(), factors=None):
     for name, cols in factors.items():
         said = "each level of " + "/".join(code[c] for c in cols)
         result.structure = result.structure.replace(said, f"each level of {name}")
+        result.failed = result.failed.replace(said, f"each level of {name}")
     for c, name in sorted(back.items(), key=lambda kv: -len(kv[0])):
         result.structure = result.structure.replace(c, name)
         result.failed = result.failed.replace(c, name)

@@ -74,20 +74,26 @@ disagreement <- function(a, b) {
   paste(words, collapse = "; ")
 }
 
-# The SDs of the participants' effects beyond SD_BOUND (glmm only), in words ("" when none).
-beyond_bound <- function(kind, m) {
+# The SDs of the participants' effects beyond SD_BOUND (glmm only), in words ("" when none). factors: the F codes'
+# columns (reduce_random), to name a participant-by-level effect by its columns.
+beyond_bound <- function(kind, m, factors = list()) {
   if (kind != "glmm") return("")
   vc <- as.data.frame(VarCorr(m))
   big <- vc[vc$grp != "Residual" & is.na(vc$var2) & vc$sdcor > SD_BOUND, ]
   if (!nrow(big)) return("")
-  sprintf(paste("the participants' SD of %s estimated at %s log-odds, beyond %g: the likelihood is flat there",
-                "(answers of a participant or a cell nearly all one way)"),
-          paste(sub("\\(Intercept\\)", "Intercept", big$var1), collapse = ", "),
-          paste(sprintf("%.3g", big$sdcor), collapse = ", "), SD_BOUND)
+  named <- vapply(seq_len(nrow(big)), function(i) {
+    if (startsWith(big$grp[i], "g:")) {
+      cols <- factors[[sub("^g:", "", big$grp[i])]]
+      sprintf("each level of %s", paste(cols, collapse = "/"))
+    } else if (big$var1[i] == "(Intercept)") "the intercept" else big$var1[i]
+  }, "")
+  sprintf(paste("gave the participants' SD of %s at %s log-odds, beyond %g (a flat likelihood: the answers of a",
+                "participant or a cell nearly all one way)"),
+          paste(named, collapse = ", "), paste(sprintf("%.3g", big$sdcor), collapse = ", "), SD_BOUND)
 }
 
 # One model fitted by both optimizers and kept only when determined (above); singular fits flagged.
-fit_one <- function(kind, d, xs, random) {
+fit_one <- function(kind, d, xs, random, factors = list()) {
   f <- as.formula(paste("y ~ 0 +", paste(xs, collapse = " + "), "+", random))
   fits <- lapply(OPTIMIZERS, function(o) fit_with(kind, f, d, o))
   names(fits) <- OPTIMIZERS
@@ -112,8 +118,8 @@ fit_one <- function(kind, d, xs, random) {
   # Both agree: the clean one with the higher likelihood.
   ll[!clean] <- -Inf
   m <- fits[[which.max(ll)]]$m
-  big <- beyond_bound(kind, m)
-  if (nzchar(big)) return(list(ok = FALSE, m = NULL, why = sprintf("is not determined (%s)", big)))
+  big <- beyond_bound(kind, m, factors)
+  if (nzchar(big)) return(list(ok = FALSE, m = NULL, why = big))
   if (isSingular(m)) {
     return(list(ok = FALSE, why = "was singular (a variance estimated at 0 or a correlation at +-1)", m = m,
                 singular = TRUE))
@@ -141,13 +147,14 @@ reduce_random <- function(kind, d, xs, slopes, factors = list(), emit = function
     units[[length(units) + 1]] <- list(cols = factors[[k]], code = code, factor = TRUE)
     emit("info", paste0("factor:", code), note = paste(factors[[k]], collapse = ","))
   }
+  by_code <- setNames(lapply(units, `[[`, "cols"), vapply(units, `[[`, "", "code"))
   uncorrelated <- function(intercept, us) {
     paste(c(if (intercept) "(1 | g)", vapply(us, function(u)
       if (u$factor) sprintf("(1 | g:%s)", u$code) else sprintf("(0 + %s | g)", u$code), "")), collapse = " + ")
   }
   said <- function(us) paste(vapply(us, function(u)
     if (u$factor) sprintf("each level of %s", paste(u$cols, collapse = "/")) else u$code, ""), collapse = ", ")
-  second <- fit_one(kind, d, xs, uncorrelated(TRUE, units))
+  second <- fit_one(kind, d, xs, uncorrelated(TRUE, units), by_code)
   if (second$ok) {
     return(list(fit = second, slopes = slopes, intercept = TRUE,
                 words = sprintf("random intercept and slopes by participant (%s), uncorrelated", said(units)),
@@ -164,7 +171,7 @@ reduce_random <- function(kind, d, xs, slopes, factors = list(), emit = function
   keep <- Filter(function(u) u$code %in% alive, units)
   intercept <- "(Intercept)" %in% alive
   if (!length(keep)) return(NULL)
-  third <- fit_one(kind, d, xs, uncorrelated(intercept, keep))
+  third <- fit_one(kind, d, xs, uncorrelated(intercept, keep), by_code)
   if (!third$ok) return(NULL)
   dropped <- c(if (!intercept) "the intercept", said(Filter(function(u) !(u$code %in% alive), units)))
   dropped <- dropped[nzchar(dropped)]

@@ -635,7 +635,10 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
             if f.failed:
                 # A fit that failed, or that the optimizers do not agree on (models.R: fit_one), is not an
                 # estimate: said in words, no number printed (a flat likelihood's numbers are the optimizer's).
-                why = glmm_not_determined(f.failed)
+                failed = f.failed
+                for c in sorted(words, key=len, reverse=True):  # the terms by their words, not patsy's names
+                    failed = failed.replace(c, words[c])
+                why = glmm_not_determined(failed)
                 notes.append(f"GLMM: {why}")
                 add_fit(model, f.engine, None, lambda c: "")
                 for r in rows:
@@ -673,9 +676,8 @@ UNHELD_SINGULAR = ("; no SE or p: a singular fit counts one participant's answer
 def glmm_not_determined(failed):
     """The words for a GLMM that models.R did not keep (failed, did not converge - its optimizers disagree or lme4's
     checks failed - or a participants' SD beyond its bound): no estimate, no SE, no p."""
-    return (f"not determined: the GLMM {failed.removeprefix('the model ')}; no estimate, SE or p is printed (a fit "
-            f"that two optimizers do not agree on gives the optimizer's numbers, not estimates) - use the "
-            f"cluster-robust GLM")
+    return (f"not determined: the GLMM {failed}; no estimate, SE or p is printed (where the likelihood gives no "
+            f"single answer a fit's numbers are its optimizer's, not estimates) - use the cluster-robust GLM")
 
 
 def without_unheld_tests(f, offered, sources=None, cell_means=False):
