@@ -630,7 +630,7 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
             model = f"glmer({_formula_text(response, formula_rhs, random)})"
             status = f.structure + ("; singular fit (the participants' spread estimated at 0)" if f.singular
                                     else "")
-            for c in sorted(slopes, key=len, reverse=True):  # the slopes by their words, not patsy's names
+            for c in sorted(words, key=len, reverse=True):  # the terms by their words, not patsy's names
                 status = status.replace(c, words[c])
             if f.failed:
                 # A fit that failed, or that the optimizers do not agree on (models.R: fit_one), is not an
