@@ -7,7 +7,8 @@
     does not use): where both are clean and agree, the report prints their numbers; else it says "not determined"
     in words and prints none - on a two-group study with a near-separated cell where bobyqa alone (the old report)
     was clean but far from the default optimizer's fit;
-  - a participants' SD beyond 10 log-odds is not printed as a fit;
+  - a participants' SD beyond 10 log-odds is not printed as a fit (nor, on the report's synthetic test 3, the
+    pattern 5 = -11.6 with an SD of 45.3 that the old report printed);
   - the group contrast of a two-group model, and which cells of a cell-means model get a test, are the same whatever
     the order of the levels given.
 """
@@ -177,6 +178,25 @@ class GlmmChecks(unittest.TestCase):
     def test_optimizers_that_disagree_are_not_determined(self):
         _, glmm, _ = self.report_or_not_determined(self.OPTIMIZERS_DISAGREE)
         self.assertTrue(glmm["estimate"].isna().all(), glmm)
+
+    def test_the_report_synthetic_study_prints_no_undetermined_fit(self):
+        # tests/synthetic.py's test 3 (the report's own end-to-end data): the old report printed pattern 5 = -11.6
+        # (p 0.15) with an SD of 45.3 log-odds between participants, bobyqa's fit of a likelihood two optimizers do
+        # not agree on (log-likelihood -8.38 vs -6.53). Now: no SD beyond 10 printed, and every GLMM number comes
+        # from a fit the test's own two optimizers reach alike.
+        import common
+        import forced_choice
+        import synthetic
+        with tempfile.TemporaryDirectory() as tmp:
+            common.setup_style()
+            trials = synthetic.write_trials_csv(os.path.join(tmp, "trials.csv"), synthetic.trials_rows())
+            charts = forced_choice.per_pattern(common.load_trials(trials), tmp, "test3-no-board")
+        table = charts[1].table
+        glmm = self.glmm(table)
+        sds = glmm[glmm["term"].str.startswith("observer SD")]["estimate"].dropna()
+        self.assertTrue((sds <= 10).all(), glmm)
+        pattern5 = self.row(table, "pattern_id 5")
+        self.assertFalse(abs(pattern5["estimate"]) > 10, pattern5)
 
     def test_group_contrast_whatever_the_level_order(self):
         # Two groups of three, three edges; the group contrast is one quantity whichever edge is the reference and
