@@ -36,7 +36,7 @@ from scipy import stats as sps
 import stats
 
 MIN_PARTICIPANTS_T = 3  # a test across participants needs some: 2 sign patterns of 4 are as extreme as any
-EXACT_SUPPORT = 1 << 21  # distinct sums enumerated exactly; beyond (never at the sizes of a study) Monte Carlo
+EXACT_SUPPORT = 1 << 21  # distinct sums convolved exactly; beyond: the sign patterns listed (<= 20), else sampled
 MONTE_CARLO_DRAWS, MONTE_CARLO_SEED = 200_000, 38
 
 
@@ -94,11 +94,21 @@ def sign_flip_p(k, n):
     unit = math.lcm(*[2 * x for x in n])
     d = [(2 * a - b) * (unit // (2 * b)) for a, b in zip(k, n)]
     observed = abs(sum(d))
-    dist = _sign_flips(tuple(sorted(abs(x) for x in d)))
-    if dist is None:  # more distinct sums than EXACT_SUPPORT: Monte Carlo sign patterns, (1 + hits) / (1 + draws)
+    # Participants with many different answer counts can put the common unit beyond 64-bit integers: sampled then.
+    dist = _sign_flips(tuple(sorted(abs(x) for x in d))) if sum(abs(x) for x in d) < 2 ** 62 else None
+    if dist is None:
+        size = np.abs(np.array(d, dtype=float)) / unit
+        target = observed / unit - 1e-9
+        if len(d) <= 20:  # every sign pattern listed, in floats (ties to 1e-9 count as reached: a larger p)
+            hits = 0
+            for start in range(0, 2 ** len(d), 1 << 16):
+                rows = np.arange(start, min(start + (1 << 16), 2 ** len(d)))[:, None] >> np.arange(len(d)) & 1
+                hits += int(np.sum(np.abs((2.0 * rows - 1) @ size) >= target))
+            return hits / 2 ** len(d)
+        # Monte Carlo sign patterns, seeded: (1 + hits) / (1 + draws) is a valid p.
         rng = np.random.default_rng(MONTE_CARLO_SEED)
         signs = rng.choice((-1.0, 1.0), size=(MONTE_CARLO_DRAWS, len(d)))
-        hits = int(np.sum(np.abs(signs @ (np.abs(d) / unit)) >= observed / unit - 1e-12))
+        hits = int(np.sum(np.abs(signs @ size) >= target))
         return (1 + hits) / (1 + MONTE_CARLO_DRAWS)
     values, probs = dist
     return float(min(1.0, probs[np.abs(values) >= observed].sum()))

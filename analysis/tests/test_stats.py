@@ -362,6 +362,14 @@ class AgainstChanceIsExactTest(unittest.TestCase):
         for ks in itertools.product(*[range(n + 1) for n in ns]):
             self.assertLessEqual(best, self.p(list(ks), ns, 1 / 3) + 1e-15, ks)
 
+    def test_answer_counts_whose_common_unit_passes_64_bits(self):
+        # Ten participants with 53-97 answers (primes): the deviations' common unit lcm(2 n) is ~1e19, beyond int64,
+        # so the sign patterns are listed in floats - the same p as listing them by hand, 2 / 2^10 when unanimous.
+        ns = [53, 59, 61, 67, 71, 73, 79, 83, 89, 97]
+        ks = [40, 45, 44, 50, 52, 55, 60, 61, 70, 20]
+        self.assertAlmostEqual(self.p(ks, ns), sign_flip_by_hand([k / n for k, n in zip(ks, ns)]), places=12)
+        self.assertAlmostEqual(self.p(ns, ns), 2 / 2 ** 10, places=15)
+
     def test_unanimous_cell_gets_its_star_and_holm_adjusts_the_printed_p(self):
         # The statistician's case: 7 participants, 35 of 35 answers for the first source in one cell (the t was
         # undefined, the sign test and Holm gave no star) and 67 % in another (which got one).
