@@ -10,9 +10,9 @@ Figures (thesis chapter 5):
 
 Every bar is a share of the answered trials with its Wilson 95 % interval. The test asks whether, among the answers
 that picked a side (not can't tell), the first source of the pair was chosen more or less often than half the time,
-with participants as the unit (study_tests.against_chance: t across the participants' shares, a sign test beside
-it; an exact binomial only where there is one participant); p-values are two-sided and Holm-adjusted over the cells
-of one chart.
+with participants as the unit (study_tests.against_chance: the exact sign-flip permutation test of the participants'
+shares around 0.5; an exact binomial only where there is one participant); p-values are two-sided and Holm-adjusted
+over the cells of one chart, and the stars show the adjusted p of that one test.
 """
 import math
 
@@ -58,8 +58,8 @@ def count_table(d, key):
     """Per value of `key`: planned, answered, answers for the pair's first and second source and can't tell, their
     shares of the answered trials with Wilson 95 % intervals (descriptive: answers pooled), and the test of first vs
     second with participants as the unit (study_tests.against_chance on each participant's share of the first source
-    among their decisive answers: t across participants with a sign test beside it; the exact binomial of the answers
-    only where the chart has one participant), Holm-adjusted over the chart's cells."""
+    among their decisive answers: the exact sign-flip permutation test across participants; the exact binomial of the
+    answers only where the chart has one participant), Holm-adjusted over the chart's cells."""
     rows = []
     people = d["participant"].nunique()
     for value, g in d.groupby(key, sort=True):
@@ -121,10 +121,10 @@ def _bars(ax, t, key, xlabels):
 def _caption_note():
     return ("bars: share of answered trials with Wilson 95 % intervals (answers pooled, descriptive); * p < 0.05, "
             "** p < 0.01, *** p < 0.001: first vs second source with participants as the unit - each participant's "
-            "share of the first source among their decisive answers (not can't tell), a one-sample t test of those "
-            "shares against 0.5 (3 or more participants; an exact sign test beside it in the table), or with one "
+            "share of the first source among their decisive answers (not can't tell), the exact sign-flip permutation "
+            "test of those shares around 0.5 (3 or more participants; with 3-5 no p can reach 0.05), or with one "
             "participant the exact binomial test of their answers (said in the column test); Holm-adjusted over the "
-            "chart's cells")
+            "chart's cells (p_holm: the p the stars show)")
 
 
 def _model(d, formula_rhs, title, extra=None):
@@ -391,7 +391,7 @@ def side_bias(df, out_dir):
         r = study_tests.against_chance(g, 0.5)
         tests.append({"test": r["test"], "p": r["p"], "participant_mean": r.get("participant_mean", math.nan),
                       "participant_low": r.get("participant_low", math.nan),
-                      "participant_high": r.get("participant_high", math.nan), "p_sign": r.get("p_sign", math.nan)})
+                      "participant_high": r.get("participant_high", math.nan)})
     t = pd.concat([t.reset_index(drop=True), pd.DataFrame(tests)], axis=1)
     t["p_holm"] = stats.holm(t["p"])
     per_p = side_table(pd.concat([dec, pooled], ignore_index=True).sort_values(["participant"], kind="stable"),
@@ -437,8 +437,8 @@ def side_bias(df, out_dir):
 
     notes = [f"{participants_note(dec)}; {len(dec)} decisive answers (left / right; can't tell and practice left out)",
              "share_left: share of the decisive answers choosing the left side, Wilson 95 % interval (a "
-             "description of the answers pooled); test, p: against 0.5 with participants as the unit (a one-sample "
-             "t of the participants' shares, from 3 participants; p_sign the sign test beside it; one participant: "
+             "description of the answers pooled); test, p: against 0.5 with participants as the unit (the exact "
+             "sign-flip permutation test of the participants' shares, from 3 participants; one participant: "
              "the exact binomial test of that participant's answers); p_holm: Holm-adjusted over the chart's rows "
              "(the pooled row included); the chart prints the adjusted p",
              "the studies counterbalance the sides (test 1 by participant, tests 2 and 3 with a swapped copy of every "

@@ -2,8 +2,11 @@
 
 One Rscript process per report (models.R --serve, started at the first model and kept; R and lme4 take a second to
 start, a model a fraction of that): the data go to a CSV in a temporary folder, models.R fits the maximal
-by-participant model (random intercept and the slopes given), falls back to the random intercept alone when that is
-singular or does not converge, and writes its table back. This module owns the call, its time limit and every
+by-participant model (random intercept and the slopes given), reduces the random part step by step when that is
+singular or not determined (a factor's levels as one participant-by-level effect), down to the random intercept
+alone, and writes its table back. A fit is determined when bobyqa and Nelder-Mead agree on it (log-likelihood
+within 0.01, fixed effects within 0.1 SE), lme4's convergence checks pass for one of them and no participants' SD
+exceeds 10 log-odds; where no random part gives one, the Fit's `failed` says so in words and carries no numbers. This module owns the call, its time limit and every
 failure, which come back as a sentence (R missing, a package missing, a fit that failed), never as a traceback.
 
 BLURCUE_RSCRIPT names the Rscript to run (default: Rscript on PATH, else /usr/bin/Rscript); set it to a path that
@@ -44,6 +47,7 @@ class Fit:
     slopes: tuple = ()                  # the columns with a random slope in the fitted model
     intercept: bool = True              # the fitted model has a random intercept (left out when estimated at 0)
     correlated: bool = True             # its random effects are correlated (the maximal model) or not
+    factors: dict = field(default_factory=dict)  # factor name -> its columns, reduced as one (1 | g:factor) effect
 
     def random_text(self, source=lambda c: c, group="participant"):
         """The fitted random part as R users write it: (1 + x | participant) for the maximal model; uncorrelated or
@@ -55,7 +59,13 @@ class Fit:
             names = list(dict.fromkeys(source(c) for c in self.slopes))
             return "(1" + "".join(f" + {v}" for v in names) + f" | {group})"
         parts = [f"(1 | {group})"] if self.intercept else []
+        of_factor = {c: name for name, cols in self.factors.items() for c in cols}
         for c in self.slopes:
+            if c in of_factor:  # a factor's participant-by-level effect, once for all its columns
+                part = f"(1 | {group}:{of_factor[c]})"
+                if part not in parts:
+                    parts.append(part)
+                continue
             level = re.search(r"\[T\.(.*)\]$", str(c))
             term = f'dummy({source(c)}, "{level.group(1)}")' if level else source(c)
             parts.append(f"(0 + {term} | {group})")
@@ -86,9 +96,9 @@ class _Server:
         return Unavailable(f"Rscript models.R stopped (exit {code}: {lines[-1] if lines else 'no message'}): "
                            f"no mixed model")
 
-    def run(self, kind, data_path, out_path, slopes):
+    def run(self, kind, data_path, out_path, slopes, factors=""):
         try:
-            self.proc.stdin.write(f"{kind}\t{data_path}\t{out_path}\t{slopes}\n")
+            self.proc.stdin.write(f"{kind}\t{data_path}\t{out_path}\t{slopes}\t{factors}\n")
             self.proc.stdin.flush()
         except (BrokenPipeError, OSError):
             raise self._died()
@@ -186,10 +196,13 @@ def slope_columns(design, groups):
     return chosen
 
 
-def fit(kind, y, design, groups, slopes=()):
+def fit(kind, y, design, groups, slopes=(), factors=None):
     """Fits y ~ 0 + design + (1 + slopes | groups) by lme4 (kind 'glmm': binomial glmer; 'lmm': lmer with
-    Satterthwaite df). Returns a Fit; raises Unavailable with the reason in words when R, a package or the call
-    fails."""
+    Satterthwaite df). factors: {factor name: its columns among the slopes}, each reduced as one participant-by-level
+    effect (1 | groups:factor) where the maximal model fails (models.R, reduce_random), the same model whatever the
+    factor's reference level. A fit models.R did not keep (failed, its optimizers disagree, lme4's convergence checks
+    failed, a participants' SD beyond its bound) comes back with `failed` in words and no numbers. Returns a Fit;
+    raises Unavailable with the reason in words when R, a package or the call fails."""
     if kind not in KINDS:
         raise ValueError(f"unknown mixed model kind {kind!r}")
     exe = rscript()
@@ -206,7 +219,10 @@ def fit(kind, y, design, groups, slopes=()):
     with tempfile.TemporaryDirectory(prefix="blurcue-lme4-") as tmp:
         data_path, out_path = os.path.join(tmp, "data.csv"), os.path.join(tmp, "out.csv")
         frame.to_csv(data_path, index=False, float_format="%.17g")
-        _server(exe).run(kind, data_path, out_path, ",".join(code[s] for s in slopes))
+        factors = {name: [c for c in cols if c in slopes] for name, cols in (factors or {}).items()}
+        factors = {name: cols for name, cols in factors.items() if cols}
+        _server(exe).run(kind, data_path, out_path, ",".join(code[s] for s in slopes),
+                         ";".join(",".join(code[c] for c in cols) for cols in factors.values()))
         out = pd.read_csv(out_path, keep_default_na=True)
     missing = out[(out["row"] == "info") & (out["term"] == "missing")]
     if len(missing):
@@ -224,13 +240,21 @@ def fit(kind, y, design, groups, slopes=()):
     result.intercept = info.get("intercept", "yes") != "no"
     result.correlated = result.structure.startswith("random intercept and slopes") and "uncorrelated" not in \
         result.structure.split(":")[0]
+    level_of = {f"F{i}": name for i, name in enumerate(factors)}  # models.R's codes of the factors, in order
+    result.factors = {name: tuple(cols) for name, cols in factors.items() if set(cols) <= set(result.slopes)}
     for _, r in out[out["row"] == "sd"].iterrows():
-        term = r["term"] if r["term"] in ("Intercept", "Residual") else back.get(r["term"], r["term"])
+        term = r["term"] if r["term"] in ("Intercept", "Residual") else f"level:{level_of[r['term']]}" \
+            if r["term"] in level_of else back.get(r["term"], r["term"])
         result.sds.append((term, float(r["estimate"]), r["note"] == "singular"))
     for _, r in out[out["row"] == "corr"].iterrows():
         a, b = (t if t == "Intercept" else back.get(t, t) for t in r["term"].split(":"))
         result.corrs.append(((a, b), float(r["estimate"]), r["note"] == "singular"))
     # The structure note names the R-side columns; put the caller's names back.
+    for name, cols in factors.items():
+        said = "each level of " + "/".join(code[c] for c in cols)
+        result.structure = result.structure.replace(said, f"each level of {name}")
+        result.failed = result.failed.replace(said, f"each level of {name}")
     for c, name in sorted(back.items(), key=lambda kv: -len(kv[0])):
         result.structure = result.structure.replace(c, name)
+        result.failed = result.failed.replace(c, name)
     return result

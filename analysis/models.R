@@ -1,7 +1,7 @@
 # Mixed models across participants by lme4, for analysis/mixed.py (which writes the data and reads the table back).
 #
-#   Rscript models.R KIND DATA.csv OUT.csv SLOPES   one model
-#   Rscript models.R --serve                        many: one job per line on stdin, KIND DATA OUT SLOPES separated
+#   Rscript models.R KIND DATA.csv OUT.csv SLOPES [FACTORS]   one model
+#   Rscript models.R --serve                        many: one job per line on stdin, KIND DATA OUT SLOPES FACTORS separated
 #                                                   by tabs, each answered by a line "done" once OUT is written (R and
 #                                                   lme4 start once per report, not once per model)
 #
@@ -11,6 +11,8 @@
 # DATA    columns y (0/1 for glmm), g (the participant), X0 .. Xk (the fixed-effects design, intercept included as a
 #         column of ones where the model has one: the fixed part is y ~ 0 + X0 + ... + Xk)
 # SLOPES  comma-separated design columns given a random slope by participant in the maximal model ("" = none)
+# FACTORS optional: the SLOPES of one factor's levels comma-separated, factors separated by ";" - reduced as one
+#         participant-by-level effect (1 | g:F), the same model whatever the factor's reference level
 #
 # The maximal model is (1 + SLOPES | g); when it is singular, does not converge or fails, the slopes uncorrelated,
 # then without the components estimated at 0 (reduce_random), and only then the intercept-only model (1 | g); the
@@ -24,31 +26,102 @@ if (!requireNamespace("lme4", quietly = TRUE)) {
 }
 suppressPackageStartupMessages(library(lme4))
 
-# One fit with its warnings and messages kept (lme4 says "boundary (singular) fit" as a message, convergence
-# trouble as warnings).
-fit_one <- function(kind, d, xs, random) {
+# A fit is kept only when it is determined (fit_one): the two optimizers below both finish, lme4's convergence checks
+# (check.conv: the gradient, the Hessian) pass for at least one of them, the two agree on the log-likelihood within
+# LOGLIK_TOL and on every fixed effect within ESTIMATE_TOL_SE of its SE (or ESTIMATE_TOL_ABS), and, for a glmm, no
+# participants' SD exceeds SD_BOUND log-odds. Found in a two-group study: bobyqa alone printed edge 11 = 12.23
+# (p 0.097) with an SD of 46.9 log-odds between participants, where lme4's default optimizer reached 1.94 with a
+# convergence warning and another level order a higher likelihood - the likelihood is flat out there (a participant
+# or cell whose answers nearly all went one way), so no optimizer's numbers are an estimate. An SD of 10 log-odds
+# puts a typical participant's odds e^10 (22000) times another's: beyond it, no spread the answers can show.
+OPTIMIZERS <- c("bobyqa", "Nelder_Mead")  # glmer's default is bobyqa, then Nelder_Mead; each alone, compared
+LOGLIK_TOL <- 0.01
+ESTIMATE_TOL_SE <- 0.1
+ESTIMATE_TOL_ABS <- 0.01
+SD_BOUND <- 10
+
+# One optimizer's fit with its warnings and messages kept (lme4 says "boundary (singular) fit" as a message,
+# convergence trouble as warnings): list(m, conv = the convergence messages, why = the error) .
+fit_with <- function(kind, f, d, optimizer) {
   said <- character()
-  f <- as.formula(paste("y ~ 0 +", paste(xs, collapse = " + "), "+", random))
   m <- withCallingHandlers(
     tryCatch(
       if (kind == "glmm") {
         glmer(f, data = d, family = binomial,
-              control = glmerControl(optimizer = "bobyqa", optCtrl = list(maxfun = 2e5)))
+              control = glmerControl(optimizer = optimizer, optCtrl = list(maxfun = 2e5)))
       } else {
-        lmerTest::lmer(f, data = d, REML = TRUE, control = lmerControl(optimizer = "bobyqa"))
+        lmerTest::lmer(f, data = d, REML = TRUE,
+                       control = lmerControl(optimizer = optimizer, optCtrl = list(maxfun = 2e5)))
       },
       error = function(e) e),
     warning = function(w) { said <<- c(said, conditionMessage(w)); invokeRestart("muffleWarning") },
     message = function(m) { said <<- c(said, trimws(conditionMessage(m))); invokeRestart("muffleMessage") })
-  if (inherits(m, "error")) {
-    return(list(ok = FALSE, why = sprintf("failed (%s)", conditionMessage(m)), m = NULL))
-  }
+  if (inherits(m, "error")) return(list(m = NULL, why = conditionMessage(m)))
   conv <- c(m@optinfo$conv$lme4$messages, if (m@optinfo$conv$opt != 0) "the optimizer did not finish",
             said[grepl("converge|unidentifiable|Hessian", said)])
-  conv <- unique(conv[!grepl("singular", conv)])
-  if (length(conv)) {
+  list(m = m, conv = unique(conv[!grepl("singular", conv)]))
+}
+
+# Why two fits of one model are not the same fit ("" when they agree within the tolerances above).
+disagreement <- function(a, b) {
+  la <- as.numeric(logLik(a$m))
+  lb <- as.numeric(logLik(b$m))
+  fa <- fixef(a$m)
+  fb <- fixef(b$m)
+  se <- sqrt(pmax(diag(as.matrix(vcov(if (la >= lb) a$m else b$m))), 0))
+  off <- names(fa)[abs(fa - fb) > pmax(ESTIMATE_TOL_SE * se, ESTIMATE_TOL_ABS) | !is.finite(fa - fb)]
+  words <- c(if (!is.finite(la - lb) || abs(la - lb) > LOGLIK_TOL)
+               sprintf("log-likelihood %.3f vs %.3f", la, lb),
+             if (length(off)) paste(sprintf("%s %.3g vs %.3g", off, fa[off], fb[off]), collapse = ", "))
+  paste(words, collapse = "; ")
+}
+
+# The SDs of the participants' effects beyond SD_BOUND (glmm only), in words ("" when none). factors: the F codes'
+# columns (reduce_random), to name a participant-by-level effect by its columns.
+beyond_bound <- function(kind, m, factors = list()) {
+  if (kind != "glmm") return("")
+  vc <- as.data.frame(VarCorr(m))
+  big <- vc[vc$grp != "Residual" & is.na(vc$var2) & vc$sdcor > SD_BOUND, ]
+  if (!nrow(big)) return("")
+  named <- vapply(seq_len(nrow(big)), function(i) {
+    if (startsWith(big$grp[i], "g:")) {
+      cols <- factors[[sub("^g:", "", big$grp[i])]]
+      sprintf("each level of %s", paste(cols, collapse = "/"))
+    } else if (big$var1[i] == "(Intercept)") "the intercept" else big$var1[i]
+  }, "")
+  sprintf(paste("gave the participants' SD of %s at %s log-odds, beyond %g (a flat likelihood: the answers of a",
+                "participant or a cell nearly all one way)"),
+          paste(named, collapse = ", "), paste(sprintf("%.3g", big$sdcor), collapse = ", "), SD_BOUND)
+}
+
+# One model fitted by both optimizers and kept only when determined (above); singular fits flagged.
+fit_one <- function(kind, d, xs, random, factors = list()) {
+  f <- as.formula(paste("y ~ 0 +", paste(xs, collapse = " + "), "+", random))
+  fits <- lapply(OPTIMIZERS, function(o) fit_with(kind, f, d, o))
+  names(fits) <- OPTIMIZERS
+  failed <- vapply(fits, function(x) is.null(x$m), TRUE)
+  if (all(failed)) return(list(ok = FALSE, why = sprintf("failed (%s)", fits[[1]]$why), m = NULL))
+  if (any(failed)) {
+    return(list(ok = FALSE, m = NULL, why = sprintf("did not converge (%s failed: %s)", OPTIMIZERS[failed][1],
+                                                   fits[failed][[1]]$why)))
+  }
+  clean <- vapply(fits, function(x) !length(x$conv), TRUE)
+  if (!any(clean)) {
+    conv <- unique(unlist(lapply(fits, `[[`, "conv")))
     return(list(ok = FALSE, why = sprintf("did not converge (%s)", paste(conv, collapse = "; ")), m = NULL))
   }
+  ll <- vapply(fits, function(x) as.numeric(logLik(x$m)), 0)
+  apart <- disagreement(fits[[1]], fits[[2]])
+  if (nzchar(apart)) {
+    # probe: the higher likelihood's fit, only for reduce_random to see which components it puts at 0.
+    return(list(ok = FALSE, m = NULL, probe = fits[[which.max(ll)]]$m,
+                why = sprintf("did not converge (%s and %s disagree: %s)", OPTIMIZERS[1], OPTIMIZERS[2], apart)))
+  }
+  # Both agree: the clean one with the higher likelihood.
+  ll[!clean] <- -Inf
+  m <- fits[[which.max(ll)]]$m
+  big <- beyond_bound(kind, m, factors)
+  if (nzchar(big)) return(list(ok = FALSE, m = NULL, why = big))
   if (isSingular(m)) {
     return(list(ok = FALSE, why = "was singular (a variance estimated at 0 or a correlation at +-1)", m = m,
                 singular = TRUE))
@@ -62,37 +135,58 @@ fit_one <- function(kind, d, xs, random) {
 # reduced as far as the data need, not at once to the intercept). NULL when no slope survives in a non-singular fit.
 # A participant effect that is real but uncorrelated, or a slope spread with no intercept spread (a depth matching's
 # set-on-real slope), keeps its slope and so its test.
-reduce_random <- function(kind, d, xs, slopes) {
-  uncorrelated <- function(intercept, s) {
-    paste(c(if (intercept) "(1 | g)", sprintf("(0 + %s | g)", s)), collapse = " + ")
+# A factor's columns (FACTORS: its levels' dummies, against a reference level or cell means) are one component, the
+# participant-by-level effect (1 | g:F), not a slope per column: uncorrelated slopes of treatment dummies are a
+# different model for each reference level (a contrast's spread is the sum of two levels' in one coding, one level's
+# in another), so the group contrast of a two-group study moved with the order of the edge levels (0.44 against
+# 0.48 in tests/test_glmm_checks.py); (1 | g:F) is the same model whatever the order.
+reduce_random <- function(kind, d, xs, slopes, factors = list(), emit = function(...) NULL) {
+  factors <- Filter(function(f) length(f) > 0, lapply(factors, function(f) intersect(f, slopes)))
+  units <- lapply(setdiff(slopes, unlist(factors)), function(x) list(cols = x, code = x, factor = FALSE))
+  for (k in seq_along(factors)) {
+    code <- sprintf("F%d", k - 1)
+    d[[code]] <- factor(do.call(paste, c(d[factors[[k]]], sep = ":")))
+    units[[length(units) + 1]] <- list(cols = factors[[k]], code = code, factor = TRUE)
+    emit("info", paste0("factor:", code), note = paste(factors[[k]], collapse = ","))
   }
-  second <- fit_one(kind, d, xs, uncorrelated(TRUE, slopes))
+  by_code <- setNames(lapply(units, `[[`, "cols"), vapply(units, `[[`, "", "code"))
+  uncorrelated <- function(intercept, us) {
+    paste(c(if (intercept) "(1 | g)", vapply(us, function(u)
+      if (u$factor) sprintf("(1 | g:%s)", u$code) else sprintf("(0 + %s | g)", u$code), "")), collapse = " + ")
+  }
+  said <- function(us) paste(vapply(us, function(u)
+    if (u$factor) sprintf("each level of %s", paste(u$cols, collapse = "/")) else u$code, ""), collapse = ", ")
+  second <- fit_one(kind, d, xs, uncorrelated(TRUE, units), by_code)
   if (second$ok) {
     return(list(fit = second, slopes = slopes, intercept = TRUE,
-                words = sprintf("random intercept and slopes by participant (%s), uncorrelated",
-                                paste(slopes, collapse = ", ")),
+                words = sprintf("random intercept and slopes by participant (%s), uncorrelated", said(units)),
                 why = "the uncorrelated one was not"))
   }
-  if (is.null(second$m)) return(NULL)
-  vc <- as.data.frame(VarCorr(second$m))
-  scale <- if (kind == "lmm") sigma(second$m) else 1
-  alive <- vc$var1[vc$grp != "Residual" & is.na(vc$var2) & vc$sdcor >= 1e-4 * scale]
-  keep <- intersect(slopes, alive)
+  probe <- if (is.null(second$m)) second$probe else second$m
+  if (is.null(probe)) return(NULL)
+  vc <- as.data.frame(VarCorr(probe))
+  scale <- if (kind == "lmm") sigma(probe) else 1
+  live <- vc$grp != "Residual" & is.na(vc$var2) & vc$sdcor >= 1e-4 * scale
+  # lme4 names a repeated grouping factor g, g.1, g.2 ...; a factor's participant-by-level effect g:F0.
+  by_level <- startsWith(vc$grp, "g:")
+  alive <- c(vc$var1[live & !by_level], sub("^g:", "", vc$grp[live & by_level]))
+  keep <- Filter(function(u) u$code %in% alive, units)
   intercept <- "(Intercept)" %in% alive
   if (!length(keep)) return(NULL)
-  third <- fit_one(kind, d, xs, uncorrelated(intercept, keep))
+  third <- fit_one(kind, d, xs, uncorrelated(intercept, keep), by_code)
   if (!third$ok) return(NULL)
-  dropped <- c(if (!intercept) "the intercept", setdiff(slopes, keep))
-  list(fit = third, slopes = keep, intercept = intercept,
+  dropped <- c(if (!intercept) "the intercept", said(Filter(function(u) !(u$code %in% alive), units)))
+  dropped <- dropped[nzchar(dropped)]
+  list(fit = third, slopes = unlist(lapply(keep, `[[`, "cols")), intercept = intercept,
        words = sprintf("%sslopes by participant (%s), uncorrelated", if (intercept) "random intercept and " else
-                       "random ", paste(keep, collapse = ", ")),
+                       "random ", said(keep)),
        why = sprintf("the uncorrelated one estimated the spread of %s at 0, so %s left out",
                      paste(dropped, collapse = ", "), if (length(dropped) > 1) "they were" else "it was"))
 }
 
 # The maximal model, else a reduced one (reduce_random), else the intercept-only one; its fixed effects, SDs and
 # correlations through emit().
-fit_job <- function(kind, data_path, slopes, emit) {
+fit_job <- function(kind, data_path, slopes, emit, factors = list()) {
   # A participant named "NA" is a participant: no text is read as missing (numbers' empty cells still are).
   d <- read.csv(data_path, stringsAsFactors = FALSE, na.strings = character(0), colClasses = c(g = "character"))
   d$g <- factor(d$g)
@@ -115,7 +209,7 @@ fit_job <- function(kind, data_path, slopes, emit) {
       kept <- slopes
       structure <- sprintf("random intercept and slopes by participant (%s)", paste(slopes, collapse = ", "))
     } else {
-      reduced <- reduce_random(kind, d, xs, slopes)
+      reduced <- reduce_random(kind, d, xs, slopes, factors, emit)
       if (!is.null(reduced)) {
         chosen <- reduced$fit
         kept <- reduced$slopes
@@ -165,7 +259,9 @@ fit_job <- function(kind, data_path, slopes, emit) {
     if (r$grp == "Residual") {
       emit("sd", "Residual", r$sdcor)
     } else if (is.na(r$var2)) {
-      name <- if (r$var1 == "(Intercept)") "Intercept" else r$var1
+      # g:F0 is a factor's participant-by-level effect (reduce_random), named by its code.
+      name <- if (startsWith(r$grp, "g:")) sub("^g:", "", r$grp) else if (r$var1 == "(Intercept)") "Intercept" else
+        r$var1
       tiny <- r$sdcor < 1e-4 * (if (kind == "lmm") sigma(m) else 1)
       emit("sd", name, if (tiny) 0 else r$sdcor, note = if (tiny) "singular" else "")
     } else {
@@ -178,7 +274,7 @@ fit_job <- function(kind, data_path, slopes, emit) {
 }
 
 # One job: the table written to out_path whatever happens inside.
-run_job <- function(kind, data_path, out_path, slopes) {
+run_job <- function(kind, data_path, out_path, slopes, factors = list()) {
   rows <- list()
   emit <- function(row, term, estimate = NA, se = NA, df = NA, p = NA, note = "") {
     rows[[length(rows) + 1]] <<- data.frame(row = row, term = term, estimate = estimate, se = se, df = df, p = p,
@@ -187,7 +283,7 @@ run_job <- function(kind, data_path, out_path, slopes) {
   if (kind == "lmm" && !requireNamespace("lmerTest", quietly = TRUE)) {
     emit("info", "missing", note = "lmerTest")
   } else {
-    result <- tryCatch(fit_job(kind, data_path, slopes, emit), error = function(e) e)
+    result <- tryCatch(fit_job(kind, data_path, slopes, emit, factors), error = function(e) e)
     if (inherits(result, "error")) emit("info", "failed", note = sprintf("failed (%s)", conditionMessage(result)))
   }
   out <- if (length(rows)) do.call(rbind, rows) else
@@ -197,6 +293,9 @@ run_job <- function(kind, data_path, out_path, slopes) {
 }
 
 slopes_of <- function(text) if (!is.na(text) && nzchar(text)) strsplit(text, ",", fixed = TRUE)[[1]] else character()
+# FACTORS: one factor's columns comma-separated, factors separated by ";" ("" = none).
+factors_of <- function(text) if (!is.na(text) && nzchar(text)) lapply(strsplit(text, ";", fixed = TRUE)[[1]], slopes_of) else
+  list()
 
 # ---- A between-subject group crossed with a within-participant factor (issue 38; analysis/groups.py) ----------------
 # KIND group_glmm (binomial glmer, Laplace) or group_lmm (lmer, REML). DATA: y, g (the participant), grp (the group,
@@ -345,8 +444,9 @@ run_group_job <- function(kind, data_path, out_path) {
 }
 
 # A job of either family: the group models (group_*) or the models across participants (run_job).
-run_any <- function(kind, data_path, out_path, slopes) {
-  if (startsWith(kind, "group_")) run_group_job(kind, data_path, out_path) else run_job(kind, data_path, out_path, slopes)
+run_any <- function(kind, data_path, out_path, slopes, factors = list()) {
+  if (startsWith(kind, "group_")) run_group_job(kind, data_path, out_path) else
+    run_job(kind, data_path, out_path, slopes, factors)
 }
 
 args <- commandArgs(trailingOnly = TRUE)
@@ -356,12 +456,12 @@ if (length(args) == 1 && args[1] == "--serve") {
     line <- readLines(input, n = 1)
     if (length(line) == 0) break
     job <- strsplit(line, "\t", fixed = TRUE)[[1]]
-    run_any(job[1], job[2], job[3], slopes_of(job[4]))
+    run_any(job[1], job[2], job[3], slopes_of(job[4]), factors_of(job[5]))
     cat("done\n")
     flush(stdout())
   }
 } else if (length(args) >= 3) {
-  run_any(args[1], args[2], args[3], slopes_of(args[4]))
+  run_any(args[1], args[2], args[3], slopes_of(args[4]), factors_of(args[5]))
 } else {
   cat("usage: Rscript models.R glmm|lmm DATA.csv OUT.csv [SLOPES] | Rscript models.R --serve\n", file = stderr())
   quit(status = 2)

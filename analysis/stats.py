@@ -4,6 +4,7 @@ Everything here works on plain numbers / arrays / DataFrames and draws nothing, 
 hand-computed answers.
 """
 import math
+import re
 import warnings
 from dataclasses import dataclass, field
 
@@ -488,16 +489,48 @@ def _kept_basis(Xk, infinite_cols):
     return [c for c in Xk.columns if c in chosen]
 
 
+def reference_not_separated(d, response, formula_rhs):
+    """formula_rhs with each treatment-coded factor's reference level (its first) moved to its first level whose
+    answers did not all go one way, and a note per move. A reference level whose answers all went one way makes the
+    intercept and every contrast against it infinite (separation), which hid the contrasts between the other levels
+    that the answers do estimate (a yes/no study whose first blur level was all 'yes' had no term left); against an
+    estimable reference they are printed, and only the separated level's own contrast is said to be separation. A
+    factor of a cell-means design (0 + C(f): no reference) is left as it is."""
+    import ast
+    import re
+    notes = []
+    cell_means = re.match(r"\s*0\s*\+\s*C\((\w+)", formula_rhs)
+
+    def move(match):
+        name, listed = match.group(1), match.group(2)
+        if name not in d or (cell_means and cell_means.group(1) == name):
+            return match.group(0)
+        levels = ast.literal_eval(f"[{listed}]") if listed else sorted(d[name].dropna().unique())
+        one_way = d.groupby(name)[response].agg(lambda v: v.nunique() <= 1)
+        mixed_levels = [v for v in levels if v in one_way.index and not one_way[v]]
+        if not mixed_levels or mixed_levels[0] == levels[0] or levels[0] not in one_way.index:
+            return match.group(0)
+        new = [mixed_levels[0]] + [v for v in levels if v != mixed_levels[0]]
+        notes.append(f"{name}: the reference level is {mixed_levels[0]}, not {levels[0]} - every answer at "
+                     f"{name} {levels[0]} went one way (separation), so contrasts against it have no estimate, and "
+                     f"the other levels are compared with the first whose answers went both ways")
+        return f"C({name}, levels={new!r})"
+    return re.sub(r"C\((\w+)(?:, levels=\[([^\]]*)\])?\)", move, formula_rhs), notes
+
+
 def observer_models(data, response, formula_rhs, group="participant", study=""):
     """Logistic models of a 0/1 response across observers; returns (table, notes), the table in MODEL_COLUMNS.
 
     - GLM, cluster-robust: a logistic GLM (statsmodels) with SEs clustered by participant (CR1) and p from t(G-1).
       Population-averaged; needs no R.
     - GLMM by lme4 (>= 3 participants): glmer, Laplace, with the maximal by-participant random part (intercept and
-      slopes of the within-participant terms), the random intercept alone when that is singular or does not converge
-      (the note says which and why); p from the Wald statistic against t(G-1), since with a handful of participants
-      the normal reference is far too liberal. Its 'observer SD' rows are the SDs of the participants' effects; one
-      estimated at 0 (a singular fit) is said in words.
+      slopes of the within-participant terms), reduced step by step when that is singular or not determined (the
+      note says which and why; mixed.fit); p from the Wald statistic against t(G-1), since with a handful of
+      participants the normal reference is far too liberal. Its 'observer SD' rows are the SDs of the participants'
+      effects; one estimated at 0 (a singular fit) is said in words. A fit that two optimizers do not agree on, that
+      fails lme4's convergence checks or has an SD beyond 10 log-odds is "not determined" in words, never numbers.
+    - A factor whose reference level's answers all went one way is compared with its first level whose answers went
+      both ways (reference_not_separated), so its estimable contrasts are printed whatever the level order given.
     - one participant: a plain logistic GLM (answers treated as independent), said so.
     Separation (a term whose answers all went one way) is found before any fit (separation()); such a term gets no
     estimate and no p in either model, and the other terms are fitted on the answers it does not predict perfectly
@@ -517,6 +550,8 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
         notes.append(f"no model across observers: {n} decisive answers ({ones} of one kind, {n - ones} of the other); "
                      f"needs >= {MIN_ANSWERS} with >= {MIN_EACH_OUTCOME} of each")
         return model_table(rows), notes
+    formula_rhs, moved = reference_not_separated(d, response, formula_rhs)
+    notes += moved
     y, X = patsy.dmatrices(f"{response} ~ {formula_rhs}", d, return_type="dataframe")
     d = d.loc[X.index]
     y = y.iloc[:, 0].to_numpy(float)
@@ -582,7 +617,11 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
         try:
             if not estimable:
                 raise mixed.Unavailable("no term left to fit after the separated ones")
-            f = mixed.fit("glmm", yr, Xr, gr, slopes)
+            levels = {}  # a factor's level columns among the slopes: reduced as one effect (mixed.fit)
+            for c in slopes:
+                if re.search(r"\[.*\]$", c):
+                    levels.setdefault(sources[c], []).append(c)
+            f = mixed.fit("glmm", yr, Xr, gr, slopes, levels)
         except mixed.Unavailable as e:
             notes.append(f"GLMM not fitted: {e}")
             f = None
@@ -591,16 +630,22 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
             model = f"glmer({_formula_text(response, formula_rhs, random)})"
             status = f.structure + ("; singular fit (the participants' spread estimated at 0)" if f.singular
                                     else "")
-            for c in sorted(slopes, key=len, reverse=True):  # the slopes by their words, not patsy's names
+            for c in sorted(words, key=len, reverse=True):  # the terms by their words, not patsy's names
                 status = status.replace(c, words[c])
             if f.failed:
-                notes.append(f"GLMM: {f.failed}")
+                # A fit that failed, or that the optimizers do not agree on (models.R: fit_one), is not an
+                # estimate: said in words, no number printed (a flat likelihood's numbers are the optimizer's).
+                failed = f.failed
+                for c in sorted(words, key=len, reverse=True):  # the terms by their words, not patsy's names
+                    failed = failed.replace(c, words[c])
+                why = glmm_not_determined(failed)
+                notes.append(f"GLMM: {why}")
                 add_fit(model, f.engine, None, lambda c: "")
                 for r in rows:
-                    if r["model"] == model and not r["note"]:
-                        r["note"] = f"no estimate: {f.failed}"
+                    if r["model"] == model and r["note"] != SEPARATION_NOTE:
+                        r["note"] = why
             else:
-                fixed = without_unheld_tests(f, slopes)
+                fixed = without_unheld_tests(f, slopes, sources, cell_means="Intercept" not in X.columns)
                 add_fit(model, f.engine, fixed, lambda c: status + fixed.set_index("term")["why"].get(c, ""))
                 rows += variance_rows(study, model, f, words, "log-odds")
     elif n_groups == 2:
@@ -628,12 +673,25 @@ UNHELD_SINGULAR = ("; no SE or p: a singular fit counts one participant's answer
                    "cluster-robust test")
 
 
-def without_unheld_tests(f, offered):
+def glmm_not_determined(failed):
+    """The words for a GLMM that models.R did not keep (failed, did not converge - its optimizers disagree or lme4's
+    checks failed - or a participants' SD beyond its bound): no estimate, no SE, no p."""
+    return (f"not determined: the GLMM {failed}; no estimate, SE or p is printed (where the likelihood gives no "
+            f"single answer a fit's numbers are its optimizer's, not estimates) - use the cluster-robust GLM")
+
+
+def without_unheld_tests(f, offered, sources=None, cell_means=False):
     """A mixed.Fit's fixed effects with se, df and p blanked (and a 'why' column) where the test does not hold: the
-    fit is singular, or the term was offered a random slope that the fitted model does not have."""
+    fit is singular, or the term was offered a random slope that the fitted model does not have. cell_means: the
+    design has no intercept (0 + C(f): one log-odds per cell), so one cell of each factor gets no slope of its own
+    (the random intercept spans it) - which cell is a matter of column order, so when any cell of a factor lost its
+    slope every cell of that factor (sources: column -> factor) loses its test, whichever came first."""
     fixed = f.fixed.copy()
     fixed["why"] = ""
     lost = set(offered) - set(f.slopes)
+    if cell_means and sources and lost:
+        factors = {sources.get(c) for c in lost}
+        lost |= {c for c in fixed["term"] if sources.get(c) in factors}
     for i, term in fixed["term"].items():
         why = UNHELD_SINGULAR if f.singular else (UNHELD_LOST_SLOPE if term in lost else "")
         if term == "Intercept" and not f.intercept and not f.singular:
@@ -650,6 +708,8 @@ def variance_rows(study, model, f, words, unit):
     rows = []
 
     def name(t):
+        if t.startswith("level:"):
+            return f"each {t[6:]} level (participant x {t[6:]})"
         if t == "Intercept":
             return "baseline (intercept)" if "Intercept" in words else "intercept"
         return words.get(t, t)

@@ -1,13 +1,32 @@
 """Tests of a study's measure with participants as the unit: answers of one participant are not independent, so a
 share is first taken per participant, and the test runs across participants.
 
-  per condition   the share of answers (Wilson 95 %, descriptive) and, against chance, a one-sample t test of the
-                  participants' shares (with 3 or more participants) beside an exact sign test (how many participants
-                  were above chance, ties left out); one participant: the exact binomial test of that participant's
-                  answers; two: no test (said in words)
+  per condition   the share of answers (Wilson 95 %, descriptive) and one exact test against chance of the
+                  participants' shares (3 or more participants; `test` names it, `p` is its p-value, the one that
+                  Holm adjusts and the chart's stars show - no second p is printed beside it):
+                  - chance 0.5 (a pair, a side): the exact sign-flip permutation test of the participants' shares
+                    around 0.5 (sign_flip_p). Under the null each participant's share - 0.5 is symmetric about 0
+                    (binomial answers at 0.5, or participants with preferences spread symmetrically about it), so
+                    each of the 2^G sign patterns of the deviations is equally likely and the p-value, the share of
+                    patterns whose |mean| reaches the observed one, is exact at any N of participants and answers.
+                    It replaced a one-sample t of the shares, whose false-positive rate was 12.5 % with 7
+                    participants of one answer each (6 of 7 one way: t p = 0.047, exact 0.125), and which was
+                    undefined where every participant chose the same side: a unanimous cell now gets the smallest p
+                    any cell of G participants can get (2 / 2^G), never a larger one than a weaker cell.
+                  - chance other than 0.5 (odd one out 1/n, correct at chance): a guessing participant's share is
+                    skewed (Binomial(n, 1/3) / n is not symmetric about 1/3), so no sign flip is exact; the test is
+                    the exact binomial test of the answers under every participant guessing at chance
+                    (binomial_null_p): under that null every answer is an independent draw at chance, so the total is
+                    binomial. With a correct answer, below chance has no mirror image, and "does anyone do better
+                    than guessing" is the question asked.
+                  The sign flips are enumerated exactly (_sum_distribution); tests/test_stats.py measures the
+                  false-positive rate at 3-12 participants with 1-20 answers each; one participant: the exact
+                  binomial test of that participant's answers (stats.binom_p); two: no test (said in words: a sign
+                  flip of 2 can never give p < 0.5).
   group effect    the participants' shares (or mean values) compared between the between-subject groups: Welch's t
                   and Mann-Whitney's U for two groups, Welch's one-way ANOVA and Kruskal-Wallis for more
 """
+import functools
 import math
 
 import numpy as np
@@ -16,7 +35,9 @@ from scipy import stats as sps
 
 import stats
 
-MIN_PARTICIPANTS_T = 3  # a t test across participants needs some spread to estimate; with 2 it has 1 df
+MIN_PARTICIPANTS_T = 3  # a test across participants needs some: 2 sign patterns of 4 are as extreme as any
+EXACT_SUPPORT = 1 << 21  # distinct sums convolved exactly; beyond: the sign patterns listed (<= 20), else sampled
+MONTE_CARLO_DRAWS, MONTE_CARLO_SEED = 200_000, 38
 
 
 def per_participant(m, column="y", by=()):
@@ -26,38 +47,121 @@ def per_participant(m, column="y", by=()):
     return g.agg(n="count", mean="mean").reset_index()
 
 
+def sides(values, chance):
+    """How many values lie above chance and how many below (those at chance in neither)."""
+    return int(np.sum(np.asarray(values) > chance + 1e-12)), int(np.sum(np.asarray(values) < chance - 1e-12))
+
+
 def sign_p(values, chance):
-    """Exact two-sided sign test: how many values lie above chance among those that differ from it."""
-    above = int(np.sum(np.asarray(values) > chance + 1e-12))
-    below = int(np.sum(np.asarray(values) < chance - 1e-12))
+    """Exact two-sided sign test: how many values lie above chance among those that differ from it. (Not the
+    per-condition test: it throws away how far each participant lies from chance, so a unanimous cell and one with
+    every participant barely above chance get the same p; sign_flip_p keeps it.)"""
+    above, below = sides(values, chance)
     return (stats.binom_p(above, above + below, 0.5) if above + below else math.nan), above, below
 
 
+def _sum_distribution(parts):
+    """The exact distribution of a sum of independent integer-valued variables, each given as (values,
+    probabilities): (values, probabilities) of the sum; None when it would hold more than EXACT_SUPPORT distinct
+    values."""
+    values, probs = np.zeros(1, np.int64), np.ones(1)
+    for v, p in parts:
+        values = (values[:, None] + np.asarray(v, np.int64)[None, :]).ravel()
+        probs = (probs[:, None] * np.asarray(p, float)[None, :]).ravel()
+        values, inverse = np.unique(values, return_inverse=True)
+        if len(values) > EXACT_SUPPORT:
+            return None
+        probs = np.bincount(inverse, weights=probs, minlength=len(values))
+    return values, probs
+
+
+@functools.lru_cache(maxsize=65536)
+def _sign_flips(deviations):
+    """The distribution of sum(+-d) over the equally likely sign patterns of the integer deviations d."""
+    return _sum_distribution([((-d, d), (0.5, 0.5)) for d in deviations if d])
+
+
+def sign_flip_p(k, n):
+    """Exact two-sided sign-flip permutation p of the participants' shares k[i] / n[i] around 0.5: the share of the
+    2^G sign patterns of (share - 0.5) whose sum is at least as far from 0 as the observed one (participants at 0.5
+    add 0 either way). Exact when each participant's deviation is symmetric about 0 under the null (binomial
+    answers at 0.5, or rates spread symmetrically about it); its smallest value is 2 / 2^G, reached when every
+    participant lies as far as possible on one side (every answer one way: unanimous). The deviations are counted
+    in integers (units of 1 / lcm(2 n)), so ties are exact."""
+    k, n = [int(x) for x in k], [int(x) for x in n]
+    if not n:
+        return math.nan
+    unit = math.lcm(*[2 * x for x in n])
+    d = [(2 * a - b) * (unit // (2 * b)) for a, b in zip(k, n)]
+    observed = abs(sum(d))
+    # Participants with many different answer counts can put the common unit beyond 64-bit integers: sampled then.
+    dist = _sign_flips(tuple(sorted(abs(x) for x in d))) if sum(abs(x) for x in d) < 2 ** 62 else None
+    if dist is None:
+        size = np.abs(np.array(d, dtype=float)) / unit
+        target = observed / unit - 1e-9
+        if len(d) <= 20:  # every sign pattern listed, in floats (ties to 1e-9 count as reached: a larger p)
+            hits = 0
+            for start in range(0, 2 ** len(d), 1 << 16):
+                rows = np.arange(start, min(start + (1 << 16), 2 ** len(d)))[:, None] >> np.arange(len(d)) & 1
+                hits += int(np.sum(np.abs((2.0 * rows - 1) @ size) >= target))
+            return hits / 2 ** len(d)
+        # Monte Carlo sign patterns, seeded: (1 + hits) / (1 + draws) is a valid p.
+        rng = np.random.default_rng(MONTE_CARLO_SEED)
+        signs = rng.choice((-1.0, 1.0), size=(MONTE_CARLO_DRAWS, len(d)))
+        hits = int(np.sum(np.abs(signs @ size) >= target))
+        return (1 + hits) / (1 + MONTE_CARLO_DRAWS)
+    values, probs = dist
+    return float(min(1.0, probs[np.abs(values) >= observed].sum()))
+
+
+def binomial_null_p(k, n, chance):
+    """Exact two-sided p of k[i] of n[i] answers per participant under every participant guessing at chance: then
+    every answer is an independent Bernoulli(chance), so the answers' total is Binomial(sum n, chance) and the test
+    is stats.binom_p of the totals (scipy's 'minlike' two-sided rule). Used where chance is not 0.5 (a guessing
+    participant's share is skewed, so no sign flip is exact); it asks whether the participants guess, which a task
+    with a correct answer asks (no one sees it below chance). Every answer correct is the least likely outcome when
+    chance < 0.5, so its p, chance^N, is the smallest of any cell of N answers."""
+    return stats.binom_p(int(np.sum(k)), int(np.sum(n)), chance)
+
+
+def exact_test_words(chance, people):
+    if abs(chance - 0.5) < 1e-12:
+        floor = 2 / 2 ** people
+        return (f"exact sign-flip permutation test of {people} participants' shares around 0.5 (all 2^{people} "
+                f"sign patterns" + (f"; with {people} participants no p can be below {floor:.3g}" if floor >= 0.05
+                                    else "") + ")")
+    return (f"exact binomial test of {people} participants' answers against chance {chance:.3g} (null: every "
+            f"participant guessing)")
+
+
 def against_chance(m, chance, people=None):
-    """The test of m's 0/1 measure against chance with participants as the unit: dict(test, p, and for 3+
-    participants mean, ci_low, ci_high of the participants' shares, t, df, p_sign, above, below). people: how many
-    participants the whole analysis has (a table's rows are tested alike): one - the exact binomial test of that
-    participant's answers."""
-    shares = per_participant(m)["mean"].to_numpy(float)
+    """The test of m's 0/1 measure (column y) against chance with participants as the unit (against_chance_counts
+    on each participant's count of 1s and answers)."""
+    pp = per_participant(m)
+    n = pp["n"].to_numpy(int)
+    return against_chance_counts(np.rint(pp["mean"].to_numpy(float) * n).astype(int), n, chance, people)
+
+
+def against_chance_counts(k, n, chance, people=None):
+    """The test against chance of participants with k[i] of n[i] answers 1: dict(test, p, and for 3+ participants
+    participant_mean, participant_low, participant_high - the participants' shares' mean with a t 95 % interval, a
+    description - participants_above, participants_below). One p: sign_flip_p at chance 0.5, binomial_null_p
+    otherwise (see the module's docstring). people: how many participants the whole analysis has (a table's rows
+    are tested alike): one - the exact binomial test of that participant's answers."""
+    k, n = np.asarray(k, int), np.asarray(n, int)
+    shares = k / n
     n_people = len(shares)
     if (people or n_people) == 1:
-        k, n = int(m["y"].sum()), len(m)
-        return {"test": "exact binomial, one participant's answers", "p": stats.binom_p(k, n, chance)}
+        return {"test": "exact binomial, one participant's answers", "p": stats.binom_p(k.sum(), n.sum(), chance)}
     if n_people < MIN_PARTICIPANTS_T:
         return {"test": f"none: {n_people} participants are too few for a test across participants (needs "
                         f">= {MIN_PARTICIPANTS_T})", "p": math.nan}
     mean, sd = shares.mean(), shares.std(ddof=1)
     half = sps.t.ppf(0.975, n_people - 1) * sd / math.sqrt(n_people)
-    p_sign, above, below = sign_p(shares, chance)
-    if sd == 0:  # every participant had the same share: t is undefined, the sign test still says something
-        t, p = math.nan, p_sign
-        test = "exact sign test across participants (every participant's share the same: no t)"
-    else:
-        t = (mean - chance) / (sd / math.sqrt(n_people))
-        p = float(2 * sps.t.sf(abs(t), n_people - 1))
-        test = f"one-sample t across {n_people} participants' shares"
-    return {"test": test, "p": p, "participant_mean": mean, "participant_low": max(0.0, mean - half),
-            "participant_high": min(1.0, mean + half), "t": t, "df": n_people - 1, "p_sign": p_sign,
+    above, below = sides(shares, chance)
+    p = sign_flip_p(k, n) if abs(chance - 0.5) < 1e-12 else binomial_null_p(k, n, chance)
+    return {"test": exact_test_words(chance, n_people), "p": p, "participant_mean": mean,
+            "participant_low": max(0.0, mean - half), "participant_high": min(1.0, mean + half),
             "participants_above": above, "participants_below": below}
 
 
@@ -84,7 +188,7 @@ def summary_words(m, chance, what):
     if chance is not None:
         r = against_chance(m, chance)
         text += (f"; against chance {chance:.2g}: {r['test']}, {p_text(r['p'])}; {r['participants_above']} of "
-                 f"{people} participants above chance ({p_text(r['p_sign'])}, sign test)")
+                 f"{people} participants above chance, {r['participants_below']} below")
     return text
 
 
