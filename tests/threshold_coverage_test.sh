@@ -18,6 +18,7 @@ exec(sys.argv[3])
 json.dump(p, open(sys.argv[2], "w"), indent=1)
 PYEOF
   PROTOCOL=$variant
+  trap 'rm -f "$variant"' EXIT  # beside the copied protocols, not left for another test to list
 fi
 weber=$(/usr/bin/python3 -c "import random; r = random.Random(38); print(' '.join(f'{r.uniform(0.25, 0.7):.3f}' for _ in range($N)))")
 i=0
