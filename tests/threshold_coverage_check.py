@@ -15,7 +15,7 @@ Asserts: at least 80 % of tracks determined, their 95 % intervals holding the tr
 relative error within max(10 %, 2 Monte Carlo SE). With PLAN_CSV (`blurcue plan`'s table for the
 same protocol), the plan's predicted share of tracks determined within 15 points of the one measured. Prints what it
 measured. (Issue 38 asks max(5 %, 2 SE): the
-staircase posterior's Weibull sits ~8 % high on this observer's function - docs/thresholds.md - so 10 % for now.)
+staircase posterior sits ~5-9 % high on this observer - docs/thresholds.md, known limit - so 10 % for now.)
 """
 import math
 import os
