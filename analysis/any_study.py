@@ -552,10 +552,14 @@ def psychometric_cells(m, kind, guess, what, design, study, out_dir, slug, note,
                 rows, xcol, xlabel, guess, study, out_dir, name, note, n_boot, seed, what, cell=cell, crit=crit,
                 tested=criteria.tested_range(params, dx) if len(dx) else None)
             charts.append(chart)
+            # The threshold's unit beside it in the table: the procedure's variable's (common.level_unit).
+            unit_words = (level_unit(rows) or UNKNOWN_UNIT) if kind == "procedure" else "arcmin"
+            if chart.table is not None:
+                chart.table.insert(chart.table.columns.get_loc("threshold") + 1, "unit", unit_words)
             where = f"{tracks.cell_label(rows) if kind == 'procedure' else cell}: " if cell else ""
             # Said as the fitted function gives it (its lapse lowers QUEST+'s 81.6 %), with the level's unit.
             said = chart.table["criterion_fitted"].iloc[0] if chart.table is not None else crit.short()
-            unit = f" {level_unit(rows) or UNKNOWN_UNIT}" if kind == "procedure" else " arcmin"
+            unit = f" {unit_words}"
             words.append(f"{where}threshold at {said} {th:.3g}{unit} [{th_lo:.3g}, {th_hi:.3g}]"
                          if not math.isnan(th_lo) and not math.isnan(th) else
                          f"{where}threshold at {said} {th:.3g}{unit} (its interval not determined)"

@@ -307,7 +307,7 @@ def psychometric(df, out_dir, n_boot=200, seed=1):
                label="answers, equal-count bins (Wilson 95 %; size ∝ n)")
     ax.set_xlim(0, float(dec["diff"].max()) * 1.02)
     ax.set_ylim(0, 1)
-    ax.set_xlabel("blur difference |r_left − r_right| (px)")
+    ax.set_xlabel("blur difference |r_left − r_right| (photo px)")
     ax.set_ylabel("share choosing the more-blurred stimulus")
     studies = ", ".join(sorted(dec["study"].unique()))
     ax.set_title(f"Choosing the more blurred one against the blur difference, pooled over forced-choice studies\n"

@@ -123,6 +123,7 @@ class CriterionAsFitted(unittest.TestCase):
         self.assertIn(said, words)
         self.assertIn("arcmin", words)
         self.assertIn("level shown (arcmin)", svg)
+        self.assertEqual(row["unit"], "arcmin")  # the threshold table says its unit
 
 
 if __name__ == "__main__":

@@ -300,8 +300,9 @@ TEST(DescribeTrial, AnObjectsDepthIsTheCalibrationsGeometryAtItsEdge) {
       EXPECT_NEAR(x < 0 ? t.below_axis_left_px : t.below_axis_right_px, fy * from_centre.dot(down) / u, 1e-6)
           << "edge " << edge << " x " << x;
     }
-    if (edge == 1) EXPECT_NEAR(t.u_left_mm, 440 - 125 * std::cos(a), 1e-6);
-    if (edge == 11) EXPECT_NEAR(t.u_left_mm, 440 + 125 * std::cos(a), 1e-6);
+    if (edge == 1 || edge == 11) {
+      EXPECT_NEAR(t.u_left_mm, 440 + (edge == 1 ? -125 : 125) * std::cos(a), 1e-6);
+    }
   }
   // A ball resting at edge 9 on the board's section 3: its centre 10 mm above the board.
   const TrialScene ball = DescribeTrial(BallProtocol(), PairTrial({{"edge", 9}}, "fitted", "fitted"), &scene);
