@@ -158,8 +158,12 @@ def predicted(d):
     offers = a.groupby("study")["chosen_side"].transform(lambda c: (c == "cant_tell").any())
     out = []
     for spec, rows in a.groupby(specs, sort=True):
-        p = observer_params(spec)
-        words = params_words(p) + ("" if spec.startswith("sim") else " (no recorded parameters: the defaults)")
+        try:
+            p = observer_params(spec)
+            said = "" if spec.startswith("sim") else " (no recorded parameters: the defaults)"
+        except ValueError:  # not written by blurcue's ToString: said, and predicted with the defaults
+            p, said = observer_params(""), f" (recorded {spec!r} unreadable: the defaults)"
+        words = params_words(p) + said
         unit = "px" if p["model"] == "pixel" else "arcmin"
         part = _predicted_with(rows, p, unit, offers)
         if len(part):
