@@ -82,6 +82,26 @@ class LevelText(unittest.TestCase):
         self.assertEqual(sorted(t["level"]), ["0.2", "0.5"])
 
 
+class DepthOnTheEdgeAxis(unittest.TestCase):
+    def test_test1s_edges_carry_the_grids_depth_from_trials_csv(self):
+        # trials.csv's u_left_mm (the calibration's geometry) beside each edge number: 341.5 + 19.7 (edge - 1) mm here,
+        # so edge 1 reads 342 mm (rounded) and edge 11 538 mm.
+        import sys
+        sys.path.insert(0, os.path.dirname(__file__))
+        import forced_choice
+        import synthetic
+        with tempfile.TemporaryDirectory() as d:
+            df = common.load_trials(synthetic.write_trials_csv(os.path.join(d, "trials.csv"), synthetic.trials_rows()))
+            df["u_left_mm"] = [f"{341.5 + (e - 1) * 19.7:.2f}" if e == e else "" for e in df["edge"]]
+            chart = forced_choice.test1_per_edge(df, d)
+            chart = chart[0] if isinstance(chart, list) else chart
+            with open(chart.svg, encoding="utf-8") as f:
+                svg = f.read()
+        self.assertIn("342 mm", svg)
+        self.assertIn("538 mm", svg)
+        self.assertIn("the grids' depth u (mm)", svg)
+
+
 class CriterionAsFitted(unittest.TestCase):
     def test_quests_criterion_with_a_lapse_says_what_the_function_gives(self):
         c = criteria.criterion("quest_plus", ARCMIN, 0.5)
