@@ -32,7 +32,8 @@ import groups
 import stats
 import study_tests
 import tracks
-from common import Chart, Skip, error_bars, participants_note, save, stars, text
+from common import (UNKNOWN_UNIT, Chart, Skip, axis_label, error_bars, factor_label, level_text, level_unit,
+                    participants_note, save, stars, text)
 from design import design_of, load_codebook  # noqa: F401  (load_codebook: report.py reads the codebook through here)
 
 KIND_TITLES = {"pair": "forced choice between two", "odd": "odd one out",
@@ -95,9 +96,9 @@ def measured(d, kind):
 
 
 def _label(value):
-    """A level as the tables write it: 3.0 as 3, a level the row does not have (NaN: not applicable) blank."""
-    words = text(pd.Series([value])).iloc[0]
-    return words[:-2] if words.endswith(".0") else words
+    """A level as the tables write it (common.level_text): 3.0 as 3, 0.2 as the protocol gave it, a side's radius with
+    its unit (object=4 photo px), a level the row does not have (NaN: not applicable) blank."""
+    return level_text(value)
 
 
 def condition_table(m, factors, chance):
@@ -165,7 +166,7 @@ def factor_chart(m, factor, chance, what, study, out_dir, name, group_note, pool
         ax.legend(loc="lower right")
     ax.set_xticks(x)
     ax.set_xticklabels(list(t[factor]))
-    ax.set_xlabel(factor)
+    ax.set_xlabel(factor_label(factor))
     ax.set_ylim(0, 1.12)
     ax.set_ylabel(f"share: {what}")
     ax.grid(axis="x", visible=False)
@@ -202,7 +203,7 @@ def value_chart(m, factor, what, study, out_dir, name, group_note, pooled_over=(
                 ecolor="#0072B2", ms=6)
     ax.set_xticks(x)
     ax.set_xticklabels(list(t[factor]))
-    ax.set_xlabel(factor)
+    ax.set_xlabel(factor_label(factor))
     ax.set_ylabel(what)
     ax.set_title(f"{study}: {what} per {factor}{pooled_title}\n{group_note}, {int(t['n'].sum())} answers", loc="left")
     png, svg = save(fig, out_dir, name)
@@ -265,7 +266,7 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
                label="share per level (size: answers)")
     ax.axhline(chance, color="#999999", ls="--", lw=1)
     if criteria.inside(th, x_lo, x_hi):
-        ax.axvline(th, color="#D55E00", lw=1, ls=":", label=f"threshold ({crit.short()}): {th:.3g}")
+        ax.axvline(th, color="#D55E00", lw=1, ls=":", label=f"threshold ({crit.label(fit.gamma, fit.lam)}): {th:.3g}")
     ax.set_xlabel(xlabel)
     ax.set_ylabel(f"share: {what}")
     ax.set_ylim(min(chance, 0.4) - 0.05, 1.05)
@@ -290,14 +291,17 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
                        "threshold_low": th_lo if bounded else math.nan,
                        "threshold_high": th_hi if bounded else math.nan, "threshold_note": interval_words,
                        "on_bound": ", ".join(f"{k} at its {v[1]} bound {v[0]:.3g}" for k, v in fit.on_bound.items()),
-                       "criterion": crit.short(), "criterion_share_correct": p_mid,
+                       "criterion": crit.short(), "criterion_fitted": crit.label(fit.gamma, fit.lam),
+                       "criterion_share_correct": p_mid,
                        # The Weibull's scale is the threshold's other name: not a number where that is not one.
                        "alpha": fit.alpha if inside else math.nan, "beta_slope": fit.beta if beta_free else math.nan,
                        "beta_low": beta_lo if beta_ci else math.nan, "beta_high": beta_hi if beta_ci else math.nan,
                        "guess": fit.gamma, "lapse": fit.lam if "lam" not in fit.on_bound else math.nan, "answers": len(x),
                        "participants": d["participant"].nunique()}])
     notes = [f"Weibull with the guess rate fixed at chance ({chance:.3g}) and a lapse rate fitted in [0, 0.1]; "
-             f"threshold at {crit.words}: " +
+             f"threshold at {crit.words}" + (f" (the fitted function gives {100 * p_mid:.1f} % there, lapse "
+                                              f"{fit.lam:.2g})" if crit.label(fit.gamma, fit.lam) != crit.short()
+                                              else "") + ": " +
              (f"{th:.3g} [{th_lo:.3g}, {th_hi:.3g}] (parametric bootstrap, {len(boot_th)} refits)" if bounded else
               f"{th:.3g}, its interval not determined (the bootstrap's reaches beyond "
               f"{criteria.range_words(x_lo, x_hi)})" if inside else
@@ -534,7 +538,7 @@ def psychometric_cells(m, kind, guess, what, design, study, out_dir, slug, note,
     the procedure's level; an odd one out's over the blur difference on screen. Returns ([Chart], words)."""
     m = m.copy()
     if kind == "procedure":
-        xcol, xlabel = "level", "level shown (the procedure's variable)"
+        xcol, xlabel = "level", axis_label("level shown", level_unit(m))
         m["level"] = _num(m["level"])
         cells = design.cell_of(m)
     else:
@@ -556,12 +560,19 @@ def psychometric_cells(m, kind, guess, what, design, study, out_dir, slug, note,
                 rows, xcol, xlabel, guess, study, out_dir, name, note, n_boot, seed, what, cell=cell, crit=crit,
                 tested=criteria.tested_range(params, dx) if len(dx) else None)
             charts.append(chart)
+            # The threshold's unit beside it in the table: the procedure's variable's (common.level_unit).
+            unit_words = (level_unit(rows) or UNKNOWN_UNIT) if kind == "procedure" else "arcmin"
+            if chart.table is not None:
+                chart.table.insert(chart.table.columns.get_loc("threshold") + 1, "unit", unit_words)
             where = f"{tracks.cell_label(rows) if kind == 'procedure' else cell}: " if cell else ""
-            words.append(f"{where}threshold at {crit.short()} {th:.3g} [{th_lo:.3g}, {th_hi:.3g}]"
+            # Said as the fitted function gives it (its lapse lowers QUEST+'s 81.6 %), with the level's unit.
+            said = chart.table["criterion_fitted"].iloc[0] if chart.table is not None else crit.short()
+            unit = f" {unit_words}"
+            words.append(f"{where}threshold at {said} {th:.3g}{unit} [{th_lo:.3g}, {th_hi:.3g}]"
                          if not math.isnan(th_lo) and not math.isnan(th) else
-                         f"{where}threshold at {crit.short()} {th:.3g} (its interval not determined)"
+                         f"{where}threshold at {said} {th:.3g}{unit} (its interval not determined)"
                          if not math.isnan(th) else
-                         f"{where}threshold at {crit.short()} " + criteria.beyond_words("beyond", th_lo, th_hi))
+                         f"{where}threshold at {said} " + criteria.beyond_words("beyond", th_lo, th_hi))
         except Skip as e:
             charts.append(Chart(name, None, None, None, [str(e)]))
         except ValueError as e:

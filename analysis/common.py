@@ -374,3 +374,107 @@ def stars(p):
     if p is None or (isinstance(p, float) and math.isnan(p)):
         return ""
     return "***" if p < 0.001 else "**" if p < 0.01 else "*" if p < 0.05 else ""
+
+
+# --------------------------------------------------------------------------------------------------------------------
+# Units and numbers as a reader checks them
+
+# A procedure's variable (procedures.csv's "variable", protocol/vocabulary.h ProcedureVariable) and its level's unit.
+LEVEL_UNITS = {"relative_difference": "ratio - 1", "difference_arcmin": "arcmin"}
+# A design column's unit read off its name, as protocol::UnitOf gives the codebook (src/protocol/level.cc).
+NAME_UNITS = (("_cm_s", "cm/s"), ("_mm", "mm"), ("_cm", "cm"), ("_ms", "ms"), ("_px", "px"), ("_arcmin", "arcmin"),
+              ("_deg", "deg"), ("_m", "m"), ("_s", "s"))
+# What a reader gets where nothing says the unit: said, never left out.
+UNKNOWN_UNIT = "unit not recorded"
+
+
+def _unit_words(unit):
+    """A codebook's unit as an axis says it: the relative difference's long words cut to 'ratio - 1'."""
+    unit = str(unit or "").strip()
+    if unit.startswith("ratio - 1"):
+        return LEVEL_UNITS["relative_difference"]
+    return "" if unit.startswith("the procedure's variable") else unit
+
+
+def _units_of_parameters(values):
+    units = []
+    for v in values:
+        if isinstance(v, str):
+            try:
+                v = json.loads(v) if v.strip() else None
+            except ValueError:
+                v = None
+        if isinstance(v, dict) and v.get("variable") in LEVEL_UNITS:
+            unit = LEVEL_UNITS[v["variable"]]
+            if unit not in units:
+                units.append(unit)
+    return units
+
+
+def level_unit(source, column="level"):
+    """The unit words of a procedure's level (column "level": "ratio - 1" for relative_difference, "arcmin" for
+    difference_arcmin) or of another column of trials.csv, from whatever says it:
+      a procedure's parameters (a dict, or its JSON text: procedures.csv's, with its "variable"),
+      rows of trials.csv (a DataFrame with procedure_parameters, as common.load_trials joins them),
+      a codebook: a DataFrame of codebook.csv, the path of codebook.csv or of the trials.csv beside it, or a
+      {column: row} mapping whose row has a unit (an attribute or a key);
+    for a column other than the level, its name's suffix (speed_cm_s: cm/s) where the source says nothing. Procedures
+    of different variables give both ("ratio - 1 or arcmin"); nothing known gives "" (see axis_label)."""
+    units = []
+    if isinstance(source, str) and source.lstrip().startswith("{"):
+        units = _units_of_parameters([source]) if column == "level" else []
+    elif isinstance(source, dict) and column == "level" and "variable" in source:
+        units = _units_of_parameters([source])
+    elif isinstance(source, pd.DataFrame) and "procedure_parameters" in source and column == "level":
+        units = _units_of_parameters(source["procedure_parameters"].dropna().unique())
+    elif isinstance(source, pd.DataFrame) and {"column", "unit"} <= set(source.columns):
+        rows = source[(source["column"] == column) & (source["table"] == "trials.csv" if "table" in source else True)]
+        units = [u for u in (_unit_words(u) for u in rows["unit"]) if u]
+    elif isinstance(source, str) and source.endswith(".csv") and os.path.isfile(source):
+        path = source if os.path.basename(source) == "codebook.csv" else \
+            os.path.join(os.path.dirname(os.path.abspath(source)), "codebook.csv")
+        return level_unit(read_text_csv(path), column) if os.path.isfile(path) else level_unit(None, column)
+    elif isinstance(source, dict) and column in source:
+        row = source[column]
+        unit = getattr(row, "unit", None) if not isinstance(row, dict) else row.get("unit")
+        units = [u for u in [_unit_words(unit)] if u]
+    if not units and column != "level":
+        units = [u for suffix, u in NAME_UNITS if column.endswith(suffix) and len(column) > len(suffix)][:1]
+    return " or ".join(dict.fromkeys(units))
+
+
+def axis_label(what, unit):
+    """'level shown (ratio - 1)': a quantity with its unit in brackets; without a known unit it says so."""
+    return f"{what} ({unit or UNKNOWN_UNIT})"
+
+
+# A side's source written as a level of the design ("object=4", "left=measured;right=3"): a number is a radius in photo
+# px (protocols/README.md: a side's fixed radius), written with its unit.
+_SIDE_NUMBER = re.compile(r"(?<![A-Za-z0-9_])(object|left|right)=([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)(?=;|$)")
+
+
+def level_text(value):
+    """A level as a reader checks it: a number at the precision the protocol gave it (0.2, never the binary sum
+    0.19999999999999996 an older export wrote; 3.0 as 3), a side's radius with its unit ("object=4 photo px"), a level
+    a row does not have (NaN) blank."""
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return ""
+    if isinstance(value, (int, np.integer)) and not isinstance(value, bool):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        return f"{float(value):.12g}"
+    words = str(value).strip()
+    if re.fullmatch(r"[-+]?\d+", words):
+        return words  # an integer as written (an id's digits are never rounded)
+    if re.fullmatch(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?", words):
+        return f"{float(words):.12g}"
+    return _SIDE_NUMBER.sub(lambda m: f"{m.group(1)}={float(m.group(2)):.12g} photo px", words)
+
+
+def factor_label(name, codebook=None):
+    """A factor as an axis names it: with its unit where the codebook or its name gives one ("speed_cm_s (cm/s)"),
+    bare where it has none (an edge's number, a source's name)."""
+    unit = level_unit(codebook, name) if codebook is not None else level_unit(None, name)
+    if not unit and name != "level":
+        unit = level_unit(None, name)
+    return f"{name} ({unit})" if unit else str(name)

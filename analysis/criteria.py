@@ -4,7 +4,9 @@ the summary and the one in its section are the same quantity, stated with the sa
 
   criterion     the share correct a threshold stands for, said with it:
                   QUEST+          its threshold parameter, the Weibull's scale: F = 1 - 1/e of the way from guessing
-                                  to the top (at guess g and no lapses, g + (1 - g)(1 - 1/e): 81.6 % at g = 0.5)
+                                  to the top (at guess g and no lapses, g + (1 - g)(1 - 1/e): 81.6 % at g = 0.5);
+                                  with a lapse rate l the function gives g + (1 - g - l)(1 - 1/e) there (77.6 % at
+                                  l = 0.063), and a label of a fitted function says that share (Criterion.label)
                   staircase       the point its rule converges to (Levitt 1971): 1-up/n-down 0.5^(1/n) of the answers
                                   correct (70.7 % for 2-down), n-up/1-down 1 - 0.5^(1/n)
                   fixed levels    half way from guessing to the top (75 % correct at guess 0.5)
@@ -33,8 +35,18 @@ class Criterion:
         return self.answers
 
     def short(self):
-        """'81.6 % correct' (no lapses) - the criterion in a few words for a summary."""
+        """'81.6 % correct without lapses' - the criterion in a few words for a summary."""
         return self.words.split(":")[0]
+
+    def label(self, guess, lapse):
+        """The criterion as a fitted function with this guess and lapse gives it: a point of the core F is a lower
+        share correct where the fit has lapses ("81.6 % correct without lapses; the fitted function gives 77.6 % there
+        (lapse 0.063)"); a share of the answers (a staircase's target, fixed levels' half way) is that share whatever
+        the lapse. A lapse of 0 or unknown (NaN: on its bound) leaves the short words."""
+        if not math.isfinite(self.core) or lapse is None or not math.isfinite(lapse) or lapse < 5e-4:
+            return self.short()
+        return (f"{self.short()}; the fitted function gives {_pct(self.psi(guess, lapse))} there "
+                f"(lapse {lapse:.2g})")
 
 
 def _pct(v):
@@ -47,9 +59,10 @@ def criterion(kind, params, guess):
     if kind == "quest_plus":
         params = params or {}
         g = float(params.get("guess", guess))
-        return Criterion(f"{_pct(g + (1 - g) * CORE_AT_ALPHA)} correct: QUEST+'s threshold parameter, the Weibull's "
-                         f"scale, where the function has risen 1 - 1/e = 63.2 % of the way from guessing ({g:.3g}) "
-                         "to the top (no lapses)", core=CORE_AT_ALPHA)
+        return Criterion(f"{_pct(g + (1 - g) * CORE_AT_ALPHA)} correct without lapses: QUEST+'s threshold "
+                         f"parameter, the Weibull's scale, where the function has risen 1 - 1/e = 63.2 % of the way "
+                         f"from guessing ({g:.3g}) to the top; with a lapse rate l it gives g + (1 - g - l) 63.2 % "
+                         "there", core=CORE_AT_ALPHA)
     if kind == "staircase":
         if not params:
             return Criterion("the staircase's target (procedures.csv missing: its rule, so its target, unknown)")

@@ -150,8 +150,12 @@ def test1_per_edge(df, out_dir):
     t = count_table(d, "edge")
     t["edge"] = t["edge"].astype(int)
     fig, ax = plt.subplots(figsize=(9, 4.2))
-    _bars(ax, t, "edge", [str(e) for e in t["edge"]])
-    ax.set_xlabel("edge of the board (1 = nearest, in focus; 11 = farthest)")
+    # Each edge with the grids' depth there (trials.csv's u_left_mm, the calibration's geometry), where recorded.
+    depth = pd.to_numeric(d["u_left_mm"], errors="coerce").groupby(d["edge"]).mean() if "u_left_mm" in d else None
+    _bars(ax, t, "edge", [f"{e}\n{depth[e]:.0f} mm" if depth is not None and e in depth and np.isfinite(depth[e])
+                          else str(e) for e in t["edge"]])
+    ax.set_xlabel("edge of the board (1 = nearest, in focus; 11 = farthest)" +
+                  (" and the grids' depth u (mm)" if depth is not None and depth.notna().any() else ""))
     ax.set_title(f"Test 1, static grids: which grid fits the scene? ({participants_note(d)}, "
                  f"{int(t['answered'].sum())} answers)", loc="left")
     png, svg = save(fig, out_dir, "test1-per-edge")
@@ -307,7 +311,7 @@ def psychometric(df, out_dir, n_boot=200, seed=1):
                label="answers, equal-count bins (Wilson 95 %; size ∝ n)")
     ax.set_xlim(0, float(dec["diff"].max()) * 1.02)
     ax.set_ylim(0, 1)
-    ax.set_xlabel("blur difference |r_left − r_right| (px)")
+    ax.set_xlabel("blur difference |r_left − r_right| (photo px)")
     ax.set_ylabel("share choosing the more-blurred stimulus")
     studies = ", ".join(sorted(dec["study"].unique()))
     ax.set_title(f"Choosing the more blurred one against the blur difference, pooled over forced-choice studies\n"

@@ -229,7 +229,11 @@ jnd, lapse = 1.4, 0.02
 target = 0.5 + (0.5 - lapse / 2) * (1 - math.exp(-1))
 truth = jnd * NormalDist().inv_cdf((target - lapse / 2) / (1 - lapse)) * arcmin_per_px
 fit = next(csv.DictReader(open(os.path.join(out, "quest-blur-difference-simulated-psychometric.csv"))))
-assert fit["criterion"] == "81.6 % correct", fit["criterion"]
+assert fit["criterion"] == "81.6 % correct without lapses", fit["criterion"]
+# What the fitted function gives there, said beside it (its lapse lowers the share): its own criterion_share_correct.
+share = float(fit["criterion_share_correct"])
+assert fit["criterion_fitted"] == fit["criterion"] or f"gives {100 * share:.1f} % there" in fit["criterion_fitted"], fit
+assert fit["unit"] == "arcmin", fit["unit"]
 lo, th, hi = float(fit["threshold_low"]), float(fit["threshold"]), float(fit["threshold_high"])
 print(f"QUEST+ threshold {th:.3f} [{lo:.3f}, {hi:.3f}] arcmin; the observers' {truth:.3f}")
 assert lo <= truth <= hi, (lo, th, hi, truth)

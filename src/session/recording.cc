@@ -1,12 +1,15 @@
 #include "session/recording.h"
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <string_view>
 #include <utility>
 
 #include "core/hash.h"
 #include "core/error.h"
+#include "display/profile.h"
 #include "protocol/design.h"
 #include "session/observer.h"
 #include "session/prepare.h"
@@ -20,6 +23,16 @@ using stimulus::Presentation;
 using stimulus::TrialScene;
 
 namespace {
+
+// A procedure's level as the protocol writes its numbers. A staircase steps by adding (0.5 - 0.1 - 0.1 - 0.1 is
+// 0.20000000000000004 in binary), so the level it reached is recorded at 12 significant digits: the decimal its start
+// and steps give (0.2), within 1e-12 of the level shown (a resumed session's replay allows 1e-9).
+double LevelAsGiven(double level) {
+  if (!std::isfinite(level)) return level;
+  char text[32];
+  std::snprintf(text, sizeof text, "%.12g", level);
+  return std::strtod(text, nullptr);
+}
 
 static_assert(std::string_view(kChoiceNone) == store::kChoiceNone);
 static_assert(std::string_view(kChoiceSkipped) == store::kChoiceSkipped);
@@ -145,7 +158,7 @@ void Recording::RecordResponse(int64_t session, int64_t trial_index, const Respo
   r.rt_ms = response.rt_ms;
   r.adjustment_json = response.adjustment_json;
   r.shown_json = response.shown_json;
-  r.level = response.level;
+  if (response.level) r.level = LevelAsGiven(*response.level);
   r.r_left_px = response.r_left_px;
   r.r_right_px = response.r_right_px;
   r.correct = response.correct;
@@ -177,7 +190,7 @@ store::RecordedVariables Variables(const protocol::Trial& trial, const TrialScen
   if (trial.cell >= 0) {  // a procedure's trial: which of its block's procedures, the test side, the level shown
     v.procedure_cell = trial.cell;
     v.test_side = trial.test_side;
-    if (!std::isnan(scene.level)) v.level = scene.level;
+    if (!std::isnan(scene.level)) v.level = LevelAsGiven(scene.level);
   }
   // Odd one out: the interval that showed the right side's object (the correct answer), and how many there were.
   const protocol::TaskTraits& task = protocol::TraitsOf(trial.task);
@@ -230,6 +243,12 @@ store::RecordedVariables Variables(const protocol::Trial& trial, const TrialScen
       v.floor_sigma_screen_px[side] = round4(presentation.ScreenPx(floor));
       v.motion_x_screen_px[side] = round4(presentation.ScreenPx(motion[0]));
       v.motion_y_screen_px[side] = round4(presentation.ScreenPx(motion[1]));
+      // Where it is: its depth (0.01 mm) and its centre's elevation on the display from the principal point.
+      v.u_mm[side] = std::round((side == kLeft ? scene.u_left_mm : scene.u_right_mm) * 100) / 100;
+      const double below_mm = presentation.ScreenPx(side == kLeft ? scene.below_axis_left_px
+                                                                  : scene.below_axis_right_px) *
+                              display::MmPerPx(presentation.profile);
+      v.elevation_deg[side] = round4(-std::atan(below_mm / presentation.profile.distance_mm) * 180 / M_PI);
     }
     v.size_left_deg = round4(scene.size_left_deg);
     if (!scene.left_only) v.size_right_deg = round4(scene.size_right_deg);

@@ -45,6 +45,51 @@ TEST(TrialVariables, GridTrialRecordsEachRadiusInPhotoPxScreenPxAndArcmin) {
               1e-4);
 }
 
+// Each object's depth and its place in the picture reach the record: u as the scene worked it out (its geometry is
+// stimulus's DescribeTrial.AnObjectsDepthIsTheCalibrationsGeometryAtItsEdge), and the elevation on the display as the
+// visual angle of the image's offset from the principal point, atan(offset px x scale x mm per px / distance).
+TEST(TrialVariables, RecordsEachObjectsDepthAndElevation) {
+  const calib::SceneCalib scene = ThesisScene();
+  protocol::Protocol p = BallProtocol();
+  p.content.type = protocol::ContentType::kGrid;
+  const TrialScene t = DescribeTrial(p, PairTrial({{"edge", 11}}, "fitted", "fitted"), &scene);
+  Presentation shown;
+  shown.scale = 1.5;
+  const Json v = TrialVariables(PairTrial({{"edge", 11}}, "fitted", "fitted"), t, shown);
+  EXPECT_NEAR(v["u_left_mm"].get<double>(), t.u_left_mm, 0.005);
+  EXPECT_NEAR(v["u_right_mm"].get<double>(), t.u_right_mm, 0.005);
+  const double pitch_mm = 531.4 / 1920, deg = 180 / 3.14159265358979323846;
+  EXPECT_NEAR(v["elevation_left_deg"].get<double>(), -std::atan(t.below_axis_left_px * 1.5 * pitch_mm / 600) * deg,
+              1e-4);
+  EXPECT_GT(v["elevation_left_deg"].get<double>(), 0);  // edge 11 lies above the principal point (the board's far end)
+  // The single layout has no right object: nothing is recorded for it.
+  TrialScene single = t;
+  single.left_only = true;
+  const Json one = TrialVariables(PairTrial({{"edge", 11}}, "fitted", "fitted"), single, shown);
+  EXPECT_TRUE(one.contains("u_left_mm"));
+  EXPECT_FALSE(one.contains("u_right_mm"));
+  EXPECT_FALSE(one.contains("elevation_right_deg"));
+}
+
+// A staircase steps by adding: 0.5 - 0.1 - 0.1 - 0.1 is 0.20000000000000004 in binary, which trials.csv wrote as
+// such. The level shown is recorded as the protocol gives its numbers (0.2), in the variables and the typed column.
+TEST(ShownVariables, RecordAProceduresLevelAsTheProtocolWritesIt) {
+  const calib::SceneCalib scene = ThesisScene();
+  protocol::Protocol p = BallProtocol();
+  p.content.type = protocol::ContentType::kGrid;
+  TrialScene t = DescribeTrial(p, PairTrial({{"edge", 6}}, "fitted", "fitted"), &scene);
+  protocol::Trial trial = PairTrial({{"edge", 6}}, "fitted", "fitted");
+  trial.cell = 0, trial.test_side = "right";
+  t.level = 0.5 - 0.1 - 0.1 - 0.1;
+  ASSERT_NE(t.level, 0.2);  // the binary sum, as the staircase reaches it
+  Presentation shown;
+  shown.scale = 1;
+  const Json v = Json::parse(ShownVariables(trial, t, shown, Scored{true, std::nullopt, std::nullopt}));
+  EXPECT_EQ(v["level"].get<double>(), 0.2);
+  EXPECT_EQ(v["level"].dump(), "0.2");
+  EXPECT_EQ(TrialVariables(trial, t, shown)["level"].dump(), "0.2");
+}
+
 // The per-pixel plan (stimulus's PlanOnScreen.PerPixelExactlyWhenTheObjectsDepthSpanReachesTheThresholdOnScreen) is
 // recorded as such.
 TEST(TrialVariables, RecordsThePerPixelBlurPlan) {

@@ -72,6 +72,11 @@ struct TrialScene {
   bool per_pixel = false;
   double r_span_screen_px = 0;  // the largest change of r across an object's depth, both sides, start and end of a run
   double size_left_deg = 0, size_right_deg = 0;  // each object's largest extent on screen at onset, visual angle
+  // Where each object is in depth and in the picture (pairs; the right one at the left's place in an intervals trial),
+  // averaged over a ball's run like the radii: its centre's depth u (camera z, mm: DESIGN.md's u) and its centre's
+  // image below the photo's principal point (photo px, down positive; the calibrated camera's distortion included).
+  double u_left_mm = 0, u_right_mm = 0;
+  double below_axis_left_px = 0, below_axis_right_px = 0;
 
   // Seconds of motion (0 for a static stimulus).
   double MotionS() const;

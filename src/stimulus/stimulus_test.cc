@@ -278,6 +278,39 @@ TEST(DescribeTrial, PlacesInMillimetresAndChecksTheBoardAndThePhoto) {
   }
 }
 
+// The record's depth of an object is the calibration's geometry: ThesisScene's camera looks along
+// f = (0, cos 38, -sin 38) in the board frame from 440 mm before the board's centre (87.5, 125, 0), so a point P lies
+// at u = 440 + (P - centre) . f, and its image (no distortion; fy = f / pitch) sits fy (P - c) . down / u below the
+// principal point, down = (0, -sin 38, -cos 38) the camera's y. Edge 1 lies at 440 - 125 cos 38 = 341.5 mm, edge 11
+// at 538.5 mm (the thesis's 342 to 527 mm).
+TEST(DescribeTrial, AnObjectsDepthIsTheCalibrationsGeometryAtItsEdge) {
+  const calib::SceneCalib scene = ThesisScene();
+  protocol::Protocol p = BallProtocol();
+  p.content.type = protocol::ContentType::kGrid;
+  const double a = 38 * M_PI / 180;
+  const cv::Vec3d forward(0, std::cos(a), -std::sin(a)), down(0, -std::sin(a), -std::cos(a)), centre(87.5, 125, 0);
+  const double fy = 21 / (23.4 / 1148);  // the thesis's 21 mm lens on a 23.4 mm sensor, 1148 px across
+  for (const int edge : {1, 6, 11}) {
+    const TrialScene t = DescribeTrial(p, PairTrial({{"edge", edge}, {"left_x_mm", -40}, {"right_x_mm", 230}},
+                                                    "fitted", "fitted"), &scene);
+    for (const double x : {-40.0, 230.0}) {
+      const cv::Vec3d from_centre = cv::Vec3d(x, (edge - 1) * 25.0, 0) - centre;
+      const double u = 440 + from_centre.dot(forward);
+      EXPECT_NEAR(x < 0 ? t.u_left_mm : t.u_right_mm, u, 1e-6) << "edge " << edge << " x " << x;
+      EXPECT_NEAR(x < 0 ? t.below_axis_left_px : t.below_axis_right_px, fy * from_centre.dot(down) / u, 1e-6)
+          << "edge " << edge << " x " << x;
+    }
+    if (edge == 1 || edge == 11) {
+      EXPECT_NEAR(t.u_left_mm, 440 + (edge == 1 ? -125 : 125) * std::cos(a), 1e-6);
+    }
+  }
+  // A ball resting at edge 9 on the board's section 3: its centre 10 mm above the board.
+  const TrialScene ball = DescribeTrial(BallProtocol(), PairTrial({{"edge", 9}}, "fitted", "fitted"), &scene);
+  const cv::Vec3d ball_centre = ObjectsAt(BallProtocol(), scene, ball, 0)[0]->object.center_board_mm;
+  EXPECT_NEAR(ball_centre[1], 200, 1e-9);
+  EXPECT_NEAR(ball.u_left_mm, 440 + (ball_centre - centre).dot(forward), 1e-6);
+}
+
 TEST(DescribeTrial, MissingLevelOrCalibrationIsAnInputErrorNamingTheField) {
   const calib::SceneCalib scene = ThesisScene();
   protocol::Protocol p = BallProtocol();

@@ -78,6 +78,19 @@ cv::Vec2d StreakAtPx(const calib::SceneCalib& s, const TrialScene& t, double y_m
   return {image[1].x - image[0].x, image[1].y - image[0].y};
 }
 
+// An object's centre at board_mm: its depth u (camera z, mm) and its image's place below the principal point (photo
+// px, down positive), through the calibrated camera (its distortion included) - where the record says it is.
+struct ObjectPlace {
+  double u_mm = 0, below_axis_px = 0;
+};
+ObjectPlace PlaceOf(const calib::SceneCalib& s, const cv::Vec3d& board_mm) {
+  std::vector<cv::Point2d> image;
+  const std::array<double, 9> k = s.camera.Intrinsics();
+  cv::projectPoints(std::vector<cv::Point3d>{cv::Point3d(board_mm)}, s.rvec, s.tvec, cv::Matx33d(k.data()),
+                    s.camera.dist_coeffs, image);
+  return {s.ToCamera(board_mm)[2], image[0].y - k[5]};
+}
+
 // The protocol's kernel as the renderer names its blur method: the one place the two vocabularies meet (render knows
 // nothing of protocols).
 std::string RenderMethod(protocol::Kernel kernel) {
@@ -225,6 +238,9 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
     const cv::Vec3d l = Card(*scene, t, true).center_board_mm, r = Card(*scene, t, right_place).center_board_mm;
     t.r_left_px = r_at(l, t.left, t.left_fixed_px, "left");
     t.r_right_px = r_at(r, t.right, t.right_fixed_px, "right");
+    const ObjectPlace pl = PlaceOf(*scene, l), pr = PlaceOf(*scene, r);
+    t.u_left_mm = pl.u_mm, t.u_right_mm = pr.u_mm;
+    t.below_axis_left_px = pl.below_axis_px, t.below_axis_right_px = pr.below_axis_px;
     // The floor at each card's place (the distortion's stretch there; ObjectsAt draws the same).
     t.floor_left_sigma_px = calib::FloorSigmaPx(*scene, t.left, scene->ToCamera(l));
     t.floor_right_sigma_px = calib::FloorSigmaPx(*scene, t.right, scene->ToCamera(r));
@@ -281,6 +297,9 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
     t.floor_right_sigma_px += calib::FloorSigmaPx(*scene, t.right, scene->ToCamera(r)) / samples;
     t.r_scene_px += 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, nullptr) +
                            r_at(r, calib::BlurSource::kFitted, 0, nullptr)) / samples;
+    const ObjectPlace pl = PlaceOf(*scene, l), pr = PlaceOf(*scene, r);
+    t.u_left_mm += pl.u_mm / samples, t.u_right_mm += pr.u_mm / samples;
+    t.below_axis_left_px += pl.below_axis_px / samples, t.below_axis_right_px += pr.below_axis_px / samples;
     t.motion_left_px += StreakAtPx(*scene, t, y, radius, true) / samples;
     t.motion_right_px += StreakAtPx(*scene, t, y, radius, right_place) / samples;
   }
@@ -352,6 +371,8 @@ TrialScene IntervalScene(const TrialScene& scene, bool right) {
     s.r_left_px = s.r_right_px;
     s.floor_left_sigma_px = s.floor_right_sigma_px;
     s.motion_left_px = s.motion_right_px;
+    s.u_left_mm = s.u_right_mm;
+    s.below_axis_left_px = s.below_axis_right_px;
   }
   return s;
 }

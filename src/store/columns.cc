@@ -195,7 +195,10 @@ std::vector<Column> MakeColumns() {
 
   // The runner's variables of a trial (session/recording.h TrialVariables), kept in its variables' JSON (factors; a
   // response's shown for what a procedure decided at the trial). Those also kept typed come first, in schema 7's order.
-  Column& level = add("level", "number", "the procedure's variable", "", "a procedure trial: the level shown", V,
+  Column& level = add("level", "number", "the procedure's variable", "",
+                      "a procedure trial: the level shown, in the procedure's variable (procedures.csv: "
+                      "relative_difference, ratio - 1: the test radius / the reference's - 1; difference_arcmin: "
+                      "arcmin added on the screen); the unit is the design's where the record says", V,
                       Cell::kText);
   level.variable = Member(&RecordedVariables::level);
   level.shown = OfResponse(Typed("responses", "REAL", "", 7, "json_extract(shown, '$.level')"),
@@ -286,6 +289,19 @@ std::vector<Column> MakeColumns() {
     variable("motion_" + side + "_y_screen_px", "number", "screen px",
              "the " + side + " object's motion streak over the exposure, down (y down), averaged over the run",
              Radius(&R::motion_y_screen_px, k));
+  }
+  // Where each object is: its depth (what an edge number stands for) and, as the eye gets it, its height in the picture.
+  for (size_t k = 0; k < 2; ++k) {
+    const std::string side = RecordedVariables::kSides[k];
+    variable("u_" + side + "_mm", "number", "mm",
+             "the " + side + " object's depth u: its centre's distance from the camera's lens plane along the optical "
+             "axis (camera z in the calibration's board pose), where its radius was evaluated (an intervals trial: the "
+             "left object's place); a ball: averaged over its run like the radii", Radius(&R::u_mm, k));
+    variable("elevation_" + side + "_deg", "number", "deg",
+             "the " + side + " object's place in the picture as a visual angle: its centre's image above (+) or below "
+             "(-) the photo's principal point (where the camera's optical axis meets the photo), on the display, "
+             "atan(offset on the screen / viewing distance); not its angular size (size_" + side + "_deg); a ball: "
+             "averaged over its run", Radius(&R::elevation_deg, k));
   }
   variable("size_left_deg", "number", "deg", "the left object's largest extent on screen at onset", Member(&R::size_left_deg));
   variable("size_right_deg", "number", "deg", "the right object's largest extent on screen at onset", Member(&R::size_right_deg));

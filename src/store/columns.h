@@ -65,6 +65,9 @@ struct RecordedVariables {
   // sides (kSides' first two) the lens floor inside the radius (std) and the streak's x and y on the screen.
   std::optional<double> exposure_ms;
   std::array<std::optional<double>, 3> floor_sigma_px, floor_sigma_screen_px, motion_x_screen_px, motion_y_screen_px;
+  // Where the left and right objects (kSides' first two) are: each centre's depth u along the camera's optical axis
+  // (mm), and its elevation on the display (deg of visual angle, up positive) from the photo's principal point.
+  std::array<std::optional<double>, 3> u_mm, elevation_deg;
 };
 
 // The JSON the record keeps `variables` in: {NAME: value} for each member set, NAME its column's.

@@ -62,6 +62,14 @@ std::string TidyCell(const Json& value) {
       if (!member.is_structured()) text += (text.empty() ? "" : ";") + key + "=" + Cell(member);
     return text;
   }
+  // A number binary cannot hold as written (a staircase's 0.5 - 0.1 - 0.1 - 0.1 = 0.20000000000000004, recorded so
+  // before the runner recorded levels as given) is written at 15 significant digits, the most a double keeps of any
+  // decimal: 0.2. A number that needs no more keeps its shortest text (4.0 stays 4.0).
+  if (value.is_number_float() && std::isfinite(value.get<double>())) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.15g", value.get<double>());
+    if (std::strtod(text, nullptr) != value.get<double>()) return text;
+  }
   return value.is_array() ? std::string() : Cell(value);
 }
 
@@ -90,7 +98,18 @@ struct TypeOf {
 struct DesignOf {
   std::set<std::string> roles;
   std::vector<std::string> allowed;  // each version's allowed text, once
+  std::set<std::string> units;       // each version's unit
 };
+
+// The unit a design column's versions give it, for the codebook ("" where they differ or give none). The procedure's
+// level is the one design column whose empty unit says something: protocol::DescribeDesign gives "arcmin" for a
+// difference_arcmin procedure and "" for relative_difference, whose level is the test radius / the reference's - 1.
+std::string UnitOfDesign(const std::string& name, const DesignOf& design) {
+  if (design.units.size() != 1) return "";
+  const std::string& unit = *design.units.begin();
+  if (name == "level" && unit.empty()) return "ratio - 1 (relative_difference: the test side's radius / the reference's - 1)";
+  return unit;
+}
 
 // The allowed values of several protocol versions as one: a list of numbers in numeric order, else of names in the
 // order met; one text when they agree; "" (any) when ranges and lists mix.
@@ -125,10 +144,11 @@ void ApplyDesign(Database& db, std::vector<ColumnDef>* columns) {
                                       "s WHERE s.protocol_version_id = pv.id) AND NOT EXISTS (SELECT 1 FROM "
                                       "design_columns d WHERE d.protocol_version_id = pv.id)") == 0;
   std::map<std::string, DesignOf> design;
-  Statement rows(db, "SELECT name, role, allowed FROM design_columns ORDER BY protocol_version_id, position");
+  Statement rows(db, "SELECT name, role, allowed, unit FROM design_columns ORDER BY protocol_version_id, position");
   while (rows.Step()) {
     DesignOf& d = design[rows.GetText(0)];
     d.roles.insert(rows.GetText(1));
+    d.units.insert(rows.GetText(3));
     if (std::find(d.allowed.begin(), d.allowed.end(), rows.GetText(2)) == d.allowed.end())
       d.allowed.push_back(rows.GetText(2));
   }
@@ -140,6 +160,9 @@ void ApplyDesign(Database& db, std::vector<ColumnDef>* columns) {
       continue;
     }
     for (const std::string& role : it->second.roles) c.role += (c.role.empty() ? "" : "|") + role;
+    // The design's unit where every version gives the same (a level of speed_cm_s is in cm/s, a difference_arcmin
+    // procedure's level in arcmin); the table's words otherwise.
+    if (const std::string unit = UnitOfDesign(c.name, it->second); !unit.empty()) c.unit = unit;
     if (complete) c.allowed = UnionAllowed(it->second.allowed);
     else c.meaning += "; allowed: the values seen (the record holds sessions from before designs were recorded)";
   }

@@ -121,5 +121,31 @@ TEST(Export, RecordWithoutADesignKeepsTheValuesSeenAndSaysSo) {
       << edge.at("meaning");
 }
 
+// The codebook gives a design column the unit its protocol versions give it: a factor speed_cm_s in cm/s, a
+// difference_arcmin procedure's level in arcmin, a relative_difference one's (the design's empty unit) as ratio - 1;
+// versions that disagree keep the table's words.
+TEST(Export, CodebookGivesTheDesignsUnitsAndTheProceduresLevelItsUnit) {
+  for (const auto& [units, expect] :
+       std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"arcmin"}, "arcmin"},
+           {{""}, "ratio - 1 (relative_difference: the test side's radius / the reference's - 1)"},
+           {{"arcmin", ""}, "the procedure's variable"}}) {
+    testing::TempDir dir;
+    {
+      Record record = Record::Open(dir / "r.sqlite");
+      for (size_t v = 0; v < units.size(); ++v) {
+        SessionMeta meta;
+        meta.protocol_version = int64_t(v + 1);
+        meta.design = {{"speed_cm_s", "within", "number", "cm/s", {1.8, 3}, {}, {}, {}},
+                       {"level", "within", "number", units[v], {0.1, 0.2}, {}, {}, {}}};
+        Session(record, "P" + std::to_string(v), v + 1, meta, {{R"({"speed_cm_s":3,"level":0.2})", ""}});
+      }
+    }
+    ASSERT_EQ(ExportCsv(dir / "r.sqlite", dir / "out"), int64_t(units.size()));
+    EXPECT_EQ(Book(dir / "out", "speed_cm_s")["unit"], "cm/s");
+    EXPECT_EQ(Book(dir / "out", "level")["unit"], expect);
+  }
+}
+
 }  // namespace
 }  // namespace blurcue::store

@@ -5,6 +5,7 @@
 
 #include <cctype>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -100,6 +101,41 @@ TEST(Export, ColumnsAreTheSameForParticipantsWithDifferentFactors) {
   for (const auto& row : codebook)
     if (row[0] == "trials.csv") named.push_back(row[1]);
   EXPECT_EQ(named, expected);
+}
+
+// Each object's depth and its elevation reach trials.csv as the runner recorded them, and the codebook states their
+// units (mm, deg) and what they are; a level the record holds as binary arithmetic left it (a staircase's
+// 0.5 - 0.1 - 0.1 - 0.1, recorded so by an older runner) is written as the protocol gives it: 0.2.
+TEST(Export, EachObjectsDepthAndElevationWithTheirUnitsAndLevelsAsGiven) {
+  testing::TempDir dir;
+  {
+    Record record = Record::Open(dir / "r.sqlite");
+    const double level = 0.5 - 0.1 - 0.1 - 0.1;
+    ASSERT_EQ(Json(level).dump(), "0.20000000000000004");
+    const Json factors = {{"edge", 11}, {"u_left_mm", 538.51}, {"u_right_mm", 538.6},
+                          {"elevation_left_deg", 4.2125}, {"elevation_right_deg", 4.25}, {"level", level},
+                          {"procedure_cell", 0}};
+    RunSession(record, "P01", factors.dump(), 1, 1);
+  }
+  ASSERT_EQ(ExportCsv(dir / "r.sqlite", dir / "out"), 1);
+  const Rows rows = ReadCsv(dir / "out" / "trials.csv");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "u_left_mm")], "538.51");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "u_right_mm")], "538.6");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "elevation_left_deg")], "4.2125");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "elevation_right_deg")], "4.25");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "level")], "0.2");
+  EXPECT_EQ(rows[1][ColumnIndex(rows, "edge")], "11");
+  std::map<std::string, std::vector<std::string>> book;
+  for (const auto& row : ReadCsv(dir / "out" / "codebook.csv"))
+    if (row[0] == "trials.csv") book[row[1]] = row;
+  for (const char* name : {"u_left_mm", "u_right_mm", "elevation_left_deg", "elevation_right_deg"})
+    ASSERT_TRUE(book.count(name)) << name;
+  EXPECT_EQ(book["u_left_mm"][2], "number");
+  EXPECT_EQ(book["u_left_mm"][3], "mm");
+  EXPECT_NE(book["u_left_mm"][5].find("depth u"), std::string::npos) << book["u_left_mm"][5];
+  EXPECT_NE(book["u_left_mm"][5].find("optical axis"), std::string::npos) << book["u_left_mm"][5];
+  EXPECT_EQ(book["elevation_right_deg"][3], "deg");
+  EXPECT_NE(book["elevation_right_deg"][5].find("not its angular size"), std::string::npos);
 }
 
 // Studies whose names differ only in what a file name cannot hold, or only in case, each keep their summary: "a<b",
