@@ -32,7 +32,7 @@ import pandas as pd
 from scipy import stats as sps
 
 import criteria
-from common import Chart, save, session_words
+from common import Chart, axis_label, level_unit, save, session_words
 
 CREDIBLE = 0.95
 COLORS = ["#0072B2", "#E69F00", "#009E73", "#CC79A7", "#D55E00", "#56B4E9", "#F0E442", "#000000"]
@@ -52,15 +52,6 @@ def parameters(g):
         return None
     texts = [t for t in g["procedure_parameters"].astype(str) if t.strip() not in ("", "nan")]
     return json.loads(texts[0]) if texts else None
-
-
-LEVEL_UNITS = {"relative_difference": "relative difference (r_test / r_ref - 1)",
-               "difference_arcmin": "arcmin (difference of blur radius)"}
-
-
-def level_units(p):
-    """The unit of a procedure's level (its variable), in words: '' where the export does not say."""
-    return LEVEL_UNITS.get((p or {}).get("variable", ""), "")
 
 
 def cell_label(g):
@@ -420,7 +411,7 @@ def track_rows(m):
             participant += f" ({said[g.index[0]]})"
         crit = criteria.criterion(kind, p, float((p or {}).get("guess", 0.5)))
         out.append({"participant": participant, "cell": label, "kind": kind, "levels": levels, "correct": correct,
-                    "criterion": crit.short(), "units": level_units(p),
+                    "criterion": crit.short(), "units": level_unit(p) if p else "",
                     "posterior": _num(g["posterior_threshold"]).to_numpy() if kind == "quest_plus" and
                     "posterior_threshold" in g else None, "result": result})
     return out
@@ -505,15 +496,15 @@ def summary_words(summary):
     N, tracks not determined): one clause per cell."""
     out = []
     for _, r in summary.iterrows():
-        unit = f" {r['units']}" if str(r.get("units", "")) not in ("", "nan") else ""
+        unit = f"{r['units']}; " if str(r.get("units", "")) not in ("", "nan") else ""
         text = f"{r['cell']}: threshold at {r['criterion']}"
         if pd.notna(r.get("mean_low")):
-            text += (f" {r['mean']:.3g}{unit} [{r['mean_low']:.3g}, {r['mean_high']:.3g}] (mean of "
+            text += (f" {r['mean']:.3g} [{r['mean_low']:.3g}, {r['mean_high']:.3g}] ({unit}mean of "
                      f"{int(r['determined'])} participants' thresholds, t 95 %)")
         elif pd.notna(r.get("mean")) and int(r["determined"]) == 1:
-            text += f" {r['mean']:.3g}{unit} (one participant's threshold)"
+            text += f" {r['mean']:.3g} ({unit}one participant's threshold)"
         elif pd.notna(r.get("mean")):
-            text += (f" {r['mean']:.3g}{unit} (mean of {int(r['determined'])} participants' thresholds; its interval "
+            text += (f" {r['mean']:.3g} ({unit}mean of {int(r['determined'])} participants' thresholds; its interval "
                      f"{r['interval']})")
         else:
             text += f" {r.get('interval') or 'not determined'}"
@@ -583,7 +574,7 @@ def _tracks_figure(tracks, cells, study, group_note, out_dir, name):
         ax.set_visible(False)
     units = "; ".join(dict.fromkeys(t.get("units", "") for t in tracks if t.get("units")))
     for ax in axes[:, 0]:
-        ax.set_ylabel(f"level shown\n{units}" if units else "level shown", fontsize=9)
+        ax.set_ylabel(axis_label("level shown", units))
     kinds = {t["kind"] for t in tracks}
     fig.suptitle(f"{study}: procedure tracks ({', '.join('QUEST+' if k == 'quest_plus' else 'staircase' for k in sorted(kinds))})"
                  f"\n{group_note}; o correct, x wrong; squares at the right: each track's threshold and interval",
@@ -613,7 +604,7 @@ def _thresholds_figure(tracks, summary, cells, study, group_note, out_dir, name)
     ax.set_xticklabels([c.replace(", ", "\n") for c in cells], fontsize=8)
     ax.set_xlim(-0.6, len(cells) - 0.4)
     units = "; ".join(dict.fromkeys(t.get("units", "") for t in tracks if t.get("units")))
-    ax.set_ylabel(f"threshold\n{units}" if units else "threshold (the procedure's level)", fontsize=9)
+    ax.set_ylabel(axis_label("threshold", units))
     ax.set_title(f"{study}: thresholds per cell\n{group_note}\ngrey: each participant with its 95 % interval; "
                  "orange: the mean with its t 95 % interval", loc="left", fontsize=10)
     fig.tight_layout()
