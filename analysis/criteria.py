@@ -53,6 +53,19 @@ def _pct(v):
     return f"{100 * v:.1f} %".replace(".0 %", " %")
 
 
+def staircase_target(up, down):
+    """Where an up/down rule converges (plan::TargetShare): the share p at which a run of `down` correct answers is as
+    likely to come before a run of `up` wrong ones as after, p^(d-1) (1 - q^u) / (p^(d-1) + q^(u-1) - p^(d-1) q^(u-1))
+    = 1/2, q = 1 - p, by bisection."""
+    lo, hi = 0.0, 1.0
+    for _ in range(100):
+        p = (lo + hi) / 2
+        a, b = p ** (down - 1), (1 - p) ** (up - 1)
+        first = a * (1 - (1 - p) ** up) / (a + b - a * b) if a + b - a * b > 0 else 0.5
+        lo, hi = (p, hi) if first < 0.5 else (lo, p)
+    return (lo + hi) / 2
+
+
 def criterion(kind, params, guess):
     """The Criterion of a procedure cell (kind: quest_plus, staircase or "" for fixed levels; params: its
     procedures.csv JSON, None where the export has none) at this guess rate."""
@@ -72,8 +85,7 @@ def criterion(kind, params, guess):
         elif down == 1:
             target = 1 - 0.5 ** (1 / up)
         else:
-            return Criterion(f"the {up}-up/{down}-down staircase's own target: the point its rule converges to "
-                             "(no closed form for this rule)", answers=math.nan)
+            target = staircase_target(up, down)
         return Criterion(f"{_pct(target)} correct: the point the {up}-up/{down}-down staircase converges to (Levitt "
                          "1971)", answers=target)
     return Criterion(f"{_pct(guess + (1 - guess) / 2)} correct: half way from guessing ({guess:.3g}) to the top (no "

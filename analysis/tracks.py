@@ -216,10 +216,15 @@ def staircase_threshold(p, levels, correct):
         return out
     lo, hi = criteria.tested_range(p, levels)
     out["range"] = (lo, hi)
-    target = criteria.criterion("staircase", p, float(p.get("guess", 0.5))).answers
+    guess = float(p.get("guess", 0.5))
+    target = criteria.criterion("staircase", p, guess).answers
     if not math.isfinite(target):
         return out | {"why": "not determined: this up/down rule has no closed-form target"}
-    fit = staircase_posterior(float(p.get("guess", 0.5)), target, lo, hi, levels, correct)
+    if not (guess + 0.01 < target < 0.94):  # as plan::TrackEstimate
+        return out | {"why": (f"not determined: a {int(p['up'])}-up/{int(p['down'])}-down staircase converges on "
+                              f"{100 * target:.1f} % correct, " + ("what guessing gives" if target <= guess + 0.01
+                                                                    else "beyond what its fit can place"))}
+    fit = staircase_posterior(guess, target, lo, hi, levels, correct)
     if not fit["determined"]:
         return out | {"why": fit["why"]}
     out.update(estimate=fit["estimate"], low=fit["low"], high=fit["high"], interval_at_bound=fit["at_bound"],

@@ -147,6 +147,22 @@ class StaircaseEstimate(unittest.TestCase):
         self.assertNotIn("estimate", r)
         self.assertTrue(r["why"].startswith("not determined: replaying the answers"), r["why"])
 
+    def test_a_rule_that_converges_on_guessing_and_an_odd_one_outs_guess(self):
+        # 1-up/1-down in a 2AFC converges on 50 %, what guessing gives: words, no number (as plan::TrackEstimate).
+        p = {"procedure": "staircase", "start": 1.0, "min": 0.02, "max": 3.0, "up": 1, "down": 1, "steps": [0.1],
+             "guess": 0.5}
+        levels, correct = np.array([1.0, 0.9, 1.0, 0.9] * 5), np.array([1, 0] * 10) == 1
+        r = tracks.staircase_threshold(p, levels, correct)
+        self.assertEqual(r["why"], "not determined: a 1-up/1-down staircase converges on 50.0 % correct, what "
+                                   "guessing gives")
+        # An odd one out of 3 (guess 1/3, exported in procedures.csv): the same rule's 50 % is a threshold, fitted
+        # with that guess rate.
+        r = tracks.staircase_threshold(p | {"guess": 1 / 3}, levels, correct)
+        fit = tracks.staircase_posterior(1 / 3, 0.5, 0.02, 3.0, levels, correct)
+        self.assertAlmostEqual(r["estimate"], fit["estimate"], places=12)
+        # A 2-up/3-down rule's target by bisection, as plan::TargetShare (no closed form): 60.4 %.
+        self.assertAlmostEqual(criteria.staircase_target(2, 3), 0.60445, places=4)
+
     def test_a_track_too_short_to_bound_its_threshold_is_not_determined(self):
         # Six answers, one wrong: the posterior reaches both ends of 0.02 to 3 (no number); the stop rule no longer
         # decides (the posterior says how settled a track is; 4 of 6 turning points could be a settled track).

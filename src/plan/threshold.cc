@@ -154,9 +154,21 @@ procedure::TrackThreshold TrackEstimate(const protocol::Procedure& procedure, co
     out.why = "not determined: no answers";
     return out;
   }
-  if (procedure.kind != protocol::Procedure::Kind::kQuestPlus)
-    return procedure::StaircasePosterior({procedure.guess, TargetShare(procedure, 0), procedure.min, procedure.max},
-                                         levels, correct);
+  if (procedure.kind != protocol::Procedure::Kind::kQuestPlus) {
+    const double target = TargetShare(procedure, 0);
+    // A rule that converges on guessing (1-up/1-down in a 2AFC) or above what a lapsing participant reaches has no
+    // threshold to fit (StaircasePosterior refuses such a spec).
+    if (!(target > procedure.guess + 0.01) || !(target < 0.94)) {
+      char text[200];
+      std::snprintf(text, sizeof text,
+                    "not determined: a %d-up/%d-down staircase converges on %.1f %% correct, %s", procedure.up,
+                    procedure.down, 100 * target,
+                    target <= procedure.guess + 0.01 ? "what guessing gives" : "beyond what its fit can place");
+      out.why = text;
+      return out;
+    }
+    return procedure::StaircasePosterior({procedure.guess, target, procedure.min, procedure.max}, levels, correct);
+  }
   session::QuestPlus quest(procedure);
   for (size_t i = 0; i < levels.size(); ++i) quest.Update(levels[i], correct[i]);
   // The threshold's marginal: the posterior runs threshold x slope x lapse, lapse fastest.

@@ -52,6 +52,23 @@ TEST(TurningPoints, StaircaseReplayedByHand) {
   EXPECT_FALSE(TrackEstimate(staircase, {}, {}).determined);
 }
 
+// A 1-up/1-down staircase in a 2AFC converges on 50 % correct, what guessing gives: no threshold, said in words
+// (the posterior refuses such a target; this was an exception before). An odd one out of 3 guesses 1/3 (the
+// protocol parser sets it) and its 1-up/1-down target, 50 %, is above guessing: fitted.
+TEST(TrackEstimate, AStaircaseConvergingOnGuessingHasNoThreshold) {
+  protocol::Procedure staircase;
+  staircase.start = 1, staircase.min = 0.02, staircase.max = 3, staircase.up = 1, staircase.down = 1;
+  staircase.steps = {0.1};
+  std::vector<double> levels(20, 0.5);
+  std::vector<bool> correct(20, false);
+  for (size_t i = 0; i < 20; i += 2) correct[i] = true;
+  const procedure::TrackThreshold t = TrackEstimate(staircase, levels, correct);
+  EXPECT_FALSE(t.determined);
+  EXPECT_EQ(t.why, "not determined: a 1-up/1-down staircase converges on 50.0 % correct, what guessing gives");
+  staircase.guess = 1.0 / 3;
+  EXPECT_EQ(TrackEstimate(staircase, levels, correct).why.find("converges"), std::string::npos);
+}
+
 // QUEST+ over thresholds {1, 2, 3}, slope 2, no lapse, guess 0.5, after one correct answer at 1: each threshold's
 // likelihood 1 - 0.5 exp(-(1 / t)^2), the marginal their share, the median interpolated in the cumulative mass.
 TEST(TrackEstimate, QuestPlusPosteriorMedianByHand) {

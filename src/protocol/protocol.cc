@@ -124,10 +124,13 @@ Protocol Parser::Parse(const Json& json) {
     if (p.layout != Layout::kOddOneOut)
       Problem("/alternatives", "is for the layout odd_one_out (the intervals of an odd-one-out trial)", json["alternatives"]);
   }
-  // QUEST+'s guess rate is the chance of a right answer by guessing: 1/n of an odd-one-out trial's n intervals.
+  // A procedure's guess rate is the chance of a right answer by guessing: 1/n of an odd-one-out trial's n intervals
+  // (QUEST+'s likelihood and a staircase's threshold posterior, procedure/threshold_fit.h, both use it).
   if (p.layout == Layout::kOddOneOut)
     for (auto& b : p.blocks)
-      if (b.procedure && b.procedure->kind == Procedure::Kind::kQuestPlus) {
+      if (b.procedure && b.procedure->kind == Procedure::Kind::kStaircase) {
+        b.procedure->guess = 1.0 / p.alternatives;
+      } else if (b.procedure && b.procedure->kind == Procedure::Kind::kQuestPlus) {
         if (!b.procedure->guess_given) b.procedure->guess = 1.0 / p.alternatives;
         else if (std::abs(b.procedure->guess - 1.0 / p.alternatives) > 1e-3)
           Problem(b.pointer + "/procedure/guess", "an odd-one-out trial of " + std::to_string(p.alternatives) +

@@ -22,7 +22,8 @@ const std::vector<ColumnDef>& ProcedureColumns() {
       {"procedure", "string", "", "staircase|quest_plus", "the adaptive procedure"},
       {"parameters", "string", "", "JSON",
        "the procedure's parameters as the protocol parser reads them: procedure, variable, reference, trials; a "
-       "staircase's start, min, max, up, down, steps, stop_reversals; QUEST+'s stimuli, thresholds, slopes, lapses "
+       "staircase's start, min, max, up, down, steps, stop_reversals and guess (1/n of an odd one out's n intervals, else "
+       "0.5); QUEST+'s stimuli, thresholds, slopes, lapses "
        "(its grid, uniform prior) and guess"},
   };
   return columns;
@@ -36,7 +37,7 @@ Json ParametersOf(const protocol::Procedure& p) {
   switch (p.kind) {
     case protocol::ProcedureKind::kStaircase:
       out.update({{"start", p.start}, {"min", p.min}, {"max", p.max}, {"up", p.up}, {"down", p.down},
-                  {"steps", p.steps}, {"stop_reversals", p.stop_reversals}});
+                  {"steps", p.steps}, {"stop_reversals", p.stop_reversals}, {"guess", p.guess}});
       break;
     case protocol::ProcedureKind::kQuestPlus:
       out.update({{"stimuli", p.stimuli}, {"thresholds", p.thresholds}, {"slopes", p.slopes}, {"lapses", p.lapses},
