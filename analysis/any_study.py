@@ -309,7 +309,15 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
              (f"; slope {fit.beta:.3g}" if beta_free else "; slope on a bound of its range: not determined") +
              ("" if beta_ci or not beta_free else "; the slope's interval reaches a bound: not determined")]
     if fit.on_bound:
-        notes.append("on a bound of its range: " + ", ".join(f"{k} ({v[1]})" for k, v in fit.on_bound.items()))
+        names = {"lam": "lapse rate", "beta": "slope", "alpha": "scale (threshold)", "gamma": "guess rate"}
+        notes.append("on a bound of its range: " + ", ".join(f"{names.get(k, k)} ({v[1]})"
+                                                             for k, v in fit.on_bound.items()))
+    if "procedure_cell" in d and d["procedure_cell"].astype(str).str.strip().isin(["", "nan"]).eq(False).any():
+        # An adaptive track's levels follow its own answers and participants differ in threshold: the pooled fit
+        # describes the answers, the study's result is each participant's track threshold (the tracks tables).
+        notes.append("a description of the answers pooled over participants, not the study's result: an adaptive "
+                     "procedure's thresholds are each participant's track's (the tracks and thresholds tables), "
+                     "summarised across participants there")
     return Chart(name, png, svg, t, notes), ((th, th_lo, th_hi, fit.beta) if bounded else
                                              (th, math.nan, math.nan, fit.beta) if inside else
                                              (math.nan, x_lo, x_hi, fit.beta))

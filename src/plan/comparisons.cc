@@ -114,8 +114,20 @@ std::vector<std::string> DesignWarnings(const Condition& c, const PowerRow& row)
     out.push_back(text);
   }
   if (c.truth_determined && c.truth > 0 && std::isfinite(row.bias) && std::abs(row.bias) > kBiasEnough * c.truth) {
-    std::snprintf(text, sizeof text, "%s: the estimates sit %+.0f %% from the true threshold on average",
-                  c.label.c_str(), 100 * row.bias / c.truth);
+    std::snprintf(text, sizeof text,
+                  "%s: the estimates sit %+.0f %% from the true threshold on average (their median %+.0f %%): more "
+                  "trials per track narrow each track's posterior and bring both toward the truth",
+                  c.label.c_str(), 100 * row.bias / c.truth,
+                  std::isfinite(row.median_estimate) ? 100 * (row.median_estimate / c.truth - 1) : kNan);
+    out.push_back(text);
+  }
+  if (!c.truth_determined && (c.truth_why.find("above the tested range") != std::string::npos ||
+                              c.truth_why.find("below the tested range") != std::string::npos)) {
+    const bool above = c.truth_why.find("above") != std::string::npos;
+    std::snprintf(text, sizeof text, "%s: the observer's threshold lies %s the levels the procedure can show: %s",
+                  c.label.c_str(), above ? "above" : "below",
+                  above ? "raise its max (QUEST+: its threshold grid and stimuli)"
+                        : "lower its min (QUEST+: its threshold grid and stimuli)");
     out.push_back(text);
   }
   return out;
@@ -180,6 +192,13 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
             covered += it->second.low <= c->truth && c->truth <= it->second.high;
           }
         row.determined_share = tracks > 0 ? determined / tracks : kNan;
+        std::vector<double> values;
+        for (const double v : Flat(g))
+          if (std::isfinite(v)) values.push_back(v);
+        if (!values.empty()) {
+          std::nth_element(values.begin(), values.begin() + long(values.size() / 2), values.end());
+          row.median_estimate = values[values.size() / 2];
+        }
         row.coverage = determined > 0 && c->truth_determined ? covered / determined : kNan;
       }
       r.rows.push_back(row);
@@ -450,6 +469,7 @@ std::string ThresholdSummary(const PlanResult& r, const PlanOptions& o) {
                       number(row.interval_width).c_str(), number(100 * row.determined_share, "%.0f %%").c_str(),
                       number(100 * row.coverage, "%.0f %%").c_str());
         out += line;
+        if (!c->target.empty()) out += "    threshold at " + c->target + "\n";
         for (const std::string& warning : DesignWarnings(*c, row)) out += "  WARNING: " + warning + "\n";
         if (!c->truth_determined)
           out += "  " + c->label + ": the true threshold is " + c->truth_why + ", so no bias is given\n";

@@ -164,6 +164,14 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
         with_truth.truth = truth.level;
         with_truth.truth_why = truth.why;
         with_truth.range_lo = truth.range_lo, with_truth.range_hi = truth.range_hi;
+        char target[160];
+        if (procedure.kind == protocol::Procedure::Kind::kQuestPlus)
+          std::snprintf(target, sizeof target, "%.1f %% correct without lapses (QUEST+'s Weibull threshold)",
+                        100 * TargetShare(procedure, 0));
+        else
+          std::snprintf(target, sizeof target, "%.1f %% correct, lapses included (the %d-up/%d-down rule's convergence point)",
+                        100 * TargetShare(procedure, 0), procedure.up, procedure.down);
+        with_truth.target = target;
         conditions->emplace(c->key, with_truth);
       }
       Track& track =

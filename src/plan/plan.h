@@ -87,6 +87,7 @@ struct Condition {
   double truth = 0;
   std::string truth_why;  // why there is no truth, in words
   double range_lo = 0, range_hi = 0;  // where the procedure measures a threshold (TrueThreshold's range)
+  std::string target;     // what the threshold means, in words ("70.7 % correct, lapses included")
 };
 
 // What one simulated participant answered: per condition (by Condition::key) the counts.
@@ -132,6 +133,7 @@ struct PowerRow {
   // whose threshold is determined (TrackEstimate's rule, the report's), and of those, the share whose own 95 %
   // interval holds the observer's true threshold (NaN where the truth is not determined).
   double determined_share = kNoValue, coverage = kNoValue;
+  double median_estimate = kNoValue;  // the estimates' median (the mean of skewed estimates runs above it)
 };
 
 struct PlanResult {
