@@ -184,12 +184,11 @@ def staircase_posterior(guess, target, lo, hi, levels, correct):
         out["why"] = f"not determined: below {criteria.range_words(lo, hi)} (the answers put it at the lowest levels)"
     elif high_at and math.log(estimate) > math.log(hi) - tenth:
         out["why"] = f"not determined: above {criteria.range_words(lo, hi)} (the answers put it at the highest levels)"
+    elif low_at or high_at:
+        out["why"] = (f"not determined: its 95 % interval reaches the {'lowest' if low_at else 'highest'} level of "
+                      f"{criteria.range_words(lo, hi)} (the answers do not bound it there)")
     else:
         out["determined"] = True
-        if low_at:
-            out.update(low=lo, at_bound="lower")
-        if high_at:
-            out.update(high=hi, at_bound="upper")
     return out
 
 
@@ -222,7 +221,7 @@ def staircase_threshold(p, levels, correct):
         return out | {"why": "not determined: this up/down rule has no closed-form target"}
     if not (guess + 0.01 < target < 0.94):  # as plan::TrackEstimate
         return out | {"why": (f"not determined: a {int(p['up'])}-up/{int(p['down'])}-down staircase converges on "
-                              f"{100 * target:.1f} % correct, " + ("what guessing gives" if target <= guess + 0.01
+                              f"{100 * target:.1f} % correct, " + ("at or below what guessing gives" if target <= guess + 0.01
                                                                     else "beyond what its fit can place"))}
     fit = staircase_posterior(guess, target, lo, hi, levels, correct)
     if not fit["determined"]:
@@ -520,18 +519,29 @@ def summary_words(summary):
 
 def comparisons_table(tracks):
     """Every pair of cells, paired across the participants with a determined threshold in both: the mean
-    difference (second minus first) with its t 95 % interval and the paired t-test."""
+    difference (second minus first) with its t 95 % interval and the paired t-test (3 or more participants). Not
+    where the cells' thresholds stand for different criteria (70.7 % against 79.4 % correct), nor where a cell's
+    summary gives no number (censored tracks, half or more not determined: summary_table's rules)."""
     by = {}
     for t in tracks:
         if "estimate" in t["result"]:
             by.setdefault(t["cell"], {})[t["participant"]] = t["result"]["estimate"]
     cells = list(dict.fromkeys(t["cell"] for t in tracks))
+    summary = summary_table(tracks).set_index("cell")
+    criterion = {c: summary.loc[c, "criterion"] for c in cells}
     rows = []
     for i, a in enumerate(cells):
         for b in cells[i + 1:]:
             both = sorted(set(by.get(a, {})) & set(by.get(b, {})))
             row = {"first": a, "second": b, "pairs": len(both)}
-            if len(both) >= MIN_FOR_INTERVAL:
+            unsummarised = [c for c in (a, b) if pd.isna(summary.loc[c].get("mean", math.nan))]
+            if criterion[a] != criterion[b]:
+                row["test"] = (f"not compared: the thresholds stand for different criteria ({criterion[a]}, "
+                               f"{criterion[b]})")
+            elif unsummarised:
+                row["test"] = (f"not determined: {unsummarised[0]}'s thresholds give no summary ("
+                               f"{summary.loc[unsummarised[0], 'interval']})")
+            elif len(both) >= MIN_FOR_INTERVAL:
                 diff = np.array([by[b][p] - by[a][p] for p in both])
                 half = sps.t.ppf(0.975, len(diff) - 1) * diff.std(ddof=1) / math.sqrt(len(diff))
                 row.update(mean_difference=float(diff.mean()), difference_low=float(diff.mean() - half),

@@ -153,8 +153,8 @@ class StaircaseEstimate(unittest.TestCase):
              "guess": 0.5}
         levels, correct = np.array([1.0, 0.9, 1.0, 0.9] * 5), np.array([1, 0] * 10) == 1
         r = tracks.staircase_threshold(p, levels, correct)
-        self.assertEqual(r["why"], "not determined: a 1-up/1-down staircase converges on 50.0 % correct, what "
-                                   "guessing gives")
+        self.assertEqual(r["why"], "not determined: a 1-up/1-down staircase converges on 50.0 % correct, at or "
+                                   "below what guessing gives")
         # An odd one out of 3 (guess 1/3, exported in procedures.csv): the same rule's 50 % is a threshold, fitted
         # with that guess rate.
         r = tracks.staircase_threshold(p | {"guess": 1 / 3}, levels, correct)
@@ -162,6 +162,32 @@ class StaircaseEstimate(unittest.TestCase):
         self.assertAlmostEqual(r["estimate"], fit["estimate"], places=12)
         # A 2-up/3-down rule's target by bisection, as plan::TargetShare (no closed form): 60.4 %.
         self.assertAlmostEqual(criteria.staircase_target(2, 3), 0.60445, places=4)
+
+    def test_an_interval_cut_at_the_range_is_not_determined(self):
+        # The adversary's range 0.02 to 0.35 below a true threshold of 0.41: right 2 of 3 times at the top, the
+        # posterior's interval runs into the top of the range - no number (it never holds a threshold beyond it).
+        levels = np.array([0.35, 0.3, 0.35, 0.3, 0.35] * 4)
+        correct = np.array([1, 0, 1, 1, 0] * 4) == 1
+        r = tracks.staircase_posterior(0.5, math.sqrt(0.5), 0.02, 0.35, levels, correct)
+        self.assertFalse(r["determined"])
+        self.assertTrue(r["why"].startswith("not determined: its 95 % interval reaches the highest level of the "
+                                            "tested range 0.02 to 0.35") or "above the tested range" in r["why"],
+                        r["why"])
+
+    def test_cells_of_other_criteria_or_without_a_summary_are_not_compared(self):
+        one = [{"cell": "a", "participant": f"P{i}", "criterion": "70.7 % correct", "result": {"estimate": 1.0 + i}}
+               for i in range(3)]
+        other = [{"cell": "b", "participant": f"P{i}", "criterion": "79.4 % correct", "result": {"estimate": 2.0 + i}}
+                 for i in range(3)]
+        table = tracks.comparisons_table(one + other)
+        self.assertTrue(table.iloc[0]["test"].startswith("not compared: the thresholds stand for different criteria"))
+        self.assertNotIn("p_paired_t", table)
+        censored = [{"cell": "c", "participant": f"P{i}", "criterion": "70.7 % correct",
+                     "result": {"why": "not determined: above the tested range 0.02 to 3 (...)"} if i else
+                     {"estimate": 1.5}} for i in range(3)]
+        table = tracks.comparisons_table(one + censored)
+        self.assertTrue(table.iloc[0]["test"].startswith("not determined: c's thresholds give no summary"),
+                        table.iloc[0]["test"])
 
     def test_a_track_too_short_to_bound_its_threshold_is_not_determined(self):
         # Six answers, one wrong: the posterior reaches both ends of 0.02 to 3 (no number); the stop rule no longer

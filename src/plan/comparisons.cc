@@ -247,6 +247,11 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
       const Condition &A = *cells[a], &B = *cells[b];
       // Thresholds in different units (a difference in arcmin, a relative one) have no difference to test: their
       // paired t-test subtracted a fraction from arcmin ("-1.035, power 1.000 at N = 4").
+      if (A.target != B.target) {
+        r.notes.push_back(B.label + " and " + A.label + " are not compared: their thresholds stand for different "
+                          "criteria (" + B.target + "; " + A.target + ")");
+        continue;
+      }
       if (A.units != B.units) {
         r.notes.push_back(B.label + " and " + A.label + " are not compared: their thresholds are in different units (" +
                           B.units + ", " + A.units + ")");

@@ -163,7 +163,7 @@ procedure::TrackThreshold TrackEstimate(const protocol::Procedure& procedure, co
       std::snprintf(text, sizeof text,
                     "not determined: a %d-up/%d-down staircase converges on %.1f %% correct, %s", procedure.up,
                     procedure.down, 100 * target,
-                    target <= procedure.guess + 0.01 ? "what guessing gives" : "beyond what its fit can place");
+                    target <= procedure.guess + 0.01 ? "at or below what guessing gives" : "beyond what its fit can place");
       out.why = text;
       return out;
     }

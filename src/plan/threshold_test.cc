@@ -64,7 +64,7 @@ TEST(TrackEstimate, AStaircaseConvergingOnGuessingHasNoThreshold) {
   for (size_t i = 0; i < 20; i += 2) correct[i] = true;
   const procedure::TrackThreshold t = TrackEstimate(staircase, levels, correct);
   EXPECT_FALSE(t.determined);
-  EXPECT_EQ(t.why, "not determined: a 1-up/1-down staircase converges on 50.0 % correct, what guessing gives");
+  EXPECT_EQ(t.why, "not determined: a 1-up/1-down staircase converges on 50.0 % correct, at or below what guessing gives");
   staircase.guess = 1.0 / 3;
   EXPECT_EQ(TrackEstimate(staircase, levels, correct).why.find("converges"), std::string::npos);
 }

@@ -103,10 +103,13 @@ TrackThreshold StaircasePosterior(const StaircaseFitSpec& spec, const std::vecto
     out.why = "not determined: below " + RangeWords(spec.lo, spec.hi) + " (the answers put it at the lowest levels)";
   } else if (high_at_bound && std::log(out.estimate) > std::log(hi) - tenth) {
     out.why = "not determined: above " + RangeWords(spec.lo, spec.hi) + " (the answers put it at the highest levels)";
+  } else if (low_at_bound || high_at_bound) {
+    // The answers do not bound it on that side: a number would read as measured, and an interval cut at the range
+    // never holds a threshold beyond it (a true 0.41 above a range to 0.35 gave 'determined' tracks at 0.1-0.26).
+    out.why = std::string("not determined: its 95 % interval reaches the ") + (low_at_bound ? "lowest" : "highest") +
+              " level of " + RangeWords(spec.lo, spec.hi) + " (the answers do not bound it there)";
   } else {
     out.determined = true;
-    if (low_at_bound) out.low = spec.lo, out.at_bound = "lower";
-    if (high_at_bound) out.high = spec.hi, out.at_bound = "upper";
   }
   return out;
 }

@@ -50,8 +50,10 @@ struct TrackThreshold {
 // "determined", the same in plan and report:
 //   not determined   fewer than kMinAnswers answers; an interval that reaches both ends of the range ("spans the whole tested range");
 //                    an interval that reaches one end with the median in the tenth of the (log) range next to it
-//                    ("below/above the tested range": the answers put it there);
-//   determined       otherwise (an end at the range's bound is named in at_bound).
+//                    ("below/above the tested range": the answers put it there); an interval that reaches one end
+//                    otherwise (the answers do not bound it there: an interval cut at the range never holds a
+//                    threshold beyond it);
+//   determined       otherwise: the whole interval inside the range (at_bound stays empty; QUEST+ uses it).
 // Throws std::invalid_argument for a spec outside its bounds (target not above guess, lo >= hi, hi <= 0).
 TrackThreshold StaircasePosterior(const StaircaseFitSpec& spec, const std::vector<double>& levels,
                                   const std::vector<bool>& correct);
