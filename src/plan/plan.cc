@@ -542,7 +542,9 @@ std::string Summary(const PlanResult& r, const PlanOptions& o) {
     std::snprintf(line, sizeof line,
                   "per condition at N = %d: the expected share (first_source: the design's first source among "
                   "decisive answers; correct; yes), the mean width of its 95 %% Wilson interval, the power of the exact "
-                  "binomial test against chance (alpha %g) and the smallest N reaching %g %%\n",
+                  "binomial test of the answers pooled against chance (alpha %g; at chance 0.5 an upper bound of the "
+                  "report's sign-flip test across participants, which needs 6 of them to reach 0.05) and the smallest "
+                  "N reaching %g %%\n",
                   o.participants, o.alpha, 100 * o.target_power);
     out += line;
     std::snprintf(line, sizeof line, "  %-28s %-13s %7s %8s %8s %7s  %s\n", "condition", "measure", "share", "width",
