@@ -27,7 +27,8 @@ TrackThreshold StaircasePosterior(const StaircaseFitSpec& spec, const std::vecto
     throw std::invalid_argument("StaircasePosterior: a spec outside its bounds");
   TrackThreshold out;
   if (levels.size() != correct.size() || levels.size() < size_t(kMinAnswers)) {
-    out.why = "not determined: " + std::to_string(levels.size()) + " answers (needs " + std::to_string(kMinAnswers) + ")";
+    out.why =
+        "not determined: " + std::to_string(levels.size()) + " answers (needs " + std::to_string(kMinAnswers) + ")";
     return out;
   }
   // The answers by level: (k correct of n) at each distinct level shown.
@@ -41,7 +42,8 @@ TrackThreshold StaircasePosterior(const StaircaseFitSpec& spec, const std::vecto
   for (int i = 0; i < kThetaPoints; ++i)
     log_theta[size_t(i)] = std::log(lo) + (std::log(hi) - std::log(lo)) * i / (kThetaPoints - 1);
   for (int j = 0; j < kSlopePoints; ++j)
-    slope[size_t(j)] = std::exp(std::log(kSlopeLow) + (std::log(kSlopeHigh) - std::log(kSlopeLow)) * j / (kSlopePoints - 1));
+    slope[size_t(j)] =
+        std::exp(std::log(kSlopeLow) + (std::log(kSlopeHigh) - std::log(kSlopeLow)) * j / (kSlopePoints - 1));
   // Log-likelihood per grid point (theta, slope, lapse; lapse fastest); a level's terms only for the answers it has
   // (0 x log 0 would be NaN where the function reaches 1). The marginal over slope and lapse below is shifted by the
   // maximum for exp.

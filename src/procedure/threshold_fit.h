@@ -15,7 +15,8 @@
 // equal-tailed 95 % credible interval (each quantile interpolated linearly in log theta between grid points).
 // Why not the mean of the last turning points: with a shallow psychometric function and large steps it ran 48 %
 // high and its t interval over 3 pairs covered the truth in 62 % of tracks; a maximum-likelihood fit with a free
-// slope covered in 70 % (the slope runs steep on 20-50 answers). Integrating over the slope covers (docs/thresholds.md).
+// slope covered in 70 % (the slope runs steep on 20-50 answers). Integrating over the slope covers
+// (docs/thresholds.md).
 #include <string>
 #include <vector>
 
@@ -48,7 +49,8 @@ struct TrackThreshold {
 
 // The threshold of one staircase track (levels shown, answers, a missed deadline counted wrong). The rule for
 // "determined", the same in plan and report:
-//   not determined   fewer than kMinAnswers answers; an interval that reaches both ends of the range ("spans the whole tested range");
+//   not determined   fewer than kMinAnswers answers; an interval that reaches both ends of the range ("spans the
+//                    whole tested range");
 //                    an interval that reaches one end with the median in the tenth of the (log) range next to it
 //                    ("below/above the tested range": the answers put it there); an interval that reaches one end
 //                    otherwise (the answers do not bound it there: an interval cut at the range never holds a
