@@ -3,7 +3,7 @@
 
   /usr/bin/python3 analysis/plan_chart.py --plan DIR/plan.csv --out DIR [--title STUDY] [--target 0.8]
 
-Writes DIR/power.png and DIR/power.svg: one line per condition's exact binomial test (thin), the t-tests across
+Writes DIR/power.png and DIR/power.svg: one line per condition's exact test (thin), the t-tests across
 participants (the GLMM stand-in, per group where the protocol has groups, thick), the comparisons between groups
 (Welch) and between procedure cells (paired t on per-participant thresholds: the model's own difference solid, a
 declared one dashed), the target power as a dashed line, and each test's smallest N reaching it marked. A plan with
@@ -45,14 +45,14 @@ def _numeric(frame, columns):
 def power_panel(ax, plan, target):
     tested = _numeric(plan[plan["test"] != "none"].copy(), ["power", "participants"])
     tested = tested[tested["power"].notna()]
-    binomial = tested[tested["test"] == "binomial"]
-    conditions = list(dict.fromkeys(binomial["condition"]))
+    exact = tested[tested["test"] == "exact"]
+    conditions = list(dict.fromkeys(exact["condition"]))
     cmap = plt.get_cmap("viridis")
     for i, condition in enumerate(conditions):
-        g = binomial[binomial["condition"] == condition].sort_values("participants")
+        g = exact[exact["condition"] == condition].sort_values("participants")
         n = smallest_n(g, target)
         ax.plot(g["participants"], g["power"], lw=1, color=cmap(i / max(1, len(conditions) - 1)),
-                label=f"binomial, {condition}" + (f" (N = {n})" if n else ""))
+                label=f"exact, {condition}" + (f" (N = {n})" if n else ""))
     for (condition, measure), g in tested[tested["test"] == "participants_t"].groupby(["condition", "measure"],
                                                                                       sort=False):
         g = g.sort_values("participants")

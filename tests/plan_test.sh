@@ -98,32 +98,41 @@ power_exact)
   # A design whose answers are binomial with a known p: one condition (edge 5), 10 repetitions, a strict 2AFC
   # between no blur and 30 px (the observer's noise 0.001 px: it always prefers the side nearer the scene's own
   # blur, except in a lapse, a coin flip with probability 0.7): P(first source) = 0.7 / 2 + 0.3 x [first preferred],
-  # 0.65 or 0.35. Power of the exact two-sided binomial test at 0.05 with 10 N answers, by the closed form:
-  # P(X <= c) + P(X >= 10N - c) at the critical value c (the largest with 2 P0(X <= c) < 0.05 under p0 = 0.5),
-  # computed here independently, against 4000 simulated studies (4.5 standard errors).
+  # 0.65 or 0.35. The report's test with participants as the unit: one participant - the exact binomial of their 10
+  # answers, whose power has a closed form (P(X <= c) + P(X >= 10 - c) at the critical value c, computed here); two
+  # to five - no p can fall below 0.05 (the sign-flip test's least p is 2 / 2^N), power 0; six - the sign-flip test
+  # of their shares, its power estimated here by drawing 4000 studies of six Binomial(10, p) participants and testing
+  # each with the report's own analysis/study_tests.py sign_flip_p (not the plan's C++), within 4.5 standard errors.
   variant "$P/test1-static-grids.json" "$W/binomial.json" '
 p["factors"] = {"edge": [5]}; p["repetitions"] = 10; p["practice"] = {"count": 0}
 p["sides"] = {"left": "none", "right": 30}; p["responses"]["cant_tell"] = None'
   $BC plan "$W/binomial.json" --participants 6 --studies 4000 --seed 3 --observer sim:jnd=0.001,bias=0,lapse=0.7 \
     --no-chart --out "$W/p" > "$W/out" 2> "$W/err" || fail "plan: $(tail -1 "$W/err")"
-  $PY - "$W/p/plan.csv" <<'PYEOF' || fail "power differs from the closed form"
+  $PY - "$W/p/plan.csv" "$(dirname "$0")/../analysis" <<'PYEOF' || fail "power differs from the report's test"
 import csv, math, sys
-rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["test"] == "binomial"]
+import numpy as np
+sys.path.insert(0, sys.argv[2])
+import study_tests
+rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["test"] == "exact"]
 assert len(rows) == 6, rows
 share = float(rows[0]["expected_share"])
 p = 0.65 if share > 0.5 else 0.35
 assert abs(share - p) < 0.005, f"expected share {share}, closed form {p}"
 pmf = lambda k, n, q: math.comb(n, k) * q ** k * (1 - q) ** (n - k)
+c = max([c for c in range(5) if 2 * sum(pmf(j, 10, 0.5) for j in range(c + 1)) < 0.05], default=-1)
+one = sum(pmf(j, 10, p) for j in range(c + 1)) + sum(pmf(j, 10, p) for j in range(10 - c, 11)) if c >= 0 else 0.0
+rng = np.random.default_rng(38)
+draws = rng.binomial(10, p, size=(4000, 6))
+six = float(np.mean([study_tests.sign_flip_p(k, [10] * 6) < 0.05 for k in draws]))
+expected = {1: one, 2: 0.0, 3: 0.0, 4: 0.0, 5: 0.0, 6: six}
 for r in rows:
-    n = 10 * int(r["participants"])
-    c = max([c for c in range(n // 2) if 2 * sum(pmf(j, n, 0.5) for j in range(c + 1)) < 0.05], default=-1)
-    exact = sum(pmf(j, n, p) for j in range(c + 1)) + sum(pmf(j, n, p) for j in range(n - c, n + 1)) if c >= 0 else 0.0
-    se = math.sqrt(max(exact * (1 - exact), 1e-4) / 4000)
-    got = float(r["power"])
-    print(f"  N = {r['participants']}: {n} answers, critical value {c}, power {got:.4f}, closed form {exact:.4f}")
-    assert abs(got - exact) < 4.5 * se, f"N = {r['participants']}: {got} vs {exact} (se {se:.4f})"
+    n = int(r["participants"])
+    got, want = float(r["power"]), expected[n]
+    se = math.sqrt(max(want * (1 - want), 1e-4) / 4000) * (math.sqrt(2) if n == 6 else 1)
+    print(f"  N = {n}: power {got:.4f}, expected {want:.4f}")
+    assert abs(got - want) < 4.5 * se, f"N = {n}: {got} vs {want} (se {se:.4f})"
 PYEOF
-  echo "ok: the plan's power matches the exact binomial power at every N" ;;
+  echo "ok: the plan's power is the report's exact test's at every N (binomial, none, sign-flip)" ;;
 same_seed)
   # The same seed gives the same plan, byte for byte, whatever the thread count; another seed another plan.
   for t in 1 2 3; do
@@ -163,7 +172,7 @@ import prediction
 t = pd.read_csv(sys.argv[1])
 t = t[(t.practice == 0) & (t.swapped == 0)]
 plan = pd.read_csv(sys.argv[2])
-plan = plan[(plan.test == "binomial") & (plan.participants == 20)]
+plan = plan[(plan.test == "exact") & (plan.participants == 20)]
 worst = 0
 for _, r in t.iterrows():
     shares = prediction.pair_choice(np.array([r.r_left_arcmin]), np.array([r.r_right_arcmin]), np.array([r.r_scene_arcmin]))
@@ -189,7 +198,7 @@ threshold_truth)
 import csv, math, sys
 from scipy.stats import norm, t as student
 rows = list(csv.DictReader(open(sys.argv[1])))
-assert not [r for r in rows if r["test"] in ("binomial", "participants_t")], "a procedure cell's share was tested"
+assert not [r for r in rows if r["test"] in ("exact", "participants_t")], "a procedure cell's share was tested"
 th = [r for r in rows if r["test"] == "threshold"]
 assert len(th) == 8 and th[0]["condition"] == "edge=9", [r["condition"] for r in th]
 trials = [r for r in csv.DictReader(open(sys.argv[2])) if r["practice"] == "0"]
@@ -423,7 +432,7 @@ groups_shared_block)
   $PY - "$W/shared-1/plan.csv" "$W/quest-shared-1/plan.csv" <<'PYEOF' || fail "shared block rows"
 import csv, sys
 pairs = list(csv.DictReader(open(sys.argv[1])))
-binomial = sorted({r["condition"] for r in pairs if r["test"] == "binomial"})
+binomial = sorted({r["condition"] for r in pairs if r["test"] == "exact"})
 assert binomial and all(c.startswith(("group=estimated: edge=", "group=no_blur: edge=")) for c in binomial), binomial
 assert len(binomial) == 12, binomial
 quest = list(csv.DictReader(open(sys.argv[2])))

@@ -407,7 +407,7 @@ PlanResult RunPlan(const PlanOptions& options) {
     std::vector<int> k(static_cast<size_t>(S), 0), n(static_cast<size_t>(S), 0);
     for (int m = 1; m <= N; ++m) {
       PowerRow row;
-      row.test = c.chance >= 0 ? "binomial" : "none";
+      row.test = c.chance >= 0 ? "exact" : "none";
       row.condition = c.label;
       row.measure = c.measure;
       row.chance = c.chance >= 0 ? c.chance : nan;
@@ -429,7 +429,23 @@ PlanResult RunPlan(const PlanOptions& options) {
         const auto [lo, hi] = Wilson95(k[size_t(s)], n[size_t(s)]);
         width += hi - lo;
         trials += n[size_t(s)];
-        if (c.chance >= 0 && n[size_t(s)] > 0 && p_of(k[size_t(s)], n[size_t(s)], c.chance) < options.alpha) ++rejected;
+        if (c.chance < 0 || n[size_t(s)] == 0) continue;
+        // The report's test (analysis/study_tests.py against_chance_counts): one participant - the exact binomial of
+        // their answers; two - none; three or more with a share - at chance 0.5 the exact sign-flip test of their
+        // shares around it, else the exact binomial of the answers pooled (every participant guessing).
+        if (m == 1) {
+          rejected += p_of(k[size_t(s)], n[size_t(s)], c.chance) < options.alpha;
+          continue;
+        }
+        std::vector<double> deviations;
+        for (int i = 0; i < m; ++i)
+          if (const auto it = r.studies[size_t(s)][size_t(i)].tallies.find(c.key);
+              it != r.studies[size_t(s)][size_t(i)].tallies.end() && it->second.n > 0)
+            deviations.push_back(double(it->second.k) / it->second.n - c.chance);
+        if (deviations.size() < 3) continue;
+        const double p = std::abs(c.chance - 0.5) < 1e-12 ? SignFlipP(deviations)
+                                                           : p_of(k[size_t(s)], n[size_t(s)], c.chance);
+        rejected += p < options.alpha;
       }
       row.wilson_width = width / S;
       row.mean_trials = trials / S;
@@ -541,10 +557,10 @@ std::string Summary(const PlanResult& r, const PlanOptions& o) {
   if (shares) {
     std::snprintf(line, sizeof line,
                   "per condition at N = %d: the expected share (first_source: the design's first source among "
-                  "decisive answers; correct; yes), the mean width of its 95 %% Wilson interval, the power of the exact "
-                  "binomial test of the answers pooled against chance (alpha %g; at chance 0.5 an upper bound of the "
-                  "report's sign-flip test across participants, which needs 6 of them to reach 0.05) and the smallest "
-                  "N reaching %g %%\n",
+                  "decisive answers; correct; yes), the mean width of its 95 %% Wilson interval, the power of the report's "
+                  "exact test against chance (alpha %g; participants as the unit: at chance 0.5 the sign-flip test of "
+                  "their shares, which needs 6 of them to reach 0.05; else the binomial of the answers; one "
+                  "participant: the binomial of their answers; two: none) and the smallest N reaching %g %%\n",
                   o.participants, o.alpha, 100 * o.target_power);
     out += line;
     std::snprintf(line, sizeof line, "  %-28s %-13s %7s %8s %8s %7s  %s\n", "condition", "measure", "share", "width",

@@ -4,9 +4,11 @@
 // procedures, stop rules, practice criteria and answers as `blurcue run --observer sim`), headless and without GL,
 // in parallel. From them, per condition, the expected share and how wide its 95 % interval would be, and the power
 // of the protocol's tests against the number of participants:
-//   binomial       per condition, the exact two-sided binomial test against chance the report runs (a pair: the
-//                  design's first source among decisive answers against 0.5; a procedure or odd one out: correct
-//                  against its guess rate), at alpha;
+//   exact          per condition, the report's exact test against chance with participants as the unit
+//                  (analysis/study_tests.py against_chance_counts; a pair: the design's first source among decisive
+//                  answers against 0.5 - the sign-flip test of the participants' shares; an odd one out: correct
+//                  against its guess rate - the binomial of the answers; one participant: the binomial of their
+//                  answers; two: none), at alpha;
 //   participants_t across participants, a one-sample t-test of each participant's share (over all their scored
 //                  trials) against chance: a stand-in for the report's GLMM (random intercept per participant), whose
 //                  fit per simulated study would take minutes; it tests the same population-level effect (the
@@ -113,7 +115,7 @@ inline constexpr double kNoValue = __builtin_nan("");
 
 // One row of the plan: a test of a condition (or of all the participants' trials) at a number of participants.
 struct PowerRow {
-  std::string test;        // "binomial" | "participants_t" | "slope_t" | "none" (a condition without a chance level) |
+  std::string test;        // "exact" | "participants_t" | "slope_t" | "none" (a condition without a chance level) |
                            // "threshold" | "paired_t" | "second_cell_t" | "groups_t" (comparisons.h)
   std::string condition;   // its label; "all" for participants_t
   std::string measure;
@@ -140,7 +142,7 @@ struct PlanResult {
   std::vector<Condition> conditions;
   std::vector<std::vector<SimParticipant>> studies;  // [study][participant]
   std::vector<PowerRow> rows;
-  std::map<std::string, int> smallest_n;   // "binomial edge=3" -> smallest N with power >= target (absent: none)
+  std::map<std::string, int> smallest_n;   // "exact edge=3" -> smallest N with power >= target (absent: none)
   std::vector<std::string> notes;          // what is not planned and why
   std::vector<std::string> groups;         // the protocol's between-subject groups (empty: none)
   int threads_used = 0;

@@ -151,4 +151,33 @@ double OlsSlope(const std::vector<std::pair<double, double>>& points) {
   return points.size() >= 2 && sxx > 1e-12 ? sxy / sxx : std::numeric_limits<double>::quiet_NaN();
 }
 
+double SignFlipP(const std::vector<double>& deviations) {
+  const size_t g = deviations.size();
+  if (g == 0 || g > 40) return std::numeric_limits<double>::quiet_NaN();
+  double observed = 0;
+  for (const double d : deviations) observed += d;
+  const double target = std::abs(observed) - 1e-9;
+  if (target <= 0) return 1;  // a sum of 0: every pattern is as far
+  // The sums of every sign pattern of one half.
+  auto sums = [&](size_t from, size_t to) {
+    std::vector<double> out(size_t(1) << (to - from));
+    for (size_t mask = 0; mask < out.size(); ++mask) {
+      double s = 0;
+      for (size_t i = from; i < to; ++i) s += (mask >> (i - from) & 1) ? deviations[i] : -deviations[i];
+      out[mask] = s;
+    }
+    return out;
+  };
+  const std::vector<double> a = sums(0, g / 2);
+  std::vector<double> b = sums(g / 2, g);
+  std::sort(b.begin(), b.end());
+  double hits = 0;
+  for (const double x : a) {
+    // |x + y| >= target: y >= target - x, or y <= -target - x.
+    hits += double(b.end() - std::lower_bound(b.begin(), b.end(), target - x));
+    hits += double(std::upper_bound(b.begin(), b.end(), -target - x) - b.begin());
+  }
+  return std::min(1.0, hits / std::ldexp(1.0, int(g)));
+}
+
 }  // namespace blurcue::plan

@@ -89,3 +89,21 @@ TEST(OlsSlope, ExactLineAndDegenerateX) {
 
 }  // namespace
 }  // namespace blurcue::plan
+
+namespace blurcue::plan {
+namespace {
+
+// Hand-worked sign-flip p (as analysis/study_tests.py sign_flip_p): 7 participants of one answer each, 6 of them one
+// way - |sum| 2.5 is reached by 6 or 7 alike of either sign: 2 (7 + 1) / 128 = 0.125 (a t test said 0.047); all 7:
+// 2 / 128; shares 1, 1, 0.5 (deviations .5 .5 0): |sum| >= 1 for (+ +) and (- -), either sign of the 0: 4 / 8.
+TEST(SignFlipP, HandWorkedCases) {
+  EXPECT_NEAR(SignFlipP({0.5, 0.5, 0.5, 0.5, 0.5, 0.5, -0.5}), 16.0 / 128, 1e-15);
+  EXPECT_NEAR(SignFlipP(std::vector<double>(7, 0.5)), 2.0 / 128, 1e-15);
+  EXPECT_NEAR(SignFlipP({0.5, 0.5, 0}), 0.5, 1e-15);
+  EXPECT_EQ(SignFlipP({0.2, -0.2}), 1);  // a sum of 0
+  // 20 participants, every one of 3 answers right (+1/2 each): only the two unanimous patterns, 2 / 2^20.
+  EXPECT_NEAR(SignFlipP(std::vector<double>(20, 0.5)), 2.0 / (1 << 20), 1e-18);
+}
+
+}  // namespace
+}  // namespace blurcue::plan
