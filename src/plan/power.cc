@@ -153,11 +153,20 @@ double OlsSlope(const std::vector<std::pair<double, double>>& points) {
 
 double SignFlipP(const std::vector<double>& deviations) {
   const size_t g = deviations.size();
-  if (g == 0 || g > 40) return std::numeric_limits<double>::quiet_NaN();
-  double observed = 0;
-  for (const double d : deviations) observed += d;
+  if (g == 0) return std::numeric_limits<double>::quiet_NaN();
+  double observed = 0, square = 0;
+  for (const double d : deviations) observed += d, square += d * d;
   const double target = std::abs(observed) - 1e-9;
   if (target <= 0) return 1;  // a sum of 0: every pattern is as far
+  // Beyond 24 participants the sum of independent +-d has its normal limit (mean 0, variance the sum of d^2), its
+  // lattice corrected by the smallest step (equal deviations: the exact binomial's continuity correction); 2^12 sums
+  // a half below that.
+  if (g > 24) {
+    double step = INFINITY;
+    for (const double d : deviations)
+      if (std::abs(d) > 1e-12) step = std::min(step, std::abs(d));
+    return std::min(1.0, std::erfc(std::max(0.0, std::abs(observed) - step) / std::sqrt(2 * square)));
+  }
   // The sums of every sign pattern of one half.
   auto sums = [&](size_t from, size_t to) {
     std::vector<double> out(size_t(1) << (to - from));

@@ -28,7 +28,7 @@ double IncompleteBeta(double a, double b, double x);
 // The exact two-sided sign-flip permutation p of deviations around 0 (analysis/study_tests.py sign_flip_p: each
 // participant's share - 0.5): the share of the 2^G sign patterns whose sum is at least as far from 0 as the
 // observed one (within 1e-9: ties count as reached). Every pattern counted, by meet in the middle (two halves'
-// sums, one sorted): 2^(G/2) log work, G up to 40. NaN for no deviations.
+// sums, one sorted): 2^(G/2) log work, up to G = 24; beyond, the sum's normal limit. NaN for no deviations.
 double SignFlipP(const std::vector<double>& deviations);
 
 // Two-sided p of a one-sample t-test of `values` against `mu`: 1 for fewer than two values; 0 or 1 when they do not

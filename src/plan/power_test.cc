@@ -103,6 +103,11 @@ TEST(SignFlipP, HandWorkedCases) {
   EXPECT_EQ(SignFlipP({0.2, -0.2}), 1);  // a sum of 0
   // 20 participants, every one of 3 answers right (+1/2 each): only the two unanimous patterns, 2 / 2^20.
   EXPECT_NEAR(SignFlipP(std::vector<double>(20, 0.5)), 2.0 / (1 << 20), 1e-18);
+  // 100 participants, 60 of them +0.1 and 40 -0.1: exactly the binomial's 2 P(X >= 60) of 100 at 1/2 = 0.05689;
+  // the normal limit with its lattice step, 2 (1 - Phi(1.9)) = 0.05743.
+  std::vector<double> many(60, 0.1);
+  many.resize(100, -0.1);
+  EXPECT_NEAR(SignFlipP(many), 0.05689, 0.001);
 }
 
 }  // namespace
