@@ -405,6 +405,13 @@ PlanResult RunPlan(const PlanOptions& options) {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     const double shown = all.shown > 0 ? all.shown : nan;
     std::vector<int> k(static_cast<size_t>(S), 0), n(static_cast<size_t>(S), 0);
+    // Per study, the participants' deviations from chance so far (participants with a counting answer), and their
+    // sum, sum of squares and smallest size for SignFlipNormalP (O(1) per N past SignFlipP's exact range).
+    struct Deviations {
+      std::vector<double> d;
+      double sum = 0, square = 0, step = INFINITY;
+    };
+    std::vector<Deviations> dev(static_cast<size_t>(S));
     for (int m = 1; m <= N; ++m) {
       PowerRow row;
       row.test = c.chance >= 0 ? "exact" : "none";
@@ -424,8 +431,16 @@ PlanResult RunPlan(const PlanOptions& options) {
       int rejected = 0;
       for (int s = 0; s < S; ++s) {
         if (const auto it = r.studies[size_t(s)][size_t(m - 1)].tallies.find(c.key);
-            it != r.studies[size_t(s)][size_t(m - 1)].tallies.end())
+            it != r.studies[size_t(s)][size_t(m - 1)].tallies.end()) {
           k[size_t(s)] += it->second.k, n[size_t(s)] += it->second.n;
+          if (it->second.n > 0) {
+            Deviations& e = dev[size_t(s)];
+            const double d = double(it->second.k) / it->second.n - c.chance;
+            if (e.d.size() <= kSignFlipExactUpTo) e.d.push_back(d);
+            e.sum += d, e.square += d * d;
+            if (std::abs(d) > 1e-12) e.step = std::min(e.step, std::abs(d));
+          }
+        }
         const auto [lo, hi] = Wilson95(k[size_t(s)], n[size_t(s)]);
         width += hi - lo;
         trials += n[size_t(s)];
@@ -437,14 +452,11 @@ PlanResult RunPlan(const PlanOptions& options) {
           rejected += p_of(k[size_t(s)], n[size_t(s)], c.chance) < options.alpha;
           continue;
         }
-        std::vector<double> deviations;
-        for (int i = 0; i < m; ++i)
-          if (const auto it = r.studies[size_t(s)][size_t(i)].tallies.find(c.key);
-              it != r.studies[size_t(s)][size_t(i)].tallies.end() && it->second.n > 0)
-            deviations.push_back(double(it->second.k) / it->second.n - c.chance);
-        if (deviations.size() < 3) continue;
-        const double p = std::abs(c.chance - 0.5) < 1e-12 ? SignFlipP(deviations)
-                                                           : p_of(k[size_t(s)], n[size_t(s)], c.chance);
+        const Deviations& e = dev[size_t(s)];
+        if (e.d.size() < 3) continue;
+        const double p = std::abs(c.chance - 0.5) >= 1e-12      ? p_of(k[size_t(s)], n[size_t(s)], c.chance)
+                         : e.d.size() <= kSignFlipExactUpTo ? SignFlipP(e.d)
+                                                            : SignFlipNormalP(e.sum, e.square, e.step);
         rejected += p < options.alpha;
       }
       row.wilson_width = width / S;

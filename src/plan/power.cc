@@ -151,6 +151,11 @@ double OlsSlope(const std::vector<std::pair<double, double>>& points) {
   return points.size() >= 2 && sxx > 1e-12 ? sxy / sxx : std::numeric_limits<double>::quiet_NaN();
 }
 
+double SignFlipNormalP(double sum, double square, double step) {
+  if (!(square > 0)) return 1;
+  return std::min(1.0, std::erfc(std::max(0.0, std::abs(sum) - step) / std::sqrt(2 * square)));
+}
+
 double SignFlipP(const std::vector<double>& deviations) {
   const size_t g = deviations.size();
   if (g == 0) return std::numeric_limits<double>::quiet_NaN();
@@ -161,11 +166,11 @@ double SignFlipP(const std::vector<double>& deviations) {
   // Beyond 24 participants the sum of independent +-d has its normal limit (mean 0, variance the sum of d^2), its
   // lattice corrected by the smallest step (equal deviations: the exact binomial's continuity correction); 2^12 sums
   // a half below that.
-  if (g > 24) {
+  if (g > kSignFlipExactUpTo) {
     double step = INFINITY;
     for (const double d : deviations)
       if (std::abs(d) > 1e-12) step = std::min(step, std::abs(d));
-    return std::min(1.0, std::erfc(std::max(0.0, std::abs(observed) - step) / std::sqrt(2 * square)));
+    return SignFlipNormalP(observed, square, step);
   }
   // The sums of every sign pattern of one half.
   auto sums = [&](size_t from, size_t to) {

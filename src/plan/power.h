@@ -2,6 +2,7 @@
 // The statistics a plan needs to say how often a study's tests would succeed: the exact binomial test the report
 // runs per condition (scipy's two-sided "minlike" rule, as analysis/stats.py binom_p), the Wilson interval it draws,
 // and a one-sample t-test across participants. Closed forms only; no randomness here.
+#include <cstddef>
 #include <utility>
 #include <vector>
 
@@ -30,6 +31,9 @@ double IncompleteBeta(double a, double b, double x);
 // observed one (within 1e-9: ties count as reached). Every pattern counted, by meet in the middle (two halves'
 // sums, one sorted): 2^(G/2) log work, up to G = 24; beyond, the sum's normal limit. NaN for no deviations.
 double SignFlipP(const std::vector<double>& deviations);
+inline constexpr size_t kSignFlipExactUpTo = 24;
+// SignFlipP's normal limit from the deviations' sum, sum of squares and smallest non-zero size (its lattice step).
+double SignFlipNormalP(double sum, double square, double step);
 
 // Two-sided p of a one-sample t-test of `values` against `mu`: 1 for fewer than two values; 0 or 1 when they do not
 // vary (0 when their mean differs from mu).
