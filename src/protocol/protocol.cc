@@ -428,6 +428,34 @@ void Parser::CheckDesign(const Protocol& p) {
                     "(\"practice\": true, \"groups\": [...]) or practise on a block every group runs",
                 Json(b.name));
       }
+  // A practice block of its own for some groups must show their condition: its sides those of a block they run, not
+  // only of a block other groups run (the adversary's practice block for no_blur showing measured vs estimated).
+  if (p.groups)
+    for (const auto& b : p.blocks) {
+      if (!b.practice || b.groups.empty() || !b.sides) continue;
+      auto same = [&](const Block& o) {
+        return o.sides && o.sides->object == b.sides->object && ToJson(o.sides->left) == ToJson(b.sides->left) &&
+               ToJson(o.sides->right) == ToJson(b.sides->right);
+      };
+      auto runs = [](const Block& o, const std::string& g) {
+        return o.groups.empty() || std::count(o.groups.begin(), o.groups.end(), g) > 0;
+      };
+      for (const auto& g : b.groups) {
+        bool own = false;
+        const Block* other = nullptr;
+        for (const auto& o : p.blocks) {
+          if (o.practice || !o.sides) continue;
+          if (runs(o, g)) own = own || same(o);
+          else if (same(o)) other = &o;
+        }
+        if (!own && other)
+          Problem(b.sides_pointer.empty() ? b.pointer + "/sides" : b.sides_pointer,
+                  "practice block " + b.name + " for group " + g + " shows the sides of block " + other->name +
+                      ", which group " + g + " never runs: it would practise another group's condition; give it the "
+                      "sides of a block group " + g + " runs",
+                  ToJson(b.sides->left));
+      }
+    }
   for (const auto& b : p.blocks)
     if (b.name == p.practice.block && p.practice.count > DesignTrials(b) && DesignTrials(b) <= kMaxTrials)
       Problem("/practice/count", "asks for " + std::to_string(p.practice.count) + " practice trials but block " +

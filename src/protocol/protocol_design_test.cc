@@ -358,6 +358,24 @@ TEST(ProtocolValidate, APracticeFromAnotherGroupsBlockIsRefused) {
   }
 }
 
+// A practice block of a group's own must show that group's condition: its sides those of a block the group runs,
+// not only of another group's (the adversary's practice block for one group showing the other's sides: accepted).
+TEST(ProtocolValidate, AGroupsPracticeBlockShowsItsOwnCondition) {
+  Json j = Valid();
+  j["groups"] = {{"names", {"a", "b"}}, {"assign", "by_number"}};
+  j["blocks"] = Json::parse(R"([
+      {"name": "main-a", "groups": ["a"], "factors": {"speed_cm_s": [3]}, "sides": {"left": "measured", "right": "estimated"}},
+      {"name": "main-b", "groups": ["b"], "factors": {"speed_cm_s": [3]}, "sides": {"left": "measured", "right": "none"}},
+      {"name": "practice-b", "practice": true, "groups": ["b"], "factors": {"speed_cm_s": [3]},
+       "sides": {"left": "measured", "right": "estimated"}}])");
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/2/sides: practice block practice-b for group b shows the sides of "
+                                       "block main-a, which group b never runs: it would practise another group's "
+                                       "condition"))
+      << OnlyProblem(j);
+  j["blocks"][2]["sides"]["right"] = "none";  // group b's own condition
+  EXPECT_TRUE(Problems(j).empty()) << Problems(j).front();
+}
+
 // Two intervals: timed by interval_ms and isi_ms (which a side-by-side protocol refuses), still pairs only.
 TEST(ProtocolValidate, TwoIntervalsAreTimedAndStill) {
   Json j = Valid();
