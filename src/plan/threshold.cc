@@ -12,23 +12,10 @@
 
 namespace blurcue::plan {
 
-double DownRunFirst(double p, int up, int down) {
-  const double q = 1 - p;
-  const double a = std::pow(p, down - 1), b = std::pow(q, up - 1);
-  const double denominator = a + b - a * b;
-  return denominator > 0 ? a * (1 - std::pow(q, up)) / denominator : 0.5;
-}
-
 double TargetShare(const protocol::Procedure& procedure, double miss) {
   if (procedure.kind == protocol::Procedure::Kind::kQuestPlus)
     return procedure.guess + (1 - procedure.guess - miss) * (1 - std::exp(-1.0));
-  // DownRunFirst rises from 0 at p = 0 to 1 at p = 1: bisection for its 1/2.
-  double lo = 0, hi = 1;
-  for (int i = 0; i < 100; ++i) {
-    const double mid = (lo + hi) / 2;
-    (DownRunFirst(mid, procedure.up, procedure.down) < 0.5 ? lo : hi) = mid;
-  }
-  return (lo + hi) / 2;
+  return protocol::StaircaseTarget(procedure.up, procedure.down);
 }
 
 namespace {

@@ -15,9 +15,8 @@
 
 namespace blurcue::plan {
 
-// P(`down` correct answers in a row come before `up` wrong ones in a row) when each answer is correct with
-// probability p, independently: p^(d-1) (1 - q^u) / (p^(d-1) + q^(u-1) - p^(d-1) q^(u-1)), q = 1 - p.
-double DownRunFirst(double p, int up, int down);
+// protocol::DownRunFirst: where an up/down rule converges (the protocol checks a staircase's target against it).
+using protocol::DownRunFirst;
 
 // The share of all answers (lapses included) at which a procedure's estimate sits for an observer who misses
 // `miss` of the easiest trials: QUEST+ - its Weibull's threshold point guess + (1 - guess - miss) (1 - 1/e);

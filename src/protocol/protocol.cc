@@ -137,6 +137,21 @@ Protocol Parser::Parse(const Json& json) {
                                                       " intervals is guessed right 1/" + std::to_string(p.alternatives) +
                                                       " of the time; leave guess out", Json(b.procedure->guess));
       }
+  // An up/down rule that converges at or below what guessing gives measures no threshold (3-up/1-down: 20.6 % of a
+  // 2AFC's answers correct, which no participant goes below): refused here rather than 'not determined' after a study.
+  for (const auto& b : p.blocks)
+    if (b.procedure && b.procedure->kind == Procedure::Kind::kStaircase) {
+      const double target = StaircaseTarget(b.procedure->up, b.procedure->down);
+      if (!(target > b.procedure->guess + 0.01)) {
+        char text[300];
+        std::snprintf(text, sizeof text,
+                      "a %d-up/%d-down staircase converges on %.1f %% correct, at or below what guessing gives here "
+                      "(%.1f %%): it measures no threshold; step down after more correct answers in a row (down) "
+                      "than it steps up after wrong ones",
+                      b.procedure->up, b.procedure->down, 100 * target, 100 * b.procedure->guess);
+        Problem(b.pointer + "/procedure/down", text, Json(b.procedure->down));
+      }
+    }
   if (const Json* v = Field(json, "participant_info", "", false)) ParseInfo(*v, "/participant_info", &p);
   if (const Json* v = Field(json, "groups", "", false)) ParseGroups(*v, json, "/groups", &p);
   if (const Json* v = Field(json, "breaks", "", false)) {
@@ -595,6 +610,23 @@ std::string RecordedText(const std::string& text, const Protocol& protocol) {
   Json& tables = json["recorded_conditions"] = Json::object();
   for (const auto& [path, table] : protocol.conditions_tables) tables[path] = table;
   return json.dump(2, ' ', false, Json::error_handler_t::replace);
+}
+
+double DownRunFirst(double p, int up, int down) {
+  const double q = 1 - p;
+  const double a = std::pow(p, down - 1), b = std::pow(q, up - 1);
+  const double denominator = a + b - a * b;
+  return denominator > 0 ? a * (1 - std::pow(q, up)) / denominator : 0.5;
+}
+
+double StaircaseTarget(int up, int down) {
+  // DownRunFirst rises from 0 at p = 0 to 1 at p = 1: bisection for its 1/2.
+  double lo = 0, hi = 1;
+  for (int i = 0; i < 100; ++i) {
+    const double mid = (lo + hi) / 2;
+    (DownRunFirst(mid, up, down) < 0.5 ? lo : hi) = mid;
+  }
+  return (lo + hi) / 2;
 }
 
 }  // namespace blurcue::protocol

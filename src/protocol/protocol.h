@@ -270,6 +270,13 @@ int IntervalCount(const Protocol& protocol);
 
 // Trials of one block's design (crossing x repetitions x swapped copies), or kMaxTrials + 1 when it has more.
 int64_t DesignTrials(const Block& block);
+// P(`down` correct answers in a row come before `up` wrong ones in a row) when each answer is correct with
+// probability p, independently: p^(d-1) (1 - q^u) / (p^(d-1) + q^(u-1) - p^(d-1) q^(u-1)), q = 1 - p.
+double DownRunFirst(double p, int up, int down);
+// The share of answers correct an up/down staircase converges to (Levitt 1971): where DownRunFirst is 1/2, by
+// bisection (1-up/n-down: 0.5^(1/n)). analysis/criteria.py staircase_target is its twin.
+double StaircaseTarget(int up, int down);
+
 // Trials of a session (practice included), or kMaxTrials + 1 when it would have more.
 int64_t SessionTrials(const Protocol& protocol);
 

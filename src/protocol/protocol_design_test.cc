@@ -358,6 +358,25 @@ TEST(ProtocolValidate, APracticeFromAnotherGroupsBlockIsRefused) {
   }
 }
 
+// An up/down rule whose convergence point is at or below the guess rate measures no threshold: refused, naming the
+// rule's share (3-up/1-down: 1 - 0.5^(1/3) = 20.6 %; 1-up/1-down: 50 %, a 2AFC's guessing). 1-up/2-down passes.
+TEST(ProtocolValidate, AStaircaseConvergingOnGuessingIsRefused) {
+  Json j = Valid();
+  j["blocks"] = Json::parse(R"([{"name": "s", "factors": {"edge": [3]},
+      "procedure": {"type": "staircase", "variable": "relative_difference", "reference": "measured", "trials": 20,
+                    "start": 1, "min": 0.05, "max": 2, "up": 3, "down": 1, "steps": [0.2]}}])");
+  j["counterbalance"] = "none";
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/0/procedure/down: a 3-up/1-down staircase converges on 20.6 % "
+                                       "correct, at or below what guessing gives here (50.0 %)"))
+      << OnlyProblem(j);
+  j["blocks"][0]["procedure"]["up"] = 1;
+  EXPECT_TRUE(Contains(OnlyProblem(j), "a 1-up/1-down staircase converges on 50.0 % correct")) << OnlyProblem(j);
+  j["blocks"][0]["procedure"]["down"] = 2;
+  EXPECT_TRUE(Problems(j).empty()) << Problems(j).front();
+  EXPECT_NEAR(StaircaseTarget(1, 2), std::sqrt(0.5), 1e-12);
+  EXPECT_NEAR(StaircaseTarget(3, 1), 1 - std::cbrt(0.5), 1e-12);
+}
+
 // A practice block of a group's own must show that group's condition: its sides those of a block the group runs,
 // not only of another group's (the adversary's practice block for one group showing the other's sides: accepted).
 TEST(ProtocolValidate, AGroupsPracticeBlockShowsItsOwnCondition) {
