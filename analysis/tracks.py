@@ -226,8 +226,7 @@ def staircase_threshold(p, levels, correct):
     fit = staircase_posterior(guess, target, lo, hi, levels, correct)
     if not fit["determined"]:
         return out | {"why": fit["why"]}
-    out.update(estimate=fit["estimate"], low=fit["low"], high=fit["high"], interval_at_bound=fit["at_bound"],
-               used=len(levels))
+    out.update(estimate=fit["estimate"], low=fit["low"], high=fit["high"], interval_at_bound=fit["at_bound"])
     return out
 
 

@@ -104,8 +104,9 @@ std::vector<std::string> DesignWarnings(const Condition& c, const PowerRow& row)
   if (std::isfinite(row.determined_share) && row.determined_share < kDeterminedEnough) {
     std::snprintf(text, sizeof text,
                   "%s: only %.0f %% of tracks determine their threshold (the report says 'not determined' for the "
-                  "rest): more trials per track, or levels nearer the threshold",
-                  c.label.c_str(), 100 * row.determined_share);
+                  "rest)%s",
+                  c.label.c_str(), 100 * row.determined_share,
+                  c.truth_beyond != 0 ? "" : ": more trials per track, or levels nearer the threshold");
     out.push_back(text);
   }
   if (std::isfinite(row.coverage) && row.coverage < kCoveredEnough) {
@@ -121,9 +122,8 @@ std::vector<std::string> DesignWarnings(const Condition& c, const PowerRow& row)
                   std::isfinite(row.median_estimate) ? 100 * (row.median_estimate / c.truth - 1) : kNan);
     out.push_back(text);
   }
-  if (!c.truth_determined && (c.truth_why.find("above the tested range") != std::string::npos ||
-                              c.truth_why.find("below the tested range") != std::string::npos)) {
-    const bool above = c.truth_why.find("above") != std::string::npos;
+  if (!c.truth_determined && c.truth_beyond != 0) {
+    const bool above = c.truth_beyond > 0;
     std::snprintf(text, sizeof text, "%s: the observer's threshold lies %s the levels the procedure can show: %s",
                   c.label.c_str(), above ? "above" : "below",
                   above ? "raise its max (QUEST+: its threshold grid and stimuli)"

@@ -163,6 +163,7 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
         with_truth.truth_determined = truth.determined;
         with_truth.truth = truth.level;
         with_truth.truth_why = truth.why;
+        with_truth.truth_beyond = truth.beyond;
         with_truth.range_lo = truth.range_lo, with_truth.range_hi = truth.range_hi;
         char target[160];
         if (procedure.kind == protocol::Procedure::Kind::kQuestPlus)

@@ -88,6 +88,7 @@ struct Condition {
   bool truth_determined = false;
   double truth = 0;
   std::string truth_why;  // why there is no truth, in words
+  int truth_beyond = 0;   // the truth lies below (-1) or above (+1) the procedure's range (TrueThreshold::beyond)
   double range_lo = 0, range_hi = 0;  // where the procedure measures a threshold (TrueThreshold's range)
   std::string target;     // what the threshold means, in words ("70.7 % correct, lapses included")
 };

@@ -75,10 +75,12 @@ TrueThreshold ObserverThreshold(const session::ObserverParams& observer, const p
   }
   if (share(range_hi) < target) {
     t.why = "above the tested range (" + Text(range_lo) + " to " + Text(range_hi) + ")";
+    t.beyond = +1;
     return t;
   }
   if (share(range_lo) > target) {
     t.why = "below the tested range (" + Text(range_lo) + " to " + Text(range_hi) + ")";
+    t.beyond = -1;
     return t;
   }
   // The share grows with the level (the test side only gets blurrier): bisection to far below any level step.

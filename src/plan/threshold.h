@@ -28,6 +28,7 @@ struct TrueThreshold {
   bool determined = false;
   double level = 0;     // when determined
   std::string why;      // when not: said in words ("beyond the tested range 0.25 to 6", ...)
+  int beyond = 0;       // when not because it lies outside the range: -1 below it, +1 above it
   // The levels within which the procedure measures a threshold: a staircase's [min, max]; QUEST+'s threshold grid
   // where its stimuli span it too (a threshold no stimulus comes near is left to the prior). Empty (lo > hi) when
   // QUEST+'s stimuli lie wholly outside its threshold grid.
