@@ -1,3 +1,4 @@
+#include <unistd.h>
 #include "core/image.h"
 #include "blurcue/source_dir.h"
 
@@ -25,7 +26,7 @@ TEST(Srgb, EightBitRoundTripIsExact) {
 }
 
 TEST(ImageFile, UnreadableFileNamesTheFile) {
-  auto path = std::filesystem::temp_directory_path() / "blurcue_not_an_image.png";
+  auto path = std::filesystem::temp_directory_path() / ("blurcue_not_an_image_" + std::to_string(::getpid()) + ".png");
   { std::FILE* f = std::fopen(path.c_str(), "w"); std::fputs("hello", f); std::fclose(f); }
   try {
     ReadImage(path);
@@ -38,7 +39,7 @@ TEST(ImageFile, UnreadableFileNamesTheFile) {
 }
 
 TEST(ImageFile, WritesAndReadsBack) {
-  auto path = std::filesystem::temp_directory_path() / "blurcue_rw" / "a.png";
+  auto path = std::filesystem::temp_directory_path() / ("blurcue_rw_" + std::to_string(::getpid())) / "a.png";
   cv::Mat img(4, 5, CV_8UC3, cv::Scalar(10, 20, 30));
   WriteImage(path, img);
   cv::Mat back = ReadImage(path);

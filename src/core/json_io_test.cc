@@ -1,3 +1,4 @@
+#include <unistd.h>
 #include "core/json_io.h"
 
 #include <sys/stat.h>
@@ -15,7 +16,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path TempFile(const std::string& name, const std::string& text) {
-  const fs::path dir = fs::temp_directory_path() / "blurcue-json-io-test";
+  const fs::path dir = fs::temp_directory_path() / ("blurcue-json-io-test-" + std::to_string(::getpid()));
   fs::create_directories(dir);
   std::ofstream(dir / name, std::ios::binary) << text;
   return dir / name;
@@ -100,7 +101,7 @@ TEST(ReadJsonFile, DeviceIsRefused) {
 }
 
 TEST(ReadJsonFile, FifoIsRefusedWithoutWaitingForAWriter) {
-  const fs::path fifo = fs::temp_directory_path() / "blurcue-json-io-test" / "fifo.json";
+  const fs::path fifo = fs::temp_directory_path() / ("blurcue-json-io-test-" + std::to_string(::getpid())) / "fifo.json";
   fs::create_directories(fifo.parent_path());
   fs::remove(fifo);
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);

@@ -1,5 +1,6 @@
 #pragma once
 // Helpers of the protocol parser's tests: a scene folder whose files exist, a small valid protocol, its problems.
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -15,7 +16,7 @@ namespace fs = std::filesystem;
 
 // A folder with a protocol's scene files, so file checks pass unless a test removes one.
 inline fs::path SceneFolder() {
-  const fs::path dir = fs::temp_directory_path() / "blurcue-protocol-test";
+  const fs::path dir = fs::temp_directory_path() / ("blurcue-protocol-test-" + std::to_string(::getpid()));
   fs::create_directories(dir / "scene");
   for (const char* name : {"scene/scene.png", "scene/scene-no-board.png", "calib.json"}) std::ofstream(dir / name) << "x";
   return dir;

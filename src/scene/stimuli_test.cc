@@ -1,3 +1,4 @@
+#include <unistd.h>
 #include "scene/stimuli.h"
 
 #include <gtest/gtest.h>
@@ -251,7 +252,7 @@ TEST(FacePicture, EyesAreDarkerThanTheCheeks) {
 }
 
 TEST(Stimuli, WriteStandardStimuliWritesFourReadablePngs) {
-  const auto dir = std::filesystem::temp_directory_path() / "blurcue_stimuli_test";
+  const auto dir = std::filesystem::temp_directory_path() / ("blurcue_stimuli_test_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   const auto files = WriteStandardStimuli(dir);
   ASSERT_EQ(files.size(), 4u);

@@ -1,5 +1,6 @@
 // Whole small sessions through the trial loop without GL: a fake presenter that records what it is asked to show (on
 // a simulated clock, as headless), a responder that answers as told, and a record in memory or in a temp file.
+#include <unistd.h>
 #include "session/trial_loop.h"
 
 #include <gtest/gtest.h>
@@ -173,7 +174,7 @@ TEST(Runner, EveryPlannedTrialGetsExactlyOneResponseInOrder) {
 }
 
 TEST(Runner, ResumedSessionContinuesAtTheFirstUnansweredTrialWithTheSameOrder) {
-  const std::filesystem::path db = std::filesystem::temp_directory_path() / "blurcue-runner-test-resume.sqlite";
+  const std::filesystem::path db = std::filesystem::temp_directory_path() / ("blurcue-runner-test-resume-" + std::to_string(::getpid()) + ".sqlite");
   std::filesystem::remove(db);
   const Json json = GridProtocol({{"factors", {{"edge", {2, 3, 4, 5, 6, 7}}}}});
   const PreparedSession prepared = Prepare(json);
@@ -244,7 +245,7 @@ TEST(Runner, StaircaseLevelsFollowTheAnswersByItsSteps) {
 // Stopped after correct, correct, wrong (the staircase at 0.8 after its first reversal), a resumed session replays
 // those answers and shows its next trial at 0.8, then goes on as an uninterrupted one would.
 TEST(Runner, ResumedStaircaseContinuesAtTheLevelItsRecordedAnswersGive) {
-  const std::filesystem::path db = std::filesystem::temp_directory_path() / "blurcue-runner-test-staircase.sqlite";
+  const std::filesystem::path db = std::filesystem::temp_directory_path() / ("blurcue-runner-test-staircase-" + std::to_string(::getpid()) + ".sqlite");
   std::filesystem::remove(db);
   const PreparedSession prepared = Prepare(StaircaseProtocol());
   {

@@ -1,6 +1,7 @@
 #pragma once
 // Test fixtures (tests only): the thesis's view built by hand, stand-ins for the files a protocol names, a ball
 // protocol, a pair trial.
+#include <unistd.h>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -46,7 +47,7 @@ inline calib::SceneCalib ThesisScene() {
 // Files a protocol names must exist: stand-ins, never read (the calibration and the photo are given by hand).
 inline Json StandInScene() {
   static const std::filesystem::path dir = [] {
-    const std::filesystem::path d = std::filesystem::temp_directory_path() / "blurcue-stand-in-scene";
+    const std::filesystem::path d = std::filesystem::temp_directory_path() / ("blurcue-stand-in-scene-" + std::to_string(::getpid()));
     std::filesystem::create_directories(d);
     for (const char* name : {"scene.png", "calib.json"}) std::ofstream(d / name) << "";
     return d;
