@@ -62,3 +62,8 @@ function(set_test_costs)
     set_tests_properties(${name} PROPERTIES COST ${seconds})
   endwhile()
 endfunction()
+
+# ${BLURCUE_EXPECT} "REGEX" COMMAND...: a test's command that passes only with exit 0 and output matching REGEX
+# (tests/expect_output.py). Used in place of CTest's PASS_REGULAR_EXPRESSION, which ignores the exit code; the test
+# suite_checks_exit_codes refuses a test that sets it.
+set(BLURCUE_EXPECT /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/expect_output.py)

@@ -61,8 +61,5 @@ add_test(NAME analysis.groups
 set_tests_properties(analysis.groups PROPERTIES LABELS analysis TIMEOUT 600
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
 
-# The psychometric fit against psignifit 4, where it is installed (from PyPI; a SKIP line where it is not).
-add_test(NAME analysis.psignifit COMMAND ${BLURCUE_ANALYSIS_PYTHON} ${CMAKE_SOURCE_DIR}/tests/psignifit_agreement.py)
-set_tests_properties(analysis.psignifit PROPERTIES LABELS analysis PASS_REGULAR_EXPRESSION "^ok:|\nok:|^SKIP:")
 # Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
 set_test_costs(analysis.report 134 analysis.mixed 76 analysis.glmm_checks 95 analysis.groups 43 analysis.tracks 24)

@@ -2,7 +2,8 @@
 a file that exists, and the page logged nothing to the console (no script errors, no failed loads it reports).
 
 usage: browser_check.py REPORT_DIR PAGE [PAGE ...]
-Exit 0 with "ok: ..." or 1 with "FAIL: ..."; "SKIP: ..." (exit 0) where chromium is not installed.
+Exit 0 with "ok: ..." or 1 with "FAIL: ..." - also where chromium is not installed (scripts/setup.sh --tests installs
+it): a check that could not run never passes.
 """
 import json
 import os
@@ -30,8 +31,8 @@ document.getElementById("page").addEventListener("load", function () {
 def check(report_dir, page):
     chromium = shutil.which("chromium") or shutil.which("chromium-browser")
     if not chromium:
-        print("SKIP: chromium is not installed (Debian package chromium)")
-        sys.exit(0)
+        print("FAIL: chromium is not installed (Debian package chromium; scripts/setup.sh --tests installs it)")
+        sys.exit(1)
     checker = os.path.join(report_dir, ".browser-check.html")
     with open(checker, "w", encoding="utf-8") as f:
         f.write(CHECKER % urllib.parse.quote(page))

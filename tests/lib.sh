@@ -24,7 +24,10 @@ start_xvfb() {
 # BC is the moved binary, the shell is in the empty W/elsewhere, and no variable points blurcue at a source tree.
 install_moved() {
   rm -rf "$W" && mkdir -p "$W/elsewhere"
-  cmake --install "$1" --prefix "$W/prefix" > "$W/install.log" || fail "install: $(tail -3 "$W/install.log")"
+  # One install at a time from a build folder: cmake --install writes BUILD/install_manifest.txt, which three tests
+  # installing at once under ctest -j2 would write together.
+  flock "$1/.install-lock" cmake --install "$1" --prefix "$W/prefix" > "$W/install.log" ||
+    fail "install: $(tail -3 "$W/install.log")"
   mv "$W/prefix" "$W/moved"
   BC=$W/moved/bin/blurcue
   cd "$W/elsewhere"

@@ -2,10 +2,10 @@
 # new one, no surviving analysis process, and leftovers that the next run removes. Over the CLI tests' scene.
 foreach(case merge export report)
   add_test(NAME outputs_kill_${case}
-           COMMAND bash ${PROJECT_SOURCE_DIR}/tests/outputs_kill_test.sh ${case} $<TARGET_FILE:blurcue>
+           COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" bash ${PROJECT_SOURCE_DIR}/tests/outputs_kill_test.sh ${case} $<TARGET_FILE:blurcue>
                    ${PROJECT_BINARY_DIR}/cli-test)
   set_tests_properties(outputs_kill_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
-                       LABELS "gl;outputs" TIMEOUT 120 PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+                       LABELS "gl;outputs" TIMEOUT 120)
 endforeach()
 
 # An output that cannot be written is exit 3 naming it (it was exit 10 when std::filesystem::rename threw): here
@@ -19,12 +19,12 @@ set_tests_properties(outputs_json_onto_a_folder PROPERTIES FIXTURES_REQUIRED sce
 
 # Installed into a temporary prefix and moved: the binary finds what it ships beside itself (tests/install_test.sh).
 add_test(NAME install_relocatable
-         COMMAND bash ${PROJECT_SOURCE_DIR}/tests/install_test.sh ${PROJECT_BINARY_DIR} ${PROJECT_BINARY_DIR}/install-test)
-set_tests_properties(install_relocatable PROPERTIES LABELS gl PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+         COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" bash ${PROJECT_SOURCE_DIR}/tests/install_test.sh ${PROJECT_BINARY_DIR} ${PROJECT_BINARY_DIR}/install-test)
+set_tests_properties(install_relocatable PROPERTIES LABELS gl)
 
 # blurcue init from an installed, moved prefix: shipped examples as study folders that validate and run.
 add_test(NAME init_from_prefix
-         COMMAND bash ${PROJECT_SOURCE_DIR}/tests/init_test.sh ${PROJECT_BINARY_DIR} ${PROJECT_BINARY_DIR}/init-test)
-set_tests_properties(init_from_prefix PROPERTIES LABELS gl PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+         COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" bash ${PROJECT_SOURCE_DIR}/tests/init_test.sh ${PROJECT_BINARY_DIR} ${PROJECT_BINARY_DIR}/init-test)
+set_tests_properties(init_from_prefix PROPERTIES LABELS gl)
 # Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
 set_test_costs(init_from_prefix 124 outputs_kill_export 21 outputs_kill_report 17)

@@ -169,7 +169,7 @@ PYEOF
 window_adjust)
   # Depth matching by a person in a window: arrow keys, the mouse wheel and a click step and accept; each answer
   # is the level the presses reach in that trial's own level order (from blurcue validate --list).
-  command -v xdotool >/dev/null || { echo "SKIP: xdotool missing"; exit 0; }
+  command -v xdotool >/dev/null || { echo "FAIL: xdotool is missing (scripts/setup.sh installs it)"; exit 1; }
   start_xvfb
   proto="$P/pre-research-depth-matching.json"
   $BC validate "$proto" --participant W1 --list > "$W/trials.jsonl"
@@ -204,7 +204,7 @@ PYEOF
 window)
   # A person at a real window under Xvfb: synthetic key presses (xdotool) answer test 1; the answers are in the
   # record as pressed: Left = left, Right = right, Down = can't tell.
-  command -v xdotool >/dev/null || { echo "SKIP: xdotool missing"; exit 0; }
+  command -v xdotool >/dev/null || { echo "FAIL: xdotool is missing (scripts/setup.sh installs it)"; exit 1; }
   start_xvfb
   $BC run "$P/test1-static-grids.json" --participant W1 --db "$W/s.sqlite" > "$W/out" 2> "$W/err" &
   run=$!
@@ -230,7 +230,7 @@ window)
 window_after_motion)
   # A person at a window presses an interval's key while the intervals still run: with responses.after_motion it is
   # ignored; the key pressed after the last interval answers, its response time after the intervals' 2.4 s.
-  command -v xdotool >/dev/null || { echo "SKIP: xdotool missing"; exit 0; }
+  command -v xdotool >/dev/null || { echo "FAIL: xdotool is missing (scripts/setup.sh installs it)"; exit 1; }
   $PY - "$P/odd-one-out-grids.json" "$W/one.json" <<'PYEOF'
 import json, sys
 p = json.load(open(sys.argv[1]))

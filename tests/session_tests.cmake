@@ -5,10 +5,9 @@ add_test(NAME session_protocols
          COMMAND ${CMAKE_COMMAND} -DSRC=${PROJECT_SOURCE_DIR} -DOUT=${T} -P ${PROJECT_SOURCE_DIR}/tests/copy_protocols.cmake)
 # The depth-matching protocol's real photos, one per distance, by the thin lens.
 add_test(NAME session_pictures
-         COMMAND ${BC} synth-pictures --camera ${T}/scene/camera.json
+         COMMAND ${BLURCUE_EXPECT} "wrote 27 photos" ${BC} synth-pictures --camera ${T}/scene/camera.json
                  --protocol ${PROJECT_SOURCE_DIR}/protocols/pre-research-depth-matching.json --out ${T}/pictures)
-set_tests_properties(session_pictures PROPERTIES FIXTURES_REQUIRED scene FIXTURES_SETUP session_pictures
-                     PASS_REGULAR_EXPRESSION "wrote 27 photos")
+set_tests_properties(session_pictures PROPERTIES FIXTURES_REQUIRED scene FIXTURES_SETUP session_pictures)
 set_tests_properties(session_protocols PROPERTIES FIXTURES_SETUP session_protocols)
 # Each script holds the cases of one concern: the record (session_test.sh), what the design records and reports
 # (session_design_test.sh), what the screen shows (session_display_test.sh); session_lib.sh is their shared part.
@@ -21,31 +20,29 @@ set(SESSION_CASES_session_display_test window window_adjust depth_arcmin frames_
     window_after_motion visibility depth_capture)
 foreach(script session_test session_design_test session_display_test)
   foreach(case ${SESSION_CASES_${script}})
-    add_test(NAME session_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/${script}.sh ${case} ${BC} ${T})
+    add_test(NAME session_${case} COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" bash ${PROJECT_SOURCE_DIR}/tests/${script}.sh ${case} ${BC} ${T})
     set_tests_properties(session_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures"
-                         LABELS "gl;session"
-                         PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+                         LABELS "gl;session")
   endforeach()
 endforeach()
 set_tests_properties(session_window session_window_adjust session_window_after_motion PROPERTIES LABELS "gl;session;window")
 # Sessions numbered per participant, protocol versions kept apart (tests/session_numbers_test.sh).
 foreach(case again protocol_version conditions_version again_group balanced_counts merge_people)
-  add_test(NAME session_numbers_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/session_numbers_test.sh ${case} ${BC} ${T})
+  add_test(NAME session_numbers_${case} COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" bash ${PROJECT_SOURCE_DIR}/tests/session_numbers_test.sh ${case} ${BC} ${T})
   set_tests_properties(session_numbers_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
-                       LABELS "gl;session" PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+                       LABELS "gl;session")
 endforeach()
 # The report analyses the design the record declares (tests/report_design_test.sh): a QUEST+ per depth per depth,
 # between-subject groups compared across participants, unfinished and repeated sessions apart.
 foreach(case quest_per_depth groups sessions mixed_blocks)
-  add_test(NAME report_design_${case} COMMAND bash ${PROJECT_SOURCE_DIR}/tests/report_design_test.sh ${case} ${BC} ${T})
+  add_test(NAME report_design_${case} COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" bash ${PROJECT_SOURCE_DIR}/tests/report_design_test.sh ${case} ${BC} ${T})
   set_tests_properties(report_design_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
-                       LABELS "gl;session" PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+                       LABELS "gl;session")
 endforeach()
 
 add_test(NAME session_preview
-         COMMAND ${BC} preview ${T}/protocols/test1-static-grids.json --out ${T}/preview-test1.png)
-set_tests_properties(session_preview PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS gl
-                     PASS_REGULAR_EXPRESSION "11 distinct stimuli of 13 trials")
+         COMMAND ${BLURCUE_EXPECT} "11 distinct stimuli of 13 trials" ${BC} preview ${T}/protocols/test1-static-grids.json --out ${T}/preview-test1.png)
+set_tests_properties(session_preview PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS gl)
 # Bad input: exit code and one line naming what is wrong (tests/expect_failure.cmake). NAME CODE TEXT ARGS...
 function(add_run_failure_test name code text)
   add_test(NAME ${name}
@@ -80,8 +77,8 @@ add_test(NAME session_run_person_without_display
 set_tests_properties(session_run_person_without_display PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols")
 
 # blurcue display check in a window (its own Xvfb): geometry, resolution check, honest timing without vsync.
-add_test(NAME display_check COMMAND bash ${PROJECT_SOURCE_DIR}/tests/display_test.sh ${BC} ${T})
-set_tests_properties(display_check PROPERTIES LABELS "gl;window" PASS_REGULAR_EXPRESSION "^ok:|\nok:"
+add_test(NAME display_check COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" bash ${PROJECT_SOURCE_DIR}/tests/display_test.sh ${BC} ${T})
+set_tests_properties(display_check PROPERTIES LABELS "gl;window"
                      FIXTURES_REQUIRED "scene;calib;session_protocols")
 
 # Protocols that cannot crash, hang or lie: a seeded generator mutates the shipped protocols (deletions, wrong types,
@@ -90,11 +87,10 @@ set_tests_properties(display_check PROPERTIES LABELS "gl;window" PASS_REGULAR_EX
 # every rejection names the protocol file on each line. The counts are printed; the seed is fixed (change it to
 # explore, keep it to reproduce).
 add_test(NAME session_protocol_fuzz
-         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/fuzz_protocols.py ${BC} ${T}/protocols ${T}/fuzz
+         COMMAND ${BLURCUE_EXPECT} "fuzz ok: 0 crashes" /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/fuzz_protocols.py ${BC} ${T}/protocols ${T}/fuzz
                  --seed 20261123 --count 240)
 set_tests_properties(session_protocol_fuzz PROPERTIES
-                     FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures" LABELS "gl;session;fuzz"
-                     PASS_REGULAR_EXPRESSION "fuzz ok: 0 crashes" TIMEOUT 1200)
+                     FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures" LABELS "gl;session;fuzz" TIMEOUT 1200)
 
 # validate == run: protocols that used to crash, hang or pass validate and then fail run. Each is refused by both
 # commands with the same one line, naming the protocol file and the field. NAME TEXT PROTOCOL-JSON
@@ -193,25 +189,24 @@ add_executable(capture_measure ${PROJECT_SOURCE_DIR}/tests/capture_measure.cc)
 target_link_libraries(capture_measure PRIVATE blurcue_calib blurcue_core)
 foreach(case blur place pose window agree thesis aliasing subpixel kernel kernel_motion distortion)
   add_test(NAME capture_${case}
-           COMMAND bash ${PROJECT_SOURCE_DIR}/tests/capture_test.sh ${case} ${BC} $<TARGET_FILE:capture_measure> ${T})
+           COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" bash ${PROJECT_SOURCE_DIR}/tests/capture_test.sh ${case} ${BC} $<TARGET_FILE:capture_measure> ${T})
   set_tests_properties(capture_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
-                       LABELS "gl;session;capture" PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+                       LABELS "gl;session;capture")
 endforeach()
 set_tests_properties(capture_window PROPERTIES LABELS "gl;session;capture;window")
 # The thesis's full-resolution scene and its calibration, made once for capture_place and capture_thesis.
 add_test(NAME capture_thesis_full
-         COMMAND bash ${PROJECT_SOURCE_DIR}/tests/capture_test.sh thesis_full ${BC} $<TARGET_FILE:capture_measure> ${T})
-set_tests_properties(capture_thesis_full PROPERTIES FIXTURES_SETUP thesis_full LABELS "session;capture"
-                     PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+         COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" bash ${PROJECT_SOURCE_DIR}/tests/capture_test.sh thesis_full ${BC} $<TARGET_FILE:capture_measure> ${T})
+set_tests_properties(capture_thesis_full PROPERTIES FIXTURES_SETUP thesis_full LABELS "session;capture")
 set_tests_properties(capture_place capture_thesis PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols;thesis_full")
 
 # QUEST+ against python3-questplus, an independent implementation (Debian's).
 add_executable(quest_trace ${PROJECT_SOURCE_DIR}/tests/quest_trace.cc)
 target_link_libraries(quest_trace PRIVATE blurcue_session)
 add_test(NAME quest_agreement
-         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/quest_agreement.py $<TARGET_FILE:quest_trace>
+         COMMAND ${BLURCUE_EXPECT} "ok: blurcue's QUEST\\+ agrees" /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/quest_agreement.py $<TARGET_FILE:quest_trace>
                  ${PROJECT_BINARY_DIR}/quest-agreement)
-set_tests_properties(quest_agreement PROPERTIES PASS_REGULAR_EXPRESSION "ok: blurcue's QUEST\\+ agrees")
+
 # Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
 set_test_costs(capture_distortion 262 session_depth_arcmin 116 capture_subpixel 114 session_protocol_fuzz 77
                session_report_any_study 65 report_design_quest_per_depth 61 report_design_mixed_blocks 60

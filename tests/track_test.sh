@@ -66,26 +66,25 @@ assert m["kind"] == "thin_lens+floor" and abs(m["focus_mm"] - 450) < 0.02 * 450,
 print(f"r_fitted_px within 2 % median / 5 % p90 on every frame; take model focus {m['focus_mm']:.1f} mm")
 PYEOF
 
-# The video, where the take has one.
-if [ -f "$W/take/take.avi" ]; then
-  "$BC" track "$W/take/take.avi" --camera "$W/take/camera.json" --out "$W/track-video" > "$W/video.out" 2>&1 ||
-    fail "track of the video failed: $(cat "$W/video.out")"
-  grep -q "6 frames: .* 0 lost" "$W/video.out" || fail "track video: $(cat "$W/video.out")"
+# The video synth-take writes beside the frames (a take without it fails: its checks would silently not run).
+[ -f "$W/take/take.avi" ] || fail "synth-take wrote no take.avi: the video checks cannot run"
+"$BC" track "$W/take/take.avi" --camera "$W/take/camera.json" --out "$W/track-video" > "$W/video.out" 2>&1 ||
+  fail "track of the video failed: $(cat "$W/video.out")"
+grep -q "6 frames: .* 0 lost" "$W/video.out" || fail "track video: $(cat "$W/video.out")"
 
-  # Truncated: the first 55 % of the bytes. Exit 3, one line naming the file, and the frames before it written.
-  size=$(stat -c %s "$W/take/take.avi")
-  head -c $((size * 55 / 100)) "$W/take/take.avi" > "$W/truncated.avi"
-  "$BC" track "$W/truncated.avi" --camera "$W/take/camera.json" --out "$W/track-truncated" --quiet \
-    > "$W/trunc.out" 2> "$W/trunc.err"
-  code=$?
-  [ $code -eq 3 ] || fail "truncated video: exit $code, expected 3: $(cat "$W/trunc.err")"
-  [ "$(wc -l < "$W/trunc.err")" -eq 1 ] || fail "truncated video: not one line on stderr: $(cat "$W/trunc.err")"
-  grep -q "truncated.avi: damaged or truncated: frame [0-9]" "$W/trunc.err" || fail "truncated video: $(cat "$W/trunc.err")"
-  rows=$(($(wc -l < "$W/track-truncated/track.csv") - 1))
-  [ $rows -ge 1 ] && [ $rows -lt 6 ] || fail "truncated video: $rows rows kept"
-  [ -f "$W/track-truncated/calib-0000.json" ] || fail "truncated video: calib-0000.json not kept"
-  echo "truncated video: exit 3, $rows frames kept: $(cat "$W/trunc.err")"
-fi
+# Truncated: the first 55 % of the bytes. Exit 3, one line naming the file, and the frames before it written.
+size=$(stat -c %s "$W/take/take.avi")
+head -c $((size * 55 / 100)) "$W/take/take.avi" > "$W/truncated.avi"
+"$BC" track "$W/truncated.avi" --camera "$W/take/camera.json" --out "$W/track-truncated" --quiet \
+  > "$W/trunc.out" 2> "$W/trunc.err"
+code=$?
+[ $code -eq 3 ] || fail "truncated video: exit $code, expected 3: $(cat "$W/trunc.err")"
+[ "$(wc -l < "$W/trunc.err")" -eq 1 ] || fail "truncated video: not one line on stderr: $(cat "$W/trunc.err")"
+grep -q "truncated.avi: damaged or truncated: frame [0-9]" "$W/trunc.err" || fail "truncated video: $(cat "$W/trunc.err")"
+rows=$(($(wc -l < "$W/track-truncated/track.csv") - 1))
+[ $rows -ge 1 ] && [ $rows -lt 6 ] || fail "truncated video: $rows rows kept"
+[ -f "$W/track-truncated/calib-0000.json" ] || fail "truncated video: calib-0000.json not kept"
+echo "truncated video: exit 3, $rows frames kept: $(cat "$W/trunc.err")"
 
 # A file that is not a video: one line, exit 3 (no backend's warnings before it).
 echo "not a video" > "$W/garbage.avi"

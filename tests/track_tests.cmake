@@ -1,24 +1,23 @@
 # blurcue synth-take and blurcue track end to end (tests/track_test.sh); the tracker against a ground-truth take is
 # src/track/tracker_test.cc.
-add_test(NAME track_cli COMMAND bash ${PROJECT_SOURCE_DIR}/tests/track_test.sh $<TARGET_FILE:blurcue>
+add_test(NAME track_cli COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" bash ${PROJECT_SOURCE_DIR}/tests/track_test.sh $<TARGET_FILE:blurcue>
                                 ${PROJECT_BINARY_DIR}/track-test)
-set_tests_properties(track_cli PROPERTIES PASS_REGULAR_EXPRESSION "^ok:|\nok:")
+
 # The track bench on 4 frames writes one row per (mode, frame) - track, track-serial, detect, calibrate in process and
 # calibrate run as a command - and says the targets and the measured ratio in words; its chart is drawn.
 add_test(NAME cli_bench_track_quick
-         COMMAND $<TARGET_FILE:blurcue> bench track --quick --out ${PROJECT_BINARY_DIR}/track-bench/track.csv)
-set_tests_properties(cli_bench_track_quick PROPERTIES LABELS slow FIXTURES_SETUP track_bench
-                     PASS_REGULAR_EXPRESSION "wrote .*track.csv \\(20 rows\\).*track +4 .*\\(3 tracked\\).*calibrate-process +4 .*track: median [0-9.]+ ms a frame wall.*track vs calibrate run as a command on each frame: [0-9.]+x faster")
+         COMMAND ${BLURCUE_EXPECT} "wrote .*track.csv \\(20 rows\\).*track +4 .*\\(3 tracked\\).*calibrate-process +4 .*track: median [0-9.]+ ms a frame wall.*track vs calibrate run as a command on each frame: [0-9.]+x faster" $<TARGET_FILE:blurcue> bench track --quick --out ${PROJECT_BINARY_DIR}/track-bench/track.csv)
+set_tests_properties(cli_bench_track_quick PROPERTIES LABELS slow FIXTURES_SETUP track_bench)
 add_test(NAME cli_bench_track_chart
-         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/analysis/track_chart.py
+         COMMAND ${BLURCUE_EXPECT} "wrote .*bench-track.png" /usr/bin/python3 ${PROJECT_SOURCE_DIR}/analysis/track_chart.py
                  ${PROJECT_BINARY_DIR}/track-bench/track.csv ${PROJECT_BINARY_DIR}/track-bench)
 set_tests_properties(cli_bench_track_chart PROPERTIES FIXTURES_REQUIRED track_bench LABELS slow
-                     WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}/analysis PASS_REGULAR_EXPRESSION "wrote .*bench-track.png")
+                     WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}/analysis)
 # blurcue ar on a ground-truth take: the ball's place and defocus against the truth, the card's blur and streak measured
 # on the written frames by numpy (tests/ar_check.py), a truncated input, bad names and values (tests/ar_test.sh).
-add_test(NAME ar_cli COMMAND bash ${PROJECT_SOURCE_DIR}/tests/ar_test.sh $<TARGET_FILE:blurcue>
+add_test(NAME ar_cli COMMAND ${BLURCUE_EXPECT} "(^|\n)ok: ar_test" bash ${PROJECT_SOURCE_DIR}/tests/ar_test.sh $<TARGET_FILE:blurcue>
                              ${PROJECT_BINARY_DIR}/ar-test)
-set_tests_properties(ar_cli PROPERTIES PASS_REGULAR_EXPRESSION "(^|\n)ok: ar_test" LABELS gl)
+set_tests_properties(ar_cli PROPERTIES LABELS gl)
 set_tests_properties(ar_cli PROPERTIES FIXTURES_SETUP ar_take)
 # The ball's r against the take's TRUE lens within 3 % (issue 27's target): the take's fitted lens model, which
 # `ar --blur fitted` draws with, must be the true one.

@@ -5,12 +5,12 @@
 # its report analyses it and describes its scene as a video; bad video scenes are one problem naming the field.
 set(T ${PROJECT_BINARY_DIR}/cli-test)
 set(VIDEO_STUDY_TEST bash ${PROJECT_SOURCE_DIR}/tests/video_study_test.sh)
-add_test(NAME video_study_take COMMAND ${VIDEO_STUDY_TEST} take $<TARGET_FILE:blurcue> ${T})
-set_tests_properties(video_study_take PROPERTIES FIXTURES_SETUP video_take PASS_REGULAR_EXPRESSION "(^|\n)ok:")
+add_test(NAME video_study_take COMMAND ${BLURCUE_EXPECT} "(^|\n)ok:" ${VIDEO_STUDY_TEST} take $<TARGET_FILE:blurcue> ${T})
+set_tests_properties(video_study_take PROPERTIES FIXTURES_SETUP video_take)
 foreach(case validate kill9 frames report bad_scene procedure rolling two_takes)
-  add_test(NAME video_study_${case} COMMAND ${VIDEO_STUDY_TEST} ${case} $<TARGET_FILE:blurcue> ${T})
+  add_test(NAME video_study_${case} COMMAND ${BLURCUE_EXPECT} "(^|\n)ok:" ${VIDEO_STUDY_TEST} ${case} $<TARGET_FILE:blurcue> ${T})
   set_tests_properties(video_study_${case} PROPERTIES FIXTURES_REQUIRED "video_take;session_protocols"
-                       LABELS "gl;session" PASS_REGULAR_EXPRESSION "(^|\n)ok:")
+                       LABELS "gl;session")
 endforeach()
 # Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
 set_test_costs(video_study_report 20 video_study_kill9 12)

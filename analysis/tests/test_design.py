@@ -1,6 +1,7 @@
 """The design read from the record (design.py), sessions kept apart (common.study_parts, session_numbers), and the
 tests with participants as the unit (study_tests.py) - against hand-worked values and R's own t.test, wilcox.test,
-oneway.test and kruskal.test (Rscript; skipped where R is not installed)."""
+oneway.test and kruskal.test (Rscript from Debian's r-base-core, which scripts/setup.sh installs: without it those
+tests fail, never pass)."""
 import math
 import os
 import shutil
@@ -68,7 +69,6 @@ class DesignFromTheRecord(unittest.TestCase):
         self.assertEqual(got.within, ("speed_cm_s",))  # edge is empty in every row: not applicable, not a factor
         self.assertEqual(list(common.text(pd.Series(["nan", float("nan"), None, " NA "]))), ["nan", "", "", "NA"])
 
-    @unittest.skipUnless(RSCRIPT, "R not installed")
     def test_a_participant_named_na_is_fitted_by_lme4(self):
         # R's read.csv takes "NA" for missing: the participant's answers were dropped from every mixed model. The
         # fit with that participant named "NA" must be the fit with them named "Pna" (renaming changes nothing).
@@ -213,7 +213,6 @@ class ParticipantsAsTheUnit(unittest.TestCase):
                 rows += [{"participant": f"{g}{i}", "group": g, "y": 1.0 if j < k else 0.0} for j in range(20)]
         return pd.DataFrame(rows)
 
-    @unittest.skipUnless(RSCRIPT, "R is not installed")
     def test_two_groups_welch_and_mann_whitney_as_r_computes_them(self):
         a, b = [0.25, 0.3, 0.45, 0.2], [0.6, 0.7, 0.55, 0.85, 0.65]
         table, _, words = study_tests.group_effect(self.group_data({"a": a, "b": b}), "group")
@@ -223,7 +222,6 @@ class ParticipantsAsTheUnit(unittest.TestCase):
         self.assertEqual(list(table["participants"]), [4, 5])
         self.assertIn("group b higher than group a", words)
 
-    @unittest.skipUnless(RSCRIPT, "R is not installed")
     def test_three_groups_welch_anova_and_kruskal_wallis_as_r_computes_them(self):
         groups = {"a": [0.25, 0.3, 0.45, 0.2], "b": [0.6, 0.7, 0.55, 0.85], "c": [0.4, 0.5, 0.35, 0.6, 0.45]}
         table, _, words = study_tests.group_effect(self.group_data(groups), "group")
@@ -233,7 +231,6 @@ class ParticipantsAsTheUnit(unittest.TestCase):
         self.assertAlmostEqual(table["p_kruskal"][0], r_value(f"kruskal.test({y}, {g})$p.value"), places=9)
         self.assertIn("highest group b, lowest a", words)
 
-    @unittest.skipUnless(RSCRIPT, "R is not installed")
     def test_a_direction_no_test_finds_is_said_as_the_samples_not_as_a_finding(self):
         # Overlapping groups (R: Welch p = 0.30, Wilcoxon p = 0.41): the means differ, no test finds it. The summary
         # said 'group b higher than group a' at p = 0.08 in an experimenter's yes/no study.

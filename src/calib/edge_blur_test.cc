@@ -141,7 +141,14 @@ EdgeImage Render(const EdgeSpec& spec) {
   return out;
 }
 
-double Tolerance(double r) { return std::max(0.25, 0.05 * r); }
+// What the edge model must get right on a clean synthetic edge (noise 1 %, any angle): within 0.06 px or 1.5 %. The
+// sweeps measured at most 0.053 px at r = 4 and 1.05 % at r = 12; the error this guards against is a radius
+// several per cent off (a whole-pixel-sampled kernel, a mis-scaled LSF moment): 5 % off fails at every r > 1.2 px,
+// 10 % off at every r > 0.6 px.
+// (It was max(0.25 px, 5 %): 50 % at r = 0.5.)
+double Tolerance(double r) { return std::max(0.06, 0.015 * r); }
+// An 8-bit edge of 5 % contrast spans ~8 code values: within 0.12 px or 3 % (measured: 0.078 px at r = 1, 2.5 % at r = 8).
+double LowContrastTolerance(double r) { return std::max(0.12, 0.03 * r); }
 
 bool HasFlag(const ModelFit& fit, const std::string& flag) {
   return std::find(fit.flags.begin(), fit.flags.end(), flag) != fit.flags.end();
@@ -530,7 +537,7 @@ TEST(EdgeModel, LowContrastEightBitEdgeStillAccurate) {
     const EdgeImage img = Render(spec);
     const ModelFit fit = MeasureEdgeModel(img.linear, img.segment);
     EXPECT_TRUE(fit.ok) << Describe(fit);
-    EXPECT_NEAR(fit.r_px, r, Tolerance(r)) << Describe(fit);
+    EXPECT_NEAR(fit.r_px, r, LowContrastTolerance(r)) << Describe(fit);
   }
 }
 
@@ -618,13 +625,16 @@ TEST(ThesisMethod, SameBlurHigherContrastReadsLarger) {
   ASSERT_TRUE(ta.ok && tb.ok);
   EXPECT_GT(tb.r_px, ta.r_px + 2);
   const ModelFit ma = MeasureEdgeModel(a.linear, a.segment), mb = MeasureEdgeModel(b.linear, b.segment);
-  EXPECT_NEAR(ma.r_px, 6, Tolerance(6));
+  EXPECT_NEAR(ma.r_px, 6, LowContrastTolerance(6));  // 10 % contrast in 8 bits
   EXPECT_NEAR(mb.r_px, 6, Tolerance(6));
   std::cout << "thesis r at contrast 0.20->0.30: " << ta.r_px << ", at 0.04->0.80: " << tb.r_px
             << "; model r: " << ma.r_px << ", " << mb.r_px << " (true 6)\n";
 }
 
 // Side by side, for the log: true r vs the model fit vs the thesis count (7 degrees, noise 0.01, 8-bit sRGB).
+// The model against the thesis's measure (section 4.3) on the same edges: the model within Tolerance at every radius,
+// the thesis's count-of-steep-pixels reading high (its threshold of 1 grey level per pixel counts the blur's tails)
+// and further from the truth than the model everywhere. Printed as a table too.
 TEST(EdgeBlurReport, TrueVsModelVsThesis) {
   std::printf("%-9s %7s %9s %9s %9s %9s\n", "psf", "true r", "model r", "err", "thesis r", "err");
   for (const std::string psf : {"disc", "gaussian"})
@@ -638,7 +648,10 @@ TEST(EdgeBlurReport, TrueVsModelVsThesis) {
       const ThesisMeasure th = MeasureEdgeThesis(img.grey8, img.segment);
       std::printf("%-9s %7.2f %9.3f %+9.3f %9.1f %+9.1f\n", psf.c_str(), r, fit.r_px, fit.r_px - r, th.r_px,
                   th.r_px - r);
-      RecordProperty(psf + "_r" + std::to_string(r), std::to_string(fit.r_px) + " / " + std::to_string(th.r_px));
+      EXPECT_NEAR(fit.r_px, r, Tolerance(r)) << psf << " r=" << r;
+      ASSERT_TRUE(th.ok) << psf << " r=" << r;
+      EXPECT_GE(th.r_px, r) << psf << " r=" << r << ": the thesis's measure reads high";
+      EXPECT_LT(std::abs(fit.r_px - r), std::abs(th.r_px - r)) << psf << " r=" << r;
     }
 }
 
