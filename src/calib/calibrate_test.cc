@@ -246,13 +246,18 @@ TEST(Calibrate, FocusInsideTheBoardFitsFocusApertureAndRadius) {
                 "p90 %.2f %%\n", name, m.kind.c_str(), m.focus_mm, m.aperture_mm, m.floor_px, 100 * fitted.median,
                 100 * fitted.p90);
     EXPECT_EQ(m.kind, "thin_lens+floor") << name;
+    // Synth renders and the fit models blur through the same optics::BlurRadiusPx; that function is pinned apart from
+    // both by ThinLens.MatchesTextbookBlurCircle and ThinLens.ThesisNumbers, so a shared error cannot cancel here.
     EXPECT_NEAR(m.focus_mm, r.scene.focus_mm, 0.02 * r.scene.focus_mm) << name;
     EXPECT_NEAR(m.aperture_mm, r.scene.camera.ApertureMm(), 0.03 * r.scene.camera.ApertureMm()) << name;
-    EXPECT_NEAR(m.floor_px, 2 * 0.35, 0.07) << name;
+    // The floor as rendered: 2 x the std of the taps synth applied (truth's floor_sigma_applied_px), not the nominal
+    // 2 x 0.35 px, which the taps match only while the supersampling is fine enough.
+    const double floor_px = 2 * r.scene.truth.at("floor_sigma_applied_px").get<double>();
+    EXPECT_NEAR(m.floor_px, floor_px, 0.07) << name;
     // The sections nearest focus read the floor itself: it is pinned, and its range holds the truth.
     EXPECT_TRUE(m.floor_determined) << name << ": " << optics::FloorText(m);
-    EXPECT_LE(m.floor_lo_px, 0.7 * 1.01) << name;
-    EXPECT_GE(m.floor_hi_px, 0.7 * 0.99) << name;
+    EXPECT_LE(m.floor_lo_px, floor_px * 1.01) << name;
+    EXPECT_GE(m.floor_hi_px, floor_px * 0.99) << name;
     EXPECT_EQ(fitted.n, int(r.cmp.sections.size())) << name;
     EXPECT_LE(fitted.median, 0.02) << name;
     EXPECT_LE(fitted.p90, 0.05) << name;

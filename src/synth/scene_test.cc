@@ -277,6 +277,14 @@ TEST_P(RenderedBlur, EdgeProfileIsTheRequestedPsfOverThePixel) {
   const Profile p = EdgeProfile(s, 3, 3);
   const std::vector<double> expected = ExpectedProfile(p, c.r, c.psf, kBlack, kWhite);
   EXPECT_LT(RmsDifference(p.values, expected), 0.01 * (kWhite - kBlack));
+  // A small blur must still be told from none (and none from a small one): the profile sits at least 3 x nearer its
+  // own radius's profile than that of the neighbouring case (r = 0 against 0.3, and 0.3 against 0).
+  if (c.r <= 0.3) {
+    const double other = c.r > 0 ? 0.0 : 0.3;
+    const double own = RmsDifference(p.values, expected);
+    const double near = RmsDifference(p.values, ExpectedProfile(p, other, c.psf, kBlack, kWhite));
+    EXPECT_GT(near, 3 * own) << "r = " << c.r << " against r = " << other;
+  }
   // Below ~0.3 px the blur hardly leaves the pixel the edge falls in, so no profile can tell the radius.
   if (c.r >= 0.3) {
     EXPECT_NEAR(FittedRadius(p, c.psf, 2 * c.r + 2), c.r, 0.03 * c.r + 0.02);
