@@ -10,7 +10,7 @@ compute, with nothing of blurcue's code:
    focus, aperture, floor r0) at the CSV's depth, r = sqrt(R^2 + r0^2), R = D F |u - u0| / (2 u (u0 - F) pitch):
    within 0.5 %. With --truth-lens, only this: the CSV's r_px against the thin-lens r of the take's true lens
    (truth-NNNN.json: focus, aperture, pixel pitch, lens floor f) at the ball centre's true depth, r = sqrt(R^2 +
-   4 f^2): within 3 % (fails today: the take's fitted lens model is not the true one, docs/track.md "Known limit").
+   4 f^2): within 3 % (registered as ar_defocus_truth_lens, which passes).
 3. The written frames (white-card and black-card runs, blurred and sharp): in linear light (sRGB decoded as IEC
    61966-2-1 says), white minus black is the card's blurred coverage alone (an unlit white card adds C x A = A; the
    ball, the photo and everything else cancel exactly). Blurring by a normalised kernel adds the kernel's mean and

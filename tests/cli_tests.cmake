@@ -120,3 +120,9 @@ add_test(NAME cli_camera_exif
 
 # Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
 set_test_costs(cli_camera_exif 13)
+
+# blurcue make-stimuli: its textures against their geometry worked out apart from it (tests/stimuli_check.py): the
+# grid's 6 x 6 bands, the soccer ball's 12 spherical pentagons (share of the sphere by spherical excess, each 63.43 deg
+# from 5 others), the face's alpha.
+add_test(NAME cli_make_stimuli
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/stimuli_check.py ${BC} ${T}/make-stimuli)

@@ -13,8 +13,7 @@ every section with an edge, per frame for a take) and exits 1 when a target is m
                issue 27 (take): every frame's measured r median <= 3 %, p90 <= 8 %;
   --what fitted (take): the take's lens model's r per frame, median <= 3 %, p90 <= 8 % (as for measured r);
   --what all: pose and blur.
-Exit 2 when blurcue itself fails (its message is printed), so an expected-to-fail blur test (WILL_FAIL) is told
-apart only by the sibling pose test, which must pass.
+Exit 2 when blurcue itself fails (its message is printed), 1 when a target is missed.
 """
 import argparse
 import csv
