@@ -60,7 +60,7 @@ def check_disc(src, out, r):
     ref = {k: blurred(a, k * r)[inner] for k in (0.9, 1.0, 1.1)}
     # Where the radius shows: opaque pixels whose value moves by more than 1 level between 0.9 r and 1.1 r (a flat
     # area is the same at every radius and would dilute the error).
-    where = (b[inner][..., 3] > 128) & (np.abs(ref[0.9][..., :3] - ref[1.1][..., :3]).max(axis=-1) > 1)
+    where = (a[inner][..., 3] > 128) & (np.abs(ref[0.9][..., :3] - ref[1.1][..., :3]).max(axis=-1) > 1)
     if where.sum() < 1000:
         return f"FAIL: {src}: only {int(where.sum())} px show the radius; pick an image with edges"
 

@@ -244,8 +244,8 @@ PYEOF
   run=$!
   at Instructions Return
   at "trial 1 of 1" 1
-  sleep 2.6
-  last=1 at "trial 1 of 1" 3
+  # The title gains " - answer" once the intervals are over (no sleep guessing when).
+  last=1 at "trial 1 of 1 - answer" 3
   wait $run || fail "run failed: $(cat "$W/err")"
   got=$(sql "$W/s.sqlite" "SELECT choice || ' ' || (rt_ms > 2400) FROM responses")
   [ "$got" = "3 1" ] || fail "answer: $got (the key pressed during the intervals must not count)"

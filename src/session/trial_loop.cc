@@ -113,6 +113,9 @@ class Runner {
     for (int k = 0; k < n; ++k) intervals.push_back(IntervalScene(scene, IntervalShowsRight(trial, scene, k)));
     // With responses.after_motion keys count (and the prompt shows) only once the motion or the intervals are over.
     const double answer_from_s = protocol_.responses.after_motion ? StimulusEndS(timing, scene) : 0;
+    // Where keys wait for the motion's end, the window's title says when they count (" - answer"): a person sees it
+    // and a test waits for it rather than for a guessed time.
+    bool answer_titled = answer_from_s <= 0;
     int composed_interval = -1;
     for (int frame = 0;; ++frame) {
       const double t = onset < 0 ? 0 : presenter_.Now() - onset - paused_s;
@@ -140,6 +143,10 @@ class Runner {
         onset = flip;
         presenter_.SetTitle(TrialTitle(trial));
         responder_.StimulusShown(trial, scene, onset);
+      }
+      if (!answer_titled && flip - onset - paused_s >= answer_from_s) {
+        presenter_.SetTitle(TrialTitle(trial) + " - answer");
+        answer_titled = true;
       }
       const bool dropped = presenter_.RealTime() && last_flip >= 0 && flip - last_flip > 1.5 * presenter_.FrameS();
       FrameRecord shown_frame;
@@ -185,7 +192,7 @@ class Runner {
           const double paused_at = presenter_.Now();
           if (!Pause()) return Outcome::kQuit;
           paused_s += presenter_.Now() - paused_at;
-          presenter_.SetTitle(TrialTitle(trial));
+          presenter_.SetTitle(TrialTitle(trial) + (answer_from_s > 0 && answer_titled ? " - answer" : ""));
           last_flip = -1;  // the gap is the pause, not a dropped frame
         } else if (KeyMap::Answers(action)) {
           response->choice = action;
