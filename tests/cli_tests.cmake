@@ -117,3 +117,15 @@ add_test(NAME cli_camera_exif
 set_tests_properties(cli_camera_exif PROPERTIES PASS_REGULAR_EXPRESSION "ok: camera.json from EXIF")
 # Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
 set_test_costs(cli_camera_exif 13)
+
+# Issue 39: a damaged image is refused, not read with grey fill. The scene's photo as a JPEG cut at 75 % of its bytes
+# (it still decoded, rows below the cut grey, and calibrated with exit 0): exit 3 naming the file and why.
+add_test(NAME cli_cut_jpeg_make
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/cut_images.py photo ${T}/scene/scene.png ${T}/cut/scene-cut.jpg)
+set_tests_properties(cli_cut_jpeg_make PROPERTIES FIXTURES_REQUIRED scene FIXTURES_SETUP cut_jpeg
+                     PASS_REGULAR_EXPRESSION "ok: cut")
+add_test(NAME cli_calibrate_cut_jpeg
+         COMMAND ${CMAKE_COMMAND} -DCMD=${BC} "-DARGS=calibrate;${T}/cut/scene-cut.jpg;--camera;${T}/scene/camera.json;--out;${T}/cut/calib.json"
+                 -DEXPECT_CODE=3 "-DEXPECT_TEXT=scene-cut.jpg: truncated JPEG" -DONE_LINE=1
+                 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+set_tests_properties(cli_calibrate_cut_jpeg PROPERTIES FIXTURES_REQUIRED cut_jpeg)
