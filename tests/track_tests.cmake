@@ -44,3 +44,15 @@ add_test(NAME track_fps_out_of_range
                  -DEXPECT_CODE=2 "-DEXPECT_TEXT=--fps: must be in [0.01, 1000] frames per second, got 1e-300"
                  -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
 set_tests_properties(track_fps_out_of_range PROPERTIES FIXTURES_REQUIRED track_cut)
+# A tracked take read back (ar) refuses hand edits: a frame's lens model not the take's, a track.csv cut inside its
+# last row, a board that is not the calibration's (tests/take_edits_check.py).
+add_test(NAME track_cut_take_tracked
+         COMMAND $<TARGET_FILE:blurcue> track ${PROJECT_BINARY_DIR}/track-cut/take/frame-%04d.png
+                 --camera ${PROJECT_BINARY_DIR}/track-cut/take/camera.json --out ${PROJECT_BINARY_DIR}/track-cut/good --quiet)
+set_tests_properties(track_cut_take_tracked PROPERTIES FIXTURES_REQUIRED track_cut FIXTURES_SETUP track_cut_good)
+add_test(NAME track_read_back_edits
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/take_edits_check.py $<TARGET_FILE:blurcue>
+                 ${PROJECT_BINARY_DIR}/track-cut/take ${PROJECT_BINARY_DIR}/track-cut/good
+                 ${PROJECT_BINARY_DIR}/track-cut/edits)
+set_tests_properties(track_read_back_edits PROPERTIES FIXTURES_REQUIRED track_cut_good LABELS gl
+                     PASS_REGULAR_EXPRESSION "ok: a tracked take's hand edits are refused")
