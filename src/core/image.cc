@@ -149,18 +149,25 @@ cv::Mat ReadImage(const std::filesystem::path& path, int flags) {
   if (bytes > uintmax_t(kMaxImageFileBytes))
     throw InputError(path.string(), "is " + std::to_string(bytes) + " bytes; image files are read up to " +
                                         std::to_string(kMaxImageFileBytes) + " bytes");
-  // The size from the header first, so a hostile 65535 x 65535 PNG is refused before it is decoded; then the whole
-  // file is checked for damage (core/image_integrity.h): a cut JPEG or PNG decodes with grey fill and no error.
-  // The decoder reads the file again from the page cache (~1 ms per 4 MB; imdecode from these bytes would skip
-  // imread's EXIF orientation handling on some OpenCV versions).
+  // The size from the header first, so a hostile 65535 x 65535 PNG is refused before it is decoded; then a JPEG or
+  // PNG is checked whole for damage (core/image_integrity.h): a cut one decodes with grey fill and no error. Other
+  // formats' bytes past the header are left to their decoder. The decoder reads the file again from the page cache
+  // (~1 ms per 4 MB; imdecode from these bytes would skip imread's EXIF orientation handling on some OpenCV versions).
   {
     std::ifstream in(path, std::ios::binary);
-    std::vector<uint8_t> whole(bytes);
-    if (!in.read(reinterpret_cast<char*>(whole.data()), std::streamsize(whole.size())))
+    std::vector<uint8_t> head(std::min<uintmax_t>(bytes, 1 << 20));
+    if (!in.read(reinterpret_cast<char*>(head.data()), std::streamsize(head.size())))
       throw InputError(path.string(), "cannot read file");
-    const auto [w, h] = HeaderSizePx(whole);
+    const auto [w, h] = HeaderSizePx(head);
     RequireSizeWithinLimits(path, w, h);
-    RequireIntactImage(path, std::string_view(reinterpret_cast<const char*>(whole.data()), whole.size()));
+    const bool checked = head.size() >= 3 && ((head[0] == 0x89 && head[1] == 'P' && head[2] == 'N') ||
+                                              (head[0] == 0xff && head[1] == 0xd8 && head[2] == 0xff));
+    if (checked && bytes > head.size()) {
+      head.resize(bytes);
+      if (!in.read(reinterpret_cast<char*>(head.data()) + (1 << 20), std::streamsize(bytes - (1 << 20))))
+        throw InputError(path.string(), "cannot read file");
+    }
+    if (checked) RequireIntactImage(path, std::string_view(reinterpret_cast<const char*>(head.data()), head.size()));
   }
   cv::Mat image;
   std::string decoder_said;
