@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 PACKAGES=(
   build-essential cmake pkg-config
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-calib3d-dev libopencv-videoio-dev
-  nlohmann-json3-dev libcli11-dev libsqlite3-dev libgtest-dev libexif-dev
+  nlohmann-json3-dev libcli11-dev libsqlite3-dev libgtest-dev libexif-dev zlib1g-dev
   libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libglfw3-dev libglm-dev xvfb xauth xdotool
   python3-pandas python3-matplotlib python3-scipy python3-statsmodels python3-jsonschema python3-numpy python3-pil
   python3-questplus

@@ -9,6 +9,7 @@ Missing tags are refused, exit 3, naming the tag and the option that gives it.
 import json
 import math
 import os
+import struct
 import subprocess
 import sys
 
@@ -180,6 +181,28 @@ check("a PNG with every number given", c["image_width_px"] == 600 and near(c["se
 p = photo("infinity.jpg", (600, 400), {MODEL: "NEX-5N"}, {FOCAL: R(21, 1), FNUMBER: R(8, 1), SUBJECT: R(2 ** 32 - 1, 1)})
 c, err = camera(p)
 check("SubjectDistance infinity is printed as infinity", "SubjectDistance): infinity" in err, err)
+
+# 13. A rational stored as the signed type (SRATIONAL, 10) is read with its sign: -21/-1 is 21 mm (libexif's
+# "fix" had made it the unsigned 4294967275/4294967295 = 0.99999999534 mm), -21/1 is refused as negative.
+def signed_focal(name, num, den):
+    path = photo(name, (600, 400), {MODEL: "NEX-5N"}, {FOCAL: R(21, 1), FNUMBER: R(8, 1)})
+    data = bytearray(open(path, "rb").read())
+    tiff = data.index(b"Exif\x00\x00") + 6
+    little = data[tiff:tiff + 2] == b"II"
+    end = "<" if little else ">"
+    entry = data.index(struct.pack(end + "HHI", FOCAL, 5, 1), tiff)  # tag, RATIONAL, one value
+    offset = struct.unpack(end + "I", data[entry + 8:entry + 12])[0]
+    data[entry:entry + 8] = struct.pack(end + "HHI", FOCAL, 10, 1)  # SRATIONAL
+    data[tiff + offset:tiff + offset + 8] = struct.pack(end + "ii", num, den)
+    open(path, "wb").write(bytes(data))
+    return path
+
+
+c, err = camera(signed_focal("srational.jpg", -21, -1))
+check("a signed rational -21/-1 is 21 mm", near(c["focal_length_mm"], 21), (c, err))
+code, _, err = run(signed_focal("negative.jpg", -21, 1))
+check("a negative focal length is refused naming the tag", code == 3 and "negative.jpg: EXIF FocalLength (0x920a) is "
+      "-21 (negative" in err and "--focal-length-mm" in err, (code, err))
 
 if failures:
     sys.exit(f"{len(failures)} failed: {failures}")

@@ -126,3 +126,14 @@ set_test_costs(cli_camera_exif 13)
 # from 5 others), the face's alpha.
 add_test(NAME cli_make_stimuli
          COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/stimuli_check.py ${BC} ${T}/make-stimuli)
+
+# Issue 39: a damaged image is refused, not read with grey fill. The scene's photo as a JPEG cut at 75 % of its bytes
+# (it still decoded, rows below the cut grey, and calibrated with exit 0): exit 3 naming the file and why.
+add_test(NAME cli_cut_jpeg_make
+         COMMAND ${BLURCUE_EXPECT} "ok: cut" /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/cut_images.py photo ${T}/scene/scene.png ${T}/cut/scene-cut.jpg)
+set_tests_properties(cli_cut_jpeg_make PROPERTIES FIXTURES_REQUIRED scene FIXTURES_SETUP cut_jpeg)
+add_test(NAME cli_calibrate_cut_jpeg
+         COMMAND ${CMAKE_COMMAND} -DCMD=${BC} "-DARGS=calibrate;${T}/cut/scene-cut.jpg;--camera;${T}/scene/camera.json;--out;${T}/cut/calib.json"
+                 -DEXPECT_CODE=3 "-DEXPECT_TEXT=scene-cut.jpg: truncated JPEG" -DONE_LINE=1
+                 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+set_tests_properties(cli_calibrate_cut_jpeg PROPERTIES FIXTURES_REQUIRED cut_jpeg)

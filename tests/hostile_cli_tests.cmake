@@ -41,7 +41,7 @@ hostile_test(cli_hostile_image_directory 3 "${D}: is a directory, not an image f
 hostile_test(cli_hostile_image_huge_header 3
              "huge-header.png: is 65535 x 65535 px; images are read up to 20000 px a side and 120 Mpx"
              blur ${D}/huge-header.png --backend cpu --radius-px 2 --out ${H}/x.png)
-hostile_test(cli_hostile_image_truncated 3 "bad-iccp-truncated.png: not a readable image"
+hostile_test(cli_hostile_image_truncated 3 "bad-iccp-truncated.png: truncated PNG"
              blur ${D}/bad-iccp-truncated.png --backend cpu --radius-px 2 --out ${H}/x.png)
 # A valid PNG with a broken iCCP profile: libpng's warning must not reach stderr.
 add_test(NAME cli_hostile_image_bad_iccp_is_quiet

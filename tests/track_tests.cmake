@@ -26,3 +26,31 @@ add_test(NAME ar_defocus_truth_lens
 set_tests_properties(ar_defocus_truth_lens PROPERTIES FIXTURES_REQUIRED ar_take)
 # Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
 set_test_costs(ar_cli 56)
+# Issue 39: a JPEG image sequence with one frame cut at 75 % (it was tracked, exit 0): exit 3 naming the frame's file.
+add_test(NAME track_cut_frame_make
+         COMMAND ${BLURCUE_EXPECT} "ok: cut frame 1 of 3" sh -c "$<TARGET_FILE:blurcue> synth-take --out ${PROJECT_BINARY_DIR}/track-cut/take --frames 3 --quiet && /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/cut_images.py sequence ${PROJECT_BINARY_DIR}/track-cut/take/frame-%04d.png ${PROJECT_BINARY_DIR}/track-cut/jpeg/frame-%04d.jpg 1")
+set_tests_properties(track_cut_frame_make PROPERTIES FIXTURES_SETUP track_cut)
+add_test(NAME track_cut_frame
+         COMMAND ${CMAKE_COMMAND} -DCMD=$<TARGET_FILE:blurcue>
+                 "-DARGS=track;${PROJECT_BINARY_DIR}/track-cut/jpeg/frame-%04d.jpg;--camera;${PROJECT_BINARY_DIR}/track-cut/take/camera.json;--out;${PROJECT_BINARY_DIR}/track-cut/track;--quiet"
+                 -DEXPECT_CODE=3 "-DEXPECT_TEXT=frame-0001.jpg: truncated JPEG"
+                 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+set_tests_properties(track_cut_frame PROPERTIES FIXTURES_REQUIRED track_cut)
+# --fps is checked before any frame is read: 1e-300 wrote a 63-digit time, then was refused.
+add_test(NAME track_fps_out_of_range
+         COMMAND ${CMAKE_COMMAND} -DCMD=$<TARGET_FILE:blurcue>
+                 "-DARGS=track;${PROJECT_BINARY_DIR}/track-cut/take/frame-%04d.png;--camera;${PROJECT_BINARY_DIR}/track-cut/take/camera.json;--out;${PROJECT_BINARY_DIR}/track-cut/fps;--fps;1e-300"
+                 -DEXPECT_CODE=2 "-DEXPECT_TEXT=--fps: must be in [0.01, 1000] frames per second, got 1e-300"
+                 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+set_tests_properties(track_fps_out_of_range PROPERTIES FIXTURES_REQUIRED track_cut)
+# A tracked take read back (ar) refuses hand edits: a frame's lens model not the take's, a track.csv cut inside its
+# last row, a board that is not the calibration's (tests/take_edits_check.py).
+add_test(NAME track_cut_take_tracked
+         COMMAND $<TARGET_FILE:blurcue> track ${PROJECT_BINARY_DIR}/track-cut/take/frame-%04d.png
+                 --camera ${PROJECT_BINARY_DIR}/track-cut/take/camera.json --out ${PROJECT_BINARY_DIR}/track-cut/good --quiet)
+set_tests_properties(track_cut_take_tracked PROPERTIES FIXTURES_REQUIRED track_cut FIXTURES_SETUP track_cut_good)
+add_test(NAME track_read_back_edits
+         COMMAND ${BLURCUE_EXPECT} "ok: a tracked take's hand edits are refused" /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/take_edits_check.py $<TARGET_FILE:blurcue>
+                 ${PROJECT_BINARY_DIR}/track-cut/take ${PROJECT_BINARY_DIR}/track-cut/good
+                 ${PROJECT_BINARY_DIR}/track-cut/edits)
+set_tests_properties(track_read_back_edits PROPERTIES FIXTURES_REQUIRED track_cut_good LABELS gl)

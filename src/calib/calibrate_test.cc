@@ -514,8 +514,11 @@ TEST(SceneCalib, MeasuredIsTheNearestEdgesOwnValueOrAnError) {
   const Calibration& r = Calibrated(Blurry());
   Json j = CalibToJson(r.result);
   for (Json& section : j["edges"][8]["sections"]) section["ok"] = false;  // edge 9: every section flagged
-  j["edges"].erase(9);                                                   // edge 10: not in the file at all
-  const SceneCalib scene = SceneCalibFromJson(j, "calib.json: ");
+  SceneCalib scene = SceneCalibFromJson(j, "calib.json: ");
+  // Edge 10: no section at all (a file lists every edge, RequireWholeCalib; a scene built in code may not).
+  scene.sections.erase(std::remove_if(scene.sections.begin(), scene.sections.end(),
+                                      [](const SceneCalib::Section& s) { return s.edge == 10; }),
+                       scene.sections.end());
   const auto midpoint = [&](int edge) { return r.result.edges[edge - 1].sections[3].midpoint_camera_mm; };
   for (int edge : {9, 10}) {
     try {
@@ -607,6 +610,70 @@ TEST(SceneCalib, ModelBlockIsReadAsWritten) {
   Json thin = written;
   thin["model"]["kind"] = "thin_lens", thin["model"]["floor_px"] = 0;
   EXPECT_EQ(SceneCalibFromJson(thin, "calib.json: ").model.floor_px, 0);
+}
+
+// A calibration is read as a whole (calib_whole.h): fields each in range but not calibrate's together are refused,
+// naming the file and the field. One edit of a written calib.json per check; the file as written reads.
+void ExpectCalibRefusedAt(const Json& j, const std::string& start) {
+  try {
+    SceneCalibFromJson(j, "calib.json: ");
+    ADD_FAILURE() << "read, though it should be refused with " << start;
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    EXPECT_EQ(std::string(e.what()).rfind(start, 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+  }
+}
+
+const Json& WrittenThesisCalib() {
+  static const Json j = CalibToJson(Calibrated(Thesis()).result);
+  return j;
+}
+
+TEST(SceneCalibWhole, TheFileAsWrittenReads) { EXPECT_NO_THROW(SceneCalibFromJson(WrittenThesisCalib(), "calib.json: ")); }
+
+TEST(SceneCalibWhole, BoardColumnsMustBeTheSectionsListed) {
+  Json j = WrittenThesisCalib();
+  j["board"]["cols"] = 8;  // the card beside edge k moved by a square's share: 67 px
+  ExpectCalibRefusedAt(j, "calib.json: /edges/0/sections: 7 sections but the board has 8 columns");
+}
+
+TEST(SceneCalibWhole, BoardRowsMustBeTheEdgesListed) {
+  Json j = WrittenThesisCalib();
+  j["board"]["rows"] = 11;
+  ExpectCalibRefusedAt(j, "calib.json: /edges: lists 11 edges but the board of 11 rows has 12");
+}
+
+TEST(SceneCalibWhole, RadiusUnitsMustBeWhatCalibrateWrites) {
+  Json j = WrittenThesisCalib();
+  j["r_units"] = "mm";
+  ExpectCalibRefusedAt(j, "calib.json: /r_units: must be what blurcue calibrate writes for a camera without "
+                          "dist_coeffs");
+}
+
+TEST(SceneCalibWhole, DepthsMustBePositiveAndFinite) {
+  Json j = WrittenThesisCalib();
+  j["edges"][3]["sections"][2]["u_mm"] = -5;
+  ExpectCalibRefusedAt(j, "calib.json: /edges/3/sections/2/u_mm: must be a depth in (0, 1e+06] mm");
+  j = WrittenThesisCalib();
+  j["edges"][4]["u_mm"] = -5;
+  ExpectCalibRefusedAt(j, "calib.json: /edges/4/u_mm: must be a depth in (0, 1e+06] mm");
+}
+
+TEST(SceneCalibWhole, SectionDepthMustBeItsMidpoints) {
+  Json j = WrittenThesisCalib();
+  j["edges"][3]["sections"][2]["u_mm"] = j["edges"][3]["sections"][2]["u_mm"].get<double>() + 10;
+  ExpectCalibRefusedAt(j, "calib.json: /edges/3/sections/2/u_mm: must be the depth of the section's midpoint_camera_mm");
+}
+
+TEST(SceneCalibWhole, ImagePointsMustBeInsideTheImage) {
+  Json j = WrittenThesisCalib();
+  ASSERT_TRUE(j["edges"][5]["sections"][3]["ok"].get<bool>());
+  j["edges"][5]["sections"][3]["image_px"][1][0] = 1e308;
+  ExpectCalibRefusedAt(j, "calib.json: /edges/5/sections/3/image_px/1: must be inside the");
+  j = WrittenThesisCalib();
+  j["edges"][5]["sections"][3]["image_px"] = {1, 2};
+  ExpectCalibRefusedAt(j, "calib.json: /edges/5/sections/3/image_px: must be the section's two ends");
 }
 
 // A command's blur source and a protocol's are one vocabulary (core/blur_source.h): each word a protocol may write

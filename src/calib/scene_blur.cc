@@ -8,6 +8,7 @@
 
 #include <opencv2/calib3d.hpp>
 
+#include "calib/calib_whole.h"
 #include "core/distortion.h"
 #include "core/error.h"
 #include "core/names.h"
@@ -192,6 +193,7 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
       s.sections.push_back(out);
     }
   }
+  RequireWholeCalib(j, s, where);
   return s;
 }
 

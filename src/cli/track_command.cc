@@ -46,7 +46,7 @@ void AddTrackCommand(CLI::App& app) {
   cmd->add_option("--square-mm", args->square_mm, "side of one square in mm")->capture_default_str()
       ->check(FiniteRange(1, 1000, "mm"));
   cmd->add_option("--fps", args->fps, "frame rate of an image sequence (a video's own rate is used when it has one)")
-      ->capture_default_str()->check(FinitePositive(1000, "frames per second"));
+      ->capture_default_str()->check(FiniteRange(track::kMinFps, track::kMaxFps, "frames per second"));
   cmd->add_option("--max-track-error-px", args->max_track_error_px,
                   "a tracked pose whose corners' rms reprojection error exceeds this falls back to full detection")
       ->capture_default_str()->check(FinitePositive(100, "px"));

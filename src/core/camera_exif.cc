@@ -7,6 +7,7 @@
 #include <memory>
 
 #include <libexif/exif-data.h>
+#include <libexif/exif-loader.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/error.h"
@@ -76,12 +77,14 @@ struct Exif {
         return double(exif_get_short(e->data, order));
       case EXIF_FORMAT_LONG:
         return double(exif_get_long(e->data, order));
+      case EXIF_FORMAT_SSHORT:
+        return double(exif_get_sshort(e->data, order));
+      case EXIF_FORMAT_SLONG:
+        return double(exif_get_slong(e->data, order));
       case EXIF_FORMAT_BYTE:
       case EXIF_FORMAT_ASCII:
       case EXIF_FORMAT_SBYTE:
       case EXIF_FORMAT_UNDEFINED:
-      case EXIF_FORMAT_SSHORT:
-      case EXIF_FORMAT_SLONG:
       case EXIF_FORMAT_FLOAT:
       case EXIF_FORMAT_DOUBLE:
         break;
@@ -98,6 +101,24 @@ struct Exif {
   }
 };
 
+// A photo's EXIF as stored. exif_data_new_from_file "fixes" a tag whose type is not the standard's: a FocalLength
+// stored as the signed rational -21/-1 became the unsigned 4294967275/4294967295 = 0.99999999534 mm. Loaded without
+// that fix, each number is read with its own type's sign (Exif::Number). nullptr when the file holds no EXIF.
+ExifData* LoadExifAsStored(const std::string& file) {
+  std::unique_ptr<ExifLoader, void (*)(ExifLoader*)> loader(exif_loader_new(), exif_loader_unref);
+  if (!loader) return nullptr;
+  exif_loader_write_file(loader.get(), file.c_str());
+  const unsigned char* buffer = nullptr;
+  unsigned int size = 0;
+  exif_loader_get_buf(loader.get(), &buffer, &size);
+  if (!buffer || size == 0) return nullptr;
+  ExifData* data = exif_data_new();
+  if (!data) return nullptr;
+  exif_data_unset_option(data, EXIF_DATA_OPTION_FOLLOW_SPECIFICATION);
+  exif_data_load_data(data, buffer, size);
+  return data;
+}
+
 }  // namespace
 
 ExifCamera CameraFromExif(const std::filesystem::path& photo, std::optional<std::pair<double, double>> sensor_mm,
@@ -105,7 +126,7 @@ ExifCamera CameraFromExif(const std::filesystem::path& photo, std::optional<std:
   const std::string file = photo.string();
   // The image as calibrate decodes it (EXIF orientation applied): its size is the calibration's.
   const cv::Mat image = ReadImage(photo, cv::IMREAD_COLOR);
-  std::unique_ptr<ExifData, void (*)(ExifData*)> data(exif_data_new_from_file(file.c_str()), exif_data_unref);
+  std::unique_ptr<ExifData, void (*)(ExifData*)> data(LoadExifAsStored(file), exif_data_unref);
   const bool have_exif = data != nullptr;
   const Exif exif{data.get(), have_exif ? exif_data_get_byte_order(data.get()) : EXIF_BYTE_ORDER_INTEL, file};
   auto number = [&](ExifTag tag) { return have_exif ? exif.Number(tag) : std::nullopt; };
@@ -131,7 +152,9 @@ ExifCamera CameraFromExif(const std::filesystem::path& photo, std::optional<std:
     if (given) return given;
     const std::optional<double> v = number(tag);
     if (v && *v > 0) return v;
-    absent.push_back(exif.Name(tag) + (v ? " is " + Num(*v) + " (unknown)" : std::string(" is missing")));
+    absent.push_back(exif.Name(tag) + (!v        ? std::string(" is missing")
+                                       : *v < 0 ? " is " + Num(*v) + " (negative: a damaged or hand-made tag)"
+                                                : " is " + Num(*v) + " (unknown)"));
     options.push_back(option);
     return std::nullopt;
   };

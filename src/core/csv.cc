@@ -1,5 +1,7 @@
 #include "core/csv.h"
 
+#include "core/error.h"
+
 namespace blurcue {
 namespace {
 
@@ -91,6 +93,19 @@ CsvText ParseCsv(std::string_view text, size_t max_records) {
     if (out.records.size() > max_records) return out;
   }
   return out;
+}
+
+void RequireFullRecords(const CsvText& csv, const std::string& file) {
+  if (csv.records.empty()) return;
+  const size_t want = csv.records.front().fields.size();
+  for (size_t k = 1; k < csv.records.size(); ++k) {
+    const CsvRecord& r = csv.records[k];
+    if (r.fields.size() == want) continue;
+    throw InputError(file + ": line " + std::to_string(r.line),
+                     "has " + std::to_string(r.fields.size()) + " fields, the header " + std::to_string(want) +
+                         (r.fields.size() < want ? ": the row is cut short (a truncated file, or an edit)"
+                                                 : ": the row has more fields than the header names"));
+  }
 }
 
 }  // namespace blurcue

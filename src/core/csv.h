@@ -30,4 +30,9 @@ struct CsvText {
 // unquoted field, a quote still open at the end of the file: each names where it is).
 CsvText ParseCsv(std::string_view text, size_t max_records);
 
+// Throws Error(kInput) "FILE: line N: has 3 fields, the header 19 ..." for the first record after the header with
+// another number of fields than the header: a row cut short (a file truncated mid-line, its last line without its
+// line break) or run together. For tables whose every row has every column (track.csv).
+void RequireFullRecords(const CsvText& csv, const std::string& file);
+
 }  // namespace blurcue

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
+
 namespace blurcue {
 namespace {
 
@@ -76,6 +78,22 @@ TEST(ParseCsv, StopsAfterTheLimit) {
   std::string text = "a\n";
   for (int i = 0; i < 50; ++i) text += "1\n";
   EXPECT_EQ(ParseCsv(text, 10).records.size(), 11u);
+}
+
+// A file cut inside its last row leaves a short record (3 of 19 fields) that parses: refused with its file and line.
+TEST(RequireFullRecords, ShortOrLongRowIsRefusedNamingFileAndLine) {
+  const std::string whole = "frame,time_s,status,note\n0,0.0,found,\"\"\n1,0.03,found,\"\"\n";
+  EXPECT_NO_THROW(RequireFullRecords(ParseCsv(whole, 100), "track.csv"));
+  const std::string cut = whole.substr(0, whole.size() - 6);  // "1,0.03,fo": no line break, 3 fields
+  try {
+    RequireFullRecords(ParseCsv(cut, 100), "track.csv");
+    FAIL() << "a cut row was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    EXPECT_EQ(std::string(e.what()), "track.csv: line 3: has 3 fields, the header 4: the row is cut short (a truncated "
+                                     "file, or an edit)");
+  }
+  EXPECT_THROW(RequireFullRecords(ParseCsv("a,b\n1,2,3\n", 100), "x.csv"), Error);
 }
 
 }  // namespace

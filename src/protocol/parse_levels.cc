@@ -84,12 +84,14 @@ void Parser::CheckLevelValue(const std::string& name, const Json& v, const std::
 
 namespace {
 
-// A level as typed once it has been checked. A value the parser refused inside an object level (an object or a list)
-// is kept as its JSON text, so the design's counts stay as written: the protocol is refused anyway.
+// A level as typed once it has been checked. A value the parser refused inside an object level (an object, a list,
+// true or null) is kept as its JSON text, so the design's counts stay as written: the protocol is refused anyway, with
+// the problem's pointer (LevelOf would have thrown without one).
 Level Typed(const std::string& factor, const Json& level) {
   if (!level.is_object()) return LevelOf(factor, level);
   Json scalars = Json::object();
-  for (const auto& [key, value] : level.items()) scalars[key] = value.is_structured() ? Json(value.dump()) : value;
+  for (const auto& [key, value] : level.items())
+    scalars[key] = value.is_number() || value.is_string() ? value : Json(value.dump());
   return LevelOf(factor, scalars);
 }
 
@@ -151,7 +153,8 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
       if (level.is_object() && !IsValueName(name)) {
         for (const auto& [key, value] : level.items()) {
           if (keys_checked.insert(key).second) CheckReadName(key, "level key", lp + "/" + Escape(key));
-          if (value.is_object() || value.is_array()) Problem(lp + "/" + Escape(key), "must be a number or a string", value);
+          if (!value.is_number() && !value.is_string())
+            Problem(lp + "/" + Escape(key), "must be a number or a string", value);
           else CheckLevelValue(key, value, lp + "/" + Escape(key));
         }
         const bool l = level.contains("left"), r = level.contains("right");

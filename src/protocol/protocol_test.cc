@@ -556,5 +556,18 @@ TEST(ProtocolTyped, AnObjectSideIsBothSides) {
   EXPECT_EQ(p.blocks[0].sides->right->source, BlurSource::kFitted);
 }
 
+// A level object's value that is neither a number nor a string (true, null) was refused as "a level must be a
+// number or a string, got null", naming neither the file nor the field (issue 39): it is a problem with its pointer.
+TEST(ProtocolValidate, ALevelValueOfTrueOrNullIsNamedByFileAndPointer) {
+  Json j = Valid();
+  j["blocks"][0]["factors"]["pattern"][0]["id"] = nullptr;
+  j["blocks"][0]["factors"]["pattern"][1]["speed_cm_s"] = true;
+  const std::vector<std::string> problems = Problems(j);
+  ASSERT_EQ(problems.size(), 2u);
+  const std::string file = (SceneFolder() / "p.json").string();
+  EXPECT_EQ(problems[0], file + ": /blocks/0/factors/pattern/0/id: must be a number or a string, got null");
+  EXPECT_EQ(problems[1], file + ": /blocks/0/factors/pattern/1/speed_cm_s: must be a number or a string, got true");
+}
+
 }  // namespace
 }  // namespace blurcue::protocol

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <optional>
 #include <sstream>
 
 #include <opencv2/calib3d.hpp>
@@ -91,6 +93,46 @@ void CheckCalibIsTheRows(const Json& json, const std::string& path, const Tracke
                      "older blurcue, or edited)" + again);
 }
 
+// A take has one lens model (track/take.h): each frame's calibration states it, and track.csv's row prints it. A
+// frame whose model is another (a hand edit: focus 500 mm in a take focused at 339.6) would draw its objects with
+// other blur than its neighbours; refused naming the file and the field. `first` is the take's first posed frame's
+// calibration (nullptr for that frame itself).
+void RequireTakesModel(const calib::SceneCalib& c, const std::string& path, const calib::SceneCalib* first,
+                       const std::string& first_name, const std::vector<std::string>& header, const CsvRecord& row) {
+  const optics::FittedModel& m = c.model;
+  auto differ = [](double a, double b, double tolerance) {
+    if (std::isinf(a) || std::isinf(b)) return a != b;
+    return !(std::abs(a - b) <= tolerance * std::max(1.0, std::abs(b)));
+  };
+  if (first) {
+    const optics::FittedModel& t = first->model;
+    const std::pair<const char*, std::pair<double, double>> fields[] = {{"focus_mm", {m.focus_mm, t.focus_mm}},
+                                                                        {"aperture_mm", {m.aperture_mm, t.aperture_mm}},
+                                                                        {"floor_px", {m.floor_px, t.floor_px}}};
+    for (const auto& [name, v] : fields)
+      if (differ(v.first, v.second, 1e-9))
+        throw InputError(path + ": /model/" + name, "must be the take's " + Num(v.second) + " (" + first_name +
+                                                        "'s: one lens model for the whole take), got " + Num(v.first));
+    if (m.kind != t.kind)
+      throw InputError(path + ": /model/kind", "must be the take's \"" + t.kind + "\" (" + first_name + "'s), got \"" +
+                                                   m.kind + "\"");
+  }
+  // track.csv prints the model to 3 and 5 decimals (track/take.cc).
+  const std::pair<const char*, std::pair<double, double>> printed[] = {{"focus_mm", {m.focus_mm, 0.0005}},
+                                                                       {"aperture_mm", {m.aperture_mm, 0.000005}}};
+  for (const auto& [name, v] : printed) {
+    const auto it = std::find(header.begin(), header.end(), name);
+    if (it == header.end()) continue;
+    const std::string& text = row.fields[size_t(it - header.begin())];
+    const std::optional<double> csv = text == "inf" ? std::optional<double>(std::numeric_limits<double>::infinity()) : ParseDecimal(text);
+    const bool same = csv && (std::isinf(*csv) || std::isinf(v.first) ? *csv == v.first
+                                                                       : std::abs(*csv - v.first) <= 1.01 * v.second);
+    if (!same)
+      throw InputError(path + ": /model/" + name, "must be the take's " + Echo(text, false) + " (track.csv line " +
+                                                      std::to_string(row.line) + "), got " + Num(v.first));
+  }
+}
+
 const std::vector<std::string> kBallKeys = {"kind", "name", "x_mm", "y_mm", "radius_mm", "texture"};
 const std::vector<std::string> kCardKeys = {"kind", "name", "x_mm", "y_mm", "width_mm", "height_mm", "rotation_deg",
                                             "texture"};
@@ -138,6 +180,7 @@ TrackedTake LoadTrackedTake(const std::filesystem::path& dir) {
   if (!csv.problems.empty())
     throw InputError(file + ": line " + std::to_string(csv.problems.front().line), csv.problems.front().message);
   if (csv.records.empty()) throw InputError(file, "is empty (no header)");
+  RequireFullRecords(csv, file);
   const std::vector<std::string>& header = csv.records.front().fields;
   auto column = [&](const char* name) {
     const auto it = std::find(header.begin(), header.end(), name);
@@ -174,6 +217,9 @@ TrackedTake LoadTrackedTake(const std::filesystem::path& dir) {
       f.calib = calib::SceneCalibFromJson(json, calib_path.string() + ": ");
       CheckCalibIsTheRows(json, calib_path.string(), f, row.fields[c_time]);
       f.signature = json["frame_signature"].get<std::vector<double>>();
+      RequireTakesModel(*f.calib, calib_path.string(), first_posed >= 0 ? &*take.frames[size_t(first_posed)].calib
+                                                                        : nullptr,
+                        track::CalibFileName(std::max(first_posed, 0)), header, row);
       if (first_posed >= 0 && !SameCamera(take.frames[size_t(first_posed)].calib->camera, f.calib->camera))
         throw InputError(calib_path.string() + ": /camera",
                          "is not the camera of " + track::CalibFileName(first_posed) +

@@ -61,6 +61,9 @@ std::filesystem::path PatternFile(const std::string& pattern, int index) {
 }
 
 FrameSource::FrameSource(const std::string& input, double fps) : input_(input), fps_(fps) {
+  if (!(fps >= kMinFps && fps <= kMaxFps))
+    throw Error(ErrorKind::kUsage, "a take's frame rate must be in [" + Num(kMinFps) + ", " + Num(kMaxFps) +
+                                       "] frames per second, got " + Num(fps));
   if (IsFramePattern(input)) {
     pattern_ = input;
     const std::filesystem::path first = PatternFile(input, 0);
@@ -84,7 +87,7 @@ FrameSource::FrameSource(const std::string& input, double fps) : input_(input), 
   cv::utils::logging::setLogLevel(level);
   if (!opened) throw InputError(input, "OpenCV's videoio (FFmpeg) cannot open it as a video");
   const double rate = video_.Get(cv::CAP_PROP_FPS);
-  if (rate > 0 && rate <= 1000) fps_ = rate;
+  if (rate >= kMinFps && rate <= kMaxFps) fps_ = rate;
   const double count = video_.Get(cv::CAP_PROP_FRAME_COUNT);
   expected_ = count > 0 && count < 1e7 ? static_cast<int>(std::lround(count)) : 0;
 }

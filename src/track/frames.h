@@ -13,16 +13,21 @@
 
 namespace blurcue::track {
 
+// The frame rates a take is read at, frames per second: at the slowest a day holds 864 frames, at the fastest frames
+// are 1 ms apart (what a tracked take's reader, stimulus/tracked_take.cc, accepts); a rate outside would write times
+// that are refused when read back, or 63-digit ones.
+constexpr double kMinFps = 0.01, kMaxFps = 1000;
+
 class FrameSource {
  public:
   // `fps` gives the frames' times for an image sequence (a video's own rate is used when it states one).
-  // Throws Error(kUsage) for a pattern with other than one integer conversion, Error(kInput) for a video that
-  // cannot be opened or a sequence whose first frame is missing.
+  // Throws Error(kUsage) for a pattern with other than one integer conversion or `fps` outside [kMinFps, kMaxFps],
+  // Error(kInput) for a video that cannot be opened or a sequence whose first frame is missing.
   FrameSource(const std::string& input, double fps);
 
   // The next frame (8-bit BGR) with its index and time; false at the clean end of the take. Throws Error(kInput)
   // naming the input and the frame for a damaged or truncated video, a missing frame inside a sequence, or an
-  // unreadable image.
+  // unreadable, damaged or truncated image (ReadImage checks each file whole).
   bool Next(cv::Mat* frame, int* index, double* time_s);
 
   bool is_video() const { return !pattern_; }
