@@ -1,7 +1,7 @@
 """Observed against predicted: real participants beside what blurcue's simulated observer would answer to the same
 trials, per condition, so an experimenter sees where people depart from the model.
 
-The model (src/session/observer.h) is implemented here independently. Each session is predicted with the parameters
+The model (src/procedure/observer.h) is implemented here independently. Each session is predicted with the parameters
 it recorded (trials.csv's observer_params, session::ToString(ObserverParams): "sim:model=arcmin,intrinsic=0.6,...";
 "sim:jnd=..." from before model= existed is the pixel model); a person's session records none and is predicted with
 the model's defaults (model=arcmin, DEFAULTS), and the chart says which it used.
@@ -35,10 +35,10 @@ import stats
 from common import Chart, Skip, error_bars, factor_label, participants_note, save, text
 
 Z75 = 0.6744897501960817  # Phi^-1(0.75)
-# The C++ model's defaults (session/observer.h ObserverParams, model=arcmin).
+# The C++ model's defaults (procedure/observer.h ObserverParams, model=arcmin).
 DEFAULTS = {"intrinsic_arcmin": 0.6, "weber": 0.35, "exponent": 2.0, "side_bias": 0.0, "blurrier_bias": 0.3,
             "lapse": 0.04}
-# model=pixel's defaults, and each parameter's name in the recorded spec (session/observer.cc ParseObserver).
+# model=pixel's defaults, and each parameter's name in the recorded spec (procedure/observer.cc ParseObserver).
 PIXEL_DEFAULTS = {"jnd_px": 0.6, "bias_px": 0.2, "lapse": 0.04}
 SPEC_NAMES = {"intrinsic": "intrinsic_arcmin", "weber": "weber", "exponent": "exponent", "side": "side_bias",
               "blurrier": "blurrier_bias", "lapse": "lapse", "jnd": "jnd_px", "bias": "bias_px"}

@@ -10,7 +10,7 @@ beside trials.csv, joined to each row as `procedure_parameters` by common.load_t
              marginal posterior (the cumulative mass interpolated linearly between grid points; the mean runs high,
              pulled by the grid's long upper tail), the interval its equal-tailed 95 % credible interval on the grid
              (the 2.5 % and 97.5 % quantiles, each the grid point where the cumulative mass first reaches it).
-  staircase  the turning points the procedure records (src/session/adaptive.cc Staircase::ReversalLevels: the level
+  staircase  the turning points the procedure records (src/procedure/adaptive.cc Staircase::ReversalLevels: the level
              shown on the answer that made the direction change), found by replaying its up/down rule on the answers;
              the threshold is the mean of the last 6 turning points (4 when there are 4 or 5), the interval a t
              interval over the midpoints of the consecutive turning-point pairs used (3 pairs: 2 degrees of freedom).
@@ -67,7 +67,7 @@ def cell_label(g):
 
 
 class _Staircase:
-    """The n-up/m-down rule of src/session/adaptive.cc Staircase: `level` is what it shows next; update() takes an
+    """The n-up/m-down rule of src/procedure/adaptive.cc Staircase: `level` is what it shows next; update() takes an
     answer; `turns` are the levels shown on the answers whose step went the other way than the last (ReversalLevels)."""
 
     def __init__(self, p):
@@ -261,7 +261,7 @@ def _likelihoods(p):
 
 
 def quest_next(post, psi, stimuli):
-    """QUEST+'s next stimulus (src/session/adaptive.cc QuestPlus::Next): least expected posterior entropy, the first
+    """QUEST+'s next stimulus (src/procedure/adaptive.cc QuestPlus::Next): least expected posterior entropy, the first
     of equals."""
     expected = np.zeros(len(stimuli))
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -1,4 +1,4 @@
-// quest_trace IN.json: runs blurcue's QUEST+ (session/adaptive.h) on a scripted observer and prints what it chose.
+// quest_trace IN.json: runs blurcue's QUEST+ (procedure/adaptive.h) on a scripted observer and prints what it chose.
 // IN: {"stimuli": [...], "threshold": [...], "slope": [...], "lapse": [...], "guess": g,
 //      "observer": {"threshold": t, "slope": b, "lapse": l}, "u": [u0, u1, ...]}
 // Trial i shows the procedure's next stimulus x_i and is answered correctly when u_i < the observer's Weibull at
@@ -9,7 +9,7 @@
 #include <iostream>
 
 #include "core/json_io.h"
-#include "session/adaptive.h"
+#include "procedure/adaptive.h"
 
 int main(int argc, char** argv) {
   if (argc != 2) return std::fprintf(stderr, "usage: quest_trace IN.json\n"), 2;
@@ -22,7 +22,7 @@ int main(int argc, char** argv) {
   p.lapses = in["lapse"].get<std::vector<double>>();
   p.guess = in["guess"].get<double>();
   const double t = in["observer"]["threshold"], b = in["observer"]["slope"], l = in["observer"]["lapse"];
-  blurcue::session::QuestPlus q(p);
+  blurcue::procedure::QuestPlus q(p);
   blurcue::Json shown = blurcue::Json::array();
   for (const auto& u : in["u"]) {
     const double x = q.Next();

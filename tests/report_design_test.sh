@@ -20,7 +20,7 @@ quest_per_depth)
   # One QUEST+ per depth (edges 3, 6, 9: three procedure cells of one block), three simulated observers: each depth
   # gets its own psychometric function labelled by its edge, over that cell's answers only, and no test against
   # chance (QUEST+ sets the share correct). The truth: the observer's own threshold per depth, from its formula
-  # (session/observer.h, model=arcmin defaults): a blur of std s = r / 2 arcmin is seen as E = sqrt(s^2 + 0.6^2);
+  # (procedure/observer.h, model=arcmin defaults): a blur of std s = r / 2 arcmin is seen as E = sqrt(s^2 + 0.6^2);
   # P(correct) = lapse / 2 + (1 - lapse) Phi(ln(E_test / E_ref) / sd), sd = ln(1.35) / Phi^-1(0.75), lapse 0.04 - so
   # the extra blur needed for QUEST+'s criterion (its Weibull's scale: 0.5 + 0.5 (1 - 1/e) = 81.6 % correct) grows
   # with the depth's own blur (Weber): the fits must rank the near and the far depth the same way, and the summary

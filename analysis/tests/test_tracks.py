@@ -1,5 +1,5 @@
 """tracks.py against truths it does not compute: simulated observers whose thresholds come from the observer model's
-own formula (src/session/observer.h, model=arcmin, worked here), QUEST+ stimuli chosen by python3-questplus (an
+own formula (src/procedure/observer.h, model=arcmin, worked here), QUEST+ stimuli chosen by python3-questplus (an
 independent implementation), a staircase run by a loop written here, and a hand-worked track."""
 import json
 import math

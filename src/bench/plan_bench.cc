@@ -12,7 +12,7 @@
 #include "core/error.h"
 #include "core/stats.h"
 #include "plan/plan.h"
-#include "session/prepare.h"
+#include "procedure/prepare.h"
 
 namespace blurcue::bench {
 namespace {
@@ -42,9 +42,9 @@ std::vector<PlanBenchRow> RunPlanBench(const PlanBenchOptions& options) {
   // caches and pages warm for every timed run alike.
   std::vector<std::filesystem::path> files = {options.protocol_file};
   if (!options.adaptive_file.empty()) files.push_back(options.adaptive_file);
-  std::vector<session::PreparedSession> studies;
+  std::vector<procedure::PreparedSession> studies;
   for (const auto& file : files) {
-    studies.push_back(session::PrepareStudy(file));
+    studies.push_back(procedure::PrepareStudy(file));
     std::vector<plan::Condition> conditions;
     std::vector<std::string> notes;
     int used = 0;

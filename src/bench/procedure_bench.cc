@@ -12,7 +12,7 @@
 #include "protocol/protocol.h"
 #include "plan/threshold.h"
 #include "procedure/threshold_fit.h"
-#include "session/adaptive.h"
+#include "procedure/adaptive.h"
 
 namespace blurcue::bench {
 namespace {
@@ -170,7 +170,7 @@ std::vector<ProcedureRow> RunProcedureBench(const ProcedureBenchOptions& options
               tallies[trial].estimates.push_back(FitThreshold(levels, correct, shown));
           }
         } else if (procedure == "quest_plus") {
-          session::QuestPlus q(Quest());
+          procedure::QuestPlus q(Quest());
           for (int trial = 1; trial <= most; ++trial) {
             const double x = q.Next();
             q.Update(x, o.Answer(x, rng));
@@ -179,7 +179,7 @@ std::vector<ProcedureRow> RunProcedureBench(const ProcedureBenchOptions& options
           }
         } else {
           const protocol::Procedure spec = Staircase(procedure == "staircase_1u2d" ? 2 : 3);
-          session::Staircase s(spec);
+          procedure::Staircase s(spec);
           std::vector<double> levels;
           std::vector<bool> answers;
           for (int trial = 1; trial <= most; ++trial) {

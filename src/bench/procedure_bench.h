@@ -4,7 +4,7 @@
 // threshold each estimates is compared with the observer's true one after 20, 40, 80 and 160 trials: bias,
 // precision (SD) and RMSE against the number of trials (speed: the participant's time), and where each fails -
 // observers with lapses, a side bias, a slope unlike QUEST+'s prior, a threshold beyond the stimulus range.
-// Pure computation (session/adaptive.h), no GL.
+// Pure computation (procedure/adaptive.h), no GL.
 #include <filesystem>
 #include <functional>
 #include <string>

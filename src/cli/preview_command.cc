@@ -19,13 +19,13 @@
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
 #include "render/gl_context.h"
-#include "session/adaptive.h"
-#include "session/answer.h"
-#include "session/observer.h"
-#include "session/prepare.h"
+#include "procedure/adaptive.h"
+#include "procedure/answer.h"
+#include "procedure/observer.h"
+#include "procedure/prepare.h"
 #include "session/stimulus_renderer.h"
 #include "stimulus/stimulus.h"
-#include "session/visibility.h"
+#include "procedure/visibility.h"
 
 namespace blurcue::cli {
 namespace {
@@ -147,8 +147,8 @@ void AddPreviewCommand(CLI::App& app) {
       ->transform(IntRange(1, 8));
   cmd->callback([args] {
     // The pre-flight of blurcue run: the same checks, and every trial's scene already worked out.
-    const session::ObserverParams observer = session::ParseObserver(args->observer);
-    session::PreparedSession prepared = session::PrepareStudy(args->protocol, args->display);
+    const procedure::ObserverParams observer = procedure::ParseObserver(args->observer);
+    procedure::PreparedSession prepared = procedure::PrepareStudy(args->protocol, args->display);
     const std::vector<std::string> groups = GroupsToCheck(prepared.protocol, args->group);
     const protocol::Protocol& p = prepared.protocol;
     const auto& scene = prepared.scene;
@@ -164,12 +164,12 @@ void AddPreviewCommand(CLI::App& app) {
     size_t trial_count = 0;
     for (size_t g = 0; g < groups.size(); ++g) {
       // Each group's own trials: its blocks, checked and drawn (a group's tiles together, labelled with its name).
-      session::PrepareParticipant(&prepared, args->participant, args->seed, groups[g]);
+      procedure::PrepareParticipant(&prepared, args->participant, args->seed, groups[g]);
       const auto& trials = prepared.trials;
       trial_count += trials.size();
       const size_t group_start = tiles.size();
       std::set<std::string> seen;  // labels or level keys already on the sheet
-      session::AdaptiveState adaptive(p);  // no answers yet: each procedure's first level
+      procedure::AdaptiveState adaptive(p);  // no answers yet: each procedure's first level
       for (const auto& t : trials) {
         const stimulus::TrialScene& s_planned = prepared.scenes[size_t(t.index)];
         if (protocol::TraitsOf(t.task).answer == protocol::TaskAnswer::kLevel) {
@@ -209,9 +209,9 @@ void AddPreviewCommand(CLI::App& app) {
           stimulus::ApplyLevel(procedure, t, level, prepared.presentation, &s);
           first = " (" + protocol::ToString(procedure.kind) + ": " + protocol::ToString(procedure.variable) + " " + Json(level).dump() +
                   " on the " + t.test_side + " at first)";
-          session::PlanLeveled(prepared, t, &s);
+          procedure::PlanLeveled(prepared, t, &s);
         }
-        const std::string levels = session::LevelsLabel(t);
+        const std::string levels = procedure::LevelsLabel(t);
         // Each side's radius as the camera made it (photo px) and as the screen shows it (screen px, arcmin): the
         // numbers the record keeps for these trials.
         const stimulus::Presentation& at = prepared.presentation;
@@ -222,9 +222,9 @@ void AddPreviewCommand(CLI::App& app) {
           return std::string(text);
         };
         // What an observer makes of the pair on this display: the object against the scene's blur for one object.
-        session::PairView view = session::ViewOf(s, at);
+        procedure::PairView view = procedure::ViewOf(s, at);
         if (s.left_only) view.r_right_px = view.r_scene_px;
-        const double p_correct = session::ProbabilityCorrect2afc(observer, view);
+        const double p_correct = procedure::ProbabilityCorrect2afc(observer, view);
         char seen[96];
         std::snprintf(seen, sizeof seen, "%s told apart %.0f %% (2AFC)%s", s.left_only ? "vs scene:" : "L vs R:",
                       100 * p_correct,
@@ -252,7 +252,7 @@ void AddPreviewCommand(CLI::App& app) {
       const std::string prefix = groups[g].empty() ? "" : "group " + groups[g] + ": ";
       for (size_t k = group_start; k < tiles.size(); ++k)
         tiles[k].label = prefix + tiles[k].label, tiles[k].key = Json::array({int(g), tiles[k].key});
-      for (const std::string& text : session::VisibilityLines(prepared, observer, args->visible, true))
+      for (const std::string& text : procedure::VisibilityLines(prepared, observer, args->visible, true))
         visibility.push_back(prefix + text);
     }
     std::stable_sort(tiles.begin(), tiles.end(), [](const Tile& a, const Tile& b) { return a.key < b.key; });

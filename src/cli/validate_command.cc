@@ -16,10 +16,10 @@
 #include "plan/threshold.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
-#include "session/observer.h"
-#include "session/prepare.h"
-#include "session/recorded_names.h"
-#include "session/visibility.h"
+#include "procedure/observer.h"
+#include "procedure/prepare.h"
+#include "procedure/recorded_names.h"
+#include "procedure/visibility.h"
 #include "stimulus/video_take.h"
 
 namespace blurcue::cli {
@@ -106,11 +106,11 @@ void AddValidateCommand(CLI::App& app) {
       ->capture_default_str()->check(FiniteRange(0.5, 1, "share correct"))->needs(plan);
   cmd->callback([args] {
     // The observer is checked before any file is read: a typo in it is a usage error, whatever the protocol.
-    std::optional<session::ObserverParams> observer;
+    std::optional<procedure::ObserverParams> observer;
     if (args->plan) {
       if (args->no_files)
         throw Error(ErrorKind::kUsage, "--plan needs the radii the files give; it cannot go with --no-files");
-      observer = session::ParseObserver(args->observer);
+      observer = procedure::ParseObserver(args->observer);
     }
     protocol::Protocol p;
     // One participant's session per group checked: its seed, trials and what the pre-flight found.
@@ -125,7 +125,7 @@ void AddValidateCommand(CLI::App& app) {
     if (args->no_files) {
       p = protocol::LoadProtocol(args->file, protocol::ValidateOptions{false});
       // As PrepareStudy does for run: each design variable recorded in a column of its own.
-      session::CheckRecordedNames(p);
+      procedure::CheckRecordedNames(p);
       for (const std::string& group : GroupsToCheck(p, args->group)) {
         const uint64_t seed = args->seed ? *args->seed : protocol::DefaultSeed(p.name, args->participant);
         checked.push_back({group, seed, protocol::BuildTrials(p, args->participant, seed, group), ""});
@@ -134,9 +134,9 @@ void AddValidateCommand(CLI::App& app) {
       // What `blurcue run` does before its first trial, through the same functions: files decoded, the
       // calibration read, every trial's scene and radii worked out - for each group's blocks.
       try {
-        session::PreparedSession prepared = session::PrepareStudy(args->file, args->display);
+        procedure::PreparedSession prepared = procedure::PrepareStudy(args->file, args->display);
         for (const std::string& group : GroupsToCheck(prepared.protocol, args->group)) {
-          session::PrepareParticipant(&prepared, args->participant, args->seed, group);
+          procedure::PrepareParticipant(&prepared, args->participant, args->seed, group);
           const stimulus::Presentation& at = prepared.presentation;
           char line[400];
           std::snprintf(line, sizeof line,
@@ -176,7 +176,7 @@ void AddValidateCommand(CLI::App& app) {
             shown += line;
           }
           if (observer) {
-            for (const std::string& text : session::VisibilityLines(prepared, *observer, args->visible, false))
+            for (const std::string& text : procedure::VisibilityLines(prepared, *observer, args->visible, false))
               shown += "  " + text + "\n";
             for (const std::string& problem : plan::QuestGridProblems(prepared, *observer, args->file))
               if (std::find(grid_problems.begin(), grid_problems.end(), problem) == grid_problems.end())

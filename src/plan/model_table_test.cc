@@ -1,4 +1,4 @@
-// The observer model's closed form in C++ (session/observer.h ProbabilityCorrect2afc) against the table the report's
+// The observer model's closed form in C++ (procedure/observer.h ProbabilityCorrect2afc) against the table the report's
 // independent Python implementation (analysis/prediction.py) is checked against too: the plan and the report's
 // prediction speak of one model.
 #include <cstdio>
@@ -9,9 +9,9 @@
 
 #include <gtest/gtest.h>
 
-#include "session/observer.h"
+#include "procedure/observer.h"
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 namespace {
 
 TEST(ObserverModelTable, CppClosedFormMatchesTheSharedTable) {
@@ -31,4 +31,4 @@ TEST(ObserverModelTable, CppClosedFormMatchesTheSharedTable) {
 }
 
 }  // namespace
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure

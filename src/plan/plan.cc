@@ -19,9 +19,9 @@
 #include "plan/power.h"
 #include "plan/threshold.h"
 #include "protocol/trials.h"
-#include "session/observer.h"
-#include "session/prepare.h"
-#include "session/trial_logic.h"
+#include "procedure/observer.h"
+#include "procedure/prepare.h"
+#include "procedure/trial_logic.h"
 #include "store/export.h"
 #include "store/record.h"
 #include "store/schema.h"
@@ -94,17 +94,17 @@ void SplitByGroup(const protocol::Protocol& protocol, const protocol::Trial& tri
 }
 
 // One simulated participant through the session's own decisions (what `blurcue run --observer sim` does headless).
-SimParticipant Simulate(session::PreparedSession& study, const session::ObserverParams& observer, const std::string& id,
+SimParticipant Simulate(procedure::PreparedSession& study, const procedure::ObserverParams& observer, const std::string& id,
                         uint64_t seed, const std::string& group, bool keep_answers, bool several_blocks,
-                        session::SceneCache* cache, std::map<ConditionKey, Condition>* conditions,
+                        procedure::SceneCache* cache, std::map<ConditionKey, Condition>* conditions,
                         std::set<std::string>* unplanned) {
-  session::PrepareParticipant(&study, id, seed, group, cache);
+  procedure::PrepareParticipant(&study, id, seed, group, cache);
   SimParticipant p;
   p.id = id;
   p.seed = seed;
   p.group = study.group;
   const protocol::Protocol& protocol = study.protocol;
-  session::SessionLogic logic(study, cache);
+  procedure::SessionLogic logic(study, cache);
   // A procedure cell's track: the levels shown and the answers as the procedure scored them (a missed deadline wrong).
   struct Track {
     const protocol::Procedure* procedure;
@@ -119,9 +119,9 @@ SimParticipant Simulate(session::PreparedSession& study, const session::Observer
     }
     double level = 0;
     const stimulus::TrialScene scene = logic.SceneOf(trial, &level);
-    const auto presses = session::ObserverPresses(observer, study.seed, protocol, trial, scene, study.presentation);
-    const std::string choice = session::HeadlessAnswer(protocol, trial, scene, presses).first;
-    const session::Scored scored = logic.Answer(trial, scene, level, choice);
+    const auto presses = procedure::ObserverPresses(observer, study.seed, protocol, trial, scene, study.presentation);
+    const std::string choice = procedure::HeadlessAnswer(protocol, trial, scene, presses).first;
+    const procedure::Scored scored = logic.Answer(trial, scene, level, choice);
     if (keep_answers) p.answers.emplace_back(trial.index, choice);
     if (trial.practice) continue;
     if (protocol::TraitsOf(trial.task).answer == protocol::TaskAnswer::kLevel &&
@@ -229,13 +229,13 @@ void CheckSizes(const PlanOptions& options) {
 }  // namespace
 
 std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& options,
-                                                         const session::PreparedSession& study,
+                                                         const procedure::PreparedSession& study,
                                                          std::vector<Condition>* conditions,
                                                          std::vector<std::string>* notes, int* threads_used) {
   CheckSizes(options);
-  const session::ObserverParams observer = session::ParseObserver(options.observer);
+  const procedure::ObserverParams observer = procedure::ParseObserver(options.observer);
   const protocol::Protocol& protocol = study.protocol;
-  session::CheckObserverCanAnswer(observer, protocol);
+  procedure::CheckObserverCanAnswer(observer, protocol);
   int main_blocks = 0;
   for (const auto& b : protocol.blocks) main_blocks += !b.practice;
   const bool several_blocks = main_blocks > 1;
@@ -262,8 +262,8 @@ std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& opti
   std::exception_ptr error;
   int64_t error_at = total;
   auto work = [&](int worker) {
-    session::PreparedSession mine = study;  // each worker's own copy (images are shared, read only)
-    session::SceneCache cache;              // and its own scenes, reused by its participants
+    procedure::PreparedSession mine = study;  // each worker's own copy (images are shared, read only)
+    procedure::SceneCache cache;              // and its own scenes, reused by its participants
     for (int64_t index; !failed && (index = next++) < total;) {
       const int s = int(index / n), i = int(index % n);
       try {
@@ -366,8 +366,8 @@ void AddSlopeRows(PlanResult& r, const Condition& c, const PlanOptions& options)
 PlanResult RunPlan(const PlanOptions& options) {
   if (!(options.alpha > 0 && options.alpha < 1)) throw Error(ErrorKind::kUsage, "--alpha must be in (0, 1)");
   PlanResult r;
-  (void)session::ParseObserver(options.observer);  // a bad --observer before any file is read
-  const session::PreparedSession study = session::PrepareStudy(options.protocol_file, options.display_profile);
+  (void)procedure::ParseObserver(options.observer);  // a bad --observer before any file is read
+  const procedure::PreparedSession study = procedure::PrepareStudy(options.protocol_file, options.display_profile);
   r.study = study.protocol.name;
   r.display = study.display.name;
   if (study.protocol.groups) r.groups = study.protocol.groups->names;
@@ -375,7 +375,7 @@ PlanResult RunPlan(const PlanOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   r.studies = SimulateStudies(options, study, &r.conditions, &r.notes, &r.threads_used);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  r.observer = session::ToString(session::ParseObserver(options.observer));
+  r.observer = procedure::ToString(procedure::ParseObserver(options.observer));
   const int N = options.participants, S = options.studies;
   if (r.conditions.empty())
     throw InputError(options.protocol_file.string(),

@@ -1,6 +1,6 @@
 #pragma once
 // Plan a study before anyone sits down: many seeded simulated studies of a protocol, each participant answered by
-// the simulated observer through the session's own decisions (session/trial_logic.h: the same trial list, scenes,
+// the simulated observer through the session's own decisions (procedure/trial_logic.h: the same trial list, scenes,
 // procedures, stop rules, practice criteria and answers as `blurcue run --observer sim`), headless and without GL,
 // in parallel. From them, per condition, the expected share and how wide its 95 % interval would be, and the power
 // of the protocol's tests against the number of participants:
@@ -36,7 +36,7 @@
 #include "procedure/threshold_fit.h"
 #include "protocol/level.h"
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 struct PreparedSession;
 }
 
@@ -56,7 +56,7 @@ struct PlanOptions {
   int participants = 20;                  // per simulated study; power is reported for 1 .. participants
   int studies = 200;                      // simulated studies
   uint64_t seed = 1;
-  std::string observer = "sim";           // session::ParseObserver's form
+  std::string observer = "sim";           // procedure::ParseObserver's form
   int threads = 0;                        // 0: every core (std::thread::hardware_concurrency)
   double alpha = 0.05;                    // the tests' level
   double target_power = 0.8;              // smallest N reaching this
@@ -157,11 +157,11 @@ struct PlanResult {
 // Throws Error(kInput) for a protocol that cannot be prepared (as `blurcue validate`), kUsage for bad options.
 PlanResult RunPlan(const PlanOptions& options);
 
-// Only the simulation, of a study already prepared (session::PrepareStudy of options.protocol_file and
+// Only the simulation, of a study already prepared (procedure::PrepareStudy of options.protocol_file and
 // display_profile), as the benchmark times it: the participants of options.studies studies x options.participants,
 // on options.threads workers; the conditions found (ordered), notes on what is not planned and the workers used.
 std::vector<std::vector<SimParticipant>> SimulateStudies(const PlanOptions& options,
-                                                         const session::PreparedSession& study,
+                                                         const procedure::PreparedSession& study,
                                                          std::vector<Condition>* conditions,
                                                          std::vector<std::string>* notes, int* threads_used);
 

@@ -7,8 +7,8 @@
 
 #include "protocol/design.h"
 #include "protocol/trials.h"
-#include "session/adaptive.h"
-#include "session/answer.h"
+#include "procedure/adaptive.h"
+#include "procedure/answer.h"
 
 namespace blurcue::plan {
 
@@ -31,7 +31,7 @@ std::string Short(double v) {
 
 }  // namespace
 
-TrueThreshold ObserverThreshold(const session::ObserverParams& observer, const protocol::Procedure& procedure,
+TrueThreshold ObserverThreshold(const procedure::ObserverParams& observer, const protocol::Procedure& procedure,
                                 const protocol::Trial& trial, const stimulus::TrialScene& planned,
                                 const stimulus::Presentation& presentation) {
   TrueThreshold t;
@@ -66,7 +66,7 @@ TrueThreshold ObserverThreshold(const session::ObserverParams& observer, const p
   auto share = [&](double level) {
     stimulus::TrialScene scene = planned;
     stimulus::ApplyLevel(procedure, trial, level, presentation, &scene);
-    return (1 - lapse) * session::ProbabilityCorrect2afc(observer, session::ViewOf(scene, presentation)) + lapse / 2;
+    return (1 - lapse) * procedure::ProbabilityCorrect2afc(observer, procedure::ViewOf(scene, presentation)) + lapse / 2;
   };
   if (!(target < 1 - lapse / 2)) {
     t.why = "never reached: with " + Text(lapse) + " lapses the observer is correct at most " +
@@ -101,8 +101,8 @@ TrueThreshold ObserverThreshold(const session::ObserverParams& observer, const p
   return t;
 }
 
-std::vector<std::string> QuestGridProblems(const session::PreparedSession& prepared,
-                                           const session::ObserverParams& observer, const std::string& file) {
+std::vector<std::string> QuestGridProblems(const procedure::PreparedSession& prepared,
+                                           const procedure::ObserverParams& observer, const std::string& file) {
   std::vector<std::string> problems;
   std::set<std::pair<std::string, int>> seen;
   for (const protocol::Trial& trial : prepared.trials) {
@@ -114,7 +114,7 @@ std::vector<std::string> QuestGridProblems(const session::PreparedSession& prepa
         ObserverThreshold(observer, procedure, trial, prepared.scenes[size_t(trial.index)], prepared.presentation);
     const std::string cell = protocol::CellLevels(prepared.protocol, trial);
     const std::string at = file + ": " + block->pointer + "/procedure/";
-    const std::string who = " (cell " + cell + ", observer " + session::ToString(observer) + ")";
+    const std::string who = " (cell " + cell + ", observer " + procedure::ToString(observer) + ")";
     if (!truth.determined) {
       if (truth.why.rfind("never reached", 0) != 0 && truth.why.rfind("not worked out", 0) != 0)
         problems.push_back(at + "threshold: the observer's threshold is " + truth.why + who +
@@ -131,7 +131,7 @@ std::vector<std::string> QuestGridProblems(const session::PreparedSession& prepa
 }
 
 std::vector<double> TurningPoints(const protocol::Procedure& procedure, const std::vector<bool>& correct) {
-  session::Staircase staircase(procedure);
+  procedure::Staircase staircase(procedure);
   for (const bool answer : correct) staircase.Update(answer);
   return staircase.ReversalLevels();
 }
@@ -158,7 +158,7 @@ procedure::TrackThreshold TrackEstimate(const protocol::Procedure& procedure, co
     }
     return procedure::StaircasePosterior({procedure.guess, target, procedure.min, procedure.max}, levels, correct);
   }
-  session::QuestPlus quest(procedure);
+  procedure::QuestPlus quest(procedure);
   for (size_t i = 0; i < levels.size(); ++i) quest.Update(levels[i], correct[i]);
   // The threshold's marginal: the posterior runs threshold x slope x lapse, lapse fastest.
   const size_t per_threshold = procedure.slopes.size() * procedure.lapses.size();

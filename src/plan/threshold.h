@@ -9,8 +9,8 @@
 #include "procedure/threshold_fit.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
-#include "session/observer.h"
-#include "session/prepare.h"
+#include "procedure/observer.h"
+#include "procedure/prepare.h"
 #include "stimulus/stimulus.h"
 
 namespace blurcue::plan {
@@ -43,7 +43,7 @@ struct TrueThreshold {
 // level; `planned` is the trial's scene as planned (before any level). Not determined - with the reason - for a task
 // the closed form does not cover (odd one out), an observer whose lapses keep it below the target share, or a level
 // outside what the procedure can show (a staircase's [min, max], QUEST+'s threshold grid within its stimuli's span).
-TrueThreshold ObserverThreshold(const session::ObserverParams& observer, const protocol::Procedure& procedure,
+TrueThreshold ObserverThreshold(const procedure::ObserverParams& observer, const protocol::Procedure& procedure,
                                 const protocol::Trial& trial, const stimulus::TrialScene& planned,
                                 const stimulus::Presentation& presentation);
 
@@ -52,10 +52,10 @@ TrueThreshold ObserverThreshold(const session::ObserverParams& observer, const p
 // One line per problem, naming the protocol file, the field's JSON pointer, the value and the grid; empty when every
 // cell's grid holds the observer. A grid that misses the observer's slope misplaces the threshold (a Weibull of
 // slope 1.5 fitted to an observer of slope 1.1 put QUEST+'s estimate 20 % high at 40 trials).
-std::vector<std::string> QuestGridProblems(const session::PreparedSession& prepared,
-                                           const session::ObserverParams& observer, const std::string& file);
+std::vector<std::string> QuestGridProblems(const procedure::PreparedSession& prepared,
+                                           const procedure::ObserverParams& observer, const std::string& file);
 
-// The procedure's turning points (session::Staircase::ReversalLevels: the level shown on the answer whose step goes
+// The procedure's turning points (procedure::Staircase::ReversalLevels: the level shown on the answer whose step goes
 // the other way than the last) replayed from a staircase's answers, in order.
 std::vector<double> TurningPoints(const protocol::Procedure& procedure, const std::vector<bool>& correct);
 

@@ -88,7 +88,7 @@ TEST(TrackEstimate, QuestPlusPosteriorMedianByHand) {
 // A pair at 2 px both sides, the right one the test side, seen by the pixel observer (jnd 0.6 px): a relative level
 // x makes the right side 2 (1 + x) px, and P(correct) = Phi(2 x / 0.6) before lapses.
 struct PixelPair {
-  session::ObserverParams observer = session::ParseObserver("sim:model=pixel,jnd=0.6,lapse=0");
+  procedure::ObserverParams observer = procedure::ParseObserver("sim:model=pixel,jnd=0.6,lapse=0");
   protocol::Trial trial;
   stimulus::TrialScene scene;
   stimulus::Presentation presentation;

@@ -152,7 +152,7 @@ struct Content {
   // ball: the camera's exposure time (ms) that a moving ball's motion blur lasts (its image-space velocity x this,
   // drawn with its defocus in one kernel); 0 (the default on a photo): no motion blur. On a tracked video, when not
   // given (exposure_given false), the session takes the take's camera's exposure_ms, or half a frame of the take
-  // where the camera does not state it (as `blurcue ar` does; session/prepare.cc).
+  // where the camera does not state it (as `blurcue ar` does; procedure/prepare.cc).
   double exposure_ms = 0;
   bool exposure_given = false;
   std::string texture = "soccer";     // grid: grid (the 5 x 5 card) | an image path; ball: soccer | wood | a path

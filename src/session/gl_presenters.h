@@ -12,7 +12,7 @@
 
 #include "render/frame_compositor.h"
 #include "render/gl_context.h"
-#include "session/prepare.h"
+#include "procedure/prepare.h"
 #include "session/presenter.h"
 #include "session/stimulus_renderer.h"
 
@@ -114,7 +114,7 @@ class HeadlessPresenter : public GlPresenter {
 // and what it shows in screen terms (trial-NNNN.json, DescribeFrame), written before the frame is flipped.
 class CapturingPresenter : public Presenter {
  public:
-  CapturingPresenter(GlPresenter& inner, const PreparedSession& prepared, std::filesystem::path dir,
+  CapturingPresenter(GlPresenter& inner, const procedure::PreparedSession& prepared, std::filesystem::path dir,
                      std::string participant)
       : inner_(inner), prepared_(prepared), protocol_(prepared.protocol), dir_(std::move(dir)),
         participant_(std::move(participant)) {}
@@ -152,7 +152,7 @@ class CapturingPresenter : public Presenter {
                double cutoff);
 
   GlPresenter& inner_;
-  const PreparedSession& prepared_;
+  const procedure::PreparedSession& prepared_;
   const protocol::Protocol& protocol_;
   std::filesystem::path dir_;
   std::string participant_;

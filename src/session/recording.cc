@@ -11,8 +11,8 @@
 #include "core/error.h"
 #include "display/profile.h"
 #include "protocol/design.h"
-#include "session/observer.h"
-#include "session/prepare.h"
+#include "procedure/observer.h"
+#include "procedure/prepare.h"
 #include "store/columns.h"
 #include "store/export.h"
 #include "store/record.h"
@@ -38,7 +38,7 @@ static_assert(std::string_view(kChoiceNone) == store::kChoiceNone);
 static_assert(std::string_view(kChoiceSkipped) == store::kChoiceSkipped);
 
 // The trial list as saved: one record per trial, with its planned radii.
-std::vector<store::TrialRecord> TrialRecords(const PreparedSession& s) {
+std::vector<store::TrialRecord> TrialRecords(const procedure::PreparedSession& s) {
   const protocol::Protocol& protocol = s.protocol;
   std::vector<store::TrialRecord> records;
   for (const protocol::Trial& trial : s.trials) {
@@ -129,7 +129,7 @@ SessionStart Recording::StartOrResumeSession(const std::string& study, const std
   meta.observer_params = info.observer_params;
   meta.canonical_observer = [](const std::string& stored) {
     try {
-      return ToString(ParseObserver(stored));
+      return procedure::ToString(procedure::ParseObserver(stored));
     } catch (const Error&) {
       return stored;  // not a spec this build reads: compared as stored, and the message shows it
     }
@@ -143,11 +143,11 @@ SessionStart Recording::StartOrResumeSession(const std::string& study, const std
   return {s.session_id, s.first_unanswered_trial, s.trial_count, s.resumed, s.group, s.session_number};
 }
 
-void Recording::SaveTrialList(int64_t session, const PreparedSession& prepared) {
+void Recording::SaveTrialList(int64_t session, const procedure::PreparedSession& prepared) {
   record_->SaveTrialList(session, TrialRecords(prepared));
 }
 
-void Recording::CheckTrialList(int64_t session, const PreparedSession& prepared) {
+void Recording::CheckTrialList(int64_t session, const procedure::PreparedSession& prepared) {
   record_->CheckTrialList(session, TrialRecords(prepared));
 }
 
@@ -274,7 +274,7 @@ Json TrialVariables(const protocol::Trial& trial, const TrialScene& scene, const
 }
 
 std::string ShownVariables(const protocol::Trial& trial, const TrialScene& scene, const Presentation& presentation,
-                           const Scored& scored) {
+                           const procedure::Scored& scored) {
   store::RecordedVariables v = Variables(trial, scene, presentation);
   v.correct = scored.correct.value_or(false);
   if (scored.reversals_before) v.reversals = *scored.reversals_before;
@@ -287,7 +287,7 @@ std::string ShownVariables(const protocol::Trial& trial, const TrialScene& scene
   return shown.dump();
 }
 
-std::string SkippedVariables(const Skip& skip) {
+std::string SkippedVariables(const procedure::Skip& skip) {
   store::RecordedVariables v;
   v.skipped = skip.why;
   if (skip.reversals) v.reversals = *skip.reversals;

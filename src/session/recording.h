@@ -11,9 +11,10 @@
 #include <vector>
 
 #include "core/json_io.h"
+#include "procedure/answer.h"
 #include "protocol/design.h"
 #include "protocol/trials.h"
-#include "session/trial_logic.h"
+#include "procedure/trial_logic.h"
 #include "stimulus/stimulus.h"
 #include "store/frame_columns.h"
 
@@ -21,15 +22,16 @@ namespace blurcue::store {
 class Record;
 }
 
+namespace blurcue::procedure {
+struct PreparedSession;
+}
+
 namespace blurcue::session {
 
-struct PreparedSession;
-
-// The choices recorded besides the answers themselves: no answer before the deadline, and a trial not shown (a
-// procedure ended by its stop rule, a practice run after the one that met its criterion). The record's own words
-// (store::kChoiceNone, store::kChoiceSkipped; recording.cc checks they agree).
-inline constexpr const char* kChoiceNone = "none";
-inline constexpr const char* kChoiceSkipped = "skipped";
+// The choices besides answers (procedure::kChoiceNone, kChoiceSkipped) are procedure/answer.h's; recording.cc checks
+// they are the record's own words.
+using procedure::kChoiceNone;
+using procedure::kChoiceSkipped;
 
 // One trial's answer as recorded (store::Response): the choice ("left" | "right" | "cant_tell" | an interval or
 // rating "1".."n" | yes | no | an adjustment level | kChoiceNone | kChoiceSkipped), its response time (NaN: none),
@@ -125,8 +127,8 @@ class Recording {
                                     bool resume);
   // A new session saves the prepared trial list (one row per trial with its planned radii and variables); a resumed
   // one checks that the list it saved is this one.
-  void SaveTrialList(int64_t session, const PreparedSession& prepared);
-  void CheckTrialList(int64_t session, const PreparedSession& prepared);
+  void SaveTrialList(int64_t session, const procedure::PreparedSession& prepared);
+  void CheckTrialList(int64_t session, const procedure::PreparedSession& prepared);
   // Commits one answer with its trial's frames, before anything else happens.
   void RecordResponse(int64_t session, int64_t trial_index, const Response& response,
                       const std::vector<FrameRecord>& frames = {});
@@ -159,8 +161,8 @@ Json TrialVariables(const protocol::Trial& trial, const stimulus::TrialScene& sc
 // A procedure trial's variables as shown (the response's copy, as JSON text): TrialVariables at the level shown, with
 // the answer as scored (correct: 1 | 0), a staircase's reversals before it and QUEST+'s posterior means after it.
 std::string ShownVariables(const protocol::Trial& trial, const stimulus::TrialScene& scene,
-                           const stimulus::Presentation& presentation, const Scored& scored);
+                           const stimulus::Presentation& presentation, const procedure::Scored& scored);
 // What a skipped trial's response records (JSON text): why (skipped) and a stop rule's reversals.
-std::string SkippedVariables(const Skip& skip);
+std::string SkippedVariables(const procedure::Skip& skip);
 
 }  // namespace blurcue::session

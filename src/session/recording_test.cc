@@ -6,7 +6,7 @@
 
 #include "core/error.h"
 #include "scene/frame.h"
-#include "session/observer.h"
+#include "procedure/observer.h"
 #include "stimulus/test_scenes.h"
 #include "store/export.h"
 #include "store/record.h"
@@ -84,7 +84,7 @@ TEST(ShownVariables, RecordAProceduresLevelAsTheProtocolWritesIt) {
   ASSERT_NE(t.level, 0.2);  // the binary sum, as the staircase reaches it
   Presentation shown;
   shown.scale = 1;
-  const Json v = Json::parse(ShownVariables(trial, t, shown, Scored{true, std::nullopt, std::nullopt}));
+  const Json v = Json::parse(ShownVariables(trial, t, shown, procedure::Scored{true, std::nullopt, std::nullopt}));
   EXPECT_EQ(v["level"].get<double>(), 0.2);
   EXPECT_EQ(v["level"].dump(), "0.2");
   EXPECT_EQ(TrialVariables(trial, t, shown)["level"].dump(), "0.2");
@@ -165,9 +165,9 @@ TEST(Recording, AnOldObserverSpellingResumesWithTodaysCanonicalForm) {
   Recording record = Recording::Open(dir / "r.sqlite");
   SessionInfo info;
   info.simulated = true;
-  info.observer_params = ToString(ParseObserver("sim:model=pixel,jnd=0.3"));
+  info.observer_params = procedure::ToString(procedure::ParseObserver("sim:model=pixel,jnd=0.3"));
   EXPECT_TRUE(record.StartOrResumeSession("s", "P1", protocol, 7, info, true).resumed);
-  info.observer_params = ToString(ParseObserver("sim:model=pixel,jnd=0.4"));  // another observer is still refused
+  info.observer_params = procedure::ToString(procedure::ParseObserver("sim:model=pixel,jnd=0.4"));  // another observer is still refused
   EXPECT_THROW(record.StartOrResumeSession("s", "P1", protocol, 7, info, true), Error);
 }
 

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "session/trial_logic.h"
+#include "procedure/trial_logic.h"
 
 namespace blurcue::session {
 
@@ -11,7 +11,7 @@ using render::InputEvent;
 
 std::vector<InputEvent> KeyResponder::Poll(double /*now_s*/) { return context_.TakeEvents(); }
 
-ObserverResponder::ObserverResponder(const ObserverParams& params, uint64_t seed, const protocol::Protocol& protocol,
+ObserverResponder::ObserverResponder(const procedure::ObserverParams& params, uint64_t seed, const protocol::Protocol& protocol,
                                      const stimulus::Presentation& presentation, const KeyMap& keys,
                                      Responder* window)
     : params_(params), seed_(seed), protocol_(protocol), presentation_(presentation), keys_(keys), window_(window) {}
@@ -35,16 +35,16 @@ void ObserverResponder::ScreenShown(double now_s) { Script("Return", now_s + 0.6
 // The observer's key presses for a trial whose stimulus appeared at `onset_s` (ObserverPresses, as a plan).
 void ObserverResponder::StimulusShown(const protocol::Trial& trial, const stimulus::TrialScene& scene,
                                       double onset_s) {
-  const std::vector<KeyPress> presses = ObserverPresses(params_, seed_, protocol_, trial, scene, presentation_);
+  const std::vector<procedure::KeyPress> presses = procedure::ObserverPresses(params_, seed_, protocol_, trial, scene, presentation_);
   if (protocol::TraitsOf(trial.task).answer != protocol::TaskAnswer::kLevel) {
     // A moving stimulus is watched to its end before the answer (task 1 is one answer per run); intervals too.
-    for (const KeyPress& press : presses)
+    for (const procedure::KeyPress& press : presses)
       Script(keys_.Key(press.action, trial.task),
-             onset_s + StimulusEndS(protocol::TimingOf(protocol_, trial), scene) + press.after_ms / 1000);
+             onset_s + procedure::StimulusEndS(protocol::TimingOf(protocol_, trial), scene) + press.after_ms / 1000);
     return;
   }
   double t = onset_s;
-  for (const KeyPress& press : presses) {
+  for (const procedure::KeyPress& press : presses) {
     t += press.after_ms / 1000;
     Script(keys_.Key(press.action, trial.task), t);
   }

@@ -13,7 +13,7 @@
 #include "protocol/trials.h"
 #include "render/gl_context.h"
 #include "session/keys.h"
-#include "session/observer.h"
+#include "procedure/observer.h"
 #include "stimulus/stimulus.h"
 
 namespace blurcue::session {
@@ -49,7 +49,7 @@ class KeyResponder : public Responder {
 // keys at the window count too (null headless).
 class ObserverResponder : public Responder {
  public:
-  ObserverResponder(const ObserverParams& params, uint64_t seed, const protocol::Protocol& protocol,
+  ObserverResponder(const procedure::ObserverParams& params, uint64_t seed, const protocol::Protocol& protocol,
                     const stimulus::Presentation& presentation, const KeyMap& keys, Responder* window);
   std::vector<render::InputEvent> Poll(double now_s) override;
   double NextPressS() const override;
@@ -61,7 +61,7 @@ class ObserverResponder : public Responder {
   // A key the observer will press at `time_s`; kept in time order.
   void Script(const std::string& key, double time_s);
 
-  ObserverParams params_;
+  procedure::ObserverParams params_;
   uint64_t seed_;
   const protocol::Protocol& protocol_;
   const stimulus::Presentation& presentation_;

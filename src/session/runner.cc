@@ -23,11 +23,11 @@
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
 #include "render/gl_context.h"
-#include "session/answer.h"
+#include "procedure/answer.h"
 #include "session/gl_presenters.h"
 #include "session/keys.h"
-#include "session/observer.h"
-#include "session/prepare.h"
+#include "procedure/observer.h"
+#include "procedure/prepare.h"
 #include "session/recording.h"
 #include "session/responder.h"
 #include "session/stimulus_renderer.h"
@@ -175,8 +175,8 @@ Json CollectInfo(const protocol::Protocol& p, const RunOptions& options, const G
 
 RunResult RunSession(const RunOptions& options) {
   protocol::CheckParticipantId(options.participant);
-  std::optional<ObserverParams> observer;
-  if (!options.observer.empty()) observer = ParseObserver(options.observer);
+  std::optional<procedure::ObserverParams> observer;
+  if (!options.observer.empty()) observer = procedure::ParseObserver(options.observer);
   if (options.sim_fps < 0) throw Error(ErrorKind::kUsage, "--sim-fps must be > 0");
 
   // --resume continues what a record holds: a missing record holds nothing (and is not created).
@@ -206,20 +206,20 @@ RunResult RunSession(const RunOptions& options) {
                                 : options.resume && sessions.unfinished ? sessions.unfinished_seed
                                 : DefaultSessionSeed(head.name, options.participant, session_number);
   // Everything checked before the first trial is what `blurcue validate` checks: the same function.
-  const PreparedSession prepared =
-      PrepareSession(options.protocol_file, options.participant, session_seed, options.display_profile, group);
+  const procedure::PreparedSession prepared =
+      procedure::PrepareSession(options.protocol_file, options.participant, session_seed, options.display_profile, group);
   const protocol::Protocol& protocol = prepared.protocol;
-  if (observer) CheckObserverCanAnswer(*observer, protocol);
+  if (observer) procedure::CheckObserverCanAnswer(*observer, protocol);
   // A new session's balanced group is decided again in the transaction that starts it: a station starting at the
   // same moment may take the group peeked above. So each group it may get is prepared (and checked) now.
   const bool balanced = protocol.groups && protocol.groups->assign == protocol::GroupAssign::kBalanced &&
                         !options.resume && !stays;
-  std::map<std::string, PreparedSession> other_groups;
+  std::map<std::string, procedure::PreparedSession> other_groups;
   if (balanced)
     for (const std::string& name : protocol.groups->names)
       if (name != prepared.group) {
-        PreparedSession other = prepared;
-        PrepareParticipant(&other, options.participant, session_seed, name);
+        procedure::PreparedSession other = prepared;
+        procedure::PrepareParticipant(&other, options.participant, session_seed, name);
         other_groups.emplace(name, std::move(other));
       }
   const std::string& protocol_text = prepared.protocol_text;
@@ -264,7 +264,7 @@ RunResult RunSession(const RunOptions& options) {
                 window ? context->width_px() : protocol.display.width_px,
                 window ? context->height_px() : protocol.display.height_px,
                 window && context->RefreshHz() > 0 ? ("@" + std::to_string(int(context->RefreshHz()))).c_str() : "",
-                context->Describe().c_str(), observer ? ("; observer " + ToString(*observer)).c_str() : "");
+                context->Describe().c_str(), observer ? ("; observer " + procedure::ToString(*observer)).c_str() : "");
   meta.display = display;
   meta.display_profile = display::ToJson(prepared.display).dump();
   meta.group = prepared.group;
@@ -274,7 +274,7 @@ RunResult RunSession(const RunOptions& options) {
     };
   meta.participant_info = info.dump();
   meta.simulated = observer.has_value();
-  meta.observer_params = observer ? ToString(*observer) : "";
+  meta.observer_params = observer ? procedure::ToString(*observer) : "";
   meta.window = window;
   meta.protocol_version = protocol.version;
   meta.design = protocol::DescribeDesign(protocol);
@@ -292,7 +292,7 @@ RunResult RunSession(const RunOptions& options) {
                                                                 seed, meta, options.resume);
   // The group the record gave (another than the one peeked when a station started at the same moment).
   const auto given = other_groups.find(start.group);
-  const PreparedSession& chosen = given == other_groups.end() ? prepared : given->second;
+  const procedure::PreparedSession& chosen = given == other_groups.end() ? prepared : given->second;
   // A new session saves its list; a resumed one must show the same trials in the same order.
   if (start.trial_count == 0)
     record.SaveTrialList(start.session_id, chosen);

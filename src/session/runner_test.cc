@@ -14,7 +14,7 @@
 
 #include "core/error.h"
 #include "session/keys.h"
-#include "session/trial_logic.h"
+#include "procedure/trial_logic.h"
 #include "stimulus/test_scenes.h"
 
 namespace blurcue::session {
@@ -40,22 +40,22 @@ Json GridProtocol(const Json& extra) {
 }
 
 // The session `blurcue run` prepares from a protocol, with the calibration and the photo given here instead of read.
-PreparedSession Prepare(const Json& json, const std::string& participant = "P1", uint64_t seed = 42) {
-  PreparedSession s;
+procedure::PreparedSession Prepare(const Json& json, const std::string& participant = "P1", uint64_t seed = 42) {
+  procedure::PreparedSession s;
   s.protocol_text = json.dump();
   s.protocol = protocol::ParseProtocol(json, "runner-test.json");
   s.scene = stimulus::fixtures::ThesisScene();
   s.images.photo = cv::Mat(764, 1148, CV_8UC3, cv::Scalar::all(128));
   s.images.texture = cv::Mat(64, 64, CV_8UC3, cv::Scalar::all(255));
   s.presentation = stimulus::Presentation::Of(s.protocol, s.images, s.display);
-  PrepareParticipant(&s, participant, seed);
+  procedure::PrepareParticipant(&s, participant, seed);
   return s;
 }
 
 // Records what the loop asks it to show, on a simulated clock like the headless presenter's.
 class FakePresenter : public Presenter {
  public:
-  explicit FakePresenter(const PreparedSession& prepared) : prepared_(prepared) {}
+  explicit FakePresenter(const procedure::PreparedSession& prepared) : prepared_(prepared) {}
   bool RealTime() const override { return false; }
   double FrameS() const override { return 0.25; }
   double Now() const override { return clock_s_; }
@@ -99,7 +99,7 @@ class FakePresenter : public Presenter {
   }
 
  private:
-  const PreparedSession& prepared_;
+  const procedure::PreparedSession& prepared_;
   std::array<std::optional<scene::BlurredObject>, 2> shown_;
   double clock_s_ = 0;
 };
@@ -137,7 +137,7 @@ class AnsweringResponder : public Responder {
 };
 
 // Starts (or resumes) the participant's session in `recording` and runs it.
-RunResult RunSessionOf(Recording& recording, const PreparedSession& prepared, Presenter& presenter,
+RunResult RunSessionOf(Recording& recording, const procedure::PreparedSession& prepared, Presenter& presenter,
                        Responder& responder, int stop_after = -1, bool resume = false) {
   const LoopOptions options{"runner-test.sqlite", stop_after};
   SessionInfo info;
@@ -155,7 +155,7 @@ RunResult RunSessionOf(Recording& recording, const PreparedSession& prepared, Pr
 double Level(const RecordedAnswer& answer) { return ParseJson(answer.shown_json, "shown")["level"].get<double>(); }
 
 TEST(Runner, EveryPlannedTrialGetsExactlyOneResponseInOrder) {
-  const PreparedSession prepared = Prepare(GridProtocol({{"factors", {{"edge", {2, 4, 6, 8}}}}, {"repetitions", 2}}));
+  const procedure::PreparedSession prepared = Prepare(GridProtocol({{"factors", {{"edge", {2, 4, 6, 8}}}}, {"repetitions", 2}}));
   ASSERT_EQ(prepared.trials.size(), 8u);
   Recording recording = Recording::Open(":memory:");
   FakePresenter presenter(prepared);
@@ -177,7 +177,7 @@ TEST(Runner, ResumedSessionContinuesAtTheFirstUnansweredTrialWithTheSameOrder) {
   const std::filesystem::path db = std::filesystem::temp_directory_path() / ("blurcue-runner-test-resume-" + std::to_string(::getpid()) + ".sqlite");
   std::filesystem::remove(db);
   const Json json = GridProtocol({{"factors", {{"edge", {2, 3, 4, 5, 6, 7}}}}});
-  const PreparedSession prepared = Prepare(json);
+  const procedure::PreparedSession prepared = Prepare(json);
   int64_t session = 0;
   {
     Recording recording = Recording::Open(db);
@@ -190,7 +190,7 @@ TEST(Runner, ResumedSessionContinuesAtTheFirstUnansweredTrialWithTheSameOrder) {
     session = first.session_id;
   }
   // Another sitting: the same participant's list, prepared again, continues where the record stops.
-  const PreparedSession again = Prepare(json);
+  const procedure::PreparedSession again = Prepare(json);
   Recording recording = Recording::Open(db);
   FakePresenter presenter(again);
   AnsweringResponder responder;
@@ -226,7 +226,7 @@ Json StaircaseProtocol() {
 // up by the next step, 0.2, to 0.8), correct, correct (down 0.2 to 0.6).
 TEST(Runner, StaircaseLevelsFollowTheAnswersByItsSteps) {
   const Json json = StaircaseProtocol();
-  const PreparedSession prepared = Prepare(json);
+  const procedure::PreparedSession prepared = Prepare(json);
   ASSERT_EQ(prepared.trials.size(), 6u);
   Recording recording = Recording::Open(":memory:");
   FakePresenter presenter(prepared);
@@ -247,7 +247,7 @@ TEST(Runner, StaircaseLevelsFollowTheAnswersByItsSteps) {
 TEST(Runner, ResumedStaircaseContinuesAtTheLevelItsRecordedAnswersGive) {
   const std::filesystem::path db = std::filesystem::temp_directory_path() / ("blurcue-runner-test-staircase-" + std::to_string(::getpid()) + ".sqlite");
   std::filesystem::remove(db);
-  const PreparedSession prepared = Prepare(StaircaseProtocol());
+  const procedure::PreparedSession prepared = Prepare(StaircaseProtocol());
   {
     Recording recording = Recording::Open(db);
     FakePresenter presenter(prepared);
@@ -275,7 +275,7 @@ TEST(Runner, PracticeUntilCriterionSkipsTheRunsAfterTheOneThatMetIt) {
                         {"factors", {{"edge", {3, 7}}}},
                         {"criterion", {{"correct", 1.0}, {"max_repeats", 3}}}},
                        {{"name", "main"}, {"factors", {{"edge", {2, 5}}}}}};
-  const PreparedSession prepared = Prepare(GridProtocol({{"blocks", blocks}}));
+  const procedure::PreparedSession prepared = Prepare(GridProtocol({{"blocks", blocks}}));
   ASSERT_EQ(prepared.trials.size(), 8u);  // 3 runs of 2 practice trials, then 2 main ones
   Recording recording = Recording::Open(":memory:");
   FakePresenter presenter(prepared);
@@ -294,7 +294,7 @@ TEST(Runner, ShowsTheInstructionsThenEachPartsScreenAsItsBlockBegins) {
   const Json blocks = {{{"name", "near"}, {"factors", {{"edge", {2, 3}}}}, {"instructions", "The near cards."}},
                        {{"name", "far"}, {"factors", {{"edge", {8, 9}}}}, {"instructions", "The far cards."}}};
   Json json = GridProtocol({{"blocks", blocks}, {"block_order", "fixed"}});
-  const PreparedSession prepared = Prepare(json);
+  const procedure::PreparedSession prepared = Prepare(json);
   Recording recording = Recording::Open(":memory:");
   FakePresenter presenter(prepared);
   AnsweringResponder responder;

@@ -12,7 +12,7 @@
 
 #include "core/error.h"
 #include "session/keys.h"
-#include "session/trial_logic.h"
+#include "procedure/trial_logic.h"
 
 namespace blurcue::session {
 namespace {
@@ -34,7 +34,7 @@ enum class Outcome { kAnswered, kQuit };
 
 class Runner {
  public:
-  Runner(const LoopOptions& options, const PreparedSession& prepared, Presenter& presenter, Responder& responder)
+  Runner(const LoopOptions& options, const procedure::PreparedSession& prepared, Presenter& presenter, Responder& responder)
       : options_(options), prepared_(prepared), protocol_(prepared.protocol), presenter_(presenter),
         responder_(responder), trials_(prepared.trials), scenes_(prepared.scenes),
         keys_{protocol_.responses, protocol_.layout == protocol::Layout::kOddOneOut} {}
@@ -112,7 +112,7 @@ class Runner {
     std::vector<TrialScene> intervals;
     for (int k = 0; k < n; ++k) intervals.push_back(IntervalScene(scene, IntervalShowsRight(trial, scene, k)));
     // With responses.after_motion keys count (and the prompt shows) only once the motion or the intervals are over.
-    const double answer_from_s = protocol_.responses.after_motion ? StimulusEndS(timing, scene) : 0;
+    const double answer_from_s = protocol_.responses.after_motion ? procedure::StimulusEndS(timing, scene) : 0;
     // Where keys wait for the motion's end, the window's title says when they count (" - answer"): a person sees it
     // and a test waits for it rather than for a guessed time.
     bool answer_titled = answer_from_s <= 0;
@@ -199,7 +199,7 @@ class Runner {
           response->rt_ms = t_ms;
           return Outcome::kAnswered;
         } else if ((action == "previous" || action == "next") && levels > 0) {
-          level = StepLevel(level, action, levels);
+          level = procedure::StepLevel(level, action, levels);
           steps.push_back({{"level", trial.adjust_levels[size_t(level)]}, {"t_ms", std::round(t_ms * 10) / 10}});
         } else if (action == "accept" && levels > 0) {
           response->choice = protocol::LevelText(trial.adjust_levels[size_t(level)]);
@@ -238,7 +238,7 @@ class Runner {
     // What the answers so far decided (procedures' levels and stop rules, practice runs, breaks): rebuilt by
     // replaying the record's answers through the same decisions a live session takes, so a resumed session
     // continues exactly where it was. Each replayed decision must be the one the record says was taken.
-    SessionLogic logic(prepared_);
+    procedure::SessionLogic logic(prepared_);
     // Breaks come every N answered main trials, counted over the whole session (a resumed one included); trials
     // skipped by a stop rule or a met criterion are no answers.
     int64_t main_answered = 0;
@@ -253,7 +253,7 @@ class Runner {
         const auto it = answered.find(i);
         if (it == answered.end()) throw cannot(i, "the record has no answer for it but has answers after it");
         const bool recorded_skip = it->second.choice == kChoiceSkipped;
-        const std::optional<Skip> why = logic.SkipReason(t);
+        const std::optional<procedure::Skip> why = logic.SkipReason(t);
         if (recorded_skip && !why)
           throw cannot(i, "the record skips it, but the answers before it show it (its procedure had not stopped, "
                           "its practice criterion was not met)");
@@ -306,7 +306,7 @@ class Runner {
       shown_practice = trial.practice;
       // Not shown, recorded as skipped: a procedure ended by its stop rule, a practice run after the run that met
       // its block's criterion.
-      if (const std::optional<Skip> why = logic.SkipReason(trial)) {
+      if (const std::optional<procedure::Skip> why = logic.SkipReason(trial)) {
         Response skipped;
         skipped.choice = kChoiceSkipped;
         skipped.rt_ms = std::numeric_limits<double>::quiet_NaN();
@@ -325,7 +325,7 @@ class Runner {
       if (RunTrial(trial, scene, &response, &frames) == Outcome::kQuit) break;
       // Scored, and taken by the procedure and the practice run (their state is only in memory; a resume replays
       // the record): a staircase's reversals before the answer and QUEST+'s posterior after it are recorded with it.
-      const Scored scored = logic.Answer(trial, scene, level, response.choice);
+      const procedure::Scored scored = logic.Answer(trial, scene, level, response.choice);
       const std::optional<bool> right = scored.correct;
       const bool correct = right.value_or(false);
       response.correct = right;
@@ -363,7 +363,7 @@ class Runner {
 
  private:
   const LoopOptions& options_;
-  const PreparedSession& prepared_;
+  const procedure::PreparedSession& prepared_;
   const protocol::Protocol& protocol_;
   Presenter& presenter_;
   Responder& responder_;
@@ -375,7 +375,7 @@ class Runner {
 
 }  // namespace
 
-RunResult RunTrials(const LoopOptions& options, const PreparedSession& prepared, Presenter& presenter,
+RunResult RunTrials(const LoopOptions& options, const procedure::PreparedSession& prepared, Presenter& presenter,
                     Responder& responder, Recording& recording, const SessionStart& start) {
   Runner runner(options, prepared, presenter, responder);
   return runner.Run(recording, start);

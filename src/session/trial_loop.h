@@ -6,7 +6,7 @@
 #include <filesystem>
 
 #include "session/presenter.h"
-#include "session/prepare.h"
+#include "procedure/prepare.h"
 #include "session/recording.h"
 #include "session/responder.h"
 #include "session/run_result.h"
@@ -22,7 +22,7 @@ struct LoopOptions {
 // Runs `prepared`'s trials of the session `start` (from its first unanswered trial) and returns what happened.
 // Throws Error(kInput) when the record's answers so far cannot be replayed (a resumed session that does not fit the
 // protocol any more).
-RunResult RunTrials(const LoopOptions& options, const PreparedSession& prepared, Presenter& presenter,
+RunResult RunTrials(const LoopOptions& options, const procedure::PreparedSession& prepared, Presenter& presenter,
                     Responder& responder, Recording& recording, const SessionStart& start);
 
 }  // namespace blurcue::session

@@ -51,7 +51,7 @@ class VideoTake {
   double fps_ = 30;
 };
 
-// What identifies a take in the record (session/prepare.cc adds it to the recorded protocol text as "recorded_take"):
+// What identifies a take in the record (procedure/prepare.cc adds it to the recorded protocol text as "recorded_take"):
 // its frame count, frame rate and a hash of every frame's status and signature (track::FrameSignature, as track
 // wrote them). Another take - or the same protocol text at a station that filmed its own - is then another protocol
 // text: refused under the same version, told apart by protocol_hash in a merged record and described apart in the

@@ -335,7 +335,7 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
       throw InputError(db_.path(), SessionName(session) + " was started with seed " + std::to_string(stored_seed) +
                                        ", got seed " + std::to_string(seed));
     // The session row names one observer: a resumed session answered by another would be recorded as the first.
-    // Parameters are compared in their canonical form (session::ToString), so an equivalent spec resumes.
+    // Parameters are compared in their canonical form (procedure::ToString), so an equivalent spec resumes.
     if (!running.IsNull(4)) {
       auto observer = [](bool simulated, const std::string& params) {
         return simulated ? "--observer " + params : std::string("a person (no --observer)");

@@ -43,7 +43,7 @@ struct SessionMeta {
   std::function<std::string(const std::map<std::string, int64_t>&)> assign_group;
   std::string participant_info = "{}";  // the participant information given: a JSON object key -> value
   // Who answers and where (typed columns of schema 7): a person or a simulated observer (its canonical parameters,
-  // session::ToString(ObserverParams)), in a real window on the real clock or headless on a simulated clock.
+  // procedure::ToString(ObserverParams)), in a real window on the real clock or headless on a simulated clock.
   bool simulated = false;
   std::string observer_params;
   // The canonical form of observer parameters as an older build recorded them (unset: compared as stored).

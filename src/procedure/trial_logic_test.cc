@@ -1,5 +1,5 @@
 // What a session decides between trials (trial_logic.h) and what it prepares before the first (prepare.h), by hand.
-#include "session/trial_logic.h"
+#include "procedure/trial_logic.h"
 
 #include <gtest/gtest.h>
 
@@ -7,11 +7,10 @@
 #include <string>
 
 #include "core/error.h"
-#include "session/prepare.h"
-#include "session/recording.h"
+#include "procedure/prepare.h"
 #include "stimulus/test_scenes.h"
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 namespace {
 
 using stimulus::TrialScene;
@@ -153,4 +152,4 @@ TEST(PrepareParticipant, AGroupTheProtocolDoesNotNameIsAnInputErrorNamingGroupsN
 }
 
 }  // namespace
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure

@@ -1,13 +1,13 @@
-#include "session/recorded_names.h"
+#include "procedure/recorded_names.h"
 
 #include <cctype>
 #include <map>
 #include <set>
 
 #include "core/error.h"
-#include "session/recording.h"
+#include "store/export.h"
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 namespace {
 
 // Where a design variable is given: its name, what gives it (in words) and the JSON pointer of that.
@@ -32,7 +32,7 @@ std::vector<std::string> RecordedNameProblems(const protocol::Protocol& protocol
   std::vector<std::string> problems;
   const std::string file = protocol.file.string();
   auto why = [](const std::string& name) {
-    const std::string column = RecordedColumn(name);
+    const std::string column = store::DesignColumn(name);
     return column == name ? std::string()
                           : " (" + name + " is a column trials.csv writes itself, so a design's " + name +
                                 " is recorded as " + column + ")";
@@ -57,8 +57,8 @@ std::vector<std::string> RecordedNameProblems(const protocol::Protocol& protocol
                            Json(o.name).dump());
         return;
       }
-      const std::string column = RecordedColumn(o.name);
-      if (IsRecordColumn(column)) {
+      const std::string column = store::DesignColumn(o.name);
+      if (store::IsRecordedName(column)) {
         problems.push_back(file + ": " + o.pointer + ": " + o.what + " would be recorded in " + column +
                            ", a column trials.csv writes itself; rename it, got " + Json(o.name).dump());
         return;
@@ -113,4 +113,4 @@ void CheckRecordedNames(const protocol::Protocol& protocol) {
   if (!problems.empty()) throw Error(ErrorKind::kInput, problems);
 }
 
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure

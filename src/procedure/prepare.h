@@ -16,7 +16,7 @@
 #include "protocol/trials.h"
 #include "stimulus/stimulus.h"
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 
 struct PreparedSession {
   protocol::Protocol protocol;
@@ -66,4 +66,4 @@ PreparedSession PrepareStudy(const std::filesystem::path& protocol_file,
 void PrepareParticipant(PreparedSession* study, const std::string& participant, std::optional<uint64_t> seed,
                         const std::string& group = "", SceneCache* cache = nullptr);
 
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure

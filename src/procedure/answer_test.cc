@@ -1,10 +1,10 @@
-#include "session/answer.h"
+#include "procedure/answer.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 
 using stimulus::Presentation;
 using stimulus::TrialScene;
@@ -93,4 +93,4 @@ TEST(AnswerTrial, SeedsDifferPerTrialAndRepeat) {
 }
 
 }  // namespace
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure

@@ -1,6 +1,6 @@
 // Adaptive procedures: the staircase's rules by hand, QUEST+ against the closed form and a simulated observer (its
 // agreement with python3-questplus is tests/quest_agreement.py), and one state per crossing.
-#include "session/adaptive.h"
+#include "procedure/adaptive.h"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 
 #include "core/error.h"
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 namespace {
 
 protocol::Procedure Stairs() {
@@ -134,4 +134,4 @@ TEST(AdaptiveState, AStaircaseStopsAtItsReversal) {
 }
 
 }  // namespace
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure

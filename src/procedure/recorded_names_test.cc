@@ -1,4 +1,4 @@
-#include "session/recorded_names.h"
+#include "procedure/recorded_names.h"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include "core/error.h"
 #include "protocol/protocol_test_util.h"
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 namespace {
 
 using protocol::test::Contains;
@@ -126,4 +126,4 @@ TEST(RecordedNames, AnAnalysedFactorsNameIsOneAModelFormulaReads) {
 }
 
 }  // namespace
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure

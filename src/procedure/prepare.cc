@@ -1,4 +1,4 @@
-#include "session/prepare.h"
+#include "procedure/prepare.h"
 
 #include "stimulus/video_take.h"
 
@@ -8,9 +8,9 @@
 
 #include "core/error.h"
 #include "core/json_io.h"
-#include "session/recorded_names.h"
+#include "procedure/recorded_names.h"
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 
 using stimulus::CheckRealPhotos;
 using stimulus::DescribeTrial;
@@ -139,4 +139,4 @@ PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const
   return s;
 }
 
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure

@@ -1,13 +1,13 @@
-#include "session/trial_logic.h"
+#include "procedure/trial_logic.h"
 
 #include <cmath>
 #include <cstdio>
 #include <limits>
 
 #include "core/error.h"
-#include "session/recording.h"
+#include "procedure/answer.h"
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 
 using stimulus::ApplyLevel;
 using stimulus::Presentation;
@@ -149,4 +149,4 @@ std::pair<std::string, double> HeadlessAnswer(const protocol::Protocol& protocol
   return {kChoiceNone, nan};
 }
 
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure

@@ -12,7 +12,7 @@
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 
 // n-up/m-down: `down` correct answers in a row step the level down (harder), `up` wrong ones in a row step it up;
 // a step in the other direction than the last one is a reversal; a move uses steps[min(reversals, n - 1)] (the
@@ -79,4 +79,4 @@ class AdaptiveState {
   std::map<std::pair<std::string, int>, State> states_;
 };
 
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure

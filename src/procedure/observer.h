@@ -47,7 +47,7 @@
 #include <string>
 #include <vector>
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 
 enum class ObserverModel { kArcmin, kPixel };
 
@@ -159,4 +159,4 @@ class SimulatedObserver {
   std::mt19937_64 rng_;
 };
 
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure

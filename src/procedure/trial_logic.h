@@ -14,13 +14,13 @@
 #include "core/json_io.h"
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
-#include "session/adaptive.h"
-#include "session/answer.h"
-#include "session/observer.h"
-#include "session/prepare.h"
+#include "procedure/adaptive.h"
+#include "procedure/answer.h"
+#include "procedure/observer.h"
+#include "procedure/prepare.h"
 #include "stimulus/stimulus.h"
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 
 // When a trial's stimulus has run its course, in seconds after onset: the end of its motion, or of its last interval
 // (timed by the trial's block's `timing`: protocol::TimingOf).
@@ -103,4 +103,4 @@ int StepLevel(int level, const std::string& action, int levels);
 std::pair<std::string, double> HeadlessAnswer(const protocol::Protocol& protocol, const protocol::Trial& trial,
                                               const stimulus::TrialScene& scene, const std::vector<KeyPress>& presses);
 
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure

@@ -1,11 +1,11 @@
-#include "session/adaptive.h"
+#include "procedure/adaptive.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include "core/error.h"
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 
 Staircase::Staircase(const protocol::Procedure& procedure) : p_(procedure), level_(procedure.start) {}
 
@@ -132,4 +132,4 @@ void AdaptiveState::Answer(const protocol::Trial& trial, double level, bool corr
   else std::get<QuestPlus>(state).Update(level, correct);
 }
 
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure

@@ -1,4 +1,4 @@
-#include "session/observer.h"
+#include "procedure/observer.h"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 
 #include "core/error.h"
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 namespace {
 
 double NormalCdf(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
@@ -534,4 +534,4 @@ TEST(SimulatedObserver, PixelModelAnswersAsTheObserverBeforeIt) {
 }
 
 }  // namespace
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure

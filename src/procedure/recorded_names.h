@@ -9,7 +9,7 @@
 #include "core/json_io.h"
 #include "protocol/protocol.h"
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 
 // Every design variable whose column in the record is not its own, one line each, "FILE: POINTER: what, got NAME":
 // a level is recorded under RecordedColumn(name) (factor_NAME for a name trials.csv writes itself, such as
@@ -24,4 +24,4 @@ std::vector<std::string> RecordedNameProblems(const protocol::Protocol& protocol
 // Throws Error(kInput) listing RecordedNameProblems, when there are any.
 void CheckRecordedNames(const protocol::Protocol& protocol);
 
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure

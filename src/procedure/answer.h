@@ -7,10 +7,16 @@
 
 #include "protocol/protocol.h"
 #include "protocol/trials.h"
-#include "session/observer.h"
+#include "procedure/observer.h"
 #include "stimulus/stimulus.h"
 
-namespace blurcue::session {
+namespace blurcue::procedure {
+
+// The choices recorded besides the answers themselves: no answer before the deadline, and a trial not shown (a
+// procedure ended by its stop rule, a practice run after the one that met its criterion). The record's own words
+// (store::kChoiceNone, store::kChoiceSkipped; session/recording.cc checks they agree).
+inline constexpr const char* kChoiceNone = "none";
+inline constexpr const char* kChoiceSkipped = "skipped";
 
 // The seed of the observer of one trial: from the session seed and the trial index (splitmix64), so a resumed
 // session answers exactly as an uninterrupted one, and a plan as a run.
@@ -36,4 +42,4 @@ void CheckObserverCanAnswer(const ObserverParams& observer, const protocol::Prot
 // What the observer sees of a trial's pair: its radii (photo px) and arcmin per photo px on this presentation.
 PairView ViewOf(const stimulus::TrialScene& scene, const stimulus::Presentation& presentation);
 
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure

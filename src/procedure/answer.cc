@@ -1,11 +1,11 @@
-#include "session/answer.h"
+#include "procedure/answer.h"
 
 #include <string>
 
 #include "core/error.h"
 #include "core/seed.h"
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 
 using stimulus::Presentation;
 using stimulus::TrialScene;
@@ -59,4 +59,4 @@ std::vector<KeyPress> AnswerTrial(SimulatedObserver& observer, const protocol::P
   return {press};
 }
 
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure

@@ -7,10 +7,10 @@
 #include <vector>
 
 #include "protocol/trials.h"
-#include "session/observer.h"
-#include "session/prepare.h"
+#include "procedure/observer.h"
+#include "procedure/prepare.h"
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 
 struct PairVisibility {
   std::string what;        // "measured vs estimated at edge 2", or "object measured vs the scene at blur 3"
@@ -63,4 +63,4 @@ std::vector<std::string> VisibilityLines(const PreparedSession& prepared, const 
 // this monitor" (the profile's distance), or "... predicted 91 % correct".
 std::string Describe(const PairVisibility& pair, const display::Profile& profile);
 
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure

@@ -1,4 +1,4 @@
-#include "session/observer.h"
+#include "procedure/observer.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,7 +14,7 @@
 #include "core/typed.h"
 #include "core/stats.h"
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 namespace {
 
 constexpr double kZ75 = 0.6744897501960817;  // Phi^-1(0.75)
@@ -307,4 +307,4 @@ std::vector<KeyPress> SimulatedObserver::Adjust(const std::vector<double>& level
   return presses;
 }
 
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure

@@ -1,4 +1,4 @@
-#include "session/visibility.h"
+#include "procedure/visibility.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,10 +6,10 @@
 #include <cstdio>
 #include <map>
 
-#include "session/adaptive.h"
-#include "session/answer.h"
+#include "procedure/adaptive.h"
+#include "procedure/answer.h"
 
-namespace blurcue::session {
+namespace blurcue::procedure {
 
 using stimulus::ApplyLevel;
 using stimulus::Presentation;
@@ -187,4 +187,4 @@ std::string Describe(const PairVisibility& pair, const display::Profile& profile
   return line;
 }
 
-}  // namespace blurcue::session
+}  // namespace blurcue::procedure
