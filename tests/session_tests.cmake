@@ -96,6 +96,16 @@ set_tests_properties(session_protocol_fuzz PROPERTIES
                      FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures" LABELS "gl;session;fuzz"
                      PASS_REGULAR_EXPRESSION "fuzz ok: 0 crashes" TIMEOUT 1200)
 
+# Nothing an experimenter owns is destroyed (tests/record_integrity_test.py): a record whose schema number was edited
+# is refused by every command that opens it, the file left as it was; studies whose names share a safe form, or are
+# too long for a file name, get exports and report charts of their own.
+foreach(case schema_numbers study_names)
+  add_test(NAME session_record_${case}
+           COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/record_integrity_test.py ${case} ${BC} ${T})
+  set_tests_properties(session_record_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
+                       LABELS "gl;session" PASS_REGULAR_EXPRESSION "^ok:|\nok:" TIMEOUT 900)
+endforeach()
+
 # validate == run: protocols that used to crash, hang or pass validate and then fail run. Each is refused by both
 # commands with the same one line, naming the protocol file and the field. NAME TEXT PROTOCOL-JSON
 set(D ${PROJECT_BINARY_DIR}/cli-test-data)
