@@ -15,8 +15,8 @@ missing file, a file that is not an image or not a calibration, an image of the 
 value, a repeated or multiplied list.
 
 Must hold, for every mutant: no signal, no exit 10 (or any code but 0, 2, 3), no timeout; a rejection names the
-protocol file and the field on every stderr line (libpng warnings aside): "FILE: /json/pointer..." or, for a problem
-of the file as a whole (not JSON, not UTF-8, empty, nested too deep), "FILE: " and where in the text (FIELD_OR_PLACE);
+protocol file and the field on every stderr line (libpng warnings aside): "FILE: /json/pointer: ..." or, for a text
+that is not JSON (empty, cut short, not UTF-8, nested too deep), "FILE: not valid JSON: ... line N, column M";
 an accepted protocol runs 3 trials (--stop-after 3) with the simulated observer and exits 0. Prints the counts and every failure with its seed and mutations; exits 1
 on any failure. Reproduce one mutant with --seed S --count 1 --first K (K is its index) --keep.
 """
@@ -263,13 +263,10 @@ def stderr_lines(text):
     return [line for line in text.splitlines() if line.strip() and not line.startswith("libpng")]
 
 
-# What a problem line says after "FILE: ": the field as a JSON pointer ("/blocks/0/factors/edge: ..."), or, for a
-# problem of the text as a whole, where in it (a parse error's line and column or byte, an empty file, bytes that are
-# not UTF-8, nesting past the limit). Anything else names no field.
-FIELD_OR_PLACE = re.compile(
-    r"(/[^:\s]*[:\s]"  # a JSON pointer, the root "/" included
-    r"|.*\b(line \d+|column \d+|byte \d+|at \d+|offset \d+)\b"  # where in the text
-    r"|(the file is empty|empty file|is empty|not UTF-8|not valid UTF-8|nested (deeper|more) than|nesting)\b)")
+# What a problem line says after "FILE: ": the field as a JSON pointer ("/blocks/0/factors/edge: ...", "/: ..." for the
+# whole document), or, for a text that is not JSON at all (empty, cut short, not UTF-8, nested too deep), where in it
+# the parser stopped. Anything else names no field.
+FIELD_OR_PLACE = re.compile(r"/\S*?: \S|not valid JSON: .*\bline \d+, column \d+")
 
 
 def refusal_problems(stderr, path):
