@@ -147,14 +147,19 @@ def study_names(bc, protocols, work):
                 fail("report: the section of %r shows %s, which is not there" % (name, chart))
             if len(os.path.basename(chart).encode("utf-8")) > 104:
                 fail("report: a chart's file name is over 104 bytes: %s" % chart)
+    # And across the page (the model comparison's section has a chart per study too): no file shown twice.
+    shown = [html.unescape(src) for src in re.findall(r"<img[^>]+src=['\"]([^'\"]+)['\"]", index)]
+    if len(shown) != len(set(shown)) or len(shown) < 2 * len(names):
+        fail("report: %d charts shown, %d distinct, expected at least %d: %s" % (
+            len(shown), len(set(shown)), 2 * len(names), shown))
     print("ok: 4 studies named 'pilot 1', 'pilot/1', 72 CJK characters and 'a<ZWSP>b': export and report exit 0, "
-          "%d summaries and %d charts, each study's its own" % (len(summaries), len(seen)))
+          "%d summaries and %d charts, each study's its own" % (len(summaries), len(shown)))
 
 
 def main():
     case, bc, folder = sys.argv[1:4]
-    protocols = os.path.join(folder, "protocols")
-    work = os.path.join(folder, "record-" + case)
+    protocols = os.path.abspath(os.path.join(folder, "protocols"))
+    work = os.path.abspath(os.path.join(folder, "record-" + case))
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
     {"schema_numbers": schema_numbers, "study_names": study_names}[case](bc, protocols, work)
