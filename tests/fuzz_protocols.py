@@ -16,7 +16,7 @@ value, a repeated or multiplied list.
 
 Must hold, for every mutant: no signal, no exit 10 (or any code but 0, 2, 3), no timeout; a rejection names the
 protocol file and the field on every stderr line (libpng warnings aside): "FILE: /json/pointer: ..." or, for a text
-that is not JSON (empty, cut short, not UTF-8, nested too deep), "FILE: not valid JSON: ... line N, column M";
+that is not JSON (empty, cut short, not UTF-8, nested too deep), "FILE: not valid JSON ... line N, column M";
 an accepted protocol runs 3 trials (--stop-after 3) with the simulated observer and exits 0. Prints the counts and every failure with its seed and mutations; exits 1
 on any failure. Reproduce one mutant with --seed S --count 1 --first K (K is its index) --keep.
 """
@@ -266,7 +266,7 @@ def stderr_lines(text):
 # What a problem line says after "FILE: ": the field as a JSON pointer ("/blocks/0/factors/edge: ...", "/: ..." for the
 # whole document), or, for a text that is not JSON at all (empty, cut short, not UTF-8, nested too deep), where in it
 # the parser stopped. Anything else names no field.
-FIELD_OR_PLACE = re.compile(r"/\S*?: \S|not valid JSON: .*\bline \d+, column \d+")
+FIELD_OR_PLACE = re.compile(r"/\S*?: \S|not valid JSON\b.*\bline \d+, column \d+")
 
 
 def refusal_problems(stderr, path):

@@ -229,7 +229,7 @@ add_test(NAME quest_agreement
                  ${PROJECT_BINARY_DIR}/quest-agreement)
 set_tests_properties(quest_agreement PROPERTIES PASS_REGULAR_EXPRESSION "ok: blurcue's QUEST\\+ agrees")
 # Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
-set_test_costs(capture_distortion 262 session_depth_arcmin 116 capture_subpixel 114 session_protocol_fuzz 190
+set_test_costs(capture_distortion 262 session_depth_arcmin 116 capture_subpixel 114 session_protocol_fuzz 200
                session_report_any_study 65 report_design_quest_per_depth 61 report_design_mixed_blocks 60
                capture_kernel_motion 47 capture_thesis_full 30 report_design_groups 38 report_design_sessions 35
                session_report_aborted 34 session_practice_criterion 34 session_resume 32 capture_kernel 29
