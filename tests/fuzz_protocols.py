@@ -307,7 +307,8 @@ def main():
         args.seed = (time.time_ns() // 1000 ^ os.getpid() << 20) % 10 ** 9
     # First: the seed and how to run these mutants again (a failure names its index for --first K --count 1).
     print("fuzz seed %d; reproduce: %s %s %s %s %s --seed %d --count %d --first %d" % (
-        args.seed, sys.executable, os.path.abspath(__file__), args.blurcue, args.protocols, args.work, args.seed,
+        args.seed, sys.executable, os.path.abspath(__file__), args.blurcue, os.path.abspath(args.protocols),
+        os.path.abspath(args.work), args.seed,
         args.count, args.first), flush=True)
 
     work = os.path.abspath(args.work)

@@ -24,8 +24,6 @@
 #include "store/schema.h"
 #include "store/sqlite.h"
 
-#include <sqlite3.h>
-
 namespace blurcue::store {
 namespace {
 

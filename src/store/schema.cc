@@ -386,7 +386,7 @@ void RequireReadableRecord(Database& db) {
   }
   RequireKnownSchema(db);
   if (SchemaVersion(db) == 0)
-    throw InputError(db.path(), "record schema number 0: it holds no record yet (nothing was ever recorded in it)");
+    throw InputError(db.path(), "record schema number 0 is an empty record: nothing was ever recorded in it");
   // Older versions lack only columns added since (readers take them where present), so a read-only archive of any
   // version up to this one reads.
   RequireIntactPages(db);
