@@ -235,4 +235,5 @@ set_test_costs(capture_distortion 262 session_depth_arcmin 116 capture_subpixel 
                session_report_aborted 34 session_practice_criterion 34 session_resume 32 capture_kernel 29
                session_recover 25 session_odd_names 25 session_adaptive 25 session_resume_guards 22
                session_resume_exact 22 session_numbers_balanced_counts 22 session_resume_display 21
-               session_groups_concurrent 21 session_codebook 21 session_groups_info 19 session_window 18)
+               session_groups_concurrent 21 session_codebook 21 session_groups_info 19 session_window 18
+               session_record_study_names 40 session_record_schema_numbers 12)
