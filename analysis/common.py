@@ -1,6 +1,5 @@
 """Shared helpers of the analysis scripts: reading trials.csv, the chart record, the paper style, saving figures."""
 import contextlib
-import hashlib
 import json
 import math
 import os

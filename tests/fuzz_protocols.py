@@ -17,8 +17,8 @@ value, a repeated or multiplied list.
 Must hold, for every mutant: no signal, no exit 10 (or any code but 0, 2, 3), no timeout; a rejection names the
 protocol file and the field on every stderr line (libpng warnings aside): "FILE: /json/pointer: ..." or, for a text
 that is not JSON (empty, cut short, not UTF-8, nested too deep), "FILE: not valid JSON ... line N, column M";
-an accepted protocol runs 3 trials (--stop-after 3) with the simulated observer and exits 0. Prints the counts and every failure with its seed and mutations; exits 1
-on any failure. Reproduce one mutant with --seed S --count 1 --first K (K is its index) --keep.
+an accepted protocol runs 3 trials (--stop-after 3) with the simulated observer and exits 0. Prints the counts and
+every failure with its seed and mutations; exits 1 on any failure. Reproduce one mutant with --seed S --count 1 --first K (K is its index) --keep.
 """
 import argparse
 import copy
@@ -280,7 +280,8 @@ def refusal_problems(stderr, path):
         lines = lines[:-1]  # the advice after a protocol whose files are missing
     m = re.fullmatch(r"\((\d+) problems(?:, the first (\d+) listed)?\)", lines[-1])
     if m and len(lines) != int(m.group(2) or m.group(1)) + 1:
-        out.append("%d lines for %s problems (an escaped newline joins two?)" % (len(lines) - 1, m.group(2) or m.group(1)))
+        out.append("%d lines for %s problems (an escaped newline joins two?)" % (len(lines) - 1,
+                                                                              m.group(2) or m.group(1)))
     body = lines[:-1] if m else lines
     for i, line in enumerate(body):
         prefix = ("blurcue: " if i == 0 else "") + path + ": "

@@ -237,7 +237,9 @@ void WriteFrames(Database& db, const std::filesystem::path& out_dir) {
 
 std::string FileStem(const std::string& name) {
   constexpr size_t kMaxBytes = 100, kHashBytes = 17;  // "-" and 16 hex digits
-  const auto plain = [](char c) { return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' || c == '_' || c == '.'; };
+  const auto plain = [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' || c == '_' || c == '.';
+  };
   // A byte outside `plain` is written '_' - an upper-case letter too, so that the hash tells "A" from "a" where the
   // file system does not.
   std::string safe = name;
