@@ -267,10 +267,10 @@ std::string Contents(Database& db) {
   return std::to_string(count) + " tables (" + tables + ")" + (id != 0 ? ", application id 0x" + std::string(text) : "");
 }
 
-// A record written before the application id was stamped: version 1 and the record's own tables.
+// A record written before the application id was stamped: the record's own tables. (Its schema number is judged by
+// RequireKnownSchema, which names it: an edited 0 or -5 used to be called "not a blurcue record".)
 bool IsUnstampedRecord(Database& db) {
-  return SchemaVersion(db) >= 1 &&
-         db.QueryInt64("SELECT count(*) FROM sqlite_schema WHERE type = 'table' AND name IN ('studies', "
+  return db.QueryInt64("SELECT count(*) FROM sqlite_schema WHERE type = 'table' AND name IN ('studies', "
                        "'protocol_versions', 'participants', 'sessions', 'trials', 'responses', 'frames')") == 7;
 }
 

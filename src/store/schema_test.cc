@@ -129,13 +129,15 @@ TEST(Schema, ReadersRefuseAForeignDatabase) {
 }
 
 // A current record of one study, then its schema number set to `number` by hand (as an adversary's sqlite3 would).
-void WriteRecordNumbered(const std::filesystem::path& path, int64_t number) {
+// `stamped`: with the application id every record has had since version 2 (without: an older record's).
+void WriteRecordNumbered(const std::filesystem::path& path, int64_t number, bool stamped) {
   {
     Record record = Record::Open(path);
     record.StartOrResumeSession("s", "P1", R"({"study":"s"})", 7, {}, false);
   }
   Database db(path);
   db.Exec("PRAGMA journal_mode = DELETE; PRAGMA user_version = " + std::to_string(number));
+  if (!stamped) db.Exec("PRAGMA application_id = 0");
 }
 
 // Every command's way into a record refuses a schema number this build does not know, or one its tables contradict,
@@ -154,22 +156,24 @@ TEST(Schema, AnUnknownOrEditedSchemaNumberIsRefusedEverywhere) {
       {"peek groups", [](const std::filesystem::path& p) { PeekGroups(p, "s", "P1"); }},
   };
   for (const int64_t number : numbers) {
-    const auto path = dir / ("n" + std::to_string(number) + ".sqlite");
-    WriteRecordNumbered(path, number);
-    const std::string before = testing::FileBytes(path);
-    for (const auto& [what, read] : readers) {
-      try {
-        read(path);
-        ADD_FAILURE() << what << " read a record numbered " << number;
-      } catch (const Error& e) {
-        const std::string message = e.what();
-        EXPECT_EQ(e.kind(), ErrorKind::kInput) << what << " " << number << ": " << message;
-        EXPECT_EQ(message.rfind(path.string() + ": record schema number " + std::to_string(number) + " ", 0), 0u)
-            << what << ": " << message;
-        EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    for (const bool stamped : {true, false}) {
+      const auto path = dir / ("n" + std::to_string(number) + (stamped ? "" : "-unstamped") + ".sqlite");
+      WriteRecordNumbered(path, number, stamped);
+      const std::string before = testing::FileBytes(path);
+      for (const auto& [what, read] : readers) {
+        try {
+          read(path);
+          ADD_FAILURE() << what << " read a record numbered " << number;
+        } catch (const Error& e) {
+          const std::string message = e.what();
+          EXPECT_EQ(e.kind(), ErrorKind::kInput) << what << " " << number << ": " << message;
+          EXPECT_EQ(message.rfind(path.string() + ": record schema number " + std::to_string(number) + " ", 0), 0u)
+              << what << ": " << message;
+          EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+        }
+        EXPECT_EQ(testing::FileBytes(path), before) << what << " " << number;
+        EXPECT_FALSE(std::filesystem::exists(dir / "merged.sqlite")) << what;
       }
-      EXPECT_EQ(testing::FileBytes(path), before) << what << " " << number;
-      EXPECT_FALSE(std::filesystem::exists(dir / "merged.sqlite")) << what;
     }
   }
 }
