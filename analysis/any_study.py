@@ -32,8 +32,8 @@ import groups
 import stats
 import study_tests
 import tracks
-from common import (UNKNOWN_UNIT, Chart, Skip, axis_label, error_bars, factor_label, level_text, level_unit,
-                    participants_note, save, stars, text)
+from common import (UNKNOWN_UNIT, Chart, Skip, axis_label, error_bars, factor_label, file_stem, level_text,
+                    level_unit, participants_note, save, stars, text)
 from design import design_of, load_codebook  # noqa: F401  (load_codebook: report.py reads the codebook through here)
 
 KIND_TITLES = {"pair": "forced choice between two", "odd": "odd one out",
@@ -383,8 +383,11 @@ def _analyse(d, study, codebook, out_dir, n_boot, seed, group, task, part):
                    + ("; none chose a side between unequal radii" if kind == "pair" and answered else "") + ")")
     design = design_of(m, codebook)
     left_out = _left_out_words(d, m, kind)
-    slug = _safe(study + (f"-{task}" if task else "") + (f"-{part.replace(', ', '-').replace(' ', '')}" if part else "")
-                 + (f"-{group.split()[0]}" if group else ""))
+    # The study's name is the record's (anything a person typed: its own stem, hashed when not plain, so "pilot 1" and
+    # "pilot/1" get charts of their own); what follows is this script's words.
+    slug = file_stem(study, 48) + _safe((f"-{task}" if task else "")
+                                        + (f"-{part.replace(', ', '-').replace(' ', '')}" if part else "")
+                                        + (f"-{group.split()[0]}" if group else ""))
     note = participants_note(m) + (f" ({group})" if group else "") + (f", {part}" if part else "")
     if "session_status" in m and (m["session_status"] == "running").any():
         n_running = m.loc[m["session_status"] == "running", "session_id"].nunique()
@@ -403,7 +406,7 @@ def _analyse(d, study, codebook, out_dir, n_boot, seed, group, task, part):
     for level in levels:
         rows = m[m[design.group].astype(str) == level]
         c, f = _analyse_rows(rows, kind, guess, what, design_of(rows, codebook), codebook, study, out_dir,
-                             f"{slug}-group-{_safe(level)}", f"group {level}: {participants_note(rows)}"
+                             f"{slug}-group-{file_stem(level, 32)}", f"group {level}: {participants_note(rows)}"
                              f"{note[len(participants_note(m)):]}", n_boot, seed,
                              _left_out_words(d[d[design.group].astype(str) == level], rows, kind))
         charts += c
@@ -557,7 +560,7 @@ def psychometric_cells(m, kind, guess, what, design, study, out_dir, slug, note,
     charts, words = [], []
     for cell in _sorted_levels(names) if all(names) else names:
         rows = m[cells == cell]
-        name = f"{slug}-psychometric" + (f"-{_safe(cell)}" if len(names) > 1 else "")
+        name = f"{slug}-psychometric" + (f"-{file_stem(cell, 48)}" if len(names) > 1 else "")
         # A procedure cell's threshold is read at its procedure's own criterion over what it could show, so the
         # fit and the tracks give one quantity (criteria.py).
         params = tracks.parameters(rows) if kind == "procedure" else None

@@ -1,6 +1,5 @@
 """Shared helpers of the analysis scripts: reading trials.csv, the chart record, the paper style, saving figures."""
 import contextlib
-import hashlib
 import json
 import math
 import os
@@ -308,16 +307,38 @@ def setup_style():
     })
 
 
-def file_stem(name):
-    """A chart's or table's NAME as a file name in the report's folder: letters, digits, '_', '-' and '.' kept, any
-    other character (the '/' of a factor named a/b, a space, a non-ASCII letter) written '_', then 8 hex digits of
-    NAME's SHA-1 so that two names differing only there stay two files; at most 200 characters. A factor named a/b
-    used to be a folder in the file name, and the report stopped (exit 10). The page shows NAME itself."""
+_STEM_PLAIN = frozenset(b"abcdefghijklmnopqrstuvwxyz0123456789-_.")
+_STEM_KEPT = _STEM_PLAIN | frozenset(b"ABCDEFGHIJKLMNOPQRSTUVWXYZ")
+_HEX = frozenset(b"0123456789abcdef")
+
+
+def fnv1a64_hex(data):
+    """FNV-1a 64 of DATA (bytes) as 16 lower-case hex digits: the project's hash of texts (src/core/hash.h)."""
+    h = 0xcbf29ce484222325
+    for byte in data:
+        h = ((h ^ byte) * 0x100000001b3) & 0xFFFFFFFFFFFFFFFF
+    return "%016x" % h
+
+
+def file_stem(name, max_bytes=100):
+    """A NAME of the record or a chart (a study's, a factor's, a group's) as a file name's stem: the one rule the
+    report and blurcue export make file names by (src/store/export.h FileStem, its twin; tests/data/file_stems.csv
+    pins both). NAME itself when it is 1 to MAX_BYTES bytes of lower-case ASCII letters, digits, '-', '_' and '.', not
+    starting with '.' and not itself ending in '-' and 16 hex digits; otherwise SAFE-HASH: SAFE the name's UTF-8 bytes
+    with every other byte (and a leading '.') written '_', cut to MAX_BYTES - 17 bytes, HASH the 16 hex digits of
+    FNV-1a 64 of the name's exact bytes. So a stem fits every file system (72 CJK characters are 216 bytes), and two
+    names differing anywhere ("pilot 1" and "pilot/1", a zero-width space, case only) are two files. A factor named a/b
+    used to be a folder in the file name (exit 10), and two studies "pilot 1" and "pilot/1" shared their charts. The
+    page shows NAME itself. A shorter MAX_BYTES (a study's part of a chart's name) keeps room for what follows."""
     name = str(name)
-    stem = re.sub(r"[^A-Za-z0-9_.-]", "_", name)
-    if stem == name and not stem.startswith(".") and len(stem) <= 200:
-        return stem
-    return stem.lstrip(".")[:191] + "-" + hashlib.sha1(name.encode("utf-8")).hexdigest()[:8]
+    raw = name.encode("utf-8", "surrogatepass")
+    safe = bytearray(c if c in _STEM_KEPT else 0x5F for c in raw)
+    if safe[:1] == b".":
+        safe[0] = 0x5F  # neither hidden nor "." nor ".."
+    looks_hashed = len(raw) > 17 and raw[-17] == 0x2D and all(c in _HEX for c in raw[-16:])
+    if raw and len(raw) <= max_bytes and raw[:1] != b"." and not looks_hashed and all(c in _STEM_PLAIN for c in raw):
+        return name
+    return safe[:max_bytes - 17].decode("ascii") + "-" + fnv1a64_hex(raw)
 
 
 @contextlib.contextmanager

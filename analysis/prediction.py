@@ -32,7 +32,7 @@ import pandas as pd
 from scipy.stats import norm
 
 import stats
-from common import Chart, Skip, error_bars, factor_label, participants_note, save, text
+from common import Chart, Skip, error_bars, factor_label, file_stem, participants_note, save, text
 
 Z75 = 0.6744897501960817  # Phi^-1(0.75)
 # The C++ model's defaults (procedure/observer.h ObserverParams, model=arcmin).
@@ -245,7 +245,9 @@ def charts(df, out_dir, codebook, pool_simulated=False):
         for who in kinds:
             part = m if who == "all" else m[m["observer"] == who]
             label = "all" if who == "all" else ("people" if who == "person" else "simulated observers")
-            slug = re.sub(r"[^A-Za-z0-9_-]", "_", f"{study}-predicted-{kind.split(':')[0]}-{label.split()[0]}")
+            # The study's name as its own stem (common.file_stem: "pilot 1" and "pilot/1" apart), then our words.
+            slug = file_stem(study, 48) + re.sub(r"[^A-Za-z0-9_-]", "_",
+                                                 f"-predicted-{kind.split(':')[0]}-{label.split()[0]}")
             group = design_of(part, codebook).group
             if not group:
                 out.append(_chart(part, any_study.design_factors(part, codebook), study, kind, label, slug,
@@ -254,7 +256,7 @@ def charts(df, out_dir, codebook, pool_simulated=False):
             for level in any_study._sorted_levels(list(part[group].astype(str).unique())):
                 rows = part[part[group].astype(str) == level]
                 out.append(_chart(rows, any_study.design_factors(rows, codebook), study, kind,
-                                  f"{label}, group {level}", f"{slug}-group-{any_study._safe(level)}", out_dir))
+                                  f"{label}, group {level}", f"{slug}-group-{file_stem(level, 32)}", out_dir))
     return out
 
 

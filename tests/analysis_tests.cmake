@@ -38,8 +38,12 @@ add_test(NAME analysis.tracks
 add_test(NAME analysis.scenes
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_scenes.py
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# The one rule for file names from names (common.file_stem) against the table its C++ twin is pinned by too.
+add_test(NAME analysis.file_stems
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_file_stems.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(analysis.stats analysis.report analysis.bench_charts analysis.prediction analysis.design
-                     analysis.tracks analysis.scenes PROPERTIES
+                     analysis.tracks analysis.scenes analysis.file_stems PROPERTIES
                      LABELS analysis TIMEOUT 180
                      # Matplotlib writes its font cache under HOME; keep it out of a read-only or shared home.
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")

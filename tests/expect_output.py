@@ -3,7 +3,9 @@
 REGEX - what CTest's PASS_REGULAR_EXPRESSION alone cannot do: with it CTest ignores the exit code, so a crash after
 the matched line (a GL teardown segfault, a sanitizer report) passed.
 
-usage: expect_output.py REGEX COMMAND [ARGS...]
+usage: expect_output.py [--exit N] REGEX COMMAND [ARGS...]
+
+--exit N: the command must exit N instead (a check that must catch something: a test of a test).
 
 REGEX is searched in the whole output as CMake's regular expressions do: '^' is the output's start, '.' matches a line
 break too. Exit 77 (a tool the test needs is missing) passes through: CTest reports the test as Skipped where its
@@ -16,10 +18,14 @@ import sys
 
 
 def main():
-    if len(sys.argv) < 3:
+    args = sys.argv[1:]
+    expected = 0
+    if args[:1] == ["--exit"] and len(args) > 1:
+        expected, args = int(args[1]), args[2:]
+    if len(args) < 2:
         print(__doc__, file=sys.stderr)
         return 2
-    pattern, command = sys.argv[1], sys.argv[2:]
+    pattern, command = args[0], args[1:]
     try:
         done = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
     except OSError as e:
@@ -27,15 +33,15 @@ def main():
         return 1
     out = done.stdout.decode("utf-8", "replace")
     sys.stdout.write(out)
-    if done.returncode == 77:
+    if done.returncode == 77 and expected != 77:
         print("expect_output: exit 77 (skipped: a tool the test needs is missing)")
         return 77
-    if done.returncode != 0:
+    if done.returncode != expected:
         what = f"signal {-done.returncode}" if done.returncode < 0 else f"exit code {done.returncode}"
-        print(f"\nexpect_output: FAILED: {what}, expected 0 (the output above may still match)")
+        print(f"\nexpect_output: FAILED: {what}, expected {expected} (the output above may still match)")
         return 1
     if not re.search(pattern, out, re.DOTALL):
-        print(f"\nexpect_output: FAILED: exit 0, but the output does not match {pattern!r}")
+        print(f"\nexpect_output: FAILED: exit {expected}, but the output does not match {pattern!r}")
         return 1
     return 0
 

@@ -4,6 +4,9 @@ a short simulated `blurcue run`.
 
 usage: fuzz_protocols.py BLURCUE PROTOCOLS_DIR WORK_DIR [--seed N] [--count N] [--keep]
 
+Without --seed each run draws a new seed (from the clock and the process id), so every CI run tries other mutants;
+the first line printed is the seed and the command that reproduces the run.
+
 PROTOCOLS_DIR holds the shipped protocols pointed at a real scene (tests/copy_protocols.cmake). Each mutant is one
 of them with 1-3 mutations: a deleted key, a wrong type, an extreme number (nan, 1e400, 1e308, 1e-300, -1, 0,
 2^64, ...), deep nesting (as written in the file, up to 100000 levels), an odd string (empty, NUL, unicode, 100 KB),
@@ -12,9 +15,10 @@ missing file, a file that is not an image or not a calibration, an image of the 
 value, a repeated or multiplied list.
 
 Must hold, for every mutant: no signal, no exit 10 (or any code but 0, 2, 3), no timeout; a rejection names the
-protocol file on every stderr line (libpng warnings aside); an accepted protocol runs 3 trials (--stop-after 3)
-with the simulated observer and exits 0. Prints the counts and every failure with its seed and mutations; exits 1
-on any failure. Reproduce one mutant with --seed S --count 1 --first K (K is its index) --keep.
+protocol file and the field on every stderr line (libpng warnings aside): "FILE: /json/pointer: ..." or, for a text
+that is not JSON (empty, cut short, not UTF-8, nested too deep), "FILE: not valid JSON ... line N, column M";
+an accepted protocol runs 3 trials (--stop-after 3) with the simulated observer and exits 0. Prints the counts and
+every failure with its seed and mutations; exits 1 on any failure. Reproduce one mutant with --seed S --count 1 --first K (K is its index) --keep.
 """
 import argparse
 import copy
@@ -259,16 +263,54 @@ def stderr_lines(text):
     return [line for line in text.splitlines() if line.strip() and not line.startswith("libpng")]
 
 
+# What a problem line says after "FILE: ": the field as a JSON pointer ("/blocks/0/factors/edge: ...", "/: ..." for the
+# whole document), or, for a text that is not JSON at all (empty, cut short, not UTF-8, nested too deep), where in it
+# the parser stopped. Anything else names no field.
+FIELD_OR_PLACE = re.compile(r"/\S*?: \S|not valid JSON\b.*\bline \d+, column \d+")
+
+
+def refusal_problems(stderr, path):
+    """Why a refusal's stderr does not name the protocol file and the field on every line ([] when it does). The
+    lines: "blurcue: FILE: FIELD...", then "FILE: FIELD..." per further problem, then "(N problems)"."""
+    lines = stderr_lines(stderr)
+    if not lines:
+        return ["no message"]
+    out = []
+    if len(lines) > 1 and lines[-1].startswith("('blurcue init DIR --from EXAMPLE'"):
+        lines = lines[:-1]  # the advice after a protocol whose files are missing
+    m = re.fullmatch(r"\((\d+) problems(?:, the first (\d+) listed)?\)", lines[-1])
+    if m and len(lines) != int(m.group(2) or m.group(1)) + 1:
+        out.append("%d lines for %s problems (an escaped newline joins two?)" % (len(lines) - 1,
+                                                                              m.group(2) or m.group(1)))
+    body = lines[:-1] if m else lines
+    for i, line in enumerate(body):
+        prefix = ("blurcue: " if i == 0 else "") + path + ": "
+        if not line.startswith(prefix):
+            out.append("does not name the file: " + line[:200])
+        elif not FIELD_OR_PLACE.match(line[len(prefix):]):
+            out.append("names no field: " + line[:200])
+        if "\\n" + path in line or "\\n(" in line:
+            out.append("joins two problems: " + line[:200])
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("blurcue")
     ap.add_argument("protocols")
     ap.add_argument("work")
-    ap.add_argument("--seed", type=int, default=20261123)
-    ap.add_argument("--count", type=int, default=240)
+    ap.add_argument("--seed", type=int, default=None, help="by default a new one each run (printed first)")
+    ap.add_argument("--count", type=int, default=600)
     ap.add_argument("--first", type=int, default=0, help="index of the first mutant (reproduce one)")
     ap.add_argument("--keep", action="store_true", help="keep every mutant file")
     args = ap.parse_args()
+    if args.seed is None:
+        args.seed = (time.time_ns() // 1000 ^ os.getpid() << 20) % 10 ** 9
+    # First: the seed and how to run these mutants again (a failure names its index for --first K --count 1).
+    print("fuzz seed %d; reproduce: %s %s %s %s %s --seed %d --count %d --first %d" % (
+        args.seed, sys.executable, os.path.abspath(__file__), args.blurcue, os.path.abspath(args.protocols),
+        os.path.abspath(args.work), args.seed,
+        args.count, args.first), flush=True)
 
     work = os.path.abspath(args.work)
     shutil.rmtree(os.path.join(work, "mutants"), ignore_errors=True)
@@ -285,7 +327,7 @@ def main():
               "timeout": 0, "accepted_then_failed": 0, "unnamed_message": 0}
     failures = []
     started = time.time()
-    print("seed %d, %d mutants of %s" % (args.seed, args.count, ", ".join(shipped)), flush=True)
+    print("%d mutants of %s" % (args.count, ", ".join(shipped)), flush=True)
     for index in range(args.first, args.first + args.count):
         rng = random.Random("%d/%d" % (args.seed, index))
         base = rng.choice(shipped)
@@ -338,19 +380,11 @@ def main():
             fail("validate exit 10", v.stderr)
         elif v.returncode in (2, 3):
             counts["rejected"] += 1
-            lines = stderr_lines(v.stderr)
-            # Every line names the protocol file: "blurcue: FILE: ..." first, then "FILE: ...", then "(N problems)".
-            ok = bool(lines) and lines[0].startswith("blurcue: " + path + ": ") and all(
-                line.startswith(path + ": ") or (line.startswith("(") and "problems" in line) or
-                line.startswith("('blurcue init DIR --from EXAMPLE'")
-                for line in lines[1:])
-            # Several problems come one per line: "(N problems)" closes N lines (an escaped "\n" would join them).
-            m = re.fullmatch(r"\((\d+) problems\)", lines[-1]) if lines else None
-            ok = ok and (m is None or len(lines) == int(m.group(1)) + 1) and not any(
-                "\\n" + path in line or "\\n(" in line for line in lines)
-            if not ok:
+            problems = refusal_problems(v.stderr, path)
+            if problems:
                 counts["unnamed_message"] += 1
-                fail("rejection does not name the protocol file on every line", v.stderr)
+                fail("rejection does not name the protocol file and the field on every line: " + problems[0],
+                     v.stderr)
         elif v.returncode == 0:
             counts["accepted"] += 1
             db = os.path.join(work, "run.sqlite")

@@ -84,13 +84,29 @@ set_tests_properties(display_check PROPERTIES LABELS "gl;window"
 # Protocols that cannot crash, hang or lie: a seeded generator mutates the shipped protocols (deletions, wrong types,
 # extremes, deep nesting, odd strings, bad paths) and runs each through `blurcue validate`, and each one accepted
 # through a short simulated `blurcue run`: no signal, no exit 10, no timeout, nothing accepted that then fails, and
-# every rejection names the protocol file on each line. The counts are printed; the seed is fixed (change it to
-# explore, keep it to reproduce).
+# every rejection names the protocol file and the field (a JSON pointer) on each line. The counts are printed; the
+# seed is new each run and printed first, with the command that runs the same mutants again.
 add_test(NAME session_protocol_fuzz
          COMMAND ${BLURCUE_EXPECT} "fuzz ok: 0 crashes" /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/fuzz_protocols.py ${BC} ${T}/protocols ${T}/fuzz
-                 --seed 20261123 --count 240)
+                 --count 600)
 set_tests_properties(session_protocol_fuzz PROPERTIES
                      FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures" LABELS "gl;session;fuzz" TIMEOUT 1200)
+# The fuzz's check itself: a stand-in blurcue whose every refusal names no field (or not even the file) fails it.
+add_test(NAME session_protocol_fuzz_catches_unnamed
+         COMMAND ${BLURCUE_EXPECT} --exit 1 "unnamed_message 8 .*\nfuzz: 8 failures" /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/fuzz_protocols.py
+                 ${PROJECT_SOURCE_DIR}/tests/fuzz_fake_blurcue.py ${T}/protocols ${T}/fuzz-self --count 8)
+set_tests_properties(session_protocol_fuzz_catches_unnamed PROPERTIES FIXTURES_REQUIRED "session_protocols"
+                     LABELS "session;fuzz")
+
+# Nothing an experimenter owns is destroyed (tests/record_integrity_test.py): a record whose schema number was edited
+# is refused by every command that opens it, the file left as it was; studies whose names share a safe form, or are
+# too long for a file name, get exports and report charts of their own.
+foreach(case schema_numbers study_names)
+  add_test(NAME session_record_${case}
+           COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/record_integrity_test.py ${case} ${BC} ${T})
+  set_tests_properties(session_record_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
+                       LABELS "gl;session" TIMEOUT 900)
+endforeach()
 
 # validate == run: protocols that used to crash, hang or pass validate and then fail run. Each is refused by both
 # commands with the same one line, naming the protocol file and the field. NAME TEXT PROTOCOL-JSON
@@ -208,10 +224,11 @@ add_test(NAME quest_agreement
                  ${PROJECT_BINARY_DIR}/quest-agreement)
 
 # Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
-set_test_costs(capture_distortion 262 session_depth_arcmin 116 capture_subpixel 114 session_protocol_fuzz 77
+set_test_costs(capture_distortion 262 session_depth_arcmin 116 capture_subpixel 114 session_protocol_fuzz 200
                session_report_any_study 65 report_design_quest_per_depth 61 report_design_mixed_blocks 60
                capture_kernel_motion 47 capture_thesis_full 30 report_design_groups 38 report_design_sessions 35
                session_report_aborted 34 session_practice_criterion 34 session_resume 32 capture_kernel 29
                session_recover 25 session_odd_names 25 session_adaptive 25 session_resume_guards 22
                session_resume_exact 22 session_numbers_balanced_counts 22 session_resume_display 21
-               session_groups_concurrent 21 session_codebook 21 session_groups_info 19 session_window 18)
+               session_groups_concurrent 21 session_codebook 21 session_groups_info 19 session_window 18
+               session_record_study_names 40 session_record_schema_numbers 12)

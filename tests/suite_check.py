@@ -30,7 +30,8 @@ def main():
             problems.append(f"{name}: SKIP_RETURN_CODE {props['SKIP_RETURN_CODE']} (the suite's skip code is 77)")
         if any(c.endswith("expect_output.py") for c in command):
             wrapped += 1
-            regex = command[[c.endswith("expect_output.py") for c in command].index(True) + 1]
+            rest = command[[c.endswith("expect_output.py") for c in command].index(True) + 1:]
+            regex = rest[2] if rest[:1] == ["--exit"] else rest[0]
             if "SKIP" in regex:
                 problems.append(f"{name}: its expected output {regex!r} lets a skip pass")
         if "TIMEOUT" in props and float(props["TIMEOUT"]) < 60:

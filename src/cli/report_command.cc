@@ -12,6 +12,8 @@
 #include "core/data_dir.h"
 #include "core/error.h"
 #include "store/export.h"
+#include "store/schema.h"
+#include "store/sqlite.h"
 
 namespace blurcue::cli {
 
@@ -72,6 +74,11 @@ void AddReportCommand(CLI::App& app) {
     const std::filesystem::path out = args->out;
     const std::filesystem::path script = DataDir().path / "analysis" / "report.py";
     if (!std::filesystem::exists(script)) throw InputError(script.string(), "the analysis script is missing");
+    {
+      // The record is judged before anything is made: a record this build cannot read leaves no folder behind.
+      store::Database record(args->db, store::OpenMode::kReadOnly);
+      store::RequireReadableRecord(record);
+    }
     RequirePython3(args->python, {"numpy", "pandas", "matplotlib", "scipy", "statsmodels"});
     for (const auto& path : RemoveStaleLeftovers(out))
       std::fprintf(stderr, "report: removed %s, left by an interrupted run\n", path.c_str());

@@ -84,14 +84,16 @@ void Parser::CheckLevelValue(const std::string& name, const Json& v, const std::
 
 namespace {
 
-// A level as typed once it has been checked. A value the parser refused inside an object level (an object, a list,
-// true or null) is kept as its JSON text, so the design's counts stay as written: the protocol is refused anyway, with
-// the problem's pointer (LevelOf would have thrown without one).
+// A level as typed once it has been checked. A value the parser refused (an object, a list, true or null, inside an
+// object level or as the level) is kept as its JSON text, so the design's counts stay as written and the refusal
+// names its field: the protocol is refused anyway. (A pattern's "right": true used to stop validate with "a level
+// must be a number or a string, got true", naming neither the file nor the field.)
+Json Kept(const Json& value) { return value.is_string() || value.is_number() ? value : Json(value.dump()); }
+
 Level Typed(const std::string& factor, const Json& level) {
-  if (!level.is_object()) return LevelOf(factor, level);
+  if (!level.is_object()) return LevelOf(factor, Kept(level));
   Json scalars = Json::object();
-  for (const auto& [key, value] : level.items())
-    scalars[key] = value.is_number() || value.is_string() ? value : Json(value.dump());
+  for (const auto& [key, value] : level.items()) scalars[key] = Kept(value);
   return LevelOf(factor, scalars);
 }
 

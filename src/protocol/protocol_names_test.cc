@@ -19,6 +19,21 @@ std::string Line(const std::string& pointer_and_message) {
   return (SceneFolder() / "p.json").string() + ": " + pointer_and_message;
 }
 
+// A level's value that is true or null - a pattern's side, its speed, a section - is refused naming the file and its
+// field (a pattern's "right": true stopped validate with "a level must be a number or a string, got true", naming
+// neither; found by the protocol fuzz).
+TEST(ProtocolValidate, ALevelsTrueOrNullIsRefusedNamingItsField) {
+  Json j = Valid();
+  j["blocks"][0]["factors"]["pattern"][1]["right"] = true;
+  EXPECT_TRUE(Contains(OnlyProblem(j), Line("/blocks/0/factors/pattern/1/right: a blur source must be ")));
+  j = Valid();
+  j["blocks"][0]["factors"]["pattern"][0]["speed_cm_s"] = nullptr;
+  ExpectProblem(j, Line("/blocks/0/factors/pattern/0/speed_cm_s: "));
+  j = Valid();
+  j["blocks"][1]["factors"]["section"][0] = true;
+  ExpectProblem(j, Line("/blocks/1/factors/section/0: "));
+}
+
 TEST(ProtocolValidate, MisspeltFactorIsRefusedWithDidYouMean) {
   Json j = Valid();
   j["blocks"][1]["factors"].erase("section");

@@ -24,8 +24,6 @@
 #include "store/schema.h"
 #include "store/sqlite.h"
 
-#include <sqlite3.h>
-
 namespace blurcue::store {
 namespace {
 
@@ -217,23 +215,8 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
 int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::path& db_path,
                       const std::filesystem::path& out_dir, const ProgressNote& note) {
   Note(note, RemoveStaleLeftovers(out_dir));
-  Database source(db_path, OpenMode::kReadOnly);
-  RequireReadableRecord(source);
-  // A record of an earlier version is exported from a migrated copy in memory (the record itself is only read: it may
-  // be a read-only archive; and a killed export leaves no copy behind): SQLite's backup copies it, the migration
-  // derives its typed columns.
-  std::optional<Database> copy;
-  if (SchemaVersion(source) < CurrentSchemaVersion()) {
-    copy.emplace(":memory:");
-    sqlite3_backup* backup = sqlite3_backup_init(copy->handle(), "main", source.handle(), "main");
-    const int step = backup ? sqlite3_backup_step(backup, -1) : SQLITE_ERROR;
-    const int finish = backup ? sqlite3_backup_finish(backup) : SQLITE_ERROR;
-    if (step != SQLITE_DONE || finish != SQLITE_OK)
-      throw InputError(db_path.string(), std::string("cannot copy the record to migrate it for export: ") +
-                                             sqlite3_errmsg(copy->handle()));
-    Migrate(*copy);
-  }
-  Database& db = copy ? *copy : source;
+  // A record of an earlier version is exported from a migrated copy in memory (the record itself is only read).
+  Database db = OpenRecordForReading(db_path);
 
   // Pass 1: every design variable in the record (factor levels and the variables recorded with them, planned and as
   // shown), with the codebook's type of each, so every participant gets the same columns.

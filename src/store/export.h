@@ -98,10 +98,16 @@ struct SessionSummary {
 // current blurcue record.
 std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path);
 
-// The file name of a study's summary, the same for the study in any record: summary-STUDY.csv when the name is
-// lower-case ASCII letters, digits, '-' and '_' only (and does not itself end in '-' and 16 hex digits); otherwise
-// summary-SAFE-HASH.csv, SAFE the name with every other byte written '_' and HASH the 16 hex digits of FNV-1a 64 of
-// the name as recorded. So "a<b", "a>b", "a b" and "A<B" get four files, none differing from another by case only.
+// A name of the record (a study's, a factor's, a group's) as a file name's stem: the one rule export and the report
+// (analysis/common.py file_stem, its twin; tests/data/file_stems.csv pins both) make file names by. The name itself
+// when it is 1-100 bytes of lower-case ASCII letters, digits, '-', '_' and '.', not starting with '.' and not itself
+// ending in '-' and 16 hex digits; otherwise SAFE-HASH: SAFE the name's UTF-8 bytes with every other byte (and a
+// leading '.') written '_', cut to 83 bytes, HASH the 16 hex digits of FNV-1a 64 of the name's exact bytes. So a stem
+// is at most 100 bytes on every file system (72 CJK characters are 216 bytes), and two names differing anywhere -
+// "pilot 1" and "pilot/1", "a b" and "A b", a zero-width space - are two files, none differing by case only.
+std::string FileStem(const std::string& name);
+
+// The file name of a study's summary, the same for the study in any record: summary-FileStem(STUDY).csv.
 std::string SummaryFileName(const std::string& study);
 
 // One CSV field, quoted when it holds a comma, quote, line break or leading/trailing space.

@@ -235,21 +235,26 @@ void WriteFrames(Database& db, const std::filesystem::path& out_dir) {
   WriteFileAtomically(out_dir / "frames.csv", text);
 }
 
-std::string SummaryFileName(const std::string& study) {
-  // Plain: what needs no change on any file system and cannot be mistaken for a name with a suffix.
-  const bool plain =
-      !study.empty() && std::all_of(study.begin(), study.end(), [](char c) {
-        return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' || c == '_';
-      });
-  const bool looks_suffixed = study.size() > 17 && study[study.size() - 17] == '-' &&
-                              study.find_first_not_of("0123456789abcdef", study.size() - 16) == std::string::npos;
-  if (plain && !looks_suffixed) return "summary-" + study + ".csv";
-  std::string safe = study;
+std::string FileStem(const std::string& name) {
+  constexpr size_t kMaxBytes = 100, kHashBytes = 17;  // "-" and 16 hex digits
+  const auto plain = [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' || c == '_' || c == '.';
+  };
+  // A byte outside `plain` is written '_' - an upper-case letter too, so that the hash tells "A" from "a" where the
+  // file system does not.
+  std::string safe = name;
   for (char& c : safe)
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
-  char hash[17];
-  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(Fnv1a64(study)));
-  return "summary-" + safe + "-" + hash + ".csv";
+    if (!plain(c) && !(c >= 'A' && c <= 'Z')) c = '_';
+  if (!safe.empty() && safe[0] == '.') safe[0] = '_';  // neither hidden nor "." nor ".."
+  // A plain name shaped like a stem with its hash is hashed too, so no plain name equals another's SAFE-HASH.
+  const bool looks_hashed = name.size() > kHashBytes && name[name.size() - kHashBytes] == '-' &&
+                            name.find_first_not_of("0123456789abcdef", name.size() - 16) == std::string::npos;
+  if (!name.empty() && name.size() <= kMaxBytes && name[0] != '.' && !looks_hashed &&
+      std::all_of(name.begin(), name.end(), plain))
+    return name;
+  return safe.substr(0, kMaxBytes - kHashBytes) + "-" + HashHex(Fnv1a64(name));
 }
+
+std::string SummaryFileName(const std::string& study) { return "summary-" + FileStem(study) + ".csv"; }
 
 }  // namespace blurcue::store

@@ -182,6 +182,45 @@ TEST(Export, SummariesOfStudiesWhoseNamesCollideAsFileNamesAreEachKept) {
   EXPECT_TRUE(named);
 }
 
+// The one rule for file names from names, against the table its Python twin (analysis/common.py file_stem) reads.
+TEST(Export, FileStemsAreTheGoldenTables) {
+  const Rows rows = ReadCsv(BLURCUE_FILE_STEMS);
+  ASSERT_GT(rows.size(), 30u);
+  ASSERT_EQ(rows[0], (std::vector<std::string>{"name", "stem"}));
+  std::set<std::string> stems;
+  for (size_t i = 1; i < rows.size(); ++i) {
+    ASSERT_EQ(rows[i].size(), 2u) << i;
+    EXPECT_EQ(FileStem(rows[i][0]), rows[i][1]) << rows[i][0];
+    EXPECT_LE(rows[i][1].size(), 100u);
+    EXPECT_TRUE(stems.insert(rows[i][1]).second) << rows[i][1];
+  }
+}
+
+// Studies whose names share a safe form ("pilot 1", "pilot/1"), one of 72 CJK characters (216 bytes: its summary's
+// name was too long for the file system, and every study's export stopped with exit 3) and one with a zero-width
+// space each get a summary of their own, of at most 112 bytes.
+TEST(Export, NamesSharingASafeFormOrTooLongGetSummariesOfTheirOwn) {
+  testing::TempDir dir;
+  std::string cjk;
+  for (int i = 0; i < 72; ++i) cjk += "\xe6\xbc\xa2";  // U+6F22
+  const std::vector<std::string> studies = {"pilot 1", "pilot/1", cjk, "a\xe2\x80\x8b" "b", "pilot_1"};
+  {
+    Record record = Record::Open(dir / "r.sqlite");
+    for (size_t i = 0; i < studies.size(); ++i)
+      RunSession(record, "P1", R"({"edge":3})", int(i) + 1, int(i) + 1, studies[i]);
+  }
+  ExportCsv(dir / "r.sqlite", dir / "out");
+  std::set<std::string> files;
+  for (size_t i = 0; i < studies.size(); ++i) {
+    const std::string file = SummaryFileName(studies[i]);
+    EXPECT_LE(file.size(), 112u) << file;
+    EXPECT_TRUE(files.insert(file).second) << file;
+    const Rows rows = ReadCsv(dir / "out" / file);
+    ASSERT_EQ(rows.size(), 2u) << file;
+    EXPECT_EQ(rows[1][ColumnIndex(rows, "planned")], std::to_string(i + 1)) << file;  // its own study's session
+  }
+}
+
 // A record of schema 6, as that version wrote it: one simulated session, one answered trial.
 void WriteVersionSixRecord(const std::filesystem::path& path) {
   Database db(path);

@@ -8,8 +8,8 @@
 namespace blurcue::store {
 
 std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path) {
-  Database db(db_path, OpenMode::kReadOnly);
-  RequireReadableRecord(db);
+  // Through a migrated copy for an earlier version, as export reads it (a schema-1 record has no group_name).
+  Database db = OpenRecordForReading(db_path);
   Statement rows(db,
                  "SELECT s.id, st.name, p.code, s.status, s.started, coalesce(s.ended, ''), s.host, s.seed, "
                  "(SELECT count(*) FROM trials t WHERE t.session_id = s.id), "

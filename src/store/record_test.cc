@@ -389,13 +389,6 @@ std::string ErrorOf(const std::function<void()>& action) {
 
 bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
-std::string FileBytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream bytes;
-  bytes << in.rdbuf();
-  return bytes.str();
-}
-
 const char* kFullProtocol = R"({"name":"test1","timing":{"inter_trial_ms":500,"stimulus_ms":0},"trials":4})";
 
 // --resume with nothing to resume says what it found and starts nothing: no session appears.
@@ -626,10 +619,10 @@ TEST(Record, ForeignDatabaseIsRefusedUntouched) {
     Database db(path);
     db.Exec("CREATE TABLE customers (id INTEGER PRIMARY KEY, name TEXT); INSERT INTO customers (name) VALUES ('x')");
   }
-  const std::string before = FileBytes(path);
+  const std::string before = testing::FileBytes(path);
   const std::string message = ErrorOf([&] { Record::Open(path); });
   EXPECT_TRUE(Contains(message, "customers.sqlite: not a blurcue record: it holds 1 tables (customers)")) << message;
-  EXPECT_EQ(FileBytes(path), before);
+  EXPECT_EQ(testing::FileBytes(path), before);
   EXPECT_FALSE(std::filesystem::exists(path.string() + "-wal"));
   // An empty file is a new record; so is a record stamped before (only its tables tell).
   std::ofstream(dir / "empty.sqlite").close();

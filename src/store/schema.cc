@@ -1,7 +1,11 @@
 #include "store/schema.h"
 
+#include <sqlite3.h>
+
 #include <algorithm>
 #include <cstdio>
+#include <iterator>
+#include <set>
 
 #include "core/error.h"
 #include "core/hash.h"
@@ -234,12 +238,11 @@ int SchemaVersion(Database& db) { return static_cast<int>(db.QueryInt64("PRAGMA 
 void Migrate(Database& db) {
   if (SchemaVersion(db) == CurrentSchemaVersion()) return;  // the common case takes no write lock
   Transaction transaction(db);
-  // Read again under the write lock: another process may have migrated in between.
+  // Read again under the write lock: another process may have migrated in between. A number this build does not
+  // know, or one its tables contradict, is refused before a step runs (a negative one indexed past the steps and
+  // crashed; a current record stamped 1 replayed version 2 on and stopped with "duplicate column").
+  RequireKnownSchema(db);
   const int version = SchemaVersion(db);
-  if (version > CurrentSchemaVersion())
-    throw InputError(db.path(), "record schema version " + std::to_string(version) +
-                                    " is newer than this blurcue understands (" +
-                                    std::to_string(CurrentSchemaVersion()) + ")");
   for (int i = version; i < CurrentSchemaVersion(); ++i) {
     const Migration& step = Migrations()[static_cast<size_t>(i)];
     if (!step.sql.empty()) db.Exec(step.sql);
@@ -264,23 +267,114 @@ std::string Contents(Database& db) {
   return std::to_string(count) + " tables (" + tables + ")" + (id != 0 ? ", application id 0x" + std::string(text) : "");
 }
 
-// A record written before the application id was stamped: version 1 and the record's own tables.
+// A record written before the application id was stamped: the record's own tables. (Its schema number is judged by
+// RequireKnownSchema, which names it: an edited 0 or -5 used to be called "not a blurcue record".)
 bool IsUnstampedRecord(Database& db) {
-  return SchemaVersion(db) >= 1 &&
-         db.QueryInt64("SELECT count(*) FROM sqlite_schema WHERE type = 'table' AND name IN ('studies', "
+  return db.QueryInt64("SELECT count(*) FROM sqlite_schema WHERE type = 'table' AND name IN ('studies', "
                        "'protocol_versions', 'participants', 'sessions', 'trials', 'responses', 'frames')") == 7;
+}
+
+// Each version's columns ("table.column"), index = version: the shipped steps applied one by one to an empty
+// database in memory, so they are what a genuine record of that version holds.
+const std::vector<std::set<std::string>>& ColumnsByVersion() {
+  static const std::vector<std::set<std::string>> by_version = [] {
+    Database db(":memory:");
+    std::vector<std::set<std::string>> out;
+    for (size_t version = 0;; ++version) {
+      std::set<std::string> columns;
+      Statement all(db, "SELECT t.name || '.' || c.name FROM sqlite_schema t, pragma_table_info(t.name) c "
+                        "WHERE t.type = 'table' AND t.name NOT LIKE 'sqlite_%'");
+      while (all.Step()) columns.insert(all.GetText(0));
+      out.push_back(std::move(columns));
+      if (version == Migrations().size()) break;
+      const Migration& step = Migrations()[version];
+      if (!step.sql.empty()) db.Exec(step.sql);
+      if (step.data) step.data(db);
+    }
+    return out;
+  }();
+  return by_version;
+}
+
+// The columns of `db` that some version of this build knows (a column or table of the experimenter's own is no
+// version's and is left out of the comparison).
+std::set<std::string> KnownColumnsOf(Database& db) {
+  const std::set<std::string>& known = ColumnsByVersion().back();
+  std::set<std::string> present;
+  Statement all(db, "SELECT t.name || '.' || c.name FROM sqlite_schema t, pragma_table_info(t.name) c "
+                    "WHERE t.type = 'table' AND t.name NOT LIKE 'sqlite_%'");
+  while (all.Step())
+    if (std::string name = all.GetText(0); known.count(name)) present.insert(std::move(name));
+  return present;
+}
+
+// Up to three names of `names`, for a message.
+std::string FewOf(const std::vector<std::string>& names) {
+  std::string text;
+  for (size_t i = 0; i < names.size() && i < 3; ++i) text += (i ? ", " : "") + names[i];
+  if (names.size() > 3) text += ", ... (" + std::to_string(names.size()) + " in all)";
+  return text;
 }
 
 }  // namespace
 
+void RequireKnownSchema(Database& db) {
+  const int64_t version = db.QueryInt64("PRAGMA user_version");  // 32-bit signed in the file's header
+  const int current = CurrentSchemaVersion();
+  const std::string number = "record schema number " + std::to_string(version);
+  if (version > current)
+    throw InputError(db.path(), number + " is newer than this blurcue reads (" + std::to_string(current) +
+                                    "); update blurcue");
+  if (version < 0)
+    throw InputError(db.path(), number + " is no version (this blurcue knows 1 to " + std::to_string(current) +
+                                    "); was it edited? The record was left untouched");
+  const std::set<std::string>& expected = ColumnsByVersion()[static_cast<size_t>(version)];
+  const std::set<std::string> present = KnownColumnsOf(db);
+  if (present == expected) return;
+  std::vector<std::string> extra, missing;
+  std::set_difference(present.begin(), present.end(), expected.begin(), expected.end(), std::back_inserter(extra));
+  std::set_difference(expected.begin(), expected.end(), present.begin(), present.end(), std::back_inserter(missing));
+  std::string whose;
+  for (int v = current; v >= 0; --v)
+    if (ColumnsByVersion()[static_cast<size_t>(v)] == present) {
+      whose = "; they are version " + std::to_string(v) + "'s";
+      break;
+    }
+  std::string what;
+  if (!extra.empty()) what = "it has " + FewOf(extra) + ", which version " + std::to_string(version) + " has not";
+  if (!missing.empty())
+    what += (what.empty() ? "it lacks " : ", and lacks ") + FewOf(missing) + ", which version " +
+            std::to_string(version) + " has";
+  throw InputError(db.path(), number + " does not match its tables (" + what + whose +
+                                  "); was it edited? The record was left untouched");
+}
+
+Database OpenRecordForReading(const std::filesystem::path& path) {
+  Database source(path, OpenMode::kReadOnly);
+  RequireReadableRecord(source);
+  if (SchemaVersion(source) == CurrentSchemaVersion()) return source;
+  // An earlier version is read from a migrated copy in memory: the record itself is only read (it may be a read-only
+  // archive, and a killed reader leaves no copy behind). SQLite's backup copies it, the migration derives its typed
+  // columns.
+  Database copy(":memory:");
+  sqlite3_backup* backup = sqlite3_backup_init(copy.handle(), "main", source.handle(), "main");
+  const int step = backup ? sqlite3_backup_step(backup, -1) : SQLITE_ERROR;
+  const int finish = backup ? sqlite3_backup_finish(backup) : SQLITE_ERROR;
+  if (step != SQLITE_DONE || finish != SQLITE_OK)
+    throw InputError(path.string(), std::string("cannot copy the record to read it at this version: ") +
+                                        sqlite3_errmsg(copy.handle()));
+  Migrate(copy);
+  return copy;
+}
+
 void RequireRecordOrEmpty(Database& db) {
   const int64_t id = db.QueryInt64("PRAGMA application_id");
-  if (id == kApplicationId) return;
   const int64_t objects = db.QueryInt64("SELECT count(*) FROM sqlite_schema");
   if (id == 0 && objects == 0 && SchemaVersion(db) == 0) return;  // new or empty: it becomes a record
-  if (id == 0 && IsUnstampedRecord(db)) return;
-  throw InputError(db.path(), "not a blurcue record: it holds " + Contents(db) +
-                                  "; it was left untouched (give a new file or an existing record)");
+  if (id != kApplicationId && !(id == 0 && IsUnstampedRecord(db)))
+    throw InputError(db.path(), "not a blurcue record: it holds " + Contents(db) +
+                                    "; it was left untouched (give a new file or an existing record)");
+  RequireKnownSchema(db);  // before the writer switches it to WAL: an edited number leaves the file as it was
 }
 
 void RequireReadableRecord(Database& db) {
@@ -290,11 +384,9 @@ void RequireReadableRecord(Database& db) {
     throw InputError(db.path(), empty ? std::string("not a blurcue record: the database is empty")
                                       : "not a blurcue record: it holds " + Contents(db));
   }
-  const int version = SchemaVersion(db);
-  if (version > CurrentSchemaVersion())
-    throw InputError(db.path(), "record schema version " + std::to_string(version) +
-                                    " is newer than this blurcue reads (" + std::to_string(CurrentSchemaVersion()) +
-                                    "); update blurcue");
+  RequireKnownSchema(db);
+  if (SchemaVersion(db) == 0)
+    throw InputError(db.path(), "record schema number 0 is an empty record: nothing was ever recorded in it");
   // Older versions lack only columns added since (readers take them where present), so a read-only archive of any
   // version up to this one reads.
   RequireIntactPages(db);

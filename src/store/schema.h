@@ -1,6 +1,7 @@
 #pragma once
 // The record's schema: a list of migrations applied in order, the count kept in PRAGMA user_version.
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,18 @@ void RequireRecordOrEmpty(Database& db);
 // For readers (sessions, export, report, merge inputs): a blurcue record at a schema version this build reads,
 // whose pages pass SQLite's quick_check (a truncated or overwritten file is refused, naming it, not half read).
 void RequireReadableRecord(Database& db);
+
+// The record's schema number (PRAGMA user_version) is one this build knows and its tables are that version's: a
+// negative number, one above CurrentSchemaVersion(), or one whose tables are another version's (a number edited by
+// hand: 1 on a current record, 0 where tables exist) is refused as one line naming the record and the number,
+// Error(kInput). Columns or tables no version has (the experimenter's own) are not compared. Reads only.
+// RequireRecordOrEmpty, RequireReadableRecord and Migrate all call it first.
+void RequireKnownSchema(Database& db);
+
+// For readers (sessions, export): the record at `path` opened read-only and checked (RequireReadableRecord); a record
+// of an earlier version comes back as a migrated copy in memory, so every reader sees today's columns and the file
+// is only read.
+Database OpenRecordForReading(const std::filesystem::path& path);
 
 // SQLite's quick_check of every page, refused as one line naming the file (a truncated or overwritten record).
 void RequireIntactPages(Database& db);

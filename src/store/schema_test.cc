@@ -1,8 +1,13 @@
 #include "store/schema.h"
 
+#include <climits>
+#include <functional>
+
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "store/export.h"
+#include "store/record.h"
 #include "store/test_util.h"
 
 namespace blurcue::store {
@@ -121,6 +126,115 @@ TEST(Schema, ReadersRefuseAForeignDatabase) {
     EXPECT_NE(std::string(e.what()).find("not a blurcue record: it holds 1 tables (other)"), std::string::npos)
         << e.what();
   }
+}
+
+// A current record of one study, then its schema number set to `number` by hand (as an adversary's sqlite3 would).
+// `stamped`: with the application id every record has had since version 2 (without: an older record's).
+void WriteRecordNumbered(const std::filesystem::path& path, int64_t number, bool stamped) {
+  {
+    Record record = Record::Open(path);
+    record.StartOrResumeSession("s", "P1", R"({"study":"s"})", 7, {}, false);
+  }
+  Database db(path);
+  db.Exec("PRAGMA journal_mode = DELETE; PRAGMA user_version = " + std::to_string(number));
+  if (!stamped) db.Exec("PRAGMA application_id = 0");
+}
+
+// Every command's way into a record refuses a schema number this build does not know, or one its tables contradict,
+// with one line naming the record and the number, exit 3 - before any work, the file byte for byte as it was. (-5
+// and INT_MIN crashed export, run and report; -1 was std::bad_alloc; 0, 1 and 6 on a current record replayed the
+// migrations and stopped with "duplicate column", exit 10.)
+TEST(Schema, AnUnknownOrEditedSchemaNumberIsRefusedEverywhere) {
+  testing::TempDir dir;
+  const int current = CurrentSchemaVersion();
+  const std::vector<int64_t> numbers = {-5, INT_MIN, -1, 0, 1, 6, current + 1};
+  const std::vector<std::pair<std::string, std::function<void(const std::filesystem::path&)>>> readers = {
+      {"open for a run", [](const std::filesystem::path& p) { Record::Open(p); }},
+      {"export", [&](const std::filesystem::path& p) { ExportCsv(p, dir / "out"); }},
+      {"sessions", [](const std::filesystem::path& p) { ListSessions(p); }},
+      {"merge", [&](const std::filesystem::path& p) { MergeDatabases({p}, dir / "merged.sqlite"); }},
+      {"peek groups", [](const std::filesystem::path& p) { PeekGroups(p, "s", "P1"); }},
+  };
+  for (const int64_t number : numbers) {
+    for (const bool stamped : {true, false}) {
+      const auto path = dir / ("n" + std::to_string(number) + (stamped ? "" : "-unstamped") + ".sqlite");
+      WriteRecordNumbered(path, number, stamped);
+      const std::string before = testing::FileBytes(path);
+      for (const auto& [what, read] : readers) {
+        try {
+          read(path);
+          ADD_FAILURE() << what << " read a record numbered " << number;
+        } catch (const Error& e) {
+          const std::string message = e.what();
+          EXPECT_EQ(e.kind(), ErrorKind::kInput) << what << " " << number << ": " << message;
+          EXPECT_EQ(message.rfind(path.string() + ": record schema number " + std::to_string(number) + " ", 0), 0u)
+              << what << ": " << message;
+          EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+        }
+        EXPECT_EQ(testing::FileBytes(path), before) << what << " " << number;
+        EXPECT_FALSE(std::filesystem::exists(dir / "merged.sqlite")) << what;
+      }
+    }
+  }
+}
+
+// What the refusal says: a number no version has, or the version whose tables the record holds.
+TEST(Schema, AnEditedNumberIsToldFromTheTablesPresent) {
+  Database db(":memory:");
+  Migrate(db);
+  db.Exec("PRAGMA user_version = 1");
+  try {
+    RequireKnownSchema(db);
+    FAIL() << "a current record numbered 1 passed";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("record schema number 1 does not match its tables (it has "), std::string::npos) << message;
+    EXPECT_NE(message.find("they are version " + std::to_string(CurrentSchemaVersion()) + "'s); was it edited?"),
+              std::string::npos)
+        << message;
+  }
+  db.Exec("PRAGMA user_version = -5");
+  EXPECT_THROW(RequireKnownSchema(db), Error);
+}
+
+// Genuine records of every version pass the check (each as its own migrations made it), and a column or table of
+// the experimenter's own is not held against it.
+TEST(Schema, EveryGenuineVersionPassesTheCheck) {
+  Database db(":memory:");
+  RequireKnownSchema(db);  // an empty file: version 0
+  for (int version = 1; version <= CurrentSchemaVersion(); ++version) {
+    const Migration& step = Migrations()[size_t(version - 1)];
+    if (!step.sql.empty()) db.Exec(step.sql);
+    if (step.data) step.data(db);
+    db.Exec("PRAGMA user_version = " + std::to_string(version));
+    EXPECT_NO_THROW(RequireKnownSchema(db)) << version;
+  }
+  db.Exec("CREATE TABLE my_notes (x TEXT); ALTER TABLE studies ADD COLUMN my_label TEXT");
+  EXPECT_NO_THROW(RequireKnownSchema(db));
+}
+
+// sessions reads an earlier version as export does, through a migrated copy (a schema-1 record has no group_name:
+// "no such column: s.group_name", exit 10).
+TEST(Schema, SessionsListsASchemaOneRecord) {
+  testing::TempDir dir;
+  const auto path = dir / "old.sqlite";
+  {
+    Database db(path);
+    db.Exec(Migrations()[0].sql);
+    db.Exec("PRAGMA user_version = 1;"
+            "INSERT INTO studies (name, created) VALUES ('s', 'now');"
+            "INSERT INTO protocol_versions (study_id, json, hash, created) VALUES (1, '{}', 'h', 'now');"
+            "INSERT INTO participants (study_id, code, created) VALUES (1, 'P1', 'now');"
+            "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, host, display, "
+            "  started, status) VALUES (1, 1, 5, 'v', 'h', 'headless', 'now', 'completed');");
+  }
+  const std::string before = testing::FileBytes(path);
+  const std::vector<SessionSummary> sessions = ListSessions(path);
+  ASSERT_EQ(sessions.size(), 1u);
+  EXPECT_EQ(sessions[0].study, "s");
+  EXPECT_EQ(sessions[0].participant, "P1");
+  EXPECT_EQ(sessions[0].number, 1);
+  EXPECT_EQ(testing::FileBytes(path), before);
 }
 
 }  // namespace

@@ -34,6 +34,14 @@ class TempDir {
   std::filesystem::path path_;
 };
 
+// The bytes of a file (a record left as it was is the same bytes).
+inline std::string FileBytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
+
 using Rows = std::vector<std::vector<std::string>>;
 
 // A small RFC 4180 reader for checking the export.
