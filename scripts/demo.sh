@@ -6,9 +6,21 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [ -n "${BLURCUE_BUILT:-}" ] || scripts/setup.sh  # set by ctest's `demo` test (scripts/test.sh built it)
-BC=build/src/cli/blurcue
-OUT=results/demo
-mkdir -p "$OUT"
+# BLURCUE_BIN and BLURCUE_RESULTS (ctest's demo test sets both: its own build's binary, a results folder inside that
+# build) let two builds run the demo at once; by hand it is build/src/cli/blurcue into results/.
+BC=${BLURCUE_BIN:-build/src/cli/blurcue}
+RESULTS=${BLURCUE_RESULTS:-results}
+OUT=$RESULTS/demo
+PROTOCOLS=protocols
+mkdir -p "$OUT" "$RESULTS/bench"
+if [ "$RESULTS" != results ]; then
+  # The shipped protocols point at ../results/demo/ and ../stimuli/: copies that point at this results folder.
+  PROTOCOLS=$RESULTS/protocols
+  mkdir -p "$PROTOCOLS"
+  for p in protocols/*.json; do
+    sed -e 's|"\.\./results/demo/|"../demo/|g' -e "s|\"\.\./stimuli/|\"$PWD/stimuli/|g" "$p" > "$PROTOCOLS/$(basename "$p")"
+  done
+fi
 $BC synth-scene --out "$OUT/scene" --seed 7 --noise 0.004
 $BC calibrate "$OUT/scene/scene.png" --camera "$OUT/scene/camera.json" --truth "$OUT/scene/truth.json" \
     --out "$OUT/calib.json"
@@ -30,13 +42,13 @@ $BC animate --calib "$OUT/calib.json" --background "$OUT/scene/scene.png" --left
 # observers, each participant with their own recorded seed, into one record: 6 through test 1, 4 through test 2,
 # 3 through test 3 and 3 through the pre-research depth matching (headless, on a simulated clock). A fresh record each time: a demo run twice must
 # not meet its own earlier sessions.
-$BC synth-pictures --protocol protocols/pre-research-depth-matching.json --out "$OUT/pictures"
-$BC preview protocols/test1-static-grids.json --out "$OUT/preview-test1.png"
+$BC synth-pictures --protocol "$PROTOCOLS/pre-research-depth-matching.json" --out "$OUT/pictures"
+$BC preview "$PROTOCOLS/test1-static-grids.json" --out "$OUT/preview-test1.png"
 rm -f "$OUT/study.sqlite" "$OUT/study.sqlite-wal" "$OUT/study.sqlite-shm"
 run() {  # PROTOCOL PARTICIPANTS...
   local protocol=$1
   shift
-  for id in "$@"; do $BC run "protocols/$protocol.json" --participant "$id" --db "$OUT/study.sqlite" --observer sim; done
+  for id in "$@"; do $BC run "$PROTOCOLS/$protocol.json" --participant "$id" --db "$OUT/study.sqlite" --observer sim; done
 }
 run test1-static-grids P1 P2 P3 P4 P5 P6
 run test2-moving-balls P1 P2 P3 P4
@@ -57,11 +69,11 @@ run video-ball-depth P1 P2 P3
 # simulated observer: its frame timing is the report's display-timing chart.
 WINDOW=()
 [ -n "${DISPLAY:-}" ] || WINDOW=(xvfb-run -a -s "-screen 0 1280x1024x24")
-"${WINDOW[@]}" $BC run protocols/test1-static-grids.json --participant W1 --db "$OUT/study.sqlite" --observer sim --window
+"${WINDOW[@]}" $BC run "$PROTOCOLS/test1-static-grids.json" --participant W1 --db "$OUT/study.sqlite" --observer sim --window
 # Speed against accuracy of every measurement and blur method (quick sweeps), for the report's charts.
-$BC bench measure --quick --out results/bench/measure.csv
-$BC bench render --quick --out results/bench/render.csv
-$BC bench record --trials 100 --folder results/bench   # what a power-loss-safe commit costs per answer
-$BC bench procedures --out results/bench/procedures.csv   # which adaptive procedure to choose (200 runs each, ~15 s)
-$BC report --db "$OUT/study.sqlite" --out "$OUT/report" --bench results/bench
+$BC bench measure --quick --out "$RESULTS/bench/measure.csv"
+$BC bench render --quick --out "$RESULTS/bench/render.csv"
+$BC bench record --trials 100 --folder "$RESULTS/bench"   # what a power-loss-safe commit costs per answer
+$BC bench procedures --out "$RESULTS/bench/procedures.csv"   # which adaptive procedure to choose (200 runs each, ~15 s)
+$BC report --db "$OUT/study.sqlite" --out "$OUT/report" --bench "$RESULTS/bench"
 echo "demo: results in $OUT/ (calib.json, ball-edge9-estimated.png, pattern3.avi, take/, track/, study.sqlite, report/index.html)"
