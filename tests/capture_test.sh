@@ -425,6 +425,9 @@ c = json.load(open(sys.argv[3]))
 c["model"]["focus_mm"] = 250
 json.dump(c, open(sys.argv[4], "w"), indent=1)
 c["camera"]["dist_coeffs"] = [-0.3, 0, 0, 0]
+# As calibrate writes it for a camera with dist_coeffs (calib.json is read as a whole: r_units must say so).
+c["r_units"] = {"sections": "r_px, r_thesis_px, r_estimated_px, r_fitted_px: photo px (distorted), across the edge",
+                "model": "floor_px and the thin lens's radius: ideal (undistorted, pinhole) px"}
 json.dump(c, open(sys.argv[5], "w"), indent=1)
 PYEOF
   # A card is two board squares high: standing, its centre is one square over the table.
