@@ -32,7 +32,7 @@ import groups
 import stats
 import study_tests
 import tracks
-from common import (UNKNOWN_UNIT, Chart, Skip, axis_label, error_bars, factor_label, file_stem, level_text,
+from common import (UNKNOWN_UNIT, Chart, Skip, axis_label, distinct_stems, error_bars, factor_label, file_stem, level_text,
                     level_unit, participants_note, save, stars, text)
 from design import design_of, load_codebook  # noqa: F401  (load_codebook: report.py reads the codebook through here)
 
@@ -557,10 +557,11 @@ def psychometric_cells(m, kind, guess, what, design, study, out_dir, slug, note,
         xcol, xlabel = "difference", "blur difference between the two, |r_right - r_left| (arcmin)"
         cells = pd.Series([""] * len(m), index=m.index)
     names = list(dict.fromkeys(cells))
+    stems = distinct_stems(names)  # readable ("edge_3"); hashed only where two cells' plain forms meet
     charts, words = [], []
     for cell in _sorted_levels(names) if all(names) else names:
         rows = m[cells == cell]
-        name = f"{slug}-psychometric" + (f"-{file_stem(cell, 48)}" if len(names) > 1 else "")
+        name = f"{slug}-psychometric" + (f"-{stems[cell]}" if len(names) > 1 else "")
         # A procedure cell's threshold is read at its procedure's own criterion over what it could show, so the
         # fit and the tracks give one quantity (criteria.py).
         params = tracks.parameters(rows) if kind == "procedure" else None

@@ -353,11 +353,32 @@ def writing(path):
         raise OSError(e.errno, e.strerror or str(e), path) from e
 
 
+def chart_stem(name):
+    """A chart's file stem: NAME as it is when it is already one (1-100 bytes of file_stem's plain characters: a name
+    composed of stems and this code's own words), else file_stem(NAME). A composed name's parts were stemmed where
+    they were made (a study's, a cell's), so it is not hashed a second time for the hash one of them carries."""
+    raw = str(name).encode("utf-8", "surrogatepass")
+    if raw and len(raw) <= 100 and raw[:1] != b"." and all(c in _STEM_PLAIN for c in raw):
+        return str(name)
+    return file_stem(name)
+
+
+def distinct_stems(names, max_bytes=48):
+    """{name: stem} for names that share a folder (a study's cells): each name's plain form (lower case, any other
+    byte '_') where no other name has the same one, file_stem(name) - with its hash - where two would meet ("edge=3"
+    and "edge_3")."""
+    plain = {n: re.sub(r"[^a-z0-9_.-]", "_", str(n).lower())[:max_bytes] or "_" for n in names}
+    taken = {}
+    for p in plain.values():
+        taken[p] = taken.get(p, 0) + 1
+    return {n: p if taken[p] == 1 and not p.startswith(".") else file_stem(n, max_bytes) for n, p in plain.items()}
+
+
 def save(fig, out_dir, name):
-    """Writes file_stem(NAME).png and .svg into out_dir; returns their paths and closes the figure."""
+    """Writes chart_stem(NAME).png and .svg into out_dir; returns their paths and closes the figure."""
     os.makedirs(out_dir, exist_ok=True)
-    png = os.path.join(out_dir, file_stem(name) + ".png")
-    svg = os.path.join(out_dir, file_stem(name) + ".svg")
+    png = os.path.join(out_dir, chart_stem(name) + ".png")
+    svg = os.path.join(out_dir, chart_stem(name) + ".svg")
     try:
         # The tight box once for both files (bbox_inches="tight" draws the figure again for each file to find it).
         fig.draw_without_rendering()

@@ -35,7 +35,7 @@ import common  # noqa: E402
 import depth_matching  # noqa: E402
 import forced_choice  # noqa: E402
 import frame_timing  # noqa: E402
-from common import Skip, TrialsError, file_stem  # noqa: E402
+from common import Skip, TrialsError, chart_stem, file_stem  # noqa: E402
 
 EXIT_INPUT = 3
 EXIT_INTERNAL = 10
@@ -112,7 +112,7 @@ def write_index(out_dir, sections, header, name="index.html", title="blurcue ana
                 parts.append(f"<img src='{html.escape(png)}' alt='{html.escape(c.name)}'>")
                 links.append(f"<a href='{html.escape(os.path.basename(c.svg))}'>SVG</a>")
             if c.table is not None and not c.table.empty:
-                links.append(f"<a href='{html.escape(file_stem(c.name))}.csv'>table as CSV</a>")
+                links.append(f"<a href='{html.escape(chart_stem(c.name))}.csv'>table as CSV</a>")
             if links:
                 parts.append(f"<p class='links'>{' | '.join(links)}</p>")
             if c.notes:
@@ -484,7 +484,7 @@ def _main(argv=None):
         charts = [c._replace(notes=[shown_text(n) for n in c.notes]) if c.notes else c for c in charts]
         for c in charts:
             if c.table is not None and not c.table.empty:
-                table = os.path.join(args.out, file_stem(c.name) + ".csv")
+                table = os.path.join(args.out, chart_stem(c.name) + ".csv")
                 with common.writing(table):
                     c.table.to_csv(table, index=False)
         sections.append((title, charts, skips))
