@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# kill -9 of track, ar and init while they write over an earlier output (issue 39): usage:
+#   outputs_take_kill_test.sh CASE BLURCUE DIR      CASE: track | ar | init
+# Two reference outputs A and B are made first; then the command is started KILLS times (20), writing A or B in
+# turn over what is there, and killed after a random delay within one run's time (seeded: OUTPUTS_KILL_SEED, printed).
+# After each kill the output must be exactly one whole reference (tests/outputs_same.py: every file, timings aside) -
+# the earlier one or the new one, never a mix and never half - or, for init, which never overwrites, none at all.
+# Then a rerun must succeed, and leave nothing of the killed runs beside its output.
+set -euo pipefail
+CASE=$1 BC=$2 DIR=$3
+W=$DIR/outputs-kill-$CASE
+rm -rf "$W" && mkdir -p "$W"
+source "$(dirname "$0")/lib.sh"
+SAME="$PY $(dirname "$0")/outputs_same.py"
+KILLS=${OUTPUTS_KILL_COUNT:-20}
+SEED=${OUTPUTS_KILL_SEED:-39}
+RANDOM=$SEED
+echo "seed $SEED (OUTPUTS_KILL_SEED), $KILLS kills"
+
+# Two small takes that differ in length and motion, each tracked (ar draws on take A).
+takes() {
+  $BC synth-take --out "$W/take-a" --frames 3 --supersample 1 --seed 1 --quiet
+  $BC synth-take --out "$W/take-b" --frames 4 --supersample 1 --seed 2 --from-lateral-mm -10 --to-lateral-mm 10 --quiet
+}
+case $CASE in
+track)
+  takes
+  run() { $BC track "$W/take-$1/take.avi" --camera "$W/take-$1/camera.json" --out "$2" --quiet; }
+  OUT=$W/out ;;
+ar)
+  takes
+  $BC track "$W/take-a/take.avi" --camera "$W/take-a/camera.json" --out "$W/track" --quiet
+  # The video, its CSV and the frames folder together in one folder: the three are one output.
+  run() {
+    mkdir -p "$2"
+    local ball=$([ $1 = a ] && echo 50,125 || echo 110,100)
+    $BC ar "$W/take-a/take.avi" --track "$W/track" --ball $ball --out "$2/ar.avi" --frames "$2/frames" --quiet
+  }
+  OUT=$W/out ;;
+init)
+  run() { $BC init "$2" --seed $([ $1 = a ] && echo 7 || echo 8) > /dev/null; }
+  OUT=$W/study ;;
+*) fail "unknown case $CASE" ;;
+esac
+
+start=$(date +%s%N)
+run a "$W/ref-a" > /dev/null
+took_ms=$((($(date +%s%N) - start) / 1000000))
+run b "$W/ref-b" > /dev/null
+[ "$($SAME "$W/ref-a" "$W/ref-b")" != 0 ] || fail "the two references are alike"
+[ "$($SAME "$W/ref-a" "$W/ref-a")" = 0 ] || fail "a reference differs from itself"
+# An earlier output to write over (init: none; it never overwrites).
+[ $CASE = init ] || run a "$OUT" > /dev/null
+echo "one run: $took_ms ms"
+
+killed=0 old=0 new=0 none=0
+for i in $(seq 1 "$KILLS"); do
+  if [ $CASE = init ]; then which=$([ $((i % 2)) = 1 ] && echo a || echo b); before=none
+  else before=$($SAME "$OUT" "$W/ref-a" "$W/ref-b"); which=$([ "$before" = 0 ] && echo b || echo a); fi
+  delay_ms=$((RANDOM % (took_ms + 1)))
+  run $which "$OUT" > /dev/null 2>&1 &
+  pid=$!
+  sleep "$(printf '%d.%03d' $((delay_ms / 1000)) $((delay_ms % 1000)))"
+  kill -9 $pid 2>/dev/null && killed=$((killed + 1)) || true
+  wait $pid 2>/dev/null || true
+  after=$($SAME "$OUT" "$W/ref-a" "$W/ref-b")
+  want=$([ $which = a ] && echo 0 || echo 1)
+  if [ $CASE = init ]; then
+    if [ -e "$OUT" ]; then
+      [ "$after" = "$want" ] || fail "init killed after $delay_ms ms left a study that is not whole: $after"
+      new=$((new + 1)); rm -rf "$OUT"
+    else none=$((none + 1)); fi
+  elif [ "$after" = "$before" ]; then old=$((old + 1))
+  elif [ "$after" = "$want" ]; then new=$((new + 1))
+  else fail "$CASE killed after $delay_ms ms (kill $i) left neither the earlier output nor the new one: $after"
+  fi
+done
+
+# A rerun succeeds, is whole, and removes what the killed runs left beside it.
+run b "$OUT" > /dev/null 2> "$W/rerun.err" || fail "the rerun failed: $(cat "$W/rerun.err")"
+[ "$($SAME "$OUT" "$W/ref-b")" = 0 ] || fail "the rerun's output is not whole: $($SAME "$OUT" "$W/ref-b")"
+left=$(cd "$(dirname "$OUT")" && ls -A | grep -E '\.(partial|tmp|old)-[0-9]+' || true)
+[ $CASE = ar ] && left="$left$(cd "$OUT" && ls -A | grep -E '\.(partial|tmp|old)-[0-9]+' || true)"
+[ -z "$left" ] || fail "left after the rerun: $left"
+if [ $CASE = init ]; then
+  echo "ok: init killed $killed of $KILLS times at random points: $none left no study, $new a whole one; the rerun" \
+       "made a whole study and removed every leftover"
+else
+  echo "ok: $CASE killed $killed of $KILLS times at random points over an earlier output: $old left the earlier" \
+       "output, $new the whole new one, never a mix; the rerun was whole and removed every leftover"
+fi
