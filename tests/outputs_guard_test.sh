@@ -3,8 +3,8 @@
 # exit 2 or 3, one line naming the option and the path, no hang (a FIFO input), and every file there byte-identical
 # afterwards (sha256 of the whole folder before and after). Usage: outputs_guard_test.sh BLURCUE DIR
 set -euo pipefail
-BC=$1 W=$2/outputs-guard
-rm -rf "$W" && mkdir -p "$W"
+BC=$1 W=$2/outputs-guard L=$2/outputs-guard-logs
+rm -rf "$W" "$L" && mkdir -p "$W" "$L"
 source "$(dirname "$0")/lib.sh"
 cd "$W"
 
@@ -30,11 +30,11 @@ cases=0
 expect() {
   local code=$1 text=$2 got=0
   shift 2
-  timeout 20 $BC "$@" > out.log 2> err.log < /dev/null || got=$?
+  timeout 20 $BC "$@" > "$L/out.log" 2> "$L/err.log" < /dev/null || got=$?
   [ $got != 124 ] || fail "$*: still running after 20 s"
-  [ $got = "$code" ] || fail "$*: exit $got, expected $code: $(cat err.log)"
-  [ "$(wc -l < err.log)" = 1 ] || fail "$*: not one line: $(cat err.log)"
-  grep -qF -- "$text" err.log || fail "$*: the message does not say '$text': $(cat err.log)"
+  [ $got = "$code" ] || fail "$*: exit $got, expected $code: $(cat "$L/err.log")"
+  [ "$(wc -l < "$L/err.log")" = 1 ] || fail "$*: not one line: $(cat "$L/err.log")"
+  grep -qF -- "$text" "$L/err.log" || fail "$*: the message does not say '$text': $(cat "$L/err.log")"
   cases=$((cases + 1))
 }
 # 2. An output that is an input.
@@ -70,12 +70,12 @@ expect 2 "--photo: test3-no-board shows the scene without the board" init study 
 expect 3 "--photo fifo: is a FIFO" init study --photo fifo --camera take/camera.json
 
 [ "$(snapshot)" = "$before" ] || fail "a refused command changed a file: $(diff <(echo "$before") <(snapshot) | head -5)"
-left=$(ls -A | grep -Ev '^(take|track|same\.avi|cp|study\.sqlite|afile|dangling|fifo|strangers|many\.json|out\.log|err\.log)$' || true)
+left=$(ls -A | grep -Ev '^(take|track|same\.avi|cp|study\.sqlite|afile|dangling|fifo|strangers|many\.json)$' || true)
 [ -z "$left" ] || fail "a refused command left: $left"
 # The photo study the adversary could not make (scene-no-board.png was never made): the default example with a
 # photo of one's own now validates, its board-free line dropped.
-$BC init photo-study --photo take/frame-0000.png --camera take/camera.json > init.log 2>&1 ||
-  fail "init with --photo: $(tail -3 init.log)"
+$BC init photo-study --photo take/frame-0000.png --camera take/camera.json > "$L/init.log" 2>&1 ||
+  fail "init with --photo: $(tail -3 "$L/init.log")"
 grep -q board_free photo-study/protocol.json && fail "the photo study names a board-free photo it does not have"
 echo "ok: $cases refusals, each exit 2 or 3 in one line naming the option and the path, none hung; every file" \
      "byte-identical afterwards and nothing new beside them; init --photo with the default example made a study"

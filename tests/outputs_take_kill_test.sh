@@ -2,7 +2,8 @@
 # kill -9 of track, ar and init while they write over an earlier output (issue 39): usage:
 #   outputs_take_kill_test.sh CASE BLURCUE DIR      CASE: track | ar | init
 # Two reference outputs A and B are made first; then the command is started KILLS times (20), writing A or B in
-# turn over what is there, and killed after a random delay within one run's time (seeded: OUTPUTS_KILL_SEED, printed).
+# turn over what is there, and killed after a random delay within one run's time, every other one near its end
+# (seeded: OUTPUTS_KILL_SEED, printed).
 # After each kill the output must be exactly one whole reference (tests/outputs_same.py: every file, timings aside) -
 # the earlier one or the new one, never a mix and never half - or, for init, which never overwrites, none at all.
 # Then a rerun must succeed, and leave nothing of the killed runs beside its output.
@@ -17,6 +18,9 @@ SEED=${OUTPUTS_KILL_SEED:-39}
 RANDOM=$SEED
 echo "seed $SEED (OUTPUTS_KILL_SEED), $KILLS kills"
 
+# run WHICH OUT: the command writing reference WHICH (a or b) to OUT. It ends in exec, so that, started with &, $! is
+# the command itself (a kill of a subshell would leave it running); called in the foreground, it runs in ( ).
+
 # Two small takes that differ in length and motion, each tracked (ar draws on take A).
 takes() {
   $BC synth-take --out "$W/take-a" --frames 3 --supersample 1 --seed 1 --quiet
@@ -25,7 +29,7 @@ takes() {
 case $CASE in
 track)
   takes
-  run() { $BC track "$W/take-$1/take.avi" --camera "$W/take-$1/camera.json" --out "$2" --quiet; }
+  run() { exec $BC track "$W/take-$1/take.avi" --camera "$W/take-$1/camera.json" --out "$2" --quiet; }
   OUT=$W/out ;;
 ar)
   takes
@@ -34,36 +38,41 @@ ar)
   run() {
     mkdir -p "$2"
     local ball=$([ $1 = a ] && echo 50,125 || echo 110,100)
-    $BC ar "$W/take-a/take.avi" --track "$W/track" --ball $ball --out "$2/ar.avi" --frames "$2/frames" --quiet
+    exec $BC ar "$W/take-a/take.avi" --track "$W/track" --ball $ball --out "$2/ar.avi" --frames "$2/frames" --quiet
   }
   OUT=$W/out ;;
 init)
-  run() { $BC init "$2" --seed $([ $1 = a ] && echo 7 || echo 8) > /dev/null; }
+  run() { exec $BC init "$2" --seed $([ $1 = a ] && echo 7 || echo 8) > /dev/null; }
   OUT=$W/study ;;
 *) fail "unknown case $CASE" ;;
 esac
 
+# The references under the output's own name (init's README names its folder).
+REF_A=$W/ref-a/$(basename "$OUT") REF_B=$W/ref-b/$(basename "$OUT")
+mkdir -p "$W/ref-a" "$W/ref-b"
 start=$(date +%s%N)
-run a "$W/ref-a" > /dev/null
+(run a "$REF_A") > /dev/null
 took_ms=$((($(date +%s%N) - start) / 1000000))
-run b "$W/ref-b" > /dev/null
-[ "$($SAME "$W/ref-a" "$W/ref-b")" != 0 ] || fail "the two references are alike"
-[ "$($SAME "$W/ref-a" "$W/ref-a")" = 0 ] || fail "a reference differs from itself"
+(run b "$REF_B") > /dev/null
+[ "$($SAME "$REF_A" "$REF_B")" != 0 ] || fail "the two references are alike"
+[ "$($SAME "$REF_A" "$REF_A")" = 0 ] || fail "a reference differs from itself"
 # An earlier output to write over (init: none; it never overwrites).
-[ $CASE = init ] || run a "$OUT" > /dev/null
+[ $CASE = init ] || (run a "$OUT") > /dev/null
 echo "one run: $took_ms ms"
 
 killed=0 old=0 new=0 none=0
 for i in $(seq 1 "$KILLS"); do
   if [ $CASE = init ]; then which=$([ $((i % 2)) = 1 ] && echo a || echo b); before=none
-  else before=$($SAME "$OUT" "$W/ref-a" "$W/ref-b"); which=$([ "$before" = 0 ] && echo b || echo a); fi
-  delay_ms=$((RANDOM % (took_ms + 1)))
+  else before=$($SAME "$OUT" "$REF_A" "$REF_B"); which=$([ "$before" = 0 ] && echo b || echo a); fi
+  # Every other kill near the end, where the output is written: anywhere in the run, or in 70-120 % of it.
+  if [ $((i % 2)) = 1 ]; then delay_ms=$((RANDOM % (took_ms + 1)))
+  else delay_ms=$((took_ms * 7 / 10 + RANDOM % (took_ms / 2 + 1))); fi
   run $which "$OUT" > /dev/null 2>&1 &
   pid=$!
   sleep "$(printf '%d.%03d' $((delay_ms / 1000)) $((delay_ms % 1000)))"
   kill -9 $pid 2>/dev/null && killed=$((killed + 1)) || true
   wait $pid 2>/dev/null || true
-  after=$($SAME "$OUT" "$W/ref-a" "$W/ref-b")
+  after=$($SAME "$OUT" "$REF_A" "$REF_B")
   want=$([ $which = a ] && echo 0 || echo 1)
   if [ $CASE = init ]; then
     if [ -e "$OUT" ]; then
@@ -72,13 +81,13 @@ for i in $(seq 1 "$KILLS"); do
     else none=$((none + 1)); fi
   elif [ "$after" = "$before" ]; then old=$((old + 1))
   elif [ "$after" = "$want" ]; then new=$((new + 1))
-  else fail "$CASE killed after $delay_ms ms (kill $i) left neither the earlier output nor the new one: $after"
+  else fail "$CASE killed after $delay_ms ms (kill $i, writing $which over ref $before) left neither the earlier output nor the new one: $after"
   fi
 done
 
 # A rerun succeeds, is whole, and removes what the killed runs left beside it.
-run b "$OUT" > /dev/null 2> "$W/rerun.err" || fail "the rerun failed: $(cat "$W/rerun.err")"
-[ "$($SAME "$OUT" "$W/ref-b")" = 0 ] || fail "the rerun's output is not whole: $($SAME "$OUT" "$W/ref-b")"
+(run b "$OUT") > /dev/null 2> "$W/rerun.err" || fail "the rerun failed: $(cat "$W/rerun.err")"
+[ "$($SAME "$OUT" "$REF_B")" = 0 ] || fail "the rerun's output is not whole: $($SAME "$OUT" "$REF_B")"
 left=$(cd "$(dirname "$OUT")" && ls -A | grep -E '\.(partial|tmp|old)-[0-9]+' || true)
 [ $CASE = ar ] && left="$left$(cd "$OUT" && ls -A | grep -E '\.(partial|tmp|old)-[0-9]+' || true)"
 [ -z "$left" ] || fail "left after the rerun: $left"

@@ -138,7 +138,11 @@ void AddArCommand(CLI::App& app) {
       return name.size() == 14 && name.rfind("frame-", 0) == 0 && name.compare(10, 4, ".png") == 0 &&
              name.find_first_not_of("0123456789", 6) == 10;
     };
-    if (!args->frames_dir.empty()) RequireReplaceableFolder(args->frames_dir, is_frame);
+    try {
+      if (!args->frames_dir.empty()) RequireReplaceableFolder(args->frames_dir, is_frame);
+    } catch (const Error& e) {
+      throw e.Wrapped(e.kind(), "--frames ");
+    }
     for (const std::string& target : {args->out, csv_path, args->frames_dir})
       if (!target.empty()) RemoveLeftoversBeside("ar", target);
     stimulus::TakeBlur blur;

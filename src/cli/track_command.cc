@@ -63,7 +63,11 @@ void AddTrackCommand(CLI::App& app) {
       OutputGuard guard;
       for (const std::filesystem::path& file : track::TakeInputFiles(args->input)) guard.Input("INPUT", file);
       guard.Input("--camera", args->camera).OutputFolder("--out", args->out).Check();
-      RequireReplaceableFolder(args->out, track::IsTrackFile);
+      try {
+        RequireReplaceableFolder(args->out, track::IsTrackFile);
+      } catch (const Error& e) {
+        throw e.Wrapped(e.kind(), "--out ");
+      }
       RemoveLeftoversBeside("track", args->out);
     }
     const Board board = Board::Parse(args->board, args->square_mm);
