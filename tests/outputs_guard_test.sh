@@ -72,6 +72,21 @@ expect 3 "--photo fifo: is a FIFO" init study --photo fifo --camera take/camera.
 [ "$(snapshot)" = "$before" ] || fail "a refused command changed a file: $(diff <(echo "$before") <(snapshot) | head -5)"
 left=$(ls -A | grep -Ev '^(take|track|same\.avi|cp|study\.sqlite|afile|dangling|fifo|strangers|many\.json)$' || true)
 [ -z "$left" ] || fail "a refused command left: $left"
+# Failures after the checks write nothing: ar stopped at frame 2 (a frame that is not the take's) leaves no video,
+# CSV or frames; init on a photo with no board (calibrate: exit 4) leaves no study.
+$PY -c "from PIL import Image; Image.open('take/frame-0000.png').point(lambda v: 128).save('grey.png')"
+mkdir mixed && cp take/frame-000[01].png mixed/ && cp grey.png mixed/frame-0002.png
+code=0
+$BC ar 'mixed/frame-%04d.png' --track track --ball 50,125 --out stopped/ar.avi --frames stopped/frames --quiet \
+  2> "$L/err.log" || code=$?
+[ $code = 3 ] || fail "ar on a take with another frame 2: exit $code: $(cat "$L/err.log")"
+grep -q "frame 2" "$L/err.log" || fail "ar on a take with another frame 2: $(cat "$L/err.log")"
+[ -z "$(ls -A stopped 2>/dev/null)" ] || fail "ar stopped at frame 2 left: $(ls -A stopped)"
+code=0
+$BC init grey-study --photo grey.png --camera take/camera.json > "$L/init.log" 2>&1 || code=$?
+[ $code = 4 ] || fail "init on a photo with no board: exit $code: $(cat "$L/init.log")"
+[ -z "$(ls -A | grep grey-study)" ] || fail "a failed init left $(ls -A | grep grey-study)"
+
 # The photo study the adversary could not make (scene-no-board.png was never made): the default example with a
 # photo of one's own now validates, its board-free line dropped.
 $BC init photo-study --photo take/frame-0000.png --camera take/camera.json > "$L/init.log" 2>&1 ||

@@ -60,7 +60,13 @@ void Step(const std::string& what, std::vector<std::string> args, const fs::path
   const int status = RunChild(args, cwd.string());
   if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return;
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 10;
-  throw Error(code == 2 || code == 3 ? ErrorKind::kInput : ErrorKind::kInternal,
+  // The step's own kind passes on (no board in your photo: 4), except that its command line is init's making, so
+  // a usage error there is a problem of the files given (3); a crash or a kill stays internal.
+  const ErrorKind kind = code == 2 || code == 3 ? ErrorKind::kInput
+                         : code == 4            ? ErrorKind::kNotFound
+                         : code == 5            ? ErrorKind::kDomain
+                                                : ErrorKind::kInternal;
+  throw Error(kind,
               "init: " + what + " failed (exit " + std::to_string(code) + "); " + dir.string() +
                   " was not made (or is left as it was)");
 }
