@@ -88,6 +88,12 @@ TakeResult TrackTake(FrameSource& source, Tracker& tracker, const std::function<
 }
 
 bool IsTrackFile(const std::string& name) {
+  // What an earlier version, which wrote into DIR itself, left when killed: .track.csv.tmp-PID. The folder is
+  // replaced whole, so it goes with the rest.
+  const size_t tmp = name.rfind(".tmp-");
+  if (name.size() > 1 && name[0] == '.' && tmp != std::string::npos && tmp + 5 < name.size() &&
+      name.find_first_not_of("0123456789", tmp + 5) == std::string::npos)
+    return IsTrackFile(name.substr(1, tmp - 1));
   const bool calib = name.size() > 11 && name.rfind("calib-", 0) == 0 && name.compare(name.size() - 5, 5, ".json") == 0 &&
                      name.find_first_not_of("0123456789", 6) == name.size() - 5;
   return calib || name == "track.csv";

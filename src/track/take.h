@@ -35,7 +35,8 @@ TakeResult TrackTake(FrameSource& source, Tracker& tracker,
 // track's (IsTrackFile) is refused, Error(kInput), before anything is written.
 void WriteTake(const TakeResult& take, const std::filesystem::path& dir, const std::string& input);
 
-// True for the names a track folder holds: track.csv and calib-NNNN.json.
+// True for the names a track folder holds: track.csv and calib-NNNN.json (and .NAME.tmp-PID of them, which a killed
+// earlier version left there).
 bool IsTrackFile(const std::string& name);
 
 // track.csv's columns, in order, with their meaning (docs/track.md explains them).
