@@ -130,6 +130,8 @@ void AddArCommand(CLI::App& app) {
       for (const std::filesystem::path& file : track::TakeInputFiles(args->input)) guard.Input("INPUT", file);
       guard.Input("--track", args->track);
       if (!args->objects.empty()) guard.Input("--objects", args->objects);
+      if (!args->balls.empty()) guard.Input("--ball-texture", scene::ResolveStimulus(args->ball_texture));
+      if (!args->cards.empty()) guard.Input("--card-texture", scene::ResolveStimulus(args->card_texture));
       guard.OutputFile("--out", args->out).OutputFile(args->csv.empty() ? "the CSV (OUT with .csv)" : "--csv", csv_path);
       if (!args->frames_dir.empty()) guard.OutputFolder("--frames", args->frames_dir);
       guard.Check();
