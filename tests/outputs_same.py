@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Which of the reference folders a folder is: outputs_same.py DIR REF... prints the index (0, 1, ...) of the
-first reference DIR equals, or 'none' with the first difference. Equal: the same names (hidden names at the top,
+"""Which of the reference folders (or files) a folder (file) is: outputs_same.py DIR REF... prints the index (0, 1, ...)
+of the first reference DIR equals, or 'none' with the first difference. Equal: the same names (hidden names at the top,
 the leftovers of killed runs, are not counted; the test checks those itself), the same bytes, except that timings
 are not compared: keys and CSV columns whose name ends in _ms (a run's own speed)."""
 import csv
@@ -43,6 +43,10 @@ def content(path):
 
 
 def difference(a, b):
+    if os.path.isfile(a) or os.path.isfile(b):
+        if not (os.path.isfile(a) and os.path.isfile(b)):
+            return "not both files"
+        return "" if content(a) == content(b) else "differs"
     fa, fb = files(a), files(b)
     if sorted(fa) != sorted(fb):
         return "names differ: %s" % sorted(set(fa) ^ set(fb))[:5]
@@ -56,7 +60,7 @@ def main():
     folder, refs = sys.argv[1], sys.argv[2:]
     why = []
     for i, ref in enumerate(refs):
-        d = difference(folder, ref) if os.path.isdir(folder) else "no folder"
+        d = difference(folder, ref) if os.path.exists(folder) else "does not exist"
         if not d:
             print(i)
             return

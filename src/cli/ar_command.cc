@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include "core/media.h"
@@ -53,6 +54,15 @@ std::vector<double> MmList(const std::string& option, const std::string& text, s
 // (64 x 18000 rows is about 200 MB).
 constexpr size_t kMaxArObjects = stimulus::kMaxPlacedObjects;
 constexpr int kMaxArFrames = 18000;  // 10 minutes at 30 fps
+
+// fsync of a finished file (the video the writer closed) so that its rename cannot outlive its bytes; a failure
+// here is not one: the file is whole, only its survival of a power cut is in doubt.
+void SyncFile(const std::filesystem::path& path) {
+  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return;
+  fsync(fd);
+  close(fd);
+}
 
 }  // namespace
 
@@ -259,6 +269,10 @@ void AddArCommand(CLI::App& app) {
       if (error) throw InputError(args->out, "cannot make " + video_partial.string() + ": " + error.message());
     }
     const fs::path video_temp = video_partial / fs::path(args->out).filename();
+    // The CSV, written whole beside its place before the video is moved: .NAME.partial-PID (removed on failure here,
+    // by the next run's RemoveStaleLeftovers after a kill).
+    const fs::path csv_temp = TemporaryBeside(csv_path, "partial");
+    const RemovedAtExit partial_csv{csv_temp};
     std::string csv = stimulus::DrawnCsvHeader();
     const bool tty = isatty(2) && !args->quiet;
     int written = 0, drawn_frames = 0, unposed = 0;
@@ -320,17 +334,20 @@ void AddArCommand(CLI::App& app) {
       if (tty) std::fprintf(stderr, "\n");
       if (written == 0) throw ended ? *ended : InputError(args->input, "holds no frame; nothing written");
       video.Release();  // the frames written so far make a whole file, also when the input ended early
+      // The video and the CSV, both whole on disk, are moved into place by two renames one after the other, and
+      // then (with --frames) the frames folder is swapped in: the three are no single step, but the moment between
+      // them is two renames and the frames' fsync (each frame was written whole), not the writing of any of them.
+      WriteFileAtomically(csv_temp, csv);
+      SyncFile(video_temp);
+      std::error_code error;
+      fs::rename(video_temp, args->out, error);
+      if (!error) fs::rename(csv_temp, csv_path, error);
+      if (error) throw InputError(args->out, "cannot move the finished video and CSV into place: " + error.message());
     };
     if (args->frames_dir.empty())
       draw({});
     else
       WriteFolderAtomically(args->frames_dir, draw, is_frame);
-    {
-      std::error_code error;
-      fs::rename(video_temp, args->out, error);
-      if (error) throw InputError(args->out, "cannot move the finished video into place: " + error.message());
-    }
-    WriteFileAtomically(csv_path, csv);
     if (!args->quiet) {
       std::printf("%d frames: %d with objects, %d without (lost or beyond track.csv); wrote %s (%s) and %s in %.1f s\n",
                   written, drawn_frames, unposed, args->out.c_str(), codec_used.c_str(), csv_path.c_str(),
