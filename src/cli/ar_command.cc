@@ -322,6 +322,7 @@ void AddArCommand(CLI::App& app) {
           char name[32];
           std::snprintf(name, sizeof name, "frame-%04d.png", index);
           WriteImage(frames_dir / name, out);
+          SyncFile(frames_dir / name);  // now, so that the folder's swap after the video's move waits on no disk
         }
         const std::string status = in_take ? track::Name(take.frames[size_t(index)].status) : "untracked";
         csv += stimulus::DrawnCsvRows(index, in_take ? take.frames[size_t(index)].time_s : time_s, status, plan.drawn);
