@@ -322,7 +322,6 @@ void AddArCommand(CLI::App& app) {
           char name[32];
           std::snprintf(name, sizeof name, "frame-%04d.png", index);
           WriteImage(frames_dir / name, out);
-          SyncFile(frames_dir / name);  // now, so that the folder's swap after the video's move waits on no disk
         }
         const std::string status = in_take ? track::Name(take.frames[size_t(index)].status) : "untracked";
         csv += stimulus::DrawnCsvRows(index, in_take ? take.frames[size_t(index)].time_s : time_s, status, plan.drawn);
@@ -335,9 +334,11 @@ void AddArCommand(CLI::App& app) {
       if (tty) std::fprintf(stderr, "\n");
       if (written == 0) throw ended ? *ended : InputError(args->input, "holds no frame; nothing written");
       video.Release();  // the frames written so far make a whole file, also when the input ended early
-      // The video and the CSV, both whole on disk, are moved into place by two renames one after the other, and
-      // then (with --frames) the frames folder is swapped in: the three are no single step, but the moment between
-      // them is two renames and the frames' fsync (each frame was written whole), not the writing of any of them.
+    };
+    // The video and the CSV, both whole on disk, are moved into place by two renames one after the other, and with
+    // --frames the frames folder is swapped in by a third right after (WriteFolderAtomically's before_swap): the
+    // three are no single step, but all that lies between them is three renames.
+    auto move_in = [&] {
       WriteFileAtomically(csv_temp, csv);
       SyncFile(video_temp);
       std::error_code error;
@@ -345,10 +346,12 @@ void AddArCommand(CLI::App& app) {
       if (!error) fs::rename(csv_temp, csv_path, error);
       if (error) throw InputError(args->out, "cannot move the finished video and CSV into place: " + error.message());
     };
-    if (args->frames_dir.empty())
+    if (args->frames_dir.empty()) {
       draw({});
-    else
-      WriteFolderAtomically(args->frames_dir, draw, is_frame);
+      move_in();
+    } else {
+      WriteFolderAtomically(args->frames_dir, draw, is_frame, move_in);
+    }
     if (!args->quiet) {
       std::printf("%d frames: %d with objects, %d without (lost or beyond track.csv); wrote %s (%s) and %s in %.1f s\n",
                   written, drawn_frames, unposed, args->out.c_str(), codec_used.c_str(), csv_path.c_str(),
