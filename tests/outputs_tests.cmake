@@ -45,3 +45,4 @@ foreach(case track ar init)
   set_tests_properties(outputs_kill_${case} PROPERTIES LABELS "gl;outputs" TIMEOUT 150
                        PASS_REGULAR_EXPRESSION "^ok:|\nok:")
 endforeach()
+set_test_costs(outputs_kill_init 31 outputs_kill_ar 25 outputs_kill_track 15 outputs_guard_cli 8)
