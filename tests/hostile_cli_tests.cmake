@@ -32,7 +32,7 @@ hostile_test(cli_hostile_blur_cutoff_zero 2 "--cutoff: must be in (0, 100000] cy
              blur ${D}/small.png --method butterworth --cutoff 0 --out ${H}/x.png)
 
 # Images that are no image: a device, a directory, a header claiming 65535 x 65535 px, a truncated PNG.
-hostile_test(cli_hostile_image_dev_zero 3 "/dev/zero: is a character device, not an image file"
+hostile_test(cli_hostile_image_dev_zero 3 "IN /dev/zero: is a character device, not a file; not read"
              blur /dev/zero --radius-px 2 --out ${H}/x.png)
 hostile_test(cli_hostile_image_directory_option 2 "File is actually a directory: ${D}"
              blur ${D} --radius-px 2 --out ${H}/x.png)
@@ -171,7 +171,7 @@ hostile_test(cli_hostile_preview_observer_model 2 "--observer model must be arcm
 # such as /dev/full) would be replaced by a plain file; opening a FIFO to write waits for a reader forever. A FIFO
 # made here stands for them all (a test must not risk /dev/null on the machine that runs it).
 execute_process(COMMAND mkfifo ${H}/fifo.png ${H}/fifo.csv RESULT_VARIABLE ignored ERROR_QUIET)
-hostile_test(cli_hostile_out_is_a_fifo 3 "fifo.png: is not a regular file (a device, FIFO or socket); not replaced"
+hostile_test(cli_hostile_out_is_a_fifo 3 "fifo.png: is a FIFO, not a file"
              blur ${D}/small.png --radius-px 2 --out ${H}/fifo.png)
 set(C ${PROJECT_BINARY_DIR}/cli-test)
 set(ANIMATE animate --calib ${C}/calib.json --background ${C}/scene/scene.png --left estimated --right none

@@ -2,7 +2,7 @@
 # new one, no surviving analysis process, and leftovers that the next run removes. Over the CLI tests' scene.
 foreach(case merge export report)
   add_test(NAME outputs_kill_${case}
-           COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" bash ${PROJECT_SOURCE_DIR}/tests/outputs_kill_test.sh ${case} $<TARGET_FILE:blurcue>
+           COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" ${BLURCUE_EXPECT} "^ok:|\nok:" bash ${PROJECT_SOURCE_DIR}/tests/outputs_kill_test.sh ${case} $<TARGET_FILE:blurcue>
                    ${PROJECT_BINARY_DIR}/cli-test)
   set_tests_properties(outputs_kill_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
                        LABELS "gl;outputs" TIMEOUT 120)
@@ -28,3 +28,20 @@ add_test(NAME init_from_prefix
 set_tests_properties(init_from_prefix PROPERTIES LABELS gl)
 # Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
 set_test_costs(init_from_prefix 124 outputs_kill_export 21 outputs_kill_report 17)
+
+# Issue 39, nothing an experimenter owns is destroyed: what an adversary tried against ar, track, init, calibrate and
+# camera (an output that is an input, a record as a CSV, a FIFO input, an output of another kind, no limits) is
+# refused before any work, in one line, and leaves every file as it was (tests/outputs_guard_test.sh).
+add_test(NAME outputs_guard_cli
+         COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" bash ${PROJECT_SOURCE_DIR}/tests/outputs_guard_test.sh $<TARGET_FILE:blurcue> ${PROJECT_BINARY_DIR})
+set_tests_properties(outputs_guard_cli PROPERTIES LABELS "gl;outputs" TIMEOUT 120)
+# 20 kill -9s of track, ar and init at random points (seeded, the seed printed) while they write over an earlier
+# output: always the earlier output or the whole new one, and a rerun that succeeds and removes the leftovers
+# (tests/outputs_take_kill_test.sh).
+foreach(case track ar init)
+  add_test(NAME outputs_kill_${case}
+           COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" bash ${PROJECT_SOURCE_DIR}/tests/outputs_take_kill_test.sh ${case} $<TARGET_FILE:blurcue>
+                   ${PROJECT_BINARY_DIR})
+  set_tests_properties(outputs_kill_${case} PROPERTIES LABELS "gl;outputs" TIMEOUT 150)
+endforeach()
+set_test_costs(outputs_kill_init 31 outputs_kill_ar 25 outputs_kill_track 15 outputs_guard_cli 8)

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <opencv2/calib3d.hpp>
+#include "core/output_guard.h"
 #include "core/media.h"
 
 #include "calib/scene_blur.h"
@@ -102,6 +103,14 @@ void AddAnimateCommand(CLI::App& app) {
       RequireReplaceableFile(args->video);
     }
     if (!args->log.empty()) RequireReplaceableFile(args->log);
+    {
+      OutputGuard guard;
+      guard.Input("--calib", args->calib).Input("--background", args->background);
+      if (!args->video.empty()) guard.OutputFile("--video", args->video);
+      if (!args->log.empty()) guard.OutputFile("--log", args->log);
+      if (!args->frames_dir.empty()) guard.OutputFolder("--frames", args->frames_dir);
+      guard.Check();
+    }
     double fixed_left = 0, fixed_right = 0;
     const calib::BlurSource left = calib::ParseBlurSource(args->left, &fixed_left);
     const calib::BlurSource right = calib::ParseBlurSource(args->right, &fixed_right);

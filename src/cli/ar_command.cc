@@ -5,10 +5,12 @@
 #include <cctype>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include "core/media.h"
@@ -18,6 +20,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/image.h"
+#include "core/output_guard.h"
 #include "core/typed.h"
 #include "render/frame_compositor.h"
 #include "render/gl_context.h"
@@ -46,6 +49,21 @@ std::vector<double> MmList(const std::string& option, const std::string& text, s
   return v;
 }
 
+// The most objects one run draws (stimulus::kMaxPlacedObjects), and the most frames: each object is drawn in every
+// frame, and the CSV (one row per object per frame) is held until the end, so both are bounded before any work
+// (64 x 18000 rows is about 200 MB).
+constexpr size_t kMaxArObjects = stimulus::kMaxPlacedObjects;
+constexpr int kMaxArFrames = 18000;  // 10 minutes at 30 fps
+
+// fsync of a finished file (the video the writer closed) so that its rename cannot outlive its bytes; a failure
+// here is not one: the file is whole, only its survival of a power cut is in doubt.
+void SyncFile(const std::filesystem::path& path) {
+  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return;
+  fsync(fd);
+  close(fd);
+}
+
 }  // namespace
 
 void AddArCommand(CLI::App& app) {
@@ -69,7 +87,11 @@ void AddArCommand(CLI::App& app) {
       "\n"
       "Writes OUT.avi (FFV1, lossless; MJPEG where videoio has no FFV1) and a CSV (--csv, default OUT.csv) with one row\n"
       "per object per frame: screen position, depth, r, floor, motion streak, the frame's tracking status.\n"
-      "A damaged or truncated INPUT ends the take: the frames drawn before it are written, exit 3.\n"
+      "A damaged or truncated INPUT ends the take: the frames drawn before it are written, exit 3. Any other\n"
+      "failure writes nothing. The outputs are built beside their places and moved in at the end: an earlier\n"
+      "OUT.avi, CSV and --frames folder stay as they were until the new ones are whole. No output may be an input\n"
+      "or lie in the --track folder, and --frames must be a folder of frame-NNNN.png only.\n"
+      "Limits: at most 64 objects and 18000 frames (10 minutes at 30 fps) a run.\n"
       "Example: blurcue ar take/take.avi --track take/track --ball 87.5,125 --card 120,150,40,30 --out ar.avi");
   cmd->add_option("input", args->input, "the take: a video file, or a printf pattern of an image sequence")
       ->required();
@@ -108,8 +130,33 @@ void AddArCommand(CLI::App& app) {
     }
     const std::string csv_path =
         args->csv.empty() ? std::filesystem::path(args->out).replace_extension(".csv").string() : args->csv;
-    RequireReplaceableFile(args->out);
-    RequireReplaceableFile(csv_path);
+    // Nothing is read or drawn before every output is known to be writable and none is an input.
+    if (args->balls.size() + args->cards.size() > kMaxArObjects)
+      throw Error(ErrorKind::kUsage, std::to_string(args->balls.size() + args->cards.size()) +
+                                         " --ball and --card options: at most " + std::to_string(kMaxArObjects) +
+                                         " objects a run");
+    {
+      OutputGuard guard;
+      for (const std::filesystem::path& file : track::TakeInputFiles(args->input)) guard.Input("INPUT", file);
+      guard.Input("--track", args->track);
+      if (!args->objects.empty()) guard.Input("--objects", args->objects);
+      if (!args->balls.empty()) guard.Input("--ball-texture", scene::ResolveStimulus(args->ball_texture));
+      if (!args->cards.empty()) guard.Input("--card-texture", scene::ResolveStimulus(args->card_texture));
+      guard.OutputFile("--out", args->out).OutputFile(args->csv.empty() ? "the CSV (OUT with .csv)" : "--csv", csv_path);
+      if (!args->frames_dir.empty()) guard.OutputFolder("--frames", args->frames_dir);
+      guard.Check();
+    }
+    auto is_frame = [](const std::string& name) {
+      return name.size() == 14 && name.rfind("frame-", 0) == 0 && name.compare(10, 4, ".png") == 0 &&
+             name.find_first_not_of("0123456789", 6) == 10;
+    };
+    try {
+      if (!args->frames_dir.empty()) RequireReplaceableFolder(args->frames_dir, is_frame);
+    } catch (const Error& e) {
+      throw e.Wrapped(e.kind(), "--frames ");
+    }
+    for (const std::string& target : {args->out, csv_path, args->frames_dir})
+      if (!target.empty()) RemoveLeftoversBeside("ar", target);
     stimulus::TakeBlur blur;
     blur.source = calib::ParseBlurSource(args->blur, &blur.fixed_r_px);
     blur.method = args->method;
@@ -119,14 +166,24 @@ void AddArCommand(CLI::App& app) {
     if (!args->objects.empty()) {
       objects = stimulus::LoadPlacedObjects(args->objects);
       for (size_t i = 0; i < objects.size(); ++i) given.push_back(args->objects + ": /objects/" + std::to_string(i));
+      if (objects.size() + args->balls.size() + args->cards.size() > kMaxArObjects)
+        throw InputError(args->objects, std::to_string(objects.size()) + " objects and " +
+                                            std::to_string(args->balls.size() + args->cards.size()) +
+                                            " on the command line: at most " + std::to_string(kMaxArObjects) +
+                                            " objects a run");
     }
+    // One texture per image, however many objects wear it: decoded once, and one GL texture (its identity).
+    std::map<std::string, scene::SurfaceTexture> textures;
     auto add = [&](const char* kind, const scene::VirtualObject& o, const std::string& texture) {
       stimulus::PlacedObject p;
       int n = 1;
       for (const auto& q : objects) n += q.object.kind == o.kind;
       p.name = kind + std::to_string(n);
       p.object = o;
-      p.object.texture = scene::SurfaceTexture(ReadImage(scene::ResolveStimulus(texture)));
+      auto known = textures.find(texture);
+      if (known == textures.end())
+        known = textures.emplace(texture, scene::SurfaceTexture(ReadImage(scene::ResolveStimulus(texture)))).first;
+      p.object.texture = known->second;
       objects.push_back(std::move(p));
     };
     for (const std::string& b : args->balls) {
@@ -148,6 +205,10 @@ void AddArCommand(CLI::App& app) {
     const Camera& camera = take.camera();
     const double take_fps = take.FramesPerSecond();
     track::FrameSource source(args->input, take_fps > 0 ? take_fps : 30);
+    if (int(take.frames.size()) > kMaxArFrames || source.expected_frames() > kMaxArFrames)
+      throw InputError(int(take.frames.size()) > kMaxArFrames ? args->track : args->input,
+                       std::to_string(std::max(int(take.frames.size()), source.expected_frames())) +
+                           " frames: ar draws at most " + std::to_string(kMaxArFrames) + " a run");
     // An object in no frame's photo would leave a video without it and a summary that counts it drawn: a slip of
     // millimetres (400 for 40) is refused before anything is written.
     for (size_t i = 0; i < objects.size(); ++i) {
@@ -190,9 +251,28 @@ void AddArCommand(CLI::App& app) {
     std::unique_ptr<render::FrameCompositor> compositor;
     media::VideoWriter video;
     std::string codec_used;
-    if (std::filesystem::path(args->out).has_parent_path())
-      std::filesystem::create_directories(std::filesystem::path(args->out).parent_path());
-    if (!args->frames_dir.empty()) std::filesystem::create_directories(args->frames_dir);
+    // The video is written under its own name (the extension tells the writer its container) inside
+    // DIR/.NAME.partial-PID, and moved into place once it, the frames and the CSV are whole; a run that fails or is
+    // killed leaves the earlier video (the next run removes the partial folder).
+    namespace fs = std::filesystem;
+    const fs::path video_partial = TemporaryBeside(args->out, "partial");
+    struct RemovedAtExit {
+      fs::path path;
+      ~RemovedAtExit() {
+        std::error_code ignored;
+        fs::remove_all(path, ignored);
+      }
+    } partial_video{video_partial};
+    {
+      std::error_code error;
+      fs::create_directories(video_partial, error);
+      if (error) throw InputError(args->out, "cannot make " + video_partial.string() + ": " + error.message());
+    }
+    const fs::path video_temp = video_partial / fs::path(args->out).filename();
+    // The CSV, written whole beside its place before the video is moved: .NAME.partial-PID (removed on failure here,
+    // by the next run's RemoveStaleLeftovers after a kill).
+    const fs::path csv_temp = TemporaryBeside(csv_path, "partial");
+    const RemovedAtExit partial_csv{csv_temp};
     std::string csv = stimulus::DrawnCsvHeader();
     const bool tty = isatty(2) && !args->quiet;
     int written = 0, drawn_frames = 0, unposed = 0;
@@ -201,52 +281,77 @@ void AddArCommand(CLI::App& app) {
     cv::Mat frame;
     int index = 0;
     double time_s = 0;
-    while (true) {
-      try {
-        if (!source.Next(&frame, &index, &time_s)) break;
-      } catch (const Error& e) {
-        ended = e;
-        break;
+    // Draws every frame: into the video, the CSV and (when not empty) `frames_dir`.
+    auto draw = [&](const fs::path& frames_dir) {
+      while (true) {
+        if (written == kMaxArFrames) {
+          ended = InputError(args->input, "more than " + std::to_string(kMaxArFrames) + " frames: ar draws at most " +
+                                              std::to_string(kMaxArFrames) + " a run");
+          break;
+        }
+        try {
+          if (!source.Next(&frame, &index, &time_s)) break;
+        } catch (const Error& e) {
+          ended = e;
+          break;
+        }
+        stimulus::CheckTakeFrame(take, index, frame, args->input, args->track);
+        if (!video.IsOpened()) {
+          const char* codec = OpenLosslessVideo(video, video_temp, source.fps() > 0 ? source.fps() : 30, frame.size());
+          if (!codec) throw InputError(args->out, "cannot open a video writer (FFV1 or MJPEG .avi)");
+          codec_used = codec;
+        }
+        const bool in_take = index < int(take.frames.size());
+        const stimulus::TrackedFramePlan plan = stimulus::PlanTrackedFrame(take, index, objects, blur);
+        cv::Mat out = frame;
+        if (in_take && take.frames[size_t(index)].calib) {
+          const calib::SceneCalib& c = *take.frames[size_t(index)].calib;
+          if (!compositor) compositor = std::make_unique<render::FrameCompositor>(camera, c.rvec, c.tvec, frame);
+          const auto draw_start = std::chrono::steady_clock::now();
+          compositor->SetFrame(c.rvec, c.tvec, frame);
+          compositor->Compose(plan.objects);
+          out = compositor->Read();
+          draw_ms.push_back(
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - draw_start).count());
+          ++drawn_frames;
+        } else {
+          ++unposed;
+        }
+        video.Write(out);
+        if (!frames_dir.empty()) {
+          char name[32];
+          std::snprintf(name, sizeof name, "frame-%04d.png", index);
+          WriteImage(frames_dir / name, out);
+        }
+        const std::string status = in_take ? track::Name(take.frames[size_t(index)].status) : "untracked";
+        csv += stimulus::DrawnCsvRows(index, in_take ? take.frames[size_t(index)].time_s : time_s, status, plan.drawn);
+        ++written;
+        if (!args->quiet && (tty || (written % 10 == 0)))
+          std::fprintf(stderr, "%sframe %d%s: %s%s", tty ? "\r" : "", index,
+                       source.expected_frames() > 0 ? ("/" + std::to_string(source.expected_frames())).c_str() : "",
+                       status.c_str(), tty ? "   " : "\n");
       }
-      stimulus::CheckTakeFrame(take, index, frame, args->input, args->track);
-      if (!video.IsOpened()) {
-        const char* codec = OpenLosslessVideo(video, args->out, source.fps() > 0 ? source.fps() : 30, frame.size());
-        if (!codec) throw InputError(args->out, "cannot open a video writer (FFV1 or MJPEG .avi)");
-        codec_used = codec;
-      }
-      const bool in_take = index < int(take.frames.size());
-      const stimulus::TrackedFramePlan plan = stimulus::PlanTrackedFrame(take, index, objects, blur);
-      cv::Mat out = frame;
-      if (in_take && take.frames[size_t(index)].calib) {
-        const calib::SceneCalib& c = *take.frames[size_t(index)].calib;
-        if (!compositor) compositor = std::make_unique<render::FrameCompositor>(camera, c.rvec, c.tvec, frame);
-        const auto draw_start = std::chrono::steady_clock::now();
-        compositor->SetFrame(c.rvec, c.tvec, frame);
-        compositor->Compose(plan.objects);
-        out = compositor->Read();
-        draw_ms.push_back(
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - draw_start).count());
-        ++drawn_frames;
-      } else {
-        ++unposed;
-      }
-      video.Write(out);
-      if (!args->frames_dir.empty()) {
-        char name[32];
-        std::snprintf(name, sizeof name, "frame-%04d.png", index);
-        WriteImage(std::filesystem::path(args->frames_dir) / name, out);
-      }
-      const std::string status = in_take ? track::Name(take.frames[size_t(index)].status) : "untracked";
-      csv += stimulus::DrawnCsvRows(index, in_take ? take.frames[size_t(index)].time_s : time_s, status, plan.drawn);
-      ++written;
-      if (!args->quiet && (tty || (written % 10 == 0)))
-        std::fprintf(stderr, "%sframe %d%s: %s%s", tty ? "\r" : "", index,
-                     source.expected_frames() > 0 ? ("/" + std::to_string(source.expected_frames())).c_str() : "",
-                     status.c_str(), tty ? "   " : "\n");
+      if (tty) std::fprintf(stderr, "\n");
+      if (written == 0) throw ended ? *ended : InputError(args->input, "holds no frame; nothing written");
+      video.Release();  // the frames written so far make a whole file, also when the input ended early
+    };
+    // The video and the CSV, both whole on disk, are moved into place by two renames one after the other, and with
+    // --frames the frames folder is swapped in by a third right after (WriteFolderAtomically's before_swap): the
+    // three are no single step, but all that lies between them is three renames.
+    auto move_in = [&] {
+      WriteFileAtomically(csv_temp, csv);
+      SyncFile(video_temp);
+      std::error_code error;
+      fs::rename(video_temp, args->out, error);
+      if (!error) fs::rename(csv_temp, csv_path, error);
+      if (error) throw InputError(args->out, "cannot move the finished video and CSV into place: " + error.message());
+    };
+    if (args->frames_dir.empty()) {
+      draw({});
+      move_in();
+    } else {
+      WriteFolderAtomically(args->frames_dir, draw, is_frame, move_in);
     }
-    if (tty) std::fprintf(stderr, "\n");
-    video.Release();  // the frames written so far make a whole file, also when the input ended early
-    WriteFileAtomically(csv_path, csv);
     if (!args->quiet) {
       std::printf("%d frames: %d with objects, %d without (lost or beyond track.csv); wrote %s (%s) and %s in %.1f s\n",
                   written, drawn_frames, unposed, args->out.c_str(), codec_used.c_str(), csv_path.c_str(),

@@ -9,6 +9,7 @@
 #include "bench/render_bench.h"
 #include "bench/track_bench.h"
 #include "cli/commands.h"
+#include "core/output_guard.h"
 #include "core/data_dir.h"
 
 namespace blurcue::cli {
@@ -41,6 +42,7 @@ void AddMeasure(CLI::App& bench) {
   cmd->add_flag("--quick", args->quick, "two levels per factor (smoke run)");
   cmd->add_flag("--no-full-res", args->no_full_res, "skip the full-resolution timing");
   cmd->callback([args] {
+    OutputGuard().OutputFile("--out", args->out).Check();
     bench::MeasureBenchOptions options;
     options.quick = args->quick;
     options.seed = args->seed;
@@ -93,6 +95,7 @@ void AddRender(CLI::App& bench) {
   cmd->add_flag("--quick", args->quick, "small sizes, few frames (smoke run)");
   cmd->add_flag("--frames-only", args->frames_only, "only parts 2 and 3, the frames (about two minutes)");
   cmd->callback([args] {
+    OutputGuard().OutputFile("--out", args->out).Check();
     bench::RenderBenchOptions options;
     options.quick = args->quick;
     options.frames_only = args->frames_only;
@@ -161,6 +164,7 @@ void AddProcedures(CLI::App& bench) {
   cmd->add_option("--seed", args->seed, "seed of the runs")->capture_default_str()->transform(SeedValidator());
   cmd->add_flag("--quick", args->quick, "40 runs (smoke run)");
   cmd->callback([args] {
+    OutputGuard().OutputFile("--out", args->out).Check();
     bench::ProcedureBenchOptions options;
     options.runs = args->quick ? 40 : args->runs;
     options.seed = args->seed;
@@ -201,6 +205,7 @@ void AddPlan(CLI::App& bench) {
   cmd->add_option("--observer", args->options.observer, "the simulated observer")->capture_default_str();
   cmd->add_flag("--quick", args->quick, "1 round of 2 studies (smoke run)");
   cmd->callback([args] {
+    OutputGuard().OutputFile("--out", args->out).Check();
     bench::PlanBenchOptions options = args->options;
     options.protocol_file = args->protocol.empty() ? DataDir().path / "protocols" / "test1-static-grids.json"
                                                    : std::filesystem::path(args->protocol);
@@ -242,6 +247,7 @@ void AddTrack(CLI::App& bench) {
       ->transform(SeedValidator());
   cmd->add_flag("--quick", args->quick, "the first 4 frames of the take (smoke run)");
   cmd->callback([args] {
+    OutputGuard().OutputFile("--out", args->out).Check();
     bench::TrackBenchOptions options;
     options.frames = args->frames;
     options.quick = args->quick;

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "cli/commands.h"
+#include "core/output_guard.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "render/blur.h"
@@ -35,6 +36,7 @@ void AddBlurCommand(CLI::App& app) {
   cmd->add_option("--backend", args->backend, "gl (Mesa/GPU through EGL, no display needed) or cpu (OpenCV)")
       ->check(CLI::IsMember({"gl", "cpu"}))->capture_default_str();
   cmd->callback([args] {
+    OutputGuard().Input("IN", args->in).OutputFile("--out", args->out).Check();
     const bool butterworth = args->method == "butterworth";
     if (butterworth && args->cutoff <= 0)
       throw Error(ErrorKind::kUsage, "--method butterworth needs --cutoff (cycles per image width)");

@@ -10,6 +10,7 @@
 #include "calib/truth.h"
 #include "cli/commands.h"
 #include "core/error.h"
+#include "core/output_guard.h"
 #include "core/image.h"
 #include "optics/fit.h"
 
@@ -51,6 +52,10 @@ void AddCalibrateCommand(CLI::App& app) {
   cmd->add_flag("--quiet", args->quiet, "print only errors");
   cmd->callback([args] {
     const auto t0 = std::chrono::steady_clock::now();
+    OutputGuard guard;
+    guard.Input("PHOTO", args->photo).Input("--camera", args->camera);
+    if (!args->truth.empty()) guard.Input("--truth", args->truth);
+    guard.OutputFile("--out", args->out).Check();
     const Board board = Board::Parse(args->board, args->square_mm);
     const Camera camera = LoadCamera(args->camera);
     const cv::Mat photo = ReadImage(args->photo, 1 /* cv::IMREAD_COLOR */);

@@ -9,6 +9,7 @@
 #include "cli/commands.h"
 #include "core/camera_exif.h"
 #include "core/json_io.h"
+#include "core/output_guard.h"
 
 namespace blurcue::cli {
 namespace {
@@ -51,6 +52,7 @@ void AddCameraCommand(CLI::App& app) {
       ->check(FinitePositive(2000, "mm"));
   cmd->add_option("--f-number", args->f_number, "the f-number, where EXIF lacks it")->check(FinitePositive(256, ""));
   cmd->callback([args] {
+    if (!args->out.empty()) OutputGuard().Input("PHOTO", args->photo).OutputFile("--out", args->out).Check();
     std::optional<std::pair<double, double>> sensor;
     if (args->sensor_mm.size() == 2) sensor = std::make_pair(args->sensor_mm[0], args->sensor_mm[1]);
     auto given = [](double v) { return v > 0 ? std::optional<double>(v) : std::nullopt; };

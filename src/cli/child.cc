@@ -14,7 +14,7 @@
 
 namespace blurcue::cli {
 
-int RunChild(const std::vector<std::string>& argv) { return RunProcess(argv); }
+int RunChild(const std::vector<std::string>& argv, const std::string& cwd) { return RunProcess(argv, nullptr, cwd); }
 
 void RunAnalysis(const std::vector<std::string>& argv, const std::string& what, const std::string& unchanged,
                  const std::vector<std::string>& promised) {

@@ -7,7 +7,8 @@ namespace blurcue::cli {
 
 // Runs `argv` (argv[0] looked up on PATH) and returns its wait status. The child dies with this process: a kill
 // of the command, -9 included, must not leave Python running on to write into a folder nobody will use.
-int RunChild(const std::vector<std::string>& argv);
+// `cwd` (when not empty) is its working folder.
+int RunChild(const std::vector<std::string>& argv, const std::string& cwd = "");
 
 // Runs the analysis script `argv` as RunChild and turns a failure into an Error that names `what` and says that
 // `unchanged` (the output folder) is left as it was: killed -> kInternal, exit 127 (no such program) -> kUsage naming

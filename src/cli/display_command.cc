@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "cli/commands.h"
+#include "core/output_guard.h"
 #include "core/error.h"
 #include "core/stats.h"
 #include "core/image.h"
@@ -91,6 +92,7 @@ void AddDisplayCommand(CLI::App& app) {
       ->transform(IntRange(0, 16));
   cmd->add_option("--screenshot", args->screenshot, "also write the test screen as a PNG");
   cmd->callback([args] {
+    if (!args->screenshot.empty()) OutputGuard().OutputFile("--screenshot", args->screenshot).Check();
     const display::Profile profile =
         args->profile.empty() ? display::DefaultProfile() : display::LoadProfile(args->profile);
     render::WindowOptions options;

@@ -15,6 +15,8 @@
 #include "core/atomic_file.h"
 #include "core/data_dir.h"
 #include "core/error.h"
+#include "core/image.h"
+#include "core/output_guard.h"
 #include "core/names.h"
 #include "core/typed.h"
 
@@ -26,7 +28,7 @@ namespace fs = std::filesystem;
 struct InitArgs {
   std::string dir;
   std::string from = "test1-static-grids";
-  std::string photo, camera;
+  std::string photo, camera, board_free;
   int seed = 7;
 };
 
@@ -49,16 +51,24 @@ std::string ReadText(const fs::path& path) {
   return s.str();
 }
 
-// Runs this blurcue with `args`; a failure stops init naming the step, and says the folder is left as far as it got.
-void Step(const std::string& what, std::vector<std::string> args, const fs::path& dir) {
+// Runs this blurcue with `args` in the folder being built (`cwd`: paths in `args` are relative to it, and so are
+// those the step records, e.g. calib.json's "photo"); a failure stops init naming the step and says that `dir` was
+// not made.
+void Step(const std::string& what, std::vector<std::string> args, const fs::path& cwd, const fs::path& dir) {
   std::cout << "init: " << what << "\n";
   args.insert(args.begin(), (ExecutableDir() / "blurcue").string());
-  const int status = RunChild(args);
+  const int status = RunChild(args, cwd.string());
   if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return;
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 10;
-  throw Error(code == 2 || code == 3 ? ErrorKind::kInput : ErrorKind::kInternal,
+  // The step's own kind passes on (no board in your photo: 4), except that its command line is init's making, so
+  // a usage error there is a problem of the files given (3); a crash or a kill stays internal.
+  const ErrorKind kind = code == 2 || code == 3 ? ErrorKind::kInput
+                         : code == 4            ? ErrorKind::kNotFound
+                         : code == 5            ? ErrorKind::kDomain
+                                                : ErrorKind::kInternal;
+  throw Error(kind,
               "init: " + what + " failed (exit " + std::to_string(code) + "); " + dir.string() +
-                  " holds what was made before it");
+                  " was not made (or is left as it was)");
 }
 
 // The ground-truth take a video example's study folder gets (scripts/demo.sh makes the same one for the shipped
@@ -108,6 +118,80 @@ std::string NextSteps(const std::string& example, const std::string& study, bool
   return s.str();
 }
 
+// Makes the study in `root` (empty, the folder being built; `dir` is where it goes, for messages): the protocol
+// `text` with its paths pointing into the folder, the scene or take, its calibration or track, and the README.
+// Children run inside `root` with paths relative to it.
+void Fill(const InitArgs& args, std::string text, bool video, const fs::path& root, const fs::path& dir) {
+  std::error_code ec;
+  fs::create_directories(root / (video ? "take" : "scene"), ec);
+  if (ec) throw InputError(dir.string(), "cannot make the folder: " + ec.message());
+  // The protocol: the example's text with its demo paths pointing into this folder (relative to the protocol).
+  const std::string demo = "../results/demo/";
+  for (size_t at = text.find(demo); at != std::string::npos; at = text.find(demo, at)) text.erase(at, demo.size());
+  const bool pictures = text.find("\"pictures/") != std::string::npos;
+  // The shipped stimuli it names ("../stimuli/face.png") are copied in, so the folder stands on its own.
+  const std::string shipped = "\"../stimuli/";
+  for (size_t at = text.find(shipped); at != std::string::npos; at = text.find(shipped, at)) {
+    const size_t end = text.find('"', at + shipped.size());
+    const std::string name = text.substr(at + shipped.size(), end - at - shipped.size());
+    fs::create_directories(root / "stimuli", ec);
+    fs::copy_file(DataDir().path / "stimuli" / name, root / "stimuli" / name, fs::copy_options::skip_existing, ec);
+    if (ec)
+      throw InputError((DataDir().path / "stimuli" / name).string(),
+                       "cannot copy into " + dir.string() + ": " + ec.message());
+    text.replace(at, shipped.size(), "\"stimuli/");
+  }
+
+  fs::path photo = "scene/scene.png";
+  const std::string seed = std::to_string(args.seed);
+  if (video) {
+    std::vector<std::string> synth = {"synth-take", "--out", "take", "--seed", seed, "--quiet"};
+    synth.insert(synth.end(), kExampleTake.begin(), kExampleTake.end());
+    Step("a ground-truth take (synth-take, seed " + seed + ")", synth, root, dir);
+    Step("the take tracked (track)",
+         {"track", "take/take.avi", "--camera", "take/camera.json", "--out", "track", "--quiet"}, root, dir);
+  } else if (args.photo.empty()) {
+    Step("a ground-truth scene (synth-scene, seed " + seed + ")",
+         {"synth-scene", "--out", "scene", "--seed", seed, "--noise", "0.004"}, root, dir);
+  } else {
+    // Your photo under its own name; the board-free one (when given) as scene-no-board with its own extension.
+    photo = fs::path("scene") / fs::path(args.photo).filename();
+    fs::copy_file(args.photo, root / photo, ec);
+    if (!ec && !args.camera.empty()) fs::copy_file(args.camera, root / "scene" / "camera.json", ec);
+    if (ec) throw InputError(args.photo, "cannot copy into " + dir.string() + ": " + ec.message());
+    auto replace_all = [&text](const std::string& from, const std::string& to) {
+      for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
+        text.replace(at, from.size(), to);
+    };
+    const std::string no_board = "\"scene/scene-no-board.png\"";
+    if (!args.board_free.empty()) {
+      const fs::path board_free = fs::path("scene") / ("scene-no-board" + fs::path(args.board_free).extension().string());
+      fs::copy_file(args.board_free, root / board_free, fs::copy_options::overwrite_existing, ec);
+      if (ec) throw InputError(args.board_free, "cannot copy into " + dir.string() + ": " + ec.message());
+      replace_all(no_board, "\"" + board_free.string() + "\"");
+    } else if (const size_t at = text.find("\"board_free\": " + no_board + ","); at != std::string::npos) {
+      // No board-free photo of yours: the example names one it does not show, so the line goes.
+      const size_t line = text.rfind('\n', at), next = text.find('\n', at);
+      text.erase(line, next - line);
+    }
+    if (args.camera.empty())
+      Step("camera.json from the photo's EXIF", {"camera", photo.string(), "--out", "scene/camera.json"}, root, dir);
+    replace_all("\"scene/scene.png\"", "\"" + photo.string() + "\"");
+  }
+  if (!video)
+    Step("calibration (calibrate)",
+         {"calibrate", photo.string(), "--camera", "scene/camera.json", "--out", "calib.json"}, root, dir);
+  WriteFileAtomically(root / "protocol.json", text);
+  // The schema its "$schema" names, beside it: an editor that reads it completes and checks the fields as typed.
+  fs::copy_file(DataDir().path / "protocols" / "protocol.schema.json", root / "protocol.schema.json", ec);
+  if (ec) throw InputError(dir.string(), "cannot copy protocol.schema.json into it: " + ec.message());
+  if (pictures)
+    Step("the real pictures at each distance (synth-pictures)",
+         {"synth-pictures", "--protocol", "protocol.json", "--out", "pictures"}, root, dir);
+  WriteFileAtomically(root / "README.md", NextSteps(args.from, dir.filename().string(), args.photo.empty(), video));
+  Step("validate", {"validate", "protocol.json"}, root, dir);
+}
+
 }  // namespace
 
 void AddInitCommand(CLI::App& app) {
@@ -121,7 +205,9 @@ void AddInitCommand(CLI::App& app) {
       "Without --photo the scene is a ground-truth one made by synth-scene (the thesis's set-up; --seed), so a lab\n"
       "with no photo yet can preview and run the study; with --photo (and --camera, or the photo's EXIF) it is\n"
       "yours. A study on a video (video-ball-depth) gets a ground-truth take instead (synth-take, tracked by\n"
-      "track: take/ and track/). DIR must not exist or be empty: init never overwrites. Example:\n"
+      "track: take/ and track/). DIR must not exist or be empty: init never overwrites. The folder is built\n"
+      "beside DIR and moved into place when every step has passed: a failed or killed init leaves no DIR (the\n"
+      "next init removes what a killed one left). Example:\n"
       "  blurcue init my-study --from yes-no-ball && cd my-study && blurcue validate protocol.json\n"
       "Examples shipped (--from):" + examples);
   cmd->add_option("dir", args->dir, "the study folder to make")->required();
@@ -129,6 +215,10 @@ void AddInitCommand(CLI::App& app) {
   cmd->add_option("--photo", args->photo, "your scene photo with the printed board (default: a synthetic scene)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--camera", args->camera, "the photo's camera.json (default: from its EXIF, blurcue camera)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--board-free", args->board_free,
+                  "with --photo: the same view without the board, for an example that shows it (test3-no-board);\n"
+                  "without it such an example is refused, and the others get no scene.board_free")
       ->check(CLI::ExistingFile);
   cmd->add_option("--seed", args->seed, "the synthetic scene's seed (recorded in scene/truth.json)")
       ->capture_default_str()->check(IntRange(0, 2147483647));
@@ -147,71 +237,36 @@ void AddInitCommand(CLI::App& app) {
     if (video && !args->photo.empty())
       throw Error(ErrorKind::kUsage, "--photo: " + args->from + " is a study on a video; init makes a ground-truth "
                                      "take for it (for your own, track it and point scene.video and scene.track at it)");
+    if (!args->board_free.empty() && args->photo.empty())
+      throw Error(ErrorKind::kUsage, "--board-free: goes with --photo (a synthetic scene has its own)");
+    const bool shows_board_free = text.find("\"show\": \"board_free\"") != std::string::npos;
+    if (shows_board_free && !args->photo.empty() && args->board_free.empty())
+      throw Error(ErrorKind::kUsage, "--photo: " + args->from + " shows the scene without the board: give that "
+                                     "photo too (--board-free), or start from another example");
+    // Everything init needs is checked before anything is written: the folder's place, and your files (an image
+    // that decodes, not a FIFO or /etc/passwd).
+    {
+      OutputGuard guard;
+      if (!args->photo.empty()) guard.Input("--photo", args->photo);
+      if (!args->camera.empty()) guard.Input("--camera", args->camera);
+      if (!args->board_free.empty()) guard.Input("--board-free", args->board_free);
+      guard.OutputFolder("DIR", dir).Check();
+      for (const auto& [option, image] : {std::pair<std::string, std::string>{"--photo", args->photo},
+                                          {"--board-free", args->board_free}}) {
+        if (image.empty()) continue;
+        try {
+          ReadImage(image);
+        } catch (const Error& e) {
+          throw Error(ErrorKind::kInput, option + " " + OneLine(image) + ": not a readable image (" + e.what() + ")");
+        }
+      }
+    }
     std::error_code ec;
     if (fs::exists(dir, ec) && !(fs::is_directory(dir, ec) && fs::is_empty(dir, ec)))
       throw InputError(dir.string(), "exists and is not an empty folder; init never overwrites: name a new folder");
-    fs::create_directories(dir / (video ? "take" : "scene"), ec);
-    if (ec) throw InputError(dir.string(), "cannot make the folder: " + ec.message());
-
-    // The protocol: the example's text with its demo paths pointing into this folder (relative to the protocol).
-    const std::string demo = "../results/demo/";
-    for (size_t at = text.find(demo); at != std::string::npos; at = text.find(demo, at)) text.erase(at, demo.size());
-    const bool pictures = text.find("\"pictures/") != std::string::npos;
-    // The shipped stimuli it names ("../stimuli/face.png") are copied in, so the folder stands on its own.
-    const std::string shipped = "\"../stimuli/";
-    for (size_t at = text.find(shipped); at != std::string::npos; at = text.find(shipped, at)) {
-      const size_t end = text.find('"', at + shipped.size());
-      const std::string name = text.substr(at + shipped.size(), end - at - shipped.size());
-      fs::create_directories(dir / "stimuli", ec);
-      fs::copy_file(DataDir().path / "stimuli" / name, dir / "stimuli" / name, fs::copy_options::skip_existing, ec);
-      if (ec)
-        throw InputError((DataDir().path / "stimuli" / name).string(),
-                         "cannot copy into " + dir.string() + ": " + ec.message());
-      text.replace(at, shipped.size(), "\"stimuli/");
-    }
-
-    const fs::path scene = dir / "scene";
-    fs::path photo = scene / "scene.png";
-    if (video) {
-      std::vector<std::string> synth = {"synth-take", "--out", (dir / "take").string(), "--seed",
-                                        std::to_string(args->seed), "--quiet"};
-      synth.insert(synth.end(), kExampleTake.begin(), kExampleTake.end());
-      Step("a ground-truth take (synth-take, seed " + std::to_string(args->seed) + ")", synth, dir);
-      Step("the take tracked (track)", {"track", (dir / "take" / "take.avi").string(), "--camera",
-                                        (dir / "take" / "camera.json").string(), "--out", (dir / "track").string(),
-                                        "--quiet"}, dir);
-    } else if (args->photo.empty()) {
-      Step("a ground-truth scene (synth-scene, seed " + std::to_string(args->seed) + ")",
-           {"synth-scene", "--out", scene.string(), "--seed", std::to_string(args->seed), "--noise", "0.004"}, dir);
-    } else {
-      // Your photo under its own name; a board-free photo (scene.board_free) stays for you to add.
-      photo = scene / fs::path(args->photo).filename();
-      fs::copy_file(args->photo, photo, ec);
-      if (!ec && !args->camera.empty()) fs::copy_file(args->camera, scene / "camera.json", ec);
-      if (ec) throw InputError(args->photo, "cannot copy into " + scene.string() + ": " + ec.message());
-      if (args->camera.empty())
-        Step("camera.json from the photo's EXIF", {"camera", photo.string(), "--out", (scene / "camera.json").string()},
-             dir);
-      const std::string from = "\"scene/scene.png\"", to = "\"scene/" + photo.filename().string() + "\"";
-      for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
-        text.replace(at, from.size(), to);
-    }
-    if (!video)
-      Step("calibration (calibrate)", {"calibrate", photo.string(), "--camera", (scene / "camera.json").string(),
-                                       "--out", (dir / "calib.json").string()}, dir);
-    WriteFileAtomically(dir / "protocol.json", text);
-    // The schema its "$schema" names, beside it: an editor that reads it completes and checks the fields as typed.
-    {
-      std::error_code ec;
-      fs::copy_file(DataDir().path / "protocols" / "protocol.schema.json", dir / "protocol.schema.json", ec);
-      if (ec) throw InputError(dir.string(), "cannot copy protocol.schema.json into it: " + ec.message());
-    }
-    if (pictures)
-      Step("the real pictures at each distance (synth-pictures)",
-           {"synth-pictures", "--protocol", (dir / "protocol.json").string(), "--out", (dir / "pictures").string()},
-           dir);
-    WriteFileAtomically(dir / "README.md", NextSteps(args->from, dir.filename().string(), args->photo.empty(), video));
-    Step("validate", {"validate", (dir / "protocol.json").string()}, dir);
+    RemoveLeftoversBeside("init", dir);
+    WriteFolderAtomically(dir, [&](const fs::path& partial) { Fill(*args, text, video, partial, dir); },
+                          [](const std::string&) { return false; });
     std::cout << "init: " << dir.string() << " is ready; its README.md lists the next steps\n";
   });
 }

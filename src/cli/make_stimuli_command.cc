@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "core/output_guard.h"
 #include "core/camera.h"
 #include "core/error.h"
 #include "core/image.h"
@@ -28,6 +29,7 @@ void AddMakeStimuliCommand(CLI::App& app) {
       "Example: blurcue make-stimuli --out stimuli");
   cmd->add_option("--out", *out, "folder to write into (created if needed)")->capture_default_str();
   cmd->callback([out] {
+    OutputGuard().OutputFolder("--out", *out).Check();
     for (const auto& file : scene::WriteStandardStimuli(*out)) std::printf("wrote %s\n", file.string().c_str());
   });
 }
@@ -66,6 +68,12 @@ void AddSynthPicturesCommand(CLI::App& app) {
       ->capture_default_str()->transform(IntRange(16, 16384, "px"));
   cmd->add_option("--out", args->out, "folder (created)")->required();
   cmd->callback([args, focus] {
+    {
+      OutputGuard guard;
+      if (!args->camera.empty()) guard.Input("--camera", args->camera);
+      if (!args->protocol.empty()) guard.Input("--protocol", args->protocol);
+      guard.OutputFolder("--out", args->out).Check();
+    }
     std::set<double> distances(args->distances_m.begin(), args->distances_m.end());
     bool focus_from_protocol = false;
     if (!args->protocol.empty()) {

@@ -14,6 +14,7 @@
 
 #include "cli/commands.h"
 #include "cli/groups.h"
+#include "core/output_guard.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "protocol/protocol.h"
@@ -146,6 +147,12 @@ void AddPreviewCommand(CLI::App& app) {
                                         "becomes a square of this many)")->capture_default_str()
       ->transform(IntRange(1, 8));
   cmd->callback([args] {
+    {
+      OutputGuard guard;
+      guard.Input("PROTOCOL", args->protocol);
+      if (!args->display.empty()) guard.Input("--display", args->display);
+      guard.OutputFile("--out", args->out).Check();
+    }
     // The pre-flight of blurcue run: the same checks, and every trial's scene already worked out.
     const procedure::ObserverParams observer = procedure::ParseObserver(args->observer);
     procedure::PreparedSession prepared = procedure::PrepareStudy(args->protocol, args->display);

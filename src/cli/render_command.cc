@@ -8,6 +8,7 @@
 
 #include "calib/scene_blur.h"
 #include "cli/commands.h"
+#include "core/output_guard.h"
 #include "core/error.h"
 #include "core/typed.h"
 #include "core/image.h"
@@ -76,6 +77,12 @@ void AddRenderCommand(CLI::App& app) {
   cmd->add_option("--out", args->out, "output PNG")->required();
   cmd->callback([args] {
     const auto t0 = std::chrono::steady_clock::now();
+    {
+      OutputGuard guard;
+      guard.Input("--background", args->background);
+      if (!args->calib.empty()) guard.Input("--calib", args->calib);
+      guard.OutputFile("--out", args->out).Check();
+    }
     if (args->object.rfind("picture", 0) == 0) {
       const std::string name = args->object.size() > 8 && args->object[7] == ':' ? args->object.substr(8) : "face";
       const cv::Mat picture = ReadImage(scene::ResolveStimulus(name));

@@ -11,6 +11,7 @@
 
 #include "cli/commands.h"
 #include "cli/scene_option_error.h"
+#include "core/output_guard.h"
 #include "core/camera.h"
 #include "core/error.h"
 #include "core/typed.h"
@@ -149,6 +150,11 @@ void AddSynthSceneCommand(CLI::App& app) {
 
   cmd->callback([args] {
     const auto t0 = std::chrono::steady_clock::now();
+    {
+      OutputGuard guard;
+      if (!args->camera.empty()) guard.Input("--camera", args->camera);
+      guard.OutputFolder("--out", args->out).Check();
+    }
     synth::SceneOptions o = args->o;
     o.seed = args->seed;
     o.jpeg_quality = args->jpeg_quality;

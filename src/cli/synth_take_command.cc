@@ -6,6 +6,7 @@
 
 #include "cli/commands.h"
 #include "cli/scene_option_error.h"
+#include "core/output_guard.h"
 #include "core/error.h"
 #include "synth/take.h"
 
@@ -67,6 +68,7 @@ void AddSynthTakeCommand(CLI::App& app) {
   cmd->add_flag("--quiet", args->quiet, "print only errors");
   cmd->callback([args] {
     const auto t0 = std::chrono::steady_clock::now();
+    OutputGuard().OutputFolder("--out", args->out).Check();
     synth::TakeOptions o = args->o;
     o.scene.seed = args->seed;
     auto progress = [&](const std::string& line) {

@@ -7,7 +7,9 @@
 
 #include "cli/commands.h"
 #include "core/camera.h"
+#include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/output_guard.h"
 #include "optics/fit.h"
 #include "track/take.h"
 
@@ -36,6 +38,8 @@ void AddTrackCommand(CLI::App& app) {
       "                       pose, the lens model's focus, aperture and floor, usable sections, ms spent\n"
       "A damaged or truncated video, or a frame missing from a sequence, ends the take: what was tracked before it\n"
       "is written, and the error is reported (exit 3). docs/track.md explains the output.\n"
+      "DIR is built beside its place and swapped in whole: an earlier track there stays until the new one is\n"
+      "complete. DIR must be new or hold only a track's files, and may not hold the take.\n"
       "Example: blurcue track take/frame-%04d.png --camera take/camera.json --out take/track");
   cmd->add_option("input", args->input, "video file, or printf pattern of an image sequence (frame-%04d.png)")
       ->required();
@@ -54,6 +58,18 @@ void AddTrackCommand(CLI::App& app) {
   cmd->add_flag("--quiet", args->quiet, "print only errors");
   cmd->callback([args] {
     const auto t0 = std::chrono::steady_clock::now();
+    // Every refusal before the first frame is read: the output's kind and place, and an input that is a FIFO.
+    {
+      OutputGuard guard;
+      for (const std::filesystem::path& file : track::TakeInputFiles(args->input)) guard.Input("INPUT", file);
+      guard.Input("--camera", args->camera).OutputFolder("--out", args->out).Check();
+      try {
+        RequireReplaceableFolder(args->out, track::IsTrackFile);
+      } catch (const Error& e) {
+        throw e.Wrapped(e.kind(), "--out ");
+      }
+      RemoveLeftoversBeside("track", args->out);
+    }
     const Board board = Board::Parse(args->board, args->square_mm);
     const Camera camera = LoadCamera(args->camera);
     track::FrameSource source(args->input, args->fps);

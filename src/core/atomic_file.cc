@@ -160,7 +160,8 @@ void RequireReplaceableFolder(const fs::path& dir, const std::function<bool(cons
 }
 
 void WriteFolderAtomically(const fs::path& dir, const std::function<void(const fs::path& partial)>& fill,
-                           const std::function<bool(const std::string& name)>& ours) {
+                           const std::function<bool(const std::string& name)>& ours,
+                           const std::function<void()>& before_swap) {
   const fs::path target = FolderTarget(dir);
   const std::string where = dir.string();
   CreateFolderOf(target, where);
@@ -186,6 +187,12 @@ void WriteFolderAtomically(const fs::path& dir, const std::function<void(const f
     const std::string reason = Errno();
     discard();
     throw InputError(where, "cannot write " + failed.string() + " to disk: " + reason);
+  }
+  try {
+    if (before_swap) before_swap();
+  } catch (...) {
+    discard();
+    throw;
   }
 
   if (!replacing) {

@@ -36,9 +36,13 @@ void RequireReplaceableFile(const std::filesystem::path& path);
 // WriteFolderAtomically's check before it writes, alone: throws its Error(kInput) when `dir` exists and is not a
 // folder or holds an entry `ours` does not claim. For a command to refuse such a folder before long work.
 void RequireReplaceableFolder(const std::filesystem::path& dir, const std::function<bool(const std::string& name)>& ours);
+// `before_swap` (optional) runs once the new folder is whole on disk, just before the rename that swaps it in: for
+// a command whose outputs are this folder and files elsewhere, to move those in at the same moment (its throwing
+// discards the folder like `fill`'s).
 void WriteFolderAtomically(const std::filesystem::path& dir,
                            const std::function<void(const std::filesystem::path& partial)>& fill,
-                           const std::function<bool(const std::string& name)>& ours);
+                           const std::function<bool(const std::string& name)>& ours,
+                           const std::function<void()>& before_swap = {});
 
 // Renames the finished file `temp` to `target` unless `target` exists (then Error(kInput) "exists; not
 // overwritten"), in one step that cannot replace a file created meanwhile, and fsyncs the folder. Throws

@@ -15,7 +15,7 @@
 
 namespace blurcue {
 
-int RunProcess(const std::vector<std::string>& argv, ProcessTimes* times) {
+int RunProcess(const std::vector<std::string>& argv, ProcessTimes* times, const std::string& cwd) {
   std::vector<char*> args;
   for (const auto& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
   args.push_back(nullptr);
@@ -29,6 +29,7 @@ int RunProcess(const std::vector<std::string>& argv, ProcessTimes* times) {
     // Only async-signal-safe calls here. PR_SET_PDEATHSIG sends SIGKILL when the parent dies; a parent that died
     // before the prctl took effect is caught by getppid() no longer being it.
     if (prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || getppid() != parent) _exit(126);
+    if (!cwd.empty() && chdir(cwd.c_str()) != 0) _exit(126);
     execvp(args[0], args.data());
     _exit(127);
   }

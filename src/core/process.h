@@ -14,6 +14,7 @@ struct ProcessTimes {
 // Runs `argv` (argv[0] looked up on PATH unless it holds a '/') and returns its wait status; `times` (optional) gets
 // its wall and CPU time. The child dies with this process: a kill of the caller, -9 included, must not leave it
 // running on to write into a folder nobody will use. Throws Error(kInternal) when it cannot be started or waited for.
-int RunProcess(const std::vector<std::string>& argv, ProcessTimes* times = nullptr);
+// `cwd` (when not empty) is the child's working folder; a child that cannot enter it exits 126.
+int RunProcess(const std::vector<std::string>& argv, ProcessTimes* times = nullptr, const std::string& cwd = "");
 
 }  // namespace blurcue

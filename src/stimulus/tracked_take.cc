@@ -1,6 +1,7 @@
 #include "stimulus/tracked_take.h"
 
 #include <algorithm>
+#include <map>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -280,8 +281,13 @@ std::vector<PlacedObject> PlacedObjectsFromJson(const Json& json, const std::str
     if (key != "objects") throw InputError(where + "/" + key, "unknown key" + DidYouMean(key, {"objects"}));
   const Json& list = json.at("objects");
   if (!list.is_array() || list.empty()) throw InputError(where + "/objects", "must be a non-empty array of objects");
+  if (list.size() > kMaxPlacedObjects)
+    throw InputError(where + "/objects", "holds " + std::to_string(list.size()) + " objects: at most " +
+                                             std::to_string(kMaxPlacedObjects) + " a run");
   std::vector<PlacedObject> out;
   int balls = 0, cards = 0;
+  // One texture per image, however many objects wear it: decoded once, and one GL texture (its identity).
+  std::map<std::string, scene::SurfaceTexture> textures;
   for (size_t i = 0; i < list.size(); ++i) {
     const std::string at = where + "/objects/" + std::to_string(i);
     const Json& o = list[i];
@@ -325,7 +331,10 @@ std::vector<PlacedObject> PlacedObjectsFromJson(const Json& json, const std::str
     }
     for (const PlacedObject& q : out)
       if (q.name == p.name) throw InputError(at + "/name", "\"" + p.name + "\" names two objects");
-    p.object.texture = scene::SurfaceTexture(ReadImage(scene::ResolveStimulus(texture)));
+    auto known = textures.find(texture);
+    if (known == textures.end())
+      known = textures.emplace(texture, scene::SurfaceTexture(ReadImage(scene::ResolveStimulus(texture)))).first;
+    p.object.texture = known->second;
     out.push_back(std::move(p));
   }
   return out;

@@ -63,6 +63,10 @@ struct PlacedObject {
 scene::VirtualObject BallAt(double x_mm, double y_mm, double radius_mm);
 scene::VirtualObject StandingCardAt(double x_mm, double y_mm, double width_mm, double height_mm, double rotation_deg);
 
+// The most objects one AR run places: each is drawn in every frame and has a CSV row per frame. A longer list is
+// refused before any texture is decoded.
+constexpr size_t kMaxPlacedObjects = 64;
+
 // Objects from a JSON file: {"objects": [{"kind": "ball", "x_mm": 87.5, "y_mm": 125, "radius_mm": 10,
 // "texture": "soccer"}, {"kind": "card", "x_mm": 60, "y_mm": 150, "width_mm": 40, "height_mm": 30,
 // "rotation_deg": 0, "texture": "wood", "name": "sign"}]}. Every key is checked (an unknown one is an error with a

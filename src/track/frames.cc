@@ -60,6 +60,22 @@ std::filesystem::path PatternFile(const std::string& pattern, int index) {
   return name;
 }
 
+std::vector<std::filesystem::path> TakeInputFiles(const std::string& input) {
+  if (!IsFramePattern(input)) return {input};
+  std::vector<std::filesystem::path> files;
+  std::error_code error;
+  for (int i = 0, missing = 0; missing <= kGapLookahead; ++i) {
+    const std::filesystem::path file = PatternFile(input, i);
+    if (std::filesystem::exists(std::filesystem::symlink_status(file, error))) {
+      files.push_back(file);
+      missing = 0;
+    } else {
+      ++missing;
+    }
+  }
+  return files;
+}
+
 FrameSource::FrameSource(const std::string& input, double fps) : input_(input), fps_(fps) {
   if (!(fps >= kMinFps && fps <= kMaxFps))
     throw Error(ErrorKind::kUsage, "a take's frame rate must be in [" + Num(kMinFps) + ", " + Num(kMaxFps) +

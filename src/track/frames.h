@@ -56,6 +56,9 @@ constexpr double kMaxSignatureDistance = 4;
 
 // True when `input` is a printf pattern (holds a '%'), i.e. an image sequence.
 bool IsFramePattern(const std::string& input);
+// The files a take is read from: the video, or the frames of a sequence that exist (numbered from 0, up to the first
+// gap the reader would end at). For a command to check its outputs against (core/output_guard.h) before reading.
+std::vector<std::filesystem::path> TakeInputFiles(const std::string& input);
 // The pattern's file for frame `index`; Error(kUsage) unless the pattern has exactly one %d-style conversion.
 std::filesystem::path PatternFile(const std::string& pattern, int index);
 

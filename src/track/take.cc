@@ -18,6 +18,8 @@ std::string Number(double v, int digits) {
   return text;
 }
 
+void WriteTakeInto(const TakeResult& take, const std::filesystem::path& dir, const std::string& input);
+
 }  // namespace
 
 const std::vector<TrackColumn> kTrackColumns = {
@@ -85,17 +87,28 @@ TakeResult TrackTake(FrameSource& source, Tracker& tracker, const std::function<
   return take;
 }
 
+bool IsTrackFile(const std::string& name) {
+  // What an earlier version, which wrote into DIR itself, left when killed: .track.csv.tmp-PID. The folder is
+  // replaced whole, so it goes with the rest.
+  const size_t tmp = name.rfind(".tmp-");
+  if (name.size() > 1 && name[0] == '.' && tmp != std::string::npos && tmp + 5 < name.size() &&
+      name.find_first_not_of("0123456789", tmp + 5) == std::string::npos)
+    return IsTrackFile(name.substr(1, tmp - 1));
+  const bool calib = name.size() > 11 && name.rfind("calib-", 0) == 0 && name.compare(name.size() - 5, 5, ".json") == 0 &&
+                     name.find_first_not_of("0123456789", 6) == name.size() - 5;
+  return calib || name == "track.csv";
+}
+
 void WriteTake(const TakeResult& take, const std::filesystem::path& dir, const std::string& input) {
-  std::filesystem::create_directories(dir);
-  // A calibration of an earlier track into the same folder, of a frame this take does not pose, would contradict
-  // track.csv: gone before this take's are written.
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-    const std::string name = entry.path().filename().string();
-    const bool calib = name.size() > 11 && name.rfind("calib-", 0) == 0 &&
-                       name.compare(name.size() - 5, 5, ".json") == 0 &&
-                       name.find_first_not_of("0123456789", 6) == name.size() - 5;
-    if (calib) std::filesystem::remove(entry.path());
-  }
+  // Built whole beside `dir`: a calibration of an earlier track, of a frame this take does not pose, would
+  // contradict track.csv, and a kill half way must not leave old and new files side by side.
+  WriteFolderAtomically(dir, [&](const std::filesystem::path& partial) { WriteTakeInto(take, partial, input); },
+                        IsTrackFile);
+}
+
+namespace {
+
+void WriteTakeInto(const TakeResult& take, const std::filesystem::path& dir, const std::string& input) {
   std::ostringstream csv;
   for (size_t i = 0; i < kTrackColumns.size(); ++i) csv << (i ? "," : "") << kTrackColumns[i].name;
   csv << "\n";
@@ -132,5 +145,7 @@ void WriteTake(const TakeResult& take, const std::filesystem::path& dir, const s
   }
   WriteFileAtomically(dir / "track.csv", csv.str());
 }
+
+}  // namespace
 
 }  // namespace blurcue::track

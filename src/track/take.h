@@ -30,7 +30,14 @@ TakeResult TrackTake(FrameSource& source, Tracker& tracker,
 
 // DIR/calib-NNNN.json for every frame with a calibration (calibrate's format, the take's lens model; "frame" and
 // "time_s" added) and DIR/track.csv, one row per frame (kTrackColumns). `input` is recorded in each calib file.
+// The folder is built beside DIR and swapped in whole (core/atomic_file.h WriteFolderAtomically): a reader, or a
+// run killed meanwhile, sees the earlier track or the new one, never a mix. A DIR holding files other than a
+// track's (IsTrackFile) is refused, Error(kInput), before anything is written.
 void WriteTake(const TakeResult& take, const std::filesystem::path& dir, const std::string& input);
+
+// True for the names a track folder holds: track.csv and calib-NNNN.json (and .NAME.tmp-PID of them, which a killed
+// earlier version left there).
+bool IsTrackFile(const std::string& name);
 
 // track.csv's columns, in order, with their meaning (docs/track.md explains them).
 struct TrackColumn {

@@ -233,3 +233,20 @@ TEST(Tracker, FrameOfAnotherSizeIsAnInputError) {
 
 }  // namespace
 }  // namespace blurcue::track
+
+namespace blurcue::track {
+namespace {
+
+// A track folder is replaced whole only when it holds a track's files alone: what an earlier, killed version left
+// there (.track.csv.tmp-PID) counts as one; anything else is the experimenter's.
+TEST(TrackFolder, OnlyATracksFilesAreReplaced) {
+  for (const char* name : {"track.csv", "calib-0000.json", "calib-12345.json", ".track.csv.tmp-812",
+                           ".calib-0003.json.tmp-77"})
+    EXPECT_TRUE(IsTrackFile(name)) << name;
+  for (const char* name : {"notes.txt", "calib-.json", "calib-00a1.json", "take.avi", ".notes.txt.tmp-1",
+                           ".track.csv.tmp-", ".track.csv.tmp-12x", "track.csv.bak"})
+    EXPECT_FALSE(IsTrackFile(name)) << name;
+}
+
+}  // namespace
+}  // namespace blurcue::track
