@@ -74,12 +74,13 @@ void AddReportCommand(CLI::App& app) {
     const std::filesystem::path out = args->out;
     const std::filesystem::path script = DataDir().path / "analysis" / "report.py";
     if (!std::filesystem::exists(script)) throw InputError(script.string(), "the analysis script is missing");
+    // The options first (a usage error, exit 2), then the record: both before anything is made, so a record this
+    // build cannot read leaves no folder behind.
+    RequirePython3(args->python, {"numpy", "pandas", "matplotlib", "scipy", "statsmodels"});
     {
-      // The record is judged before anything is made: a record this build cannot read leaves no folder behind.
       store::Database record(args->db, store::OpenMode::kReadOnly);
       store::RequireReadableRecord(record);
     }
-    RequirePython3(args->python, {"numpy", "pandas", "matplotlib", "scipy", "statsmodels"});
     for (const auto& path : RemoveStaleLeftovers(out))
       std::fprintf(stderr, "report: removed %s, left by an interrupted run\n", path.c_str());
     // An earlier report is replaced as a whole; a folder of something else is not ours to replace.
