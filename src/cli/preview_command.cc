@@ -156,6 +156,18 @@ void AddPreviewCommand(CLI::App& app) {
     // The pre-flight of blurcue run: the same checks, and every trial's scene already worked out.
     const procedure::ObserverParams observer = procedure::ParseObserver(args->observer);
     procedure::PreparedSession prepared = procedure::PrepareStudy(args->protocol, args->display);
+    {
+      // The files the protocol names are inputs too (its photo overwritten by the sheet was exit 0): checked once the
+      // protocol is read, still before any drawing.
+      const protocol::Scene& files = prepared.protocol.scene;
+      OutputGuard guard;
+      for (const auto& [name, path] : {std::pair{"scene.background", files.background},
+                                        {"scene.board_free", files.board_free}, {"scene.calib", files.calib},
+                                        {"scene.video", files.video}, {"scene.track", files.track},
+                                        {"content.image", prepared.protocol.content.image}})
+        if (!path.empty() && std::filesystem::exists(path)) guard.Input(std::string("the protocol's ") + name, path);
+      guard.OutputFile("--out", args->out).Check();
+    }
     const std::vector<std::string> groups = GroupsToCheck(prepared.protocol, args->group);
     const protocol::Protocol& p = prepared.protocol;
     const auto& scene = prepared.scene;

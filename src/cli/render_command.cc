@@ -81,6 +81,12 @@ void AddRenderCommand(CLI::App& app) {
       OutputGuard guard;
       guard.Input("--background", args->background);
       if (!args->calib.empty()) guard.Input("--calib", args->calib);
+      // A texture named by --object (ball:FILE, picture:FILE) is an input too.
+      const size_t colon = args->object.find(':');
+      if (colon != std::string::npos) {
+        const std::filesystem::path texture = scene::ResolveStimulus(args->object.substr(colon + 1));
+        if (std::filesystem::exists(texture)) guard.Input("--object", texture);
+      }
       guard.OutputFile("--out", args->out).Check();
     }
     if (args->object.rfind("picture", 0) == 0) {

@@ -1,11 +1,13 @@
 // blurcue synth-take: a ground-truth moving-camera take (src/synth/take.h) rendered and written to a folder.
 #include <chrono>
+#include <regex>
 #include <cstdio>
 #include <memory>
 #include <string>
 
 #include "cli/commands.h"
 #include "cli/scene_option_error.h"
+#include "core/atomic_file.h"
 #include "core/output_guard.h"
 #include "core/error.h"
 #include "synth/take.h"
@@ -75,8 +77,16 @@ void AddSynthTakeCommand(CLI::App& app) {
       if (!args->quiet) std::fprintf(stderr, "%s\n", line.c_str());
     };
     synth::TakeFiles files;
+    // The take is built beside --out and swapped in whole: a shorter take over a longer one left its old frames
+    // behind it (a 5-frame folder read back as a mix). A folder of anything but a take's files is refused.
+    auto ours = [](const std::string& name) {
+      static const std::regex kTakeFile(R"((frame-\d{4}\.png|truth-\d{4}\.json|take\.(avi|json)|camera\.json))");
+      return std::regex_match(name, kTakeFile);
+    };
     try {
-      files = synth::WriteTake(o, args->out, progress);
+      WriteFolderAtomically(
+          args->out, [&](const std::filesystem::path& partial) { files = synth::WriteTake(o, partial, progress); },
+          ours);
     } catch (const Error& e) {
       // The take's own fields, and the still's path fields as the take's path options.
       throw AsSceneOptionError(e, {{"frames", "--frames"}, {"fps", "--fps"},
@@ -89,7 +99,8 @@ void AddSynthTakeCommand(CLI::App& app) {
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("wrote %d frames (%s) to %s in %.1f s%s\n", files.frames, synth::kTakeFramePattern, args->out.c_str(), s,
                 files.video.empty() ? "; no video: OpenCV's videoio could not open a writer"
-                                    : (" and " + files.video + " (" + files.video_codec + ")").c_str());
+                                    : (" and " + std::filesystem::path(files.video).filename().string() + " (" +
+                                       files.video_codec + ")").c_str());
   });
 }
 

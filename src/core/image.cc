@@ -187,6 +187,15 @@ cv::Mat ReadImage(const std::filesystem::path& path, int flags) {
     throw InputError(path.string(), "damaged image: its decoder filled in pixels it could not read (" + decoder_said +
                                         ")");
   RequireSizeWithinLimits(path, image.cols, image.rows);
+  // Everything downstream is 8-bit sRGB: a 16-bit PNG or TIFF (read unchanged) is scaled to 8 bits (65535 -> 255), and
+  // a float or other depth is refused here rather than by an OpenCV assertion in the renderer (exit 10).
+  if (image.depth() == CV_16U) {
+    image.convertTo(image, CV_8U, 1.0 / 257.0);
+  } else if (image.depth() != CV_8U) {
+    throw InputError(path.string(), "has " + std::to_string(8 * int(image.elemSize1())) +
+                                        "-bit samples that are not integers of 8 or 16 bits; save it as an 8- or "
+                                        "16-bit PNG or JPEG");
+  }
   return image;
 }
 

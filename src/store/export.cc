@@ -249,8 +249,8 @@ int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::p
       info_of[info.GetInt64(0)][key] = value;
       Json parsed;
       try {
-        parsed = Json::parse(value);
-      } catch (const Json::exception&) {
+        parsed = ParseJson(value, key);  // nesting scanned first (a hand-edited record's)
+      } catch (const std::exception&) {
         parsed = value;
       }
       info_keys[key].Add(parsed.is_number() ? parsed : Json(value));

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <fstream>
 
+#include "core/json_io.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "protocol/protocol.h"
@@ -102,7 +103,7 @@ std::string WriteProcedures(Database& db, const std::filesystem::path& out_dir) 
   while (versions.Step()) {
     protocol::Protocol parsed;
     try {
-      parsed = ParseRecorded(Json::parse(versions.GetText(2)));
+      parsed = ParseRecorded(ParseJson(versions.GetText(2), "protocol"));
     } catch (const std::exception&) {
       // A text the parser refuses (an older blurcue's): no parameters to give; the analysis says its intervals are
       // not determined.

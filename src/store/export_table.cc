@@ -10,6 +10,7 @@
 #include <optional>
 #include <set>
 
+#include "core/json_io.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/hash.h"
@@ -25,13 +26,7 @@ std::string Cell(const Json& value) {
   return value.dump();
 }
 
-Json ParseColumn(const std::string& text, const std::string& where) {
-  try {
-    return Json::parse(text);
-  } catch (const Json::exception& e) {
-    throw InputError(where, std::string("not valid JSON: ") + e.what());
-  }
-}
+Json ParseColumn(const std::string& text, const std::string& where) { return ParseJson(text, where); }
 
 // Shortest text that reads back as the same double.
 std::string Number(double value) {

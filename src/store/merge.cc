@@ -19,6 +19,18 @@
 namespace blurcue::store {
 namespace {
 
+// The id a row of `input` refers to, as merged; a reference to a row the input does not hold (a hand-edited record:
+// a response whose trial was deleted, a trial of a session 999) is that input's damage, said in one line (exit 3),
+// not std::map::at's "map::at" (exit 10).
+int64_t Mapped(const std::map<int64_t, int64_t>& ids, int64_t id, const std::filesystem::path& input,
+               const char* what) {
+  const auto it = ids.find(id);
+  if (it == ids.end())
+    throw InputError(input.string(), std::string("a row refers to ") + what + " " + std::to_string(id) +
+                                         ", which the record does not hold (was it edited?); nothing was merged");
+  return it->second;
+}
+
 // The typed columns (schema 7 on) the column table keeps in `table` (columns.h), as a SELECT list for an input of
 // schema `version`: NULL for a column it predates (DeriveTypedColumns and DeriveVersionsAndNumbers fill those from
 // its texts, as a migration would); CopiedNames and CopiedPlaceholders give the INSERT's.
@@ -208,7 +220,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
           }
           std::string stored_json;
           protocol_ids[protocols.GetInt64(0)] = EnsureProtocolVersion(
-              dst, study_ids.at(protocols.GetInt64(1)), json, hash, protocols.GetText(4), &stored_json);
+              dst, Mapped(study_ids, protocols.GetInt64(1), input, "study"), json, hash, protocols.GetText(4), &stored_json);
           if (stored_json != json)
             throw InputError(input.string(), "protocol hash " + hash + " names a different protocol text in another input");
           CopyTyped("protocol_versions", protocols, 5, set_version, 1);
@@ -224,7 +236,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
                                        "unit, allowed) VALUES (?, ?, ?, ?, ?, ?, ?)");
           std::map<int64_t, bool> had_design;
           while (design.Step()) {
-            const int64_t id = protocol_ids.at(design.GetInt64(0));
+            const int64_t id = Mapped(protocol_ids, design.GetInt64(0), input, "protocol version");
             if (!had_design.count(id))
               had_design[id] = dst.QueryInt64("SELECT count(*) FROM design_columns WHERE protocol_version_id = " +
                                               std::to_string(id)) > 0;
@@ -244,7 +256,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
                                     "studies s ON s.id = p.study_id");
         Statement holds(dst, "SELECT count(*) FROM participants WHERE study_id = ? AND code = ?");
         while (participants.Step()) {
-          const int64_t study = study_ids.at(participants.GetInt64(1));
+          const int64_t study = Mapped(study_ids, participants.GetInt64(1), input, "study");
           std::string code = participants.GetText(2);
           if (const auto r = rename.find(code); r != rename.end()) {
             if (const std::string why = ParticipantIdProblem(r->second); !why.empty())
@@ -297,8 +309,8 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
                                       CopiedPlaceholders("sessions") + ")");
         const int number_at = 13 + TypedIndex("sessions", "session_number");
         while (sessions.Step()) {
-          const int64_t participant = participant_ids.at(sessions.GetInt64(1));
-          const int64_t protocol = protocol_ids.at(sessions.GetInt64(2));
+          const int64_t participant = Mapped(participant_ids, sessions.GetInt64(1), input, "participant");
+          const int64_t protocol = Mapped(protocol_ids, sessions.GetInt64(2), input, "protocol version");
           duplicate.Bind(1, participant);
           duplicate.Bind(2, protocol);
           duplicate.Bind(3, sessions.GetInt64(3));
@@ -329,7 +341,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
           Statement info(src, "SELECT session_id, key, value FROM session_info");
           Statement insert_info(dst, "INSERT INTO session_info (session_id, key, value) VALUES (?, ?, ?)");
           while (info.Step()) {
-            insert_info.Bind(1, session_ids.at(info.GetInt64(0)));
+            insert_info.Bind(1, Mapped(session_ids, info.GetInt64(0), input, "session"));
             insert_info.Bind(2, info.GetText(1));
             insert_info.Bind(3, info.GetText(2));
             insert_info.Run();
@@ -343,7 +355,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
                                     "right_shown" + CopiedNames("trials") + ") VALUES (?, ?, ?, ?, ?, ?" +
                                     CopiedPlaceholders("trials") + ")");
         while (trials.Step()) {
-          insert_trial.Bind(1, session_ids.at(trials.GetInt64(1)));
+          insert_trial.Bind(1, Mapped(session_ids, trials.GetInt64(1), input, "session"));
           insert_trial.Bind(2, trials.GetInt64(2));
           insert_trial.Bind(3, trials.GetInt64(3));
           for (int column = 4; column <= 6; ++column) insert_trial.Bind(column, trials.GetText(column));
@@ -360,7 +372,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
                                        "shown" + CopiedNames("responses") + ") VALUES (?, ?, ?, ?, ?, ?" +
                                        CopiedPlaceholders("responses") + ")");
         while (responses.Step()) {
-          insert_response.Bind(1, trial_ids.at(responses.GetInt64(0)));
+          insert_response.Bind(1, Mapped(trial_ids, responses.GetInt64(0), input, "trial"));
           insert_response.Bind(2, responses.GetText(1));
           if (responses.IsNull(2)) insert_response.BindNull(3);
           else insert_response.Bind(3, responses.GetDouble(2));
@@ -382,7 +394,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
         Statement frames(src, "SELECT trial_id" + read + " FROM frames");
         Statement insert_frame(dst, "INSERT INTO frames (trial_id" + names + ") VALUES (?" + marks + ")");
         while (frames.Step()) {
-          insert_frame.Bind(1, trial_ids.at(frames.GetInt64(0)));
+          insert_frame.Bind(1, Mapped(trial_ids, frames.GetInt64(0), input, "trial"));
           int column = 1;
           for (const FrameValue& v : FrameValues()) {
             if (frames.IsNull(column)) insert_frame.BindNull(column + 1);

@@ -389,8 +389,9 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     CheckProtocolVersion(study_id, study, canonical, hash, meta.protocol_version);
     std::string stored_json;
     const int64_t protocol_id = EnsureProtocolVersion(db_, study_id, canonical, hash, now, &stored_json);
-    if (stored_json != canonical)  // a 64-bit hash collision: refuse rather than mix texts
-      throw Error(ErrorKind::kInternal, "protocol hash " + hash + " collides with another protocol text");
+    if (stored_json != canonical)  // the text stored under this hash is another: an edited record (or a collision)
+      throw InputError(db_.path(), "the protocol text stored under hash " + hash + " is not the text that hashes to "
+                                   "it (was the record edited?); refusing to record answers against it");
     SaveDesign(protocol_id, study, meta.protocol_version, meta.design);
     // Numbered in the transaction that inserts the session, as the balanced group is: two stations never give one
     // number twice.
