@@ -45,3 +45,11 @@ foreach(case track ar init)
   set_tests_properties(outputs_kill_${case} PROPERTIES LABELS "gl;outputs" TIMEOUT 150)
 endforeach()
 set_test_costs(outputs_kill_init 31 outputs_kill_ar 25 outputs_kill_track 15 outputs_guard_cli 8)
+
+# What the adversary of issue 39 found, each mended (tests/adversary39_check.py): an edited record's dangling row and
+# protocol text (exit 10 before), preview and render over their own inputs, synth-take over a longer take.
+add_test(NAME outputs_adversary39
+         COMMAND ${BLURCUE_EXPECT} "(^|\n)ok: " /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/adversary39_check.py
+                 $<TARGET_FILE:blurcue> ${PROJECT_BINARY_DIR}/cli-test)
+set_tests_properties(outputs_adversary39 PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
+                     LABELS "gl;outputs")

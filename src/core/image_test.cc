@@ -47,6 +47,19 @@ TEST(ImageFile, WritesAndReadsBack) {
   std::filesystem::remove_all(path.parent_path());
 }
 
+// A 16-bit PNG (what a raw converter writes) reads as 8-bit sRGB, 65535 -> 255: every renderer and the blur take 8 bits
+// (it was an OpenCV assertion, exit 10, in blur, render, ar and animate).
+TEST(ImageFile, SixteenBitImageReadsAsEightBits) {
+  auto path = std::filesystem::temp_directory_path() / ("blurcue_16_" + std::to_string(::getpid())) / "a.png";
+  WriteImage(path, cv::Mat(4, 5, CV_16UC4, cv::Scalar(257 * 10, 257 * 128, 65535, 65535)));
+  const cv::Mat back = ReadImage(path);  // unchanged: alpha and all
+  ASSERT_EQ(back.depth(), CV_8U);
+  ASSERT_EQ(back.channels(), 4);
+  EXPECT_EQ(back.at<cv::Vec4b>(2, 3), cv::Vec4b(10, 128, 255, 255));
+  EXPECT_EQ(ReadImage(path, 1 /* colour */).depth(), CV_8U);
+  std::filesystem::remove_all(path.parent_path());
+}
+
 std::string ReadError(const std::filesystem::path& path) {
   try {
     ReadImage(path);
