@@ -15,6 +15,7 @@
 Target (docs/benchmarks.md, `bench measure`): |error| <= max(0.25 px, 5 %) on >= 90 % of sections (and >= 50 %
 answered).
 """
+import csv
 import os
 import textwrap
 
@@ -49,6 +50,10 @@ RENDER_COLORS = {("gaussian", "gl"): "#0072B2", ("gaussian", "cpu"): "#56B4E9", 
 RADIUS_MARKERS = {1: "o", 4: "s", 8: "^", 16: "D"}
 
 
+# The bench CSVs' text columns; every other column of theirs holds numbers (empty: none).
+BENCH_TEXT_COLUMNS = {"method", "factor", "kind", "backend", "procedure", "condition", "within_target", "fails"}
+
+
 def _read(path, columns):
     """A bench CSV, or (None, note) when missing or not what the C++ writer produces."""
     if not os.path.isfile(path):
@@ -62,6 +67,20 @@ def _read(path, columns):
         return None, f"{path}: missing columns {', '.join(missing)}"
     if df.empty:
         return None, f"{path}: no rows"
+    # Every row whole and every number a number: a file cut inside a row read as a shorter row, and a cell "abc"
+    # stopped the report (exit 10). Either is said, naming the line, and the bench charts are left out.
+    with open(path, newline="", encoding="utf-8", errors="replace") as f:
+        for line, row in enumerate(csv.reader(f), start=1):
+            if len(row) != len(df.columns):
+                return None, f"{path}: line {line} has {len(row)} fields, the header {len(df.columns)} (cut short?)"
+    for c in df.columns:
+        if c in BENCH_TEXT_COLUMNS:
+            continue
+        bad = df[c].notna() & pd.to_numeric(df[c], errors="coerce").isna()
+        if bad.any():
+            i = int(np.flatnonzero(bad.to_numpy())[0])
+            return None, f"{path}: line {i + 2}, column {c}: not a number ({df[c].iloc[i]!r})"
+        df[c] = pd.to_numeric(df[c], errors="coerce")
     return df, None
 
 

@@ -81,6 +81,25 @@ class BenchChartsTest(unittest.TestCase):
         self.assertNotIn("r = 4 px", labels)
         self.assertIn("--quick", title)
 
+    def test_a_damaged_bench_file_is_named_by_line_and_left_out(self):
+        # A cell "abc" stopped the report (exit 10); a file cut inside a row was read as a shorter row.
+        header = ",".join(bench_charts.RENDER_COLUMNS)
+        row = "blur,gaussian,gl,1,640,360,1,8.2,8.2,0.01,2.0"
+        folder = tempfile.mkdtemp()
+        with open(os.path.join(folder, "render.csv"), "w") as f:
+            f.write(f"{header}\n{row}\n{row.replace(',640,', ',abc,')}\n")
+        _, render, notes = bench_charts.load_bench(folder)
+        self.assertIsNone(render)
+        self.assertIn("render.csv: line 3, column width: not a number ('abc')", " ".join(notes))
+        with open(os.path.join(folder, "render.csv"), "w") as f:
+            f.write(f"{header}\n{row}\n{row[:20]}")
+        _, render, notes = bench_charts.load_bench(folder)
+        self.assertIsNone(render)
+        self.assertIn("render.csv: line 3 has 5 fields, the header 11 (cut short?)", " ".join(notes))
+        with open(os.path.join(folder, "render.csv"), "w") as f:
+            f.write(f"{header}\n{row}\n")
+        self.assertIsNotNone(bench_charts.load_bench(folder)[1])
+
     def test_two_sizes_get_two_panels(self):
         bench_charts.render_speed_accuracy(render_rows(((640, 360), (1920, 1080)), quick=0), self.out)
         fig = self.caught.figures["bench-render-speed-accuracy"]
