@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "core/temp_dir_test_util.h"
 
 namespace blurcue {
 namespace {
@@ -21,20 +22,9 @@ namespace {
 namespace fs = std::filesystem;
 
 // A fresh folder per test, removed afterwards.
-class AtomicFileTest : public ::testing::Test {
+class AtomicFileTest : public test::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("blurcue_atomic_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-            std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ignored;
-    fs::remove_all(dir_, ignored);
-  }
-  fs::path dir_;
+  AtomicFileTest() : TempDirTest("blurcue_atomic_") {}
 };
 
 std::string Read(const fs::path& path) {

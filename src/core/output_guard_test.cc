@@ -8,25 +8,16 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "core/temp_dir_test_util.h"
 
 namespace blurcue {
 namespace {
 
 namespace fs = std::filesystem;
 
-class OutputGuardTest : public ::testing::Test {
+class OutputGuardTest : public test::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("blurcue_guard_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-            std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ignored;
-    fs::remove_all(dir_, ignored);
-  }
+  OutputGuardTest() : TempDirTest("blurcue_guard_") {}
   void Write(const fs::path& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }
   // The kind and message of what Check() throws; kInternal and "" when it passes.
   std::pair<ErrorKind, std::string> Refusal(const OutputGuard& guard) {
@@ -37,7 +28,6 @@ class OutputGuardTest : public ::testing::Test {
     }
     return {ErrorKind::kInternal, ""};
   }
-  fs::path dir_;
 };
 
 TEST_F(OutputGuardTest, AnOutputThatIsAnInputIsRefused) {
