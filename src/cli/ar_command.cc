@@ -269,10 +269,17 @@ void AddArCommand(CLI::App& app) {
       if (error) throw InputError(args->out, "cannot make " + video_partial.string() + ": " + error.message());
     }
     const fs::path video_temp = video_partial / fs::path(args->out).filename();
-    // The CSV, written whole beside its place before the video is moved: .NAME.partial-PID (removed on failure here,
-    // by the next run's RemoveStaleLeftovers after a kill).
-    const fs::path csv_temp = TemporaryBeside(csv_path, "partial");
-    const RemovedAtExit partial_csv{csv_temp};
+    // The CSV, written whole inside a folder of its own beside its place, .NAME.partial-PID, before the video is
+    // moved: whatever a kill leaves there is one folder, removed here on failure or by the next run's
+    // RemoveStaleLeftovers (a file written atomically beside it would leave its own .tmp-PID that no one names).
+    const fs::path csv_partial = TemporaryBeside(csv_path, "partial");
+    const RemovedAtExit partial_csv{csv_partial};
+    {
+      std::error_code error;
+      fs::create_directories(csv_partial, error);
+      if (error) throw InputError(csv_path, "cannot make " + csv_partial.string() + ": " + error.message());
+    }
+    const fs::path csv_temp = csv_partial / fs::path(csv_path).filename();
     std::string csv = stimulus::DrawnCsvHeader();
     const bool tty = isatty(2) && !args->quiet;
     int written = 0, drawn_frames = 0, unposed = 0;
