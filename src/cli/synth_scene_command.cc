@@ -11,6 +11,7 @@
 
 #include "cli/commands.h"
 #include "cli/scene_option_error.h"
+#include "core/atomic_file.h"
 #include "core/output_guard.h"
 #include "core/camera.h"
 #include "core/error.h"
@@ -155,6 +156,12 @@ void AddSynthSceneCommand(CLI::App& app) {
       if (!args->camera.empty()) guard.Input("--camera", args->camera);
       guard.OutputFolder("--out", args->out).Check();
     }
+    // The four files are written beside --out and swapped in whole; a folder of anything else (a photo of one's own
+    // named scene.png among other files) is refused before the render, not overwritten.
+    const auto ours = [](const std::string& name) {
+      return name == "scene.png" || name == "scene-no-board.png" || name == "camera.json" || name == "truth.json";
+    };
+    RequireReplaceableFolder(args->out, ours);
     synth::SceneOptions o = args->o;
     o.seed = args->seed;
     o.jpeg_quality = args->jpeg_quality;
@@ -192,7 +199,9 @@ void AddSynthSceneCommand(CLI::App& app) {
       throw AsSceneOptionError(e);
     }
     const double render_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    synth::WriteScene(scene, args->out);
+    WriteFolderAtomically(
+        args->out, [&](const std::filesystem::path& partial) { synth::WriteScene(scene, partial); },
+        ours);
     const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (args->quiet) return;
 

@@ -134,6 +134,26 @@ void RequireTakesModel(const calib::SceneCalib& c, const std::string& path, cons
   }
 }
 
+// track.csv's row prints the frame's pose (rvec to 8 decimals, tvec to 4: track/take.cc); a calibration whose pose
+// is not its row's (a hand edit of either) would draw the objects where the table says the board is not.
+void RequireRowsPose(const calib::SceneCalib& c, const std::string& path, const std::vector<std::string>& header,
+                     const CsvRecord& row) {
+  static const char* const kNames[] = {"rvec_x", "rvec_y", "rvec_z", "tvec_x_mm", "tvec_y_mm", "tvec_z_mm"};
+  for (int k = 0; k < 6; ++k) {
+    const auto it = std::find(header.begin(), header.end(), kNames[k]);
+    if (it == header.end()) continue;
+    const std::string& text = row.fields[size_t(it - header.begin())];
+    const double value = k < 3 ? c.rvec[k] : c.tvec[k - 3];
+    const double half_step = k < 3 ? 0.5e-8 : 0.5e-4;
+    const std::optional<double> csv = ParseDecimal(text);
+    if (!csv || !(std::abs(*csv - value) <= 1.01 * half_step))
+      throw InputError(path + (k < 3 ? ": /pose/rvec/" : ": /pose/tvec/") + std::to_string(k % 3),
+                       "must be " + Echo(text, false) + ", the pose of its row in track.csv (line " +
+                           std::to_string(row.line) + ", " + kNames[k] + "), got " + Num(value) +
+                           ": the calibration or track.csv was edited (track the take again)");
+  }
+}
+
 const std::vector<std::string> kBallKeys = {"kind", "name", "x_mm", "y_mm", "radius_mm", "texture"};
 const std::vector<std::string> kCardKeys = {"kind", "name", "x_mm", "y_mm", "width_mm", "height_mm", "rotation_deg",
                                             "texture"};
@@ -221,6 +241,7 @@ TrackedTake LoadTrackedTake(const std::filesystem::path& dir) {
       RequireTakesModel(*f.calib, calib_path.string(), first_posed >= 0 ? &*take.frames[size_t(first_posed)].calib
                                                                         : nullptr,
                         track::CalibFileName(std::max(first_posed, 0)), header, row);
+      RequireRowsPose(*f.calib, calib_path.string(), header, row);
       if (first_posed >= 0 && !SameCamera(take.frames[size_t(first_posed)].calib->camera, f.calib->camera))
         throw InputError(calib_path.string() + ": /camera",
                          "is not the camera of " + track::CalibFileName(first_posed) +
@@ -235,6 +256,12 @@ TrackedTake LoadTrackedTake(const std::filesystem::path& dir) {
     take.frames.push_back(std::move(f));
   }
   if (take.frames.empty()) throw InputError(file, "has no frames (only a header)");
+  // A calibration past the last row: track.csv lost its last rows (cut, or a hand edit), and the take would end early.
+  if (const std::filesystem::path next = dir / track::CalibFileName(int(take.frames.size()));
+      std::filesystem::exists(next))
+    throw InputError(file, "has " + std::to_string(take.frames.size()) + " frames, but " + next.filename().string() +
+                               " holds a calibration of frame " + std::to_string(take.frames.size()) +
+                               ": track.csv was cut short or edited (track the take again)");
   (void)take.camera();  // at least one pose
   return take;
 }
