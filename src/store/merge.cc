@@ -111,22 +111,28 @@ void CheckSessionsToMerge(Database& src, const std::filesystem::path& input, std
   }
 }
 
-}  // namespace
+using IdMap = std::map<int64_t, int64_t>;
+using Renames = std::map<std::string, std::string>;  // an input's participant codes: old -> new
 
-void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out,
-                    const ProgressNote& note, const MergeOptions& options) {
-  Note(note, RemoveStaleLeftovers(out));
-  if (std::filesystem::exists(out)) throw InputError(out.string(), "exists; merge refuses to overwrite it");
+// The session numbers the inputs gave (version 8 on), by the merged session's id.
+struct Numbered {
+  std::string input;
+  int64_t session = 0, number = 0;
+};
+
+// Each rename names an input of this merge and a participant that input holds; each same-person code some input
+// holds; no input is listed twice. Read before anything is merged, so a rename or a same-person code that names
+// nobody is refused first, with the nearest code. Returns the renames by each input's canonical path.
+std::map<std::filesystem::path, Renames> CheckMergeInputs(const std::vector<std::filesystem::path>& inputs,
+                                                          const MergeOptions& options) {
   std::set<std::filesystem::path> seen;
   for (const auto& input : inputs) {
     if (!seen.insert(std::filesystem::weakly_canonical(input)).second)
       throw InputError(input.string(), "listed twice among the merge inputs");
   }
-  // Each rename names an input of this merge and a participant that input holds (checked as it is read); each
-  // same-person code some input holds.
   std::vector<std::string> input_names;
   for (const auto& input : inputs) input_names.push_back(input.string());
-  std::map<std::filesystem::path, std::map<std::string, std::string>> renames;
+  std::map<std::filesystem::path, Renames> renames;
   for (const auto& r : options.renames) {
     const auto canonical = std::filesystem::weakly_canonical(r.input);
     if (!seen.count(canonical))
@@ -135,9 +141,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
     if (!renames[canonical].emplace(r.from, r.to).second)
       throw InputError("--rename", "renames participant " + Echo(r.from) + " of " + r.input.string() + " twice");
   }
-  // The codes each input holds, read before anything is merged: a rename or a same-person code that names nobody
-  // is refused first, with the nearest code.
-  std::set<std::string> same_person(options.same_person.begin(), options.same_person.end()), held;
+  std::set<std::string> held;
   for (const auto& input : inputs) {
     Database src(input, OpenMode::kReadOnly);
     RequireReadableRecord(src);
@@ -145,7 +149,7 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
     Statement all(src, "SELECT code FROM participants");
     while (all.Step()) codes.push_back(all.GetText(0));
     held.insert(codes.begin(), codes.end());
-    const auto& own = renames[std::filesystem::weakly_canonical(input)];
+    const Renames& own = renames[std::filesystem::weakly_canonical(input)];
     for (const auto& [from, to] : own)
       if (std::find(codes.begin(), codes.end(), from) == codes.end())
         throw InputError("--rename", input.string() + " holds no participant " + Echo(from) + DidYouMean(from, codes));
@@ -170,18 +174,280 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
       holder.Reset();
     }
   }
-  for (const std::string& code : same_person)
+  for (const std::string& code : options.same_person)
     if (!held.count(code))
       throw InputError("--same-person", "no input holds a participant " + Echo(code) +
                                             DidYouMean(code, std::vector<std::string>(held.begin(), held.end())));
+  return renames;
+}
+
+// One input's studies, protocol versions (with their typed columns) and designs into `dst`.
+void CopyStudiesAndProtocols(Database& src, Database& dst, const std::filesystem::path& input, int version,
+                             IdMap& study_ids, IdMap& protocol_ids) {
+  Statement studies(src, "SELECT id, name, created FROM studies");
+  while (studies.Step()) study_ids[studies.GetInt64(0)] = EnsureStudy(dst, studies.GetText(1), studies.GetText(2));
+
+  // A protocol version's typed columns: given by the first input that has them.
+  std::string set_typed;
+  for (const Kept& kept : KeptIn(RecordColumns(), "protocol_versions", 7))
+    set_typed += (set_typed.empty() ? "" : ", ") + kept.name + " = coalesce(" + kept.name + ", ?)";
+  Statement protocols(src, "SELECT id, study_id, json, hash, created" + TypedSelect("protocol_versions", version) +
+                               " FROM protocol_versions");
+  const int pv_typed = int(KeptIn(RecordColumns(), "protocol_versions", 7).size());
+  Statement set_version(dst, "UPDATE protocol_versions SET " + set_typed + " WHERE id = ?");
+  while (protocols.Step()) {
+    // An input of schema 1 holds raw texts: the merged record keys them by their canonical text, as run does.
+    std::string json = protocols.GetText(2), hash = protocols.GetText(3);
+    try {
+      json = CanonicalProtocolText(json);
+      hash = ProtocolHash(json);
+    } catch (const Error&) {
+    }
+    std::string stored_json;
+    protocol_ids[protocols.GetInt64(0)] = EnsureProtocolVersion(
+        dst, Mapped(study_ids, protocols.GetInt64(1), input, "study"), json, hash, protocols.GetText(4), &stored_json);
+    if (stored_json != json)
+      throw InputError(input.string(), "protocol hash " + hash + " names a different protocol text in another input");
+    CopyTyped("protocol_versions", protocols, 5, set_version, 1);
+    set_version.Bind(pv_typed + 1, protocol_ids[protocols.GetInt64(0)]);
+    set_version.Run();
+    set_version.Reset();
+  }
+  if (version < 8) return;
+  // One design per protocol version: the first input that recorded it gives it.
+  Statement design(src, "SELECT protocol_version_id, position, name, role, type, unit, allowed FROM "
+                        "design_columns ORDER BY protocol_version_id, position");
+  Statement insert_design(dst, "INSERT INTO design_columns (protocol_version_id, position, name, role, type, "
+                               "unit, allowed) VALUES (?, ?, ?, ?, ?, ?, ?)");
+  std::map<int64_t, bool> had_design;
+  while (design.Step()) {
+    const int64_t id = Mapped(protocol_ids, design.GetInt64(0), input, "protocol version");
+    if (!had_design.count(id))
+      had_design[id] = dst.QueryInt64("SELECT count(*) FROM design_columns WHERE protocol_version_id = " +
+                                      std::to_string(id)) > 0;
+    if (had_design[id]) continue;
+    insert_design.Bind(1, id);
+    insert_design.Bind(2, design.GetInt64(1));
+    for (int column = 2; column <= 6; ++column) insert_design.Bind(column + 1, design.GetText(column));
+    insert_design.Run();
+    insert_design.Reset();
+  }
+}
+
+// One input's participants, renamed as asked. People kept apart: a code an earlier input holds in the same study is
+// two people or one person at two stations; merge does not guess which.
+void CopyParticipants(Database& src, Database& dst, const std::filesystem::path& input, const Renames& rename,
+                      const std::set<std::string>& same_person, const IdMap& study_ids, IdMap& participant_ids) {
+  Statement participants(src, "SELECT p.id, p.study_id, p.code, p.created, s.name FROM participants p JOIN "
+                              "studies s ON s.id = p.study_id");
+  Statement holds(dst, "SELECT count(*) FROM participants WHERE study_id = ? AND code = ?");
+  while (participants.Step()) {
+    const int64_t study = Mapped(study_ids, participants.GetInt64(1), input, "study");
+    std::string code = participants.GetText(2);
+    if (const auto r = rename.find(code); r != rename.end()) {
+      if (const std::string why = ParticipantIdProblem(r->second); !why.empty())
+        throw InputError("--rename " + input.string() + ":" + code + "=" + OneLine(r->second), "the new id " + why);
+      code = r->second;
+    }
+    holds.Bind(1, study);
+    holds.Bind(2, code);
+    holds.Step();
+    const bool taken = holds.GetInt64(0) > 0;
+    holds.Reset();
+    // A session of this participant already in the merge is an input merged twice: said by CopySessions.
+    bool merged_before = false;
+    if (taken) {
+      Statement own(src, "SELECT seed, host, started FROM sessions WHERE participant_id = ?");
+      own.Bind(1, participants.GetInt64(0));
+      Statement twin(dst, "SELECT count(*) FROM sessions s JOIN participants p ON p.id = s.participant_id "
+                          "WHERE p.study_id = ? AND p.code = ? AND s.seed = ? AND s.host = ? AND s.started = ?");
+      while (own.Step() && !merged_before) {
+        twin.Bind(1, study);
+        twin.Bind(2, code);
+        twin.Bind(3, own.GetInt64(0));
+        twin.Bind(4, own.GetText(1));
+        twin.Bind(5, own.GetText(2));
+        twin.Step();
+        merged_before = twin.GetInt64(0) > 0;
+        twin.Reset();
+      }
+    }
+    if (taken && !merged_before && !same_person.count(code))
+      throw InputError(input.string(), "participant " + code + " of study " + participants.GetText(4) +
+                                           " is also in an earlier input of this merge: two people with one id, "
+                                           "or one person who ran at two stations? Two people: give one another "
+                                           "id with --rename " + input.string() + ":" + code + "=NEW; one "
+                                           "person: say so with --same-person " + code);
+    participant_ids[participants.GetInt64(0)] = EnsureParticipant(dst, study, code, participants.GetText(3));
+  }
+}
+
+// One input's sessions and their info; the number each had in its input goes to `numbered`.
+void CopySessions(Database& src, Database& dst, const std::filesystem::path& input, int version,
+                  const IdMap& participant_ids, const IdMap& protocol_ids, IdMap& session_ids,
+                  std::map<int64_t, Numbered>& numbered) {
+  Statement sessions(src, "SELECT id, participant_id, protocol_version_id, seed, software_version, host, "
+                          "display, started, ended, status, " +
+                          std::string(version >= 3 ? "display_profile" : "'{}'") + ", " +
+                          std::string(version >= 6 ? "group_name, participant_info" : "'', '{}'") +
+                          TypedSelect("sessions", version) + " FROM sessions");
+  Statement duplicate(dst, "SELECT id FROM sessions WHERE participant_id = ? AND protocol_version_id = ? "
+                           "AND seed = ? AND host = ? AND started = ?");
+  Statement insert_session(dst, "INSERT INTO sessions (participant_id, protocol_version_id, seed, "
+                                "software_version, host, display, started, ended, status, display_profile, "
+                                "group_name, participant_info" + CopiedNames("sessions") +
+                                ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?" + CopiedPlaceholders("sessions") + ")");
+  const int number_at = 13 + TypedIndex("sessions", "session_number");
+  while (sessions.Step()) {
+    const int64_t participant = Mapped(participant_ids, sessions.GetInt64(1), input, "participant");
+    const int64_t protocol = Mapped(protocol_ids, sessions.GetInt64(2), input, "protocol version");
+    duplicate.Bind(1, participant);
+    duplicate.Bind(2, protocol);
+    duplicate.Bind(3, sessions.GetInt64(3));
+    duplicate.Bind(4, sessions.GetText(5));
+    duplicate.Bind(5, sessions.GetText(7));
+    if (duplicate.Step())
+      throw InputError(input.string(), "session " + std::to_string(sessions.GetInt64(0)) +
+                                           " is already in the merge (an input merged twice?)");
+    duplicate.Reset();
+    insert_session.Bind(1, participant);
+    insert_session.Bind(2, protocol);
+    insert_session.Bind(3, sessions.GetInt64(3));
+    for (int column = 4; column <= 7; ++column) insert_session.Bind(column, sessions.GetText(column));
+    if (sessions.IsNull(8)) insert_session.BindNull(8);
+    else insert_session.Bind(8, sessions.GetText(8));
+    for (int column = 9; column <= 12; ++column) insert_session.Bind(column, sessions.GetText(column));
+    CopyTyped("sessions", sessions, 13, insert_session, 13);
+    insert_session.Run();
+    insert_session.Reset();
+    session_ids[sessions.GetInt64(0)] = dst.LastInsertRowId();
+    if (!sessions.IsNull(number_at))
+      numbered[dst.LastInsertRowId()] = {input.string(), sessions.GetInt64(0), sessions.GetInt64(number_at)};
+  }
+  if (version < 7) return;
+  Statement info(src, "SELECT session_id, key, value FROM session_info");
+  Statement insert_info(dst, "INSERT INTO session_info (session_id, key, value) VALUES (?, ?, ?)");
+  while (info.Step()) {
+    insert_info.Bind(1, Mapped(session_ids, info.GetInt64(0), input, "session"));
+    insert_info.Bind(2, info.GetText(1));
+    insert_info.Bind(3, info.GetText(2));
+    insert_info.Run();
+    insert_info.Reset();
+  }
+}
+
+// One input's trials, answers and frames (frame_columns.h: NULL for the values its version did not have).
+void CopyTrials(Database& src, Database& dst, const std::filesystem::path& input, int version,
+                const IdMap& session_ids) {
+  IdMap trial_ids;
+  Statement trials(src, "SELECT id, session_id, trial_index, block, factors, left_shown, right_shown" +
+                            TypedSelect("trials", version) + " FROM trials");
+  Statement insert_trial(dst, "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, "
+                              "right_shown" + CopiedNames("trials") + ") VALUES (?, ?, ?, ?, ?, ?" +
+                              CopiedPlaceholders("trials") + ")");
+  while (trials.Step()) {
+    insert_trial.Bind(1, Mapped(session_ids, trials.GetInt64(1), input, "session"));
+    insert_trial.Bind(2, trials.GetInt64(2));
+    insert_trial.Bind(3, trials.GetInt64(3));
+    for (int column = 4; column <= 6; ++column) insert_trial.Bind(column, trials.GetText(column));
+    CopyTyped("trials", trials, 7, insert_trial, 7);
+    insert_trial.Run();
+    insert_trial.Reset();
+    trial_ids[trials.GetInt64(0)] = dst.LastInsertRowId();
+  }
+
+  Statement responses(src, "SELECT trial_id, choice, rt_ms, adjustment, answered_at, " +
+                               std::string(version >= 5 ? "shown" : "'{}'") + TypedSelect("responses", version) +
+                               " FROM responses");
+  Statement insert_response(dst, "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at, "
+                                 "shown" + CopiedNames("responses") + ") VALUES (?, ?, ?, ?, ?, ?" +
+                                 CopiedPlaceholders("responses") + ")");
+  while (responses.Step()) {
+    insert_response.Bind(1, Mapped(trial_ids, responses.GetInt64(0), input, "trial"));
+    insert_response.Bind(2, responses.GetText(1));
+    if (responses.IsNull(2)) insert_response.BindNull(3);
+    else insert_response.Bind(3, responses.GetDouble(2));
+    insert_response.Bind(4, responses.GetText(3));
+    insert_response.Bind(5, responses.GetText(4));
+    insert_response.Bind(6, responses.GetText(5));
+    CopyTyped("responses", responses, 6, insert_response, 7);
+    insert_response.Run();
+    insert_response.Reset();
+  }
+
+  std::string read, names, marks;
+  for (const FrameValue& v : FrameValues()) {
+    read += ", " + (version >= v.since ? v.name : std::string("NULL"));
+    names += ", " + v.name;
+    marks += ", ?";
+  }
+  Statement frames(src, "SELECT trial_id" + read + " FROM frames");
+  Statement insert_frame(dst, "INSERT INTO frames (trial_id" + names + ") VALUES (?" + marks + ")");
+  while (frames.Step()) {
+    insert_frame.Bind(1, Mapped(trial_ids, frames.GetInt64(0), input, "trial"));
+    int column = 1;
+    for (const FrameValue& v : FrameValues()) {
+      if (frames.IsNull(column)) insert_frame.BindNull(column + 1);
+      else if (v.sql == "TEXT") insert_frame.Bind(column + 1, frames.GetText(column));
+      else if (v.sql == "REAL") insert_frame.Bind(column + 1, frames.GetDouble(column));
+      else insert_frame.Bind(column + 1, frames.GetInt64(column));
+      ++column;
+    }
+    insert_frame.Run();
+    insert_frame.Reset();
+  }
+}
+
+// What the merged record says that its inputs did not: sessions numbered again, protocol versions with several
+// texts, one participant's sessions run with one seed.
+std::vector<std::string> TellWhatChanged(Database& dst, const std::map<int64_t, Numbered>& numbered) {
+  std::vector<std::string> told;
+  Statement number(dst, "SELECT s.session_number, st.name, p.code FROM sessions s JOIN participants p ON "
+                        "p.id = s.participant_id JOIN studies st ON st.id = p.study_id WHERE s.id = ?");
+  for (const auto& [id, was] : numbered) {
+    number.Bind(1, id);
+    number.Step();
+    if (number.GetInt64(0) != was.number)
+      told.push_back(was.input + ": session " + std::to_string(was.session) + " (study " + number.GetText(1) +
+                     ", participant " + number.GetText(2) + ") is session number " + std::to_string(was.number) +
+                     " there and " + std::to_string(number.GetInt64(0)) + " in the merged record (numbered by start)");
+    number.Reset();
+  }
+  // Stations that each ran another text under one version (or records made before versions were kept apart) are
+  // merged as they are; the tables cannot tell those sessions' designs apart by version, so say so.
+  Statement shared(dst, "SELECT st.name, pv.version, count(*) FROM protocol_versions pv JOIN studies st ON "
+                        "st.id = pv.study_id GROUP BY pv.study_id, pv.version HAVING count(*) > 1 "
+                        "ORDER BY st.name, pv.version");
+  while (shared.Step())
+    told.push_back("study " + shared.GetText(0) + ": protocol version " + std::to_string(shared.GetInt64(1)) +
+                   " has " + std::to_string(shared.GetInt64(2)) + " different texts in the merged record "
+                   "(protocol_hash tells their sessions apart)");
+  // Two stations that each ran a participant's first session gave both the default seed: merged they read as one
+  // person seeing one trial order twice, which run refuses. It used to pass untold; it is likely two people given
+  // one id, so say so (the record cannot tell).
+  Statement twins(dst, "SELECT st.name, p.code, group_concat(s.session_number, ', ') FROM (SELECT * FROM sessions "
+                       "ORDER BY session_number) s JOIN participants p ON p.id = s.participant_id JOIN studies st "
+                       "ON st.id = p.study_id GROUP BY s.participant_id, s.seed HAVING count(*) > 1 "
+                       "ORDER BY st.name, p.code");
+  while (twins.Step())
+    told.push_back("study " + twins.GetText(0) + ", participant " + twins.GetText(1) + ": sessions " +
+                   twins.GetText(2) + " in the merged record ran with one seed, so in one trial order - "
+                   "two people given one id at two stations, or one person shown the same order twice; "
+                   "check before analysing them as one participant");
+  return told;
+}
+
+}  // namespace
+
+void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out,
+                    const ProgressNote& note, const MergeOptions& options) {
+  Note(note, RemoveStaleLeftovers(out));
+  if (std::filesystem::exists(out)) throw InputError(out.string(), "exists; merge refuses to overwrite it");
+  const std::map<std::filesystem::path, Renames> renames = CheckMergeInputs(inputs, options);
+  const std::set<std::string> same_person(options.same_person.begin(), options.same_person.end());
   const std::filesystem::path temp = TemporaryBeside(out, "partial");
   RemoveDatabaseFiles(temp);
-  std::vector<std::string> unfinished, renumbered;
-  // The session numbers the inputs gave (version 8 on), by the merged session's id.
-  struct Numbered {
-    std::string input;
-    int64_t session = 0, number = 0;
-  };
+  std::vector<std::string> unfinished, told;
   std::map<int64_t, Numbered> numbered;
   try {
     {
@@ -194,218 +460,14 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
         // One snapshot of the input: the sessions judged below are the ones copied, with the answers they had then.
         src.Exec("BEGIN");
         CheckSessionsToMerge(src, input, &unfinished);
-        std::map<int64_t, int64_t> study_ids, protocol_ids, participant_ids, session_ids, trial_ids;
+        IdMap study_ids, protocol_ids, participant_ids, session_ids;
         const int version = SchemaVersion(src);
-
-        Statement studies(src, "SELECT id, name, created FROM studies");
-        while (studies.Step())
-          study_ids[studies.GetInt64(0)] = EnsureStudy(dst, studies.GetText(1), studies.GetText(2));
-
-        const bool v8 = version >= 8;
-        // A protocol version's typed columns: given by the first input that has them.
-        std::string set_typed;
-        for (const Kept& kept : KeptIn(RecordColumns(), "protocol_versions", 7))
-          set_typed += (set_typed.empty() ? "" : ", ") + kept.name + " = coalesce(" + kept.name + ", ?)";
-        Statement protocols(src, "SELECT id, study_id, json, hash, created" + TypedSelect("protocol_versions", version) +
-                                     " FROM protocol_versions");
-        const int pv_typed = int(KeptIn(RecordColumns(), "protocol_versions", 7).size());
-        Statement set_version(dst, "UPDATE protocol_versions SET " + set_typed + " WHERE id = ?");
-        while (protocols.Step()) {
-          // An input of schema 1 holds raw texts: the merged record keys them by their canonical text, as run does.
-          std::string json = protocols.GetText(2), hash = protocols.GetText(3);
-          try {
-            json = CanonicalProtocolText(json);
-            hash = ProtocolHash(json);
-          } catch (const Error&) {
-          }
-          std::string stored_json;
-          protocol_ids[protocols.GetInt64(0)] = EnsureProtocolVersion(
-              dst, Mapped(study_ids, protocols.GetInt64(1), input, "study"), json, hash, protocols.GetText(4), &stored_json);
-          if (stored_json != json)
-            throw InputError(input.string(), "protocol hash " + hash + " names a different protocol text in another input");
-          CopyTyped("protocol_versions", protocols, 5, set_version, 1);
-          set_version.Bind(pv_typed + 1, protocol_ids[protocols.GetInt64(0)]);
-          set_version.Run();
-          set_version.Reset();
-        }
-        if (v8) {
-          // One design per protocol version: the first input that recorded it gives it.
-          Statement design(src, "SELECT protocol_version_id, position, name, role, type, unit, allowed FROM "
-                                "design_columns ORDER BY protocol_version_id, position");
-          Statement insert_design(dst, "INSERT INTO design_columns (protocol_version_id, position, name, role, type, "
-                                       "unit, allowed) VALUES (?, ?, ?, ?, ?, ?, ?)");
-          std::map<int64_t, bool> had_design;
-          while (design.Step()) {
-            const int64_t id = Mapped(protocol_ids, design.GetInt64(0), input, "protocol version");
-            if (!had_design.count(id))
-              had_design[id] = dst.QueryInt64("SELECT count(*) FROM design_columns WHERE protocol_version_id = " +
-                                              std::to_string(id)) > 0;
-            if (had_design[id]) continue;
-            insert_design.Bind(1, id);
-            insert_design.Bind(2, design.GetInt64(1));
-            for (int column = 2; column <= 6; ++column) insert_design.Bind(column + 1, design.GetText(column));
-            insert_design.Run();
-            insert_design.Reset();
-          }
-        }
-
-        // People kept apart: a code an earlier input holds in the same study is two people or one person at two
-        // stations; merge does not guess which.
-        const auto& rename = renames[std::filesystem::weakly_canonical(input)];
-        Statement participants(src, "SELECT p.id, p.study_id, p.code, p.created, s.name FROM participants p JOIN "
-                                    "studies s ON s.id = p.study_id");
-        Statement holds(dst, "SELECT count(*) FROM participants WHERE study_id = ? AND code = ?");
-        while (participants.Step()) {
-          const int64_t study = Mapped(study_ids, participants.GetInt64(1), input, "study");
-          std::string code = participants.GetText(2);
-          if (const auto r = rename.find(code); r != rename.end()) {
-            if (const std::string why = ParticipantIdProblem(r->second); !why.empty())
-              throw InputError("--rename " + input.string() + ":" + code + "=" + OneLine(r->second), "the new id " + why);
-            code = r->second;
-          }
-          holds.Bind(1, study);
-          holds.Bind(2, code);
-          holds.Step();
-          const bool taken = holds.GetInt64(0) > 0;
-          holds.Reset();
-          // A session of this participant already in the merge is an input merged twice: said below, per session.
-          bool merged_before = false;
-          if (taken) {
-            Statement own(src, "SELECT seed, host, started FROM sessions WHERE participant_id = ?");
-            own.Bind(1, participants.GetInt64(0));
-            Statement twin(dst, "SELECT count(*) FROM sessions s JOIN participants p ON p.id = s.participant_id "
-                                "WHERE p.study_id = ? AND p.code = ? AND s.seed = ? AND s.host = ? AND s.started = ?");
-            while (own.Step() && !merged_before) {
-              twin.Bind(1, study);
-              twin.Bind(2, code);
-              twin.Bind(3, own.GetInt64(0));
-              twin.Bind(4, own.GetText(1));
-              twin.Bind(5, own.GetText(2));
-              twin.Step();
-              merged_before = twin.GetInt64(0) > 0;
-              twin.Reset();
-            }
-          }
-          if (taken && !merged_before && !same_person.count(code))
-            throw InputError(input.string(), "participant " + code + " of study " + participants.GetText(4) +
-                                                 " is also in an earlier input of this merge: two people with one id, "
-                                                 "or one person who ran at two stations? Two people: give one another "
-                                                 "id with --rename " + input.string() + ":" + code + "=NEW; one "
-                                                 "person: say so with --same-person " + code);
-          participant_ids[participants.GetInt64(0)] = EnsureParticipant(dst, study, code, participants.GetText(3));
-        }
-
-        Statement sessions(src, "SELECT id, participant_id, protocol_version_id, seed, software_version, host, "
-                                "display, started, ended, status, " +
-                                std::string(version >= 3 ? "display_profile" : "'{}'") + ", " +
-                                std::string(version >= 6 ? "group_name, participant_info" : "'', '{}'") +
-                                TypedSelect("sessions", version) + " FROM sessions");
-        Statement duplicate(dst, "SELECT id FROM sessions WHERE participant_id = ? AND protocol_version_id = ? "
-                                 "AND seed = ? AND host = ? AND started = ?");
-        Statement insert_session(dst, "INSERT INTO sessions (participant_id, protocol_version_id, seed, "
-                                      "software_version, host, display, started, ended, status, display_profile, "
-                                      "group_name, participant_info" + CopiedNames("sessions") +
-                                      ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?" +
-                                      CopiedPlaceholders("sessions") + ")");
-        const int number_at = 13 + TypedIndex("sessions", "session_number");
-        while (sessions.Step()) {
-          const int64_t participant = Mapped(participant_ids, sessions.GetInt64(1), input, "participant");
-          const int64_t protocol = Mapped(protocol_ids, sessions.GetInt64(2), input, "protocol version");
-          duplicate.Bind(1, participant);
-          duplicate.Bind(2, protocol);
-          duplicate.Bind(3, sessions.GetInt64(3));
-          duplicate.Bind(4, sessions.GetText(5));
-          duplicate.Bind(5, sessions.GetText(7));
-          if (duplicate.Step())
-            throw InputError(input.string(), "session " + std::to_string(sessions.GetInt64(0)) +
-                                                 " is already in the merge (an input merged twice?)");
-          duplicate.Reset();
-          insert_session.Bind(1, participant);
-          insert_session.Bind(2, protocol);
-          insert_session.Bind(3, sessions.GetInt64(3));
-          for (int column = 4; column <= 7; ++column) insert_session.Bind(column, sessions.GetText(column));
-          if (sessions.IsNull(8)) insert_session.BindNull(8);
-          else insert_session.Bind(8, sessions.GetText(8));
-          insert_session.Bind(9, sessions.GetText(9));
-          insert_session.Bind(10, sessions.GetText(10));
-          insert_session.Bind(11, sessions.GetText(11));
-          insert_session.Bind(12, sessions.GetText(12));
-          CopyTyped("sessions", sessions, 13, insert_session, 13);
-          insert_session.Run();
-          insert_session.Reset();
-          session_ids[sessions.GetInt64(0)] = dst.LastInsertRowId();
-          if (!sessions.IsNull(number_at))
-            numbered[dst.LastInsertRowId()] = {input.string(), sessions.GetInt64(0), sessions.GetInt64(number_at)};
-        }
-        if (version >= 7) {
-          Statement info(src, "SELECT session_id, key, value FROM session_info");
-          Statement insert_info(dst, "INSERT INTO session_info (session_id, key, value) VALUES (?, ?, ?)");
-          while (info.Step()) {
-            insert_info.Bind(1, Mapped(session_ids, info.GetInt64(0), input, "session"));
-            insert_info.Bind(2, info.GetText(1));
-            insert_info.Bind(3, info.GetText(2));
-            insert_info.Run();
-            insert_info.Reset();
-          }
-        }
-
-        Statement trials(src, "SELECT id, session_id, trial_index, block, factors, left_shown, right_shown" +
-                                  TypedSelect("trials", version) + " FROM trials");
-        Statement insert_trial(dst, "INSERT INTO trials (session_id, trial_index, block, factors, left_shown, "
-                                    "right_shown" + CopiedNames("trials") + ") VALUES (?, ?, ?, ?, ?, ?" +
-                                    CopiedPlaceholders("trials") + ")");
-        while (trials.Step()) {
-          insert_trial.Bind(1, Mapped(session_ids, trials.GetInt64(1), input, "session"));
-          insert_trial.Bind(2, trials.GetInt64(2));
-          insert_trial.Bind(3, trials.GetInt64(3));
-          for (int column = 4; column <= 6; ++column) insert_trial.Bind(column, trials.GetText(column));
-          CopyTyped("trials", trials, 7, insert_trial, 7);
-          insert_trial.Run();
-          insert_trial.Reset();
-          trial_ids[trials.GetInt64(0)] = dst.LastInsertRowId();
-        }
-
-        Statement responses(src, "SELECT trial_id, choice, rt_ms, adjustment, answered_at, " +
-                                     std::string(version >= 5 ? "shown" : "'{}'") +
-                                     TypedSelect("responses", version) + " FROM responses");
-        Statement insert_response(dst, "INSERT INTO responses (trial_id, choice, rt_ms, adjustment, answered_at, "
-                                       "shown" + CopiedNames("responses") + ") VALUES (?, ?, ?, ?, ?, ?" +
-                                       CopiedPlaceholders("responses") + ")");
-        while (responses.Step()) {
-          insert_response.Bind(1, Mapped(trial_ids, responses.GetInt64(0), input, "trial"));
-          insert_response.Bind(2, responses.GetText(1));
-          if (responses.IsNull(2)) insert_response.BindNull(3);
-          else insert_response.Bind(3, responses.GetDouble(2));
-          insert_response.Bind(4, responses.GetText(3));
-          insert_response.Bind(5, responses.GetText(4));
-          insert_response.Bind(6, responses.GetText(5));
-          CopyTyped("responses", responses, 6, insert_response, 7);
-          insert_response.Run();
-          insert_response.Reset();
-        }
-
-        // Every recorded value of a frame (frame_columns.h); NULL for those the input's version did not have.
-        std::string read, names, marks;
-        for (const FrameValue& v : FrameValues()) {
-          read += ", " + (version >= v.since ? v.name : std::string("NULL"));
-          names += ", " + v.name;
-          marks += ", ?";
-        }
-        Statement frames(src, "SELECT trial_id" + read + " FROM frames");
-        Statement insert_frame(dst, "INSERT INTO frames (trial_id" + names + ") VALUES (?" + marks + ")");
-        while (frames.Step()) {
-          insert_frame.Bind(1, Mapped(trial_ids, frames.GetInt64(0), input, "trial"));
-          int column = 1;
-          for (const FrameValue& v : FrameValues()) {
-            if (frames.IsNull(column)) insert_frame.BindNull(column + 1);
-            else if (v.sql == "TEXT") insert_frame.Bind(column + 1, frames.GetText(column));
-            else if (v.sql == "REAL") insert_frame.Bind(column + 1, frames.GetDouble(column));
-            else insert_frame.Bind(column + 1, frames.GetInt64(column));
-            ++column;
-          }
-          insert_frame.Run();
-          insert_frame.Reset();
-        }
+        CopyStudiesAndProtocols(src, dst, input, version, study_ids, protocol_ids);
+        const auto own = renames.find(std::filesystem::weakly_canonical(input));
+        CopyParticipants(src, dst, input, own == renames.end() ? Renames() : own->second, same_person, study_ids,
+                         participant_ids);
+        CopySessions(src, dst, input, version, participant_ids, protocol_ids, session_ids, numbered);
+        CopyTrials(src, dst, input, version, session_ids);
         src.Exec("COMMIT");
       }
       // Inputs from before the typed record: their typed columns from their texts, as a migration would.
@@ -414,45 +476,13 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
       // sessions cannot both be number 1. Each number that differs from its input's is told.
       DeriveVersionsAndNumbers(dst);
       NumberSessions(dst, true);
-      Statement number(dst, "SELECT s.session_number, st.name, p.code FROM sessions s JOIN participants p ON "
-                            "p.id = s.participant_id JOIN studies st ON st.id = p.study_id WHERE s.id = ?");
-      for (const auto& [id, was] : numbered) {
-        number.Bind(1, id);
-        number.Step();
-        if (number.GetInt64(0) != was.number)
-          renumbered.push_back(was.input + ": session " + std::to_string(was.session) + " (study " + number.GetText(1) +
-                               ", participant " + number.GetText(2) + ") is session number " +
-                               std::to_string(was.number) + " there and " + std::to_string(number.GetInt64(0)) +
-                               " in the merged record (numbered by start)");
-        number.Reset();
-      }
-      // Stations that each ran another text under one version (or records made before versions were kept apart)
-      // are merged as they are; the tables cannot tell those sessions' designs apart by version, so say so.
-      Statement shared(dst, "SELECT st.name, pv.version, count(*) FROM protocol_versions pv JOIN studies st ON "
-                            "st.id = pv.study_id GROUP BY pv.study_id, pv.version HAVING count(*) > 1 "
-                            "ORDER BY st.name, pv.version");
-      while (shared.Step())
-        renumbered.push_back("study " + shared.GetText(0) + ": protocol version " + std::to_string(shared.GetInt64(1)) +
-                             " has " + std::to_string(shared.GetInt64(2)) + " different texts in the merged record "
-                             "(protocol_hash tells their sessions apart)");
-      // Two stations that each ran a participant's first session gave both the default seed: merged they read as
-      // one person seeing one trial order twice, which run refuses. It used to pass untold; it is likely two people
-      // given one id, so say so (the record cannot tell).
-      Statement twins(dst, "SELECT st.name, p.code, group_concat(s.session_number, ', ') FROM (SELECT * FROM sessions "
-                           "ORDER BY session_number) s JOIN participants p ON p.id = s.participant_id JOIN studies st "
-                           "ON st.id = p.study_id GROUP BY s.participant_id, s.seed HAVING count(*) > 1 "
-                           "ORDER BY st.name, p.code");
-      while (twins.Step())
-        renumbered.push_back("study " + twins.GetText(0) + ", participant " + twins.GetText(1) + ": sessions " +
-                             twins.GetText(2) + " in the merged record ran with one seed, so in one trial order - "
-                             "two people given one id at two stations, or one person shown the same order twice; "
-                             "check before analysing them as one participant");
+      told = TellWhatChanged(dst, numbered);
       transaction.Commit();
     }  // the last connection closes: the WAL is checkpointed into the file and removed
     MoveIntoPlace(temp, out);
     if (note) {
       for (const auto& line : unfinished) note(line);
-      for (const auto& line : renumbered) note(line);
+      for (const auto& line : told) note(line);
     }
   } catch (...) {
     RemoveDatabaseFiles(temp);
