@@ -133,136 +133,164 @@ std::vector<std::string> DesignWarnings(const Condition& c, const PowerRow& row)
   return out;
 }
 
-void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
-  const int N = o.participants, S = o.studies;
-  std::vector<const Condition*> cells;
-  for (const Condition& c : r.conditions)
-    if (c.measure == "threshold") cells.push_back(&c);
-  if (cells.empty()) {
-    if (o.difference)
-      r.notes.push_back("--difference is not planned: it is a difference between thresholds, and no block of this "
-                        "protocol has a procedure (staircase or QUEST+)");
-    return;
+namespace {
+
+// The threshold rows of a plan: each procedure cell's precision, and the power of the comparisons the report would
+// run between cells (paired), between groups (Welch) and, with --difference, against a second cell like it.
+class ThresholdRows {
+ public:
+  ThresholdRows(PlanResult& r, const PlanOptions& o, std::vector<const Condition*> cells)
+      : r_(r), o_(o), cells_(std::move(cells)) {
+    for (const Condition* c : cells_) {
+      est_[c->key] = EstimatesOf(r_, c->key);
+      overall_[c->key] = MomentsOf(Flat(est_[c->key]));
+    }
   }
-  std::map<ConditionKey, Grid> est;
-  std::map<ConditionKey, Moments> overall;
-  for (const Condition* c : cells) {
-    est[c->key] = EstimatesOf(r, c->key);
-    overall[c->key] = MomentsOf(Flat(est[c->key]));
+  void Add() {
+    for (const Condition* c : cells_) AddPrecision(*c);
+    AddPaired();
+    const bool compared_groups = AddGroups();
+    if (!o_.difference) {
+      r_.notes.push_back("the power to detect a difference between thresholds is planned with --difference (e.g. "
+                         "--difference 0.5 in the procedure's units, or --difference 20%)");
+      return;
+    }
+    if (!compared_groups) AddSecondCells();
   }
-  std::vector<double> t975(1, kNan);
-  auto t_of = [&](size_t df) {
-    while (t975.size() <= df) t975.push_back(StudentT975(int(t975.size())));
-    return t975[df];
-  };
-  // Precision: over the simulated participants, the estimates against the observer's true threshold, and how wide
-  // the 95 % t interval of their mean is with N of them.
-  for (const Condition* c : cells) {
-    const Moments& all = overall[c->key];
-    const Grid& g = est[c->key];
-    for (int m = 1; m <= N; ++m) {
-      PowerRow row = Row("threshold", c->label, "threshold", m);
-      row.true_threshold = c->truth_determined ? c->truth : kNan;
-      row.mean_estimate = all.mean;
-      row.bias = c->truth_determined ? all.mean - c->truth : kNan;
-      row.sd_estimate = all.sd;
-      double width = 0, count = 0;
-      int widths = 0;
-      for (int s = 0; s < S; ++s) {
-        std::vector<double> values;
-        for (int i = 0; i < m; ++i)
-          if (std::isfinite(g[size_t(s)][size_t(i)])) values.push_back(g[size_t(s)][size_t(i)]);
-        count += double(values.size());
-        const Moments here = MomentsOf(values);
-        if (here.n < 2) continue;
-        width += 2 * t_of(size_t(here.n - 1)) * here.sd / std::sqrt(double(here.n));
-        ++widths;
-      }
-      row.mean_trials = count / S;  // here: participants with an estimate
-      row.interval_width = widths > 0 ? width / widths : kNan;
-      if (m == N) {
-        double tracks = 0, determined = 0, covered = 0;
-        for (const auto& study : r.studies)
-          for (const SimParticipant& p : study) {
-            const auto it = p.tracks.find(c->key);
-            if (it == p.tracks.end()) continue;
-            ++tracks;
-            if (!it->second.determined) continue;
-            ++determined;
-            covered += it->second.low <= c->truth && c->truth <= it->second.high;
-          }
-        row.determined_share = tracks > 0 ? determined / tracks : kNan;
-        std::vector<double> values;
-        for (const double v : Flat(g))
-          if (std::isfinite(v)) values.push_back(v);
-        if (!values.empty()) {
-          std::nth_element(values.begin(), values.begin() + long(values.size() / 2), values.end());
-          row.median_estimate = values[values.size() / 2];
+
+ private:
+  double T975(size_t df) {
+    while (t975_.size() <= df) t975_.push_back(StudentT975(int(t975_.size())));
+    return t975_[df];
+  }
+  void Note(const std::string& text) {
+    if (std::find(r_.notes.begin(), r_.notes.end(), text) == r_.notes.end()) r_.notes.push_back(text);
+  }
+  void AddPrecision(const Condition& c);
+  double Declared(const Condition& c, const Condition& other);
+  void AddPaired();
+  bool AddGroups();
+  void AddSecondCells();
+
+  PlanResult& r_;
+  const PlanOptions& o_;
+  const std::vector<const Condition*> cells_;
+  std::map<ConditionKey, Grid> est_;
+  std::map<ConditionKey, Moments> overall_;
+  std::set<ConditionKey> paired_;  // cells compared with another of the same participants
+  std::vector<double> t975_ = std::vector<double>(1, kNan);
+};
+
+// Precision: over the simulated participants, the estimates against the observer's true threshold, and how wide the
+// 95 % t interval of their mean is with N of them.
+void ThresholdRows::AddPrecision(const Condition& c) {
+  const int N = o_.participants, S = o_.studies;
+  const Moments& all = overall_[c.key];
+  const Grid& g = est_[c.key];
+  for (int m = 1; m <= N; ++m) {
+    PowerRow row = Row("threshold", c.label, "threshold", m);
+    row.true_threshold = c.truth_determined ? c.truth : kNan;
+    row.mean_estimate = all.mean;
+    row.bias = c.truth_determined ? all.mean - c.truth : kNan;
+    row.sd_estimate = all.sd;
+    double width = 0, count = 0;
+    int widths = 0;
+    for (int s = 0; s < S; ++s) {
+      std::vector<double> values;
+      for (int i = 0; i < m; ++i)
+        if (std::isfinite(g[size_t(s)][size_t(i)])) values.push_back(g[size_t(s)][size_t(i)]);
+      count += double(values.size());
+      const Moments here = MomentsOf(values);
+      if (here.n < 2) continue;
+      width += 2 * T975(size_t(here.n - 1)) * here.sd / std::sqrt(double(here.n));
+      ++widths;
+    }
+    row.mean_trials = count / S;  // here: participants with an estimate
+    row.interval_width = widths > 0 ? width / widths : kNan;
+    if (m == N) {
+      double tracks = 0, determined = 0, covered = 0;
+      for (const auto& study : r_.studies)
+        for (const SimParticipant& p : study) {
+          const auto it = p.tracks.find(c.key);
+          if (it == p.tracks.end()) continue;
+          ++tracks;
+          if (!it->second.determined) continue;
+          ++determined;
+          covered += it->second.low <= c.truth && c.truth <= it->second.high;
         }
-        row.coverage = determined > 0 && c->truth_determined ? covered / determined : kNan;
+      row.determined_share = tracks > 0 ? determined / tracks : kNan;
+      std::vector<double> values;
+      for (const double v : Flat(g))
+        if (std::isfinite(v)) values.push_back(v);
+      if (!values.empty()) {
+        std::nth_element(values.begin(), values.begin() + long(values.size() / 2), values.end());
+        row.median_estimate = values[values.size() / 2];
       }
-      r.rows.push_back(row);
+      row.coverage = determined > 0 && c.truth_determined ? covered / determined : kNan;
     }
+    r_.rows.push_back(row);
   }
-  // The declared difference in the procedure's units for a cell; NaN, with a note saying why, where it means nothing:
-  // the cell's true threshold is not known (the procedure sits at a bound of its range, or shows nothing near it:
-  // its estimates barely scatter, so any shift had "power 1.000 at N = 2"), or the second threshold, truth + the
-  // difference, lies outside what the procedure measures (--difference 1e308, -200%: a negative threshold).
-  // `c` is the cell the difference is declared from, `second` the one shifted by it (the same cell for a second cell).
-  auto note = [&](const std::string& text) {
-    if (std::find(r.notes.begin(), r.notes.end(), text) == r.notes.end()) r.notes.push_back(text);
-  };
-  auto declared = [&](const Condition& c, const Condition& other) {
-    if (!o.difference) return kNan;
-    const std::string what = "--difference " + DifferenceText(*o.difference, c.units) + " is not planned for " + c.label;
-    if (!c.truth_determined) {
-      note(what + ": its true threshold is " + c.truth_why);
-      return kNan;
-    }
-    const double delta = o.difference->relative ? o.difference->value * c.truth : o.difference->value;
-    const double second = c.truth + delta;
-    if (!(second >= other.range_lo && second <= other.range_hi)) {
-      note(what + ": the second threshold (its true " + protocol::LevelText(c.truth) + " " + (delta >= 0 ? "+ " : "- ") +
-           protocol::LevelText(std::abs(delta)) + ") would be " + (second < other.range_lo ? "below" : "above") +
-           " the tested range (" + protocol::LevelText(other.range_lo) + " to " + protocol::LevelText(other.range_hi) +
-           ")");
-      return kNan;
-    }
-    // The declared difference is planned by shifting the estimates as simulated: shifted past the range, they are
-    // estimates the procedure can never report (an observer with 90 % lapses drives QUEST+ to its grid's top, 5.95
-    // of 6, sd 0.05: "+0.5 arcmin, power 1.000 at N = 3").
-    const double shifted = overall[c.key].mean + delta;
-    if (!(shifted >= other.range_lo && shifted <= other.range_hi)) {
-      note(what + ": its estimates (mean " + protocol::LevelText(overall[c.key].mean) + ") shifted by it would be " +
-           (shifted < other.range_lo ? "below" : "above") + " the tested range (" + protocol::LevelText(other.range_lo) +
-           " to " + protocol::LevelText(other.range_hi) + "), which the procedure cannot report");
-      return kNan;
-    }
-    return delta;
-  };
-  // Between two cells of the same participants: the paired t-test of per-participant thresholds the report would run.
-  std::set<ConditionKey> paired;
-  for (size_t a = 0; a < cells.size(); ++a)
-    for (size_t b = a + 1; b < cells.size(); ++b) {
-      const Condition &A = *cells[a], &B = *cells[b];
+}
+
+// The declared difference in the procedure's units for a cell; NaN, with a note saying why, where it means nothing:
+// the cell's true threshold is not known (the procedure sits at a bound of its range, or shows nothing near it: its
+// estimates barely scatter, so any shift had "power 1.000 at N = 2"), or the second threshold, truth + the
+// difference, lies outside what the procedure measures (--difference 1e308, -200%: a negative threshold). `c` is the
+// cell the difference is declared from, `other` the one shifted by it (the same cell for a second cell).
+double ThresholdRows::Declared(const Condition& c, const Condition& other) {
+  if (!o_.difference) return kNan;
+  const std::string what = "--difference " + DifferenceText(*o_.difference, c.units) + " is not planned for " + c.label;
+  if (!c.truth_determined) {
+    Note(what + ": its true threshold is " + c.truth_why);
+    return kNan;
+  }
+  const double delta = o_.difference->relative ? o_.difference->value * c.truth : o_.difference->value;
+  const double second = c.truth + delta;
+  if (!(second >= other.range_lo && second <= other.range_hi)) {
+    Note(what + ": the second threshold (its true " + protocol::LevelText(c.truth) + " " + (delta >= 0 ? "+ " : "- ") +
+         protocol::LevelText(std::abs(delta)) + ") would be " + (second < other.range_lo ? "below" : "above") +
+         " the tested range (" + protocol::LevelText(other.range_lo) + " to " + protocol::LevelText(other.range_hi) +
+         ")");
+    return kNan;
+  }
+  // The declared difference is planned by shifting the estimates as simulated: shifted past the range, they are
+  // estimates the procedure can never report (an observer with 90 % lapses drives QUEST+ to its grid's top, 5.95 of
+  // 6, sd 0.05: "+0.5 arcmin, power 1.000 at N = 3").
+  const double shifted = overall_[c.key].mean + delta;
+  if (!(shifted >= other.range_lo && shifted <= other.range_hi)) {
+    Note(what + ": its estimates (mean " + protocol::LevelText(overall_[c.key].mean) + ") shifted by it would be " +
+         (shifted < other.range_lo ? "below" : "above") + " the tested range (" + protocol::LevelText(other.range_lo) +
+         " to " + protocol::LevelText(other.range_hi) + "), which the procedure cannot report");
+    return kNan;
+  }
+  return delta;
+}
+
+// Between two cells of the same participants: the paired t-test of per-participant thresholds the report would run.
+void ThresholdRows::AddPaired() {
+  const int N = o_.participants, S = o_.studies;
+  for (size_t a = 0; a < cells_.size(); ++a)
+    for (size_t b = a + 1; b < cells_.size(); ++b) {
+      const Condition &A = *cells_[a], &B = *cells_[b];
       // Thresholds in different units (a difference in arcmin, a relative one) have no difference to test: their
       // paired t-test subtracted a fraction from arcmin ("-1.035, power 1.000 at N = 4").
       if (A.target != B.target) {
-        r.notes.push_back(B.label + " and " + A.label + " are not compared: their thresholds stand for different "
-                          "criteria (" + B.target + "; " + A.target + ")");
+        r_.notes.push_back(B.label + " and " + A.label + " are not compared: their thresholds stand for different "
+                           "criteria (" + B.target + "; " + A.target + ")");
         continue;
       }
       if (A.units != B.units) {
-        r.notes.push_back(B.label + " and " + A.label + " are not compared: their thresholds are in different units (" +
-                          B.units + ", " + A.units + ")");
+        r_.notes.push_back(B.label + " and " + A.label + " are not compared: their thresholds are in different units (" +
+                           B.units + ", " + A.units + ")");
         continue;
       }
-      const Grid &ga = est[A.key], &gb = est[B.key];
+      const Grid &ga = est_[A.key], &gb = est_[B.key];
       bool both = false;
       for (int s = 0; s < S && !both; ++s)
-        for (int i = 0; i < N && !both; ++i) both = std::isfinite(ga[size_t(s)][size_t(i)]) && std::isfinite(gb[size_t(s)][size_t(i)]);
+        for (int i = 0; i < N && !both; ++i)
+          both = std::isfinite(ga[size_t(s)][size_t(i)]) && std::isfinite(gb[size_t(s)][size_t(i)]);
       if (!both) continue;
-      paired.insert(A.key), paired.insert(B.key);
+      paired_.insert(A.key), paired_.insert(B.key);
       const std::string name = B.label + " - " + A.label;
       auto differences = [&](int s, int m, double shift_a, double shift_b) {
         std::vector<double> d;
@@ -274,41 +302,46 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
       };
       PowerRow own = Row("paired_t", name + " (the model's own)", "threshold", 0);
       own.difference = A.truth_determined && B.truth_determined ? B.truth - A.truth : kNan;
-      own.mean_estimate = overall[B.key].mean - overall[A.key].mean;
-      AddPowerRows(r, o, own, [&](int s, int m) { return OneSampleTTestP(differences(s, m, 0, 0), 0); });
-      if (!o.difference) continue;
-      const double delta = declared(A, B);
+      own.mean_estimate = overall_[B.key].mean - overall_[A.key].mean;
+      AddPowerRows(r_, o_, own, [&](int s, int m) { return OneSampleTTestP(differences(s, m, 0, 0), 0); });
+      if (!o_.difference) continue;
+      const double delta = Declared(A, B);
       if (!std::isfinite(delta)) continue;
       // The estimates' scatter as simulated, each cell centred on its own mean estimate, the second shifted by delta.
-      PowerRow shifted = Row("paired_t", name + " (declared " + DifferenceText(*o.difference, A.units) + ")",
+      PowerRow shifted = Row("paired_t", name + " (declared " + DifferenceText(*o_.difference, A.units) + ")",
                              "threshold", 0);
       shifted.difference = delta;
-      const double ma = overall[A.key].mean, mb = overall[B.key].mean - delta;
-      AddPowerRows(r, o, shifted, [&](int s, int m) { return OneSampleTTestP(differences(s, m, ma, mb), 0); });
+      const double ma = overall_[A.key].mean, mb = overall_[B.key].mean - delta;
+      AddPowerRows(r_, o_, shifted, [&](int s, int m) { return OneSampleTTestP(differences(s, m, ma, mb), 0); });
     }
-  // Groups: the same cell (its levels) in two groups, Welch's t-test of the groups' thresholds.
+}
+
+// Groups: the same cell (its levels) in two groups, Welch's t-test of the groups' thresholds. True when some pair of
+// groups was compared.
+bool ThresholdRows::AddGroups() {
   bool compared_groups = false;
-  for (size_t g1 = 0; g1 < r.groups.size(); ++g1)
-    for (size_t g2 = g1 + 1; g2 < r.groups.size(); ++g2) {
+  const std::vector<std::string>& groups = r_.groups;
+  for (size_t g1 = 0; g1 < groups.size(); ++g1)
+    for (size_t g2 = g1 + 1; g2 < groups.size(); ++g2) {
       std::set<std::vector<protocol::Level>, protocol::LevelsLess> levels;
-      for (const Condition* c : cells) levels.insert(c->key.levels);
+      for (const Condition* c : cells_) levels.insert(c->key.levels);
       for (const std::vector<protocol::Level>& level : levels) {
         // Per group, the cell of those levels its participants run (its block may be the group's own).
         const Condition *A = nullptr, *B = nullptr;
-        for (const auto& study : r.studies)
+        for (const auto& study : r_.studies)
           for (const SimParticipant& p : study)
-            for (const Condition* c : cells)
+            for (const Condition* c : cells_)
               if (c->key.levels == level && p.thresholds.count(c->key)) {
-                if (p.group == r.groups[g1] && !A) A = c;
-                if (p.group == r.groups[g2] && !B) B = c;
+                if (p.group == groups[g1] && !A) A = c;
+                if (p.group == groups[g2] && !B) B = c;
               }
         if (!A || !B || A->units != B->units) continue;
         compared_groups = true;
-        const Grid &ga = est[A->key], &gb = est[B->key];
+        const Grid &ga = est_[A->key], &gb = est_[B->key];
         auto values = [&](const Grid& g, const std::string& group, int s, int m, double shift) {
           std::vector<double> v;
           for (int i = 0; i < m; ++i)
-            if (r.studies[size_t(s)][size_t(i)].group == group && std::isfinite(g[size_t(s)][size_t(i)]))
+            if (r_.studies[size_t(s)][size_t(i)].group == group && std::isfinite(g[size_t(s)][size_t(i)]))
               v.push_back(g[size_t(s)][size_t(i)] - shift);
           return v;
         };
@@ -317,49 +350,48 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
           const std::string prefix = "group=" + group + ": ";
           return c.label.rfind(prefix, 0) == 0 ? c.label.substr(prefix.size()) : c.label;
         };
-        const std::string la = cell(*A, r.groups[g1]), lb = cell(*B, r.groups[g2]);
-        const std::string name = "group " + r.groups[g2] + " - " + r.groups[g1] + ": " + (la == lb ? la : lb + " - " + la);
+        const std::string la = cell(*A, groups[g1]), lb = cell(*B, groups[g2]);
+        const std::string name = "group " + groups[g2] + " - " + groups[g1] + ": " + (la == lb ? la : lb + " - " + la);
         PowerRow own = Row("groups_t", name + " (the model's own)", "threshold", 0);
         own.difference = A->truth_determined && B->truth_determined ? B->truth - A->truth : kNan;
-        own.mean_estimate = overall[B->key].mean - overall[A->key].mean;
-        AddPowerRows(r, o, own, [&](int s, int m) {
-          return WelchTTestP(values(gb, r.groups[g2], s, m, 0), values(ga, r.groups[g1], s, m, 0));
+        own.mean_estimate = overall_[B->key].mean - overall_[A->key].mean;
+        AddPowerRows(r_, o_, own, [&](int s, int m) {
+          return WelchTTestP(values(gb, groups[g2], s, m, 0), values(ga, groups[g1], s, m, 0));
         });
-        if (!o.difference) continue;
-        const double delta = declared(*A, *B);
+        if (!o_.difference) continue;
+        const double delta = Declared(*A, *B);
         if (!std::isfinite(delta)) continue;
-        PowerRow shifted = Row("groups_t", name + " (declared " + DifferenceText(*o.difference, A->units) + ")",
+        PowerRow shifted = Row("groups_t", name + " (declared " + DifferenceText(*o_.difference, A->units) + ")",
                                "threshold", 0);
         shifted.difference = delta;
-        const double ma = overall[A->key].mean, mb = overall[B->key].mean - delta;
-        AddPowerRows(r, o, shifted, [&](int s, int m) {
-          return WelchTTestP(values(gb, r.groups[g2], s, m, mb), values(ga, r.groups[g1], s, m, ma));
+        const double ma = overall_[A->key].mean, mb = overall_[B->key].mean - delta;
+        AddPowerRows(r_, o_, shifted, [&](int s, int m) {
+          return WelchTTestP(values(gb, groups[g2], s, m, mb), values(ga, groups[g1], s, m, ma));
         });
       }
     }
-  if (!o.difference) {
-    r.notes.push_back("the power to detect a difference between thresholds is planned with --difference (e.g. "
-                      "--difference 0.5 in the procedure's units, or --difference 20%)");
-    return;
-  }
-  if (compared_groups) return;
-  // A cell with no partner: the power of a paired t-test against a second cell like it in the same participants,
-  // differing by the declared amount. Participant i's second track is participant i's in the next study (every
-  // simulated participant is the same observer with its own seed, so the two are independent draws).
-  for (const Condition* c : cells) {
-    if (paired.count(c->key)) continue;
-    const double delta = declared(*c, *c);
+  return compared_groups;
+}
+
+// A cell with no partner: the power of a paired t-test against a second cell like it in the same participants,
+// differing by the declared amount. Participant i's second track is participant i's in the next study (every
+// simulated participant is the same observer with its own seed, so the two are independent draws).
+void ThresholdRows::AddSecondCells() {
+  const int S = o_.studies;
+  for (const Condition* c : cells_) {
+    if (paired_.count(c->key)) continue;
+    const double delta = Declared(*c, *c);
     if (!std::isfinite(delta)) continue;
     if (S < 2) {
-      r.notes.push_back("--difference for " + c->label + " needs --studies 2 or more (a second cell's track comes "
-                        "from the next study)");
+      r_.notes.push_back("--difference for " + c->label + " needs --studies 2 or more (a second cell's track comes "
+                         "from the next study)");
       continue;
     }
-    const Grid& g = est[c->key];
-    PowerRow row = Row("second_cell_t", c->label + " vs a second cell " + DifferenceText(*o.difference, c->units),
+    const Grid& g = est_[c->key];
+    PowerRow row = Row("second_cell_t", c->label + " vs a second cell " + DifferenceText(*o_.difference, c->units),
                        "threshold", 0);
     row.difference = delta;
-    AddPowerRows(r, o, row, [&](int s, int m) {
+    AddPowerRows(r_, o_, row, [&](int s, int m) {
       std::vector<double> d;
       for (int i = 0; i < m; ++i) {
         const double x = g[size_t(s)][size_t(i)], y = g[size_t((s + 1) % S)][size_t(i)];
@@ -368,6 +400,21 @@ void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
       return OneSampleTTestP(d, 0);
     });
   }
+}
+
+}  // namespace
+
+void AddThresholdRows(PlanResult& r, const PlanOptions& o) {
+  std::vector<const Condition*> cells;
+  for (const Condition& c : r.conditions)
+    if (c.measure == "threshold") cells.push_back(&c);
+  if (cells.empty()) {
+    if (o.difference)
+      r.notes.push_back("--difference is not planned: it is a difference between thresholds, and no block of this "
+                        "protocol has a procedure (staircase or QUEST+)");
+    return;
+  }
+  ThresholdRows(r, o, std::move(cells)).Add();
 }
 
 void AddGroupShareRows(PlanResult& r, const PlanOptions& o) {
