@@ -81,7 +81,7 @@ struct Block {
   std::string conditions;             // a conditions table's path as the protocol writes it (its factor "row"); "" for none
   int repetitions = 1;
   Counterbalance counterbalance = Counterbalance::kNone;
-  // "sides": what each side shows when no factor's levels carry the sides: {"left": SOURCE, "right": SOURCE}, or the
+  // "sides": what each side shows when no factor's levels carry the sides: {left: SOURCE, right: SOURCE}, or the
   // single layout's {"object": SOURCE} (shown as the left side and recorded on both). A source the parser refused is
   // left unset.
   struct Sides {
@@ -196,6 +196,22 @@ struct Responses {
   // Answers count only after the stimulus's motion (or its intervals) ended; keys pressed before are ignored and
   // the prompt appears then. false: answering any time after onset.
   bool after_motion = false;
+
+  // The key a single-key field names ("" for none: a strict 2AFC's can't tell).
+  const std::string& Key(ResponseKey field) const { return const_cast<Responses*>(this)->Slot(field); }
+  std::string& Slot(ResponseKey field) {
+    switch (field) {
+      case ResponseKey::kLeft: return left;
+      case ResponseKey::kRight: return right;
+      case ResponseKey::kCantTell: return cant_tell;
+      case ResponseKey::kPrevious: return previous;
+      case ResponseKey::kNext: return next;
+      case ResponseKey::kAccept: return accept;
+      case ResponseKey::kYes: return yes;
+      case ResponseKey::kNo: return no;
+    }
+    return accept;
+  }
 };
 
 // How a grid or ball trial's photo maps to the screen (a picture's frame is always fitted, 4:3, at 1 screen px per
