@@ -221,8 +221,10 @@ KeyPress SimulatedObserver::ChooseBlurrier(const PairView& v) {
   const double side = params_.model == ObserverModel::kPixel ? 0 : params_.side_bias * sd;
   const double noise = Normal(), lapse_draw = Uniform(), lapse_pick = Uniform();
   const double rt = ResponseTimeMs(params_.rt_ms, difference / sd);
-  if (lapse_draw < params_.lapse) return {Action::Answer(Choice::Of(lapse_pick < 0.5 ? Side::kLeft : Side::kRight)), rt};
-  return {Action::Answer(Choice::Of(difference + side + sd * noise > 0 ? Side::kLeft : Side::kRight)), rt};
+  const Side chosen = lapse_draw < params_.lapse ? (lapse_pick < 0.5 ? Side::kLeft : Side::kRight)
+                      : difference + side + sd * noise > 0 ? Side::kLeft
+                                                           : Side::kRight;
+  return {Action::Answer(Choice::Of(chosen)), rt};
 }
 
 KeyPress SimulatedObserver::ChooseOdd(const PairView& v, int intervals, int odd) {

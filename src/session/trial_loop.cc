@@ -18,6 +18,7 @@ namespace blurcue::session {
 namespace {
 
 using protocol::Task;
+using ActionKind = procedure::Action::Kind;
 using render::InputEvent;
 using stimulus::IntervalScene;
 using stimulus::IntervalShowsRight;
@@ -187,23 +188,21 @@ class Runner {
         if (e.time_s < onset) continue;  // pressed before the stimulus was on screen
         const procedure::Action action = keys_.ActionOf(e.key, trial.task);
         const double t_ms = (e.time_s - onset - paused_s) * 1000;
-        const bool pause = action.kind == procedure::Action::Kind::kPause;
-        if (!pause && t_ms < answer_from_s * 1000) continue;  // before the motion ended
-        if (pause) {
+        if (action.kind != ActionKind::kPause && t_ms < answer_from_s * 1000) continue;  // before the motion ended
+        if (action.kind == ActionKind::kPause) {
           const double paused_at = presenter_.Now();
           if (!Pause()) return Outcome::kQuit;
           paused_s += presenter_.Now() - paused_at;
           presenter_.SetTitle(TrialTitle(trial) + (answer_from_s > 0 && answer_titled ? " - answer" : ""));
           last_flip = -1;  // the gap is the pause, not a dropped frame
-        } else if (action.kind == procedure::Action::Kind::kAnswer) {
+        } else if (action.kind == ActionKind::kAnswer) {
           response->choice = action.choice;
           response->rt_ms = t_ms;
           return Outcome::kAnswered;
-        } else if ((action.kind == procedure::Action::Kind::kPrevious || action.kind == procedure::Action::Kind::kNext) &&
-                   levels > 0) {
+        } else if ((action.kind == ActionKind::kPrevious || action.kind == ActionKind::kNext) && levels > 0) {
           level = procedure::StepLevel(level, action.kind, levels);
           steps.push_back({{"level", trial.adjust_levels[size_t(level)]}, {"t_ms", std::round(t_ms * 10) / 10}});
-        } else if (action.kind == procedure::Action::Kind::kAccept && levels > 0) {
+        } else if (action.kind == ActionKind::kAccept && levels > 0) {
           response->choice = Choice::Level(trial.adjust_levels[size_t(level)]);
           response->rt_ms = t_ms;
           response->adjustment_json = steps.dump();
@@ -226,8 +225,7 @@ class Runner {
       // A terminal gets one line rewritten after every answer; a log gets about ten lines.
       if (!tty && done % std::max<int64_t>(1, result.trial_count / 10) != 0 && done != result.trial_count)
         return;
-      const double elapsed =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
       const int64_t now = done - result.answered_before;
       const double left = now > 0 ? elapsed / double(now) * double(result.trial_count - done) : 0;
       std::fprintf(stderr, "%strial %lld of %lld  elapsed %s  remaining ~%s%s", tty ? "\r" : "",
@@ -254,7 +252,6 @@ class Runner {
         const protocol::Trial& t = trials_[size_t(i)];
         const auto it = answered.find(i);
         if (it == answered.end()) throw cannot(i, "the record has no answer for it but has answers after it");
-        // The record's text, read back as the trial's task and layout read it.
         const std::optional<Choice> recorded = keys_.Parse(it->second.choice, t);
         const bool recorded_skip = recorded && recorded->kind == Choice::Kind::kSkipped;
         const std::optional<procedure::Skip> why = logic.SkipReason(t);

@@ -20,6 +20,7 @@ namespace {
 constexpr int kLeftSection = 3, kRightSection = 5;  // the balls roll side by side, one section apart
 
 using protocol::FindLevel;
+using protocol::Side;
 
 // `where` names the field that chose the source ("FILE: /pointer"), made only when there is a problem to name. A
 // fixed radius on the screen is converted to photo px by `presentation`.
@@ -131,7 +132,7 @@ void CheckInPhoto(const protocol::Protocol& protocol, const protocol::Trial& tri
                                                                                         : "right_x_mm")
                                 : "speed_cm_s";
         throw InputError(protocol.file.string() + ": " + protocol::LevelPointer(protocol, trial, level),
-                         "the " + protocol::ToString(side == 0 ? protocol::Side::kLeft : protocol::Side::kRight) + " " + protocol::ToString(t.content) + " at (" +
+                         "the " + protocol::ToString(side == 0 ? Side::kLeft : Side::kRight) + " " + protocol::ToString(t.content) + " at (" +
                              std::to_string(int(std::lround(objects[side]->object.center_board_mm[0]))) + ", " +
                              std::to_string(int(std::lround(objects[side]->object.center_board_mm[1]))) +
                              ") mm on the board lies outside the " + std::to_string(photo.width) + " x " +
@@ -179,7 +180,6 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   }
   if (!scene) throw InputError(protocol.file.string(), "/scene/calib: a " + protocol::ToString(t.content) + " needs a calibration");
   // Where a side's source was chosen ("" for the scene's own blur, the calibration's): looked up only for a message.
-  using protocol::Side;
   auto field = [&](std::optional<Side> side) {
     return At(protocol, side ? protocol::SidePointer(protocol, trial, protocol::ToString(*side)) : "/scene/calib");
   };

@@ -334,8 +334,7 @@ int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::p
         case protocol::TaskAnswer::kSide: (AllDigits(choice) ? interval : side) = choice; break;
       }
     }
-    const std::optional<protocol::Side> chosen = protocol::ParseWord<protocol::Side>(side);
-    if (chosen && !rows.IsNull(9) && !rows.IsNull(10)) {
+    if (const auto chosen = protocol::ParseWord<protocol::Side>(side); chosen && !rows.IsNull(9) && !rows.IsNull(10)) {
       const double l = rows.GetDouble(9), r = rows.GetDouble(10);
       if (std::abs(l - r) > 1e-9) more_blurred = ((*chosen == protocol::Side::kLeft) == (l > r)) ? "1" : "0";
     }
