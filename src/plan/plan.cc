@@ -29,6 +29,7 @@
 namespace blurcue::plan {
 
 using procedure::Choice;
+using protocol::Side;
 
 bool ConditionKey::operator<(const ConditionKey& o) const {
   if (block != o.block) return block < o.block;
@@ -190,7 +191,7 @@ SimParticipant Simulate(procedure::PreparedSession& study, const procedure::Obse
     const bool none = choice.kind == Choice::Kind::kNone;
     t.none += none;
     if (c->measure == "first_source") {
-      const bool left = choice == Choice::Of(protocol::Side::kLeft), right = choice == Choice::Of(protocol::Side::kRight);
+      const bool left = choice == Choice::Of(Side::kLeft), right = choice == Choice::Of(Side::kRight);
       const bool first = trial.swapped ? right : left, second = trial.swapped ? left : right;
       t.first += first, t.second += second, t.cant_tell += choice.kind == Choice::Kind::kCantTell;
       t.k += first, t.n += first || second;

@@ -339,7 +339,8 @@ AdjustView AdjustViewOf(const protocol::Trial& trial, const stimulus::TrialScene
 }
 
 void CheckObserverCanAnswer(const ObserverParams& observer, const protocol::Protocol& protocol) {
-  if (observer.model != ObserverModel::kArcmin || protocol.content.type != protocol::ContentType::kPicture || protocol.content.real_camera)
+  if (observer.model != ObserverModel::kArcmin || protocol.content.type != protocol::ContentType::kPicture ||
+      protocol.content.real_camera)
     return;
   for (const auto& block : protocol.blocks)
     if (protocol::TraitsOf(block.task).answer == protocol::TaskAnswer::kLevel)

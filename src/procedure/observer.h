@@ -183,7 +183,8 @@ std::vector<KeyPress> AnswerTrial(SimulatedObserver& observer, const protocol::P
 
 // What the observer sees of an adjustment trial: the distance, and for a picture the real picture's blur (when the
 // protocol names its camera) and each level's blur in arcmin as this presentation shows them.
-AdjustView AdjustViewOf(const protocol::Trial& trial, const stimulus::TrialScene& scene, const stimulus::Presentation& presentation);
+AdjustView AdjustViewOf(const protocol::Trial& trial, const stimulus::TrialScene& scene,
+                        const stimulus::Presentation& presentation);
 
 // Throws Error(kInput) naming /content/real_camera when `observer` cannot answer the protocol's trials: the arcmin
 // model in a depth-matching (adjustment) block without the real photos' camera. Run and plan check before any trial.

@@ -138,7 +138,8 @@ std::optional<Block::Sides> Parser::ParseSides(const Json& v, const std::string&
   const std::string left = ToString(Side::kLeft), right = ToString(Side::kRight);
   if (!Object(v, ptr, {left, right, "object"})) return sides;
   if (const Json* s = Field(v, left, ptr, true)) CheckLevelValue(left, *s, ptr + "/" + left), sides.left = typed(*s);
-  if (const Json* s = Field(v, right, ptr, true)) CheckLevelValue(right, *s, ptr + "/" + right), sides.right = typed(*s);
+  if (const Json* s = Field(v, right, ptr, true))
+    CheckLevelValue(right, *s, ptr + "/" + right), sides.right = typed(*s);
   return sides;
 }
 
@@ -248,7 +249,7 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
   // What is shown left and right must be known for a comparison, and for any left/right counterbalancing.
   bool factor_sides = false;
   for (const auto& f : b->factors)
-    for (const auto& level : f.levels) factor_sides = factor_sides || level.Field(ToString(Side::kLeft)) || level.Field("object");
+    for (const auto& level : f.levels) factor_sides |= level.Field(ToString(Side::kLeft)) || level.Field("object");
   const std::string where = ptr.empty() ? "/" : ptr;
   if (factor_sides && sides.holder)
     Problem(sides.ptr + "/sides", "is given but a factor's levels already carry the sides (left and right, or object)",

@@ -197,20 +197,24 @@ struct Responses {
   // the prompt appears then. false: answering any time after onset.
   bool after_motion = false;
 
-  // The key a single-key field names ("" for none: a strict 2AFC's can't tell).
-  const std::string& Key(ResponseKey field) const { return const_cast<Responses*>(this)->Slot(field); }
-  std::string& Slot(ResponseKey field) {
+  // The key a single-key field names ("" for none: a strict 2AFC's can't tell), and the member that holds it.
+  const std::string& Key(ResponseKey field) const { return SlotOf(*this, field); }
+  std::string& Slot(ResponseKey field) { return SlotOf(*this, field); }
+
+ private:
+  template <typename Self>
+  static auto SlotOf(Self& r, ResponseKey field) -> decltype((r.left)) {
     switch (field) {
-      case ResponseKey::kLeft: return left;
-      case ResponseKey::kRight: return right;
-      case ResponseKey::kCantTell: return cant_tell;
-      case ResponseKey::kPrevious: return previous;
-      case ResponseKey::kNext: return next;
-      case ResponseKey::kAccept: return accept;
-      case ResponseKey::kYes: return yes;
-      case ResponseKey::kNo: return no;
+      case ResponseKey::kLeft: return r.left;
+      case ResponseKey::kRight: return r.right;
+      case ResponseKey::kCantTell: return r.cant_tell;
+      case ResponseKey::kPrevious: return r.previous;
+      case ResponseKey::kNext: return r.next;
+      case ResponseKey::kAccept: return r.accept;
+      case ResponseKey::kYes: return r.yes;
+      case ResponseKey::kNo: return r.no;
     }
-    return accept;
+    return r.accept;
   }
 };
 

@@ -318,7 +318,8 @@ std::string LevelPointer(const Protocol& protocol, const Trial& trial, const std
 Json ToJson(const Trial& t) {
   Json j = {{"index", t.index},         {"block", t.block},     {"practice", t.practice},
             {"task", ToString(t.task)}, {"repetition", t.repetition}, {"swapped", t.swapped},
-            {"levels", ToJson(t.levels)}, {ToString(Side::kLeft), ToJson(t.left)}, {ToString(Side::kRight), ToJson(t.right)}};
+            {"levels", ToJson(t.levels)}, {ToString(Side::kLeft), ToJson(t.left)},
+            {ToString(Side::kRight), ToJson(t.right)}};
   if (TraitsOf(t.task).answer == TaskAnswer::kLevel) {
     j["adjust_levels"] = t.adjust_levels;
     j["start_index"] = t.start_index;

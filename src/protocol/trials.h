@@ -31,9 +31,9 @@ struct Trial {
   std::vector<double> adjust_levels;
   int start_index = -1;
   // A procedure block's trial: which crossing of the block's factors (whose own procedure it feeds; -1 otherwise)
-  // and the side that shows the procedure's level (ToString(Side): left | right, drawn with the seed). In the odd_one_out layout
-  // every trial's test_side is the interval ("1".."n", drawn with the seed) that shows the right side's object (and a
-  // procedure's level): the correct answer.
+  // and the side that shows the procedure's level (a Side's word, drawn with the seed; TestSide reads it). In the
+  // odd_one_out layout every trial's test_side is the interval ("1".."n", drawn with the seed; TestInterval) that shows
+  // the right side's object (and a procedure's level): the correct answer.
   int cell = -1;
   std::string test_side;
 };

@@ -24,7 +24,8 @@ const TaskTraits& TraitsOf(Task task) {
   static const TaskTraits kAdjustment{TaskShows::kPicture, TaskAnswer::kLevel, false, false,
                                       {ToString(ResponseKey::kPrevious), ToString(ResponseKey::kNext),
                                        ToString(ResponseKey::kAccept)}};
-  static const TaskTraits kYesNo{TaskShows::kOneObject, TaskAnswer::kYesNo, false, true, {ToString(ResponseKey::kYes), ToString(ResponseKey::kNo)}};
+  static const TaskTraits kYesNo{TaskShows::kOneObject, TaskAnswer::kYesNo, false, true,
+                                 {ToString(ResponseKey::kYes), ToString(ResponseKey::kNo)}};
   static const TaskTraits kRating{TaskShows::kOneObject, TaskAnswer::kRatingPoint, false, true, {"rating"}};
   switch (task) {
     case Task::kForcedChoice: return kForcedChoice;

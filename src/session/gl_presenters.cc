@@ -157,7 +157,7 @@ void CapturingPresenter::Capture(const protocol::Trial& trial, const stimulus::T
   // (its "side" below is the slot it is drawn in).
   if (scene.intervals > 0)
     frame["first_interval_shows"] =
-        protocol::ToString(stimulus::IntervalShowsRight(trial, scene, 0) ? protocol::Side::kRight : protocol::Side::kLeft);
+        ToString(stimulus::IntervalShowsRight(trial, scene, 0) ? protocol::Side::kRight : protocol::Side::kLeft);
   if (!prompt.empty()) frame["prompt_rect_px"] = {0, image.rows - band, image.cols, band};
   WriteImage(dir_ / (std::string(name) + ".png"), image);
   WriteFileAtomically(dir_ / (std::string(name) + ".json"), frame.dump(1) + "\n");

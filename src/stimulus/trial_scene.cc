@@ -132,7 +132,7 @@ void CheckInPhoto(const protocol::Protocol& protocol, const protocol::Trial& tri
                                                                                         : "right_x_mm")
                                 : "speed_cm_s";
         throw InputError(protocol.file.string() + ": " + protocol::LevelPointer(protocol, trial, level),
-                         "the " + protocol::ToString(side == 0 ? Side::kLeft : Side::kRight) + " " + protocol::ToString(t.content) + " at (" +
+                         "the " + ToString(side == 0 ? Side::kLeft : Side::kRight) + " " + ToString(t.content) + " at (" +
                              std::to_string(int(std::lround(objects[side]->object.center_board_mm[0]))) + ", " +
                              std::to_string(int(std::lround(objects[side]->object.center_board_mm[1]))) +
                              ") mm on the board lies outside the " + std::to_string(photo.width) + " x " +
