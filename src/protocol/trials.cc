@@ -272,10 +272,9 @@ int BlockIndex(const Protocol& protocol, const Trial& trial) {
   return block ? static_cast<int>(block - protocol.blocks.data()) : 0;
 }
 
-std::string SidePointer(const Protocol& protocol, const Trial& trial, const std::string& side) {
+std::string SidePointer(const Protocol& protocol, const Trial& trial, Side side) {
   // A swapped trial shows the design's other side.
-  const std::optional<Side> shown = ParseWord<Side>(side);
-  const std::string designed = trial.swapped && shown ? ToString(Other(*shown)) : side;
+  const std::string designed = ToString(trial.swapped ? Other(side) : side);
   for (const auto& b : protocol.blocks) {
     if (b.name != trial.block) continue;
     for (const auto& f : b.factors) {

@@ -98,9 +98,9 @@ const std::string& PromptOf(const Protocol& protocol, const Trial& trial);
 // participant runs them, N their count.
 std::string BlockTitle(const Protocol& protocol, const std::vector<Trial>& trials, size_t index);
 
-// The JSON pointer of the field that chose what `trial` shows on `side` (left | right as shown, swaps
-// applied): the side of a level object (/blocks/1/factors/pattern/2/left) or of the block's sides (/sides/left).
-std::string SidePointer(const Protocol& protocol, const Trial& trial, const std::string& side);
+// The JSON pointer of the field that chose what `trial` shows on `side` (as shown, swaps applied): the side of a
+// level object (/blocks/1/factors/pattern/2/left) or of the block's sides (/sides/left).
+std::string SidePointer(const Protocol& protocol, const Trial& trial, Side side);
 // The side a procedure's trial shows its level on; nullopt for any other trial (an odd one out's is an interval).
 std::optional<Side> TestSide(const Trial& trial);
 // The interval (1..n) that shows an odd-one-out trial's odd object; 0 for any other trial.

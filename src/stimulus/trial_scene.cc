@@ -181,7 +181,7 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   if (!scene) throw InputError(protocol.file.string(), "/scene/calib: a " + protocol::ToString(t.content) + " needs a calibration");
   // Where a side's source was chosen ("" for the scene's own blur, the calibration's): looked up only for a message.
   auto field = [&](std::optional<Side> side) {
-    return At(protocol, side ? protocol::SidePointer(protocol, trial, protocol::ToString(*side)) : "/scene/calib");
+    return At(protocol, side ? protocol::SidePointer(protocol, trial, *side) : "/scene/calib");
   };
   t.left = Source(trial.left, &t.left_fixed_px, [&] { return field(Side::kLeft); }, presentation);
   t.right = Source(trial.right, &t.right_fixed_px, [&] { return field(Side::kRight); }, presentation);
