@@ -66,7 +66,7 @@ std::vector<PlanBenchRow> RunPlanBench(const PlanBenchOptions& options) {
                                          studies[1].protocol.name);
   }
   p.studies = options.studies;
-  std::vector<std::vector<std::vector<std::pair<int, std::string>>>> reference(files.size());
+  std::vector<std::vector<std::vector<std::pair<int, procedure::Choice>>>> reference(files.size());
   for (int round = 0; round < options.rounds; ++round) {
     // Interleaved: every protocol and thread count in each round, so a change of machine load falls on all of them.
     for (size_t f = 0; f < files.size(); ++f)
@@ -80,7 +80,7 @@ std::vector<PlanBenchRow> RunPlanBench(const PlanBenchOptions& options) {
         const auto simulated = plan::SimulateStudies(p, studies[f], &conditions, &notes, &used);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         const double cpu = CpuSeconds() - cpu_start;
-        std::vector<std::vector<std::pair<int, std::string>>> answers;
+        std::vector<std::vector<std::pair<int, procedure::Choice>>> answers;
         for (const auto& participant : simulated.front()) answers.push_back(participant.answers);
         if (reference[f].empty()) reference[f] = answers;
         if (answers != reference[f])

@@ -22,7 +22,7 @@ constexpr double kGuess = 0.5;          // 2AFC
 constexpr double kLowest = 0.125, kHighest = 3.0;  // the stimulus range every procedure is given
 
 // The simulated observer: a Weibull of threshold t, slope b and lapse l, and a share `side_bias` of answers that
-// say "left" whatever is shown (correct when the test side is left).
+// say left whatever is shown (correct when the test side is left).
 struct Observer {
   double t = 1, b = 3, lapse = 0, side_bias = 0;
   double Sensory(double x) const { return 1 - (1 - kGuess) * std::exp(-std::pow(std::max(x, 0.0) / t, b)); }

@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/stats.h"
+#include "protocol/vocabulary.h"
 #include "store/record.h"
 
 namespace blurcue::bench {
@@ -53,7 +54,7 @@ RecordBenchResult RunRecordBench(const RecordBenchOptions& options) {
   for (int i = 0; i < options.trials; ++i) {
     for (Arm& arm : arms) {
       store::Response response;
-      response.choice = i % 2 ? "left" : "right";
+      response.choice = protocol::ToString(i % 2 ? protocol::Side::kLeft : protocol::Side::kRight);
       response.rt_ms = 700;
       const auto start = std::chrono::steady_clock::now();
       arm.record->RecordResponse(arm.session, i, response, frames);

@@ -216,8 +216,8 @@ void AddPreviewCommand(CLI::App& app) {
           continue;
         }
         Json key = protocol::ToJson(t.levels);
-        key["left"] = protocol::ToJson(t.left);
-        key["right"] = protocol::ToJson(t.right);
+        key[protocol::ToString(protocol::Side::kLeft)] = protocol::ToJson(t.left);
+        key[protocol::ToString(protocol::Side::kRight)] = protocol::ToJson(t.right);
         if (!seen.insert(key.dump()).second) continue;
         // A procedure's crossing is shown at its first trial's level, on that trial's test side.
         stimulus::TrialScene s = s_planned;

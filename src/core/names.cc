@@ -36,7 +36,7 @@ std::string NearestName(const std::string& name, const std::vector<std::string>&
   // it would cost its length times each candidate's).
   if (name.empty() || name.size() > 200) return "";
   const std::string lower = Lower(name);
-  // A case slip is the likeliest meaning whatever else is near: "Left" is what someone who wrote "left" meant.
+  // A case slip is the likeliest meaning whatever else is near: "Yes" is what someone who wrote "yes" meant.
   for (const auto& c : candidates)
     if (c != name && Lower(c) == lower) return c;
   std::string best;

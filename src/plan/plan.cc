@@ -28,6 +28,9 @@
 
 namespace blurcue::plan {
 
+using procedure::Choice;
+using protocol::Side;
+
 bool ConditionKey::operator<(const ConditionKey& o) const {
   if (block != o.block) return block < o.block;
   if (slope != o.slope) return slope < o.slope;
@@ -114,13 +117,13 @@ SimParticipant Simulate(procedure::PreparedSession& study, const procedure::Obse
   std::map<ConditionKey, Track> tracks;
   for (const protocol::Trial& trial : study.trials) {
     if (logic.SkipReason(trial)) {
-      if (keep_answers) p.answers.emplace_back(trial.index, store::kChoiceSkipped);
+      if (keep_answers) p.answers.emplace_back(trial.index, Choice::Of(Choice::Kind::kSkipped));
       continue;
     }
     double level = 0;
     const stimulus::TrialScene scene = logic.SceneOf(trial, &level);
     const auto presses = procedure::ObserverPresses(observer, study.seed, protocol, trial, scene, study.presentation);
-    const std::string choice = procedure::HeadlessAnswer(protocol, trial, scene, presses).first;
+    const Choice choice = procedure::HeadlessAnswer(protocol, trial, scene, presses).first;
     const procedure::Scored scored = logic.Answer(trial, scene, level, choice);
     if (keep_answers) p.answers.emplace_back(trial.index, choice);
     if (trial.practice) continue;
@@ -138,7 +141,8 @@ SimParticipant Simulate(procedure::PreparedSession& study, const procedure::Obse
       conditions->emplace(c.key, c);
       Tally& t = p.tallies[c.key];
       ++t.shown;
-      const double cutoff = ParseDecimal(choice).value_or(0);  // a level as the record writes it
+      // The level as the record writes it (%g), as the report reads a run's: the plan fits the same numbers.
+      const double cutoff = choice.kind == Choice::Kind::kLevel ? ParseDecimal(procedure::Name(choice)).value_or(0) : 0;
       if (!(cutoff > 0) || !(scene.distance_m > 0)) {
         ++t.none;
         continue;
@@ -184,18 +188,18 @@ SimParticipant Simulate(procedure::PreparedSession& study, const procedure::Obse
     conditions->emplace(c->key, *c);
     Tally& t = p.tallies[c->key];
     ++t.shown;
-    const bool none = choice == store::kChoiceNone;
+    const bool none = choice.kind == Choice::Kind::kNone;
     t.none += none;
     if (c->measure == "first_source") {
-      const bool left = choice == "left", right = choice == "right";
+      const bool left = choice == Choice::Of(Side::kLeft), right = choice == Choice::Of(Side::kRight);
       const bool first = trial.swapped ? right : left, second = trial.swapped ? left : right;
-      t.first += first, t.second += second, t.cant_tell += choice == "cant_tell";
+      t.first += first, t.second += second, t.cant_tell += choice.kind == Choice::Kind::kCantTell;
       t.k += first, t.n += first || second;
     } else if (c->measure == "correct") {
       // The report counts answers (a missed deadline is no answer), correct against the guess rate.
       if (!none) t.k += scored.correct.value_or(false), ++t.n;
     } else if (!none) {
-      t.k += choice == "yes", ++t.n;
+      t.k += choice.kind == Choice::Kind::kYes, ++t.n;
     }
   }
   for (const auto& [key, track] : tracks) {
@@ -553,7 +557,7 @@ std::string AnswersCsv(const PlanResult& r) {
   for (const SimParticipant& p : r.studies.front())
     for (const auto& [index, choice] : p.answers)
       out += p.id + ",s" + std::to_string(p.seed) + "," + store::CsvField(p.group) + "," + std::to_string(index) + "," +
-             store::CsvField(choice) + "\n";
+             store::CsvField(procedure::Name(choice)) + "\n";
   return out;
 }
 

@@ -33,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "procedure/answer.h"
 #include "procedure/threshold_fit.h"
 #include "protocol/level.h"
 
@@ -102,7 +103,7 @@ struct Tally {
 struct SimParticipant {
   std::string id, group;
   uint64_t seed = 0;
-  std::vector<std::pair<int, std::string>> answers;  // (trial index, choice as the record stores it), every trial
+  std::vector<std::pair<int, procedure::Choice>> answers;  // (trial index, choice as the record stores it), every trial
   std::map<ConditionKey, Tally> tallies;
   // Depth matching, by condition key: (log distance, log accepted cut-off) of each answered trial.
   std::map<ConditionKey, std::vector<std::pair<double, double>>> matches;

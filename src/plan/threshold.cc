@@ -8,7 +8,7 @@
 #include "protocol/design.h"
 #include "protocol/trials.h"
 #include "procedure/adaptive.h"
-#include "procedure/answer.h"
+#include "procedure/observer.h"
 
 namespace blurcue::plan {
 

@@ -1,45 +1,68 @@
 #pragma once
-// What a simulated observer answers to a trial, from the trial and what it shows - the one place `blurcue run`
-// (headless or in a window) and `blurcue plan` (many simulated sessions, no GL) get their simulated answers from, so
-// a plan predicts the answers a run records.
-#include <cstdint>
-#include <vector>
+// The participant's answer, typed: one Choice for every layout the code knows, with one Name (its word, as the record,
+// the export and messages spell it) and one ParseChoice (a word read back). Keys, the simulated observer, scoring, the
+// record and the plan pass Choices; the words live in answer.cc's table (a side's are protocol::Side's, the record's
+// two non-answers are store's), so a new kind of answer is a value here and a row there.
+#include <optional>
+#include <string>
+#include <string_view>
 
-#include "protocol/protocol.h"
-#include "protocol/trials.h"
-#include "procedure/observer.h"
-#include "stimulus/stimulus.h"
+#include "protocol/vocabulary.h"
 
 namespace blurcue::procedure {
 
-// The choices recorded besides the answers themselves: no answer before the deadline, and a trial not shown (a
-// procedure ended by its stop rule, a practice run after the one that met its criterion). The record's own words
-// (store::kChoiceNone, store::kChoiceSkipped; session/recording.cc checks they agree).
-inline constexpr const char* kChoiceNone = "none";
-inline constexpr const char* kChoiceSkipped = "skipped";
+// An answer to one trial, or what the record holds in its place.
+struct Choice {
+  enum class Kind {
+    kNone,      // no answer before the deadline
+    kSkipped,   // a trial not shown: a procedure ended by its stop rule, a practice run after the one that met its
+                // criterion
+    kSide,      // a side of a pair (forced choice side by side or in two intervals)
+    kCantTell,  // the pair's third key, where the protocol has one
+    kInterval,  // an odd one out's interval, 1..n
+    kYes,       // yes_no: the object looks out of place
+    kNo,
+    kRating,    // a point of a rating scale, 1..n
+    kLevel,     // an adjustment's accepted level
+  };
+  Kind kind = Kind::kNone;
+  protocol::Side side = protocol::Side::kLeft;  // kSide
+  int point = 0;                                // kInterval, kRating: 1-based
+  double level = 0;                             // kLevel
 
-// The seed of the observer of one trial: from the session seed and the trial index (splitmix64), so a resumed
-// session answers exactly as an uninterrupted one, and a plan as a run.
-uint64_t TrialSeed(uint64_t session_seed, int trial_index);
+  static Choice Of(Kind kind) { return Choice{kind}; }
+  static Choice Of(protocol::Side side) { return Choice{Kind::kSide, side}; }
+  static Choice Numbered(Kind kind, int point) { return Choice{kind, protocol::Side::kLeft, point}; }
+  static Choice Level(double level) { return Choice{Kind::kLevel, protocol::Side::kLeft, 0, level}; }
+  // An answer, not one of the record's two non-answers.
+  bool Answers() const { return kind != Kind::kNone && kind != Kind::kSkipped; }
+};
+bool operator==(const Choice& a, const Choice& b);
+inline bool operator!=(const Choice& a, const Choice& b) { return !(a == b); }
 
-// The key presses a simulated observer makes for a trial whose stimulus is `scene` (after ApplyLevel for a procedure's
-// trial): the single answer, or the adjustment's presses. The task decides the question: yes/no and rating judge the
-// one object against the scene; an odd-one-out trial names an interval; a procedure's trial or a practice run to a
-// criterion asks "which side is more blurred?"; other pairs "which fits the scene?" (with can't tell when the
-// protocol has its key). The presentation gives the arcmin per photo px the arcmin model sees.
-std::vector<KeyPress> AnswerTrial(SimulatedObserver& observer, const protocol::Protocol& protocol,
-                                  const protocol::Trial& trial, const stimulus::TrialScene& scene,
-                                  const stimulus::Presentation& presentation);
+// The choice's word: left | right (protocol::Side's), cant_tell, yes, no, an interval's or a rating point's number
+// (1..n), a level as protocol::LevelText (%g), and store::kChoiceNone, store::kChoiceSkipped.
+std::string Name(const Choice& choice);
 
-// What the observer sees of an adjustment trial: the distance, and for a picture the real picture's blur (when the
-// protocol names its camera) and each level's blur in arcmin as this presentation shows them.
-AdjustView AdjustViewOf(const protocol::Trial& trial, const stimulus::TrialScene& scene, const stimulus::Presentation& presentation);
+// The choice `text` names as a record of a task answered by `answer` (`intervals`: an odd one out, whose numbers are
+// intervals; otherwise a number is a rating point), in the exact form Name writes; none and skipped are read for
+// every task. nullopt for text that no choice of the task is named by.
+std::optional<Choice> ParseChoice(std::string_view text, protocol::TaskAnswer answer, bool intervals);
 
-// Throws Error(kInput) naming /content/real_camera when `observer` cannot answer the protocol's trials: the arcmin
-// model in a depth-matching (adjustment) block without the real photos' camera. Run and plan check before any trial.
-void CheckObserverCanAnswer(const ObserverParams& observer, const protocol::Protocol& protocol);
+// What a key press asks for: an answer, a step through an adjustment's levels, the accept of the level shown, the
+// pause (Escape), or nothing (a key the protocol does not map).
+struct Action {
+  enum class Kind { kNothing, kAnswer, kPrevious, kNext, kAccept, kPause };
+  Kind kind = Kind::kNothing;
+  Choice choice;  // kAnswer
 
-// What the observer sees of a trial's pair: its radii (photo px) and arcmin per photo px on this presentation.
-PairView ViewOf(const stimulus::TrialScene& scene, const stimulus::Presentation& presentation);
+  static Action Answer(const Choice& choice) { return Action{Kind::kAnswer, choice}; }
+  static Action Of(Kind kind) { return Action{kind, Choice{}}; }
+};
+bool operator==(const Action& a, const Action& b);
+
+// The action's word, for logs and tests: the choice's Name for an answer, the /responses field for a step or the
+// accept (previous | next | accept), pause, or "" for nothing.
+std::string Name(const Action& action);
 
 }  // namespace blurcue::procedure

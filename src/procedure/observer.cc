@@ -13,8 +13,12 @@
 #include "core/names.h"
 #include "core/typed.h"
 #include "core/stats.h"
+#include "core/seed.h"
 
 namespace blurcue::procedure {
+
+using protocol::Side;
+
 namespace {
 
 constexpr double kZ75 = 0.6744897501960817;  // Phi^-1(0.75)
@@ -199,14 +203,16 @@ KeyPress SimulatedObserver::ChooseSide(const PairView& v, bool cant_tell) {
                           : (params_.blurrier_bias * more_blurred + params_.side_bias) * sd;
   const double noise = Normal(), lapse_draw = Uniform(), lapse_pick = Uniform();
   const double rt = ResponseTimeMs(params_.rt_ms, (m_right - m_left) / sd);
+  const Choice left = Choice::Of(Side::kLeft), right = Choice::Of(Side::kRight),
+               neither = Choice::Of(Choice::Kind::kCantTell);
   if (lapse_draw < params_.lapse) {
-    static const char* kActions[] = {"left", "right", "cant_tell"};
-    const int choices = cant_tell ? 3 : 2;
-    return {kActions[std::min(choices - 1, int(lapse_pick * choices))], rt};
+    const Choice choices[] = {left, right, neither};
+    const int n = cant_tell ? 3 : 2;
+    return {Action::Answer(choices[std::min(n - 1, int(lapse_pick * n))]), rt};
   }
   const double d = (m_right - m_left) + bias + sd * noise;
   const double criterion = cant_tell ? sd / 2 : 0;
-  return {d > criterion ? "left" : d < -criterion ? "right" : "cant_tell", rt};
+  return {Action::Answer(d > criterion ? left : d < -criterion ? right : neither), rt};
 }
 
 KeyPress SimulatedObserver::ChooseBlurrier(const PairView& v) {
@@ -215,8 +221,10 @@ KeyPress SimulatedObserver::ChooseBlurrier(const PairView& v) {
   const double side = params_.model == ObserverModel::kPixel ? 0 : params_.side_bias * sd;
   const double noise = Normal(), lapse_draw = Uniform(), lapse_pick = Uniform();
   const double rt = ResponseTimeMs(params_.rt_ms, difference / sd);
-  if (lapse_draw < params_.lapse) return {lapse_pick < 0.5 ? "left" : "right", rt};
-  return {difference + side + sd * noise > 0 ? "left" : "right", rt};
+  const Side chosen = lapse_draw < params_.lapse ? (lapse_pick < 0.5 ? Side::kLeft : Side::kRight)
+                      : difference + side + sd * noise > 0 ? Side::kLeft
+                                                           : Side::kRight;
+  return {Action::Answer(Choice::Of(chosen)), rt};
 }
 
 KeyPress SimulatedObserver::ChooseOdd(const PairView& v, int intervals, int odd) {
@@ -227,7 +235,8 @@ KeyPress SimulatedObserver::ChooseOdd(const PairView& v, int intervals, int odd)
   const double lapse_draw = Uniform(), lapse_pick = Uniform();
   const double rt = ResponseTimeMs(params_.rt_ms, (odd_seen - other_seen) / CompareSd());
   const int n = int(seen.size());
-  if (lapse_draw < params_.lapse) return {std::to_string(1 + std::min(n - 1, int(lapse_pick * n))), rt};
+  auto interval = [rt](int i) { return KeyPress{Action::Answer(Choice::Numbered(Choice::Kind::kInterval, i)), rt}; };
+  if (lapse_draw < params_.lapse) return interval(1 + std::min(n - 1, int(lapse_pick * n)));
   double total = 0;
   for (double x : seen) total += x;
   int best = 0;
@@ -236,7 +245,7 @@ KeyPress SimulatedObserver::ChooseOdd(const PairView& v, int intervals, int odd)
     const double others = (total - seen[size_t(i)]) / std::max(1, n - 1);
     if (std::abs(seen[size_t(i)] - others) > farthest) farthest = std::abs(seen[size_t(i)] - others), best = i;
   }
-  return {std::to_string(best + 1), rt};
+  return interval(best + 1);
 }
 
 KeyPress SimulatedObserver::SayYesNo(const PairView& v) {
@@ -244,8 +253,9 @@ KeyPress SimulatedObserver::SayYesNo(const PairView& v) {
   const double evidence = mismatch + sd * Normal();
   const double lapse_draw = Uniform(), lapse_pick = Uniform();
   const double rt = ResponseTimeMs(params_.rt_ms, mismatch / sd);
-  if (lapse_draw < params_.lapse) return {lapse_pick < 0.5 ? "yes" : "no", rt};
-  return {evidence > sd / 2 ? "yes" : "no", rt};
+  const Choice yes = Choice::Of(Choice::Kind::kYes), no = Choice::Of(Choice::Kind::kNo);
+  if (lapse_draw < params_.lapse) return {Action::Answer(lapse_pick < 0.5 ? yes : no), rt};
+  return {Action::Answer(evidence > sd / 2 ? yes : no), rt};
 }
 
 KeyPress SimulatedObserver::Rate(const PairView& v, int points) {
@@ -254,10 +264,11 @@ KeyPress SimulatedObserver::Rate(const PairView& v, int points) {
   const double lapse_draw = Uniform(), lapse_pick = Uniform();
   const double rt = ResponseTimeMs(params_.rt_ms, mismatch / sd);
   const int n = std::max(points, 1);
-  if (lapse_draw < params_.lapse) return {std::to_string(1 + std::min(n - 1, int(lapse_pick * n))), rt};
+  auto point = [rt](int i) { return KeyPress{Action::Answer(Choice::Numbered(Choice::Kind::kRating, i)), rt}; };
+  if (lapse_draw < params_.lapse) return point(1 + std::min(n - 1, int(lapse_pick * n)));
   int rating = 1;
   for (int j = 1; j < n; ++j) rating += evidence > j * sd / 2;
-  return {std::to_string(rating), rt};
+  return point(rating);
 }
 
 double SimulatedObserver::TargetCutoff(double distance_m) const {
@@ -294,7 +305,7 @@ std::vector<KeyPress> SimulatedObserver::Adjust(const std::vector<double>& level
     const double miss = look(at);
     if (miss < best_miss) best = at, best_miss = miss;
     if (miss <= accept_within || seen == n) break;
-    presses.push_back({"next", first + ResponseTimeMs(params_.step_ms)});
+    presses.push_back({Action::Of(Action::Kind::kNext), first + ResponseTimeMs(params_.step_ms)});
     first = 0;
     at = (at + 1) % n;
   }
@@ -302,9 +313,62 @@ std::vector<KeyPress> SimulatedObserver::Adjust(const std::vector<double>& level
   const int forward = ((best - at) % n + n) % n, backward = n - forward;
   const bool go_next = forward <= backward;
   for (int k = 0, steps = go_next ? forward : backward; k < steps; ++k)
-    presses.push_back({go_next ? "next" : "previous", first + ResponseTimeMs(params_.step_ms)}), first = 0;
-  presses.push_back({"accept", first + ResponseTimeMs(params_.step_ms)});
+    presses.push_back({Action::Of(go_next ? Action::Kind::kNext : Action::Kind::kPrevious),
+                       first + ResponseTimeMs(params_.step_ms)}),
+        first = 0;
+  presses.push_back({Action::Of(Action::Kind::kAccept), first + ResponseTimeMs(params_.step_ms)});
   return presses;
+}
+
+uint64_t TrialSeed(uint64_t seed, int index) { return DeriveSeed(seed, static_cast<uint64_t>(index)); }
+
+PairView ViewOf(const stimulus::TrialScene& scene, const stimulus::Presentation& presentation) {
+  // One photo px's angle at the centre of the screen (Presentation::Arcmin): the radii are a few px, where the
+  // exact 2 atan(s / 2d) and the straight line agree to far better than 1e-6.
+  return {scene.r_left_px, scene.r_right_px, scene.r_scene_px, presentation.Arcmin(1)};
+}
+
+AdjustView AdjustViewOf(const protocol::Trial& trial, const stimulus::TrialScene& scene,
+                        const stimulus::Presentation& presentation) {
+  AdjustView view;
+  view.distance_m = scene.distance_m;
+  if (scene.content != protocol::ContentType::kPicture) return view;
+  if (presentation.real_frame_px_per_px > 0) view.r_real_arcmin = presentation.RealArcmin(scene.r_scene_px);
+  for (double level : trial.adjust_levels) view.level_r_arcmin.push_back(presentation.LevelArcmin(level));
+  return view;
+}
+
+void CheckObserverCanAnswer(const ObserverParams& observer, const protocol::Protocol& protocol) {
+  if (observer.model != ObserverModel::kArcmin || protocol.content.type != protocol::ContentType::kPicture ||
+      protocol.content.real_camera)
+    return;
+  for (const auto& block : protocol.blocks)
+    if (protocol::TraitsOf(block.task).answer == protocol::TaskAnswer::kLevel)
+      throw InputError(protocol.file.string() + ": /content/real_camera",
+                       "is needed by the simulated observer (model=arcmin), which sets the picture to the real "
+                       "picture's blur in visual angle: name the camera and focus of the real photos, or use "
+                       "--observer sim:model=pixel (a cut-off per distance)");
+}
+
+std::vector<KeyPress> AnswerTrial(SimulatedObserver& observer, const protocol::Protocol& protocol,
+                                  const protocol::Trial& trial, const stimulus::TrialScene& scene,
+                                  const stimulus::Presentation& presentation) {
+  using protocol::TaskAnswer;
+  switch (protocol::TraitsOf(trial.task).answer) {
+    case TaskAnswer::kLevel:
+      return observer.Adjust(trial.adjust_levels, trial.start_index, AdjustViewOf(trial, scene, presentation));
+    case TaskAnswer::kYesNo: return {observer.SayYesNo(ViewOf(scene, presentation))};
+    case TaskAnswer::kRatingPoint:
+      return {observer.Rate(ViewOf(scene, presentation), int(protocol.responses.rating.size()))};
+    case TaskAnswer::kSide: break;
+  }
+  const PairView view = ViewOf(scene, presentation);
+  const KeyPress press =
+      scene.intervals > 2 ? observer.ChooseOdd(view, scene.intervals, protocol::TestInterval(trial))
+      // A procedure, or practice scored by a criterion: "which side is more blurred?"
+      : trial.cell >= 0 || trial.round >= 0 ? observer.ChooseBlurrier(view)
+                                            : observer.ChooseSide(view, !protocol.responses.cant_tell.empty());
+  return {press};
 }
 
 }  // namespace blurcue::procedure

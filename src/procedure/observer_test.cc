@@ -53,9 +53,9 @@ TEST(SimulatedObserver, SameSeedSameAnswers) {
   for (int i = 0; i < 200; ++i) {
     const PairView v{1.0 + 0.01 * i, 1.5, 1.2};
     const KeyPress x = a.ChooseSide(v), y = b.ChooseSide(v), z = c.ChooseSide(v);
-    EXPECT_EQ(x.action, y.action);
+    EXPECT_EQ(Name(x.action), Name(y.action));
     EXPECT_DOUBLE_EQ(x.after_ms, y.after_ms);
-    differ += x.action != z.action;
+    differ += Name(x.action) != Name(z.action);
   }
   EXPECT_GT(differ, 0) << "another seed should answer differently somewhere";
 }
@@ -72,7 +72,7 @@ TEST(SimulatedObserver, ChoiceRatesMatchTheModel) {
     const PairView v{2.0, 2.0 + delta, 2.0};
     std::map<std::string, int> n;
     const int draws = 6000;
-    for (int i = 0; i < draws; ++i) ++n[o.ChooseSide(v).action];
+    for (int i = 0; i < draws; ++i) ++n[Name(o.ChooseSide(v).action)];
     const double c = p.jnd_px / 2;
     const double left = 1 - NormalCdf((c - delta) / p.jnd_px), right = NormalCdf((-c - delta) / p.jnd_px);
     const double se = std::sqrt(0.25 / draws);
@@ -93,11 +93,11 @@ TEST(SimulatedObserver, YesNoAndRatingRatesMatchTheModel) {
   for (double m : {0.0, 0.4, 1.2}) {
     const PairView v{2.0 + m, 0, 2.0};
     int yes = 0, lowest = 0, highest = 0;
-    for (int i = 0; i < draws; ++i) yes += o.SayYesNo(v).action == "yes";
+    for (int i = 0; i < draws; ++i) yes += Name(o.SayYesNo(v).action) == "yes";
     for (int i = 0; i < draws; ++i) {
       const KeyPress k = o.Rate(v, 5);
-      lowest += k.action == "1";
-      highest += k.action == "5";
+      lowest += Name(k.action) == "1";
+      highest += Name(k.action) == "5";
     }
     EXPECT_NEAR(yes / double(draws), 1 - NormalCdf((p.jnd_px / 2 - m) / p.jnd_px), 4 * se) << "m " << m;
     EXPECT_NEAR(lowest / double(draws), NormalCdf((p.jnd_px / 2 - m) / p.jnd_px), 4 * se) << "m " << m;
@@ -120,7 +120,7 @@ TEST(SimulatedObserver, OddOneOutRatesMatchAnIndependentSimulation) {
   for (double delta : {0.0, 0.5, 1.5}) {
     const PairView v{1.0, 1.0 + delta, 1.0};
     int named[4] = {0, 0, 0, 0}, found = 0;
-    for (int i = 0; i < draws; ++i) ++named[std::stoi(o.ChooseOdd(v, n, 2).action)];
+    for (int i = 0; i < draws; ++i) ++named[std::stoi(Name(o.ChooseOdd(v, n, 2).action))];
     for (int i = 0; i < draws; ++i) {
       // The rule by hand: the interval farthest from the mean of the other two.
       const double x[3] = {1.0 + noise(rng), 1.0 + delta + noise(rng), 1.0 + noise(rng)};
@@ -147,15 +147,15 @@ TEST(SimulatedObserver, LapsesAnswerAtRandomAndBiasFavoursTheBlurredSide) {
   const PairView clear{2.0, 4.0, 2.0};  // left is right, by far
   int wrong = 0;
   const int draws = 6000;
-  for (int i = 0; i < draws; ++i) wrong += o.ChooseSide(clear).action != "left";
+  for (int i = 0; i < draws; ++i) wrong += Name(o.ChooseSide(clear).action) != "left";
   EXPECT_NEAR(wrong / double(draws), p.lapse * 2 / 3, 0.02);
 
   p.lapse = 0;
   p.bias_px = 0.5;
   SimulatedObserver biased(p, 9);
   // Equal mismatch on both sides (1 px too little vs 1 px too much): the bias decides for the blurred side.
-  EXPECT_EQ(biased.ChooseSide({1.0, 3.0, 2.0}).action, "right");
-  EXPECT_EQ(biased.ChooseSide({3.0, 1.0, 2.0}).action, "left");
+  EXPECT_EQ(Name(biased.ChooseSide({1.0, 3.0, 2.0}).action), "right");
+  EXPECT_EQ(Name(biased.ChooseSide({3.0, 1.0, 2.0}).action), "left");
 }
 
 // Steps through cyclic levels as the runner does and returns the accepted level.
@@ -172,9 +172,9 @@ double Accepted(const std::vector<double>& levels, int start, const std::vector<
   int at = start;
   const int n = static_cast<int>(levels.size());
   for (const KeyPress& k : presses) {
-    if (k.action == "next") at = (at + 1) % n;
-    if (k.action == "previous") at = (at + n - 1) % n;
-    if (k.action == "accept") return levels[size_t(at)];
+    if (Name(k.action) == "next") at = (at + 1) % n;
+    if (Name(k.action) == "previous") at = (at + n - 1) % n;
+    if (Name(k.action) == "accept") return levels[size_t(at)];
   }
   return NAN;
 }
@@ -190,7 +190,7 @@ TEST(SimulatedObserver, PixelAdjustmentAcceptsTheLevelNearestItsTarget) {
       SimulatedObserver o(p, 3);
       const auto presses = o.Adjust(levels, start, AdjustAt(distance));
       ASSERT_FALSE(presses.empty());
-      EXPECT_EQ(presses.back().action, "accept");
+      EXPECT_EQ(Name(presses.back().action), "accept");
       const double target = p.cutoff_1m * std::pow(distance, p.slope);
       const double best = *std::min_element(levels.begin(), levels.end(), [&](double a, double b) {
         return std::abs(std::log(a / target)) < std::abs(std::log(b / target));
@@ -316,7 +316,7 @@ TEST(ArcminObserver, ChoiceRatesMatchTheAnalyticProbability) {
   for (const auto& [a, b] : {std::pair{1.0, 1.0}, {1.0, 1.5}, {2.0, 3.0}, {6.0, 7.0}, {0.2, 2.0}}) {
     const PairView v{b, a, 0, arcmin_per_px};  // left the more blurred (or equal)
     int left = 0;
-    for (int i = 0; i < draws; ++i) left += o.ChooseBlurrier(v).action == "left";
+    for (int i = 0; i < draws; ++i) left += Name(o.ChooseBlurrier(v).action) == "left";
     const double truth = Correct2afc(b * arcmin_per_px / 2, a * arcmin_per_px / 2, p.intrinsic_arcmin, p.weber, 2);
     EXPECT_NEAR(left / double(draws), truth * (1 - p.lapse) + p.lapse / 2, 4 * se) << a << " vs " << b << " px";
   }
@@ -336,7 +336,7 @@ TEST(ArcminObserver, MismatchChoiceRatesMatchTheModel) {
   for (double off : {0.0, 0.6, 2.0}) {
     const PairView v{2.0, 2.0 + off, 2.0, k};  // left matches the scene
     std::map<std::string, int> n;
-    for (int i = 0; i < draws; ++i) ++n[o.ChooseSide(v).action];
+    for (int i = 0; i < draws; ++i) ++n[Name(o.ChooseSide(v).action)];
     const double delta = std::abs(ln_e(2.0 + off) - ln_e(2.0));
     EXPECT_NEAR(n["left"] / double(draws), 1 - NormalCdf((sd / 2 - delta) / sd), 4 * se) << off;
     EXPECT_NEAR(n["right"] / double(draws), NormalCdf((-sd / 2 - delta) / sd), 4 * se) << off;
@@ -351,7 +351,7 @@ TEST(ArcminObserver, AnswersDependOnVisualAngleNotPixels) {
   SimulatedObserver a(p, 5), b(p, 5);
   for (int i = 0; i < 300; ++i) {
     const KeyPress x = a.ChooseBlurrier({4.0, 3.0, 0, 0.5}), y = b.ChooseBlurrier({2.0, 1.5, 0, 1.0});
-    EXPECT_EQ(x.action, y.action);
+    EXPECT_EQ(Name(x.action), Name(y.action));
     EXPECT_NEAR(x.after_ms, y.after_ms, 1e-9);
   }
   // Near the intrinsic blur a third of the angle sinks the difference into it (66 % -> 52 %).
@@ -366,7 +366,7 @@ TEST(ArcminObserver, SideBiasFavoursTheLeftByItsNoiseSds) {
   SimulatedObserver o(p, 3);
   const int draws = 8000;
   int left = 0;
-  for (int i = 0; i < draws; ++i) left += o.ChooseBlurrier({2.0, 2.0, 0, 1.0}).action == "left";
+  for (int i = 0; i < draws; ++i) left += Name(o.ChooseBlurrier({2.0, 2.0, 0, 1.0}).action) == "left";
   EXPECT_NEAR(left / double(draws), NormalCdf(1), 4 * std::sqrt(0.25 / draws));  // equal blurs: bias over unit noise
 }
 
@@ -482,7 +482,7 @@ TEST(SimulatedObserver, ArcminAdjustmentTakesTheLevelThatLooksClosest) {
       SimulatedObserver o(p, seed);
       const int start = int(seed % 22);
       const auto presses = o.Adjust(levels, start, AdjustAt(1.0, real, level_r));
-      ASSERT_EQ(presses.back().action, "accept");
+      ASSERT_EQ(Name(presses.back().action), "accept");
       ASSERT_GE(presses.size(), levels.size());  // every level seen before the choice
       const auto chosen = std::find(levels.begin(), levels.end(), Accepted(levels, start, presses));
       share[size_t(chosen - levels.begin())] += 1.0 / n;
@@ -509,7 +509,7 @@ TEST(SimulatedObserver, PixelModelAnswersAsTheObserverBeforeIt) {
   std::string out;
   char text[64];
   auto add = [&](const KeyPress& k) {
-    std::snprintf(text, sizeof text, "%s@%.6f;", k.action.c_str(), k.after_ms);
+    std::snprintf(text, sizeof text, "%s@%.6f;", Name(k.action).c_str(), k.after_ms);
     out += text;
   };
   for (uint64_t seed = 1; seed <= 40; ++seed) {

@@ -89,7 +89,7 @@ std::vector<std::string> RecordedNameProblems(const protocol::Protocol& protocol
       for (size_t i = 0; i < f.levels.size(); ++i) {
         for (const auto& [key, value] : f.levels[i].fields) {
           // The sides are recorded as such.
-          if (key == "left" || key == "right" || key == "object" || !keys.insert(key).second) continue;
+          if (protocol::ParseWord<protocol::Side>(key) || key == "object" || !keys.insert(key).second) continue;
           if (table)
             add({key, "the column " + key + " of the conditions table " + (path.empty() ? "" : path), at}, f.name);
           else

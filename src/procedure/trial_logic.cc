@@ -20,11 +20,14 @@ double StimulusEndS(const protocol::Timing& timing, const TrialScene& scene) {
   return n > 0 ? (n * timing.interval_ms + (n - 1) * timing.isi_ms) / 1000 : scene.MotionS();
 }
 
-std::optional<bool> CorrectOf(const protocol::Trial& trial, const TrialScene& scene, const std::string& choice) {
-  if (!trial.test_side.empty()) return choice == trial.test_side;
+std::optional<bool> CorrectOf(const protocol::Trial& trial, const TrialScene& scene, const Choice& choice) {
+  using protocol::Side;
+  if (const std::optional<Side> side = protocol::TestSide(trial)) return choice == Choice::Of(*side);
+  if (const int odd = protocol::TestInterval(trial); odd > 0)
+    return choice == Choice::Numbered(Choice::Kind::kInterval, odd);
   if (!protocol::TraitsOf(trial.task).scored || scene.content == protocol::ContentType::kPicture) return std::nullopt;
-  if (std::abs(scene.r_left_px - scene.r_right_px) <= 1e-9) return choice == "cant_tell";
-  return choice == (scene.r_left_px > scene.r_right_px ? "left" : "right");
+  if (std::abs(scene.r_left_px - scene.r_right_px) <= 1e-9) return choice == Choice::Of(Choice::Kind::kCantTell);
+  return choice == Choice::Of(scene.r_left_px > scene.r_right_px ? Side::kLeft : Side::kRight);
 }
 
 PracticeRounds::PracticeRounds(const protocol::Protocol& protocol, const std::vector<protocol::Trial>& trials)
@@ -92,7 +95,7 @@ TrialScene SessionLogic::SceneOf(const protocol::Trial& trial, double* level) {
 }
 
 Scored SessionLogic::Answer(const protocol::Trial& trial, const TrialScene& shown, double level,
-                            const std::string& choice) {
+                            const Choice& choice) {
   Scored s;
   // Scored where the design defines a correct answer: a procedure's, an odd one out's, a practice run to a
   // criterion's ("which fits the scene better?" has none, whatever the radii).
@@ -116,22 +119,23 @@ std::vector<KeyPress> ObserverPresses(const ObserverParams& params, uint64_t see
   return AnswerTrial(observer, protocol, trial, scene, presentation);
 }
 
-int StepLevel(int level, const std::string& action, int levels) {
+int StepLevel(int level, Action::Kind action, int levels) {
   if (levels <= 0) return level;
-  if (action == "next") return (level + 1) % levels;
-  if (action == "previous") return (level + levels - 1) % levels;
+  if (action == Action::Kind::kNext) return (level + 1) % levels;
+  if (action == Action::Kind::kPrevious) return (level + levels - 1) % levels;
   return level;
 }
 
-std::pair<std::string, double> HeadlessAnswer(const protocol::Protocol& protocol, const protocol::Trial& trial,
+std::pair<Choice, double> HeadlessAnswer(const protocol::Protocol& protocol, const protocol::Trial& trial,
                                               const TrialScene& scene, const std::vector<KeyPress>& presses) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
+  const Choice none = Choice::Of(Choice::Kind::kNone);
   if (protocol::TraitsOf(trial.task).answer != protocol::TaskAnswer::kLevel) {
-    if (presses.empty()) return {kChoiceNone, nan};
+    if (presses.empty()) return {none, nan};
     const protocol::Timing& timing = protocol::TimingOf(protocol, trial);
     const double t_ms = (StimulusEndS(timing, scene) + presses.front().after_ms / 1000) * 1000;
-    if (timing.deadline_ms > 0 && t_ms >= timing.deadline_ms) return {kChoiceNone, nan};
-    return {presses.front().action, t_ms};
+    if (timing.deadline_ms > 0 && t_ms >= timing.deadline_ms) return {none, nan};
+    return {presses.front().action.choice, t_ms};
   }
   // The adjustment's steps through the levels (cyclic), as the runner applies them, to the one accepted.
   const int levels = static_cast<int>(trial.adjust_levels.size());
@@ -140,13 +144,14 @@ std::pair<std::string, double> HeadlessAnswer(const protocol::Protocol& protocol
   for (const KeyPress& press : presses) {
     t_ms += press.after_ms;
     if (levels == 0) break;
-    if (press.action == "next" || press.action == "previous") {
-      level = StepLevel(level, press.action, levels);
-    } else if (press.action == "accept") {
-      return {protocol::LevelText(trial.adjust_levels[size_t(level)]), t_ms};
+    const Action::Kind kind = press.action.kind;
+    if (kind == Action::Kind::kNext || kind == Action::Kind::kPrevious) {
+      level = StepLevel(level, kind, levels);
+    } else if (kind == Action::Kind::kAccept) {
+      return {Choice::Level(trial.adjust_levels[size_t(level)]), t_ms};
     }
   }
-  return {kChoiceNone, nan};
+  return {none, nan};
 }
 
 }  // namespace blurcue::procedure

@@ -29,7 +29,7 @@ double StimulusEndS(const protocol::Timing& timing, const stimulus::TrialScene& 
 // Whether `choice` answered `trial` correctly, where a trial has a correct answer: a procedure's test side or an odd
 // one out's interval; for a practice pair, the side showing the larger radius (equal radii: can't tell). Empty
 // where nothing is correct (yes/no, rating, adjustment).
-std::optional<bool> CorrectOf(const protocol::Trial& trial, const stimulus::TrialScene& scene, const std::string& choice);
+std::optional<bool> CorrectOf(const protocol::Trial& trial, const stimulus::TrialScene& scene, const Choice& choice);
 
 // Practice blocks run until a criterion: per block, per run of its design, the answers and the correct ones; a run
 // is over when all its trials are answered. A pure function of the answers, so a resumed session decides the same.
@@ -74,9 +74,9 @@ class SessionLogic {
   // The scene `trial` shows now: its planned scene, with a procedure's level from the answers so far applied and
   // planned on the screen (`*level`: that level, 0 for a trial without one).
   stimulus::TrialScene SceneOf(const protocol::Trial& trial, double* level);
-  // Scores `choice` (what the record stores: "left", "3", kChoiceNone, ...) to `trial` shown as `shown` at `level`,
-  // and feeds it to the trial's procedure and practice run.
-  Scored Answer(const protocol::Trial& trial, const stimulus::TrialScene& shown, double level, const std::string& choice);
+  // Scores `choice` (an answer, or none: a deadline passed) to `trial` shown as `shown` at `level`, and feeds it to
+  // the trial's procedure and practice run.
+  Scored Answer(const protocol::Trial& trial, const stimulus::TrialScene& shown, double level, const Choice& choice);
 
  private:
   const PreparedSession& prepared_;
@@ -94,13 +94,12 @@ std::vector<KeyPress> ObserverPresses(const ObserverParams& params, uint64_t see
                                       const protocol::Trial& trial, const stimulus::TrialScene& scene,
                                       const stimulus::Presentation& presentation);
 
-// An adjustment's level after a "next" or "previous" key (any other action leaves it): cyclic over `levels`.
-int StepLevel(int level, const std::string& action, int levels);
+// An adjustment's level after a next or previous step (any other action leaves it): cyclic over `levels`.
+int StepLevel(int level, Action::Kind action, int levels);
 
-// What a headless session records for those presses (the answering action, the adjustment's accepted level as %g),
-// and its response time in ms from onset; kChoiceNone (response time NaN) when the answer comes at or after the
-// protocol's deadline.
-std::pair<std::string, double> HeadlessAnswer(const protocol::Protocol& protocol, const protocol::Trial& trial,
+// What a headless session records for those presses (the answer pressed, the adjustment's accepted level), and its
+// response time in ms from onset; none (response time NaN) when the answer comes at or after the protocol's deadline.
+std::pair<Choice, double> HeadlessAnswer(const protocol::Protocol& protocol, const protocol::Trial& trial,
                                               const stimulus::TrialScene& scene, const std::vector<KeyPress>& presses);
 
 }  // namespace blurcue::procedure

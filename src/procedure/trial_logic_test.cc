@@ -15,12 +15,21 @@ namespace {
 
 using stimulus::TrialScene;
 
+// A choice by its record word, as a trial answered by `answer` reads it (a number: a rating point).
+Choice Word(const std::string& text, protocol::TaskAnswer answer = protocol::TaskAnswer::kSide) {
+  return ParseChoice(text, answer, false).value();
+}
+KeyPress Press(const std::string& word, double after_ms) {
+  return {Action::Answer(Word(word)), after_ms};
+}
+KeyPress Step(Action::Kind kind, double after_ms) { return {Action::Of(kind), after_ms}; }
+
 TEST(StepLevel, StepsThroughTheLevelsCyclicallyAndIgnoresOtherActions) {
-  EXPECT_EQ(StepLevel(1, "next", 3), 2);
-  EXPECT_EQ(StepLevel(2, "next", 3), 0);
-  EXPECT_EQ(StepLevel(0, "previous", 3), 2);
-  EXPECT_EQ(StepLevel(1, "accept", 3), 1);
-  EXPECT_EQ(StepLevel(4, "next", 0), 4);  // no levels: nothing to step through
+  EXPECT_EQ(StepLevel(1, Action::Kind::kNext, 3), 2);
+  EXPECT_EQ(StepLevel(2, Action::Kind::kNext, 3), 0);
+  EXPECT_EQ(StepLevel(0, Action::Kind::kPrevious, 3), 2);
+  EXPECT_EQ(StepLevel(1, Action::Kind::kAccept, 3), 1);
+  EXPECT_EQ(StepLevel(4, Action::Kind::kNext, 0), 4);  // no levels: nothing to step through
 }
 
 TEST(StimulusEndS, IsTheEndOfTheMotionOrOfTheLastInterval) {
@@ -42,23 +51,28 @@ TEST(CorrectOf, APairIsAnsweredRightByTheSideWithTheLargerRadiusOrCantTellWhenEq
   TrialScene scene;
   scene.content = protocol::ContentType::kGrid;
   scene.r_left_px = 2, scene.r_right_px = 1;
-  EXPECT_EQ(CorrectOf(trial, scene, "left"), std::optional<bool>(true));
-  EXPECT_EQ(CorrectOf(trial, scene, "right"), std::optional<bool>(false));
-  EXPECT_EQ(CorrectOf(trial, scene, "cant_tell"), std::optional<bool>(false));
+  EXPECT_EQ(CorrectOf(trial, scene, Word("left")), std::optional<bool>(true));
+  EXPECT_EQ(CorrectOf(trial, scene, Word("right")), std::optional<bool>(false));
+  EXPECT_EQ(CorrectOf(trial, scene, Word("cant_tell")), std::optional<bool>(false));
   scene.r_right_px = 2;
-  EXPECT_EQ(CorrectOf(trial, scene, "cant_tell"), std::optional<bool>(true));
-  EXPECT_EQ(CorrectOf(trial, scene, "left"), std::optional<bool>(false));
+  EXPECT_EQ(CorrectOf(trial, scene, Word("cant_tell")), std::optional<bool>(true));
+  EXPECT_EQ(CorrectOf(trial, scene, Word("left")), std::optional<bool>(false));
   // A procedure's trial: its test side, whatever the radii.
   trial.test_side = "right";
   scene.r_left_px = 5;
-  EXPECT_EQ(CorrectOf(trial, scene, "right"), std::optional<bool>(true));
+  EXPECT_EQ(CorrectOf(trial, scene, Word("right")), std::optional<bool>(true));
+  EXPECT_EQ(CorrectOf(trial, scene, Word("left")), std::optional<bool>(false));
+  // An odd one out's: its interval.
+  trial.test_side = "3";
+  EXPECT_EQ(CorrectOf(trial, scene, *ParseChoice("3", protocol::TaskAnswer::kSide, true)), std::optional<bool>(true));
+  EXPECT_EQ(CorrectOf(trial, scene, *ParseChoice("2", protocol::TaskAnswer::kSide, true)), std::optional<bool>(false));
   // Nothing is correct in a yes/no trial without a test side, nor in a picture.
   trial.test_side.clear();
   trial.task = protocol::Task::kYesNo;
-  EXPECT_FALSE(CorrectOf(trial, scene, "yes").has_value());
+  EXPECT_FALSE(CorrectOf(trial, scene, Word("yes", protocol::TaskAnswer::kYesNo)).has_value());
   trial.task = protocol::Task::kForcedChoice;
   scene.content = protocol::ContentType::kPicture;
-  EXPECT_FALSE(CorrectOf(trial, scene, "left").has_value());
+  EXPECT_FALSE(CorrectOf(trial, scene, Word("left")).has_value());
 }
 
 TEST(HeadlessAnswer, AnAnswerAtOrAfterTheDeadlineIsNoAnswer) {
@@ -68,13 +82,13 @@ TEST(HeadlessAnswer, AnAnswerAtOrAfterTheDeadlineIsNoAnswer) {
   TrialScene scene;
   scene.from_y_mm = 0, scene.to_y_mm = 10, scene.speed_mm_s = 10;  // 1 s of motion, watched to its end
   p.timing.deadline_ms = 1500;
-  const auto early = HeadlessAnswer(p, trial, scene, {{"left", 400}});
-  EXPECT_EQ(early.first, "left");
+  const auto early = HeadlessAnswer(p, trial, scene, {Press("left", 400)});
+  EXPECT_EQ(Name(early.first), "left");
   EXPECT_DOUBLE_EQ(early.second, 1400);
-  const auto late = HeadlessAnswer(p, trial, scene, {{"left", 500}});
-  EXPECT_EQ(late.first, kChoiceNone);
+  const auto late = HeadlessAnswer(p, trial, scene, {Press("left", 500)});
+  EXPECT_EQ(Name(late.first), "none");
   EXPECT_TRUE(std::isnan(late.second));
-  EXPECT_EQ(HeadlessAnswer(p, trial, scene, {}).first, kChoiceNone);
+  EXPECT_EQ(HeadlessAnswer(p, trial, scene, {}).first.kind, Choice::Kind::kNone);
 }
 
 TEST(HeadlessAnswer, AnAdjustmentAcceptsTheLevelItsStepsReached) {
@@ -86,10 +100,12 @@ TEST(HeadlessAnswer, AnAdjustmentAcceptsTheLevelItsStepsReached) {
   TrialScene scene;
   // previous from 10 wraps to 40, next to 10 again, next to 20: accepted after 100 + 200 + 300 + 400 ms.
   const auto answer =
-      HeadlessAnswer(p, trial, scene, {{"previous", 100}, {"next", 200}, {"next", 300}, {"accept", 400}});
-  EXPECT_EQ(answer.first, "20");
+      HeadlessAnswer(p, trial, scene, {Step(Action::Kind::kPrevious, 100), Step(Action::Kind::kNext, 200),
+                                       Step(Action::Kind::kNext, 300), Step(Action::Kind::kAccept, 400)});
+  EXPECT_EQ(Name(answer.first), "20");
   EXPECT_DOUBLE_EQ(answer.second, 1000);
-  EXPECT_EQ(HeadlessAnswer(p, trial, scene, {{"next", 100}}).first, kChoiceNone);  // never accepted
+  EXPECT_EQ(HeadlessAnswer(p, trial, scene, {Step(Action::Kind::kNext, 100)}).first.kind,
+            Choice::Kind::kNone);  // never accepted
 }
 
 // A study of grid cards on the thesis's view, prepared without reading a file (PrepareStudy's part given by hand).

@@ -7,7 +7,7 @@
 #include <map>
 
 #include "procedure/adaptive.h"
-#include "procedure/answer.h"
+#include "procedure/observer.h"
 
 namespace blurcue::procedure {
 

@@ -98,7 +98,7 @@ std::vector<DesignColumn> DescribeDesign(const Protocol& protocol) {
         if (!level.object) add(factor.name, cell).Add(level.value);
         else if (factor.name != "row") add(factor.name, cell).AddName(LevelName(level));
         for (const auto& [key, value] : level.fields)
-          if (key != "left" && key != "right" && key != "object" && key != factor.name) add(key, cell).Add(value);
+          if (!ParseWord<Side>(key) && key != "object" && key != factor.name) add(key, cell).Add(value);
       }
     }
   std::vector<DesignColumn> columns;

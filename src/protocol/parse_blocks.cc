@@ -53,7 +53,7 @@ std::optional<Procedure> Parser::ParseProcedure(const Json& v, const std::string
   const double hi = relative ? 20 : 600;
   const std::string unit = relative ? "(times the reference)" : "arcmin";
   if (const Json* r = Field(v, "reference", ptr, true)) {
-    CheckLevelValue("left", *r, ptr + "/reference");
+    CheckLevelValue(ToString(Side::kLeft), *r, ptr + "/reference");
     if (IsBlurSource(*r)) pr.reference = BlurSpecOf(*r);
   }
   if (auto n = Int(v, "trials", ptr, true, 1, 1000, "trials per crossing")) pr.trials = *n;
@@ -122,7 +122,7 @@ std::optional<Block::Sides> Parser::ParseSides(const Json& v, const std::string&
     return IsBlurSource(source) ? std::optional<BlurSpec>(BlurSpecOf(source)) : std::nullopt;
   };
   if (!v.is_object()) {
-    Object(v, ptr, {"left", "right", "object"});
+    Object(v, ptr, {ToString(Side::kLeft), ToString(Side::kRight), "object"});
     return std::nullopt;
   }
   Block::Sides sides;
@@ -135,9 +135,11 @@ std::optional<Block::Sides> Parser::ParseSides(const Json& v, const std::string&
     }
     return sides;
   }
-  if (!Object(v, ptr, {"left", "right", "object"})) return sides;
-  if (const Json* s = Field(v, "left", ptr, true)) CheckLevelValue("left", *s, ptr + "/left"), sides.left = typed(*s);
-  if (const Json* s = Field(v, "right", ptr, true)) CheckLevelValue("right", *s, ptr + "/right"), sides.right = typed(*s);
+  const std::string left = ToString(Side::kLeft), right = ToString(Side::kRight);
+  if (!Object(v, ptr, {left, right, "object"})) return sides;
+  if (const Json* s = Field(v, left, ptr, true)) CheckLevelValue(left, *s, ptr + "/" + left), sides.left = typed(*s);
+  if (const Json* s = Field(v, right, ptr, true))
+    CheckLevelValue(right, *s, ptr + "/" + right), sides.right = typed(*s);
   return sides;
 }
 
@@ -247,7 +249,7 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
   // What is shown left and right must be known for a comparison, and for any left/right counterbalancing.
   bool factor_sides = false;
   for (const auto& f : b->factors)
-    for (const auto& level : f.levels) factor_sides = factor_sides || level.Field("left") || level.Field("object");
+    for (const auto& level : f.levels) factor_sides |= level.Field(ToString(Side::kLeft)) || level.Field("object");
   const std::string where = ptr.empty() ? "/" : ptr;
   if (factor_sides && sides.holder)
     Problem(sides.ptr + "/sides", "is given but a factor's levels already carry the sides (left and right, or object)",

@@ -60,7 +60,7 @@ void Parser::CheckLevelValue(const std::string& name, const Json& v, const std::
   else if (name == "distance_m") number_in(0.1, 100, "m", "a distance");
   // Cycles per picture width; 0 shows the picture unfiltered.
   else if (name == "cutoff") number_in(0, 1000, "cycles per picture width", "a cut-off");
-  else if (name == "left" || name == "right" || name == "object") {
+  else if (ParseWord<Side>(name) || name == "object") {
     if (!IsBlurSource(v)) {
       std::string words;
       for (const std::string& word : BlurSourceWords()) words += word + ", ";
@@ -86,7 +86,7 @@ namespace {
 
 // A level as typed once it has been checked. A value the parser refused (an object, a list, true or null, inside an
 // object level or as the level) is kept as its JSON text, so the design's counts stay as written and the refusal
-// names its field: the protocol is refused anyway. (A pattern's "right": true used to stop validate with "a level
+// names its field: the protocol is refused anyway. (A pattern's right: true used to stop validate with "a level
 // must be a number or a string, got true", naming neither the file nor the field.)
 Json Kept(const Json& value) { return value.is_string() || value.is_number() ? value : Json(value.dump()); }
 
@@ -159,8 +159,9 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
             Problem(lp + "/" + Escape(key), "must be a number or a string", value);
           else CheckLevelValue(key, value, lp + "/" + Escape(key));
         }
-        const bool l = level.contains("left"), r = level.contains("right");
-        if (l != r) Problem(lp, std::string("has \"") + (l ? "left" : "right") + "\" but no \"" + (l ? "right" : "left") + "\"", level);
+        const bool l = level.contains(ToString(Side::kLeft)), r = level.contains(ToString(Side::kRight));
+        const Side has = l ? Side::kLeft : Side::kRight;
+        if (l != r) Problem(lp, "has \"" + ToString(has) + "\" but no \"" + ToString(Other(has)) + "\"", level);
         if (level.contains("object") && (l || r))
           Problem(lp, "has an \"object\" (layout single) and left/right (a pair): give one or the other", level);
         if ((l && r) || level.contains("object")) sides = true;

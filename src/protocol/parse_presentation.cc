@@ -12,7 +12,7 @@ namespace blurcue::protocol::detail {
 
 namespace {
 // Two names that differ only in ASCII letter case: one name, since a case slip is answered with the nearest
-// (--info handedness=Left: did you mean left?) - groups "a" and "A", or choices "left" and "Left", used to pass.
+// (--info handedness=Left: did you mean left?) - groups "a" and "A", or choices "yes" and "Yes", used to pass.
 bool SameButCase(const std::string& a, const std::string& b) {
   return a != b && a.size() == b.size() &&
          std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) { return std::tolower((unsigned char)x) ==
@@ -261,9 +261,9 @@ void Parser::ParseResponses(const Json& v, const std::string& ptr, const std::se
   // Odd one out names one of its intervals: there is no "can't tell" unless a key is given for it.
   if (p.layout == Layout::kOddOneOut) r->cant_tell = "";
   if (v.is_null()) return;
-  if (!Object(v, ptr, {"left", "right", "cant_tell", "previous", "next", "accept", "yes", "no", "rating",
-                       "alternatives", "prompt", "after_motion"}))
-    return;
+  std::vector<std::string> fields = Words<ResponseKey>();
+  fields.insert(fields.end(), {"rating", "alternatives", "prompt", "after_motion"});
+  if (!Object(v, ptr, fields)) return;
   auto key_name = [&](const Json& value, const std::string& at) -> std::optional<std::string> {
     if (!value.is_string()) return Problem(at, "must be a key name", value), std::nullopt;
     const std::string s = value.get<std::string>();
@@ -273,14 +273,13 @@ void Parser::ParseResponses(const Json& v, const std::string& ptr, const std::se
                          "or KP_0-KP_9" + DidYouMean(s, KeyNames()), value), std::nullopt;
     return s;
   };
-  std::map<std::string, std::string*> slots = {{"left", &r->left},         {"right", &r->right},
-                                               {"cant_tell", &r->cant_tell}, {"previous", &r->previous},
-                                               {"next", &r->next},         {"accept", &r->accept},
-                                               {"yes", &r->yes},           {"no", &r->no}};
+  const std::string cant_tell = ToString(ResponseKey::kCantTell);
+  std::map<std::string, std::string*> slots;
+  for (const ResponseKey field : Vocabulary<ResponseKey>::values) slots[ToString(field)] = &r->Slot(field);
   for (auto& [key, slot] : slots) {
     if (!v.contains(key)) continue;
-    // "cant_tell": null makes a strict 2AFC: no key answers can't tell.
-    if (key == "cant_tell" && v[key].is_null()) {
+    // cant_tell: null makes a strict 2AFC: no key answers can't tell.
+    if (key == cant_tell && v[key].is_null()) {
       *slot = "";
       continue;
     }
@@ -315,7 +314,7 @@ void Parser::ParseResponses(const Json& v, const std::string& ptr, const std::se
     for (const std::string& key : TraitsOf(task).keys) {
       const bool read = tasks.count(task) > 0;
       const bool intervals = p.layout == Layout::kOddOneOut && TraitsOf(task).answer == TaskAnswer::kSide &&
-                             key != "cant_tell";
+                             key != cant_tell;
       unused(key.c_str(), read && !intervals,
              read ? "is not read by the layout odd_one_out (its intervals have /responses/alternatives)"
                   : "is for the task " + ToString(task) + ", which no block has");

@@ -86,7 +86,8 @@ bool IsBlurSource(const Json& v) {
 // Names whose values CheckLevelValue knows: a level of a factor so named is that value, never an object.
 const std::vector<std::string>& ValueNames() {
   static const std::vector<std::string> kNames = {"edge",       "from_edge",  "to_edge", "section",   "speed_cm_s",
-                                                  "distance_m", "cutoff",     "left",    "right",     "y_mm",   "object",
+                                                  "distance_m", "cutoff",     ToString(Side::kLeft),
+                                                  ToString(Side::kRight),     "y_mm",    "object",
                                                   "from_y_mm",  "to_y_mm",    "left_x_mm", "right_x_mm",
                                                   "height_mm",  "rotation_deg"};
   return kNames;

@@ -326,7 +326,7 @@ void Parser::CheckDesign(const Protocol& p) {
     for (const auto& f : b.factors)
       for (const Level& level : f.levels) {
         object = object || level.Field("object");
-        pair = pair || level.Field("left");
+        pair = pair || level.Field(ToString(Side::kLeft));
       }
     if (p.layout == Layout::kSingle && pair)
       Problem(b.sides ? b.sides_pointer : b.factors_pointer,

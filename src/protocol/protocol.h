@@ -81,7 +81,7 @@ struct Block {
   std::string conditions;             // a conditions table's path as the protocol writes it (its factor "row"); "" for none
   int repetitions = 1;
   Counterbalance counterbalance = Counterbalance::kNone;
-  // "sides": what each side shows when no factor's levels carry the sides: {"left": SOURCE, "right": SOURCE}, or the
+  // "sides": what each side shows when no factor's levels carry the sides: {left: SOURCE, right: SOURCE}, or the
   // single layout's {"object": SOURCE} (shown as the left side and recorded on both). A source the parser refused is
   // left unset.
   struct Sides {
@@ -196,6 +196,26 @@ struct Responses {
   // Answers count only after the stimulus's motion (or its intervals) ended; keys pressed before are ignored and
   // the prompt appears then. false: answering any time after onset.
   bool after_motion = false;
+
+  // The key a single-key field names ("" for none: a strict 2AFC's can't tell), and the member that holds it.
+  const std::string& Key(ResponseKey field) const { return SlotOf(*this, field); }
+  std::string& Slot(ResponseKey field) { return SlotOf(*this, field); }
+
+ private:
+  template <typename Self>
+  static auto SlotOf(Self& r, ResponseKey field) -> decltype((r.left)) {
+    switch (field) {
+      case ResponseKey::kLeft: return r.left;
+      case ResponseKey::kRight: return r.right;
+      case ResponseKey::kCantTell: return r.cant_tell;
+      case ResponseKey::kPrevious: return r.previous;
+      case ResponseKey::kNext: return r.next;
+      case ResponseKey::kAccept: return r.accept;
+      case ResponseKey::kYes: return r.yes;
+      case ResponseKey::kNo: return r.no;
+    }
+    return r.accept;
+  }
 };
 
 // How a grid or ball trial's photo maps to the screen (a picture's frame is always fitted, 4:3, at 1 screen px per

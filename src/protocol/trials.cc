@@ -41,15 +41,15 @@ namespace {
 // The sides a design row shows: from the level object that carries left/right, else the block's "sides". The
 // single layout's one "object" is shown as the left side (and recorded on both).
 void SetSides(const Block& block, Trial* t) {
-  auto side = [](const Level& from, const char* key) -> std::optional<BlurSpec> {
+  auto side = [](const Level& from, const std::string& key) -> std::optional<BlurSpec> {
     const LevelValue* v = from.Field("object") ? from.Field("object") : from.Field(key);
     if (!v) return std::nullopt;
     return BlurSpecOf(ToJson(*v));
   };
   for (const Level& level : t->levels)
-    if (level.Field("left") || level.Field("object")) {
-      t->left = side(level, "left");
-      t->right = side(level, "right");
+    if (level.Field(ToString(Side::kLeft)) || level.Field("object")) {
+      t->left = side(level, ToString(Side::kLeft));
+      t->right = side(level, ToString(Side::kRight));
       return;
     }
   if (block.sides) {
@@ -110,7 +110,7 @@ void DrawAdjustment(const Block& block, int alternatives, std::mt19937_64& rng, 
     return;
   }
   if (block.procedure) {
-    t->test_side = UniformBelow(rng, 2) == 0 ? "left" : "right";
+    t->test_side = ToString(UniformBelow(rng, 2) == 0 ? Side::kLeft : Side::kRight);
     return;
   }
   if (TraitsOf(block.task).answer != TaskAnswer::kLevel || !block.adjust) return;
@@ -272,9 +272,9 @@ int BlockIndex(const Protocol& protocol, const Trial& trial) {
   return block ? static_cast<int>(block - protocol.blocks.data()) : 0;
 }
 
-std::string SidePointer(const Protocol& protocol, const Trial& trial, const std::string& side) {
+std::string SidePointer(const Protocol& protocol, const Trial& trial, Side side) {
   // A swapped trial shows the design's other side.
-  const std::string designed = trial.swapped ? (side == "left" ? "right" : "left") : side;
+  const std::string designed = ToString(trial.swapped ? Other(side) : side);
   for (const auto& b : protocol.blocks) {
     if (b.name != trial.block) continue;
     for (const auto& f : b.factors) {
@@ -288,6 +288,13 @@ std::string SidePointer(const Protocol& protocol, const Trial& trial, const std:
     return b.pointer.empty() ? "/" : b.pointer;
   }
   return "/";
+}
+
+std::optional<Side> TestSide(const Trial& trial) { return ParseWord<Side>(trial.test_side); }
+
+int TestInterval(const Trial& trial) {
+  const std::string& s = trial.test_side;
+  return !s.empty() && std::isdigit(static_cast<unsigned char>(s[0])) ? std::stoi(s) : 0;
 }
 
 std::string LevelPointer(const Protocol& protocol, const Trial& trial, const std::string& name) {
@@ -310,7 +317,8 @@ std::string LevelPointer(const Protocol& protocol, const Trial& trial, const std
 Json ToJson(const Trial& t) {
   Json j = {{"index", t.index},         {"block", t.block},     {"practice", t.practice},
             {"task", ToString(t.task)}, {"repetition", t.repetition}, {"swapped", t.swapped},
-            {"levels", ToJson(t.levels)}, {"left", ToJson(t.left)}, {"right", ToJson(t.right)}};
+            {"levels", ToJson(t.levels)}, {ToString(Side::kLeft), ToJson(t.left)},
+            {ToString(Side::kRight), ToJson(t.right)}};
   if (TraitsOf(t.task).answer == TaskAnswer::kLevel) {
     j["adjust_levels"] = t.adjust_levels;
     j["start_index"] = t.start_index;

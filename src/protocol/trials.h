@@ -31,9 +31,9 @@ struct Trial {
   std::vector<double> adjust_levels;
   int start_index = -1;
   // A procedure block's trial: which crossing of the block's factors (whose own procedure it feeds; -1 otherwise)
-  // and the side that shows the procedure's level ("left" | "right", drawn with the seed). In the odd_one_out layout
-  // every trial's test_side is the interval ("1".."n", drawn with the seed) that shows the right side's object (and a
-  // procedure's level): the correct answer.
+  // and the side that shows the procedure's level (a Side's word, drawn with the seed; TestSide reads it). In the
+  // odd_one_out layout every trial's test_side is the interval ("1".."n", drawn with the seed; TestInterval) that shows
+  // the right side's object (and a procedure's level): the correct answer.
   int cell = -1;
   std::string test_side;
 };
@@ -98,9 +98,13 @@ const std::string& PromptOf(const Protocol& protocol, const Trial& trial);
 // participant runs them, N their count.
 std::string BlockTitle(const Protocol& protocol, const std::vector<Trial>& trials, size_t index);
 
-// The JSON pointer of the field that chose what `trial` shows on `side` ("left" | "right" as shown, swaps
-// applied): the side of a level object (/blocks/1/factors/pattern/2/left) or of the block's sides (/sides/left).
-std::string SidePointer(const Protocol& protocol, const Trial& trial, const std::string& side);
+// The JSON pointer of the field that chose what `trial` shows on `side` (as shown, swaps applied): the side of a
+// level object (/blocks/1/factors/pattern/2/left) or of the block's sides (/sides/left).
+std::string SidePointer(const Protocol& protocol, const Trial& trial, Side side);
+// The side a procedure's trial shows its level on; nullopt for any other trial (an odd one out's is an interval).
+std::optional<Side> TestSide(const Trial& trial);
+// The interval (1..n) that shows an odd-one-out trial's odd object; 0 for any other trial.
+int TestInterval(const Trial& trial);
 // The JSON pointer of the level `name` of `trial` (/factors/edge/3, /blocks/0/factors/pattern/1/speed_cm_s), or
 // of its block's factors when no level has that name.
 std::string LevelPointer(const Protocol& protocol, const Trial& trial, const std::string& name);

@@ -489,8 +489,8 @@ TEST(TrialPointers, SideNamesTheLevelThatChoseIt) {
     const int at = ToJson(t.levels)["pattern"]["id"].get<int>() / 2 - 1;  // task 2 lists patterns 2, 4, 6
     const std::string level = "/blocks/1/factors/pattern/" + std::to_string(at);
     // A swapped copy shows the design's right source on the left.
-    EXPECT_EQ(SidePointer(p, t, "left"), level + (t.swapped ? "/right" : "/left"));
-    EXPECT_EQ(SidePointer(p, t, "right"), level + (t.swapped ? "/left" : "/right"));
+    EXPECT_EQ(SidePointer(p, t, Side::kLeft), level + (t.swapped ? "/right" : "/left"));
+    EXPECT_EQ(SidePointer(p, t, Side::kRight), level + (t.swapped ? "/left" : "/right"));
     EXPECT_EQ(LevelPointer(p, t, "section"),
               "/blocks/1/factors/section/" + std::to_string(ToJson(t.levels)["section"].get<int>() - 1));
     EXPECT_EQ(LevelPointer(p, t, "speed_cm_s"), level + "/speed_cm_s");
@@ -502,7 +502,7 @@ TEST(TrialPointers, SideNamesTheLevelThatChoseIt) {
 TEST(TrialPointers, SidesObjectOfTheProtocolWhenNoLevelCarriesThem) {
   const Protocol p = Shipped("test1-static-grids.json");
   const auto trials = BuildTrials(p, "P2", 1);  // even: every trial swapped
-  EXPECT_EQ(SidePointer(p, trials.back(), "left"), "/sides/right");
+  EXPECT_EQ(SidePointer(p, trials.back(), Side::kLeft), "/sides/right");
   EXPECT_EQ(LevelPointer(p, trials.back(), "edge"),
             "/factors/edge/" + std::to_string(ToJson(trials.back().levels)["edge"].get<int>() - 1));
 }

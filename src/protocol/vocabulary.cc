@@ -18,10 +18,14 @@ std::string ToString(Task value) {
 const TaskTraits& TraitsOf(Task task) {
   // shows, answer, scored, deadline, keys (the /responses fields read; an odd one out's intervals read
   // responses.alternatives, which the layout decides).
-  static const TaskTraits kForcedChoice{TaskShows::kPair, TaskAnswer::kSide, true, true, {"left", "right", "cant_tell"}};
+  static const TaskTraits kForcedChoice{TaskShows::kPair, TaskAnswer::kSide, true, true,
+                                         {ToString(ResponseKey::kLeft), ToString(ResponseKey::kRight),
+                                          ToString(ResponseKey::kCantTell)}};
   static const TaskTraits kAdjustment{TaskShows::kPicture, TaskAnswer::kLevel, false, false,
-                                      {"previous", "next", "accept"}};
-  static const TaskTraits kYesNo{TaskShows::kOneObject, TaskAnswer::kYesNo, false, true, {"yes", "no"}};
+                                      {ToString(ResponseKey::kPrevious), ToString(ResponseKey::kNext),
+                                       ToString(ResponseKey::kAccept)}};
+  static const TaskTraits kYesNo{TaskShows::kOneObject, TaskAnswer::kYesNo, false, true,
+                                 {ToString(ResponseKey::kYes), ToString(ResponseKey::kNo)}};
   static const TaskTraits kRating{TaskShows::kOneObject, TaskAnswer::kRatingPoint, false, true, {"rating"}};
   switch (task) {
     case Task::kForcedChoice: return kForcedChoice;
@@ -141,6 +145,30 @@ std::string ToString(RadiusUnit value) {
     case RadiusUnit::kPhotoPx: return "photo_px";
     case RadiusUnit::kScreenPx: return "screen_px";
     case RadiusUnit::kArcmin: return "arcmin";
+  }
+  return "";
+}
+
+std::string ToString(Side value) {
+  switch (value) {
+    case Side::kLeft: return "left";
+    case Side::kRight: return "right";
+  }
+  return "";
+}
+
+// The fields that answer a side are named by the side; can't tell by the word the record writes for it
+// (procedure/answer.cc's choice table has the same word: a key's field and its answer are spelled alike).
+std::string ToString(ResponseKey value) {
+  switch (value) {
+    case ResponseKey::kLeft: return ToString(Side::kLeft);
+    case ResponseKey::kRight: return ToString(Side::kRight);
+    case ResponseKey::kCantTell: return "cant_tell";
+    case ResponseKey::kPrevious: return "previous";
+    case ResponseKey::kNext: return "next";
+    case ResponseKey::kAccept: return "accept";
+    case ResponseKey::kYes: return "yes";
+    case ResponseKey::kNo: return "no";
   }
   return "";
 }

@@ -128,6 +128,27 @@ struct Vocabulary<RadiusUnit> {
   static constexpr std::array values{RadiusUnit::kPhotoPx, RadiusUnit::kScreenPx, RadiusUnit::kArcmin};
 };
 
+// A side of a pair as the participant sees it: the word of a level's or the sides' field, of a procedure's test side,
+// of the record's side columns and of a side answer (left | right). Every module spells a side through this one
+// table (ToString, ParseWord), so the words live in vocabulary.cc alone.
+enum class Side { kLeft, kRight };
+template <>
+struct Vocabulary<Side> {
+  static constexpr std::array values{Side::kLeft, Side::kRight};
+};
+// The side across from `side`.
+constexpr Side Other(Side side) { return side == Side::kLeft ? Side::kRight : Side::kLeft; }
+
+// A /responses field that names one key (left | right | cant_tell | previous | next | accept | yes | no), in the
+// order the parser lists the fields; the lists (rating, alternatives) have fields of their own.
+enum class ResponseKey { kLeft, kRight, kCantTell, kPrevious, kNext, kAccept, kYes, kNo };
+template <>
+struct Vocabulary<ResponseKey> {
+  static constexpr std::array values{ResponseKey::kLeft,     ResponseKey::kRight, ResponseKey::kCantTell,
+                                     ResponseKey::kPrevious, ResponseKey::kNext,  ResponseKey::kAccept,
+                                     ResponseKey::kYes,      ResponseKey::kNo};
+};
+
 // What a trial of a task shows: a picture (content "picture": the real one and the virtual one to match), one object
 // (the layout single), or a pair of objects (side by side, in two intervals, or as an odd one out of n).
 enum class TaskShows { kPicture, kOneObject, kPair };
@@ -173,6 +194,8 @@ std::string ToString(BlockSequence value);
 std::string ToString(GroupAssign value);
 std::string ToString(InfoType value);
 std::string ToString(RadiusUnit value);
+std::string ToString(Side value);
+std::string ToString(ResponseKey value);
 
 // The value a word names, or nullopt when the vocabulary has no such word.
 template <typename E>

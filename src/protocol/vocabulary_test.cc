@@ -40,6 +40,8 @@ TEST(Vocabulary, EveryValueListedAndParsedBack) {
   ExpectComplete<InfoType>();
   ExpectComplete<BlurSource>();
   ExpectComplete<RadiusUnit>();
+  ExpectComplete<Side>();
+  ExpectComplete<ResponseKey>();
 }
 
 TEST(Vocabulary, UnknownWordIsNotParsed) {

@@ -156,7 +156,8 @@ void CapturingPresenter::Capture(const protocol::Trial& trial, const stimulus::T
   // Intervals show one object at a time at the left object's place: which side's object the first interval shows
   // (its "side" below is the slot it is drawn in).
   if (scene.intervals > 0)
-    frame["first_interval_shows"] = stimulus::IntervalShowsRight(trial, scene, 0) ? "right" : "left";
+    frame["first_interval_shows"] =
+        ToString(stimulus::IntervalShowsRight(trial, scene, 0) ? protocol::Side::kRight : protocol::Side::kLeft);
   if (!prompt.empty()) frame["prompt_rect_px"] = {0, image.rows - band, image.cols, band};
   WriteImage(dir_ / (std::string(name) + ".png"), image);
   WriteFileAtomically(dir_ / (std::string(name) + ".json"), frame.dump(1) + "\n");

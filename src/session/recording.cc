@@ -34,9 +34,6 @@ double LevelAsGiven(double level) {
   return std::strtod(text, nullptr);
 }
 
-static_assert(std::string_view(kChoiceNone) == store::kChoiceNone);
-static_assert(std::string_view(kChoiceSkipped) == store::kChoiceSkipped);
-
 // The trial list as saved: one record per trial, with its planned radii.
 std::vector<store::TrialRecord> TrialRecords(const procedure::PreparedSession& s) {
   const protocol::Protocol& protocol = s.protocol;
@@ -154,7 +151,7 @@ void Recording::CheckTrialList(int64_t session, const procedure::PreparedSession
 void Recording::RecordResponse(int64_t session, int64_t trial_index, const Response& response,
                                const std::vector<FrameRecord>& frames) {
   store::Response r;
-  r.choice = response.choice;
+  r.choice = procedure::Name(response.choice);
   r.rt_ms = response.rt_ms;
   r.adjustment_json = response.adjustment_json;
   r.shown_json = response.shown_json;
@@ -195,7 +192,7 @@ store::RecordedVariables Variables(const protocol::Trial& trial, const TrialScen
   // Odd one out: the interval that showed the right side's object (the correct answer), and how many there were.
   const protocol::TaskTraits& task = protocol::TraitsOf(trial.task);
   if (scene.intervals > 2 && task.answer == protocol::TaskAnswer::kSide) {
-    v.odd_interval = std::stoi(trial.test_side);
+    v.odd_interval = protocol::TestInterval(trial);
     v.intervals = scene.intervals;
   }
   // Rounded to 1e-4 px: the record is read by people and charts, not fed back.
@@ -208,7 +205,7 @@ store::RecordedVariables Variables(const protocol::Trial& trial, const TrialScen
     for (double level : trial.adjust_levels) levels += (levels.empty() ? "" : ";") + protocol::LevelText(level);
     v.adjust_levels = levels;
   }
-  constexpr size_t kLeft = 0, kRight = 1, kScene = 2;  // RecordedVariables::kSides
+  constexpr size_t kLeft = 0, kRight = 1, kScene = 2;  // RecordedVariables::SideName
   if (scene.content == protocol::ContentType::kPicture) {
     // The virtual picture's width as shown (a level c's blur is r = 2 x 0.1874 x this / c arcmin), and the real
     // picture's blur when its camera is known: in its camera's px, on the screen and on the eye.

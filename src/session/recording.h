@@ -28,16 +28,13 @@ struct PreparedSession;
 
 namespace blurcue::session {
 
-// The choices besides answers (procedure::kChoiceNone, kChoiceSkipped) are procedure/answer.h's; recording.cc checks
-// they are the record's own words.
-using procedure::kChoiceNone;
-using procedure::kChoiceSkipped;
+using procedure::Choice;
 
-// One trial's answer as recorded (store::Response): the choice ("left" | "right" | "cant_tell" | an interval or
-// rating "1".."n" | yes | no | an adjustment level | kChoiceNone | kChoiceSkipped), its response time (NaN: none),
-// the adjustment's steps, and what a procedure's trial showed as decided then (shown_json, level, radii, correct).
+// One trial's answer as recorded (store::Response, which holds the choice's Name): the choice (an answer, none or
+// skipped), its response time (NaN: none), the adjustment's steps, and what a procedure's trial showed as decided
+// then (shown_json, level, radii, correct).
 struct Response {
-  std::string choice;
+  Choice choice;
   double rt_ms = 0;
   std::string adjustment_json = "[]";
   std::string shown_json = "{}";
@@ -80,7 +77,8 @@ struct SessionStart {
   int64_t session_number = 0;          // the participant's n-th session of the study (1, 2, ...)
 };
 
-// A recorded answer, as a resumed session replays it.
+// A recorded answer, as a resumed session replays it: the choice's text as the record holds it (KeyMap::Parse reads
+// it for its trial).
 struct RecordedAnswer {
   std::string choice;
   std::string shown_json;

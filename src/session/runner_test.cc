@@ -287,7 +287,7 @@ TEST(Runner, PracticeUntilCriterionSkipsTheRunsAfterTheOneThatMetIt) {
   EXPECT_EQ(result.skipped_by_criterion_now, 4);
   EXPECT_EQ(presenter.trials_shown, (std::vector<int>{0, 1, 6, 7}));
   const auto answers = recording.AnsweredTrials(result.session_id);
-  for (int i = 2; i < 6; ++i) EXPECT_EQ(answers.at(i).choice, kChoiceSkipped) << i;
+  for (int i = 2; i < 6; ++i) EXPECT_EQ(answers.at(i).choice, store::kChoiceSkipped) << i;
 }
 
 TEST(Runner, ShowsTheInstructionsThenEachPartsScreenAsItsBlockBegins) {

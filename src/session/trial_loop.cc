@@ -18,6 +18,7 @@ namespace blurcue::session {
 namespace {
 
 using protocol::Task;
+using ActionKind = procedure::Action::Kind;
 using render::InputEvent;
 using stimulus::IntervalScene;
 using stimulus::IntervalShowsRight;
@@ -176,33 +177,33 @@ class Runner {
       dropped_frames_ += dropped;
       last_flip = flip;
       if (presenter_.Closed()) return Outcome::kQuit;
-      // A deadline: no answer this long after onset is recorded as "none", without a response time.
+      // A deadline: no answer this long after onset is recorded as none, without a response time.
       if (timing.deadline_ms > 0 && protocol::TraitsOf(trial.task).deadline &&
           (presenter_.Now() - onset - paused_s) * 1000 >= timing.deadline_ms) {
-        response->choice = kChoiceNone;
+        response->choice = Choice::Of(Choice::Kind::kNone);
         response->rt_ms = std::numeric_limits<double>::quiet_NaN();
         return Outcome::kAnswered;
       }
       for (const InputEvent& e : responder_.Poll(presenter_.Now())) {
         if (e.time_s < onset) continue;  // pressed before the stimulus was on screen
-        const std::string action = keys_.Action(e.key, trial.task);
+        const procedure::Action action = keys_.ActionOf(e.key, trial.task);
         const double t_ms = (e.time_s - onset - paused_s) * 1000;
-        if (action != "pause" && t_ms < answer_from_s * 1000) continue;  // before the motion ended
-        if (action == "pause") {
+        if (action.kind != ActionKind::kPause && t_ms < answer_from_s * 1000) continue;  // before the motion ended
+        if (action.kind == ActionKind::kPause) {
           const double paused_at = presenter_.Now();
           if (!Pause()) return Outcome::kQuit;
           paused_s += presenter_.Now() - paused_at;
           presenter_.SetTitle(TrialTitle(trial) + (answer_from_s > 0 && answer_titled ? " - answer" : ""));
           last_flip = -1;  // the gap is the pause, not a dropped frame
-        } else if (KeyMap::Answers(action)) {
-          response->choice = action;
+        } else if (action.kind == ActionKind::kAnswer) {
+          response->choice = action.choice;
           response->rt_ms = t_ms;
           return Outcome::kAnswered;
-        } else if ((action == "previous" || action == "next") && levels > 0) {
-          level = procedure::StepLevel(level, action, levels);
+        } else if ((action.kind == ActionKind::kPrevious || action.kind == ActionKind::kNext) && levels > 0) {
+          level = procedure::StepLevel(level, action.kind, levels);
           steps.push_back({{"level", trial.adjust_levels[size_t(level)]}, {"t_ms", std::round(t_ms * 10) / 10}});
-        } else if (action == "accept" && levels > 0) {
-          response->choice = protocol::LevelText(trial.adjust_levels[size_t(level)]);
+        } else if (action.kind == ActionKind::kAccept && levels > 0) {
+          response->choice = Choice::Level(trial.adjust_levels[size_t(level)]);
           response->rt_ms = t_ms;
           response->adjustment_json = steps.dump();
           return Outcome::kAnswered;
@@ -224,8 +225,7 @@ class Runner {
       // A terminal gets one line rewritten after every answer; a log gets about ten lines.
       if (!tty && done % std::max<int64_t>(1, result.trial_count / 10) != 0 && done != result.trial_count)
         return;
-      const double elapsed =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
       const int64_t now = done - result.answered_before;
       const double left = now > 0 ? elapsed / double(now) * double(result.trial_count - done) : 0;
       std::fprintf(stderr, "%strial %lld of %lld  elapsed %s  remaining ~%s%s", tty ? "\r" : "",
@@ -252,7 +252,8 @@ class Runner {
         const protocol::Trial& t = trials_[size_t(i)];
         const auto it = answered.find(i);
         if (it == answered.end()) throw cannot(i, "the record has no answer for it but has answers after it");
-        const bool recorded_skip = it->second.choice == kChoiceSkipped;
+        const std::optional<Choice> recorded = keys_.Parse(it->second.choice, t);
+        const bool recorded_skip = recorded && recorded->kind == Choice::Kind::kSkipped;
         const std::optional<procedure::Skip> why = logic.SkipReason(t);
         if (recorded_skip && !why)
           throw cannot(i, "the record skips it, but the answers before it show it (its procedure had not stopped, "
@@ -260,7 +261,7 @@ class Runner {
         if (!recorded_skip && why)
           throw cannot(i, "the record shows it, but the answers before it skip it (" + why->why + ")");
         if (recorded_skip) continue;
-        if (!keys_.CanRecord(it->second.choice, t))
+        if (!recorded || !keys_.CanRecord(*recorded, t))
           throw cannot(i, "the record's answer '" + it->second.choice + "' is none this trial can have");
         main_answered += !t.practice;
         double level = 0;
@@ -276,7 +277,7 @@ class Runner {
                                                                               : std::string("(none)")) +
                                 " is not the " + std::to_string(level) + " its answers give");
         }
-        logic.Answer(t, scene, level, it->second.choice);
+        logic.Answer(t, scene, level, *recorded);
       }
     }
     std::string shown_block;
@@ -308,7 +309,7 @@ class Runner {
       // its block's criterion.
       if (const std::optional<procedure::Skip> why = logic.SkipReason(trial)) {
         Response skipped;
-        skipped.choice = kChoiceSkipped;
+        skipped.choice = Choice::Of(Choice::Kind::kSkipped);
         skipped.rt_ms = std::numeric_limits<double>::quiet_NaN();
         skipped.shown_json = SkippedVariables(*why);
         record.RecordResponse(start.session_id, i, skipped);
@@ -338,7 +339,7 @@ class Runner {
       record.RecordResponse(start.session_id, i, response, frames);  // committed before anything else happens
       // Feedback where an answer is right or wrong: procedure trials, odd one out, practice run to a criterion.
       if (const double feedback_ms = protocol::TimingOf(protocol_, trial).feedback_ms; right && feedback_ms > 0)
-        presenter_.ShowTextFor(response.choice == kChoiceNone ? "Too slow" : correct ? "Correct" : "Wrong",
+        presenter_.ShowTextFor(response.choice.kind == Choice::Kind::kNone ? "Too slow" : correct ? "Correct" : "Wrong",
                                feedback_ms / 1000);
       ++result.answered_now;
       progress(i + 1);

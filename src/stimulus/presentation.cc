@@ -147,7 +147,7 @@ Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, cons
     Json polygon = Json::array();
     for (const cv::Point2d& p : outline) polygon.push_back({round(p.x, 1e-3), round(p.y, 1e-3)});
     frame["objects"].push_back(
-        {{"side", side == 0 ? "left" : "right"},
+        {{"side", protocol::ToString(side == 0 ? protocol::Side::kLeft : protocol::Side::kRight)},
          {"kind", b.object.kind == scene::VirtualObject::Kind::kBall ? "ball" : "card"},
          {"source", ToString(side == 0 ? trial.left : trial.right)},
          {"kernel", b.method},

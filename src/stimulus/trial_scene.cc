@@ -20,6 +20,7 @@ namespace {
 constexpr int kLeftSection = 3, kRightSection = 5;  // the balls roll side by side, one section apart
 
 using protocol::FindLevel;
+using protocol::Side;
 
 // `where` names the field that chose the source ("FILE: /pointer"), made only when there is a problem to name. A
 // fixed radius on the screen is converted to photo px by `presentation`.
@@ -131,7 +132,7 @@ void CheckInPhoto(const protocol::Protocol& protocol, const protocol::Trial& tri
                                                                                         : "right_x_mm")
                                 : "speed_cm_s";
         throw InputError(protocol.file.string() + ": " + protocol::LevelPointer(protocol, trial, level),
-                         std::string("the ") + (side == 0 ? "left" : "right") + " " + protocol::ToString(t.content) + " at (" +
+                         "the " + ToString(side == 0 ? Side::kLeft : Side::kRight) + " " + ToString(t.content) + " at (" +
                              std::to_string(int(std::lround(objects[side]->object.center_board_mm[0]))) + ", " +
                              std::to_string(int(std::lround(objects[side]->object.center_board_mm[1]))) +
                              ") mm on the board lies outside the " + std::to_string(photo.width) + " x " +
@@ -179,11 +180,11 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   }
   if (!scene) throw InputError(protocol.file.string(), "/scene/calib: a " + protocol::ToString(t.content) + " needs a calibration");
   // Where a side's source was chosen ("" for the scene's own blur, the calibration's): looked up only for a message.
-  auto field = [&](const char* side) {
-    return At(protocol, side ? protocol::SidePointer(protocol, trial, side) : "/scene/calib");
+  auto field = [&](std::optional<Side> side) {
+    return At(protocol, side ? protocol::SidePointer(protocol, trial, *side) : "/scene/calib");
   };
-  t.left = Source(trial.left, &t.left_fixed_px, [&] { return field("left"); }, presentation);
-  t.right = Source(trial.right, &t.right_fixed_px, [&] { return field("right"); }, presentation);
+  t.left = Source(trial.left, &t.left_fixed_px, [&] { return field(Side::kLeft); }, presentation);
+  t.right = Source(trial.right, &t.right_fixed_px, [&] { return field(Side::kRight); }, presentation);
   const double s = scene->board.square_mm;
   // Where the right side's object is shown, so where its radius is evaluated: its own place, or in an intervals
   // trial the left object's (IntervalScene shows each side alone there). Evaluated at its own place, a place-dependent
@@ -191,7 +192,7 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   const bool right_place = t.intervals > 0;  // Card / Ball: true = the left object's place
   // A radius that cannot be evaluated (eq. 3.7 nearer than focus, no usable measured section) is a problem of the
   // source the protocol chose with this calibration: an input error naming that field.
-  auto r_at = [&](const cv::Vec3d& board_mm, calib::BlurSource source, double fixed, const char* side) {
+  auto r_at = [&](const cv::Vec3d& board_mm, calib::BlurSource source, double fixed, std::optional<Side> side) {
     try {
       const double r = calib::BlurAtPx(*scene, source, scene->ToCamera(board_mm), fixed);
       if (!std::isfinite(r) || r < 0) throw Error(ErrorKind::kDomain, "radius " + std::to_string(r) + " px");
@@ -236,16 +237,16 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
     t.edge = edge ? *edge : 0;
     t.from_y_mm = t.to_y_mm = y ? *y : (*edge - 1) * s;
     const cv::Vec3d l = Card(*scene, t, true).center_board_mm, r = Card(*scene, t, right_place).center_board_mm;
-    t.r_left_px = r_at(l, t.left, t.left_fixed_px, "left");
-    t.r_right_px = r_at(r, t.right, t.right_fixed_px, "right");
+    t.r_left_px = r_at(l, t.left, t.left_fixed_px, Side::kLeft);
+    t.r_right_px = r_at(r, t.right, t.right_fixed_px, Side::kRight);
     const ObjectPlace pl = PlaceOf(*scene, l), pr = PlaceOf(*scene, r);
     t.u_left_mm = pl.u_mm, t.u_right_mm = pr.u_mm;
     t.below_axis_left_px = pl.below_axis_px, t.below_axis_right_px = pr.below_axis_px;
     // The floor at each card's place (the distortion's stretch there; ObjectsAt draws the same).
     t.floor_left_sigma_px = calib::FloorSigmaPx(*scene, t.left, scene->ToCamera(l));
     t.floor_right_sigma_px = calib::FloorSigmaPx(*scene, t.right, scene->ToCamera(r));
-    t.r_scene_px = 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, nullptr) +
-                          r_at(r, calib::BlurSource::kFitted, 0, nullptr));
+    t.r_scene_px = 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, std::nullopt) +
+                          r_at(r, calib::BlurSource::kFitted, 0, std::nullopt));
     CheckInPhoto(protocol, trial, *scene, t);
     return t;
   }
@@ -291,12 +292,12 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
     const double y = t.from_y_mm + (t.to_y_mm - t.from_y_mm) * i / (samples - 1);
     const cv::Vec3d l = Ball(*scene, t, y, radius, true).center_board_mm;
     const cv::Vec3d r = Ball(*scene, t, y, radius, right_place).center_board_mm;
-    t.r_left_px += r_at(l, t.left, t.left_fixed_px, "left") / samples;
-    t.r_right_px += r_at(r, t.right, t.right_fixed_px, "right") / samples;
+    t.r_left_px += r_at(l, t.left, t.left_fixed_px, Side::kLeft) / samples;
+    t.r_right_px += r_at(r, t.right, t.right_fixed_px, Side::kRight) / samples;
     t.floor_left_sigma_px += calib::FloorSigmaPx(*scene, t.left, scene->ToCamera(l)) / samples;
     t.floor_right_sigma_px += calib::FloorSigmaPx(*scene, t.right, scene->ToCamera(r)) / samples;
-    t.r_scene_px += 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, nullptr) +
-                           r_at(r, calib::BlurSource::kFitted, 0, nullptr)) / samples;
+    t.r_scene_px += 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, std::nullopt) +
+                           r_at(r, calib::BlurSource::kFitted, 0, std::nullopt)) / samples;
     const ObjectPlace pl = PlaceOf(*scene, l), pr = PlaceOf(*scene, r);
     t.u_left_mm += pl.u_mm / samples, t.u_right_mm += pr.u_mm / samples;
     t.below_axis_left_px += pl.below_axis_px / samples, t.below_axis_right_px += pr.below_axis_px / samples;
@@ -308,8 +309,8 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   for (int k = 1; k <= edges; ++k) {
     const double y = (k - 1) * s;
     if (y < std::min(t.from_y_mm, t.to_y_mm) || y > std::max(t.from_y_mm, t.to_y_mm)) continue;
-    r_at(Ball(*scene, t, y, radius, true).center_board_mm, t.left, t.left_fixed_px, "left");
-    r_at(Ball(*scene, t, y, radius, right_place).center_board_mm, t.right, t.right_fixed_px, "right");
+    r_at(Ball(*scene, t, y, radius, true).center_board_mm, t.left, t.left_fixed_px, Side::kLeft);
+    r_at(Ball(*scene, t, y, radius, right_place).center_board_mm, t.right, t.right_fixed_px, Side::kRight);
   }
   CheckInPhoto(protocol, trial, *scene, t);
   return t;
@@ -356,8 +357,7 @@ std::array<std::optional<scene::BlurredObject>, 2> ObjectsAt(const protocol::Pro
 }
 bool IntervalShowsRight(const protocol::Trial& trial, const TrialScene& scene, int i) {
   if (scene.intervals == 2) return i == 1;
-  return protocol::TraitsOf(trial.task).answer == protocol::TaskAnswer::kSide && !trial.test_side.empty() &&
-         std::isdigit(static_cast<unsigned char>(trial.test_side[0])) && std::stoi(trial.test_side) == i + 1;
+  return protocol::TraitsOf(trial.task).answer == protocol::TaskAnswer::kSide && protocol::TestInterval(trial) == i + 1;
 }
 
 TrialScene IntervalScene(const TrialScene& scene, bool right) {
@@ -379,7 +379,7 @@ TrialScene IntervalScene(const TrialScene& scene, bool right) {
 
 void ApplyLevel(const protocol::Procedure& procedure, const protocol::Trial& trial, double level,
                 const Presentation& presentation, TrialScene* scene) {
-  const bool left = trial.test_side == "left";
+  const bool left = protocol::TestSide(trial) == protocol::Side::kLeft;
   double& gain = left ? scene->left_gain : scene->right_gain;
   double& add = left ? scene->left_add_px : scene->right_add_px;
   double& r = left ? scene->r_left_px : scene->r_right_px;

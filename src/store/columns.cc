@@ -232,9 +232,9 @@ std::vector<Column> MakeColumns() {
 
   // Each radius as the camera made it, on the screen and at the eye; the photo px ones also typed, planned (trials)
   // and as shown (responses), for a procedure decides them at the trial.
-  for (size_t k = 0; k < RecordedVariables::kSides.size(); ++k) {
-    const std::string side = RecordedVariables::kSides[k];
-    const std::string what = side == "scene" ? "the scene's own blur at the object's place (the fitted model; depth "
+  for (size_t k = 0; k < RecordedVariables::kSides; ++k) {
+    const std::string side = RecordedVariables::SideName(k);
+    const std::string what = k == 2 ? "the scene's own blur at the object's place (the fitted model; depth "
                                                "matching: the real picture's, the thin lens of content.real_camera)"
                                              : "the " + side + " object's blur radius";
     Column& px = add("r_" + side + "_px", "number", "photo px",
@@ -243,10 +243,10 @@ std::vector<Column> MakeColumns() {
     // Before version 7 only the variables' JSON had it, planned (factors) and as shown (shown).
     const Stored planned = Typed("trials", "REAL", "", 7, "json_extract(factors, '$.r_" + side + "_px')");
     const Stored shown = Typed("responses", "REAL", "", 7, "json_extract(shown, '$.r_" + side + "_px')");
-    if (side == "left") {
+    if (k == 0) {
       px.at = OfTrial(planned, [](const TrialRecord& t) { return Optional(t.r_left_px); });
       px.shown = OfResponse(shown, [](const Response& r) { return Optional(r.r_left_px); });
-    } else if (side == "right") {
+    } else if (k == 1) {
       px.at = OfTrial(planned, [](const TrialRecord& t) { return Optional(t.r_right_px); });
       px.shown = OfResponse(shown, [](const Response& r) { return Optional(r.r_right_px); });
     } else {
@@ -277,7 +277,7 @@ std::vector<Column> MakeColumns() {
   variable("exposure_ms", "number", "ms", "the exposure a moving object's motion blur lasts (content.exposure_ms; 0: none)",
            Member(&R::exposure_ms));
   for (size_t k = 0; k < 2; ++k) {
-    const std::string side = RecordedVariables::kSides[k];
+    const std::string side = RecordedVariables::SideName(k);
     variable("floor_sigma_" + side + "_px", "number", "photo px",
              "the lens floor (std) inside the " + side + " object's radius: the scene's, for a measured, measured_section "
              "or fitted source (its defocus drawn convolved with it); 0 for the others", Radius(&R::floor_sigma_px, k));
@@ -292,7 +292,7 @@ std::vector<Column> MakeColumns() {
   }
   // Where each object is: its depth (what an edge number stands for) and, as the eye gets it, its height in the picture.
   for (size_t k = 0; k < 2; ++k) {
-    const std::string side = RecordedVariables::kSides[k];
+    const std::string side = RecordedVariables::SideName(k);
     variable("u_" + side + "_mm", "number", "mm",
              "the " + side + " object's depth u: its centre's distance from the camera's lens plane along the optical "
              "axis (camera z in the calibration's board pose), where its radius was evaluated (an intervals trial: the "
@@ -352,6 +352,10 @@ void BindEach(const std::vector<Column>& columns, const std::string& table, Stat
 const std::vector<Column>& RecordColumns() {
   static const std::vector<Column> columns = MakeColumns();
   return columns;
+}
+
+std::string RecordedVariables::SideName(size_t k) {
+  return k < 2 ? protocol::ToString(protocol::Side(k)) : std::string("scene");
 }
 
 Json VariablesJson(const RecordedVariables& variables) {

@@ -58,8 +58,11 @@ struct RecordedVariables {
   std::optional<double> level, start_level, picture_width_arcmin, screen_px_per_photo_px, r_span_screen_px,
       size_left_deg, size_right_deg, brightness, contrast, white_balance_r, white_balance_g, white_balance_b,
       posterior_threshold, posterior_slope;
-  // Each radius of kSides as the camera made it (photo px), on the screen (screen px) and at the eye (arcmin).
-  static constexpr std::array<const char*, 3> kSides{"left", "right", "scene"};
+  // Each radius of the kSides places (0, 1: the left and right sides, 2: the scene; SideName spells them) as the
+  // camera made it (photo px), on the screen (screen px) and at the eye (arcmin).
+  static constexpr size_t kSides = 3;
+  // A place's word in the column names: protocol::Side's for the sides, scene for the scene.
+  static std::string SideName(size_t k);
   std::array<std::optional<double>, 3> r_px, r_screen_px, r_arcmin;
   // The PSF beside them (render/psf.h): the exposure a moving object's streak lasts, and for the left and right
   // sides (kSides' first two) the lens floor inside the radius (std) and the streak's x and y on the screen.

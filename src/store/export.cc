@@ -192,7 +192,7 @@ void SpreadObjectLevels(Json* variables) {
   for (const auto& [name, level] : variables->items())
     if (level.is_object())
       for (const auto& [key, value] : level.items())
-        if (key != "left" && key != "right" && key != "object" && !variables->contains(DesignColumn(key)) &&
+        if (!protocol::ParseWord<protocol::Side>(key) && key != "object" && !variables->contains(DesignColumn(key)) &&
             !spread.contains(DesignColumn(key)))
           spread[DesignColumn(key)] = value;
   for (auto& [key, value] : spread.items()) (*variables)[key] = std::move(value);
@@ -334,9 +334,9 @@ int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::p
         case protocol::TaskAnswer::kSide: (AllDigits(choice) ? interval : side) = choice; break;
       }
     }
-    if ((side == "left" || side == "right") && !rows.IsNull(9) && !rows.IsNull(10)) {
+    if (const auto chosen = protocol::ParseWord<protocol::Side>(side); chosen && !rows.IsNull(9) && !rows.IsNull(10)) {
       const double l = rows.GetDouble(9), r = rows.GetDouble(10);
-      if (std::abs(l - r) > 1e-9) more_blurred = ((side == "left") == (l > r)) ? "1" : "0";
+      if (std::abs(l - r) > 1e-9) more_blurred = ((*chosen == protocol::Side::kLeft) == (l > r)) ? "1" : "0";
     }
     // A column's cell as the table says it is read.
     auto cell = [&](const Column& c) -> std::string {

@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "core/hash.h"
 #include "core/typed.h"
+#include "protocol/vocabulary.h"
 #include "store/record.h"
 
 namespace blurcue::store {
@@ -103,7 +104,8 @@ std::string WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
   std::map<std::string, std::set<std::string, Natural>> answer_names;
   Statement rows(db,
                  "SELECT st.name, p.code, s.id, s.status, r.id IS NOT NULL, r.choice, r.rt_ms, "
-                 "CASE r.choice WHEN 'left' THEN t.left_shown WHEN 'right' THEN t.right_shown END "
+                 "CASE r.choice WHEN '" + protocol::ToString(protocol::Side::kLeft) + "' THEN t.left_shown WHEN '" +
+                     protocol::ToString(protocol::Side::kRight) + "' THEN t.right_shown END "
                  "FROM trials t JOIN sessions s ON s.id = t.session_id "
                  "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
                  "LEFT JOIN responses r ON r.trial_id = t.id "

@@ -115,7 +115,7 @@ inline constexpr const char* kChoiceNone = "none";
 inline constexpr const char* kChoiceSkipped = "skipped";
 
 struct Response {
-  std::string choice;                // "left" | "right" | "cant_tell" | an adjustment level | kChoiceNone | kChoiceSkipped
+  std::string choice;                // procedure::Name(Choice): the answer's word, kChoiceNone or kChoiceSkipped
   double rt_ms = 0;                  // NaN: none (recorded NULL)
   std::string adjustment_json = "[]";  // method of adjustment: the levels stepped through
   // What the trial showed as decided when it was shown (an adaptive procedure's level, the radii it made, whether
