@@ -145,7 +145,9 @@ TEST(StaircasePosterior, MatchesTheGoldenTable) {
     for (const auto& [got, want] : {std::pair{t.estimate, f[7]}, {t.low, f[8]}, {t.high, f[9]}})
       EXPECT_NEAR(got, std::stod(want), 1e-9 * std::max(1.0, std::abs(std::stod(want)))) << "row " << rows;
     EXPECT_EQ(t.at_bound, f[10]) << "row " << rows;
-    if (!t.determined) EXPECT_NE(t.why.find(f[11]), std::string::npos) << t.why;
+    if (!t.determined) {
+      EXPECT_NE(t.why.find(f[11]), std::string::npos) << t.why;
+    }
     ++rows;
   }
   EXPECT_EQ(rows, 24);

@@ -126,8 +126,8 @@ Protocol Parser::Parse(const Json& json) {
   }
   // A procedure's guess rate is the chance of a right answer by guessing: 1/n of an odd-one-out trial's n intervals
   // (QUEST+'s likelihood and a staircase's threshold posterior, procedure/threshold_fit.h, both use it).
-  if (p.layout == Layout::kOddOneOut)
-    for (auto& b : p.blocks)
+  if (p.layout == Layout::kOddOneOut) {
+    for (auto& b : p.blocks) {
       if (b.procedure && b.procedure->kind == Procedure::Kind::kStaircase) {
         b.procedure->guess = 1.0 / p.alternatives;
       } else if (b.procedure && b.procedure->kind == Procedure::Kind::kQuestPlus) {
@@ -137,6 +137,8 @@ Protocol Parser::Parse(const Json& json) {
                                                       " intervals is guessed right 1/" + std::to_string(p.alternatives) +
                                                       " of the time; leave guess out", Json(b.procedure->guess));
       }
+    }
+  }
   // An up/down rule that converges at or below what guessing gives measures no threshold (3-up/1-down: 20.6 % of a
   // 2AFC's answers correct, which no participant goes below): refused here rather than 'not determined' after a study.
   for (const auto& b : p.blocks)
