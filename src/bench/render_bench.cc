@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <cstdio>
+#include <functional>
 #include <sstream>
 
 #include <opencv2/calib3d.hpp>
@@ -71,122 +72,113 @@ void Error8(const cv::Mat& a, const cv::Mat& b, double& mean, double& max) {
   cv::minMaxLoc(diff, nullptr, &max);
 }
 
-}  // namespace
+using Say = std::function<void(const std::string&)>;
 
-std::vector<RenderRow> RunRenderBench(const RenderBenchOptions& options) {
-  std::vector<RenderRow> rows;
-  auto say = [&](const std::string& s) { if (options.progress) options.progress(s); };
-  auto context = render::GlContext::CreateOffscreen();
-  say("GL: " + context->Describe());
-  render::GlBlur gl;
-
-  // 1. One blur of a whole frame: every method, radius and size, GPU and CPU, timed; accuracy on a crop.
-  std::vector<cv::Size> sizes = {{1280, 720}, {1920, 1080}, {4592, 3056}};
-  std::vector<double> radii = {1, 4, 8, 16};
-  if (options.quick) sizes = {{640, 360}}, radii = {1, 8};
-  if (options.frames_only) sizes.clear();
+// Part 1 at one frame size: each method and radius through GL and the CPU, timed on the whole frame; accuracy on a
+// crop (the right edge of the first disc and its surroundings, 192 px square or the frame) against the exact
+// convolution.
+void AddBlurRows(render::GlBlur& gl, const RenderBenchOptions& options, const std::vector<double>& radii,
+                 const cv::Mat& frame, const Say& say, std::vector<RenderRow>& rows) {
+  const cv::Size size = frame.size();
   const int repeats = options.quick ? 1 : 3;
-  for (const cv::Size& size : sizes) {
-    const cv::Mat frame = TestFrame(size.width, size.height);
-    // The right edge of the first disc and its surroundings (192 px square or the frame, whichever is smaller).
-    const int disc_radius = std::max(4, size.height / 12);
-    const cv::Rect around(size.width / 7 + disc_radius - 96, size.height / 2 - size.height / 6 - 96, 192, 192);
-    const cv::Mat crop = frame(around & cv::Rect(0, 0, size.width, size.height)).clone();
-    for (const std::string method : {"gaussian", "disc"})
-      for (double r : radii) {
-        // Accuracy: the crop through each path against the exact convolution.
-        const cv::Mat exact = ExactBlur(crop, method, r);
-        const cv::Mat gl_crop = method == "disc" ? gl.Disc(crop, r) : gl.Gaussian(crop, r);
-        const cv::Mat cpu_crop = method == "disc" ? render::DiscBlurCpu(crop, r) : render::GaussianBlurCpu(crop, r);
-        for (const std::string backend : {"gl", "cpu"}) {
-          RenderRow row{"blur", method, backend, r, size.width, size.height};
-          // Compared away from the crop's border, where edge handling (clamp vs mirror) and not accuracy differs.
-          const int m = int(std::ceil(2 * r)) + 2;
-          const cv::Rect inner(m, m, crop.cols - 2 * m, crop.rows - 2 * m);
-          Error8((backend == "gl" ? gl_crop : cpu_crop)(inner), exact(inner), row.mean_abs_error, row.max_abs_error);
-          std::vector<double> times;
-          // A GL disc of r = 16 over 4592 x 3056 takes many seconds: once is enough to place it on the chart.
-          const int n = size.width > 2000 && backend == "gl" ? 1 : repeats;
-          render::Texture texture(size.width, size.height);
-          if (backend == "gl") texture.Upload(frame);
-          for (int i = 0; i < n; ++i) {
+  const int disc_radius = std::max(4, size.height / 12);
+  const cv::Rect around(size.width / 7 + disc_radius - 96, size.height / 2 - size.height / 6 - 96, 192, 192);
+  const cv::Mat crop = frame(around & cv::Rect(0, 0, size.width, size.height)).clone();
+  for (const std::string method : {"gaussian", "disc"})
+    for (double r : radii) {
+      // Accuracy: the crop through each path against the exact convolution.
+      const cv::Mat exact = ExactBlur(crop, method, r);
+      const cv::Mat gl_crop = method == "disc" ? gl.Disc(crop, r) : gl.Gaussian(crop, r);
+      const cv::Mat cpu_crop = method == "disc" ? render::DiscBlurCpu(crop, r) : render::GaussianBlurCpu(crop, r);
+      for (const std::string backend : {"gl", "cpu"}) {
+        RenderRow row{"blur", method, backend, r, size.width, size.height};
+        // Compared away from the crop's border, where edge handling (clamp vs mirror) and not accuracy differs.
+        const int m = int(std::ceil(2 * r)) + 2;
+        const cv::Rect inner(m, m, crop.cols - 2 * m, crop.rows - 2 * m);
+        Error8((backend == "gl" ? gl_crop : cpu_crop)(inner), exact(inner), row.mean_abs_error, row.max_abs_error);
+        std::vector<double> times;
+        // A GL disc of r = 16 over 4592 x 3056 takes many seconds: once is enough to place it on the chart.
+        const int n = size.width > 2000 && backend == "gl" ? 1 : repeats;
+        render::Texture texture(size.width, size.height);
+        if (backend == "gl") texture.Upload(frame);
+        for (int i = 0; i < n; ++i) {
+          glFinish();
+          const auto t0 = Clock::now();
+          if (backend == "gl") {
+            gl.BlurTexture(texture, method, r);
             glFinish();
-            const auto t0 = Clock::now();
-            if (backend == "gl") {
-              gl.BlurTexture(texture, method, r);
-              glFinish();
-            } else {
-              const cv::Mat out = method == "disc" ? render::DiscBlurCpu(frame, r) : render::GaussianBlurCpu(frame, r);
-            }
-            times.push_back(Ms(t0));
+          } else {
+            const cv::Mat out = method == "disc" ? render::DiscBlurCpu(frame, r) : render::GaussianBlurCpu(frame, r);
           }
-          row.samples = n;
-          row.median_ms = Percentile(times, 0.5);
-          row.p99_ms = Percentile(times, 0.99);
-          rows.push_back(row);
-          char line[200];
-          std::snprintf(line, sizeof line, "blur %-8s %-3s r=%-4g %4dx%-4d %8.1f ms  error mean %.3f max %.0f levels",
-                        method.c_str(), backend.c_str(), r, size.width, size.height, row.median_ms, row.mean_abs_error,
-                        row.max_abs_error);
-          say(line);
+          times.push_back(Ms(t0));
         }
+        row.samples = n;
+        row.median_ms = Percentile(times, 0.5);
+        row.p99_ms = Percentile(times, 0.99);
+        rows.push_back(row);
+        char line[200];
+        std::snprintf(line, sizeof line, "blur %-8s %-3s r=%-4g %4dx%-4d %8.1f ms  error mean %.3f max %.0f levels",
+                      method.c_str(), backend.c_str(), r, size.width, size.height, row.median_ms, row.mean_abs_error,
+                      row.max_abs_error);
+        say(line);
       }
-    // The library's own Gaussian on the same float image, what the CPU Gaussian (r = 8) must not be slower than:
-    // the two timed in turn (this machine is shared: alternating keeps a slow moment from favouring either), and
-    // the CPU row of r = 8 takes these times. OpenCV picks its kernel from sigma alone, with the same border.
-    {
-      RenderRow row{"reference", "opencv_gaussianblur", "cpu", 8, size.width, size.height};
-      std::vector<double> ours, library;
-      for (int i = 0; i < (options.quick ? 1 : 5); ++i) {
-        auto t0 = Clock::now();
-        const cv::Mat a = render::GaussianBlurCpu(frame, 8);
-        ours.push_back(Ms(t0));
-        t0 = Clock::now();
-        cv::Mat b;
-        cv::GaussianBlur(frame, b, cv::Size(0, 0), 8 / 2.0, 8 / 2.0, cv::BORDER_REPLICATE);
-        library.push_back(Ms(t0));
-      }
-      for (RenderRow& r : rows)
-        if (r.kind == "blur" && r.method == "gaussian" && r.backend == "cpu" && r.radius_px == 8 &&
-            r.width == size.width && r.height == size.height)
-          r.samples = int(ours.size()), r.median_ms = Percentile(ours, 0.5), r.p99_ms = Percentile(ours, 0.99);
-      row.samples = int(library.size());
-      row.median_ms = Percentile(library, 0.5);
-      row.p99_ms = Percentile(library, 0.99);
-      row.mean_abs_error = row.max_abs_error = NAN;
-      rows.push_back(row);
     }
-    // Butterworth: CPU only, frequency domain, no radius: timed at a middling cut-off.
-    RenderRow row{"blur", "butterworth", "cpu", 0, size.width, size.height};
-    std::vector<double> times;
-    for (int i = 0; i < repeats; ++i) {
-      const auto t0 = Clock::now();
-      render::ButterworthBlurCpu(frame, size.width / 40.0);
-      times.push_back(Ms(t0));
-    }
-    row.median_ms = Percentile(times, 0.5);
-    row.p99_ms = Percentile(times, 0.99);
-    row.samples = repeats;
-    row.mean_abs_error = row.max_abs_error = NAN;  // not measured (no radius to hold it to): empty cells, not 0
-    rows.push_back(row);
-    say("blur butterworth cpu " + std::to_string(size.width) + "x" + std::to_string(size.height) + " " +
-        std::to_string(int(row.median_ms)) + " ms");
-  }
+}
 
-  // 2. The test-2 frame: two soccer balls rolling side by side from edge 1 towards edge 11 over a thesis scene
-  //    at 1920 x 1080 (16:9 crop of the thesis sensor), blurred by the thin lens x 3 (stronger, as observers liked).
-  synth::SceneOptions scene_options;
-  const cv::Size frame_size = options.quick ? cv::Size(960, 540) : cv::Size(1920, 1080);
-  scene_options.camera = ThesisCamera();
-  scene_options.camera.sensor_height_mm = 23.4 * frame_size.height / frame_size.width;
-  scene_options.camera.image_width_px = frame_size.width;
-  scene_options.camera.image_height_px = frame_size.height;
-  scene_options.supersample = 2;
-  say("rendering the background scene " + std::to_string(frame_size.width) + "x" + std::to_string(frame_size.height));
-  const synth::Scene scene = synth::RenderScene(scene_options);
+// The library's own Gaussian on the same float image, what the CPU Gaussian (r = 8) must not be slower than: the two
+// timed in turn (this machine is shared: alternating keeps a slow moment from favouring either), and the CPU row of
+// r = 8 takes these times. OpenCV picks its kernel from sigma alone, with the same border. Then Butterworth: CPU
+// only, frequency domain, no radius: timed at a middling cut-off.
+void AddReferenceRows(const RenderBenchOptions& options, const cv::Mat& frame, const Say& say,
+                      std::vector<RenderRow>& rows) {
+  const cv::Size size = frame.size();
+  {
+    RenderRow row{"reference", "opencv_gaussianblur", "cpu", 8, size.width, size.height};
+    std::vector<double> ours, library;
+    for (int i = 0; i < (options.quick ? 1 : 5); ++i) {
+      auto t0 = Clock::now();
+      const cv::Mat a = render::GaussianBlurCpu(frame, 8);
+      ours.push_back(Ms(t0));
+      t0 = Clock::now();
+      cv::Mat b;
+      cv::GaussianBlur(frame, b, cv::Size(0, 0), 8 / 2.0, 8 / 2.0, cv::BORDER_REPLICATE);
+      library.push_back(Ms(t0));
+    }
+    for (RenderRow& r : rows)
+      if (r.kind == "blur" && r.method == "gaussian" && r.backend == "cpu" && r.radius_px == 8 &&
+          r.width == size.width && r.height == size.height)
+        r.samples = int(ours.size()), r.median_ms = Percentile(ours, 0.5), r.p99_ms = Percentile(ours, 0.99);
+    row.samples = int(library.size());
+    row.median_ms = Percentile(library, 0.5);
+    row.p99_ms = Percentile(library, 0.99);
+    row.mean_abs_error = row.max_abs_error = NAN;
+    rows.push_back(row);
+  }
+  const int repeats = options.quick ? 1 : 3;
+  RenderRow row{"blur", "butterworth", "cpu", 0, size.width, size.height};
+  std::vector<double> times;
+  for (int i = 0; i < repeats; ++i) {
+    const auto t0 = Clock::now();
+    render::ButterworthBlurCpu(frame, size.width / 40.0);
+    times.push_back(Ms(t0));
+  }
+  row.median_ms = Percentile(times, 0.5);
+  row.p99_ms = Percentile(times, 0.99);
+  row.samples = repeats;
+  row.mean_abs_error = row.max_abs_error = NAN;  // not measured (no radius to hold it to): empty cells, not 0
+  rows.push_back(row);
+  say("blur butterworth cpu " + std::to_string(size.width) + "x" + std::to_string(size.height) + " " +
+      std::to_string(int(row.median_ms)) + " ms");
+}
+
+// Part 2: the test-2 frame, two soccer balls rolling side by side from edge 1 towards edge 11, blurred by the thin
+// lens x 3 (stronger, as observers liked), composed region by region and the whole-frame way; each timed, and the two
+// outputs compared on a few frames.
+void AddTestTwoFrameRows(const RenderBenchOptions& options, const synth::Scene& scene,
+                         render::FrameCompositor& compositor, const scene::SurfaceTexture& soccer, const Say& say,
+                         std::vector<RenderRow>& rows) {
   const optics::Lens lens = optics::Lens::FromCamera(scene.camera);
-  render::FrameCompositor compositor(scene.camera, scene.rvec, scene.tvec, scene.image);
-  const scene::SurfaceTexture soccer(scene::SoccerTexture(1024));
+  const cv::Size frame_size(scene.camera.image_width_px, scene.camera.image_height_px);
   const int frames = options.quick ? 10 : 120;
   for (const std::string approach : {"region", "whole_frame"}) {
     std::vector<double> times;
@@ -240,51 +232,91 @@ std::vector<RenderRow> RunRenderBench(const RenderBenchOptions& options) {
                   frame_size.width, frame_size.height, row.median_ms, row.p99_ms, frames);
     say(line);
   }
+}
+
+// Part 3, one row: `objects` balls spread over the board's 7 sections and along it, rolling over `s` for
+// `growth_frames` timed frames (frame 0 uploads the texture: not timed), at the thin lens's blur x 3 or at
+// `fixed_r_px`.
+void AddGrowthRow(const std::string& swept, int growth_frames, const synth::Scene& s, render::FrameCompositor& c,
+                  const scene::SurfaceTexture& soccer, int objects, double fixed_r_px, const Say& say,
+                  std::vector<RenderRow>& rows) {
+  const optics::Lens l = optics::Lens::FromCamera(s.camera);
+  cv::Matx33d rot;
+  cv::Rodrigues(s.rvec, rot);
+  std::vector<double> times;
+  double r_sum = 0;
+  for (int i = 0; i <= growth_frames; ++i) {
+    std::vector<scene::BlurredObject> balls(static_cast<size_t>(objects));
+    for (int b = 0; b < objects; ++b) {
+      const double y = std::fmod(250.0 * i / growth_frames + 37.0 * b, 250.0);
+      auto& o = balls[size_t(b)].object;
+      o = scene::BallOnBoard(s.board, 1 + b % 7, y, 10, 0);
+      o.texture = soccer;
+      const double z = (rot * o.center_board_mm + s.tvec)[2];
+      balls[size_t(b)].r_px = fixed_r_px > 0 ? fixed_r_px : 3 * optics::BlurRadiusPx(l, s.focus_mm, z);
+      if (i > 0) r_sum += balls[size_t(b)].r_px;
+    }
+    glFinish();
+    const auto t0 = Clock::now();
+    c.Compose(balls);
+    c.Finish();
+    if (i > 0) times.push_back(Ms(t0));
+  }
+  RenderRow row{"growth", swept, "gl", r_sum / (growth_frames * objects), s.camera.image_width_px,
+                s.camera.image_height_px};
+  row.objects = objects;
+  row.samples = int(times.size());
+  row.median_ms = Percentile(times, 0.5);
+  row.p99_ms = Percentile(times, 0.99);
+  row.mean_abs_error = row.max_abs_error = std::numeric_limits<double>::quiet_NaN();
+  rows.push_back(row);
+  char line[200];
+  std::snprintf(line, sizeof line, "growth %-7s %2d balls %dx%d r %.1f px: median %.1f ms, p99 %.1f ms",
+                swept.c_str(), objects, row.width, row.height, row.radius_px, row.median_ms, row.p99_ms);
+  say(line);
+}
+
+}  // namespace
+
+std::vector<RenderRow> RunRenderBench(const RenderBenchOptions& options) {
+  std::vector<RenderRow> rows;
+  const Say say = [&](const std::string& s) { if (options.progress) options.progress(s); };
+  auto context = render::GlContext::CreateOffscreen();
+  say("GL: " + context->Describe());
+  render::GlBlur gl;
+
+  // 1. One blur of a whole frame: every method, radius and size, GPU and CPU, timed; accuracy on a crop.
+  std::vector<cv::Size> sizes = {{1280, 720}, {1920, 1080}, {4592, 3056}};
+  std::vector<double> radii = {1, 4, 8, 16};
+  if (options.quick) sizes = {{640, 360}}, radii = {1, 8};
+  if (options.frames_only) sizes.clear();
+  for (const cv::Size& size : sizes) {
+    const cv::Mat frame = TestFrame(size.width, size.height);
+    AddBlurRows(gl, options, radii, frame, say, rows);
+    AddReferenceRows(options, frame, say, rows);
+  }
+
+  // 2. The test-2 frame over a thesis scene at 1920 x 1080 (16:9 crop of the thesis sensor).
+  synth::SceneOptions scene_options;
+  const cv::Size frame_size = options.quick ? cv::Size(960, 540) : cv::Size(1920, 1080);
+  scene_options.camera = ThesisCamera();
+  scene_options.camera.sensor_height_mm = 23.4 * frame_size.height / frame_size.width;
+  scene_options.camera.image_width_px = frame_size.width;
+  scene_options.camera.image_height_px = frame_size.height;
+  scene_options.supersample = 2;
+  say("rendering the background scene " + std::to_string(frame_size.width) + "x" + std::to_string(frame_size.height));
+  const synth::Scene scene = synth::RenderScene(scene_options);
+  render::FrameCompositor compositor(scene.camera, scene.rvec, scene.tvec, scene.image);
+  const scene::SurfaceTexture soccer(scene::SoccerTexture(1024));
+  AddTestTwoFrameRows(options, scene, compositor, soccer, say, rows);
 
   // 3. How a frame's cost grows: balls per frame, frame size, blur radius - one swept at a time from the two-ball
   //    frame above, region by region.
   const int growth_frames = options.quick ? 5 : 120;  // a p99 needs more than a few dozen frames
-  auto time_frames = [&](const synth::Scene& s, render::FrameCompositor& c, int objects, double fixed_r_px) {
-    const optics::Lens l = optics::Lens::FromCamera(s.camera);
-    cv::Matx33d rot;
-    cv::Rodrigues(s.rvec, rot);
-    std::vector<double> times;
-    double r_sum = 0;
-    for (int i = 0; i <= growth_frames; ++i) {  // frame 0 uploads the texture: not timed
-      std::vector<scene::BlurredObject> balls(static_cast<size_t>(objects));
-      for (int b = 0; b < objects; ++b) {
-        // Spread over the board's 7 sections and along it, rolling.
-        const double y = std::fmod(250.0 * i / growth_frames + 37.0 * b, 250.0);
-        auto& o = balls[size_t(b)].object;
-        o = scene::BallOnBoard(s.board, 1 + b % 7, y, 10, 0);
-        o.texture = soccer;
-        const double z = (rot * o.center_board_mm + s.tvec)[2];
-        balls[size_t(b)].r_px = fixed_r_px > 0 ? fixed_r_px : 3 * optics::BlurRadiusPx(l, s.focus_mm, z);
-        if (i > 0) r_sum += balls[size_t(b)].r_px;
-      }
-      glFinish();
-      const auto t0 = Clock::now();
-      c.Compose(balls);
-      c.Finish();
-      if (i > 0) times.push_back(Ms(t0));
-    }
-    return std::make_pair(times, r_sum / (growth_frames * objects));
-  };
-  auto add = [&](const std::string& swept, const synth::Scene& s, int objects, const std::pair<std::vector<double>, double>& t) {
-    RenderRow row{"growth", swept, "gl", t.second, s.camera.image_width_px, s.camera.image_height_px};
-    row.objects = objects;
-    row.samples = int(t.first.size());
-    row.median_ms = Percentile(t.first, 0.5);
-    row.p99_ms = Percentile(t.first, 0.99);
-    row.mean_abs_error = row.max_abs_error = std::numeric_limits<double>::quiet_NaN();
-    rows.push_back(row);
-    char line[200];
-    std::snprintf(line, sizeof line, "growth %-7s %2d balls %dx%d r %.1f px: median %.1f ms, p99 %.1f ms",
-                  swept.c_str(), objects, row.width, row.height, row.radius_px, row.median_ms, row.p99_ms);
-    say(line);
-  };
-  for (const int objects : {1, 2, 8, 32}) add("objects", scene, objects, time_frames(scene, compositor, objects, 0));
-  for (const double r : {1.0, 4.0, 8.0, 16.0}) add("radius", scene, 2, time_frames(scene, compositor, 2, r));
+  for (const int objects : {1, 2, 8, 32})
+    AddGrowthRow("objects", growth_frames, scene, compositor, soccer, objects, 0, say, rows);
+  for (const double r : {1.0, 4.0, 8.0, 16.0})
+    AddGrowthRow("radius", growth_frames, scene, compositor, soccer, 2, r, say, rows);
   const std::vector<cv::Size> growth_sizes = options.quick ? std::vector<cv::Size>{{640, 360}, {960, 540}}
                                                            : std::vector<cv::Size>{{1280, 720}, {1920, 1080}, {3840, 2160}};
   for (const cv::Size& size : growth_sizes) {
@@ -295,7 +327,7 @@ std::vector<RenderRow> RunRenderBench(const RenderBenchOptions& options) {
     say("rendering the background scene " + std::to_string(size.width) + "x" + std::to_string(size.height));
     const synth::Scene s = synth::RenderScene(o);
     render::FrameCompositor c(s.camera, s.rvec, s.tvec, s.image);
-    add("size", s, 2, time_frames(s, c, 2, 0));
+    AddGrowthRow("size", growth_frames, s, c, soccer, 2, 0, say, rows);
   }
   return rows;
 }
