@@ -1,5 +1,9 @@
 // blurcue run: one participant's session of a protocol, answered by a person at a window or by the simulated
 // observer, every answer committed to the SQLite record before the next trial.
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -11,6 +15,32 @@
 #include "session/runner.h"
 
 namespace blurcue::cli {
+namespace {
+
+std::string Clock(double seconds) {
+  const int s = std::max(0, int(std::lround(seconds)));
+  char text[32];
+  std::snprintf(text, sizeof text, "%d:%02d", s / 60, s % 60);
+  return text;
+}
+
+// A terminal gets one line rewritten after every answer; a log gets about ten lines.
+void SayProgress(const session::TrialProgress& p, bool tty) {
+  if (!tty && p.done % std::max<int64_t>(1, p.total / 10) != 0 && p.done != p.total) return;
+  std::fprintf(stderr, "%strial %lld of %lld  elapsed %s  remaining ~%s%s", tty ? "\r" : "",
+               static_cast<long long>(p.done), static_cast<long long>(p.total), Clock(p.elapsed_s).c_str(),
+               Clock(p.remaining_s).c_str(), tty ? "   " : "\n");
+}
+
+// The participant's information a protocol asks for and --info did not give, asked in the terminal.
+bool AskInTerminal(const std::string& prompt, std::string* answer) {
+  std::fputs(prompt.c_str(), stderr);
+  int c;
+  while ((c = std::getchar()) != EOF && c != '\n') *answer += char(c);
+  return c != EOF;
+}
+
+}  // namespace
 
 void AddRunCommand(CLI::App& app) {
   struct Args {
@@ -123,7 +153,15 @@ void AddRunCommand(CLI::App& app) {
                                              Echo(given.first + "=" + given.second) + " and " + Echo(item) + ")");
       options.info.emplace_back(key, item.substr(eq + 1));
     }
+    const bool tty = isatty(2);
+    bool said = false;
+    options.progress = [tty, &said](const session::TrialProgress& p) {
+      SayProgress(p, tty);
+      said = true;
+    };
+    if (isatty(0)) options.ask = AskInTerminal;
     const session::RunResult r = session::RunSession(options);
+    if (tty && said) std::fprintf(stderr, "\n");
     // Trials a stopped procedure skipped are recorded too: counted as done, and said apart.
     const int64_t by_stop_rule = r.skipped_now - r.skipped_by_criterion_now;
     std::string skipped;

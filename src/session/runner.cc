@@ -152,25 +152,90 @@ Json CollectInfo(const protocol::Protocol& p, const RunOptions& options, const G
   }
   for (const auto& f : p.participant_info) {
     if (info.contains(f.key) || !f.required) continue;
-    if (!isatty(0))
+    if (!options.ask)
       throw Error(ErrorKind::kUsage, "--info: " + options.protocol_file.string() + " asks for " + f.key + " (" +
                                          describe(f) + "); give --info " + f.key + "=VALUE");
+    std::string problem;
     for (int tries = 0;; ++tries) {
-      std::fprintf(stderr, "%s (%s): ", f.prompt.empty() ? f.key.c_str() : f.prompt.c_str(), describe(f).c_str());
       std::string line;
-      int c;
-      while ((c = std::getchar()) != EOF && c != '\n') line += char(c);
-      if (c == EOF && line.empty()) throw Error(ErrorKind::kUsage, "--info: no answer for " + f.key);
+      if (!options.ask(problem + (f.prompt.empty() ? f.key : f.prompt) + " (" + describe(f) + "): ", &line) &&
+          line.empty())
+        throw Error(ErrorKind::kUsage, "--info: no answer for " + f.key);
       const std::string why = protocol::CheckInfoValue(f, line);
       if (why.empty()) {
         info[f.key] = value_of(f, line);
         break;
       }
-      std::fprintf(stderr, "  %s %s\n", f.key.c_str(), why.c_str());
+      problem = "  " + f.key + " " + why + "\n";
       if (tries >= 4) throw Error(ErrorKind::kUsage, "--info " + f.key + ": " + why);
     }
   }
   return info;
+}
+
+// The participant's window (or an offscreen context for a simulated observer without one), of the protocol's display
+// size: a window of another size (a window manager's choice, a full screen of another mode) would show every radius
+// at another scale than the record states.
+std::unique_ptr<render::GlContext> OpenDisplay(const RunOptions& options, const protocol::Protocol& protocol,
+                                               bool window, bool simulated) {
+  if (!window) return render::GlContext::CreateOffscreen();
+  render::WindowOptions w;
+  w.width_px = protocol.display.width_px;
+  w.height_px = protocol.display.height_px;
+  w.fullscreen = protocol.display.fullscreen;
+  w.monitor = protocol.display.monitor;
+  w.title = "blurcue - " + protocol.name;  // then Runner::Title names what is on screen
+  std::unique_ptr<render::GlContext> context;
+  try {
+    context = render::GlContext::CreateWindow(w);
+  } catch (const Error& e) {
+    // Only run knows the way round a missing display: a simulated observer needs no window.
+    if (e.kind() != ErrorKind::kUsage || simulated) throw;
+    throw Error(ErrorKind::kUsage, std::string(e.what()) + "; to try the protocol without a participant, run it "
+                                                            "with --observer sim");
+  }
+  if (context->width_px() != protocol.display.width_px || context->height_px() != protocol.display.height_px)
+    throw InputError(options.protocol_file.string() + ": /display",
+                     "the window opened at " + std::to_string(context->width_px()) + " x " +
+                         std::to_string(context->height_px()) + " px, the protocol's display says " +
+                         std::to_string(protocol.display.width_px) + " x " + std::to_string(protocol.display.height_px) +
+                         " px; set width_px/height_px to the screen's (full screen: the monitor's mode)");
+  return context;
+}
+
+// What the record keeps about a session besides its trials: the display as opened, the group and how a balanced one
+// is decided, the participant's information, the observer, the design, and where its seed came from.
+SessionInfo DescribeSession(const RunOptions& options, const procedure::PreparedSession& prepared,
+                            const render::GlContext& context, bool window,
+                            const std::optional<procedure::ObserverParams>& observer, const Json& info, bool balanced,
+                            int64_t session_number) {
+  const protocol::Protocol& protocol = prepared.protocol;
+  SessionInfo meta;
+  char display[256];
+  std::snprintf(display, sizeof display, "%s %dx%d%s; %s%s", window ? "window" : "headless",
+                window ? context.width_px() : protocol.display.width_px,
+                window ? context.height_px() : protocol.display.height_px,
+                window && context.RefreshHz() > 0 ? ("@" + std::to_string(int(context.RefreshHz()))).c_str() : "",
+                context.Describe().c_str(), observer ? ("; observer " + procedure::ToString(*observer)).c_str() : "");
+  meta.display = display;
+  meta.display_profile = display::ToJson(prepared.display).dump();
+  meta.group = prepared.group;
+  if (balanced) {
+    const std::string participant = options.participant;
+    const protocol::Protocol* p = &protocol;
+    meta.assign_group = [p, participant](const std::map<std::string, int64_t>& sessions) {
+      return protocol::AssignGroup(*p, participant, sessions);
+    };
+  }
+  meta.participant_info = info.dump();
+  meta.simulated = observer.has_value();
+  meta.observer_params = observer ? procedure::ToString(*observer) : "";
+  meta.window = window;
+  meta.protocol_version = protocol.version;
+  meta.design = protocol::DescribeDesign(protocol);
+  meta.seed_given = options.seed.has_value();
+  if (!options.seed && !options.resume) meta.seed_for_number = session_number;
+  return meta;
 }
 
 RunResult RunSession(const RunOptions& options) {
@@ -225,61 +290,14 @@ RunResult RunSession(const RunOptions& options) {
   const std::string& protocol_text = prepared.protocol_text;
   const uint64_t seed = prepared.seed;
   const std::optional<calib::SceneCalib>& scene = prepared.scene;
-  std::unique_ptr<render::GlContext> context;
   const bool window = !observer || options.window;
-  if (window) {
-    render::WindowOptions w;
-    w.width_px = protocol.display.width_px;
-    w.height_px = protocol.display.height_px;
-    w.fullscreen = protocol.display.fullscreen;
-    w.monitor = protocol.display.monitor;
-    w.title = "blurcue - " + protocol.name;  // then Runner::Title names what is on screen
-    try {
-      context = render::GlContext::CreateWindow(w);
-    } catch (const Error& e) {
-      // Only run knows the way round a missing display: a simulated observer needs no window.
-      if (e.kind() != ErrorKind::kUsage || observer) throw;
-      throw Error(ErrorKind::kUsage, std::string(e.what()) + "; to try the protocol without a participant, run it "
-                                                              "with --observer sim");
-    }
-  } else {
-    context = render::GlContext::CreateOffscreen();
-  }
-  // The record states what the window shows: a window of another size than the protocol's display (a window
-  // manager's choice, a full screen of another mode) would show every radius at another scale.
-  if (window && (context->width_px() != protocol.display.width_px || context->height_px() != protocol.display.height_px))
-    throw InputError(options.protocol_file.string() + ": /display",
-                     "the window opened at " + std::to_string(context->width_px()) + " x " +
-                         std::to_string(context->height_px()) + " px, the protocol's display says " +
-                         std::to_string(protocol.display.width_px) + " x " + std::to_string(protocol.display.height_px) +
-                         " px; set width_px/height_px to the screen's (full screen: the monitor's mode)");
+  const std::unique_ptr<render::GlContext> context = OpenDisplay(options, protocol, window, observer.has_value());
   StimulusRenderer renderer(protocol, scene, prepared.images, prepared.presentation);
   // The capture folder is checked before the session starts: a path that cannot hold captures stops here.
   if (!options.capture_dir.empty()) CheckCaptureFolder(options.capture_dir, protocol.name, options.participant);
 
   Recording record = Recording::Open(options.db);
-  SessionInfo meta;
-  char display[256];
-  std::snprintf(display, sizeof display, "%s %dx%d%s; %s%s", window ? "window" : "headless",
-                window ? context->width_px() : protocol.display.width_px,
-                window ? context->height_px() : protocol.display.height_px,
-                window && context->RefreshHz() > 0 ? ("@" + std::to_string(int(context->RefreshHz()))).c_str() : "",
-                context->Describe().c_str(), observer ? ("; observer " + procedure::ToString(*observer)).c_str() : "");
-  meta.display = display;
-  meta.display_profile = display::ToJson(prepared.display).dump();
-  meta.group = prepared.group;
-  if (balanced)
-    meta.assign_group = [&](const std::map<std::string, int64_t>& sessions) {
-      return protocol::AssignGroup(protocol, options.participant, sessions);
-    };
-  meta.participant_info = info.dump();
-  meta.simulated = observer.has_value();
-  meta.observer_params = observer ? procedure::ToString(*observer) : "";
-  meta.window = window;
-  meta.protocol_version = protocol.version;
-  meta.design = protocol::DescribeDesign(protocol);
-  meta.seed_given = options.seed.has_value();
-  if (!options.seed && !options.resume) meta.seed_for_number = session_number;
+  const SessionInfo meta = DescribeSession(options, prepared, *context, window, observer, info, balanced, session_number);
   if (!options.again && !options.resume) {
     // Running a participant through a study they finished is usually a typo in the id: say so.
     const std::vector<int64_t> done = record.CompletedSessions(protocol.name, options.participant);
@@ -318,7 +336,8 @@ RunResult RunSession(const RunOptions& options) {
                       KeyMap{chosen.protocol.responses, chosen.protocol.layout == protocol::Layout::kOddOneOut},
                       window ? &keys : nullptr);
   Responder& responder = simulated ? static_cast<Responder&>(*simulated) : keys;
-  RunResult result = RunTrials({options.db, options.stop_after}, chosen, presenter, responder, record, start);
+  RunResult result =
+      RunTrials({options.db, options.stop_after, options.progress}, chosen, presenter, responder, record, start);
   result.session_number = start.session_number;
   return result;
 }

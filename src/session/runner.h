@@ -6,12 +6,14 @@
 // at the first unanswered trial with the same order.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "session/run_result.h"
+#include "session/trial_loop.h"
 
 namespace blurcue::session {
 
@@ -33,6 +35,10 @@ struct RunOptions {
   // fields are asked for in the terminal when stdin is one, else refused; a resumed session keeps what it recorded.
   std::vector<std::pair<std::string, std::string>> info;
   int stop_after = -1;           // >= 0: leave the session (running, resumable) after this many new answers
+  // Asks for a missing required field of the participant's information: shows `prompt`, reads one line into
+  // *answer; false at the end of input. Empty: nothing can be asked, and a missing field is refused (--info).
+  std::function<bool(const std::string& prompt, std::string* answer)> ask;
+  std::function<void(const TrialProgress&)> progress;  // after each answer (empty: nothing said)
 };
 
 // Throws Error: kInput for a bad protocol, a locked or mismatched session; kUsage for bad options.

@@ -139,7 +139,7 @@ class AnsweringResponder : public Responder {
 // Starts (or resumes) the participant's session in `recording` and runs it.
 RunResult RunSessionOf(Recording& recording, const procedure::PreparedSession& prepared, Presenter& presenter,
                        Responder& responder, int stop_after = -1, bool resume = false) {
-  const LoopOptions options{"runner-test.sqlite", stop_after};
+  const LoopOptions options{"runner-test.sqlite", stop_after, {}};
   SessionInfo info;
   info.simulated = true;
   info.window = false;

@@ -1,6 +1,5 @@
 #include "session/trial_loop.h"
 
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -23,13 +22,6 @@ using render::InputEvent;
 using stimulus::IntervalScene;
 using stimulus::IntervalShowsRight;
 using stimulus::TrialScene;
-
-std::string Clock(double seconds) {
-  const int s = std::max(0, int(std::lround(seconds)));
-  char text[32];
-  std::snprintf(text, sizeof text, "%d:%02d", s / 60, s % 60);
-  return text;
-}
 
 enum class Outcome { kAnswered, kQuit };
 
@@ -220,17 +212,12 @@ class Runner {
     result.answered_before = start.first_unanswered_trial;
     presenter_.OnBeat([&] { record.Heartbeat(start.session_id); });
     const auto wall_start = std::chrono::steady_clock::now();
-    const bool tty = isatty(2);
     auto progress = [&](int64_t done) {
-      // A terminal gets one line rewritten after every answer; a log gets about ten lines.
-      if (!tty && done % std::max<int64_t>(1, result.trial_count / 10) != 0 && done != result.trial_count)
-        return;
+      if (!options_.progress) return;
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
       const int64_t now = done - result.answered_before;
       const double left = now > 0 ? elapsed / double(now) * double(result.trial_count - done) : 0;
-      std::fprintf(stderr, "%strial %lld of %lld  elapsed %s  remaining ~%s%s", tty ? "\r" : "",
-                   static_cast<long long>(done), static_cast<long long>(result.trial_count), Clock(elapsed).c_str(),
-                   Clock(left).c_str(), tty ? "   " : "\n");
+      options_.progress({done, result.trial_count, elapsed, left});
     };
 
     const std::string welcome = start.resumed && start.first_unanswered_trial > 0 ? "Welcome back" : "Instructions";
@@ -350,7 +337,6 @@ class Runner {
                       "Press Return to go on"))
         break;
     }
-    if (tty) std::fprintf(stderr, "\n");
     result.completed = record.FirstUnansweredTrial(start.session_id) == result.trial_count;
     presenter_.OnBeat(nullptr);  // the session's lock is released below or by the Record
     if (result.completed) {
