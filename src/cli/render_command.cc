@@ -21,12 +21,122 @@
 #include "scene/stimuli.h"
 
 namespace blurcue::cli {
+namespace {
+
+struct RenderArgs {
+  std::string calib, background, object = "ball", blur = "fitted", method = "gaussian", out, backend = "gl";
+  int edge = 1, section = 4, display_width = 0, picture_height = 0;
+  double gain = 1, brightness = 1, contrast = 1, cutoff = 0;
+};
+
+// The depth-matching study's frame: the picture low-passed on a grey upper half, the scene photo in the lower half.
+void RenderPicture(const RenderArgs& args) {
+  const std::string name = args.object.size() > 8 && args.object[7] == ':' ? args.object.substr(8) : "face";
+  const cv::Mat picture = ReadImage(scene::ResolveStimulus(name));
+  const cv::Mat photo = ReadImage(args.background, 1);
+  const int w = args.display_width > 0 ? args.display_width : 960;
+  const scene::DepthMatchingLayout l = scene::DepthMatchingLayout::Of(w, picture.size());
+  const int h = l.frame.height, half = l.upper.height;
+  const int picture_h = args.picture_height > 0 ? args.picture_height : l.picture.height;
+  if (picture_h > half)
+    throw Error(ErrorKind::kUsage, "--picture-height-px " + std::to_string(picture_h) +
+                                       " is taller than the grey half of the frame (" + std::to_string(half) +
+                                       " px)");
+  cv::Mat frame;
+  render::StackDepthMatchingFrame(render::PictureOnGrey(picture, l.upper.size(), picture_h, args.cutoff),
+                                  l.LowerHalf(photo), &frame);
+  WriteImage(args.out, frame);
+  std::printf("picture %s, cut-off %g cycles per picture width, %d px high on a %dx%d frame -> %s\n", name.c_str(),
+              args.cutoff, picture_h, w, h, args.out.c_str());
+}
+
+// A grid or a ball composited over the photo with the blur its depth calls for (one radius, or per pixel by depth
+// where the object's depth span changes it by half a pixel or more).
+void RenderObject(const RenderArgs& args, std::chrono::steady_clock::time_point t0) {
+  if (args.calib.empty()) throw Error(ErrorKind::kUsage, "--calib is required for a grid or a ball");
+  const calib::SceneCalib scene = calib::LoadSceneCalib(args.calib);
+  const cv::Mat photo = ReadImage(args.background, 1 /* colour */);
+  scene.RequireSameSize(photo, args.background);
+  if (args.edge < 1 || args.edge > scene.board.EdgeCount())
+    throw Error(ErrorKind::kUsage, "--at-edge must be 1.." + std::to_string(scene.board.EdgeCount()) + ", got " +
+                                       std::to_string(args.edge));
+  if (args.section < 1 || args.section > scene.board.SectionCount())
+    throw Error(ErrorKind::kUsage, "--section must be 1.." + std::to_string(scene.board.SectionCount()) +
+                                       ", got " + std::to_string(args.section));
+  double fixed_r = 0;
+  const calib::BlurSource source = calib::ParseBlurSource(args.blur, &fixed_r);
+
+  scene::VirtualObject object;
+  const double y = (args.edge - 1) * scene.board.square_mm;
+  std::string texture_name;
+  if (args.object == "grid") {
+    object = scene::CardBesideBoard(scene.board, args.edge, /*left=*/false);
+    texture_name = "grid";
+  } else if (args.object.rfind("ball", 0) == 0) {
+    object = scene::BallOnBoard(scene.board, args.section, y, 10, y);
+    texture_name = args.object.size() > 5 && args.object[4] == ':' ? args.object.substr(5) : "soccer";
+  } else {
+    throw Error(ErrorKind::kUsage, "--object must be grid or ball[:TEXTURE], got " + Echo(args.object));
+  }
+  object.texture = scene::SurfaceTexture(ReadImage(scene::ResolveStimulus(texture_name)));
+  object.brightness = args.brightness;
+  object.contrast = args.contrast;
+
+  auto context = render::GlContext::CreateOffscreen();
+  render::SceneRenderer renderer(scene.camera, scene.rvec, scene.tvec);
+  const scene::Footprint f = renderer.Measure(object);
+  // An object outside the photo would leave the photo as it was, written as if it were the stimulus.
+  if ((f.bounds & cv::Rect(0, 0, photo.cols, photo.rows)).empty())
+    throw Error(ErrorKind::kUsage, "the " + args.object + " at --at-edge " + std::to_string(args.edge) +
+                                       " lies outside the " + std::to_string(photo.cols) + "x" +
+                                       std::to_string(photo.rows) + " photo; nothing would be drawn");
+  const cv::Vec3d centre = scene.ToCamera(object.center_board_mm);
+  const double r = args.gain * calib::BlurAtPx(scene, source, centre, fixed_r);
+  // One radius serves while the object's depth span changes r by less than half a pixel (a session's default
+  // content.depth_blur_threshold; here the image is the photo, so photo px are screen px).
+  auto at_depth = [&](double z) { return args.gain * calib::BlurAlongSightPx(scene, source, centre, z, fixed_r); };
+  const double r_far = at_depth(f.z_max_mm), r_near = at_depth(f.z_min_mm);
+  // Say which option made an impossible radius before the blur refuses it without knowing why.
+  for (const double v : {r, r_far, r_near})
+    if (!(v >= 0 && v <= render::kMaxBlurRadiusPx))
+      throw Error(ErrorKind::kUsage, "--blur " + args.blur + " x --gain " + BoundText(args.gain) + " gives " +
+                                         BoundText(v) + " px at the object; the blur radius must be in [0, " +
+                                         BoundText(render::kMaxBlurRadiusPx) + "] px");
+  const double span = std::abs(r_far - r_near);
+  // Model no more than the scene needs: one radius while the object's depth span changes r by < 0.5 px,
+  // a per-pixel radius from depth where it does.
+  const bool varying = span >= 0.5;
+  render::Layer layer = renderer.Draw(object, render::KernelMarginPx(args.method, std::max({r, r_far, r_near})) + 1);
+  std::unique_ptr<render::GlBlur> gl;
+  if (args.backend == "gl") gl = std::make_unique<render::GlBlur>();
+  if (varying)
+    render::BlurLayerVarying(layer, args.method, at_depth, gl.get());
+  else
+    render::BlurLayer(layer, args.method, r, gl.get());
+  cv::Mat background = DecodeSrgb8(photo);
+  render::CompositeOver(background, layer);
+  cv::Mat out = EncodeSrgb8(background);
+  if (args.display_width > 0 && args.display_width != out.cols) {
+    cv::Mat scaled;
+    cv::resize(out, scaled, cv::Size(args.display_width, int(std::lround(double(out.rows) * args.display_width /
+                                                                          out.cols))),
+               0, 0, cv::INTER_AREA);
+    out = scaled;
+  }
+  WriteImage(args.out, out);
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  std::printf("%s at edge %d: depth %.1f mm, blur %s x %.2f = %.2f px (%s, %s); layer %dx%d of %dx%d -> %s in %.0f ms\n",
+              args.object.c_str(), args.edge, f.z_center_mm, ToString(source).c_str(), args.gain, r,
+              args.method.c_str(), args.backend.c_str(), layer.roi.width, layer.roi.height, photo.cols, photo.rows,
+              args.out.c_str(), ms);
+  if (varying)
+    std::printf("its depth span changes r from %.2f to %.2f px: blurred per pixel by depth\n", r_near, r_far);
+}
+
+}  // namespace
+
 void AddRenderCommand(CLI::App& app) {
-  struct Args {
-    std::string calib, background, object = "ball", blur = "fitted", method = "gaussian", out, backend = "gl";
-    int edge = 1, section = 4, display_width = 0, picture_height = 0;
-    double gain = 1, brightness = 1, contrast = 1, cutoff = 0;
-  };
+  using Args = RenderArgs;
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "render",
@@ -89,104 +199,8 @@ void AddRenderCommand(CLI::App& app) {
       }
       guard.OutputFile("--out", args->out).Check();
     }
-    if (args->object.rfind("picture", 0) == 0) {
-      const std::string name = args->object.size() > 8 && args->object[7] == ':' ? args->object.substr(8) : "face";
-      const cv::Mat picture = ReadImage(scene::ResolveStimulus(name));
-      const cv::Mat photo = ReadImage(args->background, 1);
-      const int w = args->display_width > 0 ? args->display_width : 960;
-      const scene::DepthMatchingLayout l = scene::DepthMatchingLayout::Of(w, picture.size());
-      const int h = l.frame.height, half = l.upper.height;
-      const int picture_h = args->picture_height > 0 ? args->picture_height : l.picture.height;
-      if (picture_h > half)
-        throw Error(ErrorKind::kUsage, "--picture-height-px " + std::to_string(picture_h) +
-                                           " is taller than the grey half of the frame (" + std::to_string(half) +
-                                           " px)");
-      cv::Mat frame;
-      render::StackDepthMatchingFrame(render::PictureOnGrey(picture, l.upper.size(), picture_h, args->cutoff),
-                                      l.LowerHalf(photo), &frame);
-      WriteImage(args->out, frame);
-      std::printf("picture %s, cut-off %g cycles per picture width, %d px high on a %dx%d frame -> %s\n", name.c_str(),
-                  args->cutoff, picture_h, w, h, args->out.c_str());
-      return;
-    }
-    if (args->calib.empty()) throw Error(ErrorKind::kUsage, "--calib is required for a grid or a ball");
-    const calib::SceneCalib scene = calib::LoadSceneCalib(args->calib);
-    const cv::Mat photo = ReadImage(args->background, 1 /* colour */);
-    scene.RequireSameSize(photo, args->background);
-    if (args->edge < 1 || args->edge > scene.board.EdgeCount())
-      throw Error(ErrorKind::kUsage, "--at-edge must be 1.." + std::to_string(scene.board.EdgeCount()) + ", got " +
-                                         std::to_string(args->edge));
-    if (args->section < 1 || args->section > scene.board.SectionCount())
-      throw Error(ErrorKind::kUsage, "--section must be 1.." + std::to_string(scene.board.SectionCount()) +
-                                         ", got " + std::to_string(args->section));
-    double fixed_r = 0;
-    const calib::BlurSource source = calib::ParseBlurSource(args->blur, &fixed_r);
-
-    scene::VirtualObject object;
-    const double y = (args->edge - 1) * scene.board.square_mm;
-    std::string texture_name;
-    if (args->object == "grid") {
-      object = scene::CardBesideBoard(scene.board, args->edge, /*left=*/false);
-      texture_name = "grid";
-    } else if (args->object.rfind("ball", 0) == 0) {
-      object = scene::BallOnBoard(scene.board, args->section, y, 10, y);
-      texture_name = args->object.size() > 5 && args->object[4] == ':' ? args->object.substr(5) : "soccer";
-    } else {
-      throw Error(ErrorKind::kUsage, "--object must be grid or ball[:TEXTURE], got " + Echo(args->object));
-    }
-    object.texture = scene::SurfaceTexture(ReadImage(scene::ResolveStimulus(texture_name)));
-    object.brightness = args->brightness;
-    object.contrast = args->contrast;
-
-    auto context = render::GlContext::CreateOffscreen();
-    render::SceneRenderer renderer(scene.camera, scene.rvec, scene.tvec);
-    const scene::Footprint f = renderer.Measure(object);
-    // An object outside the photo would leave the photo as it was, written as if it were the stimulus.
-    if ((f.bounds & cv::Rect(0, 0, photo.cols, photo.rows)).empty())
-      throw Error(ErrorKind::kUsage, "the " + args->object + " at --at-edge " + std::to_string(args->edge) +
-                                         " lies outside the " + std::to_string(photo.cols) + "x" +
-                                         std::to_string(photo.rows) + " photo; nothing would be drawn");
-    const cv::Vec3d centre = scene.ToCamera(object.center_board_mm);
-    const double r = args->gain * calib::BlurAtPx(scene, source, centre, fixed_r);
-    // One radius serves while the object's depth span changes r by less than half a pixel (a session's default
-    // content.depth_blur_threshold; here the image is the photo, so photo px are screen px).
-    auto at_depth = [&](double z) { return args->gain * calib::BlurAlongSightPx(scene, source, centre, z, fixed_r); };
-    const double r_far = at_depth(f.z_max_mm), r_near = at_depth(f.z_min_mm);
-    // Say which option made an impossible radius before the blur refuses it without knowing why.
-    for (const double v : {r, r_far, r_near})
-      if (!(v >= 0 && v <= render::kMaxBlurRadiusPx))
-        throw Error(ErrorKind::kUsage, "--blur " + args->blur + " x --gain " + BoundText(args->gain) + " gives " +
-                                           BoundText(v) + " px at the object; the blur radius must be in [0, " +
-                                           BoundText(render::kMaxBlurRadiusPx) + "] px");
-    const double span = std::abs(r_far - r_near);
-    // Model no more than the scene needs: one radius while the object's depth span changes r by < 0.5 px,
-    // a per-pixel radius from depth where it does.
-    const bool varying = span >= 0.5;
-    render::Layer layer = renderer.Draw(object, render::KernelMarginPx(args->method, std::max({r, r_far, r_near})) + 1);
-    std::unique_ptr<render::GlBlur> gl;
-    if (args->backend == "gl") gl = std::make_unique<render::GlBlur>();
-    if (varying)
-      render::BlurLayerVarying(layer, args->method, at_depth, gl.get());
-    else
-      render::BlurLayer(layer, args->method, r, gl.get());
-    cv::Mat background = DecodeSrgb8(photo);
-    render::CompositeOver(background, layer);
-    cv::Mat out = EncodeSrgb8(background);
-    if (args->display_width > 0 && args->display_width != out.cols) {
-      cv::Mat scaled;
-      cv::resize(out, scaled, cv::Size(args->display_width, int(std::lround(double(out.rows) * args->display_width /
-                                                                            out.cols))),
-                 0, 0, cv::INTER_AREA);
-      out = scaled;
-    }
-    WriteImage(args->out, out);
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("%s at edge %d: depth %.1f mm, blur %s x %.2f = %.2f px (%s, %s); layer %dx%d of %dx%d -> %s in %.0f ms\n",
-                args->object.c_str(), args->edge, f.z_center_mm, ToString(source).c_str(), args->gain, r,
-                args->method.c_str(), args->backend.c_str(), layer.roi.width, layer.roi.height, photo.cols,
-                photo.rows, args->out.c_str(), ms);
-    if (varying)
-      std::printf("its depth span changes r from %.2f to %.2f px: blurred per pixel by depth\n", r_near, r_far);
+    if (args->object.rfind("picture", 0) == 0) return RenderPicture(*args);
+    RenderObject(*args, t0);
   });
 }
 
