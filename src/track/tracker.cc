@@ -98,7 +98,11 @@ FrameResult Tracker::Process(const cv::Mat& photo, int index, double time_s) {
                          std::to_string(camera_.image_width_px) + "x" + std::to_string(camera_.image_height_px));
   // The frame's grey and linear-light planes, once, into the buffers of the previous frame: tracking, detection and
   // the measurement all read them.
-  planes_.Fill(photo);
+  // Without the measurement only the grey plane is needed: the linear one is a third of a pose-only frame's time.
+  if (options_.measure_blur)
+    planes_.Fill(photo);
+  else
+    ToGrey8(photo, planes_.grey8);
   const cv::Mat& grey8 = planes_.grey8;
   cv::Mat small;
   if (!options_.always_detect) {
@@ -128,6 +132,11 @@ FrameResult Tracker::Process(const cv::Mat& photo, int index, double time_s) {
   }
   before_last_ = std::exchange(last_, pose->corners);
   last_small_ = small;
+  r.pose = pose;
+  if (!options_.measure_blur) {
+    r.frame_ms = MsSince(t0);
+    return r;
+  }
 
   const auto t1 = std::chrono::steady_clock::now();
   calib::CalibrateOptions options = options_.calibrate;
@@ -141,6 +150,7 @@ FrameResult Tracker::Process(const cv::Mat& photo, int index, double time_s) {
     if (e.kind() != ErrorKind::kNotFound) throw;
     r.status = FrameStatus::kLost;
     r.note = e.what();
+    r.pose.reset();
   }
   r.measure_ms = MsSince(t1);
   r.frame_ms = MsSince(t0);

@@ -1,0 +1,60 @@
+#!/bin/bash
+# blurcue live end to end on a 60-frame ground-truth take (synth-take; tracked by track; drawn by ar for comparison):
+#   make      the take, its track folder and ar's CSV of a ball (the fixture the other cases read)
+#   window    played at 30 fps through `live --window` under an Xvfb of its own: tests/live_check.py holds the log whole,
+#             every pose within 0.1 % depth of the truth and the ball's radius within 1 % of ar's; TIMING=1 also holds
+#             the real-time bounds (dropped <= 5 %, latency median <= 33 ms, p95 <= 50 ms), which are printed otherwise
+#   headless  the same headless (EGL): the video ends, one clear line, exit 0, the log whole
+#   nocamera  a camera that is not there: exit 3, one line naming the device, and a log of no frames written whole
+# Usage: live_test.sh CASE BLURCUE DIR
+set -u
+CASE=$1 BC=$2 W=$3
+. "$(dirname "$0")/lib.sh"
+T=$W/take
+LIVE=(--camera "$T/camera.json" --track "$W/track" --ball 87.5,125 --exposure-ms 10)
+
+case $CASE in
+make)
+  rm -rf "$W" && mkdir -p "$W"
+  "$BC" synth-take --out "$T" --frames 60 --supersample 2 --quiet || fail "synth-take failed"
+  "$BC" track "$T/take.avi" --camera "$T/camera.json" --out "$W/track" --quiet || fail "track failed"
+  "$BC" ar "$T/take.avi" --track "$W/track" --ball 87.5,125 --exposure-ms 10 --out "$W/ar.avi" --quiet ||
+    fail "ar failed"
+  [ "$(wc -l < "$W/ar.csv")" -eq 61 ] || fail "ar.csv: not 60 frames: $(wc -l < "$W/ar.csv") lines"
+  echo "ok: live_test make: a 60-frame take, tracked, and ar's ball" ;;
+window)
+  rm -rf "$W/window" && mkdir -p "$W/window"
+  W=$W/window start_xvfb
+  "$BC" live "$T/take.avi" "${LIVE[@]}" --window --fps 30 --log "$W/window/log" --save-frame 30 \
+    > "$W/window/out" 2> "$W/window/err" || fail "live --window: exit $?: $(cat "$W/window/err")"
+  grep -q "in a window (vsync)" "$W/window/err" || fail "live did not say it showed a window: $(cat "$W/window/err")"
+  grep -q "take.avi ended after 60 frames" "$W/window/out" || fail "live's end: $(cat "$W/window/out")"
+  cat "$W/window/out"
+  $PY "$(dirname "$0")/live_check.py" "$W/window/log" "$T" "$W/ar.csv" 60 ${TIMING:+--timing} ||
+    fail "live_check.py (window)"
+  [ -s "$W/window/log/frame-0030.png" ] || fail "--save-frame 30 wrote no frame-0030.png"
+  echo "ok: live_test window" ;;
+headless)
+  rm -rf "$W/headless"
+  "$BC" live "$T/take.avi" "${LIVE[@]}" --log "$W/headless" > "$W/headless.out" 2> "$W/headless.err"
+  code=$?
+  [ $code = 0 ] || fail "live headless: exit $code: $(cat "$W/headless.err")"
+  head -1 "$W/headless.out" | grep -q "^$T/take.avi ended after 60 frames$" ||
+    fail "the video's end is not one clear first line: $(cat "$W/headless.out")"
+  grep -q "^[0-9]* frames shown, [0-9]* dropped" "$W/headless.out" || fail "no summary line: $(cat "$W/headless.out")"
+  grep -q '"ended": ".*take.avi ended after 60 frames"' "$W/headless/summary.json" ||
+    fail "summary.json does not say how the run ended: $(cat "$W/headless/summary.json")"
+  $PY "$(dirname "$0")/live_check.py" "$W/headless" "$T" "$W/ar.csv" 60 || fail "live_check.py (headless)"
+  echo "ok: live_test headless" ;;
+nocamera)
+  rm -rf "$W/nocamera"
+  "$BC" live /dev/video97 "${LIVE[@]}" --log "$W/nocamera" > "$W/nocamera.out" 2> "$W/nocamera.err"
+  code=$?
+  [ $code = 3 ] && [ "$(wc -l < "$W/nocamera.err")" = 1 ] &&
+    grep -q "^blurcue: /dev/video97: no camera there" "$W/nocamera.err" ||
+    fail "a missing camera: exit $code, stderr: $(cat "$W/nocamera.err")"
+  [ "$(cat "$W/nocamera/live.csv" | wc -l)" = 1 ] || fail "the log of no frames is not a header alone"
+  grep -q '"frames_shown": 0' "$W/nocamera/summary.json" || fail "summary.json: $(cat "$W/nocamera/summary.json")"
+  echo "ok: live_test nocamera: $(cat "$W/nocamera.err")" ;;
+*) fail "unknown case $CASE" ;;
+esac
