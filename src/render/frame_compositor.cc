@@ -170,7 +170,8 @@ void FrameCompositor::SetFrame(const cv::Vec3d& rvec, const cv::Vec3d& tvec, con
   const cv::Size scaled(m.view.photo_width_px, m.view.photo_height_px);
   CV_Assert(background.size() == scaled ||
             (background.cols == m.camera.image_width_px && background.rows == m.camera.image_height_px));
-  m.photo.UploadSrgb(background.size() == scaled ? background : ResampleSrgb8(background, scaled));
+  // The photo is only blitted (level 0, GL_NEAREST): its mipmaps, which llvmpipe makes on the CPU, are not made.
+  m.photo.UploadSrgb(background.size() == scaled ? background : ResampleSrgb8(background, scaled), false);
   m.renderer.SetPose(rvec, tvec);
   m.Place(m.view.x_px, m.view.y_px);  // the base frame from the new photo; the whole frame dirty
 }
