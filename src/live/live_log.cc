@@ -65,6 +65,8 @@ LiveSummary Summarize(const std::vector<LiveRow>& rows, int dropped, const std::
   s.median_render_ms = Percentile(render, 0.5);
   if (rows.size() >= 2 && rows.back().display_s > rows.front().display_s)
     s.shown_fps = (rows.size() - 1) / (rows.back().display_s - rows.front().display_s);
+  if (rows.size() >= 2 && rows.back().arrival_s > rows.front().arrival_s)
+    s.delivered_fps = (rows.back().frame - rows.front().frame) / (rows.back().arrival_s - rows.front().arrival_s);
   return s;
 }
 
@@ -73,9 +75,9 @@ std::string SummaryLine(const LiveSummary& s) {
   char line[400];
   std::snprintf(line, sizeof line,
                 "%d frames shown, %d dropped (%.1f %%); latency median %.1f ms, p95 %.1f ms, max %.1f ms; "
-                "%d found, %d tracked, %d lost; %.1f frames a second shown",
+                "%d found, %d tracked, %d lost; %.1f frames a second shown of %.1f delivered",
                 s.shown, s.dropped, delivered > 0 ? 100.0 * s.dropped / delivered : 0.0, s.median_latency_ms,
-                s.p95_latency_ms, s.max_latency_ms, s.found, s.tracked, s.lost, s.shown_fps);
+                s.p95_latency_ms, s.max_latency_ms, s.found, s.tracked, s.lost, s.shown_fps, s.delivered_fps);
   return line;
 }
 
@@ -92,6 +94,7 @@ Json SummaryJson(const LiveSummary& s) {
   j["median_track_ms"] = s.median_track_ms;
   j["median_render_ms"] = s.median_render_ms;
   j["shown_fps"] = s.shown_fps;
+  j["delivered_fps"] = s.delivered_fps;
   j["ended"] = s.ended;
   return j;
 }

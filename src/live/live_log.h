@@ -40,6 +40,8 @@ struct LiveSummary {
   double median_latency_ms = 0, p95_latency_ms = 0, max_latency_ms = 0;
   double median_track_ms = 0, median_render_ms = 0;
   double shown_fps = 0;   // frames shown a second, between the first display and the last
+  double delivered_fps = 0;  // frames the input delivered a second (dropped ones too), between the first arrival shown
+                             // and the last: a camera's own rate, or a video's pace when its decoding kept up
   std::string ended;      // why the run ended, in words
 };
 // Totals of `rows`; `dropped` the mailbox's count (frames dropped after the last frame shown included).

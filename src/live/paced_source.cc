@@ -52,12 +52,9 @@ PacedSource::~PacedSource() { Stop(); }
 int PacedSource::expected_frames() const { return file_ ? file_->expected_frames() : 0; }
 
 void PacedSource::Start(FrameMailbox* mailbox, Clock::time_point start) {
-  thread_ = std::thread([this, mailbox, start] {
+  auto guarded = [this, mailbox](auto&& body) {
     try {
-      if (file_)
-        ReadVideo(mailbox, start);
-      else
-        ReadCamera(mailbox);
+      body();
     } catch (const Error& e) {
       {
         std::lock_guard<std::mutex> lock(mutex_);
@@ -72,7 +69,13 @@ void PacedSource::Start(FrameMailbox* mailbox, Clock::time_point start) {
       }
       mailbox->Close(wrapped.what(), true);
     }
-  });
+  };
+  if (!file_) {
+    thread_ = std::thread([this, mailbox, guarded] { guarded([&] { ReadCamera(mailbox); }); });
+    return;
+  }
+  decoder_ = std::thread([this] { DecodeVideo(); });
+  thread_ = std::thread([this, mailbox, start, guarded] { guarded([&] { PaceVideo(mailbox, start); }); });
 }
 
 void PacedSource::Stop() {
@@ -81,7 +84,9 @@ void PacedSource::Stop() {
     stop_ = true;
   }
   wake_.notify_all();
+  ahead_changed_.notify_all();
   if (thread_.joinable()) thread_.join();
+  if (decoder_.joinable()) decoder_.join();
 }
 
 std::optional<Error> PacedSource::error() const {
@@ -94,21 +99,74 @@ bool PacedSource::WaitUntil(Clock::time_point due) {
   return !wake_.wait_until(lock, due, [this] { return stop_.load(); });
 }
 
-void PacedSource::ReadVideo(FrameMailbox* mailbox, Clock::time_point start) {
-  LiveFrame frame;
+void PacedSource::DecodeVideo() {
   int read = 0;
-  while (!stop_) {
-    if (max_frames_ > 0 && read == max_frames_) {
-      mailbox->Close(std::to_string(read) + " frames read (--frames)", false);
-      return;
+  std::string why;
+  std::optional<Error> error;
+  try {
+    while (true) {
+      LiveFrame frame;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        ahead_changed_.wait(lock, [this] { return stop_ || int(ahead_.size()) < kDecodeAhead; });
+        if (stop_) return;
+        if (!spare_.empty()) {
+          frame.image = std::move(spare_.back());
+          spare_.pop_back();
+        }
+      }
+      if (max_frames_ > 0 && read == max_frames_) {
+        why = std::to_string(read) + " frames read (--frames)";
+        break;
+      }
+      if (!file_->Next(&frame.image, &frame.index, &frame.time_s)) {
+        why = input_ + " ended after " + std::to_string(read) + " frames";
+        break;
+      }
+      ++read;
+      std::lock_guard<std::mutex> lock(mutex_);
+      ahead_.push_back(std::move(frame));
+      ahead_changed_.notify_all();
     }
-    // Decoded before it is due, as a camera has a frame whole before it hands it over; posted at its time, or at
-    // once when decoding took longer (then it arrives late, and the log's arrival times show it).
-    if (!file_->Next(&frame.image, &frame.index, &frame.time_s)) {
-      mailbox->Close(input_ + " ended after " + std::to_string(read) + " frames", false);
-      return;
+  } catch (const Error& e) {
+    error = e;
+    why = e.what();
+  } catch (const std::exception& e) {
+    error = Error(ErrorKind::kInput, input_ + ": " + e.what());
+    why = error->what();
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  decoded_end_ = true;
+  end_why_ = why;
+  end_error_ = error;
+  ahead_changed_.notify_all();
+}
+
+void PacedSource::PaceVideo(FrameMailbox* mailbox, Clock::time_point start) {
+  LiveFrame frame;
+  while (true) {
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      ahead_changed_.wait(lock, [this] { return stop_ || !ahead_.empty() || decoded_end_; });
+      if (stop_) return;
+      if (ahead_.empty()) {  // the decoder is done and every frame it decoded was posted
+        if (end_error_) {
+          error_ = end_error_;
+          lock.unlock();
+          mailbox->Close(end_why_, true);
+        } else {
+          lock.unlock();
+          mailbox->Close(end_why_, false);
+        }
+        return;
+      }
+      if (!frame.image.empty()) spare_.push_back(std::move(frame.image));
+      frame = std::move(ahead_.front());
+      ahead_.pop_front();
+      ahead_changed_.notify_all();
     }
-    ++read;
+    // Posted at its time, or at once when it was decoded later than that (then it arrives late, and the log's
+    // arrival times show it).
     const auto due = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
                                  frame.index / fps_));
     if (!WaitUntil(due)) return;

@@ -1,7 +1,10 @@
 #pragma once
-// INPUT as `blurcue live` reads it, on a thread of its own: a camera (a V4L2 device through OpenCV's videoio) as it
-// delivers frames, or a video file or image sequence played as a camera would deliver it - frame k at start + k / fps,
-// decoded beforehand - into a FrameMailbox (which drops, never queues, a frame the loop had no time for).
+// INPUT as `blurcue live` reads it, on threads of its own: a camera (a V4L2 device through OpenCV's videoio) as it
+// delivers frames, or a video file or image sequence played as a camera would deliver it - frame k posted at
+// start + k / fps by a pacer, decoded up to kDecodeAhead frames ahead by a decoder, so that a frame whose decoding
+// is slow for a moment still arrives on time - into a FrameMailbox (which drops, never queues, a frame the loop had
+// no time for).
+#include <deque>
 #include <atomic>
 #include <condition_variable>
 #include <memory>
@@ -9,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "core/error.h"
 #include "core/media.h"
@@ -19,6 +23,10 @@ namespace blurcue::live {
 
 // The V4L2 device INPUT names: "/dev/videoN" or a whole number N (both /dev/videoN); empty for a video or a pattern.
 std::string CameraDevice(const std::string& input);
+
+// Frames a video or sequence is decoded ahead of its pace (8 frames of 1148 x 764: 21 MB): a camera has each frame
+// whole when it hands it over, and a file's decoding, which a camera does not do, must not make frames late.
+constexpr int kDecodeAhead = 8;
 
 class PacedSource {
  public:
@@ -46,7 +54,8 @@ class PacedSource {
   std::optional<Error> error() const;
 
  private:
-  void ReadVideo(FrameMailbox* mailbox, Clock::time_point start);
+  void DecodeVideo();
+  void PaceVideo(FrameMailbox* mailbox, Clock::time_point start);
   void ReadCamera(FrameMailbox* mailbox);
   bool WaitUntil(Clock::time_point due);  // false when stopped first
 
@@ -55,7 +64,16 @@ class PacedSource {
   int max_frames_ = 0;
   std::unique_ptr<track::FrameSource> file_;
   std::unique_ptr<media::VideoReader> camera_;
-  std::thread thread_;
+  std::thread thread_, decoder_;
+  // Decoded frames waiting for their time (the decoder fills, the pacer empties), and how the file ended: `decoded_end_`
+  // once the decoder is done, with `end_why_` ("" at a clean end is not used: the reason is always said) and
+  // `end_error_` when it ended on an error.
+  std::deque<LiveFrame> ahead_;
+  std::vector<cv::Mat> spare_;  // buffers the pacer has posted and got back, for the decoder to reuse
+  bool decoded_end_ = false;
+  std::string end_why_;
+  std::optional<Error> end_error_;
+  std::condition_variable ahead_changed_;
   std::atomic<bool> stop_{false};
   mutable std::mutex mutex_;
   std::condition_variable wake_;

@@ -48,12 +48,14 @@ class Tracker {
   FrameResult Process(const cv::Mat& photo, int index, double time_s);
 
  private:
-  std::optional<calib::BoardPose> Track(const cv::Mat& grey8, const cv::Mat& small, std::string* note) const;
+  std::optional<calib::BoardPose> Track(const cv::Mat& grey8, const cv::Mat& small, double time_s,
+                                        std::string* note) const;
 
   Camera camera_;
   Board board_;
   TrackOptions options_;
   std::vector<cv::Point2f> last_, before_last_;  // corners of the last two frames with a pose (empty: none)
+  double last_time_s_ = 0, before_last_time_s_ = 0;  // and their times
   cv::Mat last_small_;  // the last frame with a pose, a quarter size, float: its shift to the next one
   calib::PhotoPlanes planes_;  // the frame's grey and linear planes; their buffers serve the whole take
 };
