@@ -14,7 +14,8 @@ FRAMES  the frames the take holds: every one is shown or counted dropped
 Checks: the log is whole (every delivered frame a row or a drop, rows in order, summary.json agreeing with live.csv);
 every frame with a pose has its depth (tvec z) within 0.1 % of the truth's - a pose one square off is 25 mm, 5 %;
 the ball live drew in each frame has the radius ar drew for that frame within 1 %, its screen place within 0.5 px,
-and its streak (live: since the frame before; ar: across both neighbours) within 10 % where it is over 1 px.
+and its streak (live: since the last frame with a pose; ar: across both neighbours) within 10 % where ar's is over
+1 px (a 30 ms exposure: 1.4-1.9 px on the test take).
 """
 import csv
 import json
@@ -66,7 +67,7 @@ def main():
     assert lost == 0, f"{lost} frames lost on a take the tracker follows whole"
 
     # Drawn: the ball's radius and place as ar drew them in the same frame.
-    worst_r, worst_xy, worst_streak, compared = 0.0, 0.0, 0.0, 0
+    worst_r, worst_xy, worst_streak, compared, streaks = 0.0, 0.0, 0.0, 0, 0
     for d in drawn:
         key = (int(d["frame"]), d["object"])
         assert key in ar, f"ar drew nothing for {key}"
@@ -77,19 +78,21 @@ def main():
                                           float(d["screen_y_px"]) - float(a["screen_y_px"])))
         m_live = np.array([float(d["motion_x_px"]), float(d["motion_y_px"])])
         m_ar = np.array([float(a["motion_x_px"]), float(a["motion_y_px"])])
-        if np.linalg.norm(m_ar) > 1 and np.linalg.norm(m_live) > 0:
+        if np.linalg.norm(m_ar) > 1 and int(d["frame"]) != int(live[0]["frame"]):
+            streaks += 1
             worst_streak = max(worst_streak, np.linalg.norm(m_live - m_ar) / np.linalg.norm(m_ar))
         compared += 1
     assert compared == len(live), (compared, len(live))
     assert worst_r <= 0.01, f"a radius {100 * worst_r:.3f} % from ar's"
     assert worst_xy <= 0.5, f"a ball {worst_xy:.3f} px from ar's"
+    assert streaks >= len(live) // 2, f"only {streaks} streaks over 1 px to compare"
     assert worst_streak <= 0.10, f"a streak {100 * worst_streak:.1f} % from ar's"
 
     median, p95 = np.percentile(latency, 50), np.percentile(latency, 95)
     share = summary["frames_dropped"] / frames
     words = (f"{len(shown)} shown, {summary['frames_dropped']} dropped ({100 * share:.1f} %), latency median "
              f"{median:.1f} ms, p95 {p95:.1f} ms; depth within {100 * worst_depth:.4f} % of the truth; radius within "
-             f"{100 * worst_r:.4f} % of ar's, place within {worst_xy:.4f} px, streak within {100 * worst_streak:.2f} %")
+             f"{100 * worst_r:.4f} % of ar's, place within {worst_xy:.4f} px, streak within {100 * worst_streak:.2f} % ({streaks} frames)")
     if timing:
         assert share <= 0.05, f"{100 * share:.1f} % of frames dropped (at most 5 %): {words}"
         assert median <= 33, f"median latency {median:.1f} ms (at most 33): {words}"

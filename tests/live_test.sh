@@ -3,22 +3,24 @@
 #   make      the take, its track folder and ar's CSV of a ball (the fixture the other cases read)
 #   window    played at 30 fps through `live --window` under an Xvfb of its own: tests/live_check.py holds the log whole,
 #             every pose within 0.1 % depth of the truth and the ball's radius within 1 % of ar's; TIMING=1 also holds
-#             the real-time bounds (dropped <= 5 %, latency median <= 33 ms, p95 <= 50 ms), which are printed otherwise
-#   headless  the same headless (EGL): the video ends, one clear line, exit 0, the log whole
+#             the real-time bounds (dropped <= 5 %, latency median <= 33 ms, p95 <= 50 ms), which are printed otherwise;
+#             then Escape pressed in the window (xdotool) ends a run: exit 0, the log whole
+#   headless  the same headless (EGL): the video ends, one clear line, exit 0, the log whole; a video cut in half:
+#             one line naming it, exit 3, the log of the frames before the damage whole
 #   nocamera  a camera that is not there: exit 3, one line naming the device, and a log of no frames written whole
 # Usage: live_test.sh CASE BLURCUE DIR
 set -u
 CASE=$1 BC=$2 W=$3
 . "$(dirname "$0")/lib.sh"
 T=$W/take
-LIVE=(--camera "$T/camera.json" --track "$W/track" --ball 87.5,125 --exposure-ms 10)
+LIVE=(--camera "$T/camera.json" --track "$W/track" --ball 87.5,125 --exposure-ms 30)
 
 case $CASE in
 make)
   rm -rf "$W" && mkdir -p "$W"
   "$BC" synth-take --out "$T" --frames 60 --supersample 2 --quiet || fail "synth-take failed"
   "$BC" track "$T/take.avi" --camera "$T/camera.json" --out "$W/track" --quiet || fail "track failed"
-  "$BC" ar "$T/take.avi" --track "$W/track" --ball 87.5,125 --exposure-ms 10 --out "$W/ar.avi" --quiet ||
+  "$BC" ar "$T/take.avi" --track "$W/track" --ball 87.5,125 --exposure-ms 30 --out "$W/ar.avi" --quiet ||
     fail "ar failed"
   [ "$(wc -l < "$W/ar.csv")" -eq 61 ] || fail "ar.csv: not 60 frames: $(wc -l < "$W/ar.csv") lines"
   echo "ok: live_test make: a 60-frame take, tracked, and ar's ball" ;;
@@ -33,6 +35,18 @@ window)
   $PY "$(dirname "$0")/live_check.py" "$W/window/log" "$T" "$W/ar.csv" 60 ${TIMING:+--timing} ||
     fail "live_check.py (window)"
   [ -s "$W/window/log/frame-0030.png" ] || fail "--save-frame 30 wrote no frame-0030.png"
+  # Escape ends a run: the take at 10 fps (6 s), Escape pressed in the window after a second; exit 0, the log whole.
+  "$BC" live "$T/take.avi" "${LIVE[@]}" --window --fps 10 --log "$W/window/escape" > "$W/window/escape.out" \
+    2> "$W/window/escape.err" &
+  pid=$!
+  wid=$(timeout 60 xdotool search --sync --name "blurcue live" | head -1)
+  sleep 1
+  xdotool windowfocus --sync "$wid" key Escape || fail "xdotool could not press Escape in the window"
+  wait $pid || fail "live --window, Escape: exit $?: $(cat "$W/window/escape.err")"
+  head -1 "$W/window/escape.out" | grep -q "^Escape pressed$" || fail "Escape: $(cat "$W/window/escape.out")"
+  shown=$(( $(wc -l < "$W/window/escape/live.csv") - 1 ))
+  [ $shown -ge 1 ] && [ $shown -lt 55 ] && grep -q "\"ended\": \"Escape pressed\"" "$W/window/escape/summary.json" ||
+    fail "Escape's log: $shown rows, $(cat "$W/window/escape/summary.json")"
   echo "ok: live_test window" ;;
 headless)
   rm -rf "$W/headless"
@@ -45,6 +59,17 @@ headless)
   grep -q '"ended": ".*take.avi ended after 60 frames"' "$W/headless/summary.json" ||
     fail "summary.json does not say how the run ended: $(cat "$W/headless/summary.json")"
   $PY "$(dirname "$0")/live_check.py" "$W/headless" "$T" "$W/ar.csv" 60 || fail "live_check.py (headless)"
+  # A video cut short: the frames before the damage are shown, then one line naming the video, exit 3, the log whole.
+  head -c $(( $(stat -c %s "$T/take.avi") / 2 )) "$T/take.avi" > "$W/cut.avi"
+  rm -rf "$W/cut"
+  "$BC" live "$W/cut.avi" "${LIVE[@]}" --log "$W/cut" > "$W/cut.out" 2> "$W/cut.err"
+  code=$?
+  [ $code = 3 ] && [ "$(grep -c '^blurcue: ' "$W/cut.err")" = 1 ] &&
+    grep -q "^blurcue: $W/cut.avi: damaged or truncated: frame [0-9]* of the 60 .*; the log of the [0-9]* frames shown is whole in $W/cut$" "$W/cut.err" ||
+    fail "a cut video: exit $code, stderr: $(cat "$W/cut.err")"
+  shown=$(( $(wc -l < "$W/cut/live.csv") - 1 ))
+  [ $shown -gt 5 ] && grep -q "\"frames_shown\": $shown," "$W/cut/summary.json" ||
+    fail "the cut video's log: $shown rows, $(cat "$W/cut/summary.json")"
   echo "ok: live_test headless" ;;
 nocamera)
   rm -rf "$W/nocamera"

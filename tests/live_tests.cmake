@@ -12,7 +12,8 @@ add_test(NAME live_missing_camera
          COMMAND ${BLURCUE_EXPECT} "ok: live_test nocamera" ${LIVE_TEST} nocamera $<TARGET_FILE:blurcue> ${LIVE_DIR})
 set_tests_properties(live_missing_camera PROPERTIES FIXTURES_REQUIRED live_take)
 find_program(LIVE_XVFB Xvfb)
-if(LIVE_XVFB)
+find_program(LIVE_XDOTOOL xdotool)
+if(LIVE_XVFB AND LIVE_XDOTOOL)
   # The real-time bounds are printed here, not held: see docs/live.md ("Timing") for why and for the run that holds
   # them (TIMING=1).
   add_test(NAME live_window_30fps
