@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -84,7 +85,8 @@ struct LiveSetup {
 struct LiveRecord {
   std::vector<live::LiveRow> rows;
   std::string live_csv = live::LiveCsvHeader(), drawn_csv = stimulus::DrawnCsvHeader();
-  std::map<int, cv::Mat> saved;
+  std::map<int, cv::Mat> saved;  // by the number of the frame shown
+  std::set<int> saved_for;       // the --save-frame numbers done
   std::string ended;
   std::optional<Error> error;
   int dropped = 0;
@@ -224,8 +226,9 @@ void ShowFrame(LiveSetup& s, const LiveArgs& a, live::LiveFrame& frame, live::Cl
   live::AppendLiveCsvRow(row, &record.live_csv);
   record.drawn_csv += stimulus::DrawnCsvRows(frame.index, frame.time_s, track::Name(result.status), plan.drawn);
   record.rows.push_back(row);
+  // Frame N, or the first shown after it when N was dropped: saved under the number of the frame it is.
   for (int wanted : a.save_frames)
-    if (wanted == frame.index) record.saved[wanted] = compositor.Read();
+    if (frame.index >= wanted && record.saved_for.insert(wanted).second) record.saved[frame.index] = compositor.Read();
 }
 
 // Frames until the input ends, the window asks to end, a signal comes, or a frame fails (kept in record.error).
@@ -388,7 +391,8 @@ void AddLiveCommand(CLI::App& app) {
                                          "at most 108000)")
       ->check(IntRange(1, kMaxLiveFrames));
   cmd->add_option("--save-frame", a->save_frames,
-                  "also write frame N as shown into DIR/frame-NNNN.png (repeatable; the read-back adds to its latency)")
+                  "also write frame N as shown into DIR/frame-NNNN.png, or the first frame shown after it when N was\n"
+                  "dropped, under its own number (repeatable; the read-back adds to that frame's latency)")
       ->check(IntRange(0, kMaxLiveFrames));
   cmd->add_flag("--quiet", a->quiet, "print only errors");
   cmd->callback([a] { RunLive(*a); });
