@@ -55,12 +55,15 @@ signal_live, signal_ar = np.abs(live - photo)[ball].sum(), np.abs(ar - photo)[ba
 assert abs(signal_live / signal_ar - 1) <= 0.01, (signal_live, signal_ar)
 print(f"{sys.argv[1].split('/')[-1]}: live's ball = ar's over {ball.sum()} px: mean {d[ball].mean():.3f} levels, max {d[ball].max():.0f}")
 PYEOF
-  # Escape ends a run: the take at 10 fps (6 s), Escape pressed in the window after a second; exit 0, the log whole.
+  # Escape ends a run: the take at 10 fps (6 s), Escape pressed in the window once it shows frames; exit 0, the log
+  # whole.
   "$BC" live "$T/take.avi" "${LIVE[@]}" --window --fps 10 --log "$W/window/escape" > "$W/window/escape.out" \
     2> "$W/window/escape.err" &
   pid=$!
-  wid=$(timeout 60 xdotool search --sync --name "blurcue live" | head -1)
-  sleep 1
+  # The title says "- showing" once the first frame is on screen; Escape half a second after that.
+  wid=$(timeout 60 xdotool search --sync --name "blurcue live: .* - showing" | head -1)
+  [ -n "$wid" ] || fail "the live window never said it was showing a frame"
+  sleep 0.5
   xdotool windowfocus --sync "$wid" key Escape || fail "xdotool could not press Escape in the window"
   wait $pid || fail "live --window, Escape: exit $?: $(cat "$W/window/escape.err")"
   head -1 "$W/window/escape.out" | grep -q "^Escape pressed$" || fail "Escape: $(cat "$W/window/escape.out")"

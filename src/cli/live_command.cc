@@ -267,6 +267,8 @@ void RunLiveLoop(LiveSetup& s, const LiveArgs& a, render::GlContext& context, re
       break;
     }
     dropped_seen = dropped;
+    // Said once, on the screen itself: the first frame is shown (a script waits for it before it presses a key).
+    if (a.window && record.rows.size() == 1) context.SetTitle("blurcue live: " + a.input + " - showing");
     if (tty) std::fprintf(stderr, "\rframe %d: %s, %d dropped   ", frame.index, track::Name(record.rows.back().status),
                           dropped);
   }
