@@ -17,6 +17,7 @@
 
 #include "calib/scene_blur.h"
 #include "cli/commands.h"
+#include "cli/placed_objects.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/image.h"
@@ -30,24 +31,6 @@
 
 namespace blurcue::cli {
 namespace {
-
-// "X,Y[,A[,B]]" in mm: 2 to `most` numbers. Error(kUsage) naming the option and the text.
-std::vector<double> MmList(const std::string& option, const std::string& text, size_t most, const char* form) {
-  std::vector<double> v;
-  bool ok = true;
-  for (size_t start = 0; ok;) {
-    const size_t comma = text.find(',', start);
-    const std::optional<double> n = ParseDecimal(text.substr(start, comma == std::string::npos ? comma : comma - start));
-    ok = n && std::abs(*n) <= 1e5;
-    if (ok) v.push_back(*n);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  if (!ok) v.clear();
-  if (v.size() < 2 || v.size() > most)
-    throw Error(ErrorKind::kUsage, option + " " + Echo(text) + ": expected " + form + " (mm, numbers within 1e5)");
-  return v;
-}
 
 // The most objects one run draws (stimulus::kMaxPlacedObjects), and the most frames: each object is drawn in every
 // frame, and the CSV (one row per object per frame) is held until the end, so both are bounded before any work
@@ -161,45 +144,9 @@ void AddArCommand(CLI::App& app) {
     blur.source = calib::ParseBlurSource(args->blur, &blur.fixed_r_px);
     blur.method = args->method;
 
-    std::vector<stimulus::PlacedObject> objects;
     std::vector<std::string> given;  // where each object was given, for messages: the option or the file's pointer
-    if (!args->objects.empty()) {
-      objects = stimulus::LoadPlacedObjects(args->objects);
-      for (size_t i = 0; i < objects.size(); ++i) given.push_back(args->objects + ": /objects/" + std::to_string(i));
-      if (objects.size() + args->balls.size() + args->cards.size() > kMaxArObjects)
-        throw InputError(args->objects, std::to_string(objects.size()) + " objects and " +
-                                            std::to_string(args->balls.size() + args->cards.size()) +
-                                            " on the command line: at most " + std::to_string(kMaxArObjects) +
-                                            " objects a run");
-    }
-    // One texture per image, however many objects wear it: decoded once, and one GL texture (its identity).
-    std::map<std::string, scene::SurfaceTexture> textures;
-    auto add = [&](const char* kind, const scene::VirtualObject& o, const std::string& texture) {
-      stimulus::PlacedObject p;
-      int n = 1;
-      for (const auto& q : objects) n += q.object.kind == o.kind;
-      p.name = kind + std::to_string(n);
-      p.object = o;
-      auto known = textures.find(texture);
-      if (known == textures.end())
-        known = textures.emplace(texture, scene::SurfaceTexture(ReadImage(scene::ResolveStimulus(texture)))).first;
-      p.object.texture = known->second;
-      objects.push_back(std::move(p));
-    };
-    for (const std::string& b : args->balls) {
-      const std::vector<double> v = MmList("--ball", b, 3, "X,Y[,RADIUS]");
-      if (v.size() == 3 && !(v[2] > 0)) throw Error(ErrorKind::kUsage, "--ball " + Echo(b) + ": RADIUS must be > 0");
-      add("ball", stimulus::BallAt(v[0], v[1], v.size() == 3 ? v[2] : 10), args->ball_texture);
-      given.push_back("--ball " + Echo(b));
-    }
-    for (const std::string& c : args->cards) {
-      const std::vector<double> v = MmList("--card", c, 4, "X,Y[,WIDTH[,HEIGHT]]");
-      const double w = v.size() >= 3 ? v[2] : 50, h = v.size() == 4 ? v[3] : w;
-      if (!(w > 0 && h > 0)) throw Error(ErrorKind::kUsage, "--card " + Echo(c) + ": WIDTH and HEIGHT must be > 0");
-      add("card", stimulus::StandingCardAt(v[0], v[1], w, h, 0), args->card_texture);
-      given.push_back("--card " + Echo(c));
-    }
-    if (objects.empty()) throw Error(ErrorKind::kUsage, "no objects: give --ball, --card or --objects");
+    const std::vector<stimulus::PlacedObject> objects = PlaceObjects(
+        {args->balls, args->cards, args->objects, args->ball_texture, args->card_texture}, &given);
 
     const stimulus::TrackedTake take = stimulus::LoadTrackedTake(args->track);
     const Camera& camera = take.camera();

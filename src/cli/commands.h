@@ -87,6 +87,7 @@ void AddSynthSceneCommand(CLI::App& app);   // synth_scene_command.cc
 void AddSynthTakeCommand(CLI::App& app);    // synth_take_command.cc
 void AddTrackCommand(CLI::App& app);        // track_command.cc
 void AddArCommand(CLI::App& app);           // ar_command.cc
+void AddLiveCommand(CLI::App& app);         // live_command.cc
 void AddCameraCommand(CLI::App& app);       // camera_command.cc
 void AddInitCommand(CLI::App& app);         // init_command.cc
 void AddCalibrateCommand(CLI::App& app);    // calibrate_command.cc

@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
       {"calibrate", &cli::AddCalibrateCommand},
       {"track", &cli::AddTrackCommand},
       {"ar", &cli::AddArCommand},
+      {"live", &cli::AddLiveCommand},
       {"estimate", &cli::AddEstimateCommand},
       {"make-stimuli", &cli::AddMakeStimuliCommand},
       {"synth-pictures", &cli::AddSynthPicturesCommand},

@@ -47,7 +47,16 @@ struct FrameCompositor::Impl {
   }
 
   // The base frame: grey (sRGB 128, as the text screens' field), the photo at (x, y), cut by the frame's edges.
+  // True when SetFrame uploaded the photo straight into `base` (it fills the frame), leaving `photo` behind.
+  bool photo_in_base = false;
+
   void Place(int x, int y) {
+    if (photo_in_base) {  // base is the photo: the photo's texture gets it back before a crop of it is placed
+      glBindFramebuffer(GL_READ_FRAMEBUFFER, base_fb.id());
+      glBindFramebuffer(GL_DRAW_FRAMEBUFFER, photo_fb.id());
+      glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+      photo_in_base = false;
+    }
     view.x_px = x, view.y_px = y;
     renderer.SetCamera(view.CameraOf(camera));
     base_fb.Bind();
@@ -170,8 +179,17 @@ void FrameCompositor::SetFrame(const cv::Vec3d& rvec, const cv::Vec3d& tvec, con
   const cv::Size scaled(m.view.photo_width_px, m.view.photo_height_px);
   CV_Assert(background.size() == scaled ||
             (background.cols == m.camera.image_width_px && background.rows == m.camera.image_height_px));
-  m.photo.UploadSrgb(background.size() == scaled ? background : ResampleSrgb8(background, scaled));
   m.renderer.SetPose(rvec, tvec);
+  if (m.view.x_px == 0 && m.view.y_px == 0 && scaled == cv::Size(m.width, m.height) && background.size() == scaled) {
+    // The photo fills the frame as it is (a live view, ar): uploaded straight into the base frame, which saves a
+    // clear and a whole-frame blit a frame (llvmpipe pays for each).
+    m.base.UploadSrgb(background, false);
+    m.photo_in_base = true;
+    m.dirty.assign(1, cv::Rect(0, 0, m.width, m.height));
+    return;
+  }
+  // The photo is only blitted (level 0, GL_NEAREST): its mipmaps, which llvmpipe makes on the CPU, are not made.
+  m.photo.UploadSrgb(background.size() == scaled ? background : ResampleSrgb8(background, scaled), false);
   m.Place(m.view.x_px, m.view.y_px);  // the base frame from the new photo; the whole frame dirty
 }
 

@@ -118,17 +118,23 @@ Texture Texture::FromSrgbImage(const cv::Mat& image) {
   return t;
 }
 
-void Texture::UploadSrgb(const cv::Mat& image) {
+void Texture::UploadSrgb(const cv::Mat& image, bool mipmaps) {
   CV_Assert(image.depth() == CV_8U && (image.channels() == 3 || image.channels() == 4 || image.channels() == 1));
   CV_Assert(image.cols == width_ && image.rows == height_ && format_ == GL_SRGB8_ALPHA8);
-  cv::Mat rgba;
-  const int code = image.channels() == 1 ? cv::COLOR_GRAY2RGBA
-                   : image.channels() == 3 ? cv::COLOR_BGR2RGBA : cv::COLOR_BGRA2RGBA;
-  cv::cvtColor(image, rgba, code);
   glBindTexture(GL_TEXTURE_2D, name_.id());
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, rgba.cols, rgba.rows, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
-  glGenerateMipmap(GL_TEXTURE_2D);
+  if (image.channels() != 1 && image.isContinuous()) {
+    // BGR(A) as it is: the driver swizzles while it copies, no converted copy made on the CPU (a video's every frame).
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, image.cols, image.rows, image.channels() == 3 ? GL_BGR : GL_BGRA,
+                    GL_UNSIGNED_BYTE, image.data);
+  } else {
+    cv::Mat rgba;
+    const int code = image.channels() == 1 ? cv::COLOR_GRAY2RGBA
+                     : image.channels() == 3 ? cv::COLOR_BGR2RGBA : cv::COLOR_BGRA2RGBA;
+    cv::cvtColor(image, rgba, code);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, rgba.cols, rgba.rows, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
+  }
+  if (mipmaps) glGenerateMipmap(GL_TEXTURE_2D);
 }
 
 void Texture::Upload(const cv::Mat& rgba) {

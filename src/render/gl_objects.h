@@ -65,8 +65,9 @@ class Texture {
   // An sRGB texture (sampling decodes to linear) from an 8-bit BGR/BGRA image, mipmapped and trilinear, for
   // object surfaces seen smaller than their texture.
   static Texture FromSrgbImage(const cv::Mat& bgr_or_bgra);
-  // Replaces an sRGB texture's image (8-bit BGR/BGRA/grey of its size) and its mipmaps.
-  void UploadSrgb(const cv::Mat& bgr_or_bgra);
+  // Replaces an sRGB texture's image (8-bit BGR/BGRA/grey of its size) and, with `mipmaps`, its mipmaps (a texture
+  // that is only blitted, as a video frame's photo, needs none).
+  void UploadSrgb(const cv::Mat& bgr_or_bgra, bool mipmaps = true);
   // Uploads CV_32FC4 (or CV_8UC4) rows top-down; row 0 of the Mat is texture row 0. Everything in blurcue keeps
   // that convention (image row = texture row = gl_FragCoord.y), so nothing is ever flipped.
   void Upload(const cv::Mat& rgba);

@@ -412,7 +412,8 @@ TrackedFramePlan PlanTrackedFrame(const TrackedTake& take, int index, const std:
   const TrackedFrame& frame = take.frames[size_t(index)];
   const calib::SceneCalib& c = *frame.calib;
   for (const PlacedObject& p : objects) {
-    const std::string who = p.name + " in frame " + std::to_string(index);
+    // The frame's own number (a live view's two-frame window holds frames of any number at places 0 and 1).
+    const std::string who = p.name + " in frame " + std::to_string(frame.index);
     DrawnObject d;
     d.name = p.name;
     d.screen_px = Project(c, p.object.center_board_mm);

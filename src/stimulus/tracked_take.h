@@ -104,8 +104,9 @@ struct TrackedFramePlan {
 // or an end, none when neither is) over their time apart - times the exposure. 0 for a lost frame or no exposure.
 cv::Vec2d StreakPx(const TrackedTake& take, int index, const cv::Vec3d& board_mm, double exposure_ms);
 
-// The objects of frame `index` at its pose, each streaked by StreakPx of its centre. Error(kDomain) naming the object
-// and the frame when its blur cannot be evaluated there or exceeds the largest blur.
+// The objects of frame `index` (its place in take.frames) at its pose, each streaked by StreakPx of its centre.
+// Error(kDomain) naming the object and the frame (take.frames[index].index: a live view plans from a two-frame window
+// of a take) when its blur cannot be evaluated there or exceeds the largest blur.
 TrackedFramePlan PlanTrackedFrame(const TrackedTake& take, int index, const std::vector<PlacedObject>& objects,
                                   const TakeBlur& blur);
 

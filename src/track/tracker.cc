@@ -41,14 +41,21 @@ const char* Name(FrameStatus status) {
 Tracker::Tracker(Camera camera, Board board, TrackOptions options)
     : camera_(std::move(camera)), board_(std::move(board)), options_(std::move(options)) {}
 
-std::optional<calib::BoardPose> Tracker::Track(const cv::Mat& grey8, const cv::Mat& small, std::string* note) const {
+std::optional<calib::BoardPose> Tracker::Track(const cv::Mat& grey8, const cv::Mat& small, double time_s,
+                                               std::string* note) const {
   if (last_.empty()) return std::nullopt;
   // Constant velocity in the image: smooth camera motion moves each corner nearly as it did a frame ago, far more
   // exactly than the refinement window (a quarter of a square) needs. With one frame of history there is no
   // velocity yet: the whole image's shift from that frame (phase correlation at a quarter size) stands in.
   std::vector<cv::Point2f> corners = last_;
   if (!before_last_.empty()) {
-    for (size_t i = 0; i < corners.size(); ++i) corners[i] += last_[i] - before_last_[i];
+    // Velocity per second, not per frame: a live view that dropped frames has them unevenly apart (a take's are even,
+    // and the factor is 1).
+    const double gap = last_time_s_ - before_last_time_s_;
+    double k = gap > 0 && time_s > last_time_s_ ? (time_s - last_time_s_) / gap : 1.0;
+    if (std::abs(k - 1) < 1e-6) k = 1;  // evenly apart, but for the rounding of index / fps
+    const float kf = float(k);
+    for (size_t i = 0; i < corners.size(); ++i) corners[i] += kf * (last_[i] - before_last_[i]);
   } else if (!last_small_.empty() && last_small_.size() == small.size()) {
     const cv::Point2d shift = cv::phaseCorrelate(last_small_, small) * double(kSmallFactor);
     for (cv::Point2f& p : corners) p += cv::Point2f(float(shift.x), float(shift.y));
@@ -98,7 +105,11 @@ FrameResult Tracker::Process(const cv::Mat& photo, int index, double time_s) {
                          std::to_string(camera_.image_width_px) + "x" + std::to_string(camera_.image_height_px));
   // The frame's grey and linear-light planes, once, into the buffers of the previous frame: tracking, detection and
   // the measurement all read them.
-  planes_.Fill(photo);
+  // Without the measurement only the grey plane is needed: the linear one is a third of a pose-only frame's time.
+  if (options_.measure_blur)
+    planes_.Fill(photo);
+  else
+    ToGrey8(photo, planes_.grey8);
   const cv::Mat& grey8 = planes_.grey8;
   cv::Mat small;
   if (!options_.always_detect) {
@@ -106,7 +117,7 @@ FrameResult Tracker::Process(const cv::Mat& photo, int index, double time_s) {
     small.convertTo(small, CV_32F);
   }
   std::optional<calib::BoardPose> pose;
-  if (!options_.always_detect) pose = Track(grey8, small, &r.note);
+  if (!options_.always_detect) pose = Track(grey8, small, time_s, &r.note);
   r.status = FrameStatus::kTracked;
   if (!pose) {
     r.status = FrameStatus::kFound;
@@ -127,7 +138,13 @@ FrameResult Tracker::Process(const cv::Mat& photo, int index, double time_s) {
     return r;
   }
   before_last_ = std::exchange(last_, pose->corners);
+  before_last_time_s_ = std::exchange(last_time_s_, time_s);
   last_small_ = small;
+  r.pose = pose;
+  if (!options_.measure_blur) {
+    r.frame_ms = MsSince(t0);
+    return r;
+  }
 
   const auto t1 = std::chrono::steady_clock::now();
   calib::CalibrateOptions options = options_.calibrate;
@@ -141,6 +158,7 @@ FrameResult Tracker::Process(const cv::Mat& photo, int index, double time_s) {
     if (e.kind() != ErrorKind::kNotFound) throw;
     r.status = FrameStatus::kLost;
     r.note = e.what();
+    r.pose.reset();
   }
   r.measure_ms = MsSince(t1);
   r.frame_ms = MsSince(t0);

@@ -22,6 +22,7 @@ struct TrackOptions {
   calib::CalibrateOptions calibrate;     // the measurement's options (known_pose is set per frame)
   double max_track_error_px = 0.5;       // a tracked pose's RMS reprojection error above this: tracking is lost
   bool always_detect = false;            // full detection on every frame (the bench's baseline)
+  bool measure_blur = true;              // false: the pose only (a lens model fixed elsewhere: blurcue live)
 };
 
 struct FrameResult {
@@ -29,7 +30,8 @@ struct FrameResult {
   double time_s = 0;
   FrameStatus status = FrameStatus::kLost;
   std::string note;                      // why a frame is lost, or why tracking fell back to detection
-  std::optional<calib::CalibResult> calib;  // empty when lost
+  std::optional<calib::CalibResult> calib;  // empty when lost, or when the blur is not measured
+  std::optional<calib::BoardPose> pose;     // the frame's pose; empty when lost
   double pose_ms = 0;                    // tracking or detection, and the pose
   double measure_ms = 0;                 // linear light, every section's blur, the frame's estimate
   double frame_ms = 0;                   // all of the frame's work (decoding excluded)
@@ -46,12 +48,14 @@ class Tracker {
   FrameResult Process(const cv::Mat& photo, int index, double time_s);
 
  private:
-  std::optional<calib::BoardPose> Track(const cv::Mat& grey8, const cv::Mat& small, std::string* note) const;
+  std::optional<calib::BoardPose> Track(const cv::Mat& grey8, const cv::Mat& small, double time_s,
+                                        std::string* note) const;
 
   Camera camera_;
   Board board_;
   TrackOptions options_;
   std::vector<cv::Point2f> last_, before_last_;  // corners of the last two frames with a pose (empty: none)
+  double last_time_s_ = 0, before_last_time_s_ = 0;  // and their times
   cv::Mat last_small_;  // the last frame with a pose, a quarter size, float: its shift to the next one
   calib::PhotoPlanes planes_;  // the frame's grey and linear planes; their buffers serve the whole take
 };

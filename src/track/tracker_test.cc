@@ -217,6 +217,24 @@ TEST(Tracker, LargeMotionNeverGivesAPoseOneSquareOff) {
   }
 }
 
+// A live view (blurcue live) measures no blur, and drops frames it has no time for: the pose alone, and the velocity
+// taken per second, so frames unevenly apart are still tracked (not detected anew), each at the pose the full
+// tracker finds for that frame.
+TEST(Tracker, PoseOnlyTracksFramesUnevenlyApart) {
+  const Tracked& t = TrackedTake();
+  TrackOptions options;
+  options.measure_blur = false;
+  Tracker tracker(t.frames[0].scene.camera, t.frames[0].scene.board, options);
+  for (int i : {0, 1, 3, 4, 7, 8, 9, 11}) {
+    const FrameResult r = tracker.Process(t.frames[size_t(i)].scene.image, i, i / 30.0);
+    EXPECT_EQ(r.status, i == 0 ? FrameStatus::kFound : FrameStatus::kTracked) << "frame " << i << ": " << r.note;
+    EXPECT_FALSE(r.calib.has_value());
+    ASSERT_TRUE(r.pose.has_value()) << "frame " << i;
+    const calib::BoardPose& full = t.results[size_t(i)].calib->pose;
+    EXPECT_LT(cv::norm(r.pose->tvec - full.tvec), 0.01) << "frame " << i;
+  }
+}
+
 TEST(Tracker, FrameOfAnotherSizeIsAnInputError) {
   const Tracked& t = TrackedTake();
   Tracker tracker(t.frames[0].scene.camera, t.frames[0].scene.board, TrackOptions{});

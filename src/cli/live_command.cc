@@ -1,0 +1,403 @@
+// blurcue live: the thesis's prototype in real time - a camera, or a video played as one, tracked frame by frame,
+// virtual objects drawn with the lens model's blur as `ar` draws them, shown in a window (or headless), and every
+// frame's latency logged (src/live/ holds the GL-free parts: the paced reader, the mailbox, the plan, the log).
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include "calib/scene_blur.h"
+#include "cli/commands.h"
+#include "cli/placed_objects.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "core/json_io.h"
+#include "core/output_guard.h"
+#include "core/typed.h"
+#include "live/live_log.h"
+#include "live/live_plan.h"
+#include "live/mailbox.h"
+#include "live/paced_source.h"
+#include "render/frame_compositor.h"
+#include "render/gl_context.h"
+#include "scene/stimuli.h"
+#include "track/frames.h"
+#include "track/tracker.h"
+
+namespace blurcue::cli {
+namespace {
+
+// A run logs at most an hour at 30 fps: the log is held in memory (about 250 bytes a frame) and written whole.
+constexpr int kMaxLiveFrames = 108000;
+
+std::atomic<int> live_signal{0};
+void OnLiveSignal(int signal) { live_signal = signal; }
+
+// Ctrl-C or a kill ends a live run like Escape: the log is written whole (handlers restored when the run ends).
+struct LiveSignals {
+  void (*old_int)(int), (*old_term)(int);
+  LiveSignals() : old_int(std::signal(SIGINT, OnLiveSignal)), old_term(std::signal(SIGTERM, OnLiveSignal)) {
+    live_signal = 0;
+  }
+  ~LiveSignals() {
+    std::signal(SIGINT, old_int);
+    std::signal(SIGTERM, old_term);
+  }
+};
+
+// The names a --log folder holds: what live writes, and nothing else is replaced.
+bool IsLiveLogFile(const std::string& name) {
+  if (name == "live.csv" || name == "drawn.csv" || name == "summary.json") return true;
+  return name.size() == 14 && name.rfind("frame-", 0) == 0 && name.compare(10, 4, ".png") == 0 &&
+         name.find_first_not_of("0123456789", 6) == 10;
+}
+
+struct LiveArgs {
+  std::string input, camera, track, calib, log, blur = "fitted", method = "disc";
+  ObjectOptions objects;
+  std::vector<int> save_frames;
+  double fps = 0, exposure_ms = -1;
+  int frames = 0;
+  bool window = false, quiet = false;
+};
+
+// What a run needs before its first frame: the lens, the objects, the tracker, the reader.
+struct LiveSetup {
+  Camera camera;
+  std::unique_ptr<live::LivePlanner> planner;
+  std::unique_ptr<track::Tracker> tracker;
+  std::unique_ptr<live::PacedSource> source;
+  double exposure_ms = 0;
+  std::string exposure_note, lens_note;
+};
+
+// The run as it goes: the rows, the drawn CSV, the frames asked for as PNGs, and how it ended.
+struct LiveRecord {
+  std::vector<live::LiveRow> rows;
+  std::string live_csv = live::LiveCsvHeader(), drawn_csv = stimulus::DrawnCsvHeader();
+  std::map<int, cv::Mat> saved;  // by the number of the frame shown
+  std::set<int> saved_for;       // the --save-frame numbers done
+  std::string ended;
+  std::optional<Error> error;
+  int dropped = 0;
+};
+
+void WriteLiveLog(const LiveArgs& a, const LiveRecord& record, const live::LiveSummary& summary) {
+  WriteFolderAtomically(
+      a.log,
+      [&](const std::filesystem::path& partial) {
+        WriteFileAtomically(partial / "live.csv", record.live_csv);
+        WriteFileAtomically(partial / "drawn.csv", record.drawn_csv);
+        Json j = live::SummaryJson(summary);
+        j["input"] = a.input;
+        WriteJsonFile(partial / "summary.json", j);
+        for (const auto& [index, image] : record.saved) {
+          char name[32];
+          std::snprintf(name, sizeof name, "frame-%04d.png", index);
+          WriteImage(partial / name, image);
+        }
+      },
+      IsLiveLogFile);
+}
+
+void GuardLiveOutputs(const LiveArgs& a) {
+  OutputGuard guard;
+  if (live::CameraDevice(a.input).empty())
+    for (const std::filesystem::path& file : track::TakeInputFiles(a.input)) guard.Input("INPUT", file);
+  guard.Input("--camera", a.camera);
+  if (!a.track.empty()) guard.Input("--track", a.track);
+  if (!a.calib.empty()) guard.Input("--calib", a.calib);
+  if (!a.objects.objects_file.empty()) guard.Input("--objects", a.objects.objects_file);
+  if (!a.objects.balls.empty()) guard.Input("--ball-texture", scene::ResolveStimulus(a.objects.ball_texture));
+  if (!a.objects.cards.empty()) guard.Input("--card-texture", scene::ResolveStimulus(a.objects.card_texture));
+  guard.OutputFolder("--log", a.log);
+  guard.Check();
+  try {
+    RequireReplaceableFolder(a.log, IsLiveLogFile);
+  } catch (const Error& e) {
+    throw e.Wrapped(e.kind(), "--log ");
+  }
+  RemoveLeftoversBeside("live", a.log);
+}
+
+LiveSetup SetUpLive(const LiveArgs& a) {
+  if (a.track.empty() == a.calib.empty())
+    throw Error(ErrorKind::kUsage, "give the lens model with one of --track DIR (a take blurcue track wrote) or "
+                                   "--calib calib.json (blurcue calibrate)");
+  GuardLiveOutputs(a);
+  LiveSetup s;
+  stimulus::TakeBlur blur;
+  blur.source = calib::ParseBlurSource(a.blur, &blur.fixed_r_px);
+  live::RequireLiveSource(blur.source, "--blur");
+  blur.method = a.method;
+  std::vector<std::string> given;
+  std::vector<stimulus::PlacedObject> objects = PlaceObjects(a.objects, &given);
+  s.camera = LoadCamera(a.camera);
+  calib::SceneCalib lens = a.track.empty() ? live::LensFromCalib(a.calib, s.camera)
+                                           : live::LensFromTrack(a.track, s.camera);
+  s.lens_note = a.track.empty() ? a.calib : a.track + " (its lens model)";
+  try {
+    s.source = std::make_unique<live::PacedSource>(a.input, a.fps, a.frames > 0 ? a.frames : kMaxLiveFrames);
+  } catch (const Error& e) {
+    // No camera there: the run ends before its first frame, and its log (no frame) says so, whole.
+    if (live::CameraDevice(a.input).empty() || e.kind() != ErrorKind::kInput) throw;
+    WriteLiveLog(a, LiveRecord(), live::Summarize({}, 0, e.what()));
+    throw;
+  }
+  const double rate = s.source->fps();
+  if (a.exposure_ms >= 0) {
+    if (const std::string beyond = stimulus::ExposureBeyondFrame(a.exposure_ms, rate); !beyond.empty())
+      throw Error(ErrorKind::kUsage, "--exposure-ms " + Num(a.exposure_ms) + ": " + beyond +
+                                         ": a camera exposes each frame within its own interval");
+    blur.exposure_ms = a.exposure_ms;
+    s.exposure_note = "given";
+  } else if (s.camera.exposure_ms) {
+    if (const std::string beyond = stimulus::ExposureBeyondFrame(*s.camera.exposure_ms, rate); !beyond.empty())
+      throw InputError(a.camera + ": exposure_ms", "is " + Num(*s.camera.exposure_ms) + " ms, " + beyond +
+                                                       ": give --exposure-ms");
+    blur.exposure_ms = *s.camera.exposure_ms;
+    s.exposure_note = "the camera's exposure_ms";
+  } else {
+    blur.exposure_ms = rate > 0 ? 1000 / rate / 2 : 0;
+    s.exposure_note = rate > 0 ? "the camera's exposure is unknown: half the frame interval at " + Num(rate) +
+                                     " fps (give --exposure-ms)"
+                               : "no motion blur: the camera's exposure is unknown (give --exposure-ms)";
+  }
+  s.exposure_ms = blur.exposure_ms;
+  track::TrackOptions options;
+  options.measure_blur = false;  // the lens model is fixed: the pose is all a frame needs
+  s.tracker = std::make_unique<track::Tracker>(s.camera, lens.board, options);
+  s.planner = std::make_unique<live::LivePlanner>(std::move(lens), std::move(objects), blur);
+  return s;
+}
+
+double MsBetween(live::Clock::time_point a, live::Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+// Why the window asks to end ("" when it does not): Escape, or the window closed.
+std::string WindowEnd(render::GlContext& context) {
+  for (const render::InputEvent& e : context.TakeEvents())
+    if (e.key == "Escape") return "Escape pressed";
+  return context.ShouldClose() ? "the window was closed" : "";
+}
+
+// One frame: pose, plan, draw, show; its row and drawn rows recorded.
+void ShowFrame(LiveSetup& s, const LiveArgs& a, live::LiveFrame& frame, live::Clock::time_point start,
+               int dropped, render::GlContext& context, render::FrameCompositor& compositor, LiveRecord& record,
+               std::optional<calib::BoardPose>& last_pose) {
+  const live::Clock::time_point t0 = live::Clock::now();
+  const track::FrameResult result = s.tracker->Process(frame.image, frame.index, frame.time_s);
+  const live::Clock::time_point t1 = live::Clock::now();
+  const stimulus::TrackedFramePlan plan = s.planner->Plan(frame.index, frame.time_s, result.status, result.pose);
+  if (result.pose) last_pose = result.pose;
+  const calib::SceneCalib& lens = s.planner->lens();
+  // A lost frame is shown as the camera saw it, without objects (at the last pose, which draws nothing).
+  compositor.SetFrame(last_pose ? last_pose->rvec : lens.rvec, last_pose ? last_pose->tvec : lens.tvec, frame.image);
+  compositor.Compose(plan.objects);
+  if (a.window) compositor.Present(context.width_px(), context.height_px());
+  compositor.Finish();
+  const live::Clock::time_point t2 = live::Clock::now();
+  if (a.window) {
+    context.SwapBuffers();  // blocks to the refresh with vsync
+    compositor.Finish();
+  }
+  const live::Clock::time_point shown = live::Clock::now();
+  live::LiveRow row;
+  row.frame = frame.index;
+  row.arrival_s = std::chrono::duration<double>(frame.arrival - start).count();
+  row.status = result.status;
+  if (result.pose) row.rvec = result.pose->rvec, row.tvec = result.pose->tvec;
+  row.track_ms = MsBetween(t0, t1);
+  row.render_ms = MsBetween(t1, t2);
+  row.display_s = std::chrono::duration<double>(shown - start).count();
+  row.latency_ms = MsBetween(frame.arrival, shown);
+  row.dropped = dropped;
+  live::AppendLiveCsvRow(row, &record.live_csv);
+  record.drawn_csv += stimulus::DrawnCsvRows(frame.index, frame.time_s, track::Name(result.status), plan.drawn);
+  record.rows.push_back(row);
+  // Frame N, or the first shown after it when N was dropped: saved under the number of the frame it is.
+  for (int wanted : a.save_frames)
+    if (frame.index >= wanted && record.saved_for.insert(wanted).second) record.saved[frame.index] = compositor.Read();
+}
+
+// Frames until the input ends, the window asks to end, a signal comes, or a frame fails (kept in record.error).
+void RunLiveLoop(LiveSetup& s, const LiveArgs& a, render::GlContext& context, render::FrameCompositor& compositor,
+                 LiveRecord& record) {
+  live::FrameMailbox mailbox;
+  const live::Clock::time_point start = live::Clock::now();
+  s.source->Start(&mailbox, start);
+  live::LiveFrame frame;
+  std::optional<calib::BoardPose> last_pose;
+  int dropped_seen = 0;
+  const bool tty = isatty(2) && !a.quiet;
+  while (true) {
+    if (live_signal != 0) {
+      record.ended = std::string("interrupted (") + (live_signal == SIGINT ? "SIGINT" : "SIGTERM") + ")";
+      break;
+    }
+    if (a.window) {
+      record.ended = WindowEnd(context);
+      if (!record.ended.empty()) break;
+    }
+    const live::FrameMailbox::Got got = mailbox.Take(frame, std::chrono::milliseconds(a.window ? 5 : 50));
+    if (got == live::FrameMailbox::Got::kTimeout) continue;
+    if (got == live::FrameMailbox::Got::kClosed) {
+      record.ended = mailbox.why_closed();
+      record.error = s.source->error();
+      break;
+    }
+    // Frames dropped while the frame before was drawn: replaced in the slot before this one was taken.
+    const int dropped = mailbox.dropped();
+    try {
+      ShowFrame(s, a, frame, start, dropped - dropped_seen, context, compositor, record, last_pose);
+    } catch (const Error& e) {
+      record.ended = "frame " + std::to_string(frame.index) + ": " + e.what();
+      record.error = Error(e.kind(), record.ended);
+      break;
+    }
+    dropped_seen = dropped;
+    // Said once, on the screen itself: the first frame is shown (a script waits for it before it presses a key).
+    if (a.window && record.rows.size() == 1) context.SetTitle("blurcue live: " + a.input + " - showing");
+    if (tty) std::fprintf(stderr, "\rframe %d: %s, %d dropped   ", frame.index, track::Name(record.rows.back().status),
+                          dropped);
+  }
+  if (tty) std::fprintf(stderr, "\n");
+  s.source->Stop();
+  record.dropped = mailbox.dropped();
+}
+
+void RunLive(const LiveArgs& a) {
+  LiveSetup s = SetUpLive(a);
+  const Camera& camera = s.camera;
+  std::unique_ptr<render::GlContext> context;
+  if (a.window) {
+    render::WindowOptions w;
+    w.width_px = std::min(camera.image_width_px, 1280);
+    w.height_px = std::max(1, w.width_px * camera.image_height_px / camera.image_width_px);
+    w.vsync = true;
+    w.title = "blurcue live: " + a.input;
+    context = render::GlContext::CreateWindow(w);
+  } else {
+    context = render::GlContext::CreateOffscreen();
+  }
+  const calib::SceneCalib& lens = s.planner->lens();
+  // Every GL object made once, before the first frame: the photo's texture and targets, each texture uploaded and
+  // mipmapped by a warm-up frame of the objects at the lens's own pose.
+  const cv::Mat grey(camera.image_height_px, camera.image_width_px, CV_8UC3, cv::Scalar::all(128));
+  render::FrameCompositor compositor(camera, lens.rvec, lens.tvec, grey);
+  {
+    std::vector<scene::BlurredObject> warm;
+    for (const stimulus::PlacedObject& p : s.planner->objects()) {
+      scene::BlurredObject b;
+      b.object = p.object;
+      b.r_px = 2;
+      warm.push_back(b);
+    }
+    compositor.Compose(warm);
+    compositor.Finish();
+  }
+  if (!a.quiet)
+    std::fprintf(stderr, "live: %s (%s), %zu objects, blur %s with the lens of %s, exposure %s ms (%s), %s\n",
+                 a.input.c_str(),
+                 s.source->is_camera() ? "a camera, at its own rate"
+                                       : ("played at " + Num(s.source->fps()) + " fps").c_str(),
+                 s.planner->objects().size(), a.blur.c_str(), s.lens_note.c_str(), Num(s.exposure_ms).c_str(),
+                 s.exposure_note.c_str(), a.window ? "in a window (vsync)" : "headless");
+  LiveRecord record;
+  record.rows.reserve(size_t(a.frames > 0 ? a.frames : 4096));
+  {
+    const LiveSignals signals;
+    RunLiveLoop(s, a, *context, compositor, record);
+  }
+  const live::LiveSummary summary = live::Summarize(record.rows, record.dropped, record.ended);
+  WriteLiveLog(a, record, summary);
+  if (!a.quiet) {
+    std::printf("%s\n%s\nwrote %s (live.csv, drawn.csv, summary.json)\n", record.ended.c_str(),
+                live::SummaryLine(summary).c_str(), a.log.c_str());
+  }
+  if (record.error)
+    throw Error(record.error->kind(), std::string(record.error->what()) + "; the log of the " +
+                                          std::to_string(record.rows.size()) + " frames shown is whole in " + a.log);
+}
+
+}  // namespace
+
+void AddLiveCommand(CLI::App& app) {
+  auto a = std::make_shared<LiveArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "live",
+      "Show virtual objects in a camera's frames as they come: the thesis's prototype in real time. Each frame's board\n"
+      "pose is tracked from the frame before (a full detection when tracking is lost), the objects are planned and\n"
+      "drawn as `blurcue ar` draws them (the lens model's defocus x floor at each object's depth, streaked by its\n"
+      "image motion since the last frame with a pose over the exposure, in linear light) and shown in a window with\n"
+      "vsync (--window; Escape or closing it ends the run) or rendered headless.\n"
+      "INPUT is a camera - /dev/videoN or an index N, through OpenCV's videoio (V4L2) - or a video file or image\n"
+      "sequence (a printf pattern) played as a camera would deliver it: frame k at k / fps s from the start. Frames\n"
+      "reach the drawing through a one-slot mailbox: one that arrives while the previous is still being drawn\n"
+      "replaces it and is counted dropped, never queued. The lens model is fixed: --track DIR (a take `blurcue track`\n"
+      "wrote with this camera) or --calib calib.json (`blurcue calibrate`); no blur is measured live.\n"
+      "Objects as in `blurcue ar`: --ball X,Y[,RADIUS], --card X,Y[,WIDTH[,HEIGHT]] (board mm), --objects FILE.\n"
+      "\n"
+      "Writes --log DIR whole at the end of the run (docs/live.md): live.csv (a row per frame shown: arrival, status,\n"
+      "pose, track ms, render ms, display time, latency, dropped), drawn.csv (ar's CSV of what was drawn) and\n"
+      "summary.json; the summary line is printed. The input ending, --frames, Escape, a closed window, Ctrl-C:\n"
+      "exit 0. A camera that stops or a damaged frame: one line, exit 3, the log of the frames before it written.\n"
+      "No camera at /dev/videoN: exit 3 naming it. DIR must be a folder of live's files only (or new).\n"
+      "Example: blurcue live take/take.avi --camera take/camera.json --track take/track --ball 87.5,125 --window\n"
+      "         --log live-run");
+  cmd->add_option("input", a->input, "/dev/videoN or N (a camera), a video file, or a printf pattern of images")
+      ->required();
+  cmd->add_option("--camera", a->camera, "the camera's camera.json (blurcue camera): the frames' size and intrinsics")
+      ->required()->check(CLI::ExistingFile);
+  cmd->add_option("--track", a->track, "the lens model of a take blurcue track wrote with this camera (its folder)");
+  cmd->add_option("--calib", a->calib, "the lens model of a calib.json blurcue calibrate wrote with this camera")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--log", a->log, "the folder the run's log is written to (live.csv, drawn.csv, summary.json)")
+      ->required();
+  cmd->add_option("--ball", a->objects.balls, "a ball resting on the board: X,Y[,RADIUS] in board mm (radius 10)");
+  cmd->add_option("--card", a->objects.cards,
+                  "a card standing on the board facing the camera: X,Y[,WIDTH[,HEIGHT]] in board mm (50 x 50)");
+  cmd->add_option("--objects", a->objects.objects_file, "objects from a JSON file (docs/ar.md)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--ball-texture", a->objects.ball_texture, "texture of --ball balls: soccer, wood or an image")
+      ->capture_default_str();
+  cmd->add_option("--card-texture", a->objects.card_texture, "texture of --card cards: a stimulus name or an image")
+      ->capture_default_str();
+  cmd->add_option("--blur", a->blur,
+                  "blur source at each object's centre: fitted (the lens model), estimated, none, or a radius in px\n"
+                  "(measured sources need sections measured in every frame, which live does not do)")
+      ->capture_default_str();
+  cmd->add_option("--method", a->method, "the defocus's shape: disc (a thin lens's pillbox) or gaussian")
+      ->capture_default_str()->check(CLI::IsMember({"disc", "gaussian"}));
+  cmd->add_option("--exposure-ms", a->exposure_ms,
+                  "the camera's exposure; objects are streaked by their image velocity over it (0: no motion blur).\n"
+                  "Default: camera.json's exposure_ms; when unknown, half the frame interval of the pace")
+      ->check(FiniteRange(0, 1000, "ms"));
+  cmd->add_flag("--window", a->window, "show the frames in a window with vsync (Escape or closing it ends the run)");
+  cmd->add_option("--fps", a->fps,
+                  "the pace a video or image sequence is delivered at, frames per second (default: the video's own\n"
+                  "rate; 30 for an image sequence); a camera keeps its own")
+      ->check(FiniteRange(0.01, 1000, "frames per second"));
+  cmd->add_option("--frames", a->frames, "read at most N frames of INPUT, then end as if it had ended (default: all, "
+                                         "at most 108000)")
+      ->check(IntRange(1, kMaxLiveFrames));
+  cmd->add_option("--save-frame", a->save_frames,
+                  "also write frame N as shown into DIR/frame-NNNN.png, or the first frame shown after it when N was\n"
+                  "dropped, under its own number (repeatable; the read-back adds to that frame's latency)")
+      ->check(IntRange(0, kMaxLiveFrames));
+  cmd->add_flag("--quiet", a->quiet, "print only errors");
+  cmd->callback([a] { RunLive(*a); });
+}
+
+}  // namespace blurcue::cli

@@ -1,0 +1,102 @@
+#include "live/live_log.h"
+
+#include <cstdio>
+
+#include "core/stats.h"
+
+namespace blurcue::live {
+
+const std::vector<LiveColumn> kLiveColumns = {
+    {"frame", "the input's frame number from 0: a video's or sequence's index, a camera's count of delivered frames "
+              "(a gap: frames dropped)"},
+    {"arrival_s", "when the frame was delivered, s from the run's start (frame 0's due time)"},
+    {"status", "found (full detection), tracked (carried from the frame before) or lost (no pose: shown without "
+               "objects)"},
+    {"rvec_x", "pose rotation (Rodrigues vector, board frame -> camera), rad; empty when lost"},
+    {"rvec_y", ""},
+    {"rvec_z", ""},
+    {"tvec_x_mm", "board origin in the camera frame, mm; empty when lost"},
+    {"tvec_y_mm", ""},
+    {"tvec_z_mm", "... its depth"},
+    {"track_ms", "finding the pose: tracking from the frame before, or detection, ms"},
+    {"render_ms", "planning the objects, uploading the photo, composing and drawing the frame (the GPU finished), ms"},
+    {"display_s", "when the frame was on screen: the window's swap returned (vsync) and the GPU finished; headless, "
+                  "when the GPU finished; s from the run's start"},
+    {"latency_ms", "display_s - arrival_s, ms"},
+    {"dropped", "frames delivered since the frame shown before and never shown (replaced in the one-slot mailbox "
+                "while a frame was processed)"},
+};
+
+std::string LiveCsvHeader() {
+  std::string line;
+  for (const LiveColumn& c : kLiveColumns) line += (line.empty() ? "" : ",") + std::string(c.name);
+  return line + "\n";
+}
+
+void AppendLiveCsvRow(const LiveRow& r, std::string* csv) {
+  char pose[160] = ",,,,,";
+  if (r.rvec && r.tvec)
+    std::snprintf(pose, sizeof pose, "%.8f,%.8f,%.8f,%.4f,%.4f,%.4f", (*r.rvec)[0], (*r.rvec)[1], (*r.rvec)[2],
+                  (*r.tvec)[0], (*r.tvec)[1], (*r.tvec)[2]);
+  char line[320];
+  std::snprintf(line, sizeof line, "%d,%.6f,%s,%s,%.3f,%.3f,%.6f,%.3f,%d\n", r.frame, r.arrival_s, track::Name(r.status),
+                pose, r.track_ms, r.render_ms, r.display_s, r.latency_ms, r.dropped);
+  csv->append(line);
+}
+
+LiveSummary Summarize(const std::vector<LiveRow>& rows, int dropped, const std::string& ended) {
+  LiveSummary s;
+  s.shown = int(rows.size());
+  s.dropped = dropped;
+  s.ended = ended;
+  std::vector<double> latency, track, render;
+  for (const LiveRow& r : rows) {
+    latency.push_back(r.latency_ms);
+    track.push_back(r.track_ms);
+    render.push_back(r.render_ms);
+    s.max_latency_ms = std::max(s.max_latency_ms, r.latency_ms);
+    s.found += r.status == track::FrameStatus::kFound;
+    s.tracked += r.status == track::FrameStatus::kTracked;
+    s.lost += r.status == track::FrameStatus::kLost;
+  }
+  s.median_latency_ms = Percentile(latency, 0.5);
+  s.p95_latency_ms = Percentile(latency, 0.95);
+  s.median_track_ms = Percentile(track, 0.5);
+  s.median_render_ms = Percentile(render, 0.5);
+  if (rows.size() >= 2 && rows.back().display_s > rows.front().display_s)
+    s.shown_fps = (rows.size() - 1) / (rows.back().display_s - rows.front().display_s);
+  if (rows.size() >= 2 && rows.back().arrival_s > rows.front().arrival_s)
+    s.delivered_fps = (rows.back().frame - rows.front().frame) / (rows.back().arrival_s - rows.front().arrival_s);
+  return s;
+}
+
+std::string SummaryLine(const LiveSummary& s) {
+  const int delivered = s.shown + s.dropped;
+  char line[400];
+  std::snprintf(line, sizeof line,
+                "%d frames shown, %d dropped (%.1f %%); latency median %.1f ms, p95 %.1f ms, max %.1f ms; "
+                "%d found, %d tracked, %d lost; %.1f frames a second shown of %.1f delivered",
+                s.shown, s.dropped, delivered > 0 ? 100.0 * s.dropped / delivered : 0.0, s.median_latency_ms,
+                s.p95_latency_ms, s.max_latency_ms, s.found, s.tracked, s.lost, s.shown_fps, s.delivered_fps);
+  return line;
+}
+
+Json SummaryJson(const LiveSummary& s) {
+  Json j;
+  j["frames_shown"] = s.shown;
+  j["frames_dropped"] = s.dropped;
+  j["found"] = s.found;
+  j["tracked"] = s.tracked;
+  j["lost"] = s.lost;
+  j["median_latency_ms"] = s.median_latency_ms;
+  j["p95_latency_ms"] = s.p95_latency_ms;
+  j["max_latency_ms"] = s.max_latency_ms;
+  j["median_track_ms"] = s.median_track_ms;
+  j["median_render_ms"] = s.median_render_ms;
+  j["shown_fps"] = s.shown_fps;
+  j["delivered_fps"] = s.delivered_fps;
+  j["ended"] = s.ended;
+  return j;
+}
+
+}  // namespace blurcue::live

@@ -1,0 +1,45 @@
+#pragma once
+// What `blurcue live` draws in a frame, GL-free: the frame's pose from the tracker (the pose only: the lens model is
+// fixed by a prior `track` or `calibrate`), and the objects planned as `blurcue ar` plans them
+// (stimulus::PlanTrackedFrame: the same defocus and floor at each object's depth), streaked by their image motion
+// since the last frame with a pose - the causal form of ar's streak, which looks at the next frame too.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "calib/scene_blur.h"
+#include "stimulus/tracked_take.h"
+#include "track/tracker.h"
+
+namespace blurcue::live {
+
+// The lens a live view draws with: calib.json's (`blurcue calibrate`), or a tracked take's (its first frame with a
+// pose: one lens model for the whole take). Its sections are left out (they belong to that photo's pose). The
+// camera must be `camera`'s (size, intrinsics, distortion), else Error(kInput) naming the file and what differs.
+calib::SceneCalib LensFromCalib(const std::filesystem::path& calib_json, const Camera& camera);
+calib::SceneCalib LensFromTrack(const std::filesystem::path& track_dir, const Camera& camera);
+
+// The blur sources a live view can draw: those that need no section measured in the frame (fitted, estimated, none,
+// a fixed radius). Error(kUsage) naming `option` for measured and measured_section.
+void RequireLiveSource(BlurSource source, const std::string& option);
+
+class LivePlanner {
+ public:
+  LivePlanner(calib::SceneCalib lens, std::vector<stimulus::PlacedObject> objects, stimulus::TakeBlur blur);
+  // Frame `index` at `time_s` (the input's clock) with its pose (empty: lost, nothing drawn). Error(kDomain) as
+  // PlanTrackedFrame, naming the object and the frame.
+  stimulus::TrackedFramePlan Plan(int index, double time_s, track::FrameStatus status,
+                                  const std::optional<calib::BoardPose>& pose);
+  const calib::SceneCalib& lens() const { return *window_.frames[1].calib; }
+  const std::vector<stimulus::PlacedObject>& objects() const { return objects_; }
+
+ private:
+  // frames[0]: the last frame with a pose (its calib empty before the first); frames[1]: the frame being planned.
+  // Two calibrations made once and updated in place: a frame allocates no calibration.
+  stimulus::TrackedTake window_;
+  std::vector<stimulus::PlacedObject> objects_;
+  stimulus::TakeBlur blur_;
+};
+
+}  // namespace blurcue::live

@@ -1,0 +1,168 @@
+// The live view's GL-free parts: the one-slot mailbox drops and never queues, the planner draws what ar plans for the
+// same frame (the causal streak), the log's summary against hand-worked numbers, INPUT's camera names.
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "live/live_log.h"
+#include "live/live_plan.h"
+#include "live/mailbox.h"
+#include "live/paced_source.h"
+
+namespace blurcue::live {
+namespace {
+
+LiveFrame Numbered(int index) {
+  LiveFrame f;
+  f.image = cv::Mat(2, 2, CV_8UC3, cv::Scalar::all(index));
+  f.index = index;
+  f.arrival = Clock::now();
+  return f;
+}
+
+TEST(FrameMailbox, AFramePostedOverAnUntakenOneReplacesItAndCountsItDropped) {
+  FrameMailbox box;
+  LiveFrame a = Numbered(0), b = Numbered(1), c = Numbered(2), got;
+  EXPECT_FALSE(box.Post(a));
+  EXPECT_TRUE(box.Post(b));
+  EXPECT_TRUE(box.Post(c));
+  ASSERT_EQ(box.Take(got, std::chrono::milliseconds(0)), FrameMailbox::Got::kFrame);
+  EXPECT_EQ(got.index, 2);  // the newest; 0 and 1 were dropped, never queued
+  EXPECT_EQ(box.dropped(), 2);
+  EXPECT_EQ(box.Take(got, std::chrono::milliseconds(1)), FrameMailbox::Got::kTimeout);
+}
+
+TEST(FrameMailbox, AFrameLeftWhenClosedIsStillTakenThenClosedIsSaid) {
+  FrameMailbox box;
+  LiveFrame a = Numbered(7), got;
+  box.Post(a);
+  box.Close("the video ended after 8 frames", false);
+  LiveFrame late = Numbered(8);
+  EXPECT_FALSE(box.Post(late));  // ignored once closed
+  ASSERT_EQ(box.Take(got, std::chrono::milliseconds(0)), FrameMailbox::Got::kFrame);
+  EXPECT_EQ(got.index, 7);
+  EXPECT_EQ(box.Take(got, std::chrono::milliseconds(0)), FrameMailbox::Got::kClosed);
+  EXPECT_EQ(box.why_closed(), "the video ended after 8 frames");
+  EXPECT_FALSE(box.failed());
+}
+
+TEST(FrameMailbox, ATakerWaitingIsWokenByAPost) {
+  FrameMailbox box;
+  std::thread poster([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    LiveFrame f = Numbered(3);
+    box.Post(f);
+  });
+  LiveFrame got;
+  EXPECT_EQ(box.Take(got, std::chrono::milliseconds(5000)), FrameMailbox::Got::kFrame);
+  EXPECT_EQ(got.index, 3);
+  poster.join();
+}
+
+TEST(PacedSource, CameraNamesAreDevicesOrIndices) {
+  EXPECT_EQ(CameraDevice("/dev/video2"), "/dev/video2");
+  EXPECT_EQ(CameraDevice("0"), "/dev/video0");
+  EXPECT_EQ(CameraDevice("take.avi"), "");
+  EXPECT_EQ(CameraDevice("frames/frame-%04d.png"), "");
+}
+
+TEST(PacedSource, AMissingCameraIsAnInputErrorNamingTheDevice) {
+  try {
+    PacedSource source("/dev/video97", 0, 0);
+    FAIL() << "opened a camera that is not there";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kInput);
+    EXPECT_NE(std::string(e.what()).find("/dev/video97: no camera there"), std::string::npos) << e.what();
+  }
+}
+
+// A board face-on at 500 mm moving -10 mm in x a frame, 30 frames a second (stimulus/tracked_take_test.cc's take).
+calib::SceneCalib FaceOnLens() {
+  calib::SceneCalib c;
+  c.camera.focal_length_mm = 20, c.camera.f_number = 4, c.camera.sensor_width_mm = 20, c.camera.sensor_height_mm = 15;
+  c.camera.image_width_px = 1000, c.camera.image_height_px = 750;
+  c.model.focus_mm = 400, c.model.aperture_mm = 5, c.model.kind = "thin_lens";
+  return c;
+}
+
+calib::BoardPose PoseAt(int i) {
+  calib::BoardPose p;
+  p.rvec = {0, 0, 0};
+  p.tvec = {-10.0 * i, 0, 500};
+  return p;
+}
+
+TEST(LivePlanner, DrawsWhatArPlansForTheLastFrameOfTheTakeSoFar) {
+  std::vector<stimulus::PlacedObject> ball(1);
+  ball[0].name = "ball1";
+  ball[0].object = stimulus::BallAt(0, 0, 10);
+  stimulus::TakeBlur blur;
+  blur.source = BlurSource::kFitted;
+  blur.exposure_ms = 15;
+  LivePlanner planner(FaceOnLens(), ball, blur);
+  stimulus::TrackedTake take;  // the frames so far, as ar would read them from a track folder
+  for (int i = 0; i < 4; ++i) {
+    const bool lost = i == 2;
+    const std::optional<calib::BoardPose> pose = lost ? std::nullopt : std::optional(PoseAt(i));
+    const auto status = lost ? track::FrameStatus::kLost : track::FrameStatus::kTracked;
+    stimulus::TrackedFrame f;
+    f.index = i, f.time_s = i / 30.0, f.status = status;
+    if (pose) {
+      f.calib = FaceOnLens();
+      f.calib->rvec = pose->rvec, f.calib->tvec = pose->tvec;
+    }
+    take.frames.push_back(f);
+    const stimulus::TrackedFramePlan live = planner.Plan(i, i / 30.0, status, pose);
+    const stimulus::TrackedFramePlan ar = stimulus::PlanTrackedFrame(take, i, ball, blur);
+    ASSERT_EQ(live.drawn.size(), ar.drawn.size()) << "frame " << i;
+    for (size_t k = 0; k < ar.drawn.size(); ++k) {
+      EXPECT_EQ(live.drawn[k].r_px, ar.drawn[k].r_px) << "frame " << i;
+      EXPECT_EQ(live.drawn[k].depth_mm, ar.drawn[k].depth_mm);
+      EXPECT_EQ(live.drawn[k].screen_px, ar.drawn[k].screen_px);
+      // The take so far ends at this frame: ar's one-sided streak there is live's (from the last frame with a pose,
+      // across the lost frame 2 for frame 3).
+      EXPECT_NEAR(cv::norm(live.drawn[k].motion_px - ar.drawn[k].motion_px), 0, 1e-9) << "frame " << i;
+    }
+  }
+}
+
+TEST(LivePlanner, MeasuredBlurNeedsSectionsLiveDoesNotMeasure) {
+  EXPECT_THROW(RequireLiveSource(BlurSource::kMeasured, "--blur"), Error);
+  EXPECT_NO_THROW(RequireLiveSource(BlurSource::kFitted, "--blur"));
+}
+
+TEST(LiveLog, SummaryCountsAndNearestRankLatencies) {
+  std::vector<LiveRow> rows;
+  for (int i = 0; i < 20; ++i) {
+    LiveRow r;
+    r.frame = i;
+    r.arrival_s = i / 30.0;
+    r.latency_ms = i + 1;  // 1 .. 20 ms
+    r.display_s = r.arrival_s + r.latency_ms / 1000;
+    r.status = i == 0 ? track::FrameStatus::kFound : track::FrameStatus::kTracked;
+    rows.push_back(r);
+  }
+  const LiveSummary s = Summarize(rows, 1, "ended");
+  EXPECT_EQ(s.shown, 20);
+  EXPECT_EQ(s.found, 1);
+  EXPECT_EQ(s.tracked, 19);
+  EXPECT_EQ(s.median_latency_ms, 11);  // nearest rank of 0.5 x 19 = 9.5 -> the 11th value
+  EXPECT_EQ(s.p95_latency_ms, 19);     // 0.95 x 19 = 18.05 -> the 19th
+  EXPECT_EQ(s.max_latency_ms, 20);
+  EXPECT_NE(SummaryLine(s).find("20 frames shown, 1 dropped (4.8 %)"), std::string::npos) << SummaryLine(s);
+}
+
+TEST(LiveLog, ALostFrameHasAnEmptyPose) {
+  LiveRow r;
+  r.frame = 4;
+  std::string csv;
+  AppendLiveCsvRow(r, &csv);
+  EXPECT_EQ(csv, "4,0.000000,lost,,,,,,,0.000,0.000,0.000000,0.000,0\n");
+  EXPECT_EQ(LiveCsvHeader(),
+            "frame,arrival_s,status,rvec_x,rvec_y,rvec_z,tvec_x_mm,tvec_y_mm,tvec_z_mm,track_ms,render_ms,display_s,"
+            "latency_ms,dropped\n");
+}
+
+}  // namespace
+}  // namespace blurcue::live

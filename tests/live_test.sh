@@ -1,0 +1,108 @@
+#!/bin/bash
+# blurcue live end to end on a 60-frame ground-truth take (synth-take; tracked by track; drawn by ar for comparison):
+#   make      the take, its track folder and ar's CSV of a ball (the fixture the other cases read)
+#   window    played at 30 fps through `live --window` under an Xvfb of its own: tests/live_check.py holds the log whole,
+#             every pose within 0.1 % depth of the truth and the ball's radius within 1 % of ar's; TIMING=1 also holds
+#             the real-time bounds (dropped <= 5 %, latency median <= 33 ms, p95 <= 50 ms), which are printed otherwise;
+#             then Escape pressed in the window (xdotool) ends a run: exit 0, the log whole
+#   headless  the same headless (EGL): the video ends, one clear line, exit 0, the log whole; a video cut in half:
+#             one line naming it, exit 3, the log of the frames before the damage whole
+#   nocamera  a camera that is not there: exit 3, one line naming the device, and a log of no frames written whole
+# Usage: live_test.sh CASE BLURCUE DIR
+set -u
+CASE=$1 BC=$2 W=$3
+. "$(dirname "$0")/lib.sh"
+T=$W/take
+LIVE=(--camera "$T/camera.json" --track "$W/track" --ball 87.5,125 --exposure-ms 30)
+
+case $CASE in
+make)
+  rm -rf "$W" && mkdir -p "$W"
+  "$BC" synth-take --out "$T" --frames 60 --supersample 2 --quiet || fail "synth-take failed"
+  "$BC" track "$T/take.avi" --camera "$T/camera.json" --out "$W/track" --quiet || fail "track failed"
+  "$BC" ar "$T/take.avi" --track "$W/track" --ball 87.5,125 --exposure-ms 30 --out "$W/ar.avi" --frames "$W/ar-frames" --quiet ||
+    fail "ar failed"
+  [ "$(wc -l < "$W/ar.csv")" -eq 61 ] || fail "ar.csv: not 60 frames: $(wc -l < "$W/ar.csv") lines"
+  echo "ok: live_test make: a 60-frame take, tracked, and ar's ball" ;;
+window)
+  rm -rf "$W/window" && mkdir -p "$W/window"
+  W=$W/window start_xvfb
+  "$BC" live "$T/take.avi" "${LIVE[@]}" --window --fps 30 --log "$W/window/log" --save-frame 30 \
+    > "$W/window/out" 2> "$W/window/err" || fail "live --window: exit $?: $(cat "$W/window/err")"
+  grep -q "in a window (vsync)" "$W/window/err" || fail "live did not say it showed a window: $(cat "$W/window/err")"
+  grep -q "take.avi ended after 60 frames" "$W/window/out" || fail "live's end: $(cat "$W/window/out")"
+  cat "$W/window/out"
+  $PY "$(dirname "$0")/live_check.py" "$W/window/log" "$T" "$W/ar.csv" 60 ${TIMING:+--timing} ||
+    fail "live_check.py (window)"
+  # Frame 30, or the first shown after it when 30 was dropped.
+  saved=$(cd "$W/window/log" && ls frame-*.png 2> /dev/null)
+  n=${saved#frame-}; n=${n%.png}
+  [ -n "$saved" ] && [ "$(echo "$saved" | wc -l)" = 1 ] && [ $((10#$n)) -ge 30 ] ||
+    fail "--save-frame 30 wrote: $saved"
+  # The frame live showed is ar's frame of the same number, pixel for pixel: the photo untouched outside the ball, the ball's pixels
+  # within a few levels (the pose tracked live may differ from track's in its last digits), and as much ball drawn.
+  $PY - "$W/window/log/$saved" "$W/ar-frames/$saved" "$T/$saved" <<'PYEOF' || fail "$saved"
+import sys
+import numpy as np
+from PIL import Image
+live, ar, photo = (np.asarray(Image.open(p).convert("RGB"), dtype=float) for p in sys.argv[1:4])
+ball = np.abs(ar - photo).sum(axis=2) > 3
+assert ball.sum() > 500, f"ar drew only {ball.sum()} pixels"
+d = np.abs(live - ar)
+assert d[~ball].max() <= 1, f"live changed the photo outside the ball by {d[~ball].max()}"
+assert d[ball].mean() <= 0.5 and d[ball].max() <= 16, f"ball pixels: mean {d[ball].mean():.3f}, max {d[ball].max()}"
+signal_live, signal_ar = np.abs(live - photo)[ball].sum(), np.abs(ar - photo)[ball].sum()
+assert abs(signal_live / signal_ar - 1) <= 0.01, (signal_live, signal_ar)
+print(f"{sys.argv[1].split('/')[-1]}: live's ball = ar's over {ball.sum()} px: mean {d[ball].mean():.3f} levels, max {d[ball].max():.0f}")
+PYEOF
+  # Escape ends a run: the take at 10 fps (6 s), Escape pressed in the window once it shows frames; exit 0, the log
+  # whole.
+  "$BC" live "$T/take.avi" "${LIVE[@]}" --window --fps 10 --log "$W/window/escape" > "$W/window/escape.out" \
+    2> "$W/window/escape.err" &
+  pid=$!
+  # The title says "- showing" once the first frame is on screen; Escape half a second after that.
+  wid=$(timeout 60 xdotool search --sync --name "blurcue live: .* - showing" | head -1)
+  [ -n "$wid" ] || fail "the live window never said it was showing a frame"
+  sleep 0.5
+  xdotool windowfocus --sync "$wid" key Escape || fail "xdotool could not press Escape in the window"
+  wait $pid || fail "live --window, Escape: exit $?: $(cat "$W/window/escape.err")"
+  head -1 "$W/window/escape.out" | grep -q "^Escape pressed$" || fail "Escape: $(cat "$W/window/escape.out")"
+  shown=$(( $(wc -l < "$W/window/escape/live.csv") - 1 ))
+  [ $shown -ge 1 ] && [ $shown -lt 55 ] && grep -q "\"ended\": \"Escape pressed\"" "$W/window/escape/summary.json" ||
+    fail "Escape's log: $shown rows, $(cat "$W/window/escape/summary.json")"
+  echo "ok: live_test window" ;;
+headless)
+  rm -rf "$W/headless"
+  "$BC" live "$T/take.avi" "${LIVE[@]}" --log "$W/headless" > "$W/headless.out" 2> "$W/headless.err"
+  code=$?
+  [ $code = 0 ] || fail "live headless: exit $code: $(cat "$W/headless.err")"
+  head -1 "$W/headless.out" | grep -q "^$T/take.avi ended after 60 frames$" ||
+    fail "the video's end is not one clear first line: $(cat "$W/headless.out")"
+  grep -q "^[0-9]* frames shown, [0-9]* dropped" "$W/headless.out" || fail "no summary line: $(cat "$W/headless.out")"
+  grep -q '"ended": ".*take.avi ended after 60 frames"' "$W/headless/summary.json" ||
+    fail "summary.json does not say how the run ended: $(cat "$W/headless/summary.json")"
+  $PY "$(dirname "$0")/live_check.py" "$W/headless" "$T" "$W/ar.csv" 60 || fail "live_check.py (headless)"
+  # A video cut short: the frames before the damage are shown, then one line naming the video, exit 3, the log whole.
+  head -c $(( $(stat -c %s "$T/take.avi") / 2 )) "$T/take.avi" > "$W/cut.avi"
+  rm -rf "$W/cut"
+  "$BC" live "$W/cut.avi" "${LIVE[@]}" --log "$W/cut" > "$W/cut.out" 2> "$W/cut.err"
+  code=$?
+  [ $code = 3 ] && [ "$(grep -c '^blurcue: ' "$W/cut.err")" = 1 ] &&
+    grep -q "^blurcue: $W/cut.avi: damaged or truncated: frame [0-9]* of the 60 .*; the log of the [0-9]* frames shown is whole in $W/cut$" "$W/cut.err" ||
+    fail "a cut video: exit $code, stderr: $(cat "$W/cut.err")"
+  shown=$(( $(wc -l < "$W/cut/live.csv") - 1 ))
+  [ $shown -gt 5 ] && grep -q "\"frames_shown\": $shown," "$W/cut/summary.json" ||
+    fail "the cut video's log: $shown rows, $(cat "$W/cut/summary.json")"
+  echo "ok: live_test headless" ;;
+nocamera)
+  rm -rf "$W/nocamera"
+  "$BC" live /dev/video97 "${LIVE[@]}" --log "$W/nocamera" > "$W/nocamera.out" 2> "$W/nocamera.err"
+  code=$?
+  [ $code = 3 ] && [ "$(wc -l < "$W/nocamera.err")" = 1 ] &&
+    grep -q "^blurcue: /dev/video97: no camera there" "$W/nocamera.err" ||
+    fail "a missing camera: exit $code, stderr: $(cat "$W/nocamera.err")"
+  [ "$(cat "$W/nocamera/live.csv" | wc -l)" = 1 ] || fail "the log of no frames is not a header alone"
+  grep -q '"frames_shown": 0' "$W/nocamera/summary.json" || fail "summary.json: $(cat "$W/nocamera/summary.json")"
+  echo "ok: live_test nocamera: $(cat "$W/nocamera.err")" ;;
+*) fail "unknown case $CASE" ;;
+esac
