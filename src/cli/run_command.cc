@@ -40,15 +40,63 @@ bool AskInTerminal(const std::string& prompt, std::string* answer) {
   return c != EOF;
 }
 
+struct RunArgs {
+  session::RunOptions options;
+  std::string protocol, db, observer;
+  std::optional<uint64_t> seed;
+  std::vector<std::string> info;
+};
+
+// What `run` does with its options: the session, then one line of what it recorded.
+void Run(const RunArgs& args) {
+  session::RunOptions options = args.options;
+  options.protocol_file = args.protocol;
+  options.db = args.db;
+  options.observer = args.observer;
+  options.seed = args.seed;
+  for (const std::string& item : args.info) {
+    const size_t eq = item.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw Error(ErrorKind::kUsage, "--info: must be KEY=VALUE, got " + Echo(item));
+    const std::string key = item.substr(0, eq);
+    // A key given twice would keep one of its values unsaid: which one was meant is the experimenter's to say.
+    for (const auto& given : options.info)
+      if (given.first == key)
+        throw Error(ErrorKind::kUsage, "--info " + Echo(key, false) + " is given twice (" +
+                                           Echo(given.first + "=" + given.second) + " and " + Echo(item) + ")");
+    options.info.emplace_back(key, item.substr(eq + 1));
+  }
+  const bool tty = isatty(2);
+  bool said = false;
+  options.progress = [tty, &said](const session::TrialProgress& p) {
+    SayProgress(p, tty);
+    said = true;
+  };
+  if (isatty(0)) options.ask = AskInTerminal;
+  const session::RunResult r = session::RunSession(options);
+  if (tty && said) std::fprintf(stderr, "\n");
+  // Trials a stopped procedure skipped are recorded too: counted as done, and said apart.
+  const int64_t by_stop_rule = r.skipped_now - r.skipped_by_criterion_now;
+  std::string skipped;
+  if (by_stop_rule > 0) skipped += ", " + std::to_string(by_stop_rule) + " skipped now: their procedure had stopped";
+  if (r.skipped_by_criterion_now > 0)
+    skipped += ", " + std::to_string(r.skipped_by_criterion_now) + " practice trials skipped now: the criterion was met";
+  std::printf("%s: participant %s, session %lld, the participant's session %lld, seed %llu: %lld of %lld trials %s "
+              "(%lld answered now%s%s)%s\n",
+              args.db.c_str(), options.participant.c_str(), static_cast<long long>(r.session_id),
+              static_cast<long long>(r.session_number),
+              static_cast<unsigned long long>(r.seed),
+              static_cast<long long>(r.answered_before + r.answered_now + r.skipped_now),
+              static_cast<long long>(r.trial_count), r.skipped_now > 0 ? "done" : "answered",
+              static_cast<long long>(r.answered_now), skipped.c_str(),
+              r.dropped_frames > 0 ? (", " + std::to_string(r.dropped_frames) + " dropped frames").c_str() : "",
+              r.completed ? "; completed" : "; not finished - continue with --resume");
+}
+
 }  // namespace
 
 void AddRunCommand(CLI::App& app) {
-  struct Args {
-    session::RunOptions options;
-    std::string protocol, db, observer;
-    std::optional<uint64_t> seed;
-    std::vector<std::string> info;
-  };
+  using Args = RunArgs;
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "run",
@@ -135,50 +183,7 @@ void AddRunCommand(CLI::App& app) {
   cmd->add_option("--stop-after", args->options.stop_after, "leave the session after this many answers (it stays "
                                                             "resumable; for tests and split sittings)")
       ->transform(IntRange(0, 1000000));
-  cmd->callback([args] {
-    session::RunOptions options = args->options;
-    options.protocol_file = args->protocol;
-    options.db = args->db;
-    options.observer = args->observer;
-    options.seed = args->seed;
-    for (const std::string& item : args->info) {
-      const size_t eq = item.find('=');
-      if (eq == std::string::npos || eq == 0)
-        throw Error(ErrorKind::kUsage, "--info: must be KEY=VALUE, got " + Echo(item));
-      const std::string key = item.substr(0, eq);
-      // A key given twice would keep one of its values unsaid: which one was meant is the experimenter's to say.
-      for (const auto& given : options.info)
-        if (given.first == key)
-          throw Error(ErrorKind::kUsage, "--info " + Echo(key, false) + " is given twice (" +
-                                             Echo(given.first + "=" + given.second) + " and " + Echo(item) + ")");
-      options.info.emplace_back(key, item.substr(eq + 1));
-    }
-    const bool tty = isatty(2);
-    bool said = false;
-    options.progress = [tty, &said](const session::TrialProgress& p) {
-      SayProgress(p, tty);
-      said = true;
-    };
-    if (isatty(0)) options.ask = AskInTerminal;
-    const session::RunResult r = session::RunSession(options);
-    if (tty && said) std::fprintf(stderr, "\n");
-    // Trials a stopped procedure skipped are recorded too: counted as done, and said apart.
-    const int64_t by_stop_rule = r.skipped_now - r.skipped_by_criterion_now;
-    std::string skipped;
-    if (by_stop_rule > 0) skipped += ", " + std::to_string(by_stop_rule) + " skipped now: their procedure had stopped";
-    if (r.skipped_by_criterion_now > 0)
-      skipped += ", " + std::to_string(r.skipped_by_criterion_now) + " practice trials skipped now: the criterion was met";
-    std::printf("%s: participant %s, session %lld, the participant's session %lld, seed %llu: %lld of %lld trials %s "
-                "(%lld answered now%s%s)%s\n",
-                args->db.c_str(), options.participant.c_str(), static_cast<long long>(r.session_id),
-                static_cast<long long>(r.session_number),
-                static_cast<unsigned long long>(r.seed),
-                static_cast<long long>(r.answered_before + r.answered_now + r.skipped_now),
-                static_cast<long long>(r.trial_count), r.skipped_now > 0 ? "done" : "answered",
-                static_cast<long long>(r.answered_now), skipped.c_str(),
-                r.dropped_frames > 0 ? (", " + std::to_string(r.dropped_frames) + " dropped frames").c_str() : "",
-                r.completed ? "; completed" : "; not finished - continue with --resume");
-  });
+  cmd->callback([args] { Run(*args); });
 }
 
 }  // namespace blurcue::cli
