@@ -29,14 +29,208 @@
 
 namespace blurcue::cli {
 
-void AddAnimateCommand(CLI::App& app) {
-  struct Args {
-    std::string calib, background, left = "estimated", right = "none", texture = "soccer", method = "gaussian";
-    std::string video, frames_dir, log;
-    double speed_cm_s = 3, fps = 60, gain = 1, exposure_ms = 0;
-    int from_edge = 1, to_edge = 11, left_section = 3, right_section = 5;
-    bool window = false, fullscreen = false;
+namespace {
+
+struct AnimateArgs {
+  std::string calib, background, left = "estimated", right = "none", texture = "soccer", method = "gaussian";
+  std::string video, frames_dir, log;
+  double speed_cm_s = 3, fps = 60, gain = 1, exposure_ms = 0;
+  int from_edge = 1, to_edge = 11, left_section = 3, right_section = 5;
+  bool window = false, fullscreen = false;
+};
+
+// The options against the calibration (edges and sections it has) and the outputs, before any frame is drawn:
+// OpenCV's writer picks its container by the extension (and prints its own multi-line warnings for one it does not
+// know), and a device or FIFO is not a file to replace (opening a FIFO to write waits for a reader forever).
+void CheckAnimateArgs(const AnimateArgs& args, const calib::SceneCalib& scene) {
+  const int edges = scene.board.EdgeCount(), sections = scene.board.SectionCount();
+  auto check = [](const char* name, int v, int lo, int hi) {
+    if (v < lo || v > hi)
+      throw Error(ErrorKind::kUsage, std::string(name) + " must be " + std::to_string(lo) + ".." +
+                                         std::to_string(hi) + ", got " + std::to_string(v));
   };
+  check("--from-edge", args.from_edge, 1, edges);
+  check("--to-edge", args.to_edge, 1, edges);
+  check("--left-section", args.left_section, 1, sections);
+  check("--right-section", args.right_section, 1, sections);
+  if (args.video.empty() && args.frames_dir.empty() && !args.window)
+    throw Error(ErrorKind::kUsage, "say where the frames go: --video, --frames or --window");
+  // Outputs checked before any frame is drawn: OpenCV's writer picks its container by the extension (and prints
+  // its own multi-line warnings for one it does not know), and a device or FIFO is not a file to replace (opening
+  // a FIFO to write waits for a reader forever).
+  if (!args.video.empty()) {
+    std::string extension = std::filesystem::path(args.video).extension().string();
+    for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (extension != ".avi")
+      throw Error(ErrorKind::kUsage, "--video " + Echo(args.video, false) + ": must end in .avi (it writes an MJPG AVI)");
+    RequireReplaceableFile(args.video);
+  }
+  if (!args.log.empty()) RequireReplaceableFile(args.log);
+  {
+    OutputGuard guard;
+    guard.Input("--calib", args.calib).Input("--background", args.background);
+    if (!args.video.empty()) guard.OutputFile("--video", args.video);
+    if (!args.log.empty()) guard.OutputFile("--log", args.log);
+    if (!args.frames_dir.empty()) guard.OutputFolder("--frames", args.frames_dir);
+    guard.Check();
+  }
+}
+
+// The two balls of each frame: rolling from --from-edge to --to-edge at --speed-cm-s, each blurred for its depth by
+// its own blur source (x --gain) and, while rolling, streaked over the exposure: where its centre's image goes from
+// half an exposure before to half after.
+class RollingBalls {
+ public:
+  RollingBalls(const AnimateArgs& args, const calib::SceneCalib& scene, const scene::SurfaceTexture& texture)
+      : args_(args), scene_(scene), texture_(texture) {
+    source_[0] = calib::ParseBlurSource(args.left, &fixed_[0]);
+    source_[1] = calib::ParseBlurSource(args.right, &fixed_[1]);
+    y0_ = (args.from_edge - 1) * scene.board.square_mm;
+    y1_ = (args.to_edge - 1) * scene.board.square_mm;
+    half_mm_ = 0.5 * speed_mm_s() * args.exposure_ms / 1000 * (y1_ >= y0_ ? 1 : -1);
+  }
+  double speed_mm_s() const { return args_.speed_cm_s * 10; }
+  double distance_mm() const { return std::abs(y1_ - y0_); }
+  // Where the balls are at time t (s), along the board.
+  double YAt(double t) const { return y0_ + (y1_ > y0_ ? 1 : -1) * std::min(distance_mm(), speed_mm_s() * t); }
+  scene::BlurredObject Ball(int b, double y) const {
+    scene::BlurredObject o;
+    o.object = scene::BallOnBoard(scene_.board, b == 0 ? args_.left_section : args_.right_section, y, kRadiusMm, y0_);
+    o.object.texture = texture_;
+    return o;
+  }
+  // Frame `i`'s two balls at time t; throws Error(kUsage) naming the option whose radius is beyond the blur's range.
+  std::vector<scene::BlurredObject> At(int i, double t) const {
+    const double y = YAt(t);
+    const bool rolling = speed_mm_s() * t < distance_mm();
+    std::vector<scene::BlurredObject> balls = {Ball(0, y), Ball(1, y)};
+    for (int b = 0; b < 2; ++b) {
+      const cv::Vec3d centre = scene_.ToCamera(balls[b].object.center_board_mm);
+      const double r = args_.gain * calib::BlurAtPx(scene_, source_[b], centre, fixed_[b]);
+      if (!(r >= 0 && r <= render::kMaxBlurRadiusPx))
+        throw Error(ErrorKind::kUsage, std::string(b == 0 ? "--left " + args_.left : "--right " + args_.right) +
+                                           " x --gain " + BoundText(args_.gain) + " gives " + BoundText(r) +
+                                           " px at frame " + std::to_string(i) + "; the blur radius must be in [0, " +
+                                           BoundText(render::kMaxBlurRadiusPx) + "] px");
+      balls[b].r_px = r;
+      balls[b].method = args_.method;
+      balls[b].floor_sigma_px = calib::FloorSigmaPx(scene_, source_[b], centre);
+      balls[b].shape = calib::ShapeAt(scene_, source_[b], centre);
+      balls[b].motion_px = rolling ? Streak(b, y) : cv::Vec2d(0, 0);
+    }
+    return balls;
+  }
+
+ private:
+  static constexpr double kRadiusMm = 10;
+  cv::Vec2d Streak(int b, double y) const {
+    if (!(half_mm_ != 0)) return {0, 0};
+    std::vector<cv::Point3d> ends = {cv::Point3d(Ball(b, y - half_mm_).object.center_board_mm),
+                                     cv::Point3d(Ball(b, y + half_mm_).object.center_board_mm)};
+    std::vector<cv::Point2d> image;
+    cv::projectPoints(ends, scene_.rvec, scene_.tvec, cv::Matx33d(scene_.camera.Intrinsics().data()),
+                      scene_.camera.dist_coeffs, image);
+    return {image[1].x - image[0].x, image[1].y - image[0].y};
+  }
+  const AnimateArgs& args_;
+  const calib::SceneCalib& scene_;
+  const scene::SurfaceTexture& texture_;
+  calib::BlurSource source_[2];
+  double fixed_[2] = {0, 0};
+  double y0_ = 0, y1_ = 0, half_mm_ = 0;
+};
+
+// Two balls rolling side by side, each re-blurred every frame for its depth by its own blur source.
+void Animate(const AnimateArgs& args) {
+  const calib::SceneCalib scene = calib::LoadSceneCalib(args.calib);
+  const cv::Mat photo = ReadImage(args.background, 1);
+  scene.RequireSameSize(photo, args.background);
+  CheckAnimateArgs(args, scene);
+  const scene::SurfaceTexture texture(ReadImage(scene::ResolveStimulus(args.texture)));
+  const RollingBalls rolling(args, scene, texture);
+
+  std::unique_ptr<render::GlContext> context;
+  if (args.window) {
+    render::WindowOptions w;
+    w.width_px = std::min(photo.cols, 1280);
+    w.height_px = w.width_px * photo.rows / photo.cols;
+    w.fullscreen = args.fullscreen;
+    context = render::GlContext::CreateWindow(w);
+  } else {
+    context = render::GlContext::CreateOffscreen();
+  }
+  render::FrameCompositor compositor(scene.camera, scene.rvec, scene.tvec, photo);
+
+  const double frame_count = std::ceil(rolling.distance_mm() / rolling.speed_mm_s() * args.fps) + 1;
+  constexpr double kMaxFrames = 36000;  // ten minutes at 60 fps
+  if (frame_count > kMaxFrames)
+    throw Error(ErrorKind::kUsage, "--speed-cm-s " + BoundText(args.speed_cm_s) + " and --fps " +
+                                       BoundText(args.fps) + " make " + BoundText(frame_count) +
+                                       " frames; at most " + BoundText(kMaxFrames) + " (go faster or lower --fps)");
+  const int frames = std::max(1, int(frame_count));
+  media::VideoWriter video;
+  if (!args.video.empty()) {
+    if (std::filesystem::path(args.video).has_parent_path())
+      std::filesystem::create_directories(std::filesystem::path(args.video).parent_path());
+    if (!video.Open(args.video, media::Fourcc('M', 'J', 'P', 'G'), args.fps, photo.size())) throw InputError(args.video, "cannot open a video writer (MJPG .avi)");
+  }
+  // The log is written whole at the end (WriteFileAtomically): a run cut short leaves no half log.
+  std::ostringstream log;
+  log << "frame,t_s,y_mm,r_left_px,r_right_px,floor_sigma_left_px,floor_sigma_right_px,motion_left_x_px,"
+         "motion_left_y_px,motion_right_x_px,motion_right_y_px,render_ms,flip_s\n";
+  using Clock = std::chrono::steady_clock;
+  {  // a warm-up frame uploads and mipmaps the texture, so frame 0 is not slower than the rest
+    compositor.Compose({rolling.Ball(0, rolling.YAt(0))});
+    compositor.Finish();
+  }
+  const bool tty = isatty(2);
+  const auto start = Clock::now();
+  double worst_ms = 0;
+  for (int i = 0; i < frames && !(context->ShouldClose()); ++i) {
+    const double t = i / args.fps;
+    const double y = rolling.YAt(t);
+    const std::vector<scene::BlurredObject> balls = rolling.At(i, t);
+    const double r[2] = {balls[0].r_px, balls[1].r_px};
+    const auto t0 = Clock::now();
+    compositor.Compose(balls);
+    compositor.Finish();
+    const double render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    worst_ms = std::max(worst_ms, render_ms);
+    double flip_s = std::chrono::duration<double>(Clock::now() - start).count();
+    if (args.window) {
+      compositor.Present(context->width_px(), context->height_px());
+      context->SwapBuffers();
+      flip_s = std::chrono::duration<double>(Clock::now() - start).count();
+    }
+    if (video.IsOpened() || !args.frames_dir.empty()) {
+      const cv::Mat frame = compositor.Read();
+      if (video.IsOpened()) video.Write(frame);
+      if (!args.frames_dir.empty()) {
+        char name[32];
+        std::snprintf(name, sizeof name, "frame-%05d.png", i);
+        WriteImage(std::filesystem::path(args.frames_dir) / name, frame);
+      }
+    }
+    log << i << "," << t << "," << y << "," << r[0] << "," << r[1] << "," << balls[0].floor_sigma_px << ","
+        << balls[1].floor_sigma_px << "," << balls[0].motion_px[0] << "," << balls[0].motion_px[1] << ","
+        << balls[1].motion_px[0] << "," << balls[1].motion_px[1] << "," << render_ms << "," << flip_s << "\n";
+    if (tty || (i + 1) % std::max(1, frames / 4) == 0 || i + 1 == frames)
+      std::fprintf(stderr, "%sframe %d/%d  y %.1f mm  r %.2f | %.2f px  %.1f ms%s", tty ? "\r" : "", i + 1, frames,
+                   y, r[0], r[1], render_ms, tty ? "" : "\n");
+  }
+  if (tty) std::fprintf(stderr, "\n");
+  if (!args.log.empty()) WriteFileAtomically(args.log, log.str());
+  std::printf("%d frames (%.1f s of motion at %.1f cm/s, %.0f fps); slowest frame %.1f ms%s%s%s\n", frames,
+              (frames - 1) / args.fps, args.speed_cm_s, args.fps, worst_ms,
+              args.video.empty() ? "" : ("; video " + args.video).c_str(),
+              args.frames_dir.empty() ? "" : ("; frames in " + args.frames_dir).c_str(),
+              args.log.empty() ? "" : ("; log " + args.log).c_str());
+}
+
+}  // namespace
+
+void AddAnimateCommand(CLI::App& app) {
+  using Args = AnimateArgs;
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "animate",
@@ -76,161 +270,7 @@ void AddAnimateCommand(CLI::App& app) {
                   "streak (x, y) in photo px, render_ms, flip_s");
   cmd->add_flag("--window", args->window, "show in a GLFW window (vsync)");
   cmd->add_flag("--fullscreen", args->fullscreen, "with --window: fullscreen on the first monitor");
-  cmd->callback([args] {
-    const calib::SceneCalib scene = calib::LoadSceneCalib(args->calib);
-    const cv::Mat photo = ReadImage(args->background, 1);
-    scene.RequireSameSize(photo, args->background);
-    const int edges = scene.board.EdgeCount(), sections = scene.board.SectionCount();
-    auto check = [](const char* name, int v, int lo, int hi) {
-      if (v < lo || v > hi)
-        throw Error(ErrorKind::kUsage, std::string(name) + " must be " + std::to_string(lo) + ".." +
-                                           std::to_string(hi) + ", got " + std::to_string(v));
-    };
-    check("--from-edge", args->from_edge, 1, edges);
-    check("--to-edge", args->to_edge, 1, edges);
-    check("--left-section", args->left_section, 1, sections);
-    check("--right-section", args->right_section, 1, sections);
-    if (args->video.empty() && args->frames_dir.empty() && !args->window)
-      throw Error(ErrorKind::kUsage, "say where the frames go: --video, --frames or --window");
-    // Outputs checked before any frame is drawn: OpenCV's writer picks its container by the extension (and prints
-    // its own multi-line warnings for one it does not know), and a device or FIFO is not a file to replace (opening
-    // a FIFO to write waits for a reader forever).
-    if (!args->video.empty()) {
-      std::string extension = std::filesystem::path(args->video).extension().string();
-      for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
-      if (extension != ".avi")
-        throw Error(ErrorKind::kUsage, "--video " + Echo(args->video, false) + ": must end in .avi (it writes an MJPG AVI)");
-      RequireReplaceableFile(args->video);
-    }
-    if (!args->log.empty()) RequireReplaceableFile(args->log);
-    {
-      OutputGuard guard;
-      guard.Input("--calib", args->calib).Input("--background", args->background);
-      if (!args->video.empty()) guard.OutputFile("--video", args->video);
-      if (!args->log.empty()) guard.OutputFile("--log", args->log);
-      if (!args->frames_dir.empty()) guard.OutputFolder("--frames", args->frames_dir);
-      guard.Check();
-    }
-    double fixed_left = 0, fixed_right = 0;
-    const calib::BlurSource left = calib::ParseBlurSource(args->left, &fixed_left);
-    const calib::BlurSource right = calib::ParseBlurSource(args->right, &fixed_right);
-    const scene::SurfaceTexture texture(ReadImage(scene::ResolveStimulus(args->texture)));
-
-    std::unique_ptr<render::GlContext> context;
-    if (args->window) {
-      render::WindowOptions w;
-      w.width_px = std::min(photo.cols, 1280);
-      w.height_px = w.width_px * photo.rows / photo.cols;
-      w.fullscreen = args->fullscreen;
-      context = render::GlContext::CreateWindow(w);
-    } else {
-      context = render::GlContext::CreateOffscreen();
-    }
-    render::FrameCompositor compositor(scene.camera, scene.rvec, scene.tvec, photo);
-
-    const double s = scene.board.square_mm, radius = 10;
-    const double y0 = (args->from_edge - 1) * s, y1 = (args->to_edge - 1) * s;
-    const double speed_mm_s = args->speed_cm_s * 10;
-    const double frame_count = std::ceil(std::abs(y1 - y0) / speed_mm_s * args->fps) + 1;
-    constexpr double kMaxFrames = 36000;  // ten minutes at 60 fps
-    if (frame_count > kMaxFrames)
-      throw Error(ErrorKind::kUsage, "--speed-cm-s " + BoundText(args->speed_cm_s) + " and --fps " +
-                                         BoundText(args->fps) + " make " + BoundText(frame_count) +
-                                         " frames; at most " + BoundText(kMaxFrames) + " (go faster or lower --fps)");
-    const int frames = std::max(1, int(frame_count));
-    media::VideoWriter video;
-    if (!args->video.empty()) {
-      if (std::filesystem::path(args->video).has_parent_path())
-        std::filesystem::create_directories(std::filesystem::path(args->video).parent_path());
-      if (!video.Open(args->video, media::Fourcc('M', 'J', 'P', 'G'), args->fps, photo.size())) throw InputError(args->video, "cannot open a video writer (MJPG .avi)");
-    }
-    // The log is written whole at the end (WriteFileAtomically): a run cut short leaves no half log.
-    std::ostringstream log;
-    log << "frame,t_s,y_mm,r_left_px,r_right_px,floor_sigma_left_px,floor_sigma_right_px,motion_left_x_px,"
-           "motion_left_y_px,motion_right_x_px,motion_right_y_px,render_ms,flip_s\n";
-    // A ball's streak over the exposure: where its centre's image goes from half an exposure before to half after.
-    const double half_mm = 0.5 * speed_mm_s * args->exposure_ms / 1000 * (y1 >= y0 ? 1 : -1);
-    auto streak = [&](int section, double y) -> cv::Vec2d {
-      if (!(half_mm != 0)) return {0, 0};
-      std::vector<cv::Point3d> ends = {
-          cv::Point3d(scene::BallOnBoard(scene.board, section, y - half_mm, radius, y0).center_board_mm),
-          cv::Point3d(scene::BallOnBoard(scene.board, section, y + half_mm, radius, y0).center_board_mm)};
-      std::vector<cv::Point2d> image;
-      cv::projectPoints(ends, scene.rvec, scene.tvec, cv::Matx33d(scene.camera.Intrinsics().data()),
-                        scene.camera.dist_coeffs, image);
-      return {image[1].x - image[0].x, image[1].y - image[0].y};
-    };
-    using Clock = std::chrono::steady_clock;
-    {  // a warm-up frame uploads and mipmaps the texture, so frame 0 is not slower than the rest
-      scene::BlurredObject b;
-      b.object = scene::BallOnBoard(scene.board, args->left_section, y0, radius, y0);
-      b.object.texture = texture;
-      compositor.Compose({b});
-      compositor.Finish();
-    }
-    const bool tty = isatty(2);
-    const auto start = Clock::now();
-    double worst_ms = 0;
-    for (int i = 0; i < frames && !(context->ShouldClose()); ++i) {
-      const double t = i / args->fps;
-      const double y = y0 + (y1 > y0 ? 1 : -1) * std::min(std::abs(y1 - y0), speed_mm_s * t);
-      const bool rolling = speed_mm_s * t < std::abs(y1 - y0);
-      std::vector<scene::BlurredObject> balls(2);
-      const int section[2] = {args->left_section, args->right_section};
-      const calib::BlurSource source[2] = {left, right};
-      const double fixed[2] = {fixed_left, fixed_right};
-      double r[2];
-      for (int b = 0; b < 2; ++b) {
-        scene::VirtualObject& o = balls[b].object;
-        o = scene::BallOnBoard(scene.board, section[b], y, radius, y0);
-        o.texture = texture;
-        r[b] = args->gain * calib::BlurAtPx(scene, source[b], scene.ToCamera(o.center_board_mm), fixed[b]);
-        if (!(r[b] >= 0 && r[b] <= render::kMaxBlurRadiusPx))
-          throw Error(ErrorKind::kUsage, std::string(b == 0 ? "--left " + args->left : "--right " + args->right) +
-                                             " x --gain " + BoundText(args->gain) + " gives " + BoundText(r[b]) +
-                                             " px at frame " + std::to_string(i) + "; the blur radius must be in [0, " +
-                                             BoundText(render::kMaxBlurRadiusPx) + "] px");
-        balls[b].r_px = r[b];
-        balls[b].method = args->method;
-        balls[b].floor_sigma_px = calib::FloorSigmaPx(scene, source[b], scene.ToCamera(o.center_board_mm));
-        balls[b].shape = calib::ShapeAt(scene, source[b], scene.ToCamera(o.center_board_mm));
-        balls[b].motion_px = rolling ? streak(section[b], y) : cv::Vec2d(0, 0);
-      }
-      const auto t0 = Clock::now();
-      compositor.Compose(balls);
-      compositor.Finish();
-      const double render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-      worst_ms = std::max(worst_ms, render_ms);
-      double flip_s = std::chrono::duration<double>(Clock::now() - start).count();
-      if (args->window) {
-        compositor.Present(context->width_px(), context->height_px());
-        context->SwapBuffers();
-        flip_s = std::chrono::duration<double>(Clock::now() - start).count();
-      }
-      if (video.IsOpened() || !args->frames_dir.empty()) {
-        const cv::Mat frame = compositor.Read();
-        if (video.IsOpened()) video.Write(frame);
-        if (!args->frames_dir.empty()) {
-          char name[32];
-          std::snprintf(name, sizeof name, "frame-%05d.png", i);
-          WriteImage(std::filesystem::path(args->frames_dir) / name, frame);
-        }
-      }
-      log << i << "," << t << "," << y << "," << r[0] << "," << r[1] << "," << balls[0].floor_sigma_px << ","
-          << balls[1].floor_sigma_px << "," << balls[0].motion_px[0] << "," << balls[0].motion_px[1] << ","
-          << balls[1].motion_px[0] << "," << balls[1].motion_px[1] << "," << render_ms << "," << flip_s << "\n";
-      if (tty || (i + 1) % std::max(1, frames / 4) == 0 || i + 1 == frames)
-        std::fprintf(stderr, "%sframe %d/%d  y %.1f mm  r %.2f | %.2f px  %.1f ms%s", tty ? "\r" : "", i + 1, frames,
-                     y, r[0], r[1], render_ms, tty ? "" : "\n");
-    }
-    if (tty) std::fprintf(stderr, "\n");
-    if (!args->log.empty()) WriteFileAtomically(args->log, log.str());
-    std::printf("%d frames (%.1f s of motion at %.1f cm/s, %.0f fps); slowest frame %.1f ms%s%s%s\n", frames,
-                (frames - 1) / args->fps, args->speed_cm_s, args->fps, worst_ms,
-                args->video.empty() ? "" : ("; video " + args->video).c_str(),
-                args->frames_dir.empty() ? "" : ("; frames in " + args->frames_dir).c_str(),
-                args->log.empty() ? "" : ("; log " + args->log).c_str());
-  });
+  cmd->callback([args] { Animate(*args); });
 }
 
 }  // namespace blurcue::cli
