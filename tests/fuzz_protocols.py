@@ -17,7 +17,9 @@ value, a repeated or multiplied list.
 Must hold, for every mutant: no signal, no exit 10 (or any code but 0, 2, 3), no timeout; a rejection names the
 protocol file and the field on every stderr line (libpng warnings aside): "FILE: /json/pointer: ..." or, for a text
 that is not JSON (empty, cut short, not UTF-8, nested too deep), "FILE: not valid JSON ... line N, column M";
-an accepted protocol runs 3 trials (--stop-after 3) with the simulated observer and exits 0. Prints the counts and
+an accepted protocol runs 3 trials (--stop-after 3) with the simulated observer and exits 0 - or run refuses it for
+that observer (exit 2 or 3) and `validate --plan --observer sim` refuses it with the same line (a protocol a person
+can run that the simulated observer cannot answer, counted apart). Prints the counts and
 every failure with its seed and mutations; exits 1 on any failure. Reproduce one mutant with --seed S --count 1 --first K (K is its index) --keep.
 """
 import argparse
@@ -294,6 +296,17 @@ def refusal_problems(stderr, path):
     return out
 
 
+def observer_refusal_agrees(blurcue, path, run_stderr, env):
+    """True when `validate --plan --observer sim` refuses the protocol with the line `run --observer sim` refused it
+    with: the two agree for that observer (validate without --observer checks the protocol for a person)."""
+    try:
+        v = subprocess.run([blurcue, "validate", path, "--plan", "--observer", "sim"], capture_output=True, text=True,
+                           errors="replace", timeout=VALIDATE_TIMEOUT_S, env=env)
+    except subprocess.TimeoutExpired:
+        return False
+    line = run_stderr.strip().splitlines()[-1] if run_stderr.strip() else ""
+    return v.returncode == 3 and line != "" and line in v.stderr
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("blurcue")
@@ -324,7 +337,7 @@ def main():
     env.pop("DISPLAY", None)  # the simulated observer runs headless
 
     counts = {"mutants": 0, "rejected": 0, "accepted": 0, "ran": 0, "crash": 0, "exit10": 0, "other_exit": 0,
-              "timeout": 0, "accepted_then_failed": 0, "unnamed_message": 0}
+              "timeout": 0, "accepted_then_failed": 0, "refused_for_the_observer": 0, "unnamed_message": 0}
     failures = []
     started = time.time()
     print("%d mutants of %s" % (args.count, ", ".join(shipped)), flush=True)
@@ -405,7 +418,11 @@ def main():
                 r = subprocess.run([args.blurcue, "run", path, "--participant", "P1", "--db", db, "--observer", "sim",
                                     "--stop-after", "3", "--sim-fps", "2"] + info,
                                    capture_output=True, text=True, errors="replace", timeout=RUN_TIMEOUT_S, env=env)
-                if r.returncode != 0:
+                if r.returncode in (2, 3) and observer_refusal_agrees(args.blurcue, path, r.stderr, env):
+                    # A protocol a person can run that the simulated observer cannot answer (no real camera for its
+                    # arcmin model): validate, asked for the same observer, refuses it with run's own line.
+                    counts["refused_for_the_observer"] += 1
+                elif r.returncode != 0:
                     counts["accepted_then_failed"] += 1
                     if r.returncode < 0:
                         counts["crash"] += 1

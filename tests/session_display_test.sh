@@ -459,8 +459,15 @@ print(f"{seen} distances: the levels alike counted apart agree")
 PYEOF
   sed 's/"real_camera"/"no_camera_here"/' "$P/pre-research-depth-matching.json" |
     $PY -c 'import json,sys; p=json.load(sys.stdin); p["content"].pop("no_camera_here"); json.dump(p, sys.stdout)' > "$P/dm-no-camera.json"
-  set +e; $BC run "$P/dm-no-camera.json" --participant X --db "$W/x.sqlite" --observer sim 2> "$W/err"; code=$?; set -e
+  set +e; $BC run "$P/dm-no-camera.json" --participant X --db "$W/x.sqlite" --observer sim 2> "$W/err"; code=$?
+  # validate agrees with run for the same observer (the fuzz found validate --plan --observer sim accepting it),
+  # and accepts the protocol for a person (no --observer).
+  $BC validate "$P/dm-no-camera.json" --plan --observer sim > /dev/null 2> "$W/verr"; vcode=$?
+  $BC validate "$P/dm-no-camera.json" > /dev/null 2>&1; pcode=$?; set -e
   rm -f "$P/dm-no-camera.json"
+  [ $vcode = 3 ] && [ "$(cat "$W/verr")" = "$(cat "$W/err")" ] ||
+    fail "validate --plan --observer sim: exit $vcode, '$(cat "$W/verr")'; run said '$(cat "$W/err")'"
+  [ $pcode = 0 ] || fail "validate (a person) refused the protocol without real_camera: exit $pcode"
   [ $code = 2 ] || [ $code = 3 ] || fail "exit $code without real_camera: $(cat "$W/err")"
   grep -q "dm-no-camera.json: /content/real_camera: is needed by the simulated observer" "$W/err" || fail "error: $(cat "$W/err")"
   [ "$(wc -l < "$W/err")" = 1 ] || fail "more than one line: $(cat "$W/err")"

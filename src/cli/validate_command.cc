@@ -176,6 +176,8 @@ void AddValidateCommand(CLI::App& app) {
             shown += line;
           }
           if (observer) {
+            // What `run --observer` refuses before its first trial, refused here by the same check.
+            procedure::CheckObserverCanAnswer(*observer, prepared.protocol);
             for (const std::string& text : procedure::VisibilityLines(prepared, *observer, args->visible, false))
               shown += "  " + text + "\n";
             for (const std::string& problem : plan::QuestGridProblems(prepared, *observer, args->file))
