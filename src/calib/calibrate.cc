@@ -256,16 +256,34 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
     if (options.parallel_sections) cv::parallel_for_(cv::Range(0, S), again, S);
     else again(cv::Range(0, S));
   }
+  // Sections sampled at few phases with blur near or below a pixel: read once per PSF family (phase_check.h).
+  if (options.phase_check && options.fit_model) {
+    auto phase = [&](const cv::Range& range) {
+      for (int k = range.start; k < range.end; ++k) {
+        SectionResult& sec = result.edges[k / S].sections[k % S];
+        if (sec.fit.ok) sec.phase = CheckPhase(linear, sec.segment, sec.fit, options.model_fit);
+      }
+    };
+    if (options.parallel_sections) cv::parallel_for_(cv::Range(0, E * S), phase, E * S);
+    else phase(cv::Range(0, E * S));
+  }
   result.measure_ms = MsSince(t0);
 
   // Estimation: eq. 3.7 from the reference edge, and a thin-lens model fitted to every usable section.
   t0 = std::chrono::steady_clock::now();
   const optics::Lens lens = optics::Lens::FromCamera(camera);
+  // The sections at other phases choose the PSF family; a section it leaves open is flagged and predicted.
+  if (options.fit_model && options.phase_check) result.phase = ChoosePhaseFamily(result);
   if (options.fit_model) RequireThreeDepths(result);  // before the reference: with no usable edge, say why
   EdgeResult& ref = result.edges[options.reference_edge - 1];
   std::vector<double> ref_r, ref_u;
   for (const auto& s : ref.sections)
     if (s.fit.ok) ref_r.push_back(s.fit.r_px), ref_u.push_back(s.u_mm);
+  // A reference edge whose every section is phase_limited still has its readings (eq. 3.7 is the thesis's estimate
+  // from them, whatever their family): taken rather than refusing the photo.
+  if (ref_r.empty())
+    for (const auto& s : ref.sections)
+      if (!s.fit.phase_why.empty()) ref_r.push_back(s.fit.r_px), ref_u.push_back(s.u_mm);
   if (ref_r.empty())
     throw Error(ErrorKind::kNotFound, "reference edge " + std::to_string(options.reference_edge) +
                                           " has no usable section (all flagged); choose another --reference-edge");
@@ -304,6 +322,33 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
   return result;
 }
 
+namespace {
+
+Json PhaseCheckJson(const PhaseCheck& p) {
+  Json readings = Json::array();
+  for (const PhaseReading& f : p.families)
+    readings.push_back({{"post_sigma_px", f.post_sigma_px}, {"r_px", f.r_px}, {"offset_px", f.offset_px},
+                        {"rms_rel", f.rms_rel}, {"chi2", f.chi2}});
+  return {{"axis_deg", p.axis_deg}, {"span_px", p.span_px}, {"phase_px", p.phase_px}, {"noise", p.noise},
+          {"bins", p.bins}, {"families", readings}};
+}
+
+Json PhaseChoiceJson(const PhaseChoice& c) {
+  Json families = Json::array();
+  for (size_t i = 0; i < c.chi2.size(); ++i)
+    families.push_back({{"post_sigma_px", PhaseFamiliesPx()[i]}, {"chi2", c.chi2[i]}, {"alike", bool(c.alike[i])}});
+  return {{"limited_sections", c.limited}, {"flagged", c.flagged}, {"post_sigma_px", c.post_sigma_px},
+          {"chi2_per_point", c.chi2_per_point}, {"families", families}, {"summary", c.summary},
+          {"note", "sections along the pixel rows or columns with blur under 2 px are read once per PSF family "
+                   "(the optics, then a Gaussian of post_sigma_px on the sampled image) with the edge where the pose "
+                   "puts it; the family whose profiles fit best over all of them (their edges at other phases) is "
+                   "taken, and "
+                   "a section whose reading moves by more than max(0.04 px, 8 %) among the families that fit alike "
+                   "is flagged phase_limited, left out of the lens fit and predicted by it"}};
+}
+
+}  // namespace
+
 Json CalibToJson(const CalibResult& r) {
   auto vec = [](const cv::Vec3d& v) { return Json::array({v[0], v[1], v[2]}); };
   auto opt = [](const std::optional<double>& v) { return v ? Json(*v) : Json(nullptr); };
@@ -331,6 +376,8 @@ Json CalibToJson(const CalibResult& r) {
                  {"thesis_ok", s.thesis.ok}};
       if (!s.estimated_note.empty()) js["r_estimated_note"] = s.estimated_note;
       if (!s.fit.crowded_why.empty()) js["crowded_why"] = s.fit.crowded_why;
+      if (!s.fit.phase_why.empty()) js["phase_why"] = s.fit.phase_why;
+      if (s.phase.limited) js["phase"] = PhaseCheckJson(s.phase);
       if (distorted) js["stretch"] = s.stretch;
       sections.push_back(js);
     }
@@ -378,6 +425,7 @@ Json CalibToJson(const CalibResult& r) {
            {"model", "floor_px and the thin lens's radius: ideal (undistorted, pinhole) px; a point's photo-px radius "
                      "is the model's times the stretch there (sections: stretch across the edge; a round blur "
                      "anywhere: sqrt(det J) of the distortion map)"}})},
+      {"phase_check", PhaseChoiceJson(r.phase)},
       {"timing_ms", {{"detect", r.detect_ms}, {"measure", r.measure_ms}, {"estimate", r.estimate_ms}}},
       {"edges", edges},
   };
