@@ -74,6 +74,24 @@ std::vector<optics::BlurSample> ModelSamples(const CalibResult& result) {
   return samples;
 }
 
+std::map<std::string, int> SectionsLeftOut(const CalibResult& result) {
+  // Informational flags never disqualify a section (edge_blur.h).
+  static const std::vector<std::string> kInformational = {"flaw", "neighbours"};
+  std::map<std::string, int> out;
+  for (const auto& edge : result.edges)
+    for (const auto& s : edge.sections) {
+      if (s.fit.ok) continue;
+      std::string why = "not measured";
+      for (const std::string& flag : s.fit.flags)
+        if (std::find(kInformational.begin(), kInformational.end(), flag) == kInformational.end()) {
+          why = flag;
+          break;
+        }
+      ++out[why];
+    }
+  return out;
+}
+
 namespace {
 // The thin lens's radius is unsigned: sections at two depths fit a focus between them and one beyond them alike
 // (an overexposed photo that leaves the first and last edges only gave focus 140 mm for 400 and an aperture 7 x off).
@@ -419,6 +437,7 @@ Json CalibToJson(const CalibResult& r) {
                  // floor_px stays a number (the model predicts with it); whether the sections pin it is said here.
                  {"floor_determined", m.floor_determined}, {"rms_px", m.rms_px},
                  {"loo_rms_px", m.loo_rms_px}, {"samples_used", m.samples_used}, {"outliers", m.outliers},
+                 {"sections_left_out", SectionsLeftOut(r)},
                  {"choice", choice}}},
       {"r_units", !distorted ? Json("px of the photo (no dist_coeffs: the photo is the pinhole image)") : Json({
            {"sections", "r_px, r_thesis_px, r_estimated_px, r_fitted_px: photo px (distorted), across the edge"},

@@ -3,6 +3,7 @@
 // every edge section two ways, and estimate every section from the reference edge (eq. 3.7) and from a thin-lens
 // model fitted to all usable sections.
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -101,6 +102,10 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
 // The usable sections as the thin-lens model's samples: depth and r_px / stretch (ideal px), so a distorted photo's
 // blur is fitted in the undistorted lens's terms. A tracked take pools these over its frames.
 std::vector<optics::BlurSample> ModelSamples(const CalibResult& result);
+
+// The sections the thin-lens model was not fitted to, counted by the flag that disqualified each (its first:
+// "phase_limited", "crowded", "low_contrast", ...).
+std::map<std::string, int> SectionsLeftOut(const CalibResult& result);
 
 // Makes `model` the result's thin-lens model: every section's r_fitted_px and every edge's mean follow it (a tracked
 // take's one lens model replacing each frame's own).

@@ -74,7 +74,8 @@ const std::vector<std::string> kTopKeys = {"format", "version", "software", "cam
                                            "photo", "frame", "time_s", "track_status", "frame_signature",
                                            "lens_model"};
 const std::vector<std::string> kModelKeys = {"kind", "focus_mm", "aperture_mm", "floor_px", "floor_determined",
-                                             "rms_px", "loo_rms_px", "samples_used", "outliers", "choice"};
+                                             "rms_px", "loo_rms_px", "samples_used", "outliers", "choice",
+                                             "sections_left_out"};
 const std::vector<std::string> kEdgeKeys = {"index", "u_mm", "usable_sections", "sections"};
 const std::vector<std::string> kSectionKeys = {"index", "u_mm", "midpoint_camera_mm", "image_px", "r_px", "r_thesis_px",
                                                "r_estimated_px", "r_fitted_px", "ok", "flags", "psf", "disc_r_px",
