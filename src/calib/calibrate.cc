@@ -309,7 +309,8 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
   result.reference_r_px = Median(ref_r);
   result.reference_u_mm = Median(ref_u);
 
-  if (options.fit_model) result.model = optics::FitThinLens(lens, ModelSamples(result), options.optics_fit);
+  if (options.fit_model)
+    result.model = FitModelWithinPhaseRanges(result, lens, options.optics_fit, &result.phase.held);
 
   for (auto& edge : result.edges) {
     double su = 0;
@@ -345,20 +346,21 @@ namespace {
 Json PhaseCheckJson(const PhaseCheck& p) {
   Json readings = Json::array();
   for (const PhaseReading& f : p.families)
-    readings.push_back({{"post_sigma_px", f.post_sigma_px}, {"r_px", f.r_px}, {"offset_px", f.offset_px},
-                        {"rms_rel", f.rms_rel}, {"chi2", f.chi2}});
+    readings.push_back({{"r_px", f.r_px}, {"offset_px", f.offset_px}, {"rms_rel", f.rms_rel}, {"chi2", f.chi2}});
   return {{"axis_deg", p.axis_deg}, {"span_px", p.span_px}, {"phase_px", p.phase_px}, {"noise", p.noise},
-          {"bins", p.bins}, {"families", readings}};
+          {"bins", p.bins}, {"range_px", {p.range_lo_px, p.range_hi_px}}, {"families", readings}};
 }
 
 Json PhaseChoiceJson(const PhaseChoice& c) {
   Json families = Json::array();
   for (size_t i = 0; i < c.chi2.size(); ++i)
-    families.push_back({{"post_sigma_px", PhaseFamiliesPx()[i]}, {"chi2", c.chi2[i]}, {"alike", bool(c.alike[i])}});
-  return {{"limited_sections", c.limited}, {"flagged", c.flagged}, {"post_sigma_px", c.post_sigma_px},
+    families.push_back({{"post_sigma_px", PhaseFamilies()[i].sigma_px}, {"sharpen", PhaseFamilies()[i].sharpen},
+                        {"chi2", c.chi2[i]}, {"alike", bool(c.alike[i])}});
+  return {{"limited_sections", c.limited}, {"flagged", c.flagged}, {"held_the_model", c.held}, {"chosen", PhaseFamilies()[c.chosen].Name()},
           {"chi2_per_point", c.chi2_per_point}, {"families", families}, {"summary", c.summary},
           {"note", "sections along the pixel rows or columns with blur under 2 px are read once per PSF family "
-                   "(the optics, then a Gaussian of post_sigma_px on the sampled image) with the edge where the pose "
+                   "(the optics, then on the sampled image a Gaussian of post_sigma_px or an unsharp mask of that std "
+                   "and amount `sharpen`; each section's phase.families in that order) with the edge where the pose "
                    "puts it; the family whose profiles fit best over all of them (their edges at other phases) is "
                    "taken, and "
                    "a section whose reading moves by more than max(0.04 px, 8 %) among the families that fit alike "

@@ -28,7 +28,7 @@ constexpr double kPoseUncertaintyPx = 0.15;  // samples of one row share a dista
 // Families fit the sections alike when their chi-square over all limited sections is within this of the best's,
 // after scaling by the best's chi-square per point where it is above 1 (a model error widens what counts as alike):
 // 25 is five standard errors of the one parameter (the filter's std) that tells the families apart.
-constexpr double kAlikeChi2 = 25;
+constexpr double kAlikeChi2 = 25, kAlikeRel = 0.25;
 // The noise std (linear) is taken to be no less than this: a noise-free 8-bit image still has its quantisation.
 constexpr double kMinNoise = 5e-4;
 // A reading that moves by more than this among the families that fit alike is not identified (the target
@@ -95,14 +95,17 @@ std::vector<Bin> ProfileBins(const cv::Mat& linear, const EdgeSegment& segment, 
   return bins;
 }
 
-// Gaussian taps of std sigma at whole pixels out to 4 sigma (at least one each side), normalised; {1} for 0.
-std::vector<double> PostTaps(double sigma) {
+// The family's kernel at whole pixels (Gaussian out to 4 sigma, at least one tap each side), normalised; {1} for the
+// optics alone.
+std::vector<double> FamilyTaps(const PhaseFamily& family) {
+  const double sigma = family.sigma_px;
   if (!(sigma > 0)) return {1.0};
   const int reach = std::max(1, static_cast<int>(std::ceil(4 * sigma)));
   std::vector<double> t(2 * reach + 1);
   double sum = 0;
   for (int k = -reach; k <= reach; ++k) sum += t[k + reach] = std::exp(-0.5 * (k / sigma) * (k / sigma));
-  for (double& v : t) v /= sum;
+  const double a = std::max(0.0, family.sharpen);
+  for (int k = -reach; k <= reach; ++k) t[k + reach] = a > 0 ? (k == 0 ? 1 + a : 0) - a * t[k + reach] / sum : t[k + reach] / sum;
   return t;
 }
 
@@ -152,9 +155,9 @@ double GoldenMin(F f, double a, double b, double tol) {
 
 // The optics' radius (a grid, then golden section around its best node) and the edge's position (within the pose's
 // uncertainty of the line the pose gives) that fit best under one family, in turns.
-PhaseReading ReadFamily(const std::vector<Bin>& bins, double sigma, double r_fit, double phi, double w1, double w2,
-                        double shift, double noise) {
-  const std::vector<double> taps = PostTaps(sigma);
+PhaseReading ReadFamily(const std::vector<Bin>& bins, const PhaseFamily& family, double r_fit, double phi, double w1,
+                        double w2, double shift, double noise) {
+  const std::vector<double> taps = FamilyTaps(family);
   double d0 = 0, r1 = 0;
   auto sse = [&](double r, double d) { return EvaluateFamily(bins, taps, shift, r, d, phi, w1, w2).sse; };
   // A coarse grid for the radius (the sum of squares may have a shoulder where r1 meets the taps' own spread), then
@@ -174,8 +177,7 @@ PhaseReading ReadFamily(const std::vector<Bin>& bins, double sigma, double r_fit
   double w = 0;
   for (const Bin& bin : bins) w += bin.w;
   PhaseReading out;
-  out.post_sigma_px = sigma;
-  out.r_px = std::sqrt(r1 * r1 + 4 * TapsVariance(taps));
+  out.r_px = std::sqrt(std::max(0.0, r1 * r1 + 4 * TapsVariance(taps)));
   out.offset_px = d0;
   out.rms_rel = std::abs(fit.step) > 1e-9 ? std::sqrt(fit.sse / std::max(w, 1.0)) / std::abs(fit.step) : 1e9;
   out.chi2 = fit.sse / (noise * noise);
@@ -184,10 +186,24 @@ PhaseReading ReadFamily(const std::vector<Bin>& bins, double sigma, double r_fit
 
 }  // namespace
 
-const std::vector<double>& PhaseFamiliesPx() {
-  // Under 0.3 px a Gaussian's taps at whole pixels are the identity to 4e-3 (0.3 px reads as 0 does); steps of
-  // 0.05 px beyond, where a step moves a sub-pixel reading by 3-8 %.
-  static const std::vector<double> families = {0, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6, 0.7, 0.8};
+std::string PhaseFamily::Name() const {
+  char text[120];
+  if (!(sigma_px > 0)) return "the optics alone";
+  if (sharpen > 0)
+    std::snprintf(text, sizeof text, "the optics then sharpening (unsharp mask of amount %.2f, std %.2f px)", sharpen,
+                  sigma_px);
+  else
+    std::snprintf(text, sizeof text, "the optics then a Gaussian of std %.2f px on the sampled image", sigma_px);
+  return text;
+}
+
+const std::vector<PhaseFamily>& PhaseFamilies() {
+  // Gaussians: under 0.3 px one's taps at whole pixels are the identity to 4e-3 (0.3 px reads as the optics alone);
+  // steps of 0.05 px beyond, where a step moves a sub-pixel reading by 3-8 %. Sharpening: a camera's unsharp masks,
+  // mild to strong, over a narrow and a wide Gaussian.
+  static const std::vector<PhaseFamily> families = {
+      {0, 0},      {0.35, 0},   {0.4, 0},   {0.45, 0},  {0.5, 0},   {0.55, 0},  {0.6, 0}, {0.7, 0}, {0.8, 0},
+      {0.6, 0.15}, {0.6, 0.3},  {0.6, 0.5}, {1.0, 0.15}, {1.0, 0.3}, {1.0, 0.5}};
   return families;
 }
 
@@ -214,14 +230,14 @@ PhaseCheck CheckPhase(const cv::Mat& linear, const EdgeSegment& segment, const M
   const double w1 = std::max(std::abs(f.n.x), std::abs(f.n.y)), w2 = std::min(std::abs(f.n.x), std::abs(f.n.y));
   // A filter's tap one pixel along the nearest axis moves the profile by this much across the edge.
   const double shift = w1;
-  for (const double sigma : PhaseFamiliesPx())
-    check.families.push_back(ReadFamily(bins, sigma, fit.r_px, phi, w1, w2, shift, check.noise));
+  for (const PhaseFamily& family : PhaseFamilies())
+    check.families.push_back(ReadFamily(bins, family, fit.r_px, phi, w1, w2, shift, check.noise));
   return check;
 }
 
 PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   PhaseChoice choice;
-  const std::vector<double>& families = PhaseFamiliesPx();
+  const std::vector<PhaseFamily>& families = PhaseFamilies();
   std::vector<SectionResult*> limited;
   int points = 0;
   for (auto& edge : result.edges)
@@ -242,16 +258,20 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   for (const SectionResult* s : limited)
     for (size_t c = 0; c < families.size(); ++c) choice.chi2[c] += s->phase.families[c].chi2;
   const size_t best = std::min_element(choice.chi2.begin(), choice.chi2.end()) - choice.chi2.begin();
-  choice.post_sigma_px = families[best];
+  choice.chosen = best;
   const int dof = std::max(1, points - 3 * choice.limited - 1);
   choice.chi2_per_point = choice.chi2[best] / dof;
   const double scale = std::max(1.0, choice.chi2_per_point);
-  for (size_t c = 0; c < families.size(); ++c) choice.alike[c] = choice.chi2[c] - choice.chi2[best] <= kAlikeChi2 * scale;
+  // Beyond the noise, a model error (a JPEG's blocks, a shape between the families') grows every family's
+  // chi-square with the points: then families within a quarter of the best's fit alike too.
+  for (size_t c = 0; c < families.size(); ++c)
+    choice.alike[c] = choice.chi2[c] - choice.chi2[best] <= std::max(kAlikeChi2 * scale, kAlikeRel * choice.chi2[best]);
   for (SectionResult* s : limited) {
     double lo = 1e18, hi = -1e18;
     for (size_t c = 0; c < families.size(); ++c)
       if (choice.alike[c]) lo = std::min(lo, s->phase.families[c].r_px), hi = std::max(hi, s->phase.families[c].r_px);
     if (best != 0) s->fit.r_px = s->phase.families[best].r_px;  // read with the chosen family
+    s->phase.range_lo_px = lo, s->phase.range_hi_px = hi;
     if (hi - lo <= std::max(kSpreadPx, kSpreadRel * s->fit.r_px)) continue;
     s->fit.ok = false;
     s->fit.flags.push_back("phase_limited");
@@ -269,14 +289,44 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   char text[400];
   std::snprintf(text, sizeof text,
                 "%d usable sections sampled at few phases with blur under %.0f px, read as %s (%d of %zu PSF families "
-                "fit their profiles alike, chi-square per point %.2f); %d flagged phase_limited",
+                "fit their profiles alike, chi-square per point %.2f); %d flagged phase_limited (each reading's range "
+                "among those families in calib.json)",
                 choice.limited, kMaxBlurPx,
-                best == 0 ? "the optics alone"
-                          : ("the optics then a Gaussian of std " + std::to_string(families[best]).substr(0, 4) +
-                             " px on the sampled image").c_str(),
+                families[best].Name().c_str(),
                 n_alike, families.size(), choice.chi2_per_point, choice.flagged);
   choice.summary = text;
   return choice;
+}
+
+optics::FittedModel FitModelWithinPhaseRanges(const CalibResult& result, const optics::Lens& lens,
+                                              const optics::FitOptions& options, int* held) {
+  const std::vector<optics::BlurSample> usable = ModelSamples(result);
+  optics::FittedModel model = optics::FitThinLens(lens, usable, options);
+  std::vector<const SectionResult*> limited;
+  for (const auto& edge : result.edges)
+    for (const auto& s : edge.sections)
+      if (!s.fit.phase_why.empty() && s.phase.range_hi_px > 0) limited.push_back(&s);
+  std::vector<double> bound(limited.size(), -1);  // where a section holds the model (-1: nowhere)
+  for (int round = 0; round < 5 && !limited.empty(); ++round) {
+    bool moved = false;
+    for (size_t i = 0; i < limited.size(); ++i) {
+      const SectionResult& s = *limited[i];
+      const double predicted = model.PredictPx(lens, s.u_mm) * s.stretch;
+      // Once held, a section stays held (the refit moves the model into its range), at the range's middle: the value
+      // that commits least to any one of the families that fit alike (its nearer end biased the model towards the
+      // unflagged sections' side: 0.75 px predicted for a true 0.86 px on a JPEG scene focused on edge 1).
+      const bool outside = predicted < s.phase.range_lo_px || predicted > s.phase.range_hi_px;
+      const double end = bound[i] >= 0 ? bound[i] : outside ? 0.5 * (s.phase.range_lo_px + s.phase.range_hi_px) : -1.0;
+      if (end != bound[i]) bound[i] = end, moved = true;
+    }
+    if (!moved) break;
+    std::vector<optics::BlurSample> samples = usable;
+    for (size_t i = 0; i < limited.size(); ++i)
+      if (bound[i] >= 0) samples.push_back({limited[i]->u_mm, bound[i] / limited[i]->stretch, 1.0});
+    model = optics::FitThinLens(lens, samples, options);
+  }
+  if (held) *held = static_cast<int>(std::count_if(bound.begin(), bound.end(), [](double b) { return b >= 0; }));
+  return model;
 }
 
 }  // namespace blurcue::calib

@@ -112,7 +112,12 @@ void AddCalibrateCommand(CLI::App& app) {
       std::printf("the model is fitted to %d of %d sections%s\n", sections - n_left, sections,
                   left.empty() ? "" : ("; left out (it predicts them): " + left).c_str());
     }
-    if (options.phase_check) std::printf("phase check: %s\n", result.phase.summary.c_str());
+    if (options.phase_check) {
+      std::printf("phase check: %s\n", result.phase.summary.c_str());
+      if (result.phase.held > 0)
+        std::printf("phase check: the model predicted %d phase_limited sections outside the range their families "
+                    "leave open; their ranges' middles joined its fit\n", result.phase.held);
+    }
     // Why this model (calib.json's model.choice): both candidates' held-out errors, and eq. 3.7 as published.
     const Json& choice = json["model"]["choice"];
     if (std::isfinite(m.floor_loo_rms_px))
