@@ -130,6 +130,39 @@ void RequireThreeDepths(const CalibResult& result) {
                   "them fit alike); retake the photo so that more of the board's edges are measured (exposure, "
                   "framing, focus)");
 }
+// The reference edge's depth and blur for eq. 3.7: the medians over its usable sections (the median resists a flawed
+// section; the thesis averaged its 7 sections). Error(kNotFound) when it has none.
+void SetReference(CalibResult& result, int reference_edge) {
+  const EdgeResult& ref = result.edges[reference_edge - 1];
+  std::vector<double> ref_r, ref_u;
+  for (const auto& s : ref.sections)
+    if (s.fit.ok) ref_r.push_back(s.fit.r_px), ref_u.push_back(s.u_mm);
+  // A reference edge whose every section is phase_limited still has its readings (eq. 3.7 is the thesis's estimate
+  // from them, whatever their family): taken rather than refusing the photo.
+  if (ref_r.empty())
+    for (const auto& s : ref.sections)
+      if (!s.fit.phase_why.empty()) ref_r.push_back(s.fit.r_px), ref_u.push_back(s.u_mm);
+  if (ref_r.empty())
+    throw Error(ErrorKind::kNotFound, "reference edge " + std::to_string(reference_edge) +
+                                          " has no usable section (all flagged); choose another --reference-edge");
+  result.reference_r_px = Median(ref_r);
+  result.reference_u_mm = Median(ref_u);
+}
+
+// Sections sampled at few phases with blur near or below a pixel: read once per PSF family (phase_check.h), each
+// on its own (on every core, as the blur fit).
+void CheckPhases(CalibResult& result, const cv::Mat& linear, const CalibrateOptions& options) {
+  const int S = result.board.SectionCount(), n = result.board.EdgeCount() * S;
+  auto phase = [&](const cv::Range& range) {
+    for (int k = range.start; k < range.end; ++k) {
+      SectionResult& sec = result.edges[k / S].sections[k % S];
+      if (sec.fit.ok) sec.phase = CheckPhase(linear, sec.segment, sec.fit, options.model_fit);
+    }
+  };
+  if (options.parallel_sections) cv::parallel_for_(cv::Range(0, n), phase, n);
+  else phase(cv::Range(0, n));
+}
+
 }  // namespace
 
 void ApplyModel(CalibResult& result, const optics::FittedModel& model) {
@@ -274,17 +307,7 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
     if (options.parallel_sections) cv::parallel_for_(cv::Range(0, S), again, S);
     else again(cv::Range(0, S));
   }
-  // Sections sampled at few phases with blur near or below a pixel: read once per PSF family (phase_check.h).
-  if (options.phase_check && options.fit_model) {
-    auto phase = [&](const cv::Range& range) {
-      for (int k = range.start; k < range.end; ++k) {
-        SectionResult& sec = result.edges[k / S].sections[k % S];
-        if (sec.fit.ok) sec.phase = CheckPhase(linear, sec.segment, sec.fit, options.model_fit);
-      }
-    };
-    if (options.parallel_sections) cv::parallel_for_(cv::Range(0, E * S), phase, E * S);
-    else phase(cv::Range(0, E * S));
-  }
+  if (options.phase_check && options.fit_model) CheckPhases(result, linear, options);
   result.measure_ms = MsSince(t0);
 
   // Estimation: eq. 3.7 from the reference edge, and a thin-lens model fitted to every usable section.
@@ -293,21 +316,7 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
   // The sections at other phases choose the PSF family; a section it leaves open is flagged and predicted.
   if (options.fit_model && options.phase_check) result.phase = ChoosePhaseFamily(result);
   if (options.fit_model) RequireThreeDepths(result);  // before the reference: with no usable edge, say why
-  EdgeResult& ref = result.edges[options.reference_edge - 1];
-  std::vector<double> ref_r, ref_u;
-  for (const auto& s : ref.sections)
-    if (s.fit.ok) ref_r.push_back(s.fit.r_px), ref_u.push_back(s.u_mm);
-  // A reference edge whose every section is phase_limited still has its readings (eq. 3.7 is the thesis's estimate
-  // from them, whatever their family): taken rather than refusing the photo.
-  if (ref_r.empty())
-    for (const auto& s : ref.sections)
-      if (!s.fit.phase_why.empty()) ref_r.push_back(s.fit.r_px), ref_u.push_back(s.u_mm);
-  if (ref_r.empty())
-    throw Error(ErrorKind::kNotFound, "reference edge " + std::to_string(options.reference_edge) +
-                                          " has no usable section (all flagged); choose another --reference-edge");
-  // The median resists a flawed section; the thesis averaged its 7 sections.
-  result.reference_r_px = Median(ref_r);
-  result.reference_u_mm = Median(ref_u);
+  SetReference(result, options.reference_edge);
 
   if (options.fit_model)
     result.model = FitModelWithinPhaseRanges(result, lens, options.optics_fit, &result.phase.held);

@@ -28,7 +28,7 @@ constexpr double kPoseUncertaintyPx = 0.15;  // samples of one row share a dista
 // Families fit the sections alike when their chi-square over all limited sections is within this of the best's,
 // after scaling by the best's chi-square per point where it is above 1 (a model error widens what counts as alike):
 // 25 is five standard errors of the one parameter (the filter's std) that tells the families apart.
-constexpr double kAlikeChi2 = 25, kAlikeRel = 0.25;
+constexpr double kAlikeChi2 = 25, kAlikeRel = 0.15;
 // The noise std (linear) is taken to be no less than this: a noise-free 8-bit image still has its quantisation.
 constexpr double kMinNoise = 5e-4;
 // A reading that moves by more than this among the families that fit alike is not identified (the target

@@ -47,6 +47,15 @@ double PostFilterVariancePx2(const std::vector<float>& taps) {
   return second / sum;
 }
 
+Json PostFilterTruth(const PostFilterOptions& o, const std::vector<float>& taps) {
+  Json list = Json::array();
+  for (const float t : taps) list.push_back(t);
+  return {{"kind", Name(o.kind)}, {"sigma_px", o.sigma_px}, {"amount", o.amount}, {"taps", list},
+          {"variance_px2", PostFilterVariancePx2(taps)},
+          {"note", "applied to the sampled image (rows and columns) after the noise; every section's r_px^2 = "
+                   "r_optical_px^2 + 4 variance_px2 (the taps' second moment)"}};
+}
+
 void ApplyPostFilter(cv::Mat& linear, const std::vector<float>& taps) {
   CV_Assert(linear.type() == CV_32FC1);
   if (taps.size() <= 1) return;

@@ -8,6 +8,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "core/json_io.h"
+
 namespace blurcue::synth {
 
 // What is applied to the sampled image.
@@ -32,6 +34,8 @@ std::vector<float> PostFilterTaps(const PostFilterOptions& options);
 // Second moment (px^2) of the taps about their centre, divided by their sum, from the array: what the filter adds to
 // the variance of a line-spread function across an edge of any direction (the kernel is the same on both axes).
 double PostFilterVariancePx2(const std::vector<float>& taps);
+// truth.json's post_filter block: kind, sigma_px, amount, the taps and their second moment (variance_px2).
+Json PostFilterTruth(const PostFilterOptions& options, const std::vector<float>& taps);
 // Applies the taps along rows and columns of a CV_32F image in place (edges replicated).
 void ApplyPostFilter(cv::Mat& linear, const std::vector<float>& taps);
 

@@ -666,14 +666,7 @@ Scene RenderScene(const SceneOptions& o) {
   j["floor_sigma_applied_px"] = std::sqrt(floor_var_px2);
   // The whole view's blur with the floor (every point has it: nothing in the view is sharper than the floor), and the
   // defocus alone (the lens formula's range, before discretisation).
-  if (post_taps.size() > 1) {
-    Json taps = Json::array();
-    for (const float t : post_taps) taps.push_back(t);
-    j["post_filter"] = {{"kind", Name(o.post_filter.kind)}, {"sigma_px", o.post_filter.sigma_px},
-                        {"amount", o.post_filter.amount}, {"taps", taps}, {"variance_px2", post_var_px2},
-                        {"note", "applied to the sampled image (rows and columns) after the noise; every section's "
-                                 "r_px^2 = r_optical_px^2 + 4 variance_px2 (the taps' second moment)"}};
-  }
+  if (post_taps.size() > 1) j["post_filter"] = PostFilterTruth(o.post_filter, post_taps);
   // (and the post-sampling filter's, where there is one).
   const double added_px2 = 4 * (floor_var_px2 + post_var_px2);
   j["r_range_px"] = {std::sqrt(std::max(0.0, r_min * r_min + added_px2)), std::sqrt(std::max(0.0, r_max * r_max + added_px2))};
