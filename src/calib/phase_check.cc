@@ -21,13 +21,15 @@ constexpr double kMinSpanPx = 1.0;
 // Blur: beyond about 2 px the profile has samples enough across the edge that the families read within 2-5 % of
 // each other at any phase (measured: 2.00 vs 1.90-2.16 px at r = 2); below, up to a factor 2 apart.
 constexpr double kMaxBlurPx = 2.0;
-constexpr double kBinPx = 0.05;
+constexpr double kBinPx = 0.05;  // one row's samples share a distance across a level edge: bins far finer than 1 px
 // The pose puts an edge within a few hundredths of a pixel (synth scenes: 0.02-0.06 px); each family finds it within
 // this of the pose's line. Fixed at the line, the pose's own error, not the family, would decide the fit.
-constexpr double kPoseUncertaintyPx = 0.15;  // samples of one row share a distance across a level edge: bins far finer than 1 px
-// Families fit the sections alike when their chi-square over all limited sections is within this of the best's,
-// after scaling by the best's chi-square per point where it is above 1 (a model error widens what counts as alike):
-// 25 is five standard errors of the one parameter (the filter's std) that tells the families apart.
+constexpr double kPoseUncertaintyPx = 0.15;
+// Families fit the sections alike when their chi-square over all limited sections is within kAlikeChi2 of the best's
+// after scaling by the best's chi-square per point where it is above 1 (25: five standard errors of the one parameter
+// that tells the families apart), or within kAlikeRel of it: a model error (a JPEG's blocks, an interpolation) grows
+// every family's chi-square with the points, and then the noise no longer says what fits alike. 0.15: a JPEG of
+// quality 90 put the true family at 1.14 x the best's; 0.25 took a 0.5 px Gaussian alike on physical optics.
 constexpr double kAlikeChi2 = 25, kAlikeRel = 0.15;
 // The noise std (linear) is taken to be no less than this: a noise-free 8-bit image still has its quantisation.
 constexpr double kMinNoise = 5e-4;
@@ -105,7 +107,8 @@ std::vector<double> FamilyTaps(const PhaseFamily& family) {
   double sum = 0;
   for (int k = -reach; k <= reach; ++k) sum += t[k + reach] = std::exp(-0.5 * (k / sigma) * (k / sigma));
   const double a = std::max(0.0, family.sharpen);
-  for (int k = -reach; k <= reach; ++k) t[k + reach] = a > 0 ? (k == 0 ? 1 + a : 0) - a * t[k + reach] / sum : t[k + reach] / sum;
+  for (int k = -reach; k <= reach; ++k)
+    t[k + reach] = a > 0 ? (k == 0 ? 1 + a : 0) - a * t[k + reach] / sum : t[k + reach] / sum;
   return t;
 }
 
@@ -225,7 +228,8 @@ PhaseCheck CheckPhase(const cv::Mat& linear, const EdgeSegment& segment, const M
   if (bins.size() < 6) return check;
   check.limited = true;
   check.bins = static_cast<int>(bins.size());
-  // The optics' shape: the blur fit's, taken to the nearer pure shape (closed forms: the families are read many times).
+  // The optics' shape: the blur fit's (disc x Gaussian); rounded to the nearer pure shape, the misfit of a mixed one
+  // made a post filter look better than the optics alone on physical optics.
   const double phi = std::atan2(2 * fit.floor_sigma_px, fit.disc_r_px);
   const double w1 = std::max(std::abs(f.n.x), std::abs(f.n.y)), w2 = std::min(std::abs(f.n.x), std::abs(f.n.y));
   // A filter's tap one pixel along the nearest axis moves the profile by this much across the edge.
@@ -262,8 +266,8 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   const int dof = std::max(1, points - 3 * choice.limited - 1);
   choice.chi2_per_point = choice.chi2[best] / dof;
   const double scale = std::max(1.0, choice.chi2_per_point);
-  // Beyond the noise, a model error (a JPEG's blocks, a shape between the families') grows every family's
-  // chi-square with the points: then families within a quarter of the best's fit alike too.
+  // Beyond the noise, a model error grows every family's chi-square with the points: then families within kAlikeRel
+  // of the best's fit alike too.
   for (size_t c = 0; c < families.size(); ++c)
     choice.alike[c] = choice.chi2[c] - choice.chi2[best] <= std::max(kAlikeChi2 * scale, kAlikeRel * choice.chi2[best]);
   for (SectionResult* s : limited) {

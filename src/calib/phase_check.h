@@ -64,7 +64,7 @@ struct PhaseChoice {
   int held = 0;                  // of those, sections whose range held the lens model (FitModelWithinPhaseRanges)
   size_t chosen = 0;             // the family chosen (PhaseFamilies(); 0: the optics alone)
   // Per family: chi-square of its profiles over every limited section (the filter is the whole photo's), and whether
-  // it fits them alike with the chosen one (within 25 after scaling by the best's chi-square per point, or 25 % of it).
+  // it fits them alike with the chosen one (within 25 after scaling by the best's chi-square per point, or 15 % of it).
   std::vector<double> chi2;
   std::vector<bool> alike;
   double chi2_per_point = 0;     // the chosen family's: about 1 where it describes the profiles to the noise

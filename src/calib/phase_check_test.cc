@@ -16,7 +16,9 @@ namespace {
 
 double Phi(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
 // Integral of Phi(t / s) dt: the Gaussian ESF's antiderivative.
-double IntPhi(double t, double s) { return t * Phi(t / s) + s * std::exp(-0.5 * t * t / (s * s)) / std::sqrt(2 * M_PI); }
+double IntPhi(double t, double s) {
+  return t * Phi(t / s) + s * std::exp(-0.5 * t * t / (s * s)) / std::sqrt(2 * M_PI);
+}
 
 struct Drawn {
   cv::Mat linear;
@@ -66,7 +68,8 @@ TEST(PhaseCheck, LevelEdgeFilteredAfterSamplingReadsTrueUnderItsFamilyAndNotUnde
   const size_t right = FamilyIndex(0.45, 0);
   ASSERT_LT(right, check.families.size());
   EXPECT_NEAR(check.families[right].r_px, d.true_r_px, 0.03 * d.true_r_px);
-  EXPECT_GT(std::abs(check.families[0].r_px - d.true_r_px), 0.15 * d.true_r_px) << "optics alone " << check.families[0].r_px;
+  EXPECT_GT(std::abs(check.families[0].r_px - d.true_r_px), 0.15 * d.true_r_px)
+      << "optics alone " << check.families[0].r_px;
   for (size_t c = 0; c < check.families.size(); ++c)
     EXPECT_LE(check.families[right].chi2, check.families[c].chi2) << PhaseFamilies()[c].Name();
 }

@@ -669,7 +669,8 @@ Scene RenderScene(const SceneOptions& o) {
   if (post_taps.size() > 1) j["post_filter"] = PostFilterTruth(o.post_filter, post_taps);
   // (and the post-sampling filter's, where there is one).
   const double added_px2 = 4 * (floor_var_px2 + post_var_px2);
-  j["r_range_px"] = {std::sqrt(std::max(0.0, r_min * r_min + added_px2)), std::sqrt(std::max(0.0, r_max * r_max + added_px2))};
+  j["r_range_px"] = {std::sqrt(std::max(0.0, r_min * r_min + added_px2)),
+                     std::sqrt(std::max(0.0, r_max * r_max + added_px2))};
   j["defocus_r_range_px"] = {r_min, r_max};
   j["blur_levels_px"] = levels_json;
   j["sections"] = sections;
