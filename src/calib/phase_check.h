@@ -68,7 +68,7 @@ struct PhaseChoice {
   std::vector<double> chi2;
   std::vector<bool> alike;
   double chi2_per_point = 0;     // the chosen family's: about 1 where it describes the profiles to the noise
-  std::string summary;           // in words, for the command's output
+  std::string summary = "not checked (--no-phase-check, or a take's frames: no lens fit per frame)";  // in words
 };
 
 struct CalibResult;
