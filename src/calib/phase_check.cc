@@ -21,7 +21,7 @@ constexpr double kMinSpanPx = 1.0;
 // Blur: beyond about 2 px the profile has samples enough across the edge that the families read within 2-5 % of
 // each other at any phase (measured: 2.00 vs 1.90-2.16 px at r = 2); below, up to a factor 2 apart.
 constexpr double kMaxBlurPx = 2.0;
-constexpr double kBinPx = 0.05;  // one row's samples share a distance across a level edge: bins far finer than 1 px
+constexpr double kBinPx = 0.1;  // one row's samples share a distance across a level edge: bins far finer than 1 px
 // The pose puts an edge within a few hundredths of a pixel (synth scenes: 0.02-0.06 px); each family finds it within
 // this of the pose's line. Fixed at the line, the pose's own error, not the family, would decide the fit.
 constexpr double kPoseUncertaintyPx = 0.15;
