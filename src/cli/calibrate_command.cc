@@ -114,6 +114,15 @@ void AddCalibrateCommand(CLI::App& app) {
     }
     if (options.phase_check) {
       std::printf("phase check: %s\n", result.phase.summary.c_str());
+      // Each edge with phase_limited sections, once, with its first section's reason (every one's is in calib.json).
+      for (const auto& e : result.edges) {
+        int n = 0;
+        const std::string* why = nullptr;
+        for (const auto& sec : e.sections)
+          if (!sec.fit.phase_why.empty()) ++n, why = why ? why : &sec.fit.phase_why;
+        if (n > 0) std::printf("  edge %d: %d of %zu sections phase_limited: %s\n", e.index, n, e.sections.size(),
+                               why->c_str());
+      }
       if (result.phase.held > 0)
         std::printf("phase check: the model predicted %d phase_limited sections outside the range their families "
                     "leave open; their ranges' middles joined its fit\n", result.phase.held);
