@@ -9,7 +9,8 @@ blurcue's output goes to DIR/calib-WHAT.json or DIR/track-WHAT/ (so two checks o
 Prints every figure (pose, depth error, measured r_px and fitted r_fitted_px: median and p90 of |error| / truth over
 every section with an edge, per frame for a take) and exits 1 when a target is missed:
   --what pose: board found (every frame tracked or found), section depths within 0.1 % of the truth;
-  --what blur: issue 25 (still): median <= 2 %, p90 <= 5 % for measured and fitted r;
+  --what blur: issue 25 (still): median <= 2 %, p90 <= 5 % for measured and fitted r (a section flagged
+               phase_limited counts with its reading; at most 10 such, issue 42);
                issue 27 (take): every frame's measured r median <= 3 %, p90 <= 8 %;
   --what fitted (take): the take's lens model's r per frame, median <= 3 %, p90 <= 8 % (as for measured r);
   --what all: pose and blur.
@@ -35,11 +36,23 @@ def rel_errors(calib, truth):
         for s in e["sections"]:
             t = true[(e["index"], s["index"])]
             depth = max(depth, abs(s["u_mm"] - t["u_mm"]) / t["u_mm"])
-            if s.get("ok") and s.get("r_px") is not None:
+            # phase_limited (issue 42): measured, but the PSF families that fit alike leave its value open by more than
+            # 8 %; its reading (the chosen family's) counts, and the flag is counted apart (phase_limited()).
+            if (s.get("ok") or phase_limited(s)) and s.get("r_px") is not None:
                 measured.append(abs(s["r_px"] - t["r_px"]) / t["r_px"])
             if s.get("r_fitted_px") is not None:
                 fitted.append(abs(s["r_fitted_px"] - t["r_px"]) / t["r_px"])
     return np.array(measured), np.array(fitted), depth, len(true)
+
+
+# Physically rendered scenes (optics before the pixel aperture) may leave a few level sections' PSF family open; more
+# would be the check misreading physical optics as filtered (none is flagged on these scenes today; with 0.05 px bins
+# the distorted one flagged 9 of 77, all read within 3 %).
+MAX_PHASE_LIMITED = 10
+
+
+def phase_limited(section):
+    return "phase_limited" in (section.get("flags") or [])
 
 
 def summary(errs):
@@ -74,11 +87,15 @@ def check_calibrate(args):
     print("%s: %s, floor %.2f px, focus %.0f mm, r %.2f-%.2f px; %d of %d sections measured (%d across their "
           "neighbouring edges)" % (d, truth["psf"], truth["options"]["floor_sigma_px"], truth["focus_mm"], min(r_true),
                                    max(r_true), len(m), n, across))
+    flagged = 0
     for e in calib["edges"]:
         for s in e["sections"]:
-            if not s.get("ok"):
+            if phase_limited(s):
+                flagged += 1
+            elif not s.get("ok"):
                 print("  edge %d section %d not measured: %s %s" % (e["index"], s["index"], s.get("flags"),
                                                                   s.get("crowded_why", "")))
+    print("  %d sections flagged phase_limited (measured; left out of the lens fit, which predicts them)" % flagged)
     print("  depth error max %.4f %%" % (100 * depth))
     print("  measured r_px:      median %s, p90 %s" % (pct(mm), pct(mp)))
     print("  fitted r_fitted_px: median %s, p90 %s" % (pct(fm), pct(fp)))
@@ -91,6 +108,9 @@ def check_calibrate(args):
                 missed.append("%s r: median %s, p90 %s (target <= 2 %%, <= 5 %%)" % (name, pct(med), pct(p90)))
         if len(m) < n:
             missed.append("%d of %d sections unmeasured" % (n - len(m), n))
+        if flagged > MAX_PHASE_LIMITED:
+            missed.append("%d sections flagged phase_limited (at most %d on physically rendered optics)" %
+                          (flagged, MAX_PHASE_LIMITED))
     return missed
 
 

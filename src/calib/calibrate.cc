@@ -74,6 +74,24 @@ std::vector<optics::BlurSample> ModelSamples(const CalibResult& result) {
   return samples;
 }
 
+std::map<std::string, int> SectionsLeftOut(const CalibResult& result) {
+  // Informational flags never disqualify a section (edge_blur.h).
+  static const std::vector<std::string> kInformational = {"flaw", "neighbours"};
+  std::map<std::string, int> out;
+  for (const auto& edge : result.edges)
+    for (const auto& s : edge.sections) {
+      if (s.fit.ok) continue;
+      std::string why = "not measured";
+      for (const std::string& flag : s.fit.flags)
+        if (std::find(kInformational.begin(), kInformational.end(), flag) == kInformational.end()) {
+          why = flag;
+          break;
+        }
+      ++out[why];
+    }
+  return out;
+}
+
 namespace {
 // The thin lens's radius is unsigned: sections at two depths fit a focus between them and one beyond them alike
 // (an overexposed photo that leaves the first and last edges only gave focus 140 mm for 400 and an aperture 7 x off).
@@ -112,6 +130,39 @@ void RequireThreeDepths(const CalibResult& result) {
                   "them fit alike); retake the photo so that more of the board's edges are measured (exposure, "
                   "framing, focus)");
 }
+// The reference edge's depth and blur for eq. 3.7: the medians over its usable sections (the median resists a flawed
+// section; the thesis averaged its 7 sections). Error(kNotFound) when it has none.
+void SetReference(CalibResult& result, int reference_edge) {
+  const EdgeResult& ref = result.edges[reference_edge - 1];
+  std::vector<double> ref_r, ref_u;
+  for (const auto& s : ref.sections)
+    if (s.fit.ok) ref_r.push_back(s.fit.r_px), ref_u.push_back(s.u_mm);
+  // A reference edge whose every section is phase_limited still has its readings (eq. 3.7 is the thesis's estimate
+  // from them, whatever their family): taken rather than refusing the photo.
+  if (ref_r.empty())
+    for (const auto& s : ref.sections)
+      if (!s.fit.phase_why.empty()) ref_r.push_back(s.fit.r_px), ref_u.push_back(s.u_mm);
+  if (ref_r.empty())
+    throw Error(ErrorKind::kNotFound, "reference edge " + std::to_string(reference_edge) +
+                                          " has no usable section (all flagged); choose another --reference-edge");
+  result.reference_r_px = Median(ref_r);
+  result.reference_u_mm = Median(ref_u);
+}
+
+// Sections sampled at few phases with blur near or below a pixel: read once per PSF family (phase_check.h), each
+// on its own (on every core, as the blur fit).
+void CheckPhases(CalibResult& result, const cv::Mat& linear, const CalibrateOptions& options) {
+  const int S = result.board.SectionCount(), n = result.board.EdgeCount() * S;
+  auto phase = [&](const cv::Range& range) {
+    for (int k = range.start; k < range.end; ++k) {
+      SectionResult& sec = result.edges[k / S].sections[k % S];
+      if (sec.fit.ok) sec.phase = CheckPhase(linear, sec.segment, sec.fit, options.model_fit);
+    }
+  };
+  if (options.parallel_sections) cv::parallel_for_(cv::Range(0, n), phase, n);
+  else phase(cv::Range(0, n));
+}
+
 }  // namespace
 
 void ApplyModel(CalibResult& result, const optics::FittedModel& model) {
@@ -256,24 +307,19 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
     if (options.parallel_sections) cv::parallel_for_(cv::Range(0, S), again, S);
     else again(cv::Range(0, S));
   }
+  if (options.phase_check && options.fit_model) CheckPhases(result, linear, options);
   result.measure_ms = MsSince(t0);
 
   // Estimation: eq. 3.7 from the reference edge, and a thin-lens model fitted to every usable section.
   t0 = std::chrono::steady_clock::now();
   const optics::Lens lens = optics::Lens::FromCamera(camera);
+  // The sections at other phases choose the PSF family; a section it leaves open is flagged and predicted.
+  if (options.fit_model && options.phase_check) result.phase = ChoosePhaseFamily(result);
   if (options.fit_model) RequireThreeDepths(result);  // before the reference: with no usable edge, say why
-  EdgeResult& ref = result.edges[options.reference_edge - 1];
-  std::vector<double> ref_r, ref_u;
-  for (const auto& s : ref.sections)
-    if (s.fit.ok) ref_r.push_back(s.fit.r_px), ref_u.push_back(s.u_mm);
-  if (ref_r.empty())
-    throw Error(ErrorKind::kNotFound, "reference edge " + std::to_string(options.reference_edge) +
-                                          " has no usable section (all flagged); choose another --reference-edge");
-  // The median resists a flawed section; the thesis averaged its 7 sections.
-  result.reference_r_px = Median(ref_r);
-  result.reference_u_mm = Median(ref_u);
+  SetReference(result, options.reference_edge);
 
-  if (options.fit_model) result.model = optics::FitThinLens(lens, ModelSamples(result), options.optics_fit);
+  if (options.fit_model)
+    result.model = FitModelWithinPhaseRanges(result, lens, options.optics_fit, &result.phase.held);
 
   for (auto& edge : result.edges) {
     double su = 0;
@@ -304,6 +350,35 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
   return result;
 }
 
+namespace {
+
+Json PhaseCheckJson(const PhaseCheck& p) {
+  Json readings = Json::array();
+  for (const PhaseReading& f : p.families)
+    readings.push_back({{"r_px", f.r_px}, {"offset_px", f.offset_px}, {"rms_rel", f.rms_rel}, {"chi2", f.chi2}});
+  return {{"axis_deg", p.axis_deg}, {"span_px", p.span_px}, {"phase_px", p.phase_px}, {"noise", p.noise},
+          {"bins", p.bins}, {"range_px", {p.range_lo_px, p.range_hi_px}}, {"families", readings}};
+}
+
+Json PhaseChoiceJson(const PhaseChoice& c) {
+  Json families = Json::array();
+  for (size_t i = 0; i < c.chi2.size(); ++i)
+    families.push_back({{"post_sigma_px", PhaseFamilies()[i].sigma_px}, {"sharpen", PhaseFamilies()[i].sharpen},
+                        {"chi2", c.chi2[i]}, {"alike", bool(c.alike[i])}});
+  return {{"limited_sections", c.limited}, {"flagged", c.flagged}, {"held_the_model", c.held},
+          {"chosen", c.limited > 0 ? Json(PhaseFamilies()[c.chosen].Name()) : Json(nullptr)},
+          {"chi2_per_point", c.chi2_per_point}, {"families", families}, {"summary", c.summary},
+          {"note", "sections along the pixel rows or columns with blur under 2 px are read once per PSF family "
+                   "(the optics, then on the sampled image a Gaussian of post_sigma_px or an unsharp mask of that std "
+                   "and amount `sharpen`; each section's phase.families in that order) with the edge where the pose "
+                   "puts it; the family whose profiles fit best over all of them (their edges at other phases) is "
+                   "taken, and "
+                   "a section whose reading moves by more than max(0.04 px, 8 %) among the families that fit alike "
+                   "is flagged phase_limited, left out of the lens fit and predicted by it"}};
+}
+
+}  // namespace
+
 Json CalibToJson(const CalibResult& r) {
   auto vec = [](const cv::Vec3d& v) { return Json::array({v[0], v[1], v[2]}); };
   auto opt = [](const std::optional<double>& v) { return v ? Json(*v) : Json(nullptr); };
@@ -331,6 +406,8 @@ Json CalibToJson(const CalibResult& r) {
                  {"thesis_ok", s.thesis.ok}};
       if (!s.estimated_note.empty()) js["r_estimated_note"] = s.estimated_note;
       if (!s.fit.crowded_why.empty()) js["crowded_why"] = s.fit.crowded_why;
+      if (!s.fit.phase_why.empty()) js["phase_why"] = s.fit.phase_why;
+      if (s.phase.limited) js["phase"] = PhaseCheckJson(s.phase);
       if (distorted) js["stretch"] = s.stretch;
       sections.push_back(js);
     }
@@ -372,12 +449,14 @@ Json CalibToJson(const CalibResult& r) {
                  // floor_px stays a number (the model predicts with it); whether the sections pin it is said here.
                  {"floor_determined", m.floor_determined}, {"rms_px", m.rms_px},
                  {"loo_rms_px", m.loo_rms_px}, {"samples_used", m.samples_used}, {"outliers", m.outliers},
+                 {"sections_left_out", SectionsLeftOut(r)},
                  {"choice", choice}}},
       {"r_units", !distorted ? Json("px of the photo (no dist_coeffs: the photo is the pinhole image)") : Json({
            {"sections", "r_px, r_thesis_px, r_estimated_px, r_fitted_px: photo px (distorted), across the edge"},
            {"model", "floor_px and the thin lens's radius: ideal (undistorted, pinhole) px; a point's photo-px radius "
                      "is the model's times the stretch there (sections: stretch across the edge; a round blur "
                      "anywhere: sqrt(det J) of the distortion map)"}})},
+      {"phase_check", PhaseChoiceJson(r.phase)},
       {"timing_ms", {{"detect", r.detect_ms}, {"measure", r.measure_ms}, {"estimate", r.estimate_ms}}},
       {"edges", edges},
   };

@@ -3,6 +3,7 @@
 // every edge section two ways, and estimate every section from the reference edge (eq. 3.7) and from a thin-lens
 // model fitted to all usable sections.
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -11,6 +12,7 @@
 
 #include "calib/board_pose.h"
 #include "calib/edge_blur.h"
+#include "calib/phase_check.h"
 #include "core/board.h"
 #include "core/camera.h"
 #include "core/json_io.h"
@@ -31,6 +33,10 @@ struct CalibrateOptions {
   // Fit the scene's lens model to this photo's sections (false: the result's model is left empty and r_fitted_px 0,
   // for a caller that fits one model to many photos and applies it with ApplyModel: track, a take's frames).
   bool fit_model = true;
+  // Read sections whose phases are few with each PSF family and flag those the families leave open phase_limited
+  // (phase_check.h; with fit_model only: the sections at other phases choose the family through the lens fit). false:
+  // the blur fit's readings as they are, none flagged (to compare).
+  bool phase_check = true;
 };
 
 struct SectionResult {
@@ -40,6 +46,7 @@ struct SectionResult {
   EdgeSegment segment;                // the section in the photo (end points, window across it)
   ModelFit fit;                       // r_px = fit.r_px, usable when fit.ok
   ThesisMeasure thesis;               // r_thesis_px
+  PhaseCheck phase;                   // the readings per PSF family where its phases are few
   // How much the lens distortion (camera.json's dist_coeffs) stretches a blur across this edge at its midpoint
   // (core/distortion.h; 1 without distortion): photo px per ideal (pinhole) px. The thin-lens model lives in ideal
   // px, so it is fitted to r_px / stretch and predicts r_fitted_px = model x stretch.
@@ -66,6 +73,7 @@ struct CalibResult {
   int reference_edge = 1;
   double reference_u_mm = 0, reference_r_px = 0;
   optics::FittedModel model;
+  PhaseChoice phase;  // the PSF family the sections chose where phases are few, and how many were flagged
   std::vector<EdgeResult> edges;
   double detect_ms = 0, measure_ms = 0, estimate_ms = 0;  // where the time went
 };
@@ -94,6 +102,10 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
 // The usable sections as the thin-lens model's samples: depth and r_px / stretch (ideal px), so a distorted photo's
 // blur is fitted in the undistorted lens's terms. A tracked take pools these over its frames.
 std::vector<optics::BlurSample> ModelSamples(const CalibResult& result);
+
+// The sections the thin-lens model was not fitted to, counted by the flag that disqualified each (its first:
+// "phase_limited", "crowded", "low_contrast", ...).
+std::map<std::string, int> SectionsLeftOut(const CalibResult& result);
 
 // Makes `model` the result's thin-lens model: every section's r_fitted_px and every edge's mean follow it (a tracked
 // take's one lens model replacing each frame's own).

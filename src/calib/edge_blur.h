@@ -47,10 +47,14 @@ struct ModelFitOptions {
 
 struct ModelFit {
   bool ok = false;                 // usable: none of the disqualifying flags below
-  std::vector<std::string> flags;  // "low_contrast", "saturated", "crowded", "poor_fit", "too_few_pixels"
+  std::vector<std::string> flags;  // "low_contrast", "saturated", "crowded", "poor_fit", "too_few_pixels",
+                                   // "phase_limited" (phase_check.h)
                                    // disqualify; "flaw" (robustly rejected outliers) and "neighbours" (measured
                                    // across the neighbouring edges, their steps in the model) are informational
   std::string crowded_why;         // with "crowded": why the blur cannot be measured here, in words
+  // With "phase_limited" (set by the calibration, phase_check.h: an edge along the pixel rows with blur near or
+  // below a pixel, whose reading depends on a PSF family the photo does not pin): why, in words.
+  std::string phase_why;
   double r_px = 0;                 // optical blur radius: 2 x the std of the optical LSF, pixel aperture removed
                                    // (the fitted disc x Gaussian's second moment, whatever its shape)
   // The shape within r_px^2 = disc_r_px^2 + 4 floor_sigma_px^2 (DESIGN.md): a defocus disc and a Gaussian floor.

@@ -69,16 +69,19 @@ void KnownKeys(const Json& obj, const std::string& where, const std::vector<std:
 
 const std::vector<std::string> kTopKeys = {"format", "version", "software", "camera", "board", "pose",
                                            "reference_edge", "reference", "model", "r_units", "timing_ms", "edges",
+                                           "phase_check",
                                            // a tracked frame's (track/take.cc)
                                            "photo", "frame", "time_s", "track_status", "frame_signature",
                                            "lens_model"};
 const std::vector<std::string> kModelKeys = {"kind", "focus_mm", "aperture_mm", "floor_px", "floor_determined",
-                                             "rms_px", "loo_rms_px", "samples_used", "outliers", "choice"};
+                                             "rms_px", "loo_rms_px", "samples_used", "outliers", "choice",
+                                             "sections_left_out"};
 const std::vector<std::string> kEdgeKeys = {"index", "u_mm", "usable_sections", "sections"};
 const std::vector<std::string> kSectionKeys = {"index", "u_mm", "midpoint_camera_mm", "image_px", "r_px", "r_thesis_px",
                                                "r_estimated_px", "r_fitted_px", "ok", "flags", "psf", "disc_r_px",
                                                "floor_sigma_px", "shape_ambiguous", "fit_rms_rel", "step_linear",
-                                               "thesis_ok", "r_estimated_note", "crowded_why", "stretch"};
+                                               "thesis_ok", "r_estimated_note", "crowded_why", "stretch",
+                                               "phase", "phase_why"};
 const std::vector<std::string> kModelKinds = {"thin_lens", "thin_lens+floor"};
 
 // A boolean field (absent: `absent`).

@@ -21,7 +21,7 @@ void AddCalibrateCommand(CLI::App& app) {
     std::string photo, camera, out = "calib.json", board = "7x10", truth;
     double square_mm = 25;
     int reference_edge = 1;
-    bool quiet = false;
+    bool quiet = false, no_phase_check = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -49,6 +49,9 @@ void AddCalibrateCommand(CLI::App& app) {
                   "truth.json of a ground-truth scene (blurcue synth-scene): adds the true radius to the table\n"
                   "and prints the pose and blur errors of every method")
       ->check(CLI::ExistingFile);
+  cmd->add_flag("--no-phase-check", args->no_phase_check,
+                "take every section's blur fit as it reads, also where the edge runs along the pixel rows with blur\n"
+                "near or below a pixel (none flagged phase_limited; to compare: docs/definitions.md)");
   cmd->add_flag("--quiet", args->quiet, "print only errors");
   cmd->callback([args] {
     const auto t0 = std::chrono::steady_clock::now();
@@ -62,6 +65,7 @@ void AddCalibrateCommand(CLI::App& app) {
     const double read_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     calib::CalibrateOptions options;
     options.reference_edge = args->reference_edge;
+    options.phase_check = !args->no_phase_check;
     calib::CalibResult result;
     try {
       result = calib::Calibrate(photo, camera, board, options);
@@ -97,6 +101,32 @@ void AddCalibrateCommand(CLI::App& app) {
                 " leave-one-out %.3f px, %d outliers of %d\n",
                 m.kind.c_str(), m.focus_mm, m.aperture_mm, camera.ApertureMm(), optics::FloorText(m).c_str(),
                 m.rms_px, m.loo_rms_px, m.outliers, m.samples_used);
+    // How many sections the model was fitted to, and why the others were left out.
+    {
+      int sections = 0;
+      for (const auto& e : result.edges) sections += static_cast<int>(e.sections.size());
+      std::string left;
+      int n_left = 0;
+      for (const auto& [why, n] : calib::SectionsLeftOut(result))
+        left += (left.empty() ? "" : ", ") + std::to_string(n) + " " + why, n_left += n;
+      std::printf("the model is fitted to %d of %d sections%s\n", sections - n_left, sections,
+                  left.empty() ? "" : ("; left out (it predicts them): " + left).c_str());
+    }
+    if (options.phase_check) {
+      std::printf("phase check: %s\n", result.phase.summary.c_str());
+      // Each edge with phase_limited sections, once, with its first section's reason (every one's is in calib.json).
+      for (const auto& e : result.edges) {
+        int n = 0;
+        const std::string* why = nullptr;
+        for (const auto& sec : e.sections)
+          if (!sec.fit.phase_why.empty()) ++n, why = why ? why : &sec.fit.phase_why;
+        if (n > 0) std::printf("  edge %d: %d of %zu sections phase_limited: %s\n", e.index, n, e.sections.size(),
+                               why->c_str());
+      }
+      if (result.phase.held > 0)
+        std::printf("phase check: the model predicted %d phase_limited sections outside the range their families "
+                    "leave open; their ranges' middles joined its fit\n", result.phase.held);
+    }
     // Why this model (calib.json's model.choice): both candidates' held-out errors, and eq. 3.7 as published.
     const Json& choice = json["model"]["choice"];
     if (std::isfinite(m.floor_loo_rms_px))

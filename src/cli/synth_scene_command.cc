@@ -45,6 +45,7 @@ Error AsSceneOptionError(const Error& e, const std::map<std::string, std::string
       {"table", "--table"},             {"noise_std", "--noise"},       {"jpeg_quality", "--jpeg-quality"},
       {"flaws", "--flaws"},             {"supersample", "--supersample"}, {"board", "--board"},
       {"floor_sigma_px", "--floor-sigma-px"}, {"vignetting", "--vignetting"},
+      {"post_sigma_px", "--post-sigma-px"}, {"post_amount", "--post-amount"},
   };
   for (const auto& [field, option] : renamed) options[field] = option;
   const std::string message = e.what();
@@ -59,7 +60,7 @@ Error AsSceneOptionError(const Error& e, const std::map<std::string, std::string
 
 void AddSynthSceneCommand(CLI::App& app) {
   struct Args {
-    std::string out, preset = "quarter", camera, focus, psf = "disc", board = "7x10";
+    std::string out, preset = "quarter", camera, focus, psf = "disc", board = "7x10", post_filter = "none";
     uint64_t seed = 1;
     int width = 0, height = 0, jpeg_quality = 0, flaws = 0;
     std::optional<int> supersample;
@@ -127,6 +128,15 @@ void AddSynthSceneCommand(CLI::App& app) {
   cmd->add_option("--floor-sigma-px", o.floor_sigma_px,
                   "lens floor: every PSF convolved with a Gaussian of this std, px (truth adds its second moment)")
       ->capture_default_str()->check(FiniteRange(0, 20, "px"));
+  cmd->add_option("--post-filter", args->post_filter,
+                  "a filter on the sampled image, after the noise, as demosaicing or sharpening do: none, gaussian\n"
+                  "(taps of a Gaussian of std --post-sigma-px at whole pixels) or sharpen (unsharp mask: 1 + amount\n"
+                  "times the image less amount times that Gaussian); truth adds the taps' second moment")
+      ->check(CLI::IsMember({"none", "gaussian", "sharpen"}))->capture_default_str();
+  cmd->add_option("--post-sigma-px", o.post_filter.sigma_px, "std of the post filter's Gaussian, px (0, 5]")
+      ->check(FiniteRange(0, 5, "px"));
+  cmd->add_option("--post-amount", o.post_filter.amount, "sharpen: how much of the blurred copy is taken away (0, 5]")
+      ->check(FiniteRange(0, 5, ""));
   cmd->add_option("--vignetting", o.vignetting, "light fall-off at the image corner, 0..0.9 (0.35: corners at 65 %)")
       ->capture_default_str()->check(FiniteRange(0, 0.9, ""));
   cmd->add_option("--noise", o.noise_std,
@@ -168,6 +178,7 @@ void AddSynthSceneCommand(CLI::App& app) {
     o.flaws = args->flaws;
     o.fixed_r_px = args->fixed_r_px;
     o.psf = args->psf == "gaussian" ? synth::Psf::kGaussian : synth::Psf::kDisc;
+    o.post_filter.kind = synth::ParsePostFilter(args->post_filter);
     if (!args->focus.empty()) o.focus_mm = ParseFocus(args->focus);
     o.board = Board::Parse(args->board, args->square_mm);
     if (!(args->square_mm > 0)) throw UsageError("--square-mm", "must be > 0, got " + std::to_string(args->square_mm));
@@ -224,6 +235,11 @@ void AddSynthSceneCommand(CLI::App& app) {
                 "%.2f px (lens floor included)\n",
                 edge_u(1), edge_r(1), edges, edge_u(edges), edge_r(edges),
                 scene.truth["r_range_px"][0].get<double>(), scene.truth["r_range_px"][1].get<double>());
+    if (o.post_filter.kind != synth::PostFilter::kNone)
+      std::printf("filtered after sampling: %s, std %.2f px%s (its taps' second moment is in every r above)\n",
+                  synth::Name(o.post_filter.kind), o.post_filter.sigma_px,
+                  o.post_filter.kind == synth::PostFilter::kSharpen
+                      ? (", amount " + std::to_string(o.post_filter.amount).substr(0, 4)).c_str() : "");
     if (o.flaws > 0) std::printf("%d printing flaws touching %d edge sections\n", o.flaws, flawed);
     std::printf("wrote %s/{scene.png, scene-no-board.png, camera.json, truth.json} in %.2f s (render %.2f s)\n",
                 args->out.c_str(), total_s, render_s);

@@ -197,6 +197,8 @@ void AddNoise(cv::Mat& linear, double noise, double white, Rng rng) {
 
 cv::Mat Finish(cv::Mat linear, const SceneOptions& o, Rng rng) {
   AddNoise(linear, o.noise_std, o.white, rng);
+  // After the noise, as a camera's pipeline filters the sensor's samples (the noise too).
+  ApplyPostFilter(linear, PostFilterTaps(o.post_filter));
   cv::Mat grey8 = EncodeSrgb8(linear), bgr;
   cv::cvtColor(grey8, bgr, cv::COLOR_GRAY2BGR);
   if (o.jpeg_quality > 0) {
@@ -234,6 +236,10 @@ void ValidateOptions(const SceneOptions& o) {
     throw InputError("vignetting", "must be in [0, 0.9] (fall-off at the image corner), got " + Num(o.vignetting));
   if (!(o.noise_std >= 0 && o.noise_std <= 1))
     throw InputError("noise_std", "must be in [0, 1] (linear units), got " + Num(o.noise_std));
+  if (o.post_filter.kind != PostFilter::kNone && !(o.post_filter.sigma_px > 0 && o.post_filter.sigma_px <= 5))
+    throw InputError("post_sigma_px", "must be in (0, 5] px with a post filter, got " + Num(o.post_filter.sigma_px));
+  if (o.post_filter.kind == PostFilter::kSharpen && !(o.post_filter.amount > 0 && o.post_filter.amount <= 5))
+    throw InputError("post_amount", "must be in (0, 5] to sharpen, got " + Num(o.post_filter.amount));
   if (o.jpeg_quality < 0 || o.jpeg_quality > 100)
     throw InputError("jpeg_quality", "must be 0 (no JPEG) or 1..100, got " + std::to_string(o.jpeg_quality));
   if (o.flaws < 0 || o.flaws > 10000) throw InputError("flaws", "must be in [0, 10000], got " + std::to_string(o.flaws));
@@ -274,6 +280,9 @@ Json OptionsToJson(const SceneOptions& o) {
   j["supersample"] = o.supersample;
   j["floor_sigma_px"] = o.floor_sigma_px;
   j["vignetting"] = o.vignetting;
+  j["post_filter"] = Name(o.post_filter.kind);
+  if (o.post_filter.kind != PostFilter::kNone) j["post_sigma_px"] = o.post_filter.sigma_px;
+  if (o.post_filter.kind == PostFilter::kSharpen) j["post_amount"] = o.post_filter.amount;
   return j;
 }
 
@@ -595,6 +604,9 @@ Scene RenderScene(const SceneOptions& o) {
   scene.tvec = pose.t;
   scene.focus_mm = focus;
 
+  // The post-sampling filter's taps as applied (float), and their second moment: every section's truth adds it.
+  const std::vector<float> post_taps = PostFilterTaps(o.post_filter);
+  const double post_var_px2 = PostFilterVariancePx2(post_taps);
   Json sections = Json::array();
   for (int e = 1; e <= board.EdgeCount(); ++e)
     for (int s = 1; s <= board.SectionCount(); ++s) {
@@ -615,12 +627,14 @@ Scene RenderScene(const SceneOptions& o) {
       const Point2 a = ideal_px(board.SectionStart(e, s)), b = ideal_px(board.SectionEnd(e, s));
       t.stretch = distortion.StretchAcross(ideal_px(mid), {a[1] - b[1], b[0] - a[0]});
       t.r_ideal_px = 2 * std::sqrt(var_px2);
-      t.r_px = t.r_ideal_px * t.stretch;
+      t.r_optical_px = t.r_ideal_px * t.stretch;
+      t.r_px = std::sqrt(std::max(0.0, t.r_optical_px * t.r_optical_px + 4 * post_var_px2));
       t.flawed = flawed[e - 1][s - 1];
       scene.sections.push_back(t);
       Json row = {{"edge", e}, {"section", s}, {"u_mm", u}, {"r_px", t.r_px}, {"defocus_r_px", t.defocus_r_px},
                   {"flawed", t.flawed}};
       if (!distortion.Identity()) row["r_ideal_px"] = t.r_ideal_px, row["stretch"] = t.stretch;
+      if (post_taps.size() > 1) row["r_optical_px"] = t.r_optical_px;
       sections.push_back(row);
     }
 
@@ -652,7 +666,11 @@ Scene RenderScene(const SceneOptions& o) {
   j["floor_sigma_applied_px"] = std::sqrt(floor_var_px2);
   // The whole view's blur with the floor (every point has it: nothing in the view is sharper than the floor), and the
   // defocus alone (the lens formula's range, before discretisation).
-  j["r_range_px"] = {std::sqrt(r_min * r_min + 4 * floor_var_px2), std::sqrt(r_max * r_max + 4 * floor_var_px2)};
+  if (post_taps.size() > 1) j["post_filter"] = PostFilterTruth(o.post_filter, post_taps);
+  // (and the post-sampling filter's, where there is one).
+  const double added_px2 = 4 * (floor_var_px2 + post_var_px2);
+  j["r_range_px"] = {std::sqrt(std::max(0.0, r_min * r_min + added_px2)),
+                     std::sqrt(std::max(0.0, r_max * r_max + added_px2))};
   j["defocus_r_range_px"] = {r_min, r_max};
   j["blur_levels_px"] = levels_json;
   j["sections"] = sections;

@@ -13,6 +13,7 @@
 #include "core/board.h"
 #include "core/camera.h"
 #include "core/json_io.h"
+#include "synth/post_filter.h"
 
 namespace blurcue::synth {
 
@@ -42,6 +43,8 @@ struct SceneOptions {
   double black = 0.04;         // ... of the black squares
   double table = 0.30;         // mean of the (textured) table
   double noise_std = 0.0;      // Gaussian sensor noise, linear units, plus shot noise of the same scale at white
+  // A filter on the sampled image after the sensor noise (demosaicing, sharpening: post_filter.h); none by default.
+  PostFilterOptions post_filter;
   int jpeg_quality = 0;        // 0: none; 1..100: JPEG round trip before writing PNG
   int flaws = 0;               // dark printing spots on white squares near edges (thesis Fig. 4.15)
   uint64_t seed = 1;
@@ -60,6 +63,9 @@ struct SectionTruth {
   // With dist_coeffs: r_px = r_ideal_px x stretch, the blur applied in the ideal (pinhole) image times the map's
   // stretch across the edge at the midpoint (core/distortion.h); both 1:1 without distortion.
   double r_ideal_px = 0, stretch = 1;
+  // The blur before the post-sampling filter (r_ideal_px x stretch); r_px adds the filter's second moment to it:
+  // r_px^2 = r_optical_px^2 + 4 variance of the filter's taps (0 when the sum is not positive: sharpened past it).
+  double r_optical_px = 0;
   bool flawed = false;  // a printing flaw touches this section
 };
 

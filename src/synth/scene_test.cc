@@ -246,6 +246,53 @@ TEST(SynthScene, FloorAddsItsSecondMomentToTheTruthAndTheImage) {
   }
 }
 
+// A filter on the sampled image: truth.json holds its taps and their second moment, computed here from the Gaussian
+// written out (not from synth's arrays), every section's r_px adds it, and the image's edge profile carries it.
+TEST(SynthScene, PostFilterAddsItsTapsSecondMomentToTheTruthAndTheImage) {
+  const double sigma = 0.8, amount = 0.4;
+  double g_sum = 0, g_second = 0;
+  for (int k = -4; k <= 4; ++k) {  // 4 sigma = 3.2 px: taps out to 4
+    const double g = std::exp(-0.5 * k * k / (sigma * sigma));
+    g_sum += g, g_second += k * k * g;
+  }
+  const double gauss_var = g_second / g_sum;
+  for (const PostFilter kind : {PostFilter::kGaussian, PostFilter::kSharpen}) {
+    SceneOptions o = FixedBlur(3, Psf::kGaussian);
+    o.post_filter = {kind, sigma, kind == PostFilter::kSharpen ? amount : 0};
+    const Scene s = RenderScene(o);
+    const double var = kind == PostFilter::kGaussian ? gauss_var : -amount * gauss_var;
+    EXPECT_NEAR(s.truth["post_filter"]["variance_px2"].get<double>(), var, 1e-6);
+    EXPECT_EQ(s.truth["post_filter"]["taps"].size(), 9u);
+    EXPECT_EQ(s.truth["options"]["post_filter"], Name(kind));
+    const SectionTruth& t = s.sections[2 * 5 + 2];  // edge 3, section 3
+    EXPECT_NEAR(t.r_optical_px, 3, 0.01 * 3);
+    EXPECT_NEAR(t.r_px, std::sqrt(t.r_optical_px * t.r_optical_px + 4 * var), 1e-6);  // taps applied as float
+    const Profile p = EdgeProfile(s, 3, 3);
+    double m0 = 0, m1 = 0, m2 = 0;
+    for (size_t i = 0; i + 1 < p.values.size(); ++i) {
+      const double g = p.values[i + 1] - p.values[i], x = i + 0.5;
+      m0 += g, m1 += g * x, m2 += g * x * x;
+    }
+    const double measured = m2 / m0 - (m1 / m0) * (m1 / m0);
+    EXPECT_NEAR(2 * std::sqrt(measured - 1.0 / 6), t.r_px, 0.03 * t.r_px) << Name(kind) << " variance " << measured;
+  }
+  // Without a filter truth.json has no post_filter block and r_px is the optics' alone.
+  const Scene plain = RenderScene(FixedBlur(3, Psf::kGaussian));
+  EXPECT_FALSE(plain.truth.contains("post_filter"));
+  EXPECT_DOUBLE_EQ(plain.sections[0].r_px, plain.sections[0].r_optical_px);
+}
+
+// The filter's word and its options are checked where they are read.
+TEST(SynthScene, PostFilterWordsAndOptionsAreChecked) {
+  EXPECT_EQ(ParsePostFilter("sharpen"), PostFilter::kSharpen);
+  EXPECT_THROW(ParsePostFilter("unsharp"), Error);
+  SceneOptions o = Small();
+  o.post_filter = {PostFilter::kGaussian, 0, 0};
+  EXPECT_THROW(CheckSceneOptions(o), Error);
+  o.post_filter = {PostFilter::kSharpen, 0.6, 0};
+  EXPECT_THROW(CheckSceneOptions(o), Error);
+}
+
 // Vignetting darkens the corners by the fraction asked and leaves the centre as it was.
 TEST(SynthScene, VignettingDarkensTheCornersByTheFractionAsked) {
   SceneOptions o = FixedBlur(1, Psf::kDisc);

@@ -1,0 +1,88 @@
+#pragma once
+// Identifiability per section (issue 42). An edge within a few degrees of the pixel rows (or columns) is sampled at
+// one sub-pixel phase all along it: its profile is a handful of samples across the edge, and where the blur is near
+// or below a pixel those samples cannot tell a PSF's shape from its width. The same samples fit an optical blur
+// (before the pixel aperture, as the lens makes it) and a sharper one filtered on the sampled image (after the
+// pixel aperture, as demosaicing and sharpening do) alike, with second moments up to a factor 2 apart depending on
+// where the edge lies between rows. So on such sections blur is read once per PSF family, with the edge's position
+// from the pose; a filter on the sampled image is the whole photo's, so the family is chosen by all those sections
+// together, whose edges lie at other phases (the one whose profiles fit them best). A section whose reading still
+// depends on which of the families that fit alike is taken is flagged `phase_limited`, left out of the lens fit, and
+// predicted by it.
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "calib/edge_blur.h"
+#include "optics/fit.h"
+#include "optics/thin_lens.h"
+
+namespace blurcue::calib {
+
+// A PSF family: the optics (disc x Gaussian of the section's fitted shape) then, on the sampled image, a kernel at
+// whole pixels on both axes: a Gaussian of std sigma_px (sharpen 0; sigma 0: the optics alone, the model the blur fit
+// assumes), or an unsharp mask, (1 + sharpen) x the identity - sharpen x that Gaussian (a negative second moment).
+struct PhaseFamily {
+  double sigma_px = 0, sharpen = 0;
+  std::string Name() const;  // "the optics alone", "the optics then a Gaussian of std 0.45 px on the sampled image"
+};
+
+// What one family reads on a section.
+struct PhaseReading {
+  double r_px = 0;       // 2 x the std of the whole line spread: sqrt(r_optics^2 + 4 x the kernel's second moment)
+  double offset_px = 0;  // where it puts the edge, from the pose's line (within 0.15 px of it)
+  double rms_rel = 0;    // its residual rms / |step|
+  double chi2 = 0;       // its residual sum of squares over the noise variance (PhaseCheck::noise)
+};
+
+struct PhaseCheck {
+  // Few phases and blur near or below a pixel: the readings below were taken (otherwise empty).
+  bool limited = false;
+  double axis_deg = 0;  // the edge's angle to the nearest pixel axis
+  double span_px = 0;   // how far its sub-pixel phase moves along the part measured (1 px or more: every phase)
+  double phase_px = 0;  // where the edge (from the pose) lies between pixel centres at its midpoint, 0..1
+  double noise = 0;     // the pixels' noise std about the profile (linear light), from the spread within its bins
+  int bins = 0;         // profile points the families were fitted to
+  std::vector<PhaseReading> families;  // one per PhaseFamilies(), in that order
+  // Set by ChoosePhaseFamily: the readings of the families that fit the photo's profiles alike span this (px).
+  double range_lo_px = 0, range_hi_px = 0;
+};
+
+// The families read (the optics alone first).
+const std::vector<PhaseFamily>& PhaseFamilies();
+
+// Reads a section's blur once per family where its phases are few and its blur (`fit`, the blur fit's own reading)
+// is below about 2 px; `linear` as for MeasureEdgeModel. The edge lies where the pose puts it (the segment line).
+PhaseCheck CheckPhase(const cv::Mat& linear, const EdgeSegment& segment, const ModelFit& fit,
+                      const ModelFitOptions& options = {});
+
+// What the sections at other phases chose (calib.json's phase_check).
+struct PhaseChoice {
+  int limited = 0;               // usable sections whose phases are few (PhaseCheck::limited)
+  int flagged = 0;               // of those, flagged phase_limited
+  int held = 0;                  // of those, sections whose range held the lens model (FitModelWithinPhaseRanges)
+  size_t chosen = 0;             // the family chosen (PhaseFamilies(); 0: the optics alone)
+  // Per family: chi-square of its profiles over every limited section (the filter is the whole photo's), and whether
+  // it fits them alike with the chosen one (within 25 after scaling by the best's chi-square per point, or 15 % of it).
+  std::vector<double> chi2;
+  std::vector<bool> alike;
+  double chi2_per_point = 0;     // the chosen family's: about 1 where it describes the profiles to the noise
+  std::string summary = "not checked (--no-phase-check, or a take's frames: no lens fit per frame)";  // in words
+};
+
+struct CalibResult;
+// Chooses the family over `result`'s limited sections (the one whose profiles fit best over all of them: sections at
+// other phases tell the families apart where one cannot), reads them with it, and flags `phase_limited` (ok = false,
+// with ModelFit::phase_why) those whose readings differ by more than max(0.04 px, 8 %) among the families that fit
+// alike.
+PhaseChoice ChoosePhaseFamily(CalibResult& result);
+
+// The thin-lens model fitted to the usable sections (ModelSamples) and held to the range each phase_limited section
+// leaves open: where it predicts such a section outside [range_lo_px, range_hi_px], the range's middle joins the
+// samples and the model is fitted again (a few rounds). A section whose range holds the prediction stays out. Without
+// them the sections near focus, where the blur is sub-pixel, could all be gone and nothing would pin the floor.
+optics::FittedModel FitModelWithinPhaseRanges(const CalibResult& result, const optics::Lens& lens,
+                                              const optics::FitOptions& options, int* held = nullptr);
+
+}  // namespace blurcue::calib

@@ -1,0 +1,150 @@
+// Identifiability per section (phase_check.h) against truth computed here: a level edge drawn in closed form (a
+// Gaussian blur over the pixel's box) and filtered after sampling by taps written out in the test, and a filtered
+// ground-truth scene (synth's truth: its kernels' and the post filter's taps' second moments).
+#include "calib/phase_check.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "calib/calibrate.h"
+#include "synth/scene.h"
+
+namespace blurcue::calib {
+namespace {
+
+double Phi(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
+// Integral of Phi(t / s) dt: the Gaussian ESF's antiderivative.
+double IntPhi(double t, double s) {
+  return t * Phi(t / s) + s * std::exp(-0.5 * t * t / (s * s)) / std::sqrt(2 * M_PI);
+}
+
+struct Drawn {
+  cv::Mat linear;
+  double true_r_px = 0;
+};
+
+// A dark-to-bright edge along the rows at y = edge_y (slope: its rise per column), a Gaussian optical blur of std
+// sigma_px averaged over each pixel's box, then a Gaussian of std post_px at whole pixels down the columns.
+Drawn DrawEdge(double edge_y, double slope, double sigma_px, double post_px) {
+  cv::Mat sampled(60, 200, CV_32F);
+  for (int y = 0; y < sampled.rows; ++y)
+    for (int x = 0; x < sampled.cols; ++x) {
+      const double d = y - (edge_y + slope * (x - 100));
+      const double esf = IntPhi(d + 0.5, sigma_px) - IntPhi(d - 0.5, sigma_px);
+      sampled.at<float>(y, x) = static_cast<float>(0.05 + 0.75 * esf);
+    }
+  std::vector<double> taps;
+  double sum = 0, second = 0;
+  for (int k = -3; k <= 3; ++k) taps.push_back(std::exp(-0.5 * k * k / (post_px * post_px))), sum += taps.back();
+  for (int k = -3; k <= 3; ++k) taps[k + 3] /= sum, second += k * k * taps[k + 3];
+  Drawn out;
+  out.linear = cv::Mat::zeros(sampled.size(), CV_32F);
+  for (int y = 3; y < sampled.rows - 3; ++y)
+    for (int x = 0; x < sampled.cols; ++x)
+      for (int k = -3; k <= 3; ++k) out.linear.at<float>(y, x) += float(taps[k + 3]) * sampled.at<float>(y - k, x);
+  out.true_r_px = 2 * std::sqrt(sigma_px * sigma_px + second);
+  return out;
+}
+
+size_t FamilyIndex(double sigma_px, double sharpen) {
+  const auto& f = PhaseFamilies();
+  for (size_t i = 0; i < f.size(); ++i)
+    if (std::abs(f[i].sigma_px - sigma_px) < 1e-9 && std::abs(f[i].sharpen - sharpen) < 1e-9) return i;
+  return f.size();
+}
+
+TEST(PhaseCheck, LevelEdgeFilteredAfterSamplingReadsTrueUnderItsFamilyAndNotUnderTheOptics) {
+  // Halfway between rows, where the optics-alone model reads sub-pixel blur about half its size.
+  const Drawn d = DrawEdge(30.5, 0, 0.2, 0.45);
+  const EdgeSegment segment{{40, 30.5}, {160, 30.5}, 12};
+  const ModelFit fit = MeasureEdgeModel(d.linear, segment);
+  ASSERT_TRUE(fit.ok);
+  const PhaseCheck check = CheckPhase(d.linear, segment, fit);
+  ASSERT_TRUE(check.limited);
+  EXPECT_NEAR(check.span_px, 0, 1e-9);
+  EXPECT_NEAR(check.phase_px, 0.5, 1e-9);
+  const size_t right = FamilyIndex(0.45, 0);
+  ASSERT_LT(right, check.families.size());
+  EXPECT_NEAR(check.families[right].r_px, d.true_r_px, 0.03 * d.true_r_px);
+  EXPECT_GT(std::abs(check.families[0].r_px - d.true_r_px), 0.15 * d.true_r_px)
+      << "optics alone " << check.families[0].r_px;
+  for (size_t c = 0; c < check.families.size(); ++c)
+    EXPECT_LE(check.families[right].chi2, check.families[c].chi2) << PhaseFamilies()[c].Name();
+}
+
+TEST(PhaseCheck, EdgeCrossingThePixelRowsIsSampledAtEveryPhase) {
+  // 1.5 deg: its phase moves 1.6 px along the 60 px measured.
+  const double slope = std::tan(1.5 * M_PI / 180);
+  const Drawn d = DrawEdge(30.3, slope, 0.4, 0.45);
+  const EdgeSegment segment{{40, 30.3 - 60 * slope}, {160, 30.3 + 60 * slope}, 12};
+  const ModelFit fit = MeasureEdgeModel(d.linear, segment);
+  const PhaseCheck check = CheckPhase(d.linear, segment, fit);
+  EXPECT_FALSE(check.limited);
+  EXPECT_NEAR(check.axis_deg, 1.5, 1e-6);
+  EXPECT_GT(check.span_px, 1);
+  EXPECT_TRUE(check.families.empty());
+}
+
+// Sections made by hand: the families' chi-squares choose one; a section whose alike families' readings differ is
+// flagged with its reason and left unusable, one whose readings agree keeps the chosen family's reading.
+TEST(PhaseCheck, SectionTheAlikeFamiliesLeaveOpenIsFlaggedAndTheOthersReadWithTheChosenFamily) {
+  const size_t n = PhaseFamilies().size(), a = FamilyIndex(0.4, 0), b = FamilyIndex(0.45, 0);
+  CalibResult result;
+  result.edges.resize(2);
+  for (int e = 0; e < 2; ++e) {
+    SectionResult s;
+    s.edge = e + 1, s.section = 1, s.u_mm = 400;
+    s.fit.ok = true, s.fit.r_px = 0.7;
+    s.phase.limited = true, s.phase.bins = 20;
+    s.phase.families.assign(n, PhaseReading{});
+    for (size_t c = 0; c < n; ++c) s.phase.families[c] = {1.5, 0, 0.01, 1e4};
+    s.phase.families[a] = {e == 0 ? 0.80 : 0.86, 0, 0.001, 20};  // alike with b (within 25 x the best's per point)
+    s.phase.families[b] = {0.87, 0, 0.001, 18};
+    result.edges[e].sections.push_back(s);
+  }
+  const PhaseChoice choice = ChoosePhaseFamily(result);
+  EXPECT_EQ(choice.chosen, b);
+  EXPECT_TRUE(choice.alike[a]);
+  EXPECT_EQ(choice.limited, 2);
+  EXPECT_EQ(choice.flagged, 1);
+  const ModelFit& open = result.edges[0].sections[0].fit;
+  EXPECT_FALSE(open.ok);
+  EXPECT_EQ(open.flags, std::vector<std::string>{"phase_limited"});
+  EXPECT_NE(open.phase_why.find("0.80-0.87 px"), std::string::npos) << open.phase_why;
+  const ModelFit& agreed = result.edges[1].sections[0].fit;
+  EXPECT_TRUE(agreed.ok);
+  EXPECT_DOUBLE_EQ(agreed.r_px, 0.87);
+  EXPECT_EQ(SectionsLeftOut(result), (std::map<std::string, int>{{"phase_limited", 1}}));
+}
+
+// The scene: a level camera, the image filtered after sampling. The check finds the filter and every section
+// reads within max(0.05 px, 10 %) of synth's truth or is flagged; without it, the edges halfway between rows do not.
+TEST(PhaseCheck, FilteredSceneReadsTrueOrFlaggedWhereTheUncheckedReadingIsOff) {
+  synth::SceneOptions o;
+  o.focus_mm = 430;
+  o.floor_sigma_px = 0.2;
+  o.noise_std = 0.0025;
+  o.seed = 3;
+  o.post_filter = {synth::PostFilter::kGaussian, 0.45, 0};
+  const synth::Scene scene = synth::RenderScene(o);
+  auto off = [&](const CalibResult& r) {
+    int n = 0;
+    for (const auto& e : r.edges)
+      for (const auto& s : e.sections) {
+        const double truth = scene.sections[(e.index - 1) * 7 + (s.section - 1)].r_px;
+        n += s.fit.ok && std::abs(s.fit.r_px - truth) > std::max(0.05, 0.1 * truth);
+      }
+    return n;
+  };
+  const CalibResult checked = Calibrate(scene.image, scene.camera, scene.board);
+  EXPECT_EQ(PhaseFamilies()[checked.phase.chosen].sigma_px, 0.45);
+  EXPECT_EQ(off(checked), 0);
+  CalibrateOptions unchecked;
+  unchecked.phase_check = false;
+  EXPECT_GE(off(Calibrate(scene.image, scene.camera, scene.board, unchecked)), 5);
+}
+
+}  // namespace
+}  // namespace blurcue::calib
