@@ -99,7 +99,8 @@ void AddValidateCommand(CLI::App& app) {
                                       "two sides apart on this display (flags the invisible ones), and per "
                                       "depth-matching distance which levels it cannot tell from the real picture");
   cmd->add_option("--observer", args->observer, "with --plan: the observer model, as blurcue run --observer "
-                                                "(sim: the arcmin model's defaults)")
+                                                "(sim: the arcmin model's defaults); a protocol that observer cannot "
+                                                "answer is refused as run refuses it")
       ->capture_default_str()->needs(plan);  // an option nothing would read is refused
   cmd->add_option("--visible", args->visible, "with --plan: the predicted share correct (2AFC) below which a pair "
                                               "is flagged invisible")
