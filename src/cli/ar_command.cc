@@ -51,9 +51,8 @@ void SyncFile(const std::filesystem::path& path) {
 
 void AddArCommand(CLI::App& app) {
   struct Args {
-    std::string input, track, out, csv, objects, frames_dir, blur = "fitted", method = "disc";
-    std::string ball_texture = "soccer", card_texture = "wood";
-    std::vector<std::string> balls, cards;
+    std::string input, track, out, csv, frames_dir, blur = "fitted", method = "disc";
+    ObjectOptions objects;
     double exposure_ms = -1;
     bool quiet = false;
   };
@@ -82,14 +81,7 @@ void AddArCommand(CLI::App& app) {
       ->required();
   cmd->add_option("--out", args->out, "the AR video to write (.avi)")->required();
   cmd->add_option("--csv", args->csv, "what was drawn, per frame and object (default: OUT with .csv)");
-  cmd->add_option("--ball", args->balls, "a ball resting on the board: X,Y[,RADIUS] in board mm (radius 10)");
-  cmd->add_option("--card", args->cards,
-                  "a card standing on the board facing the camera: X,Y[,WIDTH[,HEIGHT]] in board mm (50 x 50)");
-  cmd->add_option("--objects", args->objects, "objects from a JSON file (docs/ar.md)")->check(CLI::ExistingFile);
-  cmd->add_option("--ball-texture", args->ball_texture, "texture of --ball balls: soccer, wood or an image")
-      ->capture_default_str();
-  cmd->add_option("--card-texture", args->card_texture, "texture of --card cards: a stimulus name or an image")
-      ->capture_default_str();
+  AddObjectOptions(cmd, &args->objects);
   cmd->add_option("--blur", args->blur,
                   "blur source at each object's centre: fitted (the take's lens model), measured, measured_section,\n"
                   "estimated, none, or a radius in px")
@@ -114,17 +106,15 @@ void AddArCommand(CLI::App& app) {
     const std::string csv_path =
         args->csv.empty() ? std::filesystem::path(args->out).replace_extension(".csv").string() : args->csv;
     // Nothing is read or drawn before every output is known to be writable and none is an input.
-    if (args->balls.size() + args->cards.size() > kMaxArObjects)
-      throw Error(ErrorKind::kUsage, std::to_string(args->balls.size() + args->cards.size()) +
+    if (args->objects.balls.size() + args->objects.cards.size() > kMaxArObjects)
+      throw Error(ErrorKind::kUsage, std::to_string(args->objects.balls.size() + args->objects.cards.size()) +
                                          " --ball and --card options: at most " + std::to_string(kMaxArObjects) +
                                          " objects a run");
     {
       OutputGuard guard;
       for (const std::filesystem::path& file : track::TakeInputFiles(args->input)) guard.Input("INPUT", file);
       guard.Input("--track", args->track);
-      if (!args->objects.empty()) guard.Input("--objects", args->objects);
-      if (!args->balls.empty()) guard.Input("--ball-texture", scene::ResolveStimulus(args->ball_texture));
-      if (!args->cards.empty()) guard.Input("--card-texture", scene::ResolveStimulus(args->card_texture));
+      GuardObjectInputs(guard, args->objects);
       guard.OutputFile("--out", args->out).OutputFile(args->csv.empty() ? "the CSV (OUT with .csv)" : "--csv", csv_path);
       if (!args->frames_dir.empty()) guard.OutputFolder("--frames", args->frames_dir);
       guard.Check();
@@ -145,8 +135,7 @@ void AddArCommand(CLI::App& app) {
     blur.method = args->method;
 
     std::vector<std::string> given;  // where each object was given, for messages: the option or the file's pointer
-    const std::vector<stimulus::PlacedObject> objects = PlaceObjects(
-        {args->balls, args->cards, args->objects, args->ball_texture, args->card_texture}, &given);
+    const std::vector<stimulus::PlacedObject> objects = PlaceObjects(args->objects, &given);
 
     const stimulus::TrackedTake take = stimulus::LoadTrackedTake(args->track);
     const Camera& camera = take.camera();

@@ -117,9 +117,7 @@ void GuardLiveOutputs(const LiveArgs& a) {
   guard.Input("--camera", a.camera);
   if (!a.track.empty()) guard.Input("--track", a.track);
   if (!a.calib.empty()) guard.Input("--calib", a.calib);
-  if (!a.objects.objects_file.empty()) guard.Input("--objects", a.objects.objects_file);
-  if (!a.objects.balls.empty()) guard.Input("--ball-texture", scene::ResolveStimulus(a.objects.ball_texture));
-  if (!a.objects.cards.empty()) guard.Input("--card-texture", scene::ResolveStimulus(a.objects.card_texture));
+  GuardObjectInputs(guard, a.objects);
   guard.OutputFolder("--log", a.log);
   guard.Check();
   try {
@@ -365,15 +363,7 @@ void AddLiveCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--log", a->log, "the folder the run's log is written to (live.csv, drawn.csv, summary.json)")
       ->required();
-  cmd->add_option("--ball", a->objects.balls, "a ball resting on the board: X,Y[,RADIUS] in board mm (radius 10)");
-  cmd->add_option("--card", a->objects.cards,
-                  "a card standing on the board facing the camera: X,Y[,WIDTH[,HEIGHT]] in board mm (50 x 50)");
-  cmd->add_option("--objects", a->objects.objects_file, "objects from a JSON file (docs/ar.md)")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--ball-texture", a->objects.ball_texture, "texture of --ball balls: soccer, wood or an image")
-      ->capture_default_str();
-  cmd->add_option("--card-texture", a->objects.card_texture, "texture of --card cards: a stimulus name or an image")
-      ->capture_default_str();
+  AddObjectOptions(cmd, &a->objects);
   cmd->add_option("--blur", a->blur,
                   "blur source at each object's centre: fitted (the lens model), estimated, none, or a radius in px\n"
                   "(measured sources need sections measured in every frame, which live does not do)")

@@ -80,4 +80,21 @@ std::vector<stimulus::PlacedObject> PlaceObjects(const ObjectOptions& options, s
   return objects;
 }
 
+void AddObjectOptions(CLI::App* cmd, ObjectOptions* o) {
+  cmd->add_option("--ball", o->balls, "a ball resting on the board: X,Y[,RADIUS] in board mm (radius 10)");
+  cmd->add_option("--card", o->cards,
+                  "a card standing on the board facing the camera: X,Y[,WIDTH[,HEIGHT]] in board mm (50 x 50)");
+  cmd->add_option("--objects", o->objects_file, "objects from a JSON file (docs/ar.md)")->check(CLI::ExistingFile);
+  cmd->add_option("--ball-texture", o->ball_texture, "texture of --ball balls: soccer, wood or an image")
+      ->capture_default_str();
+  cmd->add_option("--card-texture", o->card_texture, "texture of --card cards: a stimulus name or an image")
+      ->capture_default_str();
+}
+
+void GuardObjectInputs(OutputGuard& guard, const ObjectOptions& o) {
+  if (!o.objects_file.empty()) guard.Input("--objects", o.objects_file);
+  if (!o.balls.empty()) guard.Input("--ball-texture", scene::ResolveStimulus(o.ball_texture));
+  if (!o.cards.empty()) guard.Input("--card-texture", scene::ResolveStimulus(o.card_texture));
+}
+
 }  // namespace blurcue::cli

@@ -4,6 +4,9 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
+
+#include "core/output_guard.h"
 #include "stimulus/tracked_take.h"
 
 namespace blurcue::cli {
@@ -12,6 +15,11 @@ struct ObjectOptions {
   std::vector<std::string> balls, cards;
   std::string objects_file, ball_texture = "soccer", card_texture = "wood";
 };
+
+// --ball, --card, --objects, --ball-texture and --card-texture on `cmd`, into `options`.
+void AddObjectOptions(CLI::App* cmd, ObjectOptions* options);
+// The files the options read (the objects file, the textures of the objects given), as inputs no output may be.
+void GuardObjectInputs(OutputGuard& guard, const ObjectOptions& options);
 
 // The objects of the file first, then the balls, then the cards; `given[i]` says where object i was given, for
 // messages (the option, or the file and its JSON pointer). Error(kUsage) naming the option for a malformed value,
