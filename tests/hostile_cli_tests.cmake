@@ -103,6 +103,11 @@ hostile_test(cli_hostile_synth_scene_focus_nan 2 "--focus-mm: must be a distance
              synth-scene --out ${H}/scene --focus-mm nan)
 hostile_test(cli_hostile_synth_scene_noise_nan 2 "--noise: must be in [0, 1] linear units, got 'nan'"
              synth-scene --out ${H}/scene --noise nan)
+# A post filter's option without that filter would be ignored: refused.
+hostile_test(cli_hostile_synth_scene_post_sigma_without_filter 2 "--post-sigma-px: needs --post-filter gaussian or sharpen"
+             synth-scene --out ${H}/scene --post-sigma-px 0.5)
+hostile_test(cli_hostile_synth_scene_post_amount_gaussian 2 "--post-amount: is for --post-filter sharpen, not gaussian"
+             synth-scene --out ${H}/scene --post-filter gaussian --post-amount 0.3)
 hostile_test(cli_hostile_synth_scene_seed_negative 2 "--seed: must be a whole number from 0 to 18446744073709551615, got '-3'"
              synth-scene --out ${H}/scene --seed=-3)
 hostile_test(cli_hostile_synth_pictures_focus_inf 2 "--focus-m: must be in (0, 1000] m, got 'inf'"

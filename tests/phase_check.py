@@ -37,7 +37,8 @@ def main():
     p.add_argument("--max-flagged", type=int, default=0)
     p.add_argument("--no-phase-check", action="store_true")
     a = p.parse_args()
-    out = os.path.join(a.dir, "calib-%s%s.json" % (a.expect, "-unchecked" if a.no_phase_check else ""))
+    # Beside the scene's folder, not in it: synth-scene replaces its folder whole and refuses one holding other files.
+    out = os.path.normpath(a.dir) + "-calib-%s%s.json" % (a.expect, "-unchecked" if a.no_phase_check else "")
     cmd = [a.blurcue, "calibrate", os.path.join(a.dir, "scene.png"), "--camera", os.path.join(a.dir, "camera.json"),
            "--out", out]
     if a.no_phase_check:

@@ -133,9 +133,9 @@ void AddSynthSceneCommand(CLI::App& app) {
                   "(taps of a Gaussian of std --post-sigma-px at whole pixels) or sharpen (unsharp mask: 1 + amount\n"
                   "times the image less amount times that Gaussian); truth adds the taps' second moment")
       ->check(CLI::IsMember({"none", "gaussian", "sharpen"}))->capture_default_str();
-  cmd->add_option("--post-sigma-px", o.post_filter.sigma_px, "std of the post filter's Gaussian, px (0, 5]")
+  CLI::Option* post_sigma = cmd->add_option("--post-sigma-px", o.post_filter.sigma_px, "std of the post filter's Gaussian, px (0, 5]")
       ->check(FiniteRange(0, 5, "px"));
-  cmd->add_option("--post-amount", o.post_filter.amount, "sharpen: how much of the blurred copy is taken away (0, 5]")
+  CLI::Option* post_amount = cmd->add_option("--post-amount", o.post_filter.amount, "sharpen: how much of the blurred copy is taken away (0, 5]")
       ->check(FiniteRange(0, 5, ""));
   cmd->add_option("--vignetting", o.vignetting, "light fall-off at the image corner, 0..0.9 (0.35: corners at 65 %)")
       ->capture_default_str()->check(FiniteRange(0, 0.9, ""));
@@ -159,7 +159,7 @@ void AddSynthSceneCommand(CLI::App& app) {
       ->transform(IntRange(1, 16));
   cmd->add_flag("--quiet", args->quiet, "print only errors");
 
-  cmd->callback([args] {
+  cmd->callback([args, post_sigma, post_amount] {
     const auto t0 = std::chrono::steady_clock::now();
     {
       OutputGuard guard;
@@ -179,6 +179,12 @@ void AddSynthSceneCommand(CLI::App& app) {
     o.fixed_r_px = args->fixed_r_px;
     o.psf = args->psf == "gaussian" ? synth::Psf::kGaussian : synth::Psf::kDisc;
     o.post_filter.kind = synth::ParsePostFilter(args->post_filter);
+    // A filter's option without that filter would be ignored: refused, naming what it needs.
+    if (o.post_filter.kind == synth::PostFilter::kNone && (post_sigma->count() > 0 || post_amount->count() > 0))
+      throw UsageError(post_sigma->count() > 0 ? "--post-sigma-px" : "--post-amount",
+                       "needs --post-filter gaussian or sharpen (the filter is none)");
+    if (o.post_filter.kind == synth::PostFilter::kGaussian && post_amount->count() > 0)
+      throw UsageError("--post-amount", "is for --post-filter sharpen, not gaussian");
     if (!args->focus.empty()) o.focus_mm = ParseFocus(args->focus);
     o.board = Board::Parse(args->board, args->square_mm);
     if (!(args->square_mm > 0)) throw UsageError("--square-mm", "must be > 0, got " + std::to_string(args->square_mm));
