@@ -37,6 +37,10 @@ struct CalibrateOptions {
   // (phase_check.h; with fit_model only: the sections at other phases choose the family through the lens fit). false:
   // the blur fit's readings as they are, none flagged (to compare).
   bool phase_check = true;
+  // Measure only these sections (flat index (edge - 1) * SectionCount() + section - 1; the others are left unmeasured,
+  // not usable): a live view's rotating subset. Empty: every section. Only without fit_model (a subset rarely pins a
+  // lens), and the reference edge may then have no usable section (its reference is left 0, not refused).
+  std::vector<int> only_sections;
 };
 
 struct SectionResult {

@@ -2,6 +2,7 @@
 #include <iostream>
 #include <string>
 
+#include "bench/live_bench.h"
 #include "bench/measure_bench.h"
 #include "bench/plan_bench.h"
 #include "bench/procedure_bench.h"
@@ -259,6 +260,46 @@ void AddTrack(CLI::App& bench) {
   });
 }
 
+void AddLive(CLI::App& bench) {
+  struct Args {
+    std::string out = "results/bench/live.csv";
+    bool quick = false;
+    bench::LiveBenchOptions options;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = bench.add_subcommand(
+      "live",
+      "Speed against accuracy of `blurcue live --measure-sections N`: latency and dropped frames against the board\n"
+      "sections measured a frame, and the blur accuracy that buys.\n"
+      "Renders a ground-truth take (synth-take's defaults: 1148 x 764, fixed focus at 450 mm, 0.35 px lens floor,\n"
+      "noise 0.004) and a lens model calibrated at a focus of 400 mm (the focus ring turned since: a stale model),\n"
+      "then runs `blurcue live` on the take's video, headless, at --fps, once for each N, with a ball at 87.5,125:\n"
+      "N sections measured a frame in turn and the lens fitted again to their latest readings (N = 0: the stale\n"
+      "model throughout). Each row, from the run's own log: frames shown and dropped, latency (median, p95), the\n"
+      "time measuring took, and the ball's drawn r against the true lens's (median over the frames drawn, and over\n"
+      "their last third). Prints the ratios measured in the run. analysis/live_chart.py charts it.\n"
+      "--quick: 12 frames, N = 0, 4, 77 (a smoke run).");
+  cmd->add_option("--out", args->out, "CSV, one row per N")->capture_default_str();
+  cmd->add_option("--frames", args->options.frames, "frames in the take")->capture_default_str()
+      ->transform(IntRange(4, 1000));
+  cmd->add_option("--fps", args->options.fps, "the pace the take is played at")->capture_default_str()
+      ->check(FiniteRange(1, 240, "frames per second"));
+  cmd->add_option("--sections", args->options.sections, "the values of N (sections measured a frame)")
+      ->capture_default_str()->check(IntRange(0, 10000))->delimiter(',');
+  cmd->add_option("--seed", args->options.seed, "seed of the take's texture and noise")->capture_default_str()
+      ->transform(SeedValidator());
+  cmd->add_flag("--quick", args->quick, "12 frames, N = 0, 4, 77 (smoke run)");
+  cmd->callback([args] {
+    OutputGuard().OutputFile("--out", args->out).Check();
+    bench::LiveBenchOptions options = args->options;
+    options.quick = args->quick;
+    options.progress = ProgressLine;
+    const auto rows = bench::RunLiveBench(options);
+    bench::WriteLiveBenchCsv(rows, args->out, args->quick);
+    std::printf("wrote %s (%zu rows)\n%s", args->out.c_str(), rows.size(), bench::SummarizeLiveBench(rows).c_str());
+  });
+}
+
 }  // namespace
 
 void AddBenchCommand(CLI::App& app) {
@@ -270,6 +311,7 @@ void AddBenchCommand(CLI::App& app) {
   AddProcedures(*bench);
   AddPlan(*bench);
   AddTrack(*bench);
+  AddLive(*bench);
 }
 
 }  // namespace blurcue::cli

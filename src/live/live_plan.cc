@@ -1,5 +1,6 @@
 #include "live/live_plan.h"
 
+#include <set>
 #include <utility>
 
 #include "core/error.h"
@@ -44,8 +45,42 @@ calib::SceneCalib LensFromTrack(const std::filesystem::path& track_dir, const Ca
 void RequireLiveSource(BlurSource source, const std::string& option) {
   if (source == BlurSource::kMeasured || source == BlurSource::kMeasuredSection)
     throw Error(ErrorKind::kUsage, option + " " + ToString(source) +
-                                       ": needs each frame's board sections measured, and live measures the pose "
-                                       "only; give fitted (the lens model), estimated, none or a radius in px");
+                                       ": needs each frame's board sections measured, and live measures a few a "
+                                       "frame at most (--measure-sections, which feed its lens model); give fitted "
+                                       "(the lens model), estimated, none or a radius in px");
+}
+
+bool LiveLens::Update(const calib::CalibResult& frame) {
+  bool changed = false;
+  for (const calib::EdgeResult& edge : frame.edges)
+    for (const calib::SectionResult& s : edge.sections) {
+      const std::pair<int, int> key(s.edge, s.section);
+      if (s.fit.ok) {
+        latest_[key] = {s.u_mm, s.fit.r_px / s.stretch, 1.0};  // ideal px, as calib::ModelSamples gives them
+        changed = true;
+      } else if (!s.fit.flags.empty()) {
+        changed |= latest_.erase(key) > 0;  // measured and flagged: its earlier reading no longer stands
+      }
+    }
+  if (!changed) return false;
+  std::vector<optics::BlurSample> samples;
+  samples.reserve(latest_.size());
+  std::set<int> edges;
+  for (const auto& [key, sample] : latest_) samples.push_back(sample), edges.insert(key.first);
+  // As calibrate asks of a photo: sections on 3 edges at least (3 depths a square apart), else no model yet.
+  if (edges.size() < 3) return false;
+  try {
+    model_ = optics::FitThinLens(optics::Lens::FromCamera(camera_), samples);
+  } catch (const Error& e) {
+    if (e.kind() != ErrorKind::kNotFound) throw;  // too few readings yet, or all at one depth
+    return false;
+  }
+  return true;
+}
+
+void LivePlanner::SetModel(const optics::FittedModel& model) {
+  for (stimulus::TrackedFrame& f : window_.frames)
+    if (f.calib) f.calib->model = model;
 }
 
 LivePlanner::LivePlanner(calib::SceneCalib lens, std::vector<stimulus::PlacedObject> objects, stimulus::TakeBlur blur)

@@ -4,10 +4,12 @@
 // (stimulus::PlanTrackedFrame: the same defocus and floor at each object's depth), streaked by their image motion
 // since the last frame with a pose - the causal form of ar's streak, which looks at the next frame too.
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "calib/calibrate.h"
 #include "calib/scene_blur.h"
 #include "stimulus/tracked_take.h"
 #include "track/tracker.h"
@@ -24,6 +26,26 @@ calib::SceneCalib LensFromTrack(const std::filesystem::path& track_dir, const Ca
 // a fixed radius). Error(kUsage) naming `option` for measured and measured_section.
 void RequireLiveSource(BlurSource source, const std::string& option);
 
+// The lens model a live view fits as it goes (--measure-sections): the latest reading of every board section
+// measured so far - each a depth and a blur, true whatever the pose was, since the focus is fixed - and the thin lens
+// fitted to them (optics::FitThinLens, as `track` fits a take's one model to every frame's sections).
+class LiveLens {
+ public:
+  explicit LiveLens(Camera camera) : camera_(std::move(camera)) {}
+  // Keeps the usable sections of `frame` (a subset measured: calib::CalibrateOptions::only_sections) as their
+  // sections' latest readings, a section measured unusable forgetting its earlier one; then fits the model to all
+  // of them. True when a model was fitted (readings on 3 edges at least, as calibrate asks); false keeps the model
+  // fitted before.
+  bool Update(const calib::CalibResult& frame);
+  const std::optional<optics::FittedModel>& model() const { return model_; }
+  int sections() const { return model_ ? model_->samples_used : 0; }  // the model's readings
+
+ private:
+  Camera camera_;
+  std::map<std::pair<int, int>, optics::BlurSample> latest_;  // by (edge, section)
+  std::optional<optics::FittedModel> model_;
+};
+
 class LivePlanner {
  public:
   LivePlanner(calib::SceneCalib lens, std::vector<stimulus::PlacedObject> objects, stimulus::TakeBlur blur);
@@ -32,6 +54,8 @@ class LivePlanner {
   stimulus::TrackedFramePlan Plan(int index, double time_s, track::FrameStatus status,
                                   const std::optional<calib::BoardPose>& pose);
   const calib::SceneCalib& lens() const { return *window_.frames[1].calib; }
+  // Draws the next frames with `model` (a LiveLens's) in place of the lens model it was made with.
+  void SetModel(const optics::FittedModel& model);
   const std::vector<stimulus::PlacedObject>& objects() const { return objects_; }
 
  private:

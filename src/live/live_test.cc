@@ -1,5 +1,6 @@
 // The live view's GL-free parts: the one-slot mailbox drops and never queues, the planner draws what ar plans for the
 // same frame (the causal streak), the log's summary against hand-worked numbers, INPUT's camera names.
+#include <algorithm>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include "live/live_plan.h"
 #include "live/mailbox.h"
 #include "live/paced_source.h"
+#include "optics/thin_lens.h"
 
 namespace blurcue::live {
 namespace {
@@ -127,6 +129,48 @@ TEST(LivePlanner, DrawsWhatArPlansForTheLastFrameOfTheTakeSoFar) {
   }
 }
 
+// A frame's calibration in which only the sections of `edges` were measured, at depths 400 + 20 (edge - 1) + 2 section
+// mm, their blur the thin lens's with focus 450 mm and aperture 5 mm; `flagged` (edge, section) measured unusable.
+calib::CalibResult MeasuredEdges(const std::vector<int>& edges, std::pair<int, int> flagged = {0, 0}) {
+  calib::CalibResult c;
+  c.camera = FaceOnLens().camera;
+  optics::Lens lens = optics::Lens::FromCamera(c.camera);
+  lens.aperture_mm = 5;
+  for (int e = 1; e <= 11; ++e) {
+    calib::EdgeResult edge;
+    edge.index = e;
+    for (int k = 1; k <= 7; ++k) {
+      calib::SectionResult sec;
+      sec.edge = e, sec.section = k;
+      sec.u_mm = 400 + 20 * (e - 1) + 2 * k;
+      const bool measured = std::find(edges.begin(), edges.end(), e) != edges.end();
+      sec.fit.ok = measured;
+      if (measured) sec.fit.r_px = optics::BlurRadiusPx(lens, 450, sec.u_mm);
+      if (flagged == std::pair(e, k)) sec.fit.ok = false, sec.fit.flags = {"poor_fit"};
+      edge.sections.push_back(sec);
+    }
+    c.edges.push_back(edge);
+  }
+  return c;
+}
+
+TEST(LiveLens, FitsTheLensToTheLatestReadingOfEverySectionMeasuredSoFar) {
+  LiveLens lens(FaceOnLens().camera);
+  EXPECT_FALSE(lens.Update(MeasuredEdges({})));   // nothing measured: no model
+  EXPECT_FALSE(lens.model().has_value());
+  EXPECT_FALSE(lens.Update(MeasuredEdges({1, 6})));  // two edges: too few depths for a model
+  EXPECT_FALSE(lens.model().has_value());
+  ASSERT_TRUE(lens.Update(MeasuredEdges({11})));  // three frames' subsets make one model: 21 readings
+  EXPECT_EQ(lens.sections(), 21);
+  EXPECT_NEAR(lens.model()->focus_mm, 450, 0.5);
+  EXPECT_NEAR(lens.model()->aperture_mm, 5, 0.01);
+  // A section measured again and flagged forgets its earlier reading; one not measured keeps it.
+  ASSERT_TRUE(lens.Update(MeasuredEdges({}, {6, 3})));
+  EXPECT_EQ(lens.sections(), 20);
+  EXPECT_FALSE(lens.Update(MeasuredEdges({})));
+  EXPECT_EQ(lens.sections(), 20);
+}
+
 TEST(LivePlanner, MeasuredBlurNeedsSectionsLiveDoesNotMeasure) {
   EXPECT_THROW(RequireLiveSource(BlurSource::kMeasured, "--blur"), Error);
   EXPECT_NO_THROW(RequireLiveSource(BlurSource::kFitted, "--blur"));
@@ -158,10 +202,10 @@ TEST(LiveLog, ALostFrameHasAnEmptyPose) {
   r.frame = 4;
   std::string csv;
   AppendLiveCsvRow(r, &csv);
-  EXPECT_EQ(csv, "4,0.000000,lost,,,,,,,0.000,0.000,0.000000,0.000,0\n");
+  EXPECT_EQ(csv, "4,0.000000,lost,,,,,,,0.000,0.000,0.000000,0.000,0,0,0.000,0\n");
   EXPECT_EQ(LiveCsvHeader(),
             "frame,arrival_s,status,rvec_x,rvec_y,rvec_z,tvec_x_mm,tvec_y_mm,tvec_z_mm,track_ms,render_ms,display_s,"
-            "latency_ms,dropped\n");
+            "latency_ms,dropped,sections,measure_ms,lens_sections\n");
 }
 
 }  // namespace
