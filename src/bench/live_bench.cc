@@ -193,10 +193,10 @@ std::string SummarizeLiveBench(const std::vector<LiveBenchRow>& rows) {
                   100 * r.r_late_median_rel_error, 100 * r.r_late_max_rel_error, r.settle_frames, r.load1);
     out << line;
   }
-  out << "(latency: median ms from arrival to display; meas_ms: median ms a frame measuring sections and fitting the "
-         "lens; lens: the readings the last frame's model was fitted to, 0: the given one; r_err: the ball's drawn r "
-         "against the true lens's, median over the frames drawn; late: over their last third; settle: frames drawn "
-         "before every later one is within 2 %)\n";
+  out << "(latency: median ms from arrival to display; meas_ms: median ms a frame measuring sections (the lens is "
+         "fitted on a thread of its own); lens: the readings the last frame's model was fitted to, 0: the given one; "
+         "r_err: the ball's drawn r against the true lens's, median over the frames drawn; late: over their last "
+         "third; settle: frames drawn before every later one is within 2 %)\n";
   // Ratios in this run: what the sections cost against the pose-only run, per section measured.
   const auto base =
       std::find_if(rows.begin(), rows.end(), [](const LiveBenchRow& r) { return r.sections_per_frame == 0; });

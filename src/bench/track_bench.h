@@ -9,7 +9,9 @@
 namespace blurcue::bench {
 
 struct TrackRow {
-  // "track" (carried pose), "track-serial" (the same, its sections measured one after another on one core),
+  // "track" (carried pose, the next frame decoded meanwhile as track::TrackTake does), "track-inline" (the same,
+  // each frame decoded before it is processed), "track-serial" (decoded in line, its sections measured one after
+  // another on one core),
   // "detect" (full detection every frame), "calibrate" (calib::Calibrate in this process),
   // "calibrate-process" (`blurcue calibrate` run as a command on the frame's PNG: start-up, decode, calib.json
   // written; wall and the child's CPU time; its accuracy is the in-process calibrate's when it wrote the same

@@ -234,13 +234,14 @@ void AddTrack(CLI::App& bench) {
       "Speed against accuracy of `blurcue track`: carried pose vs full detection vs calibrate, frame by frame.\n"
       "Renders a ground-truth moving-camera take (synth-take's defaults: 1148 x 764, fixed focus inside the board,\n"
       "0.35 px lens floor, noise 0.004), PNG-encodes each frame, then in one process runs on every frame: tracking\n"
-      "(track; track-serial: its sections measured on one core), full detection on every frame (detect) and\n"
-      "calib::Calibrate as `calibrate` does (calibrate); then\n"
+      "(track, the next frame decoded meanwhile as `blurcue track` does; track-inline: each frame decoded before it\n"
+      "is tracked; track-serial: decoded in line, its sections measured on one core), full detection on every frame\n"
+      "(detect) and calib::Calibrate as `calibrate` does (calibrate); then\n"
       "runs `blurcue calibrate` as a command on each frame's PNG, one process a frame (calibrate-process: wall and\n"
       "the child's CPU time, start-up and calib.json included). Each row: the frame's time (decoding timed apart\n"
-      "in process), its pose and measurement parts, depth and blur errors against the truth. Prints the ratios\n"
-      "measured in the run. Targets: track's median <= 33 ms a frame and >= 6x faster than calibrate run on each\n"
-      "frame.\n"
+      "in process; period_ms: decoding included), its pose and measurement parts, depth and blur errors against the\n"
+      "truth. Prints the ratios measured in the run. Targets: track's median <= 33 ms a frame, decoding included, and\n"
+      ">= 6x faster than calibrate run on each frame.\n"
       "analysis/track_chart.py charts time per frame against accuracy. --quick: the first 4 frames of the take.");
   cmd->add_option("--out", args->out, "CSV, one row per (mode, frame)")->capture_default_str();
   cmd->add_option("--frames", args->frames, "frames in the take")->capture_default_str()->transform(IntRange(2, 1000));

@@ -205,7 +205,13 @@ void ShowFrame(LiveSetup& s, const LiveArgs& a, live::LiveFrame& frame, live::Cl
                std::optional<calib::BoardPose>& last_pose) {
   const live::Clock::time_point t0 = live::Clock::now();
   const track::FrameResult result = s.tracker->Process(frame.image, frame.index, frame.time_s);
-  if (result.calib && s.live_lens && s.live_lens->Update(*result.calib)) s.planner->SetModel(*s.live_lens->model());
+  if (s.live_lens) {
+    // The model a fit finished since the frame before, then this frame's readings (a fit of them started meanwhile
+    // on a thread of its own: the next frames draw with it once it is done).
+    optics::FittedModel model;
+    if (s.live_lens->TakeModel(&model)) s.planner->SetModel(model);
+    if (result.calib) s.live_lens->Update(*result.calib);
+  }
   const live::Clock::time_point t1 = live::Clock::now();
   const stimulus::TrackedFramePlan plan = s.planner->Plan(frame.index, frame.time_s, result.status, result.pose);
   if (result.pose) last_pose = result.pose;

@@ -28,7 +28,8 @@ const std::vector<LiveColumn> kLiveColumns = {
                 "while a frame was processed)"},
     {"sections", "board sections whose blur this frame measured (--measure-sections N: a rotating subset of N; 0: none, "
                  "lost, or no --measure-sections)"},
-    {"measure_ms", "measuring them and fitting the lens model to every section's latest reading again, ms"},
+    {"measure_ms", "measuring them, ms (the lens model is fitted to every section's latest reading on a thread of its "
+                   "own, meanwhile)"},
     {"lens_sections", "sections the lens model this frame was drawn with was fitted to live (their latest readings); "
                       "0: the model of --track or --calib"},
 };

@@ -24,7 +24,7 @@ struct LiveRow {
   double latency_ms = 0;          // display_s - arrival_s
   int dropped = 0;                // frames dropped since the frame shown before (replaced in the mailbox unseen)
   int sections = 0;               // board sections whose blur this frame measured (--measure-sections; 0: none)
-  double measure_ms = 0;          // measuring them and fitting the lens model again
+  double measure_ms = 0;          // measuring them (the lens is fitted on a thread of its own)
   int lens_sections = 0;          // sections the lens model drawn with was fitted to live (0: the given model)
 };
 

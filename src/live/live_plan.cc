@@ -1,5 +1,6 @@
 #include "live/live_plan.h"
 
+#include <chrono>
 #include <set>
 #include <utility>
 
@@ -51,31 +52,45 @@ void RequireLiveSource(BlurSource source, const std::string& option) {
 }
 
 bool LiveLens::Update(const calib::CalibResult& frame) {
-  bool changed = false;
   for (const calib::EdgeResult& edge : frame.edges)
     for (const calib::SectionResult& s : edge.sections) {
       const std::pair<int, int> key(s.edge, s.section);
       if (s.fit.ok) {
         latest_[key] = {s.u_mm, s.fit.r_px / s.stretch, 1.0};  // ideal px, as calib::ModelSamples gives them
-        changed = true;
+        changed_ = true;
       } else if (!s.fit.flags.empty()) {
-        changed |= latest_.erase(key) > 0;  // measured and flagged: its earlier reading no longer stands
+        changed_ |= latest_.erase(key) > 0;  // measured and flagged: its earlier reading no longer stands
       }
     }
-  if (!changed) return false;
+  if (!changed_ || fit_.valid()) return false;
   std::vector<optics::BlurSample> samples;
   samples.reserve(latest_.size());
   std::set<int> edges;
   for (const auto& [key, sample] : latest_) samples.push_back(sample), edges.insert(key.first);
-  // As calibrate asks of a photo: sections on 3 edges at least (3 depths a square apart), else no model yet.
   if (edges.size() < 3) return false;
-  try {
-    model_ = optics::FitThinLens(optics::Lens::FromCamera(camera_), samples);
-  } catch (const Error& e) {
-    if (e.kind() != ErrorKind::kNotFound) throw;  // too few readings yet, or all at one depth
-    return false;
-  }
+  changed_ = false;
+  fit_ = std::async(std::launch::async, [lens = optics::Lens::FromCamera(camera_), samples = std::move(samples)] {
+    try {
+      return std::optional(optics::FitThinLens(lens, samples));
+    } catch (const Error& e) {
+      if (e.kind() != ErrorKind::kNotFound) throw;  // all at one depth: no model from these readings
+      return std::optional<optics::FittedModel>();
+    }
+  });
   return true;
+}
+
+bool LiveLens::TakeModel(optics::FittedModel* model) {
+  if (!fit_.valid() || fit_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
+  const std::optional<optics::FittedModel> fitted = fit_.get();  // a fit's unexpected error surfaces here
+  if (!fitted) return false;
+  *model = *fitted;
+  sections_ = fitted->samples_used;
+  return true;
+}
+
+void LiveLens::Wait() {
+  if (fit_.valid()) fit_.wait();
 }
 
 void LivePlanner::SetModel(const optics::FittedModel& model) {

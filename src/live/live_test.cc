@@ -156,19 +156,39 @@ calib::CalibResult MeasuredEdges(const std::vector<int>& edges, std::pair<int, i
 
 TEST(LiveLens, FitsTheLensToTheLatestReadingOfEverySectionMeasuredSoFar) {
   LiveLens lens(FaceOnLens().camera);
-  EXPECT_FALSE(lens.Update(MeasuredEdges({})));   // nothing measured: no model
-  EXPECT_FALSE(lens.model().has_value());
+  optics::FittedModel model;
+  EXPECT_FALSE(lens.Update(MeasuredEdges({})));  // nothing measured: no fit
   EXPECT_FALSE(lens.Update(MeasuredEdges({1, 6})));  // two edges: too few depths for a model
-  EXPECT_FALSE(lens.model().has_value());
+  lens.Wait();
+  EXPECT_FALSE(lens.TakeModel(&model));
   ASSERT_TRUE(lens.Update(MeasuredEdges({11})));  // three frames' subsets make one model: 21 readings
+  lens.Wait();
+  ASSERT_TRUE(lens.TakeModel(&model));
   EXPECT_EQ(lens.sections(), 21);
-  EXPECT_NEAR(lens.model()->focus_mm, 450, 0.5);
-  EXPECT_NEAR(lens.model()->aperture_mm, 5, 0.01);
+  EXPECT_NEAR(model.focus_mm, 450, 0.5);
+  EXPECT_NEAR(model.aperture_mm, 5, 0.01);
+  EXPECT_FALSE(lens.TakeModel(&model));  // taken once
   // A section measured again and flagged forgets its earlier reading; one not measured keeps it.
   ASSERT_TRUE(lens.Update(MeasuredEdges({}, {6, 3})));
+  lens.Wait();
+  ASSERT_TRUE(lens.TakeModel(&model));
   EXPECT_EQ(lens.sections(), 20);
-  EXPECT_FALSE(lens.Update(MeasuredEdges({})));
+  EXPECT_FALSE(lens.Update(MeasuredEdges({})));  // nothing new: no fit
   EXPECT_EQ(lens.sections(), 20);
+}
+
+TEST(LiveLens, NoFitStartsWhileTheLastOneIsNotTaken) {
+  LiveLens lens(FaceOnLens().camera);
+  ASSERT_TRUE(lens.Update(MeasuredEdges({1, 6, 11})));
+  EXPECT_FALSE(lens.Update(MeasuredEdges({2})));  // its readings wait for the next fit
+  lens.Wait();
+  optics::FittedModel model;
+  ASSERT_TRUE(lens.TakeModel(&model));
+  EXPECT_EQ(lens.sections(), 21);
+  ASSERT_TRUE(lens.Update(MeasuredEdges({})));  // edge 2's readings, kept, start the next fit
+  lens.Wait();
+  ASSERT_TRUE(lens.TakeModel(&model));
+  EXPECT_EQ(lens.sections(), 28);
 }
 
 TEST(LivePlanner, MeasuredBlurNeedsSectionsLiveDoesNotMeasure) {
