@@ -51,7 +51,7 @@ def chart(df, out_dir):
                     xytext=(3, 3), textcoords="offset points")
     ax.set_xlabel("median latency, ms")
     ax.set_ylabel("ball's median |r error| / r, %")
-    ax.set_yscale("symlog", linthresh=1)
+    ax.set_yscale("log")
     ax.legend(fontsize=8)
     quick = " (quick run)" if "quick" in df and df["quick"].astype(bool).any() else ""
     fig.suptitle(f"blurcue bench live: sections measured a frame against latency and blur accuracy{quick} "
