@@ -1,9 +1,12 @@
 // The live view's GL-free parts: the one-slot mailbox drops and never queues, the planner draws what ar plans for the
 // same frame (the causal streak), the log's summary against hand-worked numbers, INPUT's camera names.
 #include <algorithm>
+#include <filesystem>
 #include <thread>
 
 #include <gtest/gtest.h>
+#include <unistd.h>
+
 
 #include "core/error.h"
 #include "live/live_log.h"
@@ -77,6 +80,37 @@ TEST(PacedSource, AMissingCameraIsAnInputErrorNamingTheDevice) {
     EXPECT_EQ(e.kind(), ErrorKind::kInput);
     EXPECT_NE(std::string(e.what()).find("/dev/video97: no camera there"), std::string::npos) << e.what();
   }
+}
+
+TEST(PacedSource, ACameraThatStopsDeliveringClosesTheMailboxWithOneLineNamingItAndTheFramesRead) {
+  // The camera is a 5-frame video read through the reader a camera is read through: its end is a read that fails,
+  // as a camera unplugged mid-run.
+  const std::filesystem::path video =
+      std::filesystem::temp_directory_path() / ("blurcue-live-camera-" + std::to_string(getpid()) + ".avi");
+  {
+    media::VideoWriter writer;
+    ASSERT_TRUE(writer.Open(video.string(), media::Fourcc('M', 'J', 'P', 'G'), 30, cv::Size(64, 48)));
+    for (int i = 0; i < 5; ++i) writer.Write(cv::Mat(48, 64, CV_8UC3, cv::Scalar::all(40 * i)));
+  }
+  auto reader = std::make_unique<media::VideoReader>();
+  ASSERT_TRUE(reader->Open(video.string()));
+  PacedSource source("/dev/video42", std::move(reader), 0);
+  EXPECT_TRUE(source.is_camera());
+  FrameMailbox box;
+  source.Start(&box, Clock::now());
+  LiveFrame got;
+  int taken = 0;
+  FrameMailbox::Got status;
+  while ((status = box.Take(got, std::chrono::milliseconds(5000))) == FrameMailbox::Got::kFrame) ++taken;
+  source.Stop();
+  std::filesystem::remove(video);
+  ASSERT_EQ(status, FrameMailbox::Got::kClosed);
+  EXPECT_EQ(taken + box.dropped(), 5);  // every frame delivered: taken, or replaced unseen
+  EXPECT_TRUE(box.failed());
+  EXPECT_EQ(box.why_closed(), "/dev/video42: the camera stopped delivering frames after 5 frames");
+  ASSERT_TRUE(source.error().has_value());
+  EXPECT_EQ(source.error()->kind(), ErrorKind::kInput);
+  EXPECT_EQ(std::string(source.error()->what()).find('\n'), std::string::npos);  // one line
 }
 
 // A board face-on at 500 mm moving -10 mm in x a frame, 30 frames a second (stimulus/tracked_take_test.cc's take).
