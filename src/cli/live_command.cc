@@ -233,7 +233,7 @@ void ShowFrame(LiveSetup& s, const LiveArgs& a, live::LiveFrame& frame, live::Cl
   row.status = result.status;
   if (result.pose) row.rvec = result.pose->rvec, row.tvec = result.pose->tvec;
   row.track_ms = result.pose_ms;
-  row.measure_ms = MsBetween(t0, t1) - result.pose_ms;  // the sections and the model's fit
+  row.measure_ms = MsBetween(t0, t1) - result.pose_ms;  // the sections (the model's fit runs on its own thread)
   row.sections = result.calib ? result.sections_measured : 0;
   row.lens_sections = s.live_lens ? s.live_lens->sections() : 0;
   row.render_ms = MsBetween(t1, t2);
@@ -409,7 +409,8 @@ void AddLiveCommand(CLI::App& app) {
   cmd->add_option("--measure-sections", a->measure_sections,
                   "measure the blur of N board sections a frame, a rotating subset (all of them once in every\n"
                   "sections / N frames), and draw with the thin lens fitted to every section's latest reading once\n"
-                  "they lie on 3 edges (the given model until then); live.csv says how many each frame measured.\n"
+                  "they lie on 3 edges (the given model until then; fitted on a thread of its own, a frame draws with\n"
+                  "the newest fit finished); live.csv says how many each frame measured.\n"
                   "0: none, the given model throughout; at least the board's sections: all of them every frame")
       ->capture_default_str()->check(IntRange(0, 10000));
   cmd->add_flag("--quiet", a->quiet, "print only errors");
