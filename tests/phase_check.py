@@ -1,11 +1,12 @@
 #!/usr/bin/python3
-"""blurcue calibrate on level-geometry scenes against synth-scene's truth, section by section (issue 42, item 1).
+"""blurcue calibrate on synth-scene scenes against their truth, section by section (issue 42: tests/phase_tests.cmake,
+level scenes; tests/turned_tests.cmake, turned boards and large blur).
 
   phase_check.py BLURCUE DIR --expect filtered|physical [--max-flagged N] [--max-bias F] [--min-measured F]
                  [--no-phase-check]
 
 DIR holds scene.png, camera.json and truth.json from `blurcue synth-scene` (level camera: every board edge runs along
-the pixel rows). The truth is synth's: each section's r_px from the kernels it applied, the post-sampling filter's
+the pixel rows; with --yaw-deg, across them). The truth is synth's: each section's r_px from the kernels it applied, the post-sampling filter's
 taps' second moment included (truth.json post_filter.variance_px2), computed without the measurement code.
 
 Prints every section (reading / truth, '*' flagged phase_limited, '!' a reading off the target unflagged) and the
