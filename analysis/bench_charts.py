@@ -6,9 +6,11 @@
   speed vs accuracy, rendering     time per whole-frame blur (log) against max error in 8-bit levels against the exact
                                    convolution, per frame size; Pareto front per size and radius
   two-ball frame                   region-by-region vs the thesis's whole-frame blur, median and p99 per frame
-  stability                        share of sections within target, and mean |error|, against each swept factor
-                                   (noise, contrast, JPEG, flaws, blur size, tilt, vignetting); the target line of
-                                   docs/benchmarks.md and the level where each method first fails
+  stability                        share of sections within target, mean |error|, and share of sections flagged
+                                   (not answered; phase_limited dotted) against each swept factor (noise, contrast,
+                                   JPEG, flaws, blur size, tilt, vignetting, distortion, a filter on the sampled image,
+                                   the edge angle, the sub-pixel phase); the target line of docs/benchmarks.md and the
+                                   level where each method first fails
   error against r, per PSF         median (and p90) |error| / true r against the true r for each PSF family (disc,
                                    Gaussian, disc x floor at floor/defocus ratios, near focus with a 0.35 px floor),
                                    one panel per method; the issue's 2 % / 5 % lines and where each family breaks
@@ -44,7 +46,11 @@ METHOD_COLORS = {"model_fit": "#0072B2", "thesis": "#D55E00", "eq37": "#E69F00",
 FACTOR_LABELS = {"noise": "sensor noise std (fraction of full scale)", "contrast": "Michelson contrast",
                  "jpeg": "JPEG quality", "flaws": "printing flaws (dark spots)", "blur": "true blur radius r (px)",
                  "tilt": "camera tilt (deg)", "vignetting": "vignetting (fall-off at the corner)",
-                 "distortion": "lens distortion k1 in camera.json (barrel < 0)"}
+                 "distortion": "lens distortion k1 in camera.json (barrel < 0)",
+                 "post_gaussian": "Gaussian on the sampled image, std (px)",
+                 "post_sharpen": "unsharp mask on the sampled image (std 0.6 px), amount",
+                 "edge_angle": "edges' angle to the pixel rows (deg; board turned)",
+                 "phase": "edge's distance from a pixel centre (px; level board, 0.45 px filter)"}
 RENDER_COLORS = {("gaussian", "gl"): "#0072B2", ("gaussian", "cpu"): "#56B4E9", ("disc", "gl"): "#D55E00",
                  ("disc", "cpu"): "#E69F00"}
 RADIUS_MARKERS = {1: "o", 4: "s", 8: "^", 16: "D"}
@@ -337,8 +343,10 @@ def stability(measure, out_dir):
             return against_r
         raise Skip("bench measure: no swept factors in measure.csv (only the base scene)")
     table = breakpoints(measure)
+    measure = measure.assign(flagged=1 - measure["answered"] / measure["sections"].clip(lower=1))
     for what, column, ylabel in (("within-target", "within_target", "share of sections within target"),
-                                 ("error", "mean_abs_error_px", "mean |error| (px, log)")):
+                                 ("error", "mean_abs_error_px", "mean |error| (px, log)"),
+                                 ("flagged", "flagged", "share of sections not answered")):
         ncols = 3
         nrows = int(np.ceil(len(sweeps) / ncols))
         fig, axes = plt.subplots(nrows, ncols, figsize=(12, 3.4 * nrows), squeeze=False)
@@ -363,6 +371,13 @@ def stability(measure, out_dir):
             if column == "within_target":
                 ax.axhline(WITHIN_TARGET, color="black", ls="--", lw=0.9)
                 ax.set_ylim(-0.03, 1.05)
+            elif column == "flagged":
+                # Of them, flagged phase_limited (issue 42; older measure.csv files have no such column).
+                if "phase_limited" in measure.columns:
+                    g = measure[(measure["factor"] == factor) & (measure["method"] == "model_fit")]
+                    g = g.assign(x=g["level"].map(pos)).sort_values("x")
+                    ax.plot(g["x"], g["phase_limited"] / g["sections"].clip(lower=1), ":", color="black", lw=1.3)
+                ax.set_ylim(-0.03, 1.05)
             else:
                 ax.set_yscale("log")
                 plain_log_ticks(ax.yaxis)
@@ -375,13 +390,17 @@ def stability(measure, out_dir):
         handles += [plt.Line2D([], [], color="black", ls="--", lw=0.9),
                     plt.Line2D([], [], marker="X", ls="none", color="#777777", markeredgecolor="black", ms=9),
                     plt.Line2D([], [], marker="o", ls="none", markerfacecolor="white", markeredgecolor="#777777")]
+        if column == "flagged":
+            handles[-3] = plt.Line2D([], [], color="black", ls=":", lw=1.3)
         labels += ["target: 90 % of sections within max(0.25 px, 5 %)" if column == "within_target"
+                   else "model fit: flagged phase_limited" if column == "flagged"
                    else "0.25 px (the target's absolute floor)",
                    "first level where the method misses the target", "board not found: measured at the true pose"]
         fig.legend(handles, labels, loc="lower center", ncol=3, bbox_to_anchor=(0.5, -0.02 - 0.04 / nrows),
                    fontsize=9)
-        title = ("Where each measurement method breaks: share of sections within target" if what == "within-target"
-                 else "Where each measurement method breaks: mean |error| against ground truth")
+        title = {"within-target": "Where each measurement method breaks: share of sections within target",
+                 "error": "Where each measurement method breaks: mean |error| against ground truth",
+                 "flagged": "Where each method gives no value: share of sections flagged"}[what]
         fig.suptitle(title + " (one factor swept at a time from the base scene)" + quick_note(measure, "\n"),
                      x=0.01, ha="left", fontsize=12)
         fig.tight_layout(rect=(0, 0.06, 1, 1))

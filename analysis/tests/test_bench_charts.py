@@ -6,6 +6,7 @@ import sys
 import tempfile
 import unittest
 
+import numpy as np
 import pandas as pd
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -210,6 +211,19 @@ class BenchChartsTest(unittest.TestCase):
         t = charts[0].table.set_index(["method", "factor"])
         self.assertEqual(t.loc[("model_fit", "vignetting"), "holds_at"], "0.28, 0.48")
         self.assertEqual(t.loc[("model_fit", "vignetting"), "breaks_at"], "0.68")
+
+    def test_flagged_share_per_level_with_the_phase_limited_line(self):
+        rows = measure_rows()
+        phase = rows[rows["factor"] == "noise"].assign(factor="phase", level=rows["level"] * 10 + 0.05)
+        phase = phase.assign(answered=[10, 7, 4] * 2, phase_limited=[0, 3, 6] * 2)
+        rows = pd.concat([rows.assign(phase_limited=0), phase], ignore_index=True)
+        bench_charts.stability(rows, self.out)
+        fig = self.caught.figures["bench-stability-flagged"]
+        ax = next(a for a in fig.axes if a.get_visible() and "pixel" in a.get_xlabel())
+        model = [ln for ln in ax.get_lines() if ln.get_label() == bench_charts.METHOD_LABELS["model_fit"]][0]
+        self.assertEqual(list(np.round(model.get_ydata(), 3)), [0.0, 0.3, 0.6])  # 1 - answered / sections
+        dotted = [ln for ln in ax.get_lines() if ln.get_linestyle() == ":"][0]
+        self.assertEqual(list(np.round(dotted.get_ydata(), 3)), [0.0, 0.3, 0.6])  # phase_limited / sections
 
     def test_levels_are_written_with_three_significant_digits(self):
         self.assertEqual([bench_charts.level_text(v) for v in (0.279508, 17.8885, 1000, 95, 0.04, -0.3, 0)],

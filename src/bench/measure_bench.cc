@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <map>
 #include <sstream>
+#include <functional>
 
 #include <opencv2/imgcodecs.hpp>  // its flags (the functions: core/media.h)
 #include "bench/clock.h"
@@ -31,6 +32,10 @@ struct Condition {
   // The level is the blur radius rendered: replaced by the scene's applied truth (the median section's r_px, 2 x the
   // std of the kernels synth really applied), not the nominal sqrt(R^2 + 4 sigma^2), 12 % high at R = 0.25 px.
   bool level_is_true_r = false;
+  // The level is the edges' angle to the pixel rows in the photo (the median over the sections), not the board's yaw.
+  bool level_is_edge_angle = false;
+  // The sections are split by their edge's sub-pixel phase (PhaseLevels): one row per phase band, not per scene.
+  bool per_phase = false;
 };
 
 synth::SceneOptions Base(uint64_t seed) {
@@ -38,6 +43,48 @@ synth::SceneOptions Base(uint64_t seed) {
   o.noise_std = 0.004;
   o.seed = seed;
   return o;
+}
+
+// Issue 42: the post-sampling PSF family, the edge angle and the sub-pixel phase (`pick` keeps two levels in a quick
+// run).
+template <class Pick>
+void AddSamplingConditions(uint64_t seed, const Pick& pick, std::vector<Condition>* out) {
+  std::vector<Condition>& c = *out;
+  // Near focus inside the board (r about 0.9-1.5 px, where they matter), noise 0.0025. A filter on the sampled image (as a camera's demosaicing and
+  // sharpening): a Gaussian of std level px over a disc x 0.2 px floor, then an unsharp mask of amount level (std
+  // 0.6 px) over a disc x 0.5 px floor; the truth adds the filter's taps' second moment.
+  auto near_inside = [&](double floor_px) {
+    auto o = Base(seed);
+    o.focus_mm = 430, o.floor_sigma_px = floor_px, o.noise_std = 0.0025;
+    return o;
+  };
+  for (double sigma : pick({0.35, 0.45, 0.6, 0.8})) {
+    auto o = near_inside(0.2);
+    o.post_filter.kind = synth::PostFilter::kGaussian, o.post_filter.sigma_px = sigma;
+    c.push_back({"post_gaussian", sigma, o});
+  }
+  for (double amount : pick({0.15, 0.3, 0.5})) {
+    auto o = near_inside(0.5);
+    o.post_filter.kind = synth::PostFilter::kSharpen, o.post_filter.sigma_px = 0.6, o.post_filter.amount = amount;
+    c.push_back({"post_sharpen", amount, o});
+  }
+  // The board turned on the table (physical optics: disc x 0.45 px floor): its edges at level deg to the pixel rows.
+  for (double yaw : pick({0, 10, 20, 30, 45, 60})) {
+    auto o = near_inside(0.45);
+    o.yaw_deg = yaw;
+    Condition cond{"edge_angle", yaw, o};
+    cond.level_is_edge_angle = true;
+    c.push_back(cond);
+  }
+  // The sub-pixel phase: a level board's sections (each edge along the pixel rows, at one phase) under a Gaussian of
+  // 0.45 px on the sampled image, split by how far their edge lies from the nearest pixel centre (0-0.5 px).
+  {
+    auto o = near_inside(0.2);
+    o.post_filter.kind = synth::PostFilter::kGaussian, o.post_filter.sigma_px = 0.45;
+    Condition cond{"phase", 0, o};
+    cond.per_phase = true;
+    c.push_back(cond);
+  }
 }
 
 // One factor at a time from the base scene, in order of increasing difficulty.
@@ -127,6 +174,7 @@ std::vector<Condition> Conditions(bool quick, uint64_t seed) {
     o.camera.dist_coeffs = {k1, 0, 0, 0};
     c.push_back({"distortion", k1, o});
   }
+  AddSamplingConditions(seed, pick, &c);
   for (double t : pick({20, 30, 45, 55, 65, 75})) {
     auto o = Base(seed);
     o.tilt_deg = t;
@@ -136,12 +184,13 @@ std::vector<Condition> Conditions(bool quick, uint64_t seed) {
 }
 
 MeasureRow Summarize(const std::string& method, const Condition& cond, const calib::TruthComparison& cmp,
-                     calib::MethodError calib::SectionComparison::*member, double time_us) {
+                     calib::MethodError calib::SectionComparison::*member, double time_us, int phase_limited) {
   MeasureRow row;
   row.method = method;
   row.factor = cond.factor;
   row.level = cond.level;
   row.sections = int(cmp.sections.size());
+  row.phase_limited = phase_limited;
   row.time_us_per_section = time_us;
   const calib::MethodSummary m = calib::SummarizeMethod(cmp, member);
   row.answered = m.answered;
@@ -176,6 +225,58 @@ void TimeMethods(const cv::Mat& photo, const calib::CalibResult& result, int rep
     thesis_us = std::min(thesis_us, 1000 * Ms(t0) / n);
   }
 }
+
+// The edges' median angle to the nearest pixel axis in the photo, degrees (the sections' segments).
+double MedianEdgeAngleDeg(const calib::CalibResult& result) {
+  std::vector<double> a;
+  for (const auto& e : result.edges)
+    for (const auto& s : e.sections) {
+      const cv::Point2d d = s.segment.b - s.segment.a;
+      a.push_back(std::atan2(std::min(std::abs(d.x), std::abs(d.y)), std::max(std::abs(d.x), std::abs(d.y))) * 180 /
+                  3.14159265358979323846);
+    }
+  if (a.empty()) return 0;
+  std::nth_element(a.begin(), a.begin() + long(a.size() / 2), a.end());
+  return a[a.size() / 2];
+}
+
+// A section's sub-pixel phase: how far its edge's midpoint lies from the nearest pixel centre across the nearer
+// pixel axis, 0-0.5 px (from the segment the pose gives).
+double SectionPhasePx(const calib::SectionResult& s) {
+  const cv::Point2d m = 0.5 * (s.segment.a + s.segment.b), d = s.segment.b - s.segment.a;
+  const double across = std::abs(d.x) >= std::abs(d.y) ? m.y : m.x;
+  return std::abs(across - std::round(across));
+}
+
+// The four methods' rows of one scene (or one phase band of it: `keep` picks the sections).
+void AddRows(const Condition& cond, const calib::CalibResult& result, const calib::TruthComparison& all,
+             double model_us, double thesis_us, bool found, const std::function<bool(const calib::SectionResult&)>& keep,
+             std::vector<MeasureRow>* rows) {
+  calib::TruthComparison cmp = all;
+  cmp.sections.clear();
+  int phase_limited = 0;
+  std::map<std::pair<int, int>, const calib::SectionResult*> by_index;
+  for (const auto& e : result.edges)
+    for (const auto& sec : e.sections) by_index[{sec.edge, sec.section}] = &sec;
+  for (const calib::SectionComparison& c : all.sections) {
+    const auto found_section = by_index.find({c.edge, c.section});
+    if (found_section == by_index.end() || !keep(*found_section->second)) continue;
+    const calib::SectionResult& s = *found_section->second;
+    cmp.sections.push_back(c);
+    const auto& flags = s.fit.flags;
+    phase_limited += std::find(flags.begin(), flags.end(), "phase_limited") != flags.end();
+  }
+  const double n = double(all.sections.size());
+  rows->push_back(Summarize("model_fit", cond, cmp, &calib::SectionComparison::model, model_us, phase_limited));
+  rows->push_back(Summarize("thesis", cond, cmp, &calib::SectionComparison::thesis, thesis_us, phase_limited));
+  rows->push_back(Summarize("eq37", cond, cmp, &calib::SectionComparison::estimated, 0, phase_limited));
+  rows->push_back(Summarize("fitted_model", cond, cmp, &calib::SectionComparison::fitted,
+                            1000 * result.estimate_ms / n, phase_limited));
+  for (size_t i = rows->size() - 4; i < rows->size(); ++i) (*rows)[i].board_found = found;
+}
+
+// Phase bands of 0.1 px (their middles are the levels).
+constexpr double kPhaseBands[] = {0.05, 0.15, 0.25, 0.35, 0.45};
 
 }  // namespace
 
@@ -228,13 +329,17 @@ std::vector<MeasureRow> RunMeasureBench(const MeasureBenchOptions& options) {
     const calib::TruthComparison cmp = calib::CompareToTruth(result, scene.truth, "truth");
     double model_us = 0, thesis_us = 0;
     TimeMethods(scene.image, result, 3, model_us, thesis_us);
-    const double n = double(cmp.sections.size());
-    rows.push_back(Summarize("model_fit", cond, cmp, &calib::SectionComparison::model, model_us));
-    rows.push_back(Summarize("thesis", cond, cmp, &calib::SectionComparison::thesis, thesis_us));
-    rows.push_back(Summarize("eq37", cond, cmp, &calib::SectionComparison::estimated, 0));
-    rows.push_back(Summarize("fitted_model", cond, cmp, &calib::SectionComparison::fitted,
-                             1000 * result.estimate_ms / n));
-    for (size_t i = rows.size() - 4; i < rows.size(); ++i) rows[i].board_found = found;
+    if (cond.level_is_edge_angle) cond.level = MedianEdgeAngleDeg(result);
+    if (!cond.per_phase) {
+      AddRows(cond, result, cmp, model_us, thesis_us, found, [](const calib::SectionResult&) { return true; }, &rows);
+    } else {
+      for (const double band : kPhaseBands) {
+        cond.level = band;
+        AddRows(cond, result, cmp, model_us, thesis_us, found, [band](const calib::SectionResult& s) {
+          return std::abs(SectionPhasePx(s) - band) <= 0.05;
+        }, &rows);
+      }
+    }
     if (options.progress) {
       char line[256];
       std::snprintf(line, sizeof line,
@@ -252,14 +357,15 @@ void WriteMeasureCsv(const std::vector<MeasureRow>& rows, const std::filesystem:
   std::string text =
       "method,factor,level,sections,answered,mean_abs_error_px,median_abs_error_px,p90_abs_error_px,"
       "max_abs_error_px,bias_px,within_target,time_us_per_section,meets_target,board_found,median_rel_error,"
-      "p90_rel_error,quick\n";
+      "p90_rel_error,phase_limited,quick\n";
   for (const auto& r : rows) {
     char line[512];
-    std::snprintf(line, sizeof line, "%s,%s,%g,%d,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.2f,%d,%d,%.5f,%.5f,%d\n",
+    std::snprintf(line, sizeof line, "%s,%s,%g,%d,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.2f,%d,%d,%.5f,%.5f,%d,%d\n",
                   r.method.c_str(),
                   r.factor.c_str(), r.level, r.sections, r.answered, r.mean_abs_error_px, r.median_abs_error_px,
                   r.p90_abs_error_px, r.max_abs_error_px, r.bias_px, r.within_target, r.time_us_per_section,
-                  int(r.meets_target), int(r.board_found), r.median_rel_error, r.p90_rel_error, int(quick));
+                  int(r.meets_target), int(r.board_found), r.median_rel_error, r.p90_rel_error, r.phase_limited,
+                  int(quick));
     text += line;
   }
   WriteFileAtomically(path, text);

@@ -12,9 +12,14 @@ struct MeasureRow {
   std::string method;      // "model_fit", "thesis", "eq37", "fitted_model"
   std::string factor;      // "base", "noise", "contrast", "jpeg", "flaws", "blur", "tilt", the PSF family
                            // ("psf_disc", "psf_gaussian", "psf_disc_floor_0.25" ... : floor sigma / disc radius),
-                           // "near_focus" (disc + 0.35 px floor), "vignetting"
+                           // "near_focus" (disc + 0.35 px floor), "vignetting", "distortion", and (issue 42)
+                           // "post_gaussian", "post_sharpen" (a filter on the sampled image), "edge_angle",
+                           // "phase" (the sections of one level scene, split by their edge's sub-pixel phase)
   double level = 0;        // the factor's value (noise std, Michelson contrast, JPEG quality, spots, r px, deg;
-                           // PSF family and near focus: the true r px; vignetting: fall-off at the corner)
+                           // PSF family and near focus: the true r px; vignetting: fall-off at the corner;
+                           // post_gaussian: its std px; post_sharpen: its amount; edge_angle: the edges' median
+                           // angle to the pixel rows in the photo, deg; phase: the middle of a 0.1 px band of
+                           // distance from the nearest pixel centre, px)
   int sections = 0;        // sections in the scene
   int answered = 0;        // sections the method gave a value for (model fit: flagged ok)
   double mean_abs_error_px = 0, median_abs_error_px = 0, p90_abs_error_px = 0, max_abs_error_px = 0;
@@ -24,6 +29,7 @@ struct MeasureRow {
   double time_us_per_section = 0;  // measurement methods: per section; estimators: per section from measured input
   bool meets_target = false;   // answered >= 50 % of sections and >= 90 % of them within target
   bool board_found = true;     // false: detection failed here, and the blur was measured at the true pose
+  int phase_limited = 0;       // sections the calibration flagged phase_limited (not answered by the model fit)
 };
 
 struct MeasureBenchOptions {

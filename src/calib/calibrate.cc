@@ -76,7 +76,7 @@ std::vector<optics::BlurSample> ModelSamples(const CalibResult& result) {
 
 std::map<std::string, int> SectionsLeftOut(const CalibResult& result) {
   // Informational flags never disqualify a section (edge_blur.h).
-  static const std::vector<std::string> kInformational = {"flaw", "neighbours"};
+  static const std::vector<std::string> kInformational = {"flaw", "neighbours", "short"};
   std::map<std::string, int> out;
   for (const auto& edge : result.edges)
     for (const auto& s : edge.sections) {
@@ -149,18 +149,10 @@ void SetReference(CalibResult& result, int reference_edge) {
   result.reference_u_mm = Median(ref_u);
 }
 
-// Sections sampled at few phases with blur near or below a pixel: read once per PSF family (phase_check.h), each
-// on its own (on every core, as the blur fit).
+// Sections sampled at few phases with blur near or below a pixel: read once per PSF family that could fit them
+// (phase_check.h), each on its own (on every core, as the blur fit).
 void CheckPhases(CalibResult& result, const cv::Mat& linear, const CalibrateOptions& options) {
-  const int S = result.board.SectionCount(), n = result.board.EdgeCount() * S;
-  auto phase = [&](const cv::Range& range) {
-    for (int k = range.start; k < range.end; ++k) {
-      SectionResult& sec = result.edges[k / S].sections[k % S];
-      if (sec.fit.ok) sec.phase = CheckPhase(linear, sec.segment, sec.fit, options.model_fit);
-    }
-  };
-  if (options.parallel_sections) cv::parallel_for_(cv::Range(0, n), phase, n);
-  else phase(cv::Range(0, n));
+  ReadPhaseFamilies(result, linear, options.model_fit, options.parallel_sections);
 }
 
 }  // namespace

@@ -312,7 +312,8 @@ TEST(EdgeModel, BowedEdgeMeasuredAcrossItsCurve) {
   EXPECT_TRUE(curved.ok) << Describe(curved);
   EXPECT_NEAR(curved.r_px, 1.2, 0.02 * 1.2) << Describe(curved);
   const ModelFit straight = MeasureEdgeModel(img.linear, img.segment);
-  EXPECT_GT(std::abs(straight.r_px - 1.2), 0.1 * 1.2) << Describe(straight);
+  // Taken as straight it reads 9 % high (11 % before the bins' own spread was modelled: part of that was theirs).
+  EXPECT_GT(std::abs(straight.r_px - 1.2), 0.05 * 1.2) << Describe(straight);
 }
 
 TEST(EdgeModel, SharpEdgeMeasuresNearZero) {

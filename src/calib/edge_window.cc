@@ -130,6 +130,19 @@ double BlurReachPx(const ModelFit& fit) {
   return fit.disc_r_px + 3 * fit.floor_sigma_px + 1.5;
 }
 
+double JunctionMarginPerUnusedPx(const EdgeSegment& segment, const EdgeWindow& window) {
+  const double length = cv::norm(segment.b - segment.a);
+  double margin = 1e300;
+  for (double d : {window.lo(), window.hi()}) margin = std::min(margin, 0.5 * (length + (window.kb - window.ka) * d));
+  // The X-junctions' distance from the samples is taken across the crossing lines (shorter where they lean).
+  return std::max(0.0, margin) / std::sqrt(1 + std::max(window.ka * window.ka, window.kb * window.kb));
+}
+
+double AlongFractionClearOfJunctions(const EdgeSegment& segment, const EdgeWindow& window, double r_px) {
+  const double per = JunctionMarginPerUnusedPx(segment, window);
+  return per > 0 && std::isfinite(r_px) ? 1 - (r_px + 1) / per : 0;
+}
+
 std::string CrowdedReason(const EdgeSegment& segment, const EdgeWindow& window, const ModelFit& fit,
                           double along_fraction, double along_span_px, bool plain) {
   const double r = fit.r_px, offset = std::abs(fit.offset_px);
@@ -152,11 +165,7 @@ std::string CrowdedReason(const EdgeSegment& segment, const EdgeWindow& window, 
     }
   }
   const double length = cv::norm(segment.b - segment.a), frac = std::clamp(along_fraction, 0.0, 1.0);
-  double margin = 1e300;
-  for (double d : {window.lo(), window.hi()})
-    margin = std::min(margin, 0.5 * (1 - frac) * (length + (window.kb - window.ka) * d));
-  // The X-junctions' distance from the samples is taken across the crossing lines (shorter where they lean).
-  margin /= std::sqrt(1 + std::max(window.ka * window.ka, window.kb * window.kb));
+  const double margin = (1 - frac) * JunctionMarginPerUnusedPx(segment, window);
   if (margin < r + 1)
     return Format("the X-junctions at the section's ends lie %.1f px from the part measured, within its blur (r = "
                   "%.2f px): the section is too short", margin, r);

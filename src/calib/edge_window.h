@@ -62,6 +62,13 @@ bool WidenFreeSides(const cv::Mat& linear, const EdgeSegment& segment, double re
 // floor's spread), a pixel and a plateau sample; a Gaussian's 3 std when the shape is ambiguous. px.
 double BlurReachPx(const ModelFit& fit);
 
+// The X-junctions at the section's ends: how far they lie from the part measured, per unit of the section's length
+// left unused (the part used is its central `along_fraction`; the distance is taken across the crossing lines).
+double JunctionMarginPerUnusedPx(const EdgeSegment& segment, const EdgeWindow& window);
+// The largest central fraction of the section whose samples keep the X-junctions out of a blur of r_px (r + 1 px
+// away, as CrowdedReason asks); <= 0 when none does.
+double AlongFractionClearOfJunctions(const EdgeSegment& segment, const EdgeWindow& window, double r_px);
+
 // Why `fit`, measured in `window` over samples spanning `along_span_px` of the section, cannot be trusted ("" when
 // it can): the blur reaching past the window's free side, a neighbouring edge inside the blur or the edge after it
 // within reach, the X-junctions within reach of the part used, or the image border leaving too little of it.

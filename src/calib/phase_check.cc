@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 
 #include "calib/calibrate.h"
@@ -36,6 +37,8 @@ constexpr double kMinNoise = 5e-4;
 // A reading that moves by more than this among the families that fit alike is not identified (the target
 // is max(0.05 px, 10 %): a reading within the alike families' spread of a family that holds meets it with margin).
 constexpr double kSpreadPx = 0.04, kSpreadRel = 0.08;
+// Sections every family is read on before the families that fit them far worse are ruled out (ReadPhaseFamilies).
+constexpr size_t kChoiceSections = 12;
 
 struct Bin {
   double x = 0, v = 0, w = 0;
@@ -210,8 +213,17 @@ const std::vector<PhaseFamily>& PhaseFamilies() {
   return families;
 }
 
-PhaseCheck CheckPhase(const cv::Mat& linear, const EdgeSegment& segment, const ModelFit& fit,
-                      const ModelFitOptions& options) {
+namespace {
+
+// A section's gate and profile (CheckPhase's first half): where `check.limited` comes back true, `profile` holds what
+// its families are read on.
+struct PhaseProfile {
+  std::vector<Bin> bins;
+  double phi = 0, w1 = 1, w2 = 0, shift = 1, r_fit = 0;
+};
+
+PhaseCheck GatePhase(const cv::Mat& linear, const EdgeSegment& segment, const ModelFit& fit,
+                     const ModelFitOptions& options, PhaseProfile* profile) {
   PhaseCheck check;
   const EdgeFrame f = MakeEdgeFrame(segment);
   if (!(f.length > 1)) return check;
@@ -233,10 +245,89 @@ PhaseCheck CheckPhase(const cv::Mat& linear, const EdgeSegment& segment, const M
   const double phi = std::atan2(2 * fit.floor_sigma_px, fit.disc_r_px);
   const double w1 = std::max(std::abs(f.n.x), std::abs(f.n.y)), w2 = std::min(std::abs(f.n.x), std::abs(f.n.y));
   // A filter's tap one pixel along the nearest axis moves the profile by this much across the edge.
-  const double shift = w1;
-  for (const PhaseFamily& family : PhaseFamilies())
-    check.families.push_back(ReadFamily(bins, family, fit.r_px, phi, w1, w2, shift, check.noise));
+  *profile = {bins, phi, w1, w2, /*shift=*/w1, fit.r_px};
   return check;
+}
+
+// Reads the families marked in `read` (all when empty); the others are left unread: r_px NaN, chi2 infinity.
+void ReadFamilies(const PhaseProfile& p, const std::vector<bool>& read, PhaseCheck* check) {
+  const std::vector<PhaseFamily>& families = PhaseFamilies();
+  check->families.clear();
+  for (size_t c = 0; c < families.size(); ++c) {
+    if (!read.empty() && !read[c]) {
+      PhaseReading unread;
+      unread.r_px = unread.offset_px = unread.rms_rel = std::numeric_limits<double>::quiet_NaN();
+      unread.chi2 = std::numeric_limits<double>::infinity();
+      check->families.push_back(unread);
+      continue;
+    }
+    check->families.push_back(ReadFamily(p.bins, families[c], p.r_fit, p.phi, p.w1, p.w2, p.shift, check->noise));
+  }
+}
+
+}  // namespace
+
+PhaseCheck CheckPhase(const cv::Mat& linear, const EdgeSegment& segment, const ModelFit& fit,
+                      const ModelFitOptions& options) {
+  PhaseProfile profile;
+  PhaseCheck check = GatePhase(linear, segment, fit, options, &profile);
+  if (check.limited) ReadFamilies(profile, {}, &check);
+  return check;
+}
+
+void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFitOptions& options, bool parallel) {
+  std::vector<SectionResult*> usable;
+  for (auto& edge : result.edges)
+    for (auto& s : edge.sections)
+      if (s.fit.ok) usable.push_back(&s);
+  std::vector<PhaseProfile> profiles(usable.size());
+  auto each = [parallel](size_t n, const std::function<void(size_t)>& body) {
+    auto range = [&](const cv::Range& r) {
+      for (int k = r.start; k < r.end; ++k) body(static_cast<size_t>(k));
+    };
+    if (parallel && n > 1) cv::parallel_for_(cv::Range(0, int(n)), range, int(n));
+    else range(cv::Range(0, int(n)));
+  };
+  each(usable.size(), [&](size_t k) { usable[k]->phase = GatePhase(linear, usable[k]->segment, usable[k]->fit,
+                                                                   options, &profiles[k]); });
+  std::vector<size_t> limited;
+  for (size_t k = 0; k < usable.size(); ++k)
+    if (usable[k]->phase.limited) limited.push_back(k);
+  // Few sections: every family on each, as CheckPhase. Otherwise the families are first read on kChoiceSections of
+  // them at phases spread over the pixel (sorted by phase, evenly picked): the families those fit far worse than the
+  // best (twice ChoosePhaseFamily's "alike" margins) are not read on the others. The rest of the choice is
+  // ChoosePhaseFamily's over all of them, as before; the profiles' misfit of a ruled-out family only grows with more
+  // sections, so it would not have been alike. On physical optics this reads 1-3 families on most sections, not 15.
+  if (limited.size() <= 2 * kChoiceSections) {
+    each(limited.size(), [&](size_t i) { ReadFamilies(profiles[limited[i]], {}, &usable[limited[i]]->phase); });
+    return;
+  }
+  std::vector<size_t> by_phase = limited;
+  std::stable_sort(by_phase.begin(), by_phase.end(),
+                   [&](size_t a, size_t b) { return usable[a]->phase.phase_px < usable[b]->phase.phase_px; });
+  std::vector<bool> first(usable.size(), false);
+  std::vector<size_t> chosen;
+  for (size_t i = 0; i < kChoiceSections; ++i) {
+    const size_t k = by_phase[(2 * i + 1) * by_phase.size() / (2 * kChoiceSections)];
+    if (!first[k]) first[k] = true, chosen.push_back(k);
+  }
+  each(chosen.size(), [&](size_t i) { ReadFamilies(profiles[chosen[i]], {}, &usable[chosen[i]]->phase); });
+  const size_t nf = PhaseFamilies().size();
+  std::vector<double> chi2(nf, 0.0);
+  int points = 0;
+  for (const size_t k : chosen) {
+    points += usable[k]->phase.bins;
+    for (size_t c = 0; c < nf; ++c) chi2[c] += usable[k]->phase.families[c].chi2;
+  }
+  const size_t best = std::min_element(chi2.begin(), chi2.end()) - chi2.begin();
+  const double scale = std::max(1.0, chi2[best] / std::max(1, points - 3 * int(chosen.size()) - 1));
+  std::vector<bool> read(nf);
+  for (size_t c = 0; c < nf; ++c)
+    read[c] = c == 0 || chi2[c] - chi2[best] <= 2 * std::max(kAlikeChi2 * scale, kAlikeRel * chi2[best]);
+  std::vector<size_t> rest;
+  for (const size_t k : limited)
+    if (!first[k]) rest.push_back(k);
+  each(rest.size(), [&](size_t i) { ReadFamilies(profiles[rest[i]], read, &usable[rest[i]]->phase); });
 }
 
 PhaseChoice ChoosePhaseFamily(CalibResult& result) {
@@ -288,16 +379,20 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
     s->fit.phase_why = why;
     ++choice.flagged;
   }
-  int n_alike = 0;
+  int n_alike = 0, n_read = 0;
   for (const bool a : choice.alike) n_alike += a;
-  char text[400];
+  for (const double c : choice.chi2) n_read += std::isfinite(c);
+  char text[520], ruled[120] = "";
+  if (n_read < int(families.size()))
+    std::snprintf(ruled, sizeof ruled, "; %zu ruled out on %zu sections at spread phases and not read on the others",
+                  families.size() - n_read, kChoiceSections);
   std::snprintf(text, sizeof text,
                 "%d usable sections sampled at few phases with blur under %.0f px, read as %s (%d of %zu PSF families "
-                "fit their profiles alike, chi-square per point %.2f); %d flagged phase_limited (each reading's range "
-                "among those families in calib.json)",
+                "fit their profiles alike, chi-square per point %.2f%s); %d flagged phase_limited (each reading's "
+                "range among those families in calib.json)",
                 choice.limited, kMaxBlurPx,
                 families[best].Name().c_str(),
-                n_alike, families.size(), choice.chi2_per_point, choice.flagged);
+                n_alike, families.size(), choice.chi2_per_point, ruled, choice.flagged);
   choice.summary = text;
   return choice;
 }

@@ -44,7 +44,9 @@ struct PhaseCheck {
   double phase_px = 0;  // where the edge (from the pose) lies between pixel centres at its midpoint, 0..1
   double noise = 0;     // the pixels' noise std about the profile (linear light), from the spread within its bins
   int bins = 0;         // profile points the families were fitted to
-  std::vector<PhaseReading> families;  // one per PhaseFamilies(), in that order
+  // One per PhaseFamilies(), in that order; a family ReadPhaseFamilies ruled out before reading it here has r_px NaN
+  // and chi2 infinity.
+  std::vector<PhaseReading> families;
   // Set by ChoosePhaseFamily: the readings of the families that fit the photo's profiles alike span this (px).
   double range_lo_px = 0, range_hi_px = 0;
 };
@@ -56,6 +58,13 @@ const std::vector<PhaseFamily>& PhaseFamilies();
 // is below about 2 px; `linear` as for MeasureEdgeModel. The edge lies where the pose puts it (the segment line).
 PhaseCheck CheckPhase(const cv::Mat& linear, const EdgeSegment& segment, const ModelFit& fit,
                       const ModelFitOptions& options = {});
+
+struct CalibResult;
+// CheckPhase on every usable section of `result` (on every core when `parallel`), reading no more than the photo
+// needs: where more than 24 sections are limited, every family is read on 12 of them at phases spread over the pixel,
+// and on the others only the families that fit those 12 within twice ChoosePhaseFamily's "alike" margin of the best
+// (and the optics alone). The choice and the flags are ChoosePhaseFamily's, over every limited section, as before.
+void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFitOptions& options, bool parallel);
 
 // What the sections at other phases chose (calib.json's phase_check).
 struct PhaseChoice {
@@ -71,7 +80,6 @@ struct PhaseChoice {
   std::string summary = "not checked (--no-phase-check, or a take's frames: no lens fit per frame)";  // in words
 };
 
-struct CalibResult;
 // Chooses the family over `result`'s limited sections (the one whose profiles fit best over all of them: sections at
 // other phases tell the families apart where one cannot), reads them with it, and flags `phase_limited` (ok = false,
 // with ModelFit::phase_why) those whose readings differ by more than max(0.04 px, 8 %) among the families that fit

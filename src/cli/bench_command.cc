@@ -31,9 +31,11 @@ void AddMeasure(CLI::App& bench) {
       "measure",
       "Speed against accuracy of the blur measurement and estimation methods.\n"
       "Renders ground-truth scenes (the thesis set-up), sweeping one factor at a time - sensor noise, contrast,\n"
-      "JPEG quality, printing flaws, blur size, camera tilt - calibrates each, and records for every method\n"
-      "(model_fit = r_px, thesis = r_thesis_px, eq37 = r_estimated_px, fitted_model = r_fitted_px) how many\n"
-      "sections it answered, its error against the true radius and its time per section. A method meets the\n"
+      "JPEG quality, printing flaws, blur size, PSF shape, vignetting, distortion, camera tilt, a filter on the\n"
+      "sampled image, the edges' angle to the pixel rows, their sub-pixel phase - calibrates each, and records\n"
+      "for every method (model_fit = r_px, thesis = r_thesis_px, eq37 = r_estimated_px, fitted_model =\n"
+      "r_fitted_px) how many sections it answered (and how many were flagged phase_limited), its error against\n"
+      "the true radius and its time per section. A method meets the\n"
       "target in a condition when it answers >= 50 % of sections and >= 90 % of those are within max(0.25 px, 5 %).\n"
       "Then times the whole calibration of one full-resolution 4592 x 3056 photo.\n"
       "Takes a few minutes; --quick runs two levels per factor.");

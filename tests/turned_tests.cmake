@@ -1,0 +1,41 @@
+# Turned boards (issue 42, item 2): the board turned 0-60 degrees about the table normal (`blurcue synth-scene
+# --yaw-deg`), so its edges run diagonally across the pixel grid; tests/phase_check.py runs `blurcue calibrate` and holds
+# every section against synth's truth (the applied kernels' second moments, from their arrays): measured and fitted r_px
+# median <= 2 %, p90 <= 5 %, nothing flagged, and (turned) the measured readings' signed median within +-0.4 %. Before
+# the bins' own spread was modelled (edge_blur.cc, MakeBins) a turned board read +0.7-0.9 % high on these scenes (yaw
+# 20/45/60: +0.84/+0.89/+0.74 %; level: +0.42 %), inside the 2 % target but a bias. Scenes under the build dir.
+set(TURNED_DIR ${PROJECT_BINARY_DIR}/turned)
+set(TURNED_CHECK /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/phase_check.py $<TARGET_FILE:blurcue>)
+
+function(turned_scene name)
+  add_test(NAME turned_gen_${name} COMMAND $<TARGET_FILE:blurcue> synth-scene --out ${TURNED_DIR}/${name} --quiet ${ARGN})
+  set_tests_properties(turned_gen_${name} PROPERTIES FIXTURES_SETUP turned_${name} LABELS "slow;turned")
+endfunction()
+function(turned_check name)
+  add_test(NAME turned_${name} COMMAND ${BLURCUE_EXPECT} "\nok: physical targets met" ${TURNED_CHECK}
+                                       ${TURNED_DIR}/${name} --expect physical --max-flagged 0 ${ARGN})
+  set_tests_properties(turned_${name} PROPERTIES FIXTURES_REQUIRED turned_${name} LABELS "slow;turned")
+endfunction()
+
+# Disc x a 0.45 px floor, focus inside the board (r 0.9-2.4 px: sub-pixel sections included), noise 0.0025.
+foreach(yaw 0 20 45 60)
+  turned_scene(${yaw} --yaw-deg ${yaw} --focus-mm 430 --floor-sigma-px 0.45 --noise 0.0025 --seed 3)
+endforeach()
+# Level: each edge at one sub-pixel phase, where a bias of +0.4 % is the phase's (tests/phase_tests.cmake), not the turn.
+turned_check(0)
+foreach(yaw 20 45 60)
+  turned_check(${yaw} --max-bias 0.004)
+endforeach()
+# One blur everywhere (no depth change along a section): a disc of 0.8 px x a 0.3 px floor (r 1.00 px), turned 45
+# degrees: +0.87 % before, -0.08 % after (level: +0.49 %).
+turned_scene(45_fixed --yaw-deg 45 --fixed-r-px 0.8 --floor-sigma-px 0.3 --noise 0.0025 --seed 3)
+turned_check(45_fixed --max-bias 0.004)
+# Focus in front of the board (r 1.5-4.0 px) at the widest turn, a 0.6 px floor.
+turned_scene(60_far --yaw-deg 60 --focus-mm 260 --floor-sigma-px 0.6 --noise 0.0025 --seed 5)
+turned_check(60_far --max-bias 0.004)
+# Focus in front of the board with r up to 8 px, turned 45 degrees (disc x 0.5 px floor, r 6.2-8.4 px): the far
+# squares' sections are short for such a blur, their X-junctions within its reach of the central half used; they are
+# measured on a shorter central part (flag `short`, edge_blur.cc) instead of refused. Before: 65 of 77 measured (12
+# `crowded`); after: 76 of 77. At least 95 % measured (issue 42, item 3), and the accuracy targets over them.
+turned_scene(45_front --yaw-deg 45 --focus-mm 175 --floor-sigma-px 0.5 --noise 0.003 --seed 17)
+turned_check(45_front --min-measured 0.95)
