@@ -1,6 +1,7 @@
 #pragma once
 // The session's one door to the record (store): what a session records, in session terms. Nothing else in session/
 // includes a store header (this one includes the frame's values, store/frame_columns.h); recording.cc turns these into the record's rows.
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -32,19 +33,21 @@ using procedure::Choice;
 
 // One trial's answer as recorded (store::Response, which holds the choice's Name): the choice (an answer, none or
 // skipped), its response time (NaN: none), the adjustment's steps, and what a procedure's trial showed as decided
-// then (shown_json, level, radii, correct).
+// then (shown_json, level, each side's radius, correct).
 struct Response {
   Choice choice;
   double rt_ms = 0;
   std::string adjustment_json = "[]";
   std::string shown_json = "{}";
-  std::optional<double> level, r_left_px, r_right_px;
+  std::optional<double> level;
+  std::array<std::optional<double>, 2> r_px;  // photo px, indexed by protocol::Index(side)
   std::optional<bool> correct;
 };
 
 // One flip of a trial as the record keeps it (store/frame_columns.h, the one definition of a frame's values): its
 // time from onset, whether a frame was dropped before it, what it showed of a pair and, on video, of the take.
 using FrameRecord = store::FrameRecord;
+using FrameSide = store::FrameSide;
 
 // The station a session runs on, as the record states it (store::SessionMeta).
 struct SessionInfo {
@@ -150,8 +153,9 @@ bool IsRecordColumn(const std::string& column);
 // The variables recorded with a trial beside its factor levels: practice, block_name, swapped, and for pairs each
 // radius in photo px, screen px and arcmin (r_left_px, r_left_screen_px, r_left_arcmin; the same for right and
 // scene) with the presentation's screen_px_per_photo_px and the blur plan (blur_plan: one_radius | per_pixel,
-// r_span_screen_px) and each object's size_left_deg / size_right_deg, or start_level and adjust_levels (adjustment;
-// a picture: picture_width_arcmin, and the real picture's r_scene_* when content.real_camera names its camera).
+// r_span_screen_px) and each object's floor, streak, place and size (size_left_deg, ...: store::SideVariables), or
+// start_level and adjust_levels (adjustment; a picture: picture_width_arcmin, and the real picture's r_scene_* when
+// content.real_camera names its camera).
 // Each level is recorded under store::DesignColumn(name): factor_NAME for one named like any of those or like a
 // column of trials.csv (store::IsRecordedName), so nothing recorded takes a level's place.
 Json TrialVariables(const protocol::Trial& trial, const stimulus::TrialScene& scene,

@@ -47,21 +47,22 @@ BlurSource Source(const std::optional<protocol::BlurSpec>& spec, double* fixed,
 
 // Board-frame placement of the two objects of a pair (scene's poses on the board; x and y in mm where the trial
 // says so).
-scene::VirtualObject Card(const calib::SceneCalib& s, const TrialScene& t, bool left) {
-  scene::VirtualObject o = scene::CardBesideBoard(s.board, 1, left, t.card_width_mm);
+// `place` is the side whose place the object takes (in an intervals trial the right side's object takes the left's).
+scene::VirtualObject Card(const calib::SceneCalib& s, const TrialScene& t, Side place) {
+  scene::VirtualObject o = scene::CardBesideBoard(s.board, 1, place == Side::kLeft, t.card_width_mm);
   o.card_height_mm = t.card_height_mm;
   o.standing = t.standing;
   o.rotation_deg = t.rotation_deg;
-  const double x = left ? t.left_x_mm : t.right_x_mm;
+  const double x = t.side(place).x_mm;
   // Its centre at the placement; a standing card's lowest edge rests at height_mm above the table.
   const double h = o.card_height_mm > 0 ? o.card_height_mm : o.size_mm;
   o.center_board_mm = {std::isnan(x) ? o.center_board_mm[0] : x, t.from_y_mm, t.height_mm + (t.standing ? h / 2 : 0)};
   return o;
 }
-scene::VirtualObject Ball(const calib::SceneCalib& s, const TrialScene& t, double y_mm, double radius_mm, bool left) {
+scene::VirtualObject Ball(const calib::SceneCalib& s, const TrialScene& t, double y_mm, double radius_mm, Side place) {
   scene::VirtualObject o =
-      scene::BallOnBoard(s.board, left ? kLeftSection : kRightSection, y_mm, radius_mm, t.from_y_mm);
-  const double x = left ? t.left_x_mm : t.right_x_mm;
+      scene::BallOnBoard(s.board, place == Side::kLeft ? kLeftSection : kRightSection, y_mm, radius_mm, t.from_y_mm);
+  const double x = t.side(place).x_mm;
   if (!std::isnan(x)) o.center_board_mm[0] = x;
   o.center_board_mm[2] += t.height_mm;
   return o;
@@ -69,11 +70,11 @@ scene::VirtualObject Ball(const calib::SceneCalib& s, const TrialScene& t, doubl
 
 // The streak a ball centred at y_mm leaves over the trial's exposure while it rolls (photo px): where its centre's
 // image goes from half an exposure before to half after, through the calibrated camera (its distortion included).
-cv::Vec2d StreakAtPx(const calib::SceneCalib& s, const TrialScene& t, double y_mm, double radius_mm, bool left) {
+cv::Vec2d StreakAtPx(const calib::SceneCalib& s, const TrialScene& t, double y_mm, double radius_mm, Side place) {
   if (!(t.exposure_ms > 0 && t.speed_mm_s > 0)) return {0, 0};
   const double half = 0.5 * t.speed_mm_s * t.exposure_ms / 1000 * (t.to_y_mm >= t.from_y_mm ? 1 : -1);
-  std::vector<cv::Point3d> ends = {cv::Point3d(Ball(s, t, y_mm - half, radius_mm, left).center_board_mm),
-                                   cv::Point3d(Ball(s, t, y_mm + half, radius_mm, left).center_board_mm)};
+  std::vector<cv::Point3d> ends = {cv::Point3d(Ball(s, t, y_mm - half, radius_mm, place).center_board_mm),
+                                   cv::Point3d(Ball(s, t, y_mm + half, radius_mm, place).center_board_mm)};
   std::vector<cv::Point2d> image;
   cv::projectPoints(ends, s.rvec, s.tvec, cv::Matx33d(s.camera.Intrinsics().data()), s.camera.dist_coeffs, image);
   return {image[1].x - image[0].x, image[1].y - image[0].y};
@@ -122,19 +123,19 @@ void CheckInPhoto(const protocol::Protocol& protocol, const protocol::Trial& tri
                   const TrialScene& t) {
   const cv::Rect photo(0, 0, scene.camera.image_width_px, scene.camera.image_height_px);
   for (const auto& objects : RunEnds(protocol, scene, t)) {
-    for (size_t side = 0; side < 2; ++side) {
-      // An intervals trial shows the right side's object at the left's place (IntervalScene): side 0's check is its.
-      if (!objects[side] || (side == 1 && t.intervals > 0)) continue;
-      if ((scene::FootprintOf(scene.camera, scene.rvec, scene.tvec, objects[side]->object).bounds & photo).empty()) {
-        const char* level = t.content == protocol::ContentType::kGrid
-                                ? (std::isnan(side == 0 ? t.left_x_mm : t.right_x_mm) ? "edge"
-                                   : side == 0                                          ? "left_x_mm"
-                                                                                        : "right_x_mm")
-                                : "speed_cm_s";
+    for (const Side side : protocol::Vocabulary<Side>::values) {
+      const auto& object = objects[protocol::Index(side)];
+      // An intervals trial shows the right side's object at the left's place (IntervalScene): the left's check is its.
+      if (!object || (side == Side::kRight && t.intervals > 0)) continue;
+      if ((scene::FootprintOf(scene.camera, scene.rvec, scene.tvec, object->object).bounds & photo).empty()) {
+        // The level that placed it: its side's x (left_x_mm, right_x_mm), else the edge.
+        const std::string level = t.content == protocol::ContentType::kGrid
+                                      ? (std::isnan(t.side(side).x_mm) ? "edge" : ToString(side) + "_x_mm")
+                                      : "speed_cm_s";
         throw InputError(protocol.file.string() + ": " + protocol::LevelPointer(protocol, trial, level),
-                         "the " + ToString(side == 0 ? Side::kLeft : Side::kRight) + " " + ToString(t.content) + " at (" +
-                             std::to_string(int(std::lround(objects[side]->object.center_board_mm[0]))) + ", " +
-                             std::to_string(int(std::lround(objects[side]->object.center_board_mm[1]))) +
+                         "the " + ToString(side) + " " + ToString(t.content) + " at (" +
+                             std::to_string(int(std::lround(object->object.center_board_mm[0]))) + ", " +
+                             std::to_string(int(std::lround(object->object.center_board_mm[1]))) +
                              ") mm on the board lies outside the " + std::to_string(photo.width) + " x " +
                              std::to_string(photo.height) + " photo (trial " + std::to_string(trial.index) + ")");
       }
@@ -183,13 +184,17 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   auto field = [&](std::optional<Side> side) {
     return At(protocol, side ? protocol::SidePointer(protocol, trial, *side) : "/scene/calib");
   };
-  t.left = Source(trial.left, &t.left_fixed_px, [&] { return field(Side::kLeft); }, presentation);
-  t.right = Source(trial.right, &t.right_fixed_px, [&] { return field(Side::kRight); }, presentation);
+  for (const Side side : protocol::Vocabulary<Side>::values) {
+    SideShown& shown = t.side(side);
+    shown.source = Source(side == Side::kLeft ? trial.left : trial.right, &shown.fixed_px,
+                          [&] { return field(side); }, presentation);
+  }
   const double s = scene->board.square_mm;
-  // Where the right side's object is shown, so where its radius is evaluated: its own place, or in an intervals
-  // trial the left object's (IntervalScene shows each side alone there). Evaluated at its own place, a place-dependent
-  // source (measured_section, estimated, fitted) gave the right interval a radius of somewhere not shown.
-  const bool right_place = t.intervals > 0;  // Card / Ball: true = the left object's place
+  // Where each side's object is shown, so where its radius is evaluated: its own place, but the right side's in an
+  // intervals trial at the left object's (IntervalScene shows each side alone there). Evaluated at its own place, a
+  // place-dependent source (measured_section, estimated, fitted) gave the right interval a radius of somewhere not
+  // shown.
+  const std::array<Side, 2> place_of = {Side::kLeft, t.intervals > 0 ? Side::kLeft : Side::kRight};
   // A radius that cannot be evaluated (eq. 3.7 nearer than focus, no usable measured section) is a problem of the
   // source the protocol chose with this calibration: an input error naming that field.
   auto r_at = [&](const cv::Vec3d& board_mm, calib::BlurSource source, double fixed, std::optional<Side> side) {
@@ -219,8 +224,8 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
     const protocol::LevelValue* v = FindLevel(trial.levels, name);
     return v && v->IsNumber() ? std::optional<double>(v->number) : std::nullopt;
   };
-  if (auto x = mm_level("left_x_mm")) t.left_x_mm = *x;
-  if (auto x = mm_level("right_x_mm")) t.right_x_mm = *x;
+  for (const Side side : protocol::Vocabulary<Side>::values)
+    if (auto x = mm_level((ToString(side) + "_x_mm").c_str())) t.side(side).x_mm = *x;
   t.height_mm = mm_level("height_mm").value_or(protocol.content.height_mm);
   if (t.content == protocol::ContentType::kGrid) {
     t.card_width_mm = protocol.content.size_mm;
@@ -236,17 +241,21 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
                        "a grid needs an integer level edge or a y_mm" + trial_text);
     t.edge = edge ? *edge : 0;
     t.from_y_mm = t.to_y_mm = y ? *y : (*edge - 1) * s;
-    const cv::Vec3d l = Card(*scene, t, true).center_board_mm, r = Card(*scene, t, right_place).center_board_mm;
-    t.r_left_px = r_at(l, t.left, t.left_fixed_px, Side::kLeft);
-    t.r_right_px = r_at(r, t.right, t.right_fixed_px, Side::kRight);
-    const ObjectPlace pl = PlaceOf(*scene, l), pr = PlaceOf(*scene, r);
-    t.u_left_mm = pl.u_mm, t.u_right_mm = pr.u_mm;
-    t.below_axis_left_px = pl.below_axis_px, t.below_axis_right_px = pr.below_axis_px;
-    // The floor at each card's place (the distortion's stretch there; ObjectsAt draws the same).
-    t.floor_left_sigma_px = calib::FloorSigmaPx(*scene, t.left, scene->ToCamera(l));
-    t.floor_right_sigma_px = calib::FloorSigmaPx(*scene, t.right, scene->ToCamera(r));
-    t.r_scene_px = 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, std::nullopt) +
-                          r_at(r, calib::BlurSource::kFitted, 0, std::nullopt));
+    std::array<cv::Vec3d, 2> at;  // each card's centre (board mm)
+    for (size_t k = 0; k < 2; ++k) at[k] = Card(*scene, t, place_of[k]).center_board_mm;
+    for (const Side side : protocol::Vocabulary<Side>::values) {
+      SideShown& shown = t.side(side);
+      shown.r_px = r_at(at[protocol::Index(side)], shown.source, shown.fixed_px, side);
+    }
+    for (const Side side : protocol::Vocabulary<Side>::values) {
+      SideShown& shown = t.side(side);
+      const ObjectPlace place = PlaceOf(*scene, at[protocol::Index(side)]);
+      shown.u_mm = place.u_mm, shown.below_axis_px = place.below_axis_px;
+      // The floor at the card's place (the distortion's stretch there; ObjectsAt draws the same).
+      shown.floor_sigma_px = calib::FloorSigmaPx(*scene, shown.source, scene->ToCamera(at[protocol::Index(side)]));
+    }
+    t.r_scene_px = 0.5 * (r_at(at[0], calib::BlurSource::kFitted, 0, std::nullopt) +
+                          r_at(at[1], calib::BlurSource::kFitted, 0, std::nullopt));
     CheckInPhoto(protocol, trial, *scene, t);
     return t;
   }
@@ -290,27 +299,37 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   const double radius = protocol.content.radius_mm;
   for (int i = 0; i < samples; ++i) {
     const double y = t.from_y_mm + (t.to_y_mm - t.from_y_mm) * i / (samples - 1);
-    const cv::Vec3d l = Ball(*scene, t, y, radius, true).center_board_mm;
-    const cv::Vec3d r = Ball(*scene, t, y, radius, right_place).center_board_mm;
-    t.r_left_px += r_at(l, t.left, t.left_fixed_px, Side::kLeft) / samples;
-    t.r_right_px += r_at(r, t.right, t.right_fixed_px, Side::kRight) / samples;
-    t.floor_left_sigma_px += calib::FloorSigmaPx(*scene, t.left, scene->ToCamera(l)) / samples;
-    t.floor_right_sigma_px += calib::FloorSigmaPx(*scene, t.right, scene->ToCamera(r)) / samples;
-    t.r_scene_px += 0.5 * (r_at(l, calib::BlurSource::kFitted, 0, std::nullopt) +
-                           r_at(r, calib::BlurSource::kFitted, 0, std::nullopt)) / samples;
-    const ObjectPlace pl = PlaceOf(*scene, l), pr = PlaceOf(*scene, r);
-    t.u_left_mm += pl.u_mm / samples, t.u_right_mm += pr.u_mm / samples;
-    t.below_axis_left_px += pl.below_axis_px / samples, t.below_axis_right_px += pr.below_axis_px / samples;
-    t.motion_left_px += StreakAtPx(*scene, t, y, radius, true) / samples;
-    t.motion_right_px += StreakAtPx(*scene, t, y, radius, right_place) / samples;
+    std::array<cv::Vec3d, 2> at;  // each ball's centre (board mm)
+    for (size_t k = 0; k < 2; ++k) at[k] = Ball(*scene, t, y, radius, place_of[k]).center_board_mm;
+    for (const Side side : protocol::Vocabulary<Side>::values) {
+      SideShown& shown = t.side(side);
+      shown.r_px += r_at(at[protocol::Index(side)], shown.source, shown.fixed_px, side) / samples;
+    }
+    for (const Side side : protocol::Vocabulary<Side>::values) {
+      SideShown& shown = t.side(side);
+      shown.floor_sigma_px += calib::FloorSigmaPx(*scene, shown.source, scene->ToCamera(at[protocol::Index(side)])) /
+                              samples;
+    }
+    t.r_scene_px += 0.5 * (r_at(at[0], calib::BlurSource::kFitted, 0, std::nullopt) +
+                           r_at(at[1], calib::BlurSource::kFitted, 0, std::nullopt)) / samples;
+    for (const Side side : protocol::Vocabulary<Side>::values) {
+      SideShown& shown = t.side(side);
+      const ObjectPlace place = PlaceOf(*scene, at[protocol::Index(side)]);
+      shown.u_mm += place.u_mm / samples;
+      shown.below_axis_px += place.below_axis_px / samples;
+      shown.motion_px += StreakAtPx(*scene, t, y, radius, place_of[protocol::Index(side)]) / samples;
+    }
   }
   // Every edge the run passes, too: the samples step over edges on a long board, and a frame there must have a
   // radius (a measured source is its nearest edge's value, refused for an edge with no usable section).
   for (int k = 1; k <= edges; ++k) {
     const double y = (k - 1) * s;
     if (y < std::min(t.from_y_mm, t.to_y_mm) || y > std::max(t.from_y_mm, t.to_y_mm)) continue;
-    r_at(Ball(*scene, t, y, radius, true).center_board_mm, t.left, t.left_fixed_px, Side::kLeft);
-    r_at(Ball(*scene, t, y, radius, right_place).center_board_mm, t.right, t.right_fixed_px, Side::kRight);
+    for (const Side side : protocol::Vocabulary<Side>::values) {
+      const SideShown& shown = t.side(side);
+      r_at(Ball(*scene, t, y, radius, place_of[protocol::Index(side)]).center_board_mm, shown.source, shown.fixed_px,
+           side);
+    }
   }
   CheckInPhoto(protocol, trial, *scene, t);
   return t;
@@ -320,21 +339,21 @@ std::array<std::optional<scene::BlurredObject>, 2> ObjectsAt(const protocol::Pro
                                                               const calib::SceneCalib& s, const TrialScene& trial,
                                                               double t_s) {
   std::array<std::optional<scene::BlurredObject>, 2> shown;
-  for (const bool left : {true, false}) {
-    if (!left && trial.left_only) continue;
+  for (const Side side : protocol::Vocabulary<Side>::values) {
+    if (side == Side::kRight && trial.left_only) continue;
     scene::BlurredObject b;
     scene::VirtualObject& o = b.object;
-    const calib::BlurSource source = left ? trial.left : trial.right;
-    const double fixed = left ? trial.left_fixed_px : trial.right_fixed_px;
-    const double gain = left ? trial.left_gain : trial.right_gain, add = left ? trial.left_add_px : trial.right_add_px;
+    const SideShown& shown_side = trial.side(side);
+    const calib::BlurSource source = shown_side.source;
+    const double fixed = shown_side.fixed_px, gain = shown_side.gain, add = shown_side.add_px;
     if (trial.content == protocol::ContentType::kGrid) {
-      o = Card(s, trial, left);
+      o = Card(s, trial, side);
     } else {
       const double y = trial.BallYMm(t_s);
       if (!std::isfinite(y)) continue;  // wiped at the end of a section
-      o = Ball(s, trial, y, protocol.content.radius_mm, left);
+      o = Ball(s, trial, y, protocol.content.radius_mm, side);
       // Rolling (onset to arrival): the streak of its velocity there over the exposure; at rest, none.
-      if (t_s >= 0 && t_s < trial.MotionS()) b.motion_px = StreakAtPx(s, trial, y, protocol.content.radius_mm, left);
+      if (t_s >= 0 && t_s < trial.MotionS()) b.motion_px = StreakAtPx(s, trial, y, protocol.content.radius_mm, side);
     }
     // The scene's floor and stretch at the object's place: its PSF is the photo's there (docs/distortion.md).
     b.floor_sigma_px = calib::FloorSigmaPx(s, source, s.ToCamera(o.center_board_mm));
@@ -351,7 +370,7 @@ std::array<std::optional<scene::BlurredObject>, 2> ObjectsAt(const protocol::Pro
     o.white_balance = {trial.white_balance[0], trial.white_balance[1], trial.white_balance[2]};
     b.method = RenderMethod(trial.kernel);
     b.r_px = gain * calib::BlurAtPx(s, source, s.ToCamera(o.center_board_mm), fixed) + add;
-    shown[left ? 0 : 1] = std::move(b);
+    shown[protocol::Index(side)] = std::move(b);
   }
   return shown;
 }
@@ -364,25 +383,22 @@ TrialScene IntervalScene(const TrialScene& scene, bool right) {
   TrialScene s = scene;
   s.left_only = true;
   if (right) {
-    s.left = s.right;
-    s.left_fixed_px = s.right_fixed_px;
-    s.left_gain = s.right_gain;
-    s.left_add_px = s.right_add_px;
-    s.r_left_px = s.r_right_px;
-    s.floor_left_sigma_px = s.floor_right_sigma_px;
-    s.motion_left_px = s.motion_right_px;
-    s.u_left_mm = s.u_right_mm;
-    s.below_axis_left_px = s.below_axis_right_px;
+    // The right side's object at the left's place: the left's x (its place), the right's all else.
+    const double x_mm = s.side(Side::kLeft).x_mm;
+    const double size_deg = s.side(Side::kLeft).size_deg;
+    s.side(Side::kLeft) = s.side(Side::kRight);
+    s.side(Side::kLeft).x_mm = x_mm;
+    s.side(Side::kLeft).size_deg = size_deg;
   }
   return s;
 }
 
 void ApplyLevel(const protocol::Procedure& procedure, const protocol::Trial& trial, double level,
                 const Presentation& presentation, TrialScene* scene) {
-  const bool left = protocol::TestSide(trial) == protocol::Side::kLeft;
-  double& gain = left ? scene->left_gain : scene->right_gain;
-  double& add = left ? scene->left_add_px : scene->right_add_px;
-  double& r = left ? scene->r_left_px : scene->r_right_px;
+  SideShown& test = scene->side(protocol::TestSide(trial).value_or(Side::kRight));
+  double& gain = test.gain;
+  double& add = test.add_px;
+  double& r = test.r_px;
   const double reference = (r - add) / gain;  // as DescribeTrial made it
   if (procedure.variable == protocol::ProcedureVariable::kRelativeDifference) {
     gain = 1 + level, add = 0;
@@ -418,7 +434,7 @@ void PlanOnScreen(const protocol::Protocol& protocol, const calib::SceneCalib& s
   trial->per_pixel = span >= threshold;
   const auto& onset = ends[0];
   for (size_t side = 0; side < 2; ++side)
-    (side == 0 ? trial->size_left_deg : trial->size_right_deg) =
+    trial->sides[side].size_deg =
         onset[side] ? display::ArcminOfScreenPx(presentation.profile,
                                                 presentation.ScreenPx(ExtentPx(scene::OutlineOf(
                                                     s.camera, s.rvec, s.tvec, onset[side]->object)))) /

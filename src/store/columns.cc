@@ -61,15 +61,22 @@ std::function<Json(const RecordedVariables&)> Member(std::optional<T> RecordedVa
     else return Json(*x);
   };
 }
-// One side's radius of RecordedVariables::r_px, r_screen_px or r_arcmin.
-std::function<Json(const RecordedVariables&)> Radius(std::array<std::optional<double>, 3> RecordedVariables::*radii,
-                                                    size_t side) {
-  return [radii, side](const RecordedVariables& v) { return (v.*radii)[side] ? Json(*(v.*radii)[side]) : Json(); };
+// One place's radius of RecordedVariables::r_px, r_screen_px or r_arcmin.
+std::function<Json(const RecordedVariables&)> Radius(
+    std::array<std::optional<double>, RecordedVariables::kSides> RecordedVariables::*radii, size_t place) {
+  return [radii, place](const RecordedVariables& v) { return (v.*radii)[place] ? Json(*(v.*radii)[place]) : Json(); };
+}
+// One side's member of RecordedVariables::sides.
+std::function<Json(const RecordedVariables&)> OfSide(std::optional<double> SideVariables::*member, size_t side) {
+  return [member, side](const RecordedVariables& v) {
+    const std::optional<double>& x = v.sides[side].*member;
+    return x ? Json(*x) : Json();
+  };
 }
 
-Stored OfSession(Stored s, Value (*of)(const SessionValues&)) { return s.of_session = of, s; }
-Stored OfTrial(Stored s, Value (*of)(const TrialRecord&)) { return s.of_trial = of, s; }
-Stored OfResponse(Stored s, Value (*of)(const Response&)) { return s.of_response = of, s; }
+Stored OfSession(Stored s, std::function<Value(const SessionValues&)> of) { return s.of_session = std::move(of), s; }
+Stored OfTrial(Stored s, std::function<Value(const TrialRecord&)> of) { return s.of_trial = std::move(of), s; }
+Stored OfResponse(Stored s, std::function<Value(const Response&)> of) { return s.of_response = std::move(of), s; }
 
 std::vector<Column> MakeColumns() {
   std::vector<Column> c;
@@ -177,21 +184,20 @@ std::vector<Column> MakeColumns() {
 
   // Each side's source, with the answer in trials.csv; in schema 7's order before the planned radii.
   const std::string sources = SourceColumns::Names();
-  add("left_source", "string", "", sources, "the left side's blur source (the single layout's object); empty: none shown",
-      A, Cell::kText)
-      .at = OfTrial(Typed("trials", "TEXT", "", 7, SourceOf("left_shown")),
-                    [](const TrialRecord& t) { return NonEmpty(SourceColumns::Of(t.left_json).source); });
-  add("left_fixed", "number", "the source's unit", ">= 0", "a fixed_* left source's radius, in the unit its name says",
-      A, Cell::kNumber)
-      .at = OfTrial(Typed("trials", "REAL", "", 7, FixedOf("left_shown")),
-                    [](const TrialRecord& t) { return Optional(SourceColumns::Of(t.left_json).fixed); });
-  add("right_source", "string", "", sources, "the right side's blur source; empty: none shown", A, Cell::kText)
-      .at = OfTrial(Typed("trials", "TEXT", "", 7, SourceOf("right_shown")),
-                    [](const TrialRecord& t) { return NonEmpty(SourceColumns::Of(t.right_json).source); });
-  add("right_fixed", "number", "the source's unit", ">= 0", "a fixed_* right source's radius, in the unit its name says",
-      A, Cell::kNumber)
-      .at = OfTrial(Typed("trials", "REAL", "", 7, FixedOf("right_shown")),
-                    [](const TrialRecord& t) { return Optional(SourceColumns::Of(t.right_json).fixed); });
+  for (const protocol::Side side : protocol::Vocabulary<protocol::Side>::values) {
+    const std::string word = protocol::ToString(side), shown = SideColumn("", side, "shown");
+    const size_t k = protocol::Index(side);
+    add(SideColumn("", side, "source"), "string", "", sources,
+        "the " + word + " side's blur source" + (side == protocol::Side::kLeft ? " (the single layout's object)" : "") +
+            "; empty: none shown",
+        A, Cell::kText)
+        .at = OfTrial(Typed("trials", "TEXT", "", 7, SourceOf(shown)),
+                      [k](const TrialRecord& t) { return NonEmpty(SourceColumns::Of(t.source_json[k]).source); });
+    add(SideColumn("", side, "fixed"), "number", "the source's unit", ">= 0",
+        "a fixed_* " + word + " source's radius, in the unit its name says", A, Cell::kNumber)
+        .at = OfTrial(Typed("trials", "REAL", "", 7, FixedOf(shown)),
+                      [k](const TrialRecord& t) { return Optional(SourceColumns::Of(t.source_json[k]).fixed); });
+  }
 
   // The runner's variables of a trial (session/recording.h TrialVariables), kept in its variables' JSON (factors; a
   // response's shown for what a procedure decided at the trial). Those also kept typed come first, in schema 7's order.
@@ -237,24 +243,22 @@ std::vector<Column> MakeColumns() {
     const std::string what = k == 2 ? "the scene's own blur at the object's place (the fitted model; depth "
                                                "matching: the real picture's, the thin lens of content.real_camera)"
                                              : "the " + side + " object's blur radius";
-    Column& px = add("r_" + side + "_px", "number", "photo px",
+    const std::string name = SideColumn("r", side, "px");
+    Column& px = add(name, "number", "photo px",
                      "", what + ", as the camera makes it (moving: averaged over the run)", V, Cell::kText);
     px.variable = Radius(&RecordedVariables::r_px, k);
     // Before version 7 only the variables' JSON had it, planned (factors) and as shown (shown).
-    const Stored planned = Typed("trials", "REAL", "", 7, "json_extract(factors, '$.r_" + side + "_px')");
-    const Stored shown = Typed("responses", "REAL", "", 7, "json_extract(shown, '$.r_" + side + "_px')");
-    if (k == 0) {
-      px.at = OfTrial(planned, [](const TrialRecord& t) { return Optional(t.r_left_px); });
-      px.shown = OfResponse(shown, [](const Response& r) { return Optional(r.r_left_px); });
-    } else if (k == 1) {
-      px.at = OfTrial(planned, [](const TrialRecord& t) { return Optional(t.r_right_px); });
-      px.shown = OfResponse(shown, [](const Response& r) { return Optional(r.r_right_px); });
-    } else {
+    const Stored planned = Typed("trials", "REAL", "", 7, "json_extract(factors, '$." + name + "')");
+    const Stored shown = Typed("responses", "REAL", "", 7, "json_extract(shown, '$." + name + "')");
+    if (k == RecordedVariables::kScene) {
       px.at = OfTrial(planned, [](const TrialRecord& t) { return Optional(t.r_scene_px); });
+    } else {
+      px.at = OfTrial(planned, [k](const TrialRecord& t) { return Optional(t.r_px[k]); });
+      px.shown = OfResponse(shown, [k](const Response& r) { return Optional(r.r_px[k]); });
     }
-    add("r_" + side + "_screen_px", "number", "screen px", "", what + ", on the screen", V, Cell::kText).variable =
-        Radius(&RecordedVariables::r_screen_px, k);
-    add("r_" + side + "_arcmin", "number", "arcmin", "", what + ", at the eye", V, Cell::kText).variable =
+    add(SideColumn("r", side, "screen_px"), "number", "screen px", "", what + ", on the screen", V, Cell::kText)
+        .variable = Radius(&RecordedVariables::r_screen_px, k);
+    add(SideColumn("r", side, "arcmin"), "number", "arcmin", "", what + ", at the eye", V, Cell::kText).variable =
         Radius(&RecordedVariables::r_arcmin, k);
   }
   Column& rt = add("rt_ms", "number", "ms", ">= 0", "response time from the stimulus's first frame; empty without an answer",
@@ -276,35 +280,40 @@ std::vector<Column> MakeColumns() {
   // The PSF beside each radius (render/psf.h): the lens floor inside it and the motion streak over the exposure.
   variable("exposure_ms", "number", "ms", "the exposure a moving object's motion blur lasts (content.exposure_ms; 0: none)",
            Member(&R::exposure_ms));
+  using SV = SideVariables;
   for (size_t k = 0; k < 2; ++k) {
     const std::string side = RecordedVariables::SideName(k);
-    variable("floor_sigma_" + side + "_px", "number", "photo px",
+    variable(SideColumn("floor_sigma", side, "px"), "number", "photo px",
              "the lens floor (std) inside the " + side + " object's radius: the scene's, for a measured, measured_section "
-             "or fitted source (its defocus drawn convolved with it); 0 for the others", Radius(&R::floor_sigma_px, k));
-    variable("floor_sigma_" + side + "_screen_px", "number", "screen px", "the same on the screen",
-             Radius(&R::floor_sigma_screen_px, k));
-    variable("motion_" + side + "_x_screen_px", "number", "screen px",
+             "or fitted source (its defocus drawn convolved with it); 0 for the others",
+             OfSide(&SV::floor_sigma_px, k));
+    variable(SideColumn("floor_sigma", side, "screen_px"), "number", "screen px", "the same on the screen",
+             OfSide(&SV::floor_sigma_screen_px, k));
+    variable(SideColumn("motion", side, "x_screen_px"), "number", "screen px",
              "the " + side + " object's motion streak over the exposure, across (x right), averaged over the run",
-             Radius(&R::motion_x_screen_px, k));
-    variable("motion_" + side + "_y_screen_px", "number", "screen px",
+             OfSide(&SV::motion_x_screen_px, k));
+    variable(SideColumn("motion", side, "y_screen_px"), "number", "screen px",
              "the " + side + " object's motion streak over the exposure, down (y down), averaged over the run",
-             Radius(&R::motion_y_screen_px, k));
+             OfSide(&SV::motion_y_screen_px, k));
   }
   // Where each object is: its depth (what an edge number stands for) and, as the eye gets it, its height in the picture.
   for (size_t k = 0; k < 2; ++k) {
     const std::string side = RecordedVariables::SideName(k);
-    variable("u_" + side + "_mm", "number", "mm",
+    variable(SideColumn("u", side, "mm"), "number", "mm",
              "the " + side + " object's depth u: its centre's distance from the camera's lens plane along the optical "
              "axis (camera z in the calibration's board pose), where its radius was evaluated (an intervals trial: the "
-             "left object's place); a ball: averaged over its run like the radii", Radius(&R::u_mm, k));
-    variable("elevation_" + side + "_deg", "number", "deg",
+             "left object's place); a ball: averaged over its run like the radii", OfSide(&SV::u_mm, k));
+    variable(SideColumn("elevation", side, "deg"), "number", "deg",
              "the " + side + " object's place in the picture as a visual angle: its centre's image above (+) or below "
              "(-) the photo's principal point (where the camera's optical axis meets the photo), on the display, "
-             "atan(offset on the screen / viewing distance); not its angular size (size_" + side + "_deg); a ball: "
-             "averaged over its run", Radius(&R::elevation_deg, k));
+             "atan(offset on the screen / viewing distance); not its angular size (" + SideColumn("size", side, "deg") +
+             "); a ball: averaged over its run", OfSide(&SV::elevation_deg, k));
   }
-  variable("size_left_deg", "number", "deg", "the left object's largest extent on screen at onset", Member(&R::size_left_deg));
-  variable("size_right_deg", "number", "deg", "the right object's largest extent on screen at onset", Member(&R::size_right_deg));
+  for (size_t k = 0; k < 2; ++k) {
+    const std::string side = RecordedVariables::SideName(k);
+    variable(SideColumn("size", side, "deg"), "number", "deg",
+             "the " + side + " object's largest extent on screen at onset", OfSide(&SV::size_deg, k));
+  }
   variable("brightness", "number", "", "the object's brightness matching (factor of its texture's values)", Member(&R::brightness));
   variable("contrast", "number", "", "the object's contrast matching", Member(&R::contrast));
   variable("white_balance_r", "number", "", "the object's red gain in linear light", Member(&R::white_balance_r));
@@ -355,7 +364,15 @@ const std::vector<Column>& RecordColumns() {
 }
 
 std::string RecordedVariables::SideName(size_t k) {
-  return k < 2 ? protocol::ToString(protocol::Side(k)) : std::string("scene");
+  return k < 2 ? protocol::ToString(protocol::Vocabulary<protocol::Side>::values[k]) : std::string("scene");
+}
+
+std::string SideColumn(const std::string& quantity, const std::string& side, const std::string& suffix) {
+  return (quantity.empty() ? "" : quantity + "_") + side + (suffix.empty() ? "" : "_" + suffix);
+}
+
+std::string SideColumn(const std::string& quantity, protocol::Side side, const std::string& suffix) {
+  return SideColumn(quantity, protocol::ToString(side), suffix);
 }
 
 Json VariablesJson(const RecordedVariables& variables) {

@@ -294,8 +294,12 @@ int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::p
   // What every row needs (who, which trial, its variables, the answer and the radii it is judged by), then each
   // column of the table that is read from the record, as it says (SelectOf), at `at[column]`.
   std::string select = "SELECT st.name, p.code, s.id, t.trial_index, t.factors, coalesce(r.shown, '{}'), r.id IS NULL, "
-                       "r.choice, coalesce(t.task, ''), coalesce(r.r_left_px, t.r_left_px), "
-                       "coalesce(r.r_right_px, t.r_right_px), r.adjustment, s.group_name";
+                       "r.choice, coalesce(t.task, '')";
+  for (const protocol::Side side : protocol::Vocabulary<protocol::Side>::values) {
+    const std::string r = SideColumn("r", side, "px");
+    select += ", coalesce(r." + r + ", t." + r + ")";
+  }
+  select += ", r.adjustment, s.group_name";
   std::map<const Column*, int> at;
   int next = 13;
   for (const Column& c : table)

@@ -516,8 +516,8 @@ void Record::SaveTrialList(int64_t session, const std::vector<TrialRecord>& tria
     insert.Bind(2, trial.index);
     insert.Bind(3, trial.block);
     insert.Bind(4, trial.factors_json);
-    insert.Bind(5, trial.left_json);
-    insert.Bind(6, trial.right_json);
+    insert.Bind(5, trial.source_json[0]);
+    insert.Bind(6, trial.source_json[1]);
     BindTyped(RecordColumns(), insert, 7, trial);
     insert.Run();
     insert.Reset();
@@ -541,10 +541,15 @@ void Record::CheckTrialList(int64_t session, const std::vector<TrialRecord>& tri
       change = "block " + std::to_string(saved.GetInt64(1)) + " saved, " + std::to_string(trials[i].block) + " now";
     else if (saved.GetText(2) != trials[i].factors_json)
       change = "levels " + saved.GetText(2) + " saved, " + trials[i].factors_json + " now";
-    else if (saved.GetText(3) != trials[i].left_json)
-      change = "left side " + saved.GetText(3) + " saved, " + trials[i].left_json + " now";
-    else if (saved.GetText(4) != trials[i].right_json)
-      change = "right side " + saved.GetText(4) + " saved, " + trials[i].right_json + " now";
+    else
+      for (const protocol::Side side : protocol::Vocabulary<protocol::Side>::values) {
+        const std::string& now = trials[i].source_json[protocol::Index(side)];
+        const std::string was = saved.GetText(3 + int(protocol::Index(side)));
+        if (was != now) {
+          change = protocol::ToString(side) + " side " + was + " saved, " + now + " now";
+          break;
+        }
+      }
     if (!change.empty())
       throw InputError(db_.path(), SessionName(session) + " trial " + std::to_string(i) + " differs from the one made "
                                        "now (" + OneLine(change) + "): a file it reads (the calibration, a picture, a "
