@@ -145,6 +145,197 @@ void CheckInPhoto(const protocol::Protocol& protocol, const protocol::Trial& tri
 
 }  // namespace
 
+namespace {
+
+// The real picture's blur (depth matching): the thin lens of the camera that took its photo (content.real_camera).
+void DescribePicture(const protocol::Protocol& protocol, const protocol::Trial& trial, const std::string& trial_text,
+                     TrialScene* t) {
+  const protocol::LevelValue* d = FindLevel(trial.levels, "distance_m");
+  t->distance_m = d && d->IsNumber() ? d->number : 1.0;
+  if (const auto& camera = protocol.content.real_camera) {
+    try {
+      t->r_scene_px = optics::BlurRadiusPx(optics::Lens::FromCamera(*camera), protocol.content.real_focus_m * 1000,
+                                           t->distance_m * 1000);
+      // As synth-pictures refuses to make such a photo: a blur past any kernel is a wrong focus or camera.
+      if (!(t->r_scene_px <= optics::kMaxBlurRadiusPx))
+        throw Error(ErrorKind::kDomain, "the real picture at " + protocol::LevelText(t->distance_m) +
+                                            " m would be blurred by " + std::to_string(std::lround(t->r_scene_px)) +
+                                            " px, more than the largest blur (" +
+                                            std::to_string(int(optics::kMaxBlurRadiusPx)) + " px)");
+    } catch (const Error& e) {
+      throw InputError(At(protocol, "/content/real_camera"), std::string(e.what()) + trial_text);
+    }
+  }
+}
+
+// A pair trial being described over its calibrated scene: its levels read as the board and millimetres they stand
+// for, radii evaluated there, and problems named by the protocol field that asked for what cannot be shown, with the
+// trial as a detail.
+struct PairDescription {
+  const protocol::Protocol& protocol;
+  const protocol::Trial& trial;
+  const calib::SceneCalib& scene;
+  std::string trial_text;
+
+  // Where a side's source was chosen (for the scene's own blur, the calibration): looked up only for a message.
+  std::string Field(std::optional<Side> side) const {
+    return At(protocol, side ? protocol::SidePointer(protocol, trial, *side) : "/scene/calib");
+  }
+  // The radius of `source` at board_mm (photo px). One that cannot be evaluated (eq. 3.7 nearer than focus, no usable
+  // measured section) is a problem of the source the protocol chose with this calibration: an input error naming
+  // that field.
+  double RadiusAt(const cv::Vec3d& board_mm, calib::BlurSource source, double fixed, std::optional<Side> side) const {
+    try {
+      const double r = calib::BlurAtPx(scene, source, scene.ToCamera(board_mm), fixed);
+      if (!std::isfinite(r) || r < 0) throw Error(ErrorKind::kDomain, "radius " + std::to_string(r) + " px");
+      return r;
+    } catch (const Error& e) {
+      throw InputError(Field(side), ToString(source) + " blur cannot be evaluated with " +
+                                        protocol.scene.calib.string() + trial_text + ": " + e.what());
+    }
+  }
+  // Edges and sections are the calibrated board's: its own count, whatever its size.
+  int Edges() const { return scene.board.EdgeCount(); }
+  // An integer level `name` naming an edge or a section (1..most) of the calibrated board; none when not an integer.
+  std::optional<int> BoardLevel(const char* name, int most) const {
+    const protocol::LevelValue* v = FindLevel(trial.levels, name);
+    if (!v || v->kind != protocol::LevelValue::Kind::kInteger) return std::nullopt;
+    if (!(v->number >= 1 && v->number <= most))
+      throw InputError(At(protocol, protocol::LevelPointer(protocol, trial, name)),
+                       std::string(name) + " " + v->text + " is not on the calibrated board (" +
+                           std::to_string(scene.board.cols) + " x " + std::to_string(scene.board.rows) +
+                           " squares: edges 1-" + std::to_string(Edges()) + ", sections 1-" +
+                           std::to_string(Edges() - 1) + ")" + trial_text);
+    return int(v->number);
+  }
+  // A number level `name` (mm, deg), none when the trial has no such number.
+  std::optional<double> NumberLevel(const std::string& name) const {
+    const protocol::LevelValue* v = FindLevel(trial.levels, name);
+    return v && v->IsNumber() ? std::optional<double>(v->number) : std::nullopt;
+  }
+};
+
+// Where each side's object is shown, so where its radius is evaluated: its own place, but the right side's in an
+// intervals trial at the left object's (IntervalScene shows each side alone there). Evaluated at its own place, a
+// place-dependent source (measured_section, estimated, fitted) gave the right interval a radius of somewhere not shown.
+std::array<Side, 2> PlacesOf(const TrialScene& t) {
+  return {Side::kLeft, t.intervals > 0 ? Side::kLeft : Side::kRight};
+}
+
+// Two grid cards at an edge (or y_mm): each side's radius, floor and place at its card's centre.
+void DescribeGrid(const PairDescription& pair, TrialScene* t) {
+  const auto edge = pair.BoardLevel("edge", pair.Edges());
+  const auto y = pair.NumberLevel("y_mm");
+  if (!edge && !y)
+    throw InputError(At(pair.protocol, protocol::LevelPointer(pair.protocol, pair.trial, "edge")),
+                     "a grid needs an integer level edge or a y_mm" + pair.trial_text);
+  t->edge = edge ? *edge : 0;
+  t->from_y_mm = t->to_y_mm = y ? *y : (*edge - 1) * pair.scene.board.square_mm;
+  const std::array<Side, 2> place_of = PlacesOf(*t);
+  std::array<cv::Vec3d, 2> at;  // each card's centre (board mm)
+  for (size_t k = 0; k < 2; ++k) at[k] = Card(pair.scene, *t, place_of[k]).center_board_mm;
+  for (const Side side : protocol::Vocabulary<Side>::values) {
+    SideShown& shown = t->side(side);
+    shown.r_px = pair.RadiusAt(at[protocol::Index(side)], shown.source, shown.fixed_px, side);
+  }
+  for (const Side side : protocol::Vocabulary<Side>::values) {
+    SideShown& shown = t->side(side);
+    const ObjectPlace place = PlaceOf(pair.scene, at[protocol::Index(side)]);
+    shown.u_mm = place.u_mm, shown.below_axis_px = place.below_axis_px;
+    // The floor at the card's place (the distortion's stretch there; ObjectsAt draws the same).
+    shown.floor_sigma_px = calib::FloorSigmaPx(pair.scene, shown.source, pair.scene.ToCamera(at[protocol::Index(side)]));
+  }
+  t->r_scene_px = 0.5 * (pair.RadiusAt(at[0], calib::BlurSource::kFitted, 0, std::nullopt) +
+                         pair.RadiusAt(at[1], calib::BlurSource::kFitted, 0, std::nullopt));
+}
+
+// Balls: their run from the levels - a section run (edge s to s + 1, wiped on arrival), explicit edges, the whole
+// board, or at rest at an edge. A ball without a speed rests where it starts, and its radii are those of that place,
+// not of a run.
+void DescribeBallRun(const PairDescription& pair, TrialScene* t) {
+  const protocol::Trial& trial = pair.trial;
+  const double s = pair.scene.board.square_mm;
+  const int edges = pair.Edges();
+  int from = 1, to = edges;
+  const protocol::LevelValue* speed = FindLevel(trial.levels, "speed_cm_s");
+  t->speed_mm_s = speed && speed->IsNumber() ? 10 * speed->number : 0;
+  const auto edge = pair.BoardLevel("edge", edges);
+  const auto rest_y = pair.NumberLevel("y_mm");
+  if (edge || rest_y) {
+    if (t->speed_mm_s > 0 || FindLevel(trial.levels, "section") || FindLevel(trial.levels, "from_edge") ||
+        FindLevel(trial.levels, "to_edge") || FindLevel(trial.levels, "from_y_mm") ||
+        FindLevel(trial.levels, "to_y_mm") || (edge && rest_y))
+      throw InputError(At(pair.protocol, protocol::LevelPointer(pair.protocol, trial, edge ? "edge" : "y_mm")),
+                       "a ball at an edge (or y_mm) rests there: it takes no speed_cm_s, section, from/to edge or "
+                       "y_mm, and not both edge and y_mm" + pair.trial_text);
+    if (edge) from = to = *edge;
+  } else if (const auto section = pair.BoardLevel("section", edges - 1)) {
+    from = *section;
+    to = from + 1;
+    t->wipe_at_end = true;
+  } else {
+    if (const auto f = pair.BoardLevel("from_edge", edges)) from = *f;
+    if (const auto e = pair.BoardLevel("to_edge", edges)) to = *e;
+  }
+  // Without a speed the ball rests where it starts: an end or a section it would run to is never shown (it would be
+  // recorded all the same).
+  if (t->speed_mm_s <= 0)
+    for (const char* run_level : {"section", "to_edge", "to_y_mm"})
+      if (FindLevel(trial.levels, run_level))
+        throw InputError(At(pair.protocol, protocol::LevelPointer(pair.protocol, trial, run_level)),
+                         std::string("a ball without a speed_cm_s rests where it starts: ") + run_level +
+                             " describes a run it never makes (give a speed, or place it with edge, y_mm or "
+                             "from_edge)" + pair.trial_text);
+  t->from_y_mm = rest_y ? *rest_y : pair.NumberLevel("from_y_mm").value_or((from - 1) * s);
+  t->to_y_mm = rest_y ? *rest_y : pair.NumberLevel("to_y_mm").value_or((to - 1) * s);
+  if (t->speed_mm_s <= 0) t->to_y_mm = t->from_y_mm;
+}
+
+// Each side's radius, floor, place and streak averaged over the balls' run (what the observer sees on the whole),
+// sampled evenly along it; every edge the run passes is evaluated too.
+void AverageOverBallRun(const PairDescription& pair, TrialScene* t) {
+  const calib::SceneCalib& scene = pair.scene;
+  const std::array<Side, 2> place_of = PlacesOf(*t);
+  const int samples = 21;
+  const double radius = pair.protocol.content.radius_mm;
+  for (int i = 0; i < samples; ++i) {
+    const double y = t->from_y_mm + (t->to_y_mm - t->from_y_mm) * i / (samples - 1);
+    std::array<cv::Vec3d, 2> at;  // each ball's centre (board mm)
+    for (size_t k = 0; k < 2; ++k) at[k] = Ball(scene, *t, y, radius, place_of[k]).center_board_mm;
+    for (const Side side : protocol::Vocabulary<Side>::values) {
+      SideShown& shown = t->side(side);
+      shown.r_px += pair.RadiusAt(at[protocol::Index(side)], shown.source, shown.fixed_px, side) / samples;
+    }
+    for (const Side side : protocol::Vocabulary<Side>::values) {
+      SideShown& shown = t->side(side);
+      shown.floor_sigma_px += calib::FloorSigmaPx(scene, shown.source, scene.ToCamera(at[protocol::Index(side)])) /
+                              samples;
+    }
+    t->r_scene_px += 0.5 * (pair.RadiusAt(at[0], calib::BlurSource::kFitted, 0, std::nullopt) +
+                            pair.RadiusAt(at[1], calib::BlurSource::kFitted, 0, std::nullopt)) / samples;
+    for (const Side side : protocol::Vocabulary<Side>::values) {
+      SideShown& shown = t->side(side);
+      const ObjectPlace place = PlaceOf(scene, at[protocol::Index(side)]);
+      shown.u_mm += place.u_mm / samples;
+      shown.below_axis_px += place.below_axis_px / samples;
+      shown.motion_px += StreakAtPx(scene, *t, y, radius, place_of[protocol::Index(side)]) / samples;
+    }
+  }
+  // Every edge the run passes, too: the samples step over edges on a long board, and a frame there must have a
+  // radius (a measured source is its nearest edge's value, refused for an edge with no usable section).
+  for (int k = 1; k <= pair.Edges(); ++k) {
+    const double y = (k - 1) * scene.board.square_mm;
+    if (y < std::min(t->from_y_mm, t->to_y_mm) || y > std::max(t->from_y_mm, t->to_y_mm)) continue;
+    for (const Side side : protocol::Vocabulary<Side>::values) {
+      const SideShown& shown = t->side(side);
+      pair.RadiusAt(Ball(scene, *t, y, radius, place_of[protocol::Index(side)]).center_board_mm, shown.source,
+                    shown.fixed_px, side);
+    }
+  }
+}
+
+}  // namespace
+
 TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Trial& trial,
                          const calib::SceneCalib* scene, const Presentation* presentation) {
   TrialScene t;
@@ -160,176 +351,28 @@ TrialScene DescribeTrial(const protocol::Protocol& protocol, const protocol::Tri
   // Problems name the protocol field that asked for what cannot be shown, and the trial as a detail.
   const std::string trial_text = " (trial " + std::to_string(trial.index) + ", block " + trial.block + ")";
   if (t.content == protocol::ContentType::kPicture) {
-    const protocol::LevelValue* d = FindLevel(trial.levels, "distance_m");
-    t.distance_m = d && d->IsNumber() ? d->number : 1.0;
-    // The real picture's blur: the thin lens of the camera that took its photo (content.real_camera).
-    if (const auto& camera = protocol.content.real_camera) {
-      try {
-        t.r_scene_px = optics::BlurRadiusPx(optics::Lens::FromCamera(*camera), protocol.content.real_focus_m * 1000,
-                                            t.distance_m * 1000);
-        // As synth-pictures refuses to make such a photo: a blur past any kernel is a wrong focus or camera.
-        if (!(t.r_scene_px <= optics::kMaxBlurRadiusPx))
-          throw Error(ErrorKind::kDomain, "the real picture at " + protocol::LevelText(t.distance_m) +
-                                              " m would be blurred by " + std::to_string(std::lround(t.r_scene_px)) +
-                                              " px, more than the largest blur (" +
-                                              std::to_string(int(optics::kMaxBlurRadiusPx)) + " px)");
-      } catch (const Error& e) {
-        throw InputError(At(protocol, "/content/real_camera"), std::string(e.what()) + trial_text);
-      }
-    }
+    DescribePicture(protocol, trial, trial_text, &t);
     return t;
   }
   if (!scene) throw InputError(protocol.file.string(), "/scene/calib: a " + protocol::ToString(t.content) + " needs a calibration");
-  // Where a side's source was chosen ("" for the scene's own blur, the calibration's): looked up only for a message.
-  auto field = [&](std::optional<Side> side) {
-    return At(protocol, side ? protocol::SidePointer(protocol, trial, *side) : "/scene/calib");
-  };
+  const PairDescription pair{protocol, trial, *scene, trial_text};
   for (const Side side : protocol::Vocabulary<Side>::values) {
     SideShown& shown = t.side(side);
     shown.source = Source(side == Side::kLeft ? trial.left : trial.right, &shown.fixed_px,
-                          [&] { return field(side); }, presentation);
+                          [&] { return pair.Field(side); }, presentation);
   }
-  const double s = scene->board.square_mm;
-  // Where each side's object is shown, so where its radius is evaluated: its own place, but the right side's in an
-  // intervals trial at the left object's (IntervalScene shows each side alone there). Evaluated at its own place, a
-  // place-dependent source (measured_section, estimated, fitted) gave the right interval a radius of somewhere not
-  // shown.
-  const std::array<Side, 2> place_of = {Side::kLeft, t.intervals > 0 ? Side::kLeft : Side::kRight};
-  // A radius that cannot be evaluated (eq. 3.7 nearer than focus, no usable measured section) is a problem of the
-  // source the protocol chose with this calibration: an input error naming that field.
-  auto r_at = [&](const cv::Vec3d& board_mm, calib::BlurSource source, double fixed, std::optional<Side> side) {
-    try {
-      const double r = calib::BlurAtPx(*scene, source, scene->ToCamera(board_mm), fixed);
-      if (!std::isfinite(r) || r < 0) throw Error(ErrorKind::kDomain, "radius " + std::to_string(r) + " px");
-      return r;
-    } catch (const Error& e) {
-      throw InputError(field(side), ToString(source) + " blur cannot be evaluated with " +
-                                        protocol.scene.calib.string() + trial_text + ": " + e.what());
-    }
-  };
-  // Edges and sections are the calibrated board's: its own count, whatever its size.
-  const int edges = scene->board.EdgeCount();
-  auto board_level = [&](const char* name, int most) -> std::optional<int> {
-    const protocol::LevelValue* v = FindLevel(trial.levels, name);
-    if (!v || v->kind != protocol::LevelValue::Kind::kInteger) return std::nullopt;
-    if (!(v->number >= 1 && v->number <= most))
-      throw InputError(At(protocol, protocol::LevelPointer(protocol, trial, name)),
-                       std::string(name) + " " + v->text + " is not on the calibrated board (" +
-                           std::to_string(scene->board.cols) + " x " + std::to_string(scene->board.rows) +
-                           " squares: edges 1-" + std::to_string(edges) + ", sections 1-" + std::to_string(edges - 1) +
-                           ")" + trial_text);
-    return int(v->number);
-  };
-  auto mm_level = [&](const char* name) {
-    const protocol::LevelValue* v = FindLevel(trial.levels, name);
-    return v && v->IsNumber() ? std::optional<double>(v->number) : std::nullopt;
-  };
   for (const Side side : protocol::Vocabulary<Side>::values)
-    if (auto x = mm_level((ToString(side) + "_x_mm").c_str())) t.side(side).x_mm = *x;
-  t.height_mm = mm_level("height_mm").value_or(protocol.content.height_mm);
+    if (auto x = pair.NumberLevel(ToString(side) + "_x_mm")) t.side(side).x_mm = *x;
+  t.height_mm = pair.NumberLevel("height_mm").value_or(protocol.content.height_mm);
   if (t.content == protocol::ContentType::kGrid) {
     t.card_width_mm = protocol.content.size_mm;
     t.card_height_mm = protocol.content.card_height_mm;
     t.standing = protocol.content.standing;
-    t.rotation_deg = mm_level("rotation_deg").value_or(protocol.content.rotation_deg);
-  }
-  if (t.content == protocol::ContentType::kGrid) {
-    const auto edge = board_level("edge", edges);
-    const auto y = mm_level("y_mm");
-    if (!edge && !y)
-      throw InputError(At(protocol, protocol::LevelPointer(protocol, trial, "edge")),
-                       "a grid needs an integer level edge or a y_mm" + trial_text);
-    t.edge = edge ? *edge : 0;
-    t.from_y_mm = t.to_y_mm = y ? *y : (*edge - 1) * s;
-    std::array<cv::Vec3d, 2> at;  // each card's centre (board mm)
-    for (size_t k = 0; k < 2; ++k) at[k] = Card(*scene, t, place_of[k]).center_board_mm;
-    for (const Side side : protocol::Vocabulary<Side>::values) {
-      SideShown& shown = t.side(side);
-      shown.r_px = r_at(at[protocol::Index(side)], shown.source, shown.fixed_px, side);
-    }
-    for (const Side side : protocol::Vocabulary<Side>::values) {
-      SideShown& shown = t.side(side);
-      const ObjectPlace place = PlaceOf(*scene, at[protocol::Index(side)]);
-      shown.u_mm = place.u_mm, shown.below_axis_px = place.below_axis_px;
-      // The floor at the card's place (the distortion's stretch there; ObjectsAt draws the same).
-      shown.floor_sigma_px = calib::FloorSigmaPx(*scene, shown.source, scene->ToCamera(at[protocol::Index(side)]));
-    }
-    t.r_scene_px = 0.5 * (r_at(at[0], calib::BlurSource::kFitted, 0, std::nullopt) +
-                          r_at(at[1], calib::BlurSource::kFitted, 0, std::nullopt));
-    CheckInPhoto(protocol, trial, *scene, t);
-    return t;
-  }
-  // Balls: a section run (edge s to s + 1, wiped on arrival), explicit edges, the whole board, or at rest at an
-  // edge. A ball without a speed rests where it starts, and its radii are those of that place, not of a run.
-  int from = 1, to = scene->board.EdgeCount();
-  const protocol::LevelValue* speed = FindLevel(trial.levels, "speed_cm_s");
-  t.speed_mm_s = speed && speed->IsNumber() ? 10 * speed->number : 0;
-  const auto edge = board_level("edge", edges);
-  const auto rest_y = mm_level("y_mm");
-  if (edge || rest_y) {
-    if (t.speed_mm_s > 0 || FindLevel(trial.levels, "section") || FindLevel(trial.levels, "from_edge") ||
-        FindLevel(trial.levels, "to_edge") || FindLevel(trial.levels, "from_y_mm") ||
-        FindLevel(trial.levels, "to_y_mm") || (edge && rest_y))
-      throw InputError(At(protocol, protocol::LevelPointer(protocol, trial, edge ? "edge" : "y_mm")),
-                       "a ball at an edge (or y_mm) rests there: it takes no speed_cm_s, section, from/to edge or "
-                       "y_mm, and not both edge and y_mm" + trial_text);
-    if (edge) from = to = *edge;
-  } else if (const auto section = board_level("section", edges - 1)) {
-    from = *section;
-    to = from + 1;
-    t.wipe_at_end = true;
+    t.rotation_deg = pair.NumberLevel("rotation_deg").value_or(protocol.content.rotation_deg);
+    DescribeGrid(pair, &t);
   } else {
-    if (const auto f = board_level("from_edge", edges)) from = *f;
-    if (const auto e = board_level("to_edge", edges)) to = *e;
-  }
-  // Without a speed the ball rests where it starts: an end or a section it would run to is never shown (it would be
-  // recorded all the same).
-  if (t.speed_mm_s <= 0)
-    for (const char* run_level : {"section", "to_edge", "to_y_mm"})
-      if (FindLevel(trial.levels, run_level))
-        throw InputError(At(protocol, protocol::LevelPointer(protocol, trial, run_level)),
-                         std::string("a ball without a speed_cm_s rests where it starts: ") + run_level +
-                             " describes a run it never makes (give a speed, or place it with edge, y_mm or "
-                             "from_edge)" + trial_text);
-  t.from_y_mm = rest_y ? *rest_y : mm_level("from_y_mm").value_or((from - 1) * s);
-  t.to_y_mm = rest_y ? *rest_y : mm_level("to_y_mm").value_or((to - 1) * s);
-  if (t.speed_mm_s <= 0) t.to_y_mm = t.from_y_mm;
-  // Radii averaged over the run (what the observer sees on the whole), sampled evenly along it.
-  const int samples = 21;
-  const double radius = protocol.content.radius_mm;
-  for (int i = 0; i < samples; ++i) {
-    const double y = t.from_y_mm + (t.to_y_mm - t.from_y_mm) * i / (samples - 1);
-    std::array<cv::Vec3d, 2> at;  // each ball's centre (board mm)
-    for (size_t k = 0; k < 2; ++k) at[k] = Ball(*scene, t, y, radius, place_of[k]).center_board_mm;
-    for (const Side side : protocol::Vocabulary<Side>::values) {
-      SideShown& shown = t.side(side);
-      shown.r_px += r_at(at[protocol::Index(side)], shown.source, shown.fixed_px, side) / samples;
-    }
-    for (const Side side : protocol::Vocabulary<Side>::values) {
-      SideShown& shown = t.side(side);
-      shown.floor_sigma_px += calib::FloorSigmaPx(*scene, shown.source, scene->ToCamera(at[protocol::Index(side)])) /
-                              samples;
-    }
-    t.r_scene_px += 0.5 * (r_at(at[0], calib::BlurSource::kFitted, 0, std::nullopt) +
-                           r_at(at[1], calib::BlurSource::kFitted, 0, std::nullopt)) / samples;
-    for (const Side side : protocol::Vocabulary<Side>::values) {
-      SideShown& shown = t.side(side);
-      const ObjectPlace place = PlaceOf(*scene, at[protocol::Index(side)]);
-      shown.u_mm += place.u_mm / samples;
-      shown.below_axis_px += place.below_axis_px / samples;
-      shown.motion_px += StreakAtPx(*scene, t, y, radius, place_of[protocol::Index(side)]) / samples;
-    }
-  }
-  // Every edge the run passes, too: the samples step over edges on a long board, and a frame there must have a
-  // radius (a measured source is its nearest edge's value, refused for an edge with no usable section).
-  for (int k = 1; k <= edges; ++k) {
-    const double y = (k - 1) * s;
-    if (y < std::min(t.from_y_mm, t.to_y_mm) || y > std::max(t.from_y_mm, t.to_y_mm)) continue;
-    for (const Side side : protocol::Vocabulary<Side>::values) {
-      const SideShown& shown = t.side(side);
-      r_at(Ball(*scene, t, y, radius, place_of[protocol::Index(side)]).center_board_mm, shown.source, shown.fixed_px,
-           side);
-    }
+    DescribeBallRun(pair, &t);
+    AverageOverBallRun(pair, &t);
   }
   CheckInPhoto(protocol, trial, *scene, t);
   return t;
