@@ -86,19 +86,9 @@ std::vector<store::DesignColumnRecord> DesignRecord(const std::vector<protocol::
 std::string RecordedColumn(const std::string& name) { return store::DesignColumn(name); }
 bool IsRecordColumn(const std::string& column) { return store::IsRecordedName(column); }
 
-SessionsSoFar PeekSessions(const std::filesystem::path& db, const std::string& study, const std::string& participant) {
-  const store::SessionsSoFar s = store::PeekSessions(db, study, participant);
-  return {s.next_number, s.unfinished, s.unfinished_seed, s.unfinished_number};
-}
-
 uint64_t DefaultSessionSeed(const std::string& study, const std::string& participant, int64_t session_number) {
   if (session_number <= 1) return protocol::DefaultSeed(study, participant);
   return Fnv1a64(study + "/" + participant + "#" + std::to_string(session_number));
-}
-
-GroupsSoFar PeekGroups(const std::filesystem::path& db, const std::string& study, const std::string& participant) {
-  const store::GroupsSoFar g = store::PeekGroups(db, study, participant);
-  return {g.sessions, g.unfinished, g.unfinished_group, g.unfinished_info, g.earlier_group};
 }
 
 Recording::Recording(std::unique_ptr<store::Record> record) : record_(std::move(record)) {}
@@ -136,8 +126,7 @@ SessionStart Recording::StartOrResumeSession(const std::string& study, const std
   meta.design = DesignRecord(info.design);
   meta.seed_given = info.seed_given;
   meta.seed_for_number = info.seed_for_number;
-  const store::SessionStart s = record_->StartOrResumeSession(study, participant, protocol_text, seed, meta, resume);
-  return {s.session_id, s.first_unanswered_trial, s.trial_count, s.resumed, s.group, s.session_number};
+  return record_->StartOrResumeSession(study, participant, protocol_text, seed, meta, resume);
 }
 
 void Recording::SaveTrialList(int64_t session, const procedure::PreparedSession& prepared) {
@@ -168,9 +157,7 @@ void Recording::CompleteSession(int64_t session) { record_->FinishSession(sessio
 int64_t Recording::FirstUnansweredTrial(int64_t session) { return record_->FirstUnansweredTrial(session); }
 
 std::map<int64_t, RecordedAnswer> Recording::AnsweredTrials(int64_t session) {
-  std::map<int64_t, RecordedAnswer> answers;
-  for (const auto& [index, a] : record_->AnsweredTrials(session)) answers[index] = {a.choice, a.shown_json};
-  return answers;
+  return record_->AnsweredTrials(session);
 }
 
 namespace {
