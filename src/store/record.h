@@ -258,6 +258,9 @@ class Record {
                   const std::vector<DesignColumnRecord>& design);
   int64_t NextSessionNumber(int64_t participant_id, const std::string& study, const std::string& participant,
                             uint64_t seed, const SessionMeta& meta);
+  // Inserts a new running session, locked by this Record, with the group and number `start` gives it; its id.
+  int64_t InsertSession(int64_t participant_id, int64_t protocol_id, uint64_t seed, const SessionMeta& meta,
+                        const std::string& now, const SessionStart& start);
 
   Database db_;
   RecordOptions options_;
