@@ -38,6 +38,14 @@ enum class Cell { kText, kInteger, kNumber, kSeed, kAnswer };
 // The cells decided from the answer when it is exported: one column per kind of answer, each of one type.
 enum class Answer { kNone, kStatus, kChosenSide, kChoseMoreBlurred, kChosenInterval, kYesNo, kRating, kAdjustedLevel };
 
+// What the codebook says of a column - the part every table of the record and its exports shares (trials.csv's
+// columns below, frames.csv's FrameValue, procedures.csv's and adjustments.csv's ColumnDef): its name in the table
+// and the CSV, its type (string | integer | number | boolean: 0|1 | datetime: ISO 8601 UTC), unit, allowed values
+// and meaning. A table's header and its codebook rows are written from the same ColumnSpec (CodebookRow).
+struct ColumnSpec {
+  std::string name, type, unit, allowed, meaning;
+};
+
 // A value for a typed column: NULL, an integer, a number or a text.
 using Value = std::variant<std::monostate, int64_t, double, std::string>;
 
@@ -106,12 +114,9 @@ struct Stored {
   std::function<Value(const Response&)> of_response;
 };
 
-struct Column {
-  std::string name;     // trials.csv's and the codebook's
-  std::string type;     // the codebook's: string | integer | number | boolean (0|1) | datetime (ISO 8601 UTC)
-  std::string unit;
-  std::string allowed;  // what the record allows; a variable of type string without it: the values seen
-  std::string meaning;
+// A column of trials.csv: its codebook definition (ColumnSpec; `allowed` is what the record allows, and a variable of
+// type string without it lists the values seen), where the CSV puts it and how it is read and kept.
+struct Column : ColumnSpec {
   Place place = Place::kNone;
   Cell cell = Cell::kText;
   std::string select;   // the export's SQL over st, pv, p, s, t, r; "" = the kept column (at), e.g. t.block_name

@@ -31,7 +31,7 @@ namespace {
 std::vector<ColumnDef> Defs(const std::vector<Column>& table, Place place) {
   std::vector<ColumnDef> defs;
   for (const Column& c : table)
-    if (c.place == place) defs.push_back({c.name, c.type, c.unit, c.allowed, c.meaning});
+    if (c.place == place) defs.push_back(ColumnDef{c});
   return defs;
 }
 
@@ -364,12 +364,9 @@ std::string AdjustmentRows(const std::string& study, const std::string& particip
 // The codebook's rows of trials.csv (`columns`), adjustments.csv and frames.csv: a design's column with its role.
 std::string CodebookRows(const std::vector<ColumnDef>& columns) {
   std::string codebook = CsvLine({"table", "column", "type", "unit", "allowed", "meaning", "role"});
-  for (const auto& c : columns)
-    codebook += CsvLine({"trials.csv", c.name, c.type, c.unit, c.allowed, c.meaning, c.role});
-  for (const auto& c : AdjustmentColumns())
-    codebook += CsvLine({"adjustments.csv", c.name, c.type, c.unit, c.allowed, c.meaning, ""});
-  for (const auto& [c, select, cell] : FrameColumns())
-    codebook += CsvLine({"frames.csv", c.name, c.type, c.unit, c.allowed, c.meaning, ""});
+  for (const auto& c : columns) codebook += CodebookRow("trials.csv", c, c.role);
+  for (const auto& c : AdjustmentColumns()) codebook += CodebookRow("adjustments.csv", c);
+  for (const auto& [c, select, cell] : FrameColumns()) codebook += CodebookRow("frames.csv", c);
   return codebook;
 }
 

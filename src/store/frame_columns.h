@@ -38,9 +38,9 @@ struct FrameRecord {
 // The take statuses a frame may record (take_status's CHECK and the codebook's allowed values).
 inline constexpr const char* kTakeStatuses[] = {"found", "tracked", "held"};
 
-struct FrameValue {
-  std::string name;                  // the column, in the frames table and frames.csv
-  std::string type, unit, allowed, meaning;  // the codebook's
+// A frame's value: its column in the frames table and frames.csv (ColumnSpec: name and codebook), its SQL type and
+// CHECK, the schema version that added it and how it is read from a FrameRecord.
+struct FrameValue : ColumnSpec {
   std::string sql, check;            // INTEGER | REAL | TEXT; "" = no CHECK
   int since = 1;                     // the schema version that added it (1: the table's own)
   std::function<Value(const FrameRecord&)> of;
