@@ -19,7 +19,7 @@ import pandas as pd
 from common import save
 
 COLUMNS = ["mode", "frame", "status", "frame_ms", "cpu_ms", "max_depth_error_rel", "r_median_rel_error"]
-COLORS = {"track": "#0072B2", "track-serial": "#56B4E9", "detect": "#E69F00", "calibrate": "#D55E00", "calibrate-process": "#CC79A7"}
+COLORS = {"track": "#0072B2", "track-inline": "#009E73", "track-serial": "#56B4E9", "detect": "#E69F00", "calibrate": "#D55E00", "calibrate-process": "#CC79A7"}
 FRAME_BUDGET_MS = 1000 / 30
 DEPTH_TARGET = 0.001
 

@@ -4,7 +4,8 @@
 #   window    played at 30 fps through `live --window` under an Xvfb of its own: tests/live_check.py holds the log whole,
 #             every pose within 0.1 % depth of the truth and the ball's radius within 1 % of ar's; TIMING=1 also holds
 #             the real-time bounds (dropped <= 5 %, latency median <= 33 ms, p95 <= 50 ms), which are printed otherwise;
-#             then Escape pressed in the window (xdotool) ends a run: exit 0, the log whole
+#             then Escape pressed in the window (xdotool) ends a run, and so does the window closed (WM_DELETE_WINDOW,
+#             tests/close_window.py): exit 0, one line, the log whole
 #   headless  the same headless (EGL): the video ends, one clear line, exit 0, the log whole; a video cut in half:
 #             one line naming it, exit 3, the log of the frames before the damage whole
 #   nocamera  a camera that is not there: exit 3, one line naming the device, and a log of no frames written whole
@@ -70,6 +71,21 @@ PYEOF
   shown=$(( $(wc -l < "$W/window/escape/live.csv") - 1 ))
   [ $shown -ge 1 ] && [ $shown -lt 55 ] && grep -q "\"ended\": \"Escape pressed\"" "$W/window/escape/summary.json" ||
     fail "Escape's log: $shown rows, $(cat "$W/window/escape/summary.json")"
+  # The window closed as a window manager's close button closes it (WM_DELETE_WINDOW, tests/close_window.py): the
+  # run ends with one line saying so, exit 0, the log whole.
+  "$BC" live "$T/take.avi" "${LIVE[@]}" --window --fps 10 --log "$W/window/closed" > "$W/window/closed.out" \
+    2> "$W/window/closed.err" &
+  pid=$!
+  wid=$(timeout 60 xdotool search --sync --name "blurcue live: .* - showing" | head -1)
+  [ -n "$wid" ] || fail "the live window (to close) never said it was showing a frame"
+  sleep 0.5
+  $PY "$(dirname "$0")/close_window.py" "$wid" || fail "could not ask the window to close"
+  wait $pid || fail "live --window, closed: exit $?: $(cat "$W/window/closed.err")"
+  head -1 "$W/window/closed.out" | grep -q "^the window was closed$" || fail "closed: $(cat "$W/window/closed.out")"
+  shown=$(( $(wc -l < "$W/window/closed/live.csv") - 1 ))
+  [ $shown -ge 1 ] && [ $shown -lt 55 ] && grep -q "\"frames_shown\": $shown," "$W/window/closed/summary.json" &&
+    grep -q "\"ended\": \"the window was closed\"" "$W/window/closed/summary.json" ||
+    fail "the closed window's log: $shown rows, $(cat "$W/window/closed/summary.json")"
   echo "ok: live_test window" ;;
 headless)
   rm -rf "$W/headless"

@@ -20,3 +20,18 @@ if(LIVE_XVFB AND LIVE_XDOTOOL)
            COMMAND ${BLURCUE_EXPECT} "ok: live_test window" ${LIVE_TEST} window $<TARGET_FILE:blurcue> ${LIVE_DIR})
   set_tests_properties(live_window_30fps PROPERTIES FIXTURES_REQUIRED live_take LABELS "gl;window")
 endif()
+# bench live (issue 43, item 4) on 12 frames, N = 0, 4, 77 sections a frame: a row per N, and its values sane against
+# what the runs must show whatever the machine's speed (tests/live_bench_check.py; no timing bound); its chart drawn.
+add_test(NAME cli_bench_live_quick
+         COMMAND ${BLURCUE_EXPECT} "wrote .*live.csv \\(3 rows\\).*77 sections a frame: latency [0-9.]+x the pose-only run's"
+                 $<TARGET_FILE:blurcue> bench live --quick --out ${PROJECT_BINARY_DIR}/live-bench/live.csv)
+set_tests_properties(cli_bench_live_quick PROPERTIES LABELS "slow;gl" FIXTURES_SETUP live_bench)
+add_test(NAME cli_bench_live_values
+         COMMAND ${BLURCUE_EXPECT} "ok: live_bench_check" /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/live_bench_check.py
+                 ${PROJECT_BINARY_DIR}/live-bench/live.csv)
+set_tests_properties(cli_bench_live_values PROPERTIES FIXTURES_REQUIRED live_bench)
+add_test(NAME cli_bench_live_chart
+         COMMAND ${BLURCUE_EXPECT} "wrote .*bench-live.png" /usr/bin/python3 ${PROJECT_SOURCE_DIR}/analysis/live_chart.py
+                 ${PROJECT_BINARY_DIR}/live-bench/live.csv ${PROJECT_BINARY_DIR}/live-bench)
+set_tests_properties(cli_bench_live_chart PROPERTIES FIXTURES_REQUIRED live_bench LABELS slow
+                     WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}/analysis)

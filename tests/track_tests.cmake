@@ -3,10 +3,10 @@
 add_test(NAME track_cli COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" bash ${PROJECT_SOURCE_DIR}/tests/track_test.sh $<TARGET_FILE:blurcue>
                                 ${PROJECT_BINARY_DIR}/track-test)
 
-# The track bench on 4 frames writes one row per (mode, frame) - track, track-serial, detect, calibrate in process and
+# The track bench on 4 frames writes one row per (mode, frame) - track, track-inline, track-serial, detect, calibrate in process and
 # calibrate run as a command - and says the targets and the measured ratio in words; its chart is drawn.
 add_test(NAME cli_bench_track_quick
-         COMMAND ${BLURCUE_EXPECT} "wrote .*track.csv \\(20 rows\\).*track +4 .*\\(3 tracked\\).*calibrate-process +4 .*track: median [0-9.]+ ms a frame wall.*track vs calibrate run as a command on each frame: [0-9.]+x faster" $<TARGET_FILE:blurcue> bench track --quick --out ${PROJECT_BINARY_DIR}/track-bench/track.csv)
+         COMMAND ${BLURCUE_EXPECT} "wrote .*track.csv \\(24 rows\\).*track +4 .*\\(3 tracked\\).*calibrate-process +4 .*track decoding the next frame meanwhile: [0-9.]+x.*track: median [0-9.]+ ms a frame wall.*track vs calibrate run as a command on each frame: [0-9.]+x faster" $<TARGET_FILE:blurcue> bench track --quick --out ${PROJECT_BINARY_DIR}/track-bench/track.csv)
 set_tests_properties(cli_bench_track_quick PROPERTIES LABELS slow FIXTURES_SETUP track_bench)
 add_test(NAME cli_bench_track_chart
          COMMAND ${BLURCUE_EXPECT} "wrote .*bench-track.png" /usr/bin/python3 ${PROJECT_SOURCE_DIR}/analysis/track_chart.py

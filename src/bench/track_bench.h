@@ -9,7 +9,9 @@
 namespace blurcue::bench {
 
 struct TrackRow {
-  // "track" (carried pose), "track-serial" (the same, its sections measured one after another on one core),
+  // "track" (carried pose, the next frame decoded meanwhile as track::TrackTake does), "track-inline" (the same,
+  // each frame decoded before it is processed), "track-serial" (decoded in line, its sections measured one after
+  // another on one core),
   // "detect" (full detection every frame), "calibrate" (calib::Calibrate in this process),
   // "calibrate-process" (`blurcue calibrate` run as a command on the frame's PNG: start-up, decode, calib.json
   // written; wall and the child's CPU time; its accuracy is the in-process calibrate's when it wrote the same
@@ -22,6 +24,10 @@ struct TrackRow {
   double cpu_ms = 0;       // the process's CPU time over the frame's work (all threads): what the frame costs when
                            // the machine is shared and wall time is not the frame's own
   double decode_ms = 0;    // PNG decode of the frame (the same for every mode)
+  // The frame's time decoding included, as a take is tracked: track decodes the next frame on a thread of its own
+  // while this one is processed (track::TrackTake), so its period is from the end of the frame before to the end of
+  // this one; the other in-process modes decode in line (decode_ms + frame_ms); calibrate-process: frame_ms.
+  double period_ms = 0;
   double max_depth_error_rel = 0;     // max over sections of |u - u_true| / u_true
   double translation_error_mm = 0;    // |t - t_true|
   int answered = 0, sections = 0;     // usable sections

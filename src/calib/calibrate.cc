@@ -276,15 +276,22 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
   // Each section's measurement reads the photo and writes only its own result, so measured on every core (OpenCV's
   // thread pool, made once per process) the numbers are the serial ones; one stripe a section balances their
   // unequal costs.
+  std::vector<int> order;
+  if (options.only_sections.empty())
+    for (int k = 0; k < E * S; ++k) order.push_back(k);
+  for (const int k : options.only_sections)
+    if (k >= 0 && k < E * S) order.push_back(k);
+  const int measured = int(order.size());
   auto measure = [&](const cv::Range& range) {
-    for (int k = range.start; k < range.end; ++k) {
+    for (int i = range.start; i < range.end; ++i) {
+      const int k = order[i];
       SectionResult& sec = result.edges[k / S].sections[k % S];
       sec.fit = MeasureEdgeModel(linear, sec.segment, options.model_fit);
       sec.thesis = MeasureEdgeThesis(grey8, sec.segment, options.thesis);
     }
   };
-  if (options.parallel_sections) cv::parallel_for_(cv::Range(0, E * S), measure, E * S);
-  else measure(cv::Range(0, E * S));
+  if (options.parallel_sections && measured > 1) cv::parallel_for_(cv::Range(0, measured), measure, measured);
+  else measure(cv::Range(0, measured));
   // A section measured across its neighbouring edges took their blur for its own; measured again with each
   // neighbour's own measured blur (where usable; edge by edge, so a neighbour measured again already counts), since
   // their depths differ by a square's.
@@ -316,7 +323,8 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
   // The sections at other phases choose the PSF family; a section it leaves open is flagged and predicted.
   if (options.fit_model && options.phase_check) result.phase = ChoosePhaseFamily(result);
   if (options.fit_model) RequireThreeDepths(result);  // before the reference: with no usable edge, say why
-  SetReference(result, options.reference_edge);
+  // A subset (a live view's few sections a frame) leaves the reference edge unmeasured most frames: no reference then.
+  if (options.only_sections.empty()) SetReference(result, options.reference_edge);
 
   if (options.fit_model)
     result.model = FitModelWithinPhaseRanges(result, lens, options.optics_fit, &result.phase.held);
@@ -325,11 +333,15 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
     double su = 0;
     for (auto& s : edge.sections) {
       su += s.u_mm;
-      try {
-        s.r_estimated_px = optics::Eq37Px(lens, result.reference_u_mm, result.reference_r_px, s.u_mm);
-      } catch (const Error& e) {
-        if (e.kind() != ErrorKind::kDomain) throw;
-        s.estimated_note = e.what();
+      if (result.reference_u_mm <= 0) {
+        s.estimated_note = "no reference: its edge was not measured in this frame";
+      } else {
+        try {
+          s.r_estimated_px = optics::Eq37Px(lens, result.reference_u_mm, result.reference_r_px, s.u_mm);
+        } catch (const Error& e) {
+          if (e.kind() != ErrorKind::kDomain) throw;
+          s.estimated_note = e.what();
+        }
       }
       if (s.fit.ok) {
         ++edge.usable;

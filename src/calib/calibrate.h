@@ -37,6 +37,11 @@ struct CalibrateOptions {
   // (phase_check.h; with fit_model only: the sections at other phases choose the family through the lens fit). false:
   // the blur fit's readings as they are, none flagged (to compare).
   bool phase_check = true;
+  // Measure only these sections (flat index (edge - 1) * SectionCount() + section - 1; the others are left unmeasured,
+  // not usable): a live view's rotating subset. Empty: every section. Meant without fit_model (a subset rarely pins a
+  // lens); no reference edge is taken then (reference_u_mm and _r_px 0, no eq. 3.7 estimates), as a subset mostly
+  // leaves it unmeasured.
+  std::vector<int> only_sections;
 };
 
 struct SectionResult {

@@ -81,6 +81,37 @@ TEST(Calibrate, PoseWithinOneMillimetreAndHalfDegree) {
 
 // The sections measured on every core must give the numbers measured one after another, bit for bit: two orders of
 // the same computation, on rendered photos with noise (sharp and blurred edges, a distorted lens: bowed sections).
+// A live view's subset (only_sections): those sections read what the whole measurement reads for them, the others
+// are left unmeasured (not usable, no flags), and no reference edge is asked for.
+TEST(Calibrate, OnlySectionsMeasuresThoseAloneAsTheWholeMeasurementDoes) {
+  const synth::Scene& scene = Rendered(Thesis());
+  CalibrateOptions whole, subset;
+  whole.fit_model = subset.fit_model = false;
+  subset.only_sections = {7 * 4 + 2, 7 * 9 + 6, 3};  // edge 5 section 3, edge 10 section 7, edge 1 section 4
+  const CalibResult a = Calibrate(scene.image, scene.camera, scene.board, whole);
+  const CalibResult b = Calibrate(scene.image, scene.camera, scene.board, subset);
+  int measured = 0;
+  for (size_t e = 0; e < a.edges.size(); ++e)
+    for (size_t k = 0; k < a.edges[e].sections.size(); ++k) {
+      const SectionResult &x = a.edges[e].sections[k], &y = b.edges[e].sections[k];
+      const int flat = int(e * 7 + k);
+      const bool asked = flat == 7 * 4 + 2 || flat == 7 * 9 + 6 || flat == 3;
+      SCOPED_TRACE("edge " + std::to_string(x.edge) + " section " + std::to_string(x.section));
+      if (asked) {
+        ++measured;
+        EXPECT_TRUE(x.fit.ok);
+        EXPECT_EQ(y.fit.ok, x.fit.ok);
+        EXPECT_EQ(y.fit.r_px, x.fit.r_px);
+        EXPECT_EQ(y.thesis.r_px, x.thesis.r_px);
+      } else {
+        EXPECT_FALSE(y.fit.ok);
+        EXPECT_TRUE(y.fit.flags.empty());
+      }
+      EXPECT_EQ(y.u_mm, x.u_mm);  // every section's geometry is the pose's either way
+    }
+  EXPECT_EQ(measured, 3);
+}
+
 TEST(Calibrate, ParallelSectionsGiveTheSerialNumbers) {
   std::printf("OpenCV threads: %d\n", cv::getNumThreads());
   synth::SceneOptions distorted = Thesis();

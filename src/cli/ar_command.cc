@@ -47,16 +47,222 @@ void SyncFile(const std::filesystem::path& path) {
   close(fd);
 }
 
+struct ArArgs {
+  std::string input, track, out, csv, frames_dir, blur = "fitted", method = "disc";
+  ObjectOptions objects;
+  double exposure_ms = -1;
+  bool quiet = false;
+};
+
+namespace fs = std::filesystem;
+
+// A name --frames may hold: frame-NNNN.png.
+bool IsArFrameName(const std::string& name) {
+  return name.size() == 14 && name.rfind("frame-", 0) == 0 && name.compare(10, 4, ".png") == 0 &&
+         name.find_first_not_of("0123456789", 6) == 10;
+}
+
+// Nothing is read or drawn before every output is known to be writable and none is an input: checks them, removes
+// what an earlier run left beside them, and returns the CSV's path.
+std::string CheckArOutputs(const ArArgs& args) {
+  {
+    std::string extension = fs::path(args.out).extension().string();
+    for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (extension != ".avi") throw Error(ErrorKind::kUsage, "--out " + Echo(args.out) + ": must end in .avi");
+  }
+  const std::string csv_path = args.csv.empty() ? fs::path(args.out).replace_extension(".csv").string() : args.csv;
+  if (args.objects.balls.size() + args.objects.cards.size() > kMaxArObjects)
+    throw Error(ErrorKind::kUsage, std::to_string(args.objects.balls.size() + args.objects.cards.size()) +
+                                       " --ball and --card options: at most " + std::to_string(kMaxArObjects) +
+                                       " objects a run");
+  {
+    OutputGuard guard;
+    for (const fs::path& file : track::TakeInputFiles(args.input)) guard.Input("INPUT", file);
+    guard.Input("--track", args.track);
+    GuardObjectInputs(guard, args.objects);
+    guard.OutputFile("--out", args.out).OutputFile(args.csv.empty() ? "the CSV (OUT with .csv)" : "--csv", csv_path);
+    if (!args.frames_dir.empty()) guard.OutputFolder("--frames", args.frames_dir);
+    guard.Check();
+  }
+  try {
+    if (!args.frames_dir.empty()) RequireReplaceableFolder(args.frames_dir, IsArFrameName);
+  } catch (const Error& e) {
+    throw e.Wrapped(e.kind(), "--frames ");
+  }
+  for (const std::string& target : {args.out, csv_path, args.frames_dir})
+    if (!target.empty()) RemoveLeftoversBeside("ar", target);
+  return csv_path;
+}
+
+// The take within the frame limit, and every object seen in at least one of its frames.
+void CheckArTake(const ArArgs& args, const stimulus::TrackedTake& take, const track::FrameSource& source,
+                 const std::vector<stimulus::PlacedObject>& objects, const std::vector<std::string>& given) {
+  if (int(take.frames.size()) > kMaxArFrames || source.expected_frames() > kMaxArFrames)
+    throw InputError(int(take.frames.size()) > kMaxArFrames ? args.track : args.input,
+                     std::to_string(std::max(int(take.frames.size()), source.expected_frames())) +
+                         " frames: ar draws at most " + std::to_string(kMaxArFrames) + " a run");
+  // An object in no frame's photo would leave a video without it and a summary that counts it drawn: a slip of
+  // millimetres (400 for 40) is refused before anything is written.
+  for (size_t i = 0; i < objects.size(); ++i) {
+    if (!stimulus::SeenInAnyFrame(take, objects[i].object))
+      throw InputError(given[i], objects[i].name + " at (" + Num(objects[i].object.center_board_mm[0]) + ", " +
+                                     Num(objects[i].object.center_board_mm[1]) +
+                                     ") mm on the board lies outside the photo in every frame of the take (the board "
+                                     "is " + Num(take.board().WidthMm()) + " x " + Num(take.board().LengthMm()) +
+                                     " mm): nothing of it would be drawn");
+  }
+}
+
+// The exposure that streaks the objects, into blur->exposure_ms: --exposure-ms, else the camera's, else half a
+// video's frame interval, else none. Returns where it came from, for the run's first line.
+std::string ChooseArExposure(const ArArgs& args, const stimulus::TrackedTake& take, const track::FrameSource& source,
+                             stimulus::TakeBlur* blur) {
+  const Camera& camera = take.camera();
+  const double take_fps = take.FramesPerSecond();
+  std::string exposure_note = "given";
+  if (args.exposure_ms < 0 && camera.exposure_ms) {
+    // A frame is exposed within its own interval: a longer exposure is a camera.json of a photo, not of this take.
+    if (const std::string beyond = stimulus::ExposureBeyondFrame(*camera.exposure_ms, take_fps); !beyond.empty())
+      throw InputError(args.track + ": the camera's exposure_ms",
+                       "is " + Num(*camera.exposure_ms) + " ms, " + beyond +
+                           ": not this take's camera? give --exposure-ms");
+    blur->exposure_ms = *camera.exposure_ms;
+    exposure_note = "the camera's exposure_ms, as tracked";
+  } else if (args.exposure_ms < 0) {
+    const bool rate_known = source.is_video() && source.fps() > 0;
+    blur->exposure_ms = rate_known ? 1000 / source.fps() / 2 : 0;
+    exposure_note = rate_known ? "the camera's exposure is unknown: half the frame interval of the video's " +
+                                     Num(source.fps()) + " fps (give --exposure-ms)"
+                               : "no motion blur: the camera's exposure is unknown and an image sequence states no "
+                                 "frame rate (give --exposure-ms)";
+  } else {
+    if (const std::string beyond = stimulus::ExposureBeyondFrame(args.exposure_ms, take_fps); !beyond.empty())
+      throw Error(ErrorKind::kUsage, "--exposure-ms " + Num(args.exposure_ms) + ": " + beyond +
+                                         ": a camera exposes each frame within its own interval");
+    blur->exposure_ms = args.exposure_ms;
+  }
+  return exposure_note;
+}
+
+// A folder removed with what is in it when the run ends, written whole or not.
+struct RemovedAtExit {
+  fs::path path;
+  ~RemovedAtExit() {
+    std::error_code ignored;
+    fs::remove_all(path, ignored);
+  }
+};
+
+// Makes `partial`, the folder an output (`target`) is built in.
+void MakePartialFolder(const fs::path& partial, const std::string& target) {
+  std::error_code error;
+  fs::create_directories(partial, error);
+  if (error) throw InputError(target, "cannot make " + partial.string() + ": " + error.message());
+}
+
+// One run's drawing: every frame of the source into the video (opened at the first frame), the CSV's rows and the
+// --frames PNGs, and what the summary counts.
+struct ArDrawing {
+  const ArArgs& args;
+  const stimulus::TrackedTake& take;
+  const std::vector<stimulus::PlacedObject>& objects;
+  const stimulus::TakeBlur& blur;
+  track::FrameSource& source;
+  fs::path video_temp;
+  std::unique_ptr<render::FrameCompositor> compositor = nullptr;
+  media::VideoWriter video = {};
+  std::string codec_used = {};
+  std::string csv = stimulus::DrawnCsvHeader();
+  int written = 0, drawn_frames = 0, unposed = 0;
+  std::optional<Error> ended = std::nullopt;
+  std::vector<double> draw_ms = {};  // per frame with objects: photo upload, pose, compose, read back
+
+  // Draws every frame: into the video, the CSV and (when not empty) `frames_dir`.
+  void DrawFrames(const fs::path& frames_dir) {
+    const bool tty = isatty(2) && !args.quiet;
+    cv::Mat frame;
+    int index = 0;
+    double time_s = 0;
+    while (true) {
+      if (written == kMaxArFrames) {
+        ended = InputError(args.input, "more than " + std::to_string(kMaxArFrames) + " frames: ar draws at most " +
+                                           std::to_string(kMaxArFrames) + " a run");
+        break;
+      }
+      try {
+        if (!source.Next(&frame, &index, &time_s)) break;
+      } catch (const Error& e) {
+        ended = e;
+        break;
+      }
+      const std::string status = DrawFrame(frame, index, time_s, frames_dir);
+      ++written;
+      if (!args.quiet && (tty || (written % 10 == 0)))
+        std::fprintf(stderr, "%sframe %d%s: %s%s", tty ? "\r" : "", index,
+                     source.expected_frames() > 0 ? ("/" + std::to_string(source.expected_frames())).c_str() : "",
+                     status.c_str(), tty ? "   " : "\n");
+    }
+    if (tty) std::fprintf(stderr, "\n");
+    if (written == 0) throw ended ? *ended : InputError(args.input, "holds no frame; nothing written");
+    video.Release();  // the frames written so far make a whole file, also when the input ended early
+  }
+
+  // One frame with its objects (when it has a pose) into the video, its rows into the CSV; returns its status.
+  std::string DrawFrame(const cv::Mat& frame, int index, double time_s, const fs::path& frames_dir) {
+    stimulus::CheckTakeFrame(take, index, frame, args.input, args.track);
+    if (!video.IsOpened()) {
+      const char* codec = OpenLosslessVideo(video, video_temp, source.fps() > 0 ? source.fps() : 30, frame.size());
+      if (!codec) throw InputError(args.out, "cannot open a video writer (FFV1 or MJPEG .avi)");
+      codec_used = codec;
+    }
+    const bool in_take = index < int(take.frames.size());
+    const stimulus::TrackedFramePlan plan = stimulus::PlanTrackedFrame(take, index, objects, blur);
+    cv::Mat out = frame;
+    if (in_take && take.frames[size_t(index)].calib) {
+      const calib::SceneCalib& c = *take.frames[size_t(index)].calib;
+      if (!compositor) compositor = std::make_unique<render::FrameCompositor>(take.camera(), c.rvec, c.tvec, frame);
+      const auto draw_start = std::chrono::steady_clock::now();
+      compositor->SetFrame(c.rvec, c.tvec, frame);
+      compositor->Compose(plan.objects);
+      out = compositor->Read();
+      draw_ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - draw_start).count());
+      ++drawn_frames;
+    } else {
+      ++unposed;
+    }
+    video.Write(out);
+    if (!frames_dir.empty()) {
+      char name[32];
+      std::snprintf(name, sizeof name, "frame-%04d.png", index);
+      WriteImage(frames_dir / name, out);
+    }
+    const std::string status = in_take ? track::Name(take.frames[size_t(index)].status) : "untracked";
+    csv += stimulus::DrawnCsvRows(index, in_take ? take.frames[size_t(index)].time_s : time_s, status, plan.drawn);
+    return status;
+  }
+};
+
+// What was written and how long drawing took (not with --quiet).
+void PrintArSummary(const ArArgs& args, const ArDrawing& d, const std::string& csv_path, double seconds) {
+  std::printf("%d frames: %d with objects, %d without (lost or beyond track.csv); wrote %s (%s) and %s in %.1f s\n",
+              d.written, d.drawn_frames, d.unposed, args.out.c_str(), d.codec_used.c_str(), csv_path.c_str(), seconds);
+  if (!d.draw_ms.empty()) {
+    std::vector<double> draw_ms = d.draw_ms;
+    std::sort(draw_ms.begin(), draw_ms.end());
+    std::printf("drawing: median %.1f ms a frame, slowest %.1f ms (photo upload, objects composed, frame read "
+                "back; decoding and encoding not included)\n",
+                draw_ms[draw_ms.size() / 2], draw_ms.back());
+  }
+  if (!d.ended && d.written < int(d.take.frames.size()))
+    std::printf("note: %s ended after %d frames; track.csv has %zu\n", args.input.c_str(), d.written,
+                d.take.frames.size());
+}
+
 }  // namespace
 
 void AddArCommand(CLI::App& app) {
-  struct Args {
-    std::string input, track, out, csv, frames_dir, blur = "fitted", method = "disc";
-    ObjectOptions objects;
-    double exposure_ms = -1;
-    bool quiet = false;
-  };
-  auto args = std::make_shared<Args>();
+  auto args = std::make_shared<ArArgs>();
   CLI::App* cmd = app.add_subcommand(
       "ar",
       "Draw virtual objects into a tracked take: the offline AR view, every frame at its own pose, each object blurred\n"
@@ -98,38 +304,7 @@ void AddArCommand(CLI::App& app) {
   cmd->add_flag("--quiet", args->quiet, "print only errors");
   cmd->callback([args] {
     const auto t0 = std::chrono::steady_clock::now();
-    {
-      std::string extension = std::filesystem::path(args->out).extension().string();
-      for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
-      if (extension != ".avi") throw Error(ErrorKind::kUsage, "--out " + Echo(args->out) + ": must end in .avi");
-    }
-    const std::string csv_path =
-        args->csv.empty() ? std::filesystem::path(args->out).replace_extension(".csv").string() : args->csv;
-    // Nothing is read or drawn before every output is known to be writable and none is an input.
-    if (args->objects.balls.size() + args->objects.cards.size() > kMaxArObjects)
-      throw Error(ErrorKind::kUsage, std::to_string(args->objects.balls.size() + args->objects.cards.size()) +
-                                         " --ball and --card options: at most " + std::to_string(kMaxArObjects) +
-                                         " objects a run");
-    {
-      OutputGuard guard;
-      for (const std::filesystem::path& file : track::TakeInputFiles(args->input)) guard.Input("INPUT", file);
-      guard.Input("--track", args->track);
-      GuardObjectInputs(guard, args->objects);
-      guard.OutputFile("--out", args->out).OutputFile(args->csv.empty() ? "the CSV (OUT with .csv)" : "--csv", csv_path);
-      if (!args->frames_dir.empty()) guard.OutputFolder("--frames", args->frames_dir);
-      guard.Check();
-    }
-    auto is_frame = [](const std::string& name) {
-      return name.size() == 14 && name.rfind("frame-", 0) == 0 && name.compare(10, 4, ".png") == 0 &&
-             name.find_first_not_of("0123456789", 6) == 10;
-    };
-    try {
-      if (!args->frames_dir.empty()) RequireReplaceableFolder(args->frames_dir, is_frame);
-    } catch (const Error& e) {
-      throw e.Wrapped(e.kind(), "--frames ");
-    }
-    for (const std::string& target : {args->out, csv_path, args->frames_dir})
-      if (!target.empty()) RemoveLeftoversBeside("ar", target);
+    const std::string csv_path = CheckArOutputs(*args);
     stimulus::TakeBlur blur;
     blur.source = calib::ParseBlurSource(args->blur, &blur.fixed_r_px);
     blur.method = args->method;
@@ -138,151 +313,37 @@ void AddArCommand(CLI::App& app) {
     const std::vector<stimulus::PlacedObject> objects = PlaceObjects(args->objects, &given);
 
     const stimulus::TrackedTake take = stimulus::LoadTrackedTake(args->track);
-    const Camera& camera = take.camera();
     const double take_fps = take.FramesPerSecond();
     track::FrameSource source(args->input, take_fps > 0 ? take_fps : 30);
-    if (int(take.frames.size()) > kMaxArFrames || source.expected_frames() > kMaxArFrames)
-      throw InputError(int(take.frames.size()) > kMaxArFrames ? args->track : args->input,
-                       std::to_string(std::max(int(take.frames.size()), source.expected_frames())) +
-                           " frames: ar draws at most " + std::to_string(kMaxArFrames) + " a run");
-    // An object in no frame's photo would leave a video without it and a summary that counts it drawn: a slip of
-    // millimetres (400 for 40) is refused before anything is written.
-    for (size_t i = 0; i < objects.size(); ++i) {
-      if (!stimulus::SeenInAnyFrame(take, objects[i].object))
-        throw InputError(given[i], objects[i].name + " at (" + Num(objects[i].object.center_board_mm[0]) + ", " +
-                                       Num(objects[i].object.center_board_mm[1]) +
-                                       ") mm on the board lies outside the photo in every frame of the take (the board "
-                                       "is " + Num(take.board().WidthMm()) + " x " + Num(take.board().LengthMm()) +
-                                       " mm): nothing of it would be drawn");
-    }
-
-    std::string exposure_note = "given";
-    if (args->exposure_ms < 0 && camera.exposure_ms) {
-      // A frame is exposed within its own interval: a longer exposure is a camera.json of a photo, not of this take.
-      if (const std::string beyond = stimulus::ExposureBeyondFrame(*camera.exposure_ms, take_fps); !beyond.empty())
-        throw InputError(args->track + ": the camera's exposure_ms",
-                         "is " + Num(*camera.exposure_ms) + " ms, " + beyond +
-                             ": not this take's camera? give --exposure-ms");
-      blur.exposure_ms = *camera.exposure_ms;
-      exposure_note = "the camera's exposure_ms, as tracked";
-    } else if (args->exposure_ms < 0) {
-      const bool rate_known = source.is_video() && source.fps() > 0;
-      blur.exposure_ms = rate_known ? 1000 / source.fps() / 2 : 0;
-      exposure_note = rate_known ? "the camera's exposure is unknown: half the frame interval of the video's " +
-                                       Num(source.fps()) + " fps (give --exposure-ms)"
-                                 : "no motion blur: the camera's exposure is unknown and an image sequence states no "
-                                   "frame rate (give --exposure-ms)";
-    } else {
-      if (const std::string beyond = stimulus::ExposureBeyondFrame(args->exposure_ms, take_fps); !beyond.empty())
-        throw Error(ErrorKind::kUsage, "--exposure-ms " + Num(args->exposure_ms) + ": " + beyond +
-                                           ": a camera exposes each frame within its own interval");
-      blur.exposure_ms = args->exposure_ms;
-    }
+    CheckArTake(*args, take, source, objects, given);
+    const std::string exposure_note = ChooseArExposure(*args, take, source, &blur);
     if (!args->quiet)
       std::fprintf(stderr, "%zu objects, blur %s, exposure %s ms (%s), %zu frames in %s\n", objects.size(),
                    args->blur.c_str(), Num(blur.exposure_ms).c_str(), exposure_note.c_str(), take.frames.size(),
                    args->track.c_str());
 
     std::unique_ptr<render::GlContext> context = render::GlContext::CreateOffscreen();
-    std::unique_ptr<render::FrameCompositor> compositor;
-    media::VideoWriter video;
-    std::string codec_used;
     // The video is written under its own name (the extension tells the writer its container) inside
     // DIR/.NAME.partial-PID, and moved into place once it, the frames and the CSV are whole; a run that fails or is
     // killed leaves the earlier video (the next run removes the partial folder).
-    namespace fs = std::filesystem;
     const fs::path video_partial = TemporaryBeside(args->out, "partial");
-    struct RemovedAtExit {
-      fs::path path;
-      ~RemovedAtExit() {
-        std::error_code ignored;
-        fs::remove_all(path, ignored);
-      }
-    } partial_video{video_partial};
-    {
-      std::error_code error;
-      fs::create_directories(video_partial, error);
-      if (error) throw InputError(args->out, "cannot make " + video_partial.string() + ": " + error.message());
-    }
+    const RemovedAtExit partial_video{video_partial};
+    MakePartialFolder(video_partial, args->out);
     const fs::path video_temp = video_partial / fs::path(args->out).filename();
     // The CSV, written whole inside a folder of its own beside its place, .NAME.partial-PID, before the video is
     // moved: whatever a kill leaves there is one folder, removed here on failure or by the next run's
     // RemoveStaleLeftovers (a file written atomically beside it would leave its own .tmp-PID that no one names).
     const fs::path csv_partial = TemporaryBeside(csv_path, "partial");
     const RemovedAtExit partial_csv{csv_partial};
-    {
-      std::error_code error;
-      fs::create_directories(csv_partial, error);
-      if (error) throw InputError(csv_path, "cannot make " + csv_partial.string() + ": " + error.message());
-    }
+    MakePartialFolder(csv_partial, csv_path);
     const fs::path csv_temp = csv_partial / fs::path(csv_path).filename();
-    std::string csv = stimulus::DrawnCsvHeader();
-    const bool tty = isatty(2) && !args->quiet;
-    int written = 0, drawn_frames = 0, unposed = 0;
-    std::optional<Error> ended;
-    std::vector<double> draw_ms;  // per frame with objects: photo upload, pose, compose, read back
-    cv::Mat frame;
-    int index = 0;
-    double time_s = 0;
-    // Draws every frame: into the video, the CSV and (when not empty) `frames_dir`.
-    auto draw = [&](const fs::path& frames_dir) {
-      while (true) {
-        if (written == kMaxArFrames) {
-          ended = InputError(args->input, "more than " + std::to_string(kMaxArFrames) + " frames: ar draws at most " +
-                                              std::to_string(kMaxArFrames) + " a run");
-          break;
-        }
-        try {
-          if (!source.Next(&frame, &index, &time_s)) break;
-        } catch (const Error& e) {
-          ended = e;
-          break;
-        }
-        stimulus::CheckTakeFrame(take, index, frame, args->input, args->track);
-        if (!video.IsOpened()) {
-          const char* codec = OpenLosslessVideo(video, video_temp, source.fps() > 0 ? source.fps() : 30, frame.size());
-          if (!codec) throw InputError(args->out, "cannot open a video writer (FFV1 or MJPEG .avi)");
-          codec_used = codec;
-        }
-        const bool in_take = index < int(take.frames.size());
-        const stimulus::TrackedFramePlan plan = stimulus::PlanTrackedFrame(take, index, objects, blur);
-        cv::Mat out = frame;
-        if (in_take && take.frames[size_t(index)].calib) {
-          const calib::SceneCalib& c = *take.frames[size_t(index)].calib;
-          if (!compositor) compositor = std::make_unique<render::FrameCompositor>(camera, c.rvec, c.tvec, frame);
-          const auto draw_start = std::chrono::steady_clock::now();
-          compositor->SetFrame(c.rvec, c.tvec, frame);
-          compositor->Compose(plan.objects);
-          out = compositor->Read();
-          draw_ms.push_back(
-              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - draw_start).count());
-          ++drawn_frames;
-        } else {
-          ++unposed;
-        }
-        video.Write(out);
-        if (!frames_dir.empty()) {
-          char name[32];
-          std::snprintf(name, sizeof name, "frame-%04d.png", index);
-          WriteImage(frames_dir / name, out);
-        }
-        const std::string status = in_take ? track::Name(take.frames[size_t(index)].status) : "untracked";
-        csv += stimulus::DrawnCsvRows(index, in_take ? take.frames[size_t(index)].time_s : time_s, status, plan.drawn);
-        ++written;
-        if (!args->quiet && (tty || (written % 10 == 0)))
-          std::fprintf(stderr, "%sframe %d%s: %s%s", tty ? "\r" : "", index,
-                       source.expected_frames() > 0 ? ("/" + std::to_string(source.expected_frames())).c_str() : "",
-                       status.c_str(), tty ? "   " : "\n");
-      }
-      if (tty) std::fprintf(stderr, "\n");
-      if (written == 0) throw ended ? *ended : InputError(args->input, "holds no frame; nothing written");
-      video.Release();  // the frames written so far make a whole file, also when the input ended early
-    };
+    ArDrawing drawing{*args, take, objects, blur, source, video_temp};
+    auto draw = [&](const fs::path& frames_dir) { drawing.DrawFrames(frames_dir); };
     // The video and the CSV, both whole on disk, are moved into place by two renames one after the other, and with
     // --frames the frames folder is swapped in by a third right after (WriteFolderAtomically's before_swap): the
     // three are no single step, but all that lies between them is three renames.
     auto move_in = [&] {
-      WriteFileAtomically(csv_temp, csv);
+      WriteFileAtomically(csv_temp, drawing.csv);
       SyncFile(video_temp);
       std::error_code error;
       fs::rename(video_temp, args->out, error);
@@ -293,25 +354,14 @@ void AddArCommand(CLI::App& app) {
       draw({});
       move_in();
     } else {
-      WriteFolderAtomically(args->frames_dir, draw, is_frame, move_in);
+      WriteFolderAtomically(args->frames_dir, draw, IsArFrameName, move_in);
     }
-    if (!args->quiet) {
-      std::printf("%d frames: %d with objects, %d without (lost or beyond track.csv); wrote %s (%s) and %s in %.1f s\n",
-                  written, drawn_frames, unposed, args->out.c_str(), codec_used.c_str(), csv_path.c_str(),
-                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-      if (!draw_ms.empty()) {
-        std::sort(draw_ms.begin(), draw_ms.end());
-        std::printf("drawing: median %.1f ms a frame, slowest %.1f ms (photo upload, objects composed, frame read "
-                    "back; decoding and encoding not included)\n",
-                    draw_ms[draw_ms.size() / 2], draw_ms.back());
-      }
-      if (!ended && written < int(take.frames.size()))
-        std::printf("note: %s ended after %d frames; track.csv has %zu\n", args->input.c_str(), written,
-                    take.frames.size());
-    }
-    if (ended)
-      throw Error(ended->kind(), std::string(ended->what()) + "; the " + std::to_string(written) +
-                                     " frames before it are in " + args->out);
+    if (!args->quiet)
+      PrintArSummary(*args, drawing, csv_path,
+                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    if (drawing.ended)
+      throw Error(drawing.ended->kind(), std::string(drawing.ended->what()) + "; the " +
+                                             std::to_string(drawing.written) + " frames before it are in " + args->out);
   });
 }
 

@@ -16,6 +16,106 @@
 
 namespace blurcue::cli {
 
+namespace {
+
+// A pose that fits badly, or a lens model far from the camera's f-number: warnings on stderr (even with --quiet).
+void WarnAboutCalibration(const calib::CalibResult& result, const Camera& camera, const std::string& camera_file,
+                          const std::string& photo_file) {
+  // A pose that fits its corners badly: the camera is not this photo's (distortion, sensor, focal length).
+  if (result.pose.reprojection_error_px > 1)
+    std::fprintf(stderr,
+                 "blurcue: warning: %s: the board's corners fit the pose only to %.2f px (a photo of this camera "
+                 "fits to well under 1 px): check its dist_coeffs, sensor size and focal length; the depths and "
+                 "blurs measured rest on that pose\n",
+                 camera_file.c_str(), result.pose.reprojection_error_px);
+  // A lens model whose aperture is far from the camera's f-number fits sections that may not measure the board's
+  // edges (an edge covered or shaded reads sharp: a covered board gave focus 21 mm and an aperture of 0).
+  if (const double ratio = result.model.aperture_mm / camera.ApertureMm(); !(ratio >= 0.5 && ratio <= 2))
+    std::fprintf(stderr,
+                 "blurcue: warning: %s: the fitted aperture %.3f mm is %.2f x the camera's (%.3f mm, f/%g): the "
+                 "sections may not measure the board's edges (covered, shaded, reflections; see the table's "
+                 "flags) or camera.json's f_number is not the photo's\n",
+                 photo_file.c_str(), result.model.aperture_mm, ratio, camera.ApertureMm(), camera.f_number);
+}
+
+// The board, the reference edge, the fitted model and the sections it was fitted to.
+void PrintCalibrationSummary(const calib::CalibResult& result, const Board& board, const Camera& camera) {
+  const auto& m = result.model;
+  std::printf("board %s found; pose reprojection error %.3f px; board origin %.1f mm from the lens\n",
+              board.Name().c_str(), result.pose.reprojection_error_px, cv::norm(result.pose.tvec));
+  std::printf("reference edge %d: u = %.1f mm, r = %.2f px (median of its usable sections)\n",
+              result.reference_edge, result.reference_u_mm, result.reference_r_px);
+  std::printf("fitted %s model: focus %.1f mm, aperture %.3f mm (nominal %.3f), %s, rms %.3f px,"
+              " leave-one-out %.3f px, %d outliers of %d\n",
+              m.kind.c_str(), m.focus_mm, m.aperture_mm, camera.ApertureMm(), optics::FloorText(m).c_str(),
+              m.rms_px, m.loo_rms_px, m.outliers, m.samples_used);
+  // How many sections the model was fitted to, and why the others were left out.
+  {
+    int sections = 0;
+    for (const auto& e : result.edges) sections += static_cast<int>(e.sections.size());
+    std::string left;
+    int n_left = 0;
+    for (const auto& [why, n] : calib::SectionsLeftOut(result))
+      left += (left.empty() ? "" : ", ") + std::to_string(n) + " " + why, n_left += n;
+    std::printf("the model is fitted to %d of %d sections%s\n", sections - n_left, sections,
+                left.empty() ? "" : ("; left out (it predicts them): " + left).c_str());
+  }
+}
+
+// The phase check's summary, and each edge with phase_limited sections.
+void PrintPhaseCheck(const calib::CalibResult& result) {
+  std::printf("phase check: %s\n", result.phase.summary.c_str());
+  // Each edge with phase_limited sections, once, with its first section's reason (every one's is in calib.json).
+  for (const auto& e : result.edges) {
+    int n = 0;
+    const std::string* why = nullptr;
+    for (const auto& sec : e.sections)
+      if (!sec.fit.phase_why.empty()) ++n, why = why ? why : &sec.fit.phase_why;
+    if (n > 0) std::printf("  edge %d: %d of %zu sections phase_limited: %s\n", e.index, n, e.sections.size(),
+                           why->c_str());
+  }
+  if (result.phase.held > 0)
+    std::printf("phase check: the model predicted %d phase_limited sections outside the range their families "
+                "leave open; their ranges' middles joined its fit\n", result.phase.held);
+}
+
+// Why this model (calib.json's model.choice): both candidates' held-out errors, and eq. 3.7 as published.
+void PrintModelChoice(const calib::CalibResult& result, const Json& choice) {
+  const auto& m = result.model;
+  if (std::isfinite(m.floor_loo_rms_px))
+    std::printf("model choice, held-out error: thin lens %.3f px, thin lens + floor %.3f px (%s)\n",
+                m.thin_loo_rms_px, m.floor_loo_rms_px, optics::kModelChoiceRule);
+  else
+    std::printf("model: the thin lens alone (the floor model needs at least 10 sections; %d usable)\n",
+                m.samples_used);
+  if (choice["eq37"]["rms_px"].is_number())
+    std::printf("eq. 3.7 (the thesis's estimate from reference edge %d, no parameters fitted): rms %.3f px against "
+                "the measured sections%s\n",
+                result.reference_edge, choice["eq37"]["rms_px"].get<double>(),
+                m.kind == "thin_lens+floor" ? " (it takes the reference's whole blur for defocus, floor included)"
+                                            : "");
+}
+
+// --truth: the pose and every method's blur against the ground truth; the true radius of each edge, for the table.
+std::vector<double> PrintAgainstTruth(const calib::CalibResult& result, const std::string& truth_file) {
+  const calib::TruthComparison cmp =
+      calib::CompareToTruth(result, ReadJsonFile(truth_file), truth_file + ": ");
+  std::printf("against truth: pose %.3f mm / %.3f deg, section depths within %.3f mm\n",
+              cmp.translation_error_mm, cmp.rotation_error_deg, cmp.max_depth_error_mm);
+  auto summary = [&](const char* name, calib::MethodError calib::SectionComparison::*method) {
+    const calib::MethodSummary m = calib::SummarizeMethod(cmp, method);
+    std::printf("  %-22s answered %2d/%d, mean |error| %.3f px, worst %.3f px, within max(0.25 px, 5%%): %d\n",
+                name, m.answered, m.sections, m.mean_abs_error_px, m.max_abs_error_px, m.within_target);
+  };
+  summary("model fit (r_px)", &calib::SectionComparison::model);
+  summary("thesis (r_thesis_px)", &calib::SectionComparison::thesis);
+  summary("eq. 3.7 (r_estimated)", &calib::SectionComparison::estimated);
+  summary("fitted (r_fitted_px)", &calib::SectionComparison::fitted);
+  return cmp.true_r_per_edge;
+}
+
+}  // namespace
+
 void AddCalibrateCommand(CLI::App& app) {
   struct Args {
     std::string photo, camera, out = "calib.json", board = "7x10", truth;
@@ -76,88 +176,13 @@ void AddCalibrateCommand(CLI::App& app) {
     Json json = calib::CalibToJson(result);
     json["photo"] = args->photo;
     WriteJsonFile(args->out, json);
-    // A pose that fits its corners badly: the camera is not this photo's (distortion, sensor, focal length).
-    if (result.pose.reprojection_error_px > 1)
-      std::fprintf(stderr,
-                   "blurcue: warning: %s: the board's corners fit the pose only to %.2f px (a photo of this camera "
-                   "fits to well under 1 px): check its dist_coeffs, sensor size and focal length; the depths and "
-                   "blurs measured rest on that pose\n",
-                   args->camera.c_str(), result.pose.reprojection_error_px);
-    // A lens model whose aperture is far from the camera's f-number fits sections that may not measure the board's
-    // edges (an edge covered or shaded reads sharp: a covered board gave focus 21 mm and an aperture of 0).
-    if (const double ratio = result.model.aperture_mm / camera.ApertureMm(); !(ratio >= 0.5 && ratio <= 2))
-      std::fprintf(stderr,
-                   "blurcue: warning: %s: the fitted aperture %.3f mm is %.2f x the camera's (%.3f mm, f/%g): the "
-                   "sections may not measure the board's edges (covered, shaded, reflections; see the table's "
-                   "flags) or camera.json's f_number is not the photo's\n",
-                   args->photo.c_str(), result.model.aperture_mm, ratio, camera.ApertureMm(), camera.f_number);
+    WarnAboutCalibration(result, camera, args->camera, args->photo);
     if (args->quiet) return;
-    const auto& m = result.model;
-    std::printf("board %s found; pose reprojection error %.3f px; board origin %.1f mm from the lens\n",
-                board.Name().c_str(), result.pose.reprojection_error_px, cv::norm(result.pose.tvec));
-    std::printf("reference edge %d: u = %.1f mm, r = %.2f px (median of its usable sections)\n",
-                result.reference_edge, result.reference_u_mm, result.reference_r_px);
-    std::printf("fitted %s model: focus %.1f mm, aperture %.3f mm (nominal %.3f), %s, rms %.3f px,"
-                " leave-one-out %.3f px, %d outliers of %d\n",
-                m.kind.c_str(), m.focus_mm, m.aperture_mm, camera.ApertureMm(), optics::FloorText(m).c_str(),
-                m.rms_px, m.loo_rms_px, m.outliers, m.samples_used);
-    // How many sections the model was fitted to, and why the others were left out.
-    {
-      int sections = 0;
-      for (const auto& e : result.edges) sections += static_cast<int>(e.sections.size());
-      std::string left;
-      int n_left = 0;
-      for (const auto& [why, n] : calib::SectionsLeftOut(result))
-        left += (left.empty() ? "" : ", ") + std::to_string(n) + " " + why, n_left += n;
-      std::printf("the model is fitted to %d of %d sections%s\n", sections - n_left, sections,
-                  left.empty() ? "" : ("; left out (it predicts them): " + left).c_str());
-    }
-    if (options.phase_check) {
-      std::printf("phase check: %s\n", result.phase.summary.c_str());
-      // Each edge with phase_limited sections, once, with its first section's reason (every one's is in calib.json).
-      for (const auto& e : result.edges) {
-        int n = 0;
-        const std::string* why = nullptr;
-        for (const auto& sec : e.sections)
-          if (!sec.fit.phase_why.empty()) ++n, why = why ? why : &sec.fit.phase_why;
-        if (n > 0) std::printf("  edge %d: %d of %zu sections phase_limited: %s\n", e.index, n, e.sections.size(),
-                               why->c_str());
-      }
-      if (result.phase.held > 0)
-        std::printf("phase check: the model predicted %d phase_limited sections outside the range their families "
-                    "leave open; their ranges' middles joined its fit\n", result.phase.held);
-    }
-    // Why this model (calib.json's model.choice): both candidates' held-out errors, and eq. 3.7 as published.
-    const Json& choice = json["model"]["choice"];
-    if (std::isfinite(m.floor_loo_rms_px))
-      std::printf("model choice, held-out error: thin lens %.3f px, thin lens + floor %.3f px (%s)\n",
-                  m.thin_loo_rms_px, m.floor_loo_rms_px, optics::kModelChoiceRule);
-    else
-      std::printf("model: the thin lens alone (the floor model needs at least 10 sections; %d usable)\n",
-                  m.samples_used);
-    if (choice["eq37"]["rms_px"].is_number())
-      std::printf("eq. 3.7 (the thesis's estimate from reference edge %d, no parameters fitted): rms %.3f px against "
-                  "the measured sections%s\n",
-                  result.reference_edge, choice["eq37"]["rms_px"].get<double>(),
-                  m.kind == "thin_lens+floor" ? " (it takes the reference's whole blur for defocus, floor included)"
-                                              : "");
-    std::vector<double> true_r;
-    if (!args->truth.empty()) {
-      const calib::TruthComparison cmp =
-          calib::CompareToTruth(result, ReadJsonFile(args->truth), args->truth + ": ");
-      true_r = cmp.true_r_per_edge;
-      std::printf("against truth: pose %.3f mm / %.3f deg, section depths within %.3f mm\n",
-                  cmp.translation_error_mm, cmp.rotation_error_deg, cmp.max_depth_error_mm);
-      auto summary = [&](const char* name, calib::MethodError calib::SectionComparison::*method) {
-        const calib::MethodSummary m = calib::SummarizeMethod(cmp, method);
-        std::printf("  %-22s answered %2d/%d, mean |error| %.3f px, worst %.3f px, within max(0.25 px, 5%%): %d\n",
-                    name, m.answered, m.sections, m.mean_abs_error_px, m.max_abs_error_px, m.within_target);
-      };
-      summary("model fit (r_px)", &calib::SectionComparison::model);
-      summary("thesis (r_thesis_px)", &calib::SectionComparison::thesis);
-      summary("eq. 3.7 (r_estimated)", &calib::SectionComparison::estimated);
-      summary("fitted (r_fitted_px)", &calib::SectionComparison::fitted);
-    }
+    PrintCalibrationSummary(result, board, camera);
+    if (options.phase_check) PrintPhaseCheck(result);
+    PrintModelChoice(result, json["model"]["choice"]);
+    const std::vector<double> true_r =
+        args->truth.empty() ? std::vector<double>() : PrintAgainstTruth(result, args->truth);
     std::printf("\n%s\n", calib::FormatEdgeTable(result, true_r).c_str());
     std::printf("time: read %.0f ms, detect+pose %.0f ms, measure %.0f ms, estimate %.1f ms\n", read_ms,
                 result.detect_ms, result.measure_ms, result.estimate_ms);

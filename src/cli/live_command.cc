@@ -67,7 +67,7 @@ struct LiveArgs {
   ObjectOptions objects;
   std::vector<int> save_frames;
   double fps = 0, exposure_ms = -1;
-  int frames = 0;
+  int frames = 0, measure_sections = 0;
   bool window = false, quiet = false;
 };
 
@@ -77,6 +77,7 @@ struct LiveSetup {
   std::unique_ptr<live::LivePlanner> planner;
   std::unique_ptr<track::Tracker> tracker;
   std::unique_ptr<live::PacedSource> source;
+  std::unique_ptr<live::LiveLens> live_lens;  // --measure-sections: the lens model fitted as the frames come
   double exposure_ms = 0;
   std::string exposure_note, lens_note;
 };
@@ -173,7 +174,15 @@ LiveSetup SetUpLive(const LiveArgs& a) {
   }
   s.exposure_ms = blur.exposure_ms;
   track::TrackOptions options;
-  options.measure_blur = false;  // the lens model is fixed: the pose is all a frame needs
+  // A fixed lens model needs the pose alone; --measure-sections N measures N sections a frame, in turn, and fits the
+  // model to every section's latest reading.
+  options.measure_blur = a.measure_sections > 0;
+  options.sections_per_frame = a.measure_sections;
+  if (a.measure_sections > 0) {
+    s.live_lens = std::make_unique<live::LiveLens>(s.camera);
+    s.lens_note += ", fitted again to the sections measured live (" + std::to_string(a.measure_sections) +
+                   " a frame) once they lie on 3 edges";
+  }
   s.tracker = std::make_unique<track::Tracker>(s.camera, lens.board, options);
   s.planner = std::make_unique<live::LivePlanner>(std::move(lens), std::move(objects), blur);
   return s;
@@ -196,6 +205,13 @@ void ShowFrame(LiveSetup& s, const LiveArgs& a, live::LiveFrame& frame, live::Cl
                std::optional<calib::BoardPose>& last_pose) {
   const live::Clock::time_point t0 = live::Clock::now();
   const track::FrameResult result = s.tracker->Process(frame.image, frame.index, frame.time_s);
+  if (s.live_lens) {
+    // The model a fit finished since the frame before, then this frame's readings (a fit of them started meanwhile
+    // on a thread of its own: the next frames draw with it once it is done).
+    optics::FittedModel model;
+    if (s.live_lens->TakeModel(&model)) s.planner->SetModel(model);
+    if (result.calib) s.live_lens->Update(*result.calib);
+  }
   const live::Clock::time_point t1 = live::Clock::now();
   const stimulus::TrackedFramePlan plan = s.planner->Plan(frame.index, frame.time_s, result.status, result.pose);
   if (result.pose) last_pose = result.pose;
@@ -216,7 +232,10 @@ void ShowFrame(LiveSetup& s, const LiveArgs& a, live::LiveFrame& frame, live::Cl
   row.arrival_s = std::chrono::duration<double>(frame.arrival - start).count();
   row.status = result.status;
   if (result.pose) row.rvec = result.pose->rvec, row.tvec = result.pose->tvec;
-  row.track_ms = MsBetween(t0, t1);
+  row.track_ms = result.pose_ms;
+  row.measure_ms = MsBetween(t0, t1) - result.pose_ms;  // the sections (the model's fit runs on its own thread)
+  row.sections = result.calib ? result.sections_measured : 0;
+  row.lens_sections = s.live_lens ? s.live_lens->sections() : 0;
   row.render_ms = MsBetween(t1, t2);
   row.display_s = std::chrono::duration<double>(shown - start).count();
   row.latency_ms = MsBetween(frame.arrival, shown);
@@ -343,8 +362,9 @@ void AddLiveCommand(CLI::App& app) {
       "INPUT is a camera - /dev/videoN or an index N, through OpenCV's videoio (V4L2) - or a video file or image\n"
       "sequence (a printf pattern) played as a camera would deliver it: frame k at k / fps s from the start. Frames\n"
       "reach the drawing through a one-slot mailbox: one that arrives while the previous is still being drawn\n"
-      "replaces it and is counted dropped, never queued. The lens model is fixed: --track DIR (a take `blurcue track`\n"
-      "wrote with this camera) or --calib calib.json (`blurcue calibrate`); no blur is measured live.\n"
+      "replaces it and is counted dropped, never queued. The lens model: --track DIR (a take `blurcue track` wrote\n"
+      "with this camera) or --calib calib.json (`blurcue calibrate`), fixed; with --measure-sections N, N board\n"
+      "sections are measured a frame, in turn, and the model is fitted again to every section's latest reading.\n"
       "Objects as in `blurcue ar`: --ball X,Y[,RADIUS], --card X,Y[,WIDTH[,HEIGHT]] (board mm), --objects FILE.\n"
       "\n"
       "Writes --log DIR whole at the end of the run (docs/live.md): live.csv (a row per frame shown: arrival, status,\n"
@@ -386,6 +406,13 @@ void AddLiveCommand(CLI::App& app) {
                   "also write frame N as shown into DIR/frame-NNNN.png, or the first frame shown after it when N was\n"
                   "dropped, under its own number (repeatable; the read-back adds to that frame's latency)")
       ->check(IntRange(0, kMaxLiveFrames));
+  cmd->add_option("--measure-sections", a->measure_sections,
+                  "measure the blur of N board sections a frame, a rotating subset (all of them once in every\n"
+                  "sections / N frames), and draw with the thin lens fitted to every section's latest reading once\n"
+                  "they lie on 3 edges (the given model until then; fitted on a thread of its own, a frame draws with\n"
+                  "the newest fit finished); live.csv says how many each frame measured.\n"
+                  "0: none, the given model throughout; at least the board's sections: all of them every frame")
+      ->capture_default_str()->check(IntRange(0, 10000));
   cmd->add_flag("--quiet", a->quiet, "print only errors");
   cmd->callback([a] { RunLive(*a); });
 }

@@ -99,8 +99,8 @@ void AddTrackCommand(CLI::App& app) {
       std::sort(ms.begin(), ms.end());
       const double median = ms.empty() ? 0 : (ms.size() % 2 ? ms[ms.size() / 2]
                                                              : 0.5 * (ms[ms.size() / 2 - 1] + ms[ms.size() / 2]));
-      std::printf("%d frames: %d tracked, %d found by full detection, %d lost; median %.1f ms a frame (decoding "
-                  "%.1f ms a frame more)\n",
+      std::printf("%d frames: %d tracked, %d found by full detection, %d lost; median %.1f ms a frame (decoding, "
+                  "%.1f ms a frame, done meanwhile on a thread of its own)\n",
                   n, take.tracked, take.found, take.lost, median, n > 0 ? take.decode_ms / n : 0.0);
       if (take.model) {
         const auto& m = *take.model;

@@ -65,6 +65,129 @@ std::string ProcedureDesignLines(const protocol::Protocol& protocol, const Args&
   return out;
 }
 
+// One participant's session per group checked: its seed, trials and what the pre-flight found.
+struct CheckedGroup {
+  std::string group;
+  uint64_t seed = 0;
+  std::vector<protocol::Trial> trials;
+  std::string shown;  // how a frame reaches the screen and the eye
+};
+
+// How a prepared participant's frames reach the screen and the eye: the frame and window, the take, the group and
+// the blur plan, a line each.
+std::string PresentationLines(const procedure::PreparedSession& prepared) {
+  const stimulus::Presentation& at = prepared.presentation;
+  char line[400];
+  std::snprintf(line, sizeof line,
+                "  shown: a %d x %d %s in a %d x %d window (%s) at %.4f screen px per photo px; %s: %.2f px "
+                "per degree, 1 photo px = %.3f arcmin\n",
+                at.frame_width_px, at.frame_height_px,
+                prepared.images.take ? "video" : prepared.scene ? "photo" : "frame", at.window_width_px,
+                at.window_height_px, at.scaling.c_str(), at.scale, at.profile.name.c_str(),
+                display::PxPerDeg(at.profile), at.Arcmin(1));
+  std::string shown = line;
+  if (const auto& take = prepared.images.take) {
+    const protocol::Content& c = prepared.protocol.content;
+    shown += "  take: " + std::to_string(take->take().frames.size()) + " frames at " +
+             Num(std::round(take->fps() * 100) / 100) + " fps";
+    if (c.type == protocol::ContentType::kBall)
+      shown += "; exposure " + Num(std::round(c.exposure_ms * 1000) / 1000) + " ms (" +
+               (c.exposure_given ? std::string("content.exposure_ms")
+                : take->take().camera().exposure_ms ? std::string("the take's camera.json exposure_ms")
+                                                    : std::string("half a frame: the take's camera states no "
+                                                                  "exposure_ms; give content.exposure_ms")) +
+               ")";
+    shown += "\n";
+  }
+  if (prepared.protocol.groups)
+    shown += "  group: " + prepared.group +
+             (prepared.protocol.groups->assign == protocol::GroupAssign::kBalanced
+                  ? " (balanced: a run takes the group with the fewest sessions in its record)\n"
+                  : " (by participant number)\n");
+  if (prepared.scene) {
+    size_t per_pixel = 0;
+    for (const auto& scene : prepared.scenes) per_pixel += scene.per_pixel;
+    std::snprintf(line, sizeof line,
+                  "  blur plan: %zu of %zu trials per pixel by depth (depth span >= %g %s), the rest one "
+                  "radius\n",
+                  per_pixel, prepared.scenes.size(), prepared.protocol.content.depth_blur_threshold,
+                  prepared.protocol.content.depth_blur_threshold_unit == protocol::ThresholdUnit::kArcmin ? "arcmin" : "screen px");
+    shown += line;
+  }
+  return shown;
+}
+
+// --no-files: the protocol alone, and each group's trial list.
+std::vector<CheckedGroup> CheckProtocolAlone(const Args& args, protocol::Protocol* p) {
+  std::vector<CheckedGroup> checked;
+  *p = protocol::LoadProtocol(args.file, protocol::ValidateOptions{false});
+  // As PrepareStudy does for run: each design variable recorded in a column of its own.
+  procedure::CheckRecordedNames(*p);
+  for (const std::string& group : GroupsToCheck(*p, args.group)) {
+    const uint64_t seed = args.seed ? *args.seed : protocol::DefaultSeed(p->name, args.participant);
+    checked.push_back({group, seed, protocol::BuildTrials(*p, args.participant, seed, group), ""});
+  }
+  return checked;
+}
+
+// What `blurcue run` does before its first trial, through the same functions: files decoded, the calibration read,
+// every trial's scene and radii worked out - for each group's blocks. With `observer` (--plan), what it can see, and
+// the QUEST+ grids that do not hold it (in `grid_problems`, each once).
+std::vector<CheckedGroup> CheckAsRunWould(const Args& args, const std::optional<procedure::ObserverParams>& observer,
+                                          protocol::Protocol* p, std::vector<std::string>* grid_problems) {
+  std::vector<CheckedGroup> checked;
+  try {
+    procedure::PreparedSession prepared = procedure::PrepareStudy(args.file, args.display);
+    for (const std::string& group : GroupsToCheck(prepared.protocol, args.group)) {
+      procedure::PrepareParticipant(&prepared, args.participant, args.seed, group);
+      std::string shown = PresentationLines(prepared);
+      if (observer) {
+        // What `run --observer` refuses before its first trial, refused here by the same check.
+        procedure::CheckObserverCanAnswer(*observer, prepared.protocol);
+        for (const std::string& text : procedure::VisibilityLines(prepared, *observer, args.visible, false))
+          shown += "  " + text + "\n";
+        for (const std::string& problem : plan::QuestGridProblems(prepared, *observer, args.file))
+          if (std::find(grid_problems->begin(), grid_problems->end(), problem) == grid_problems->end())
+            grid_problems->push_back(problem);
+        if (checked.empty()) shown += ProcedureDesignLines(prepared.protocol, args);
+      }
+      checked.push_back({group, prepared.seed, prepared.trials, shown});
+    }
+    *p = std::move(prepared.protocol);
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    if (message.find(": no such file: ") == std::string::npos) throw;
+    throw e.Wrapped(e.kind(), "", "('blurcue init DIR --from EXAMPLE' makes a shipped example a study folder with "
+                                  "its own scene and calibration; --no-files skips the file checks)");
+  }
+  return checked;
+}
+
+// A checked group's summary: its trials (with --list), their count and hash, and each block's share.
+void PrintCheckedGroup(const CheckedGroup& one, const protocol::Protocol& p, const Args& args) {
+  const auto& trials = one.trials;
+  if (args.list)
+    for (const auto& t : trials) std::cout << protocol::ToJson(t).dump() << "\n";
+  std::cout << "ok: " << trials.size() << " trials for participant " << args.participant << " with seed "
+            << one.seed << " (hash " << HashHex(protocol::TrialsHash(trials)) << ")"
+            << (one.group.empty() ? "" : ", group " + one.group) << "\n";
+  std::string counts;
+  int practice = 0;
+  for (const auto& t : trials) practice += t.practice ? 1 : 0;
+  if (practice > 0) counts = "practice " + std::to_string(practice);
+  for (const auto& b : p.blocks) {
+    // A group's own blocks (and those every group runs); another group's are its to report.
+    if (!one.group.empty() && !b.groups.empty() &&
+        std::find(b.groups.begin(), b.groups.end(), one.group) == b.groups.end())
+      continue;
+    int n = 0;
+    for (const auto& t : trials) n += (!t.practice && t.block == b.name) ? 1 : 0;
+    counts += (counts.empty() ? "" : ", ") + b.name + " " + std::to_string(n) + " (" + protocol::ToString(b.task) +
+              ", " + protocol::ToString(b.counterbalance) + ")";
+  }
+  std::cout << "  " << counts << "\n" << one.shown;
+}
+
 }  // namespace
 
 void AddValidateCommand(CLI::App& app) {
@@ -114,113 +237,12 @@ void AddValidateCommand(CLI::App& app) {
       observer = procedure::ParseObserver(args->observer);
     }
     protocol::Protocol p;
-    // One participant's session per group checked: its seed, trials and what the pre-flight found.
-    struct Checked {
-      std::string group;
-      uint64_t seed = 0;
-      std::vector<protocol::Trial> trials;
-      std::string shown;  // how a frame reaches the screen and the eye
-    };
-    std::vector<Checked> checked;
     std::vector<std::string> grid_problems;  // --plan: a QUEST+ grid that does not hold the observer
-    if (args->no_files) {
-      p = protocol::LoadProtocol(args->file, protocol::ValidateOptions{false});
-      // As PrepareStudy does for run: each design variable recorded in a column of its own.
-      procedure::CheckRecordedNames(p);
-      for (const std::string& group : GroupsToCheck(p, args->group)) {
-        const uint64_t seed = args->seed ? *args->seed : protocol::DefaultSeed(p.name, args->participant);
-        checked.push_back({group, seed, protocol::BuildTrials(p, args->participant, seed, group), ""});
-      }
-    } else {
-      // What `blurcue run` does before its first trial, through the same functions: files decoded, the
-      // calibration read, every trial's scene and radii worked out - for each group's blocks.
-      try {
-        procedure::PreparedSession prepared = procedure::PrepareStudy(args->file, args->display);
-        for (const std::string& group : GroupsToCheck(prepared.protocol, args->group)) {
-          procedure::PrepareParticipant(&prepared, args->participant, args->seed, group);
-          const stimulus::Presentation& at = prepared.presentation;
-          char line[400];
-          std::snprintf(line, sizeof line,
-                        "  shown: a %d x %d %s in a %d x %d window (%s) at %.4f screen px per photo px; %s: %.2f px "
-                        "per degree, 1 photo px = %.3f arcmin\n",
-                        at.frame_width_px, at.frame_height_px,
-                        prepared.images.take ? "video" : prepared.scene ? "photo" : "frame", at.window_width_px,
-                        at.window_height_px, at.scaling.c_str(), at.scale, at.profile.name.c_str(),
-                        display::PxPerDeg(at.profile), at.Arcmin(1));
-          std::string shown = line;
-          if (const auto& take = prepared.images.take) {
-            const protocol::Content& c = prepared.protocol.content;
-            shown += "  take: " + std::to_string(take->take().frames.size()) + " frames at " +
-                     Num(std::round(take->fps() * 100) / 100) + " fps";
-            if (c.type == protocol::ContentType::kBall)
-              shown += "; exposure " + Num(std::round(c.exposure_ms * 1000) / 1000) + " ms (" +
-                       (c.exposure_given ? std::string("content.exposure_ms")
-                        : take->take().camera().exposure_ms ? std::string("the take's camera.json exposure_ms")
-                                                            : std::string("half a frame: the take's camera states no "
-                                                                          "exposure_ms; give content.exposure_ms")) +
-                       ")";
-            shown += "\n";
-          }
-          if (prepared.protocol.groups)
-            shown += "  group: " + prepared.group +
-                     (prepared.protocol.groups->assign == protocol::GroupAssign::kBalanced
-                          ? " (balanced: a run takes the group with the fewest sessions in its record)\n"
-                          : " (by participant number)\n");
-          if (prepared.scene) {
-            size_t per_pixel = 0;
-            for (const auto& scene : prepared.scenes) per_pixel += scene.per_pixel;
-            std::snprintf(line, sizeof line,
-                          "  blur plan: %zu of %zu trials per pixel by depth (depth span >= %g %s), the rest one "
-                          "radius\n",
-                          per_pixel, prepared.scenes.size(), prepared.protocol.content.depth_blur_threshold,
-                          prepared.protocol.content.depth_blur_threshold_unit == protocol::ThresholdUnit::kArcmin ? "arcmin" : "screen px");
-            shown += line;
-          }
-          if (observer) {
-            // What `run --observer` refuses before its first trial, refused here by the same check.
-            procedure::CheckObserverCanAnswer(*observer, prepared.protocol);
-            for (const std::string& text : procedure::VisibilityLines(prepared, *observer, args->visible, false))
-              shown += "  " + text + "\n";
-            for (const std::string& problem : plan::QuestGridProblems(prepared, *observer, args->file))
-              if (std::find(grid_problems.begin(), grid_problems.end(), problem) == grid_problems.end())
-                grid_problems.push_back(problem);
-            if (checked.empty()) shown += ProcedureDesignLines(prepared.protocol, *args);
-          }
-          checked.push_back({group, prepared.seed, prepared.trials, shown});
-        }
-        p = std::move(prepared.protocol);
-      } catch (const Error& e) {
-        const std::string message = e.what();
-        if (message.find(": no such file: ") == std::string::npos) throw;
-        throw e.Wrapped(e.kind(), "", "('blurcue init DIR --from EXAMPLE' makes a shipped example a study folder with "
-                                      "its own scene and calibration; --no-files skips the file checks)");
-      }
-    }
+    const std::vector<CheckedGroup> checked =
+        args->no_files ? CheckProtocolAlone(*args, &p) : CheckAsRunWould(*args, observer, &p, &grid_problems);
     // Each on its own line, as a protocol's problems are (one joined text came out as one line with "\n" in it).
     if (!grid_problems.empty()) throw Error(ErrorKind::kInput, grid_problems);
-    for (const Checked& one : checked) {
-      const auto& trials = one.trials;
-      if (args->list)
-        for (const auto& t : trials) std::cout << protocol::ToJson(t).dump() << "\n";
-      std::cout << "ok: " << trials.size() << " trials for participant " << args->participant << " with seed "
-                << one.seed << " (hash " << HashHex(protocol::TrialsHash(trials)) << ")"
-                << (one.group.empty() ? "" : ", group " + one.group) << "\n";
-      std::string counts;
-      int practice = 0;
-      for (const auto& t : trials) practice += t.practice ? 1 : 0;
-      if (practice > 0) counts = "practice " + std::to_string(practice);
-      for (const auto& b : p.blocks) {
-        // A group's own blocks (and those every group runs); another group's are its to report.
-        if (!one.group.empty() && !b.groups.empty() &&
-            std::find(b.groups.begin(), b.groups.end(), one.group) == b.groups.end())
-          continue;
-        int n = 0;
-        for (const auto& t : trials) n += (!t.practice && t.block == b.name) ? 1 : 0;
-        counts += (counts.empty() ? "" : ", ") + b.name + " " + std::to_string(n) + " (" + protocol::ToString(b.task) +
-                  ", " + protocol::ToString(b.counterbalance) + ")";
-      }
-      std::cout << "  " << counts << "\n" << one.shown;
-    }
+    for (const CheckedGroup& one : checked) PrintCheckedGroup(one, p, *args);
   });
 }
 

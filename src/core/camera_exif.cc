@@ -119,6 +119,65 @@ ExifData* LoadExifAsStored(const std::string& file) {
   return data;
 }
 
+// The sensor's size in mm, in the stored image's orientation, from the first source that gives one: --sensor-mm,
+// the focal-plane resolution, the sensor table, the 35 mm equivalent (with the focal length `fl`); the source goes
+// into out->sensor_source. {0, 0} when none does: why into `absent` (unless only the focal length is missing), the
+// option into `options`.
+std::pair<double, double> SensorSizeMm(const Exif& exif, bool have_exif,
+                                       std::optional<std::pair<double, double>> sensor_mm, bool turned,
+                                       double stored_w, double stored_h, const std::optional<double>& fl,
+                                       ExifCamera* out_camera, std::vector<std::string>* absent,
+                                       std::vector<std::string>* options) {
+  ExifCamera& out = *out_camera;
+  const Camera& c = out.camera;
+  auto number = [&](ExifTag tag) { return have_exif ? exif.Number(tag) : std::nullopt; };
+  double sw = 0, sh = 0;
+  const std::optional<double> xres = number(EXIF_TAG_FOCAL_PLANE_X_RESOLUTION);
+  const std::optional<double> yres = number(EXIF_TAG_FOCAL_PLANE_Y_RESOLUTION);
+  const std::optional<double> unit = number(EXIF_TAG_FOCAL_PLANE_RESOLUTION_UNIT);
+  const std::optional<double> fl35 = number(EXIF_TAG_FOCAL_LENGTH_IN_35MM_FILM);
+  const KnownSensor* known = nullptr;
+  for (const KnownSensor& k : KnownSensors())
+    if (out.model == k.model) known = &k;
+  if (sensor_mm) {
+    sw = turned ? sensor_mm->second : sensor_mm->first, sh = turned ? sensor_mm->first : sensor_mm->second;
+    out.sensor_source = "given (--sensor-mm)";
+  } else if (xres && yres && *xres > 0 && *yres > 0 && unit && (*unit == 2 || *unit == 3 || *unit == 4)) {
+    const double mm_per_unit = *unit == 2 ? 25.4 : *unit == 3 ? 10.0 : 1.0;  // inch, cm, mm (4: some makers)
+    sw = stored_w / *xres * mm_per_unit, sh = stored_h / *yres * mm_per_unit;
+    out.sensor_source = "focal-plane resolution";
+  } else if (known) {
+    const bool portrait = stored_h > stored_w;
+    sw = portrait ? known->height_mm : known->width_mm, sh = portrait ? known->width_mm : known->height_mm;
+    out.sensor_source = std::string("sensor table (") + known->model + ")";
+  } else if (fl35 && *fl35 > 0 && fl) {
+    // The 35 mm equivalent keeps the diagonal: 43.27 mm x f / f35; the image's sides give the aspect.
+    const double diagonal = std::hypot(36.0, 24.0) * c.focal_length_mm / *fl35;
+    const double aspect = stored_w / stored_h;
+    sh = diagonal / std::sqrt(1 + aspect * aspect), sw = sh * aspect;
+    out.sensor_source = "35 mm equivalent focal length (" + Num(*fl35) + " mm)";
+    out.notes.push_back("the sensor size is approximate: EXIF rounds the 35 mm equivalent to whole mm (up to " +
+                        Num(50 / *fl35) + " % here); give --sensor-mm W H from the maker's data for a better one");
+  } else if (fl35 && *fl35 > 0) {
+    // The 35 mm equivalent gives the sensor once the focal length (named missing above) is given.
+  } else {
+    // Why each source of a sensor size gave none: a tag absent, or present with a value that says "unknown".
+    auto said = [&](ExifTag tag, const std::optional<double>& v, const char* why) {
+      return exif.Name(tag) + (v ? " is " + Num(*v) + " (" + why + ")" : std::string(" is missing"));
+    };
+    absent->push_back("no sensor size (" +
+                     (!(xres && *xres > 0)   ? said(EXIF_TAG_FOCAL_PLANE_X_RESOLUTION, xres, "no resolution")
+                      : !(yres && *yres > 0) ? said(EXIF_TAG_FOCAL_PLANE_Y_RESOLUTION, yres, "no resolution")
+                                             : said(EXIF_TAG_FOCAL_PLANE_RESOLUTION_UNIT, unit, "not inch, cm or mm")) +
+                     ", " + said(EXIF_TAG_FOCAL_LENGTH_IN_35MM_FILM, fl35, "unknown") +
+                     (out.model.empty() ? ", no EXIF Model"
+                                        : ", model '" + out.model + "' not in the sensor table") +
+                     ")");
+    options->push_back("--sensor-mm W H");
+  }
+  return {sw, sh};
+}
+
 }  // namespace
 
 ExifCamera CameraFromExif(const std::filesystem::path& photo, std::optional<std::pair<double, double>> sensor_mm,
@@ -168,50 +227,9 @@ ExifCamera CameraFromExif(const std::filesystem::path& photo, std::optional<std:
   const bool turned = orientation && *orientation >= 5 && *orientation <= 8;
   const double stored_w = px ? *px : turned ? image.rows : image.cols;
   const double stored_h = py ? *py : turned ? image.cols : image.rows;
-  double sw = 0, sh = 0;  // in the stored image's orientation
-  const std::optional<double> xres = number(EXIF_TAG_FOCAL_PLANE_X_RESOLUTION);
-  const std::optional<double> yres = number(EXIF_TAG_FOCAL_PLANE_Y_RESOLUTION);
-  const std::optional<double> unit = number(EXIF_TAG_FOCAL_PLANE_RESOLUTION_UNIT);
-  const std::optional<double> fl35 = number(EXIF_TAG_FOCAL_LENGTH_IN_35MM_FILM);
-  const KnownSensor* known = nullptr;
-  for (const KnownSensor& k : KnownSensors())
-    if (out.model == k.model) known = &k;
-  if (sensor_mm) {
-    sw = turned ? sensor_mm->second : sensor_mm->first, sh = turned ? sensor_mm->first : sensor_mm->second;
-    out.sensor_source = "given (--sensor-mm)";
-  } else if (xres && yres && *xres > 0 && *yres > 0 && unit && (*unit == 2 || *unit == 3 || *unit == 4)) {
-    const double mm_per_unit = *unit == 2 ? 25.4 : *unit == 3 ? 10.0 : 1.0;  // inch, cm, mm (4: some makers)
-    sw = stored_w / *xres * mm_per_unit, sh = stored_h / *yres * mm_per_unit;
-    out.sensor_source = "focal-plane resolution";
-  } else if (known) {
-    const bool portrait = stored_h > stored_w;
-    sw = portrait ? known->height_mm : known->width_mm, sh = portrait ? known->width_mm : known->height_mm;
-    out.sensor_source = std::string("sensor table (") + known->model + ")";
-  } else if (fl35 && *fl35 > 0 && fl) {
-    // The 35 mm equivalent keeps the diagonal: 43.27 mm x f / f35; the image's sides give the aspect.
-    const double diagonal = std::hypot(36.0, 24.0) * c.focal_length_mm / *fl35;
-    const double aspect = stored_w / stored_h;
-    sh = diagonal / std::sqrt(1 + aspect * aspect), sw = sh * aspect;
-    out.sensor_source = "35 mm equivalent focal length (" + Num(*fl35) + " mm)";
-    out.notes.push_back("the sensor size is approximate: EXIF rounds the 35 mm equivalent to whole mm (up to " +
-                        Num(50 / *fl35) + " % here); give --sensor-mm W H from the maker's data for a better one");
-  } else if (fl35 && *fl35 > 0) {
-    // The 35 mm equivalent gives the sensor once the focal length (named missing above) is given.
-  } else {
-    // Why each source of a sensor size gave none: a tag absent, or present with a value that says "unknown".
-    auto said = [&](ExifTag tag, const std::optional<double>& v, const char* why) {
-      return exif.Name(tag) + (v ? " is " + Num(*v) + " (" + why + ")" : std::string(" is missing"));
-    };
-    absent.push_back("no sensor size (" +
-                     (!(xres && *xres > 0)   ? said(EXIF_TAG_FOCAL_PLANE_X_RESOLUTION, xres, "no resolution")
-                      : !(yres && *yres > 0) ? said(EXIF_TAG_FOCAL_PLANE_Y_RESOLUTION, yres, "no resolution")
-                                             : said(EXIF_TAG_FOCAL_PLANE_RESOLUTION_UNIT, unit, "not inch, cm or mm")) +
-                     ", " + said(EXIF_TAG_FOCAL_LENGTH_IN_35MM_FILM, fl35, "unknown") +
-                     (out.model.empty() ? ", no EXIF Model"
-                                        : ", model '" + out.model + "' not in the sensor table") +
-                     ")");
-    options.push_back("--sensor-mm W H");
-  }
+  // In the stored image's orientation.
+  const auto [sw, sh] = SensorSizeMm(exif, have_exif, sensor_mm, turned, stored_w, stored_h, fl, &out, &absent,
+                                     &options);
   if (!options.empty()) {
     std::string give;
     for (size_t i = 0; i < options.size(); ++i)

@@ -1,5 +1,6 @@
 #include "live/live_log.h"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "core/stats.h"
@@ -25,6 +26,12 @@ const std::vector<LiveColumn> kLiveColumns = {
     {"latency_ms", "display_s - arrival_s, ms"},
     {"dropped", "frames delivered since the frame shown before and never shown (replaced in the one-slot mailbox "
                 "while a frame was processed)"},
+    {"sections", "board sections whose blur this frame measured (--measure-sections N: a rotating subset of N; 0: none, "
+                 "lost, or no --measure-sections)"},
+    {"measure_ms", "measuring them, ms (the lens model is fitted to every section's latest reading on a thread of its "
+                   "own, meanwhile)"},
+    {"lens_sections", "sections the lens model this frame was drawn with was fitted to live (their latest readings); "
+                      "0: the model of --track or --calib"},
 };
 
 std::string LiveCsvHeader() {
@@ -38,9 +45,10 @@ void AppendLiveCsvRow(const LiveRow& r, std::string* csv) {
   if (r.rvec && r.tvec)
     std::snprintf(pose, sizeof pose, "%.8f,%.8f,%.8f,%.4f,%.4f,%.4f", (*r.rvec)[0], (*r.rvec)[1], (*r.rvec)[2],
                   (*r.tvec)[0], (*r.tvec)[1], (*r.tvec)[2]);
-  char line[320];
-  std::snprintf(line, sizeof line, "%d,%.6f,%s,%s,%.3f,%.3f,%.6f,%.3f,%d\n", r.frame, r.arrival_s, track::Name(r.status),
-                pose, r.track_ms, r.render_ms, r.display_s, r.latency_ms, r.dropped);
+  char line[360];
+  std::snprintf(line, sizeof line, "%d,%.6f,%s,%s,%.3f,%.3f,%.6f,%.3f,%d,%d,%.3f,%d\n", r.frame, r.arrival_s,
+                track::Name(r.status), pose, r.track_ms, r.render_ms, r.display_s, r.latency_ms, r.dropped, r.sections,
+                r.measure_ms, r.lens_sections);
   csv->append(line);
 }
 
@@ -49,9 +57,11 @@ LiveSummary Summarize(const std::vector<LiveRow>& rows, int dropped, const std::
   s.shown = int(rows.size());
   s.dropped = dropped;
   s.ended = ended;
-  std::vector<double> latency, track, render;
+  std::vector<double> latency, track, render, measure;
   for (const LiveRow& r : rows) {
     latency.push_back(r.latency_ms);
+    measure.push_back(r.measure_ms);
+    s.sections_per_frame = std::max(s.sections_per_frame, r.sections);
     track.push_back(r.track_ms);
     render.push_back(r.render_ms);
     s.max_latency_ms = std::max(s.max_latency_ms, r.latency_ms);
@@ -63,6 +73,7 @@ LiveSummary Summarize(const std::vector<LiveRow>& rows, int dropped, const std::
   s.p95_latency_ms = Percentile(latency, 0.95);
   s.median_track_ms = Percentile(track, 0.5);
   s.median_render_ms = Percentile(render, 0.5);
+  s.median_measure_ms = Percentile(measure, 0.5);
   if (rows.size() >= 2 && rows.back().display_s > rows.front().display_s)
     s.shown_fps = (rows.size() - 1) / (rows.back().display_s - rows.front().display_s);
   if (rows.size() >= 2 && rows.back().arrival_s > rows.front().arrival_s)
@@ -93,6 +104,8 @@ Json SummaryJson(const LiveSummary& s) {
   j["max_latency_ms"] = s.max_latency_ms;
   j["median_track_ms"] = s.median_track_ms;
   j["median_render_ms"] = s.median_render_ms;
+  j["median_measure_ms"] = s.median_measure_ms;
+  j["sections_per_frame"] = s.sections_per_frame;
   j["shown_fps"] = s.shown_fps;
   j["delivered_fps"] = s.delivered_fps;
   j["ended"] = s.ended;

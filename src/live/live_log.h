@@ -23,6 +23,9 @@ struct LiveRow {
   double display_s = 0;           // when it was on screen: the swap returned (vsync) and the GPU finished
   double latency_ms = 0;          // display_s - arrival_s
   int dropped = 0;                // frames dropped since the frame shown before (replaced in the mailbox unseen)
+  int sections = 0;               // board sections whose blur this frame measured (--measure-sections; 0: none)
+  double measure_ms = 0;          // measuring them (the lens is fitted on a thread of its own)
+  int lens_sections = 0;          // sections the lens model drawn with was fitted to live (0: the given model)
 };
 
 struct LiveColumn {
@@ -38,7 +41,8 @@ void AppendLiveCsvRow(const LiveRow& row, std::string* csv);
 struct LiveSummary {
   int shown = 0, dropped = 0, found = 0, tracked = 0, lost = 0;
   double median_latency_ms = 0, p95_latency_ms = 0, max_latency_ms = 0;
-  double median_track_ms = 0, median_render_ms = 0;
+  double median_track_ms = 0, median_render_ms = 0, median_measure_ms = 0;
+  int sections_per_frame = 0;  // the most sections a frame measured (--measure-sections)
   double shown_fps = 0;   // frames shown a second, between the first display and the last
   double delivered_fps = 0;  // frames the input delivered a second (dropped ones too), between the first arrival shown
                              // and the last: a camera's own rate, or a video's pace when its decoding kept up

@@ -1,5 +1,7 @@
 #include "live/live_plan.h"
 
+#include <chrono>
+#include <set>
 #include <utility>
 
 #include "core/error.h"
@@ -44,8 +46,56 @@ calib::SceneCalib LensFromTrack(const std::filesystem::path& track_dir, const Ca
 void RequireLiveSource(BlurSource source, const std::string& option) {
   if (source == BlurSource::kMeasured || source == BlurSource::kMeasuredSection)
     throw Error(ErrorKind::kUsage, option + " " + ToString(source) +
-                                       ": needs each frame's board sections measured, and live measures the pose "
-                                       "only; give fitted (the lens model), estimated, none or a radius in px");
+                                       ": needs each frame's board sections measured, and live measures a few a "
+                                       "frame at most (--measure-sections, which feed its lens model); give fitted "
+                                       "(the lens model), estimated, none or a radius in px");
+}
+
+bool LiveLens::Update(const calib::CalibResult& frame) {
+  for (const calib::EdgeResult& edge : frame.edges)
+    for (const calib::SectionResult& s : edge.sections) {
+      const std::pair<int, int> key(s.edge, s.section);
+      if (s.fit.ok) {
+        latest_[key] = {s.u_mm, s.fit.r_px / s.stretch, 1.0};  // ideal px, as calib::ModelSamples gives them
+        changed_ = true;
+      } else if (!s.fit.flags.empty()) {
+        changed_ |= latest_.erase(key) > 0;  // measured and flagged: its earlier reading no longer stands
+      }
+    }
+  if (!changed_ || fit_.valid()) return false;
+  std::vector<optics::BlurSample> samples;
+  samples.reserve(latest_.size());
+  std::set<int> edges;
+  for (const auto& [key, sample] : latest_) samples.push_back(sample), edges.insert(key.first);
+  if (edges.size() < 3) return false;
+  changed_ = false;
+  fit_ = std::async(std::launch::async, [lens = optics::Lens::FromCamera(camera_), samples = std::move(samples)] {
+    try {
+      return std::optional(optics::FitThinLens(lens, samples));
+    } catch (const Error& e) {
+      if (e.kind() != ErrorKind::kNotFound) throw;  // all at one depth: no model from these readings
+      return std::optional<optics::FittedModel>();
+    }
+  });
+  return true;
+}
+
+bool LiveLens::TakeModel(optics::FittedModel* model) {
+  if (!fit_.valid() || fit_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
+  const std::optional<optics::FittedModel> fitted = fit_.get();  // a fit's unexpected error surfaces here
+  if (!fitted) return false;
+  *model = *fitted;
+  sections_ = fitted->samples_used;
+  return true;
+}
+
+void LiveLens::Wait() {
+  if (fit_.valid()) fit_.wait();
+}
+
+void LivePlanner::SetModel(const optics::FittedModel& model) {
+  for (stimulus::TrackedFrame& f : window_.frames)
+    if (f.calib) f.calib->model = model;
 }
 
 LivePlanner::LivePlanner(calib::SceneCalib lens, std::vector<stimulus::PlacedObject> objects, stimulus::TakeBlur blur)

@@ -1,14 +1,19 @@
 // The live view's GL-free parts: the one-slot mailbox drops and never queues, the planner draws what ar plans for the
 // same frame (the causal streak), the log's summary against hand-worked numbers, INPUT's camera names.
+#include <algorithm>
+#include <filesystem>
 #include <thread>
 
 #include <gtest/gtest.h>
+#include <unistd.h>
+
 
 #include "core/error.h"
 #include "live/live_log.h"
 #include "live/live_plan.h"
 #include "live/mailbox.h"
 #include "live/paced_source.h"
+#include "optics/thin_lens.h"
 
 namespace blurcue::live {
 namespace {
@@ -77,6 +82,37 @@ TEST(PacedSource, AMissingCameraIsAnInputErrorNamingTheDevice) {
   }
 }
 
+TEST(PacedSource, ACameraThatStopsDeliveringClosesTheMailboxWithOneLineNamingItAndTheFramesRead) {
+  // The camera is a 5-frame video read through the reader a camera is read through: its end is a read that fails,
+  // as a camera unplugged mid-run.
+  const std::filesystem::path video =
+      std::filesystem::temp_directory_path() / ("blurcue-live-camera-" + std::to_string(getpid()) + ".avi");
+  {
+    media::VideoWriter writer;
+    ASSERT_TRUE(writer.Open(video.string(), media::Fourcc('M', 'J', 'P', 'G'), 30, cv::Size(64, 48)));
+    for (int i = 0; i < 5; ++i) writer.Write(cv::Mat(48, 64, CV_8UC3, cv::Scalar::all(40 * i)));
+  }
+  auto reader = std::make_unique<media::VideoReader>();
+  ASSERT_TRUE(reader->Open(video.string()));
+  PacedSource source("/dev/video42", std::move(reader), 0);
+  EXPECT_TRUE(source.is_camera());
+  FrameMailbox box;
+  source.Start(&box, Clock::now());
+  LiveFrame got;
+  int taken = 0;
+  FrameMailbox::Got status;
+  while ((status = box.Take(got, std::chrono::milliseconds(5000))) == FrameMailbox::Got::kFrame) ++taken;
+  source.Stop();
+  std::filesystem::remove(video);
+  ASSERT_EQ(status, FrameMailbox::Got::kClosed);
+  EXPECT_EQ(taken + box.dropped(), 5);  // every frame delivered: taken, or replaced unseen
+  EXPECT_TRUE(box.failed());
+  EXPECT_EQ(box.why_closed(), "/dev/video42: the camera stopped delivering frames after 5 frames");
+  ASSERT_TRUE(source.error().has_value());
+  EXPECT_EQ(source.error()->kind(), ErrorKind::kInput);
+  EXPECT_EQ(std::string(source.error()->what()).find('\n'), std::string::npos);  // one line
+}
+
 // A board face-on at 500 mm moving -10 mm in x a frame, 30 frames a second (stimulus/tracked_take_test.cc's take).
 calib::SceneCalib FaceOnLens() {
   calib::SceneCalib c;
@@ -127,6 +163,68 @@ TEST(LivePlanner, DrawsWhatArPlansForTheLastFrameOfTheTakeSoFar) {
   }
 }
 
+// A frame's calibration in which only the sections of `edges` were measured, at depths 400 + 20 (edge - 1) + 2 section
+// mm, their blur the thin lens's with focus 450 mm and aperture 5 mm; `flagged` (edge, section) measured unusable.
+calib::CalibResult MeasuredEdges(const std::vector<int>& edges, std::pair<int, int> flagged = {0, 0}) {
+  calib::CalibResult c;
+  c.camera = FaceOnLens().camera;
+  optics::Lens lens = optics::Lens::FromCamera(c.camera);
+  lens.aperture_mm = 5;
+  for (int e = 1; e <= 11; ++e) {
+    calib::EdgeResult edge;
+    edge.index = e;
+    for (int k = 1; k <= 7; ++k) {
+      calib::SectionResult sec;
+      sec.edge = e, sec.section = k;
+      sec.u_mm = 400 + 20 * (e - 1) + 2 * k;
+      const bool measured = std::find(edges.begin(), edges.end(), e) != edges.end();
+      sec.fit.ok = measured;
+      if (measured) sec.fit.r_px = optics::BlurRadiusPx(lens, 450, sec.u_mm);
+      if (flagged == std::pair(e, k)) sec.fit.ok = false, sec.fit.flags = {"poor_fit"};
+      edge.sections.push_back(sec);
+    }
+    c.edges.push_back(edge);
+  }
+  return c;
+}
+
+TEST(LiveLens, FitsTheLensToTheLatestReadingOfEverySectionMeasuredSoFar) {
+  LiveLens lens(FaceOnLens().camera);
+  optics::FittedModel model;
+  EXPECT_FALSE(lens.Update(MeasuredEdges({})));  // nothing measured: no fit
+  EXPECT_FALSE(lens.Update(MeasuredEdges({1, 6})));  // two edges: too few depths for a model
+  lens.Wait();
+  EXPECT_FALSE(lens.TakeModel(&model));
+  ASSERT_TRUE(lens.Update(MeasuredEdges({11})));  // three frames' subsets make one model: 21 readings
+  lens.Wait();
+  ASSERT_TRUE(lens.TakeModel(&model));
+  EXPECT_EQ(lens.sections(), 21);
+  EXPECT_NEAR(model.focus_mm, 450, 0.5);
+  EXPECT_NEAR(model.aperture_mm, 5, 0.01);
+  EXPECT_FALSE(lens.TakeModel(&model));  // taken once
+  // A section measured again and flagged forgets its earlier reading; one not measured keeps it.
+  ASSERT_TRUE(lens.Update(MeasuredEdges({}, {6, 3})));
+  lens.Wait();
+  ASSERT_TRUE(lens.TakeModel(&model));
+  EXPECT_EQ(lens.sections(), 20);
+  EXPECT_FALSE(lens.Update(MeasuredEdges({})));  // nothing new: no fit
+  EXPECT_EQ(lens.sections(), 20);
+}
+
+TEST(LiveLens, NoFitStartsWhileTheLastOneIsNotTaken) {
+  LiveLens lens(FaceOnLens().camera);
+  ASSERT_TRUE(lens.Update(MeasuredEdges({1, 6, 11})));
+  EXPECT_FALSE(lens.Update(MeasuredEdges({2})));  // its readings wait for the next fit
+  lens.Wait();
+  optics::FittedModel model;
+  ASSERT_TRUE(lens.TakeModel(&model));
+  EXPECT_EQ(lens.sections(), 21);
+  ASSERT_TRUE(lens.Update(MeasuredEdges({})));  // edge 2's readings, kept, start the next fit
+  lens.Wait();
+  ASSERT_TRUE(lens.TakeModel(&model));
+  EXPECT_EQ(lens.sections(), 28);
+}
+
 TEST(LivePlanner, MeasuredBlurNeedsSectionsLiveDoesNotMeasure) {
   EXPECT_THROW(RequireLiveSource(BlurSource::kMeasured, "--blur"), Error);
   EXPECT_NO_THROW(RequireLiveSource(BlurSource::kFitted, "--blur"));
@@ -158,10 +256,10 @@ TEST(LiveLog, ALostFrameHasAnEmptyPose) {
   r.frame = 4;
   std::string csv;
   AppendLiveCsvRow(r, &csv);
-  EXPECT_EQ(csv, "4,0.000000,lost,,,,,,,0.000,0.000,0.000000,0.000,0\n");
+  EXPECT_EQ(csv, "4,0.000000,lost,,,,,,,0.000,0.000,0.000000,0.000,0,0,0.000,0\n");
   EXPECT_EQ(LiveCsvHeader(),
             "frame,arrival_s,status,rvec_x,rvec_y,rvec_z,tvec_x_mm,tvec_y_mm,tvec_z_mm,track_ms,render_ms,display_s,"
-            "latency_ms,dropped\n");
+            "latency_ms,dropped,sections,measure_ms,lens_sections\n");
 }
 
 }  // namespace

@@ -47,6 +47,9 @@ PacedSource::PacedSource(const std::string& input, double fps, int max_frames)
   if (!opened) throw InputError(device_, "OpenCV's videoio (V4L2) cannot open it as a camera (busy, or not a camera)");
 }
 
+PacedSource::PacedSource(const std::string& device, std::unique_ptr<media::VideoReader> reader, int max_frames)
+    : input_(device), device_(device), max_frames_(max_frames), camera_(std::move(reader)) {}
+
 PacedSource::~PacedSource() { Stop(); }
 
 int PacedSource::expected_frames() const { return file_ ? file_->expected_frames() : 0; }

@@ -35,6 +35,9 @@ class PacedSource {
   // Throws Error(kInput) naming the device when no camera is there or videoio cannot open it, and as
   // track::FrameSource for a video or a sequence; Error(kUsage) for `fps` given with a camera or out of range.
   PacedSource(const std::string& input, double fps, int max_frames);
+  // A camera read through `reader`, opened already, named `device` in what it says: the frames as the reader hands
+  // them over, its first failed read the camera stopping (a test plays a short video as the camera).
+  PacedSource(const std::string& device, std::unique_ptr<media::VideoReader> reader, int max_frames);
   ~PacedSource();
   PacedSource(const PacedSource&) = delete;
   PacedSource& operator=(const PacedSource&) = delete;

@@ -365,112 +365,99 @@ void AddSlopeRows(PlanResult& r, const Condition& c, const PlanOptions& options)
   for (auto row = r.rows.end() - N; row != r.rows.end(); ++row) row->expected_share = count > 0 ? sum / count : nan;
 }
 
-}  // namespace
-
-PlanResult RunPlan(const PlanOptions& options) {
-  if (!(options.alpha > 0 && options.alpha < 1)) throw Error(ErrorKind::kUsage, "--alpha must be in (0, 1)");
-  PlanResult r;
-  (void)procedure::ParseObserver(options.observer);  // a bad --observer before any file is read
-  const procedure::PreparedSession study = procedure::PrepareStudy(options.protocol_file, options.display_profile);
-  r.study = study.protocol.name;
-  r.display = study.display.name;
-  if (study.protocol.groups) r.groups = study.protocol.groups->names;
-  r.protocol_hash = store::ProtocolHash(store::CanonicalProtocolText(study.protocol_text));
-  const auto start = std::chrono::steady_clock::now();
-  r.studies = SimulateStudies(options, study, &r.conditions, &r.notes, &r.threads_used);
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  r.observer = procedure::ToString(procedure::ParseObserver(options.observer));
-  const int N = options.participants, S = options.studies;
-  if (r.conditions.empty())
-    throw InputError(options.protocol_file.string(),
-                     "nothing to plan: no main trial has a share to test (forced choice, a procedure, odd one out or "
-                     "yes/no) or a depth matching over distances");
-  // p-values of the exact test are a function of (k, n, chance): each (n, chance) computed once.
-  std::map<std::pair<int, double>, std::vector<double>> p_cache;
-  auto p_of = [&](int k, int n, double chance) {
-    auto& v = p_cache[{n, chance}];
+// p-values of the exact test are a function of (k, n, chance): each (n, chance) computed once.
+class ExactBinomialP {
+ public:
+  double operator()(int k, int n, double chance) {
+    auto& v = cache_[{n, chance}];
     if (v.empty()) v = BinomialTestPAll(n, chance);
     return v[size_t(k)];
-  };
-  for (const Condition& c : r.conditions) {
-    if (c.measure == "log_cutoff_slope") {
-      AddSlopeRows(r, c, options);
-      continue;
-    }
-    if (c.measure == "threshold") continue;  // comparisons.h
-    // The expected shares over every study and participant.
-    Tally all;
-    for (const auto& study : r.studies)
-      for (const auto& p : study)
-        if (const auto it = p.tallies.find(c.key); it != p.tallies.end()) {
-          const Tally& t = it->second;
-          all.k += t.k, all.n += t.n, all.first += t.first, all.second += t.second, all.cant_tell += t.cant_tell,
-              all.none += t.none, all.shown += t.shown;
-        }
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    const double shown = all.shown > 0 ? all.shown : nan;
-    std::vector<int> k(static_cast<size_t>(S), 0), n(static_cast<size_t>(S), 0);
-    // Per study, the participants' deviations from chance so far (participants with a counting answer), and their
-    // sum, sum of squares and smallest size for SignFlipNormalP (O(1) per N past SignFlipP's exact range).
-    struct Deviations {
-      std::vector<double> d;
-      double sum = 0, square = 0, step = INFINITY;
-    };
-    std::vector<Deviations> dev(static_cast<size_t>(S));
-    for (int m = 1; m <= N; ++m) {
-      PowerRow row;
-      row.test = c.chance >= 0 ? "exact" : "none";
-      row.condition = c.label;
-      row.measure = c.measure;
-      row.chance = c.chance >= 0 ? c.chance : nan;
-      row.participants = m;
-      row.expected_share = all.n > 0 ? double(all.k) / all.n : nan;
-      if (c.measure == "first_source") {
-        row.share_first = all.first / shown, row.share_second = all.second / shown;
-        row.share_cant_tell = all.cant_tell / shown, row.share_none = all.none / shown;
-      } else {
-        row.share_first = row.share_second = row.share_cant_tell = nan;
-        row.share_none = all.none / shown;
-      }
-      double width = 0, trials = 0;
-      int rejected = 0;
-      for (int s = 0; s < S; ++s) {
-        if (const auto it = r.studies[size_t(s)][size_t(m - 1)].tallies.find(c.key);
-            it != r.studies[size_t(s)][size_t(m - 1)].tallies.end()) {
-          k[size_t(s)] += it->second.k, n[size_t(s)] += it->second.n;
-          if (it->second.n > 0) {
-            Deviations& e = dev[size_t(s)];
-            const double d = double(it->second.k) / it->second.n - c.chance;
-            if (e.d.size() <= kSignFlipExactUpTo) e.d.push_back(d);
-            e.sum += d, e.square += d * d;
-            if (std::abs(d) > 1e-12) e.step = std::min(e.step, std::abs(d));
-          }
-        }
-        const auto [lo, hi] = Wilson95(k[size_t(s)], n[size_t(s)]);
-        width += hi - lo;
-        trials += n[size_t(s)];
-        if (c.chance < 0 || n[size_t(s)] == 0) continue;
-        // The report's test (analysis/study_tests.py against_chance_counts): one participant - the exact binomial of
-        // their answers; two - none; three or more with a share - at chance 0.5 the exact sign-flip test of their
-        // shares around it, else the exact binomial of the answers pooled (every participant guessing).
-        if (m == 1) {
-          rejected += p_of(k[size_t(s)], n[size_t(s)], c.chance) < options.alpha;
-          continue;
-        }
-        const Deviations& e = dev[size_t(s)];
-        if (e.d.size() < 3) continue;
-        const double p = std::abs(c.chance - 0.5) >= 1e-12      ? p_of(k[size_t(s)], n[size_t(s)], c.chance)
-                         : e.d.size() <= kSignFlipExactUpTo ? SignFlipP(e.d)
-                                                            : SignFlipNormalP(e.sum, e.square, e.step);
-        rejected += p < options.alpha;
-      }
-      row.wilson_width = width / S;
-      row.mean_trials = trials / S;
-      row.power = c.chance >= 0 ? double(rejected) / S : nan;
-      r.rows.push_back(row);
-    }
   }
-  // Across participants: each participant's share over all the trials of one measure, against its chance level.
+
+ private:
+  std::map<std::pair<int, double>, std::vector<double>> cache_;
+};
+
+// A condition's rows of the exact test against chance: per N, the expected shares, the mean Wilson width and the
+// power of the report's test.
+void AddExactRows(PlanResult& r, const Condition& c, const PlanOptions& options, ExactBinomialP& p_of) {
+  const int N = options.participants, S = options.studies;
+  // The expected shares over every study and participant.
+  Tally all;
+  for (const auto& study : r.studies)
+    for (const auto& p : study)
+      if (const auto it = p.tallies.find(c.key); it != p.tallies.end()) {
+        const Tally& t = it->second;
+        all.k += t.k, all.n += t.n, all.first += t.first, all.second += t.second, all.cant_tell += t.cant_tell,
+            all.none += t.none, all.shown += t.shown;
+      }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double shown = all.shown > 0 ? all.shown : nan;
+  std::vector<int> k(static_cast<size_t>(S), 0), n(static_cast<size_t>(S), 0);
+  // Per study, the participants' deviations from chance so far (participants with a counting answer), and their
+  // sum, sum of squares and smallest size for SignFlipNormalP (O(1) per N past SignFlipP's exact range).
+  struct Deviations {
+    std::vector<double> d;
+    double sum = 0, square = 0, step = INFINITY;
+  };
+  std::vector<Deviations> dev(static_cast<size_t>(S));
+  for (int m = 1; m <= N; ++m) {
+    PowerRow row;
+    row.test = c.chance >= 0 ? "exact" : "none";
+    row.condition = c.label;
+    row.measure = c.measure;
+    row.chance = c.chance >= 0 ? c.chance : nan;
+    row.participants = m;
+    row.expected_share = all.n > 0 ? double(all.k) / all.n : nan;
+    if (c.measure == "first_source") {
+      row.share_first = all.first / shown, row.share_second = all.second / shown;
+      row.share_cant_tell = all.cant_tell / shown, row.share_none = all.none / shown;
+    } else {
+      row.share_first = row.share_second = row.share_cant_tell = nan;
+      row.share_none = all.none / shown;
+    }
+    double width = 0, trials = 0;
+    int rejected = 0;
+    for (int s = 0; s < S; ++s) {
+      if (const auto it = r.studies[size_t(s)][size_t(m - 1)].tallies.find(c.key);
+          it != r.studies[size_t(s)][size_t(m - 1)].tallies.end()) {
+        k[size_t(s)] += it->second.k, n[size_t(s)] += it->second.n;
+        if (it->second.n > 0) {
+          Deviations& e = dev[size_t(s)];
+          const double d = double(it->second.k) / it->second.n - c.chance;
+          if (e.d.size() <= kSignFlipExactUpTo) e.d.push_back(d);
+          e.sum += d, e.square += d * d;
+          if (std::abs(d) > 1e-12) e.step = std::min(e.step, std::abs(d));
+        }
+      }
+      const auto [lo, hi] = Wilson95(k[size_t(s)], n[size_t(s)]);
+      width += hi - lo;
+      trials += n[size_t(s)];
+      if (c.chance < 0 || n[size_t(s)] == 0) continue;
+      // The report's test (analysis/study_tests.py against_chance_counts): one participant - the exact binomial of
+      // their answers; two - none; three or more with a share - at chance 0.5 the exact sign-flip test of their
+      // shares around it, else the exact binomial of the answers pooled (every participant guessing).
+      if (m == 1) {
+        rejected += p_of(k[size_t(s)], n[size_t(s)], c.chance) < options.alpha;
+        continue;
+      }
+      const Deviations& e = dev[size_t(s)];
+      if (e.d.size() < 3) continue;
+      const double p = std::abs(c.chance - 0.5) >= 1e-12      ? p_of(k[size_t(s)], n[size_t(s)], c.chance)
+                       : e.d.size() <= kSignFlipExactUpTo ? SignFlipP(e.d)
+                                                          : SignFlipNormalP(e.sum, e.square, e.step);
+      rejected += p < options.alpha;
+    }
+    row.wilson_width = width / S;
+    row.mean_trials = trials / S;
+    row.power = c.chance >= 0 ? double(rejected) / S : nan;
+    r.rows.push_back(row);
+  }
+}
+
+// Across participants: each participant's share over all the trials of one measure, against its chance level.
+void AddParticipantRows(PlanResult& r, const PlanOptions& options) {
+  const int N = options.participants, S = options.studies;
   std::set<std::pair<std::string, double>> measures;
   for (const Condition& c : r.conditions)
     if (c.chance >= 0 && c.measure != "log_cutoff_slope" && r.groups.size() < 2) measures.insert({c.measure, c.chance});
@@ -513,6 +500,37 @@ PlanResult RunPlan(const PlanOptions& options) {
       r.rows.push_back(row);
     }
   }
+}
+
+}  // namespace
+
+PlanResult RunPlan(const PlanOptions& options) {
+  if (!(options.alpha > 0 && options.alpha < 1)) throw Error(ErrorKind::kUsage, "--alpha must be in (0, 1)");
+  PlanResult r;
+  (void)procedure::ParseObserver(options.observer);  // a bad --observer before any file is read
+  const procedure::PreparedSession study = procedure::PrepareStudy(options.protocol_file, options.display_profile);
+  r.study = study.protocol.name;
+  r.display = study.display.name;
+  if (study.protocol.groups) r.groups = study.protocol.groups->names;
+  r.protocol_hash = store::ProtocolHash(store::CanonicalProtocolText(study.protocol_text));
+  const auto start = std::chrono::steady_clock::now();
+  r.studies = SimulateStudies(options, study, &r.conditions, &r.notes, &r.threads_used);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.observer = procedure::ToString(procedure::ParseObserver(options.observer));
+  if (r.conditions.empty())
+    throw InputError(options.protocol_file.string(),
+                     "nothing to plan: no main trial has a share to test (forced choice, a procedure, odd one out or "
+                     "yes/no) or a depth matching over distances");
+  ExactBinomialP p_of;
+  for (const Condition& c : r.conditions) {
+    if (c.measure == "log_cutoff_slope") {
+      AddSlopeRows(r, c, options);
+      continue;
+    }
+    if (c.measure == "threshold") continue;  // comparisons.h
+    AddExactRows(r, c, options, p_of);
+  }
+  AddParticipantRows(r, options);
   // Groups are compared, not pooled: each group's own test against chance and the between-group test.
   AddGroupShareRows(r, options);
   AddThresholdRows(r, options);

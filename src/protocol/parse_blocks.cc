@@ -143,6 +143,47 @@ std::optional<Block::Sides> Parser::ParseSides(const Json& v, const std::string&
   return sides;
 }
 
+// How block `b` runs, from its own fields only: its screens, order, practice and criterion, and groups.
+void Parser::ParseBlockRun(const Json& obj, const std::string& ptr, Block* b) {
+  const TaskTraits& task = TraitsOf(b->task);
+  if (auto s = Text(obj, "instructions", ptr, false, kMaxTextChars, false)) b->instructions = *s;
+  // What the participant sees: a title of one line, a prompt of its own (the timing is read once the layout is known).
+  // Blank (spaces only) is empty: it used to pass and open the block with no title on screen.
+  auto blank = [](const std::string& t) { return t.find_first_not_of(' ') == std::string::npos; };
+  if (auto s = Text(obj, "title", ptr, false, 100, true)) {
+    if (blank(*s)) Problem(ptr + "/title", "must not be empty (leave it out for \"Part n of N\")", Json(*s));
+    b->title = *s;
+  }
+  if (auto s = Text(obj, "prompt", ptr, false, 200, true)) {
+    if (blank(*s)) Problem(ptr + "/prompt", "must not be empty (leave it out for /responses/prompt)", Json(*s));
+    b->prompt = *s;
+  }
+  if (auto s = Bool(obj, "shuffle", ptr)) b->shuffle = *s;
+  if (auto s = Bool(obj, "practice", ptr)) b->practice = *s;
+  // Practice until a criterion: the share correct in one run of the design, and how many runs at most.
+  if (const Json* c = Field(obj, "criterion", ptr, false)) {
+    const std::string at = ptr + "/criterion";
+    if (Object(*c, at, {"correct", "max_repeats"})) {
+      Block::Criterion criterion;
+      if (auto x = Number(*c, "correct", at, true, 0.01, 1, "")) criterion.correct = *x;
+      if (auto n = Int(*c, "max_repeats", at, true, 2, 20, "runs of the design")) criterion.max_repeats = *n;
+      b->criterion = criterion;
+    }
+    if (!b->practice) Problem(at, "is for a practice block (\"practice\": true): a scored block runs once", *c);
+    if (!task.scored || b->procedure)
+      Problem(at, "needs answers that are right or wrong: a forced choice without a procedure", *c);
+  }
+  if (const Json* g = Field(obj, "groups", ptr, false)) {
+    if (!g->is_array() || g->empty())
+      Problem(ptr + "/groups", "must be a list of the protocol's group names", *g);
+    else
+      for (size_t i = 0; i < g->size(); ++i) {
+        if ((*g)[i].is_string()) b->groups.push_back((*g)[i].get<std::string>());
+        else Problem(ptr + "/groups/" + std::to_string(i), "must be a group name", (*g)[i]);
+      }
+  }
+}
+
 void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top, Block* b) {
   // A field of the block, else of the protocol: the object that holds it and that object's pointer. Inherited
   // fields are checked again per block; Problem() keeps each message once.
@@ -209,42 +250,7 @@ void Parser::ParseBlock(const Json& obj, const std::string& ptr, const Json& top
       Problem(b->counterbalance_pointer, "must be none for a procedure (the test side is drawn at random per trial)",
               Json(ToString(b->counterbalance)));
   }
-  if (auto s = Text(obj, "instructions", ptr, false, kMaxTextChars, false)) b->instructions = *s;
-  // What the participant sees: a title of one line, a prompt of its own (the timing is read once the layout is known).
-  // Blank (spaces only) is empty: it used to pass and open the block with no title on screen.
-  auto blank = [](const std::string& t) { return t.find_first_not_of(' ') == std::string::npos; };
-  if (auto s = Text(obj, "title", ptr, false, 100, true)) {
-    if (blank(*s)) Problem(ptr + "/title", "must not be empty (leave it out for \"Part n of N\")", Json(*s));
-    b->title = *s;
-  }
-  if (auto s = Text(obj, "prompt", ptr, false, 200, true)) {
-    if (blank(*s)) Problem(ptr + "/prompt", "must not be empty (leave it out for /responses/prompt)", Json(*s));
-    b->prompt = *s;
-  }
-  if (auto s = Bool(obj, "shuffle", ptr)) b->shuffle = *s;
-  if (auto s = Bool(obj, "practice", ptr)) b->practice = *s;
-  // Practice until a criterion: the share correct in one run of the design, and how many runs at most.
-  if (const Json* c = Field(obj, "criterion", ptr, false)) {
-    const std::string at = ptr + "/criterion";
-    if (Object(*c, at, {"correct", "max_repeats"})) {
-      Block::Criterion criterion;
-      if (auto x = Number(*c, "correct", at, true, 0.01, 1, "")) criterion.correct = *x;
-      if (auto n = Int(*c, "max_repeats", at, true, 2, 20, "runs of the design")) criterion.max_repeats = *n;
-      b->criterion = criterion;
-    }
-    if (!b->practice) Problem(at, "is for a practice block (\"practice\": true): a scored block runs once", *c);
-    if (!task.scored || b->procedure)
-      Problem(at, "needs answers that are right or wrong: a forced choice without a procedure", *c);
-  }
-  if (const Json* g = Field(obj, "groups", ptr, false)) {
-    if (!g->is_array() || g->empty())
-      Problem(ptr + "/groups", "must be a list of the protocol's group names", *g);
-    else
-      for (size_t i = 0; i < g->size(); ++i) {
-        if ((*g)[i].is_string()) b->groups.push_back((*g)[i].get<std::string>());
-        else Problem(ptr + "/groups/" + std::to_string(i), "must be a group name", (*g)[i]);
-      }
-  }
+  ParseBlockRun(obj, ptr, b);
 
   // What is shown left and right must be known for a comparison, and for any left/right counterbalancing.
   bool factor_sides = false;

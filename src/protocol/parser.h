@@ -135,9 +135,25 @@ class Parser {
   std::optional<Block::Sides> ParseSides(const Json& v, const std::string& ptr);
   // Fills `b` from `obj` at `ptr`, falling back to the protocol-level defaults in `top`.
   void ParseBlock(const Json& obj, const std::string& ptr, const Json& top, Block* b);
+  // ParseBlock's part that reads only the block's own fields (after its design: task, factors, sides, procedure).
+  void ParseBlockRun(const Json& obj, const std::string& ptr, Block* b);
   void ParseResponses(const Json& v, const std::string& ptr, const std::set<Task>& tasks, const Protocol& p,
                       Responses* r);
+  // Parse's parts, in the order Parse calls them (the order of the problems they report).
+  bool ParseContentAndScene(const Json& json, Protocol* p);  // true when the content type is given and valid
+  void ParseBlocks(const Json& json, Protocol* p);
+  void ParsePractice(const Json& json, Protocol* p);
+  void ParseLayout(const Json& json, bool typed, Protocol* p);
+  void CheckRealPhotos(const Json& json, const Protocol& p);
+  void ParseResponsesAndTiming(const Json& json, Protocol* p);
+  void ParseDisplay(const Json& json, bool typed, Protocol* p);
   void CheckDesign(const Protocol& p);
+  // CheckDesign's parts, one per kind of check, in the order it calls them.
+  void CheckGroups(const Protocol& p);
+  void CheckBlockLevels(const Protocol& p, const Block& b);
+  void CheckBlockLayout(const Protocol& p, const Block& b);
+  void CheckSessionSize(const Protocol& p);
+  void CheckGroupPractice(const Protocol& p);
   static bool Provides(const Block& b, const std::string& name);
 
   fs::path file_, base_;

@@ -32,6 +32,38 @@ Protocol Parser::Parse(const Json& json) {
   if (auto n = Int(json, "version", "", true, 1, 1000000)) p.version = *n;
   if (auto s = Text(json, "description", "", false, 5 * kMaxTextChars, false)) p.description = *s;
   if (auto s = Text(json, "instructions", "", false, kMaxTextChars, false)) p.instructions = *s;
+  const bool typed = ParseContentAndScene(json, &p);
+  // Protocol-level design fields are checked where they are written even when no block inherits them.
+  if (json.contains("factors")) ParseFactors(json["factors"], "/factors");
+  if (json.contains("sides")) ParseSides(json["sides"], "/sides");
+  if (json.contains("adjust")) ParseAdjust(json["adjust"], "/adjust");
+  if (json.contains("repetitions")) Int(json, "repetitions", "", true, 1, kMaxTrials, "repetitions");
+  if (json.contains("counterbalance"))
+    Word<Counterbalance>(json, "counterbalance", "", true);
+  if (json.contains("task")) Word<Task>(json, "task", "", true);
+
+  ParseBlocks(json, &p);
+  ParsePractice(json, &p);
+  ParseLayout(json, typed, &p);
+  if (const Json* v = Field(json, "participant_info", "", false)) ParseInfo(*v, "/participant_info", &p);
+  if (const Json* v = Field(json, "groups", "", false)) ParseGroups(*v, json, "/groups", &p);
+  if (const Json* v = Field(json, "breaks", "", false)) {
+    if (Object(*v, "/breaks", {"every_trials", "text"})) {
+      if (auto n = Int(*v, "every_trials", "/breaks", true, 1, kMaxTrials, "trials")) p.break_every_trials = *n;
+      if (auto s = Text(*v, "text", "/breaks", false, kMaxTextChars, false)) p.break_text = *s;
+    }
+  }
+  CheckRealPhotos(json, p);
+  ParseResponsesAndTiming(json, &p);
+  ParseDisplay(json, typed, &p);
+  CheckDesign(p);
+  p.conditions_tables = tables_;
+  return p;
+}
+
+// content and scene: which scene a content needs. True when the file gives a valid content type.
+bool Parser::ParseContentAndScene(const Json& json, Protocol* out) {
+  Protocol& p = *out;
   if (const Json* v = Field(json, "content", "", true)) ParseContent(*v, "/content", &p);
   // Whether the file gives a valid content type (ParseContent then set it): the checks that depend on it stay
   // silent when it is missing or invalid (already reported).
@@ -59,15 +91,12 @@ Protocol Parser::Parse(const Json& json) {
       (typed && (type == ContentType::kGrid || type == ContentType::kBall)))
     Problem("/scene/calib", "is required for a " + ToString(type) + " (its blur comes from the calibration) but missing");
 
-  // Protocol-level design fields are checked where they are written even when no block inherits them.
-  if (json.contains("factors")) ParseFactors(json["factors"], "/factors");
-  if (json.contains("sides")) ParseSides(json["sides"], "/sides");
-  if (json.contains("adjust")) ParseAdjust(json["adjust"], "/adjust");
-  if (json.contains("repetitions")) Int(json, "repetitions", "", true, 1, kMaxTrials, "repetitions");
-  if (json.contains("counterbalance"))
-    Word<Counterbalance>(json, "counterbalance", "", true);
-  if (json.contains("task")) Word<Task>(json, "task", "", true);
+  return typed;
+}
 
+// The blocks, or the one block of a file without "blocks" (the top level is its own).
+void Parser::ParseBlocks(const Json& json, Protocol* out) {
+  Protocol& p = *out;
   const Json* blocks = Field(json, "blocks", "", false);
   if (!blocks) {
     Block b;
@@ -94,7 +123,11 @@ Protocol Parser::Parse(const Json& json) {
       p.blocks.push_back(std::move(b));
     }
   }
+}
 
+// The protocol's practice: how many trials, drawn from which block.
+void Parser::ParsePractice(const Json& json, Protocol* out) {
+  Protocol& p = *out;
   if (const Json* v = Field(json, "practice", "", false)) {
     if (Object(*v, "/practice", {"count", "block", "instructions"})) {
       if (auto n = Int(*v, "count", "/practice", true, 0, 1000, "trials")) p.practice.count = *n;
@@ -111,6 +144,12 @@ Protocol Parser::Parse(const Json& json) {
       }
     }
   }
+}
+
+// block_order, layout and alternatives, and what the layout makes of each procedure's guess rate.
+void Parser::ParseLayout(const Json& json, bool typed, Protocol* out) {
+  Protocol& p = *out;
+  const ContentType type = p.content.type;
   if (auto order = Word<BlockSequence>(json, "block_order", "", false)) p.block_order = *order;
   if (auto layout = Word<Layout>(json, "layout", "", false)) {
     p.layout = *layout;
@@ -154,15 +193,10 @@ Protocol Parser::Parse(const Json& json) {
         Problem(b.pointer + "/procedure/down", text, Json(b.procedure->down));
       }
     }
-  if (const Json* v = Field(json, "participant_info", "", false)) ParseInfo(*v, "/participant_info", &p);
-  if (const Json* v = Field(json, "groups", "", false)) ParseGroups(*v, json, "/groups", &p);
-  if (const Json* v = Field(json, "breaks", "", false)) {
-    if (Object(*v, "/breaks", {"every_trials", "text"})) {
-      if (auto n = Int(*v, "every_trials", "/breaks", true, 1, kMaxTrials, "trials")) p.break_every_trials = *n;
-      if (auto s = Text(*v, "text", "/breaks", false, kMaxTextChars, false)) p.break_text = *s;
-    }
-  }
-  // The real photos: one per distance the design shows.
+}
+
+// The real photos: one per distance the design shows.
+void Parser::CheckRealPhotos(const Json& json, const Protocol& p) {
   if (!p.content.real_photos.empty() && options_.check_files) {
     const std::set<double> distances = NumericLevels(p, "distance_m");
     if (distances.empty())
@@ -174,6 +208,11 @@ Protocol Parser::Parse(const Json& json) {
                 json["content"]["real_photos"]);
     }
   }
+}
+
+// responses, then timing: the protocol's, and each block's resolved over it.
+void Parser::ParseResponsesAndTiming(const Json& json, Protocol* out) {
+  Protocol& p = *out;
   std::set<Task> tasks;
   for (const auto& b : p.blocks) tasks.insert(b.task);
   const Json* responses = Field(json, "responses", "", false);
@@ -190,6 +229,12 @@ Protocol Parser::Parse(const Json& json) {
     const Json& obj = json.at(Json::json_pointer(b.pointer));
     if (const Json* v = Field(obj, "timing", b.pointer, false)) ParseTiming(*v, b.pointer + "/timing", p, {&b}, &b.timing);
   }
+}
+
+// display: the window, the monitor and how the photo maps to the screen.
+void Parser::ParseDisplay(const Json& json, bool typed, Protocol* out) {
+  Protocol& p = *out;
+  const ContentType type = p.content.type;
   if (const Json* v = Field(json, "display", "", false)) {
     if (Object(*v, "/display", {"width_px", "height_px", "fullscreen", "monitor", "profile", "scale", "width_deg"})) {
       // From VGA's 320 x 240 to 4K UHD (a depth-matching frame as wide as the display is filtered on the CPU).
@@ -217,18 +262,43 @@ Protocol Parser::Parse(const Json& json) {
                 v->contains("scale") ? (*v)["scale"] : (*v)["width_deg"]);
     }
   }
-  CheckDesign(p);
-  p.conditions_tables = tables_;
-  return p;
 }
 
 // The design as a whole, once every field is valid: what each block shows fits the content, every trial has
 // the levels its content needs, and the session's size is within the cap.
 void Parser::CheckDesign(const Protocol& p) {
   if (calls_ > 0) return;  // a design built from fields with problems would only repeat them
-  const ContentType type = p.content.type;
-  const std::string type_name = ToString(type), layout_name = ToString(p.layout);
-  // Groups: a block names only the protocol's groups, and every group runs at least one block.
+  CheckGroups(p);
+  for (const auto& b : p.blocks) {
+    CheckBlockLevels(p, b);
+    CheckBlockLayout(p, b);
+  }
+  CheckSessionSize(p);
+  if (!p.blocks.empty() && std::all_of(p.blocks.begin(), p.blocks.end(), [](const Block& b) { return b.practice; }))
+    Problem("/blocks", "every block is a practice block: nothing would be scored");
+  // Answering only after the motion needs something that moves or runs in intervals.
+  if (p.responses.after_motion && IntervalCount(p) == 0 &&
+      std::none_of(p.blocks.begin(), p.blocks.end(), [&](const Block& b) { return Provides(b, "speed_cm_s"); }))
+    Problem("/responses/after_motion", "no block moves its objects (a speed_cm_s level) and the layout has no "
+                                       "intervals: there is no motion to wait for", Json(true));
+  for (const auto& b : p.blocks)
+    if (b.practice && b.procedure)
+      Problem(b.pointer + "/practice", "a procedure's block is scored by its procedure; practise in a block without one",
+              Json(true));
+  for (const auto& b : p.blocks)
+    if (b.name == p.practice.block && p.practice.count > 0 && b.procedure)
+      Problem("/practice/block", "names block " + b.name + ", whose trials its procedure decides from the answers; "
+                                 "practise on a block without a procedure", Json(b.name));
+  CheckGroupPractice(p);
+  for (const auto& b : p.blocks)
+    if (b.name == p.practice.block && p.practice.count > DesignTrials(b) && DesignTrials(b) <= kMaxTrials)
+      Problem("/practice/count", "asks for " + std::to_string(p.practice.count) + " practice trials but block " +
+                                     b.name + " has only " + std::to_string(DesignTrials(b)),
+              Json(p.practice.count));
+}
+
+// Groups: a block names only the protocol's groups, and every group runs at least one block.
+void Parser::CheckGroups(const Protocol& p) {
   for (const auto& b : p.blocks)
     for (size_t i = 0; i < b.groups.size(); ++i)
       if (!p.groups || std::find(p.groups->names.begin(), p.groups->names.end(), b.groups[i]) == p.groups->names.end())
@@ -242,107 +312,122 @@ void Parser::CheckDesign(const Protocol& p) {
             return b.groups.empty() || std::count(b.groups.begin(), b.groups.end(), g);
           }))
         Problem("/groups/names", "group " + g + " runs no block", Json(g));
-  for (const auto& b : p.blocks) {
-    // The renderer draws a picture for adjustment (cut-offs) and a pair of grids or balls for forced choice.
-    const TaskTraits& task = TraitsOf(b.task);
-    const bool picture_task = task.shows == TaskShows::kPicture;
-    if (type == ContentType::kPicture && !picture_task)
-      Problem(b.task_pointer, "must be " + TaskWords([](const TaskTraits& t) { return t.shows == TaskShows::kPicture; }) +
-                                  " for a picture (forced_choice compares a pair of grids or balls)",
-              Json(ToString(b.task)));
-    if (type != ContentType::kPicture && picture_task)
-      Problem(b.task_pointer, "must be forced_choice for a " + type_name + " (adjustment steps through the cut-offs of a "
-                              "picture)", Json(ToString(b.task)));
-    // A level that places or moves a stimulus is read only by the content it is for: anywhere else it would be
-    // recorded but not shown.
-    static const std::map<ContentType, std::set<std::string>> kUses = {
-        {ContentType::kGrid, {"edge", "y_mm", "left_x_mm", "right_x_mm", "height_mm", "rotation_deg"}},
-        {ContentType::kBall, {"edge", "from_edge", "to_edge", "section", "speed_cm_s", "y_mm", "from_y_mm", "to_y_mm",
-                  "left_x_mm", "right_x_mm", "height_mm"}},
-        {ContentType::kPicture, {"distance_m"}}};
-    static const std::set<std::string> kStimulusLevels = {"edge",      "from_edge",  "to_edge",   "section",
-                                                          "speed_cm_s", "distance_m", "y_mm",      "from_y_mm",
-                                                          "to_y_mm",   "left_x_mm",  "right_x_mm", "height_mm",
-                                                          "rotation_deg"};
-    const auto uses = kUses.find(type);
-    for (const auto& f : b.factors) {
-      std::set<std::string> names{f.name};
-      for (const Level& level : f.levels)
-        for (const auto& [key, value] : level.fields) names.insert(key);
-      for (const auto& name : names)
-        if (kStimulusLevels.count(name) && uses != kUses.end() && !uses->second.count(name))
-          Problem(b.factors_pointer + "/" + f.name,
-                  "a " + type_name + " does not use " + name + " (it would be recorded but not shown); a " + type_name +
-                      " uses " + [&] {
-                        std::string list;
-                        for (const auto& u : uses->second) list += (list.empty() ? "" : ", ") + u;
-                        return list;
-                      }());
-    }
-    // Every layout but side_by_side draws its objects - the single one, each interval's - at the left one's place,
-    // and intervals hold them still: a level that places the right object, or ends a run in intervals, would be
-    // recorded but not shown. Named at the factor, or at the first level (a conditions table's row) that gives it.
-    if (uses != kUses.end() && type != ContentType::kPicture && p.layout != Layout::kSideBySide) {
-      std::vector<std::pair<std::string, std::string>> unshown = {
-          {"right_x_mm", "the layout " + layout_name + " shows every object at the left one's place (move it with "
-                         "left_x_mm): a right_x_mm level would be recorded but not shown"}};
-      if (IntervalCount(p) > 0)
-        for (const char* end : {"to_edge", "to_y_mm"})
-          unshown.push_back({end, std::string("intervals show still objects, where a run would start: a ") + end +
-                                      " level would be recorded but not shown"});
-      for (const auto& [name, why] : unshown)
-        for (const auto& f : b.factors) {
-          if (f.name == name) {
-            Json levels = Json::array();
-            for (const Level& level : f.levels) levels.push_back(ToJson(level));
-            Problem(b.factors_pointer + "/" + JsonPointerToken(f.name), why, levels);
-            continue;
-          }
-          for (size_t i = 0; i < f.levels.size(); ++i)
-            if (const LevelValue* value = f.levels[i].Field(name)) {
-              Problem(b.factors_pointer + "/" + JsonPointerToken(f.name) + "/" + std::to_string(i) + "/" + name, why,
-                      ToJson(*value));
-              break;
-            }
-        }
-    }
-    if (IntervalCount(p) > 0 && Provides(b, "speed_cm_s"))
-      Problem(b.factors_pointer, "intervals show still objects: a speed_cm_s level would move them");
-    // The layout decides the question: one object is answered yes/no or rated, a pair or N intervals chosen from.
-    const bool one = task.shows == TaskShows::kOneObject;
-    if (p.layout == Layout::kSingle && type != ContentType::kPicture && !one)
-      Problem(b.task_pointer, "must be " + TaskWords([](const TaskTraits& t) { return t.shows == TaskShows::kOneObject; }) +
-                                  " for the layout single (one object: nothing to choose between)",
-              Json(ToString(b.task)));
-    if (p.layout != Layout::kSingle && one)
-      Problem(b.task_pointer, "is for the layout single (one object); a " + layout_name + " trial is a forced choice",
-              Json(ToString(b.task)));
-    if (p.layout == Layout::kSingle && b.counterbalance != Counterbalance::kNone)
-      Problem(b.counterbalance_pointer, "must be none for the layout single (one object: no sides to swap)",
-              Json(ToString(b.counterbalance)));
-    if (p.layout == Layout::kSingle && b.procedure)
-      Problem(b.pointer + "/procedure", "needs a forced choice (layouts side_by_side, two_intervals, odd_one_out)");
-    // "object" is the single layout's one source; a pair layout reads left and right.
-    bool object = b.sides && b.sides->object;
-    bool pair = b.sides && !b.sides->object;
-    for (const auto& f : b.factors)
-      for (const Level& level : f.levels) {
-        object = object || level.Field("object");
-        pair = pair || level.Field(ToString(Side::kLeft));
-      }
-    if (p.layout == Layout::kSingle && pair)
-      Problem(b.sides ? b.sides_pointer : b.factors_pointer,
-              "the layout single shows one object: give \"object\", not left and right");
-    if (p.layout != Layout::kSingle && object)
-      Problem(b.sides ? b.sides_pointer : b.factors_pointer,
-              "\"object\" is for the layout single; a " + layout_name + " trial shows left and right");
-    if (type == ContentType::kGrid && !Provides(b, "edge") && !Provides(b, "y_mm"))
-      Problem(b.factors_pointer, "a grid stands at an edge: needs a factor edge (or y_mm), or a factor whose every "
-                                 "level has an edge (1..11 on the thesis's board)");
-    if (type == ContentType::kPicture && !p.content.real_photos.empty() && !Provides(b, "distance_m"))
-      Problem(b.factors_pointer, "content.real_photos chooses the photo by distance: needs a factor distance_m, or "
-                                 "a factor whose every level has a distance_m");
+}
+
+// What block `b` shows fits the content: its task, and the levels that place or move a stimulus.
+void Parser::CheckBlockLevels(const Protocol& p, const Block& b) {
+  const ContentType type = p.content.type;
+  const std::string type_name = ToString(type), layout_name = ToString(p.layout);
+  // The renderer draws a picture for adjustment (cut-offs) and a pair of grids or balls for forced choice.
+  const TaskTraits& task = TraitsOf(b.task);
+  const bool picture_task = task.shows == TaskShows::kPicture;
+  if (type == ContentType::kPicture && !picture_task)
+    Problem(b.task_pointer, "must be " + TaskWords([](const TaskTraits& t) { return t.shows == TaskShows::kPicture; }) +
+                                " for a picture (forced_choice compares a pair of grids or balls)",
+            Json(ToString(b.task)));
+  if (type != ContentType::kPicture && picture_task)
+    Problem(b.task_pointer, "must be forced_choice for a " + type_name + " (adjustment steps through the cut-offs of a "
+                            "picture)", Json(ToString(b.task)));
+  // A level that places or moves a stimulus is read only by the content it is for: anywhere else it would be
+  // recorded but not shown.
+  static const std::map<ContentType, std::set<std::string>> kUses = {
+      {ContentType::kGrid, {"edge", "y_mm", "left_x_mm", "right_x_mm", "height_mm", "rotation_deg"}},
+      {ContentType::kBall, {"edge", "from_edge", "to_edge", "section", "speed_cm_s", "y_mm", "from_y_mm", "to_y_mm",
+                "left_x_mm", "right_x_mm", "height_mm"}},
+      {ContentType::kPicture, {"distance_m"}}};
+  static const std::set<std::string> kStimulusLevels = {"edge",      "from_edge",  "to_edge",   "section",
+                                                        "speed_cm_s", "distance_m", "y_mm",      "from_y_mm",
+                                                        "to_y_mm",   "left_x_mm",  "right_x_mm", "height_mm",
+                                                        "rotation_deg"};
+  const auto uses = kUses.find(type);
+  for (const auto& f : b.factors) {
+    std::set<std::string> names{f.name};
+    for (const Level& level : f.levels)
+      for (const auto& [key, value] : level.fields) names.insert(key);
+    for (const auto& name : names)
+      if (kStimulusLevels.count(name) && uses != kUses.end() && !uses->second.count(name))
+        Problem(b.factors_pointer + "/" + f.name,
+                "a " + type_name + " does not use " + name + " (it would be recorded but not shown); a " + type_name +
+                    " uses " + [&] {
+                      std::string list;
+                      for (const auto& u : uses->second) list += (list.empty() ? "" : ", ") + u;
+                      return list;
+                    }());
   }
+  // Every layout but side_by_side draws its objects - the single one, each interval's - at the left one's place,
+  // and intervals hold them still: a level that places the right object, or ends a run in intervals, would be
+  // recorded but not shown. Named at the factor, or at the first level (a conditions table's row) that gives it.
+  if (uses != kUses.end() && type != ContentType::kPicture && p.layout != Layout::kSideBySide) {
+    std::vector<std::pair<std::string, std::string>> unshown = {
+        {"right_x_mm", "the layout " + layout_name + " shows every object at the left one's place (move it with "
+                       "left_x_mm): a right_x_mm level would be recorded but not shown"}};
+    if (IntervalCount(p) > 0)
+      for (const char* end : {"to_edge", "to_y_mm"})
+        unshown.push_back({end, std::string("intervals show still objects, where a run would start: a ") + end +
+                                    " level would be recorded but not shown"});
+    for (const auto& [name, why] : unshown)
+      for (const auto& f : b.factors) {
+        if (f.name == name) {
+          Json levels = Json::array();
+          for (const Level& level : f.levels) levels.push_back(ToJson(level));
+          Problem(b.factors_pointer + "/" + JsonPointerToken(f.name), why, levels);
+          continue;
+        }
+        for (size_t i = 0; i < f.levels.size(); ++i)
+          if (const LevelValue* value = f.levels[i].Field(name)) {
+            Problem(b.factors_pointer + "/" + JsonPointerToken(f.name) + "/" + std::to_string(i) + "/" + name, why,
+                    ToJson(*value));
+            break;
+          }
+      }
+  }
+  if (IntervalCount(p) > 0 && Provides(b, "speed_cm_s"))
+    Problem(b.factors_pointer, "intervals show still objects: a speed_cm_s level would move them");
+}
+
+// What block `b` asks fits the layout: the task, the sides, and the levels a grid or real photos need.
+void Parser::CheckBlockLayout(const Protocol& p, const Block& b) {
+  const ContentType type = p.content.type;
+  const std::string layout_name = ToString(p.layout);
+  const TaskTraits& task = TraitsOf(b.task);
+  // The layout decides the question: one object is answered yes/no or rated, a pair or N intervals chosen from.
+  const bool one = task.shows == TaskShows::kOneObject;
+  if (p.layout == Layout::kSingle && type != ContentType::kPicture && !one)
+    Problem(b.task_pointer, "must be " + TaskWords([](const TaskTraits& t) { return t.shows == TaskShows::kOneObject; }) +
+                                " for the layout single (one object: nothing to choose between)",
+            Json(ToString(b.task)));
+  if (p.layout != Layout::kSingle && one)
+    Problem(b.task_pointer, "is for the layout single (one object); a " + layout_name + " trial is a forced choice",
+            Json(ToString(b.task)));
+  if (p.layout == Layout::kSingle && b.counterbalance != Counterbalance::kNone)
+    Problem(b.counterbalance_pointer, "must be none for the layout single (one object: no sides to swap)",
+            Json(ToString(b.counterbalance)));
+  if (p.layout == Layout::kSingle && b.procedure)
+    Problem(b.pointer + "/procedure", "needs a forced choice (layouts side_by_side, two_intervals, odd_one_out)");
+  // "object" is the single layout's one source; a pair layout reads left and right.
+  bool object = b.sides && b.sides->object;
+  bool pair = b.sides && !b.sides->object;
+  for (const auto& f : b.factors)
+    for (const Level& level : f.levels) {
+      object = object || level.Field("object");
+      pair = pair || level.Field(ToString(Side::kLeft));
+    }
+  if (p.layout == Layout::kSingle && pair)
+    Problem(b.sides ? b.sides_pointer : b.factors_pointer,
+            "the layout single shows one object: give \"object\", not left and right");
+  if (p.layout != Layout::kSingle && object)
+    Problem(b.sides ? b.sides_pointer : b.factors_pointer,
+            "\"object\" is for the layout single; a " + layout_name + " trial shows left and right");
+  if (type == ContentType::kGrid && !Provides(b, "edge") && !Provides(b, "y_mm"))
+    Problem(b.factors_pointer, "a grid stands at an edge: needs a factor edge (or y_mm), or a factor whose every "
+                               "level has an edge (1..11 on the thesis's board)");
+  if (type == ContentType::kPicture && !p.content.real_photos.empty() && !Provides(b, "distance_m"))
+    Problem(b.factors_pointer, "content.real_photos chooses the photo by distance: needs a factor distance_m, or "
+                               "a factor whose every level has a distance_m");
+}
+
+// The session's size: within kMaxTrials (and the blocks' shares spelled out when it is not), and not empty.
+void Parser::CheckSessionSize(const Protocol& p) {
   const int64_t trials = SessionTrials(p);
   if (trials > kMaxTrials) {
     // Where the trials come from: every block's share counted as SessionTrials counts it - a practice criterion's
@@ -410,23 +495,11 @@ void Parser::CheckDesign(const Protocol& p) {
   } else if (trials == 0) {
     Problem("/", "makes no trials");
   }
-  if (!p.blocks.empty() && std::all_of(p.blocks.begin(), p.blocks.end(), [](const Block& b) { return b.practice; }))
-    Problem("/blocks", "every block is a practice block: nothing would be scored");
-  // Answering only after the motion needs something that moves or runs in intervals.
-  if (p.responses.after_motion && IntervalCount(p) == 0 &&
-      std::none_of(p.blocks.begin(), p.blocks.end(), [&](const Block& b) { return Provides(b, "speed_cm_s"); }))
-    Problem("/responses/after_motion", "no block moves its objects (a speed_cm_s level) and the layout has no "
-                                       "intervals: there is no motion to wait for", Json(true));
-  for (const auto& b : p.blocks)
-    if (b.practice && b.procedure)
-      Problem(b.pointer + "/practice", "a procedure's block is scored by its procedure; practise in a block without one",
-              Json(true));
-  for (const auto& b : p.blocks)
-    if (b.name == p.practice.block && p.practice.count > 0 && b.procedure)
-      Problem("/practice/block", "names block " + b.name + ", whose trials its procedure decides from the answers; "
-                                 "practise on a block without a procedure", Json(b.name));
-  // Each group practises its own condition: the protocol's practice is drawn from one block for every participant,
-  // so a block that only some groups run would show the other groups a condition they never run (issue 38).
+}
+
+// Each group practises its own condition: the protocol's practice is drawn from one block for every participant,
+// so a block that only some groups run would show the other groups a condition they never run (issue 38).
+void Parser::CheckGroupPractice(const Protocol& p) {
   if (p.groups && p.practice.count > 0)
     for (const auto& b : p.blocks)
       if (b.name == p.practice.block && !b.groups.empty()) {
@@ -473,11 +546,6 @@ void Parser::CheckDesign(const Protocol& p) {
                   ToJson(b.sides->left));
       }
     }
-  for (const auto& b : p.blocks)
-    if (b.name == p.practice.block && p.practice.count > DesignTrials(b) && DesignTrials(b) <= kMaxTrials)
-      Problem("/practice/count", "asks for " + std::to_string(p.practice.count) + " practice trials but block " +
-                                     b.name + " has only " + std::to_string(DesignTrials(b)),
-              Json(p.practice.count));
 }
 
 // True when every trial of `b` has a level `name`: a factor of that name, or a factor whose levels all carry it.

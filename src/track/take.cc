@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <future>
 #include <sstream>
 
 #include "core/atomic_file.h"
@@ -55,21 +56,39 @@ std::string CalibFileName(int index) {
 
 TakeResult TrackTake(FrameSource& source, Tracker& tracker, const std::function<void(const FrameResult&)>& progress) {
   TakeResult take;
-  cv::Mat frame;
-  int index = 0;
-  double time_s = 0;
-  for (;;) {
+  // The next frame is read and decoded on a thread of its own while this one is tracked (decoding is a third of a
+  // frame's time, and the measurement's stripes leave a core idle at their ends): the frames, their order and the
+  // errors are the reader's, one frame ahead. Two buffers take turns: a frame is never decoded into the one tracked.
+  struct Read {
+    cv::Mat frame;
+    int index = 0;
+    double time_s = 0;
+    bool got = false;
+    double decode_ms = 0;
+  };
+  auto read = [&source](Read* r) {
     const auto t0 = std::chrono::steady_clock::now();
+    r->got = source.Next(&r->frame, &r->index, &r->time_s);
+    r->decode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  };
+  Read buffers[2];
+  Read *now = &buffers[0], *next = &buffers[1];
+  std::future<void> ahead = std::async(std::launch::async, read, now);
+  for (;;) {
     try {
-      if (!source.Next(&frame, &index, &time_s)) break;
-      take.decode_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      take.frames.push_back(tracker.Process(frame, index, time_s));
-      take.frames.back().signature = FrameSignature(frame);
+      ahead.get();  // an input error of the frame read ahead surfaces here, in its turn
+      if (!now->got) break;
+      take.decode_ms += now->decode_ms;
+      ahead = std::async(std::launch::async, read, next);
+      take.frames.push_back(tracker.Process(now->frame, now->index, now->time_s));
+      take.frames.back().signature = FrameSignature(now->frame);
     } catch (const Error& e) {
+      if (ahead.valid()) ahead.wait();  // the reader is done with its buffer before the take ends
       if (e.kind() != ErrorKind::kInput) throw;
       take.error = e;
       break;
     }
+    std::swap(now, next);  // the buffers' roles, not their contents: the reader is filling *next
     const FrameResult& r = take.frames.back();
     switch (r.status) {
       case FrameStatus::kFound: ++take.found; break;

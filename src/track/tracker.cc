@@ -150,6 +150,18 @@ FrameResult Tracker::Process(const cv::Mat& photo, int index, double time_s) {
   calib::CalibrateOptions options = options_.calibrate;
   options.known_pose = *pose;
   options.fit_model = false;  // one model for the whole take, fitted to every frame's sections at the end (FitTakeModel)
+  const int edges = board_.EdgeCount(), total = edges * board_.SectionCount();
+  r.sections_measured = total;
+  if (options_.sections_per_frame > 0 && options_.sections_per_frame < total) {
+    // Edge after edge within a section number (section 1 of edges 1 .. E, then section 2, ...): a few sections of a
+    // frame lie at the board's different depths, which is what a lens fit needs.
+    for (int i = 0; i < options_.sections_per_frame; ++i) {
+      const int k = (next_section_ + i) % total;
+      options.only_sections.push_back((k % edges) * board_.SectionCount() + k / edges);
+    }
+    next_section_ = (next_section_ + options_.sections_per_frame) % total;
+    r.sections_measured = options_.sections_per_frame;
+  }
   try {
     r.calib = calib::Calibrate(planes_, camera_, board_, options);
     r.calib->detect_ms = r.pose_ms;

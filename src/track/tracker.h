@@ -23,6 +23,10 @@ struct TrackOptions {
   double max_track_error_px = 0.5;       // a tracked pose's RMS reprojection error above this: tracking is lost
   bool always_detect = false;            // full detection on every frame (the bench's baseline)
   bool measure_blur = true;              // false: the pose only (a lens model fixed elsewhere: blurcue live)
+  // With measure_blur: 0 measures every section of every frame; N > 0 a rotating subset of N a frame (the next N in
+  // the order section 1 of edges 1 .. E, section 2 of edges 1 .. E, ..., wrapping round, on each frame with a pose),
+  // so every section is measured once in every ceil(sections / N) frames (blurcue live --measure-sections).
+  int sections_per_frame = 0;
 };
 
 struct FrameResult {
@@ -35,6 +39,7 @@ struct FrameResult {
   double pose_ms = 0;                    // tracking or detection, and the pose
   double measure_ms = 0;                 // linear light, every section's blur, the frame's estimate
   double frame_ms = 0;                   // all of the frame's work (decoding excluded)
+  int sections_measured = 0;             // sections whose blur was measured in this frame (usable or not)
   std::vector<double> signature;         // FrameSignature of the frame (TrackTake fills it)
 };
 
@@ -58,6 +63,7 @@ class Tracker {
   double last_time_s_ = 0, before_last_time_s_ = 0;  // and their times
   cv::Mat last_small_;  // the last frame with a pose, a quarter size, float: its shift to the next one
   calib::PhotoPlanes planes_;  // the frame's grey and linear planes; their buffers serve the whole take
+  int next_section_ = 0;       // the first section of the next frame's subset (sections_per_frame > 0)
 };
 
 // The take's one lens model (fixed focus and aperture): the thin-lens fit to every usable section of every frame
