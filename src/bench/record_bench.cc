@@ -46,8 +46,8 @@ RecordBenchResult RunRecordBench(const RecordBenchOptions& options) {
     store::FrameRecord& frame = frames[size_t(f)];
     frame.frame_index = f;
     frame.flip_time_s = f / 60.0;
-    frame.r_left_px = 1.5 + 0.01 * f;
-    frame.r_right_px = 2.5 + 0.01 * f;
+    frame.sides[0].r_px = 1.5 + 0.01 * f;
+    frame.sides[1].r_px = 2.5 + 0.01 * f;
     frame.y_mm = 0.5 * f;
   }
   // Interleaved, so both arms meet the same moments of a shared, noisy machine.

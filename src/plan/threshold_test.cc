@@ -94,7 +94,7 @@ struct PixelPair {
   stimulus::Presentation presentation;
   PixelPair() {
     trial.cell = 0, trial.test_side = "right";
-    scene.r_left_px = scene.r_right_px = 2;
+    scene.side(protocol::Side::kLeft).r_px = scene.side(protocol::Side::kRight).r_px = 2;
   }
 };
 

@@ -149,29 +149,29 @@ void AddPairTiles(const procedure::PreparedSession& prepared, const SheetOptions
   };
   // What an observer makes of the pair on this display: the object against the scene's blur for one object.
   procedure::PairView view = procedure::ViewOf(s, at);
-  if (s.left_only) view.r_right_px = view.r_scene_px;
+  if (s.left_only) view.r_px[protocol::Index(protocol::Side::kRight)] = view.r_scene_px;
   const double p_correct = procedure::ProbabilityCorrect2afc(options.observer, view);
   char seen[96];
   std::snprintf(seen, sizeof seen, "%s told apart %.0f %% (2AFC)%s", s.left_only ? "vs scene:" : "L vs R:",
                 100 * p_correct,
                 p_correct >= options.visible ? "" : s.left_only ? " - as blurred as the scene" : " - INVISIBLE");
   const size_t first_tile = tiles->size();
+  const double r_left = s.side(protocol::Side::kLeft).r_px, r_right = s.side(protocol::Side::kRight).r_px;
   if (s.left_only) {  // layout single: its one object
-    tiles->push_back({s, 0, levels + first, side("object", t.left, s.r_left_px), key});
+    tiles->push_back({s, 0, levels + first, side("object", t.left, r_left), key});
   } else if (s.intervals > 0) {
     // Intervals show one object at a time, at the left object's place: a tile for each kind of interval.
     const bool odd = s.intervals > 2;
     Json first_key = key;
     first_key["interval"] = 1;
     tiles->push_back({stimulus::IntervalScene(s, false), 0, levels + first,
-                      side(odd ? "the others: L" : "1st interval: L", t.left, s.r_left_px), first_key});
+                      side(odd ? "the others: L" : "1st interval: L", t.left, r_left), first_key});
     Json second = key;
     second["interval"] = 2;
     tiles->push_back({stimulus::IntervalScene(s, true), 0, levels + first,
-                      side(odd ? "the odd one: R" : "2nd interval: R", t.right, s.r_right_px), second});
+                      side(odd ? "the odd one: R" : "2nd interval: R", t.right, r_right), second});
   } else {
-    tiles->push_back(
-        {s, 0, levels + first, side("L", t.left, s.r_left_px) + " | " + side("R", t.right, s.r_right_px), key});
+    tiles->push_back({s, 0, levels + first, side("L", t.left, r_left) + " | " + side("R", t.right, r_right), key});
   }
   for (size_t k = first_tile; k < tiles->size(); ++k) (*tiles)[k].seen = seen;
 }

@@ -30,7 +30,7 @@ TEST(AnswerTrial, EachTaskAsksItsQuestion) {
   protocol.responses.cant_tell = "Down";
   protocol.responses.rating = {"1", "2", "3", "4", "5"};
   TrialScene scene;
-  scene.r_left_px = 2.0, scene.r_right_px = 2.6, scene.r_scene_px = 2.1;
+  scene.side(protocol::Side::kLeft).r_px = 2.0, scene.side(protocol::Side::kRight).r_px = 2.6, scene.r_scene_px = 2.1;
   const Presentation shown = At(0.9);
   const PairView view = ViewOf(scene, shown);
   EXPECT_DOUBLE_EQ(view.arcmin_per_px, shown.Arcmin(1));
@@ -67,7 +67,7 @@ TEST(AnswerTrial, SeesTheRadiiAtThePresentationsScale) {
   protocol::Trial trial;
   trial.cell = 0;
   TrialScene scene;
-  scene.r_left_px = 1.0, scene.r_right_px = 0.5;
+  scene.side(protocol::Side::kLeft).r_px = 1.0, scene.side(protocol::Side::kRight).r_px = 0.5;
   ObserverParams params;
   params.lapse = 0;
   const int draws = 6000;

@@ -150,10 +150,10 @@ double ProbabilityCorrect2afc(const ObserverParams& p, double r_a_arcmin, double
 }
 
 double ProbabilityCorrect2afc(const ObserverParams& p, const PairView& v) {
-  if (p.model == ObserverModel::kPixel) return StdNormalCdf(std::abs(v.r_left_px - v.r_right_px) / p.jnd_px);
+  if (p.model == ObserverModel::kPixel) return StdNormalCdf(std::abs(v.r(Side::kLeft) - v.r(Side::kRight)) / p.jnd_px);
   if (!(v.arcmin_per_px > 0))
     throw Error(ErrorKind::kInternal, "the arcmin observer was given a pair without its arcmin per photo px");
-  return ProbabilityCorrect2afc(p, v.r_left_px * v.arcmin_per_px, v.r_right_px * v.arcmin_per_px);
+  return ProbabilityCorrect2afc(p, v.r(Side::kLeft) * v.arcmin_per_px, v.r(Side::kRight) * v.arcmin_per_px);
 }
 
 double DiscriminationThresholdArcmin(const ObserverParams& p, double r_ref_arcmin) {
@@ -195,9 +195,9 @@ double SimulatedObserver::CompareSd() const {
 // of old: a seed answers as it did before the arcmin model existed.
 KeyPress SimulatedObserver::ChooseSide(const PairView& v, bool cant_tell) {
   const double sd = CompareSd();
-  const double m_left = std::abs(Seen(v.r_left_px, v) - Seen(v.r_scene_px, v)),
-               m_right = std::abs(Seen(v.r_right_px, v) - Seen(v.r_scene_px, v));
-  const double more_blurred = v.r_left_px > v.r_right_px ? 1 : v.r_left_px < v.r_right_px ? -1 : 0;
+  const double m_left = std::abs(Seen(v.r(Side::kLeft), v) - Seen(v.r_scene_px, v)),
+               m_right = std::abs(Seen(v.r(Side::kRight), v) - Seen(v.r_scene_px, v));
+  const double more_blurred = v.r(Side::kLeft) > v.r(Side::kRight) ? 1 : v.r(Side::kLeft) < v.r(Side::kRight) ? -1 : 0;
   const double bias = params_.model == ObserverModel::kPixel
                           ? params_.bias_px * more_blurred
                           : (params_.blurrier_bias * more_blurred + params_.side_bias) * sd;
@@ -217,7 +217,7 @@ KeyPress SimulatedObserver::ChooseSide(const PairView& v, bool cant_tell) {
 
 KeyPress SimulatedObserver::ChooseBlurrier(const PairView& v) {
   const double sd = CompareSd();
-  const double difference = Seen(v.r_left_px, v) - Seen(v.r_right_px, v);
+  const double difference = Seen(v.r(Side::kLeft), v) - Seen(v.r(Side::kRight), v);
   const double side = params_.model == ObserverModel::kPixel ? 0 : params_.side_bias * sd;
   const double noise = Normal(), lapse_draw = Uniform(), lapse_pick = Uniform();
   const double rt = ResponseTimeMs(params_.rt_ms, difference / sd);
@@ -229,7 +229,7 @@ KeyPress SimulatedObserver::ChooseBlurrier(const PairView& v) {
 
 KeyPress SimulatedObserver::ChooseOdd(const PairView& v, int intervals, int odd) {
   // Every interval is seen with its own noise; the odd one is the one farthest from the mean of the others.
-  const double look = LookSd(), odd_seen = Seen(v.r_right_px, v), other_seen = Seen(v.r_left_px, v);
+  const double look = LookSd(), odd_seen = Seen(v.r(Side::kRight), v), other_seen = Seen(v.r(Side::kLeft), v);
   std::vector<double> seen(size_t(std::max(intervals, 1)));
   for (size_t i = 0; i < seen.size(); ++i) seen[i] = (int(i) + 1 == odd ? odd_seen : other_seen) + look * Normal();
   const double lapse_draw = Uniform(), lapse_pick = Uniform();
@@ -249,7 +249,7 @@ KeyPress SimulatedObserver::ChooseOdd(const PairView& v, int intervals, int odd)
 }
 
 KeyPress SimulatedObserver::SayYesNo(const PairView& v) {
-  const double sd = CompareSd(), mismatch = std::abs(Seen(v.r_left_px, v) - Seen(v.r_scene_px, v));
+  const double sd = CompareSd(), mismatch = std::abs(Seen(v.r(Side::kLeft), v) - Seen(v.r_scene_px, v));
   const double evidence = mismatch + sd * Normal();
   const double lapse_draw = Uniform(), lapse_pick = Uniform();
   const double rt = ResponseTimeMs(params_.rt_ms, mismatch / sd);
@@ -259,7 +259,7 @@ KeyPress SimulatedObserver::SayYesNo(const PairView& v) {
 }
 
 KeyPress SimulatedObserver::Rate(const PairView& v, int points) {
-  const double sd = CompareSd(), mismatch = std::abs(Seen(v.r_left_px, v) - Seen(v.r_scene_px, v));
+  const double sd = CompareSd(), mismatch = std::abs(Seen(v.r(Side::kLeft), v) - Seen(v.r_scene_px, v));
   const double evidence = mismatch + sd * Normal();
   const double lapse_draw = Uniform(), lapse_pick = Uniform();
   const double rt = ResponseTimeMs(params_.rt_ms, mismatch / sd);
@@ -325,7 +325,7 @@ uint64_t TrialSeed(uint64_t seed, int index) { return DeriveSeed(seed, static_ca
 PairView ViewOf(const stimulus::TrialScene& scene, const stimulus::Presentation& presentation) {
   // One photo px's angle at the centre of the screen (Presentation::Arcmin): the radii are a few px, where the
   // exact 2 atan(s / 2d) and the straight line agree to far better than 1e-6.
-  return {scene.r_left_px, scene.r_right_px, scene.r_scene_px, presentation.Arcmin(1)};
+  return {{scene.side(Side::kLeft).r_px, scene.side(Side::kRight).r_px}, scene.r_scene_px, presentation.Arcmin(1)};
 }
 
 AdjustView AdjustViewOf(const protocol::Trial& trial, const stimulus::TrialScene& scene,

@@ -42,6 +42,7 @@
 // exp(N(0, sd_log)), a straight line in log-log (the shape of the thesis's Fig. 3.3), steps "next" until a level is
 // within tolerance_log of it in log units and accepts that; after seeing them all it steps back the shorter way to
 // the closest one seen and accepts it.
+#include <array>
 #include <cstdint>
 #include <random>
 #include <string>
@@ -92,8 +93,10 @@ std::string ToString(const ObserverParams& params);
 
 // What the observer sees of a pair trial: the radii (photo px, as recorded) and how large a photo px is on the eye.
 struct PairView {
-  double r_left_px = 0, r_right_px = 0, r_scene_px = 0;  // photo px, as today
+  std::array<double, 2> r_px{0, 0};  // each side's radius (photo px, as today), indexed by protocol::Index(side)
+  double r_scene_px = 0;             // the scene's own blur there (photo px)
   double arcmin_per_px = 0;  // visual angle (arcmin) per photo px as shown; 0 = unknown (model=arcmin refuses it)
+  double r(protocol::Side side) const { return r_px[protocol::Index(side)]; }
 };
 
 // model=arcmin: the probability that the observer (no lapse, no bias) tells radii a and b (arcmin, blurcue's r)

@@ -26,8 +26,9 @@ std::optional<bool> CorrectOf(const protocol::Trial& trial, const TrialScene& sc
   if (const int odd = protocol::TestInterval(trial); odd > 0)
     return choice == Choice::Numbered(Choice::Kind::kInterval, odd);
   if (!protocol::TraitsOf(trial.task).scored || scene.content == protocol::ContentType::kPicture) return std::nullopt;
-  if (std::abs(scene.r_left_px - scene.r_right_px) <= 1e-9) return choice == Choice::Of(Choice::Kind::kCantTell);
-  return choice == Choice::Of(scene.r_left_px > scene.r_right_px ? Side::kLeft : Side::kRight);
+  const double r_left = scene.side(Side::kLeft).r_px, r_right = scene.side(Side::kRight).r_px;
+  if (std::abs(r_left - r_right) <= 1e-9) return choice == Choice::Of(Choice::Kind::kCantTell);
+  return choice == Choice::Of(r_left > r_right ? Side::kLeft : Side::kRight);
 }
 
 PracticeRounds::PracticeRounds(const protocol::Protocol& protocol, const std::vector<protocol::Trial>& trials)

@@ -50,16 +50,16 @@ TEST(CorrectOf, APairIsAnsweredRightByTheSideWithTheLargerRadiusOrCantTellWhenEq
   trial.task = protocol::Task::kForcedChoice;
   TrialScene scene;
   scene.content = protocol::ContentType::kGrid;
-  scene.r_left_px = 2, scene.r_right_px = 1;
+  scene.side(protocol::Side::kLeft).r_px = 2, scene.side(protocol::Side::kRight).r_px = 1;
   EXPECT_EQ(CorrectOf(trial, scene, Word("left")), std::optional<bool>(true));
   EXPECT_EQ(CorrectOf(trial, scene, Word("right")), std::optional<bool>(false));
   EXPECT_EQ(CorrectOf(trial, scene, Word("cant_tell")), std::optional<bool>(false));
-  scene.r_right_px = 2;
+  scene.side(protocol::Side::kRight).r_px = 2;
   EXPECT_EQ(CorrectOf(trial, scene, Word("cant_tell")), std::optional<bool>(true));
   EXPECT_EQ(CorrectOf(trial, scene, Word("left")), std::optional<bool>(false));
   // A procedure's trial: its test side, whatever the radii.
   trial.test_side = "right";
-  scene.r_left_px = 5;
+  scene.side(protocol::Side::kLeft).r_px = 5;
   EXPECT_EQ(CorrectOf(trial, scene, Word("right")), std::optional<bool>(true));
   EXPECT_EQ(CorrectOf(trial, scene, Word("left")), std::optional<bool>(false));
   // An odd one out's: its interval.
@@ -137,11 +137,11 @@ TEST(PrepareParticipant, SameSeedSameTrialsWithOneScenePerTrialPlannedOnTheScree
   EXPECT_EQ(a.seed, 7u);
   for (size_t i = 0; i < a.trials.size(); ++i) {
     EXPECT_EQ(a.trials[i].levels, b.trials[i].levels) << i;
-    EXPECT_DOUBLE_EQ(a.scenes[i].r_left_px, b.scenes[i].r_left_px) << i;
+    EXPECT_DOUBLE_EQ(a.scenes[i].side(protocol::Side::kLeft).r_px, b.scenes[i].side(protocol::Side::kLeft).r_px) << i;
     // The fitted side is blurred, the other not; the plan on the screen has been worked out (sizes in degrees).
-    EXPECT_GT(a.scenes[i].r_left_px, 0) << i;
-    EXPECT_EQ(a.scenes[i].r_right_px, 0) << i;
-    EXPECT_GT(a.scenes[i].size_left_deg, 0) << i;
+    EXPECT_GT(a.scenes[i].side(protocol::Side::kLeft).r_px, 0) << i;
+    EXPECT_EQ(a.scenes[i].side(protocol::Side::kRight).r_px, 0) << i;
+    EXPECT_GT(a.scenes[i].side(protocol::Side::kLeft).size_deg, 0) << i;
   }
   // Without a seed, the participant's default seed: another participant gets another one.
   PreparedSession c = Study(), d = Study();

@@ -73,13 +73,13 @@ std::vector<PairVisibility> PairVisibilities(const PreparedSession& prepared, co
       // One object: does it look out of place - its blur against the scene's own there.
       pair.what = "object " + a + " vs the scene";
       pair.against_scene = true;
-      view.r_right_px = view.r_scene_px;
+      view.r_px[protocol::Index(protocol::Side::kRight)] = view.r_scene_px;
     } else {
       pair.what = a + " vs " + b;
     }
     if (!at.empty()) pair.what += " at " + at;
-    pair.r_a_arcmin = prepared.presentation.Arcmin(view.r_left_px);
-    pair.r_b_arcmin = prepared.presentation.Arcmin(view.r_right_px);
+    pair.r_a_arcmin = prepared.presentation.Arcmin(view.r(protocol::Side::kLeft));
+    pair.r_b_arcmin = prepared.presentation.Arcmin(view.r(protocol::Side::kRight));
     pair.p_correct = ProbabilityCorrect2afc(observer, view);
     pair.visible = pair.p_correct >= level;
     pair.trials = 1;

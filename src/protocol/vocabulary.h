@@ -138,6 +138,8 @@ struct Vocabulary<Side> {
 };
 // The side across from `side`.
 constexpr Side Other(Side side) { return side == Side::kLeft ? Side::kRight : Side::kLeft; }
+// A side's place in a pair's std::array<T, 2> of per-side values: 0 left, 1 right (Vocabulary<Side>::values' order).
+constexpr size_t Index(Side side) { return side == Side::kLeft ? 0 : 1; }
 
 // A /responses field that names one key (left | right | cant_tell | previous | next | accept | yes | no), in the
 // order the parser lists the fields; the lists (rating, alternatives) have fields of their own.

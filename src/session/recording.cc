@@ -44,8 +44,7 @@ std::vector<store::TrialRecord> TrialRecords(const procedure::PreparedSession& s
     r.block = protocol::BlockIndex(protocol, trial);
     const TrialScene& planned = s.scenes[size_t(trial.index)];
     r.factors_json = TrialVariables(trial, planned, s.presentation).dump();
-    r.left_json = protocol::ToJson(trial.left).dump();
-    r.right_json = protocol::ToJson(trial.right).dump();
+    r.source_json = {protocol::ToJson(trial.left).dump(), protocol::ToJson(trial.right).dump()};
     r.block_name = trial.block;
     r.task = protocol::ToString(trial.task);
     r.practice = trial.practice;
@@ -53,8 +52,9 @@ std::vector<store::TrialRecord> TrialRecords(const procedure::PreparedSession& s
     r.cell = protocol::CellLevels(protocol, trial);
     if (planned.content != protocol::ContentType::kPicture &&
         protocol::TraitsOf(trial.task).shows != protocol::TaskShows::kPicture) {
-      r.r_left_px = planned.r_left_px;
-      if (!planned.left_only) r.r_right_px = planned.r_right_px;
+      for (const protocol::Side side : protocol::Vocabulary<protocol::Side>::values)
+        if (side == protocol::Side::kLeft || !planned.left_only)
+          r.r_px[protocol::Index(side)] = planned.side(side).r_px;
       r.r_scene_px = planned.r_scene_px;
     }
     records.push_back(std::move(r));
@@ -86,19 +86,9 @@ std::vector<store::DesignColumnRecord> DesignRecord(const std::vector<protocol::
 std::string RecordedColumn(const std::string& name) { return store::DesignColumn(name); }
 bool IsRecordColumn(const std::string& column) { return store::IsRecordedName(column); }
 
-SessionsSoFar PeekSessions(const std::filesystem::path& db, const std::string& study, const std::string& participant) {
-  const store::SessionsSoFar s = store::PeekSessions(db, study, participant);
-  return {s.next_number, s.unfinished, s.unfinished_seed, s.unfinished_number};
-}
-
 uint64_t DefaultSessionSeed(const std::string& study, const std::string& participant, int64_t session_number) {
   if (session_number <= 1) return protocol::DefaultSeed(study, participant);
   return Fnv1a64(study + "/" + participant + "#" + std::to_string(session_number));
-}
-
-GroupsSoFar PeekGroups(const std::filesystem::path& db, const std::string& study, const std::string& participant) {
-  const store::GroupsSoFar g = store::PeekGroups(db, study, participant);
-  return {g.sessions, g.unfinished, g.unfinished_group, g.unfinished_info, g.earlier_group};
 }
 
 Recording::Recording(std::unique_ptr<store::Record> record) : record_(std::move(record)) {}
@@ -136,8 +126,7 @@ SessionStart Recording::StartOrResumeSession(const std::string& study, const std
   meta.design = DesignRecord(info.design);
   meta.seed_given = info.seed_given;
   meta.seed_for_number = info.seed_for_number;
-  const store::SessionStart s = record_->StartOrResumeSession(study, participant, protocol_text, seed, meta, resume);
-  return {s.session_id, s.first_unanswered_trial, s.trial_count, s.resumed, s.group, s.session_number};
+  return record_->StartOrResumeSession(study, participant, protocol_text, seed, meta, resume);
 }
 
 void Recording::SaveTrialList(int64_t session, const procedure::PreparedSession& prepared) {
@@ -156,8 +145,7 @@ void Recording::RecordResponse(int64_t session, int64_t trial_index, const Respo
   r.adjustment_json = response.adjustment_json;
   r.shown_json = response.shown_json;
   if (response.level) r.level = LevelAsGiven(*response.level);
-  r.r_left_px = response.r_left_px;
-  r.r_right_px = response.r_right_px;
+  r.r_px = response.r_px;
   r.correct = response.correct;
   record_->RecordResponse(session, trial_index, r, frames);
 }
@@ -169,9 +157,7 @@ void Recording::CompleteSession(int64_t session) { record_->FinishSession(sessio
 int64_t Recording::FirstUnansweredTrial(int64_t session) { return record_->FirstUnansweredTrial(session); }
 
 std::map<int64_t, RecordedAnswer> Recording::AnsweredTrials(int64_t session) {
-  std::map<int64_t, RecordedAnswer> answers;
-  for (const auto& [index, a] : record_->AnsweredTrials(session)) answers[index] = {a.choice, a.shown_json};
-  return answers;
+  return record_->AnsweredTrials(session);
 }
 
 namespace {
@@ -205,7 +191,7 @@ store::RecordedVariables Variables(const protocol::Trial& trial, const TrialScen
     for (double level : trial.adjust_levels) levels += (levels.empty() ? "" : ";") + protocol::LevelText(level);
     v.adjust_levels = levels;
   }
-  constexpr size_t kLeft = 0, kRight = 1, kScene = 2;  // RecordedVariables::SideName
+  constexpr size_t kScene = store::RecordedVariables::kScene;  // the scene's place after the two sides
   if (scene.content == protocol::ContentType::kPicture) {
     // The virtual picture's width as shown (a level c's blur is r = 2 x 0.1874 x this / c arcmin), and the real
     // picture's blur when its camera is known: in its camera's px, on the screen and on the eye.
@@ -218,37 +204,35 @@ store::RecordedVariables Variables(const protocol::Trial& trial, const TrialScen
   } else if (task.shows != protocol::TaskShows::kPicture) {
     // Each radius as the camera made it (photo px), as the window shows it (screen px) and as the eye gets it.
     // The single layout shows only its object, recorded as the left side.
-    for (const auto& [side, r] : {std::pair<size_t, double>{kLeft, scene.r_left_px}, {kRight, scene.r_right_px},
-                                  {kScene, scene.r_scene_px}}) {
-      if (scene.left_only && side == kRight) continue;
-      v.r_px[side] = round4(r);
-      v.r_screen_px[side] = round4(presentation.ScreenPx(r));
-      v.r_arcmin[side] = round4(presentation.Arcmin(r));
-    }
+    auto radius = [&](size_t place, double r) {
+      v.r_px[place] = round4(r);
+      v.r_screen_px[place] = round4(presentation.ScreenPx(r));
+      v.r_arcmin[place] = round4(presentation.Arcmin(r));
+    };
+    for (const protocol::Side side : protocol::Vocabulary<protocol::Side>::values)
+      if (side == protocol::Side::kLeft || !scene.left_only) radius(protocol::Index(side), scene.side(side).r_px);
+    radius(kScene, scene.r_scene_px);
     v.screen_px_per_photo_px = std::round(presentation.scale * 1e6) / 1e6;
     v.kernel = protocol::ToString(scene.kernel);
     v.blur_plan = scene.per_pixel ? "per_pixel" : "one_radius";
     v.r_span_screen_px = round4(scene.r_span_screen_px);
     v.exposure_ms = scene.exposure_ms;
-    for (const size_t side : {kLeft, kRight}) {
-      if (scene.left_only && side == kRight) continue;
+    for (const protocol::Side side : protocol::Vocabulary<protocol::Side>::values) {
+      if (scene.left_only && side == protocol::Side::kRight) continue;
+      const stimulus::SideShown& shown = scene.side(side);
+      store::SideVariables& out = v.sides[protocol::Index(side)];
       // As drawn (render::Psf): a floor beyond half the radius is the whole of it.
-      const double floor = std::min(side == kLeft ? scene.floor_left_sigma_px : scene.floor_right_sigma_px,
-                                    std::max(0.0, side == kLeft ? scene.r_left_px : scene.r_right_px) / 2);
-      const cv::Vec2d motion = side == kLeft ? scene.motion_left_px : scene.motion_right_px;
-      v.floor_sigma_px[side] = round4(floor);
-      v.floor_sigma_screen_px[side] = round4(presentation.ScreenPx(floor));
-      v.motion_x_screen_px[side] = round4(presentation.ScreenPx(motion[0]));
-      v.motion_y_screen_px[side] = round4(presentation.ScreenPx(motion[1]));
+      const double floor = std::min(shown.floor_sigma_px, std::max(0.0, shown.r_px) / 2);
+      out.floor_sigma_px = round4(floor);
+      out.floor_sigma_screen_px = round4(presentation.ScreenPx(floor));
+      out.motion_x_screen_px = round4(presentation.ScreenPx(shown.motion_px[0]));
+      out.motion_y_screen_px = round4(presentation.ScreenPx(shown.motion_px[1]));
       // Where it is: its depth (0.01 mm) and its centre's elevation on the display from the principal point.
-      v.u_mm[side] = std::round((side == kLeft ? scene.u_left_mm : scene.u_right_mm) * 100) / 100;
-      const double below_mm = presentation.ScreenPx(side == kLeft ? scene.below_axis_left_px
-                                                                  : scene.below_axis_right_px) *
-                              display::MmPerPx(presentation.profile);
-      v.elevation_deg[side] = round4(-std::atan(below_mm / presentation.profile.distance_mm) * 180 / M_PI);
+      out.u_mm = std::round(shown.u_mm * 100) / 100;
+      const double below_mm = presentation.ScreenPx(shown.below_axis_px) * display::MmPerPx(presentation.profile);
+      out.elevation_deg = round4(-std::atan(below_mm / presentation.profile.distance_mm) * 180 / M_PI);
+      out.size_deg = round4(shown.size_deg);
     }
-    v.size_left_deg = round4(scene.size_left_deg);
-    if (!scene.left_only) v.size_right_deg = round4(scene.size_right_deg);
     v.brightness = scene.brightness;
     v.contrast = scene.contrast;
     v.white_balance_r = scene.white_balance[0];

@@ -1,6 +1,8 @@
 #pragma once
 // The session's one door to the record (store): what a session records, in session terms. Nothing else in session/
-// includes a store header (this one includes the frame's values, store/frame_columns.h); recording.cc turns these into the record's rows.
+// includes a store header. The record's own types are used as they are (aliased below); recording.cc turns the two
+// that carry session types (Response's Choice, SessionInfo's design) into the record's.
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -16,11 +18,7 @@
 #include "protocol/trials.h"
 #include "procedure/trial_logic.h"
 #include "stimulus/stimulus.h"
-#include "store/frame_columns.h"
-
-namespace blurcue::store {
-class Record;
-}
+#include "store/record.h"
 
 namespace blurcue::procedure {
 struct PreparedSession;
@@ -32,19 +30,32 @@ using procedure::Choice;
 
 // One trial's answer as recorded (store::Response, which holds the choice's Name): the choice (an answer, none or
 // skipped), its response time (NaN: none), the adjustment's steps, and what a procedure's trial showed as decided
-// then (shown_json, level, radii, correct).
+// then (shown_json, level, each side's radius, correct).
 struct Response {
   Choice choice;
   double rt_ms = 0;
   std::string adjustment_json = "[]";
   std::string shown_json = "{}";
-  std::optional<double> level, r_left_px, r_right_px;
+  std::optional<double> level;
+  std::array<std::optional<double>, 2> r_px;  // photo px, indexed by protocol::Index(side)
   std::optional<bool> correct;
 };
 
 // One flip of a trial as the record keeps it (store/frame_columns.h, the one definition of a frame's values): its
 // time from onset, whether a frame was dropped before it, what it showed of a pair and, on video, of the take.
 using FrameRecord = store::FrameRecord;
+using FrameSide = store::FrameSide;
+
+// A started or resumed session (its id, first unanswered trial, trial count, whether resumed, its seed, group and
+// number), a recorded answer as a resumed session replays it (the choice's text, KeyMap::Parse reads it for its
+// trial), and what a record already says, read without writing, of a study's groups and a participant's sessions:
+// the record's own (store/record.h).
+using SessionStart = store::SessionStart;
+using RecordedAnswer = store::Record::Answered;
+using GroupsSoFar = store::GroupsSoFar;
+using SessionsSoFar = store::SessionsSoFar;
+using store::PeekGroups;
+using store::PeekSessions;
 
 // The station a session runs on, as the record states it (store::SessionMeta).
 struct SessionInfo {
@@ -67,42 +78,9 @@ struct SessionInfo {
   int64_t seed_for_number = 0;
 };
 
-// A started or resumed session (store::SessionStart).
-struct SessionStart {
-  int64_t session_id = 0;
-  int64_t first_unanswered_trial = 0;  // = trial_count when all are answered
-  int64_t trial_count = 0;             // 0: a new session without its trial list yet
-  bool resumed = false;
-  std::string group;                   // the group the record gave
-  int64_t session_number = 0;          // the participant's n-th session of the study (1, 2, ...)
-};
 
-// A recorded answer, as a resumed session replays it: the choice's text as the record holds it (KeyMap::Parse reads
-// it for its trial).
-struct RecordedAnswer {
-  std::string choice;
-  std::string shown_json;
-};
 
-// What a record already says of a study's groups and a participant's unfinished session (store::GroupsSoFar), read
-// without writing; a missing file says nothing.
-struct GroupsSoFar {
-  std::map<std::string, int64_t> sessions;
-  bool unfinished = false;
-  std::string unfinished_group, unfinished_info = "{}";
-  std::string earlier_group;  // the participant's latest session's group that was not aborted (store::GroupsSoFar)
-};
-GroupsSoFar PeekGroups(const std::filesystem::path& db, const std::string& study, const std::string& participant);
 
-// What a record says of a participant's sessions of a study (store::SessionsSoFar), read without writing: the
-// number a new session would get, and an unfinished session's number and seed.
-struct SessionsSoFar {
-  int64_t next_number = 1;
-  bool unfinished = false;
-  uint64_t unfinished_seed = 0;
-  int64_t unfinished_number = 0;
-};
-SessionsSoFar PeekSessions(const std::filesystem::path& db, const std::string& study, const std::string& participant);
 
 // The seed of a participant's session `session_number` when none is given: protocol::DefaultSeed(study,
 // participant) for the first (records made before sessions were numbered keep their seeds), FNV-1a 64 of
@@ -150,8 +128,9 @@ bool IsRecordColumn(const std::string& column);
 // The variables recorded with a trial beside its factor levels: practice, block_name, swapped, and for pairs each
 // radius in photo px, screen px and arcmin (r_left_px, r_left_screen_px, r_left_arcmin; the same for right and
 // scene) with the presentation's screen_px_per_photo_px and the blur plan (blur_plan: one_radius | per_pixel,
-// r_span_screen_px) and each object's size_left_deg / size_right_deg, or start_level and adjust_levels (adjustment;
-// a picture: picture_width_arcmin, and the real picture's r_scene_* when content.real_camera names its camera).
+// r_span_screen_px) and each object's floor, streak, place and size (size_left_deg, ...: store::SideVariables), or
+// start_level and adjust_levels (adjustment; a picture: picture_width_arcmin, and the real picture's r_scene_* when
+// content.real_camera names its camera).
 // Each level is recorded under store::DesignColumn(name): factor_NAME for one named like any of those or like a
 // column of trials.csv (store::IsRecordedName), so nothing recorded takes a level's place.
 Json TrialVariables(const protocol::Trial& trial, const stimulus::TrialScene& scene,

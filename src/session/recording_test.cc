@@ -38,7 +38,7 @@ TEST(TrialVariables, GridTrialRecordsEachRadiusInPhotoPxScreenPxAndArcmin) {
   for (const char* key : {"edge", "practice", "block_name", "swapped", "r_left_px", "r_right_px", "r_scene_px",
                           "r_left_screen_px", "r_right_arcmin", "r_scene_arcmin", "screen_px_per_photo_px"})
     EXPECT_TRUE(v.contains(key)) << key;
-  const double r = far.r_right_px;
+  const double r = far.side(protocol::Side::kRight).r_px;
   EXPECT_NEAR(v["r_right_screen_px"].get<double>(), r * 1622.0 / 4592.0, 1e-4);
   const double pitch_mm = 531.4 / 1920, deg = 180 / 3.14159265358979323846;
   EXPECT_NEAR(v["r_right_arcmin"].get<double>(), 2 * std::atan(0.5 * r * 1622.0 / 4592.0 * pitch_mm / 600) * deg * 60,
@@ -56,11 +56,11 @@ TEST(TrialVariables, RecordsEachObjectsDepthAndElevation) {
   Presentation shown;
   shown.scale = 1.5;
   const Json v = TrialVariables(PairTrial({{"edge", 11}}, "fitted", "fitted"), t, shown);
-  EXPECT_NEAR(v["u_left_mm"].get<double>(), t.u_left_mm, 0.005);
-  EXPECT_NEAR(v["u_right_mm"].get<double>(), t.u_right_mm, 0.005);
+  EXPECT_NEAR(v["u_left_mm"].get<double>(), t.side(protocol::Side::kLeft).u_mm, 0.005);
+  EXPECT_NEAR(v["u_right_mm"].get<double>(), t.side(protocol::Side::kRight).u_mm, 0.005);
   const double pitch_mm = 531.4 / 1920, deg = 180 / 3.14159265358979323846;
-  EXPECT_NEAR(v["elevation_left_deg"].get<double>(), -std::atan(t.below_axis_left_px * 1.5 * pitch_mm / 600) * deg,
-              1e-4);
+  EXPECT_NEAR(v["elevation_left_deg"].get<double>(),
+              -std::atan(t.side(protocol::Side::kLeft).below_axis_px * 1.5 * pitch_mm / 600) * deg, 1e-4);
   EXPECT_GT(v["elevation_left_deg"].get<double>(), 0);  // edge 11 lies above the principal point (the board's far end)
   // The single layout has no right object: nothing is recorded for it.
   TrialScene single = t;
@@ -135,7 +135,8 @@ TEST(TrialVariables, LevelsNamedLikeRecordedVariablesKeepTheirValuesUnderFactorN
   EXPECT_EQ(v["factor_group"], "g");
   EXPECT_EQ(v["edge"], 2);
   EXPECT_EQ(v["label"], "near");
-  EXPECT_NEAR(v["r_left_px"].get<double>(), t.r_left_px, 1e-4);  // the radius shown, not the table's 7.5
+  // The radius shown, not the table's 7.5.
+  EXPECT_NEAR(v["r_left_px"].get<double>(), t.side(protocol::Side::kLeft).r_px, 1e-4);
   EXPECT_NE(v["r_left_px"], 7.5);
   EXPECT_EQ(v["level"], 0.4);
   EXPECT_EQ(v["test_side"], "right");

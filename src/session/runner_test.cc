@@ -122,7 +122,9 @@ class AnsweringResponder : public Responder {
   }
   void ScreenShown(double now_s) override { planned_.push_back({"Return", now_s + 0.6}); }
   void StimulusShown(const protocol::Trial& trial, const TrialScene& scene, double onset_s) override {
-    const bool right_side = trial.cell >= 0 ? trial.test_side == "right" : scene.r_right_px > scene.r_left_px;
+    const bool right_side = trial.cell >= 0
+                                ? trial.test_side == "right"
+                                : scene.side(protocol::Side::kRight).r_px > scene.side(protocol::Side::kLeft).r_px;
     bool correct = true;
     if (!correct_.empty()) correct = correct_.front(), correct_.pop_front();
     planned_.push_back({right_side == correct ? "Right" : "Left", onset_s + 0.3});

@@ -154,10 +154,11 @@ class Runner {
           const scene::BlurredObject& o = *objects[i];
           // An interval shows one side's object in the left slot.
           const bool right = i == 1 || (n > 0 && IntervalShowsRight(trial, scene, on));
-          (right ? shown_frame.r_right_px : shown_frame.r_left_px) = o.r_px;
-          (right ? shown_frame.floor_sigma_right_px : shown_frame.floor_sigma_left_px) = o.floor_sigma_px;
-          (right ? shown_frame.motion_right_x_px : shown_frame.motion_left_x_px) = o.motion_px[0];
-          (right ? shown_frame.motion_right_y_px : shown_frame.motion_left_y_px) = o.motion_px[1];
+          FrameSide& side = shown_frame.sides[protocol::Index(right ? protocol::Side::kRight : protocol::Side::kLeft)];
+          side.r_px = o.r_px;
+          side.floor_sigma_px = o.floor_sigma_px;
+          side.motion_x_px = o.motion_px[0];
+          side.motion_y_px = o.motion_px[1];
           if (!shown_frame.y_mm) shown_frame.y_mm = o.object.center_board_mm[1];
         }
         if (const auto take = presenter_.ShownTake()) {
@@ -320,8 +321,7 @@ class Runner {
       if (trial.cell >= 0) {
         response.shown_json = ShownVariables(trial, scene, prepared_.presentation, scored);
         response.level = level;
-        response.r_left_px = scene.r_left_px;
-        response.r_right_px = scene.r_right_px;
+        for (size_t side = 0; side < 2; ++side) response.r_px[side] = scene.sides[side].r_px;
       }
       record.RecordResponse(start.session_id, i, response, frames);  // committed before anything else happens
       // Feedback where an answer is right or wrong: procedure trials, odd one out, practice run to a criterion.

@@ -147,9 +147,9 @@ Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, cons
     Json polygon = Json::array();
     for (const cv::Point2d& p : outline) polygon.push_back({round(p.x, 1e-3), round(p.y, 1e-3)});
     frame["objects"].push_back(
-        {{"side", protocol::ToString(side == 0 ? protocol::Side::kLeft : protocol::Side::kRight)},
+        {{"side", protocol::ToString(protocol::Vocabulary<protocol::Side>::values[size_t(side)])},
          {"kind", b.object.kind == scene::VirtualObject::Kind::kBall ? "ball" : "card"},
-         {"source", ToString(side == 0 ? trial.left : trial.right)},
+         {"source", ToString(trial.sides[size_t(side)].source)},
          {"kernel", b.method},
          {"center_px", {round(centre[0].x, 1e-3), round(centre[0].y, 1e-3)}},
          {"outline_px", polygon},

@@ -29,16 +29,38 @@ namespace blurcue::stimulus {
 
 class VideoTake;
 
+// What one side of a pair (grid, ball) shows, from the protocol's source to the record: each quantity spelled once,
+// the record's column names made from it and the side's word (store::SideColumn).
+struct SideShown {
+  // The source as shown (swaps applied), and a fixed source's radius (photo px).
+  calib::BlurSource source = calib::BlurSource::kNone;
+  double fixed_px = 0;
+  // Across the board (x, 0 at its left edge): NaN for the default place - a card beside the board, a ball on section 3
+  // (left) or 5 (right). From the level left_x_mm / right_x_mm.
+  double x_mm = std::numeric_limits<double>::quiet_NaN();
+  // A procedure's level on the test side (ApplyLevel): the radius is gain x its source's + add_px.
+  double gain = 1, add_px = 0;
+  // The radius rendered (photo px), averaged over the run for balls.
+  double r_px = 0;
+  // The lens floor inside the radius (std, photo px; calib::FloorSigmaPx of the source at the object's place, averaged
+  // over the run for balls): a scene source's defocus is drawn convolved with the scene's floor.
+  double floor_sigma_px = 0;
+  // A ball's streak over the exposure (photo px, image x right, y down), averaged over the run like the radius.
+  cv::Vec2d motion_px{0, 0};
+  // The object's largest extent on screen at onset (visual angle, deg; PlanOnScreen).
+  double size_deg = 0;
+  // Where the object is in depth and in the picture (the right one at the left's place in an intervals trial),
+  // averaged over a ball's run like the radius: its centre's depth u (camera z, mm: DESIGN.md's u) and its centre's
+  // image below the photo's principal point (photo px, down positive; the calibrated camera's distortion included).
+  double u_mm = 0, below_axis_px = 0;
+};
+
 struct TrialScene {
   protocol::ContentType content = protocol::ContentType::kGrid;
-  // Pairs (grid, ball): the source on each side as shown (swaps applied).
-  calib::BlurSource left = calib::BlurSource::kNone, right = calib::BlurSource::kNone;
-  double left_fixed_px = 0, right_fixed_px = 0;
+  // Pairs (grid, ball): what each side shows, indexed by protocol::Index(side) (side() below).
+  std::array<SideShown, 2> sides;
   int edge = 1;                       // grid: the edge the cards are aligned with (0: placed by y_mm)
   double from_y_mm = 0, to_y_mm = 0;  // along the board's y (0 at edge 1): a ball's run, a card's place
-  // Across the board (x, 0 at its left edge), per side: NaN for the default place - a card beside the board, a ball
-  // on section 3 (left) or 5 (right). From the levels left_x_mm / right_x_mm.
-  double left_x_mm = std::numeric_limits<double>::quiet_NaN(), right_x_mm = std::numeric_limits<double>::quiet_NaN();
   // Grid: the card's width and height (mm; 0: two board squares, square), upright or flat, turned about the
   // vertical; grid and ball: raised above the table (content defaults, or the levels height_mm / rotation_deg).
   double card_width_mm = 0, card_height_mm = 0, rotation_deg = 0, height_mm = 0;
@@ -49,21 +71,15 @@ struct TrialScene {
   protocol::Kernel kernel = protocol::Kernel::kGaussian;  // pairs: the blur kernel, and the object's matching
   double brightness = 1, contrast = 1;
   std::array<double, 3> white_balance{1, 1, 1};  // red, green, blue gains
-  // A procedure's level on the test side (ApplyLevel): each side's radius is gain x its source's + add_px.
-  double left_gain = 1, right_gain = 1, left_add_px = 0, right_add_px = 0;
   double level = std::numeric_limits<double>::quiet_NaN();  // the procedure's level shown; NaN: none (yet)
   // Only the left object: the layout single's one object, or one interval of an intervals trial (IntervalScene).
   bool left_only = false;
   int intervals = 0;       // the intervals a pair trial shows one after the other (protocol::IntervalCount), else 0
-  // The radii rendered, averaged over the run for balls, and the scene's own blur (the fitted model) there.
-  double r_left_px = 0, r_right_px = 0, r_scene_px = 0;
-  // Each side's lens floor inside its radius (std, photo px; calib::FloorSigmaPx of its source at the object's place,
-  // averaged over the run for balls): a scene source's defocus is drawn convolved with the scene's floor.
-  double floor_left_sigma_px = 0, floor_right_sigma_px = 0;
-  // Motion blur: the exposure (content.exposure_ms; 0: none) and each ball's streak over it (photo px, image x right,
-  // y down), averaged over the run like the radii.
+  // The scene's own blur (the fitted model) at the objects' places (a picture: the real picture's), averaged like
+  // the sides' radii.
+  double r_scene_px = 0;
+  // Motion blur: the exposure (content.exposure_ms; 0: none) each ball's streak (SideShown::motion_px) lasts.
   double exposure_ms = 0;
-  cv::Vec2d motion_left_px{0, 0}, motion_right_px{0, 0};
   // A study on video: the take plays while the trial is shown (VideoTake), so every frame is composed again.
   bool video = false;
 
@@ -71,13 +87,10 @@ struct TrialScene {
   // the protocol's depth_blur_threshold, else one radius at its centre.
   bool per_pixel = false;
   double r_span_screen_px = 0;  // the largest change of r across an object's depth, both sides, start and end of a run
-  double size_left_deg = 0, size_right_deg = 0;  // each object's largest extent on screen at onset, visual angle
-  // Where each object is in depth and in the picture (pairs; the right one at the left's place in an intervals trial),
-  // averaged over a ball's run like the radii: its centre's depth u (camera z, mm: DESIGN.md's u) and its centre's
-  // image below the photo's principal point (photo px, down positive; the calibrated camera's distortion included).
-  double u_left_mm = 0, u_right_mm = 0;
-  double below_axis_left_px = 0, below_axis_right_px = 0;
 
+  // The side `side` of the pair.
+  SideShown& side(protocol::Side side) { return sides[protocol::Index(side)]; }
+  const SideShown& side(protocol::Side side) const { return sides[protocol::Index(side)]; }
   // Seconds of motion (0 for a static stimulus).
   double MotionS() const;
   // The balls' y (board frame, mm) at t_s after onset; negative infinity when wiped.
@@ -118,7 +131,7 @@ TrialScene IntervalScene(const TrialScene& scene, bool right);
 bool IntervalShowsRight(const protocol::Trial& trial, const TrialScene& scene, int i);
 
 // Works out what the screen `presentation` shows of a pair trial: each object's size in degrees at onset
-// (size_left_deg, size_right_deg) and the blur plan - each object's radius at its nearest and farthest depth (along
+// (each side's size_deg) and the blur plan - each object's radius at its nearest and farthest depth (along
 // its line of sight), at the start and the end of its run, against the protocol's depth_blur_threshold (arcmin
 // converted by the display profile), setting per_pixel and r_span_screen_px.
 void PlanOnScreen(const protocol::Protocol& protocol, const calib::SceneCalib& scene, const Presentation& presentation,

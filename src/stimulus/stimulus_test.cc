@@ -18,6 +18,7 @@ namespace {
 using fixtures::BallProtocol;
 using fixtures::PairTrial;
 using fixtures::ThesisScene;
+using protocol::Side;
 
 TEST(DescribeTrial, SectionRunGoesEdgeToEdgeAtThePatternSpeedAndIsWiped) {
   const calib::SceneCalib scene = ThesisScene();
@@ -30,8 +31,8 @@ TEST(DescribeTrial, SectionRunGoesEdgeToEdgeAtThePatternSpeedAndIsWiped) {
   EXPECT_DOUBLE_EQ(t.BallYMm(0), 50);
   EXPECT_NEAR(t.BallYMm(t.MotionS() / 2), 62.5, 1e-9);
   EXPECT_TRUE(std::isinf(t.BallYMm(t.MotionS() + 0.01)));  // gone at the edge
-  EXPECT_DOUBLE_EQ(t.r_left_px, 1.5);                       // a fixed radius, the same all along
-  EXPECT_DOUBLE_EQ(t.r_right_px, 0);
+  EXPECT_DOUBLE_EQ(t.side(Side::kLeft).r_px, 1.5);         // a fixed radius, the same all along
+  EXPECT_DOUBLE_EQ(t.side(Side::kRight).r_px, 0);
 }
 
 TEST(DescribeTrial, WholeRunRestsAtTheFarEdgeAndAveragesTheGrowingBlur) {
@@ -43,11 +44,11 @@ TEST(DescribeTrial, WholeRunRestsAtTheFarEdgeAndAveragesTheGrowingBlur) {
   EXPECT_NEAR(t.MotionS(), 250.0 / 30.0, 1e-12);
   EXPECT_DOUBLE_EQ(t.BallYMm(100), 250);  // arrived, not wiped
   // The fitted source is the scene's own blur: the two agree; the mean lies between the run's ends.
-  EXPECT_NEAR(t.r_left_px, t.r_scene_px, 0.05);
+  EXPECT_NEAR(t.side(Side::kLeft).r_px, t.r_scene_px, 0.05);
   const double r0 = calib::BlurAtPx(scene, calib::BlurSource::kFitted, scene.ToCamera({62.5, 0, 10}));
   const double r1 = calib::BlurAtPx(scene, calib::BlurSource::kFitted, scene.ToCamera({62.5, 250, 10}));
-  EXPECT_GT(t.r_left_px, std::min(r0, r1));
-  EXPECT_LT(t.r_left_px, std::max(r0, r1));
+  EXPECT_GT(t.side(Side::kLeft).r_px, std::min(r0, r1));
+  EXPECT_LT(t.side(Side::kLeft).r_px, std::max(r0, r1));
 }
 
 // What Compose draws comes from ObjectsAt: the protocol's kernel and brightness/contrast reach every object, and the
@@ -87,11 +88,11 @@ TEST(DescribeTrial, BallAtAnEdgeRestsThereWithThatPlacesBlur) {
   const auto shown = ObjectsAt(BallProtocol(), scene, t, 3.0);
   ASSERT_TRUE(shown[0]);
   EXPECT_DOUBLE_EQ(shown[0]->object.center_board_mm[1], 200);
-  EXPECT_NEAR(t.r_left_px, shown[0]->r_px, 1e-9);  // the record is what the frame shows
+  EXPECT_NEAR(t.side(Side::kLeft).r_px, shown[0]->r_px, 1e-9);  // the record is what the frame shows
   // Without a speed a ball rests where it starts, and is recorded there too.
   const TrialScene still = DescribeTrial(BallProtocol(), PairTrial(Json::object(), "fitted", "none"), &scene);
   const auto at_rest = ObjectsAt(BallProtocol(), scene, still, 0);
-  EXPECT_NEAR(still.r_left_px, at_rest[0]->r_px, 1e-9);
+  EXPECT_NEAR(still.side(Side::kLeft).r_px, at_rest[0]->r_px, 1e-9);
   // An edge with a speed is a contradiction, named at the field.
   EXPECT_THROW(DescribeTrial(BallProtocol(), PairTrial({{"edge", 9}, {"speed_cm_s", 3}}, "fitted", "none"), &scene),
                Error);
@@ -127,15 +128,15 @@ TEST(DescribeTrial, IntervalsRecordTheRightSidesRadiusWhereItsIntervalShowsIt) {
   intervals.layout = protocol::Layout::kTwoIntervals;
   const protocol::Trial trial = PairTrial({{"edge", 6}, {"left_x_mm", -30}}, "measured_section", "measured_section");
   const TrialScene side_by_side = DescribeTrial(pair, trial, &scene);
-  EXPECT_DOUBLE_EQ(side_by_side.r_left_px, 0.5);   // nearest the left ball: section 1
-  EXPECT_DOUBLE_EQ(side_by_side.r_right_px, 1.5);  // nearest the right ball on section 5: section 7
+  EXPECT_DOUBLE_EQ(side_by_side.side(Side::kLeft).r_px, 0.5);   // nearest the left ball: section 1
+  EXPECT_DOUBLE_EQ(side_by_side.side(Side::kRight).r_px, 1.5);  // nearest the right ball on section 5: section 7
   const TrialScene t = DescribeTrial(intervals, trial, &scene);
   ASSERT_EQ(t.intervals, 2);
   const auto shown = ObjectsAt(intervals, scene, IntervalScene(t, true), 0);
   ASSERT_TRUE(shown[0]);
   EXPECT_NEAR(shown[0]->object.center_board_mm[0], -30, 1e-9);  // the right side's interval, at the left's place
-  EXPECT_NEAR(t.r_right_px, shown[0]->r_px, 1e-9);                // recorded as drawn
-  EXPECT_NEAR(t.r_right_px, t.r_left_px, 1e-9);                   // the same source at the same place
+  EXPECT_NEAR(t.side(Side::kRight).r_px, shown[0]->r_px, 1e-9);            // recorded as drawn
+  EXPECT_NEAR(t.side(Side::kRight).r_px, t.side(Side::kLeft).r_px, 1e-9);  // the same source at the same place
   // Nor is the photo checked at the right object's unshown place: only where the intervals draw (the parser refuses
   // a right_x_mm with intervals; here it stands for a right default place off the photo).
   const protocol::Trial off = PairTrial({{"edge", 6}, {"left_x_mm", -30}, {"right_x_mm", 5000}}, "fitted", "fitted");
@@ -155,7 +156,8 @@ TEST(DescribeTrial, GridCardsSitBesideTheBoardAtTheirEdge) {
   const TrialScene near = DescribeTrial(p, PairTrial({{"edge", 2}}, "measured", "fitted"), &scene);
   const TrialScene far = DescribeTrial(p, PairTrial({{"edge", 11}}, "estimated", "fitted"), &scene);
   EXPECT_EQ(near.edge, 2);
-  EXPECT_DOUBLE_EQ(near.r_left_px, 0.45);  // its own edge's measured value, beside the board on the edge's line
+  // Its own edge's measured value, beside the board on the edge's line.
+  EXPECT_DOUBLE_EQ(near.side(Side::kLeft).r_px, 0.45);
   // Edge 11 has no measured section: "measured" there is refused, naming the side's field, not given edge 2's value.
   try {
     DescribeTrial(p, PairTrial({{"edge", 11}}, "measured", "fitted"), &scene);
@@ -165,7 +167,7 @@ TEST(DescribeTrial, GridCardsSitBesideTheBoardAtTheirEdge) {
     EXPECT_NE(std::string(e.what()).find("edge 11 (the nearest) has no usable measured section"), std::string::npos)
         << e.what();
   }
-  EXPECT_GT(far.r_right_px, near.r_right_px + 1);  // fitted blur grows with distance from focus
+  EXPECT_GT(far.side(Side::kRight).r_px, near.side(Side::kRight).r_px + 1);  // fitted blur grows away from focus
   // A 4592 x 3056 photo fitted into a 1920 x 1080 window: 1080 / 3056 of a photo px per screen px, floored to
   // whole shown pixels (1622 of 1622.8); on the default monitor (37.84 px per degree) that is the arcmin.
   Presentation shown;
@@ -215,7 +217,7 @@ TEST(PlanOnScreen, PerPixelExactlyWhenTheObjectsDepthSpanReachesTheThresholdOnSc
   EXPECT_TRUE(t.per_pixel);
   // Recorded as blur_plan per_pixel: TrialVariables.RecordsThePerPixelBlurPlan (session).
   // A procedure's gain on a side scales its radius at every depth, and so its span.
-  t.left_gain = 3;
+  t.side(Side::kLeft).gain = 3;
   PlanOnScreen(p, scene, shown, &t);
   EXPECT_NEAR(t.r_span_screen_px, 3 * span, 1e-6 + 3e-3 * span);
 }
@@ -231,9 +233,9 @@ TEST(DescribeTrial, ARadiusGivenOnTheScreenIsTurnedIntoPhotoPxByThePresentation)
   const TrialScene t = DescribeTrial(p, PairTrial({{"edge", 3}}, Json{{"arcmin", 2}}, Json{{"screen_px", 1.5}}),
                                      &scene, &shown);
   const double pitch = 531.4 / 1920, screen = 2 * 600 * std::tan(M_PI / 180 / 60) / pitch;
-  EXPECT_NEAR(t.r_left_px, screen / 0.5, 1e-3);
-  EXPECT_NEAR(t.r_right_px, 3.0, 1e-12);
-  EXPECT_NEAR(shown.Arcmin(t.r_left_px), 2.0, 1e-3);
+  EXPECT_NEAR(t.side(Side::kLeft).r_px, screen / 0.5, 1e-3);
+  EXPECT_NEAR(t.side(Side::kRight).r_px, 3.0, 1e-12);
+  EXPECT_NEAR(shown.Arcmin(t.side(Side::kLeft).r_px), 2.0, 1e-3);
   try {
     DescribeTrial(p, PairTrial({{"edge", 3}}, Json{{"arcmin", 2}}, "none"), &scene);
     ADD_FAILURE() << "an arcmin radius without a display was accepted";
@@ -254,7 +256,8 @@ TEST(DescribeTrial, PlacesInMillimetresAndChecksTheBoardAndThePhoto) {
   const auto cards = ObjectsAt(p, scene, card, 0);
   EXPECT_EQ(cards[0]->object.center_board_mm, cv::Vec3d(-40, 60, 0));
   EXPECT_EQ(cards[1]->object.center_board_mm, cv::Vec3d(230, 60, 0));
-  EXPECT_NEAR(card.r_left_px, calib::BlurAtPx(scene, calib::BlurSource::kFitted, scene.ToCamera({-40, 60, 0})), 1e-9);
+  EXPECT_NEAR(card.side(Side::kLeft).r_px,
+              calib::BlurAtPx(scene, calib::BlurSource::kFitted, scene.ToCamera({-40, 60, 0})), 1e-9);
   p.content.type = protocol::ContentType::kBall;
   const TrialScene ball = DescribeTrial(p, PairTrial({{"from_y_mm", 10}, {"to_y_mm", 110}, {"speed_cm_s", 2},
                                                       {"left_x_mm", 50}}, "fitted", "none"), &scene);
@@ -296,19 +299,21 @@ TEST(DescribeTrial, AnObjectsDepthIsTheCalibrationsGeometryAtItsEdge) {
     for (const double x : {-40.0, 230.0}) {
       const cv::Vec3d from_centre = cv::Vec3d(x, (edge - 1) * 25.0, 0) - centre;
       const double u = 440 + from_centre.dot(forward);
-      EXPECT_NEAR(x < 0 ? t.u_left_mm : t.u_right_mm, u, 1e-6) << "edge " << edge << " x " << x;
-      EXPECT_NEAR(x < 0 ? t.below_axis_left_px : t.below_axis_right_px, fy * from_centre.dot(down) / u, 1e-6)
+      EXPECT_NEAR(x < 0 ? t.side(Side::kLeft).u_mm : t.side(Side::kRight).u_mm, u, 1e-6)
+          << "edge " << edge << " x " << x;
+      EXPECT_NEAR(x < 0 ? t.side(Side::kLeft).below_axis_px : t.side(Side::kRight).below_axis_px,
+                  fy * from_centre.dot(down) / u, 1e-6)
           << "edge " << edge << " x " << x;
     }
     if (edge == 1 || edge == 11) {
-      EXPECT_NEAR(t.u_left_mm, 440 + (edge == 1 ? -125 : 125) * std::cos(a), 1e-6);
+      EXPECT_NEAR(t.side(Side::kLeft).u_mm, 440 + (edge == 1 ? -125 : 125) * std::cos(a), 1e-6);
     }
   }
   // A ball resting at edge 9 on the board's section 3: its centre 10 mm above the board.
   const TrialScene ball = DescribeTrial(BallProtocol(), PairTrial({{"edge", 9}}, "fitted", "fitted"), &scene);
   const cv::Vec3d ball_centre = ObjectsAt(BallProtocol(), scene, ball, 0)[0]->object.center_board_mm;
   EXPECT_NEAR(ball_centre[1], 200, 1e-9);
-  EXPECT_NEAR(ball.u_left_mm, 440 + (ball_centre - centre).dot(forward), 1e-6);
+  EXPECT_NEAR(ball.side(Side::kLeft).u_mm, 440 + (ball_centre - centre).dot(forward), 1e-6);
 }
 
 TEST(DescribeTrial, MissingLevelOrCalibrationIsAnInputErrorNamingTheField) {
@@ -328,6 +333,32 @@ TEST(DescribeTrial, MissingLevelOrCalibrationIsAnInputErrorNamingTheField) {
                                          "block task2)"), std::string::npos) << e.what();
   }
   EXPECT_THROW(DescribeTrial(p, PairTrial({{"edge", 2}}, "measured", "fitted"), nullptr), Error);
+}
+
+// An interval of the right side shows all that side shows (source, radius, gain, floor, streak, depth) at the left
+// object's place (its x) and as large as the left one on screen.
+TEST(IntervalScene, ShowsTheRightSideAtTheLeftObjectsPlace) {
+  TrialScene t;
+  SideShown& left = t.side(Side::kLeft);
+  left.source = calib::BlurSource::kMeasured, left.x_mm = -30, left.size_deg = 2, left.r_px = 1;
+  SideShown& right = t.side(Side::kRight);
+  right.source = calib::BlurSource::kFitted, right.x_mm = 200, right.size_deg = 3, right.r_px = 4, right.gain = 2;
+  right.floor_sigma_px = 0.5, right.motion_px = {1, -1}, right.u_mm = 420, right.below_axis_px = 12;
+  const TrialScene second = IntervalScene(t, true);
+  EXPECT_TRUE(second.left_only);
+  const SideShown& shown = second.side(Side::kLeft);
+  EXPECT_EQ(shown.source, calib::BlurSource::kFitted);
+  EXPECT_EQ(shown.r_px, 4);
+  EXPECT_EQ(shown.gain, 2);
+  EXPECT_EQ(shown.floor_sigma_px, 0.5);
+  EXPECT_EQ(shown.motion_px, cv::Vec2d(1, -1));
+  EXPECT_EQ(shown.u_mm, 420);
+  EXPECT_EQ(shown.below_axis_px, 12);
+  EXPECT_EQ(shown.x_mm, -30);
+  EXPECT_EQ(shown.size_deg, 2);
+  const TrialScene first = IntervalScene(t, false);
+  EXPECT_EQ(first.side(Side::kLeft).source, calib::BlurSource::kMeasured);
+  EXPECT_EQ(first.side(Side::kLeft).r_px, 1);
 }
 
 }  // namespace

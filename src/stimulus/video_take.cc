@@ -202,20 +202,19 @@ TrialScene DescribeVideoTrial(const protocol::Protocol& protocol, const VideoTak
   for (const auto& [posed, w] : weight) total += w;
   if (!(total > 0)) return scene;
   TrialScene mean = scene;
-  mean.r_left_px = mean.r_right_px = mean.r_scene_px = mean.floor_left_sigma_px = mean.floor_right_sigma_px = 0;
-  mean.motion_left_px = mean.motion_right_px = cv::Vec2d(0, 0);
+  mean.r_scene_px = 0;
+  for (SideShown& side : mean.sides) side.r_px = side.floor_sigma_px = 0, side.motion_px = cv::Vec2d(0, 0);
   mean.r_span_screen_px = 0;
   mean.per_pixel = false;
   for (const auto& [posed, w] : weight) {
     const TrialScene t = posed == take.first_posed() ? scene : describe(posed);
     const double a = w / total;
-    mean.r_left_px += a * t.r_left_px;
-    mean.r_right_px += a * t.r_right_px;
     mean.r_scene_px += a * t.r_scene_px;
-    mean.floor_left_sigma_px += a * t.floor_left_sigma_px;
-    mean.floor_right_sigma_px += a * t.floor_right_sigma_px;
-    mean.motion_left_px += a * t.motion_left_px;
-    mean.motion_right_px += a * t.motion_right_px;
+    for (size_t side = 0; side < 2; ++side) {
+      mean.sides[side].r_px += a * t.sides[side].r_px;
+      mean.sides[side].floor_sigma_px += a * t.sides[side].floor_sigma_px;
+      mean.sides[side].motion_px += a * t.sides[side].motion_px;
+    }
     mean.r_span_screen_px = std::max(mean.r_span_screen_px, t.r_span_screen_px);
     mean.per_pixel = mean.per_pixel || t.per_pixel;
   }
@@ -252,8 +251,9 @@ TrialScene DescribeVideoTrial(const protocol::Protocol& protocol, const VideoTak
         }
     }
   });
-  if (weight_of[0] > 0) mean.r_left_px = r[0] / weight_of[0], mean.motion_left_px = motion[0] / weight_of[0];
-  if (weight_of[1] > 0) mean.r_right_px = r[1] / weight_of[1], mean.motion_right_px = motion[1] / weight_of[1];
+  for (size_t side = 0; side < 2; ++side)
+    if (weight_of[side] > 0)
+      mean.sides[side].r_px = r[side] / weight_of[side], mean.sides[side].motion_px = motion[side] / weight_of[side];
   return mean;
 }
 

@@ -66,8 +66,9 @@ std::array<std::optional<scene::BlurredObject>, 2> VideoObjectsAt(const protocol
                                                                    const TrialScene& trial, double t_s);
 
 // A trial on video as the take plays under it: DescribeTrial and PlanOnScreen at every frame with a pose the trial
-// shows, the record's radii, floors, streaks and scene blur (r_left_px ... motion_right_px, r_scene_px) averaged over
-// the time each frame is on screen while the stimulus is (TakeWindowS), a per-pixel plan where any frame asks for one.
+// shows, the record's radii, floors, streaks and scene blur (each side's r_px, floor_sigma_px and motion_px,
+// r_scene_px) averaged over the time each frame is on screen while the stimulus is (TakeWindowS), a per-pixel plan
+// where any frame asks for one.
 // What the trial shows first (place, size at onset) is the first frame's. A frame whose objects cannot be drawn or
 // lie outside its photo is an error (kInput) naming the protocol file, the trial and the take's frame. The trial's
 // radii are thus the ones its participant sees on the whole, as a rolling ball's are averaged over its run.

@@ -2,6 +2,8 @@
 #include "store/columns.h"
 #include "store/frame_columns.h"
 
+#include <deque>
+#include <iterator>
 #include <optional>
 #include <type_traits>
 
@@ -61,38 +63,61 @@ std::function<Json(const RecordedVariables&)> Member(std::optional<T> RecordedVa
     else return Json(*x);
   };
 }
-// One side's radius of RecordedVariables::r_px, r_screen_px or r_arcmin.
-std::function<Json(const RecordedVariables&)> Radius(std::array<std::optional<double>, 3> RecordedVariables::*radii,
-                                                    size_t side) {
-  return [radii, side](const RecordedVariables& v) { return (v.*radii)[side] ? Json(*(v.*radii)[side]) : Json(); };
+// One place's radius of RecordedVariables::r_px, r_screen_px or r_arcmin.
+std::function<Json(const RecordedVariables&)> Radius(
+    std::array<std::optional<double>, RecordedVariables::kSides> RecordedVariables::*radii, size_t place) {
+  return [radii, place](const RecordedVariables& v) { return (v.*radii)[place] ? Json(*(v.*radii)[place]) : Json(); };
+}
+// One side's member of RecordedVariables::sides.
+std::function<Json(const RecordedVariables&)> OfSide(std::optional<double> SideVariables::*member, size_t side) {
+  return [member, side](const RecordedVariables& v) {
+    const std::optional<double>& x = v.sides[side].*member;
+    return x ? Json(*x) : Json();
+  };
 }
 
-Stored OfSession(Stored s, Value (*of)(const SessionValues&)) { return s.of_session = of, s; }
-Stored OfTrial(Stored s, Value (*of)(const TrialRecord&)) { return s.of_trial = of, s; }
-Stored OfResponse(Stored s, Value (*of)(const Response&)) { return s.of_response = of, s; }
+Stored OfSession(Stored s, std::function<Value(const SessionValues&)> of) { return s.of_session = std::move(of), s; }
+Stored OfTrial(Stored s, std::function<Value(const TrialRecord&)> of) { return s.of_trial = std::move(of), s; }
+Stored OfResponse(Stored s, std::function<Value(const Response&)> of) { return s.of_response = std::move(of), s; }
 
-std::vector<Column> MakeColumns() {
-  std::vector<Column> c;
-  c.reserve(128);  // rows are filled in through references to them
+// Builds the record's column table in order, one row per call; a row stays where it is (a deque) while the rest of
+// it is set through the reference the call returns.
+class ColumnList {
+ public:
   // One row: name, codebook type, unit, allowed, meaning, place, cell; the rest set on the returned row.
-  auto add = [&](const std::string& name, const std::string& type, const std::string& unit,
-                 const std::string& allowed, const std::string& meaning, Place place, Cell cell) -> Column& {
+  Column& operator()(const std::string& name, const std::string& type, const std::string& unit,
+                     const std::string& allowed, const std::string& meaning, Place place, Cell cell) {
     Column column;
     column.name = name, column.type = type, column.unit = unit, column.allowed = allowed;
     column.meaning = meaning, column.place = place, column.cell = cell;
-    c.push_back(std::move(column));
-    return c.back();
-  };
-  const Place S = Place::kSession, T = Place::kTrial, V = Place::kVariable, A = Place::kAnswer, N = Place::kNone;
+    rows_.push_back(std::move(column));
+    return rows_.back();
+  }
+  // A variable the runner records in the trial's variables' JSON, read from RecordedVariables by `read`.
+  void Variable(const std::string& name, const std::string& type, const std::string& unit, const std::string& meaning,
+                std::function<Json(const RecordedVariables&)> read) {
+    (*this)(name, type, unit, "", meaning, Place::kVariable, Cell::kText).variable = std::move(read);
+  }
+  std::vector<Column> Take() { return {std::make_move_iterator(rows_.begin()), std::make_move_iterator(rows_.end())}; }
 
+ private:
+  std::deque<Column> rows_;
+};
+
+// The places of the table's rows, short: the rows read as a table.
+constexpr Place S = Place::kSession, T = Place::kTrial, V = Place::kVariable, A = Place::kAnswer, N = Place::kNone;
+
+// The session's columns, and the display profile's geometry kept typed.
+void AddSessionColumns(ColumnList& add) {
   // The session's.
   add("study", "string", "", "", "the protocol's name", S, Cell::kText).at = Plain("studies", "name", "TEXT", 1);
   add("protocol_hash", "string", "", "16 hex digits", "FNV-1a-64 of the protocol's canonical text: its version", S,
       Cell::kText).at = Plain("protocol_versions", "hash", "TEXT", 1);
-  add("protocol_version", "integer", "", ">= 1",
-      "the protocol's declared \"version\" the session ran (one text per version of a study)", S, Cell::kInteger)
-      .at = Typed("protocol_versions", "INTEGER", "version >= 1", 8);
-  c.back().at.column = "version";  // written by the record with the protocol version (EnsureProtocolVersion)
+  Column& version = add("protocol_version", "integer", "", ">= 1",
+                         "the protocol's declared \"version\" the session ran (one text per version of a study)", S,
+                         Cell::kInteger);
+  version.at = Typed("protocol_versions", "INTEGER", "version >= 1", 8);
+  version.at.column = "version";  // written by the record with the protocol version (EnsureProtocolVersion)
   add("participant", "string", "", "", "the participant's id", S, Cell::kText).at = Plain("participants", "code", "TEXT", 1);
   Column& observer = add("observer", "string", "", "person|simulated",
                          "who answered: a person, or blurcue's simulated observer", S, Cell::kText);
@@ -143,7 +168,10 @@ std::vector<Column> MakeColumns() {
       "the seed of the session's trial order, a 64-bit unsigned integer written with a leading s so that spreadsheets, "
       "R and JavaScript keep every digit; blurcue run --seed takes it as written", S, Cell::kSeed)
       .at = Plain("sessions", "seed", "INTEGER", 1);
+}
 
+// The trial's columns.
+void AddTrialColumns(ColumnList& add) {
   // The trial's.
   add("trial_index", "integer", "", ">= 0", "the trial's place in the session, practice included, from 0", T,
       Cell::kInteger).at = Plain("trials", "trial_index", "INTEGER", 1);
@@ -174,24 +202,26 @@ std::vector<Column> MakeColumns() {
       "a procedure trial's cell by its levels (NAME=LEVEL;... of its block's factors): its own track and threshold; "
       "empty outside a procedure and in records made before cells were recorded", T, Cell::kText)
       .at = OfTrial(Typed("trials", "TEXT", "", 8), [](const TrialRecord& t) { return NonEmpty(t.cell); });
+}
 
+// Each side's source and fixed radius (named by SideColumn), and a procedure's level.
+void AddSourceColumns(ColumnList& add) {
   // Each side's source, with the answer in trials.csv; in schema 7's order before the planned radii.
   const std::string sources = SourceColumns::Names();
-  add("left_source", "string", "", sources, "the left side's blur source (the single layout's object); empty: none shown",
-      A, Cell::kText)
-      .at = OfTrial(Typed("trials", "TEXT", "", 7, SourceOf("left_shown")),
-                    [](const TrialRecord& t) { return NonEmpty(SourceColumns::Of(t.left_json).source); });
-  add("left_fixed", "number", "the source's unit", ">= 0", "a fixed_* left source's radius, in the unit its name says",
-      A, Cell::kNumber)
-      .at = OfTrial(Typed("trials", "REAL", "", 7, FixedOf("left_shown")),
-                    [](const TrialRecord& t) { return Optional(SourceColumns::Of(t.left_json).fixed); });
-  add("right_source", "string", "", sources, "the right side's blur source; empty: none shown", A, Cell::kText)
-      .at = OfTrial(Typed("trials", "TEXT", "", 7, SourceOf("right_shown")),
-                    [](const TrialRecord& t) { return NonEmpty(SourceColumns::Of(t.right_json).source); });
-  add("right_fixed", "number", "the source's unit", ">= 0", "a fixed_* right source's radius, in the unit its name says",
-      A, Cell::kNumber)
-      .at = OfTrial(Typed("trials", "REAL", "", 7, FixedOf("right_shown")),
-                    [](const TrialRecord& t) { return Optional(SourceColumns::Of(t.right_json).fixed); });
+  for (const protocol::Side side : protocol::Vocabulary<protocol::Side>::values) {
+    const std::string word = protocol::ToString(side), shown = SideColumn("", side, "shown");
+    const size_t k = protocol::Index(side);
+    add(SideColumn("", side, "source"), "string", "", sources,
+        "the " + word + " side's blur source" + (side == protocol::Side::kLeft ? " (the single layout's object)" : "") +
+            "; empty: none shown",
+        A, Cell::kText)
+        .at = OfTrial(Typed("trials", "TEXT", "", 7, SourceOf(shown)),
+                      [k](const TrialRecord& t) { return NonEmpty(SourceColumns::Of(t.source_json[k]).source); });
+    add(SideColumn("", side, "fixed"), "number", "the source's unit", ">= 0",
+        "a fixed_* " + word + " source's radius, in the unit its name says", A, Cell::kNumber)
+        .at = OfTrial(Typed("trials", "REAL", "", 7, FixedOf(shown)),
+                      [k](const TrialRecord& t) { return Optional(SourceColumns::Of(t.source_json[k]).fixed); });
+  }
 
   // The runner's variables of a trial (session/recording.h TrialVariables), kept in its variables' JSON (factors; a
   // response's shown for what a procedure decided at the trial). Those also kept typed come first, in schema 7's order.
@@ -203,7 +233,10 @@ std::vector<Column> MakeColumns() {
   level.variable = Member(&RecordedVariables::level);
   level.shown = OfResponse(Typed("responses", "REAL", "", 7, "json_extract(shown, '$.level')"),
                            [](const Response& r) { return Optional(r.level); });
+}
 
+// The answer's columns, decided from it when exported, and whether it was correct.
+void AddAnswerColumns(ColumnList& add) {
   // The answer.
   add("status", "string", "", "answered|timed_out|skipped|unanswered",
       "answered; timed_out: no answer before the deadline; skipped: not shown (a stopped procedure, a practice "
@@ -229,7 +262,10 @@ std::vector<Column> MakeColumns() {
   correct.at = OfResponse(Typed("responses", "INTEGER", "correct IN (0, 1)", 7, "json_extract(shown, '$.correct')"), [](const Response& r) {
     return r.correct ? Value(int64_t(*r.correct ? 1 : 0)) : Value();
   });
+}
 
+// Each place's radius in photo px, screen px and arcmin; the response time and when it was recorded.
+void AddRadiusColumns(ColumnList& add) {
   // Each radius as the camera made it, on the screen and at the eye; the photo px ones also typed, planned (trials)
   // and as shown (responses), for a procedure decides them at the trial.
   for (size_t k = 0; k < RecordedVariables::kSides; ++k) {
@@ -237,24 +273,22 @@ std::vector<Column> MakeColumns() {
     const std::string what = k == 2 ? "the scene's own blur at the object's place (the fitted model; depth "
                                                "matching: the real picture's, the thin lens of content.real_camera)"
                                              : "the " + side + " object's blur radius";
-    Column& px = add("r_" + side + "_px", "number", "photo px",
+    const std::string name = SideColumn("r", side, "px");
+    Column& px = add(name, "number", "photo px",
                      "", what + ", as the camera makes it (moving: averaged over the run)", V, Cell::kText);
     px.variable = Radius(&RecordedVariables::r_px, k);
     // Before version 7 only the variables' JSON had it, planned (factors) and as shown (shown).
-    const Stored planned = Typed("trials", "REAL", "", 7, "json_extract(factors, '$.r_" + side + "_px')");
-    const Stored shown = Typed("responses", "REAL", "", 7, "json_extract(shown, '$.r_" + side + "_px')");
-    if (k == 0) {
-      px.at = OfTrial(planned, [](const TrialRecord& t) { return Optional(t.r_left_px); });
-      px.shown = OfResponse(shown, [](const Response& r) { return Optional(r.r_left_px); });
-    } else if (k == 1) {
-      px.at = OfTrial(planned, [](const TrialRecord& t) { return Optional(t.r_right_px); });
-      px.shown = OfResponse(shown, [](const Response& r) { return Optional(r.r_right_px); });
-    } else {
+    const Stored planned = Typed("trials", "REAL", "", 7, "json_extract(factors, '$." + name + "')");
+    const Stored shown = Typed("responses", "REAL", "", 7, "json_extract(shown, '$." + name + "')");
+    if (k == RecordedVariables::kScene) {
       px.at = OfTrial(planned, [](const TrialRecord& t) { return Optional(t.r_scene_px); });
+    } else {
+      px.at = OfTrial(planned, [k](const TrialRecord& t) { return Optional(t.r_px[k]); });
+      px.shown = OfResponse(shown, [k](const Response& r) { return Optional(r.r_px[k]); });
     }
-    add("r_" + side + "_screen_px", "number", "screen px", "", what + ", on the screen", V, Cell::kText).variable =
-        Radius(&RecordedVariables::r_screen_px, k);
-    add("r_" + side + "_arcmin", "number", "arcmin", "", what + ", at the eye", V, Cell::kText).variable =
+    add(SideColumn("r", side, "screen_px"), "number", "screen px", "", what + ", on the screen", V, Cell::kText)
+        .variable = Radius(&RecordedVariables::r_screen_px, k);
+    add(SideColumn("r", side, "arcmin"), "number", "arcmin", "", what + ", at the eye", V, Cell::kText).variable =
         Radius(&RecordedVariables::r_arcmin, k);
   }
   Column& rt = add("rt_ms", "number", "ms", ">= 0", "response time from the stimulus's first frame; empty without an answer",
@@ -262,71 +296,85 @@ std::vector<Column> MakeColumns() {
   rt.at = Plain("responses", "rt_ms", "REAL", 1);
   add("answered_at", "datetime", "", "", "when the answer was recorded (UTC)", A, Cell::kText)
       .at = Plain("responses", "answered_at", "TEXT", 1);
+}
 
-  auto variable = [&](const std::string& name, const std::string& type, const std::string& unit,
-                      const std::string& meaning, std::function<Json(const RecordedVariables&)> read) {
-    add(name, type, unit, "", meaning, V, Cell::kText).variable = std::move(read);
-  };
+// The rest of the runner's variables of a trial.
+void AddVariableColumns(ColumnList& add) {
   using R = RecordedVariables;
-  variable("screen_px_per_photo_px", "number", "screen px / photo px", "how the photo was scaled onto the screen", Member(&R::screen_px_per_photo_px));
-  variable("kernel", "string", "", "the blur kernel (gaussian | disc)", Member(&R::kernel));
-  variable("blur_plan", "string", "", "one_radius: each object blurred with one radius; per_pixel: by depth",
+  add.Variable("screen_px_per_photo_px", "number", "screen px / photo px", "how the photo was scaled onto the screen", Member(&R::screen_px_per_photo_px));
+  add.Variable("kernel", "string", "", "the blur kernel (gaussian | disc)", Member(&R::kernel));
+  add.Variable("blur_plan", "string", "", "one_radius: each object blurred with one radius; per_pixel: by depth",
            Member(&R::blur_plan));
-  variable("r_span_screen_px", "number", "screen px", "the largest change of a radius across an object's depth", Member(&R::r_span_screen_px));
+  add.Variable("r_span_screen_px", "number", "screen px", "the largest change of a radius across an object's depth", Member(&R::r_span_screen_px));
   // The PSF beside each radius (render/psf.h): the lens floor inside it and the motion streak over the exposure.
-  variable("exposure_ms", "number", "ms", "the exposure a moving object's motion blur lasts (content.exposure_ms; 0: none)",
+  add.Variable("exposure_ms", "number", "ms", "the exposure a moving object's motion blur lasts (content.exposure_ms; 0: none)",
            Member(&R::exposure_ms));
+  using SV = SideVariables;
   for (size_t k = 0; k < 2; ++k) {
     const std::string side = RecordedVariables::SideName(k);
-    variable("floor_sigma_" + side + "_px", "number", "photo px",
+    add.Variable(SideColumn("floor_sigma", side, "px"), "number", "photo px",
              "the lens floor (std) inside the " + side + " object's radius: the scene's, for a measured, measured_section "
-             "or fitted source (its defocus drawn convolved with it); 0 for the others", Radius(&R::floor_sigma_px, k));
-    variable("floor_sigma_" + side + "_screen_px", "number", "screen px", "the same on the screen",
-             Radius(&R::floor_sigma_screen_px, k));
-    variable("motion_" + side + "_x_screen_px", "number", "screen px",
+             "or fitted source (its defocus drawn convolved with it); 0 for the others",
+             OfSide(&SV::floor_sigma_px, k));
+    add.Variable(SideColumn("floor_sigma", side, "screen_px"), "number", "screen px", "the same on the screen",
+             OfSide(&SV::floor_sigma_screen_px, k));
+    add.Variable(SideColumn("motion", side, "x_screen_px"), "number", "screen px",
              "the " + side + " object's motion streak over the exposure, across (x right), averaged over the run",
-             Radius(&R::motion_x_screen_px, k));
-    variable("motion_" + side + "_y_screen_px", "number", "screen px",
+             OfSide(&SV::motion_x_screen_px, k));
+    add.Variable(SideColumn("motion", side, "y_screen_px"), "number", "screen px",
              "the " + side + " object's motion streak over the exposure, down (y down), averaged over the run",
-             Radius(&R::motion_y_screen_px, k));
+             OfSide(&SV::motion_y_screen_px, k));
   }
   // Where each object is: its depth (what an edge number stands for) and, as the eye gets it, its height in the picture.
   for (size_t k = 0; k < 2; ++k) {
     const std::string side = RecordedVariables::SideName(k);
-    variable("u_" + side + "_mm", "number", "mm",
+    add.Variable(SideColumn("u", side, "mm"), "number", "mm",
              "the " + side + " object's depth u: its centre's distance from the camera's lens plane along the optical "
              "axis (camera z in the calibration's board pose), where its radius was evaluated (an intervals trial: the "
-             "left object's place); a ball: averaged over its run like the radii", Radius(&R::u_mm, k));
-    variable("elevation_" + side + "_deg", "number", "deg",
+             "left object's place); a ball: averaged over its run like the radii", OfSide(&SV::u_mm, k));
+    add.Variable(SideColumn("elevation", side, "deg"), "number", "deg",
              "the " + side + " object's place in the picture as a visual angle: its centre's image above (+) or below "
              "(-) the photo's principal point (where the camera's optical axis meets the photo), on the display, "
-             "atan(offset on the screen / viewing distance); not its angular size (size_" + side + "_deg); a ball: "
-             "averaged over its run", Radius(&R::elevation_deg, k));
+             "atan(offset on the screen / viewing distance); not its angular size (" + SideColumn("size", side, "deg") +
+             "); a ball: averaged over its run", OfSide(&SV::elevation_deg, k));
   }
-  variable("size_left_deg", "number", "deg", "the left object's largest extent on screen at onset", Member(&R::size_left_deg));
-  variable("size_right_deg", "number", "deg", "the right object's largest extent on screen at onset", Member(&R::size_right_deg));
-  variable("brightness", "number", "", "the object's brightness matching (factor of its texture's values)", Member(&R::brightness));
-  variable("contrast", "number", "", "the object's contrast matching", Member(&R::contrast));
-  variable("white_balance_r", "number", "", "the object's red gain in linear light", Member(&R::white_balance_r));
-  variable("white_balance_g", "number", "", "the object's green gain in linear light", Member(&R::white_balance_g));
-  variable("white_balance_b", "number", "", "the object's blue gain in linear light", Member(&R::white_balance_b));
-  variable("start_level", "number", "the adjusted parameter's unit", "adjustment: the level shown first", Member(&R::start_level));
-  variable("adjust_levels", "string", "the adjusted parameter's unit",
+  for (size_t k = 0; k < 2; ++k) {
+    const std::string side = RecordedVariables::SideName(k);
+    add.Variable(SideColumn("size", side, "deg"), "number", "deg",
+             "the " + side + " object's largest extent on screen at onset", OfSide(&SV::size_deg, k));
+  }
+  add.Variable("brightness", "number", "", "the object's brightness matching (factor of its texture's values)", Member(&R::brightness));
+  add.Variable("contrast", "number", "", "the object's contrast matching", Member(&R::contrast));
+  add.Variable("white_balance_r", "number", "", "the object's red gain in linear light", Member(&R::white_balance_r));
+  add.Variable("white_balance_g", "number", "", "the object's green gain in linear light", Member(&R::white_balance_g));
+  add.Variable("white_balance_b", "number", "", "the object's blue gain in linear light", Member(&R::white_balance_b));
+  add.Variable("start_level", "number", "the adjusted parameter's unit", "adjustment: the level shown first", Member(&R::start_level));
+  add.Variable("adjust_levels", "string", "the adjusted parameter's unit",
            "adjustment: the levels in the order the next key steps through them (cyclic), separated by ;",
            Member(&R::adjust_levels));
-  variable("picture_width_arcmin", "number", "arcmin",
+  add.Variable("picture_width_arcmin", "number", "arcmin",
            "depth matching: the virtual picture's width at the eye (a cut-off c's blur is r = 2 x 0.1874 x this / c)", Member(&R::picture_width_arcmin));
-  variable("procedure_cell", "integer", "", "a procedure trial: which crossing of its block's factors (its own procedure)", Member(&R::procedure_cell));
-  variable("test_side", "string", "", "a procedure trial: the side (or odd-one-out interval) showing the procedure's level", Member(&R::test_side));
-  variable("reversals", "integer", "", "a staircase trial: the staircase's reversals before this answer (or when it stopped)", Member(&R::reversals));
-  variable("skipped", "string", "", "why a trial was not shown (stop rule: its staircase had ended)", Member(&R::skipped));
-  variable("posterior_threshold", "number", "the procedure's variable",
+  add.Variable("procedure_cell", "integer", "", "a procedure trial: which crossing of its block's factors (its own procedure)", Member(&R::procedure_cell));
+  add.Variable("test_side", "string", "", "a procedure trial: the side (or odd-one-out interval) showing the procedure's level", Member(&R::test_side));
+  add.Variable("reversals", "integer", "", "a staircase trial: the staircase's reversals before this answer (or when it stopped)", Member(&R::reversals));
+  add.Variable("skipped", "string", "", "why a trial was not shown (stop rule: its staircase had ended)", Member(&R::skipped));
+  add.Variable("posterior_threshold", "number", "the procedure's variable",
            "a QUEST+ trial: the posterior mean of the threshold after this answer (its running estimate)", Member(&R::posterior_threshold));
-  variable("posterior_slope", "number", "", "a QUEST+ trial: the posterior mean of the slope after this answer", Member(&R::posterior_slope));
-  variable("round", "integer", "", "a practice block run until a criterion: which run of its design (from 1)", Member(&R::round));
-  variable("odd_interval", "integer", "", "odd one out: the interval that showed the right side's object (the correct answer)", Member(&R::odd_interval));
-  variable("intervals", "integer", "", "odd one out: intervals per trial", Member(&R::intervals));
-  return c;
+  add.Variable("posterior_slope", "number", "", "a QUEST+ trial: the posterior mean of the slope after this answer", Member(&R::posterior_slope));
+  add.Variable("round", "integer", "", "a practice block run until a criterion: which run of its design (from 1)", Member(&R::round));
+  add.Variable("odd_interval", "integer", "", "odd one out: the interval that showed the right side's object (the correct answer)", Member(&R::odd_interval));
+  add.Variable("intervals", "integer", "", "odd one out: intervals per trial", Member(&R::intervals));
+}
+
+std::vector<Column> MakeColumns() {
+  ColumnList add;
+  AddSessionColumns(add);
+  AddTrialColumns(add);
+  AddSourceColumns(add);
+  AddAnswerColumns(add);
+  AddRadiusColumns(add);
+  AddVariableColumns(add);
+  return add.Take();
 }
 
 // The export's alias of each table the record keeps a variable in.
@@ -355,7 +403,15 @@ const std::vector<Column>& RecordColumns() {
 }
 
 std::string RecordedVariables::SideName(size_t k) {
-  return k < 2 ? protocol::ToString(protocol::Side(k)) : std::string("scene");
+  return k < 2 ? protocol::ToString(protocol::Vocabulary<protocol::Side>::values[k]) : std::string("scene");
+}
+
+std::string SideColumn(const std::string& quantity, const std::string& side, const std::string& suffix) {
+  return (quantity.empty() ? "" : quantity + "_") + side + (suffix.empty() ? "" : "_" + suffix);
+}
+
+std::string SideColumn(const std::string& quantity, protocol::Side side, const std::string& suffix) {
+  return SideColumn(quantity, protocol::ToString(side), suffix);
 }
 
 Json VariablesJson(const RecordedVariables& variables) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/json_io.h"
+#include "protocol/vocabulary.h"
 
 namespace blurcue::store {
 
@@ -37,8 +38,31 @@ enum class Cell { kText, kInteger, kNumber, kSeed, kAnswer };
 // The cells decided from the answer when it is exported: one column per kind of answer, each of one type.
 enum class Answer { kNone, kStatus, kChosenSide, kChoseMoreBlurred, kChosenInterval, kYesNo, kRating, kAdjustedLevel };
 
+// What the codebook says of a column - the part every table of the record and its exports shares (trials.csv's
+// columns below, frames.csv's FrameValue, procedures.csv's and adjustments.csv's ColumnDef): its name in the table
+// and the CSV, its type (string | integer | number | boolean: 0|1 | datetime: ISO 8601 UTC), unit, allowed values
+// and meaning. A table's header and its codebook rows are written from the same ColumnSpec (CodebookRow).
+struct ColumnSpec {
+  std::string name, type, unit, allowed, meaning;
+};
+
 // A value for a typed column: NULL, an integer, a number or a text.
 using Value = std::variant<std::monostate, int64_t, double, std::string>;
+
+// The name of a column of one side's (or the scene's) quantity, QUANTITY_SIDE_SUFFIX with the side's word
+// (protocol::Side's, or scene): r_left_px, floor_sigma_right_screen_px, motion_left_x_px, u_right_mm. The one place
+// every per-side column of the record and its exports is named, for both sides.
+std::string SideColumn(const std::string& quantity, const std::string& side, const std::string& suffix);
+std::string SideColumn(const std::string& quantity, protocol::Side side, const std::string& suffix);
+
+// What the runner records of one object of a pair beside its radius (RecordedVariables::r_px): the PSF's other parts
+// (render/psf.h) - the lens floor inside the radius (std) and the streak's x and y on the screen - where it is (its
+// centre's depth u along the camera's optical axis, mm, and its elevation on the display, deg of visual angle, up
+// positive, from the photo's principal point) and its largest extent on screen at onset (deg).
+struct SideVariables {
+  std::optional<double> floor_sigma_px, floor_sigma_screen_px, motion_x_screen_px, motion_y_screen_px, u_mm,
+      elevation_deg, size_deg;
+};
 
 // What a new session's typed columns are read from: its description, its display profile parsed, its number.
 struct SessionValues {
@@ -56,21 +80,17 @@ struct RecordedVariables {
   std::optional<std::string> block_name, test_side, adjust_levels, kernel, blur_plan, skipped;
   std::optional<int64_t> round, procedure_cell, odd_interval, intervals, reversals;
   std::optional<double> level, start_level, picture_width_arcmin, screen_px_per_photo_px, r_span_screen_px,
-      size_left_deg, size_right_deg, brightness, contrast, white_balance_r, white_balance_g, white_balance_b,
-      posterior_threshold, posterior_slope;
-  // Each radius of the kSides places (0, 1: the left and right sides, 2: the scene; SideName spells them) as the
-  // camera made it (photo px), on the screen (screen px) and at the eye (arcmin).
-  static constexpr size_t kSides = 3;
+      brightness, contrast, white_balance_r, white_balance_g, white_balance_b, posterior_threshold, posterior_slope;
+  // Each radius of the kSides places (protocol::Index(side) for the two sides, kScene for the scene; SideName spells
+  // them) as the camera made it (photo px), on the screen (screen px) and at the eye (arcmin).
+  static constexpr size_t kSides = 3, kScene = 2;
   // A place's word in the column names: protocol::Side's for the sides, scene for the scene.
   static std::string SideName(size_t k);
-  std::array<std::optional<double>, 3> r_px, r_screen_px, r_arcmin;
-  // The PSF beside them (render/psf.h): the exposure a moving object's streak lasts, and for the left and right
-  // sides (kSides' first two) the lens floor inside the radius (std) and the streak's x and y on the screen.
+  std::array<std::optional<double>, kSides> r_px, r_screen_px, r_arcmin;
+  // The exposure a moving object's streak lasts, and the rest of what each side's object shows, indexed by
+  // protocol::Index(side).
   std::optional<double> exposure_ms;
-  std::array<std::optional<double>, 3> floor_sigma_px, floor_sigma_screen_px, motion_x_screen_px, motion_y_screen_px;
-  // Where the left and right objects (kSides' first two) are: each centre's depth u along the camera's optical axis
-  // (mm), and its elevation on the display (deg of visual angle, up positive) from the photo's principal point.
-  std::array<std::optional<double>, 3> u_mm, elevation_deg;
+  std::array<SideVariables, 2> sides;
 };
 
 // The JSON the record keeps `variables` in: {NAME: value} for each member set, NAME its column's.
@@ -89,17 +109,14 @@ struct Stored {
   // Version 7: how a row written before it had the value (SQL over the row's older texts: the display, the display
   // profile, the variables' JSON), for DeriveTypedColumns; "" for none.
   std::string derive;
-  Value (*of_session)(const SessionValues&) = nullptr;
-  Value (*of_trial)(const TrialRecord&) = nullptr;
-  Value (*of_response)(const Response&) = nullptr;
+  std::function<Value(const SessionValues&)> of_session;
+  std::function<Value(const TrialRecord&)> of_trial;
+  std::function<Value(const Response&)> of_response;
 };
 
-struct Column {
-  std::string name;     // trials.csv's and the codebook's
-  std::string type;     // the codebook's: string | integer | number | boolean (0|1) | datetime (ISO 8601 UTC)
-  std::string unit;
-  std::string allowed;  // what the record allows; a variable of type string without it: the values seen
-  std::string meaning;
+// A column of trials.csv: its codebook definition (ColumnSpec; `allowed` is what the record allows, and a variable of
+// type string without it lists the values seen), where the CSV puts it and how it is read and kept.
+struct Column : ColumnSpec {
   Place place = Place::kNone;
   Cell cell = Cell::kText;
   std::string select;   // the export's SQL over st, pv, p, s, t, r; "" = the kept column (at), e.g. t.block_name

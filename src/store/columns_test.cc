@@ -8,6 +8,7 @@
 
 #include "store/export.h"
 #include "store/export_table.h"
+#include "store/frame_columns.h"
 #include "store/record.h"
 #include "store/schema.h"
 #include "store/sqlite.h"
@@ -47,12 +48,12 @@ void OneAnsweredTrial(const std::filesystem::path& db_path) {
   const int64_t session = record.StartOrResumeSession("s", "P1", R"({"study":"s"})", 7, meta, false).session_id;
   TrialRecord t;
   t.factors_json = R"({"block_name":"b","edge":9,"kernel":"gaussian","practice":0,"r_left_px":3.5,"swapped":0})";
-  t.left_json = R"("measured")";
-  t.right_json = R"({"screen_px":2.5})";
+  t.source_json[0] = R"("measured")";
+  t.source_json[1] = R"({"screen_px":2.5})";
   t.block_name = "b";
   t.task = "forced_choice";
-  t.r_left_px = 3.5;
-  t.r_right_px = 1.25;
+  t.r_px[0] = 3.5;
+  t.r_px[1] = 1.25;
   record.SaveTrialList(session, {t});
   Response r;
   r.choice = "left";
@@ -283,16 +284,47 @@ TEST(Columns, TheRunnersVariablesAreTheTablesColumns) {
   all.block_name = all.test_side = all.adjust_levels = all.kernel = all.blur_plan = all.skipped = std::string("x");
   all.round = all.procedure_cell = all.odd_interval = all.intervals = all.reversals = int64_t{1};
   for (std::optional<double>* x : {&all.level, &all.start_level, &all.picture_width_arcmin,
-                                   &all.screen_px_per_photo_px, &all.r_span_screen_px, &all.size_left_deg,
-                                   &all.size_right_deg, &all.brightness, &all.contrast, &all.white_balance_r,
-                                   &all.white_balance_g, &all.white_balance_b, &all.posterior_threshold,
-                                   &all.posterior_slope})
+                                   &all.screen_px_per_photo_px, &all.r_span_screen_px, &all.brightness,
+                                   &all.contrast, &all.white_balance_r, &all.white_balance_g, &all.white_balance_b,
+                                   &all.posterior_threshold, &all.posterior_slope})
     *x = 2.5;
+  for (SideVariables& side : all.sides) side.size_deg = 2.5;  // size_left_deg, size_right_deg
   for (size_t k = 0; k < 3; ++k) all.r_px[k] = all.r_screen_px[k] = all.r_arcmin[k] = 3.5;
   const Json json = VariablesJson(all);
   EXPECT_EQ(json.size(), 28u + 9u) << json.dump();
   EXPECT_EQ(json["practice"], 0);
   EXPECT_EQ(json["r_right_screen_px"], 3.5);
+}
+
+// Each side's columns are named from one place (SideColumn), the same way for both sides; the names are the users'
+// data format, so the frames table's are pinned here, and each reads its own side's values.
+TEST(Columns, BothSidesColumnsAreNamedFromOnePlace) {
+  EXPECT_EQ(SideColumn("floor_sigma", protocol::Side::kRight, "screen_px"), "floor_sigma_right_screen_px");
+  EXPECT_EQ(SideColumn("", protocol::Side::kLeft, "source"), "left_source");
+  EXPECT_EQ(SideColumn("r", "scene", "px"), "r_scene_px");
+  std::vector<std::string> names;
+  for (const FrameValue& v : FrameValues()) names.push_back(v.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"frame_index", "flip_time_s", "dropped", "r_left_px", "r_right_px", "y_mm",
+                                             "take_frame", "take_status", "floor_sigma_left_px",
+                                             "floor_sigma_right_px", "motion_left_x_px", "motion_left_y_px",
+                                             "motion_right_x_px", "motion_right_y_px"}));
+  FrameRecord f;
+  f.sides[protocol::Index(protocol::Side::kLeft)] = {1.0, 2.0, 3.0, 4.0};
+  f.sides[protocol::Index(protocol::Side::kRight)] = {5.0, 6.0, 7.0, 8.0};
+  std::map<std::string, Value> read;
+  for (const FrameValue& v : FrameValues()) read[v.name] = v.of(f);
+  EXPECT_EQ(read["r_left_px"], Value(1.0));
+  EXPECT_EQ(read["floor_sigma_left_px"], Value(2.0));
+  EXPECT_EQ(read["motion_left_y_px"], Value(4.0));
+  EXPECT_EQ(read["r_right_px"], Value(5.0));
+  EXPECT_EQ(read["motion_right_x_px"], Value(7.0));
+  EXPECT_EQ(read["motion_right_y_px"], Value(8.0));
+  EXPECT_EQ(read["y_mm"], Value());
+  // The runner's variables of a side land in that side's columns.
+  RecordedVariables v;
+  v.sides[protocol::Index(protocol::Side::kRight)].size_deg = 1.5;
+  v.sides[protocol::Index(protocol::Side::kLeft)].u_mm = 400;
+  EXPECT_EQ(VariablesJson(v).dump(), R"({"size_right_deg":1.5,"u_left_mm":400.0})");
 }
 
 }  // namespace

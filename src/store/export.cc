@@ -31,7 +31,7 @@ namespace {
 std::vector<ColumnDef> Defs(const std::vector<Column>& table, Place place) {
   std::vector<ColumnDef> defs;
   for (const Column& c : table)
-    if (c.place == place) defs.push_back({c.name, c.type, c.unit, c.allowed, c.meaning});
+    if (c.place == place) defs.push_back(ColumnDef{c});
   return defs;
 }
 
@@ -212,65 +212,69 @@ int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::p
   return ExportCsvWith(RecordColumns(), db_path, out_dir, note);
 }
 
-int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::path& db_path,
-                      const std::filesystem::path& out_dir, const ProgressNote& note) {
-  Note(note, RemoveStaleLeftovers(out_dir));
-  // A record of an earlier version is exported from a migrated copy in memory (the record itself is only read).
-  Database db = OpenRecordForReading(db_path);
+namespace {
 
-  // Pass 1: every design variable in the record (factor levels and the variables recorded with them, planned and as
-  // shown), with the codebook's type of each, so every participant gets the same columns.
+// Pass 1: every design variable in the record (factor levels and the variables recorded with them, planned and as
+// shown) that no typed column keeps, with the codebook's type of each, so every participant gets the same columns.
+std::map<std::string, TypeOf> DesignVariables(const std::vector<Column>& table, Database& db,
+                                              const std::filesystem::path& db_path) {
   std::map<std::string, TypeOf> keys;
-  {
-    Statement factors(db, "SELECT t.session_id, t.trial_index, t.factors, coalesce(r.shown, '{}') FROM trials t "
-                          "LEFT JOIN responses r ON r.trial_id = t.id");
-    while (factors.Step()) {
-      const std::string where = Where(db_path, factors.GetInt64(0), factors.GetInt64(1));
-      for (int column : {2, 3}) {
-        Json object = ParseColumn(factors.GetText(column), where + (column == 2 ? " factors" : " shown"));
-        if (column == 2) SpreadObjectLevels(&object);
-        if (!object.is_object())
-          throw InputError(where, std::string(column == 2 ? "factors" : "shown") + " must be a JSON object");
-        for (const auto& item : object.items())
-          if (!TypedVariable(table, item.key())) keys[item.key()].Add(item.value());
-      }
+  Statement factors(db, "SELECT t.session_id, t.trial_index, t.factors, coalesce(r.shown, '{}') FROM trials t "
+                        "LEFT JOIN responses r ON r.trial_id = t.id");
+  while (factors.Step()) {
+    const std::string where = Where(db_path, factors.GetInt64(0), factors.GetInt64(1));
+    for (int column : {2, 3}) {
+      Json object = ParseColumn(factors.GetText(column), where + (column == 2 ? " factors" : " shown"));
+      if (column == 2) SpreadObjectLevels(&object);
+      if (!object.is_object())
+        throw InputError(where, std::string(column == 2 ? "factors" : "shown") + " must be a JSON object");
+      for (const auto& item : object.items())
+        if (!TypedVariable(table, item.key())) keys[item.key()].Add(item.value());
     }
   }
-  // Between-subject groups and participant information, when any session has them: a column "group" and one
-  // "info_KEY" per key given anywhere.
-  const bool groups = db.QueryInt64("SELECT count(*) FROM sessions WHERE group_name <> ''") > 0;
-  // Read once: each session's answers, and per key the codebook's type of them.
-  std::map<std::string, TypeOf> info_keys;
-  std::map<int64_t, std::map<std::string, std::string>> info_of;
-  {
-    Statement info(db, "SELECT session_id, key, value FROM session_info");
-    while (info.Step()) {
-      const std::string key = info.GetText(1), value = info.GetText(2);
-      info_of[info.GetInt64(0)][key] = value;
-      Json parsed;
-      try {
-        parsed = ParseJson(value, key);  // nesting scanned first (a hand-edited record's)
-      } catch (const std::exception&) {
-        parsed = value;
-      }
-      info_keys[key].Add(parsed.is_number() ? parsed : Json(value));
-    }
-  }
+  return keys;
+}
 
-  // The header and the codebook, from the same definitions.
+// The participant information, read once: each session's answers, and per key the codebook's type of them.
+struct SessionInfo {
+  std::map<std::string, TypeOf> keys;
+  std::map<int64_t, std::map<std::string, std::string>> of;
+};
+SessionInfo ReadSessionInfo(Database& db) {
+  SessionInfo read;
+  Statement info(db, "SELECT session_id, key, value FROM session_info");
+  while (info.Step()) {
+    const std::string key = info.GetText(1), value = info.GetText(2);
+    read.of[info.GetInt64(0)][key] = value;
+    Json parsed;
+    try {
+      parsed = ParseJson(value, key);  // nesting scanned first (a hand-edited record's)
+    } catch (const std::exception&) {
+      parsed = value;
+    }
+    read.keys[key].Add(parsed.is_number() ? parsed : Json(value));
+  }
+  return read;
+}
+
+// trials.csv's columns, for its header and the codebook alike: the session's, a group column and one info_KEY per
+// key of participant information when any session has them, the trial's, the design's variables (`variables`, each
+// key as the record holds it, set in the same order) and the answer's.
+std::vector<ColumnDef> TrialsColumns(const std::vector<Column>& table, Database& db, bool groups,
+                                     const SessionInfo& info, const std::map<std::string, TypeOf>& keys,
+                                     std::vector<std::string>* variables) {
   std::vector<ColumnDef> columns = Defs(table, Place::kSession);
   if (groups) columns.push_back({"group", "string", "", "", "the between-subject group the session ran"});
-  for (const auto& [key, type] : info_keys)
+  for (const auto& [key, type] : info.keys)
     columns.push_back({"info_" + key, type.Type(), "", type.Allowed(), "participant information: " + key});
   const std::vector<ColumnDef> trial_columns = Defs(table, Place::kTrial);
   columns.insert(columns.end(), trial_columns.begin(), trial_columns.end());
-  std::vector<std::string> variable_names;
   for (const auto& [key, type] : keys) {
     // A recorded variable keeps its name; a level named like one (the runner records it as factor_NAME; a record of
     // before that holds it under its own name where no recorded variable took it) gets the same prefix.
     const Column* known = RecordedVariable(table, key);
     const std::string name = known ? key : DesignColumn(key);
-    variable_names.push_back(key);
+    variables->push_back(key);
     const std::string level = key.rfind("factor_", 0) == 0 && IsRecordedName(key.substr(7)) ? key.substr(7) : key;
     // A recorded measurement takes any value; a name (kernel, plan) or a level of the design one of those seen.
     if (known)
@@ -286,16 +290,116 @@ int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::p
   const std::vector<ColumnDef> answer_columns = Defs(table, Place::kAnswer);
   columns.insert(columns.end(), answer_columns.begin(), answer_columns.end());
   ApplyDesign(db, &columns);
+  return columns;
+}
+
+// The answer split by what it is: one cell per kind of answer, each of one type, decided when it is exported.
+struct AnswerCells {
+  std::string status, side, more_blurred, interval, yes_no, rating, level;
+
+  // `answered`: the trial has a response; `choice` its text; `task` the trial's task word (an unknown word is read
+  // as a side or interval, as forced choice); `radii` each side's radius it is judged by (photo px; none: unknown).
+  AnswerCells(bool answered, const std::string& choice, const std::string& task,
+              const std::array<std::optional<double>, 2>& radii) {
+    const std::optional<protocol::Task> parsed = protocol::ParseWord<protocol::Task>(task);
+    const protocol::TaskAnswer kind = parsed ? protocol::TraitsOf(*parsed).answer : protocol::TaskAnswer::kSide;
+    status = !answered                  ? "unanswered"
+             : choice == kChoiceNone    ? "timed_out"
+             : choice == kChoiceSkipped ? "skipped"
+                                        : "answered";
+    if (status == "answered") {
+      switch (kind) {
+        case protocol::TaskAnswer::kLevel: level = choice; break;
+        case protocol::TaskAnswer::kYesNo: yes_no = choice; break;
+        case protocol::TaskAnswer::kRatingPoint: rating = choice; break;
+        case protocol::TaskAnswer::kSide: (AllDigits(choice) ? interval : side) = choice; break;
+      }
+    }
+    const std::optional<double>& l = radii[protocol::Index(protocol::Side::kLeft)];
+    const std::optional<double>& r = radii[protocol::Index(protocol::Side::kRight)];
+    if (const auto chosen = protocol::ParseWord<protocol::Side>(side); chosen && l && r)
+      if (std::abs(*l - *r) > 1e-9) more_blurred = ((*chosen == protocol::Side::kLeft) == (*l > *r)) ? "1" : "0";
+  }
+  // The cell of a column decided from the answer; none for another column.
+  std::optional<std::string> Of(Answer answer) const {
+    switch (answer) {
+      case Answer::kStatus: return status;
+      case Answer::kChosenSide: return side;
+      case Answer::kChoseMoreBlurred: return more_blurred;
+      case Answer::kChosenInterval: return interval;
+      case Answer::kYesNo: return yes_no;
+      case Answer::kRating: return rating;
+      case Answer::kAdjustedLevel: return level;
+      case Answer::kNone: break;
+    }
+    return std::nullopt;
+  }
+};
+
+// A column's cell read from the record at `i`, as the table says it is written (NULL: Column::if_null).
+std::string KeptCell(Statement& rows, int i, const Column& c) {
+  if (rows.IsNull(i)) return c.if_null;
+  switch (c.cell) {
+    case Cell::kInteger: return std::to_string(rows.GetInt64(i));
+    case Cell::kNumber: return Number(rows.GetDouble(i));
+    case Cell::kSeed: return "s" + std::to_string(static_cast<uint64_t>(rows.GetInt64(i)));
+    case Cell::kText:
+    case Cell::kAnswer: break;
+  }
+  return rows.GetText(i);
+}
+
+// The adjustment path of a trial, long: one row of adjustments.csv per step.
+std::string AdjustmentRows(const std::string& study, const std::string& participant, int64_t session, int64_t trial,
+                           const Json& steps) {
+  std::string rows;
+  if (!steps.is_array()) return rows;
+  for (size_t i = 0; i < steps.size(); ++i)
+    rows += CsvLine({study, participant, std::to_string(session), std::to_string(trial), std::to_string(i + 1),
+                     steps[i].is_object() ? TidyCell(steps[i].value("level", Json())) : "",
+                     steps[i].is_object() ? TidyCell(steps[i].value("t_ms", Json())) : ""});
+  return rows;
+}
+
+// The codebook's rows of trials.csv (`columns`), adjustments.csv and frames.csv: a design's column with its role.
+std::string CodebookRows(const std::vector<ColumnDef>& columns) {
+  std::string codebook = CsvLine({"table", "column", "type", "unit", "allowed", "meaning", "role"});
+  for (const auto& c : columns) codebook += CodebookRow("trials.csv", c, c.role);
+  for (const auto& c : AdjustmentColumns()) codebook += CodebookRow("adjustments.csv", c);
+  for (const auto& [c, select, cell] : FrameColumns()) codebook += CodebookRow("frames.csv", c);
+  return codebook;
+}
+
+}  // namespace
+
+int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::path& db_path,
+                      const std::filesystem::path& out_dir, const ProgressNote& note) {
+  Note(note, RemoveStaleLeftovers(out_dir));
+  // A record of an earlier version is exported from a migrated copy in memory (the record itself is only read).
+  Database db = OpenRecordForReading(db_path);
+  const std::map<std::string, TypeOf> keys = DesignVariables(table, db, db_path);
+  // Between-subject groups and participant information, when any session has them.
+  const bool groups = db.QueryInt64("SELECT count(*) FROM sessions WHERE group_name <> ''") > 0;
+  SessionInfo info = ReadSessionInfo(db);
+  // The header and the codebook, from the same definitions.
+  std::vector<std::string> variable_names;
+  const std::vector<ColumnDef> columns = TrialsColumns(table, db, groups, info, keys, &variable_names);
   std::vector<std::string> header;
   for (const auto& c : columns) header.push_back(c.name);
   std::string text = CsvLine(header);
-  std::string adjustments = CsvLine({"study", "participant", "session_id", "trial_index", "step", "level", "t_ms"});
+  header.clear();
+  for (const auto& c : AdjustmentColumns()) header.push_back(c.name);
+  std::string adjustments = CsvLine(header);
 
   // What every row needs (who, which trial, its variables, the answer and the radii it is judged by), then each
   // column of the table that is read from the record, as it says (SelectOf), at `at[column]`.
   std::string select = "SELECT st.name, p.code, s.id, t.trial_index, t.factors, coalesce(r.shown, '{}'), r.id IS NULL, "
-                       "r.choice, coalesce(t.task, ''), coalesce(r.r_left_px, t.r_left_px), "
-                       "coalesce(r.r_right_px, t.r_right_px), r.adjustment, s.group_name";
+                       "r.choice, coalesce(t.task, '')";
+  for (const protocol::Side side : protocol::Vocabulary<protocol::Side>::values) {
+    const std::string r = SideColumn("r", side, "px");
+    select += ", coalesce(r." + r + ", t." + r + ")";
+  }
+  select += ", r.adjustment, s.group_name";
   std::map<const Column*, int> at;
   int next = 13;
   for (const Column& c : table)
@@ -314,64 +418,26 @@ int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::p
     const int64_t session = rows.GetInt64(2);
     const int64_t trial = rows.GetInt64(3);
     const std::string where = Where(db_path, session, trial);
-    // The answer, split by what it is: one column per kind of answer, each of one type.
     const bool answered = rows.GetInt64(6) == 0;
-    const std::string choice = answered ? rows.GetText(7) : "";
-    // The task's kind of answer (a record's task column holds a word of the task vocabulary; an unknown word is
-    // read as a side or interval, as forced choice).
-    const std::optional<protocol::Task> task = protocol::ParseWord<protocol::Task>(rows.GetText(8));
-    const protocol::TaskAnswer kind = task ? protocol::TraitsOf(*task).answer : protocol::TaskAnswer::kSide;
-    const std::string status = !answered                  ? "unanswered"
-                               : choice == kChoiceNone    ? "timed_out"
-                               : choice == kChoiceSkipped ? "skipped"
-                                                          : "answered";
-    std::string side, more_blurred, interval, yes_no, rating, level;
-    if (status == "answered") {
-      switch (kind) {
-        case protocol::TaskAnswer::kLevel: level = choice; break;
-        case protocol::TaskAnswer::kYesNo: yes_no = choice; break;
-        case protocol::TaskAnswer::kRatingPoint: rating = choice; break;
-        case protocol::TaskAnswer::kSide: (AllDigits(choice) ? interval : side) = choice; break;
-      }
-    }
-    if (const auto chosen = protocol::ParseWord<protocol::Side>(side); chosen && !rows.IsNull(9) && !rows.IsNull(10)) {
-      const double l = rows.GetDouble(9), r = rows.GetDouble(10);
-      if (std::abs(l - r) > 1e-9) more_blurred = ((*chosen == protocol::Side::kLeft) == (l > r)) ? "1" : "0";
-    }
+    std::array<std::optional<double>, 2> radii;
+    for (size_t k = 0; k < 2; ++k)
+      if (!rows.IsNull(9 + int(k))) radii[k] = rows.GetDouble(9 + int(k));
+    const AnswerCells answer(answered, answered ? rows.GetText(7) : "", rows.GetText(8), radii);
     // A column's cell as the table says it is read.
-    auto cell = [&](const Column& c) -> std::string {
-      switch (c.answer) {
-        case Answer::kStatus: return status;
-        case Answer::kChosenSide: return side;
-        case Answer::kChoseMoreBlurred: return more_blurred;
-        case Answer::kChosenInterval: return interval;
-        case Answer::kYesNo: return yes_no;
-        case Answer::kRating: return rating;
-        case Answer::kAdjustedLevel: return level;
-        case Answer::kNone: break;
-      }
-      const int i = at.at(&c);
-      if (rows.IsNull(i)) return c.if_null;
-      switch (c.cell) {
-        case Cell::kInteger: return std::to_string(rows.GetInt64(i));
-        case Cell::kNumber: return Number(rows.GetDouble(i));
-        case Cell::kSeed: return "s" + std::to_string(static_cast<uint64_t>(rows.GetInt64(i)));
-        case Cell::kText:
-        case Cell::kAnswer: break;
-      }
-      return rows.GetText(i);
-    };
     auto cells_of = [&](Place place, std::vector<std::string>* cells) {
       for (const Column& c : table)
-        if (c.place == place) cells->push_back(cell(c));
+        if (c.place == place) {
+          const std::optional<std::string> decided = answer.Of(c.answer);
+          cells->push_back(decided ? *decided : KeptCell(rows, at.at(&c), c));
+        }
     };
     std::vector<std::string> cells;
     cells_of(Place::kSession, &cells);
     if (groups) cells.push_back(rows.GetText(12));
-    for (const auto& [key, type] : info_keys) {
-      const auto& info = info_of[session];
-      const auto it = info.find(key);
-      cells.push_back(it == info.end() ? std::string() : it->second);
+    for (const auto& [key, type] : info.keys) {
+      const auto& given = info.of[session];
+      const auto it = given.find(key);
+      cells.push_back(it == given.end() ? std::string() : it->second);
     }
     cells_of(Place::kTrial, &cells);
     // The plan's variables, with what the trial showed when it was shown laid over them (adaptive levels).
@@ -384,25 +450,12 @@ int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::p
       cells.push_back(factors.contains(key) ? TidyCell(factors.at(key)) : std::string());
     cells_of(Place::kAnswer, &cells);
     text += CsvLine(cells);
-    // The adjustment path, long: one row per step.
-    if (answered && !rows.IsNull(11)) {
-      const Json steps = ParseColumn(rows.GetText(11), where + " adjustment");
-      if (steps.is_array())
-        for (size_t i = 0; i < steps.size(); ++i)
-          adjustments += CsvLine({rows.GetText(0), rows.GetText(1), std::to_string(session), std::to_string(trial),
-                                  std::to_string(i + 1), steps[i].is_object() ? TidyCell(steps[i].value("level", Json())) : "",
-                                  steps[i].is_object() ? TidyCell(steps[i].value("t_ms", Json())) : ""});
-    }
+    if (answered && !rows.IsNull(11))
+      adjustments += AdjustmentRows(rows.GetText(0), rows.GetText(1), session, trial,
+                                    ParseColumn(rows.GetText(11), where + " adjustment"));
     ++count;
   }
-  // The codebook: every column of every table this export writes; a design's column with its role.
-  std::string codebook = CsvLine({"table", "column", "type", "unit", "allowed", "meaning", "role"});
-  for (const auto& c : columns)
-    codebook += CsvLine({"trials.csv", c.name, c.type, c.unit, c.allowed, c.meaning, c.role});
-  for (const auto& c : AdjustmentColumns())
-    codebook += CsvLine({"adjustments.csv", c.name, c.type, c.unit, c.allowed, c.meaning, ""});
-  for (const auto& [c, select, cell] : FrameColumns())
-    codebook += CsvLine({"frames.csv", c.name, c.type, c.unit, c.allowed, c.meaning, ""});
+  std::string codebook = CodebookRows(columns);
   // Every table of one export appears together: a kill leaves the previous export whole, never its frames.csv
   // beside a new trials.csv.
   WriteFolderAtomically(

@@ -119,7 +119,7 @@ std::string WriteProcedures(Database& db, const std::filesystem::path& out_dir) 
   WriteFileAtomically(out_dir / "procedures.csv", text);
   std::string codebook;
   for (const auto& c : ProcedureColumns())
-    codebook += CsvLine({"procedures.csv", c.name, c.type, c.unit, c.allowed, c.meaning, ""});
+    codebook += CodebookRow("procedures.csv", c);
   return codebook;
 }
 

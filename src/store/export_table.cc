@@ -144,11 +144,11 @@ std::string WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
         {"planned", "integer", "", ">= 0", "trials planned, practice apart"},
         {"answered", "integer", "", ">= 0", "trials answered, practice apart"},
         {"median_rt_ms", "number", "ms", ">= 0", "the median response time of the answered trials"}};
-    for (const auto& c : columns) codebook += CsvLine({file, c.name, c.type, c.unit, c.allowed, c.meaning, ""});
+    for (const auto& c : columns) codebook += CodebookRow(file, c);
     for (const auto& name : answer_names[study])
-      codebook += CsvLine({file, "n_" + name, "integer", "", ">= 0",
-                           "how often the answer " + name + " was given (forced choice: the source chosen, or "
-                           "cant_tell; adjustment: the level accepted)", ""});
+      codebook += CodebookRow(file, {"n_" + name, "integer", "", ">= 0",
+                                     "how often the answer " + name + " was given (forced choice: the source chosen, "
+                                     "or cant_tell; adjustment: the level accepted)"});
     std::string text = CsvLine(header);
     for (auto& [session, row] : sessions) {
       std::sort(row.rts.begin(), row.rts.end());
@@ -163,6 +163,10 @@ std::string WriteSummaries(Database& db, const std::filesystem::path& out_dir) {
     WriteFileAtomically(out_dir / file, text);
   }
   return codebook;
+}
+
+std::string CodebookRow(const std::string& table, const ColumnSpec& column, const std::string& role) {
+  return CsvLine({table, column.name, column.type, column.unit, column.allowed, column.meaning, role});
 }
 
 // The columns of adjustments.csv and frames.csv, for their writers and the codebook.
@@ -191,7 +195,7 @@ const std::vector<FrameColumn>& FrameColumns() {
     };
     // The frame's recorded values, as the record keeps them.
     for (const FrameValue& v : FrameValues())
-      c.push_back({{v.name, v.type, v.unit, v.allowed, v.meaning}, "f." + v.name,
+      c.push_back({ColumnDef{v}, "f." + v.name,
                    v.sql == "TEXT" ? Cell::kText : v.sql == "REAL" ? Cell::kNumber : Cell::kInteger});
     return c;
   }();

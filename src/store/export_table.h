@@ -13,13 +13,14 @@
 
 namespace blurcue::store {
 
-// What the codebook says of a column: its type (string, integer, number, boolean - 0 or 1 -, datetime - ISO 8601
-// UTC), unit, allowed values and meaning. The tables are written from these definitions and the codebook is written
-// from the same ones, so the two cannot drift.
-struct ColumnDef {
-  std::string name, type, unit, allowed, meaning;
+// A column of an exported table as the codebook says it (ColumnSpec), with a design column's role. The tables are
+// written from these definitions and the codebook is written from the same ones, so the two cannot drift.
+struct ColumnDef : ColumnSpec {
   std::string role = "";  // a design's column: within, group, procedure_cell, label or practice (the design table's)
 };
+
+// The codebook's row (table, column, type, unit, allowed, meaning, role) of `column` of `table` (e.g. "frames.csv").
+std::string CodebookRow(const std::string& table, const ColumnSpec& column, const std::string& role = "");
 
 
 // A JSON value as a cell: strings bare, null empty, anything else as compact JSON.

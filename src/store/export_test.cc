@@ -41,8 +41,8 @@ void RunSession(Record& record, const std::string& participant, const std::strin
     t.index = i;
     t.block = i / 2;
     t.factors_json = factors_json;
-    t.left_json = R"("measured")";
-    t.right_json = R"({"screen_px":2.5})";
+    t.source_json[0] = R"("measured")";
+    t.source_json[1] = R"({"screen_px":2.5})";
     trials.push_back(t);
   }
   record.SaveTrialList(session, trials);
@@ -256,8 +256,8 @@ TEST(Merge, AnOlderAndANewRecordMergeWithTheirTypedColumns) {
     const int64_t session = record.StartOrResumeSession("s", "P2", "{}", 9, meta, false).session_id;
     std::vector<TrialRecord> trials(1);
     trials[0].block_name = "b";
-    trials[0].r_left_px = 1.23456789;
-    trials[0].left_json = R"("estimated")";
+    trials[0].r_px[0] = 1.23456789;
+    trials[0].source_json[0] = R"("estimated")";
     record.SaveTrialList(session, trials);
   }
   MergeDatabases({dir / "old.sqlite", dir / "new.sqlite"}, dir / "all.sqlite");
@@ -458,8 +458,8 @@ int64_t StartHalfASession(Record& record) {
   for (int i = 0; i < 4; ++i) {
     trials[i].index = i;
     trials[i].factors_json = "{}";
-    trials[i].left_json = R"("measured")";
-    trials[i].right_json = R"("none")";
+    trials[i].source_json[0] = R"("measured")";
+    trials[i].source_json[1] = R"("none")";
   }
   record.SaveTrialList(session, trials);
   for (int i = 0; i < 2; ++i) {

@@ -1,5 +1,6 @@
 #include "store/frame_columns.h"
 
+#include "protocol/vocabulary.h"
 #include "store/sqlite.h"
 
 namespace blurcue::store {
@@ -21,50 +22,72 @@ std::string StatusAllowed() {
 
 }  // namespace
 
-const std::vector<FrameValue>& FrameValues() {
+namespace {
+
+// One quantity of each side in photo px (FrameSide's member): its two columns, named by SideColumn, in the table's
+// order. `meaning` gives a side's text of the codebook.
+void AddSides(std::vector<FrameValue>* values, const std::string& quantity, const std::string& suffix,
+              std::optional<double> FrameSide::*member, const std::string& allowed, int since,
+              const std::function<std::string(protocol::Side)>& meaning) {
+  for (const protocol::Side side : protocol::Vocabulary<protocol::Side>::values)
+    values->push_back(
+        {SideColumn(quantity, side, suffix), "number", "photo px", allowed, meaning(side), "REAL", "", since,
+         [member, k = protocol::Index(side)](const FrameRecord& f) { return Maybe(f.sides[k].*member); }});
+}
+
+// long: a data table, one row per column of frames.csv.
+std::vector<FrameValue> MakeFrameValues() {
   using F = FrameRecord;
-  static const std::vector<FrameValue> values = {
+  using protocol::Side;
+  std::vector<FrameValue> values = {
       {"frame_index", "integer", "", ">= 0", "the frame's place in the trial", "INTEGER", "", 1,
        [](const F& f) { return Value(f.frame_index); }},
       {"flip_time_s", "number", "s", ">= 0", "when the frame reached the screen, from the trial's first flip", "REAL",
        "", 1, [](const F& f) { return Value(f.flip_time_s); }},
       {"dropped", "boolean", "", "0|1", "1: more than 1.5 refresh periods after the frame before (window only)",
        "INTEGER", "", 1, [](const F& f) { return Value(int64_t(f.dropped ? 1 : 0)); }},
-      {"r_left_px", "number", "photo px", ">= 0",
-       "the left object's blur radius as drawn in this frame (without the motion; under a streak at least the width "
-       "the streak is drawn with across it, up to 1 screen px); empty: not shown",
-       "REAL", "", 4, [](const F& f) { return Maybe(f.r_left_px); }},
-      {"r_right_px", "number", "photo px", ">= 0", "the right object's blur radius in this frame; empty: not shown",
-       "REAL", "", 4, [](const F& f) { return Maybe(f.r_right_px); }},
-      {"y_mm", "number", "mm", "", "the objects' place along the board's y in this frame (0 at edge 1)", "REAL", "", 4,
-       [](const F& f) { return Maybe(f.y_mm); }},
+  };
+  AddSides(&values, "r", "px", &FrameSide::r_px, ">= 0", 4, [](Side side) -> std::string {
+    if (side == Side::kRight) return "the right object's blur radius in this frame; empty: not shown";
+    return "the left object's blur radius as drawn in this frame (without the motion; under a streak at least the "
+           "width the streak is drawn with across it, up to 1 screen px); empty: not shown";
+  });
+  values.push_back({"y_mm", "number", "mm", "", "the objects' place along the board's y in this frame (0 at edge 1)",
+                    "REAL", "", 4, [](const F& f) { return Maybe(f.y_mm); }});
+  values.push_back(
       {"take_frame", "integer", "", ">= 0",
        "a study on video: the take's frame at this moment (its index in track.csv; past the take's end its last); "
        "when held, the photo and objects on screen are those of the last frame with a pose before it; empty for a "
        "photo",
-       "INTEGER",
-       "take_frame >= 0", 9,
-       [](const F& f) { return f.take_frame ? Value(*f.take_frame) : Value(); }},
+       "INTEGER", "take_frame >= 0", 9, [](const F& f) { return f.take_frame ? Value(*f.take_frame) : Value(); }});
+  values.push_back(
       {"take_status", "string", "", StatusAllowed(),
        "a study on video: the take frame's status (found or tracked: shown at its own pose; held: a lost frame or one "
        "past the take's end, showing the last frame with a pose); empty for a photo",
-       "TEXT", StatusCheck(), 9, [](const F& f) { return f.take_status ? Value(*f.take_status) : Value(); }},
-      {"floor_sigma_left_px", "number", "photo px", ">= 0",
-       "the lens floor (std) inside the left object's radius in this frame; empty: not shown", "REAL", "", 9,
-       [](const F& f) { return Maybe(f.floor_sigma_left_px); }},
-      {"floor_sigma_right_px", "number", "photo px", ">= 0", "... the right object's", "REAL", "", 9,
-       [](const F& f) { return Maybe(f.floor_sigma_right_px); }},
-      {"motion_left_x_px", "number", "photo px", "",
-       "the left object's motion streak in this frame (its image velocity x the exposure: its own motion's and, on "
-       "video, the camera's), x right; empty: not shown",
-       "REAL", "", 9, [](const F& f) { return Maybe(f.motion_left_x_px); }},
-      {"motion_left_y_px", "number", "photo px", "", "... y down", "REAL", "", 9,
-       [](const F& f) { return Maybe(f.motion_left_y_px); }},
-      {"motion_right_x_px", "number", "photo px", "", "the right object's, x right", "REAL", "", 9,
-       [](const F& f) { return Maybe(f.motion_right_x_px); }},
-      {"motion_right_y_px", "number", "photo px", "", "... y down", "REAL", "", 9,
-       [](const F& f) { return Maybe(f.motion_right_y_px); }},
-  };
+       "TEXT", StatusCheck(), 9, [](const F& f) { return f.take_status ? Value(*f.take_status) : Value(); }});
+  AddSides(&values, "floor_sigma", "px", &FrameSide::floor_sigma_px, ">= 0", 9, [](Side side) -> std::string {
+    if (side == Side::kRight) return "... the right object's";
+    return "the lens floor (std) inside the left object's radius in this frame; empty: not shown";
+  });
+  // A streak's x and y of one side, then the other's.
+  for (const Side side : protocol::Vocabulary<Side>::values) {
+    const size_t k = protocol::Index(side);
+    values.push_back({SideColumn("motion", side, "x_px"), "number", "photo px", "",
+                      side == Side::kLeft
+                          ? "the left object's motion streak in this frame (its image velocity x the exposure: its own "
+                            "motion's and, on video, the camera's), x right; empty: not shown"
+                          : "the right object's, x right",
+                      "REAL", "", 9, [k](const F& f) { return Maybe(f.sides[k].motion_x_px); }});
+    values.push_back({SideColumn("motion", side, "y_px"), "number", "photo px", "", "... y down", "REAL", "", 9,
+                      [k](const F& f) { return Maybe(f.sides[k].motion_y_px); }});
+  }
+  return values;
+}
+
+}  // namespace
+
+const std::vector<FrameValue>& FrameValues() {
+  static const std::vector<FrameValue> values = MakeFrameValues();
   return values;
 }
 

@@ -3,7 +3,9 @@
 // value with its SQL type and CHECK, the schema version that added it and its row of the codebook. Generated from it:
 // the migration that adds version 9's, the record's INSERT, the merge's copy, and frames.csv's columns after the
 // session's and the trial's.
+#include <array>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,31 +14,36 @@
 
 namespace blurcue::store {
 
+// What a frame showed on one side of a pair: the blur radius (photo px) and, schema 9, the lens floor (std) and the
+// motion streak (photo px, x right, y down); empty for a side not shown (a ball wiped at the end of its section) and
+// for pictures. Recorded as r_SIDE_px, floor_sigma_SIDE_px, motion_SIDE_x_px, motion_SIDE_y_px (SideColumn).
+struct FrameSide {
+  std::optional<double> r_px, floor_sigma_px, motion_x_px, motion_y_px;
+};
+
 struct FrameRecord {
   int64_t frame_index = 0;
   double flip_time_s = 0;
   bool dropped = false;
-  // What the frame showed of a pair: each side's blur radius (photo px) and the objects' place along the board's y
-  // (mm); empty for a side not shown (a ball wiped at the end of its section) and for pictures.
-  std::optional<double> r_left_px, r_right_px, y_mm;
+  // What the frame showed of a pair, indexed by protocol::Index(side).
+  std::array<FrameSide, 2> sides;
+  // The objects' place along the board's y (mm); empty for pictures.
+  std::optional<double> y_mm;
   // Schema 9. A study on video: the take's frame on screen and its status (found, tracked, or held: a lost frame or
-  // one past the take's end, showing the last frame with a pose); empty for a photo's study. Each side shown: its
-  // lens floor (std) and motion streak (photo px, x right, y down) in this frame.
+  // one past the take's end, showing the last frame with a pose); empty for a photo's study.
   std::optional<int64_t> take_frame;
   std::optional<std::string> take_status;
-  std::optional<double> floor_sigma_left_px, floor_sigma_right_px, motion_left_x_px, motion_left_y_px,
-      motion_right_x_px, motion_right_y_px;
 };
 
 // The take statuses a frame may record (take_status's CHECK and the codebook's allowed values).
 inline constexpr const char* kTakeStatuses[] = {"found", "tracked", "held"};
 
-struct FrameValue {
-  std::string name;                  // the column, in the frames table and frames.csv
-  std::string type, unit, allowed, meaning;  // the codebook's
+// A frame's value: its column in the frames table and frames.csv (ColumnSpec: name and codebook), its SQL type and
+// CHECK, the schema version that added it and how it is read from a FrameRecord.
+struct FrameValue : ColumnSpec {
   std::string sql, check;            // INTEGER | REAL | TEXT; "" = no CHECK
   int since = 1;                     // the schema version that added it (1: the table's own)
-  Value (*of)(const FrameRecord&) = nullptr;
+  std::function<Value(const FrameRecord&)> of;
 };
 
 // In the table's order.

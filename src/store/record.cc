@@ -288,6 +288,128 @@ std::string DisplayChanges(const std::string& recorded, const std::string& given
   return name_a.dump() + ", got " + name_b.dump() + " (" + (a == b ? "the same values" : JsonChanges(a, b)) + ")";
 }
 
+// A participant's running session as the resume rules read it: its protocol version, seed, observer, clock and
+// display (NULL in records from before they were recorded), and its group and number.
+struct RunningSession {
+  int64_t id = 0;
+  uint64_t seed = 0;
+  std::string hash, json;  // its protocol version's hash and canonical text
+  std::optional<std::string> observer, observer_params, display_profile, group;
+  std::optional<int64_t> window, number;
+};
+
+// The participant's latest running session, if any.
+std::optional<RunningSession> FindRunning(Database& db, int64_t participant_id) {
+  Statement running(db, "SELECT s.id, s.seed, p.hash, p.json, s.observer, s.observer_params, s.display_profile, "
+                        "s.group_name, s.window, s.session_number "
+                        "FROM sessions s "
+                        "JOIN protocol_versions p "
+                        "ON p.id = s.protocol_version_id WHERE s.participant_id = ? AND s.status = 'running' "
+                        "ORDER BY s.id DESC LIMIT 1");
+  running.Bind(1, participant_id);
+  if (!running.Step()) return std::nullopt;
+  auto text = [&](int i) { return running.IsNull(i) ? std::nullopt : std::optional<std::string>(running.GetText(i)); };
+  auto number = [&](int i) { return running.IsNull(i) ? std::nullopt : std::optional<int64_t>(running.GetInt64(i)); };
+  RunningSession r;
+  r.id = running.GetInt64(0);
+  r.seed = static_cast<uint64_t>(running.GetInt64(1));
+  r.hash = running.GetText(2);
+  r.json = running.GetText(3);
+  r.observer = text(4), r.observer_params = text(5), r.display_profile = text(6), r.group = text(7);
+  r.window = number(8), r.number = number(9);
+  return r;
+}
+
+// The resume rules: a session continues only as it started - under the same protocol text, seed, observer, clock and
+// display profile, or the trials it made and the times it recorded would be another session's. Throws Error(kInput)
+// on `db`, naming what differs and how to resume or close it (`abort_hint` and the session's id).
+void CheckResumesAsStarted(const std::string& db, const RunningSession& r, const std::string& canonical,
+                           const std::string& hash, uint64_t seed, const SessionMeta& meta,
+                           const std::string& abort_hint) {
+  const std::string session = SessionName(r.id), close = abort_hint + std::to_string(r.id) + " (its answers are kept)";
+  if (r.hash != hash)
+    throw InputError(db, session + " was started with another version of the protocol (" +
+                             ProtocolChanges(r.json, canonical) +
+                             "); run it with the protocol it started with, or close it with " + close);
+  if (r.seed != seed)
+    throw InputError(db, session + " was started with seed " + std::to_string(r.seed) + ", got seed " +
+                             std::to_string(seed));
+  // The session row names one observer: a resumed session answered by another would be recorded as the first.
+  // Parameters are compared in their canonical form (procedure::ToString), so an equivalent spec resumes.
+  if (r.observer) {
+    auto observer = [](bool simulated, const std::string& params) {
+      return simulated ? "--observer " + params : std::string("a person (no --observer)");
+    };
+    const bool stored_simulated = *r.observer == "simulated";
+    // A record from before model= holds sim:jnd=...: read in today's canonical form, so the spelling the message
+    // suggests resumes it.
+    std::string stored_params = r.observer_params.value_or("");
+    if (stored_simulated && meta.canonical_observer) stored_params = meta.canonical_observer(stored_params);
+    if (stored_simulated != meta.simulated || (meta.simulated && stored_params != meta.observer_params))
+      throw InputError(db, session + " was started with " + observer(stored_simulated, stored_params) + ", got " +
+                               observer(meta.simulated, meta.observer_params) +
+                               "; resume it with the observer it started with, or close it with " + close);
+  }
+  // A simulated observer answers headless on a simulated clock or in a window on the real one: its times (rt_ms,
+  // flips) are of one kind or the other, never both in one session.
+  if (r.window && meta.simulated && (*r.window != 0) != meta.window) {
+    auto where = [](bool window) { return window ? std::string("in a window (--window)") : std::string("headless"); };
+    throw InputError(db, session + " was started " + where(*r.window != 0) + ", got " + where(meta.window) +
+                             "; resume it the way it started, or close it with " + close);
+  }
+  // Every radius in screen px and arcmin follows the display profile: another one would make other trials.
+  if (const std::string changes = DisplayChanges(r.display_profile.value_or("{}"), meta.display_profile);
+      !changes.empty())
+    throw InputError(db, session + " was started with display profile " + changes +
+                             "; resume it with the --display (or the protocol's display.profile) it started with, "
+                             "or close it with " + close);
+}
+
+// --resume with no running session: refused, saying what the participant has instead of starting a whole new
+// session unasked.
+[[noreturn]] void RefuseNothingToResume(Database& db, int64_t participant_id, const std::string& study,
+                                        const std::string& participant) {
+  Statement past(db, "SELECT status, count(*), max(id) FROM sessions WHERE participant_id = ? GROUP BY status");
+  past.Bind(1, participant_id);
+  std::string found;
+  while (past.Step())
+    found += std::string(found.empty() ? "" : ", ") + std::to_string(past.GetInt64(1)) + " " + past.GetText(0) +
+             " (last: session " + std::to_string(past.GetInt64(2)) + ")";
+  throw InputError(db.path(), "--resume: participant " + participant + " of study " + study +
+                                  " has no unfinished session to continue (" +
+                                  (found.empty() ? std::string("no sessions at all") : found) +
+                                  "); leave out --resume to start a new session" +
+                                  (found.find("completed") != std::string::npos ? ", with --again" : ""));
+}
+
+// A resumed session continues at its first unanswered trial; answers or frames past it mean the record was changed
+// outside blurcue (a deleted answer leaves a gap), and resuming would write over them or beside them: refused.
+void CheckNothingPastFirstUnanswered(Database& db, const SessionStart& start) {
+  const std::string s = std::to_string(start.session_id), f = std::to_string(start.first_unanswered_trial);
+  const int64_t past = db.QueryInt64(
+      "SELECT (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE t.session_id = " + s +
+      " AND t.trial_index >= " + f + ") + (SELECT COUNT(*) FROM frames fr JOIN trials t ON t.id = fr.trial_id "
+      "WHERE t.session_id = " + s + " AND t.trial_index >= " + f + ")");
+  if (past > 0)
+    throw InputError(db.path(), SessionName(start.session_id) + ": its first unanswered trial is " + f +
+                                    ", but the record holds answers or frames of trials after it (changed "
+                                    "outside blurcue?); it cannot be resumed");
+}
+
+// The participant information, one row per key (text as given; numbers as JSON text).
+void SaveParticipantInfo(Database& db, int64_t session, const std::string& participant_info) {
+  const Json info = ParseJson(participant_info, "participant information");
+  if (!info.is_object()) return;
+  Statement row(db, "INSERT INTO session_info (session_id, key, value) VALUES (?, ?, ?)");
+  for (const auto& [key, value] : info.items()) {
+    row.Bind(1, session);
+    row.Bind(2, key);
+    row.Bind(3, value.is_string() ? value.get<std::string>() : value.dump());
+    row.Run();
+    row.Reset();
+  }
+}
+
 }  // namespace
 
 SessionStart Record::StartOrResumeSession(const std::string& study, const std::string& participant,
@@ -300,19 +422,11 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
 
   const int64_t study_id = EnsureStudy(db_, study, now);
   const int64_t participant_id = EnsureParticipant(db_, study_id, participant, now);
-
-  Statement running(db_, "SELECT s.id, s.seed, p.hash, p.json, s.observer, s.observer_params, s.display_profile, s.group_name, "
-                         "s.window, s.session_number "
-                         "FROM sessions s "
-                         "JOIN protocol_versions p "
-                         "ON p.id = s.protocol_version_id WHERE s.participant_id = ? AND s.status = 'running' "
-                         "ORDER BY s.id DESC LIMIT 1");
-  running.Bind(1, participant_id);
   SessionStart start;
   start.seed = seed;
   const std::string abort_hint = "blurcue sessions --db " + db_.path() + " --abort ";
-  if (running.Step()) {
-    const int64_t session = running.GetInt64(0);
+  if (const std::optional<RunningSession> running = FindRunning(db_, participant_id)) {
+    const int64_t session = running->id;
     if (!resume) {
       // Another station starting the same participant a moment earlier holds it alive: --resume would only be
       // refused again, and --abort would close a session someone is answering.
@@ -325,66 +439,14 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
                                        SessionName(session) + "; continue it with --resume, or close it with " +
                                        abort_hint + std::to_string(session) + " (its answers are kept)");
     }
-    if (running.GetText(2) != hash)
-      throw InputError(db_.path(), SessionName(session) + " was started with another version of the protocol (" +
-                                       ProtocolChanges(running.GetText(3), canonical) +
-                                       "); run it with the protocol it started with, or close it with " +
-                                       abort_hint + std::to_string(session) + " (its answers are kept)");
-    const uint64_t stored_seed = static_cast<uint64_t>(running.GetInt64(1));
-    if (stored_seed != seed)
-      throw InputError(db_.path(), SessionName(session) + " was started with seed " + std::to_string(stored_seed) +
-                                       ", got seed " + std::to_string(seed));
-    // The session row names one observer: a resumed session answered by another would be recorded as the first.
-    // Parameters are compared in their canonical form (procedure::ToString), so an equivalent spec resumes.
-    if (!running.IsNull(4)) {
-      auto observer = [](bool simulated, const std::string& params) {
-        return simulated ? "--observer " + params : std::string("a person (no --observer)");
-      };
-      const bool stored_simulated = running.GetText(4) == "simulated";
-      // A record from before model= holds sim:jnd=...: read in today's canonical form, so the spelling the message
-      // suggests resumes it.
-      std::string stored_params = running.IsNull(5) ? "" : running.GetText(5);
-      if (stored_simulated && meta.canonical_observer) stored_params = meta.canonical_observer(stored_params);
-      if (stored_simulated != meta.simulated || (meta.simulated && stored_params != meta.observer_params))
-        throw InputError(db_.path(), SessionName(session) + " was started with " +
-                                         observer(stored_simulated, stored_params) + ", got " +
-                                         observer(meta.simulated, meta.observer_params) +
-                                         "; resume it with the observer it started with, or close it with " +
-                                         abort_hint + std::to_string(session) + " (its answers are kept)");
-    }
-    // A simulated observer answers headless on a simulated clock or in a window on the real one: its times (rt_ms,
-    // flips) are of one kind or the other, never both in one session.
-    if (!running.IsNull(8) && meta.simulated && (running.GetInt64(8) != 0) != meta.window) {
-      auto where = [](bool window) { return window ? std::string("in a window (--window)") : std::string("headless"); };
-      throw InputError(db_.path(), SessionName(session) + " was started " + where(running.GetInt64(8) != 0) +
-                                       ", got " + where(meta.window) + "; resume it the way it started, or close it "
-                                       "with " + abort_hint + std::to_string(session) + " (its answers are kept)");
-    }
-    // Every radius in screen px and arcmin follows the display profile: another one would make other trials.
-    if (const std::string changes = DisplayChanges(running.IsNull(6) ? "{}" : running.GetText(6), meta.display_profile);
-        !changes.empty())
-      throw InputError(db_.path(), SessionName(session) + " was started with display profile " + changes +
-                                       "; resume it with the --display (or the protocol's display.profile) it "
-                                       "started with, or close it with " + abort_hint + std::to_string(session) +
-                                       " (its answers are kept)");
+    CheckResumesAsStarted(db_.path(), *running, canonical, hash, seed, meta, abort_hint);
     TakeLock(session);
     start.session_id = session;
     start.resumed = true;
-    start.group = running.IsNull(7) ? "" : running.GetText(7);
-    start.session_number = running.IsNull(9) ? 1 : running.GetInt64(9);
+    start.group = running->group.value_or("");
+    start.session_number = running->number.value_or(1);
   } else if (resume) {
-    // Nothing to continue: say what there is instead of starting a whole new session unasked.
-    Statement past(db_, "SELECT status, count(*), max(id) FROM sessions WHERE participant_id = ? GROUP BY status");
-    past.Bind(1, participant_id);
-    std::string found;
-    while (past.Step())
-      found += std::string(found.empty() ? "" : ", ") + std::to_string(past.GetInt64(1)) + " " + past.GetText(0) +
-               " (last: session " + std::to_string(past.GetInt64(2)) + ")";
-    throw InputError(db_.path(), "--resume: participant " + participant + " of study " + study +
-                                     " has no unfinished session to continue (" +
-                                     (found.empty() ? std::string("no sessions at all") : found) +
-                                     "); leave out --resume to start a new session" +
-                                     (found.find("completed") != std::string::npos ? ", with --again" : ""));
+    RefuseNothingToResume(db_, participant_id, study, participant);
   } else {
     CheckProtocolVersion(study_id, study, canonical, hash, meta.protocol_version);
     std::string stored_json;
@@ -399,63 +461,44 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
     // Counted and inserted in one transaction (BEGIN IMMEDIATE): a station starting at the same moment waits for
     // this one's session and counts it.
     start.group = meta.assign_group ? meta.assign_group(SessionsPerGroup(db_, study, options_)) : meta.group;
-
-    // The typed columns (who answered, where, the display's geometry, the session's number) as the column table
-    // reads them (columns.h) from the session's description and the display profile it records whole.
-    Statement insert(db_, "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, "
-                          "host, display, started, status, lock_host, lock_pid, lock_token, lock_heartbeat_ms, "
-                          "display_profile, group_name, participant_info" + InsertNames(RecordColumns(), "sessions") +
-                          ") VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?" +
-                          InsertPlaceholders(RecordColumns(), "sessions") + ")");
-    insert.Bind(1, participant_id);
-    insert.Bind(2, protocol_id);
-    insert.Bind(3, static_cast<int64_t>(seed));
-    insert.Bind(4, meta.software_version.empty() ? std::string(BLURCUE_VERSION) : meta.software_version);
-    insert.Bind(5, meta.host.empty() ? lock_host_ : meta.host);
-    insert.Bind(6, meta.display);
-    insert.Bind(7, now);
-    insert.Bind(8, lock_host_);
-    insert.Bind(9, pid_);
-    insert.Bind(10, token_);
-    insert.Bind(11, NowMs());
-    insert.Bind(12, meta.display_profile);
-    insert.Bind(13, start.group);
-    insert.Bind(14, meta.participant_info);
-    const Json profile = ParseJson(meta.display_profile, "display profile");
-    BindTyped(RecordColumns(), insert, 15, SessionValues{meta, profile, start.session_number});
-    insert.Run();
-    start.session_id = db_.LastInsertRowId();
-    // The participant information, one row per key (text as given; numbers as JSON text).
-    const Json info = ParseJson(meta.participant_info, "participant information");
-    if (info.is_object()) {
-      Statement row(db_, "INSERT INTO session_info (session_id, key, value) VALUES (?, ?, ?)");
-      for (const auto& [key, value] : info.items()) {
-        row.Bind(1, start.session_id);
-        row.Bind(2, key);
-        row.Bind(3, value.is_string() ? value.get<std::string>() : value.dump());
-        row.Run();
-        row.Reset();
-      }
-    }
+    start.session_id = InsertSession(participant_id, protocol_id, seed, meta, now, start);
+    SaveParticipantInfo(db_, start.session_id, meta.participant_info);
   }
   transaction.Commit();
   start.trial_count = db_.QueryInt64("SELECT COUNT(*) FROM trials WHERE session_id = " +
                                      std::to_string(start.session_id));
   start.first_unanswered_trial = FirstUnansweredTrial(start.session_id);
-  if (start.resumed) {
-    // A session continues at its first unanswered trial; answers or frames past it mean the record was changed
-    // outside blurcue (a deleted answer leaves a gap), and resuming would write over them or beside them.
-    const std::string s = std::to_string(start.session_id), f = std::to_string(start.first_unanswered_trial);
-    const int64_t past = db_.QueryInt64(
-        "SELECT (SELECT COUNT(*) FROM responses r JOIN trials t ON t.id = r.trial_id WHERE t.session_id = " + s +
-        " AND t.trial_index >= " + f + ") + (SELECT COUNT(*) FROM frames fr JOIN trials t ON t.id = fr.trial_id "
-        "WHERE t.session_id = " + s + " AND t.trial_index >= " + f + ")");
-    if (past > 0)
-      throw InputError(db_.path(), SessionName(start.session_id) + ": its first unanswered trial is " + f +
-                                       ", but the record holds answers or frames of trials after it (changed "
-                                       "outside blurcue?); it cannot be resumed");
-  }
+  if (start.resumed) CheckNothingPastFirstUnanswered(db_, start);
   return start;
+}
+
+int64_t Record::InsertSession(int64_t participant_id, int64_t protocol_id, uint64_t seed, const SessionMeta& meta,
+                              const std::string& now, const SessionStart& start) {
+  // The typed columns (who answered, where, the display's geometry, the session's number) as the column table
+  // reads them (columns.h) from the session's description and the display profile it records whole.
+  Statement insert(db_, "INSERT INTO sessions (participant_id, protocol_version_id, seed, software_version, "
+                        "host, display, started, status, lock_host, lock_pid, lock_token, lock_heartbeat_ms, "
+                        "display_profile, group_name, participant_info" + InsertNames(RecordColumns(), "sessions") +
+                        ") VALUES (?, ?, ?, ?, ?, ?, ?, 'running', ?, ?, ?, ?, ?, ?, ?" +
+                        InsertPlaceholders(RecordColumns(), "sessions") + ")");
+  insert.Bind(1, participant_id);
+  insert.Bind(2, protocol_id);
+  insert.Bind(3, static_cast<int64_t>(seed));
+  insert.Bind(4, meta.software_version.empty() ? std::string(BLURCUE_VERSION) : meta.software_version);
+  insert.Bind(5, meta.host.empty() ? lock_host_ : meta.host);
+  insert.Bind(6, meta.display);
+  insert.Bind(7, now);
+  insert.Bind(8, lock_host_);
+  insert.Bind(9, pid_);
+  insert.Bind(10, token_);
+  insert.Bind(11, NowMs());
+  insert.Bind(12, meta.display_profile);
+  insert.Bind(13, start.group);
+  insert.Bind(14, meta.participant_info);
+  const Json profile = ParseJson(meta.display_profile, "display profile");
+  BindTyped(RecordColumns(), insert, 15, SessionValues{meta, profile, start.session_number});
+  insert.Run();
+  return db_.LastInsertRowId();
 }
 
 namespace {
@@ -516,8 +559,8 @@ void Record::SaveTrialList(int64_t session, const std::vector<TrialRecord>& tria
     insert.Bind(2, trial.index);
     insert.Bind(3, trial.block);
     insert.Bind(4, trial.factors_json);
-    insert.Bind(5, trial.left_json);
-    insert.Bind(6, trial.right_json);
+    insert.Bind(5, trial.source_json[0]);
+    insert.Bind(6, trial.source_json[1]);
     BindTyped(RecordColumns(), insert, 7, trial);
     insert.Run();
     insert.Reset();
@@ -541,10 +584,15 @@ void Record::CheckTrialList(int64_t session, const std::vector<TrialRecord>& tri
       change = "block " + std::to_string(saved.GetInt64(1)) + " saved, " + std::to_string(trials[i].block) + " now";
     else if (saved.GetText(2) != trials[i].factors_json)
       change = "levels " + saved.GetText(2) + " saved, " + trials[i].factors_json + " now";
-    else if (saved.GetText(3) != trials[i].left_json)
-      change = "left side " + saved.GetText(3) + " saved, " + trials[i].left_json + " now";
-    else if (saved.GetText(4) != trials[i].right_json)
-      change = "right side " + saved.GetText(4) + " saved, " + trials[i].right_json + " now";
+    else
+      for (const protocol::Side side : protocol::Vocabulary<protocol::Side>::values) {
+        const std::string& now = trials[i].source_json[protocol::Index(side)];
+        const std::string was = saved.GetText(3 + int(protocol::Index(side)));
+        if (was != now) {
+          change = protocol::ToString(side) + " side " + was + " saved, " + now + " now";
+          break;
+        }
+      }
     if (!change.empty())
       throw InputError(db_.path(), SessionName(session) + " trial " + std::to_string(i) + " differs from the one made "
                                        "now (" + OneLine(change) + "): a file it reads (the calibration, a picture, a "

@@ -1,6 +1,7 @@
 #pragma once
 // The crash-safe record a session runner writes: one transaction per answer, resume at the first unanswered
 // trial, and one writer per running session (a lock row naming host, pid and a per-Record token).
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -87,14 +88,15 @@ struct TrialRecord {
   int64_t index = 0;
   int64_t block = 0;
   std::string factors_json = "{}";  // object: factor name -> level, and the trial's other variables
-  std::string left_json = "null";   // what was shown on the left
-  std::string right_json = "null";
+  // What each side showed (its blur spec), indexed by protocol::Index(side): kept in left_shown, right_shown.
+  std::array<std::string, 2> source_json = {"null", "null"};
   // Typed (schema 7): the block's name, practice (not scored), left and right exchanged against the design, and the
-  // radii planned in photo px (none for a picture). Each side's source and fixed radius are read from left_json /
-  // right_json by the record itself (SourceColumns).
+  // radii planned in photo px, each side's (indexed as source_json) and the scene's (none for a picture). Each side's
+  // source and fixed radius are read from source_json by the record itself (SourceColumns).
   std::string block_name, task;  // task: forced_choice | adjustment | yes_no | rating
   bool practice = false, swapped = false;
-  std::optional<double> r_left_px, r_right_px, r_scene_px;
+  std::array<std::optional<double>, 2> r_px;
+  std::optional<double> r_scene_px;
   std::string cell;  // a procedure trial's cell by its levels ("edge=9", "edge=9;speed_cm_s=3"); "" otherwise
 };
 
@@ -123,8 +125,9 @@ struct Response {
   std::string shown_json = "{}";
   std::string answered_at;           // ISO 8601 UTC; empty = now
   // Typed (schema 7): an adaptive procedure's level shown and whether the answer was correct, and the radii shown
-  // when they were decided at the trial (photo px); empty otherwise.
-  std::optional<double> level, r_left_px, r_right_px;
+  // when they were decided at the trial (photo px, indexed by protocol::Index(side)); empty otherwise.
+  std::optional<double> level;
+  std::array<std::optional<double>, 2> r_px;
   std::optional<bool> correct;
 };
 
@@ -255,6 +258,9 @@ class Record {
                   const std::vector<DesignColumnRecord>& design);
   int64_t NextSessionNumber(int64_t participant_id, const std::string& study, const std::string& participant,
                             uint64_t seed, const SessionMeta& meta);
+  // Inserts a new running session, locked by this Record, with the group and number `start` gives it; its id.
+  int64_t InsertSession(int64_t participant_id, int64_t protocol_id, uint64_t seed, const SessionMeta& meta,
+                        const std::string& now, const SessionStart& start);
 
   Database db_;
   RecordOptions options_;

@@ -37,8 +37,8 @@ std::vector<TrialRecord> Trials(int n) {
     t.index = i;
     t.block = i / 5;
     t.factors_json = R"({"edge":)" + std::to_string(i % 11 + 1) + R"(,"blur":"measured"})";
-    t.left_json = R"("measured")";
-    t.right_json = R"("estimated")";
+    t.source_json[0] = R"("measured")";
+    t.source_json[1] = R"("estimated")";
     trials.push_back(t);
   }
   return trials;
@@ -93,16 +93,16 @@ TEST(Record, WritesTheTypedColumns) {
   std::vector<TrialRecord> trials = Trials(2);
   trials[0].block_name = "main";
   trials[0].practice = true;
-  trials[0].r_left_px = 1.23456789;
+  trials[0].r_px[0] = 1.23456789;
   trials[0].r_scene_px = 0.5;
   trials[1].swapped = true;
-  trials[1].left_json = "2.5";
-  trials[1].right_json = R"({"arcmin":3})";
+  trials[1].source_json[0] = "2.5";
+  trials[1].source_json[1] = R"({"arcmin":3})";
   record.SaveTrialList(session, trials);
   Response answer = Answer("left");
   answer.level = 0.125;
   answer.correct = false;
-  answer.r_right_px = 9.87654321;
+  answer.r_px[1] = 9.87654321;
   record.RecordResponse(session, 1, answer);
   Database& db = record.database();
   EXPECT_EQ(db.QueryText("SELECT observer || '|' || observer_params || '|' || window || '|' || profile_name || '|' || "

@@ -130,9 +130,8 @@ std::vector<Migration> MakeMigrations() {
   steps.push_back({"ALTER TABLE sessions ADD COLUMN display_profile TEXT NOT NULL DEFAULT '{}';"});
   // 4: what each frame showed of a pair (moving balls change radius from frame to frame): each side's radius in
   // photo px and the objects' place along the board's y in mm; NULL where nothing was shown and before version 4.
-  steps.push_back({"ALTER TABLE frames ADD COLUMN r_left_px REAL;"
-                   "ALTER TABLE frames ADD COLUMN r_right_px REAL;"
-                   "ALTER TABLE frames ADD COLUMN y_mm REAL;"});
+  // (frame_columns.h's columns that say since 4: r_left_px, r_right_px, y_mm).
+  steps.push_back({AddFrameColumnsSql(4)});
   // 5: what a trial showed as decided when it was shown (an adaptive procedure's level and the radii it made, the
   // answer's correctness): a JSON object of trial variables export lays over the planned ones; '{}' otherwise.
   steps.push_back({"ALTER TABLE responses ADD COLUMN shown TEXT NOT NULL DEFAULT '{}';"});
