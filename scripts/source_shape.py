@@ -50,7 +50,10 @@ def long_functions(path):
         line = lines[i]
         if re.match(r"^[A-Za-z~]", line) and not NOT_A_FUNCTION.match(line) and not line.rstrip().endswith(";"):
             j = i
-            while j < len(lines) and j < i + 8 and not lines[j].rstrip().endswith(("{", ";")):
+            # A signature ends at its '{'; a line that ends in ';' or '}' (a declaration, a one-line function) or a
+            # blank line ends the search: the next function's '{' is not this one's.
+            while (j < len(lines) and j < i + 8 and lines[j].strip()
+                   and not lines[j].rstrip().endswith(("{", ";", "}"))):
                 j += 1
             if j < len(lines) and lines[j].rstrip().endswith("{") and not lines[j].rstrip().endswith("= {"):
                 k = j + 1
