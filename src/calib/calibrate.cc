@@ -177,29 +177,12 @@ CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& b
   return Calibrate(planes, camera, board, options);
 }
 
-CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Board& board,
-                      const CalibrateOptions& options) {
-  const cv::Mat& photo = planes.grey8;
-  if (photo.cols != camera.image_width_px || photo.rows != camera.image_height_px)
-    throw InputError("camera /image_width_px, /image_height_px",
-                     "say " + std::to_string(camera.image_width_px) + "x" + std::to_string(camera.image_height_px) +
-                         " but the photo is " + std::to_string(photo.cols) + "x" + std::to_string(photo.rows));
-  if (options.reference_edge < 1 || options.reference_edge > board.EdgeCount())
-    throw Error(ErrorKind::kUsage, "--reference-edge must be 1.." + std::to_string(board.EdgeCount()) + ", got " +
-                                       std::to_string(options.reference_edge));
-  CalibResult result;
-  result.camera = camera;
-  result.board = board;
-  result.reference_edge = options.reference_edge;
+namespace {
 
-  auto t0 = std::chrono::steady_clock::now();
-  const cv::Mat& grey8 = planes.grey8;
-  result.pose = options.known_pose ? *options.known_pose : FindBoardPose(grey8, camera, board, options.detect);
-  result.detect_ms = MsSince(t0);
-
-  // Geometry of every section: end points in the photo and 3-D midpoint.
-  t0 = std::chrono::steady_clock::now();
-  const cv::Mat& linear = planes.linear;
+// Geometry of every section: end points in the photo and 3-D midpoint, its sampling window, its neighbouring
+// edges' sections and the distortion's stretch across it - result->edges from result->pose.
+void PlaceSections(CalibResult* out, const Camera& camera, const Board& board) {
+  CalibResult& result = *out;
   const int E = board.EdgeCount(), S = board.SectionCount();
   // Per section: start, end, midpoint, and a point a tenth of a square along the board line crossing the edge at
   // the start and at the end (their directions in the photo shape the sampling window, edge_blur.h).
@@ -265,6 +248,16 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
     }
     result.edges.push_back(std::move(edge));
   }
+}
+
+// Every section (or options.only_sections) measured on every core, then the ones read across a neighbouring edge
+// measured again with that neighbour's own blur.
+void MeasureSections(CalibResult* out, const PhotoPlanes& planes, const Board& board,
+                     const CalibrateOptions& options) {
+  CalibResult& result = *out;
+  const cv::Mat& linear = planes.linear;
+  const cv::Mat& grey8 = planes.grey8;
+  const int E = board.EdgeCount(), S = board.SectionCount();
   // Each section's measurement reads the photo and writes only its own result, so measured on every core (OpenCV's
   // thread pool, made once per process) the numbers are the serial ones; one stripe a section balances their
   // unequal costs.
@@ -306,21 +299,11 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
     if (options.parallel_sections) cv::parallel_for_(cv::Range(0, S), again, S);
     else again(cv::Range(0, S));
   }
-  if (options.phase_check && options.fit_model) CheckPhases(result, linear, options);
-  result.measure_ms = MsSince(t0);
+}
 
-  // Estimation: eq. 3.7 from the reference edge, and a thin-lens model fitted to every usable section.
-  t0 = std::chrono::steady_clock::now();
-  const optics::Lens lens = optics::Lens::FromCamera(camera);
-  // The sections at other phases choose the PSF family; a section it leaves open is flagged and predicted.
-  if (options.fit_model && options.phase_check) result.phase = ChoosePhaseFamily(result);
-  if (options.fit_model) RequireThreeDepths(result);  // before the reference: with no usable edge, say why
-  // A subset (a live view's few sections a frame) leaves the reference edge unmeasured most frames: no reference then.
-  if (options.only_sections.empty()) SetReference(result, options.reference_edge);
-
-  if (options.fit_model)
-    result.model = FitModelWithinPhaseRanges(result, lens, options.optics_fit, &result.phase.held);
-
+// Each section's eq. 3.7 estimate from the reference, and each edge's means over its usable sections.
+void SummariseEdges(CalibResult* out, const optics::Lens& lens) {
+  CalibResult& result = *out;
   for (auto& edge : result.edges) {
     double su = 0;
     for (auto& s : edge.sections) {
@@ -349,6 +332,49 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
       if (edge.estimated > 0) edge.r_estimated_px /= edge.estimated;
     }
   }
+}
+
+}  // namespace
+
+CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Board& board,
+                      const CalibrateOptions& options) {
+  const cv::Mat& photo = planes.grey8;
+  if (photo.cols != camera.image_width_px || photo.rows != camera.image_height_px)
+    throw InputError("camera /image_width_px, /image_height_px",
+                     "say " + std::to_string(camera.image_width_px) + "x" + std::to_string(camera.image_height_px) +
+                         " but the photo is " + std::to_string(photo.cols) + "x" + std::to_string(photo.rows));
+  if (options.reference_edge < 1 || options.reference_edge > board.EdgeCount())
+    throw Error(ErrorKind::kUsage, "--reference-edge must be 1.." + std::to_string(board.EdgeCount()) + ", got " +
+                                       std::to_string(options.reference_edge));
+  CalibResult result;
+  result.camera = camera;
+  result.board = board;
+  result.reference_edge = options.reference_edge;
+
+  auto t0 = std::chrono::steady_clock::now();
+  result.pose = options.known_pose ? *options.known_pose : FindBoardPose(photo, camera, board, options.detect);
+  result.detect_ms = MsSince(t0);
+
+  // Geometry of every section, then its measurement.
+  t0 = std::chrono::steady_clock::now();
+  PlaceSections(&result, camera, board);
+  MeasureSections(&result, planes, board, options);
+  if (options.phase_check && options.fit_model) CheckPhases(result, planes.linear, options);
+  result.measure_ms = MsSince(t0);
+
+  // Estimation: eq. 3.7 from the reference edge, and a thin-lens model fitted to every usable section.
+  t0 = std::chrono::steady_clock::now();
+  const optics::Lens lens = optics::Lens::FromCamera(camera);
+  // The sections at other phases choose the PSF family; a section it leaves open is flagged and predicted.
+  if (options.fit_model && options.phase_check) result.phase = ChoosePhaseFamily(result);
+  if (options.fit_model) RequireThreeDepths(result);  // before the reference: with no usable edge, say why
+  // A subset (a live view's few sections a frame) leaves the reference edge unmeasured most frames: no reference then.
+  if (options.only_sections.empty()) SetReference(result, options.reference_edge);
+
+  if (options.fit_model)
+    result.model = FitModelWithinPhaseRanges(result, lens, options.optics_fit, &result.phase.held);
+
+  SummariseEdges(&result, lens);
   if (options.fit_model) ApplyModel(result, result.model);
   result.estimate_ms = MsSince(t0);
   return result;
