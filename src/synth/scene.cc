@@ -346,20 +346,14 @@ SceneGeometry CheckedGeometry(const SceneOptions& o) {
 
 void CheckSceneOptions(const SceneOptions& options) { CheckedGeometry(options); }
 
-Scene RenderScene(const SceneOptions& o) {
-  const SceneGeometry geometry = CheckedGeometry(o);
-  const Board& board = o.board;
-  const Camera& cam = o.camera;
-  const int W = cam.image_width_px, H = cam.image_height_px, ss = o.supersample;
-  const std::array<double, 9> K = cam.Intrinsics();
-  const Pose& pose = geometry.pose;
-  const optics::Lens lens = optics::Lens::FromCamera(cam);
-  const LensDistortion distortion(cam);
-  const detail::IdealCanvas& canvas = geometry.canvas;
-  const int Wi = canvas.width, Hi = canvas.height;
-  const double edge1_u = (pose.R * cv::Vec3d(board.WidthMm() / 2, 0, 0) + pose.t)[2];
-  const double focus = std::isnan(o.focus_mm) ? edge1_u : o.focus_mm;
+namespace {
 
+// The camera, pose and lens as the shading and blur passes read them (scene_view.h).
+View MakeView(const SceneOptions& o, const Pose& pose, const detail::IdealCanvas& canvas, double focus) {
+  const Board& board = o.board;
+  const std::array<double, 9> K = o.camera.Intrinsics();
+  const optics::Lens lens = optics::Lens::FromCamera(o.camera);
+  const int ss = o.supersample;
   View v;
   v.fx = K[0], v.fy = K[4], v.cx = K[2] + canvas.ox, v.cy = K[5] + canvas.oy;
   v.ss = ss;
@@ -381,9 +375,13 @@ Scene RenderScene(const SceneOptions& o) {
   v.a = std::isinf(focus) ? 1 : 1 / (1 - v.f / focus);
   v.gain = o.blur_gain;
   v.fixed_r = o.fixed_r_px;
+  return v;
+}
 
-  // Pass 1: the range of blur radii, row by row, to choose the levels and the margin.
-  const int hss = Hi * ss, wss = Wi * ss;
+// Pass 1: the range of blur radii {min, max} over the hss x wss sub-pixels, row by row, to choose the levels and
+// the margin; a view nearer than the focal length, or blur over a quarter of the image, refused.
+std::pair<double, double> BlurRange(const View& v, const SceneOptions& o, int hss, int wss) {
+  const int W = o.camera.image_width_px, H = o.camera.image_height_px;
   std::vector<float> row_min(hss), row_max(hss);
   std::atomic<bool> too_near{false};
   cv::parallel_for_(cv::Range(0, hss), [&](const cv::Range& range) {
@@ -402,22 +400,22 @@ Scene RenderScene(const SceneOptions& o) {
   if (r_max > 0.25 * std::min(W, H))
     throw InputError(o.fixed_r_px ? "fixed_r_px" : "focus_mm",
                      "blur up to " + Num(r_max) + " px is more than a quarter of the image; nothing would be left to see");
-  const std::vector<Level> levels = ChooseLevels(r_min, r_max, o.fixed_r_px, ss, o.psf);
-  int reach = 0;
-  for (const Level& l : levels) reach = std::max(reach, l.reach);
-  // The floor is spatially invariant, so it is applied to the sharp scene first (convolution commutes); its
-  // truth is its taps' variance, not the sigma asked for.
-  const std::vector<double> floor_taps = detail::FloorTaps(o.floor_sigma_px, ss);
-  const int floor_reach = static_cast<int>(floor_taps.size()) / 2;
-  const double floor_var_px2 = detail::TapsVariance(floor_taps) / (double(ss) * ss);
-  // The sharp scene is rendered this far beyond the image: blur brings light in from there.
-  const int m = reach + floor_reach + 2;
+  return {r_min, r_max};
+}
 
-  // Flaws: dark spots on white squares, near an edge, in the middle half of a section.
+// Flaws: dark spots on white squares, near an edge, in the middle half of a section; each with its padded sub-pixel
+// bounding box (m sub-pixels of margin), the sections it touches marked in touched_sections, listed in truth.
+std::vector<Flaw> PlaceFlaws(const SceneOptions& o, const Pose& pose, const View& v, int m,
+                             std::vector<std::vector<bool>>* touched_sections, Json* truth) {
+  const Board& board = o.board;
+  const std::array<double, 9> K = o.camera.Intrinsics();
+  const int ss = o.supersample;
   Rng flaw_rng(o.seed, kFlawStream);
   std::vector<Flaw> flaws;
-  std::vector<std::vector<bool>> flawed(board.EdgeCount(), std::vector<bool>(board.SectionCount(), false));
-  Json flaws_json = Json::array();
+  std::vector<std::vector<bool>>& flawed = *touched_sections;
+  flawed.assign(board.EdgeCount(), std::vector<bool>(board.SectionCount(), false));
+  Json& flaws_json = *truth;
+  flaws_json = Json::array();
   const double sq = board.square_mm;
   for (int n = 0; n < o.flaws; ++n) {
     Flaw fl;
@@ -464,17 +462,15 @@ Scene RenderScene(const SceneOptions& o) {
     flaws.push_back(fl);
     flaws_json.push_back({{"x_mm", fl.x}, {"y_mm", fl.y}, {"radius_mm", fl.radius}, {"sections", touched}});
   }
+  return flaws;
+}
 
-  // Pass 2: the sharp scene, box-filtered per sub-pixel, with and without the board, m sub-pixels beyond the image.
-  Rng texture_rng(o.seed, kTextureStream);
-  const Wood wood(texture_rng, o.table);
-  const double wall_phase = texture_rng.Uniform(0, 2 * kPi);
-  const double wall_level = std::clamp(0.5 * (o.table + o.white), 0.0, 1.0);
-  const int hp = hss + 2 * m, wp = wss + 2 * m;
+// The table and wall, shaded once per output pixel over the ideal canvas (Wi x Hi) plus mb pixels each side.
+cv::Mat ShadeBackground(const View& v, const Wood& wood, double wall_phase, double wall_level, int Wi, int Hi,
+                        int mb) {
   const double cyaw = std::cos(v.yaw), syaw = std::sin(v.yaw);
   // The table and wall are smooth, so they are shaded once per output pixel (footprint: the pixel) over the image
   // plus the margin; the board's edges, which carry the measurement, are shaded per sub-pixel.
-  const int mb = (m + ss - 1) / ss;  // margin in whole pixels
   cv::Mat background(Hi + 2 * mb, Wi + 2 * mb, CV_32F);
   cv::parallel_for_(cv::Range(0, background.rows), [&](const cv::Range& range) {
     for (int by = range.start; by < range.end; ++by) {
@@ -503,8 +499,157 @@ Scene RenderScene(const SceneOptions& o) {
       }
     }
   });
+  return background;
+}
+
+// Light fall-off on the sensor, from the photo's principal point: `amount` at the farthest corner.
+void Vignette(double amount, const std::array<double, 9>& K, int W, int H, std::initializer_list<cv::Mat*> images) {
+  const double cx = K[2], cy = K[5];
+  const double rho2_corner = std::max({cx * cx + cy * cy, (W - 1 - cx) * (W - 1 - cx) + cy * cy,
+                                       cx * cx + (H - 1 - cy) * (H - 1 - cy),
+                                       (W - 1 - cx) * (W - 1 - cx) + (H - 1 - cy) * (H - 1 - cy)});
+  for (cv::Mat* img : images)
+    for (int y = 0; y < H; ++y) {
+      float* p = img->ptr<float>(y);
+      for (int x = 0; x < W; ++x) {
+        const double rho2 = (x - cx) * (x - cx) + (y - cy) * (y - cy);
+        p[x] = static_cast<float>(p[x] * (1 - amount * rho2 / rho2_corner));
+      }
+    }
+}
+
+// Every section's truth (what was applied: the mixed levels' and the floor's variances, the distortion's stretch,
+// the post filter's taps) and truth.json's content, into scene.
+void AddTruth(Scene* out, const SceneOptions& o, const Pose& pose, const View& v, const std::vector<Level>& levels,
+              double floor_var_px2, std::pair<double, double> r_range,
+              const std::vector<std::vector<bool>>& flawed, const Json& flaws_json) {
+  Scene& scene = *out;
+  const Board& board = o.board;
+  const Camera& cam = o.camera;
+  const std::array<double, 9> K = cam.Intrinsics();
+  const int ss = o.supersample;
+  const optics::Lens lens = optics::Lens::FromCamera(cam);
+  const LensDistortion distortion(cam);
+  const double focus = scene.focus_mm, r_min = r_range.first, r_max = r_range.second;
+  const cv::Vec3d rvec = scene.rvec;
+  // The post-sampling filter's taps as applied (float), and their second moment: every section's truth adds it.
+  const std::vector<float> post_taps = PostFilterTaps(o.post_filter);
+  const double post_var_px2 = PostFilterVariancePx2(post_taps);
+  Json sections = Json::array();
+  for (int e = 1; e <= board.EdgeCount(); ++e)
+    for (int s = 1; s <= board.SectionCount(); ++s) {
+      const auto mid = board.SectionMidpoint(e, s);
+      const double u = (pose.R * cv::Vec3d(mid[0], mid[1], mid[2]) + pose.t)[2];
+      SectionTruth t;
+      t.edge = e;
+      t.section = s;
+      t.u_mm = u;
+      t.defocus_r_px = o.fixed_r_px ? *o.fixed_r_px : optics::BlurRadiusPx(lens, focus, u) * o.blur_gain;
+      // Truth is what was applied: the mixed defocus levels' and the floor taps' variances from their arrays (in
+      // ideal px), times the distortion's stretch across the edge at the midpoint (1 without distortion).
+      const double var_px2 = detail::AppliedVarianceSs(levels, t.defocus_r_px, ss) / (double(ss) * ss) + floor_var_px2;
+      auto ideal_px = [&](const std::array<double, 3>& b) {
+        const cv::Vec3d P = pose.R * cv::Vec3d(b[0], b[1], b[2]) + pose.t;
+        return Point2{K[0] * P[0] / P[2] + K[2], K[4] * P[1] / P[2] + K[5]};
+      };
+      const Point2 a = ideal_px(board.SectionStart(e, s)), b = ideal_px(board.SectionEnd(e, s));
+      t.stretch = distortion.StretchAcross(ideal_px(mid), {a[1] - b[1], b[0] - a[0]});
+      t.r_ideal_px = 2 * std::sqrt(var_px2);
+      t.r_optical_px = t.r_ideal_px * t.stretch;
+      t.r_px = std::sqrt(std::max(0.0, t.r_optical_px * t.r_optical_px + 4 * post_var_px2));
+      t.flawed = flawed[e - 1][s - 1];
+      scene.sections.push_back(t);
+      Json row = {{"edge", e}, {"section", s}, {"u_mm", u}, {"r_px", t.r_px}, {"defocus_r_px", t.defocus_r_px},
+                  {"flawed", t.flawed}};
+      if (!distortion.Identity()) row["r_ideal_px"] = t.r_ideal_px, row["stretch"] = t.stretch;
+      if (post_taps.size() > 1) row["r_optical_px"] = t.r_optical_px;
+      sections.push_back(row);
+    }
+
+  Json rotation = Json::array();
+  for (int i = 0; i < 3; ++i) rotation.push_back({pose.R(i, 0), pose.R(i, 1), pose.R(i, 2)});
+  Json levels_json = Json::array();
+  for (const Level& l : levels) levels_json.push_back(l.r_px);
+  Json& j = scene.truth;
+  j["generator"] = "blurcue synth-scene";
+  j["options"] = OptionsToJson(o);
+  j["camera"] = CameraToJson(cam);
+  j["board"] = {{"cols", board.cols}, {"rows", board.rows}, {"square_mm", board.square_mm}};
+  j["pose"] = {{"rvec", {rvec[0], rvec[1], rvec[2]}},
+               {"tvec", {pose.t[0], pose.t[1], pose.t[2]}},
+               {"rotation", rotation},
+               {"convention", "board frame (mm) -> camera (x right, y down, z forward), OpenCV"},
+               {"camera_height_mm", -v.c_table}};
+  j["focus_mm"] = std::isfinite(focus) ? Json(focus) : Json(nullptr);
+  j["focus_at_infinity"] = std::isinf(focus);
+  j["aperture_mm"] = lens.aperture_mm;
+  j["pixel_pitch_mm"] = lens.pixel_pitch_mm;
+  j["psf"] = o.psf == Psf::kDisc ? "disc" : "gaussian";
+  j["r_unit"] = distortion.Identity()
+                   ? "px, 2 x std of the line-spread function of the kernels applied (defocus and floor), optical only "
+                     "(pixel area excluded)"
+                   : "photo px, 2 x std of the line-spread function across the edge of the kernels applied (defocus "
+                     "and floor, in ideal px: r_ideal_px) times the distortion's stretch across the edge at the "
+                     "section's midpoint (stretch = 1 / |J^-T n|), optical only (pixel area excluded)";
+  j["floor_sigma_applied_px"] = std::sqrt(floor_var_px2);
+  // The whole view's blur with the floor (every point has it: nothing in the view is sharper than the floor), and the
+  // defocus alone (the lens formula's range, before discretisation).
+  if (post_taps.size() > 1) j["post_filter"] = PostFilterTruth(o.post_filter, post_taps);
+  // (and the post-sampling filter's, where there is one).
+  const double added_px2 = 4 * (floor_var_px2 + post_var_px2);
+  j["r_range_px"] = {std::sqrt(std::max(0.0, r_min * r_min + added_px2)),
+                     std::sqrt(std::max(0.0, r_max * r_max + added_px2))};
+  j["defocus_r_range_px"] = {r_min, r_max};
+  j["blur_levels_px"] = levels_json;
+  j["sections"] = sections;
+  j["flaws"] = flaws_json;
+}
+
+}  // namespace
+
+Scene RenderScene(const SceneOptions& o) {
+  const SceneGeometry geometry = CheckedGeometry(o);
+  const Board& board = o.board;
+  const Camera& cam = o.camera;
+  const int W = cam.image_width_px, H = cam.image_height_px, ss = o.supersample;
+  const std::array<double, 9> K = cam.Intrinsics();
+  const Pose& pose = geometry.pose;
+  const LensDistortion distortion(cam);
+  const detail::IdealCanvas& canvas = geometry.canvas;
+  const int Wi = canvas.width, Hi = canvas.height;
+  const double edge1_u = (pose.R * cv::Vec3d(board.WidthMm() / 2, 0, 0) + pose.t)[2];
+  const double focus = std::isnan(o.focus_mm) ? edge1_u : o.focus_mm;
+  const View v = MakeView(o, pose, canvas, focus);
+
+  const int hss = Hi * ss, wss = Wi * ss;
+  const std::pair<double, double> r_range = BlurRange(v, o, hss, wss);
+  const std::vector<Level> levels = ChooseLevels(r_range.first, r_range.second, o.fixed_r_px, ss, o.psf);
+  int reach = 0;
+  for (const Level& l : levels) reach = std::max(reach, l.reach);
+  // The floor is spatially invariant, so it is applied to the sharp scene first (convolution commutes); its
+  // truth is its taps' variance, not the sigma asked for.
+  const std::vector<double> floor_taps = detail::FloorTaps(o.floor_sigma_px, ss);
+  const int floor_reach = static_cast<int>(floor_taps.size()) / 2;
+  const double floor_var_px2 = detail::TapsVariance(floor_taps) / (double(ss) * ss);
+  // The sharp scene is rendered this far beyond the image: blur brings light in from there.
+  const int m = reach + floor_reach + 2;
+
+  std::vector<std::vector<bool>> flawed;
+  Json flaws_json;
+  const std::vector<Flaw> flaws = PlaceFlaws(o, pose, v, m, &flawed, &flaws_json);
+
+  // Pass 2: the sharp scene, box-filtered per sub-pixel, with and without the board, m sub-pixels beyond the image.
+  Rng texture_rng(o.seed, kTextureStream);
+  const Wood wood(texture_rng, o.table);
+  const double wall_phase = texture_rng.Uniform(0, 2 * kPi);
+  const double wall_level = std::clamp(0.5 * (o.table + o.white), 0.0, 1.0);
+  const int hp = hss + 2 * m, wp = wss + 2 * m;
+  // The table and wall are smooth, so they are shaded once per output pixel (footprint: the pixel) over the image
+  // plus the margin; the board's edges, which carry the measurement, are shaded per sub-pixel.
+  const int mb = (m + ss - 1) / ss;  // margin in whole pixels
+  const cv::Mat background = ShadeBackground(v, wood, wall_phase, wall_level, Wi, Hi, mb);
   cv::Mat sharp(hp, wp, CV_32F), sharp_no_board(hp, wp, CV_32F);
-  const double bw = board.WidthMm(), bl = board.LengthMm();
+  const double bw = board.WidthMm(), bl = board.LengthMm(), sq = board.square_mm;
   const double dn = 1.0 / (v.fx * ss), dm = 1.0 / (v.fy * ss);  // normalized step per sub-pixel
   const double rt0[3] = {v.Rt(0, 0), v.Rt(0, 1), v.Rt(0, 2)}, rt1[3] = {v.Rt(1, 0), v.Rt(1, 1), v.Rt(1, 2)};
   const cv::Vec3d tb = v.Rt * v.t;  // B = Rt (s d - t) = s (Rt d) - Rt t
@@ -577,21 +722,7 @@ Scene RenderScene(const SceneOptions& o) {
     std::vector<cv::Mat> photo = detail::DistortAndDownsample(ideal, distortion, canvas, ss, H, W);
     linear = photo[0], linear_no_board = photo[1];
   }
-  if (o.vignetting > 0) {
-    // On the sensor: from the photo's principal point.
-    v.cx = K[2], v.cy = K[5];
-    const double rho2_corner = std::max({v.cx * v.cx + v.cy * v.cy, (W - 1 - v.cx) * (W - 1 - v.cx) + v.cy * v.cy,
-                                         v.cx * v.cx + (H - 1 - v.cy) * (H - 1 - v.cy),
-                                         (W - 1 - v.cx) * (W - 1 - v.cx) + (H - 1 - v.cy) * (H - 1 - v.cy)});
-    for (cv::Mat* img : {&linear, &linear_no_board})
-      for (int y = 0; y < H; ++y) {
-        float* p = img->ptr<float>(y);
-        for (int x = 0; x < W; ++x) {
-          const double rho2 = (x - v.cx) * (x - v.cx) + (y - v.cy) * (y - v.cy);
-          p[x] = static_cast<float>(p[x] * (1 - o.vignetting * rho2 / rho2_corner));
-        }
-      }
-  }
+  if (o.vignetting > 0) Vignette(o.vignetting, K, W, H, {&linear, &linear_no_board});
 
   Scene scene;
   scene.image = Finish(linear, o, Rng(o.noise_seed.value_or(o.seed), kNoiseStream));
@@ -604,77 +735,7 @@ Scene RenderScene(const SceneOptions& o) {
   scene.tvec = pose.t;
   scene.focus_mm = focus;
 
-  // The post-sampling filter's taps as applied (float), and their second moment: every section's truth adds it.
-  const std::vector<float> post_taps = PostFilterTaps(o.post_filter);
-  const double post_var_px2 = PostFilterVariancePx2(post_taps);
-  Json sections = Json::array();
-  for (int e = 1; e <= board.EdgeCount(); ++e)
-    for (int s = 1; s <= board.SectionCount(); ++s) {
-      const auto mid = board.SectionMidpoint(e, s);
-      const double u = (pose.R * cv::Vec3d(mid[0], mid[1], mid[2]) + pose.t)[2];
-      SectionTruth t;
-      t.edge = e;
-      t.section = s;
-      t.u_mm = u;
-      t.defocus_r_px = o.fixed_r_px ? *o.fixed_r_px : optics::BlurRadiusPx(lens, focus, u) * o.blur_gain;
-      // Truth is what was applied: the mixed defocus levels' and the floor taps' variances from their arrays (in
-      // ideal px), times the distortion's stretch across the edge at the midpoint (1 without distortion).
-      const double var_px2 = detail::AppliedVarianceSs(levels, t.defocus_r_px, ss) / (double(ss) * ss) + floor_var_px2;
-      auto ideal_px = [&](const std::array<double, 3>& b) {
-        const cv::Vec3d P = pose.R * cv::Vec3d(b[0], b[1], b[2]) + pose.t;
-        return Point2{K[0] * P[0] / P[2] + K[2], K[4] * P[1] / P[2] + K[5]};
-      };
-      const Point2 a = ideal_px(board.SectionStart(e, s)), b = ideal_px(board.SectionEnd(e, s));
-      t.stretch = distortion.StretchAcross(ideal_px(mid), {a[1] - b[1], b[0] - a[0]});
-      t.r_ideal_px = 2 * std::sqrt(var_px2);
-      t.r_optical_px = t.r_ideal_px * t.stretch;
-      t.r_px = std::sqrt(std::max(0.0, t.r_optical_px * t.r_optical_px + 4 * post_var_px2));
-      t.flawed = flawed[e - 1][s - 1];
-      scene.sections.push_back(t);
-      Json row = {{"edge", e}, {"section", s}, {"u_mm", u}, {"r_px", t.r_px}, {"defocus_r_px", t.defocus_r_px},
-                  {"flawed", t.flawed}};
-      if (!distortion.Identity()) row["r_ideal_px"] = t.r_ideal_px, row["stretch"] = t.stretch;
-      if (post_taps.size() > 1) row["r_optical_px"] = t.r_optical_px;
-      sections.push_back(row);
-    }
-
-  Json rotation = Json::array();
-  for (int i = 0; i < 3; ++i) rotation.push_back({pose.R(i, 0), pose.R(i, 1), pose.R(i, 2)});
-  Json levels_json = Json::array();
-  for (const Level& l : levels) levels_json.push_back(l.r_px);
-  Json& j = scene.truth;
-  j["generator"] = "blurcue synth-scene";
-  j["options"] = OptionsToJson(o);
-  j["camera"] = CameraToJson(cam);
-  j["board"] = {{"cols", board.cols}, {"rows", board.rows}, {"square_mm", board.square_mm}};
-  j["pose"] = {{"rvec", {rvec[0], rvec[1], rvec[2]}},
-               {"tvec", {pose.t[0], pose.t[1], pose.t[2]}},
-               {"rotation", rotation},
-               {"convention", "board frame (mm) -> camera (x right, y down, z forward), OpenCV"},
-               {"camera_height_mm", -v.c_table}};
-  j["focus_mm"] = std::isfinite(focus) ? Json(focus) : Json(nullptr);
-  j["focus_at_infinity"] = std::isinf(focus);
-  j["aperture_mm"] = lens.aperture_mm;
-  j["pixel_pitch_mm"] = lens.pixel_pitch_mm;
-  j["psf"] = o.psf == Psf::kDisc ? "disc" : "gaussian";
-  j["r_unit"] = distortion.Identity()
-                   ? "px, 2 x std of the line-spread function of the kernels applied (defocus and floor), optical only "
-                     "(pixel area excluded)"
-                   : "photo px, 2 x std of the line-spread function across the edge of the kernels applied (defocus "
-                     "and floor, in ideal px: r_ideal_px) times the distortion's stretch across the edge at the "
-                     "section's midpoint (stretch = 1 / |J^-T n|), optical only (pixel area excluded)";
-  j["floor_sigma_applied_px"] = std::sqrt(floor_var_px2);
-  // The whole view's blur with the floor (every point has it: nothing in the view is sharper than the floor), and the
-  // defocus alone (the lens formula's range, before discretisation).
-  if (post_taps.size() > 1) j["post_filter"] = PostFilterTruth(o.post_filter, post_taps);
-  // (and the post-sampling filter's, where there is one).
-  const double added_px2 = 4 * (floor_var_px2 + post_var_px2);
-  j["r_range_px"] = {std::sqrt(std::max(0.0, r_min * r_min + added_px2)),
-                     std::sqrt(std::max(0.0, r_max * r_max + added_px2))};
-  j["defocus_r_range_px"] = {r_min, r_max};
-  j["blur_levels_px"] = levels_json;
-  j["sections"] = sections;
-  j["flaws"] = flaws_json;
+  AddTruth(&scene, o, pose, v, levels, floor_var_px2, r_range, flawed, flaws_json);
   return scene;
 }
 
