@@ -30,7 +30,7 @@ set_tests_properties(suite_checks_exit_codes PROPERTIES LABELS docs)
 # functions, none with a reason yet: their modules' splits are under way); they go down to 8 and 0 as those merge.
 add_test(NAME source_shape
          COMMAND ${BLURCUE_EXPECT} "(^|\n)ok: [0-9]+ functions over 120 lines" /usr/bin/python3
-                 ${PROJECT_SOURCE_DIR}/scripts/source_shape.py ${PROJECT_SOURCE_DIR}/src --max-long 9 --max-unjustified 9)
+                 ${PROJECT_SOURCE_DIR}/scripts/source_shape.py ${PROJECT_SOURCE_DIR}/src --max-long 8 --max-unjustified 0)
 set_tests_properties(source_shape PROPERTIES LABELS docs)
 # ... and the check itself catches what it is for, at the default limits: a 127-line function without a reason and
 # an 801-line header.

@@ -605,49 +605,13 @@ void AddTruth(Scene* out, const SceneOptions& o, const Pose& pose, const View& v
   j["flaws"] = flaws_json;
 }
 
-}  // namespace
-
-Scene RenderScene(const SceneOptions& o) {
-  const SceneGeometry geometry = CheckedGeometry(o);
+// Pass 2's board: each sub-pixel of the hp x wp sharp scene (m sub-pixels beyond the image) box-filtered over its
+// footprint on the board, the flaws drawn over it, the background behind (mb pixels of margin); the same view
+// without the board beside it.
+std::pair<cv::Mat, cv::Mat> ShadeSharp(const View& v, const SceneOptions& o, const std::vector<Flaw>& flaws,
+                                       const cv::Mat& background, int hp, int wp, int m, int mb) {
   const Board& board = o.board;
-  const Camera& cam = o.camera;
-  const int W = cam.image_width_px, H = cam.image_height_px, ss = o.supersample;
-  const std::array<double, 9> K = cam.Intrinsics();
-  const Pose& pose = geometry.pose;
-  const LensDistortion distortion(cam);
-  const detail::IdealCanvas& canvas = geometry.canvas;
-  const int Wi = canvas.width, Hi = canvas.height;
-  const double edge1_u = (pose.R * cv::Vec3d(board.WidthMm() / 2, 0, 0) + pose.t)[2];
-  const double focus = std::isnan(o.focus_mm) ? edge1_u : o.focus_mm;
-  const View v = MakeView(o, pose, canvas, focus);
-
-  const int hss = Hi * ss, wss = Wi * ss;
-  const std::pair<double, double> r_range = BlurRange(v, o, hss, wss);
-  const std::vector<Level> levels = ChooseLevels(r_range.first, r_range.second, o.fixed_r_px, ss, o.psf);
-  int reach = 0;
-  for (const Level& l : levels) reach = std::max(reach, l.reach);
-  // The floor is spatially invariant, so it is applied to the sharp scene first (convolution commutes); its
-  // truth is its taps' variance, not the sigma asked for.
-  const std::vector<double> floor_taps = detail::FloorTaps(o.floor_sigma_px, ss);
-  const int floor_reach = static_cast<int>(floor_taps.size()) / 2;
-  const double floor_var_px2 = detail::TapsVariance(floor_taps) / (double(ss) * ss);
-  // The sharp scene is rendered this far beyond the image: blur brings light in from there.
-  const int m = reach + floor_reach + 2;
-
-  std::vector<std::vector<bool>> flawed;
-  Json flaws_json;
-  const std::vector<Flaw> flaws = PlaceFlaws(o, pose, v, m, &flawed, &flaws_json);
-
-  // Pass 2: the sharp scene, box-filtered per sub-pixel, with and without the board, m sub-pixels beyond the image.
-  Rng texture_rng(o.seed, kTextureStream);
-  const Wood wood(texture_rng, o.table);
-  const double wall_phase = texture_rng.Uniform(0, 2 * kPi);
-  const double wall_level = std::clamp(0.5 * (o.table + o.white), 0.0, 1.0);
-  const int hp = hss + 2 * m, wp = wss + 2 * m;
-  // The table and wall are smooth, so they are shaded once per output pixel (footprint: the pixel) over the image
-  // plus the margin; the board's edges, which carry the measurement, are shaded per sub-pixel.
-  const int mb = (m + ss - 1) / ss;  // margin in whole pixels
-  const cv::Mat background = ShadeBackground(v, wood, wall_phase, wall_level, Wi, Hi, mb);
+  const int ss = o.supersample;
   cv::Mat sharp(hp, wp, CV_32F), sharp_no_board(hp, wp, CV_32F);
   const double bw = board.WidthMm(), bl = board.LengthMm(), sq = board.square_mm;
   const double dn = 1.0 / (v.fx * ss), dm = 1.0 / (v.fy * ss);  // normalized step per sub-pixel
@@ -700,6 +664,53 @@ Scene RenderScene(const SceneOptions& o) {
       }
     }
   });
+  return {sharp, sharp_no_board};
+}
+
+}  // namespace
+
+Scene RenderScene(const SceneOptions& o) {
+  const SceneGeometry geometry = CheckedGeometry(o);
+  const Board& board = o.board;
+  const Camera& cam = o.camera;
+  const int W = cam.image_width_px, H = cam.image_height_px, ss = o.supersample;
+  const std::array<double, 9> K = cam.Intrinsics();
+  const Pose& pose = geometry.pose;
+  const LensDistortion distortion(cam);
+  const detail::IdealCanvas& canvas = geometry.canvas;
+  const int Wi = canvas.width, Hi = canvas.height;
+  const double edge1_u = (pose.R * cv::Vec3d(board.WidthMm() / 2, 0, 0) + pose.t)[2];
+  const double focus = std::isnan(o.focus_mm) ? edge1_u : o.focus_mm;
+  const View v = MakeView(o, pose, canvas, focus);
+
+  const int hss = Hi * ss, wss = Wi * ss;
+  const std::pair<double, double> r_range = BlurRange(v, o, hss, wss);
+  const std::vector<Level> levels = ChooseLevels(r_range.first, r_range.second, o.fixed_r_px, ss, o.psf);
+  int reach = 0;
+  for (const Level& l : levels) reach = std::max(reach, l.reach);
+  // The floor is spatially invariant, so it is applied to the sharp scene first (convolution commutes); its
+  // truth is its taps' variance, not the sigma asked for.
+  const std::vector<double> floor_taps = detail::FloorTaps(o.floor_sigma_px, ss);
+  const int floor_reach = static_cast<int>(floor_taps.size()) / 2;
+  const double floor_var_px2 = detail::TapsVariance(floor_taps) / (double(ss) * ss);
+  // The sharp scene is rendered this far beyond the image: blur brings light in from there.
+  const int m = reach + floor_reach + 2;
+
+  std::vector<std::vector<bool>> flawed;
+  Json flaws_json;
+  const std::vector<Flaw> flaws = PlaceFlaws(o, pose, v, m, &flawed, &flaws_json);
+
+  // Pass 2: the sharp scene, box-filtered per sub-pixel, with and without the board, m sub-pixels beyond the image.
+  Rng texture_rng(o.seed, kTextureStream);
+  const Wood wood(texture_rng, o.table);
+  const double wall_phase = texture_rng.Uniform(0, 2 * kPi);
+  const double wall_level = std::clamp(0.5 * (o.table + o.white), 0.0, 1.0);
+  const int hp = hss + 2 * m, wp = wss + 2 * m;
+  // The table and wall are smooth, so they are shaded once per output pixel (footprint: the pixel) over the image
+  // plus the margin; the board's edges, which carry the measurement, are shaded per sub-pixel.
+  const int mb = (m + ss - 1) / ss;  // margin in whole pixels
+  const cv::Mat background = ShadeBackground(v, wood, wall_phase, wall_level, Wi, Hi, mb);
+  auto [sharp, sharp_no_board] = ShadeSharp(v, o, flaws, background, hp, wp, m, mb);
 
   // Pass 3: the floor, depth-varying blur, downsample, vignetting; then noise, sRGB, JPEG.
   if (floor_reach > 0) {
