@@ -62,7 +62,7 @@ add_test(NAME cli_render_ball
 set_tests_properties(cli_render_ball PROPERTIES FIXTURES_REQUIRED "scene;calib" LABELS gl FIXTURES_SETUP render_ball)
 add_test(NAME cli_render_bad_source
          COMMAND ${CMAKE_COMMAND} -DCMD=${BC} "-DARGS=render;--calib;${T}/calib.json;--background;${T}/scene/scene.png;--blur;blurry;--out;${T}/x.png"
-                 -DEXPECT_CODE=2 "-DEXPECT_TEXT=blur source must be none, measured, measured_section, estimated, fitted or a radius"
+                 -DEXPECT_CODE=2 "-DEXPECT_TEXT=--blur: blur source must be none, measured, measured_section, estimated, fitted or a radius"
                  -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
 set_tests_properties(cli_render_bad_source PROPERTIES FIXTURES_REQUIRED "scene;calib")
 add_test(NAME cli_animate_video

@@ -52,7 +52,7 @@ add_test(NAME cli_hostile_image_bad_iccp_is_quiet
 
 # render: a fixed radius of 1e9 and a NaN gain used to write the photo without the object and exit 0.
 hostile_test(cli_hostile_render_blur_1e9 2
-             "fitted or a radius in [0, 500] px, got '1e9'"
+             "--blur: blur source must be none, measured, measured_section, estimated, fitted or a radius in [0, 500] px, got '1e9'"
              render --calib ${T}/calib.json --background ${T}/scene/scene.png --blur 1e9 --out ${H}/x.png)
 hostile_test(cli_hostile_render_gain_nan 2 "--gain: must be a number in [0, 100], got 'nan'"
              render --calib ${T}/calib.json --background ${T}/scene/scene.png --gain nan --out ${H}/x.png)
@@ -184,7 +184,11 @@ set(ANIMATE animate --calib ${C}/calib.json --background ${C}/scene/scene.png --
 hostile_test(cli_hostile_animate_log_is_a_fifo 3 "fifo.csv: is not a regular file" ${ANIMATE} --video ${H}/v.avi
              --log ${H}/fifo.csv)
 hostile_test(cli_hostile_animate_video_not_avi 2 "--video ${H}/v.mp4: must end in .avi" ${ANIMATE} --video ${H}/v.mp4)
-set_tests_properties(cli_hostile_animate_log_is_a_fifo cli_hostile_animate_video_not_avi PROPERTIES
+# A blur source the command cannot read names the option it came from (it named none: "blur source must be ...").
+hostile_test(cli_hostile_animate_right_blur_negative 2 "--right: blur source must be" animate --calib ${C}/calib.json
+             --background ${C}/scene/scene.png --left estimated --right=-1 --video ${H}/v.avi)
+set_tests_properties(cli_hostile_animate_log_is_a_fifo cli_hostile_animate_video_not_avi
+                     cli_hostile_animate_right_blur_negative PROPERTIES
                      FIXTURES_REQUIRED "scene;calib" TIMEOUT 60)
 
 # A participant information key given twice: refused naming the key and both values, not the last one kept.

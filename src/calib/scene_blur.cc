@@ -204,7 +204,7 @@ SceneCalib LoadSceneCalib(const std::filesystem::path& path) {
   return SceneCalibFromJson(ReadJsonFile(path), path.string() + ": ");
 }
 
-BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px) {
+BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px, const std::string& option) {
   for (const BlurSource source : kBlurSources)
     if (source != BlurSource::kFixed && ToString(source) == text) return source;
   const std::optional<double> r = ParseDecimal(text);
@@ -214,7 +214,7 @@ BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px) {
   }
   std::string words;
   for (const std::string& word : BlurSourceWords()) words += (words.empty() ? "" : ", ") + word;
-  throw Error(ErrorKind::kUsage, "blur source must be " + words + " or a radius in [0, " +
+  throw Error(ErrorKind::kUsage, (option.empty() ? "" : option + ": ") + "blur source must be " + words + " or a radius in [0, " +
                                      std::to_string(int(optics::kMaxBlurRadiusPx)) + "] px, got " + Echo(text) +
                                      DidYouMean(text, BlurSourceWords()));
 }

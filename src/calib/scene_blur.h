@@ -45,8 +45,8 @@ SceneCalib SceneCalibFromJson(const Json& json, const std::string& where);
 using ::blurcue::BlurSource;
 using ::blurcue::ToString;
 // A word of BlurSourceWords() ("none", "measured", ...) or a number (a fixed radius in px), as a command takes it.
-// Throws Error(kUsage) otherwise, with a did-you-mean.
-BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px);
+// Throws Error(kUsage) otherwise, with a did-you-mean, its line starting "OPTION: " where the option is given.
+BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px, const std::string& option = "");
 
 // Blur radius (px) the scene calls for at a camera-frame point:
 //   measured  - the thesis's edge value (its Fig. 4.11): the mean r_px of the usable sections of the board edge

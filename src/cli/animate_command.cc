@@ -83,8 +83,8 @@ class RollingBalls {
  public:
   RollingBalls(const AnimateArgs& args, const calib::SceneCalib& scene, const scene::SurfaceTexture& texture)
       : args_(args), scene_(scene), texture_(texture) {
-    source_[0] = calib::ParseBlurSource(args.left, &fixed_[0]);
-    source_[1] = calib::ParseBlurSource(args.right, &fixed_[1]);
+    source_[0] = calib::ParseBlurSource(args.left, &fixed_[0], "--left");
+    source_[1] = calib::ParseBlurSource(args.right, &fixed_[1], "--right");
     y0_ = (args.from_edge - 1) * scene.board.square_mm;
     y1_ = (args.to_edge - 1) * scene.board.square_mm;
     half_mm_ = 0.5 * speed_mm_s() * args.exposure_ms / 1000 * (y1_ >= y0_ ? 1 : -1);

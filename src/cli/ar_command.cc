@@ -306,7 +306,7 @@ void AddArCommand(CLI::App& app) {
     const auto t0 = std::chrono::steady_clock::now();
     const std::string csv_path = CheckArOutputs(*args);
     stimulus::TakeBlur blur;
-    blur.source = calib::ParseBlurSource(args->blur, &blur.fixed_r_px);
+    blur.source = calib::ParseBlurSource(args->blur, &blur.fixed_r_px, "--blur");
     blur.method = args->method;
 
     std::vector<std::string> given;  // where each object was given, for messages: the option or the file's pointer

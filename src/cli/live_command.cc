@@ -136,7 +136,7 @@ LiveSetup SetUpLive(const LiveArgs& a) {
   GuardLiveOutputs(a);
   LiveSetup s;
   stimulus::TakeBlur blur;
-  blur.source = calib::ParseBlurSource(a.blur, &blur.fixed_r_px);
+  blur.source = calib::ParseBlurSource(a.blur, &blur.fixed_r_px, "--blur");
   live::RequireLiveSource(blur.source, "--blur");
   blur.method = a.method;
   std::vector<std::string> given;

@@ -64,7 +64,7 @@ void RenderObject(const RenderArgs& args, std::chrono::steady_clock::time_point 
     throw Error(ErrorKind::kUsage, "--section must be 1.." + std::to_string(scene.board.SectionCount()) +
                                        ", got " + std::to_string(args.section));
   double fixed_r = 0;
-  const calib::BlurSource source = calib::ParseBlurSource(args.blur, &fixed_r);
+  const calib::BlurSource source = calib::ParseBlurSource(args.blur, &fixed_r, "--blur");
 
   scene::VirtualObject object;
   const double y = (args.edge - 1) * scene.board.square_mm;
