@@ -63,7 +63,7 @@ class EndToEndTest(ReportTestCase):
                     "test2-pattern2-per-section", "test2-pattern4-per-section", "test2-pattern6-per-section",
                     "test3-pattern2-per-section", "test3-pattern4-per-section", "test3-pattern6-per-section",
                     "psychometric", "side-bias", "frame-intervals", "bench-measure-speed-accuracy", "bench-stability-within-target",
-                    "bench-stability-error", "bench-render-speed-accuracy", "bench-frame", "bench-frame-growth",
+                    "bench-stability-error", "bench-stability-flagged", "bench-render-speed-accuracy", "bench-frame", "bench-frame-growth",
                     "bench-procedures", "test1-static-grids-predicted-pair-simulated",
                     "test2-moving-balls-predicted-pair-simulated", "test3-no-board-predicted-pair-simulated"}
         self.assertEqual({p[:-4] for p in pngs}, expected)
