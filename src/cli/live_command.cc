@@ -133,11 +133,16 @@ LiveSetup SetUpLive(const LiveArgs& a) {
   if (a.track.empty() == a.calib.empty())
     throw Error(ErrorKind::kUsage, "give the lens model with one of --track DIR (a take blurcue track wrote) or "
                                    "--calib calib.json (blurcue calibrate)");
-  GuardLiveOutputs(a);
-  LiveSetup s;
   stimulus::TakeBlur blur;
   blur.source = calib::ParseBlurSource(a.blur, &blur.fixed_r_px, "--blur");
   live::RequireLiveSource(blur.source, "--blur");
+  // The sections measured live feed the lens model only: a source that draws without it would measure for nothing.
+  if (a.measure_sections > 0 && (blur.source == BlurSource::kNone || blur.source == BlurSource::kFixed))
+    throw Error(ErrorKind::kUsage,
+                "--measure-sections " + std::to_string(a.measure_sections) + ": feeds the lens model, which --blur " +
+                    a.blur + " does not draw with; give --blur fitted or estimated, or leave --measure-sections out");
+  GuardLiveOutputs(a);
+  LiveSetup s;
   blur.method = a.method;
   std::vector<std::string> given;
   std::vector<stimulus::PlacedObject> objects = PlaceObjects(a.objects, &given);
