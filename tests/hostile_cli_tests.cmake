@@ -234,3 +234,9 @@ foreach(pair "none;none" "radius;3")
                --measure-sections 5 --blur ${value} --log ${H}/live-measure-${tag})
   set_tests_properties(cli_hostile_live_measure_sections_blur_${tag} PROPERTIES FIXTURES_REQUIRED "scene;calib")
 endforeach()
+# bench live --quick runs N = 0, 4, 77 on at most 12 frames: --sections, or --frames over 12, beside it was ignored
+# (the run took minutes and its CSV said nothing of it). Refused before anything is rendered.
+hostile_test(cli_hostile_bench_live_quick_sections 2 "--sections: --quick runs N = 0, 4, 77 and would ignore it"
+             bench live --quick --sections 1,2 --out ${H}/bench-live.csv)
+hostile_test(cli_hostile_bench_live_quick_frames 2 "--frames 20: --quick runs at most 12 frames and would ignore it"
+             bench live --quick --frames 20 --out ${H}/bench-live.csv)

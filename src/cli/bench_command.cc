@@ -292,7 +292,16 @@ void AddLive(CLI::App& bench) {
   cmd->add_option("--seed", args->options.seed, "seed of the take's texture and noise")->capture_default_str()
       ->transform(SeedValidator());
   cmd->add_flag("--quick", args->quick, "12 frames, N = 0, 4, 77 (smoke run)");
-  cmd->callback([args] {
+  cmd->callback([args, cmd] {
+    // --quick sets the values of N itself and runs at most 12 frames: --sections, or --frames over 12, given beside
+    // it would be ignored.
+    if (args->quick && cmd->count("--sections") > 0)
+      throw Error(ErrorKind::kUsage, "--sections: --quick runs N = 0, 4, 77 and would ignore it; leave out --quick "
+                                     "or --sections");
+    if (args->quick && cmd->count("--frames") > 0 && args->options.frames > 12)
+      throw Error(ErrorKind::kUsage, "--frames " + std::to_string(args->options.frames) +
+                                         ": --quick runs at most 12 frames and would ignore it; leave out --quick or "
+                                         "give --frames 12 or fewer");
     OutputGuard().OutputFile("--out", args->out).Check();
     bench::LiveBenchOptions options = args->options;
     options.quick = args->quick;
