@@ -240,3 +240,14 @@ hostile_test(cli_hostile_bench_live_quick_sections 2 "--sections: --quick runs N
              bench live --quick --sections 1,2 --out ${H}/bench-live.csv)
 hostile_test(cli_hostile_bench_live_quick_frames 2 "--frames 20: --quick runs at most 12 frames and would ignore it"
              bench live --quick --frames 20 --out ${H}/bench-live.csv)
+# A TMPDIR that is a file or no folder at all: bench live (and bench track) ended in std::filesystem's own words as an
+# internal error (exit 10); now one line naming TMPDIR, exit 3, before anything is rendered. Their scratch folder is
+# made new (mkdtemp): bench live used to remove whatever TMPDIR/blurcue-bench-live-PID held first.
+foreach(pair "file;${D}/small.png;Not a directory" "missing;${H}/no-such-tmpdir;No such file or directory")
+  list(GET pair 0 tag)
+  list(GET pair 1 value)
+  list(GET pair 2 why)
+  hostile_test(cli_hostile_bench_live_tmpdir_${tag} 3 "TMPDIR ${value}: ${why}; the bench writes its take there"
+               bench live --quick --out ${H}/bench-live.csv)
+  set_tests_properties(cli_hostile_bench_live_tmpdir_${tag} PROPERTIES ENVIRONMENT "TMPDIR=${value}")
+endforeach()
