@@ -222,10 +222,11 @@ add_test(NAME cli_calibrate_aperture_far_from_nominal
          COMMAND ${BLURCUE_EXPECT} "warning: .*scene.png: the fitted aperture [0-9.]+ mm is 0.2[0-9] x the camera's \\(15.000 mm, f/1.4\\)" sh -c "/usr/bin/python3 -c \"import json, sys; c = json.load(open(sys.argv[1])); c['f_number'] = 1.4; json.dump(c, open(sys.argv[2], 'w'))\" ${T}/scene/camera.json ${H}/camera-f1.4.json && $<TARGET_FILE:blurcue> calibrate ${T}/scene/scene.png --camera ${H}/camera-f1.4.json --out ${H}/calib-f1.4.json --quiet")
 set_tests_properties(cli_calibrate_aperture_far_from_nominal PROPERTIES FIXTURES_REQUIRED scene)
 
-# live --measure-sections N feeds the lens model alone: with --blur none or a fixed radius the sections were measured
-# every frame (live.csv said so, lens_sections counted them) and nothing drawn used them. Refused before any file is
+# live --measure-sections N feeds the lens model alone: with --blur none, a fixed radius or estimated (eq. 3.7 from the
+# given reference edge) the sections were measured every frame (live.csv said so, lens_sections counted them) and
+# nothing drawn used them. Refused before any file is
 # read, naming both options.
-foreach(pair "none;none" "radius;3")
+foreach(pair "none;none" "radius;3" "estimated;estimated")
   list(GET pair 0 tag)
   list(GET pair 1 value)
   hostile_test(cli_hostile_live_measure_sections_blur_${tag} 2

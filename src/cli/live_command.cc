@@ -136,11 +136,12 @@ LiveSetup SetUpLive(const LiveArgs& a) {
   stimulus::TakeBlur blur;
   blur.source = calib::ParseBlurSource(a.blur, &blur.fixed_r_px, "--blur");
   live::RequireLiveSource(blur.source, "--blur");
-  // The sections measured live feed the lens model only: a source that draws without it would measure for nothing.
-  if (a.measure_sections > 0 && (blur.source == BlurSource::kNone || blur.source == BlurSource::kFixed))
+  // The sections measured live feed the lens model only: a source that draws without it would measure for nothing
+  // (estimated is eq. 3.7 from the given calibration's reference edge and the nominal aperture: no model either).
+  if (a.measure_sections > 0 && blur.source != BlurSource::kFitted)
     throw Error(ErrorKind::kUsage,
                 "--measure-sections " + std::to_string(a.measure_sections) + ": feeds the lens model, which --blur " +
-                    a.blur + " does not draw with; give --blur fitted or estimated, or leave --measure-sections out");
+                    a.blur + " does not draw with; give --blur fitted, or leave --measure-sections out");
   GuardLiveOutputs(a);
   LiveSetup s;
   blur.method = a.method;
@@ -416,7 +417,8 @@ void AddLiveCommand(CLI::App& app) {
                   "sections / N frames), and draw with the thin lens fitted to every section's latest reading once\n"
                   "they lie on 3 edges (the given model until then; fitted on a thread of its own, a frame draws with\n"
                   "the newest fit finished); live.csv says how many each frame measured.\n"
-                  "0: none, the given model throughout; at least the board's sections: all of them every frame")
+                  "0: none, the given model throughout; at least the board's sections: all of them every frame.\n"
+                  "With --blur fitted only (no other source draws with the model)")
       ->capture_default_str()->check(IntRange(0, 10000));
   cmd->add_flag("--quiet", a->quiet, "print only errors");
   cmd->callback([a] { RunLive(*a); });
