@@ -108,6 +108,14 @@ hostile_test(cli_hostile_synth_scene_post_sigma_without_filter 2 "--post-sigma-p
              synth-scene --out ${H}/scene --post-sigma-px 0.5)
 hostile_test(cli_hostile_synth_scene_post_amount_gaussian 2 "--post-amount: is for --post-filter sharpen, not gaussian"
              synth-scene --out ${H}/scene --post-filter gaussian --post-amount 0.3)
+# --post-amount alone named gaussian as a filter it would do for (it is sharpen's alone), and a filter given without
+# its values quoted the unset default ("--post-sigma-px: must be in (0, 5] px with a post filter, got 0").
+hostile_test(cli_hostile_synth_scene_post_amount_without_filter 2 "--post-amount: needs --post-filter sharpen (the filter is none)"
+             synth-scene --out ${H}/scene --post-amount 0.3)
+hostile_test(cli_hostile_synth_scene_post_filter_without_sigma 2 "--post-filter gaussian: needs --post-sigma-px S"
+             synth-scene --out ${H}/scene --post-filter gaussian)
+hostile_test(cli_hostile_synth_scene_sharpen_without_amount 2 "--post-filter sharpen: needs --post-amount A"
+             synth-scene --out ${H}/scene --post-filter sharpen --post-sigma-px 0.6)
 hostile_test(cli_hostile_synth_scene_seed_negative 2 "--seed: must be a whole number from 0 to 18446744073709551615, got '-3'"
              synth-scene --out ${H}/scene --seed=-3)
 hostile_test(cli_hostile_synth_pictures_focus_inf 2 "--focus-m: must be in (0, 1000] m, got 'inf'"

@@ -181,11 +181,17 @@ synth::SceneOptions SceneOptionsFrom(const SynthSceneArgs& a) {
   o.psf = a.psf == "gaussian" ? synth::Psf::kGaussian : synth::Psf::kDisc;
   o.post_filter.kind = synth::ParsePostFilter(a.post_filter);
   // A filter's option without that filter would be ignored: refused, naming what it needs.
-  if (o.post_filter.kind == synth::PostFilter::kNone && (a.post_sigma->count() > 0 || a.post_amount->count() > 0))
-    throw UsageError(a.post_sigma->count() > 0 ? "--post-sigma-px" : "--post-amount",
-                     "needs --post-filter gaussian or sharpen (the filter is none)");
+  if (o.post_filter.kind == synth::PostFilter::kNone && a.post_sigma->count() > 0)
+    throw UsageError("--post-sigma-px", "needs --post-filter gaussian or sharpen (the filter is none)");
+  if (o.post_filter.kind == synth::PostFilter::kNone && a.post_amount->count() > 0)
+    throw UsageError("--post-amount", "needs --post-filter sharpen (the filter is none)");
   if (o.post_filter.kind == synth::PostFilter::kGaussian && a.post_amount->count() > 0)
     throw UsageError("--post-amount", "is for --post-filter sharpen, not gaussian");
+  // A filter without its values: named as missing (the message used to quote the unset default, "got 0").
+  if (o.post_filter.kind != synth::PostFilter::kNone && a.post_sigma->count() == 0)
+    throw UsageError("--post-filter " + a.post_filter, "needs --post-sigma-px S, the std of its Gaussian in (0, 5] px");
+  if (o.post_filter.kind == synth::PostFilter::kSharpen && a.post_amount->count() == 0)
+    throw UsageError("--post-filter sharpen", "needs --post-amount A, how much of the blurred copy it takes away, in (0, 5]");
   if (!a.focus.empty()) o.focus_mm = ParseFocus(a.focus);
   o.board = Board::Parse(a.board, a.square_mm);
   if (!(a.square_mm > 0)) throw UsageError("--square-mm", "must be > 0, got " + std::to_string(a.square_mm));
