@@ -249,6 +249,9 @@ hostile_test(cli_hostile_bench_live_quick_sections 2 "--sections: --quick runs N
              bench live --quick --sections 1,2 --out ${H}/bench-live.csv)
 hostile_test(cli_hostile_bench_live_quick_frames 2 "--frames 20: --quick runs at most 12 frames and would ignore it"
              bench live --quick --frames 20 --out ${H}/bench-live.csv)
+# A value of N given twice ran twice, into the same log folder, and wrote two rows for it.
+hostile_test(cli_hostile_bench_live_sections_twice 2 "--sections: 4 is given twice; give each value of N once"
+             bench live --sections 0,4,4 --out ${H}/bench-live.csv)
 # A TMPDIR that is a file or no folder at all: bench live (and bench track) ended in std::filesystem's own words as an
 # internal error (exit 10); now one line naming TMPDIR, exit 3, before anything is rendered. Their scratch folder is
 # made new (mkdtemp): bench live used to remove whatever TMPDIR/blurcue-bench-live-PID held first.

@@ -302,6 +302,12 @@ void AddLive(CLI::App& bench) {
       throw Error(ErrorKind::kUsage, "--frames " + std::to_string(args->options.frames) +
                                          ": --quick runs at most 12 frames and would ignore it; leave out --quick or "
                                          "give --frames 12 or fewer");
+    // A value of N given twice ran twice into the same log folder and wrote two rows for it.
+    for (size_t i = 0; i < args->options.sections.size(); ++i)
+      for (size_t j = 0; j < i; ++j)
+        if (args->options.sections[i] == args->options.sections[j])
+          throw Error(ErrorKind::kUsage, "--sections: " + std::to_string(args->options.sections[i]) +
+                                             " is given twice; give each value of N once");
     OutputGuard().OutputFile("--out", args->out).Check();
     bench::LiveBenchOptions options = args->options;
     options.quick = args->quick;
