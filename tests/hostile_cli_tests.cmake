@@ -252,6 +252,12 @@ hostile_test(cli_hostile_bench_live_quick_frames 2 "--frames 20: --quick runs at
 # A value of N given twice ran twice, into the same log folder, and wrote two rows for it.
 hostile_test(cli_hostile_bench_live_sections_twice 2 "--sections: 4 is given twice; give each value of N once"
              bench live --sections 0,4,4 --out ${H}/bench-live.csv)
+# bench live and bench track run the blurcue beside them: --out naming that executable replaced it with the CSV.
+foreach(bench live track)
+  hostile_test(cli_hostile_bench_${bench}_out_is_blurcue 2
+               "is also the input the blurcue it runs $<TARGET_FILE:blurcue>; an output may not replace an input"
+               bench ${bench} --quick --out $<TARGET_FILE:blurcue>)
+endforeach()
 # A TMPDIR that is a file or no folder at all: bench live (and bench track) ended in std::filesystem's own words as an
 # internal error (exit 10); now one line naming TMPDIR, exit 3, before anything is rendered. Their scratch folder is
 # made new (mkdtemp): bench live used to remove whatever TMPDIR/blurcue-bench-live-PID held first.

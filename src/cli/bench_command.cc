@@ -251,7 +251,8 @@ void AddTrack(CLI::App& bench) {
       ->transform(SeedValidator());
   cmd->add_flag("--quick", args->quick, "the first 4 frames of the take (smoke run)");
   cmd->callback([args] {
-    OutputGuard().OutputFile("--out", args->out).Check();
+    // It runs this blurcue as a child: --out naming it would replace the executable with the CSV.
+    OutputGuard().Input("the blurcue it runs", ExecutableDir() / "blurcue").OutputFile("--out", args->out).Check();
     bench::TrackBenchOptions options;
     options.frames = args->frames;
     options.quick = args->quick;
@@ -308,7 +309,8 @@ void AddLive(CLI::App& bench) {
         if (args->options.sections[i] == args->options.sections[j])
           throw Error(ErrorKind::kUsage, "--sections: " + std::to_string(args->options.sections[i]) +
                                              " is given twice; give each value of N once");
-    OutputGuard().OutputFile("--out", args->out).Check();
+    // It runs this blurcue once for each N: --out naming it replaced the executable with the CSV.
+    OutputGuard().Input("the blurcue it runs", ExecutableDir() / "blurcue").OutputFile("--out", args->out).Check();
     bench::LiveBenchOptions options = args->options;
     options.quick = args->quick;
     options.progress = ProgressLine;
