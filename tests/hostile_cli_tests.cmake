@@ -279,3 +279,12 @@ hostile_test(cli_hostile_live_log_of_frames 3 "--log ${H}/live-frames-only: hold
              live ${T}/scene/scene.png --camera ${T}/scene/camera.json --calib ${T}/calib.json --ball 87.5,125
              --log ${H}/live-frames-only)
 set_tests_properties(cli_hostile_live_log_of_frames PROPERTIES FIXTURES_REQUIRED "scene;calib;live_frames_only")
+# synth-scene --out DIR replaces DIR whole when it holds its four file names only: a folder of one's own camera.json
+# (or a photo named scene.png) alone was replaced, the file gone. A scene it wrote always holds truth.json.
+add_test(NAME cli_hostile_synth_scene_own_camera_make
+         COMMAND ${CMAKE_COMMAND} -E copy ${T}/scene/camera.json ${H}/own-camera/camera.json)
+set_tests_properties(cli_hostile_synth_scene_own_camera_make PROPERTIES FIXTURES_REQUIRED scene
+                     FIXTURES_SETUP own_camera)
+hostile_test(cli_hostile_synth_scene_own_camera 3 "--out ${H}/own-camera: holds no truth.json: not a scene synth-scene wrote"
+             synth-scene --out ${H}/own-camera --width 300)
+set_tests_properties(cli_hostile_synth_scene_own_camera PROPERTIES FIXTURES_REQUIRED own_camera)
