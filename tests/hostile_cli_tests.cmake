@@ -288,3 +288,7 @@ set_tests_properties(cli_hostile_synth_scene_own_camera_make PROPERTIES FIXTURES
 hostile_test(cli_hostile_synth_scene_own_camera 3 "--out ${H}/own-camera: holds no truth.json: not a scene synth-scene wrote"
              synth-scene --out ${H}/own-camera --width 300)
 set_tests_properties(cli_hostile_synth_scene_own_camera PROPERTIES FIXTURES_REQUIRED own_camera)
+# The same for synth-take --out (a take it wrote always holds take.json).
+hostile_test(cli_hostile_synth_take_own_camera 3 "--out ${H}/own-camera: holds no take.json: not a take synth-take wrote"
+             synth-take --out ${H}/own-camera --frames 2)
+set_tests_properties(cli_hostile_synth_take_own_camera PROPERTIES FIXTURES_REQUIRED own_camera)
