@@ -108,6 +108,14 @@ hostile_test(cli_hostile_synth_scene_post_sigma_without_filter 2 "--post-sigma-p
              synth-scene --out ${H}/scene --post-sigma-px 0.5)
 hostile_test(cli_hostile_synth_scene_post_amount_gaussian 2 "--post-amount: is for --post-filter sharpen, not gaussian"
              synth-scene --out ${H}/scene --post-filter gaussian --post-amount 0.3)
+# --post-amount alone named gaussian as a filter it would do for (it is sharpen's alone), and a filter given without
+# its values quoted the unset default ("--post-sigma-px: must be in (0, 5] px with a post filter, got 0").
+hostile_test(cli_hostile_synth_scene_post_amount_without_filter 2 "--post-amount: needs --post-filter sharpen (the filter is none)"
+             synth-scene --out ${H}/scene --post-amount 0.3)
+hostile_test(cli_hostile_synth_scene_post_filter_without_sigma 2 "--post-filter gaussian: needs --post-sigma-px S"
+             synth-scene --out ${H}/scene --post-filter gaussian)
+hostile_test(cli_hostile_synth_scene_sharpen_without_amount 2 "--post-filter sharpen: needs --post-amount A"
+             synth-scene --out ${H}/scene --post-filter sharpen --post-sigma-px 0.6)
 hostile_test(cli_hostile_synth_scene_seed_negative 2 "--seed: must be a whole number from 0 to 18446744073709551615, got '-3'"
              synth-scene --out ${H}/scene --seed=-3)
 hostile_test(cli_hostile_synth_pictures_focus_inf 2 "--focus-m: must be in (0, 1000] m, got 'inf'"
@@ -221,3 +229,66 @@ set_tests_properties(cli_hostile_calibrate_two_depths PROPERTIES FIXTURES_REQUIR
 add_test(NAME cli_calibrate_aperture_far_from_nominal
          COMMAND ${BLURCUE_EXPECT} "warning: .*scene.png: the fitted aperture [0-9.]+ mm is 0.2[0-9] x the camera's \\(15.000 mm, f/1.4\\)" sh -c "/usr/bin/python3 -c \"import json, sys; c = json.load(open(sys.argv[1])); c['f_number'] = 1.4; json.dump(c, open(sys.argv[2], 'w'))\" ${T}/scene/camera.json ${H}/camera-f1.4.json && $<TARGET_FILE:blurcue> calibrate ${T}/scene/scene.png --camera ${H}/camera-f1.4.json --out ${H}/calib-f1.4.json --quiet")
 set_tests_properties(cli_calibrate_aperture_far_from_nominal PROPERTIES FIXTURES_REQUIRED scene)
+
+# live --measure-sections N feeds the lens model alone: with --blur none, a fixed radius or estimated (eq. 3.7 from the
+# given reference edge) the sections were measured every frame (live.csv said so, lens_sections counted them) and
+# nothing drawn used them. Refused before any file is
+# read, naming both options.
+foreach(pair "none;none" "radius;3" "estimated;estimated")
+  list(GET pair 0 tag)
+  list(GET pair 1 value)
+  hostile_test(cli_hostile_live_measure_sections_blur_${tag} 2
+               "--measure-sections 5: feeds the lens model, which --blur ${value} does not draw with"
+               live ${T}/scene/scene.png --camera ${T}/scene/camera.json --calib ${T}/calib.json --ball 87.5,125
+               --measure-sections 5 --blur ${value} --log ${H}/live-measure-${tag})
+  set_tests_properties(cli_hostile_live_measure_sections_blur_${tag} PROPERTIES FIXTURES_REQUIRED "scene;calib")
+endforeach()
+# bench live --quick runs N = 0, 4, 77 on at most 12 frames: --sections, or --frames over 12, beside it was ignored
+# (the run took minutes and its CSV said nothing of it). Refused before anything is rendered.
+hostile_test(cli_hostile_bench_live_quick_sections 2 "--sections: --quick runs N = 0, 4, 77 and would ignore it"
+             bench live --quick --sections 1,2 --out ${H}/bench-live.csv)
+hostile_test(cli_hostile_bench_live_quick_frames 2 "--frames 20: --quick runs at most 12 frames and would ignore it"
+             bench live --quick --frames 20 --out ${H}/bench-live.csv)
+# A value of N given twice ran twice, into the same log folder, and wrote two rows for it.
+hostile_test(cli_hostile_bench_live_sections_twice 2 "--sections: 4 is given twice; give each value of N once"
+             bench live --sections 0,4,4 --out ${H}/bench-live.csv)
+# bench live and bench track run the blurcue beside them: --out naming that executable replaced it with the CSV.
+foreach(bench live track)
+  hostile_test(cli_hostile_bench_${bench}_out_is_blurcue 2
+               "is also the input the blurcue it runs $<TARGET_FILE:blurcue>; an output may not replace an input"
+               bench ${bench} --quick --out $<TARGET_FILE:blurcue>)
+endforeach()
+# A TMPDIR that is a file or no folder at all: bench live (and bench track) ended in std::filesystem's own words as an
+# internal error (exit 10); now one line naming TMPDIR, exit 3, before anything is rendered. Their scratch folder is
+# made new (mkdtemp): bench live used to remove whatever TMPDIR/blurcue-bench-live-PID held first.
+foreach(pair "file;${D}/small.png;Not a directory" "missing;${H}/no-such-tmpdir;No such file or directory")
+  list(GET pair 0 tag)
+  list(GET pair 1 value)
+  list(GET pair 2 why)
+  hostile_test(cli_hostile_bench_live_tmpdir_${tag} 3 "TMPDIR ${value}: ${why}; the bench writes its take there"
+               bench live --quick --out ${H}/bench-live.csv)
+  set_tests_properties(cli_hostile_bench_live_tmpdir_${tag} PROPERTIES ENVIRONMENT "TMPDIR=${value}")
+endforeach()
+# live --log DIR replaces DIR whole when it holds live's files only; frame-NNNN.png counts as one (--save-frame), so a
+# folder of such images alone (ar --frames, a take's frames) was replaced and its images deleted. A log live wrote
+# always holds live.csv: without it, refused before anything is read.
+add_test(NAME cli_hostile_live_log_of_frames_make
+         COMMAND ${CMAKE_COMMAND} -E copy ${D}/small.png ${H}/live-frames-only/frame-0000.png)
+set_tests_properties(cli_hostile_live_log_of_frames_make PROPERTIES FIXTURES_SETUP live_frames_only)
+hostile_test(cli_hostile_live_log_of_frames 3 "--log ${H}/live-frames-only: holds no live.csv: not a log live wrote"
+             live ${T}/scene/scene.png --camera ${T}/scene/camera.json --calib ${T}/calib.json --ball 87.5,125
+             --log ${H}/live-frames-only)
+set_tests_properties(cli_hostile_live_log_of_frames PROPERTIES FIXTURES_REQUIRED "scene;calib;live_frames_only")
+# synth-scene --out DIR replaces DIR whole when it holds its four file names only: a folder of one's own camera.json
+# (or a photo named scene.png) alone was replaced, the file gone. A scene it wrote always holds truth.json.
+add_test(NAME cli_hostile_synth_scene_own_camera_make
+         COMMAND ${CMAKE_COMMAND} -E copy ${T}/scene/camera.json ${H}/own-camera/camera.json)
+set_tests_properties(cli_hostile_synth_scene_own_camera_make PROPERTIES FIXTURES_REQUIRED scene
+                     FIXTURES_SETUP own_camera)
+hostile_test(cli_hostile_synth_scene_own_camera 3 "--out ${H}/own-camera: holds no truth.json: not a scene synth-scene wrote"
+             synth-scene --out ${H}/own-camera --width 300)
+set_tests_properties(cli_hostile_synth_scene_own_camera PROPERTIES FIXTURES_REQUIRED own_camera)
+# The same for synth-take --out (a take it wrote always holds take.json).
+hostile_test(cli_hostile_synth_take_own_camera 3 "--out ${H}/own-camera: holds no take.json: not a take synth-take wrote"
+             synth-take --out ${H}/own-camera --frames 2)
+set_tests_properties(cli_hostile_synth_take_own_camera PROPERTIES FIXTURES_REQUIRED own_camera)

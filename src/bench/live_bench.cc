@@ -10,6 +10,7 @@
 #include <map>
 #include <sstream>
 
+#include "bench/scratch.h"
 #include "calib/calibrate.h"
 #include "core/atomic_file.h"
 #include "core/csv.h"
@@ -120,10 +121,8 @@ std::vector<LiveBenchRow> RunLiveBench(const LiveBenchOptions& options) {
   take.scene.noise_std = 0.004;
   take.scene.seed = options.seed;
   const std::vector<int> sections = options.quick ? std::vector<int>{0, 4, 77} : options.sections;
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("blurcue-bench-live-" + std::to_string(getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  // A folder of its own, made new (it used to remove whatever TMPDIR/blurcue-bench-live-PID held first).
+  const std::filesystem::path dir = detail::MakeScratchFolder("blurcue-bench-live-");
   const synth::TakeFiles files = synth::WriteTake(take, dir / "take", options.progress);
   // Played as a camera delivers: the video where OpenCV could write one, else the frames.
   const std::string input = (dir / "take" / (files.video.empty() ? synth::kTakeFramePattern : files.video)).string();

@@ -16,6 +16,7 @@
 
 #include <opencv2/imgcodecs.hpp>  // its flags (the functions: core/media.h)
 #include "bench/clock.h"
+#include "bench/scratch.h"
 #include "core/media.h"
 
 #include "calib/calibrate.h"
@@ -97,9 +98,7 @@ std::vector<TrackRow> CalibrateProcessRows(const std::vector<std::vector<uint8_t
                                            const TrackBenchOptions& options) {
   const int frames = int(png.size());
   const std::filesystem::path exe = ExecutableDir() / "blurcue";
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("blurcue-bench-track-" + std::to_string(getpid()));
-  std::filesystem::create_directories(dir);
+  const std::filesystem::path dir = detail::MakeScratchFolder("blurcue-bench-track-");
   WriteJsonFile(dir / "camera.json", CameraToJson(camera));
   std::map<int, const TrackRow*> in_process;
   for (const TrackRow& r : rows)

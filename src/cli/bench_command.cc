@@ -251,7 +251,8 @@ void AddTrack(CLI::App& bench) {
       ->transform(SeedValidator());
   cmd->add_flag("--quick", args->quick, "the first 4 frames of the take (smoke run)");
   cmd->callback([args] {
-    OutputGuard().OutputFile("--out", args->out).Check();
+    // It runs this blurcue as a child: --out naming it would replace the executable with the CSV.
+    OutputGuard().Input("the blurcue it runs", ExecutableDir() / "blurcue").OutputFile("--out", args->out).Check();
     bench::TrackBenchOptions options;
     options.frames = args->frames;
     options.quick = args->quick;
@@ -292,8 +293,24 @@ void AddLive(CLI::App& bench) {
   cmd->add_option("--seed", args->options.seed, "seed of the take's texture and noise")->capture_default_str()
       ->transform(SeedValidator());
   cmd->add_flag("--quick", args->quick, "12 frames, N = 0, 4, 77 (smoke run)");
-  cmd->callback([args] {
-    OutputGuard().OutputFile("--out", args->out).Check();
+  cmd->callback([args, cmd] {
+    // --quick sets the values of N itself and runs at most 12 frames: --sections, or --frames over 12, given beside
+    // it would be ignored.
+    if (args->quick && cmd->count("--sections") > 0)
+      throw Error(ErrorKind::kUsage, "--sections: --quick runs N = 0, 4, 77 and would ignore it; leave out --quick "
+                                     "or --sections");
+    if (args->quick && cmd->count("--frames") > 0 && args->options.frames > 12)
+      throw Error(ErrorKind::kUsage, "--frames " + std::to_string(args->options.frames) +
+                                         ": --quick runs at most 12 frames and would ignore it; leave out --quick or "
+                                         "give --frames 12 or fewer");
+    // A value of N given twice ran twice into the same log folder and wrote two rows for it.
+    for (size_t i = 0; i < args->options.sections.size(); ++i)
+      for (size_t j = 0; j < i; ++j)
+        if (args->options.sections[i] == args->options.sections[j])
+          throw Error(ErrorKind::kUsage, "--sections: " + std::to_string(args->options.sections[i]) +
+                                             " is given twice; give each value of N once");
+    // It runs this blurcue once for each N: --out naming it replaced the executable with the CSV.
+    OutputGuard().Input("the blurcue it runs", ExecutableDir() / "blurcue").OutputFile("--out", args->out).Check();
     bench::LiveBenchOptions options = args->options;
     options.quick = args->quick;
     options.progress = ProgressLine;

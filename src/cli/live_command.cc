@@ -126,6 +126,14 @@ void GuardLiveOutputs(const LiveArgs& a) {
   } catch (const Error& e) {
     throw e.Wrapped(e.kind(), "--log ");
   }
+  // A log live wrote always holds live.csv: a folder of frame-NNNN.png alone (ar --frames, a take's frames) passed
+  // the check above and was replaced, its images gone.
+  std::error_code ec;
+  if (std::filesystem::is_directory(a.log, ec) && !std::filesystem::is_empty(a.log, ec) &&
+      !std::filesystem::exists(std::filesystem::path(a.log) / "live.csv", ec))
+    throw InputError("--log " + a.log, "holds no live.csv: not a log live wrote (frame-NNNN.png images of another "
+                                       "run or tool?), and the folder is replaced as a whole, so give a new or empty "
+                                       "one (nothing was written)");
   RemoveLeftoversBeside("live", a.log);
 }
 
@@ -133,11 +141,17 @@ LiveSetup SetUpLive(const LiveArgs& a) {
   if (a.track.empty() == a.calib.empty())
     throw Error(ErrorKind::kUsage, "give the lens model with one of --track DIR (a take blurcue track wrote) or "
                                    "--calib calib.json (blurcue calibrate)");
-  GuardLiveOutputs(a);
-  LiveSetup s;
   stimulus::TakeBlur blur;
   blur.source = calib::ParseBlurSource(a.blur, &blur.fixed_r_px, "--blur");
   live::RequireLiveSource(blur.source, "--blur");
+  // The sections measured live feed the lens model only: a source that draws without it would measure for nothing
+  // (estimated is eq. 3.7 from the given calibration's reference edge and the nominal aperture: no model either).
+  if (a.measure_sections > 0 && blur.source != BlurSource::kFitted)
+    throw Error(ErrorKind::kUsage,
+                "--measure-sections " + std::to_string(a.measure_sections) + ": feeds the lens model, which --blur " +
+                    a.blur + " does not draw with; give --blur fitted, or leave --measure-sections out");
+  GuardLiveOutputs(a);
+  LiveSetup s;
   blur.method = a.method;
   std::vector<std::string> given;
   std::vector<stimulus::PlacedObject> objects = PlaceObjects(a.objects, &given);
@@ -411,7 +425,8 @@ void AddLiveCommand(CLI::App& app) {
                   "sections / N frames), and draw with the thin lens fitted to every section's latest reading once\n"
                   "they lie on 3 edges (the given model until then; fitted on a thread of its own, a frame draws with\n"
                   "the newest fit finished); live.csv says how many each frame measured.\n"
-                  "0: none, the given model throughout; at least the board's sections: all of them every frame")
+                  "0: none, the given model throughout; at least the board's sections: all of them every frame.\n"
+                  "With --blur fitted only (no other source draws with the model)")
       ->capture_default_str()->check(IntRange(0, 10000));
   cmd->add_flag("--quiet", a->quiet, "print only errors");
   cmd->callback([a] { RunLive(*a); });

@@ -181,11 +181,17 @@ synth::SceneOptions SceneOptionsFrom(const SynthSceneArgs& a) {
   o.psf = a.psf == "gaussian" ? synth::Psf::kGaussian : synth::Psf::kDisc;
   o.post_filter.kind = synth::ParsePostFilter(a.post_filter);
   // A filter's option without that filter would be ignored: refused, naming what it needs.
-  if (o.post_filter.kind == synth::PostFilter::kNone && (a.post_sigma->count() > 0 || a.post_amount->count() > 0))
-    throw UsageError(a.post_sigma->count() > 0 ? "--post-sigma-px" : "--post-amount",
-                     "needs --post-filter gaussian or sharpen (the filter is none)");
+  if (o.post_filter.kind == synth::PostFilter::kNone && a.post_sigma->count() > 0)
+    throw UsageError("--post-sigma-px", "needs --post-filter gaussian or sharpen (the filter is none)");
+  if (o.post_filter.kind == synth::PostFilter::kNone && a.post_amount->count() > 0)
+    throw UsageError("--post-amount", "needs --post-filter sharpen (the filter is none)");
   if (o.post_filter.kind == synth::PostFilter::kGaussian && a.post_amount->count() > 0)
     throw UsageError("--post-amount", "is for --post-filter sharpen, not gaussian");
+  // A filter without its values: named as missing (the message used to quote the unset default, "got 0").
+  if (o.post_filter.kind != synth::PostFilter::kNone && a.post_sigma->count() == 0)
+    throw UsageError("--post-filter " + a.post_filter, "needs --post-sigma-px S, the std of its Gaussian in (0, 5] px");
+  if (o.post_filter.kind == synth::PostFilter::kSharpen && a.post_amount->count() == 0)
+    throw UsageError("--post-filter sharpen", "needs --post-amount A, how much of the blurred copy it takes away, in (0, 5]");
   if (!a.focus.empty()) o.focus_mm = ParseFocus(a.focus);
   o.board = Board::Parse(a.board, a.square_mm);
   if (!(a.square_mm > 0)) throw UsageError("--square-mm", "must be > 0, got " + std::to_string(a.square_mm));
@@ -254,6 +260,14 @@ void RunSynthScene(const SynthSceneArgs& a) {
   // The four files are written beside --out and swapped in whole; a folder of anything else (a photo of one's own
   // named scene.png among other files) is refused before the render, not overwritten.
   RequireReplaceableFolder(a.out, OurSceneFile);
+  // A scene synth-scene wrote always holds truth.json: a folder of one's own camera.json or photo named scene.png
+  // alone passed the check above and was replaced, the file gone.
+  std::error_code ec;
+  if (std::filesystem::is_directory(a.out, ec) && !std::filesystem::is_empty(a.out, ec) &&
+      !std::filesystem::exists(std::filesystem::path(a.out) / "truth.json", ec))
+    throw InputError("--out " + a.out, "holds no truth.json: not a scene synth-scene wrote (one's own camera.json or "
+                                       "scene.png?), and the folder is replaced as a whole, so give a new or empty "
+                                       "one (nothing was written)");
   const synth::SceneOptions o = SceneOptionsFrom(a);
   synth::Scene scene;
   try {

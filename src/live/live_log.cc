@@ -62,6 +62,7 @@ LiveSummary Summarize(const std::vector<LiveRow>& rows, int dropped, const std::
     latency.push_back(r.latency_ms);
     measure.push_back(r.measure_ms);
     s.sections_per_frame = std::max(s.sections_per_frame, r.sections);
+    s.lens_sections = r.lens_sections;
     track.push_back(r.track_ms);
     render.push_back(r.render_ms);
     s.max_latency_ms = std::max(s.max_latency_ms, r.latency_ms);
@@ -89,6 +90,11 @@ std::string SummaryLine(const LiveSummary& s) {
                 "%d found, %d tracked, %d lost; %.1f frames a second shown of %.1f delivered",
                 s.shown, s.dropped, delivered > 0 ? 100.0 * s.dropped / delivered : 0.0, s.median_latency_ms,
                 s.p95_latency_ms, s.max_latency_ms, s.found, s.tracked, s.lost, s.shown_fps, s.delivered_fps);
+  // --measure-sections: whether the lens model was ever fitted live, else the run drew with the given one throughout.
+  if (s.sections_per_frame > 0)
+    return line + (s.lens_sections > 0 ? "; lens model fitted live to " + std::to_string(s.lens_sections) + " readings"
+                                       : std::string("; lens model never fitted live (readings on fewer than 3 "
+                                                     "edges, or no fit found one): the given one throughout"));
   return line;
 }
 
@@ -106,6 +112,7 @@ Json SummaryJson(const LiveSummary& s) {
   j["median_render_ms"] = s.median_render_ms;
   j["median_measure_ms"] = s.median_measure_ms;
   j["sections_per_frame"] = s.sections_per_frame;
+  j["lens_sections"] = s.lens_sections;
   j["shown_fps"] = s.shown_fps;
   j["delivered_fps"] = s.delivered_fps;
   j["ended"] = s.ended;

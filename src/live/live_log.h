@@ -43,6 +43,7 @@ struct LiveSummary {
   double median_latency_ms = 0, p95_latency_ms = 0, max_latency_ms = 0;
   double median_track_ms = 0, median_render_ms = 0, median_measure_ms = 0;
   int sections_per_frame = 0;  // the most sections a frame measured (--measure-sections)
+  int lens_sections = 0;  // the readings the last frame's lens model was fitted to live (0: the given model)
   double shown_fps = 0;   // frames shown a second, between the first display and the last
   double delivered_fps = 0;  // frames the input delivered a second (dropped ones too), between the first arrival shown
                              // and the last: a camera's own rate, or a video's pace when its decoding kept up

@@ -249,6 +249,22 @@ TEST(LiveLog, SummaryCountsAndNearestRankLatencies) {
   EXPECT_EQ(s.p95_latency_ms, 19);     // 0.95 x 19 = 18.05 -> the 19th
   EXPECT_EQ(s.max_latency_ms, 20);
   EXPECT_NE(SummaryLine(s).find("20 frames shown, 1 dropped (4.8 %)"), std::string::npos) << SummaryLine(s);
+  EXPECT_EQ(SummaryLine(s).find("lens model"), std::string::npos) << SummaryLine(s);  // no --measure-sections
+}
+
+// A run with --measure-sections says whether its lens model was ever fitted live (a take too short for 3 edges'
+// readings drew with the given one throughout, and the summary used to say nothing of it).
+TEST(LiveLog, SummarySaysWhetherTheLensWasFittedLive) {
+  std::vector<LiveRow> rows(2);
+  for (LiveRow& r : rows) r.sections = 1;
+  LiveSummary s = Summarize(rows, 0, "ended");
+  EXPECT_EQ(s.lens_sections, 0);
+  EXPECT_NE(SummaryLine(s).find("lens model never fitted live"), std::string::npos) << SummaryLine(s);
+  EXPECT_EQ(SummaryJson(s)["lens_sections"], 0);
+  rows.back().lens_sections = 3;
+  s = Summarize(rows, 0, "ended");
+  EXPECT_NE(SummaryLine(s).find("lens model fitted live to 3 readings"), std::string::npos) << SummaryLine(s);
+  EXPECT_EQ(SummaryJson(s)["lens_sections"], 3);
 }
 
 TEST(LiveLog, ALostFrameHasAnEmptyPose) {
