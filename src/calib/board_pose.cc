@@ -107,8 +107,10 @@ BoardPose FindBoardPose(const cv::Mat& grey8, const Camera& camera, const Board&
 
   RefineCorners(grey8, board, found);
 
-  // OpenCV returns ny rows of nx corners in one of four orders; put them in the board frame: y (rows) away from
-  // the camera so edge 1 is the nearest, x left to right in the image.
+  // OpenCV returns ny rows of nx corners in one of four orders; put them in the board frame with z = x cross y up
+  // (towards the camera) and edge 1 the nearest. The two orders with z up are a half turn apart (the board looks
+  // the same turned half a turn); of those, edge 1 is the one whose first row is nearer at the board's middle. (Its
+  // x = 0 end, or "x left to right in the image", picks the wrong one on a board turned past about 75 deg.)
   auto at = [&](int ix, int iy, bool flip_x, bool flip_y) {
     return found[(flip_y ? ny - 1 - iy : iy) * nx + (flip_x ? nx - 1 - ix : ix)];
   };
@@ -118,14 +120,25 @@ BoardPose FindBoardPose(const cv::Mat& grey8, const Camera& camera, const Board&
       for (int ix = 0; ix < nx; ++ix) c.push_back(at(ix, iy, flip_x, flip_y));
     return c;
   };
-  const bool flip_x = at(nx - 1, 0, false, false).x < at(0, 0, false, false).x;
+  bool flip_x = at(nx - 1, 0, false, false).x < at(0, 0, false, false).x, flip_y = false;
   BoardPose pose;
-  pose.corners = ordered(flip_x, false);
-  SolvePose(pose.corners, board, camera, pose.rvec, pose.tvec);
-  const double z_first = ToCamera(pose, {0, board.square_mm, 0})[2];
-  const double z_last = ToCamera(pose, {0, ny * board.square_mm, 0})[2];
-  // Flipping the row order alone keeps x left to right; with y away from the camera, z = x cross y points up.
-  if (z_last < z_first) pose.corners = ordered(flip_x, true);
+  auto solve = [&] {
+    pose.corners = ordered(flip_x, flip_y);
+    SolvePose(pose.corners, board, camera, pose.rvec, pose.tvec);
+  };
+  solve();
+  cv::Matx33d rotation;
+  cv::Rodrigues(pose.rvec, rotation);
+  // Mirroring the rows mirrors the frame: the solved board's normal turns over.
+  if (cv::Vec3d(rotation(0, 2), rotation(1, 2), rotation(2, 2)).dot(pose.tvec) > 0) {
+    flip_y = true;
+    solve();
+  }
+  const double middle_mm = 0.5 * (nx + 1) * board.square_mm;
+  const double z_first = ToCamera(pose, {middle_mm, board.square_mm, 0})[2];
+  const double z_last = ToCamera(pose, {middle_mm, ny * board.square_mm, 0})[2];
+  if (z_last < z_first) flip_x = !flip_x, flip_y = !flip_y;
+  pose.corners = ordered(flip_x, flip_y);
   pose.reprojection_error_px = SolvePose(pose.corners, board, camera, pose.rvec, pose.tvec);
   return pose;
 }
