@@ -4,6 +4,7 @@ import json
 import math
 import os
 import re
+import sys
 from collections import namedtuple
 
 import matplotlib
@@ -389,6 +390,24 @@ def save(fig, out_dir, name):
     finally:
         plt.close(fig)
     return png, svg
+
+
+def chart_command(argv, default_csv, command, columns, chart):
+    """A bench chart's command line: `python3 X_chart.py [CSV [OUT_DIR]]` draws chart(table, out_dir) from the CSV
+    `blurcue COMMAND` wrote (default default_csv); exit 3 with one line when it is missing or lacks a column."""
+    path = argv[1] if len(argv) > 1 else default_csv
+    out_dir = argv[2] if len(argv) > 2 else os.path.dirname(path) or "."
+    if not os.path.isfile(path):
+        print(f"{path}: no such file (run blurcue {command})", file=sys.stderr)
+        return 3
+    df = pd.read_csv(path)
+    missing = [c for c in columns if c not in df.columns]
+    if missing:
+        print(f"{path}: missing columns {', '.join(missing)}", file=sys.stderr)
+        return 3
+    png, _ = chart(df, out_dir)
+    print(f"wrote {png}")
+    return 0
 
 
 def wilson_columns(table, k_col, n_col, prefix):

@@ -8,15 +8,13 @@ and the blur accuracy it buys, one point per N.
 
 Usage: live_chart.py [results/bench/live.csv] [OUT_DIR]   (writes OUT_DIR/bench-live.png and .svg)
 """
-import os
 import sys
 
 import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
-import pandas as pd
 
-from common import save
+from common import chart_command, save
 
 COLUMNS = ["sections_per_frame", "frames_delivered", "frames_dropped", "median_latency_ms", "p95_latency_ms",
            "r_median_rel_error", "r_late_median_rel_error", "load1"]
@@ -61,19 +59,7 @@ def chart(df, out_dir):
 
 
 def main(argv):
-    path = argv[1] if len(argv) > 1 else "results/bench/live.csv"
-    out_dir = argv[2] if len(argv) > 2 else os.path.dirname(path) or "."
-    if not os.path.isfile(path):
-        print(f"{path}: no such file (run blurcue bench live)", file=sys.stderr)
-        return 3
-    df = pd.read_csv(path)
-    missing = [c for c in COLUMNS if c not in df.columns]
-    if missing:
-        print(f"{path}: missing columns {', '.join(missing)}", file=sys.stderr)
-        return 3
-    png, _ = chart(df, out_dir)
-    print(f"wrote {png}")
-    return 0
+    return chart_command(argv, "results/bench/live.csv", "bench live", COLUMNS, chart)
 
 
 if __name__ == "__main__":

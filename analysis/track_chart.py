@@ -8,15 +8,13 @@ on every frame (calibrate-process; its accuracy is the in-process calibrate's, N
 
 Usage: track_chart.py [results/bench/track.csv] [OUT_DIR]   (writes OUT_DIR/bench-track.png and .svg)
 """
-import os
 import sys
 
 import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
-import pandas as pd
 
-from common import save
+from common import chart_command, save
 
 COLUMNS = ["mode", "frame", "status", "frame_ms", "cpu_ms", "max_depth_error_rel", "r_median_rel_error"]
 COLORS = {"track": "#0072B2", "track-inline": "#009E73", "track-serial": "#56B4E9", "detect": "#E69F00", "calibrate": "#D55E00", "calibrate-process": "#CC79A7"}
@@ -45,19 +43,7 @@ def chart(df, out_dir):
 
 
 def main(argv):
-    path = argv[1] if len(argv) > 1 else "results/bench/track.csv"
-    out_dir = argv[2] if len(argv) > 2 else os.path.dirname(path) or "."
-    if not os.path.isfile(path):
-        print(f"{path}: no such file (run blurcue bench track)", file=sys.stderr)
-        return 3
-    df = pd.read_csv(path)
-    missing = [c for c in COLUMNS if c not in df.columns]
-    if missing:
-        print(f"{path}: missing columns {', '.join(missing)}", file=sys.stderr)
-        return 3
-    png, _ = chart(df, out_dir)
-    print(f"wrote {png}")
-    return 0
+    return chart_command(argv, "results/bench/track.csv", "bench track", COLUMNS, chart)
 
 
 if __name__ == "__main__":
