@@ -26,6 +26,12 @@ foreach(backend cpu gl)
 endforeach()
 hostile_test(cli_hostile_blur_radius_not_a_number 2 "--radius-px: must be in [0, 500] px, got '3px'"
              blur ${D}/small.png --radius-px 3px --out ${H}/x.png)
+# An image name no encoder writes was refused only after the work, exit 3, naming no option ("cannot encode an image
+# as ''"): now before it, exit 2, naming the option.
+hostile_test(cli_hostile_blur_out_no_extension 2 "--out ${H}/blurred: no image can be written as ''"
+             blur ${D}/small.png --radius-px 2 --out ${H}/blurred)
+hostile_test(cli_hostile_preview_out_unknown_extension 2 "--out ${H}/sheet.xyz: no image can be written as '.xyz': name the file .png"
+             preview ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json --out ${H}/sheet.xyz)
 hostile_test(cli_hostile_blur_cutoff_nan 2 "--cutoff: must be in (0, 100000] cycles per image width, got 'nan'"
              blur ${D}/small.png --method butterworth --cutoff nan --out ${H}/x.png)
 hostile_test(cli_hostile_blur_cutoff_zero 2 "--cutoff: must be in (0, 100000] cycles per image width, got 0"

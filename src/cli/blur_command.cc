@@ -37,6 +37,7 @@ void AddBlurCommand(CLI::App& app) {
       ->check(CLI::IsMember({"gl", "cpu"}))->capture_default_str();
   cmd->callback([args] {
     OutputGuard().Input("IN", args->in).OutputFile("--out", args->out).Check();
+    RequireImageName("--out", args->out);
     const bool butterworth = args->method == "butterworth";
     if (butterworth && args->cutoff <= 0)
       throw Error(ErrorKind::kUsage, "--method butterworth needs --cutoff (cycles per image width)");

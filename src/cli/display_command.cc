@@ -92,7 +92,10 @@ void AddDisplayCommand(CLI::App& app) {
       ->transform(IntRange(0, 16));
   cmd->add_option("--screenshot", args->screenshot, "also write the test screen as a PNG");
   cmd->callback([args] {
-    if (!args->screenshot.empty()) OutputGuard().OutputFile("--screenshot", args->screenshot).Check();
+    if (!args->screenshot.empty()) {
+      OutputGuard().OutputFile("--screenshot", args->screenshot).Check();
+      RequireImageName("--screenshot", args->screenshot);
+    }
     const display::Profile profile =
         args->profile.empty() ? display::DefaultProfile() : display::LoadProfile(args->profile);
     render::WindowOptions options;

@@ -72,6 +72,7 @@ void AddPreviewCommand(CLI::App& app) {
       guard.Input("PROTOCOL", args->protocol);
       if (!args->display.empty()) guard.Input("--display", args->display);
       guard.OutputFile("--out", args->out).Check();
+      RequireImageName("--out", args->out);
     }
     // The pre-flight of blurcue run: the same checks, and every trial's scene already worked out.
     preview::SheetOptions options;
@@ -88,6 +89,7 @@ void AddPreviewCommand(CLI::App& app) {
                                         {"content.image", prepared.protocol.content.image}})
         if (!path.empty() && std::filesystem::exists(path)) guard.Input(std::string("the protocol's ") + name, path);
       guard.OutputFile("--out", args->out).Check();
+      RequireImageName("--out", args->out);
     }
     options.groups = GroupsToCheck(prepared.protocol, args->group);
     options.participant = args->participant;

@@ -198,6 +198,7 @@ void AddRenderCommand(CLI::App& app) {
         if (std::filesystem::exists(texture)) guard.Input("--object", texture);
       }
       guard.OutputFile("--out", args->out).Check();
+      RequireImageName("--out", args->out);
     }
     if (args->object.rfind("picture", 0) == 0) return RenderPicture(*args);
     RenderObject(*args, t0);

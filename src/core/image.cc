@@ -199,6 +199,18 @@ cv::Mat ReadImage(const std::filesystem::path& path, int flags) {
   return image;
 }
 
+void RequireImageName(const std::string& option, const std::filesystem::path& path) {
+  std::vector<uchar> bytes;
+  bool ok = false;
+  try {
+    ok = media::Imencode(path.extension().string(), cv::Mat(1, 1, CV_8UC3, cv::Scalar::all(0)), &bytes);
+  } catch (const cv::Exception&) {
+  }
+  if (!ok)
+    throw Error(ErrorKind::kUsage, option + " " + path.string() + ": no image can be written as '" +
+                                       path.extension().string() + "': " + kImageNameHint);
+}
+
 void WriteImage(const std::filesystem::path& path, const cv::Mat& image) {
   // Encoded in memory (OpenCV picks the encoder from the target's extension), then one atomic write.
   std::vector<uchar> bytes;
@@ -208,7 +220,7 @@ void WriteImage(const std::filesystem::path& path, const cv::Mat& image) {
   } catch (const cv::Exception&) {
     // OpenCV's own text runs over several lines and names its source file: say what the user can change instead.
     throw InputError(path.string(), "cannot encode an image as '" + path.extension().string() +
-                                        "': name the file .png, .jpg, .tif or .bmp");
+                                        "': " + kImageNameHint);
   }
   if (!ok) throw InputError(path.string(), "cannot encode image");
   WriteFileAtomically(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));

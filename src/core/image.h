@@ -13,6 +13,11 @@ namespace blurcue {
 cv::Mat ReadImage(const std::filesystem::path& path, int flags = -1 /* cv::IMREAD_UNCHANGED */);
 // Writes atomically (core/atomic_file.h); creates the folder; throws naming the file on failure.
 void WriteImage(const std::filesystem::path& path, const cv::Mat& image);
+// What an image's name should end in, as the refusals say it.
+inline constexpr const char* kImageNameHint = "name the file .png, .jpg, .tif or .bmp";
+// Refuses (Error(kUsage), naming `option` and the path) a name WriteImage could not encode an image as ('x',
+// 'x.xyz': no encoder for its extension, tried on one pixel), so a command says so before its work, not after.
+void RequireImageName(const std::string& option, const std::filesystem::path& path);
 
 // Opens `video` on an .avi at `path`: lossless FFV1 first (measurements are of edges a JPEG would soften), MJPEG,
 // which every videoio writes, else. Returns the codec opened ("FFV1" or "MJPG"), or nullptr when neither opens.
