@@ -52,3 +52,9 @@ foreach(yaw 85 -80)
   set_tests_properties(turned_pose_${yaw}_gen PROPERTIES FIXTURES_SETUP turned_pose_${yaw} LABELS turned)
   set_tests_properties(turned_pose_${yaw} PROPERTIES FIXTURES_REQUIRED turned_pose_${yaw} LABELS turned)
 endforeach()
+# The summary says how many used sections were read on a shorter part (it named only those left out).
+add_test(NAME turned_45_front_says_short
+         COMMAND ${BLURCUE_EXPECT} "\n[1-9][0-9]* of them read on a shorter central part \\(flag short"
+                 $<TARGET_FILE:blurcue> calibrate ${TURNED_DIR}/45_front/scene.png --camera ${TURNED_DIR}/45_front/camera.json
+                 --out ${TURNED_DIR}/45_front-summary-calib.json)
+set_tests_properties(turned_45_front_says_short PROPERTIES FIXTURES_REQUIRED turned_45_front LABELS "slow;turned")

@@ -59,6 +59,15 @@ void PrintCalibrationSummary(const calib::CalibResult& result, const Board& boar
       left += (left.empty() ? "" : ", ") + std::to_string(n) + " " + why, n_left += n;
     std::printf("the model is fitted to %d of %d sections%s\n", sections - n_left, sections,
                 left.empty() ? "" : ("; left out (it predicts them): " + left).c_str());
+    // Sections used but read on a shorter central part (a neighbouring X-junction within the blur's reach): said,
+    // as the flag in calib.json says it, since such a reading can run a few per cent high.
+    int n_short = 0;
+    for (const auto& e : result.edges)
+      for (const auto& sec : e.sections)
+        n_short += sec.fit.ok && std::find(sec.fit.flags.begin(), sec.fit.flags.end(), "short") != sec.fit.flags.end();
+    if (n_short > 0)
+      std::printf("%d of them read on a shorter central part (flag short: an X-junction within the blur's reach of "
+                  "the usual half)\n", n_short);
   }
 }
 
