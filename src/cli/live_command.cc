@@ -126,14 +126,8 @@ void GuardLiveOutputs(const LiveArgs& a) {
   } catch (const Error& e) {
     throw e.Wrapped(e.kind(), "--log ");
   }
-  // A log live wrote always holds live.csv: a folder of frame-NNNN.png alone (ar --frames, a take's frames) passed
-  // the check above and was replaced, its images gone.
-  std::error_code ec;
-  if (std::filesystem::is_directory(a.log, ec) && !std::filesystem::is_empty(a.log, ec) &&
-      !std::filesystem::exists(std::filesystem::path(a.log) / "live.csv", ec))
-    throw InputError("--log " + a.log, "holds no live.csv: not a log live wrote (frame-NNNN.png images of another "
-                                       "run or tool?), and the folder is replaced as a whole, so give a new or empty "
-                                       "one (nothing was written)");
+  // A folder of frame-NNNN.png alone (ar --frames, a take's frames) passed the check above and was replaced.
+  RequireMarkedFolder("--log", a.log, "live.csv", "a log live wrote", "frame-NNNN.png images of another run or tool?");
   RemoveLeftoversBeside("live", a.log);
 }
 

@@ -260,14 +260,8 @@ void RunSynthScene(const SynthSceneArgs& a) {
   // The four files are written beside --out and swapped in whole; a folder of anything else (a photo of one's own
   // named scene.png among other files) is refused before the render, not overwritten.
   RequireReplaceableFolder(a.out, OurSceneFile);
-  // A scene synth-scene wrote always holds truth.json: a folder of one's own camera.json or photo named scene.png
-  // alone passed the check above and was replaced, the file gone.
-  std::error_code ec;
-  if (std::filesystem::is_directory(a.out, ec) && !std::filesystem::is_empty(a.out, ec) &&
-      !std::filesystem::exists(std::filesystem::path(a.out) / "truth.json", ec))
-    throw InputError("--out " + a.out, "holds no truth.json: not a scene synth-scene wrote (one's own camera.json or "
-                                       "scene.png?), and the folder is replaced as a whole, so give a new or empty "
-                                       "one (nothing was written)");
+  // A folder of one's own camera.json or photo named scene.png alone passed the check above and was replaced.
+  RequireMarkedFolder("--out", a.out, "truth.json", "a scene synth-scene wrote", "one's own camera.json or scene.png?");
   const synth::SceneOptions o = SceneOptionsFrom(a);
   synth::Scene scene;
   try {

@@ -71,14 +71,8 @@ void AddSynthTakeCommand(CLI::App& app) {
   cmd->callback([args] {
     const auto t0 = std::chrono::steady_clock::now();
     OutputGuard().OutputFolder("--out", args->out).Check();
-    // A take synth-take wrote always holds take.json: a folder of one's own camera.json or frame-NNNN.png images alone
-    // passed as a take's files and was replaced, the files gone.
-    std::error_code ec;
-    if (std::filesystem::is_directory(args->out, ec) && !std::filesystem::is_empty(args->out, ec) &&
-        !std::filesystem::exists(std::filesystem::path(args->out) / "take.json", ec))
-      throw InputError("--out " + args->out, "holds no take.json: not a take synth-take wrote (one's own camera.json "
-                                             "or frames?), and the folder is replaced as a whole, so give a new or "
-                                             "empty one (nothing was written)");
+    // A folder of one's own camera.json or frame-NNNN.png images alone passed as a take's files and was replaced.
+    RequireMarkedFolder("--out", args->out, "take.json", "a take synth-take wrote", "one's own camera.json or frames?");
     synth::TakeOptions o = args->o;
     o.scene.seed = args->seed;
     auto progress = [&](const std::string& line) {

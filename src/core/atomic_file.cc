@@ -159,6 +159,15 @@ void RequireReplaceableFolder(const fs::path& dir, const std::function<bool(cons
   if (error) throw InputError(where, "cannot list the folder: " + error.message());
 }
 
+void RequireMarkedFolder(const std::string& option, const fs::path& dir, const std::string& marker,
+                         const std::string& what, const std::string& guess) {
+  std::error_code ec;
+  if (fs::is_directory(dir, ec) && !fs::is_empty(dir, ec) && !fs::exists(dir / marker, ec))
+    throw InputError(option + " " + dir.string(), "holds no " + marker + ": not " + what + " (" + guess +
+                                                      "), and the folder is replaced as a whole, so give a new or "
+                                                      "empty one (nothing was written)");
+}
+
 void WriteFolderAtomically(const fs::path& dir, const std::function<void(const fs::path& partial)>& fill,
                            const std::function<bool(const std::string& name)>& ours,
                            const std::function<void()>& before_swap) {

@@ -36,6 +36,11 @@ void RequireReplaceableFile(const std::filesystem::path& path);
 // WriteFolderAtomically's check before it writes, alone: throws its Error(kInput) when `dir` exists and is not a
 // folder or holds an entry `ours` does not claim. For a command to refuse such a folder before long work.
 void RequireReplaceableFolder(const std::filesystem::path& dir, const std::function<bool(const std::string& name)>& ours);
+// A folder a command replaces whole and always writes `marker` into (truth.json, take.json, live.csv): a non-empty
+// `dir` without it is someone else's (files named like the command's own, say) and is refused, Error(kInput)
+// "OPTION DIR: holds no MARKER: not WHAT (GUESS), and the folder is replaced as a whole, ...".
+void RequireMarkedFolder(const std::string& option, const std::filesystem::path& dir, const std::string& marker,
+                         const std::string& what, const std::string& guess);
 // `before_swap` (optional) runs once the new folder is whole on disk, just before the rename that swaps it in: for
 // a command whose outputs are this folder and files elsewhere, to move those in at the same moment (its throwing
 // discards the folder like `fill`'s).
