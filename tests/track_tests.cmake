@@ -54,3 +54,21 @@ add_test(NAME track_read_back_edits
                  ${PROJECT_BINARY_DIR}/track-cut/take ${PROJECT_BINARY_DIR}/track-cut/good
                  ${PROJECT_BINARY_DIR}/track-cut/edits)
 set_tests_properties(track_read_back_edits PROPERTIES FIXTURES_REQUIRED track_cut_good LABELS gl)
+# ar --frames DIR replaces DIR whole when it holds ar's files only; a folder of one's own frame-NNNN.png images alone
+# passed that check and was replaced, its images deleted. ar writes ar-frames.txt into every frames folder: a folder
+# without it is refused before any work (exit 3), and one ar wrote is replaced by the next run.
+set(AR_OWN ${PROJECT_BINARY_DIR}/track-cut/own-frames)
+add_test(NAME ar_frames_own_images_make
+         COMMAND ${CMAKE_COMMAND} -E copy ${PROJECT_BINARY_DIR}/track-cut/take/frame-0000.png ${AR_OWN}/frame-0000.png)
+set_tests_properties(ar_frames_own_images_make PROPERTIES FIXTURES_REQUIRED track_cut FIXTURES_SETUP ar_own_frames)
+set(AR_ARGS ar;${PROJECT_BINARY_DIR}/track-cut/take/frame-%04d.png;--track;${PROJECT_BINARY_DIR}/track-cut/good;--ball;87.5,125)
+string(REPLACE ";" " " AR_WORDS "${AR_ARGS}")
+add_test(NAME ar_frames_own_images_refused
+         COMMAND ${CMAKE_COMMAND} -DCMD=$<TARGET_FILE:blurcue> "-DARGS=${AR_ARGS};--out;${AR_OWN}.avi;--frames;${AR_OWN}"
+                 -DEXPECT_CODE=3 "-DEXPECT_TEXT=--frames ${AR_OWN}: holds no ar-frames.txt: not frames ar drew"
+                 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+set_tests_properties(ar_frames_own_images_refused PROPERTIES FIXTURES_REQUIRED "track_cut_good;ar_own_frames" LABELS gl)
+add_test(NAME ar_frames_replaced_when_ars
+         COMMAND sh -c "set -e; B=${PROJECT_BINARY_DIR}/track-cut/ar-again; rm -rf $B $B.avi $B.csv; for i in 1 2; do $<TARGET_FILE:blurcue> ${AR_WORDS} --out $B.avi --frames $B --quiet; rm $B.avi $B.csv; done; ls $B | tr '\\n' ' '; echo END")
+set_tests_properties(ar_frames_replaced_when_ars PROPERTIES FIXTURES_REQUIRED track_cut_good LABELS gl
+                     PASS_REGULAR_EXPRESSION "^ar-frames.txt frame-0000.png frame-0001.png frame-0002.png END")

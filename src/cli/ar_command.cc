@@ -56,8 +56,13 @@ struct ArArgs {
 
 namespace fs = std::filesystem;
 
-// A name --frames may hold: frame-NNNN.png.
+// The file ar writes into every --frames folder beside its images: a non-empty folder without it is not one ar
+// wrote (one's own frame-NNNN.png images, say) and is refused rather than replaced.
+constexpr const char* kArFramesMarker = "ar-frames.txt";
+
+// A name --frames may hold: frame-NNNN.png, and the marker.
 bool IsArFrameName(const std::string& name) {
+  if (name == kArFramesMarker) return true;
   return name.size() == 14 && name.rfind("frame-", 0) == 0 && name.compare(10, 4, ".png") == 0 &&
          name.find_first_not_of("0123456789", 6) == 10;
 }
@@ -89,6 +94,10 @@ std::string CheckArOutputs(const ArArgs& args) {
   } catch (const Error& e) {
     throw e.Wrapped(e.kind(), "--frames ");
   }
+  // A folder of frame-NNNN.png alone (one's own images, a take's frames) passed the check above and was replaced.
+  if (!args.frames_dir.empty())
+    RequireMarkedFolder("--frames", args.frames_dir, kArFramesMarker, "frames ar drew",
+                        "one's own frame-NNNN.png images?");
   for (const std::string& target : {args.out, csv_path, args.frames_dir})
     if (!target.empty()) RemoveLeftoversBeside("ar", target);
   return csv_path;
@@ -338,7 +347,13 @@ void AddArCommand(CLI::App& app) {
     MakePartialFolder(csv_partial, csv_path);
     const fs::path csv_temp = csv_partial / fs::path(csv_path).filename();
     ArDrawing drawing{*args, take, objects, blur, source, video_temp};
-    auto draw = [&](const fs::path& frames_dir) { drawing.DrawFrames(frames_dir); };
+    auto draw = [&](const fs::path& frames_dir) {
+      drawing.DrawFrames(frames_dir);
+      if (!frames_dir.empty())
+        WriteFileAtomically(frames_dir / kArFramesMarker,
+                            "frame-NNNN.png: frames blurcue ar drew (its video's frames with the objects); a later "
+                            "`ar --frames` may replace this folder whole, as it holds this file.\n");
+    };
     // The video and the CSV, both whole on disk, are moved into place by two renames one after the other, and with
     // --frames the frames folder is swapped in by a third right after (WriteFolderAtomically's before_swap): the
     // three are no single step, but all that lies between them is three renames.
