@@ -633,9 +633,9 @@ ModelFit MeasureEdgeModel(const cv::Mat& linear, const EdgeSegment& segment, con
   // The X-junctions at the section's ends within reach of the part used (a large blur on a short section: a turned
   // board's far squares): a shorter central part, down to a fifth of the section, keeps them out of the blur's whole
   // reach (BlurReachPx: a Gaussian's 3 std, a disc's radius + 3 floor std), not only of r + 1 as CrowdedReason asks:
-  // at r + 1 the short parts read up to 6 % high on turned scenes, at the whole reach within 4 % (why the shorter
-  // part reads higher at all is not known: docs/independent-truth.md). Only where that is the one reason left; the
-  // size and position start from the fit so far.
+  // at r + 1 the short parts read up to 6 % high on turned scenes, at the whole reach within 4 % (mostly the
+  // neighbours' steps misplaced, since fixed in NeighbourWindow: docs/independent-truth.md). Only where that is the
+  // one reason left; the size and position start from the fit so far.
   const double shorter = AlongFractionClearOfJunctions(segment, used, BlurReachPx(fit) - 1);
   if (!why.empty() && fit.r_px > 0 && shorter < options.along_fraction && shorter >= kMinAlongFraction) {
     ModelFitOptions narrower = options;
