@@ -76,7 +76,7 @@ std::vector<optics::BlurSample> ModelSamples(const CalibResult& result) {
 
 std::map<std::string, int> SectionsLeftOut(const CalibResult& result) {
   // Informational flags never disqualify a section (edge_blur.h).
-  static const std::vector<std::string> kInformational = {"flaw", "neighbours", "short"};
+  static const std::vector<std::string> kInformational = {"flaw", "neighbours", "short", "junctions"};
   std::map<std::string, int> out;
   for (const auto& edge : result.edges)
     for (const auto& s : edge.sections) {

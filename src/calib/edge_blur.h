@@ -50,9 +50,11 @@ struct ModelFit {
   std::vector<std::string> flags;  // "low_contrast", "saturated", "crowded", "poor_fit", "too_few_pixels",
                                    // "phase_limited" (phase_check.h)
                                    // disqualify; "flaw" (robustly rejected outliers), "neighbours" (measured
-                                   // across the neighbouring edges, their steps in the model) and "short" (a
+                                   // across the neighbouring edges, their steps in the model), "short" (a
                                    // shorter central part than along_fraction, to keep the X-junctions out of a
-                                   // large blur) are informational
+                                   // large blur) and "junctions" (the X-junctions within the blur's reach of even
+                                   // the shortest part: the crossing lines in the model, edge_junction.h) are
+                                   // informational
   std::string crowded_why;         // with "crowded": why the blur cannot be measured here, in words
   // With "phase_limited" (set by the calibration, phase_check.h: an edge along the pixel rows with blur near or
   // below a pixel, whose reading depends on a PSF family the photo does not pin): why, in words.

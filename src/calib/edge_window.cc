@@ -8,14 +8,19 @@
 namespace blurcue::calib {
 namespace {
 
-// Signed distance along the normal from the section's middle to the neighbour's line (px); 0 when the neighbour is
-// degenerate or runs along the normal.
-double NeighbourDistance(const EdgeFrame& x, const NeighbourEdge& k) {
-  const cv::Point2d m = x.a + 0.5 * x.length * x.t, dir = k.b - k.a;
-  const double along = x.t.dot(dir);
-  if (!(std::abs(along) > 1e-9)) return 0;
-  const double lambda = x.t.dot(m - k.a) / along;  // where the normal through m meets the neighbour's line
-  const double g = x.n.dot(k.a + lambda * dir - m);
+// Signed distance along the normal from the section's middle to the neighbour's line (px), where the samples' strip
+// meets it: the strip's centre leaves the middle along n + shear t (shear: the mean slant of the crossing lines the
+// samples keep between, EdgeWindow::ka and kb). The board's rows converge in the image, so on a turned board (its
+// squares parallelograms: shear of 1-2) the neighbour lies nearer or farther there than on the normal; its step
+// modelled at the normal's distance made short far sections read 3-5 % high. 0 when the neighbour is degenerate or
+// runs along the strip.
+double NeighbourDistance(const EdgeFrame& x, const NeighbourEdge& k, double shear) {
+  const cv::Point2d m = x.a + 0.5 * x.length * x.t, dir = k.b - k.a, centre = x.n + shear * x.t;
+  // m + g centre = k.a + lambda dir, solved for g (Cramer's rule).
+  const cv::Point2d rhs = k.a - m;
+  const double det = centre.x * (-dir.y) - centre.y * (-dir.x);
+  if (!(std::abs(det) > 1e-9 * cv::norm(dir))) return 0;
+  const double g = (rhs.x * (-dir.y) - rhs.y * (-dir.x)) / det;
   return std::isfinite(g) ? g : 0;
 }
 
@@ -69,10 +74,18 @@ EdgeWindow PlainWindow(const EdgeSegment& segment) {
 EdgeWindow NeighbourWindow(const EdgeSegment& segment, double reach_px) {
   EdgeWindow w = PlainWindow(segment);
   const EdgeFrame x = MakeEdgeFrame(segment);
+  // The crossing lines' own directions where calibrate gave them; otherwise the lines to the neighbours' ends.
+  const bool crossing = segment.cross_a != cv::Point2d(0, 0) || segment.cross_b != cv::Point2d(0, 0);
   double ka = 0, kb = 0;
   int slopes = 0;
   for (const NeighbourEdge& k : segment.neighbours) {
-    const double g = NeighbourDistance(x, k);
+    if (!(k.beyond_px >= 0) || NeighbourDistance(x, k, 0) == 0) continue;
+    ka += ColumnSlope(x, segment.a, k.a), kb += ColumnSlope(x, segment.b, k.b), ++slopes;
+  }
+  if (slopes > 0 && !crossing) w.ka = ka / slopes, w.kb = kb / slopes;
+  const double shear = 0.5 * (w.ka + w.kb);
+  for (const NeighbourEdge& k : segment.neighbours) {
+    const double g = NeighbourDistance(x, k, shear);
     if (g == 0 || !(k.beyond_px >= 0)) continue;
     EdgeWindow::Side& side = g > 0 ? w.plus : w.minus;
     if (side.neighbour_px > 0 && side.neighbour_px <= std::abs(g)) continue;  // the nearer one on a side
@@ -80,11 +93,7 @@ EdgeWindow NeighbourWindow(const EdgeSegment& segment, double reach_px) {
     side.neighbour_r_px = std::isfinite(k.r_px) && k.r_px > 0 ? k.r_px : 0;
     // Past the neighbour until the edge after it (2 x beyond_px further) comes within reach.
     side.end_px = side.neighbour_px + std::max(0.0, std::min(k.beyond_px, 2 * k.beyond_px - reach_px));
-    ka += ColumnSlope(x, segment.a, k.a), kb += ColumnSlope(x, segment.b, k.b), ++slopes;
   }
-  // The crossing lines' own directions where calibrate gave them; otherwise the lines to the neighbours' ends.
-  const bool crossing = segment.cross_a != cv::Point2d(0, 0) || segment.cross_b != cv::Point2d(0, 0);
-  if (slopes > 0 && !crossing) w.ka = ka / slopes, w.kb = kb / slopes;
   return w;
 }
 
@@ -144,7 +153,7 @@ double AlongFractionClearOfJunctions(const EdgeSegment& segment, const EdgeWindo
 }
 
 std::string CrowdedReason(const EdgeSegment& segment, const EdgeWindow& window, const ModelFit& fit,
-                          double along_fraction, double along_span_px, bool plain) {
+                          double along_fraction, double along_span_px, bool plain, bool junctions_modelled) {
   const double r = fit.r_px, offset = std::abs(fit.offset_px);
   const double reach = plain ? 1.5 * r + 2 : BlurReachPx(fit);
   for (const EdgeWindow::Side* side : {&window.minus, &window.plus}) {
@@ -166,7 +175,7 @@ std::string CrowdedReason(const EdgeSegment& segment, const EdgeWindow& window, 
   }
   const double length = cv::norm(segment.b - segment.a), frac = std::clamp(along_fraction, 0.0, 1.0);
   const double margin = (1 - frac) * JunctionMarginPerUnusedPx(segment, window);
-  if (margin < r + 1)
+  if (margin < r + 1 && !junctions_modelled)
     return Format("the X-junctions at the section's ends lie %.1f px from the part measured, within its blur (r = "
                   "%.2f px): the section is too short", margin, r);
   if (along_span_px < std::min(2 * reach, 0.5 * frac * length))

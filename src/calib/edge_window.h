@@ -74,7 +74,8 @@ double AlongFractionClearOfJunctions(const EdgeSegment& segment, const EdgeWindo
 // within reach, the X-junctions within reach of the part used, or the image border leaving too little of it.
 // `plain`: the window holds no neighbour, so the levels rest on the plateaus alone and need the plain margin
 // (1.5 r + 2 px on each side).
+// `junctions_modelled`: the X-junctions are in the profile model (edge_junction.h), so their reach is no reason.
 std::string CrowdedReason(const EdgeSegment& segment, const EdgeWindow& window, const ModelFit& fit,
-                          double along_fraction, double along_span_px, bool plain);
+                          double along_fraction, double along_span_px, bool plain, bool junctions_modelled = false);
 
 }  // namespace blurcue::calib

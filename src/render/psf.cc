@@ -138,6 +138,12 @@ double Psf::RadiusAcrossPx(const cv::Vec2d& normal) const {
   return r_px * cv::norm(shape.t() * (normal / len));
 }
 
+double Psf::FloorAcrossPx(const cv::Vec2d& normal) const {
+  const double len = cv::norm(normal);
+  if (!(len > 0)) return FloorSigmaPx();
+  return FloorSigmaPx() * cv::norm(shape.t() * (normal / len));
+}
+
 bool Psf::General() const {
   return MotionLengthPx() > 0 || Stretched() || (method == "disc" && FloorSigmaPx() > 0);
 }

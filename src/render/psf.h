@@ -32,6 +32,10 @@ struct Psf {
   // The radius (2 x the std of the line-spread function, without the motion) across an edge whose normal is
   // `normal` (any length): r |shape^T n|. (1, 0): across a vertical edge, the profile along x; (0, 1): along y.
   double RadiusAcrossPx(const cv::Vec2d& normal) const;
+  // The lens floor's std as drawn across an edge whose normal is `normal`: FloorSigmaPx() |shape^T n|. The floor is
+  // inside the round PSF the shape stretches, so it is stretched along and across as the photo's floor is there
+  // (docs/distortion.md); floor_sigma_px is the round value (their geometric mean).
+  double FloorAcrossPx(const cv::Vec2d& normal) const;
   // Whether it needs the general kernel (one 2-D pass): a streak, a pillbox with a floor, or a shape. Otherwise the
   // separable Gaussian or the pillbox pass draws it (a Gaussian defocus x a Gaussian floor is the Gaussian of r).
   bool General() const;

@@ -164,6 +164,9 @@ Json DescribeFrame(const calib::SceneCalib* scene, const TrialScene& trial, cons
                     {round(b.shape(1, 0), 1e-6), round(b.shape(1, 1), 1e-6)}}},
          // The PSF's parts (render/psf.h): r^2 = defocus_r^2 + 4 floor_sigma^2, and the motion streak beside it.
          {"floor_sigma_screen_px", round(presentation.ScreenPx(floor), 1e-4)},
+         // The floor is inside the PSF the shape stretches: across a vertical and a horizontal edge, as the photo's.
+         {"floor_sigma_x_screen_px", round(presentation.ScreenPx(floor * cv::norm(cv::Vec2d(b.shape(0, 0), b.shape(0, 1)))), 1e-4)},
+         {"floor_sigma_y_screen_px", round(presentation.ScreenPx(floor * cv::norm(cv::Vec2d(b.shape(1, 0), b.shape(1, 1)))), 1e-4)},
          {"defocus_r_screen_px", round(presentation.ScreenPx(std::sqrt(std::max(0.0, b.r_px * b.r_px - 4 * floor * floor))), 1e-4)},
          {"motion_screen_px", {round(presentation.ScreenPx(b.motion_px[0]), 1e-4),
                                round(presentation.ScreenPx(b.motion_px[1]), 1e-4)}},

@@ -196,7 +196,8 @@ struct Presentation {
 // its line-spread function, as the measurement states it; under distortion the geometric mean of the elliptical PSF's
 // principal radii), r_x_screen_px and r_y_screen_px (the radius across a vertical and a horizontal edge: the profile
 // along x and along y), shape (the PSF's map of determinant 1, identity when round), floor_sigma_screen_px and defocus_r_screen_px (its parts:
-// r^2 = defocus_r^2 + 4 floor_sigma^2), motion_screen_px ([x, y], the streak over exposure_ms) and size_deg (the
+// r^2 = defocus_r^2 + 4 floor_sigma^2; round values), floor_sigma_x_screen_px and floor_sigma_y_screen_px (the floor
+// across a vertical and a horizontal edge, stretched by the shape as r_x and r_y are), motion_screen_px ([x, y], the streak over exposure_ms) and size_deg (the
 // outline's largest extent).
 // A picture's frame (`scene` may be null; no objects) instead: the virtual picture (rect_px, its outline before the
 // blur; cutoff, the level shown; its blur as r_screen_px and r_arcmin; width_arcmin) and the real one (rect_px, the
