@@ -231,7 +231,9 @@ void ShowFrame(LiveSetup& s, const LiveArgs& a, live::LiveFrame& frame, live::Cl
   if (result.pose) last_pose = result.pose;
   const calib::SceneCalib& lens = s.planner->lens();
   // A lost frame is shown as the camera saw it, without objects (at the last pose, which draws nothing).
-  compositor.SetFrame(last_pose ? last_pose->rvec : lens.rvec, last_pose ? last_pose->tvec : lens.tvec, frame.image);
+  // Composed once (a frame is shown once): the photo is uploaded straight into the frame the objects are blended over.
+  compositor.SetFrame(last_pose ? last_pose->rvec : lens.rvec, last_pose ? last_pose->tvec : lens.tvec, frame.image,
+                      true);
   compositor.Compose(plan.objects);
   if (a.window) compositor.Present(context.width_px(), context.height_px());
   compositor.Finish();
