@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <ctime>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -92,7 +93,15 @@ struct LiveRecord {
   std::string ended;
   std::optional<Error> error;
   int dropped = 0;
+  double cpu_s = 0;  // the process's CPU time (every thread) from the start to the end of the frames
 };
+
+// CPU time of the whole process, every thread, s.
+double ProcessCpuS() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
 
 void WriteLiveLog(const LiveArgs& a, const LiveRecord& record, const live::LiveSummary& summary) {
   WriteFolderAtomically(
@@ -268,6 +277,7 @@ void ShowFrame(LiveSetup& s, const LiveArgs& a, live::LiveFrame& frame, live::Cl
 void RunLiveLoop(LiveSetup& s, const LiveArgs& a, render::GlContext& context, render::FrameCompositor& compositor,
                  LiveRecord& record) {
   live::FrameMailbox mailbox;
+  const double cpu0 = ProcessCpuS();
   const live::Clock::time_point start = live::Clock::now();
   s.source->Start(&mailbox, start);
   live::LiveFrame frame;
@@ -308,6 +318,7 @@ void RunLiveLoop(LiveSetup& s, const LiveArgs& a, render::GlContext& context, re
   if (tty) std::fprintf(stderr, "\n");
   s.source->Stop();
   record.dropped = mailbox.dropped();
+  record.cpu_s = ProcessCpuS() - cpu0;
 }
 
 void RunLive(const LiveArgs& a) {
@@ -358,6 +369,7 @@ void RunLive(const LiveArgs& a) {
   }
   live::LiveSummary summary = live::Summarize(record.rows, record.dropped, record.ended);
   summary.preloaded_frames = s.source->preloaded_frames();
+  if (summary.shown > 0) summary.cpu_ms_per_frame = 1000 * record.cpu_s / summary.shown;
   WriteLiveLog(a, record, summary);
   if (!a.quiet) {
     std::printf("%s\n%s\nwrote %s (live.csv, drawn.csv, summary.json)\n", record.ended.c_str(),

@@ -91,6 +91,12 @@ std::string SummaryLine(const LiveSummary& s) {
                 s.shown, s.dropped, delivered > 0 ? 100.0 * s.dropped / delivered : 0.0, s.median_latency_ms,
                 s.p95_latency_ms, s.max_latency_ms, s.found, s.tracked, s.lost, s.shown_fps, s.delivered_fps);
   std::string out = line;
+  // What the frames cost the computer, which other work on it inflates less than their latency.
+  if (s.cpu_ms_per_frame > 0) {
+    char cpu[80];
+    std::snprintf(cpu, sizeof cpu, "; %.1f ms of CPU a frame shown", s.cpu_ms_per_frame);
+    out += cpu;
+  }
   // --preload: the decoding a camera never costs was done before the start, and no latency holds it.
   if (s.preloaded_frames > 0)
     out += "; decoding taken out (--preload: " + std::to_string(s.preloaded_frames) + " frames decoded before the start)";
@@ -121,6 +127,7 @@ Json SummaryJson(const LiveSummary& s) {
   j["delivered_fps"] = s.delivered_fps;
   j["ended"] = s.ended;
   j["preloaded_frames"] = s.preloaded_frames;
+  j["cpu_ms_per_frame_shown"] = s.cpu_ms_per_frame;
   return j;
 }
 
