@@ -8,6 +8,7 @@ LOG     the --log folder of a live run over TAKE/take.avi (live.csv, drawn.csv, 
 TAKE    the synth-take folder (truth-NNNN.json: each frame's true pose)
 AR_CSV  the CSV `blurcue ar` wrote for the same take and objects
 FRAMES  the frames the take holds: every one is shown or counted dropped
+--preloaded  the run was given --preload: summary.json must say all FRAMES were decoded before the start
 --timing  also hold issue 43's real-time bounds: at most 5 % dropped, latency median <= 33 ms and p95 <= 50 ms,
           from this run's own live.csv (else they are printed, not held)
 
@@ -93,6 +94,12 @@ def main():
     words = (f"{len(shown)} shown, {summary['frames_dropped']} dropped ({100 * share:.1f} %), latency median "
              f"{median:.1f} ms, p95 {p95:.1f} ms; depth within {100 * worst_depth:.4f} % of the truth; radius within "
              f"{100 * worst_r:.4f} % of ar's, place within {worst_xy:.4f} px, streak within {100 * worst_streak:.2f} % ({streaks} frames)")
+    if "--preloaded" in sys.argv:
+        assert summary["preloaded_frames"] == frames, summary
+        words += f"; decoding taken out (--preload: {summary['preloaded_frames']} frames decoded before the start)"
+    else:
+        assert summary["preloaded_frames"] == 0, summary
+        words += "; decoding timed (decoded as played)"
     if timing:
         assert share <= 0.05, f"{100 * share:.1f} % of frames dropped (at most 5 %): {words}"
         assert median <= 33, f"median latency {median:.1f} ms (at most 33): {words}"

@@ -28,12 +28,17 @@ make)
 window)
   rm -rf "$W/window" && mkdir -p "$W/window"
   W=$W/window start_xvfb
-  "$BC" live "$T/take.avi" "${LIVE[@]}" --window --fps 30 --log "$W/window/log" --save-frame 30 \
+  # --preload: the take decoded before the clock starts and delivered from memory, as a camera hands over decoded
+  # frames (decoding FFV1 costs ~17 ms of CPU a frame, which no camera asks of this computer); the Escape and close
+  # runs below, and the headless case, decode as they play.
+  "$BC" live "$T/take.avi" "${LIVE[@]}" --window --fps 30 --preload --log "$W/window/log" --save-frame 30 \
     > "$W/window/out" 2> "$W/window/err" || fail "live --window: exit $?: $(cat "$W/window/err")"
+  grep -q "^live: --preload: 60 frames (158 MB) decoded in .* s before the start; decoding is not timed$" "$W/window/err" ||
+    fail "live --preload did not say what it decoded: $(cat "$W/window/err")"
   grep -q "in a window (vsync)" "$W/window/err" || fail "live did not say it showed a window: $(cat "$W/window/err")"
   grep -q "take.avi ended after 60 frames" "$W/window/out" || fail "live's end: $(cat "$W/window/out")"
   cat "$W/window/out"
-  $PY "$(dirname "$0")/live_check.py" "$W/window/log" "$T" "$W/ar.csv" 60 ${TIMING:+--timing} ||
+  $PY "$(dirname "$0")/live_check.py" "$W/window/log" "$T" "$W/ar.csv" 60 --preloaded ${TIMING:+--timing} ||
     fail "live_check.py (window)"
   # Frame 30, or the first shown after it when 30 was dropped.
   saved=$(cd "$W/window/log" && ls frame-*.png 2> /dev/null)
@@ -109,6 +114,18 @@ headless)
   shown=$(( $(wc -l < "$W/cut/live.csv") - 1 ))
   [ $shown -gt 5 ] && grep -q "\"frames_shown\": $shown," "$W/cut/summary.json" ||
     fail "the cut video's log: $shown rows, $(cat "$W/cut/summary.json")"
+  # The same with --preload: the damage is found before the start, the frames before it are played, then the same
+  # line and exit 3.
+  rm -rf "$W/cut-preload"
+  "$BC" live "$W/cut.avi" "${LIVE[@]}" --preload --log "$W/cut-preload" > "$W/cut-preload.out" 2> "$W/cut-preload.err"
+  code=$?
+  [ $code = 3 ] && [ "$(grep -c '^blurcue: ' "$W/cut-preload.err")" = 1 ] &&
+    grep -q "^blurcue: $W/cut.avi: damaged or truncated: frame [0-9]* of the 60 .*; the log of the [0-9]* frames shown is whole in $W/cut-preload$" "$W/cut-preload.err" ||
+    fail "a cut video, --preload: exit $code, stderr: $(cat "$W/cut-preload.err")"
+  preloaded=$(grep -o '"preloaded_frames": [0-9]*' "$W/cut-preload/summary.json" | grep -o '[0-9]*$')
+  shown=$(( $(wc -l < "$W/cut-preload/live.csv") - 1 ))
+  [ "${preloaded:-0}" -gt 5 ] && [ $shown -le "$preloaded" ] && [ $shown -gt 5 ] ||
+    fail "the cut video's log, --preload: $shown rows, $(cat "$W/cut-preload/summary.json")"
   echo "ok: live_test headless" ;;
 nocamera)
   rm -rf "$W/nocamera"
@@ -119,6 +136,12 @@ nocamera)
     fail "a missing camera: exit $code, stderr: $(cat "$W/nocamera.err")"
   [ "$(cat "$W/nocamera/live.csv" | wc -l)" = 1 ] || fail "the log of no frames is not a header alone"
   grep -q '"frames_shown": 0' "$W/nocamera/summary.json" || fail "summary.json: $(cat "$W/nocamera/summary.json")"
+  # --preload is for a file: a camera decodes its own frames (a usage error before the camera is looked for).
+  "$BC" live /dev/video97 "${LIVE[@]}" --preload --log "$W/nocamera-preload" > /dev/null 2> "$W/nocamera-preload.err"
+  code=$?
+  [ $code = 2 ] && [ "$(wc -l < "$W/nocamera-preload.err")" = 1 ] &&
+    grep -q "^blurcue: --preload: /dev/video97 is a camera" "$W/nocamera-preload.err" ||
+    fail "--preload with a camera: exit $code, stderr: $(cat "$W/nocamera-preload.err")"
   echo "ok: live_test nocamera: $(cat "$W/nocamera.err")" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -18,7 +18,8 @@ struct LiveBenchRow {
   int lens_sections = 0;            // the readings the last frame's lens model was fitted to (0: the given model)
   double median_latency_ms = 0, p95_latency_ms = 0;
   double median_track_ms = 0, median_measure_ms = 0, median_render_ms = 0;
-  double cpu_ms = 0;                // the live process's CPU time over the whole run (start-up included)
+  double cpu_ms = 0;                // the live process's CPU time over the whole run (start-up and --preload included)
+  double cpu_ms_per_frame = 0;      // its CPU time over the frames (every thread) / frames shown: summary.json's
   // |drawn r_px - true r| / true r of the ball, over the frames drawn: median, and median and worst over the last
   // third of them (once the model has had a third of the run to settle).
   double r_median_rel_error = 0, r_late_median_rel_error = 0, r_late_max_rel_error = 0;

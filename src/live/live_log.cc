@@ -90,12 +90,22 @@ std::string SummaryLine(const LiveSummary& s) {
                 "%d found, %d tracked, %d lost; %.1f frames a second shown of %.1f delivered",
                 s.shown, s.dropped, delivered > 0 ? 100.0 * s.dropped / delivered : 0.0, s.median_latency_ms,
                 s.p95_latency_ms, s.max_latency_ms, s.found, s.tracked, s.lost, s.shown_fps, s.delivered_fps);
+  std::string out = line;
+  // What the frames cost the computer, which other work on it inflates less than their latency.
+  if (s.cpu_ms_per_frame > 0) {
+    char cpu[80];
+    std::snprintf(cpu, sizeof cpu, "; %.1f ms of CPU a frame shown", s.cpu_ms_per_frame);
+    out += cpu;
+  }
+  // --preload: the decoding a camera never costs was done before the start, and no latency holds it.
+  if (s.preloaded_frames > 0)
+    out += "; decoding taken out (--preload: " + std::to_string(s.preloaded_frames) + " frames decoded before the start)";
   // --measure-sections: whether the lens model was ever fitted live, else the run drew with the given one throughout.
   if (s.sections_per_frame > 0)
-    return line + (s.lens_sections > 0 ? "; lens model fitted live to " + std::to_string(s.lens_sections) + " readings"
+    return out + (s.lens_sections > 0 ? "; lens model fitted live to " + std::to_string(s.lens_sections) + " readings"
                                        : std::string("; lens model never fitted live (readings on fewer than 3 "
                                                      "edges, or no fit found one): the given one throughout"));
-  return line;
+  return out;
 }
 
 Json SummaryJson(const LiveSummary& s) {
@@ -116,6 +126,8 @@ Json SummaryJson(const LiveSummary& s) {
   j["shown_fps"] = s.shown_fps;
   j["delivered_fps"] = s.delivered_fps;
   j["ended"] = s.ended;
+  j["preloaded_frames"] = s.preloaded_frames;
+  j["cpu_ms_per_frame_shown"] = s.cpu_ms_per_frame;
   return j;
 }
 

@@ -48,6 +48,8 @@ struct LiveSummary {
   double delivered_fps = 0;  // frames the input delivered a second (dropped ones too), between the first arrival shown
                              // and the last: a camera's own rate, or a video's pace when its decoding kept up
   std::string ended;      // why the run ended, in words
+  double cpu_ms_per_frame = 0;  // the process's CPU time over the run (every thread: reader, decoder, GL) / frames shown
+  int preloaded_frames = 0;  // --preload: frames decoded before the start (their decoding untimed); 0: decoded as played
 };
 // Totals of `rows`; `dropped` the mailbox's count (frames dropped after the last frame shown included).
 LiveSummary Summarize(const std::vector<LiveRow>& rows, int dropped, const std::string& ended);

@@ -113,6 +113,64 @@ TEST(PacedSource, ACameraThatStopsDeliveringClosesTheMailboxWithOneLineNamingItA
   EXPECT_EQ(std::string(source.error()->what()).find('\n'), std::string::npos);  // one line
 }
 
+// A video of `frames` frames of 64 x 48 in FFV1 (lossless: every frame reads back as written), frame i grey 40 i.
+std::filesystem::path GreyVideo(const std::string& name, int frames) {
+  const std::filesystem::path video =
+      std::filesystem::temp_directory_path() / ("blurcue-live-" + name + "-" + std::to_string(getpid()) + ".avi");
+  media::VideoWriter writer;
+  EXPECT_TRUE(writer.Open(video.string(), media::Fourcc('F', 'F', 'V', '1'), 30, cv::Size(64, 48)));
+  for (int i = 0; i < frames; ++i) writer.Write(cv::Mat(48, 64, CV_8UC3, cv::Scalar::all(40 * i)));
+  return video;
+}
+
+// --preload: every frame decoded before the start, then delivered at its pace from memory, each the frame the
+// decoder gives when decoding as it plays, and the end said as then.
+TEST(PacedSource, APreloadedVideoDeliversEveryFrameAsDecodedAndEndsAsOneDecodedWhilePlayed) {
+  const std::filesystem::path video = GreyVideo("preload", 5);
+  PacedSource source(video.string(), 100, 0);
+  source.Preload();
+  EXPECT_EQ(source.preloaded_frames(), 5);
+  EXPECT_NEAR(source.preloaded_mb(), 5 * 64 * 48 * 3 * 1e-6, 1e-9);
+  FrameMailbox box;
+  source.Start(&box, Clock::now());
+  LiveFrame got;
+  std::vector<int> seen;
+  FrameMailbox::Got status;
+  while ((status = box.Take(got, std::chrono::milliseconds(5000))) == FrameMailbox::Got::kFrame) {
+    seen.push_back(got.index);
+    EXPECT_EQ(cv::mean(got.image)[0], 40 * got.index) << got.index;  // the frame's own pixels, not a recycled buffer's
+  }
+  source.Stop();
+  std::filesystem::remove(video);
+  ASSERT_EQ(status, FrameMailbox::Got::kClosed);
+  EXPECT_EQ(int(seen.size()) + box.dropped(), 5);
+  EXPECT_FALSE(box.failed());
+  EXPECT_EQ(box.why_closed(), video.string() + " ended after 5 frames");
+}
+
+// More frames than the memory --preload may hold: one line naming INPUT and the --frames that fit, a usage error,
+// before any frame is delivered; --frames within it preloads those.
+TEST(PacedSource, APreloadBeyondItsMemoryIsOneUsageLineNamingTheFramesThatFit) {
+  const std::filesystem::path video = GreyVideo("preload-cap", 5);
+  const double frame_mb = 64 * 48 * 3 * 1e-6;
+  try {
+    PacedSource source(video.string(), 30, 0);
+    source.Preload(3.5 * frame_mb);
+    ADD_FAILURE() << "5 frames preloaded into room for 3";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kUsage);
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find(video.string() + ": --preload would hold its 5 frames"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("give --frames 3"), std::string::npos) << e.what();
+  }
+  PacedSource three(video.string(), 30, 3);
+  three.Preload(3.5 * frame_mb);
+  EXPECT_EQ(three.preloaded_frames(), 3);
+  std::filesystem::remove(video);
+  EXPECT_THROW(PacedSource("/dev/video42", nullptr, 0).Preload(), Error);  // a camera decodes its own frames
+}
+
 // A board face-on at 500 mm moving -10 mm in x a frame, 30 frames a second (stimulus/tracked_take_test.cc's take).
 calib::SceneCalib FaceOnLens() {
   calib::SceneCalib c;
@@ -265,6 +323,18 @@ TEST(LiveLog, SummarySaysWhetherTheLensWasFittedLive) {
   s = Summarize(rows, 0, "ended");
   EXPECT_NE(SummaryLine(s).find("lens model fitted live to 3 readings"), std::string::npos) << SummaryLine(s);
   EXPECT_EQ(SummaryJson(s)["lens_sections"], 3);
+}
+
+// A preloaded run says so on its summary line and in summary.json: its latencies leave the decoding out.
+TEST(LiveLog, SummarySaysWhenTheDecodingWasTakenOut) {
+  std::vector<LiveRow> rows(2);
+  LiveSummary s = Summarize(rows, 0, "ended");
+  EXPECT_EQ(SummaryLine(s).find("--preload"), std::string::npos) << SummaryLine(s);
+  EXPECT_EQ(SummaryJson(s)["preloaded_frames"], 0);
+  s.preloaded_frames = 60;
+  EXPECT_NE(SummaryLine(s).find("decoding taken out (--preload: 60 frames decoded before the start)"),
+            std::string::npos) << SummaryLine(s);
+  EXPECT_EQ(SummaryJson(s)["preloaded_frames"], 60);
 }
 
 TEST(LiveLog, ALostFrameHasAnEmptyPose) {

@@ -77,7 +77,7 @@ void PacedSource::Start(FrameMailbox* mailbox, Clock::time_point start) {
     thread_ = std::thread([this, mailbox, guarded] { guarded([&] { ReadCamera(mailbox); }); });
     return;
   }
-  decoder_ = std::thread([this] { DecodeVideo(); });
+  if (!decoded_end_) decoder_ = std::thread([this] { DecodeVideo(); });  // else preloaded whole
   thread_ = std::thread([this, mailbox, start, guarded] { guarded([&] { PaceVideo(mailbox, start); }); });
 }
 
@@ -102,17 +102,31 @@ bool PacedSource::WaitUntil(Clock::time_point due) {
   return !wake_.wait_until(lock, due, [this] { return stop_.load(); });
 }
 
-void PacedSource::DecodeVideo() {
+void PacedSource::DecodeVideo() { DecodeFrames(kDecodeAhead, 0); }
+
+double PacedSource::Preload(double max_mb) {
+  if (!file_)
+    throw Error(ErrorKind::kUsage, "--preload: " + device_ + " is a camera, which hands over its frames decoded already; "
+                                   "--preload is for a video or an image sequence");
+  const auto t0 = Clock::now();
+  DecodeFrames(0, max_mb);
+  preloaded_frames_ = int(ahead_.size());
+  for (const LiveFrame& f : ahead_) preloaded_mb_ += 1e-6 * double(f.image.total() * f.image.elemSize());
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+bool PacedSource::DecodeFrames(int ahead_limit, double max_mb) {
   int read = 0;
-  std::string why;
+  double held_mb = 0;
+  std::string why, too_much;
   std::optional<Error> error;
   try {
     while (true) {
       LiveFrame frame;
       {
         std::unique_lock<std::mutex> lock(mutex_);
-        ahead_changed_.wait(lock, [this] { return stop_ || int(ahead_.size()) < kDecodeAhead; });
-        if (stop_) return;
+        ahead_changed_.wait(lock, [&] { return stop_ || ahead_limit == 0 || int(ahead_.size()) < ahead_limit; });
+        if (stop_) return false;
         if (!spare_.empty()) {
           frame.image = std::move(spare_.back());
           spare_.pop_back();
@@ -127,6 +141,20 @@ void PacedSource::DecodeVideo() {
         break;
       }
       ++read;
+      const double frame_mb = 1e-6 * double(frame.image.total() * frame.image.elemSize());
+      held_mb += frame_mb;
+      if (max_mb > 0) {
+        // Known once the first frame is decoded: the video's header says how many follow.
+        const int promised = std::max(read, std::min(file_->expected_frames(), max_frames_ > 0 ? max_frames_ : 1 << 30));
+        if (held_mb > max_mb || promised * frame_mb > max_mb) {
+          const std::string most = std::to_string(int(max_mb / frame_mb));
+          too_much = input_ + ": --preload would hold " + (promised > read ? "its " : "more than ") +
+                     std::to_string(promised) + " frames decoded, " + Num(frame_mb) + " MB each: more than the " +
+                     Num(max_mb) + " MB it may hold (" + most + " frames); give --frames " + most +
+                     ", or leave --preload out";
+          break;
+        }
+      }
       std::lock_guard<std::mutex> lock(mutex_);
       ahead_.push_back(std::move(frame));
       ahead_changed_.notify_all();
@@ -138,11 +166,13 @@ void PacedSource::DecodeVideo() {
     error = Error(ErrorKind::kInput, input_ + ": " + e.what());
     why = error->what();
   }
+  if (!too_much.empty()) throw Error(ErrorKind::kUsage, too_much);  // only Preload sets a limit
   std::lock_guard<std::mutex> lock(mutex_);
   decoded_end_ = true;
   end_why_ = why;
   end_error_ = error;
   ahead_changed_.notify_all();
+  return true;
 }
 
 void PacedSource::PaceVideo(FrameMailbox* mailbox, Clock::time_point start) {

@@ -27,6 +27,9 @@ std::string CameraDevice(const std::string& input);
 // Frames a video or sequence is decoded ahead of its pace (8 frames of 1148 x 764: 21 MB): a camera has each frame
 // whole when it hands it over, and a file's decoding, which a camera does not do, must not make frames late.
 constexpr int kDecodeAhead = 8;
+// The most a preloaded input may hold decoded in memory (--preload), MB of 10^6 bytes: 760 frames of 1148 x 764 BGR
+// (25 s at 30 fps).
+constexpr double kMaxPreloadMb = 2000;
 
 class PacedSource {
  public:
@@ -48,6 +51,16 @@ class PacedSource {
   // Frames the video's header promises (0 for a sequence or a camera).
   int expected_frames() const;
 
+  // A video or a sequence decoded whole before the clock starts (--preload): the frames are then delivered at their
+  // pace from memory, as a camera hands over frames it has decoded itself, and no decoding competes with the drawing.
+  // Returns the seconds the decoding took. Throws Error(kUsage) naming INPUT when the frames would hold more than
+  // `max_mb` MB (before decoding them when the video's header says how many there are) or for a camera; a damaged
+  // frame ends the preload, and the frames before it are played, then the error (as without it).
+  double Preload(double max_mb = kMaxPreloadMb);
+  // Frames held decoded by Preload (0: none, decoded as they are played), and the MB they hold.
+  int preloaded_frames() const { return preloaded_frames_; }
+  double preloaded_mb() const { return preloaded_mb_; }
+
   // Starts the reader: every frame is posted to `mailbox`, stamped with its arrival; the input's end (a clean end,
   // max_frames, or an error) closes the mailbox with the reason. `start` is frame 0's due time.
   void Start(FrameMailbox* mailbox, Clock::time_point start);
@@ -58,6 +71,10 @@ class PacedSource {
 
  private:
   void DecodeVideo();
+  // Decodes frames into ahead_ until the input ends, `max_frames_`, `ahead_limit` frames are waiting (0: no limit) or
+  // Stop; false when stopped. At its end sets decoded_end_, end_why_ and end_error_. `max_mb` > 0: throws Error(kUsage)
+  // when the frames decoded would hold more.
+  bool DecodeFrames(int ahead_limit, double max_mb);
   void PaceVideo(FrameMailbox* mailbox, Clock::time_point start);
   void ReadCamera(FrameMailbox* mailbox);
   bool WaitUntil(Clock::time_point due);  // false when stopped first
@@ -65,6 +82,8 @@ class PacedSource {
   std::string input_, device_;
   double fps_ = 0;
   int max_frames_ = 0;
+  int preloaded_frames_ = 0;
+  double preloaded_mb_ = 0;
   std::unique_ptr<track::FrameSource> file_;
   std::unique_ptr<media::VideoReader> camera_;
   std::thread thread_, decoder_;

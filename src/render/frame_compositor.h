@@ -37,7 +37,11 @@ class FrameCompositor {
   // The next frame of a video: `background` (8-bit sRGB, the camera's size, or already resampled to the view's photo
   // size: ScaledPhoto) uploaded into the photo's texture and the board at rvec/tvec, in the targets made once (a
   // video allocates no GL object per frame).
-  void SetFrame(const cv::Vec3d& rvec, const cv::Vec3d& tvec, const cv::Mat& background);
+  // `compose_once` (a live view, which shows each photo once): the next Compose is the only one on this photo, so a
+  // photo that fills the frame is uploaded straight into the frame, without the base frame a second Compose restores
+  // the photo from (a whole-frame copy saved a frame: 6-7 ms on llvmpipe); Compose again or Place before the next
+  // SetFrame throws Error(kInternal).
+  void SetFrame(const cv::Vec3d& rvec, const cv::Vec3d& tvec, const cv::Mat& background, bool compose_once = false);
   // A photo of the camera's size resampled as this compositor shows it (linear light, area filter): what SetFrame
   // takes without resampling again.
   cv::Mat ScaledPhoto(const cv::Mat& background) const;

@@ -354,6 +354,33 @@ TEST_F(SceneRenderTest, AFrameWithoutObjectsIsThePhotoExactlyAfterFramesWithThem
   EXPECT_EQ(cv::norm(gpu.Read(), photo, cv::NORM_INF), 0);
 }
 
+// A live view composes each photo once and uploads it straight into the frame (SetFrame's compose_once): the frame
+// is the one the base-frame path composes, byte for byte, with photos that change between frames; composing the same
+// photo again, which would need the base it skipped, is refused.
+TEST_F(SceneRenderTest, AFrameComposedOnceIsTheFrameTheBasePathComposes) {
+  const View v;
+  const cv::Mat first = Photo(v.camera);
+  cv::Mat second;
+  cv::flip(first, second, 1);  // another photo: the objects of the frame before must leave no trace
+  std::vector<BlurredObject> balls = {{Ball(150), "gaussian", 3.0, 0, {0, 0}, {}}, {Ball(200), "disc", 5.0, 0, {0, 0}, {}}};
+  balls[1].object.center_board_mm[0] = 137.5;
+  FrameCompositor base(v.camera, v.rvec, v.tvec, first), once(v.camera, v.rvec, v.tvec, first);
+  for (const cv::Mat* photo : std::vector<const cv::Mat*>{&first, &second, &first}) {
+    base.SetFrame(v.rvec, v.tvec, *photo);
+    base.Compose(balls);
+    once.SetFrame(v.rvec, v.tvec, *photo, true);
+    once.Compose(balls);
+    const cv::Mat want = base.Read();
+    EXPECT_GT(cv::norm(want, *photo, cv::NORM_INF), 10);  // the balls are drawn
+    EXPECT_EQ(cv::norm(once.Read(), want, cv::NORM_INF), 0);
+  }
+  EXPECT_THROW(once.Compose(balls), Error);
+  EXPECT_THROW(once.Place(1, 0), Error);
+  once.SetFrame(v.rvec, v.tvec, second);  // the base path again: composed as often as asked
+  once.Compose({});
+  EXPECT_EQ(cv::norm(once.Read(), second, cv::NORM_INF), 0);
+}
+
 TEST_F(SceneRenderTest, DepthVaryingBlurFollowsEachEdgesDepth) {
   const View v;
   SceneRenderer renderer(v.camera, v.rvec, v.tvec);

@@ -111,8 +111,10 @@ FrameResult Tracker::Process(const cv::Mat& photo, int index, double time_s) {
   else
     ToGrey8(photo, planes_.grey8);
   const cv::Mat& grey8 = planes_.grey8;
+  // The quarter-size copy serves only the phase correlation of a history one frame long: made when this frame may
+  // start a history (none yet) or is its second frame; a frame tracked at constant velocity needs none.
   cv::Mat small;
-  if (!options_.always_detect) {
+  if (!options_.always_detect && before_last_.empty()) {
     cv::resize(grey8, small, cv::Size(), 1.0 / kSmallFactor, 1.0 / kSmallFactor, cv::INTER_AREA);
     small.convertTo(small, CV_32F);
   }
