@@ -178,27 +178,15 @@ double SumOfSquares(const std::vector<double>& r) {
   return s;
 }
 
-// The optics' radius r1, the edge's position d0 (within the pose's uncertainty of the line the pose gives) and the
-// optics' shape phi that fit best under one family: a grid for the radius at two shapes (the sum of squares may have
-// a shoulder where r1 meets the taps' own spread), then Levenberg-Marquardt on all three at once. The three are
-// correlated (a sharpening filter's overshoot trades against the optics' shape): turns of one-dimensional searches
-// settled on a ridge, 2-5 % short of the true reading with the true family on sharpened scenes (amount 0.5), so that
-// a wrong family fitted better; the joint steps reach the minimum in about ten iterations.
-PhaseReading ReadFamily(const std::vector<Bin>& bins, const PhaseFamily& family, double r_fit, double phi_fit,
-                        double w1, double w2, double shift, double noise) {
-  const std::vector<double> taps = FamilyTaps(family);
+// Levenberg-Marquardt from p = {r1, d0, phi} on the family's residuals (the optics' radius, the edge's position
+// within the pose's uncertainty, the optics' shape); returns the sum of squares at the p it leaves.
+double RefineFamily(const std::vector<Bin>& bins, const std::vector<double>& taps, double shift, double w1, double w2,
+                    double* p) {
   std::vector<double> res, trial, col[3];
-  double p[3] = {0, 0, phi_fit}, best = std::numeric_limits<double>::infinity();
-  const double top = std::max(2.5, 1.6 * r_fit), grid = top / 12;
-  for (const double phi : {phi_fit, std::abs(phi_fit - kPi / 4) < 0.2 ? kPi / 2 : kPi / 4})
-    for (int k = 0; k <= 12; ++k) {
-      const double q[3] = {k * grid, 0, phi};
-      FamilyResiduals(bins, taps, shift, q, w1, w2, &res);
-      if (const double v = SumOfSquares(res); v < best) best = v, p[0] = q[0], p[2] = q[2];
-    }
+  FamilyResiduals(bins, taps, shift, p, w1, w2, &res);
+  double best = SumOfSquares(res);
   const double lo[3] = {0, -kPoseUncertaintyPx, 0}, hi[3] = {1e9, kPoseUncertaintyPx, kPi / 2};
   const double h[3] = {1e-3, 1e-3, 2e-3};
-  FamilyResiduals(bins, taps, shift, p, w1, w2, &res);
   double lambda = 1e-2;
   for (int it = 0; it < 30; ++it) {
     // Forward differences (inward at a bound).
@@ -243,6 +231,28 @@ PhaseReading ReadFamily(const std::vector<Bin>& bins, const PhaseFamily& family,
     }
     if (!improved) break;
   }
+  return best;
+}
+
+// The optics' radius r1, the edge's position d0 (within the pose's uncertainty of the line the pose gives) and the
+// optics' shape phi that fit best under one family: a grid for the radius at two shapes, the blur fit's and another
+// (the sum of squares may have a shoulder where r1 meets the taps' own spread), then all three at once from the best
+// node (RefineFamily). The three are correlated (a sharpening filter's overshoot trades against the optics' shape):
+// turns of one-dimensional searches with the blur fit's shape settled on a ridge, 2-5 % short of the true reading with
+// the true family on sharpened scenes (amount 0.5), so that a wrong family fitted better.
+PhaseReading ReadFamily(const std::vector<Bin>& bins, const PhaseFamily& family, double r_fit, double phi_fit,
+                        double w1, double w2, double shift, double noise) {
+  const std::vector<double> taps = FamilyTaps(family);
+  std::vector<double> res;
+  double p[3] = {0, 0, phi_fit}, best = std::numeric_limits<double>::infinity();
+  const double top = std::max(2.5, 1.6 * r_fit), grid = top / 12;
+  for (const double phi : {phi_fit, std::abs(phi_fit - kPi / 4) < 0.2 ? kPi / 2 : kPi / 4})
+    for (int k = 0; k <= 12; ++k) {
+      const double q[3] = {k * grid, 0, phi};
+      FamilyResiduals(bins, taps, shift, q, w1, w2, &res);
+      if (const double v = SumOfSquares(res); v < best) best = v, p[0] = q[0], p[2] = q[2];
+    }
+  RefineFamily(bins, taps, shift, w1, w2, p);
   const double r1 = p[0], d0 = p[1], phi = p[2];
   const FamilyFit fit = EvaluateFamily(bins, taps, shift, r1, d0, phi, w1, w2);
   double w = 0;
@@ -276,6 +286,36 @@ const std::vector<PhaseFamily>& PhaseFamilies() {
       {0, 0},      {0.35, 0},   {0.4, 0},   {0.45, 0},  {0.5, 0},   {0.55, 0},  {0.6, 0}, {0.7, 0}, {0.8, 0},
       {0.6, 0.15}, {0.6, 0.3},  {0.6, 0.5}, {0.6, 0.7}, {1.0, 0.15}, {1.0, 0.3}, {1.0, 0.5}, {1.0, 0.7}};
   return families;
+}
+
+std::vector<size_t> PhaseNeighbours(size_t c) {
+  // Axes: the Gaussians by std, and the unsharp masks of each std by amount; the optics alone is the zero of each.
+  const std::vector<PhaseFamily>& f = PhaseFamilies();
+  auto param = [&](size_t a) { return f[a].sharpen > 0 ? f[a].sharpen : f[a].sigma_px; };
+  auto on_axis = [&](size_t a, size_t of) {  // a lies on the axis of family `of` (not the optics alone)
+    return a == 0 || ((f[a].sharpen > 0) == (f[of].sharpen > 0) && (f[of].sharpen <= 0 || f[a].sigma_px == f[of].sigma_px));
+  };
+  std::vector<size_t> out;
+  auto add = [&](size_t a) {
+    if (a < f.size() && std::find(out.begin(), out.end(), a) == out.end()) out.push_back(a);
+  };
+  for (size_t axis = 1; axis < f.size(); ++axis) {
+    if (c != 0 && axis != c) continue;
+    // The nearest on each side of c along this axis.
+    size_t below = f.size(), above = f.size();
+    for (size_t a = 0; a < f.size(); ++a) {
+      if (a == c || !on_axis(a, axis)) continue;
+      const double d = param(a) - (c == 0 ? 0.0 : param(c));
+      if (a == 0 || d < 0) {
+        if (below == f.size() || d > param(below) - param(c)) below = a;
+      } else if (d > 0 && (above == f.size() || d < param(above) - (c == 0 ? 0.0 : param(c)))) {
+        above = a;
+      }
+    }
+    if (c != 0) add(below);
+    add(above);
+  }
+  return out;
 }
 
 namespace {
@@ -389,6 +429,7 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
   std::vector<bool> read(nf);
   for (size_t c = 0; c < nf; ++c)
     read[c] = c == 0 || chi2[c] - chi2[best] <= 2 * std::max(kAlikeChi2 * scale, kAlikeRel * chi2[best]);
+  for (const size_t c : PhaseNeighbours(best)) read[c] = true;  // ChoosePhaseFamily's jump test reads them
   std::vector<size_t> rest;
   for (const size_t k : limited)
     if (!first[k]) rest.push_back(k);
@@ -408,9 +449,16 @@ double CancellationPx(double r, double taps_variance) {
 }
 
 // A flagged section's reason, in words (calib.json's phase_why and the summary).
-std::string PhaseWhy(const SectionResult& s, double lo, double hi, double r, double v, double moved) {
+std::string PhaseWhy(const SectionResult& s, double lo, double hi, double r, double v, double moved, double nearest) {
   char why[480];
-  if (hi - lo > std::max(kSpreadPx, kSpreadRel * r))
+  const double target = std::max(kSpreadPx, kSpreadRel * r);
+  if (hi - lo <= target && moved <= target)
+    std::snprintf(why, sizeof why,
+                  "its reading under the chosen PSF family (%.2f px) lies %.2f px outside the neighbouring families' "
+                  "(from %.2f px), more than max(%.2f px, %.0f %%): the fit follows something in this profile "
+                  "that no family explains (a JPEG block, a flaw); the lens fit predicts it",
+                  r, std::abs(nearest - r), nearest, kSpreadPx, 100 * kSpreadRel);
+  else if (hi - lo > target)
     std::snprintf(why, sizeof why,
                   "the edge runs %.1f deg off the pixel axis, so its sub-pixel phase moves only %.2f px along the part "
                   "measured (edge %.2f px past a pixel centre), and the PSF families that fit the board's profiles "
@@ -460,21 +508,33 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   for (size_t c = 0; c < families.size(); ++c)
     choice.alike[c] = choice.chi2[c] - choice.chi2[best] <= std::max(kAlikeChi2 * scale, kAlikeRel * choice.chi2[best]);
   const double v_best = TapsVariance(FamilyTaps(families[best]));
-  int cancelled = 0;
+  int cancelled = 0, jumped = 0;
+  const std::vector<size_t> neighbours = PhaseNeighbours(best);
   for (SectionResult* s : limited) {
     double lo = 1e18, hi = -1e18;
     for (size_t c = 0; c < families.size(); ++c)
       if (choice.alike[c]) lo = std::min(lo, s->phase.families[c].r_px), hi = std::max(hi, s->phase.families[c].r_px);
     const double r = s->phase.families[best].r_px, moved = CancellationPx(r, v_best);
     if (best != 0) s->fit.r_px = r;  // read with the chosen family
-    s->phase.range_lo_px = std::max(0.0, std::min(lo, r - moved)), s->phase.range_hi_px = std::max(hi, r + moved);
+    // The chosen family's neighbours on either side (read on every section) bracket its reading where the reading
+    // follows the filter's parameter smoothly; one that lies outside their readings by more than the target is the
+    // fit following something in the profile that no family explains. (With one neighbour, nothing brackets it.)
+    double n_lo = 1e18, n_hi = -1e18;
+    int n_read = 0;
+    for (const size_t c : neighbours)
+      if (const double v = s->phase.families[c].r_px; std::isfinite(v)) n_lo = std::min(n_lo, v), n_hi = std::max(n_hi, v), ++n_read;
+    const double jump = n_read >= 2 ? std::max({0.0, n_lo - r, r - n_hi}) : 0;
+    const double nearest = r < n_lo ? n_lo : n_hi;
+    s->phase.range_lo_px = std::max(0.0, std::min({lo, r - moved, r - jump}));
+    s->phase.range_hi_px = std::max({hi, r + moved, r + jump});
     const double target = std::max(kSpreadPx, kSpreadRel * r);
-    if (hi - lo <= target && moved <= target) continue;
+    if (hi - lo <= target && moved <= target && jump <= target) continue;
     s->fit.ok = false;
     s->fit.flags.push_back("phase_limited");
-    s->fit.phase_why = PhaseWhy(*s, lo, hi, r, v_best, moved);
+    s->fit.phase_why = PhaseWhy(*s, lo, hi, r, v_best, moved, nearest);
     ++choice.flagged;
-    cancelled += hi - lo <= target;
+    cancelled += hi - lo <= target && moved > target;
+    jumped += hi - lo <= target && moved <= target;
   }
   int n_alike = 0, n_read = 0;
   for (const bool a : choice.alike) n_alike += a;
@@ -486,10 +546,11 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   std::snprintf(text, sizeof text,
                 "%d usable sections sampled at few phases with blur under %.0f px, read as %s (%d of %zu PSF families "
                 "fit their profiles alike, chi-square per point %.2f%s); %d flagged phase_limited (%d where the "
-                "sharpening cancels most of the optics' blur; each reading's range in calib.json)",
+                "sharpening cancels most of the optics' blur, %d whose reading jumps between neighbouring families; "
+                "each reading's range in calib.json)",
                 choice.limited, kMaxBlurPx,
                 families[best].Name().c_str(),
-                n_alike, families.size(), choice.chi2_per_point, ruled, choice.flagged, cancelled);
+                n_alike, families.size(), choice.chi2_per_point, ruled, choice.flagged, cancelled, jumped);
   choice.summary = text;
   return choice;
 }
