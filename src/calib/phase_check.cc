@@ -224,7 +224,7 @@ double RefineFamily(const std::vector<Bin>& bins, const std::vector<double>& tap
         best = v, res.swap(trial);
         for (int c = 0; c < 3; ++c) p[c] = q[c];
         lambda = std::max(1e-6, lambda * 0.3);
-        if (gain < 1e-7 * best + 1e-15) it = 30;  // settled
+        if (gain < 1e-4 * best + 1e-15) it = 30;  // settled: a chi-square moving by 1e-4 of itself
       } else {
         lambda *= 10;
       }
