@@ -51,3 +51,25 @@ phase_check(phase_filtered_focus_edge1 edge1 "phase_limited.*\nok: filtered targ
 phase_scene(sharpen --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.6 --post-amount 0.3
             --noise 0.0025 --seed 6)
 phase_check(phase_filtered_sharpen sharpen "\nok: filtered targets met" --expect filtered)
+# Stronger sharpening (amount 0.5 over 0.6 px: -0.176 px^2), the bench's open failure: the families' optics had the
+# blur fit's shape (a disc, on a sharpened profile) and a wrong mask (amount 0.15) fitted best; 35 sections read 10-25 %
+# high unflagged, the model median 9.1 %, p90 22.0 %. Now each family's optics shape is fitted with its radius.
+phase_scene(sharpen05 --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.6 --post-amount 0.5
+            --noise 0.0025 --seed 6)
+phase_check(phase_filtered_sharpen_05 sharpen05 "\nok: filtered targets met" --expect filtered)
+# Amount 0.7 (-0.246 px^2): near focus the mask cancels up to 97 % of the optics' second moment (truth 0.16 px from
+# optics of 1.0 px), where a 2 % error in the optics' reading moves the section's by 0.1 px: those sections are flagged
+# (35 of 77, edges 4-8) and every other one holds the rule. The lens model breaks here (median 2.4 %, p90 19 %: no thin
+# lens bends to sqrt(r^2 - 0.98)), so only the sections are held.
+phase_scene(sharpen07 --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.6 --post-amount 0.7
+            --noise 0.0025 --seed 6)
+phase_check(phase_filtered_sharpen_07 sharpen07 "phase_limited \\(35 where the sharpening cancels.*\nok: filtered targets met"
+            --expect filtered --sections-only)
+# The Gaussian post filter's ends (0.35 and 0.8 px, the bench's levels). At 0.35 px the optics alone fitted best and
+# 7 sections (edge 4) read 10-12 % high unflagged; now the 0.35 px family is chosen.
+phase_scene(gauss035 --focus-mm 430 --floor-sigma-px 0.2 --post-filter gaussian --post-sigma-px 0.35 --noise 0.0025
+            --seed 4)
+phase_check(phase_filtered_gauss_035 gauss035 "\nok: filtered targets met" --expect filtered)
+phase_scene(gauss08 --focus-mm 430 --floor-sigma-px 0.2 --post-filter gaussian --post-sigma-px 0.8 --noise 0.0025
+            --seed 4)
+phase_check(phase_filtered_gauss_08 gauss08 "\nok: filtered targets met" --expect filtered)

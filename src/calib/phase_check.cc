@@ -37,6 +37,10 @@ constexpr double kMinNoise = 5e-4;
 // A reading that moves by more than this among the families that fit alike is not identified (the target
 // is max(0.05 px, 10 %): a reading within the alike families' spread of a family that holds meets it with margin).
 constexpr double kSpreadPx = 0.04, kSpreadRel = 0.08;
+// The optics' own reading is good to about this (relative; the physical scenes' median error is 0.5-1.1 %, p90
+// 1.5-3.3 %): where a sharpening mask cancels most of it, the section's reading is flagged when an error this size moves
+// it past the spread above (CancellationPx). Readings under kOpticsFloorPx count as that (the error is not relative).
+constexpr double kOpticsRel = 0.02, kOpticsFloorPx = 0.05;
 // Sections every family is read on before the families that fit them far worse are ruled out (ReadPhaseFamilies).
 constexpr size_t kChoiceSections = 12;
 
@@ -147,38 +151,109 @@ FamilyFit EvaluateFamily(const std::vector<Bin>& bins, const std::vector<double>
   return out;
 }
 
-// Golden-section minimum of f on [a, b].
-template <class F>
-double GoldenMin(F f, double a, double b, double tol) {
-  constexpr double g = 0.6180339887498949;
-  double c = b - g * (b - a), d = a + g * (b - a), fc = f(c), fd = f(d);
-  for (int it = 0; it < 40 && b - a > tol; ++it) {
-    if (fc < fd) b = d, d = c, fd = fc, c = b - g * (b - a), fc = f(c);
-    else a = c, c = d, fc = fd, d = a + g * (b - a), fd = f(d);
+// The family's residuals (sqrt(w) x (value - model)) at parameters p = {r1, d0, phi}, its two levels by least squares
+// (solved again at every p: the levels are projected out, so the search is over the three shape parameters only).
+void FamilyResiduals(const std::vector<Bin>& bins, const std::vector<double>& taps, double shift, const double* p,
+                     double w1, double w2, std::vector<double>* res) {
+  const EsfModel model(std::max(p[0], 0.02), p[2], w1, w2);
+  const int reach = static_cast<int>(taps.size()) / 2;
+  std::vector<double>& e = *res;
+  e.resize(bins.size());
+  double s1 = 0, se = 0, see = 0, sv = 0, sev = 0;
+  for (size_t i = 0; i < bins.size(); ++i) {
+    const Bin& b = bins[i];
+    double m = 0;
+    for (int k = -reach; k <= reach; ++k) m += taps[k + reach] * model(b.x - p[1] - k * shift);
+    e[i] = m;
+    s1 += b.w, se += b.w * m, see += b.w * m * m, sv += b.w * b.v, sev += b.w * m * b.v;
   }
-  return fc < fd ? c : d;
+  const double det = s1 * see - se * se;
+  const double step = det > 1e-12 * s1 * s1 ? (s1 * sev - se * sv) / det : 0, low = (sv - step * se) / s1;
+  for (size_t i = 0; i < bins.size(); ++i) e[i] = std::sqrt(bins[i].w) * (bins[i].v - low - step * e[i]);
 }
 
-// The optics' radius (a grid, then golden section around its best node) and the edge's position (within the pose's
-// uncertainty of the line the pose gives) that fit best under one family, in turns.
-PhaseReading ReadFamily(const std::vector<Bin>& bins, const PhaseFamily& family, double r_fit, double phi, double w1,
-                        double w2, double shift, double noise) {
-  const std::vector<double> taps = FamilyTaps(family);
-  double d0 = 0, r1 = 0;
-  auto sse = [&](double r, double d) { return EvaluateFamily(bins, taps, shift, r, d, phi, w1, w2).sse; };
-  // A coarse grid for the radius (the sum of squares may have a shoulder where r1 meets the taps' own spread), then
-  // turns of golden section on each, in brackets that narrow as they settle.
-  const double top = std::max(2.5, 1.6 * r_fit), step = top / 12;
-  double best = std::numeric_limits<double>::infinity();
-  for (int k = 0; k <= 12; ++k)
-    if (const double v = sse(k * step, d0); v < best) best = v, r1 = k * step;
-  double r_half = step, d_half = kPoseUncertaintyPx;
-  for (int round = 0; round < 3; ++round) {
-    r1 = GoldenMin([&](double r) { return sse(r, d0); }, std::max(0.0, r1 - r_half), r1 + r_half, 2e-3);
-    d0 = GoldenMin([&](double d) { return sse(r1, d); }, std::max(-kPoseUncertaintyPx, d0 - d_half),
-                   std::min(kPoseUncertaintyPx, d0 + d_half), 2e-3);
-    r_half *= 0.4, d_half *= 0.4;
+double SumOfSquares(const std::vector<double>& r) {
+  double s = 0;
+  for (const double v : r) s += v * v;
+  return s;
+}
+
+// Levenberg-Marquardt from p = {r1, d0, phi} on the family's residuals (the optics' radius, the edge's position
+// within the pose's uncertainty, the optics' shape); returns the sum of squares at the p it leaves.
+double RefineFamily(const std::vector<Bin>& bins, const std::vector<double>& taps, double shift, double w1, double w2,
+                    double* p) {
+  std::vector<double> res, trial, col[3];
+  FamilyResiduals(bins, taps, shift, p, w1, w2, &res);
+  double best = SumOfSquares(res);
+  const double lo[3] = {0, -kPoseUncertaintyPx, 0}, hi[3] = {1e9, kPoseUncertaintyPx, kPi / 2};
+  const double h[3] = {1e-3, 1e-3, 2e-3};
+  double lambda = 1e-2;
+  for (int it = 0; it < 30; ++it) {
+    // Forward differences (inward at a bound).
+    double jtj[3][3] = {}, jtr[3] = {};
+    for (int c = 0; c < 3; ++c) {
+      double q[3] = {p[0], p[1], p[2]};
+      const double hc = q[c] + h[c] > hi[c] ? -h[c] : h[c];
+      q[c] += hc;
+      FamilyResiduals(bins, taps, shift, q, w1, w2, &col[c]);
+      for (size_t i = 0; i < res.size(); ++i) col[c][i] = (col[c][i] - res[i]) / hc;
+    }
+    for (int a = 0; a < 3; ++a) {
+      for (size_t i = 0; i < res.size(); ++i) jtr[a] += col[a][i] * res[i];
+      for (int b = 0; b < 3; ++b)
+        for (size_t i = 0; i < res.size(); ++i) jtj[a][b] += col[a][i] * col[b][i];
+    }
+    bool improved = false;
+    for (int tries = 0; tries < 8 && !improved; ++tries) {
+      cv::Matx33d m;
+      cv::Vec3d g;
+      for (int a = 0; a < 3; ++a) {
+        for (int b = 0; b < 3; ++b) m(a, b) = jtj[a][b];
+        m(a, a) += lambda * std::max(jtj[a][a], 1e-12);
+        g[a] = -jtr[a];
+      }
+      cv::Vec3d delta;
+      if (!cv::solve(m, g, delta, cv::DECOMP_CHOLESKY)) break;
+      double q[3];
+      for (int c = 0; c < 3; ++c) q[c] = std::clamp(p[c] + delta[c], lo[c], hi[c]);
+      FamilyResiduals(bins, taps, shift, q, w1, w2, &trial);
+      const double v = SumOfSquares(trial);
+      if (v < best) {
+        improved = true;
+        const double gain = best - v;
+        best = v, res.swap(trial);
+        for (int c = 0; c < 3; ++c) p[c] = q[c];
+        lambda = std::max(1e-6, lambda * 0.3);
+        if (gain < 1e-4 * best + 1e-15) it = 30;  // settled: a chi-square moving by 1e-4 of itself
+      } else {
+        lambda *= 10;
+      }
+    }
+    if (!improved) break;
   }
+  return best;
+}
+
+// The optics' radius r1, the edge's position d0 (within the pose's uncertainty of the line the pose gives) and the
+// optics' shape phi that fit best under one family: a grid for the radius at two shapes, the blur fit's and another
+// (the sum of squares may have a shoulder where r1 meets the taps' own spread), then all three at once from the best
+// node (RefineFamily). The three are correlated (a sharpening filter's overshoot trades against the optics' shape):
+// turns of one-dimensional searches with the blur fit's shape settled on a ridge, 2-5 % short of the true reading with
+// the true family on sharpened scenes (amount 0.5), so that a wrong family fitted better.
+PhaseReading ReadFamily(const std::vector<Bin>& bins, const PhaseFamily& family, double r_fit, double phi_fit,
+                        double w1, double w2, double shift, double noise) {
+  const std::vector<double> taps = FamilyTaps(family);
+  std::vector<double> res;
+  double p[3] = {0, 0, phi_fit}, best = std::numeric_limits<double>::infinity();
+  const double top = std::max(2.5, 1.6 * r_fit), grid = top / 12;
+  for (const double phi : {phi_fit, std::abs(phi_fit - kPi / 4) < 0.2 ? kPi / 2 : kPi / 4})
+    for (int k = 0; k <= 12; ++k) {
+      const double q[3] = {k * grid, 0, phi};
+      FamilyResiduals(bins, taps, shift, q, w1, w2, &res);
+      if (const double v = SumOfSquares(res); v < best) best = v, p[0] = q[0], p[2] = q[2];
+    }
+  RefineFamily(bins, taps, shift, w1, w2, p);
+  const double r1 = p[0], d0 = p[1], phi = p[2];
   const FamilyFit fit = EvaluateFamily(bins, taps, shift, r1, d0, phi, w1, w2);
   double w = 0;
   for (const Bin& bin : bins) w += bin.w;
@@ -209,8 +284,38 @@ const std::vector<PhaseFamily>& PhaseFamilies() {
   // mild to strong, over a narrow and a wide Gaussian.
   static const std::vector<PhaseFamily> families = {
       {0, 0},      {0.35, 0},   {0.4, 0},   {0.45, 0},  {0.5, 0},   {0.55, 0},  {0.6, 0}, {0.7, 0}, {0.8, 0},
-      {0.6, 0.15}, {0.6, 0.3},  {0.6, 0.5}, {1.0, 0.15}, {1.0, 0.3}, {1.0, 0.5}};
+      {0.6, 0.15}, {0.6, 0.3},  {0.6, 0.5}, {0.6, 0.7}, {1.0, 0.15}, {1.0, 0.3}, {1.0, 0.5}, {1.0, 0.7}};
   return families;
+}
+
+std::vector<size_t> PhaseNeighbours(size_t c) {
+  // Axes: the Gaussians by std, and the unsharp masks of each std by amount; the optics alone is the zero of each.
+  const std::vector<PhaseFamily>& f = PhaseFamilies();
+  auto param = [&](size_t a) { return f[a].sharpen > 0 ? f[a].sharpen : f[a].sigma_px; };
+  auto on_axis = [&](size_t a, size_t of) {  // a lies on the axis of family `of` (not the optics alone)
+    return a == 0 || ((f[a].sharpen > 0) == (f[of].sharpen > 0) && (f[of].sharpen <= 0 || f[a].sigma_px == f[of].sigma_px));
+  };
+  std::vector<size_t> out;
+  auto add = [&](size_t a) {
+    if (a < f.size() && std::find(out.begin(), out.end(), a) == out.end()) out.push_back(a);
+  };
+  for (size_t axis = 1; axis < f.size(); ++axis) {
+    if (c != 0 && axis != c) continue;
+    // The nearest on each side of c along this axis.
+    size_t below = f.size(), above = f.size();
+    for (size_t a = 0; a < f.size(); ++a) {
+      if (a == c || !on_axis(a, axis)) continue;
+      const double d = param(a) - (c == 0 ? 0.0 : param(c));
+      if (a == 0 || d < 0) {
+        if (below == f.size() || d > param(below) - param(c)) below = a;
+      } else if (d > 0 && (above == f.size() || d < param(above) - (c == 0 ? 0.0 : param(c)))) {
+        above = a;
+      }
+    }
+    if (c != 0) add(below);
+    add(above);
+  }
+  return out;
 }
 
 namespace {
@@ -324,11 +429,52 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
   std::vector<bool> read(nf);
   for (size_t c = 0; c < nf; ++c)
     read[c] = c == 0 || chi2[c] - chi2[best] <= 2 * std::max(kAlikeChi2 * scale, kAlikeRel * chi2[best]);
+  for (const size_t c : PhaseNeighbours(best)) read[c] = true;  // ChoosePhaseFamily's jump test reads them
   std::vector<size_t> rest;
   for (const size_t k : limited)
     if (!first[k]) rest.push_back(k);
   each(rest.size(), [&](size_t i) { ReadFamilies(profiles[rest[i]], read, &usable[rest[i]]->phase); });
 }
+
+namespace {
+
+// Where the family sharpens (taps' variance V < 0) the reading is the optics' second moment less the mask's:
+// r^2 = r1^2 - 4|V|. Where the mask cancels most of r1^2, an error of kOpticsRel in the optics' own reading moves r by
+// r1^2 / r^2 times as much, relatively: that is how far (px) this section's reading could move for it. 0 for a
+// family that does not sharpen (r >= r1: no amplification).
+double CancellationPx(double r, double taps_variance) {
+  if (!(taps_variance < 0)) return 0;
+  const double r1_sq = r * r - 4 * taps_variance;
+  return kOpticsRel * r1_sq / std::max(r, kOpticsFloorPx);
+}
+
+// A flagged section's reason, in words (calib.json's phase_why and the summary).
+std::string PhaseWhy(const SectionResult& s, double lo, double hi, double r, double v, double moved, double nearest) {
+  char why[480];
+  const double target = std::max(kSpreadPx, kSpreadRel * r);
+  if (hi - lo <= target && moved <= target)
+    std::snprintf(why, sizeof why,
+                  "its reading under the chosen PSF family (%.2f px) lies %.2f px outside the neighbouring families' "
+                  "(from %.2f px), more than max(%.2f px, %.0f %%): the fit follows something in this profile "
+                  "that no family explains (a JPEG block, a flaw); the lens fit predicts it",
+                  r, std::abs(nearest - r), nearest, kSpreadPx, 100 * kSpreadRel);
+  else if (hi - lo > target)
+    std::snprintf(why, sizeof why,
+                  "the edge runs %.1f deg off the pixel axis, so its sub-pixel phase moves only %.2f px along the part "
+                  "measured (edge %.2f px past a pixel centre), and the PSF families that fit the board's profiles "
+                  "alike read %.2f-%.2f px here: its blur is not identified; the lens fit predicts it",
+                  s.phase.axis_deg, s.phase.span_px, s.phase.phase_px, lo, hi);
+  else
+    std::snprintf(why, sizeof why,
+                  "the photo was sharpened after sampling and here the mask cancels %.0f %% of the optics' blur "
+                  "(optics %.2f px, read %.2f px): a %.0f %% error in the optics' reading moves this one by %.2f px, "
+                  "more than max(%.2f px, %.0f %%); the lens fit predicts it",
+                  100 * std::min(1.0, -4 * v / (r * r - 4 * v)), std::sqrt(r * r - 4 * v), r, 100 * kOpticsRel, moved,
+                  kSpreadPx, 100 * kSpreadRel);
+  return why;
+}
+
+}  // namespace
 
 PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   PhaseChoice choice;
@@ -361,23 +507,34 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   // of the best's fit alike too.
   for (size_t c = 0; c < families.size(); ++c)
     choice.alike[c] = choice.chi2[c] - choice.chi2[best] <= std::max(kAlikeChi2 * scale, kAlikeRel * choice.chi2[best]);
+  const double v_best = TapsVariance(FamilyTaps(families[best]));
+  int cancelled = 0, jumped = 0;
+  const std::vector<size_t> neighbours = PhaseNeighbours(best);
   for (SectionResult* s : limited) {
     double lo = 1e18, hi = -1e18;
     for (size_t c = 0; c < families.size(); ++c)
       if (choice.alike[c]) lo = std::min(lo, s->phase.families[c].r_px), hi = std::max(hi, s->phase.families[c].r_px);
-    if (best != 0) s->fit.r_px = s->phase.families[best].r_px;  // read with the chosen family
-    s->phase.range_lo_px = lo, s->phase.range_hi_px = hi;
-    if (hi - lo <= std::max(kSpreadPx, kSpreadRel * s->fit.r_px)) continue;
+    const double r = s->phase.families[best].r_px, moved = CancellationPx(r, v_best);
+    if (best != 0) s->fit.r_px = r;  // read with the chosen family
+    // The chosen family's neighbours on either side (read on every section) bracket its reading where the reading
+    // follows the filter's parameter smoothly; one that lies outside their readings by more than the target is the
+    // fit following something in the profile that no family explains. (With one neighbour, nothing brackets it.)
+    double n_lo = 1e18, n_hi = -1e18;
+    int n_read = 0;
+    for (const size_t c : neighbours)
+      if (const double v = s->phase.families[c].r_px; std::isfinite(v)) n_lo = std::min(n_lo, v), n_hi = std::max(n_hi, v), ++n_read;
+    const double jump = n_read >= 2 ? std::max({0.0, n_lo - r, r - n_hi}) : 0;
+    const double nearest = r < n_lo ? n_lo : n_hi;
+    s->phase.range_lo_px = std::max(0.0, std::min({lo, r - moved, r - jump}));
+    s->phase.range_hi_px = std::max({hi, r + moved, r + jump});
+    const double target = std::max(kSpreadPx, kSpreadRel * r);
+    if (hi - lo <= target && moved <= target && jump <= target) continue;
     s->fit.ok = false;
     s->fit.flags.push_back("phase_limited");
-    char why[400];
-    std::snprintf(why, sizeof why,
-                  "the edge runs %.1f deg off the pixel axis, so its sub-pixel phase moves only %.2f px along the part "
-                  "measured (edge %.2f px past a pixel centre), and the PSF families that fit the board's profiles "
-                  "alike read %.2f-%.2f px here: its blur is not identified; the lens fit predicts it",
-                  s->phase.axis_deg, s->phase.span_px, s->phase.phase_px, lo, hi);
-    s->fit.phase_why = why;
+    s->fit.phase_why = PhaseWhy(*s, lo, hi, r, v_best, moved, nearest);
     ++choice.flagged;
+    cancelled += hi - lo <= target && moved > target;
+    jumped += hi - lo <= target && moved <= target;
   }
   int n_alike = 0, n_read = 0;
   for (const bool a : choice.alike) n_alike += a;
@@ -388,11 +545,12 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
                   families.size() - n_read, kChoiceSections);
   std::snprintf(text, sizeof text,
                 "%d usable sections sampled at few phases with blur under %.0f px, read as %s (%d of %zu PSF families "
-                "fit their profiles alike, chi-square per point %.2f%s); %d flagged phase_limited (each reading's "
-                "range among those families in calib.json)",
+                "fit their profiles alike, chi-square per point %.2f%s); %d flagged phase_limited (%d where the "
+                "sharpening cancels most of the optics' blur, %d whose reading jumps between neighbouring families; "
+                "each reading's range in calib.json)",
                 choice.limited, kMaxBlurPx,
                 families[best].Name().c_str(),
-                n_alike, families.size(), choice.chi2_per_point, ruled, choice.flagged);
+                n_alike, families.size(), choice.chi2_per_point, ruled, choice.flagged, cancelled, jumped);
   choice.summary = text;
   return choice;
 }

@@ -54,6 +54,10 @@ struct PhaseCheck {
 // The families read (the optics alone first).
 const std::vector<PhaseFamily>& PhaseFamilies();
 
+// The families next to family c along its own axis (a Gaussian's std, an unsharp mask's amount at its std; the optics
+// alone is the zero of each), indices into PhaseFamilies(): ChoosePhaseFamily's jump test reads a section with them.
+std::vector<size_t> PhaseNeighbours(size_t c);
+
 // Reads a section's blur once per family where its phases are few and its blur (`fit`, the blur fit's own reading)
 // is below about 2 px; `linear` as for MeasureEdgeModel. The edge lies where the pose puts it (the segment line).
 PhaseCheck CheckPhase(const cv::Mat& linear, const EdgeSegment& segment, const ModelFit& fit,

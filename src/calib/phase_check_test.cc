@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
 #include "calib/calibrate.h"
@@ -117,6 +119,62 @@ TEST(PhaseCheck, SectionTheAlikeFamiliesLeaveOpenIsFlaggedAndTheOthersReadWithTh
   EXPECT_TRUE(agreed.ok);
   EXPECT_DOUBLE_EQ(agreed.r_px, 0.87);
   EXPECT_EQ(SectionsLeftOut(result), (std::map<std::string, int>{{"phase_limited", 1}}));
+}
+
+// Neighbours along each family's own axis, as the families are listed (std for the Gaussians, amount for the unsharp
+// masks of one std; the optics alone is the zero of every axis).
+TEST(PhaseCheck, NeighboursAreTheNextStdOrAmountOnEitherSide) {
+  auto set = [](std::vector<size_t> v) {
+    std::sort(v.begin(), v.end());
+    return v;
+  };
+  EXPECT_EQ(set(PhaseNeighbours(FamilyIndex(0.45, 0))), set({FamilyIndex(0.4, 0), FamilyIndex(0.5, 0)}));
+  EXPECT_EQ(set(PhaseNeighbours(FamilyIndex(0.35, 0))), set({0, FamilyIndex(0.4, 0)}));
+  EXPECT_EQ(set(PhaseNeighbours(FamilyIndex(0.6, 0.5))), set({FamilyIndex(0.6, 0.3), FamilyIndex(0.6, 0.7)}));
+  EXPECT_EQ(set(PhaseNeighbours(FamilyIndex(1.0, 0.15))), set({0, FamilyIndex(1.0, 0.3)}));
+  EXPECT_EQ(set(PhaseNeighbours(FamilyIndex(0.8, 0))), set({FamilyIndex(0.7, 0)}));
+  EXPECT_EQ(set(PhaseNeighbours(0)), set({FamilyIndex(0.35, 0), FamilyIndex(0.6, 0.15), FamilyIndex(1.0, 0.15)}));
+}
+
+// Sections made by hand, read best by an unsharp mask of amount 0.5 (std 0.6 px). Its taps' second moment, written
+// out here: -0.5 x the Gaussian's at whole pixels. Where the mask cancels most of the optics' blur (read 0.30 px from
+// optics of sqrt(0.30^2 - 4 V) px) a 2 % error in the optics' reading moves the section's by more than 0.04 px: flagged,
+// with the optics' radius in the reason; at 0.90 px it moves it by less than 8 %: kept. A third section whose reading
+// lies 0.15 px below both neighbouring amounts' readings is flagged for that.
+TEST(PhaseCheck, SectionWhereTheChosenSharpeningCancelsMostOfTheBlurOrJumpsIsFlagged) {
+  const size_t n = PhaseFamilies().size(), chosen = FamilyIndex(0.6, 0.5);
+  double sum = 0, second = 0;
+  for (int k = -3; k <= 3; ++k) sum += std::exp(-0.5 * k * k / 0.36), second += k * k * std::exp(-0.5 * k * k / 0.36);
+  const double v = -0.5 * second / sum;  // the unsharp mask's taps' variance (px^2)
+  CalibResult result;
+  const double reading[3] = {0.30, 0.90, 0.75}, neighbour[3] = {0.30, 0.90, 0.92};
+  result.edges.resize(3);
+  for (int e = 0; e < 3; ++e) {
+    SectionResult s;
+    s.edge = e + 1, s.section = 1, s.u_mm = 400;
+    s.fit.ok = true, s.fit.r_px = 1.0;
+    s.phase.limited = true, s.phase.bins = 20;
+    s.phase.families.assign(n, PhaseReading{});
+    for (size_t c = 0; c < n; ++c) s.phase.families[c] = {1.5, 0, 0.01, 1e4};
+    for (const size_t c : PhaseNeighbours(chosen)) s.phase.families[c] = {neighbour[e], 0, 0.01, 1e4};
+    s.phase.families[chosen] = {reading[e], 0, 0.001, 18};
+    result.edges[e].sections.push_back(s);
+  }
+  const PhaseChoice choice = ChoosePhaseFamily(result);
+  EXPECT_EQ(choice.chosen, chosen);
+  EXPECT_EQ(choice.flagged, 2);
+  const ModelFit& cancelled = result.edges[0].sections[0].fit;
+  EXPECT_FALSE(cancelled.ok);
+  char optics[40];
+  std::snprintf(optics, sizeof optics, "optics %.2f px, read 0.30 px", std::sqrt(0.09 - 4 * v));
+  EXPECT_NE(cancelled.phase_why.find(optics), std::string::npos) << cancelled.phase_why << " / " << optics;
+  EXPECT_TRUE(result.edges[1].sections[0].fit.ok);
+  EXPECT_DOUBLE_EQ(result.edges[1].sections[0].fit.r_px, 0.90);
+  const ModelFit& jumped = result.edges[2].sections[0].fit;
+  EXPECT_FALSE(jumped.ok);
+  EXPECT_NE(jumped.phase_why.find("lies 0.17 px outside"), std::string::npos) << jumped.phase_why;
+  EXPECT_NE(choice.summary.find("2 flagged phase_limited (1 where the sharpening cancels"), std::string::npos)
+      << choice.summary;
 }
 
 // The scene: a level camera, the image filtered after sampling. The check finds the filter and every section
