@@ -303,7 +303,7 @@ TEST(Columns, BothSidesColumnsAreNamedFromOnePlace) {
   EXPECT_EQ(SideColumn("", protocol::Side::kLeft, "source"), "left_source");
   EXPECT_EQ(SideColumn("r", "scene", "px"), "r_scene_px");
   std::vector<std::string> names;
-  for (const FrameValue& v : FrameValues()) names.push_back(v.name);
+  for (const FrameColumn* v : KeptColumns(FrameColumns())) names.push_back(v->name);
   EXPECT_EQ(names, (std::vector<std::string>{"frame_index", "flip_time_s", "dropped", "r_left_px", "r_right_px", "y_mm",
                                              "take_frame", "take_status", "floor_sigma_left_px",
                                              "floor_sigma_right_px", "motion_left_x_px", "motion_left_y_px",
@@ -312,7 +312,7 @@ TEST(Columns, BothSidesColumnsAreNamedFromOnePlace) {
   f.sides[protocol::Index(protocol::Side::kLeft)] = {1.0, 2.0, 3.0, 4.0};
   f.sides[protocol::Index(protocol::Side::kRight)] = {5.0, 6.0, 7.0, 8.0};
   std::map<std::string, Value> read;
-  for (const FrameValue& v : FrameValues()) read[v.name] = v.of(f);
+  for (const FrameColumn* v : KeptColumns(FrameColumns())) read[v->name] = v->of(f);
   EXPECT_EQ(read["r_left_px"], Value(1.0));
   EXPECT_EQ(read["floor_sigma_left_px"], Value(2.0));
   EXPECT_EQ(read["motion_left_y_px"], Value(4.0));
