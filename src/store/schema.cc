@@ -65,6 +65,16 @@ void CanonicalProtocolHashes(Database& db) {
   }
 }
 
+// 10: each protocol version's adaptive procedures, one row per block with a procedure (procedures.h: its columns are
+// ProcedureColumns' since 10), recorded when the version's first session starts; a record of before gets them from
+// its recorded texts (DeriveProcedures), which export used to parse at every export.
+Migration ProceduresStep(const std::string& strict) {
+  return {"CREATE TABLE procedures ("
+          "  protocol_version_id INTEGER NOT NULL REFERENCES protocol_versions(id)" +
+              CreatedColumnsSql(ProcedureColumns(), 10) + ", PRIMARY KEY (protocol_version_id, block))" + strict + ";",
+          [](Database& db) { DeriveProcedures(db); }};
+}
+
 std::vector<Migration> MakeMigrations() {
   const std::string strict = Strict();
   std::vector<Migration> steps;
@@ -175,14 +185,7 @@ std::vector<Migration> MakeMigrations() {
   // 9: a study on video - what each frame showed of the take (frame_columns.h: the take's frame and status, each
   // side's lens floor and motion streak); NULL for photos and before version 9.
   steps.push_back({AddColumnsSql(RecordColumns(), 9) + AddTableColumnsSql("frames", FrameColumns(), 9)});
-  // 10: each protocol version's adaptive procedures, one row per block with a procedure (procedures.h: its columns
-  // are ProcedureColumns' since 10), recorded when the version's first session starts; a record of before gets them
-  // from its recorded texts (DeriveProcedures), which export used to parse at every export.
-  steps.push_back({"CREATE TABLE procedures ("
-                   "  protocol_version_id INTEGER NOT NULL REFERENCES protocol_versions(id)" +
-                       CreatedColumnsSql(ProcedureColumns(), 10) +
-                       ", PRIMARY KEY (protocol_version_id, block))" + strict + ";",
-                   [](Database& db) { DeriveProcedures(db); }});
+  steps.push_back(ProceduresStep(strict));
   // 11 on: a typed column the column table adds with `since` N is migration N (NULL in the rows already there). A
   // version that needs more (a table, a derivation from older texts) is written above as its own step.
   int last = 0;
