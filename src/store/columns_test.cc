@@ -347,7 +347,8 @@ TEST(TableColumns, TheShippedMigrationsAreGeneratedUnchanged) {
             "BETWEEN 0 AND 1), parameters TEXT NOT NULL CHECK (json_valid(parameters))");
   // frames.csv: the join's columns, then the table's; the INSERT writes only the table's.
   EXPECT_EQ(CsvHeader(FrameColumns()).size(), 5 + KeptColumns(FrameColumns()).size());
-  EXPECT_EQ(InsertSql("frames", "trial_id", FrameColumns()).rfind("INSERT INTO frames (trial_id, frame_index, ", 0), 0u);
+  EXPECT_EQ(InsertSql("frames", "trial_id", FrameColumns()).rfind("INSERT INTO frames (trial_id, frame_index, ", 0),
+            0u);
 }
 
 // A column added to a one-list table reaches its migration, INSERT, merge copy, CSV and codebook.

@@ -125,10 +125,12 @@ std::string TableRows(Database& db) {
 TEST(ProceduresTable, WrittenWhenAVersionIsFirstRecordedFromTheProceduresGiven) {
   testing::TempDir dir;
   SessionMeta meta;
-  meta.procedures = std::vector<ProcedureRecord>{{1, "s", "staircase", "relative_difference", 3, 0.5, R"({"marker":1})"}};
+  meta.procedures =
+      std::vector<ProcedureRecord>{{1, "s", "staircase", "relative_difference", 3, 0.5, R"({"marker":1})"}};
   {
     Record record = Record::Open(dir / "r.sqlite");
-    const int64_t session = record.StartOrResumeSession("two-procedures", "P1", kTwoProcedures, 7, meta, false).session_id;
+    const int64_t session =
+        record.StartOrResumeSession("two-procedures", "P1", kTwoProcedures, 7, meta, false).session_id;
     record.FinishSession(session, SessionStatus::kCompleted);
     meta.procedures->front().parameters = R"({"marker":2})";
     record.StartOrResumeSession("two-procedures", "P2", kTwoProcedures, 8, meta, false);

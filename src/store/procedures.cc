@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/json_io.h"
+#include "protocol/protocol.h"
 #include "protocol/vocabulary.h"
 #include "store/sqlite.h"
 
@@ -14,7 +15,7 @@ namespace {
 
 // A column of the table (and of procedures.csv unless `exported` is false), NOT NULL: a row is a whole procedure.
 ProcedureColumn ProcedureKept(ColumnSpec spec, const std::string& sql, const std::string& check,
-                     std::function<Value(const ProcedureRecord&)> of, bool exported = true) {
+                              std::function<Value(const ProcedureRecord&)> of, bool exported = true) {
   ProcedureColumn c;
   static_cast<ColumnSpec&>(c) = std::move(spec);
   c.sql = sql, c.check = check, c.required = true, c.since = 10, c.of = std::move(of), c.exported = exported;
@@ -40,41 +41,57 @@ std::vector<ProcedureColumn> MakeProcedureColumns() {
   const std::vector<std::string> variables = protocol::Words<protocol::ProcedureVariable>();
   return WithCells(std::vector<ProcedureColumn>{
       ProcedureJoined({"study", "string", "", "", "the study (protocol name)"}, "st.name"),
-      ProcedureJoined({"protocol_hash", "string", "", "16 hex digits", "the protocol version, as trials.csv's protocol_hash"},
-             "pv.hash"),
+      ProcedureJoined(
+          {"protocol_hash", "string", "", "16 hex digits", "the protocol version, as trials.csv's protocol_hash"},
+          "pv.hash"),
       ProcedureKept({"block", "integer", "", "", "the block's index in the protocol, as trials.csv's block"}, "INTEGER",
-           "block >= 0", [](const R& r) { return Value(r.block); }),
+                    "block >= 0", [](const R& r) { return Value(r.block); }),
       ProcedureKept({"block_name", "string", "", "", "the block's name"}, "TEXT", "",
-           [](const R& r) { return Value(r.block_name); }),
+                    [](const R& r) { return Value(r.block_name); }),
       // No CHECK from the vocabularies: a shipped migration's SQL never changes, and a later word must fit.
       ProcedureKept({"procedure", "string", "", ProcedureWords(kinds, "|"), "the adaptive procedure"}, "TEXT", "",
-           [](const R& r) { return Value(r.procedure); }),
+                    [](const R& r) { return Value(r.procedure); }),
       // Typed in the table for SQL over the record; procedures.csv gives them in parameters.
-      ProcedureKept({"variable", "string", "", ProcedureWords(variables, "|"), "the procedure's variable"}, "TEXT", "",
-           [](const R& r) { return Value(r.variable); }, false),
-      ProcedureKept({"trials", "integer", "", ">= 1", "trials per crossing of the block's factors"}, "INTEGER", "trials >= 1",
-           [](const R& r) { return Value(r.trials); }, false),
-      ProcedureKept({"guess", "number", "", "0..1", "the chance rate the procedure assumes"}, "REAL", "guess BETWEEN 0 AND 1",
-           [](const R& r) { return Value(r.guess); }, false),
-      ProcedureKept({"parameters", "string", "", "JSON",
-            "the procedure's parameters as the protocol parser reads them: procedure, variable, reference, trials; a "
-            "staircase's start, min, max, up, down, steps, stop_reversals and guess (1/n of an odd one out's n "
-            "intervals, else 0.5); QUEST+'s stimuli, thresholds, slopes, lapses (its grid, uniform prior) and guess"},
-           "TEXT", "json_valid(parameters)", [](const R& r) { return Value(r.parameters); }),
+      ProcedureKept(
+          {"variable", "string", "", ProcedureWords(variables, "|"), "the procedure's variable"}, "TEXT", "",
+          [](const R& r) { return Value(r.variable); }, false),
+      ProcedureKept(
+          {"trials", "integer", "", ">= 1", "trials per crossing of the block's factors"}, "INTEGER", "trials >= 1",
+          [](const R& r) { return Value(r.trials); }, false),
+      ProcedureKept(
+          {"guess", "number", "", "0..1", "the chance rate the procedure assumes"}, "REAL", "guess BETWEEN 0 AND 1",
+          [](const R& r) { return Value(r.guess); }, false),
+      ProcedureKept(
+          {"parameters", "string", "", "JSON",
+           "the procedure's parameters as the protocol parser reads them: procedure, variable, reference, trials; a "
+           "staircase's start, min, max, up, down, steps, stop_reversals and guess (1/n of an odd one out's n "
+           "intervals, else 0.5); QUEST+'s stimuli, thresholds, slopes, lapses (its grid, uniform prior) and guess"},
+          "TEXT", "json_valid(parameters)", [](const R& r) { return Value(r.parameters); }),
   });
 }
 
 // The parameters as procedures.csv gives them (analysis/tracks.py reads them): the shared ones, then the kind's.
 Json ParametersOf(const protocol::Procedure& p) {
-  Json out = {{"procedure", protocol::ToString(p.kind)}, {"variable", protocol::ToString(p.variable)},
-              {"reference", protocol::ToJson(std::optional<protocol::BlurSpec>(p.reference))}, {"trials", p.trials}};
+  Json out = {{"procedure", protocol::ToString(p.kind)},
+              {"variable", protocol::ToString(p.variable)},
+              {"reference", protocol::ToJson(std::optional<protocol::BlurSpec>(p.reference))},
+              {"trials", p.trials}};
   switch (p.kind) {
     case protocol::ProcedureKind::kStaircase:
-      out.update({{"start", p.start}, {"min", p.min}, {"max", p.max}, {"up", p.up}, {"down", p.down},
-                  {"steps", p.steps}, {"stop_reversals", p.stop_reversals}, {"guess", p.guess}});
+      out.update({{"start", p.start},
+                  {"min", p.min},
+                  {"max", p.max},
+                  {"up", p.up},
+                  {"down", p.down},
+                  {"steps", p.steps},
+                  {"stop_reversals", p.stop_reversals},
+                  {"guess", p.guess}});
       break;
     case protocol::ProcedureKind::kQuestPlus:
-      out.update({{"stimuli", p.stimuli}, {"thresholds", p.thresholds}, {"slopes", p.slopes}, {"lapses", p.lapses},
+      out.update({{"stimuli", p.stimuli},
+                  {"thresholds", p.thresholds},
+                  {"slopes", p.slopes},
+                  {"lapses", p.lapses},
                   {"guess", p.guess}});
       break;
   }
@@ -93,8 +110,8 @@ std::vector<ProcedureRecord> ProcedureRecords(const std::vector<protocol::Block>
   for (size_t b = 0; b < blocks.size(); ++b) {
     if (!blocks[b].procedure) continue;
     const protocol::Procedure& p = *blocks[b].procedure;
-    records.push_back({int64_t(b), blocks[b].name, protocol::ToString(p.kind), protocol::ToString(p.variable),
-                       p.trials, p.guess, ParametersOf(p).dump()});
+    records.push_back({int64_t(b), blocks[b].name, protocol::ToString(p.kind), protocol::ToString(p.variable), p.trials,
+                       p.guess, ParametersOf(p).dump()});
   }
   return records;
 }
@@ -132,8 +149,8 @@ void SaveProcedures(Database& db, int64_t protocol_version_id, const std::vector
 }
 
 void DeriveProcedures(Database& db, const std::string& where) {
-  Statement versions(db, "SELECT id, json FROM protocol_versions" + (where.empty() ? "" : " WHERE " + where) +
-                             " ORDER BY id");
+  Statement versions(
+      db, "SELECT id, json FROM protocol_versions" + (where.empty() ? "" : " WHERE " + where) + " ORDER BY id");
   std::vector<std::pair<int64_t, std::string>> texts;
   while (versions.Step()) texts.emplace_back(versions.GetInt64(0), versions.GetText(1));
   for (const auto& [id, text] : texts) SaveProcedures(db, id, RecordedProcedures(text));

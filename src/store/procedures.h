@@ -13,8 +13,11 @@
 #include <string>
 #include <vector>
 
-#include "protocol/protocol.h"
 #include "store/table_columns.h"
+
+namespace blurcue::protocol {
+struct Block;
+}
 
 namespace blurcue::store {
 
@@ -22,13 +25,13 @@ class Database;
 
 // One procedure block of a protocol version, as the record keeps it.
 struct ProcedureRecord {
-  int64_t block = 0;          // the block's index in the protocol's list of blocks (trials.csv's block)
+  int64_t block = 0;  // the block's index in the protocol's list of blocks (trials.csv's block)
   std::string block_name;
-  std::string procedure;      // staircase | quest_plus
-  std::string variable;       // the procedure's variable (relative_difference, difference_arcmin, ...)
-  int64_t trials = 0;         // per crossing of the block's factors
-  double guess = 0.5;         // the chance rate the procedure assumes
-  std::string parameters;     // all of them as JSON text (ProcedureParameters), as procedures.csv gives them
+  std::string procedure;   // staircase | quest_plus
+  std::string variable;    // the procedure's variable (relative_difference, difference_arcmin, ...)
+  int64_t trials = 0;      // per crossing of the block's factors
+  double guess = 0.5;      // the chance rate the procedure assumes
+  std::string parameters;  // all of them as JSON text (ProcedureParameters), as procedures.csv gives them
 };
 
 using ProcedureColumn = TableColumn<ProcedureRecord>;

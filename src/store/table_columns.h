@@ -28,13 +28,13 @@ std::string CodebookRow(const std::string& table, const ColumnSpec& column, cons
 
 template <typename Row>
 struct TableColumn : ColumnSpec {
-  std::string sql;     // INTEGER | REAL | TEXT; "" = not kept in the table: the CSV reads it through `select`
-  std::string check;   // the CHECK expression; "" for none
+  std::string sql;        // INTEGER | REAL | TEXT; "" = not kept in the table: the CSV reads it through `select`
+  std::string check;      // the CHECK expression; "" for none
   bool required = false;  // NOT NULL (a column a new table's CREATE makes; one added later cannot be)
-  int since = 0;       // the schema version that added it to the table
+  int since = 0;          // the schema version that added it to the table
   std::function<Value(const Row&)> of;  // what the record writes (a kept column of a row the record inserts)
-  std::string select;  // the export's SQL for its cell; "" = ALIAS.NAME of the table's own column
-  bool exported = true;  // false: kept in the table only (no CSV column, no codebook row)
+  std::string select;                   // the export's SQL for its cell; "" = ALIAS.NAME of the table's own column
+  bool exported = true;                 // false: kept in the table only (no CSV column, no codebook row)
   // How the CSV writes the cell: kText, kInteger or kNumber (NULL: empty); for a kept column its SQL type's.
   enum Cell cell = Cell::kText;
 };
