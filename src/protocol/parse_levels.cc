@@ -225,21 +225,31 @@ std::vector<Factor> Parser::ParseConditions(const Json& v, const std::string& pt
   const auto text = Text(v, "conditions", ptr.substr(0, ptr.rfind('/')), true, kMaxPathChars, true);
   if (!text) return {};
   const fs::path file = (base_ / *text).lexically_normal();
-  if (!CheckFile(file, ptr, Json(*text))) return {};
   const std::string where = file.string();
-  std::error_code size_error;
-  const uintmax_t bytes = fs::file_size(file, size_error);
-  if (!size_error && bytes > kMaxJsonBytes) {
-    Problem(ptr, where + ": a conditions table may have at most 16 MiB (" + std::to_string(kMaxTrials) +
-                     " rows); this file has " + std::to_string(bytes) + " bytes", Json(*text));
-    return {};
-  }
   std::string csv;
-  try {
-    csv = ReadTextFile(file, "a conditions table");
-  } catch (const std::exception& e) {
-    Problem(ptr, e.what(), Json(*text));
-    return {};
+  if (options_.conditions_tables) {
+    // A recorded version's table, as it was read when the version ran (no file is read).
+    const auto recorded = options_.conditions_tables->find(*text);
+    if (recorded == options_.conditions_tables->end()) {
+      Problem(ptr, "no recorded conditions table " + Echo(*text), Json(*text));
+      return {};
+    }
+    csv = recorded->second;
+  } else {
+    if (!CheckFile(file, ptr, Json(*text))) return {};
+    std::error_code size_error;
+    const uintmax_t bytes = fs::file_size(file, size_error);
+    if (!size_error && bytes > kMaxJsonBytes) {
+      Problem(ptr, where + ": a conditions table may have at most 16 MiB (" + std::to_string(kMaxTrials) +
+                       " rows); this file has " + std::to_string(bytes) + " bytes", Json(*text));
+      return {};
+    }
+    try {
+      csv = ReadTextFile(file, "a conditions table");
+    } catch (const std::exception& e) {
+      Problem(ptr, e.what(), Json(*text));
+      return {};
+    }
   }
   tables_[*text] = csv;
   const CsvText table = ParseCsv(csv, size_t(kMaxTrials) + 1);

@@ -306,6 +306,9 @@ std::set<double> NumericLevels(const Protocol& protocol, const std::string& fact
 
 struct ValidateOptions {
   bool check_files = true;            // false: skip the existence checks of referenced files
+  // Set: the conditions tables are read from here (path as the protocol writes it -> the table's text: a recorded
+  // version's "recorded_conditions", RecordedText), not from files; a path it lacks is a problem.
+  const std::map<std::string, std::string>* conditions_tables = nullptr;
 };
 
 // Every problem of `json` read from `file` (used in messages and to resolve relative paths), in document order;

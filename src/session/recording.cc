@@ -124,6 +124,7 @@ SessionStart Recording::StartOrResumeSession(const std::string& study, const std
   meta.window = info.window;
   meta.protocol_version = info.protocol_version;
   meta.design = DesignRecord(info.design);
+  meta.procedures = store::ProcedureRecords(info.blocks);
   meta.seed_given = info.seed_given;
   meta.seed_for_number = info.seed_for_number;
   return record_->StartOrResumeSession(study, participant, protocol_text, seed, meta, resume);

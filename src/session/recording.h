@@ -71,6 +71,8 @@ struct SessionInfo {
   // The protocol's declared "version" and its design (protocol::DescribeDesign), recorded once per protocol version.
   int64_t protocol_version = 1;
   std::vector<protocol::DesignColumn> design;
+  // The protocol's blocks as parsed: their procedures are recorded once per protocol version (no text parsed again).
+  std::vector<protocol::Block> blocks;
   // The seed was given (--seed): refused when an earlier session of the participant used it. Else, for a new
   // session, the number its default seed was made for (DefaultSessionSeed): refused if the record numbers it
   // otherwise (another station started one meanwhile); 0: not checked.

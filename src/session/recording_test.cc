@@ -172,5 +172,30 @@ TEST(Recording, AnOldObserverSpellingResumesWithTodaysCanonicalForm) {
   EXPECT_THROW(record.StartOrResumeSession("s", "P1", protocol, 7, info, true), Error);
 }
 
+// The adapter records the procedures of the blocks the session parsed (SessionInfo::blocks), once per protocol
+// version: a text that holds no procedure at all still gets the given block's row, so nothing was parsed from it.
+TEST(Recording, RecordsTheProceduresOfTheBlocksTheSessionParsed) {
+  store::testing::TempDir dir;
+  SessionInfo info;
+  protocol::Block plain, adaptive;
+  plain.name = "practice";
+  adaptive.name = "q";
+  adaptive.procedure = protocol::Procedure{};
+  adaptive.procedure->kind = protocol::ProcedureKind::kQuestPlus;
+  adaptive.procedure->variable = protocol::ProcedureVariable::kDifferenceArcmin;
+  adaptive.procedure->trials = 12;
+  adaptive.procedure->guess = 1.0 / 3;
+  info.blocks = {plain, adaptive};
+  {
+    Recording record = Recording::Open(dir / "r.sqlite");
+    record.StartOrResumeSession("s", "P1", R"({"name":"s","version":1})", 7, info, false);
+  }
+  store::Database db(dir / "r.sqlite", store::OpenMode::kReadOnly);
+  EXPECT_EQ(db.QueryText("SELECT group_concat(block || '|' || block_name || '|' || procedure || '|' || variable || '|' "
+                         "|| trials || '|' || round(guess, 4), ',') FROM procedures"),
+            "1|q|quest_plus|difference_arcmin|12|0.3333");
+  EXPECT_NE(db.QueryText("SELECT parameters FROM procedures").find(R"("guess":0.3333333333333333)"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace blurcue::session

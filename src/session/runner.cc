@@ -233,6 +233,7 @@ SessionInfo DescribeSession(const RunOptions& options, const procedure::Prepared
   meta.window = window;
   meta.protocol_version = protocol.version;
   meta.design = protocol::DescribeDesign(protocol);
+  meta.blocks = protocol.blocks;
   meta.seed_given = options.seed.has_value();
   if (!options.seed && !options.resume) meta.seed_for_number = session_number;
   return meta;

@@ -6,7 +6,8 @@
 // record's INSERT of a session's, a trial's and a response's typed columns, the export's SELECT and cells, the
 // codebook's rows, the names a design's level may not take (IsRecordedName) and the merge's column lists. Values the
 // protocol allows (levels, ranges, choices) are not here: the design table (design_columns) gives them per protocol
-// version. The columns of the tables beside trials.csv (frames.csv, adjustments.csv, summaries) are export_table.cc's.
+// version. The tables beside trials.csv have one list each: frames (frame_columns.h) and procedures (procedures.h)
+// through table_columns.h, adjustments.csv's in export_table.h; the summaries' are written with them.
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -39,7 +40,7 @@ enum class Cell { kText, kInteger, kNumber, kSeed, kAnswer };
 enum class Answer { kNone, kStatus, kChosenSide, kChoseMoreBlurred, kChosenInterval, kYesNo, kRating, kAdjustedLevel };
 
 // What the codebook says of a column - the part every table of the record and its exports shares (trials.csv's
-// columns below, frames.csv's FrameValue, procedures.csv's and adjustments.csv's ColumnDef): its name in the table
+// columns below, the TableColumn of frames.csv and procedures.csv, adjustments.csv's AdjustmentColumn): its name in the table
 // and the CSV, its type (string | integer | number | boolean: 0|1 | datetime: ISO 8601 UTC), unit, allowed values
 // and meaning. A table's header and its codebook rows are written from the same ColumnSpec (CodebookRow).
 struct ColumnSpec {
@@ -48,6 +49,8 @@ struct ColumnSpec {
 
 // A value for a typed column: NULL, an integer, a number or a text.
 using Value = std::variant<std::monostate, int64_t, double, std::string>;
+// Binds a value to parameter `index` of `insert` (NULL for none).
+void BindValue(Statement& insert, int index, const Value& value);
 
 // The name of a column of one side's (or the scene's) quantity, QUANTITY_SIDE_SUFFIX with the side's word
 // (protocol::Side's, or scene): r_left_px, floor_sigma_right_screen_px, motion_left_x_px, u_right_mm. The one place

@@ -9,6 +9,7 @@
 #include "store/export.h"
 #include "store/export_table.h"
 #include "store/frame_columns.h"
+#include "store/procedures.h"
 #include "store/record.h"
 #include "store/schema.h"
 #include "store/sqlite.h"
@@ -303,7 +304,7 @@ TEST(Columns, BothSidesColumnsAreNamedFromOnePlace) {
   EXPECT_EQ(SideColumn("", protocol::Side::kLeft, "source"), "left_source");
   EXPECT_EQ(SideColumn("r", "scene", "px"), "r_scene_px");
   std::vector<std::string> names;
-  for (const FrameValue& v : FrameValues()) names.push_back(v.name);
+  for (const FrameColumn* v : KeptColumns(FrameColumns())) names.push_back(v->name);
   EXPECT_EQ(names, (std::vector<std::string>{"frame_index", "flip_time_s", "dropped", "r_left_px", "r_right_px", "y_mm",
                                              "take_frame", "take_status", "floor_sigma_left_px",
                                              "floor_sigma_right_px", "motion_left_x_px", "motion_left_y_px",
@@ -312,7 +313,7 @@ TEST(Columns, BothSidesColumnsAreNamedFromOnePlace) {
   f.sides[protocol::Index(protocol::Side::kLeft)] = {1.0, 2.0, 3.0, 4.0};
   f.sides[protocol::Index(protocol::Side::kRight)] = {5.0, 6.0, 7.0, 8.0};
   std::map<std::string, Value> read;
-  for (const FrameValue& v : FrameValues()) read[v.name] = v.of(f);
+  for (const FrameColumn* v : KeptColumns(FrameColumns())) read[v->name] = v->of(f);
   EXPECT_EQ(read["r_left_px"], Value(1.0));
   EXPECT_EQ(read["floor_sigma_left_px"], Value(2.0));
   EXPECT_EQ(read["motion_left_y_px"], Value(4.0));
@@ -325,6 +326,55 @@ TEST(Columns, BothSidesColumnsAreNamedFromOnePlace) {
   v.sides[protocol::Index(protocol::Side::kRight)].size_deg = 1.5;
   v.sides[protocol::Index(protocol::Side::kLeft)].u_mm = 400;
   EXPECT_EQ(VariablesJson(v).dump(), R"({"size_right_deg":1.5,"u_left_mm":400.0})");
+}
+
+// The tables beside trials.csv keep their shipped SQL too: the frames columns versions 4 and 9 added, and version 10's
+// procedures table, as their one lists (frame_columns.h, procedures.h) generate them.
+TEST(TableColumns, TheShippedMigrationsAreGeneratedUnchanged) {
+  EXPECT_EQ(AddTableColumnsSql("frames", FrameColumns(), 4),
+            "ALTER TABLE frames ADD COLUMN r_left_px REAL;ALTER TABLE frames ADD COLUMN r_right_px REAL;"
+            "ALTER TABLE frames ADD COLUMN y_mm REAL;");
+  EXPECT_EQ(AddTableColumnsSql("frames", FrameColumns(), 9),
+            "ALTER TABLE frames ADD COLUMN take_frame INTEGER CHECK (take_frame >= 0);"
+            "ALTER TABLE frames ADD COLUMN take_status TEXT CHECK (take_status IN ('found', 'tracked', 'held'));"
+            "ALTER TABLE frames ADD COLUMN floor_sigma_left_px REAL;ALTER TABLE frames ADD COLUMN floor_sigma_right_px "
+            "REAL;ALTER TABLE frames ADD COLUMN motion_left_x_px REAL;ALTER TABLE frames ADD COLUMN motion_left_y_px "
+            "REAL;ALTER TABLE frames ADD COLUMN motion_right_x_px REAL;ALTER TABLE frames ADD COLUMN "
+            "motion_right_y_px REAL;");
+  EXPECT_EQ(CreatedColumnsSql(ProcedureColumns(), 10),
+            ", block INTEGER NOT NULL CHECK (block >= 0), block_name TEXT NOT NULL, procedure TEXT NOT NULL, "
+            "variable TEXT NOT NULL, trials INTEGER NOT NULL CHECK (trials >= 1), guess REAL NOT NULL CHECK (guess "
+            "BETWEEN 0 AND 1), parameters TEXT NOT NULL CHECK (json_valid(parameters))");
+  // frames.csv: the join's columns, then the table's; the INSERT writes only the table's.
+  EXPECT_EQ(CsvHeader(FrameColumns()).size(), 5 + KeptColumns(FrameColumns()).size());
+  EXPECT_EQ(InsertSql("frames", "trial_id", FrameColumns()).rfind("INSERT INTO frames (trial_id, frame_index, ", 0),
+            0u);
+}
+
+// A column added to a one-list table reaches its migration, INSERT, merge copy, CSV and codebook.
+TEST(TableColumns, AColumnAddedReachesEveryGeneratedPart) {
+  struct Row {
+    double x = 1.5;
+  };
+  TableColumn<Row> c;
+  static_cast<ColumnSpec&>(c) = {"x_mm", "number", "mm", "", "a test column"};
+  c.sql = "REAL", c.since = 99, c.of = [](const Row& r) { return Value(r.x); };
+  const std::vector<TableColumn<Row>> columns = WithCells(std::vector<TableColumn<Row>>{c});
+  EXPECT_EQ(AddTableColumnsSql("t", columns, 99), "ALTER TABLE t ADD COLUMN x_mm REAL;");
+  EXPECT_EQ(InsertSql("t", "k", columns), "INSERT INTO t (k, x_mm) VALUES (?, ?)");
+  EXPECT_EQ(CopySelect(columns, 98), ", NULL");
+  EXPECT_EQ(CopySelect(columns, 99), ", x_mm");
+  EXPECT_EQ(CsvSelect(columns, "a"), "a.x_mm");
+  EXPECT_EQ(CsvCodebook("t.csv", columns), "t.csv,x_mm,number,mm,,a test column,\r\n");
+  Database db(":memory:");
+  db.Exec("CREATE TABLE t (k INTEGER, x_mm REAL)");
+  Statement insert(db, InsertSql("t", "k", columns));
+  insert.Bind(1, int64_t(1));
+  BindRow(columns, insert, 2, Row{});
+  insert.Run();
+  Statement read(db, "SELECT " + CsvSelect(columns, "a") + " FROM t a");
+  ASSERT_TRUE(read.Step());
+  EXPECT_EQ(CsvCells(columns, read), std::vector<std::string>{"1.5"});
 }
 
 }  // namespace

@@ -20,6 +20,7 @@
 #include "store/columns.h"
 #include "store/export_procedures.h"
 #include "store/export_table.h"
+#include "store/frame_columns.h"
 #include "store/record.h"
 #include "store/schema.h"
 #include "store/sqlite.h"
@@ -207,6 +208,27 @@ Json LevelVariables(const Json& levels) {
   return v;
 }
 
+const std::vector<AdjustmentColumn>& AdjustmentColumns() {
+  // A step's recorded value (level, t_ms) as a cell; a step that is no object gives empty ones.
+  auto recorded = [](const char* key) {
+    return [key](const AdjustmentStep& s) { return s.step.is_object() ? TidyCell(s.step.value(key, Json())) : ""; };
+  };
+  static const std::vector<AdjustmentColumn> columns = {
+      {{"study", "string", "", "", "the protocol's name"}, [](const AdjustmentStep& s) { return s.study; }},
+      {{"participant", "string", "", "", "the participant's id"},
+       [](const AdjustmentStep& s) { return s.participant; }},
+      {{"session_id", "integer", "", ">= 1", "the session's id in this record (as in trials.csv)"},
+       [](const AdjustmentStep& s) { return std::to_string(s.session); }},
+      {{"trial_index", "integer", "", ">= 0", "the trial (as in trials.csv)"},
+       [](const AdjustmentStep& s) { return std::to_string(s.trial); }},
+      {{"step", "integer", "", ">= 1", "the step's place in the trial's adjustment, from 1"},
+       [](const AdjustmentStep& s) { return std::to_string(s.index + 1); }},
+      {{"level", "number", "the adjusted parameter's unit", "", "the level stepped to"}, recorded("level")},
+      {{"t_ms", "number", "ms", ">= 0", "when, from the stimulus's first frame"}, recorded("t_ms")},
+  };
+  return columns;
+}
+
 int64_t ExportCsv(const std::filesystem::path& db_path, const std::filesystem::path& out_dir,
                   const ProgressNote& note) {
   return ExportCsvWith(RecordColumns(), db_path, out_dir, note);
@@ -349,15 +371,17 @@ std::string KeptCell(Statement& rows, int i, const Column& c) {
   return rows.GetText(i);
 }
 
-// The adjustment path of a trial, long: one row of adjustments.csv per step.
+// The adjustment path of a trial, long: one row of adjustments.csv per step (AdjustmentColumns).
 std::string AdjustmentRows(const std::string& study, const std::string& participant, int64_t session, int64_t trial,
                            const Json& steps) {
   std::string rows;
   if (!steps.is_array()) return rows;
-  for (size_t i = 0; i < steps.size(); ++i)
-    rows += CsvLine({study, participant, std::to_string(session), std::to_string(trial), std::to_string(i + 1),
-                     steps[i].is_object() ? TidyCell(steps[i].value("level", Json())) : "",
-                     steps[i].is_object() ? TidyCell(steps[i].value("t_ms", Json())) : ""});
+  for (size_t i = 0; i < steps.size(); ++i) {
+    const AdjustmentStep step{study, participant, session, trial, i, steps[i]};
+    std::vector<std::string> cells;
+    for (const AdjustmentColumn& c : AdjustmentColumns()) cells.push_back(c.cell(step));
+    rows += CsvLine(cells);
+  }
   return rows;
 }
 
@@ -366,7 +390,7 @@ std::string CodebookRows(const std::vector<ColumnDef>& columns) {
   std::string codebook = CsvLine({"table", "column", "type", "unit", "allowed", "meaning", "role"});
   for (const auto& c : columns) codebook += CodebookRow("trials.csv", c, c.role);
   for (const auto& c : AdjustmentColumns()) codebook += CodebookRow("adjustments.csv", c);
-  for (const auto& [c, select, cell] : FrameColumns()) codebook += CodebookRow("frames.csv", c);
+  codebook += CsvCodebook("frames.csv", FrameColumns());
   return codebook;
 }
 

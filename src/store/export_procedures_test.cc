@@ -10,6 +10,7 @@
 #include "protocol/protocol.h"
 #include "store/export.h"
 #include "store/record.h"
+#include "store/schema.h"
 #include "store/test_util.h"
 
 namespace blurcue::store {
@@ -60,8 +61,8 @@ TEST(ExportProcedures, OneRowPerProcedureBlockWithTheParsersDefaults) {
   std::ifstream codebook(dir / "out" / "codebook.csv");
   std::stringstream text;
   text << codebook.rdbuf();
-  for (const auto& c : ProcedureColumns())
-    EXPECT_NE(text.str().find("procedures.csv," + c.name + ","), std::string::npos) << c.name;
+  for (const ProcedureColumn* c : CsvColumns(ProcedureColumns()))
+    EXPECT_NE(text.str().find("procedures.csv," + c->name + ","), std::string::npos) << c->name;
 }
 
 // A staircase over a conditions table: the record keeps the table beside the text (protocol::RecordedText), and the
@@ -87,6 +88,146 @@ TEST(ExportProcedures, AVersionReadingAConditionsTableKeepsItsRow) {
   const std::vector<std::string> lines = Lines(dir / "out" / "procedures.csv");
   ASSERT_EQ(lines.size(), 3u);
   EXPECT_NE(lines[2].find(",1,s,staircase,"), std::string::npos) << lines[2];
+}
+
+
+// The kTwoProcedures study whose second block reads a conditions table, as a session records it: the recorded text
+// (the table kept beside it) and the protocol the session parsed from the file.
+struct WithTable {
+  std::string recorded;
+  protocol::Protocol parsed;
+};
+WithTable TwoProceduresWithATable(const std::filesystem::path& dir) {
+  std::string text = kTwoProcedures;
+  const std::string factors = R"("factors": {"edge": [3, 5]})";
+  text.replace(text.find(factors), factors.size(), R"("conditions": "../tables/rows.csv")");
+  std::filesystem::create_directories(dir / "protocols");
+  std::filesystem::create_directories(dir / "tables");
+  std::ofstream(dir / "protocols" / "p.json") << text;
+  std::ofstream(dir / "tables" / "rows.csv") << "edge\r\n3\r\n5\r\n";
+  WithTable out;
+  out.parsed = protocol::LoadProtocol(dir / "protocols" / "p.json", protocol::ValidateOptions{false});
+  out.recorded = protocol::RecordedText(text, out.parsed);
+  std::filesystem::remove_all(dir / "tables");
+  return out;
+}
+
+// The table's rows as one text, in order.
+std::string TableRows(Database& db) {
+  return db.QueryText("SELECT coalesce(group_concat(r, '\n'), '') FROM (SELECT protocol_version_id || '|' || block || "
+                      "'|' || block_name || '|' || procedure || '|' || variable || '|' || trials || '|' || guess || "
+                      "'|' || parameters AS r FROM procedures ORDER BY protocol_version_id, block)");
+}
+
+// A session records the procedures it was given (as the runner gives them, parsed) when its protocol version is first
+// recorded, and export writes procedures.csv from them: parameters no parse of the text would give (a marker) are what
+// the file shows, so nothing was parsed again. A later session of the version keeps the first one's rows.
+TEST(ProceduresTable, WrittenWhenAVersionIsFirstRecordedFromTheProceduresGiven) {
+  testing::TempDir dir;
+  SessionMeta meta;
+  meta.procedures =
+      std::vector<ProcedureRecord>{{1, "s", "staircase", "relative_difference", 3, 0.5, R"({"marker":1})"}};
+  {
+    Record record = Record::Open(dir / "r.sqlite");
+    const int64_t session =
+        record.StartOrResumeSession("two-procedures", "P1", kTwoProcedures, 7, meta, false).session_id;
+    record.FinishSession(session, SessionStatus::kCompleted);
+    meta.procedures->front().parameters = R"({"marker":2})";
+    record.StartOrResumeSession("two-procedures", "P2", kTwoProcedures, 8, meta, false);
+    EXPECT_EQ(TableRows(record.database()), R"(1|1|s|staircase|relative_difference|3|0.5|{"marker":1})");
+  }
+  ExportCsv(dir / "r.sqlite", dir / "out");
+  const std::vector<std::string> lines = Lines(dir / "out" / "procedures.csv");
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[1].substr(lines[1].find(',', lines[1].find(',') + 1)), R"(,1,s,staircase,"{""marker"":1}")");
+}
+
+// What the runner records (ProcedureRecords of the blocks it parsed from the file, conditions table read from disk)
+// equals what a recorded text gives when parsed with its recorded tables in memory (RecordedProcedures: how a record
+// of before the table gets its rows) - the two ways the table is filled agree, and the second reads no file.
+TEST(ProceduresTable, TheParsedBlocksAndTheRecordedTextGiveTheSameRows) {
+  testing::TempDir dir;
+  const WithTable study = TwoProceduresWithATable(dir.path());
+  const std::vector<ProcedureRecord> parsed = ProcedureRecords(study.parsed.blocks);
+  const std::vector<ProcedureRecord> recorded = RecordedProcedures(study.recorded);
+  ASSERT_EQ(parsed.size(), 2u);
+  ASSERT_EQ(recorded.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(recorded[i].block, parsed[i].block);
+    EXPECT_EQ(recorded[i].block_name, parsed[i].block_name);
+    EXPECT_EQ(recorded[i].procedure, parsed[i].procedure);
+    EXPECT_EQ(recorded[i].parameters, parsed[i].parameters);
+  }
+  EXPECT_EQ(parsed[1].parameters.rfind(R"({"down":2,)", 0), 0u) << parsed[1].parameters;
+  EXPECT_EQ(parsed[0].guess, 0.5);
+  // The table the text names, missing from what it recorded: no rows (the parser refuses), not a read of the disk.
+  Json without = ParseJson(study.recorded, "recorded");
+  without["recorded_conditions"] = Json::object();
+  EXPECT_TRUE(RecordedProcedures(without.dump()).empty());
+}
+
+// A record of schema 9 (no procedures table) holding the kTwoProcedures text with its conditions table: export (a
+// migrated copy in memory) gives procedures.csv as export parsed it before the table, and a writer that opens it
+// migrates it in place, its rows derived from the recorded text.
+TEST(ProceduresTable, ARecordOfSchemaNineGetsItsRowsFromItsRecordedTexts) {
+  testing::TempDir dir;
+  const WithTable study = TwoProceduresWithATable(dir.path());
+  {
+    Database db(dir / "old.sqlite");
+    for (int i = 0; i < 9; ++i) {
+      const Migration& step = Migrations()[size_t(i)];
+      if (!step.sql.empty()) db.Exec(step.sql);
+      if (step.data) step.data(db);
+    }
+    db.Exec("PRAGMA user_version = 9; PRAGMA application_id = " + std::to_string(kApplicationId));
+    const std::string canonical = CanonicalProtocolText(study.recorded);
+    Statement insert(db, "INSERT INTO protocol_versions (study_id, json, hash, created, version) VALUES (1, ?, ?, "
+                         "'now', 1)");
+    db.Exec("INSERT INTO studies (name, created) VALUES ('two-procedures', 'now')");
+    insert.Bind(1, canonical);
+    insert.Bind(2, ProtocolHash(canonical));
+    insert.Run();
+    EXPECT_EQ(db.QueryInt64("SELECT count(*) FROM sqlite_schema WHERE name = 'procedures'"), 0);
+  }
+  ExportCsv(dir / "old.sqlite", dir / "out");
+  const std::vector<std::string> lines = Lines(dir / "out" / "procedures.csv");
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_NE(lines[1].find(",0,q,quest_plus,"), std::string::npos) << lines[1];
+  EXPECT_NE(lines[1].find(R"(""guess"":0.5)"), std::string::npos) << lines[1];
+  EXPECT_NE(lines[2].find(",1,s,staircase,"), std::string::npos) << lines[2];
+  EXPECT_NE(lines[2].find(R"(""steps"":[0.2,0.1])"), std::string::npos) << lines[2];
+  // Merged as it is (merge reads its inputs unmigrated): the merged record derives them as the migration would.
+  MergeDatabases({dir / "old.sqlite"}, dir / "merged.sqlite");
+  EXPECT_EQ(Database(dir / "merged.sqlite", OpenMode::kReadOnly).QueryInt64("SELECT count(*) FROM procedures"), 2);
+  Record record = Record::Open(dir / "old.sqlite");
+  EXPECT_EQ(SchemaVersion(record.database()), CurrentSchemaVersion());
+  EXPECT_EQ(record.database().QueryText("SELECT group_concat(block || ':' || procedure || ':' || trials, ',') FROM "
+                                        "(SELECT * FROM procedures ORDER BY block)"),
+            "0:quest_plus:4,1:staircase:3");
+}
+
+// Merge copies the procedures of every input, once per protocol version (the first input's), with the versions' new
+// ids; an input of schema 9 gets them from its texts.
+TEST(ProceduresTable, MergeCopiesEachVersionsRowsOnce) {
+  testing::TempDir dir;
+  for (const char* name : {"a", "b"}) {
+    Record record = Record::Open(dir / (std::string(name) + ".sqlite"));
+    // A version only b records first gives b's study its own id in the merged record.
+    if (std::string(name) == "b") record.StartOrResumeSession("other", "Q1", R"({"name": "other"})", 3, {}, false);
+    const int64_t session =
+        record.StartOrResumeSession("two-procedures", std::string("P") + name, kTwoProcedures, 7, {}, false).session_id;
+    record.FinishSession(session, SessionStatus::kCompleted);
+  }
+  MergeDatabases({dir / "a.sqlite", dir / "b.sqlite"}, dir / "merged.sqlite");
+  Database merged(dir / "merged.sqlite", OpenMode::kReadOnly);
+  EXPECT_EQ(merged.QueryInt64("SELECT count(*) FROM procedures"), 2);
+  EXPECT_EQ(merged.QueryText("SELECT group_concat(st.name || ':' || pr.block || ':' || pr.procedure, ',') FROM "
+                             "procedures pr JOIN protocol_versions pv ON pv.id = pr.protocol_version_id JOIN studies "
+                             "st ON st.id = pv.study_id"),
+            "two-procedures:0:quest_plus,two-procedures:1:staircase");
+  Database a(dir / "a.sqlite", OpenMode::kReadOnly);
+  EXPECT_EQ(merged.QueryText("SELECT group_concat(parameters, '|') FROM procedures"),
+            a.QueryText("SELECT group_concat(parameters, '|') FROM procedures"));
 }
 
 }  // namespace

@@ -169,70 +169,16 @@ std::string CodebookRow(const std::string& table, const ColumnSpec& column, cons
   return CsvLine({table, column.name, column.type, column.unit, column.allowed, column.meaning, role});
 }
 
-// The columns of adjustments.csv and frames.csv, for their writers and the codebook.
-const std::vector<ColumnDef>& AdjustmentColumns() {
-  static const std::vector<ColumnDef> columns = {
-      {"study", "string", "", "", "the protocol's name"},
-      {"participant", "string", "", "", "the participant's id"},
-      {"session_id", "integer", "", ">= 1", "the session's id in this record (as in trials.csv)"},
-      {"trial_index", "integer", "", ">= 0", "the trial (as in trials.csv)"},
-      {"step", "integer", "", ">= 1", "the step's place in the trial's adjustment, from 1"},
-      {"level", "number", "the adjusted parameter's unit", "", "the level stepped to"},
-      {"t_ms", "number", "ms", ">= 0", "when, from the stimulus's first frame"},
-  };
-  return columns;
-}
-const std::vector<FrameColumn>& FrameColumns() {
-  static const std::vector<FrameColumn> columns = [] {
-    std::vector<FrameColumn> c = {
-        {{"study", "string", "", "", "the protocol's name"}, "st.name", Cell::kText},
-        {{"participant", "string", "", "", "the participant's id"}, "p.code", Cell::kText},
-        {{"session_id", "integer", "", ">= 1", "the session's id in this record (as in trials.csv)"}, "s.id",
-         Cell::kInteger},
-        {{"window", "boolean", "", "0|1", "1: a real window on the real clock; 0: headless on a simulated clock"},
-         "coalesce(s.window, s.display LIKE 'window%')", Cell::kInteger},
-        {{"trial_index", "integer", "", ">= 0", "the trial (as in trials.csv)"}, "t.trial_index", Cell::kInteger},
-    };
-    // The frame's recorded values, as the record keeps them.
-    for (const FrameValue& v : FrameValues())
-      c.push_back({ColumnDef{v}, "f." + v.name,
-                   v.sql == "TEXT" ? Cell::kText : v.sql == "REAL" ? Cell::kNumber : Cell::kInteger});
-    return c;
-  }();
-  return columns;
-}
-
 // OUT/frames.csv: every recorded display flip, one row each (FrameColumns): what each frame showed of a pair, empty
 // where nothing was shown and for pictures.
 void WriteFrames(Database& db, const std::filesystem::path& out_dir) {
   const std::vector<FrameColumn>& columns = FrameColumns();
-  std::vector<std::string> header;
-  std::string select;
-  for (const FrameColumn& c : columns) {
-    header.push_back(c.def.name);
-    select += (select.empty() ? "" : ", ") + c.select;
-  }
-  std::string text = CsvLine(header);
-  Statement rows(db, "SELECT " + select +
+  std::string text = CsvLine(CsvHeader(columns));
+  Statement rows(db, "SELECT " + CsvSelect(columns, "f") +
                          " FROM frames f JOIN trials t ON t.id = f.trial_id JOIN sessions s ON s.id = t.session_id "
                          "JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
                          "ORDER BY st.name, p.code, s.id, t.trial_index, f.frame_index");
-  auto cell = [&](int at, enum Cell kind) -> std::string {
-    if (rows.IsNull(at)) return "";
-    switch (kind) {
-      case Cell::kInteger: return std::to_string(rows.GetInt64(at));
-      case Cell::kNumber: return Number(rows.GetDouble(at));
-      case Cell::kText:
-      case Cell::kSeed:
-      case Cell::kAnswer: break;
-    }
-    return rows.GetText(at);
-  };
-  while (rows.Step()) {
-    std::vector<std::string> cells;
-    for (size_t i = 0; i < columns.size(); ++i) cells.push_back(cell(int(i), columns[i].cell));
-    text += CsvLine(cells);
-  }
+  while (rows.Step()) text += CsvLine(CsvCells(columns, rows));
   WriteFileAtomically(out_dir / "frames.csv", text);
 }
 

@@ -3,6 +3,7 @@
 // tables beside trials.csv (summaries, adjustments, frames) with their codebook rows.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include "store/columns.h"
 #include "store/export.h"
 #include "store/sqlite.h"
+#include "store/table_columns.h"
 
 namespace blurcue::store {
 
@@ -19,8 +21,6 @@ struct ColumnDef : ColumnSpec {
   std::string role = "";  // a design's column: within, group, procedure_cell, label or practice (the design table's)
 };
 
-// The codebook's row (table, column, type, unit, allowed, meaning, role) of `column` of `table` (e.g. "frames.csv").
-std::string CodebookRow(const std::string& table, const ColumnSpec& column, const std::string& role = "");
 
 
 // A JSON value as a cell: strings bare, null empty, anything else as compact JSON.
@@ -51,19 +51,22 @@ int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::p
 // cant_tell, for adjustment the level accepted. Writes OUT/SummaryFileName(STUDY) for every study and returns the
 // codebook's rows for them.
 std::string WriteSummaries(Database& db, const std::filesystem::path& out_dir);
-// A column of frames.csv, defined once: its codebook row, what the export selects for it (SQL over f = frames, t, s,
-// p, st) and how its cell is written (kText, kInteger, kNumber; NULL: empty). Its header, SELECT, cells and codebook
-// rows are generated from this table.
-struct FrameColumn {
-  ColumnDef def;
-  std::string select;
-  enum Cell cell = Cell::kText;  // the enum (columns.h), which the function Cell below hides
+// One step of a trial's recorded adjustment (responses.adjustment: [{"level": L, "t_ms": T}, ...]) with its trial.
+struct AdjustmentStep {
+  const std::string& study;
+  const std::string& participant;
+  int64_t session, trial;
+  size_t index;      // from 0
+  const Json& step;  // the step as recorded
 };
-// The columns of adjustments.csv and frames.csv, for their writers and the codebook.
-const std::vector<ColumnDef>& AdjustmentColumns();
-const std::vector<FrameColumn>& FrameColumns();
-// OUT/frames.csv: every recorded display flip, one row each (FrameColumns): what each frame showed of a pair, empty
-// where nothing was shown and for pictures.
+// A column of adjustments.csv, defined once: its codebook definition and how its cell is read from a step (a
+// recorded value by export.cc's TidyCell). Its header, cells and codebook rows are generated from the list.
+struct AdjustmentColumn : ColumnSpec {
+  std::function<std::string(const AdjustmentStep&)> cell;
+};
+const std::vector<AdjustmentColumn>& AdjustmentColumns();
+// OUT/frames.csv: every recorded display flip, one row each (frame_columns.h FrameColumns): what each frame showed of
+// a pair, empty where nothing was shown and for pictures.
 void WriteFrames(Database& db, const std::filesystem::path& out_dir);
 
 }  // namespace blurcue::store

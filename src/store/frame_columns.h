@@ -1,8 +1,9 @@
 #pragma once
-// The frames table's recorded values, defined once: what each display flip of a trial showed (FrameRecord), each
-// value with its SQL type and CHECK, the schema version that added it and its row of the codebook. Generated from it:
-// the migration that adds version 9's, the record's INSERT, the merge's copy, and frames.csv's columns after the
-// session's and the trial's.
+// The frames table and frames.csv, defined once: what each display flip of a trial showed (FrameRecord), each value
+// with its SQL type and CHECK, the schema version that added it and its row of the codebook, and frames.csv's columns
+// read from the session and the trial (a declared join). Generated from the one list (FrameColumns, table_columns.h):
+// the migrations that added versions 4's and 9's columns, the record's INSERT, the merge's copy, frames.csv's header,
+// SELECT and cells, and the codebook's rows.
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -10,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "store/columns.h"
+#include "store/table_columns.h"
 
 namespace blurcue::store {
 
@@ -38,21 +39,11 @@ struct FrameRecord {
 // The take statuses a frame may record (take_status's CHECK and the codebook's allowed values).
 inline constexpr const char* kTakeStatuses[] = {"found", "tracked", "held"};
 
-// A frame's value: its column in the frames table and frames.csv (ColumnSpec: name and codebook), its SQL type and
-// CHECK, the schema version that added it and how it is read from a FrameRecord.
-struct FrameValue : ColumnSpec {
-  std::string sql, check;            // INTEGER | REAL | TEXT; "" = no CHECK
-  int since = 1;                     // the schema version that added it (1: the table's own)
-  std::function<Value(const FrameRecord&)> of;
-};
+// A column of the frames table (kept: read from a FrameRecord by `of`) or of frames.csv only (the session's and the
+// trial's, selected over f = frames, t = trials, s = sessions, p = participants, st = studies).
+using FrameColumn = TableColumn<FrameRecord>;
 
-// In the table's order.
-const std::vector<FrameValue>& FrameValues();
-
-// "ALTER TABLE frames ADD COLUMN ...;" for the values schema version `version` added.
-std::string AddFrameColumnsSql(int version);
-
-// Binds a value to parameter `index` (NULL for none).
-void BindValue(Statement& insert, int index, const Value& value);
+// In frames.csv's order: the session's and the trial's columns, then the table's own in the table's order.
+const std::vector<FrameColumn>& FrameColumns();
 
 }  // namespace blurcue::store

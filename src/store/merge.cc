@@ -11,6 +11,7 @@
 #include "store/export.h"
 #include "store/columns.h"
 #include "store/frame_columns.h"
+#include "store/procedures.h"
 #include "store/export_table.h"
 #include "store/record.h"
 #include "store/schema.h"
@@ -181,7 +182,27 @@ std::map<std::filesystem::path, Renames> CheckMergeInputs(const std::vector<std:
   return renames;
 }
 
-// One input's studies, protocol versions (with their typed columns) and designs into `dst`.
+// One input's procedures (procedures.h): a version's rows as the first input that recorded them gives them; an input
+// of before schema 10 gives them from its recorded texts, as its migration would.
+void CopyProcedures(Database& src, Database& dst, const std::filesystem::path& input, int version,
+                    const IdMap& protocol_ids) {
+  if (version < 10) {
+    std::string ids;
+    for (const auto& [from, to] : protocol_ids) ids += (ids.empty() ? "" : ", ") + std::to_string(to);
+    if (!ids.empty()) DeriveProcedures(dst, "id IN (" + ids + ")");
+    return;
+  }
+  Statement rows(src, "SELECT protocol_version_id" + CopySelect(ProcedureColumns(), version) + " FROM procedures");
+  Statement insert(dst, InsertSql("procedures", "protocol_version_id", ProcedureColumns(), "INSERT OR IGNORE"));
+  while (rows.Step()) {
+    insert.Bind(1, Mapped(protocol_ids, rows.GetInt64(0), input, "protocol version"));
+    CopyKept(ProcedureColumns(), rows, 1, insert, 2);
+    insert.Run();
+    insert.Reset();
+  }
+}
+
+// One input's studies, protocol versions (with their typed columns), procedures and designs into `dst`.
 void CopyStudiesAndProtocols(Database& src, Database& dst, const std::filesystem::path& input, int version,
                              IdMap& study_ids, IdMap& protocol_ids) {
   Statement studies(src, "SELECT id, name, created FROM studies");
@@ -213,6 +234,7 @@ void CopyStudiesAndProtocols(Database& src, Database& dst, const std::filesystem
     set_version.Run();
     set_version.Reset();
   }
+  CopyProcedures(src, dst, input, version, protocol_ids);
   if (version < 8) return;
   // One design per protocol version: the first input that recorded it gives it.
   Statement design(src, "SELECT protocol_version_id, position, name, role, type, unit, allowed FROM "
@@ -375,24 +397,11 @@ void CopyTrials(Database& src, Database& dst, const std::filesystem::path& input
     insert_response.Reset();
   }
 
-  std::string read, names, marks;
-  for (const FrameValue& v : FrameValues()) {
-    read += ", " + (version >= v.since ? v.name : std::string("NULL"));
-    names += ", " + v.name;
-    marks += ", ?";
-  }
-  Statement frames(src, "SELECT trial_id" + read + " FROM frames");
-  Statement insert_frame(dst, "INSERT INTO frames (trial_id" + names + ") VALUES (?" + marks + ")");
+  Statement frames(src, "SELECT trial_id" + CopySelect(FrameColumns(), version) + " FROM frames");
+  Statement insert_frame(dst, InsertSql("frames", "trial_id", FrameColumns()));
   while (frames.Step()) {
     insert_frame.Bind(1, Mapped(trial_ids, frames.GetInt64(0), input, "trial"));
-    int column = 1;
-    for (const FrameValue& v : FrameValues()) {
-      if (frames.IsNull(column)) insert_frame.BindNull(column + 1);
-      else if (v.sql == "TEXT") insert_frame.Bind(column + 1, frames.GetText(column));
-      else if (v.sql == "REAL") insert_frame.Bind(column + 1, frames.GetDouble(column));
-      else insert_frame.Bind(column + 1, frames.GetInt64(column));
-      ++column;
-    }
+    CopyKept(FrameColumns(), frames, 1, insert_frame, 2);
     insert_frame.Run();
     insert_frame.Reset();
   }

@@ -18,6 +18,7 @@
 #include "core/json_io.h"
 #include "protocol/level.h"
 #include "store/columns.h"
+#include "store/procedures.h"
 #include "store/record_texts.h"
 #include "store/schema.h"
 
@@ -455,6 +456,8 @@ SessionStart Record::StartOrResumeSession(const std::string& study, const std::s
       throw InputError(db_.path(), "the protocol text stored under hash " + hash + " is not the text that hashes to "
                                    "it (was the record edited?); refusing to record answers against it");
     SaveDesign(protocol_id, study, meta.protocol_version, meta.design);
+    // Its procedures once per version, as the session parsed them (a caller that gives none: from the text).
+    SaveProcedures(db_, protocol_id, meta.procedures ? *meta.procedures : RecordedProcedures(canonical));
     // Numbered in the transaction that inserts the session, as the balanced group is: two stations never give one
     // number twice.
     start.session_number = NextSessionNumber(participant_id, study, participant, seed, meta);
@@ -648,13 +651,10 @@ void Record::RecordResponse(int64_t session, int64_t trial_index, const Response
   insert.Bind(6, response.shown_json);
   BindTyped(RecordColumns(), insert, 7, response);  // the level, correctness and radii decided at the trial
   insert.Run();
-  std::string names, marks;
-  for (const FrameValue& v : FrameValues()) names += ", " + v.name, marks += ", ?";
-  Statement frame(db_, "INSERT INTO frames (trial_id" + names + ") VALUES (?" + marks + ")");
+  Statement frame(db_, InsertSql("frames", "trial_id", FrameColumns()));
   for (const FrameRecord& f : frames) {
     frame.Bind(1, trial_id);
-    int column = 2;
-    for (const FrameValue& v : FrameValues()) BindValue(frame, column++, v.of(f));
+    BindRow(FrameColumns(), frame, 2, f);
     frame.Run();
     frame.Reset();
   }

@@ -13,6 +13,7 @@
 #include "store/sqlite.h"
 
 #include "store/frame_columns.h"
+#include "store/procedures.h"
 
 namespace blurcue::store {
 
@@ -53,6 +54,9 @@ struct SessionMeta {
   // The protocol's declared "version" and its design (recorded once per protocol version; empty: none recorded).
   int64_t protocol_version = 1;
   std::vector<DesignColumnRecord> design;
+  // The protocol's procedures (ProcedureRecords of its parsed blocks), recorded once per protocol version; unset: read
+  // from the protocol text (RecordedProcedures).
+  std::optional<std::vector<ProcedureRecord>> procedures;
   // The seed was given (--seed), not derived: one an earlier session of the participant used is refused as such.
   bool seed_given = false;
   // > 0: the seed was derived for this session number, and a new session given another number (a station started

@@ -12,6 +12,7 @@
 #include "core/json_io.h"
 #include "store/columns.h"
 #include "store/frame_columns.h"
+#include "store/procedures.h"
 
 namespace blurcue::store {
 namespace {
@@ -62,6 +63,16 @@ void CanonicalProtocolHashes(Database& db) {
     }
     same.Reset();
   }
+}
+
+// 10: each protocol version's adaptive procedures, one row per block with a procedure (procedures.h: its columns are
+// ProcedureColumns' since 10), recorded when the version's first session starts; a record of before gets them from
+// its recorded texts (DeriveProcedures), which export used to parse at every export.
+Migration ProceduresStep(const std::string& strict) {
+  return {"CREATE TABLE procedures ("
+          "  protocol_version_id INTEGER NOT NULL REFERENCES protocol_versions(id)" +
+              CreatedColumnsSql(ProcedureColumns(), 10) + ", PRIMARY KEY (protocol_version_id, block))" + strict + ";",
+          [](Database& db) { DeriveProcedures(db); }};
 }
 
 std::vector<Migration> MakeMigrations() {
@@ -131,7 +142,7 @@ std::vector<Migration> MakeMigrations() {
   // 4: what each frame showed of a pair (moving balls change radius from frame to frame): each side's radius in
   // photo px and the objects' place along the board's y in mm; NULL where nothing was shown and before version 4.
   // (frame_columns.h's columns that say since 4: r_left_px, r_right_px, y_mm).
-  steps.push_back({AddFrameColumnsSql(4)});
+  steps.push_back({AddTableColumnsSql("frames", FrameColumns(), 4)});
   // 5: what a trial showed as decided when it was shown (an adaptive procedure's level and the radii it made, the
   // answer's correctness): a JSON object of trial variables export lays over the planned ones; '{}' otherwise.
   steps.push_back({"ALTER TABLE responses ADD COLUMN shown TEXT NOT NULL DEFAULT '{}';"});
@@ -173,8 +184,9 @@ std::vector<Migration> MakeMigrations() {
                    &DeriveVersionsAndNumbers});
   // 9: a study on video - what each frame showed of the take (frame_columns.h: the take's frame and status, each
   // side's lens floor and motion streak); NULL for photos and before version 9.
-  steps.push_back({AddColumnsSql(RecordColumns(), 9) + AddFrameColumnsSql(9)});
-  // 10 on: a typed column the column table adds with `since` N is migration N (NULL in the rows already there). A
+  steps.push_back({AddColumnsSql(RecordColumns(), 9) + AddTableColumnsSql("frames", FrameColumns(), 9)});
+  steps.push_back(ProceduresStep(strict));
+  // 11 on: a typed column the column table adds with `since` N is migration N (NULL in the rows already there). A
   // version that needs more (a table, a derivation from older texts) is written above as its own step.
   int last = 0;
   for (const Column& c : RecordColumns()) last = std::max({last, c.at.since, c.shown.since});
