@@ -114,6 +114,10 @@ hostile_test(cli_hostile_camera_huge_focal 3
              estimate --camera ${H}/camera-huge-focal.json ${ESTIMATE_ARGS})
 
 # The numeric options of the other commands: each names its range and unit.
+# camera's options hold the ranges camera.json does: a focal length of 0.001 mm passed the option's (0, 2000] and was
+# refused afterwards naming the photo ("scene.png: /focal_length_mm: must be in [0.5, 2000] mm").
+hostile_test(cli_hostile_camera_focal_length_tiny 2 "--focal-length-mm: must be in [0.5, 2000] mm, got 0.001"
+             camera ${D}/small.png --sensor-mm 23.4 15.6 --focal-length-mm 0.001 --f-number 5.6)
 hostile_test(cli_hostile_estimate_u_nan 2 "--u-mm: must be in (0, 1000000] mm, got 'nan'"
              estimate --camera ${D}/thesis-camera.json --ref-u-mm 342.3 --ref-r-px 8 --u-mm nan)
 hostile_test(cli_hostile_estimate_ref_u_inf 2 "--ref-u-mm: must be in [0, 1000000] mm, got 'inf'"
