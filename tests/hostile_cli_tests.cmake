@@ -239,6 +239,18 @@ add_test(NAME cli_hostile_plan_no_share_is_no_nan
 set_tests_properties(cli_hostile_plan_no_share_is_no_nan PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
                      LABELS plan)
 
+# report --out an earlier report replaced it whole, with whatever someone had put into it (notes.txt here; a report
+# made inside it, rep/sub, went too): a report replaces only a folder of its own files (index.html, bench.html, charts,
+# their tables, tables/ as export writes it).
+add_test(NAME cli_hostile_report_own_file_make
+         COMMAND bash -c "rm -rf '${H}/report-own' '${H}/report-own.sqlite' && '$<TARGET_FILE:blurcue>' run '${T}/protocols/test1-static-grids.json' --participant P1 --db '${H}/report-own.sqlite' --observer sim --stop-after 1 && mkdir -p '${H}/report-own' && touch '${H}/report-own/index.html' && echo notes > '${H}/report-own/notes.txt'")
+set_tests_properties(cli_hostile_report_own_file_make PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
+                     FIXTURES_SETUP report_own)
+hostile_test(cli_hostile_report_own_file_kept 3
+             "report-own: holds notes.txt, which this command did not write; the folder is replaced as a whole"
+             report --db ${H}/report-own.sqlite --out ${H}/report-own)
+set_tests_properties(cli_hostile_report_own_file_kept PROPERTIES FIXTURES_REQUIRED report_own LABELS analysis)
+
 # What a trial shows must be drawable on its screen: a radius or a motion streak past the renderer's largest blur
 # (500 screen px) validated, and run stopped at that trial with "blur radius must be in [0, 500] px, got 800", exit 5,
 # naming no file (a fixed 100 photo px at display.scale 8; a ball at 100 cm/s under a 1 s exposure; a staircase whose
