@@ -251,6 +251,16 @@ hostile_test(cli_hostile_report_own_file_kept 3
              report --db ${H}/report-own.sqlite --out ${H}/report-own)
 set_tests_properties(cli_hostile_report_own_file_kept PROPERTIES FIXTURES_REQUIRED report_own LABELS analysis)
 
+# The same for plan --out: an earlier plan with a file put beside it (plan.csv and notes.txt) is refused, not replaced.
+add_test(NAME cli_hostile_plan_own_file_make
+         COMMAND bash -c "rm -rf '${H}/plan-own' && mkdir -p '${H}/plan-own' && touch '${H}/plan-own/plan.csv' && echo notes > '${H}/plan-own/notes.txt'")
+set_tests_properties(cli_hostile_plan_own_file_make PROPERTIES FIXTURES_SETUP plan_own)
+hostile_test(cli_hostile_plan_own_file_kept 3
+             "plan-own: holds notes.txt, which this command did not write; the folder is replaced as a whole"
+             plan ${T}/protocols/test1-static-grids.json --participants 1 --studies 1 --no-chart --out ${H}/plan-own)
+set_tests_properties(cli_hostile_plan_own_file_kept PROPERTIES
+                     FIXTURES_REQUIRED "plan_own;scene;calib;session_protocols" LABELS plan)
+
 # What a trial shows must be drawable on its screen: a radius or a motion streak past the renderer's largest blur
 # (500 screen px) validated, and run stopped at that trial with "blur radius must be in [0, 500] px, got 800", exit 5,
 # naming no file (a fixed 100 photo px at display.scale 8; a ball at 100 cm/s under a 1 s exposure; a staircase whose

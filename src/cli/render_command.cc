@@ -40,8 +40,9 @@ ObjectSpec ParseObject(const std::string& text) {
   const size_t colon = text.find(':');
   ObjectSpec o{text.substr(0, colon), colon == std::string::npos ? "" : text.substr(colon + 1)};
   const std::vector<std::string> kinds = {"grid", "ball", "picture"};
-  if (std::find(kinds.begin(), kinds.end(), o.kind) == kinds.end() || (o.kind == "grid" && colon != std::string::npos) ||
-      (colon != std::string::npos && o.image.empty()))
+  const bool image = colon != std::string::npos;
+  if (std::find(kinds.begin(), kinds.end(), o.kind) == kinds.end() || (o.kind == "grid" && image) ||
+      (image && o.image.empty()))
     throw Error(ErrorKind::kUsage, "--object must be grid, ball[:TEXTURE] or picture[:IMAGE], got " + Echo(text) +
                                        DidYouMean(o.kind, kinds));
   return o;

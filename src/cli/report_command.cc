@@ -55,7 +55,8 @@ void AddReportCommand(CLI::App& app) {
       "-statsmodels (scripts/setup.sh installs them).\n"
       "The folder is built beside DIR as .DIR.partial-PID and swapped in only when the analysis succeeded: an\n"
       "interrupted or failed report leaves the previous one (or none), never half of one, and the analysis dies\n"
-      "with blurcue. An existing DIR must be an earlier report (index.html or tables/trials.csv) or empty.\n"
+      "with blurcue. An existing DIR must be an earlier report (index.html or tables/trials.csv) holding only\n"
+      "what a report writes (index.html, bench.html, charts, their .csv tables, tables/), or empty.\n"
       "Example: blurcue report --db results/demo/study.sqlite --out results/demo/report");
   cmd->add_option("--db", args->db, "the SQLite record")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "folder for the report (created)")->required();
