@@ -173,7 +173,9 @@ def thesis_findings(trials, sections):
                  (((d["left"] == "measured") & (d["right"] == "estimated")) |
                   ((d["left"] == "estimated") & (d["right"] == "measured")))]
         cant = d[d["answered"]]
-        share_cant = (cant["chosen_source"] == "cant_tell").mean() if len(cant) else float("nan")
+        # No answer (practice apart): no share of can't tell to give (it read "can't tell nan%").
+        cant_text = (f"; can't tell {(cant['chosen_source'] == 'cant_tell').mean():.0%} of all answers" if len(cant)
+                     else "; no answers")
         if len(pair):
             k, n = int((pair["chosen_source"] == "measured").sum()), len(pair)
             p, lo, hi = stats.wilson(k, n)
@@ -182,10 +184,9 @@ def thesis_findings(trials, sections):
             people = pair["participant"].nunique()
             out[study] = (f"measured chosen over estimated {p:.2f} [{lo:.2f}, {hi:.2f}] of {n} decisive answers from "
                           f"{people} participant{'s' if people != 1 else ''}; against 0.5: {test['test']}"
-                          + (f", {common.p_text(test['p'])}" if not math.isnan(test["p"]) else "") +
-                          f"; can't tell {share_cant:.0%} of all answers")
+                          + (f", {common.p_text(test['p'])}" if not math.isnan(test["p"]) else "") + cant_text)
         else:
-            out[study] = f"no measured-vs-estimated pairs answered; can't tell {share_cant:.0%} of all answers"
+            out[study] = "no measured-vs-estimated pairs answered" + cant_text
     return out
 
 

@@ -36,6 +36,11 @@ hostile_test(cli_hostile_blur_cutoff_nan 2 "--cutoff: must be in (0, 100000] cyc
              blur ${D}/small.png --method butterworth --cutoff nan --out ${H}/x.png)
 hostile_test(cli_hostile_blur_cutoff_zero 2 "--cutoff: must be in (0, 100000] cycles per image width, got 0"
              blur ${D}/small.png --method butterworth --cutoff 0 --out ${H}/x.png)
+# The other method's value is refused, not ignored (a Butterworth given --radius-px blurred by its cut-off alone).
+hostile_test(cli_hostile_blur_cutoff_on_gaussian 2 "--cutoff: is for --method butterworth; gaussian reads --radius-px"
+             blur ${D}/small.png --radius-px 2 --cutoff 3 --out ${H}/x.png)
+hostile_test(cli_hostile_blur_radius_on_butterworth 2 "--radius-px: is for --method gaussian or disc; butterworth reads --cutoff"
+             blur ${D}/small.png --method butterworth --cutoff 3 --radius-px 2 --out ${H}/x.png)
 
 # Images that are no image: a device, a directory, a header claiming 65535 x 65535 px, a truncated PNG.
 hostile_test(cli_hostile_image_dev_zero 3 "IN /dev/zero: is a character device, not a file; not read"
@@ -70,6 +75,19 @@ hostile_test(cli_hostile_render_radius_times_gain 2
 set_tests_properties(cli_hostile_render_radius_times_gain PROPERTIES FIXTURES_REQUIRED "scene;calib" LABELS gl)
 hostile_test(cli_hostile_render_cutoff_nan 2 "--cutoff: must be in [0, 100000] cycles per picture width, got 'nan'"
              render --object picture --background ${D}/small.png --cutoff nan --out ${H}/x.png)
+# --object is read whole ("balloon" and "ball:" were drawn as the soccer ball, "picturesque" as the face), and an option
+# the object does not read is refused, not ignored (a --cutoff on a ball, a --blur on the picture; the calibration is
+# not read before the refusal).
+hostile_test(cli_hostile_render_object_unknown 2 "--object must be grid, ball[:TEXTURE] or picture[:IMAGE], got 'balloon'"
+             render --calib ${D}/thesis-camera.json --background ${D}/small.png --object balloon --out ${H}/x.png)
+hostile_test(cli_hostile_render_object_empty_texture 2 "--object must be grid, ball[:TEXTURE] or picture[:IMAGE], got 'ball:'"
+             render --calib ${D}/thesis-camera.json --background ${D}/small.png --object ball: --out ${H}/x.png)
+hostile_test(cli_hostile_render_cutoff_on_ball 2 "--cutoff: is for a picture, not --object ball (nothing reads it)"
+             render --calib ${D}/thesis-camera.json --background ${D}/small.png --cutoff 5 --out ${H}/x.png)
+hostile_test(cli_hostile_render_blur_on_picture 2 "--blur: is for a grid or a ball, not --object picture (nothing reads it)"
+             render --object picture --background ${D}/small.png --blur 3 --out ${H}/x.png)
+hostile_test(cli_hostile_render_section_on_grid 2 "--section: is for a ball, not --object grid (nothing reads it)"
+             render --calib ${D}/thesis-camera.json --background ${D}/small.png --object grid --section 2 --out ${H}/x.png)
 
 # camera.json: a width of 2^32 + 1148 used to wrap to 1148 and calibrate; every number has a physical range.
 set(CAMERA_REST "\"sensor_width_mm\": 23.4, \"sensor_height_mm\": 15.6, \"image_height_px\": 764")
@@ -96,6 +114,10 @@ hostile_test(cli_hostile_camera_huge_focal 3
              estimate --camera ${H}/camera-huge-focal.json ${ESTIMATE_ARGS})
 
 # The numeric options of the other commands: each names its range and unit.
+# camera's options hold the ranges camera.json does: a focal length of 0.001 mm passed the option's (0, 2000] and was
+# refused afterwards naming the photo ("scene.png: /focal_length_mm: must be in [0.5, 2000] mm").
+hostile_test(cli_hostile_camera_focal_length_tiny 2 "--focal-length-mm: must be in [0.5, 2000] mm, got 0.001"
+             camera ${D}/small.png --sensor-mm 23.4 15.6 --focal-length-mm 0.001 --f-number 5.6)
 hostile_test(cli_hostile_estimate_u_nan 2 "--u-mm: must be in (0, 1000000] mm, got 'nan'"
              estimate --camera ${D}/thesis-camera.json --ref-u-mm 342.3 --ref-r-px 8 --u-mm nan)
 hostile_test(cli_hostile_estimate_ref_u_inf 2 "--ref-u-mm: must be in [0, 1000000] mm, got 'inf'"
@@ -201,9 +223,74 @@ hostile_test(cli_hostile_animate_video_not_avi 2 "--video ${H}/v.mp4: must end i
 # A blur source the command cannot read names the option it came from (it named none: "blur source must be ...").
 hostile_test(cli_hostile_animate_right_blur_negative 2 "--right: blur source must be" animate --calib ${C}/calib.json
              --background ${C}/scene/scene.png --left estimated --right=-1 --video ${H}/v.avi)
+# --fullscreen without --window was ignored.
+hostile_test(cli_hostile_animate_fullscreen_without_window 2 "--fullscreen requires --window" ${ANIMATE} --fullscreen
+             --video ${H}/v.avi)
 set_tests_properties(cli_hostile_animate_log_is_a_fifo cli_hostile_animate_video_not_avi
-                     cli_hostile_animate_right_blur_negative PROPERTIES
+                     cli_hostile_animate_right_blur_negative cli_hostile_animate_fullscreen_without_window PROPERTIES
                      FIXTURES_REQUIRED "scene;calib" TIMEOUT 60)
+
+# plan: a condition without one decisive answer (every simulated answer can't tell; one participant, seed 1: edges 1
+# and 3 on the CLI tests' scene) has no share: its share and its Wilson width are "-", not "nan" and 1.000.
+add_test(NAME cli_hostile_plan_no_share_is_no_nan
+         COMMAND ${BLURCUE_EXPECT} "edge=[0-9]+ +first_source +- +- +0.000"
+                 $<TARGET_FILE:blurcue> plan ${T}/protocols/test1-static-grids.json --participants 1 --studies 2
+                 --no-chart --out ${H}/plan-no-share)
+set_tests_properties(cli_hostile_plan_no_share_is_no_nan PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
+                     LABELS plan)
+
+# report --out an earlier report replaced it whole, with whatever someone had put into it (notes.txt here; a report
+# made inside it, rep/sub, went too): a report replaces only a folder of its own files (index.html, bench.html, charts,
+# their tables, tables/ as export writes it).
+add_test(NAME cli_hostile_report_own_file_make
+         COMMAND bash -c "rm -rf '${H}/report-own' '${H}/report-own.sqlite' && '$<TARGET_FILE:blurcue>' run '${T}/protocols/test1-static-grids.json' --participant P1 --db '${H}/report-own.sqlite' --observer sim --stop-after 1 && mkdir -p '${H}/report-own' && touch '${H}/report-own/index.html' && echo notes > '${H}/report-own/notes.txt'")
+set_tests_properties(cli_hostile_report_own_file_make PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
+                     FIXTURES_SETUP report_own)
+hostile_test(cli_hostile_report_own_file_kept 3
+             "report-own: holds notes.txt, which this command did not write; the folder is replaced as a whole"
+             report --db ${H}/report-own.sqlite --out ${H}/report-own)
+set_tests_properties(cli_hostile_report_own_file_kept PROPERTIES FIXTURES_REQUIRED report_own LABELS analysis)
+
+# The same for plan --out: an earlier plan with a file put beside it (plan.csv and notes.txt) is refused, not replaced.
+add_test(NAME cli_hostile_plan_own_file_make
+         COMMAND bash -c "rm -rf '${H}/plan-own' && mkdir -p '${H}/plan-own' && touch '${H}/plan-own/plan.csv' && echo notes > '${H}/plan-own/notes.txt'")
+set_tests_properties(cli_hostile_plan_own_file_make PROPERTIES FIXTURES_SETUP plan_own)
+hostile_test(cli_hostile_plan_own_file_kept 3
+             "plan-own: holds notes.txt, which this command did not write; the folder is replaced as a whole"
+             plan ${T}/protocols/test1-static-grids.json --participants 1 --studies 1 --no-chart --out ${H}/plan-own)
+set_tests_properties(cli_hostile_plan_own_file_kept PROPERTIES
+                     FIXTURES_REQUIRED "plan_own;scene;calib;session_protocols" LABELS plan)
+
+# What a trial shows must be drawable on its screen: a radius or a motion streak past the renderer's largest blur
+# (500 screen px) validated, and run stopped at that trial with "blur radius must be in [0, 500] px, got 800", exit 5,
+# naming no file (a fixed 100 photo px at display.scale 8; a ball at 100 cm/s under a 1 s exposure; a staircase whose
+# max of 10 makes a 100 px reference 1100 photo px, 550 on the screen at scale 0.5). validate and run now refuse it,
+# exit 3, naming the field.
+set(SCREEN_PROTOCOL_REST "\"version\": 1, \"task\": \"forced_choice\",
+ \"scene\": {\"background\": \"${T}/scene/scene.png\", \"calib\": \"${T}/calib.json\", \"show\": \"background\"},
+ \"responses\": {\"left\": \"Left\", \"right\": \"Right\", \"cant_tell\": \"Down\"}")
+file(WRITE ${H}/screen-radius.json "{\"name\": \"screen-radius\", ${SCREEN_PROTOCOL_REST},
+ \"content\": {\"type\": \"grid\"}, \"factors\": {\"edge\": [1]}, \"sides\": {\"left\": 100, \"right\": \"none\"},
+ \"display\": {\"width_px\": 1280, \"height_px\": 720, \"scale\": 8}}")
+file(WRITE ${H}/screen-streak.json "{\"name\": \"screen-streak\", ${SCREEN_PROTOCOL_REST},
+ \"content\": {\"type\": \"ball\", \"exposure_ms\": 1000}, \"factors\": {\"speed_cm_s\": [100]},
+ \"sides\": {\"left\": \"fitted\", \"right\": \"none\"}, \"display\": {\"width_px\": 1280, \"height_px\": 720}}")
+file(WRITE ${H}/screen-staircase.json "{\"name\": \"screen-staircase\", ${SCREEN_PROTOCOL_REST},
+ \"content\": {\"type\": \"grid\"}, \"display\": {\"width_px\": 1280, \"height_px\": 720, \"scale\": 0.5},
+ \"blocks\": [{\"name\": \"s\", \"factors\": {\"edge\": [1]}, \"procedure\": {\"type\": \"staircase\",
+   \"variable\": \"relative_difference\", \"reference\": 100, \"trials\": 4, \"start\": 1, \"min\": 0, \"max\": 10,
+   \"steps\": [1]}}]}")
+foreach(case "radius;/sides/left: the left grid would be blurred by 100 photo px, 800 px on the screen (8 screen px per photo px), more than the largest blur drawn (500 px)"
+             "streak;/content/exposure_ms: is 1000 ms: the left ball rolling at 100 cm/s would be streaked over"
+             "staircase;/blocks/0/procedure/max: at its largest level, 10, a radius of 1100 photo px, 550 px on the screen (0.5 screen px per photo px)")
+  list(GET case 0 tag)
+  list(GET case 1 text)
+  hostile_test(cli_hostile_validate_screen_${tag} 3 "screen-${tag}.json: ${text}" validate ${H}/screen-${tag}.json)
+  hostile_test(cli_hostile_run_screen_${tag} 3 "screen-${tag}.json: ${text}"
+               run ${H}/screen-${tag}.json --participant P1 --db ${H}/screen-${tag}.sqlite --observer sim)
+  set_tests_properties(cli_hostile_validate_screen_${tag} cli_hostile_run_screen_${tag} PROPERTIES
+                       FIXTURES_REQUIRED "scene;calib")
+endforeach()
 
 # A participant information key given twice: refused naming the key and both values, not the last one kept.
 hostile_test(cli_hostile_run_info_given_twice 2 "--info age is given twice ('age=34' and 'age=35')"

@@ -295,6 +295,16 @@ class AbortedSessionsTest(ReportTestCase):
         self.assertIn("left out 1 aborted session (P1 (session id 99))", index)
         self.assertNotIn("decisive answers", index)
 
+    def test_a_session_aborted_after_its_practice_gives_no_share(self):
+        # Aborted after one practice trial and analysed (--include-aborted): no answer to share out (the summary said
+        # "can't tell nan% of all answers").
+        rows = synthetic.trials_rows(participants=("P1",), studies=["test1-static-grids"], unanswered=0)
+        session = [dict(r, session=99, session_status="aborted", choice=r["choice"] if r.get("practice") else None)
+                   for r in rows]
+        index, _ = self.report(session, "--include-aborted")
+        self.assertIn("no measured-vs-estimated pairs answered; no answers", index)
+        self.assertNotIn("nan%", index)
+
 
 if __name__ == "__main__":
     unittest.main()

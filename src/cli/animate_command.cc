@@ -268,8 +268,9 @@ void AddAnimateCommand(CLI::App& app) {
   cmd->add_option("--log", args->log,
                   "per-frame CSV: index, t_s, y_mm, r_left_px, r_right_px, each ball's lens floor (std) and motion\n"
                   "streak (x, y) in photo px, render_ms, flip_s");
-  cmd->add_flag("--window", args->window, "show in a GLFW window (vsync)");
-  cmd->add_flag("--fullscreen", args->fullscreen, "with --window: fullscreen on the first monitor");
+  CLI::Option* window = cmd->add_flag("--window", args->window, "show in a GLFW window (vsync)");
+  // Without a window nothing would read it (it was ignored).
+  cmd->add_flag("--fullscreen", args->fullscreen, "with --window: fullscreen on the first monitor")->needs(window);
   cmd->callback([args] { Animate(*args); });
 }
 

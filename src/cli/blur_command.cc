@@ -35,10 +35,15 @@ void AddBlurCommand(CLI::App& app) {
       ->check(FinitePositive(render::kMaxCutoffCyclesPerWidth, "cycles per image width"));
   cmd->add_option("--backend", args->backend, "gl (Mesa/GPU through EGL, no display needed) or cpu (OpenCV)")
       ->check(CLI::IsMember({"gl", "cpu"}))->capture_default_str();
-  cmd->callback([args] {
+  cmd->callback([args, cmd] {
     OutputGuard().Input("IN", args->in).OutputFile("--out", args->out).Check();
     RequireImageName("--out", args->out);
     const bool butterworth = args->method == "butterworth";
+    // The other method's value is refused, not ignored (--radius-px 2 on a Butterworth blurred by the cut-off alone).
+    if (butterworth && cmd->count("--radius-px") > 0)
+      throw Error(ErrorKind::kUsage, "--radius-px: is for --method gaussian or disc; butterworth reads --cutoff");
+    if (!butterworth && cmd->count("--cutoff") > 0)
+      throw Error(ErrorKind::kUsage, "--cutoff: is for --method butterworth; " + args->method + " reads --radius-px");
     if (butterworth && args->cutoff <= 0)
       throw Error(ErrorKind::kUsage, "--method butterworth needs --cutoff (cycles per image width)");
     if (!butterworth && args->radius_px < 0)

@@ -47,10 +47,12 @@ void AddCameraCommand(CLI::App& app) {
       ->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "camera.json to write (default: print it)");
   cmd->add_option("--sensor-mm", args->sensor_mm, "the sensor's width and height in mm, as the maker gives them")
-      ->expected(2)->check(FinitePositive(500, "mm"));
+      ->expected(2)->check(FiniteRange(CameraLimits::kSensorMm[0], CameraLimits::kSensorMm[1], "mm"));
+  // The ranges camera.json holds (CameraLimits): a value outside is refused naming the option, not the photo.
   cmd->add_option("--focal-length-mm", args->focal_length_mm, "the focal length, where EXIF lacks it")
-      ->check(FinitePositive(2000, "mm"));
-  cmd->add_option("--f-number", args->f_number, "the f-number, where EXIF lacks it")->check(FinitePositive(256, ""));
+      ->check(FiniteRange(CameraLimits::kFocalLengthMm[0], CameraLimits::kFocalLengthMm[1], "mm"));
+  cmd->add_option("--f-number", args->f_number, "the f-number, where EXIF lacks it")
+      ->check(FiniteRange(CameraLimits::kFNumber[0], CameraLimits::kFNumber[1], ""));
   cmd->callback([args] {
     if (!args->out.empty()) OutputGuard().Input("PHOTO", args->photo).OutputFile("--out", args->out).Check();
     std::optional<std::pair<double, double>> sensor;

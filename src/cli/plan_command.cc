@@ -100,7 +100,13 @@ void WritePlan(const PlanArgs& args) {
   if (std::filesystem::exists(out, ignored) && !std::filesystem::is_directory(out, ignored))
     throw InputError(out.string(), "--out: is a file, not a folder");
   const bool earlier = std::filesystem::exists(out / "plan.csv", ignored);
-  RequireReplaceableFolder(out, [earlier](const std::string&) { return earlier; });
+  // An earlier plan is replaced whole: its own files only, so a file someone put beside them is not deleted with it.
+  const auto ours = [earlier](const std::string& name) {
+    for (const char* own : {"plan.csv", "answers.csv", "plan.json", "power.png", "power.svg"})
+      if (name == own) return earlier;
+    return false;
+  };
+  RequireReplaceableFolder(out, ours);
   const plan::PlanResult result = plan::RunPlan(options);
   std::fprintf(stderr, "plan: %zu participants in %.2f s on %d threads (%.2f ms per participant)\n",
                static_cast<size_t>(options.studies) * static_cast<size_t>(options.participants), result.seconds,
@@ -133,7 +139,7 @@ void WritePlan(const PlanArgs& args) {
                       "the chart", out.string(),
                       {(partial / "power.png").string(), (partial / "power.svg").string()});
       },
-      [earlier](const std::string&) { return earlier; });
+      ours);
   std::printf("%s", plan::Summary(result, options).c_str());
   std::printf("wrote %s (plan.csv, answers.csv, plan.json%s)\n", out.c_str(),
               args.no_chart ? "" : ", power.png, power.svg");
@@ -168,7 +174,8 @@ void AddPlanCommand(CLI::App& app) {
   cmd->add_option("--difference", args->difference,
                   "procedure cells: the threshold difference to plan the power for, in the procedure's units (0.5) "
                   "or relative to the true threshold (20%)");
-  cmd->add_option("--out", args->out, "output folder (created; an earlier plan there is replaced)")
+  cmd->add_option("--out", args->out,
+                  "output folder (created; an earlier plan there is replaced when it holds only the files plan writes)")
       ->capture_default_str();
   cmd->add_option("--python", args->python, "the Python that draws the chart")->capture_default_str();
   cmd->add_flag("--no-chart", args->no_chart, "write the tables only");

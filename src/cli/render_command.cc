@@ -2,6 +2,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <string>
 
 #include <opencv2/imgproc.hpp>
@@ -10,6 +11,7 @@
 #include "cli/commands.h"
 #include "core/output_guard.h"
 #include "core/error.h"
+#include "core/names.h"
 #include "core/typed.h"
 #include "core/image.h"
 #include "render/blur.h"
@@ -29,9 +31,43 @@ struct RenderArgs {
   double gain = 1, brightness = 1, contrast = 1, cutoff = 0;
 };
 
+// --object KIND[:IMAGE], read whole: "balloon" is no ball and "ball:" names no texture (both were drawn as the
+// default ball, silently).
+struct ObjectSpec {
+  std::string kind, image;  // kind: grid, ball or picture; image: the texture or picture given ("" = the default)
+};
+ObjectSpec ParseObject(const std::string& text) {
+  const size_t colon = text.find(':');
+  ObjectSpec o{text.substr(0, colon), colon == std::string::npos ? "" : text.substr(colon + 1)};
+  const std::vector<std::string> kinds = {"grid", "ball", "picture"};
+  const bool image = colon != std::string::npos;
+  if (std::find(kinds.begin(), kinds.end(), o.kind) == kinds.end() || (o.kind == "grid" && image) ||
+      (image && o.image.empty()))
+    throw Error(ErrorKind::kUsage, "--object must be grid, ball[:TEXTURE] or picture[:IMAGE], got " + Echo(text) +
+                                       DidYouMean(o.kind, kinds));
+  return o;
+}
+
+// The options a kind of object does not read, given: refused, not ignored (a --cutoff on a ball, a --blur on the
+// picture). `given` says whether an option was on the command line.
+void RequireOptionsOf(const std::string& kind, const std::function<bool(const std::string&)>& given) {
+  const std::vector<std::pair<std::string, std::string>> read_by = {
+      {"--calib", "grid ball"},      {"--at-edge", "grid ball"},    {"--section", "ball"},
+      {"--blur", "grid ball"},       {"--gain", "grid ball"},       {"--method", "grid ball"},
+      {"--brightness", "grid ball"}, {"--contrast", "grid ball"},   {"--backend", "grid ball"},
+      {"--cutoff", "picture"},       {"--picture-height-px", "picture"}};
+  for (const auto& [option, kinds] : read_by)
+    if (given(option) && (" " + kinds + " ").find(" " + kind + " ") == std::string::npos) {
+      std::string those = kinds;
+      if (const size_t space = those.find(' '); space != std::string::npos) those.replace(space, 1, " or a ");
+      throw Error(ErrorKind::kUsage, option + ": is for a " + those + ", not --object " + kind + " (nothing reads it)");
+    }
+}
+
 // The depth-matching study's frame: the picture low-passed on a grey upper half, the scene photo in the lower half.
 void RenderPicture(const RenderArgs& args) {
-  const std::string name = args.object.size() > 8 && args.object[7] == ':' ? args.object.substr(8) : "face";
+  const ObjectSpec spec = ParseObject(args.object);
+  const std::string name = spec.image.empty() ? "face" : spec.image;
   const cv::Mat picture = ReadImage(scene::ResolveStimulus(name));
   const cv::Mat photo = ReadImage(args.background, 1);
   const int w = args.display_width > 0 ? args.display_width : 960;
@@ -69,14 +105,13 @@ void RenderObject(const RenderArgs& args, std::chrono::steady_clock::time_point 
   scene::VirtualObject object;
   const double y = (args.edge - 1) * scene.board.square_mm;
   std::string texture_name;
-  if (args.object == "grid") {
+  const ObjectSpec spec = ParseObject(args.object);
+  if (spec.kind == "grid") {
     object = scene::CardBesideBoard(scene.board, args.edge, /*left=*/false);
     texture_name = "grid";
-  } else if (args.object.rfind("ball", 0) == 0) {
-    object = scene::BallOnBoard(scene.board, args.section, y, 10, y);
-    texture_name = args.object.size() > 5 && args.object[4] == ':' ? args.object.substr(5) : "soccer";
   } else {
-    throw Error(ErrorKind::kUsage, "--object must be grid or ball[:TEXTURE], got " + Echo(args.object));
+    object = scene::BallOnBoard(scene.board, args.section, y, 10, y);
+    texture_name = spec.image.empty() ? "soccer" : spec.image;
   }
   object.texture = scene::SurfaceTexture(ReadImage(scene::ResolveStimulus(texture_name)));
   object.brightness = args.brightness;
@@ -162,7 +197,7 @@ void AddRenderCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--background", args->background, "the scene photo (same camera)")->required()
       ->check(CLI::ExistingFile);
-  cmd->add_option("--object", args->object, "grid or ball[:TEXTURE]")->capture_default_str();
+  cmd->add_option("--object", args->object, "grid, ball[:TEXTURE] or picture[:IMAGE]")->capture_default_str();
   cmd->add_option("--at-edge", args->edge, "edge the object is aligned with (1 = nearest)")->capture_default_str()
       ->transform(IntRange(1, 1000));
   cmd->add_option("--section", args->section, "section along the edge for a ball (1..7)")->capture_default_str()
@@ -185,8 +220,9 @@ void AddRenderCommand(CLI::App& app) {
                                                                 "grey half)")
       ->transform(IntRange(0, 7680, "px"));
   cmd->add_option("--out", args->out, "output PNG")->required();
-  cmd->callback([args] {
+  cmd->callback([args, cmd] {
     const auto t0 = std::chrono::steady_clock::now();
+    RequireOptionsOf(ParseObject(args->object).kind, [cmd](const std::string& o) { return cmd->count(o) > 0; });
     {
       OutputGuard guard;
       guard.Input("--background", args->background);
@@ -200,7 +236,7 @@ void AddRenderCommand(CLI::App& app) {
       guard.OutputFile("--out", args->out).Check();
       RequireImageName("--out", args->out);
     }
-    if (args->object.rfind("picture", 0) == 0) return RenderPicture(*args);
+    if (ParseObject(args->object).kind == "picture") return RenderPicture(*args);
     RenderObject(*args, t0);
   });
 }

@@ -12,6 +12,7 @@
 #include "core/data_dir.h"
 #include "core/error.h"
 #include "store/export.h"
+#include "store/export_table.h"
 #include "store/schema.h"
 #include "store/sqlite.h"
 
@@ -54,7 +55,8 @@ void AddReportCommand(CLI::App& app) {
       "-statsmodels (scripts/setup.sh installs them).\n"
       "The folder is built beside DIR as .DIR.partial-PID and swapped in only when the analysis succeeded: an\n"
       "interrupted or failed report leaves the previous one (or none), never half of one, and the analysis dies\n"
-      "with blurcue. An existing DIR must be an earlier report (index.html or tables/trials.csv) or empty.\n"
+      "with blurcue. An existing DIR must be an earlier report (index.html or tables/trials.csv) holding only\n"
+      "what a report writes (index.html, bench.html, charts, their .csv tables, tables/), or empty.\n"
       "Example: blurcue report --db results/demo/study.sqlite --out results/demo/report");
   cmd->add_option("--db", args->db, "the SQLite record")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "folder for the report (created)")->required();
@@ -83,10 +85,21 @@ void AddReportCommand(CLI::App& app) {
     }
     for (const auto& path : RemoveStaleLeftovers(out))
       std::fprintf(stderr, "report: removed %s, left by an interrupted run\n", path.c_str());
-    // An earlier report is replaced as a whole; a folder of something else is not ours to replace.
+    // An earlier report is replaced as a whole; a folder of something else is not ours to replace, nor is a file
+    // someone put into an earlier report (notes.txt, another report made inside it: they were deleted with it). A
+    // report holds index.html, bench.html, its charts (.png, .svg) with their tables (.csv), and tables/ as export
+    // writes it.
     std::error_code ignored;
     const bool earlier_report = std::filesystem::exists(out / "index.html", ignored) ||
                                 std::filesystem::exists(out / "tables" / "trials.csv", ignored);
+    const auto ours = [earlier_report](const std::string& name) {
+      const auto ends = [&name](const std::string& tail) {
+        return name.size() > tail.size() && name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
+      };
+      return earlier_report && (name == "index.html" || name == "bench.html" || name == "tables" || ends(".png") ||
+                                ends(".svg") || ends(".csv"));
+    };
+    if (earlier_report) RequireReplaceableFolder(out / "tables", store::IsExportFile);
     WriteFolderAtomically(
         out,
         [&](const std::filesystem::path& partial) {
@@ -104,7 +117,7 @@ void AddReportCommand(CLI::App& app) {
           if (args->include_unfinished) argv.push_back("--include-unfinished");
           RunAnalysis(argv, "the analysis", out.string(), {(partial / "index.html").string()});
         },
-        [earlier_report](const std::string&) { return earlier_report; });
+        ours);
     std::printf("wrote %s/index.html\n", args->out.c_str());
   });
 }

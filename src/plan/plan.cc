@@ -448,7 +448,8 @@ void AddExactRows(PlanResult& r, const Condition& c, const PlanOptions& options,
                                                           : SignFlipNormalP(e.sum, e.square, e.step);
       rejected += p < options.alpha;
     }
-    row.wilson_width = width / S;
+    // No counting answer in any study (every one can't tell, say): no share, and an interval of [0, 1] says nothing.
+    row.wilson_width = all.n > 0 ? width / S : nan;
     row.mean_trials = trials / S;
     row.power = c.chance >= 0 ? double(rejected) / S : nan;
     r.rows.push_back(row);
@@ -620,8 +621,10 @@ std::string Summary(const PlanResult& r, const PlanOptions& o) {
                     std::isfinite(row.expected_share) ? Number(row.expected_share, "%.3f").c_str() : "-", "",
                     row.power, reached.c_str());
     } else {
-      std::snprintf(line, sizeof line, "  %-28s %-13s %7.3f %8.3f %8s %7s  %s\n", row.condition.c_str(),
-                    row.measure.c_str(), row.expected_share, row.wilson_width,
+      // A condition without one counting answer has no share (nor width): "-", never "nan".
+      auto shown3 = [](double v) { return std::isfinite(v) ? Number(v, "%.3f") : std::string("-"); };
+      std::snprintf(line, sizeof line, "  %-28s %-13s %7s %8s %8s %7s  %s\n", row.condition.c_str(),
+                    row.measure.c_str(), shown3(row.expected_share).c_str(), shown3(row.wilson_width).c_str(),
                     std::isfinite(row.power) ? Number(row.power, "%.3f").c_str() : "-", reached.c_str(), shown.c_str());
     }
     out += line;

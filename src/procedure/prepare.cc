@@ -76,7 +76,22 @@ TrialScene Describe(const PreparedSession& s, const protocol::Trial& trial) {
     return scene;
   }
   TrialScene scene = DescribeTrial(s.protocol, trial, s.scene ? &*s.scene : nullptr, &s.presentation);
-  if (s.scene) PlanOnScreen(s.protocol, *s.scene, s.presentation, &scene);
+  if (!s.scene) return scene;
+  PlanOnScreen(s.protocol, *s.scene, s.presentation, &scene);
+  // Drawable on this screen: as the trial starts, and for a procedure's trial at the largest level it can reach (a
+  // staircase's max, QUEST+'s largest stimulus), so that run never stops at a radius past the renderer's.
+  stimulus::CheckBlurOnScreen(s.protocol, trial, *s.scene, s.presentation, scene);
+  if (trial.cell >= 0) {
+    const protocol::Block& block = *protocol::BlockOf(s.protocol, trial);
+    const protocol::Procedure& p = *block.procedure;
+    const bool staircase = p.kind == protocol::Procedure::Kind::kStaircase;
+    const double most = staircase || p.stimuli.empty() ? p.max : *std::max_element(p.stimuli.begin(), p.stimuli.end());
+    TrialScene at_most = scene;
+    stimulus::ApplyLevel(p, trial, most, s.presentation, &at_most);
+    stimulus::CheckBlurOnScreen(s.protocol, trial, *s.scene, s.presentation, at_most,
+                                block.pointer + (staircase ? "/procedure/max" : "/procedure/stimuli"),
+                                "its largest level, " + Num(most));
+  }
   return scene;
 }
 

@@ -137,6 +137,16 @@ bool IntervalShowsRight(const protocol::Trial& trial, const TrialScene& scene, i
 void PlanOnScreen(const protocol::Protocol& protocol, const calib::SceneCalib& scene, const Presentation& presentation,
               TrialScene* trial);
 
+// Throws Error(kInput) naming the protocol field that asked for it when what `trial` shows (`scene`, its sides'
+// gains and additions as ApplyLevel left them) cannot be drawn on the screen `presentation` describes: a radius (at any
+// depth of the object, as the per-pixel plan draws it) or a rolling ball's motion streak longer than the largest blur
+// the renderer draws (optics::kMaxBlurRadiusPx screen px). The field is the side's source, or `level_pointer` with
+// `level_text` (a procedure's largest level: "/blocks/0/procedure/max", "its largest level, 3") when a level set it;
+// a streak names /content/exposure_ms. What validate checks so that run does not stop at that trial.
+void CheckBlurOnScreen(const protocol::Protocol& protocol, const protocol::Trial& trial, const calib::SceneCalib& s,
+                       const Presentation& presentation, const TrialScene& scene, const std::string& level_pointer = "",
+                       const std::string& level_text = "");
+
 // The protocol's calibration (none for a picture without one). Throws Error(kInput) naming the protocol file and
 // /scene/calib when the file is not a calibration written by `blurcue calibrate`.
 std::optional<calib::SceneCalib> LoadProtocolScene(const protocol::Protocol& protocol);

@@ -485,4 +485,40 @@ void PlanOnScreen(const protocol::Protocol& protocol, const calib::SceneCalib& s
                     : 0;
 }
 
+
+void CheckBlurOnScreen(const protocol::Protocol& protocol, const protocol::Trial& trial, const calib::SceneCalib& s,
+                       const Presentation& presentation, const TrialScene& scene, const std::string& level_pointer,
+                       const std::string& level_text) {
+  if (scene.content == protocol::ContentType::kPicture) return;
+  const double most = optics::kMaxBlurRadiusPx;
+  const std::string trial_text = " (trial " + std::to_string(trial.index) + ", block " + trial.block + ")";
+  const std::string largest = ", more than the largest blur drawn (" + Num(most) + " px)";
+  // The per-pixel plan's objects: each one's radius at its nearest and farthest depth is what some pixel of it gets.
+  TrialScene as_per_pixel = scene;
+  as_per_pixel.per_pixel = true;
+  for (const auto& objects : RunEnds(protocol, s, as_per_pixel))
+    for (const Side side : protocol::Vocabulary<Side>::values) {
+      const auto& object = objects[protocol::Index(side)];
+      if (!object) continue;
+      const scene::Footprint f = scene::FootprintOf(s.camera, s.rvec, s.tvec, object->object);
+      const double r_px =
+          std::max({object->r_px, object->r_of_depth_px(f.z_min_mm), object->r_of_depth_px(f.z_max_mm)});
+      const double r = presentation.ScreenPx(r_px), streak = presentation.ScreenPx(cv::norm(object->motion_px));
+      const std::string what = "the " + ToString(side) + " " + protocol::ToString(scene.content);
+      const std::string scale = " (" + Num(presentation.scale) + " screen px per photo px)";
+      const std::string radius = Num(r_px) + " photo px, " + Num(r) + " px on the screen" + scale + largest;
+      if (!(r <= most) && level_text.empty())
+        throw InputError(At(protocol, protocol::SidePointer(protocol, trial, side)),
+                         what + " would be blurred by " + radius + trial_text);
+      if (!(r <= most))  // the test side's, whichever it is
+        throw InputError(At(protocol, level_pointer),
+                         "at " + level_text + ", a radius of " + radius + ", for " + what + trial_text);
+      if (!(streak <= most))
+        throw InputError(At(protocol, "/content/exposure_ms"),
+                         "is " + Num(scene.exposure_ms) + " ms: " + what + " rolling at " + Num(scene.speed_mm_s / 10) +
+                             " cm/s would be streaked over " + Num(streak) + " px on the screen" + scale + largest +
+                             trial_text);
+    }
+}
+
 }  // namespace blurcue::stimulus
