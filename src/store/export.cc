@@ -19,6 +19,7 @@
 #include "protocol/vocabulary.h"
 #include "store/columns.h"
 #include "store/export_procedures.h"
+#include "store/procedures.h"
 #include "store/export_table.h"
 #include "store/frame_columns.h"
 #include "store/record.h"
@@ -479,6 +480,7 @@ int64_t ExportCsvWith(const std::vector<Column>& table, const std::filesystem::p
                                     ParseColumn(rows.GetText(11), where + " adjustment"));
     ++count;
   }
+  CheckProcedures(db, db_path.string());
   std::string codebook = CodebookRows(columns);
   // Every table of one export appears together: a kill leaves the previous export whole, never its frames.csv
   // beside a new trials.csv.

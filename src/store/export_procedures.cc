@@ -1,6 +1,7 @@
 #include "store/export_procedures.h"
 
 #include "core/atomic_file.h"
+#include "store/procedures.h"
 
 namespace blurcue::store {
 

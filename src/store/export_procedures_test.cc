@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
 #include "protocol/protocol.h"
 #include "store/export.h"
 #include "store/record.h"
@@ -120,26 +121,111 @@ std::string TableRows(Database& db) {
 }
 
 // A session records the procedures it was given (as the runner gives them, parsed) when its protocol version is first
-// recorded, and export writes procedures.csv from them: parameters no parse of the text would give (a marker) are what
-// the file shows, so nothing was parsed again. A later session of the version keeps the first one's rows.
+// recorded, and export writes procedures.csv from them: parameters no parse of the text would give (a marker start)
+// are what the file shows, so nothing was parsed again. A later session of the version keeps the first one's rows.
 TEST(ProceduresTable, WrittenWhenAVersionIsFirstRecordedFromTheProceduresGiven) {
   testing::TempDir dir;
   SessionMeta meta;
-  meta.procedures =
-      std::vector<ProcedureRecord>{{1, "s", "staircase", "relative_difference", 3, 0.5, R"({"marker":1})"}};
+  std::vector<ProcedureRecord> given = ProcedureRecords(
+      protocol::ParseProtocol(ParseJson(kTwoProcedures, "p"), "p.json", protocol::ValidateOptions{false}).blocks);
+  ASSERT_EQ(given.size(), 2u);
+  auto marked = [&](double start) {
+    Json p = ParseJson(given[1].parameters, "p");
+    p["start"] = start;
+    given[1].parameters = p.dump();
+    return given;
+  };
+  meta.procedures = marked(0.777);
   {
     Record record = Record::Open(dir / "r.sqlite");
     const int64_t session =
         record.StartOrResumeSession("two-procedures", "P1", kTwoProcedures, 7, meta, false).session_id;
     record.FinishSession(session, SessionStatus::kCompleted);
-    meta.procedures->front().parameters = R"({"marker":2})";
+    meta.procedures = marked(0.888);
     record.StartOrResumeSession("two-procedures", "P2", kTwoProcedures, 8, meta, false);
-    EXPECT_EQ(TableRows(record.database()), R"(1|1|s|staircase|relative_difference|3|0.5|{"marker":1})");
+    EXPECT_NE(TableRows(record.database()).find(R"("start":0.777)"), std::string::npos);
+    EXPECT_EQ(TableRows(record.database()).find(R"("start":0.888)"), std::string::npos);
   }
   ExportCsv(dir / "r.sqlite", dir / "out");
   const std::vector<std::string> lines = Lines(dir / "out" / "procedures.csv");
-  ASSERT_EQ(lines.size(), 2u);
-  EXPECT_EQ(lines[1].substr(lines[1].find(',', lines[1].find(',') + 1)), R"(,1,s,staircase,"{""marker"":1}")");
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_NE(lines[2].find(R"(""start"":0.777)"), std::string::npos) << lines[2];
+}
+
+// The table as a reader trusts it (CheckProcedures): a hand-edited row - its JSON broken, a parameter of the wrong type
+// or missing, a word not of the vocabulary, a row of no protocol version, a guess no rate - is refused by export and
+// merge with one line naming the record, the row and the field (it exported, merged or crashed the report before);
+// two inputs that recorded one version's parameters differently are refused by merge (it kept the first silently).
+TEST(ProceduresTable, AHandEditedRowIsRefusedByExportAndMerge) {
+  testing::TempDir dir;
+  {
+    Record record = Record::Open(dir / "r.sqlite");
+    record.StartOrResumeSession("two-procedures", "P1", kTwoProcedures, 7, {}, false);
+  }
+  const std::vector<std::pair<std::string, std::string>> edits = {
+      {"UPDATE procedures SET parameters = '{not json' WHERE block = 1", "parameters '{not json': not JSON"},
+      {"UPDATE procedures SET parameters = json_set(parameters, '$.steps', 'x') WHERE block = 1",
+       "parameters.steps: '\"x\"': not a list of positive numbers"},
+      {"UPDATE procedures SET parameters = json_set(parameters, '$.up', json('[1]')) WHERE block = 1",
+       "parameters.up: '[1]': not a whole number >= 1"},
+      {"UPDATE procedures SET parameters = json_remove(parameters, '$.down') WHERE block = 1",
+       "parameters.down: missing"},
+      {"UPDATE procedures SET parameters = json_set(parameters, '$.thresholds', 'half') WHERE block = 0",
+       "parameters.thresholds: '\"half\"': not a list of numbers"},
+      {"UPDATE procedures SET parameters = json_set(parameters, '$.start', 5) WHERE block = 1",
+       "parameters.start 5: not within [min, max] = [0.02, 2]"},
+      {"UPDATE procedures SET procedure = 'bogus' WHERE block = 1", "procedure 'bogus': not one of"},
+      {"UPDATE procedures SET procedure = 'quest_plus' WHERE block = 1",
+       "parameters.procedure: not the row's procedure 'quest_plus'"},
+      {"UPDATE procedures SET guess = 5, parameters = json_set(parameters, '$.guess', 5) WHERE block = 1",
+       "guess 5: not a rate in [0, 1)"},
+      {"UPDATE procedures SET block = -1 WHERE block = 1", "block -1: not a block's index"},
+      {"UPDATE procedures SET protocol_version_id = 99 WHERE block = 1", "(protocol version 99, block 1): no such"},
+  };
+  for (const auto& [sql, message] : edits) {
+    const std::filesystem::path edited = dir / "edited.sqlite";
+    std::filesystem::copy_file(dir / "r.sqlite", edited, std::filesystem::copy_options::overwrite_existing);
+    {
+      Database db(edited);
+      db.Exec("PRAGMA ignore_check_constraints = ON; PRAGMA foreign_keys = OFF; " + sql);
+    }
+    for (const bool merge : {false, true}) {
+      std::filesystem::remove_all(dir / "out");
+      std::filesystem::remove(dir / "merged.sqlite");
+      try {
+        if (merge)
+          MergeDatabases({edited}, dir / "merged.sqlite");
+        else
+          ExportCsv(edited, dir / "out");
+        ADD_FAILURE() << (merge ? "merged: " : "exported: ") << sql;
+      } catch (const Error& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::kInput) << sql;
+        EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << sql << "\n" << e.what();
+        EXPECT_NE(std::string(e.what()).find("edited.sqlite"), std::string::npos) << e.what();
+      }
+      EXPECT_FALSE(std::filesystem::exists(dir / "merged.sqlite")) << sql;
+    }
+  }
+  // One version, two stations, its start changed in one to another valid value: merge refuses, in either order.
+  std::filesystem::copy_file(dir / "r.sqlite", dir / "other.sqlite");
+  {
+    Database db(dir / "other.sqlite");
+    db.Exec("UPDATE procedures SET parameters = json_set(parameters, '$.start', 1.5) WHERE block = 1");
+  }
+  for (const bool swapped : {false, true}) {
+    std::filesystem::remove(dir / "merged.sqlite");
+    const std::vector<std::filesystem::path> inputs =
+        swapped ? std::vector<std::filesystem::path>{dir / "other.sqlite", dir / "r.sqlite"}
+                : std::vector<std::filesystem::path>{dir / "r.sqlite", dir / "other.sqlite"};
+    try {
+      MergeDatabases(inputs, dir / "merged.sqlite");
+      ADD_FAILURE() << "merged two records that recorded one version's parameters differently";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::kInput);
+      EXPECT_NE(std::string(e.what()).find("its parameters differ from those an earlier input recorded"),
+                std::string::npos) << e.what();
+    }
+  }
 }
 
 // What the runner records (ProcedureRecords of the blocks it parsed from the file, conditions table read from disk)

@@ -192,11 +192,28 @@ void CopyProcedures(Database& src, Database& dst, const std::filesystem::path& i
     if (!ids.empty()) DeriveProcedures(dst, "id IN (" + ids + ")");
     return;
   }
-  Statement rows(src, "SELECT protocol_version_id" + CopySelect(ProcedureColumns(), version) + " FROM procedures");
-  Statement insert(dst, InsertSql("procedures", "protocol_version_id", ProcedureColumns(), "INSERT OR IGNORE"));
+  CheckProcedures(src, input.string());
+  // A version two inputs share was recorded by each: the first input's rows stand, and the next must agree with them
+  // (its parameters were hand-edited otherwise); a block only the next recorded is added.
+  Statement rows(src, "SELECT protocol_version_id, block, parameters, block_name" +
+                          CopySelect(ProcedureColumns(), version) + " FROM procedures");
+  Statement held(dst, "SELECT parameters, block_name FROM procedures WHERE protocol_version_id = ? AND block = ?");
+  Statement insert(dst, InsertSql("procedures", "protocol_version_id", ProcedureColumns(), "INSERT"));
   while (rows.Step()) {
-    insert.Bind(1, Mapped(protocol_ids, rows.GetInt64(0), input, "protocol version"));
-    CopyKept(ProcedureColumns(), rows, 1, insert, 2);
+    const int64_t to = Mapped(protocol_ids, rows.GetInt64(0), input, "protocol version");
+    held.Bind(1, to);
+    held.Bind(2, rows.GetInt64(1));
+    if (held.Step()) {
+      if (held.GetText(0) != rows.GetText(2) || held.GetText(1) != rows.GetText(3))
+        throw InputError(input.string(), "procedures row (block " + std::to_string(rows.GetInt64(1)) +
+                                             "): its parameters differ from those an earlier input recorded for the "
+                                             "same protocol version (a hand-edited record?)");
+      held.Reset();
+      continue;
+    }
+    held.Reset();
+    insert.Bind(1, to);
+    CopyKept(ProcedureColumns(), rows, 4, insert, 2);
     insert.Run();
     insert.Reset();
   }

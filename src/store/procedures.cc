@@ -2,10 +2,14 @@
 // recorded before the table (from its text, read in memory).
 #include "store/procedures.h"
 
+#include <algorithm>
+#include <cmath>
 #include <map>
 
 #include "core/error.h"
 #include "core/json_io.h"
+#include "core/names.h"
+#include "core/typed.h"
 #include "protocol/protocol.h"
 #include "protocol/vocabulary.h"
 #include "store/sqlite.h"
@@ -145,6 +149,95 @@ void SaveProcedures(Database& db, int64_t protocol_version_id, const std::vector
     BindRow(ProcedureColumns(), insert, 2, r);
     insert.Run();
     insert.Reset();
+  }
+}
+
+namespace {
+
+// What a reader needs of one parameter: a number, a whole number >= 1 (or >= 0), or a non-empty list of numbers (positive ones
+// for a staircase's steps).
+enum class Need { kNumber, kCount, kCountOrNone, kNumbers, kPositiveNumbers };
+
+std::string CheckedParameter(const Json& parameters, const std::string& name, Need need) {
+  if (!parameters.contains(name)) return "parameters." + name + ": missing";
+  const Json& v = parameters[name];
+  const std::string said = "parameters." + name + ": " + Echo(v.dump()) + ": ";
+  switch (need) {
+    case Need::kNumber:
+      return v.is_number() && std::isfinite(v.get<double>()) ? "" : said + "not a number";
+    case Need::kCount:
+      return v.is_number_integer() && v.get<int64_t>() >= 1 ? "" : said + "not a whole number >= 1";
+    case Need::kCountOrNone:  // 0: no such rule (a staircase without a stop rule)
+      return v.is_number_integer() && v.get<int64_t>() >= 0 ? "" : said + "not a whole number >= 0";
+    case Need::kNumbers:
+    case Need::kPositiveNumbers:
+    {
+      const std::string list = need == Need::kPositiveNumbers ? "not a list of positive numbers" : "not a list of numbers";
+      if (!v.is_array() || v.empty()) return said + list;
+      for (const Json& x : v)
+        if (!x.is_number() || !std::isfinite(x.get<double>()) || (need == Need::kPositiveNumbers && !(x.get<double>() > 0)))
+          return said + list;
+      return "";
+    }
+  }
+  return "";
+}
+
+// What is wrong with one row, "" when nothing.
+std::string ProcedureRowProblem(const ProcedureRecord& r) {
+  const std::vector<std::string> kinds = protocol::Words<protocol::ProcedureKind>();
+  const std::vector<std::string> variables = protocol::Words<protocol::ProcedureVariable>();
+  if (std::find(kinds.begin(), kinds.end(), r.procedure) == kinds.end())
+    return "procedure " + Echo(r.procedure) + ": not one of " + ProcedureWords(kinds, ", ") + DidYouMean(r.procedure, kinds);
+  if (std::find(variables.begin(), variables.end(), r.variable) == variables.end())
+    return "variable " + Echo(r.variable) + ": not one of " + ProcedureWords(variables, ", ") +
+           DidYouMean(r.variable, variables);
+  if (!(r.guess >= 0 && r.guess < 1)) return "guess " + Num(r.guess) + ": not a rate in [0, 1)";
+  Json p;
+  try {
+    p = Json::parse(r.parameters);
+  } catch (const std::exception&) {
+    return "parameters " + Echo(r.parameters) + ": not JSON";
+  }
+  if (!p.is_object()) return "parameters " + Echo(r.parameters) + ": not a JSON object";
+  if (p.value("procedure", Json()) != Json(r.procedure)) return "parameters.procedure: not the row's procedure " + Echo(r.procedure);
+  if (p.value("variable", Json()) != Json(r.variable)) return "parameters.variable: not the row's variable " + Echo(r.variable);
+  if (p.value("trials", Json()) != Json(r.trials)) return "parameters.trials: not the row's trials " + std::to_string(r.trials);
+  if (!p.contains("guess") || !p["guess"].is_number() || p["guess"].get<double>() != r.guess)
+    return "parameters.guess: not the row's guess " + Num(r.guess);
+  if (!p.contains("reference")) return "parameters.reference: missing";
+  const bool staircase = r.procedure == protocol::ToString(protocol::ProcedureKind::kStaircase);
+  const std::vector<std::pair<const char*, Need>> needs =
+      staircase ? std::vector<std::pair<const char*, Need>>{{"start", Need::kNumber}, {"min", Need::kNumber},
+                                                             {"max", Need::kNumber}, {"up", Need::kCount},
+                                                             {"down", Need::kCount}, {"stop_reversals", Need::kCountOrNone},
+                                                             {"steps", Need::kPositiveNumbers}}
+                : std::vector<std::pair<const char*, Need>>{{"stimuli", Need::kNumbers}, {"thresholds", Need::kNumbers},
+                                                             {"slopes", Need::kNumbers}, {"lapses", Need::kNumbers}};
+  for (const auto& [name, need] : needs)
+    if (std::string problem = CheckedParameter(p, name, need); !problem.empty()) return problem;
+  if (staircase && !(p["min"].get<double>() <= p["start"].get<double>() && p["start"].get<double>() <= p["max"].get<double>()))
+    return "parameters.start " + Num(p["start"].get<double>()) + ": not within [min, max] = [" + Num(p["min"].get<double>()) +
+           ", " + Num(p["max"].get<double>()) + "]";
+  return "";
+}
+
+}  // namespace
+
+void CheckProcedures(Database& db, const std::string& file) {
+  Statement rows(db, "SELECT pv.hash, pr.block, pr.block_name, pr.procedure, pr.variable, pr.trials, pr.guess, "
+                     "pr.parameters, pr.protocol_version_id FROM procedures pr LEFT JOIN protocol_versions pv "
+                     "ON pv.id = pr.protocol_version_id ORDER BY pr.protocol_version_id, pr.block");
+  while (rows.Step()) {
+    const std::string row = "procedures row (protocol version " +
+                            (rows.IsNull(0) ? std::to_string(rows.GetInt64(8)) : rows.GetText(0)) + ", block " +
+                            std::to_string(rows.GetInt64(1)) + ")";
+    if (rows.IsNull(0)) throw InputError(file, row + ": no such protocol version in the record");
+    const ProcedureRecord r{rows.GetInt64(1), rows.GetText(2), rows.GetText(3), rows.GetText(4),
+                            rows.GetInt64(5), rows.GetDouble(6), rows.GetText(7)};
+    if (r.block < 0) throw InputError(file, row + ": block " + std::to_string(r.block) + ": not a block's index");
+    if (const std::string problem = ProcedureRowProblem(r); !problem.empty())
+      throw InputError(file, row + ": " + problem + " (a hand-edited record?)");
   }
 }
 

@@ -51,6 +51,14 @@ std::vector<ProcedureRecord> RecordedProcedures(const std::string& text);
 // session's).
 void SaveProcedures(Database& db, int64_t protocol_version_id, const std::vector<ProcedureRecord>& procedures);
 
+// Every row of the record's procedures table checked as a reader trusts it (export, merge): its protocol version
+// recorded, its procedure and variable words of the vocabulary, its parameters a JSON object that agrees with the
+// typed columns and holds its kind's parameters with their types (a staircase's start within [min, max], whole up,
+// down and stop_reversals, steps of positive numbers; QUEST+'s grids of numbers), the guess a rate in [0, 1).
+// Throws Error(kInput) naming `file`, the row (version hash, block) and the field, for a hand-edited row. What it
+// cannot tell: a value changed to another valid one (the record's text is not parsed again to compare).
+void CheckProcedures(Database& db, const std::string& file);
+
 // Schema 10's data step: every protocol version's procedures from its recorded text (RecordedProcedures). `where`:
 // an SQL condition on protocol_versions (e.g. its ids), "" for every version.
 void DeriveProcedures(Database& db, const std::string& where = "");
