@@ -35,8 +35,11 @@ add_test(NAME cli_bench_live_chart
                  ${PROJECT_BINARY_DIR}/live-bench/live.csv ${PROJECT_BINARY_DIR}/live-bench)
 set_tests_properties(cli_bench_live_chart PROPERTIES FIXTURES_REQUIRED live_bench LABELS slow
                      WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}/analysis)
-# Ctrl-C (SIGINT) ends a run cleanly: exit 0, one line, the log whole (tests/live_interrupt_test.sh).
-add_test(NAME live_interrupted
-         COMMAND ${BLURCUE_EXPECT} "ok: live_interrupt" bash ${PROJECT_SOURCE_DIR}/tests/live_interrupt_test.sh
-                 $<TARGET_FILE:blurcue> ${LIVE_DIR})
-set_tests_properties(live_interrupted PROPERTIES FIXTURES_REQUIRED live_take LABELS gl)
+# Ctrl-C (SIGINT) ends a run cleanly, while it plays and while it preloads: exit 0, one line, the log whole
+# (tests/live_interrupt_test.sh).
+foreach(case play preload)
+  add_test(NAME live_interrupted_${case}
+           COMMAND ${BLURCUE_EXPECT} "ok: live_interrupt ${case}" bash ${PROJECT_SOURCE_DIR}/tests/live_interrupt_test.sh
+                   $<TARGET_FILE:blurcue> ${LIVE_DIR} ${case})
+  set_tests_properties(live_interrupted_${case} PROPERTIES FIXTURES_REQUIRED live_take LABELS gl)
+endforeach()

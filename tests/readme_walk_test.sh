@@ -55,9 +55,12 @@ answers=$(sql "$S/record.sqlite" "SELECT count(*) FROM responses r JOIN trials t
 
 # With a photo: the ground-truth scene as a JPEG whose EXIF Pillow writes (an independent writer): the thesis's
 # camera by its model (the sensor table's 23.4 x 15.6 mm), 21 mm, f/5.6. blurcue camera must give back the camera
-# synth-scene rendered the scene with, and init and calibrate must find the board in it.
+# synth-scene rendered the scene with, and init and calibrate must find the board in it. Focused a little in front
+# of the board's near edge, as the README advises: focused on it, edges 1-3 are sub-pixel and the JPEG's sections
+# there are flagged phase_limited (their readings 15-25 % low), so the example's `measured` blur at edge 3 is unknown
+# and init refuses the study, naming the edge.
 mkdir "$W/photo" && cd "$W/photo"
-blurcue synth-scene --out truth --seed 7 > /dev/null || fail "synth-scene"
+blurcue synth-scene --out truth --seed 7 --focus-mm 300 > /dev/null || fail "synth-scene"
 $PY - truth/scene.png scene.jpg <<'PYEOF' || fail "could not write the JPEG with EXIF"
 import sys
 from PIL import Image, TiffImagePlugin

@@ -175,7 +175,10 @@ LiveSetup SetUpLive(const LiveArgs& a) {
     throw;
   }
   // Decoded whole before the clock starts: frames then come from memory, as a camera hands over the frames it decoded.
-  if (a.preload) s.preload_s = s.source->Preload();
+  if (a.preload) {
+    if (!a.quiet) std::fprintf(stderr, "live: --preload: decoding %s before the start ...\n", a.input.c_str());
+    s.preload_s = s.source->Preload(live::kMaxPreloadMb, &live_signal);
+  }
   const double rate = s.source->fps();
   if (a.exposure_ms >= 0) {
     if (const std::string beyond = stimulus::ExposureBeyondFrame(a.exposure_ms, rate); !beyond.empty())
@@ -322,6 +325,9 @@ void RunLiveLoop(LiveSetup& s, const LiveArgs& a, render::GlContext& context, re
 }
 
 void RunLive(const LiveArgs& a) {
+  // From before the preload to the log written: a signal then ends the run as Escape does (the preload stops, the
+  // loop ends at once), and one during the log's writing waits for it - the log is always whole.
+  const LiveSignals signals;
   LiveSetup s = SetUpLive(a);
   const Camera& camera = s.camera;
   std::unique_ptr<render::GlContext> context;
@@ -363,10 +369,7 @@ void RunLive(const LiveArgs& a) {
                  s.source->preloaded_frames(), s.source->preloaded_mb(), s.preload_s);
   LiveRecord record;
   record.rows.reserve(size_t(a.frames > 0 ? a.frames : 4096));
-  {
-    const LiveSignals signals;
-    RunLiveLoop(s, a, *context, compositor, record);
-  }
+  RunLiveLoop(s, a, *context, compositor, record);
   live::LiveSummary summary = live::Summarize(record.rows, record.dropped, record.ended);
   summary.preloaded_frames = s.source->preloaded_frames();
   if (summary.shown > 0) summary.cpu_ms_per_frame = 1000 * record.cpu_s / summary.shown;

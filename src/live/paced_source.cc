@@ -104,12 +104,14 @@ bool PacedSource::WaitUntil(Clock::time_point due) {
 
 void PacedSource::DecodeVideo() { DecodeFrames(kDecodeAhead, 0); }
 
-double PacedSource::Preload(double max_mb) {
+double PacedSource::Preload(double max_mb, const std::atomic<int>* interrupt) {
   if (!file_)
     throw Error(ErrorKind::kUsage, "--preload: " + device_ + " is a camera, which hands over its frames decoded already; "
                                    "--preload is for a video or an image sequence");
   const auto t0 = Clock::now();
+  interrupt_ = interrupt;
   DecodeFrames(0, max_mb);
+  interrupt_ = nullptr;
   preloaded_frames_ = int(ahead_.size());
   for (const LiveFrame& f : ahead_) preloaded_mb_ += 1e-6 * double(f.image.total() * f.image.elemSize());
   return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -131,6 +133,10 @@ bool PacedSource::DecodeFrames(int ahead_limit, double max_mb) {
           frame.image = std::move(spare_.back());
           spare_.pop_back();
         }
+      }
+      if (interrupt_ && *interrupt_ != 0) {
+        why = "interrupted while preloading, after " + std::to_string(read) + " frames";
+        break;
       }
       if (max_frames_ > 0 && read == max_frames_) {
         why = std::to_string(read) + " frames read (--frames)";

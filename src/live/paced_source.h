@@ -55,8 +55,10 @@ class PacedSource {
   // pace from memory, as a camera hands over frames it has decoded itself, and no decoding competes with the drawing.
   // Returns the seconds the decoding took. Throws Error(kUsage) naming INPUT when the frames would hold more than
   // `max_mb` MB (before decoding them when the video's header says how many there are) or for a camera; a damaged
-  // frame ends the preload, and the frames before it are played, then the error (as without it).
-  double Preload(double max_mb = kMaxPreloadMb);
+  // frame ends the preload, and the frames before it are played, then the error (as without it). `interrupt`, when
+  // given and non-zero (a signal's number: Ctrl-C), ends the decoding at the next frame: the frames decoded so far
+  // are held, and the input ends there.
+  double Preload(double max_mb = kMaxPreloadMb, const std::atomic<int>* interrupt = nullptr);
   // Frames held decoded by Preload (0: none, decoded as they are played), and the MB they hold.
   int preloaded_frames() const { return preloaded_frames_; }
   double preloaded_mb() const { return preloaded_mb_; }
@@ -84,6 +86,7 @@ class PacedSource {
   int max_frames_ = 0;
   int preloaded_frames_ = 0;
   double preloaded_mb_ = 0;
+  const std::atomic<int>* interrupt_ = nullptr;  // Preload's; nullptr otherwise
   std::unique_ptr<track::FrameSource> file_;
   std::unique_ptr<media::VideoReader> camera_;
   std::thread thread_, decoder_;

@@ -66,32 +66,6 @@ TEST(ExportProcedures, OneRowPerProcedureBlockWithTheParsersDefaults) {
     EXPECT_NE(text.str().find("procedures.csv," + c->name + ","), std::string::npos) << c->name;
 }
 
-// A staircase over a conditions table: the record keeps the table beside the text (protocol::RecordedText), and the
-// export parses the text with it - one row, though the table's file is gone.
-TEST(ExportProcedures, AVersionReadingAConditionsTableKeepsItsRow) {
-  testing::TempDir dir;
-  std::string text = kTwoProcedures;
-  const std::string factors = R"("factors": {"edge": [3, 5]})";
-  text.replace(text.find(factors), factors.size(), R"("conditions": "../tables/rows.csv")");
-  std::filesystem::create_directories(dir / "protocols");
-  std::filesystem::create_directories(dir / "tables");
-  std::ofstream(dir / "protocols" / "p.json") << text;
-  std::ofstream(dir / "tables" / "rows.csv") << "edge\r\n3\r\n5\r\n";
-  const protocol::Protocol parsed = protocol::LoadProtocol(dir / "protocols" / "p.json", protocol::ValidateOptions{false});
-  const std::string recorded = protocol::RecordedText(text, parsed);
-  ASSERT_NE(recorded.find("recorded_conditions"), std::string::npos);
-  std::filesystem::remove_all(dir / "tables");
-  {
-    Record record = Record::Open(dir / "r.sqlite");
-    record.StartOrResumeSession("two-procedures", "P1", recorded, 7, {}, false);
-  }
-  ExportCsv(dir / "r.sqlite", dir / "out");
-  const std::vector<std::string> lines = Lines(dir / "out" / "procedures.csv");
-  ASSERT_EQ(lines.size(), 3u);
-  EXPECT_NE(lines[2].find(",1,s,staircase,"), std::string::npos) << lines[2];
-}
-
-
 // The kTwoProcedures study whose second block reads a conditions table, as a session records it: the recorded text
 // (the table kept beside it) and the protocol the session parsed from the file.
 struct WithTable {
@@ -112,6 +86,23 @@ WithTable TwoProceduresWithATable(const std::filesystem::path& dir) {
   std::filesystem::remove_all(dir / "tables");
   return out;
 }
+
+// A staircase over a conditions table: the record keeps the table beside the text (protocol::RecordedText), and the
+// export parses the text with it - one row, though the table's file is gone.
+TEST(ExportProcedures, AVersionReadingAConditionsTableKeepsItsRow) {
+  testing::TempDir dir;
+  const std::string recorded = TwoProceduresWithATable(dir.path()).recorded;
+  ASSERT_NE(recorded.find("recorded_conditions"), std::string::npos);
+  {
+    Record record = Record::Open(dir / "r.sqlite");
+    record.StartOrResumeSession("two-procedures", "P1", recorded, 7, {}, false);
+  }
+  ExportCsv(dir / "r.sqlite", dir / "out");
+  const std::vector<std::string> lines = Lines(dir / "out" / "procedures.csv");
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_NE(lines[2].find(",1,s,staircase,"), std::string::npos) << lines[2];
+}
+
 
 // The table's rows as one text, in order.
 std::string TableRows(Database& db) {
