@@ -43,3 +43,15 @@ foreach(case play preload)
                    $<TARGET_FILE:blurcue> ${LIVE_DIR} ${case})
   set_tests_properties(live_interrupted_${case} PROPERTIES FIXTURES_REQUIRED live_take LABELS gl)
 endforeach()
+# A frame of another size than camera.json says: one line naming the input, the frame and the camera.json, exit 3
+# (it said "frame 0: frame 0: is 574x382 but the camera says 1148x764", naming neither file).
+add_test(NAME live_frame_of_another_size_make
+         COMMAND /usr/bin/python3 -c "import os, sys; from PIL import Image; os.makedirs(sys.argv[2], exist_ok=True); im = Image.open(sys.argv[1]); im.resize((im.width // 2, im.height // 2)).save(sys.argv[2] + '/frame-0000.png')"
+                 ${LIVE_DIR}/take/frame-0000.png ${LIVE_DIR}/small)
+set_tests_properties(live_frame_of_another_size_make PROPERTIES FIXTURES_REQUIRED live_take FIXTURES_SETUP live_small)
+add_test(NAME live_frame_of_another_size
+         COMMAND ${CMAKE_COMMAND} -DCMD=$<TARGET_FILE:blurcue>
+                 "-DARGS=live;${LIVE_DIR}/small/frame-%04d.png;--camera;${LIVE_DIR}/take/camera.json;--track;${LIVE_DIR}/track;--ball;87.5,125;--log;${LIVE_DIR}/small-log;--quiet"
+                 -DEXPECT_CODE=3 "-DEXPECT_TEXT=small/frame-%04d.png, frame 0: is 574x382 but the camera (${LIVE_DIR}/take/camera.json) says 1148x764"
+                 -DONE_LINE=1 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
+set_tests_properties(live_frame_of_another_size PROPERTIES FIXTURES_REQUIRED live_small LABELS gl)

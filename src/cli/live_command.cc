@@ -308,7 +308,14 @@ void RunLiveLoop(LiveSetup& s, const LiveArgs& a, render::GlContext& context, re
     try {
       ShowFrame(s, a, frame, start, dropped - dropped_seen, context, compositor, record, last_pose);
     } catch (const Error& e) {
-      record.ended = "frame " + std::to_string(frame.index) + ": " + e.what();
+      // Named by the input and the frame once (the tracker's message names the frame already), and a frame of
+      // another size by the camera.json it contradicts.
+      const std::string own = "frame " + std::to_string(frame.index) + ": ";
+      std::string what = e.what();
+      if (what.rfind(own, 0) == 0) what.erase(0, own.size());
+      if (const size_t at = what.find("the camera says"); at != std::string::npos)
+        what.replace(at, 15, "the camera (" + a.camera + ") says");
+      record.ended = a.input + ", " + own + what;
       record.error = Error(e.kind(), record.ended);
       break;
     }

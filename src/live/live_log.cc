@@ -84,6 +84,10 @@ LiveSummary Summarize(const std::vector<LiveRow>& rows, int dropped, const std::
 
 std::string SummaryLine(const LiveSummary& s) {
   const int delivered = s.shown + s.dropped;
+  // No frame shown: no latency or rate to give (a 0.0 ms median would read as a measurement).
+  if (s.shown == 0)
+    return "no frames shown, " + std::to_string(s.dropped) + " dropped: no latency to give" +
+           (s.preloaded_frames > 0 ? "; " + std::to_string(s.preloaded_frames) + " frames preloaded" : std::string());
   char line[400];
   std::snprintf(line, sizeof line,
                 "%d frames shown, %d dropped (%.1f %%); latency median %.1f ms, p95 %.1f ms, max %.1f ms; "
@@ -128,6 +132,12 @@ Json SummaryJson(const LiveSummary& s) {
   j["ended"] = s.ended;
   j["preloaded_frames"] = s.preloaded_frames;
   j["cpu_ms_per_frame_shown"] = s.cpu_ms_per_frame;
+  // No frame shown: the times and rates are not determined (null), not 0.
+  if (s.shown == 0)
+    for (const char* key : {"median_latency_ms", "p95_latency_ms", "max_latency_ms", "median_track_ms",
+                            "median_render_ms", "median_measure_ms", "shown_fps", "delivered_fps",
+                            "cpu_ms_per_frame_shown"})
+      j[key] = nullptr;
   return j;
 }
 

@@ -312,6 +312,18 @@ TEST(LiveLog, SummaryCountsAndNearestRankLatencies) {
 
 // A run with --measure-sections says whether its lens model was ever fitted live (a take too short for 3 edges'
 // readings drew with the given one throughout, and the summary used to say nothing of it).
+// A run that showed no frame (a camera not there, Ctrl-C during the preload) gives no latency: the line says so and
+// summary.json's times are null (they were 0.0 ms, which reads as a measurement).
+TEST(LiveLog, NoFrameShownGivesNoLatency) {
+  LiveSummary s = Summarize({}, 2, "interrupted (SIGINT)");
+  EXPECT_EQ(SummaryLine(s), "no frames shown, 2 dropped: no latency to give");
+  const Json j = SummaryJson(s);
+  EXPECT_EQ(j["frames_shown"], 0);
+  EXPECT_TRUE(j["median_latency_ms"].is_null());
+  EXPECT_TRUE(j["p95_latency_ms"].is_null());
+  EXPECT_TRUE(j["shown_fps"].is_null());
+}
+
 TEST(LiveLog, SummarySaysWhetherTheLensWasFittedLive) {
   std::vector<LiveRow> rows(2);
   for (LiveRow& r : rows) r.sections = 1;
