@@ -365,11 +365,12 @@ void RunLive(const LiveArgs& a) {
     compositor.Finish();
   }
   if (!a.quiet)
-    std::fprintf(stderr, "live: %s (%s), %zu objects, blur %s with the lens of %s, exposure %s ms (%s), %s\n",
+    std::fprintf(stderr, "live: %s (%s), %zu object%s, blur %s with the lens of %s, exposure %s ms (%s), %s\n",
                  a.input.c_str(),
                  s.source->is_camera() ? "a camera, at its own rate"
                                        : ("played at " + Num(s.source->fps()) + " fps").c_str(),
-                 s.planner->objects().size(), a.blur.c_str(), s.lens_note.c_str(), Num(s.exposure_ms).c_str(),
+                 s.planner->objects().size(), s.planner->objects().size() == 1 ? "" : "s", a.blur.c_str(),
+                 s.lens_note.c_str(), Num(s.exposure_ms).c_str(),
                  s.exposure_note.c_str(), a.window ? "in a window (vsync)" : "headless");
   if (!a.quiet && a.preload)
     std::fprintf(stderr, "live: --preload: %d frames (%.0f MB) decoded in %.1f s before the start; decoding is not timed\n",
@@ -396,11 +397,11 @@ void AddLiveCommand(CLI::App& app) {
   auto a = std::make_shared<LiveArgs>();
   CLI::App* cmd = app.add_subcommand(
       "live",
-      "Show virtual objects in a camera's frames as they come: the thesis's prototype in real time. Each frame's board\n"
-      "pose is tracked from the frame before (a full detection when tracking is lost), the objects are planned and\n"
-      "drawn as `blurcue ar` draws them (the lens model's defocus x floor at each object's depth, streaked by its\n"
-      "image motion since the last frame with a pose over the exposure, in linear light) and shown in a window with\n"
-      "vsync (--window; Escape or closing it ends the run) or rendered headless.\n"
+      "Show virtual objects in a camera's frames as they come: the thesis's prototype in real time.\n"
+      "Each frame's board pose is tracked from the frame before (a full detection when tracking is lost), the objects\n"
+      "are planned and drawn as `blurcue ar` draws them (the lens model's defocus x floor at each object's depth,\n"
+      "streaked by its image motion since the last frame with a pose over the exposure, in linear light) and shown\n"
+      "in a window with vsync (--window; Escape or closing it ends the run) or rendered headless.\n"
       "INPUT is a camera - /dev/videoN or an index N, through OpenCV's videoio (V4L2) - or a video file or image\n"
       "sequence (a printf pattern) played as a camera would deliver it: frame k at k / fps s from the start. Frames\n"
       "reach the drawing through a one-slot mailbox: one that arrives while the previous is still being drawn\n"
