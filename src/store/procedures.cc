@@ -195,7 +195,7 @@ std::string ProcedureRowProblem(const ProcedureRecord& r) {
   if (!(r.guess >= 0 && r.guess < 1)) return "guess " + Num(r.guess) + ": not a rate in [0, 1)";
   Json p;
   try {
-    p = Json::parse(r.parameters);
+    p = ParseJson(r.parameters, "parameters");  // the project's parser: its depth guard, its duplicate-key check
   } catch (const std::exception&) {
     return "parameters " + Echo(r.parameters) + ": not JSON";
   }
