@@ -16,6 +16,7 @@
 #include "calib/scene_blur.h"
 #include "core/image.h"
 #include "render/psf.h"
+#include "synth/edge_profile_test_util.h"
 #include "synth/scene.h"
 
 namespace blurcue::render {
@@ -35,31 +36,7 @@ cv::Point2d Project(const synth::Scene& s, const cv::Point3d& p, bool distorted)
   return q[0];
 }
 
-// 2 x the std of the photo's line-spread function across the edge through `m` with unit normal `n`: pixels within
-// 8 px of m along the edge and 9 px across, binned at 0.1 px by signed distance, the binned profile differenced, its
-// variance less the pixel's own 1/12.
-double PhotoRadiusAcross(const cv::Mat& lin, const cv::Point2d& m, const cv::Point2d& n) {
-  const cv::Point2d t(n.y, -n.x);
-  const int nb = 180;
-  std::vector<double> sum(nb, 0), count(nb, 0);
-  for (int py = int(m.y) - 14; py <= int(m.y) + 14; ++py)
-    for (int px = int(m.x) - 14; px <= int(m.x) + 14; ++px) {
-      const cv::Point2d d(px - m.x, py - m.y);
-      const double a = d.dot(t), c = d.dot(n);
-      if (std::abs(a) > 8 || std::abs(c) >= 9) continue;
-      const int b = int((c + 9) / 0.1);
-      sum[b] += lin.at<float>(py, px), count[b] += 1;
-    }
-  std::vector<double> xs, vs;
-  for (int b = 0; b < nb; ++b)
-    if (count[b] > 0) xs.push_back(-9 + (b + 0.5) * 0.1), vs.push_back(sum[b] / count[b]);
-  double m0 = 0, m1 = 0, m2 = 0;
-  for (size_t i = 0; i + 1 < vs.size(); ++i) {
-    const double g = vs[i + 1] - vs[i], xm = 0.5 * (xs[i] + xs[i + 1]);
-    m0 += g, m1 += g * xm, m2 += g * xm * xm;
-  }
-  return 2 * std::sqrt(m2 / m0 - (m1 / m0) * (m1 / m0) - 1.0 / 12);
-}
+using synth::testing::PhotoRadiusAcross;
 
 // A drawn kernel's std across unit normal n, from its taps.
 double KernelStdAcross(const cv::Mat& k, const cv::Point2d& n) {

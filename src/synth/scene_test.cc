@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "core/image.h"
+#include "synth/edge_profile_test_util.h"
 
 namespace blurcue::synth {
 namespace {
@@ -519,27 +520,7 @@ TEST(SynthScene, DistortedBlurIsTheAppliedBlurTimesTheStretchAcrossTheEdge) {
       const double sq = s.board.square_mm, y = (edge - 1) * sq, x = (section - 0.5) * sq;
       const cv::Point2d m = project(x, y), along = project(x + 0.01, y) - project(x - 0.01, y);
       cv::Point2d tan = along / cv::norm(along), n(-tan.y, tan.x);
-      // Pixels within 8 px of the midpoint along the edge and 9 px across, binned at 0.1 px by distance.
-      const int nb = 180;
-      std::vector<double> sum(nb, 0), count(nb, 0);
-      for (int py = int(m.y) - 14; py <= int(m.y) + 14; ++py)
-        for (int px = int(m.x) - 14; px <= int(m.x) + 14; ++px) {
-          const cv::Point2d d(px - m.x, py - m.y);
-          const double a = d.dot(tan), c = d.dot(n);
-          if (std::abs(a) > 8 || std::abs(c) >= 9) continue;
-          const int b = int((c + 9) / 0.1);
-          sum[b] += lin.at<float>(py, px), count[b] += 1;
-        }
-      std::vector<double> xs, vs;
-      for (int b = 0; b < nb; ++b)
-        if (count[b] > 0) xs.push_back(-9 + (b + 0.5) * 0.1), vs.push_back(sum[b] / count[b]);
-      double m0 = 0, m1 = 0, m2 = 0;
-      for (size_t i = 0; i + 1 < vs.size(); ++i) {
-        const double g = vs[i + 1] - vs[i], xm = 0.5 * (xs[i] + xs[i + 1]);
-        m0 += g, m1 += g * xm, m2 += g * xm * xm;
-      }
-      const double var = m2 / m0 - (m1 / m0) * (m1 / m0) - 1.0 / 12;
-      const double measured = 2 * std::sqrt(var);
+      const double measured = synth::testing::PhotoRadiusAcross(lin, m, n);
       EXPECT_NEAR(measured, t.r_px, 0.01 * t.r_px) << "edge " << edge << " section " << section << ", stretch "
                                                     << t.stretch << ", ideal " << t.r_ideal_px;
       stretch_min = std::min(stretch_min, t.stretch);
