@@ -364,11 +364,12 @@ foreach(pair "file;${D}/small.png;Not a directory" "missing;${H}/no-such-tmpdir;
 endforeach()
 # live --log DIR replaces DIR whole when it holds live's files only; frame-NNNN.png counts as one (--save-frame), so a
 # folder of such images alone (ar --frames, a take's frames) was replaced and its images deleted. A log live wrote
-# always holds live.csv: without it, refused before anything is read.
+# always holds live.csv: without it, refused before anything is read (a usage error, exit 2, as for any folder live
+# may not replace: docs/live.md).
 add_test(NAME cli_hostile_live_log_of_frames_make
          COMMAND ${CMAKE_COMMAND} -E copy ${D}/small.png ${H}/live-frames-only/frame-0000.png)
 set_tests_properties(cli_hostile_live_log_of_frames_make PROPERTIES FIXTURES_SETUP live_frames_only)
-hostile_test(cli_hostile_live_log_of_frames 3 "--log ${H}/live-frames-only: holds no live.csv: not a log live wrote"
+hostile_test(cli_hostile_live_log_of_frames 2 "--log ${H}/live-frames-only: holds no live.csv: not a log live wrote"
              live ${T}/scene/scene.png --camera ${T}/scene/camera.json --calib ${T}/calib.json --ball 87.5,125
              --log ${H}/live-frames-only)
 set_tests_properties(cli_hostile_live_log_of_frames PROPERTIES FIXTURES_REQUIRED "scene;calib;live_frames_only")
