@@ -10,6 +10,7 @@
 #include "core/camera_exif.h"
 #include "core/json_io.h"
 #include "core/output_guard.h"
+#include "core/own_output.h"
 
 namespace blurcue::cli {
 namespace {
@@ -54,7 +55,14 @@ void AddCameraCommand(CLI::App& app) {
   cmd->add_option("--f-number", args->f_number, "the f-number, where EXIF lacks it")
       ->check(FiniteRange(CameraLimits::kFNumber[0], CameraLimits::kFNumber[1], ""));
   cmd->callback([args] {
-    if (!args->out.empty()) OutputGuard().Input("PHOTO", args->photo).OutputFile("--out", args->out).Check();
+    if (!args->out.empty()) {
+      OutputGuard().Input("PHOTO", args->photo).OutputFile("--out", args->out).Check();
+      // A camera.json (one's own, written by hand, is the same kind) and nothing else: not a protocol or a calib.
+      RequireOwnFile("--out", args->out, "a camera.json", [](std::string_view head) {
+        return head.find("\"focal_length_mm\"") != std::string_view::npos &&
+               head.find("\"format\": \"blurcue-calib\"") == std::string_view::npos;
+      });
+    }
     std::optional<std::pair<double, double>> sensor;
     if (args->sensor_mm.size() == 2) sensor = std::make_pair(args->sensor_mm[0], args->sensor_mm[1]);
     auto given = [](double v) { return v > 0 ? std::optional<double>(v) : std::nullopt; };
