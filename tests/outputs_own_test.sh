@@ -20,11 +20,13 @@ $BC run "$P1" --participant p1 --db study.sqlite --observer sim --stop-after 1 >
 mkdir own-stimuli && cp photo.png own-stimuli/face.png
 mkdir real-photos && cp photo.png real-photos/face-1m.png
 mkdir own-frames && cp photo.png own-frames/frame-00000.png
+mkdir own-shots && cp photo.png own-shots/trial-0001.png
 mkdir own-calibs && cp "$T/calib.json" own-calibs/calib-0000.json
 mkdir own-plan && echo "n,power" > own-plan/plan.csv
 mkdir own-tables && echo "participant,answer" > own-tables/trials.csv
 echo "not a video" > notes.avi
-snapshot() { find . -type f -print0 | sort -z | xargs -0 sha256sum; }
+# Every file's bytes; SQLite's -shm and an empty -wal (a refused run opened the record and wrote nothing) aside.
+snapshot() { find . -type f ! -name '*-shm' ! \( -name '*-wal' -size 0 \) -print0 | sort -z | xargs -0 sha256sum; }
 before=$(snapshot)
 
 cases=0
@@ -61,8 +63,9 @@ expect 3 "--frames own-frames: holds no animate-frames.txt: not frames animate d
 expect 3 "--out own-calibs: holds no track.csv: not a take track wrote" track take/take.avi --camera take/camera.json --out own-calibs
 expect 3 "--out own-plan: holds no plan.json: not a plan blurcue plan wrote" plan "$P1" --out own-plan --no-chart
 expect 3 "--out own-tables: holds no codebook.csv: not tables export wrote" export --db study.sqlite --out own-tables
+expect 3 "own-shots: --capture: holds 'trial-0001.png' and no trial-NNNN.json: images, not a capture" run "$P1" --participant p2 --db study.sqlite --observer sim --stop-after 1 --capture own-shots
 [ "$(snapshot)" = "$before" ] || fail "a refused command changed a file: $(diff <(echo "$before") <(snapshot) | head -5)"
-left=$(ls -A | grep -Ev '^(protocol\.json|photo\.png|their-calib\.json|take|study\.sqlite|own-.*|real-photos|notes\.avi|sheet\.png)$' || true)
+left=$(ls -A | grep -Ev '^(protocol\.json|photo\.png|their-calib\.json|take|study\.sqlite(-wal|-shm)?|own-.*|real-photos|notes\.avi|sheet\.png)$' || true)
 [ -z "$left" ] || fail "a refused command left: $left"
 
 # Small mends, one line each: a card raised 1 m (behind the camera) is blamed on the field that raised it (it was

@@ -100,18 +100,17 @@ void WritePlan(const PlanArgs& args) {
   std::error_code ignored;
   if (std::filesystem::exists(out, ignored) && !std::filesystem::is_directory(out, ignored))
     throw InputError(out.string(), "--out: is a file, not a folder");
-  // An earlier plan holds the plan.json plan wrote: a folder of one's own plan.csv or answers.csv alone, or beside a
-  // plan.json of another tool, was replaced as if it were one.
-  RequireMarkedFolder("--out", out, "plan.json", "a plan blurcue plan wrote", "one's own plan.csv or tables?");
-  RequireOwnFile("--out", out / "plan.json", "a plan.json plan wrote", Holds("\"smallest_n\""));
-  const bool earlier = std::filesystem::exists(out / "plan.json", ignored);
   // An earlier plan is replaced whole: its own files only, so a file someone put beside them is not deleted with it.
-  const auto ours = [earlier](const std::string& name) {
+  const auto ours = [](const std::string& name) {
     for (const char* own : {"plan.csv", "answers.csv", "plan.json", "power.png", "power.svg"})
-      if (name == own) return earlier;
+      if (name == own) return true;
     return false;
   };
   RequireReplaceableFolder(out, ours);
+  // And it holds the plan.json plan wrote: a folder of one's own plan.csv or answers.csv alone, or beside a
+  // plan.json of another tool, was replaced as if it were one.
+  RequireMarkedFolder("--out", out, "plan.json", "a plan blurcue plan wrote", "one's own plan.csv or tables?");
+  RequireOwnFile("--out", out / "plan.json", "a plan.json plan wrote", Holds("\"smallest_n\""));
   const plan::PlanResult result = plan::RunPlan(options);
   std::fprintf(stderr, "plan: %zu participants in %.2f s on %d threads (%.2f ms per participant)\n",
                static_cast<size_t>(options.studies) * static_cast<size_t>(options.participants), result.seconds,
