@@ -47,6 +47,7 @@ expect 3 "--log protocol.json: exists and is not a log animate wrote (it begins 
 expect 3 "--video notes.avi: exists and is not a video (an AVI) (it begins \"not a video\")" "${ANIM[@]}" --video notes.avi
 expect 3 "--out protocol.json: exists and is not a calib.json calibrate wrote" calibrate "$T/scene/scene.png" --camera "$T/scene/camera.json" --out protocol.json
 expect 3 "--out protocol.json: exists and is not a camera.json" camera "$T/scene/scene.png" --focal-length-mm 21 --f-number 5.6 --sensor-mm 23.4 15.6 --out protocol.json
+# A protocol and a calib.json both name a focal length: the camera.json reader tells them apart.
 expect 3 "--out their-calib.json: exists and is not a camera.json" camera "$T/scene/scene.png" --focal-length-mm 21 --f-number 5.6 --sensor-mm 23.4 15.6 --out their-calib.json
 expect 3 "--out protocol.json: exists and is not a CSV bench plan wrote" bench plan --quick --out protocol.json
 expect 3 "--out protocol.json: exists and is not a CSV bench procedures wrote" bench procedures --quick --out protocol.json

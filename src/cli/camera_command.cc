@@ -7,7 +7,9 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "core/camera.h"
 #include "core/camera_exif.h"
+#include "core/error.h"
 #include "core/json_io.h"
 #include "core/output_guard.h"
 #include "core/own_output.h"
@@ -57,10 +59,15 @@ void AddCameraCommand(CLI::App& app) {
   cmd->callback([args] {
     if (!args->out.empty()) {
       OutputGuard().Input("PHOTO", args->photo).OutputFile("--out", args->out).Check();
-      // A camera.json (one's own, written by hand, is the same kind) and nothing else: not a protocol or a calib.
-      RequireOwnFile("--out", args->out, "a camera.json", [](std::string_view head) {
-        return head.find("\"focal_length_mm\"") != std::string_view::npos &&
-               head.find("\"format\": \"blurcue-calib\"") == std::string_view::npos;
+      // A camera.json (one's own, written by hand, is the same kind) and nothing else: what the camera.json reader
+      // takes whole, so not a protocol or a calib.json that names a focal length.
+      RequireOwnFile("--out", args->out, "a camera.json", [&](std::string_view) {
+        try {
+          LoadCamera(args->out);
+          return true;
+        } catch (const Error&) {
+          return false;
+        }
       });
     }
     std::optional<std::pair<double, double>> sensor;
