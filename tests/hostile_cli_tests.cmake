@@ -386,3 +386,13 @@ set_tests_properties(cli_hostile_synth_scene_own_camera PROPERTIES FIXTURES_REQU
 hostile_test(cli_hostile_synth_take_own_camera 3 "--out ${H}/own-camera: holds no take.json: not a take synth-take wrote"
              synth-take --out ${H}/own-camera --frames 2)
 set_tests_properties(cli_hostile_synth_take_own_camera PROPERTIES FIXTURES_REQUIRED own_camera)
+
+# --- guard: small mends of the outputs audit (tests/outputs_own_test.sh holds the rest, over the CLI tests' scene).
+# A repeated distance wrote one photo and said "wrote 1 photos"; two distances %g prints alike wrote one file.
+hostile_test(cli_hostile_synth_pictures_repeated_distance 2 "--distances-m 1 is given twice"
+             synth-pictures --camera ${D}/thesis-camera.json --distances-m 1 1 --out ${H}/pictures-twice)
+hostile_test(cli_hostile_synth_pictures_distances_one_name 2 "distances 1 and 1.0000001 m both name face-1m.png"
+             synth-pictures --camera ${D}/thesis-camera.json --distances-m 1 1.0000001 --out ${H}/pictures-twice)
+# A display no participant has (render wrote a 1 x 1 image): the display profile's width range.
+hostile_test(cli_hostile_render_display_width_1 2 "--display-width: must be 0 (the photo's own width) or a display's width, 320 to 16384 px"
+             render --background ${D}/small.png --object picture --display-width 1 --out ${H}/tiny.png)
