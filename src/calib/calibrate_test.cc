@@ -563,7 +563,15 @@ TEST(SceneCalib, MeasuredIsTheNearestEdgesOwnValueOrAnError) {
   // Its neighbours keep their own values, and the other sources still answer at edge 9.
   for (int edge : {8, 11}) EXPECT_NEAR(BlurAtPx(scene, BlurSource::kMeasured, midpoint(edge)), r.result.edges[edge - 1].r_px, 1e-9);
   EXPECT_GT(BlurAtPx(scene, BlurSource::kFitted, midpoint(9)), 0);
-  EXPECT_GT(BlurAtPx(scene, BlurSource::kMeasuredSection, midpoint(9)), 0);
+  // measured_section alike: the nearest section's own value or an error naming it (it gave edge 8's or 10's section
+  // before, recorded as this place's), and a usable section's own value.
+  try {
+    BlurAtPx(scene, BlurSource::kMeasuredSection, midpoint(9));
+    ADD_FAILURE() << "edge 9 section 4 is not usable, yet measured_section gave a value";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("edge 9 section 4 (the nearest) is not usable"), std::string::npos) << e.what();
+  }
+  EXPECT_NEAR(BlurAtPx(scene, BlurSource::kMeasuredSection, midpoint(8)), r.result.edges[7].sections[3].fit.r_px, 1e-9);
 }
 
 // SceneCalibFromJson refuses `j` with Error(kInput) whose message is exactly `expected`.

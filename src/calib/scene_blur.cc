@@ -235,14 +235,19 @@ double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& p, 
     // The model is in ideal px; the photo's blur at the point is that times the distortion's stretch there.
     case BlurSource::kFitted: return scene.model.PredictPx(lens, p[2]) * StretchAt(scene, p);
     case BlurSource::kMeasuredSection: {
+      // The nearest section, usable or not: a flagged one has no measured value, and the next usable one's (another
+      // edge's, perhaps) would be recorded as this place's, so it is an error, as for `measured`.
       const SceneCalib::Section* best = nullptr;
       double best_d = 1e300;
       for (const auto& s : scene.sections) {
-        if (!s.ok) continue;
         const double d = cv::norm(s.midpoint_camera_mm - p);
         if (d < best_d) best_d = d, best = &s;
       }
-      if (!best) throw Error(ErrorKind::kNotFound, "the calibration has no usable measured section");
+      if (!best) throw Error(ErrorKind::kNotFound, "the calibration has no measured section");
+      if (!best->ok)
+        throw Error(ErrorKind::kNotFound, "edge " + std::to_string(best->edge) + " section " +
+                                              std::to_string(best->section) + " (the nearest) is not usable, so its "
+                                              "measured blur is unknown; estimated or fitted give one");
       return best->r_px;
     }
     case BlurSource::kMeasured: {

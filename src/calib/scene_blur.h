@@ -53,7 +53,8 @@ BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px, const st
 //               whose line (from the board and its pose) passes nearest the point; a card beside the board aligned
 //               with edge k gets edge k's value whichever side it is on; Error(kNotFound) naming the edge when it
 //               has no usable section (never another edge's value);
-//   measured_section - r_px of the nearest usable measured section alone (3-D distance between midpoints);
+//   measured_section - r_px of the nearest measured section alone (3-D distance between midpoints);
+//               Error(kNotFound) naming it when it is not usable (never another section's value);
 //   estimated - eq. 3.7 from the reference edge at the point's depth (Error(kDomain) nearer than focus);
 //   fitted    - the fitted thin-lens model at the point's depth (ideal px), times StretchAt the point (photo px);
 //   fixed     - fixed_r_px; none - 0.
