@@ -115,9 +115,9 @@ TEST(SignFlipP, HandWorkedCases) {
   EXPECT_NEAR(SignFlipP(many), 0.05689, 0.001);
 }
 
-// A single answer is no test, whatever the chance level: at 1/25 (an odd one out of 25) one right answer has the
-// binomial p = 0.04, which plan counted as a rejection at alpha 0.05 where the report says "none: one answer cannot
-// test anything".
+// A single answer is no test, whatever the chance level: at chance 0.04 one right answer has the binomial p = 0.04,
+// which plan counted as a rejection at alpha 0.05 where the report says "none: one answer cannot test anything" (no
+// protocol reaches such a chance level today: an odd one out has at most 6 alternatives).
 TEST(OneParticipantTest, ASingleAnswerIsNoTest) {
   EXPECT_NEAR(BinomialTestP(1, 1, 0.04), 0.04, 1e-12);
   EXPECT_TRUE(std::isnan(OneParticipantTestP(1, 1, 0.04)));
