@@ -161,8 +161,8 @@ void CheckTruthScene(const Json& truth, const std::string& file, const Board& bo
 
 // After detection: the truth's pose must put the board where the photo shows it. Each corner found is matched to the
 // nearest of the truth's projected corners (so a board read half a turn round still matches: that is the
-// calibration's error, which --truth is there to print); the median distance is ~0.03 px for the truth of this
-// photo, tens to hundreds of px for another scene's.
+// calibration's error, which --truth is there to print); the median distance is a small fraction of a pixel for the
+// truth of this photo (its pose 0.03 mm / 0.004 deg from the one found), 19 px for the same scene turned 25 deg.
 void CheckTruthPose(const Json& truth, const std::string& file, const calib::CalibResult& result, const Board& board,
                     const Camera& camera, const std::string& photo_file) {
   if (!truth.contains("pose") || !truth["pose"].is_object()) return;  // CompareToTruth names what is missing
