@@ -160,6 +160,11 @@ def against_chance(m, chance, people=None):
     return against_chance_counts(np.rint(pp["mean"].to_numpy(float) * n).astype(int), n, chance, people)
 
 
+def participants_words(count):
+    """The subject of a sentence saying they are too few: "1 participant is", "2 participants are"."""
+    return f"{count} participant is" if count == 1 else f"{count} participants are"
+
+
 def against_chance_counts(k, n, chance, people=None):
     """The test against chance of participants with k[i] of n[i] answers 1: dict(test, p, and for 3+ participants
     participant_mean, participant_low, participant_high - the participants' shares' mean with a t 95 % interval, a
@@ -172,7 +177,7 @@ def against_chance_counts(k, n, chance, people=None):
     if (people or n_people) == 1:
         return one_participant_test(k.sum(), n.sum(), chance)
     if n_people < MIN_PARTICIPANTS_T:
-        return {"test": f"none: {n_people} participants are too few for a test across participants (needs "
+        return {"test": f"none: {participants_words(n_people)} too few for a test across participants (needs "
                         f">= {MIN_PARTICIPANTS_T})", "p": math.nan}
     mean, sd = shares.mean(), shares.std(ddof=1)
     half = sps.t.ppf(0.975, n_people - 1) * sd / math.sqrt(n_people)

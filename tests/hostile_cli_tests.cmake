@@ -396,3 +396,61 @@ hostile_test(cli_hostile_synth_pictures_distances_one_name 2 "distances 1 and 1.
 # A display no participant has (render wrote a 1 x 1 image): the display profile's width range.
 hostile_test(cli_hostile_render_display_width_1 2 "--display-width: must be 0 (the photo's own width) or a display's width, 320 to 16384 px"
              render --background ${D}/small.png --object picture --display-width 1 --out ${H}/tiny.png)
+# names: every name on the command line is checked (the charter: a name the code would ignore is an error with a
+# did-you-mean). An unknown option said only "The following arguments were not expected: sharpen --post-filtr", and
+# a slip of a required option's name ("--boadr") only that the option was missing, or that its value was no file.
+hostile_test(cli_names_unknown_option 2 "synth-scene: unknown option --post-filtr (did you mean --post-filter?)"
+             synth-scene --out ${H}/names-scene --post-filtr sharpen)
+hostile_test(cli_names_unknown_flag 2 "calibrate: unknown option --no-phase-chek (did you mean --no-phase-check?)"
+             calibrate ${D}/small.png --camera ${D}/thesis-camera.json --no-phase-chek)
+hostile_test(cli_names_unknown_option_before_required 2 "calibrate: unknown option --boadr (did you mean --board?)"
+             calibrate --boadr 10x7 ${D}/small.png)
+hostile_test(cli_names_unknown_option_with_value 2 "render: unknown option --backgrund (did you mean --background?)"
+             render --calib ${D}/thesis-camera.json --backgrund=${D}/small.png --out ${H}/x.png)
+hostile_test(cli_names_unknown_option_far 2
+             "synth-scene: unknown option --frobnicate; 'blurcue synth-scene --help' lists the options"
+             synth-scene --out ${H}/names-scene --frobnicate)
+# A value that looks like an option is the option's value, as CLI11 reads it: the slip after it is still found.
+hostile_test(cli_names_unknown_after_negative_value 2 "synth-take: unknown option --to-lateral (did you mean --to-lateral-mm?)"
+             synth-take --out ${H}/names-take --from-lateral-mm -15 --to-lateral 15)
+hostile_test(cli_names_unknown_subcommand 2 "bench: unknown command 'rendr' (did you mean render?)" bench rendr)
+# Word options (every command's, declared through cli::OneOf): the value's nearest allowed word, a case slip first.
+hostile_test(cli_names_enum_value 2 "--psf: must be one of disc, gaussian, got 'disk' (did you mean disc?)"
+             synth-scene --out ${H}/names-scene --psf disk)
+hostile_test(cli_names_enum_case 2 "--preset: must be one of quarter, thesis, got 'Quarter' (did you mean quarter?)"
+             synth-scene --out ${H}/names-scene --preset Quarter)
+hostile_test(cli_names_enum_far 2 "--backend: must be one of gl, cpu, got 'vulkan'"
+             blur ${D}/small.png --radius-px 2 --backend vulkan --out ${H}/x.png)
+# camera.json: a misspelt key is named with its did-you-mean ("/f_number: is required but missing" named neither).
+file(WRITE ${H}/camera-misspelt.json
+     "{\"focal_length_mm\": 21, \"f_numbr\": 5.6, ${CAMERA_REST}, \"image_width_px\": 1148}")
+hostile_test(cli_names_camera_key 3 "camera-misspelt.json: /f_numbr: is not a camera field (did you mean f_number?)"
+             estimate --camera ${H}/camera-misspelt.json ${ESTIMATE_ARGS})
+# init --photo of a PNG (no EXIF) said to give --focal-length-mm, --f-number and --sensor-mm, which init does not take.
+hostile_test(cli_names_init_photo_without_exif 3
+             "(EXIF is read from JPEG files); give init --camera FILE, a camera.json made by 'blurcue camera"
+             init ${H}/names-study --photo ${D}/small.png)
+# calibrate --board 10x7 on a 7x10 board: found all the same (the grid turned a quarter), exit 0 and all 8 edges at
+# one depth (440.8 mm). Refused, naming the other reading; --board-turned takes it (turned_pose_85).
+hostile_test(cli_names_board_transposed 2
+             "scene.png: board 10x7 found with its edges running into depth (90.0 deg from across the view: its 8 edges within 0.0 mm of one depth"
+             calibrate ${T}/scene/scene.png --camera ${T}/scene/camera.json --board 10x7 --out ${H}/names-calib.json)
+set_tests_properties(cli_names_board_transposed PROPERTIES FIXTURES_REQUIRED scene)
+# calibrate --truth of another scene printed its pose as the calibration's error (221 mm / 89 deg): refused, before
+# anything is written - another camera or board at once, another pose after detection.
+add_test(NAME cli_names_other_scene COMMAND ${BC} synth-scene --out ${H}/names-other --seed 3 --yaw-deg 25 --quiet)
+set_tests_properties(cli_names_other_scene PROPERTIES FIXTURES_SETUP names_other)
+hostile_test(cli_names_truth_other_pose 3 "its pose puts the board's corners"
+             calibrate ${T}/scene/scene.png --camera ${T}/scene/camera.json --truth ${H}/names-other/truth.json
+             --out ${H}/names-calib.json)
+set_tests_properties(cli_names_truth_other_pose PROPERTIES FIXTURES_REQUIRED "scene;names_other")
+add_test(NAME cli_names_small_scene COMMAND ${BC} synth-scene --out ${H}/names-small --seed 3 --width 600 --quiet)
+set_tests_properties(cli_names_small_scene PROPERTIES FIXTURES_SETUP names_small)
+hostile_test(cli_names_truth_other_camera 3 "names-small/truth.json: /camera/image_width_px is 600, "
+             calibrate ${T}/scene/scene.png --camera ${T}/scene/camera.json --truth ${H}/names-small/truth.json
+             --out ${H}/names-calib.json)
+set_tests_properties(cli_names_truth_other_camera PROPERTIES FIXTURES_REQUIRED "scene;names_small")
+hostile_test(cli_names_truth_other_board 3 "/board is 7x10 of 25 mm, not the --board 10x7 of 25 mm given: the truth of another scene"
+             calibrate ${T}/scene/scene.png --camera ${T}/scene/camera.json --board 10x7 --truth ${T}/scene/truth.json
+             --out ${H}/names-calib.json)
+set_tests_properties(cli_names_truth_other_board PROPERTIES FIXTURES_REQUIRED scene)

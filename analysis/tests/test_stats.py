@@ -624,6 +624,14 @@ class PerPatternUnitTest(TempDirCase):
         self.assertAlmostEqual(r["p"], 2 / 64, places=12)
         self.assertEqual(r["test"], "exact binomial, one participant's answers")
 
+    def test_one_participant_of_several_in_a_cell_is_said_in_the_singular(self):
+        # Three in the analysis, one with answers in this cell: "1 participant is too few", not "1 participants are".
+        r = study_tests.against_chance_counts([4], [5], 0.5, people=3)
+        self.assertTrue(math.isnan(r["p"]))
+        self.assertTrue(r["test"].startswith("none: 1 participant is too few for a test across participants"), r)
+        r = study_tests.against_chance_counts([4, 1], [5, 5], 0.5, people=3)
+        self.assertTrue(r["test"].startswith("none: 2 participants are too few"), r)
+
     def test_a_participants_single_decisive_answer_has_no_side_bias_p(self):
         rows = fc_rows("test1-static-grids", "P1", ["left"] * 8 + ["right"] * 2) + \
             fc_rows("test1-static-grids", "P2", ["left", "cant_tell"], swapped=1)

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -55,7 +58,40 @@ double SolvePose(const std::vector<cv::Point2f>& corners, const Board& board, co
   return std::sqrt(sum / corners.size());
 }
 
+// A board whose edges run into depth: its corners are the grid of a board of the size given, but turned a quarter -
+// a 7x10 board read as 10x7 is found all the same (OpenCV's pattern of 9x6 inner corners matches the 6x9 grid turned),
+// and then every edge lies at one depth and the calibration charts nothing against depth. No picture tells a 7x10
+// board turned 90 deg from a 10x7 one lying straight, so the refusal names both readings.
+void RefuseEdgesIntoDepth(const BoardPose& pose, const Board& board, double within_deg) {
+  const double turn = EdgeTurnFromAcrossDeg(pose);
+  if (!(turn > 90 - within_deg)) return;  // NaN (facing the camera) passes
+  const double s = board.square_mm, mid_x = 0.5 * board.cols * s, mid_y = 0.5 * board.rows * s;
+  const double across = std::abs(ToCamera(pose, {mid_x, board.rows * s, 0})[2] - ToCamera(pose, {mid_x, 0, 0})[2]);
+  const double along = std::abs(ToCamera(pose, {board.cols * s, mid_y, 0})[2] - ToCamera(pose, {0, mid_y, 0})[2]);
+  const std::string turned = std::to_string(board.rows) + "x" + std::to_string(board.cols);
+  auto mm = [](double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f", v);
+    return std::string(text);
+  };
+  throw Error(ErrorKind::kUsage,
+              "board " + board.Name() + " found with its edges running into depth (" + mm(turn) +
+                  " deg from across the view: its " + std::to_string(board.EdgeCount()) + " edges within " +
+                  mm(across) + " mm of one depth, each spanning " + mm(along) +
+                  " mm): a " + turned + " board read a quarter turned? give --board " + turned +
+                  " (or --board-turned for a board lying that far turned on purpose)");
+}
+
 }  // namespace
+
+double EdgeTurnFromAcrossDeg(const BoardPose& pose) {
+  cv::Matx33d rotation;
+  cv::Rodrigues(pose.rvec, rotation);
+  // Camera depth z of a board point (x, y, 0) changes by R20 per mm along x (an edge) and R21 per mm along y.
+  const double along = std::abs(rotation(2, 0)), across = std::abs(rotation(2, 1));
+  if (std::hypot(along, across) < std::sin(5 * M_PI / 180)) return std::numeric_limits<double>::quiet_NaN();
+  return std::atan2(along, across) * 180 / M_PI;
+}
 
 void RefineCorners(const cv::Mat& grey8, const Board& board, std::vector<cv::Point2f>& corners) {
   const int nx = board.InnerCornersX(), ny = board.InnerCornersY();
@@ -140,6 +176,7 @@ BoardPose FindBoardPose(const cv::Mat& grey8, const Camera& camera, const Board&
   if (z_last < z_first) flip_x = !flip_x, flip_y = !flip_y;
   pose.corners = ordered(flip_x, flip_y);
   pose.reprojection_error_px = SolvePose(pose.corners, board, camera, pose.rvec, pose.tvec);
+  if (options.refuse_edges_into_depth_deg > 0) RefuseEdgesIntoDepth(pose, board, options.refuse_edges_into_depth_deg);
   return pose;
 }
 

@@ -303,7 +303,7 @@ void AddAnimateCommand(CLI::App& app) {
   cmd->add_option("--right", args->right, "blur source of the right ball")->capture_default_str();
   cmd->add_option("--texture", args->texture, "soccer, wood or an equirectangular image")->capture_default_str();
   cmd->add_option("--method", args->method, "gaussian or disc")->capture_default_str()
-      ->check(CLI::IsMember({"gaussian", "disc"}));
+      ->check(OneOf({"gaussian", "disc"}));
   cmd->add_option("--gain", args->gain, "multiplies both radii")->capture_default_str()->check(FiniteRange(0, 100, ""));
   cmd->add_option("--speed-cm-s", args->speed_cm_s, "rolling speed (the thesis: 3 and 1.8)")->capture_default_str()
       ->check(FiniteRange(0.1, 1000, "cm/s"));

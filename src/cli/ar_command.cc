@@ -305,7 +305,7 @@ void AddArCommand(CLI::App& app) {
                   "estimated, none, or a radius in px")
       ->capture_default_str();
   cmd->add_option("--method", args->method, "the defocus's shape: disc (a thin lens's pillbox) or gaussian")
-      ->capture_default_str()->check(CLI::IsMember({"disc", "gaussian"}));
+      ->capture_default_str()->check(OneOf({"disc", "gaussian"}));
   cmd->add_option("--exposure-ms", args->exposure_ms,
                   "the camera's exposure; objects are streaked by their image velocity over it (0: no motion blur).\n"
                   "Default: the camera's exposure_ms (camera.json, as tracked: EXIF ExposureTime from `blurcue\n"

@@ -29,13 +29,13 @@ void AddBlurCommand(CLI::App& app) {
   cmd->add_option("in", args->in, "input image (PNG/JPEG, sRGB, alpha kept)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "output image")->required();
   cmd->add_option("--method", args->method, "gaussian, disc or butterworth")
-      ->check(CLI::IsMember({"gaussian", "disc", "butterworth"}))->capture_default_str();
+      ->check(OneOf({"gaussian", "disc", "butterworth"}))->capture_default_str();
   cmd->add_option("--radius-px", args->radius_px, "blur radius r in px (2 x std of the line-spread function)")
       ->check(FiniteRange(0, render::kMaxBlurRadiusPx, "px"));
   cmd->add_option("--cutoff", args->cutoff, "Butterworth cut-off, cycles per image width")
       ->check(FinitePositive(render::kMaxCutoffCyclesPerWidth, "cycles per image width"));
   cmd->add_option("--backend", args->backend, "gl (Mesa/GPU through EGL, no display needed) or cpu (OpenCV)")
-      ->check(CLI::IsMember({"gl", "cpu"}))->capture_default_str();
+      ->check(OneOf({"gl", "cpu"}))->capture_default_str();
   cmd->callback([args, cmd] {
     OutputGuard().Input("IN", args->in).OutputFile("--out", args->out).Check();
     RequireImageName("--out", args->out);

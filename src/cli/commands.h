@@ -1,6 +1,7 @@
 #pragma once
 // The subcommands of `blurcue`. Each Add* registers one CLI11 subcommand whose callback does the work and throws
 // blurcue::Error on failure; main() turns that into one line on stderr and the error's exit code.
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -8,9 +9,11 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
+#include "core/names.h"
 #include "core/typed.h"
 
 namespace blurcue::cli {
@@ -80,6 +83,23 @@ inline CLI::Validator SeedValidator() {
         return digits ? "" : "must be a whole number from 0 to 18446744073709551615, got " + Echo(text);
       },
       "SEED");
+}
+
+// A word option's allowed values, for every command's enum options (--psf, --preset, --method, ...): CLI::IsMember
+// with a did-you-mean, "--psf: must be one of disc, gaussian, got 'disk' (did you mean disc?)". Its help text is
+// IsMember's ("{disc,gaussian}"), so the commands' --help reads as before.
+inline CLI::Validator OneOf(const std::vector<std::string>& words) {
+  std::string set, list;
+  for (size_t i = 0; i < words.size(); ++i) {
+    set += (i == 0 ? "" : ",") + words[i];
+    list += (i == 0 ? "" : ", ") + words[i];
+  }
+  return CLI::Validator(
+      [words, list](std::string& text) -> std::string {
+        if (std::find(words.begin(), words.end(), text) != words.end()) return "";
+        return "must be one of " + list + ", got " + Echo(text) + DidYouMean(text, words);
+      },
+      "{" + set + "}");
 }
 
 void AddEstimateCommand(CLI::App& app);     // estimate_command.cc

@@ -13,6 +13,7 @@
 #include "cli/child.h"
 #include "cli/commands.h"
 #include "core/atomic_file.h"
+#include "core/camera_exif.h"
 #include "core/data_dir.h"
 #include "core/error.h"
 #include "core/image.h"
@@ -258,6 +259,18 @@ void AddInitCommand(CLI::App& app) {
           ReadImage(image);
         } catch (const Error& e) {
           throw Error(ErrorKind::kInput, option + " " + OneLine(image) + ": not a readable image (" + e.what() + ")");
+        }
+      }
+      // Without --camera, its camera.json comes from the photo's EXIF (blurcue camera): where that lacks a number,
+      // say so now, and point to what init takes - the numbers' own options are camera's, not init's.
+      if (!args->photo.empty() && args->camera.empty()) {
+        try {
+          CameraFromExif(args->photo);
+        } catch (const Error& e) {
+          const std::string what = e.what();
+          throw Error(e.kind(), "--photo " + what.substr(0, what.find("; give ")) + "; give init --camera FILE, a "
+                                "camera.json made by 'blurcue camera " + OneLine(args->photo) + " --focal-length-mm "
+                                "F --f-number N --sensor-mm W H --out FILE' (those options are camera's)");
         }
       }
     }

@@ -449,7 +449,7 @@ void AddLiveCommand(CLI::App& app) {
                   "(measured sources need sections measured in every frame, which live does not do)")
       ->capture_default_str();
   cmd->add_option("--method", a->method, "the defocus's shape: disc (a thin lens's pillbox) or gaussian")
-      ->capture_default_str()->check(CLI::IsMember({"disc", "gaussian"}));
+      ->capture_default_str()->check(OneOf({"disc", "gaussian"}));
   cmd->add_option("--exposure-ms", a->exposure_ms,
                   "the camera's exposure; objects are streaked by their image velocity over it (0: no motion blur).\n"
                   "Default: camera.json's exposure_ms; when unknown, half the frame interval of the pace")

@@ -1,5 +1,6 @@
 // blurcue: measure the defocus blur of a real scene, predict it anywhere, render and run depth-cue studies.
 #include <algorithm>
+#include <cctype>
 #include <iostream>
 #include <string>
 #include <utility>
@@ -10,6 +11,61 @@
 
 #include "cli/commands.h"
 #include "core/error.h"
+#include "core/names.h"
+#include "core/typed.h"
+
+namespace {
+
+// After a failed parse: the first name on the command line that its command does not know - an option, or a
+// subcommand of bench or display - with the nearest known one ("synth-scene: unknown option --post-filtr (did you
+// mean --post-filter?)"); "" when every name is known and the parse failed for another reason (CLI11's message
+// says which). CLI11 alone said "The following arguments were not expected: sharpen --post-filtr", or, where the
+// slip left a required option out, only that. Read as CLI11 reads: an option's values are the words after it (its
+// least count of them, none for a flag), "--" ends the options, "-5" is a number.
+std::string UnknownName(CLI::App& app, int argc, char** argv) {
+  CLI::App* at = &app;
+  std::string command;  // "synth-scene", "bench blur"
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--") break;
+    const bool is_long = arg.size() > 2 && arg.compare(0, 2, "--") == 0;
+    const bool is_short =
+        !is_long && arg.size() > 1 && arg[0] == '-' && std::isalpha(static_cast<unsigned char>(arg[1]));
+    if (!is_long && !is_short) {
+      std::vector<std::string> subcommands;
+      for (CLI::App* sub : at->get_subcommands({}))
+        if (!sub->get_name().empty()) subcommands.push_back(sub->get_name());  // not an option group
+      if (const auto it = std::find(subcommands.begin(), subcommands.end(), arg); it != subcommands.end()) {
+        at = at->get_subcommand(arg);
+        command += (command.empty() ? "" : " ") + arg;
+      } else if (!subcommands.empty() && at != &app &&
+                 at->get_options([](const CLI::Option* o) { return o->get_positional(); }).empty()) {
+        const std::string hint = blurcue::DidYouMean(arg, subcommands);
+        return command + ": unknown command " + blurcue::Echo(arg) +
+               (hint.empty() ? "; 'blurcue " + command + " --help' lists them" : hint);
+      }
+      continue;
+    }
+    const std::string name = is_long ? arg.substr(0, arg.find('=')) : arg.substr(0, 2);
+    if (const CLI::Option* option = at->get_option_no_throw(name)) {
+      const bool inline_value = is_long ? arg.find('=') != std::string::npos : arg.size() > 2;
+      i += std::max(0, option->get_expected_min() - (inline_value ? 1 : 0));
+      continue;
+    }
+    std::vector<std::string> known;
+    for (const CLI::Option* o : at->get_options()) {
+      for (const std::string& l : o->get_lnames()) known.push_back("--" + l);
+      for (const std::string& s : o->get_snames()) known.push_back("-" + s);
+    }
+    const std::string hint = blurcue::DidYouMean(name, known);
+    const std::string who = command.empty() ? "blurcue" : "blurcue " + command;
+    return (command.empty() ? "" : command + ": ") + "unknown option " + blurcue::Echo(name, false) +
+           (hint.empty() ? "; '" + who + " --help' lists the options" : hint);
+  }
+  return "";
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace blurcue;
@@ -96,8 +152,10 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
-    // One line like every other error (CLI11's own printer adds "Run with --help for more information.").
-    std::cerr << "blurcue: " << OneLine(e.what()) << "\n";
+    // One line like every other error (CLI11's own printer adds "Run with --help for more information."); a name
+    // the command does not know is said first, with the nearest it does.
+    const std::string unknown = UnknownName(app, argc, argv);
+    std::cerr << "blurcue: " << OneLine(unknown.empty() ? std::string(e.what()) : unknown) << "\n";
     return static_cast<int>(ErrorKind::kUsage);
   } catch (const Error& e) {
     // Each problem on its own line (a protocol's every problem at once), each line escaped.

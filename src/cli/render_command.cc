@@ -208,13 +208,13 @@ void AddRenderCommand(CLI::App& app) {
   cmd->add_option("--blur", args->blur, "blur source")->capture_default_str();
   cmd->add_option("--gain", args->gain, "multiplies the radius")->capture_default_str()->check(FiniteRange(0, 100, ""));
   cmd->add_option("--method", args->method, "gaussian or disc")->capture_default_str()
-      ->check(CLI::IsMember({"gaussian", "disc"}));
+      ->check(OneOf({"gaussian", "disc"}));
   cmd->add_option("--brightness", args->brightness, "multiplies the object's linear colour")->capture_default_str()
       ->check(FiniteRange(0, 100, ""));
   cmd->add_option("--contrast", args->contrast, "scales the object's texture around mid grey")->capture_default_str()
       ->check(FiniteRange(0, 100, ""));
   cmd->add_option("--backend", args->backend, "blur on gl or cpu")->capture_default_str()
-      ->check(CLI::IsMember({"gl", "cpu"}));
+      ->check(OneOf({"gl", "cpu"}));
   cmd->add_option("--display-width", args->display_width,
                   "scale the output to this width (0 = full resolution; else a display's width, " +
                       std::to_string(display::kMinWidthPx) + " to " + std::to_string(display::kMaxWidthPx) + " px)")

@@ -108,7 +108,7 @@ void AddSceneOptions(CLI::App* cmd, SynthSceneArgs* a) {
       ->transform(SeedValidator());
   cmd->add_option("--preset", a->preset,
                   "quarter: thesis set-up at 1148 x 764 (default); thesis: full 4592 x 3056 (supersample 2)")
-      ->check(CLI::IsMember({"quarter", "thesis"}))->capture_default_str();
+      ->check(OneOf({"quarter", "thesis"}))->capture_default_str();
   cmd->add_option("--camera", a->camera, "camera.json to shoot with instead of the preset's camera")
       ->check(CLI::ExistingFile);
   cmd->add_option("--width", a->width, "image width in px (the sensor is resampled; height follows the aspect)")
@@ -128,7 +128,7 @@ void AddSceneOptions(CLI::App* cmd, SynthSceneArgs* a) {
       ->capture_default_str()->check(FiniteRange(-89.9, 89.9, "degrees"));
   cmd->add_option("--focus-mm", a->focus, "focus distance in mm, or 'inf' (default: edge 1's midpoint)");
   cmd->add_option("--psf", a->psf, "point-spread function: disc (thin lens) or gaussian")
-      ->check(CLI::IsMember({"disc", "gaussian"}))->capture_default_str();
+      ->check(OneOf({"disc", "gaussian"}))->capture_default_str();
   cmd->add_option("--fixed-r-px", a->fixed_r_px, "one blur radius everywhere instead of the thin lens's, px")
       ->check(FiniteRange(0, optics::kMaxBlurRadiusPx, "px"));
   cmd->add_option("--blur-gain", a->o.blur_gain, "multiplies every thin-lens radius (a lens blurrier than ideal)")
@@ -140,7 +140,7 @@ void AddSceneOptions(CLI::App* cmd, SynthSceneArgs* a) {
                   "a filter on the sampled image, after the noise, as demosaicing or sharpening do: none, gaussian\n"
                   "(taps of a Gaussian of std --post-sigma-px at whole pixels) or sharpen (unsharp mask: 1 + amount\n"
                   "times the image less amount times that Gaussian); truth adds the taps' second moment")
-      ->check(CLI::IsMember({"none", "gaussian", "sharpen"}))->capture_default_str();
+      ->check(OneOf({"none", "gaussian", "sharpen"}))->capture_default_str();
   a->post_sigma = cmd->add_option("--post-sigma-px", a->o.post_filter.sigma_px,
                                   "std of the post filter's Gaussian, px (0, 5]")
       ->check(FiniteRange(0, 5, "px"));

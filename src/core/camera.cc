@@ -142,16 +142,12 @@ void Camera::Validate(const std::string& where) const {
 
 Camera CameraFromJson(const Json& json, const std::string& where) {
   Camera c;
-  c.focal_length_mm = RequireNumber(json, "focal_length_mm", where);
-  c.f_number = RequireNumber(json, "f_number", where);
-  c.sensor_width_mm = RequireNumber(json, "sensor_width_mm", where);
-  c.sensor_height_mm = RequireNumber(json, "sensor_height_mm", where);
-  c.image_width_px = ImageSidePx(json, "image_width_px", where);
-  c.image_height_px = ImageSidePx(json, "image_height_px", where);
+  // An unknown key first: a misspelt f_number ("f_numbr") is named with its did-you-mean, not reported as the
+  // required f_number missing.
   static const char* kKnown[] = {"focal_length_mm", "f_number", "sensor_width_mm", "sensor_height_mm",
                                  "image_width_px", "image_height_px", "camera_matrix", "dist_coeffs", "exposure_ms",
                                  "name"};
-  for (auto it = json.begin(); it != json.end(); ++it) {
+  for (auto it = json.begin(); json.is_object() && it != json.end(); ++it) {
     bool known = false;
     for (const char* k : kKnown) known = known || it.key() == k;
     if (!known)
@@ -159,6 +155,12 @@ Camera CameraFromJson(const Json& json, const std::string& where) {
                        "is not a camera field" + DidYouMean(it.key(), std::vector<std::string>(std::begin(kKnown),
                                                                                               std::end(kKnown))));
   }
+  c.focal_length_mm = RequireNumber(json, "focal_length_mm", where);
+  c.f_number = RequireNumber(json, "f_number", where);
+  c.sensor_width_mm = RequireNumber(json, "sensor_width_mm", where);
+  c.sensor_height_mm = RequireNumber(json, "sensor_height_mm", where);
+  c.image_width_px = ImageSidePx(json, "image_width_px", where);
+  c.image_height_px = ImageSidePx(json, "image_height_px", where);
   if (json.contains("camera_matrix")) {
     const Json& m = json["camera_matrix"];
     std::array<double, 9> k{};

@@ -435,10 +435,11 @@ void AddExactRows(PlanResult& r, const Condition& c, const PlanOptions& options,
       trials += n[size_t(s)];
       if (c.chance < 0 || n[size_t(s)] == 0) continue;
       // The report's test (analysis/study_tests.py against_chance_counts): one participant - the exact binomial of
-      // their answers; two - none; three or more with a share - at chance 0.5 the exact sign-flip test of their
-      // shares around it, else the exact binomial of the answers pooled (every participant guessing).
+      // their answers, none for a single answer (OneParticipantTestP: its NaN is never below alpha); two - none;
+      // three or more with a share - at chance 0.5 the exact sign-flip test of their shares around it, else the
+      // exact binomial of the answers pooled (every participant guessing).
       if (m == 1) {
-        rejected += p_of(k[size_t(s)], n[size_t(s)], c.chance) < options.alpha;
+        rejected += OneParticipantTestP(k[size_t(s)], n[size_t(s)], c.chance) < options.alpha;
         continue;
       }
       const Deviations& e = dev[size_t(s)];
@@ -596,7 +597,8 @@ std::string Summary(const PlanResult& r, const PlanOptions& o) {
                   "decisive answers; correct; yes), the mean width of its 95 %% Wilson interval, the power of the report's "
                   "exact test against chance (alpha %g; participants as the unit: at chance 0.5 the sign-flip test of "
                   "their shares, which needs 6 of them to reach 0.05; else the binomial of the answers; one "
-                  "participant: the binomial of their answers; two: none) and the smallest N reaching %g %%\n",
+                  "participant: the binomial of their answers, none for one answer; two: none) and the smallest N "
+                  "reaching %g %%\n",
                   o.participants, o.alpha, 100 * o.target_power);
     out += line;
     std::snprintf(line, sizeof line, "  %-28s %-13s %7s %8s %8s %7s  %s\n", "condition", "measure", "share", "width",

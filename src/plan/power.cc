@@ -27,6 +27,10 @@ double BinomialTestP(int k, int n, double p) {
   return std::min(1.0, total);
 }
 
+double OneParticipantTestP(int k, int n, double chance) {
+  return n < 2 ? std::numeric_limits<double>::quiet_NaN() : BinomialTestP(k, n, chance);
+}
+
 std::vector<double> BinomialTestPAll(int n, double p) {
   if (n <= 0) return {1.0};
   std::vector<double> pmf(size_t(n) + 1);

@@ -20,6 +20,12 @@ double BinomialTestP(int k, int n, double p);
 // --participants x trials, which one BinomialTestP (O(n)) per k made O(n^3) - minutes to hours past 3000 participants.
 std::vector<double> BinomialTestPAll(int n, double p);
 
+// The report's test of one participant's k of n answers against chance (analysis/study_tests.py
+// one_participant_test): the exact binomial p (BinomialTestP); NaN - no test - for n < 2: a single answer is one way
+// or the other and guessing gives either often (at a chance level below alpha, one answer right would otherwise count
+// as a rejection the report never makes). tests/one_participant_golden.py holds the two equal on a grid of cases.
+double OneParticipantTestP(int k, int n, double chance);
+
 // Wilson score interval (95 %) of k of n: (low, high); (0, 1) when n == 0.
 std::pair<double, double> Wilson95(int k, int n);
 

@@ -1,7 +1,12 @@
 // The plan's statistics against closed forms worked by hand (the arithmetic in the comments).
 #include "plan/power.h"
 
+#include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -108,6 +113,44 @@ TEST(SignFlipP, HandWorkedCases) {
   std::vector<double> many(60, 0.1);
   many.resize(100, -0.1);
   EXPECT_NEAR(SignFlipP(many), 0.05689, 0.001);
+}
+
+// A single answer is no test, whatever the chance level: at chance 0.04 one right answer has the binomial p = 0.04,
+// which plan counted as a rejection at alpha 0.05 where the report says "none: one answer cannot test anything" (no
+// protocol reaches such a chance level today: an odd one out has at most 6 alternatives).
+TEST(OneParticipantTest, ASingleAnswerIsNoTest) {
+  EXPECT_NEAR(BinomialTestP(1, 1, 0.04), 0.04, 1e-12);
+  EXPECT_TRUE(std::isnan(OneParticipantTestP(1, 1, 0.04)));
+  EXPECT_FALSE(OneParticipantTestP(1, 1, 0.04) < 0.05);
+  // Two answers both right at 1/25: 0.04^2 = 0.0016, a test.
+  EXPECT_NEAR(OneParticipantTestP(2, 2, 0.04), 0.0016, 1e-12);
+}
+
+// The golden table (tests/one_participant_golden.py writes it from the report's one_participant_test): tested or
+// not, and p to 1e-9 relative, for every k of 1-12, 20 and 40 answers at chance 0.5, 1/3, 0.25, 0.1, 0.04, 0.01.
+TEST(OneParticipantTest, MatchesTheReportOnTheGoldenTable) {
+  std::ifstream file(BLURCUE_ONE_PARTICIPANT_GOLDEN);
+  ASSERT_TRUE(file) << BLURCUE_ONE_PARTICIPANT_GOLDEN;
+  std::string line;
+  std::getline(file, line);
+  int rows = 0, untested = 0;
+  while (std::getline(file, line)) {
+    std::vector<std::string> f;
+    std::stringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) f.push_back(cell);
+    ASSERT_EQ(f.size(), 5u) << line;
+    const double p = OneParticipantTestP(std::stoi(f[0]), std::stoi(f[1]), std::stod(f[2]));
+    if (f[3] == "0") {
+      EXPECT_TRUE(std::isnan(p)) << line << ": plan gives p " << p;
+      ++untested;
+    } else {
+      const double want = std::stod(f[4]);
+      EXPECT_NEAR(p, want, 1e-9 * std::max(1.0, want)) << line;
+    }
+    ++rows;
+  }
+  EXPECT_EQ(rows, 912);
+  EXPECT_EQ(untested, 12);  // k = 0 and 1 of one answer at each of the six chance levels
 }
 
 }  // namespace
