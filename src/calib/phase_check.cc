@@ -9,6 +9,7 @@
 #include "calib/calibrate.h"
 #include "calib/edge_esf.h"
 #include "calib/edge_window.h"
+#include "calib/phase_fit.h"
 #include "core/error.h"
 
 namespace blurcue::calib {
@@ -268,13 +269,15 @@ PhaseReading ReadFamily(const std::vector<Bin>& bins, const PhaseFamily& family,
 }  // namespace
 
 std::string PhaseFamily::Name() const {
-  char text[120];
+  char text[160];
   if (!(sigma_px > 0)) return "the optics alone";
+  const char* between = fitted ? ", fitted between the families" : "";
   if (sharpen > 0)
-    std::snprintf(text, sizeof text, "the optics then sharpening (unsharp mask of amount %.2f, std %.2f px)", sharpen,
-                  sigma_px);
+    std::snprintf(text, sizeof text, "the optics then sharpening (unsharp mask of amount %.2f, std %.2f px%s)", sharpen,
+                  sigma_px, between);
   else
-    std::snprintf(text, sizeof text, "the optics then a Gaussian of std %.2f px on the sampled image", sigma_px);
+    std::snprintf(text, sizeof text, "the optics then a Gaussian of std %.2f px on the sampled image%s", sigma_px,
+                  between);
   return text;
 }
 
@@ -284,7 +287,8 @@ const std::vector<PhaseFamily>& PhaseFamilies() {
   // mild to strong, over a narrow and a wide Gaussian.
   static const std::vector<PhaseFamily> families = {
       {0, 0},      {0.35, 0},   {0.4, 0},   {0.45, 0},  {0.5, 0},   {0.55, 0},  {0.6, 0}, {0.7, 0}, {0.8, 0},
-      {0.6, 0.15}, {0.6, 0.3},  {0.6, 0.5}, {0.6, 0.7}, {1.0, 0.15}, {1.0, 0.3}, {1.0, 0.5}, {1.0, 0.7}};
+      {0.6, 0.15}, {0.6, 0.3},  {0.6, 0.5}, {0.6, 0.7}, {0.8, 0.15}, {0.8, 0.3}, {0.8, 0.5}, {0.8, 0.7},
+      {1.0, 0.15}, {1.0, 0.3}, {1.0, 0.5}, {1.0, 0.7}};
   return families;
 }
 
@@ -403,8 +407,36 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
   // best (twice ChoosePhaseFamily's "alike" margins) are not read on the others. The rest of the choice is
   // ChoosePhaseFamily's over all of them, as before; the profiles' misfit of a ruled-out family only grows with more
   // sections, so it would not have been alike. On physical optics this reads 1-3 families on most sections, not 15.
+  result.phase.families = PhaseFamilies();
+  // Where the family that fits the sections `deciders` best is a filter, the filter between the families that fits
+  // them best (RefinePhaseFamily: about 30 readings of each), read on every limited section as one family more.
+  auto fit_between = [&](const std::vector<size_t>& deciders) {
+    const size_t nf = PhaseFamilies().size();
+    std::vector<double> total(nf, 0.0);
+    for (const size_t k : deciders)
+      for (size_t c = 0; c < nf; ++c) total[c] += usable[k]->phase.families[c].chi2;
+    const size_t best = std::min_element(total.begin(), total.end()) - total.begin();
+    if (best == 0) return;
+    std::vector<double> chi2(deciders.size());
+    const PhaseFamily fitted = RefinePhaseFamily(PhaseFamilies()[best], [&](const PhaseFamily& family) {
+      each(deciders.size(), [&](size_t i) {
+        const PhaseProfile& p = profiles[deciders[i]];
+        chi2[i] = ReadFamily(p.bins, family, p.r_fit, p.phi, p.w1, p.w2, p.shift, usable[deciders[i]]->phase.noise).chi2;
+      });
+      double sum = 0;
+      for (const double v : chi2) sum += v;
+      return sum;
+    });
+    result.phase.families.push_back(fitted);
+    each(limited.size(), [&](size_t i) {
+      const PhaseProfile& p = profiles[limited[i]];
+      PhaseCheck& check = usable[limited[i]]->phase;
+      check.families.push_back(ReadFamily(p.bins, fitted, p.r_fit, p.phi, p.w1, p.w2, p.shift, check.noise));
+    });
+  };
   if (limited.size() <= 2 * kChoiceSections) {
     each(limited.size(), [&](size_t i) { ReadFamilies(profiles[limited[i]], {}, &usable[limited[i]]->phase); });
+    fit_between(limited);
     return;
   }
   std::vector<size_t> by_phase = limited;
@@ -434,6 +466,7 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
   for (const size_t k : limited)
     if (!first[k]) rest.push_back(k);
   each(rest.size(), [&](size_t i) { ReadFamilies(profiles[rest[i]], read, &usable[rest[i]]->phase); });
+  fit_between(chosen);
 }
 
 namespace {
@@ -478,7 +511,8 @@ std::string PhaseWhy(const SectionResult& s, double lo, double hi, double r, dou
 
 PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   PhaseChoice choice;
-  const std::vector<PhaseFamily>& families = PhaseFamilies();
+  const std::vector<PhaseFamily> families = result.phase.families.empty() ? PhaseFamilies() : result.phase.families;
+  choice.families = families;
   std::vector<SectionResult*> limited;
   int points = 0;
   for (auto& edge : result.edges)
@@ -498,18 +532,26 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   // section's few phases leave the families alike; the edges' different phases tell them apart.
   for (const SectionResult* s : limited)
     for (size_t c = 0; c < families.size(); ++c) choice.chi2[c] += s->phase.families[c].chi2;
-  const size_t best = std::min_element(choice.chi2.begin(), choice.chi2.end()) - choice.chi2.begin();
-  choice.chosen = best;
+  const size_t least = std::min_element(choice.chi2.begin(), choice.chi2.end()) - choice.chi2.begin();
   const int dof = std::max(1, points - 3 * choice.limited - 1);
-  choice.chi2_per_point = choice.chi2[best] / dof;
-  const double scale = std::max(1.0, choice.chi2_per_point);
+  const double scale = std::max(1.0, choice.chi2[least] / dof);
   // Beyond the noise, a model error grows every family's chi-square with the points: then families within kAlikeRel
   // of the best's fit alike too.
   for (size_t c = 0; c < families.size(); ++c)
-    choice.alike[c] = choice.chi2[c] - choice.chi2[best] <= std::max(kAlikeChi2 * scale, kAlikeRel * choice.chi2[best]);
+    choice.alike[c] = choice.chi2[c] - choice.chi2[least] <= std::max(kAlikeChi2 * scale, kAlikeRel * choice.chi2[least]);
+  // A filter fitted between the families is taken only where it fits better than every family beyond the noise: one
+  // that only fits the noise (a Gaussian of 0.34 px on physical optics under a JPEG) leaves the family it came from,
+  // or the optics alone, as the reading; the fitted one's readings still count in the alike spread.
+  size_t best = least;
+  if (families[least].fitted)
+    for (size_t c = 0; c < families.size(); ++c)
+      if (!families[c].fitted && choice.alike[c] && (families[best].fitted || choice.chi2[c] < choice.chi2[best])) best = c;
+  choice.chosen = best;
+  choice.chi2_per_point = choice.chi2[best] / dof;
   const double v_best = TapsVariance(FamilyTaps(families[best]));
   int cancelled = 0, jumped = 0;
-  const std::vector<size_t> neighbours = PhaseNeighbours(best);
+  // A filter fitted between the families has no neighbours along one axis that bracket its reading.
+  const std::vector<size_t> neighbours = best < PhaseFamilies().size() ? PhaseNeighbours(best) : std::vector<size_t>{};
   for (SectionResult* s : limited) {
     double lo = 1e18, hi = -1e18;
     for (size_t c = 0; c < families.size(); ++c)
