@@ -59,13 +59,17 @@ phase_scene(sharpen05 --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen 
 phase_check(phase_filtered_sharpen_05 sharpen05 "\nok: filtered targets met" --expect filtered)
 # Amount 0.7 (-0.246 px^2): near focus the mask cancels up to 97 % of the optics' second moment (truth 0.16 px from
 # optics of 1.0 px), where a 2 % error in the optics' reading moves the section's by 0.1 px: those sections are flagged
-# (35 of 77, edges 4-8; with the mask refined between the families it fits alike, 27 of them for the cancellation and
-# 8 for the spread) and every other one holds the rule. The lens model breaks here (median 2.4 %, p90 19 %: no thin
-# lens bends to sqrt(r^2 - 0.98)), so only the sections are held.
+# (35 of 77, edges 4-8) and every other one holds the rule. They join the lens fit at their readings (each unsure
+# alone, the fit pools them): left out, nothing near focus pinned the floor and the model read 0.19 px for 0.16 px
+# (median 2.4 %, p90 19.1 % here; 1.2-2.3 / 22-29 % on five other seeds). Now median 0.6-1.1 %, p90 1.8-8.1 % over
+# the six seeds (this one 0.9 / 3.9 %): the 5 % p90 holds on 4 of 6, so the model is held to 10 % here - the break,
+# docs/independent-truth.md. With the mask refined between the families (phase_fit.h), the refined one fits alike and
+# 8 of the 35 are flagged for the spread rather than the cancellation (27 join the fit): the model median 1.2 %, p90 1.4 %.
 phase_scene(sharpen07 --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.6 --post-amount 0.7
             --noise 0.0025 --seed 6)
-phase_check(phase_filtered_sharpen_07 sharpen07 "35 flagged phase_limited \\([0-9]+ where the sharpening cancels.*\nok: filtered targets met"
-            --expect filtered --sections-only)
+phase_check(phase_filtered_sharpen_07 sharpen07
+            "[23][0-9] of them phase_limited where the sharpening cancels.*\nok: filtered targets met" --expect filtered --fitted-p90 0.10)
+
 # The Gaussian post filter's ends (0.35 and 0.8 px, the bench's levels). At 0.35 px the optics alone fitted best and
 # 7 sections (edge 4) read 10-12 % high unflagged; now the 0.35 px family is chosen.
 phase_scene(gauss035 --focus-mm 430 --floor-sigma-px 0.2 --post-filter gaussian --post-sigma-px 0.35 --noise 0.0025
@@ -84,7 +88,7 @@ phase_check(phase_filtered_sharpen_off_grid sharpen_off_grid "\nok: filtered tar
 phase_scene(sharpen_09 --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.9
             --post-amount 0.25 --noise 0.0025 --seed 5)
 phase_check(phase_filtered_sharpen_09 sharpen_09 "fitted between the families.*\nok: filtered targets met"
-            --expect filtered --sections-only)
+            --expect filtered --fitted-p90 0.10)
 # Amount 0.5 over 0.8 px (-0.32 px^2): the mask cancels the whole second moment near focus (truth 0 on edges 4-8),
 # where 55-57 sections are flagged; 1-3 others read 0.07-0.1 px off unflagged before. The lens model breaks here
 # (no thin lens bends to that), so the sections alone are held.

@@ -70,7 +70,7 @@ std::vector<optics::BlurSample> ModelSamples(const CalibResult& result) {
   std::vector<optics::BlurSample> samples;
   for (const auto& edge : result.edges)
     for (const auto& s : edge.sections)
-      if (s.fit.ok) samples.push_back({s.u_mm, s.fit.r_px / s.stretch, 1.0});
+      if (s.fit.ok || s.phase.joins_fit) samples.push_back({s.u_mm, s.fit.r_px / s.stretch, 1.0});
   return samples;
 }
 
@@ -80,7 +80,7 @@ std::map<std::string, int> SectionsLeftOut(const CalibResult& result) {
   std::map<std::string, int> out;
   for (const auto& edge : result.edges)
     for (const auto& s : edge.sections) {
-      if (s.fit.ok) continue;
+      if (s.fit.ok || s.phase.joins_fit) continue;
       std::string why = "not measured";
       for (const std::string& flag : s.fit.flags)
         if (std::find(kInformational.begin(), kInformational.end(), flag) == kInformational.end()) {
@@ -387,7 +387,8 @@ Json PhaseCheckJson(const PhaseCheck& p) {
   for (const PhaseReading& f : p.families)
     readings.push_back({{"r_px", f.r_px}, {"offset_px", f.offset_px}, {"rms_rel", f.rms_rel}, {"chi2", f.chi2}});
   return {{"axis_deg", p.axis_deg}, {"span_px", p.span_px}, {"phase_px", p.phase_px}, {"noise", p.noise},
-          {"bins", p.bins}, {"range_px", {p.range_lo_px, p.range_hi_px}}, {"families", readings}};
+          {"bins", p.bins}, {"range_px", {p.range_lo_px, p.range_hi_px}}, {"joins_fit", p.joins_fit},
+          {"families", readings}};
 }
 
 Json PhaseChoiceJson(const PhaseChoice& c) {

@@ -104,11 +104,12 @@ CalibResult Calibrate(const cv::Mat& photo, const Camera& camera, const Board& b
 CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Board& board,
                       const CalibrateOptions& options = {});
 
-// The usable sections as the thin-lens model's samples: depth and r_px / stretch (ideal px), so a distorted photo's
-// blur is fitted in the undistorted lens's terms. A tracked take pools these over its frames.
+// The usable sections as the thin-lens model's samples, with the phase_limited ones that join the fit
+// (PhaseCheck::joins_fit): depth and r_px / stretch (ideal px), so a distorted photo's blur is fitted in the
+// undistorted lens's terms. A tracked take pools these over its frames.
 std::vector<optics::BlurSample> ModelSamples(const CalibResult& result);
 
-// The sections the thin-lens model was not fitted to, counted by the flag that disqualified each (its first:
+// The sections the thin-lens model was not fitted to (those not in ModelSamples), counted by the flag that disqualified each (its first:
 // "phase_limited", "crowded", "low_contrast", ...).
 std::map<std::string, int> SectionsLeftOut(const CalibResult& result);
 

@@ -574,6 +574,7 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
     s->fit.ok = false;
     s->fit.flags.push_back("phase_limited");
     s->fit.phase_why = PhaseWhy(*s, lo, hi, r, v_best, moved, nearest);
+    s->phase.joins_fit = hi - lo <= target && jump <= target;  // flagged by the cancellation alone
     ++choice.flagged;
     cancelled += hi - lo <= target && moved > target;
     jumped += hi - lo <= target && moved <= target;
@@ -604,7 +605,7 @@ optics::FittedModel FitModelWithinPhaseRanges(const CalibResult& result, const o
   std::vector<const SectionResult*> limited;
   for (const auto& edge : result.edges)
     for (const auto& s : edge.sections)
-      if (!s.fit.phase_why.empty() && s.phase.range_hi_px > 0) limited.push_back(&s);
+      if (!s.fit.phase_why.empty() && !s.phase.joins_fit && s.phase.range_hi_px > 0) limited.push_back(&s);
   std::vector<double> bound(limited.size(), -1);  // where a section holds the model (-1: nowhere)
   for (int round = 0; round < 5 && !limited.empty(); ++round) {
     bool moved = false;

@@ -59,6 +59,13 @@ void PrintCalibrationSummary(const calib::CalibResult& result, const Board& boar
       left += (left.empty() ? "" : ", ") + std::to_string(n) + " " + why, n_left += n;
     std::printf("the model is fitted to %d of %d sections%s\n", sections - n_left, sections,
                 left.empty() ? "" : ("; left out (it predicts them): " + left).c_str());
+    // phase_limited sections flagged only by a sharpening's amplification join the fit at their readings.
+    int n_joined = 0;
+    for (const auto& e : result.edges)
+      for (const auto& sec : e.sections) n_joined += sec.phase.joins_fit;
+    if (n_joined > 0)
+      std::printf("%d of them phase_limited where the sharpening cancels most of the optics' blur: each reading unsure "
+                  "alone, pooled by the fit\n", n_joined);
     // Sections used but read on a shorter central part (a neighbouring X-junction within the blur's reach): said,
     // as the flag in calib.json says it, since such a reading can run a few per cent high.
     int n_short = 0;
