@@ -364,7 +364,8 @@ def side_table(dec, by):
                      "n_left": n_left, "n_right": len(g) - n_left, "first_on_left": g["first_on_left"].mean()})
     t = pd.DataFrame(rows)
     wilson_columns(t, "n_left", "decisive", "share_left")
-    t["p_binom"] = [stats.binom_p(k, n) for k, n in zip(t["n_left"], t["decisive"])]
+    # One decisive answer cannot test anything (its p is 1 whichever side it is): no p, not p = 1.
+    t["p_binom"] = [stats.binom_p(k, n) if n > 1 else math.nan for k, n in zip(t["n_left"], t["decisive"])]
     return t
 
 
@@ -466,8 +467,10 @@ def side_bias(df, out_dir):
             f"much as a side preference")
     return [Chart("side-bias", png, svg, t, notes),
             Chart("side-bias-per-participant", None, None, per_p,
-                  ["per participant within each study and pooled over the studies; p_holm: Holm-adjusted over the "
-                   "participants of one study (or of the pooled rows)"] + participant_notes)]
+                  ["per participant within each study and pooled over the studies; p_binom: the exact binomial test "
+                   "of the participant's decisive answers against 0.5, empty for one answer (one answer cannot test "
+                   "anything); p_holm: Holm-adjusted over the participants of one study (or of the pooled rows)"]
+                  + participant_notes)]
 
 
 def charts(df, out_dir, n_boot=200):

@@ -21,8 +21,10 @@ share is first taken per participant, and the test runs across participants.
                     than guessing" is the question asked.
                   The sign flips are enumerated exactly (_sum_distribution); tests/test_stats.py measures the
                   false-positive rate at 3-12 participants with 1-20 answers each; one participant: the exact
-                  binomial test of that participant's answers (stats.binom_p); two: no test (said in words: a sign
-                  flip of 2 can never give p < 0.5).
+                  binomial test of that participant's answers (stats.binom_p; one_participant_test), none for a
+                  single answer (said in words: one answer cannot test anything - at chance 0.5 its p is 1 whichever
+                  it is), and where n answers can never reach p < 0.05 the words say how low p can go; two: no test
+                  (said in words: a sign flip of 2 can never give p < 0.5).
   group effect    the participants' shares (or mean values) compared between the between-subject groups: Welch's t
                   and Mann-Whitney's U for two groups, Welch's one-way ANOVA and Kruskal-Wallis for more
 """
@@ -124,6 +126,22 @@ def binomial_null_p(k, n, chance):
     return stats.binom_p(int(np.sum(k)), int(np.sum(n)), chance)
 
 
+def one_participant_test(k, n, chance):
+    """One participant's k of n answers against chance: dict(test, p). The exact binomial test of the answers, and none
+    for a single answer: it is one way or the other, and guessing gives either often (at chance 0.5 its p is 1
+    whichever it is; a statistic is printed only where it means something). Where no count of n answers could reach
+    p < 0.05 (n < 6 at chance 0.5), the words say how low p can go."""
+    k, n = int(k), int(n)
+    if n == 1:
+        return {"test": "none: one answer cannot test anything (one way or the other, guessing gives either often)",
+                "p": math.nan}
+    words = "exact binomial, one participant's answers"
+    floor = min(stats.binom_p(j, n, chance) for j in range(n + 1)) if n > 0 else math.nan
+    if floor >= 0.05:
+        words += f" (with {n} answers no p can be below {floor:.3g})"
+    return {"test": words, "p": stats.binom_p(k, n, chance)}
+
+
 def exact_test_words(chance, people):
     if abs(chance - 0.5) < 1e-12:
         floor = 2 / 2 ** people
@@ -152,7 +170,7 @@ def against_chance_counts(k, n, chance, people=None):
     shares = k / n
     n_people = len(shares)
     if (people or n_people) == 1:
-        return {"test": "exact binomial, one participant's answers", "p": stats.binom_p(k.sum(), n.sum(), chance)}
+        return one_participant_test(k.sum(), n.sum(), chance)
     if n_people < MIN_PARTICIPANTS_T:
         return {"test": f"none: {n_people} participants are too few for a test across participants (needs "
                         f">= {MIN_PARTICIPANTS_T})", "p": math.nan}
@@ -174,7 +192,9 @@ def summary_words(m, chance, what):
         p, lo, hi = stats.wilson(k, n)
         text = f"{what} {p:.2f} [{lo:.2f}, {hi:.2f}] of {n} answers (one participant)"
         if chance is not None:
-            text += f"; chance {chance:.2g}, {p_text(stats.binom_p(k, n, chance))} (exact binomial)"
+            r = one_participant_test(k, n, chance)
+            text += (f"; chance {chance:.2g}, {p_text(r['p'])} (exact binomial)" if not math.isnan(r["p"]) else
+                     f"; chance {chance:.2g}: one answer cannot test anything")
         return text
     shares = per_participant(m)["mean"].to_numpy(float)
     mean = shares.mean()

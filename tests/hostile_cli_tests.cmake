@@ -364,11 +364,12 @@ foreach(pair "file;${D}/small.png;Not a directory" "missing;${H}/no-such-tmpdir;
 endforeach()
 # live --log DIR replaces DIR whole when it holds live's files only; frame-NNNN.png counts as one (--save-frame), so a
 # folder of such images alone (ar --frames, a take's frames) was replaced and its images deleted. A log live wrote
-# always holds live.csv: without it, refused before anything is read.
+# always holds live.csv: without it, refused before anything is read (a usage error, exit 2, as for any folder live
+# may not replace: docs/live.md).
 add_test(NAME cli_hostile_live_log_of_frames_make
          COMMAND ${CMAKE_COMMAND} -E copy ${D}/small.png ${H}/live-frames-only/frame-0000.png)
 set_tests_properties(cli_hostile_live_log_of_frames_make PROPERTIES FIXTURES_SETUP live_frames_only)
-hostile_test(cli_hostile_live_log_of_frames 3 "--log ${H}/live-frames-only: holds no live.csv: not a log live wrote"
+hostile_test(cli_hostile_live_log_of_frames 2 "--log ${H}/live-frames-only: holds no live.csv: not a log live wrote"
              live ${T}/scene/scene.png --camera ${T}/scene/camera.json --calib ${T}/calib.json --ball 87.5,125
              --log ${H}/live-frames-only)
 set_tests_properties(cli_hostile_live_log_of_frames PROPERTIES FIXTURES_REQUIRED "scene;calib;live_frames_only")
@@ -385,3 +386,13 @@ set_tests_properties(cli_hostile_synth_scene_own_camera PROPERTIES FIXTURES_REQU
 hostile_test(cli_hostile_synth_take_own_camera 3 "--out ${H}/own-camera: holds no take.json: not a take synth-take wrote"
              synth-take --out ${H}/own-camera --frames 2)
 set_tests_properties(cli_hostile_synth_take_own_camera PROPERTIES FIXTURES_REQUIRED own_camera)
+
+# --- guard: small mends of the outputs audit (tests/outputs_own_test.sh holds the rest, over the CLI tests' scene).
+# A repeated distance wrote one photo and said "wrote 1 photos"; two distances %g prints alike wrote one file.
+hostile_test(cli_hostile_synth_pictures_repeated_distance 2 "--distances-m 1 is given twice"
+             synth-pictures --camera ${D}/thesis-camera.json --distances-m 1 1 --out ${H}/pictures-twice)
+hostile_test(cli_hostile_synth_pictures_distances_one_name 2 "distances 1 and 1.0000001 m both name face-1m.png"
+             synth-pictures --camera ${D}/thesis-camera.json --distances-m 1 1.0000001 --out ${H}/pictures-twice)
+# A display no participant has (render wrote a 1 x 1 image): the display profile's width range.
+hostile_test(cli_hostile_render_display_width_1 2 "--display-width: must be 0 (the photo's own width) or a display's width, 320 to 16384 px"
+             render --background ${D}/small.png --object picture --display-width 1 --out ${H}/tiny.png)

@@ -9,6 +9,8 @@
 #   headless  the same headless (EGL): the video ends, one clear line, exit 0, the log whole; a video cut in half:
 #             one line naming it, exit 3, the log of the frames before the damage whole
 #   nocamera  a camera that is not there: exit 3, one line naming the device, and a log of no frames written whole
+#   refusals  a --log live may not replace (one's own files, another tool's frames, an input's folder: exit 2; a file:
+#             exit 3), and a --preload of more frames than it may hold: refused at once, before a frame is decoded
 # Usage: live_test.sh CASE BLURCUE DIR
 set -u
 CASE=$1 BC=$2 W=$3
@@ -103,6 +105,9 @@ headless)
   grep -q '"ended": ".*take.avi ended after 60 frames"' "$W/headless/summary.json" ||
     fail "summary.json does not say how the run ended: $(cat "$W/headless/summary.json")"
   $PY "$(dirname "$0")/live_check.py" "$W/headless" "$T" "$W/ar.csv" 60 || fail "live_check.py (headless)"
+  # Without --measure-sections no frame measures a section, and none takes time for it (it logged 0.002 ms a frame).
+  awk -F, 'NR > 1 && ($15 != 0 || $16 != "0.000") { bad++ } END { exit bad > 0 }' "$W/headless/live.csv" ||
+    fail "measure_ms or sections not 0 without --measure-sections: $(cut -d, -f15,16 "$W/headless/live.csv" | sort | uniq -c)"
   # A video cut short: the frames before the damage are shown, then one line naming the video, exit 3, the log whole.
   head -c $(( $(stat -c %s "$T/take.avi") / 2 )) "$T/take.avi" > "$W/cut.avi"
   rm -rf "$W/cut"
@@ -111,6 +116,9 @@ headless)
   [ $code = 3 ] && [ "$(grep -c '^blurcue: ' "$W/cut.err")" = 1 ] &&
     grep -q "^blurcue: $W/cut.avi: damaged or truncated: frame [0-9]* of the 60 .*; the log of the [0-9]* frames shown is whole in $W/cut$" "$W/cut.err" ||
     fail "a cut video: exit $code, stderr: $(cat "$W/cut.err")"
+  # Said once: the error on stderr, not its end line on stdout besides (stdout: the summary and where the log is).
+  ! grep -q "damaged or truncated" "$W/cut.out" && grep -q "^[0-9]* frames shown, " "$W/cut.out" &&
+    grep -q "^wrote $W/cut " "$W/cut.out" || fail "a cut video: the error said twice, or no summary: $(cat "$W/cut.out")"
   shown=$(( $(wc -l < "$W/cut/live.csv") - 1 ))
   [ $shown -gt 5 ] && grep -q "\"frames_shown\": $shown," "$W/cut/summary.json" ||
     fail "the cut video's log: $shown rows, $(cat "$W/cut/summary.json")"
@@ -143,5 +151,37 @@ nocamera)
     grep -q "^blurcue: --preload: /dev/video97 is a camera" "$W/nocamera-preload.err" ||
     fail "--preload with a camera: exit $code, stderr: $(cat "$W/nocamera-preload.err")"
   echo "ok: live_test nocamera: $(cat "$W/nocamera.err")" ;;
+refusals)
+  # Refused before the first frame, each in one line: --log DIR that live may not replace for what it holds - one's
+  # own files, another tool's frames, an input's folder - is one usage error, exit 2 (one's own files were exit 3 and
+  # an input's folder exit 2); a --log that is a file (a path of the wrong kind) is exit 3, as for every command.
+  R=$W/refusals
+  rm -rf "$R" && mkdir -p "$R/own" "$R/frames"
+  echo "my notes" > "$R/own/notes.txt"
+  cp "$T/frame-0000.png" "$R/frames/frame-0000.png"
+  echo "a file" > "$R/file"
+  refused() {  # refused CODE TEXT LOG_DIR
+    "$BC" live "$T/take.avi" "${LIVE[@]}" --log "$3" > "$R/out" 2> "$R/err"
+    code=$?
+    [ $code = "$1" ] && [ "$(wc -l < "$R/err")" = 1 ] && grep -q -- "$2" "$R/err" ||
+      fail "--log $3: exit $code (wanted $1 and '$2'): $(cat "$R/err")"
+  }
+  refused 2 "^blurcue: --log $R/own: holds notes.txt, which this command did not write" "$R/own"
+  refused 2 "^blurcue: --log $R/frames: holds no live.csv: not a log live wrote" "$R/frames"
+  refused 2 "^blurcue: --log $T: holds the input" "$T"
+  refused 3 "^blurcue: --log $R/file: " "$R/file"
+  [ "$(cat "$R/own/notes.txt")" = "my notes" ] && [ -f "$R/frames/frame-0000.png" ] || fail "a refused --log was changed"
+  # --preload of more than it may hold: the frames are counted and refused at once, in round numbers, before one is
+  # decoded: these 800 "frames" are no images, so decoding the first would have ended the run on a damaged frame
+  # (exit 3) - as it did, after decoding up to 2000 MB where the frames were real.
+  mkdir -p "$R/seq"
+  for i in $(seq 0 799); do printf 'not a PNG' > "$R/seq/$(printf 'frame-%04d.png' "$i")"; done
+  "$BC" live "$R/seq/frame-%04d.png" "${LIVE[@]}" --preload --log "$R/seq-log" > "$R/out" 2> "$R/err"
+  code=$?
+  [ $code = 2 ] && [ "$(wc -l < "$R/err")" = 1 ] &&
+    grep -qx "blurcue: $R/seq/frame-%04d.png: --preload would hold its 800 frames decoded, 2.6 MB each (2105 MB): more than the 2000 MB it may hold (760 frames); give --frames 760, or leave --preload out" "$R/err" ||
+    fail "--preload of 800 frames: exit $code: $(cat "$R/err")"
+  [ ! -e "$R/seq-log" ] || fail "--preload refused, yet a log was written"
+  echo "ok: live_test refusals" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -11,6 +11,11 @@ set_tests_properties(live_headless_video_ends PROPERTIES FIXTURES_REQUIRED live_
 add_test(NAME live_missing_camera
          COMMAND ${BLURCUE_EXPECT} "ok: live_test nocamera" ${LIVE_TEST} nocamera $<TARGET_FILE:blurcue> ${LIVE_DIR})
 set_tests_properties(live_missing_camera PROPERTIES FIXTURES_REQUIRED live_take)
+# Refused before the first frame: a --log live may not replace (exit 2 for what it holds, 3 for a file), and a
+# --preload of more than 2000 MB, counted before a frame is decoded (tests/live_test.sh refusals).
+add_test(NAME live_refusals
+         COMMAND ${BLURCUE_EXPECT} "ok: live_test refusals" ${LIVE_TEST} refusals $<TARGET_FILE:blurcue> ${LIVE_DIR})
+set_tests_properties(live_refusals PROPERTIES FIXTURES_REQUIRED live_take)
 find_program(LIVE_XVFB Xvfb)
 find_program(LIVE_XDOTOOL xdotool)
 if(LIVE_XVFB AND LIVE_XDOTOOL)

@@ -53,3 +53,14 @@ add_test(NAME outputs_adversary39
                  $<TARGET_FILE:blurcue> ${PROJECT_BINARY_DIR}/cli-test)
 set_tests_properties(outputs_adversary39 PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
                      LABELS "gl;outputs")
+
+# An output replaces only what its own command wrote (tests/outputs_own_test.sh): a protocol at animate --log,
+# calibrate --out, camera --out or bench --out, a protocol named .png at an image output, one's own face.png, real
+# photos, frames, calib-NNNN.json, plan.csv or trials.csv in make-stimuli's, synth-pictures', animate's, track's,
+# plan's or export's folder - each was replaced, exit 0 - is refused in one line, exit 3, every file left as it was;
+# each command's own outputs are replaced on a rerun. With it the small mends of the same audit (validate's field
+# and one line, synth-pictures' repeated distance, render's display width).
+add_test(NAME outputs_own_files
+         COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" bash ${PROJECT_SOURCE_DIR}/tests/outputs_own_test.sh $<TARGET_FILE:blurcue> ${PROJECT_BINARY_DIR})
+set_tests_properties(outputs_own_files PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
+                     LABELS "gl;outputs" TIMEOUT 300)

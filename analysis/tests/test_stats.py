@@ -589,6 +589,51 @@ class PerPatternUnitTest(TempDirCase):
         self.assertAlmostEqual(float(t.loc[2, "p"]), sps.binomtest(4, 10, 0.5).pvalue, places=12)
         self.assertIn("one participant", t.loc[1, "test"])
 
+    def test_one_decisive_answer_of_one_participant_is_no_test_said_in_words(self):
+        # A cell of one decisive answer: the exact binomial of 1 of 1 at 0.5 is p = 1 whichever side it is (scipy:
+        # binomtest(1, 1) = binomtest(0, 1) = 1), a statistic that means nothing; the report printed "exact
+        # binomial, p = 1". Section 1 here has one measured answer (and a can't tell), section 2 ten answers.
+        df = pd.DataFrame(self.rows("P1", 1, 0, pattern=2, section=1, cant=1)
+                          + self.rows("P1", 9, 1, pattern=2, section=2))
+        t = forced_choice.per_section(df, self.tmp, "test2-moving-balls")[0].table.set_index("section")
+        self.assertEqual(int(t.loc[1, "decisive"]), 1)
+        self.assertTrue(math.isnan(float(t.loc[1, "p"])), t.loc[1, "p"])
+        self.assertTrue(math.isnan(float(t.loc[1, "p_holm"])))
+        self.assertEqual(t.loc[1, "test"], "none: one answer cannot test anything (one way or the other, guessing "
+                                           "gives either often)")
+        # The other cell keeps its test, and Holm adjusts over the one p there is.
+        from scipy import stats as sps
+        self.assertAlmostEqual(float(t.loc[2, "p"]), sps.binomtest(9, 10, 0.5).pvalue, places=12)
+        self.assertAlmostEqual(float(t.loc[2, "p_holm"]), float(t.loc[2, "p"]), places=12)
+        # At another chance level too (odd one out of 3: a correct answer's p would be 1/3).
+        r = study_tests.against_chance_counts([1], [1], 1 / 3)
+        self.assertTrue(math.isnan(r["p"]) and r["test"].startswith("none: one answer"), r)
+        # The summary's line for one participant's single answer says it in words, with no p.
+        one = pd.DataFrame({"participant": ["P1"], "y": [1.0]})
+        words = study_tests.summary_words(one, 0.5, "share correct")
+        self.assertIn("one answer cannot test anything", words)
+        self.assertNotIn("p =", words)
+
+    def test_one_participants_few_answers_say_how_low_p_can_go(self):
+        # 3 answers at 0.5: the smallest two-sided p is 2 / 2^3 = 0.25 (all three one way), so no p can reach 0.05;
+        # 6 answers: 2 / 64 = 0.03125 can.
+        r = study_tests.against_chance_counts([3], [3], 0.5)
+        self.assertAlmostEqual(r["p"], 0.25, places=12)
+        self.assertEqual(r["test"], "exact binomial, one participant's answers (with 3 answers no p can be below 0.25)")
+        r = study_tests.against_chance_counts([6], [6], 0.5)
+        self.assertAlmostEqual(r["p"], 2 / 64, places=12)
+        self.assertEqual(r["test"], "exact binomial, one participant's answers")
+
+    def test_a_participants_single_decisive_answer_has_no_side_bias_p(self):
+        rows = fc_rows("test1-static-grids", "P1", ["left"] * 8 + ["right"] * 2) + \
+            fc_rows("test1-static-grids", "P2", ["left", "cant_tell"], swapped=1)
+        per_p = forced_choice.side_bias(pd.DataFrame(rows), self.tmp)[1].table
+        p2 = per_p[(per_p["study"] == "test1-static-grids") & (per_p["participant"] == "P2")].iloc[0]
+        self.assertEqual(int(p2["decisive"]), 1)
+        self.assertTrue(math.isnan(p2["p_binom"]) and math.isnan(p2["p_holm"]), p2)
+        p1 = per_p[(per_p["study"] == "test1-static-grids") & (per_p["participant"] == "P1")].iloc[0]
+        self.assertAlmostEqual(p1["p_binom"], binom_two_sided_half(8, 10), places=12)
+        self.assertAlmostEqual(p1["p_holm"], p1["p_binom"], places=12)  # the one p of its study
 
 class FrameTimingTest(TempDirCase):
     # Window session 7: two trials of 30 intervals each, 29 x 16.7 ms and one 50 ms in each -> 62 flips, 60

@@ -11,6 +11,7 @@
 
 #include <opencv2/calib3d.hpp>
 #include "core/output_guard.h"
+#include "core/own_output.h"
 #include "core/media.h"
 
 #include "calib/scene_blur.h"
@@ -38,6 +39,21 @@ struct AnimateArgs {
   int from_edge = 1, to_edge = 11, left_section = 3, right_section = 5;
   bool window = false, fullscreen = false;
 };
+
+// --log's first line: a file at --log is replaced only when it begins with it (a log animate wrote).
+constexpr const char* kLogHeader =
+    "frame,t_s,y_mm,r_left_px,r_right_px,floor_sigma_left_px,floor_sigma_right_px,motion_left_x_px,"
+    "motion_left_y_px,motion_right_x_px,motion_right_y_px,render_ms,flip_s\n";
+// --frames is replaced as a whole, and only when it holds this file, which every run writes into it (a folder of
+// frame-NNNNN.png alone may be one's own images).
+constexpr const char* kFramesMarker = "animate-frames.txt";
+
+// A name --frames may hold: frame-NNNNN.png, and the marker.
+bool IsAnimateFrameName(const std::string& name) {
+  if (name == kFramesMarker) return true;
+  return name.size() == 15 && name.rfind("frame-", 0) == 0 && name.compare(11, 4, ".png") == 0 &&
+         name.find_first_not_of("0123456789", 6) == 11;
+}
 
 // The options against the calibration (edges and sections it has) and the outputs, before any frame is drawn:
 // OpenCV's writer picks its container by the extension (and prints its own multi-line warnings for one it does not
@@ -74,6 +90,21 @@ void CheckAnimateArgs(const AnimateArgs& args, const calib::SceneCalib& scene) {
     if (!args.frames_dir.empty()) guard.OutputFolder("--frames", args.frames_dir);
     guard.Check();
   }
+  // What the guard lets pass is still someone's unless animate wrote it: a protocol at --log, one's own take at
+  // --video, one's own images in --frames.
+  if (!args.video.empty()) RequireOwnFile("--video", args.video, "a video (an AVI)", AviFile());
+  if (!args.log.empty()) RequireOwnFile("--log", args.log, "a log animate wrote", BeginsWith(kLogHeader));
+  if (!args.frames_dir.empty()) {
+    try {
+      RequireReplaceableFolder(args.frames_dir, IsAnimateFrameName);
+    } catch (const Error& e) {
+      throw e.Wrapped(e.kind(), "--frames ");
+    }
+    RequireMarkedFolder("--frames", args.frames_dir, kFramesMarker, "frames animate drew",
+                        "one's own frame-NNNNN.png images?");
+  }
+  for (const std::string& target : {args.video, args.log, args.frames_dir})
+    if (!target.empty()) RemoveLeftoversBeside("animate", target);
 }
 
 // The two balls of each frame: rolling from --from-edge to --to-edge at --speed-cm-s, each blurred for its depth by
@@ -140,6 +171,61 @@ class RollingBalls {
   double y0_ = 0, y1_ = 0, half_mm_ = 0;
 };
 
+struct Drawn {
+  double worst_ms = 0;
+  std::string log;
+};
+
+// Draws the frames to the window, the video and (when not empty) `frames_dir`; returns the log and the slowest.
+Drawn DrawFrames(const AnimateArgs& args, const RollingBalls& rolling, int frames, render::GlContext& context,
+                 render::FrameCompositor& compositor, media::VideoWriter& video,
+                 const std::filesystem::path& frames_dir) {
+  std::ostringstream log;
+  log << kLogHeader;
+  using Clock = std::chrono::steady_clock;
+  {  // a warm-up frame uploads and mipmaps the texture, so frame 0 is not slower than the rest
+    compositor.Compose({rolling.Ball(0, rolling.YAt(0))});
+    compositor.Finish();
+  }
+  const bool tty = isatty(2);
+  const auto start = Clock::now();
+  double worst_ms = 0;
+  for (int i = 0; i < frames && !(context.ShouldClose()); ++i) {
+    const double t = i / args.fps;
+    const double y = rolling.YAt(t);
+    const std::vector<scene::BlurredObject> balls = rolling.At(i, t);
+    const double r[2] = {balls[0].r_px, balls[1].r_px};
+    const auto t0 = Clock::now();
+    compositor.Compose(balls);
+    compositor.Finish();
+    const double render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    worst_ms = std::max(worst_ms, render_ms);
+    double flip_s = std::chrono::duration<double>(Clock::now() - start).count();
+    if (args.window) {
+      compositor.Present(context.width_px(), context.height_px());
+      context.SwapBuffers();
+      flip_s = std::chrono::duration<double>(Clock::now() - start).count();
+    }
+    if (video.IsOpened() || !frames_dir.empty()) {
+      const cv::Mat frame = compositor.Read();
+      if (video.IsOpened()) video.Write(frame);
+      if (!frames_dir.empty()) {
+        char name[32];
+        std::snprintf(name, sizeof name, "frame-%05d.png", i);
+        WriteImage(frames_dir / name, frame);
+      }
+    }
+    log << i << "," << t << "," << y << "," << r[0] << "," << r[1] << "," << balls[0].floor_sigma_px << ","
+        << balls[1].floor_sigma_px << "," << balls[0].motion_px[0] << "," << balls[0].motion_px[1] << ","
+        << balls[1].motion_px[0] << "," << balls[1].motion_px[1] << "," << render_ms << "," << flip_s << "\n";
+    if (tty || (i + 1) % std::max(1, frames / 4) == 0 || i + 1 == frames)
+      std::fprintf(stderr, "%sframe %d/%d  y %.1f mm  r %.2f | %.2f px  %.1f ms%s", tty ? "\r" : "", i + 1, frames,
+                   y, r[0], r[1], render_ms, tty ? "" : "\n");
+  }
+  if (tty) std::fprintf(stderr, "\n");
+  return {worst_ms, log.str()};
+}
+
 // Two balls rolling side by side, each re-blurred every frame for its depth by its own blur source.
 void Animate(const AnimateArgs& args) {
   const calib::SceneCalib scene = calib::LoadSceneCalib(args.calib);
@@ -174,52 +260,22 @@ void Animate(const AnimateArgs& args) {
       std::filesystem::create_directories(std::filesystem::path(args.video).parent_path());
     if (!video.Open(args.video, media::Fourcc('M', 'J', 'P', 'G'), args.fps, photo.size())) throw InputError(args.video, "cannot open a video writer (MJPG .avi)");
   }
-  // The log is written whole at the end (WriteFileAtomically): a run cut short leaves no half log.
-  std::ostringstream log;
-  log << "frame,t_s,y_mm,r_left_px,r_right_px,floor_sigma_left_px,floor_sigma_right_px,motion_left_x_px,"
-         "motion_left_y_px,motion_right_x_px,motion_right_y_px,render_ms,flip_s\n";
-  using Clock = std::chrono::steady_clock;
-  {  // a warm-up frame uploads and mipmaps the texture, so frame 0 is not slower than the rest
-    compositor.Compose({rolling.Ball(0, rolling.YAt(0))});
-    compositor.Finish();
-  }
-  const bool tty = isatty(2);
-  const auto start = Clock::now();
-  double worst_ms = 0;
-  for (int i = 0; i < frames && !(context->ShouldClose()); ++i) {
-    const double t = i / args.fps;
-    const double y = rolling.YAt(t);
-    const std::vector<scene::BlurredObject> balls = rolling.At(i, t);
-    const double r[2] = {balls[0].r_px, balls[1].r_px};
-    const auto t0 = Clock::now();
-    compositor.Compose(balls);
-    compositor.Finish();
-    const double render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-    worst_ms = std::max(worst_ms, render_ms);
-    double flip_s = std::chrono::duration<double>(Clock::now() - start).count();
-    if (args.window) {
-      compositor.Present(context->width_px(), context->height_px());
-      context->SwapBuffers();
-      flip_s = std::chrono::duration<double>(Clock::now() - start).count();
-    }
-    if (video.IsOpened() || !args.frames_dir.empty()) {
-      const cv::Mat frame = compositor.Read();
-      if (video.IsOpened()) video.Write(frame);
-      if (!args.frames_dir.empty()) {
-        char name[32];
-        std::snprintf(name, sizeof name, "frame-%05d.png", i);
-        WriteImage(std::filesystem::path(args.frames_dir) / name, frame);
-      }
-    }
-    log << i << "," << t << "," << y << "," << r[0] << "," << r[1] << "," << balls[0].floor_sigma_px << ","
-        << balls[1].floor_sigma_px << "," << balls[0].motion_px[0] << "," << balls[0].motion_px[1] << ","
-        << balls[1].motion_px[0] << "," << balls[1].motion_px[1] << "," << render_ms << "," << flip_s << "\n";
-    if (tty || (i + 1) % std::max(1, frames / 4) == 0 || i + 1 == frames)
-      std::fprintf(stderr, "%sframe %d/%d  y %.1f mm  r %.2f | %.2f px  %.1f ms%s", tty ? "\r" : "", i + 1, frames,
-                   y, r[0], r[1], render_ms, tty ? "" : "\n");
-  }
-  if (tty) std::fprintf(stderr, "\n");
-  if (!args.log.empty()) WriteFileAtomically(args.log, log.str());
+  // The log is written whole at the end (WriteFileAtomically): a run cut short leaves no half log. The frames are
+  // drawn into a folder beside --frames and swapped in whole, with the marker that lets a later run replace it.
+  Drawn drawn;
+  auto draw = [&](const std::filesystem::path& frames_dir) {
+    drawn = DrawFrames(args, rolling, frames, *context, compositor, video, frames_dir);
+    if (!frames_dir.empty())
+      WriteFileAtomically(frames_dir / kFramesMarker, "frame-NNNNN.png: frames blurcue animate drew; a later "
+                                                      "`animate --frames` may replace this folder whole, as it holds "
+                                                      "this file.\n");
+  };
+  if (args.frames_dir.empty())
+    draw({});
+  else
+    WriteFolderAtomically(args.frames_dir, draw, IsAnimateFrameName);
+  const double worst_ms = drawn.worst_ms;
+  if (!args.log.empty()) WriteFileAtomically(args.log, drawn.log);
   std::printf("%d frames (%.1f s of motion at %.1f cm/s, %.0f fps); slowest frame %.1f ms%s%s%s\n", frames,
               (frames - 1) / args.fps, args.speed_cm_s, args.fps, worst_ms,
               args.video.empty() ? "" : ("; video " + args.video).c_str(),
@@ -263,11 +319,14 @@ void AddAnimateCommand(CLI::App& app) {
       ->transform(IntRange(1, 1000));
   cmd->add_option("--right-section", args->right_section, "section the right ball rolls along")
       ->capture_default_str()->transform(IntRange(1, 1000));
-  cmd->add_option("--video", args->video, "write an MJPG .avi");
-  cmd->add_option("--frames", args->frames_dir, "write frame PNGs into this folder");
+  cmd->add_option("--video", args->video, "write an MJPG .avi (an existing file is replaced only when it is an AVI)");
+  cmd->add_option("--frames", args->frames_dir,
+                  "write frame-NNNNN.png into this folder, swapped in whole; an existing folder is replaced only when\n"
+                  "animate drew it (it holds animate-frames.txt)");
   cmd->add_option("--log", args->log,
                   "per-frame CSV: index, t_s, y_mm, r_left_px, r_right_px, each ball's lens floor (std) and motion\n"
-                  "streak (x, y) in photo px, render_ms, flip_s");
+                  "streak (x, y) in photo px, render_ms, flip_s; an existing file is replaced only when it is such a\n"
+                  "log");
   CLI::Option* window = cmd->add_flag("--window", args->window, "show in a GLFW window (vsync)");
   // Without a window nothing would read it (it was ignored).
   cmd->add_flag("--fullscreen", args->fullscreen, "with --window: fullscreen on the first monitor")->needs(window);

@@ -231,7 +231,10 @@ struct ArDrawing {
       const calib::SceneCalib& c = *take.frames[size_t(index)].calib;
       if (!compositor) compositor = std::make_unique<render::FrameCompositor>(take.camera(), c.rvec, c.tvec, frame);
       const auto draw_start = std::chrono::steady_clock::now();
-      compositor->SetFrame(c.rvec, c.tvec, frame);
+      // Composed once (each frame is drawn once, then read back), as live composes: the photo is uploaded straight
+      // into the frame the objects are blended over, without the whole-frame copy from a base frame a second
+      // composition would restore it from (the frames written are byte for byte the same: docs/ar.md).
+      compositor->SetFrame(c.rvec, c.tvec, frame, true);
       compositor->Compose(plan.objects);
       out = compositor->Read();
       draw_ms.push_back(

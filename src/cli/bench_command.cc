@@ -11,11 +11,17 @@
 #include "bench/track_bench.h"
 #include "cli/commands.h"
 #include "core/output_guard.h"
+#include "core/own_output.h"
 #include "core/data_dir.h"
 
 namespace blurcue::cli {
-
 namespace {
+
+// An existing --out is replaced only when it is this bench's CSV (its header's first columns): a protocol, a
+// calib.json or one's own table given by mistake is refused before the run.
+void RequireBenchCsv(const std::string& out, const std::string& bench, const std::string& header_start) {
+  RequireOwnFile("--out", out, "a CSV bench " + bench + " wrote", BeginsWith(header_start));
+}
 
 // A bench's progress: one line on stderr (stdout carries its results).
 void ProgressLine(const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); }
@@ -48,6 +54,7 @@ void AddMeasure(CLI::App& bench) {
   cmd->add_flag("--no-full-res", args->no_full_res, "skip the full-resolution timing");
   cmd->callback([args] {
     OutputGuard().OutputFile("--out", args->out).Check();
+    RequireBenchCsv(args->out, "measure", "method,factor,level,");
     bench::MeasureBenchOptions options;
     options.quick = args->quick;
     options.seed = args->seed;
@@ -101,6 +108,7 @@ void AddRender(CLI::App& bench) {
   cmd->add_flag("--frames-only", args->frames_only, "only parts 2 and 3, the frames (about two minutes)");
   cmd->callback([args] {
     OutputGuard().OutputFile("--out", args->out).Check();
+    RequireBenchCsv(args->out, "render", "kind,method,backend,");
     bench::RenderBenchOptions options;
     options.quick = args->quick;
     options.frames_only = args->frames_only;
@@ -170,6 +178,7 @@ void AddProcedures(CLI::App& bench) {
   cmd->add_flag("--quick", args->quick, "40 runs (smoke run)");
   cmd->callback([args] {
     OutputGuard().OutputFile("--out", args->out).Check();
+    RequireBenchCsv(args->out, "procedures", "procedure,condition,trials,");
     bench::ProcedureBenchOptions options;
     options.runs = args->quick ? 40 : args->runs;
     options.seed = args->seed;
@@ -211,6 +220,7 @@ void AddPlan(CLI::App& bench) {
   cmd->add_flag("--quick", args->quick, "1 round of 2 studies (smoke run)");
   cmd->callback([args] {
     OutputGuard().OutputFile("--out", args->out).Check();
+    RequireBenchCsv(args->out, "plan", "protocol,threads,round,");
     bench::PlanBenchOptions options = args->options;
     options.protocol_file = args->protocol.empty() ? DataDir().path / "protocols" / "test1-static-grids.json"
                                                    : std::filesystem::path(args->protocol);
@@ -255,6 +265,7 @@ void AddTrack(CLI::App& bench) {
   cmd->callback([args] {
     // It runs this blurcue as a child: --out naming it would replace the executable with the CSV.
     OutputGuard().Input("the blurcue it runs", ExecutableDir() / "blurcue").OutputFile("--out", args->out).Check();
+    RequireBenchCsv(args->out, "track", "mode,frame,status,");
     bench::TrackBenchOptions options;
     options.frames = args->frames;
     options.quick = args->quick;
@@ -313,6 +324,7 @@ void AddLive(CLI::App& bench) {
                                              " is given twice; give each value of N once");
     // It runs this blurcue once for each N: --out naming it replaced the executable with the CSV.
     OutputGuard().Input("the blurcue it runs", ExecutableDir() / "blurcue").OutputFile("--out", args->out).Check();
+    RequireBenchCsv(args->out, "live", "sections_per_frame,frames_delivered,");
     bench::LiveBenchOptions options = args->options;
     options.quick = args->quick;
     options.progress = ProgressLine;

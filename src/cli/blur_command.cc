@@ -4,6 +4,7 @@
 
 #include "cli/commands.h"
 #include "core/output_guard.h"
+#include "core/own_output.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "render/blur.h"
@@ -38,6 +39,8 @@ void AddBlurCommand(CLI::App& app) {
   cmd->callback([args, cmd] {
     OutputGuard().Input("IN", args->in).OutputFile("--out", args->out).Check();
     RequireImageName("--out", args->out);
+    // An image of another kind at its path (a protocol named .png, a JPEG named .png) is not replaced.
+    RequireOwnFile("--out", args->out, "an image of the kind its name says", ImageOfExtension(args->out));
     const bool butterworth = args->method == "butterworth";
     // The other method's value is refused, not ignored (--radius-px 2 on a Butterworth blurred by the cut-off alone).
     if (butterworth && cmd->count("--radius-px") > 0)

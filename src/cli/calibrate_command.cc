@@ -11,6 +11,7 @@
 #include "cli/commands.h"
 #include "core/error.h"
 #include "core/output_guard.h"
+#include "core/own_output.h"
 #include "core/image.h"
 #include "optics/fit.h"
 
@@ -175,6 +176,8 @@ void AddCalibrateCommand(CLI::App& app) {
     guard.Input("PHOTO", args->photo).Input("--camera", args->camera);
     if (!args->truth.empty()) guard.Input("--truth", args->truth);
     guard.OutputFile("--out", args->out).Check();
+    // What the guard lets pass may still be someone's: a protocol, a camera.json that is not --camera's.
+    RequireOwnFile("--out", args->out, "a calib.json calibrate wrote", Holds("\"format\": \"blurcue-calib\""));
     const Board board = Board::Parse(args->board, args->square_mm);
     const Camera camera = LoadCamera(args->camera);
     const cv::Mat photo = ReadImage(args->photo, 1 /* cv::IMREAD_COLOR */);

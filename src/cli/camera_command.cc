@@ -7,9 +7,12 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "core/camera.h"
 #include "core/camera_exif.h"
+#include "core/error.h"
 #include "core/json_io.h"
 #include "core/output_guard.h"
+#include "core/own_output.h"
 
 namespace blurcue::cli {
 namespace {
@@ -54,7 +57,19 @@ void AddCameraCommand(CLI::App& app) {
   cmd->add_option("--f-number", args->f_number, "the f-number, where EXIF lacks it")
       ->check(FiniteRange(CameraLimits::kFNumber[0], CameraLimits::kFNumber[1], ""));
   cmd->callback([args] {
-    if (!args->out.empty()) OutputGuard().Input("PHOTO", args->photo).OutputFile("--out", args->out).Check();
+    if (!args->out.empty()) {
+      OutputGuard().Input("PHOTO", args->photo).OutputFile("--out", args->out).Check();
+      // A camera.json (one's own, written by hand, is the same kind) and nothing else: what the camera.json reader
+      // takes whole, so not a protocol or a calib.json that names a focal length.
+      RequireOwnFile("--out", args->out, "a camera.json", [&](std::string_view) {
+        try {
+          LoadCamera(args->out);
+          return true;
+        } catch (const Error&) {
+          return false;
+        }
+      });
+    }
     std::optional<std::pair<double, double>> sensor;
     if (args->sensor_mm.size() == 2) sensor = std::make_pair(args->sensor_mm[0], args->sensor_mm[1]);
     auto given = [](double v) { return v > 0 ? std::optional<double>(v) : std::nullopt; };

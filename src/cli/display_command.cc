@@ -11,6 +11,7 @@
 
 #include "cli/commands.h"
 #include "core/output_guard.h"
+#include "core/own_output.h"
 #include "core/error.h"
 #include "core/stats.h"
 #include "core/image.h"
@@ -95,6 +96,9 @@ void AddDisplayCommand(CLI::App& app) {
     if (!args->screenshot.empty()) {
       OutputGuard().OutputFile("--screenshot", args->screenshot).Check();
       RequireImageName("--screenshot", args->screenshot);
+      // An image of another kind at its path (a protocol named .png, a JPEG named .png) is not replaced.
+      RequireOwnFile("--screenshot", args->screenshot, "an image of the kind its name says",
+                     ImageOfExtension(args->screenshot));
     }
     const display::Profile profile =
         args->profile.empty() ? display::DefaultProfile() : display::LoadProfile(args->profile);

@@ -131,13 +131,24 @@ void GuardLiveOutputs(const LiveArgs& a) {
   GuardObjectInputs(guard, a.objects);
   guard.OutputFolder("--log", a.log);
   guard.Check();
+  // A folder live may not replace for what it holds - an input (the guard above), one's own files, another tool's
+  // frames - is one refusal, a usage error (exit 2): nothing in it is read or wrong, and the way out is another --log
+  // (it was exit 3 for one's own files and 2 for an input's folder). A path of the wrong kind - a file, a FIFO, a
+  // folder live cannot write in - stays the guard's exit 3, as for every command's output (docs/ar.md says the same).
+  const auto holds = [](const Error& e) {
+    return std::string(e.what()).find(": holds ") != std::string::npos ? ErrorKind::kUsage : e.kind();
+  };
   try {
     RequireReplaceableFolder(a.log, IsLiveLogFile);
   } catch (const Error& e) {
-    throw e.Wrapped(e.kind(), "--log ");
+    throw e.Wrapped(holds(e), "--log ");
   }
-  // A folder of frame-NNNN.png alone (ar --frames, a take's frames) passed the check above and was replaced.
-  RequireMarkedFolder("--log", a.log, "live.csv", "a log live wrote", "frame-NNNN.png images of another run or tool?");
+  try {
+    // A folder of frame-NNNN.png alone (ar --frames, a take's frames) passes the check above and was replaced.
+    RequireMarkedFolder("--log", a.log, "live.csv", "a log live wrote", "frame-NNNN.png images of another run or tool?");
+  } catch (const Error& e) {
+    throw Error(holds(e), e.lines());
+  }
   RemoveLeftoversBeside("live", a.log);
 }
 
@@ -176,8 +187,10 @@ LiveSetup SetUpLive(const LiveArgs& a) {
   }
   // Decoded whole before the clock starts: frames then come from memory, as a camera hands over the frames it decoded.
   if (a.preload) {
+    const cv::Size frame_size(s.camera.image_width_px, s.camera.image_height_px);
+    s.source->CheckPreloadFits(frame_size, live::kMaxPreloadMb);  // refused before a frame is decoded
     if (!a.quiet) std::fprintf(stderr, "live: --preload: decoding %s before the start ...\n", a.input.c_str());
-    s.preload_s = s.source->Preload(live::kMaxPreloadMb, &live_signal);
+    s.preload_s = s.source->Preload(frame_size, live::kMaxPreloadMb, &live_signal);
   }
   const double rate = s.source->fps();
   if (a.exposure_ms >= 0) {
@@ -261,8 +274,10 @@ void ShowFrame(LiveSetup& s, const LiveArgs& a, live::LiveFrame& frame, live::Cl
   row.status = result.status;
   if (result.pose) row.rvec = result.pose->rvec, row.tvec = result.pose->tvec;
   row.track_ms = result.pose_ms;
-  row.measure_ms = MsBetween(t0, t1) - result.pose_ms;  // the sections (the model's fit runs on its own thread)
   row.sections = result.calib ? result.sections_measured : 0;
+  // The sections (the model's fit runs on its own thread); 0 for a frame that measured none (the tracker's work
+  // besides the pose left 0.002 ms there, a time for nothing done).
+  row.measure_ms = row.sections > 0 ? MsBetween(t0, t1) - result.pose_ms : 0;
   row.lens_sections = s.live_lens ? s.live_lens->sections() : 0;
   row.render_ms = MsBetween(t1, t2);
   row.display_s = std::chrono::duration<double>(shown - start).count();
@@ -382,9 +397,11 @@ void RunLive(const LiveArgs& a) {
   summary.preloaded_frames = s.source->preloaded_frames();
   if (summary.shown > 0) summary.cpu_ms_per_frame = 1000 * record.cpu_s / summary.shown;
   WriteLiveLog(a, record, summary);
+  // An end that is an error is said once, by the error on stderr (its line names the log too); a clean end here.
   if (!a.quiet) {
-    std::printf("%s\n%s\nwrote %s (live.csv, drawn.csv, summary.json)\n", record.ended.c_str(),
-                live::SummaryLine(summary).c_str(), a.log.c_str());
+    if (!record.error) std::printf("%s\n", record.ended.c_str());
+    std::printf("%s\nwrote %s (live.csv, drawn.csv, summary.json)\n", live::SummaryLine(summary).c_str(),
+                a.log.c_str());
   }
   if (record.error)
     throw Error(record.error->kind(), std::string(record.error->what()) + "; the log of the " +
@@ -401,7 +418,7 @@ void AddLiveCommand(CLI::App& app) {
       "Each frame's board pose is tracked from the frame before (a full detection when tracking is lost), the objects\n"
       "are planned and drawn as `blurcue ar` draws them (the lens model's defocus x floor at each object's depth,\n"
       "streaked by its image motion since the last frame with a pose over the exposure, in linear light) and shown\n"
-      "in a window with vsync (--window; Escape or closing it ends the run) or rendered headless.\n"
+      "in a window with vsync (--window; Escape or closing it ends the run) or, without --window, headless.\n"
       "INPUT is a camera - /dev/videoN or an index N, through OpenCV's videoio (V4L2) - or a video file or image\n"
       "sequence (a printf pattern) played as a camera would deliver it: frame k at k / fps s from the start. Frames\n"
       "reach the drawing through a one-slot mailbox: one that arrives while the previous is still being drawn\n"
@@ -414,7 +431,7 @@ void AddLiveCommand(CLI::App& app) {
       "pose, track ms, render ms, display time, latency, dropped), drawn.csv (ar's CSV of what was drawn) and\n"
       "summary.json; the summary line is printed. The input ending, --frames, Escape, a closed window, Ctrl-C:\n"
       "exit 0. A camera that stops or a damaged frame: one line, exit 3, the log of the frames before it written.\n"
-      "No camera at /dev/videoN: exit 3 naming it. DIR must be a folder of live's files only (or new).\n"
+      "No camera at /dev/videoN: exit 3 naming it. DIR must be new or a log live wrote (other files: exit 2).\n"
       "Example: blurcue live take/take.avi --camera take/camera.json --track take/track --ball 87.5,125 --window\n"
       "         --log live-run");
   cmd->add_option("input", a->input, "/dev/videoN or N (a camera), a video file, or a printf pattern of images")
@@ -461,7 +478,8 @@ void AddLiveCommand(CLI::App& app) {
                 "decode the whole video or image sequence before the clock starts and deliver the frames from memory\n"
                 "at their pace, as a camera hands over frames it decoded itself: the decoding, which a camera never\n"
                 "costs this computer, is taken out of the latency (the summary line and summary.json say so). At most\n"
-                "2000 MB decoded (760 frames of 1148 x 764; --frames to play fewer); not for a camera");
+                "2000 MB decoded (760 frames of 1148 x 764; more is refused before decoding; --frames to play fewer);\n"
+                "not for a camera");
   cmd->add_flag("--quiet", a->quiet, "print only errors");
   cmd->callback([a] { RunLive(*a); });
 }

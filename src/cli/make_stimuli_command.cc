@@ -3,11 +3,14 @@
 #include <string>
 
 #include <filesystem>
+#include <map>
 #include <set>
 #include <vector>
 
 #include "cli/commands.h"
+#include "core/atomic_file.h"
 #include "core/output_guard.h"
+#include "core/own_output.h"
 #include "core/camera.h"
 #include "core/error.h"
 #include "core/image.h"
@@ -16,6 +19,18 @@
 #include "scene/stimuli.h"
 
 namespace blurcue::cli {
+namespace {
+
+// A scratch folder removed however the command ends.
+struct RemovedWhenDone {
+  std::filesystem::path path;
+  ~RemovedWhenDone() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path, ignored);
+  }
+};
+
+}  // namespace
 
 void AddMakeStimuliCommand(CLI::App& app) {
   auto out = std::make_shared<std::string>("stimuli");
@@ -27,10 +42,22 @@ void AddMakeStimuliCommand(CLI::App& app) {
       "  grid.png    1024 x 1024 white card with a 5 x 5 black grid, the virtual content of test 1\n"
       "  face.png    800 x 1200 face picture with alpha, the pre-research's depth-matching content\n"
       "Example: blurcue make-stimuli --out stimuli");
-  cmd->add_option("--out", *out, "folder to write into (created if needed)")->capture_default_str();
+  cmd->add_option("--out", *out, "folder to write into (created if needed); a file of the same name there is\n"
+                                  "replaced only when make-stimuli wrote it (OUT/make-stimuli.txt lists it)")
+      ->capture_default_str();
   cmd->callback([out] {
     OutputGuard().OutputFolder("--out", *out).Check();
-    for (const auto& file : scene::WriteStandardStimuli(*out)) std::printf("wrote %s\n", file.string().c_str());
+    RemoveLeftoversBeside("make-stimuli", *out);
+    // Drawn into a folder of its own beside OUT, then moved in: OUT may hold one's own pictures under the same
+    // names (face.png), which are refused before any file is replaced.
+    const std::filesystem::path partial = TemporaryBeside(*out, "partial");
+    std::error_code ignored;
+    std::filesystem::remove_all(partial, ignored);
+    std::filesystem::create_directories(partial, ignored);
+    const RemovedWhenDone remove_partial{partial};
+    scene::WriteStandardStimuli(partial);
+    for (const auto& file : PlaceOwnFiles("--out", *out, partial, "make-stimuli.txt", "make-stimuli"))
+      std::printf("wrote %s\n", file.string().c_str());
   });
 }
 
@@ -66,7 +93,10 @@ void AddSynthPicturesCommand(CLI::App& app) {
       ->check(FinitePositive(10000, "mm"));
   cmd->add_option("--width-px", args->width_px, "photo width (the camera's sensor scaled to it)")
       ->capture_default_str()->transform(IntRange(16, 16384, "px"));
-  cmd->add_option("--out", args->out, "folder (created)")->required();
+  cmd->add_option("--out", args->out, "folder (created); a photo of the same name there is replaced only\n"
+                                      "when synth-pictures wrote it (OUT/synth-pictures.txt lists it): real photos are\n"
+                                      "refused")
+      ->required();
   cmd->callback([args, focus] {
     {
       OutputGuard guard;
@@ -74,7 +104,10 @@ void AddSynthPicturesCommand(CLI::App& app) {
       if (!args->protocol.empty()) guard.Input("--protocol", args->protocol);
       guard.OutputFolder("--out", args->out).Check();
     }
-    std::set<double> distances(args->distances_m.begin(), args->distances_m.end());
+    std::set<double> distances;
+    for (double d : args->distances_m)
+      if (!distances.insert(d).second)
+        throw Error(ErrorKind::kUsage, "--distances-m " + BoundText(d) + " is given twice; each distance is one photo");
     bool focus_from_protocol = false;
     if (!args->protocol.empty()) {
       protocol::ValidateOptions no_files;
@@ -92,12 +125,26 @@ void AddSynthPicturesCommand(CLI::App& app) {
                                                                           camera.image_height_px /
                                                                           camera.image_width_px)));
     const cv::Mat picture = ReadImage(scene::ResolveStimulus(args->picture), -1);
-    std::filesystem::create_directories(args->out);
     const std::string stem = std::filesystem::path(args->picture).stem().string();
+    // Each distance's file name, told apart: %g keeps 6 digits, so 1 and 1.0000001 would write one file.
+    std::map<std::string, double> named;
     for (double d : distances) {
       char name[64];
       std::snprintf(name, sizeof name, "%s-%gm.png", stem.c_str(), d);
-      const auto path = std::filesystem::path(args->out) / name;
+      if (const auto [at, fresh] = named.emplace(name, d); !fresh)
+        throw Error(ErrorKind::kUsage, "distances " + BoundText(at->second) + " and " + BoundText(d) + " m both "
+                                       "name " + name + " (its name keeps 6 digits); give distances apart");
+    }
+    RemoveLeftoversBeside("synth-pictures", args->out);
+    // Made in a folder of its own beside OUT, then moved in: OUT may hold real photos of the same names (a
+    // protocol's real_photos), which are refused before any file is replaced.
+    const std::filesystem::path partial = TemporaryBeside(args->out, "partial");
+    std::error_code ignored;
+    std::filesystem::remove_all(partial, ignored);
+    std::filesystem::create_directories(partial, ignored);
+    const RemovedWhenDone remove_partial{partial};
+    for (const auto& [name, d] : named) {
+      const auto path = partial / name;
       cv::Mat photo;
       try {
         photo = render::RealPicturePhoto(picture, scaled, args->focus_m * 1000, d * 1000, args->height_mm, args->grey);
@@ -109,8 +156,9 @@ void AddSynthPicturesCommand(CLI::App& app) {
       }
       WriteImage(path, photo);
     }
-    std::printf("wrote %zu photos (%s, %dx%d, focus %g m) to %s\n", distances.size(), stem.c_str(),
-                scaled.image_width_px, scaled.image_height_px, args->focus_m, args->out.c_str());
+    PlaceOwnFiles("--out", args->out, partial, "synth-pictures.txt", "synth-pictures");
+    std::printf("wrote %zu photo%s (%s, %dx%d, focus %g m) to %s\n", named.size(), named.size() == 1 ? "" : "s",
+                stem.c_str(), scaled.image_width_px, scaled.image_height_px, args->focus_m, args->out.c_str());
   });
 }
 

@@ -10,6 +10,7 @@
 #include "cli/child.h"
 #include "cli/commands.h"
 #include "core/atomic_file.h"
+#include "core/own_output.h"
 #include "core/data_dir.h"
 #include "core/error.h"
 #include "core/hash.h"
@@ -99,14 +100,17 @@ void WritePlan(const PlanArgs& args) {
   std::error_code ignored;
   if (std::filesystem::exists(out, ignored) && !std::filesystem::is_directory(out, ignored))
     throw InputError(out.string(), "--out: is a file, not a folder");
-  const bool earlier = std::filesystem::exists(out / "plan.csv", ignored);
   // An earlier plan is replaced whole: its own files only, so a file someone put beside them is not deleted with it.
-  const auto ours = [earlier](const std::string& name) {
+  const auto ours = [](const std::string& name) {
     for (const char* own : {"plan.csv", "answers.csv", "plan.json", "power.png", "power.svg"})
-      if (name == own) return earlier;
+      if (name == own) return true;
     return false;
   };
   RequireReplaceableFolder(out, ours);
+  // And it holds the plan.json plan wrote: a folder of one's own plan.csv or answers.csv alone, or beside a
+  // plan.json of another tool, was replaced as if it were one.
+  RequireMarkedFolder("--out", out, "plan.json", "a plan blurcue plan wrote", "one's own plan.csv or tables?");
+  RequireOwnFile("--out", out / "plan.json", "a plan.json plan wrote", Holds("\"smallest_n\""));
   const plan::PlanResult result = plan::RunPlan(options);
   std::fprintf(stderr, "plan: %zu participants in %.2f s on %d threads (%.2f ms per participant)\n",
                static_cast<size_t>(options.studies) * static_cast<size_t>(options.participants), result.seconds,
@@ -175,7 +179,8 @@ void AddPlanCommand(CLI::App& app) {
                   "procedure cells: the threshold difference to plan the power for, in the procedure's units (0.5) "
                   "or relative to the true threshold (20%)");
   cmd->add_option("--out", args->out,
-                  "output folder (created; an earlier plan there is replaced when it holds only the files plan writes)")
+                  "output folder (created; an earlier plan there is replaced when it holds only the files plan\n"
+                  "writes, its plan.json among them)")
       ->capture_default_str();
   cmd->add_option("--python", args->python, "the Python that draws the chart")->capture_default_str();
   cmd->add_flag("--no-chart", args->no_chart, "write the tables only");

@@ -12,6 +12,7 @@
 #include "cli/groups.h"
 #include "core/image.h"
 #include "core/output_guard.h"
+#include "core/own_output.h"
 #include "preview/preview.h"
 #include "procedure/observer.h"
 #include "procedure/prepare.h"
@@ -73,6 +74,8 @@ void AddPreviewCommand(CLI::App& app) {
       if (!args->display.empty()) guard.Input("--display", args->display);
       guard.OutputFile("--out", args->out).Check();
       RequireImageName("--out", args->out);
+      // An image of another kind at its path (a protocol named .png, a JPEG named .png) is not replaced.
+      RequireOwnFile("--out", args->out, "an image of the kind its name says", ImageOfExtension(args->out));
     }
     // The pre-flight of blurcue run: the same checks, and every trial's scene already worked out.
     preview::SheetOptions options;

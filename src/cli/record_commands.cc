@@ -1,12 +1,15 @@
 // blurcue export / merge: the SQLite record out to analysis tables, and several stations' records into one.
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "cli/commands.h"
+#include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/own_output.h"
 #include "core/typed.h"
 #include "store/export.h"
 #include "store/record.h"
@@ -40,11 +43,17 @@ void AddExportCommand(CLI::App& app) {
       "A record of an earlier version is exported from a migrated copy; the record itself is only read.\n"
       "The folder is written as a whole: built beside DIR as .DIR.partial-PID and swapped in at the end, so an\n"
       "interrupted export leaves the previous tables complete (its leftovers are removed by the next export). An\n"
-      "existing DIR must hold only such tables: a folder of other files is refused, not replaced.\n"
+      "existing DIR must hold only such tables, its codebook.csv among them: a folder of other files (or of one's own\n"
+      "trials.csv alone) is refused, not replaced.\n"
       "Example: blurcue export --db results/study.sqlite --out results/tables");
   cmd->add_option("--db", args->db, "the SQLite record")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "folder for the tables (created)")->required();
   cmd->callback([args] {
+    // export replaces DIR whole when it holds only names of its tables: a folder of one's own trials.csv alone was
+    // replaced. Tables export wrote always hold its codebook.csv, with this header.
+    RequireMarkedFolder("--out", args->out, "codebook.csv", "tables export wrote", "one's own trials.csv?");
+    RequireOwnFile("--out", std::filesystem::path(args->out) / "codebook.csv", "a codebook.csv export wrote",
+                   BeginsWith("table,column,type,unit,allowed,meaning"));
     const int64_t rows = store::ExportCsv(args->db, args->out, [](const std::string& line) {
       std::fprintf(stderr, "export: %s\n", line.c_str());
     });

@@ -10,6 +10,8 @@
 #include "calib/scene_blur.h"
 #include "cli/commands.h"
 #include "core/output_guard.h"
+#include "core/own_output.h"
+#include "display/profile.h"
 #include "core/error.h"
 #include "core/names.h"
 #include "core/typed.h"
@@ -212,8 +214,19 @@ void AddRenderCommand(CLI::App& app) {
       ->check(FiniteRange(0, 100, ""));
   cmd->add_option("--backend", args->backend, "blur on gl or cpu")->capture_default_str()
       ->check(CLI::IsMember({"gl", "cpu"}));
-  cmd->add_option("--display-width", args->display_width, "scale the output to this width (0 = full resolution)")
-      ->transform(IntRange(0, 7680, "px"));
+  cmd->add_option("--display-width", args->display_width,
+                  "scale the output to this width (0 = full resolution; else a display's width, " +
+                      std::to_string(display::kMinWidthPx) + " to " + std::to_string(display::kMaxWidthPx) + " px)")
+      ->transform(IntRange(0, display::kMaxWidthPx, "px"))
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            const int w = std::atoi(text.c_str());
+            if (w == 0 || w >= display::kMinWidthPx) return "";
+            return "must be 0 (the photo's own width) or a display's width, " + std::to_string(display::kMinWidthPx) +
+                   " to " + std::to_string(display::kMaxWidthPx) + " px (a display profile's width_px range), got " +
+                   text;
+          },
+          ""));
   cmd->add_option("--cutoff", args->cutoff, "picture: Butterworth cut-off, cycles per picture width (0 = sharp)")
       ->check(FiniteRange(0, render::kMaxCutoffCyclesPerWidth, "cycles per picture width"));
   cmd->add_option("--picture-height-px", args->picture_height, "picture: its height on screen (default 60 % of the "
@@ -235,6 +248,8 @@ void AddRenderCommand(CLI::App& app) {
       }
       guard.OutputFile("--out", args->out).Check();
       RequireImageName("--out", args->out);
+      // An image of another kind at its path (a protocol named .png, a JPEG named .png) is not replaced.
+      RequireOwnFile("--out", args->out, "an image of the kind its name says", ImageOfExtension(args->out));
     }
     if (ParseObject(args->object).kind == "picture") return RenderPicture(*args);
     RenderObject(*args, t0);

@@ -10,6 +10,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/output_guard.h"
+#include "core/own_output.h"
 #include "optics/fit.h"
 #include "track/take.h"
 
@@ -39,7 +40,7 @@ void AddTrackCommand(CLI::App& app) {
       "A damaged or truncated video, or a frame missing from a sequence, ends the take: what was tracked before it\n"
       "is written, and the error is reported (exit 3). docs/track.md explains the output.\n"
       "DIR is built beside its place and swapped in whole: an earlier track there stays until the new one is\n"
-      "complete. DIR must be new or hold only a track's files, and may not hold the take.\n"
+      "complete. DIR must be new or hold only a track's files, its track.csv among them, and may not hold the take.\n"
       "Example: blurcue track take/frame-%04d.png --camera take/camera.json --out take/track");
   cmd->add_option("input", args->input, "video file, or printf pattern of an image sequence (frame-%04d.png)")
       ->required();
@@ -68,6 +69,11 @@ void AddTrackCommand(CLI::App& app) {
       } catch (const Error& e) {
         throw e.Wrapped(e.kind(), "--out ");
       }
+      // A folder of one's own calib-NNNN.json or a track.csv of another tool passed the names' check and was
+      // replaced: a take track wrote always holds its track.csv, with this header.
+      RequireMarkedFolder("--out", args->out, "track.csv", "a take track wrote", "one's own calib-NNNN.json files?");
+      RequireOwnFile("--out", std::filesystem::path(args->out) / "track.csv", "a track.csv track wrote",
+                     BeginsWith("frame,time_s,status,reprojection_error_px,"));
       RemoveLeftoversBeside("track", args->out);
     }
     const Board board = Board::Parse(args->board, args->square_mm);

@@ -157,8 +157,11 @@ std::vector<CheckedGroup> CheckAsRunWould(const Args& args, const std::optional<
   } catch (const Error& e) {
     const std::string message = e.what();
     if (message.find(": no such file: ") == std::string::npos) throw;
-    throw e.Wrapped(e.kind(), "", "('blurcue init DIR --from EXAMPLE' makes a shipped example a study folder with "
-                                  "its own scene and calibration; --no-files skips the file checks)");
+    // One problem is one line, the hint at its end; a list keeps its own lines and the hint as the last.
+    const std::string hint = "'blurcue init DIR --from EXAMPLE' makes a shipped example a study folder with its own "
+                             "scene and calibration; --no-files skips the file checks";
+    if (e.lines().size() == 1) throw Error(e.kind(), message + " (" + hint + ")");
+    throw e.Wrapped(e.kind(), "", "(" + hint + ")");
   }
   return checked;
 }

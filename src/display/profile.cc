@@ -141,8 +141,8 @@ std::vector<std::string> ValidateProfile(const Json& json, const std::filesystem
     else if (!IsPrintableUtf8(name))
       check.Problem("/name", "must not contain control characters (line breaks, tabs, escapes), got " + Echo(name));
   }
-  check.Number(json, "width_px", 320, 16384, "px", &p.width_px);
-  check.Number(json, "height_px", 200, 16384, "px", &p.height_px);
+  check.Number(json, "width_px", kMinWidthPx, kMaxWidthPx, "px", &p.width_px);
+  check.Number(json, "height_px", kMinHeightPx, kMaxHeightPx, "px", &p.height_px);
   check.Number(json, "width_mm", 50, 20000, "mm", &p.width_mm);
   check.Number(json, "height_mm", 30, 20000, "mm", &p.height_mm);
   check.Number(json, "distance_mm", 100, 20000, "mm", &p.distance_mm);

@@ -21,6 +21,9 @@ namespace blurcue::display {
 
 enum class TransferKind { kSrgb, kGamma, kMeasured };
 
+// The resolutions a display profile accepts (width_px, height_px): no participant's display is smaller or larger.
+inline constexpr int kMinWidthPx = 320, kMaxWidthPx = 16384, kMinHeightPx = 200, kMaxHeightPx = 16384;
+
 struct LuminancePoint {
   double level = 0;   // drive level, 0..1
   double cd_m2 = 0;   // measured luminance

@@ -75,10 +75,15 @@ LiveSummary Summarize(const std::vector<LiveRow>& rows, int dropped, const std::
   s.median_track_ms = Percentile(track, 0.5);
   s.median_render_ms = Percentile(render, 0.5);
   s.median_measure_ms = Percentile(measure, 0.5);
-  if (rows.size() >= 2 && rows.back().display_s > rows.front().display_s)
-    s.shown_fps = (rows.size() - 1) / (rows.back().display_s - rows.front().display_s);
-  if (rows.size() >= 2 && rows.back().arrival_s > rows.front().arrival_s)
-    s.delivered_fps = (rows.back().frame - rows.front().frame) / (rows.back().arrival_s - rows.front().arrival_s);
+  // Both rates over one span, the arrivals of the first and the last frame shown, so that the frames shown are a part
+  // of those delivered: shown <= delivered, equal when none was dropped between. (The shown rate was taken between
+  // the first and last display: when the first frame took longer than the last - a full detection, a warm-up - that
+  // span was the shorter, and 60 frames delivered at 31.2 a second read as 31.5 shown.)
+  if (rows.size() >= 2 && rows.back().arrival_s > rows.front().arrival_s) {
+    const double span_s = rows.back().arrival_s - rows.front().arrival_s;
+    s.shown_fps = (rows.size() - 1) / span_s;
+    s.delivered_fps = (rows.back().frame - rows.front().frame) / span_s;
+  }
   return s;
 }
 

@@ -44,9 +44,11 @@ struct LiveSummary {
   double median_track_ms = 0, median_render_ms = 0, median_measure_ms = 0;
   int sections_per_frame = 0;  // the most sections a frame measured (--measure-sections)
   int lens_sections = 0;  // the readings the last frame's lens model was fitted to live (0: the given model)
-  double shown_fps = 0;   // frames shown a second, between the first display and the last
-  double delivered_fps = 0;  // frames the input delivered a second (dropped ones too), between the first arrival shown
-                             // and the last: a camera's own rate, or a video's pace when its decoding kept up
+  // Frames a second over one span, from the arrival of the first frame shown to that of the last: shown_fps counts
+  // the frames shown, delivered_fps every frame the input delivered (dropped ones too: a camera's own rate, or a
+  // video's pace when its decoding kept up); shown_fps <= delivered_fps, equal when none was dropped.
+  double shown_fps = 0;
+  double delivered_fps = 0;
   std::string ended;      // why the run ended, in words
   double cpu_ms_per_frame = 0;  // the process's CPU time over the run (every thread: reader, decoder, GL) / frames shown
   int preloaded_frames = 0;  // --preload: frames decoded before the start (their decoding untimed); 0: decoded as played

@@ -2,6 +2,7 @@
 // same frame (the causal streak), the log's summary against hand-worked numbers, INPUT's camera names.
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -128,7 +129,7 @@ std::filesystem::path GreyVideo(const std::string& name, int frames) {
 TEST(PacedSource, APreloadedVideoDeliversEveryFrameAsDecodedAndEndsAsOneDecodedWhilePlayed) {
   const std::filesystem::path video = GreyVideo("preload", 5);
   PacedSource source(video.string(), 100, 0);
-  source.Preload();
+  source.Preload(cv::Size(64, 48));
   EXPECT_EQ(source.preloaded_frames(), 5);
   EXPECT_NEAR(source.preloaded_mb(), 5 * 64 * 48 * 3 * 1e-6, 1e-9);
   FrameMailbox box;
@@ -155,7 +156,7 @@ TEST(PacedSource, APreloadBeyondItsMemoryIsOneUsageLineNamingTheFramesThatFit) {
   const double frame_mb = 64 * 48 * 3 * 1e-6;
   try {
     PacedSource source(video.string(), 30, 0);
-    source.Preload(3.5 * frame_mb);
+    source.Preload(cv::Size(64, 48), 3.5 * frame_mb);
     ADD_FAILURE() << "5 frames preloaded into room for 3";
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::kUsage);
@@ -165,10 +166,44 @@ TEST(PacedSource, APreloadBeyondItsMemoryIsOneUsageLineNamingTheFramesThatFit) {
     EXPECT_NE(std::string(e.what()).find("give --frames 3"), std::string::npos) << e.what();
   }
   PacedSource three(video.string(), 30, 3);
-  three.Preload(3.5 * frame_mb);
+  three.Preload(cv::Size(64, 48), 3.5 * frame_mb);
   EXPECT_EQ(three.preloaded_frames(), 3);
   std::filesystem::remove(video);
-  EXPECT_THROW(PacedSource("/dev/video42", nullptr, 0).Preload(), Error);  // a camera decodes its own frames
+  EXPECT_THROW(PacedSource("/dev/video42", nullptr, 0).Preload(cv::Size(64, 48)), Error);  // a camera decodes its own frames
+}
+
+// An image sequence's frames are counted, so its size is known before a frame is decoded: the refusal comes at once,
+// in round numbers (it came after decoding up to the limit - 12 s and 2 GB for 900 frames - and said "more than 761
+// frames" and "2.63122 MB"). The files here are no images: decoding one would end the preload on a damaged frame
+// instead, so the refusal shows it decoded none.
+TEST(PacedSource, ASequenceTooLargeToPreloadIsRefusedBeforeAFrameIsDecoded) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("blurcue-live-sequence-" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  for (int i = 0; i < 900; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame-%04d.png", i);
+    std::ofstream(dir / name) << "not a PNG";
+  }
+  const std::string pattern = (dir / "frame-%04d.png").string();
+  const cv::Size size(1148, 764);  // 2.63 MB a frame: 760 fit in 2000 MB
+  try {
+    PacedSource source(pattern, 30, 0);
+    source.Preload(size, 2000);
+    ADD_FAILURE() << "900 frames of 2.6 MB preloaded into 2000 MB";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::kUsage) << e.what();
+    EXPECT_EQ(std::string(e.what()), pattern + ": --preload would hold its 900 frames decoded, 2.6 MB each (2368 MB): "
+                                               "more than the 2000 MB it may hold (760 frames); give --frames 760, or "
+                                               "leave --preload out");
+  }
+  // --frames within the limit: those are decoded (and the first is no image: the preload ends on it, as a damaged
+  // frame ends it, with the error kept for the end of the run).
+  PacedSource fits(pattern, 30, 760);
+  EXPECT_NO_THROW(fits.CheckPreloadFits(size, 2000));
+  fits.Preload(size, 2000);
+  EXPECT_EQ(fits.preloaded_frames(), 0);
+  std::filesystem::remove_all(dir);
 }
 
 // A board face-on at 500 mm moving -10 mm in x a frame, 30 frames a second (stimulus/tracked_take_test.cc's take).
@@ -308,6 +343,33 @@ TEST(LiveLog, SummaryCountsAndNearestRankLatencies) {
   EXPECT_EQ(s.max_latency_ms, 20);
   EXPECT_NE(SummaryLine(s).find("20 frames shown, 1 dropped (4.8 %)"), std::string::npos) << SummaryLine(s);
   EXPECT_EQ(SummaryLine(s).find("lens model"), std::string::npos) << SummaryLine(s);  // no --measure-sections
+}
+
+// The two rates are taken over one span, so the frames shown are a part of those delivered. A first frame slower
+// than the rest (a full detection) made the shown rate, taken between the first and last display, the larger:
+// 60 frames delivered at 30 a second, none dropped, read "30.6 frames a second shown of 30.0 delivered".
+TEST(LiveLog, FramesShownASecondAreAPartOfThoseDelivered) {
+  std::vector<LiveRow> rows;
+  for (int i = 0; i < 60; ++i) {
+    LiveRow r;
+    r.frame = i;
+    r.arrival_s = i / 30.0;
+    r.latency_ms = i == 0 ? 60 : 20;
+    r.display_s = r.arrival_s + r.latency_ms / 1000;
+    rows.push_back(r);
+  }
+  LiveSummary s = Summarize(rows, 0, "ended");
+  EXPECT_NEAR(s.delivered_fps, 30, 1e-9);
+  EXPECT_NEAR(s.shown_fps, 30, 1e-9);  // none dropped: every frame delivered was shown
+  EXPECT_NE(SummaryLine(s).find("30.0 frames a second shown of 30.0 delivered"), std::string::npos)
+      << SummaryLine(s);
+  // Every other frame dropped: half of them shown, whatever the latencies.
+  std::vector<LiveRow> half;
+  for (size_t i = 0; i < rows.size(); i += 2) half.push_back(rows[i]);
+  half.back().latency_ms = 5, half.back().display_s = half.back().arrival_s + 0.005;
+  s = Summarize(half, 29, "ended");
+  EXPECT_NEAR(s.delivered_fps, 30, 1e-9);
+  EXPECT_NEAR(s.shown_fps, 15, 1e-9);
 }
 
 // A run with --measure-sections says whether its lens model was ever fitted live (a take too short for 3 edges'

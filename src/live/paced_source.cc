@@ -1,6 +1,9 @@
 #include "live/paced_source.h"
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <regex>
 
 #include <opencv2/core/utils/logger.hpp>
@@ -104,10 +107,41 @@ bool PacedSource::WaitUntil(Clock::time_point due) {
 
 void PacedSource::DecodeVideo() { DecodeFrames(kDecodeAhead, 0); }
 
-double PacedSource::Preload(double max_mb, const std::atomic<int>* interrupt) {
+int PacedSource::FramesToPreload() const {
+  const int most = max_frames_ > 0 ? max_frames_ : std::numeric_limits<int>::max();
+  if (file_->is_video()) return std::min(file_->expected_frames(), most);
+  int frames = 0;
+  std::error_code error;
+  while (frames < most && std::filesystem::exists(track::PatternFile(input_, frames), error)) ++frames;
+  return frames;
+}
+
+Error PacedSource::TooMuchToPreload(int frames, bool known, double frame_mb, double max_mb) const {
+  // Round numbers for a person: whole frames and MB, a frame's MB to a tenth.
+  const int fit = int(max_mb / frame_mb);
+  char each[96];
+  std::snprintf(each, sizeof each, "%.1f MB each%s", frame_mb,
+                known ? (" (" + std::to_string(int(std::lround(frames * frame_mb))) + " MB)").c_str() : "");
+  return Error(ErrorKind::kUsage, input_ + ": --preload would hold " +
+                                      (known ? "its " + std::to_string(frames) : "more than " + std::to_string(fit)) +
+                                      " frames decoded, " + each + ": more than the " + Num(max_mb) +
+                                      " MB it may hold (" + std::to_string(fit) + " frames); give --frames " +
+                                      std::to_string(fit) + ", or leave --preload out");
+}
+
+void PacedSource::CheckPreloadFits(cv::Size frame_size, double max_mb) const {
   if (!file_)
     throw Error(ErrorKind::kUsage, "--preload: " + device_ + " is a camera, which hands over its frames decoded already; "
                                    "--preload is for a video or an image sequence");
+  // Refused before a frame is decoded (it was found after decoding up to the limit: 12 s and 2 GB for a sequence of
+  // 900 frames).
+  const double frame_mb = 1e-6 * 3.0 * frame_size.area();
+  if (const int frames = FramesToPreload(); frame_mb > 0 && frames * frame_mb > max_mb)
+    throw TooMuchToPreload(frames, true, frame_mb, max_mb);
+}
+
+double PacedSource::Preload(cv::Size frame_size, double max_mb, const std::atomic<int>* interrupt) {
+  CheckPreloadFits(frame_size, max_mb);
   const auto t0 = Clock::now();
   interrupt_ = interrupt;
   DecodeFrames(0, max_mb);
@@ -149,17 +183,10 @@ bool PacedSource::DecodeFrames(int ahead_limit, double max_mb) {
       ++read;
       const double frame_mb = 1e-6 * double(frame.image.total() * frame.image.elemSize());
       held_mb += frame_mb;
-      if (max_mb > 0) {
-        // Known once the first frame is decoded: the video's header says how many follow.
-        const int promised = std::max(read, std::min(file_->expected_frames(), max_frames_ > 0 ? max_frames_ : 1 << 30));
-        if (held_mb > max_mb || promised * frame_mb > max_mb) {
-          const std::string most = std::to_string(int(max_mb / frame_mb));
-          too_much = input_ + ": --preload would hold " + (promised > read ? "its " : "more than ") +
-                     std::to_string(promised) + " frames decoded, " + Num(frame_mb) + " MB each: more than the " +
-                     Num(max_mb) + " MB it may hold (" + most + " frames); give --frames " + most +
-                     ", or leave --preload out";
-          break;
-        }
+      // A video whose header gives no count, or frames larger than the camera's: found as they are decoded.
+      if (max_mb > 0 && held_mb > max_mb) {
+        too_much = TooMuchToPreload(read, false, frame_mb, max_mb).what();
+        break;
       }
       std::lock_guard<std::mutex> lock(mutex_);
       ahead_.push_back(std::move(frame));

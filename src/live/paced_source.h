@@ -53,12 +53,16 @@ class PacedSource {
 
   // A video or a sequence decoded whole before the clock starts (--preload): the frames are then delivered at their
   // pace from memory, as a camera hands over frames it has decoded itself, and no decoding competes with the drawing.
-  // Returns the seconds the decoding took. Throws Error(kUsage) naming INPUT when the frames would hold more than
-  // `max_mb` MB (before decoding them when the video's header says how many there are) or for a camera; a damaged
+  // Returns the seconds the decoding took. `frame_size`: the size every frame has (camera.json's; a frame of another
+  // size is refused when shown): with the frames INPUT holds - a video's header, a sequence's files counted - it
+  // gives the memory they need before a frame is decoded. Throws Error(kUsage) naming INPUT when that is more than
+  // `max_mb` MB - at once; while decoding, for a video whose header gives no count - or for a camera; a damaged
   // frame ends the preload, and the frames before it are played, then the error (as without it). `interrupt`, when
   // given and non-zero (a signal's number: Ctrl-C), ends the decoding at the next frame: the frames decoded so far
   // are held, and the input ends there.
-  double Preload(double max_mb = kMaxPreloadMb, const std::atomic<int>* interrupt = nullptr);
+  double Preload(cv::Size frame_size, double max_mb = kMaxPreloadMb, const std::atomic<int>* interrupt = nullptr);
+  // Preload's refusal before decoding, alone (for a caller to refuse before it says it decodes); Preload calls it.
+  void CheckPreloadFits(cv::Size frame_size, double max_mb = kMaxPreloadMb) const;
   // Frames held decoded by Preload (0: none, decoded as they are played), and the MB they hold.
   int preloaded_frames() const { return preloaded_frames_; }
   double preloaded_mb() const { return preloaded_mb_; }
@@ -73,6 +77,11 @@ class PacedSource {
 
  private:
   void DecodeVideo();
+  // The frames a preload would decode, known before decoding: a video's header count, a sequence's files from 0 up to
+  // the first missing one, at most max_frames_ (0: a video whose header does not say).
+  int FramesToPreload() const;
+  // Error(kUsage) naming INPUT: `frames` (or more than them when !known) of `frame_mb` MB do not fit in `max_mb`.
+  Error TooMuchToPreload(int frames, bool known, double frame_mb, double max_mb) const;
   // Decodes frames into ahead_ until the input ends, `max_frames_`, `ahead_limit` frames are waiting (0: no limit) or
   // Stop; false when stopped. At its end sets decoded_end_, end_why_ and end_error_. `max_mb` > 0: throws Error(kUsage)
   // when the frames decoded would hold more.

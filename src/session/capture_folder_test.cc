@@ -56,6 +56,15 @@ TEST(CaptureFolder, OnlyThisParticipantsEarlierCaptureMayBeThere) {
   EXPECT_NE(notes.find("holds 'notes.txt', which is not a capture"), std::string::npos) << notes;
 }
 
+TEST(CaptureFolder, ImagesWithoutACapturesJsonAreSomeonesOwn) {
+  store::testing::TempDir dir;
+  fs::create_directories(dir / "shots");
+  std::ofstream(dir / "shots" / "trial-0001.png") << "my own photo";  // was overwritten by the first trial's frame
+  const std::string own = ErrorOf(dir / "shots", "P1");
+  EXPECT_NE(own.find("holds 'trial-0001.png' and no trial-NNNN.json: images, not a capture"), std::string::npos)
+      << own;
+}
+
 TEST(CaptureFolder, AFolderThatCannotBeWrittenStopsBeforeTheSession) {
   store::testing::TempDir dir;
   fs::create_directories(dir / "shots");

@@ -61,7 +61,10 @@ void CheckCaptureFolder(const std::filesystem::path& dir, const std::string& stu
     throw InputError(where, "--capture: cannot make a folder here (" + (ec ? ec.message() : std::string("not a folder")) +
                                 ")");
   // Empty, or an earlier capture of this participant in this study (a resumed session goes on where it left off):
-  // anything else would be overwritten or mixed with this session's frames.
+  // anything else would be overwritten or mixed with this session's frames. A capture's images come with its
+  // trial-NNNN.json: images alone are someone's own (they were overwritten).
+  std::string first_image;
+  int captures = 0;
   for (const fs::directory_entry& entry : fs::directory_iterator(dir, ec)) {
     const std::string name = entry.path().filename().string();
     if (entry.is_symlink())
@@ -69,7 +72,11 @@ void CheckCaptureFolder(const std::filesystem::path& dir, const std::string& stu
     if (!IsCaptureFile(name) || !entry.is_regular_file())
       throw InputError(where, "--capture: holds " + Echo(name) + ", which is not a capture; capture into an empty "
                               "folder (or one holding only this participant's earlier capture)");
-    if (entry.path().extension() != ".json") continue;
+    if (entry.path().extension() != ".json") {
+      if (first_image.empty()) first_image = name;
+      continue;
+    }
+    ++captures;
     std::string owner;
     try {
       const Json frame = ReadJsonFile(entry.path());
@@ -84,6 +91,9 @@ void CheckCaptureFolder(const std::filesystem::path& dir, const std::string& stu
                               "session would overwrite; capture into another folder");
   }
   if (ec) throw InputError(where, "--capture: cannot list the folder (" + ec.message() + ")");
+  if (!first_image.empty() && captures == 0)
+    throw InputError(where, "--capture: holds " + Echo(first_image) + " and no trial-NNNN.json: images, not a "
+                            "capture (one's own?); capture into another folder");
   // Writable now, not at the first trial: a read-only folder used to stop the session there, left running at 0.
   const fs::path probe = dir / (".blurcue-capture-probe-" + std::to_string(getpid()));
   const int fd = ::open(probe.c_str(), O_CREAT | O_EXCL | O_WRONLY | O_NOFOLLOW | O_CLOEXEC, 0600);

@@ -190,9 +190,33 @@ struct PairDescription {
       if (!std::isfinite(r) || r < 0) throw Error(ErrorKind::kDomain, "radius " + std::to_string(r) + " px");
       return r;
     } catch (const Error& e) {
+      // An object placed at or behind the lens (a card raised 1 m over a table the camera looks down on) is the
+      // placement's problem, not the blur source's.
+      const double u_mm = scene.ToCamera(board_mm)[2];
+      if (!(u_mm > scene.camera.focal_length_mm))
+        throw InputError(PlacementField(), HeightText() + "places the " + protocol::ToString(protocol.content.type) +
+                                               " at u = " + Num(u_mm) + " mm from the lens (f = " +
+                                               Num(scene.camera.focal_length_mm) + " mm): " +
+                                               (u_mm <= 0 ? "behind the camera" : "nearer than its focal length") +
+                                               ", where no blur exists" + trial_text);
       throw InputError(Field(side), ToString(source) + " blur cannot be evaluated with " +
                                         protocol.scene.calib.string() + trial_text + ": " + e.what());
     }
+  }
+  // "is 1000 mm: " when the object's height placed it (PlacementField names a height), else "".
+  std::string HeightText() const {
+    const std::optional<double> level = NumberLevel("height_mm");
+    if (!level && protocol.content.height_mm == 0) return "";
+    return "is " + Num(level.value_or(protocol.content.height_mm)) + " mm: ";
+  }
+  // The field that placed the object: its height (a level, or content.height_mm), else the level that put it along
+  // the board; looked up only for a message.
+  std::string PlacementField() const {
+    if (NumberLevel("height_mm")) return At(protocol, protocol::LevelPointer(protocol, trial, "height_mm"));
+    if (protocol.content.height_mm != 0) return At(protocol, "/content/height_mm");
+    for (const char* name : {"left_x_mm", "right_x_mm", "y_mm", "edge"})
+      if (FindLevel(trial.levels, name)) return At(protocol, protocol::LevelPointer(protocol, trial, name));
+    return At(protocol, "/content");
   }
   // Edges and sections are the calibrated board's: its own count, whatever its size.
   int Edges() const { return scene.board.EdgeCount(); }
