@@ -164,9 +164,9 @@ void ApplyModel(CalibResult& result, const optics::FittedModel& model) {
     edge.r_fitted_px = 0;
     for (auto& s : edge.sections) {
       s.r_fitted_px = model.PredictPx(lens, s.u_mm) * s.stretch;
-      if (s.fit.ok) edge.r_fitted_px += s.r_fitted_px;
+      edge.r_fitted_px += s.r_fitted_px;
     }
-    if (edge.usable > 0) edge.r_fitted_px /= edge.usable;
+    if (!edge.sections.empty()) edge.r_fitted_px /= double(edge.sections.size());
   }
 }
 
@@ -405,7 +405,10 @@ Json PhaseChoiceJson(const PhaseChoice& c) {
                    "puts it; the family whose profiles fit best over all of them (their edges at other phases) is "
                    "taken, and "
                    "a section whose reading moves by more than max(0.04 px, 8 %) among the families that fit alike "
-                   "is flagged phase_limited, left out of the lens fit and predicted by it"}};
+                   "(or under a sharpening that cancels most of the optics' blur, or that jumps outside its "
+                   "neighbouring families' readings) is flagged phase_limited (phase_why says which) and predicted "
+                   "by the lens fit; it is left out of that fit but for those flagged by the cancellation alone "
+                   "(phase.joins_fit), which join it at their readings"}};
 }
 
 }  // namespace
@@ -503,7 +506,11 @@ std::string FormatEdgeTable(const CalibResult& r, const std::vector<double>& tru
   for (size_t i = 0; i < r.edges.size(); ++i) {
     const EdgeResult& e = r.edges[i];
     if (e.usable == 0) {
-      std::snprintf(line, sizeof line, "%4d %8.1f %6s %9s %9s %9s %9s", e.index, e.u_mm, "0/7", "-", "-", "-", "-");
+      const std::string none = "0/" + std::to_string(e.sections.size());
+      char fitted[32] = "        -";  // without a fitted model
+      if (r.model.samples_used > 0) std::snprintf(fitted, sizeof fitted, "%9.2f", e.r_fitted_px);
+      std::snprintf(line, sizeof line, "%4d %8.1f %6s %9s %9s %9s %s", e.index, e.u_mm, none.c_str(), "-", "-", "-",
+                    fitted);
     } else {
       char est[32] = "        -";  // eq. 3.7 does not hold nearer than focus
       if (e.estimated > 0) std::snprintf(est, sizeof est, "%9.2f", e.r_estimated_px);

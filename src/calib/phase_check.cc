@@ -529,7 +529,8 @@ std::string PhaseWhy(const SectionResult& s, double lo, double hi, double r, dou
     std::snprintf(why, sizeof why,
                   "the photo was sharpened after sampling and here the mask cancels %.0f %% of the optics' blur "
                   "(optics %.2f px, read %.2f px): a %.0f %% error in the optics' reading moves this one by %.2f px, "
-                  "more than max(%.2f px, %.0f %%); the lens fit predicts it",
+                  "more than max(%.2f px, %.0f %%); it joins the lens fit, which pools such sections, and is predicted "
+                  "by it",
                   100 * std::min(1.0, -4 * v / (r * r - 4 * v)), std::sqrt(r * r - 4 * v), r, 100 * kOpticsRel, moved,
                   kSpreadPx, 100 * kSpreadRel);
   return why;

@@ -44,8 +44,15 @@ void PrintCalibrationSummary(const calib::CalibResult& result, const Board& boar
   const auto& m = result.model;
   std::printf("board %s found; pose reprojection error %.3f px; board origin %.1f mm from the lens\n",
               board.Name().c_str(), result.pose.reprojection_error_px, cv::norm(result.pose.tvec));
-  std::printf("reference edge %d: u = %.1f mm, r = %.2f px (median of its usable sections)\n",
-              result.reference_edge, result.reference_u_mm, result.reference_r_px);
+  // calibrate.cc's SetReference takes a reference edge's phase_limited readings where none of its sections is usable.
+  const calib::EdgeResult& ref = result.edges[result.reference_edge - 1];
+  if (ref.usable > 0)
+    std::printf("reference edge %d: u = %.1f mm, r = %.2f px (median of its usable sections)\n",
+                result.reference_edge, result.reference_u_mm, result.reference_r_px);
+  else
+    std::printf("reference edge %d: u = %.1f mm, r = %.2f px (median of its phase_limited sections' readings: none "
+                "of them is usable, so eq. 3.7's estimates below are as unsure as they are)\n",
+                result.reference_edge, result.reference_u_mm, result.reference_r_px);
   std::printf("fitted %s model: focus %.1f mm, aperture %.3f mm (nominal %.3f), %s, rms %.3f px,"
               " leave-one-out %.3f px, %d outliers of %d\n",
               m.kind.c_str(), m.focus_mm, m.aperture_mm, camera.ApertureMm(), optics::FloorText(m).c_str(),
@@ -94,6 +101,19 @@ void PrintPhaseCheck(const calib::CalibResult& result) {
   if (result.phase.held > 0)
     std::printf("phase check: the model predicted %d phase_limited sections outside the range their families "
                 "leave open; their ranges' middles joined its fit\n", result.phase.held);
+  // What to do about them: a filter after sampling is the camera's (turning the board leaves it unmodelled: the
+  // check reads only sections along the pixel rows); without one, turning the board gives every edge all phases.
+  if (result.phase.flagged > 0) {
+    if (result.phase.chosen != 0)
+      std::printf("what to do: this photo was filtered after it was sampled (the camera's sharpening or smoothing); "
+                  "for measured blur on the flagged edges turn that processing off (or take raw) and photograph "
+                  "again - turning the board would leave the filter unread; until then the blur source `fitted` "
+                  "gives those places the model's value\n");
+    else
+      std::printf("what to do: for measured blur on the flagged edges turn the board a few degrees on the table so "
+                  "its edges cross the pixel rows (every phase is then sampled); the blur source `fitted` gives "
+                  "those places the model's value\n");
+  }
 }
 
 // Why this model (calib.json's model.choice): both candidates' held-out errors, and eq. 3.7 as published.
