@@ -21,9 +21,7 @@ if [ "$RESULTS" != results ]; then
     sed -e 's|"\.\./results/demo/|"../demo/|g' -e "s|\"\.\./stimuli/|\"$PWD/stimuli/|g" "$p" > "$PROTOCOLS/$(basename "$p")"
   done
 fi
-# A lens with a floor of blur (std 0.3 px), as real ones have: focused on edge 1 it still blurs there, which eq. 3.7
-# (the thesis's estimate, in test 2) takes from that edge; with none, eq. 3.7 refuses every point nearer than edge 1.
-$BC synth-scene --out "$OUT/scene" --seed 7 --noise 0.004 --floor-sigma-px 0.3
+$BC synth-scene --out "$OUT/scene" --seed 7 --noise 0.004
 $BC calibrate "$OUT/scene/scene.png" --camera "$OUT/scene/camera.json" --truth "$OUT/scene/truth.json" \
     --out "$OUT/calib.json"
 # A moving camera (the thesis's future work, 6.2): a short take of the same set-up with known per-frame truth - the lens

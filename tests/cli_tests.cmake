@@ -2,10 +2,8 @@
 set(BC $<TARGET_FILE:blurcue>)
 set(T ${PROJECT_BINARY_DIR}/cli-test)
 
-# A small ground-truth scene shared by the calibrate tests, with a real lens's floor of blur (std 0.3 px): a perfect
-# lens focused on edge 1 has no blur there, and eq. 3.7 as published then refuses every point nearer than edge 1,
-# where test 2's balls start (its reading 0.16 px for a true 0 px hid that until the shape fix of issue 42).
-add_test(NAME cli_synth_scene COMMAND ${BC} synth-scene --out ${T}/scene --seed 3 --noise 0.004 --floor-sigma-px 0.3)
+# A small ground-truth scene shared by the calibrate tests.
+add_test(NAME cli_synth_scene COMMAND ${BC} synth-scene --out ${T}/scene --seed 3 --noise 0.004)
 set_tests_properties(cli_synth_scene PROPERTIES FIXTURES_SETUP scene)
 
 add_test(NAME cli_calibrate_scene
