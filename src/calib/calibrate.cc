@@ -394,10 +394,10 @@ Json PhaseCheckJson(const PhaseCheck& p) {
 Json PhaseChoiceJson(const PhaseChoice& c) {
   Json families = Json::array();
   for (size_t i = 0; i < c.chi2.size(); ++i)
-    families.push_back({{"post_sigma_px", c.families[i].sigma_px}, {"sharpen", c.families[i].sharpen},
-                        {"fitted", c.families[i].fitted}, {"chi2", c.chi2[i]}, {"alike", bool(c.alike[i])}});
+    families.push_back({{"post_sigma_px", PhaseFamilies()[i].sigma_px}, {"sharpen", PhaseFamilies()[i].sharpen},
+                        {"chi2", c.chi2[i]}, {"alike", bool(c.alike[i])}});
   return {{"limited_sections", c.limited}, {"flagged", c.flagged}, {"held_the_model", c.held},
-          {"chosen", c.limited > 0 ? Json(c.families[c.chosen].Name()) : Json(nullptr)},
+          {"chosen", c.limited > 0 ? Json(PhaseFamilies()[c.chosen].Name()) : Json(nullptr)},
           {"chi2_per_point", c.chi2_per_point}, {"families", families}, {"summary", c.summary},
           {"note", "sections along the pixel rows or columns with blur under 2 px are read once per PSF family "
                    "(the optics, then on the sampled image a Gaussian of post_sigma_px or an unsharp mask of that std "

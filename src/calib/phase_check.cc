@@ -9,7 +9,6 @@
 #include "calib/calibrate.h"
 #include "calib/edge_esf.h"
 #include "calib/edge_window.h"
-#include "calib/phase_fit.h"
 #include "core/error.h"
 
 namespace blurcue::calib {
@@ -42,9 +41,6 @@ constexpr double kSpreadPx = 0.04, kSpreadRel = 0.08;
 // 1.5-3.3 %): where a sharpening mask cancels most of it, the section's reading is flagged when an error this size moves
 // it past the spread above (CancellationPx). Readings under kOpticsFloorPx count as that (the error is not relative).
 constexpr double kOpticsRel = 0.02, kOpticsFloorPx = 0.05;
-// A section off the line through its edge's others by more than this is flagged (FlagOffTheirEdge): the spread above
-// (0.03 px, 6 % flagged a correct section of a physical disc x 0.2 px floor scene, 0.035 px off its edge's line).
-constexpr double kEdgeLinePx = 0.04, kEdgeLineRel = 0.08;
 // Sections every family is read on before the families that fit them far worse are ruled out (ReadPhaseFamilies).
 constexpr size_t kChoiceSections = 12;
 
@@ -283,15 +279,13 @@ PhaseReading ReadFamily(const std::vector<Bin>& bins, const PhaseFamily& family,
 }  // namespace
 
 std::string PhaseFamily::Name() const {
-  char text[160];
+  char text[120];
   if (!(sigma_px > 0)) return "the optics alone";
-  const char* between = fitted ? ", fitted between the families" : "";
   if (sharpen > 0)
-    std::snprintf(text, sizeof text, "the optics then sharpening (unsharp mask of amount %.2f, std %.2f px%s)", sharpen,
-                  sigma_px, between);
+    std::snprintf(text, sizeof text, "the optics then sharpening (unsharp mask of amount %.2f, std %.2f px)", sharpen,
+                  sigma_px);
   else
-    std::snprintf(text, sizeof text, "the optics then a Gaussian of std %.2f px on the sampled image%s", sigma_px,
-                  between);
+    std::snprintf(text, sizeof text, "the optics then a Gaussian of std %.2f px on the sampled image", sigma_px);
   return text;
 }
 
@@ -301,8 +295,7 @@ const std::vector<PhaseFamily>& PhaseFamilies() {
   // mild to strong, over a narrow and a wide Gaussian.
   static const std::vector<PhaseFamily> families = {
       {0, 0},      {0.35, 0},   {0.4, 0},   {0.45, 0},  {0.5, 0},   {0.55, 0},  {0.6, 0}, {0.7, 0}, {0.8, 0},
-      {0.6, 0.15}, {0.6, 0.3},  {0.6, 0.5}, {0.6, 0.7}, {0.8, 0.15}, {0.8, 0.3}, {0.8, 0.5}, {0.8, 0.7},
-      {1.0, 0.15}, {1.0, 0.3}, {1.0, 0.5}, {1.0, 0.7}};
+      {0.6, 0.15}, {0.6, 0.3},  {0.6, 0.5}, {0.6, 0.7}, {1.0, 0.15}, {1.0, 0.3}, {1.0, 0.5}, {1.0, 0.7}};
   return families;
 }
 
@@ -423,37 +416,8 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
   // best (twice ChoosePhaseFamily's "alike" margins) are not read on the others. The rest of the choice is
   // ChoosePhaseFamily's over all of them, as before; the profiles' misfit of a ruled-out family only grows with more
   // sections, so it would not have been alike. On physical optics this reads 1-3 families on most sections, not 15.
-  result.phase.families = PhaseFamilies();
-  // Where the family that fits the sections `deciders` best is a filter, the filter between the families that fits
-  // them best (RefinePhaseFamily: about 30 readings of each), read on every limited section as one family more.
-  auto fit_between = [&](const std::vector<size_t>& deciders) {
-    const size_t nf = PhaseFamilies().size();
-    std::vector<double> total(nf, 0.0);
-    for (const size_t k : deciders)
-      for (size_t c = 0; c < nf; ++c) total[c] += usable[k]->phase.families[c].chi2;
-    const size_t best = std::min_element(total.begin(), total.end()) - total.begin();
-    if (best == 0) return;
-    std::vector<double> chi2(deciders.size());
-    const PhaseFamily fitted = RefinePhaseFamily(PhaseFamilies()[best], [&](const PhaseFamily& family) {
-      each(deciders.size(), [&](size_t i) {
-        const PhaseProfile& p = profiles[deciders[i]];
-        chi2[i] = ReadFamily(p.bins, family, p.r_fit, p.phi, p.w1, p.w2, p.shift, usable[deciders[i]]->phase.noise,
-                             p.one_shape).chi2;
-      });
-      double sum = 0;
-      for (const double v : chi2) sum += v;
-      return sum;
-    });
-    result.phase.families.push_back(fitted);
-    each(limited.size(), [&](size_t i) {
-      const PhaseProfile& p = profiles[limited[i]];
-      PhaseCheck& check = usable[limited[i]]->phase;
-      check.families.push_back(ReadFamily(p.bins, fitted, p.r_fit, p.phi, p.w1, p.w2, p.shift, check.noise, p.one_shape));
-    });
-  };
   if (limited.size() <= 2 * kChoiceSections) {
     each(limited.size(), [&](size_t i) { ReadFamilies(profiles[limited[i]], {}, &usable[limited[i]]->phase); });
-    fit_between(limited);
     return;
   }
   std::vector<size_t> by_phase = limited;
@@ -483,7 +447,6 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
   for (const size_t k : limited)
     if (!first[k]) rest.push_back(k);
   each(rest.size(), [&](size_t i) { ReadFamilies(profiles[rest[i]], read, &usable[rest[i]]->phase); });
-  fit_between(chosen);
 }
 
 namespace {
@@ -536,54 +499,11 @@ std::string PhaseWhy(const SectionResult& s, double lo, double hi, double r, dou
   return why;
 }
 
-// Blur changes smoothly along an edge (with its depth): an unflagged limited section whose reading lies more than
-// max(kEdgeLinePx, kEdgeLineRel) off the line (r against depth) through its edge's other unflagged limited sections (4 or
-// more) is flagged. Where an edge lies within about 0.1 px of a pixel centre its profile is a handful of samples and
-// the noise trades the optics' shape against its width section by section: under a Gaussian of 0.35 px on the sampled
-// image, edge 7's seven sections of one true blur (0.62 px) read 0.58-0.70 px under the family that fits, the
-// reading's spread among families 0.03 px (the bench's section off the rule unflagged, +12.5 %). Returns how many.
-int FlagOffTheirEdge(CalibResult& result) {
-  int flagged = 0;
-  for (auto& edge : result.edges) {
-    std::vector<SectionResult*> sections;
-    for (auto& s : edge.sections)
-      if (s.fit.ok && s.phase.limited) sections.push_back(&s);
-    if (sections.size() < 5) continue;
-    std::vector<std::pair<SectionResult*, double>> off;
-    for (SectionResult* s : sections) {
-      double n = 0, su = 0, sr = 0, suu = 0, sur = 0;
-      for (const SectionResult* o : sections)
-        if (o != s) n += 1, su += o->u_mm, sr += o->fit.r_px, suu += o->u_mm * o->u_mm, sur += o->u_mm * o->fit.r_px;
-      const double var_u = suu / n - (su / n) * (su / n);
-      const double slope = var_u > 1e-6 ? (sur / n - su / n * sr / n) / var_u : 0;  // 1e-6 mm^2: a level edge
-      const double line = sr / n + slope * (s->u_mm - su / n);
-      if (std::abs(s->fit.r_px - line) > std::max(kEdgeLinePx, kEdgeLineRel * s->fit.r_px)) off.emplace_back(s, line);
-    }
-    for (auto& [s, line] : off) {  // after every section was held to the others as read
-      char why[360];
-      std::snprintf(why, sizeof why,
-                    "its reading (%.2f px) lies %.2f px off the line through its edge's other %zu sections sampled at "
-                    "the same few phases (%.2f px here), more than max(%.2f px, %.0f %%): the profile's few samples let "
-                    "the noise trade the optics' shape against its width; the lens fit predicts it",
-                    s->fit.r_px, std::abs(s->fit.r_px - line), sections.size() - 1, line, kEdgeLinePx,
-                    100 * kEdgeLineRel);
-      s->fit.ok = false;
-      s->fit.flags.push_back("phase_limited");
-      s->fit.phase_why = why;
-      s->phase.range_lo_px = std::min({s->phase.range_lo_px, s->fit.r_px, line});
-      s->phase.range_hi_px = std::max({s->phase.range_hi_px, s->fit.r_px, line});
-      ++flagged;
-    }
-  }
-  return flagged;
-}
-
 }  // namespace
 
 PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   PhaseChoice choice;
-  const std::vector<PhaseFamily> families = result.phase.families.empty() ? PhaseFamilies() : result.phase.families;
-  choice.families = families;
+  const std::vector<PhaseFamily>& families = PhaseFamilies();
   std::vector<SectionResult*> limited;
   int points = 0;
   for (auto& edge : result.edges)
@@ -603,26 +523,18 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   // section's few phases leave the families alike; the edges' different phases tell them apart.
   for (const SectionResult* s : limited)
     for (size_t c = 0; c < families.size(); ++c) choice.chi2[c] += s->phase.families[c].chi2;
-  const size_t least = std::min_element(choice.chi2.begin(), choice.chi2.end()) - choice.chi2.begin();
+  const size_t best = std::min_element(choice.chi2.begin(), choice.chi2.end()) - choice.chi2.begin();
+  choice.chosen = best;
   const int dof = std::max(1, points - 3 * choice.limited - 1);
-  const double scale = std::max(1.0, choice.chi2[least] / dof);
+  choice.chi2_per_point = choice.chi2[best] / dof;
+  const double scale = std::max(1.0, choice.chi2_per_point);
   // Beyond the noise, a model error grows every family's chi-square with the points: then families within kAlikeRel
   // of the best's fit alike too.
   for (size_t c = 0; c < families.size(); ++c)
-    choice.alike[c] = choice.chi2[c] - choice.chi2[least] <= std::max(kAlikeChi2 * scale, kAlikeRel * choice.chi2[least]);
-  // A filter fitted between the families is taken only where it fits better than every family beyond the noise: one
-  // that only fits the noise (a Gaussian of 0.34 px on physical optics under a JPEG) leaves the family it came from,
-  // or the optics alone, as the reading; the fitted one's readings still count in the alike spread.
-  size_t best = least;
-  if (families[least].fitted)
-    for (size_t c = 0; c < families.size(); ++c)
-      if (!families[c].fitted && choice.alike[c] && (families[best].fitted || choice.chi2[c] < choice.chi2[best])) best = c;
-  choice.chosen = best;
-  choice.chi2_per_point = choice.chi2[best] / dof;
+    choice.alike[c] = choice.chi2[c] - choice.chi2[best] <= std::max(kAlikeChi2 * scale, kAlikeRel * choice.chi2[best]);
   const double v_best = TapsVariance(FamilyTaps(families[best]));
   int cancelled = 0, jumped = 0;
-  // A filter fitted between the families has no neighbours along one axis that bracket its reading.
-  const std::vector<size_t> neighbours = best < PhaseFamilies().size() ? PhaseNeighbours(best) : std::vector<size_t>{};
+  const std::vector<size_t> neighbours = PhaseNeighbours(best);
   for (SectionResult* s : limited) {
     double lo = 1e18, hi = -1e18;
     for (size_t c = 0; c < families.size(); ++c)
@@ -633,14 +545,11 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
     // follows the filter's parameter smoothly; one that lies outside their readings by more than the target is the
     // fit following something in the profile that no family explains. (With one neighbour, nothing brackets it.)
     double n_lo = 1e18, n_hi = -1e18;
-    int n_read = 0, n_blur = 0;
+    int n_read = 0;
     for (const size_t c : neighbours)
       if (const double v = s->phase.families[c].r_px; std::isfinite(v) && !(best == 0 && AtOwnFloor(families[c], v)))
-        n_lo = std::min(n_lo, v), n_hi = std::max(n_hi, v), ++n_read, n_blur += !(families[c].sharpen > 0);
-    // The optics alone lies between the Gaussians and the masks: only one of each brackets it (two masks of other
-    // stds, both on the sharpening side, flagged 6 correct sections of a physical disc x 0.2 px floor scene).
-    const bool brackets = best == 0 ? n_blur >= 1 && n_read - n_blur >= 1 : n_read >= 2;
-    const double jump = brackets ? std::max({0.0, n_lo - r, r - n_hi}) : 0;
+        n_lo = std::min(n_lo, v), n_hi = std::max(n_hi, v), ++n_read;
+    const double jump = n_read >= 2 ? std::max({0.0, n_lo - r, r - n_hi}) : 0;
     const double nearest = r < n_lo ? n_lo : n_hi;
     s->phase.range_lo_px = std::max(0.0, std::min({lo, r - moved, r - jump}));
     s->phase.range_hi_px = std::max({hi, r + moved, r + jump});
@@ -654,26 +563,21 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
     cancelled += hi - lo <= target && moved > target;
     jumped += hi - lo <= target && moved <= target;
   }
-  // Only where a filter after sampling was chosen: under the optics alone (physical optics) the blur fit's reading is
-  // the one the physical scenes hold to median 2 %, p90 5 %, and a section 9 % high on a Gaussian x 0.2 px floor scene
-  // would be flagged for noise the targets allow.
-  const int off_edge = best != 0 ? FlagOffTheirEdge(result) : 0;
-  choice.flagged += off_edge;
   int n_alike = 0, n_read = 0;
   for (const bool a : choice.alike) n_alike += a;
   for (const double c : choice.chi2) n_read += std::isfinite(c);
-  char text[600], ruled[120] = "";
+  char text[520], ruled[120] = "";
   if (n_read < int(families.size()))
     std::snprintf(ruled, sizeof ruled, "; %zu ruled out on %zu sections at spread phases and not read on the others",
                   families.size() - n_read, kChoiceSections);
   std::snprintf(text, sizeof text,
                 "%d usable sections sampled at few phases with blur under %.0f px, read as %s (%d of %zu PSF families "
                 "fit their profiles alike, chi-square per point %.2f%s); %d flagged phase_limited (%d where the "
-                "sharpening cancels most of the optics' blur, %d whose reading jumps between neighbouring families, "
-                "%d off the line through their edge's other sections; each reading's range in calib.json)",
+                "sharpening cancels most of the optics' blur, %d whose reading jumps between neighbouring families; "
+                "each reading's range in calib.json)",
                 choice.limited, kMaxBlurPx,
                 families[best].Name().c_str(),
-                n_alike, families.size(), choice.chi2_per_point, ruled, choice.flagged, cancelled, jumped, off_edge);
+                n_alike, families.size(), choice.chi2_per_point, ruled, choice.flagged, cancelled, jumped);
   choice.summary = text;
   return choice;
 }

@@ -25,7 +25,6 @@ namespace blurcue::calib {
 // assumes), or an unsharp mask, (1 + sharpen) x the identity - sharpen x that Gaussian (a negative second moment).
 struct PhaseFamily {
   double sigma_px = 0, sharpen = 0;
-  bool fitted = false;  // not one of PhaseFamilies(): refined between them (phase_fit.h)
   std::string Name() const;  // "the optics alone", "the optics then a Gaussian of std 0.45 px on the sampled image"
 };
 
@@ -75,9 +74,7 @@ struct CalibResult;
 // CheckPhase on every usable section of `result` (on every core when `parallel`), reading no more than the photo
 // needs: where more than 24 sections are limited, every family is read on 12 of them at phases spread over the pixel,
 // and on the others only the families that fit those 12 within twice ChoosePhaseFamily's "alike" margin of the best
-// (and the optics alone). Where that best is a filter, it is refined between the families on those 12 (all, with 24
-// or fewer; RefinePhaseFamily) and read on every limited section as one more family (result.phase.families). The
-// choice and the flags are ChoosePhaseFamily's, over every limited section.
+// (and the optics alone). The choice and the flags are ChoosePhaseFamily's, over every limited section, as before.
 void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFitOptions& options, bool parallel);
 
 // What the sections at other phases chose (calib.json's phase_check).
@@ -85,10 +82,7 @@ struct PhaseChoice {
   int limited = 0;               // usable sections whose phases are few (PhaseCheck::limited)
   int flagged = 0;               // of those, flagged phase_limited
   int held = 0;                  // of those, sections whose range held the lens model (FitModelWithinPhaseRanges)
-  // The families read on this photo: PhaseFamilies() and, where one of its filters fitted the sections at spread
-  // phases best, that filter refined between them (RefinePhaseFamily) last. Empty: PhaseFamilies().
-  std::vector<PhaseFamily> families;
-  size_t chosen = 0;             // the family chosen (in `families`; 0: the optics alone)
+  size_t chosen = 0;             // the family chosen (PhaseFamilies(); 0: the optics alone)
   // Per family: chi-square of its profiles over every limited section (the filter is the whole photo's), and whether
   // it fits them alike with the chosen one (within 25 after scaling by the best's chi-square per point, or 15 % of it).
   std::vector<double> chi2;
