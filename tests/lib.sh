@@ -33,3 +33,16 @@ install_moved() {
   cd "$W/elsewhere"
   unset BLURCUE_DATA_DIR BLURCUE_SHADER_DIR
 }
+
+# expect CODE TEXT ARGS...: $BC ARGS exits CODE within ${EXPECT_TIMEOUT:-20} s with one line on stderr (in $L/err.log)
+# holding TEXT; counts the case in $cases (outputs_guard_test.sh, outputs_own_test.sh).
+expect() {
+  local code=$1 text=$2 got=0 limit=${EXPECT_TIMEOUT:-20}
+  shift 2
+  timeout "$limit" $BC "$@" > "$L/out.log" 2> "$L/err.log" < /dev/null || got=$?
+  [ $got != 124 ] || fail "$*: still running after $limit s"
+  [ $got = "$code" ] || fail "$*: exit $got, expected $code: $(head -5 "$L/err.log")"
+  [ "$(wc -l < "$L/err.log")" = 1 ] || fail "$*: not one line: $(head -5 "$L/err.log")"
+  grep -qF -- "$text" "$L/err.log" || fail "$*: the message does not say '$text': $(cat "$L/err.log")"
+  cases=$((cases + 1))
+}

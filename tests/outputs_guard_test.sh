@@ -26,17 +26,7 @@ before=$(snapshot)
 
 AR=(ar take/take.avi --track track --ball 50,125 --quiet)
 cases=0
-# expect CODE TEXT ARGS...: blurcue ARGS exits CODE within 20 s with one line on stderr holding TEXT.
-expect() {
-  local code=$1 text=$2 got=0
-  shift 2
-  timeout 20 $BC "$@" > "$L/out.log" 2> "$L/err.log" < /dev/null || got=$?
-  [ $got != 124 ] || fail "$*: still running after 20 s"
-  [ $got = "$code" ] || fail "$*: exit $got, expected $code: $(cat "$L/err.log")"
-  [ "$(wc -l < "$L/err.log")" = 1 ] || fail "$*: not one line: $(cat "$L/err.log")"
-  grep -qF -- "$text" "$L/err.log" || fail "$*: the message does not say '$text': $(cat "$L/err.log")"
-  cases=$((cases + 1))
-}
+EXPECT_TIMEOUT=20  # expect: tests/lib.sh
 # 2. An output that is an input.
 expect 2 "--out same.avi: is also the input INPUT same.avi" ar same.avi --track track --ball 50,125 --out same.avi
 expect 2 "--frames cp: holds the input INPUT cp/frame-0000.png" ar 'cp/frame-%04d.png' --track track --ball 50,125 --out x.avi --frames cp

@@ -30,17 +30,7 @@ snapshot() { find . -type f ! -name '*-shm' ! \( -name '*-wal' -size 0 \) -print
 before=$(snapshot)
 
 cases=0
-# expect CODE TEXT ARGS...: blurcue ARGS exits CODE within 60 s with one line on stderr holding TEXT.
-expect() {
-  local code=$1 text=$2 got=0
-  shift 2
-  timeout 60 $BC "$@" > "$L/out.log" 2> "$L/err.log" < /dev/null || got=$?
-  [ $got != 124 ] || fail "$*: still running after 60 s"
-  [ $got = "$code" ] || fail "$*: exit $got, expected $code: $(head -3 "$L/err.log")"
-  [ "$(wc -l < "$L/err.log")" = 1 ] || fail "$*: not one line: $(head -5 "$L/err.log")"
-  grep -qF -- "$text" "$L/err.log" || fail "$*: the message does not say '$text': $(cat "$L/err.log")"
-  cases=$((cases + 1))
-}
+EXPECT_TIMEOUT=60  # expect: tests/lib.sh
 ANIM=(animate --calib "$T/calib.json" --background "$T/scene/scene.png" --from-edge 1 --to-edge 2 --speed-cm-s 100)
 # Files of another kind at a file output (each was replaced, exit 0).
 expect 3 "--log protocol.json: exists and is not a log animate wrote (it begins \"{\")" "${ANIM[@]}" --log protocol.json --video a.avi
