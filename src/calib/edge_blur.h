@@ -10,6 +10,11 @@
 
 namespace blurcue::calib {
 
+// Under this radius (px) a section whose profile does not tell the PSF's shape (ModelFit::shape_ambiguous) is read
+// with the Gaussian shape, by the blur fit and by the phase check's families alike: a shape the profile cannot tell
+// still moves the size there where the edge lies near a pixel centre (edge_blur.cc says what was measured).
+constexpr double kOneShapeBelowPx = 0.7;
+
 // A board edge parallel to a section and next to it: the same section of the edge before or after it, in image px,
 // its ends listed in the same order as the section's (a at the same column line as the section's a).
 struct NeighbourEdge {
@@ -64,7 +69,7 @@ struct ModelFit {
   // The shape within r_px^2 = disc_r_px^2 + 4 floor_sigma_px^2 (DESIGN.md): a defocus disc and a Gaussian floor.
   double disc_r_px = 0, floor_sigma_px = 0;
   double shape_se_rad = 0;         // standard error of the shape angle atan(2 floor_sigma / disc_r)
-  bool shape_ambiguous = true;     // the profile does not pin the split (r_px stays well determined)
+  bool shape_ambiguous = true;     // the profile does not pin the split (under kOneShapeBelowPx, read as a Gaussian)
   std::string psf;                 // "disc", "gaussian" or "disc x gaussian": the fitted shape
   double offset_px = 0;            // fitted edge position along the normal, relative to the segment line
   double step = 0;                 // signed step in linear light (dark->bright along the normal is > 0)
