@@ -43,11 +43,17 @@ phase_check(phase_physical_gauss gaussopt "\nok: physical targets met" --expect 
 # does not tell the PSF's shape, yet the shape moved the size: a disc fitted best by noise read 8-20 % high (edge 7),
 # measured p90 6.3-8.4 %, 2-6 sections off unflagged and 10-11 correct ones flagged (their jump judged against a
 # 0.35 px Gaussian stuck at its own floor). Now read with the Gaussian shape under 0.7 px where the shape is
-# ambiguous (an independent erf fit of the same pixels read them within 1 %), and no section flagged.
+# ambiguous (an independent erf fit of the same pixels read them within 1 %). Edges within 0.1 px of a pixel centre
+# at r 0.4-0.5 px still scatter 10-20 % with the noise: a section whose standard error with the shape held is over 2 %
+# is flagged and joins the lens fit at its reading (23-24 of 77 here; none at floor 0.45, phase_physical_disc).
 phase_scene(disc02 --focus-mm 430 --floor-sigma-px 0.2 --noise 0.003 --seed 22)
-phase_check(phase_physical_disc_floor02 disc02 "\nok: physical targets met" --expect physical --max-flagged 0)
+phase_check(phase_physical_disc_floor02 disc02 "too unsure near a pixel centre.*\nok: physical targets met" --expect physical --max-flagged 30)
 phase_scene(gauss02 --focus-mm 430 --psf gaussian --floor-sigma-px 0.2 --noise 0.003 --seed 26)
-phase_check(phase_physical_gauss_floor02 gauss02 "\nok: physical targets met" --expect physical --max-flagged 0)
+phase_check(phase_physical_gauss_floor02 gauss02 "\nok: physical targets met" --expect physical --max-flagged 30)
+# An adversary's sweep: focus 500 mm puts edges 8-11 at r 0.40-0.50 px near pixel centres; before, measured p90 6.5 %
+# and the fitted model 2.1 / 7.1 % (the optics alone's family reading stuck at r = 0 held it low).
+phase_scene(gauss02f500 --focus-mm 500 --psf gaussian --floor-sigma-px 0.2 --noise 0.0025 --seed 680)
+phase_check(phase_physical_floor02_focus500 gauss02f500 "\nok: physical targets met" --expect physical --max-flagged 30)
 # Focus on edge 1 (the thesis's set-up) and a JPEG of quality 90 over a post filter of std 0.45 px: only edges 1-8 are
 # under 2 px and the JPEG's blocks blur which family fits best (4 of 15 alike): 14 sections are flagged (edges 1 and 2,
 # their families' readings 0.77-0.91 px apart for a true 0.86-0.92 px) and predicted by the model, held to their
@@ -76,7 +82,7 @@ phase_check(phase_filtered_sharpen_05 sharpen05 "\nok: filtered targets met" --e
 phase_scene(sharpen07 --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.6 --post-amount 0.7
             --noise 0.0025 --seed 6)
 phase_check(phase_filtered_sharpen_07 sharpen07
-            "35 of them phase_limited where the sharpening cancels.*\nok: filtered targets met" --expect filtered --fitted-p90 0.10)
+            "35 of them phase_limited but joined at their readings.*\nok: filtered targets met" --expect filtered --fitted-p90 0.10)
 
 # The Gaussian post filter's ends (0.35 and 0.8 px, the bench's levels). At 0.35 px the optics alone fitted best and
 # 7 sections (edge 4) read 10-12 % high unflagged; now the 0.35 px family is chosen.

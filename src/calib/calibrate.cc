@@ -407,8 +407,10 @@ Json PhaseChoiceJson(const PhaseChoice& c) {
                    "a section whose reading moves by more than max(0.04 px, 8 %) among the families that fit alike "
                    "(or under a sharpening that cancels most of the optics' blur, or that jumps outside its "
                    "neighbouring families' readings) is flagged phase_limited (phase_why says which) and predicted "
-                   "by the lens fit; it is left out of that fit but for those flagged by the cancellation alone "
-                   "(phase.joins_fit), which join it at their readings"}};
+                   "by the lens fit; with the optics alone, one whose reading's standard error (r_se_px) exceeds "
+                   "2 % (an edge near a pixel centre) is flagged too; it is left out of that fit but for those "
+                   "flagged by the cancellation or the standard error alone (phase.joins_fit), which join it at "
+                   "their readings"}};
 }
 
 }  // namespace
@@ -440,6 +442,7 @@ Json CalibToJson(const CalibResult& r) {
                  {"thesis_ok", s.thesis.ok}};
       if (!s.estimated_note.empty()) js["r_estimated_note"] = s.estimated_note;
       if (!s.fit.crowded_why.empty()) js["crowded_why"] = s.fit.crowded_why;
+      if (s.fit.r_se_px > 0) js["r_se_px"] = s.fit.r_se_px;
       if (!s.fit.phase_why.empty()) js["phase_why"] = s.fit.phase_why;
       if (s.phase.limited) js["phase"] = PhaseCheckJson(s.phase);
       if (distorted) js["stretch"] = s.stretch;

@@ -489,13 +489,20 @@ void DescribeFit(const FitState& best, const std::array<std::array<double, 3>, 3
 void ReadOneShapeUnderAPixel(const FitSetup& setup, const FitState& best,
                              const std::array<std::array<double, 3>, 3>& jtj, const std::vector<Bin>& bins,
                              double d0_limit, ModelFit* fit) {
-  if (!(fit->shape_ambiguous && fit->r_px < kOneShapeBelowPx && best.phi < kPi / 2)) return;
+  if (!(fit->shape_ambiguous && fit->r_px < kOneShapeBelowPx)) return;
   FitState start_state = best;
   start_state.phi = kPi / 2;
-  const FitState gauss = FitShape(setup, start_state, /*free_phi=*/false, d0_limit);
+  std::array<std::array<double, 3>, 3> a{};
+  const FitState gauss = FitShape(setup, start_state, /*free_phi=*/false, d0_limit, &a);
   if (!std::isfinite(gauss.sse)) return;
   DescribeFit(gauss, jtj, setup, bins, fit);
   fit->shape_ambiguous = true;
+  // The size's standard error with the shape held: the Gauss-Newton curvature of the reduced problem over (d0, r),
+  // the residual variance per bin from the fit (model error included).
+  const int params = 2 + (setup.slopes ? 4 : 2) + static_cast<int>(setup.steps.size());
+  const double dof = std::max(1.0, double(bins.size()) - params);
+  const double det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+  if (det > 0 && std::isfinite(gauss.sse)) fit->r_se_px = std::sqrt(gauss.sse / dof * a[0][0] / det);
 }
 
 ModelFit FitInWindow(const cv::Mat& linear, const EdgeSegment& segment, const ModelFitOptions& options,

@@ -81,7 +81,7 @@ const std::vector<std::string> kSectionKeys = {"index", "u_mm", "midpoint_camera
                                                "r_estimated_px", "r_fitted_px", "ok", "flags", "psf", "disc_r_px",
                                                "floor_sigma_px", "shape_ambiguous", "fit_rms_rel", "step_linear",
                                                "thesis_ok", "r_estimated_note", "crowded_why", "stretch",
-                                               "phase", "phase_why"};
+                                               "phase", "phase_why", "r_se_px"};
 const std::vector<std::string> kModelKinds = {"thin_lens", "thin_lens+floor"};
 
 // A boolean field (absent: `absent`).

@@ -73,8 +73,9 @@ void PrintCalibrationSummary(const calib::CalibResult& result, const Board& boar
     for (const auto& e : result.edges)
       for (const auto& sec : e.sections) n_joined += sec.phase.joins_fit;
     if (n_joined > 0)
-      std::printf("%d of them phase_limited where the sharpening cancels most of the optics' blur: each reading unsure "
-                  "alone, pooled by the fit\n", n_joined);
+      std::printf("%d of them phase_limited but joined at their readings (a sharpening that cancels most of the "
+                  "optics' blur there, or an edge near a pixel centre): each reading unsure alone, pooled by the fit\n",
+                  n_joined);
     // Sections used but read on a shorter central part (a neighbouring X-junction within the blur's reach): said,
     // as the flag in calib.json says it, since such a reading can run a few per cent high.
     int n_short = 0;
