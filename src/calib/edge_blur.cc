@@ -495,8 +495,11 @@ void ReadOneShapeUnderAPixel(const FitSetup& setup, const FitState& best,
   std::array<std::array<double, 3>, 3> a{};
   const FitState gauss = FitShape(setup, start_state, /*free_phi=*/false, d0_limit, &a);
   if (!std::isfinite(gauss.sse)) return;
-  DescribeFit(gauss, jtj, setup, bins, fit);
-  fit->shape_ambiguous = true;
+  // A fit already at the Gaussian shape keeps its reading (only its standard error is taken from the re-fit).
+  if (best.phi < kPi / 2) {
+    DescribeFit(gauss, jtj, setup, bins, fit);
+    fit->shape_ambiguous = true;
+  }
   // The size's standard error with the shape held: the Gauss-Newton curvature of the reduced problem over (d0, r),
   // the residual variance per bin from the fit (model error included).
   const int params = 2 + (setup.slopes ? 4 : 2) + static_cast<int>(setup.steps.size());

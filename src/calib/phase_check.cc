@@ -516,7 +516,7 @@ std::string PhaseWhy(const SectionResult& s, double lo, double hi, double r, dou
 // the lens fit at its reading, as a cancelled one does (the fit pools them), and the model predicts it.
 bool FlagUnsureAtItsPhase(SectionResult* s) {
   const double r = s->fit.r_px;
-  if (!(s->fit.r_se_px > kMaxRelSe * r)) return false;
+  if (!s->phase.limited || !(s->fit.r_se_px > kMaxRelSe * r)) return false;  // few phases only
   char why[400];
   std::snprintf(why, sizeof why,
                 "with blur under a pixel (%.2f px) and its edge %.2f px past a pixel centre, the profile pins its blur "

@@ -192,7 +192,10 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
       out.midpoint_camera_mm = Vec3(sec, "midpoint_camera_mm", sw, kMaxDistanceMm, "mm");
       out.ok = Flag(sec, "ok", sw, false);
       // A section the fit gave up on keeps whatever number it had; only usable ones feed a blur.
-      out.r_px = out.ok ? Ranged(sec, "r_px", sw, 0, optics::kMaxBlurRadiusPx, "px") : RequireNumber(sec, "r_px", sw);
+      if (const auto ph = sec.find("phase"); ph != sec.end() && ph->is_object())
+        if (const auto jf = ph->find("joins_fit"); jf != ph->end() && jf->is_boolean()) out.pooled = *jf && !out.ok;
+      out.r_px = out.ok || out.pooled ? Ranged(sec, "r_px", sw, 0, optics::kMaxBlurRadiusPx, "px")
+                                      : RequireNumber(sec, "r_px", sw);
       s.sections.push_back(out);
     }
   }
@@ -266,7 +269,7 @@ double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& p, 
       double sum = 0;
       int usable = 0, listed = 0;
       for (const auto& s : scene.sections)
-        if (s.edge == nearest) ++listed, usable += s.ok, sum += s.ok ? s.r_px : 0;
+        if (s.edge == nearest) ++listed, usable += s.ok || s.pooled, sum += s.ok || s.pooled ? s.r_px : 0;
       if (usable == 0)
         throw Error(ErrorKind::kNotFound, "edge " + std::to_string(nearest) + " (the nearest) has no usable measured "
                                           "section (" + std::to_string(listed) + " listed, none usable), so its "

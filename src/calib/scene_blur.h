@@ -28,6 +28,9 @@ struct SceneCalib {
     cv::Vec3d midpoint_camera_mm;
     double r_px = 0;
     bool ok = false;
+    // Flagged phase_limited yet joined to the lens fit at its reading (calib.json phase.joins_fit): unsure alone, its
+    // edge's mean pools it (the blur source `measured`), `measured_section` does not take it.
+    bool pooled = false;
   };
   std::vector<Section> sections;
 
