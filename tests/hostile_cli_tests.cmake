@@ -454,3 +454,30 @@ hostile_test(cli_names_truth_other_board 3 "/board is 7x10 of 25 mm, not the --b
              calibrate ${T}/scene/scene.png --camera ${T}/scene/camera.json --board 10x7 --truth ${T}/scene/truth.json
              --out ${H}/names-calib.json)
 set_tests_properties(cli_names_truth_other_board PROPERTIES FIXTURES_REQUIRED scene)
+
+# --- mends: refusals and warnings around calibrate, render and run.
+# measured / measured_section where the nearest edge's sections are all flagged (here edge 5's, phase_limited, as a
+# photo filtered after sampling leaves an edge along the pixel rows): exit 4 and a line naming neither calib.json nor
+# its field. Now exit 3 naming the file, the sections' "ok" and their flags - through render and through a protocol.
+add_test(NAME cli_hostile_measured_flagged_make
+         COMMAND /usr/bin/python3 -c "import json, sys; c = json.load(open(sys.argv[1]))\nfor s in c['edges'][4]['sections']: s['ok'] = False; s['flags'] = ['phase_limited']\nc['edges'][4]['usable_sections'] = 0; json.dump(c, open(sys.argv[2], 'w'), indent=1)\np = json.load(open(sys.argv[3])); p['scene'] = {'background': sys.argv[5], 'calib': sys.argv[2], 'show': 'background'}; json.dump(p, open(sys.argv[4], 'w'), indent=1)"
+                 ${T}/calib.json ${H}/calib-e5.json ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json
+                 ${H}/protocol-e5.json ${T}/scene/scene.png)
+set_tests_properties(cli_hostile_measured_flagged_make PROPERTIES FIXTURES_REQUIRED "scene;calib"
+                     FIXTURES_SETUP measured_flagged)
+hostile_test(cli_hostile_render_measured_flagged_edge 3
+             "calib-e5.json: /edges/4: edge 5 (the nearest) has no usable measured section: "
+             render --calib ${H}/calib-e5.json --background ${T}/scene/scene.png --blur measured --at-edge 5 --out ${H}/x.png)
+hostile_test(cli_hostile_render_measured_section_flagged 3
+             "calib-e5.json: /edges/4/sections/3/ok: is false (flagged phase_limited): edge 5 section 4 (the nearest) is not usable"
+             render --calib ${H}/calib-e5.json --background ${T}/scene/scene.png --blur measured_section --at-edge 5
+             --out ${H}/x.png)
+hostile_test(cli_hostile_validate_measured_flagged_edge 3
+             "calib-e5.json: /edges/4: edge 5 (the nearest) has no usable measured section: "
+             validate ${H}/protocol-e5.json)
+hostile_test(cli_hostile_run_measured_flagged_edge 3
+             "calib-e5.json: /edges/4: edge 5 (the nearest) has no usable measured section: "
+             run ${H}/protocol-e5.json --participant P1 --db ${H}/measured-flagged.sqlite --observer sim)
+set_tests_properties(cli_hostile_render_measured_flagged_edge cli_hostile_render_measured_section_flagged
+                     cli_hostile_validate_measured_flagged_edge cli_hostile_run_measured_flagged_edge PROPERTIES
+                     FIXTURES_REQUIRED "scene;calib;measured_flagged")
