@@ -20,7 +20,7 @@ void AddTrackCommand(CLI::App& app) {
   struct Args {
     std::string input, camera, out, board = "7x10";
     double square_mm = 25, fps = 30, max_track_error_px = 0.5;
-    bool detect_every_frame = false, quiet = false;
+    bool detect_every_frame = false, quiet = false, board_turned = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -56,6 +56,10 @@ void AddTrackCommand(CLI::App& app) {
                   "a tracked pose whose corners' rms reprojection error exceeds this falls back to full detection")
       ->capture_default_str()->check(FinitePositive(100, "px"));
   cmd->add_flag("--detect-every-frame", args->detect_every_frame, "full detection on every frame (no tracking)");
+  cmd->add_flag("--board-turned", args->board_turned,
+                "take a board found with its edges within 10 deg of running straight away from the camera (refused\n"
+                "without it, as calibrate refuses it: every edge then lies at one depth, and a 10x7 board so found is\n"
+                "likelier a 7x10 one)");
   cmd->add_flag("--quiet", args->quiet, "print only errors");
   cmd->callback([args] {
     const auto t0 = std::chrono::steady_clock::now();
@@ -82,6 +86,9 @@ void AddTrackCommand(CLI::App& app) {
     track::TrackOptions options;
     options.max_track_error_px = args->max_track_error_px;
     options.always_detect = args->detect_every_frame;
+    // The check calibrate makes (calib/board_pose.h): a board detected with its edges running into depth is refused,
+    // before anything is written, naming the frame; --board-turned takes it.
+    options.calibrate.detect.refuse_edges_into_depth_deg = args->board_turned ? 0 : 10;
     track::Tracker tracker(camera, board, options);
     const int expected = source.expected_frames();
     auto progress = [&](const track::FrameResult& r) {
@@ -96,7 +103,14 @@ void AddTrackCommand(CLI::App& app) {
                            : "",
                    usable, r.frame_ms, r.note.empty() ? "" : " - ", r.note.c_str());
     };
-    const track::TakeResult take = track::TrackTake(source, tracker, progress);
+    const track::TakeResult take = [&] {
+      try {
+        return track::TrackTake(source, tracker, progress);
+      } catch (const Error& e) {
+        if (e.kind() != ErrorKind::kUsage) throw;
+        throw e.Wrapped(ErrorKind::kUsage, args->input + ": ");
+      }
+    }();
     track::WriteTake(take, args->out, args->input);
     const int n = static_cast<int>(take.frames.size());
     if (!args->quiet) {
