@@ -1,9 +1,11 @@
 // blurcue track: a video or image sequence tracked frame by frame (src/track).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "cli/commands.h"
 #include "core/camera.h"
@@ -15,6 +17,34 @@
 #include "track/take.h"
 
 namespace blurcue::cli {
+
+namespace {
+
+// What a take came to: its frames, how each was found, the take's lens model, what was written.
+void PrintTakeSummary(const track::TakeResult& take, const Camera& camera, const std::string& out,
+                      std::chrono::steady_clock::time_point t0) {
+  const int n = static_cast<int>(take.frames.size());
+  std::vector<double> ms;
+  for (const auto& f : take.frames) ms.push_back(f.frame_ms);
+  std::sort(ms.begin(), ms.end());
+  const double median = ms.empty() ? 0 : (ms.size() % 2 ? ms[ms.size() / 2]
+                                                         : 0.5 * (ms[ms.size() / 2 - 1] + ms[ms.size() / 2]));
+  std::printf("%d frames: %d tracked, %d found by full detection, %d lost; median %.1f ms a frame (decoding, "
+              "%.1f ms a frame, done meanwhile on a thread of its own)\n",
+              n, take.tracked, take.found, take.lost, median, n > 0 ? take.decode_ms / n : 0.0);
+  if (take.model) {
+    const auto& m = *take.model;
+    std::printf("the take's lens model (%s, %d sections): focus %s mm, aperture %.3f mm (nominal %.3f), %s, "
+                "rms %.3f px\n",
+                m.kind.c_str(), m.samples_used,
+                std::isinf(m.focus_mm) ? "infinity" : std::to_string(m.focus_mm).substr(0, 7).c_str(),
+                m.aperture_mm, camera.ApertureMm(), optics::FloorText(m).c_str(), m.rms_px);
+  }
+  std::printf("wrote %s/track.csv and %d calib-NNNN.json in %.1f s\n", out.c_str(), n - take.lost,
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+}
+
+}  // namespace
 
 void AddTrackCommand(CLI::App& app) {
   struct Args {
@@ -113,26 +143,7 @@ void AddTrackCommand(CLI::App& app) {
     }();
     track::WriteTake(take, args->out, args->input);
     const int n = static_cast<int>(take.frames.size());
-    if (!args->quiet) {
-      std::vector<double> ms;
-      for (const auto& f : take.frames) ms.push_back(f.frame_ms);
-      std::sort(ms.begin(), ms.end());
-      const double median = ms.empty() ? 0 : (ms.size() % 2 ? ms[ms.size() / 2]
-                                                             : 0.5 * (ms[ms.size() / 2 - 1] + ms[ms.size() / 2]));
-      std::printf("%d frames: %d tracked, %d found by full detection, %d lost; median %.1f ms a frame (decoding, "
-                  "%.1f ms a frame, done meanwhile on a thread of its own)\n",
-                  n, take.tracked, take.found, take.lost, median, n > 0 ? take.decode_ms / n : 0.0);
-      if (take.model) {
-        const auto& m = *take.model;
-        std::printf("the take's lens model (%s, %d sections): focus %s mm, aperture %.3f mm (nominal %.3f), %s, "
-                    "rms %.3f px\n",
-                    m.kind.c_str(), m.samples_used,
-                    std::isinf(m.focus_mm) ? "infinity" : std::to_string(m.focus_mm).substr(0, 7).c_str(),
-                    m.aperture_mm, camera.ApertureMm(), optics::FloorText(m).c_str(), m.rms_px);
-      }
-      std::printf("wrote %s/track.csv and %d calib-NNNN.json in %.1f s\n", args->out.c_str(), n - take.lost,
-                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    }
+    if (!args->quiet) PrintTakeSummary(take, camera, args->out, t0);
     if (take.error) {
       const std::string kept = n > 0 ? "; the " + std::to_string(n) + " frames before it are in " + args->out
                                      : "; no frame was read";
