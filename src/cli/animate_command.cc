@@ -329,7 +329,9 @@ void AddAnimateCommand(CLI::App& app) {
       ->transform(IntRange(1, 1000));
   cmd->add_option("--right-section", args->right_section, "section the right ball rolls along")
       ->capture_default_str()->transform(IntRange(1, 1000));
-  cmd->add_option("--video", args->video, "write an MJPG .avi (an existing file is replaced only when it is an AVI)");
+  cmd->add_option("--video", args->video, "write an MJPG .avi (an existing file is replaced only when it is an AVI; it is\n"
+                  "written beside it as .NAME.partial-PID and renamed when whole, so a run killed midway leaves the\n"
+                  "earlier video)");
   cmd->add_option("--frames", args->frames_dir,
                   "write frame-NNNNN.png into this folder, swapped in whole; an existing folder is replaced only when\n"
                   "animate drew it (it holds animate-frames.txt)");
