@@ -11,17 +11,17 @@
 namespace blurcue::cli {
 
 // The fitted aperture over the camera's nominal one (f / N) beyond which calibrate warns: two thirds of a stop
-// (2^(1/3) = 1.26 either way). A lens's marked f-numbers are rounded to a third of a stop; the suite's scenes fit
-// within 0.97-1.04 x.
+// (2^(1/3) = 1.26 either way). A lens's marked f-numbers are rounded to a third of a stop; the suite's calibrations
+// fit 0.876-1.038 x (docs/calibrate-checks.md).
 inline constexpr double kApertureWarnFactor = 1.2599210498948732;
 
 // The chosen PSF family's chi-square per profile point (phase check) above which no blurred edge explains the board's
-// profiles: residuals 100 x the pixels' noise. The suite's scenes stay under 160 (a JPEG of quality 90 over a
-// filter); a JPEG of quality 20 reads 45000, of quality 3 480000.
+// profiles: residuals 100 x the pixels' noise. The suite's 37 calibrations stay under 160 (a JPEG of quality 90 over
+// a filter); a JPEG of quality 20 reads 45000, of quality 3 480000.
 inline constexpr double kMaxChi2PerPoint = 1e4;
 
 // The share of the lens fit's sections that may be its outliers (residual over 3 Huber widths) before the sections'
-// blurs are said not to follow one thin lens: the suite's scenes have none; a focal length 1.7 x the photo's makes
+// blurs are said not to follow one thin lens: the suite's 37 calibrations have none; a focal length 1.7 x the photo's makes
 // 58 %, a JPEG of quality 5 10 %.
 inline constexpr double kMaxOutlierShare = 0.25;
 
