@@ -170,7 +170,9 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
     throw InputError(where + "/version", "must be 1 (this blurcue reads calibrations of format version 1), got " +
                                              j["version"].dump());
   SceneCalib s;
-  s.file = where.size() >= 2 && where.compare(where.size() - 2, 2, ": ") == 0 ? where.substr(0, where.size() - 2) : where;
+  // The file alone, for a message: `where` is "path: ".
+  const bool colon = where.size() >= 2 && where.compare(where.size() - 2, 2, ": ") == 0;
+  s.file = colon ? where.substr(0, where.size() - 2) : where;
   s.camera = CameraFromJson(Object(j, "camera", where), where + "/camera");
   const Json& board = Object(j, "board", where);
   s.board.cols = RangedInt(board, "cols", where + "/board", 2, 100);

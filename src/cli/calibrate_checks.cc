@@ -33,10 +33,10 @@ std::string Fixed(double v, int digits) {
   const double pose_px = result.pose.reprojection_error_px;
   if (pose_px > kPoseSuspectPx)
     throw InputError(camera_file + ": /focal_length_mm",
-                     "is " + Num(camera.focal_length_mm) + " mm, and with it the board's corners fit the pose only to " +
-                         Fixed(pose_px, 2) + " px in " + photo_file + " (a photo of this camera fits to well under 1 "
-                         "px); " + why + ": is this camera.json the photo's (focal length, sensor size, "
-                         "dist_coeffs)? nothing written");
+                     "is " + Num(camera.focal_length_mm) + " mm, and with it the board's corners fit the pose only "
+                     "to " + Fixed(pose_px, 2) + " px in " + photo_file + " (a photo of this camera fits to well "
+                     "under 1 px); " + why + ": is this camera.json the photo's (focal length, sensor size, "
+                     "dist_coeffs)? nothing written");
   throw InputError(photo_file, why + "; nothing written");
 }
 

@@ -21,8 +21,8 @@ inline constexpr double kApertureWarnFactor = 1.2599210498948732;
 inline constexpr double kMaxChi2PerPoint = 1e4;
 
 // The share of the lens fit's sections that may be its outliers (residual over 3 Huber widths) before the sections'
-// blurs are said not to follow one thin lens: the suite's 37 calibrations have none; a focal length 1.7 x the photo's makes
-// 58 %, a JPEG of quality 5 10 %.
+// blurs are said not to follow one thin lens: the suite's 37 calibrations have none; a focal length 1.7 x the
+// photo's makes 58 %, a JPEG of quality 5 10 %.
 inline constexpr double kMaxOutlierShare = 0.25;
 
 // Throws Error(kInput) with one line when the calibration is physically absurd for its photo or its edges fit no
