@@ -137,3 +137,24 @@ add_test(NAME cli_calibrate_cut_jpeg
                  -DEXPECT_CODE=3 "-DEXPECT_TEXT=scene-cut.jpg: truncated JPEG" -DONE_LINE=1
                  -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
 set_tests_properties(cli_calibrate_cut_jpeg PROPERTIES FIXTURES_REQUIRED cut_jpeg)
+
+# --- mends. The fitted aperture 0.74 x and 1.31 x the nominal (camera.json at f/4 and f/7.1 for a scene taken at
+# f/5.6) passed without a word under the old bound of 2 x: now the warning and the summary say it, beyond two thirds
+# of a stop either way.
+set(MENDS_SENSOR "\"focal_length_mm\": 21, \"sensor_width_mm\": 23.4, \"sensor_height_mm\": 15.6, \"image_width_px\": 1148, \"image_height_px\": 764")
+foreach(pair "4;0.74;5.250" "7.1;1.31;2.958")
+  list(GET pair 0 n)
+  list(GET pair 1 ratio)
+  list(GET pair 2 nominal)
+  file(WRITE ${T}/mends/camera-f${n}.json "{\"f_number\": ${n}, ${MENDS_SENSOR}}")
+  add_test(NAME cli_calibrate_aperture_warn_f${n}
+           COMMAND ${BLURCUE_EXPECT} "warning: .*scene.png: the fitted aperture 3.[0-9]+ mm is ${ratio} x the camera's \\(${nominal} mm, f/${n}\\), more than two thirds of a stop off.*aperture 3.[0-9]+ mm \\(nominal ${nominal}, ${ratio} x: more than two thirds of a stop off\\)"
+                   ${BC} calibrate ${T}/scene/scene.png --camera ${T}/mends/camera-f${n}.json --out ${T}/mends/calib-f${n}.json)
+  set_tests_properties(cli_calibrate_aperture_warn_f${n} PROPERTIES FIXTURES_REQUIRED scene)
+endforeach()
+# animate --video killed midway left half a video under its final name: now it leaves the earlier one unchanged, and
+# the next run removes the partial folder (tests/animate_kill_test.sh).
+add_test(NAME cli_animate_video_killed
+         COMMAND ${BLURCUE_EXPECT} "ok: a killed animate --video left the earlier video unchanged"
+                 bash ${PROJECT_SOURCE_DIR}/tests/animate_kill_test.sh ${BC} ${T}/calib.json ${T}/scene/scene.png ${T}/animate-kill)
+set_tests_properties(cli_animate_video_killed PROPERTIES FIXTURES_REQUIRED "scene;calib" LABELS gl)

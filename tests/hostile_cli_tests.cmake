@@ -454,3 +454,60 @@ hostile_test(cli_names_truth_other_board 3 "/board is 7x10 of 25 mm, not the --b
              calibrate ${T}/scene/scene.png --camera ${T}/scene/camera.json --board 10x7 --truth ${T}/scene/truth.json
              --out ${H}/names-calib.json)
 set_tests_properties(cli_names_truth_other_board PROPERTIES FIXTURES_REQUIRED scene)
+
+# --- mends: refusals and warnings around calibrate, render and run.
+# measured / measured_section where the nearest edge's sections are all flagged (here edge 5's, phase_limited, as a
+# photo filtered after sampling leaves an edge along the pixel rows): exit 4 and a line naming neither calib.json nor
+# its field. Now exit 3 naming the file, the sections' "ok" and their flags - through render and through a protocol.
+add_test(NAME cli_hostile_measured_flagged_make
+         COMMAND /usr/bin/python3 -c "import json, sys; c = json.load(open(sys.argv[1]))\nfor s in c['edges'][4]['sections']: s['ok'] = False; s['flags'] = ['phase_limited']\nc['edges'][4]['usable_sections'] = 0; json.dump(c, open(sys.argv[2], 'w'), indent=1)\np = json.load(open(sys.argv[3])); p['scene'] = {'background': sys.argv[5], 'calib': sys.argv[2], 'show': 'background'}; json.dump(p, open(sys.argv[4], 'w'), indent=1)"
+                 ${T}/calib.json ${H}/calib-e5.json ${PROJECT_SOURCE_DIR}/protocols/test1-static-grids.json
+                 ${H}/protocol-e5.json ${T}/scene/scene.png)
+set_tests_properties(cli_hostile_measured_flagged_make PROPERTIES FIXTURES_REQUIRED "scene;calib"
+                     FIXTURES_SETUP measured_flagged)
+hostile_test(cli_hostile_render_measured_flagged_edge 3
+             "calib-e5.json: /edges/4: edge 5 (the nearest) has no usable measured section: "
+             render --calib ${H}/calib-e5.json --background ${T}/scene/scene.png --blur measured --at-edge 5 --out ${H}/x.png)
+hostile_test(cli_hostile_render_measured_section_flagged 3
+             "calib-e5.json: /edges/4/sections/3/ok: is false (flagged phase_limited): edge 5 section 4 (the nearest) is not usable"
+             render --calib ${H}/calib-e5.json --background ${T}/scene/scene.png --blur measured_section --at-edge 5
+             --out ${H}/x.png)
+hostile_test(cli_hostile_validate_measured_flagged_edge 3
+             "calib-e5.json: /edges/4: edge 5 (the nearest) has no usable measured section: "
+             validate ${H}/protocol-e5.json)
+hostile_test(cli_hostile_run_measured_flagged_edge 3
+             "calib-e5.json: /edges/4: edge 5 (the nearest) has no usable measured section: "
+             run ${H}/protocol-e5.json --participant P1 --db ${H}/measured-flagged.sqlite --observer sim)
+set_tests_properties(cli_hostile_render_measured_flagged_edge cli_hostile_render_measured_section_flagged
+                     cli_hostile_validate_measured_flagged_edge cli_hostile_run_measured_flagged_edge PROPERTIES
+                     FIXTURES_REQUIRED "scene;calib;measured_flagged")
+# calibrate with a camera.json whose focal length is far off the photo's (50 mm for 21): the pose fits its corners to
+# 8.6 px, the reference edge's phase_limited readings gave r = 109695 px and eq. 3.7 110000 px, exit 0. Refused,
+# naming camera.json's focal_length_mm: no section of a board whose squares span 61 px can show such a blur.
+set(CAMERA_SENSOR "\"sensor_width_mm\": 23.4, \"sensor_height_mm\": 15.6, \"image_width_px\": 1148, \"image_height_px\": 764")
+file(WRITE ${H}/camera-f50.json "{\"focal_length_mm\": 50, \"f_number\": 5.6, ${CAMERA_SENSOR}}")
+hostile_test(cli_hostile_calibrate_focal_length_far 3
+             "camera-f50.json: /focal_length_mm: is 50 mm, and with it the board's corners fit the pose only to 8.59 px"
+             calibrate ${T}/scene/scene.png --camera ${H}/camera-f50.json --reference-edge 5 --out ${H}/calib-f50.json)
+set_tests_properties(cli_hostile_calibrate_focal_length_far PROPERTIES FIXTURES_REQUIRED scene)
+# A JPEG of quality 3 of the scene: every section off, chi-square per point 484550, exit 0. Refused, saying why.
+add_test(NAME cli_hostile_jpeg_q3_make
+         COMMAND /usr/bin/python3 -c "import sys; from PIL import Image; Image.open(sys.argv[1]).convert('RGB').save(sys.argv[2], quality=3)"
+                 ${T}/scene/scene.png ${H}/scene-q3.jpg)
+set_tests_properties(cli_hostile_jpeg_q3_make PROPERTIES FIXTURES_REQUIRED scene FIXTURES_SETUP jpeg_q3)
+hostile_test(cli_hostile_calibrate_jpeg_q3 3
+             "scene-q3.jpg: the board's edges do not fit a blurred edge: the best of the PSF families leaves residuals 696 x the pixels' noise"
+             calibrate ${H}/scene-q3.jpg --camera ${T}/scene/camera.json --out ${H}/calib-q3.json)
+set_tests_properties(cli_hostile_calibrate_jpeg_q3 PROPERTIES FIXTURES_REQUIRED "scene;jpeg_q3")
+# track --board 10x7 on a 7x10 board: tracked with exit 0 (calibrate refuses it). Refused alike, naming the frame.
+add_test(NAME cli_hostile_track_transposed_make COMMAND ${CMAKE_COMMAND} -E copy ${T}/scene/scene.png ${H}/seq/frame-0000.png)
+set_tests_properties(cli_hostile_track_transposed_make PROPERTIES FIXTURES_REQUIRED scene FIXTURES_SETUP one_frame)
+hostile_test(cli_hostile_track_board_transposed 2
+             "frame-%04d.png: frame 0: board 10x7 found with its edges running into depth (90.0 deg from across the view"
+             track ${H}/seq/frame-%04d.png --camera ${T}/scene/camera.json --board 10x7 --out ${H}/track-transposed --quiet)
+set_tests_properties(cli_hostile_track_board_transposed PROPERTIES FIXTURES_REQUIRED "scene;one_frame")
+# run refusing --capture (a folder of one's own) on an existing record left its -wal and -shm beside it.
+add_test(NAME cli_hostile_run_capture_refused_no_sidecars
+         COMMAND ${BLURCUE_EXPECT} "ok: refused, no -wal or -shm"
+                 sh -c "rm -rf ${H}/sidecars && mkdir -p ${H}/sidecars/shots && echo mine > ${H}/sidecars/shots/notes.txt && $<TARGET_FILE:blurcue> run ${T}/protocols/test1-static-grids.json --participant P1 --db ${H}/sidecars/r.sqlite --observer sim --stop-after 1 > /dev/null 2>&1; $<TARGET_FILE:blurcue> run ${T}/protocols/test1-static-grids.json --participant P1 --db ${H}/sidecars/r.sqlite --observer sim --resume --capture ${H}/sidecars/shots 2> ${H}/sidecars/err; test $? = 3 && grep -q 'holds .notes.txt., which is not a capture' ${H}/sidecars/err && test -s ${H}/sidecars/r.sqlite && test ! -e ${H}/sidecars/r.sqlite-wal && test ! -e ${H}/sidecars/r.sqlite-shm && echo 'ok: refused, no -wal or -shm'")
+set_tests_properties(cli_hostile_run_capture_refused_no_sidecars PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS gl)

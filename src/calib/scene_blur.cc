@@ -91,6 +91,60 @@ bool Flag(const Json& obj, const std::string& key, const std::string& where, boo
   return obj[key].get<bool>();
 }
 
+// A section's flags as calib.json lists them ("phase_limited, flaw"); empty where it lists none (a message's words).
+std::string FlagsText(const Json& sec) {
+  std::string text;
+  if (sec.contains("flags") && sec["flags"].is_array())
+    for (const Json& flag : sec["flags"])
+      if (flag.is_string()) text += (text.empty() ? "" : ", ") + flag.get<std::string>();
+  return text;
+}
+
+// "FILE: POINTER: " of a message about the calibration (a scene built in code names none).
+std::string At(const SceneCalib& scene, const std::string& pointer) {
+  return (scene.file.empty() ? std::string("the calibration") : scene.file) + ": " + pointer + ": ";
+}
+
+// A measured source with no value here: the calibration holds none, so it is an input error naming calib.json, the
+// field and its value (exit 3), not "nothing found" (exit 4): another source, or another photo, is the remedy.
+constexpr const char* kOtherSources = "so its measured blur is unknown; fitted (the lens model) or estimated "
+                                      "(eq. 3.7) give one";
+
+// The flags of the sections `of`, counted ("7 flagged phase_limited"; "" when none is flagged).
+std::string FlagCounts(const std::vector<const SceneCalib::Section*>& of) {
+  std::map<std::string, int> n;
+  for (const SceneCalib::Section* s : of) n[s->flags.empty() ? "with no flag" : "flagged " + s->flags] += 1;
+  std::string text;
+  for (const auto& [flags, count] : n) text += (text.empty() ? "" : ", ") + std::to_string(count) + " " + flags;
+  return text;
+}
+
+[[noreturn]] void NoMeasuredEdge(const SceneCalib& scene, int edge) {
+  std::vector<const SceneCalib::Section*> listed;
+  for (const auto& s : scene.sections)
+    if (s.edge == edge) listed.push_back(&s);
+  const std::string who = "edge " + std::to_string(edge) + " (the nearest) has no usable measured section";
+  if (listed.empty() || listed.front()->pointer.empty())
+    throw InputError((scene.file.empty() ? std::string("the calibration") : scene.file) + ": /edges",
+                     who + " (" + std::to_string(listed.size()) + " of its sections listed, none usable), " +
+                         kOtherSources);
+  const std::string& p = listed.front()->pointer;
+  throw Error(ErrorKind::kInput, At(scene, p.substr(0, p.find("/sections/"))) + who + ": \"ok\" is false in all " +
+                                     std::to_string(listed.size()) + " of its sections (" + FlagCounts(listed) + "), " +
+                                     kOtherSources);
+}
+
+[[noreturn]] void NoMeasuredSection(const SceneCalib& scene, const SceneCalib::Section& s) {
+  const std::string who = "edge " + std::to_string(s.edge) + " section " + std::to_string(s.section) +
+                          " (the nearest) is not usable, ";
+  if (s.pointer.empty())
+    throw Error(ErrorKind::kInput, (scene.file.empty() ? std::string("the calibration") : scene.file) + ": " + who +
+                                       kOtherSources);
+  throw Error(ErrorKind::kInput, At(scene, s.pointer + "/ok") + "is false (" +
+                                     (s.flags.empty() ? std::string("no flag") : "flagged " + s.flags) + "): " + who +
+                                     kOtherSources);
+}
+
 }  // namespace
 
 cv::Vec3d SceneCalib::ToCamera(const cv::Vec3d& board_mm) const {
@@ -116,6 +170,9 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
     throw InputError(where + "/version", "must be 1 (this blurcue reads calibrations of format version 1), got " +
                                              j["version"].dump());
   SceneCalib s;
+  // The file alone, for a message: `where` is "path: ".
+  const bool colon = where.size() >= 2 && where.compare(where.size() - 2, 2, ": ") == 0;
+  s.file = colon ? where.substr(0, where.size() - 2) : where;
   s.camera = CameraFromJson(Object(j, "camera", where), where + "/camera");
   const Json& board = Object(j, "board", where);
   s.board.cols = RangedInt(board, "cols", where + "/board", 2, 100);
@@ -196,6 +253,8 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
         if (const auto jf = ph->find("joins_fit"); jf != ph->end() && jf->is_boolean()) out.pooled = *jf && !out.ok;
       out.r_px = out.ok || out.pooled ? Ranged(sec, "r_px", sw, 0, optics::kMaxBlurRadiusPx, "px")
                                       : RequireNumber(sec, "r_px", sw);
+      out.pointer = "/edges/" + std::to_string(e) + "/sections/" + std::to_string(k);
+      out.flags = FlagsText(sec);
       s.sections.push_back(out);
     }
   }
@@ -246,11 +305,10 @@ double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& p, 
         const double d = cv::norm(s.midpoint_camera_mm - p);
         if (d < best_d) best_d = d, best = &s;
       }
-      if (!best) throw Error(ErrorKind::kNotFound, "the calibration has no measured section");
-      if (!best->ok)
-        throw Error(ErrorKind::kNotFound, "edge " + std::to_string(best->edge) + " section " +
-                                              std::to_string(best->section) + " (the nearest) is not usable, so its "
-                                              "measured blur is unknown; estimated or fitted give one");
+      if (!best)
+        throw Error(ErrorKind::kInput, At(scene, "/edges") + "lists no section, so no measured blur is known; fitted "
+                                                             "(the lens model) or estimated (eq. 3.7) give one");
+      if (!best->ok) NoMeasuredSection(scene, *best);
       return best->r_px;
     }
     case BlurSource::kMeasured: {
@@ -267,13 +325,10 @@ double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& p, 
         if (d < best_d) best_d = d, nearest = edge;
       }
       double sum = 0;
-      int usable = 0, listed = 0;
+      int usable = 0;
       for (const auto& s : scene.sections)
-        if (s.edge == nearest) ++listed, usable += s.ok || s.pooled, sum += s.ok || s.pooled ? s.r_px : 0;
-      if (usable == 0)
-        throw Error(ErrorKind::kNotFound, "edge " + std::to_string(nearest) + " (the nearest) has no usable measured "
-                                          "section (" + std::to_string(listed) + " listed, none usable), so its "
-                                          "measured blur is unknown; measured_section, estimated or fitted give one");
+        if (s.edge == nearest) usable += s.ok || s.pooled, sum += s.ok || s.pooled ? s.r_px : 0;
+      if (usable == 0) NoMeasuredEdge(scene, nearest);
       return sum / usable;
     }
   }

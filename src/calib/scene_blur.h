@@ -31,8 +31,12 @@ struct SceneCalib {
     // Flagged phase_limited yet joined to the lens fit at its reading (calib.json phase.joins_fit): unsure alone, its
     // edge's mean pools it (the blur source `measured`), `measured_section` does not take it.
     bool pooled = false;
+    // Where it is in calib.json ("/edges/0/sections/3") and its flags there ("phase_limited"), for a message.
+    std::string pointer, flags;
   };
   std::vector<Section> sections;
+  // The calib.json it was read from (empty: built in code), for a message.
+  std::string file;
 
   // Board-frame point (mm) -> camera frame (mm).
   cv::Vec3d ToCamera(const cv::Vec3d& board_mm) const;
@@ -54,10 +58,11 @@ BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px, const st
 // Blur radius (px) the scene calls for at a camera-frame point:
 //   measured  - the thesis's edge value (its Fig. 4.11): the mean r_px of the usable sections of the board edge
 //               whose line (from the board and its pose) passes nearest the point; a card beside the board aligned
-//               with edge k gets edge k's value whichever side it is on; Error(kNotFound) naming the edge when it
-//               has no usable section (never another edge's value);
+//               with edge k gets edge k's value whichever side it is on; Error(kInput) naming calib.json, the edge's
+//               sections' "ok" and their flags when it has no usable section (never another edge's value);
 //   measured_section - r_px of the nearest measured section alone (3-D distance between midpoints);
-//               Error(kNotFound) naming it when it is not usable (never another section's value);
+//               Error(kInput) naming calib.json, the section's "ok" and its flags when it is not usable (never
+//               another section's value);
 //   estimated - eq. 3.7 from the reference edge at the point's depth (Error(kDomain) nearer than focus);
 //   fitted    - the fitted thin-lens model at the point's depth (ideal px), times StretchAt the point (photo px);
 //   fixed     - fixed_r_px; none - 0.

@@ -2,6 +2,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <cctype>
 #include <sstream>
 #include <string>
@@ -254,11 +255,16 @@ void Animate(const AnimateArgs& args) {
                                        BoundText(args.fps) + " make " + BoundText(frame_count) +
                                        " frames; at most " + BoundText(kMaxFrames) + " (go faster or lower --fps)");
   const int frames = std::max(1, int(frame_count));
+  // The video is written as DIR/.NAME.partial-PID/NAME and renamed to --video once whole: a run killed or failing
+  // midway leaves the earlier video (or none), never half of one under its name; a later run removes what a killed
+  // one left.
   media::VideoWriter video;
+  std::optional<PartialFile> video_file;
   if (!args.video.empty()) {
-    if (std::filesystem::path(args.video).has_parent_path())
-      std::filesystem::create_directories(std::filesystem::path(args.video).parent_path());
-    if (!video.Open(args.video, media::Fourcc('M', 'J', 'P', 'G'), args.fps, photo.size())) throw InputError(args.video, "cannot open a video writer (MJPG .avi)");
+    RemoveStaleLeftovers(args.video);
+    video_file.emplace(args.video);
+    if (!video.Open(video_file->path().string(), media::Fourcc('M', 'J', 'P', 'G'), args.fps, photo.size()))
+      throw InputError(args.video, "cannot open a video writer (MJPG .avi)");
   }
   // The log is written whole at the end (WriteFileAtomically): a run cut short leaves no half log. The frames are
   // drawn into a folder beside --frames and swapped in whole, with the marker that lets a later run replace it.
@@ -275,6 +281,10 @@ void Animate(const AnimateArgs& args) {
   else
     WriteFolderAtomically(args.frames_dir, draw, IsAnimateFrameName);
   const double worst_ms = drawn.worst_ms;
+  if (video_file) {
+    video.Release();
+    video_file->Finish();
+  }
   if (!args.log.empty()) WriteFileAtomically(args.log, drawn.log);
   std::printf("%d frames (%.1f s of motion at %.1f cm/s, %.0f fps); slowest frame %.1f ms%s%s%s\n", frames,
               (frames - 1) / args.fps, args.speed_cm_s, args.fps, worst_ms,
@@ -319,7 +329,9 @@ void AddAnimateCommand(CLI::App& app) {
       ->transform(IntRange(1, 1000));
   cmd->add_option("--right-section", args->right_section, "section the right ball rolls along")
       ->capture_default_str()->transform(IntRange(1, 1000));
-  cmd->add_option("--video", args->video, "write an MJPG .avi (an existing file is replaced only when it is an AVI)");
+  cmd->add_option("--video", args->video, "write an MJPG .avi (an existing file is replaced only when it is an AVI; it is\n"
+                  "written beside it as .NAME.partial-PID and renamed when whole, so a run killed midway leaves the\n"
+                  "earlier video)");
   cmd->add_option("--frames", args->frames_dir,
                   "write frame-NNNNN.png into this folder, swapped in whole; an existing folder is replaced only when\n"
                   "animate drew it (it holds animate-frames.txt)");

@@ -9,6 +9,7 @@
 
 #include "calib/calibrate.h"
 #include "calib/truth.h"
+#include "cli/calibrate_checks.h"
 #include "cli/commands.h"
 #include "core/error.h"
 #include "core/output_guard.h"
@@ -31,13 +32,15 @@ void WarnAboutCalibration(const calib::CalibResult& result, const Camera& camera
                  "blurs measured rest on that pose\n",
                  camera_file.c_str(), result.pose.reprojection_error_px);
   // A lens model whose aperture is far from the camera's f-number fits sections that may not measure the board's
-  // edges (an edge covered or shaded reads sharp: a covered board gave focus 21 mm and an aperture of 0).
-  if (const double ratio = result.model.aperture_mm / camera.ApertureMm(); !(ratio >= 0.5 && ratio <= 2))
+  // edges (an edge covered or shaded reads sharp: a covered board gave focus 21 mm and an aperture of 0). Far: over
+  // two thirds of a stop either way (kApertureWarnFactor; 0.6 x and 1.29 x passed unsaid under the old bound of 2 x).
+  if (ApertureFarFromNominal(result, camera))
     std::fprintf(stderr,
-                 "blurcue: warning: %s: the fitted aperture %.3f mm is %.2f x the camera's (%.3f mm, f/%g): the "
-                 "sections may not measure the board's edges (covered, shaded, reflections; see the table's "
-                 "flags) or camera.json's f_number is not the photo's\n",
-                 photo_file.c_str(), result.model.aperture_mm, ratio, camera.ApertureMm(), camera.f_number);
+                 "blurcue: warning: %s: the fitted aperture %.3f mm is %.2f x the camera's (%.3f mm, f/%g), more "
+                 "than two thirds of a stop off: the sections may not measure the board's edges (covered, shaded, "
+                 "reflections; see the table's flags) or camera.json's f_number is not the photo's\n",
+                 photo_file.c_str(), result.model.aperture_mm, ApertureRatio(result, camera), camera.ApertureMm(),
+                 camera.f_number);
 }
 
 // The board, the reference edge, the fitted model and the sections it was fitted to.
@@ -54,10 +57,14 @@ void PrintCalibrationSummary(const calib::CalibResult& result, const Board& boar
     std::printf("reference edge %d: u = %.1f mm, r = %.2f px (median of its phase_limited sections' readings: none "
                 "of them is usable, so eq. 3.7's estimates below are as unsure as they are)\n",
                 result.reference_edge, result.reference_u_mm, result.reference_r_px);
-  std::printf("fitted %s model: focus %.1f mm, aperture %.3f mm (nominal %.3f), %s, rms %.3f px,"
+  const std::string far = ApertureFarFromNominal(result, camera)
+                              ? ", " + Num(std::round(ApertureRatio(result, camera) * 100) / 100) +
+                                    " x: more than two thirds of a stop off"
+                              : "";
+  std::printf("fitted %s model: focus %.1f mm, aperture %.3f mm (nominal %.3f%s), %s, rms %.3f px,"
               " leave-one-out %.3f px, %d outliers of %d\n",
-              m.kind.c_str(), m.focus_mm, m.aperture_mm, camera.ApertureMm(), optics::FloorText(m).c_str(),
-              m.rms_px, m.loo_rms_px, m.outliers, m.samples_used);
+              m.kind.c_str(), m.focus_mm, m.aperture_mm, camera.ApertureMm(), far.c_str(),
+              optics::FloorText(m).c_str(), m.rms_px, m.loo_rms_px, m.outliers, m.samples_used);
   // How many sections the model was fitted to, and why the others were left out.
   {
     int sections = 0;
@@ -290,6 +297,9 @@ void AddCalibrateCommand(CLI::App& app) {
       throw Error(e.kind(), (e.kind() == ErrorKind::kInput ? args->camera : args->photo) + ": " + e.what());
     }
     if (!args->truth.empty()) CheckTruthPose(truth, args->truth, result, board, camera, args->photo);
+    // A calibration absurd for its photo (a blur no section could show, edges no blurred edge explains) is refused
+    // before anything is written.
+    RefuseAbsurdCalibration(result, camera, args->camera, args->photo);
     Json json = calib::CalibToJson(result);
     json["photo"] = args->photo;
     WriteJsonFile(args->out, json);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -13,6 +14,7 @@
 #include "core/error.h"
 #include "core/typed.h"
 #include "session/runner.h"
+#include "store/sqlite.h"
 
 namespace blurcue::cli {
 namespace {
@@ -38,6 +40,23 @@ bool AskInTerminal(const std::string& prompt, std::string* answer) {
   int c;
   while ((c = std::getchar()) != EOF && c != '\n') *answer += char(c);
   return c != EOF;
+}
+
+// A refused run leaves the record as it found it. A read-only look at a record in WAL mode (its session numbers and
+// groups, before anything is checked) makes its -wal and -shm files, which only a read-write connection removes as
+// it closes: a run that starts removes them when it ends, one refused before (a --capture folder, a protocol) left
+// them. So after a refusal, where neither was there before, one connection opens the record, reads its schema and
+// closes: SQLite, the last to close, removes them (and leaves them while another process has the record open).
+void TidySidecars(const std::filesystem::path& db) {
+  std::error_code error;
+  const bool left = std::filesystem::exists(db.string() + "-wal", error) ||
+                    std::filesystem::exists(db.string() + "-shm", error);
+  if (!left || !std::filesystem::is_regular_file(db, error)) return;
+  try {
+    store::Database record(db, store::OpenMode::kReadWrite);
+    record.QueryInt64("SELECT count(*) FROM sqlite_schema");
+  } catch (const std::exception&) {  // not a record SQLite opens: its refusal is the one to report
+  }
 }
 
 struct RunArgs {
@@ -73,7 +92,16 @@ void Run(const RunArgs& args) {
     said = true;
   };
   if (isatty(0)) options.ask = AskInTerminal;
-  const session::RunResult r = session::RunSession(options);
+  std::error_code error;
+  const bool sidecars_before = std::filesystem::exists(args.db + "-wal", error) ||
+                               std::filesystem::exists(args.db + "-shm", error);
+  session::RunResult r;
+  try {
+    r = session::RunSession(options);
+  } catch (...) {
+    if (!sidecars_before) TidySidecars(args.db);
+    throw;
+  }
   if (tty && said) std::fprintf(stderr, "\n");
   // Trials a stopped procedure skipped are recorded too: counted as done, and said apart.
   const int64_t by_stop_rule = r.skipped_now - r.skipped_by_criterion_now;

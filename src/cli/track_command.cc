@@ -1,9 +1,11 @@
 // blurcue track: a video or image sequence tracked frame by frame (src/track).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "cli/commands.h"
 #include "core/camera.h"
@@ -16,11 +18,39 @@
 
 namespace blurcue::cli {
 
+namespace {
+
+// What a take came to: its frames, how each was found, the take's lens model, what was written.
+void PrintTakeSummary(const track::TakeResult& take, const Camera& camera, const std::string& out,
+                      std::chrono::steady_clock::time_point t0) {
+  const int n = static_cast<int>(take.frames.size());
+  std::vector<double> ms;
+  for (const auto& f : take.frames) ms.push_back(f.frame_ms);
+  std::sort(ms.begin(), ms.end());
+  const double median = ms.empty() ? 0 : (ms.size() % 2 ? ms[ms.size() / 2]
+                                                         : 0.5 * (ms[ms.size() / 2 - 1] + ms[ms.size() / 2]));
+  std::printf("%d frames: %d tracked, %d found by full detection, %d lost; median %.1f ms a frame (decoding, "
+              "%.1f ms a frame, done meanwhile on a thread of its own)\n",
+              n, take.tracked, take.found, take.lost, median, n > 0 ? take.decode_ms / n : 0.0);
+  if (take.model) {
+    const auto& m = *take.model;
+    std::printf("the take's lens model (%s, %d sections): focus %s mm, aperture %.3f mm (nominal %.3f), %s, "
+                "rms %.3f px\n",
+                m.kind.c_str(), m.samples_used,
+                std::isinf(m.focus_mm) ? "infinity" : std::to_string(m.focus_mm).substr(0, 7).c_str(),
+                m.aperture_mm, camera.ApertureMm(), optics::FloorText(m).c_str(), m.rms_px);
+  }
+  std::printf("wrote %s/track.csv and %d calib-NNNN.json in %.1f s\n", out.c_str(), n - take.lost,
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+}
+
+}  // namespace
+
 void AddTrackCommand(CLI::App& app) {
   struct Args {
     std::string input, camera, out, board = "7x10";
     double square_mm = 25, fps = 30, max_track_error_px = 0.5;
-    bool detect_every_frame = false, quiet = false;
+    bool detect_every_frame = false, quiet = false, board_turned = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -56,6 +86,10 @@ void AddTrackCommand(CLI::App& app) {
                   "a tracked pose whose corners' rms reprojection error exceeds this falls back to full detection")
       ->capture_default_str()->check(FinitePositive(100, "px"));
   cmd->add_flag("--detect-every-frame", args->detect_every_frame, "full detection on every frame (no tracking)");
+  cmd->add_flag("--board-turned", args->board_turned,
+                "take a board found with its edges within 10 deg of running straight away from the camera (refused\n"
+                "without it, as calibrate refuses it: every edge then lies at one depth, and a 10x7 board so found is\n"
+                "likelier a 7x10 one)");
   cmd->add_flag("--quiet", args->quiet, "print only errors");
   cmd->callback([args] {
     const auto t0 = std::chrono::steady_clock::now();
@@ -82,6 +116,9 @@ void AddTrackCommand(CLI::App& app) {
     track::TrackOptions options;
     options.max_track_error_px = args->max_track_error_px;
     options.always_detect = args->detect_every_frame;
+    // The check calibrate makes (calib/board_pose.h): a board detected with its edges running into depth is refused,
+    // before anything is written, naming the frame; --board-turned takes it.
+    options.calibrate.detect.refuse_edges_into_depth_deg = args->board_turned ? 0 : 10;
     track::Tracker tracker(camera, board, options);
     const int expected = source.expected_frames();
     auto progress = [&](const track::FrameResult& r) {
@@ -96,29 +133,17 @@ void AddTrackCommand(CLI::App& app) {
                            : "",
                    usable, r.frame_ms, r.note.empty() ? "" : " - ", r.note.c_str());
     };
-    const track::TakeResult take = track::TrackTake(source, tracker, progress);
+    const track::TakeResult take = [&] {
+      try {
+        return track::TrackTake(source, tracker, progress);
+      } catch (const Error& e) {
+        if (e.kind() != ErrorKind::kUsage) throw;
+        throw e.Wrapped(ErrorKind::kUsage, args->input + ": ");
+      }
+    }();
     track::WriteTake(take, args->out, args->input);
     const int n = static_cast<int>(take.frames.size());
-    if (!args->quiet) {
-      std::vector<double> ms;
-      for (const auto& f : take.frames) ms.push_back(f.frame_ms);
-      std::sort(ms.begin(), ms.end());
-      const double median = ms.empty() ? 0 : (ms.size() % 2 ? ms[ms.size() / 2]
-                                                             : 0.5 * (ms[ms.size() / 2 - 1] + ms[ms.size() / 2]));
-      std::printf("%d frames: %d tracked, %d found by full detection, %d lost; median %.1f ms a frame (decoding, "
-                  "%.1f ms a frame, done meanwhile on a thread of its own)\n",
-                  n, take.tracked, take.found, take.lost, median, n > 0 ? take.decode_ms / n : 0.0);
-      if (take.model) {
-        const auto& m = *take.model;
-        std::printf("the take's lens model (%s, %d sections): focus %s mm, aperture %.3f mm (nominal %.3f), %s, "
-                    "rms %.3f px\n",
-                    m.kind.c_str(), m.samples_used,
-                    std::isinf(m.focus_mm) ? "infinity" : std::to_string(m.focus_mm).substr(0, 7).c_str(),
-                    m.aperture_mm, camera.ApertureMm(), optics::FloorText(m).c_str(), m.rms_px);
-      }
-      std::printf("wrote %s/track.csv and %d calib-NNNN.json in %.1f s\n", args->out.c_str(), n - take.lost,
-                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    }
+    if (!args->quiet) PrintTakeSummary(take, camera, args->out, t0);
     if (take.error) {
       const std::string kept = n > 0 ? "; the " + std::to_string(n) + " frames before it are in " + args->out
                                      : "; no frame was read";

@@ -9,6 +9,9 @@
 #include <map>
 #include <sstream>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/hash.h"
@@ -150,6 +153,40 @@ std::vector<fs::path> PlaceOwnFiles(const std::string& option, const fs::path& d
     if (fs::exists(dir / name, error)) text += hash + " " + name + "\n";
   WriteFileAtomically(dir / manifest, text);
   return written;
+}
+
+namespace {
+// fsync of a file or folder by name; a failure is not reported: the file is whole, only its survival of a power cut
+// is in doubt.
+void SyncByName(const fs::path& path, bool folder) {
+  const int fd = open(path.c_str(), (folder ? O_RDONLY | O_DIRECTORY : O_RDONLY) | O_CLOEXEC);
+  if (fd < 0) return;
+  fsync(fd);
+  close(fd);
+}
+}  // namespace
+
+PartialFile::PartialFile(fs::path target) : target_(std::move(target)) {
+  folder_ = TemporaryBeside(target_, "partial");
+  path_ = folder_ / target_.filename();
+  std::error_code error;
+  fs::create_directories(folder_, error);
+  if (error)
+    throw InputError(OneLine(target_.string()), "cannot make " + OneLine(folder_.string()) + " to write it in: " +
+                                                     error.message());
+}
+
+PartialFile::~PartialFile() {
+  std::error_code ignored;
+  fs::remove_all(folder_, ignored);
+}
+
+void PartialFile::Finish() {
+  SyncByName(path_, false);
+  if (std::rename(path_.c_str(), target_.c_str()) != 0)
+    throw InputError(OneLine(target_.string()), "cannot move the finished file into place: " +
+                                                     std::string(std::strerror(errno)));
+  SyncByName(target_.has_parent_path() ? target_.parent_path() : fs::path("."), true);
 }
 
 }  // namespace blurcue

@@ -41,4 +41,24 @@ std::vector<std::filesystem::path> PlaceOwnFiles(const std::string& option, cons
                                                  const std::filesystem::path& partial, const std::string& manifest,
                                                  const std::string& command);
 
+// A file that a writer opens by its own name (a video: the extension tells it the container), built where a kill
+// cannot leave half of it under the final name: DIR/.NAME.partial-PID/NAME (atomic_file.h's names, so a killed run's
+// is removed by a later RemoveStaleLeftovers(target)). The caller writes path() and closes its writer; Finish() then
+// fsyncs the file and renames it over `target` (which the caller checked before its work: RequireReplaceableFile,
+// RequireOwnFile). The partial folder goes when the object does, finished or not.
+class PartialFile {
+ public:
+  // Makes the partial folder (and target's folder); Error(kInput) naming `target` when it cannot.
+  explicit PartialFile(std::filesystem::path target);
+  ~PartialFile();
+  PartialFile(const PartialFile&) = delete;
+  PartialFile& operator=(const PartialFile&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+  // Moves the finished file into place; Error(kInput) naming the target when it cannot (the target then unchanged).
+  void Finish();
+
+ private:
+  std::filesystem::path target_, folder_, path_;
+};
+
 }  // namespace blurcue

@@ -1,6 +1,7 @@
 #include "core/own_output.h"
 
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -110,6 +111,33 @@ TEST_F(OwnOutputTest, TheSameBytesNeedNoListAndAForeignListIsRefused) {
   Write(dir_ / "p2" / "face.png", "drawn face");
   EXPECT_NE(Place(dir_ / "p2").find("holds tool.txt, which tool did not write"), std::string::npos);
   EXPECT_EQ(Read(dir_ / "out" / "tool.txt"), "my notes\n");
+}
+
+// A file its writer opens by name is written beside its target: the target keeps its old bytes until Finish() (a
+// kill before leaves them), and the partial folder is gone afterwards, finished or not.
+TEST_F(OwnOutputTest, APartialFileReplacesItsTargetOnlyWhenFinished) {
+  const fs::path target = dir_ / "clips" / "anim.avi";
+  fs::create_directories(target.parent_path());
+  Write(target, "old video");
+  fs::path folder;
+  {
+    PartialFile unfinished(target);
+    folder = unfinished.path().parent_path();
+    EXPECT_EQ(unfinished.path().filename(), "anim.avi");  // the extension still names the container
+    EXPECT_EQ(folder.parent_path(), target.parent_path());
+    Write(unfinished.path(), "half a vid");
+    EXPECT_EQ(Read(target), "old video");
+  }
+  EXPECT_FALSE(fs::exists(folder));
+  EXPECT_EQ(Read(target), "old video");
+  {
+    PartialFile done(target);
+    Write(done.path(), "new video");
+    done.Finish();
+    EXPECT_EQ(Read(target), "new video");
+  }
+  EXPECT_FALSE(fs::exists(folder));
+  EXPECT_EQ(std::distance(fs::directory_iterator(target.parent_path()), fs::directory_iterator()), 1);
 }
 
 }  // namespace

@@ -126,6 +126,9 @@ FrameResult Tracker::Process(const cv::Mat& photo, int index, double time_s) {
     try {
       pose = calib::FindBoardPose(grey8, camera_, board_, options_.calibrate.detect);
     } catch (const Error& e) {
+      // A board refused as found (its edges running into depth: a transposed --board) is the take's, said with its
+      // frame.
+      if (e.kind() == ErrorKind::kUsage) throw e.Wrapped(ErrorKind::kUsage, "frame " + std::to_string(index) + ": ");
       if (e.kind() != ErrorKind::kNotFound) throw;
       r.status = FrameStatus::kLost;
       r.note = r.note.empty() ? e.what() : r.note + "; " + e.what();

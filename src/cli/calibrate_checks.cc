@@ -1,0 +1,101 @@
+#include "cli/calibrate_checks.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/error.h"
+
+namespace blurcue::cli {
+namespace {
+
+// A pose fitting the board's corners worse than this is not this camera's (a photo of it fits to well under 1 px):
+// the warning calibrate prints has the same bound.
+constexpr double kPoseSuspectPx = 1;
+
+// The side of a board square where a section lies (photo px): the larger of its length along the edge and the gap to
+// the parallel edge beside it (twice its window's half width).
+double SquareSidePx(const calib::SectionResult& s) {
+  return std::max(std::hypot(s.segment.b.x - s.segment.a.x, s.segment.b.y - s.segment.a.y),
+                  2 * s.segment.half_window_px);
+}
+
+std::string Fixed(double v, int digits) {
+  char text[48];
+  std::snprintf(text, sizeof text, "%.*f", digits, v);
+  return text;
+}
+
+// Where a refusal points: camera.json's focal length when the pose says the camera is not the photo's, else the
+// photo; `why` is the rest of the line.
+[[noreturn]] void Refuse(const calib::CalibResult& result, const Camera& camera, const std::string& camera_file,
+                         const std::string& photo_file, const std::string& why) {
+  const double pose_px = result.pose.reprojection_error_px;
+  if (pose_px > kPoseSuspectPx)
+    throw InputError(camera_file + ": /focal_length_mm",
+                     "is " + Num(camera.focal_length_mm) + " mm, and with it the board's corners fit the pose only "
+                     "to " + Fixed(pose_px, 2) + " px in " + photo_file + " (a photo of this camera fits to well "
+                     "under 1 px); " + why + ": is this camera.json the photo's (focal length, sensor size, "
+                     "dist_coeffs)? nothing written");
+  throw InputError(photo_file, why + "; nothing written");
+}
+
+// The first radius the calibration states that is over twice the side of a square where it is read: "" when none.
+std::string AbsurdRadius(const calib::CalibResult& result) {
+  auto over = [](double r, double side) { return !(r <= 2 * side); };
+  auto text = [](const std::string& what, double r, double side) {
+    return what + " is " + Fixed(r, 1) + " px where a square of the board spans " + Fixed(side, 0) +
+           " px: a blur over twice that leaves the board grey, so no section could have measured it";
+  };
+  // The reference edge (eq. 3.7's anchor): the mean side of its squares.
+  const calib::EdgeResult& ref = result.edges[size_t(result.reference_edge - 1)];
+  double side = 0;
+  for (const auto& s : ref.sections) side += SquareSidePx(s) / double(ref.sections.size());
+  if (!ref.sections.empty() && over(result.reference_r_px, side))
+    return text("reference edge " + std::to_string(result.reference_edge) + "'s blur r", result.reference_r_px, side);
+  for (const auto& e : result.edges)
+    for (const auto& s : e.sections) {
+      const std::string where = "edge " + std::to_string(s.edge) + " section " + std::to_string(s.section);
+      if (s.fit.ok && over(s.fit.r_px, SquareSidePx(s)))
+        return text(where + "'s measured blur", s.fit.r_px, SquareSidePx(s));
+      if (over(s.r_fitted_px, SquareSidePx(s)))
+        return text("the lens model's blur at " + where, s.r_fitted_px, SquareSidePx(s));
+    }
+  return "";
+}
+
+}  // namespace
+
+double ApertureRatio(const calib::CalibResult& result, const Camera& camera) {
+  return result.model.aperture_mm / camera.ApertureMm();
+}
+
+bool ApertureFarFromNominal(const calib::CalibResult& result, const Camera& camera) {
+  const double ratio = ApertureRatio(result, camera);
+  return !(ratio >= 1 / kApertureWarnFactor && ratio <= kApertureWarnFactor);
+}
+
+void RefuseAbsurdCalibration(const calib::CalibResult& result, const Camera& camera, const std::string& camera_file,
+                             const std::string& photo_file) {
+  if (const std::string absurd = AbsurdRadius(result); !absurd.empty())
+    Refuse(result, camera, camera_file, photo_file, absurd);
+  // The profiles themselves: the PSF family that fits the limited sections best leaves residuals far over the pixels'
+  // noise (chi-square per point ~ 1 where it explains them): no blurred edge is there to measure.
+  const double chi2 = result.phase.chi2_per_point;
+  if (chi2 > kMaxChi2PerPoint)
+    Refuse(result, camera, camera_file, photo_file,
+           "the board's edges do not fit a blurred edge: the best of the PSF families leaves residuals " +
+               Fixed(std::sqrt(chi2), 0) + " x the pixels' noise (chi-square per point " + Fixed(chi2, 0) +
+               ", over " + Num(kMaxChi2PerPoint) + "; the suite's scenes read under 160, JPEGs of quality 90 among "
+               "them): compression (JPEG blocks), motion, or a board that is not the one given");
+  // The sections' blurs together: one thin lens leaves many of them far off (outliers of its robust fit).
+  const optics::FittedModel& m = result.model;
+  if (m.samples_used > 0 && m.outliers > kMaxOutlierShare * m.samples_used)
+    Refuse(result, camera, camera_file, photo_file,
+           "the blur of " + std::to_string(m.outliers) + " of the " + std::to_string(m.samples_used) +
+               " sections the lens model is fitted to is far from it (outliers; over a quarter): the sections' "
+               "blurs do not follow one thin lens (compression, motion, a board not flat, or sections off the "
+               "board's edges)");
+}
+
+}  // namespace blurcue::cli

@@ -1,0 +1,42 @@
+#pragma once
+// What `calibrate` refuses or states loudly about a measured photo beyond what calib::Calibrate refuses: a blur no
+// section of this photo could show (a camera.json whose focal length is not the photo's put every section off its
+// edge), edges that no blurred edge explains (a JPEG of quality 1), and a fitted aperture far from the nominal one.
+// docs/calibration.md says what each bound is and how it was chosen.
+#include <string>
+
+#include "calib/calibrate.h"
+#include "core/camera.h"
+
+namespace blurcue::cli {
+
+// The fitted aperture over the camera's nominal one (f / N) beyond which calibrate warns: two thirds of a stop
+// (2^(1/3) = 1.26 either way). A lens's marked f-numbers are rounded to a third of a stop; the suite's calibrations
+// fit 0.876-1.038 x (docs/calibrate-checks.md).
+inline constexpr double kApertureWarnFactor = 1.2599210498948732;
+
+// The chosen PSF family's chi-square per profile point (phase check) above which no blurred edge explains the board's
+// profiles: residuals 100 x the pixels' noise. The suite's 37 calibrations stay under 160 (a JPEG of quality 90 over
+// a filter); a JPEG of quality 20 reads 45000, of quality 3 480000.
+inline constexpr double kMaxChi2PerPoint = 1e4;
+
+// The share of the lens fit's sections that may be its outliers (residual over 3 Huber widths) before the sections'
+// blurs are said not to follow one thin lens: the suite's 37 calibrations have none; a focal length 1.7 x the
+// photo's makes 58 %, a JPEG of quality 5 10 %.
+inline constexpr double kMaxOutlierShare = 0.25;
+
+// Throws Error(kInput) with one line when the calibration is physically absurd for its photo or its edges fit no
+// blurred edge: a radius (the reference edge's, a usable section's, the model's at a section) over twice the side of
+// a board square where it is read (a blur that wide leaves the board grey: no section could have measured it), the
+// chi-square per point over kMaxChi2PerPoint, or more than kMaxOutlierShare of the lens fit's sections its outliers.
+// The line names `camera_file` and its focal length when the pose fits the corners worse than 1 px (the camera is
+// then likelier not the photo's), `photo_file` otherwise.
+void RefuseAbsurdCalibration(const calib::CalibResult& result, const Camera& camera, const std::string& camera_file,
+                             const std::string& photo_file);
+
+// The fitted aperture over the nominal (f / N of camera.json).
+double ApertureRatio(const calib::CalibResult& result, const Camera& camera);
+// Whether ApertureRatio is beyond kApertureWarnFactor either way.
+bool ApertureFarFromNominal(const calib::CalibResult& result, const Camera& camera);
+
+}  // namespace blurcue::cli
