@@ -96,7 +96,7 @@ struct PhaseChoice {
   size_t chosen = 0;             // the family chosen (in `families`; 0: the optics alone)
   size_t choice_sections = 0;    // sections every family was read on before others were ruled out (0: every one)
   // Per family: chi-square of its profiles over every limited section (the filter is the whole photo's), each section's
-  // in units of its own misfit (its best family's chi-square per degree of freedom where above 1), and whether it fits
+  // in units of its own misfit (WeighedTotals in phase_check.cc), and whether it fits
   // them alike with the chosen one (within 25 after scaling by the best's chi-square per point, or 15 % of it).
   std::vector<double> chi2;
   std::vector<bool> alike;
