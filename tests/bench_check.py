@@ -4,7 +4,9 @@
   measure.csv  every condition answered by the edge model: its median relative error within issue 25's 2 % wherever
                the true radius is 1 px or more (the PSF families, near focus, the blur sweep), within 8 % from 0.5 px (the blur sweep's 0.5 px is a pure disc with no lens floor, read
                with the Gaussian shape under 0.7 px where the profile cannot tell it: 7.5 %; 10 % off fails),
-               and below the thesis's own measure's mean absolute error on every row both answered
+               and below the thesis's own measure's mean absolute error on every row both answered; on images
+               filtered after sampling (post_gaussian, post_sharpen, phase) no section of the edge model off issue
+               42's rule (off_rule 0: each within max(0.05 px, 10 %) of the truth or flagged phase_limited)
   render.csv   the GL blur against the CPU reference: mean absolute difference within 1 grey level
 
 usage: bench_check.py BENCH_DIR     (results/bench after scripts/demo.sh)
@@ -32,6 +34,9 @@ def main():
         if thesis and int(thesis["answered"]) > 0 and float(r["mean_abs_error_px"]) >= float(thesis["mean_abs_error_px"]):
             problems.append(f"{r['factor']} {level:g}: the model's mean error {r['mean_abs_error_px']} px is not below "
                             f"the thesis measure's {thesis['mean_abs_error_px']} px")
+        if r.get("off_rule") not in (None, "") and int(r["off_rule"]) > 0:
+            problems.append(f"{r['factor']} {level:g}: {r['off_rule']} of {r['sections']} sections off max(0.05 px, "
+                            f"10 %) of the truth, unflagged")
         checked += 1
     render = [r for r in csv.DictReader(open(f"{folder}/render.csv")) if r["mean_abs_error_levels"] not in ("", "nan")]
     for r in render:

@@ -78,11 +78,12 @@ phase_check(phase_filtered_sharpen_05 sharpen05 "\nok: filtered targets met" --e
 # alone, the fit pools them): left out, nothing near focus pinned the floor and the model read 0.19 px for 0.16 px
 # (median 2.4 %, p90 19.1 % here; 1.2-2.3 / 22-29 % on five other seeds). Now median 0.6-1.1 %, p90 1.8-8.1 % over
 # the six seeds (this one 0.9 / 3.9 %): the 5 % p90 holds on 4 of 6, so the model is held to 10 % here - the break,
-# docs/independent-truth.md.
+# docs/independent-truth.md. With the mask refined between the families (phase_fit.h), the refined one fits alike and
+# 8 of the 35 are flagged for the spread rather than the cancellation (27 join the fit): the model median 1.2 %, p90 1.4 %.
 phase_scene(sharpen07 --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.6 --post-amount 0.7
             --noise 0.0025 --seed 6)
 phase_check(phase_filtered_sharpen_07 sharpen07
-            "35 of them phase_limited but joined at their readings.*\nok: filtered targets met" --expect filtered --fitted-p90 0.10)
+            "[23][0-9] of them phase_limited but joined at their readings.*\nok: filtered targets met" --expect filtered --fitted-p90 0.10)
 
 # The Gaussian post filter's ends (0.35 and 0.8 px, the bench's levels). At 0.35 px the optics alone fitted best and
 # 7 sections (edge 4) read 10-12 % high unflagged; now the 0.35 px family is chosen.
@@ -92,3 +93,50 @@ phase_check(phase_filtered_gauss_035 gauss035 "\nok: filtered targets met" --exp
 phase_scene(gauss08 --focus-mm 430 --floor-sigma-px 0.2 --post-filter gaussian --post-sigma-px 0.8 --noise 0.0025
             --seed 4)
 phase_check(phase_filtered_gauss_08 gauss08 "\nok: filtered targets met" --expect filtered)
+# Masks between the families (a camera's filter is never exactly one): amount 0.3 over a Gaussian of 0.8 px (-0.192
+# px^2) read as the family 0.15 at 1.0 px left 7 sections (edge 5, truth 0.49 px) at 0.40-0.42 px unflagged; amount
+# 0.25 over 0.9 px (-0.2025 px^2), read as 0.3 at 0.8 px, 13 sections (edges 4 and 7) 10-13 % high unflagged. Now the
+# family that fits best is refined between the families (phase_fit.h) and the 0.8 px masks are families.
+phase_scene(sharpen_off_grid --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.8
+            --post-amount 0.3 --noise 0.0025 --seed 6)
+phase_check(phase_filtered_sharpen_off_grid sharpen_off_grid "\nok: filtered targets met" --expect filtered)
+phase_scene(sharpen_09 --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.9
+            --post-amount 0.25 --noise 0.0025 --seed 5)
+phase_check(phase_filtered_sharpen_09 sharpen_09 "fitted between the families.*\nok: filtered targets met"
+            --expect filtered --fitted-p90 0.10)
+# Amount 0.5 over 0.8 px (-0.32 px^2): the mask cancels the whole second moment near focus (truth 0 on edges 4-8),
+# where 55-57 sections are flagged; 1-3 others read 0.07-0.1 px off unflagged before. The lens model breaks here
+# (no thin lens bends to that), so the sections alone are held.
+phase_scene(sharpen_05_08 --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.8
+            --post-amount 0.5 --noise 0.0025 --seed 2)
+phase_check(phase_filtered_sharpen_05_08 sharpen_05_08 "\nok: filtered targets met" --expect filtered --sections-only)
+# The bench's Gaussian of 0.35 px (bench measure --quick, seed 1): edge 7 lies 0.09 px past a pixel centre, its profile
+# a handful of samples, and its seven sections of one true blur (0.62 px) read 0.58-0.70 px under the family that fits
+# (the families' spread 0.03 px): section 1 at 0.70 px (+12.5 %) unflagged. Now a section off the line through its
+# edge's other sections by more than max(0.04 px, 8 %) is flagged where a filter was chosen.
+phase_scene(gauss035_bench --focus-mm 430 --floor-sigma-px 0.2 --post-filter gaussian --post-sigma-px 0.35
+            --noise 0.0025 --seed 1)
+phase_check(phase_filtered_gauss_035_bench gauss035_bench "off the line through their edge.*\nok: filtered targets met"
+            --expect filtered)
+# Boards turned a few degrees under a filter after sampling (an adversary's finding): sections whose edge crosses a
+# pixel row or more along the part measured sample every phase and were not read per family, so the photo's filter
+# went unread on them. Turned 3 deg under a mask of amount 0.7 over 0.6 px, main read 28 sections off the rule
+# unflagged (edge 4: 0.73-0.75 px for 0.32-0.36 px) and the model median 16 %, p90 60 %; under a Gaussian of 0.45 px,
+# edge 4 10-12 % low. Turned 20 deg (every section at every phase): mask model median 46 %, p90 282 %; Gaussian
+# sections 10-13 % low, model median 7 %, p90 12 %. Now every section under 2 px is read with the family chosen.
+# Turned 20 deg the mask's model misses p90 5 % near focus (6.9 %: truths of 0.12-0.2 px, where the mask cancels most
+# of the optics' blur), the break the level amount-0.7 scene holds to 10 % (Step 3 of the issue's note, open).
+foreach(turn 3 20)
+  set(p90 0.05)
+  if(turn EQUAL 20)
+    set(p90 0.10)
+  endif()
+  phase_scene(turn${turn}_sharpen --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.6
+              --post-amount 0.7 --noise 0.0025 --seed 6 --yaw-deg ${turn})
+  phase_check(phase_turned_${turn}_sharpen_07 turn${turn}_sharpen
+              "and [1-9][0-9]* at every phase.*\nok: filtered targets met" --expect filtered --fitted-p90 ${p90})
+  phase_scene(turn${turn}_gauss --focus-mm 430 --floor-sigma-px 0.2 --post-filter gaussian --post-sigma-px 0.45
+              --noise 0.0025 --seed 3 --yaw-deg ${turn})
+  phase_check(phase_turned_${turn}_gauss turn${turn}_gauss
+              "and [1-9][0-9]* at every phase.*\nok: filtered targets met" --expect filtered)
+endforeach()

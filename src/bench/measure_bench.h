@@ -33,6 +33,9 @@ struct MeasureRow {
                                // model median <= 2 %, p90 <= 5 %
   bool board_found = true;     // false: detection failed here, and the blur was measured at the true pose
   int phase_limited = 0;       // sections the calibration flagged phase_limited (not answered by the model fit)
+  // post_gaussian, post_sharpen and phase (issue 42's rule): answered sections off max(0.05 px, 10 %) of the truth,
+  // i.e. neither within it nor flagged; -1 elsewhere (the CSV leaves it empty).
+  int off_rule = -1;
 };
 
 struct MeasureBenchOptions {

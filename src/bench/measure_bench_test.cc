@@ -35,5 +35,16 @@ TEST(MeasureBench, BreakpointsSayWhatTheyMean) {
   EXPECT_NE(text.find("detection    contrast breaks at 0.02: board not found"), std::string::npos) << text;
 }
 
+// Issue 42's rule is stated, and each filtered condition's sections off it counted, for the blur fit only.
+TEST(MeasureBench, SamplingRuleCountsSectionsOffIt) {
+  MeasureRow gauss = Row("model_fit", "post_gaussian", 0.35, false), fitted = Row("fitted_model", "post_gaussian", 0.35, true);
+  gauss.off_rule = 1, gauss.phase_limited = 0, fitted.off_rule = 0;
+  MeasureRow noise = Row("model_fit", "noise", 0.01, true);
+  const std::string text = DescribeBreakpoints({gauss, fitted, noise});
+  EXPECT_NE(text.find("within max(0.05 px, 10 %) of the truth or flagged phase_limited"), std::string::npos) << text;
+  EXPECT_NE(text.find("post_gaussian 0.35   1 of 77 sections off the rule, 0 flagged\n"), std::string::npos) << text;
+  EXPECT_EQ(text.find("noise         0.01"), std::string::npos) << text;
+}
+
 }  // namespace
 }  // namespace blurcue::bench

@@ -386,7 +386,7 @@ Json PhaseCheckJson(const PhaseCheck& p) {
   Json readings = Json::array();
   for (const PhaseReading& f : p.families)
     readings.push_back({{"r_px", f.r_px}, {"offset_px", f.offset_px}, {"rms_rel", f.rms_rel}, {"chi2", f.chi2}});
-  return {{"axis_deg", p.axis_deg}, {"span_px", p.span_px}, {"phase_px", p.phase_px}, {"noise", p.noise},
+  return {{"axis_deg", p.axis_deg}, {"span_px", p.span_px}, {"every_phase", p.every_phase}, {"phase_px", p.phase_px}, {"noise", p.noise},
           {"bins", p.bins}, {"range_px", {p.range_lo_px, p.range_hi_px}}, {"joins_fit", p.joins_fit},
           {"families", readings}};
 }
@@ -394,10 +394,11 @@ Json PhaseCheckJson(const PhaseCheck& p) {
 Json PhaseChoiceJson(const PhaseChoice& c) {
   Json families = Json::array();
   for (size_t i = 0; i < c.chi2.size(); ++i)
-    families.push_back({{"post_sigma_px", PhaseFamilies()[i].sigma_px}, {"sharpen", PhaseFamilies()[i].sharpen},
-                        {"chi2", c.chi2[i]}, {"alike", bool(c.alike[i])}});
-  return {{"limited_sections", c.limited}, {"flagged", c.flagged}, {"held_the_model", c.held},
-          {"chosen", c.limited > 0 ? Json(PhaseFamilies()[c.chosen].Name()) : Json(nullptr)},
+    families.push_back({{"post_sigma_px", c.families[i].sigma_px}, {"sharpen", c.families[i].sharpen},
+                        {"fitted", c.families[i].fitted}, {"chi2", c.chi2[i]}, {"alike", bool(c.alike[i])}});
+  return {{"limited_sections", c.limited}, {"every_phase_sections", c.every_phase}, {"flagged", c.flagged},
+          {"held_the_model", c.held},
+          {"chosen", c.limited + c.every_phase > 0 ? Json(c.families[c.chosen].Name()) : Json(nullptr)},
           {"chi2_per_point", c.chi2_per_point}, {"families", families}, {"summary", c.summary},
           {"note", "sections along the pixel rows or columns with blur under 2 px are read once per PSF family "
                    "(the optics, then on the sampled image a Gaussian of post_sigma_px or an unsharp mask of that std "
@@ -444,7 +445,7 @@ Json CalibToJson(const CalibResult& r) {
       if (!s.fit.crowded_why.empty()) js["crowded_why"] = s.fit.crowded_why;
       if (s.fit.r_se_px > 0) js["r_se_px"] = s.fit.r_se_px;
       if (!s.fit.phase_why.empty()) js["phase_why"] = s.fit.phase_why;
-      if (s.phase.limited) js["phase"] = PhaseCheckJson(s.phase);
+      if (s.phase.limited || s.phase.every_phase) js["phase"] = PhaseCheckJson(s.phase);
       if (distorted) js["stretch"] = s.stretch;
       sections.push_back(js);
     }

@@ -25,6 +25,7 @@ namespace blurcue::calib {
 // assumes), or an unsharp mask, (1 + sharpen) x the identity - sharpen x that Gaussian (a negative second moment).
 struct PhaseFamily {
   double sigma_px = 0, sharpen = 0;
+  bool fitted = false;  // not one of PhaseFamilies(): refined between them (phase_fit.h)
   std::string Name() const;  // "the optics alone", "the optics then a Gaussian of std 0.45 px on the sampled image"
 };
 
@@ -39,6 +40,10 @@ struct PhaseReading {
 struct PhaseCheck {
   // Few phases and blur near or below a pixel: the readings below were taken (otherwise empty).
   bool limited = false;
+  // Every phase and blur under 2 px: the families were read too (ReadPhaseFamilies, not CheckPhase). Such a section
+  // tells the families apart on its own and joins the choice; where a filter after sampling is chosen it is read with
+  // it (a board turned a few degrees under a filter: read as the optics alone, 28 sections were off the rule).
+  bool every_phase = false;
   double axis_deg = 0;  // the edge's angle to the nearest pixel axis
   double span_px = 0;   // how far its sub-pixel phase moves along the part measured (1 px or more: every phase)
   double phase_px = 0;  // where the edge (from the pose) lies between pixel centres at its midpoint, 0..1
@@ -76,17 +81,25 @@ struct CalibResult;
 // CheckPhase on every usable section of `result` (on every core when `parallel`), reading no more than the photo
 // needs: where more than 24 sections are limited, every family is read on 12 of them at phases spread over the pixel,
 // and on the others only the families that fit those 12 within twice ChoosePhaseFamily's "alike" margin of the best
-// (and the optics alone). The choice and the flags are ChoosePhaseFamily's, over every limited section, as before.
+// (and the optics alone). Where that best is a filter, it is refined between the families on those 12 (all, with 24
+// or fewer; RefinePhaseFamily) and read on every limited section as one more family (result.phase.families). The
+// choice and the flags are ChoosePhaseFamily's, over every limited section.
 void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFitOptions& options, bool parallel);
 
 // What the sections at other phases chose (calib.json's phase_check).
 struct PhaseChoice {
   int limited = 0;               // usable sections whose phases are few (PhaseCheck::limited)
+  int every_phase = 0;           // usable sections at every phase with blur under 2 px (PhaseCheck::every_phase)
   int flagged = 0;               // of those, flagged phase_limited
   int held = 0;                  // of those, sections whose range held the lens model (FitModelWithinPhaseRanges)
-  size_t chosen = 0;             // the family chosen (PhaseFamilies(); 0: the optics alone)
-  // Per family: chi-square of its profiles over every limited section (the filter is the whole photo's), and whether
-  // it fits them alike with the chosen one (within 25 after scaling by the best's chi-square per point, or 15 % of it).
+  // The families read on this photo: PhaseFamilies() and, where one of its filters fitted the sections at spread
+  // phases best, that filter refined between them (RefinePhaseFamily) last. Empty: PhaseFamilies().
+  std::vector<PhaseFamily> families;
+  size_t chosen = 0;             // the family chosen (in `families`; 0: the optics alone)
+  size_t choice_sections = 0;    // sections every family was read on before others were ruled out (0: every one)
+  // Per family: chi-square of its profiles over every limited section (the filter is the whole photo's), each section's
+  // in units of its own misfit (WeighedTotals in phase_check.cc), and whether it fits
+  // them alike with the chosen one (within 25 after scaling by the best's chi-square per point, or 15 % of it).
   std::vector<double> chi2;
   std::vector<bool> alike;
   double chi2_per_point = 0;     // the chosen family's: about 1 where it describes the profiles to the noise

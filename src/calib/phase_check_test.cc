@@ -2,6 +2,7 @@
 // Gaussian blur over the pixel's box) and filtered after sampling by taps written out in the test, and a filtered
 // ground-truth scene (synth's truth: its kernels' and the post filter's taps' second moments).
 #include "calib/phase_check.h"
+#include "calib/phase_fit.h"
 
 #include <gtest/gtest.h>
 
@@ -133,7 +134,29 @@ TEST(PhaseCheck, NeighboursAreTheNextStdOrAmountOnEitherSide) {
   EXPECT_EQ(set(PhaseNeighbours(FamilyIndex(0.6, 0.5))), set({FamilyIndex(0.6, 0.3), FamilyIndex(0.6, 0.7)}));
   EXPECT_EQ(set(PhaseNeighbours(FamilyIndex(1.0, 0.15))), set({0, FamilyIndex(1.0, 0.3)}));
   EXPECT_EQ(set(PhaseNeighbours(FamilyIndex(0.8, 0))), set({FamilyIndex(0.7, 0)}));
-  EXPECT_EQ(set(PhaseNeighbours(0)), set({FamilyIndex(0.35, 0), FamilyIndex(0.6, 0.15), FamilyIndex(1.0, 0.15)}));
+  EXPECT_EQ(set(PhaseNeighbours(0)), set({FamilyIndex(0.35, 0), FamilyIndex(0.6, 0.15), FamilyIndex(0.8, 0.15),
+                                          FamilyIndex(1.0, 0.15)}));
+}
+
+// The refinement between the families finds a bowl's floor that lies off the grid (an unsharp mask of amount 0.25,
+// std 0.9 px, between the families' 0.8 and 1.0 px), staying a mask; a Gaussian is refined along its std alone.
+TEST(PhaseFit, RefinesBetweenTheFamiliesToTheLeastChiSquare) {
+  int calls = 0;
+  auto bowl = [&](const PhaseFamily& f) {
+    ++calls;
+    return 100 + 4000 * (f.sigma_px - 0.9) * (f.sigma_px - 0.9) + 9000 * (f.sharpen - 0.25) * (f.sharpen - 0.25);
+  };
+  const PhaseFamily mask = RefinePhaseFamily({0.8, 0.3}, bowl, 40);
+  EXPECT_TRUE(mask.fitted);
+  EXPECT_NEAR(mask.sigma_px, 0.9, 0.02);
+  EXPECT_NEAR(mask.sharpen, 0.25, 0.02);
+  EXPECT_LE(calls, 40);
+  auto gauss_bowl = [](const PhaseFamily& f) { return 50 + 3000 * (f.sigma_px - 0.38) * (f.sigma_px - 0.38) + f.sharpen; };
+  const PhaseFamily gauss = RefinePhaseFamily({0.35, 0}, gauss_bowl, 20);
+  EXPECT_NEAR(gauss.sigma_px, 0.38, 0.01);
+  EXPECT_EQ(gauss.sharpen, 0.0);
+  // The optics alone has nothing to refine.
+  EXPECT_FALSE(RefinePhaseFamily({0, 0}, bowl).fitted);
 }
 
 // Sections made by hand, read best by an unsharp mask of amount 0.5 (std 0.6 px). Its taps' second moment, written
