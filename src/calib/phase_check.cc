@@ -267,8 +267,9 @@ PhaseReading ReadFamily(const std::vector<Bin>& bins, const PhaseFamily& family,
   // At r = 0 the profile's slope in r vanishes (its variance grows as r^2), so a refinement started there stays: on an
   // edge near a pixel centre the grid's best node was 0 and the optics alone read 0.00 px where the blur fit read
   // 0.42-0.51 px (true 0.43 px; floor 0.2 px), flagged as a jump and holding the model 7 % low. Started from the blur
-  // fit's reading too, the better end is kept.
-  if (p[0] < 0.05 && r_fit > 0.05) {
+  // fit's reading too, the better end is kept - for the optics alone only: restarted, filter families that had
+  // stuck at 0 on an aliased take frame (supersample 1) came to fit alike and flagged a whole edge.
+  if (!(family.sigma_px > 0) && p[0] < 0.05 && r_fit > 0.05) {
     double q[3] = {r_fit, 0, p[2]};
     if (const double v = RefineFamily(bins, taps, shift, w1, w2, q); v < sse) sse = v, p[0] = q[0], p[1] = q[1], p[2] = q[2];
   }
