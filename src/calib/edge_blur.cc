@@ -489,7 +489,7 @@ void DescribeFit(const FitState& best, const std::array<std::array<double, 3>, 3
 void ReadOneShapeUnderAPixel(const FitSetup& setup, const FitState& best,
                              const std::array<std::array<double, 3>, 3>& jtj, const std::vector<Bin>& bins,
                              double d0_limit, ModelFit* fit) {
-  if (!(fit->shape_ambiguous && fit->r_px < kOneShapeBelowPx)) return;
+  if (!(fit->shape_ambiguous && fit->r_px < kOneShapeBelowPx && fit->r_px >= kOneShapeFromPx)) return;
   FitState start_state = best;
   start_state.phi = kPi / 2;
   std::array<std::array<double, 3>, 3> a{};

@@ -14,6 +14,12 @@ namespace blurcue::calib {
 // with the Gaussian shape, by the blur fit and by the phase check's families alike: a shape the profile cannot tell
 // still moves the size there where the edge lies near a pixel centre (edge_blur.cc says what was measured).
 constexpr double kOneShapeBelowPx = 0.7;
+// ... and from this one: under it the profile is little more than the pixel's own box and the size is not determined
+// (on the tests' scene focused on edge 1, a true 0 read 0.02-0.48 px section by section, the free shape and the
+// Gaussian alike), so the blur fit's free reading stands there as before. The floor-0.2 scenes' sections read 0.4 px
+// and up. (The tests' scenes rest on edge 1's median, 0.30 px: eq. 3.7 as published from a reference of 0.02 px
+// refuses every point nearer than that edge, where test 2's balls start.)
+constexpr double kOneShapeFromPx = 0.35;
 
 // A board edge parallel to a section and next to it: the same section of the edge before or after it, in image px,
 // its ends listed in the same order as the section's (a at the same column line as the section's a).

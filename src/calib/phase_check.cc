@@ -387,7 +387,7 @@ PhaseCheck GatePhase(const cv::Mat& linear, const EdgeSegment& segment, const Mo
   const double phi = std::atan2(2 * fit.floor_sigma_px, fit.disc_r_px);
   const double w1 = std::max(std::abs(f.n.x), std::abs(f.n.y)), w2 = std::min(std::abs(f.n.x), std::abs(f.n.y));
   // A filter's tap one pixel along the nearest axis moves the profile by this much across the edge.
-  *profile = {bins, phi, w1, w2, /*shift=*/w1, fit.r_px, fit.shape_ambiguous && fit.r_px < kOneShapeBelowPx};
+  *profile = {bins, phi, w1, w2, /*shift=*/w1, fit.r_px, fit.shape_ambiguous && fit.r_px < kOneShapeBelowPx && fit.r_px >= kOneShapeFromPx};
   return check;
 }
 
