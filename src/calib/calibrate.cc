@@ -148,8 +148,9 @@ void SetReference(CalibResult& result, int reference_edge) {
   std::vector<double> ref_r, ref_u;
   for (const auto& s : ref.sections)
     if (s.fit.ok || s.phase.joins_fit) ref_r.push_back(s.fit.r_px), ref_u.push_back(s.u_mm);
-  // (Sections flagged but joined to the lens fit at their readings are pooled here as there.) A reference edge whose every section is phase_limited still has its readings (eq. 3.7 is the thesis's estimate
-  // from them, whatever their family): taken rather than refusing the photo.
+  // (Sections flagged but joined to the lens fit at their readings are pooled here as there.) A reference edge whose
+  // every section is phase_limited still has its readings (eq. 3.7 is the thesis's estimate from them, whatever their
+  // family): taken rather than refusing the photo.
   if (ref_r.empty())
     for (const auto& s : ref.sections)
       if (!s.fit.phase_why.empty()) ref_r.push_back(s.fit.r_px), ref_u.push_back(s.u_mm);
