@@ -1,5 +1,7 @@
 #include "calib/calibrate.h"
 
+#include "calib/calib_checks.h"
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -120,15 +122,11 @@ void RequireThreeDepths(const CalibResult& result) {
     flags += (i ? ", " : "") + common[i].second + " (" + std::to_string(-common[i].first) + " sections)";
   // A pose that fits the corners only to a pixel or more says the camera is not the photo's (a focal length of 50 mm
   // for 21 left 2 edges usable): that is named, as calibrate's other refusals of an absurd calibration name it.
-  if (result.pose.reprojection_error_px > 1) {
-    char pose[240];
-    std::snprintf(pose, sizeof pose,
-                  "is %g mm, and with it the board's corners fit the pose only to %.2f px (a photo of this camera fits "
-                  "to well under 1 px); only %zu of %zu edges have a usable section: is this camera.json the photo's "
-                  "(focal length, sensor size, dist_coeffs)?",
-                  result.camera.focal_length_mm, result.pose.reprojection_error_px, usable.size(), result.edges.size());
-    throw InputError("/focal_length_mm", pose);
-  }
+  if (result.pose.reprojection_error_px > kPoseSuspectPx)
+    throw InputError("/focal_length_mm", PoseSuspectText(result, "") + "; only " + std::to_string(usable.size()) +
+                                             " of " + std::to_string(result.edges.size()) +
+                                             " edges have a usable section: is this camera.json the photo's (focal "
+                                             "length, sensor size, dist_coeffs)?");
   throw Error(ErrorKind::kNotFound,
               (usable.empty() ? "none of the " + std::to_string(result.edges.size()) + " edges has"
                               : "only " + std::to_string(usable.size()) + " of " + std::to_string(result.edges.size()) +

@@ -7,9 +7,9 @@
 #include <iostream>
 #include <string>
 
+#include "calib/calib_checks.h"
 #include "calib/calibrate.h"
 #include "calib/truth.h"
-#include "cli/calibrate_checks.h"
 #include "cli/commands.h"
 #include "core/error.h"
 #include "core/output_guard.h"
@@ -25,7 +25,7 @@ namespace {
 void WarnAboutCalibration(const calib::CalibResult& result, const Camera& camera, const std::string& camera_file,
                           const std::string& photo_file) {
   // A pose that fits its corners badly: the camera is not this photo's (distortion, sensor, focal length).
-  if (result.pose.reprojection_error_px > 1)
+  if (result.pose.reprojection_error_px > calib::kPoseSuspectPx)
     std::fprintf(stderr,
                  "blurcue: warning: %s: the board's corners fit the pose only to %.2f px (a photo of this camera "
                  "fits to well under 1 px): check its dist_coeffs, sensor size and focal length; the depths and "
@@ -34,12 +34,12 @@ void WarnAboutCalibration(const calib::CalibResult& result, const Camera& camera
   // A lens model whose aperture is far from the camera's f-number fits sections that may not measure the board's
   // edges (an edge covered or shaded reads sharp: a covered board gave focus 21 mm and an aperture of 0). Far: over
   // two thirds of a stop either way (kApertureWarnFactor; 0.6 x and 1.29 x passed unsaid under the old bound of 2 x).
-  if (ApertureFarFromNominal(result, camera))
+  if (calib::ApertureFarFromNominal(result, camera))
     std::fprintf(stderr,
                  "blurcue: warning: %s: the fitted aperture %.3f mm is %.2f x the camera's (%.3f mm, f/%g), more "
                  "than two thirds of a stop off: the sections may not measure the board's edges (covered, shaded, "
                  "reflections; see the table's flags) or camera.json's f_number is not the photo's\n",
-                 photo_file.c_str(), result.model.aperture_mm, ApertureRatio(result, camera), camera.ApertureMm(),
+                 photo_file.c_str(), result.model.aperture_mm, calib::ApertureRatio(result, camera), camera.ApertureMm(),
                  camera.f_number);
 }
 
@@ -57,8 +57,8 @@ void PrintCalibrationSummary(const calib::CalibResult& result, const Board& boar
     std::printf("reference edge %d: u = %.1f mm, r = %.2f px (median of its phase_limited sections' readings: none "
                 "of them is usable, so eq. 3.7's estimates below are as unsure as they are)\n",
                 result.reference_edge, result.reference_u_mm, result.reference_r_px);
-  const std::string far = ApertureFarFromNominal(result, camera)
-                              ? ", " + Num(std::round(ApertureRatio(result, camera) * 100) / 100) +
+  const std::string far = calib::ApertureFarFromNominal(result, camera)
+                              ? ", " + Num(std::round(calib::ApertureRatio(result, camera) * 100) / 100) +
                                     " x: more than two thirds of a stop off"
                               : "";
   std::printf("fitted %s model: focus %.1f mm, aperture %.3f mm (nominal %.3f%s), %s, rms %.3f px,"
@@ -299,7 +299,7 @@ void AddCalibrateCommand(CLI::App& app) {
     if (!args->truth.empty()) CheckTruthPose(truth, args->truth, result, board, camera, args->photo);
     // A calibration absurd for its photo (a blur no section could show, edges no blurred edge explains) is refused
     // before anything is written.
-    RefuseAbsurdCalibration(result, camera, args->camera, args->photo);
+    calib::RefuseAbsurdCalibration(result, camera, args->camera, args->photo);
     Json json = calib::CalibToJson(result);
     json["photo"] = args->photo;
     WriteJsonFile(args->out, json);

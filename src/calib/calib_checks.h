@@ -1,5 +1,5 @@
 #pragma once
-// What `calibrate` refuses or states loudly about a measured photo beyond what calib::Calibrate refuses: a blur no
+// What `calibrate` refuses or states loudly about a measured photo beyond what Calibrate refuses: a blur no
 // section of this photo could show (a camera.json whose focal length is not the photo's put every section off its
 // edge), edges that no blurred edge explains (a JPEG of quality 1), and a fitted aperture far from the nominal one.
 // docs/calibration.md says what each bound is and how it was chosen.
@@ -8,7 +8,7 @@
 #include "calib/calibrate.h"
 #include "core/camera.h"
 
-namespace blurcue::cli {
+namespace blurcue::calib {
 
 // The fitted aperture over the camera's nominal one (f / N) beyond which calibrate warns: two thirds of a stop
 // (2^(1/3) = 1.26 either way). A lens's marked f-numbers are rounded to a third of a stop; the suite's calibrations
@@ -31,12 +31,20 @@ inline constexpr double kMaxOutlierShare = 0.25;
 // chi-square per point over kMaxChi2PerPoint, or more than kMaxOutlierShare of the lens fit's sections its outliers.
 // The line names `camera_file` and its focal length when the pose fits the corners worse than 1 px (the camera is
 // then likelier not the photo's), `photo_file` otherwise.
-void RefuseAbsurdCalibration(const calib::CalibResult& result, const Camera& camera, const std::string& camera_file,
+void RefuseAbsurdCalibration(const CalibResult& result, const Camera& camera, const std::string& camera_file,
                              const std::string& photo_file);
 
-// The fitted aperture over the nominal (f / N of camera.json).
-double ApertureRatio(const calib::CalibResult& result, const Camera& camera);
-// Whether ApertureRatio is beyond kApertureWarnFactor either way.
-bool ApertureFarFromNominal(const calib::CalibResult& result, const Camera& camera);
+// A pose fitting the board's corners worse than this is not this camera's (a photo of it fits to well under 1 px):
+// refusals then name camera.json's focal length (RefuseAbsurdCalibration here, RequireThreeDepths in calibrate.cc).
+inline constexpr double kPoseSuspectPx = 1;
 
-}  // namespace blurcue::cli
+// "is F mm, and with it the board's corners fit the pose only to E px in PHOTO (a photo of this camera fits to well
+// under 1 px)": how such a refusal starts (`photo_file` empty: no "in PHOTO").
+std::string PoseSuspectText(const CalibResult& result, const std::string& photo_file);
+
+// The fitted aperture over the nominal (f / N of camera.json).
+double ApertureRatio(const CalibResult& result, const Camera& camera);
+// Whether ApertureRatio is beyond kApertureWarnFactor either way.
+bool ApertureFarFromNominal(const CalibResult& result, const Camera& camera);
+
+}  // namespace blurcue::calib

@@ -1,4 +1,4 @@
-#include "cli/calibrate_checks.h"
+#include "calib/calib_checks.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,16 +6,12 @@
 
 #include "core/error.h"
 
-namespace blurcue::cli {
+namespace blurcue::calib {
 namespace {
-
-// A pose fitting the board's corners worse than this is not this camera's (a photo of it fits to well under 1 px):
-// the warning calibrate prints has the same bound.
-constexpr double kPoseSuspectPx = 1;
 
 // The side of a board square where a section lies (photo px): the larger of its length along the edge and the gap to
 // the parallel edge beside it (twice its window's half width).
-double SquareSidePx(const calib::SectionResult& s) {
+double SquareSidePx(const SectionResult& s) {
   return std::max(std::hypot(s.segment.b.x - s.segment.a.x, s.segment.b.y - s.segment.a.y),
                   2 * s.segment.half_window_px);
 }
@@ -28,27 +24,24 @@ std::string Fixed(double v, int digits) {
 
 // Where a refusal points: camera.json's focal length when the pose says the camera is not the photo's, else the
 // photo; `why` is the rest of the line.
-[[noreturn]] void Refuse(const calib::CalibResult& result, const Camera& camera, const std::string& camera_file,
+[[noreturn]] void Refuse(const CalibResult& result, const Camera& camera, const std::string& camera_file,
                          const std::string& photo_file, const std::string& why) {
-  const double pose_px = result.pose.reprojection_error_px;
-  if (pose_px > kPoseSuspectPx)
+  if (result.pose.reprojection_error_px > kPoseSuspectPx)
     throw InputError(camera_file + ": /focal_length_mm",
-                     "is " + Num(camera.focal_length_mm) + " mm, and with it the board's corners fit the pose only "
-                     "to " + Fixed(pose_px, 2) + " px in " + photo_file + " (a photo of this camera fits to well "
-                     "under 1 px); " + why + ": is this camera.json the photo's (focal length, sensor size, "
-                     "dist_coeffs)? nothing written");
+                     PoseSuspectText(result, photo_file) + "; " + why +
+                         ": is this camera.json the photo's (focal length, sensor size, dist_coeffs)? nothing written");
   throw InputError(photo_file, why + "; nothing written");
 }
 
 // The first radius the calibration states that is over twice the side of a square where it is read: "" when none.
-std::string AbsurdRadius(const calib::CalibResult& result) {
+std::string AbsurdRadius(const CalibResult& result) {
   auto over = [](double r, double side) { return !(r <= 2 * side); };
   auto text = [](const std::string& what, double r, double side) {
     return what + " is " + Fixed(r, 1) + " px where a square of the board spans " + Fixed(side, 0) +
            " px: a blur over twice that leaves the board grey, so no section could have measured it";
   };
   // The reference edge (eq. 3.7's anchor): the mean side of its squares.
-  const calib::EdgeResult& ref = result.edges[size_t(result.reference_edge - 1)];
+  const EdgeResult& ref = result.edges[size_t(result.reference_edge - 1)];
   double side = 0;
   for (const auto& s : ref.sections) side += SquareSidePx(s) / double(ref.sections.size());
   if (!ref.sections.empty() && over(result.reference_r_px, side))
@@ -66,16 +59,22 @@ std::string AbsurdRadius(const calib::CalibResult& result) {
 
 }  // namespace
 
-double ApertureRatio(const calib::CalibResult& result, const Camera& camera) {
+std::string PoseSuspectText(const CalibResult& result, const std::string& photo_file) {
+  return "is " + Num(result.camera.focal_length_mm) + " mm, and with it the board's corners fit the pose only to " +
+         Fixed(result.pose.reprojection_error_px, 2) + " px" + (photo_file.empty() ? "" : " in " + photo_file) +
+         " (a photo of this camera fits to well under 1 px)";
+}
+
+double ApertureRatio(const CalibResult& result, const Camera& camera) {
   return result.model.aperture_mm / camera.ApertureMm();
 }
 
-bool ApertureFarFromNominal(const calib::CalibResult& result, const Camera& camera) {
+bool ApertureFarFromNominal(const CalibResult& result, const Camera& camera) {
   const double ratio = ApertureRatio(result, camera);
   return !(ratio >= 1 / kApertureWarnFactor && ratio <= kApertureWarnFactor);
 }
 
-void RefuseAbsurdCalibration(const calib::CalibResult& result, const Camera& camera, const std::string& camera_file,
+void RefuseAbsurdCalibration(const CalibResult& result, const Camera& camera, const std::string& camera_file,
                              const std::string& photo_file) {
   if (const std::string absurd = AbsurdRadius(result); !absurd.empty())
     Refuse(result, camera, camera_file, photo_file, absurd);
@@ -98,4 +97,4 @@ void RefuseAbsurdCalibration(const calib::CalibResult& result, const Camera& cam
                "board's edges)");
 }
 
-}  // namespace blurcue::cli
+}  // namespace blurcue::calib
