@@ -727,7 +727,7 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   std::snprintf(text, sizeof text,
                 "%d sections with blur under %.0f px along the pixel rows or columns (and %d at every phase) read under "
                 "%zu kinds of blur (the lens alone, or then a smoothing or sharpening of the pixels): the photo fits "
-                "best as %s (%d kinds fit alike, chi-square per point %.2f%s); %d flagged phase_limited (%d where the "
+                "best as %s (%d of the kinds fit alike, chi-square per point %.2f%s); %d flagged phase_limited (%d where the "
                 "sharpening cancels most of the lens's blur, %d jumping between neighbouring kinds, %d off the line "
                 "through their edge's other sections, %d too unsure near a pixel centre; each reading's range in "
                 "calib.json)",

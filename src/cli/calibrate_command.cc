@@ -110,18 +110,19 @@ void PrintPhaseCheck(const calib::CalibResult& result) {
   if (result.phase.held > 0)
     std::printf("phase check: the model predicted %d phase_limited sections outside the range their families "
                 "leave open; their ranges' middles joined its fit\n", result.phase.held);
-  // What to do about them: a filter after sampling is the camera's (turning the board leaves it unmodelled: the
-  // check reads only sections along the pixel rows); without one, turning the board gives every edge all phases.
+  // What to do about them: a filter after sampling is in every section (a turned board is read with it up to 25 deg
+  // off the pixel axes, but it still cancels or blurs what the lens did); without one, turning the board gives every
+  // edge all phases.
   if (result.phase.flagged > 0) {
     if (result.phase.chosen != 0)
       std::printf("what to do: this photo was filtered after it was sampled (the camera's sharpening or smoothing); "
                   "for measured blur on the flagged edges turn that processing off (or take raw) and photograph "
-                  "again - turning the board would leave the filter unread; until then the blur source `fitted` "
-                  "gives those places the model's value\n");
+                  "again; until then the blur source `fitted` gives those places the model's value\n");
     else
       std::printf("what to do: for measured blur on the flagged edges turn the board a few degrees on the table so "
-                  "its edges cross the pixel rows (every phase is then sampled); the blur source `fitted` gives "
-                  "those places the model's value\n");
+                  "its edges cross the pixel rows (every phase is then sampled); until then `measured` averages an "
+                  "edge's readings, those flagged as unsure alone included, and `fitted` gives every place the "
+                  "model's value\n");
   }
 }
 
