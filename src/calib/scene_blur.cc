@@ -250,7 +250,7 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
       out.ok = Flag(sec, "ok", sw, false);
       // A section the fit gave up on keeps whatever number it had; only usable ones feed a blur.
       if (const auto ph = sec.find("phase"); ph != sec.end() && ph->is_object())
-        if (const auto jf = ph->find("joins_fit"); jf != ph->end() && jf->is_boolean()) out.pooled = *jf && !out.ok;
+        out.pooled = Flag(*ph, "joins_fit", sw + "/phase", false) && !out.ok;  // a non-boolean is refused
       out.r_px = out.ok || out.pooled ? Ranged(sec, "r_px", sw, 0, optics::kMaxBlurRadiusPx, "px")
                                       : RequireNumber(sec, "r_px", sw);
       out.pointer = "/edges/" + std::to_string(e) + "/sections/" + std::to_string(k);
