@@ -54,6 +54,12 @@ phase_check(phase_physical_gauss_floor02 gauss02 "\nok: physical targets met" --
 # and the fitted model 2.1 / 7.1 % (the optics alone's family reading stuck at r = 0 held it low).
 phase_scene(gauss02f500 --focus-mm 500 --psf gaussian --floor-sigma-px 0.2 --noise 0.0025 --seed 680)
 phase_check(phase_physical_floor02_focus500 gauss02f500 "\nok: physical targets met" --expect physical --max-flagged 30)
+# JPEG 95 over the same floor (the sweep's seed 204): the compression takes the tails of edge 8's section 2 (0.41 px,
+# its edge 0.06 px past a pixel centre) and the blur fit's Gaussian reading collapsed to 0.02 px, unflagged (its
+# standard error was not taken: no curvature in r there). Now infinite, it is flagged. A JPEG acts on the sampled
+# image, so the filtered rule holds: every section within max(0.05 px, 10 %) or flagged, the model within 2 / 5 %.
+phase_scene(gauss02jpeg --focus-mm 470 --psf gaussian --floor-sigma-px 0.2 --noise 0.0025 --jpeg-quality 95 --seed 204)
+phase_check(phase_physical_floor02_jpeg95 gauss02jpeg "\nok: filtered targets met" --expect filtered)
 # Focus on edge 1 (the thesis's set-up) and a JPEG of quality 90 over a post filter of std 0.45 px: only edges 1-8 are
 # under 2 px and the JPEG's blocks blur which family fits best (4 of 15 alike): 14 sections are flagged (edges 1 and 2,
 # their families' readings 0.77-0.91 px apart for a true 0.86-0.92 px) and predicted by the model, held to their

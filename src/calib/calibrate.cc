@@ -453,7 +453,7 @@ Json CalibToJson(const CalibResult& r) {
                  {"thesis_ok", s.thesis.ok}};
       if (!s.estimated_note.empty()) js["r_estimated_note"] = s.estimated_note;
       if (!s.fit.crowded_why.empty()) js["crowded_why"] = s.fit.crowded_why;
-      if (s.fit.r_se_px > 0) js["r_se_px"] = s.fit.r_se_px;
+      if (s.fit.r_se_px > 0 && std::isfinite(s.fit.r_se_px)) js["r_se_px"] = s.fit.r_se_px;
       if (!s.fit.phase_why.empty()) js["phase_why"] = s.fit.phase_why;
       if (s.phase.limited || s.phase.every_phase) js["phase"] = PhaseCheckJson(s.phase);
       if (distorted) js["stretch"] = s.stretch;
