@@ -720,17 +720,17 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   int n_alike = 0, n_read = 0;
   for (const bool a : choice.alike) n_alike += a;
   for (const double c : choice.chi2) n_read += std::isfinite(c);
-  char text[720], ruled[120] = "";
+  char text[900], ruled[120] = "";
   if (n_read < int(families.size()))
     std::snprintf(ruled, sizeof ruled, "; %zu ruled out on %zu sections at spread phases and not read on the rest",
                   families.size() - n_read, result.phase.choice_sections);
   std::snprintf(text, sizeof text,
                 "%d sections with blur under %.0f px along the pixel rows or columns (and %d at every phase) read under "
                 "%zu kinds of blur (the lens alone, or then a smoothing or sharpening of the pixels): the photo fits "
-                "best as %s (%d of the kinds fit alike, chi-square per point %.2f%s); %d flagged phase_limited (%d where the "
-                "sharpening cancels most of the lens's blur, %d jumping between neighbouring kinds, %d off the line "
-                "through their edge's other sections, %d too unsure near a pixel centre; each reading's range in "
-                "calib.json)",
+                "best as %s (%d of the kinds fit alike, chi-square per point %.2f, 1 where only the noise is left%s); %d "
+                "flagged phase_limited (%d where the sharpening cancels most of the lens's blur, %d jumping between "
+                "neighbouring kinds, %d off the line through their edge's other sections, %d too unsure near a pixel "
+                "centre; each reading's range in calib.json)",
                 choice.limited, kMaxBlurPx, choice.every_phase, families.size(), families[best].Name().c_str(), n_alike,
                 choice.chi2_per_point, ruled, choice.flagged, cancelled, jumped, off_edge, unsure);
   choice.summary = text;
