@@ -68,7 +68,8 @@ void PrintCalibrationSummary(const calib::CalibResult& result, const Board& boar
                 result.reference_edge, result.reference_u_mm, result.reference_r_px);
   else
     std::printf("reference edge %d: u = %.1f mm, r = %.2f px (median of its phase_limited sections' readings: none "
-                "of them is usable, so eq. 3.7's estimates below are as unsure as they are)\n",
+                "of them is usable, so eq. 3.7's estimates below are as unsure as they are; --reference-edge N takes "
+                "another edge)\n",
                 result.reference_edge, result.reference_u_mm, result.reference_r_px);
   const std::string far = calib::ApertureFarFromNominal(result, camera)
                               ? ", " + Num(std::round(calib::ApertureRatio(result, camera) * 100) / 100) +
