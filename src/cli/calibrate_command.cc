@@ -140,8 +140,8 @@ void PrintPhaseCheck(const calib::CalibResult& result) {
   if (result.phase.held > 0)
     std::printf("phase check: the model predicted %d phase_limited sections outside the range their families "
                 "leave open; their ranges' middles joined its fit\n", result.phase.held);
-  // What to do about them: a filter after sampling is in every section (a turned board is read with it up to 25 deg
-  // off the pixel axes, but it still cancels or blurs what the lens did); without one, turning the board gives every
+  // What to do about them: a filter after sampling is in every section (a turned board is read with it at any angle
+  // to the pixel axes, but it still cancels or blurs what the lens did); without one, turning the board gives every
   // edge all phases.
   if (result.phase.flagged > 0) {
     if (result.phase.chosen != 0)
