@@ -231,8 +231,8 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
     """A Weibull with the guess rate at chance over one procedure cell's (or one odd one out's) answers; raises Skip
     with too few levels or answers. crit: the threshold's criteria.Criterion (the cell's procedure's own; fixed
     levels' by default), tested: the tested range (criteria.tested_range; the levels shown by default). Returns
-    (Chart, (threshold, low, high, slope) or (nan, low, high of the tested range, slope) when the threshold lies
-    beyond it)."""
+    (Chart, words): the threshold and slope as the summary says them - a number only where determined (the threshold
+    inside the tested range with its interval too, the slope with an interval off its range's bounds), else words."""
     where = f" ({cell})" if cell else ""
     d = m.dropna(subset=[xcol])
     x, k = d[xcol].to_numpy(float), d["y"].to_numpy(float)
@@ -240,23 +240,10 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
         raise Skip(f"{study}{where}: psychometric function needs >= 3 stimulus levels and >= 20 answers "
                    f"(has {len(np.unique(x))} levels, {len(x)} answers)")
     fit = stats.fit_psychometric(x, k, None, kind="weibull", gamma=chance, lam=(0.0, 0.1))
+    # One bootstrap, --boot samples: the band and the threshold's interval come from the same refits.
     grid, lo, hi = stats.bootstrap(x, k, np.ones_like(k), fit, n_boot=n_boot, seed=seed)
     crit = crit or criteria.criterion("", None, chance)
-    x_lo, x_hi = tested or criteria.tested_range(None, x)
-    p_mid = crit.psi(fit.gamma, fit.lam)
-    th = stats.threshold(fit, p_mid)
-    boot_th = []
-    rng = np.random.default_rng(seed)
-    for _ in range(max(50, n_boot // 2)):
-        kb = rng.binomial(1, np.clip(fit(x), 0, 1)).astype(float)
-        try:
-            refit = stats.fit_psychometric(x, kb, None, kind="weibull", gamma=chance, lam=(0.0, 0.1),
-                                           starts=[(fit.alpha, fit.beta)])
-            boot_th.append(stats.threshold(refit, crit.psi(refit.gamma, refit.lam)))
-        except ValueError:
-            pass
-    boot_th = np.array([b for b in boot_th if not math.isnan(b)])
-    th_lo, th_hi = (np.percentile(boot_th, [2.5, 97.5]) if len(boot_th) else (math.nan, math.nan))
+    said = fitted_threshold(fit, crit, tested or criteria.tested_range(None, x))
     levels = pd.DataFrame({"x": x, "y": k}).groupby("x")["y"].agg(["sum", "count"]).reset_index()
     fig, ax = plt.subplots(figsize=(5.5, 3.8))
     ax.fill_between(grid, lo, hi, color="#0072B2", alpha=0.2, lw=0, label="95 % bootstrap band")
@@ -265,8 +252,11 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
     ax.scatter(levels["x"], levels["sum"] / levels["count"], s=sizes, color="#333333", zorder=3,
                label="share per level (size: answers)")
     ax.axhline(chance, color="#999999", ls="--", lw=1)
-    if criteria.inside(th, x_lo, x_hi):
-        ax.axvline(th, color="#D55E00", lw=1, ls=":", label=f"threshold ({crit.label(fit.gamma, fit.lam)}): {th:.3g}")
+    label = crit.label(fit.gamma, fit.lam)
+    if said["determined"]:
+        ax.axvline(said["th"], color="#D55E00", lw=1, ls=":", label=f"threshold ({label}): {said['th']:.3g}")
+    else:  # no line where no value is: the legend says why in words
+        ax.plot([], [], " ", label=f"threshold ({label}): not determined")
     ax.set_xlabel(xlabel)
     ax.set_ylabel(f"share: {what}")
     ax.set_ylim(min(chance, 0.4) - 0.05, 1.05)
@@ -274,40 +264,24 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
     ax.set_title(f"{study}: psychometric function{' - cell ' + cell if cell else ''}\n{group_note}, {len(x)} answers",
                  loc="left")
     png, svg = save(fig, out_dir, name)
-    inside = criteria.inside(th, x_lo, x_hi)
-    # A threshold beyond the tested range is an extrapolation, and an interval that reaches beyond it (or that the
-    # bootstrap could not bound) is not determined by these answers: both are written in words, not as numbers.
-    bounded = inside and not math.isnan(th_lo) and x_lo <= th_lo and th_hi <= x_hi
-    side = "below" if not math.isnan(th) and th < x_lo else "above" if not math.isnan(th) else "beyond"
-    beta_lo, beta_hi = fit.ci.get("beta", (math.nan, math.nan))
-    b_bounds = fit.options.get("beta_bounds") or (0.0, math.inf)
-    beta_free = "beta" not in fit.on_bound
-    beta_ci = beta_free and not math.isnan(beta_lo) and beta_lo > b_bounds[0] * 1.001 + 1e-9 and \
-        beta_hi < b_bounds[1] * 0.999
-    interval_words = ("" if bounded else f"the threshold's 95 % interval reaches beyond "
-                      f"{criteria.range_words(x_lo, x_hi)}: not determined by these answers" if inside else
-                      criteria.beyond_words(side, x_lo, x_hi))
-    t = pd.DataFrame([{**({"cell": cell} if cell else {}), "threshold": th if inside else math.nan,
-                       "threshold_low": th_lo if bounded else math.nan,
-                       "threshold_high": th_hi if bounded else math.nan, "threshold_note": interval_words,
+    th_ok, beta_ok = said["determined"], said["slope_determined"]
+    t = pd.DataFrame([{**({"cell": cell} if cell else {}), "threshold": said["th"] if th_ok else math.nan,
+                       "threshold_low": said["low"] if th_ok else math.nan,
+                       "threshold_high": said["high"] if th_ok else math.nan, "threshold_note": said["note"],
                        "on_bound": ", ".join(f"{k} at its {v[1]} bound {v[0]:.3g}" for k, v in fit.on_bound.items()),
-                       "criterion": crit.short(), "criterion_fitted": crit.label(fit.gamma, fit.lam),
-                       "criterion_share_correct": p_mid,
+                       "criterion": crit.short(), "criterion_fitted": label,
+                       "criterion_share_correct": crit.psi(fit.gamma, fit.lam),
                        # The Weibull's scale is the threshold's other name: not a number where that is not one.
-                       "alpha": fit.alpha if inside else math.nan, "beta_slope": fit.beta if beta_free else math.nan,
-                       "beta_low": beta_lo if beta_ci else math.nan, "beta_high": beta_hi if beta_ci else math.nan,
+                       "alpha": fit.alpha if th_ok else math.nan, "beta_slope": fit.beta if beta_ok else math.nan,
+                       "beta_low": fit.ci["beta"][0] if beta_ok else math.nan,
+                       "beta_high": fit.ci["beta"][1] if beta_ok else math.nan, "slope_note": said["slope_note"],
                        "guess": fit.gamma, "lapse": fit.lam if "lam" not in fit.on_bound else math.nan, "answers": len(x),
                        "participants": d["participant"].nunique()}])
+    p_mid = crit.psi(fit.gamma, fit.lam)
     notes = [f"Weibull with the guess rate fixed at chance ({chance:.3g}) and a lapse rate fitted in [0, 0.1]; "
              f"threshold at {crit.words}" + (f" (the fitted function gives {100 * p_mid:.1f} % there, lapse "
-                                              f"{fit.lam:.2g})" if crit.label(fit.gamma, fit.lam) != crit.short()
-                                              else "") + ": " +
-             (f"{th:.3g} [{th_lo:.3g}, {th_hi:.3g}] (parametric bootstrap, {len(boot_th)} refits)" if bounded else
-              f"{th:.3g}, its interval not determined (the bootstrap's reaches beyond "
-              f"{criteria.range_words(x_lo, x_hi)})" if inside else
-              criteria.beyond_words(side, x_lo, x_hi, "an extrapolation, not an estimate")) +
-             (f"; slope {fit.beta:.3g}" if beta_free else "; slope on a bound of its range: not determined") +
-             ("" if beta_ci or not beta_free else "; the slope's interval reaches a bound: not determined")]
+                                              f"{fit.lam:.2g})" if label != crit.short() else "") + ": " +
+             said["words"] + "; " + said["slope_words"]]
     if fit.on_bound:
         names = {"lam": "lapse rate", "beta": "slope", "alpha": "scale (threshold)", "gamma": "guess rate"}
         notes.append("on a bound of its range: " + ", ".join(f"{names.get(k, k)} ({v[1]})"
@@ -318,9 +292,40 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
         notes.append("a description of the answers pooled over participants, not the study's result: an adaptive "
                      "procedure's thresholds are each participant's track's (the tracks and thresholds tables), "
                      "summarised across participants there")
-    return Chart(name, png, svg, t, notes), ((th, th_lo, th_hi, fit.beta) if bounded else
-                                             (th, math.nan, math.nan, fit.beta) if inside else
-                                             (math.nan, x_lo, x_hi, fit.beta))
+    return Chart(name, png, svg, t, notes), said["words"]
+
+
+def fitted_threshold(fit, crit, tested):
+    """The threshold of a bootstrapped fit (stats.bootstrap) at crit over the tested range (low, high), and its slope,
+    each as a number only where determined, else in words: a threshold beyond the range is an extrapolation, one whose
+    interval reaches beyond it (or that the refits could not bound) is not determined by the answers, and so is a
+    slope on a bound of its range or whose interval reaches one. Returns a dict: th, low, high, determined, note (the
+    table's words, empty when determined), words (the threshold with its interval, or why not), slope_determined,
+    slope_note, slope_words."""
+    x_lo, x_hi = tested
+    th = stats.threshold(fit, crit.psi(fit.gamma, fit.lam))
+    boot_th = np.array([stats.threshold(r, crit.psi(r.gamma, r.lam)) for r in fit.refits])
+    boot_th = boot_th[~np.isnan(boot_th)]
+    th_lo, th_hi = (np.percentile(boot_th, [2.5, 97.5]) if len(boot_th) else (math.nan, math.nan))
+    inside = criteria.inside(th, x_lo, x_hi)
+    determined = inside and not math.isnan(th_lo) and x_lo <= th_lo and th_hi <= x_hi
+    side = "below" if not math.isnan(th) and th < x_lo else "above" if not math.isnan(th) else "beyond"
+    refits = f"{len(boot_th)} refits" + (f" of {fit.n_boot} samples" if len(boot_th) != fit.n_boot else "")
+    note = ("" if determined else
+            f"not determined: its 95 % interval reaches beyond {criteria.range_words(x_lo, x_hi)} (parametric "
+            f"bootstrap, {refits})" if inside else
+            criteria.beyond_words(side, x_lo, x_hi, "an extrapolation, not an estimate"))
+    words = f"{th:.3g} [{th_lo:.3g}, {th_hi:.3g}] (parametric bootstrap, {refits})" if determined else note
+    b_lo, b_hi = fit.ci.get("beta", (math.nan, math.nan))
+    b_bounds = fit.options.get("beta_bounds") or (0.0, math.inf)
+    on_bound = "beta" in fit.on_bound
+    slope_ok = not on_bound and not math.isnan(b_lo) and b_lo > b_bounds[0] * 1.001 + 1e-9 and \
+        b_hi < b_bounds[1] * 0.999
+    slope_note = ("" if slope_ok else "not determined: on a bound of its range" if on_bound else
+                  "not determined: its 95 % interval reaches a bound of its range")
+    return {"th": th, "low": th_lo, "high": th_hi, "determined": determined, "note": note, "words": words,
+            "slope_determined": slope_ok, "slope_note": slope_note,
+            "slope_words": (f"slope {fit.beta:.3g} [{b_lo:.3g}, {b_hi:.3g}]" if slope_ok else "slope " + slope_note)}
 
 
 def side_bias_table(m, study, group_note):
@@ -568,23 +573,18 @@ def psychometric_cells(m, kind, guess, what, design, study, out_dir, slug, note,
         crit = criteria.criterion((params or {}).get("procedure", ""), params, guess)
         try:
             dx = rows[xcol].dropna().to_numpy(float)
-            chart, (th, th_lo, th_hi, _) = psychometric_chart(
+            chart, said = psychometric_chart(
                 rows, xcol, xlabel, guess, study, out_dir, name, note, n_boot, seed, what, cell=cell, crit=crit,
                 tested=criteria.tested_range(params, dx) if len(dx) else None)
             charts.append(chart)
             # The threshold's unit beside it in the table: the procedure's variable's (common.level_unit).
             unit_words = (level_unit(rows) or UNKNOWN_UNIT) if kind == "procedure" else "arcmin"
-            if chart.table is not None:
-                chart.table.insert(chart.table.columns.get_loc("threshold") + 1, "unit", unit_words)
+            chart.table.insert(chart.table.columns.get_loc("threshold") + 1, "unit", unit_words)
             where = f"{tracks.cell_label(rows) if kind == 'procedure' else cell}: " if cell else ""
             # Said as the fitted function gives it (its lapse lowers QUEST+'s 81.6 %), with the level's unit.
-            said = chart.table["criterion_fitted"].iloc[0] if chart.table is not None else crit.short()
-            unit = f" {unit_words}"
-            words.append(f"{where}threshold at {said} {th:.3g}{unit} [{th_lo:.3g}, {th_hi:.3g}]"
-                         if not math.isnan(th_lo) and not math.isnan(th) else
-                         f"{where}threshold at {said} {th:.3g}{unit} (its interval not determined)"
-                         if not math.isnan(th) else
-                         f"{where}threshold at {said} " + criteria.beyond_words("beyond", th_lo, th_hi))
+            determined = not math.isnan(chart.table["threshold"].iloc[0])
+            words.append(f"{where}threshold at {chart.table['criterion_fitted'].iloc[0]} " +
+                         (said.replace(" [", f" {unit_words} [", 1) if determined else said))
         except Skip as e:
             charts.append(Chart(name, None, None, None, [str(e)]))
         except ValueError as e:

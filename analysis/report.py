@@ -291,7 +291,8 @@ def _main(argv=None):
                         "folder beside its target): index.html and messages name paths there")
     parser.add_argument("--db", help="the SQLite record trials.csv was exported from (blurcue report gives it): its "
                         "protocols say what each study's scene was (a video's take, frames and exposure)")
-    parser.add_argument("--boot", type=int, default=200, help="bootstrap samples for the psychometric band")
+    parser.add_argument("--boot", type=int, default=200, help="bootstrap samples of each psychometric fit (its band and its "
+                        "threshold's interval come from the same samples)")
     parser.add_argument("--seed", type=int, default=1, help="bootstrap seed")
     parser.add_argument("--debug", action="store_true", help="let an unexpected error raise (with its traceback)")
     parser.add_argument("--pool-simulated", action="store_true",

@@ -124,6 +124,8 @@ class PsychometricFit:
     converged: bool
     options: dict = field(default_factory=dict)  # the gamma / lam / beta_bounds arguments of the fit, for refits
     ci: dict = field(default_factory=dict)   # parameter -> (low, high), filled by bootstrap()
+    refits: list = field(default_factory=list, repr=False)  # bootstrap()'s refitted PsychometricFits, for any quantity
+    n_boot: int = 0                          # the samples bootstrap() drew (refits that failed are not in refits)
 
     @property
     def aic(self):
@@ -251,7 +253,9 @@ def fit_psychometric(x, k, n=None, kind="weibull", gamma=0.5, lam=(0.0, 0.1), st
 
 
 def bootstrap(x, k, n, fit, method="parametric", n_boot=200, seed=0, grid=None, level=0.95, **fit_kwargs):
-    """Percentile bootstrap of a psychometric fit; fills fit.ci and returns (grid, band_low, band_high).
+    """Percentile bootstrap of a psychometric fit; fills fit.ci, fit.refits (every refit, so a derived quantity
+    such as a threshold takes its interval from the same n_boot samples) and fit.n_boot, and returns (grid, band_low,
+    band_high).
 
     parametric: new k at every level drawn from Binomial(n, fitted psi), then refitted.
     nonparametric: the (x, k, n) rows resampled with replacement (pass one row per trial for a trial bootstrap).
@@ -267,6 +271,7 @@ def bootstrap(x, k, n, fit, method="parametric", n_boot=200, seed=0, grid=None, 
     # Refits start from the point estimate only: the bootstrap samples sit close to the data.
     fit_kwargs["starts"] = [(fit.alpha, fit.beta)]
     params, curves = [], []
+    fit.refits, fit.n_boot = [], n_boot
     for _ in range(n_boot):
         if method == "parametric":
             xb, nb = x, n
@@ -282,6 +287,7 @@ def bootstrap(x, k, n, fit, method="parametric", n_boot=200, seed=0, grid=None, 
             continue
         params.append((fb.alpha, fb.beta, fb.gamma, fb.lam))
         curves.append(fb(grid))
+        fit.refits.append(fb)
     if not params:
         raise ValueError("every bootstrap sample failed to fit")
     params = np.array(params)

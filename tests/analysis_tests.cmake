@@ -34,6 +34,11 @@ add_test(NAME analysis.design
 add_test(NAME analysis.tracks
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_tracks.py
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# A procedure cell's pooled fit: a threshold or slope that is not determined in words, never a number (table,
+# chart, summary), against the record of an 8-trial staircase and observers of known threshold; --boot's samples.
+add_test(NAME analysis.psychometric
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_psychometric.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 # A study on a tracked video: its scene described from a hand-made record, track.csv, trials and frames (scenes.py).
 add_test(NAME analysis.scenes
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_scenes.py
@@ -43,7 +48,7 @@ add_test(NAME analysis.file_stems
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_file_stems.py
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(analysis.stats analysis.report analysis.bench_charts analysis.prediction analysis.design
-                     analysis.tracks analysis.scenes analysis.file_stems PROPERTIES
+                     analysis.tracks analysis.scenes analysis.file_stems analysis.psychometric PROPERTIES
                      LABELS analysis TIMEOUT 180
                      # Matplotlib writes its font cache under HOME; keep it out of a read-only or shared home.
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
