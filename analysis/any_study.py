@@ -34,7 +34,7 @@ import study_tests
 import tracks
 from common import (UNKNOWN_UNIT, Chart, Skip, axis_label, distinct_stems, error_bars, factor_label, file_stem, level_text,
                     level_unit, participants_note, save, stars, text)
-from design import design_of, load_codebook  # noqa: F401  (load_codebook: report.py reads the codebook through here)
+from design import comparing_factors, design_of, load_codebook  # noqa: F401  (load_codebook: report.py reads the codebook through here)
 
 KIND_TITLES = {"pair": "forced choice between two", "odd": "odd one out",
                "procedure": "adaptive procedure", "yes_no": "yes / no", "rating": "rating",
@@ -514,7 +514,9 @@ def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, 
         for f in factors:
             charts.append(factor_chart(m, f, chance, what, study, out_dir, f"{slug}-per-{f}", note,
                                        [g for g in factors if g != f]))
-        finding = f"{KIND_TITLES[kind]}: " + study_tests.summary_words(m, chance, what)
+        apart = comparing_factors(m, factors)  # levels that ask different questions are summarised apart
+        finding = f"{KIND_TITLES[kind]}: " + (study_tests.summary_by_level(m, chance, what, apart) if apart else
+                                              study_tests.summary_words(m, chance, what))
     else:
         finding = (f"{KIND_TITLES[kind]}: {participants_note(m)}, {len(m)} answers (share correct set by the "
                    f"procedure, not tested)")

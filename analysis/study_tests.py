@@ -188,9 +188,34 @@ def against_chance_counts(k, n, chance, people=None):
             "participants_above": above, "participants_below": below}
 
 
-def summary_words(m, chance, what):
+def summary_by_level(m, chance, what, by):
+    """The summary per level of the factors `by` (their levels ask different questions: design.comparing_factors),
+    never pooled across them; p Holm-adjusted over the levels. One line."""
+    parts = list(m.groupby([m[f].astype(str) for f in by], sort=True))
+    raw = [chance_p(d, chance) for _, d in parts]
+    adjusted = stats.holm(raw)
+    words = []
+    for (level, d), p in zip(parts, adjusted):
+        name = ", ".join(f"{f} {v}" for f, v in zip(by, level if isinstance(level, tuple) else (level,)))
+        words.append(f"{name}: " + summary_words(d, chance, what, p_holm=(p, len(parts))))
+    return (f"per {', '.join(by)}, no pooled figure ({', '.join(by)} changes which sources are compared, so a share "
+            f"across its levels would average different questions): " + "; ".join(words))
+
+
+def chance_p(m, chance):
+    """The p of summary_words' test of m against chance (NaN where it gives none)."""
+    if chance is None:
+        return math.nan
+    if m["participant"].nunique() == 1:
+        return one_participant_test(int(m["y"].sum()), len(m), chance)["p"]
+    return against_chance(m, chance)["p"]
+
+
+def summary_words(m, chance, what, p_holm=None):
     """One line for the report's summary: the measure over participants and its test against chance (None: no
-    chance level, the share only)."""
+    chance level, the share only). p_holm: (p, levels) where the line is one of a set of levels, Holm-adjusted."""
+    def said(p):
+        return p_text(p) if p_holm is None else f"{p_text(p_holm[0])} (Holm over {p_holm[1]} levels)"
     k, n = int(m["y"].sum()), len(m)
     people = m["participant"].nunique()
     if people == 1:
@@ -198,7 +223,7 @@ def summary_words(m, chance, what):
         text = f"{what} {p:.2f} [{lo:.2f}, {hi:.2f}] of {n} answers (one participant)"
         if chance is not None:
             r = one_participant_test(k, n, chance)
-            text += (f"; chance {chance:.2g}, {p_text(r['p'])} (exact binomial)" if not math.isnan(r["p"]) else
+            text += (f"; chance {chance:.2g}, {said(r['p'])} (exact binomial)" if not math.isnan(r["p"]) else
                      f"; chance {chance:.2g}: one answer cannot test anything")
         return text
     shares = per_participant(m)["mean"].to_numpy(float)
@@ -212,7 +237,7 @@ def summary_words(m, chance, what):
             f"{min(1.0, mean + half):.2f}] ({n} answers)")
     if chance is not None:
         r = against_chance(m, chance)
-        text += (f"; against chance {chance:.2g}: {r['test']}, {p_text(r['p'])}; {r['participants_above']} of "
+        text += (f"; against chance {chance:.2g}: {r['test']}, {said(r['p'])}; {r['participants_above']} of "
                  f"{people} participants above chance, {r['participants_below']} below")
     return text
 

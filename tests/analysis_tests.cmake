@@ -39,6 +39,11 @@ add_test(NAME analysis.tracks
 add_test(NAME analysis.psychometric
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_psychometric.py
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# The summary's line of a study: per level of a factor that changes which sources are compared, never pooled over
+# them; the smallest attainable p, the models' limits in words (hand-worked shares and exact p-values).
+add_test(NAME analysis.summary
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_summary.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 # A study on a tracked video: its scene described from a hand-made record, track.csv, trials and frames (scenes.py).
 add_test(NAME analysis.scenes
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_scenes.py
@@ -48,7 +53,7 @@ add_test(NAME analysis.file_stems
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_file_stems.py
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(analysis.stats analysis.report analysis.bench_charts analysis.prediction analysis.design
-                     analysis.tracks analysis.scenes analysis.file_stems analysis.psychometric PROPERTIES
+                     analysis.tracks analysis.scenes analysis.file_stems analysis.psychometric analysis.summary PROPERTIES
                      LABELS analysis TIMEOUT 180
                      # Matplotlib writes its font cache under HOME; keep it out of a read-only or shared home.
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
