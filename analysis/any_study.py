@@ -420,6 +420,33 @@ def _analyse(d, study, codebook, out_dir, n_boot, seed, group, task, part):
     return charts + c, "; ".join(findings + [f]) + left_out
 
 
+def more_blurred_words(m, factors):
+    """What "chose the more blurred side" means in these rows, per pair of sources compared: which source was the more
+    blurred one (by the radii shown, r_left_arcmin / r_right_arcmin), and where that changes between the conditions
+    (the crossing of factors) - there the same share means choosing a different source. "" without the columns."""
+    need = {"left_source", "right_source", "r_left_arcmin", "r_right_arcmin"}
+    if not need <= set(m.columns) or m.empty:
+        return ""
+    left, right = text(m["left_source"]), text(m["right_source"])
+    r_l, r_r = _num(m["r_left_arcmin"]), _num(m["r_right_arcmin"])
+    blurrier = np.where(r_l > r_r, left, np.where(r_r > r_l, right, "neither"))
+    pair = pd.Series([" and ".join(sorted(p)) for p in zip(left, right)], index=m.index)
+    condition = (m[list(factors)].astype(str).apply(lambda r: ", ".join(f"{f} {v}" for f, v in r.items()), axis=1)
+                 if factors else pd.Series([""] * len(m), index=m.index))
+    words = []
+    for name, rows in pd.DataFrame({"pair": pair, "blurrier": blurrier, "condition": condition}).groupby("pair"):
+        sources = rows.groupby("condition", sort=False)["blurrier"].agg(lambda v: " or ".join(sorted(set(v))))
+        if sources.nunique() == 1:
+            words.append(f"between {name}, the more blurred side showed {sources.iloc[0]}" +
+                         (" in every condition" if factors else ""))
+        else:
+            where = "; ".join(f"{src} at {', '.join(c for c in sources.index[sources == src])}"
+                              for src in dict.fromkeys(sources))
+            words.append(f"between {name}, the more blurred side showed {where}: the share means choosing a "
+                         f"different source where that changes")
+    return "; " + "; ".join(words) if words else ""
+
+
 def _left_out_words(d, m, kind):
     """The answered rows a pair's shares leave out, said (", 14 of 60 answers can't tell, left out of the shares"):
     a "can't tell" chooses no side, and a pair of equal radii has no more blurred side."""
@@ -517,6 +544,8 @@ def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, 
         apart = comparing_factors(m, factors)  # levels that ask different questions are summarised apart
         finding = f"{KIND_TITLES[kind]}: " + (study_tests.summary_by_level(m, chance, what, apart) if apart else
                                               study_tests.summary_words(m, chance, what))
+        if kind == "pair":
+            finding += more_blurred_words(m, factors)
     else:
         finding = (f"{KIND_TITLES[kind]}: {participants_note(m)}, {len(m)} answers (share correct set by the "
                    f"procedure, not tested)")

@@ -7,6 +7,7 @@ import unittest
 import pandas as pd
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+import any_study  # noqa: E402
 import design  # noqa: E402
 import study_tests  # noqa: E402
 
@@ -53,6 +54,35 @@ class NotPooledAcrossQuestions(unittest.TestCase):
         self.assertIn("no pooled figure", words)
         # The pooled mean (69/96 = 0.72) of the two questions is nowhere.
         self.assertNotIn("0.72", words)
+
+
+
+class WhatTheMeasureMeans(unittest.TestCase):
+    """A pair study's measure is "chose the more blurred side" (the thesis's views alone count the first source): the
+    summary says which source that was, and where it changes between conditions."""
+
+    def rows(self, radii):
+        """One row per edge and side order: radii {edge: (r measured, r estimated)} in arcmin."""
+        out = []
+        for edge, (r_m, r_e) in radii.items():
+            for swapped in (0, 1):
+                left, right = (("estimated", r_e), ("measured", r_m)) if swapped else (("measured", r_m),
+                                                                                        ("estimated", r_e))
+                out.append({"edge": edge, "left_source": left[0], "right_source": right[0],
+                            "r_left_arcmin": str(left[1]), "r_right_arcmin": str(right[1])})
+        return pd.DataFrame(out)
+
+    def test_the_same_source_everywhere_is_named(self):
+        words = any_study.more_blurred_words(self.rows({"2": (0.48, 0.99), "5": (1.69, 2.18)}), ["edge"])
+        self.assertEqual(words, "; between estimated and measured, the more blurred side showed estimated in every "
+                                "condition")
+
+    def test_a_source_that_changes_between_edges_is_said(self):
+        # The lens model's estimate above the measurement at edges 3 and 6, below it at edge 9.
+        words = any_study.more_blurred_words(self.rows({"3": (1.0, 1.3), "6": (2.0, 2.2), "9": (3.4, 3.1)}),
+                                             ["edge"])
+        self.assertIn("the more blurred side showed estimated at edge 3, edge 6; measured at edge 9: the share "
+                      "means choosing a different source where that changes", words)
 
 
 if __name__ == "__main__":
