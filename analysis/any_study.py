@@ -178,7 +178,8 @@ def factor_chart(m, factor, chance, what, study, out_dir, name, group_note, pool
               if over else "") +
              (f"; * p < 0.05, ** < 0.01, *** < 0.001 against chance, Holm-adjusted over the chart's bars, with "
               f"participants as the unit: {'; '.join(tests)}" if chance is not None else "")]
-    return Chart(name, png, svg, t, notes)
+    floor = study_tests.holm_floor_words(t, chance, m["participant"].nunique(), "bars")
+    return Chart(name, png, svg, t, notes + ([floor] if floor else []))
 
 
 def value_chart(m, factor, what, study, out_dir, name, group_note, pooled_over=()):
@@ -536,7 +537,8 @@ def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, 
                          ("; against chance with participants as the unit (test column), Holm-adjusted over the "
                           "conditions" if chance is not None else
                           NO_CHANCE_WHY.get(kind, "; no test against chance: the design defines no chance "
-                                                  "level for it"))]))
+                                                  "level for it"))] +
+                        [w for w in [study_tests.holm_floor_words(table, chance, m["participant"].nunique())] if w]))
     if kind != "procedure":
         for f in factors:
             charts.append(factor_chart(m, f, chance, what, study, out_dir, f"{slug}-per-{f}", note,

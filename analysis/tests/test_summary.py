@@ -52,9 +52,35 @@ class NotPooledAcrossQuestions(unittest.TestCase):
                       "participants' shares 0.52", words)
         self.assertIn("p = 1.000 (Holm over 2 levels)", words)
         self.assertIn("no pooled figure", words)
+        # Neither level can reach 0.05: said once, with the smallest p attainable, 2 x 2/2^6 = 0.0625.
+        self.assertEqual(words.count("none of the 2 levels can reach p < 0.05 after Holm's correction: the smallest "
+                                     "p attainable is 0.0625"), 1, words)
         # The pooled mean (69/96 = 0.72) of the two questions is nowhere.
         self.assertNotIn("0.72", words)
 
+
+
+class SmallestAttainableP(unittest.TestCase):
+    """Six cells of 6 participants Holm-adjusted: the sign-flip test's least p is 2/2^6 = 1/32, and Holm's first step
+    multiplies it by 6, so no cell can reach 0.05 (0.1875); with 8 participants 6 x 2/2^8 = 0.047 can."""
+
+    def table(self, people, cells=6, answers=24):
+        return pd.DataFrame({"participants": [people] * cells, "n": [answers] * cells, "p": [0.5] * cells})
+
+    def test_six_cells_of_six_participants_cannot_reach_005(self):
+        words = study_tests.holm_floor_words(self.table(6), 0.5, 6)
+        self.assertIn("none of the 6 conditions can reach p < 0.05 after Holm's correction: the smallest p "
+                      "attainable is 0.188 (6 tests x 0.0312", words)
+        self.assertIn("0.0938", study_tests.holm_floor_words(self.table(7), 0.5, 7))  # 6 x 2/128
+
+    def test_silent_where_a_cell_can_reach_it_or_is_alone(self):
+        self.assertEqual(study_tests.holm_floor_words(self.table(8), 0.5, 8), "")      # 6 x 2/256 = 0.047
+        self.assertEqual(study_tests.holm_floor_words(self.table(4, cells=1), 0.5, 4), "")  # its test says it
+
+    def test_one_participants_binomial_floor(self):
+        # One participant, 4 answers per cell, 3 cells: the exact binomial's least p is 2 x 0.5^4 = 0.125; x 3 = 0.375.
+        words = study_tests.holm_floor_words(self.table(1, cells=3, answers=4), 0.5, 1)
+        self.assertIn("the smallest p attainable is 0.375 (3 tests x 0.125", words)
 
 
 class WhatTheMeasureMeans(unittest.TestCase):
