@@ -316,6 +316,7 @@ def threshold(fit, p=0.75):
 
 
 MIN_ANSWERS = 10        # fewer decisive answers than this: no model, a note instead
+MIN_PARTICIPANTS_MODEL = 3  # fewer (but more than one): no model across participants, said in words
 MIN_EACH_OUTCOME = 2    # and at least this many of each outcome (else the log-odds run off to infinity)
 
 
@@ -537,7 +538,7 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
       fails lme4's convergence checks or has an SD beyond 10 log-odds is "not determined" in words, never numbers.
     - A factor whose reference level's answers all went one way is compared with its first level whose answers went
       both ways (reference_not_separated), so its estimable contrasts are printed whatever the level order given.
-    - one participant: a plain logistic GLM (answers treated as independent), said so.
+    - one participant: a plain logistic GLM (answers treated as independent), said so; two: no model, said so.
     Separation (a term whose answers all went one way) is found before any fit (separation()); such a term gets no
     estimate and no p in either model, and the other terms are fitted on the answers it does not predict perfectly
     (the limit of the maximum-likelihood fit). Without R the table has the GLM and a note saying the GLMM is missing.
@@ -563,6 +564,13 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
     y = y.iloc[:, 0].to_numpy(float)
     groups = d[group].astype(str).to_numpy()
     n_groups = len(set(groups))
+    if n_groups == 2:
+        # Two clusters give a sandwich SE from two residual sums and a t(1) reference, and a spread between
+        # participants from two: neither is an estimate, so no model across them (one participant: a plain GLM).
+        notes.append(f"two participants: too few for a model across participants (a cluster-robust SE from two "
+                     f"participants with t(1), or a GLMM's spread between two, is not an estimate); no model fitted - "
+                     f"the shares per condition are in the tables, and a model needs >= {MIN_PARTICIPANTS_MODEL}")
+        return model_table(rows), notes
     sources = _term_sources(X)
     words = {c: term_in_words(c, d) for c in X.columns}
 
@@ -654,9 +662,6 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
                 fixed = without_unheld_tests(f, slopes, sources, cell_means="Intercept" not in X.columns)
                 add_fit(model, f.engine, fixed, lambda c: status + fixed.set_index("term")["why"].get(c, ""))
                 rows += variance_rows(study, model, f, words, "log-odds")
-    elif n_groups == 2:
-        notes.append("two participants: too few for a GLMM (a spread between participants from two is not an "
-                     "estimate); cluster-robust GLM only")
     table = model_table(rows)
     if not table.empty:
         notes += disagreements(table)

@@ -9,6 +9,7 @@ import pandas as pd
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import any_study  # noqa: E402
 import design  # noqa: E402
+import stats  # noqa: E402
 import study_tests  # noqa: E402
 
 # twofac.json's design: edge 3, 6, 9 x comparison (measured vs none, measured vs estimated), sides swapped in half.
@@ -81,6 +82,20 @@ class SmallestAttainableP(unittest.TestCase):
         # One participant, 4 answers per cell, 3 cells: the exact binomial's least p is 2 x 0.5^4 = 0.125; x 3 = 0.375.
         words = study_tests.holm_floor_words(self.table(1, cells=3, answers=4), 0.5, 1)
         self.assertIn("the smallest p attainable is 0.375 (3 tests x 0.125", words)
+
+
+class TwoParticipantsNoModel(unittest.TestCase):
+    def test_two_participants_get_no_model_across_them_in_words(self):
+        # Two participants, edges 5 and 8, 12 answers each: a cluster-robust GLM would be a sandwich of two residual
+        # sums referred to t(1) (it printed "edge 5: 1.386, SE not determined"); a GLMM's spread from two likewise.
+        rows = []
+        for who, (at5, at8) in {"P1": (9, 12), "P2": (10, 12)}.items():
+            for edge, k in (("5", at5), ("8", at8)):
+                rows += [{"participant": who, "edge": edge, "y": float(j < k)} for j in range(12)]
+        table, notes = stats.observer_models(pd.DataFrame(rows), "y", "0 + C(edge)", study="s")
+        self.assertTrue(table.empty, table)
+        self.assertEqual(len(notes), 1, notes)
+        self.assertTrue(notes[0].startswith("two participants: too few for a model across participants"), notes)
 
 
 class WhatTheMeasureMeans(unittest.TestCase):
