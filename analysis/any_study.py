@@ -28,6 +28,7 @@ import numpy as np
 import pandas as pd
 
 import criteria
+import crossed
 import groups
 import stats
 import study_tests
@@ -212,9 +213,9 @@ def value_chart(m, factor, what, study, out_dir, name, group_note, pooled_over=(
                                      (f"; each pools the levels of {' and '.join(over)}" if over else "")])
 
 
-def models(m, factors, study, group_note, what):
-    """Logistic models across participants of the 0/1 measure against the factors, terms in words, and which to
-    trust where the GLM and the GLMM disagree."""
+def models(m, factors, study, group_note, what, additive_note=""):
+    """Logistic models across participants of the 0/1 measure against the factors (added), terms in words, and which
+    to trust where the GLM and the GLMM disagree. additive_note: said where the factors could interact."""
     d = m.copy()
     for f in factors:
         d[f] = d[f].map(_label)
@@ -223,8 +224,33 @@ def models(m, factors, study, group_note, what):
     if table.empty:
         return Chart(f"{study}-models", None, None, table, notes)
     notes.insert(0, f"{group_note}: logistic models of '{what}' across participants; estimates in log-odds, each "
-                    f"term against the baseline it names")
+                    f"term against the baseline it names" + (f"; {additive_note}" if additive_note else ""))
     return Chart(f"{study}-models", None, None, table, notes)
+
+
+def within_models(m, table, factors, chance, what, study, out_dir, slug, note):
+    """The models of a 0/1 measure (or none for a rating or level) across participants; where two within factors
+    cross, the shares drawn by both and the model with their interaction beside the additive one (crossed.py)."""
+    if "y" not in m:
+        return [models(m, factors, slug, note, what)]
+    if len(factors) < 2:
+        return [models(m, factors, slug, note, what)]
+    crossed_note = crossed.NO_INTERACTION_NOTE.format(
+        others="s" if len(factors) > 2 else "",
+        name=f"{slug}-models-interaction" if len(factors) == 2 else "no table: with more than two factors none is "
+                                                                    "fitted")
+    charts = [models(m, factors, slug, note, what, crossed_note)]
+    if len(factors) != 2:
+        return charts
+    a, b = sorted(factors, key=lambda f: -m[f].nunique())  # the factor of more levels along the x axis
+    levels = {f: _sorted_levels(list(m[f].map(_label).unique())) for f in factors}
+    t = table.assign(_a=table[a].map(levels[a].index), _b=table[b].map(levels[b].index)).sort_values(["_b", "_a"])
+    charts.append(crossed.crossing_chart(t, a, b, chance, what, study, out_dir, f"{slug}-per-{a}-by-{b}", note))
+    d = m.copy()
+    for f in factors:
+        d[f] = d[f].map(_label)
+    charts.append(crossed.interaction_models(d, factors, slug, note, what, levels))
+    return charts
 
 
 def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note, n_boot, seed, what, cell="",
@@ -576,7 +602,7 @@ def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, 
     if kind == "procedure":
         charts += track_charts
     else:
-        charts.append(models(m, factors, slug, note, what))
+        charts += within_models(m, table, factors, chance, what, study, out_dir, slug, note)
     if "chosen_side" in m and m["chosen_side"].isin(["left", "right"]).any():
         charts.append(side_bias_table(m, slug, note))
     return charts, finding

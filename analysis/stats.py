@@ -333,6 +333,10 @@ def term_in_words(term, data):
         return "baseline (intercept)"
     if term in CENTRED:
         return CENTRED[term]
+    parts = _interaction_parts(term)
+    if len(parts) > 1:  # 'C(a)[T.x]:C(b)[T.y]': how far that crossing departs from the two effects added
+        inner = [re.sub(r" \(against .*\)$", "", term_in_words(p, data)) for p in parts]
+        return " x ".join(inner) + " (interaction: beyond the effects added)"
     match = re.fullmatch(r"C\((\w+)(?:, levels=\[(.*)\])?\)\[(T\.)?(.+)\]", term)
     if not match:
         return term
@@ -348,6 +352,18 @@ def term_in_words(term, data):
         base = str(values[0]) if len(values) else "its first level"
     base = base[:-2] if base.endswith(".0") else base
     return f"{name} {level} (against {name} {base})"
+
+
+def _interaction_parts(term):
+    """A patsy column name split at its ':' outside brackets and parentheses ('C(a)[T.x]:C(b)[T.y]' -> two parts;
+    a level holding ':' stays whole)."""
+    parts, depth, start = [], 0, 0
+    for i, ch in enumerate(term):
+        depth += 1 if ch in "([" else -1 if ch in ")]" else 0
+        if ch == ":" and depth == 0:
+            parts.append(term[start:i])
+            start = i + 1
+    return parts + [term[start:]]
 
 
 # Every model table has these columns and no others: one row per (model, term), terms in words, the engine that

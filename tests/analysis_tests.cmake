@@ -75,5 +75,14 @@ add_test(NAME analysis.groups
 set_tests_properties(analysis.groups PROPERTIES LABELS analysis TIMEOUT 600
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
 
+# Two within factors crossed (crossed.py): the model with their interaction against a direct glmer call on the same
+# data, a planted interaction found with its sign; the additive model's note and the chart by both factors. Needs R
+# with lme4: fails without it (never skips). ~75 s of CPU, 165 s of wall time on a loaded machine.
+add_test(NAME analysis.crossed
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_crossed.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(analysis.crossed PROPERTIES LABELS analysis TIMEOUT 600
+                     ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
+
 # Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
-set_test_costs(analysis.report 134 analysis.mixed 76 analysis.glmm_checks 95 analysis.groups 43 analysis.tracks 24)
+set_test_costs(analysis.report 134 analysis.crossed 165 analysis.mixed 76 analysis.glmm_checks 95 analysis.groups 43 analysis.tracks 24)
