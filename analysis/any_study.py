@@ -229,10 +229,8 @@ def models(m, factors, study, group_note, what, additive_note=""):
 
 
 def within_models(m, table, factors, chance, what, study, out_dir, slug, note):
-    """The models of a 0/1 measure (or none for a rating or level) across participants; where two within factors
-    cross, the shares drawn by both and the model with their interaction beside the additive one (crossed.py)."""
-    if "y" not in m:
-        return [models(m, factors, slug, note, what)]
+    """The models of a 0/1 measure across participants; where two within factors cross, the shares drawn by both and
+    the model with their interaction beside the additive one (crossed.py). table: the conditions table."""
     if len(factors) < 2:
         return [models(m, factors, slug, note, what)]
     crossed_note = crossed.NO_INTERACTION_NOTE.format(
