@@ -133,8 +133,12 @@ void AddSessionsCommand(CLI::App& app) {
       "List the sessions of a record: study, participant, the participant's session number (n), group, observer\n"
       "(person or simulated), status, trials answered of planned (skipped and timed-out trials counted apart, never\n"
       "as answered), seed, start and end, host, and who holds its lock (a writer alive, or a stale lock left by a\n"
-      "crash). An unfinished session continues with blurcue run ... --resume. A read-only record (an archive, a\n"
-      "read-only mount) lists too.\n"
+      "crash). The status is completed, aborted, or for a session neither (the record's and export's 'running'):\n"
+      "  running      another process runs it now (a live writer holds its lock)\n"
+      "  unfinished   its run left it: the participant quit, the window was closed, or --stop-after was reached\n"
+      "  interrupted  its writer died holding the lock (killed, crashed); the next run takes the lock over\n"
+      "An unfinished or interrupted session continues with blurcue run ... --resume. A read-only record (an archive,\n"
+      "a read-only mount) lists too.\n"
       "\n"
       "Two repairs, each the experimenter's explicit call:\n"
       "  --abort ID       close an unfinished session as aborted, keeping every answer (e.g. its protocol was\n"
@@ -173,23 +177,27 @@ void AddSessionsCommand(CLI::App& app) {
     }
     // answered: answers given of the trials planned; skipped and timed-out trials are counted apart, never as
     // answered. n: the participant's n-th session of the study.
-    std::printf("%4s  %-28s %-12s %3s %-12s %-9s %-9s %9s %7s %9s  %-20s  %-24s %-24s %s\n", "id", "study",
+    std::printf("%4s  %-28s %-12s %3s %-12s %-9s %-11s %9s %7s %9s  %-20s  %-24s %-24s %s\n", "id", "study",
                 "participant", "n", "group", "observer", "status", "answered", "skipped", "timed_out", "seed",
                 "started", "ended", "host");
-    int unfinished = 0;
+    int unfinished = 0, running_now = 0;
     for (const auto& s : sessions) {
       const std::string answered = std::to_string(s.answered) + "/" + std::to_string(s.planned);
       const std::string number = s.number > 0 ? std::to_string(s.number) : "-";
-      std::printf("%4lld  %-28s %-12s %3s %-12s %-9s %-9s %9s %7lld %9lld  %-20llu  %-24s %-24s %s%s\n",
+      std::printf("%4lld  %-28s %-12s %3s %-12s %-9s %-11s %9s %7lld %9lld  %-20llu  %-24s %-24s %s%s\n",
                   static_cast<long long>(s.id), s.study.c_str(), s.participant.c_str(), number.c_str(),
                   s.group.empty() ? "-" : s.group.c_str(), s.observer.empty() ? "-" : s.observer.c_str(),
-                  s.status.c_str(), answered.c_str(), static_cast<long long>(s.skipped),
+                  s.state.c_str(), answered.c_str(), static_cast<long long>(s.skipped),
                   static_cast<long long>(s.timed_out), static_cast<unsigned long long>(s.seed), s.started.c_str(),
                   s.ended.empty() ? "-" : s.ended.c_str(), s.host.c_str(),
                   s.writer.empty() ? "" : ("  lock: " + s.writer).c_str());
       unfinished += s.status == "running";
+      running_now += s.state == "running";
     }
-    std::printf("%zu sessions, %d unfinished\n", sessions.size(), unfinished);
+    // Unfinished as the record and the report count them: every session neither completed nor aborted.
+    std::printf("%zu sessions, %d unfinished", sessions.size(), unfinished);
+    if (running_now > 0) std::printf(" (%d of them running now)", running_now);
+    std::printf("\n");
   });
 }
 
