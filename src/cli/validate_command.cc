@@ -52,12 +52,21 @@ std::string ProcedureDesignLines(const protocol::Protocol& protocol, const Args&
     if (c.measure != "threshold") continue;
     for (const plan::PowerRow& row : r.rows) {
       if (row.test != "threshold" || row.condition != c.label || row.participants != options.participants) continue;
+      // Coverage is a share of the determined tracks against a known truth: without either, which one is missing.
+      std::string covered;
+      if (std::isfinite(row.coverage))
+        covered = std::to_string(int(std::lround(100 * row.coverage))) +
+                  " % of their 95 % intervals hold the observer's true threshold";
+      else if (!c.truth_determined)
+        covered = "the observer's true threshold is " + c.truth_why;
+      else {
+        char truth[64];
+        std::snprintf(truth, sizeof truth, "%.3g", c.truth);
+        covered = "so no interval to check against the observer's true threshold, " + std::string(truth) + " " + c.units;
+      }
       std::snprintf(line, sizeof line,
                     "  procedure cell %s: %.0f %% of 200 simulated tracks determine their threshold; %s\n",
-                    c.label.c_str(), 100 * row.determined_share,
-                    std::isfinite(row.coverage) ? (std::to_string(int(std::lround(100 * row.coverage))) +
-                                                   " % of their 95 % intervals hold the observer's true threshold").c_str()
-                                                : ("the observer's true threshold is " + c.truth_why).c_str());
+                    c.label.c_str(), 100 * row.determined_share, covered.c_str());
       out += line;
       for (const std::string& warning : plan::DesignWarnings(c, row)) out += "  WARNING: " + warning + "\n";
     }
