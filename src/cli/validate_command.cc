@@ -175,18 +175,32 @@ std::vector<CheckedGroup> CheckAsRunWould(const Args& args, const std::optional<
   return checked;
 }
 
-// A checked group's summary: its trials (with --list), their count and hash, and each block's share.
+// Whether a block's planned trials may not all be shown: a staircase's stop rule, or a practice criterion (the runs
+// after the one that met it) ends it sooner, the rest recorded as skipped.
+bool CanEndSooner(const protocol::Block& b) {
+  return (b.procedure && b.procedure->stop_reversals > 0) || b.criterion;
+}
+
+// A checked group's summary: its trials (with --list), their count and hash, and each block's share; "up to" where
+// a block can end sooner (the list holds every trial it may show).
 void PrintCheckedGroup(const CheckedGroup& one, const protocol::Protocol& p, const Args& args) {
   const auto& trials = one.trials;
   if (args.list)
     for (const auto& t : trials) std::cout << protocol::ToJson(t).dump() << "\n";
-  std::cout << "ok: " << trials.size() << " trials for participant " << args.participant << " with seed "
-            << one.seed << " (hash " << HashHex(protocol::TrialsHash(trials)) << ")"
+  auto sooner = [&](const protocol::Trial& t) {
+    const protocol::Block* b = protocol::BlockOf(p, t);
+    return b && CanEndSooner(*b);
+  };
+  const bool up_to = std::any_of(trials.begin(), trials.end(), sooner);
+  std::cout << "ok: " << (up_to ? "up to " : "") << trials.size() << " trials for participant " << args.participant
+            << " with seed " << one.seed << " (hash " << HashHex(protocol::TrialsHash(trials)) << ")"
             << (one.group.empty() ? "" : ", group " + one.group) << "\n";
   std::string counts;
   int practice = 0;
-  for (const auto& t : trials) practice += t.practice ? 1 : 0;
-  if (practice > 0) counts = "practice " + std::to_string(practice);
+  bool practice_sooner = false;
+  for (const auto& t : trials)
+    if (t.practice) ++practice, practice_sooner = practice_sooner || sooner(t);
+  if (practice > 0) counts = std::string("practice ") + (practice_sooner ? "up to " : "") + std::to_string(practice);
   for (const auto& b : p.blocks) {
     // A group's own blocks (and those every group runs); another group's are its to report.
     if (!one.group.empty() && !b.groups.empty() &&
@@ -194,8 +208,9 @@ void PrintCheckedGroup(const CheckedGroup& one, const protocol::Protocol& p, con
       continue;
     int n = 0;
     for (const auto& t : trials) n += (!t.practice && t.block == b.name) ? 1 : 0;
-    counts += (counts.empty() ? "" : ", ") + b.name + " " + std::to_string(n) + " (" + protocol::ToString(b.task) +
-              ", " + protocol::ToString(b.counterbalance) + ")";
+    counts += (counts.empty() ? "" : ", ") + b.name + " " + (CanEndSooner(b) && n > 0 ? "up to " : "") +
+              std::to_string(n) + " (" + protocol::ToString(b.task) + ", " + protocol::ToString(b.counterbalance) +
+              ")";
   }
   std::cout << "  " << counts << "\n" << one.shown;
 }
