@@ -23,9 +23,10 @@ void AddExportCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "export",
-      "Write a record's answers as tidy tables, one row per planned trial (answered or not), one column per\n"
-      "variable and one type per column, no JSON in any cell; DIR/codebook.csv says every column's type, unit,\n"
-      "allowed values and meaning (written from the same definitions as the tables):\n"
+      "Write a record's answers as tidy tables, with the codebook that says what each column holds.\n"
+      "One row per planned trial (answered or not), one column per variable and one type per column, no JSON in any\n"
+      "cell; DIR/codebook.csv says every column's type, unit, allowed values and meaning (written from the same\n"
+      "definitions as the tables):\n"
       "  trials.csv       who (observer person|simulated, its parameters, window or headless), the session (its id,\n"
       "                   the participant's session number and its status: running|completed|aborted), the seed (s<digits>: exact in R, spreadsheets and\n"
       "                   JavaScript; run --seed takes it), the trial's block, task, practice, swap and every design\n"
@@ -70,8 +71,8 @@ void AddMergeCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "merge",
-      "Combine the records of several lab stations into a new one, with fresh ids (nothing collides); protocol\n"
-      "versions are shared by their hash and participants by their code. Refuses an existing --out. The record is\n"
+      "Combine the records of several lab stations into a new one, with fresh ids (nothing collides).\n"
+      "Protocol versions are shared by their hash and participants by their code. Refuses an existing --out. The record is\n"
       "built beside it as .OUT.partial-PID and renamed to OUT when complete; an interrupted merge's leftovers are\n"
       "removed by the next merge to the same OUT.\n"
       "A session still being written (its lock held by a live run, as blurcue sessions shows it) is refused, exit 3,\n"
@@ -130,10 +131,10 @@ void AddSessionsCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "sessions",
-      "List the sessions of a record: study, participant, the participant's session number (n), group, observer\n"
-      "(person or simulated), status, trials answered of planned (skipped and timed-out trials counted apart, never\n"
-      "as answered), seed, start and end, host, and who holds its lock (a writer alive, or a stale lock left by a\n"
-      "crash). The status is completed, aborted, or for a session neither (the record's and export's 'running'):\n"
+      "List the sessions of a record: who took each, how far it got and what became of it.\n"
+      "Each row: study, participant, the participant's session number (n), group, observer (person or simulated),\n"
+      "status, trials answered of planned (skipped and timed-out trials counted apart, never as answered), seed, start\n"
+      "and end, host, and who holds its lock (a writer alive, or a stale lock left by a crash). The status is completed, aborted, or for a session neither (the record's and export's 'running'):\n"
       "  running      another process runs it now (a live writer holds its lock)\n"
       "  unfinished   its run left it: the participant quit, the window was closed, or --stop-after was reached\n"
       "  interrupted  its writer died holding the lock (killed, crashed); the next run takes the lock over\n"
