@@ -600,8 +600,8 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
     estimable = len(fit_cols) > 0 and min(yr.sum(), len(yr) - yr.sum()) >= 1
     if infinite_cols:
         notes.append(f"separation in {', '.join(words[c] for c in infinite_cols)}: "
-                     f"{int(separated.sum())} answers that those terms predict perfectly left out of the other "
-                     f"terms' fits" + ("" if estimable else "; no other term can be estimated apart from them"))
+                     f"{int(separated.sum())} answer{'s' if int(separated.sum()) != 1 else ''} that those terms "
+                     f"predict perfectly left out of the other terms' fits" + ("" if estimable else "; no other term can be estimated apart from them"))
     sm_version = statsmodels.__version__.split("+")[0]
 
     def add_fit(model, engine, table, note_of):

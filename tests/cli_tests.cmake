@@ -170,3 +170,10 @@ add_test(NAME cli_animate_video_killed
          COMMAND ${BLURCUE_EXPECT} "ok: a killed animate --video left the earlier video unchanged"
                  bash ${PROJECT_SOURCE_DIR}/tests/animate_kill_test.sh ${BC} ${T}/calib.json ${T}/scene/scene.png ${T}/animate-kill)
 set_tests_properties(cli_animate_video_killed PROPERTIES FIXTURES_REQUIRED "scene;calib" LABELS gl)
+
+# 'blurcue --help' lists each command by its first sentence: every one whole, none cut to " ..." or ending at a colon
+# (make-stimuli's ended "PNG):", preview's and eight others' " ...").
+add_test(NAME cli_help_whole_first_sentences COMMAND ${BC} --help)
+set_tests_properties(cli_help_whole_first_sentences PROPERTIES
+                     PASS_REGULAR_EXPRESSION "\n  make-stimuli +Draw the study's stimulus textures \\(procedural, deterministic, 8-bit sRGB PNG\\)\\.\n.*\n  preview +Draw a contact sheet of every distinct stimulus a protocol shows, to check the protocol by eye before a session\\.\n"
+                     FAIL_REGULAR_EXPRESSION "\n  [a-z-]+  +[^\n]*(\\.\\.\\.|:)\n")

@@ -462,6 +462,21 @@ import csv, sys
 rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["test"] == "threshold" and r["participants"] == "10"]
 assert len(rows) == 2 and all(float(r["determined_share"]) < 0.8 for r in rows), rows
 PYEOF
+  # No track determined (8 answers), so no interval to hold the truth: the sentence says so and gives the truth, the
+  # plan's true_threshold of the cell (it used to end at "the observer's true threshold is ").
+  $PY - "$W/validate.out" "$W/p/plan.csv" <<'PYEOF' || fail "validate --plan's cell lines: $(grep "procedure cell" "$W/validate.out")"
+import csv, re, sys
+lines = [l.rstrip("\n") for l in open(sys.argv[1]) if l.startswith("  procedure cell ")]
+truth = {r["condition"]: float(r["true_threshold"]) for r in csv.DictReader(open(sys.argv[2]))
+         if r["test"] == "threshold" and r["participants"] == "10"}
+assert len(lines) == 2, lines
+for line in lines:
+    m = re.fullmatch(r"  procedure cell (.+): 0 % of 200 simulated tracks determine their threshold; so no interval to "
+                     r"check against the observer's true threshold, ([0-9.e+-]+) (\w+)", line)
+    assert m, line
+    assert abs(float(m.group(2)) - truth[m.group(1)]) <= 0.0051 * truth[m.group(1)], (line, truth)
+print("validate --plan:", lines)
+PYEOF
   echo "ok: a design that rarely determines its threshold is warned of by validate --plan and plan" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -14,6 +14,11 @@ endforeach()
 add_test(NAME cli_validate_explicit_seed
          COMMAND ${BLURCUE_EXPECT} "ok: 74 trials for participant P4 with seed 4 \\(hash [0-9a-f]+\\)" $<TARGET_FILE:blurcue> validate ${PROJECT_SOURCE_DIR}/protocols/test2-moving-balls.json --no-files
                  --participant P4 --seed 4)
+# A staircase that stops at its 6th reversal (30 trials at each of two speeds at most): the list holds all 60, the
+# session shows up to 60, and validate says "up to" (it said "60 trials", the maximum, where runs take fewer).
+add_test(NAME cli_validate_stop_rule_up_to
+         COMMAND ${BLURCUE_EXPECT} "ok: up to 60 trials for participant P1 [^\n]*\n  staircase up to 60 \\(forced_choice"
+                 $<TARGET_FILE:blurcue> validate ${PROJECT_SOURCE_DIR}/protocols/staircase-ball-gain.json --no-files)
 
 set(BROKEN_PROTOCOL ${PROJECT_SOURCE_DIR}/tests/data/broken-protocol.json)
 foreach(expect "/factors/pattern/0/speed_cm_s: a speed must be a number in [0.1, 100] cm/s, got -3"

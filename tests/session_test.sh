@@ -94,7 +94,12 @@ merge_live_writer)
   $BC merge "$W/b.sqlite" "$W/a.sqlite" --out "$W/all.sqlite" > "$W/out" 2> "$W/err"
   code=$?
   set -e
+  # Being written: the one session `sessions` lists as running, its live writer named.
+  $BC sessions --db "$W/a.sqlite" > "$W/sessions"
   kill -0 $pid 2>/dev/null || fail "the run ended before the merge was tried: $(cat "$W/err")"
+  grep -Eq "test2-moving-balls +L1 +1 +- +simulated +running +[0-9]+/74 .*lock: pid $pid on host .*\(alive\)" "$W/sessions" \
+    || fail "sessions of a session being written: $(cat "$W/sessions")"
+  grep -q "^1 sessions, 1 unfinished (1 of them running now)$" "$W/sessions" || fail "sessions: $(cat "$W/sessions")"
   kill -9 $pid; wait $pid 2>/dev/null || true
   [ $code = 3 ] || fail "merge of a session being written: exit $code: $(cat "$W/err")"
   [ "$(wc -l < "$W/err")" = 1 ] || fail "more than one line: $(cat "$W/err")"
@@ -137,6 +142,10 @@ resume)
     $BC run "$P/$proto.json" --participant R2 --db "$W/whole.sqlite" --observer sim --seed 5
     $BC run "$P/$proto.json" --participant R2 --db "$W/parts.sqlite" --observer sim --seed 5 --stop-after 20 \
       | grep -q "not finished" || fail "$proto: stop-after did not leave the session open"
+    # Left by its run, no writer: listed as unfinished, not as running, with no lock.
+    listed=$($BC sessions --db "$W/parts.sqlite" | grep -E " $proto +R2 " || true)
+    echo "$listed" | grep -Eq " +simulated +unfinished +20/[0-9]+ " && [[ "$listed" != *lock:* ]] \
+      || fail "$proto: sessions after --stop-after: $listed"
     if $BC run "$P/$proto.json" --participant R2 --db "$W/parts.sqlite" --observer sim --seed 5 2>"$W/err"; then
       fail "$proto: a second session started while one is running"
     fi
@@ -158,8 +167,9 @@ kill9)
   pid=$!
   wait_for_answers "$W/killed.sqlite" 8
   kill -9 $pid; wait $pid 2>/dev/null || true
-  # Killed: the session is still running (resumable) and its lock names the dead writer.
-  $BC sessions --db "$W/killed.sqlite" | grep -Eq "test2-moving-balls +K1 +1 +- +simulated +running +[0-9]+/74 .*lock: pid $pid on .*gone" \
+  # Killed: the session is listed as interrupted (resumable; the record keeps it running) and its lock names the
+  # dead writer.
+  $BC sessions --db "$W/killed.sqlite" | grep -Eq "test2-moving-balls +K1 +1 +- +simulated +interrupted +[0-9]+/74 .*lock: pid $pid on .*gone" \
     || fail "sessions after kill: $($BC sessions --db "$W/killed.sqlite")"
   answered=$(sql "$W/killed.sqlite" "SELECT count(*) FROM responses")
   [ "$answered" -ge 8 ] && [ "$answered" -lt 74 ] || fail "killed after $answered answers, expected mid-session"

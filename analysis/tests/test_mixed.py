@@ -211,7 +211,13 @@ class SeparationTest(unittest.TestCase):
         # The other cell is the limit of the ML fit: its own log-odds, log(12 / 8).
         b = table[(table["term"] == "cell b") & table["engine"].str.contains("cluster-robust")].iloc[0]
         self.assertAlmostEqual(b["estimate"], math.log(12 / 8), places=6)
-        self.assertTrue(any("separation in cell a" in n for n in notes), notes)
+        self.assertTrue(any("separation in cell a: 20 answers that those terms predict" in n for n in notes), notes)
+
+    def test_one_separated_answer_is_one_answer(self):
+        # A cell of one answer is separated by it: the note counts it in the singular ("1 answers" it said).
+        _, notes = stats.observer_models(self.cells(1, 0, 12, 8), "y", "0 + C(cell)", study="s")
+        self.assertTrue(any("separation in cell a: 1 answer that those terms predict perfectly" in n for n in notes),
+                        notes)
 
     def test_separated_baseline_leaves_the_other_factor_estimated(self):
         # The first cell a went all one way, so against it the intercept and every cell's contrast were infinite,

@@ -249,9 +249,9 @@ void AddArCommand(CLI::App& app) {
   auto args = std::make_shared<ArArgs>();
   CLI::App* cmd = app.add_subcommand(
       "ar",
-      "Draw virtual objects into a tracked take: the offline AR view, every frame at its own pose, each object blurred\n"
-      "for its depth (the frame's blur model: defocus x the lens floor) and for its image motion between frames over\n"
-      "the exposure, in one pass in linear light, through the GL renderer (headless).\n"
+      "Draw virtual objects into a tracked take: the offline AR view, every frame at its own pose.\n"
+      "Each object is blurred for its depth (the frame's blur model: defocus x the lens floor) and for its image motion\n"
+      "between frames over the exposure, in one pass in linear light, through the GL renderer (headless).\n"
       "INPUT is the take `blurcue track` read (a video, or an image sequence as a printf pattern); --track is the\n"
       "folder it wrote. Objects: --ball X,Y[,RADIUS] and --card X,Y[,WIDTH[,HEIGHT]] in board mm (repeatable; a ball\n"
       "resting on the board over X,Y; a card standing on the board facing the camera, its bottom edge's middle at\n"

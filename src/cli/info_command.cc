@@ -34,8 +34,8 @@ void AddInfoCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "info",
-      "Print what this blurcue is and what it will use: its version, the folder it reads its shaders, stimuli,\n"
-      "analysis and example protocols from (and how it found it: BLURCUE_DATA_DIR, installed beside the binary, or\n"
+      "Print what this blurcue is and what it will use, and whether everything it needs is there.\n"
+      "Its version, the folder it reads its shaders, stimuli, analysis and example protocols from (and how it found it: BLURCUE_DATA_DIR, installed beside the binary, or\n"
       "the source tree it was built from), the GL renderer an offscreen context gets, the record schema it writes,\n"
       "and the Python `blurcue report` runs with the packages it needs. Exit 0 when everything is there.\n"
       "Example: blurcue info");

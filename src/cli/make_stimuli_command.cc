@@ -36,7 +36,7 @@ void AddMakeStimuliCommand(CLI::App& app) {
   auto out = std::make_shared<std::string>("stimuli");
   CLI::App* cmd = app.add_subcommand(
       "make-stimuli",
-      "Draw the study's stimulus textures (procedural, deterministic, 8-bit sRGB PNG):\n"
+      "Draw the study's stimulus textures (procedural, deterministic, 8-bit sRGB PNG). Into --out:\n"
       "  soccer.png  2048 x 1024 equirectangular soccer ball (truncated icosahedron) for the balls of tests 2-3\n"
       "  wood.png    2048 x 1024 equirectangular wood grain (seed 1), the alternative ball texture\n"
       "  grid.png    1024 x 1024 white card with a 5 x 5 black grid, the virtual content of test 1\n"
@@ -71,8 +71,8 @@ void AddSynthPicturesCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "synth-pictures",
-      "Photos of the depth-matching study's real picture at each distance, made with the thin lens, for trying\n"
-      "the study without a photo session: the picture (8 x 12 cm by default) faces the camera at distance d,\n"
+      "Make photos of the depth-matching study's real picture at each distance with the thin lens, to try the study\n"
+      "without a photo session. The picture (8 x 12 cm by default) faces the camera at distance d,\n"
       "imaged at magnification f / (d - f), blurred by the thin-lens disc for the lens focused at --focus-m, on a\n"
       "grey wall. Writes OUT/PICTURE-{d}m.png (d as %g) at --width-px wide with the camera's aspect, the names a\n"
       "protocol's content.real_photos pattern (e.g. \"pictures/face-{distance_m}m.png\") finds. With --protocol, the\n"

@@ -29,7 +29,7 @@ struct PlanArgs {
 
 // The help text: what a plan simulates, what it reports and what it writes.
 const char* const kPlanHelp =
-    "Plan a study before anyone sits down: how many participants does a protocol need?\n"
+    "Plan a study before anyone sits down: how many participants a protocol needs, and what it can find.\n"
     "Simulates --studies whole studies of --participants participants each, every participant answered by the\n"
     "simulated observer (--observer, as 'blurcue run --observer') through the runner's own decisions - the same trial\n"
     "list, scenes on --display, staircases and QUEST+, stop rules, practice criteria and deadlines - headless, without\n"

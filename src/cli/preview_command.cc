@@ -30,11 +30,10 @@ void AddPreviewCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "preview",
-      "Draw a contact sheet of every distinct stimulus a protocol shows (each at its onset, as the window shows it),\n"
-      "labelled with its levels, the blur radius on each side in photo px, screen px and arcmin, and its blur plan\n"
-      "(one radius, or per pixel by depth where the object's depth span changes r by the protocol's\n"
-      "content.depth_blur_threshold) with what a frame of it costs to compose here, so a protocol can be checked by\n"
-      "eye before a session.\n"
+      "Draw a contact sheet of every distinct stimulus a protocol shows, to check the protocol by eye before a session.\n"
+      "Each is drawn at its onset, as the window shows it, labelled with its levels, the blur radius on each side in\n"
+      "photo px, screen px and arcmin, and its blur plan (one radius, or per pixel by depth where the object's depth\n"
+      "span changes r by the protocol's content.depth_blur_threshold) with what a frame of it costs to compose here.\n"
       "Distinct: the same levels and sides drawn once (practice copies and repetitions are not repeated); for\n"
       "depth matching, one tile per adjustment level and one per distance.\n"
       "Each pair's tile says the probability that an observer (--observer's model, no lapses or bias) tells its two\n"

@@ -23,9 +23,10 @@ void AddExportCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "export",
-      "Write a record's answers as tidy tables, one row per planned trial (answered or not), one column per\n"
-      "variable and one type per column, no JSON in any cell; DIR/codebook.csv says every column's type, unit,\n"
-      "allowed values and meaning (written from the same definitions as the tables):\n"
+      "Write a record's answers as tidy tables, with the codebook that says what each column holds.\n"
+      "One row per planned trial (answered or not), one column per variable and one type per column, no JSON in any\n"
+      "cell; DIR/codebook.csv says every column's type, unit, allowed values and meaning (written from the same\n"
+      "definitions as the tables):\n"
       "  trials.csv       who (observer person|simulated, its parameters, window or headless), the session (its id,\n"
       "                   the participant's session number and its status: running|completed|aborted), the seed (s<digits>: exact in R, spreadsheets and\n"
       "                   JavaScript; run --seed takes it), the trial's block, task, practice, swap and every design\n"
@@ -70,8 +71,8 @@ void AddMergeCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "merge",
-      "Combine the records of several lab stations into a new one, with fresh ids (nothing collides); protocol\n"
-      "versions are shared by their hash and participants by their code. Refuses an existing --out. The record is\n"
+      "Combine the records of several lab stations into a new one, with fresh ids (nothing collides).\n"
+      "Protocol versions are shared by their hash and participants by their code. Refuses an existing --out. The record is\n"
       "built beside it as .OUT.partial-PID and renamed to OUT when complete; an interrupted merge's leftovers are\n"
       "removed by the next merge to the same OUT.\n"
       "A session still being written (its lock held by a live run, as blurcue sessions shows it) is refused, exit 3,\n"
@@ -130,11 +131,15 @@ void AddSessionsCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "sessions",
-      "List the sessions of a record: study, participant, the participant's session number (n), group, observer\n"
-      "(person or simulated), status, trials answered of planned (skipped and timed-out trials counted apart, never\n"
-      "as answered), seed, start and end, host, and who holds its lock (a writer alive, or a stale lock left by a\n"
-      "crash). An unfinished session continues with blurcue run ... --resume. A read-only record (an archive, a\n"
-      "read-only mount) lists too.\n"
+      "List the sessions of a record: who took each, how far it got and what became of it.\n"
+      "Each row: study, participant, the participant's session number (n), group, observer (person or simulated),\n"
+      "status, trials answered of planned (skipped and timed-out trials counted apart, never as answered), seed, start\n"
+      "and end, host, and who holds its lock (a writer alive, or a stale lock left by a crash). The status is completed, aborted, or for a session neither (the record's and export's 'running'):\n"
+      "  running      another process runs it now (a live writer holds its lock)\n"
+      "  unfinished   its run left it: the participant quit, the window was closed, or --stop-after was reached\n"
+      "  interrupted  its writer died holding the lock (killed, crashed); the next run takes the lock over\n"
+      "An unfinished or interrupted session continues with blurcue run ... --resume. A read-only record (an archive,\n"
+      "a read-only mount) lists too.\n"
       "\n"
       "Two repairs, each the experimenter's explicit call:\n"
       "  --abort ID       close an unfinished session as aborted, keeping every answer (e.g. its protocol was\n"
@@ -173,23 +178,27 @@ void AddSessionsCommand(CLI::App& app) {
     }
     // answered: answers given of the trials planned; skipped and timed-out trials are counted apart, never as
     // answered. n: the participant's n-th session of the study.
-    std::printf("%4s  %-28s %-12s %3s %-12s %-9s %-9s %9s %7s %9s  %-20s  %-24s %-24s %s\n", "id", "study",
+    std::printf("%4s  %-28s %-12s %3s %-12s %-9s %-11s %9s %7s %9s  %-20s  %-24s %-24s %s\n", "id", "study",
                 "participant", "n", "group", "observer", "status", "answered", "skipped", "timed_out", "seed",
                 "started", "ended", "host");
-    int unfinished = 0;
+    int unfinished = 0, running_now = 0;
     for (const auto& s : sessions) {
       const std::string answered = std::to_string(s.answered) + "/" + std::to_string(s.planned);
       const std::string number = s.number > 0 ? std::to_string(s.number) : "-";
-      std::printf("%4lld  %-28s %-12s %3s %-12s %-9s %-9s %9s %7lld %9lld  %-20llu  %-24s %-24s %s%s\n",
+      std::printf("%4lld  %-28s %-12s %3s %-12s %-9s %-11s %9s %7lld %9lld  %-20llu  %-24s %-24s %s%s\n",
                   static_cast<long long>(s.id), s.study.c_str(), s.participant.c_str(), number.c_str(),
                   s.group.empty() ? "-" : s.group.c_str(), s.observer.empty() ? "-" : s.observer.c_str(),
-                  s.status.c_str(), answered.c_str(), static_cast<long long>(s.skipped),
+                  s.state.c_str(), answered.c_str(), static_cast<long long>(s.skipped),
                   static_cast<long long>(s.timed_out), static_cast<unsigned long long>(s.seed), s.started.c_str(),
                   s.ended.empty() ? "-" : s.ended.c_str(), s.host.c_str(),
                   s.writer.empty() ? "" : ("  lock: " + s.writer).c_str());
       unfinished += s.status == "running";
+      running_now += s.state == "running";
     }
-    std::printf("%zu sessions, %d unfinished\n", sessions.size(), unfinished);
+    // Unfinished as the record and the report count them: every session neither completed nor aborted.
+    std::printf("%zu sessions, %d unfinished", sessions.size(), unfinished);
+    if (running_now > 0) std::printf(" (%d of them running now)", running_now);
+    std::printf("\n");
   });
 }
 

@@ -27,9 +27,10 @@ void AddReportCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "report",
-      "Write the report of a record: the tables (DIR/tables/, as blurcue export, with their codebook), then every\n"
-      "chart as PNG and SVG with its numbers beside it, DIR/index.html (a summary of what each study found, then a\n"
-      "section per study) and DIR/bench.html (the software benchmarks):\n"
+      "Write the report of a record: its tables, a chart of every analysis with its numbers, and a page to read them.\n"
+      "The tables (DIR/tables/, as blurcue export, with their codebook), then every chart as PNG and SVG with its\n"
+      "numbers beside it, DIR/index.html (a summary of what each study found, then a section per study) and\n"
+      "DIR/bench.html (the software benchmarks):\n"
       "  any study, from what its trials declare: per condition the share with Wilson intervals and a test against\n"
       "          chance with participants as the unit (Holm), a chart per factor, a psychometric function per\n"
       "          procedure cell over its level, or an odd one out's over the blur difference on screen (Weibull, guess\n"

@@ -117,7 +117,7 @@ void Run(const RunArgs& args) {
               static_cast<long long>(r.answered_before + r.answered_now + r.skipped_now),
               static_cast<long long>(r.trial_count), r.skipped_now > 0 ? "done" : "answered",
               static_cast<long long>(r.answered_now), skipped.c_str(),
-              r.dropped_frames > 0 ? (", " + std::to_string(r.dropped_frames) + " dropped frames").c_str() : "",
+              r.dropped_frames > 0 ? (", " + std::to_string(r.dropped_frames) + " dropped frames in the session").c_str() : "",
               r.completed ? "; completed" : "; not finished - continue with --resume");
 }
 

@@ -52,12 +52,21 @@ std::string ProcedureDesignLines(const protocol::Protocol& protocol, const Args&
     if (c.measure != "threshold") continue;
     for (const plan::PowerRow& row : r.rows) {
       if (row.test != "threshold" || row.condition != c.label || row.participants != options.participants) continue;
+      // Coverage is a share of the determined tracks against a known truth: without either, which one is missing.
+      std::string covered;
+      if (std::isfinite(row.coverage))
+        covered = std::to_string(int(std::lround(100 * row.coverage))) +
+                  " % of their 95 % intervals hold the observer's true threshold";
+      else if (!c.truth_determined)
+        covered = "the observer's true threshold is " + c.truth_why;
+      else {
+        char truth[64];
+        std::snprintf(truth, sizeof truth, "%.3g", c.truth);
+        covered = "so no interval to check against the observer's true threshold, " + std::string(truth) + " " + c.units;
+      }
       std::snprintf(line, sizeof line,
                     "  procedure cell %s: %.0f %% of 200 simulated tracks determine their threshold; %s\n",
-                    c.label.c_str(), 100 * row.determined_share,
-                    std::isfinite(row.coverage) ? (std::to_string(int(std::lround(100 * row.coverage))) +
-                                                   " % of their 95 % intervals hold the observer's true threshold").c_str()
-                                                : ("the observer's true threshold is " + c.truth_why).c_str());
+                    c.label.c_str(), 100 * row.determined_share, covered.c_str());
       out += line;
       for (const std::string& warning : plan::DesignWarnings(c, row)) out += "  WARNING: " + warning + "\n";
     }
@@ -166,18 +175,32 @@ std::vector<CheckedGroup> CheckAsRunWould(const Args& args, const std::optional<
   return checked;
 }
 
-// A checked group's summary: its trials (with --list), their count and hash, and each block's share.
+// Whether a block's planned trials may not all be shown: a staircase's stop rule, or a practice criterion (the runs
+// after the one that met it) ends it sooner, the rest recorded as skipped.
+bool CanEndSooner(const protocol::Block& b) {
+  return (b.procedure && b.procedure->stop_reversals > 0) || b.criterion;
+}
+
+// A checked group's summary: its trials (with --list), their count and hash, and each block's share; "up to" where
+// a block can end sooner (the list holds every trial it may show).
 void PrintCheckedGroup(const CheckedGroup& one, const protocol::Protocol& p, const Args& args) {
   const auto& trials = one.trials;
   if (args.list)
     for (const auto& t : trials) std::cout << protocol::ToJson(t).dump() << "\n";
-  std::cout << "ok: " << trials.size() << " trials for participant " << args.participant << " with seed "
-            << one.seed << " (hash " << HashHex(protocol::TrialsHash(trials)) << ")"
+  auto sooner = [&](const protocol::Trial& t) {
+    const protocol::Block* b = protocol::BlockOf(p, t);
+    return b && CanEndSooner(*b);
+  };
+  const bool up_to = std::any_of(trials.begin(), trials.end(), sooner);
+  std::cout << "ok: " << (up_to ? "up to " : "") << trials.size() << " trials for participant " << args.participant
+            << " with seed " << one.seed << " (hash " << HashHex(protocol::TrialsHash(trials)) << ")"
             << (one.group.empty() ? "" : ", group " + one.group) << "\n";
   std::string counts;
   int practice = 0;
-  for (const auto& t : trials) practice += t.practice ? 1 : 0;
-  if (practice > 0) counts = "practice " + std::to_string(practice);
+  bool practice_sooner = false;
+  for (const auto& t : trials)
+    if (t.practice) ++practice, practice_sooner = practice_sooner || sooner(t);
+  if (practice > 0) counts = std::string("practice ") + (practice_sooner ? "up to " : "") + std::to_string(practice);
   for (const auto& b : p.blocks) {
     // A group's own blocks (and those every group runs); another group's are its to report.
     if (!one.group.empty() && !b.groups.empty() &&
@@ -185,8 +208,9 @@ void PrintCheckedGroup(const CheckedGroup& one, const protocol::Protocol& p, con
       continue;
     int n = 0;
     for (const auto& t : trials) n += (!t.practice && t.block == b.name) ? 1 : 0;
-    counts += (counts.empty() ? "" : ", ") + b.name + " " + std::to_string(n) + " (" + protocol::ToString(b.task) +
-              ", " + protocol::ToString(b.counterbalance) + ")";
+    counts += (counts.empty() ? "" : ", ") + b.name + " " + (CanEndSooner(b) && n > 0 ? "up to " : "") +
+              std::to_string(n) + " (" + protocol::ToString(b.task) + ", " + protocol::ToString(b.counterbalance) +
+              ")";
   }
   std::cout << "  " << counts << "\n" << one.shown;
 }

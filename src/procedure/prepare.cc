@@ -21,12 +21,30 @@ using stimulus::Presentation;
 using stimulus::TrialScene;
 using stimulus::CheckVideoTrial;
 
+protocol::ValidateOptions WithCalibratedBoard(const Json& json, const std::filesystem::path& protocol_file) {
+  protocol::ValidateOptions options;
+  if (!json.is_object() || !json.contains("scene") || !json["scene"].is_object()) return options;
+  const Json& scene = json["scene"];
+  if (scene.contains("track") || !scene.contains("calib") || !scene["calib"].is_string()) return options;
+  const std::filesystem::path base = protocol_file.has_parent_path() ? protocol_file.parent_path() : ".";
+  const std::filesystem::path path = (base / scene["calib"].get<std::string>()).lexically_normal();
+  // Only a regular file, as the parser checks it after: a FIFO or a device would be waited on here.
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) return options;
+  try {
+    const calib::SceneCalib calib = calib::LoadSceneCalib(path);
+    options.board_cols = calib.board.cols, options.board_rows = calib.board.rows;
+  } catch (const std::exception&) {
+  }
+  return options;
+}
+
 PreparedSession PrepareStudy(const std::filesystem::path& protocol_file, const std::filesystem::path& display_profile) {
   PreparedSession s;
   // Read once: the text recorded with the session is the text that was validated.
   const std::string text = ReadTextFile(protocol_file);
   const Json json = ParseJson(text, protocol_file.string());
-  s.protocol = protocol::ParseProtocol(json, protocol_file);
+  s.protocol = protocol::ParseProtocol(json, protocol_file, WithCalibratedBoard(json, protocol_file));
   // Each design variable in a column of its own (the record's rule: recorded_names.h), before anything else is read.
   CheckRecordedNames(s.protocol);
   s.protocol_text = protocol::RecordedText(text, s.protocol);

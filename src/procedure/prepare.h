@@ -62,6 +62,11 @@ std::string SceneKey(const protocol::Trial& trial);
 // participant's seed, group, trials and scenes into it (replacing any before). Throw as PrepareSession.
 PreparedSession PrepareStudy(const std::filesystem::path& protocol_file,
                              const std::filesystem::path& display_profile = {});
+// How PrepareStudy parses `json` (the protocol read from `protocol_file`): against the board of the calibration its
+// photo scene names (scene.calib, resolved as the parser does), read ahead so that an edge or section past that board
+// is named with every other problem of the protocol; without that board (none, a take, one that does not load - which
+// LoadProtocolScene then refuses), against the largest board a calibration can have.
+protocol::ValidateOptions WithCalibratedBoard(const Json& json, const std::filesystem::path& protocol_file);
 // `cache`: scenes of earlier participants of the same study (PrepareStudy's, unchanged since) to reuse.
 void PrepareParticipant(PreparedSession* study, const std::string& participant, std::optional<uint64_t> seed,
                         const std::string& group = "", SceneCache* cache = nullptr);

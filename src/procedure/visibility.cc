@@ -8,6 +8,7 @@
 
 #include "procedure/adaptive.h"
 #include "procedure/observer.h"
+#include "protocol/design.h"
 
 namespace blurcue::procedure {
 
@@ -18,9 +19,12 @@ using stimulus::TrialScene;
 std::string LevelsLabel(const protocol::Trial& t) {
   std::string levels;
   for (const protocol::Level& level : t.levels) {
+    // An object level by its name as trials.csv gives it (its id, else its members), never as a JSON object.
     const protocol::LevelValue* id = level.object ? level.Field("id") : nullptr;
-    levels += (levels.empty() ? "" : " ") + level.factor + " " +
-              (id ? protocol::ToJson(*id).dump() : protocol::ToJson(level).dump());
+    const std::string name = id             ? protocol::ToJson(*id).dump()
+                             : level.object ? protocol::LevelName(level)
+                                            : protocol::ToJson(level).dump();
+    levels += (levels.empty() ? "" : " ") + level.factor + " " + name;
   }
   return levels;
 }

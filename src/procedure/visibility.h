@@ -23,7 +23,8 @@ struct PairVisibility {
   bool against_scene = false;
 };
 
-// A trial's levels as a label: "edge 2", "edge 2 speed 3" ("" without levels).
+// A trial's levels as a label: "edge 2", "edge 2 speed 3", an object level by its id or its members
+// ("comparison left=measured;right=estimated edge 3"); "" without levels.
 std::string LevelsLabel(const protocol::Trial& trial);
 
 // Every distinct pair of the prepared session's trial list (the same levels and sources, either side order, counted

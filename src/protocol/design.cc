@@ -8,10 +8,6 @@
 #include <set>
 
 namespace blurcue::protocol {
-namespace {
-
-// A level as trials.csv shows it: a string bare, a number as JSON (LevelValue::text, both), an object by its id (else
-// its members as key=value;...), as the export's TidyCell does.
 std::string LevelName(const Level& level) {
   if (!level.object) return level.value.text;
   if (const LevelValue* id = level.Field("id")) return id->text;
@@ -19,6 +15,8 @@ std::string LevelName(const Level& level) {
   for (const auto& [key, member] : level.fields) text += (text.empty() ? "" : ";") + key + "=" + member.text;
   return text;
 }
+
+namespace {
 
 // The values one column takes, collected over blocks: numbers apart, so they are given in numeric order.
 struct Values {

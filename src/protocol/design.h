@@ -37,6 +37,10 @@ struct DesignColumn {
 // the group, each participant_info key (info_KEY: its choices or range), and practice (0|1).
 std::vector<DesignColumn> DescribeDesign(const Protocol& protocol);
 
+// A level as trials.csv shows it: a string bare, a number as JSON (LevelValue::text, both), an object by its id (else
+// its members as key=value;... : "left=measured;right=estimated"), as the export's TidyCell does.
+std::string LevelName(const Level& level);
+
 // A procedure trial's cell by its levels: its block's factors as NAME=LEVEL joined by ';' in name order ("edge=9",
 // "edge=9;speed_cm_s=3"; numbers as LevelText, an object level by its id); "" for a trial outside a procedure.
 std::string CellLevels(const Protocol& protocol, const Trial& trial);

@@ -48,8 +48,18 @@ void Parser::CheckLevelValue(const std::string& name, const Json& v, const std::
   auto number_in = [&](double lo, double hi, const std::string& unit, const std::string& what) {
     if (!NumberIn(v, lo, hi)) report(what + " must be a number in " + Range(lo, hi, unit));
   };
-  if (name == "edge" || name == "from_edge" || name == "to_edge") integer_in(1, kEdges, "an edge");
-  else if (name == "section") integer_in(1, kEdges - 1, "a section (edge s to s + 1)");
+  // An edge or a section of the calibrated board where it is known (so one past it is named with every other
+  // problem; the trial list refuses it too), else of the largest board a calibration can have.
+  auto board_level = [&](int most, int most_on_board, const std::string& what) {
+    if (options_.board_rows <= 0) return integer_in(1, most, what);
+    if (!IntegerIn(v, 1, most_on_board))
+      report(what + " must be an integer in " + Range(1, most_on_board, "") + ", the calibrated board's (" +
+             BoardLevelsText(options_.board_cols, options_.board_rows) + ")");
+  };
+  if (name == "edge" || name == "from_edge" || name == "to_edge")
+    board_level(kEdges, options_.board_rows + 1, "an edge");
+  else if (name == "section")
+    board_level(kEdges - 1, options_.board_rows, "a section (edge s to s + 1)");
   // A place on the board in mm (x across it from its left edge, y along it from edge 1): up to 10 m away.
   else if (name == "y_mm" || name == "from_y_mm" || name == "to_y_mm" || name == "left_x_mm" || name == "right_x_mm")
     number_in(-10000, 10000, "mm", "a place on the board");

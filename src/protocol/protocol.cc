@@ -659,6 +659,11 @@ std::set<double> NumericLevels(const Protocol& protocol, const std::string& fact
   return values;
 }
 
+std::string BoardLevelsText(int cols, int rows) {
+  return std::to_string(cols) + " x " + std::to_string(rows) + " squares: edges 1-" + std::to_string(rows + 1) +
+         ", sections 1-" + std::to_string(rows);
+}
+
 std::string LevelText(double level) {
   char text[32];
   std::snprintf(text, sizeof text, "%g", level);

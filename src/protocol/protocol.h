@@ -171,6 +171,10 @@ struct Content {
 // A numeric level as text, as the record writes it (%g): an adjusted level's answer, a real photo's {distance_m}.
 std::string LevelText(double level);
 
+// The edges and sections a board of cols x rows squares has, as a refusal names them: "7 x 10 squares: edges 1-11,
+// sections 1-10" (a section s runs from edge s to s + 1).
+std::string BoardLevelsText(int cols, int rows);
+
 // The real photo of `content` for a distance (content.real_photos with {distance_m} replaced).
 std::filesystem::path RealPhotoFor(const Content& content, double distance_m);
 
@@ -306,6 +310,9 @@ std::set<double> NumericLevels(const Protocol& protocol, const std::string& fact
 
 struct ValidateOptions {
   bool check_files = true;            // false: skip the existence checks of referenced files
+  // > 0: the calibrated board's squares (scene.calib's board, read before the protocol: PrepareStudy), so that a
+  // level naming an edge or a section past it is a problem named with every other one, not refused alone later.
+  int board_cols = 0, board_rows = 0;
   // Set: the conditions tables are read from here (path as the protocol writes it -> the table's text: a recorded
   // version's "recorded_conditions", RecordedText), not from files; a path it lacks is a problem.
   const std::map<std::string, std::string>* conditions_tables = nullptr;

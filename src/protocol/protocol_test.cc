@@ -67,6 +67,30 @@ TEST(ProtocolValidate, EdgeOutsideAnyBoardRejected) {
       << OnlyProblem(j);
 }
 
+// With the calibrated board known (7 x 10 squares: edges 1-11, sections 1-10), every level past it is a problem of
+// the one pass, beside one past any board: edges 0 and 12 and section 11 at once (edge 12 used to be refused alone,
+// by the trial list, once edge 0 was fixed).
+TEST(ProtocolValidate, EveryLevelPastTheCalibratedBoardIsNamedAtOnce) {
+  Json j = Valid();
+  j["blocks"][1]["factors"] = {{"edge", {0, 5, 8, 11, 12}}};
+  j["blocks"][1]["sides"] = {{"left", "measured"}, {"right", "estimated"}};
+  j["blocks"][0]["factors"]["section"] = {1, 10, 11};
+  ValidateOptions board;
+  board.board_cols = 7, board.board_rows = 10;
+  const auto problems = Validate(j, SceneFolder() / "p.json", board);
+  const std::string of_board = ", the calibrated board's (7 x 10 squares: edges 1-11, sections 1-10), got ";
+  ASSERT_EQ(problems.size(), 3u) << ::testing::PrintToString(problems);
+  EXPECT_TRUE(Contains(problems[0], ": /blocks/0/factors/section/2: a section (edge s to s + 1) must be an integer in "
+                                    "[1, 10]" + of_board + "11")) << problems[0];
+  EXPECT_TRUE(Contains(problems[1], ": /blocks/1/factors/edge/0: an edge must be an integer in [1, 11]" + of_board + "0"))
+      << problems[1];
+  EXPECT_TRUE(Contains(problems[2], ": /blocks/1/factors/edge/4: an edge must be an integer in [1, 11]" + of_board + "12"))
+      << problems[2];
+  // Without the board, only the level past any board is.
+  j["blocks"][0]["factors"].erase("section");
+  EXPECT_TRUE(Contains(OnlyProblem(j), ": /blocks/1/factors/edge/0: an edge must be an integer in [1, 101], got 0"));
+}
+
 TEST(ProtocolValidate, UnknownBlurSourceRejected) {
   Json j = Valid();
   j["blocks"][0]["factors"]["pattern"][0]["right"] = "blurry";

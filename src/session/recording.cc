@@ -156,6 +156,7 @@ void Recording::Heartbeat(int64_t session) { record_->Heartbeat(session); }
 void Recording::CompleteSession(int64_t session) { record_->FinishSession(session, store::SessionStatus::kCompleted); }
 
 int64_t Recording::FirstUnansweredTrial(int64_t session) { return record_->FirstUnansweredTrial(session); }
+int64_t Recording::DroppedFrames(int64_t session) { return record_->DroppedFrames(session); }
 
 std::map<int64_t, RecordedAnswer> Recording::AnsweredTrials(int64_t session) {
   return record_->AnsweredTrials(session);

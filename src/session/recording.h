@@ -114,6 +114,7 @@ class Recording {
   // Marks the session completed and releases its lock.
   void CompleteSession(int64_t session);
   int64_t FirstUnansweredTrial(int64_t session);
+  int64_t DroppedFrames(int64_t session);
   std::map<int64_t, RecordedAnswer> AnsweredTrials(int64_t session);
 
  private:

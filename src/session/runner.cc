@@ -261,7 +261,9 @@ RunResult RunSession(const RunOptions& options) {
                                           "--resume to start one");
   // Groups and participant information: what the record already says (a resumed session keeps its group and its
   // information), then the group a new session gets and the information it is given.
-  const protocol::Protocol head = protocol::LoadProtocol(options.protocol_file);
+  const Json head_json = ReadJsonFile(options.protocol_file);
+  const protocol::Protocol head = protocol::ParseProtocol(
+      head_json, options.protocol_file, procedure::WithCalibratedBoard(head_json, options.protocol_file));
   GroupsSoFar so_far;
   if (head.groups || !head.participant_info.empty())
     so_far = PeekGroups(options.db, head.name, options.participant);

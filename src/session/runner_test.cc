@@ -16,6 +16,7 @@
 #include "session/keys.h"
 #include "procedure/trial_logic.h"
 #include "stimulus/test_scenes.h"
+#include "store/sqlite.h"
 
 namespace blurcue::session {
 namespace {
@@ -304,6 +305,62 @@ TEST(Runner, ShowsTheInstructionsThenEachPartsScreenAsItsBlockBegins) {
   EXPECT_EQ(presenter.screens, (std::vector<std::string>{"Instructions: Which one is more blurred?",
                                                          "Part 1 of 2: The near cards.", "Part 2 of 2: The far cards.",
                                                          "Thank you"}));
+}
+
+// On the real clock as a window is (so a late flip is a dropped frame): every trial's third flip comes late, four
+// frame periods after the one before (more than the runner's 1.5), and the window is closed at the third trial's
+// fourth flip - after its late one, before it is answered.
+class LateFlipPresenter : public FakePresenter {
+ public:
+  using FakePresenter::FakePresenter;
+  bool RealTime() const override { return true; }
+  double FrameS() const override { return 0.02; }
+  bool Closed() const override { return closed_; }
+  void ShowStimulus(const StimulusFrame& frame) override {
+    FakePresenter::ShowStimulus(frame);
+    index_ = frame.index;
+  }
+  int late_flips = 0;
+
+ protected:
+  double DoFlip(double wake_s) override {
+    if (index_ == 2) {
+      Wait(3 * FrameS());
+      ++late_flips;
+    }
+    if (trials_shown.size() == 3 && index_ == 3) closed_ = true;
+    index_ = -1;  // a text screen's flips are no trial's
+    return FakePresenter::DoFlip(wake_s);
+  }
+
+ private:
+  int index_ = -1;
+  bool closed_ = false;
+};
+
+// What run says of dropped frames is what the record holds: the quit trial's late flip was seen but, unanswered, its
+// frames are not recorded, so it is in no count (it was in run's, which said 3 where frames.csv has 2).
+TEST(Runner, DroppedFramesAreTheRecordsCountNotTheQuitTrials) {
+  const std::filesystem::path db = std::filesystem::temp_directory_path() /
+                                   ("blurcue-runner-test-dropped-" + std::to_string(::getpid()) + ".sqlite");
+  std::filesystem::remove(db);
+  const procedure::PreparedSession prepared = Prepare(GridProtocol({{"factors", {{"edge", {2, 4, 6, 8}}}}}));
+  RunResult result;
+  LateFlipPresenter presenter(prepared);
+  {
+    Recording recording = Recording::Open(db);
+    AnsweringResponder responder;
+    result = RunSessionOf(recording, prepared, presenter, responder);
+  }
+  EXPECT_FALSE(result.completed);
+  EXPECT_EQ(result.answered_now, 2);
+  EXPECT_EQ(presenter.late_flips, 3);  // two answered trials' and the quit one's
+  EXPECT_EQ(result.dropped_frames, 2);
+  // The record, read apart from the runner: one dropped flip in each answered trial, at its third frame.
+  store::Database record(db, store::OpenMode::kReadOnly);
+  EXPECT_EQ(record.QueryInt64("SELECT count(*) FROM frames WHERE dropped = 1 AND frame_index = 2"), 2);
+  EXPECT_EQ(record.QueryInt64("SELECT count(*) FROM frames WHERE dropped = 1"), 2);
+  std::filesystem::remove(db);
 }
 
 }  // namespace

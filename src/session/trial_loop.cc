@@ -167,7 +167,6 @@ class Runner {
         }
       }
       frames->push_back(shown_frame);
-      dropped_frames_ += dropped;
       last_flip = flip;
       if (presenter_.Closed()) return Outcome::kQuit;
       // A deadline: no answer this long after onset is recorded as none, without a response time.
@@ -343,7 +342,6 @@ class Runner {
       record.CompleteSession(start.session_id);
       presenter_.ShowLast("Thank you", "The session is complete.");
     }
-    result.dropped_frames = dropped_frames_;
     return result;
   }
 
@@ -357,7 +355,6 @@ class Runner {
   const std::vector<protocol::Trial>& trials_;
   const std::vector<TrialScene>& scenes_;
   KeyMap keys_;
-  int64_t dropped_frames_ = 0;
 };
 
 }  // namespace
@@ -365,7 +362,10 @@ class Runner {
 RunResult RunTrials(const LoopOptions& options, const procedure::PreparedSession& prepared, Presenter& presenter,
                     Responder& responder, Recording& recording, const SessionStart& start) {
   Runner runner(options, prepared, presenter, responder);
-  return runner.Run(recording, start);
+  RunResult result = runner.Run(recording, start);
+  // However the run ended (a quit on a text screen too), the frames counted are the record's.
+  result.dropped_frames = recording.DroppedFrames(start.session_id);
+  return result;
 }
 
 }  // namespace blurcue::session

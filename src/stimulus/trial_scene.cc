@@ -227,9 +227,7 @@ struct PairDescription {
     if (!(v->number >= 1 && v->number <= most))
       throw InputError(At(protocol, protocol::LevelPointer(protocol, trial, name)),
                        std::string(name) + " " + v->text + " is not on the calibrated board (" +
-                           std::to_string(scene.board.cols) + " x " + std::to_string(scene.board.rows) +
-                           " squares: edges 1-" + std::to_string(Edges()) + ", sections 1-" +
-                           std::to_string(Edges() - 1) + ")" + trial_text);
+                           protocol::BoardLevelsText(scene.board.cols, scene.board.rows) + ")" + trial_text);
     return int(v->number);
   }
   // A number level `name` (mm, deg), none when the trial has no such number.

@@ -81,7 +81,13 @@ void MergeDatabases(const std::vector<std::filesystem::path>& inputs, const std:
 // One session as the experimenter sees it: who, what, how far.
 struct SessionSummary {
   int64_t id = 0;
-  std::string study, participant, status, started, ended, host;
+  std::string study, participant, status, started, ended, host;  // status: the record's (running|completed|aborted)
+  // What became of the session, as `sessions` lists it: completed or aborted as recorded; a running one (the record
+  // keeps every unfinished session running, resumable) is "running" only while a live writer holds its lock (another
+  // process runs it now), "unfinished" when its run left it (quit, window closed, --stop-after: the lock released),
+  // "interrupted" when its writer died holding the lock (killed, crashed: a stale lock, taken over by the next run).
+  // Unfinished and interrupted sessions continue with blurcue run --resume.
+  std::string state;
   std::string group;     // the between-subject group, "" without groups
   std::string observer;  // "person" or "simulated" ("" in a record too old to say)
   int64_t number = 0;    // the participant's n-th session of the study (0 in a record too old to say)

@@ -40,7 +40,14 @@ std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path) {
     s.answered = rows.GetInt64(9);
     s.skipped = rows.GetInt64(10);
     s.timed_out = rows.GetInt64(11);
-    if (rows.GetInt64(12) != 0) s.writer = JudgeLock(rows.GetText(14), rows.GetInt64(13), rows.GetInt64(15)).text;
+    s.state = s.status;
+    if (rows.GetInt64(12) != 0) {
+      const LockState lock = JudgeLock(rows.GetText(14), rows.GetInt64(13), rows.GetInt64(15));
+      s.writer = lock.text;
+      if (s.status == "running" && lock.stale) s.state = "interrupted";
+    } else if (s.status == "running") {
+      s.state = "unfinished";
+    }
     s.group = rows.GetText(16);
     s.observer = rows.GetText(17);
     s.number = rows.GetInt64(18);

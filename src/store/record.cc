@@ -702,6 +702,14 @@ int64_t Record::FirstUnansweredTrial(int64_t session) {
   return db_.QueryInt64("SELECT COUNT(*) FROM trials WHERE session_id = " + std::to_string(session));
 }
 
+int64_t Record::DroppedFrames(int64_t session) {
+  Statement query(db_, "SELECT COUNT(*) FROM frames f JOIN trials t ON t.id = f.trial_id "
+                       "WHERE t.session_id = ? AND f.dropped = 1");
+  query.Bind(1, session);
+  query.Step();
+  return query.GetInt64(0);
+}
+
 GroupsSoFar PeekGroups(const std::filesystem::path& db_path, const std::string& study, const std::string& participant) {
   GroupsSoFar so_far;
   std::error_code ec;

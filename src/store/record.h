@@ -223,6 +223,9 @@ class Record {
 
   // The smallest trial index without a response (= trial count when all are answered).
   int64_t FirstUnansweredTrial(int64_t session);
+  // The session's recorded flips marked dropped (frames.dropped): the count frames.csv and the report give. A trial
+  // left unanswered (quit) recorded no frames, so its drops are in no count.
+  int64_t DroppedFrames(int64_t session);
   // The answered trials' shown objects (Response::shown_json) and choices, by trial index: what a resumed adaptive
   // procedure replays.
   struct Answered {

@@ -2,6 +2,8 @@
 // (schema 8): the record's side, on :memory: and on real files.
 #include <chrono>
 #include <functional>
+#include <map>
+#include <utility>
 #include <thread>
 #include <string>
 #include <vector>
@@ -209,6 +211,37 @@ TEST(Record, ProcedureTrialKeepsItsCellByLevels) {
 
 // A record of version 7 knew no session numbers nor declared versions: the migration numbers each participant's
 // sessions by start and reads the version off each protocol text.
+// `sessions` says what became of each session the record keeps running (unfinished): run now by a live writer, left
+// by its run (quit, --stop-after: the lock released), or interrupted (a writer that died holding the lock); the
+// record's own status stays running for all three, as export and report read it.
+TEST(Sessions, ARunningSessionIsListedByWhatBecameOfIt) {
+  testing::TempDir dir;
+  const auto path = dir / "r.sqlite";
+  Record live = Record::Open(path);
+  live.StartOrResumeSession("s", "LIVE", kV1, 1, {}, false);
+  {
+    Record left = Record::Open(path);
+    left.StartOrResumeSession("s", "LEFT", kV1, 2, {}, false);
+  }  // its run ended without completing it: quit, or --stop-after
+  int64_t died = 0;
+  {
+    Record dead = Record::Open(path);
+    died = dead.StartOrResumeSession("s", "DIED", kV1, 3, {}, false).session_id;
+  }
+  // The lock a killed writer of this host leaves: pid 1 is alive (a reused pid), silent for two minutes.
+  const int64_t old_ms = std::chrono::duration_cast<std::chrono::milliseconds>(
+                             std::chrono::system_clock::now().time_since_epoch()).count() - 120000;
+  live.database().Exec("UPDATE sessions SET lock_host = '" + HostName() + "', lock_pid = 1, lock_token = 'x', "
+                       "lock_heartbeat_ms = " + std::to_string(old_ms) + " WHERE id = " + std::to_string(died));
+  Complete(live, "DONE", kV1, 4);
+  std::map<std::string, std::pair<std::string, std::string>> listed;  // participant -> (state, status)
+  for (const SessionSummary& s : ListSessions(path)) listed[s.participant] = {s.state, s.status};
+  EXPECT_EQ(listed["LIVE"], std::make_pair(std::string("running"), std::string("running")));
+  EXPECT_EQ(listed["LEFT"], std::make_pair(std::string("unfinished"), std::string("running")));
+  EXPECT_EQ(listed["DIED"], std::make_pair(std::string("interrupted"), std::string("running")));
+  EXPECT_EQ(listed["DONE"], std::make_pair(std::string("completed"), std::string("completed")));
+}
+
 TEST(Schema, VersionSevenRecordGetsSessionNumbersByStartAndVersionsFromItsTexts) {
   testing::TempDir dir;
   {
