@@ -103,6 +103,9 @@ struct PhaseChoice {
   std::vector<double> chi2;
   std::vector<bool> alike;
   double chi2_per_point = 0;     // the chosen family's: about 1 where it describes the profiles to the noise
+  // The chosen family's taps' second moment across a level edge (px^2; negative for a mask, 0 for the optics alone):
+  // a section reads sqrt(r_optics^2 + 4 variance_px2) (FitModelWithinPhaseRanges fits a mask's photo in r_optics).
+  double variance_px2 = 0;
   std::string summary = "not checked (--no-phase-check, or a take's frames: no lens fit per frame)";  // in words
 };
 
@@ -116,6 +119,9 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result);
 // other phase_limited section leaves open: where it predicts such a section outside [range_lo_px, range_hi_px], the range's middle joins the
 // samples and the model is fitted again (a few rounds). A section whose range holds the prediction stays out. Without
 // them the sections near focus, where the blur is sub-pixel, could all be gone and nothing would pin the floor.
+// Where the chosen family sharpens (PhaseChoice::variance_px2 < 0) the model is fitted to the optics' readings,
+// sqrt(r^2 - 4 variance_px2), and returned with the filter added back to its floor: near focus the mask magnifies an
+// error in the optics' reading by r_optics / r, and in the optics' terms the floor is the lens's.
 optics::FittedModel FitModelWithinPhaseRanges(const CalibResult& result, const optics::Lens& lens,
                                               const optics::FitOptions& options, int* held = nullptr);
 
