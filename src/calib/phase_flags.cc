@@ -9,6 +9,8 @@
 
 #include "calib/phase_check.h"
 
+#include <opencv2/core.hpp>
+
 namespace blurcue::calib {
 namespace {
 
@@ -111,7 +113,8 @@ int FlagOffTheirEdge(CalibResult& result) {
 // the sections there counted as surely as the optics' own, the model read the floor from them and missed p90 5 % on
 // 4 of 6 seeds (4.0-13.8 %); in the optics' terms the floor is the lens's (1.0 px) and the sections weigh as they read.
 optics::FittedModel FitModelWithinPhaseRanges(const CalibResult& result, const optics::Lens& lens,
-                                              const optics::FitOptions& options, int* held) {
+                                              const optics::FitOptions& options, int* held,
+                                              optics::FittedModel* optics_model) {
   const double v = std::min(0.0, result.phase.variance_px2);
   std::vector<optics::BlurSample> usable = ModelSamples(result);
   std::vector<const SectionResult*> limited;
@@ -145,7 +148,99 @@ optics::FittedModel FitModelWithinPhaseRanges(const CalibResult& result, const o
     model = optics::FitThinLens(lens, samples, options);
   }
   if (held) *held = static_cast<int>(std::count_if(bound.begin(), bound.end(), [](double b) { return b >= 0; }));
+  if (optics_model) *optics_model = model;
   return v < 0 ? WithFilter(model, v) : model;
+}
+
+namespace {
+
+// Beyond this relative standard error the model's blur at a depth is "not determined within 5 %".
+constexpr double kModelSeRel = 0.05;
+
+// d PredictPx(u) / d (focus, aperture[, floor]) by central differences; the floor where the model has one.
+std::vector<double> ModelGradient(const optics::FittedModel& m, const optics::Lens& lens, double u_mm) {
+  std::vector<double> g;
+  auto diff = [&](double optics::FittedModel::*p, double h) {
+    optics::FittedModel a = m, b = m;
+    a.*p += h, b.*p -= h;
+    g.push_back((a.PredictPx(lens, u_mm) - b.PredictPx(lens, u_mm)) / (2 * h));
+  };
+  diff(&optics::FittedModel::focus_mm, 1e-5 * m.focus_mm);
+  diff(&optics::FittedModel::aperture_mm, 1e-5 * m.aperture_mm);
+  if (m.kind == "thin_lens+floor" && m.floor_px > 0) diff(&optics::FittedModel::floor_px, 1e-5 * m.floor_px);
+  return g;
+}
+
+}  // namespace
+
+// The covariance of the optics model's parameters from its readings' scatter about it, each edge's sections one sample
+// (a cluster-robust sandwich: the sections of an edge share its depth and sub-pixel phase, and a noise-free scene's
+// readings err alike along an edge, by up to 0.5 % of the optics' blur), then through r = sqrt(r_optics^2 + 4 v).
+void PropagateModelError(CalibResult& result, const optics::Lens& lens, const optics::FittedModel& m) {
+  const double v = std::min(0.0, result.phase.variance_px2);
+  if (!(v < 0) || !std::isfinite(m.focus_mm) || !(m.aperture_mm > 0)) return;
+  const int k = static_cast<int>(ModelGradient(m, lens, result.edges.at(0).sections.at(0).u_mm).size());
+  cv::Mat_<double> a = cv::Mat_<double>::zeros(k, k), b = cv::Mat_<double>::zeros(k, k);
+  int clusters = 0;
+  double u_lo = 1e300, u_hi = -1e300;
+  for (const auto& edge : result.edges) {
+    cv::Mat_<double> g = cv::Mat_<double>::zeros(k, 1);
+    bool any = false;
+    for (const auto& s : edge.sections) {
+      u_lo = std::min(u_lo, s.u_mm), u_hi = std::max(u_hi, s.u_mm);
+      if (!(s.fit.ok || s.phase.joins_fit)) continue;  // as ModelSamples takes them
+      const std::vector<double> j = ModelGradient(m, lens, s.u_mm);
+      const double e = OpticsPx(s.fit.r_px, s.stretch, v) - m.PredictPx(lens, s.u_mm);
+      for (int r = 0; r < k; ++r) {
+        g(r) += j[r] * e;
+        for (int c = 0; c < k; ++c) a(r, c) += j[r] * j[c];
+      }
+      any = true;
+    }
+    if (any) b += g * g.t(), ++clusters;
+  }
+  cv::Mat_<double> a_inv;
+  if (clusters <= k || cv::invert(a, a_inv, cv::DECOMP_SVD) == 0) return;
+  const cv::Mat_<double> cov = a_inv * b * a_inv * (double(clusters) / (clusters - 1));
+  // The photo's blur at u and its standard error (photo px).
+  auto spread = [&](double u_mm, double stretch, double* r_px) {
+    const double optics = m.PredictPx(lens, u_mm) * stretch;
+    *r_px = std::sqrt(std::max(0.0, optics * optics + 4 * v));
+    const std::vector<double> j = ModelGradient(m, lens, u_mm);
+    double var = 0;
+    for (int r = 0; r < k; ++r)
+      for (int c = 0; c < k; ++c) var += j[r] * cov(r, c) * j[c];
+    // d r / d optics = optics / r; where the filter cancels the whole blur, the error no longer is linear: r's own
+    // scale (the tests' 0.05 px) bounds it.
+    return optics * stretch / std::max(*r_px, 0.05) * std::sqrt(std::max(0.0, var));
+  };
+  for (auto& edge : result.edges)
+    for (auto& s : edge.sections) {
+      double r;
+      s.r_fitted_se_px = spread(s.u_mm, s.stretch, &r);
+    }
+  PhaseChoice& p = result.phase;
+  p.undetermined_lo_mm = p.undetermined_hi_mm = p.worst_se_rel = 0;
+  p.undetermined.clear();
+  bool found = false;
+  for (int i = 0; i <= 200; ++i) {  // the board's depths, every 0.5 % of their span
+    const double u = u_lo + (u_hi - u_lo) * i / 200.0;
+    double r;
+    const double rel = spread(u, 1.0, &r) / std::max(r, 0.05);
+    p.worst_se_rel = std::max(p.worst_se_rel, rel);
+    if (rel > kModelSeRel) {
+      if (!found) p.undetermined_lo_mm = u;
+      p.undetermined_hi_mm = u, found = true;
+    }
+  }
+  if (!found) return;
+  char text[480];
+  std::snprintf(text, sizeof text,
+                "the model's blur is not determined within %.0f %% at depths %.0f-%.0f mm: its standard error reaches "
+                "%.0f %% there (the sharpening after sampling cancels most of the optics' blur, magnifying the optics' "
+                "own uncertainty); there r_fitted_px is the model's estimate, not a result within 5 %%",
+                100 * kModelSeRel, p.undetermined_lo_mm, p.undetermined_hi_mm, 100 * p.worst_se_rel);
+  p.undetermined = text;
 }
 
 }  // namespace blurcue::calib

@@ -107,6 +107,7 @@ void PrintPhaseCheck(const calib::CalibResult& result) {
     if (n > 0) std::printf("  edge %d: %d of %zu sections phase_limited: %s\n", e.index, n, e.sections.size(),
                            why->c_str());
   }
+  if (!result.phase.undetermined.empty()) std::printf("phase check: %s\n", result.phase.undetermined.c_str());
   if (result.phase.held > 0)
     std::printf("phase check: the model predicted %d phase_limited sections outside the range their families "
                 "leave open; their ranges' middles joined its fit\n", result.phase.held);
