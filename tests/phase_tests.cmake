@@ -77,13 +77,23 @@ phase_check(phase_filtered_sharpen_05 sharpen05 "\nok: filtered targets met" --e
 # (35 of 77, edges 4-8) and every other one holds the rule. They join the lens fit at their readings (each unsure
 # alone, the fit pools them): left out, nothing near focus pinned the floor and the model read 0.19 px for 0.16 px
 # (median 2.4 %, p90 19.1 % here; 1.2-2.3 / 22-29 % on five other seeds). Now median 0.6-1.1 %, p90 1.8-8.1 % over
-# the six seeds (this one 0.9 / 3.9 %): the 5 % p90 holds on 4 of 6, so the model is held to 10 % here - the break,
-# docs/independent-truth.md. With the mask refined between the families (phase_fit.h), the refined one fits alike and
-# 8 of the 35 are flagged for the spread rather than the cancellation (27 join the fit): the model median 1.2 %, p90 1.4 %.
+# the six seeds (this one 0.9 / 3.9 %). Fitted to r itself, those sections counted as surely as the optics' own
+# reading, where the mask magnifies its error 5-8 times; now the model is fitted to the optics' readings (sqrt(r^2 - 4V))
+# and the filter added back: p90 1.0-5.7 % on seeds 1-4 and 6 (this one 1.5 / 2.0 %; on main 1.8-13.4 %), 8.3 % on
+# seed 5 (a neighbouring mask chosen). The model's own standard error there (edges as clusters) reaches 14-28 % near
+# focus: calibrate names those depths (407-453 mm) "not determined within 5 %", and every section the model misses by
+# more than 5 % lies within them (--undetermined-covers). Seed 2 (p90 5.7 %: edges 5-6, inside the named depths) holds
+# that at 10 %.
 phase_scene(sharpen07 --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.6 --post-amount 0.7
             --noise 0.0025 --seed 6)
 phase_check(phase_filtered_sharpen_07 sharpen07
-            "[23][0-9] of them phase_limited but joined at their readings.*\nok: filtered targets met" --expect filtered --fitted-p90 0.10)
+            "[23][0-9] of them phase_limited but joined at their readings.*\ncalibrate: the model's blur is not determined within 5 % at depths 4[01][0-9]-4[45][0-9] mm.*\nok: filtered targets met"
+            --expect filtered --undetermined-covers)
+phase_scene(sharpen07_seed2 --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.6
+            --post-amount 0.7 --noise 0.0025 --seed 2)
+phase_check(phase_filtered_sharpen_07_seed2 sharpen07_seed2
+            "calibrate: the model's blur is not determined within 5 % at depths 4[01][0-9]-4[45][0-9] mm.*\nok: filtered targets met"
+            --expect filtered --undetermined-covers --fitted-p90 0.10)
 
 # The Gaussian post filter's ends (0.35 and 0.8 px, the bench's levels). At 0.35 px the optics alone fitted best and
 # 7 sections (edge 4) read 10-12 % high unflagged; now the 0.35 px family is chosen.
@@ -103,7 +113,7 @@ phase_check(phase_filtered_sharpen_off_grid sharpen_off_grid "\nok: filtered tar
 phase_scene(sharpen_09 --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.9
             --post-amount 0.25 --noise 0.0025 --seed 5)
 phase_check(phase_filtered_sharpen_09 sharpen_09 "fitted between the families.*\nok: filtered targets met"
-            --expect filtered --fitted-p90 0.10)
+            --expect filtered --undetermined-covers)
 # Amount 0.5 over 0.8 px (-0.32 px^2): the mask cancels the whole second moment near focus (truth 0 on edges 4-8),
 # where 55-57 sections are flagged; 1-3 others read 0.07-0.1 px off unflagged before. The lens model breaks here
 # (no thin lens bends to that), so the sections alone are held.
@@ -124,17 +134,13 @@ phase_check(phase_filtered_gauss_035_bench gauss035_bench "off the line through 
 # unflagged (edge 4: 0.73-0.75 px for 0.32-0.36 px) and the model median 16 %, p90 60 %; under a Gaussian of 0.45 px,
 # edge 4 10-12 % low. Turned 20 deg (every section at every phase): mask model median 46 %, p90 282 %; Gaussian
 # sections 10-13 % low, model median 7 %, p90 12 %. Now every section under 2 px is read with the family chosen.
-# Turned 20 deg the mask's model misses p90 5 % near focus (6.9 %: truths of 0.12-0.2 px, where the mask cancels most
-# of the optics' blur), the break the level amount-0.7 scene holds to 10 % (Step 3 of the issue's note, open).
+# Turned 20 deg the mask's model missed p90 5 % near focus (4.9-6.9 %: truths of 0.12-0.2 px, where the mask cancels
+# most of the optics' blur); fitted to the optics' readings (sqrt(r^2 - 4V)) it is 2.3 %.
 foreach(turn 3 20)
-  set(p90 0.05)
-  if(turn EQUAL 20)
-    set(p90 0.10)
-  endif()
   phase_scene(turn${turn}_sharpen --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.6
               --post-amount 0.7 --noise 0.0025 --seed 6 --yaw-deg ${turn})
   phase_check(phase_turned_${turn}_sharpen_07 turn${turn}_sharpen
-              "and [1-9][0-9]* at every phase.*\nok: filtered targets met" --expect filtered --fitted-p90 ${p90})
+              "and [1-9][0-9]* at every phase.*\nok: filtered targets met" --expect filtered --undetermined-covers)
   phase_scene(turn${turn}_gauss --focus-mm 430 --floor-sigma-px 0.2 --post-filter gaussian --post-sigma-px 0.45
               --noise 0.0025 --seed 3 --yaw-deg ${turn})
   phase_check(phase_turned_${turn}_gauss turn${turn}_gauss
