@@ -89,6 +89,15 @@ phase_scene(sharpen07 --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen 
 phase_check(phase_filtered_sharpen_07 sharpen07
             "[23][0-9] of them phase_limited but joined at their readings.*\ncalibrate: the model's blur is not determined within 5 % at depths 4[01][0-9]-4[45][0-9] mm.*\nok: filtered targets met"
             --expect filtered --undetermined-covers)
+# A mask photo's calib.json (with model.fitted_to and each section's r_fitted_se_px) is read by render: the reader
+# refused fields it did not know.
+set_tests_properties(phase_filtered_sharpen_07 PROPERTIES FIXTURES_SETUP phase_sharpen07_calib)
+add_test(NAME phase_filtered_sharpen_07_render
+         COMMAND ${BLURCUE_EXPECT} "ball at edge 5: depth [0-9.]+ mm, blur fitted" $<TARGET_FILE:blurcue> render
+                 --calib ${PHASE_DIR}/sharpen07-calib-filtered.json --background ${PHASE_DIR}/sharpen07/scene.png
+                 --object ball --at-edge 5 --blur fitted --out ${PHASE_DIR}/sharpen07-ball.png)
+set_tests_properties(phase_filtered_sharpen_07_render PROPERTIES FIXTURES_REQUIRED "phase_sharpen07;phase_sharpen07_calib"
+                     LABELS "slow;phase;gl")
 phase_scene(sharpen07_seed2 --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.6
             --post-amount 0.7 --noise 0.0025 --seed 2)
 phase_check(phase_filtered_sharpen_07_seed2 sharpen07_seed2

@@ -506,7 +506,12 @@ Json CalibToJson(const CalibResult& r) {
                  {"floor_determined", m.floor_determined}, {"rms_px", m.rms_px},
                  {"loo_rms_px", m.loo_rms_px}, {"samples_used", m.samples_used}, {"outliers", m.outliers},
                  {"sections_left_out", SectionsLeftOut(r)},
-                 {"choice", choice}}},
+                 {"choice", choice},
+                 {"fitted_to", r.phase.variance_px2 < 0
+                                   ? "the optics' readings sqrt(r_px^2 - 4 phase_check.variance_px2) (a sharpening after "
+                                     "sampling was chosen); floor_px and its range have the sharpening added back, "
+                                     "the rms figures are the optics' px"
+                                   : "r_px"}}},
       {"r_units", !distorted ? Json("px of the photo (no dist_coeffs: the photo is the pinhole image)") : Json({
            {"sections", "r_px, r_thesis_px, r_estimated_px, r_fitted_px: photo px (distorted), across the edge"},
            {"model", "floor_px and the thin lens's radius: ideal (undistorted, pinhole) px; a point's photo-px radius "

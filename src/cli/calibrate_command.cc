@@ -62,9 +62,11 @@ void PrintCalibrationSummary(const calib::CalibResult& result, const Board& boar
                                     " x: more than two thirds of a stop off"
                               : "";
   std::printf("fitted %s model: focus %.1f mm, aperture %.3f mm (nominal %.3f%s), %s, rms %.3f px,"
-              " leave-one-out %.3f px, %d outliers of %d\n",
+              " leave-one-out %.3f px, %d outliers of %d%s\n",
               m.kind.c_str(), m.focus_mm, m.aperture_mm, camera.ApertureMm(), far.c_str(),
-              optics::FloorText(m).c_str(), m.rms_px, m.loo_rms_px, m.outliers, m.samples_used);
+              optics::FloorText(m).c_str(), m.rms_px, m.loo_rms_px, m.outliers, m.samples_used,
+              result.phase.variance_px2 < 0 ? " (fitted to the optics' readings under the sharpening: rms in their px)"
+                                            : "");
   // How many sections the model was fitted to, and why the others were left out.
   {
     int sections = 0;
