@@ -28,13 +28,14 @@ import numpy as np
 import pandas as pd
 
 import criteria
+import crossed
 import groups
 import stats
 import study_tests
 import tracks
 from common import (UNKNOWN_UNIT, Chart, Skip, axis_label, distinct_stems, error_bars, factor_label, file_stem, level_text,
                     level_unit, participants_note, save, stars, text)
-from design import design_of, load_codebook  # noqa: F401  (load_codebook: report.py reads the codebook through here)
+from design import comparing_factors, design_of, load_codebook  # noqa: F401  (load_codebook: report.py reads the codebook through here)
 
 KIND_TITLES = {"pair": "forced choice between two", "odd": "odd one out",
                "procedure": "adaptive procedure", "yes_no": "yes / no", "rating": "rating",
@@ -178,7 +179,8 @@ def factor_chart(m, factor, chance, what, study, out_dir, name, group_note, pool
               if over else "") +
              (f"; * p < 0.05, ** < 0.01, *** < 0.001 against chance, Holm-adjusted over the chart's bars, with "
               f"participants as the unit: {'; '.join(tests)}" if chance is not None else "")]
-    return Chart(name, png, svg, t, notes)
+    floor = study_tests.holm_floor_words(t, chance, m["participant"].nunique(), "bars")
+    return Chart(name, png, svg, t, notes + ([floor] if floor else []))
 
 
 def value_chart(m, factor, what, study, out_dir, name, group_note, pooled_over=()):
@@ -211,9 +213,9 @@ def value_chart(m, factor, what, study, out_dir, name, group_note, pooled_over=(
                                      (f"; each pools the levels of {' and '.join(over)}" if over else "")])
 
 
-def models(m, factors, study, group_note, what):
-    """Logistic models across participants of the 0/1 measure against the factors, terms in words, and which to
-    trust where the GLM and the GLMM disagree."""
+def models(m, factors, study, group_note, what, additive_note=""):
+    """Logistic models across participants of the 0/1 measure against the factors (added), terms in words, and which
+    to trust where the GLM and the GLMM disagree. additive_note: said where the factors could interact."""
     d = m.copy()
     for f in factors:
         d[f] = d[f].map(_label)
@@ -222,8 +224,31 @@ def models(m, factors, study, group_note, what):
     if table.empty:
         return Chart(f"{study}-models", None, None, table, notes)
     notes.insert(0, f"{group_note}: logistic models of '{what}' across participants; estimates in log-odds, each "
-                    f"term against the baseline it names")
+                    f"term against the baseline it names" + (f"; {additive_note}" if additive_note else ""))
     return Chart(f"{study}-models", None, None, table, notes)
+
+
+def within_models(m, table, factors, chance, what, study, out_dir, slug, note):
+    """The models of a 0/1 measure across participants; where two within factors cross, the shares drawn by both and
+    the model with their interaction beside the additive one (crossed.py). table: the conditions table."""
+    if len(factors) < 2:
+        return [models(m, factors, slug, note, what)]
+    crossed_note = crossed.NO_INTERACTION_NOTE.format(
+        others="s" if len(factors) > 2 else "",
+        name=f"{slug}-models-interaction" if len(factors) == 2 else "no table: with more than two factors none is "
+                                                                    "fitted")
+    charts = [models(m, factors, slug, note, what, crossed_note)]
+    if len(factors) != 2:
+        return charts
+    a, b = sorted(factors, key=lambda f: -m[f].nunique())  # the factor of more levels along the x axis
+    levels = {f: _sorted_levels(list(m[f].map(_label).unique())) for f in factors}
+    t = table.assign(_a=table[a].map(levels[a].index), _b=table[b].map(levels[b].index)).sort_values(["_b", "_a"])
+    charts.append(crossed.crossing_chart(t, a, b, chance, what, study, out_dir, f"{slug}-per-{a}-by-{b}", note))
+    d = m.copy()
+    for f in factors:
+        d[f] = d[f].map(_label)
+    charts.append(crossed.interaction_models(d, factors, slug, note, what, levels))
+    return charts
 
 
 def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note, n_boot, seed, what, cell="",
@@ -231,8 +256,8 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
     """A Weibull with the guess rate at chance over one procedure cell's (or one odd one out's) answers; raises Skip
     with too few levels or answers. crit: the threshold's criteria.Criterion (the cell's procedure's own; fixed
     levels' by default), tested: the tested range (criteria.tested_range; the levels shown by default). Returns
-    (Chart, (threshold, low, high, slope) or (nan, low, high of the tested range, slope) when the threshold lies
-    beyond it)."""
+    (Chart, words): the threshold and slope as the summary says them - a number only where determined (the threshold
+    inside the tested range with its interval too, the slope with an interval off its range's bounds), else words."""
     where = f" ({cell})" if cell else ""
     d = m.dropna(subset=[xcol])
     x, k = d[xcol].to_numpy(float), d["y"].to_numpy(float)
@@ -240,23 +265,10 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
         raise Skip(f"{study}{where}: psychometric function needs >= 3 stimulus levels and >= 20 answers "
                    f"(has {len(np.unique(x))} levels, {len(x)} answers)")
     fit = stats.fit_psychometric(x, k, None, kind="weibull", gamma=chance, lam=(0.0, 0.1))
+    # One bootstrap, --boot samples: the band and the threshold's interval come from the same refits.
     grid, lo, hi = stats.bootstrap(x, k, np.ones_like(k), fit, n_boot=n_boot, seed=seed)
     crit = crit or criteria.criterion("", None, chance)
-    x_lo, x_hi = tested or criteria.tested_range(None, x)
-    p_mid = crit.psi(fit.gamma, fit.lam)
-    th = stats.threshold(fit, p_mid)
-    boot_th = []
-    rng = np.random.default_rng(seed)
-    for _ in range(max(50, n_boot // 2)):
-        kb = rng.binomial(1, np.clip(fit(x), 0, 1)).astype(float)
-        try:
-            refit = stats.fit_psychometric(x, kb, None, kind="weibull", gamma=chance, lam=(0.0, 0.1),
-                                           starts=[(fit.alpha, fit.beta)])
-            boot_th.append(stats.threshold(refit, crit.psi(refit.gamma, refit.lam)))
-        except ValueError:
-            pass
-    boot_th = np.array([b for b in boot_th if not math.isnan(b)])
-    th_lo, th_hi = (np.percentile(boot_th, [2.5, 97.5]) if len(boot_th) else (math.nan, math.nan))
+    said = fitted_threshold(fit, crit, tested or criteria.tested_range(None, x))
     levels = pd.DataFrame({"x": x, "y": k}).groupby("x")["y"].agg(["sum", "count"]).reset_index()
     fig, ax = plt.subplots(figsize=(5.5, 3.8))
     ax.fill_between(grid, lo, hi, color="#0072B2", alpha=0.2, lw=0, label="95 % bootstrap band")
@@ -265,8 +277,11 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
     ax.scatter(levels["x"], levels["sum"] / levels["count"], s=sizes, color="#333333", zorder=3,
                label="share per level (size: answers)")
     ax.axhline(chance, color="#999999", ls="--", lw=1)
-    if criteria.inside(th, x_lo, x_hi):
-        ax.axvline(th, color="#D55E00", lw=1, ls=":", label=f"threshold ({crit.label(fit.gamma, fit.lam)}): {th:.3g}")
+    label = crit.label(fit.gamma, fit.lam)
+    if said["determined"]:
+        ax.axvline(said["th"], color="#D55E00", lw=1, ls=":", label=f"threshold ({label}): {said['th']:.3g}")
+    else:  # no line where no value is: the legend says why in words
+        ax.plot([], [], " ", label=f"threshold ({label}): not determined")
     ax.set_xlabel(xlabel)
     ax.set_ylabel(f"share: {what}")
     ax.set_ylim(min(chance, 0.4) - 0.05, 1.05)
@@ -274,40 +289,24 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
     ax.set_title(f"{study}: psychometric function{' - cell ' + cell if cell else ''}\n{group_note}, {len(x)} answers",
                  loc="left")
     png, svg = save(fig, out_dir, name)
-    inside = criteria.inside(th, x_lo, x_hi)
-    # A threshold beyond the tested range is an extrapolation, and an interval that reaches beyond it (or that the
-    # bootstrap could not bound) is not determined by these answers: both are written in words, not as numbers.
-    bounded = inside and not math.isnan(th_lo) and x_lo <= th_lo and th_hi <= x_hi
-    side = "below" if not math.isnan(th) and th < x_lo else "above" if not math.isnan(th) else "beyond"
-    beta_lo, beta_hi = fit.ci.get("beta", (math.nan, math.nan))
-    b_bounds = fit.options.get("beta_bounds") or (0.0, math.inf)
-    beta_free = "beta" not in fit.on_bound
-    beta_ci = beta_free and not math.isnan(beta_lo) and beta_lo > b_bounds[0] * 1.001 + 1e-9 and \
-        beta_hi < b_bounds[1] * 0.999
-    interval_words = ("" if bounded else f"the threshold's 95 % interval reaches beyond "
-                      f"{criteria.range_words(x_lo, x_hi)}: not determined by these answers" if inside else
-                      criteria.beyond_words(side, x_lo, x_hi))
-    t = pd.DataFrame([{**({"cell": cell} if cell else {}), "threshold": th if inside else math.nan,
-                       "threshold_low": th_lo if bounded else math.nan,
-                       "threshold_high": th_hi if bounded else math.nan, "threshold_note": interval_words,
+    th_ok, beta_ok = said["determined"], said["slope_determined"]
+    t = pd.DataFrame([{**({"cell": cell} if cell else {}), "threshold": said["th"] if th_ok else math.nan,
+                       "threshold_low": said["low"] if th_ok else math.nan,
+                       "threshold_high": said["high"] if th_ok else math.nan, "threshold_note": said["note"],
                        "on_bound": ", ".join(f"{k} at its {v[1]} bound {v[0]:.3g}" for k, v in fit.on_bound.items()),
-                       "criterion": crit.short(), "criterion_fitted": crit.label(fit.gamma, fit.lam),
-                       "criterion_share_correct": p_mid,
+                       "criterion": crit.short(), "criterion_fitted": label,
+                       "criterion_share_correct": crit.psi(fit.gamma, fit.lam),
                        # The Weibull's scale is the threshold's other name: not a number where that is not one.
-                       "alpha": fit.alpha if inside else math.nan, "beta_slope": fit.beta if beta_free else math.nan,
-                       "beta_low": beta_lo if beta_ci else math.nan, "beta_high": beta_hi if beta_ci else math.nan,
+                       "alpha": fit.alpha if th_ok else math.nan, "beta_slope": fit.beta if beta_ok else math.nan,
+                       "beta_low": fit.ci["beta"][0] if beta_ok else math.nan,
+                       "beta_high": fit.ci["beta"][1] if beta_ok else math.nan, "slope_note": said["slope_note"],
                        "guess": fit.gamma, "lapse": fit.lam if "lam" not in fit.on_bound else math.nan, "answers": len(x),
                        "participants": d["participant"].nunique()}])
+    p_mid = crit.psi(fit.gamma, fit.lam)
     notes = [f"Weibull with the guess rate fixed at chance ({chance:.3g}) and a lapse rate fitted in [0, 0.1]; "
              f"threshold at {crit.words}" + (f" (the fitted function gives {100 * p_mid:.1f} % there, lapse "
-                                              f"{fit.lam:.2g})" if crit.label(fit.gamma, fit.lam) != crit.short()
-                                              else "") + ": " +
-             (f"{th:.3g} [{th_lo:.3g}, {th_hi:.3g}] (parametric bootstrap, {len(boot_th)} refits)" if bounded else
-              f"{th:.3g}, its interval not determined (the bootstrap's reaches beyond "
-              f"{criteria.range_words(x_lo, x_hi)})" if inside else
-              criteria.beyond_words(side, x_lo, x_hi, "an extrapolation, not an estimate")) +
-             (f"; slope {fit.beta:.3g}" if beta_free else "; slope on a bound of its range: not determined") +
-             ("" if beta_ci or not beta_free else "; the slope's interval reaches a bound: not determined")]
+                                              f"{fit.lam:.2g})" if label != crit.short() else "") + ": " +
+             said["words"] + "; " + said["slope_words"]]
     if fit.on_bound:
         names = {"lam": "lapse rate", "beta": "slope", "alpha": "scale (threshold)", "gamma": "guess rate"}
         notes.append("on a bound of its range: " + ", ".join(f"{names.get(k, k)} ({v[1]})"
@@ -318,9 +317,40 @@ def psychometric_chart(m, xcol, xlabel, chance, study, out_dir, name, group_note
         notes.append("a description of the answers pooled over participants, not the study's result: an adaptive "
                      "procedure's thresholds are each participant's track's (the tracks and thresholds tables), "
                      "summarised across participants there")
-    return Chart(name, png, svg, t, notes), ((th, th_lo, th_hi, fit.beta) if bounded else
-                                             (th, math.nan, math.nan, fit.beta) if inside else
-                                             (math.nan, x_lo, x_hi, fit.beta))
+    return Chart(name, png, svg, t, notes), said["words"]
+
+
+def fitted_threshold(fit, crit, tested):
+    """The threshold of a bootstrapped fit (stats.bootstrap) at crit over the tested range (low, high), and its slope,
+    each as a number only where determined, else in words: a threshold beyond the range is an extrapolation, one whose
+    interval reaches beyond it (or that the refits could not bound) is not determined by the answers, and so is a
+    slope on a bound of its range or whose interval reaches one. Returns a dict: th, low, high, determined, note (the
+    table's words, empty when determined), words (the threshold with its interval, or why not), slope_determined,
+    slope_note, slope_words."""
+    x_lo, x_hi = tested
+    th = stats.threshold(fit, crit.psi(fit.gamma, fit.lam))
+    boot_th = np.array([stats.threshold(r, crit.psi(r.gamma, r.lam)) for r in fit.refits])
+    boot_th = boot_th[~np.isnan(boot_th)]
+    th_lo, th_hi = (np.percentile(boot_th, [2.5, 97.5]) if len(boot_th) else (math.nan, math.nan))
+    inside = criteria.inside(th, x_lo, x_hi)
+    determined = inside and not math.isnan(th_lo) and x_lo <= th_lo and th_hi <= x_hi
+    side = "below" if not math.isnan(th) and th < x_lo else "above" if not math.isnan(th) else "beyond"
+    refits = f"{len(boot_th)} refits" + (f" of {fit.n_boot} samples" if len(boot_th) != fit.n_boot else "")
+    note = ("" if determined else
+            f"not determined: its 95 % interval reaches beyond {criteria.range_words(x_lo, x_hi)} (parametric "
+            f"bootstrap, {refits})" if inside else
+            criteria.beyond_words(side, x_lo, x_hi, "an extrapolation, not an estimate"))
+    words = f"{th:.3g} [{th_lo:.3g}, {th_hi:.3g}] (parametric bootstrap, {refits})" if determined else note
+    b_lo, b_hi = fit.ci.get("beta", (math.nan, math.nan))
+    b_bounds = fit.options.get("beta_bounds") or (0.0, math.inf)
+    on_bound = "beta" in fit.on_bound
+    slope_ok = not on_bound and not math.isnan(b_lo) and b_lo > b_bounds[0] * 1.001 + 1e-9 and \
+        b_hi < b_bounds[1] * 0.999
+    slope_note = ("" if slope_ok else "not determined: on a bound of its range" if on_bound else
+                  "not determined: its 95 % interval reaches a bound of its range")
+    return {"th": th, "low": th_lo, "high": th_hi, "determined": determined, "note": note, "words": words,
+            "slope_determined": slope_ok, "slope_note": slope_note,
+            "slope_words": (f"slope {fit.beta:.3g} [{b_lo:.3g}, {b_hi:.3g}]" if slope_ok else "slope " + slope_note)}
 
 
 def side_bias_table(m, study, group_note):
@@ -415,6 +445,33 @@ def _analyse(d, study, codebook, out_dir, n_boot, seed, group, task, part):
     return charts + c, "; ".join(findings + [f]) + left_out
 
 
+def more_blurred_words(m, factors):
+    """What "chose the more blurred side" means in these rows, per pair of sources compared: which source was the more
+    blurred one (by the radii shown, r_left_arcmin / r_right_arcmin), and where that changes between the conditions
+    (the crossing of factors) - there the same share means choosing a different source. "" without the columns."""
+    need = {"left_source", "right_source", "r_left_arcmin", "r_right_arcmin"}
+    if not need <= set(m.columns) or m.empty:
+        return ""
+    left, right = text(m["left_source"]), text(m["right_source"])
+    r_l, r_r = _num(m["r_left_arcmin"]), _num(m["r_right_arcmin"])
+    blurrier = np.where(r_l > r_r, left, np.where(r_r > r_l, right, "neither"))
+    pair = pd.Series([" and ".join(sorted(p)) for p in zip(left, right)], index=m.index)
+    condition = (m[list(factors)].astype(str).apply(lambda r: ", ".join(f"{f} {v}" for f, v in r.items()), axis=1)
+                 if factors else pd.Series([""] * len(m), index=m.index))
+    words = []
+    for name, rows in pd.DataFrame({"pair": pair, "blurrier": blurrier, "condition": condition}).groupby("pair"):
+        sources = rows.groupby("condition", sort=False)["blurrier"].agg(lambda v: " or ".join(sorted(set(v))))
+        if sources.nunique() == 1:
+            words.append(f"between {name}, the more blurred side showed {sources.iloc[0]}" +
+                         (" in every condition" if factors else ""))
+        else:
+            where = "; ".join(f"{src} at {', '.join(c for c in sources.index[sources == src])}"
+                              for src in dict.fromkeys(sources))
+            words.append(f"between {name}, the more blurred side showed {where}: the share means choosing a "
+                         f"different source where that changes")
+    return "; " + "; ".join(words) if words else ""
+
+
 def _left_out_words(d, m, kind):
     """The answered rows a pair's shares leave out, said (", 14 of 60 answers can't tell, left out of the shares"):
     a "can't tell" chooses no side, and a pair of equal radii has no more blurred side."""
@@ -504,12 +561,17 @@ def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, 
                          ("; against chance with participants as the unit (test column), Holm-adjusted over the "
                           "conditions" if chance is not None else
                           NO_CHANCE_WHY.get(kind, "; no test against chance: the design defines no chance "
-                                                  "level for it"))]))
+                                                  "level for it"))] +
+                        [w for w in [study_tests.holm_floor_words(table, chance, m["participant"].nunique())] if w]))
     if kind != "procedure":
         for f in factors:
             charts.append(factor_chart(m, f, chance, what, study, out_dir, f"{slug}-per-{f}", note,
                                        [g for g in factors if g != f]))
-        finding = f"{KIND_TITLES[kind]}: " + study_tests.summary_words(m, chance, what)
+        apart = comparing_factors(m, factors)  # levels that ask different questions are summarised apart
+        finding = f"{KIND_TITLES[kind]}: " + (study_tests.summary_by_level(m, chance, what, apart) if apart else
+                                              study_tests.summary_words(m, chance, what))
+        if kind == "pair":
+            finding += more_blurred_words(m, factors)
     else:
         finding = (f"{KIND_TITLES[kind]}: {participants_note(m)}, {len(m)} answers (share correct set by the "
                    f"procedure, not tested)")
@@ -538,7 +600,7 @@ def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, 
     if kind == "procedure":
         charts += track_charts
     else:
-        charts.append(models(m, factors, slug, note, what))
+        charts += within_models(m, table, factors, chance, what, study, out_dir, slug, note)
     if "chosen_side" in m and m["chosen_side"].isin(["left", "right"]).any():
         charts.append(side_bias_table(m, slug, note))
     return charts, finding
@@ -568,23 +630,18 @@ def psychometric_cells(m, kind, guess, what, design, study, out_dir, slug, note,
         crit = criteria.criterion((params or {}).get("procedure", ""), params, guess)
         try:
             dx = rows[xcol].dropna().to_numpy(float)
-            chart, (th, th_lo, th_hi, _) = psychometric_chart(
+            chart, said = psychometric_chart(
                 rows, xcol, xlabel, guess, study, out_dir, name, note, n_boot, seed, what, cell=cell, crit=crit,
                 tested=criteria.tested_range(params, dx) if len(dx) else None)
             charts.append(chart)
             # The threshold's unit beside it in the table: the procedure's variable's (common.level_unit).
             unit_words = (level_unit(rows) or UNKNOWN_UNIT) if kind == "procedure" else "arcmin"
-            if chart.table is not None:
-                chart.table.insert(chart.table.columns.get_loc("threshold") + 1, "unit", unit_words)
+            chart.table.insert(chart.table.columns.get_loc("threshold") + 1, "unit", unit_words)
             where = f"{tracks.cell_label(rows) if kind == 'procedure' else cell}: " if cell else ""
             # Said as the fitted function gives it (its lapse lowers QUEST+'s 81.6 %), with the level's unit.
-            said = chart.table["criterion_fitted"].iloc[0] if chart.table is not None else crit.short()
-            unit = f" {unit_words}"
-            words.append(f"{where}threshold at {said} {th:.3g}{unit} [{th_lo:.3g}, {th_hi:.3g}]"
-                         if not math.isnan(th_lo) and not math.isnan(th) else
-                         f"{where}threshold at {said} {th:.3g}{unit} (its interval not determined)"
-                         if not math.isnan(th) else
-                         f"{where}threshold at {said} " + criteria.beyond_words("beyond", th_lo, th_hi))
+            determined = not math.isnan(chart.table["threshold"].iloc[0])
+            words.append(f"{where}threshold at {chart.table['criterion_fitted'].iloc[0]} " +
+                         (said.replace(" [", f" {unit_words} [", 1) if determined else said))
         except Skip as e:
             charts.append(Chart(name, None, None, None, [str(e)]))
         except ValueError as e:

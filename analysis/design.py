@@ -68,6 +68,18 @@ def cell_columns(d):
     return out
 
 
+def comparing_factors(d, factors):
+    """The factors whose levels change which sources a pair compares (left_source and right_source as an unordered
+    pair, whatever side each was shown on): a share pooled across their levels would average the answers to
+    different questions (measured vs none with measured vs estimated), so a summary goes per level of these."""
+    if not {"left_source", "right_source"} <= set(d.columns):
+        return []
+    left, right = _text(d["left_source"]), _text(d["right_source"])
+    pair = pd.Series([" vs ".join(sorted(p)) for p in zip(left, right)], index=d.index)
+    return [f for f in factors if f in d and
+            len({frozenset(v) for _, v in pair.groupby(_text(d[f]))}) > 1]
+
+
 @dataclass(frozen=True)
 class Design:
     """The design of one set of rows (a study, or a part of one): the columns that vary in them, by role."""

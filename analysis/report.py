@@ -222,10 +222,27 @@ def unfinished_sessions(trials, included):
         if included:
             out.append((study, f"included {what} as partial data (--include-unfinished): stopped, killed or still "
                                f"running, each is a part of a session"))
+        elif answers == 0:  # nothing that --include-unfinished could analyse
+            out.append((study, f"left out {what} (of {len(d)} trials): stopped, killed or still running before any "
+                               f"answer"))
         else:
             out.append((study, f"left out {what}: stopped, killed or still running, a part of a session is not a "
                                f"participant's data; blurcue report --include-unfinished analyses them as partial data"))
     return out
+
+
+def nothing_to_analyse(trials, n_read, path):
+    """One line where the rows to analyse hold no answer at all (the report is written, with nothing in it to
+    analyse, and exits 0 as for a study with no answers), else "". trials: the rows left after the sessions left
+    out; n_read: the rows of the file at path."""
+    if n_read == 0:
+        return f"{path}: no trials - nothing to analyse, every trial section is skipped"
+    if trials.empty:
+        return (f"nothing to analyse: all {n_read} rows of {path} are of sessions left out (above); "
+                "the report holds no result")
+    if not trials["answered"].any():
+        return f"nothing to analyse: none of the {len(trials)} trials analysed was answered; the report holds no result"
+    return ""
 
 
 def kept_apart(trials):
@@ -291,7 +308,8 @@ def _main(argv=None):
                         "folder beside its target): index.html and messages name paths there")
     parser.add_argument("--db", help="the SQLite record trials.csv was exported from (blurcue report gives it): its "
                         "protocols say what each study's scene was (a video's take, frames and exposure)")
-    parser.add_argument("--boot", type=int, default=200, help="bootstrap samples for the psychometric band")
+    parser.add_argument("--boot", type=int, default=200, help="bootstrap samples of each psychometric fit (its band and its "
+                        "threshold's interval come from the same samples)")
     parser.add_argument("--seed", type=int, default=1, help="bootstrap seed")
     parser.add_argument("--debug", action="store_true", help="let an unexpected error raise (with its traceback)")
     parser.add_argument("--pool-simulated", action="store_true",
@@ -383,6 +401,7 @@ def _main(argv=None):
     except TrialsError as e:
         say(str(e))  # the only line: the file and what is wrong with it
         return EXIT_INPUT
+    n_read = len(holder["trials"])  # the file's rows, before any session is left out
     # An aborted session was given up (sessions --abort): its answers are not the study's unless asked for.
     session_lines = aborted_sessions(holder["trials"], args.include_aborted)
     if not args.include_aborted:
@@ -441,11 +460,12 @@ def _main(argv=None):
     steps = thesis_steps + study_steps + [predict_step] + steps[8:] + bench_steps
     n_data_steps = len(steps) - len(bench_steps)
     total = len(steps) + 2  # + reading trials.csv + writing the index
-    say(f"[1/{total}] read {shown(args.trials)}: {len(all_trials)} rows")
+    analysed = f" ({len(all_trials)} of them analysed)" if len(all_trials) != n_read else ""
+    say(f"[1/{total}] read {shown(args.trials)}: {n_read} rows{analysed}")
     studies = all_trials["study"].value_counts().sort_index()
     known = set(common.STUDY_TITLES)
     n_people = all_trials["participant"].nunique()
-    header = [f"trials: {os.path.abspath(shown(args.trials))} - {len(all_trials)} rows, "
+    header = [f"trials: {os.path.abspath(shown(args.trials))} - {n_read} rows{analysed}, "
               f"{int(all_trials['answered'].sum())} answered, {n_people} participant{'' if n_people == 1 else 's'}",
               "studies: " + (", ".join(f"{s} ({n} rows)" for s, n in studies.items()) or "none"),
               f"frames: {os.path.abspath(shown(frames_path))}",
@@ -458,8 +478,10 @@ def _main(argv=None):
     header.insert(1, "participants: " + ", ".join(f"{n} {'people' if k == 'person' else 'simulated'}"
                                                     for k, n in observers.items()) +
                   ("; analysed apart" if len(observers) > 1 and not args.pool_simulated else ""))
-    if all_trials.empty:
-        say(f"{args.trials}: no trials - every trial section is skipped")
+    nothing = nothing_to_analyse(all_trials, n_read, shown(args.trials))
+    if nothing:
+        say(nothing)
+        header.insert(0, nothing)
 
     sections = []
     failed = []

@@ -124,6 +124,8 @@ class PsychometricFit:
     converged: bool
     options: dict = field(default_factory=dict)  # the gamma / lam / beta_bounds arguments of the fit, for refits
     ci: dict = field(default_factory=dict)   # parameter -> (low, high), filled by bootstrap()
+    refits: list = field(default_factory=list, repr=False)  # bootstrap()'s refitted PsychometricFits, for any quantity
+    n_boot: int = 0                          # the samples bootstrap() drew (refits that failed are not in refits)
 
     @property
     def aic(self):
@@ -251,7 +253,9 @@ def fit_psychometric(x, k, n=None, kind="weibull", gamma=0.5, lam=(0.0, 0.1), st
 
 
 def bootstrap(x, k, n, fit, method="parametric", n_boot=200, seed=0, grid=None, level=0.95, **fit_kwargs):
-    """Percentile bootstrap of a psychometric fit; fills fit.ci and returns (grid, band_low, band_high).
+    """Percentile bootstrap of a psychometric fit; fills fit.ci, fit.refits (every refit, so a derived quantity
+    such as a threshold takes its interval from the same n_boot samples) and fit.n_boot, and returns (grid, band_low,
+    band_high).
 
     parametric: new k at every level drawn from Binomial(n, fitted psi), then refitted.
     nonparametric: the (x, k, n) rows resampled with replacement (pass one row per trial for a trial bootstrap).
@@ -267,6 +271,7 @@ def bootstrap(x, k, n, fit, method="parametric", n_boot=200, seed=0, grid=None, 
     # Refits start from the point estimate only: the bootstrap samples sit close to the data.
     fit_kwargs["starts"] = [(fit.alpha, fit.beta)]
     params, curves = [], []
+    fit.refits, fit.n_boot = [], n_boot
     for _ in range(n_boot):
         if method == "parametric":
             xb, nb = x, n
@@ -282,6 +287,7 @@ def bootstrap(x, k, n, fit, method="parametric", n_boot=200, seed=0, grid=None, 
             continue
         params.append((fb.alpha, fb.beta, fb.gamma, fb.lam))
         curves.append(fb(grid))
+        fit.refits.append(fb)
     if not params:
         raise ValueError("every bootstrap sample failed to fit")
     params = np.array(params)
@@ -310,6 +316,7 @@ def threshold(fit, p=0.75):
 
 
 MIN_ANSWERS = 10        # fewer decisive answers than this: no model, a note instead
+MIN_PARTICIPANTS_MODEL = 3  # fewer (but more than one): no model across participants, said in words
 MIN_EACH_OUTCOME = 2    # and at least this many of each outcome (else the log-odds run off to infinity)
 
 
@@ -326,6 +333,10 @@ def term_in_words(term, data):
         return "baseline (intercept)"
     if term in CENTRED:
         return CENTRED[term]
+    parts = _interaction_parts(term)
+    if len(parts) > 1:  # 'C(a)[T.x]:C(b)[T.y]': how far that crossing departs from the two effects added
+        inner = [re.sub(r" \(against .*\)$", "", term_in_words(p, data)) for p in parts]
+        return " x ".join(inner) + " (interaction: beyond the effects added)"
     match = re.fullmatch(r"C\((\w+)(?:, levels=\[(.*)\])?\)\[(T\.)?(.+)\]", term)
     if not match:
         return term
@@ -341,6 +352,18 @@ def term_in_words(term, data):
         base = str(values[0]) if len(values) else "its first level"
     base = base[:-2] if base.endswith(".0") else base
     return f"{name} {level} (against {name} {base})"
+
+
+def _interaction_parts(term):
+    """A patsy column name split at its ':' outside brackets and parentheses ('C(a)[T.x]:C(b)[T.y]' -> two parts;
+    a level holding ':' stays whole)."""
+    parts, depth, start = [], 0, 0
+    for i, ch in enumerate(term):
+        depth += 1 if ch in "([" else -1 if ch in ")]" else 0
+        if ch == ":" and depth == 0:
+            parts.append(term[start:i])
+            start = i + 1
+    return parts + [term[start:]]
 
 
 # Every model table has these columns and no others: one row per (model, term), terms in words, the engine that
@@ -531,7 +554,7 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
       fails lme4's convergence checks or has an SD beyond 10 log-odds is "not determined" in words, never numbers.
     - A factor whose reference level's answers all went one way is compared with its first level whose answers went
       both ways (reference_not_separated), so its estimable contrasts are printed whatever the level order given.
-    - one participant: a plain logistic GLM (answers treated as independent), said so.
+    - one participant: a plain logistic GLM (answers treated as independent), said so; two: no model, said so.
     Separation (a term whose answers all went one way) is found before any fit (separation()); such a term gets no
     estimate and no p in either model, and the other terms are fitted on the answers it does not predict perfectly
     (the limit of the maximum-likelihood fit). Without R the table has the GLM and a note saying the GLMM is missing.
@@ -557,6 +580,13 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
     y = y.iloc[:, 0].to_numpy(float)
     groups = d[group].astype(str).to_numpy()
     n_groups = len(set(groups))
+    if n_groups == 2:
+        # Two clusters give a sandwich SE from two residual sums and a t(1) reference, and a spread between
+        # participants from two: neither is an estimate, so no model across them (one participant: a plain GLM).
+        notes.append(f"two participants: too few for a model across participants (a cluster-robust SE from two "
+                     f"participants with t(1), or a GLMM's spread between two, is not an estimate); no model fitted - "
+                     f"the shares per condition are in the tables, and a model needs >= {MIN_PARTICIPANTS_MODEL}")
+        return model_table(rows), notes
     sources = _term_sources(X)
     words = {c: term_in_words(c, d) for c in X.columns}
 
@@ -648,9 +678,6 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
                 fixed = without_unheld_tests(f, slopes, sources, cell_means="Intercept" not in X.columns)
                 add_fit(model, f.engine, fixed, lambda c: status + fixed.set_index("term")["why"].get(c, ""))
                 rows += variance_rows(study, model, f, words, "log-odds")
-    elif n_groups == 2:
-        notes.append("two participants: too few for a GLMM (a spread between participants from two is not an "
-                     "estimate); cluster-robust GLM only")
     table = model_table(rows)
     if not table.empty:
         notes += disagreements(table)

@@ -188,9 +188,69 @@ def against_chance_counts(k, n, chance, people=None):
             "participants_above": above, "participants_below": below}
 
 
-def summary_words(m, chance, what):
+def summary_by_level(m, chance, what, by):
+    """The summary per level of the factors `by` (their levels ask different questions: design.comparing_factors),
+    never pooled across them; p Holm-adjusted over the levels. One line."""
+    parts = list(m.groupby([m[f].astype(str) for f in by], sort=True))
+    raw = [chance_p(d, chance) for _, d in parts]
+    adjusted = stats.holm(raw)
+    words = []
+    for (level, d), p in zip(parts, adjusted):
+        name = ", ".join(f"{f} {v}" for f, v in zip(by, level if isinstance(level, tuple) else (level,)))
+        words.append(f"{name}: " + summary_words(d, chance, what, p_holm=(p, len(parts))))
+    table = pd.DataFrame([{"participants": d["participant"].nunique(), "n": len(d), "p": p}
+                          for (_, d), p in zip(parts, raw)])
+    floor = holm_floor_words(table, chance, m["participant"].nunique(), "levels")
+    return (f"per {', '.join(by)}, no pooled figure ({', '.join(by)} changes which sources are compared, so a share "
+            f"across its levels would average different questions): " + "; ".join(words) +
+            (f"; {floor}" if floor else ""))
+
+
+def smallest_p(participants, answers, chance, people):
+    """The smallest p the test of one condition against chance can give (the sign-flip test's 2 / 2^G at 0.5, the
+    binomial's at either extreme count otherwise or for one participant's answers); NaN where it gives no test."""
+    if people == 1:
+        return min(stats.binom_p(j, answers, chance) for j in range(answers + 1)) if answers > 1 else math.nan
+    if participants < MIN_PARTICIPANTS_T:
+        return math.nan
+    if abs(chance - 0.5) < 1e-12:
+        return 2 / 2 ** participants
+    return min(stats.binom_p(0, answers, chance), stats.binom_p(answers, answers, chance))
+
+
+def holm_floor_words(t, chance, people, what="conditions", alpha=0.05):
+    """Where no row of a table tested against chance and Holm-adjusted over its rows can reach alpha: one sentence
+    with the smallest p attainable after the correction (the number of tests times the smallest p any row's test can
+    give); else "". t: rows with participants, n and p (NaN where untested); people: the analysis's participants."""
+    if chance is None or t.empty or "p" not in t:
+        return ""
+    tested = t[t["p"].notna()]
+    floors = [smallest_p(int(g), int(n), chance, people) for g, n in zip(tested["participants"], tested["n"])]
+    floors = [f for f in floors if not math.isnan(f)]
+    if len(tested) < 2 or not floors:
+        return ""  # one test: its own words say how low its p can go
+    best = min(1.0, len(tested) * min(floors))
+    if best < alpha:
+        return ""
+    return (f"none of the {len(tested)} {what} can reach p < {alpha:g} after Holm's correction: the smallest p "
+            f"attainable is {best:.3g} ({len(tested)} tests x {min(floors):.3g}, the smallest p one test of these "
+            f"participants and answers can give)")
+
+
+def chance_p(m, chance):
+    """The p of summary_words' test of m against chance (NaN where it gives none)."""
+    if chance is None:
+        return math.nan
+    if m["participant"].nunique() == 1:
+        return one_participant_test(int(m["y"].sum()), len(m), chance)["p"]
+    return against_chance(m, chance)["p"]
+
+
+def summary_words(m, chance, what, p_holm=None):
     """One line for the report's summary: the measure over participants and its test against chance (None: no
-    chance level, the share only)."""
+    chance level, the share only). p_holm: (p, levels) where the line is one of a set of levels, Holm-adjusted."""
+    def said(p):
+        return p_text(p) if p_holm is None else f"{p_text(p_holm[0])} (Holm over {p_holm[1]} levels)"
     k, n = int(m["y"].sum()), len(m)
     people = m["participant"].nunique()
     if people == 1:
@@ -198,7 +258,7 @@ def summary_words(m, chance, what):
         text = f"{what} {p:.2f} [{lo:.2f}, {hi:.2f}] of {n} answers (one participant)"
         if chance is not None:
             r = one_participant_test(k, n, chance)
-            text += (f"; chance {chance:.2g}, {p_text(r['p'])} (exact binomial)" if not math.isnan(r["p"]) else
+            text += (f"; chance {chance:.2g}, {said(r['p'])} (exact binomial)" if not math.isnan(r["p"]) else
                      f"; chance {chance:.2g}: one answer cannot test anything")
         return text
     shares = per_participant(m)["mean"].to_numpy(float)
@@ -212,7 +272,7 @@ def summary_words(m, chance, what):
             f"{min(1.0, mean + half):.2f}] ({n} answers)")
     if chance is not None:
         r = against_chance(m, chance)
-        text += (f"; against chance {chance:.2g}: {r['test']}, {p_text(r['p'])}; {r['participants_above']} of "
+        text += (f"; against chance {chance:.2g}: {r['test']}, {said(r['p'])}; {r['participants_above']} of "
                  f"{people} participants above chance, {r['participants_below']} below")
     return text
 

@@ -34,6 +34,16 @@ add_test(NAME analysis.design
 add_test(NAME analysis.tracks
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_tracks.py
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# A procedure cell's pooled fit: a threshold or slope that is not determined in words, never a number (table,
+# chart, summary), against the record of an 8-trial staircase and observers of known threshold; --boot's samples.
+add_test(NAME analysis.psychometric
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_psychometric.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# The summary's line of a study: per level of a factor that changes which sources are compared, never pooled over
+# them; the smallest attainable p, the models' limits in words (hand-worked shares and exact p-values).
+add_test(NAME analysis.summary
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_summary.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 # A study on a tracked video: its scene described from a hand-made record, track.csv, trials and frames (scenes.py).
 add_test(NAME analysis.scenes
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_scenes.py
@@ -43,7 +53,7 @@ add_test(NAME analysis.file_stems
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_file_stems.py
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(analysis.stats analysis.report analysis.bench_charts analysis.prediction analysis.design
-                     analysis.tracks analysis.scenes analysis.file_stems PROPERTIES
+                     analysis.tracks analysis.scenes analysis.file_stems analysis.psychometric analysis.summary PROPERTIES
                      LABELS analysis TIMEOUT 180
                      # Matplotlib writes its font cache under HOME; keep it out of a read-only or shared home.
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
@@ -65,5 +75,14 @@ add_test(NAME analysis.groups
 set_tests_properties(analysis.groups PROPERTIES LABELS analysis TIMEOUT 600
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
 
+# Two within factors crossed (crossed.py): the model with their interaction against a direct glmer call on the same
+# data, a planted interaction found with its sign; the additive model's note and the chart by both factors. Needs R
+# with lme4: fails without it (never skips). ~75 s of CPU, 165 s of wall time on a loaded machine.
+add_test(NAME analysis.crossed
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_crossed.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(analysis.crossed PROPERTIES LABELS analysis TIMEOUT 600
+                     ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
+
 # Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
-set_test_costs(analysis.report 134 analysis.mixed 76 analysis.glmm_checks 95 analysis.groups 43 analysis.tracks 24)
+set_test_costs(analysis.report 134 analysis.crossed 165 analysis.mixed 76 analysis.glmm_checks 95 analysis.groups 43 analysis.tracks 24)

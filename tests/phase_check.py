@@ -3,7 +3,7 @@
 level scenes; tests/turned_tests.cmake, turned boards and large blur).
 
   phase_check.py BLURCUE DIR --expect filtered|physical [--max-flagged N] [--max-bias F] [--min-measured F]
-                 [--fitted-p90 F] [--sections-only] [--no-phase-check]
+                 [--fitted-p90 F] [--sections-only] [--max-off N] [--no-phase-check]
 
 DIR holds scene.png, camera.json and truth.json from `blurcue synth-scene` (level camera: every board edge runs along
 the pixel rows; with --yaw-deg, across them). The truth is synth's: each section's r_px from the kernels it applied, the post-sampling filter's
@@ -24,6 +24,8 @@ figures, and exits 1 when a target is missed:
 --undetermined-covers: with --expect filtered, every section whose fitted model misses max(0.05 px, 5 %) must lie within
       the depths calib.json's phase_check.model_undetermined names (where calibrate says the model is not determined
       within 5 %: a mask that cancels most of the optics' blur near focus); none named counts as no depth.
+--max-off N: with --expect filtered, at most N sections off max(0.05 px, 10 %) unflagged in place of 0 (a known miss,
+      named where the test is defined; every such section is still printed).
 --sections-only: with --expect filtered, the per-section rule alone (a mask that cancels the whole second moment near
       focus, truth 0 px on a third of the sections: no thin lens bends to that).
 A section whose truth is under 0.05 px (a mask that cancels the blur's whole second moment) is held to the 0.05 px
@@ -55,6 +57,7 @@ def main():
     p.add_argument("--fitted-p90", type=float, default=0.05)
     p.add_argument("--sections-only", action="store_true")
     p.add_argument("--undetermined-covers", action="store_true")
+    p.add_argument("--max-off", type=int, default=0)
     p.add_argument("--no-phase-check", action="store_true")
     a = p.parse_args()
     # Beside the scene's folder, not in it: synth-scene replaces its folder whole and refuses one holding other files.
@@ -118,7 +121,11 @@ def main():
     missed = []
     if a.expect == "filtered":
         for edge, section, r, t in off:
-            missed.append("edge %d section %d reads %.3f px for %.3f px, unflagged" % (edge, section, r, t))
+            line = "edge %d section %d reads %.3f px for %.3f px, unflagged" % (edge, section, r, t)
+            if len(off) > a.max_off:
+                missed.append(line)
+            else:
+                print("allowed (--max-off %d): %s" % (a.max_off, line))
     else:
         if mm > 0.02 or mp > 0.05:
             missed.append("measured r median %s, p90 %s (target <= 2 %%, <= 5 %%)" % (pct(mm), pct(mp)))

@@ -306,6 +306,30 @@ class AbortedSessionsTest(ReportTestCase):
         self.assertNotIn("nan%", index)
 
 
+class UnansweredOnlyTest(ReportTestCase):
+    """A record whose only session stopped before its first answer (blurcue report builds the report in a partial
+    folder): the rows read are counted as the file holds them, one line says there is nothing to analyse, and every
+    message names the user's folder, never the partial one."""
+
+    def test_one_line_naming_the_users_paths(self):
+        rows = [dict(r, session=7, session_status="running", choice=None) for r in
+                synthetic.trials_rows(participants=("S9",), studies=["test1-static-grids"], unanswered=0)]
+        partial, final = os.path.join(self.tmp, ".rep.partial-1"), os.path.join(self.tmp, "rep")
+        os.makedirs(os.path.join(partial, "tables"))
+        trials = synthetic.write_trials_csv(os.path.join(partial, "tables", "trials.csv"), rows)
+        code, _, err = run_report(trials, os.path.join(self.tmp, "nobench"), partial, "--final-out", final)
+        self.assertEqual(code, 0, err)  # a report was written, saying there is nothing in it (as a study unanswered)
+        self.assertCleanStderr(err)
+        self.assertNotIn(".rep.partial-1", err)
+        shown = os.path.join(final, "tables", "trials.csv")
+        self.assertIn(f"read {shown}: {len(rows)} rows (0 of them analysed)", err)  # was "0 rows"
+        said = f"nothing to analyse: all {len(rows)} rows of {shown} are of sessions left out (above)"
+        self.assertEqual(sum(said in line for line in err.splitlines()), 1, err)
+        self.assertIn("left out 1 unfinished session (S9 (session id 7)) with 0 answers", err)
+        self.assertNotIn("--include-unfinished analyses", err)  # nothing it could analyse
+        self.assertIn(html.escape(said), read(partial, "index.html"))
+
+
 if __name__ == "__main__":
     unittest.main()
 

@@ -202,10 +202,13 @@ class ObserverModelTest(unittest.TestCase):
 
     @staticmethod
     def same_at_both_edges():
-        """Two participants whose answers at edge 6 are those at edge 3, answer for answer, in each blur cell: the
-        response is constant across the two edges, so the edge term is 0 by construction."""
+        """Three participants whose answers at edge 6 are those at edge 3, answer for answer, in each blur cell: the
+        response is constant across the two edges, so the edge term is 0 by construction. P3 answers at exactly the
+        pooled rates (5/8 sharp, 2/8 blurred), so its scores are 0 and P1's and P2's cancel: the baseline's
+        cluster-robust SE is 0 (two participants get no model across them at all)."""
         rows = []
-        for p, (sharp, blurred) in {"P1": ([1, 1, 1, 0], [0, 0, 1, 0]), "P2": ([1, 1, 0, 0], [0, 1, 0, 0])}.items():
+        for p, (sharp, blurred) in {"P1": ([1, 1, 1, 0], [0, 0, 1, 0]), "P2": ([1, 1, 0, 0], [0, 1, 0, 0]),
+                                    "P3": ([1, 1, 1, 1, 1, 0, 0, 0], [1, 1, 0, 0, 0, 0, 0, 0])}.items():
             for edge in (3, 6):
                 rows += [{"participant": p, "edge": edge, "blur": "sharp", "y": float(v)} for v in sharp]
                 rows += [{"participant": p, "edge": edge, "blur": "blurred", "y": float(v)} for v in blurred]
@@ -226,7 +229,7 @@ class ObserverModelTest(unittest.TestCase):
 
     def test_se_of_zero_is_said_in_words_and_the_estimate_kept(self):
         table, _ = stats.observer_models(self.same_at_both_edges(), "y", "C(blur) + C(edge)")
-        # Both participants said yes to 2 of their 8 blurred balls: the baseline is log(2/6) in each, no spread.
+        # Every participant said yes to a quarter of their blurred balls: the baseline is log(2/6) in each, no spread.
         base = table[table["term"] == "baseline (intercept)"].iloc[0]
         self.assertAlmostEqual(base["estimate"], math.log(2 / 6), places=6)
         self.assertTrue(math.isnan(base["se"]) and math.isnan(base["p"]))

@@ -76,9 +76,31 @@ std::vector<optics::BlurSample> ModelSamples(const CalibResult& result) {
   return samples;
 }
 
-std::map<std::string, int> SectionsLeftOut(const CalibResult& result) {
+const std::vector<std::string>& InformationalFlags() {
   // Informational flags never disqualify a section (edge_blur.h).
   static const std::vector<std::string> kInformational = {"flaw", "neighbours", "short", "junctions"};
+  return kInformational;
+}
+
+std::string SectionFlagMeaning(const std::string& flag) {
+  static const std::map<std::string, std::string> kMeaning = {
+      {"low_contrast", "the step across the edge is too faint to measure (shade, glare)"},
+      {"saturated", "too many of its pixels are clipped at white or black"},
+      {"crowded", "its blur reaches the next edges or the X-junctions where no model of them holds"},
+      {"poor_fit", "the blur model fits its profile worse than 8 % of the step (a smudge, a reflection, a fold)"},
+      {"too_few_pixels", "too few pixels across or along it"},
+      {"phase_limited", "its blur is not identified where its edge falls between pixel rows (the phase check)"},
+      {"not measured", "no blur was read there"},
+      {"flaw", "printing spots near the edge, left out of the profile (the section is used)"},
+      {"neighbours", "measured across the neighbouring edges, their steps in the model (used)"},
+      {"short", "read on a shorter central part, to keep the X-junctions out of its blur (used)"},
+      {"junctions", "the X-junctions within its blur's reach, modelled (used)"}};
+  const auto it = kMeaning.find(flag);
+  return it == kMeaning.end() ? std::string() : it->second;
+}
+
+std::map<std::string, int> SectionsLeftOut(const CalibResult& result) {
+  const std::vector<std::string>& kInformational = InformationalFlags();
   std::map<std::string, int> out;
   for (const auto& edge : result.edges)
     for (const auto& s : edge.sections) {
@@ -460,7 +482,7 @@ Json CalibToJson(const CalibResult& r) {
                  {"thesis_ok", s.thesis.ok}};
       if (!s.estimated_note.empty()) js["r_estimated_note"] = s.estimated_note;
       if (!s.fit.crowded_why.empty()) js["crowded_why"] = s.fit.crowded_why;
-      if (s.fit.r_se_px > 0) js["r_se_px"] = s.fit.r_se_px;
+      if (s.fit.r_se_px > 0 && std::isfinite(s.fit.r_se_px)) js["r_se_px"] = s.fit.r_se_px;
       if (s.r_fitted_se_px > 0) js["r_fitted_se_px"] = s.r_fitted_se_px;
       if (!s.fit.phase_why.empty()) js["phase_why"] = s.fit.phase_why;
       if (s.phase.limited || s.phase.every_phase) js["phase"] = PhaseCheckJson(s.phase);

@@ -115,6 +115,12 @@ std::vector<optics::BlurSample> ModelSamples(const CalibResult& result);
 // "phase_limited", "crowded", "low_contrast", ...).
 std::map<std::string, int> SectionsLeftOut(const CalibResult& result);
 
+// A section flag in words, for a summary: what it means and whether the section is used ("poor_fit": "the blur model
+// fits the profile worse than 8 % of the step (a smudge, a reflection)"). Empty for a name it does not know.
+std::string SectionFlagMeaning(const std::string& flag);
+// The informational flags (never disqualify a section): "flaw", "neighbours", "short", "junctions".
+const std::vector<std::string>& InformationalFlags();
+
 // Makes `model` the result's thin-lens model: every section's r_fitted_px and every edge's mean follow it (a tracked
 // take's one lens model replacing each frame's own).
 void ApplyModel(CalibResult& result, const optics::FittedModel& model);

@@ -489,7 +489,24 @@ void DescribeFit(const FitState& best, const std::array<std::array<double, 3>, 3
 void ReadOneShapeUnderAPixel(const FitSetup& setup, const FitState& best,
                              const std::array<std::array<double, 3>, 3>& jtj, const std::vector<Bin>& bins,
                              double d0_limit, ModelFit* fit) {
-  if (!(fit->shape_ambiguous && fit->r_px < kOneShapeBelowPx && fit->r_px >= kOneShapeFromPx)) return;
+  const int params = 2 + (setup.slopes ? 4 : 2) + static_cast<int>(setup.steps.size());
+  const double dof = std::max(1.0, double(bins.size()) - params);
+  // The size's standard error with the shape held: the Gauss-Newton curvature of the reduced problem over (d0, r),
+  // the residual variance per bin from the fit (model error included); infinite where the curvature in r vanishes
+  // (a reading near 0, where the profile's slope in r does).
+  auto size_se = [&](const std::array<std::array<double, 3>, 3>& a, double sse) {
+    const double det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+    return det > 0 && std::isfinite(sse) ? std::sqrt(sse / dof * a[0][0] / det)
+                                         : std::numeric_limits<double>::infinity();
+  };
+  // Under kOneShapeFromPx the reading stands as the free fit read it; its standard error says whether the profile
+  // pinned it (a Gaussian x 0.2 px floor scene under JPEG 95 read a section of 0.41 px as 0.02 px, its neighbours
+  // 0.37-0.49 px, with nothing to flag it).
+  if (fit->r_px < kOneShapeFromPx) {
+    fit->r_se_px = size_se(jtj, best.sse);
+    return;
+  }
+  if (!(fit->shape_ambiguous && fit->r_px < kOneShapeBelowPx)) return;
   FitState start_state = best;
   start_state.phi = kPi / 2;
   std::array<std::array<double, 3>, 3> a{};
@@ -500,12 +517,9 @@ void ReadOneShapeUnderAPixel(const FitSetup& setup, const FitState& best,
     DescribeFit(gauss, jtj, setup, bins, fit);
     fit->shape_ambiguous = true;
   }
-  // The size's standard error with the shape held: the Gauss-Newton curvature of the reduced problem over (d0, r),
-  // the residual variance per bin from the fit (model error included).
-  const int params = 2 + (setup.slopes ? 4 : 2) + static_cast<int>(setup.steps.size());
-  const double dof = std::max(1.0, double(bins.size()) - params);
-  const double det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
-  if (det > 0 && std::isfinite(gauss.sse)) fit->r_se_px = std::sqrt(gauss.sse / dof * a[0][0] / det);
+  // Where the Gaussian re-fit collapsed to its least radius (JPEG 95 had taken a 0.41 px section's tails: 0.02 px,
+  // its neighbours 0.37-0.49 px) the curvature in r vanishes and the standard error is infinite: not determined.
+  fit->r_se_px = size_se(a, gauss.sse);
 }
 
 ModelFit FitInWindow(const cv::Mat& linear, const EdgeSegment& segment, const ModelFitOptions& options,

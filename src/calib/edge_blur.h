@@ -75,8 +75,9 @@ struct ModelFit {
   // The shape within r_px^2 = disc_r_px^2 + 4 floor_sigma_px^2 (DESIGN.md): a defocus disc and a Gaussian floor.
   double disc_r_px = 0, floor_sigma_px = 0;
   double shape_se_rad = 0;         // standard error of the shape angle atan(2 floor_sigma / disc_r)
-  // Under kOneShapeBelowPx, where the shape is ambiguous: the standard error of r_px with the Gaussian shape held
-  // (0 where not read so). Near a pixel centre it grows (phase_check.cc: a section too unsure there is flagged).
+  // Under kOneShapeBelowPx, where the shape is ambiguous: the standard error of r_px with the shape held (the Gaussian
+  // from kOneShapeFromPx, the free fit's under it; 0 where not read so, infinite where the profile does not bound the
+  // reading). Near a pixel centre it grows (phase_flags.cc: a section too unsure there is flagged).
   double r_se_px = 0;
   bool shape_ambiguous = true;     // the profile does not pin the split (under kOneShapeBelowPx, read as a Gaussian)
   std::string psf;                 // "disc", "gaussian" or "disc x gaussian": the fitted shape

@@ -9,6 +9,7 @@
 #include "calib/calibrate.h"
 #include "calib/edge_esf.h"
 #include "calib/edge_window.h"
+#include "calib/family_esf.h"
 #include "calib/phase_fit.h"
 #include "calib/phase_flags.h"
 #include "core/error.h"
@@ -16,15 +17,15 @@
 namespace blurcue::calib {
 namespace {
 
-using detail::EsfModel;
+using detail::FamilyProfile;
+using detail::FamilyTaps;
+using detail::ProjectTaps;
+using detail::ProjectedTap;
+using detail::TapsVariance;
 constexpr double kPi = 3.14159265358979323846;
 // Phases: an edge whose sub-pixel position moves by a pixel or more along the part measured is sampled at every
 // phase (the blur fit super-resolves its profile); under that, few phases.
 constexpr double kMinSpanPx = 1.0;
-// A family's taps act along the nearest pixel axis (ReadFamily); an edge further off it than this is read by no family
-// (the other axis's taps move its profile by 0.42 px or more per pixel): on physical boards turned 45 and 60 deg the
-// one-axis model let a Gaussian of 0.35 px fit their long profiles better than the optics alone, and it was chosen.
-constexpr double kMaxFilterAxisDeg = 25;
 // Blur: beyond about 2 px the profile has samples enough across the edge that the families read within 2-5 % of
 // each other at any phase (measured: 2.00 vs 1.90-2.16 px at r = 2); below, up to a factor 2 apart.
 constexpr double kMaxBlurPx = 2.0;
@@ -111,72 +112,28 @@ std::vector<Bin> ProfileBins(const cv::Mat& linear, const EdgeSegment& segment, 
   return bins;
 }
 
-// The family's kernel at whole pixels (Gaussian out to 4 sigma, at least one tap each side), normalised; {1} for the
-// optics alone.
-std::vector<double> FamilyTaps(const PhaseFamily& family) {
-  const double sigma = family.sigma_px;
-  if (!(sigma > 0)) return {1.0};
-  const int reach = std::max(1, static_cast<int>(std::ceil(4 * sigma)));
-  std::vector<double> t(2 * reach + 1);
-  double sum = 0;
-  for (int k = -reach; k <= reach; ++k) sum += t[k + reach] = std::exp(-0.5 * (k / sigma) * (k / sigma));
-  const double a = std::max(0.0, family.sharpen);
-  for (int k = -reach; k <= reach; ++k)
-    t[k + reach] = a > 0 ? (k == 0 ? 1 + a : 0) - a * t[k + reach] / sum : t[k + reach] / sum;
-  return t;
-}
-
-double TapsVariance(const std::vector<double>& t) {
-  const int reach = static_cast<int>(t.size()) / 2;
-  double v = 0;
-  for (int k = -reach; k <= reach; ++k) v += double(k) * k * t[k + reach];
-  return v;
-}
-
-struct FamilyFit {
-  double sse = std::numeric_limits<double>::infinity(), step = 0;
-};
-
-// The family's profile (optics of radius r1 and shape phi, then the taps across the rows, each a shift of `shift`
-// px across the edge) with its two levels by least squares, the edge at d = d0.
-FamilyFit EvaluateFamily(const std::vector<Bin>& bins, const std::vector<double>& taps, double shift, double r1,
-                         double d0, double phi, double w1, double w2) {
-  const EsfModel model(std::max(r1, 0.02), phi, w1, w2);
-  const int reach = static_cast<int>(taps.size()) / 2;
-  double s1 = 0, se = 0, see = 0, sv = 0, sev = 0, svv = 0;
-  for (const Bin& b : bins) {
-    double e = 0;
-    for (int k = -reach; k <= reach; ++k) e += taps[k + reach] * model(b.x - d0 - k * shift);
-    s1 += b.w, se += b.w * e, see += b.w * e * e, sv += b.w * b.v, sev += b.w * e * b.v, svv += b.w * b.v * b.v;
-  }
-  FamilyFit out;
-  const double det = s1 * see - se * se;
-  if (!(det > 1e-12 * s1 * s1)) return out;
-  const double step = (s1 * sev - se * sv) / det, low = (sv - step * se) / s1;
-  out.step = step;
-  out.sse = std::max(0.0, svv - low * sv - step * sev);
-  return out;
-}
-
-// The family's residuals (sqrt(w) x (value - model)) at parameters p = {r1, d0, phi}, its two levels by least squares
-// (solved again at every p: the levels are projected out, so the search is over the three shape parameters only).
-void FamilyResiduals(const std::vector<Bin>& bins, const std::vector<double>& taps, double shift, const double* p,
-                     double w1, double w2, std::vector<double>* res) {
-  const EsfModel model(std::max(p[0], 0.02), p[2], w1, w2);
-  const int reach = static_cast<int>(taps.size()) / 2;
+// The family's profile at each bin (optics p = {r1, d0, phi}, then the family's taps `taps` projected across the
+// edge: ProjectTaps), its two levels by least squares (solved again at every p: the levels are projected out, so the
+// search is over the three shape parameters only); `res` gets sqrt(w) x (value - model) and `step` the step. False
+// where the profile does not tell the levels apart (the step is then 0).
+bool FamilyResiduals(const std::vector<Bin>& bins, const std::vector<ProjectedTap>& taps, const double* p, double w1,
+                     double w2, std::vector<double>* res, double* step_out = nullptr) {
+  const FamilyProfile profile(std::max(p[0], 0.02), p[2], w1, w2, taps, bins.size());
   std::vector<double>& e = *res;
   e.resize(bins.size());
   double s1 = 0, se = 0, see = 0, sv = 0, sev = 0;
   for (size_t i = 0; i < bins.size(); ++i) {
     const Bin& b = bins[i];
-    double m = 0;
-    for (int k = -reach; k <= reach; ++k) m += taps[k + reach] * model(b.x - p[1] - k * shift);
+    const double m = profile(b.x - p[1]);
     e[i] = m;
     s1 += b.w, se += b.w * m, see += b.w * m * m, sv += b.w * b.v, sev += b.w * m * b.v;
   }
   const double det = s1 * see - se * se;
-  const double step = det > 1e-12 * s1 * s1 ? (s1 * sev - se * sv) / det : 0, low = (sv - step * se) / s1;
+  const bool ok = det > 1e-12 * s1 * s1;
+  const double step = ok ? (s1 * sev - se * sv) / det : 0, low = (sv - step * se) / s1;
   for (size_t i = 0; i < bins.size(); ++i) e[i] = std::sqrt(bins[i].w) * (bins[i].v - low - step * e[i]);
+  if (step_out) *step_out = step;
+  return ok;
 }
 
 double SumOfSquares(const std::vector<double>& r) {
@@ -187,10 +144,10 @@ double SumOfSquares(const std::vector<double>& r) {
 
 // Levenberg-Marquardt from p = {r1, d0, phi} on the family's residuals (the optics' radius, the edge's position
 // within the pose's uncertainty, the optics' shape); returns the sum of squares at the p it leaves.
-double RefineFamily(const std::vector<Bin>& bins, const std::vector<double>& taps, double shift, double w1, double w2,
+double RefineFamily(const std::vector<Bin>& bins, const std::vector<ProjectedTap>& taps, double w1, double w2,
                     double* p, bool hold_shape = false) {
   std::vector<double> res, trial, col[3];
-  FamilyResiduals(bins, taps, shift, p, w1, w2, &res);
+  FamilyResiduals(bins, taps, p, w1, w2, &res);
   double best = SumOfSquares(res);
   const double lo[3] = {0, -kPoseUncertaintyPx, 0}, hi[3] = {1e9, kPoseUncertaintyPx, kPi / 2};
   const double h[3] = {1e-3, 1e-3, 2e-3};
@@ -206,7 +163,7 @@ double RefineFamily(const std::vector<Bin>& bins, const std::vector<double>& tap
       double q[3] = {p[0], p[1], p[2]};
       const double hc = q[c] + h[c] > hi[c] ? -h[c] : h[c];
       q[c] += hc;
-      FamilyResiduals(bins, taps, shift, q, w1, w2, &col[c]);
+      FamilyResiduals(bins, taps, q, w1, w2, &col[c]);
       for (size_t i = 0; i < res.size(); ++i) col[c][i] = (col[c][i] - res[i]) / hc;
     }
     for (int a = 0; a < 3; ++a) {
@@ -227,7 +184,7 @@ double RefineFamily(const std::vector<Bin>& bins, const std::vector<double>& tap
       if (!cv::solve(m, g, delta, cv::DECOMP_CHOLESKY)) break;
       double q[3];
       for (int c = 0; c < 3; ++c) q[c] = std::clamp(p[c] + delta[c], lo[c], hi[c]);
-      FamilyResiduals(bins, taps, shift, q, w1, w2, &trial);
+      FamilyResiduals(bins, taps, q, w1, w2, &trial);
       const double v = SumOfSquares(trial);
       if (v < best) {
         improved = true;
@@ -252,18 +209,19 @@ double RefineFamily(const std::vector<Bin>& bins, const std::vector<double>& tap
 // turns of one-dimensional searches with the blur fit's shape settled on a ridge, 2-5 % short of the true reading with
 // the true family on sharpened scenes (amount 0.5), so that a wrong family fitted better.
 PhaseReading ReadFamily(const std::vector<Bin>& bins, const PhaseFamily& family, double r_fit, double phi_fit,
-                        double w1, double w2, double shift, double noise, bool one_shape) {
-  const std::vector<double> taps = FamilyTaps(family);
+                        double w1, double w2, double noise, bool one_shape) {
+  const std::vector<double> taps1 = FamilyTaps(family);
+  const std::vector<ProjectedTap> taps = ProjectTaps(taps1, w1, w2);
   std::vector<double> res;
   double p[3] = {0, 0, phi_fit}, best = std::numeric_limits<double>::infinity();
   const double top = std::max(2.5, 1.6 * r_fit), grid = top / 12;
   for (const double phi : {phi_fit, std::abs(phi_fit - kPi / 4) < 0.2 ? kPi / 2 : kPi / 4})
     for (int k = 0; k <= 12; ++k) {
       const double q[3] = {k * grid, 0, phi};
-      FamilyResiduals(bins, taps, shift, q, w1, w2, &res);
+      FamilyResiduals(bins, taps, q, w1, w2, &res);
       if (const double v = SumOfSquares(res); v < best) best = v, p[0] = q[0], p[2] = q[2];
     }
-  double sse = RefineFamily(bins, taps, shift, w1, w2, p);
+  double sse = RefineFamily(bins, taps, w1, w2, p);
   // At r = 0 the profile's slope in r vanishes (its variance grows as r^2), so a refinement started there stays: on an
   // edge near a pixel centre the grid's best node was 0 and the optics alone read 0.00 px where the blur fit read
   // 0.42-0.51 px (true 0.43 px; floor 0.2 px), flagged as a jump and holding the model 7 % low. Started from the blur
@@ -271,28 +229,29 @@ PhaseReading ReadFamily(const std::vector<Bin>& bins, const PhaseFamily& family,
   // stuck at 0 on an aliased take frame (supersample 1) came to fit alike and flagged a whole edge.
   if (!(family.sigma_px > 0) && p[0] < 0.05 && r_fit > 0.05) {
     double q[3] = {r_fit, 0, p[2]};
-    if (const double v = RefineFamily(bins, taps, shift, w1, w2, q); v < sse) sse = v, p[0] = q[0], p[1] = q[1], p[2] = q[2];
+    if (const double v = RefineFamily(bins, taps, w1, w2, q); v < sse) sse = v, p[0] = q[0], p[1] = q[1], p[2] = q[2];
   }
   // Where the blur fit found the shape ambiguous under a pixel and read the size as a Gaussian (edge_blur.cc), the
   // family's optics under a pixel are read so too: a shape the profile cannot tell moved the optics-alone reading
   // 8-20 % off on physical optics, and it off its neighbouring families' readings (disc x 0.2 px floor).
   if (one_shape && p[0] < kOneShapeBelowPx) {
     p[2] = kPi / 2;
-    RefineFamily(bins, taps, shift, w1, w2, p, /*hold_shape=*/true);
+    RefineFamily(bins, taps, w1, w2, p, /*hold_shape=*/true);
   }
-  const double r1 = p[0], d0 = p[1], phi = p[2];
-  const FamilyFit fit = EvaluateFamily(bins, taps, shift, r1, d0, phi, w1, w2);
+  const double r1 = p[0], d0 = p[1];
+  double step = 0;
+  const bool ok = FamilyResiduals(bins, taps, p, w1, w2, &res, &step);
+  sse = ok ? SumOfSquares(res) : std::numeric_limits<double>::infinity();
   double w = 0;
   for (const Bin& bin : bins) w += bin.w;
   PhaseReading out;
-  // The taps act along the nearest pixel axis, `shift` px across the edge per pixel: their second moment across it is
-  // V x shift^2. On an edge turned off the axis the filter along the other axis (V x the rest) is absorbed by the
-  // optics' reading r1, so the whole is r1^2 + 4 V shift^2 (with 4 V it read a board turned 20 deg under a mask of
-  // amount 0.7 3 % low, the lens model's floor 0 and its p90 31 %). Level edges: shift 1.
-  out.r_px = std::sqrt(std::max(0.0, r1 * r1 + 4 * TapsVariance(taps) * shift * shift));
+  // The filter is the taps on both axes (ProjectTaps): its variance across an edge of any direction is the taps' V, so
+  // the whole is r1^2 + 4 V. (Read with the taps along the nearest axis alone, the other axis's share was left to
+  // the optics' r1, an approximation that let edges only 25 deg off an axis be read per family.)
+  out.r_px = std::sqrt(std::max(0.0, r1 * r1 + 4 * TapsVariance(taps1)));
   out.offset_px = d0;
-  out.rms_rel = std::abs(fit.step) > 1e-9 ? std::sqrt(fit.sse / std::max(w, 1.0)) / std::abs(fit.step) : 1e9;
-  out.chi2 = fit.sse / (noise * noise);
+  out.rms_rel = std::abs(step) > 1e-9 ? std::sqrt(sse / std::max(w, 1.0)) / std::abs(step) : 1e9;
+  out.chi2 = sse / (noise * noise);
   return out;
 }
 
@@ -358,7 +317,7 @@ namespace {
 // its families are read on.
 struct PhaseProfile {
   std::vector<Bin> bins;
-  double phi = 0, w1 = 1, w2 = 0, shift = 1, r_fit = 0;
+  double phi = 0, w1 = 1, w2 = 0, r_fit = 0;
   bool one_shape = false;  // the blur fit read the size with the Gaussian shape (ambiguous under a pixel)
 };
 
@@ -375,7 +334,9 @@ PhaseCheck GatePhase(const cv::Mat& linear, const EdgeSegment& segment, const Mo
   const double across = ax >= ay ? mid.y : mid.x;
   check.phase_px = across - std::floor(across);
   const bool few = check.span_px < kMinSpanPx;
-  if (!(fit.r_px > 0 && fit.r_px < kMaxBlurPx) || (!few && check.axis_deg > kMaxFilterAxisDeg)) return check;
+  // At any angle: a family's taps act on both axes (ProjectTaps). Read along the nearest axis alone, edges more than
+  // 25 deg off it were not read (physical boards turned 45 and 60 deg chose a Gaussian of 0.35 px that no photo had).
+  if (!(fit.r_px > 0 && fit.r_px < kMaxBlurPx)) return check;
   const double half = std::min(segment.half_window_px, 2 * fit.r_px + 6);
   const std::vector<Bin> bins = ProfileBins(linear, segment, options.along_fraction, half, &check.noise);
   if (bins.size() < 6) return check;
@@ -386,8 +347,7 @@ PhaseCheck GatePhase(const cv::Mat& linear, const EdgeSegment& segment, const Mo
   // made a post filter look better than the optics alone on physical optics.
   const double phi = std::atan2(2 * fit.floor_sigma_px, fit.disc_r_px);
   const double w1 = std::max(std::abs(f.n.x), std::abs(f.n.y)), w2 = std::min(std::abs(f.n.x), std::abs(f.n.y));
-  // A filter's tap one pixel along the nearest axis moves the profile by this much across the edge.
-  *profile = {bins, phi, w1, w2, /*shift=*/w1, fit.r_px, fit.shape_ambiguous && fit.r_px < kOneShapeBelowPx && fit.r_px >= kOneShapeFromPx};
+  *profile = {bins, phi, w1, w2, fit.r_px, fit.shape_ambiguous && fit.r_px < kOneShapeBelowPx && fit.r_px >= kOneShapeFromPx};
   return check;
 }
 
@@ -408,17 +368,24 @@ double MisfitScale(const PhaseCheck& check, double sd) {
 // asked with every section weighed from 1 x its dof (there the optics alone fits best, 2307 against 3623; the filtered
 // scenes' filters win by 815-46000); which filter, with only misfit beyond 4 standard deviations of the noise weighed
 // (weighed from 1 x dof, the noise alone moved the bench's mask of amount 0.7 to 0.3 over 0.8 px, model p90 21 %; the
-// take frame weighed so chose a Gaussian of 0.31 px).
-std::vector<double> WeighedTotals(const std::vector<const PhaseCheck*>& checks, size_t nf,
-                                  std::vector<double>* any_out = nullptr) {
+// take frame weighed so chose a Gaussian of 0.31 px). A filter is taken only where one fits better than the optics
+// alone by kAlikeChi2 in the first weighing (each section in its own noise units): on a physical board turned 60 deg
+// a Gaussian of 0.35 px (taps 0.017, 0.966, 0.017) fitted 8185.0 against the optics alone's 8186.9 and was chosen,
+// flagging a correct section. `best` is the family chosen so (0: the optics alone), `chi2` the weighing it is chosen by.
+struct WeighedChi2 {
+  std::vector<double> chi2, any;
+  size_t best = 0;
+};
+WeighedChi2 WeighedTotals(const std::vector<const PhaseCheck*>& checks, size_t nf) {
   std::vector<double> any(nf, 0.0), which(nf, 0.0);
   for (const PhaseCheck* c : checks) {
     const double w_any = 1 / MisfitScale(*c, 0), w_which = 1 / MisfitScale(*c, 4);
     for (size_t f = 0; f < nf; ++f) any[f] += w_any * c->families[f].chi2, which[f] += w_which * c->families[f].chi2;
   }
-  const bool filter = nf > 1 && *std::min_element(any.begin() + 1, any.end()) < any[0];
-  if (any_out) *any_out = any;
-  return filter ? which : any;
+  const bool filter = nf > 1 && *std::min_element(any.begin() + 1, any.end()) < any[0] - kAlikeChi2;
+  WeighedChi2 out{filter ? which : any, any, 0};
+  if (filter) out.best = std::min_element(which.begin(), which.end()) - which.begin();
+  return out;
 }
 
 // How many sections every family is read on before the others are ruled out: kChoiceSections, or fewer where the
@@ -447,7 +414,7 @@ void ReadFamilies(const PhaseProfile& p, const std::vector<bool>& read, PhaseChe
       continue;
     }
     check->families.push_back(
-        ReadFamily(p.bins, families[c], p.r_fit, p.phi, p.w1, p.w2, p.shift, check->noise, p.one_shape));
+        ReadFamily(p.bins, families[c], p.r_fit, p.phi, p.w1, p.w2, check->noise, p.one_shape));
   }
 }
 
@@ -495,14 +462,13 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
     std::vector<double> weight;  // every section in its own units (WeighedTotals's first weighing)
     for (const size_t k : deciders)
       checks.push_back(&usable[k]->phase), weight.push_back(1 / MisfitScale(usable[k]->phase, 0));
-    const std::vector<double> total = WeighedTotals(checks, nf);
-    const size_t best = std::min_element(total.begin(), total.end()) - total.begin();
+    const size_t best = WeighedTotals(checks, nf).best;
     if (best == 0) return;
     std::vector<double> chi2(deciders.size());
     const PhaseFamily fitted = RefinePhaseFamily(PhaseFamilies()[best], [&](const PhaseFamily& family) {
       each(deciders.size(), [&](size_t i) {
         const PhaseProfile& p = profiles[deciders[i]];
-        chi2[i] = weight[i] * ReadFamily(p.bins, family, p.r_fit, p.phi, p.w1, p.w2, p.shift,
+        chi2[i] = weight[i] * ReadFamily(p.bins, family, p.r_fit, p.phi, p.w1, p.w2,
                                          usable[deciders[i]]->phase.noise, p.one_shape).chi2;
       });
       double sum = 0;
@@ -513,7 +479,7 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
     each(limited.size(), [&](size_t i) {
       const PhaseProfile& p = profiles[limited[i]];
       PhaseCheck& check = usable[limited[i]]->phase;
-      check.families.push_back(ReadFamily(p.bins, fitted, p.r_fit, p.phi, p.w1, p.w2, p.shift, check.noise, p.one_shape));
+      check.families.push_back(ReadFamily(p.bins, fitted, p.r_fit, p.phi, p.w1, p.w2, check.noise, p.one_shape));
     });
   };
   if (limited.size() <= 2 * kChoiceSections) {
@@ -536,8 +502,9 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
   int points = 0;
   std::vector<const PhaseCheck*> checks;
   for (const size_t k : chosen) points += usable[k]->phase.bins, checks.push_back(&usable[k]->phase);
-  const std::vector<double> chi2 = WeighedTotals(checks, nf);
-  const size_t best = std::min_element(chi2.begin(), chi2.end()) - chi2.begin();
+  const WeighedChi2 totals = WeighedTotals(checks, nf);
+  const std::vector<double>& chi2 = totals.chi2;
+  const size_t best = totals.best;
   const int dof = std::max(1, points - 3 * int(chosen.size()) - 1);
   const double scale = std::max(1.0, chi2[best] / dof), excess = std::max(0.0, chi2[best] - dof);
   std::vector<bool> read(nf);
@@ -650,9 +617,10 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
     checks.push_back(&s->phase);
     for (size_t c = 0; c < families.size(); ++c) raw[c] += s->phase.families[c].chi2;
   }
-  std::vector<double> any;
-  choice.chi2 = WeighedTotals(checks, families.size(), &any);
-  const size_t least = std::min_element(choice.chi2.begin(), choice.chi2.end()) - choice.chi2.begin();
+  const WeighedChi2 totals = WeighedTotals(checks, families.size());
+  choice.chi2 = totals.chi2;
+  const std::vector<double>& any = totals.any;
+  const size_t least = totals.best;
   const int dof = std::max(1, points - 3 * int(limited.size()) - 1);
   const double scale = std::max(1.0, choice.chi2[least] / dof);
   // Beyond the noise, a model error grows every family's chi-square with the points: then families within kAlikeRel
@@ -721,17 +689,17 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   int n_alike = 0, n_read = 0;
   for (const bool a : choice.alike) n_alike += a;
   for (const double c : choice.chi2) n_read += std::isfinite(c);
-  char text[720], ruled[120] = "";
+  char text[900], ruled[120] = "";
   if (n_read < int(families.size()))
     std::snprintf(ruled, sizeof ruled, "; %zu ruled out on %zu sections at spread phases and not read on the rest",
                   families.size() - n_read, result.phase.choice_sections);
   std::snprintf(text, sizeof text,
                 "%d sections with blur under %.0f px along the pixel rows or columns (and %d at every phase) read under "
                 "%zu kinds of blur (the lens alone, or then a smoothing or sharpening of the pixels): the photo fits "
-                "best as %s (%d of the kinds fit alike, chi-square per point %.2f%s); %d flagged phase_limited (%d where the "
-                "sharpening cancels most of the lens's blur, %d jumping between neighbouring kinds, %d off the line "
-                "through their edge's other sections, %d too unsure near a pixel centre; each reading's range in "
-                "calib.json)",
+                "best as %s (%d of the kinds fit alike, chi-square per point %.2f, 1 where only the noise is left%s); %d "
+                "flagged phase_limited (%d where the sharpening cancels most of the lens's blur, %d jumping between "
+                "neighbouring kinds, %d off the line through their edge's other sections, %d too unsure near a pixel "
+                "centre; each reading's range in calib.json)",
                 choice.limited, kMaxBlurPx, choice.every_phase, families.size(), families[best].Name().c_str(), n_alike,
                 choice.chi2_per_point, ruled, choice.flagged, cancelled, jumped, off_edge, unsure);
   choice.summary = text;

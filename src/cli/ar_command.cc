@@ -10,18 +10,15 @@
 #include <string>
 #include <vector>
 
-#include <fcntl.h>
-#include <unistd.h>
-
-#include "core/media.h"
-
 #include "calib/scene_blur.h"
 #include "cli/commands.h"
 #include "cli/placed_objects.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/image.h"
+#include "core/media.h"
 #include "core/output_guard.h"
+#include "core/own_output.h"
 #include "core/typed.h"
 #include "render/frame_compositor.h"
 #include "render/gl_context.h"
@@ -37,15 +34,6 @@ namespace {
 // (64 x 18000 rows is about 200 MB).
 constexpr size_t kMaxArObjects = stimulus::kMaxPlacedObjects;
 constexpr int kMaxArFrames = 18000;  // 10 minutes at 30 fps
-
-// fsync of a finished file (the video the writer closed) so that its rename cannot outlive its bytes; a failure
-// here is not one: the file is whole, only its survival of a power cut is in doubt.
-void SyncFile(const std::filesystem::path& path) {
-  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return;
-  fsync(fd);
-  close(fd);
-}
 
 struct ArArgs {
   std::string input, track, out, csv, frames_dir, blur = "fitted", method = "disc";
@@ -151,22 +139,6 @@ std::string ChooseArExposure(const ArArgs& args, const stimulus::TrackedTake& ta
     blur->exposure_ms = args.exposure_ms;
   }
   return exposure_note;
-}
-
-// A folder removed with what is in it when the run ends, written whole or not.
-struct RemovedAtExit {
-  fs::path path;
-  ~RemovedAtExit() {
-    std::error_code ignored;
-    fs::remove_all(path, ignored);
-  }
-};
-
-// Makes `partial`, the folder an output (`target`) is built in.
-void MakePartialFolder(const fs::path& partial, const std::string& target) {
-  std::error_code error;
-  fs::create_directories(partial, error);
-  if (error) throw InputError(target, "cannot make " + partial.string() + ": " + error.message());
 }
 
 // One run's drawing: every frame of the source into the video (opened at the first frame), the CSV's rows and the
@@ -335,21 +307,12 @@ void AddArCommand(CLI::App& app) {
                    args->track.c_str());
 
     std::unique_ptr<render::GlContext> context = render::GlContext::CreateOffscreen();
-    // The video is written under its own name (the extension tells the writer its container) inside
-    // DIR/.NAME.partial-PID, and moved into place once it, the frames and the CSV are whole; a run that fails or is
-    // killed leaves the earlier video (the next run removes the partial folder).
-    const fs::path video_partial = TemporaryBeside(args->out, "partial");
-    const RemovedAtExit partial_video{video_partial};
-    MakePartialFolder(video_partial, args->out);
-    const fs::path video_temp = video_partial / fs::path(args->out).filename();
-    // The CSV, written whole inside a folder of its own beside its place, .NAME.partial-PID, before the video is
-    // moved: whatever a kill leaves there is one folder, removed here on failure or by the next run's
-    // RemoveStaleLeftovers (a file written atomically beside it would leave its own .tmp-PID that no one names).
-    const fs::path csv_partial = TemporaryBeside(csv_path, "partial");
-    const RemovedAtExit partial_csv{csv_partial};
-    MakePartialFolder(csv_partial, csv_path);
-    const fs::path csv_temp = csv_partial / fs::path(csv_path).filename();
-    ArDrawing drawing{*args, take, objects, blur, source, video_temp};
+    // The video is written under its own name (the extension tells the writer its container) and the CSV whole,
+    // each inside a folder of its own beside its place (PartialFile), and both are moved into place once the video,
+    // the frames and the CSV are whole; a run that fails or is killed leaves the earlier ones (the next run removes
+    // the partial folders).
+    PartialFile video_file(args->out), csv_file(csv_path);
+    ArDrawing drawing{*args, take, objects, blur, source, video_file.path()};
     auto draw = [&](const fs::path& frames_dir) {
       drawing.DrawFrames(frames_dir);
       if (!frames_dir.empty())
@@ -361,12 +324,9 @@ void AddArCommand(CLI::App& app) {
     // --frames the frames folder is swapped in by a third right after (WriteFolderAtomically's before_swap): the
     // three are no single step, but all that lies between them is three renames.
     auto move_in = [&] {
-      WriteFileAtomically(csv_temp, drawing.csv);
-      SyncFile(video_temp);
-      std::error_code error;
-      fs::rename(video_temp, args->out, error);
-      if (!error) fs::rename(csv_temp, csv_path, error);
-      if (error) throw InputError(args->out, "cannot move the finished video and CSV into place: " + error.message());
+      WriteFileAtomically(csv_file.path(), drawing.csv);
+      video_file.Finish();
+      csv_file.Finish();
     };
     if (args->frames_dir.empty()) {
       draw({});

@@ -34,7 +34,20 @@ void WarnAboutCalibration(const calib::CalibResult& result, const Camera& camera
   // A lens model whose aperture is far from the camera's f-number fits sections that may not measure the board's
   // edges (an edge covered or shaded reads sharp: a covered board gave focus 21 mm and an aperture of 0). Far: over
   // two thirds of a stop either way (kApertureWarnFactor; 0.6 x and 1.29 x passed unsaid under the old bound of 2 x).
-  if (calib::ApertureFarFromNominal(result, camera))
+  // Where the phase check found a filter after sampling, that is the first suspect: it adds one variance to every
+  // section's blur (a sharpening takes it away), which the thin lens (+ a floor of 0 or more) does not have, so the
+  // fit bends focus and aperture instead (a mask of amount 0.5 over 0.8 px, focus 300 mm: aperture 1.42 x, focus
+  // 342 mm).
+  const bool filtered = result.phase.chosen != 0 && result.phase.chosen < result.phase.families.size();
+  if (calib::ApertureFarFromNominal(result, camera) && filtered)
+    std::fprintf(stderr,
+                 "blurcue: warning: %s: the fitted aperture %.3f mm is %.2f x the camera's (%.3f mm, f/%g), more "
+                 "than two thirds of a stop off: the photo was processed after it was sampled (the phase check found "
+                 "%s), which the lens model does not represent, so its focus and aperture are bent to fit; "
+                 "photograph the board again with the camera's sharpening or smoothing off (or raw)\n",
+                 photo_file.c_str(), result.model.aperture_mm, calib::ApertureRatio(result, camera), camera.ApertureMm(),
+                 camera.f_number, result.phase.families[result.phase.chosen].Name().c_str());
+  else if (calib::ApertureFarFromNominal(result, camera))
     std::fprintf(stderr,
                  "blurcue: warning: %s: the fitted aperture %.3f mm is %.2f x the camera's (%.3f mm, f/%g), more "
                  "than two thirds of a stop off: the sections may not measure the board's edges (covered, shaded, "
@@ -55,16 +68,22 @@ void PrintCalibrationSummary(const calib::CalibResult& result, const Board& boar
                 result.reference_edge, result.reference_u_mm, result.reference_r_px);
   else
     std::printf("reference edge %d: u = %.1f mm, r = %.2f px (median of its phase_limited sections' readings: none "
-                "of them is usable, so eq. 3.7's estimates below are as unsure as they are)\n",
+                "of them is usable, so eq. 3.7's estimates below are as unsure as they are; --reference-edge N takes "
+                "another edge)\n",
                 result.reference_edge, result.reference_u_mm, result.reference_r_px);
   const std::string far = calib::ApertureFarFromNominal(result, camera)
                               ? ", " + Num(std::round(calib::ApertureRatio(result, camera) * 100) / 100) +
                                     " x: more than two thirds of a stop off"
                               : "";
+  // Its samples: the sections it is fitted to, and the middles of the phase_limited ranges that held it.
+  const std::string held = result.phase.held > 0 ? " (" + std::to_string(m.samples_used - result.phase.held) +
+                                                       " sections and " + std::to_string(result.phase.held) +
+                                                       " held ranges' middles)"
+                                                 : "";
   std::printf("fitted %s model: focus %.1f mm, aperture %.3f mm (nominal %.3f%s), %s, rms %.3f px,"
-              " leave-one-out %.3f px, %d outliers of %d%s\n",
+              " leave-one-out %.3f px, %d outliers of its %d samples%s%s\n",
               m.kind.c_str(), m.focus_mm, m.aperture_mm, camera.ApertureMm(), far.c_str(),
-              optics::FloorText(m).c_str(), m.rms_px, m.loo_rms_px, m.outliers, m.samples_used,
+              optics::FloorText(m).c_str(), m.rms_px, m.loo_rms_px, m.outliers, m.samples_used, held.c_str(),
               result.phase.variance_px2 < 0 ? " (fitted to the optics' readings under the sharpening: rms in their px)"
                                             : "");
   // How many sections the model was fitted to, and why the others were left out.
@@ -77,6 +96,17 @@ void PrintCalibrationSummary(const calib::CalibResult& result, const Board& boar
       left += (left.empty() ? "" : ", ") + std::to_string(n) + " " + why, n_left += n;
     std::printf("the model is fitted to %d of %d sections%s\n", sections - n_left, sections,
                 left.empty() ? "" : ("; left out (it predicts them): " + left).c_str());
+    // What each flag means, once (phase_limited has its own lines below), and the informational ones.
+    for (const auto& [why, n] : calib::SectionsLeftOut(result))
+      if (why != "phase_limited") std::printf("  %s: %s\n", why.c_str(), calib::SectionFlagMeaning(why).c_str());
+    for (const std::string& flag : calib::InformationalFlags()) {
+      int n = 0;
+      for (const auto& e : result.edges)
+        for (const auto& sec : e.sections)
+          n += std::find(sec.fit.flags.begin(), sec.fit.flags.end(), flag) != sec.fit.flags.end();
+      if (n > 0 && flag != "short")  // short: its own line below
+        std::printf("%d sections flagged %s: %s\n", n, flag.c_str(), calib::SectionFlagMeaning(flag).c_str());
+    }
     // phase_limited sections flagged only by a sharpening's amplification join the fit at their readings.
     int n_joined = 0;
     for (const auto& e : result.edges)
@@ -113,8 +143,8 @@ void PrintPhaseCheck(const calib::CalibResult& result) {
   if (result.phase.held > 0)
     std::printf("phase check: the model predicted %d phase_limited sections outside the range their families "
                 "leave open; their ranges' middles joined its fit\n", result.phase.held);
-  // What to do about them: a filter after sampling is in every section (a turned board is read with it up to 25 deg
-  // off the pixel axes, but it still cancels or blurs what the lens did); without one, turning the board gives every
+  // What to do about them: a filter after sampling is in every section (a turned board is read with it at any angle
+  // to the pixel axes, but it still cancels or blurs what the lens did); without one, turning the board gives every
   // edge all phases.
   if (result.phase.flagged > 0) {
     if (result.phase.chosen != 0)
@@ -314,7 +344,12 @@ void AddCalibrateCommand(CLI::App& app) {
     PrintModelChoice(result, json["model"]["choice"]);
     const std::vector<double> true_r =
         args->truth.empty() ? std::vector<double>() : PrintAgainstTruth(result, args->truth);
-    std::printf("\n%s\n", calib::FormatEdgeTable(result, true_r).c_str());
+    std::printf("\n%s", calib::FormatEdgeTable(result, true_r).c_str());
+    std::printf("measured: median r_px of the edge's usable sections; thesis: the thesis's pixel count (r_thesis_px, "
+                "section 4.3), kept for comparison with it only: it counts the edge's whole grey ramp and runs "
+                "several px over the optical blur; eq3.7: the thesis's estimate from reference edge %d; fitted: the "
+                "lens model's prediction (blur source `fitted`)%s\n\n",
+                result.reference_edge, true_r.empty() ? "" : "; true: the scene's truth");
     std::printf("time: read %.0f ms, detect+pose %.0f ms, measure %.0f ms, estimate %.1f ms\n", read_ms,
                 result.detect_ms, result.measure_ms, result.estimate_ms);
     std::printf("wrote %s\n", args->out.c_str());

@@ -62,7 +62,8 @@ void AddReportCommand(CLI::App& app) {
   cmd->add_option("--out", args->out, "folder for the report (created)")->required();
   CLI::Option* bench = cmd->add_option("--bench", args->bench, "folder of the benchmark CSVs (by default results/bench, "
                                       "where it exists: without benchmarks the report has no benchmark page)");
-  cmd->add_option("--boot", args->boot, "bootstrap samples of the psychometric fit")->capture_default_str()
+  cmd->add_option("--boot", args->boot, "bootstrap samples of each psychometric fit: its band and its threshold's "
+                 "interval come from the same samples")->capture_default_str()
       ->transform(IntRange(10, 100000));
   cmd->add_option("--python", args->python, "the Python that sees the analysis packages")->capture_default_str();
   cmd->add_flag("--pool-simulated", args->pool_simulated,
