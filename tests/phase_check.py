@@ -21,6 +21,9 @@ figures, and exits 1 when a target is missed:
       board, r up to 8 px).
 --fitted-p90 F: with --expect filtered, the fitted model's p90 target F in place of 5 % (where it is known to break:
       sharpening that cancels most of the optics' blur near focus, docs/independent-truth.md).
+--undetermined-covers: with --expect filtered, every section whose fitted model misses max(0.05 px, 5 %) must lie within
+      the depths calib.json's phase_check.model_undetermined names (where calibrate says the model is not determined
+      within 5 %: a mask that cancels most of the optics' blur near focus); none named counts as no depth.
 --max-off N: with --expect filtered, at most N sections off max(0.05 px, 10 %) unflagged in place of 0 (a known miss,
       named where the test is defined; every such section is still printed).
 --sections-only: with --expect filtered, the per-section rule alone (a mask that cancels the whole second moment near
@@ -53,6 +56,7 @@ def main():
     p.add_argument("--min-measured", type=float)
     p.add_argument("--fitted-p90", type=float, default=0.05)
     p.add_argument("--sections-only", action="store_true")
+    p.add_argument("--undetermined-covers", action="store_true")
     p.add_argument("--max-off", type=int, default=0)
     p.add_argument("--no-phase-check", action="store_true")
     a = p.parse_args()
@@ -77,7 +81,11 @@ def main():
                                               "none" if not post else "%s std %.2f px, amount %.2f, taps' variance "
                                               "%.4f px^2" % (post["kind"], post["sigma_px"], post["amount"],
                                                              post["variance_px2"])))
-    measured, signed, fitted, off, flagged = [], [], [], [], 0
+    measured, signed, fitted, off, flagged, uncovered = [], [], [], [], 0, []
+    undetermined = (calib.get("phase_check") or {}).get("model_undetermined")
+    u_lo, u_hi = undetermined["u_mm"] if undetermined else (1, 0)
+    if undetermined:
+        print("calibrate: %s" % undetermined["why"])
     for e in calib["edges"]:
         row = []
         y = e["sections"][len(e["sections"]) // 2]["image_px"][0][1]
@@ -85,6 +93,8 @@ def main():
             t = true[(e["index"], s["index"])]
             tr = max(t, 0.05)  # the relative figures' denominator (a truth near 0: the rule's 0.05 px)
             fitted.append(abs(s["r_fitted_px"] - t) / tr)
+            if abs(s["r_fitted_px"] - t) > max(0.05, 0.05 * t) and not u_lo <= s["u_mm"] <= u_hi:
+                uncovered.append((e["index"], s["index"], s["r_fitted_px"], t, s["u_mm"]))
             phase_limited = "phase_limited" in (s.get("flags") or [])
             flagged += phase_limited
             mark = " "
@@ -121,6 +131,10 @@ def main():
             missed.append("measured r median %s, p90 %s (target <= 2 %%, <= 5 %%)" % (pct(mm), pct(mp)))
         if flagged > a.max_flagged:
             missed.append("%d sections flagged phase_limited (at most %d)" % (flagged, a.max_flagged))
+    if a.undetermined_covers:
+        for edge, section, r, t, u in uncovered:
+            missed.append("edge %d section %d (u %.0f mm): the model predicts %.3f px for %.3f px, outside the depths "
+                          "calibrate calls not determined within 5 %%" % (edge, section, u, r, t))
     if a.min_measured is not None and len(measured) < a.min_measured * n:
         missed.append("%d of %d sections measured (at least %.0f %%)" % (len(measured), n, 100 * a.min_measured))
     if a.max_bias is not None and abs(bias) > a.max_bias:

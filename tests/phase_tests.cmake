@@ -83,13 +83,32 @@ phase_check(phase_filtered_sharpen_05 sharpen05 "\nok: filtered targets met" --e
 # (35 of 77, edges 4-8) and every other one holds the rule. They join the lens fit at their readings (each unsure
 # alone, the fit pools them): left out, nothing near focus pinned the floor and the model read 0.19 px for 0.16 px
 # (median 2.4 %, p90 19.1 % here; 1.2-2.3 / 22-29 % on five other seeds). Now median 0.6-1.1 %, p90 1.8-8.1 % over
-# the six seeds (this one 0.9 / 3.9 %): the 5 % p90 holds on 4 of 6, so the model is held to 10 % here - the break,
-# docs/independent-truth.md. With the mask refined between the families (phase_fit.h), the refined one fits alike and
-# 8 of the 35 are flagged for the spread rather than the cancellation (27 join the fit): the model median 1.2 %, p90 1.4 %.
+# the six seeds (this one 0.9 / 3.9 %). Fitted to r itself, those sections counted as surely as the optics' own
+# reading, where the mask magnifies its error 5-8 times; now the model is fitted to the optics' readings (sqrt(r^2 - 4V))
+# and the filter added back: p90 1.0-5.7 % on seeds 1-4 and 6 (this one 1.5 / 2.0 %; on main 1.8-13.4 %), 8.3 % on
+# seed 5 (a neighbouring mask chosen). The model's own standard error there (edges as clusters) reaches 14-28 % near
+# focus: calibrate names those depths (407-453 mm) "not determined within 5 %", and every section the model misses by
+# more than 5 % lies within them (--undetermined-covers). Seed 2 (p90 5.7 %: edges 5-6, inside the named depths) holds
+# that at 10 %.
 phase_scene(sharpen07 --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.6 --post-amount 0.7
             --noise 0.0025 --seed 6)
 phase_check(phase_filtered_sharpen_07 sharpen07
-            "[23][0-9] of them phase_limited but joined at their readings.*\nok: filtered targets met" --expect filtered --fitted-p90 0.10)
+            "[23][0-9] of them phase_limited but joined at their readings.*\ncalibrate: the model's blur is not determined within 5 % at depths 4[01][0-9]-4[45][0-9] mm.*\nok: filtered targets met"
+            --expect filtered --undetermined-covers)
+# A mask photo's calib.json (with model.fitted_to and each section's r_fitted_se_px) is read by render: the reader
+# refused fields it did not know.
+set_tests_properties(phase_filtered_sharpen_07 PROPERTIES FIXTURES_SETUP phase_sharpen07_calib)
+add_test(NAME phase_filtered_sharpen_07_render
+         COMMAND ${BLURCUE_EXPECT} "ball at edge 5: depth [0-9.]+ mm, blur fitted" $<TARGET_FILE:blurcue> render
+                 --calib ${PHASE_DIR}/sharpen07-calib-filtered.json --background ${PHASE_DIR}/sharpen07/scene.png
+                 --object ball --at-edge 5 --blur fitted --out ${PHASE_DIR}/sharpen07-ball.png)
+set_tests_properties(phase_filtered_sharpen_07_render PROPERTIES FIXTURES_REQUIRED "phase_sharpen07;phase_sharpen07_calib"
+                     LABELS "slow;phase;gl")
+phase_scene(sharpen07_seed2 --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.6
+            --post-amount 0.7 --noise 0.0025 --seed 2)
+phase_check(phase_filtered_sharpen_07_seed2 sharpen07_seed2
+            "calibrate: the model's blur is not determined within 5 % at depths 4[01][0-9]-4[45][0-9] mm.*\nok: filtered targets met"
+            --expect filtered --undetermined-covers --fitted-p90 0.10)
 
 # The Gaussian post filter's ends (0.35 and 0.8 px, the bench's levels). At 0.35 px the optics alone fitted best and
 # 7 sections (edge 4) read 10-12 % high unflagged; now the 0.35 px family is chosen.
@@ -109,7 +128,7 @@ phase_check(phase_filtered_sharpen_off_grid sharpen_off_grid "\nok: filtered tar
 phase_scene(sharpen_09 --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.9
             --post-amount 0.25 --noise 0.0025 --seed 5)
 phase_check(phase_filtered_sharpen_09 sharpen_09 "fitted between the families.*\nok: filtered targets met"
-            --expect filtered --fitted-p90 0.10)
+            --expect filtered --undetermined-covers)
 # Amount 0.5 over 0.8 px (-0.32 px^2): the mask cancels the whole second moment near focus (truth 0 on edges 4-8),
 # where 55-57 sections are flagged; 1-3 others read 0.07-0.1 px off unflagged before. The lens model breaks here
 # (no thin lens bends to that), so the sections alone are held.
@@ -142,11 +161,16 @@ phase_check(phase_filtered_gauss_035_bench gauss035_bench "off the line through 
 # phase check empty, as on main) and the model median 2.3 %, p90 30.6 % (near focus, truths 0.12-0.2 px, where the
 # mask cancels most of the optics' blur). Held to what they read, named here (docs/independent-truth.md): 45 deg the
 # model within p90 10 %, 60 deg the sections alone (--sections-only), each at most the two sections named off.
+# With the lens model fitted to the optics' readings where a mask is chosen (phase_flags.cc), fitted median / p90 on
+# this branch (main after the two-axis model -> this): 20 deg 0.6 / 2.4 -> 0.6 / 1.3 %, 30 deg 0.3 / 3.7 -> 0.5 / 5.6 %
+# (edge 8, 0.11 px low near focus, inside the depths calibrate names not determined within 5 %, 422-439 mm: held to
+# 10 % and to that), 45 deg 1.7 / 8.6 -> 1.0 / 1.1 % (now held to 5 %), 60 deg 2.3 / 30.6 -> 2.5 / 10.8 %.
 foreach(turn 3 20 30 45 60)
-  set(model --fitted-p90 0.05)
+  set(model --fitted-p90 0.05 --undetermined-covers)
   set(off 0)
-  if(turn EQUAL 45)
-    set(model --fitted-p90 0.10)
+  if(turn EQUAL 30)
+    set(model --fitted-p90 0.10 --undetermined-covers)
+  elseif(turn EQUAL 45)
     set(off 2)
   elseif(turn EQUAL 60)
     set(model --sections-only)

@@ -403,11 +403,13 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
   // A subset (a live view's few sections a frame) leaves the reference edge unmeasured most frames: no reference then.
   if (options.only_sections.empty()) SetReference(result, options.reference_edge);
 
+  optics::FittedModel optics_model;
   if (options.fit_model)
-    result.model = FitModelWithinPhaseRanges(result, lens, options.optics_fit, &result.phase.held);
+    result.model = FitModelWithinPhaseRanges(result, lens, options.optics_fit, &result.phase.held, &optics_model);
 
   SummariseEdges(&result, lens);
   if (options.fit_model) ApplyModel(result, result.model);
+  if (options.fit_model && result.phase.variance_px2 < 0) PropagateModelError(result, lens, optics_model);
   result.estimate_ms = MsSince(t0);
   return result;
 }
@@ -431,7 +433,12 @@ Json PhaseChoiceJson(const PhaseChoice& c) {
   return {{"limited_sections", c.limited}, {"every_phase_sections", c.every_phase}, {"flagged", c.flagged},
           {"held_the_model", c.held},
           {"chosen", c.limited + c.every_phase > 0 ? Json(c.families[c.chosen].Name()) : Json(nullptr)},
-          {"chi2_per_point", c.chi2_per_point}, {"families", families}, {"summary", c.summary},
+          {"chi2_per_point", c.chi2_per_point}, {"variance_px2", c.variance_px2}, {"families", families},
+          {"summary", c.summary},
+          {"model_undetermined", c.undetermined.empty() ? Json(nullptr)
+                                                        : Json({{"u_mm", {c.undetermined_lo_mm, c.undetermined_hi_mm}},
+                                                                {"worst_se_rel", c.worst_se_rel},
+                                                                {"why", c.undetermined}})},
           {"note", "sections along the pixel rows or columns with blur under 2 px are read once per PSF family "
                    "(the optics, then on the sampled image a Gaussian of post_sigma_px or an unsharp mask of that std "
                    "and amount `sharpen`; each section's phase.families in that order) with the edge where the pose "
@@ -476,6 +483,7 @@ Json CalibToJson(const CalibResult& r) {
       if (!s.estimated_note.empty()) js["r_estimated_note"] = s.estimated_note;
       if (!s.fit.crowded_why.empty()) js["crowded_why"] = s.fit.crowded_why;
       if (s.fit.r_se_px > 0 && std::isfinite(s.fit.r_se_px)) js["r_se_px"] = s.fit.r_se_px;
+      if (s.r_fitted_se_px > 0) js["r_fitted_se_px"] = s.r_fitted_se_px;
       if (!s.fit.phase_why.empty()) js["phase_why"] = s.fit.phase_why;
       if (s.phase.limited || s.phase.every_phase) js["phase"] = PhaseCheckJson(s.phase);
       if (distorted) js["stretch"] = s.stretch;
@@ -520,7 +528,12 @@ Json CalibToJson(const CalibResult& r) {
                  {"floor_determined", m.floor_determined}, {"rms_px", m.rms_px},
                  {"loo_rms_px", m.loo_rms_px}, {"samples_used", m.samples_used}, {"outliers", m.outliers},
                  {"sections_left_out", SectionsLeftOut(r)},
-                 {"choice", choice}}},
+                 {"choice", choice},
+                 {"fitted_to", r.phase.variance_px2 < 0
+                                   ? "the optics' readings sqrt(r_px^2 - 4 phase_check.variance_px2) (a sharpening after "
+                                     "sampling was chosen); floor_px and its range have the sharpening added back, "
+                                     "the rms figures are the optics' px"
+                                   : "r_px"}}},
       {"r_units", !distorted ? Json("px of the photo (no dist_coeffs: the photo is the pinhole image)") : Json({
            {"sections", "r_px, r_thesis_px, r_estimated_px, r_fitted_px: photo px (distorted), across the edge"},
            {"model", "floor_px and the thin lens's radius: ideal (undistorted, pinhole) px; a point's photo-px radius "

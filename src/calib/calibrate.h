@@ -59,6 +59,7 @@ struct SectionResult {
   std::optional<double> r_estimated_px;  // eq. 3.7 from the reference edge; empty where it does not hold
   std::string estimated_note;            // why it is empty
   double r_fitted_px = 0;                // fitted thin-lens model, in photo px (the model's ideal px x stretch)
+  double r_fitted_se_px = 0;             // its standard error where a mask was chosen (PropagateModelError), else 0
 };
 
 struct EdgeResult {

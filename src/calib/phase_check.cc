@@ -641,6 +641,7 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   choice.chosen = best;
   choice.chi2_per_point = raw[best] / dof;
   const double v_best = TapsVariance(FamilyTaps(families[best]));
+  choice.variance_px2 = v_best;
   int cancelled = 0, jumped = 0, unsure = 0;
   // A filter fitted between the families has no neighbours along one axis that bracket its reading.
   const std::vector<size_t> neighbours = best < PhaseFamilies().size() ? PhaseNeighbours(best) : std::vector<size_t>{};

@@ -103,6 +103,13 @@ struct PhaseChoice {
   std::vector<double> chi2;
   std::vector<bool> alike;
   double chi2_per_point = 0;     // the chosen family's: about 1 where it describes the profiles to the noise
+  // The chosen family's taps' second moment across a level edge (px^2; negative for a mask, 0 for the optics alone):
+  // a section reads sqrt(r_optics^2 + 4 variance_px2) (FitModelWithinPhaseRanges fits a mask's photo in r_optics).
+  double variance_px2 = 0;
+  // Where it sharpens: the depths (mm) where the lens model's own standard error (PropagateModelError) exceeds 5 % of
+  // its prediction, in words (empty where nowhere on the board), and the largest relative standard error there.
+  double undetermined_lo_mm = 0, undetermined_hi_mm = 0, worst_se_rel = 0;
+  std::string undetermined;
   std::string summary = "not checked (--no-phase-check, or a take's frames: no lens fit per frame)";  // in words
 };
 
@@ -116,7 +123,17 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result);
 // other phase_limited section leaves open: where it predicts such a section outside [range_lo_px, range_hi_px], the range's middle joins the
 // samples and the model is fitted again (a few rounds). A section whose range holds the prediction stays out. Without
 // them the sections near focus, where the blur is sub-pixel, could all be gone and nothing would pin the floor.
+// Where the chosen family sharpens (PhaseChoice::variance_px2 < 0) the model is fitted to the optics' readings,
+// sqrt(r^2 - 4 variance_px2), and returned with the filter added back to its floor: near focus the mask magnifies an
+// error in the optics' reading by r_optics / r, and in the optics' terms the floor is the lens's.
+// `optics_model`, where given, receives the model as fitted (of the optics alone where the family sharpens).
 optics::FittedModel FitModelWithinPhaseRanges(const CalibResult& result, const optics::Lens& lens,
-                                              const optics::FitOptions& options, int* held = nullptr);
+                                              const optics::FitOptions& options, int* held = nullptr,
+                                              optics::FittedModel* optics_model = nullptr);
+
+// Where the chosen family sharpens: the lens model's standard error at every section (SectionResult::r_fitted_se_px)
+// and the depths where it exceeds 5 % (PhaseChoice::undetermined), propagated from `optics_model`'s fit to the
+// optics' readings (FitModelWithinPhaseRanges) with the sections of one edge as one sample (they share its phase).
+void PropagateModelError(CalibResult& result, const optics::Lens& lens, const optics::FittedModel& optics_model);
 
 }  // namespace blurcue::calib

@@ -75,13 +75,13 @@ const std::vector<std::string> kTopKeys = {"format", "version", "software", "cam
                                            "lens_model"};
 const std::vector<std::string> kModelKeys = {"kind", "focus_mm", "aperture_mm", "floor_px", "floor_determined",
                                              "rms_px", "loo_rms_px", "samples_used", "outliers", "choice",
-                                             "sections_left_out"};
+                                             "sections_left_out", "fitted_to"};
 const std::vector<std::string> kEdgeKeys = {"index", "u_mm", "usable_sections", "sections"};
 const std::vector<std::string> kSectionKeys = {"index", "u_mm", "midpoint_camera_mm", "image_px", "r_px", "r_thesis_px",
                                                "r_estimated_px", "r_fitted_px", "ok", "flags", "psf", "disc_r_px",
                                                "floor_sigma_px", "shape_ambiguous", "fit_rms_rel", "step_linear",
                                                "thesis_ok", "r_estimated_note", "crowded_why", "stretch",
-                                               "phase", "phase_why", "r_se_px"};
+                                               "phase", "phase_why", "r_se_px", "r_fitted_se_px"};
 const std::vector<std::string> kModelKinds = {"thin_lens", "thin_lens+floor"};
 
 // A boolean field (absent: `absent`).

@@ -81,9 +81,11 @@ void PrintCalibrationSummary(const calib::CalibResult& result, const Board& boar
                                                        " held ranges' middles)"
                                                  : "";
   std::printf("fitted %s model: focus %.1f mm, aperture %.3f mm (nominal %.3f%s), %s, rms %.3f px,"
-              " leave-one-out %.3f px, %d outliers of its %d samples%s\n",
+              " leave-one-out %.3f px, %d outliers of its %d samples%s%s\n",
               m.kind.c_str(), m.focus_mm, m.aperture_mm, camera.ApertureMm(), far.c_str(),
-              optics::FloorText(m).c_str(), m.rms_px, m.loo_rms_px, m.outliers, m.samples_used, held.c_str());
+              optics::FloorText(m).c_str(), m.rms_px, m.loo_rms_px, m.outliers, m.samples_used, held.c_str(),
+              result.phase.variance_px2 < 0 ? " (fitted to the optics' readings under the sharpening: rms in their px)"
+                                            : "");
   // How many sections the model was fitted to, and why the others were left out.
   {
     int sections = 0;
@@ -137,6 +139,7 @@ void PrintPhaseCheck(const calib::CalibResult& result) {
     if (n > 0) std::printf("  edge %d: %d of %zu sections phase_limited: %s\n", e.index, n, e.sections.size(),
                            why->c_str());
   }
+  if (!result.phase.undetermined.empty()) std::printf("phase check: %s\n", result.phase.undetermined.c_str());
   if (result.phase.held > 0)
     std::printf("phase check: the model predicted %d phase_limited sections outside the range their families "
                 "leave open; their ranges' middles joined its fit\n", result.phase.held);
