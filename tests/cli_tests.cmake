@@ -173,7 +173,8 @@ set_tests_properties(cli_animate_video_killed PROPERTIES FIXTURES_REQUIRED "scen
 
 # 'blurcue --help' lists each command by its first sentence: every one whole, none cut to " ..." or ending at a colon
 # (make-stimuli's ended "PNG):", preview's and eight others' " ...").
-add_test(NAME cli_help_whole_first_sentences COMMAND ${BC} --help)
+add_test(NAME cli_help_whole_first_sentences
+         COMMAND ${BLURCUE_EXPECT} "\n  make-stimuli +Draw the study's stimulus textures \\(procedural, deterministic, 8-bit sRGB PNG\\)\\.\n.*\n  preview +Draw a contact sheet of every distinct stimulus a protocol shows, to check the protocol by eye before a session\\.\n"
+                 ${BC} --help)
 set_tests_properties(cli_help_whole_first_sentences PROPERTIES
-                     PASS_REGULAR_EXPRESSION "\n  make-stimuli +Draw the study's stimulus textures \\(procedural, deterministic, 8-bit sRGB PNG\\)\\.\n.*\n  preview +Draw a contact sheet of every distinct stimulus a protocol shows, to check the protocol by eye before a session\\.\n"
                      FAIL_REGULAR_EXPRESSION "\n  [a-z-]+  +[^\n]*(\\.\\.\\.|:)\n")
