@@ -62,13 +62,39 @@ def _fmt(value):
     return str(value)
 
 
+# A text cell longer than this is written once under the table and marked in its cells: a test's description repeated
+# in every row made each row ten lines tall and pushed the p columns off a 1280 px page (a first-time reader's
+# finding). The CSV keeps every cell whole.
+LONG_CELL = 48
+
+
 def _table_html(table):
     if table is None or table.empty:
         return ""
     # No value in an object column is None, which pandas writes as "None" whatever na_rep says: NaN, written blank.
     table = table.where(table.notna(), np.nan)
-    return table.to_html(index=False, na_rep="", formatters={c: _fmt for c in table.columns}, border=0,
+    marks = {}  # long text -> its mark, in order of first appearance
+
+    def mark(value):
+        if not isinstance(value, str) or len(value) <= LONG_CELL:
+            return value
+        return "(" + marks.setdefault(value, _footnote_mark(len(marks))) + ")"
+
+    table = table.copy()
+    for column in table.columns:
+        if table[column].dtype == object:
+            table[column] = table[column].map(mark)
+    body = table.to_html(index=False, na_rep="", formatters={c: _fmt for c in table.columns}, border=0,
                          classes="data")
+    if marks:
+        body += "<ul class='notes'>" + "".join(f"<li>({m}) {html.escape(text)}</li>" for text, m in marks.items()) + \
+            "</ul>"
+    return body
+
+
+def _footnote_mark(i):
+    """a, b, ..., z, aa, ab, ...: the i-th long cell's mark."""
+    return _footnote_mark(i // 26 - 1) + chr(ord("a") + i % 26) if i >= 26 else chr(ord("a") + i)
 
 
 def write_index(out_dir, sections, header, name="index.html", title="blurcue analysis report", summary=None,
