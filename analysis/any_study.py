@@ -164,9 +164,11 @@ def factor_chart(m, factor, chance, what, study, out_dir, name, group_note, pool
         for xi, p, hi in zip(x, t["p_holm"], t["share_high"]):
             if stars(p):
                 ax.text(xi, hi + 0.03, stars(p), ha="center", va="bottom")
-        ax.legend(loc="lower right")
+        # Beside the axes, not on them: inside, it covered a bar (a first-time experimenter's finding).
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0))
     ax.set_xticks(x)
-    ax.set_xticklabels(list(t[factor]))
+    # Each bar's answers under its level: a share of 1 answer and one of 40 look alike as bars.
+    ax.set_xticklabels([f"{level}\nn = {int(n)}" for level, n in zip(t[factor], t["n"])])
     ax.set_xlabel(factor_label(factor))
     ax.set_ylim(0, 1.12)
     ax.set_ylabel(f"share: {what}")

@@ -574,7 +574,9 @@ def _tracks_figure(tracks, cells, study, group_note, out_dir, name):
             c = COLORS[i % len(COLORS)] if len(these) <= len(COLORS) else "#0072B2"
             alpha = 0.9 if len(these) <= len(COLORS) else 0.35
             step = np.arange(1, len(t["levels"]) + 1)
-            ax.plot(step, t["levels"], "-", color=c, lw=1, alpha=alpha)
+            # Labelled once per participant (the colour is the participant's within a cell) where they are told apart.
+            ax.plot(step, t["levels"], "-", color=c, lw=1, alpha=alpha,
+                    label=str(t["participant"]) if len(these) <= len(COLORS) else None)
             if len(these) <= len(COLORS):
                 ax.plot(step[t["correct"]], t["levels"][t["correct"]], "o", color=c, ms=3)
                 ax.plot(step[~t["correct"]], t["levels"][~t["correct"]], "x", color=c, ms=3.5)
@@ -584,6 +586,8 @@ def _tracks_figure(tracks, cells, study, group_note, out_dir, name):
                             lw=0.9, alpha=alpha)
         ax.set_title(cell, loc="left", fontsize=10)
         ax.set_xlabel("trial of the procedure")
+        if 1 < len(these) <= len(COLORS):
+            ax.legend(title="participant", fontsize=7, title_fontsize=7, loc="best")
     for ax in axes.flat[n:]:
         ax.set_visible(False)
     units = "; ".join(dict.fromkeys(t.get("units", "") for t in tracks if t.get("units")))
