@@ -128,6 +128,7 @@ def write_index(out_dir, sections, header, name="index.html", title="blurcue ana
     parts.append("</ol>")
     for i, (title, charts, skips) in enumerate(sections):
         parts.append(f"<h2 id='s{i}'>{html.escape(title)}</h2>")
+        shown = {}  # a table's HTML -> the chart that showed it (one factor: its bars' table is the conditions')
         for s in skips:
             parts.append(f"<div class='skip'>Skipped: {html.escape(s)}</div>")
         for c in charts:
@@ -144,7 +145,10 @@ def write_index(out_dir, sections, header, name="index.html", title="blurcue ana
             if c.notes:
                 parts.append("<ul class='notes'>" + "".join(f"<li>{html.escape(n)}</li>" for n in c.notes) + "</ul>")
             table = _table_html(c.table)
-            if table:
+            if table and table in shown:
+                parts.append(f"<p class='notes'>its table is {html.escape(shown[table])}'s, above</p>")
+            elif table:
+                shown[table] = c.name
                 parts.append(f"<div class='scroll'>{table}</div>")
     parts.append("</body></html>")
     path = os.path.join(out_dir, name)

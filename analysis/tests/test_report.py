@@ -330,10 +330,6 @@ class UnansweredOnlyTest(ReportTestCase):
         self.assertIn(html.escape(said), read(partial, "index.html"))
 
 
-if __name__ == "__main__":
-    unittest.main()
-
-
 class FileStemTest(unittest.TestCase):
     """A chart's name as a file name (issue 24: a factor named a/b made report write into a folder a/ that did not
     exist, exit 10): safe names as they are, others with '_' for each unsafe character and a hash of the name."""
@@ -348,3 +344,31 @@ class FileStemTest(unittest.TestCase):
         self.assertRegex(slash, r"^[A-Za-z0-9_.-]+$")
         self.assertFalse(file_stem("../x").startswith("."))
         self.assertLessEqual(len(file_stem("é" * 300)), 200)
+
+
+class TableLayoutTest(unittest.TestCase):
+    """index.html's tables as a reader sees them (a first-time experimenter's findings): a long text cell written once
+    under its table, and a table a section already showed not shown again."""
+
+    def test_long_cells_once_and_a_repeated_table_named(self):
+        sys.path.insert(0, os.path.dirname(HERE))
+        import pandas as pd
+        import report
+        from common import Chart
+        words = "exact sign-flip permutation test of 3 participants' shares around 0.5 (all 2^3 sign patterns)"
+        table = pd.DataFrame({"edge": [2, 5, 8], "test": [words, words, "none: too few"], "p": [0.5, 1.0, float("nan")]})
+        out = tempfile.mkdtemp()
+        try:
+            charts = [Chart("study-conditions", None, None, table, []), Chart("study-per-edge", None, None, table, [])]
+            page = read(report.write_index(out, [("study", charts, [])], ["header"]))
+        finally:
+            shutil.rmtree(out)
+        self.assertEqual(page.count(html.escape(words)), 1)  # under the first table only
+        self.assertEqual(len(re.findall(r"<td>\(a\)</td>", page)), 2)
+        self.assertIn("<td>none: too few</td>", page)  # short cells stay in place
+        self.assertEqual(page.count("<table"), 1)
+        self.assertIn("its table is study-conditions's, above", page)
+
+
+if __name__ == "__main__":
+    unittest.main()
