@@ -131,8 +131,16 @@ def write_index(out_dir, sections, header, name="index.html", title="blurcue ana
         shown = {}  # a table's HTML -> the chart that showed it (one factor: its bars' table is the conditions')
         for s in skips:
             parts.append(f"<div class='skip'>Skipped: {html.escape(s)}</div>")
+        # Headings without the study's part every chart of the section shares ("my-cards-simulated-"), the whole name
+        # (its files') beside them in grey; a one-word share ("side-", "test2-") stays, the heading would lose sense.
+        prefix = os.path.commonprefix([c.name for c in charts]) if len(charts) > 1 else ""
+        prefix = prefix[:prefix.rfind("-") + 1]
+        prefix = prefix if prefix.count("-") >= 2 else ""
         for c in charts:
-            parts.append(f"<h3>{html.escape(c.name)}</h3>")
+            short = c.name[len(prefix):]
+            parts.append(f"<h3>{html.escape(short)}" +
+                         (f" <span class='notes'>({html.escape(c.name)})</span>" if short != c.name else "") +
+                         "</h3>")
             links = []
             if c.png:
                 png = os.path.basename(c.png)

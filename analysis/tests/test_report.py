@@ -359,7 +359,7 @@ class TableLayoutTest(unittest.TestCase):
         table = pd.DataFrame({"edge": [2, 5, 8], "test": [words, words, "none: too few"], "p": [0.5, 1.0, float("nan")]})
         out = tempfile.mkdtemp()
         try:
-            charts = [Chart("study-conditions", None, None, table, []), Chart("study-per-edge", None, None, table, [])]
+            charts = [Chart("my-study-conditions", None, None, table, []), Chart("my-study-per-edge", None, None, table, [])]
             page = read(report.write_index(out, [("study", charts, [])], ["header"]))
         finally:
             shutil.rmtree(out)
@@ -367,7 +367,9 @@ class TableLayoutTest(unittest.TestCase):
         self.assertEqual(len(re.findall(r"<td>\(a\)</td>", page)), 2)
         self.assertIn("<td>none: too few</td>", page)  # short cells stay in place
         self.assertEqual(page.count("<table"), 1)
-        self.assertIn("its table is study-conditions's, above", page)
+        self.assertIn("its table is my-study-conditions's, above", page)
+        # Headings without the part the section's charts share, the whole name (the files') beside them.
+        self.assertIn("<h3>per-edge <span class='notes'>(my-study-per-edge)</span></h3>", page)
 
 
 if __name__ == "__main__":
