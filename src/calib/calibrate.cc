@@ -68,11 +68,15 @@ void PhotoPlanes::Fill(const cv::Mat& photo) {
   LinearGrey(photo, linear);
 }
 
-std::vector<optics::BlurSample> ModelSamples(const CalibResult& result) {
+bool InModel(const SectionResult& s) { return s.fit.ok || s.phase.joins_fit; }
+
+std::vector<optics::BlurSample> ModelSamples(const CalibResult& result, double filter_variance_px2) {
+  const double v = std::min(0.0, filter_variance_px2);
   std::vector<optics::BlurSample> samples;
   for (const auto& edge : result.edges)
     for (const auto& s : edge.sections)
-      if (s.fit.ok || s.phase.joins_fit) samples.push_back({s.u_mm, s.fit.r_px / s.stretch, 1.0});
+      if (InModel(s))
+        samples.push_back({s.u_mm, (v < 0 ? std::sqrt(s.fit.r_px * s.fit.r_px - 4 * v) : s.fit.r_px) / s.stretch, 1.0});
   return samples;
 }
 
@@ -104,7 +108,7 @@ std::map<std::string, int> SectionsLeftOut(const CalibResult& result) {
   std::map<std::string, int> out;
   for (const auto& edge : result.edges)
     for (const auto& s : edge.sections) {
-      if (s.fit.ok || s.phase.joins_fit) continue;
+      if (InModel(s)) continue;
       std::string why = "not measured";
       for (const std::string& flag : s.fit.flags)
         if (std::find(kInformational.begin(), kInformational.end(), flag) == kInformational.end()) {
@@ -126,7 +130,7 @@ void RequireThreeDepths(const CalibResult& result) {
   std::map<std::string, int> why;  // the flags of the unusable edges' sections (a section may carry two)
   for (const auto& edge : result.edges) {
     bool any = false;
-    for (const auto& s : edge.sections) any = any || s.fit.ok || s.phase.joins_fit;  // as ModelSamples takes them
+    for (const auto& s : edge.sections) any = any || InModel(s);
     if (any) {
       usable.push_back(edge.index);
       continue;
@@ -167,7 +171,7 @@ void SetReference(CalibResult& result, int reference_edge) {
   const EdgeResult& ref = result.edges[reference_edge - 1];
   std::vector<double> ref_r, ref_u;
   for (const auto& s : ref.sections)
-    if (s.fit.ok || s.phase.joins_fit) ref_r.push_back(s.fit.r_px), ref_u.push_back(s.u_mm);
+    if (InModel(s)) ref_r.push_back(s.fit.r_px), ref_u.push_back(s.u_mm);
   // (Sections flagged but joined to the lens fit at their readings are pooled here as there.) A reference edge whose
   // every section is phase_limited still has its readings (eq. 3.7 is the thesis's estimate from them, whatever their
   // family): taken rather than refusing the photo.

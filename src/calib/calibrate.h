@@ -108,8 +108,11 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
 
 // The usable sections as the thin-lens model's samples, with the phase_limited ones that join the fit
 // (PhaseCheck::joins_fit): depth and r_px / stretch (ideal px), so a distorted photo's blur is fitted in the
-// undistorted lens's terms. A tracked take pools these over its frames.
-std::vector<optics::BlurSample> ModelSamples(const CalibResult& result);
+// undistorted lens's terms. A tracked take pools these over its frames. With a sharpening's variance (< 0: the chosen
+// family's taps, PhaseChoice::variance_px2), the optics' readings before it, sqrt(r_px^2 - 4 v) / stretch.
+std::vector<optics::BlurSample> ModelSamples(const CalibResult& result, double filter_variance_px2 = 0);
+// Whether a section is one of ModelSamples's: usable, or phase_limited but joined at its reading (joins_fit).
+bool InModel(const SectionResult& s);
 
 // The sections the thin-lens model was not fitted to (those not in ModelSamples), counted by the flag that disqualified each (its first:
 // "phase_limited", "crowded", "low_contrast", ...).

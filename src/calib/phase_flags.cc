@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -38,7 +37,7 @@ optics::FittedModel WithFilter(optics::FittedModel m, double v) {
   m.floor_candidate_px = through(m.floor_candidate_px);
   m.floor_lo_px = through(m.floor_lo_px), m.floor_hi_px = through(m.floor_hi_px);
   m.floor_determined = m.kind == "thin_lens+floor" && !cancelled &&
-                       m.floor_hi_px - m.floor_lo_px <= std::max(0.1, 0.2 * m.floor_px);  // FitThinLens's rule
+                       optics::FloorRangePinned(m.floor_lo_px, m.floor_hi_px, m.floor_px);
   return m;
 }
 
@@ -127,16 +126,11 @@ optics::FittedModel FitModelWithinPhaseRanges(const CalibResult& result, const o
                                               const optics::FitOptions& options, int* held,
                                               optics::FittedModel* optics_model) {
   const double v = std::min(0.0, result.phase.variance_px2);
-  std::vector<optics::BlurSample> usable = ModelSamples(result);
+  const std::vector<optics::BlurSample> usable = ModelSamples(result, v);  // the optics' readings (OpticsPx)
   std::vector<const SectionResult*> limited;
-  size_t i_used = 0;
   for (const auto& edge : result.edges)
-    for (const auto& s : edge.sections) {
-      if ((s.fit.ok || s.phase.joins_fit) && i_used < usable.size())  // as ModelSamples takes them, in its order
-        usable[i_used].r_px = OpticsPx(s.fit.r_px, s.stretch, v), ++i_used;
+    for (const auto& s : edge.sections)
       if (!s.fit.phase_why.empty() && !s.phase.joins_fit && s.phase.range_hi_px > 0) limited.push_back(&s);
-    }
-  if (i_used != usable.size()) throw std::logic_error("FitModelWithinPhaseRanges: ModelSamples's sections differ");
   optics::FittedModel model = optics::FitThinLens(lens, usable, options);
   std::vector<double> bound(limited.size(), -1);  // where a section holds the model (-1: nowhere)
   for (int round = 0; round < 5 && !limited.empty(); ++round) {
@@ -199,7 +193,7 @@ void PropagateModelError(CalibResult& result, const optics::Lens& lens, const op
     bool any = false;
     for (const auto& s : edge.sections) {
       u_lo = std::min(u_lo, s.u_mm), u_hi = std::max(u_hi, s.u_mm);
-      if (!(s.fit.ok || s.phase.joins_fit)) continue;  // as ModelSamples takes them
+      if (!InModel(s)) continue;
       const std::vector<double> j = ModelGradient(m, lens, s.u_mm);
       const double e = OpticsPx(s.fit.r_px, s.stretch, v) - m.PredictPx(lens, s.u_mm);
       for (int r = 0; r < k; ++r) {

@@ -376,6 +376,8 @@ double FittedModel::PredictPx(const Lens& lens, double u_mm) const {
   return std::sqrt(thin * thin + floor_px * floor_px);
 }
 
+bool FloorRangePinned(double lo, double hi, double floor_px) { return hi - lo <= std::max(0.1, 0.2 * floor_px); }
+
 bool FloorPinned(const FittedModel& m) { return m.kind != "thin_lens+floor" || m.floor_determined; }
 
 std::string FloorText(const FittedModel& m) {
@@ -506,7 +508,7 @@ FittedModel FitThinLens(const Lens& lens, const std::vector<BlurSample>& samples
   } else {
     out.floor_lo_px = out.floor_hi_px = nan;
   }
-  out.floor_determined = use_floor && out.floor_hi_px - out.floor_lo_px <= std::max(0.1, 0.2 * out.floor_px);
+  out.floor_determined = use_floor && FloorRangePinned(out.floor_lo_px, out.floor_hi_px, out.floor_px);
   return out;
 }
 

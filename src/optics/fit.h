@@ -46,6 +46,10 @@ struct FittedModel {
   double PredictPx(const Lens& lens, double u_mm) const;
 };
 
+// The floors lo..hi fit alike: they pin floor_px when the range spans at most max(0.1 px, 20 % of it) (FittedModel's
+// floor_determined).
+bool FloorRangePinned(double lo, double hi, double floor_px);
+
 // Whether the model's floor_px is a result: the thin lens alone (floor 0) or a floor the sections pin.
 bool FloorPinned(const FittedModel& m);
 
