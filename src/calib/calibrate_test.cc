@@ -611,6 +611,29 @@ TEST(SceneCalib, BadFieldIsNamed) {
   EXPECT_THROW(ParseBlurSource("blurry", nullptr), Error);
 }
 
+// phase_check.model_undetermined (calibrate's depths where the lens model is not determined within 5 %) is read:
+// the fitted source inside them gets a note naming the file and the field, outside them and other sources none; a
+// hand edit that would move or hide them is refused, named.
+TEST(SceneCalib, UndeterminedDepthsAreReadAndNoted) {
+  const Calibration& r = Calibrated(Thesis());
+  Json j = CalibToJson(r.result);
+  j["phase_check"] = {{"model_undetermined", {{"u_mm", {400.0, 420.0}}, {"worst_se_rel", 0.12}, {"why", "w"}}}};
+  const SceneCalib s = SceneCalibFromJson(j, "calib.json: ");
+  EXPECT_EQ(UndeterminedNote(s, BlurSource::kFitted, 410),
+            "the fitted blur at 410 mm is the lens model's estimate, not a result within 5 %: the model is not "
+            "determined within 5 % at 400-420 mm (its standard error up to 12 %: a sharpening after sampling cancels "
+            "most of the optics' blur there; calib.json /phase_check/model_undetermined)");
+  EXPECT_EQ(UndeterminedNote(s, BlurSource::kFitted, 421), "");
+  EXPECT_EQ(UndeterminedNote(s, BlurSource::kEstimated, 410), "");
+  j["phase_check"]["model_undetermined"] = nullptr;
+  EXPECT_EQ(UndeterminedNote(SceneCalibFromJson(j, "calib.json: "), BlurSource::kFitted, 410), "");
+  j["phase_check"]["model_undetermined"] = {{"u_mm", {420.0, 400.0}}, {"worst_se_rel", 0.12}};
+  ExpectCalibRefused(j, "calib.json: /phase_check/model_undetermined/u_mm: must be [near, far] depths in mm, 0 < near "
+                        "<= far, got [420.0,400.0]");
+  j["phase_check"]["model_undetermined"] = {{"u_mm", {400.0, 420.0}}};
+  ExpectCalibRefused(j, "calib.json: /phase_check/model_undetermined/worst_se_rel: is required but missing");
+}
+
 // The model block says which model predicts: its kind is one of the two, the floor model states its floor (a missing
 // one was read as 0: the objects drawn without the scene's floor), the thin lens has none (a floor beside it was
 // drawn), the focus lies beyond the focal length, and a key calibrate does not write is a hand edit the reader would

@@ -160,6 +160,27 @@ void SceneCalib::RequireSameSize(const cv::Mat& photo, const std::string& photo_
                                      "x" + std::to_string(camera.image_height_px));
 }
 
+namespace {
+// calib.json's phase_check.model_undetermined (null where calibrate named no depth): its depths and standard error.
+void ReadUndetermined(const Json& j, const std::string& where, SceneCalib* s) {
+  const auto check = j.find("phase_check");
+  if (check == j.end() || !check->is_object()) return;
+  const auto und = check->find("model_undetermined");
+  if (und == check->end() || und->is_null()) return;
+  const std::string uw = where + "/phase_check/model_undetermined";
+  if (!und->is_object()) throw InputError(uw, "must be an object or null, got " + und->dump());
+  const auto u = und->find("u_mm");
+  if (u == und->end() || !u->is_array() || u->size() != 2 || !(*u)[0].is_number() || !(*u)[1].is_number() ||
+      !((*u)[0].get<double>() > 0) || !((*u)[0].get<double>() <= (*u)[1].get<double>()) ||
+      !((*u)[1].get<double>() <= kMaxDistanceMm))
+    throw InputError(uw + "/u_mm", "must be [near, far] depths in mm, 0 < near <= far, got " +
+                                       (u == und->end() ? std::string("nothing") : u->dump()));
+  s->undetermined_lo_mm = (*u)[0].get<double>();
+  s->undetermined_hi_mm = (*u)[1].get<double>();
+  s->undetermined_se_rel = Ranged(*und, "worst_se_rel", uw, 0, 1e6, "(a share)");
+}
+}  // namespace
+
 SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
   if (!j.is_object())  // `where` is "path: "
     throw Error(ErrorKind::kInput, where + "must be a JSON object (a calibration), got " + j.type_name());
@@ -258,8 +279,23 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
       s.sections.push_back(out);
     }
   }
+  ReadUndetermined(j, where, &s);
   RequireWholeCalib(j, s, where);
   return s;
+}
+
+std::string UndeterminedNote(const SceneCalib& scene, BlurSource source, double u_mm) {
+  if (source != BlurSource::kFitted || !(scene.undetermined_hi_mm > 0) || u_mm < scene.undetermined_lo_mm ||
+      u_mm > scene.undetermined_hi_mm)
+    return "";
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "the fitted blur at %.0f mm is the lens model's estimate, not a result within 5 %%: the model is "
+                "not determined within 5 %% at %.0f-%.0f mm (its standard error up to %.0f %%: a sharpening after "
+                "sampling cancels most of the optics' blur there; %s /phase_check/model_undetermined)",
+                u_mm, scene.undetermined_lo_mm, scene.undetermined_hi_mm, 100 * scene.undetermined_se_rel,
+                scene.file.empty() ? "the calibration" : scene.file.c_str());
+  return text;
 }
 
 SceneCalib LoadSceneCalib(const std::filesystem::path& path) {

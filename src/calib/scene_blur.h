@@ -37,6 +37,10 @@ struct SceneCalib {
   std::vector<Section> sections;
   // The calib.json it was read from (empty: built in code), for a message.
   std::string file;
+  // Where calibrate found the lens model not determined within 5 % (calib.json phase_check.model_undetermined: a
+  // sharpening after sampling that cancels most of the optics' blur there): camera depths (mm) and the largest
+  // relative standard error there; hi 0 where it named none.
+  double undetermined_lo_mm = 0, undetermined_hi_mm = 0, undetermined_se_rel = 0;
 
   // Board-frame point (mm) -> camera frame (mm).
   cv::Vec3d ToCamera(const cv::Vec3d& board_mm) const;
@@ -67,6 +71,11 @@ BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px, const st
 //   fitted    - the fitted thin-lens model at the point's depth (ideal px), times StretchAt the point (photo px);
 //   fixed     - fixed_r_px; none - 0.
 double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& point_camera_mm, double fixed_r_px = 0);
+
+// Where `source` is the fitted model and camera depth u_mm lies where calibrate found that model not determined
+// within 5 %: one sentence saying so, with the depths and calib.json's field, for a command's note (render, validate,
+// run); "" otherwise. The number drawn there is the model's estimate, not a result within 5 %.
+std::string UndeterminedNote(const SceneCalib& scene, BlurSource source, double u_mm);
 
 // How much camera.json's dist_coeffs stretch a round blur at a camera-frame point's place in the photo: sqrt(det J)
 // of the distortion map there (core/distortion.h), 1 without distortion. Photo px per ideal (pinhole) px.

@@ -119,6 +119,7 @@ void Run(const RunArgs& args) {
               static_cast<long long>(r.answered_now), skipped.c_str(),
               r.dropped_frames > 0 ? (", " + std::to_string(r.dropped_frames) + " dropped frames in the session").c_str() : "",
               r.completed ? "; completed" : "; not finished - continue with --resume");
+  if (!r.blur_note.empty()) std::printf("note: %s\n", r.blur_note.c_str());
 }
 
 }  // namespace

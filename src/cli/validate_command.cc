@@ -150,6 +150,8 @@ std::vector<CheckedGroup> CheckAsRunWould(const Args& args, const std::optional<
     for (const std::string& group : GroupsToCheck(prepared.protocol, args.group)) {
       procedure::PrepareParticipant(&prepared, args.participant, args.seed, group);
       std::string shown = PresentationLines(prepared);
+      if (const std::string note = procedure::UndeterminedBlurNote(prepared); !note.empty())
+        shown += "  note: " + note + "\n";
       if (observer) {
         // What `run --observer` refuses before its first trial, refused here by the same check.
         procedure::CheckObserverCanAnswer(*observer, prepared.protocol);

@@ -172,4 +172,21 @@ PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const
   return s;
 }
 
+std::string UndeterminedBlurNote(const PreparedSession& prepared) {
+  if (!prepared.scene) return "";
+  size_t n = 0;
+  std::string note;
+  for (const TrialScene& scene : prepared.scenes) {
+    std::string first;
+    for (const stimulus::SideShown& side : scene.sides)
+      if (first.empty()) first = calib::UndeterminedNote(*prepared.scene, side.source, side.u_mm);
+    if (first.empty()) continue;
+    if (note.empty()) note = first;
+    ++n;
+  }
+  if (n == 0) return "";
+  return std::to_string(n) + " of " + std::to_string(prepared.scenes.size()) + " trials show the fitted blur where it is not " +
+         "determined within 5 %; the first: " + note;
+}
+
 }  // namespace blurcue::procedure

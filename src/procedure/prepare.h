@@ -42,6 +42,11 @@ PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const
                                std::optional<uint64_t> seed, const std::filesystem::path& display_profile = {},
                                const std::string& group = "");
 
+// The trials whose fitted blur falls where calibrate found the lens model not determined within 5 %
+// (calib::UndeterminedNote at each side's depth, a ball's averaged over its run): "N of M trials ..." with the
+// calibration's note; "" where none does (or the session has no calibrated scene). validate and run print it.
+std::string UndeterminedBlurNote(const PreparedSession& prepared);
+
 // PlanOnScreen for a trial of this session whose radii a procedure's level changed (ApplyLevel): on the photo, or on
 // every frame of the take the trial shows (stimulus::PlanVideoOnScreen). Needs a scene (prepared.scene).
 void PlanLeveled(const PreparedSession& prepared, const protocol::Trial& trial, stimulus::TrialScene* scene);

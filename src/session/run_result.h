@@ -1,6 +1,7 @@
 #pragma once
 // What running a session did (RunSession, RunTrials).
 #include <cstdint>
+#include <string>
 
 namespace blurcue::session {
 
@@ -17,6 +18,9 @@ struct RunResult {
   // The session's recorded frames marked dropped, earlier sittings' included (Recording::DroppedFrames: the
   // record's count, as frames.csv and the report give it).
   int64_t dropped_frames = 0;
+  // procedure::UndeterminedBlurNote of the trials run: fitted blur where the calibration's model is not determined
+  // within 5 % ("" where none).
+  std::string blur_note;
 };
 
 }  // namespace blurcue::session

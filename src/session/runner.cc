@@ -352,6 +352,7 @@ RunResult RunSession(const RunOptions& options) {
   RunResult result =
       RunTrials({options.db, options.stop_after, options.progress}, chosen, presenter, responder, record, start);
   result.session_number = start.session_number;
+  result.blur_note = procedure::UndeterminedBlurNote(chosen);
   return result;
 }
 
