@@ -199,7 +199,7 @@ foreach(turn 45 60)
 endforeach()
 
 # Where calibrate names depths at which the lens model is not determined within 5 % (the mask scene above: edges 4-7),
-# what uses the model there says so: render (the ball at edge 5, 415 mm) and validate and run (a grid study over edges
+# what uses the model there says so: render (the ball at edge 5, 415 mm), animate (balls rolling edge 3 -> 8), validate and run (a grid study over edges
 # 2 and 5 with fitted blur on one side): the trial at edge 5 is named, edge 2's (356 mm) is not. Before, all three drew
 # or planned 0.20 px there without a word.
 file(WRITE ${PHASE_DIR}/undetermined-grids.json [=[
@@ -228,6 +228,11 @@ add_test(NAME phase_undetermined_run_note
          COMMAND ${BLURCUE_EXPECT} "2 of 2 trials answered.*completed\nnote: 1 of 2 trials show the fitted blur where it is not determined within 5 %"
                  $<TARGET_FILE:blurcue> run ${PHASE_DIR}/undetermined-grids.json --db ${PHASE_DIR}/undetermined.db
                  --participant P1 --observer sim --again)
+add_test(NAME phase_undetermined_animate_note
+         COMMAND ${BLURCUE_EXPECT} "12 frames .*\nnote: the fitted blur at 4[0-4][0-9] mm is the lens model's estimate"
+                 $<TARGET_FILE:blurcue> animate --calib ${PHASE_DIR}/sharpen07-calib-filtered.json
+                 --background ${PHASE_DIR}/sharpen07/scene.png --left fitted --right none --from-edge 3 --to-edge 8
+                 --speed-cm-s 6 --fps 5 --log ${PHASE_DIR}/undetermined-animate.csv --frames ${PHASE_DIR}/undetermined-frames)
 set_tests_properties(phase_undetermined_render_note phase_determined_render_no_note phase_undetermined_validate_note
-                     phase_undetermined_run_note
+                     phase_undetermined_run_note phase_undetermined_animate_note
                      PROPERTIES FIXTURES_REQUIRED "phase_sharpen07;phase_sharpen07_calib" LABELS "slow;phase;gl")

@@ -131,6 +131,9 @@ class RollingBalls {
     o.object.texture = texture_;
     return o;
   }
+  // The first ball drawn whose fitted blur lies where calibrate found the model not determined within 5 %
+  // (calib::UndeterminedNote; "" where none): said once after the frames.
+  const std::string& note() const { return note_; }
   // Frame `i`'s two balls at time t; throws Error(kUsage) naming the option whose radius is beyond the blur's range.
   std::vector<scene::BlurredObject> At(int i, double t) const {
     const double y = YAt(t);
@@ -145,6 +148,7 @@ class RollingBalls {
                                            " px at frame " + std::to_string(i) + "; the blur radius must be in [0, " +
                                            BoundText(render::kMaxBlurRadiusPx) + "] px");
       balls[b].r_px = r;
+      if (note_.empty()) note_ = calib::UndeterminedNote(scene_, source_[b], centre[2]);
       balls[b].method = args_.method;
       balls[b].floor_sigma_px = calib::FloorSigmaPx(scene_, source_[b], centre);
       balls[b].shape = calib::ShapeAt(scene_, source_[b], centre);
@@ -167,6 +171,7 @@ class RollingBalls {
   const AnimateArgs& args_;
   const calib::SceneCalib& scene_;
   const scene::SurfaceTexture& texture_;
+  mutable std::string note_;  // note()
   calib::BlurSource source_[2];
   double fixed_[2] = {0, 0};
   double y0_ = 0, y1_ = 0, half_mm_ = 0;
@@ -291,6 +296,7 @@ void Animate(const AnimateArgs& args) {
               args.video.empty() ? "" : ("; video " + args.video).c_str(),
               args.frames_dir.empty() ? "" : ("; frames in " + args.frames_dir).c_str(),
               args.log.empty() ? "" : ("; log " + args.log).c_str());
+  if (!rolling.note().empty()) std::printf("note: %s\n", rolling.note().c_str());
 }
 
 }  // namespace
