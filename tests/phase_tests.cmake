@@ -233,6 +233,13 @@ add_test(NAME phase_undetermined_animate_note
                  $<TARGET_FILE:blurcue> animate --calib ${PHASE_DIR}/sharpen07-calib-filtered.json
                  --background ${PHASE_DIR}/sharpen07/scene.png --left fitted --right none --from-edge 3 --to-edge 8
                  --speed-cm-s 6 --fps 5 --log ${PHASE_DIR}/undetermined-animate.csv --frames ${PHASE_DIR}/undetermined-frames)
+# calibrate's own summary: its advice names those depths and its table puts the model's value there in parentheses
+# (edges 5 and 6, 421 and 441 mm; edge 4 at 401 mm and edge 7 at 461 mm outside them stay bare).
+add_test(NAME phase_undetermined_calibrate_table
+         COMMAND ${BLURCUE_EXPECT} "what to do: [^\n]*the model's value \\(an estimate at 4[01][0-9]-4[45][0-9] mm, where it is not determined within 5 %\\)\n.*\n   4 [^\n(]*\n   5 [^\n]* +\\(0\\.[0-9][0-9]\\)\n   6 [^\n]* +\\(0\\.[0-9][0-9]\\)\n   7 [^\n(]*\n.*, in parentheses where it is not determined within 5 %"
+                 $<TARGET_FILE:blurcue> calibrate ${PHASE_DIR}/sharpen07/scene.png --camera ${PHASE_DIR}/sharpen07/camera.json
+                 --out ${PHASE_DIR}/sharpen07-calib-table.json)
+set_tests_properties(phase_undetermined_calibrate_table PROPERTIES FIXTURES_REQUIRED phase_sharpen07 LABELS "slow;phase")
 set_tests_properties(phase_undetermined_render_note phase_determined_render_no_note phase_undetermined_validate_note
                      phase_undetermined_run_note phase_undetermined_animate_note
                      PROPERTIES FIXTURES_REQUIRED "phase_sharpen07;phase_sharpen07_calib" LABELS "slow;phase;gl")

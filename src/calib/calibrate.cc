@@ -558,17 +558,24 @@ std::string FormatEdgeTable(const CalibResult& r, const std::vector<double>& tru
   out += line;
   for (size_t i = 0; i < r.edges.size(); ++i) {
     const EdgeResult& e = r.edges[i];
+    // The model's value, in parentheses where it is not determined within 5 % (PhaseChoice::undetermined).
+    char fitted[32] = "        -";  // without a fitted model
+    if (r.model.samples_used > 0) {
+      const bool unsure = !r.phase.undetermined.empty() && e.u_mm >= r.phase.undetermined_lo_mm &&
+                          e.u_mm <= r.phase.undetermined_hi_mm;
+      char value[24];
+      std::snprintf(value, sizeof value, unsure ? "(%.2f)" : "%.2f", e.r_fitted_px);
+      std::snprintf(fitted, sizeof fitted, "%9s", value);
+    }
     if (e.usable == 0) {
       const std::string none = "0/" + std::to_string(e.sections.size());
-      char fitted[32] = "        -";  // without a fitted model
-      if (r.model.samples_used > 0) std::snprintf(fitted, sizeof fitted, "%9.2f", e.r_fitted_px);
       std::snprintf(line, sizeof line, "%4d %8.1f %6s %9s %9s %9s %s", e.index, e.u_mm, none.c_str(), "-", "-", "-",
                     fitted);
     } else {
       char est[32] = "        -";  // eq. 3.7 does not hold nearer than focus
       if (e.estimated > 0) std::snprintf(est, sizeof est, "%9.2f", e.r_estimated_px);
-      std::snprintf(line, sizeof line, "%4d %8.1f %4d/%d %9.2f %9.2f %s %9.2f", e.index, e.u_mm, e.usable,
-                    int(e.sections.size()), e.r_px, e.r_thesis_px, est, e.r_fitted_px);
+      std::snprintf(line, sizeof line, "%4d %8.1f %4d/%d %9.2f %9.2f %s %s", e.index, e.u_mm, e.usable,
+                    int(e.sections.size()), e.r_px, e.r_thesis_px, est, fitted);
     }
     out += line;
     if (truth) {

@@ -150,7 +150,12 @@ void PrintPhaseCheck(const calib::CalibResult& result) {
     if (result.phase.chosen != 0)
       std::printf("what to do: this photo was filtered after it was sampled (the camera's sharpening or smoothing); "
                   "for measured blur on the flagged edges turn that processing off (or take raw) and photograph "
-                  "again; until then the blur source `fitted` gives those places the model's value\n");
+                  "again; until then the blur source `fitted` gives those places the model's value%s\n",
+                  result.phase.undetermined.empty()
+                      ? ""
+                      : (" (an estimate at " + Num(std::round(result.phase.undetermined_lo_mm)) + "-" +
+                         Num(std::round(result.phase.undetermined_hi_mm)) +
+                         " mm, where it is not determined within 5 %)").c_str());
     else
       std::printf("what to do: for measured blur on the flagged edges turn the board a few degrees on the table so "
                   "its edges cross the pixel rows (every phase is then sampled); until then `measured` averages an "
@@ -348,8 +353,10 @@ void AddCalibrateCommand(CLI::App& app) {
     std::printf("measured: median r_px of the edge's usable sections; thesis: the thesis's pixel count (r_thesis_px, "
                 "section 4.3), kept for comparison with it only: it counts the edge's whole grey ramp and runs "
                 "several px over the optical blur; eq3.7: the thesis's estimate from reference edge %d; fitted: the "
-                "lens model's prediction (blur source `fitted`)%s\n\n",
-                result.reference_edge, true_r.empty() ? "" : "; true: the scene's truth");
+                "lens model's prediction (blur source `fitted`)%s%s\n\n",
+                result.reference_edge,
+                result.phase.undetermined.empty() ? "" : ", in parentheses where it is not determined within 5 %",
+                true_r.empty() ? "" : "; true: the scene's truth");
     std::printf("time: read %.0f ms, detect+pose %.0f ms, measure %.0f ms, estimate %.1f ms\n", read_ms,
                 result.detect_ms, result.measure_ms, result.estimate_ms);
     std::printf("wrote %s\n", args->out.c_str());
