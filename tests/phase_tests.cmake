@@ -199,7 +199,7 @@ foreach(turn 45 60)
 endforeach()
 
 # Where calibrate names depths at which the lens model is not determined within 5 % (the mask scene above: edges 4-7),
-# what uses the model there says so: render (the ball at edge 5, 415 mm), animate (balls rolling edge 3 -> 8), validate and run (a grid study over edges
+# what uses the model there says so: render (the ball at edge 5, 415 mm), animate (balls rolling edge 3 -> 8), preview, validate and run (a grid study over edges
 # 2 and 5 with fitted blur on one side): the trial at edge 5 is named, edge 2's (356 mm) is not. Before, all three drew
 # or planned 0.20 px there without a word.
 file(WRITE ${PHASE_DIR}/undetermined-grids.json [=[
@@ -240,6 +240,9 @@ add_test(NAME phase_undetermined_calibrate_table
                  $<TARGET_FILE:blurcue> calibrate ${PHASE_DIR}/sharpen07/scene.png --camera ${PHASE_DIR}/sharpen07/camera.json
                  --out ${PHASE_DIR}/sharpen07-calib-table.json)
 set_tests_properties(phase_undetermined_calibrate_table PROPERTIES FIXTURES_REQUIRED phase_sharpen07 LABELS "slow;phase")
+add_test(NAME phase_undetermined_preview_note
+         COMMAND ${BLURCUE_EXPECT} "2 distinct stimuli of 2 trials.*\nnote: 1 of 2 trials show the fitted blur where it is not determined within 5 %"
+                 $<TARGET_FILE:blurcue> preview ${PHASE_DIR}/undetermined-grids.json --out ${PHASE_DIR}/undetermined-sheet.png)
 set_tests_properties(phase_undetermined_render_note phase_determined_render_no_note phase_undetermined_validate_note
-                     phase_undetermined_run_note phase_undetermined_animate_note
+                     phase_undetermined_run_note phase_undetermined_animate_note phase_undetermined_preview_note
                      PROPERTIES FIXTURES_REQUIRED "phase_sharpen07;phase_sharpen07_calib" LABELS "slow;phase;gl")

@@ -115,6 +115,7 @@ void AddPreviewCommand(CLI::App& app) {
                 sheet.trial_count, in_groups.empty() ? "" : (in_groups + ")").c_str(), args->out.c_str());
     // What a participant can see of it (as blurcue validate --plan): the invisible pairs, each depth-matching distance.
     for (const std::string& text : sheet.visibility) std::printf("%s\n", text.c_str());
+    for (const std::string& text : sheet.notes) std::printf("note: %s\n", text.c_str());
   });
 }
 

@@ -199,6 +199,8 @@ std::vector<Tile> ChooseTiles(procedure::PreparedSession* prepared, const SheetO
       tiles[k].label = prefix + tiles[k].label, tiles[k].key = Json::array({int(g), tiles[k].key});
     for (const std::string& text : procedure::VisibilityLines(*prepared, options.observer, options.visible, true))
       sheet->visibility.push_back(prefix + text);
+    if (const std::string note = procedure::UndeterminedBlurNote(*prepared); !note.empty())
+      sheet->notes.push_back(prefix + note);
   }
   std::stable_sort(tiles.begin(), tiles.end(), [](const Tile& a, const Tile& b) { return a.key < b.key; });
   return tiles;

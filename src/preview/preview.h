@@ -33,6 +33,9 @@ struct Sheet {
   std::vector<std::string> tiles;       // per tile, in sheet order: "#N levels: sides | plan | seen"
   size_t trial_count = 0;               // the trials of every group drawn
   std::vector<std::string> visibility;  // procedure::VisibilityLines of each group, prefixed "group NAME: "
+  // procedure::UndeterminedBlurNote of each group that has one (fitted blur where the calibration's model is not
+  // determined within 5 %), prefixed as visibility.
+  std::vector<std::string> notes;
 };
 
 // Called after each tile is drawn with its number (1-based), the tile count and its line of Sheet::tiles.
