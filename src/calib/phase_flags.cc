@@ -200,7 +200,8 @@ std::vector<double> ModelGradient(const optics::FittedModel& m, const optics::Le
 
 // The covariance of the optics model's parameters from its readings' scatter about it, each edge's sections one sample
 // (a cluster-robust sandwich: the sections of an edge share its depth and sub-pixel phase, and a noise-free scene's
-// readings err alike along an edge, by up to 0.5 % of the optics' blur), then through r = sqrt(r_optics^2 + 4 v).
+// readings err alike along an edge, by up to 0.5 % of the optics' blur), the readings' own error added (kReadingRel,
+// or kCancelledRel where the filter cancels the whole blur on an edge), then through r = sqrt(r_optics^2 + 4 v).
 void PropagateModelError(CalibResult& result, const optics::Lens& lens, const optics::FittedModel& m) {
   const double v = std::min(0.0, result.phase.variance_px2);
   if (!(v < 0) || !std::isfinite(m.focus_mm) || !(m.aperture_mm > 0)) return;
@@ -243,7 +244,7 @@ void PropagateModelError(CalibResult& result, const optics::Lens& lens, const op
     double var = (floor_rel * ideal) * (floor_rel * ideal);
     for (int r = 0; r < k; ++r)
       for (int c = 0; c < k; ++c) var += j[r] * cov(r, c) * j[c];
-    // d r / d optics = optics / r (so r / r: r_optics^2 / r^2 times the optics' relative error); where the filter
+    // d r / d optics = optics / r, so r's relative error is r_optics^2 / r^2 times the optics' own; where the filter
     // cancels the whole blur, the error no longer is linear: r's own scale (the tests' 0.05 px) bounds it.
     return optics * stretch / std::max(*r_px, 0.05) * std::sqrt(var);
   };
