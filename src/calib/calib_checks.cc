@@ -24,7 +24,7 @@ std::string Fixed(double v, int digits) {
 
 // Where a refusal points: camera.json's focal length when the pose says the camera is not the photo's, else the
 // photo; `why` is the rest of the line.
-[[noreturn]] void Refuse(const CalibResult& result, const Camera& camera, const std::string& camera_file,
+[[noreturn]] void Refuse(const CalibResult& result, const std::string& camera_file,
                          const std::string& photo_file, const std::string& why) {
   if (result.pose.reprojection_error_px > kPoseSuspectPx)
     throw InputError(camera_file + ": /focal_length_mm",
@@ -74,15 +74,15 @@ bool ApertureFarFromNominal(const CalibResult& result, const Camera& camera) {
   return !(ratio >= 1 / kApertureWarnFactor && ratio <= kApertureWarnFactor);
 }
 
-void RefuseAbsurdCalibration(const CalibResult& result, const Camera& camera, const std::string& camera_file,
+void RefuseAbsurdCalibration(const CalibResult& result, const std::string& camera_file,
                              const std::string& photo_file) {
   if (const std::string absurd = AbsurdRadius(result); !absurd.empty())
-    Refuse(result, camera, camera_file, photo_file, absurd);
+    Refuse(result, camera_file, photo_file, absurd);
   // The profiles themselves: the PSF family that fits the limited sections best leaves residuals far over the pixels'
   // noise (chi-square per point ~ 1 where it explains them): no blurred edge is there to measure.
   const double chi2 = result.phase.chi2_per_point;
   if (chi2 > kMaxChi2PerPoint)
-    Refuse(result, camera, camera_file, photo_file,
+    Refuse(result, camera_file, photo_file,
            "the board's edges do not fit a blurred edge: the best of the PSF families leaves residuals " +
                Fixed(std::sqrt(chi2), 0) + " x the pixels' noise (chi-square per point " + Fixed(chi2, 0) +
                ", over " + Num(kMaxChi2PerPoint) + "; the suite's scenes read under 160, JPEGs of quality 90 among "
@@ -90,7 +90,7 @@ void RefuseAbsurdCalibration(const CalibResult& result, const Camera& camera, co
   // The sections' blurs together: one thin lens leaves many of them far off (outliers of its robust fit).
   const optics::FittedModel& m = result.model;
   if (m.samples_used > 0 && m.outliers > kMaxOutlierShare * m.samples_used)
-    Refuse(result, camera, camera_file, photo_file,
+    Refuse(result, camera_file, photo_file,
            "the blur of " + std::to_string(m.outliers) + " of the " + std::to_string(m.samples_used) +
                " sections the lens model is fitted to is far from it (outliers; over a quarter): the sections' "
                "blurs do not follow one thin lens (compression, motion, a board not flat, or sections off the "

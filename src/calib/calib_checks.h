@@ -31,7 +31,7 @@ inline constexpr double kMaxOutlierShare = 0.25;
 // chi-square per point over kMaxChi2PerPoint, or more than kMaxOutlierShare of the lens fit's sections its outliers.
 // The line names `camera_file` and its focal length when the pose fits the corners worse than 1 px (the camera is
 // then likelier not the photo's), `photo_file` otherwise.
-void RefuseAbsurdCalibration(const CalibResult& result, const Camera& camera, const std::string& camera_file,
+void RefuseAbsurdCalibration(const CalibResult& result, const std::string& camera_file,
                              const std::string& photo_file);
 
 // A pose fitting the board's corners worse than this is not this camera's (a photo of it fits to well under 1 px):

@@ -338,7 +338,7 @@ void AddCalibrateCommand(CLI::App& app) {
     if (!args->truth.empty()) CheckTruthPose(truth, args->truth, result, board, camera, args->photo);
     // A calibration absurd for its photo (a blur no section could show, edges no blurred edge explains) is refused
     // before anything is written.
-    calib::RefuseAbsurdCalibration(result, camera, args->camera, args->photo);
+    calib::RefuseAbsurdCalibration(result, args->camera, args->photo);
     Json json = calib::CalibToJson(result);
     json["photo"] = args->photo;
     WriteJsonFile(args->out, json);
