@@ -35,7 +35,7 @@ import study_tests
 import tracks
 from common import (UNKNOWN_UNIT, Chart, Skip, axis_label, distinct_stems, error_bars, factor_label, file_stem, level_text,
                     level_unit, participants_note, save, stars, text)
-from design import comparing_factors, design_of, load_codebook  # noqa: F401  (load_codebook: report.py reads the codebook through here)
+from design import comparing_factors, design_of
 
 KIND_TITLES = {"pair": "forced choice between two", "odd": "odd one out",
                "procedure": "adaptive procedure", "yes_no": "yes / no", "rating": "rating",
