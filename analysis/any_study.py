@@ -524,7 +524,7 @@ def group_section(m, kind, what, design, codebook, study, out_dir, slug, note):
         ax.set_ylim(-0.03, 1.03)
     ax.set_title(f"{study}: {what} per group (grey: each participant)\n{note}", loc="left")
     png, svg = save(fig, out_dir, f"{slug}-per-group")
-    notes = notes + ["blue: the mean of the participants' values with its t 95 % interval (none with one participant)"]
+    notes = notes + ["blue: the mean of the participants' values with its t 95 % interval (none with fewer than 3 participants)"]
     charts = [Chart(f"{slug}-per-group", png, svg, table, notes)]
     if column == "y":
         shared = [f for f in design.factors if f != group]

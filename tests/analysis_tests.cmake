@@ -80,6 +80,15 @@ add_test(NAME analysis.groups
 set_tests_properties(analysis.groups PROPERTIES LABELS analysis TIMEOUT 600
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
 
+# Models across participants only with three or more (depth matching, a group's interval, the group models' contrasts:
+# two give t(1), said in words), and the depth-matching slope's printed intervals cover a known slope in simulation
+# (CR1 with t(G-1), lmer with Satterthwaite df). Needs R with lme4: fails without it (never skips). ~90 s of CPU.
+add_test(NAME analysis.depth_matching
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_depth_matching.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(analysis.depth_matching PROPERTIES LABELS analysis TIMEOUT 600
+                     ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
+
 # Two within factors crossed (crossed.py): the model with their interaction against a direct glmer call on the same
 # data, a planted interaction found with its sign; the additive model's note and the chart by both factors. Needs R
 # with lme4: fails without it (never skips). ~75 s of CPU, 165 s of wall time on a loaded machine.
