@@ -564,7 +564,8 @@ def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, 
                           "conditions" if chance is not None else
                           NO_CHANCE_WHY.get(kind, "; no test against chance: the design defines no chance "
                                                   "level for it"))] +
-                        [w for w in [study_tests.holm_floor_words(table, chance, m["participant"].nunique())] if w]))
+                        [w for w in [study_tests.holm_floor_words(table, chance, m["participant"].nunique()),
+                                     crossed.missing_words(table, factors)] if w]))
     if kind != "procedure":
         for f in factors:
             charts.append(factor_chart(m, f, chance, what, study, out_dir, f"{slug}-per-{f}", note,

@@ -273,6 +273,9 @@ class ObserverModelTest(unittest.TestCase):
         self.assertEqual(stats.term_in_words("C(pattern_id)[1]", d), "pattern_id 1")
         self.assertEqual(stats.term_in_words("C(edge)[T.6]", d), "edge 6 (against edge 3)")
         self.assertEqual(stats.term_in_words("C(edge, levels=['9', '3'])[T.3]", d), "edge 3 (against edge 9)")
+        # A baseline level holding a comma and quotes is named whole (it was cut at the comma: 'against c naïve').
+        self.assertEqual(stats.term_in_words("C(c, levels=['naïve, µ \\'a\\'', 'Ω,<b>'])[T.Ω,<b>]", d),
+                         "c Ω,<b> (against c naïve, µ 'a')")
         self.assertEqual(stats.term_in_words("Intercept", d), "baseline (intercept)")
         self.assertEqual(stats.term_in_words("edge_c", d), "per edge (edge centred at 6)")
 
