@@ -233,7 +233,7 @@ set_tests_properties(cli_hostile_animate_log_is_a_fifo cli_hostile_animate_video
 # plan: a condition without one decisive answer (every simulated answer can't tell; one participant, seed 1: edges 1
 # and 3 on the CLI tests' scene) has no share: its share and its Wilson width are "-", not "nan" and 1.000.
 add_test(NAME cli_hostile_plan_no_share_is_no_nan
-         COMMAND ${BLURCUE_EXPECT} "edge=[0-9]+ +more_blurred +- +- +0.000"
+         COMMAND ${BLURCUE_EXPECT} "edge=[0-9]+ +first_source +- +- +0.000"
                  $<TARGET_FILE:blurcue> plan ${T}/protocols/test1-static-grids.json --participants 1 --studies 2
                  --no-chart --out ${H}/plan-no-share)
 set_tests_properties(cli_hostile_plan_no_share_is_no_nan PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"

@@ -54,6 +54,12 @@ std::string LevelText(const protocol::Level& level) {
   return protocol::ToJson(level).dump();
 }
 
+// The thesis's forced-choice studies, which the report analyses with their own views (analysis/common.py
+// FORCED_CHOICE_STUDIES): the share of the design's first source among decisive answers.
+bool IsThesisForcedChoice(const std::string& study) {
+  return study == "test1-static-grids" || study == "test2-moving-balls" || study == "test3-no-board";
+}
+
 // The condition of a main (not practice) trial and the measure its tests use; nullopt for what is not planned.
 std::optional<Condition> ConditionOf(const protocol::Protocol& protocol, const protocol::Trial& trial,
                                      const stimulus::TrialScene& scene, bool several_blocks) {
@@ -77,10 +83,12 @@ std::optional<Condition> ConditionOf(const protocol::Protocol& protocol, const p
     c.measure = "correct";
     c.chance = scene.intervals > 2 ? 1.0 / scene.intervals : 0.5;
   } else if (task.answer == protocol::TaskAnswer::kSide && scene.content != protocol::ContentType::kPicture) {
-    // The report's measure of a pair (trials.csv's chose_more_blurred): the side that showed the larger blur radius,
-    // among decisive answers where the radii differ. It was the design's first source, which reads the other way
-    // round wherever the second source is the blurrier one (a comparison of none against measured: 0.1 for 0.9).
-    c.measure = "more_blurred";
+    // The report's measure of a pair: for any study, trials.csv's chose_more_blurred - the side that showed the
+    // larger blur radius, among decisive answers where the radii differ (the design's first source, planned before,
+    // reads the other way round wherever the second source is the blurrier one: a comparison of none against
+    // measured gave 0.1 for the report's 0.9); for the thesis's own forced-choice studies, whose report view
+    // (analysis/forced_choice.py) tests the design's first source, that source.
+    c.measure = IsThesisForcedChoice(protocol.name) ? "first_source" : "more_blurred";
     c.chance = 0.5;
   } else {
     return std::nullopt;
@@ -97,6 +105,28 @@ void SplitByGroup(const protocol::Protocol& protocol, const protocol::Trial& tri
   if (protocol::BlockOf(protocol, trial)->groups.size() == 1) return;
   c->key.group = group;
   c->label = "group=" + group + ": " + c->label;
+}
+
+// A pair's answer counted: by the source chosen (as designed) and, as the report's measure, whether the side chosen
+// showed the larger radius - as store/export.cc's chose_more_blurred: radii within 1e-9 px are equal and count for
+// neither side.
+void TallyPair(const protocol::Trial& trial, const stimulus::TrialScene& scene, const Choice& choice, bool by_first,
+               Tally* t) {
+  const bool left = choice == Choice::Of(Side::kLeft), right = choice == Choice::Of(Side::kRight);
+  const bool first = trial.swapped ? right : left, second = trial.swapped ? left : right;
+  t->first += first, t->second += second, t->cant_tell += choice.kind == Choice::Kind::kCantTell;
+  const double r_left = scene.sides[protocol::Index(Side::kLeft)].r_px;
+  const double r_right = scene.sides[protocol::Index(Side::kRight)].r_px;
+  const bool differ = std::abs(r_left - r_right) > 1e-9, left_blurrier = r_left > r_right;
+  if (!differ) {
+    ++t->blurrier_equal;
+  } else {
+    (left_blurrier != trial.swapped ? t->blurrier_first : t->blurrier_second) += 1;
+  }
+  if (by_first)
+    t->k += first, t->n += first || second;
+  else if (differ && (left || right))
+    t->k += left == left_blurrier, ++t->n;
 }
 
 // One simulated participant through the session's own decisions (what `blurcue run --observer sim` does headless).
@@ -193,21 +223,8 @@ SimParticipant Simulate(procedure::PreparedSession& study, const procedure::Obse
     ++t.shown;
     const bool none = choice.kind == Choice::Kind::kNone;
     t.none += none;
-    if (c->measure == "more_blurred") {
-      const bool left = choice == Choice::Of(Side::kLeft), right = choice == Choice::Of(Side::kRight);
-      const bool first = trial.swapped ? right : left, second = trial.swapped ? left : right;
-      t.first += first, t.second += second, t.cant_tell += choice.kind == Choice::Kind::kCantTell;
-      // As store/export.cc's chose_more_blurred: radii within 1e-9 px are equal, and count for neither side.
-      const double r_left = scene.sides[protocol::Index(Side::kLeft)].r_px;
-      const double r_right = scene.sides[protocol::Index(Side::kRight)].r_px;
-      const bool differ = std::abs(r_left - r_right) > 1e-9;
-      const bool left_blurrier = r_left > r_right;
-      if (!differ) {
-        ++t.blurrier_equal;
-      } else {
-        (left_blurrier != trial.swapped ? t.blurrier_first : t.blurrier_second) += 1;
-      }
-      if (differ && (left || right)) t.k += left == left_blurrier, ++t.n;
+    if (c->measure == "more_blurred" || c->measure == "first_source") {
+      TallyPair(trial, scene, choice, c->measure == "first_source", &t);
     } else if (c->measure == "correct") {
       // The report counts answers (a missed deadline is no answer), correct against the guess rate.
       if (!none) t.k += scored.correct.value_or(false), ++t.n;
@@ -430,7 +447,7 @@ void AddExactRows(PlanResult& r, const Condition& c, const PlanOptions& options,
     row.chance = c.chance >= 0 ? c.chance : nan;
     row.participants = m;
     row.expected_share = all.n > 0 ? double(all.k) / all.n : nan;
-    if (c.measure == "more_blurred") {
+    if (c.measure == "more_blurred" || c.measure == "first_source") {
       row.more_blurred = BlurrierSource(all);
       row.share_first = all.first / shown, row.share_second = all.second / shown;
       row.share_cant_tell = all.cant_tell / shown, row.share_none = all.none / shown;
@@ -618,7 +635,8 @@ std::string Summary(const PlanResult& r, const PlanOptions& o) {
     std::snprintf(line, sizeof line,
                   "per condition at N = %d: the expected share (more_blurred: the side showing the larger blur radius "
                   "among decisive answers, the report's chose_more_blurred - 'more blurred:' names which source that "
-                  "was, as designed; correct; yes), the mean width of its 95 %% Wilson interval, the power of the report's "
+                  "was, as designed; first_source: the thesis's own studies, whose report view tests the design's first "
+                  "source; correct; yes), the mean width of its 95 %% Wilson interval, the power of the report's "
                   "exact test against chance (alpha %g; participants as the unit: at chance 0.5 the sign-flip test of "
                   "their shares, which needs 6 of them to reach 0.05; else the binomial of the answers; one "
                   "participant: the binomial of their answers, none for one answer; two: none) and the smallest N "

@@ -82,7 +82,8 @@ struct Condition {
   ConditionKey key;       // unique
   int block = 0;          // index in protocol.blocks (conditions are ordered by block, then levels)
   std::string label;      // "edge=3" (and the block's name when the protocol has several)
-  std::string measure;    // "more_blurred" (a pair: the report's chose_more_blurred) | "correct" | "yes" | "log_cutoff_slope" (depth matching)
+  std::string measure;    // "more_blurred" (a pair: the report's chose_more_blurred) | "first_source" (a pair of
+                          // the thesis's studies, as the report's thesis view) | "correct" | "yes" | "log_cutoff_slope" (depth matching)
                           // | "threshold" (a procedure cell: what it estimates, not its share correct)
   double chance = -1;     // the test's null share; < 0: no test (yes/no, threshold)
   // A procedure cell: its variable (the threshold's unit) and the simulated observer's true threshold (threshold.h).
