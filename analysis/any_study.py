@@ -35,7 +35,7 @@ import study_tests
 import tracks
 from common import (UNKNOWN_UNIT, Chart, Skip, axis_label, distinct_stems, error_bars, factor_label, file_stem, level_text,
                     level_unit, participants_note, save, stars, text)
-from design import comparing_factors, design_of, load_codebook  # noqa: F401  (load_codebook: report.py reads the codebook through here)
+from design import comparing_factors, design_of
 
 KIND_TITLES = {"pair": "forced choice between two", "odd": "odd one out",
                "procedure": "adaptive procedure", "yes_no": "yes / no", "rating": "rating",
@@ -524,7 +524,7 @@ def group_section(m, kind, what, design, codebook, study, out_dir, slug, note):
         ax.set_ylim(-0.03, 1.03)
     ax.set_title(f"{study}: {what} per group (grey: each participant)\n{note}", loc="left")
     png, svg = save(fig, out_dir, f"{slug}-per-group")
-    notes = notes + ["blue: the mean of the participants' values with its t 95 % interval (none with one participant)"]
+    notes = notes + ["blue: the mean of the participants' values with its t 95 % interval (none with fewer than 3 participants)"]
     charts = [Chart(f"{slug}-per-group", png, svg, table, notes)]
     if column == "y":
         shared = [f for f in design.factors if f != group]
@@ -564,7 +564,8 @@ def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, 
                           "conditions" if chance is not None else
                           NO_CHANCE_WHY.get(kind, "; no test against chance: the design defines no chance "
                                                   "level for it"))] +
-                        [w for w in [study_tests.holm_floor_words(table, chance, m["participant"].nunique())] if w]))
+                        [w for w in [study_tests.holm_floor_words(table, chance, m["participant"].nunique()),
+                                     crossed.missing_words(table, factors)] if w]))
     if kind != "procedure":
         for f in factors:
             charts.append(factor_chart(m, f, chance, what, study, out_dir, f"{slug}-per-{f}", note,

@@ -18,6 +18,27 @@ NO_INTERACTION_NOTE = ("no interaction term: this model assumes each factor's ef
                        "the chart by both factors, and the model with the interaction is in {name}")
 
 
+def missing_crossings(table, factors):
+    """The crossings of the factors (each level as the table writes it) that have no row in a conditions table, in
+    words ('edge 9 with rotation_deg 30'): a design that left one out, or one nobody answered, has no share there."""
+    import itertools
+    if len(factors) < 2 or table is None or table.empty:
+        return []
+    levels = [list(dict.fromkeys(table[f])) for f in factors]
+    present = set(map(tuple, table[list(factors)].astype(str).to_numpy()))
+    return [" with ".join(f"{f} {v}" for f, v in zip(factors, combo)) for combo in itertools.product(*levels)
+            if tuple(map(str, combo)) not in present]
+
+
+def missing_words(table, factors):
+    """A note naming the crossings without answers, or '' when every crossing has some."""
+    missing = missing_crossings(table, factors)
+    if not missing:
+        return ""
+    return (f"no answers at {len(missing)} crossing{'s' if len(missing) > 1 else ''} of {' and '.join(factors)}: "
+            f"{'; '.join(missing)} - no share there, and the model with the interaction has no term for it")
+
+
 def crossing_chart(table, a, b, chance, what, study, out_dir, name, group_note):
     """The share per crossing of factors a (x axis) and b (one line each), Wilson 95 % intervals, from
     any_study.condition_table's rows (levels already in their sorted order)."""
@@ -39,9 +60,11 @@ def crossing_chart(table, a, b, chance, what, study, out_dir, name, group_note):
     ax.legend(fontsize=8, loc="best")
     ax.set_title(f"{study}: {what} per {a} and {b}\n{group_note}, {int(table['n'].sum())} answers", loc="left")
     png, svg = save(fig, out_dir, name)
+    missing = missing_words(table, [a, b])
     return Chart(name, png, svg, None, [f"the share per crossing of {a} and {b} with Wilson 95 % intervals (answers "
                                         "pooled: a description); lines that are not parallel on the log-odds scale "
-                                        "are what an interaction is (the models table with the interaction tests it)"])
+                                        "are what an interaction is (the models table with the interaction tests it)"]
+                 + ([missing + " (no point drawn)"] if missing else []))
 
 
 def interaction_models(d, factors, study, group_note, what, levels):

@@ -9,7 +9,8 @@ with its limit said: the real blur is V-shaped around the focus, so one power la
 Model table (stats.MODEL_COLUMNS), where the record allows:
   set on real       set_arcmin ~ real_arcmin: lmer with a random intercept and slope by participant (Satterthwaite
                     df; intercept-only when that is singular), and pooled OLS with SEs clustered by participant (CR1,
-                    t(G-1)); needs r_scene_arcmin and picture_width_arcmin. The slope is tested against 1 (set as
+                    t(G-1); with two participants neither: said in words); needs r_scene_arcmin and
+                    picture_width_arcmin. The slope is tested against 1 (set as
                     real: t = (b - 1) / SE on the fit's df) and, on a row beside it, against 0. The intercept (the
                     set blur at real blur 0) is not tested: 'set as real' there is a set blur of 0, which no level
                     can give (the sharpest level's blur, from the trials' adjust_levels, is said in its note)
@@ -28,6 +29,9 @@ import mixed
 import prediction
 import stats
 from common import Chart, Skip, STUDY_DEPTH, participants_note, save, study_rows
+
+
+MIN_OBSERVERS_CI = stats.MIN_PARTICIPANTS_MODEL  # an interval or a model across observers needs this many
 
 
 def charts(df, out_dir):
@@ -55,8 +59,10 @@ def charts(df, out_dir):
     # Per distance across observers: geometric mean (mean of log cut-off per observer, then across observers).
     per_obs = a.groupby(["distance_m", "participant"])["log_c"].mean().reset_index()
     summary = per_obs.groupby("distance_m")["log_c"].agg(["mean", "std", "count"]).reset_index()
+    # An interval across observers needs three (a t(1) interval from two is 12.7 of their SEs wide and says nothing
+    # of the spread): fewer get none, said in the table's note.
     tcrit = sps.t.ppf(0.975, np.maximum(summary["count"] - 1, 1))
-    half = np.where(summary["count"] >= 2, tcrit * summary["std"] / np.sqrt(summary["count"]), np.nan)
+    half = np.where(summary["count"] >= MIN_OBSERVERS_CI, tcrit * summary["std"] / np.sqrt(summary["count"]), np.nan)
     summary["geo_mean"] = np.exp(summary["mean"])
     summary["low"] = np.exp(summary["mean"] - half)
     summary["high"] = np.exp(summary["mean"] + half)
@@ -71,7 +77,8 @@ def charts(df, out_dir):
                 yerr=np.vstack([np.nan_to_num(summary["geo_mean"] - summary["low"]),
                                 np.nan_to_num(summary["high"] - summary["geo_mean"])]),
                 fmt="s", color="black", ms=4.5, lw=1, zorder=5,
-                label="geometric mean" + (" (95 % CI across observers)" if len(observers) >= 2 else ""))
+                label="geometric mean" + (" (95 % CI across observers)" if len(observers) >= MIN_OBSERVERS_CI
+                                          else ""))
     if pooled is not None:
         grid = np.linspace(a["distance_m"].min(), a["distance_m"].max(), 200)
         aa, bb = pooled
@@ -97,7 +104,10 @@ def charts(df, out_dir):
     out = [Chart("depth-matching", png, svg, table, notes),
            Chart("depth-matching-per-distance", None, None, summary,
                  ["geometric mean of the accepted cut-off per distance; low/high: 95 % t-interval across observers "
-                  "of the observers' log cut-offs"])]
+                  "of the observers' log cut-offs" + (
+                      "" if summary["observers"].min() >= MIN_OBSERVERS_CI else
+                      f"; none where fewer than {MIN_OBSERVERS_CI} observers answered at a distance (from two, a "
+                      "t(1) interval is no estimate of their spread)")])]
     arcmin = _in_visual_angle(a, out_dir)
     if arcmin is not None:
         out.append(arcmin)
@@ -178,6 +188,12 @@ def _ols_rows(g, x, y, model, words, study):
     return out
 
 
+# Two participants: no model across them, in the forced choice's words (stats.observer_models).
+TWO_PARTICIPANTS = ("{label}: two participants: too few for a model across participants (a cluster-robust SE from two "
+                    "participants with t(1), or a mixed model's spread between two, is not an estimate); no model "
+                    "fitted, no SE, no p - the answers per distance are in the tables, and a model needs >= {minimum}")
+
+
 def _across(a, x, y, label, words, notes, study, floor_arcmin=None):
     """Pooled OLS clustered by participant and the lmer of y on x with a random intercept and slope by participant;
     rows and the pooled (intercept, slope). floor_arcmin: the least blur the design can set (the match's intercept's
@@ -192,7 +208,15 @@ def _across(a, x, y, label, words, notes, study, floor_arcmin=None):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         zero_se = {}
-        if n_groups >= 2:
+        if n_groups == 2:
+            # Two clusters give a sandwich SE from two residual sums and a t(1) reference: no estimate of the
+            # spread between participants (as stats.observer_models says for the forced choice). The pooled line
+            # is still drawn, from plain OLS, and each observer's own fit is in the table where there is one.
+            res = sm.OLS(a[y].to_numpy(float), X).fit()
+            pooled = (float(res.params.iloc[0]), float(res.params.iloc[1]))
+            notes.append(TWO_PARTICIPANTS.format(label=label, minimum=stats.MIN_PARTICIPANTS_MODEL))
+            return rows, pooled
+        if n_groups >= 3:
             t = stats.cluster_robust(a[y].to_numpy(float), X, groups, family=sm.families.Gaussian())
             pooled = (float(t["estimate"].iloc[0]), float(t["estimate"].iloc[1]))  # before any is said in words
             t, zero_se = stats.without_zero_se(t, words)
@@ -227,8 +251,6 @@ def _across(a, x, y, label, words, notes, study, floor_arcmin=None):
         # The SD of the participants' slopes is a spread, tested against nothing: named without a test's words.
         sd_words = {**words, x: "per arcmin of real blur"} if words is WORDS_MATCH else words
         rows += stats.variance_rows(study, model, f, sd_words, "arcmin" if y == "set_arcmin" else "log cut-off")
-    elif n_groups == 2:
-        notes.append(f"{label}: two participants, too few for a mixed model")
     return rows, pooled
 
 

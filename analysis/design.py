@@ -60,8 +60,8 @@ def cell_columns(d):
     out = []
     if "cell" not in d:
         return out
-    for text in _text(d["cell"]).unique():
-        for part in filter(None, text.split(";")):
+    for cell_text in _text(d["cell"]).unique():
+        for part in filter(None, cell_text.split(";")):
             name = part.split("=", 1)[0]
             if name not in out:
                 out.append(name)

@@ -55,12 +55,32 @@ def _named(words, factor):
     return re.sub(r"\bw\b", factor, re.sub(r"\bg\b", "participant", words))
 
 
+# A contrast's t needs this many df: t(1) (a GLMM's G - groups with 3 participants in 2 groups) has no variance, and
+# its 95 % interval is 12.7 SEs wide; such a contrast keeps its estimate and gets no SE, df or p, in words.
+MIN_CONTRAST_DF = 2
+
+
+def few_df_words(df, family, people, n_groups):
+    """Why a contrast on df below MIN_CONTRAST_DF has no SE or p, in words."""
+    if family == "glmm":
+        return (f"no SE or p: {people} participants in {n_groups} groups leave {people - n_groups} df for the groups' "
+                f"difference (t(G - groups)), too few for a test; needs >= {n_groups + MIN_CONTRAST_DF} participants")
+    return (f"no SE or p: the groups' difference has {df:.2g} Satterthwaite df (below {MIN_CONTRAST_DF}), too few "
+            f"participants for a test")
+
+
 def fit(m, column, factor, group, others=(), family="glmm"):
     """The interaction model of rows m (measure `column`, participants in `participant`) by lme4. Returns a dict:
     test (statistic, df, df2, p, engine, random, structure) or why (not determined, in words), contrasts (factor's level,
     group_a, group_b, estimate, se, df, p), emmeans (level, group, estimate, se)."""
     out = {"why": "", "test": None, "contrasts": pd.DataFrame(), "emmeans": pd.DataFrame(), "structure": "",
            "random": "", "engine": ""}
+    people = text(m["participant"]).nunique()
+    if people < stats.MIN_PARTICIPANTS_MODEL:
+        out["why"] = (f"not determined: {people} participant{'s' if people != 1 else ''}: too few for a model across "
+                      f"participants (a mixed model's spread between {people}, or a t({max(people - 1, 0)}) test, is "
+                      f"not an estimate); no model fitted - a model needs >= {stats.MIN_PARTICIPANTS_MODEL}")
+        return out
     exe = mixed.rscript()
     if exe is None:
         out["why"] = "not determined: R is not installed (no Rscript): no mixed model; install r-base-core and r-cran-lme4"
@@ -107,8 +127,11 @@ def fit(m, column, factor, group, others=(), family="glmm"):
     rows = []
     for _, r in table[table["row"] == "contrast"].iterrows():
         level, a, b = str(r["term"]).split("|")
-        rows.append({"level": back_w[level], "group_a": back_g[a], "group_b": back_g[b], "estimate": r["estimate"],
-                     "se": r["se"], "df": r["df"], "p": r["p"]})
+        row = {"level": back_w[level], "group_a": back_g[a], "group_b": back_g[b], "estimate": r["estimate"],
+               "se": r["se"], "df": r["df"], "p": r["p"], "says": ""}
+        if not (r["df"] >= MIN_CONTRAST_DF):  # NaN too
+            row.update(se=math.nan, df=math.nan, p=math.nan, says=few_df_words(r["df"], family, people, len(groups)))
+        rows.append(row)
     out["contrasts"] = pd.DataFrame(rows)
     out["emmeans"] = pd.DataFrame([{"level": back_w[str(r["term"]).split("|")[0]],
                                     "group": back_g[str(r["term"]).split("|")[1]], "estimate": r["estimate"],
@@ -285,7 +308,7 @@ def charts(m, kind, design, slug, note, what):
                 out.update(model_estimate=h["estimate"], model_se=h["se"], model_df=h["df"], model_p=h["p"],
                            model_says="emmeans from the model with the interaction" +
                                       (" (Wald z against t(G - groups))" if family == "glmm" else
-                                       " (Satterthwaite df)"))
+                                       " (Satterthwaite df)") + (f"; {h['says']}" if h["says"] else ""))
             else:
                 out.update(model_estimate=math.nan, model_se=math.nan, model_df=math.nan, model_p=math.nan,
                            model_says=r.get("missing") or r["why"] or "not determined: no contrast from the model")

@@ -35,7 +35,8 @@ import common  # noqa: E402
 import depth_matching  # noqa: E402
 import forced_choice  # noqa: E402
 import frame_timing  # noqa: E402
-from common import Skip, TrialsError, chart_stem, file_stem  # noqa: E402
+from common import Skip, TrialsError, chart_stem  # noqa: E402
+from design import load_codebook  # noqa: E402
 
 EXIT_INPUT = 3
 EXIT_INTERNAL = 10
@@ -455,7 +456,7 @@ def _main(argv=None):
     session_lines += kept_apart(all_trials)
     holder["trials"] = common.main_rows(all_trials)
     trials = holder["trials"]
-    codebook = any_study.load_codebook(args.trials)
+    codebook = load_codebook(args.trials)
 
     # Every other study, analysed from what its trials declare (any_study.py); people and simulated observers apart
     # unless --pool-simulated.

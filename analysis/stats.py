@@ -345,7 +345,13 @@ def term_in_words(term, data):
     if not treatment:
         return f"{name} {level}"
     if levels:
-        base = levels.split(",")[0].strip().strip("'\"")
+        # The levels as patsy was given them (a Python list): a level may hold a comma ('naïve, µ'), which a split at
+        # commas cut off (the baseline read 'label=naïve').
+        import ast
+        try:
+            base = str(ast.literal_eval(f"[{levels}]")[0])
+        except (ValueError, SyntaxError):
+            base = levels.split(",")[0].strip().strip("'\"")
     else:
         values = sorted(data[name].dropna().unique(), key=lambda v: (not isinstance(v, (int, float)), v)) \
             if name in data else []
@@ -372,6 +378,10 @@ MODEL_COLUMNS = ["study", "model", "term", "estimate", "se", "df", "p", "engine"
 SEPARATION_NOTE = ("separation: every answer behind this term went one way, so it has no finite estimate and no p "
                    "(found by the linear program of Konis 2007, not by the size of a fit); see the binomial test of "
                    "its cell")
+
+
+EMPTY_NOTE = ("not determined: no answers at this crossing (it was not shown, or nothing there was answered), so "
+              "nothing estimates how far it departs from the effects added; no estimate, no p")
 
 
 # A cluster-robust SE below this (log-odds) is 0 to rounding: a real one this small needs some 10^12 answers.
@@ -590,9 +600,18 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
     sources = _term_sources(X)
     words = {c: term_in_words(c, d) for c in X.columns}
 
+    # A column no answer has (a crossing of two factors never answered) is not determined by anything: said so, and
+    # kept out of the separation check (whose linear program could set its coefficient freely and call it
+    # separation).
+    empty_cols = [c for c in X.columns if not np.any(X[c].to_numpy() != 0)]
+    if empty_cols:
+        notes.append(f"no answers at {', '.join(words[c] for c in empty_cols)}: "
+                     f"{'these terms are' if len(empty_cols) > 1 else 'this term is'} not determined (nothing was "
+                     f"answered there), and the other terms are fitted without {'them' if len(empty_cols) > 1 else 'it'}")
     # Separation first: its terms are missing from every model, the rest fitted on the answers it leaves.
-    infinite, separated = separation(X.to_numpy(float), y)
-    infinite_cols = [X.columns[j] for j in infinite]
+    present = [c for c in X.columns if c not in empty_cols]
+    infinite, separated = separation(X[present].to_numpy(float), y)
+    infinite_cols = [present[j] for j in infinite]
     keep = ~separated
     Xr = X.loc[keep, _kept_basis(X.loc[keep], infinite_cols)]
     yr, gr = y[keep], groups[keep]
@@ -607,7 +626,9 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
     def add_fit(model, engine, table, note_of):
         by_term = {r["term"]: r for _, r in table.iterrows()} if table is not None else {}
         for c in X.columns:
-            if c in infinite_cols:
+            if c in empty_cols:
+                rows.append(model_row(study, model, words[c], engine=engine, note=EMPTY_NOTE))
+            elif c in infinite_cols:
                 rows.append(model_row(study, model, words[c], engine=engine, note=SEPARATION_NOTE))
             elif c in by_term:
                 r = by_term[c]
@@ -672,7 +693,7 @@ def observer_models(data, response, formula_rhs, group="participant", study=""):
                 notes.append(f"GLMM: {why}")
                 add_fit(model, f.engine, None, lambda c: "")
                 for r in rows:
-                    if r["model"] == model and r["note"] != SEPARATION_NOTE:
+                    if r["model"] == model and r["note"] not in (SEPARATION_NOTE, EMPTY_NOTE):
                         r["note"] = why
             else:
                 fixed = without_unheld_tests(f, slopes, sources, cell_means="Intercept" not in X.columns)

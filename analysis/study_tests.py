@@ -294,17 +294,24 @@ def group_effect(m, group, column="y"):
     for level, g in pp.groupby(group):
         v = g["mean"].to_numpy(float)
         samples[str(level)] = v
-        half = sps.t.ppf(0.975, len(v) - 1) * v.std(ddof=1) / math.sqrt(len(v)) if len(v) > 1 else math.nan
+        # From two participants a t(1) interval is 12.7 of their SEs wide and no estimate of their spread: none.
+        half = (sps.t.ppf(0.975, len(v) - 1) * v.std(ddof=1) / math.sqrt(len(v)) if len(v) >= MIN_PARTICIPANTS_T
+                else math.nan)
         rows.append({"group": str(level), "participants": len(v), "answers": int(g["n"].sum()),
                      "participant_mean": v.mean(),
-                     # Shares (column y) cannot leave [0, 1]: their t interval is cut there.
-                     "ci_low": max(0.0, v.mean() - half) if column == "y" else v.mean() - half,
-                     "ci_high": min(1.0, v.mean() + half) if column == "y" else v.mean() + half,
+                     # Shares (column y) cannot leave [0, 1]: their t interval is cut there (np.clip keeps a NaN,
+                     # where max(0.0, nan) gave 0 and a group without an interval read [0, 1]).
+                     "ci_low": float(np.clip(v.mean() - half, 0.0, 1.0)) if column == "y" else v.mean() - half,
+                     "ci_high": float(np.clip(v.mean() + half, 0.0, 1.0)) if column == "y" else v.mean() + half,
                      "participant_sd": v.std(ddof=1) if len(v) > 1 else math.nan})
     table = pd.DataFrame(rows)
     names = list(samples)
     notes = ["one value per participant (the share of their answers, or their mean), compared between the groups"]
     sizes = [len(samples[n]) for n in names]
+    few = [n for n in names if len(samples[n]) < MIN_PARTICIPANTS_T]
+    if few:
+        notes.append(f"no interval for group{'s' if len(few) > 1 else ''} {', '.join(few)}: fewer than "
+                     f"{MIN_PARTICIPANTS_T} participants (from two, a t(1) interval is no estimate of their spread)")
     if len(names) < 2:
         return table, notes, "one group only"
     # Welch's t on 2 against 2 has about 1.6 degrees of freedom: as few as the test against chance takes (3).

@@ -52,8 +52,13 @@ add_test(NAME analysis.scenes
 add_test(NAME analysis.file_stems
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_file_stems.py
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# Every level with its unit, at the protocol's precision, and a threshold's criterion as its fit gives it.
+add_test(NAME analysis.units
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_units.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(analysis.stats analysis.report analysis.bench_charts analysis.prediction analysis.design
-                     analysis.tracks analysis.scenes analysis.file_stems analysis.psychometric analysis.summary PROPERTIES
+                     analysis.tracks analysis.scenes analysis.file_stems analysis.psychometric analysis.summary
+                     analysis.units PROPERTIES
                      LABELS analysis TIMEOUT 180
                      # Matplotlib writes its font cache under HOME; keep it out of a read-only or shared home.
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
@@ -73,6 +78,15 @@ add_test(NAME analysis.groups
          COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_groups.py
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(analysis.groups PROPERTIES LABELS analysis TIMEOUT 600
+                     ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
+
+# Models across participants only with three or more (depth matching, a group's interval, the group models' contrasts:
+# two give t(1), said in words), and the depth-matching slope's printed intervals cover a known slope in simulation
+# (CR1 with t(G-1), lmer with Satterthwaite df). Needs R with lme4: fails without it (never skips). ~90 s of CPU.
+add_test(NAME analysis.depth_matching
+         COMMAND ${BLURCUE_ANALYSIS_PYTHON} -m unittest discover -s analysis/tests -t analysis -p test_depth_matching.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(analysis.depth_matching PROPERTIES LABELS analysis TIMEOUT 600
                      ENVIRONMENT "MPLCONFIGDIR=${PROJECT_BINARY_DIR}/mplconfig;PYTHONDONTWRITEBYTECODE=1")
 
 # Two within factors crossed (crossed.py): the model with their interaction against a direct glmer call on the same

@@ -411,7 +411,7 @@ p["blocks"].append({"name": "pairs", "groups": ["b"], "factors": {"edge": [1, 9]
   grep -q "note: quest-rel: edge=9 and quest: edge=9 are not compared: their thresholds are in different units (relative_difference, difference_arcmin)" \
     "$W/units.out" || fail "units: $(cat "$W/units.out")"
   ! cut -d, -f1 "$W/units/plan.csv" | grep -q paired_t || fail "units: a paired_t row across units"
-  grep -q "note: first_source is not compared between groups: group a runs no block that gives it" "$W/half.out" \
+  grep -q "note: more_blurred is not compared between groups: group a runs no block that gives it" "$W/half.out" \
     || fail "half: $(cat "$W/half.out")"
   ! grep -q "group=a\|group b - a" "$W/half/plan.csv" || fail "half: a row for group a's missing pairs"
   grep -q "^participants_t,group=b," "$W/half/plan.csv" || fail "half: no row for group b"
@@ -478,5 +478,55 @@ for line in lines:
 print("validate --plan:", lines)
 PYEOF
   echo "ok: a design that rarely determines its threshold is warned of by validate --plan and plan" ;;
+more_blurred_as_report)
+  # The plan's share of a pair is the report's: the side showing the larger blur radius (chose_more_blurred), not the
+  # design's first source (except for the thesis's own studies, whose report view tests the first source). A comparison whose blurrier source changes between its levels (measured against none, and
+  # none against measured): before, the plan gave 0.00 at none-vs-measured edge 9 (the first source, none, chosen in
+  # no decisive answer) where the report's table says 1.00 for the same answers. The truth: the report's own
+  # conditions table on the same participants' answers, recorded by blurcue run with the plan's seeds.
+  variant "$P/test1-static-grids.json" "$W/bc.json" 'p.update(name="blurrier-changes", repetitions=4, counterbalance="swap_copies", factors={"edge": [2, 9], "comparison": [{"left": "measured", "right": "none"}, {"left": "none", "right": "measured"}]}); p.pop("sides"); p.pop("practice")'
+  $BC plan "$W/bc.json" --participants 3 --studies 1 --seed 5 --no-chart --out "$W/p" > "$W/plan.out" 2>&1 \
+    || fail "plan: $(tail -2 "$W/plan.out")"
+  grep -q "more blurred: second source" "$W/plan.out" || fail "the summary does not name the blurrier source"
+  same_as_run "$W/p/answers.csv" "$W/bc.json" sim > /dev/null
+  MPLCONFIGDIR=$W/mpl $BC report --db "$W/run-bc.sqlite" --out "$W/report" --bench "$W/no-bench" --boot 40 \
+    > /dev/null 2> "$W/err" || fail "report: $(tail -3 "$W/err")"
+  $PY - "$W/p/plan.csv" "$W/report/blurrier-changes-simulated-conditions.csv" <<'PYEOF' || fail "shares differ"
+import csv, json, re, sys
+plan = {}
+for r in csv.DictReader(open(sys.argv[1])):
+    if r["test"] == "exact" and r["participants"] == "3":
+        m = re.fullmatch(r"comparison=(\{.*\}) edge=(\d+)", r["condition"])
+        level = ";".join(f"{k}={v}" for k, v in sorted(json.loads(m[1]).items()))
+        plan[(level, m[2])] = (float(r["expected_share"]), r["more_blurred_source"])
+report = {(r["comparison"], r["edge"]): float(r["share"]) for r in csv.DictReader(open(sys.argv[2]))}
+assert set(plan) == set(report) and len(plan) == 4, (sorted(plan), sorted(report))
+for key, (share, source) in plan.items():
+    assert abs(share - report[key]) < 1e-6, (key, share, report[key])
+    assert source == ("first" if key[0] == "left=measured;right=none" else "second"), (key, source)
+far = report[("left=none;right=measured", "9")]
+assert far > 0.5, far  # the blurred side is seen at edge 9, though it is the second source
+print(f"  the plan's 4 shares are the report's ({', '.join(f'{k[0]} edge {k[1]}: {v[0]:.3f}' for k, v in sorted(plan.items()))})")
+PYEOF
+  # The thesis's own test 1 keeps the first source: its report view (forced_choice.py) tests that share.
+  $BC plan "$P/test1-static-grids.json" --participants 3 --studies 1 --seed 5 --no-chart --out "$W/t1" > /dev/null 2>&1 \
+    || fail "plan test1"
+  same_as_run "$W/t1/answers.csv" "$P/test1-static-grids.json" sim > /dev/null
+  MPLCONFIGDIR=$W/mpl $BC report --db "$W/run-test1-static-grids.sqlite" --out "$W/report1" --bench "$W/no-bench" \
+    --boot 40 > /dev/null 2> "$W/err" || fail "report test1: $(tail -3 "$W/err")"
+  $PY - "$W/t1/plan.csv" "$W/report1/test1-per-edge.csv" <<'PYEOF' || fail "test 1 shares differ"
+import csv, math, sys
+plan = {r["condition"]: r for r in csv.DictReader(open(sys.argv[1])) if r["test"] == "exact" and r["participants"] == "3"}
+report = {f"edge={r['edge']}": r for r in csv.DictReader(open(sys.argv[2]))}
+assert set(plan) == set(report) and len(plan) == 11, (sorted(plan), sorted(report))
+for edge, r in plan.items():
+    assert r["measure"] == "first_source", r
+    want = report[edge]["share_first_of_decisive"]
+    assert (r["expected_share"] == "") == (want in ("", "nan")), (edge, r["expected_share"], want)
+    if want not in ("", "nan"):
+        assert abs(float(r["expected_share"]) - float(want)) < 1e-6, (edge, r["expected_share"], want)
+print("  test 1: the first source's share per edge, as its report view")
+PYEOF
+  echo "ok: plan's share of a pair is the report's chose_more_blurred, the blurrier source named; test 1's the first source, as its report" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -2,7 +2,7 @@
 set(BC $<TARGET_FILE:blurcue>)
 set(T ${PROJECT_BINARY_DIR}/cli-test)
 foreach(case same_as_run power_exact same_seed chart prediction depth_slope threshold_truth difference_power groups
-       difference_meaningless units_and_groups groups_shared_block design_warnings)
+       difference_meaningless units_and_groups groups_shared_block design_warnings more_blurred_as_report)
   add_test(NAME plan_${case} COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" bash ${PROJECT_SOURCE_DIR}/tests/plan_test.sh ${case} ${BC} ${T})
   set_tests_properties(plan_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures" LABELS "gl;plan" TIMEOUT 600)
 endforeach()

@@ -186,5 +186,57 @@ print(f"the fixed block's {n} answers analysed beside the procedure's cells")
 PYEOF
   $PY "$(dirname "$0")/report_numbers_check.py" "$W/report" > "$W/numbers" || fail "$(cat "$W/numbers")"
   echo "ok: an adaptive and a fixed-levels block of one study each analysed as what it is: $(cat "$W/found")" ;;
+crossed_hostile)
+  # Two within factors crossed in records a reviewer would try: a crossing left out of the design (edge 9 with
+  # rotation_deg 30) beside cells three times the size of the others, and a 3 x 2 crossing whose levels carry a
+  # comma, quotes, non-ASCII letters and HTML. Before: the empty crossing's interaction term was called separation
+  # ("every answer behind this term went one way": it has no answers), the tables did not name it, and a baseline
+  # level with a comma was cut at it ("against comparison label=naïve)").
+  protocol crossed-empty
+  cp "$DATA/crossed-empty.csv" "$W/"
+  protocol crossed-labels
+  for id in X1 X2 X3 X4; do
+    $BC run "$W/crossed-empty.json" --participant $id --db "$W/e.sqlite" --observer sim > /dev/null 2>&1 || fail "run $id"
+    $BC run "$W/crossed-labels.json" --participant $id --db "$W/l.sqlite" --observer sim > /dev/null 2>&1 || fail "run $id"
+  done
+  report "$W/e.sqlite" "$W/empty" > /dev/null 2> "$W/err" || fail "report: $(tail -3 "$W/err")"
+  report "$W/l.sqlite" "$W/labels" > /dev/null 2> "$W/err" || fail "report: $(tail -3 "$W/err")"
+  $PY - "$W/empty" "$W/labels" <<'PYEOF' > "$W/found" || fail "crossed: $(cat "$W/found")"
+import csv, glob, html, os, re, sys
+empty, labels = sys.argv[1], sys.argv[2]
+def table(folder, suffix):  # the report folder is named for its study: empty -> crossed-empty-simulated-...
+    name = f"crossed-{os.path.basename(folder)}-simulated-{suffix}"
+    return list(csv.DictReader(open(os.path.join(folder, name), encoding="utf-8")))
+cond = table(empty, "conditions.csv")
+assert sorted((r["edge"], r["rotation_deg"]) for r in cond) == [("3", "0"), ("3", "30"), ("6", "0"), ("6", "30"), ("9", "0")], cond
+assert [r["n"] for r in cond if (r["edge"], r["rotation_deg"]) == ("3", "0")] == ["72"], cond  # 3 x 2 x 3 x 4
+inter = table(empty, "models-interaction.csv")
+cell = [r for r in inter if r["term"] == "edge 9 x rotation_deg 30 (interaction: beyond the effects added)"]
+assert len(cell) == 2, [r["term"] for r in inter]  # the cluster-robust GLM and the GLMM
+for r in cell:
+    assert r["estimate"] == r["se"] == r["p"] == "" and r["note"].startswith("not determined: no answers at this crossing"), r
+for r in inter:  # a separated term: no number either
+    if r["note"].startswith("separation"):
+        assert r["estimate"] == r["p"] == "", r
+page = html.unescape(re.sub(r"<[^>]+>", " ", open(os.path.join(empty, "index.html"), encoding="utf-8").read()))
+page = re.sub(r"\s+", " ", page)
+assert "no answers at 1 crossing of edge and rotation_deg: edge 9 with rotation_deg 30" in page, "empty crossing not named"
+# The labels: the baseline named whole, the HTML shown as text.
+cond = table(labels, "conditions.csv")
+assert len(cond) == 6 and {r["edge"] for r in cond} == {"3", "6", "9"}, cond
+none = 'label=naïve, µ "a";left=measured;right=none'
+assert {r["comparison"] for r in cond} == {none, "label=Ω,<b>β</b>;left=measured;right=estimated"}, cond
+terms = [r["term"] for r in table(labels, "models-interaction.csv")]
+against = [t for t in terms if "(against comparison" in t]
+assert against and all(t.endswith(f"(against comparison {none})") for t in against), against
+raw = open(os.path.join(labels, "index.html"), encoding="utf-8").read()
+assert "<b>β</b>" not in raw and "&lt;b&gt;β&lt;/b&gt;" in raw, "a level's markup reached the page as markup"
+print(f"empty crossing named, its term not determined in words; {len(against)} terms name the baseline whole")
+PYEOF
+  for r in empty labels; do
+    $PY "$(dirname "$0")/browser_check.py" "$W/$r" index.html > "$W/browser" || fail "$r: $(cat "$W/browser")"
+    $PY "$(dirname "$0")/report_numbers_check.py" "$W/$r" > "$W/numbers" || fail "$r: $(cat "$W/numbers")"
+  done
+  echo "ok: crossed factors with an empty crossing, unbalanced cells and hostile level names: $(cat "$W/found"); $(sed 's/^ok: //' "$W/numbers")" ;;
 *) fail "unknown case $CASE" ;;
 esac

@@ -33,8 +33,9 @@ foreach(case again protocol_version conditions_version again_group balanced_coun
                        LABELS "gl;session")
 endforeach()
 # The report analyses the design the record declares (tests/report_design_test.sh): a QUEST+ per depth per depth,
-# between-subject groups compared across participants, unfinished and repeated sessions apart.
-foreach(case quest_per_depth groups sessions mixed_blocks)
+# between-subject groups compared across participants, unfinished and repeated sessions apart; two within factors
+# crossed with an empty crossing, unbalanced cells and level names holding commas, quotes, unicode and HTML.
+foreach(case quest_per_depth groups sessions mixed_blocks crossed_hostile)
   add_test(NAME report_design_${case} COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" bash ${PROJECT_SOURCE_DIR}/tests/report_design_test.sh ${case} ${BC} ${T})
   set_tests_properties(report_design_${case} PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
                        LABELS "gl;session")

@@ -175,6 +175,21 @@ class GroupByDepth(unittest.TestCase):
         self.assertIn("(1 | participant) was singular", inter["says"])
         self.assertIn("not determined", words)
 
+    def test_too_few_participants_for_a_t_say_so_in_words(self):
+        # Before: 3 participants in 2 groups gave each level's contrast with df 1 (t(1): edge 9's -0.46 +- 0.76,
+        # p = 0.66 from t(1)); 2 participants an R message about singular fits. After: the estimate without SE or p,
+        # and the count of participants, in words.
+        m = simulate(3, 0.0, per_group=2)
+        charts, _ = groups.charts(m[m["participant"] != "b2"], "pair", DESIGN, "s", "note", "chose it")
+        level = charts[1].table
+        self.assertEqual(len(level), 3)
+        self.assertTrue(level["model_estimate"].notna().all(), level)  # R fitted it
+        self.assertTrue(level["model_se"].isna().all() and level["model_p"].isna().all(), level)
+        self.assertTrue(level["model_says"].str.contains("3 participants in 2 groups leave 1 df").all(), level)
+        charts, _ = groups.charts(simulate(3, 0.0, per_group=1), "pair", DESIGN, "s", "note", "chose it")
+        self.assertIn("2 participants: too few for a model across participants", charts[0].table["says"].iloc[0])
+        self.assertTrue(charts[1].table["model_estimate"].isna().all())
+
     def test_a_rating_study_gets_the_linear_model_and_kenward_roger(self):
         # Ratings: group b rates 1 point higher at edge 9 only; the truth -1 (a - b) at 9, 0 elsewhere.
         rng = np.random.default_rng(5)

@@ -236,17 +236,19 @@ class ObserverModelTest(unittest.TestCase):
         self.assertIn("SE not determined", base["note"])
 
     def test_depth_matching_zero_se_is_said_in_words(self):
-        # Two participants who set exactly the same blur at every distance: the cluster-robust SE is 0 to rounding (no
-        # participant's settings pull the fit), so the slope gets no SE and no p, in words - and the pooled line used
-        # by the charts keeps its estimates.
+        # Three participants who set exactly the same blur at every distance: the cluster-robust SE is 0 to rounding
+        # (no participant's settings pull the fit), so the slope gets no SE and no p, in words - and the pooled line
+        # used by the charts keeps its estimates. (Two participants get no model across them at all:
+        # test_depth_matching.TwoParticipants.)
         import depth_matching
         real = [0.5, 1.0, 2.0, 3.0, 4.0]
         rows = [{"participant": p, "real_arcmin": r, "set_arcmin": 1.0 + 0.5 * r + e}
-                for p in ("P1", "P2") for r, e in zip(real, [0.1, -0.2, 0.15, -0.05, 0.0])]
+                for p in ("P1", "P2", "P3") for r, e in zip(real, [0.1, -0.2, 0.15, -0.05, 0.0])]
         out, pooled = depth_matching._across(pd.DataFrame(rows), "real_arcmin", "set_arcmin", "set on real",
                                              depth_matching.WORDS_MATCH, [], "s")
         table = stats.model_table(out)
-        slope = table[table["term"] == depth_matching.WORDS_MATCH["real_arcmin"]].iloc[0]
+        slope = table[(table["term"] == depth_matching.WORDS_MATCH["real_arcmin"]) &
+                      table["engine"].str.contains("cluster-robust")].iloc[0]
         self.assertTrue(math.isnan(slope["se"]) and math.isnan(slope["p"]), slope.to_dict())
         self.assertIn("SE not determined", slope["note"])
         self.assertAlmostEqual(slope["estimate"], pooled[1], places=9)
@@ -271,6 +273,9 @@ class ObserverModelTest(unittest.TestCase):
         self.assertEqual(stats.term_in_words("C(pattern_id)[1]", d), "pattern_id 1")
         self.assertEqual(stats.term_in_words("C(edge)[T.6]", d), "edge 6 (against edge 3)")
         self.assertEqual(stats.term_in_words("C(edge, levels=['9', '3'])[T.3]", d), "edge 3 (against edge 9)")
+        # A baseline level holding a comma and quotes is named whole (it was cut at the comma: 'against c naïve').
+        self.assertEqual(stats.term_in_words("C(c, levels=['naïve, µ \\'a\\'', 'Ω,<b>'])[T.Ω,<b>]", d),
+                         "c Ω,<b> (against c naïve, µ 'a')")
         self.assertEqual(stats.term_in_words("Intercept", d), "baseline (intercept)")
         self.assertEqual(stats.term_in_words("edge_c", d), "per edge (edge centred at 6)")
 

@@ -54,6 +54,12 @@ std::string LevelText(const protocol::Level& level) {
   return protocol::ToJson(level).dump();
 }
 
+// The thesis's forced-choice studies, which the report analyses with their own views (analysis/common.py
+// FORCED_CHOICE_STUDIES): the share of the design's first source among decisive answers.
+bool IsThesisForcedChoice(const std::string& study) {
+  return study == "test1-static-grids" || study == "test2-moving-balls" || study == "test3-no-board";
+}
+
 // The condition of a main (not practice) trial and the measure its tests use; nullopt for what is not planned.
 std::optional<Condition> ConditionOf(const protocol::Protocol& protocol, const protocol::Trial& trial,
                                      const stimulus::TrialScene& scene, bool several_blocks) {
@@ -77,7 +83,12 @@ std::optional<Condition> ConditionOf(const protocol::Protocol& protocol, const p
     c.measure = "correct";
     c.chance = scene.intervals > 2 ? 1.0 / scene.intervals : 0.5;
   } else if (task.answer == protocol::TaskAnswer::kSide && scene.content != protocol::ContentType::kPicture) {
-    c.measure = "first_source";
+    // The report's measure of a pair: for any study, trials.csv's chose_more_blurred - the side that showed the
+    // larger blur radius, among decisive answers where the radii differ (the design's first source, planned before,
+    // reads the other way round wherever the second source is the blurrier one: a comparison of none against
+    // measured gave 0.1 for the report's 0.9); for the thesis's own forced-choice studies, whose report view
+    // (analysis/forced_choice.py) tests the design's first source, that source.
+    c.measure = IsThesisForcedChoice(protocol.name) ? "first_source" : "more_blurred";
     c.chance = 0.5;
   } else {
     return std::nullopt;
@@ -94,6 +105,28 @@ void SplitByGroup(const protocol::Protocol& protocol, const protocol::Trial& tri
   if (protocol::BlockOf(protocol, trial)->groups.size() == 1) return;
   c->key.group = group;
   c->label = "group=" + group + ": " + c->label;
+}
+
+// A pair's answer counted: by the source chosen (as designed) and, as the report's measure, whether the side chosen
+// showed the larger radius - as store/export.cc's chose_more_blurred: radii within 1e-9 px are equal and count for
+// neither side.
+void TallyPair(const protocol::Trial& trial, const stimulus::TrialScene& scene, const Choice& choice, bool by_first,
+               Tally* t) {
+  const bool left = choice == Choice::Of(Side::kLeft), right = choice == Choice::Of(Side::kRight);
+  const bool first = trial.swapped ? right : left, second = trial.swapped ? left : right;
+  t->first += first, t->second += second, t->cant_tell += choice.kind == Choice::Kind::kCantTell;
+  const double r_left = scene.sides[protocol::Index(Side::kLeft)].r_px;
+  const double r_right = scene.sides[protocol::Index(Side::kRight)].r_px;
+  const bool differ = std::abs(r_left - r_right) > 1e-9, left_blurrier = r_left > r_right;
+  if (!differ) {
+    ++t->blurrier_equal;
+  } else {
+    (left_blurrier != trial.swapped ? t->blurrier_first : t->blurrier_second) += 1;
+  }
+  if (by_first)
+    t->k += first, t->n += first || second;
+  else if (differ && (left || right))
+    t->k += left == left_blurrier, ++t->n;
 }
 
 // One simulated participant through the session's own decisions (what `blurcue run --observer sim` does headless).
@@ -190,11 +223,8 @@ SimParticipant Simulate(procedure::PreparedSession& study, const procedure::Obse
     ++t.shown;
     const bool none = choice.kind == Choice::Kind::kNone;
     t.none += none;
-    if (c->measure == "first_source") {
-      const bool left = choice == Choice::Of(Side::kLeft), right = choice == Choice::Of(Side::kRight);
-      const bool first = trial.swapped ? right : left, second = trial.swapped ? left : right;
-      t.first += first, t.second += second, t.cant_tell += choice.kind == Choice::Kind::kCantTell;
-      t.k += first, t.n += first || second;
+    if (c->measure == "more_blurred" || c->measure == "first_source") {
+      TallyPair(trial, scene, choice, c->measure == "first_source", &t);
     } else if (c->measure == "correct") {
       // The report counts answers (a missed deadline is no answer), correct against the guess rate.
       if (!none) t.k += scored.correct.value_or(false), ++t.n;
@@ -365,6 +395,13 @@ void AddSlopeRows(PlanResult& r, const Condition& c, const PlanOptions& options)
   for (auto row = r.rows.end() - N; row != r.rows.end(); ++row) row->expected_share = count > 0 ? sum / count : nan;
 }
 
+// Which of a pair's sources (as designed, swaps undone) showed the larger radius in a condition's trials, in a word.
+std::string BlurrierSource(const Tally& t) {
+  const int kinds = (t.blurrier_first > 0) + (t.blurrier_second > 0) + (t.blurrier_equal > 0);
+  if (kinds > 1) return "varies";
+  return t.blurrier_first > 0 ? "first" : t.blurrier_second > 0 ? "second" : t.blurrier_equal > 0 ? "equal" : "";
+}
+
 // p-values of the exact test are a function of (k, n, chance): each (n, chance) computed once.
 class ExactBinomialP {
  public:
@@ -389,7 +426,8 @@ void AddExactRows(PlanResult& r, const Condition& c, const PlanOptions& options,
       if (const auto it = p.tallies.find(c.key); it != p.tallies.end()) {
         const Tally& t = it->second;
         all.k += t.k, all.n += t.n, all.first += t.first, all.second += t.second, all.cant_tell += t.cant_tell,
-            all.none += t.none, all.shown += t.shown;
+            all.none += t.none, all.shown += t.shown, all.blurrier_first += t.blurrier_first,
+            all.blurrier_second += t.blurrier_second, all.blurrier_equal += t.blurrier_equal;
       }
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double shown = all.shown > 0 ? all.shown : nan;
@@ -409,7 +447,8 @@ void AddExactRows(PlanResult& r, const Condition& c, const PlanOptions& options,
     row.chance = c.chance >= 0 ? c.chance : nan;
     row.participants = m;
     row.expected_share = all.n > 0 ? double(all.k) / all.n : nan;
-    if (c.measure == "first_source") {
+    if (c.measure == "more_blurred" || c.measure == "first_source") {
+      row.more_blurred = BlurrierSource(all);
       row.share_first = all.first / shown, row.share_second = all.second / shown;
       row.share_cant_tell = all.cant_tell / shown, row.share_none = all.none / shown;
     } else {
@@ -547,7 +586,8 @@ PlanResult RunPlan(const PlanOptions& options) {
 std::string PlanCsv(const PlanResult& r) {
   std::string out =
       "test,condition,measure,chance,participants,expected_share,share_first,share_second,share_cant_tell,share_none,"
-      "mean_trials,wilson_width,power,true_threshold,mean_estimate,bias,sd_estimate,interval_width,difference,determined_share,coverage\n";
+      "mean_trials,wilson_width,power,true_threshold,mean_estimate,bias,sd_estimate,interval_width,difference,determined_share,coverage,"
+      "more_blurred_source\n";
   for (const PowerRow& row : r.rows)
     out += row.test + "," + store::CsvField(row.condition) + "," + row.measure + "," + Number(row.chance, "%.6g") + "," +
            std::to_string(row.participants) + "," + Number(row.expected_share) + "," + Number(row.share_first) + "," +
@@ -555,7 +595,7 @@ std::string PlanCsv(const PlanResult& r) {
            Number(row.mean_trials, "%.3f") + "," + Number(row.wilson_width) + "," + Number(row.power) + "," +
            Number(row.true_threshold) + "," + Number(row.mean_estimate) + "," + Number(row.bias) + "," +
            Number(row.sd_estimate) + "," + Number(row.interval_width) + "," + Number(row.difference) + "," +
-           Number(row.determined_share) + "," + Number(row.coverage) + "\n";
+           Number(row.determined_share) + "," + Number(row.coverage) + "," + row.more_blurred + "\n";
   return out;
 }
 
@@ -593,8 +633,10 @@ std::string Summary(const PlanResult& r, const PlanOptions& o) {
   for (const PowerRow& row : r.rows) shares = shares || row.measure != "threshold";
   if (shares) {
     std::snprintf(line, sizeof line,
-                  "per condition at N = %d: the expected share (first_source: the design's first source among "
-                  "decisive answers; correct; yes), the mean width of its 95 %% Wilson interval, the power of the report's "
+                  "per condition at N = %d: the expected share (more_blurred: the side showing the larger blur radius "
+                  "among decisive answers, the report's chose_more_blurred - 'more blurred:' names which source that "
+                  "was, as designed; first_source: the thesis's own studies, whose report view tests the design's first "
+                  "source; correct; yes), the mean width of its 95 %% Wilson interval, the power of the report's "
                   "exact test against chance (alpha %g; participants as the unit: at chance 0.5 the sign-flip test of "
                   "their shares, which needs 6 of them to reach 0.05; else the binomial of the answers; one "
                   "participant: the binomial of their answers, none for one answer; two: none) and the smallest N "
@@ -614,7 +656,8 @@ std::string Summary(const PlanResult& r, const PlanOptions& o) {
     std::string shown;
     if (std::isfinite(row.share_first))
       shown = Number(row.share_first, "%.2f") + " / " + Number(row.share_second, "%.2f") + " / " +
-              Number(row.share_cant_tell, "%.2f") + " / " + Number(row.share_none, "%.2f");
+              Number(row.share_cant_tell, "%.2f") + " / " + Number(row.share_none, "%.2f") +
+              (row.more_blurred.empty() ? "" : "; more blurred: " + row.more_blurred + " source");
     if (row.test == "participants_t" || row.test == "groups_t") {
       const std::string label = row.test == "groups_t"   ? row.condition + ": Welch t"
                                 : row.condition == "all" ? std::string("all: t across participants")

@@ -5,8 +5,9 @@
 // in parallel. From them, per condition, the expected share and how wide its 95 % interval would be, and the power
 // of the protocol's tests against the number of participants:
 //   exact          per condition, the report's exact test against chance with participants as the unit
-//                  (analysis/study_tests.py against_chance_counts; a pair: the design's first source among decisive
-//                  answers against 0.5 - the sign-flip test of the participants' shares; an odd one out: correct
+//                  (analysis/study_tests.py against_chance_counts; a pair: the side showing the larger blur radius
+//                  - trials.csv's chose_more_blurred - among decisive answers where the radii differ, against 0.5 -
+//                  the sign-flip test of the participants' shares; an odd one out: correct
 //                  against its guess rate - the binomial of the answers; one participant: the binomial of their
 //                  answers; two: none), at alpha;
 //   participants_t across participants, a one-sample t-test of each participant's share (over all their scored
@@ -81,7 +82,8 @@ struct Condition {
   ConditionKey key;       // unique
   int block = 0;          // index in protocol.blocks (conditions are ordered by block, then levels)
   std::string label;      // "edge=3" (and the block's name when the protocol has several)
-  std::string measure;    // "first_source" (a pair) | "correct" | "yes" | "log_cutoff_slope" (depth matching)
+  std::string measure;    // "more_blurred" (a pair: the report's chose_more_blurred) | "first_source" (a pair of
+                          // the thesis's studies, as the report's thesis view) | "correct" | "yes" | "log_cutoff_slope" (depth matching)
                           // | "threshold" (a procedure cell: what it estimates, not its share correct)
   double chance = -1;     // the test's null share; < 0: no test (yes/no, threshold)
   // A procedure cell: its variable (the threshold's unit) and the simulated observer's true threshold (threshold.h).
@@ -98,6 +100,8 @@ struct Condition {
 struct Tally {
   int k = 0, n = 0;       // successes (first source, correct, yes) of the trials that count (decisive, answered)
   int first = 0, second = 0, cant_tell = 0, none = 0, shown = 0;  // a pair's answers (none: past the deadline)
+  // A pair's trials by the source (as designed) that showed the larger radius: the first, the second, neither (equal).
+  int blurrier_first = 0, blurrier_second = 0, blurrier_equal = 0;
 };
 
 struct SimParticipant {
@@ -125,6 +129,9 @@ struct PowerRow {
   int participants = 0;
   double expected_share = 0;   // over every simulated study and participant (slope_t: the mean slope b)
   double share_first = 0, share_second = 0, share_cant_tell = 0, share_none = 0;  // a pair's answers, of shown
+  // A pair: which source (as designed) showed the larger radius - "first", "second", "equal" or "varies" (trials of
+  // the condition differ); empty for other measures.
+  std::string more_blurred;
   double mean_trials = 0;      // counting trials per study at this N (mean)
   double wilson_width = 0;     // mean width of the 95 % Wilson interval at this N (slope_t: of the slope's t interval)
   double power = 0;            // share of studies whose test has p < alpha (NaN for "none")
