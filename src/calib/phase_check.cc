@@ -30,6 +30,13 @@ constexpr double kMinSpanPx = 1.0;
 // each other at any phase (measured: 2.00 vs 1.90-2.16 px at r = 2); below, up to a factor 2 apart.
 constexpr double kMaxBlurPx = 2.0;
 constexpr double kBinPx = 0.1;  // one row's samples share a distance across a level edge: bins far finer than 1 px
+// A section at every phase spreads its samples evenly across the edge: a 0.1 px bin holds a tenth of the length used
+// (2 on the far sections of a board turned 45-60 deg). Held to 3 samples, as a level edge's bins are, such a section
+// kept 11 of ~150 bins (edge 11 section 7 at 45 deg: 0.75 px for a true 0.85 px, every family alike) or fewer than 6
+// (edge 5 section 7 at 60 deg: not read per family, its phase check empty, 0.61 px for 0.13 px unflagged); every bin
+// with a sample is kept there (with 3, the interquartile mean is the plain mean anyway). Level edges keep 3.
+constexpr size_t kLevelBinSamples = 3, kEveryPhaseBinSamples = 1;
+constexpr size_t kMinNoiseSamples = 12;  // deviations the noise is taken from, at least (else pairs' join them)
 // The pose puts an edge within a few hundredths of a pixel (synth scenes: 0.02-0.06 px); each family finds it within
 // this of the pose's line. Fixed at the line, the pose's own error, not the family, would decide the fit.
 constexpr double kPoseUncertaintyPx = 0.15;
@@ -65,9 +72,11 @@ double InterquartileMean(std::vector<float>& v) {
   return sum / double(hi - lo);
 }
 
-// The profile across the edge, from the pose's line (d = 0), over |d| <= half_px, in the central part along.
+// The profile across the edge, from the pose's line (d = 0), over |d| <= half_px, in the central part along. A bin
+// holds at least `min_samples` pixels (its interquartile mean: robust to a printing spot); the noise comes from the bins
+// of 3 or more (those of 2 where they are too few).
 std::vector<Bin> ProfileBins(const cv::Mat& linear, const EdgeSegment& segment, double along_fraction,
-                             double half_px, double* noise) {
+                             double half_px, size_t min_samples, double* noise) {
   const EdgeFrame f = MakeEdgeFrame(segment);
   const double margin = 0.5 * (1 - std::clamp(along_fraction, 0.0, 1.0)) * f.length;
   const double bow = std::isfinite(segment.bow_px) ? segment.bow_px : 0;
@@ -97,13 +106,16 @@ std::vector<Bin> ProfileBins(const cv::Mat& linear, const EdgeSegment& segment, 
     }
   }
   std::vector<Bin> bins;
-  std::vector<float> dev;  // |value - its bin's middle|: the noise, robustly (a spot is a few of them)
+  std::vector<float> dev, dev2;  // |value - its bin's middle|: the noise, robustly (a spot is a few of them)
   for (int i = 0; i < nb; ++i)
-    if (values[i].size() >= 3) {
+    if (values[i].size() >= std::max<size_t>(1, min_samples)) {
       const double n = static_cast<double>(values[i].size());
       bins.push_back({sum_d[i] / n, InterquartileMean(values[i]), n});
-      for (const float v : values[i]) dev.push_back(static_cast<float>(std::abs(v - bins.back().v)));
+      // A pair's deviations from its mean are sqrt(3/4) of a triple's (std sqrt(1/2) against sqrt(2/3) of the noise's).
+      for (const float v : values[i])
+        (n >= 3 ? dev : dev2).push_back(static_cast<float>(std::abs(v - bins.back().v) * (n >= 3 ? 1 : std::sqrt(4.0 / 3))));
     }
+  if (dev.size() < kMinNoiseSamples) dev.insert(dev.end(), dev2.begin(), dev2.end());
   *noise = kMinNoise;
   if (!dev.empty()) {
     std::nth_element(dev.begin(), dev.begin() + dev.size() / 2, dev.end());
@@ -338,7 +350,8 @@ PhaseCheck GatePhase(const cv::Mat& linear, const EdgeSegment& segment, const Mo
   // 25 deg off it were not read (physical boards turned 45 and 60 deg chose a Gaussian of 0.35 px that no photo had).
   if (!(fit.r_px > 0 && fit.r_px < kMaxBlurPx)) return check;
   const double half = std::min(segment.half_window_px, 2 * fit.r_px + 6);
-  const std::vector<Bin> bins = ProfileBins(linear, segment, options.along_fraction, half, &check.noise);
+  const std::vector<Bin> bins = ProfileBins(linear, segment, options.along_fraction, half,
+                                            few ? kLevelBinSamples : kEveryPhaseBinSamples, &check.noise);
   if (bins.size() < 6) return check;
   check.limited = few;
   check.every_phase = !few;
