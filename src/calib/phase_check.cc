@@ -348,13 +348,15 @@ PhaseCheck GatePhase(const cv::Mat& linear, const EdgeSegment& segment, const Mo
   const bool few = check.span_px < kMinSpanPx;
   // At any angle: a family's taps act on both axes (ProjectTaps). Read along the nearest axis alone, edges more than
   // 25 deg off it were not read (physical boards turned 45 and 60 deg chose a Gaussian of 0.35 px that no photo had).
-  if (!(fit.r_px > 0 && fit.r_px < kMaxBlurPx)) return check;
+  if (!(fit.r_px > 0 && std::isfinite(fit.r_px))) return check;
   const double half = std::min(segment.half_window_px, 2 * fit.r_px + 6);
   const std::vector<Bin> bins = ProfileBins(linear, segment, options.along_fraction, half,
                                             few ? kLevelBinSamples : kEveryPhaseBinSamples, &check.noise);
   if (bins.size() < 6) return check;
-  check.limited = few;
-  check.every_phase = !few;
+  const bool wide = fit.r_px >= kMaxBlurPx;
+  check.limited = few && !wide;
+  check.every_phase = !few && !wide;
+  check.wide = wide;
   check.bins = static_cast<int>(bins.size());
   // The optics' shape: the blur fit's (disc x Gaussian); rounded to the nearer pure shape, the misfit of a mixed one
   // made a post filter look better than the optics alone on physical optics.
@@ -438,7 +440,7 @@ PhaseCheck CheckPhase(const cv::Mat& linear, const EdgeSegment& segment, const M
   PhaseProfile profile;
   PhaseCheck check = GatePhase(linear, segment, fit, options, &profile);
   if (check.limited) ReadFamilies(profile, {}, &check);
-  check.every_phase = false;  // read by ReadPhaseFamilies only, with the photo's other sections
+  check.every_phase = check.wide = false;  // read by ReadPhaseFamilies only, with the photo's other sections
   return check;
 }
 
@@ -457,9 +459,23 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
   };
   each(usable.size(), [&](size_t k) { usable[k]->phase = GatePhase(linear, usable[k]->segment, usable[k]->fit,
                                                                    options, &profiles[k]); });
-  std::vector<size_t> limited;
+  std::vector<size_t> limited, wide;
   for (size_t k = 0; k < usable.size(); ++k)
     if (usable[k]->phase.limited || usable[k]->phase.every_phase) limited.push_back(k);
+    else if (usable[k]->phase.wide) wide.push_back(k);
+  // The sections of 2 px or more, where a filter fitted the choice's sections best (fit_between appended it): read with
+  // the families marked in `read` (all when empty) and the fitted one, for ChoosePhaseFamily to take the chosen one's
+  // reading. They do not join the choice: at that blur the families read within 2-5 % of each other.
+  auto read_wide = [&](const std::vector<bool>& read) {
+    if (result.phase.families.size() <= PhaseFamilies().size()) return;
+    const PhaseFamily& fitted = result.phase.families.back();
+    each(wide.size(), [&](size_t i) {
+      const PhaseProfile& p = profiles[wide[i]];
+      PhaseCheck& check = usable[wide[i]]->phase;
+      ReadFamilies(p, read, &check);
+      check.families.push_back(ReadFamily(p.bins, fitted, p.r_fit, p.phi, p.w1, p.w2, check.noise, p.one_shape));
+    });
+  };
   // Few sections: every family on each, as CheckPhase. Otherwise the families are first read on kChoiceSections of
   // them at phases spread over the pixel (sorted by phase, evenly picked): the families those fit far worse than the
   // best (twice ChoosePhaseFamily's "alike" margins) are not read on the others. The rest of the choice is
@@ -498,6 +514,7 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
   if (limited.size() <= 2 * kChoiceSections) {
     each(limited.size(), [&](size_t i) { ReadFamilies(profiles[limited[i]], {}, &usable[limited[i]]->phase); });
     fit_between(limited);
+    read_wide({});
     return;
   }
   std::vector<size_t> by_phase = limited;
@@ -540,6 +557,7 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
     ReadFamilies(profiles[rest[i]], check.limited ? read_few : read_every, &check);
   });
   fit_between(chosen);
+  read_wide(read_every);
 }
 
 namespace {
@@ -694,6 +712,15 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
     cancelled += hi - lo <= target && moved > target;
     jumped += hi - lo <= target && moved <= target;
   }
+  // Sections of 2 px or more read with the families (ReadPhaseFamilies, where a filter fitted best): the chosen one's
+  // reading, unflagged (the families that fit alike read them within 2-5 %).
+  int wide = 0;
+  if (best != 0)
+    for (auto& edge : result.edges)
+      for (auto& s : edge.sections)
+        if (s.fit.ok && s.phase.wide && s.phase.families.size() == families.size() &&
+            std::isfinite(s.phase.families[best].r_px))
+          s.fit.r_px = s.phase.families[best].r_px, ++wide;
   // Only where a filter after sampling was chosen: under the optics alone (physical optics) the blur fit's reading is
   // the one the physical scenes hold to median 2 %, p90 5 %, and a section 9 % high on a Gaussian x 0.2 px floor scene
   // would be flagged for noise the targets allow.
@@ -702,7 +729,7 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   int n_alike = 0, n_read = 0;
   for (const bool a : choice.alike) n_alike += a;
   for (const double c : choice.chi2) n_read += std::isfinite(c);
-  char text[900], ruled[120] = "";
+  char text[1000], ruled[120] = "";
   if (n_read < int(families.size()))
     std::snprintf(ruled, sizeof ruled, "; %zu ruled out on %zu sections at spread phases and not read on the rest",
                   families.size() - n_read, result.phase.choice_sections);
@@ -712,9 +739,9 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
                 "best as %s (%d of the kinds fit alike, chi-square per point %.2f, 1 where only the noise is left%s); %d "
                 "flagged phase_limited (%d where the sharpening cancels most of the lens's blur, %d jumping between "
                 "neighbouring kinds, %d off the line through their edge's other sections, %d too unsure near a pixel "
-                "centre; each reading's range in calib.json)",
+                "centre; each reading's range in calib.json); %d sections of %.0f px or more read with it too",
                 choice.limited, kMaxBlurPx, choice.every_phase, families.size(), families[best].Name().c_str(), n_alike,
-                choice.chi2_per_point, ruled, choice.flagged, cancelled, jumped, off_edge, unsure);
+                choice.chi2_per_point, ruled, choice.flagged, cancelled, jumped, off_edge, unsure, wide, kMaxBlurPx);
   choice.summary = text;
   return choice;
 }

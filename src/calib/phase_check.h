@@ -44,6 +44,11 @@ struct PhaseCheck {
   // tells the families apart on its own and joins the choice; where a filter after sampling is chosen it is read with
   // it (a board turned a few degrees under a filter: read as the optics alone, 28 sections were off the rule).
   bool every_phase = false;
+  // Blur of 2 px or more (neither of the above): where a filter after sampling fits the others best, read with the
+  // families read on them (ReadPhaseFamilies) and then with the chosen one (ChoosePhaseFamily), not with the optics
+  // alone: under a mask the blur fit's disc x Gaussian reads about the optics' blur without the mask's negative second
+  // moment (turned 60 deg, amount 0.7 over 0.6 px: edge 1 section 1 at 2.54 px for a true 2.26 px, the optics 2.47 px).
+  bool wide = false;
   double axis_deg = 0;  // the edge's angle to the nearest pixel axis
   double span_px = 0;   // how far its sub-pixel phase moves along the part measured (1 px or more: every phase)
   double phase_px = 0;  // where the edge (from the pose) lies between pixel centres at its midpoint, 0..1
