@@ -9,6 +9,7 @@
 // together, whose edges lie at other phases (the one whose profiles fit them best). A section whose reading still
 // depends on which of the families that fit alike is taken is flagged `phase_limited`, left out of the lens fit, and
 // predicted by it.
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,9 @@ struct PhaseReading {
   double offset_px = 0;  // where it puts the edge, from the pose's line (within 0.15 px of it)
   double rms_rel = 0;    // its residual rms / |step|
   double chi2 = 0;       // its residual sum of squares over the noise variance (PhaseCheck::noise)
+  // On a board's outer edge, where the table's texture may slope across the window: r_px read with that slope as one
+  // more linear term (NaN elsewhere). ChoosePhaseFamily flags a section whose two readings differ by the target.
+  double r_table_px = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct PhaseCheck {
