@@ -1,6 +1,7 @@
 #include "calib/phase_check.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -319,64 +320,6 @@ PhaseReading ReadFamily(const std::vector<Bin>& bins, const PhaseFamily& family,
   return out;
 }
 
-}  // namespace
-
-std::string PhaseFamily::Name() const {
-  char text[160];
-  if (!(sigma_px > 0)) return "the optics alone";
-  const char* between = fitted ? ", fitted between the families" : "";
-  if (sharpen > 0)
-    std::snprintf(text, sizeof text, "the optics then sharpening (unsharp mask of amount %.2f, std %.2f px%s)", sharpen,
-                  sigma_px, between);
-  else
-    std::snprintf(text, sizeof text, "the optics then a Gaussian of std %.2f px on the sampled image%s", sigma_px,
-                  between);
-  return text;
-}
-
-const std::vector<PhaseFamily>& PhaseFamilies() {
-  // Gaussians: under 0.3 px one's taps at whole pixels are the identity to 4e-3 (0.3 px reads as the optics alone);
-  // steps of 0.05 px beyond, where a step moves a sub-pixel reading by 3-8 %. Sharpening: a camera's unsharp masks,
-  // mild to strong, over a narrow and a wide Gaussian.
-  static const std::vector<PhaseFamily> families = {
-      {0, 0},      {0.35, 0},   {0.4, 0},   {0.45, 0},  {0.5, 0},   {0.55, 0},  {0.6, 0}, {0.7, 0}, {0.8, 0},
-      {0.6, 0.15}, {0.6, 0.3},  {0.6, 0.5}, {0.6, 0.7}, {0.8, 0.15}, {0.8, 0.3}, {0.8, 0.5}, {0.8, 0.7},
-      {1.0, 0.15}, {1.0, 0.3}, {1.0, 0.5}, {1.0, 0.7}};
-  return families;
-}
-
-std::vector<size_t> PhaseNeighbours(size_t c) {
-  // Axes: the Gaussians by std, and the unsharp masks of each std by amount; the optics alone is the zero of each.
-  const std::vector<PhaseFamily>& f = PhaseFamilies();
-  auto param = [&](size_t a) { return f[a].sharpen > 0 ? f[a].sharpen : f[a].sigma_px; };
-  auto on_axis = [&](size_t a, size_t of) {  // a lies on the axis of family `of` (not the optics alone)
-    return a == 0 || ((f[a].sharpen > 0) == (f[of].sharpen > 0) && (f[of].sharpen <= 0 || f[a].sigma_px == f[of].sigma_px));
-  };
-  std::vector<size_t> out;
-  auto add = [&](size_t a) {
-    if (a < f.size() && std::find(out.begin(), out.end(), a) == out.end()) out.push_back(a);
-  };
-  for (size_t axis = 1; axis < f.size(); ++axis) {
-    if (c != 0 && axis != c) continue;
-    // The nearest on each side of c along this axis.
-    size_t below = f.size(), above = f.size();
-    for (size_t a = 0; a < f.size(); ++a) {
-      if (a == c || !on_axis(a, axis)) continue;
-      const double d = param(a) - (c == 0 ? 0.0 : param(c));
-      if (a == 0 || d < 0) {
-        if (below == f.size() || d > param(below) - param(c)) below = a;
-      } else if (d > 0 && (above == f.size() || d < param(above) - (c == 0 ? 0.0 : param(c)))) {
-        above = a;
-      }
-    }
-    if (c != 0) add(below);
-    add(above);
-  }
-  return out;
-}
-
-namespace {
-
 // A section's gate and profile (CheckPhase's first half): where `check.limited` comes back true, `profile` holds what
 // its families are read on.
 struct PhaseProfile {
@@ -654,6 +597,27 @@ std::string TableWhy(double r, double r_table) {
   return why;
 }
 
+// Sections of 2 px or more read with the families (ReadPhaseFamilies, where a filter fitted best): the chosen one's
+// (`best` of `nf`) reading, unflagged (the families that fit alike read them within 2-5 %) unless the table's slope
+// moves it (TableWhy; counted in `tabled`). Returns how many took it.
+int TakeWideReadings(CalibResult& result, size_t best, size_t nf, int* tabled) {
+  int wide = 0;
+  for (auto& edge : result.edges)
+    for (auto& s : edge.sections) {
+      if (!(s.fit.ok && s.phase.wide && s.phase.families.size() == nf && std::isfinite(s.phase.families[best].r_px)))
+        continue;
+      const double r = s.fit.r_px = s.phase.families[best].r_px, r_table = s.phase.families[best].r_table_px;
+      ++wide;
+      if (!(std::abs(r_table - r) > std::max(kSpreadPx, kSpreadRel * r))) continue;  // NaN: not on the outer edge
+      s.fit.ok = false;
+      s.fit.flags.push_back("phase_limited");
+      s.fit.phase_why = TableWhy(r, r_table);
+      s.phase.range_lo_px = std::min(r, r_table), s.phase.range_hi_px = std::max(r, r_table);
+      ++*tabled;
+    }
+  return wide;
+}
+
 // A flagged section's reason, in words (calib.json's phase_why and the summary).
 std::string PhaseWhy(const SectionResult& s, double lo, double hi, double r, double v, double moved, double nearest) {
   char why[480];
@@ -684,6 +648,35 @@ std::string PhaseWhy(const SectionResult& s, double lo, double hi, double r, dou
                   100 * std::min(1.0, -4 * v / (r * r - 4 * v)), std::sqrt(r * r - 4 * v), r, 100 * kOpticsRel, moved,
                   kSpreadPx, 100 * kSpreadRel);
   return why;
+}
+
+}  // namespace
+
+namespace {
+
+// ChoosePhaseFamily's summary: `flags` counts the flags by reason (cancelled, jumped, off their edge, unsure, moved by
+// the table's slope); `wide` the sections of 2 px or more read with the chosen family.
+std::string ChoiceSummary(const PhaseChoice& choice, size_t best, const std::array<int, 5>& flags, int wide) {
+  const std::vector<PhaseFamily>& families = choice.families;
+  int n_alike = 0, n_read = 0;
+  for (const bool a : choice.alike) n_alike += a;
+  for (const double c : choice.chi2) n_read += std::isfinite(c);
+  char text[1000], ruled[120] = "";
+  if (n_read < int(families.size()))
+    std::snprintf(ruled, sizeof ruled, "; %zu ruled out on %zu sections at spread phases and not read on the rest",
+                  families.size() - n_read, choice.choice_sections);
+  std::snprintf(text, sizeof text,
+                "%d sections with blur under %.0f px along the pixel rows or columns (and %d at every phase) read under "
+                "%zu kinds of blur (the lens alone, or then a smoothing or sharpening of the pixels): the photo fits "
+                "best as %s (%d of the kinds fit alike, chi-square per point %.2f, 1 where only the noise is left%s); %d "
+                "flagged phase_limited (%d where the sharpening cancels most of the lens's blur, %d jumping between "
+                "neighbouring kinds, %d off the line through their edge's other sections, %d too unsure near a pixel "
+                "centre, %d on the board's outer edge moved by the table's slope; each reading's range in calib.json); "
+                "%d sections of %.0f px or more read with it too",
+                choice.limited, kMaxBlurPx, choice.every_phase, families.size(), families[best].Name().c_str(), n_alike,
+                choice.chi2_per_point, ruled, choice.flagged, flags[0], flags[1], flags[2], flags[3], flags[4], wide,
+                kMaxBlurPx);
+  return text;
 }
 
 }  // namespace
@@ -791,46 +784,15 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
     cancelled += hi - lo <= target && moved > target && table <= target;
     jumped += hi - lo <= target && moved <= target && table <= target;
   }
-  // Sections of 2 px or more read with the families (ReadPhaseFamilies, where a filter fitted best): the chosen one's
-  // reading, unflagged (the families that fit alike read them within 2-5 %).
-  int wide = 0;
-  if (best != 0)
-    for (auto& edge : result.edges)
-      for (auto& s : edge.sections) {
-        if (!(s.fit.ok && s.phase.wide && s.phase.families.size() == families.size() &&
-              std::isfinite(s.phase.families[best].r_px)))
-          continue;
-        const double r = s.fit.r_px = s.phase.families[best].r_px, r_table = s.phase.families[best].r_table_px;
-        ++wide;
-        if (!(std::abs(r_table - r) > std::max(kSpreadPx, kSpreadRel * r))) continue;  // NaN: not on the outer edge
-        s.fit.ok = false;
-        s.fit.flags.push_back("phase_limited");
-        s.fit.phase_why = TableWhy(r, r_table);
-        s.phase.range_lo_px = std::min(r, r_table), s.phase.range_hi_px = std::max(r, r_table);
-        ++choice.flagged, ++tabled;
-      }
+  int wide_flagged = 0;
+  const int wide = best != 0 ? TakeWideReadings(result, best, families.size(), &wide_flagged) : 0;
+  tabled += wide_flagged, choice.flagged += wide_flagged;
   // Only where a filter after sampling was chosen: under the optics alone (physical optics) the blur fit's reading is
   // the one the physical scenes hold to median 2 %, p90 5 %, and a section 9 % high on a Gaussian x 0.2 px floor scene
   // would be flagged for noise the targets allow.
   const int off_edge = best != 0 ? FlagOffTheirEdge(result) : 0;
   choice.flagged += off_edge;
-  int n_alike = 0, n_read = 0;
-  for (const bool a : choice.alike) n_alike += a;
-  for (const double c : choice.chi2) n_read += std::isfinite(c);
-  char text[1000], ruled[120] = "";
-  if (n_read < int(families.size()))
-    std::snprintf(ruled, sizeof ruled, "; %zu ruled out on %zu sections at spread phases and not read on the rest",
-                  families.size() - n_read, result.phase.choice_sections);
-  std::snprintf(text, sizeof text,
-                "%d sections with blur under %.0f px along the pixel rows or columns (and %d at every phase) read under "
-                "%zu kinds of blur (the lens alone, or then a smoothing or sharpening of the pixels): the photo fits "
-                "best as %s (%d of the kinds fit alike, chi-square per point %.2f, 1 where only the noise is left%s); %d "
-                "flagged phase_limited (%d where the sharpening cancels most of the lens's blur, %d jumping between "
-                "neighbouring kinds, %d off the line through their edge's other sections, %d too unsure near a pixel "
-                "centre, %d on the board's outer edge moved by the table's slope; each reading's range in calib.json); %d sections of %.0f px or more read with it too",
-                choice.limited, kMaxBlurPx, choice.every_phase, families.size(), families[best].Name().c_str(), n_alike,
-                choice.chi2_per_point, ruled, choice.flagged, cancelled, jumped, off_edge, unsure, tabled, wide, kMaxBlurPx);
-  choice.summary = text;
+  choice.summary = ChoiceSummary(choice, best, {cancelled, jumped, off_edge, unsure, tabled}, wide);
   return choice;
 }
 
