@@ -119,8 +119,8 @@ std::vector<Bin> ProfileBins(const cv::Mat& linear, const EdgeSegment& segment, 
       const double n = static_cast<double>(values[i].size());
       bins.push_back({sum_d[i] / n, InterquartileMean(values[i]), n});
       // A pair's deviations from its mean are sqrt(3/4) of a triple's (std sqrt(1/2) against sqrt(2/3) of the noise's).
-      for (const float v : values[i])
-        (n >= 3 ? dev : dev2).push_back(static_cast<float>(std::abs(v - bins.back().v) * (n >= 3 ? 1 : std::sqrt(4.0 / 3))));
+      const double scale = n >= 3 ? 1 : std::sqrt(4.0 / 3);
+      for (const float v : values[i]) (n >= 3 ? dev : dev2).push_back(float(std::abs(v - bins.back().v) * scale));
     }
   if (dev.size() < kMinNoiseSamples) dev.insert(dev.end(), dev2.begin(), dev2.end());
   *noise = kMinNoise;
