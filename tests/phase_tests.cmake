@@ -179,19 +179,28 @@ phase_check(phase_filtered_gauss_035_bench gauss035_bench "off the line through 
 # this branch (main after the two-axis model -> this): 20 deg 0.6 / 2.4 -> 0.6 / 1.3 %, 30 deg 0.3 / 3.7 -> 0.5 / 5.6 %
 # (edge 8, 0.11 px low near focus, inside the depths calibrate names not determined within 5 %, 422-439 mm, now
 # 407-456 mm with the readings' own error: held to 10 % and to that), 45 deg 1.7 / 8.6 -> 1.0 / 1.1 % (now held to 5 %), 60 deg 2.3 / 30.6 -> 2.5 / 10.8 %.
+# The four misses (issue 42), found: a section at every phase kept only the 0.1 px bins of 3 samples or more, as a level
+# edge's, and a far section of a board turned 45-60 deg puts about 2 in each: edge 11 section 7 at 45 deg kept 11 of
+# ~150 bins (0.75 px for 0.85), edge 5 section 7 at 60 deg under 6 (not read per family at all: 0.61 px for 0.13
+# unflagged); every bin with a sample is now kept there: 0.84 px, and 0.09 px flagged (the mask cancels most of its
+# blur). Sections over 2 px were the blur fit's optics alone, which under the mask reads about the optics' blur:
+# edge 1 section 1 at 60 deg 2.54 px for 2.26, now read with the chosen family, 2.38 px. Edge 11 section 4 at 45 deg
+# lies on the board's outer edge, beside the table, whose wood grain crosses it obliquely and leaves a ramp across
+# the window (the table 2 % of the step darker at the edge than 7 px out; the same scene with a flat table read it
+# 0.53 px for 0.52): read again with the table's slope it reads 0.56 px against 0.62, and such a section is flagged.
+# Now 45 deg: none off the rule, model median 1.3 %, p90 6.9 % (0.011 px high at truths 0.13-0.16 px, 426-440 mm,
+# inside the depths calibrate names not determined within 5 %, 419-441 mm: held to 10 % and to that, as 30 deg);
+# 60 deg: none off, model 1.1 / 2.2 % (held to 5 %). Seeds 2 and 9 (45, 60 deg): sections off the rule unflagged
+# 0, 3, 3, 2 -> 1, 0, 0, 2 and model p90 1.4, 17.8, 16.0, 32.9 -> 1.2, 3.9, 1.7, 13.3 %; their misses left are on
+# the outer edges at 0.46-0.64 px, 10-14 % high, where the table's slope moves them less than the flag's 8 %.
 foreach(turn 3 20 30 45 60)
   set(model --fitted-p90 0.05 --undetermined-covers)
   set(off 0)
   # Turned 20 deg: where the search between the families follows the valley of one second moment (phase_fit.cc), the
   # grid's own 0.7 over 0.6 px (the true mask) is chosen, and the model misses edges 5-7 by up to 18 % near focus (p90
   # 8.8 %; it was 1.3 % with a refined family a little off the truth), all within the depths named (407-456 mm).
-  if(turn EQUAL 20 OR turn EQUAL 30)
+  if(turn EQUAL 20 OR turn EQUAL 30 OR turn EQUAL 45)
     set(model --fitted-p90 0.10 --undetermined-covers)
-  elseif(turn EQUAL 45)
-    set(off 2)
-  elseif(turn EQUAL 60)
-    set(model --sections-only --undetermined-covers)  # held on main too (named 397-492 mm, now 396-492 mm)
-    set(off 2)
   endif()
   phase_scene(turn${turn}_sharpen --focus-mm 430 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.6
               --post-amount 0.7 --noise 0.0025 --seed 6 --yaw-deg ${turn})

@@ -422,8 +422,10 @@ namespace {
 
 Json PhaseCheckJson(const PhaseCheck& p) {
   Json readings = Json::array();
-  for (const PhaseReading& f : p.families)
+  for (const PhaseReading& f : p.families) {
     readings.push_back({{"r_px", f.r_px}, {"offset_px", f.offset_px}, {"rms_rel", f.rms_rel}, {"chi2", f.chi2}});
+    if (std::isfinite(f.r_table_px)) readings.back()["r_table_px"] = f.r_table_px;  // on the board's outer edge
+  }
   return {{"axis_deg", p.axis_deg}, {"span_px", p.span_px}, {"every_phase", p.every_phase}, {"phase_px", p.phase_px}, {"noise", p.noise},
           {"bins", p.bins}, {"range_px", {p.range_lo_px, p.range_hi_px}}, {"joins_fit", p.joins_fit},
           {"families", readings}};
@@ -454,7 +456,9 @@ Json PhaseChoiceJson(const PhaseChoice& c) {
                    "by the lens fit; with the optics alone, one whose reading's standard error (r_se_px) exceeds "
                    "2 % (an edge near a pixel centre) is flagged too; it is left out of that fit but for those "
                    "flagged by the cancellation or the standard error alone (phase.joins_fit), which join it at "
-                   "their readings"}};
+                   "their readings; on the board's outer edges each family is read again with the table's slope "
+                   "(r_table_px) and, where a filter is chosen, a section whose two readings differ by that much is "
+                   "flagged too; sections of 2 px or more are read with the chosen filter"}};
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <deque>
 #include <memory>
 
@@ -118,3 +119,61 @@ double FamilyProfile::operator()(double x) const {
 }
 
 }  // namespace blurcue::calib::detail
+
+namespace blurcue::calib {
+
+std::string PhaseFamily::Name() const {
+  char text[160];
+  if (!(sigma_px > 0)) return "the optics alone";
+  const char* between = fitted ? ", fitted between the families" : "";
+  if (sharpen > 0)
+    std::snprintf(text, sizeof text, "the optics then sharpening (unsharp mask of amount %.2f, std %.2f px%s)", sharpen,
+                  sigma_px, between);
+  else
+    std::snprintf(text, sizeof text, "the optics then a Gaussian of std %.2f px on the sampled image%s", sigma_px,
+                  between);
+  return text;
+}
+
+const std::vector<PhaseFamily>& PhaseFamilies() {
+  // Gaussians: under 0.3 px one's taps at whole pixels are the identity to 4e-3 (0.3 px reads as the optics alone);
+  // steps of 0.05 px beyond, where a step moves a sub-pixel reading by 3-8 %. Sharpening: a camera's unsharp masks,
+  // mild to strong, over a narrow and a wide Gaussian.
+  static const std::vector<PhaseFamily> families = {
+      {0, 0},      {0.35, 0},   {0.4, 0},   {0.45, 0},  {0.5, 0},   {0.55, 0},  {0.6, 0}, {0.7, 0}, {0.8, 0},
+      {0.6, 0.15}, {0.6, 0.3},  {0.6, 0.5}, {0.6, 0.7}, {0.8, 0.15}, {0.8, 0.3}, {0.8, 0.5}, {0.8, 0.7},
+      {1.0, 0.15}, {1.0, 0.3}, {1.0, 0.5}, {1.0, 0.7}};
+  return families;
+}
+
+std::vector<size_t> PhaseNeighbours(size_t c) {
+  // Axes: the Gaussians by std, and the unsharp masks of each std by amount; the optics alone is the zero of each.
+  const std::vector<PhaseFamily>& f = PhaseFamilies();
+  auto param = [&](size_t a) { return f[a].sharpen > 0 ? f[a].sharpen : f[a].sigma_px; };
+  auto on_axis = [&](size_t a, size_t of) {  // a lies on the axis of family `of` (not the optics alone)
+    return a == 0 || ((f[a].sharpen > 0) == (f[of].sharpen > 0) && (f[of].sharpen <= 0 || f[a].sigma_px == f[of].sigma_px));
+  };
+  std::vector<size_t> out;
+  auto add = [&](size_t a) {
+    if (a < f.size() && std::find(out.begin(), out.end(), a) == out.end()) out.push_back(a);
+  };
+  for (size_t axis = 1; axis < f.size(); ++axis) {
+    if (c != 0 && axis != c) continue;
+    // The nearest on each side of c along this axis.
+    size_t below = f.size(), above = f.size();
+    for (size_t a = 0; a < f.size(); ++a) {
+      if (a == c || !on_axis(a, axis)) continue;
+      const double d = param(a) - (c == 0 ? 0.0 : param(c));
+      if (a == 0 || d < 0) {
+        if (below == f.size() || d > param(below) - param(c)) below = a;
+      } else if (d > 0 && (above == f.size() || d < param(above) - (c == 0 ? 0.0 : param(c)))) {
+        above = a;
+      }
+    }
+    if (c != 0) add(below);
+    add(above);
+  }
+  return out;
+}
+
+}  // namespace blurcue::calib

@@ -1,6 +1,7 @@
 #include "calib/phase_check.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -30,6 +31,12 @@ constexpr double kMinSpanPx = 1.0;
 // each other at any phase (measured: 2.00 vs 1.90-2.16 px at r = 2); below, up to a factor 2 apart.
 constexpr double kMaxBlurPx = 2.0;
 constexpr double kBinPx = 0.1;  // one row's samples share a distance across a level edge: bins far finer than 1 px
+// A section at every phase spreads its samples evenly across the edge: a 0.1 px bin holds a tenth of the length used
+// (2 on the far sections of a board turned 45-60 deg). Held to 3 samples, as a level edge's bins are, such a section
+// kept 11 of ~150 bins (edge 11 section 7 at 45 deg: 0.75 px for a true 0.85 px, every family alike) or fewer than 6
+// (edge 5 section 7 at 60 deg: not read per family, its phase check empty, 0.61 px for 0.13 px unflagged); every bin
+// with a sample is kept there (with 3, the interquartile mean is the plain mean anyway). Level edges keep 3.
+constexpr size_t kLevelBinSamples = 3, kEveryPhaseBinSamples = 1, kMinNoiseSamples = 12;  // the last: ProfileBins
 // The pose puts an edge within a few hundredths of a pixel (synth scenes: 0.02-0.06 px); each family finds it within
 // this of the pose's line. Fixed at the line, the pose's own error, not the family, would decide the fit.
 constexpr double kPoseUncertaintyPx = 0.15;
@@ -56,6 +63,13 @@ struct Bin {
   double x = 0, v = 0, w = 0;
 };
 
+// How a section's profile lies across the pixels and the board: its normal's components (|n| larger, smaller; see
+// ProjectTaps) and, on the board's outer edges, the side (+1: the normal's, -1: the other) that is the table.
+struct Across {
+  double w1 = 1, w2 = 0;
+  int free_side = 0;  // 0: squares on both sides (or not known)
+};
+
 // The mean of the middle half: robust to a printing spot as the median is, without snapping to 8-bit code values.
 double InterquartileMean(std::vector<float>& v) {
   std::sort(v.begin(), v.end());
@@ -65,9 +79,11 @@ double InterquartileMean(std::vector<float>& v) {
   return sum / double(hi - lo);
 }
 
-// The profile across the edge, from the pose's line (d = 0), over |d| <= half_px, in the central part along.
+// The profile across the edge, from the pose's line (d = 0), over |d| <= half_px, in the central part along. A bin
+// holds at least `min_samples` pixels (its interquartile mean: robust to a printing spot); the noise comes from the bins
+// of 3 or more (those of 2 too, where they give fewer than kMinNoiseSamples deviations).
 std::vector<Bin> ProfileBins(const cv::Mat& linear, const EdgeSegment& segment, double along_fraction,
-                             double half_px, double* noise) {
+                             double half_px, size_t min_samples, double* noise) {
   const EdgeFrame f = MakeEdgeFrame(segment);
   const double margin = 0.5 * (1 - std::clamp(along_fraction, 0.0, 1.0)) * f.length;
   const double bow = std::isfinite(segment.bow_px) ? segment.bow_px : 0;
@@ -97,13 +113,16 @@ std::vector<Bin> ProfileBins(const cv::Mat& linear, const EdgeSegment& segment, 
     }
   }
   std::vector<Bin> bins;
-  std::vector<float> dev;  // |value - its bin's middle|: the noise, robustly (a spot is a few of them)
+  std::vector<float> dev, dev2;  // |value - its bin's middle|: the noise, robustly (a spot is a few of them)
   for (int i = 0; i < nb; ++i)
-    if (values[i].size() >= 3) {
+    if (values[i].size() >= std::max<size_t>(1, min_samples)) {
       const double n = static_cast<double>(values[i].size());
       bins.push_back({sum_d[i] / n, InterquartileMean(values[i]), n});
-      for (const float v : values[i]) dev.push_back(static_cast<float>(std::abs(v - bins.back().v)));
+      // A pair's deviations from its mean are sqrt(3/4) of a triple's (std sqrt(1/2) against sqrt(2/3) of the noise's).
+      const double scale = n >= 3 ? 1 : std::sqrt(4.0 / 3);
+      for (const float v : values[i]) (n >= 3 ? dev : dev2).push_back(float(std::abs(v - bins.back().v) * scale));
     }
+  if (dev.size() < kMinNoiseSamples) dev.insert(dev.end(), dev2.begin(), dev2.end());
   *noise = kMinNoise;
   if (!dev.empty()) {
     std::nth_element(dev.begin(), dev.begin() + dev.size() / 2, dev.end());
@@ -112,15 +131,46 @@ std::vector<Bin> ProfileBins(const cv::Mat& linear, const EdgeSegment& segment, 
   return bins;
 }
 
+// FamilyResiduals on a board's outer edge: the levels, the step and the table's slope by least squares, the model
+// low + step x m(x) + slope x max(0, side x) (x from the edge). The table beside the board is a photo's content, not
+// print: synth's wood grain, stripes of 9 mm crossing a turned board's outer edge obliquely, left a ramp across edge 11
+// section 4's window at 45 deg (the table 2 % of the step darker at the edge than 7 px out) and every family read
+// 0.62 px for a true 0.52 px (0.53 px on the same scene with a flat table). The ramp is taken unblurred: its kink at
+// the edge, blurred, moves the model by under 1e-3 of the step.
+bool TableSlopeResiduals(const std::vector<Bin>& bins, const FamilyProfile& profile, double d0, int side,
+                         std::vector<double>* res, double* step_out) {
+  std::vector<double>& e = *res;
+  cv::Matx33d a = cv::Matx33d::zeros();
+  cv::Vec3d y(0, 0, 0);
+  for (size_t i = 0; i < bins.size(); ++i) {
+    const Bin& b = bins[i];
+    const double m = profile(b.x - d0);
+    e[i] = m;
+    const cv::Vec3d f(1, m, std::max(0.0, side * (b.x - d0)));
+    a += b.w * f * f.t();
+    y += b.w * b.v * f;
+  }
+  cv::Vec3d c(0, 0, 0);
+  if (!(a(2, 2) > 0)) a(2, 2) = 1;  // no bin on the table's side: the slope stays 0
+  const bool ok = cv::determinant(a) > 1e-12 * a(0, 0) * a(1, 1) * a(2, 2) && cv::solve(a, y, c, cv::DECOMP_CHOLESKY);
+  if (!ok) c = cv::Vec3d(0, 0, 0);
+  for (size_t i = 0; i < bins.size(); ++i)
+    e[i] = std::sqrt(bins[i].w) * (bins[i].v - c[0] - c[1] * e[i] - c[2] * std::max(0.0, side * (bins[i].x - d0)));
+  if (step_out) *step_out = c[1];
+  return ok;
+}
+
 // The family's profile at each bin (optics p = {r1, d0, phi}, then the family's taps `taps` projected across the
 // edge: ProjectTaps), its two levels by least squares (solved again at every p: the levels are projected out, so the
 // search is over the three shape parameters only); `res` gets sqrt(w) x (value - model) and `step` the step. False
-// where the profile does not tell the levels apart (the step is then 0).
-bool FamilyResiduals(const std::vector<Bin>& bins, const std::vector<ProjectedTap>& taps, const double* p, double w1,
-                     double w2, std::vector<double>* res, double* step_out = nullptr) {
-  const FamilyProfile profile(std::max(p[0], 0.02), p[2], w1, w2, taps, bins.size());
+// where the profile does not tell the levels apart (the step is then 0). On a board's outer edge the table's level
+// may slope across the window: a third linear term, its slope from the edge outwards on the table's side (TableSlope).
+bool FamilyResiduals(const std::vector<Bin>& bins, const std::vector<ProjectedTap>& taps, const double* p,
+                     const Across& across, std::vector<double>* res, double* step_out = nullptr) {
+  const FamilyProfile profile(std::max(p[0], 0.02), p[2], across.w1, across.w2, taps, bins.size());
   std::vector<double>& e = *res;
   e.resize(bins.size());
+  if (across.free_side != 0) return TableSlopeResiduals(bins, profile, p[1], across.free_side, res, step_out);
   double s1 = 0, se = 0, see = 0, sv = 0, sev = 0;
   for (size_t i = 0; i < bins.size(); ++i) {
     const Bin& b = bins[i];
@@ -144,10 +194,10 @@ double SumOfSquares(const std::vector<double>& r) {
 
 // Levenberg-Marquardt from p = {r1, d0, phi} on the family's residuals (the optics' radius, the edge's position
 // within the pose's uncertainty, the optics' shape); returns the sum of squares at the p it leaves.
-double RefineFamily(const std::vector<Bin>& bins, const std::vector<ProjectedTap>& taps, double w1, double w2,
+double RefineFamily(const std::vector<Bin>& bins, const std::vector<ProjectedTap>& taps, const Across& across,
                     double* p, bool hold_shape = false) {
   std::vector<double> res, trial, col[3];
-  FamilyResiduals(bins, taps, p, w1, w2, &res);
+  FamilyResiduals(bins, taps, p, across, &res);
   double best = SumOfSquares(res);
   const double lo[3] = {0, -kPoseUncertaintyPx, 0}, hi[3] = {1e9, kPoseUncertaintyPx, kPi / 2};
   const double h[3] = {1e-3, 1e-3, 2e-3};
@@ -163,7 +213,7 @@ double RefineFamily(const std::vector<Bin>& bins, const std::vector<ProjectedTap
       double q[3] = {p[0], p[1], p[2]};
       const double hc = q[c] + h[c] > hi[c] ? -h[c] : h[c];
       q[c] += hc;
-      FamilyResiduals(bins, taps, q, w1, w2, &col[c]);
+      FamilyResiduals(bins, taps, q, across, &col[c]);
       for (size_t i = 0; i < res.size(); ++i) col[c][i] = (col[c][i] - res[i]) / hc;
     }
     for (int a = 0; a < 3; ++a) {
@@ -184,7 +234,7 @@ double RefineFamily(const std::vector<Bin>& bins, const std::vector<ProjectedTap
       if (!cv::solve(m, g, delta, cv::DECOMP_CHOLESKY)) break;
       double q[3];
       for (int c = 0; c < 3; ++c) q[c] = std::clamp(p[c] + delta[c], lo[c], hi[c]);
-      FamilyResiduals(bins, taps, q, w1, w2, &trial);
+      FamilyResiduals(bins, taps, q, across, &trial);
       const double v = SumOfSquares(trial);
       if (v < best) {
         improved = true;
@@ -208,20 +258,20 @@ double RefineFamily(const std::vector<Bin>& bins, const std::vector<ProjectedTap
 // node (RefineFamily). The three are correlated (a sharpening filter's overshoot trades against the optics' shape):
 // turns of one-dimensional searches with the blur fit's shape settled on a ridge, 2-5 % short of the true reading with
 // the true family on sharpened scenes (amount 0.5), so that a wrong family fitted better.
-PhaseReading ReadFamily(const std::vector<Bin>& bins, const PhaseFamily& family, double r_fit, double phi_fit,
-                        double w1, double w2, double noise, bool one_shape) {
+PhaseReading ReadFamilyAs(const std::vector<Bin>& bins, const PhaseFamily& family, double r_fit, double phi_fit,
+                          const Across& across, double noise, bool one_shape) {
   const std::vector<double> taps1 = FamilyTaps(family);
-  const std::vector<ProjectedTap> taps = ProjectTaps(taps1, w1, w2);
+  const std::vector<ProjectedTap> taps = ProjectTaps(taps1, across.w1, across.w2);
   std::vector<double> res;
   double p[3] = {0, 0, phi_fit}, best = std::numeric_limits<double>::infinity();
   const double top = std::max(2.5, 1.6 * r_fit), grid = top / 12;
   for (const double phi : {phi_fit, std::abs(phi_fit - kPi / 4) < 0.2 ? kPi / 2 : kPi / 4})
     for (int k = 0; k <= 12; ++k) {
       const double q[3] = {k * grid, 0, phi};
-      FamilyResiduals(bins, taps, q, w1, w2, &res);
+      FamilyResiduals(bins, taps, q, across, &res);
       if (const double v = SumOfSquares(res); v < best) best = v, p[0] = q[0], p[2] = q[2];
     }
-  double sse = RefineFamily(bins, taps, w1, w2, p);
+  double sse = RefineFamily(bins, taps, across, p);
   // At r = 0 the profile's slope in r vanishes (its variance grows as r^2), so a refinement started there stays: on an
   // edge near a pixel centre the grid's best node was 0 and the optics alone read 0.00 px where the blur fit read
   // 0.42-0.51 px (true 0.43 px; floor 0.2 px), flagged as a jump and holding the model 7 % low. Started from the blur
@@ -229,18 +279,18 @@ PhaseReading ReadFamily(const std::vector<Bin>& bins, const PhaseFamily& family,
   // stuck at 0 on an aliased take frame (supersample 1) came to fit alike and flagged a whole edge.
   if (!(family.sigma_px > 0) && p[0] < 0.05 && r_fit > 0.05) {
     double q[3] = {r_fit, 0, p[2]};
-    if (const double v = RefineFamily(bins, taps, w1, w2, q); v < sse) sse = v, p[0] = q[0], p[1] = q[1], p[2] = q[2];
+    if (const double v = RefineFamily(bins, taps, across, q); v < sse) sse = v, p[0] = q[0], p[1] = q[1], p[2] = q[2];
   }
   // Where the blur fit found the shape ambiguous under a pixel and read the size as a Gaussian (edge_blur.cc), the
   // family's optics under a pixel are read so too: a shape the profile cannot tell moved the optics-alone reading
   // 8-20 % off on physical optics, and it off its neighbouring families' readings (disc x 0.2 px floor).
   if (one_shape && p[0] < kOneShapeBelowPx) {
     p[2] = kPi / 2;
-    RefineFamily(bins, taps, w1, w2, p, /*hold_shape=*/true);
+    RefineFamily(bins, taps, across, p, /*hold_shape=*/true);
   }
   const double r1 = p[0], d0 = p[1];
   double step = 0;
-  const bool ok = FamilyResiduals(bins, taps, p, w1, w2, &res, &step);
+  const bool ok = FamilyResiduals(bins, taps, p, across, &res, &step);
   sse = ok ? SumOfSquares(res) : std::numeric_limits<double>::infinity();
   double w = 0;
   for (const Bin& bin : bins) w += bin.w;
@@ -255,69 +305,25 @@ PhaseReading ReadFamily(const std::vector<Bin>& bins, const PhaseFamily& family,
   return out;
 }
 
-}  // namespace
-
-std::string PhaseFamily::Name() const {
-  char text[160];
-  if (!(sigma_px > 0)) return "the optics alone";
-  const char* between = fitted ? ", fitted between the families" : "";
-  if (sharpen > 0)
-    std::snprintf(text, sizeof text, "the optics then sharpening (unsharp mask of amount %.2f, std %.2f px%s)", sharpen,
-                  sigma_px, between);
-  else
-    std::snprintf(text, sizeof text, "the optics then a Gaussian of std %.2f px on the sampled image%s", sigma_px,
-                  between);
-  return text;
-}
-
-const std::vector<PhaseFamily>& PhaseFamilies() {
-  // Gaussians: under 0.3 px one's taps at whole pixels are the identity to 4e-3 (0.3 px reads as the optics alone);
-  // steps of 0.05 px beyond, where a step moves a sub-pixel reading by 3-8 %. Sharpening: a camera's unsharp masks,
-  // mild to strong, over a narrow and a wide Gaussian.
-  static const std::vector<PhaseFamily> families = {
-      {0, 0},      {0.35, 0},   {0.4, 0},   {0.45, 0},  {0.5, 0},   {0.55, 0},  {0.6, 0}, {0.7, 0}, {0.8, 0},
-      {0.6, 0.15}, {0.6, 0.3},  {0.6, 0.5}, {0.6, 0.7}, {0.8, 0.15}, {0.8, 0.3}, {0.8, 0.5}, {0.8, 0.7},
-      {1.0, 0.15}, {1.0, 0.3}, {1.0, 0.5}, {1.0, 0.7}};
-  return families;
-}
-
-std::vector<size_t> PhaseNeighbours(size_t c) {
-  // Axes: the Gaussians by std, and the unsharp masks of each std by amount; the optics alone is the zero of each.
-  const std::vector<PhaseFamily>& f = PhaseFamilies();
-  auto param = [&](size_t a) { return f[a].sharpen > 0 ? f[a].sharpen : f[a].sigma_px; };
-  auto on_axis = [&](size_t a, size_t of) {  // a lies on the axis of family `of` (not the optics alone)
-    return a == 0 || ((f[a].sharpen > 0) == (f[of].sharpen > 0) && (f[of].sharpen <= 0 || f[a].sigma_px == f[of].sigma_px));
-  };
-  std::vector<size_t> out;
-  auto add = [&](size_t a) {
-    if (a < f.size() && std::find(out.begin(), out.end(), a) == out.end()) out.push_back(a);
-  };
-  for (size_t axis = 1; axis < f.size(); ++axis) {
-    if (c != 0 && axis != c) continue;
-    // The nearest on each side of c along this axis.
-    size_t below = f.size(), above = f.size();
-    for (size_t a = 0; a < f.size(); ++a) {
-      if (a == c || !on_axis(a, axis)) continue;
-      const double d = param(a) - (c == 0 ? 0.0 : param(c));
-      if (a == 0 || d < 0) {
-        if (below == f.size() || d > param(below) - param(c)) below = a;
-      } else if (d > 0 && (above == f.size() || d < param(above) - (c == 0 ? 0.0 : param(c)))) {
-        above = a;
-      }
-    }
-    if (c != 0) add(below);
-    add(above);
-  }
+// ReadFamilyAs with the two levels; on a board's outer edge (across.free_side) and where `table`, read again with the
+// table's slope taken (TableSlopeResiduals) into r_table_px. Taken always, the slope's own noise moved correct
+// readings as much as the ramps it took out (turned 60 deg: edge 11 section 6 0.48 -> 0.52 px for a true 0.46 px,
+// edge 11 at 45 deg section 4 0.62 -> 0.56 px for 0.52 px): the two readings apart is the reading not identified.
+PhaseReading ReadFamily(const std::vector<Bin>& bins, const PhaseFamily& family, double r_fit, double phi_fit,
+                        const Across& across, double noise, bool one_shape, bool table = true) {
+  const Across plain{across.w1, across.w2, 0};
+  PhaseReading out = ReadFamilyAs(bins, family, r_fit, phi_fit, plain, noise, one_shape);
+  if (table && across.free_side != 0)
+    out.r_table_px = ReadFamilyAs(bins, family, r_fit, phi_fit, across, noise, one_shape).r_px;
   return out;
 }
-
-namespace {
 
 // A section's gate and profile (CheckPhase's first half): where `check.limited` comes back true, `profile` holds what
 // its families are read on.
 struct PhaseProfile {
   std::vector<Bin> bins;
-  double phi = 0, w1 = 1, w2 = 0, r_fit = 0;
+  double phi = 0, r_fit = 0;
+  Across across;
   bool one_shape = false;  // the blur fit read the size with the Gaussian shape (ambiguous under a pixel)
 };
 
@@ -336,18 +342,29 @@ PhaseCheck GatePhase(const cv::Mat& linear, const EdgeSegment& segment, const Mo
   const bool few = check.span_px < kMinSpanPx;
   // At any angle: a family's taps act on both axes (ProjectTaps). Read along the nearest axis alone, edges more than
   // 25 deg off it were not read (physical boards turned 45 and 60 deg chose a Gaussian of 0.35 px that no photo had).
-  if (!(fit.r_px > 0 && fit.r_px < kMaxBlurPx)) return check;
+  if (!(fit.r_px > 0 && std::isfinite(fit.r_px))) return check;
   const double half = std::min(segment.half_window_px, 2 * fit.r_px + 6);
-  const std::vector<Bin> bins = ProfileBins(linear, segment, options.along_fraction, half, &check.noise);
+  const std::vector<Bin> bins = ProfileBins(linear, segment, options.along_fraction, half,
+                                            few ? kLevelBinSamples : kEveryPhaseBinSamples, &check.noise);
   if (bins.size() < 6) return check;
-  check.limited = few;
-  check.every_phase = !few;
+  const bool wide = fit.r_px >= kMaxBlurPx;
+  // A section of 2 px or more with printing spots keeps the blur fit's reading, which rejects them: the profile's
+  // interquartile means do not where a spot covers a quarter of the part measured (edge 10 section 6 of a sharpened
+  // scene with 20 flaws, two spots of 1.1 and 1.9 mm: 4.59 px under the chosen mask for a true 2.70 px; 3.11 px so).
+  if (wide && std::find(fit.flags.begin(), fit.flags.end(), "flaw") != fit.flags.end()) return check;
+  check.limited = few && !wide, check.every_phase = !few && !wide, check.wide = wide;
   check.bins = static_cast<int>(bins.size());
   // The optics' shape: the blur fit's (disc x Gaussian); rounded to the nearer pure shape, the misfit of a mixed one
   // made a post filter look better than the optics alone on physical optics.
   const double phi = std::atan2(2 * fit.floor_sigma_px, fit.disc_r_px);
-  const double w1 = std::max(std::abs(f.n.x), std::abs(f.n.y)), w2 = std::min(std::abs(f.n.x), std::abs(f.n.y));
-  *profile = {bins, phi, w1, w2, fit.r_px, fit.shape_ambiguous && fit.r_px < kOneShapeBelowPx && fit.r_px >= kOneShapeFromPx};
+  Across placed{std::max(std::abs(f.n.x), std::abs(f.n.y)), std::min(std::abs(f.n.x), std::abs(f.n.y)), 0};
+  // A board's outer edge has a parallel board edge on one side only (calibrate.cc): the other is the table.
+  if (segment.neighbours.size() == 1) {
+    const NeighbourEdge& o = segment.neighbours[0];
+    placed.free_side = f.n.dot(0.5 * (o.a + o.b) - 0.5 * (segment.a + segment.b)) > 0 ? -1 : 1;
+  }
+  *profile = {bins, phi, fit.r_px, placed,
+              fit.shape_ambiguous && fit.r_px < kOneShapeBelowPx && fit.r_px >= kOneShapeFromPx};
   return check;
 }
 
@@ -414,7 +431,7 @@ void ReadFamilies(const PhaseProfile& p, const std::vector<bool>& read, PhaseChe
       continue;
     }
     check->families.push_back(
-        ReadFamily(p.bins, families[c], p.r_fit, p.phi, p.w1, p.w2, check->noise, p.one_shape));
+        ReadFamily(p.bins, families[c], p.r_fit, p.phi, p.across, check->noise, p.one_shape));
   }
 }
 
@@ -425,7 +442,7 @@ PhaseCheck CheckPhase(const cv::Mat& linear, const EdgeSegment& segment, const M
   PhaseProfile profile;
   PhaseCheck check = GatePhase(linear, segment, fit, options, &profile);
   if (check.limited) ReadFamilies(profile, {}, &check);
-  check.every_phase = false;  // read by ReadPhaseFamilies only, with the photo's other sections
+  check.every_phase = check.wide = false;  // read by ReadPhaseFamilies only, with the photo's other sections
   return check;
 }
 
@@ -444,9 +461,23 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
   };
   each(usable.size(), [&](size_t k) { usable[k]->phase = GatePhase(linear, usable[k]->segment, usable[k]->fit,
                                                                    options, &profiles[k]); });
-  std::vector<size_t> limited;
+  std::vector<size_t> limited, wide;
   for (size_t k = 0; k < usable.size(); ++k)
     if (usable[k]->phase.limited || usable[k]->phase.every_phase) limited.push_back(k);
+    else if (usable[k]->phase.wide) wide.push_back(k);
+  // The sections of 2 px or more, where a filter fitted the choice's sections best (fit_between appended it): read with
+  // the families marked in `read` (all when empty) and the fitted one, for ChoosePhaseFamily to take the chosen one's
+  // reading. They do not join the choice: at that blur the families read within 2-5 % of each other.
+  auto read_wide = [&](const std::vector<bool>& read) {
+    if (result.phase.families.size() <= PhaseFamilies().size()) return;
+    const PhaseFamily& fitted = result.phase.families.back();
+    each(wide.size(), [&](size_t i) {
+      const PhaseProfile& p = profiles[wide[i]];
+      PhaseCheck& check = usable[wide[i]]->phase;
+      ReadFamilies(p, read, &check);
+      check.families.push_back(ReadFamily(p.bins, fitted, p.r_fit, p.phi, p.across, check.noise, p.one_shape));
+    });
+  };
   // Few sections: every family on each, as CheckPhase. Otherwise the families are first read on kChoiceSections of
   // them at phases spread over the pixel (sorted by phase, evenly picked): the families those fit far worse than the
   // best (twice ChoosePhaseFamily's "alike" margins) are not read on the others. The rest of the choice is
@@ -468,8 +499,8 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
     const PhaseFamily fitted = RefinePhaseFamily(PhaseFamilies()[best], [&](const PhaseFamily& family) {
       each(deciders.size(), [&](size_t i) {
         const PhaseProfile& p = profiles[deciders[i]];
-        chi2[i] = weight[i] * ReadFamily(p.bins, family, p.r_fit, p.phi, p.w1, p.w2,
-                                         usable[deciders[i]]->phase.noise, p.one_shape).chi2;
+        chi2[i] = weight[i] * ReadFamily(p.bins, family, p.r_fit, p.phi, p.across,
+                                         usable[deciders[i]]->phase.noise, p.one_shape, /*table=*/false).chi2;
       });
       double sum = 0;
       for (const double v : chi2) sum += v;
@@ -479,12 +510,13 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
     each(limited.size(), [&](size_t i) {
       const PhaseProfile& p = profiles[limited[i]];
       PhaseCheck& check = usable[limited[i]]->phase;
-      check.families.push_back(ReadFamily(p.bins, fitted, p.r_fit, p.phi, p.w1, p.w2, check.noise, p.one_shape));
+      check.families.push_back(ReadFamily(p.bins, fitted, p.r_fit, p.phi, p.across, check.noise, p.one_shape));
     });
   };
   if (limited.size() <= 2 * kChoiceSections) {
     each(limited.size(), [&](size_t i) { ReadFamilies(profiles[limited[i]], {}, &usable[limited[i]]->phase); });
     fit_between(limited);
+    read_wide({});
     return;
   }
   std::vector<size_t> by_phase = limited;
@@ -527,6 +559,7 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
     ReadFamilies(profiles[rest[i]], check.limited ? read_few : read_every, &check);
   });
   fit_between(chosen);
+  read_wide(read_every);
 }
 
 namespace {
@@ -550,6 +583,38 @@ double CancellationPx(double r, double taps_variance) {
 // flagged (docs/independent-truth.md).
 bool AtOwnFloor(const PhaseFamily& family, double r_px) {
   return r_px <= std::sqrt(std::max(0.0, 4 * TapsVariance(FamilyTaps(family)))) + 1e-3;
+}
+
+// Why a section on the board's outer edge is flagged where its reading moves with the table's slope, in words.
+std::string TableWhy(double r, double r_table) {
+  char why[400];
+  std::snprintf(why, sizeof why,
+                "on the board's outer edge the table beside it is not flat across the window (its texture): read with "
+                "the table's slope taken, this section reads %.2f px against %.2f px, more than max(%.2f px, %.0f %%) "
+                "apart; its blur is not identified; the lens fit predicts it",
+                r_table, r, kSpreadPx, 100 * kSpreadRel);
+  return why;
+}
+
+// Sections of 2 px or more read with the families (ReadPhaseFamilies, where a filter fitted best): the chosen one's
+// (`best` of `nf`) reading, unflagged (the families that fit alike read them within 2-5 %) unless the table's slope
+// moves it (TableWhy; counted in `tabled`). Returns how many took it.
+int TakeWideReadings(CalibResult& result, size_t best, size_t nf, int* tabled) {
+  int wide = 0;
+  for (auto& edge : result.edges)
+    for (auto& s : edge.sections) {
+      if (!(s.fit.ok && s.phase.wide && s.phase.families.size() == nf && std::isfinite(s.phase.families[best].r_px)))
+        continue;
+      const double r = s.fit.r_px = s.phase.families[best].r_px, r_table = s.phase.families[best].r_table_px;
+      ++wide;
+      if (!(std::abs(r_table - r) > std::max(kSpreadPx, kSpreadRel * r))) continue;  // NaN: not on the outer edge
+      s.fit.ok = false;
+      s.fit.flags.push_back("phase_limited");
+      s.fit.phase_why = TableWhy(r, r_table);
+      s.phase.range_lo_px = std::min(r, r_table), s.phase.range_hi_px = std::max(r, r_table);
+      ++*tabled;
+    }
+  return wide;
 }
 
 // A flagged section's reason, in words (calib.json's phase_why and the summary).
@@ -582,6 +647,35 @@ std::string PhaseWhy(const SectionResult& s, double lo, double hi, double r, dou
                   100 * std::min(1.0, -4 * v / (r * r - 4 * v)), std::sqrt(r * r - 4 * v), r, 100 * kOpticsRel, moved,
                   kSpreadPx, 100 * kSpreadRel);
   return why;
+}
+
+}  // namespace
+
+namespace {
+
+// ChoosePhaseFamily's summary: `flags` counts the flags by reason (cancelled, jumped, off their edge, unsure, moved by
+// the table's slope); `wide` the sections of 2 px or more read with the chosen family.
+std::string ChoiceSummary(const PhaseChoice& choice, size_t best, const std::array<int, 5>& flags, int wide) {
+  const std::vector<PhaseFamily>& families = choice.families;
+  int n_alike = 0, n_read = 0;
+  for (const bool a : choice.alike) n_alike += a;
+  for (const double c : choice.chi2) n_read += std::isfinite(c);
+  char text[1000], ruled[120] = "";
+  if (n_read < int(families.size()))
+    std::snprintf(ruled, sizeof ruled, "; %zu ruled out on %zu sections at spread phases and not read on the rest",
+                  families.size() - n_read, choice.choice_sections);
+  std::snprintf(text, sizeof text,
+                "%d sections with blur under %.0f px along the pixel rows or columns (and %d at every phase) read under "
+                "%zu kinds of blur (the lens alone, or then a smoothing or sharpening of the pixels): the photo fits "
+                "best as %s (%d of the kinds fit alike, chi-square per point %.2f, 1 where only the noise is left%s); %d "
+                "flagged phase_limited (%d where the sharpening cancels most of the lens's blur, %d jumping between "
+                "neighbouring kinds, %d off the line through their edge's other sections, %d too unsure near a pixel "
+                "centre, %d on the board's outer edge moved by the table's slope; each reading's range in calib.json); "
+                "%d sections of %.0f px or more read with it too",
+                choice.limited, kMaxBlurPx, choice.every_phase, families.size(), families[best].Name().c_str(), n_alike,
+                choice.chi2_per_point, ruled, choice.flagged, flags[0], flags[1], flags[2], flags[3], flags[4], wide,
+                kMaxBlurPx);
+  return text;
 }
 
 }  // namespace
@@ -642,7 +736,7 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   choice.chi2_per_point = raw[best] / dof;
   const double v_best = TapsVariance(FamilyTaps(families[best]));
   choice.variance_px2 = v_best;
-  int cancelled = 0, jumped = 0, unsure = 0;
+  int cancelled = 0, jumped = 0, unsure = 0, tabled = 0;
   // A filter fitted between the families has no neighbours along one axis that bracket its reading.
   const std::vector<size_t> neighbours = best < PhaseFamilies().size() ? PhaseNeighbours(best) : std::vector<size_t>{};
   for (SectionResult* s : limited) {
@@ -652,6 +746,9 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
     for (size_t c = 0; c < families.size(); ++c)
       if (choice.alike[c]) lo = std::min(lo, s->phase.families[c].r_px), hi = std::max(hi, s->phase.families[c].r_px);
     const double r = s->phase.families[best].r_px, moved = CancellationPx(r, v_best);
+    // On the board's outer edge (where a filter is chosen): how far the table's slope moves the reading.
+    const double r_table = s->phase.families[best].r_table_px;
+    const double table = best != 0 && std::isfinite(r_table) ? std::abs(r_table - r) : 0;
     if (best != 0) s->fit.r_px = r;  // read with the chosen family
     // The chosen family's neighbours on either side (read on every section) bracket its reading where the reading
     // follows the filter's parameter smoothly; one that lies outside their readings by more than the target is the
@@ -669,40 +766,32 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
     s->phase.range_lo_px = std::max(0.0, std::min({lo, r - moved, r - jump}));
     s->phase.range_hi_px = std::max({hi, r + moved, r + jump});
     const double target = std::max(kSpreadPx, kSpreadRel * r);
-    if (hi - lo <= target && moved <= target && jump <= target) {
+    if (table > target) {
+      s->phase.range_lo_px = std::min(s->phase.range_lo_px, r_table);
+      s->phase.range_hi_px = std::max(s->phase.range_hi_px, r_table);
+    }
+    if (hi - lo <= target && moved <= target && jump <= target && table <= target) {
       if (best == 0 && FlagUnsureAtItsPhase(s)) ++choice.flagged, ++unsure;
       continue;
     }
     s->fit.ok = false;
     s->fit.flags.push_back("phase_limited");
-    s->fit.phase_why = PhaseWhy(*s, lo, hi, r, v_best, moved, nearest);
-    s->phase.joins_fit = hi - lo <= target && jump <= target;  // flagged by the cancellation alone
+    s->fit.phase_why = table > target ? TableWhy(r, r_table) : PhaseWhy(*s, lo, hi, r, v_best, moved, nearest);
+    s->phase.joins_fit = hi - lo <= target && jump <= target && table <= target;  // by the cancellation alone
     ++choice.flagged;
-    cancelled += hi - lo <= target && moved > target;
-    jumped += hi - lo <= target && moved <= target;
+    tabled += table > target;
+    cancelled += hi - lo <= target && moved > target && table <= target;
+    jumped += hi - lo <= target && moved <= target && table <= target;
   }
+  int wide_flagged = 0;
+  const int wide = best != 0 ? TakeWideReadings(result, best, families.size(), &wide_flagged) : 0;
+  tabled += wide_flagged, choice.flagged += wide_flagged;
   // Only where a filter after sampling was chosen: under the optics alone (physical optics) the blur fit's reading is
   // the one the physical scenes hold to median 2 %, p90 5 %, and a section 9 % high on a Gaussian x 0.2 px floor scene
   // would be flagged for noise the targets allow.
   const int off_edge = best != 0 ? FlagOffTheirEdge(result) : 0;
   choice.flagged += off_edge;
-  int n_alike = 0, n_read = 0;
-  for (const bool a : choice.alike) n_alike += a;
-  for (const double c : choice.chi2) n_read += std::isfinite(c);
-  char text[900], ruled[120] = "";
-  if (n_read < int(families.size()))
-    std::snprintf(ruled, sizeof ruled, "; %zu ruled out on %zu sections at spread phases and not read on the rest",
-                  families.size() - n_read, result.phase.choice_sections);
-  std::snprintf(text, sizeof text,
-                "%d sections with blur under %.0f px along the pixel rows or columns (and %d at every phase) read under "
-                "%zu kinds of blur (the lens alone, or then a smoothing or sharpening of the pixels): the photo fits "
-                "best as %s (%d of the kinds fit alike, chi-square per point %.2f, 1 where only the noise is left%s); %d "
-                "flagged phase_limited (%d where the sharpening cancels most of the lens's blur, %d jumping between "
-                "neighbouring kinds, %d off the line through their edge's other sections, %d too unsure near a pixel "
-                "centre; each reading's range in calib.json)",
-                choice.limited, kMaxBlurPx, choice.every_phase, families.size(), families[best].Name().c_str(), n_alike,
-                choice.chi2_per_point, ruled, choice.flagged, cancelled, jumped, off_edge, unsure);
-  choice.summary = text;
+  choice.summary = ChoiceSummary(choice, best, {cancelled, jumped, off_edge, unsure, tabled}, wide);
   return choice;
 }
 

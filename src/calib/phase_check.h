@@ -9,6 +9,7 @@
 // together, whose edges lie at other phases (the one whose profiles fit them best). A section whose reading still
 // depends on which of the families that fit alike is taken is flagged `phase_limited`, left out of the lens fit, and
 // predicted by it.
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,9 @@ struct PhaseReading {
   double offset_px = 0;  // where it puts the edge, from the pose's line (within 0.15 px of it)
   double rms_rel = 0;    // its residual rms / |step|
   double chi2 = 0;       // its residual sum of squares over the noise variance (PhaseCheck::noise)
+  // On a board's outer edge, where the table's texture may slope across the window: r_px read with that slope as one
+  // more linear term (NaN elsewhere). ChoosePhaseFamily flags a section whose two readings differ by the target.
+  double r_table_px = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct PhaseCheck {
@@ -44,6 +48,11 @@ struct PhaseCheck {
   // tells the families apart on its own and joins the choice; where a filter after sampling is chosen it is read with
   // it (a board turned a few degrees under a filter: read as the optics alone, 28 sections were off the rule).
   bool every_phase = false;
+  // Blur of 2 px or more (neither of the above): where a filter after sampling fits the others best, read with the
+  // families read on them (ReadPhaseFamilies) and then with the chosen one (ChoosePhaseFamily), not with the optics
+  // alone: under a mask the blur fit's disc x Gaussian reads about the optics' blur without the mask's negative second
+  // moment (turned 60 deg, amount 0.7 over 0.6 px: edge 1 section 1 at 2.54 px for a true 2.26 px, the optics 2.47 px).
+  bool wide = false;
   double axis_deg = 0;  // the edge's angle to the nearest pixel axis
   double span_px = 0;   // how far its sub-pixel phase moves along the part measured (1 px or more: every phase)
   double phase_px = 0;  // where the edge (from the pose) lies between pixel centres at its midpoint, 0..1

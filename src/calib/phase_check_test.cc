@@ -252,5 +252,36 @@ TEST(PhaseCheck, FilteredSceneReadsTrueOrFlaggedWhereTheUncheckedReadingIsOff) {
   EXPECT_GE(off(Calibrate(scene.image, scene.camera, scene.board, unchecked)), 5);
 }
 
+
+// A short section of an edge 37 deg off the pixel rows (every phase): its 18 px measured put about 1.8 pixels in each
+// 0.1 px bin across it. Held to 3 samples a bin, as a level edge's, the profile kept a handful of bins (fewer than 6:
+// not read per family at all; a board turned 60 deg read such a section 0.61 px for 0.13 px, unflagged).
+TEST(PhaseCheck, ShortSectionAtEveryPhaseKeepsItsWholeProfile) {
+  const double sigma_px = 0.35, angle = 37 * M_PI / 180;  // a Gaussian's r is 2 sigma
+  const cv::Point2d c(40.3, 40.1), t(std::cos(angle), std::sin(angle)), n(-t.y, t.x);
+  cv::Mat linear(80, 80, CV_32F);
+  for (int y = 0; y < linear.rows; ++y)
+    for (int x = 0; x < linear.cols; ++x) {
+      double sum = 0;  // the Gaussian ESF averaged over the pixel's box (8 x 8 points)
+      for (int i = 0; i < 8; ++i)
+        for (int j = 0; j < 8; ++j)
+          sum += Phi(n.dot(cv::Point2d(x + (i + 0.5) / 8 - 0.5, y + (j + 0.5) / 8 - 0.5) - c) / sigma_px);
+      linear.at<float>(y, x) = static_cast<float>(0.05 + 0.75 * sum / 64);
+    }
+  CalibResult result;
+  result.edges.resize(1);
+  SectionResult s;
+  s.segment = EdgeSegment{c - 18 * t, c + 18 * t, 10};
+  s.fit = MeasureEdgeModel(linear, s.segment);
+  ASSERT_TRUE(s.fit.ok);
+  result.edges[0].sections.push_back(s);
+  ReadPhaseFamilies(result, linear, {}, false);
+  const PhaseCheck& check = result.edges[0].sections[0].phase;
+  ASSERT_TRUE(check.every_phase) << "bins " << check.bins;
+  EXPECT_GT(check.bins, 100);  // +-(2 r + 6) px at 0.1 px: 148
+  ASSERT_FALSE(check.families.empty());
+  EXPECT_NEAR(check.families[0].r_px, 2 * sigma_px, 0.03 * 2 * sigma_px);
+}
+
 }  // namespace
 }  // namespace blurcue::calib
