@@ -621,7 +621,7 @@ TEST(SceneCalib, UndeterminedDepthsAreReadAndNoted) {
   const SceneCalib s = SceneCalibFromJson(j, "calib.json: ");
   EXPECT_EQ(UndeterminedNote(s, BlurSource::kFitted, 410),
             "the fitted blur at 410 mm is the lens model's estimate, not a result within 5 %: the model is not "
-            "determined within 5 % at 400-420 mm (its standard error up to 12 %: a sharpening after sampling cancels "
+            "determined within 5 % at 400-420 mm (its error up to 12 %: a sharpening after sampling cancels "
             "most of the optics' blur there; calib.json /phase_check/model_undetermined)");
   EXPECT_EQ(UndeterminedNote(s, BlurSource::kFitted, 421), "");
   EXPECT_EQ(UndeterminedNote(s, BlurSource::kEstimated, 410), "");

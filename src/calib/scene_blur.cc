@@ -291,7 +291,7 @@ std::string UndeterminedNote(const SceneCalib& scene, BlurSource source, double 
   char text[400];
   std::snprintf(text, sizeof text,
                 "the fitted blur at %.0f mm is the lens model's estimate, not a result within 5 %%: the model is "
-                "not determined within 5 %% at %.0f-%.0f mm (its standard error up to %.0f %%: a sharpening after "
+                "not determined within 5 %% at %.0f-%.0f mm (its error up to %.0f %%: a sharpening after "
                 "sampling cancels most of the optics' blur there; %s /phase_check/model_undetermined)",
                 u_mm, scene.undetermined_lo_mm, scene.undetermined_hi_mm, 100 * scene.undetermined_se_rel,
                 scene.file.empty() ? "the calibration" : scene.file.c_str());
