@@ -149,8 +149,10 @@ def _pooled(m, factors):
     return over, title
 
 
-def factor_chart(m, factor, chance, what, study, out_dir, name, group_note, pooled_over=()):
-    """Bars per level of `factor`; each pools the answers over the levels of the factors in pooled_over (said)."""
+def factor_chart(m, factor, chance, what, study, out_dir, name, group_note, pooled_over=(), mixed=()):
+    """Bars per level of `factor`; each pools the answers over the levels of the factors in pooled_over (said). Where
+    `mixed` names factors among them whose levels change which sources a pair compares (design.comparing_factors),
+    the caller passes chance None: such a bar averages different questions, so it is not tested (said)."""
     t = condition_table(m, [factor], chance)
     over, pooled_title = _pooled(m, pooled_over)
     t = t.set_index(factor).loc[_sorted_levels(list(t[factor]))].reset_index()
@@ -180,7 +182,9 @@ def factor_chart(m, factor, chance, what, study, out_dir, name, group_note, pool
              (f"; each bar pools the levels of {' and '.join(over)}: the per-condition table has each crossing"
               if over else "") +
              (f"; * p < 0.05, ** < 0.01, *** < 0.001 against chance, Holm-adjusted over the chart's bars, with "
-              f"participants as the unit: {'; '.join(tests)}" if chance is not None else "")]
+              f"participants as the unit: {'; '.join(tests)}" if chance is not None else "") +
+             (f"; no test against chance: each bar pools the levels of {' and '.join(mixed)}, which compare "
+              "other sources (different questions); the per-condition table tests each crossing" if mixed else "")]
     floor = study_tests.holm_floor_words(t, chance, m["participant"].nunique(), "bars")
     return Chart(name, png, svg, t, notes + ([floor] if floor else []))
 
@@ -567,10 +571,13 @@ def _analyse_rows(m, kind, guess, what, design, codebook, study, out_dir, slug, 
                         [w for w in [study_tests.holm_floor_words(table, chance, m["participant"].nunique()),
                                      crossed.missing_words(table, factors)] if w]))
     if kind != "procedure":
-        for f in factors:
-            charts.append(factor_chart(m, f, chance, what, study, out_dir, f"{slug}-per-{f}", note,
-                                       [g for g in factors if g != f]))
         apart = comparing_factors(m, factors)  # levels that ask different questions are summarised apart
+        for f in factors:
+            # A bar pooling the levels of a factor that changes which sources are compared averages the answers to
+            # different questions: drawn (a description), not tested against chance.
+            mixed = [g for g in apart if g != f]
+            charts.append(factor_chart(m, f, None if mixed else chance, what, study, out_dir, f"{slug}-per-{f}",
+                                       note, [g for g in factors if g != f], mixed))
         finding = f"{KIND_TITLES[kind]}: " + (study_tests.summary_by_level(m, chance, what, apart) if apart else
                                               study_tests.summary_words(m, chance, what))
         if kind == "pair":

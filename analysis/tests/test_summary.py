@@ -2,6 +2,7 @@
 that changes which sources a pair compares), checked against hand-worked shares and exact p-values."""
 import os
 import sys
+import tempfile
 import unittest
 
 import pandas as pd
@@ -128,3 +129,23 @@ class WhatTheMeasureMeans(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class FactorBarsNotTestedAcrossQuestions(unittest.TestCase):
+    def test_a_factors_bars_pooling_the_comparisons_draw_no_test(self):
+        # Per edge, each bar pools measured vs none with measured vs estimated (0.92 and 0.52 by hand above): a test of
+        # that mean against chance (it was starred) answers no question the study asked. Per comparison, each bar is
+        # one question: tested.
+        m = twofac_rows()
+        d = design.Design(within=("comparison", "edge"))
+        with tempfile.TemporaryDirectory() as out:
+            charts, _ = any_study._analyse_rows(m, "pair", 0.5, "chose the more blurred side", d, None, "twofac", out,
+                                                "twofac", "6 participants", 0, 1)
+        by_name = {c.name: c for c in charts}
+        edge, comparison = by_name["twofac-per-edge"], by_name["twofac-per-comparison"]
+        self.assertNotIn("p_holm", edge.table.columns)
+        self.assertIn("no test against chance: each bar pools the levels of comparison, which compare other sources",
+                      " ".join(edge.notes))
+        self.assertIn("p_holm", comparison.table.columns)
+        self.assertNotIn("no test against chance", " ".join(comparison.notes))
+
