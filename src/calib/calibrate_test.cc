@@ -632,6 +632,8 @@ TEST(SceneCalib, UndeterminedDepthsAreReadAndNoted) {
                         "<= far, got [420.0,400.0]");
   j["phase_check"]["model_undetermined"] = {{"u_mm", {400.0, 420.0}}};
   ExpectCalibRefused(j, "calib.json: /phase_check/model_undetermined/worst_se_rel: is required but missing");
+  j["phase_check"] = Json::array();  // a hand edit that would hide the depths
+  ExpectCalibRefused(j, "calib.json: /phase_check: must be an object, got []");
 }
 
 // The model block says which model predicts: its kind is one of the two, the floor model states its floor (a missing

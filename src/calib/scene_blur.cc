@@ -164,7 +164,8 @@ namespace {
 // calib.json's phase_check.model_undetermined (null where calibrate named no depth): its depths and standard error.
 void ReadUndetermined(const Json& j, const std::string& where, SceneCalib* s) {
   const auto check = j.find("phase_check");
-  if (check == j.end() || !check->is_object()) return;
+  if (check == j.end()) return;
+  if (!check->is_object()) throw InputError(where + "/phase_check", "must be an object, got " + check->dump());
   const auto und = check->find("model_undetermined");
   if (und == check->end() || und->is_null()) return;
   const std::string uw = where + "/phase_check/model_undetermined";
