@@ -11,4 +11,8 @@ cd build
 status=0
 ctest --output-on-failure -j2 --timeout 600 || status=$?
 echo "test.sh: the demo and the tests took $((SECONDS - stage)) s; all together $((SECONDS - start)) s"
+# Where the tests' time went: the 15 longest of this run (wall seconds, two at a time), from ctest's own log.
+echo "test.sh: the longest tests (s):"
+awk '/^Test time =/ {t = $4} /" end time:/ {n = $1; gsub(/"/, "", n); printf "%8.1f %s\n", t, n}' \
+    Testing/Temporary/LastTest.log 2>/dev/null | sort -g -r | head -15 || true
 exit $status
