@@ -30,6 +30,7 @@ import pandas as pd
 import criteria
 import crossed
 import groups
+import across_observers
 import stats
 import study_tests
 import tracks
@@ -226,7 +227,7 @@ def models(m, factors, study, group_note, what, additive_note=""):
     for f in factors:
         d[f] = d[f].map(_label)
     rhs = " + ".join(f"C({f}, levels={_sorted_levels(list(d[f].unique()))!r})" for f in factors) if factors else "1"
-    table, notes = stats.observer_models(d, "y", rhs, study=study)
+    table, notes = across_observers.observer_models(d, "y", rhs, study=study)
     if table.empty:
         return Chart(f"{study}-models", None, None, table, notes)
     notes.insert(0, f"{group_note}: logistic models of '{what}' across participants; estimates in log-odds, each "

@@ -4,13 +4,13 @@ logistic models across participants with their interaction, beside the additive 
 The additive model assumes each factor's effect in log-odds is the same at every level of the other; where the
 shares say otherwise (measured vs none rising over the edges while measured vs estimated stays flat) that is the
 interaction, which the additive model averages away. The interaction model (`y ~ A * B`) is fitted by the same
-stats.observer_models as every other model (the cluster-robust GLM and lme4's GLMM, its random part reduced step by
+across_observers.observer_models as every other model (the cluster-robust GLM and lme4's GLMM, its random part reduced step by
 step where not determined, separation found first), so its terms are in the same words and held to the same rules.
 """
 import matplotlib.pyplot as plt
 import numpy as np
 
-import stats
+import across_observers
 from common import Chart, error_bars, factor_label, save
 
 NO_INTERACTION_NOTE = ("no interaction term: this model assumes each factor's effect (in log-odds) is the same at "
@@ -71,7 +71,7 @@ def interaction_models(d, factors, study, group_note, what, levels):
     """The logistic models across participants with every interaction of the factors (d: the rows with the factors
     as their labels; levels: each factor's sorted levels). Returns a Chart named STUDY-models-interaction."""
     rhs = " * ".join(f"C({f}, levels={levels[f]!r})" for f in factors)
-    table, notes = stats.observer_models(d, "y", rhs, study=study)
+    table, notes = across_observers.observer_models(d, "y", rhs, study=study)
     name = f"{study}-models-interaction"
     if not table.empty:
         notes.insert(0, f"{group_note}: logistic models of '{what}' across participants with the interaction of "

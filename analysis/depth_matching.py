@@ -6,7 +6,7 @@ against the real picture's blur, both in arcmin at the eye (trials.csv's r_scene
 equivalent Gaussian's). The thesis's power law of cut-off over distance is kept as the replication of its Fig. 3.3,
 with its limit said: the real blur is V-shaped around the focus, so one power law over distance flattens it.
 
-Model table (stats.MODEL_COLUMNS), where the record allows:
+Model table (across_observers.MODEL_COLUMNS), where the record allows:
   set on real       set_arcmin ~ real_arcmin: lmer with a random intercept and slope by participant (Satterthwaite
                     df; intercept-only when that is singular), and pooled OLS with SEs clustered by participant (CR1,
                     t(G-1); with two participants neither: said in words); needs r_scene_arcmin and
@@ -27,11 +27,11 @@ from scipy import stats as sps
 
 import mixed
 import prediction
-import stats
+import across_observers
 from common import Chart, Skip, STUDY_DEPTH, participants_note, save, study_rows
 
 
-MIN_OBSERVERS_CI = stats.MIN_PARTICIPANTS_MODEL  # an interval or a model across observers needs this many
+MIN_OBSERVERS_CI = across_observers.MIN_PARTICIPANTS_MODEL  # an interval or a model across observers needs this many
 
 
 def charts(df, out_dir):
@@ -55,7 +55,7 @@ def charts(df, out_dir):
                        if "picture_width_arcmin" in a else np.nan)
     a["real_arcmin"] = pd.to_numeric(a["r_scene_arcmin"], errors="coerce") if "r_scene_arcmin" in a else np.nan
     rows, pooled = fits(a, notes)
-    table = stats.model_table(rows)
+    table = across_observers.model_table(rows)
     # Per distance across observers: geometric mean (mean of log cut-off per observer, then across observers).
     per_obs = a.groupby(["distance_m", "participant"])["log_c"].mean().reset_index()
     summary = per_obs.groupby("distance_m")["log_c"].agg(["mean", "std", "count"]).reset_index()
@@ -168,11 +168,11 @@ def _rows_of(study, model, words, term, est, se, df, p, engine, note, floor_arcm
     1) / SE on df - then the fit's p against 0), any other term once (the intercepts without p: _meaningful)."""
     if words is not WORDS_MATCH or term != "real_arcmin":
         p, note = _meaningful(term, words, p, note, floor_arcmin)
-        return [stats.model_row(study, model, words[term], est, se, df, p, engine, note)]
+        return [across_observers.model_row(study, model, words[term], est, se, df, p, engine, note)]
     ok = math.isfinite(p) and se > 0 and df > 0
     p1 = float(2 * sps.t.sf(abs(est - 1) / se, df)) if ok else math.nan
-    return [stats.model_row(study, model, words[term], est, se, df, p1, engine, note),
-            stats.model_row(study, model, MATCH_SLOPE_AGAINST_0, est, se, df, p, engine, note)]
+    return [across_observers.model_row(study, model, words[term], est, se, df, p1, engine, note),
+            across_observers.model_row(study, model, MATCH_SLOPE_AGAINST_0, est, se, df, p, engine, note)]
 
 
 def _ols_rows(g, x, y, model, words, study):
@@ -188,7 +188,7 @@ def _ols_rows(g, x, y, model, words, study):
     return out
 
 
-# Two participants: no model across them, in the forced choice's words (stats.observer_models).
+# Two participants: no model across them, in the forced choice's words (across_observers.observer_models).
 TWO_PARTICIPANTS = ("{label}: two participants: too few for a model across participants (a cluster-robust SE from two "
                     "participants with t(1), or a mixed model's spread between two, is not an estimate); no model "
                     "fitted, no SE, no p - the answers per distance are in the tables, and a model needs >= {minimum}")
@@ -210,16 +210,16 @@ def _across(a, x, y, label, words, notes, study, floor_arcmin=None):
         zero_se = {}
         if n_groups == 2:
             # Two clusters give a sandwich SE from two residual sums and a t(1) reference: no estimate of the
-            # spread between participants (as stats.observer_models says for the forced choice). The pooled line
+            # spread between participants (as across_observers.observer_models says for the forced choice). The pooled line
             # is still drawn, from plain OLS, and each observer's own fit is in the table where there is one.
             res = sm.OLS(a[y].to_numpy(float), X).fit()
             pooled = (float(res.params.iloc[0]), float(res.params.iloc[1]))
-            notes.append(TWO_PARTICIPANTS.format(label=label, minimum=stats.MIN_PARTICIPANTS_MODEL))
+            notes.append(TWO_PARTICIPANTS.format(label=label, minimum=across_observers.MIN_PARTICIPANTS_MODEL))
             return rows, pooled
         if n_groups >= 3:
-            t = stats.cluster_robust(a[y].to_numpy(float), X, groups, family=sm.families.Gaussian())
+            t = across_observers.cluster_robust(a[y].to_numpy(float), X, groups, family=sm.families.Gaussian())
             pooled = (float(t["estimate"].iloc[0]), float(t["estimate"].iloc[1]))  # before any is said in words
-            t, zero_se = stats.without_zero_se(t, words)
+            t, zero_se = across_observers.without_zero_se(t, words)
             engine = f"statsmodels {version} OLS cluster-robust CR1, t(G-1)"
             model = f"lm({y} ~ {x}), cluster-robust"
         else:
@@ -245,12 +245,12 @@ def _across(a, x, y, label, words, notes, study, floor_arcmin=None):
             notes.append(f"{label}: mixed model {f.failed}")
             return rows, pooled
         status = f.structure + ("; singular fit" if f.singular else "")
-        for _, r in stats.without_unheld_tests(f, [x]).iterrows():
+        for _, r in across_observers.without_unheld_tests(f, [x]).iterrows():
             rows += _rows_of(study, model, words, r["term"], r["estimate"], r["se"], r["df"], r["p"], f.engine,
                              status + r["why"], floor_arcmin)
         # The SD of the participants' slopes is a spread, tested against nothing: named without a test's words.
         sd_words = {**words, x: "per arcmin of real blur"} if words is WORDS_MATCH else words
-        rows += stats.variance_rows(study, model, f, sd_words, "arcmin" if y == "set_arcmin" else "log cut-off")
+        rows += across_observers.variance_rows(study, model, f, sd_words, "arcmin" if y == "set_arcmin" else "log cut-off")
     return rows, pooled
 
 

@@ -21,6 +21,7 @@ import pandas as pd
 
 import matplotlib.pyplot as plt
 
+import across_observers
 import stats
 import study_tests
 from common import (Chart, Skip, SOURCE_COLORS, SOURCE_LABELS, STUDY_TEST1, STUDY_TEST2, STUDY_TEST3, STUDY_TITLES,
@@ -128,11 +129,11 @@ def _caption_note():
 
 
 def _model(d, formula_rhs, title, extra=None):
-    """Logistic models across observers of 'chose the first source' among decisive answers (see stats.observer_models)."""
+    """Logistic models across observers of 'chose the first source' among decisive answers (see across_observers.observer_models)."""
     dec = d[d["answered"] & d["decisive"]].copy()
     dec["chose_first"] = (dec["chosen_source"] == dec["first"]).astype(float)
     study = str(dec["study"].iloc[0]) if "study" in dec and len(dec) else ""
-    table, notes = stats.observer_models(dec, "chose_first", formula_rhs, study=study)
+    table, notes = across_observers.observer_models(dec, "chose_first", formula_rhs, study=study)
     if extra is not None and not table.empty:  # e.g. the pattern, named in the model column (the columns are fixed)
         table["model"] = ", ".join(f"{k} {v}" for k, v in extra.items()) + ": " + table["model"]
     return table, [f"{title}: {n}" for n in notes]
@@ -269,7 +270,7 @@ def psychometric(df, out_dir, n_boot=200, seed=1):
     psychometric function with a 2AFC guess rate is fitted (it would assume the choice tends to the more blurred one
     as the difference grows, a direction the data must show instead). Drawn: the share in equal-count bins of the
     difference with Wilson 95 % intervals; tested: a logistic model of choosing the more blurred one on the difference
-    across participants (stats.observer_models: GLM clustered by participant, GLMM by lme4), whose slope says whether
+    across participants (across_observers.observer_models: GLM clustered by participant, GLMM by lme4), whose slope says whether
     and which way the choice moves with the difference. Only decisive answers (left/right) with a non-zero difference
     count: can't tell is not a choice of either stimulus, and with equal blur neither is the more blurred.
     n_boot and seed are kept for the caller; nothing here resamples.
@@ -299,7 +300,7 @@ def psychometric(df, out_dir, n_boot=200, seed=1):
     b["k"] = b["k"].astype(int)
     wilson_columns(b, "k", "n", "share")
     b["bin"] = b["bin"].astype(str)
-    model, model_notes = stats.observer_models(dec, "y", "diff", study="tests 1-3 pooled")
+    model, model_notes = across_observers.observer_models(dec, "y", "diff", study="tests 1-3 pooled")
 
     fig, ax = plt.subplots(figsize=(7.2, 4.6))
     ax.axhline(0.5, color="#888888", lw=0.8, ls=":", label="no preference (0.5)")

@@ -27,6 +27,7 @@ import pandas as pd
 from scipy import stats as sps
 
 import mixed
+import across_observers
 import stats
 import study_tests
 from common import Chart, text
@@ -76,10 +77,10 @@ def fit(m, column, factor, group, others=(), family="glmm"):
     out = {"why": "", "test": None, "contrasts": pd.DataFrame(), "emmeans": pd.DataFrame(), "structure": "",
            "random": "", "engine": ""}
     people = text(m["participant"]).nunique()
-    if people < stats.MIN_PARTICIPANTS_MODEL:
+    if people < across_observers.MIN_PARTICIPANTS_MODEL:
         out["why"] = (f"not determined: {people} participant{'s' if people != 1 else ''}: too few for a model across "
                       f"participants (a mixed model's spread between {people}, or a t({max(people - 1, 0)}) test, is "
-                      f"not an estimate); no model fitted - a model needs >= {stats.MIN_PARTICIPANTS_MODEL}")
+                      f"not an estimate); no model fitted - a model needs >= {across_observers.MIN_PARTICIPANTS_MODEL}")
         return out
     exe = mixed.rscript()
     if exe is None:

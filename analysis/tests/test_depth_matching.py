@@ -22,7 +22,7 @@ from scipy import stats as sps
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import depth_matching  # noqa: E402
-import stats  # noqa: E402
+import across_observers  # noqa: E402
 import study_tests  # noqa: E402
 
 SLOPE = 0.8  # the participants' mean slope of set on real blur
@@ -63,7 +63,7 @@ class TwoParticipants(unittest.TestCase):
         a = simulate(np.random.default_rng(2), 2)
         notes = []
         rows, pooled = depth_matching.fits(a, notes)
-        t = stats.model_table(rows)
+        t = across_observers.model_table(rows)
         across = t[~t["model"].str.contains("observer ")]
         self.assertTrue(across.empty, across)
         self.assertFalse((t["df"] == 1).any(), t)
@@ -133,7 +133,7 @@ class Coverage(unittest.TestCase):
             for _ in range(400):
                 a = simulate(rng, 3)
                 X = pd.DataFrame({"Intercept": 1.0, "real_arcmin": a["real_arcmin"]})
-                t = stats.cluster_robust(a["set_arcmin"].to_numpy(float), X, a["participant"].to_numpy(),
+                t = across_observers.cluster_robust(a["set_arcmin"].to_numpy(float), X, a["participant"].to_numpy(),
                                          family=sm.families.Gaussian())
                 half = sps.t.ppf(0.975, t["df"].iloc[1]) * t["se"].iloc[1]
                 hits.append(abs(t["estimate"].iloc[1] - SLOPE) <= half)

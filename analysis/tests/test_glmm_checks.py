@@ -27,7 +27,7 @@ sys.path.insert(0, os.path.dirname(HERE))
 sys.path.insert(0, HERE)
 
 import mixed  # noqa: E402
-import stats  # noqa: E402
+import across_observers  # noqa: E402
 
 SKIP = 77
 RSCRIPT = mixed.rscript()
@@ -140,7 +140,7 @@ class GlmmChecks(unittest.TestCase):
         """The report's GLMM against its formula refitted here by lme4's default optimizer and by nloptwrap: the same
         numbers where those two are determined (clean, agreeing, SDs <= 10), else "not determined" and no numbers."""
         d = two_groups(counts, 8)
-        table, notes = stats.observer_models(d, "y", self.FORMULA)
+        table, notes = across_observers.observer_models(d, "y", self.FORMULA)
         glmm = self.glmm(table)
         fixed = glmm[glmm["term"].isin(list(self.R_NAMES))]
         self.assertEqual(len(fixed), 4, table)
@@ -205,8 +205,8 @@ class GlmmChecks(unittest.TestCase):
         counts = {f"P{i}": ("A" if i < 3 else "B", list(rng.binomial(10, [0.35, 0.5, 0.7] if i < 3 else
                                                                       [0.55, 0.7, 0.85]))) for i in range(6)}
         d = two_groups(counts, 10)
-        first, _ = stats.observer_models(d, "y", "C(edge, levels=['a', 'b', 'c']) + C(group, levels=['A', 'B'])")
-        second, _ = stats.observer_models(d, "y", "C(edge, levels=['c', 'b', 'a']) + C(group, levels=['B', 'A'])")
+        first, _ = across_observers.observer_models(d, "y", "C(edge, levels=['a', 'b', 'c']) + C(group, levels=['A', 'B'])")
+        second, _ = across_observers.observer_models(d, "y", "C(edge, levels=['c', 'b', 'a']) + C(group, levels=['B', 'A'])")
         a = self.row(first, "group B (against group A)")
         b = self.row(second, "group A (against group B)")
         if math.isnan(a["estimate"]) or math.isnan(b["estimate"]):
@@ -230,7 +230,7 @@ class GlmmChecks(unittest.TestCase):
         d = pd.DataFrame(rows)
         tested = []
         for order in ([1, 2, 3, 4], [3, 1, 4, 2]):
-            table, notes = stats.observer_models(d, "y", f"0 + C(pattern_id, levels={order})")
+            table, notes = across_observers.observer_models(d, "y", f"0 + C(pattern_id, levels={order})")
             glmm = self.glmm(table)
             glmm = glmm[~glmm["term"].str.startswith("observer")]
             tested.append({(r["term"], not math.isnan(r["p"])) for _, r in glmm.iterrows()})

@@ -24,7 +24,7 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import depth_matching  # noqa: E402
 import design  # noqa: E402
 import groups  # noqa: E402
-import stats  # noqa: E402
+import across_observers  # noqa: E402
 
 DEPTH = {3: -0.5, 6: 0.3, 9: 0.9}  # log-odds of each edge, shared by both groups
 DELTA = 2.0                         # the planted interaction: group b's extra log-odds at edge 9 only
@@ -227,7 +227,7 @@ class DepthMatchingIntercept(unittest.TestCase):
         a["cutoff"] = 2 * depth_matching.EQUIVALENT_S * 600 / a["set_arcmin"]
         a["log_d"], a["log_c"] = np.log(a["distance_m"]), np.log(a["cutoff"])
         self.assertAlmostEqual(depth_matching.sharpest_level_arcmin(a), 2.81085, places=4)
-        t = stats.model_table(depth_matching.fits(a, [])[0])
+        t = across_observers.model_table(depth_matching.fits(a, [])[0])
         intercepts = t[t["term"] == depth_matching.WORDS_MATCH["Intercept"]]
         self.assertGreaterEqual(len(intercepts), 2, t)  # the clustered OLS and the lmer
         for _, row in intercepts.iterrows():

@@ -1,4 +1,4 @@
-"""The models across observers (stats.observer_models, mixed.py + models.R) and the depth-matching LMM against truth
+"""The models across observers (across_observers.observer_models, mixed.py + models.R) and the depth-matching LMM against truth
 they do not compute the same way: a direct glmer call written here in R, simulated observers with known parameters,
 hand-worked cells, a cluster-robust sandwich computed here with numpy, scipy's t distribution."""
 import math
@@ -18,7 +18,7 @@ sys.path.insert(0, HERE)
 
 import depth_matching  # noqa: E402
 import mixed  # noqa: E402
-import stats  # noqa: E402
+import across_observers  # noqa: E402
 import synthetic  # noqa: E402
 
 RSCRIPT = mixed.rscript()
@@ -85,7 +85,7 @@ def rows_of(table, engine_prefix):
 class GlmmAgainstDirectGlmer(NeedsLme4):
     def test_estimates_and_se_agree_with_glmer_written_here(self):
         d = simulated(10, 110, sd_intercept=0.8, sd_slope=0.25)
-        table, notes = stats.observer_models(d, "y", "edge_c", study="s")
+        table, notes = across_observers.observer_models(d, "y", "edge_c", study="s")
         glmm = rows_of(table, "lme4")
         model = glmm["model"].iloc[0]
         # The maximal model is what the data support here (both SDs clearly non-zero); the direct call fits the same.
@@ -111,7 +111,7 @@ class GlmmAgainstDirectGlmer(NeedsLme4):
         self.assertTrue(maximal_singular)
         fixed, _, singular = direct_glmer(d, "y ~ edge_c + (1 | participant)")
         self.assertFalse(singular)
-        table, _ = stats.observer_models(d, "y", "edge_c", study="s")
+        table, _ = across_observers.observer_models(d, "y", "edge_c", study="s")
         glmm = rows_of(table, "lme4")
         self.assertIn("(1 | participant)", glmm["model"].iloc[0])
         slope = glmm[glmm["term"] == "per edge (edge centred at 6)"].iloc[0]
@@ -134,7 +134,7 @@ class GlmmAgainstDirectGlmer(NeedsLme4):
         self.assertLess(sds["(Intercept)"], 1e-4)
         fixed, sds, singular = direct_glmer(d, "y ~ edge_c + (0 + edge_c | participant)")
         self.assertFalse(singular)
-        table, notes = stats.observer_models(d, "y", "edge_c", study="s")
+        table, notes = across_observers.observer_models(d, "y", "edge_c", study="s")
         glmm = rows_of(table, "lme4")
         self.assertIn("y ~ edge_c + (0 + edge_c | participant))", glmm["model"].iloc[0], notes)
         slope = glmm[glmm["term"] == "per edge (edge centred at 6)"].iloc[0]
@@ -153,7 +153,7 @@ class GlmmAgainstDirectGlmer(NeedsLme4):
         # (at SD 0 each participant's score is 0, so the likelihood falls as the SD grows), so the fit is singular.
         one = simulated(1, 66, 0, 0, seed=11)[["edge_c", "y"]]
         d = pd.concat([one.assign(participant=f"P{i}") for i in range(6)], ignore_index=True)
-        table, notes = stats.observer_models(d, "y", "edge_c", study="s")
+        table, notes = across_observers.observer_models(d, "y", "edge_c", study="s")
         sd = rows_of(table, "lme4")
         sd = sd[sd["term"].str.startswith("observer SD")]
         self.assertGreaterEqual(len(sd), 1, table)
@@ -166,7 +166,7 @@ class GlmmAgainstDirectGlmer(NeedsLme4):
     def test_random_identical_observers_follow_glmer_verdict(self):
         # Six simulated observers with the same parameters (truth SD 0), answers drawn at random.
         d = simulated(6, 66, 0, 0, seed=3)
-        table, _ = stats.observer_models(d, "y", "edge_c", study="s")
+        table, _ = across_observers.observer_models(d, "y", "edge_c", study="s")
         row = table[table["term"] == "observer SD: baseline (intercept)"].iloc[0]
         _, sds, singular = direct_glmer(d, "y ~ edge_c + (1 | participant)")
         if singular:
@@ -202,7 +202,7 @@ class SeparationTest(unittest.TestCase):
 
     def test_separated_cell_has_no_estimate_and_no_p(self):
         d = self.cells(20, 0, 12, 8)
-        table, notes = stats.observer_models(d, "y", "0 + C(cell)", study="s")
+        table, notes = across_observers.observer_models(d, "y", "0 + C(cell)", study="s")
         a = table[table["term"] == "cell a"]
         self.assertEqual(len(a), 2 if HAVE_LME4 else 1, table)
         for _, row in a.iterrows():
@@ -215,7 +215,7 @@ class SeparationTest(unittest.TestCase):
 
     def test_one_separated_answer_is_one_answer(self):
         # A cell of one answer is separated by it: the note counts it in the singular ("1 answers" it said).
-        _, notes = stats.observer_models(self.cells(1, 0, 12, 8), "y", "0 + C(cell)", study="s")
+        _, notes = across_observers.observer_models(self.cells(1, 0, 12, 8), "y", "0 + C(cell)", study="s")
         self.assertTrue(any("separation in cell a: 1 answer that those terms predict perfectly" in n for n in notes),
                         notes)
 
@@ -232,7 +232,7 @@ class SeparationTest(unittest.TestCase):
                 for y in [1.0] * ones + [0.0] * zeros]
         d = pd.DataFrame(rows, columns=["cell", "side", "y"])
         d["participant"] = [f"P{i % 4}" for i in range(len(d))]
-        table, notes = stats.observer_models(d, "y", "C(cell) + C(side)", study="s")
+        table, notes = across_observers.observer_models(d, "y", "C(cell) + C(side)", study="s")
         glm = table[table["engine"].str.contains("cluster-robust")]
         side = glm[glm["term"] == "side r (against side l)"].iloc[0]
         self.assertAlmostEqual(side["estimate"], math.log(2), places=5)
@@ -246,7 +246,7 @@ class SeparationTest(unittest.TestCase):
         self.assertIn("separation", a["note"])
         self.assertTrue(any("reference level is b, not a" in n for n in notes), notes)
         # The same contrast whatever the level order given.
-        again, _ = stats.observer_models(d, "y", "C(cell, levels=['c', 'a', 'b']) + C(side)", study="s")
+        again, _ = across_observers.observer_models(d, "y", "C(cell, levels=['c', 'a', 'b']) + C(side)", study="s")
         glm2 = again[again["engine"].str.contains("cluster-robust")]
         b = glm2[glm2["term"] == "cell b (against cell c)"].iloc[0]
         self.assertAlmostEqual(b["estimate"], -c["estimate"], places=5)
@@ -258,7 +258,7 @@ class SeparationTest(unittest.TestCase):
 
     def test_large_finite_effect_is_not_separation(self):
         d = self.cells(49, 3, 26, 26)
-        table, _ = stats.observer_models(d, "y", "0 + C(cell)", study="s")
+        table, _ = across_observers.observer_models(d, "y", "0 + C(cell)", study="s")
         glm = table[table["engine"].str.contains("cluster-robust")]
         a = glm[glm["term"] == "cell a"].iloc[0]
         self.assertAlmostEqual(a["estimate"], math.log(49 / 3), places=6)  # cell means: the cell's own log-odds
@@ -267,10 +267,10 @@ class SeparationTest(unittest.TestCase):
 
     def test_linear_program_on_hand_cases(self):
         X = np.column_stack([np.ones(6), [1.0, 2, 3, 4, 5, 6]])
-        self.assertEqual(stats.separation(X, [0, 0, 0, 1, 1, 1])[0], [0, 1])  # complete: threshold at 3.5
-        self.assertEqual(stats.separation(X, [0, 1, 0, 1, 0, 1])[0], [])      # overlap
+        self.assertEqual(across_observers.separation(X, [0, 0, 0, 1, 1, 1])[0], [0, 1])  # complete: threshold at 3.5
+        self.assertEqual(across_observers.separation(X, [0, 1, 0, 1, 0, 1])[0], [])      # overlap
         # Quasi-complete: both answers at x = 3, all 0 below and all 1 above; those two are the only rows left.
-        infinite, rows = stats.separation(np.column_stack([np.ones(6), [1.0, 2, 3, 3, 4, 5]]), [0, 0, 0, 1, 1, 1])
+        infinite, rows = across_observers.separation(np.column_stack([np.ones(6), [1.0, 2, 3, 3, 4, 5]]), [0, 0, 0, 1, 1, 1])
         self.assertEqual(infinite, [0, 1])
         self.assertEqual(list(rows), [True, True, False, False, True, True])
 
@@ -282,7 +282,7 @@ class ClusterRobustTest(unittest.TestCase):
         u = d["participant"].map(dict(zip("ABCD", [-0.6, 0.1, 0.4, 0.9])))
         d["y"] = rng.binomial(1, 1 / (1 + np.exp(-(0.2 + u + 0.7 * d["x"])))).astype(float)
         with mock_env(BLURCUE_RSCRIPT="/nonexistent/Rscript"):
-            table, _ = stats.observer_models(d, "y", "x", study="s")
+            table, _ = across_observers.observer_models(d, "y", "x", study="s")
         # The logistic ML fit by Newton's method, the CR1 sandwich and t(3) computed here.
         X = np.column_stack([np.ones(len(d)), d["x"]])
         y = d["y"].to_numpy()
@@ -325,8 +325,8 @@ class WithoutRTest(unittest.TestCase):
     def test_no_r_says_so_and_gives_no_approximate_p(self):
         d = simulated(6, 44, 0.5, 0.0)
         with mock_env(BLURCUE_RSCRIPT="/nonexistent/Rscript"):
-            table, notes = stats.observer_models(d, "y", "edge_c", study="s")
-        self.assertEqual(list(table.columns), stats.MODEL_COLUMNS)
+            table, notes = across_observers.observer_models(d, "y", "edge_c", study="s")
+        self.assertEqual(list(table.columns), across_observers.MODEL_COLUMNS)
         self.assertTrue(table["engine"].str.contains("cluster-robust").all(), table)
         self.assertFalse(table["engine"].str.contains("lme4|Bayes|VB").any())
         self.assertTrue(any("GLMM not fitted: R is not installed" in n for n in notes), notes)
@@ -343,7 +343,7 @@ class WithoutRTest(unittest.TestCase):
         if probe.returncode != 0:
             self.skipTest("lme4 is installed outside the site library")
         with mock_env(BLURCUE_RSCRIPT=wrapper):
-            table, notes = stats.observer_models(simulated(6, 44, 0.5, 0.0), "y", "edge_c", study="s")
+            table, notes = across_observers.observer_models(simulated(6, 44, 0.5, 0.0), "y", "edge_c", study="s")
         self.assertFalse(table["engine"].str.contains("lme4").any())
         self.assertTrue(any("GLMM not fitted: the R package lme4 is not installed" in n for n in notes), notes)
 
@@ -359,7 +359,7 @@ class WithoutRTest(unittest.TestCase):
         self.assertEqual(run.returncode, 0, run.stderr)
         self.assertNotIn("Traceback", run.stderr)
         model = pd.read_csv(os.path.join(out, "test1-model.csv"))
-        self.assertEqual(list(model.columns), stats.MODEL_COLUMNS)
+        self.assertEqual(list(model.columns), across_observers.MODEL_COLUMNS)
         self.assertFalse(model["engine"].str.contains("lme4|Bayes|VB").any())
         with open(os.path.join(out, "index.html")) as f:
             self.assertIn("R is not installed", f.read())
@@ -381,7 +381,7 @@ class DepthMatchingLmmTest(NeedsLme4):
         a["log_d"], a["log_c"] = np.log(a["distance_m"]), np.log(a["cutoff"])
         notes = []
         rows, _ = depth_matching.fits(a, notes)
-        t = stats.model_table(rows)
+        t = across_observers.model_table(rows)
         slope = t[t["model"].str.startswith("set on real: lmer(set_arcmin ~ real_arcmin + (1 + real_arcmin")
                   & (t["term"] == "per arcmin of real blur, against 1 (set as real)")]
         self.assertEqual(len(slope), 1, (t, notes))
@@ -407,7 +407,7 @@ class DepthMatchingLmmTest(NeedsLme4):
         notes = []
         rows, _ = depth_matching._across(a, "real_arcmin", "set_arcmin", "set on real", depth_matching.WORDS_MATCH,
                                          notes, "s")
-        t = stats.model_table(rows)
+        t = across_observers.model_table(rows)
         lmer = t[t["engine"].str.startswith("lme4")]
         one = lmer[lmer["term"] == depth_matching.WORDS_MATCH["real_arcmin"]].iloc[0]
         zero = lmer[lmer["term"] == depth_matching.MATCH_SLOPE_AGAINST_0].iloc[0]

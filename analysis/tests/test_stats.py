@@ -17,6 +17,7 @@ import pandas as pd  # noqa: E402
 import common  # noqa: E402
 import forced_choice  # noqa: E402
 import frame_timing  # noqa: E402
+import across_observers  # noqa: E402
 import stats  # noqa: E402
 import study_tests  # noqa: E402
 import synthetic  # noqa: E402
@@ -182,21 +183,21 @@ class ObserverModelTest(unittest.TestCase):
         return d
 
     def test_several_observers(self):
-        table, notes = stats.observer_models(self.frame(list("ABCDEF"), 44), "y", "edge")
-        self.assertEqual(list(table.columns), stats.MODEL_COLUMNS)
+        table, notes = across_observers.observer_models(self.frame(list("ABCDEF"), 44), "y", "edge")
+        self.assertEqual(list(table.columns), across_observers.MODEL_COLUMNS)
         glm = table[table["engine"].str.contains("cluster-robust")]
         self.assertEqual(set(glm["df"]), {5.0})  # t with G - 1 = 5 df
         slope = glm[glm["term"] == "edge"].iloc[0]
         self.assertAlmostEqual(slope["estimate"], 0.5, delta=0.2)
 
     def test_one_observer_falls_back_with_a_note(self):
-        table, notes = stats.observer_models(self.frame(["A"], 66), "y", "edge")
+        table, notes = across_observers.observer_models(self.frame(["A"], 66), "y", "edge")
         self.assertEqual(set(table["model"]), {"glm(y ~ edge)"})
         self.assertTrue(table["note"].str.contains("one observer").all())
         self.assertTrue(any("one participant" in n for n in notes))
 
     def test_too_few_answers(self):
-        table, notes = stats.observer_models(self.frame(list("AB"), 3), "y", "edge")
+        table, notes = across_observers.observer_models(self.frame(list("AB"), 3), "y", "edge")
         self.assertTrue(table.empty)
         self.assertTrue(any("no model across observers" in n for n in notes))
 
@@ -215,7 +216,7 @@ class ObserverModelTest(unittest.TestCase):
         return pd.DataFrame(rows)
 
     def test_term_zero_by_construction_is_said_in_words_not_as_rounding_noise(self):
-        table, _ = stats.observer_models(self.same_at_both_edges(), "y", "C(blur) + C(edge)")
+        table, _ = across_observers.observer_models(self.same_at_both_edges(), "y", "C(blur) + C(edge)")
         edge = table[table["term"] == "edge 6 (against edge 3)"].iloc[0]
         # The fit gives some 1e-16 with an SE of the same size, and a p from their ratio: none of them is printed.
         for column in ("estimate", "se", "p"):
@@ -228,7 +229,7 @@ class ObserverModelTest(unittest.TestCase):
         self.assertEqual(blur["note"], "")
 
     def test_se_of_zero_is_said_in_words_and_the_estimate_kept(self):
-        table, _ = stats.observer_models(self.same_at_both_edges(), "y", "C(blur) + C(edge)")
+        table, _ = across_observers.observer_models(self.same_at_both_edges(), "y", "C(blur) + C(edge)")
         # Every participant said yes to a quarter of their blurred balls: the baseline is log(2/6) in each, no spread.
         base = table[table["term"] == "baseline (intercept)"].iloc[0]
         self.assertAlmostEqual(base["estimate"], math.log(2 / 6), places=6)
@@ -246,7 +247,7 @@ class ObserverModelTest(unittest.TestCase):
                 for p in ("P1", "P2", "P3") for r, e in zip(real, [0.1, -0.2, 0.15, -0.05, 0.0])]
         out, pooled = depth_matching._across(pd.DataFrame(rows), "real_arcmin", "set_arcmin", "set on real",
                                              depth_matching.WORDS_MATCH, [], "s")
-        table = stats.model_table(out)
+        table = across_observers.model_table(out)
         slope = table[(table["term"] == depth_matching.WORDS_MATCH["real_arcmin"]) &
                       table["engine"].str.contains("cluster-robust")].iloc[0]
         self.assertTrue(math.isnan(slope["se"]) and math.isnan(slope["p"]), slope.to_dict())
@@ -257,27 +258,27 @@ class ObserverModelTest(unittest.TestCase):
     def test_disagreeing_models_are_called_borderline(self):
         glm = "statsmodels 0.13.5 GLM cluster-robust CR1, t(G-1)"
         lme4 = "lme4 1.1-31 glmer (Laplace), Wald t(G-1)"
-        table = stats.model_table([
-            stats.model_row("s", "glm", "per edge", p=0.01, engine=glm),
-            stats.model_row("s", "glmer", "per edge", p=0.2, engine=lme4),
-            stats.model_row("s", "glm", "pattern_id 3", p=0.01, engine=glm),
-            stats.model_row("s", "glmer", "pattern_id 3", engine=lme4, note=stats.UNHELD_LOST_SLOPE),
-            stats.model_row("s", "glm", "pattern_id 4", p=0.2, engine=glm),
-            stats.model_row("s", "glmer", "pattern_id 4", p=0.3, engine=lme4)])
-        notes = stats.disagreements(table)
+        table = across_observers.model_table([
+            across_observers.model_row("s", "glm", "per edge", p=0.01, engine=glm),
+            across_observers.model_row("s", "glmer", "per edge", p=0.2, engine=lme4),
+            across_observers.model_row("s", "glm", "pattern_id 3", p=0.01, engine=glm),
+            across_observers.model_row("s", "glmer", "pattern_id 3", engine=lme4, note=across_observers.UNHELD_LOST_SLOPE),
+            across_observers.model_row("s", "glm", "pattern_id 4", p=0.2, engine=glm),
+            across_observers.model_row("s", "glmer", "pattern_id 4", p=0.3, engine=lme4)])
+        notes = across_observers.disagreements(table)
         self.assertEqual(len(notes), 1, notes)
         self.assertIn("per edge: the cluster-robust GLM says p = 0.010, the GLMM p = 0.200 - borderline", notes[0])
 
     def test_terms_in_words(self):
         d = pd.DataFrame({"edge": [3, 6, 9]})
-        self.assertEqual(stats.term_in_words("C(pattern_id)[1]", d), "pattern_id 1")
-        self.assertEqual(stats.term_in_words("C(edge)[T.6]", d), "edge 6 (against edge 3)")
-        self.assertEqual(stats.term_in_words("C(edge, levels=['9', '3'])[T.3]", d), "edge 3 (against edge 9)")
+        self.assertEqual(across_observers.term_in_words("C(pattern_id)[1]", d), "pattern_id 1")
+        self.assertEqual(across_observers.term_in_words("C(edge)[T.6]", d), "edge 6 (against edge 3)")
+        self.assertEqual(across_observers.term_in_words("C(edge, levels=['9', '3'])[T.3]", d), "edge 3 (against edge 9)")
         # A baseline level holding a comma and quotes is named whole (it was cut at the comma: 'against c naïve').
-        self.assertEqual(stats.term_in_words("C(c, levels=['naïve, µ \\'a\\'', 'Ω,<b>'])[T.Ω,<b>]", d),
+        self.assertEqual(across_observers.term_in_words("C(c, levels=['naïve, µ \\'a\\'', 'Ω,<b>'])[T.Ω,<b>]", d),
                          "c Ω,<b> (against c naïve, µ 'a')")
-        self.assertEqual(stats.term_in_words("Intercept", d), "baseline (intercept)")
-        self.assertEqual(stats.term_in_words("edge_c", d), "per edge (edge centred at 6)")
+        self.assertEqual(across_observers.term_in_words("Intercept", d), "baseline (intercept)")
+        self.assertEqual(across_observers.term_in_words("edge_c", d), "per edge (edge centred at 6)")
 
 
 class AgainstChanceIsExactTest(unittest.TestCase):

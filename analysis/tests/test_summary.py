@@ -10,7 +10,7 @@ import pandas as pd
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import any_study  # noqa: E402
 import design  # noqa: E402
-import stats  # noqa: E402
+import across_observers  # noqa: E402
 import study_tests  # noqa: E402
 
 # twofac.json's design: edge 3, 6, 9 x comparison (measured vs none, measured vs estimated), sides swapped in half.
@@ -93,7 +93,7 @@ class TwoParticipantsNoModel(unittest.TestCase):
         for who, (at5, at8) in {"P1": (9, 12), "P2": (10, 12)}.items():
             for edge, k in (("5", at5), ("8", at8)):
                 rows += [{"participant": who, "edge": edge, "y": float(j < k)} for j in range(12)]
-        table, notes = stats.observer_models(pd.DataFrame(rows), "y", "0 + C(edge)", study="s")
+        table, notes = across_observers.observer_models(pd.DataFrame(rows), "y", "0 + C(edge)", study="s")
         self.assertTrue(table.empty, table)
         self.assertEqual(len(notes), 1, notes)
         self.assertTrue(notes[0].startswith("two participants: too few for a model across participants"), notes)
