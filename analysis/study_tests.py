@@ -191,7 +191,8 @@ def against_chance_counts(k, n, chance, people=None):
 def summary_by_level(m, chance, what, by):
     """The summary per level of the factors `by` (their levels ask different questions: design.comparing_factors),
     never pooled across them; p Holm-adjusted over the levels. One line."""
-    parts = list(m.groupby([m[f].astype(str) for f in by], sort=True))
+    keys = [m[f].astype(str) for f in by]
+    parts = list(m.groupby(keys if len(keys) > 1 else keys[0], sort=True))  # one factor: its level, not a 1-tuple
     raw = [chance_p(d, chance) for _, d in parts]
     adjusted = stats.holm(raw)
     words = []
