@@ -60,3 +60,5 @@ add_test(NAME live_frame_of_another_size
                  -DEXPECT_CODE=3 "-DEXPECT_TEXT=small/frame-%04d.png, frame 0: is 574x382 but the camera (${LIVE_DIR}/take/camera.json) says 1148x764"
                  -DONE_LINE=1 -P ${PROJECT_SOURCE_DIR}/tests/expect_failure.cmake)
 set_tests_properties(live_frame_of_another_size PROPERTIES FIXTURES_REQUIRED live_small LABELS gl)
+# Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
+set_test_costs(live_make 47 cli_bench_live_quick 30)

@@ -64,3 +64,4 @@ add_test(NAME outputs_own_files
          COMMAND ${BLURCUE_EXPECT} "^ok:|\nok:" bash ${PROJECT_SOURCE_DIR}/tests/outputs_own_test.sh $<TARGET_FILE:blurcue> ${PROJECT_BINARY_DIR})
 set_tests_properties(outputs_own_files PROPERTIES FIXTURES_REQUIRED "scene;calib;session_protocols"
                      LABELS "gl;outputs" TIMEOUT 300)
+set_test_costs(outputs_own_files 38)  # started first on a fresh clone (seconds in one ctest -j2 run)
