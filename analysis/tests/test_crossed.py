@@ -45,8 +45,8 @@ class InteractionModel(unittest.TestCase):
             self.fail("R with lme4 is needed for this test (and is not installed): it cannot pass without it")
 
     def test_the_glmm_with_the_interaction_is_lme4s_own(self):
-        d = planted(people=5)  # 8 made the same checks at 47 s of R (a maximal random part to reduce), 5 at 19 s
-        chart = crossed.interaction_models(d, ["comparison", "edge"], "s", "5 participants", "y",
+        d = planted()
+        chart = crossed.interaction_models(d, ["comparison", "edge"], "s", "8 participants", "y",
                                            {"comparison": COMPARISONS, "edge": EDGES})
         t = chart.table
         glmm = t[t["engine"].str.startswith("lme4")]
