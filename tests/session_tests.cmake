@@ -143,7 +143,7 @@ add_preflight_test(speed-1e-300 "/factors/pattern/0/speed_cm_s: a speed must be 
 # Edges past the calibrated board (7 x 10 squares here) are named at once with one past any board (edge 12 used to be
 # refused only once edge 0 was fixed).
 set(cards "{\"name\": \"t\", \"version\": 1, \"content\": {\"type\": \"grid\", \"cells\": 5}, \"task\": \"forced_choice\", ${ball_scene}, \"sides\": {\"left\": \"measured\", \"right\": \"estimated\"}")
-add_preflight_test(edges-0-and-12 "/factors/edge/0: an edge must be an integer in [1, 11], the calibrated board's (7 x 10 squares: edges 1-11, sections 1-10), got 0\n${D}/edges-0-and-12.json: /factors/edge/3: an edge must be an integer in [1, 11], the calibrated board's (7 x 10 squares: edges 1-11, sections 1-10), got 12\n(2 problems)"
+add_preflight_test(edges-0-and-12 "/factors/edge/0: an edge must be an integer in [1, 11], the calibrated board's (7 x 10 squares: edges 1-11, sections 1-10 between them), got 0\n${D}/edges-0-and-12.json: /factors/edge/3: an edge must be an integer in [1, 11], the calibrated board's (7 x 10 squares: edges 1-11, sections 1-10 between them), got 12\n(2 problems)"
                    "${cards}, \"factors\": {\"edge\": [0, 5, 8, 12]}}")
 add_preflight_test(inter-trial-1e308 "/timing/inter_trial_ms: must be a number in [0, 60000] ms, got 1e+308"
                    "${ball_head} ${ball_scene}, \"factors\": {\"pattern\": [${pattern}]}, \"timing\": {\"inter_trial_ms\": 1e308}}")

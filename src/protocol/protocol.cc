@@ -661,7 +661,7 @@ std::set<double> NumericLevels(const Protocol& protocol, const std::string& fact
 
 std::string BoardLevelsText(int cols, int rows) {
   return std::to_string(cols) + " x " + std::to_string(rows) + " squares: edges 1-" + std::to_string(rows + 1) +
-         ", sections 1-" + std::to_string(rows);
+         ", sections 1-" + std::to_string(rows) + " between them";
 }
 
 std::string LevelText(double level) {

@@ -67,7 +67,7 @@ TEST(ProtocolValidate, EdgeOutsideAnyBoardRejected) {
       << OnlyProblem(j);
 }
 
-// With the calibrated board known (7 x 10 squares: edges 1-11, sections 1-10), every level past it is a problem of
+// With the calibrated board known (7 x 10 squares: edges 1-11, sections 1-10 between them), every level past it is a problem of
 // the one pass, beside one past any board: edges 0 and 12 and section 11 at once (edge 12 used to be refused alone,
 // by the trial list, once edge 0 was fixed).
 TEST(ProtocolValidate, EveryLevelPastTheCalibratedBoardIsNamedAtOnce) {
@@ -78,7 +78,7 @@ TEST(ProtocolValidate, EveryLevelPastTheCalibratedBoardIsNamedAtOnce) {
   ValidateOptions board;
   board.board_cols = 7, board.board_rows = 10;
   const auto problems = Validate(j, SceneFolder() / "p.json", board);
-  const std::string of_board = ", the calibrated board's (7 x 10 squares: edges 1-11, sections 1-10), got ";
+  const std::string of_board = ", the calibrated board's (7 x 10 squares: edges 1-11, sections 1-10 between them), got ";
   ASSERT_EQ(problems.size(), 3u) << ::testing::PrintToString(problems);
   EXPECT_TRUE(Contains(problems[0], ": /blocks/0/factors/section/2: a section (edge s to s + 1) must be an integer in "
                                     "[1, 10]" + of_board + "11")) << problems[0];
