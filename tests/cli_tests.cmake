@@ -164,7 +164,7 @@ add_test(NAME cli_calibrate_sharpened_scene_make
                  --post-filter sharpen --post-sigma-px 0.8 --post-amount 0.7 --quiet)
 set_tests_properties(cli_calibrate_sharpened_scene_make PROPERTIES FIXTURES_SETUP sharpened)
 add_test(NAME cli_calibrate_sharpened_warning_names_it
-         COMMAND ${BLURCUE_EXPECT} "warning: .*scene.png: the fitted aperture [0-9.]+ mm is 1.[3-5][0-9]* x the camera's .*: the photo was processed after it was sampled \\(the phase check found the optics then sharpening \\(unsharp mask of amount 0.[67][0-9], std 0.[6-9][0-9] px\\)\\).*\n[0-9]+ sections flagged flaw: printing spots near the edge, left out of the profile \\(the section is used\\).*\nmeasured: median r_px of the edge's usable sections; thesis: the thesis's pixel count"
+         COMMAND ${BLURCUE_EXPECT} "warning: .*scene.png: the fitted aperture [0-9.]+ mm is 1.[3-5][0-9]* x the camera's .*: the photo was processed after it was sampled \\(the phase check found the optics then sharpening \\(unsharp mask of amount 0.[67][0-9], std 0.[6-9][0-9] px\\)\\).*\n[0-9]+ sections flagged flaw: printing spots near the edge, left out of the profile \\(the section is used\\).*\nmeasured: the mean r_px of the edge's usable sections and of those pooled into the lens fit, the value blur source .measured. draws there.*; thesis: the thesis's pixel count"
                  ${BC} calibrate ${T}/sharpened/scene.png --camera ${T}/sharpened/camera.json --out ${T}/sharpened-calib.json)
 set_tests_properties(cli_calibrate_sharpened_warning_names_it PROPERTIES FIXTURES_REQUIRED sharpened)
 # animate --video killed midway left half a video under its final name: now it leaves the earlier one unchanged, and

@@ -354,19 +354,16 @@ void SummariseEdges(CalibResult* out, const optics::Lens& lens) {
           s.estimated_note = e.what();
         }
       }
-      if (s.fit.ok) {
-        ++edge.usable;
-        edge.r_px += s.fit.r_px;
-        edge.r_thesis_px += s.thesis.r_px;
-        if (s.r_estimated_px) ++edge.estimated, edge.r_estimated_px += *s.r_estimated_px;
-      }
+      // The edge's measured value is what blur source `measured` draws (scene_blur.cc): the mean over its usable
+      // sections and those pooled into the lens fit (phase.joins_fit). Eq. 3.7 needs only a section's depth.
+      if (s.fit.ok) ++edge.usable, edge.r_thesis_px += s.thesis.r_px;
+      if (s.fit.ok || s.phase.joins_fit) ++edge.measured, edge.r_px += s.fit.r_px;
+      if (s.r_estimated_px) ++edge.estimated, edge.r_estimated_px += *s.r_estimated_px;
     }
     edge.u_mm = su / edge.sections.size();
-    if (edge.usable > 0) {
-      edge.r_px /= edge.usable;
-      edge.r_thesis_px /= edge.usable;
-      if (edge.estimated > 0) edge.r_estimated_px /= edge.estimated;
-    }
+    if (edge.usable > 0) edge.r_thesis_px /= edge.usable;
+    if (edge.measured > 0) edge.r_px /= edge.measured;
+    if (edge.estimated > 0) edge.r_estimated_px /= edge.estimated;
   }
 }
 
@@ -571,16 +568,19 @@ std::string FormatEdgeTable(const CalibResult& r, const std::vector<double>& tru
       std::snprintf(value, sizeof value, unsure ? "(%.2f)" : "%.2f", e.r_fitted_px);
       std::snprintf(fitted, sizeof fitted, "%9s", value);
     }
-    if (e.usable == 0) {
-      const std::string none = "0/" + std::to_string(e.sections.size());
-      std::snprintf(line, sizeof line, "%4d %8.1f %6s %9s %9s %9s %s", e.index, e.u_mm, none.c_str(), "-", "-", "-",
-                    fitted);
-    } else {
-      char est[32] = "        -";  // eq. 3.7 does not hold nearer than focus
-      if (e.estimated > 0) std::snprintf(est, sizeof est, "%9.2f", e.r_estimated_px);
-      std::snprintf(line, sizeof line, "%4d %8.1f %4d/%d %9.2f %9.2f %s %s", e.index, e.u_mm, e.usable,
-                    int(e.sections.size()), e.r_px, e.r_thesis_px, est, fitted);
+    // measured: in brackets where only pooled readings give it (no usable section), '-' where nothing does (a
+    // session refuses `measured` there); eq. 3.7 '-' nearer than focus, where it does not hold.
+    char measured[32] = "        -", thesis[32] = "        -", est[32] = "        -";
+    if (e.measured > 0) {
+      char value[24];
+      std::snprintf(value, sizeof value, e.usable > 0 ? "%.2f" : "[%.2f]", e.r_px);
+      std::snprintf(measured, sizeof measured, "%9s", value);
     }
+    if (e.usable > 0) std::snprintf(thesis, sizeof thesis, "%9.2f", e.r_thesis_px);
+    if (e.estimated > 0) std::snprintf(est, sizeof est, "%9.2f", e.r_estimated_px);
+    const std::string usable = std::to_string(e.usable) + "/" + std::to_string(e.sections.size());
+    std::snprintf(line, sizeof line, "%4d %8.1f %6s %s %s %s %s", e.index, e.u_mm, usable.c_str(), measured, thesis,
+                  est, fitted);
     out += line;
     if (truth) {
       std::snprintf(line, sizeof line, " %9.2f", true_r_per_edge[i]);

@@ -66,10 +66,12 @@ struct EdgeResult {
   int index = 0;
   double u_mm = 0;  // mean depth of its sections
   std::vector<SectionResult> sections;
-  // Means over usable sections (NaN-free: count says how many were usable); r_fitted_px over every section (the
-  // model predicts each, usable or not).
+  // Means (NaN-free: each count says over how many): r_thesis_px over usable sections; r_px, the value blur source
+  // `measured` draws, over usable sections and those pooled into the lens fit (phase.joins_fit); r_estimated_px over
+  // the sections where eq. 3.7 holds; r_fitted_px over every section (the model predicts each, usable or not).
   int usable = 0;
-  int estimated = 0;  // usable sections where eq. 3.7 holds (r_estimated_px averages those)
+  int measured = 0;   // usable or pooled sections (r_px averages those)
+  int estimated = 0;  // sections where eq. 3.7 holds (r_estimated_px averages those)
   double r_px = 0, r_thesis_px = 0, r_estimated_px = 0, r_fitted_px = 0;
 };
 

@@ -350,7 +350,9 @@ void AddCalibrateCommand(CLI::App& app) {
     const std::vector<double> true_r =
         args->truth.empty() ? std::vector<double>() : PrintAgainstTruth(result, args->truth);
     std::printf("\n%s", calib::FormatEdgeTable(result, true_r).c_str());
-    std::printf("measured: median r_px of the edge's usable sections; thesis: the thesis's pixel count (r_thesis_px, "
+    std::printf("measured: the mean r_px of the edge's usable sections and of those pooled into the lens fit, the "
+                "value blur source `measured` draws there ([in brackets] where only pooled readings give it; '-': "
+                "refused); thesis: the thesis's pixel count (r_thesis_px, "
                 "section 4.3), kept for comparison with it only: it counts the edge's whole grey ramp and runs "
                 "several px over the optical blur; eq3.7: the thesis's estimate from reference edge %d; fitted: the "
                 "lens model's prediction (blur source `fitted`)%s%s\n\n",
