@@ -48,19 +48,6 @@ constexpr double kPoseUncertaintyPx = 0.15;
 constexpr double kAlikeChi2 = 25, kAlikeRel = 0.15;
 // The noise std (linear) is taken to be no less than this: a noise-free 8-bit image still has its quantisation.
 constexpr double kMinNoise = 5e-4;
-// A reading that moves by more than this among the families that fit alike is not identified (the target
-// is max(0.05 px, 10 %): a reading within the alike families' spread of a family that holds meets it with margin).
-constexpr double kSpreadPx = 0.04, kSpreadRel = 0.08;
-// A section at every phase under a chosen filter whose reading's standard error (ReadingSe) times this exceeds the
-// spread above is flagged: the reading is not pinned within the target. 2: on 16 boards turned 45-60 deg under a
-// mask (amount 0.7 over 0.6 px; seeds 2, 9, 11-16) the five sections off the rule unflagged, all on the board's outer
-// edges, had standard errors of 4.5-9.4 % (two of them 1.14 x the spread's 8 %); 24 of the 122 other outer-edge
-// sections measured were flagged with them, none of the 433 inner ones (1.8: 19; 2.5: 44 and 2 inner).
-constexpr double kSeSpan = 2;
-// The optics' own reading is good to about this (relative; the physical scenes' median error is 0.5-1.1 %, p90
-// 1.5-3.3 %): where a sharpening mask cancels most of it, the section's reading is flagged when an error this size moves
-// it past the spread above (CancellationPx). Readings under kOpticsFloorPx count as that (the error is not relative).
-constexpr double kOpticsRel = 0.02, kOpticsFloorPx = 0.05;
 // Sections every family is read on before the families that fit them far worse are ruled out (ReadPhaseFamilies).
 constexpr size_t kChoiceSections = 12;
 constexpr double kChoiceBins = 600;  // ... or fewer sections holding about this many profile points (ChoiceSections)
@@ -622,29 +609,6 @@ bool AtOwnFloor(const PhaseFamily& family, double r_px) {
   return r_px <= std::sqrt(std::max(0.0, 4 * TapsVariance(FamilyTaps(family)))) + 1e-3;
 }
 
-// Why a section on the board's outer edge is flagged where its reading moves with the table's slope, in words.
-std::string TableWhy(double r, double r_table) {
-  char why[400];
-  std::snprintf(why, sizeof why,
-                "on the board's outer edge the table beside it is not flat across the window (its texture): read with "
-                "the table's slope taken, this section reads %.2f px against %.2f px, more than max(%.2f px, %.0f %%) "
-                "apart; its blur is not identified; the lens fit predicts it",
-                r_table, r, kSpreadPx, 100 * kSpreadRel);
-  return why;
-}
-
-// Why a section at every phase is flagged where its reading's standard error is too large for the target, in words.
-std::string NoisyWhy(double r, double se, bool outer) {
-  char why[400];
-  std::snprintf(why, sizeof why,
-                "its profile pins its blur (%.2f px) to +-%.0f %% only (standard error, from the spread of its pixels "
-                "about the profile%s): two standard errors are more than max(%.2f px, %.0f %%); it joins the lens "
-                "fit, which pools such sections, and is predicted by it",
-                r, 100 * se / r, outer ? ", which on the board's outer edge takes in the table's texture" : "",
-                kSpreadPx, 100 * kSpreadRel);
-  return why;
-}
-
 // Sections of 2 px or more read with the families (ReadPhaseFamilies, where a filter fitted best): the chosen one's
 // (`best` of `nf`) reading, unflagged (the families that fit alike read them within 2-5 %) unless the table's slope
 // moves it (TableWhy; counted in `tabled`). Returns how many took it.
@@ -666,44 +630,12 @@ int TakeWideReadings(CalibResult& result, size_t best, size_t nf, int* tabled) {
   return wide;
 }
 
-// A flagged section's reason, in words (calib.json's phase_why and the summary).
-std::string PhaseWhy(const SectionResult& s, double lo, double hi, double r, double v, double moved, double nearest) {
-  char why[480];
-  const double target = std::max(kSpreadPx, kSpreadRel * r);
-  if (hi - lo <= target && moved <= target)
-    std::snprintf(why, sizeof why,
-                  "its reading under the chosen PSF family (%.2f px) lies %.2f px outside the neighbouring families' "
-                  "(from %.2f px), more than max(%.2f px, %.0f %%): the fit follows something in this profile "
-                  "that no family explains (a JPEG block, a flaw); the lens fit predicts it",
-                  r, std::abs(nearest - r), nearest, kSpreadPx, 100 * kSpreadRel);
-  else if (hi - lo > target && s.phase.every_phase)
-    std::snprintf(why, sizeof why,
-                  "the PSF families that fit the board's profiles alike read %.2f-%.2f px here (edge sampled at every "
-                  "phase): its blur is not identified; the lens fit predicts it",
-                  lo, hi);
-  else if (hi - lo > target)
-    std::snprintf(why, sizeof why,
-                  "the edge runs %.1f deg off the pixel axis, so its sub-pixel phase moves only %.2f px along the part "
-                  "measured (edge %.2f px past a pixel centre), and the PSF families that fit the board's profiles "
-                  "alike read %.2f-%.2f px here: its blur is not identified; the lens fit predicts it",
-                  s.phase.axis_deg, s.phase.span_px, s.phase.phase_px, lo, hi);
-  else
-    std::snprintf(why, sizeof why,
-                  "the photo was sharpened after sampling and here the mask cancels %.0f %% of the optics' blur "
-                  "(optics %.2f px, read %.2f px): a %.0f %% error in the optics' reading moves this one by %.2f px, "
-                  "more than max(%.2f px, %.0f %%); it joins the lens fit, which pools such sections, and is predicted "
-                  "by it",
-                  100 * std::min(1.0, -4 * v / (r * r - 4 * v)), std::sqrt(r * r - 4 * v), r, 100 * kOpticsRel, moved,
-                  kSpreadPx, 100 * kSpreadRel);
-  return why;
-}
-
 }  // namespace
 
 namespace {
 
 // ChoosePhaseFamily's summary: `flags` counts the flags by reason (cancelled, jumped, off their edge, unsure, moved by
-// the table's slope); `wide` the sections of 2 px or more read with the chosen family.
+// the table's slope, noisy at every phase); `wide` the sections of 2 px or more read with the chosen family.
 std::string ChoiceSummary(const PhaseChoice& choice, size_t best, const std::array<int, 6>& flags, int wide) {
   const std::vector<PhaseFamily>& families = choice.families;
   int n_alike = 0, n_read = 0;
@@ -821,29 +753,19 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
       s->phase.range_lo_px = std::min(s->phase.range_lo_px, r_table);
       s->phase.range_hi_px = std::max(s->phase.range_hi_px, r_table);
     }
-    // At every phase under a filter: the reading's own standard error (kSeSpan; NaN: not taken, a reading of 0).
-    const double se = s->phase.every_phase && best != 0 ? s->phase.families[best].r_se_px : 0;
-    const bool noisy_here = kSeSpan * se > target;
-    if (hi - lo <= target && moved <= target && jump <= target && table <= target && !noisy_here) {
+    if (hi - lo <= target && moved <= target && jump <= target && table <= target) {
       if (best == 0 && FlagUnsureAtItsPhase(s)) ++choice.flagged, ++unsure;
+      if (best != 0 && FlagNoisyAtEveryPhase(s, best, target)) ++choice.flagged, ++noisy;
       continue;
     }
     s->fit.ok = false;
     s->fit.flags.push_back("phase_limited");
-    const bool only_noisy = hi - lo <= target && moved <= target && jump <= target && table <= target;
-    if (only_noisy) {  // its range: +-kSeSpan standard errors (it joins the fit at its reading, as an unsure one)
-      s->phase.range_lo_px = std::min(s->phase.range_lo_px, std::max(0.0, r - kSeSpan * se));
-      s->phase.range_hi_px = std::max(s->phase.range_hi_px, r + kSeSpan * se);
-    }
-    s->fit.phase_why = table > target ? TableWhy(r, r_table)
-                       : only_noisy   ? NoisyWhy(r, se, std::isfinite(r_table))
-                                      : PhaseWhy(*s, lo, hi, r, v_best, moved, nearest);
+    s->fit.phase_why = table > target ? TableWhy(r, r_table) : PhaseWhy(*s, lo, hi, r, v_best, moved, nearest);
     s->phase.joins_fit = hi - lo <= target && jump <= target && table <= target;  // by the cancellation alone
     ++choice.flagged;
     tabled += table > target;
-    noisy += only_noisy;
     cancelled += hi - lo <= target && moved > target && table <= target;
-    jumped += hi - lo <= target && moved <= target && table <= target && !only_noisy;
+    jumped += hi - lo <= target && moved <= target && table <= target;
   }
   int wide_flagged = 0;
   const int wide = best != 0 ? TakeWideReadings(result, best, families.size(), &wide_flagged) : 0;
