@@ -422,6 +422,7 @@ Json PhaseCheckJson(const PhaseCheck& p) {
   for (const PhaseReading& f : p.families) {
     readings.push_back({{"r_px", f.r_px}, {"offset_px", f.offset_px}, {"rms_rel", f.rms_rel}, {"chi2", f.chi2}});
     if (std::isfinite(f.r_table_px)) readings.back()["r_table_px"] = f.r_table_px;  // on the board's outer edge
+    if (std::isfinite(f.r_se_px)) readings.back()["r_se_px"] = f.r_se_px;
   }
   return {{"axis_deg", p.axis_deg}, {"span_px", p.span_px}, {"every_phase", p.every_phase}, {"phase_px", p.phase_px}, {"noise", p.noise},
           {"bins", p.bins}, {"range_px", {p.range_lo_px, p.range_hi_px}}, {"joins_fit", p.joins_fit},

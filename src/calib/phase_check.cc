@@ -48,13 +48,6 @@ constexpr double kPoseUncertaintyPx = 0.15;
 constexpr double kAlikeChi2 = 25, kAlikeRel = 0.15;
 // The noise std (linear) is taken to be no less than this: a noise-free 8-bit image still has its quantisation.
 constexpr double kMinNoise = 5e-4;
-// A reading that moves by more than this among the families that fit alike is not identified (the target
-// is max(0.05 px, 10 %): a reading within the alike families' spread of a family that holds meets it with margin).
-constexpr double kSpreadPx = 0.04, kSpreadRel = 0.08;
-// The optics' own reading is good to about this (relative; the physical scenes' median error is 0.5-1.1 %, p90
-// 1.5-3.3 %): where a sharpening mask cancels most of it, the section's reading is flagged when an error this size moves
-// it past the spread above (CancellationPx). Readings under kOpticsFloorPx count as that (the error is not relative).
-constexpr double kOpticsRel = 0.02, kOpticsFloorPx = 0.05;
 // Sections every family is read on before the families that fit them far worse are ruled out (ReadPhaseFamilies).
 constexpr size_t kChoiceSections = 12;
 constexpr double kChoiceBins = 600;  // ... or fewer sections holding about this many profile points (ChoiceSections)
@@ -252,6 +245,35 @@ double RefineFamily(const std::vector<Bin>& bins, const std::vector<ProjectedTap
   return best;
 }
 
+// The standard error of a family's reading r = sqrt(r1^2 + 4 V) at its best p = {r1, d0, phi} (`res` its residuals
+// there): the noise through the inverse of J'J over the parameters the reading was fitted with (the shape too unless
+// `held`), the levels profiled out. The section's noise is the spread within its bins, so on a board's outer edge it
+// takes in the table's texture (the table beside the board varies along the edge, and a 0.1 px bin of a section at
+// every phase holds pixels from a few places along it): there the readings' standard errors were 2-9 % of the reading
+// (shape free), 3 times the inner edges'.
+double ReadingSe(const std::vector<Bin>& bins, const std::vector<ProjectedTap>& taps, const Across& across,
+                 const double* p, const std::vector<double>& res, bool held, double noise, double r) {
+  const int n = held ? 2 : 3;
+  std::vector<double> col[3];
+  const double h[3] = {1e-3, 1e-3, 2e-3};
+  for (int c = 0; c < n; ++c) {
+    double q[3] = {p[0], p[1], p[2]};
+    const double hc = c == 2 && q[2] + h[2] > kPi / 2 ? -h[2] : h[c];
+    q[c] += hc;
+    FamilyResiduals(bins, taps, q, across, &col[c]);
+    for (size_t i = 0; i < res.size(); ++i) col[c][i] = (col[c][i] - res[i]) / hc;
+  }
+  cv::Matx33d m = cv::Matx33d::eye();  // the shape's row and column stay the identity where it was held
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < n; ++b) {
+      m(a, b) = 0;
+      for (size_t i = 0; i < res.size(); ++i) m(a, b) += col[a][i] * col[b][i];
+    }
+  cv::Matx33d inv;
+  if (!(cv::invert(m, inv, cv::DECOMP_SVD) > 0) || !(inv(0, 0) >= 0)) return std::numeric_limits<double>::infinity();
+  return std::max(p[0], 0.02) / r * noise * std::sqrt(inv(0, 0));  // dr/dr1 = r1 / r
+}
+
 // The optics' radius r1, the edge's position d0 (within the pose's uncertainty of the line the pose gives) and the
 // optics' shape phi that fit best under one family: a grid for the radius at two shapes, the blur fit's and another
 // (the sum of squares may have a shoulder where r1 meets the taps' own spread), then all three at once from the best
@@ -259,7 +281,7 @@ double RefineFamily(const std::vector<Bin>& bins, const std::vector<ProjectedTap
 // turns of one-dimensional searches with the blur fit's shape settled on a ridge, 2-5 % short of the true reading with
 // the true family on sharpened scenes (amount 0.5), so that a wrong family fitted better.
 PhaseReading ReadFamilyAs(const std::vector<Bin>& bins, const PhaseFamily& family, double r_fit, double phi_fit,
-                          const Across& across, double noise, bool one_shape) {
+                          const Across& across, double noise, bool one_shape, bool se = false) {
   const std::vector<double> taps1 = FamilyTaps(family);
   const std::vector<ProjectedTap> taps = ProjectTaps(taps1, across.w1, across.w2);
   std::vector<double> res;
@@ -284,7 +306,8 @@ PhaseReading ReadFamilyAs(const std::vector<Bin>& bins, const PhaseFamily& famil
   // Where the blur fit found the shape ambiguous under a pixel and read the size as a Gaussian (edge_blur.cc), the
   // family's optics under a pixel are read so too: a shape the profile cannot tell moved the optics-alone reading
   // 8-20 % off on physical optics, and it off its neighbouring families' readings (disc x 0.2 px floor).
-  if (one_shape && p[0] < kOneShapeBelowPx) {
+  const bool held = one_shape && p[0] < kOneShapeBelowPx;
+  if (held) {
     p[2] = kPi / 2;
     RefineFamily(bins, taps, across, p, /*hold_shape=*/true);
   }
@@ -302,6 +325,7 @@ PhaseReading ReadFamilyAs(const std::vector<Bin>& bins, const PhaseFamily& famil
   out.offset_px = d0;
   out.rms_rel = std::abs(step) > 1e-9 ? std::sqrt(sse / std::max(w, 1.0)) / std::abs(step) : 1e9;
   out.chi2 = sse / (noise * noise);
+  if (se && ok && out.r_px > 0) out.r_se_px = ReadingSe(bins, taps, across, p, res, held, noise, out.r_px);
   return out;
 }
 
@@ -312,7 +336,7 @@ PhaseReading ReadFamilyAs(const std::vector<Bin>& bins, const PhaseFamily& famil
 PhaseReading ReadFamily(const std::vector<Bin>& bins, const PhaseFamily& family, double r_fit, double phi_fit,
                         const Across& across, double noise, bool one_shape, bool table = true) {
   const Across plain{across.w1, across.w2, 0};
-  PhaseReading out = ReadFamilyAs(bins, family, r_fit, phi_fit, plain, noise, one_shape);
+  PhaseReading out = ReadFamilyAs(bins, family, r_fit, phi_fit, plain, noise, one_shape, /*se=*/table);
   if (table && across.free_side != 0)
     out.r_table_px = ReadFamilyAs(bins, family, r_fit, phi_fit, across, noise, one_shape).r_px;
   return out;
@@ -585,17 +609,6 @@ bool AtOwnFloor(const PhaseFamily& family, double r_px) {
   return r_px <= std::sqrt(std::max(0.0, 4 * TapsVariance(FamilyTaps(family)))) + 1e-3;
 }
 
-// Why a section on the board's outer edge is flagged where its reading moves with the table's slope, in words.
-std::string TableWhy(double r, double r_table) {
-  char why[400];
-  std::snprintf(why, sizeof why,
-                "on the board's outer edge the table beside it is not flat across the window (its texture): read with "
-                "the table's slope taken, this section reads %.2f px against %.2f px, more than max(%.2f px, %.0f %%) "
-                "apart; its blur is not identified; the lens fit predicts it",
-                r_table, r, kSpreadPx, 100 * kSpreadRel);
-  return why;
-}
-
 // Sections of 2 px or more read with the families (ReadPhaseFamilies, where a filter fitted best): the chosen one's
 // (`best` of `nf`) reading, unflagged (the families that fit alike read them within 2-5 %) unless the table's slope
 // moves it (TableWhy; counted in `tabled`). Returns how many took it.
@@ -617,50 +630,18 @@ int TakeWideReadings(CalibResult& result, size_t best, size_t nf, int* tabled) {
   return wide;
 }
 
-// A flagged section's reason, in words (calib.json's phase_why and the summary).
-std::string PhaseWhy(const SectionResult& s, double lo, double hi, double r, double v, double moved, double nearest) {
-  char why[480];
-  const double target = std::max(kSpreadPx, kSpreadRel * r);
-  if (hi - lo <= target && moved <= target)
-    std::snprintf(why, sizeof why,
-                  "its reading under the chosen PSF family (%.2f px) lies %.2f px outside the neighbouring families' "
-                  "(from %.2f px), more than max(%.2f px, %.0f %%): the fit follows something in this profile "
-                  "that no family explains (a JPEG block, a flaw); the lens fit predicts it",
-                  r, std::abs(nearest - r), nearest, kSpreadPx, 100 * kSpreadRel);
-  else if (hi - lo > target && s.phase.every_phase)
-    std::snprintf(why, sizeof why,
-                  "the PSF families that fit the board's profiles alike read %.2f-%.2f px here (edge sampled at every "
-                  "phase): its blur is not identified; the lens fit predicts it",
-                  lo, hi);
-  else if (hi - lo > target)
-    std::snprintf(why, sizeof why,
-                  "the edge runs %.1f deg off the pixel axis, so its sub-pixel phase moves only %.2f px along the part "
-                  "measured (edge %.2f px past a pixel centre), and the PSF families that fit the board's profiles "
-                  "alike read %.2f-%.2f px here: its blur is not identified; the lens fit predicts it",
-                  s.phase.axis_deg, s.phase.span_px, s.phase.phase_px, lo, hi);
-  else
-    std::snprintf(why, sizeof why,
-                  "the photo was sharpened after sampling and here the mask cancels %.0f %% of the optics' blur "
-                  "(optics %.2f px, read %.2f px): a %.0f %% error in the optics' reading moves this one by %.2f px, "
-                  "more than max(%.2f px, %.0f %%); it joins the lens fit, which pools such sections, and is predicted "
-                  "by it",
-                  100 * std::min(1.0, -4 * v / (r * r - 4 * v)), std::sqrt(r * r - 4 * v), r, 100 * kOpticsRel, moved,
-                  kSpreadPx, 100 * kSpreadRel);
-  return why;
-}
-
 }  // namespace
 
 namespace {
 
 // ChoosePhaseFamily's summary: `flags` counts the flags by reason (cancelled, jumped, off their edge, unsure, moved by
-// the table's slope); `wide` the sections of 2 px or more read with the chosen family.
-std::string ChoiceSummary(const PhaseChoice& choice, size_t best, const std::array<int, 5>& flags, int wide) {
+// the table's slope, noisy at every phase); `wide` the sections of 2 px or more read with the chosen family.
+std::string ChoiceSummary(const PhaseChoice& choice, size_t best, const std::array<int, 6>& flags, int wide) {
   const std::vector<PhaseFamily>& families = choice.families;
   int n_alike = 0, n_read = 0;
   for (const bool a : choice.alike) n_alike += a;
   for (const double c : choice.chi2) n_read += std::isfinite(c);
-  char text[1000], ruled[120] = "";
+  char text[1100], ruled[120] = "";
   if (n_read < int(families.size()))
     std::snprintf(ruled, sizeof ruled, "; %zu ruled out on %zu sections at spread phases and not read on the rest",
                   families.size() - n_read, choice.choice_sections);
@@ -670,10 +651,12 @@ std::string ChoiceSummary(const PhaseChoice& choice, size_t best, const std::arr
                 "best as %s (%d of the kinds fit alike, chi-square per point %.2f, 1 where only the noise is left%s); %d "
                 "flagged phase_limited (%d where the sharpening cancels most of the lens's blur, %d jumping between "
                 "neighbouring kinds, %d off the line through their edge's other sections, %d too unsure near a pixel "
-                "centre, %d on the board's outer edge moved by the table's slope; each reading's range in calib.json); "
+                "centre, %d on the board's outer edge moved by the table's slope, %d at every phase whose standard "
+                "error leaves the target; each reading's range in calib.json); "
                 "%d sections of %.0f px or more read with it too",
                 choice.limited, kMaxBlurPx, choice.every_phase, families.size(), families[best].Name().c_str(), n_alike,
-                choice.chi2_per_point, ruled, choice.flagged, flags[0], flags[1], flags[2], flags[3], flags[4], wide,
+                choice.chi2_per_point, ruled, choice.flagged, flags[0], flags[1], flags[2], flags[3], flags[4], flags[5],
+                wide,
                 kMaxBlurPx);
   return text;
 }
@@ -736,7 +719,7 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   choice.chi2_per_point = raw[best] / dof;
   const double v_best = TapsVariance(FamilyTaps(families[best]));
   choice.variance_px2 = v_best;
-  int cancelled = 0, jumped = 0, unsure = 0, tabled = 0;
+  int cancelled = 0, jumped = 0, unsure = 0, tabled = 0, noisy = 0;
   // A filter fitted between the families has no neighbours along one axis that bracket its reading.
   const std::vector<size_t> neighbours = best < PhaseFamilies().size() ? PhaseNeighbours(best) : std::vector<size_t>{};
   for (SectionResult* s : limited) {
@@ -772,6 +755,7 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
     }
     if (hi - lo <= target && moved <= target && jump <= target && table <= target) {
       if (best == 0 && FlagUnsureAtItsPhase(s)) ++choice.flagged, ++unsure;
+      if (best != 0 && FlagNoisyAtEveryPhase(s, best, target)) ++choice.flagged, ++noisy;
       continue;
     }
     s->fit.ok = false;
@@ -791,7 +775,7 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   // would be flagged for noise the targets allow.
   const int off_edge = best != 0 ? FlagOffTheirEdge(result) : 0;
   choice.flagged += off_edge;
-  choice.summary = ChoiceSummary(choice, best, {cancelled, jumped, off_edge, unsure, tabled}, wide);
+  choice.summary = ChoiceSummary(choice, best, {cancelled, jumped, off_edge, unsure, tabled, noisy}, wide);
   return choice;
 }
 

@@ -39,6 +39,9 @@ struct PhaseReading {
   // On a board's outer edge, where the table's texture may slope across the window: r_px read with that slope as one
   // more linear term (NaN elsewhere). ChoosePhaseFamily flags a section whose two readings differ by the target.
   double r_table_px = std::numeric_limits<double>::quiet_NaN();
+  // r_px's standard error (the section's noise through the fit; ReadingSe), NaN where not taken (the refinement
+  // between families), infinite where the profile does not bound it.
+  double r_se_px = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct PhaseCheck {

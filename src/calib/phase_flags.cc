@@ -289,4 +289,67 @@ void PropagateModelError(CalibResult& result, const optics::Lens& lens, const op
   p.undetermined = text;
 }
 
+std::string TableWhy(double r, double r_table) {
+  char why[400];
+  std::snprintf(why, sizeof why,
+                "on the board's outer edge the table beside it is not flat across the window (its texture): read with "
+                "the table's slope taken, this section reads %.2f px against %.2f px, more than max(%.2f px, %.0f %%) "
+                "apart; its blur is not identified; the lens fit predicts it",
+                r_table, r, kSpreadPx, 100 * kSpreadRel);
+  return why;
+}
+
+std::string PhaseWhy(const SectionResult& s, double lo, double hi, double r, double v, double moved, double nearest) {
+  char why[480];
+  const double target = std::max(kSpreadPx, kSpreadRel * r);
+  if (hi - lo <= target && moved <= target)
+    std::snprintf(why, sizeof why,
+                  "its reading under the chosen PSF family (%.2f px) lies %.2f px outside the neighbouring families' "
+                  "(from %.2f px), more than max(%.2f px, %.0f %%): the fit follows something in this profile "
+                  "that no family explains (a JPEG block, a flaw); the lens fit predicts it",
+                  r, std::abs(nearest - r), nearest, kSpreadPx, 100 * kSpreadRel);
+  else if (hi - lo > target && s.phase.every_phase)
+    std::snprintf(why, sizeof why,
+                  "the PSF families that fit the board's profiles alike read %.2f-%.2f px here (edge sampled at every "
+                  "phase): its blur is not identified; the lens fit predicts it",
+                  lo, hi);
+  else if (hi - lo > target)
+    std::snprintf(why, sizeof why,
+                  "the edge runs %.1f deg off the pixel axis, so its sub-pixel phase moves only %.2f px along the part "
+                  "measured (edge %.2f px past a pixel centre), and the PSF families that fit the board's profiles "
+                  "alike read %.2f-%.2f px here: its blur is not identified; the lens fit predicts it",
+                  s.phase.axis_deg, s.phase.span_px, s.phase.phase_px, lo, hi);
+  else
+    std::snprintf(why, sizeof why,
+                  "the photo was sharpened after sampling and here the mask cancels %.0f %% of the optics' blur "
+                  "(optics %.2f px, read %.2f px): a %.0f %% error in the optics' reading moves this one by %.2f px, "
+                  "more than max(%.2f px, %.0f %%); it joins the lens fit, which pools such sections, and is predicted "
+                  "by it",
+                  100 * std::min(1.0, -4 * v / (r * r - 4 * v)), std::sqrt(r * r - 4 * v), r, 100 * kOpticsRel, moved,
+                  kSpreadPx, 100 * kSpreadRel);
+  return why;
+}
+
+bool FlagNoisyAtEveryPhase(SectionResult* s, size_t best, double target) {
+  if (!s->phase.every_phase || best >= s->phase.families.size()) return false;
+  const PhaseReading& f = s->phase.families[best];
+  const double r = f.r_px, se = f.r_se_px;
+  if (!(kSeSpan * se > target)) return false;  // NaN: not taken (a reading of 0)
+  char why[420];
+  std::snprintf(why, sizeof why,
+                "its profile pins its blur (%.2f px) to +-%.0f %% only (standard error, from the spread of its pixels "
+                "about the profile%s): %.0f standard errors are more than max(%.2f px, %.0f %%); it joins the lens fit, "
+                "which pools such sections, and is predicted by it",
+                r, 100 * se / std::max(r, 1e-9),
+                std::isfinite(f.r_table_px) ? ", which on the board's outer edge takes in the table's texture" : "",
+                kSeSpan, kSpreadPx, 100 * kSpreadRel);
+  s->fit.ok = false;
+  s->fit.flags.push_back("phase_limited");
+  s->fit.phase_why = why;
+  s->phase.joins_fit = true;
+  s->phase.range_lo_px = std::min(s->phase.range_lo_px, std::max(0.0, r - kSeSpan * se));
+  s->phase.range_hi_px = std::max(s->phase.range_hi_px, r + kSeSpan * se);
+  return true;
+}
+
 }  // namespace blurcue::calib
