@@ -156,17 +156,19 @@ endforeach()
 # the board, printing flaws. The aperture came out 1.40 x and the warning blamed covered edges or the f-number, not
 # the sharpening the phase check had found; the summary never said what poor_fit or the flaws meant, nor that the
 # table's thesis column is the thesis's pixel count (several px over the optical blur). Since the sections over 2 px
-# are read with the chosen mask (phase_check.h, PhaseCheck::wide) that scene's aperture is 1.23 x (its sections'
-# median error 5.2 -> 0.5 %), inside two thirds of a stop, so the scene is now a mask of amount 0.7 over 0.8 px:
-# 1.44 x before, 1.33 x now.
+# are read with the chosen mask (phase_check.h, PhaseCheck::wide) that scene's aperture was 1.23 x, so the scene
+# became a mask of amount 0.7 over 0.8 px: 1.44 x, then 1.33 x with the warning naming the sharpening. Since the
+# sections the mask cancels to 0 px are bounds, not values (PhaseCheck::bound, model.cancel_px2), the lens is fitted
+# right there: focus 305 mm for 300, aperture 1.05 x, and no warning (the output starts with the board; a warning
+# would come first).
 add_test(NAME cli_calibrate_sharpened_scene_make
          COMMAND ${BC} synth-scene --out ${T}/sharpened --seed 3 --noise 0.003 --focus-mm 300 --flaws 20
                  --post-filter sharpen --post-sigma-px 0.8 --post-amount 0.7 --quiet)
 set_tests_properties(cli_calibrate_sharpened_scene_make PROPERTIES FIXTURES_SETUP sharpened)
-add_test(NAME cli_calibrate_sharpened_warning_names_it
-         COMMAND ${BLURCUE_EXPECT} "warning: .*scene.png: the fitted aperture [0-9.]+ mm is 1.[3-5][0-9]* x the camera's .*: the photo was processed after it was sampled \\(the phase check found the optics then sharpening \\(unsharp mask of amount 0.[67][0-9], std 0.[6-9][0-9] px\\)\\).*\n[0-9]+ sections flagged flaw: printing spots near the edge, left out of the profile \\(the section is used\\).*\nmeasured: the mean r_px of the edge's usable sections and of those pooled into the lens fit, the value blur source .measured. draws there.*; thesis: the thesis's pixel count"
+add_test(NAME cli_calibrate_sharpened_fits_the_lens
+         COMMAND ${BLURCUE_EXPECT} "^board 7x10 found.*\nfitted thin_lens(\\+floor)? model: focus 30[0-9]\\.[0-9] mm, aperture 3\\.[7-9][0-9]* mm \\(nominal 3.750\\).*\n[0-9]+ sections flagged flaw: printing spots near the edge, left out of the profile \\(the section is used\\).*\nmeasured: the mean r_px of the edge's usable sections and of those pooled into the lens fit, the value blur source .measured. draws there.*; thesis: the thesis's pixel count"
                  ${BC} calibrate ${T}/sharpened/scene.png --camera ${T}/sharpened/camera.json --out ${T}/sharpened-calib.json)
-set_tests_properties(cli_calibrate_sharpened_warning_names_it PROPERTIES FIXTURES_REQUIRED sharpened)
+set_tests_properties(cli_calibrate_sharpened_fits_the_lens PROPERTIES FIXTURES_REQUIRED sharpened)
 # animate --video killed midway left half a video under its final name: now it leaves the earlier one unchanged, and
 # the next run removes the partial folder (tests/animate_kill_test.sh).
 add_test(NAME cli_animate_video_killed

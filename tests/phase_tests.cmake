@@ -138,6 +138,15 @@ phase_scene(sharpen_09_seed12 --focus-mm 430 --floor-sigma-px 0.5 --post-filter 
             --post-amount 0.25 --noise 0.002 --seed 12)
 phase_check(phase_filtered_sharpen_09_seed12 sharpen_09_seed12 "fitted between the families.*\nok: filtered targets met"
             --expect filtered --undetermined-covers)
+# A mask that cancels the optics' whole blur on four edges (0.7 over 0.8 px, 1.34 px of it) with focus in front of the
+# board (330 mm; a first-time experimenter's scene): their 28 sections read 0 px. Joined to the lens fit at that bound
+# as values, they put its focus at 375 mm and drew 0.65, 0.25, 0.12, 0.45 px on edges 1-4 (true 0) and 1.02 px for a
+# true 0.82 px on edge 6 (model p90 far past 5 %). As bounds (PhaseCheck::bound) with the mask beyond the floor taken
+# from the thin lens too (model.cancel_px2): focus 330.7 mm, every section's model within median 0.5 %, p90 0.6 %.
+phase_scene(sharpen_07_08_front --focus-mm 330 --post-filter sharpen --post-sigma-px 0.8 --post-amount 0.7 --noise 0.004
+            --seed 3)
+phase_check(phase_filtered_sharpen_07_08_front sharpen_07_08_front "28 sections read 0 px, a bound.*\nok: filtered targets met"
+            --expect filtered)
 # Amount 0.5 over 0.8 px (-0.32 px^2): the mask cancels the whole second moment near focus (truth 0 on edges 4-8),
 # where 55-57 sections are flagged; 1-3 others read 0.07-0.1 px off unflagged before. The lens model breaks here
 # (no thin lens bends to that), so the sections alone are held, and the model's misses must lie within the depths

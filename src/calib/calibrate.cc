@@ -425,7 +425,7 @@ Json PhaseCheckJson(const PhaseCheck& p) {
     if (std::isfinite(f.r_se_px)) readings.back()["r_se_px"] = f.r_se_px;
   }
   return {{"axis_deg", p.axis_deg}, {"span_px", p.span_px}, {"every_phase", p.every_phase}, {"phase_px", p.phase_px}, {"noise", p.noise},
-          {"bins", p.bins}, {"range_px", {p.range_lo_px, p.range_hi_px}}, {"joins_fit", p.joins_fit},
+          {"bins", p.bins}, {"range_px", {p.range_lo_px, p.range_hi_px}}, {"joins_fit", p.joins_fit}, {"bound", p.bound},
           {"families", readings}};
 }
 
@@ -529,7 +529,7 @@ Json CalibToJson(const CalibResult& r) {
       {"reference_edge", r.reference_edge},
       {"reference", {{"u_mm", r.reference_u_mm}, {"r_px", r.reference_r_px}}},
       {"model", {{"kind", m.kind}, {"focus_mm", std::isinf(m.focus_mm) ? Json("infinity") : Json(m.focus_mm)},
-                 {"aperture_mm", m.aperture_mm}, {"floor_px", m.floor_px},
+                 {"aperture_mm", m.aperture_mm}, {"floor_px", m.floor_px}, {"cancel_px2", m.cancel_px2},
                  // floor_px stays a number (the model predicts with it); whether the sections pin it is said here.
                  {"floor_determined", m.floor_determined}, {"rms_px", m.rms_px},
                  {"loo_rms_px", m.loo_rms_px}, {"samples_used", m.samples_used}, {"outliers", m.outliers},

@@ -635,8 +635,9 @@ int TakeWideReadings(CalibResult& result, size_t best, size_t nf, int* tabled) {
 namespace {
 
 // ChoosePhaseFamily's summary: `flags` counts the flags by reason (cancelled, jumped, off their edge, unsure, moved by
-// the table's slope, noisy at every phase); `wide` the sections of 2 px or more read with the chosen family.
-std::string ChoiceSummary(const PhaseChoice& choice, size_t best, const std::array<int, 6>& flags, int wide) {
+// the table's slope, noisy at every phase, read apart by the families that fit alike); `wide` the sections of 2 px or
+// more read with the chosen family.
+std::string ChoiceSummary(const PhaseChoice& choice, size_t best, const std::array<int, 7>& flags, int wide) {
   const std::vector<PhaseFamily>& families = choice.families;
   int n_alike = 0, n_read = 0;
   for (const bool a : choice.alike) n_alike += a;
@@ -649,13 +650,15 @@ std::string ChoiceSummary(const PhaseChoice& choice, size_t best, const std::arr
                 "%d sections with blur under %.0f px along the pixel rows or columns (and %d at every phase) read under "
                 "%zu kinds of blur (the lens alone, or then a smoothing or sharpening of the pixels): the photo fits "
                 "best as %s (%d of the kinds fit alike, chi-square per point %.2f, 1 where only the noise is left%s); %d "
-                "flagged phase_limited (%d where the sharpening cancels most of the lens's blur, %d jumping between "
+                "flagged phase_limited (%d where the kinds that fit alike read apart, %d where the sharpening cancels "
+                "most of the lens's blur, %d jumping between "
                 "neighbouring kinds, %d off the line through their edge's other sections, %d too unsure near a pixel "
                 "centre, %d on the board's outer edge moved by the table's slope, %d at every phase whose standard "
                 "error leaves the target; each reading's range in calib.json); "
                 "%d sections of %.0f px or more read with it too",
                 choice.limited, kMaxBlurPx, choice.every_phase, families.size(), families[best].Name().c_str(), n_alike,
-                choice.chi2_per_point, ruled, choice.flagged, flags[0], flags[1], flags[2], flags[3], flags[4], flags[5],
+                choice.chi2_per_point, ruled, choice.flagged, flags[6], flags[0], flags[1], flags[2], flags[3], flags[4],
+                flags[5],
                 wide,
                 kMaxBlurPx);
   return text;
@@ -719,7 +722,7 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   choice.chi2_per_point = raw[best] / dof;
   const double v_best = TapsVariance(FamilyTaps(families[best]));
   choice.variance_px2 = v_best;
-  int cancelled = 0, jumped = 0, unsure = 0, tabled = 0, noisy = 0;
+  int cancelled = 0, jumped = 0, unsure = 0, tabled = 0, noisy = 0, apart = 0;
   // A filter fitted between the families has no neighbours along one axis that bracket its reading.
   const std::vector<size_t> neighbours = best < PhaseFamilies().size() ? PhaseNeighbours(best) : std::vector<size_t>{};
   for (SectionResult* s : limited) {
@@ -760,12 +763,21 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
     }
     s->fit.ok = false;
     s->fit.flags.push_back("phase_limited");
-    s->fit.phase_why = table > target ? TableWhy(r, r_table) : PhaseWhy(*s, lo, hi, r, v_best, moved, nearest);
     s->phase.joins_fit = hi - lo <= target && jump <= target && table <= target;  // by the cancellation alone
+    // Read 0 under a mask: a bound (PhaseCheck::bound). Joined at it, as a value, 28 such sections of a scene focused
+    // in front of the board (mask 0.7 over 0.8 px, focus 330 mm) put the fit's focus at 375 mm and its blur 24 % high
+    // on the next edge. Its range: 0 to the blur an error of kOpticsRel in the optics' second moment leaves.
+    if (s->phase.joins_fit && v_best < 0 && r < kCancelledPx) {
+      s->phase.joins_fit = false, s->phase.bound = true;
+      s->phase.range_lo_px = 0;
+      s->phase.range_hi_px = std::sqrt(std::max(r * r, 2 * kOpticsRel * (r * r - 4 * v_best)));
+    }
+    s->fit.phase_why = table > target ? TableWhy(r, r_table) : PhaseWhy(*s, lo, hi, r, v_best, moved, nearest);
     ++choice.flagged;
     tabled += table > target;
     cancelled += hi - lo <= target && moved > target && table <= target;
     jumped += hi - lo <= target && moved <= target && table <= target;
+    apart += hi - lo > target && table <= target;
   }
   int wide_flagged = 0;
   const int wide = best != 0 ? TakeWideReadings(result, best, families.size(), &wide_flagged) : 0;
@@ -775,7 +787,7 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   // would be flagged for noise the targets allow.
   const int off_edge = best != 0 ? FlagOffTheirEdge(result) : 0;
   choice.flagged += off_edge;
-  choice.summary = ChoiceSummary(choice, best, {cancelled, jumped, off_edge, unsure, tabled, noisy}, wide);
+  choice.summary = ChoiceSummary(choice, best, {cancelled, jumped, off_edge, unsure, tabled, noisy, apart}, wide);
   return choice;
 }
 

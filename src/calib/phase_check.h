@@ -75,6 +75,10 @@ struct PhaseCheck {
   // Flagged for its standard error alone (FlagUnsureAtItsPhase: an edge near a pixel centre under a pixel of blur)
   // joins it too: its reading is unbiased but noisy, and pooled it pins the model near focus.
   bool joins_fit = false;
+  // Its reading under a sharpening family is under kCancelledPx: the mask cancels the optics' whole second moment
+  // there, so the reading is a bound (the optics' blur at most the mask's), not a value: it does not join the lens fit
+  // at it, and its range (0 to what kOpticsRel of the optics' blur leaves) holds the model instead.
+  bool bound = false;
 };
 
 // The families read (the optics alone first).

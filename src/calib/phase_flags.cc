@@ -33,6 +33,9 @@ double OpticsPx(double r_photo_px, double stretch, double v) {
 optics::FittedModel WithFilter(optics::FittedModel m, double v) {
   auto through = [v](double x) { return std::isfinite(x) ? std::sqrt(std::max(0.0, x * x + 4 * v)) : x; };
   const bool cancelled = m.floor_px * m.floor_px + 4 * v <= 0;
+  // Beyond the floor the sharpening cancels the thin lens's blur too (a mask of 0.7 over 0.8 px, 1.34 px of it, over a
+  // lens with no floor: taken from the floor alone, the model drew the optics' blur, 1.57 px for a true 0.82 px).
+  m.cancel_px2 = cancelled ? m.floor_px * m.floor_px + 4 * v : 0;
   m.floor_px = through(m.floor_px);
   m.floor_candidate_px = through(m.floor_candidate_px);
   m.floor_lo_px = through(m.floor_lo_px), m.floor_hi_px = through(m.floor_hi_px);
@@ -168,19 +171,19 @@ constexpr double kModelSeRel = 0.05;
 // from focus the model erred 1-3 % with a standard error of 0.3-0.9 %. With 0.4 % there, p90 1.4-1.7 and 0-4.5 % of the
 // sections beyond 2 (a normal's 1.64 and 4.6 %); 0.7 % overstated it (p90 0.9-1.2).
 constexpr double kReadingRel = 0.004;
-// A section in the fit read under this (px) reads the mask cancelling the blur's whole second moment: its profile
-// reads 0, and its optics' reading sqrt(-4 v) is a bound, not a value (the tests' scale for a blur near 0). Where most
-// of an edge's sections in the fit, kCancelledMin or more, read so, the board has such depths (one alone is the noise:
+// Where most of an edge's sections in the fit or held by their bound (PhaseCheck::bound), kCancelledMin or more, read
+// under kCancelledPx, the board has depths where the mask cancels the whole blur (one alone is the noise:
 // mask 0.7 over 0.6 px, seed 2, the only one of edge 5's sections in the fit read 0 for a true 0.16 px, its neighbours
 // 0.15-0.17 px; where the whole blur cancels, 4 edges' 28 sections read 0).
-constexpr double kCancelledPx = 0.05;
 constexpr int kCancelledMin = 3;
-// There the model's form fails, not its scatter: fitted through those bounds it erred by 1-4 % in the optics' blur at
-// every other depth (mask 0.35 over 0.9 px, focus 450 mm, seeds 1-6: +8.9 % at 0.72 px, +18 % at 0.48 px; the
-// standard error 2-3 % there). This error in place of kReadingRel, magnified by r_optics^2 / r^2, names the depths
-// where it can exceed 5 %: all but the farthest from focus (there within 0.2 %); |error| / standard error median 0.69,
-// p90 1.42.
-constexpr double kCancelledRel = 0.03;
+// There the model rests on the other edges alone, those bounds holding it through their ranges (PhaseCheck::bound):
+// the readings' own error is taken at kCancelledRel in place of kReadingRel, magnified by r_optics^2 / r^2. Fitted
+// through the bounds as values it erred by 1-4 % in the optics' blur at every other depth (mask 0.35 over 0.9 px, focus
+// 450 mm, seeds 1-6: +8.9 % at 0.72 px, +18 % at 0.48 px) and took 3 %, which named the whole board. As bounds, on
+// seeds 1-6 (masks 0.35 over 0.9 px focus 450 mm, 0.5 over 0.8 px): 0.4 % named 396-508 and 377-500 mm with the
+// model's p90 4.9 % and 3.6 % outside (|error| / standard error p90 1.84, 1.64); 1 % names 389-527 and 369-515 mm,
+// p90 2.5 % and 3.3 % outside (p90 0.83, 0.79), none missing 5 %: 1 % keeps a margin.
+constexpr double kCancelledRel = 0.01;
 
 // d PredictPx(u) / d (focus, aperture[, floor]) by central differences; the floor where the model has one.
 std::vector<double> ModelGradient(const optics::FittedModel& m, const optics::Lens& lens, double u_mm) {
@@ -216,9 +219,10 @@ void PropagateModelError(CalibResult& result, const optics::Lens& lens, const op
     double zero_lo = 1e300, zero_hi = -1e300;
     for (const auto& s : edge.sections) {
       u_lo = std::min(u_lo, s.u_mm), u_hi = std::max(u_hi, s.u_mm);
-      if (!InModel(s)) continue;
+      if (!InModel(s) && !s.phase.bound) continue;
       ++in_fit;
       if (s.fit.r_px < kCancelledPx) ++zero, zero_lo = std::min(zero_lo, s.u_mm), zero_hi = std::max(zero_hi, s.u_mm);
+      if (!InModel(s)) continue;  // a bound holds the model through its range, not in its scatter
       const std::vector<double> j = ModelGradient(m, lens, s.u_mm);
       const double e = OpticsPx(s.fit.r_px, s.stretch, v) - m.PredictPx(lens, s.u_mm);
       for (int r = 0; r < k; ++r) {
@@ -268,24 +272,27 @@ void PropagateModelError(CalibResult& result, const optics::Lens& lens, const op
     }
   }
   if (!found) return;
+  // Where the blur there is near 0 its error is no percentage of it (one scene read 3439 %): said so in words.
+  char reach[96];
+  if (p.worst_se_rel > 1)
+    std::snprintf(reach, sizeof reach, "exceeds the blur itself there");
+  else
+    std::snprintf(reach, sizeof reach, "reaches %.0f %% there", 100 * p.worst_se_rel);
   char text[640];
   if (cancelled > 0)
     std::snprintf(text, sizeof text,
                   "the model's blur is not determined within %.0f %% at depths %.0f-%.0f mm: the sharpening after "
                   "sampling cancels the whole blur at %.0f-%.0f mm (%d sections read 0 px, a bound, not a value), and "
-                  "a lens fitted through them errs by a few %% in the optics' blur, which the sharpening magnifies "
-                  "(its error reaches %.0f %% there); there r_fitted_px is the model's estimate, not a result within "
-                  "5 %%",
-                  100 * kModelSeRel, p.undetermined_lo_mm, p.undetermined_hi_mm, cut_lo, cut_hi, cancelled,
-                  100 * p.worst_se_rel);
+                  "a lens fitted beside them errs by a few %% in the optics' blur, which the sharpening magnifies "
+                  "(its error %s); there r_fitted_px is the model's estimate, not a result within 5 %%",
+                  100 * kModelSeRel, p.undetermined_lo_mm, p.undetermined_hi_mm, cut_lo, cut_hi, cancelled, reach);
   else
     std::snprintf(text, sizeof text,
                   "the model's blur is not determined within %.0f %% at depths %.0f-%.0f mm: its error (standard "
-                  "error and the readings' own %.1f %% in the optics' blur) reaches %.0f %% there (the sharpening "
-                  "after sampling cancels most of the optics' blur, magnifying the optics' own uncertainty); there "
-                  "r_fitted_px is the model's estimate, not a result within 5 %%",
-                  100 * kModelSeRel, p.undetermined_lo_mm, p.undetermined_hi_mm, 100 * kReadingRel,
-                  100 * p.worst_se_rel);
+                  "error and the readings' own %.1f %% in the optics' blur) %s (the sharpening after sampling cancels "
+                  "most of the optics' blur, magnifying the optics' own uncertainty); there r_fitted_px is the model's "
+                  "estimate, not a result within 5 %%",
+                  100 * kModelSeRel, p.undetermined_lo_mm, p.undetermined_hi_mm, 100 * kReadingRel, reach);
   p.undetermined = text;
 }
 
@@ -319,6 +326,12 @@ std::string PhaseWhy(const SectionResult& s, double lo, double hi, double r, dou
                   "measured (edge %.2f px past a pixel centre), and the PSF families that fit the board's profiles "
                   "alike read %.2f-%.2f px here: its blur is not identified; the lens fit predicts it",
                   s.phase.axis_deg, s.phase.span_px, s.phase.phase_px, lo, hi);
+  else if (s.phase.bound)
+    std::snprintf(why, sizeof why,
+                  "the photo was sharpened after sampling and here the mask cancels the optics' whole blur (read "
+                  "%.2f px: the optics' blur is at most the mask's %.2f px, a bound, not a value); it is left out of the "
+                  "lens fit, which predicts it, held within %.2f-%.2f px",
+                  r, std::sqrt(-4 * v), s.phase.range_lo_px, s.phase.range_hi_px);
   else
     std::snprintf(why, sizeof why,
                   "the photo was sharpened after sampling and here the mask cancels %.0f %% of the optics' blur "

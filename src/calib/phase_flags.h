@@ -14,6 +14,9 @@ inline constexpr double kSpreadPx = 0.04, kSpreadRel = 0.08;
 // 1.5-3.3 %): where a sharpening mask cancels most of it, the section's reading is flagged when an error this size moves
 // it past the spread above (CancellationPx). Readings under kOpticsFloorPx count as that (the error is not relative).
 inline constexpr double kOpticsRel = 0.02, kOpticsFloorPx = 0.05;
+// A reading under this (px) where the chosen family sharpens reads the mask cancelling the optics' whole second moment:
+// its profile reads 0, and its optics' reading sqrt(-4 v) is a bound, not a value (the tests' scale for a blur near 0).
+inline constexpr double kCancelledPx = 0.05;
 // A section at every phase under a chosen filter whose reading's standard error (PhaseReading::r_se_px) times this
 // exceeds the spread above is flagged (FlagNoisyAtEveryPhase): the reading is not pinned within the target. 2: on 16
 // boards turned 45-60 deg under a mask (amount 0.7 over 0.6 px; seeds 2, 9, 11-16) the five sections off the rule

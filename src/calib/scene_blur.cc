@@ -73,7 +73,7 @@ const std::vector<std::string> kTopKeys = {"format", "version", "software", "cam
                                            // a tracked frame's (track/take.cc)
                                            "photo", "frame", "time_s", "track_status", "frame_signature",
                                            "lens_model"};
-const std::vector<std::string> kModelKeys = {"kind", "focus_mm", "aperture_mm", "floor_px", "floor_determined",
+const std::vector<std::string> kModelKeys = {"kind", "focus_mm", "aperture_mm", "floor_px", "cancel_px2", "floor_determined",
                                              "rms_px", "loo_rms_px", "samples_used", "outliers", "choice",
                                              "sections_left_out", "fitted_to"};
 const std::vector<std::string> kEdgeKeys = {"index", "u_mm", "usable_sections", "sections"};
@@ -232,6 +232,9 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
     throw InputError(mw + "/floor_px", "must be 0 for model kind \"thin_lens\" (no floor), got " +
                                            Num(s.model.floor_px) + "; a floor needs kind \"thin_lens+floor\"");
   s.model.floor_determined = Flag(model, "floor_determined", mw, !floored);
+  // A sharpening that cancels more than the floor (optics::FittedModel::cancel_px2); 0 where calib.json predates it.
+  if (model.contains("cancel_px2"))
+    s.model.cancel_px2 = Ranged(model, "cancel_px2", mw, -optics::kMaxBlurRadiusPx * optics::kMaxBlurRadiusPx, 0, "px^2");
   // The thin lens forms an image of its focus plane only beyond its focal length.
   if (const double f_mm = s.camera.focal_length_mm; !(s.model.focus_mm > f_mm))
     throw InputError(mw + "/focus_mm", "must be beyond the camera's focal length (" + Num(f_mm) +

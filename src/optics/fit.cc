@@ -373,7 +373,7 @@ const char* const kModelChoiceRule =
 double FittedModel::PredictPx(const Lens& lens, double u_mm) const {
   const Lens fitted{lens.focal_length_mm, aperture_mm, lens.pixel_pitch_mm};
   const double thin = SignedBlurRadiusPx(fitted, focus_mm, u_mm);
-  return std::sqrt(thin * thin + floor_px * floor_px);
+  return std::sqrt(std::max(0.0, thin * thin + floor_px * floor_px + cancel_px2));
 }
 
 bool FloorRangePinned(double lo, double hi, double floor_px) { return hi - lo <= std::max(0.1, 0.2 * floor_px); }

@@ -41,6 +41,10 @@ struct FittedModel {
   // The kept floor is pinned by the sections: that range spans at most max(0.1 px, 20 % of it). False for the thin
   // lens alone (no floor kept) and where focus off the board leaves the floor free (a wide range).
   bool floor_determined = false;
+  // A sharpening after sampling that cancels more than the floor's whole second moment (r^2 units, px^2, <= 0): the
+  // part beyond the floor, taken from the thin lens's too, so the photo's blur is sqrt(max(0, thin^2 + floor^2 +
+  // cancel_px2)) (calib's WithFilter; calib.json model.cancel_px2). 0 for every photo whose floor it leaves.
+  double cancel_px2 = 0;
 
   // Predicted unsigned radius at depth u (px), with the lens's f and pitch.
   double PredictPx(const Lens& lens, double u_mm) const;
