@@ -319,3 +319,5 @@ add_test(NAME phase_section_rule_turned
                  ${PHASE_DIR}/coverage_turned --seeds 11,13
                  --masks "turned 45 sharpen 0.7/0.6,turned 60 sharpen 0.7/0.6")
 set_tests_properties(phase_section_rule_turned PROPERTIES LABELS "slow;phase")
+# Started first on a fresh clone: seconds in one ctest -j2 run (cmake/BlurcueHelpers.cmake, set_test_costs).
+set_test_costs(phase_undetermined_coverage 156 phase_section_rule_turned 45)
