@@ -764,14 +764,7 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
     s->fit.ok = false;
     s->fit.flags.push_back("phase_limited");
     s->phase.joins_fit = hi - lo <= target && jump <= target && table <= target;  // by the cancellation alone
-    // Read 0 under a mask: a bound (PhaseCheck::bound). Joined at it, as a value, 28 such sections of a scene focused
-    // in front of the board (mask 0.7 over 0.8 px, focus 330 mm) put the fit's focus at 375 mm and its blur 24 % high
-    // on the next edge. Its range: 0 to the blur an error of kOpticsRel in the optics' second moment leaves.
-    if (s->phase.joins_fit && v_best < 0 && r < kCancelledPx) {
-      s->phase.joins_fit = false, s->phase.bound = true;
-      s->phase.range_lo_px = 0;
-      s->phase.range_hi_px = std::sqrt(std::max(r * r, 2 * kOpticsRel * (r * r - 4 * v_best)));
-    }
+    HoldAsBound(s, r, v_best);
     s->fit.phase_why = table > target ? TableWhy(r, r_table) : PhaseWhy(*s, lo, hi, r, v_best, moved, nearest);
     ++choice.flagged;
     tabled += table > target;

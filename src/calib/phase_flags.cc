@@ -296,6 +296,15 @@ void PropagateModelError(CalibResult& result, const optics::Lens& lens, const op
   p.undetermined = text;
 }
 
+bool HoldAsBound(SectionResult* s, double r, double v) {
+  if (!(s->phase.joins_fit && v < 0 && r < kCancelledPx)) return false;
+  s->phase.joins_fit = false, s->phase.bound = true;
+  // 0 to the blur an error of kOpticsRel in the optics' second moment leaves.
+  s->phase.range_lo_px = 0;
+  s->phase.range_hi_px = std::sqrt(std::max(r * r, 2 * kOpticsRel * (r * r - 4 * v)));
+  return true;
+}
+
 std::string TableWhy(double r, double r_table) {
   char why[400];
   std::snprintf(why, sizeof why,

@@ -35,9 +35,10 @@ void WarnAboutCalibration(const calib::CalibResult& result, const Camera& camera
   // edges (an edge covered or shaded reads sharp: a covered board gave focus 21 mm and an aperture of 0). Far: over
   // two thirds of a stop either way (kApertureWarnFactor; 0.6 x and 1.29 x passed unsaid under the old bound of 2 x).
   // Where the phase check found a filter after sampling, that is the first suspect: it adds one variance to every
-  // section's blur (a sharpening takes it away), which the thin lens (+ a floor of 0 or more) does not have, so the
-  // fit bends focus and aperture instead (a mask of amount 0.7 over 0.8 px, focus 300 mm: aperture 1.33 x; at amount
-  // 0.5 it was 1.42 x before the phase check read turned and large sections with the family, 1.23 x since).
+  // section's blur (a sharpening takes it away); a family that does not quite match the camera's filter leaves the fit
+  // to bend focus and aperture (a mask of amount 0.5 over 0.8 px, focus 300 mm: 1.42 x before the phase check read
+  // turned and large sections with the family; amount 0.7 1.33 x until the sections it cancels to 0 px were taken as
+  // bounds, 1.05 x since).
   const bool filtered = result.phase.chosen != 0 && result.phase.chosen < result.phase.families.size();
   if (calib::ApertureFarFromNominal(result, camera) && filtered)
     std::fprintf(stderr,

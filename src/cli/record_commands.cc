@@ -34,6 +34,8 @@ void AddExportCommand(CLI::App& app) {
       "                   chosen_side, chose_more_blurred, chosen_interval, yes_no, rating, adjusted_level, correct,\n"
       "                   rt_ms, answered_at\n"
       "  adjustments.csv  every step of a method-of-adjustment trial (level, time)\n"
+      "  procedures.csv   every adaptive procedure a study version ran (staircase, QUEST+): its cell, guess rate and\n"
+      "                   every parameter as the parser read it, from the record (no protocol parsed again)\n"
       "  frames.csv       every display flip (time from the trial's first flip, dropped or not, each side's radius\n"
       "                   and the objects' place along the board)\n"
       "  summary-STUDY.csv  per session the trials planned and answered (practice apart), the median response\n"

@@ -5,12 +5,14 @@
 #include <cmath>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <opencv2/core/utility.hpp>
 
 #include "core/data_dir.h"
 #include "core/error.h"
 #include "core/image.h"
+#include "core/names.h"
 
 namespace blurcue::scene {
 
@@ -18,7 +20,16 @@ std::filesystem::path ResolveStimulus(const std::string& name) {
   if (std::filesystem::exists(name)) return name;
   const auto shipped = DataDir().path / "stimuli" / (name + ".png");
   if (std::filesystem::exists(shipped)) return shipped;
-  throw InputError(name, "no such image, and no shipped stimulus " + shipped.string());
+  // The shipped ones by name, so a misspelt or guessed one is answered with what there is.
+  std::vector<std::string> names;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(DataDir().path / "stimuli", error))
+    if (entry.path().extension() == ".png") names.push_back(entry.path().stem().string());
+  std::sort(names.begin(), names.end());
+  std::string listed;
+  for (const std::string& n : names) listed += (listed.empty() ? "" : ", ") + n;
+  throw InputError(name, "no such image, and no shipped stimulus " + shipped.string() +
+                             (listed.empty() ? std::string() : " (shipped: " + listed + ")") + DidYouMean(name, names));
 }
 
 namespace {
