@@ -115,7 +115,7 @@ def study_names(bc, protocols, work):
     db = os.path.join(work, "names.sqlite")
     for i, name in enumerate(names):
         path = protocol(protocols, work, name, "names-%d.json" % i)
-        for participant in ("P1", "P2", "P3"):
+        for participant in ("P1", "P2"):  # two: the names are the question, not the models across participants
             record(bc, path, db, participant)
     r = run([bc, "export", "--db", db, "--out", os.path.join(work, "tables")])
     if r.returncode != 0:

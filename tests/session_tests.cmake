@@ -89,7 +89,7 @@ set_tests_properties(display_check PROPERTIES LABELS "gl;window"
 # seed is new each run and printed first, with the command that runs the same mutants again.
 add_test(NAME session_protocol_fuzz
          COMMAND ${BLURCUE_EXPECT} "fuzz ok: 0 crashes" /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tests/fuzz_protocols.py ${BC} ${T}/protocols ${T}/fuzz
-                 --count 400)
+                 --count 250)
 set_tests_properties(session_protocol_fuzz PROPERTIES
                      FIXTURES_REQUIRED "scene;calib;session_protocols;session_pictures" LABELS "gl;session;fuzz" TIMEOUT 1200)
 # The fuzz's check itself: a stand-in blurcue whose every refusal names no field (or not even the file) fails it.
