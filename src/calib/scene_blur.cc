@@ -292,12 +292,18 @@ std::string UndeterminedNote(const SceneCalib& scene, BlurSource source, double 
   if (source != BlurSource::kFitted || !(scene.undetermined_hi_mm > 0) || u_mm < scene.undetermined_lo_mm ||
       u_mm > scene.undetermined_hi_mm)
     return "";
+  // An error beyond the blur itself (near 0 there) is no percentage of it: said in words, as calibrate says it.
+  char reach[64];
+  if (scene.undetermined_se_rel > 1)
+    std::snprintf(reach, sizeof reach, "up to more than the blur itself");
+  else
+    std::snprintf(reach, sizeof reach, "up to %.0f %%", 100 * scene.undetermined_se_rel);
   char text[400];
   std::snprintf(text, sizeof text,
                 "the fitted blur at %.0f mm is the lens model's estimate, not a result within 5 %%: the model is "
-                "not determined within 5 %% at %.0f-%.0f mm (its error up to %.0f %%: a sharpening after "
+                "not determined within 5 %% at %.0f-%.0f mm (its error %s: a sharpening after "
                 "sampling cancels most of the optics' blur there; %s /phase_check/model_undetermined)",
-                u_mm, scene.undetermined_lo_mm, scene.undetermined_hi_mm, 100 * scene.undetermined_se_rel,
+                u_mm, scene.undetermined_lo_mm, scene.undetermined_hi_mm, reach,
                 scene.file.empty() ? "the calibration" : scene.file.c_str());
   return text;
 }
