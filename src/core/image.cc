@@ -137,7 +137,7 @@ std::string DecoderClause(const std::string& text) {
 
 }  // namespace
 
-cv::Mat ReadImage(const std::filesystem::path& path, int flags) {
+void RequireImageFileWhole(const std::filesystem::path& path) {
   std::error_code ec;
   const std::filesystem::file_status status = std::filesystem::status(path, ec);
   if (!std::filesystem::exists(status)) throw InputError(path.string(), "no such file");
@@ -153,22 +153,24 @@ cv::Mat ReadImage(const std::filesystem::path& path, int flags) {
   // PNG is checked whole for damage (core/image_integrity.h): a cut one decodes with grey fill and no error. Other
   // formats' bytes past the header are left to their decoder. The decoder reads the file again from the page cache
   // (~1 ms per 4 MB; imdecode from these bytes would skip imread's EXIF orientation handling on some OpenCV versions).
-  {
-    std::ifstream in(path, std::ios::binary);
-    std::vector<uint8_t> head(std::min<uintmax_t>(bytes, 1 << 20));
-    if (!in.read(reinterpret_cast<char*>(head.data()), std::streamsize(head.size())))
+  std::ifstream in(path, std::ios::binary);
+  std::vector<uint8_t> head(std::min<uintmax_t>(bytes, 1 << 20));
+  if (!in.read(reinterpret_cast<char*>(head.data()), std::streamsize(head.size())))
+    throw InputError(path.string(), "cannot read file");
+  const auto [w, h] = HeaderSizePx(head);
+  RequireSizeWithinLimits(path, w, h);
+  const bool checked = head.size() >= 3 && ((head[0] == 0x89 && head[1] == 'P' && head[2] == 'N') ||
+                                            (head[0] == 0xff && head[1] == 0xd8 && head[2] == 0xff));
+  if (checked && bytes > head.size()) {
+    head.resize(bytes);
+    if (!in.read(reinterpret_cast<char*>(head.data()) + (1 << 20), std::streamsize(bytes - (1 << 20))))
       throw InputError(path.string(), "cannot read file");
-    const auto [w, h] = HeaderSizePx(head);
-    RequireSizeWithinLimits(path, w, h);
-    const bool checked = head.size() >= 3 && ((head[0] == 0x89 && head[1] == 'P' && head[2] == 'N') ||
-                                              (head[0] == 0xff && head[1] == 0xd8 && head[2] == 0xff));
-    if (checked && bytes > head.size()) {
-      head.resize(bytes);
-      if (!in.read(reinterpret_cast<char*>(head.data()) + (1 << 20), std::streamsize(bytes - (1 << 20))))
-        throw InputError(path.string(), "cannot read file");
-    }
-    if (checked) RequireIntactImage(path, std::string_view(reinterpret_cast<const char*>(head.data()), head.size()));
   }
+  if (checked) RequireIntactImage(path, std::string_view(reinterpret_cast<const char*>(head.data()), head.size()));
+}
+
+cv::Mat ReadImage(const std::filesystem::path& path, int flags) {
+  RequireImageFileWhole(path);
   cv::Mat image;
   std::string decoder_said;
   {

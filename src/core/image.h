@@ -11,6 +11,9 @@ namespace blurcue {
 
 // Reads an image as 8-bit BGR or grey as stored; throws Error(kInput) naming the file when unreadable.
 cv::Mat ReadImage(const std::filesystem::path& path, int flags = -1 /* cv::IMREAD_UNCHANGED */);
+// What ReadImage checks before it decodes, without decoding: a regular file within the size limits, its header's
+// size within them, and a JPEG or PNG whole (core/image_integrity.h). Throws Error(kInput) naming the file.
+void RequireImageFileWhole(const std::filesystem::path& path);
 // Writes atomically (core/atomic_file.h); creates the folder; throws naming the file on failure.
 void WriteImage(const std::filesystem::path& path, const cv::Mat& image);
 // What an image's name should end in, as the refusals say it.

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "core/error.h"
+#include "core/image.h"
 #include "core/json_io.h"
 #include "procedure/recorded_names.h"
 
@@ -23,6 +24,21 @@ using stimulus::CheckVideoTrial;
 
 protocol::ValidateOptions WithCalibratedBoard(const Json& json, const std::filesystem::path& protocol_file) {
   protocol::ValidateOptions options;
+  // Each photo, picture and calibration the protocol names read as the session reads it (the image's header and whole
+  // bytes, the calibration parsed), so that a cut photo is named with every other problem, not only once the rest
+  // is mended.
+  options.check_content = [](const std::filesystem::path& path, protocol::FileUse use) -> std::string {
+    try {
+      if (use == protocol::FileUse::kImage)
+        RequireImageFileWhole(path);
+      else
+        calib::LoadSceneCalib(path);
+    } catch (const std::exception& e) {
+      return use == protocol::FileUse::kImage ? std::string(e.what())
+                                              : std::string(stimulus::kNotACalibration) + e.what();
+    }
+    return "";
+  };
   if (!json.is_object() || !json.contains("scene") || !json["scene"].is_object()) return options;
   const Json& scene = json["scene"];
   if (scene.contains("track") || !scene.contains("calib") || !scene["calib"].is_string()) return options;

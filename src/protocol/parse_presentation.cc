@@ -42,9 +42,9 @@ void Parser::ParseScene(const Json& v, const std::string& ptr, Protocol* p) {
     }
     return;
   }
-  p->scene.background = Path(v, "background", ptr, true);
-  p->scene.board_free = Path(v, "board_free", ptr, false);
-  p->scene.calib = Path(v, "calib", ptr, false);
+  p->scene.background = Path(v, "background", ptr, true, FileUse::kImage);
+  p->scene.board_free = Path(v, "board_free", ptr, false, FileUse::kImage);
+  p->scene.calib = Path(v, "calib", ptr, false, FileUse::kCalibration);
   if (auto show = Word<ScenePhoto>(v, "show", ptr, false)) p->scene.show = *show;
   if (p->scene.show == ScenePhoto::kBoardFree && !v.contains("board_free"))
     Problem(ptr + "/show", "names the board-free photo but /scene/board_free is missing", v["show"]);
@@ -100,7 +100,7 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
         Problem(ptr + "/texture", "must be " + (grid ? std::string("grid") : "soccer or wood") +
                                       " or an image file (did you mean " + nearest + "?)", Json(*t));
       } else {
-        p->content.texture = Path(v, "texture", ptr, true).string();
+        p->content.texture = Path(v, "texture", ptr, true, FileUse::kImage).string();
       }
     }
   }
@@ -135,7 +135,7 @@ void Parser::ParseContent(const Json& v, const std::string& ptr, Protocol* p) {
       p->content.exposure_ms = *e, p->content.exposure_given = true;
   } else {
     Object(v, ptr, {"type", "image", "real_photos", "real_camera"});
-    p->content.image = Path(v, "image", ptr, true);
+    p->content.image = Path(v, "image", ptr, true, FileUse::kImage);
     if (auto pattern = Text(v, "real_photos", ptr, false, kMaxPathChars, true)) {
       if (pattern->find("{distance_m}") == std::string::npos)
         Problem(ptr + "/real_photos", "must contain {distance_m} (one photo per distance)", Json(*pattern));

@@ -282,7 +282,8 @@ std::optional<bool> Parser::Bool(const Json& obj, const std::string& key, const 
 }
 
 // A path relative to the protocol file's folder; checked for existence unless options say otherwise.
-fs::path Parser::Path(const Json& obj, const std::string& key, const std::string& ptr, bool required) {
+fs::path Parser::Path(const Json& obj, const std::string& key, const std::string& ptr, bool required,
+                      std::optional<FileUse> use) {
   const auto s = Text(obj, key, ptr, required, kMaxPathChars, true);
   if (!s) return {};
   if (s->empty()) {
@@ -290,7 +291,10 @@ fs::path Parser::Path(const Json& obj, const std::string& key, const std::string
     return {};
   }
   const fs::path resolved = (base_ / *s).lexically_normal();
-  if (options_.check_files) CheckFile(resolved, ptr + "/" + Escape(key), Json(*s));
+  if (options_.check_files && CheckFile(resolved, ptr + "/" + Escape(key), Json(*s)) && use &&
+      options_.check_content)
+    if (const std::string wrong = options_.check_content(resolved, *use); !wrong.empty())
+      Problem(ptr + "/" + Escape(key), wrong);  // the reader names the file
   return resolved;
 }
 

@@ -101,11 +101,14 @@ class Parser {
 
   std::optional<bool> Bool(const Json& obj, const std::string& key, const std::string& ptr);
 
-  // A path relative to the protocol file's folder; checked for existence unless options say otherwise.
-  fs::path Path(const Json& obj, const std::string& key, const std::string& ptr, bool required);
+  // A path relative to the protocol file's folder; checked for existence unless options say otherwise, and, with
+  // `use`, its content by options' check_content.
+  fs::path Path(const Json& obj, const std::string& key, const std::string& ptr, bool required,
+                std::optional<FileUse> use = std::nullopt);
 
   // A regular file: not missing, not a folder, not a device (/dev/zero) or FIFO that a reader would wait on.
-  // What is in it (an image that decodes, a calibration that parses) is checked before a session: PrepareSession.
+  // What is in it (an image that decodes, a calibration that parses) is checked before a session (PrepareSession),
+  // and here where the options' check_content reads it (Path's `use`).
   bool CheckFile(const fs::path& resolved, const std::string& ptr, const Json& got);
 
   // The protocol `json` describes; its problems are in `problems` (and counted in more_problems) afterwards.

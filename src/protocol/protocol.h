@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <optional>
 #include <set>
@@ -308,8 +309,16 @@ int64_t SessionTrials(const Protocol& protocol);
 // levels, or the key of object levels and conditions rows.
 std::set<double> NumericLevels(const Protocol& protocol, const std::string& factor);
 
+// What a file a protocol names is read as, for ValidateOptions::check_content.
+enum class FileUse { kImage, kCalibration };
+
 struct ValidateOptions {
   bool check_files = true;            // false: skip the existence checks of referenced files
+  // Set (with check_files): each scene photo, picture, texture file and calibration the protocol names, once it is
+  // a regular file, is read by this, and what it returns (empty: nothing wrong) is a problem at its field, so a
+  // damaged photo or calibration is named with every other problem (PrepareStudy: core's image check, calib's
+  // reader); the protocol module itself reads no image or calibration.
+  std::function<std::string(const std::filesystem::path&, FileUse)> check_content = nullptr;
   // > 0: the calibrated board's squares (scene.calib's board, read before the protocol: PrepareStudy), so that a
   // level naming an edge or a section past it is a problem named with every other one, not refused alone later.
   int board_cols = 0, board_rows = 0;

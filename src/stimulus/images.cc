@@ -42,7 +42,7 @@ std::optional<calib::SceneCalib> LoadProtocolScene(const protocol::Protocol& pro
   try {
     return calib::LoadSceneCalib(protocol.scene.calib);
   } catch (const std::exception& e) {
-    throw InputError(At(protocol, "/scene/calib"), std::string("not a calibration from blurcue calibrate: ") + e.what());
+    throw InputError(At(protocol, "/scene/calib"), std::string(kNotACalibration) + e.what());
   }
 }
 

@@ -148,7 +148,9 @@ void CheckBlurOnScreen(const protocol::Protocol& protocol, const protocol::Trial
                        const std::string& level_text = "");
 
 // The protocol's calibration (none for a picture without one). Throws Error(kInput) naming the protocol file and
-// /scene/calib when the file is not a calibration written by `blurcue calibrate`.
+// /scene/calib when the file is not a calibration written by `blurcue calibrate` (kNotACalibration, the reader's
+// reason after it).
+inline constexpr const char* kNotACalibration = "not a calibration from blurcue calibrate: ";
 std::optional<calib::SceneCalib> LoadProtocolScene(const protocol::Protocol& protocol);
 
 // The images a protocol's trials show, decoded (8-bit) and checked against what shows them.
