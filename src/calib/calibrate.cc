@@ -1,6 +1,7 @@
 #include "calib/calibrate.h"
 
 #include "calib/calib_checks.h"
+#include "calib/phase_flags.h"
 
 #include <algorithm>
 #include <array>
@@ -408,9 +409,16 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
   if (options.fit_model)
     result.model = FitModelWithinPhaseRanges(result, lens, options.optics_fit, &result.phase.held, &optics_model);
 
-  SummariseEdges(&result, lens);
   if (options.fit_model) ApplyModel(result, result.model);
   if (options.fit_model && result.phase.variance_px2 < 0) PropagateModelError(result, lens, optics_model);
+  if (options.fit_model && options.phase_check && options.only_sections.empty())
+    if (const int off = FlagOffTheLensFit(result); off > 0) {
+      result.phase.flagged += off;
+      result.phase.summary += "; after the lens fit " + std::to_string(off) +
+                              " more on the board's outer edge (beside the table) off its prediction by more than "
+                              "max(0.04 px, 8 %) less its standard error";
+    }
+  SummariseEdges(&result, lens);
   result.estimate_ms = MsSince(t0);
   return result;
 }
@@ -456,7 +464,9 @@ Json PhaseChoiceJson(const PhaseChoice& c) {
                    "flagged by the cancellation or the standard error alone (phase.joins_fit), which join it at "
                    "their readings; on the board's outer edges each family is read again with the table's slope "
                    "(r_table_px) and, where a filter is chosen, a section whose two readings differ by that much is "
-                   "flagged too; sections of 2 px or more are read with the chosen filter"}};
+                   "flagged too, as is one (after the lens fit) whose reading lies off the fit's prediction by more "
+                   "than that less the prediction's standard error (the table's texture); sections of 2 px or more "
+                   "are read with the chosen filter"}};
 }
 
 }  // namespace

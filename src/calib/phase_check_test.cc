@@ -3,6 +3,7 @@
 // ground-truth scene (synth's truth: its kernels' and the post filter's taps' second moments).
 #include "calib/phase_check.h"
 #include "calib/phase_fit.h"
+#include "calib/phase_flags.h"
 
 #include <gtest/gtest.h>
 
@@ -223,6 +224,38 @@ TEST(PhaseCheck, SectionWhereTheChosenSharpeningCancelsMostOfTheBlurOrJumpsIsFla
   EXPECT_NE(jumped.phase_why.find("lies 0.17 px outside"), std::string::npos) << jumped.phase_why;
   EXPECT_NE(choice.summary.find("2 flagged phase_limited (0 where the kinds that fit alike read apart, 1 where the sharpening cancels"), std::string::npos)
       << choice.summary;
+}
+
+// After the lens fit, a measured section on the board's outer edge whose reading lies off the fit's prediction by more
+// than max(0.04 px, 8 %) less the prediction's standard error is flagged and joins the fit at its reading (worked
+// by hand: 0.70 against 0.62 +- 0.01 is 0.08 off, over 0.056 - 0.01; 0.66 is 0.04 off, under it; an inner edge's
+// and the optics alone's are never flagged).
+TEST(PhaseCheck, OuterEdgeSectionOffTheLensFitIsFlaggedAfterIt) {
+  auto section = [](int edge, double r, double fitted) {
+    SectionResult s;
+    s.edge = edge, s.section = 1, s.u_mm = 400;
+    s.fit.ok = true, s.fit.r_px = r;
+    s.r_fitted_px = fitted, s.r_fitted_se_px = 0.01;
+    return s;
+  };
+  CalibResult result;
+  result.edges.resize(3);
+  result.edges[0].sections = {section(1, 0.70, 0.62), section(1, 0.66, 0.62)};
+  result.edges[1].sections = {section(2, 0.80, 0.62)};  // inner: the table is not beside it
+  result.edges[2].sections = {section(3, 0.50, 0.62)};  // 0.12 off: flagged
+  EXPECT_EQ(FlagOffTheLensFit(result), 0);              // the optics alone chosen: nothing after the fit
+  result.phase.chosen = 1;
+  EXPECT_EQ(FlagOffTheLensFit(result), 2);
+  const SectionResult& off = result.edges[0].sections[0];
+  EXPECT_FALSE(off.fit.ok);
+  EXPECT_TRUE(off.phase.joins_fit);
+  EXPECT_DOUBLE_EQ(off.phase.range_lo_px, 0.62);
+  EXPECT_DOUBLE_EQ(off.phase.range_hi_px, 0.70);
+  EXPECT_NE(off.fit.phase_why.find("its reading (0.70 px) lies 0.08 px off the lens fit's 0.62 px"), std::string::npos)
+      << off.fit.phase_why;
+  EXPECT_TRUE(result.edges[0].sections[1].fit.ok);
+  EXPECT_TRUE(result.edges[1].sections[0].fit.ok);
+  EXPECT_FALSE(result.edges[2].sections[0].fit.ok);
 }
 
 // The scene: a level camera, the image filtered after sampling. The check finds the filter and every section

@@ -374,4 +374,35 @@ bool FlagNoisyAtEveryPhase(SectionResult* s, size_t best, double target) {
   return true;
 }
 
+int FlagOffTheLensFit(CalibResult& result) {
+  if (result.phase.chosen == 0 || result.edges.empty()) return 0;
+  int flagged = 0;
+  const size_t last = result.edges.size() - 1;
+  for (size_t e : {size_t(0), last}) {
+    for (auto& s : result.edges[e].sections) {
+      if (!s.fit.ok) continue;
+      const double r = s.fit.r_px, m = s.r_fitted_px, se = std::max(0.0, s.r_fitted_se_px);
+      const double target = std::max(kSpreadPx, kSpreadRel * r);
+      if (!(std::abs(r - m) > target - se)) continue;
+      char why[420];
+      std::snprintf(why, sizeof why,
+                    "on the board's outer edge, beside the table, its reading (%.2f px) lies %.2f px off the lens "
+                    "fit's %.2f px (standard error %.2f px): more than max(%.2f px, %.0f %%) less that error; the "
+                    "table's texture moves such a reading more than its own standard error says. It joins the lens "
+                    "fit at its reading, which pools it, and is predicted by it",
+                    r, std::abs(r - m), m, se, kSpreadPx, 100 * kSpreadRel);
+      s.fit.ok = false;
+      s.fit.flags.push_back("phase_limited");
+      s.fit.phase_why = why;
+      s.phase.joins_fit = true;
+      const bool ranged = s.phase.range_hi_px > 0;  // a range the families that fit alike gave it
+      s.phase.range_lo_px = ranged ? std::min({s.phase.range_lo_px, r, m}) : std::min(r, m);
+      s.phase.range_hi_px = std::max({s.phase.range_hi_px, r, m});
+      ++flagged;
+    }
+    if (last == 0) break;
+  }
+  return flagged;
+}
+
 }  // namespace blurcue::calib
