@@ -117,8 +117,8 @@ std::string PresentationLines(const procedure::PreparedSession& prepared) {
     size_t per_pixel = 0;
     for (const auto& scene : prepared.scenes) per_pixel += scene.per_pixel;
     std::snprintf(line, sizeof line,
-                  "  blur plan: %zu of %zu trials per pixel by depth (depth span >= %g %s), the rest one "
-                  "radius\n",
+                  "  blur plan: %zu of %zu trials blur the object pixel by pixel at each one's depth (where its "
+                  "blur changes by %g %s or more across it: content.depth_blur_threshold), the rest with one radius\n",
                   per_pixel, prepared.scenes.size(), prepared.protocol.content.depth_blur_threshold,
                   prepared.protocol.content.depth_blur_threshold_unit == protocol::ThresholdUnit::kArcmin ? "arcmin" : "screen px");
     shown += line;

@@ -159,7 +159,9 @@ std::vector<Factor> Parser::ParseFactors(const Json& v, const std::string& ptr) 
       // Repeats found by the text of each level (numbers by value: 2 and 2.0 are one level), in linear time.
       const std::string text = level.is_number() ? Json(level.get<double>()).dump() : level.dump();
       if (const auto [first, fresh] = seen.emplace(text, i); !fresh)
-        Problem(lp, "repeats level " + std::to_string(first->second), level);
+        Problem(lp, "repeats the level at " + fp + "/" + std::to_string(first->second) +
+                        " (a factor lists each of its levels once; repetitions sets how often each is shown)",
+                level);
       // A factor named for a value (edge, speed_cm_s, ...) holds that value itself; any other factor's object
       // levels carry named values.
       if (level.is_object() && !IsValueName(name)) {

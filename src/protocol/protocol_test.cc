@@ -442,8 +442,8 @@ TEST(ProtocolValidate, RepeatedLevelNamesItsFirstOccurrence) {
   j["blocks"][1]["factors"]["label_size"] = {1, 2, 1.0, 3, 2};
   const auto problems = Problems(j);
   ASSERT_EQ(problems.size(), 2u);
-  EXPECT_TRUE(Contains(problems[0], "/blocks/1/factors/label_size/2: repeats level 0, got 1.0")) << problems[0];
-  EXPECT_TRUE(Contains(problems[1], "/blocks/1/factors/label_size/4: repeats level 1, got 2")) << problems[1];
+  EXPECT_TRUE(Contains(problems[0], "/blocks/1/factors/label_size/2: repeats the level at /blocks/1/factors/label_size/0 (a factor lists each of its levels once; repetitions sets how often each is shown), got 1.0")) << problems[0];
+  EXPECT_TRUE(Contains(problems[1], "/blocks/1/factors/label_size/4: repeats the level at /blocks/1/factors/label_size/1 (")) << problems[1];
 }
 
 TEST(ProtocolValidate, ObjectLevelOfAValueFactorRejected) {
