@@ -230,6 +230,7 @@ struct Drawn {
   std::vector<std::pair<std::string, cv::Mat>> insets;  // label, 1:1 crop (zoomed)
   std::vector<std::string> lines;
   std::string listed;  // its line of Sheet::tiles
+  double ms = 0;       // what composing a frame of it cost here
 };
 
 // Tile `i` composed as a session composes it, with its label lines (wrapped to the tile) and its line for the list.
@@ -251,6 +252,7 @@ Drawn DrawTile(session::StimulusRenderer& renderer, const procedure::PreparedSes
   }
   const cv::Mat full = renderer.Read();
   Drawn d;
+  d.ms = ms;
   d.whole = layout.whole_at_1to1 ? full.clone() : ResampleSrgb8(full, cv::Size(layout.tw, layout.th));
   const auto& scene = prepared.scene;
   const Json described = stimulus::DescribeFrame(scene ? &*scene : nullptr, tile.scene, prepared.presentation,
@@ -333,6 +335,25 @@ Sheet DrawContactSheet(procedure::PreparedSession* prepared, const SheetOptions&
     if (progress) progress(i + 1, tiles.size(), sheet.tiles.back());
   }
   sheet.image = AssembleSheet(drawn, layout, options.columns);
+  // A frame's cost against the display's frame interval: a tile slower than it would drop frames in a session on
+  // this machine's renderer (a session's frame log says what each shown frame took).
+  const auto slowest = std::max_element(drawn.begin(), drawn.end(),
+                                        [](const Drawn& a, const Drawn& b) { return a.ms < b.ms; });
+  const double budget = 1000 / prepared->presentation.profile.refresh_hz;
+  const size_t over = std::count_if(drawn.begin(), drawn.end(), [&](const Drawn& d) { return d.ms > budget; });
+  char line[400];
+  if (over > 0)
+    std::snprintf(line, sizeof line,
+                  "%zu of %zu tiles took longer to compose here than the display's frame (%.1f ms at %g Hz; the "
+                  "slowest, #%zu, %.1f ms): on this machine's renderer their trials would drop frames; run them on "
+                  "the lab's GPU and check their dropped frames (export's frames.csv)",
+                  over, drawn.size(), budget, prepared->presentation.profile.refresh_hz,
+                  size_t(slowest - drawn.begin()) + 1, slowest->ms);
+  else
+    std::snprintf(line, sizeof line, "every tile composed within the display's frame here (the slowest, #%zu, %.1f ms "
+                  "of %.1f ms at %g Hz)", size_t(slowest - drawn.begin()) + 1, slowest->ms, budget,
+                  prepared->presentation.profile.refresh_hz);
+  sheet.notes.push_back(line);
   return sheet;
 }
 
