@@ -103,8 +103,8 @@ groups_info)
   $BC run "$G" --participant G5 --db "$W/g.sqlite" --observer sim --resume > /dev/null 2>&1 || fail "resume with the recorded info"
   # sessions names each session's group and observer.
   $BC sessions --db "$W/g.sqlite" > "$W/sessions"
-  grep -Eq "groups-and-info +G1 +1 +estimated +simulated +completed +12/12 +0 +0 " "$W/sessions" \
-    && grep -Eq "groups-and-info +G2 +1 +no_blur +simulated +completed +12/12 +0 +0 " "$W/sessions" \
+  grep -Eq "groups-and-info +1 +G1 +1 +estimated +simulated +completed +12/12 +0 +0 " "$W/sessions" \
+    && grep -Eq "groups-and-info +1 +G2 +1 +no_blur +simulated +completed +12/12 +0 +0 " "$W/sessions" \
     || fail "sessions: $(cat "$W/sessions")"
   $BC export --db "$W/g.sqlite" --out "$W/tables" > /dev/null
   $PY - "$W/tables/trials.csv" <<'PYEOF' || fail "groups and info in trials.csv"
@@ -279,7 +279,7 @@ PYEOF
   grep -q "12 practice trials skipped now: the criterion was met" "$W/out" || fail "good observer: $(tail -1 "$W/out")"
   grep -q "procedure had stopped" "$W/out" && fail "good observer: a stop rule named where none ran: $(tail -1 "$W/out")"
   # sessions counts the skipped practice trials apart, never as answered: 6 + 4 answered of 22, 12 skipped.
-  $BC sessions --db "$W/s.sqlite" | grep -Eq "practice-criterion +G1 +1 +- +simulated +completed +10/22 +12 +0 " \
+  $BC sessions --db "$W/s.sqlite" | grep -Eq "practice-criterion +1 +G1 +1 +- +simulated +completed +10/22 +12 +0 " \
     || fail "sessions: $($BC sessions --db "$W/s.sqlite")"
   # Another protocol text under the study's name in the same record: a new version.
   sed 's/"correct": 0.8/"correct": 1/; s/"version": 1/"version": 2/' "$W/p.json" > "$W/strict.json"

@@ -97,7 +97,7 @@ merge_live_writer)
   # Being written: the one session `sessions` lists as running, its live writer named.
   $BC sessions --db "$W/a.sqlite" > "$W/sessions"
   kill -0 $pid 2>/dev/null || fail "the run ended before the merge was tried: $(cat "$W/err")"
-  grep -Eq "test2-moving-balls +L1 +1 +- +simulated +running +[0-9]+/74 .*lock: pid $pid on host .*\(alive\)" "$W/sessions" \
+  grep -Eq "test2-moving-balls +1 +L1 +1 +- +simulated +running +[0-9]+/74 .*lock: pid $pid on host .*\(alive\)" "$W/sessions" \
     || fail "sessions of a session being written: $(cat "$W/sessions")"
   grep -q "^1 sessions, 1 unfinished (1 of them running now)$" "$W/sessions" || fail "sessions: $(cat "$W/sessions")"
   kill -9 $pid; wait $pid 2>/dev/null || true
@@ -143,7 +143,7 @@ resume)
     $BC run "$P/$proto.json" --participant R2 --db "$W/parts.sqlite" --observer sim --seed 5 --stop-after 20 \
       | grep -q "not finished" || fail "$proto: stop-after did not leave the session open"
     # Left by its run, no writer: listed as unfinished, not as running, with no lock.
-    listed=$($BC sessions --db "$W/parts.sqlite" | grep -E " $proto +R2 " || true)
+    listed=$($BC sessions --db "$W/parts.sqlite" | grep -E " $proto +1 +R2 " || true)
     echo "$listed" | grep -Eq " +simulated +unfinished +20/[0-9]+ " && [[ "$listed" != *lock:* ]] \
       || fail "$proto: sessions after --stop-after: $listed"
     if $BC run "$P/$proto.json" --participant R2 --db "$W/parts.sqlite" --observer sim --seed 5 2>"$W/err"; then
@@ -156,8 +156,8 @@ resume)
   integrity "$W/parts.sqlite"
   # The record lists both participants' sessions as completed, every trial answered.
   $BC sessions --db "$W/parts.sqlite" > "$W/sessions"
-  grep -Eq "pre-research-depth-matching +R2 +1 +- +simulated +completed +28/28" "$W/sessions" || fail "sessions: $(cat "$W/sessions")"
-  grep -Eq "test2-moving-balls +R2 +1 +- +simulated +completed +74/74" "$W/sessions" || fail "sessions: $(cat "$W/sessions")"
+  grep -Eq "pre-research-depth-matching +1 +R2 +1 +- +simulated +completed +28/28" "$W/sessions" || fail "sessions: $(cat "$W/sessions")"
+  grep -Eq "test2-moving-balls +1 +R2 +1 +- +simulated +completed +74/74" "$W/sessions" || fail "sessions: $(cat "$W/sessions")"
   echo "ok: stopped at 20 and resumed = uninterrupted (test 2, depth matching)" ;;
 kill9)
   # kill -9 in the middle of a session, then --resume: nothing lost, nothing twice, same as uninterrupted.
@@ -169,7 +169,7 @@ kill9)
   kill -9 $pid; wait $pid 2>/dev/null || true
   # Killed: the session is listed as interrupted (resumable; the record keeps it running) and its lock names the
   # dead writer.
-  $BC sessions --db "$W/killed.sqlite" | grep -Eq "test2-moving-balls +K1 +1 +- +simulated +interrupted +[0-9]+/74 .*lock: pid $pid on .*gone" \
+  $BC sessions --db "$W/killed.sqlite" | grep -Eq "test2-moving-balls +1 +K1 +1 +- +simulated +interrupted +[0-9]+/74 .*lock: pid $pid on .*gone" \
     || fail "sessions after kill: $($BC sessions --db "$W/killed.sqlite")"
   answered=$(sql "$W/killed.sqlite" "SELECT count(*) FROM responses")
   [ "$answered" -ge 8 ] && [ "$answered" -lt 74 ] || fail "killed after $answered answers, expected mid-session"
@@ -307,7 +307,7 @@ PYEOF
     || fail "changed protocol: $(cat "$W/err")"
   grep -q "blurcue sessions --db $W/s.sqlite --abort 1 (its answers are kept)" "$W/err" || fail "no way out: $(cat "$W/err")"
   $BC sessions --db "$W/s.sqlite" --abort 1 | grep -q "session 1 closed as aborted; its answers are kept" || fail "abort"
-  $BC sessions --db "$W/s.sqlite" | grep -Eq "test1-static-grids +S1 +1 +- +simulated +aborted +6/13" || fail "sessions: $($BC sessions --db "$W/s.sqlite")"
+  $BC sessions --db "$W/s.sqlite" | grep -Eq "test1-static-grids +1 +S1 +1 +- +simulated +aborted +6/13" || fail "sessions: $($BC sessions --db "$W/s.sqlite")"
   set +e; $BC sessions --db "$W/s.sqlite" --abort 1 2> "$W/err"; code=$?; set -e
   [ $code = 3 ] && grep -q "session 1 is aborted; only a running session can be aborted" "$W/err" || fail "abort twice: $(cat "$W/err")"
   # Run anew, the changed text is another version of the study's protocol: its "version" is raised.
@@ -341,7 +341,7 @@ readonly)
   chmod 444 "$W/arch/study.sqlite"; chmod 555 "$W/arch"
   mkdir -p "$W/out"; chmod 777 "$W/out"
   as_nobody() { setpriv --reuid=65534 --regid=65534 --clear-groups env HOME="$W/out" MPLCONFIGDIR="$W/out/mpl" "$@"; }
-  as_nobody $BC sessions --db "$W/arch/study.sqlite" | grep -Eq "test1-static-grids +A1 +1 +- +simulated +completed +13/13" \
+  as_nobody $BC sessions --db "$W/arch/study.sqlite" | grep -Eq "test1-static-grids +1 +A1 +1 +- +simulated +completed +13/13" \
     || fail "sessions of a read-only record: $(as_nobody $BC sessions --db "$W/arch/study.sqlite" 2>&1)"
   as_nobody $BC export --db "$W/arch/study.sqlite" --out "$W/out/tables" > /dev/null 2> "$W/err" || fail "export: $(cat "$W/err")"
   [ "$(wc -l < "$W/out/tables/trials.csv")" = 14 ] || fail "export of a read-only record: $(wc -l < "$W/out/tables/trials.csv") lines"

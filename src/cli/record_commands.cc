@@ -134,9 +134,9 @@ void AddSessionsCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "sessions",
       "List the sessions of a record: who took each, how far it got and what became of it.\n"
-      "Each row: study, participant, the participant's session number (n), group, observer (person or simulated),\n"
-      "status, trials answered of planned (skipped and timed-out trials counted apart, never as answered), seed, start\n"
-      "and end, host, and who holds its lock (a writer alive, or a stale lock left by a crash). The status is completed, aborted, or for a session neither (the record's and export's 'running'):\n"
+      "Each row: study, the protocol's \"version\" it ran (v), participant, the participant's session number (n),\n"
+      "group, observer (person or simulated), status, trials answered of planned (skipped and timed-out trials\n"
+      "counted apart, never as answered), seed, start and end, host, and who holds its lock (a writer alive, or a stale lock left by a crash). The status is completed, aborted, or for a session neither (the record's and export's 'running'):\n"
       "  running      another process runs it now (a live writer holds its lock)\n"
       "  unfinished   its run left it: the participant quit, the window was closed, or --stop-after was reached\n"
       "  interrupted  its writer died holding the lock (killed, crashed); the next run takes the lock over\n"
@@ -179,16 +179,17 @@ void AddSessionsCommand(CLI::App& app) {
       return;
     }
     // answered: answers given of the trials planned; skipped and timed-out trials are counted apart, never as
-    // answered. n: the participant's n-th session of the study.
-    std::printf("%4s  %-28s %-12s %3s %-12s %-9s %-11s %9s %7s %9s  %-20s  %-24s %-24s %s\n", "id", "study",
-                "participant", "n", "group", "observer", "status", "answered", "skipped", "timed_out", "seed",
+    // answered. v: the protocol's declared version the session ran; n: the participant's n-th session of the study.
+    std::printf("%4s  %-28s %3s %-12s %3s %-12s %-9s %-11s %9s %7s %9s  %-20s  %-24s %-24s %s\n", "id", "study",
+                "v", "participant", "n", "group", "observer", "status", "answered", "skipped", "timed_out", "seed",
                 "started", "ended", "host");
     int unfinished = 0, running_now = 0;
     for (const auto& s : sessions) {
       const std::string answered = std::to_string(s.answered) + "/" + std::to_string(s.planned);
       const std::string number = s.number > 0 ? std::to_string(s.number) : "-";
-      std::printf("%4lld  %-28s %-12s %3s %-12s %-9s %-11s %9s %7lld %9lld  %-20llu  %-24s %-24s %s%s\n",
-                  static_cast<long long>(s.id), s.study.c_str(), s.participant.c_str(), number.c_str(),
+      const std::string version = s.protocol_version > 0 ? std::to_string(s.protocol_version) : "-";
+      std::printf("%4lld  %-28s %3s %-12s %3s %-12s %-9s %-11s %9s %7lld %9lld  %-20llu  %-24s %-24s %s%s\n",
+                  static_cast<long long>(s.id), s.study.c_str(), version.c_str(), s.participant.c_str(), number.c_str(),
                   s.group.empty() ? "-" : s.group.c_str(), s.observer.empty() ? "-" : s.observer.c_str(),
                   s.state.c_str(), answered.c_str(), static_cast<long long>(s.skipped),
                   static_cast<long long>(s.timed_out), static_cast<unsigned long long>(s.seed), s.started.c_str(),

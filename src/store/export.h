@@ -91,6 +91,7 @@ struct SessionSummary {
   std::string group;     // the between-subject group, "" without groups
   std::string observer;  // "person" or "simulated" ("" in a record too old to say)
   int64_t number = 0;    // the participant's n-th session of the study (0 in a record too old to say)
+  int64_t protocol_version = 0;  // the protocol's declared "version" it ran (0 in a record too old to say)
   uint64_t seed = 0;
   // Planned trials (practice included) and what became of them: answered (an answer given), skipped (not shown: a
   // stopped procedure, practice after its criterion was met), timed out (shown, no answer before the deadline).

@@ -20,8 +20,10 @@ std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path) {
                  "(SELECT count(*) FROM trials t JOIN responses r ON r.trial_id = t.id WHERE t.session_id = s.id "
                  " AND r.choice = ?1), "
                  "s.lock_token IS NOT NULL, coalesce(s.lock_pid, 0), coalesce(s.lock_host, ''), "
-                 "coalesce(s.lock_heartbeat_ms, 0), s.group_name, coalesce(s.observer, ''), coalesce(s.session_number, 0) "
+                 "coalesce(s.lock_heartbeat_ms, 0), s.group_name, coalesce(s.observer, ''), coalesce(s.session_number, 0), "
+                 "coalesce(pv.version, 0) "
                  "FROM sessions s JOIN participants p ON p.id = s.participant_id JOIN studies st ON st.id = p.study_id "
+                 "JOIN protocol_versions pv ON pv.id = s.protocol_version_id "
                  "ORDER BY st.name, p.code, s.id");
   rows.Bind(1, std::string_view(kChoiceNone));
   rows.Bind(2, std::string_view(kChoiceSkipped));
@@ -51,6 +53,7 @@ std::vector<SessionSummary> ListSessions(const std::filesystem::path& db_path) {
     s.group = rows.GetText(16);
     s.observer = rows.GetText(17);
     s.number = rows.GetInt64(18);
+    s.protocol_version = rows.GetInt64(19);
     sessions.push_back(std::move(s));
   }
   return sessions;
