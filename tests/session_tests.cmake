@@ -147,7 +147,7 @@ add_preflight_test(edges-0-and-12 "/factors/edge/0: an edge must be an integer i
                    "${cards}, \"factors\": {\"edge\": [0, 5, 8, 12]}}")
 # A cut photo and a calibration that does not parse are named with every other problem, not only once the protocol's
 # own are mended (validate named the repetitions alone, then the photo): the parser reads each file a protocol
-# names as the session will (procedure::WithCalibratedBoard's check_content).
+# names as the session will (procedure::PreflightOptions's check_content).
 add_preflight_test(cut-photo-with-others "/scene/background: ${PROJECT_SOURCE_DIR}/tests/data/bad-iccp-truncated.png: truncated PNG: chunk 'IDAT' at byte 76 says it holds 457 bytes, past the end of the 92-byte file; the image is cut short\n${D}/cut-photo-with-others.json: /scene/calib: not a calibration from blurcue calibrate: ${T}/scene/camera.json: /format: must be \"blurcue-calib\" (a file written by blurcue calibrate)\n${D}/cut-photo-with-others.json: /repetitions: must be an integer in [1, 10000] repetitions, got 0\n(3 problems)"
                    "${ball_head} \"scene\": {\"background\": \"${PROJECT_SOURCE_DIR}/tests/data/bad-iccp-truncated.png\", \"calib\": \"${T}/scene/camera.json\"}, \"factors\": {\"pattern\": [${pattern}]}, \"repetitions\": 0}")
 add_preflight_test(inter-trial-1e308 "/timing/inter_trial_ms: must be a number in [0, 60000] ms, got 1e+308"

@@ -21,7 +21,7 @@ under 0.05 px at 0.05 px (as tests/phase_check.py does). Per mask it prints, ove
   - the per-section rule: how many sections were measured (calib.json ok), how many flagged phase_limited, and every
     measured section whose r_px is off max(0.05 px, 10 %) of the truth (seed, edge, section, reading, truth): none
     may be (a section not measured, for whatever flag, counts as flagged, as tests/phase_check.py decides).
-The turned kinds (the board turned 45 and 60 deg under the 0.7 over 0.6 px mask, as tests/phase_tests.cmake's
+The turned kinds (the board turned 20, 30, 45 and 60 deg under the 0.7 over 0.6 px mask, as tests/phase_tests.cmake's
 phase_turned_*_sharpen_07 scenes) are run only when named in --masks; --sections-only holds the per-section rule alone
 (the fitted model's figures are printed, not held).
 Exits 1 when the claim or the rule fails on any mask, 2 when blurcue fails.
@@ -39,7 +39,9 @@ import numpy as np
 # name: (synth-scene arguments, a control: no sharpening, so nothing may be named)
 MASK_07 = ["--focus-mm", "430", "--floor-sigma-px", "0.5", "--post-filter", "sharpen", "--post-sigma-px", "0.6",
            "--post-amount", "0.7"]
-TURNED = {"turned 45 sharpen 0.7/0.6": (MASK_07 + ["--yaw-deg", "45"], False),
+TURNED = {"turned 20 sharpen 0.7/0.6": (MASK_07 + ["--yaw-deg", "20"], False),
+          "turned 30 sharpen 0.7/0.6": (MASK_07 + ["--yaw-deg", "30"], False),
+          "turned 45 sharpen 0.7/0.6": (MASK_07 + ["--yaw-deg", "45"], False),
           "turned 60 sharpen 0.7/0.6": (MASK_07 + ["--yaw-deg", "60"], False)}
 MASKS = {
     "sharpen 0.7/0.6": (["--focus-mm", "430", "--floor-sigma-px", "0.5", "--post-filter", "sharpen",

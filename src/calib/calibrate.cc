@@ -411,13 +411,7 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
 
   if (options.fit_model) ApplyModel(result, result.model);
   if (options.fit_model && result.phase.variance_px2 < 0) PropagateModelError(result, lens, optics_model);
-  if (options.fit_model && options.phase_check && options.only_sections.empty())
-    if (const int off = FlagOffTheLensFit(result); off > 0) {
-      result.phase.flagged += off;
-      result.phase.summary += "; after the lens fit " + std::to_string(off) +
-                              " more on the board's outer edge (beside the table) off its prediction by more than "
-                              "max(0.04 px, 8 %) less its standard error";
-    }
+  if (options.fit_model && options.phase_check && options.only_sections.empty()) FlagOffTheLensFit(result);
   SummariseEdges(&result, lens);
   result.estimate_ms = MsSince(t0);
   return result;

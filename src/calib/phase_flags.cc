@@ -402,6 +402,12 @@ int FlagOffTheLensFit(CalibResult& result) {
     }
     if (last == 0) break;
   }
+  if (flagged > 0) {
+    result.phase.flagged += flagged;
+    result.phase.summary += "; after the lens fit " + std::to_string(flagged) +
+                            " more on the board's outer edge (beside the table) off its prediction by more than "
+                            "max(0.04 px, 8 %) less its standard error";
+  }
   return flagged;
 }
 

@@ -61,7 +61,8 @@ int FlagOffTheirEdge(CalibResult& result);
 // fit at its reading, which the fit held already (the model unchanged). The table's texture there moves a reading
 // more than its standard error says: over 200 scenes (10 kinds of filter and turn, seeds 1-10 and 17-26) 5 outer-edge
 // sections read 10-15 % high unflagged at 2.8-4.1 standard errors, none of the inner ones; this flags all 5 and 66 of
-// the 2656 outer-edge sections measured. Returns how many it flagged.
+// the 2656 outer-edge sections measured. Counts them in result.phase (flagged, and a clause of its summary); returns
+// how many it flagged.
 int FlagOffTheLensFit(CalibResult& result);
 
 }  // namespace blurcue::calib

@@ -22,7 +22,7 @@ using stimulus::Presentation;
 using stimulus::TrialScene;
 using stimulus::CheckVideoTrial;
 
-protocol::ValidateOptions WithCalibratedBoard(const Json& json, const std::filesystem::path& protocol_file) {
+protocol::ValidateOptions PreflightOptions(const Json& json, const std::filesystem::path& protocol_file) {
   protocol::ValidateOptions options;
   // Each photo, picture and calibration the protocol names read as the session reads it (the image's header and whole
   // bytes, the calibration parsed), so that a cut photo is named with every other problem, not only once the rest
@@ -60,7 +60,7 @@ PreparedSession PrepareStudy(const std::filesystem::path& protocol_file, const s
   // Read once: the text recorded with the session is the text that was validated.
   const std::string text = ReadTextFile(protocol_file);
   const Json json = ParseJson(text, protocol_file.string());
-  s.protocol = protocol::ParseProtocol(json, protocol_file, WithCalibratedBoard(json, protocol_file));
+  s.protocol = protocol::ParseProtocol(json, protocol_file, PreflightOptions(json, protocol_file));
   // Each design variable in a column of its own (the record's rule: recorded_names.h), before anything else is read.
   CheckRecordedNames(s.protocol);
   s.protocol_text = protocol::RecordedText(text, s.protocol);

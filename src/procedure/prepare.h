@@ -70,8 +70,10 @@ PreparedSession PrepareStudy(const std::filesystem::path& protocol_file,
 // How PrepareStudy parses `json` (the protocol read from `protocol_file`): against the board of the calibration its
 // photo scene names (scene.calib, resolved as the parser does), read ahead so that an edge or section past that board
 // is named with every other problem of the protocol; without that board (none, a take, one that does not load - which
-// LoadProtocolScene then refuses), against the largest board a calibration can have.
-protocol::ValidateOptions WithCalibratedBoard(const Json& json, const std::filesystem::path& protocol_file);
+// LoadProtocolScene then refuses), against the largest board a calibration can have. Each photo, picture, texture
+// file and calibration it names is read as the session reads it (check_content: the image's header and whole bytes,
+// the calibration parsed), so a cut photo is named with the protocol's other problems too.
+protocol::ValidateOptions PreflightOptions(const Json& json, const std::filesystem::path& protocol_file);
 // `cache`: scenes of earlier participants of the same study (PrepareStudy's, unchanged since) to reuse.
 void PrepareParticipant(PreparedSession* study, const std::string& participant, std::optional<uint64_t> seed,
                         const std::string& group = "", SceneCache* cache = nullptr);

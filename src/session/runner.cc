@@ -263,7 +263,7 @@ RunResult RunSession(const RunOptions& options) {
   // information), then the group a new session gets and the information it is given.
   const Json head_json = ReadJsonFile(options.protocol_file);
   const protocol::Protocol head = protocol::ParseProtocol(
-      head_json, options.protocol_file, procedure::WithCalibratedBoard(head_json, options.protocol_file));
+      head_json, options.protocol_file, procedure::PreflightOptions(head_json, options.protocol_file));
   GroupsSoFar so_far;
   if (head.groups || !head.participant_info.empty())
     so_far = PeekGroups(options.db, head.name, options.participant);
