@@ -410,7 +410,8 @@ CalibResult Calibrate(const PhotoPlanes& planes, const Camera& camera, const Boa
     result.model = FitModelWithinPhaseRanges(result, lens, options.optics_fit, &result.phase.held, &optics_model);
 
   if (options.fit_model) ApplyModel(result, result.model);
-  if (options.fit_model && result.phase.variance_px2 < 0) PropagateModelError(result, lens, optics_model);
+  if (options.fit_model && result.phase.variance_px2 < 0)
+    PropagateModelError(result, lens, optics_model, ValleyModels(result, lens, options.optics_fit));
   if (options.fit_model && options.phase_check && options.only_sections.empty()) FlagOffTheLensFit(result);
   SummariseEdges(&result, lens);
   result.estimate_ms = MsSince(t0);

@@ -500,6 +500,9 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
       PhaseCheck& check = usable[wide[i]]->phase;
       ReadFamilies(p, read, &check);
       check.families.push_back(ReadFamily(p.bins, fitted, p.r_fit, p.phi, p.across, check.noise, p.one_shape));
+      for (int e = 0; e < 2 && result.phase.has_valley; ++e)
+        check.valley_r_px[e] = ReadFamily(p.bins, result.phase.valley[e], p.r_fit, p.phi, p.across, check.noise,
+                                          p.one_shape).r_px;
     });
   };
   // Few sections: every family on each, as CheckPhase. Otherwise the families are first read on kChoiceSections of
@@ -520,7 +523,8 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
     const size_t best = WeighedTotals(checks, nf).best;
     if (best == 0) return;
     std::vector<double> chi2(deciders.size());
-    const PhaseFamily fitted = RefinePhaseFamily(PhaseFamilies()[best], [&](const PhaseFamily& family) {
+    int points = 0;
+    auto total = [&](const PhaseFamily& family) {
       each(deciders.size(), [&](size_t i) {
         const PhaseProfile& p = profiles[deciders[i]];
         chi2[i] = weight[i] * ReadFamily(p.bins, family, p.r_fit, p.phi, p.across,
@@ -529,12 +533,20 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
       double sum = 0;
       for (const double v : chi2) sum += v;
       return sum;
-    });
+    };
+    const PhaseFamily fitted = RefinePhaseFamily(PhaseFamilies()[best], total);
     result.phase.families.push_back(fitted);
+    // Its valley's ends within the margin the choice calls alike (ChoosePhaseFamily's, on these sections).
+    for (const size_t k : deciders) points += usable[k]->phase.bins;
+    const double at = total(fitted), dof = std::max(1, points - 3 * int(deciders.size()) - 1);
+    const auto ends = ValleyEnds(fitted, total, std::max(kAlikeChi2 * std::max(1.0, at / dof), kAlikeRel * (at - dof)));
+    result.phase.has_valley = fitted.sharpen > 0, result.phase.valley[0] = ends[0], result.phase.valley[1] = ends[1];
     each(limited.size(), [&](size_t i) {
       const PhaseProfile& p = profiles[limited[i]];
       PhaseCheck& check = usable[limited[i]]->phase;
       check.families.push_back(ReadFamily(p.bins, fitted, p.r_fit, p.phi, p.across, check.noise, p.one_shape));
+      for (int e = 0; e < 2 && result.phase.has_valley; ++e)
+        check.valley_r_px[e] = ReadFamily(p.bins, ends[e], p.r_fit, p.phi, p.across, check.noise, p.one_shape).r_px;
     });
   };
   if (limited.size() <= 2 * kChoiceSections) {
@@ -670,7 +682,8 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   PhaseChoice choice;
   const std::vector<PhaseFamily> families = result.phase.families.empty() ? PhaseFamilies() : result.phase.families;
   choice.families = families;
-  choice.choice_sections = result.phase.choice_sections;
+  choice.choice_sections = result.phase.choice_sections, choice.has_valley = result.phase.has_valley;
+  std::copy(std::begin(result.phase.valley), std::end(result.phase.valley), choice.valley);
   std::vector<SectionResult*> limited;
   int points = 0;
   for (auto& edge : result.edges)

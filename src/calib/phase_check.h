@@ -79,6 +79,8 @@ struct PhaseCheck {
   // there, so the reading is a bound (the optics' blur at most the mask's), not a value: it does not join the lens fit
   // at it, and its range (0 to what kOpticsRel of the optics' blur leaves) holds the model instead.
   bool bound = false;
+  // Read with the families at either end of the chosen mask's valley (PhaseChoice::valley), NaN where not read.
+  double valley_r_px[2] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
 };
 
 // The families read (the optics alone first).
@@ -119,6 +121,12 @@ struct PhaseChoice {
   std::vector<double> chi2;
   std::vector<bool> alike;
   double chi2_per_point = 0;     // the chosen family's: about 1 where it describes the profiles to the noise
+  // Where a mask was refined between the families: the masks either side along its valley of one second moment that
+  // the deciding sections' profiles cannot tell from it (ValleyEnds), read on every section it reads (valley_r_px).
+  // The readings move alike along it (a mask of 0.25 over 0.9 px read as 0.24 over 0.95 px: every edge 2-5 % low),
+  // which no scatter about the lens model shows: PropagateModelError adds the models refitted under them.
+  bool has_valley = false;
+  PhaseFamily valley[2];
   // The chosen family's taps' second moment across a level edge (px^2; negative for a mask, 0 for the optics alone):
   // a section reads sqrt(r_optics^2 + 4 variance_px2) (FitModelWithinPhaseRanges fits a mask's photo in r_optics).
   double variance_px2 = 0;
@@ -151,6 +159,15 @@ optics::FittedModel FitModelWithinPhaseRanges(const CalibResult& result, const o
 // and the depths where it exceeds 5 % (PhaseChoice::undetermined), propagated from `optics_model`'s fit to the
 // optics' readings (FitModelWithinPhaseRanges) with the sections of one edge as one sample (they share its phase),
 // the readings' own error in the optics' blur added (larger where the filter cancels the whole blur on an edge).
-void PropagateModelError(CalibResult& result, const optics::Lens& lens, const optics::FittedModel& optics_model);
+// `valley`: the optics' models refitted with the readings under PhaseChoice::valley's masks (ValleyModels), each
+// with its mask's variance: half their largest difference from the model's blur is added to its standard error.
+struct ValleyModel {
+  optics::FittedModel optics;
+  double variance_px2 = 0;
+};
+std::vector<ValleyModel> ValleyModels(const CalibResult& result, const optics::Lens& lens,
+                                      const optics::FitOptions& options);
+void PropagateModelError(CalibResult& result, const optics::Lens& lens, const optics::FittedModel& optics_model,
+                         const std::vector<ValleyModel>& valley = {});
 
 }  // namespace blurcue::calib

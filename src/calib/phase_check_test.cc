@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -183,6 +184,16 @@ TEST(PhaseFit, FollowsTheValleyOfOneSecondMoment) {
   const PhaseFamily mask = RefinePhaseFamily({0.6, 0.7}, valley, 30);
   EXPECT_NEAR(mask.sigma_px, 0.9, 0.05);
   EXPECT_NEAR(mask.sharpen, 0.25, 0.03);
+
+  // The valley's ends that fit alike (within 10 of the found one's 100 here: 300 x d^2 > 10 past d = 0.183 px, the
+  // first 0.02 px step beyond at 0.20 px), each with the found mask's second moment, a Gaussian none.
+  const std::array<PhaseFamily, 2> ends = ValleyEnds({0.9, 0.25}, valley, 10);
+  EXPECT_NEAR(ends[0].sigma_px, 0.70, 1e-9);
+  EXPECT_NEAR(ends[1].sigma_px, 1.10, 1e-9);
+  for (const PhaseFamily& end : ends) EXPECT_NEAR(variance(end), target, 1e-9 * target);
+  const std::array<PhaseFamily, 2> none = ValleyEnds({0.45, 0}, valley, 10);
+  EXPECT_EQ(none[0].sigma_px, 0.45);
+  EXPECT_EQ(none[1].sigma_px, 0.45);
 }
 
 // Sections made by hand, read best by an unsharp mask of amount 0.5 (std 0.6 px). Its taps' second moment, written

@@ -101,4 +101,19 @@ PhaseFamily RefinePhaseFamily(const PhaseFamily& start, const std::function<doub
   return FromPoint(x[best], mask);
 }
 
+std::array<PhaseFamily, 2> ValleyEnds(const PhaseFamily& found, const std::function<double(const PhaseFamily&)>& chi2,
+                                      double margin) {
+  std::array<PhaseFamily, 2> ends{found, found};
+  if (!(found.sharpen > 0 && found.sigma_px > 0)) return ends;
+  const double second = found.sharpen * GaussianTapsVariance(found.sigma_px), limit = chi2(found) + margin;
+  for (int side = 0; side < 2; ++side)
+    for (int step = 1; step <= 15; ++step) {
+      const double sigma = found.sigma_px + (side == 0 ? -0.02 : 0.02) * step;
+      if (sigma < kMinSigmaPx || sigma > kMaxSigmaPx) break;
+      ends[side] = FromPoint({sigma, second}, true);
+      if (chi2(ends[side]) > limit) break;
+    }
+  return ends;
+}
+
 }  // namespace blurcue::calib

@@ -6,7 +6,9 @@
 #include <utility>
 #include <vector>
 
+#include "calib/family_esf.h"
 #include "calib/phase_check.h"
+#include "core/error.h"
 
 #include <opencv2/core.hpp>
 
@@ -205,7 +207,31 @@ std::vector<double> ModelGradient(const optics::FittedModel& m, const optics::Le
 // (a cluster-robust sandwich: the sections of an edge share its depth and sub-pixel phase, and a noise-free scene's
 // readings err alike along an edge, by up to 0.5 % of the optics' blur), the readings' own error added (kReadingRel,
 // or kCancelledRel where the filter cancels the whole blur on an edge), then through r = sqrt(r_optics^2 + 4 v).
-void PropagateModelError(CalibResult& result, const optics::Lens& lens, const optics::FittedModel& m) {
+std::vector<ValleyModel> ValleyModels(const CalibResult& result, const optics::Lens& lens,
+                                      const optics::FitOptions& options) {
+  std::vector<ValleyModel> out;
+  const PhaseChoice& p = result.phase;
+  // Only where the mask refined between the families is the one chosen: the ends lie either side of it.
+  if (!p.has_valley || p.families.empty() || p.chosen + 1 != p.families.size()) return out;
+  for (const PhaseFamily& end : p.valley) {
+    CalibResult alt = result;
+    alt.phase.variance_px2 = detail::TapsVariance(detail::FamilyTaps(end));
+    for (auto& edge : alt.edges)
+      for (auto& s : edge.sections)
+        if (std::isfinite(s.phase.valley_r_px[&end - p.valley])) s.fit.r_px = s.phase.valley_r_px[&end - p.valley];
+    ValleyModel v{{}, alt.phase.variance_px2};
+    try {
+      FitModelWithinPhaseRanges(alt, lens, options, nullptr, &v.optics);
+    } catch (const Error&) {
+      continue;  // too few sections under that mask: no term from it
+    }
+    out.push_back(v);
+  }
+  return out;
+}
+
+void PropagateModelError(CalibResult& result, const optics::Lens& lens, const optics::FittedModel& m,
+                         const std::vector<ValleyModel>& valley) {
   const double v = std::min(0.0, result.phase.variance_px2);
   if (!(v < 0) || !std::isfinite(m.focus_mm) || !(m.aperture_mm > 0)) return;
   const int k = static_cast<int>(ModelGradient(m, lens, result.edges.at(0).sections.at(0).u_mm).size());
@@ -250,7 +276,15 @@ void PropagateModelError(CalibResult& result, const optics::Lens& lens, const op
       for (int c = 0; c < k; ++c) var += j[r] * cov(r, c) * j[c];
     // d r / d optics = optics / r, so r's relative error is r_optics^2 / r^2 times the optics' own; where the filter
     // cancels the whole blur, the error no longer is linear: r's own scale (the tests' 0.05 px) bounds it.
-    return optics * stretch / std::max(*r_px, 0.05) * std::sqrt(var);
+    const double se = optics * stretch / std::max(*r_px, 0.05) * std::sqrt(var);
+    // The masks along the chosen one's valley that fit alike (ValleyModels): half the largest move of the blur under
+    // them, as the ends lie about two standard errors out.
+    double moved = 0;
+    for (const ValleyModel& end : valley) {
+      const double o = end.optics.PredictPx(lens, u_mm) * stretch;
+      moved = std::max(moved, std::abs(std::sqrt(std::max(0.0, o * o + 4 * end.variance_px2)) - *r_px));
+    }
+    return std::hypot(se, moved / 2);
   };
   for (auto& edge : result.edges)
     for (auto& s : edge.sections) {
@@ -289,7 +323,7 @@ void PropagateModelError(CalibResult& result, const optics::Lens& lens, const op
   else
     std::snprintf(text, sizeof text,
                   "the model's blur is not determined within %.0f %% at depths %.0f-%.0f mm: its error (standard "
-                  "error and the readings' own %.1f %% in the optics' blur) %s (the sharpening after sampling cancels "
+                  "error, the readings' own %.1f %% in the optics' blur and the masks that fit alike) %s (the sharpening after sampling cancels "
                   "most of the optics' blur, magnifying the optics' own uncertainty); there r_fitted_px is the model's "
                   "estimate, not a result within 5 %%",
                   100 * kModelSeRel, p.undetermined_lo_mm, p.undetermined_hi_mm, 100 * kReadingRel, reach);
