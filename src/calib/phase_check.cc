@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numeric>
 #include <cstdio>
 #include <functional>
 #include <limits>
@@ -470,6 +471,7 @@ PhaseCheck CheckPhase(const cv::Mat& linear, const EdgeSegment& segment, const M
   return check;
 }
 
+// long: one reading plan on shared profiles (deciders, the rest, the refined mask and its valley, the wide).
 void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFitOptions& options, bool parallel) {
   std::vector<SectionResult*> usable;
   for (auto& edge : result.edges)
@@ -518,26 +520,24 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
     const size_t nf = PhaseFamilies().size();
     std::vector<const PhaseCheck*> checks;
     std::vector<double> weight;  // every section in its own units (WeighedTotals's first weighing)
+    int points = 0;
     for (const size_t k : deciders)
-      checks.push_back(&usable[k]->phase), weight.push_back(1 / MisfitScale(usable[k]->phase, 0));
+      checks.push_back(&usable[k]->phase), weight.push_back(1 / MisfitScale(usable[k]->phase, 0)),
+          points += usable[k]->phase.bins;
     const size_t best = WeighedTotals(checks, nf).best;
     if (best == 0) return;
     std::vector<double> chi2(deciders.size());
-    int points = 0;
     auto total = [&](const PhaseFamily& family) {
       each(deciders.size(), [&](size_t i) {
         const PhaseProfile& p = profiles[deciders[i]];
         chi2[i] = weight[i] * ReadFamily(p.bins, family, p.r_fit, p.phi, p.across,
                                          usable[deciders[i]]->phase.noise, p.one_shape, /*table=*/false).chi2;
       });
-      double sum = 0;
-      for (const double v : chi2) sum += v;
-      return sum;
+      return std::accumulate(chi2.begin(), chi2.end(), 0.0);
     };
     const PhaseFamily fitted = RefinePhaseFamily(PhaseFamilies()[best], total);
     result.phase.families.push_back(fitted);
     // Its valley's ends within the margin the choice calls alike (ChoosePhaseFamily's, on these sections).
-    for (const size_t k : deciders) points += usable[k]->phase.bins;
     const double at = total(fitted), dof = std::max(1, points - 3 * int(deciders.size()) - 1);
     const auto ends = ValleyEnds(fitted, total, std::max(kAlikeChi2 * std::max(1.0, at / dof), kAlikeRel * (at - dof)));
     result.phase.has_valley = fitted.sharpen > 0, result.phase.valley[0] = ends[0], result.phase.valley[1] = ends[1];
