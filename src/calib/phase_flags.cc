@@ -213,12 +213,12 @@ std::vector<ValleyModel> ValleyModels(const CalibResult& result, const optics::L
   const PhaseChoice& p = result.phase;
   // Only where the mask refined between the families is the one chosen: the ends lie either side of it.
   if (!p.has_valley || p.families.empty() || p.chosen + 1 != p.families.size()) return out;
-  for (const PhaseFamily& end : p.valley) {
+  for (int e = 0; e < 2; ++e) {
     CalibResult alt = result;
-    alt.phase.variance_px2 = detail::TapsVariance(detail::FamilyTaps(end));
+    alt.phase.variance_px2 = detail::TapsVariance(detail::FamilyTaps(p.valley[e]));
     for (auto& edge : alt.edges)
       for (auto& s : edge.sections)
-        if (std::isfinite(s.phase.valley_r_px[&end - p.valley])) s.fit.r_px = s.phase.valley_r_px[&end - p.valley];
+        if (std::isfinite(s.phase.valley_r_px[e])) s.fit.r_px = s.phase.valley_r_px[e];
     ValleyModel v{{}, alt.phase.variance_px2};
     try {
       FitModelWithinPhaseRanges(alt, lens, options, nullptr, &v.optics);

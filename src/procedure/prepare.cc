@@ -22,23 +22,29 @@ using stimulus::Presentation;
 using stimulus::TrialScene;
 using stimulus::CheckVideoTrial;
 
+namespace {
+
+// What reading `path` as the session reads it finds wrong (empty: nothing): an image's header and whole bytes, or a
+// calibration parsed.
+std::string ContentProblem(const std::filesystem::path& path, protocol::FileUse use) {
+  try {
+    if (use == protocol::FileUse::kImage)
+      RequireImageFileWhole(path);
+    else
+      calib::LoadSceneCalib(path);
+  } catch (const std::exception& e) {
+    return use == protocol::FileUse::kImage ? std::string(e.what()) : std::string(stimulus::kNotACalibration) + e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
 protocol::ValidateOptions PreflightOptions(const Json& json, const std::filesystem::path& protocol_file) {
   protocol::ValidateOptions options;
-  // Each photo, picture and calibration the protocol names read as the session reads it (the image's header and whole
-  // bytes, the calibration parsed), so that a cut photo is named with every other problem, not only once the rest
-  // is mended.
-  options.check_content = [](const std::filesystem::path& path, protocol::FileUse use) -> std::string {
-    try {
-      if (use == protocol::FileUse::kImage)
-        RequireImageFileWhole(path);
-      else
-        calib::LoadSceneCalib(path);
-    } catch (const std::exception& e) {
-      return use == protocol::FileUse::kImage ? std::string(e.what())
-                                              : std::string(stimulus::kNotACalibration) + e.what();
-    }
-    return "";
-  };
+  // Each photo, picture and calibration the protocol names read as the session reads it, so that a cut photo is named
+  // with every other problem, not only once the rest is mended.
+  options.check_content = ContentProblem;
   if (!json.is_object() || !json.contains("scene") || !json["scene"].is_object()) return options;
   const Json& scene = json["scene"];
   if (scene.contains("track") || !scene.contains("calib") || !scene["calib"].is_string()) return options;
@@ -47,11 +53,17 @@ protocol::ValidateOptions PreflightOptions(const Json& json, const std::filesyst
   // Only a regular file, as the parser checks it after: a FIFO or a device would be waited on here.
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error)) return options;
+  // Read once: its board for the parser, and what it found wrong as the calibration's content problem.
+  std::string wrong;
   try {
     const calib::SceneCalib calib = calib::LoadSceneCalib(path);
     options.board_cols = calib.board.cols, options.board_rows = calib.board.rows;
-  } catch (const std::exception&) {
+  } catch (const std::exception& e) {
+    wrong = std::string(stimulus::kNotACalibration) + e.what();
   }
+  options.check_content = [path, wrong](const std::filesystem::path& file, protocol::FileUse use) {
+    return use == protocol::FileUse::kCalibration && file == path ? wrong : ContentProblem(file, use);
+  };
   return options;
 }
 
