@@ -427,9 +427,12 @@ Json PhaseCheckJson(const PhaseCheck& p) {
     if (std::isfinite(f.r_table_px)) readings.back()["r_table_px"] = f.r_table_px;  // on the board's outer edge
     if (std::isfinite(f.r_se_px)) readings.back()["r_se_px"] = f.r_se_px;
   }
-  return {{"axis_deg", p.axis_deg}, {"span_px", p.span_px}, {"every_phase", p.every_phase}, {"phase_px", p.phase_px}, {"noise", p.noise},
-          {"bins", p.bins}, {"range_px", {p.range_lo_px, p.range_hi_px}}, {"joins_fit", p.joins_fit}, {"bound", p.bound},
-          {"families", readings}};
+  Json j = {{"axis_deg", p.axis_deg}, {"span_px", p.span_px}, {"every_phase", p.every_phase}, {"phase_px", p.phase_px},
+            {"noise", p.noise}, {"bins", p.bins}, {"range_px", {p.range_lo_px, p.range_hi_px}}, {"joins_fit", p.joins_fit},
+            {"bound", p.bound}, {"families", readings}};
+  if (std::isfinite(p.valley_r_px[0]) && std::isfinite(p.valley_r_px[1]))  // the chosen mask's valley ends' readings
+    j["valley_r_px"] = {p.valley_r_px[0], p.valley_r_px[1]};
+  return j;
 }
 
 Json PhaseChoiceJson(const PhaseChoice& c) {

@@ -233,8 +233,48 @@ TEST(PhaseCheck, SectionWhereTheChosenSharpeningCancelsMostOfTheBlurOrJumpsIsFla
   const ModelFit& jumped = result.edges[2].sections[0].fit;
   EXPECT_FALSE(jumped.ok);
   EXPECT_NE(jumped.phase_why.find("lies 0.17 px outside"), std::string::npos) << jumped.phase_why;
-  EXPECT_NE(choice.summary.find("2 flagged phase_limited (0 where the kinds that fit alike read apart, 1 where the sharpening cancels"), std::string::npos)
+  EXPECT_NE(choice.summary.find("2 flagged phase_limited (0 where the kinds that fit alike read apart, 0 where masks along "
+                                "the chosen one's valley (one second moment, fitting alike) read apart, 1 where the "
+                                "sharpening cancels"),
+            std::string::npos)
       << choice.summary;
+}
+
+// The chosen mask's valley ends (masks of its second moment that fit alike) read a section at few phases 0.72 and
+// 0.88 px about its 0.80 px: 0.16 px apart, over max(0.04 px, 8 % of 0.80); flagged, and it joins the lens fit at its
+// reading. One whose ends read 0.88-0.93 px about 0.90 is not (0.05 under 0.072), nor one at every phase whose ends
+// read 0.70-0.95 px (its own profile pins the optics' shape).
+TEST(PhaseCheck, SectionTheMaskValleyReadsApartIsFlaggedAndJoinsTheFit) {
+  const size_t n = PhaseFamilies().size(), chosen = FamilyIndex(0.6, 0.5);
+  CalibResult result;
+  result.phase.has_valley = true;
+  result.phase.valley[0] = {0.56, 0.55, true}, result.phase.valley[1] = {0.64, 0.45, true};
+  const double reading[3] = {0.80, 0.90, 0.85}, ends[3][2] = {{0.72, 0.88}, {0.88, 0.93}, {0.70, 0.95}};
+  result.edges.resize(3);
+  for (int e = 0; e < 3; ++e) {
+    SectionResult s;
+    s.edge = e + 1, s.section = 1, s.u_mm = 400;
+    s.fit.ok = true, s.fit.r_px = 1.0;
+    s.phase.limited = e < 2, s.phase.every_phase = e == 2, s.phase.bins = 20;
+    s.phase.families.assign(n, PhaseReading{});
+    for (size_t c = 0; c < n; ++c) s.phase.families[c] = {1.5, 0, 0.01, 1e4};
+    for (const size_t c : PhaseNeighbours(chosen)) s.phase.families[c] = {reading[e], 0, 0.01, 1e4};
+    s.phase.families[chosen] = {reading[e], 0, 0.001, 18};
+    s.phase.valley_r_px[0] = ends[e][0], s.phase.valley_r_px[1] = ends[e][1];
+    result.edges[e].sections.push_back(s);
+  }
+  const PhaseChoice choice = ChoosePhaseFamily(result);
+  EXPECT_EQ(choice.chosen, chosen);
+  EXPECT_EQ(choice.flagged, 1);
+  const SectionResult& apart = result.edges[0].sections[0];
+  EXPECT_FALSE(apart.fit.ok);
+  EXPECT_TRUE(apart.phase.joins_fit);
+  EXPECT_NE(apart.fit.phase_why.find("read 0.72-0.88 px here"), std::string::npos) << apart.fit.phase_why;
+  EXPECT_DOUBLE_EQ(apart.phase.range_lo_px, 0.72);
+  EXPECT_DOUBLE_EQ(apart.phase.range_hi_px, 0.88);
+  EXPECT_TRUE(result.edges[1].sections[0].fit.ok);
+  EXPECT_TRUE(result.edges[2].sections[0].fit.ok);
+  EXPECT_NE(choice.summary.find("1 where masks along the chosen one's valley"), std::string::npos) << choice.summary;
 }
 
 // After the lens fit, a measured section on the board's outer edge whose reading lies off the fit's prediction by more

@@ -1,6 +1,7 @@
 #include "calib/phase_flags.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <utility>
@@ -443,6 +444,45 @@ int FlagOffTheLensFit(CalibResult& result) {
                             "max(0.04 px, 8 %) less its standard error";
   }
   return flagged;
+}
+
+std::string ChoiceSummary(const PhaseChoice& choice, size_t best, const std::array<int, 8>& flags, int wide) {
+  const std::vector<PhaseFamily>& families = choice.families;
+  int n_alike = 0, n_read = 0;
+  for (const bool a : choice.alike) n_alike += a;
+  for (const double c : choice.chi2) n_read += std::isfinite(c);
+  char text[1300], ruled[120] = "";
+  if (n_read < int(families.size()))
+    std::snprintf(ruled, sizeof ruled, "; %zu ruled out on %zu sections at spread phases and not read on the rest",
+                  families.size() - n_read, choice.choice_sections);
+  std::snprintf(text, sizeof text,
+                "%d sections with blur under %.0f px along the pixel rows or columns (and %d at every phase) read under "
+                "%zu kinds of blur (the lens alone, or then a smoothing or sharpening of the pixels): the photo fits "
+                "best as %s (%d of the kinds fit alike, chi-square per point %.2f, 1 where only the noise is left%s); %d "
+                "flagged phase_limited (%d where the kinds that fit alike read apart, %d where masks along the chosen one's "
+                "valley (one second moment, fitting alike) read apart, %d where the sharpening cancels "
+                "most of the lens's blur, %d jumping between "
+                "neighbouring kinds, %d off the line through their edge's other sections, %d too unsure near a pixel "
+                "centre, %d on the board's outer edge moved by the table's slope, %d at every phase whose standard "
+                "error leaves the target; each reading's range in calib.json); "
+                "%d sections of %.0f px or more read with it too",
+                choice.limited, kMaxBlurPx, choice.every_phase, families.size(), families[best].Name().c_str(), n_alike,
+                choice.chi2_per_point, ruled, choice.flagged, flags[6], flags[7], flags[0], flags[1], flags[2], flags[3], flags[4],
+                flags[5],
+                wide,
+                kMaxBlurPx);
+  return text;
+}
+
+std::string ValleyWhy(double r, double lo, double hi) {
+  char why[400];
+  std::snprintf(why, sizeof why,
+                "the mask fitted between the families is not pinned along its valley (masks of the same second moment "
+                "and other stds fit the board's profiles alike) and those read %.2f-%.2f px here, more than max(%.2f "
+                "px, %.0f %%) apart around %.2f px: it joins the lens fit at its reading (the valley's move is in the "
+                "model's standard error)",
+                lo, hi, kSpreadPx, 100 * kSpreadRel, r);
+  return why;
 }
 
 }  // namespace blurcue::calib

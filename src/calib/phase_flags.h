@@ -3,6 +3,7 @@
 // (phase_check.h's FitModelWithinPhaseRanges): what ChoosePhaseFamily does with a section once the family is chosen.
 #include "calib/calibrate.h"
 
+#include <array>
 #include <string>
 
 namespace blurcue::calib {
@@ -36,6 +37,12 @@ std::string TableWhy(double r, double r_table);
 // A flagged section's reason, in words (calib.json's phase_why and the summary): the families alike read lo-hi, the
 // chosen one r under a filter of variance v, `moved` by the cancellation, `nearest` its nearest neighbouring family's.
 std::string PhaseWhy(const SectionResult& s, double lo, double hi, double r, double v, double moved, double nearest);
+// A section flagged where the masks at the ends of the chosen mask's valley (PhaseChoice::valley) read lo-hi about its r.
+std::string ValleyWhy(double r, double lo, double hi);
+// ChoosePhaseFamily's summary: `flags` counts the flags by reason (cancelled, jumped, off their edge, unsure, moved by
+// the table's slope, noisy at every phase, read apart by the families that fit alike, read apart along the valley);
+// `wide` the sections of 2 px or more read with the chosen family.
+std::string ChoiceSummary(const PhaseChoice& choice, size_t best, const std::array<int, 8>& flags, int wide);
 
 // Where a filter after sampling was chosen (family `best`), a section at every phase that no other rule flagged and
 // whose reading's standard error times kSeSpan exceeds `target` is flagged phase_limited and joins the lens fit at its

@@ -108,13 +108,14 @@ void PrintCalibrationSummary(const calib::CalibResult& result, const Board& boar
       if (n > 0 && flag != "short")  // short: its own line below
         std::printf("%d sections flagged %s: %s\n", n, flag.c_str(), calib::SectionFlagMeaning(flag).c_str());
     }
-    // phase_limited sections flagged only by a sharpening's amplification join the fit at their readings.
+    // phase_limited sections flagged only by a sharpening's amplification, the valley or their noise join the fit.
     int n_joined = 0;
     for (const auto& e : result.edges)
       for (const auto& sec : e.sections) n_joined += sec.phase.joins_fit;
     if (n_joined > 0)
       std::printf("%d of them phase_limited but joined at their readings (a sharpening that cancels most of the "
-                  "optics' blur there, or an edge near a pixel centre): each reading unsure alone, pooled by the fit\n",
+                  "optics' blur there, masks along the chosen one's valley that read them apart, or an edge near a "
+                  "pixel centre): each reading unsure alone, pooled by the fit\n",
                   n_joined);
     // Sections used but read on a shorter central part (a neighbouring X-junction within the blur's reach): said,
     // as the flag in calib.json says it, since such a reading can run a few per cent high.
