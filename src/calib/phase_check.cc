@@ -645,28 +645,12 @@ int TakeWideReadings(CalibResult& result, size_t best, size_t nf, int* tabled) {
 }  // namespace
 
 
-PhaseChoice ChoosePhaseFamily(CalibResult& result) {
-  PhaseChoice choice;
-  const std::vector<PhaseFamily> families = result.phase.families.empty() ? PhaseFamilies() : result.phase.families;
-  choice.families = families;
-  choice.choice_sections = result.phase.choice_sections, choice.has_valley = result.phase.has_valley;
-  std::copy(std::begin(result.phase.valley), std::end(result.phase.valley), choice.valley);
-  std::vector<SectionResult*> limited;
-  int points = 0;
-  for (auto& edge : result.edges)
-    for (auto& s : edge.sections)
-      if (s.fit.ok && (s.phase.limited || s.phase.every_phase) && s.phase.families.size() == families.size()) {
-        limited.push_back(&s);
-        points += s.phase.bins;
-        choice.limited += s.phase.limited;
-        choice.every_phase += s.phase.every_phase;
-      }
-  choice.chi2.assign(families.size(), 0.0);
-  choice.alike.assign(families.size(), false);
-  if (limited.empty()) {
-    choice.summary = "no usable section has blur under 2 px";
-    return choice;
-  }
+namespace {
+
+// ChoosePhaseFamily's choice over the `limited` sections (`points` profile points in all): every family's chi-square,
+// which fit alike, and the one chosen (choice.chi2, alike, chosen, chi2_per_point); returns the chosen.
+size_t ChooseOverSections(const std::vector<SectionResult*>& limited, int points, PhaseChoice& choice) {
+  const std::vector<PhaseFamily>& families = choice.families;
   // A filter on the sampled image is the whole photo's: each family's chi-square over every limited section. One
   // section's few phases leave the families alike; the edges' different phases tell them apart.
   // Each section weighed by its own misfit (MisfitScale); the raw sum is kept for the chosen family's chi-square per
@@ -700,6 +684,34 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
       if (!families[c].fitted && choice.alike[c] && (families[best].fitted || choice.chi2[c] < choice.chi2[best])) best = c;
   choice.chosen = best;
   choice.chi2_per_point = raw[best] / dof;
+  return best;
+}
+
+}  // namespace
+
+PhaseChoice ChoosePhaseFamily(CalibResult& result) {
+  PhaseChoice choice;
+  const std::vector<PhaseFamily> families = result.phase.families.empty() ? PhaseFamilies() : result.phase.families;
+  choice.families = families;
+  choice.choice_sections = result.phase.choice_sections, choice.has_valley = result.phase.has_valley;
+  std::copy(std::begin(result.phase.valley), std::end(result.phase.valley), choice.valley);
+  std::vector<SectionResult*> limited;
+  int points = 0;
+  for (auto& edge : result.edges)
+    for (auto& s : edge.sections)
+      if (s.fit.ok && (s.phase.limited || s.phase.every_phase) && s.phase.families.size() == families.size()) {
+        limited.push_back(&s);
+        points += s.phase.bins;
+        choice.limited += s.phase.limited;
+        choice.every_phase += s.phase.every_phase;
+      }
+  choice.chi2.assign(families.size(), 0.0);
+  choice.alike.assign(families.size(), false);
+  if (limited.empty()) {
+    choice.summary = "no usable section has blur under 2 px";
+    return choice;
+  }
+  const size_t best = ChooseOverSections(limited, points, choice);
   const double v_best = TapsVariance(FamilyTaps(families[best]));
   choice.variance_px2 = v_best;
   int cancelled = 0, jumped = 0, unsure = 0, tabled = 0, noisy = 0, apart = 0, valleyed = 0;
