@@ -173,6 +173,15 @@ phase_scene(turn30_sharpen_seed18 --focus-mm 430 --floor-sigma-px 0.5 --post-fil
 phase_check(phase_turned_30_sharpen_07_outer_edge turn30_sharpen_seed18
             "after the lens fit 1 more on the board's outer edge.*\nok: filtered targets met" --expect filtered
             --fitted-p90 0.10 --undetermined-covers)
+# Held out (tests/undetermined_coverage.py, seeds 27-36): the mask 0.35 over 0.9 px focused at 450 mm is refined to
+# 0.25 over 1.04 px on seed 33, along its valley of one second moment, and edge 3 read 6-13 % low (section 2: 0.63 px
+# for 0.72 px) unflagged. The valley's ends read it 0.55-0.68 px: a section at few phases whose reading moves by more
+# than max(0.04 px, 8 %) between them is flagged and joins the lens fit (PhaseCheck.SectionTheMaskValleyReadsApart...).
+phase_scene(sharpen_035_09_f450_seed33 --focus-mm 450 --floor-sigma-px 0.5 --post-filter sharpen --post-sigma-px 0.9
+            --post-amount 0.35 --noise 0.002 --seed 33)
+phase_check(phase_filtered_sharpen_035_09_valley sharpen_035_09_f450_seed33
+            "[1-9][0-9]* where masks along the chosen one's valley.*\nok: filtered targets met" --expect filtered
+            --sections-only --undetermined-covers)
 # The bench's Gaussian of 0.35 px (bench measure --quick, seed 1): edge 7 lies 0.09 px past a pixel centre, its profile
 # a handful of samples, and its seven sections of one true blur (0.62 px) read 0.58-0.70 px under the family that fits
 # (the families' spread 0.03 px): section 1 at 0.70 px (+12.5 %) unflagged. Now a section off the line through its
