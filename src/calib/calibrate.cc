@@ -358,7 +358,7 @@ void SummariseEdges(CalibResult* out, const optics::Lens& lens) {
       // The edge's measured value is what blur source `measured` draws (scene_blur.cc): the mean over its usable
       // sections and those pooled into the lens fit (phase.joins_fit). Eq. 3.7 needs only a section's depth.
       if (s.fit.ok) ++edge.usable, edge.r_thesis_px += s.thesis.r_px;
-      if (s.fit.ok || s.phase.joins_fit) ++edge.measured, edge.r_px += s.fit.r_px;
+      if (InModel(s)) ++edge.measured, edge.r_px += s.fit.r_px;
       if (s.r_estimated_px) ++edge.estimated, edge.r_estimated_px += *s.r_estimated_px;
     }
     edge.u_mm = su / edge.sections.size();
@@ -456,11 +456,12 @@ Json PhaseChoiceJson(const PhaseChoice& c) {
                    "taken, and "
                    "a section whose reading moves by more than max(0.04 px, 8 %) among the families that fit alike "
                    "(or under a sharpening that cancels most of the optics' blur, or that jumps outside its "
-                   "neighbouring families' readings) is flagged phase_limited (phase_why says which) and predicted "
+                   "neighbouring families' readings, or, at few phases, between the masks at the ends of a refined "
+                   "mask's valley, valley_r_px) is flagged phase_limited (phase_why says which) and predicted "
                    "by the lens fit; with the optics alone, one whose reading's standard error (r_se_px) exceeds "
                    "2 % (an edge near a pixel centre) is flagged too; it is left out of that fit but for those "
-                   "flagged by the cancellation or the standard error alone (phase.joins_fit), which join it at "
-                   "their readings; on the board's outer edges each family is read again with the table's slope "
+                   "flagged by the cancellation, the valley or the standard error alone (phase.joins_fit), which "
+                   "join it at their readings; on the board's outer edges each family is read again with the table's slope "
                    "(r_table_px) and, where a filter is chosen, a section whose two readings differ by that much is "
                    "flagged too, as is one (after the lens fit) whose reading lies off the fit's prediction by more "
                    "than that less the prediction's standard error (the table's texture); sections of 2 px or more "
