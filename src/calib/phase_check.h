@@ -155,7 +155,7 @@ optics::FittedModel FitModelWithinPhaseRanges(const CalibResult& result, const o
                                               const optics::FitOptions& options, int* held = nullptr,
                                               optics::FittedModel* optics_model = nullptr);
 
-// Where the chosen family sharpens: the lens model's standard error at every section (SectionResult::r_fitted_se_px)
+// On every photo with a lens fit: the lens model's standard error at every section (SectionResult::r_fitted_se_px)
 // and the depths where it exceeds 5 % (PhaseChoice::undetermined), propagated from `optics_model`'s fit to the
 // optics' readings (FitModelWithinPhaseRanges) with the sections of one edge as one sample (they share its phase),
 // the readings' own error in the optics' blur added (larger where the filter cancels the whole blur on an edge).
