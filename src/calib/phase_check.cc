@@ -642,11 +642,6 @@ int TakeWideReadings(CalibResult& result, size_t best, size_t nf, int* tabled) {
   return wide;
 }
 
-}  // namespace
-
-
-namespace {
-
 // ChoosePhaseFamily's choice over the `limited` sections (`points` profile points in all): every family's chi-square,
 // which fit alike, and the one chosen (choice.chi2, alike, chosen, chi2_per_point); returns the chosen.
 size_t ChooseOverSections(const std::vector<SectionResult*>& limited, int points, PhaseChoice& choice) {
