@@ -323,20 +323,17 @@ void PropagateModelError(CalibResult& result, const optics::Lens& lens, const op
                   "a lens fitted beside them errs by a few %% in the optics' blur, which the sharpening magnifies "
                   "(its error %s); there r_fitted_px is the model's estimate, not a result within 5 %%",
                   100 * kModelSeRel, p.undetermined_lo_mm, p.undetermined_hi_mm, cut_lo, cut_hi, cancelled, reach);
-  else if (v < 0)
+  else  // the error's parts and its cause: the mask's, or near focus the profiles' own
     std::snprintf(text, sizeof text,
                   "the model's blur is not determined within %.0f %% at depths %.0f-%.0f mm: its error (standard "
-                  "error, the readings' own %.1f %% in the optics' blur and the masks that fit alike) %s (the "
-                  "sharpening after sampling cancels most of the optics' blur, magnifying the optics' own "
-                  "uncertainty); there r_fitted_px is the model's estimate, not a result within 5 %%",
-                  100 * kModelSeRel, p.undetermined_lo_mm, p.undetermined_hi_mm, 100 * kReadingRel, reach);
-  else
-    std::snprintf(text, sizeof text,
-                  "the model's blur is not determined within %.0f %% at depths %.0f-%.0f mm: its error (standard "
-                  "error and the readings' own %.1f %%) %s (near focus the blur is small and its profiles pin it least: a "
-                  "sharp step reads alike from 0 to about 0.3 px); there r_fitted_px is the model's estimate, not a "
-                  "result within 5 %%",
-                  100 * kModelSeRel, p.undetermined_lo_mm, p.undetermined_hi_mm, 100 * kReadingRel, reach);
+                  "error, the readings' own %.1f %%%s) %s (%s); there r_fitted_px is the model's estimate, not a result "
+                  "within 5 %%",
+                  100 * kModelSeRel, p.undetermined_lo_mm, p.undetermined_hi_mm, 100 * kReadingRel,
+                  v < 0 ? " in the optics' blur and the masks that fit alike" : "", reach,
+                  v < 0 ? "the sharpening after sampling cancels most of the optics' blur, magnifying the optics' own "
+                          "uncertainty"
+                        : "near focus the blur is small and its profiles pin it least: a sharp step reads alike from 0 "
+                          "to about 0.3 px");
   p.undetermined = text;
 }
 
