@@ -22,7 +22,7 @@ figures, and exits 1 when a target is missed:
 --fitted-p90 F: with --expect filtered, the fitted model's p90 target F in place of 5 % (where it is known to break:
       sharpening that cancels most of the optics' blur near focus, docs/independent-truth.md).
 --undetermined-covers: with --expect filtered, every section whose fitted model misses max(0.05 px, 5 %) must lie within
-      the depths calib.json's phase_check.model_undetermined names (where calibrate says the model is not determined
+      the depths calib.json's model.undetermined names (where calibrate says the model is not determined
       within 5 %: a mask that cancels most of the optics' blur near focus); none named counts as no depth.
 --max-off N: with --expect filtered, at most N sections off max(0.05 px, 10 %) unflagged in place of 0 (a known miss,
       named where the test is defined; every such section is still printed).
@@ -82,7 +82,7 @@ def main():
                                               "%.4f px^2" % (post["kind"], post["sigma_px"], post["amount"],
                                                              post["variance_px2"])))
     measured, signed, fitted, off, flagged, uncovered = [], [], [], [], 0, []
-    undetermined = (calib.get("phase_check") or {}).get("model_undetermined")
+    undetermined = calib["model"].get("undetermined")
     u_lo, u_hi = undetermined["u_mm"] if undetermined else (1, 0)
     if undetermined:
         print("calibrate: %s" % undetermined["why"])

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Checks by simulation calibrate's claim "the model's blur is not determined within 5 % at depths X-Y mm" (issue 42,
-calib.json phase_check.model_undetermined): outside the depths it names, the fitted model holds issue 42's target;
+calib.json model.undetermined): outside the depths it names, the fitted model holds issue 42's target;
 and issue 42's per-section rule for images filtered after sampling: each section's reading within max(0.05 px, 10 %)
 of the truth or flagged phase_limited.
 
@@ -92,7 +92,7 @@ def sections(calib, truth):
     """Per section: (u_mm, fitted, truth, se or nan, inside the named depths); the model_undetermined named; and the
     per-section rule: (measured, flagged phase_limited, [(edge, section, r_px, truth) off the rule unflagged])."""
     true = {(s["edge"], s["section"]): s["r_px"] for s in truth["sections"]}
-    named = (calib.get("phase_check") or {}).get("model_undetermined")
+    named = calib["model"].get("undetermined")
     lo, hi = named["u_mm"] if named else (1, 0)
     rows, measured, flagged, off = [], 0, 0, []
     for e in calib["edges"]:

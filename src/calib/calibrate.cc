@@ -447,10 +447,6 @@ Json PhaseChoiceJson(const PhaseChoice& c) {
           {"chosen", c.limited + c.every_phase > 0 ? Json(c.families[c.chosen].Name()) : Json(nullptr)},
           {"chi2_per_point", c.chi2_per_point}, {"variance_px2", c.variance_px2}, {"families", families},
           {"summary", c.summary},
-          {"model_undetermined", c.undetermined.empty() ? Json(nullptr)
-                                                        : Json({{"u_mm", {c.undetermined_lo_mm, c.undetermined_hi_mm}},
-                                                                {"worst_se_rel", c.worst_se_rel},
-                                                                {"why", c.undetermined}})},
           {"note", "sections along the pixel rows or columns with blur under 2 px are read once per PSF family "
                    "(the optics, then on the sampled image a Gaussian of post_sigma_px or an unsharp mask of that std "
                    "and amount `sharpen`; each section's phase.families in that order) with the edge where the pose "
@@ -545,6 +541,10 @@ Json CalibToJson(const CalibResult& r) {
                  {"floor_determined", m.floor_determined}, {"rms_px", m.rms_px},
                  {"loo_rms_px", m.loo_rms_px}, {"samples_used", m.samples_used}, {"outliers", m.outliers},
                  {"sections_left_out", SectionsLeftOut(r)},
+                 {"undetermined", !r.undetermined.Named() ? Json(nullptr)
+                                                          : Json({{"u_mm", {r.undetermined.lo_mm, r.undetermined.hi_mm}},
+                                                                  {"worst_se_rel", r.undetermined.worst_se_rel},
+                                                                  {"why", r.undetermined.why}})},
                  {"choice", choice},
                  {"fitted_to", r.phase.variance_px2 < 0
                                    ? "the optics' readings sqrt(r_px^2 - 4 phase_check.variance_px2) (a sharpening after "
@@ -571,11 +571,10 @@ std::string FormatEdgeTable(const CalibResult& r, const std::vector<double>& tru
   out += line;
   for (size_t i = 0; i < r.edges.size(); ++i) {
     const EdgeResult& e = r.edges[i];
-    // The model's value, in parentheses where it is not determined within 5 % (PhaseChoice::undetermined).
+    // The model's value, in parentheses where it is not determined within 5 % (CalibResult::undetermined).
     char fitted[32] = "        -";  // without a fitted model
     if (r.model.samples_used > 0) {
-      const bool unsure = !r.phase.undetermined.empty() && e.u_mm >= r.phase.undetermined_lo_mm &&
-                          e.u_mm <= r.phase.undetermined_hi_mm;
+      const bool unsure = r.undetermined.Inside(e.u_mm);
       char value[24];
       std::snprintf(value, sizeof value, unsure ? "(%.2f)" : "%.2f", e.r_fitted_px);
       std::snprintf(fitted, sizeof fitted, "%9s", value);

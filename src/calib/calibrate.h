@@ -75,6 +75,16 @@ struct EdgeResult {
   double r_px = 0, r_thesis_px = 0, r_estimated_px = 0, r_fitted_px = 0;
 };
 
+// Where the lens model's blur is not determined within 5 % (PropagateModelError: its standard error, the readings' own
+// and, under a mask, the masks that fit alike): camera depths (mm), the largest relative standard error on the board,
+// and the sentence that says why (empty where nowhere on the board).
+struct ModelUndetermined {
+  double lo_mm = 0, hi_mm = 0, worst_se_rel = 0;
+  std::string why;
+  bool Named() const { return !why.empty(); }
+  bool Inside(double u_mm) const { return Named() && u_mm >= lo_mm && u_mm <= hi_mm; }
+};
+
 struct CalibResult {
   Camera camera;
   Board board;
@@ -82,6 +92,7 @@ struct CalibResult {
   int reference_edge = 1;
   double reference_u_mm = 0, reference_r_px = 0;
   optics::FittedModel model;
+  ModelUndetermined undetermined;  // where `model` is not determined within 5 % (calib.json model.undetermined)
   PhaseChoice phase;  // the PSF family the sections chose where phases are few, and how many were flagged
   std::vector<EdgeResult> edges;
   double detect_ms = 0, measure_ms = 0, estimate_ms = 0;  // where the time went

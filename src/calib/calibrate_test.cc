@@ -611,27 +611,33 @@ TEST(SceneCalib, BadFieldIsNamed) {
   EXPECT_THROW(ParseBlurSource("blurry", nullptr), Error);
 }
 
-// phase_check.model_undetermined (calibrate's depths where the lens model is not determined within 5 %) is read:
-// the fitted source inside them gets a note naming the file and the field, outside them and other sources none; a
-// hand edit that would move or hide them is refused, named.
+// model.undetermined (calibrate's depths where the lens model is not determined within 5 %) is read: the fitted
+// source inside them gets a note naming the file and the field, outside them and other sources none; a hand edit
+// that would move or hide them is refused, named, as is a calibration that kept them in their earlier place.
 TEST(SceneCalib, UndeterminedDepthsAreReadAndNoted) {
   const Calibration& r = Calibrated(Thesis());
   Json j = CalibToJson(r.result);
-  j["phase_check"] = {{"model_undetermined", {{"u_mm", {400.0, 420.0}}, {"worst_se_rel", 0.12}, {"why", "w"}}}};
+  j["model"]["undetermined"] = {{"u_mm", {400.0, 420.0}}, {"worst_se_rel", 0.12}, {"why", "w"}};
   const SceneCalib s = SceneCalibFromJson(j, "calib.json: ");
   EXPECT_EQ(UndeterminedNote(s, BlurSource::kFitted, 410),
             "the fitted blur at 410 mm is the lens model's estimate, not a result within 5 %: the model is not "
-            "determined within 5 % at 400-420 mm (its error up to 12 %: a sharpening after sampling cancels "
-            "most of the optics' blur there; calib.json /phase_check/model_undetermined)");
+            "determined within 5 % at 400-420 mm (its error up to 12 %; why: calib.json /model/undetermined)");
   EXPECT_EQ(UndeterminedNote(s, BlurSource::kFitted, 421), "");
   EXPECT_EQ(UndeterminedNote(s, BlurSource::kEstimated, 410), "");
-  j["phase_check"]["model_undetermined"] = nullptr;
+  j["model"]["undetermined"] = nullptr;
   EXPECT_EQ(UndeterminedNote(SceneCalibFromJson(j, "calib.json: "), BlurSource::kFitted, 410), "");
-  j["phase_check"]["model_undetermined"] = {{"u_mm", {420.0, 400.0}}, {"worst_se_rel", 0.12}};
-  ExpectCalibRefused(j, "calib.json: /phase_check/model_undetermined/u_mm: must be [near, far] depths in mm, 0 < near "
+  j["model"]["undetermined"] = {{"u_mm", {420.0, 400.0}}, {"worst_se_rel", 0.12}};
+  ExpectCalibRefused(j, "calib.json: /model/undetermined/u_mm: must be [near, far] depths in mm, 0 < near "
                         "<= far, got [420.0,400.0]");
-  j["phase_check"]["model_undetermined"] = {{"u_mm", {400.0, 420.0}}};
-  ExpectCalibRefused(j, "calib.json: /phase_check/model_undetermined/worst_se_rel: is required but missing");
+  j["model"]["undetermined"] = {{"u_mm", {400.0, 420.0}}};
+  ExpectCalibRefused(j, "calib.json: /model/undetermined/worst_se_rel: is required but missing");
+  j["model"]["undetermined"] = nullptr;
+  j["phase_check"]["model_undetermined"] = {{"u_mm", {400.0, 420.0}}, {"worst_se_rel", 0.12}, {"why", "w"}};
+  ExpectCalibRefused(j, "calib.json: /phase_check/model_undetermined: is now read from /model/undetermined (a "
+                        "calibration written before kept it here, where its depths would go unsaid): calibrate the "
+                        "photo again, or move the field there");
+  j["phase_check"]["model_undetermined"] = nullptr;  // an earlier calibration that named none
+  EXPECT_EQ(UndeterminedNote(SceneCalibFromJson(j, "calib.json: "), BlurSource::kFitted, 410), "");
   j["phase_check"] = Json::array();  // a hand edit that would hide the depths
   ExpectCalibRefused(j, "calib.json: /phase_check: must be an object, got []");
 }

@@ -130,10 +130,6 @@ struct PhaseChoice {
   // The chosen family's taps' second moment across a level edge (px^2; negative for a mask, 0 for the optics alone):
   // a section reads sqrt(r_optics^2 + 4 variance_px2) (FitModelWithinPhaseRanges fits a mask's photo in r_optics).
   double variance_px2 = 0;
-  // Where it sharpens: the depths (mm) where the lens model's standard error (PropagateModelError) exceeds 5 % of
-  // its prediction, in words (empty where nowhere on the board), and the largest relative standard error there.
-  double undetermined_lo_mm = 0, undetermined_hi_mm = 0, worst_se_rel = 0;
-  std::string undetermined;
   std::string summary = "not checked (--no-phase-check, or a take's frames: no lens fit per frame)";  // in words
 };
 
@@ -156,7 +152,7 @@ optics::FittedModel FitModelWithinPhaseRanges(const CalibResult& result, const o
                                               optics::FittedModel* optics_model = nullptr);
 
 // On every photo with a lens fit: the lens model's standard error at every section (SectionResult::r_fitted_se_px)
-// and the depths where it exceeds 5 % (PhaseChoice::undetermined), propagated from `optics_model`'s fit to the
+// and the depths where it exceeds 5 % (CalibResult::undetermined), propagated from `optics_model`'s fit to the
 // optics' readings (FitModelWithinPhaseRanges) with the sections of one edge as one sample (they share its phase),
 // the readings' own error in the optics' blur added (larger where the filter cancels the whole blur on an edge).
 // `valley`: the optics' models refitted with the readings under PhaseChoice::valley's masks (ValleyModels), each

@@ -294,9 +294,8 @@ void PropagateModelError(CalibResult& result, const optics::Lens& lens, const op
       double r;
       s.r_fitted_se_px = spread(s.u_mm, s.stretch, &r);
     }
-  PhaseChoice& p = result.phase;
-  p.undetermined_lo_mm = p.undetermined_hi_mm = p.worst_se_rel = 0;
-  p.undetermined.clear();
+  ModelUndetermined& p = result.undetermined;
+  p = ModelUndetermined();
   bool found = false;
   for (int i = 0; i <= 200; ++i) {  // the board's depths, every 0.5 % of their span
     const double u = u_lo + (u_hi - u_lo) * i / 200.0;
@@ -304,8 +303,8 @@ void PropagateModelError(CalibResult& result, const optics::Lens& lens, const op
     const double rel = spread(u, 1.0, &r) / std::max(r, 0.05);
     p.worst_se_rel = std::max(p.worst_se_rel, rel);
     if (rel > kModelSeRel) {
-      if (!found) p.undetermined_lo_mm = u;
-      p.undetermined_hi_mm = u, found = true;
+      if (!found) p.lo_mm = u;
+      p.hi_mm = u, found = true;
     }
   }
   if (!found) return;
@@ -322,19 +321,19 @@ void PropagateModelError(CalibResult& result, const optics::Lens& lens, const op
                   "sampling cancels the whole blur at %.0f-%.0f mm (%d sections read 0 px, a bound, not a value), and "
                   "a lens fitted beside them errs by a few %% in the optics' blur, which the sharpening magnifies "
                   "(its error %s); there r_fitted_px is the model's estimate, not a result within 5 %%",
-                  100 * kModelSeRel, p.undetermined_lo_mm, p.undetermined_hi_mm, cut_lo, cut_hi, cancelled, reach);
+                  100 * kModelSeRel, p.lo_mm, p.hi_mm, cut_lo, cut_hi, cancelled, reach);
   else  // the error's parts and its cause: the mask's, or near focus the profiles' own
     std::snprintf(text, sizeof text,
                   "the model's blur is not determined within %.0f %% at depths %.0f-%.0f mm: its error (standard "
                   "error, the readings' own %.1f %%%s) %s (%s); there r_fitted_px is the model's estimate, not a result "
                   "within 5 %%",
-                  100 * kModelSeRel, p.undetermined_lo_mm, p.undetermined_hi_mm, 100 * kReadingRel,
+                  100 * kModelSeRel, p.lo_mm, p.hi_mm, 100 * kReadingRel,
                   v < 0 ? " in the optics' blur and the masks that fit alike" : "", reach,
                   v < 0 ? "the sharpening after sampling cancels most of the optics' blur, magnifying the optics' own "
                           "uncertainty"
                         : "near focus the blur is small and its profiles pin it least: a sharp step reads alike from 0 "
                           "to about 0.3 px");
-  p.undetermined = text;
+  p.why = text;
 }
 
 bool HoldAsBound(SectionResult* s, double r, double v) {

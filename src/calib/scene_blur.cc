@@ -75,7 +75,7 @@ const std::vector<std::string> kTopKeys = {"format", "version", "software", "cam
                                            "lens_model"};
 const std::vector<std::string> kModelKeys = {"kind", "focus_mm", "aperture_mm", "floor_px", "cancel_px2", "floor_determined",
                                              "rms_px", "loo_rms_px", "samples_used", "outliers", "choice",
-                                             "sections_left_out", "fitted_to"};
+                                             "sections_left_out", "fitted_to", "undetermined"};
 const std::vector<std::string> kEdgeKeys = {"index", "u_mm", "usable_sections", "sections"};
 const std::vector<std::string> kSectionKeys = {"index", "u_mm", "midpoint_camera_mm", "image_px", "r_px", "r_thesis_px",
                                                "r_estimated_px", "r_fitted_px", "ok", "flags", "psf", "disc_r_px",
@@ -161,14 +161,21 @@ void SceneCalib::RequireSameSize(const cv::Mat& photo, const std::string& photo_
 }
 
 namespace {
-// calib.json's phase_check.model_undetermined (null where calibrate named no depth): its depths and standard error.
+// calib.json's model.undetermined (null where calibrate named no depth): its depths and standard error. Earlier
+// calibrations kept it in phase_check.model_undetermined; one naming depths there is refused (its depths would go
+// unsaid), one naming none is read as none.
 void ReadUndetermined(const Json& j, const std::string& where, SceneCalib* s) {
-  const auto check = j.find("phase_check");
-  if (check == j.end()) return;
-  if (!check->is_object()) throw InputError(where + "/phase_check", "must be an object, got " + check->dump());
-  const auto und = check->find("model_undetermined");
-  if (und == check->end() || und->is_null()) return;
-  const std::string uw = where + "/phase_check/model_undetermined";
+  if (const auto check = j.find("phase_check"); check != j.end()) {
+    if (!check->is_object()) throw InputError(where + "/phase_check", "must be an object, got " + check->dump());
+    if (const auto old = check->find("model_undetermined"); old != check->end() && !old->is_null())
+      throw InputError(where + "/phase_check/model_undetermined",
+                       "is now read from /model/undetermined (a calibration written before kept it here, "
+                       "where its depths would go unsaid): calibrate the photo again, or move the field there");
+  }
+  const Json& model = j.at("model");  // read and checked already
+  const auto und = model.find("undetermined");
+  if (und == model.end() || und->is_null()) return;
+  const std::string uw = where + "/model/undetermined";
   if (!und->is_object()) throw InputError(uw, "must be an object or null, got " + und->dump());
   const auto u = und->find("u_mm");
   if (u == und->end() || !u->is_array() || u->size() != 2 || !(*u)[0].is_number() || !(*u)[1].is_number() ||
@@ -301,8 +308,7 @@ std::string UndeterminedNote(const SceneCalib& scene, BlurSource source, double 
   char text[400];
   std::snprintf(text, sizeof text,
                 "the fitted blur at %.0f mm is the lens model's estimate, not a result within 5 %%: the model is "
-                "not determined within 5 %% at %.0f-%.0f mm (its error %s: a sharpening after "
-                "sampling cancels most of the optics' blur there; %s /phase_check/model_undetermined)",
+                "not determined within 5 %% at %.0f-%.0f mm (its error %s; why: %s /model/undetermined)",
                 u_mm, scene.undetermined_lo_mm, scene.undetermined_hi_mm, reach,
                 scene.file.empty() ? "the calibration" : scene.file.c_str());
   return text;

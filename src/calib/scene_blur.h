@@ -37,9 +37,8 @@ struct SceneCalib {
   std::vector<Section> sections;
   // The calib.json it was read from (empty: built in code), for a message.
   std::string file;
-  // Where calibrate found the lens model not determined within 5 % (calib.json phase_check.model_undetermined: a
-  // sharpening after sampling that cancels most of the optics' blur there): camera depths (mm) and the largest
-  // relative standard error there; hi 0 where it named none.
+  // Where calibrate found the lens model not determined within 5 % (calib.json model.undetermined): camera depths
+  // (mm) and the largest relative standard error there; hi 0 where it named none.
   double undetermined_lo_mm = 0, undetermined_hi_mm = 0, undetermined_se_rel = 0;
 
   // Board-frame point (mm) -> camera frame (mm).

@@ -141,7 +141,6 @@ void PrintPhaseCheck(const calib::CalibResult& result) {
     if (n > 0) std::printf("  edge %d: %d of %zu sections phase_limited: %s\n", e.index, n, e.sections.size(),
                            why->c_str());
   }
-  if (!result.phase.undetermined.empty()) std::printf("phase check: %s\n", result.phase.undetermined.c_str());
   if (result.phase.held > 0)
     std::printf("phase check: the model predicted %d phase_limited sections outside the range their families "
                 "leave open; their ranges' middles joined its fit\n", result.phase.held);
@@ -153,10 +152,10 @@ void PrintPhaseCheck(const calib::CalibResult& result) {
       std::printf("what to do: this photo was filtered after it was sampled (the camera's sharpening or smoothing); "
                   "for measured blur on the flagged edges turn that processing off (or take raw) and photograph "
                   "again; until then the blur source `fitted` gives those places the model's value%s\n",
-                  result.phase.undetermined.empty()
+                  !result.undetermined.Named()
                       ? ""
-                      : (" (an estimate at " + Num(std::round(result.phase.undetermined_lo_mm)) + "-" +
-                         Num(std::round(result.phase.undetermined_hi_mm)) +
+                      : (" (an estimate at " + Num(std::round(result.undetermined.lo_mm)) + "-" +
+                         Num(std::round(result.undetermined.hi_mm)) +
                          " mm, where it is not determined within 5 %)").c_str());
     else
       std::printf("what to do: for measured blur on the flagged edges turn the board a few degrees on the table so "
@@ -181,6 +180,7 @@ void PrintModelChoice(const calib::CalibResult& result, const Json& choice) {
                 result.reference_edge, choice["eq37"]["rms_px"].get<double>(),
                 m.kind == "thin_lens+floor" ? " (it takes the reference's whole blur for defocus, floor included)"
                                             : "");
+  if (result.undetermined.Named()) std::printf("model: %s\n", result.undetermined.why.c_str());
 }
 
 // --truth: the pose and every method's blur against the ground truth; the true radius of each edge, for the table.
@@ -359,7 +359,7 @@ void AddCalibrateCommand(CLI::App& app) {
                 "several px over the optical blur; eq3.7: the thesis's estimate from reference edge %d; fitted: the "
                 "lens model's prediction (blur source `fitted`)%s%s\n\n",
                 result.reference_edge,
-                result.phase.undetermined.empty() ? "" : ", in parentheses where it is not determined within 5 %",
+                !result.undetermined.Named() ? "" : ", in parentheses where it is not determined within 5 %",
                 true_r.empty() ? "" : "; true: the scene's truth");
     std::printf("time: read %.0f ms, detect+pose %.0f ms, measure %.0f ms, estimate %.1f ms\n", read_ms,
                 result.detect_ms, result.measure_ms, result.estimate_ms);
