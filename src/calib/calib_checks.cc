@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "calib/scene_blur.h"
 #include "core/error.h"
 
 namespace blurcue::calib {
@@ -95,6 +96,26 @@ void RefuseAbsurdCalibration(const CalibResult& result, const std::string& camer
                " sections the lens model is fitted to is far from it (outliers; over a quarter): the sections' "
                "blurs do not follow one thin lens (compression, motion, a board not flat, or sections off the "
                "board's edges)");
+  // A sharpening after sampling on a photo with every edge blurred 2 px or more (ReadPhaseFamilies): its lobes show
+  // in the profiles, but no edge is sharp enough to pin its strength apart from the lens's blur.
+  if (const PhaseChoice::Wide& w = result.phase.wide; !w.sharpening.empty() && w.moved_rel > kMaxWideSharpeningMove)
+    Refuse(result, camera_file, photo_file,
+           "the board's edges fit " + w.sharpening + " better than the optics alone (chi-square " + Fixed(w.chi2_sharpening, 0) + " against " + Fixed(w.chi2_optics, 0) + " over " +
+               std::to_string(w.sections) + " sections, in units of their noise), which moves their readings by " +
+               Fixed(100 * w.moved_rel, 1) + " % (median; at least), and with every edge blurred 2 px or more "
+               "nothing in the photo pins the sharpening apart from the lens: each blur read would be the two "
+               "together. Turn the camera's sharpening off (or take raw), or focus nearer the board so that some "
+               "edges blur under 2 px");
+  // What is written must be what every reader takes (render, run, validate read calib.json through
+  // SceneCalibFromJson): a fit that lands outside the readers' ranges (all edges at one depth: an aperture of 2.5 m)
+  // is refused here, naming the field, not by the next command.
+  try {
+    SceneCalibFromJson(CalibToJson(result), "");
+  } catch (const Error& e) {
+    Refuse(result, camera_file, photo_file,
+           std::string("the calibration would not be one blurcue can use (") + e.what() +
+               "): the board's edges may not span enough depths to fit a lens (photograph the board at a slant, not face on)");
+  }
 }
 
 }  // namespace blurcue::calib

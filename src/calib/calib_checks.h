@@ -25,6 +25,12 @@ inline constexpr double kMaxChi2PerPoint = 1e4;
 // photo's makes 58 %, a JPEG of quality 5 10 %.
 inline constexpr double kMaxOutlierShare = 0.25;
 
+// With every edge blurred 2 px or more, where a sharpening after sampling fits the profiles better than the lens alone
+// (PhaseChoice::wide): the median move of the readings under it beyond which the photo is refused. A mask of 0.7 over
+// 0.6 px focused at 5 m moved them 1.3 % and read 1.6 % high (kept); masks of amount 1-3 over 1-2 px moved them 4.8-6.2 %
+// (a lower bound: the families stop at 0.7 over 1 px) and read 10 % to 2.5 px off.
+inline constexpr double kMaxWideSharpeningMove = 0.03;
+
 // Throws Error(kInput) with one line when the calibration is physically absurd for its photo or its edges fit no
 // blurred edge: a radius (the reference edge's, a usable section's, the model's at a section) over twice the side of
 // a board square where it is read (a blur that wide leaves the board grey: no section could have measured it), the

@@ -491,6 +491,31 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
   for (size_t k = 0; k < usable.size(); ++k)
     if (usable[k]->phase.limited || usable[k]->phase.every_phase) limited.push_back(k);
     else if (usable[k]->phase.wide) wide.push_back(k);
+  // No section under 2 px: nothing to choose a family on, and none is chosen. A strong sharpening still shows in wide
+  // profiles (its lobes), and there every reading is the lens's and the mask's together, with nothing to pin the mask
+  // (the adversary's scene focused at 5 m under a mask of amount 1 over 2 px: every section 2.5 px off, exit 0).
+  // Asked as the choice asks whether a photo has a filter, on up to kChoiceSections of them spread over the board.
+  if (limited.empty() && !wide.empty()) {
+    const size_t n = std::min(wide.size(), kChoiceSections);
+    std::vector<PhaseCheck> read(n);
+    each(n, [&](size_t i) {
+      const size_t k = wide[(2 * i + 1) * wide.size() / (2 * n)];
+      read[i] = usable[k]->phase;
+      ReadFamilies(profiles[k], {}, &read[i]);
+    });
+    std::vector<const PhaseCheck*> checks;
+    for (const PhaseCheck& c : read) checks.push_back(&c);
+    const WeighedChi2 t = WeighedTotals(checks, PhaseFamilies().size());
+    if (t.best != 0 && TapsVariance(FamilyTaps(PhaseFamilies()[t.best])) < 0) {
+      std::vector<double> apart;  // how far the mask moves each reading from the lens's alone
+      for (const PhaseCheck& c : read)
+        apart.push_back(std::abs(c.families[t.best].r_px - c.families[0].r_px) / std::max(c.families[0].r_px, 1e-9));
+      std::nth_element(apart.begin(), apart.begin() + apart.size() / 2, apart.end());
+      result.phase.wide = {PhaseFamilies()[t.best].Name(), t.any[0], t.any[t.best], static_cast<int>(n),
+                           apart[apart.size() / 2]};
+    }
+    return;
+  }
   // The sections of 2 px or more, where a filter fitted the choice's sections best (fit_between appended it): read with
   // the families marked in `read` (all when empty) and the fitted one, for ChoosePhaseFamily to take the chosen one's
   // reading. They do not join the choice: at that blur the families read within 2-5 % of each other.
@@ -689,6 +714,7 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   const std::vector<PhaseFamily> families = result.phase.families.empty() ? PhaseFamilies() : result.phase.families;
   choice.families = families;
   choice.choice_sections = result.phase.choice_sections, choice.has_valley = result.phase.has_valley;
+  choice.wide = result.phase.wide;
   std::copy(std::begin(result.phase.valley), std::end(result.phase.valley), choice.valley);
   std::vector<SectionResult*> limited;
   int points = 0;
@@ -704,6 +730,12 @@ PhaseChoice ChoosePhaseFamily(CalibResult& result) {
   choice.alike.assign(families.size(), false);
   if (limited.empty()) {
     choice.summary = "no usable section has blur under 2 px";
+    if (!choice.wide.sharpening.empty()) {  // kept where it moves the readings little (calib_checks.h)
+      char moved[96];
+      std::snprintf(moved, sizeof moved, ", moving their readings by %.1f %% (median)", 100 * choice.wide.moved_rel);
+      choice.summary += "; " + choice.wide.sharpening + " fits " + std::to_string(choice.wide.sections) +
+                        " of the wider sections better than the optics alone" + moved;
+    }
     return choice;
   }
   const size_t best = ChooseOverSections(limited, points, choice);

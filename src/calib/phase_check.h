@@ -131,6 +131,17 @@ struct PhaseChoice {
   // a section reads sqrt(r_optics^2 + 4 variance_px2) (FitModelWithinPhaseRanges fits a mask's photo in r_optics).
   double variance_px2 = 0;
   std::string summary = "not checked (--no-phase-check, or a take's frames: no lens fit per frame)";  // in words
+  // With no section under 2 px (nothing to choose a family on): where a sharpening after sampling fits the wide
+  // sections' profiles better than the lens alone (WeighedTotals's test on up to 12 of them), its name, both
+  // chi-squares and how far it moves their readings; calibrate refuses such a photo where that is over
+  // kMaxWideSharpeningMove (calib_checks.h): the readings are the lens's and the mask's together there, and nothing in
+  // the photo pins the mask (the families' grid stops at a mask of 0.7 over 1 px, so the move is a lower bound).
+  struct Wide {
+    std::string sharpening;  // empty: none fits better
+    double chi2_optics = 0, chi2_sharpening = 0;
+    int sections = 0;
+    double moved_rel = 0;  // the median of |its reading - the lens's alone| / the lens's alone over those sections
+  } wide;
 };
 
 // Chooses the family over `result`'s limited sections (the one whose profiles fit best over all of them: sections at

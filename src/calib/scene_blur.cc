@@ -73,6 +73,16 @@ const std::vector<std::string> kTopKeys = {"format", "version", "software", "cam
                                            // a tracked frame's (track/take.cc)
                                            "photo", "frame", "time_s", "track_status", "frame_signature",
                                            "lens_model"};
+// The smaller objects' fields, each as CalibToJson writes them; phase_check's are for the reader of the file (only its
+// earlier model_undetermined is read), named so that a misspelt one is not taken for read.
+const std::vector<std::string> kBoardKeys = {"cols", "rows", "square_mm"};
+const std::vector<std::string> kPoseKeys = {"rvec", "tvec", "reprojection_error_px"};
+const std::vector<std::string> kReferenceKeys = {"u_mm", "r_px"};
+const std::vector<std::string> kTimingKeys = {"detect", "measure", "estimate"};
+const std::vector<std::string> kUndeterminedKeys = {"u_mm", "worst_se_rel", "why"};
+const std::vector<std::string> kPhaseCheckKeys = {"limited_sections", "every_phase_sections", "flagged",
+                                                  "held_the_model", "chosen", "chi2_per_point", "variance_px2",
+                                                  "families", "summary", "note", "model_undetermined"};
 const std::vector<std::string> kModelKeys = {"kind", "focus_mm", "aperture_mm", "floor_px", "cancel_px2", "floor_determined",
                                              "rms_px", "loo_rms_px", "samples_used", "outliers", "choice",
                                              "sections_left_out", "fitted_to", "undetermined"};
@@ -167,6 +177,7 @@ namespace {
 void ReadUndetermined(const Json& j, const std::string& where, SceneCalib* s) {
   if (const auto check = j.find("phase_check"); check != j.end()) {
     if (!check->is_object()) throw InputError(where + "/phase_check", "must be an object, got " + check->dump());
+    KnownKeys(*check, where + "/phase_check", kPhaseCheckKeys);
     if (const auto old = check->find("model_undetermined"); old != check->end() && !old->is_null())
       throw InputError(where + "/phase_check/model_undetermined",
                        "is now read from /model/undetermined (a calibration written before kept it here, "
@@ -177,15 +188,20 @@ void ReadUndetermined(const Json& j, const std::string& where, SceneCalib* s) {
   if (und == model.end() || und->is_null()) return;
   const std::string uw = where + "/model/undetermined";
   if (!und->is_object()) throw InputError(uw, "must be an object or null, got " + und->dump());
+  KnownKeys(*und, uw, kUndeterminedKeys);
+  if (const auto why = und->find("why"); why != und->end() && !why->is_string())
+    throw InputError(uw + "/why", "must be the reason in words (a string), got " + why->dump());
   const auto u = und->find("u_mm");
   if (u == und->end() || !u->is_array() || u->size() != 2 || !(*u)[0].is_number() || !(*u)[1].is_number() ||
-      !((*u)[0].get<double>() > 0) || !((*u)[0].get<double>() <= (*u)[1].get<double>()) ||
+      !((*u)[0].get<double>() > s->camera.focal_length_mm) || !((*u)[0].get<double>() <= (*u)[1].get<double>()) ||
       !((*u)[1].get<double>() <= kMaxDistanceMm))
-    throw InputError(uw + "/u_mm", "must be [near, far] depths in mm, 0 < near <= far, got " +
+    throw InputError(uw + "/u_mm", "must be [near, far] depths in mm, beyond the focal length (" +
+                                       Num(s->camera.focal_length_mm) + " mm), near <= far, got " +
                                        (u == und->end() ? std::string("nothing") : u->dump()));
   s->undetermined_lo_mm = (*u)[0].get<double>();
   s->undetermined_hi_mm = (*u)[1].get<double>();
-  s->undetermined_se_rel = Ranged(*und, "worst_se_rel", uw, 0, 1e6, "(a share)");
+  // Named depths are where it exceeds 5 % (calibrate's kModelSeRel): a smaller one contradicts them.
+  s->undetermined_se_rel = Ranged(*und, "worst_se_rel", uw, 0.05, 1e6, "(a share, over 0.05 where depths are named)");
 }
 }  // namespace
 
@@ -204,15 +220,28 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
   s.file = colon ? where.substr(0, where.size() - 2) : where;
   s.camera = CameraFromJson(Object(j, "camera", where), where + "/camera");
   const Json& board = Object(j, "board", where);
+  KnownKeys(board, where + "/board", kBoardKeys);
   s.board.cols = RangedInt(board, "cols", where + "/board", 2, 100);
   s.board.rows = RangedInt(board, "rows", where + "/board", 2, 100);
   s.board.square_mm = Ranged(board, "square_mm", where + "/board", 1, 1000, "mm");
   s.board.Validate(where + "/board");
   const Json& pose = Object(j, "pose", where);
+  KnownKeys(pose, where + "/pose", kPoseKeys);
   s.rvec = Vec3(pose, "rvec", where + "/pose", 4 * M_PI, "rad");
   s.tvec = Vec3(pose, "tvec", where + "/pose", kMaxDistanceMm, "mm");
+  // The board in front of the lens: a pose that put it behind drew objects at negative depths, exit 0.
+  for (const double x : {0.0, s.board.cols * s.board.square_mm})
+    for (const double y : {0.0, s.board.rows * s.board.square_mm})
+      if (!(s.ToCamera({x, y, 0})[2] > s.camera.focal_length_mm))
+        throw InputError(where + "/pose", "must put the whole board in front of the lens (beyond its focal length), "
+                                          "got rvec " + pose["rvec"].dump() + ", tvec " + pose["tvec"].dump());
+  if (const auto timing = j.find("timing_ms"); timing != j.end()) {
+    if (!timing->is_object()) throw InputError(where + "/timing_ms", "must be an object, got " + timing->dump());
+    KnownKeys(*timing, where + "/timing_ms", kTimingKeys);
+  }
   s.reference_edge = RangedInt(j, "reference_edge", where, 1, s.board.EdgeCount());
   const Json& ref = Object(j, "reference", where);
+  KnownKeys(ref, where + "/reference", kReferenceKeys);
   s.reference_u_mm = Ranged(ref, "u_mm", where + "/reference", 0, kMaxDistanceMm, "mm");
   s.reference_r_px = Ranged(ref, "r_px", where + "/reference", 0, optics::kMaxBlurRadiusPx, "px");
   const Json& model = Object(j, "model", where);

@@ -264,7 +264,7 @@ void AddTrack(CLI::App& bench) {
   cmd->add_flag("--quick", args->quick, "the first 4 frames of the take (smoke run)");
   cmd->callback([args] {
     // It runs this blurcue as a child: --out naming it would replace the executable with the CSV.
-    OutputGuard().Input("the blurcue it runs", ExecutableDir() / "blurcue").OutputFile("--out", args->out).Check();
+    OutputGuard().Input("the blurcue it runs", ExecutablePath()).OutputFile("--out", args->out).Check();
     RequireBenchCsv(args->out, "track", "mode,frame,status,");
     bench::TrackBenchOptions options;
     options.frames = args->frames;
@@ -323,7 +323,7 @@ void AddLive(CLI::App& bench) {
           throw Error(ErrorKind::kUsage, "--sections: " + std::to_string(args->options.sections[i]) +
                                              " is given twice; give each value of N once");
     // It runs this blurcue once for each N: --out naming it replaced the executable with the CSV.
-    OutputGuard().Input("the blurcue it runs", ExecutableDir() / "blurcue").OutputFile("--out", args->out).Check();
+    OutputGuard().Input("the blurcue it runs", ExecutablePath()).OutputFile("--out", args->out).Check();
     RequireBenchCsv(args->out, "live", "sections_per_frame,frames_delivered,");
     bench::LiveBenchOptions options = args->options;
     options.quick = args->quick;

@@ -57,7 +57,7 @@ std::string ReadText(const fs::path& path) {
 // not made.
 void Step(const std::string& what, std::vector<std::string> args, const fs::path& cwd, const fs::path& dir) {
   std::cout << "init: " << what << "\n";
-  args.insert(args.begin(), (ExecutableDir() / "blurcue").string());
+  args.insert(args.begin(), ExecutablePath().string());
   const int status = RunChild(args, cwd.string());
   if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return;
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 10;

@@ -7,9 +7,14 @@
 namespace blurcue {
 
 std::filesystem::path ExecutableDir() {
+  const std::filesystem::path exe = ExecutablePath();
+  return exe.has_parent_path() ? exe.parent_path() : std::filesystem::path();
+}
+
+std::filesystem::path ExecutablePath() {
   std::error_code ec;
   const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  return ec ? std::filesystem::path() : exe.parent_path();
+  return ec ? std::filesystem::path("blurcue") : exe;
 }
 
 const DataDirectory& DataDir() {

@@ -19,5 +19,8 @@ const DataDirectory& DataDir();
 
 // The folder of the running executable (/proc/self/exe); empty when it cannot be read.
 std::filesystem::path ExecutableDir();
+// The running executable itself, whatever it is named (a copy as /tmp/bc ran /tmp/blurcue); "blurcue" on PATH when
+// /proc/self/exe cannot be read.
+std::filesystem::path ExecutablePath();
 
 }  // namespace blurcue
