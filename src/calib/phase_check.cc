@@ -13,6 +13,7 @@
 #include "calib/edge_window.h"
 #include "calib/family_esf.h"
 #include "calib/phase_fit.h"
+#include "calib/phase_profile.h"
 #include "calib/phase_flags.h"
 #include "core/error.h"
 
@@ -24,20 +25,18 @@ using detail::FamilyTaps;
 using detail::ProjectTaps;
 using detail::ProjectedTap;
 using detail::TapsVariance;
+using detail::Bin;
+using detail::ProfileBins;
 constexpr double kPi = 3.14159265358979323846;
 // Phases: an edge whose sub-pixel position moves by a pixel or more along the part measured is sampled at every
 // phase (the blur fit super-resolves its profile); under that, few phases.
 constexpr double kMinSpanPx = 1.0;
-// Blur: beyond about 2 px the profile has samples enough across the edge that the families read within 2-5 % of
-// each other at any phase (measured: 2.00 vs 1.90-2.16 px at r = 2); below, up to a factor 2 apart.
-constexpr double kMaxBlurPx = 2.0;
-constexpr double kBinPx = 0.1;  // one row's samples share a distance across a level edge: bins far finer than 1 px
 // A section at every phase spreads its samples evenly across the edge: a 0.1 px bin holds a tenth of the length used
 // (2 on the far sections of a board turned 45-60 deg). Held to 3 samples, as a level edge's bins are, such a section
 // kept 11 of ~150 bins (edge 11 section 7 at 45 deg: 0.75 px for a true 0.85 px, every family alike) or fewer than 6
 // (edge 5 section 7 at 60 deg: not read per family, its phase check empty, 0.61 px for 0.13 px unflagged); every bin
 // with a sample is kept there (with 3, the interquartile mean is the plain mean anyway). Level edges keep 3.
-constexpr size_t kLevelBinSamples = 3, kEveryPhaseBinSamples = 1, kMinNoiseSamples = 12;  // the last: ProfileBins
+constexpr size_t kLevelBinSamples = 3, kEveryPhaseBinSamples = 1;
 // The pose puts an edge within a few hundredths of a pixel (synth scenes: 0.02-0.06 px); each family finds it within
 // this of the pose's line. Fixed at the line, the pose's own error, not the family, would decide the fit.
 constexpr double kPoseUncertaintyPx = 0.15;
@@ -47,15 +46,9 @@ constexpr double kPoseUncertaintyPx = 0.15;
 // every family's chi-square with the points, and then the noise no longer says what fits alike. 0.15: a JPEG of
 // quality 90 put the true family at 1.14 x the best's; 0.25 took a 0.5 px Gaussian alike on physical optics.
 constexpr double kAlikeChi2 = 25, kAlikeRel = 0.15;
-// The noise std (linear) is taken to be no less than this: a noise-free 8-bit image still has its quantisation.
-constexpr double kMinNoise = 5e-4;
 // Sections every family is read on before the families that fit them far worse are ruled out (ReadPhaseFamilies).
 constexpr size_t kChoiceSections = 12;
 constexpr double kChoiceBins = 600;  // ... or fewer sections holding about this many profile points (ChoiceSections)
-
-struct Bin {
-  double x = 0, v = 0, w = 0;
-};
 
 // How a section's profile lies across the pixels and the board: its normal's components (|n| larger, smaller; see
 // ProjectTaps) and, on the board's outer edges, the side (+1: the normal's, -1: the other) that is the table.
@@ -63,67 +56,6 @@ struct Across {
   double w1 = 1, w2 = 0;
   int free_side = 0;  // 0: squares on both sides (or not known)
 };
-
-// The mean of the middle half: robust to a printing spot as the median is, without snapping to 8-bit code values.
-double InterquartileMean(std::vector<float>& v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size(), lo = n / 4, hi = std::max(lo + 1, n - n / 4);
-  double sum = 0;
-  for (size_t i = lo; i < hi; ++i) sum += v[i];
-  return sum / double(hi - lo);
-}
-
-// The profile across the edge, from the pose's line (d = 0), over |d| <= half_px, in the central part along. A bin
-// holds at least `min_samples` pixels (its interquartile mean: robust to a printing spot); the noise comes from the bins
-// of 3 or more (those of 2 too, where they give fewer than kMinNoiseSamples deviations).
-std::vector<Bin> ProfileBins(const cv::Mat& linear, const EdgeSegment& segment, double along_fraction,
-                             double half_px, size_t min_samples, double* noise) {
-  const EdgeFrame f = MakeEdgeFrame(segment);
-  const double margin = 0.5 * (1 - std::clamp(along_fraction, 0.0, 1.0)) * f.length;
-  const double bow = std::isfinite(segment.bow_px) ? segment.bow_px : 0;
-  const int nb = static_cast<int>(std::ceil(2 * half_px / kBinPx));
-  std::vector<std::vector<float>> values(nb);
-  std::vector<double> sum_d(nb, 0.0);
-  double xmin = 1e18, xmax = -1e18, ymin = 1e18, ymax = -1e18;
-  for (double s : {margin, f.length - margin})
-    for (double d : {-half_px, half_px}) {
-      const cv::Point2d p = f.a + s * f.t + d * f.n;
-      xmin = std::min(xmin, p.x), xmax = std::max(xmax, p.x), ymin = std::min(ymin, p.y), ymax = std::max(ymax, p.y);
-    }
-  const int x0 = std::max(0, int(std::ceil(xmin))), x1 = std::min(linear.cols - 1, int(std::floor(xmax)));
-  const int y0 = std::max(0, int(std::ceil(ymin))), y1 = std::min(linear.rows - 1, int(std::floor(ymax)));
-  for (int y = y0; y <= y1; ++y) {
-    const float* row = linear.ptr<float>(y);
-    for (int x = x0; x <= x1; ++x) {
-      const cv::Point2d q(x - f.a.x, y - f.a.y);
-      const double s = q.dot(f.t);
-      if (s < margin || s > f.length - margin || !std::isfinite(row[x])) continue;
-      const double u = 2 * s / f.length - 1;
-      const double d = q.dot(f.n) - bow * (1 - u * u);
-      if (std::abs(d) > half_px) continue;
-      const int i = std::clamp(static_cast<int>((d + half_px) / kBinPx), 0, nb - 1);
-      values[i].push_back(row[x]);
-      sum_d[i] += d;
-    }
-  }
-  std::vector<Bin> bins;
-  std::vector<float> dev, dev2;  // |value - its bin's middle|: the noise, robustly (a spot is a few of them)
-  for (int i = 0; i < nb; ++i)
-    if (values[i].size() >= std::max<size_t>(1, min_samples)) {
-      const double n = static_cast<double>(values[i].size());
-      bins.push_back({sum_d[i] / n, InterquartileMean(values[i]), n});
-      // A pair's deviations from its mean are sqrt(3/4) of a triple's (std sqrt(1/2) against sqrt(2/3) of the noise's).
-      const double scale = n >= 3 ? 1 : std::sqrt(4.0 / 3);
-      for (const float v : values[i]) (n >= 3 ? dev : dev2).push_back(float(std::abs(v - bins.back().v) * scale));
-    }
-  if (dev.size() < kMinNoiseSamples) dev.insert(dev.end(), dev2.begin(), dev2.end());
-  *noise = kMinNoise;
-  if (!dev.empty()) {
-    std::nth_element(dev.begin(), dev.begin() + dev.size() / 2, dev.end());
-    *noise = std::max(kMinNoise, 1.4826 * dev[dev.size() / 2]);
-  }
-  return bins;
-}
 
 // FamilyResiduals on a board's outer edge: the levels, the step and the table's slope by least squares, the model
 // low + step x m(x) + slope x max(0, side x) (x from the edge). The table beside the board is a photo's content, not
@@ -460,6 +392,34 @@ void ReadFamilies(const PhaseProfile& p, const std::vector<bool>& read, PhaseChe
   }
 }
 
+using Each = std::function<void(size_t, const std::function<void(size_t)>&)>;
+
+// No section under 2 px: nothing to choose a family on, and none is chosen. A strong sharpening still shows in wide
+// profiles (its lobes), and there every reading is the lens's and the mask's together, with nothing to pin the mask
+// (the adversary's scene focused at 5 m under a mask of amount 1 over 2 px: every section 2.5 px off, exit 0).
+// Asked as the choice asks whether a photo has a filter, on up to kChoiceSections of them spread over the board.
+PhaseChoice::Wide AskWideForSharpening(const std::vector<SectionResult*>& usable, const std::vector<size_t>& wide,
+                                       const std::vector<PhaseProfile>& profiles, const Each& each) {
+  const size_t n = std::min(wide.size(), kChoiceSections);
+  std::vector<PhaseCheck> read(n);
+  each(n, [&](size_t i) {
+    const size_t k = wide[(2 * i + 1) * wide.size() / (2 * n)];
+    read[i] = usable[k]->phase;
+    ReadFamilies(profiles[k], {}, &read[i]);
+  });
+  std::vector<const PhaseCheck*> checks;
+  for (const PhaseCheck& c : read) checks.push_back(&c);
+  const WeighedChi2 t = WeighedTotals(checks, PhaseFamilies().size());
+  if (t.best != 0 && TapsVariance(FamilyTaps(PhaseFamilies()[t.best])) < 0) {
+    std::vector<double> apart;  // how far the mask moves each reading from the lens's alone
+    for (const PhaseCheck& c : read)
+      apart.push_back(std::abs(c.families[t.best].r_px - c.families[0].r_px) / std::max(c.families[0].r_px, 1e-9));
+    std::nth_element(apart.begin(), apart.begin() + apart.size() / 2, apart.end());
+    return {PhaseFamilies()[t.best].Name(), t.any[0], t.any[t.best], static_cast<int>(n), apart[apart.size() / 2]};
+  }
+  return {};
+}
+
 }  // namespace
 
 PhaseCheck CheckPhase(const cv::Mat& linear, const EdgeSegment& segment, const ModelFit& fit,
@@ -491,29 +451,8 @@ void ReadPhaseFamilies(CalibResult& result, const cv::Mat& linear, const ModelFi
   for (size_t k = 0; k < usable.size(); ++k)
     if (usable[k]->phase.limited || usable[k]->phase.every_phase) limited.push_back(k);
     else if (usable[k]->phase.wide) wide.push_back(k);
-  // No section under 2 px: nothing to choose a family on, and none is chosen. A strong sharpening still shows in wide
-  // profiles (its lobes), and there every reading is the lens's and the mask's together, with nothing to pin the mask
-  // (the adversary's scene focused at 5 m under a mask of amount 1 over 2 px: every section 2.5 px off, exit 0).
-  // Asked as the choice asks whether a photo has a filter, on up to kChoiceSections of them spread over the board.
   if (limited.empty() && !wide.empty()) {
-    const size_t n = std::min(wide.size(), kChoiceSections);
-    std::vector<PhaseCheck> read(n);
-    each(n, [&](size_t i) {
-      const size_t k = wide[(2 * i + 1) * wide.size() / (2 * n)];
-      read[i] = usable[k]->phase;
-      ReadFamilies(profiles[k], {}, &read[i]);
-    });
-    std::vector<const PhaseCheck*> checks;
-    for (const PhaseCheck& c : read) checks.push_back(&c);
-    const WeighedChi2 t = WeighedTotals(checks, PhaseFamilies().size());
-    if (t.best != 0 && TapsVariance(FamilyTaps(PhaseFamilies()[t.best])) < 0) {
-      std::vector<double> apart;  // how far the mask moves each reading from the lens's alone
-      for (const PhaseCheck& c : read)
-        apart.push_back(std::abs(c.families[t.best].r_px - c.families[0].r_px) / std::max(c.families[0].r_px, 1e-9));
-      std::nth_element(apart.begin(), apart.begin() + apart.size() / 2, apart.end());
-      result.phase.wide = {PhaseFamilies()[t.best].Name(), t.any[0], t.any[t.best], static_cast<int>(n),
-                           apart[apart.size() / 2]};
-    }
+    result.phase.wide = AskWideForSharpening(usable, wide, profiles, each);
     return;
   }
   // The sections of 2 px or more, where a filter fitted the choice's sections best (fit_between appended it): read with
