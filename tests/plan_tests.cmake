@@ -163,3 +163,19 @@ set_tests_properties(threshold_coverage_staircase threshold_coverage_1up3down th
                      FIXTURES_REQUIRED "scene;calib;session_protocols" LABELS "gl;plan" TIMEOUT 600)
 set_tests_properties(threshold_coverage_staircase threshold_coverage_1up3down PROPERTIES ENVIRONMENT "FPS=0.2")
 set_test_costs(threshold_coverage_1up3down 71 threshold_coverage_staircase 42 threshold_coverage_quest 39)
+# validate's blur plan for a procedure's trials bounds what run records (tests/blur_plan_bounds.py): a staircase of
+# grid cards at a near and a far edge (validate said 0 of 80 per pixel; run drew 138 of 226 so).
+file(WRITE ${T}/plan-stairs.json [=[
+{"name": "plan-stairs", "version": 1,
+ "scene": {"background": "scene/scene.png", "calib": "calib.json"},
+ "content": {"type": "grid", "cells": 5}, "task": "forced_choice",
+ "blocks": [{"name": "stairs", "factors": {"edge": [4, 9]},
+   "procedure": {"type": "staircase", "variable": "relative_difference", "reference": "measured", "trials": 40,
+                 "start": 1.0, "min": 0.02, "max": 3, "up": 1, "down": 2, "steps": [0.4, 0.2, 0.1],
+                 "stop": {"reversals": 8}}}],
+ "responses": {"left": "Left", "right": "Right"}}
+]=])
+add_test(NAME validate_blur_plan_bounds_the_record
+         COMMAND ${BLURCUE_EXPECT} "ok: the record keeps within validate's blur plan" /usr/bin/python3
+                 ${PROJECT_SOURCE_DIR}/tests/blur_plan_bounds.py ${BC} ${T}/plan-stairs.json ${T}/plan-stairs.sqlite)
+set_tests_properties(validate_blur_plan_bounds_the_record PROPERTIES FIXTURES_REQUIRED "scene;calib" LABELS plan)

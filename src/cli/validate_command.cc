@@ -114,14 +114,27 @@ std::string PresentationLines(const procedure::PreparedSession& prepared) {
                   ? " (balanced: a run takes the group with the fewest sessions in its record)\n"
                   : " (by participant number)\n");
   if (prepared.scene) {
-    size_t per_pixel = 0;
-    for (const auto& scene : prepared.scenes) per_pixel += scene.per_pixel;
-    std::snprintf(line, sizeof line,
-                  "  blur plan: %zu of %zu trials blur the object pixel by pixel at each one's depth (where its "
-                  "blur changes by %g %s or more across it: content.depth_blur_threshold), the rest with one radius\n",
-                  per_pixel, prepared.scenes.size(), prepared.protocol.content.depth_blur_threshold,
-                  prepared.protocol.content.depth_blur_threshold_unit == protocol::ThresholdUnit::kArcmin ? "arcmin" : "screen px");
-    shown += line;
+    const procedure::BlurPlans plans = procedure::CountBlurPlans(prepared);
+    const protocol::Content& c = prepared.protocol.content;
+    std::snprintf(line, sizeof line, "by depth, where its blur changes by %g %s or more across it: "
+                  "content.depth_blur_threshold", c.depth_blur_threshold,
+                  c.depth_blur_threshold_unit == protocol::ThresholdUnit::kArcmin ? "arcmin" : "screen px");
+    const std::string where = line;
+    shown += "  blur plan: ";
+    if (plans.fixed > 0) {
+      std::snprintf(line, sizeof line, "%zu of %zu trials blur the object pixel by pixel (%s), the rest with one "
+                    "radius", plans.fixed_per_pixel, plans.fixed, where.c_str());
+      shown += line;
+    }
+    if (plans.leveled > 0) {  // run plans each at its level as it is shown
+      std::snprintf(line, sizeof line,
+                    "%sthe %zu procedure trials are planned at their level as each is shown: %zu would be per pixel%s "
+                    "at the procedure's least level, %zu at its largest",
+                    plans.fixed > 0 ? "; " : "", plans.leveled, plans.per_pixel_at_least,
+                    plans.fixed > 0 ? "" : (" (" + where + ")").c_str(), plans.per_pixel_at_most);
+      shown += line;
+    }
+    shown += "\n";
   }
   return shown;
 }

@@ -150,6 +150,34 @@ void PlanLeveled(const PreparedSession& s, const protocol::Trial& trial, TrialSc
     PlanOnScreen(s.protocol, *s.scene, s.presentation, scene);
 }
 
+BlurPlans CountBlurPlans(const PreparedSession& s) {
+  BlurPlans plans;
+  std::map<std::pair<std::string, double>, bool> planned;  // participants' trials repeat: each planned once
+  for (size_t i = 0; i < s.trials.size() && i < s.scenes.size(); ++i) {
+    const protocol::Trial& trial = s.trials[i];
+    if (trial.cell < 0) {
+      ++plans.fixed, plans.fixed_per_pixel += s.scenes[i].per_pixel;
+      continue;
+    }
+    ++plans.leveled;
+    if (!s.scene && !s.images.take) continue;
+    const protocol::Procedure& p = *protocol::BlockOf(s.protocol, trial)->procedure;
+    const bool staircase = p.kind == protocol::Procedure::Kind::kStaircase;
+    const double least = staircase || p.stimuli.empty() ? p.min : *std::min_element(p.stimuli.begin(), p.stimuli.end());
+    const double most = staircase || p.stimuli.empty() ? p.max : *std::max_element(p.stimuli.begin(), p.stimuli.end());
+    auto per_pixel = [&](double level) {
+      const auto key = std::make_pair(SceneKey(trial), level);
+      if (const auto it = planned.find(key); it != planned.end()) return it->second;
+      TrialScene scene = s.scenes[i];
+      stimulus::ApplyLevel(p, trial, level, s.presentation, &scene);
+      PlanLeveled(s, trial, &scene);
+      return planned[key] = scene.per_pixel;
+    };
+    plans.per_pixel_at_least += per_pixel(least), plans.per_pixel_at_most += per_pixel(most);
+  }
+  return plans;
+}
+
 std::string SceneKey(const protocol::Trial& t) {
   std::string key = t.block + '\n' + std::to_string(int(t.task)) + ' ' + std::to_string(t.practice) + ' ' +
                     std::to_string(t.round) + ' ' + std::to_string(t.swapped) + ' ' + std::to_string(t.cell) + ' ' +

@@ -47,6 +47,15 @@ PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const
 // calibration's note; "" where none does (or the session has no calibrated scene). validate and run print it.
 std::string UndeterminedBlurNote(const PreparedSession& prepared);
 
+// The session's blur plans (stimulus::PlanOnScreen: one radius, or per pixel by depth): the fixed trials' as planned;
+// a procedure's trials' (their level moves as the participant answers, and run plans each at its level) at the
+// procedure's least and largest level (a staircase's min and max, QUEST+'s stimuli). validate prints it.
+struct BlurPlans {
+  size_t fixed = 0, fixed_per_pixel = 0;
+  size_t leveled = 0, per_pixel_at_least = 0, per_pixel_at_most = 0;
+};
+BlurPlans CountBlurPlans(const PreparedSession& prepared);
+
 // PlanOnScreen for a trial of this session whose radii a procedure's level changed (ApplyLevel): on the photo, or on
 // every frame of the take the trial shows (stimulus::PlanVideoOnScreen). Needs a scene (prepared.scene).
 void PlanLeveled(const PreparedSession& prepared, const protocol::Trial& trial, stimulus::TrialScene* scene);
