@@ -179,3 +179,8 @@ add_test(NAME validate_blur_plan_bounds_the_record
          COMMAND ${BLURCUE_EXPECT} "ok: the record keeps within validate's blur plan" /usr/bin/python3
                  ${PROJECT_SOURCE_DIR}/tests/blur_plan_bounds.py ${BC} ${T}/plan-stairs.json ${T}/plan-stairs.sqlite)
 set_tests_properties(validate_blur_plan_bounds_the_record PROPERTIES FIXTURES_REQUIRED "scene;calib" LABELS plan)
+# Ctrl-C during run (tests/run_interrupt.py): stops between trials, says what was saved, exits 130; --resume completes.
+add_test(NAME run_interrupted_says_what_was_saved
+         COMMAND ${BLURCUE_EXPECT} "ok: Ctrl-C stops run with every answer saved" /usr/bin/python3
+                 ${PROJECT_SOURCE_DIR}/tests/run_interrupt.py ${BC} ${T}/plan-stairs.json ${T}/run-interrupted.sqlite)
+set_tests_properties(run_interrupted_says_what_was_saved PROPERTIES FIXTURES_REQUIRED "scene;calib" LABELS session)

@@ -22,6 +22,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/image.h"
+#include "core/interrupt.h"
 #include "core/json_io.h"
 #include "core/output_guard.h"
 #include "core/typed.h"
@@ -41,20 +42,6 @@ namespace {
 // A run logs at most an hour at 30 fps: the log is held in memory (about 250 bytes a frame) and written whole.
 constexpr int kMaxLiveFrames = 108000;
 
-std::atomic<int> live_signal{0};
-void OnLiveSignal(int signal) { live_signal = signal; }
-
-// Ctrl-C or a kill ends a live run like Escape: the log is written whole (handlers restored when the run ends).
-struct LiveSignals {
-  void (*old_int)(int), (*old_term)(int);
-  LiveSignals() : old_int(std::signal(SIGINT, OnLiveSignal)), old_term(std::signal(SIGTERM, OnLiveSignal)) {
-    live_signal = 0;
-  }
-  ~LiveSignals() {
-    std::signal(SIGINT, old_int);
-    std::signal(SIGTERM, old_term);
-  }
-};
 
 // The names a --log folder holds: what live writes, and nothing else is replaced.
 bool IsLiveLogFile(const std::string& name) {
@@ -190,7 +177,7 @@ LiveSetup SetUpLive(const LiveArgs& a) {
     const cv::Size frame_size(s.camera.image_width_px, s.camera.image_height_px);
     s.source->CheckPreloadFits(frame_size, live::kMaxPreloadMb);  // refused before a frame is decoded
     if (!a.quiet) std::fprintf(stderr, "live: --preload: decoding %s before the start ...\n", a.input.c_str());
-    s.preload_s = s.source->Preload(frame_size, live::kMaxPreloadMb, &live_signal);
+    s.preload_s = s.source->Preload(frame_size, live::kMaxPreloadMb, &InterruptSignal());
   }
   const double rate = s.source->fps();
   if (a.exposure_ms >= 0) {
@@ -303,8 +290,8 @@ void RunLiveLoop(LiveSetup& s, const LiveArgs& a, render::GlContext& context, re
   int dropped_seen = 0;
   const bool tty = isatty(2) && !a.quiet;
   while (true) {
-    if (live_signal != 0) {
-      record.ended = std::string("interrupted (") + (live_signal == SIGINT ? "SIGINT" : "SIGTERM") + ")";
+    if (Interrupted()) {
+      record.ended = std::string("interrupted (") + InterruptName(InterruptSignal()) + ")";
       break;
     }
     if (a.window) {
@@ -349,7 +336,7 @@ void RunLiveLoop(LiveSetup& s, const LiveArgs& a, render::GlContext& context, re
 void RunLive(const LiveArgs& a) {
   // From before the preload to the log written: a signal then ends the run as Escape does (the preload stops, the
   // loop ends at once), and one during the log's writing waits for it - the log is always whole.
-  const LiveSignals signals;
+  const InterruptScope signals;
   LiveSetup s = SetUpLive(a);
   const Camera& camera = s.camera;
   std::unique_ptr<render::GlContext> context;

@@ -12,6 +12,7 @@
 
 #include "cli/commands.h"
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "core/typed.h"
 #include "session/runner.h"
 #include "store/sqlite.h"
@@ -96,6 +97,9 @@ void Run(const RunArgs& args) {
   const bool sidecars_before = std::filesystem::exists(args.db + "-wal", error) ||
                                std::filesystem::exists(args.db + "-shm", error);
   session::RunResult r;
+  // Ctrl-C or a kill stops the session between trials (or on a text screen): what was answered is committed already,
+  // and the session is left to --resume, as a quit with Escape leaves it.
+  const InterruptScope interrupt;
   try {
     r = session::RunSession(options);
   } catch (...) {
@@ -120,6 +124,12 @@ void Run(const RunArgs& args) {
               r.dropped_frames > 0 ? (", " + std::to_string(r.dropped_frames) + " dropped frames in the session").c_str() : "",
               r.completed ? "; completed" : "; not finished - continue with --resume");
   if (!r.blur_note.empty()) std::printf("note: %s\n", r.blur_note.c_str());
+  if (const int signal = InterruptSignal(); signal != 0 && !r.completed) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "blurcue run: interrupted (%s): every answer so far is saved in %s; continue the session "
+                         "with --resume\n", InterruptName(signal), args.db.c_str());
+    std::exit(InterruptExitCode(signal));
+  }
 }
 
 }  // namespace
@@ -143,6 +153,7 @@ void AddRunCommand(CLI::App& app) {
       "  forced choice: the protocol's left / right / can't-tell keys (default Left, Right, Down);\n"
       "  adjustment:    previous / next keys or the mouse wheel step through the levels, Return or a click accepts;\n"
       "  Escape pauses and asks whether to quit (Q) or go on (Return). Quitting keeps every answer so far.\n"
+      "  Ctrl-C (or a kill) in the terminal stops the session between trials the same way (exit 130).\n"
       "Response times run from the first frame of the stimulus; every frame's flip time and dropped frames are\n"
       "recorded. The terminal shows trial n of N, the time elapsed and an estimate of the time left.\n"
       "\n"

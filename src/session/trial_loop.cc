@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "session/keys.h"
 #include "procedure/trial_logic.h"
 
@@ -40,7 +41,7 @@ class Runner {
     for (;;) {
       presenter_.DrawScreen();
       presenter_.Flip(responder_.NextPressS());
-      if (presenter_.Closed()) return "";
+      if (presenter_.Closed() || Interrupted()) return "";
       for (const InputEvent& e : responder_.Poll(presenter_.Now()))
         if (std::find(keys.begin(), keys.end(), e.key) != keys.end()) return e.key;
     }
@@ -168,7 +169,7 @@ class Runner {
       }
       frames->push_back(shown_frame);
       last_flip = flip;
-      if (presenter_.Closed()) return Outcome::kQuit;
+      if (presenter_.Closed() || Interrupted()) return Outcome::kQuit;
       // A deadline: no answer this long after onset is recorded as none, without a response time.
       if (timing.deadline_ms > 0 && protocol::TraitsOf(trial.task).deadline &&
           (presenter_.Now() - onset - paused_s) * 1000 >= timing.deadline_ms) {
@@ -269,7 +270,7 @@ class Runner {
     }
     std::string shown_block;
     bool shown_practice = false;  // the trial before was practice (the next main one says the practice is over)
-    for (int64_t i = start.first_unanswered_trial; i < result.trial_count; ++i) {
+    for (int64_t i = start.first_unanswered_trial; i < result.trial_count && !Interrupted(); ++i) {
       if (options_.stop_after >= 0 && result.answered_now >= options_.stop_after) break;
       const protocol::Trial& trial = trials_[size_t(i)];
       // Instructions when the part changes: practice, then each block.
