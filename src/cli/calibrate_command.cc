@@ -96,7 +96,7 @@ void PrintCalibrationSummary(const calib::CalibResult& result, const Board& boar
     for (const auto& [why, n] : calib::SectionsLeftOut(result))
       left += (left.empty() ? "" : ", ") + std::to_string(n) + " " + why, n_left += n;
     std::printf("the model is fitted to %d of %d sections%s\n", sections - n_left, sections,
-                left.empty() ? "" : ("; left out (it predicts them): " + left).c_str());
+                left.empty() ? "" : ("; left out at their readings (it predicts them): " + left).c_str());
     // What each flag means, once (phase_limited has its own lines below), and the informational ones.
     for (const auto& [why, n] : calib::SectionsLeftOut(result))
       if (why != "phase_limited") std::printf("  %s: %s\n", why.c_str(), calib::SectionFlagMeaning(why).c_str());
