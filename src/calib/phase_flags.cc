@@ -172,7 +172,9 @@ constexpr double kModelSeRel = 0.05;
 // alike on an edge's sections and on neighbouring edges. Without it |error| / standard error had median 0.71-1.46,
 // p90 2.7-2.9 (masks 0.7 over 0.6, 0.3 over 0.8, 0.25 over 0.9 px; seeds 1-6, tests/undetermined_coverage.py): far
 // from focus the model erred 1-3 % with a standard error of 0.3-0.9 %. With 0.4 % there, p90 1.4-1.7 and 0-4.5 % of the
-// sections beyond 2 (a normal's 1.64 and 4.6 %); 0.7 % overstated it (p90 0.9-1.2).
+// sections beyond 2 (a normal's 1.64 and 4.6 %); 0.7 % overstated it (p90 0.9-1.2). Those with the plain sandwich;
+// with CR3 (PropagateModelError) held out, seeds 27-36: masks p90 0.82-0.88, none beyond 2; no filter 1.35, 0 %;
+// a Gaussian after sampling 1.67, 1.8 % (docs/independent-truth.md).
 constexpr double kReadingRel = 0.004;
 // Where most of an edge's sections in the fit or held by their bound (PhaseCheck::bound), kCancelledMin or more, read
 // under kCancelledPx, the board has depths where the mask cancels the whole blur (one alone is the noise:
