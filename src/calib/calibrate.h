@@ -12,6 +12,7 @@
 
 #include "calib/board_pose.h"
 #include "calib/edge_blur.h"
+#include "calib/model_undetermined.h"
 #include "calib/phase_check.h"
 #include "core/board.h"
 #include "core/camera.h"
@@ -73,16 +74,6 @@ struct EdgeResult {
   int measured = 0;   // usable or pooled sections (r_px averages those)
   int estimated = 0;  // sections where eq. 3.7 holds (r_estimated_px averages those)
   double r_px = 0, r_thesis_px = 0, r_estimated_px = 0, r_fitted_px = 0;
-};
-
-// Where the lens model's blur is not determined within 5 % (PropagateModelError: its standard error, the readings' own
-// and, under a mask, the masks that fit alike): camera depths (mm), the largest relative standard error on the board,
-// and the sentence that says why (empty where nowhere on the board).
-struct ModelUndetermined {
-  double lo_mm = 0, hi_mm = 0, worst_se_rel = 0;
-  std::string why;
-  bool Named() const { return !why.empty(); }
-  bool Inside(double u_mm) const { return Named() && u_mm >= lo_mm && u_mm <= hi_mm; }
 };
 
 struct CalibResult {

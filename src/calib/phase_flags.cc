@@ -214,12 +214,7 @@ namespace {
 // that cancels the whole blur (`cancelled` sections read 0 px at cut_lo-cut_hi mm under v < 0), sections that read 0
 // with no filter, or the error's parts (the mask's, or near focus the profiles' own).
 std::string UndeterminedWhy(const ModelUndetermined& p, double v, int cancelled, double cut_lo, double cut_hi) {
-  // Where the blur there is near 0 its error is no percentage of it (one scene read 3439 %): said so in words.
-  char reach[96];
-  if (p.worst_se_rel > 1)
-    std::snprintf(reach, sizeof reach, "exceeds the blur itself there");
-  else
-    std::snprintf(reach, sizeof reach, "reaches %.0f %% there", 100 * p.worst_se_rel);
+  const std::string reach = "reaches " + p.Reach() + " there";
   char text[640];
   if (cancelled > 0 && v < 0)
     std::snprintf(text, sizeof text,
@@ -227,20 +222,20 @@ std::string UndeterminedWhy(const ModelUndetermined& p, double v, int cancelled,
                   "sampling cancels the whole blur at %.0f-%.0f mm (%d sections read 0 px, a bound, not a value), and "
                   "a lens fitted beside them errs by a few %% in the optics' blur, which the sharpening magnifies "
                   "(its error %s); there r_fitted_px is the model's estimate, not a result within 5 %%",
-                  100 * kModelSeRel, p.lo_mm, p.hi_mm, cut_lo, cut_hi, cancelled, reach);
+                  100 * kModelSeRel, p.lo_mm, p.hi_mm, cut_lo, cut_hi, cancelled, reach.c_str());
   else if (cancelled > 0)  // no filter: edges sharp beyond what a profile shows (in focus, or no blur at all)
     std::snprintf(text, sizeof text,
                   "the model's blur is not determined within %.0f %% at depths %.0f-%.0f mm: %d sections at "
                   "%.0f-%.0f mm read 0 px, sharper than their profiles can tell apart, and the model's error %s; "
                   "there r_fitted_px is the model's estimate, not a result within 5 %%",
-                  100 * kModelSeRel, p.lo_mm, p.hi_mm, cancelled, cut_lo, cut_hi, reach);
+                  100 * kModelSeRel, p.lo_mm, p.hi_mm, cancelled, cut_lo, cut_hi, reach.c_str());
   else  // the error's parts and its cause: the mask's, or near focus the profiles' own
     std::snprintf(text, sizeof text,
                   "the model's blur is not determined within %.0f %% at depths %.0f-%.0f mm: its error (standard "
                   "error, the readings' own %.1f %%%s) %s (%s); there r_fitted_px is the model's estimate, not a result "
                   "within 5 %%",
                   100 * kModelSeRel, p.lo_mm, p.hi_mm, 100 * kReadingRel,
-                  v < 0 ? " in the optics' blur and the masks that fit alike" : "", reach,
+                  v < 0 ? " in the optics' blur and the masks that fit alike" : "", reach.c_str(),
                   v < 0 ? "the sharpening after sampling cancels most of the optics' blur, magnifying the optics' own "
                           "uncertainty"
                         : "near focus the blur is small and its profiles pin it least: a sharp step reads alike from 0 "

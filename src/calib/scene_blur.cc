@@ -198,10 +198,10 @@ void ReadUndetermined(const Json& j, const std::string& where, SceneCalib* s) {
     throw InputError(uw + "/u_mm", "must be [near, far] depths in mm, beyond the focal length (" +
                                        Num(s->camera.focal_length_mm) + " mm), near <= far, got " +
                                        (u == und->end() ? std::string("nothing") : u->dump()));
-  s->undetermined_lo_mm = (*u)[0].get<double>();
-  s->undetermined_hi_mm = (*u)[1].get<double>();
+  s->undetermined.lo_mm = (*u)[0].get<double>();
+  s->undetermined.hi_mm = (*u)[1].get<double>();
   // Named depths are where it exceeds 5 % (calibrate's kModelSeRel): a smaller one contradicts them.
-  s->undetermined_se_rel = Ranged(*und, "worst_se_rel", uw, 0.05, 1e6, "(a share, over 0.05 where depths are named)");
+  s->undetermined.worst_se_rel = Ranged(*und, "worst_se_rel", uw, 0.05, 1e6, "(a share, over 0.05 where depths are named)");
 }
 }  // namespace
 
@@ -325,20 +325,13 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
 }
 
 std::string UndeterminedNote(const SceneCalib& scene, BlurSource source, double u_mm) {
-  if (source != BlurSource::kFitted || !(scene.undetermined_hi_mm > 0) || u_mm < scene.undetermined_lo_mm ||
-      u_mm > scene.undetermined_hi_mm)
-    return "";
-  // An error beyond the blur itself (near 0 there) is no percentage of it: said in words, as calibrate says it.
-  char reach[64];
-  if (scene.undetermined_se_rel > 1)
-    std::snprintf(reach, sizeof reach, "up to more than the blur itself");
-  else
-    std::snprintf(reach, sizeof reach, "up to %.0f %%", 100 * scene.undetermined_se_rel);
+  const ModelUndetermined& und = scene.undetermined;
+  if (source != BlurSource::kFitted || !und.Inside(u_mm)) return "";
   char text[400];
   std::snprintf(text, sizeof text,
                 "the fitted blur at %.0f mm is the lens model's estimate, not a result within 5 %%: the model is "
-                "not determined within 5 %% at %.0f-%.0f mm (its error %s; why: %s /model/undetermined)",
-                u_mm, scene.undetermined_lo_mm, scene.undetermined_hi_mm, reach,
+                "not determined within 5 %% at %.0f-%.0f mm (its error up to %s; why: %s /model/undetermined)",
+                u_mm, und.lo_mm, und.hi_mm, und.Reach().c_str(),
                 scene.file.empty() ? "the calibration" : scene.file.c_str());
   return text;
 }

@@ -8,6 +8,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "calib/model_undetermined.h"
 #include "core/blur_source.h"
 #include "core/board.h"
 #include "core/camera.h"
@@ -37,9 +38,8 @@ struct SceneCalib {
   std::vector<Section> sections;
   // The calib.json it was read from (empty: built in code), for a message.
   std::string file;
-  // Where calibrate found the lens model not determined within 5 % (calib.json model.undetermined): camera depths
-  // (mm) and the largest relative standard error there; hi 0 where it named none.
-  double undetermined_lo_mm = 0, undetermined_hi_mm = 0, undetermined_se_rel = 0;
+  // Where calibrate found the lens model not determined within 5 % (calib.json model.undetermined); none named: hi 0.
+  ModelUndetermined undetermined;
 
   // Board-frame point (mm) -> camera frame (mm).
   cv::Vec3d ToCamera(const cv::Vec3d& board_mm) const;
