@@ -124,8 +124,19 @@ void Camera::Validate(const std::string& where) const {
       throw InputError(where + "/camera_matrix", "must be [[fx,s,cx],[0,fy,cy],[0,0,1]]");
     RequireIn(where, "camera_matrix/0/0", k[0], CameraLimits::kFocalLengthPx, "px");
     RequireIn(where, "camera_matrix/1/1", k[4], CameraLimits::kFocalLengthPx, "px");
-    if (!(std::abs(k[1]) <= k[0]))
-      throw InputError(where + "/camera_matrix/0/1", "(skew) must be in [-fx, fx], got " + Num(k[1]));
+    // The scene's projections (render, the objects' outlines) take fx, fy, cx, cy alone: a skew would move the board's
+    // pose and not what is drawn on it. OpenCV's calibrateCamera gives 0 (CALIB_FIX_SKEW is its default).
+    if (k[1] != 0)
+      throw InputError(where + "/camera_matrix/0/1", "(skew) must be 0: blurcue's camera model has none, got " + Num(k[1]));
+    // fx and fy are the lens-to-sensor distance in pixels: near focal_length_mm / pitch (more when focused near: twice it
+    // at 1:1 magnification). A matrix far from it is another camera's or another image size's; the thin lens takes
+    // focal_length_mm, the drawing fx, and they would disagree (an identity matrix drew a 67 px ball as 5 px).
+    const double nominal = focal_length_mm / PixelPitchMm();
+    for (const int i : {0, 4})
+      if (!(k[i] >= 0.5 * nominal && k[i] <= 3 * nominal))
+        throw InputError(where + "/camera_matrix/" + std::to_string(i / 3) + "/" + std::to_string(i % 3),
+                         "must be within 0.5-3 x focal_length_mm / pixel pitch (" + Num(std::round(nominal)) +
+                             " px), got " + Num(k[i]) + ": a matrix for another camera or image size?");
     // The principal point lies on the sensor: anything else is a matrix for another image size.
     const double cx[2] = {0, double(image_width_px)}, cy[2] = {0, double(image_height_px)};
     RequireIn(where, "camera_matrix/0/2", k[2], cx, "px");

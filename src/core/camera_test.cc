@@ -143,6 +143,12 @@ TEST(Camera, NonFiniteValuesAreRefused) {
   EXPECT_EQ(ErrorOf(j), "cam.json: /camera_matrix/0/2: must be finite, got inf");
   j["camera_matrix"][0][2] = 1e9;
   EXPECT_EQ(ErrorOf(j), "cam.json: /camera_matrix/0/2: must be in [0, 4592] px, got 1e+09");
+  j["camera_matrix"][0][2] = 2296.0;
+  j["camera_matrix"][0][1] = 1030.0;  // a skew the pose took and the drawing did not
+  EXPECT_EQ(ErrorOf(j), "cam.json: /camera_matrix/0/1: (skew) must be 0: blurcue's camera model has none, got 1030");
+  j["camera_matrix"] = {{1.0, 0.0, 2296.0}, {0.0, 4000.0, 1528.0}, {0.0, 0.0, 1.0}};  // another camera's
+  EXPECT_EQ(ErrorOf(j), "cam.json: /camera_matrix/0/0: must be within 0.5-3 x focal_length_mm / pixel pitch (4121 px), "
+                        "got 1: a matrix for another camera or image size?");
   j = ThesisJson();
   j["dist_coeffs"] = {0.1, -0.2, 0.0, 0.0, 1e308};
   EXPECT_EQ(ErrorOf(j), "cam.json: /dist_coeffs/4: must be in [-10000, 10000], got 1e+308");
