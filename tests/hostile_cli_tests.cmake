@@ -73,6 +73,17 @@ hostile_test(cli_hostile_render_radius_times_gain 2
              "--blur 400 x --gain 2 gives 800 px at the object; the blur radius must be in [0, 500] px"
              render --calib ${T}/calib.json --background ${T}/scene/scene.png --blur 400 --gain 2 --out ${H}/x.png)
 set_tests_properties(cli_hostile_render_radius_times_gain PROPERTIES FIXTURES_REQUIRED "scene;calib" LABELS gl)
+# A radius the calibration gives (a hand-edited floor of 500 px): the message names the file and its field, not only
+# the options (it blamed `--blur fitted x --gain 1`).
+add_test(NAME cli_hostile_render_floor_500_make
+         COMMAND /usr/bin/python3 -c "import json, sys; c = json.load(open(sys.argv[1])); c['model'].update(kind='thin_lens+floor', floor_px=500, floor_determined=True); json.dump(c, open(sys.argv[2], 'w'))"
+                 ${T}/calib.json ${H}/calib-floor-500.json)
+set_tests_properties(cli_hostile_render_floor_500_make PROPERTIES FIXTURES_REQUIRED "scene;calib" FIXTURES_SETUP floor_500)
+hostile_test(cli_hostile_render_floor_500_names_file 2
+             "px at the object (the lens model, ${H}/calib-floor-500.json /model); the blur radius must be in [0, 500] px"
+             render --calib ${H}/calib-floor-500.json --background ${T}/scene/scene.png --at-edge 2 --blur fitted --out ${H}/x.png)
+set_tests_properties(cli_hostile_render_floor_500_names_file PROPERTIES
+                     FIXTURES_REQUIRED "scene;calib;floor_500")
 hostile_test(cli_hostile_render_cutoff_nan 2 "--cutoff: must be in [0, 100000] cycles per picture width, got 'nan'"
              render --object picture --background ${D}/small.png --cutoff nan --out ${H}/x.png)
 # --object is read whole ("balloon" and "ball:" were drawn as the soccer ball, "picturesque" as the face), and an option

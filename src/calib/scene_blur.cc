@@ -324,6 +324,17 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
   return s;
 }
 
+std::string BlurFrom(const SceneCalib& scene, BlurSource source) {
+  const std::string file = scene.file.empty() ? "the calibration" : scene.file;
+  switch (source) {
+    case BlurSource::kFitted: return " (the lens model, " + file + " /model)";
+    case BlurSource::kEstimated: return " (eq. 3.7 from the reference edge, " + file + " /reference and /model)";
+    case BlurSource::kMeasured:
+    case BlurSource::kMeasuredSection: return " (the sections' readings, " + file + " /edges)";
+    default: return "";
+  }
+}
+
 std::string UndeterminedNote(const SceneCalib& scene, BlurSource source, double u_mm) {
   const ModelUndetermined& und = scene.undetermined;
   if (source != BlurSource::kFitted || !und.Inside(u_mm)) return "";

@@ -71,6 +71,10 @@ BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px, const st
 //   fixed     - fixed_r_px; none - 0.
 double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& point_camera_mm, double fixed_r_px = 0);
 
+// Where a source's blur comes from in the calibration, for a message about a radius it gave: " (the lens model,
+// calib.json /model)"; "" for none and a fixed radius (the command's own).
+std::string BlurFrom(const SceneCalib& scene, BlurSource source);
+
 // Where `source` is the fitted model and camera depth u_mm lies where calibrate found that model not determined
 // within 5 %: one sentence saying so, with the depths and calib.json's field, for a command's note (render, validate,
 // run); "" otherwise. The number drawn there is the model's estimate, not a result within 5 %.

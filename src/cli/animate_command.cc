@@ -145,7 +145,8 @@ class RollingBalls {
       if (!(r >= 0 && r <= render::kMaxBlurRadiusPx))
         throw Error(ErrorKind::kUsage, std::string(b == 0 ? "--left " + args_.left : "--right " + args_.right) +
                                            " x --gain " + BoundText(args_.gain) + " gives " + BoundText(r) +
-                                           " px at frame " + std::to_string(i) + "; the blur radius must be in [0, " +
+                                           " px at frame " + std::to_string(i) + calib::BlurFrom(scene_, source_[b]) +
+                                           "; the blur radius must be in [0, " +
                                            BoundText(render::kMaxBlurRadiusPx) + "] px");
       balls[b].r_px = r;
       if (note_.empty()) note_ = calib::UndeterminedNote(scene_, source_[b], centre[2]);

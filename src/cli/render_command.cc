@@ -137,8 +137,9 @@ void RenderObject(const RenderArgs& args, std::chrono::steady_clock::time_point 
   for (const double v : {r, r_far, r_near})
     if (!(v >= 0 && v <= render::kMaxBlurRadiusPx))
       throw Error(ErrorKind::kUsage, "--blur " + args.blur + " x --gain " + BoundText(args.gain) + " gives " +
-                                         BoundText(v) + " px at the object; the blur radius must be in [0, " +
-                                         BoundText(render::kMaxBlurRadiusPx) + "] px");
+                                         BoundText(v) + " px at the object" + calib::BlurFrom(scene, source) +
+                                         "; the blur radius must be in [0, " + BoundText(render::kMaxBlurRadiusPx) +
+                                         "] px");
   const double span = std::abs(r_far - r_near);
   // Model no more than the scene needs: one radius while the object's depth span changes r by < 0.5 px,
   // a per-pixel radius from depth where it does.
