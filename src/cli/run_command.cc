@@ -124,6 +124,10 @@ void Run(const RunArgs& args) {
               r.dropped_frames > 0 ? (", " + std::to_string(r.dropped_frames) + " dropped frames in the session").c_str() : "",
               r.completed ? "; completed" : "; not finished - continue with --resume");
   if (!r.blur_note.empty()) std::printf("note: %s\n", r.blur_note.c_str());
+  if (!r.ids_like.empty())
+    std::printf("note: participant %s is new to this record's study; it also holds %s, differing only in case: ids are "
+                "case-sensitive, so these are different people (if one was meant, `blurcue sessions --db %s` lists "
+                "them)\n", options.participant.c_str(), r.ids_like.c_str(), args.db.c_str());
   if (const int signal = InterruptSignal(); signal != 0 && !r.completed) {
     std::fflush(stdout);
     std::fprintf(stderr, "blurcue run: interrupted (%s): every answer so far is saved in %s; continue the session "

@@ -103,6 +103,10 @@ std::vector<int64_t> Recording::CompletedSessions(const std::string& study, cons
   return record_->CompletedSessions(study, participant);
 }
 
+std::vector<std::string> Recording::CodesDifferingInCase(const std::string& study, const std::string& participant) {
+  return record_->CodesDifferingInCase(study, participant);
+}
+
 SessionStart Recording::StartOrResumeSession(const std::string& study, const std::string& participant,
                                              const std::string& protocol_text, uint64_t seed,
                                              const SessionInfo& info, bool resume) {

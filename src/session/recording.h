@@ -100,6 +100,7 @@ class Recording {
   Recording& operator=(Recording&&) = delete;
 
   std::vector<int64_t> CompletedSessions(const std::string& study, const std::string& participant);
+  std::vector<std::string> CodesDifferingInCase(const std::string& study, const std::string& participant);
   SessionStart StartOrResumeSession(const std::string& study, const std::string& participant,
                                     const std::string& protocol_text, uint64_t seed, const SessionInfo& info,
                                     bool resume);

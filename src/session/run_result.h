@@ -21,6 +21,9 @@ struct RunResult {
   // procedure::UndeterminedBlurNote of the trials run: fitted blur where the calibration's model is not determined
   // within 5 % ("" where none).
   std::string blur_note;
+  // A participant's first session where the study holds codes differing from theirs only in case ("s1" beside "S1":
+  // two people to the record, usually one typo): those codes ("" where none, or not a first session).
+  std::string ids_like;
 };
 
 }  // namespace blurcue::session

@@ -353,6 +353,9 @@ RunResult RunSession(const RunOptions& options) {
       RunTrials({options.db, options.stop_after, options.progress}, chosen, presenter, responder, record, start);
   result.session_number = start.session_number;
   result.blur_note = procedure::UndeterminedBlurNote(chosen);
+  if (start.session_number == 1)
+    for (const std::string& code : record.CodesDifferingInCase(protocol.name, options.participant))
+      result.ids_like += (result.ids_like.empty() ? "" : ", ") + code;
   return result;
 }
 

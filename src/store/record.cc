@@ -620,6 +620,17 @@ std::vector<int64_t> Record::CompletedSessions(const std::string& study, const s
   return ids;
 }
 
+std::vector<std::string> Record::CodesDifferingInCase(const std::string& study, const std::string& participant) {
+  Statement like(db_, "SELECT p.code FROM participants p JOIN studies st ON st.id = p.study_id "
+                      "WHERE st.name = ? AND p.code = ? COLLATE NOCASE AND p.code != ? ORDER BY p.code");
+  like.Bind(1, study);
+  like.Bind(2, participant);
+  like.Bind(3, participant);
+  std::vector<std::string> codes;
+  while (like.Step()) codes.push_back(like.GetText(0));
+  return codes;
+}
+
 std::map<int64_t, Record::Answered> Record::AnsweredTrials(int64_t session) {
   Statement rows(db_, "SELECT t.trial_index, r.choice, r.shown FROM responses r JOIN trials t ON t.id = r.trial_id "
                       "WHERE t.session_id = ? ORDER BY t.trial_index");

@@ -208,6 +208,8 @@ class Record {
 
   // The ids of the participant's completed sessions of `study`, oldest first.
   std::vector<int64_t> CompletedSessions(const std::string& study, const std::string& participant);
+  // The other participant codes of `study` that differ from `participant` only in ASCII case ("S1" for "s1").
+  std::vector<std::string> CodesDifferingInCase(const std::string& study, const std::string& participant);
 
   // Records one answer and the display flips of its trial in one transaction: both or neither. Throws
   // Error(kInput) when the trial does not exist or already has a response, or when this Record does not hold the
