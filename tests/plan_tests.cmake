@@ -184,3 +184,27 @@ add_test(NAME run_interrupted_says_what_was_saved
          COMMAND ${BLURCUE_EXPECT} "ok: Ctrl-C stops run with every answer saved" /usr/bin/python3
                  ${PROJECT_SOURCE_DIR}/tests/run_interrupt.py ${BC} ${T}/plan-stairs.json ${T}/run-interrupted.sqlite)
 set_tests_properties(run_interrupted_says_what_was_saved PROPERTIES FIXTURES_REQUIRED "scene;calib" LABELS session)
+# `measured` at an edge with no usable section (the CLI scene's edge 1: its seven readings phase_limited, pooled into
+# the lens fit) was drawn with no word; validate and render now say what that value is, as for fitted blur where the
+# model is not determined. Edge 4 (seven usable sections) gets none.
+file(WRITE ${T}/pooled-edges.json [=[
+{"name": "pooled-edges", "version": 1,
+ "scene": {"background": "scene/scene.png", "calib": "calib.json"},
+ "content": {"type": "grid", "cells": 5}, "task": "forced_choice",
+ "sides": {"left": "measured", "right": "none"},
+ "blocks": [{"name": "main", "factors": {"edge": [1, 4]}}],
+ "responses": {"left": "Left", "right": "Right"}}
+]=])
+add_test(NAME validate_measured_pooled_edge_note
+         COMMAND ${BLURCUE_EXPECT} "\n  note: 1 of 2 trials show the measured blur of an edge with no usable section; the first: the measured blur at edge 1 \\([0-9.]+ px\\) is the mean of 7 readings none of which is usable alone"
+                 ${BC} validate ${T}/pooled-edges.json)
+add_test(NAME render_measured_pooled_edge_note
+         COMMAND ${BLURCUE_EXPECT} "\nnote: the measured blur at edge 1 \\([0-9.]+ px\\) is the mean of 7 readings none of which is usable alone"
+                 ${BC} render --calib ${T}/calib.json --background ${T}/scene/scene.png --object ball --at-edge 1
+                 --blur measured --out ${T}/pooled-edge-ball.png)
+add_test(NAME render_measured_usable_edge_no_note
+         COMMAND ${BLURCUE_EXPECT} "^ball at edge 4: [^\n]*\n$"
+                 ${BC} render --calib ${T}/calib.json --background ${T}/scene/scene.png --object ball --at-edge 4
+                 --blur measured --out ${T}/usable-edge-ball.png)
+set_tests_properties(validate_measured_pooled_edge_note render_measured_pooled_edge_note
+                     render_measured_usable_edge_no_note PROPERTIES FIXTURES_REQUIRED "scene;calib" LABELS "plan;gl")

@@ -324,6 +324,35 @@ SceneCalib SceneCalibFromJson(const Json& j, const std::string& where) {
   return s;
 }
 
+int NearestEdge(const SceneCalib& scene, const cv::Vec3d& p) {
+  const Board& board = scene.board;
+  int nearest = 0;
+  double best_d = 1e300;
+  for (int edge = 1; edge <= board.EdgeCount(); ++edge) {
+    const cv::Vec3d a = scene.ToCamera(cv::Vec3d(board.SectionStart(edge, 1).data()));
+    const cv::Vec3d b = scene.ToCamera(cv::Vec3d(board.SectionEnd(edge, board.SectionCount()).data()));
+    const double d = cv::norm((p - a).cross((b - a) / cv::norm(b - a)));
+    if (d < best_d) best_d = d, nearest = edge;
+  }
+  return nearest;
+}
+
+std::string PooledNote(const SceneCalib& scene, BlurSource source, int edge) {
+  if (source != BlurSource::kMeasured) return "";
+  int ok = 0, pooled = 0;
+  double sum = 0;
+  for (const auto& s : scene.sections)
+    if (s.edge == edge) ok += s.ok, pooled += s.pooled, sum += s.pooled ? s.r_px : 0;
+  if (ok > 0 || pooled == 0) return "";
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "the measured blur at edge %d (%.2f px) is the mean of %d readings none of which is usable alone "
+                "(phase_limited, pooled into the lens fit: %s /edges/%d/sections/*/phase_why); `fitted` gives the "
+                "model's value there",
+                edge, sum / pooled, pooled, scene.file.empty() ? "the calibration" : scene.file.c_str(), edge - 1);
+  return text;
+}
+
 std::string BlurFrom(const SceneCalib& scene, BlurSource source) {
   const std::string file = scene.file.empty() ? "the calibration" : scene.file;
   switch (source) {
@@ -400,15 +429,7 @@ double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& p, 
       // The edge whose line passes nearest the point, from the board and its pose (every edge the board has, measured
       // or not); its value is the mean r of its usable sections. An edge with none has no measured value: another
       // edge's would be recorded as this one's, so it is an error, not a fallback.
-      const Board& board = scene.board;
-      int nearest = 0;
-      double best_d = 1e300;
-      for (int edge = 1; edge <= board.EdgeCount(); ++edge) {
-        const cv::Vec3d a = scene.ToCamera(cv::Vec3d(board.SectionStart(edge, 1).data()));
-        const cv::Vec3d b = scene.ToCamera(cv::Vec3d(board.SectionEnd(edge, board.SectionCount()).data()));
-        const double d = cv::norm((p - a).cross((b - a) / cv::norm(b - a)));
-        if (d < best_d) best_d = d, nearest = edge;
-      }
+      const int nearest = NearestEdge(scene, p);
       double sum = 0;
       int usable = 0;
       for (const auto& s : scene.sections)

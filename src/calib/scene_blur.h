@@ -71,6 +71,14 @@ BlurSource ParseBlurSource(const std::string& text, double* fixed_r_px, const st
 //   fixed     - fixed_r_px; none - 0.
 double BlurAtPx(const SceneCalib& scene, BlurSource source, const cv::Vec3d& point_camera_mm, double fixed_r_px = 0);
 
+// The board edge whose line passes nearest a point (camera frame, mm): the edge blur source `measured` reads there.
+int NearestEdge(const SceneCalib& scene, const cv::Vec3d& point_camera_mm);
+
+// Where `source` is `measured` and `edge` has no usable section, only readings flagged phase_limited and pooled into
+// the lens fit (an edge near focus: the init example's edge 1 reads 0.30 px for a true 0): one sentence saying what
+// that value is, for a command's note (render, validate, run), as UndeterminedNote says it of `fitted`; "" otherwise.
+std::string PooledNote(const SceneCalib& scene, BlurSource source, int edge);
+
 // Where a source's blur comes from in the calibration, for a message about a radius it gave: " (the lens model,
 // calib.json /model)"; "" for none and a fixed radius (the command's own).
 std::string BlurFrom(const SceneCalib& scene, BlurSource source);

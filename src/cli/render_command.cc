@@ -171,6 +171,8 @@ void RenderObject(const RenderArgs& args, std::chrono::steady_clock::time_point 
     std::printf("its depth span changes r from %.2f to %.2f px: blurred per pixel by depth\n", r_near, r_far);
   if (const std::string note = calib::UndeterminedNote(scene, source, centre[2]); !note.empty())
     std::printf("note: %s\n", note.c_str());
+  if (const std::string note = calib::PooledNote(scene, source, calib::NearestEdge(scene, centre)); !note.empty())
+    std::printf("note: %s\n", note.c_str());
 }
 
 }  // namespace

@@ -230,19 +230,27 @@ PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const
 
 std::string UndeterminedBlurNote(const PreparedSession& prepared) {
   if (!prepared.scene) return "";
-  size_t n = 0;
-  std::string note;
+  size_t n_fitted = 0, n_pooled = 0;
+  std::string fitted, pooled;
   for (const TrialScene& scene : prepared.scenes) {
-    std::string first;
-    for (const stimulus::SideShown& side : scene.sides)
-      if (first.empty()) first = calib::UndeterminedNote(*prepared.scene, side.source, side.u_mm);
-    if (first.empty()) continue;
-    if (note.empty()) note = first;
-    ++n;
+    std::string first_fitted, first_pooled;
+    for (const stimulus::SideShown& side : scene.sides) {
+      if (first_fitted.empty()) first_fitted = calib::UndeterminedNote(*prepared.scene, side.source, side.u_mm);
+      // A card at an edge draws that edge's measured value (a ball's run crosses several: not said).
+      if (first_pooled.empty() && scene.content == protocol::ContentType::kGrid && scene.edge > 0)
+        first_pooled = calib::PooledNote(*prepared.scene, side.source, scene.edge);
+    }
+    if (!first_fitted.empty()) n_fitted += 1, fitted = fitted.empty() ? first_fitted : fitted;
+    if (!first_pooled.empty()) n_pooled += 1, pooled = pooled.empty() ? first_pooled : pooled;
   }
-  if (n == 0) return "";
-  return std::to_string(n) + " of " + std::to_string(prepared.scenes.size()) + " trials show the fitted blur where it is not " +
-         "determined within 5 %; the first: " + note;
+  const std::string of = " of " + std::to_string(prepared.scenes.size()) + " trials show the ";
+  std::string note;
+  if (n_fitted > 0)
+    note = std::to_string(n_fitted) + of + "fitted blur where it is not determined within 5 %; the first: " + fitted;
+  if (n_pooled > 0)
+    note += (note.empty() ? "" : "; and ") + std::to_string(n_pooled) + of +
+            "measured blur of an edge with no usable section; the first: " + pooled;
+  return note;
 }
 
 }  // namespace blurcue::procedure

@@ -43,8 +43,9 @@ PreparedSession PrepareSession(const std::filesystem::path& protocol_file, const
                                const std::string& group = "");
 
 // The trials whose fitted blur falls where calibrate found the lens model not determined within 5 %
-// (calib::UndeterminedNote at each side's depth, a ball's averaged over its run): "N of M trials ..." with the
-// calibration's note; "" where none does (or the session has no calibrated scene). validate and run print it.
+// (calib::UndeterminedNote at each side's depth, a ball's averaged over its run), and those whose card draws the
+// measured blur of an edge with no usable section (calib::PooledNote): "N of M trials ..." with the calibration's
+// note; "" where none does (or the session has no calibrated scene). validate and run print it.
 std::string UndeterminedBlurNote(const PreparedSession& prepared);
 
 // The session's blur plans (stimulus::PlanOnScreen: one radius, or per pixel by depth): the fixed trials' as planned;
