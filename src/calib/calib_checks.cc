@@ -112,9 +112,12 @@ void RefuseAbsurdCalibration(const CalibResult& result, const std::string& camer
   try {
     SceneCalibFromJson(CalibToJson(result), "");
   } catch (const Error& e) {
+    const std::string what = e.what();
     Refuse(result, camera_file, photo_file,
-           std::string("the calibration would not be one blurcue can use (") + e.what() +
-               "): the board's edges may not span enough depths to fit a lens (photograph the board at a slant, not face on)");
+           "the calibration would not be one blurcue can use (" + what + ")" +
+               (what.rfind("/model/", 0) == 0 ? ": the board's edges may not span enough depths to fit a lens "
+                                                "(photograph the board at a slant, not face on)"
+                                              : ""));
   }
 }
 

@@ -413,7 +413,9 @@ PhaseChoice::Wide AskWideForSharpening(const std::vector<SectionResult*>& usable
   if (t.best != 0 && TapsVariance(FamilyTaps(PhaseFamilies()[t.best])) < 0) {
     std::vector<double> apart;  // how far the mask moves each reading from the lens's alone
     for (const PhaseCheck& c : read)
-      apart.push_back(std::abs(c.families[t.best].r_px - c.families[0].r_px) / std::max(c.families[0].r_px, 1e-9));
+      if (const double r = c.families[0].r_px, m = c.families[t.best].r_px; std::isfinite(r) && std::isfinite(m))
+        apart.push_back(std::abs(m - r) / std::max(r, 1e-9));
+    if (apart.empty()) return {};
     std::nth_element(apart.begin(), apart.begin() + apart.size() / 2, apart.end());
     return {PhaseFamilies()[t.best].Name(), t.any[0], t.any[t.best], static_cast<int>(n), apart[apart.size() / 2]};
   }

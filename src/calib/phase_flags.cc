@@ -206,10 +206,6 @@ std::vector<double> ModelGradient(const optics::FittedModel& m, const optics::Le
   return g;
 }
 
-}  // namespace
-
-namespace {
-
 // The sentence that names the depths where the model is not determined (ModelUndetermined::why), and its cause: a mask
 // that cancels the whole blur (`cancelled` sections read 0 px at cut_lo-cut_hi mm under v < 0), sections that read 0
 // with no filter, or the error's parts (the mask's, or near focus the profiles' own).

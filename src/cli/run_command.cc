@@ -97,9 +97,6 @@ void Run(const RunArgs& args) {
   const bool sidecars_before = std::filesystem::exists(args.db + "-wal", error) ||
                                std::filesystem::exists(args.db + "-shm", error);
   session::RunResult r;
-  // Ctrl-C or a kill stops the session between trials (or on a text screen): what was answered is committed already,
-  // and the session is left to --resume, as a quit with Escape leaves it.
-  const InterruptScope interrupt;
   try {
     r = session::RunSession(options);
   } catch (...) {
@@ -128,7 +125,7 @@ void Run(const RunArgs& args) {
     std::printf("note: participant %s is new to this record's study; it also holds %s, differing only in case: ids are "
                 "case-sensitive, so these are different people (if one was meant, `blurcue sessions --db %s` lists "
                 "them)\n", options.participant.c_str(), r.ids_like.c_str(), args.db.c_str());
-  if (const int signal = InterruptSignal(); signal != 0 && !r.completed) {
+  if (const int signal = r.interrupted; signal != 0 && !r.completed) {  // session::RunTrials stopped between trials
     std::fflush(stdout);
     std::fprintf(stderr, "blurcue run: interrupted (%s): every answer so far is saved in %s; continue the session "
                          "with --resume\n", InterruptName(signal), args.db.c_str());

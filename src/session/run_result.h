@@ -14,7 +14,8 @@ struct RunResult {
   int64_t answered_now = 0;
   int64_t skipped_now = 0;       // trials recorded as skipped, not shown: by a procedure's stop rule ...
   int64_t skipped_by_criterion_now = 0;  // ... or, these of them, as practice runs after the one that met its criterion
-  bool completed = false;        // false: quit, window closed or stop_after reached; resume with --resume
+  bool completed = false;
+  int interrupted = 0;           // the signal (SIGINT, SIGTERM) that stopped the loop; 0: none        // false: quit, window closed or stop_after reached; resume with --resume
   // The session's recorded frames marked dropped, earlier sittings' included (Recording::DroppedFrames: the
   // record's count, as frames.csv and the report give it).
   int64_t dropped_frames = 0;

@@ -363,7 +363,12 @@ class Runner {
 RunResult RunTrials(const LoopOptions& options, const procedure::PreparedSession& prepared, Presenter& presenter,
                     Responder& responder, Recording& recording, const SessionStart& start) {
   Runner runner(options, prepared, presenter, responder);
+  // Ctrl-C or a kill while trials run stops the loop between trials (or on a text screen): what was answered is
+  // committed already, and the session is left to --resume, as a quit with Escape leaves it. Before and after the
+  // loop (preparing the trials, decoding a take) a signal ends the process as it always did.
+  const InterruptScope interrupt;
   RunResult result = runner.Run(recording, start);
+  result.interrupted = InterruptSignal();
   // However the run ended (a quit on a text screen too), the frames counted are the record's.
   result.dropped_frames = recording.DroppedFrames(start.session_id);
   return result;
